@@ -1,0 +1,95 @@
+"""One exception hierarchy for physcam.
+
+Every error physcam raises on purpose derives from :class:`PhysCamError`, so a
+pipeline can catch one class and the CLI can print one line and exit 2. A bug
+(anything else) still shows a traceback.
+"""
+
+from __future__ import annotations
+
+import math
+from numbers import Real
+
+__all__ = [
+    "PhysCamError",
+    "InputError",
+    "UnitError",
+    "OpticsError",
+    "SensorError",
+    "LensFileError",
+    "ExportError",
+    "BackendError",
+    "PhysCamWarning",
+    "require_finite",
+    "require_positive",
+]
+
+
+class PhysCamError(Exception):
+    """Root of every error physcam raises deliberately."""
+
+
+class InputError(PhysCamError, ValueError):
+    """A value given by the user is out of range or inconsistent; the message says what to change."""
+
+
+class UnitError(InputError):
+    """A distance or angle could not be read (unknown unit, not a number)."""
+
+
+class OpticsError(PhysCamError):
+    """The optics have no answer: no real image, the lens cannot focus there, no ray passes."""
+
+
+class SensorError(InputError):
+    """Unknown sensor or film-gate name; the message lists the closest known names."""
+
+
+class LensFileError(PhysCamError):
+    """A lens file could not be read or does not describe a valid lens.
+
+    ``path`` and ``line`` (1-based, ``None`` when not known) say where.
+    """
+
+    def __init__(self, message: str, path: str | None = None, line: int | None = None):
+        self.path = None if path is None else str(path)
+        self.line = line
+        self.reason = message
+        where = ""
+        if self.path is not None:
+            where = self.path if line is None else f"{self.path}:{line}"
+            where += ": "
+        super().__init__(where + message)
+
+
+class ExportError(PhysCamError):
+    """A file could not be written (exists without --force, bad stage, foreign prim)."""
+
+
+class BackendError(PhysCamError):
+    """An array backend (numba, numpy) was asked for but cannot be used."""
+
+
+class PhysCamWarning(UserWarning):
+    """An approximation was made; the message says which."""
+
+
+def require_finite(name: str, value, *, error=InputError) -> float:
+    """Return ``value`` as float, or raise ``error`` naming ``name`` when it is NaN, inf or not a number."""
+    if isinstance(value, bool) or not isinstance(value, (Real,)) and not hasattr(value, "__float__"):
+        raise error(f"{name} must be a number, got {value!r}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise error(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise error(f"{name} must be a finite number, got {v}")
+    return v
+
+
+def require_positive(name: str, value, *, unit: str = "mm", error=InputError) -> float:
+    """Return ``value`` as a finite float > 0, or raise ``error`` with a message naming ``name``."""
+    v = require_finite(name, value, error=error)
+    if v <= 0.0:
+        raise error(f"{name} must be greater than 0 {unit}".rstrip() + f", got {v:g}")
+    return v

@@ -1,0 +1,275 @@
+"""The lens prescription: surfaces front to back, their media, apertures, focus groups.
+
+A :class:`Prescription` is plain validated numbers. Readers (``physcam.lens.formats``)
+build one; optics code (``physcam.optics.paraxial``, ``physcam.trace``) reads one and
+never parses text.
+
+Conventions (docs/conventions.md): millimetres; surfaces listed from the object
+(scene) side to the image (film) side; light travels toward +z; the first vertex is
+at z = 0; a radius is positive when its centre of curvature lies on the image side
+(+z) of the vertex, 0 means flat; ``thickness`` is the axial distance from this
+vertex to the next one (for the last surface: to the film plane at infinity focus,
+0 when unknown); ``medium`` is what fills the gap *after* the surface.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Iterable
+
+from ..errors import LensFileError
+
+__all__ = [
+    "SURFACE_KINDS",
+    "Medium",
+    "AIR",
+    "Surface",
+    "VariableGap",
+    "Focus",
+    "LensMetadata",
+    "Prescription",
+]
+
+#: The surface types physcam understands, as stored in files.
+SURFACE_KINDS = ("spherical", "flat", "stop", "aspheric", "cylindrical_x", "cylindrical_y")
+
+#: Highest even-asphere term kept: A4, A6, ..., A16 (7 coefficients).
+MAX_ASPHERIC_TERMS = 7
+
+
+@dataclass(frozen=True, slots=True)
+class Medium:
+    """The optical medium after a surface.
+
+    ``nd`` is the refractive index at the helium d line (587.5618 nm); ``vd`` the
+    Abbe number (nd - 1) / (nF - nC), 0 for a medium treated as non-dispersive
+    (air). ``glass`` is an optional catalogue name (e.g. ``"N-BK7"``).
+    """
+
+    nd: float = 1.0
+    vd: float = 0.0
+    glass: str | None = None
+
+    @property
+    def is_air(self) -> bool:
+        return self.nd == 1.0 and self.vd == 0.0 and self.glass is None
+
+
+AIR = Medium()
+
+
+@dataclass(frozen=True, slots=True)
+class Surface:
+    """One refracting surface (or the aperture stop) of a sequential lens.
+
+    radius: signed radius of curvature in mm, 0 = flat (see module notes).
+    thickness: axial distance to the next vertex in mm (at infinity focus).
+    medium: the medium after this surface.
+    semi_diameter: clear semi-diameter in mm (half the clear aperture).
+    kind: one of :data:`SURFACE_KINDS`.
+    conic: conic constant k of an even asphere (0 sphere, -1 paraboloid).
+    aspheric: even-polynomial coefficients (A4, A6, ... A16) of r**4, r**6, ...
+      in mm**(1-2i); sag z(r) = c r^2 / (1 + sqrt(1 - (1+k) c^2 r^2)) + sum A_2i r^2i.
+    """
+
+    radius: float
+    thickness: float
+    medium: Medium = AIR
+    semi_diameter: float = 0.0
+    kind: str = "spherical"
+    conic: float = 0.0
+    aspheric: tuple[float, ...] = ()
+
+    @property
+    def curvature(self) -> float:
+        """1 / radius in 1/mm, 0 for a flat surface or the stop."""
+        return 0.0 if self.radius == 0.0 or self.kind in ("flat", "stop") else 1.0 / self.radius
+
+    @property
+    def curvature_x(self) -> float:
+        """Curvature seen in the X-Z meridian (a cylinder in Y is flat there)."""
+        return 0.0 if self.kind == "cylindrical_y" else self.curvature
+
+    @property
+    def curvature_y(self) -> float:
+        """Curvature seen in the Y-Z meridian (a cylinder in X is flat there)."""
+        return 0.0 if self.kind == "cylindrical_x" else self.curvature
+
+    @property
+    def is_stop(self) -> bool:
+        return self.kind == "stop"
+
+
+@dataclass(frozen=True, slots=True)
+class VariableGap:
+    """An air gap that changes with focus: its thickness at infinity and at the close distance."""
+
+    surface: int  # 0-based index of the surface whose following gap varies
+    thickness_infinity: float
+    thickness_close: float
+
+
+@dataclass(frozen=True, slots=True)
+class Focus:
+    """Internal focusing: gaps given at infinity and at ``close_distance``.
+
+    ``close_distance`` is the object distance for the close set of gaps, in mm,
+    measured from the front vertex (the patent convention of variable-distance
+    tables). Several gaps may move (floating elements).
+    """
+
+    close_distance: float
+    gaps: tuple[VariableGap, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class LensMetadata:
+    """What a lens is and where its numbers come from."""
+
+    name: str = "unnamed lens"
+    maker: str | None = None
+    patent: str | None = None
+    focal_length: float | None = None  # nominal, as engraved, mm
+    max_fstop: float | None = None
+    coating: str | None = None  # "none", "single", "multi" or free text
+    source: str | None = None  # provenance: file, book, patent table
+    notes: str | None = None
+
+
+@dataclass(frozen=True)
+class Prescription:
+    """A sequential lens: surfaces front (scene side) to back (film side).
+
+    ``squeeze`` is the anamorphic squeeze factor (1 for spherical lenses).
+    ``wavelength_nm`` is the design wavelength used when none is asked for.
+    Call :meth:`validate` (readers do) to check it describes a buildable lens.
+    """
+
+    surfaces: tuple[Surface, ...]
+    metadata: LensMetadata = field(default_factory=LensMetadata)
+    focus: Focus | None = None
+    squeeze: float = 1.0
+    wavelength_nm: float = 587.5618
+
+    # ---- derived geometry -------------------------------------------------
+    @property
+    def name(self) -> str:
+        return self.metadata.name
+
+    @property
+    def stop_index(self) -> int:
+        """Index of the aperture stop surface."""
+        for i, s in enumerate(self.surfaces):
+            if s.is_stop:
+                return i
+        raise LensFileError(f"lens {self.name!r} has no aperture stop")
+
+    @property
+    def vertex_z(self) -> tuple[float, ...]:
+        """Axial position of each vertex, mm from the first vertex (+z toward the film)."""
+        z, out = 0.0, []
+        for s in self.surfaces:
+            out.append(z)
+            z += s.thickness
+        return tuple(out)
+
+    @property
+    def total_track(self) -> float:
+        """First vertex to last vertex, mm (the glass length, without the back focus)."""
+        return sum(s.thickness for s in self.surfaces[:-1])
+
+    @property
+    def is_anamorphic(self) -> bool:
+        return self.squeeze != 1.0 or any(s.kind.startswith("cylindrical") for s in self.surfaces)
+
+    def with_surfaces(self, surfaces: Iterable[Surface]) -> "Prescription":
+        return replace(self, surfaces=tuple(surfaces))
+
+    def with_thicknesses(self, thicknesses: dict[int, float]) -> "Prescription":
+        """A copy with some gaps changed (``{surface index: thickness}``)."""
+        s = list(self.surfaces)
+        for i, t in thicknesses.items():
+            s[i] = replace(s[i], thickness=float(t))
+        return self.with_surfaces(s)
+
+    # ---- validation -------------------------------------------------------
+    def validate(self, path: str | None = None, lines: list[int | None] | None = None) -> "Prescription":
+        """Check the lens is buildable; raise :class:`LensFileError` naming the surface.
+
+        ``lines`` (optional) maps each surface to the file line it came from, so the
+        error points there. Checks: at least one surface, finite numbers, exactly one
+        stop, positive semi-diameters that fit on their sphere, indices >= 1, no
+        negative gaps, neighbouring surfaces that do not cross inside their apertures,
+        focus gaps that exist and are air.
+        """
+
+        def fail(msg: str, i: int | None = None) -> LensFileError:
+            line = lines[i] if (lines is not None and i is not None and i < len(lines)) else None
+            where = f"surface {i}: " if i is not None else ""
+            return LensFileError(f"lens {self.name!r}: {where}{msg}", path, line)
+
+        if not self.surfaces:
+            raise fail("no surfaces")
+        if not (math.isfinite(self.squeeze) and self.squeeze > 0):
+            raise fail(f"squeeze must be a positive number, got {self.squeeze}")
+        stops = [i for i, s in enumerate(self.surfaces) if s.is_stop]
+        if not stops:
+            raise fail("no aperture stop (mark one surface as the stop)")
+        if len(stops) > 1:
+            raise fail(f"{len(stops)} aperture stops (surfaces {stops}); a lens has exactly one")
+        for i, s in enumerate(self.surfaces):
+            nums = (s.radius, s.thickness, s.semi_diameter, s.medium.nd, s.medium.vd, s.conic, *s.aspheric)
+            if not all(math.isfinite(v) for v in nums):
+                raise fail("contains NaN or infinity", i)
+            if s.kind not in SURFACE_KINDS:
+                raise fail(f"unknown surface type {s.kind!r}; use one of {', '.join(SURFACE_KINDS)}", i)
+            if s.semi_diameter <= 0:
+                raise fail(f"clear semi-diameter must be > 0 mm, got {s.semi_diameter:g}", i)
+            if s.medium.nd < 1.0:
+                raise fail(f"refractive index after the surface must be >= 1, got {s.medium.nd:g}", i)
+            if s.medium.vd < 0:
+                raise fail(f"Abbe number must be >= 0, got {s.medium.vd:g}", i)
+            if s.thickness < 0 and not (i == len(self.surfaces) - 1):
+                raise fail(f"negative axial gap {s.thickness:g} mm", i)
+            if s.kind in ("cylindrical_x", "cylindrical_y", "aspheric") and s.radius == 0:
+                raise fail(f"a {s.kind} surface needs a non-zero radius", i)
+            if (s.conic or s.aspheric) and s.kind != "aspheric":
+                raise fail("conic or aspheric coefficients on a surface not marked aspheric", i)
+            if len(s.aspheric) > MAX_ASPHERIC_TERMS:
+                raise fail(f"at most {MAX_ASPHERIC_TERMS} aspheric terms (A4..A16), got {len(s.aspheric)}", i)
+            c = s.curvature
+            if c != 0.0 and s.kind != "aspheric" and abs(s.semi_diameter * c) > 1.0 + 1e-9:
+                raise fail(
+                    f"semi-diameter {s.semi_diameter:g} mm exceeds the radius {abs(s.radius):g} mm of its sphere", i
+                )
+            if s.kind == "aspheric" and c != 0.0 and (1.0 + s.conic) * (c * s.semi_diameter) ** 2 > 1.0 + 1e-9:
+                raise fail(f"semi-diameter {s.semi_diameter:g} mm lies beyond the conic's edge", i)
+        # Surfaces that cross: sag of the next surface at the common aperture must not
+        # come before the sag of this one (measured from this vertex).
+        from .geometry import sag  # local import: geometry depends on nothing but math
+
+        for i in range(len(self.surfaces) - 1):
+            a, b = self.surfaces[i], self.surfaces[i + 1]
+            r = min(a.semi_diameter, b.semi_diameter)
+            for axis in ("x", "y"):
+                za = sag(a, r, axis)
+                zb = a.thickness + sag(b, r, axis)
+                if zb < za - 1e-6:
+                    raise fail(
+                        f"crosses surface {i + 1} inside the clear aperture (at height {r:g} mm the next surface is "
+                        f"{za - zb:.3g} mm in front of this one); check thickness and semi-diameters",
+                        i,
+                    )
+        if self.focus is not None:
+            f = self.focus
+            if not (math.isfinite(f.close_distance) and f.close_distance > 0):
+                raise fail(f"focus close_distance must be > 0 mm, got {f.close_distance}")
+            for g in f.gaps:
+                if not 0 <= g.surface < len(self.surfaces):
+                    raise fail(f"focus group gap refers to surface {g.surface}, which does not exist")
+                if not self.surfaces[g.surface].medium.is_air and self.surfaces[g.surface].medium.nd != 1.0:
+                    raise fail("a focus gap must be an air gap", g.surface)
+                if not (math.isfinite(g.thickness_close) and g.thickness_close >= 0):
+                    raise fail(f"focus gap at close distance must be >= 0 mm, got {g.thickness_close}", g.surface)
+        return self

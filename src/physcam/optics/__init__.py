@@ -1,0 +1,1 @@
+"""physcam.optics"""
