@@ -143,6 +143,7 @@ class Prescription:
 
     ``squeeze`` is the anamorphic squeeze factor (1 for spherical lenses).
     ``wavelength_nm`` is the design wavelength used when none is asked for.
+    ``extras`` holds file blocks physcam carries but does not model (see the field).
     Call :meth:`validate` (readers do) to check it describes a buildable lens.
     """
 
@@ -151,6 +152,10 @@ class Prescription:
     focus: Focus | None = None
     squeeze: float = 1.0
     wavelength_nm: float = 587.5618
+    #: Blocks of a lens file that physcam does not model (ISET's microlens array, a
+    #: file's provenance), carried unchanged as ``(key, JSON text)`` pairs so that
+    #: write(read(file)) round-trips. Optics code ignores them. See docs/lens-formats.md.
+    extras: tuple[tuple[str, str], ...] = ()
 
     # ---- derived geometry -------------------------------------------------
     @property
