@@ -1,0 +1,446 @@
+"""Focusing a lens at a distance marked from the film plane, and focus breathing.
+
+On set a focus mark D is the distance from the film plane (the body's Φ mark) to
+the subject (docs/conventions.md). Two ways a lens reaches it:
+
+* **unit focusing** – the whole lens moves away from the film. With the Gaussian
+  object distance s from H1 and image distance s' from H2 (air on both sides),
+  s + s' = D - hiatus and 1/s + 1/s' = 1/f give
+  s' = (T - sqrt(T^2 - 4 f T)) / 2 with T = D - hiatus (Smith, *Modern Optical
+  Engineering*, 4th ed., 2.4; the general-index form is solved below). No real
+  focus exists for T < 4 f (closer than 1:1).
+* **internal focusing** – the prescription's :class:`~physcam.lens.prescription.Focus`
+  gaps change. As in the seed's design notes (003), each variable gap is
+  interpolated linearly in reciprocal object distance between its infinity and
+  close values, alpha = close_distance / d with d the object distance from the
+  first vertex; then the lens-to-film distance that images the object on the film
+  is solved, with d chosen so that d + glass length + back focus = D. Marks closer
+  than the close calibration point raise :class:`OpticsError` naming the closest
+  focus (the seed silently clamps; physcam refuses).
+
+Focus breathing: the effective focal length and the horizontal field of view
+(from the paraxial chief ray reaching the sensor edge) against the focus mark.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+from ..errors import InputError, OpticsError, require_positive
+from ..lens.prescription import Prescription
+from . import paraxial
+
+__all__ = [
+    "FOCUS_METHODS",
+    "FocusState",
+    "TechnicalPlanes",
+    "BreathingRow",
+    "interpolated_gaps",
+    "image_distance",
+    "focus",
+    "closest_focus",
+    "gaussian_at_focus",
+    "technical_planes",
+    "breathing_table",
+]
+
+FOCUS_METHODS = ("auto", "unit", "internal")
+
+#: Default focus marks (mm from the film) of a breathing table, before the closest focus.
+DEFAULT_BREATHING_MARKS = (math.inf, 10000.0, 5000.0, 3000.0, 2000.0, 1500.0, 1000.0, 700.0, 500.0, 400.0, 300.0, 250.0, 200.0)
+
+
+@dataclass(frozen=True)
+class FocusState:
+    """A lens focused at a mark.
+
+    ``prescription`` has the focused gaps and its last thickness set to
+    ``back_focus_mm`` (last vertex to film). ``object_distance_mm`` is from the first
+    vertex to the subject, ``focus_from_film_mm`` from the film plane (inf allowed).
+    ``extension_mm`` is the back-focus change from infinity focus (the lens moving
+    out for unit focusing; a residual for internal focusing). ``alpha`` is the
+    fraction of the focus gaps' travel (0 at infinity, 1 at the close point).
+    """
+
+    focus_from_film_mm: float
+    method: str
+    axis: str
+    prescription: Prescription
+    object_distance_mm: float
+    back_focus_mm: float
+    back_focus_infinity_mm: float
+    extension_mm: float
+    alpha: float
+
+    @property
+    def object_z(self) -> float:
+        """Lens-space z of the subject (-inf at infinity)."""
+        return -self.object_distance_mm
+
+    @property
+    def film_z(self) -> float:
+        """Lens-space z of the film plane."""
+        return self.prescription.vertex_z[-1] + self.back_focus_mm
+
+
+@dataclass(frozen=True)
+class TechnicalPlanes:
+    """What the on-set report's technical model needs, at one focus.
+
+    Every ``*_from_film_mm`` is a distance **in front of the film plane, positive
+    toward the subject** (``*_from_flange_mm`` likewise from the flange, when the
+    flange focal distance is known). ``back_focus_mm`` is the last vertex to the
+    film; ``efl_mm`` the effective focal length at this focus; ``hiatus_mm`` = H1 - H2
+    positions (positive when H1 lies in front of H2).
+    """
+
+    focus_from_film_mm: float
+    method: str
+    axis: str
+    wavelength_nm: float
+    efl_mm: float
+    h1_from_film_mm: float
+    h2_from_film_mm: float
+    entrance_pupil_from_film_mm: float
+    exit_pupil_from_film_mm: float
+    front_vertex_from_film_mm: float
+    back_focus_mm: float
+    hiatus_mm: float
+    f_number: float
+    working_f_number: float
+    magnification: float
+    entrance_pupil_diameter_mm: float
+    flange_focal_distance_mm: float | None = None
+    h1_from_flange_mm: float | None = None
+    h2_from_flange_mm: float | None = None
+    entrance_pupil_from_flange_mm: float | None = None
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
+
+
+@dataclass(frozen=True)
+class BreathingRow:
+    """One focus mark of a breathing table (lengths mm, angles degrees)."""
+
+    focus_from_film_mm: float
+    efl_mm: float
+    hfov_deg: float
+    breathing_focal_length_mm: float  # sensor half-width / tan(half HFOV): the focal length the framing suggests
+    magnification: float
+    back_focus_mm: float
+    fov_change_pct: float  # HFOV change from infinity focus, percent
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
+
+
+def _method(prescription: Prescription, method: str) -> str:
+    if method not in FOCUS_METHODS:
+        raise InputError(f"focus method must be one of {', '.join(FOCUS_METHODS)}, got {method!r}")
+    if method == "auto":
+        return "internal" if prescription.focus is not None else "unit"
+    if method == "internal" and prescription.focus is None:
+        raise InputError(f"lens {prescription.name!r} has no focus groups; use unit focusing")
+    return method
+
+
+def _mark(focus_from_film_mm) -> float:
+    d = float(focus_from_film_mm)
+    if math.isnan(d) or d <= 0:
+        raise InputError(f"focus distance must be a positive distance from the film plane, got {focus_from_film_mm!r}")
+    return d
+
+
+def interpolated_gaps(prescription: Prescription, object_distance_mm: float) -> tuple[dict[int, float], float]:
+    """Focus-group gaps for an object ``object_distance_mm`` in front of the first vertex.
+
+    Linear in reciprocal object distance (seed 003): alpha = close_distance / d,
+    clamped to [0, 1]; gap = t_inf + alpha (t_close - t_inf). Returns (gaps, alpha).
+    """
+    f = prescription.focus
+    if f is None:
+        return {}, 0.0
+    alpha = 0.0 if math.isinf(object_distance_mm) else min(max(f.close_distance / object_distance_mm, 0.0), 1.0)
+    return {g.surface: g.thickness_infinity + alpha * (g.thickness_close - g.thickness_infinity) for g in f.gaps}, alpha
+
+
+def image_distance(prescription: Prescription, object_distance_mm: float, axis: str = "y", wavelength_nm=None) -> float:
+    """Last vertex to the paraxial image (mm, + toward the film) of an axial object.
+
+    ``object_distance_mm`` is from the first vertex to the object (inf allowed: the BFL).
+    """
+    a, b, c, d = paraxial.system_matrix(prescription, axis, wavelength_nm)
+    n_img = paraxial.media_indices(prescription, wavelength_nm)[-1]
+    if math.isinf(object_distance_mm):
+        y, nu = a, c
+    else:  # ray leaving the axial object with n u = 1 (object space is air)
+        y, nu = a * object_distance_mm + b, c * object_distance_mm + d
+    if abs(nu) < 1e-15:
+        raise OpticsError("the object is at the front focal point: its image is at infinity")
+    return -y * n_img / nu
+
+
+def _unit_focus(p: Prescription, mark: float, axis: str, lam, max_extension_mm) -> FocusState:
+    g = paraxial.gaussian(p, axis=axis, wavelength_nm=lam)
+    b_inf = g.bfl
+    if math.isinf(mark):
+        return FocusState(mark, "unit", axis, p.with_thicknesses({len(p.surfaces) - 1: b_inf}), math.inf, b_inf, b_inf, 0.0, 0.0)
+    phi = 1.0 / g.efl
+    if phi <= 0:
+        raise OpticsError(f"lens {p.name!r} has negative power: it forms no real image to focus")
+    n2 = g.image_index
+    hiatus = g.z_rear_principal_plane - g.z_front_principal_plane  # H1 -> H2 along +z
+    T = mark - hiatus  # s + s' (s from H1 toward the subject, s' from H2 toward the film)
+    # 1/s + n'/s' = phi with s = T - s'  ->  phi s'^2 - (phi T + n' - 1) s' + n' T = 0
+    bq = phi * T + n2 - 1.0
+    disc = bq * bq - 4.0 * phi * n2 * T
+    if T <= 0 or disc < 0:
+        t_min = (1.0 + math.sqrt(n2)) ** 2 / phi  # discriminant zero: the 1:1 conjugate in air
+        raise OpticsError(
+            f"lens {p.name!r} cannot focus at {mark:.1f} mm from the film by unit focusing: the closest real focus "
+            f"(1:1) is {t_min + hiatus:.1f} mm from the film plane"
+        )
+    s2 = (bq - math.sqrt(disc)) / (2.0 * phi)  # the root that tends to f' at infinity
+    z_film = g.z_rear_principal_plane + s2
+    back = z_film - p.vertex_z[-1]
+    extension = back - b_inf
+    if max_extension_mm is not None and extension > max_extension_mm + 1e-9:
+        s2_max = g.rear_focal_length + max_extension_mm
+        s_max = 1.0 / (phi - n2 / s2_max)
+        raise OpticsError(
+            f"lens {p.name!r} cannot focus at {mark:.1f} mm: with {max_extension_mm:g} mm of focus travel its closest "
+            f"focus is {s_max + s2_max + hiatus:.1f} mm from the film plane"
+        )
+    d_obj = mark - back - p.total_track
+    if d_obj <= 0:
+        raise OpticsError(
+            f"lens {p.name!r}: a subject {mark:.1f} mm from the film would be inside the lens once focused; "
+            "mark a longer distance"
+        )
+    return FocusState(mark, "unit", axis, p.with_thicknesses({len(p.surfaces) - 1: back}), d_obj, back, b_inf, extension, 0.0)
+
+
+def _internal_state(p: Prescription, d_obj: float, axis: str, lam):
+    gaps, alpha = interpolated_gaps(p, d_obj)
+    q = p.with_thicknesses(gaps)
+    back = image_distance(q, d_obj, axis, lam)
+    return q, back, alpha
+
+
+def closest_focus(prescription: Prescription, *, method: str = "auto", axis: str = "y", wavelength_nm=None) -> float:
+    """Closest focus mark (mm from the film plane).
+
+    Internal focusing: the close calibration point of the focus groups. Unit
+    focusing (no mechanical limit known): the 1:1 conjugate, 4 f + hiatus in air.
+    """
+    method = _method(prescription, method)
+    if method == "internal":
+        d = prescription.focus.close_distance
+        q, back, _ = _internal_state(prescription, d, axis, wavelength_nm)
+        return d + q.total_track + back
+    g = paraxial.gaussian(prescription, axis=axis, wavelength_nm=wavelength_nm)
+    if g.efl <= 0:
+        raise OpticsError(f"lens {prescription.name!r} has negative power: it forms no real image to focus")
+    return (1.0 + math.sqrt(g.image_index)) ** 2 * g.efl + (g.z_rear_principal_plane - g.z_front_principal_plane)
+
+
+def _internal_focus(p: Prescription, mark: float, axis: str, lam) -> FocusState:
+    q_inf, b_inf, _ = _internal_state(p, math.inf, axis, lam)
+    if math.isinf(mark):
+        return FocusState(mark, "internal", axis, q_inf.with_thicknesses({len(p.surfaces) - 1: b_inf}), math.inf, b_inf, b_inf, 0.0, 0.0)
+    d_close = p.focus.close_distance
+
+    def residual(d):  # marked distance reached with the subject d in front of the first vertex, minus the mark
+        q, back, _ = _internal_state(p, d, axis, lam)
+        return d + q.total_track + back - mark
+
+    r_lo = residual(d_close)
+    if r_lo > 1e-9:
+        raise OpticsError(
+            f"lens {p.name!r} cannot focus at {mark:.1f} mm: its closest focus is {mark + r_lo:.1f} mm "
+            "from the film plane (focus groups at their close position)"
+        )
+    lo, hi = d_close, max(mark, d_close)
+    if residual(hi) < 0:
+        raise OpticsError(f"lens {p.name!r}: no internal focus solution for {mark:.1f} mm from the film")
+    for _ in range(200):  # bisection: the residual grows with d for any sane focus group
+        mid = 0.5 * (lo + hi)
+        if residual(mid) > 0:
+            hi = mid
+        else:
+            lo = mid
+        if hi - lo < 1e-9 * max(1.0, hi):
+            break
+    d = 0.5 * (lo + hi)
+    q, back, alpha = _internal_state(p, d, axis, lam)
+    if back <= 0:
+        raise OpticsError(f"lens {p.name!r}: at {mark:.1f} mm the image falls inside the lens (back focus {back:.2f} mm)")
+    return FocusState(mark, "internal", axis, q.with_thicknesses({len(p.surfaces) - 1: back}), d, back, b_inf, back - b_inf, alpha)
+
+
+def focus(
+    prescription: Prescription,
+    focus_from_film_mm: float,
+    *,
+    method: str = "auto",
+    axis: str = "y",
+    wavelength_nm=None,
+    max_extension_mm: float | None = None,
+) -> FocusState:
+    """Focus ``prescription`` on a subject ``focus_from_film_mm`` in front of the film plane.
+
+    ``method``: ``"unit"`` (the lens moves), ``"internal"`` (the focus groups move,
+    then the back focus is solved), ``"auto"`` (internal when the lens has focus
+    groups). ``axis``: the meridian that is focused (Y, the spherical meridian of
+    an anamorphic, as cinematographers focus). ``max_extension_mm`` limits unit
+    focusing travel. Raises :class:`OpticsError` naming the closest focus when
+    the mark is too close.
+    """
+    method = _method(prescription, method)
+    mark = _mark(focus_from_film_mm)
+    paraxial._axis(axis)
+    if max_extension_mm is not None:
+        max_extension_mm = require_positive("maximum focus extension", max_extension_mm)
+    if method == "internal":
+        return _internal_focus(prescription, mark, axis, wavelength_nm)
+    return _unit_focus(prescription, mark, axis, wavelength_nm, max_extension_mm)
+
+
+def gaussian_at_focus(
+    prescription: Prescription,
+    focus_from_film_mm: float = math.inf,
+    *,
+    axis: str = "y",
+    focus_axis: str = "y",
+    method: str = "auto",
+    wavelength_nm=None,
+    fstop=None,
+    flange_focal_distance_mm=None,
+) -> paraxial.GaussianData:
+    """Gaussian data in the ``axis`` meridian with the lens focused (in ``focus_axis``) at the mark."""
+    st = focus(prescription, focus_from_film_mm, method=method, axis=focus_axis, wavelength_nm=wavelength_nm)
+    return paraxial.gaussian(
+        st.prescription,
+        axis=axis,
+        wavelength_nm=wavelength_nm,
+        fstop=fstop,
+        object_z=st.object_z,
+        film_z=st.film_z,
+        flange_focal_distance_mm=flange_focal_distance_mm,
+    )
+
+
+def technical_planes(
+    prescription: Prescription,
+    focus_from_film_mm: float,
+    flange_focal_distance_mm: float | None = None,
+    wavelength_nm: float | None = None,
+    *,
+    fstop: float | None = None,
+    method: str = "auto",
+    axis: str = "y",
+) -> TechnicalPlanes:
+    """EFL, H1, H2 and the entrance pupil **in front of the film plane** at a focus mark.
+
+    For the on-set report's technical model. ``focus_from_film_mm`` is the mark
+    (mm from the film plane, inf allowed); distances returned are positive toward
+    the subject; ``back_focus_mm`` is last vertex to film. With
+    ``flange_focal_distance_mm`` the same planes are also given from the flange.
+    """
+    g = gaussian_at_focus(
+        prescription,
+        focus_from_film_mm,
+        axis=axis,
+        focus_axis=axis,
+        method=method,
+        wavelength_nm=wavelength_nm,
+        fstop=fstop,
+        flange_focal_distance_mm=flange_focal_distance_mm,
+    )
+    st_method = _method(prescription, method)
+    fl = {}
+    if flange_focal_distance_mm is not None:
+        fl = dict(
+            h1_from_flange_mm=g.in_front_of("front_principal_plane", "flange"),
+            h2_from_flange_mm=g.in_front_of("rear_principal_plane", "flange"),
+            entrance_pupil_from_flange_mm=g.in_front_of("entrance_pupil", "flange"),
+        )
+    return TechnicalPlanes(
+        focus_from_film_mm=float(focus_from_film_mm),
+        method=st_method,
+        axis=axis,
+        wavelength_nm=g.wavelength_nm,
+        efl_mm=g.efl,
+        h1_from_film_mm=g.in_front_of("front_principal_plane"),
+        h2_from_film_mm=g.in_front_of("rear_principal_plane"),
+        entrance_pupil_from_film_mm=g.in_front_of("entrance_pupil"),
+        exit_pupil_from_film_mm=g.in_front_of("exit_pupil"),
+        front_vertex_from_film_mm=g.z_film - g.z_front_vertex,
+        back_focus_mm=g.z_film - g.z_rear_vertex,
+        hiatus_mm=g.z_rear_principal_plane - g.z_front_principal_plane,
+        f_number=g.f_number,
+        working_f_number=g.working_f_number,
+        magnification=g.magnification,
+        entrance_pupil_diameter_mm=g.entrance_pupil_diameter,
+        flange_focal_distance_mm=g.flange_focal_distance,
+        **fl,
+    )
+
+
+def breathing_table(
+    prescription: Prescription,
+    focus_marks_mm=None,
+    *,
+    sensor_width_mm: float = 36.0,
+    method: str = "auto",
+    wavelength_nm=None,
+) -> list[BreathingRow]:
+    """Effective focal length and horizontal field of view against focus mark.
+
+    ``focus_marks_mm``: marks from the film plane (default: infinity, 10 m, 5 m, ...
+    down to the closest focus). The horizontal field uses the X meridian (the squeezed one of
+    an anamorphic) with the lens focused in Y; HFOV = 2 atan(...) of the paraxial
+    chief ray reaching the sensor edge (``sensor_width_mm``/2 off axis).
+    """
+    w = require_positive("sensor width", sensor_width_mm)
+    method = _method(prescription, method)
+    if focus_marks_mm is None:
+        near = closest_focus(prescription, method=method, wavelength_nm=wavelength_nm)
+        # internal focusing ends at its close point; unit focusing (no mechanical limit known) stops
+        # at the last default mark beyond 1:1
+        marks = [m for m in DEFAULT_BREATHING_MARKS if m > near] + ([near] if method == "internal" else [])
+    else:
+        marks = [_mark(m) for m in focus_marks_mm]
+        if not marks:
+            raise InputError("give at least one focus distance for the breathing table")
+    rows = []
+    hfov0 = None
+    for m in marks:
+        st = focus(prescription, m, method=method, axis="y", wavelength_nm=wavelength_nm)
+        gx = paraxial.gaussian(st.prescription, axis="x", wavelength_nm=wavelength_nm, object_z=st.object_z, film_z=st.film_z)
+        half = abs(paraxial.field_angle(st.prescription, w / 2.0, st.film_z, "x", wavelength_nm))
+        hfov = math.degrees(2.0 * half)
+        if hfov0 is None:
+            hfov0 = hfov if math.isinf(m) else gaussian_hfov_infinity(prescription, w, method, wavelength_nm)
+        rows.append(
+            BreathingRow(
+                focus_from_film_mm=m,
+                efl_mm=gx.efl,
+                hfov_deg=hfov,
+                breathing_focal_length_mm=(w / 2.0) / math.tan(half),
+                magnification=gx.magnification,
+                back_focus_mm=st.back_focus_mm,
+                fov_change_pct=100.0 * (hfov / hfov0 - 1.0),
+            )
+        )
+    return rows
+
+
+def gaussian_hfov_infinity(prescription: Prescription, sensor_width_mm: float, method: str = "auto", wavelength_nm=None) -> float:
+    """Horizontal field of view (degrees, X meridian) at infinity focus."""
+    st = focus(prescription, math.inf, method=method, axis="y", wavelength_nm=wavelength_nm)
+    return math.degrees(2.0 * abs(paraxial.field_angle(st.prescription, sensor_width_mm / 2.0, st.film_z, "x", wavelength_nm)))

@@ -1,0 +1,181 @@
+"""Focusing from a film-plane mark, close-focus limits, technical planes and breathing."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+from _gauss_lenses import dgauss, thin_lens, thin_pair
+from physcam.errors import InputError, OpticsError
+from physcam.optics import focusing
+from physcam.optics.paraxial import gaussian
+
+# Published dgauss.50mm figures (see test_paraxial): f, H1 from V1, H2 from V2, BFL, track
+F, ZH1, H2V2, BFL, TRACK = 50.3582, 23.2357, -14.2523, 36.1059, 32.04
+HIATUS = (TRACK + H2V2) - ZH1  # z_H2 - z_H1
+
+
+def unit_image_distance(mark, f, hiatus):
+    """s' from H2 for a mark D from the film: s + s' = D - hiatus, 1/s + 1/s' = 1/f (thin-lens algebra)."""
+    t = mark - hiatus
+    return (t - math.sqrt(t * t - 4 * f * t)) / 2
+
+
+def test_unit_focus_thin_lens_closed_form():
+    f, mark = 50.0, 1000.0
+    stt = focusing.focus(thin_lens(f), mark)
+    s2 = (mark - math.sqrt(mark**2 - 4 * f * mark)) / 2
+    assert stt.method == "unit"
+    assert stt.back_focus_mm == pytest.approx(s2, rel=1e-12)
+    assert stt.object_distance_mm == pytest.approx(mark - s2, rel=1e-12)
+    assert stt.extension_mm == pytest.approx(s2 - f, rel=1e-9)
+    assert 1 / stt.object_distance_mm + 1 / stt.back_focus_mm == pytest.approx(1 / f, rel=1e-12)
+
+
+@pytest.mark.parametrize("mark", [300.0, 600.0, 1000.0, 3048.0, 20000.0])
+def test_unit_focus_dgauss_from_published_cardinal_points(mark):
+    stt = focusing.focus(dgauss(), mark)
+    s2 = unit_image_distance(mark, F, HIATUS)
+    assert stt.back_focus_mm == pytest.approx(s2 + H2V2, abs=2e-3)
+    assert stt.film_z - stt.object_z == pytest.approx(mark, abs=1e-9)  # the mark is from the film plane
+    assert stt.extension_mm == pytest.approx(s2 + H2V2 - BFL, abs=2e-3)
+
+
+def test_infinity_focus_puts_the_film_at_the_rear_focal_point():
+    stt = focusing.focus(dgauss(), math.inf)
+    assert stt.back_focus_mm == pytest.approx(BFL, abs=1e-3)
+    assert stt.extension_mm == 0.0
+
+
+def test_unit_focus_closer_than_one_to_one_names_the_closest_focus():
+    near = 4 * F + HIATUS
+    assert focusing.closest_focus(dgauss()) == pytest.approx(near, abs=5e-3)
+    with pytest.raises(OpticsError, match=rf"closest real focus .* is {near:.1f} mm from the film"):
+        focusing.focus(dgauss(), 150.0)
+
+
+def test_unit_focus_with_limited_travel():
+    # 5 mm of extension: s' = f + 5 -> s = f s'/(s' - f); the mark adds the hiatus
+    s2 = F + 5.0
+    near = F * s2 / 5.0 + s2 + HIATUS
+    with pytest.raises(OpticsError, match=f"closest focus is {near:.1f} mm"):
+        focusing.focus(dgauss(), near - 20.0, max_extension_mm=5.0)
+    assert focusing.focus(dgauss(), near + 20.0, max_extension_mm=5.0).extension_mm < 5.0
+
+
+def test_internal_focus_thin_pair_closed_form():
+    # Two thin lenses d apart; the gap shrinks toward the close point, interpolated in 1/distance.
+    f1, f2, d, close, d_close = 60.0, 90.0, 20.0, 500.0, 14.0
+    lens = thin_pair(f1, f2, d, focus=(close, d_close))
+    mark = 1200.0
+    stt = focusing.focus(lens, mark)
+    assert stt.method == "internal"
+    obj = stt.object_distance_mm
+    alpha = close / obj
+    gap = d + alpha * (d_close - d)
+    assert stt.alpha == pytest.approx(alpha, rel=1e-9)
+    assert stt.prescription.surfaces[2].thickness == pytest.approx(gap, rel=1e-9)
+    # thin-lens imaging, lens by lens
+    s1 = 1 / (1 / f1 - 1 / obj)
+    s2 = 1 / (1 / f2 - 1 / (gap - s1))
+    assert stt.back_focus_mm == pytest.approx(s2, rel=1e-9)
+    assert obj + gap + s2 == pytest.approx(mark, rel=1e-9)
+
+
+def test_internal_focus_close_limit():
+    f1, f2, d, close, d_close = 60.0, 90.0, 20.0, 500.0, 14.0
+    lens = thin_pair(f1, f2, d, focus=(close, d_close))
+    s1 = 1 / (1 / f1 - 1 / close)
+    s2 = 1 / (1 / f2 - 1 / (d_close - s1))
+    near = close + d_close + s2
+    assert focusing.closest_focus(lens) == pytest.approx(near, rel=1e-12)
+    at_near = focusing.focus(lens, near)
+    assert at_near.alpha == pytest.approx(1.0, abs=1e-9)
+    with pytest.raises(OpticsError, match=f"closest focus is {near:.1f} mm from the film plane"):
+        focusing.focus(lens, near - 50.0)
+    # the same lens can still be unit-focused closer
+    assert focusing.focus(lens, near - 50.0, method="unit").method == "unit"
+
+
+def test_focus_bad_input():
+    with pytest.raises(InputError, match="positive distance"):
+        focusing.focus(dgauss(), -3.0)
+    with pytest.raises(InputError, match="positive distance"):
+        focusing.focus(dgauss(), float("nan"))
+    with pytest.raises(InputError, match="no focus groups"):
+        focusing.focus(dgauss(), 1000.0, method="internal")
+    with pytest.raises(InputError, match="focus method"):
+        focusing.focus(dgauss(), 1000.0, method="helical")
+
+
+def test_technical_planes_at_infinity_from_published_figures():
+    tp = focusing.technical_planes(dgauss(), math.inf, 52.0)
+    z_film = TRACK + BFL
+    assert tp.efl_mm == pytest.approx(F, abs=1e-3)
+    assert tp.back_focus_mm == pytest.approx(BFL, abs=1e-3)
+    assert tp.h1_from_film_mm == pytest.approx(z_film - ZH1, abs=1e-3)
+    assert tp.h2_from_film_mm == pytest.approx(BFL - H2V2, abs=1e-3)
+    assert tp.entrance_pupil_from_film_mm == pytest.approx(z_film - 19.9465, abs=1e-3)
+    assert tp.entrance_pupil_from_flange_mm == pytest.approx(z_film - 19.9465 - 52.0, abs=1e-3)
+    assert tp.h1_from_flange_mm == pytest.approx(tp.h1_from_film_mm - 52.0, abs=1e-12)
+    assert tp.to_dict()["focus_from_film_mm"] is None  # infinity is null in JSON
+
+
+def test_technical_planes_at_a_mark_unit_focus():
+    mark = 2000.0
+    tp = focusing.technical_planes(dgauss(), mark)
+    s2 = unit_image_distance(mark, F, HIATUS)
+    assert tp.h2_from_film_mm == pytest.approx(s2, abs=2e-3)
+    assert tp.h1_from_film_mm == pytest.approx(s2 + HIATUS, abs=2e-3)  # z_H1 = z_H2 - hiatus
+    s = mark - HIATUS - s2
+    assert tp.magnification == pytest.approx(-s2 / s, rel=1e-4)
+    assert tp.flange_focal_distance_mm is None and tp.h1_from_flange_mm is None
+
+
+def test_breathing_thin_lens_stop_at_lens():
+    # stop at a thin lens: the chief ray is undeviated, tan(half HFOV) = (w/2) / s'
+    f, w = 50.0, 36.0
+    rows = focusing.breathing_table(thin_lens(f), [math.inf, 1000.0, 500.0], sensor_width_mm=w)
+    assert rows[0].hfov_deg == pytest.approx(math.degrees(2 * math.atan(w / 2 / f)), rel=1e-12)
+    for r in rows[1:]:
+        s2 = (r.focus_from_film_mm - math.sqrt(r.focus_from_film_mm**2 - 4 * f * r.focus_from_film_mm)) / 2
+        assert r.hfov_deg == pytest.approx(math.degrees(2 * math.atan(w / 2 / s2)), rel=1e-12)
+        assert r.breathing_focal_length_mm == pytest.approx(s2, rel=1e-12)
+        assert r.efl_mm == pytest.approx(f, rel=1e-12)
+    assert rows[2].fov_change_pct < rows[1].fov_change_pct < 0
+
+
+def test_breathing_default_table_of_an_internal_focus_lens_ends_at_the_close_point():
+    lens = thin_pair(60.0, 90.0, 20.0, focus=(500.0, 14.0))
+    rows = focusing.breathing_table(lens)
+    assert math.isinf(rows[0].focus_from_film_mm)
+    assert rows[-1].focus_from_film_mm == pytest.approx(focusing.closest_focus(lens), rel=1e-12)
+    # the focal length changes with the gap: closed form of the thin pair at the close gap
+    assert rows[-1].efl_mm == pytest.approx(60.0 * 90.0 / (150.0 - 14.0), rel=1e-9)
+    assert rows[0].efl_mm == pytest.approx(60.0 * 90.0 / (150.0 - 20.0), rel=1e-9)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.floats(250.0, 1e5))
+def test_focused_image_lies_on_the_film(mark):
+    p = dgauss()
+    assume(mark > focusing.closest_focus(p) + 1.0)
+    stt = focusing.focus(p, mark)
+    g = gaussian(stt.prescription, object_z=stt.object_z)
+    assert g.z_image == pytest.approx(stt.film_z, abs=1e-7)
+    assert stt.film_z - stt.object_z == pytest.approx(mark, rel=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.floats(600.0, 1e6))
+def test_internal_focus_solution_satisfies_the_mark(mark):
+    lens = thin_pair(60.0, 90.0, 20.0, focus=(500.0, 14.0))
+    assume(mark > focusing.closest_focus(lens))
+    stt = focusing.focus(lens, mark)
+    assert 0.0 <= stt.alpha <= 1.0
+    assert stt.object_distance_mm + stt.prescription.total_track + stt.back_focus_mm == pytest.approx(mark, rel=1e-8)
+    g = gaussian(stt.prescription, object_z=stt.object_z)
+    assert g.z_image == pytest.approx(stt.film_z, abs=1e-6)
