@@ -1,1 +1,4 @@
-"""physcam.export"""
+"""Exporters: translate physcam's optics into renderer and pipeline parameters.
+
+Exporters convert units and parameterisations; they do not compute optics.
+"""

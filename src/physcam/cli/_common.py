@@ -1,0 +1,50 @@
+"""Helpers shared by the CLI commands: unit parsing types, JSON and table output."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+from ..errors import PhysCamError
+from ..units import parse_distance
+
+
+def distance(name: str, allow_inf: bool = False):
+    """An argparse type reading a distance with units (bare number = mm)."""
+
+    def parse(text):
+        try:
+            return parse_distance(text, name=name, allow_inf=allow_inf)
+        except PhysCamError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parse.__name__ = name
+    return parse
+
+
+def number(name: str):
+    def parse(text):
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number, got {text!r}") from None
+        if not math.isfinite(v):
+            raise argparse.ArgumentTypeError(f"{name} must be a finite number, got {text!r}")
+        return v
+
+    parse.__name__ = name
+    return parse
+
+
+def print_json(obj) -> None:
+    json.dump(obj, sys.stdout, indent=2, allow_nan=False)
+    sys.stdout.write("\n")
+
+
+def console(stderr: bool = False):
+    """A rich Console with markup and highlighting off (user text is never interpreted)."""
+    from rich.console import Console
+
+    return Console(stderr=stderr, markup=False, highlight=False, emoji=False)

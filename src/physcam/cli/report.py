@@ -1,0 +1,161 @@
+"""``physcam report``: the on-set lens report (practical and technical models)."""
+
+from __future__ import annotations
+
+from ._common import distance, number
+
+EPILOG = """\
+distances accept units as said on set: 3m, 10ft, 6in, 450mm, 10'6" (a bare number is mm).
+Focus, near, far and --sensor-front are measured from the film plane; --h1/--h2/--pupil are
+distances in front of the reference plane (--reference film|flange).
+
+examples:
+  physcam report --focal 50 --fstop 2.8 --focus 3m --sensor "ALEXA 35"
+  physcam report --focal 35 --focus 10ft --near 8ft --coc 0.025 --tstop 2.8   (solve f-stop)
+  physcam report --focal 50 --near 2.5m --far 4m --fstop 4 --sensor S35         (solve focus)
+  physcam report --model technical --focal 50 --fstop 2 --focus 2m --h1 80 --h2 60 --pupil 95
+"""
+
+
+def register(sub) -> None:
+    import argparse
+
+    p = sub.add_parser(
+        "report",
+        help="on-set lens report: DOF, FOV, hyperfocal, pivot, USD and RenderMan cameras",
+        description="Solve the on-set lens report (thin-lens practical model or datasheet technical model).",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_report_arguments(p)
+    p.add_argument("--json", action="store_true", help="print the report as JSON (for pipelines)")
+    p.add_argument("--cameras", action="store_true", help="also print the UsdGeomCamera and RenderMan blocks")
+    p.add_argument("--plot", metavar="FILE", help="draw the depth-of-field zone to FILE (.png or .svg)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing --plot file")
+    p.set_defaults(handler=run)
+
+
+def add_report_arguments(p) -> None:
+    g = p.add_argument_group("lens and sensor")
+    g.add_argument("--focal", type=distance("focal length"), help="focal length (mm)")
+    g.add_argument("--fstop", type=number("f-stop"), help="f-stop (geometric f-number); solved if omitted")
+    g.add_argument("--tstop", type=number("T-stop"), help="marked T-stop, compared with the effective f-stop")
+    g.add_argument("--focus", type=distance("focus distance"), help="focus mark, film plane to subject")
+    g.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (see physcam sensors)')
+    g.add_argument("--sensor-width", type=distance("sensor width"), help="sensor width (mm)")
+    g.add_argument("--sensor-height", type=distance("sensor height"), help="sensor height (mm)")
+    g.add_argument("--squeeze", type=number("squeeze"), default=1.0, help="anamorphic squeeze (default 1)")
+    g.add_argument("--coc", default=None,
+                   help="circle of confusion: d/1500 (default), d/1000, d/1730, cine (0.025 mm) or a value in mm")
+    g = p.add_argument_group("measured depth of field (inverse solve)")
+    g.add_argument("--near", type=distance("near limit"), help="measured near limit, from the film plane")
+    g.add_argument("--far", type=distance("far limit", allow_inf=True), help="measured far limit (or inf)")
+    g = p.add_argument_group("model")
+    g.add_argument("--model", choices=("practical", "technical"), default="practical",
+                   help="practical = thin lens; technical = datasheet principal planes")
+    g.add_argument("--h1", type=distance("H1 offset"), help="front principal plane, in front of the reference")
+    g.add_argument("--h2", type=distance("H2 offset"), help="rear principal plane, in front of the reference")
+    g.add_argument("--pupil", type=distance("entrance pupil offset"),
+                   help="entrance pupil, in front of the reference plane (technical)")
+    g.add_argument("--reference", choices=("film", "flange"), default="film",
+                   help="plane the datasheet offsets are measured from")
+    g.add_argument("--flange", type=distance("flange focal distance"),
+                   help="flange focal distance (e.g. 52 for PL, 44 for LPL) when --reference flange")
+    g.add_argument("--sensor-front", type=distance("sensor-to-lens-front distance"),
+                   help="tape measure: film mark to the front of the lens (practical pupil estimate)")
+    g.add_argument("--lens-length", type=distance("lens length"), help="physical lens length")
+    g.add_argument("--pupil-fraction", type=number("pupil fraction"), default=0.4,
+                   help="entrance pupil this fraction of the lens length behind its front (default 0.4)")
+    g = p.add_argument_group("cameras")
+    g.add_argument("--meters-per-unit", type=number("metersPerUnit"), default=0.01,
+                   help="scene unit for USD/RenderMan values (default 0.01 = cm)")
+    g.add_argument("--shutter-angle", type=number("shutter angle"), default=180.0, help="degrees (default 180)")
+
+
+def resolve_sensor(args):
+    from ..errors import InputError
+    from ..onset.sensors import Sensor, find_sensor
+
+    if args.sensor and (args.sensor_width or args.sensor_height):
+        raise InputError("give either --sensor NAME or --sensor-width/--sensor-height, not both")
+    if args.sensor:
+        return find_sensor(args.sensor)
+    if args.sensor_width or args.sensor_height:
+        if not (args.sensor_width and args.sensor_height):
+            raise InputError("give both --sensor-width and --sensor-height")
+        if args.sensor_width <= 0 or args.sensor_height <= 0:
+            raise InputError("sensor width and height must be greater than 0 mm")
+        return Sensor("custom", f"custom {args.sensor_width:g} x {args.sensor_height:g} mm",
+                      args.sensor_width, args.sensor_height)
+    return find_sensor("Super 35")
+
+
+def solve_from_args(args):
+    from ..errors import InputError
+    from ..onset.report import solve_lens_report
+
+    if args.focal is None:
+        raise InputError("give the focal length, e.g. --focal 50")
+    coc = args.coc
+    if coc is not None:
+        try:
+            coc = float(coc)
+        except ValueError:
+            pass
+    return solve_lens_report(
+        focal_length_mm=args.focal,
+        sensor=resolve_sensor(args),
+        fstop=args.fstop,
+        focus_mm=args.focus,
+        coc=coc,
+        near_mm=args.near,
+        far_mm=args.far,
+        tstop=args.tstop,
+        squeeze=args.squeeze,
+        model=args.model,
+        h1_mm=args.h1,
+        h2_mm=args.h2,
+        pupil_mm=args.pupil,
+        reference_plane=args.reference,
+        flange_focal_distance_mm=args.flange,
+        sensor_front_mm=args.sensor_front,
+        lens_length_mm=args.lens_length,
+        pupil_fraction=args.pupil_fraction,
+    )
+
+
+def camera_blocks(report, args) -> dict:
+    from ..export.renderman import renderman_camera_values
+    from ..export.usdgeom import usdgeom_camera_values
+
+    mpu = args.meters_per_unit
+    return {
+        "meters_per_unit": mpu,
+        "usd_geom_camera": usdgeom_camera_values(report, mpu, shutter_angle_deg=args.shutter_angle),
+        "renderman": renderman_camera_values(report, mpu),
+    }
+
+
+def run(args) -> int:
+    from ._common import console, print_json
+
+    report = solve_from_args(args)
+    cams = camera_blocks(report, args)
+    if args.plot:
+        from ..onset.dof_plot import plot_dof_zone
+
+        plot_dof_zone(report, args.plot, force=args.force)
+    if args.json:
+        d = report.to_dict()
+        d["cameras"] = cams
+        print_json(d)
+        return 0
+    from ..onset.table import report_table
+
+    out = console()
+    out.print(report_table(report))
+    if args.cameras:
+        print_json(cams)
+    if args.plot:
+        console(stderr=True).print(f"wrote {args.plot}")
+    return 0

@@ -1,0 +1,496 @@
+"""The on-set lens report: one solver, two models, forward and inverse inputs.
+
+*Practical* model: a thin lens (H1 = H2) whose principal plane sits s' in front of
+the film, so a focus mark D (film plane to subject) is s + s' = D, not s = D
+(docs/conventions.md; seed 000's "s = marked distance" is corrected here).
+*Technical* model: datasheet principal planes H1, H2 (and the entrance pupil) given
+as distances in front of a reference plane (the film, or the lens flange with its
+flange focal distance): s = D - H1; the image then forms s' behind H2, and the report
+gives the focus error (where the sharp image lies relative to the film).
+
+Depth of field uses the exact thin-lens forms (physcam.optics.dof) about H1 and is
+reported both from H1 and from the film plane. Inputs may be forward (f-stop, CoC)
+or inverse (near and/or far limits measured on a plate), in which case the report
+solves the effective f-stop, the CoC or the focus distance, and says what it solved.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from ..errors import InputError, OpticsError, require_finite, require_positive
+from ..optics import dof as _dof
+from ..optics import thinlens
+from ..optics.coc import circle_of_confusion
+from .pupil import entrance_pupil_practical, pivot_camera_space
+from .sensors import Sensor
+
+__all__ = ["LensReport", "DepthOfField", "solve_lens_report", "REPORT_SCHEMA", "REPORT_VERSION"]
+
+REPORT_SCHEMA = "physcam.lens_report"
+REPORT_VERSION = 1
+
+
+@dataclass(frozen=True)
+class DepthOfField:
+    """Limits of acceptable sharpness for one circle of confusion.
+
+    ``*_mm`` are from the front principal plane H1, ``*_from_film_mm`` from the film plane;
+    ``far`` is ``inf`` when focused at or beyond the hyperfocal distance.
+    """
+
+    coc_mm: float
+    hyperfocal_mm: float
+    hyperfocal_from_film_mm: float
+    near_mm: float
+    far_mm: float
+    near_from_film_mm: float
+    far_from_film_mm: float
+
+    @property
+    def total_mm(self) -> float:
+        return self.far_mm - self.near_mm
+
+    @property
+    def far_is_infinite(self) -> bool:
+        return math.isinf(self.far_mm)
+
+    def to_dict(self) -> dict:
+        return {
+            "coc_mm": self.coc_mm,
+            "hyperfocal_mm": self.hyperfocal_mm,
+            "hyperfocal_from_film_mm": self.hyperfocal_from_film_mm,
+            "near_mm": self.near_mm,
+            "far_mm": _finite_or_none(self.far_mm),
+            "total_mm": _finite_or_none(self.total_mm),
+            "near_from_film_mm": self.near_from_film_mm,
+            "far_from_film_mm": _finite_or_none(self.far_from_film_mm),
+            "far_is_infinite": self.far_is_infinite,
+        }
+
+
+def _finite_or_none(v: float | None):
+    return None if v is None or math.isinf(v) else v
+
+
+@dataclass(frozen=True)
+class LensReport:
+    """Everything the lens report knows. Lengths in mm, angles in degrees.
+
+    Positions are distances in front of the film plane (``*_from_film_mm``) unless the
+    name says otherwise; ``object_distance_mm`` is from H1, ``image_distance_mm`` from H2.
+    """
+
+    model: str
+    focal_length_mm: float
+    fstop: float
+    sensor: Sensor
+    squeeze: float
+    coc_mm: float
+    coc_convention: str
+    focus_from_film_mm: float
+    object_distance_mm: float
+    image_distance_mm: float
+    h1_from_film_mm: float
+    h2_from_film_mm: float
+    focus_error_mm: float
+    magnification: float
+    dof: DepthOfField
+    dof_horizontal: DepthOfField | None
+    hfov_inf_deg: float
+    vfov_inf_deg: float
+    dfov_inf_deg: float
+    hfov_focus_deg: float
+    vfov_focus_deg: float
+    dfov_focus_deg: float
+    entrance_pupil_from_film_mm: float | None
+    entrance_pupil_source: str
+    solved: dict = field(default_factory=dict)
+    measured: dict = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+    lens_name: str | None = None
+    reference_plane: str = "film"
+    flange_focal_distance_mm: float | None = None
+    tstop: float | None = None
+
+    # --- convenience --------------------------------------------------------
+    @property
+    def aperture_diameter_mm(self) -> float:
+        """Entrance-pupil diameter f / N."""
+        return self.focal_length_mm / self.fstop
+
+    @property
+    def pivot_camera_space_mm(self):
+        """The parallax-free pivot in camera space (mm), or None when no pupil is known."""
+        if self.entrance_pupil_from_film_mm is None:
+            return None
+        return pivot_camera_space(self.entrance_pupil_from_film_mm)
+
+    @property
+    def desqueezed_width_mm(self) -> float:
+        return self.sensor.width_mm * self.squeeze
+
+    def to_dict(self) -> dict:
+        """Versioned, JSON-ready dict with stable keys; infinities become null plus a flag."""
+        s = self.sensor
+        return {
+            "schema": REPORT_SCHEMA,
+            "version": REPORT_VERSION,
+            "units": {"length": "mm", "angle": "degree"},
+            "reference": "distances *_from_film_mm are in front of the film plane; object distance from H1, "
+            "image distance from H2",
+            "model": self.model,
+            "lens": self.lens_name,
+            "focal_length_mm": self.focal_length_mm,
+            "fstop": self.fstop,
+            "tstop": self.tstop,
+            "aperture_diameter_mm": self.aperture_diameter_mm,
+            "squeeze": self.squeeze,
+            "sensor": {
+                "key": s.key,
+                "name": s.name,
+                "width_mm": s.width_mm,
+                "height_mm": s.height_mm,
+                "diagonal_mm": s.diagonal_mm,
+            },
+            "coc_mm": self.coc_mm,
+            "coc_convention": self.coc_convention,
+            "focus_from_film_mm": self.focus_from_film_mm,
+            "object_distance_mm": self.object_distance_mm,
+            "image_distance_mm": self.image_distance_mm,
+            "h1_from_film_mm": self.h1_from_film_mm,
+            "h2_from_film_mm": self.h2_from_film_mm,
+            "reference_plane": self.reference_plane,
+            "flange_focal_distance_mm": self.flange_focal_distance_mm,
+            "focus_error_mm": self.focus_error_mm,
+            "magnification": self.magnification,
+            "dof": self.dof.to_dict(),
+            "dof_horizontal": None if self.dof_horizontal is None else self.dof_horizontal.to_dict(),
+            "fov_deg": {
+                "infinity": {"horizontal": self.hfov_inf_deg, "vertical": self.vfov_inf_deg,
+                             "diagonal": self.dfov_inf_deg},
+                "focus": {"horizontal": self.hfov_focus_deg, "vertical": self.vfov_focus_deg,
+                          "diagonal": self.dfov_focus_deg},
+            },
+            "entrance_pupil_from_film_mm": self.entrance_pupil_from_film_mm,
+            "entrance_pupil_source": self.entrance_pupil_source,
+            "pivot_camera_space_mm": None if self.pivot_camera_space_mm is None else list(self.pivot_camera_space_mm),
+            "solved": dict(self.solved),
+            "measured": {k: _finite_or_none(v) if isinstance(v, float) else v for k, v in self.measured.items()},
+            "notes": list(self.notes),
+        }
+
+
+# --------------------------------------------------------------------------------------
+def _fov_deg(size, focal_or_image_distance):
+    return math.degrees(2.0 * math.atan(size / (2.0 * focal_or_image_distance)))
+
+
+def _dof_block(f, n, c, s, h1_film_at) -> DepthOfField:
+    """DOF for object distance s (from H1); ``h1_film_at(s)`` gives H1's distance from the film."""
+    near, far = _dof.dof_limits(f, n, c, s)
+    H = _dof.hyperfocal_distance(f, n, c)
+    return DepthOfField(
+        coc_mm=c,
+        hyperfocal_mm=H,
+        hyperfocal_from_film_mm=H + h1_film_at(H),
+        near_mm=near,
+        far_mm=far,
+        near_from_film_mm=near + h1_film_at(s),
+        far_from_film_mm=far + h1_film_at(s),
+    )
+
+
+def solve_lens_report(
+    *,
+    focal_length_mm: float,
+    sensor: Sensor,
+    fstop: float | None = None,
+    focus_mm: float | None = None,
+    coc: str | float | None = None,
+    near_mm: float | None = None,
+    far_mm: float | None = None,
+    tstop: float | None = None,
+    squeeze: float = 1.0,
+    model: str = "practical",
+    h1_mm: float | None = None,
+    h2_mm: float | None = None,
+    pupil_mm: float | None = None,
+    reference_plane: str = "film",
+    flange_focal_distance_mm: float | None = None,
+    sensor_front_mm: float | None = None,
+    lens_length_mm: float | None = None,
+    pupil_fraction: float = 0.4,
+    lens_name: str | None = None,
+) -> LensReport:
+    """Solve the lens report.
+
+    Distances measured on set (``focus_mm``, ``near_mm``, ``far_mm``, ``sensor_front_mm``)
+    are from the film plane. Technical offsets (``h1_mm``, ``h2_mm``, ``pupil_mm``) are
+    in front of ``reference_plane`` ("film" or "flange"; the flange lies
+    ``flange_focal_distance_mm`` in front of the film).
+
+    Solving rules: with a near and/or far limit measured, the report solves the focus
+    (when ``focus_mm`` is missing), then the effective f-stop (when ``fstop`` is missing,
+    or when both fstop and an explicit ``coc`` are given) or else the CoC. Without
+    measured limits it is a forward report and ``fstop`` is required.
+    """
+    notes: list[str] = []
+    f = require_positive("focal length", focal_length_mm)
+    sq = require_positive("anamorphic squeeze", squeeze, unit="")
+    if model not in ("practical", "technical"):
+        raise InputError(f"model must be 'practical' or 'technical', got {model!r}")
+    w, h = sensor.width_mm, sensor.height_mm
+    coc_explicit = coc is not None
+    c, coc_name = circle_of_confusion(w, h, coc)
+    N = None if fstop is None else require_positive("f-stop", fstop, unit="")
+    T = None if tstop is None else require_positive("T-stop", tstop, unit="")
+    D = None if focus_mm is None else require_positive("focus distance", focus_mm)
+    near_m = None if near_mm is None else require_positive("near limit", near_mm)
+    far_m = None
+    if far_mm is not None:
+        far_m = float(far_mm)
+        if math.isnan(far_m) or far_m <= 0:
+            raise InputError(f"far limit must be a positive distance (or inf), got {far_mm!r}")
+    if near_m is not None and far_m is not None and not near_m < far_m:
+        raise InputError(f"near limit {near_m:g} mm must be closer than far limit {far_m:g} mm")
+
+    # --- where H1, H2 and the pupil sit, and how a mark maps to s --------------------
+    ffd = None
+    if reference_plane not in ("film", "flange"):
+        raise InputError(f"reference plane must be 'film' or 'flange', got {reference_plane!r}")
+    if reference_plane == "flange":
+        if flange_focal_distance_mm is None:
+            raise InputError("a flange reference needs the flange focal distance (e.g. 52 mm for PL, 44 mm for LPL)")
+        ffd = require_positive("flange focal distance", flange_focal_distance_mm)
+    ref = ffd or 0.0
+
+    if model == "technical":
+        if h1_mm is None or h2_mm is None:
+            raise InputError("the technical model needs --h1 and --h2 (principal planes from the reference plane)")
+        P1 = ref + require_finite("H1 offset", h1_mm)
+        P2 = ref + require_finite("H2 offset", h2_mm)
+
+        def h1_at(_s):
+            return P1
+
+        def s_for_mark(mark):
+            s = mark - P1
+            if s <= f:
+                raise OpticsError(
+                    f"focus mark {mark:g} mm puts the subject {s:g} mm in front of H1, at or inside the "
+                    f"{f:g} mm focal length: no real image"
+                )
+            return s
+
+        def mark_for_s(s):
+            return s + P1
+
+    else:
+        P1 = P2 = None
+
+        def h1_at(s):
+            return thinlens.image_distance(f, s)
+
+        def s_for_mark(mark):
+            return thinlens.object_distance_for_marked(f, mark)
+
+        def mark_for_s(s):
+            return s + thinlens.image_distance(f, s)
+
+    def to_h1(d_film, s):
+        """A film-plane distance as a distance from H1 (for the current focus s)."""
+        return d_film - h1_at(s)
+
+    solved: dict = {}
+    measured: dict = {}
+    if near_m is not None:
+        measured["near_from_film_mm"] = near_m
+    if far_m is not None:
+        measured["far_from_film_mm"] = far_m
+
+    # --- focus ----------------------------------------------------------------
+    if D is None:
+        if near_m is not None and far_m is not None:
+            # 1/near + 1/far = 2/s about H1; H1 moves with focus in the practical model,
+            # so iterate the film->H1 conversion (converges in a few steps: s' ~ f).
+            s = _solve_focus_from_bracket(near_m, far_m, h1_at, f)
+        elif N is not None and (near_m is not None or far_m is not None):
+            hp = f * f / (N * c)
+            s = _solve_focus_from_one_limit(near_m, far_m, hp, f, h1_at)
+        else:
+            raise InputError(
+                "give a focus distance (--focus), or measured near and far limits (--near, --far), "
+                "or one limit with the f-stop"
+            )
+        D = mark_for_s(s)
+        solved["focus_from_film_mm"] = D
+    s = s_for_mark(D)
+    s_img = thinlens.image_distance(f, s)
+
+    # --- inversions from measured limits ---------------------------------------------
+    if near_m is not None or far_m is not None:
+        hp_near = hp_far = None
+        if near_m is not None:
+            hp_near = _dof.hyperfocal_parameter_from_near(f, s, to_h1(near_m, s))
+        if far_m is not None and math.isfinite(far_m):
+            hp_far = _dof.hyperfocal_parameter_from_far(f, s, to_h1(far_m, s))
+        hp = hp_near if hp_near is not None else hp_far
+        if hp is None:
+            raise InputError("an infinite far limit alone cannot give the aperture; measure the near limit too")
+        if hp_near is not None and hp_far is not None:
+            solved["hyperfocal_parameter_from_near_mm"] = hp_near
+            solved["hyperfocal_parameter_from_far_mm"] = hp_far
+            solved["consistency"] = abs(hp_far - hp_near) / hp_near
+            notes.append(
+                "near and far limits agree to {:.1%} in the hyperfocal parameter".format(solved["consistency"])
+            )
+        if N is None or coc_explicit:
+            marked = N
+            N = _dof.f_number_for_dof(f, c, hp)
+            solved["fstop"] = N
+            if marked is not None:
+                solved["fstop_drift_stops"] = _dof.stops_between(N, marked)
+        else:
+            c = _dof.coc_for_dof(f, N, hp)
+            coc_name = "solved"
+            solved["coc_mm"] = c
+        if far_m is not None and hp_near is not None:
+            _, far_pred = _dof.dof_limits(f, N, c, s)
+            pred_film = far_pred + h1_at(s)
+            solved["far_predicted_from_film_mm"] = _finite_or_none(pred_film)
+            solved["far_error_mm"] = (
+                0.0 if math.isinf(pred_film) and math.isinf(far_m)
+                else (None if math.isinf(pred_film) or math.isinf(far_m) else pred_film - far_m)
+            )
+    if N is None:
+        raise InputError("give the f-stop (--fstop) or a measured near/far limit to solve it")
+    if T is not None:
+        solved["tstop_drift_stops"] = _dof.stops_between(N, T)
+        if T < N - 1e-9:
+            notes.append("the T-stop is faster than the f-stop: a T-stop is never below the f-number")
+
+    # --- depth of field --------------------------------------------------------
+    dof = _dof_block(f, N, c, s, h1_at)
+    dof_h = None
+    if sq != 1.0:
+        dof_h = _dof_block(f, N, c / sq, s, h1_at)
+        notes.append(f"anamorphic {sq:g}x: horizontal CoC is c / squeeze = {c / sq:.4g} mm")
+
+    # --- focus error (technical) ------------------------------------------------
+    if model == "technical":
+        h1_film, h2_film = P1, P2
+        focus_error = P2 - s_img  # where the sharp image lies, in front of the film (+)
+        if abs(focus_error) > 1e-6:
+            notes.append(
+                f"with these principal planes the sharp image lies {abs(focus_error):.3f} mm "
+                f"{'in front of' if focus_error > 0 else 'behind'} the film plane"
+            )
+    else:
+        h1_film = h2_film = s_img
+        focus_error = 0.0
+
+    # --- field of view -------------------------------------------------------------
+    wd = w * sq
+    dg = math.hypot(wd, h)
+    fov = dict(
+        hfov_inf_deg=_fov_deg(wd, f),
+        vfov_inf_deg=_fov_deg(h, f),
+        dfov_inf_deg=_fov_deg(dg, f),
+        hfov_focus_deg=_fov_deg(wd, s_img),
+        vfov_focus_deg=_fov_deg(h, s_img),
+        dfov_focus_deg=_fov_deg(dg, s_img),
+    )
+
+    # --- entrance pupil -----------------------------------------------------------
+    pupil, pupil_src = None, "unknown"
+    if model == "technical" and pupil_mm is not None:
+        pupil, pupil_src = ref + require_finite("entrance pupil offset", pupil_mm), "datasheet"
+    elif sensor_front_mm is not None and lens_length_mm is not None:
+        pupil = entrance_pupil_practical(sensor_front_mm, lens_length_mm, pupil_fraction)
+        pupil_src = f"estimate: {pupil_fraction:g} of the lens length behind its front"
+    elif model == "practical":
+        pupil, pupil_src = h1_film, "thin lens: at the principal plane"
+    if pupil is None:
+        notes.append("no entrance pupil: give --pupil (technical) or --sensor-front and --lens-length")
+
+    report = LensReport(
+        model=model,
+        focal_length_mm=f,
+        fstop=N,
+        sensor=sensor,
+        squeeze=sq,
+        coc_mm=c,
+        coc_convention=coc_name,
+        focus_from_film_mm=D,
+        object_distance_mm=s,
+        image_distance_mm=s_img,
+        h1_from_film_mm=h1_film,
+        h2_from_film_mm=h2_film,
+        focus_error_mm=focus_error,
+        magnification=f / (s - f),
+        dof=dof,
+        dof_horizontal=dof_h,
+        entrance_pupil_from_film_mm=pupil,
+        entrance_pupil_source=pupil_src,
+        solved=solved,
+        measured=measured,
+        notes=tuple(notes),
+        lens_name=lens_name,
+        reference_plane=reference_plane,
+        flange_focal_distance_mm=ffd,
+        tstop=T,
+        **fov,
+    )
+    _check_finite(report)
+    return report
+
+
+def _solve_focus_from_bracket(near_film, far_film, h1_at, f):
+    p = f  # first guess for H1's distance from the film
+    for _ in range(100):
+        n, F = near_film - p, far_film - p
+        if n <= f:
+            raise OpticsError("the measured near limit is inside the focal length")
+        s = float(_dof.focus_for_dof_limits(n, F))
+        p_new = h1_at(s)
+        if abs(p_new - p) < 1e-10 * max(1.0, p):
+            return s
+        p = p_new
+    raise OpticsError("could not solve the focus distance from the near/far bracket")
+
+
+def _solve_focus_from_one_limit(near_film, far_film, hp, f, h1_at):
+    p = f
+    for _ in range(100):
+        if near_film is not None:
+            n = near_film - p
+            if not 0 < n < hp:
+                raise InputError("the near limit lies beyond half the hyperfocal distance: no focus gives it")
+            s = n * (hp - f) / (hp - n)
+        else:
+            F = far_film - p
+            s = F * (hp + f) / (hp + F)
+        p_new = h1_at(s)
+        if abs(p_new - p) < 1e-10 * max(1.0, p):
+            return s
+        p = p_new
+    raise OpticsError("could not solve the focus distance from the measured limit")
+
+
+def _check_finite(report: LensReport) -> None:
+    """No NaN leaves the library; infinities only where documented (far limits)."""
+    d = report.to_dict()
+
+    def walk(x, path):
+        if isinstance(x, float) and not math.isfinite(x):
+            raise OpticsError(f"the report's {path} came out {x}; check the inputs")
+        if isinstance(x, dict):
+            for k, v in x.items():
+                walk(v, f"{path}.{k}" if path else k)
+        if isinstance(x, list):
+            for i, v in enumerate(x):
+                walk(v, f"{path}[{i}]")
+
+    walk(d, "")

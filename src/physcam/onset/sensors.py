@@ -1,0 +1,95 @@
+"""Cinema sensors and film gates, by name or alias.
+
+The table ``physcam/data/sensors.csv`` holds active-area (or camera-aperture)
+width and height in mm with their sources; the values were checked against the
+shared reference table ``sensor_formats.csv`` (see tests/onset/test_sensors.py,
+which also checks each diagonal). Lookup ignores case, spaces and punctuation;
+an unknown name raises :class:`~physcam.errors.SensorError` listing the closest names.
+"""
+
+from __future__ import annotations
+
+import csv
+import difflib
+import math
+import re
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import resources
+
+from ..errors import SensorError
+
+__all__ = ["Sensor", "sensors", "find_sensor"]
+
+
+@dataclass(frozen=True, slots=True)
+class Sensor:
+    """A sensor or film gate: active area ``width_mm`` x ``height_mm``."""
+
+    key: str
+    name: str
+    width_mm: float
+    height_mm: float
+    aliases: tuple[str, ...] = ()
+    kind: str = "digital"
+    source: str = ""
+
+    @property
+    def diagonal_mm(self) -> float:
+        return math.hypot(self.width_mm, self.height_mm)
+
+    @property
+    def aspect(self) -> float:
+        return self.width_mm / self.height_mm
+
+
+def _norm(text: str) -> str:
+    return re.sub(r"[^a-z0-9]+", "", text.lower())
+
+
+@lru_cache(maxsize=1)
+def sensors() -> tuple[Sensor, ...]:
+    """Every known sensor, in table order."""
+    text = resources.files("physcam.data").joinpath("sensors.csv").read_text(encoding="utf-8")
+    out = []
+    for row in csv.DictReader(text.splitlines()):
+        out.append(
+            Sensor(
+                key=row["key"],
+                name=row["name"],
+                width_mm=float(row["width_mm"]),
+                height_mm=float(row["height_mm"]),
+                aliases=tuple(a.strip() for a in row["aliases"].split(";") if a.strip()),
+                kind=row["kind"],
+                source=row["source"],
+            )
+        )
+    return tuple(out)
+
+
+@lru_cache(maxsize=1)
+def _index() -> dict[str, Sensor]:
+    idx: dict[str, Sensor] = {}
+    for s in sensors():
+        for label in (s.key, s.name, *s.aliases):
+            idx.setdefault(_norm(label), s)
+    return idx
+
+
+def find_sensor(name: str) -> Sensor:
+    """The sensor called ``name`` (key, full name or alias; case and punctuation ignored).
+
+    >>> find_sensor("alexa 35").width_mm
+    27.99
+    """
+    idx = _index()
+    key = _norm(name)
+    if key in idx:
+        return idx[key]
+    labels = {}
+    for s in sensors():
+        for label in (s.name, *s.aliases):
+            labels.setdefault(_norm(label), label)
+    close = difflib.get_close_matches(key, list(labels), n=4, cutoff=0.4)
+    hint = "; closest: " + ", ".join(repr(labels[c]) for c in close) if close else ""
+    raise SensorError(f"unknown sensor {name!r}{hint}. `physcam sensors` lists them all")

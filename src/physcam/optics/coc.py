@@ -1,0 +1,67 @@
+"""Circle of confusion: named conventions, one dispatcher.
+
+The acceptable blur on the film depends on how the picture will be seen; the
+conventions below are the ones camera departments actually quote.
+
+- ``d/1500`` (default): sensor diagonal / 1500, the "modern Zeiss" rule, 0.029 mm on a
+  36x24 frame (Wikipedia "Zeiss formula"; "Circle of confusion", table convention).
+- ``d/1000``: diagonal / 1000, the traditional Zeiss rule.
+- ``cine``: 0.025 mm (0.001 in), the American Cinematographer Manual's 35 mm motion
+  picture value (ACM 1986, quoted by DOFMaster).
+- a number: the user's own value in mm.
+
+See ``reference/formats/coc_conventions.csv`` in the shared data for sources.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+
+from ..errors import InputError, require_positive
+
+__all__ = ["COC_CONVENTIONS", "DEFAULT_COC_CONVENTION", "circle_of_confusion"]
+
+#: name -> (description, function of (width_mm, height_mm) -> coc_mm)
+COC_CONVENTIONS = {
+    "d/1500": ("sensor diagonal / 1500 (modern Zeiss)", lambda w, h: math.hypot(w, h) / 1500.0),
+    "d/1000": ("sensor diagonal / 1000 (traditional Zeiss)", lambda w, h: math.hypot(w, h) / 1000.0),
+    "d/1730": ("sensor diagonal / 1730 ('Zeiss formula')", lambda w, h: math.hypot(w, h) / 1730.0),
+    "cine": ("0.025 mm fixed (ACM 1986, 35 mm motion picture)", lambda w, h: 0.025),
+}
+_ALIASES = {"zeiss": "d/1500", "modern": "d/1500", "traditional": "d/1000", "acm": "cine", "0.025": "cine"}
+
+DEFAULT_COC_CONVENTION = "d/1500"
+
+
+def circle_of_confusion(width_mm: float, height_mm: float, convention: str | float | None = None):
+    """(coc_mm, convention_name) for a sensor of ``width_mm`` x ``height_mm``.
+
+    ``convention`` is a name from :data:`COC_CONVENTIONS`, a number (user value, mm) or
+    ``None`` for the default ``d/1500``. Unknown names raise :class:`InputError` listing
+    the choices.
+
+    >>> c, name = circle_of_confusion(36.0, 24.0)
+    >>> round(c, 4), name
+    (0.0288, 'd/1500')
+    """
+    w = require_positive("sensor width", width_mm)
+    h = require_positive("sensor height", height_mm)
+    if convention is None:
+        convention = DEFAULT_COC_CONVENTION
+    if isinstance(convention, (int, float)):
+        return require_positive("circle of confusion", convention), "user"
+    key = str(convention).strip().lower()
+    key = _ALIASES.get(key, key)
+    if key in COC_CONVENTIONS:
+        return COC_CONVENTIONS[key][1](w, h), key
+    try:
+        value = float(key.removesuffix("mm"))
+    except ValueError:
+        close = difflib.get_close_matches(key, list(COC_CONVENTIONS), n=3, cutoff=0.3)
+        hint = f" (did you mean {', '.join(close)}?)" if close else ""
+        raise InputError(
+            f"unknown circle-of-confusion convention {convention!r}{hint}; "
+            f"use one of {', '.join(COC_CONVENTIONS)} or a value in mm"
+        ) from None
+    return require_positive("circle of confusion", value), "user"

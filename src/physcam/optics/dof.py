@@ -1,0 +1,148 @@
+"""Depth of field of a thin lens, in exact form, and its inversions.
+
+With f the focal length, N the f-number, c the circle of confusion on the film and s
+the focused object distance measured from the front principal plane H1, the exact
+thin-lens limits are
+
+    h = f^2 / (N c)                       (the "hyperfocal parameter")
+    H = h + f                             (hyperfocal distance, from H1)
+    near = h s / (h + (s - f))
+    far  = h s / (h - (s - f))            (infinite when s >= H)
+
+These follow from similar triangles with the entrance pupil (diameter f/N) at the
+principal plane. Sources: Wikipedia, "Depth of field", section "Derivation of the
+DOF formulae" (the forms with the hyperfocal distance H = f²/(Nc) + f); S. Ray,
+*Applied Photographic Optics*, 3rd ed., §8.2; DOFMaster's calculator
+(dofmaster.com/equations.html) uses the same forms. The seed document paired
+H = f²/(Nc) + f with near/far forms that expect h: physcam does not (docs/dof.md).
+
+The limits are reported from H1; the lens report converts them to the film plane.
+Everything broadcasts over numpy arrays; lengths in mm.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import InputError, OpticsError
+
+__all__ = [
+    "hyperfocal_distance",
+    "dof_limits",
+    "hyperfocal_parameter_from_near",
+    "hyperfocal_parameter_from_far",
+    "focus_for_dof_limits",
+    "f_number_for_dof",
+    "coc_for_dof",
+]
+
+
+def _arr(x):
+    return np.asarray(x, dtype=float)
+
+
+def _out(x):
+    x = np.asarray(x)
+    return x if x.ndim else float(x)
+
+
+def hyperfocal_distance(focal_length, f_number, coc):
+    """Hyperfocal distance H = f²/(N c) + f, in mm from the front principal plane H1.
+
+    Focused at H, the far limit reaches infinity and the near limit is H/2 (exactly,
+    for this form). Source: Wikipedia "Hyperfocal distance", definition 1.
+
+    >>> round(float(hyperfocal_distance(35.0, 11.0, 0.03)), 2)
+    3747.12
+    """
+    f = _arr(focal_length)
+    return _out(f * f / (_arr(f_number) * _arr(coc)) + f)
+
+
+def dof_limits(focal_length, f_number, coc, object_distance):
+    """(near, far) limits of acceptable sharpness, in mm from H1 (exact thin-lens forms).
+
+    ``far`` is ``inf`` when the focus is at or beyond the hyperfocal distance.
+    Raises :class:`OpticsError` if the subject is at or inside the focal length.
+
+    DOFMaster's example, 50 mm f/4 focused 10 ft with c = 0.03 mm, gives near 8 ft 9 in
+    and far 11 ft 8 in:
+
+    >>> n, f = dof_limits(50.0, 4.0, 0.03, 3048.0)
+    >>> round(n / 304.8, 3), round(f / 304.8, 3)
+    (8.742, 11.681)
+    """
+    f = _arr(focal_length)
+    s = _arr(object_distance)
+    if np.any(s <= f):
+        raise OpticsError("focus distance is at or inside the focal length: no real image forms")
+    h = f * f / (_arr(f_number) * _arr(coc))
+    near = h * s / (h + (s - f))
+    denom = h - (s - f)
+    with np.errstate(divide="ignore"):
+        far = np.where(denom > 0, h * s / np.where(denom > 0, denom, 1.0), np.inf)
+    return _out(near), _out(far)
+
+
+def hyperfocal_parameter_from_near(focal_length, object_distance, near):
+    """h = f²/(N c) recovered from a measured near limit: h = near (s - f) / (s - near).
+
+    Distances from H1. Requires near < s.
+    """
+    f, s, n = _arr(focal_length), _arr(object_distance), _arr(near)
+    if np.any(n >= s):
+        raise InputError("the near limit must be closer than the focus distance")
+    if np.any(n <= 0):
+        raise InputError("the near limit must be in front of the lens (> 0)")
+    return _out(n * (s - f) / (s - n))
+
+
+def hyperfocal_parameter_from_far(focal_length, object_distance, far):
+    """h = f²/(N c) recovered from a measured far limit: h = far (s - f) / (far - s).
+
+    Distances from H1. Requires far > s; an infinite far limit gives no finite h.
+    """
+    f, s, F = _arr(focal_length), _arr(object_distance), _arr(far)
+    if np.any(F <= s):
+        raise InputError("the far limit must be beyond the focus distance")
+    if np.any(~np.isfinite(F)):
+        raise InputError(
+            "an infinite far limit only says the focus is at or beyond the hyperfocal distance; give a near limit"
+        )
+    return _out(F * (s - f) / (F - s))
+
+
+def focus_for_dof_limits(near, far):
+    """Focus distance s (from H1) that puts the limits at ``near`` and ``far``.
+
+    From the exact forms, 1/near + 1/far = 2/s, so s is their harmonic mean
+    2 near far / (near + far) whatever f, N and c are. An infinite far gives s = 2 near.
+    """
+    n, F = _arr(near), _arr(far)
+    if np.any(n <= 0) or np.any(F <= n):
+        raise InputError("need 0 < near limit < far limit")
+    with np.errstate(invalid="ignore"):
+        s = np.where(np.isfinite(F), 2.0 * n * F / (n + np.where(np.isfinite(F), F, 0.0)), 2.0 * n)
+    return _out(s)
+
+
+def f_number_for_dof(focal_length, coc, h):
+    """N = f² / (c h) for a hyperfocal parameter h (see the ``*_from_near`` helpers)."""
+    f = _arr(focal_length)
+    return _out(f * f / (_arr(coc) * _arr(h)))
+
+
+def coc_for_dof(focal_length, f_number, h):
+    """c = f² / (N h) for a hyperfocal parameter h."""
+    f = _arr(focal_length)
+    return _out(f * f / (_arr(f_number) * _arr(h)))
+
+
+def stops_between(n_effective: float, n_marked: float) -> float:
+    """Difference in stops from ``n_marked`` to ``n_effective``: 2 log2(N_eff / N_marked).
+
+    Positive means the effective aperture is smaller (more DOF) than marked.
+    """
+    return 2.0 * math.log2(n_effective / n_marked)

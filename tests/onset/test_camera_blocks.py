@@ -1,0 +1,65 @@
+"""Camera blocks: FOV recomputed from the UsdGeomCamera and RenderMan values and from Gf.Camera."""
+
+import math
+
+import pytest
+
+from physcam.export.renderman import renderman_camera_values
+from physcam.export.usdgeom import shutter_interval, usdgeom_camera_values
+from physcam.onset.report import solve_lens_report
+from physcam.onset.sensors import Sensor, find_sensor
+
+
+@pytest.fixture(params=[(1.0, "ALEXA 35"), (2.0, "35mm anamorphic"), (1.0, "Super 16")])
+def report(request):
+    sq, name = request.param
+    return solve_lens_report(focal_length_mm=40.0, sensor=find_sensor(name), fstop=2.8, focus_mm=2500.0,
+                             squeeze=sq)
+
+
+@pytest.mark.parametrize("mpu", [0.01, 1.0, 0.0254])
+def test_usd_block_fov_matches_gf_camera(report, mpu):
+    from pxr import Gf
+
+    v = usdgeom_camera_values(report, mpu)
+    hfov = math.degrees(2 * math.atan(v["horizontalAperture"] / (2 * v["focalLength"])))
+    vfov = math.degrees(2 * math.atan(v["verticalAperture"] / (2 * v["focalLength"])))
+    assert hfov == pytest.approx(report.hfov_inf_deg, abs=1e-9)
+    assert vfov == pytest.approx(report.vfov_inf_deg, abs=1e-9)
+    cam = Gf.Camera()
+    cam.focalLength = v["focalLength"]
+    cam.horizontalAperture = v["horizontalAperture"]
+    cam.verticalAperture = v["verticalAperture"]
+    assert cam.GetFieldOfView(Gf.Camera.FOVHorizontal) == pytest.approx(report.hfov_inf_deg, abs=1e-4)
+    assert cam.GetFieldOfView(Gf.Camera.FOVVertical) == pytest.approx(report.vfov_inf_deg, abs=1e-4)
+    # scene units: focus distance in metres * 1/mpu
+    assert v["focusDistance"] * mpu * 1000 == pytest.approx(report.object_distance_mm)
+
+
+def test_usd_units_hand_values():
+    r = solve_lens_report(focal_length_mm=50.0, sensor=Sensor("x", "x", 36.0, 24.0), fstop=2.0, focus_mm=3000.0)
+    cm = usdgeom_camera_values(r, 0.01)
+    m = usdgeom_camera_values(r, 1.0)
+    assert cm["focalLength"] == pytest.approx(50.0) and m["focalLength"] == pytest.approx(0.5)
+    assert cm["horizontalAperture"] == pytest.approx(36.0) and m["horizontalAperture"] == pytest.approx(0.36)
+    assert cm["clippingRange"] == pytest.approx((10.0, 1e6)) and m["clippingRange"] == pytest.approx((0.1, 1e4))
+
+
+def test_renderman_block_fov(report):
+    rm = renderman_camera_values(report)
+    fov = math.radians(rm["Projection"]["fov"])
+    l, r, b, t = rm["ScreenWindow"]
+    # the screen window spans tan(fov/2) per unit: width of the frame in angle
+    hfov = math.degrees(2 * math.atan((r - l) / 2 * math.tan(fov / 2)))
+    vfov = math.degrees(2 * math.atan((t - b) / 2 * math.tan(fov / 2)))
+    assert hfov == pytest.approx(report.hfov_inf_deg, abs=1e-9)
+    assert vfov == pytest.approx(report.vfov_inf_deg, abs=1e-9)
+    f = rm["Format"]
+    assert f["pixelaspect"] == report.squeeze
+    assert f["xres"] * f["pixelaspect"] / f["yres"] == pytest.approx((r - l) / (t - b), rel=2e-3)
+
+
+def test_shutter_interval():
+    assert shutter_interval(180.0) == (0.0, 0.5)
+    assert shutter_interval(172.8, "centered") == pytest.approx((-0.24, 0.24))
+    assert shutter_interval(360.0, "end") == (-1.0, 0.0)

@@ -1,0 +1,135 @@
+"""The lens report: film-plane conversions, both models, inversions, camera blocks."""
+
+import json
+import math
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from physcam import InputError, OpticsError, SensorError
+from physcam.onset.report import solve_lens_report
+from physcam.onset.sensors import Sensor, find_sensor
+
+FF = Sensor("ff", "36x24", 36.0, 24.0)
+
+
+def test_practical_marked_distance_is_s_plus_s_prime():
+    r = solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=4.0, focus_mm=3048.0, coc=0.03)
+    # hand: s^2 - D s + D f = 0 -> s = (3048 + sqrt(3048^2 - 4*3048*50)) / 2
+    s = (3048 + math.sqrt(3048**2 - 4 * 3048 * 50)) / 2
+    assert r.object_distance_mm == pytest.approx(s, rel=1e-12)
+    assert r.object_distance_mm + r.image_distance_mm == pytest.approx(3048.0)
+    # near/far from the film = limits from H1 plus H1's distance s' from the film
+    h = 50**2 / (4 * 0.03)
+    near_h1 = h * s / (h + s - 50)
+    assert r.dof.near_from_film_mm == pytest.approx(near_h1 + r.image_distance_mm, rel=1e-12)
+    assert r.coc_convention == "user"
+
+
+def test_technical_model_conversion_and_focus_error():
+    # Datasheet: H1 80 mm and H2 60 mm in front of the flange; PL flange 52 mm.
+    r = solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=2.0, focus_mm=2000.0, model="technical",
+                          h1_mm=80.0, h2_mm=60.0, pupil_mm=95.0, reference_plane="flange",
+                          flange_focal_distance_mm=52.0)
+    s = 2000.0 - (52.0 + 80.0)
+    assert r.object_distance_mm == pytest.approx(s)
+    s_img = s * 50 / (s - 50)
+    assert r.image_distance_mm == pytest.approx(s_img)
+    assert r.focus_error_mm == pytest.approx(52.0 + 60.0 - s_img)
+    assert r.entrance_pupil_from_film_mm == pytest.approx(147.0)
+    assert r.h1_from_film_mm == pytest.approx(132.0)
+
+
+def test_coc_default_and_named():
+    r = solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=4.0, focus_mm=3000.0)
+    assert r.coc_convention == "d/1500"
+    assert r.coc_mm == pytest.approx(math.hypot(36, 24) / 1500)
+    r = solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=4.0, focus_mm=3000.0, coc="cine")
+    assert r.coc_mm == 0.025
+    with pytest.raises(InputError, match="d/1500"):
+        solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=4.0, focus_mm=3000.0, coc="zeis")
+
+
+def test_inverse_effective_fstop_and_tstop_drift():
+    fwd = solve_lens_report(focal_length_mm=35.0, sensor=FF, fstop=5.6, focus_mm=2500.0, coc=0.025)
+    inv = solve_lens_report(focal_length_mm=35.0, sensor=FF, focus_mm=2500.0, coc=0.025,
+                            near_mm=fwd.dof.near_from_film_mm, tstop=4.0)
+    assert inv.fstop == pytest.approx(5.6, rel=1e-9)
+    assert inv.solved["tstop_drift_stops"] == pytest.approx(2 * math.log2(5.6 / 4.0))
+
+
+def test_inverse_coc():
+    fwd = solve_lens_report(focal_length_mm=85.0, sensor=FF, fstop=2.8, focus_mm=4000.0, coc=0.02)
+    inv = solve_lens_report(focal_length_mm=85.0, sensor=FF, fstop=2.8, focus_mm=4000.0,
+                            near_mm=fwd.dof.near_from_film_mm)
+    assert inv.coc_mm == pytest.approx(0.02, rel=1e-9)
+    assert inv.coc_convention == "solved"
+
+
+def test_inverse_focus_from_bracket_and_consistency():
+    fwd = solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=4.0, focus_mm=3000.0, coc=0.03)
+    inv = solve_lens_report(focal_length_mm=50.0, sensor=FF, coc=0.03,
+                            near_mm=fwd.dof.near_from_film_mm, far_mm=fwd.dof.far_from_film_mm)
+    assert inv.focus_from_film_mm == pytest.approx(3000.0, rel=1e-9)
+    assert inv.fstop == pytest.approx(4.0, rel=1e-9)
+    assert inv.solved["consistency"] == pytest.approx(0.0, abs=1e-9)
+    # an inconsistent far limit shows up in the consistency figure
+    bad = solve_lens_report(focal_length_mm=50.0, sensor=FF, coc=0.03, focus_mm=3000.0,
+                            near_mm=fwd.dof.near_from_film_mm, far_mm=fwd.dof.far_from_film_mm * 1.1)
+    assert bad.solved["consistency"] > 0.05
+
+
+def test_focus_from_one_limit_with_fstop():
+    fwd = solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=4.0, focus_mm=3000.0, coc=0.03)
+    inv = solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=4.0, coc=0.03, near_mm=fwd.dof.near_from_film_mm)
+    assert inv.focus_from_film_mm == pytest.approx(3000.0, rel=1e-9)
+
+
+def test_anamorphic_horizontal_fov_and_coc():
+    r = solve_lens_report(focal_length_mm=50.0, sensor=Sensor("a", "a", 22.0, 18.59), fstop=2.8,
+                          focus_mm=3000.0, squeeze=2.0, coc=0.025)
+    assert r.hfov_inf_deg == pytest.approx(math.degrees(2 * math.atan(44.0 / 100.0)))
+    assert r.vfov_inf_deg == pytest.approx(math.degrees(2 * math.atan(18.59 / 100.0)))
+    assert r.dof_horizontal.coc_mm == pytest.approx(0.0125)
+    assert r.dof_horizontal.far_mm - r.dof_horizontal.near_mm < r.dof.far_mm - r.dof.near_mm
+
+
+@pytest.mark.parametrize("kwargs, err", [
+    (dict(focus_mm=30.0, fstop=2.0), OpticsError),
+    (dict(focus_mm=3000.0, fstop=0.0), InputError),
+    (dict(focus_mm=3000.0, fstop=-2.0), InputError),
+    (dict(focus_mm=3000.0, fstop=float("nan")), InputError),
+    (dict(focus_mm=float("inf"), fstop=2.0), InputError),
+    (dict(focus_mm=3000.0, fstop=2.0, coc=0.0), InputError),
+    (dict(focus_mm=3000.0, near_mm=3500.0), InputError),
+    (dict(focus_mm=3000.0, far_mm=2500.0, fstop=2.0, coc=0.03), InputError),
+    (dict(focus_mm=3000.0), InputError),
+    (dict(focus_mm=3000.0, fstop=2.0, model="technical"), InputError),
+])
+def test_bad_input_is_a_clear_error(kwargs, err):
+    with pytest.raises(err):
+        solve_lens_report(focal_length_mm=50.0, sensor=FF, **kwargs)
+
+
+def test_unknown_sensor_suggests():
+    with pytest.raises(SensorError, match="ALEXA 35"):
+        find_sensor("ALEXA 53")
+
+
+def test_json_is_strict_and_versioned():
+    r = solve_lens_report(focal_length_mm=24.0, sensor=FF, fstop=11.0, focus_mm=5000.0, coc=0.03)
+    assert r.dof.far_is_infinite
+    d = json.loads(json.dumps(r.to_dict(), allow_nan=False))
+    assert d["schema"] == "physcam.lens_report" and d["version"] == 1
+    assert d["dof"]["far_mm"] is None and d["dof"]["far_is_infinite"] is True
+
+
+@given(st.floats(12, 200), st.floats(1.4, 22), st.floats(1.2, 80))
+@settings(max_examples=150, deadline=None)
+def test_report_forward_then_inverse(f, N, k):
+    D = 4 * f * k
+    fwd = solve_lens_report(focal_length_mm=f, sensor=FF, fstop=N, focus_mm=D, coc=0.03)
+    assert fwd.dof.near_from_film_mm < D < fwd.dof.far_from_film_mm
+    inv = solve_lens_report(focal_length_mm=f, sensor=FF, focus_mm=D, coc=0.03, near_mm=fwd.dof.near_from_film_mm)
+    assert math.isclose(inv.fstop, N, rel_tol=1e-6)

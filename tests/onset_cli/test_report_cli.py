@@ -1,0 +1,75 @@
+"""The report CLI in-process and as a subprocess: flags, units, errors, JSON, plot, demo."""
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from physcam.cli import main
+from physcam.units import parse_distance
+
+
+@pytest.mark.parametrize("text, mm", [("3m", 3000.0), ("10ft", 3048.0), ("6in", 152.4), ("450mm", 450.0),
+                                      ("450", 450.0), ("2.5 cm", 25.0), ("10'6\"", 3200.4)])
+def test_units(text, mm):
+    assert parse_distance(text) == pytest.approx(mm)
+
+
+def test_report_json(capsys):
+    assert main(["report", "--focal", "50", "--fstop", "4", "--focus", "10ft", "--sensor-width", "36",
+                 "--sensor-height", "24", "--coc", "0.03", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["focus_from_film_mm"] == pytest.approx(3048.0)
+    assert d["coc_mm"] == 0.03
+    assert d["cameras"]["usd_geom_camera"]["focalLength"] == pytest.approx(50.0)
+
+
+def test_report_table_and_plot(tmp_path, capsys):
+    plot = tmp_path / "dof.png"
+    assert main(["report", "--focal", "35", "--fstop", "2.8", "--focus", "3m", "--sensor", "ALEXA 35",
+                 "--plot", str(plot)]) == 0
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "near limit" in capsys.readouterr().out
+    # no clobber without --force
+    assert main(["report", "--focal", "35", "--fstop", "2.8", "--focus", "3m", "--plot", str(plot)]) == 2
+    assert main(["report", "--focal", "35", "--fstop", "2.8", "--focus", "3m", "--plot", str(plot), "--force"]) == 0
+
+
+@pytest.mark.parametrize("argv", [
+    ["report", "--focal", "50", "--fstop", "2", "--focus", "20mm"],
+    ["report", "--focal", "50", "--fstop", "-2", "--focus", "3m"],
+    ["report", "--focal", "50", "--fstop", "nan", "--focus", "3m"],
+    ["report", "--focal", "50", "--fstop", "2", "--focus", "3 parsecs"],
+    ["report", "--focal", "50", "--fstop", "2", "--focus", "3m", "--sensor", "ALEXA 53"],
+    ["report", "--focal", "50", "--focus", "3m", "--near", "4m"],
+    ["report", "--focal", "50", "--fstop", "2", "--focus", "3m", "--model", "technical"],
+])
+def test_bad_input_one_line_exit_2(argv):
+    env = dict(os.environ)
+    p = subprocess.run([sys.executable, "-m", "physcam", *argv], capture_output=True, text=True, env=env)
+    assert p.returncode == 2, p.stderr
+    assert "Traceback" not in p.stderr
+    assert len(p.stderr.strip().splitlines()) == 1
+    assert p.stderr.startswith("physcam: error:")
+
+
+def test_version_and_sensors(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["--version"])
+    assert e.value.code == 0
+    assert capsys.readouterr().out.startswith("physcam ")
+    assert main(["sensors", "--json"]) == 0
+    names = [s["name"] for s in json.loads(capsys.readouterr().out)]
+    assert "ARRI ALEXA 35 4.6K 3:2 Open Gate" in names
+
+
+def test_demo_writes_outputs(tmp_path, capsys):
+    out = tmp_path / "demo"
+    assert main(["demo", "--out", str(out), "--json"]) == 0
+    files = json.loads(capsys.readouterr().out)["files"]
+    assert (out / "report.json").exists() and (out / "dof.png").exists()
+    assert all(os.path.exists(f) for f in files)
+    assert json.loads((out / "report.json").read_text())["schema"] == "physcam.lens_report"
+    assert main(["demo", "--out", str(out)]) == 2  # exists, no --force
