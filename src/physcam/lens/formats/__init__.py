@@ -1,0 +1,99 @@
+"""Lens file formats: read any supported file into a :class:`Prescription`, write one back.
+
+=============  ===========================  ==========================================
+format         extensions                   module
+=============  ===========================  ==========================================
+``physcam``    ``.toml`` (physcam-lens/1)   :mod:`.physcam_toml` (lossless, default)
+``seed-toml``  ``.toml`` (``aperture`` key)  :mod:`.seedtoml` (Blender extension)
+``pbrt``       ``.dat``                     :mod:`.pbrt`
+``iset``       ``.json``                    :mod:`.iset`
+``zemax``      ``.zmx``                     :mod:`.zemax`
+=============  ===========================  ==========================================
+
+Every reader returns a validated prescription or raises
+:class:`~physcam.errors.LensFileError` with the file and line. See docs/lens-formats.md.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ...errors import ExportError, LensFileError
+from ...io import atomic_write
+from ..prescription import Prescription
+from . import iset, pbrt, physcam_toml, seedtoml, zemax
+from ._common import decode, parse_toml, read_text
+
+__all__ = ["FORMATS", "read_lens", "loads_lens", "write_lens", "dumps_lens", "detect_format"]
+
+#: Format name -> module with ``loads(text, path=None, name=None)`` and ``dumps(p)``.
+FORMATS = {"physcam": physcam_toml, "seed-toml": seedtoml, "pbrt": pbrt, "iset": iset, "zemax": zemax}
+_EXT = {".dat": "pbrt", ".json": "iset", ".zmx": "zemax", ".toml": "physcam"}
+
+
+def detect_format(path, text: str | None = None) -> str:
+    """The format of ``path`` from its extension (and, for ``.toml``, its content)."""
+    ext = Path(path).suffix.lower()
+    fmt = _EXT.get(ext)
+    if fmt is None and text is not None:
+        head = text.lstrip()[:2000]
+        if head.startswith("{"):
+            fmt = "iset"
+        elif "SURF " in head and ("UNIT" in head or "VERS" in head):
+            fmt = "zemax"
+        elif "[[surface]]" in text or "[lens]" in text:
+            fmt = "physcam"
+        else:
+            fmt = "pbrt"
+    if fmt is None:
+        raise LensFileError(
+            f"unknown lens file extension {ext or '(none)'!r}; use .toml, .dat, .json or .zmx, or pass format=",
+            str(path),
+        )
+    if fmt == "physcam" and text is not None and 'format = "physcam-lens/' not in text:
+        fmt = "seed-toml"
+    return fmt
+
+
+def _module(fmt: str):
+    try:
+        return FORMATS[fmt]
+    except KeyError:
+        raise LensFileError(f"unknown lens format {fmt!r}; use one of {', '.join(FORMATS)}") from None
+
+
+def loads_lens(text: str, format: str, path=None, name: str | None = None) -> Prescription:
+    """Parse lens text of a named ``format``."""
+    return _module(format).loads(text, path, name)
+
+
+def read_lens(path, format: str | None = None) -> Prescription:
+    """Read a lens file into a validated :class:`Prescription`.
+
+    ``format`` is one of :data:`FORMATS`; by default it comes from the extension
+    (``.toml`` files are told apart by content: physcam's own carry ``format =
+    "physcam-lens/1"``). Raises :class:`LensFileError` (with path and line) for
+    anything that is not a valid lens.
+    """
+    text = read_text(path)
+    fmt = format or detect_format(path, text)
+    return loads_lens(text, fmt, str(path))
+
+
+def dumps_lens(p: Prescription, format: str = "physcam") -> str:
+    """The text of ``p`` in ``format`` (:class:`ExportError` when the format cannot hold it)."""
+    return _module(format).dumps(p)
+
+
+def write_lens(p: Prescription, path, format: str | None = None, force: bool = False) -> Path:
+    """Write ``p`` to ``path`` (atomically; an existing file only with ``force``).
+
+    ``format`` defaults from the extension (``.toml`` -> physcam's own TOML; ask for
+    ``"seed-toml"`` for the Blender extension's). Raises :class:`ExportError` when the
+    format cannot hold the lens (e.g. a cylinder in pbrt) or the file exists.
+    """
+    fmt = format or _EXT.get(Path(path).suffix.lower())
+    if fmt is None:
+        raise ExportError(f"cannot tell the lens format of {path}; use .toml, .dat, .json or .zmx, or pass format=")
+    text = dumps_lens(p, fmt)
+    return atomic_write(path, text, force=force)

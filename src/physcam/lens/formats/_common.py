@@ -1,0 +1,178 @@
+"""Helpers shared by the lens-file readers: safe text loading and checked numbers."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+from ...errors import LensFileError
+from ..prescription import Prescription
+
+#: Files larger than this are refused before parsing (a lens file is a few kB).
+MAX_FILE_BYTES = 10 * 1024 * 1024
+#: More surfaces than this is not a camera lens.
+MAX_SURFACES = 500
+#: Largest length (mm) accepted in a file: 1 km. Guards the geometry from overflow.
+MAX_LENGTH_MM = 1.0e6
+
+
+def read_text(path) -> str:
+    """The file's text (UTF-8, BOM allowed); LensFileError for missing, huge or binary files."""
+    p = Path(path)
+    try:
+        size = p.stat().st_size
+    except OSError as exc:
+        raise LensFileError(f"cannot read lens file: {exc.strerror or exc}", str(p)) from None
+    if not p.is_file():
+        raise LensFileError("not a file", str(p))
+    if size > MAX_FILE_BYTES:
+        raise LensFileError(f"file is {size} bytes; lens files over {MAX_FILE_BYTES} bytes are refused", str(p))
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise LensFileError(f"cannot read lens file: {exc.strerror or exc}", str(p)) from None
+    return decode(data, str(p))
+
+
+def decode(data: bytes, path: str | None) -> str:
+    if len(data) > MAX_FILE_BYTES:
+        raise LensFileError(f"lens files over {MAX_FILE_BYTES} bytes are refused", path)
+    try:
+        if data[:2] in (b"\xff\xfe", b"\xfe\xff"):  # Zemax writes UTF-16 with a BOM
+            text = data.decode("utf-16")
+        else:
+            text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise LensFileError("not a UTF-8 text file (binary data?)", path, line) from None
+    if "\x00" in text:
+        raise LensFileError("contains NUL bytes; not a text lens file", path, text[: text.index("\x00")].count("\n") + 1)
+    return text
+
+
+def number(value, what: str, path, line, *, length: bool = True) -> float:
+    """``value`` as a finite float, else LensFileError naming ``what`` at ``path:line``."""
+    if isinstance(value, bool):
+        raise LensFileError(f"{what} must be a number, got {value!r}", path, line)
+    if isinstance(value, str):
+        try:
+            v = float(value)
+        except ValueError:
+            raise LensFileError(f"{what} must be a number, got {value!r}", path, line) from None
+    elif isinstance(value, (int, float)):
+        try:
+            v = float(value)
+        except OverflowError:
+            raise LensFileError(f"{what} is too large: {value!r}", path, line) from None
+    else:
+        raise LensFileError(f"{what} must be a number, got {type(value).__name__}", path, line)
+    if not math.isfinite(v):
+        raise LensFileError(f"{what} must be a finite number, got {value!r}", path, line)
+    if length and abs(v) > MAX_LENGTH_MM:
+        raise LensFileError(f"{what} {v:g} mm is beyond {MAX_LENGTH_MM:g} mm; check the units", path, line)
+    return v
+
+
+def check_count(n: int, path, line=None) -> None:
+    if n == 0:
+        raise LensFileError("no surfaces found", path, line)
+    if n > MAX_SURFACES:
+        raise LensFileError(f"{n} surfaces; more than {MAX_SURFACES} is refused", path, line)
+
+
+def validated(p: Prescription, path, lines) -> Prescription:
+    """``p.validate(path, lines)``, turning arithmetic overflow into LensFileError."""
+    try:
+        return p.validate(None if path is None else str(path), list(lines))
+    except (ArithmeticError, ValueError) as exc:
+        raise LensFileError(f"lens geometry cannot be evaluated ({exc}); check the numbers", path) from None
+
+
+def fmt(v: float) -> str:
+    """Shortest text that reads back as the same float (``repr``), ints without '.0' noise kept."""
+    return repr(float(v))
+
+
+def extra(p: Prescription, key: str, default=None):
+    """The decoded JSON value stored under ``key`` in ``p.extras``."""
+    for k, v in p.extras:
+        if k == key:
+            return json.loads(v)
+    return default
+
+
+def json_text(value) -> str:
+    """Canonical JSON text for an extras value (stable: compact separators, keys in file order)."""
+    return json.dumps(value, separators=(",", ":"), ensure_ascii=False, allow_nan=False)
+
+
+# ---- TOML (reading: tomllib; writing: by hand so comments and order stay readable) ----
+
+_TOML_LINE = __import__("re").compile(r"at line (\d+)")
+
+
+def parse_toml(text: str, path):
+    """``tomllib.loads`` with errors as LensFileError carrying the line."""
+    import tomllib
+
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        m = _TOML_LINE.search(str(exc))
+        raise LensFileError(f"not valid TOML: {str(exc).split(' (at')[0]}", path, int(m.group(1)) if m else None) from None
+    except (RecursionError, ValueError) as exc:
+        raise LensFileError(f"not valid TOML: {exc}", path) from None
+
+
+def table_lines(text: str, header: str, n: int) -> list[int | None]:
+    """1-based line numbers of the first ``n`` array-of-table headers ``[[header]]``."""
+    import re
+
+    pat = re.compile(r"^\s*\[\[\s*" + re.escape(header).replace(r"\.", r"\s*\.\s*") + r"\s*\]\]")
+    found = [i for i, line in enumerate(text.splitlines(), start=1) if pat.match(line)]
+    return (found + [None] * n)[:n]
+
+
+def toml_value(v) -> str:
+    """TOML text for a str, bool, int, float or list of them."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v, ensure_ascii=False).replace("\x7f", "\\u007f")
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def toml_key(k: str) -> str:
+    import re
+
+    return k if re.fullmatch(r"[A-Za-z0-9_-]+", k) else toml_value(k)
+
+
+def table(d: dict, where: str, path, line=None) -> dict:
+    if not isinstance(d, dict):
+        raise LensFileError(f"{where} must be a table", path, line)
+    return d
+
+
+def unknown_keys(d: dict, allowed, where: str, path, line=None) -> None:
+    extra_keys = [k for k in d if k not in allowed]
+    if extra_keys:
+        raise LensFileError(
+            f"{where}: unknown key {extra_keys[0]!r}; allowed keys are {', '.join(allowed)}", path, line
+        )
+
+
+def text_field(d: dict, key: str, where: str, path, line=None) -> str | None:
+    v = d.get(key)
+    if v is None:
+        return None
+    if not isinstance(v, str):
+        raise LensFileError(f"{where}.{key} must be a string, got {v!r}", path, line)
+    return v

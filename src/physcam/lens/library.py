@@ -1,0 +1,143 @@
+"""The bundled lens library: published prescriptions shipped in ``physcam/data/lenses``.
+
+Each bundled lens is a physcam lens TOML converted from the project's reference files
+by ``scripts/build_lens_library.py``, with its provenance (original file and format,
+source, and any correction made, with the reason) in the ``[provenance]`` table.
+
+>>> from physcam.lens.library import list_lenses, load_lens
+>>> lens = load_lens("dgauss.50mm")            # slug, name, alias or a file path
+>>> [r.slug for r in list_lenses()][:2]        # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+
+from ..errors import InputError
+from .prescription import Prescription
+
+__all__ = ["LensRecord", "list_lenses", "load_lens", "find_lens", "library_dir"]
+
+_FILE_SUFFIXES = (".toml", ".dat", ".json", ".zmx")
+
+
+@dataclass(frozen=True, slots=True)
+class LensRecord:
+    """What ``physcam lenses`` lists about one bundled lens (lengths in mm)."""
+
+    slug: str  # file stem in the library, the canonical short name
+    name: str
+    maker: str | None
+    focal_length: float | None  # nominal (engraved), mm
+    max_fstop: float | None
+    squeeze: float
+    anamorphic: bool
+    surfaces: int
+    has_focus_groups: bool
+    original_format: str | None  # pbrt, iset, seed-toml, ...
+    original_file: str | None
+    source: str | None
+    corrected: bool  # the bundled copy differs from the original file (see notes)
+    aliases: tuple[str, ...]
+    path: str
+
+    def to_dict(self) -> dict:
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in
+                ((f, getattr(self, f)) for f in self.__dataclass_fields__)}
+
+
+def library_dir() -> Path:
+    """Folder of the bundled lens TOML files."""
+    return Path(str(resources.files("physcam") / "data" / "lenses"))
+
+
+def _key(s: str) -> str:
+    """Loose match key: lower case, runs of non-alphanumerics as one '_'."""
+    return re.sub(r"[^a-z0-9]+", "_", s.lower()).strip("_")
+
+
+@lru_cache(maxsize=1)
+def _index() -> tuple[tuple[LensRecord, Prescription], ...]:
+    from .formats import read_lens
+    from .formats._common import extra
+
+    out = []
+    for path in sorted(library_dir().glob("*.toml")):
+        p = read_lens(path, "physcam")
+        m = p.metadata
+        corrections = extra(p, "provenance.corrections", [])
+        rec = LensRecord(
+            slug=path.stem,
+            name=m.name,
+            maker=m.maker,
+            focal_length=m.focal_length,
+            max_fstop=m.max_fstop,
+            squeeze=p.squeeze,
+            anamorphic=p.is_anamorphic,
+            surfaces=len(p.surfaces),
+            has_focus_groups=p.focus is not None,
+            original_format=extra(p, "provenance.original_format"),
+            original_file=extra(p, "provenance.original_file"),
+            source=m.source,
+            corrected=bool(corrections),
+            aliases=tuple(extra(p, "provenance.aliases", [])),
+            path=str(path),
+        )
+        out.append((rec, p))
+    return tuple(out)
+
+
+def list_lenses() -> list[LensRecord]:
+    """Records of every bundled lens, sorted by slug."""
+    return [rec for rec, _ in _index()]
+
+
+def find_lens(name: str) -> LensRecord:
+    """The bundled lens whose slug, name or alias matches ``name`` (case and punctuation ignored).
+
+    Raises :class:`InputError` naming the closest bundled lenses when nothing matches.
+    """
+    key = _key(str(name))
+    table: dict[str, LensRecord] = {}
+    for rec, _ in _index():
+        for label in (rec.slug, rec.name, *rec.aliases):
+            table.setdefault(_key(label), rec)
+    if key in table:
+        return table[key]
+    close = difflib.get_close_matches(key, list(table), n=3, cutoff=0.5)
+    names = []
+    for c in close:
+        if table[c].slug not in names:
+            names.append(table[c].slug)
+    hint = f"; did you mean {', '.join(names)}?" if names else ""
+    raise InputError(f"no bundled lens called {name!r}{hint} (`physcam lenses` lists them; a file path also works)")
+
+
+def load_lens(name_or_path) -> Prescription:
+    """A bundled lens by slug/name/alias, or any lens file by path (format from its extension).
+
+    A string with a path separator or a lens-file extension that names an existing file
+    is read as a file; otherwise it is looked up in the library.
+    """
+    s = str(name_or_path)
+    p = Path(s)
+    looks_like_path = isinstance(name_or_path, Path) or "/" in s or "\\" in s or p.suffix.lower() in _FILE_SUFFIXES
+    if p.is_file() and looks_like_path:
+        from .formats import read_lens
+
+        return read_lens(p)
+    try:
+        rec = find_lens(s)
+    except InputError:
+        if looks_like_path and p.suffix.lower() in _FILE_SUFFIXES:
+            raise InputError(f"{s}: no such lens file, and no bundled lens of that name") from None
+        raise
+    for r, lens in _index():
+        if r.slug == rec.slug:
+            return lens
+    raise AssertionError("unreachable")  # pragma: no cover
