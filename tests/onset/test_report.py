@@ -133,3 +133,17 @@ def test_report_forward_then_inverse(f, N, k):
     assert fwd.dof.near_from_film_mm < D < fwd.dof.far_from_film_mm
     inv = solve_lens_report(focal_length_mm=f, sensor=FF, focus_mm=D, coc=0.03, near_mm=fwd.dof.near_from_film_mm)
     assert math.isclose(inv.fstop, N, rel_tol=1e-6)
+
+
+def test_report_from_a_lens_prescription():
+    # dgauss.50mm: EFL 50.3582 mm (three independent optics programs, issue 3); unit focusing
+    # keeps the EFL; focused by the lens itself, the technical model's focus error vanishes.
+    from physcam.lens.library import load_lens
+
+    lens = load_lens("dgauss.50mm")
+    r = solve_lens_report(focal_length_mm=None, sensor=FF, fstop=2.8, focus_mm=2000.0, lens=lens)
+    assert r.model == "technical" and r.lens_name == lens.name
+    assert r.focal_length_mm == pytest.approx(50.3582, abs=1e-3)
+    assert r.focus_error_mm == pytest.approx(0.0, abs=1e-6)
+    assert r.object_distance_mm + r.h1_from_film_mm == pytest.approx(2000.0)
+    assert r.entrance_pupil_source == "prescription"

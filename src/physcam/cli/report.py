@@ -14,6 +14,7 @@ examples:
   physcam report --focal 35 --focus 10ft --near 8ft --coc 0.025 --tstop 2.8   (solve f-stop)
   physcam report --focal 50 --near 2.5m --far 4m --fstop 4 --sensor S35         (solve focus)
   physcam report --model technical --focal 50 --fstop 2 --focus 2m --h1 80 --h2 60 --pupil 95
+  physcam report --lens dgauss.50mm --fstop 2.8 --focus 2m                     (planes from the lens)
 """
 
 
@@ -37,6 +38,8 @@ def register(sub) -> None:
 
 def add_report_arguments(p) -> None:
     g = p.add_argument_group("lens and sensor")
+    g.add_argument("--lens", metavar="NAME_OR_FILE",
+                   help="a real lens (bundled name or prescription file): fills the technical model from it")
     g.add_argument("--focal", type=distance("focal length"), help="focal length (mm)")
     g.add_argument("--fstop", type=number("f-stop"), help="f-stop (geometric f-number); solved if omitted")
     g.add_argument("--tstop", type=number("T-stop"), help="marked T-stop, compared with the effective f-stop")
@@ -94,8 +97,15 @@ def solve_from_args(args):
     from ..errors import InputError
     from ..onset.report import solve_lens_report
 
-    if args.focal is None:
-        raise InputError("give the focal length, e.g. --focal 50")
+    lens = None
+    if getattr(args, "lens", None):
+        from ..lens.library import load_lens
+
+        lens = load_lens(args.lens)
+        if args.focal is not None:
+            raise InputError("give either --lens or --focal: the lens sets its own focal length")
+    elif args.focal is None:
+        raise InputError("give the focal length, e.g. --focal 50, or a lens with --lens NAME")
     coc = args.coc
     if coc is not None:
         try:
@@ -121,6 +131,7 @@ def solve_from_args(args):
         sensor_front_mm=args.sensor_front,
         lens_length_mm=args.lens_length,
         pupil_fraction=args.pupil_fraction,
+        lens=lens,
     )
 
 

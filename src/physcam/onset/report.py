@@ -223,6 +223,7 @@ def solve_lens_report(
     lens_length_mm: float | None = None,
     pupil_fraction: float = 0.4,
     lens_name: str | None = None,
+    lens=None,
 ) -> LensReport:
     """Solve the lens report.
 
@@ -235,8 +236,35 @@ def solve_lens_report(
     (when ``focus_mm`` is missing), then the effective f-stop (when ``fstop`` is missing,
     or when both fstop and an explicit ``coc`` are given) or else the CoC. Without
     measured limits it is a forward report and ``fstop`` is required.
+
+    ``lens`` (a :class:`~physcam.lens.prescription.Prescription`) fills the technical
+    model from the lens itself: its Gaussian engine, focused at ``focus_mm`` (unit or
+    internal focusing), gives the effective focal length, H1, H2 and the entrance pupil
+    in front of the film, so no datasheet is needed; ``focal_length_mm`` may then be None
+    and ``fstop`` defaults to the lens's maximum aperture.
     """
     notes: list[str] = []
+    pupil_origin = "datasheet"
+    if lens is not None:
+        pupil_origin = "prescription"
+        from ..optics.focusing import technical_planes
+
+        if focus_mm is None:
+            raise InputError("with a lens prescription, give the focus mark (--focus)")
+        if fstop is None and near_mm is None and far_mm is None:
+            fstop = lens.metadata.max_fstop
+        planes = technical_planes(lens, require_positive("focus distance", focus_mm), fstop=fstop)
+        focal_length_mm = planes.efl_mm
+        model, reference_plane = "technical", "film"
+        h1_mm, h2_mm, pupil_mm = planes.h1_from_film_mm, planes.h2_from_film_mm, planes.entrance_pupil_from_film_mm
+        squeeze = squeeze if squeeze != 1.0 else lens.squeeze
+        lens_name = lens_name or lens.name
+        notes.append(
+            f"planes from the prescription focused at the mark ({planes.method} focusing): EFL {planes.efl_mm:.3f} mm, "
+            f"back focus {planes.back_focus_mm:.3f} mm"
+        )
+    if focal_length_mm is None:
+        raise InputError("give the focal length (--focal) or a lens (--lens)")
     f = require_positive("focal length", focal_length_mm)
     sq = require_positive("anamorphic squeeze", squeeze, unit="")
     if model not in ("practical", "technical"):
@@ -406,7 +434,7 @@ def solve_lens_report(
     # --- entrance pupil -----------------------------------------------------------
     pupil, pupil_src = None, "unknown"
     if model == "technical" and pupil_mm is not None:
-        pupil, pupil_src = ref + require_finite("entrance pupil offset", pupil_mm), "datasheet"
+        pupil, pupil_src = ref + require_finite("entrance pupil offset", pupil_mm), pupil_origin
     elif sensor_front_mm is not None and lens_length_mm is not None:
         pupil = entrance_pupil_practical(sensor_front_mm, lens_length_mm, pupil_fraction)
         pupil_src = f"estimate: {pupil_fraction:g} of the lens length behind its front"
