@@ -1,0 +1,458 @@
+"""Write a PhysicalCamera and its companion UsdGeomCamera.
+
+A camera physcam writes is a ``PhysicalCamera`` prim (the body, with one
+``PhysicalCameraSensorAPI:main`` and one ``PhysicalCameraLensAPI:main``), a lens
+model prim it points at (``<camera>/Pinhole`` or ``<camera>/Orthographic``), and a
+child ``UsdGeomCamera`` named ``Camera`` that every Hydra delegate and renderer can
+use. The two are written from the same numbers:
+
+* physical values in **millimetres** (hardware does not change with the scene);
+* ``UsdGeomCamera`` values in the stage's units through
+  :func:`physcam.export.usdgeom.usdgeom_camera_values`: focal length and apertures
+  in tenths of a scene unit, focus and clipping distances in scene units
+  (``metersPerUnit``; docs/conventions.md);
+* ``exposure:*``, ``shutter:open/close`` (in time codes, from the stage's
+  ``timeCodesPerSecond``) and RenderMan's ``ri:aperture*``, ``ri:shutterOpenTime``,
+  ``ri:shutterCloseTime``, ``ri:shutteropening`` (hdPrman's camera tokens; seed 002).
+
+Transform: the body's origin is the centre of the film plane. Its ops are
+``translate`` (where the entrance pupil is), ``rotateXYZ`` (pan/tilt/roll about
+the pupil) and ``translate:pupilToFilm`` (0, 0, +p), so rotations pivot about the
+no-parallax point. The companion camera's eye sits back on the pupil, and its
+``focusDistance`` is measured from there to the plane of sharp focus, so that plane
+lands where the focus mark says (for a thin lens this is the Gaussian object
+distance s).
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+from dataclasses import dataclass
+
+from ..errors import ExportError, InputError, require_finite, require_positive
+from .plugin import ensure_registered
+
+__all__ = [
+    "CameraSpec",
+    "DEFAULT_CAMERA_PATH",
+    "LENS_INSTANCE",
+    "SENSOR_INSTANCE",
+    "author_camera",
+    "author_from_report",
+    "spec_from_report",
+    "new_stage",
+    "save_stage",
+    "write_camera",
+    "report_for_spec",
+    "shutter_opening_curve",
+]
+
+DEFAULT_CAMERA_PATH = "/Cameras/Camera"
+SENSOR_INSTANCE = "main"
+LENS_INSTANCE = "main"
+RENDER_CAMERA_NAME = "Camera"
+
+
+@dataclass(frozen=True)
+class CameraSpec:
+    """A physical camera as plain numbers (mm, seconds, degrees), what the schema stores.
+
+    ``focus_mm`` is measured in front of the film plane (the on-set mark).
+    ``entrance_pupil_mm``: the pupil in front of the film plane; ``None`` uses the thin
+    lens (the pupil on the principal plane, s' in front of the film).
+    ``clipping_mm``: near/far clipping from the eye, in mm (written in scene units).
+    ``projection``: "perspective" (a pinhole/thin-lens model) or "orthographic"
+    (a telecentric model imaging ``sensor / magnification`` of the scene).
+    """
+
+    focal_length_mm: float = 50.0
+    sensor_width_mm: float = 36.0
+    sensor_height_mm: float = 24.0
+    fstop: float = 8.0
+    focus_mm: float = 3000.0
+    coc_mm: float = 0.03
+    squeeze: float = 1.0
+    entrance_pupil_mm: float | None = None
+    shift_mm: tuple[float, float] = (0.0, 0.0)
+    iso: float = 100.0
+    transmittance: float = 1.0
+    flange_distance_mm: float = 52.0
+    aperture_distance_mm: float | None = None
+    shutter_open_s: float = 0.0
+    shutter_duration_s: float = 1.0 / 48.0
+    shutter_opening: tuple[float, float] = (0.0, 1.0)
+    aperture_blades: int = 7
+    aperture_angle_deg: float = 0.0
+    aperture_roundness: float = 0.0
+    aperture_density: float = 0.0
+    clipping_mm: tuple[float, float] = (100.0, 1.0e7)
+    projection: str = "perspective"
+    magnification: float = 1.0
+    lens_name: str | None = None
+    sensor_name: str | None = None
+
+    def checked(self) -> "CameraSpec":
+        """Return self after range checks; raise :class:`InputError` saying what to change."""
+        for name in ("focal_length_mm", "sensor_width_mm", "sensor_height_mm", "fstop", "focus_mm", "coc_mm",
+                     "squeeze", "iso", "flange_distance_mm", "shutter_duration_s", "magnification"):
+            require_positive(name, getattr(self, name), unit="")
+        require_finite("shutter_open_s", self.shutter_open_s)
+        for name in ("aperture_angle_deg", "aperture_roundness", "aperture_density", "transmittance"):
+            require_finite(name, getattr(self, name))
+        if not 0.0 < self.transmittance <= 1.0:
+            raise InputError(f"transmittance must be in (0, 1], got {self.transmittance:g}")
+        for name in ("aperture_roundness", "aperture_density"):
+            if not -1.0 <= getattr(self, name) <= 1.0:
+                raise InputError(f"{name} must be between -1 and 1 (RenderMan's range), got {getattr(self, name):g}")
+        o, c = (require_finite("shutter opening time", self.shutter_opening[0]),
+                require_finite("shutter closing time", self.shutter_opening[1]))
+        if not 0.0 <= o <= c <= 1.0:
+            raise InputError(f"shutter opening (opentime, closetime) needs 0 <= open <= close <= 1, got ({o:g}, {c:g})")
+        if isinstance(self.aperture_blades, bool) or int(self.aperture_blades) != self.aperture_blades \
+                or self.aperture_blades < 0:
+            raise InputError(f"aperture blades must be a whole number >= 0, got {self.aperture_blades!r}")
+        near, far = (require_positive("near clipping distance", self.clipping_mm[0]),
+                     require_positive("far clipping distance", self.clipping_mm[1]))
+        if not far > near:
+            raise InputError(f"far clipping distance {far:g} mm must be beyond the near one {near:g} mm")
+        for v in self.shift_mm:
+            require_finite("sensor shift", v)
+        if self.entrance_pupil_mm is not None:
+            require_finite("entrance pupil distance", self.entrance_pupil_mm)
+        if self.aperture_distance_mm is not None:
+            require_finite("aperture distance", self.aperture_distance_mm)
+        if self.projection not in ("perspective", "orthographic"):
+            raise InputError(f"projection must be perspective or orthographic, got {self.projection!r}")
+        return self
+
+
+def report_for_spec(spec: CameraSpec):
+    """The on-set :class:`~physcam.onset.report.LensReport` (practical thin-lens model) of ``spec``."""
+    from ..onset.report import solve_lens_report
+    from ..onset.sensors import Sensor
+
+    sensor = Sensor(
+        key=spec.sensor_name or "custom",
+        name=spec.sensor_name or f"{spec.sensor_width_mm:g} x {spec.sensor_height_mm:g} mm",
+        width_mm=spec.sensor_width_mm,
+        height_mm=spec.sensor_height_mm,
+    )
+    return solve_lens_report(
+        focal_length_mm=spec.focal_length_mm,
+        sensor=sensor,
+        fstop=spec.fstop,
+        focus_mm=spec.focus_mm,
+        coc=spec.coc_mm,
+        squeeze=spec.squeeze,
+        lens_name=spec.lens_name,
+    )
+
+
+def spec_from_report(report, **body) -> CameraSpec:
+    """A :class:`CameraSpec` from a lens report plus body/shutter/aperture keywords of CameraSpec."""
+    s = report.sensor
+    return CameraSpec(
+        focal_length_mm=report.focal_length_mm,
+        sensor_width_mm=s.width_mm,
+        sensor_height_mm=s.height_mm,
+        fstop=report.fstop,
+        focus_mm=report.focus_from_film_mm,
+        coc_mm=report.coc_mm,
+        squeeze=report.squeeze,
+        entrance_pupil_mm=report.entrance_pupil_from_film_mm,
+        flange_distance_mm=body.pop("flange_distance_mm", report.flange_focal_distance_mm or 52.0),
+        lens_name=report.lens_name,
+        sensor_name=s.name,
+        **body,
+    ).checked()
+
+
+def shutter_opening_curve(opentime: float, closetime: float) -> list[float]:
+    """RenderMan's ``shutteropening`` control points [c1 c2 d1 d2 e1 e2 f1 f2] for seed 002's linear ramps.
+
+    Seed 002: the shutter opens linearly from 0 to ``opentime`` (fractions of the
+    exposure), is fully open until ``closetime`` and closes linearly until 1. The two
+    interior points of each ramp are placed at its thirds, so the curve is exactly
+    those straight ramps.
+    """
+    o, c = float(opentime), float(closetime)
+    return [o / 3.0, 1.0 / 3.0, 2.0 * o / 3.0, 2.0 / 3.0,
+            c + (1.0 - c) / 3.0, 2.0 / 3.0, c + 2.0 * (1.0 - c) / 3.0, 1.0 / 3.0]
+
+
+def new_stage(meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y"):
+    """An in-memory stage with physcam's metadata: metersPerUnit, upAxis, time codes per second."""
+    ensure_registered()
+    from pxr import Usd, UsdGeom
+
+    mpu = require_positive("metersPerUnit", meters_per_unit, unit="")
+    rate = require_positive("frames per second", fps, unit="")
+    if up_axis not in ("Y", "Z"):
+        raise InputError(f"up axis must be Y or Z, got {up_axis!r}")
+    stage = Usd.Stage.CreateInMemory()
+    UsdGeom.SetStageMetersPerUnit(stage, mpu)
+    UsdGeom.SetStageUpAxis(stage, up_axis)
+    stage.SetTimeCodesPerSecond(rate)
+    stage.SetFramesPerSecond(rate)
+    return stage
+
+
+def _eye_from_film(spec: CameraSpec, report) -> float:
+    if spec.entrance_pupil_mm is not None:
+        return spec.entrance_pupil_mm
+    if report is not None and report.entrance_pupil_from_film_mm is not None:
+        return report.entrance_pupil_from_film_mm
+    return 0.0
+
+
+def _f32(x: float) -> float:
+    return struct.unpack("f", struct.pack("f", x))[0]
+
+
+def _f32_neighbours(x: float, k: int):
+    """``x`` rounded to float32 and the ``k`` float32 values on either side of it."""
+    bits = struct.unpack("i", struct.pack("f", _f32(x)))[0]
+    return [struct.unpack("f", struct.pack("i", bits + d))[0] for d in range(-k, k + 1)]
+
+
+def fov_preserving_float32(focal: float, width: float, height: float, k: int = 24) -> tuple[float, float, float]:
+    """Float32 values of (focal length, horizontal, vertical aperture) that keep the two ratios.
+
+    UsdGeomCamera stores these as 32-bit floats; rounding each on its own moves the field
+    of view by up to ~3e-6 degrees. The field of view depends only on aperture / focal
+    length, so this picks, within ``k`` float32 steps of the focal length, the value
+    whose best-rounded apertures give ratios closest to the exact ones (each value stays
+    within a few ulps, ~1e-6 relative, of its exact value).
+    """
+    rw, rh = width / focal, height / focal
+    best = None
+    for fc in _f32_neighbours(focal, k):
+        cw = min(_f32_neighbours(rw * fc, 1), key=lambda w: abs(w / fc - rw))
+        ch = min(_f32_neighbours(rh * fc, 1), key=lambda h: abs(h / fc - rh))
+        err = max(abs(cw / fc - rw) / rw, abs(ch / fc - rh) / rh)
+        if best is None or err < best[0]:
+            best = (err, fc, cw, ch)
+    return best[1], best[2], best[3]
+
+
+def _set(prim, name, type_name, value, custom=False):
+    attr = prim.GetAttribute(name)
+    if not attr:
+        attr = prim.CreateAttribute(name, type_name, custom)
+    attr.Set(value)
+    return attr
+
+
+def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0),
+                  rotate_xyz_deg=(0.0, 0.0, 0.0), report=None):
+    """Author ``spec`` at ``path`` on ``stage`` (its current edit target); return the PhysicalCamera prim.
+
+    ``position``: where the entrance pupil is, in scene units in the parent's space;
+    ``rotate_xyz_deg``: rotation about the pupil (degrees, XYZ order).
+    ``report``: the lens report of ``spec`` when the caller has one (else it is solved).
+    Works inside a variant edit context, so kits and lens libraries reuse it.
+    """
+    ensure_registered()
+    from pxr import Gf, Sdf, UsdGeom
+
+    from ..export.usdgeom import mm_to_scene_units
+
+    spec = spec.checked()
+    try:
+        sdf_path = Sdf.Path(path)
+    except Exception:  # pxr raises Tf errors of several kinds for bad paths
+        sdf_path = Sdf.Path()
+    if sdf_path.isEmpty or not sdf_path.IsAbsolutePath() or not sdf_path.IsPrimPath():
+        raise ExportError(f"camera path {path!r} is not an absolute prim path such as /Cameras/Hero")
+    existing = stage.GetPrimAtPath(sdf_path)
+    if existing and existing.GetTypeName() not in ("", "PhysicalCamera"):
+        raise ExportError(
+            f"prim {sdf_path} is a {existing.GetTypeName()}, not a PhysicalCamera; choose another camera path"
+        )
+    mpu = UsdGeom.GetStageMetersPerUnit(stage)
+    su = lambda mm: mm_to_scene_units(mm, mpu)  # noqa: E731
+    if report is None and spec.projection == "perspective":
+        report = report_for_spec(spec)
+    eye = _eye_from_film(spec, report)
+
+    for parent in reversed(sdf_path.GetParentPath().GetPrefixes()):
+        if not stage.GetPrimAtPath(parent):
+            UsdGeom.Xform.Define(stage, parent)
+    cam = stage.DefinePrim(sdf_path, "PhysicalCamera")
+    if not stage.GetDefaultPrim():
+        stage.SetDefaultPrim(stage.GetPrimAtPath(sdf_path.GetPrefixes()[0]))
+    cam.ApplyAPI("PhysicalCameraSensorAPI", SENSOR_INSTANCE)
+    cam.ApplyAPI("PhysicalCameraLensAPI", LENS_INSTANCE)
+
+    # --- body -------------------------------------------------------------------
+    _set(cam, "flangeDistance", Sdf.ValueTypeNames.Float, spec.flange_distance_mm)
+    _set(cam, "shutterOpen", Sdf.ValueTypeNames.Float, spec.shutter_open_s)
+    _set(cam, "shutterDuration", Sdf.ValueTypeNames.Float, spec.shutter_duration_s)
+    _set(cam, "shutterOpening", Sdf.ValueTypeNames.Float2, Gf.Vec2f(*spec.shutter_opening))
+    _set(cam, "iris", Sdf.ValueTypeNames.Float, spec.focal_length_mm / spec.fstop)
+    xf = UsdGeom.Xformable(cam)
+    xf.ClearXformOpOrder()
+    xf.AddTranslateOp().Set(Gf.Vec3d(*map(float, position)))
+    xf.AddRotateXYZOp().Set(Gf.Vec3f(*map(float, rotate_xyz_deg)))
+    xf.AddTranslateOp(opSuffix="pupilToFilm").Set(Gf.Vec3d(0.0, 0.0, su(eye)))
+
+    # --- sensor -----------------------------------------------------------------
+    sp = f"sensor:{SENSOR_INSTANCE}:"
+    _set(cam, sp + "aperture", Sdf.ValueTypeNames.Float2, Gf.Vec2f(spec.sensor_width_mm, spec.sensor_height_mm))
+    _set(cam, sp + "shift", Sdf.ValueTypeNames.Float2, Gf.Vec2f(*spec.shift_mm))
+    _set(cam, sp + "circleOfConfusion", Sdf.ValueTypeNames.Float, spec.coc_mm)
+    _set(cam, sp + "iso", Sdf.ValueTypeNames.Float, spec.iso)
+    if spec.sensor_name:
+        cam.SetCustomDataByKey("physcam:sensorName", spec.sensor_name)
+
+    # --- lens and its model ------------------------------------------------------
+    lp = f"lens:{LENS_INSTANCE}:"
+    _set(cam, lp + "fStop", Sdf.ValueTypeNames.Float, spec.fstop)
+    _set(cam, lp + "iris", Sdf.ValueTypeNames.Float, spec.focal_length_mm / spec.fstop)
+    _set(cam, lp + "entrancePupilDistance", Sdf.ValueTypeNames.Float, eye)
+    _set(cam, lp + "apertureDistance", Sdf.ValueTypeNames.Float,
+         eye if spec.aperture_distance_mm is None else spec.aperture_distance_mm)
+    _set(cam, lp + "shutterBlades", Sdf.ValueTypeNames.UInt, int(spec.aperture_blades))
+    _set(cam, lp + "apertureAngle", Sdf.ValueTypeNames.Float, spec.aperture_angle_deg)
+    _set(cam, lp + "apertureRoundness", Sdf.ValueTypeNames.Float, spec.aperture_roundness)
+    _set(cam, lp + "apertureDensity", Sdf.ValueTypeNames.Float, spec.aperture_density)
+    _set(cam, lp + "clippingRange", Sdf.ValueTypeNames.Float2,
+         Gf.Vec2f(su(spec.clipping_mm[0]), su(spec.clipping_mm[1])))
+    if spec.projection == "perspective":
+        model = stage.DefinePrim(sdf_path.AppendChild("Pinhole"), "PhysicalCameraLensModelPinhole")
+        _set(model, "focalLength", Sdf.ValueTypeNames.Float, spec.focal_length_mm)
+    else:
+        model = stage.DefinePrim(sdf_path.AppendChild("Orthographic"), "PhysicalCameraLensModelOrthographic")
+        _set(model, "magnification", Sdf.ValueTypeNames.Float, spec.magnification)
+        # the focal length still drives depth of field; kept on the lens model's custom data
+        model.SetCustomDataByKey("physcam:focalLength", float(spec.focal_length_mm))
+    _set(model, "focusDistance", Sdf.ValueTypeNames.Float, spec.focus_mm)
+    _set(model, "squeeze", Sdf.ValueTypeNames.Float, spec.squeeze)
+    _set(model, "transmittance", Sdf.ValueTypeNames.Float, spec.transmittance)
+    if spec.lens_name:
+        model.SetCustomDataByKey("physcam:lensName", spec.lens_name)
+    cam.GetRelationship(lp + "lensModel") or cam.CreateRelationship(lp + "lensModel", False)
+    cam.GetRelationship(lp + "lensModel").SetTargets([model.GetPath()])
+
+    # --- the companion UsdGeomCamera -------------------------------------------
+    author_render_camera(stage, sdf_path, spec, report=report)
+    return cam
+
+
+def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None):
+    """Write ``<cam_path>/Camera``, the UsdGeomCamera that matches ``spec`` in the stage's units."""
+    from pxr import Gf, Sdf, UsdGeom
+
+    from ..export.usdgeom import mm_to_scene_units, mm_to_tenths_of_scene_unit, usdgeom_camera_values
+
+    mpu = UsdGeom.GetStageMetersPerUnit(stage)
+    su = lambda mm: mm_to_scene_units(mm, mpu)  # noqa: E731
+    tenths = lambda mm: mm_to_tenths_of_scene_unit(mm, mpu)  # noqa: E731
+    tcps = stage.GetTimeCodesPerSecond()
+    if spec.projection == "perspective":
+        if report is None:
+            report = report_for_spec(spec)
+        values = usdgeom_camera_values(report, mpu, clipping_range_mm=spec.clipping_mm, shift_mm=spec.shift_mm)
+        eye = _eye_from_film(spec, report)
+        # from the eye (entrance pupil) to the plane of sharp focus, so that plane lands on the mark
+        values["focusDistance"] = su(spec.focus_mm - eye)
+    else:
+        eye = _eye_from_film(spec, None)
+        m, sq = spec.magnification, spec.squeeze
+        values = {
+            "projection": "orthographic",
+            "focalLength": tenths(spec.focal_length_mm),
+            "horizontalAperture": tenths(spec.sensor_width_mm * sq / m),
+            "verticalAperture": tenths(spec.sensor_height_mm / m),
+            "horizontalApertureOffset": tenths(spec.shift_mm[0] * sq / m),
+            "verticalApertureOffset": tenths(spec.shift_mm[1] / m),
+            "focusDistance": su(spec.focus_mm - eye),
+            "fStop": spec.fstop,
+            "clippingRange": (su(spec.clipping_mm[0]), su(spec.clipping_mm[1])),
+        }
+    if spec.projection == "perspective":
+        values["focalLength"], values["horizontalAperture"], values["verticalAperture"] = fov_preserving_float32(
+            values["focalLength"], values["horizontalAperture"], values["verticalAperture"])
+    values["shutter:open"] = spec.shutter_open_s * tcps
+    values["shutter:close"] = (spec.shutter_open_s + spec.shutter_duration_s) * tcps
+    for k, v in values.items():
+        if isinstance(v, float) and not math.isfinite(v):
+            raise ExportError(f"{cam_path}/{RENDER_CAMERA_NAME}: {k} came out {v}; check the camera's numbers")
+
+    geom = UsdGeom.Camera.Define(stage, Sdf.Path(str(cam_path)).AppendChild(RENDER_CAMERA_NAME))
+    geom.CreateProjectionAttr(values["projection"])
+    geom.CreateFocalLengthAttr(values["focalLength"])
+    geom.CreateHorizontalApertureAttr(values["horizontalAperture"])
+    geom.CreateVerticalApertureAttr(values["verticalAperture"])
+    geom.CreateHorizontalApertureOffsetAttr(values["horizontalApertureOffset"])
+    geom.CreateVerticalApertureOffsetAttr(values["verticalApertureOffset"])
+    geom.CreateFocusDistanceAttr(values["focusDistance"])
+    geom.CreateFStopAttr(values["fStop"])
+    geom.CreateClippingRangeAttr(Gf.Vec2f(*values["clippingRange"]))
+    geom.CreateShutterOpenAttr(values["shutter:open"])
+    geom.CreateShutterCloseAttr(values["shutter:close"])
+    geom.CreateExposureTimeAttr(spec.shutter_duration_s)
+    geom.CreateExposureFStopAttr(spec.fstop / math.sqrt(spec.transmittance))  # photometric: the T-stop
+    geom.CreateExposureIsoAttr(spec.iso)
+    prim = geom.GetPrim()
+    _set(prim, "ri:apertureNSides", Sdf.ValueTypeNames.Int, int(spec.aperture_blades), custom=True)
+    _set(prim, "ri:apertureAngle", Sdf.ValueTypeNames.Float, spec.aperture_angle_deg, custom=True)
+    _set(prim, "ri:apertureRoundness", Sdf.ValueTypeNames.Float, spec.aperture_roundness, custom=True)
+    _set(prim, "ri:apertureDensity", Sdf.ValueTypeNames.Float, spec.aperture_density, custom=True)
+    _set(prim, "ri:shutterOpenTime", Sdf.ValueTypeNames.Float, spec.shutter_opening[0], custom=True)
+    _set(prim, "ri:shutterCloseTime", Sdf.ValueTypeNames.Float, spec.shutter_opening[1], custom=True)
+    _set(prim, "ri:shutteropening", Sdf.ValueTypeNames.FloatArray,
+         shutter_opening_curve(*spec.shutter_opening), custom=True)
+    xf = UsdGeom.Xformable(prim)
+    xf.ClearXformOpOrder()
+    xf.AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, -su(eye)))
+    return geom
+
+
+def author_from_report(stage, path: str, report, *, position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0),
+                       **body):
+    """Author the camera of a :class:`~physcam.onset.report.LensReport` (see :func:`author_camera`)."""
+    return author_camera(stage, path, spec_from_report(report, **body), position=position,
+                         rotate_xyz_deg=rotate_xyz_deg, report=report)
+
+
+def save_stage(stage, file, *, force: bool = False):
+    """Validate ``stage`` (usd-core's validators), then write its root layer to ``file`` atomically.
+
+    The layer is exported to text in memory and written with :func:`physcam.io.atomic_write`
+    (temporary file in the same folder, then rename); an existing file is kept unless
+    ``force``. Returns the Path. ``.usda`` writes text; ``.usd``/``.usdc`` write crate.
+    """
+    from pathlib import Path
+
+    from ..io import atomic_write, check_writable
+    from .validate import check_stage
+
+    p = check_writable(file, force=force)
+    if p.suffix not in (".usda", ".usd", ".usdc"):
+        raise ExportError(f"{p}: a USD file name ends in .usda, .usd or .usdc")
+    check_stage(stage)
+    if p.suffix == ".usda":
+        return atomic_write(p, stage.GetRootLayer().ExportToString(), force=force)
+    # binary crate: export next to the target, then move it into place through atomic_write's checks
+    import os
+    import tempfile
+
+    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".usdc", dir=p.parent if p.parent.exists() else None)
+    os.close(fd)
+    try:
+        if not stage.GetRootLayer().Export(tmp):
+            raise ExportError(f"USD could not write {p}")
+        return atomic_write(p, Path(tmp).read_bytes(), force=force)
+    finally:
+        os.unlink(tmp)
+
+
+def write_camera(file, spec: CameraSpec, *, force: bool = False, path: str = DEFAULT_CAMERA_PATH,
+                 meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y",
+                 position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), report=None):
+    """Write a one-camera layer to ``file`` (see :func:`author_camera`); return the Path."""
+    stage = new_stage(meters_per_unit, fps, up_axis)
+    author_camera(stage, path, spec, position=position, rotate_xyz_deg=rotate_xyz_deg, report=report)
+    return save_stage(stage, file, force=force)

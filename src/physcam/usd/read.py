@@ -1,0 +1,242 @@
+"""Read a PhysicalCamera prim (composed: variants, references, layers) back into physcam values.
+
+:func:`read_camera` returns a :class:`CameraReading`: the :class:`~physcam.usd.author.CameraSpec`
+(millimetres), which lens model the lens's ``lensModel`` relationship chose, the
+prescription when that model is a ``PhysicalCameraLensModelPrescription``, and the
+lens report (:func:`CameraReading.report`). Values come from the composed stage,
+so the selected variants and the strongest layer win. A prim that is not a
+PhysicalCamera, or a lens that points nowhere, raises
+:class:`~physcam.errors.ExportError` naming the prim.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..errors import ExportError
+from .author import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec
+from .plugin import ensure_registered
+
+__all__ = ["CameraReading", "find_cameras", "open_stage", "read_camera", "read_prescription"]
+
+
+@dataclass(frozen=True)
+class CameraReading:
+    """What a PhysicalCamera prim says, in physcam's units (mm)."""
+
+    path: str
+    spec: CameraSpec
+    lens_model_path: str
+    lens_model_type: str
+    prescription: object | None = None
+    variants: dict = field(default_factory=dict)
+
+    def report(self):
+        """The on-set lens report of this camera (practical thin-lens model)."""
+        from .author import report_for_spec
+
+        return report_for_spec(self.spec)
+
+    def to_dict(self) -> dict:
+        from dataclasses import asdict
+
+        return {
+            "path": self.path,
+            "lens_model": {"path": self.lens_model_path, "type": self.lens_model_type},
+            "variants": dict(self.variants),
+            "camera": asdict(self.spec),
+            "has_prescription": self.prescription is not None,
+        }
+
+
+def open_stage(file):
+    """Open ``file`` as a USD stage, or raise :class:`ExportError` saying why not."""
+    ensure_registered()
+    from pathlib import Path
+
+    from pxr import Tf, Usd
+
+    p = Path(file)
+    if not p.is_file():
+        raise ExportError(f"{p}: no such USD file")
+    try:
+        stage = Usd.Stage.Open(str(p))
+    except Tf.ErrorException as exc:
+        raise ExportError(f"{p}: USD cannot open it: {str(exc).strip().splitlines()[-1]}") from None
+    if stage is None:
+        raise ExportError(f"{p}: USD cannot open it")
+    return stage
+
+
+def find_cameras(stage) -> list[str]:
+    """Paths of every PhysicalCamera prim on ``stage`` (composed, active, defined)."""
+    ensure_registered()
+    from pxr import Usd
+
+    t = Usd.SchemaRegistry.GetTypeFromSchemaTypeName("PhysicalCamera")
+    return [str(p.GetPath()) for p in stage.Traverse() if p.IsA(t)]
+
+
+def _get(prim, name, what):
+    attr = prim.GetAttribute(name)
+    if not attr:
+        raise ExportError(f"{prim.GetPath()}: has no {name} attribute; {what}")
+    v = attr.Get()
+    if v is None:
+        raise ExportError(f"{prim.GetPath()}: {name} has no value; {what}")
+    return v
+
+
+def _instance(prim, schema: str, preferred: str) -> str:
+    names = [s.split(":", 1)[1] for s in prim.GetAppliedSchemas() if s.startswith(schema + ":")]
+    if not names:
+        raise ExportError(f"{prim.GetPath()}: no {schema} is applied; apply {schema}:{preferred}")
+    return preferred if preferred in names else names[0]
+
+
+def read_prescription(model_prim):
+    """A :class:`~physcam.lens.prescription.Prescription` from a PhysicalCameraLensModelPrescription prim."""
+    from ..errors import LensFileError
+    from ..lens.prescription import Focus, LensMetadata, Medium, Prescription, Surface, VariableGap
+
+    where = f"{model_prim.GetPath()}"
+    arrays = {n: list(model_prim.GetAttribute(n).Get() or []) for n in
+              ("radius", "thickness", "nd", "vd", "semiDiameter", "surfaceKind", "conic", "asphericCoefficients",
+               "glass")}
+    n = len(arrays["radius"])
+    if n == 0:
+        raise ExportError(f"{where}: the prescription has no surfaces (radius is empty)")
+    for key in ("thickness", "nd", "vd", "semiDiameter", "surfaceKind"):
+        if len(arrays[key]) != n:
+            raise ExportError(f"{where}: {key} has {len(arrays[key])} values for {n} surfaces")
+    conic = arrays["conic"] or [0.0] * n
+    asph = arrays["asphericCoefficients"] or [0.0] * (7 * n)
+    glass = arrays["glass"] or [""] * n
+    if len(conic) != n or len(asph) != 7 * n or len(glass) != n:
+        raise ExportError(f"{where}: conic, glass need one value per surface and asphericCoefficients 7 per surface")
+    surfaces = []
+    for i in range(n):
+        a = tuple(asph[7 * i: 7 * i + 7])
+        while a and a[-1] == 0.0:
+            a = a[:-1]
+        surfaces.append(Surface(
+            radius=float(arrays["radius"][i]), thickness=float(arrays["thickness"][i]),
+            medium=Medium(float(arrays["nd"][i]), float(arrays["vd"][i]), glass[i] or None),
+            semi_diameter=float(arrays["semiDiameter"][i]), kind=str(arrays["surfaceKind"][i]),
+            conic=float(conic[i]), aspheric=a,
+        ))
+    focus = None
+    close = model_prim.GetAttribute("focusCloseDistance").Get() or 0.0
+    if close > 0:
+        idx = list(model_prim.GetAttribute("focusGapSurface").Get() or [])
+        t_inf = list(model_prim.GetAttribute("focusGapThicknessInfinity").Get() or [])
+        t_close = list(model_prim.GetAttribute("focusGapThicknessClose").Get() or [])
+        if not len(idx) == len(t_inf) == len(t_close):
+            raise ExportError(f"{where}: focusGapSurface and the focus gap thicknesses differ in length")
+        focus = Focus(float(close), tuple(VariableGap(int(i), float(a), float(b)) for i, a, b in zip(idx, t_inf, t_close)))
+    meta = LensMetadata(
+        name=model_prim.GetAttribute("lensName").Get() or model_prim.GetName(),
+        maker=model_prim.GetAttribute("maker").Get() or None,
+        source=model_prim.GetAttribute("source").Get() or None,
+        focal_length=(model_prim.GetAttribute("nominalFocalLength").Get() or None),
+    )
+    rx = Prescription(
+        surfaces=tuple(surfaces), metadata=meta, focus=focus,
+        squeeze=float(model_prim.GetAttribute("squeeze").Get()),
+        wavelength_nm=float(model_prim.GetAttribute("designWavelength").Get()),
+    )
+    try:
+        return rx.validate()
+    except LensFileError as exc:
+        raise ExportError(f"{where}: {exc}") from None
+
+
+def read_camera(stage, path: str | None = None) -> CameraReading:
+    """Read the PhysicalCamera at ``path`` (default: the only one on the stage)."""
+    ensure_registered()
+    from pxr import Sdf, Usd, UsdGeom
+
+    from ..export.usdgeom import mm_to_scene_units
+
+    if path is None:
+        cams = find_cameras(stage)
+        if len(cams) != 1:
+            listed = ", ".join(cams) if cams else "none"
+            raise ExportError(f"found {len(cams)} PhysicalCamera prims ({listed}); name the one to read")
+        path = cams[0]
+    prim = stage.GetPrimAtPath(Sdf.Path(path)) if Sdf.Path.IsValidPathString(path) else None
+    if not prim:
+        raise ExportError(f"{path}: no prim at that path")
+    if not prim.IsA(Usd.SchemaRegistry.GetTypeFromSchemaTypeName("PhysicalCamera")):
+        kind = prim.GetTypeName() or "typeless prim"
+        raise ExportError(f"{path}: is a {kind}, not a PhysicalCamera")
+    s = _instance(prim, "PhysicalCameraSensorAPI", SENSOR_INSTANCE)
+    ln = _instance(prim, "PhysicalCameraLensAPI", LENS_INSTANCE)
+    sp, lp = f"sensor:{s}:", f"lens:{ln}:"
+    targets = prim.GetRelationship(lp + "lensModel").GetForwardedTargets() if prim.GetRelationship(lp + "lensModel") \
+        else []
+    if not targets:
+        raise ExportError(f"{path}: {lp}lensModel points at no lens model; target a PhysicalCameraLensModel* prim")
+    model = stage.GetPrimAtPath(targets[0])
+    if not model:
+        raise ExportError(f"{path}: {lp}lensModel points at {targets[0]}, which does not exist")
+    mtype = model.GetTypeName()
+    rx = None
+    if mtype == "PhysicalCameraLensModelPinhole":
+        focal = float(_get(model, "focalLength", "author the focal length in mm"))
+        projection, magnification = "perspective", 1.0
+    elif mtype == "PhysicalCameraLensModelOrthographic":
+        focal = float(model.GetCustomDataByKey("physcam:focalLength") or 50.0)
+        projection, magnification = "orthographic", float(_get(model, "magnification", "author it"))
+    elif mtype == "PhysicalCameraLensModelPrescription":
+        from ..optics.paraxial import gaussian
+
+        rx = read_prescription(model)
+        focal = float(gaussian(rx).efl)
+        projection, magnification = "perspective", 1.0
+    else:
+        raise ExportError(f"{path}: {lp}lensModel points at {model.GetPath()}, a {mtype or 'typeless prim'}, "
+                          "not a PhysicalCameraLensModel")
+    mpu = UsdGeom.GetStageMetersPerUnit(stage)
+    clip = _get(prim, lp + "clippingRange", "author it in scene units")
+    to_mm = 1.0 / mm_to_scene_units(1.0, mpu)
+    aperture = _get(prim, sp + "aperture", "author the sensor size in mm")
+    shift = _get(prim, sp + "shift", "")
+    opening = _get(prim, "shutterOpening", "")
+    spec = CameraSpec(
+        focal_length_mm=focal,
+        sensor_width_mm=float(aperture[0]),
+        sensor_height_mm=float(aperture[1]),
+        fstop=float(_get(prim, lp + "fStop", "author the f-stop")),
+        focus_mm=float(_get(model, "focusDistance", "author the focus distance in mm")),
+        coc_mm=float(_get(prim, sp + "circleOfConfusion", "")),
+        squeeze=float(_get(model, "squeeze", "")),
+        entrance_pupil_mm=float(_get(prim, lp + "entrancePupilDistance", "")),
+        shift_mm=(float(shift[0]), float(shift[1])),
+        iso=float(_get(prim, sp + "iso", "")),
+        transmittance=float(_get(model, "transmittance", "")),
+        flange_distance_mm=float(_get(prim, "flangeDistance", "")),
+        aperture_distance_mm=float(_get(prim, lp + "apertureDistance", "")),
+        shutter_open_s=float(_get(prim, "shutterOpen", "")),
+        shutter_duration_s=float(_get(prim, "shutterDuration", "")),
+        shutter_opening=(float(opening[0]), float(opening[1])),
+        aperture_blades=int(_get(prim, lp + "shutterBlades", "")),
+        aperture_angle_deg=float(_get(prim, lp + "apertureAngle", "")),
+        aperture_roundness=float(_get(prim, lp + "apertureRoundness", "")),
+        aperture_density=float(_get(prim, lp + "apertureDensity", "")),
+        clipping_mm=(float(clip[0]) * to_mm, float(clip[1]) * to_mm),
+        projection=projection,
+        magnification=magnification,
+        lens_name=(model.GetCustomDataByKey("physcam:lensName") or (rx.name if rx else None)),
+        sensor_name=prim.GetCustomDataByKey("physcam:sensorName"),
+    )
+    try:
+        spec = spec.checked()
+    except Exception as exc:
+        raise ExportError(f"{path}: {exc}") from None
+    variants = {}
+    for p in [prim, *prim.GetAllChildren()][:1]:
+        vsets = p.GetVariantSets()
+        for name in vsets.GetNames():
+            variants[name] = vsets.GetVariantSelection(name)
+    return CameraReading(str(prim.GetPath()), spec, str(model.GetPath()), mtype, rx, variants)

@@ -1,0 +1,3 @@
+"""USD tests: register physcam's schema plugin before any stage exists in this process."""
+
+import physcam.usd  # noqa: F401  (registers the PhysicalCamera plugin on import)

@@ -1,0 +1,217 @@
+"""Authoring: the companion UsdGeomCamera against independent numbers (Gf.Camera, closed forms)."""
+
+import math
+import os
+import subprocess
+import sys
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from physcam.errors import ExportError, InputError, PhysCamError
+from physcam.usd import PLUGIN_DIR
+from physcam.usd.author import CameraSpec, author_camera, new_stage, shutter_opening_curve, write_camera
+from physcam.usd.validate import validation_errors
+
+pxr = pytest.importorskip("pxr")
+from pxr import Gf, Usd, UsdGeom  # noqa: E402
+
+F32_EPS = 2.0 ** -24  # relative rounding of a 32-bit float (UsdGeomCamera's attributes are floats)
+
+
+def fov_deg(size_mm, focal_mm):
+    """Pinhole field of view 2 atan(size / 2f), degrees (seed 001 with its inversion corrected)."""
+    return math.degrees(2.0 * math.atan(size_mm / (2.0 * focal_mm)))
+
+
+def gf_camera(stage, path="/Cameras/Camera/Camera"):
+    return UsdGeom.Camera(stage.GetPrimAtPath(path)).GetCamera(Usd.TimeCode.Default())
+
+
+@pytest.mark.parametrize("mpu", [0.01, 1.0])
+@pytest.mark.parametrize(
+    "focal,w,h,squeeze",
+    [(50.0, 36.0, 24.0, 1.0), (35.0, 27.99, 19.22, 1.0), (18.0, 24.89, 18.66, 1.0), (13.7, 23.76, 13.365, 1.0),
+     (50.0, 22.0, 18.6, 2.0), (40.0, 27.99, 19.22, 1.8)],
+)
+def test_gf_camera_reproduces_fov(mpu, focal, w, h, squeeze):
+    """Gf.Camera from the written UsdGeomCamera gives 2 atan(w / 2f) to 1e-6 degrees.
+
+    The frustum (double precision) is compared with the closed form on the exact numbers;
+    Gf.Camera.GetFieldOfView returns a 32-bit float, so it is held to its own rounding.
+    """
+    stage = new_stage(mpu)
+    spec = CameraSpec(focal_length_mm=focal, sensor_width_mm=w, sensor_height_mm=h, squeeze=squeeze)
+    author_camera(stage, "/Cameras/Camera", spec)
+    cam = gf_camera(stage)
+    window = cam.frustum.GetWindow()  # perspective window at unit distance: aperture / (2 focal length)
+    hfov = math.degrees(2.0 * math.atan(window.GetMax()[0]))
+    vfov = math.degrees(2.0 * math.atan(window.GetMax()[1]))
+    # the desqueezed horizontal field of an anamorphic lens: 2 atan(squeeze w / 2f)
+    assert hfov == pytest.approx(fov_deg(w * squeeze, focal), abs=1e-6)
+    assert vfov == pytest.approx(fov_deg(h, focal), abs=1e-6)
+    ulp = 40.0 * F32_EPS * 4  # float32 result: one ulp is 2^-24 relative, FOVs here are below 160 degrees
+    assert cam.GetFieldOfView(Gf.Camera.FOVHorizontal) == pytest.approx(fov_deg(w * squeeze, focal), abs=4 * ulp)
+    assert cam.GetFieldOfView(Gf.Camera.FOVVertical) == pytest.approx(fov_deg(h, focal), abs=4 * ulp)
+
+
+@pytest.mark.parametrize("mpu,focal_expected", [(0.01, 50.0), (1.0, 0.5), (0.0254, 50.0 / 2.54)])
+def test_units_tenths_of_scene_unit(mpu, focal_expected):
+    """50 mm is 50 tenths of a cm, 0.5 tenths of a metre, 19.685 tenths of an inch (2.54 mm each)."""
+    stage = new_stage(mpu)
+    author_camera(stage, "/Cameras/Camera", CameraSpec(focal_length_mm=50.0, focus_mm=3000.0,
+                                                       clipping_mm=(100.0, 1.0e6)))
+    g = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
+    # float32 values chosen to keep aperture/focal exact stay within a few ulps (2e-6) of the exact ones
+    assert g.GetFocalLengthAttr().Get() == pytest.approx(focal_expected, rel=2e-6)
+    assert g.GetHorizontalApertureAttr().Get() == pytest.approx(36.0 * focal_expected / 50.0, rel=2e-6)
+    near, far = g.GetClippingRangeAttr().Get()
+    assert near == pytest.approx(0.1 / mpu, rel=1e-7) and far == pytest.approx(1000.0 / mpu, rel=1e-7)
+    # thin lens at a 3 m mark: s + s' = 3000, s' = f s / (s - f) -> s = 2949.1377 mm (hand-solved quadratic)
+    s = (3000.0 + math.sqrt(3000.0**2 - 4 * 50.0 * 3000.0)) / 2.0
+    assert g.GetFocusDistanceAttr().Get() == pytest.approx(s / (1000.0 * mpu), rel=1e-6)
+    assert not validation_errors(stage)
+
+
+def test_dof_survives_unit_change():
+    """Focus, pupil and eye positions scale with metersPerUnit; world focus plane lands on the mark."""
+    out = {}
+    for mpu in (0.01, 1.0):
+        stage = new_stage(mpu)
+        author_camera(stage, "/Cameras/Camera", CameraSpec(focus_mm=2500.0, fstop=2.8))
+        g = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
+        eye = g.ComputeLocalToWorldTransform(Usd.TimeCode.Default()).ExtractTranslation()
+        film = UsdGeom.Xformable(stage.GetPrimAtPath("/Cameras/Camera")).ComputeLocalToWorldTransform(
+            Usd.TimeCode.Default()).ExtractTranslation()
+        # focus plane (eye + focusDistance along -Z) is 2500 mm in front of the film plane
+        plane = eye[2] - g.GetFocusDistanceAttr().Get()
+        out[mpu] = (film[2] - plane) * 1000.0 * mpu
+        assert g.GetFStopAttr().Get() == pytest.approx(2.8, rel=1e-7)
+    assert out[0.01] == pytest.approx(2500.0, rel=1e-6)
+    assert out[1.0] == pytest.approx(2500.0, rel=1e-6)
+
+
+def test_pivot_is_the_entrance_pupil():
+    """Rotating the body leaves the eye (entrance pupil) where it was: a nodal pan."""
+    stage = new_stage(0.01)
+    author_camera(stage, "/Cameras/Camera", CameraSpec(entrance_pupil_mm=120.0), position=(10.0, 20.0, 30.0),
+                  rotate_xyz_deg=(15.0, 40.0, 5.0))
+    eye = UsdGeom.Xformable(stage.GetPrimAtPath("/Cameras/Camera/Camera")).ComputeLocalToWorldTransform(
+        Usd.TimeCode.Default()).ExtractTranslation()
+    assert tuple(eye) == pytest.approx((10.0, 20.0, 30.0), abs=1e-9)
+    film = UsdGeom.Xformable(stage.GetPrimAtPath("/Cameras/Camera")).ComputeLocalToWorldTransform(
+        Usd.TimeCode.Default()).ExtractTranslation()
+    assert (film - eye).GetLength() == pytest.approx(12.0, rel=1e-12)  # 120 mm = 12 cm
+
+
+def test_exposure_shutter_and_renderman():
+    stage = new_stage(0.01, fps=25.0)
+    spec = CameraSpec(fstop=4.0, transmittance=0.81, shutter_open_s=-0.01, shutter_duration_s=0.02,
+                      shutter_opening=(0.25, 0.75), aperture_blades=9, aperture_roundness=0.5, iso=800.0)
+    author_camera(stage, "/Cameras/Camera", spec)
+    prim = stage.GetPrimAtPath("/Cameras/Camera/Camera")
+    g = UsdGeom.Camera(prim)
+    assert g.GetShutterOpenAttr().Get() == pytest.approx(-0.25)  # -0.01 s at 25 fps
+    assert g.GetShutterCloseAttr().Get() == pytest.approx(0.25)
+    assert g.GetExposureTimeAttr().Get() == pytest.approx(0.02)
+    assert g.GetExposureFStopAttr().Get() == pytest.approx(4.0 / 0.9)  # T = N / sqrt(t)
+    assert g.GetExposureIsoAttr().Get() == 800.0
+    assert prim.GetAttribute("ri:apertureNSides").Get() == 9
+    assert prim.GetAttribute("ri:apertureRoundness").Get() == 0.5
+    assert (prim.GetAttribute("ri:shutterOpenTime").Get(), prim.GetAttribute("ri:shutterCloseTime").Get()) == (
+        0.25, 0.75)
+    assert len(prim.GetAttribute("ri:shutteropening").Get()) == 8
+
+
+@given(o=st.floats(0.0, 1.0), c=st.floats(0.0, 1.0))
+def test_shutter_curve_points_lie_on_the_ramps(o, c):
+    o, c = min(o, c), max(o, c)
+    p = shutter_opening_curve(o, c)
+    # opening ramp y = x / o and closing ramp y = (1 - x) / (1 - c) (seed 002), wherever defined
+    for x, y in ((p[0], p[1]), (p[2], p[3])):
+        assert 0.0 <= x <= o + 1e-12 and (o < 1e-9 or y == pytest.approx(x / o))
+    for x, y in ((p[4], p[5]), (p[6], p[7])):
+        assert c - 1e-12 <= x <= 1.0 and (c > 1 - 1e-9 or y == pytest.approx((1.0 - x) / (1.0 - c)))
+
+
+def test_orthographic_camera():
+    stage = new_stage(1.0)
+    author_camera(stage, "/Cameras/Camera", CameraSpec(projection="orthographic", magnification=0.01))
+    g = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
+    assert g.GetProjectionAttr().Get() == "orthographic"
+    # 36 mm / 0.01 = 3.6 m wide = 36 tenths of a metre
+    assert g.GetHorizontalApertureAttr().Get() == pytest.approx(36.0, rel=1e-7)
+    assert gf_camera(stage).projection == Gf.Camera.Orthographic
+    assert not validation_errors(stage)
+
+
+def test_write_validates_and_refuses_to_overwrite(tmp_path):
+    f = tmp_path / "cam.usda"
+    write_camera(f, CameraSpec())
+    assert not validation_errors(Usd.Stage.Open(str(f)))
+    before = f.read_bytes()
+    with pytest.raises(ExportError, match="already exists"):
+        write_camera(f, CameraSpec(focal_length_mm=85.0))
+    assert f.read_bytes() == before
+    write_camera(f, CameraSpec(focal_length_mm=85.0), force=True)
+    assert b"focalLength = 85" in f.read_bytes()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temp file left behind
+
+
+def test_foreign_prim_is_named(tmp_path):
+    stage = new_stage()
+    UsdGeom.Sphere.Define(stage, "/Cameras/Ball")
+    with pytest.raises(ExportError, match="/Cameras/Ball.*Sphere"):
+        author_camera(stage, "/Cameras/Ball", CameraSpec())
+    with pytest.raises(ExportError, match="not an absolute prim path"):
+        author_camera(stage, "Cameras/x y", CameraSpec())
+
+
+@pytest.mark.parametrize("bad", [dict(fstop=float("nan")), dict(focal_length_mm=-5.0), dict(sensor_width_mm=0.0),
+                                 dict(aperture_roundness=2.0), dict(shutter_opening=(0.8, 0.2)),
+                                 dict(clipping_mm=(10.0, 5.0)), dict(focus_mm=float("inf"))])
+def test_bad_input_is_a_physcam_error(bad):
+    with pytest.raises(InputError):
+        author_camera(new_stage(), "/Cameras/Camera", CameraSpec(**bad))
+
+
+def test_second_process_sees_schema_with_only_the_plugin_path(tmp_path):
+    f = tmp_path / "cam.usda"
+    write_camera(f, CameraSpec(focal_length_mm=35.0))
+    code = f"""
+import sys
+from pxr import Usd, Sdf
+assert 'physcam' not in sys.modules
+stage = Usd.Stage.Open({str(f)!r})
+reg = Usd.SchemaRegistry
+prim = stage.GetPrimAtPath('/Cameras/Camera')
+t = reg.GetTypeFromSchemaTypeName('PhysicalCamera')
+assert not t.isUnknown, 'PhysicalCamera unknown'
+assert prim.IsA(t) and prim.GetTypeName() == 'PhysicalCamera'
+assert prim.HasAPI(reg.GetTypeFromSchemaTypeName('PhysicalCameraLensAPI'), 'main')
+assert prim.GetAttribute('shutterOpen').Get() == 0.0
+assert abs(prim.GetAttribute('flangeDistance').Get() - 52.0) < 1e-6
+# fallback values from the schema (never authored by physcam)
+assert tuple(prim.GetAttribute('sensor:main:enlarge').Get()) == (1.0, 1.0)
+assert prim.GetAttribute('sensor:main:handedness').Get() == 1.0
+model = stage.GetPrimAtPath('/Cameras/Camera/Pinhole')
+assert model.IsA(reg.GetTypeFromSchemaTypeName('PhysicalCameraLensModel'))
+assert model.GetAttribute('focalLength').Get() == 35.0
+fresh = stage.DefinePrim('/Fresh', 'PhysicalCameraLensModelPinhole')
+assert fresh.GetAttribute('focalLength').Get() == 50.0 and fresh.GetAttribute('focusDistance').Get() == 1000.0
+print('ok')
+"""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("PXR_", "PYTHONPATH"))}
+    env["PXR_PLUGINPATH_NAME"] = str(PLUGIN_DIR)
+    res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.strip() == "ok"
+    # without the plugin path the same process does not know the type (the test is not vacuous)
+    del env["PXR_PLUGINPATH_NAME"]
+    res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, cwd=tmp_path)
+    assert res.returncode != 0 and "PhysicalCamera unknown" in res.stderr
+
+
+def test_errors_are_physcam_errors():
+    assert issubclass(ExportError, PhysCamError)
