@@ -1,0 +1,59 @@
+"""Focus breathing plot: horizontal field of view and focal length against focus mark.
+
+The x axis is the reciprocal of the focus mark (1/m, dioptres of the mark measured
+from the film plane), so infinity sits at 0 and close focus spreads out; tick labels
+give the marks in metres. Rows come from :func:`physcam.optics.focusing.breathing_table`.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from pathlib import Path
+
+from ..errors import ExportError, InputError
+
+__all__ = ["PLOT_FORMATS", "breathing_figure", "save_breathing_plot"]
+
+PLOT_FORMATS = ("png", "svg", "pdf")
+
+
+def breathing_figure(rows, *, title: str = "focus breathing", sensor_width_mm: float | None = None):
+    """A matplotlib Figure (Agg canvas) of HFOV (left axis) and EFL (right axis) against 1/mark."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    if not rows:
+        raise InputError("no breathing rows to plot")
+    x = [0.0 if math.isinf(r.focus_from_film_mm) else 1000.0 / r.focus_from_film_mm for r in rows]
+    fig = Figure(figsize=(7.5, 4.2))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 1, 1)
+    ax.plot(x, [r.hfov_deg for r in rows], marker="o", color="#1f4e79", label="horizontal FOV")
+    ax.set_ylabel("horizontal field of view (deg)" + (f", {sensor_width_mm:g} mm sensor" if sensor_width_mm else ""))
+    ax.set_xlabel("focus mark from the film plane (m)")
+    ticks = [r for r in rows if not math.isinf(r.focus_from_film_mm)]
+    ax.set_xticks([0.0] + [1000.0 / r.focus_from_film_mm for r in ticks])
+    ax.set_xticklabels(["∞"] + [f"{r.focus_from_film_mm / 1000.0:.2g}" for r in ticks], fontsize=7)
+    ax2 = ax.twinx()
+    ax2.plot(x, [r.efl_mm for r in rows], marker="s", linestyle="--", color="#c0392b", label="EFL")
+    ax2.set_ylabel("effective focal length (mm)")
+    ax.grid(True, alpha=0.3)
+    ax.set_title(title, fontsize=10)
+    fig.legend(loc="lower left", bbox_to_anchor=(0.1, 0.15), fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def save_breathing_plot(rows, path, *, force: bool = False, **kwargs) -> Path:
+    """Write the breathing plot to ``path`` (.png, .svg, .pdf) through atomic_write."""
+    from ..io import atomic_write, check_writable
+
+    p = Path(path)
+    fmt = p.suffix.lower().lstrip(".")
+    if fmt not in PLOT_FORMATS:
+        raise ExportError(f"cannot plot to {p.name!r}: use a .png, .svg or .pdf file name")
+    check_writable(p, force=force)
+    buf = io.BytesIO()
+    breathing_figure(rows, **kwargs).savefig(buf, format=fmt, dpi=150)
+    return atomic_write(p, buf.getvalue(), force=force)

@@ -1,0 +1,251 @@
+"""Lens diagram: elements, stop, real marginal and chief rays, cardinal points.
+
+Drawn in one meridian (Y by default; X shows an anamorphic's cylinders) in lens
+space: z along the axis from the first vertex (+z toward the film), millimetres.
+Element outlines come from each surface's sag (physcam.lens.geometry.sag) over its
+clear semi-diameter. Rays are traced for real, meridionally, inside this module
+(surface intersection by Newton iteration on the sag, Snell's law in vector form,
+as in Welford, *Aberrations of Optical Systems*, ch. 4): a marginal fan from an
+axial object at the focus distance, and the chief and rim rays of an off-axis field
+aimed at the paraxial entrance pupil. A ray that misses a surface, leaves its
+clear aperture or is totally reflected stops where that happens.
+Cardinal points (F, F', H, H', entrance and exit pupils) are the Gaussian ones of
+:mod:`physcam.optics.paraxial` at the same focus.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import ExportError, InputError
+from ..lens.geometry import sag
+from ..lens.prescription import Prescription
+from ..optics import focusing, paraxial
+
+__all__ = ["DIAGRAM_FORMATS", "trace_meridional_ray", "LensDiagram", "lens_diagram", "save_lens_diagram"]
+
+DIAGRAM_FORMATS = ("png", "svg", "pdf")
+
+
+def _sag_slope(surface, h: float, axis: str) -> float:
+    e = 1e-6 * max(1.0, abs(h))
+    return (sag(surface, h + e, axis) - sag(surface, h - e, axis)) / (2 * e)
+
+
+def trace_meridional_ray(prescription: Prescription, y0: float, z0: float, dy: float, dz: float, *, axis: str = "y",
+                         wavelength_nm=None, film_z: float | None = None):
+    """Trace a real ray in the meridian plane; return its polyline [(z, y), ...].
+
+    The ray starts at (z0, y0) with direction (dz, dy) in object space (air) and
+    is refracted at every surface; the stop clips it. It ends at the film plane
+    (``film_z``) or where it is vignetted, misses a surface or is totally reflected.
+    """
+    n = paraxial.media_indices(prescription, wavelength_nm)
+    norm = math.hypot(dy, dz)
+    dy, dz = dy / norm, dz / norm
+    z, y = float(z0), float(y0)
+    pts = [(z, y)]
+    zv = prescription.vertex_z
+    for i, s in enumerate(prescription.surfaces):
+        if abs(dz) < 1e-12:
+            return pts
+        # intersection: solve z + t dz = zv + sag(y + t dy) by Newton from the vertex plane
+        t = (zv[i] - z) / dz
+        for _ in range(30):
+            h = y + t * dy
+            f = z + t * dz - zv[i] - sag(s, h, axis)
+            fp = dz - _sag_slope(s, h, axis) * dy
+            if abs(fp) < 1e-12:
+                return pts
+            step = f / fp
+            t -= step
+            if abs(step) < 1e-10:
+                break
+        else:
+            return pts
+        h = y + t * dy
+        if not math.isfinite(h) or t < -1e-9:
+            return pts
+        z, y = z + t * dz, h
+        pts.append((z, y))
+        if abs(h) > s.semi_diameter * (1 + 1e-9):
+            return pts  # vignetted by this surface's clear aperture
+        if s.is_stop or s.kind == "flat" and n[i] == n[i + 1]:
+            continue
+        # unit normal (nz, ny) of z - sag(h) = const, pointing toward +z
+        m = _sag_slope(s, h, axis)
+        nz, ny = 1.0 / math.hypot(1.0, m), -m / math.hypot(1.0, m)
+        mu = n[i] / n[i + 1]
+        cos_i = dz * nz + dy * ny
+        k = 1.0 - mu * mu * (1.0 - cos_i * cos_i)
+        if k < 0:
+            return pts  # total internal reflection
+        g = math.sqrt(k) - mu * cos_i
+        dz, dy = mu * dz + g * nz, mu * dy + g * ny
+    if film_z is not None and abs(dz) > 1e-12:
+        t = (film_z - z) / dz
+        if t > 0:
+            pts.append((film_z, y + t * dy))
+    return pts
+
+
+@dataclass
+class LensDiagram:
+    """What a diagram shows (lens-space z, mm), computed once; :meth:`figure` draws it."""
+
+    prescription: Prescription
+    gaussian: paraxial.GaussianData
+    axis: str
+    field_deg: float
+    rays: list[tuple[str, list[tuple[float, float]]]]
+
+    def figure(self, *, width_in: float = 10.0):
+        """A matplotlib Figure (Agg canvas)."""
+        from matplotlib.figure import Figure
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        p, g, axis = self.prescription, self.gaussian, self.axis
+        zv = p.vertex_z
+        sds = [s.semi_diameter for s in p.surfaces]
+        hmax = max(sds)
+        fig = Figure(figsize=(width_in, width_in * 0.45))
+        FigureCanvasAgg(fig)
+        ax = fig.add_subplot(1, 1, 1)
+        # elements: glass between surface i and i+1
+        for i in range(len(p.surfaces) - 1):
+            a, b = p.surfaces[i], p.surfaces[i + 1]
+            if a.medium.nd == 1.0 and a.medium.vd == 0.0:
+                continue
+            k = 24
+            front = [(zv[i] + sag(a, a.semi_diameter * (2 * j / k - 1), axis), a.semi_diameter * (2 * j / k - 1)) for j in range(k + 1)]
+            back = [(zv[i + 1] + sag(b, b.semi_diameter * (1 - 2 * j / k), axis), b.semi_diameter * (1 - 2 * j / k)) for j in range(k + 1)]
+            poly = front + back
+            ax.fill([q[0] for q in poly], [q[1] for q in poly], facecolor="#cfe3f5", edgecolor="#1f4e79", linewidth=1.0)
+        # the aperture stop
+        k = p.stop_index
+        r = g.stop_semi_diameter
+        for sgn in (1, -1):
+            ax.plot([zv[k], zv[k]], [sgn * r, sgn * (r + 0.25 * hmax)], color="black", linewidth=2.5)
+        ax.text(zv[k], 1.3 * hmax, "stop", ha="center", fontsize=8)
+        # rays
+        colours = {"marginal": "#c0392b", "chief": "#27ae60", "rim": "#7fbf7f"}
+        for kind, pts in self.rays:
+            ax.plot([q[0] for q in pts], [q[1] for q in pts], color=colours[kind], linewidth=0.9 if kind != "rim" else 0.6)
+        # film plane
+        ax.plot([g.z_film, g.z_film], [-hmax, hmax], color="0.3", linewidth=1.5)
+        ax.text(g.z_film, -1.3 * hmax, "film", ha="center", fontsize=8)
+        # cardinal points on the axis
+        ax.axhline(0.0, color="0.5", linewidth=0.5, linestyle="-.")
+        marks = [("F", g.z_front_focal_point), ("F'", g.z_rear_focal_point), ("H", g.z_front_principal_plane),
+                 ("H'", g.z_rear_principal_plane)]
+        for label, zp in marks:
+            ax.plot([zp], [0.0], marker="o", color="#8e44ad", markersize=4)
+            ax.annotate(label, (zp, 0.0), textcoords="offset points", xytext=(0, 6 if "H" in label else -12),
+                        ha="center", fontsize=8, color="#8e44ad")
+        for label, zp, d in (("EP", g.z_entrance_pupil, g.entrance_pupil_diameter), ("XP", g.z_exit_pupil, g.exit_pupil_diameter)):
+            ax.plot([zp, zp], [-d / 2, d / 2], color="#e67e22", linewidth=1.2, linestyle="--")
+            ax.annotate(label, (zp, d / 2), textcoords="offset points", xytext=(0, 3), ha="center", fontsize=8, color="#e67e22")
+        # the view: the rays' start to just past the film; points outside are listed below the plot
+        z_lo = min(min(q[0] for _, pts in self.rays for q in pts), -0.05 * g.z_film)
+        z_hi = 1.08 * g.z_film if g.z_film > 0 else p.total_track + 10.0
+        ax.set_xlim(z_lo, z_hi)
+        ax.set_ylim(-1.6 * hmax, 1.6 * hmax)
+        outside = [f"{lbl} at z = {zp:.1f} mm" for lbl, zp in marks + [("EP", g.z_entrance_pupil), ("XP", g.z_exit_pupil)]
+                   if not z_lo <= zp <= z_hi]
+        if outside:
+            ax.text(0.01, 0.02, "outside the view: " + ", ".join(outside), transform=ax.transAxes, fontsize=7, color="0.3")
+        ax.set_aspect("equal", adjustable="box")
+        ax.set_xlabel("z from the first vertex (mm, + toward the film)")
+        ax.set_ylabel(f"{axis} (mm)")
+        ax.set_title(
+            f"{p.name}: EFL {g.efl:.2f} mm, f/{g.f_number:.2f}, half-field {self.field_deg:.1f}° "
+            f"({axis.upper()} meridian)",
+            fontsize=10,
+        )
+        fig.tight_layout()
+        return fig
+
+
+def _default_field(p: Prescription, g: paraxial.GaussianData, axis: str, wavelength_nm) -> float:
+    """Half-field (rad) of the widest paraxially unvignetted pencil (Smith 7.2), 90% of it.
+
+    At every surface the chief-ray height plus the marginal-ray height must fit
+    inside the clear semi-diameter; falls back to 70% of the chief-ray limit when
+    even the axial pencil fills a surface.
+    """
+    n = paraxial.media_indices(p, wavelength_nm)
+    zep, a = g.z_entrance_pupil, g.entrance_pupil_diameter / 2
+    # chief ray with unit slope through the EP centre (height -zep at the first vertex)
+    yc, _ = paraxial.paraxial_trace(p, -zep, n[0], axis, wavelength_nm)
+    if math.isinf(g.z_object):
+        ym, _ = paraxial.paraxial_trace(p, a, 0.0, axis, wavelength_nm)
+    else:
+        u = a / (zep - g.z_object)
+        ym, _ = paraxial.paraxial_trace(p, -u * g.z_object, n[0] * u, axis, wavelength_nm)
+    free = [(s.semi_diameter - abs(m)) / abs(c) for s, c, m in zip(p.surfaces, yc, ym) if abs(c) > 1e-12 and not s.is_stop]
+    chief = [s.semi_diameter / abs(c) for s, c in zip(p.surfaces, yc) if abs(c) > 1e-12 and not s.is_stop]
+    if not chief:
+        return math.atan(0.3)
+    u = 0.9 * min(free) if min(free) > 0 else 0.7 * min(chief)
+    return math.atan(min(u, 1.5))
+
+
+def lens_diagram(prescription: Prescription, *, axis: str = "y", focus_from_film_mm: float = math.inf,
+                 fstop=None, field_deg: float | None = None, wavelength_nm=None, rays: int = 3) -> LensDiagram:
+    """Compute a :class:`LensDiagram` with the lens focused at ``focus_from_film_mm`` (from the film plane)."""
+    if axis not in paraxial.AXES:
+        raise InputError(f"meridian must be 'x' or 'y', got {axis!r}")
+    st = focusing.focus(prescription, focus_from_film_mm, axis="y", wavelength_nm=wavelength_nm)
+    p = st.prescription
+    g = paraxial.gaussian(p, axis=axis, wavelength_nm=wavelength_nm, fstop=fstop, object_z=st.object_z, film_z=st.film_z)
+    if fstop is not None:  # draw the stop at the asked opening
+        from dataclasses import replace
+
+        k = p.stop_index
+        s = list(p.surfaces)
+        s[k] = replace(s[k], semi_diameter=g.stop_semi_diameter)
+        p = p.with_surfaces(s)
+    if field_deg is None:
+        half = _default_field(p, g, axis, wavelength_nm)
+    else:
+        half = math.radians(float(field_deg))
+        if not (0 <= half < math.pi / 2):
+            raise InputError(f"field angle must be between 0 and 90 degrees, got {field_deg}")
+    track = p.total_track
+    z_start = -max(0.3 * track, 10.0)
+    if math.isfinite(st.object_z):
+        z_start = max(z_start, st.object_z)
+    ep, a = g.z_entrance_pupil, g.entrance_pupil_diameter / 2
+    out = []
+    fan = [a * (2 * j / (rays - 1) - 1) for j in range(rays)] if rays > 1 else [a]
+    for h in fan:  # marginal fan from the axial object
+        if math.isinf(st.object_z):
+            pts = trace_meridional_ray(p, h, z_start, 0.0, 1.0, axis=axis, wavelength_nm=wavelength_nm, film_z=g.z_film)
+        else:
+            pts = trace_meridional_ray(p, 0.0, st.object_z, h, ep - st.object_z, axis=axis,
+                                       wavelength_nm=wavelength_nm, film_z=g.z_film)
+        out.append(("marginal", pts))
+    tu = math.tan(half)
+    for h, kind in ((0.0, "chief"), (a * 0.98, "rim"), (-a * 0.98, "rim")):  # field aimed at the paraxial EP
+        y_start = h - tu * (ep - z_start)
+        out.append((kind, trace_meridional_ray(p, y_start, z_start, tu, 1.0, axis=axis, wavelength_nm=wavelength_nm,
+                                               film_z=g.z_film)))
+    return LensDiagram(p, g, axis, math.degrees(half), out)
+
+
+def save_lens_diagram(prescription: Prescription, path, *, force: bool = False, **kwargs) -> Path:
+    """Draw the diagram to ``path`` (.png, .svg or .pdf) through atomic_write; kwargs as :func:`lens_diagram`."""
+    from ..io import atomic_write, check_writable
+
+    p = Path(path)
+    fmt = p.suffix.lower().lstrip(".")
+    if fmt not in DIAGRAM_FORMATS:
+        raise ExportError(f"cannot draw a diagram to {p.name!r}: use a .png, .svg or .pdf file name")
+    check_writable(p, force=force)
+    fig = lens_diagram(prescription, **kwargs).figure()
+    buf = io.BytesIO()
+    fig.savefig(buf, format=fmt, dpi=150)
+    return atomic_write(p, buf.getvalue(), force=force)

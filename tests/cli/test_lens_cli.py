@@ -1,0 +1,127 @@
+"""`physcam lenses` and `physcam lens show|diagram|breathing`, run in-process."""
+
+from __future__ import annotations
+
+import json
+import math
+import struct
+
+import pytest
+
+from physcam.cli import main
+
+
+@pytest.fixture(autouse=True)
+def wide_terminal(monkeypatch):
+    monkeypatch.setenv("COLUMNS", "200")
+
+
+def run(capsys, *argv):
+    rc = main(list(argv))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def test_lenses_lists_the_library_with_paraxial_data(capsys):
+    rc, out, _ = run(capsys, "lenses", "--json")
+    assert rc == 0
+    rows = {r["slug"]: r for r in json.loads(out)}
+    # pbrt dgauss.50mm: the published EFL; f-number = EFL / entrance pupil diameter (published figures)
+    assert rows["dgauss_50mm"]["efl_mm"] == pytest.approx(50.3582, abs=1e-3)
+    assert rows["dgauss_50mm"]["f_number"] == pytest.approx(50.3582 / 24.8051, abs=1e-4)
+    rc, out, _ = run(capsys, "lenses")
+    assert rc == 0 and "dgauss_50mm" in out
+
+
+def test_show_json_matches_published_dgauss_figures(capsys):
+    rc, out, _ = run(capsys, "lens", "show", "dgauss.50mm", "--json", "--flange", "52mm")
+    assert rc == 0
+    d = json.loads(out)
+    y = d["meridians"]["y"]
+    assert y["efl"] == pytest.approx(50.3582, abs=1e-3)
+    assert y["bfl"] == pytest.approx(36.1059, abs=1e-3)
+    assert y["positions"]["front_vertex"]["front_principal_plane"] == pytest.approx(23.2357, abs=1e-3)
+    assert y["positions"]["rear_vertex"]["rear_principal_plane"] == pytest.approx(-14.2523, abs=1e-3)
+    assert y["positions"]["front_vertex"]["entrance_pupil"] == pytest.approx(19.9465, abs=1e-3)
+    assert y["positions"]["rear_vertex"]["exit_pupil"] == pytest.approx(-17.7714, abs=1e-3)
+    assert y["entrance_pupil_diameter"] == pytest.approx(24.8051, abs=1e-3)
+    assert y["exit_pupil_diameter"] == pytest.approx(26.5385, abs=1e-3)
+    # film at F' (infinity): the entrance pupil is BFL + track - 19.9465 in front of the film, 52 less from the flange
+    ep_film = 36.1059 + 32.04 - 19.9465
+    assert y["positions"]["film"]["entrance_pupil"] == pytest.approx(ep_film, abs=1e-3)
+    assert y["positions"]["flange"]["entrance_pupil"] == pytest.approx(ep_film - 52.0, abs=1e-3)
+    assert d["focus"]["focus_from_film_mm"] is None  # infinity
+    assert "NaN" not in out and "Infinity" not in out
+
+
+def test_show_at_a_focus_and_fstop(capsys):
+    rc, out, _ = run(capsys, "lens", "show", "dgauss.50mm", "--focus", "2m", "--fstop", "4", "--json")
+    assert rc == 0
+    d = json.loads(out)
+    y = d["meridians"]["y"]
+    assert y["f_number"] == pytest.approx(4.0)
+    assert y["entrance_pupil_diameter"] == pytest.approx(50.3582 / 4, abs=1e-3)
+    # unit focus, published f and principal planes: s + s' = D - hiatus, 1/s + 1/s' = 1/f
+    hiatus = (32.04 - 14.2523) - 23.2357
+    t = 2000.0 - hiatus
+    s2 = (t - math.sqrt(t * t - 4 * 50.3582 * t)) / 2
+    assert y["positions"]["film"]["rear_principal_plane"] == pytest.approx(s2, abs=2e-3)
+    assert d["focus"]["method"] == "unit"
+    rc, out, _ = run(capsys, "lens", "show", "dgauss.50mm", "--focus", "6ft")
+    assert rc == 0 and "focus 1829 mm from the film" in out
+
+
+def test_anamorphic_lens_reports_both_meridians(capsys):
+    rc, out, _ = run(capsys, "lens", "show", "navarro_anamorphic_2x", "--json")
+    assert rc == 0
+    m = json.loads(out)["meridians"]
+    # a 2x anamorphic: the X focal length is about half the Y focal length
+    assert m["x"]["efl"] / m["y"]["efl"] == pytest.approx(0.5, abs=0.05)
+
+
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (("lens", "show", "dgauss.50mm", "--focus", "10cm"), "closest real focus"),
+        (("lens", "show", "no_such_lens_at_all"), "no bundled lens"),
+        (("lens", "show", "dgauss.50mm", "--fstop", "1.2"), "widest aperture"),
+        (("lens", "show", "navarro_anamorphic_2x", "--focus", "0.5m"), "closest focus is"),
+        (("lens", "diagram", "dgauss.50mm", "-o", "out.txt"), ".png, .svg"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, monkeypatch, argv, needle):
+    monkeypatch.chdir(tmp_path)
+    rc, out, err = run(capsys, *argv)
+    assert rc == 2
+    assert needle in err and err.count("\n") == 1
+
+
+def test_diagram_png_and_svg_and_no_overwrite(capsys, tmp_path):
+    png = tmp_path / "dg.png"
+    rc, _, _ = run(capsys, "lens", "diagram", "dgauss.50mm", "-o", str(png))
+    assert rc == 0
+    data = png.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    w, h = struct.unpack(">II", data[16:24])
+    assert w > 500 and h > 200
+    rc, _, err = run(capsys, "lens", "diagram", "dgauss.50mm", "-o", str(png))
+    assert rc == 2 and "--force" in err
+    assert run(capsys, "lens", "diagram", "dgauss.50mm", "-o", str(png), "--force", "--focus", "1m")[0] == 0
+    svg = tmp_path / "nav.svg"
+    assert run(capsys, "lens", "diagram", "navarro_anamorphic_2x", "--axis", "x", "-o", str(svg))[0] == 0
+    assert b"<svg" in svg.read_bytes()[:500]
+
+
+def test_breathing_table_json_and_plot(capsys, tmp_path):
+    plot = tmp_path / "b.png"
+    rc, out, _ = run(capsys, "lens", "breathing", "dgauss.50mm", "--sensor-width", "36mm", "--at", "inf", "3m", "1m",
+                     "-o", str(plot), "--json")
+    assert rc == 0
+    d = json.loads(out)
+    rows = d["rows"]
+    assert rows[0]["focus_from_film_mm"] is None
+    assert rows[0]["hfov_deg"] == pytest.approx(math.degrees(2 * math.atan(18 / 50.3582)), abs=1e-3)
+    assert rows[2]["hfov_deg"] < rows[1]["hfov_deg"] < rows[0]["hfov_deg"]  # unit focus: the view narrows
+    assert plot.read_bytes()[:4] == b"\x89PNG"
+    rc, out, _ = run(capsys, "lens", "breathing", "canon_rf_85mm_f1_2")
+    assert rc == 0 and "breathing" in out
