@@ -176,3 +176,8 @@ def text_field(d: dict, key: str, where: str, path, line=None) -> str | None:
     if not isinstance(v, str):
         raise LensFileError(f"{where}.{key} must be a string, got {v!r}", path, line)
     return v
+
+
+def one_line(s: str) -> str:
+    """``s`` made safe for a single comment/header line: control characters become spaces."""
+    return "".join(" " if (ord(c) < 32 and c != "\t") or ord(c) == 127 or c in "\x85\u2028\u2029" else c for c in s)

@@ -28,6 +28,7 @@ from ._common import (
     MAX_SURFACES,
     check_count,
     number,
+    one_line,
     parse_toml,
     table,
     table_lines,
@@ -151,9 +152,9 @@ def dumps(p: Prescription) -> str:
     out = []
     for label, value in (("maker", m.maker), ("source", m.source)):
         if value:
-            out.append(f"# {label}: {value}".replace("\n", " "))
+            out.append(one_line(f"# {label}: {value}"))
     if m.notes:
-        out += [f"# {line}" for line in m.notes.splitlines()]
+        out += [one_line(f"# {line}") for line in m.notes.splitlines()]
     out.append("[lens]")
     out.append(f"name = {toml_value(m.name)}")
     for key in ("patent", "focal_length", "max_fstop", "coating"):

@@ -25,7 +25,7 @@ from pathlib import Path
 from ...errors import ExportError, InputError, LensFileError, PhysCamWarning
 from ..catalog import find_glass
 from ..prescription import AIR, LensMetadata, Medium, Prescription, Surface
-from ._common import MAX_SURFACES, check_count, fmt, number, validated
+from ._common import MAX_SURFACES, check_count, fmt, number, one_line, validated
 
 __all__ = ["loads", "dumps"]
 
@@ -105,6 +105,9 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
             if n != int(n) or not 0 <= n <= 16:
                 raise LensFileError(f"PARM number {tok[1]} is not 0..16", path, lineno)
             cur["parm"][int(n)] = _num(tok, 2, f"PARM {int(n)}", path, lineno, length=False)
+            if cur["parm"][int(n)] != 0.0 and (n == 1 or n > 8):
+                raise LensFileError(f"PARM {int(n)} is not supported (physcam keeps A4..A16 = PARM 2..8; "
+                                    "fold an r^2 term into CURV)", path, lineno)
         elif key == "GLAS":
             cur["glass"] = _glass(tok, path, lineno)
             cur["glass_line"] = lineno
@@ -200,9 +203,9 @@ def dumps(p: Prescription) -> str:
         raise ExportError(f"lens {p.name!r} is anamorphic; write physcam TOML instead")
     if p.focus is not None:
         warnings.warn(f"Zemax writer drops the focus groups of lens {p.name!r}", PhysCamWarning, stacklevel=3)
-    out = ["VERS 190513 80 123457", "MODE SUDA", f"NAME {p.name}".rstrip(), "UNIT MM X W X CM MR CPMM"]
+    out = ["VERS 190513 80 123457", "MODE SUDA", one_line(f"NAME {p.name}").rstrip(), "UNIT MM X W X CM MR CPMM"]
     if p.metadata.notes:
-        out += [f"NOTE 0 {line}".rstrip() for line in p.metadata.notes.splitlines()]
+        out += [one_line(f"NOTE 0 {line}").rstrip() for line in p.metadata.notes.splitlines()]
     out.append(f"WAVL {fmt(p.wavelength_nm / 1000.0)}")
     out += ["SURF 0", "  TYPE STANDARD", "  CURV 0.0", "  DISZ INFINITY"]
     for i, s in enumerate(p.surfaces, start=1):

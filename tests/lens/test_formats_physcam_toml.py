@@ -1,0 +1,99 @@
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from physcam.errors import LensFileError
+from physcam.lens.catalog import find_glass
+from physcam.lens.formats import dumps_lens, loads_lens
+from physcam.lens.prescription import AIR, Focus, LensMetadata, Medium, Prescription, Surface, VariableGap
+
+finite = st.floats(min_value=-1e3, max_value=1e3, allow_nan=False, allow_infinity=False)
+
+
+@st.composite
+def lenses(draw):
+    """Valid lenses: thin elements (|R| >= 40, semi <= 10) separated by generous gaps, one stop."""
+    n = draw(st.integers(2, 8))
+    stop = draw(st.integers(0, n - 1))
+    surfaces = []
+    for i in range(n):
+        semi = draw(st.floats(1.0, 10.0))
+        if i == stop:
+            surfaces.append(Surface(0.0, draw(st.floats(6.0, 20.0)), AIR, semi, "stop"))
+            continue
+        r = draw(st.floats(40.0, 1e4)) * draw(st.sampled_from([-1, 1]))
+        kind = draw(st.sampled_from(["spherical", "aspheric", "cylindrical_x", "cylindrical_y", "flat"]))
+        medium = draw(st.sampled_from([AIR, Medium(1.5168, 64.17, "N-BK7"),
+                                       Medium(draw(st.floats(1.0, 2.0)), draw(st.floats(0.0, 90.0)))]))
+        conic, asph = 0.0, ()
+        if kind == "aspheric":
+            conic = draw(st.floats(-2.0, 0.5))
+            # each term at most 0.01 mm at the 10 mm edge, so elements cannot cross
+            asph = tuple(draw(st.floats(-1.0, 1.0)) * 1e-2 / 10.0 ** (2 * k + 4) for k in range(draw(st.integers(0, 7))))
+        surfaces.append(Surface(0.0 if kind == "flat" else r, draw(st.floats(6.0, 20.0)), medium, semi, kind, conic, asph))
+    focus = None
+    air = [i for i, s in enumerate(surfaces) if s.medium == AIR]
+    if air and draw(st.booleans()):
+        i = draw(st.sampled_from(air))
+        focus = Focus(draw(st.floats(100.0, 1e4)), (VariableGap(i, surfaces[i].thickness, draw(st.floats(0.0, 20.0))),))
+    meta = LensMetadata(name=draw(st.text(min_size=1, max_size=20)), maker=draw(st.none() | st.text(max_size=10)),
+                        focal_length=draw(st.none() | st.floats(1.0, 1e3)), notes=draw(st.none() | st.text(max_size=40)))
+    extras = tuple(sorted({("iset.microlens", '{"x":[1,2]}'), ("provenance.aliases", '["a","b"]')}))
+    p = Prescription(tuple(surfaces), meta, focus, draw(st.sampled_from([1.0, 1.33, 2.0])), extras=extras)
+    return p.validate()
+
+
+@settings(max_examples=60, deadline=None)
+@given(lenses())
+def test_round_trip_property(p):
+    assert loads_lens(dumps_lens(p, "physcam"), "physcam") == p
+
+
+@settings(max_examples=40, deadline=None)
+@given(lenses())
+def test_seed_toml_keeps_the_geometry(p):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        q = loads_lens(dumps_lens(p, "seed-toml"), "seed-toml")
+    strip = lambda s: (s.radius, s.thickness, s.semi_diameter, s.kind, s.conic, s.aspheric, s.medium.nd, s.medium.vd)
+    assert [strip(s) for s in q.surfaces] == [strip(s) for s in p.surfaces]
+    assert q.focus == p.focus and q.squeeze == p.squeeze
+
+
+MINIMAL = """format = "physcam-lens/1"
+[lens]
+name = "glass by name"
+[[surface]]
+kind = "spherical"
+radius = 60.0
+thickness = 6.0
+semi_diameter = 12.0
+medium = { glass = "n-bk7" }
+[[surface]]
+kind = "stop"
+radius = 0.0
+thickness = 50.0
+semi_diameter = 10.0
+medium = "air"
+"""
+
+
+def test_glass_name_from_the_catalogue():
+    s = loads_lens(MINIMAL, "physcam").surfaces[0]
+    assert (s.medium.nd, s.medium.vd) == (1.5168, 64.17)  # SCHOTT N-BK7 datasheet
+    assert find_glass("N-SF11").nd == 1.78472 and find_glass("f2").vd == 36.37
+
+
+def test_unknown_glass_suggests():
+    with pytest.raises(LensFileError, match="N-BK7") as exc:
+        loads_lens(MINIMAL.replace("n-bk7", "N-BK8"), "physcam", "g.toml")
+    assert exc.value.line == 4
+
+
+def test_unknown_kind_and_bad_extras():
+    with pytest.raises(LensFileError, match="unknown kind"):
+        loads_lens(MINIMAL.replace('kind = "spherical"', 'kind = "toric"'), "physcam")
+    with pytest.raises(LensFileError, match="JSON"):
+        loads_lens(MINIMAL + '[extras]\n"a" = "{nope"\n', "physcam")

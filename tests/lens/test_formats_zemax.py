@@ -1,0 +1,104 @@
+import pytest
+
+from physcam.errors import ExportError, LensFileError
+from physcam.lens.catalog import find_glass
+from physcam.lens.formats import dumps_lens, loads_lens
+from physcam.lens.library import load_lens
+
+SINGLET = """VERS 190513 80 123457
+MODE SUDA
+NAME test singlet
+UNIT MM X W X CM MR CPMM
+SURF 0
+  TYPE STANDARD
+  CURV 0.0
+  DISZ INFINITY
+SURF 1
+  STOP
+  TYPE STANDARD
+  CURV 0.0
+  DISZ 2.0
+  DIAM 4.0 1 0 0 1 ""
+SURF 2
+  TYPE STANDARD
+  CURV 0.01 0 0 0 0 ""
+  DISZ 5.0
+  GLAS N-BK7 0 0 1.5168 64.17 0 0 0 0 0 0
+  DIAM 10.0 1 0 0 1 ""
+SURF 3
+  TYPE EVENASPH
+  CURV -0.02
+  CONI -1.5
+  PARM 1 0
+  PARM 2 1e-6
+  PARM 3 -2e-9
+  DISZ 90.0
+  DIAM 10.0 1 0 0 1 ""
+SURF 4
+  TYPE STANDARD
+  CURV 0.0
+  DISZ 0.0
+"""
+
+
+def test_reads_standard_and_even_asphere():
+    p = loads_lens(SINGLET, "zemax", "s.zmx")
+    assert p.name == "test singlet" and p.stop_index == 0
+    a, b = p.surfaces[1], p.surfaces[2]
+    assert a.radius == 100.0 and a.semi_diameter == 10.0  # CURV 0.01 -> R 100; DIAM is the semi-diameter
+    g = find_glass("N-BK7")
+    assert (a.medium.nd, a.medium.vd, a.medium.glass) == (1.5168, 64.17, "N-BK7") == (g.nd, g.vd, g.name)
+    assert (b.kind, b.radius, b.conic, b.aspheric) == ("aspheric", -50.0, -1.5, (1e-6, -2e-9))
+    assert b.thickness == 90.0 and b.medium.is_air
+    assert loads_lens(dumps_lens(p, "zemax"), "zemax") .surfaces == p.surfaces
+
+
+def test_model_glass():
+    text = SINGLET.replace("GLAS N-BK7 0 0 1.5168 64.17", "GLAS ___BLANK 1 0 1.7 30.5")
+    s = loads_lens(text, "zemax").surfaces[1]
+    assert (s.medium.nd, s.medium.vd, s.medium.glass) == (1.7, 30.5, None)
+
+
+@pytest.mark.parametrize(
+    "old, new, line, match",
+    [
+        ("TYPE EVENASPH", "TYPE TOROIDAL", 22, "TOROIDAL is not supported"),
+        ("GLAS N-BK7", "GLAS UNOBTAINIUM", 19, "unknown glass 'UNOBTAINIUM'"),
+        ("GLAS N-BK7", "GLAS MIRROR", 19, "MIRROR"),
+        ("UNIT MM", "UNIT IN", 4, "UNIT MM"),
+        ("PARM 1 0", "PARM 1 0.5", 25, "PARM 1"),
+        ("CURV 0.01", "CURV zz", 17, "CURV must be a number"),
+        ("  STOP\n", "", None, "no aperture stop"),
+    ],
+)
+def test_refuses_clearly(old, new, line, match):
+    with pytest.raises(LensFileError, match=match) as exc:
+        loads_lens(SINGLET.replace(old, new, 1), "zemax", "s.zmx")
+    assert exc.value.line == line and exc.value.path == "s.zmx"
+
+
+def test_curved_stop_refused():
+    text = SINGLET.replace("  STOP\n", "").replace("SURF 2\n", "SURF 2\n  STOP\n")
+    with pytest.raises(LensFileError, match="STOP is on a curved surface"):
+        loads_lens(text, "zemax")
+
+
+@pytest.mark.parametrize("name", ["canon_rf_85mm_f1_2", "dgauss_50mm", "zeiss_planar_80mm_f2_8"])
+def test_bundled_lenses_round_trip_through_zemax(name):
+    p = load_lens(name)
+    with pytest.warns(Warning) if p.focus else _nullcontext():
+        text = dumps_lens(p, "zemax")
+    assert loads_lens(text, "zemax").surfaces == p.surfaces
+
+
+def test_anamorphic_refused():
+    with pytest.raises(ExportError, match="cylindrical"):
+        dumps_lens(load_lens("navarro_anamorphic_2x"), "zemax")
+
+
+class _nullcontext:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *a):
+        return False
