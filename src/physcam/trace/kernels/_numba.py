@@ -1,0 +1,209 @@
+"""The JIT kernel: rays in blocks, each block traced surface by surface.
+
+Same algorithm, order of operations and answers as :mod:`._numpy` (see that module and
+docs/ray-tracing.md for the maths). Imported only through :mod:`physcam.trace.kernels`.
+
+Layout: ``prange`` over blocks of :data:`BLOCK` rays; for each surface an inner loop over the
+block's rays. One ray through eleven surfaces is a long chain of dependent square roots and
+divisions (latency-bound); looping over independent rays innermost lets the CPU overlap them,
+which measured about 2x faster than one ray through all surfaces per iteration.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from ._layout import A4, AX, AY, AZ, CK, CV, ETA, N1, N2, NAA, NAB, NBA, NBB, NEWTON_MAX_ITER, NEWTON_TOL
+from ._layout import CLIPPED, MISSED, RSC, SEMI, TIR, UNIT, VZ
+
+_FLAT, _STOP, _QUADRIC, _ASPHERE = 0, 1, 2, 3
+
+#: Rays per block: 9 float64 columns x 256 rays stay in the L1 cache.
+BLOCK = 256
+
+
+@nb.njit(parallel=True, fastmath=False, cache=True, nogil=True)
+def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
+    """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``."""
+    ns = S.shape[0]
+    n = x.shape[0]
+    nblocks = (n + BLOCK - 1) // BLOCK
+    for blk in nb.prange(nblocks):
+        i0 = blk * BLOCK
+        i1 = min(n, i0 + BLOCK)
+        il2 = np.empty(i1 - i0)
+        if not mono:
+            for i in range(i0, i1):
+                il2[i - i0] = 1.0 / (wl[i] * wl[i])
+        for s in range(ns):
+            kd = kinds[s]
+            vz = S[s, VZ]
+            ax = S[s, AX]
+            ay = S[s, AY]
+            az = S[s, AZ]
+            sd2 = S[s, SEMI] * S[s, SEMI]
+            unit = S[s, UNIT] != 0.0
+            rsc = S[s, RSC]
+            cv = S[s, CV]
+            ck1 = (1.0 + S[s, CK]) * cv * cv
+            for i in range(i0, i1):
+                if flag[i] != 0:
+                    continue
+                px = x[i]
+                py = y[i]
+                pz = z[i]
+                dx = L[i]
+                dy = M[i]
+                dz = N[i]
+                qz = pz - vz
+                # -- intersection: nearest-vertex root of ax x^2 + ay y^2 + az z^2 - 2 z = 0
+                if kd <= _STOP:
+                    if dz == 0.0:
+                        flag[i] = MISSED
+                        w[i] = 0.0
+                        continue
+                    t = -qz / dz
+                else:
+                    a = ax * dx * dx + ay * dy * dy + az * dz * dz
+                    b = ax * px * dx + ay * py * dy + az * qz * dz - dz
+                    c = ax * px * px + ay * py * py + az * qz * qz - 2.0 * qz
+                    disc = b * b - a * c
+                    if disc < 0.0:
+                        flag[i] = MISSED
+                        w[i] = 0.0
+                        continue
+                    sq = math.sqrt(disc)
+                    den = -b - sq if b >= 0.0 else -b + sq
+                    if den == 0.0:
+                        flag[i] = MISSED
+                        w[i] = 0.0
+                        continue
+                    t = c / den
+                dsr = 0.0
+                if kd == _ASPHERE:
+                    # -- Newton iteration on g(t) = z(t) - sag(r(t)), started at the conic root
+                    conv = False
+                    for _it in range(NEWTON_MAX_ITER):
+                        X = px + t * dx
+                        Y = py + t * dy
+                        Z = qz + t * dz
+                        r2 = X * X + Y * Y
+                        arg = 1.0 - ck1 * r2
+                        if arg < 0.0:
+                            break
+                        sa = math.sqrt(arg)
+                        sag = cv * r2 / (1.0 + sa)
+                        dsr = cv / sa
+                        p = r2 * r2
+                        q = r2
+                        for j in range(7):
+                            aj = S[s, A4 + j]
+                            sag = sag + aj * p
+                            dsr = dsr + (2.0 * j + 4.0) * aj * q
+                            p = p * r2
+                            q = q * r2
+                        g = Z - sag
+                        gp = dz - dsr * (X * dx + Y * dy)
+                        if gp == 0.0:
+                            break
+                        dt = g / gp
+                        t = t - dt
+                        if abs(dt) < NEWTON_TOL:
+                            conv = True
+                            break
+                    X = px + t * dx
+                    Y = py + t * dy
+                    r2 = X * X + Y * Y
+                    arg = 1.0 - ck1 * r2
+                    if not conv or arg < 0.0:
+                        flag[i] = MISSED
+                        w[i] = 0.0
+                        continue
+                    dsr = cv / math.sqrt(arg)
+                    q = r2
+                    for j in range(7):
+                        dsr = dsr + (2.0 * j + 4.0) * S[s, A4 + j] * q
+                        q = q * r2
+                hx = px + t * dx
+                hy = py + t * dy
+                hz = pz + t * dz
+                # -- clip at the clear semi-diameter (and the stop)
+                if clip and hx * hx + hy * hy > sd2:
+                    flag[i] = CLIPPED
+                    w[i] = 0.0
+                    continue
+                x[i] = hx
+                y[i] = hy
+                z[i] = hz
+                if kd == _STOP:
+                    continue
+                if mono:
+                    n1 = S[s, N1]
+                    n2 = S[s, N2]
+                    eta = S[s, ETA]
+                else:
+                    n1 = S[s, NBA] + S[s, NBB] * il2[i - i0]
+                    n2 = S[s, NAA] + S[s, NAB] * il2[i - i0]
+                    eta = n1 / n2
+                if n1 == n2:
+                    continue
+                # -- unit surface normal, pointing to -z at the vertex
+                if kd == _FLAT:
+                    gx = 0.0
+                    gy = 0.0
+                    gz = -1.0
+                elif kd == _QUADRIC:
+                    gx = ax * hx
+                    gy = ay * hy
+                    gz = az * (hz - vz) - 1.0
+                else:
+                    gx = dsr * hx
+                    gy = dsr * hy
+                    gz = -1.0
+                if not unit:
+                    inv = 1.0 / math.sqrt(gx * gx + gy * gy + gz * gz)
+                    gx = gx * inv
+                    gy = gy * inv
+                    gz = gz * inv
+                ci = dx * gx + dy * gy + dz * gz
+                if ci < 0.0:
+                    gx = -gx
+                    gy = -gy
+                    gz = -gz
+                    ci = -ci
+                # -- Snell's law in vector form; total internal reflection
+                kk = 1.0 - eta * eta * (1.0 - ci * ci)
+                if kk < 0.0:
+                    flag[i] = TIR
+                    w[i] = 0.0
+                    continue
+                ct = math.sqrt(kk)
+                if fresnel:
+                    ec = eta * ci
+                    et = eta * ct
+                    sm = (ec - ct) * (ci + et)
+                    pm = (ci - et) * (ec + ct)
+                    sp = (ec + ct) * (ci + et)
+                    rr = 0.5 * (sm * sm + pm * pm) / (sp * sp) * rsc
+                    if rr > 1.0:
+                        rr = 1.0
+                    w[i] = w[i] * (1.0 - rr)
+                f = ct - eta * ci
+                L[i] = eta * dx + f * gx
+                M[i] = eta * dy + f * gy
+                N[i] = eta * dz + f * gz
+        if has_end:
+            for i in range(i0, i1):
+                if flag[i] != 0:
+                    continue
+                if N[i] == 0.0:
+                    flag[i] = MISSED
+                    w[i] = 0.0
+                    continue
+                t = (end_z - z[i]) / N[i]
+                x[i] = x[i] + t * L[i]
+                y[i] = y[i] + t * M[i]
+                z[i] = end_z

@@ -1,0 +1,103 @@
+"""Rays as a structure of arrays.
+
+A :class:`RayBatch` holds one float64 array per component: position ``x, y, z`` (mm, lens
+space: z = 0 at the first vertex, +z toward the film; docs/conventions.md), direction
+cosines ``L, M, N`` (unit vector, L^2 + M^2 + N^2 = 1), ``wavelength_nm``, ``weight``
+(radiometric throughput, 0 for a lost ray) and ``flag`` (uint8, one of :data:`OK`,
+:data:`MISSED`, :data:`CLIPPED`, :data:`TIR`). A lost ray keeps its last finite position
+and direction, never NaN.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["OK", "MISSED", "CLIPPED", "TIR", "FLAG_NAMES", "RayBatch"]
+
+OK = 0  #: the ray went through every surface
+MISSED = 1  #: the ray did not meet a surface (or met it behind itself)
+CLIPPED = 2  #: the ray met a surface outside its clear semi-diameter (or the stop)
+TIR = 3  #: total internal reflection
+FLAG_NAMES = {OK: "ok", MISSED: "missed", CLIPPED: "clipped", TIR: "tir"}
+
+
+@dataclass
+class RayBatch:
+    """Rays in lens space, one float64 array per component (see module notes)."""
+
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    L: np.ndarray
+    M: np.ndarray
+    N: np.ndarray
+    wavelength_nm: np.ndarray
+    weight: np.ndarray
+    flag: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.x.shape[0])
+
+    @classmethod
+    def from_arrays(cls, position, direction, wavelength_nm=587.5618, weight=1.0) -> "RayBatch":
+        """Rays from an (n, 3) ``position`` (mm) and an (n, 3) ``direction`` (normalised here).
+
+        Raises :class:`InputError` on NaN/inf, a zero direction or mismatched shapes.
+        """
+        p = np.atleast_2d(np.asarray(position, dtype=np.float64))
+        d = np.atleast_2d(np.asarray(direction, dtype=np.float64))
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise InputError(f"ray positions must have shape (n, 3), got {p.shape}")
+        p, d = np.broadcast_arrays(p, d)
+        if d.shape != p.shape:
+            raise InputError(f"ray directions must have shape {p.shape}, got {d.shape}")
+        if not (np.isfinite(p).all() and np.isfinite(d).all()):
+            raise InputError("ray positions and directions must be finite numbers (found NaN or inf)")
+        norm = np.sqrt((d * d).sum(axis=1))
+        if (norm == 0).any():
+            raise InputError("a ray direction is the zero vector; give a non-zero direction")
+        d = d / norm[:, None]
+        n = p.shape[0]
+        wl = np.broadcast_to(np.asarray(wavelength_nm, dtype=np.float64), (n,)).copy()
+        if not (np.isfinite(wl).all() and (wl > 0).all()):
+            raise InputError("wavelength_nm must be finite and > 0 nm")
+        w = np.broadcast_to(np.asarray(weight, dtype=np.float64), (n,)).copy()
+        if not (np.isfinite(w).all() and (w >= 0).all()):
+            raise InputError("ray weights must be finite and >= 0")
+        return cls(
+            np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1]), np.ascontiguousarray(p[:, 2]),
+            np.ascontiguousarray(d[:, 0]), np.ascontiguousarray(d[:, 1]), np.ascontiguousarray(d[:, 2]),
+            wl, w, np.zeros(n, dtype=np.uint8),
+        )
+
+    @classmethod
+    def collimated(cls, x, y, z0: float, direction=(0.0, 0.0, 1.0), wavelength_nm=587.5618) -> "RayBatch":
+        """Parallel rays starting at heights ``x, y`` (mm) on the plane z = ``z0``, all along ``direction``."""
+        x = np.asarray(x, dtype=np.float64).ravel()
+        y = np.asarray(y, dtype=np.float64).ravel()
+        p = np.stack([x, y, np.full_like(x, float(z0))], axis=1)
+        return cls.from_arrays(p, np.asarray(direction, dtype=np.float64)[None, :], wavelength_nm)
+
+    def copy(self) -> "RayBatch":
+        return RayBatch(*(np.array(a, copy=True) for a in self.columns()))
+
+    def columns(self):
+        return (self.x, self.y, self.z, self.L, self.M, self.N, self.wavelength_nm, self.weight, self.flag)
+
+    def take(self, index) -> "RayBatch":
+        """The rays selected by a boolean mask or index array."""
+        return RayBatch(*(a[index] for a in self.columns()))
+
+    @property
+    def ok(self) -> np.ndarray:
+        """Boolean mask of rays that went through."""
+        return self.flag == OK
+
+    def counts(self) -> dict[str, int]:
+        """How many rays carry each flag, by name."""
+        c = np.bincount(self.flag, minlength=4)
+        return {FLAG_NAMES[i]: int(c[i]) for i in range(4)}

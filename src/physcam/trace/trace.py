@@ -1,0 +1,212 @@
+"""Public tracing API: object space to film, and film to scene (camera rays for renderers).
+
+Distances are mm in lens space (z = 0 at the first vertex, +z toward the film;
+docs/conventions.md). ``film_z`` is the film plane's z in lens space, i.e. the last vertex z
+plus the back focal distance the film sits at.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError, OpticsError, require_finite
+from ..lens.prescription import Prescription
+from .kernels import get_kernel
+from .kernels._layout import pack, set_wavelength
+from .rays import OK, RayBatch
+from .surfaces import surface_table
+
+__all__ = ["DEFAULT_CHUNK", "trace_to_film", "trace_through", "paraxial_image_z", "CameraRays", "camera_rays"]
+
+#: Rays per kernel call: bounds the numpy kernel's temporaries (about 40 arrays of this size).
+DEFAULT_CHUNK = 1 << 18
+
+
+def _check_lens(lens) -> Prescription:
+    if not isinstance(lens, Prescription):
+        raise InputError(f"expected a physcam Prescription, got {type(lens).__name__}")
+    return lens
+
+
+def _run(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chunk_size):
+    has_end = end_z is not None
+    ez = float(end_z) if has_end else 0.0
+    n = len(rays)
+    cols = rays.columns()
+    for a in range(0, n, chunk_size):
+        b = min(n, a + chunk_size)
+        wl = rays.wavelength_nm[a:b]
+        mono = bool(wl.size) and bool(wl.min() == wl.max())
+        if mono:
+            set_wavelength(S, float(wl[0]))
+        kernel(*(c[a:b] for c in cols), S, kinds, bool(clip), bool(fresnel), ez, has_end, mono)
+    return rays
+
+
+def trace_through(
+    lens: Prescription,
+    rays: RayBatch,
+    *,
+    reverse: bool = False,
+    end_z: float | None = None,
+    clip: bool = True,
+    fresnel: bool = False,
+    coating: str | None = "none",
+    stop_semi_diameter: float | None = None,
+    backend: str = "auto",
+    chunk_size: int = DEFAULT_CHUNK,
+) -> RayBatch:
+    """Trace a copy of ``rays`` through every surface (front to back, or back to front when
+    ``reverse``), then, if ``end_z`` is given, on to the plane z = ``end_z`` (mm, lens space).
+
+    Returns the rays after the last surface (or on the end plane) with flags and weights.
+    """
+    _check_lens(lens)
+    if chunk_size < 1:
+        raise InputError(f"chunk_size must be >= 1, got {chunk_size}")
+    if end_z is not None:
+        end_z = require_finite("end_z", end_z)
+    table = surface_table(lens, reverse=reverse, stop_semi_diameter=stop_semi_diameter, coating=coating)
+    S, kinds = pack(table)
+    out = rays.copy()
+    return _run(get_kernel(backend), out, S, kinds, clip=clip, fresnel=fresnel, end_z=end_z, chunk_size=chunk_size)
+
+
+def trace_to_film(
+    lens: Prescription,
+    rays: RayBatch,
+    film_z: float | None = None,
+    **kwargs,
+) -> RayBatch:
+    """Trace object-space ``rays`` (z before the first vertex) through ``lens`` to the film plane.
+
+    ``film_z`` (mm, lens space) defaults to the paraxial image plane of an object at infinity at
+    the lens's design wavelength. Keyword arguments as :func:`trace_through` (``clip``,
+    ``fresnel``, ``coating``, ``stop_semi_diameter``, ``backend``, ``chunk_size``).
+    """
+    if film_z is None:
+        film_z = paraxial_image_z(_check_lens(lens))
+    return trace_through(lens, rays, end_z=film_z, **kwargs)
+
+
+def paraxial_image_z(lens: Prescription, wavelength_nm: float | None = None, *, backend: str = "numpy") -> float:
+    """z (mm, lens space) of the paraxial image of an axial object at infinity.
+
+    Found with real rays parallel to the axis at heights h and 2h (h = 1e-3 of the front
+    semi-diameter), unclipped; their axis crossings z(h) = z0 + a h^2 + O(h^4) are
+    extrapolated to h = 0 (Richardson). Agrees with the paraxial (ABCD) image plane to ~1e-9 mm.
+    Raises :class:`OpticsError` for an afocal or diverging lens (no real image).
+    """
+    _check_lens(lens)
+    wl = lens.wavelength_nm if wavelength_nm is None else require_finite("wavelength_nm", wavelength_nm)
+    h = 1e-3 * lens.surfaces[0].semi_diameter
+    rays = RayBatch.collimated([0.0, 0.0], [h, 2 * h], -1.0, wavelength_nm=wl)
+    out = trace_through(lens, rays, clip=False, backend=backend)
+    if not out.ok.all() or not (out.M < 0).all():
+        raise OpticsError(f"lens {lens.name!r} forms no real image of an axial object at infinity")
+    zc = out.z - out.y * out.N / out.M
+    return float((4.0 * zc[0] - zc[1]) / 3.0)
+
+
+@dataclass
+class CameraRays:
+    """Rays leaving the lens toward the scene, for a renderer.
+
+    ``origin`` and ``direction`` are (n, 3) in physcam camera space (docs/conventions.md: origin
+    at the film centre, looking down -Z, +Y up, mm); ``weight`` is the radiometric weight
+    (0 for a blocked ray); ``lens_rays`` the same rays in lens space with their flags.
+    """
+
+    origin: np.ndarray
+    direction: np.ndarray
+    weight: np.ndarray
+    lens_rays: RayBatch
+
+    @property
+    def ok(self) -> np.ndarray:
+        return self.lens_rays.flag == OK
+
+
+def camera_rays(
+    lens: Prescription,
+    film_xy,
+    pupil_samples,
+    film_z: float | None = None,
+    *,
+    wavelength_nm=None,
+    bounds=None,
+    aperture=None,
+    fresnel: bool = False,
+    coating: str | None = "none",
+    stop_semi_diameter: float | None = None,
+    backend: str = "auto",
+    chunk_size: int = DEFAULT_CHUNK,
+) -> CameraRays:
+    """Film point + pupil sample -> ray leaving the front of the lens, and its weight.
+
+    ``film_xy`` (n, 2) mm on the film plane z = ``film_z`` (default: paraxial focus at infinity);
+    ``pupil_samples`` (n, 2) in [0, 1)^2 pick a point on the rectangle the ray is aimed at on
+    the rear vertex plane: ``bounds`` (a :class:`~physcam.trace.pupil_bounds.PupilBounds`, per
+    film point) or the rear element's bounding square. ``aperture`` (an
+    :class:`~physcam.trace.aperture.Aperture`) masks and weights rays at the stop.
+
+    Weight (pbrt-v4 ``RealisticCamera``): E = T cos^4(theta) A / d^2, with theta the ray's angle
+    to the axis at the film, A the sampled rectangle's area and d the film-to-rear-vertex
+    distance; T the Fresnel transmittance when ``fresnel``, times the aperture density.
+    """
+    _check_lens(lens)
+    fxy = np.atleast_2d(np.asarray(film_xy, dtype=np.float64))
+    uv = np.atleast_2d(np.asarray(pupil_samples, dtype=np.float64))
+    if fxy.shape[-1] != 2 or uv.shape[-1] != 2:
+        raise InputError("film_xy and pupil_samples must have shape (n, 2)")
+    fxy, uv = np.broadcast_arrays(fxy, uv)
+    if not (np.isfinite(fxy).all() and np.isfinite(uv).all()):
+        raise InputError("film_xy and pupil_samples must be finite numbers")
+    if film_z is None:
+        film_z = paraxial_image_z(lens)
+    film_z = require_finite("film_z", film_z)
+    z_rear = lens.vertex_z[-1]
+    d = film_z - z_rear
+    if d <= 0:
+        raise InputError(f"the film plane (z = {film_z:g} mm) must lie behind the last vertex (z = {z_rear:g} mm)")
+    n = fxy.shape[0]
+    if bounds is None:
+        r = lens.surfaces[-1].semi_diameter
+        x0 = np.full(n, -r)
+        x1 = np.full(n, r)
+        y0 = np.full(n, -r)
+        y1 = np.full(n, r)
+    else:
+        x0, x1, y0, y1 = bounds.rect_at(fxy[:, 0], fxy[:, 1])
+    px = x0 + uv[:, 0] * (x1 - x0)
+    py = y0 + uv[:, 1] * (y1 - y0)
+    area = (x1 - x0) * (y1 - y0)
+    start = np.stack([fxy[:, 0], fxy[:, 1], np.full(n, film_z)], axis=1)
+    dirn = np.stack([px - fxy[:, 0], py - fxy[:, 1], np.full(n, -d)], axis=1)
+    wl = lens.wavelength_nm if wavelength_nm is None else wavelength_nm
+    rays = RayBatch.from_arrays(start, dirn, wl)
+    cos_t = -rays.N
+    rays.weight[:] = cos_t**4 * area / (d * d)
+
+    table = surface_table(lens, reverse=True, stop_semi_diameter=stop_semi_diameter, coating=coating)
+    S, kinds = pack(table)
+    kernel = get_kernel(backend)
+    if aperture is None:
+        _run(kernel, rays, S, kinds, clip=True, fresnel=fresnel, end_z=None, chunk_size=chunk_size)
+    else:
+        # trace film -> stop, weigh by the aperture shape there, then stop -> front
+        k = int(np.flatnonzero(table.index == lens.stop_index)[0])
+        _run(kernel, rays, S[: k + 1], kinds[: k + 1], clip=True, fresnel=fresnel, end_z=None, chunk_size=chunk_size)
+        rstop = table.semi_diameter[k]
+        dens = aperture.density_at(rays.x / rstop, rays.y / rstop)
+        live = rays.flag == OK
+        rays.weight[live] *= dens[live]
+        blocked = live & (dens <= 0.0)
+        rays.flag[blocked] = 2
+        rays.weight[blocked] = 0.0
+        _run(kernel, rays, S[k + 1 :], kinds[k + 1 :], clip=True, fresnel=fresnel, end_z=None, chunk_size=chunk_size)
+    origin = np.stack([rays.x, rays.y, rays.z - film_z], axis=1)
+    direction = np.stack([rays.L, rays.M, rays.N], axis=1)
+    return CameraRays(origin, direction, rays.weight, rays)

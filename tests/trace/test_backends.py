@@ -1,0 +1,96 @@
+"""The numba and numpy kernels give the same rays; properties that hold for any ray."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from physcam.errors import BackendError
+from physcam.lens.prescription import Medium, Prescription, Surface
+from physcam.trace import RayBatch, trace_through, trace_to_film
+from physcam.trace.kernels import resolve_backend
+
+from _trace_lenses import DGAUSS_ROWS, build_pbrt
+
+ABBE = [47.0, 0, 47.0, 30.0, 0, 0, 38.0, 57.0, 0, 48.0, 0]
+
+
+def mixed_lens():
+    """A made-up lens exercising every surface kind (asphere, conic, cylinders, flat, stop)."""
+    return Prescription(
+        (
+            Surface(40.0, 4.0, Medium(1.62, 58.0), 14.0, "aspheric", conic=-0.5, aspheric=(-1e-5, 2e-8)),
+            Surface(-120.0, 2.0, Medium(), 14.0, "aspheric", conic=3.0),
+            Surface(0.0, 3.0, Medium(), 9.0, "stop"),
+            Surface(60.0, 3.0, Medium(1.7, 30.0), 11.0, "cylindrical_x"),
+            Surface(0.0, 2.0, Medium(1.5, 64.0), 11.0, "flat"),
+            Surface(-80.0, 30.0, Medium(), 11.0, "cylindrical_y"),
+        )
+    )
+
+
+def random_rays(n, seed, spread=16.0):
+    rng = np.random.default_rng(seed)
+    p = np.stack([rng.uniform(-spread, spread, n), rng.uniform(-spread, spread, n), np.full(n, -3.0)], axis=1)
+    d = np.stack([rng.normal(0, 0.15, n), rng.normal(0, 0.15, n), np.ones(n)], axis=1)
+    return RayBatch.from_arrays(p, d, rng.uniform(420, 680, n))
+
+
+@pytest.mark.parametrize("lens_factory", [lambda: build_pbrt(DGAUSS_ROWS, abbe=ABBE), mixed_lens])
+@pytest.mark.parametrize("fresnel", [False, True])
+def test_numba_and_numpy_agree(lens_factory, fresnel):
+    lens = lens_factory()
+    rays = random_rays(3000, 11)
+    kw = dict(end_z=80.0, fresnel=fresnel, coating="single", chunk_size=1000)
+    a = trace_through(lens, rays, backend="numba", **kw)
+    b = trace_through(lens, rays, backend="numpy", **kw)
+    np.testing.assert_array_equal(a.flag, b.flag)
+    assert 0 < a.ok.sum() < len(rays)  # some pass, some are lost
+    for u, v in zip(a.columns()[:8], b.columns()[:8]):
+        np.testing.assert_allclose(u, v, rtol=0, atol=1e-12)
+
+
+def test_monochrome_fast_path_matches_per_ray_indices():
+    lens = build_pbrt(DGAUSS_ROWS, abbe=ABBE)
+    rays = random_rays(500, 3, spread=10.0)
+    rays.wavelength_nm[:] = 486.1327
+    mono = trace_through(lens, rays, end_z=70.0, fresnel=True)  # one wavelength: precomputed indices
+    rays.wavelength_nm[-1] = 500.0  # now two wavelengths: per-ray indices
+    mixed = trace_through(lens, rays, end_z=70.0, fresnel=True)
+    for u, v in zip(mono.columns()[:6], mixed.columns()[:6]):
+        np.testing.assert_array_equal(u[:-1], v[:-1])
+
+
+def test_unknown_backend_is_refused():
+    with pytest.raises(BackendError):
+        resolve_backend("cuda")
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    x=st.floats(-30, 30), y=st.floats(-30, 30), l=st.floats(-0.6, 0.6), m=st.floats(-0.6, 0.6),
+    wl=st.floats(380, 760), backend=st.sampled_from(["numba", "numpy"]),
+)
+def test_any_ray_comes_out_finite_unit_and_flagged(x, y, l, m, wl, backend):
+    lens = mixed_lens()
+    rays = RayBatch.from_arrays([[x, y, -3.0]], [[l, m, 1.0]], wl)
+    out = trace_through(lens, rays, end_z=60.0, fresnel=True, backend=backend)
+    for a in out.columns()[:8]:
+        assert np.isfinite(a).all()
+    assert abs(out.L[0] ** 2 + out.M[0] ** 2 + out.N[0] ** 2 - 1.0) < 1e-12
+    assert 0.0 <= out.weight[0] <= 1.0
+    assert (out.weight[0] == 0.0) == (out.flag[0] != 0)
+
+
+@settings(max_examples=30, deadline=None)
+@given(h=st.floats(0.0, 10.0), phi=st.floats(0, 6.2831), wl=st.floats(420, 680))
+def test_rotational_symmetry_of_a_spherical_lens(h, phi, wl):
+    # A rotationally symmetric lens maps a ray at (h, 0) and the same ray rotated by phi to
+    # image points related by the same rotation.
+    lens = build_pbrt(DGAUSS_ROWS, abbe=ABBE)
+    rays = RayBatch.collimated([h, h * np.cos(phi)], [0.0, h * np.sin(phi)], -1.0, wavelength_nm=wl)
+    out = trace_to_film(lens, rays, 68.0)
+    assert out.flag[0] == out.flag[1]
+    if out.flag[0] == 0:
+        assert out.x[1] == pytest.approx(out.x[0] * np.cos(phi), abs=1e-9)
+        assert out.y[1] == pytest.approx(out.x[0] * np.sin(phi), abs=1e-9)
