@@ -244,15 +244,24 @@ def _set(prim, name, type_name, value, custom=False):
     return attr
 
 
+ALL_PARTS = ("body", "sensor", "lens", "render")
+
+
 def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0),
-                  rotate_xyz_deg=(0.0, 0.0, 0.0), report=None):
+                  rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, parts=ALL_PARTS):
     """Author ``spec`` at ``path`` on ``stage`` (its current edit target); return the PhysicalCamera prim.
 
     ``position``: where the entrance pupil is, in scene units in the parent's space;
     ``rotate_xyz_deg``: rotation about the pupil (degrees, XYZ order).
     ``report``: the lens report of ``spec`` when the caller has one (else it is solved).
     Works inside a variant edit context, so kits and lens libraries reuse it.
+    ``parts`` limits what is written: "body" (transform, shutter), "sensor", "lens"
+    (lens API and lens model prim), "render" (the companion UsdGeomCamera); a body file
+    and a lens file each write their own parts and a shot composes them.
     """
+    bad = set(parts) - set(ALL_PARTS)
+    if bad:
+        raise InputError(f"unknown camera parts {sorted(bad)}; use {', '.join(ALL_PARTS)}")
     ensure_registered()
     from pxr import Gf, Sdf, UsdGeom
 
@@ -282,10 +291,24 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
     cam = stage.DefinePrim(sdf_path, "PhysicalCamera")
     if not stage.GetDefaultPrim():
         stage.SetDefaultPrim(stage.GetPrimAtPath(sdf_path.GetPrefixes()[0]))
-    cam.ApplyAPI("PhysicalCameraSensorAPI", SENSOR_INSTANCE)
-    cam.ApplyAPI("PhysicalCameraLensAPI", LENS_INSTANCE)
+    if "sensor" in parts:
+        cam.ApplyAPI("PhysicalCameraSensorAPI", SENSOR_INSTANCE)
+    if "lens" in parts:
+        cam.ApplyAPI("PhysicalCameraLensAPI", LENS_INSTANCE)
+    if "body" in parts:
+        _author_body(cam, spec, position, rotate_xyz_deg, su(eye))
+    if "sensor" in parts:
+        _author_sensor(cam, spec)
+    if "lens" in parts:
+        _author_lens(stage, cam, spec, eye, su)
+    if "render" in parts:
+        author_render_camera(stage, sdf_path, spec, report=report)
+    return cam
 
-    # --- body -------------------------------------------------------------------
+
+def _author_body(cam, spec, position, rotate_xyz_deg, eye_su):
+    from pxr import Gf, Sdf, UsdGeom
+
     _set(cam, "flangeDistance", Sdf.ValueTypeNames.Float, spec.flange_distance_mm)
     _set(cam, "shutterOpen", Sdf.ValueTypeNames.Float, spec.shutter_open_s)
     _set(cam, "shutterDuration", Sdf.ValueTypeNames.Float, spec.shutter_duration_s)
@@ -295,9 +318,12 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
     xf.ClearXformOpOrder()
     xf.AddTranslateOp().Set(Gf.Vec3d(*map(float, position)))
     xf.AddRotateXYZOp().Set(Gf.Vec3f(*map(float, rotate_xyz_deg)))
-    xf.AddTranslateOp(opSuffix="pupilToFilm").Set(Gf.Vec3d(0.0, 0.0, su(eye)))
+    xf.AddTranslateOp(opSuffix="pupilToFilm").Set(Gf.Vec3d(0.0, 0.0, eye_su))
 
-    # --- sensor -----------------------------------------------------------------
+
+def _author_sensor(cam, spec):
+    from pxr import Gf, Sdf
+
     sp = f"sensor:{SENSOR_INSTANCE}:"
     _set(cam, sp + "aperture", Sdf.ValueTypeNames.Float2, Gf.Vec2f(spec.sensor_width_mm, spec.sensor_height_mm))
     _set(cam, sp + "shift", Sdf.ValueTypeNames.Float2, Gf.Vec2f(*spec.shift_mm))
@@ -306,7 +332,11 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
     if spec.sensor_name:
         cam.SetCustomDataByKey("physcam:sensorName", spec.sensor_name)
 
-    # --- lens and its model ------------------------------------------------------
+
+def _author_lens(stage, cam, spec, eye, su):
+    from pxr import Gf, Sdf
+
+    sdf_path = cam.GetPath()
     lp = f"lens:{LENS_INSTANCE}:"
     _set(cam, lp + "fStop", Sdf.ValueTypeNames.Float, spec.fstop)
     _set(cam, lp + "iris", Sdf.ValueTypeNames.Float, spec.focal_length_mm / spec.fstop)
@@ -334,10 +364,6 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
         model.SetCustomDataByKey("physcam:lensName", spec.lens_name)
     cam.GetRelationship(lp + "lensModel") or cam.CreateRelationship(lp + "lensModel", False)
     cam.GetRelationship(lp + "lensModel").SetTargets([model.GetPath()])
-
-    # --- the companion UsdGeomCamera -------------------------------------------
-    author_render_camera(stage, sdf_path, spec, report=report)
-    return cam
 
 
 def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None):

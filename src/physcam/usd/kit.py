@@ -1,0 +1,299 @@
+"""The "Physical Cameras for USD" proposal's pipeline use cases, built from physcam cameras.
+
+* :func:`write_lens_file`: a lens library entry, one file per lens, with one
+  ``characterization`` variant per measuring day plus ``current`` (a copy of the
+  latest, selected by default) ("Interesting Looking Models").
+* :func:`write_body_file` and :func:`write_shot`: bodies and lenses in their own files,
+  referenced together per shot, with shot-level overrides ("Likeable Puppets").
+* :func:`write_previs_kit`: one file, eight ``setup`` variants (Doll House, Over The
+  Shoulder, Out in the Desert, ...) ("Bellam Blvd Previs").
+* :func:`write_vendor_lens`: a vendor's lens file with the real prescription and a
+  best-match pinhole, a ``lensModel`` variant choosing which renders ("Beloved Lens Co").
+
+Every file is validated with usd-core's validators and written atomically
+(:func:`physcam.usd.author.save_stage`). Lengths in mm (docs/usd.md).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from ..errors import ExportError, InputError
+from .author import LENS_INSTANCE, CameraSpec, author_camera, author_render_camera, new_stage, save_stage
+from .plugin import ensure_registered
+
+__all__ = [
+    "PREVIS_SETUPS",
+    "SHOT_OVERRIDES",
+    "best_match_pinhole",
+    "write_body_file",
+    "write_lens_file",
+    "write_previs_kit",
+    "write_shot",
+    "write_vendor_lens",
+]
+
+LENS_PRIM = "/Lens"
+BODY_PRIM = "/Body"
+
+#: The previs kit's eight setups: variant name -> camera (mm, f-numbers; focus from the film plane).
+PREVIS_SETUPS: dict[str, CameraSpec] = {
+    "DollHouse": CameraSpec(focal_length_mm=24.0, fstop=16.0, focus_mm=300.0, sensor_width_mm=23.6,
+                            sensor_height_mm=15.6, coc_mm=0.02, clipping_mm=(10.0, 1.0e5)),
+    "OverTheShoulder": CameraSpec(focal_length_mm=50.0, fstop=2.8, focus_mm=1500.0, sensor_width_mm=24.89,
+                                  sensor_height_mm=18.66, coc_mm=0.025),
+    "OutInTheDesert": CameraSpec(focal_length_mm=24.0, fstop=11.0, focus_mm=20000.0, sensor_width_mm=24.89,
+                                 sensor_height_mm=18.66, coc_mm=0.025, clipping_mm=(500.0, 1.0e8)),
+    "CloseUp": CameraSpec(focal_length_mm=85.0, fstop=2.0, focus_mm=1000.0, sensor_width_mm=24.89,
+                          sensor_height_mm=18.66, coc_mm=0.025),
+    "WideMaster": CameraSpec(focal_length_mm=18.0, fstop=5.6, focus_mm=4000.0, sensor_width_mm=24.89,
+                             sensor_height_mm=18.66, coc_mm=0.025),
+    "LongLens": CameraSpec(focal_length_mm=200.0, fstop=4.0, focus_mm=30000.0, sensor_width_mm=24.89,
+                           sensor_height_mm=18.66, coc_mm=0.025, clipping_mm=(1000.0, 1.0e8)),
+    "Anamorphic": CameraSpec(focal_length_mm=50.0, fstop=2.8, focus_mm=3000.0, sensor_width_mm=22.0,
+                             sensor_height_mm=18.6, squeeze=2.0, coc_mm=0.025, aperture_blades=11),
+    "TopDownPlan": CameraSpec(projection="orthographic", magnification=0.002, focal_length_mm=50.0,
+                              focus_mm=10000.0, sensor_width_mm=36.0, sensor_height_mm=24.0,
+                              clipping_mm=(100.0, 1.0e6)),
+}
+
+#: CameraSpec fields a shot may override, and the schema attributes each one writes.
+SHOT_OVERRIDES = {
+    "fstop": "lens", "focus_mm": "lens", "transmittance": "lens", "aperture_blades": "lens",
+    "aperture_angle_deg": "lens", "aperture_roundness": "lens", "aperture_density": "lens",
+    "clipping_mm": "lens",
+    "shift_mm": "sensor", "iso": "sensor", "coc_mm": "sensor",
+    "shutter_open_s": "body", "shutter_duration_s": "body", "shutter_opening": "body",
+}
+
+
+def _stage(meters_per_unit, fps):
+    return new_stage(meters_per_unit, fps)
+
+
+def write_lens_file(file, characterizations: dict, *, force: bool = False, meters_per_unit: float = 0.01,
+                    fps: float = 24.0):
+    """One lens, one file: ``characterizations`` maps a date ("2026-03-01") to the lens's CameraSpec that day.
+
+    Only the lens part is written (lens API, lens model). Variant set
+    ``characterization`` holds one variant per date (names get a ``d`` prefix, USD
+    variant names cannot start with a digit... they can, but ``-`` is not allowed,
+    so ``2026-03-01`` becomes ``d2026_03_01``) and ``current``, a copy of the latest
+    date, selected by default. Returns the Path.
+    """
+    ensure_registered()
+    if not characterizations:
+        raise InputError("a lens file needs at least one characterization (date -> lens values)")
+    stage = _stage(meters_per_unit, fps)
+    prim = stage.DefinePrim(LENS_PRIM, "PhysicalCamera")
+    stage.SetDefaultPrim(prim)
+    vset = prim.GetVariantSets().AddVariantSet("characterization")
+    dates = sorted(characterizations)
+    entries = [(_variant_name(d), characterizations[d]) for d in dates]
+    entries.append(("current", characterizations[dates[-1]]))
+    for name, spec in entries:
+        vset.AddVariant(name)
+        vset.SetVariantSelection(name)
+        with vset.GetVariantEditContext():
+            author_camera(stage, LENS_PRIM, spec, parts=("lens",))
+    vset.SetVariantSelection("current")
+    prim.SetCustomDataByKey("physcam:currentIs", _variant_name(dates[-1]))
+    return save_stage(stage, file, force=force)
+
+
+def _variant_name(date: str) -> str:
+    name = "d" + "".join(c if c.isalnum() else "_" for c in str(date))
+    return name
+
+
+def write_body_file(file, spec: CameraSpec, *, force: bool = False, meters_per_unit: float = 0.01,
+                    fps: float = 24.0):
+    """A camera body (flange, shutter, transform pivot) with its sensor, at ``/Body``."""
+    stage = _stage(meters_per_unit, fps)
+    author_camera(stage, BODY_PRIM, spec, parts=("body", "sensor"))
+    return save_stage(stage, file, force=force)
+
+
+def write_shot(file, body_file, lens_file, *, overrides: dict | None = None, lens_variant: str | None = None,
+               path: str = "/Cameras/Shot", position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0),
+               force: bool = False, meters_per_unit: float = 0.01, fps: float = 24.0):
+    """A shot layer: ``path`` references the body and the lens files; the shot's overrides are local.
+
+    The composed camera is read back, ``overrides`` (CameraSpec fields listed in
+    :data:`SHOT_OVERRIDES`) are applied as shot-layer opinions, and the companion
+    UsdGeomCamera is written from the composed result. Re-run it when a referenced file
+    changes so the companion camera follows. ``lens_variant`` pins a characterization
+    (for archiving); the default keeps the lens file's selection ("current").
+    """
+    from pathlib import Path
+
+    from pxr import Sdf, Usd, UsdGeom
+
+    from .read import read_camera
+
+    overrides = dict(overrides or {})
+    unknown = set(overrides) - set(SHOT_OVERRIDES)
+    if unknown:
+        raise InputError(f"cannot override {sorted(unknown)} per shot; choose from {', '.join(sorted(SHOT_OVERRIDES))}")
+    out = Path(file).resolve()
+    if not Sdf.Path.IsValidPathString(path) or not Sdf.Path(path).IsAbsolutePath():
+        raise ExportError(f"shot camera path {path!r} is not an absolute prim path such as /Cameras/Shot")
+    # an in-memory layer that carries the output path, so relative references resolve from its folder
+    layer = Sdf.Find(str(out)) or Sdf.Layer.New(Sdf.FileFormat.FindByExtension("usda"), str(out))
+    layer.Clear()
+    stage = Usd.Stage.Open(layer)
+    UsdGeom.SetStageMetersPerUnit(stage, meters_per_unit)
+    UsdGeom.SetStageUpAxis(stage, "Y")
+    stage.SetTimeCodesPerSecond(fps)
+    stage.SetFramesPerSecond(fps)
+    for parent in reversed(Sdf.Path(path).GetParentPath().GetPrefixes()):
+        UsdGeom.Xform.Define(stage, parent)
+    cam = stage.DefinePrim(path, "PhysicalCamera")
+    stage.SetDefaultPrim(stage.GetPrimAtPath(Sdf.Path(path).GetPrefixes()[0]))
+    refs = cam.GetReferences()
+    for f, prim_path in ((lens_file, LENS_PRIM), (body_file, BODY_PRIM)):  # lens listed first: stronger
+        p = Path(f)
+        if not p.is_file():
+            raise ExportError(f"{p}: no such file to reference")
+        refs.AddReference(Path(_relpath(p.resolve(), out.parent)).as_posix(), Sdf.Path(prim_path))
+    if lens_variant is not None:
+        vsets = cam.GetVariantSets()
+        if "characterization" not in vsets.GetNames() or lens_variant not in \
+                vsets.GetVariantSet("characterization").GetVariantNames():
+            raise ExportError(f"{path}: lens file {lens_file} has no characterization variant {lens_variant!r}")
+        vsets.GetVariantSet("characterization").SetVariantSelection(lens_variant)
+    spec = replace(read_camera(stage, path).spec, **overrides).checked()
+    parts = {SHOT_OVERRIDES[k] for k in overrides}
+    if parts - {"body"}:
+        author_camera(stage, path, spec, parts=tuple(p for p in ("sensor", "lens") if p in parts))
+    # the shot places the camera: its transform (pivot at the entrance pupil) and shutter are shot-level
+    author_camera(stage, path, spec, position=position, rotate_xyz_deg=rotate_xyz_deg, parts=("body",))
+    author_render_camera(stage, Sdf.Path(path), spec)
+    try:
+        return save_stage(stage, out, force=force)
+    finally:
+        layer.Clear()
+
+
+def _relpath(target, start) -> str:
+    import os
+
+    return os.path.relpath(target, start)
+
+
+def write_previs_kit(file, setups: dict | None = None, *, default: str = "OverTheShoulder", force: bool = False,
+                     path: str = "/PrevisKit", meters_per_unit: float = 0.01, fps: float = 24.0):
+    """One file, one camera, a ``setup`` variant per entry of ``setups`` (default :data:`PREVIS_SETUPS`)."""
+    setups = dict(PREVIS_SETUPS if setups is None else setups)
+    if default not in setups:
+        raise InputError(f"default setup {default!r} is not one of {', '.join(setups)}")
+    stage = _stage(meters_per_unit, fps)
+    prim = stage.DefinePrim(path, "PhysicalCamera")
+    stage.SetDefaultPrim(stage.GetPrimAtPath(prim.GetPath().GetPrefixes()[0]))
+    vset = prim.GetVariantSets().AddVariantSet("setup")
+    for name, spec in setups.items():
+        if not name.replace("_", "").isalnum():
+            raise InputError(f"setup name {name!r} must be letters, digits and underscores")
+        vset.AddVariant(name)
+        vset.SetVariantSelection(name)
+        with vset.GetVariantEditContext():
+            author_camera(stage, path, spec)
+    vset.SetVariantSelection(default)
+    return save_stage(stage, file, force=force)
+
+
+def best_match_pinhole(prescription, *, focus_mm: float, fstop: float, sensor_width_mm: float,
+                       sensor_height_mm: float, coc_mm: float = 0.03):
+    """(CameraSpec of the pinhole, report of the real lens): the pinhole matches the lens's FOV at ``focus_mm``.
+
+    The real lens's report (technical model from its own Gaussian optics focused at the
+    mark) gives the horizontal field of view at that focus, breathing included; the
+    pinhole's focal length is w / (2 tan(hfov / 2)), so a real-time renderer frames the
+    same picture. f-stop, focus mark, CoC and the entrance pupil are carried over.
+    """
+    from ..onset.report import solve_lens_report
+    from ..onset.sensors import Sensor
+
+    sensor = Sensor(key="custom", name=f"{sensor_width_mm:g} x {sensor_height_mm:g} mm",
+                    width_mm=sensor_width_mm, height_mm=sensor_height_mm)
+    report = solve_lens_report(focal_length_mm=None, sensor=sensor, fstop=fstop, focus_mm=focus_mm, coc=coc_mm,
+                               lens=prescription)
+    w = sensor_width_mm * report.squeeze
+    f_match = w / (2.0 * math.tan(math.radians(report.hfov_focus_deg) / 2.0))
+    spec = CameraSpec(focal_length_mm=f_match, sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm,
+                      fstop=fstop, focus_mm=focus_mm, coc_mm=coc_mm, squeeze=report.squeeze,
+                      entrance_pupil_mm=report.entrance_pupil_from_film_mm, lens_name=prescription.name)
+    return spec.checked(), report
+
+
+def _author_prescription(stage, path, rx, focus_mm: float):
+    from pxr import Sdf, Vt
+
+    prim = stage.DefinePrim(path, "PhysicalCameraLensModelPrescription")
+    S = rx.surfaces
+    T = Sdf.ValueTypeNames
+    vals = {
+        "radius": (T.DoubleArray, [s.radius for s in S]),
+        "thickness": (T.DoubleArray, [s.thickness for s in S]),
+        "nd": (T.DoubleArray, [s.medium.nd for s in S]),
+        "vd": (T.DoubleArray, [s.medium.vd for s in S]),
+        "semiDiameter": (T.DoubleArray, [s.semi_diameter for s in S]),
+        "surfaceKind": (T.TokenArray, [s.kind for s in S]),
+        "conic": (T.DoubleArray, [s.conic for s in S]),
+        "asphericCoefficients": (T.DoubleArray,
+                                 [a for s in S for a in (list(s.aspheric) + [0.0] * 7)[:7]]),
+        "glass": (T.StringArray, [s.medium.glass or "" for s in S]),
+        "lensName": (T.String, rx.name),
+        "maker": (T.String, rx.metadata.maker or ""),
+        "source": (T.String, rx.metadata.source or ""),
+        "nominalFocalLength": (T.Float, float(rx.metadata.focal_length or 0.0)),
+        "designWavelength": (T.Double, float(rx.wavelength_nm)),
+        "squeeze": (T.Float, float(rx.squeeze)),
+        "focusDistance": (T.Float, float(focus_mm)),
+    }
+    if rx.focus is not None:
+        vals["focusCloseDistance"] = (T.Double, float(rx.focus.close_distance))
+        vals["focusGapSurface"] = (T.IntArray, [g.surface for g in rx.focus.gaps])
+        vals["focusGapThicknessInfinity"] = (T.DoubleArray, [g.thickness_infinity for g in rx.focus.gaps])
+        vals["focusGapThicknessClose"] = (T.DoubleArray, [g.thickness_close for g in rx.focus.gaps])
+    for name, (t, v) in vals.items():
+        prim.CreateAttribute(name, t, False).Set(v)
+    return prim
+
+
+def write_vendor_lens(file, prescription, *, focus_mm: float, fstop: float | None = None,
+                      sensor_width_mm: float = 36.0, sensor_height_mm: float = 24.0, coc_mm: float = 0.03,
+                      use: str = "pinhole", force: bool = False, meters_per_unit: float = 0.01, fps: float = 24.0):
+    """A vendor lens file: ``/Lens`` with a Prescription model, its best-match Pinhole, and a ``lensModel`` variant.
+
+    ``use`` ("pinhole" or "prescription") is the default variant: it sets the lens's
+    ``lensModel`` relationship, i.e. which model renders. The companion UsdGeomCamera
+    always shows the best-match pinhole.
+    """
+    from pxr import Sdf
+
+    if use not in ("pinhole", "prescription"):
+        raise InputError(f"use must be pinhole or prescription, got {use!r}")
+    fstop = fstop or prescription.metadata.max_fstop
+    if fstop is None:
+        raise InputError(f"lens {prescription.name!r} has no maximum aperture on file; give the f-stop")
+    spec, _report = best_match_pinhole(prescription, focus_mm=focus_mm, fstop=fstop,
+                                       sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm,
+                                       coc_mm=coc_mm)
+    stage = _stage(meters_per_unit, fps)
+    cam = author_camera(stage, LENS_PRIM, spec)
+    rx_prim = _author_prescription(stage, Sdf.Path(LENS_PRIM).AppendChild("Prescription"), prescription, focus_mm)
+    pin = stage.GetPrimAtPath(Sdf.Path(LENS_PRIM).AppendChild("Pinhole"))
+    rel_name = f"lens:{LENS_INSTANCE}:lensModel"
+    cam.GetRelationship(rel_name).ClearTargets(True)  # the variant decides
+    vset = cam.GetVariantSets().AddVariantSet("lensModel")
+    for name, target in (("pinhole", pin.GetPath()), ("prescription", rx_prim.GetPath())):
+        vset.AddVariant(name)
+        vset.SetVariantSelection(name)
+        with vset.GetVariantEditContext():
+            cam.GetRelationship(rel_name).SetTargets([target])
+    vset.SetVariantSelection(use)
+    return save_stage(stage, file, force=force)
+
+
