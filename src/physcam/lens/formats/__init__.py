@@ -22,9 +22,9 @@ from ...errors import ExportError, LensFileError
 from ...io import atomic_write
 from ..prescription import Prescription
 from . import iset, pbrt, physcam_toml, seedtoml, zemax
-from ._common import decode, parse_toml, read_text
+from ._common import decode, extra, parse_toml, read_text
 
-__all__ = ["FORMATS", "read_lens", "loads_lens", "write_lens", "dumps_lens", "detect_format"]
+__all__ = ["FORMATS", "extra", "read_lens", "loads_lens", "write_lens", "dumps_lens", "detect_format"]
 
 #: Format name -> module with ``loads(text, path=None, name=None)`` and ``dumps(p)``.
 FORMATS = {"physcam": physcam_toml, "seed-toml": seedtoml, "pbrt": pbrt, "iset": iset, "zemax": zemax}
