@@ -3,7 +3,7 @@
 
     .venv/bin/python scripts/build_lens_library.py [--reference DIR] [--out DIR] [--force]
 
-Reads /work/shared/reference/lenses/{pbrt-dat,iset-json,physical-camera-toml} with
+Reads ../shared/reference/lenses/ (or tests/data/reference_lenses/){pbrt-dat,iset-json,physical-camera-toml} with
 physcam's own readers, adds curated metadata and provenance, applies the documented
 corrections below (only where the original file does not describe a buildable lens or
 contradicts its own engraved f-number), validates, and writes
@@ -209,7 +209,7 @@ def convert(path: Path, fmt: str, folder: str) -> tuple[str, Prescription]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--reference", default="/work/shared/reference/lenses")
+    ap.add_argument("--reference", default=str(Path(__file__).resolve().parents[1] / "tests" / "data" / "reference_lenses"))
     ap.add_argument("--out", default=str(ROOT / "src/physcam/data/lenses"))
     ap.add_argument("--force", action="store_true", help="overwrite existing library files")
     args = ap.parse_args(argv)

@@ -1,7 +1,8 @@
 from pathlib import Path
 
 
-REFERENCE = Path("/work/shared/reference/lenses")
+# Copies of ../shared/reference/lenses (see SOURCES.md there), so CI needs nothing beside the checkout.
+REFERENCE = Path(__file__).resolve().parents[1] / "data" / "reference_lenses"
 PBRT_FILES = sorted((REFERENCE / "pbrt-dat").glob("*.dat"))
 ISET_FILES = sorted((REFERENCE / "iset-json").glob("*.json"))
 SEED_FILES = sorted((REFERENCE / "physical-camera-toml").glob("*.toml"))
