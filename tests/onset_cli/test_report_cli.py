@@ -69,7 +69,12 @@ def test_demo_writes_outputs(tmp_path, capsys):
     out = tmp_path / "demo"
     assert main(["demo", "--out", str(out), "--json"]) == 0
     files = json.loads(capsys.readouterr().out)["files"]
-    assert (out / "report.json").exists() and (out / "dof.png").exists()
+    for name in ("report.json", "report.txt", "dof.png", "lens.json", "lens_diagram.png", "breathing.png",
+                 "camera.usda"):
+        assert (out / name).exists(), name
+    assert (out / "lens_diagram.png").read_bytes()[:4] == b"\x89PNG"
+    lens = json.loads((out / "lens.json").read_text())
+    assert lens["gaussian"]["efl"] == pytest.approx(50.3582, abs=1e-3)  # published dgauss.50mm EFL
     assert all(os.path.exists(f) for f in files)
     assert json.loads((out / "report.json").read_text())["schema"] == "physcam.lens_report"
     assert main(["demo", "--out", str(out)]) == 2  # exists, no --force

@@ -1,15 +1,21 @@
 """``physcam demo``: the main job on the bundled default lens and sensor.
 
-Writes a complete lens report for a default setup into a folder and prints it:
-``report.json`` (the versioned report with its camera blocks), ``report.txt`` (the
-table), ``dof.png`` (the depth-of-field zone), plus what later stages add (lens data,
-diagram, USD camera, bokeh and spot diagram).
+The default setup is the bundled ``dgauss_50mm`` (pbrt's double Gauss, US 2,673,491) on an
+ARRI ALEXA 35 open gate at f/2.8, focused 3 m from the film plane. The demo writes into a
+folder and prints the report:
+
+- ``report.json`` / ``report.txt``: the lens report, technical model filled from the lens
+  itself, with its UsdGeomCamera and RenderMan blocks; ``dof.png``: the depth-of-field zone;
+- ``lens.json``: the lens's Gaussian data at that focus; ``lens_diagram.png``: elements, stop,
+  rays and cardinal points; ``breathing.png``: field of view against focus distance;
+- ``camera.usda``: the PhysicalCamera and its companion UsdGeomCamera;
+- ``spot.png`` and ``bokeh.png``: real-ray spot diagram and bokeh of a point light.
 """
 
 from __future__ import annotations
 
 DEFAULTS = {
-    "focal": 50.0,
+    "lens": "dgauss_50mm",
     "fstop": 2.8,
     "focus": 3000.0,
     "sensor": "ALEXA 35",
@@ -28,42 +34,110 @@ def _args():
     from argparse import Namespace
 
     return Namespace(
-        focal=DEFAULTS["focal"], fstop=DEFAULTS["fstop"], tstop=None, focus=DEFAULTS["focus"],
-        lens=None, sensor=DEFAULTS["sensor"], sensor_width=None, sensor_height=None, squeeze=1.0, coc=None,
-        near=None, far=None, model="practical", h1=None, h2=None, pupil=None, reference="film", flange=None,
+        lens=DEFAULTS["lens"], focal=None, fstop=DEFAULTS["fstop"], tstop=None, focus=DEFAULTS["focus"],
+        sensor=DEFAULTS["sensor"], sensor_width=None, sensor_height=None, squeeze=1.0, coc=None,
+        near=None, far=None, model="technical", h1=None, h2=None, pupil=None, reference="film", flange=None,
         sensor_front=None, lens_length=None, pupil_fraction=0.4, meters_per_unit=0.01, shutter_angle=180.0,
     )
 
 
-def run(args) -> int:
+def _steps():
+    """(name, function(out_dir, context, force) -> list of written paths), in order."""
+    return [
+        ("lens report", _report_step),
+        ("Gaussian data and diagram", _lens_step),
+        ("USD camera", _usd_step),
+    ]
+
+
+def _report_step(out, ctx, force):
     import json
-    from pathlib import Path
 
     from ..io import atomic_write
     from ..onset.dof_plot import plot_dof_zone
     from ..onset.table import report_table
-    from ._common import console, print_json
+    from ._common import console
     from .report import camera_blocks, solve_from_args
 
-    out = Path(args.out)
     ns = _args()
     report = solve_from_args(ns)
-    written = []
+    ctx["report"] = report
     d = report.to_dict()
     d["cameras"] = camera_blocks(report, ns)
-    written.append(atomic_write(out / "report.json", json.dumps(d, indent=2, allow_nan=False) + "\n",
-                                force=args.force))
     con = console()
     with con.capture() as cap:
         con.print(report_table(report))
-    table_text = cap.get()
-    written.append(atomic_write(out / "report.txt", table_text, force=args.force))
-    written.append(plot_dof_zone(report, out / "dof.png", force=args.force))
+    ctx["table"] = cap.get()
+    return [
+        atomic_write(out / "report.json", json.dumps(d, indent=2, allow_nan=False) + "\n", force=force),
+        atomic_write(out / "report.txt", ctx["table"], force=force),
+        plot_dof_zone(report, out / "dof.png", force=force),
+    ]
+
+
+def _lens_step(out, ctx, force):
+    import json
+    import math
+
+    from ..analysis.breathing_plot import save_breathing_plot
+    from ..analysis.diagram import save_lens_diagram
+    from ..io import atomic_write
+    from ..lens.library import load_lens
+    from ..optics import focusing, paraxial
+
+    lens = load_lens(DEFAULTS["lens"])
+    ctx["lens"] = lens
+    st = focusing.focus(lens, DEFAULTS["focus"])
+    g = paraxial.gaussian(st.prescription, fstop=DEFAULTS["fstop"], object_z=st.object_z, film_z=st.film_z)
+    data = {"lens": lens.name, "focus_from_film_mm": DEFAULTS["focus"], "fstop": DEFAULTS["fstop"],
+            "back_focus_mm": st.back_focus_mm, "gaussian": g.to_dict()}
+    text = json.dumps(data, indent=2, allow_nan=False, default=lambda v: None if isinstance(v, float)
+                      and not math.isfinite(v) else str(v))
+    sensor = ctx["report"].sensor
+    rows = focusing.breathing_table(lens, [600.0, 1000.0, 2000.0, 5000.0, math.inf], sensor_width_mm=sensor.width_mm)
+    return [
+        atomic_write(out / "lens.json", text + "\n", force=force),
+        save_lens_diagram(lens, out / "lens_diagram.png", force=force, fstop=DEFAULTS["fstop"]),
+        save_breathing_plot(rows, out / "breathing.png", force=force, title=f"focus breathing: {lens.name}",
+                            sensor_width_mm=sensor.width_mm),
+    ]
+
+
+def _usd_step(out, ctx, force):
+    from ..usd.author import author_from_report, new_stage, save_stage
+
+    stage = new_stage(0.01)
+    author_from_report(stage, "/Camera", ctx["report"])
+    return [save_stage(stage, out / "camera.usda", force=force)]
+
+
+def _trace_step(out, ctx, force):
+    from ..analysis.bokeh import save_bokeh_plot
+    from ..analysis.spot import save_spot_plot
+
+    lens = ctx["lens"]
+    return [
+        save_spot_plot(lens, out / "spot.png", force=force),
+        save_bokeh_plot(lens, out / "bokeh.png", force=force, fstop=DEFAULTS["fstop"]),
+    ]
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    from ._common import console, print_json
+
+    out = Path(args.out)
+    ctx: dict = {}
+    written = []
+    err = console(stderr=True)
+    for name, step in _steps():
+        paths = step(out, ctx, args.force)
+        written.extend(paths)
+        if not args.json:
+            err.print(f"{name}: " + ", ".join(str(p) for p in paths))
     if args.json:
         print_json({"out": str(out), "files": [str(p) for p in written]})
         return 0
-    print(table_text, end="")
-    err = console(stderr=True)
-    for p in written:
-        err.print(f"wrote {p}")
+    print(ctx["table"], end="")
     return 0
