@@ -1,6 +1,7 @@
 # physcam: two entry points for a fresh machine.
 #   make demo   create .venv if missing, install physcam, run the main job
 #   make test   create .venv if missing, install physcam with test tools, run every test
+#   make schema regenerate the USD schema plugin; make bench runs the benchmarks
 PYTHON ?= python3
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
@@ -26,6 +27,12 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/startup.py
+	$(PY) benchmarks/trace.py
+
+# Regenerate the USD schema plugin (plugInfo.json, generatedSchema.usda) from
+# src/physcam/usd/schema/schema.usda with usd-core's own usdGenSchema.
+schema: $(STAMP)
+	$(PY) scripts/gen_usd_schema.py
 
 clean:
 	rm -rf $(VENV) demo-output build *.egg-info src/*.egg-info
