@@ -78,3 +78,15 @@ def test_demo_writes_outputs(tmp_path, capsys):
     assert all(os.path.exists(f) for f in files)
     assert json.loads((out / "report.json").read_text())["schema"] == "physcam.lens_report"
     assert main(["demo", "--out", str(out)]) == 2  # exists, no --force
+
+
+def test_report_json_imports_no_heavy_library():
+    # The start-up goal (benchmarks/startup.py, < 0.3 s) rests on `physcam report --json` not
+    # importing numpy, matplotlib, rich tables, USD or numba; guard that structurally.
+    code = ("import sys, io, contextlib\nfrom physcam.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    main(['report', '--focal', '50', '--fstop', '2.8', '--focus', '3m', '--json'])\n"
+            "heavy = [m for m in ('numpy', 'matplotlib', 'pxr', 'numba', 'rich.table') if m in sys.modules]\n"
+            "print(','.join(heavy))")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert p.stdout.strip() == ""

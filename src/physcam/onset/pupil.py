@@ -12,8 +12,6 @@ USD's: the camera looks down -Z with +Y up, origin at the film plane centre.
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..errors import InputError, require_finite, require_positive
 
 __all__ = ["entrance_pupil_practical", "pivot_camera_space", "pivot_world"]
@@ -55,6 +53,8 @@ def pivot_world(pupil_from_film_mm: float, camera_to_world, mm_per_unit: float =
     (p_world = p_camera @ M, translation in the last row), in world units;
     ``mm_per_unit`` converts the pivot's millimetres to those units (10 for centimetres).
     """
+    import numpy as np
+
     m = np.asarray(camera_to_world, dtype=float)
     if m.shape != (4, 4) or not np.all(np.isfinite(m)):
         raise InputError("camera transform must be a finite 4x4 matrix")

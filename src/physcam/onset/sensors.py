@@ -15,7 +15,7 @@ import math
 import re
 from dataclasses import dataclass
 from functools import lru_cache
-from importlib import resources
+from pathlib import Path
 
 from ..errors import SensorError
 
@@ -50,7 +50,7 @@ def _norm(text: str) -> str:
 @lru_cache(maxsize=1)
 def sensors() -> tuple[Sensor, ...]:
     """Every known sensor, in table order."""
-    text = resources.files("physcam.data").joinpath("sensors.csv").read_text(encoding="utf-8")
+    text = (Path(__file__).resolve().parent.parent / "data" / "sensors.csv").read_text(encoding="utf-8")
     out = []
     for row in csv.DictReader(text.splitlines()):
         out.append(

@@ -24,9 +24,8 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ..errors import InputError, OpticsError
+from . import _num as nx
 
 __all__ = [
     "hyperfocal_distance",
@@ -39,13 +38,8 @@ __all__ = [
 ]
 
 
-def _arr(x):
-    return np.asarray(x, dtype=float)
-
-
-def _out(x):
-    x = np.asarray(x)
-    return x if x.ndim else float(x)
+_arr = nx.value
+_out = nx.out
 
 
 def hyperfocal_distance(focal_length, f_number, coc):
@@ -76,13 +70,12 @@ def dof_limits(focal_length, f_number, coc, object_distance):
     """
     f = _arr(focal_length)
     s = _arr(object_distance)
-    if np.any(s <= f):
+    if nx.any_true(s <= f):
         raise OpticsError("focus distance is at or inside the focal length: no real image forms")
     h = f * f / (_arr(f_number) * _arr(coc))
     near = h * s / (h + (s - f))
     denom = h - (s - f)
-    with np.errstate(divide="ignore"):
-        far = np.where(denom > 0, h * s / np.where(denom > 0, denom, 1.0), np.inf)
+    far = nx.where(denom > 0, h * s / nx.where(denom > 0, denom, 1.0), math.inf)
     return _out(near), _out(far)
 
 
@@ -92,9 +85,9 @@ def hyperfocal_parameter_from_near(focal_length, object_distance, near):
     Distances from H1. Requires near < s.
     """
     f, s, n = _arr(focal_length), _arr(object_distance), _arr(near)
-    if np.any(n >= s):
+    if nx.any_true(n >= s):
         raise InputError("the near limit must be closer than the focus distance")
-    if np.any(n <= 0):
+    if nx.any_true(n <= 0):
         raise InputError("the near limit must be in front of the lens (> 0)")
     return _out(n * (s - f) / (s - n))
 
@@ -105,9 +98,9 @@ def hyperfocal_parameter_from_far(focal_length, object_distance, far):
     Distances from H1. Requires far > s; an infinite far limit gives no finite h.
     """
     f, s, F = _arr(focal_length), _arr(object_distance), _arr(far)
-    if np.any(F <= s):
+    if nx.any_true(F <= s):
         raise InputError("the far limit must be beyond the focus distance")
-    if np.any(~np.isfinite(F)):
+    if not nx.all_true(nx.isfinite(F)):
         raise InputError(
             "an infinite far limit only says the focus is at or beyond the hyperfocal distance; give a near limit"
         )
@@ -121,10 +114,11 @@ def focus_for_dof_limits(near, far):
     2 near far / (near + far) whatever f, N and c are. An infinite far gives s = 2 near.
     """
     n, F = _arr(near), _arr(far)
-    if np.any(n <= 0) or np.any(F <= n):
+    if nx.any_true(n <= 0) or nx.any_true(F <= n):
         raise InputError("need 0 < near limit < far limit")
-    with np.errstate(invalid="ignore"):
-        s = np.where(np.isfinite(F), 2.0 * n * F / (n + np.where(np.isfinite(F), F, 0.0)), 2.0 * n)
+    fin = nx.isfinite(F)
+    Ff = nx.where(fin, F, 0.0)
+    s = nx.where(fin, 2.0 * n * Ff / (n + Ff), 2.0 * n)
     return _out(s)
 
 

@@ -12,9 +12,8 @@ the name says ``_deg``.
 
 from __future__ import annotations
 
-import numpy as np
-
 from ..errors import OpticsError
+from . import _num as nx
 
 __all__ = [
     "image_distance",
@@ -35,12 +34,11 @@ def image_distance(focal_length, object_distance):
     >>> float(image_distance(50.0, 100.0))
     100.0
     """
-    f = np.asarray(focal_length, dtype=float)
-    s = np.asarray(object_distance, dtype=float)
-    if np.any(s <= f):
+    f = nx.value(focal_length)
+    s = nx.value(object_distance)
+    if nx.any_true(s <= f):
         raise OpticsError("the subject is at or inside the focal length: no real image forms on the film")
-    out = s * f / (s - f)
-    return out if out.ndim else float(out)
+    return nx.out(s * f / (s - f))
 
 
 def object_distance(focal_length, image_distance_):
@@ -50,12 +48,11 @@ def object_distance(focal_length, image_distance_):
 
 def magnification(focal_length, object_distance):
     """|m| = s'/s = f / (s - f), the size on the film over the size of the subject."""
-    f = np.asarray(focal_length, dtype=float)
-    s = np.asarray(object_distance, dtype=float)
-    if np.any(s <= f):
+    f = nx.value(focal_length)
+    s = nx.value(object_distance)
+    if nx.any_true(s <= f):
         raise OpticsError("the subject is at or inside the focal length: no real image forms on the film")
-    out = f / (s - f)
-    return out if out.ndim else float(out)
+    return nx.out(f / (s - f))
 
 
 def minimum_marked_distance(focal_length, hiatus=0.0):
@@ -63,7 +60,7 @@ def minimum_marked_distance(focal_length, hiatus=0.0):
 
     At that distance s = s' = 2f and the magnification is 1 (Hecht §5.2.3).
     """
-    return 4.0 * np.asarray(focal_length, dtype=float) + hiatus
+    return nx.out(4.0 * nx.value(focal_length) + hiatus)
 
 
 def object_distance_for_marked(focal_length, marked_distance, hiatus=0.0):
@@ -78,17 +75,18 @@ def object_distance_for_marked(focal_length, marked_distance, hiatus=0.0):
     >>> round(float(object_distance_for_marked(50.0, 200.0)), 6)  # 1:1 macro: s = s' = 2f
     100.0
     """
-    f = np.asarray(focal_length, dtype=float)
-    L = np.asarray(marked_distance, dtype=float) - hiatus
+    f = nx.value(focal_length)
+    D = nx.value(marked_distance)
+    L = D - hiatus
     disc = L * L - 4.0 * L * f
-    if np.any(disc < -1e-9 * L * L) or np.any(L <= 0):
-        closest = float(np.max(4.0 * f + hiatus))
+    if nx.any_true(disc < -1e-9 * L * L) or nx.any_true(L <= 0):
+        fmax = f if nx.is_scalar(f) else float(f.max())
+        dmin = D if nx.is_scalar(D) else float(D.min())
         raise OpticsError(
-            f"focus mark {float(np.min(np.asarray(marked_distance))):.6g} mm is closer than this lens can focus: "
-            f"the closest mark for a {float(np.max(f)):g} mm thin lens is {closest:.6g} mm from the film plane (4f)"
+            f"focus mark {dmin:.6g} mm is closer than this lens can focus: "
+            f"the closest mark for a {fmax:g} mm thin lens is {4.0 * fmax + hiatus:.6g} mm from the film plane (4f)"
         )
-    out = 0.5 * (L + np.sqrt(np.maximum(disc, 0.0)))
-    return out if out.ndim else float(out)
+    return nx.out(0.5 * (L + nx.sqrt(nx.maximum(disc, 0.0))))
 
 
 def field_of_view(size, focal_length, object_distance=None):
@@ -99,12 +97,9 @@ def field_of_view(size, focal_length, object_distance=None):
     (focus breathing of a unit-focusing lens). Source: Hecht §5.7 (field stop and
     angular field); thin lens, so the pupils sit at the principal planes.
 
-    >>> round(float(np.degrees(field_of_view(36.0, 50.0))), 4)
+    >>> import math; round(math.degrees(field_of_view(36.0, 50.0)), 4)
     39.5978
     """
-    size = np.asarray(size, dtype=float)
-    if object_distance is None:
-        d = np.asarray(focal_length, dtype=float)
-    else:
-        d = image_distance(focal_length, object_distance)
-    return 2.0 * np.arctan(size / (2.0 * np.asarray(d, dtype=float)))
+    size = nx.value(size)
+    d = nx.value(focal_length) if object_distance is None else image_distance(focal_length, object_distance)
+    return nx.out(2.0 * nx.atan(size / (2.0 * d)))
