@@ -82,6 +82,18 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                         w[i] = 0.0
                         continue
                     t = c / den
+                    # nearest root on the far cap (back of a sphere): use the vertex branch,
+                    # where az * z < 1 (see the numpy kernel)
+                    if az * (qz + t * dz) >= 1.0:
+                        if a == 0.0:
+                            flag[i] = MISSED
+                            w[i] = 0.0
+                            continue
+                        t = den / a
+                        if not az * (qz + t * dz) < 1.0:
+                            flag[i] = MISSED
+                            w[i] = 0.0
+                            continue
                 dsr = 0.0
                 if kd == _ASPHERE:
                     # -- Newton iteration on g(t) = z(t) - sag(r(t)), started at the conic root

@@ -65,8 +65,13 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                 disc = b * b - a * c
                 sq = np.sqrt(np.maximum(disc, 0.0))
                 den = np.where(b >= 0.0, -b - sq, -b + sq)
-                bad = (disc < 0.0) | (den == 0.0)
                 t = c / den
+                # The root nearest in t may lie on the far cap of the quadric (the back of a
+                # sphere met first by a ray starting far from the vertex): the surface is the
+                # branch through the vertex, where az * z < 1; take the other root there.
+                far_side = az * (qz + t * dz) >= 1.0
+                t = np.where(far_side, den / a, t)
+                bad = (disc < 0.0) | (den == 0.0) | (far_side & ((a == 0.0) | ~(az * (qz + t * dz) < 1.0)))
                 if bad.any():
                     fail(bad, MISSED)
                     t = t[~bad]
