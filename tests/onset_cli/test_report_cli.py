@@ -70,7 +70,7 @@ def test_demo_writes_outputs(tmp_path, capsys):
     assert main(["demo", "--out", str(out), "--json"]) == 0
     files = json.loads(capsys.readouterr().out)["files"]
     for name in ("report.json", "report.txt", "dof.png", "lens.json", "lens_diagram.png", "breathing.png",
-                 "camera.usda"):
+                 "camera.usda", "spot.png", "bokeh.png"):
         assert (out / name).exists(), name
     assert (out / "lens_diagram.png").read_bytes()[:4] == b"\x89PNG"
     lens = json.loads((out / "lens.json").read_text())

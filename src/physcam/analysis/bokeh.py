@@ -51,10 +51,9 @@ class BokehImage:
                 "rays_passed": self.rays_passed, "film_z_mm": self.film_z_mm, "centroid_mm": [cx, cy]}
 
     def plot(self, path=None, *, force: bool = False):
-        import matplotlib
+        from ..figures import pyplot
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = pyplot()
 
         img = self.image / max(self.image.max(), 1e-300)
         if img.shape[2] == 1:
@@ -65,16 +64,11 @@ class BokehImage:
         ax.set_ylabel("film y (mm)")
         ax.set_title(f"{self.lens_name}: bokeh", fontsize=9)
         fig.tight_layout()
-        if path is not None:
-            import io as _io
+        if path is None:
+            return fig
+        from ..figures import save_figure
 
-            from ..io import atomic_write
-
-            buf = _io.BytesIO()
-            fig.savefig(buf, format="png", dpi=130)
-            atomic_write(path, buf.getvalue(), force=force)
-            plt.close(fig)
-        return fig
+        return save_figure(fig, path, force=force)
 
 
 def bokeh_image(
@@ -90,11 +84,16 @@ def bokeh_image(
     spectral: bool = False,
     fresnel: bool = True,
     stop_semi_diameter: float | None = None,
+    aperture=None,
     chunk: int = 1_000_000,
     seed: int = 0,
     backend: str = "auto",
 ) -> BokehImage:
-    """Image of a point light through ``lens`` on the film (see module notes)."""
+    """Image of a point light through ``lens`` on the film (see module notes).
+
+    ``aperture`` (a :class:`~physcam.trace.aperture.Aperture`: blades, angle, roundness,
+    density) shapes the stop, so the bokeh shows the iris polygon and its brightness ramp.
+    """
     from ..trace import RayBatch, paraxial_image_z, trace_to_film
 
     depth = require_positive("depth", depth_mm)
@@ -128,7 +127,8 @@ def bokeh_image(
 
     if extent_mm is None:  # a pilot trace sizes the window
         pilot, _ = batch(20_000)
-        pr = trace_to_film(lens, pilot, film_z, stop_semi_diameter=stop_semi_diameter, backend=backend)
+        pr = trace_to_film(lens, pilot, film_z, stop_semi_diameter=stop_semi_diameter, aperture=aperture,
+                           backend=backend)
         if not pr.ok.any():
             raise OpticsError(f"no light from ({x_mm:g}, {y_mm:g}) mm at depth {depth:g} mm reaches the film")
         xs, ys = pr.x[pr.ok], pr.y[pr.ok]
@@ -144,7 +144,8 @@ def bokeh_image(
     while done < rays:
         n = min(chunk, rays - done)
         b, ch = batch(n)
-        out = trace_to_film(lens, b, film_z, fresnel=fresnel, stop_semi_diameter=stop_semi_diameter, backend=backend)
+        out = trace_to_film(lens, b, film_z, fresnel=fresnel, stop_semi_diameter=stop_semi_diameter,
+                            aperture=aperture, backend=backend, in_place=True)
         ok = out.ok
         ix = np.floor((out.x - x0) / (x1 - x0) * pixels).astype(np.int64)
         iy = np.floor((out.y - y0) / (y1 - y0) * pixels).astype(np.int64)

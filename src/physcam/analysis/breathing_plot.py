@@ -7,11 +7,10 @@ give the marks in metres. Rows come from :func:`physcam.optics.focusing.breathin
 
 from __future__ import annotations
 
-import io
 import math
 from pathlib import Path
 
-from ..errors import ExportError, InputError
+from ..errors import InputError
 
 __all__ = ["PLOT_FORMATS", "breathing_figure", "save_breathing_plot"]
 
@@ -47,13 +46,6 @@ def breathing_figure(rows, *, title: str = "focus breathing", sensor_width_mm: f
 
 def save_breathing_plot(rows, path, *, force: bool = False, **kwargs) -> Path:
     """Write the breathing plot to ``path`` (.png, .svg, .pdf) through atomic_write."""
-    from ..io import atomic_write, check_writable
+    from ..figures import save_figure
 
-    p = Path(path)
-    fmt = p.suffix.lower().lstrip(".")
-    if fmt not in PLOT_FORMATS:
-        raise ExportError(f"cannot plot to {p.name!r}: use a .png, .svg or .pdf file name")
-    check_writable(p, force=force)
-    buf = io.BytesIO()
-    breathing_figure(rows, **kwargs).savefig(buf, format=fmt, dpi=150)
-    return atomic_write(p, buf.getvalue(), force=force)
+    return save_figure(breathing_figure(rows, **kwargs), path, force=force, dpi=150)

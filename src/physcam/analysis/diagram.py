@@ -15,7 +15,6 @@ Cardinal points (F, F', H, H', entrance and exit pupils) are the Gaussian ones o
 
 from __future__ import annotations
 
-import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -238,14 +237,11 @@ def lens_diagram(prescription: Prescription, *, axis: str = "y", focus_from_film
 
 def save_lens_diagram(prescription: Prescription, path, *, force: bool = False, **kwargs) -> Path:
     """Draw the diagram to ``path`` (.png, .svg or .pdf) through atomic_write; kwargs as :func:`lens_diagram`."""
-    from ..io import atomic_write, check_writable
+    from ..figures import save_figure
+    from ..io import check_writable
 
     p = Path(path)
-    fmt = p.suffix.lower().lstrip(".")
-    if fmt not in DIAGRAM_FORMATS:
+    if p.suffix.lower().lstrip(".") not in DIAGRAM_FORMATS:
         raise ExportError(f"cannot draw a diagram to {p.name!r}: use a .png, .svg or .pdf file name")
-    check_writable(p, force=force)
-    fig = lens_diagram(prescription, **kwargs).figure()
-    buf = io.BytesIO()
-    fig.savefig(buf, format=fmt, dpi=150)
-    return atomic_write(p, buf.getvalue(), force=force)
+    check_writable(p, force=force)  # before the work of drawing
+    return save_figure(lens_diagram(prescription, **kwargs).figure(), p, force=force, dpi=150)

@@ -66,11 +66,10 @@ class SpotDiagram:
                 "fields": [f.to_dict() for f in self.fields]}
 
     def plot(self, path=None, *, force: bool = False):
-        """Draw one panel per field (positions relative to the centroid, um); write PNG if ``path``."""
-        import matplotlib
+        """Draw one panel per field (positions relative to the centroid, um); write it to ``path`` (PNG/SVG/PDF) and return the path, else return the figure."""
+        from ..figures import pyplot
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = pyplot()
 
         n = len(self.fields)
         fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 3.4), squeeze=False)
@@ -83,16 +82,11 @@ class SpotDiagram:
         axes[0][0].set_ylabel("y (um)")
         fig.suptitle(f"{self.lens_name}: spot diagram at {self.wavelength_nm:g} nm", fontsize=9)
         fig.tight_layout()
-        if path is not None:
-            import io as _io
+        if path is None:
+            return fig
+        from ..figures import save_figure
 
-            from ..io import atomic_write
-
-            buf = _io.BytesIO()
-            fig.savefig(buf, format="png", dpi=130)
-            atomic_write(path, buf.getvalue(), force=force)
-            plt.close(fig)
-        return fig
+        return save_figure(fig, path, force=force)
 
 
 def spot_diagram(

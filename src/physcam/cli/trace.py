@@ -26,6 +26,16 @@ def register(sub) -> None:
     b.add_argument("--rays", type=int, default=1_000_000)
     b.add_argument("--pixels", type=int, default=256)
     b.add_argument("--spectral", action="store_true", help="three wavelengths (620/550/460 nm) as RGB")
+    b.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=None,
+                   help="focus mark from the film plane (default infinity); the lens is focused there")
+    b.add_argument("--fstop", type=number("f-stop"), default=None, help="stop the lens down to this f-number")
+    b.add_argument("--blades", type=int, default=0, help="iris blades (< 3: circular; seed 002 nsides)")
+    b.add_argument("--blade-angle", type=number("blade angle"), default=0.0, metavar="DEG",
+                   help="rotation of the iris polygon (degrees)")
+    b.add_argument("--roundness", type=number("roundness"), default=0.0,
+                   help="-1..1: 0 straight blades, 1 bowed out to a circle, -1 bowed in (star)")
+    b.add_argument("--density", type=number("density"), default=0.0,
+                   help="-1..1: brightness ramp across the aperture (+ brighter rim, - brighter centre)")
     b.add_argument("--json", action="store_true", help="print as JSON")
     b.add_argument("-o", "--output", metavar="FILE.png", help="write the bokeh image")
     b.add_argument("--force", action="store_true", help="overwrite an existing output file")
@@ -62,8 +72,20 @@ def run_bokeh(args) -> int:
 
     if args.output:
         check_writable(args.output, force=args.force)
+    import math
+
+    from ..optics import focusing, paraxial
+    from ..trace.aperture import Aperture
+
     lens = load_lens(args.lens)
-    res = bokeh_image(lens, args.depth, args.x, args.y, rays=args.rays, pixels=args.pixels, spectral=args.spectral)
+    st = focusing.focus(lens, math.inf if args.focus is None else args.focus)
+    stop = None if args.fstop is None else paraxial.stop_semi_diameter_for_fstop(st.prescription, args.fstop)
+    aperture = None
+    if args.blades >= 3 or args.density != 0.0:
+        aperture = Aperture(nsides=args.blades, angle_deg=args.blade_angle, roundness=args.roundness,
+                            density=args.density)
+    res = bokeh_image(st.prescription, args.depth, args.x, args.y, film_z=st.film_z, rays=args.rays,
+                      pixels=args.pixels, spectral=args.spectral, stop_semi_diameter=stop, aperture=aperture)
     if args.output:
         res.plot(args.output, force=args.force)
     if args.json:

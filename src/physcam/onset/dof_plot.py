@@ -2,20 +2,16 @@
 
 from __future__ import annotations
 
-import io
-
 
 def plot_dof_zone(report, path, *, force: bool = False):
     """Draw near, focus, far and hyperfocal on a distance axis (from the film plane); PNG or SVG.
 
     Written atomically through :func:`physcam.io.atomic_write`.
     """
-    import matplotlib
+    from ..figures import pyplot, save_figure
+    from ..io import check_writable
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from ..io import atomic_write, check_writable
+    plt = pyplot()
 
     check_writable(path, force=force)
     d = report.dof
@@ -53,8 +49,4 @@ def plot_dof_zone(report, path, *, force: bool = False):
     ax.set_title(title, fontsize=9)
     ax.legend(loc="lower right", fontsize=7)
     fig.tight_layout()
-    buf = io.BytesIO()
-    fmt = "svg" if str(path).lower().endswith(".svg") else "png"
-    fig.savefig(buf, format=fmt)
-    plt.close(fig)
-    return atomic_write(path, buf.getvalue(), force=force)
+    return save_figure(fig, path, force=force)

@@ -15,7 +15,7 @@ from ..errors import InputError, OpticsError, require_finite
 from ..lens.prescription import Prescription
 from .kernels import get_kernel
 from .kernels._layout import pack, set_wavelength
-from .rays import OK, RayBatch
+from .rays import CLIPPED, OK, RayBatch
 from .surfaces import surface_table
 
 __all__ = ["DEFAULT_CHUNK", "trace_to_film", "trace_through", "paraxial_image_z", "CameraRays", "camera_rays"]
@@ -55,12 +55,17 @@ def trace_through(
     fresnel: bool = False,
     coating: str | None = "none",
     stop_semi_diameter: float | None = None,
+    aperture=None,
     backend: str = "auto",
     chunk_size: int = DEFAULT_CHUNK,
+    in_place: bool = False,
 ) -> RayBatch:
     """Trace a copy of ``rays`` through every surface (front to back, or back to front when
     ``reverse``), then, if ``end_z`` is given, on to the plane z = ``end_z`` (mm, lens space).
 
+    ``aperture`` (an :class:`~physcam.trace.aperture.Aperture`, seed 002) shapes the stop: rays
+    are traced to the stop, masked and weighted there by the aperture density on the stop's
+    unit disk, then traced on. ``in_place`` traces ``rays`` itself instead of a copy.
     Returns the rays after the last surface (or on the end plane) with flags and weights.
     """
     _check_lens(lens)
@@ -70,8 +75,22 @@ def trace_through(
         end_z = require_finite("end_z", end_z)
     table = surface_table(lens, reverse=reverse, stop_semi_diameter=stop_semi_diameter, coating=coating)
     S, kinds = pack(table)
-    out = rays.copy()
-    return _run(get_kernel(backend), out, S, kinds, clip=clip, fresnel=fresnel, end_z=end_z, chunk_size=chunk_size)
+    out = rays if in_place else rays.copy()
+    kernel = get_kernel(backend)
+    if aperture is None:
+        return _run(kernel, out, S, kinds, clip=clip, fresnel=fresnel, end_z=end_z, chunk_size=chunk_size)
+    # trace to the stop, weigh by the aperture shape there, then on through the rest
+    k = int(np.flatnonzero(table.index == lens.stop_index)[0])
+    _run(kernel, out, S[: k + 1], kinds[: k + 1], clip=clip, fresnel=fresnel, end_z=None, chunk_size=chunk_size)
+    rstop = table.semi_diameter[k]
+    dens = aperture.density_at(out.x / rstop, out.y / rstop)
+    live = out.flag == OK
+    out.weight[live] *= dens[live]
+    blocked = live & (dens <= 0.0)
+    out.flag[blocked] = CLIPPED
+    out.weight[blocked] = 0.0
+    return _run(kernel, out, S[k + 1 :], kinds[k + 1 :], clip=clip, fresnel=fresnel, end_z=end_z,
+                chunk_size=chunk_size)
 
 
 def trace_to_film(
@@ -190,23 +209,9 @@ def camera_rays(
     cos_t = -rays.N
     rays.weight[:] = cos_t**4 * area / (d * d)
 
-    table = surface_table(lens, reverse=True, stop_semi_diameter=stop_semi_diameter, coating=coating)
-    S, kinds = pack(table)
-    kernel = get_kernel(backend)
-    if aperture is None:
-        _run(kernel, rays, S, kinds, clip=True, fresnel=fresnel, end_z=None, chunk_size=chunk_size)
-    else:
-        # trace film -> stop, weigh by the aperture shape there, then stop -> front
-        k = int(np.flatnonzero(table.index == lens.stop_index)[0])
-        _run(kernel, rays, S[: k + 1], kinds[: k + 1], clip=True, fresnel=fresnel, end_z=None, chunk_size=chunk_size)
-        rstop = table.semi_diameter[k]
-        dens = aperture.density_at(rays.x / rstop, rays.y / rstop)
-        live = rays.flag == OK
-        rays.weight[live] *= dens[live]
-        blocked = live & (dens <= 0.0)
-        rays.flag[blocked] = 2
-        rays.weight[blocked] = 0.0
-        _run(kernel, rays, S[k + 1 :], kinds[k + 1 :], clip=True, fresnel=fresnel, end_z=None, chunk_size=chunk_size)
+    trace_through(lens, rays, reverse=True, clip=True, fresnel=fresnel, coating=coating,
+                  stop_semi_diameter=stop_semi_diameter, aperture=aperture, backend=backend,
+                  chunk_size=chunk_size, in_place=True)
     origin = np.stack([rays.x, rays.y, rays.z - film_z], axis=1)
     direction = np.stack([rays.L, rays.M, rays.N], axis=1)
     return CameraRays(origin, direction, rays.weight, rays)
