@@ -63,3 +63,12 @@ def test_shutter_interval():
     assert shutter_interval(180.0) == (0.0, 0.5)
     assert shutter_interval(172.8, "centered") == pytest.approx((-0.24, 0.24))
     assert shutter_interval(360.0, "end") == (-1.0, 0.0)
+
+
+def test_focus_distance_is_measured_from_the_entrance_pupil():
+    # technical model, pupil 95 mm in front of the film, mark 2 m: the camera sits at the pupil,
+    # so focusDistance = 2000 - 95 mm = 190.5 cm at metersPerUnit 0.01 (RenderMan likewise)
+    r = solve_lens_report(focal_length_mm=50.0, sensor=Sensor("x", "x", 36.0, 24.0), fstop=2.0, focus_mm=2000.0,
+                          model="technical", h1_mm=80.0, h2_mm=60.0, pupil_mm=95.0)
+    assert usdgeom_camera_values(r, 0.01)["focusDistance"] == pytest.approx(190.5)
+    assert renderman_camera_values(r, 1.0)["Projection"]["focalDistance"] == pytest.approx(1.905)

@@ -7,7 +7,8 @@ a >= 1 (RenderMan Interface Specification 3.2, "Camera": ScreenWindow default an
 that convention. Anamorphic: the image is the squeezed plate, so ``Format`` carries
 pixel aspect = squeeze and the frame aspect is the de-squeezed one. ``focalLength``
 and ``focalDistance`` are in scene units (PxrCamera's depth of field uses them with
-``fStop``), ``focalDistance`` being the Gaussian object distance from H1.
+``fStop``), ``focalDistance`` being measured from the entrance pupil (the camera's centre
+of projection; see :func:`physcam.export.usdgeom.focus_distance_from_pupil_mm`).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from __future__ import annotations
 import math
 
 from ..errors import InputError
-from .usdgeom import DEFAULT_METERS_PER_UNIT, mm_to_scene_units
+from .usdgeom import DEFAULT_METERS_PER_UNIT, focus_distance_from_pupil_mm, mm_to_scene_units
 
 __all__ = ["renderman_camera_values"]
 
@@ -58,6 +59,6 @@ def renderman_camera_values(
             "fov": fov,
             "fStop": report.fstop,
             "focalLength": su(f),
-            "focalDistance": su(report.object_distance_mm),
+            "focalDistance": su(focus_distance_from_pupil_mm(report)),
         },
     }

@@ -22,6 +22,7 @@ __all__ = [
     "mm_to_scene_units",
     "mm_to_tenths_of_scene_unit",
     "shutter_interval",
+    "focus_distance_from_pupil_mm",
     "usdgeom_camera_values",
 ]
 
@@ -66,6 +67,13 @@ def shutter_interval(shutter_angle_deg: float = 180.0, phase: str = "start") -> 
     raise InputError(f"shutter phase must be start, centered or end, got {phase!r}")
 
 
+def focus_distance_from_pupil_mm(report) -> float:
+    """Distance (mm) from the entrance pupil to the plane of sharp focus; s from H1 without a pupil."""
+    if report.entrance_pupil_from_film_mm is None:
+        return report.object_distance_mm
+    return report.focus_from_film_mm - report.entrance_pupil_from_film_mm
+
+
 def usdgeom_camera_values(
     report,
     meters_per_unit: float = DEFAULT_METERS_PER_UNIT,
@@ -81,9 +89,11 @@ def usdgeom_camera_values(
     Anamorphic lenses: the horizontal aperture is the *desqueezed* film width
     (width x squeeze), so a spherical CG camera sees the de-squeezed field of view;
     the squeeze itself is not an aperture offset (seed 000's note is wrong there).
-    ``focusDistance`` is the Gaussian object distance s from the front principal plane,
-    the distance a thin-lens renderer focuses at. ``shift_mm`` is a sensor (lens) shift
-    on the film, in mm, becoming the aperture offsets.
+    ``focusDistance`` is measured from the camera's centre of projection, the entrance pupil,
+    where physcam places the camera prim (``physcam.usd``): focus mark minus the pupil's
+    distance from the film. Without a known pupil it is the Gaussian object distance s from
+    H1 (for the practical thin lens the two agree: the pupil sits at the principal plane).
+    ``shift_mm`` is a sensor (lens) shift on the film, in mm, becoming the aperture offsets.
     """
     near_mm, far_mm = clipping_range_mm
     require_positive("near clipping distance", near_mm)
@@ -102,7 +112,7 @@ def usdgeom_camera_values(
         "verticalAperture": t(report.sensor.height_mm),
         "horizontalApertureOffset": t(shift_mm[0] * sq),
         "verticalApertureOffset": t(shift_mm[1]),
-        "focusDistance": su(report.object_distance_mm),
+        "focusDistance": su(focus_distance_from_pupil_mm(report)),
         "fStop": report.fstop,
         "clippingRange": (su(near_mm), su(far_mm)),
         "shutter:open": open_,
