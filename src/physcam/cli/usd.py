@@ -74,8 +74,14 @@ def run_write(args) -> int:
     spec = spec_from_report(report, projection="orthographic" if args.orthographic else "perspective",
                             magnification=args.magnification, aperture_blades=args.blades,
                             shutter_duration_s=args.shutter_angle / 360.0 / args.fps)
+    distortion = None
+    if getattr(args, "lens", None) and not args.orthographic:  # a prescription-backed report: its real distortion
+        from ..lens.library import load_lens
+        from ..usd.kit import prescription_distortion
+
+        distortion = prescription_distortion(load_lens(args.lens), report.sensor.width_mm, report.sensor.height_mm)
     path = write_camera(args.file, spec, force=args.force, path=args.path, meters_per_unit=args.meters_per_unit,
-                        fps=args.fps, report=report if not args.orthographic else None)
+                        fps=args.fps, report=report if not args.orthographic else None, lens_distortion=distortion)
     return _done(args, path)
 
 

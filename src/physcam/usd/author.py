@@ -11,6 +11,8 @@ use. The two are written from the same numbers:
   :func:`physcam.export.usdgeom.usdgeom_camera_values`: focal length and apertures
   in tenths of a scene unit, focus and clipping distances in scene units
   (``metersPerUnit``; docs/conventions.md);
+* Hydra's ``lensDistortion:*`` when a fitted model is given (a real lens's traced distortion,
+  :mod:`physcam.analysis.distortion`);
 * ``exposure:*``, ``shutter:open/close`` (in time codes, from the stage's
   ``timeCodesPerSecond``) and RenderMan's ``ri:aperture*``, ``ri:shutterOpenTime``,
   ``ri:shutterCloseTime``, ``ri:shutteropening`` (hdPrman's camera tokens; seed 002).
@@ -248,7 +250,7 @@ ALL_PARTS = ("body", "sensor", "lens", "render")
 
 
 def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0),
-                  rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, parts=ALL_PARTS):
+                  rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, parts=ALL_PARTS, lens_distortion=None):
     """Author ``spec`` at ``path`` on ``stage`` (its current edit target); return the PhysicalCamera prim.
 
     ``position``: where the entrance pupil is, in scene units in the parent's space;
@@ -258,6 +260,9 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
     ``parts`` limits what is written: "body" (transform, shutter), "sensor", "lens"
     (lens API and lens model prim), "render" (the companion UsdGeomCamera); a body file
     and a lens file each write their own parts and a shot composes them.
+    ``lens_distortion``: a fitted radial model
+    (:class:`physcam.analysis.distortion.StandardDistortion`, or its ``usd_attributes()`` dict),
+    written as Hydra's ``lensDistortion:*`` on the companion UsdGeomCamera.
     """
     bad = set(parts) - set(ALL_PARTS)
     if bad:
@@ -302,7 +307,7 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
     if "lens" in parts:
         _author_lens(stage, cam, spec, eye, su)
     if "render" in parts:
-        author_render_camera(stage, sdf_path, spec, report=report)
+        author_render_camera(stage, sdf_path, spec, report=report, lens_distortion=lens_distortion)
     return cam
 
 
@@ -366,8 +371,14 @@ def _author_lens(stage, cam, spec, eye, su):
     cam.GetRelationship(lp + "lensModel").SetTargets([model.GetPath()])
 
 
-def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None):
-    """Write ``<cam_path>/Camera``, the UsdGeomCamera that matches ``spec`` in the stage's units."""
+def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None, lens_distortion=None):
+    """Write ``<cam_path>/Camera``, the UsdGeomCamera that matches ``spec`` in the stage's units.
+
+    With ``lens_distortion`` (see :func:`author_camera`) the camera also gets Hydra's
+    ``lensDistortion:type``/``k1``/``k2``/``center``/``anaSq``/``asym``/``scale`` attributes
+    (``HdCameraTokens``; hdPrman passes them to PxrCamera). They are not UsdGeomCamera schema
+    attributes in usd-core, so they are written as custom attributes, like ``ri:*``.
+    """
     from pxr import Gf, Sdf, UsdGeom
 
     from ..export.usdgeom import mm_to_scene_units, mm_to_tenths_of_scene_unit, usdgeom_camera_values
@@ -430,17 +441,49 @@ def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None):
     _set(prim, "ri:shutterCloseTime", Sdf.ValueTypeNames.Float, spec.shutter_opening[1], custom=True)
     _set(prim, "ri:shutteropening", Sdf.ValueTypeNames.FloatArray,
          shutter_opening_curve(*spec.shutter_opening), custom=True)
+    if lens_distortion is not None:
+        _author_lens_distortion(prim, lens_distortion)
     xf = UsdGeom.Xformable(prim)
     xf.ClearXformOpOrder()
     xf.AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, -su(eye)))
     return geom
 
 
+#: Hydra's lens distortion parameters and their USD value types (HdCameraTokens, "standard" model).
+LENS_DISTORTION_TYPES = {
+    "lensDistortion:type": "Token",
+    "lensDistortion:k1": "Float",
+    "lensDistortion:k2": "Float",
+    "lensDistortion:center": "Float2",
+    "lensDistortion:anaSq": "Float",
+    "lensDistortion:asym": "Float2",
+    "lensDistortion:scale": "Float",
+}
+
+
+def _author_lens_distortion(prim, lens_distortion):
+    from pxr import Gf, Sdf
+
+    values = lens_distortion.usd_attributes() if hasattr(lens_distortion, "usd_attributes") else dict(lens_distortion)
+    unknown = set(values) - set(LENS_DISTORTION_TYPES)
+    if unknown:
+        raise ExportError(f"unknown lens distortion attributes {sorted(unknown)}; use {', '.join(LENS_DISTORTION_TYPES)}")
+    for name, value in values.items():
+        kind = LENS_DISTORTION_TYPES[name]
+        if kind == "Token":
+            v = str(value)
+        elif kind == "Float2":
+            v = Gf.Vec2f(*(require_finite(name, x, error=ExportError) for x in value))
+        else:
+            v = require_finite(name, value, error=ExportError)
+        _set(prim, name, getattr(Sdf.ValueTypeNames, kind), v, custom=True)
+
+
 def author_from_report(stage, path: str, report, *, position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0),
-                       **body):
+                       lens_distortion=None, **body):
     """Author the camera of a :class:`~physcam.onset.report.LensReport` (see :func:`author_camera`)."""
     return author_camera(stage, path, spec_from_report(report, **body), position=position,
-                         rotate_xyz_deg=rotate_xyz_deg, report=report)
+                         rotate_xyz_deg=rotate_xyz_deg, report=report, lens_distortion=lens_distortion)
 
 
 def save_stage(stage, file, *, force: bool = False):
@@ -477,8 +520,9 @@ def save_stage(stage, file, *, force: bool = False):
 
 def write_camera(file, spec: CameraSpec, *, force: bool = False, path: str = DEFAULT_CAMERA_PATH,
                  meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y",
-                 position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), report=None):
+                 position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, lens_distortion=None):
     """Write a one-camera layer to ``file`` (see :func:`author_camera`); return the Path."""
     stage = new_stage(meters_per_unit, fps, up_axis)
-    author_camera(stage, path, spec, position=position, rotate_xyz_deg=rotate_xyz_deg, report=report)
+    author_camera(stage, path, spec, position=position, rotate_xyz_deg=rotate_xyz_deg, report=report,
+                  lens_distortion=lens_distortion)
     return save_stage(stage, file, force=force)

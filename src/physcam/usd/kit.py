@@ -227,6 +227,16 @@ def best_match_pinhole(prescription, *, focus_mm: float, fstop: float, sensor_wi
     return spec.checked(), report
 
 
+def prescription_distortion(prescription, sensor_width_mm: float = 36.0, sensor_height_mm: float = 24.0):
+    """The standard radial distortion model fitted to ``prescription``'s traced chief rays (object at infinity).
+
+    See :mod:`physcam.analysis.distortion`; written as ``lensDistortion:*`` on the companion camera.
+    """
+    from ..analysis.distortion import real_distortion
+
+    return real_distortion(prescription, sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm).fit
+
+
 def _author_prescription(stage, path, rx, focus_mm: float):
     from pxr import Sdf, Vt
 
@@ -282,7 +292,8 @@ def write_vendor_lens(file, prescription, *, focus_mm: float, fstop: float | Non
                                        sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm,
                                        coc_mm=coc_mm)
     stage = _stage(meters_per_unit, fps)
-    cam = author_camera(stage, LENS_PRIM, spec)
+    cam = author_camera(stage, LENS_PRIM, spec,
+                        lens_distortion=prescription_distortion(prescription, sensor_width_mm, sensor_height_mm))
     rx_prim = _author_prescription(stage, Sdf.Path(LENS_PRIM).AppendChild("Prescription"), prescription, focus_mm)
     pin = stage.GetPrimAtPath(Sdf.Path(LENS_PRIM).AppendChild("Pinhole"))
     rel_name = f"lens:{LENS_INSTANCE}:lensModel"

@@ -1,0 +1,183 @@
+"""Longitudinal and lateral colour (chromatic aberration) of a lens, object at infinity.
+
+- **Longitudinal colour** (axial colour): the image plane moves with wavelength. Paraxial: the
+  rear focal point z_F'(lambda) from the Gaussian engine (:func:`physcam.optics.paraxial.gaussian`);
+  real: where a real ray parallel to the axis at ``zone`` x the entrance-pupil radius crosses
+  the axis after the lens. Reported relative to the reference wavelength (d line by default)
+  and as the F-C difference z(C) - z(F) (positive: red focuses farther from the lens). For a
+  thin lens it is f / Vd to first order (Smith, *Modern Optical Engineering*, 4th ed., 10.4;
+  Kingslake & Johnson, *Lens Design Fundamentals*, 5.3).
+- **Lateral colour** (transverse colour, chromatic difference of magnification): the height of
+  the real chief ray (aimed through the stop centre per wavelength) on the film plane
+  ``film_z`` (default: paraxial focus at the reference wavelength), h_F - h_C, in micrometres.
+
+Indices per wavelength come from the glass model of :mod:`physcam.optics.glass` (two-term Cauchy
+from nd and Vd), so a lens file with Vd = 0 everywhere shows no colour at all. Fraunhofer lines:
+F 486.1327 nm, d 587.5618 nm, C 656.2725 nm.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError, OpticsError, require_finite, require_positive
+from ..lens.prescription import Prescription
+from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM
+
+__all__ = ["LateralColourPoint", "ColourResult", "chromatic_aberration"]
+
+
+@dataclass(frozen=True)
+class LateralColourPoint:
+    field_deg: float
+    heights_mm: dict  # wavelength (nm, as text) -> chief ray height on the film
+    lateral_colour_um: float  # h(F) - h(C)
+
+    def to_dict(self) -> dict:
+        return {"field_deg": self.field_deg, "heights_mm": dict(self.heights_mm),
+                "lateral_colour_um": self.lateral_colour_um}
+
+
+@dataclass
+class ColourResult:
+    lens_name: str
+    reference_nm: float
+    film_z_mm: float
+    zone: float
+    wavelengths_nm: list[float]
+    paraxial_focus_z_mm: list[float]  # rear focal point per wavelength (lens space)
+    real_focus_z_mm: list[float]  # zone ray's axis crossing per wavelength
+    longitudinal_paraxial_mm: float  # z(C) - z(F), paraxial
+    longitudinal_real_mm: float  # z(C) - z(F), real zone ray
+    curve_nm: list[float]
+    curve_shift_mm: list[float]  # paraxial focus relative to the reference wavelength
+    lateral: list[LateralColourPoint]
+    efl_mm: float
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return {
+            "lens": self.lens_name, "reference_nm": self.reference_nm, "film_z_mm": self.film_z_mm,
+            "zone": self.zone, "wavelengths_nm": self.wavelengths_nm,
+            "paraxial_focus_z_mm": self.paraxial_focus_z_mm, "real_focus_z_mm": self.real_focus_z_mm,
+            "longitudinal_paraxial_mm": self.longitudinal_paraxial_mm,
+            "longitudinal_real_mm": self.longitudinal_real_mm, "efl_mm": self.efl_mm,
+            "curve": {"wavelength_nm": self.curve_nm, "focus_shift_mm": self.curve_shift_mm},
+            "lateral": [p.to_dict() for p in self.lateral],
+            "conventions": "z in lens space (mm from the first vertex, + toward the film); longitudinal = z(C) - z(F); "
+                           "lateral = h(F) - h(C) on the film",
+            "notes": list(self.notes),
+        }
+
+    def plot(self, path=None, *, force: bool = False):
+        from ._plot import figure, save
+
+        fig, (a1, a2) = figure(9.0, 3.6, ncols=2)
+        a1.plot(self.curve_shift_mm, self.curve_nm, "-")
+        a1.axvline(0.0, color="0.6", lw=0.6)
+        a1.set_xlabel(f"paraxial focus shift from {self.reference_nm:g} nm (mm)")
+        a1.set_ylabel("wavelength (nm)")
+        a1.set_title(f"longitudinal colour: C - F = {self.longitudinal_paraxial_mm * 1e3:.1f} um (paraxial)", fontsize=8)
+        if self.lateral:
+            a2.plot([p.field_deg for p in self.lateral], [p.lateral_colour_um for p in self.lateral], "o-", ms=3)
+        a2.axhline(0.0, color="0.6", lw=0.6)
+        a2.set_xlabel("field angle (deg)")
+        a2.set_ylabel("lateral colour F - C (um)")
+        a2.set_title("lateral colour on the film", fontsize=8)
+        fig.suptitle(self.lens_name, fontsize=9)
+        return save(fig, path, force)
+
+
+def _zone_focus(lens, height, wl, backend):
+    from ..trace import RayBatch, trace_through
+
+    out = trace_through(lens, RayBatch.collimated([0.0], [height], -1.0, wavelength_nm=wl), backend=backend)
+    if not out.ok.all() or out.M[0] >= 0:
+        raise OpticsError(
+            f"the zone ray at {height:.3g} mm does not reach a real focus through {lens.name!r} at {wl:g} nm; "
+            "use a smaller zone"
+        )
+    return float(out.z[0] - out.y[0] * out.N[0] / out.M[0])
+
+
+def chromatic_aberration(
+    lens: Prescription,
+    fields_deg=None,
+    *,
+    wavelengths_nm=(LINE_F_NM, LINE_D_NM, LINE_C_NM),
+    reference_nm: float = LINE_D_NM,
+    zone: float = math.sqrt(0.5),
+    max_field_deg: float | None = None,
+    sensor_width_mm: float = 36.0,
+    sensor_height_mm: float = 24.0,
+    n_fields: int = 8,
+    film_z: float | None = None,
+    backend: str = "auto",
+) -> ColourResult:
+    """Longitudinal and lateral colour of ``lens`` (module notes).
+
+    ``wavelengths_nm`` are reported; F and C are always added for the F-C figures. ``zone``
+    (0-1] is the real ray's height as a fraction of the entrance-pupil radius. Fields in degrees
+    (default: ``n_fields`` up to the sensor corner or ``max_field_deg``).
+    """
+    from ..optics.paraxial import gaussian
+    from ..trace import RayBatch, paraxial_image_z, trace_through
+    from ._chief import aim_from_infinity, field_direction
+
+    ref = require_positive("reference wavelength", reference_nm, unit="nm")
+    zone = require_finite("zone", zone)
+    if not 0 < zone <= 1:
+        raise InputError(f"zone must be a fraction of the pupil radius in (0, 1], got {zone:g}")
+    wls = sorted({float(require_positive("wavelength", w, unit="nm")) for w in wavelengths_nm} | {LINE_F_NM, LINE_C_NM})
+    if min(wls) < 300 or max(wls) > 1100:
+        raise InputError("wavelengths must lie between 300 and 1100 nm (the glass model is fitted to the visible)")
+    g_ref = gaussian(lens, wavelength_nm=ref)
+    if g_ref.efl <= 0:
+        raise OpticsError(f"lens {lens.name!r} has no positive focal length: no real image")
+    if film_z is None:
+        film_z = paraxial_image_z(lens, ref)
+    film_z = require_finite("film_z", film_z)
+    par = [gaussian(lens, wavelength_nm=w).z_rear_focal_point for w in wls]
+    r_ep = 0.5 * g_ref.entrance_pupil_diameter
+    real = [_zone_focus(lens, zone * r_ep, w, backend) for w in wls]
+    iF, iC = wls.index(LINE_F_NM), wls.index(LINE_C_NM)
+    curve = list(np.arange(400.0, 701.0, 10.0))
+    z_ref = g_ref.z_rear_focal_point
+    shift = [gaussian(lens, wavelength_nm=w).z_rear_focal_point - z_ref for w in curve]
+
+    if fields_deg is None:
+        top = max_field_deg
+        if top is None:
+            top = math.degrees(math.atan(0.5 * math.hypot(sensor_width_mm, sensor_height_mm) / g_ref.efl))
+        top = require_finite("max field", top)
+        if not 0 < top < 89:
+            raise InputError(f"max field must lie between 0 and 89 degrees, got {top:g}")
+        fields = np.linspace(0.0, top, max(2, int(n_fields)))
+    else:
+        fields = np.array([require_finite("field angle", f) for f in np.atleast_1d(fields_deg)], dtype=float)
+        if fields.size == 0 or (np.abs(fields) >= 89).any():
+            raise InputError("give field angles between -89 and 89 degrees")
+    dirs = field_direction(np.radians(fields), "y")
+    heights = {}
+    for w in wls:
+        aimed = aim_from_infinity(lens, dirs, wavelength_nm=w, backend=backend)
+        out = trace_through(lens, RayBatch.from_arrays(aimed.start, aimed.direction, w), end_z=film_z, backend=backend)
+        ok = aimed.ok & out.ok
+        if not ok.all():
+            bad = float(fields[~ok][0])
+            raise OpticsError(f"the chief ray at {bad:g} deg ({w:g} nm) does not pass {lens.name!r}; "
+                              "choose smaller fields (--max-field)")
+        heights[w] = out.y.copy()
+    lateral = [
+        LateralColourPoint(float(f), {f"{w:g}": float(heights[w][i]) for w in wls},
+                           float((heights[LINE_F_NM][i] - heights[LINE_C_NM][i]) * 1e3))
+        for i, f in enumerate(fields)
+    ]
+    return ColourResult(
+        lens.name, ref, float(film_z), zone, wls, [float(v) for v in par], real,
+        float(par[iC] - par[iF]), float(real[iC] - real[iF]),
+        [float(v) for v in curve], [float(v) for v in shift], lateral, float(g_ref.efl),
+    )

@@ -1,0 +1,257 @@
+"""Real distortion against field, and a radial model for Hydra's ``lensDistortion:*`` attributes.
+
+For each field angle theta (object at infinity) the real chief ray -- aimed through the centre
+of the stop, see :mod:`physcam.analysis._chief` -- is traced to the film plane ``film_z``
+(default: the paraxial image plane at the wavelength). Its height h is compared with the
+paraxial image height f tan(theta) of the same meridian (f = EFL; Smith, *Modern Optical
+Engineering*, 4th ed., 3.5 and 10.5; Kingslake & Johnson, *Lens Design Fundamentals*, 12.4):
+
+    distortion (%) = 100 (h - f tan theta) / (f tan theta)
+
+negative is barrel, positive pincushion. Anamorphic lenses are measured in the X-Z and the
+Y-Z meridians with their own EFL each. Heights are in mm on the film, field angles in degrees.
+
+Radial model ("standard", two coefficients)::
+
+    r_real = r_ideal (1 + k1 rho^2 + k2 rho^4),    rho = r_ideal / (sensor width / 2)
+
+r_ideal is the distortion-free (pinhole) image radius f tan(theta); rho is normalised so that
+the edge of the film gate's width is 1 (the horizontal half-extent of a RenderMan screen window).
+k1, k2 come from a linear least-squares fit to the traced distortion. This is what physcam writes
+as ``lensDistortion:type = "standard"``, ``lensDistortion:k1``, ``lensDistortion:k2`` (with
+``center`` (0, 0), ``anaSq`` 1, ``asym`` (0, 0), ``scale`` 1) on the UsdGeomCamera: Hydra's
+camera parameters (``HdCameraTokens``) that hdPrman hands to PxrCamera's ``radial1``/``radial2``.
+OpenUSD does not document the normalisation or direction of that mapping; physcam's convention
+is the one above (docs/analyses.md), so the coefficients are checked against traced rays, not
+against a renderer.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError, OpticsError, require_finite, require_positive
+from ..lens.prescription import Prescription
+
+__all__ = ["DistortionPoint", "StandardDistortion", "DistortionResult", "real_distortion", "fit_standard_distortion"]
+
+
+@dataclass(frozen=True)
+class DistortionPoint:
+    """One field angle in one meridian (mm, degrees, percent)."""
+
+    axis: str
+    field_deg: float
+    real_height_mm: float
+    paraxial_height_mm: float
+    distortion_pct: float
+
+    def to_dict(self) -> dict:
+        return dict(axis=self.axis, field_deg=self.field_deg, real_height_mm=self.real_height_mm,
+                    paraxial_height_mm=self.paraxial_height_mm, distortion_pct=self.distortion_pct)
+
+
+@dataclass(frozen=True)
+class StandardDistortion:
+    """Fitted r_real = r_ideal (1 + k1 rho^2 + k2 rho^4), rho = r_ideal / ``norm_radius_mm`` (module notes)."""
+
+    k1: float
+    k2: float
+    norm_radius_mm: float
+    max_residual_pct: float  # largest |fitted - traced| distortion over the fitted points, percent
+    center: tuple[float, float] = (0.0, 0.0)
+    ana_sq: float = 1.0
+    asym: tuple[float, float] = (0.0, 0.0)
+    scale: float = 1.0
+
+    def distortion_pct(self, r_ideal_mm) -> np.ndarray:
+        rho2 = (np.asarray(r_ideal_mm, dtype=float) / self.norm_radius_mm) ** 2
+        return 100.0 * (self.k1 * rho2 + self.k2 * rho2 * rho2)
+
+    def usd_attributes(self) -> dict:
+        """Hydra ``lensDistortion:*`` attribute names and values (type token, floats, float2s)."""
+        return {
+            "lensDistortion:type": "standard",
+            "lensDistortion:k1": float(self.k1),
+            "lensDistortion:k2": float(self.k2),
+            "lensDistortion:center": tuple(map(float, self.center)),
+            "lensDistortion:anaSq": float(self.ana_sq),
+            "lensDistortion:asym": tuple(map(float, self.asym)),
+            "lensDistortion:scale": float(self.scale),
+        }
+
+    def to_dict(self) -> dict:
+        return {"type": "standard", "k1": self.k1, "k2": self.k2, "norm_radius_mm": self.norm_radius_mm,
+                "max_residual_pct": self.max_residual_pct, "center": list(self.center), "anaSq": self.ana_sq,
+                "asym": list(self.asym), "scale": self.scale,
+                "model": "r_real = r_ideal (1 + k1 rho^2 + k2 rho^4), rho = r_ideal / norm_radius_mm"}
+
+
+def fit_standard_distortion(r_ideal_mm, distortion_pct, norm_radius_mm: float) -> StandardDistortion:
+    """Least-squares k1, k2 of the standard model to (ideal radius, percent distortion) samples."""
+    r = np.asarray(r_ideal_mm, dtype=float)
+    d = np.asarray(distortion_pct, dtype=float) / 100.0
+    norm = require_positive("normalising radius", norm_radius_mm)
+    keep = r > 0
+    if keep.sum() < 2:
+        raise InputError("fitting the distortion model needs at least two field points off axis")
+    rho2 = (r[keep] / norm) ** 2
+    A = np.stack([rho2, rho2 * rho2], axis=1)
+    (k1, k2), *_ = np.linalg.lstsq(A, d[keep], rcond=None)
+    res = 100.0 * np.abs(A @ np.array([k1, k2]) - d[keep])
+    return StandardDistortion(float(k1), float(k2), norm, float(res.max()))
+
+
+@dataclass
+class DistortionResult:
+    lens_name: str
+    wavelength_nm: float
+    film_z_mm: float
+    efl_x_mm: float
+    efl_y_mm: float
+    sensor_mm: tuple[float, float]
+    points: list[DistortionPoint]
+    fit: StandardDistortion | None  # None with fewer than two field points off axis
+    notes: list[str] = field(default_factory=list)
+
+    def meridian(self, axis: str) -> list[DistortionPoint]:
+        return [p for p in self.points if p.axis == axis]
+
+    def to_dict(self) -> dict:
+        return {
+            "lens": self.lens_name, "wavelength_nm": self.wavelength_nm, "film_z_mm": self.film_z_mm,
+            "film_z_reference": "lens space: mm from the first vertex, +z toward the film",
+            "efl_x_mm": self.efl_x_mm, "efl_y_mm": self.efl_y_mm, "sensor_mm": list(self.sensor_mm),
+            "definition": "100 (h_real - f tan theta) / (f tan theta); negative = barrel",
+            "points": [p.to_dict() for p in self.points],
+            "fit": None if self.fit is None else self.fit.to_dict(),
+            "usd": None if self.fit is None else self.fit.usd_attributes(), "notes": list(self.notes),
+        }
+
+    def plot(self, path=None, *, force: bool = False):
+        """Percent distortion against field angle per meridian, with the fitted model; PNG if ``path``."""
+        from ._plot import figure, save
+
+        fig, ax = figure(5.2, 3.6)
+        for axis, style in (("y", "o-"), ("x", "s--")):
+            pts = self.meridian(axis)
+            if not pts:
+                continue
+            f = [p.field_deg for p in pts]
+            ax.plot(f, [p.distortion_pct for p in pts], style, ms=3, label=f"traced ({axis.upper()} meridian)")
+            if self.fit is not None:
+                ax.plot(f, self.fit.distortion_pct([abs(p.paraxial_height_mm) for p in pts]), ":",
+                        label=f"fit ({axis.upper()})")
+        ax.axhline(0.0, color="0.6", lw=0.6)
+        ax.set_xlabel("field angle (deg)")
+        ax.set_ylabel("distortion (%)")
+        fit = "" if self.fit is None else f"\nk1 = {self.fit.k1:.5f}, k2 = {self.fit.k2:.5f}"
+        ax.set_title(f"{self.lens_name}: real distortion at {self.wavelength_nm:g} nm{fit}", fontsize=8)
+        ax.legend(fontsize=7)
+        return save(fig, path, force)
+
+
+def _max_field_deg(lens, axis, wl, half_diag, efl, backend) -> float:
+    """Largest field (deg) up to the sensor corner whose chief ray reaches the film unclipped."""
+    lo, hi = 0.0, min(math.degrees(math.atan(half_diag / abs(efl))), 89.0)
+    if _chief_heights(lens, [hi], axis, wl, None, backend, clip=True)[1].all():
+        return hi
+    for _ in range(24):
+        mid = 0.5 * (lo + hi)
+        if _chief_heights(lens, [mid], axis, wl, None, backend, clip=True)[1].all():
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+def _chief_heights(lens, fields_deg, axis, wl, film_z, backend, clip=True):
+    """Film heights (mm, along ``axis``) of the aimed chief rays, and which reached the film."""
+    from ..trace import RayBatch, paraxial_image_z, trace_through
+    from ._chief import aim_from_infinity, field_direction
+
+    if film_z is None:
+        film_z = paraxial_image_z(lens, wl)
+    aimed = aim_from_infinity(lens, field_direction(np.radians(fields_deg), axis), wavelength_nm=wl, backend=backend)
+    out = trace_through(lens, RayBatch.from_arrays(aimed.start, aimed.direction, wl), end_z=film_z, clip=clip,
+                        backend=backend)
+    ok = aimed.ok & out.ok
+    h = out.x if axis == "x" else out.y
+    return np.where(ok, h, 0.0), ok
+
+
+def real_distortion(
+    lens: Prescription,
+    fields_deg=None,
+    *,
+    sensor_width_mm: float = 36.0,
+    sensor_height_mm: float = 24.0,
+    n_fields: int = 15,
+    wavelength_nm: float | None = None,
+    film_z: float | None = None,
+    backend: str = "auto",
+) -> DistortionResult:
+    """Real distortion of ``lens`` (module notes) and the fitted standard model.
+
+    ``fields_deg``: field angles in degrees (default ``n_fields`` angles from 0 to the field whose
+    paraxial image reaches the sensor corner, or the widest field whose chief ray passes the
+    lens when that is smaller). Anamorphic lenses are measured in both meridians. A field whose
+    chief ray misses or is clipped raises :class:`OpticsError` naming the widest field that passes.
+    """
+    from ..optics.paraxial import gaussian_xy
+    from ..trace import paraxial_image_z
+
+    wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
+    w = require_positive("sensor width", sensor_width_mm)
+    h = require_positive("sensor height", sensor_height_mm)
+    if film_z is None:
+        film_z = paraxial_image_z(lens, wl)
+    film_z = require_finite("film_z", film_z)
+    g = gaussian_xy(lens, wavelength_nm=wl)
+    axes = ("y", "x") if lens.is_anamorphic else ("y",)
+    half_diag = 0.5 * math.hypot(w, h)
+    notes = []
+    points: list[DistortionPoint] = []
+    for axis in axes:
+        efl = g[axis].efl
+        if efl <= 0:
+            raise OpticsError(f"lens {lens.name!r} has no positive focal length in {axis.upper()}: no real image")
+        if fields_deg is None:
+            corner = math.degrees(math.atan(half_diag / efl))
+            top = _max_field_deg(lens, axis, wl, half_diag, efl, backend)
+            if top < corner - 1e-6:
+                notes.append(f"{axis.upper()} meridian: chief rays pass only up to {top:.2f} deg "
+                             f"(sensor corner at {corner:.2f} deg)")
+            if n_fields < 3:
+                raise InputError(f"n_fields must be >= 3, got {n_fields}")
+            fields = np.linspace(0.0, top, n_fields)
+        else:
+            fields = np.array([require_finite("field angle", f) for f in np.atleast_1d(fields_deg)], dtype=float)
+            if fields.size == 0:
+                raise InputError("give at least one field angle")
+            if (np.abs(fields) >= 89.0).any():
+                raise InputError("field angles must lie between -89 and 89 degrees (f tan theta is infinite at 90)")
+        heights, ok = _chief_heights(lens, fields, axis, wl, film_z, backend)
+        if not ok.all():
+            bad = float(fields[~ok][0])
+            top = _max_field_deg(lens, axis, wl, half_diag, efl, backend)
+            raise OpticsError(
+                f"the chief ray at {bad:g} deg ({axis.upper()} meridian) does not pass {lens.name!r}; "
+                f"choose fields up to {top:.2f} deg"
+            )
+        par = efl * np.tan(np.radians(fields))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dist = np.where(np.abs(par) > 1e-12, 100.0 * (heights - par) / np.where(par == 0, 1.0, par), 0.0)
+        for f, hr, hp, d in zip(fields, heights, par, dist):
+            points.append(DistortionPoint(axis, float(f), float(hr), float(hp), float(d)))
+    r_ideal = np.array([abs(p.paraxial_height_mm) for p in points])
+    fit = None
+    if (r_ideal > 0).sum() >= 2:
+        fit = fit_standard_distortion(r_ideal, [p.distortion_pct for p in points], w / 2.0)
+    else:
+        notes.append("fewer than two field points off axis: no distortion model fitted")
+    return DistortionResult(lens.name, float(wl), float(film_z), float(g["x"].efl), float(g["y"].efl), (w, h),
+                            points, fit, notes)

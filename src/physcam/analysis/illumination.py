@@ -1,0 +1,212 @@
+"""Relative illumination against field: the irradiance on the film relative to the centre.
+
+An object at infinity of uniform radiance L sends, from a small solid angle d(omega) about the
+direction theta, a collimated beam; the part that passes every real aperture (element rims and
+the stop: vignetting) carries the flux dPhi = L d(omega) A(theta), with A(theta) the beam's
+cross-section perpendicular to its direction. That flux lands on the film area dA that the lens
+maps d(omega) onto, so the irradiance is E = L A(theta) d(omega)/dA (Slater, *Photographic
+Systems for Engineers*, ch. 6; Kingslake & Johnson, *Lens Design Fundamentals*, 7.7;
+Siew, *Breaking down the cosine fourth power law*, 2019). Relative illumination
+RI(theta) = E(theta) / E(0). No cos^4 is put in: it emerges from the real rays.
+
+- A(theta): collimated rays on a fine square grid over the part of the front vertex plane that
+  a pilot grid found to pass (the pilot grid covers the whole front element), traced to the
+  film with clipping at every clear semi-diameter and the stop; each passing ray stands for its
+  grid cell's area times cos(theta) (the cell foreshortened as seen along the beam), times its
+  Fresnel transmission when ``fresnel``.
+- d(omega)/dA: the real chief rays (aimed through the stop centre) of the direction cosines
+  (l, m) and of (l + e, m), (l, m + e); their film positions give the Jacobian J = d(x, y)/d(l, m),
+  and d(omega) = dl dm / n, so dA/d(omega) = |J| n with n = cos(theta). This includes the
+  lens's distortion (and anamorphic mapping).
+
+For a distortion-free lens whose pupil stays a circle of fixed size (a small stop at the centre
+of curvature of a single refracting surface), A = A0 cos(theta) and dA/d(omega) = f^2 / cos^3
+give the cos^4 law (tests/analysis). Fields in degrees, areas in mm^2.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError, OpticsError, require_finite, require_positive
+from ..lens.prescription import Prescription
+
+__all__ = ["IlluminationPoint", "IlluminationResult", "relative_illumination"]
+
+
+@dataclass(frozen=True)
+class IlluminationPoint:
+    axis: str
+    field_deg: float
+    relative_illumination: float  # E(theta) / E(0)
+    cos4: float
+    beam_area_mm2: float  # A(theta): passing beam cross-section perpendicular to the beam
+    vignetting_factor: float  # A(theta) / (A(0) cos theta): 1 when the pupil is only foreshortened
+    mapping_mm2_per_sr: float  # dA / d(omega) on the film
+    film_height_mm: float  # chief ray height on the film
+
+    def to_dict(self) -> dict:
+        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+
+
+@dataclass
+class IlluminationResult:
+    lens_name: str
+    wavelength_nm: float
+    film_z_mm: float
+    fresnel: bool
+    grid: int
+    points: list[IlluminationPoint]
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return {"lens": self.lens_name, "wavelength_nm": self.wavelength_nm, "film_z_mm": self.film_z_mm,
+                "fresnel": self.fresnel, "grid": self.grid, "points": [p.to_dict() for p in self.points],
+                "definition": "irradiance on the film relative to the centre, object of uniform radiance at infinity",
+                "notes": list(self.notes)}
+
+    def plot(self, path=None, *, force: bool = False):
+        from ._plot import figure, save
+
+        fig, ax = figure(5.2, 3.6)
+        for axis, style in (("y", "o-"), ("x", "s--")):
+            pts = [p for p in self.points if p.axis == axis]
+            if pts:
+                f = [p.field_deg for p in pts]
+                ax.plot(f, [p.relative_illumination for p in pts], style, ms=3,
+                        label=f"relative illumination ({axis.upper()})")
+                ax.plot(f, [p.vignetting_factor for p in pts], ":", label=f"vignetting factor ({axis.upper()})")
+        pts = [p for p in self.points if p.axis == "y"]
+        ax.plot([p.field_deg for p in pts], [p.cos4 for p in pts], "-", color="0.5", lw=0.8, label="cos^4")
+        ax.set_ylim(0, 1.1)
+        ax.set_xlabel("field angle (deg)")
+        ax.set_ylabel("relative to the centre")
+        ax.set_title(f"{self.lens_name}: relative illumination at {self.wavelength_nm:g} nm", fontsize=8)
+        ax.legend(fontsize=7)
+        return save(fig, path, force)
+
+
+def _beam_area(lens, direction, wl, film_z, grid, fresnel, stop_sd, backend):
+    """Cross-section (mm^2, perpendicular to the beam) of the collimated beam that reaches the film."""
+    from ..trace import RayBatch, trace_to_film
+
+    n_z = direction[2]
+
+    def passing(x0, x1, y0, y1, n):
+        xs = x0 + (np.arange(n) + 0.5) * (x1 - x0) / n
+        ys = y0 + (np.arange(n) + 0.5) * (y1 - y0) / n
+        X, Y = np.meshgrid(xs, ys)
+        pos = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)
+        out = trace_to_film(lens, RayBatch.from_arrays(pos, direction[None, :], wl), film_z, clip=True,
+                            fresnel=fresnel, stop_semi_diameter=stop_sd, backend=backend)
+        return X.ravel(), Y.ravel(), out.ok, out.weight
+
+    # pilot grids: the whole front element, then zoom on what passed until the beam is well resolved
+    r = 1.05 * lens.surfaces[0].semi_diameter
+    x0, x1, y0, y1 = -r, r, -r, r
+    npil = 64
+    for _ in range(4):
+        X, Y, ok, _ = passing(x0, x1, y0, y1, npil)
+        if not ok.any():
+            return 0.0
+        cx, cy = (x1 - x0) / npil, (y1 - y0) / npil
+        x0, x1 = X[ok].min() - 2 * cx, X[ok].max() + 2 * cx
+        y0, y1 = Y[ok].min() - 2 * cy, Y[ok].max() + 2 * cy
+        if ok.sum() >= 400:
+            break
+    X, Y, ok, w = passing(x0, x1, y0, y1, grid)
+    dA = (x1 - x0) * (y1 - y0) / grid**2
+    return float(w[ok].sum() * dA * n_z)
+
+
+def _mapping(lens, l, m, wl, film_z, backend, eps=1e-5):
+    """Film position of the chief ray of direction cosines (l, m) and dA/d(omega) there (mm^2/sr)."""
+    from ..trace import RayBatch, trace_through
+    from ._chief import aim_from_infinity
+
+    L = np.array([l, l + eps, l - eps, l, l])
+    M = np.array([m, m, m, m + eps, m - eps])
+    d = np.stack([L, M, np.sqrt(1.0 - L * L - M * M)], axis=1)
+    aimed = aim_from_infinity(lens, d, wavelength_nm=wl, backend=backend)
+    out = trace_through(lens, RayBatch.from_arrays(aimed.start, aimed.direction, wl), end_z=film_z, clip=False,
+                        backend=backend)
+    if not (aimed.ok.all() and out.ok.all()):
+        return None
+    jxl, jyl = (out.x[1] - out.x[2]) / (2 * eps), (out.y[1] - out.y[2]) / (2 * eps)
+    jxm, jym = (out.x[3] - out.x[4]) / (2 * eps), (out.y[3] - out.y[4]) / (2 * eps)
+    det = abs(jxl * jym - jxm * jyl)
+    return float(out.x[0]), float(out.y[0]), det * d[0, 2]
+
+
+def relative_illumination(
+    lens: Prescription,
+    fields_deg=None,
+    *,
+    max_field_deg: float | None = None,
+    n_fields: int = 10,
+    sensor_width_mm: float = 36.0,
+    sensor_height_mm: float = 24.0,
+    grid: int = 200,
+    fresnel: bool = False,
+    stop_semi_diameter: float | None = None,
+    wavelength_nm: float | None = None,
+    film_z: float | None = None,
+    backend: str = "auto",
+) -> IlluminationResult:
+    """Relative illumination of ``lens`` at field angles in degrees (module notes).
+
+    Default fields: ``n_fields`` from 0 to the sensor corner (``max_field_deg`` overrides).
+    Anamorphic lenses are evaluated in both meridians. ``grid``: rays per side of the sampling
+    grid (``grid``^2 per field). ``stop_semi_diameter`` (mm) stops the lens down. A field where no
+    ray passes, or whose chief ray does not, raises :class:`OpticsError`.
+    """
+    from ..optics.paraxial import gaussian_xy
+    from ..trace import paraxial_image_z
+    from ._chief import field_direction
+
+    wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
+    if not isinstance(grid, (int, np.integer)) or grid < 16:
+        raise InputError(f"grid must be a whole number >= 16, got {grid!r}")
+    if film_z is None:
+        film_z = paraxial_image_z(lens, wl)
+    film_z = require_finite("film_z", film_z)
+    g = gaussian_xy(lens, wavelength_nm=wl)
+    axes = ("y", "x") if lens.is_anamorphic else ("y",)
+    w, h = require_positive("sensor width", sensor_width_mm), require_positive("sensor height", sensor_height_mm)
+    d0 = np.array([0.0, 0.0, 1.0])
+    a0 = _beam_area(lens, d0, wl, film_z, grid, fresnel, stop_semi_diameter, backend)
+    m0 = _mapping(lens, 0.0, 0.0, wl, film_z, backend)
+    if a0 <= 0 or m0 is None:
+        raise OpticsError(f"no on-axis light passes {lens.name!r}")
+    e0 = a0 / m0[2]
+    points = []
+    for axis in axes:
+        if fields_deg is None:
+            top = max_field_deg
+            if top is None:
+                top = math.degrees(math.atan(0.5 * math.hypot(w, h) / abs(g[axis].efl)))
+            top = require_finite("max field", top)
+            if not 0 < top < 89:
+                raise InputError(f"max field must lie between 0 and 89 degrees, got {top:g}")
+            fields = np.linspace(0.0, top, max(2, int(n_fields)))
+        else:
+            fields = np.array([require_finite("field angle", f) for f in np.atleast_1d(fields_deg)], dtype=float)
+            if fields.size == 0 or (np.abs(fields) >= 89).any():
+                raise InputError("give field angles between -89 and 89 degrees")
+        for fd in fields:
+            d = field_direction(math.radians(fd), axis)[0]
+            a = _beam_area(lens, d, wl, film_z, grid, fresnel, stop_semi_diameter, backend) if fd != 0 else a0
+            mp = _mapping(lens, d[0], d[1], wl, film_z, backend) if fd != 0 else m0
+            if a <= 0 or mp is None:
+                raise OpticsError(
+                    f"at {fd:g} deg ({axis.upper()} meridian) {'no light' if a <= 0 else 'no chief ray'} passes "
+                    f"{lens.name!r}; choose a smaller field (max_field_deg)"
+                )
+            c = math.cos(math.radians(fd))
+            points.append(IlluminationPoint(
+                axis, float(fd), float((a / mp[2]) / e0), c**4, a, a / (a0 * c), mp[2],
+                mp[0] if axis == "x" else mp[1]))
+    return IlluminationResult(lens.name, float(wl), float(film_z), bool(fresnel), int(grid), points)

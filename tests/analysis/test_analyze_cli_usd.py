@@ -1,0 +1,80 @@
+"""The analysis commands and the lensDistortion hook in the USD cameras."""
+
+import json
+
+import pytest
+
+from physcam.analysis.distortion import real_distortion
+from physcam.cli import main
+from physcam.errors import ExportError
+from physcam.lens.library import load_lens
+
+
+@pytest.mark.parametrize("argv", [
+    ["distortion", "dgauss.50mm", "--field", "0", "--field", "5", "--field", "10"],
+    ["illumination", "dgauss.50mm", "--field", "0", "--field", "10", "--grid", "40", "--fstop", "4"],
+    ["colour", "tessar_50mm_f2_8", "--field", "0", "--field", "8", "--wavelength", "450"],
+    ["breathing-real", "dgauss.50mm", "--focus", "inf", "--focus", "1m"],
+    ["ghosts", "dgauss.50mm", "--field", "5", "--top", "3"],
+])
+def test_commands_print_json_and_tables(argv, capsys):
+    assert main(argv + ["--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["lens"]
+    assert main(argv) == 0
+    assert capsys.readouterr().out.strip()
+
+
+def test_plots_are_written_once(tmp_path, capsys):
+    out = tmp_path / "d.png"
+    assert main(["distortion", "dgauss.50mm", "-o", str(out)]) == 0
+    assert out.read_bytes()[:4] == b"\x89PNG"
+    assert main(["distortion", "dgauss.50mm", "-o", str(out)]) == 2
+    assert "already exists" in capsys.readouterr().err
+    for cmd, extra in (("illumination", ["--grid", "32", "--max-field", "10"]), ("colour", ["--max-field", "10"]),
+                       ("breathing-real", ["--focus", "inf", "--focus", "2m"]),
+                       ("ghosts", ["--rays", "2000", "--pixels", "32"])):
+        p = tmp_path / f"{cmd}.png"
+        assert main([cmd, "dgauss.50mm", "-o", str(p)] + extra) == 0
+        assert p.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_bad_input_is_one_line(capsys):
+    assert main(["distortion", "dgauss.50mm", "--field", "60"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("physcam: error:") and err.count("\n") == 1
+
+
+def test_usd_camera_carries_the_fitted_distortion(tmp_path, capsys):
+    from pxr import Usd
+
+    out = tmp_path / "cam.usda"
+    assert main(["usd", "write", str(out), "--lens", "dgauss.50mm", "--fstop", "2.8", "--focus", "2m",
+                 "--sensor-width", "36", "--sensor-height", "24"]) == 0
+    stage = Usd.Stage.Open(str(out))
+    cam = stage.GetPrimAtPath("/Cameras/Camera/Camera")
+    fit = real_distortion(load_lens("dgauss.50mm"), sensor_width_mm=36.0, sensor_height_mm=24.0).fit
+    assert cam.GetAttribute("lensDistortion:type").Get() == "standard"
+    assert cam.GetAttribute("lensDistortion:k1").Get() == pytest.approx(fit.k1, rel=1e-6)
+    assert cam.GetAttribute("lensDistortion:k2").Get() == pytest.approx(fit.k2, rel=1e-6)
+    assert tuple(cam.GetAttribute("lensDistortion:center").Get()) == (0.0, 0.0)
+    # the model reproduces the traced distortion at the sensor edge
+    r = real_distortion(load_lens("dgauss.50mm"), [15.0])
+    p = r.points[0]
+    assert fit.distortion_pct(p.paraxial_height_mm) == pytest.approx(p.distortion_pct, abs=0.005)
+
+
+def test_vendor_lens_file_and_bad_values(tmp_path):
+    from pxr import Usd
+
+    from physcam.usd.author import CameraSpec, new_stage, author_camera
+    from physcam.usd.kit import write_vendor_lens
+
+    path = write_vendor_lens(tmp_path / "v.usda", load_lens("dgauss.50mm"), focus_mm=3000.0, fstop=2.8)
+    stage = Usd.Stage.Open(str(path))
+    cams = [p for p in stage.Traverse() if p.GetTypeName() == "Camera"]
+    assert cams and cams[0].GetAttribute("lensDistortion:k1").Get() < 0  # barrel
+    with pytest.raises(ExportError):
+        author_camera(new_stage(), "/C", CameraSpec(), lens_distortion={"lensDistortion:k3": 0.1})
+    with pytest.raises(ExportError):
+        author_camera(new_stage(), "/C", CameraSpec(), lens_distortion={"lensDistortion:k1": float("nan")})
