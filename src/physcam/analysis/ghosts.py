@@ -95,7 +95,7 @@ class GhostResult:
         ax.set_ylabel("film y (mm)")
         ax.legend(fontsize=7, loc="upper right")
         fig.colorbar(im, ax=ax, label="log10 ghost irradiance (direct flux = 1 per mm^2)")
-        ax.set_title(f"{self.lens_name}: ghosts of a light at {self.field_deg:g} deg, coating {self.coating}",
+        ax.set_title(f"{self.lens_name}\nghosts of a light at {self.field_deg:g} deg, coating {self.coating}",
                      fontsize=8)
         return save(fig, path, force)
 
