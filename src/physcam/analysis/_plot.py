@@ -1,30 +1,16 @@
-"""Matplotlib helpers for the analyses: Agg backend, imported lazily; PNGs written atomically."""
+"""Matplotlib helpers for the analyses (see :mod:`physcam.figures`)."""
 
 from __future__ import annotations
 
+from ..figures import pyplot, save_figure
+
 
 def figure(width: float = 5.0, height: float = 3.6, ncols: int = 1):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, ncols, figsize=(width, height), squeeze=True)
+    fig, axes = pyplot().subplots(1, ncols, figsize=(width, height), squeeze=True)
     return fig, axes
 
 
 def save(fig, path=None, force: bool = False):
-    """Write ``fig`` as PNG to ``path`` through :func:`physcam.io.atomic_write` (when given); return it."""
+    """Lay out ``fig``; write it to ``path`` and return the path, or return the figure."""
     fig.tight_layout()
-    if path is not None:
-        import io as _io
-
-        import matplotlib.pyplot as plt
-
-        from ..io import atomic_write
-
-        buf = _io.BytesIO()
-        fig.savefig(buf, format="png", dpi=130)
-        atomic_write(path, buf.getvalue(), force=force)
-        plt.close(fig)
-    return fig
+    return fig if path is None else save_figure(fig, path, force=force)

@@ -101,13 +101,13 @@ def real_breathing(
     backend: str = "auto",
 ) -> RealBreathing:
     """Real against paraxial breathing of ``lens`` (module notes); marks default as in the breathing table."""
-    from ..optics.focusing import _method, breathing_table, focus
+    from ..optics.focusing import breathing_table, focus, focus_method
 
     w = require_positive("sensor width", sensor_width_mm)
     h = require_positive("sensor height", sensor_height_mm)
     wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
     table = breathing_table(lens, focus_marks_mm, sensor_width_mm=w, method=method, wavelength_nm=wl)
-    m = _method(lens, method)
+    m = focus_method(lens, method)
     rows = []
     first = None
     for row in table:

@@ -175,7 +175,7 @@ def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float, *, coat
                 stop_semi_diameter=None, backend: str = "auto", _tables=None):
     """Trace object-space ``rays`` (a RayBatch, copied) along ghost path (i, j) to the film plane ``film_z``."""
     from ..trace.kernels import get_kernel
-    from ..trace.trace import DEFAULT_CHUNK, _run
+    from ..trace.trace import DEFAULT_CHUNK, trace_packed
 
     n = len(lens.surfaces)
     if not (0 <= j < i < n):
@@ -183,7 +183,7 @@ def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float, *, coat
     T = _tables or _Tables(lens, coating, stop_semi_diameter)
     kern = get_kernel(backend)
     r = rays.copy()
-    run = lambda S, K, end=None: _run(kern, r, S, K, clip=True, fresnel=True, end_z=end,  # noqa: E731
+    run = lambda S, K, end=None: trace_packed(kern, r, S, K, clip=True, fresnel=True, end_z=end,  # noqa: E731
                                       chunk_size=DEFAULT_CHUNK)
     # leg 1: forward through 0..i-1, stop on surface i; reflect there
     run(*T._ending(T.Sf, T.kf, 0, i + 1))

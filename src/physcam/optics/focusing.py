@@ -138,7 +138,8 @@ class BreathingRow:
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
 
 
-def _method(prescription: Prescription, method: str) -> str:
+def focus_method(prescription: Prescription, method: str = "auto") -> str:
+    """The focusing method a lens uses: "auto" resolves to "internal" (focus groups) or "unit"."""
     if method not in FOCUS_METHODS:
         raise InputError(f"focus method must be one of {', '.join(FOCUS_METHODS)}, got {method!r}")
     if method == "auto":
@@ -237,7 +238,7 @@ def closest_focus(prescription: Prescription, *, method: str = "auto", axis: str
     Internal focusing: the close calibration point of the focus groups. Unit
     focusing (no mechanical limit known): the 1:1 conjugate, 4 f + hiatus in air.
     """
-    method = _method(prescription, method)
+    method = focus_method(prescription, method)
     if method == "internal":
         d = prescription.focus.close_distance
         q, back, _ = _internal_state(prescription, d, axis, wavelength_nm)
@@ -300,7 +301,7 @@ def focus(
     focusing travel. Raises :class:`OpticsError` naming the closest focus when
     the mark is too close.
     """
-    method = _method(prescription, method)
+    method = focus_method(prescription, method)
     mark = _mark(focus_from_film_mm)
     paraxial._axis(axis)
     if max_extension_mm is not None:
@@ -361,7 +362,7 @@ def technical_planes(
         fstop=fstop,
         flange_focal_distance_mm=flange_focal_distance_mm,
     )
-    st_method = _method(prescription, method)
+    st_method = focus_method(prescription, method)
     fl = {}
     if flange_focal_distance_mm is not None:
         fl = dict(
@@ -407,7 +408,7 @@ def breathing_table(
     chief ray reaching the sensor edge (``sensor_width_mm``/2 off axis).
     """
     w = require_positive("sensor width", sensor_width_mm)
-    method = _method(prescription, method)
+    method = focus_method(prescription, method)
     if focus_marks_mm is None:
         near = closest_focus(prescription, method=method, wavelength_nm=wavelength_nm)
         # internal focusing ends at its close point; unit focusing (no mechanical limit known) stops

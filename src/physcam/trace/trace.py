@@ -30,7 +30,12 @@ def _check_lens(lens) -> Prescription:
     return lens
 
 
-def _run(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chunk_size):
+def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chunk_size=DEFAULT_CHUNK):
+    """Trace ``rays`` in place through rows of a packed surface table (``kernels._layout.pack``).
+
+    The low-level step under :func:`trace_through`, public for analyses that trace a lens in
+    legs (ghost paths reflect between legs). ``kernel`` comes from ``kernels.get_kernel``.
+    """
     has_end = end_z is not None
     ez = float(end_z) if has_end else 0.0
     n = len(rays)
@@ -78,10 +83,10 @@ def trace_through(
     out = rays if in_place else rays.copy()
     kernel = get_kernel(backend)
     if aperture is None:
-        return _run(kernel, out, S, kinds, clip=clip, fresnel=fresnel, end_z=end_z, chunk_size=chunk_size)
+        return trace_packed(kernel, out, S, kinds, clip=clip, fresnel=fresnel, end_z=end_z, chunk_size=chunk_size)
     # trace to the stop, weigh by the aperture shape there, then on through the rest
     k = int(np.flatnonzero(table.index == lens.stop_index)[0])
-    _run(kernel, out, S[: k + 1], kinds[: k + 1], clip=clip, fresnel=fresnel, end_z=None, chunk_size=chunk_size)
+    trace_packed(kernel, out, S[: k + 1], kinds[: k + 1], clip=clip, fresnel=fresnel, end_z=None, chunk_size=chunk_size)
     rstop = table.semi_diameter[k]
     dens = aperture.density_at(out.x / rstop, out.y / rstop)
     live = out.flag == OK
@@ -89,7 +94,7 @@ def trace_through(
     blocked = live & (dens <= 0.0)
     out.flag[blocked] = CLIPPED
     out.weight[blocked] = 0.0
-    return _run(kernel, out, S[k + 1 :], kinds[k + 1 :], clip=clip, fresnel=fresnel, end_z=end_z,
+    return trace_packed(kernel, out, S[k + 1 :], kinds[k + 1 :], clip=clip, fresnel=fresnel, end_z=end_z,
                 chunk_size=chunk_size)
 
 
