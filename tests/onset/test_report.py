@@ -147,3 +147,51 @@ def test_report_from_a_lens_prescription():
     assert r.focus_error_mm == pytest.approx(0.0, abs=1e-6)
     assert r.object_distance_mm + r.h1_from_film_mm == pytest.approx(2000.0)
     assert r.entrance_pupil_source == "prescription"
+
+
+def test_anamorphic_lens_uses_its_own_x_focal_length():
+    # navarro_anamorphic_2x is nominally 2x; its X and Y effective focal lengths differ by less.
+    # The report's horizontal field must be what the X meridian images: 2 atan(w / 2 EFL_x).
+    from physcam.lens.library import load_lens
+    from physcam.optics import focusing, paraxial
+
+    lens = load_lens("navarro_anamorphic_2x")
+    gate = find_sensor("35mm anamorphic")
+    r = solve_lens_report(focal_length_mm=None, sensor=gate, focus_mm=3000.0, lens=lens)
+    st = focusing.focus(lens, 3000.0)
+    efl_x = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z).efl
+    assert r.hfov_inf_deg == pytest.approx(math.degrees(2 * math.atan(gate.width_mm / (2 * efl_x))), rel=1e-9)
+    assert 1.8 < r.squeeze < 2.0
+    # no f-stop given: wide open, which for this prescription is slower than the engraved T3
+    assert r.fstop >= paraxial.gaussian(lens).f_number - 1e-9
+
+
+def test_lens_without_engraved_fstop_opens_at_its_stop():
+    from physcam.lens.library import load_lens
+    from physcam.optics import paraxial
+
+    lens = load_lens("dgauss_77deg_3_5201mm")
+    r = solve_lens_report(focal_length_mm=None, sensor=find_sensor("Super 16"), focus_mm=1000.0, lens=lens)
+    assert r.fstop == pytest.approx(paraxial.gaussian(lens).f_number)
+
+
+def test_huge_far_limit_is_refused_not_overflowed():
+    with pytest.raises(InputError, match="1000 km"):
+        solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=4.0, focus_mm=3000.0, far_mm=1e308)
+    # a large but finite far limit inverts without overflow: h = (s - f) / (1 - s/F)
+    r = solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=4.0, focus_mm=3000.0, far_mm=1e8)
+    assert math.isfinite(r.coc_mm) and r.coc_mm > 0
+
+
+def test_focus_from_one_limit_solves_nothing_else():
+    # one limit + f-stop + CoC convention give the focus; they cannot also give a CoC
+    r = solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=4.0, near_mm=1000.0)
+    assert set(r.solved) == {"focus_from_film_mm"}
+    assert r.coc_convention == "d/1500"
+
+
+def test_technical_fov_at_focus_uses_where_the_film_is():
+    # H2 60 mm in front of the film: the film sits 60 mm behind H2 whatever s' the mark implies
+    r = solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=2.0, focus_mm=2000.0, model="technical",
+                          h1_mm=80.0, h2_mm=60.0)
+    assert r.hfov_focus_deg == pytest.approx(math.degrees(2 * math.atan(36.0 / 120.0)))

@@ -1,6 +1,7 @@
 """Exit-pupil bounds and camera rays (film -> scene)."""
 
 import numpy as np
+import pytest
 
 from physcam.trace import camera_rays
 from physcam.trace.aperture import Aperture
@@ -36,3 +37,31 @@ def test_camera_rays_on_axis_are_symmetric_and_leave_toward_the_scene(dgauss):
     hexa = camera_rays(dgauss, np.zeros((4000, 2)), u, aperture=Aperture(6, 0.0, 0.0, 0.0))
     assert hexa.ok.sum() < ok.sum()  # the hexagon is inside the circular stop
     assert (hexa.weight[~hexa.ok] == 0).all()
+
+
+def test_camera_ray_weights_are_unbiased_and_match_the_pupil_solid_angle(dgauss):
+    # pbrt's estimator E = cos^4(theta) A / d^2 is an unbiased Monte Carlo estimate of the
+    # irradiance integral over the rear region: sampling the full rear square or only the tight
+    # exit-pupil bounds must give the same mean weight. On axis that mean is the solid angle of
+    # the exit pupil seen from the film in cos^4 measure, ~ pi / (4 N_w^2) with N_w the working
+    # f-number (Gaussian engine), to the accuracy of the paraxial pupil.
+    import math
+
+    import numpy as np
+
+    from physcam.optics import paraxial
+    from physcam.trace import camera_rays, paraxial_image_z
+
+    film_z = paraxial_image_z(dgauss)
+    pb = exit_pupil_bounds(dgauss, 18.0, 12.0, nx=5, ny=5, samples=32)
+    rng = np.random.default_rng(1)
+    n = 400_000
+    for xy in ((0.0, 0.0), (12.0, 8.0)):
+        film = np.tile(xy, (n, 1))
+        full = camera_rays(dgauss, film, rng.random((n, 2)), film_z).weight.mean()
+        tight = camera_rays(dgauss, film, rng.random((n, 2)), film_z, bounds=pb).weight.mean()
+        assert tight == pytest.approx(full, rel=0.02)
+    g = paraxial.gaussian(dgauss)
+    on_axis = camera_rays(dgauss, np.zeros((n, 2)), rng.random((n, 2)), film_z, bounds=pb).weight.mean()
+    # (the f-number at infinity is the working f-number here: the film is at the focal plane)
+    assert on_axis == pytest.approx(math.pi / (4 * g.f_number**2), rel=0.02)

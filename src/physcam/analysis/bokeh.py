@@ -99,8 +99,8 @@ def bokeh_image(
     depth = require_positive("depth", depth_mm)
     x_mm = require_finite("light x", x_mm)
     y_mm = require_finite("light y", y_mm)
-    if rays < 1 or pixels < 8 or chunk < 1000:
-        raise InputError("bokeh needs rays >= 1, pixels >= 8 and chunk >= 1000")
+    if not (1 <= rays <= 10**11 and 8 <= pixels <= 4096 and 1000 <= chunk <= 10**7):
+        raise InputError("bokeh needs 1 <= rays <= 1e11, 8 <= pixels <= 4096 and 1000 <= chunk <= 1e7")
     if film_z is None:
         film_z = paraxial_image_z(lens)
     z_src = film_z - depth

@@ -111,8 +111,8 @@ def spot_diagram(
     wl = lens.wavelength_nm if wavelength_nm is None else require_finite("wavelength_nm", wavelength_nm)
     if film_z is None:
         film_z = paraxial_image_z(lens, wl)
-    if rings < 1:
-        raise InputError(f"rings must be >= 1, got {rings}")
+    if not 1 <= rings <= 2000:
+        raise InputError(f"rings must lie between 1 and 2000 (3 n (n + 1) rays per field), got {rings}")
     g = gaussian(lens, wavelength_nm=wl)
     z_ep, r_ep = g.z_entrance_pupil, g.entrance_pupil_diameter / 2
     beam = r_ep * overfill if pupil_radius is None else require_finite("pupil_radius", pupil_radius)

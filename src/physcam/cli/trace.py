@@ -81,7 +81,7 @@ def run_bokeh(args) -> int:
     st = focusing.focus(lens, math.inf if args.focus is None else args.focus)
     stop = None if args.fstop is None else paraxial.stop_semi_diameter_for_fstop(st.prescription, args.fstop)
     aperture = None
-    if args.blades >= 3 or args.density != 0.0:
+    if args.blades >= 3 or args.density != 0.0 or args.roundness != 0.0 or args.blade_angle != 0.0:
         aperture = Aperture(nsides=args.blades, angle_deg=args.blade_angle, roundness=args.roundness,
                             density=args.density)
     res = bokeh_image(st.prescription, args.depth, args.x, args.y, film_z=st.film_z, rays=args.rays,

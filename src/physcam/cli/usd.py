@@ -70,6 +70,9 @@ def run_write(args) -> int:
     from ..usd.author import spec_from_report, write_camera
     from .report import solve_from_args
 
+    from ..export.usdgeom import shutter_interval
+
+    shutter_interval(args.shutter_angle)  # validates 0 < angle <= 360
     report = solve_from_args(args)
     spec = spec_from_report(report, projection="orthographic" if args.orthographic else "perspective",
                             magnification=args.magnification, aperture_blades=args.blades,

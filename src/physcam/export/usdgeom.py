@@ -19,6 +19,7 @@ from ..errors import InputError, require_positive
 
 __all__ = [
     "DEFAULT_METERS_PER_UNIT",
+    "require_meters_per_unit",
     "mm_to_scene_units",
     "mm_to_tenths_of_scene_unit",
     "shutter_interval",
@@ -29,14 +30,21 @@ __all__ = [
 DEFAULT_METERS_PER_UNIT = 0.01
 
 
+def require_meters_per_unit(meters_per_unit) -> float:
+    """``meters_per_unit`` as a float in 1e-6..1e6 (micrometres to megametres), else InputError."""
+    mpu = require_positive("metersPerUnit", meters_per_unit, unit="")
+    if not 1e-6 <= mpu <= 1e6:
+        raise InputError(f"metersPerUnit must lie between 1e-6 and 1e6 (0.01 = centimetres), got {mpu:g}")
+    return mpu
+
+
 def mm_to_scene_units(mm: float, meters_per_unit: float = DEFAULT_METERS_PER_UNIT) -> float:
     """Millimetres as scene units of ``meters_per_unit`` metres.
 
     >>> mm_to_scene_units(1500.0, 0.01), mm_to_scene_units(1500.0, 1.0)
     (150.0, 1.5)
     """
-    mpu = require_positive("metersPerUnit", meters_per_unit, unit="")
-    return mm / (1000.0 * mpu)
+    return mm / (1000.0 * require_meters_per_unit(meters_per_unit))
 
 
 def mm_to_tenths_of_scene_unit(mm: float, meters_per_unit: float = DEFAULT_METERS_PER_UNIT) -> float:

@@ -249,24 +249,45 @@ def solve_lens_report(
         pupil_origin = "prescription"
         from ..optics.focusing import technical_planes
 
+        from ..optics import focusing, paraxial
+
         if focus_mm is None:
             raise InputError("with a lens prescription, give the focus mark (--focus)")
+        D_lens = _require_distance("focus distance", focus_mm)
         if fstop is None and near_mm is None and far_mm is None:
-            fstop = lens.metadata.max_fstop
-        planes = technical_planes(lens, require_positive("focus distance", focus_mm), fstop=fstop)
+            # wide open: the engraved f-stop, unless the prescription's stop is slower
+            file_n = paraxial.gaussian(lens).f_number
+            fstop = max(file_n, lens.metadata.max_fstop or 0.0)
+            notes.append(f"f-stop not given: wide open at f/{fstop:.3g}")
+        planes = technical_planes(lens, D_lens, fstop=fstop)
         focal_length_mm = planes.efl_mm
         model, reference_plane = "technical", "film"
         h1_mm, h2_mm, pupil_mm = planes.h1_from_film_mm, planes.h2_from_film_mm, planes.entrance_pupil_from_film_mm
-        squeeze = squeeze if squeeze != 1.0 else lens.squeeze
         lens_name = lens_name or lens.name
         notes.append(
             f"planes from the prescription focused at the mark ({planes.method} focusing): EFL {planes.efl_mm:.3f} mm, "
             f"back focus {planes.back_focus_mm:.3f} mm"
         )
+        if lens.is_anamorphic and squeeze == 1.0:
+            # the squeeze the lens really has at this focus: EFL in Y over EFL in X
+            st = focusing.focus(lens, D_lens)
+            efl_x = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z).efl
+            squeeze = planes.efl_mm / efl_x
+            notes.append(
+                f"anamorphic: EFL {planes.efl_mm:.3f} mm (Y) and {efl_x:.3f} mm (X), effective squeeze "
+                f"{squeeze:.4f} (nominal {lens.squeeze:g})"
+            )
     if focal_length_mm is None:
         raise InputError("give the focal length (--focal) or a lens (--lens)")
     f = require_positive("focal length", focal_length_mm)
+    if f > 1.0e5:
+        raise InputError(f"focal length {f:g} mm is beyond any camera lens; give it in mm (e.g. --focal 50)")
     sq = require_positive("anamorphic squeeze", squeeze, unit="")
+    if not 0.1 <= sq <= 10.0:
+        raise InputError(f"anamorphic squeeze must lie between 0.1 and 10, got {sq:g}")
+    for name, v in (("sensor width", sensor.width_mm), ("sensor height", sensor.height_mm)):
+        if not 0.0 < v <= 1000.0:
+            raise InputError(f"{name} must lie between 0 and 1000 mm, got {v:g}")
     if model not in ("practical", "technical"):
         raise InputError(f"model must be 'practical' or 'technical', got {model!r}")
     w, h = sensor.width_mm, sensor.height_mm
@@ -274,13 +295,15 @@ def solve_lens_report(
     c, coc_name = circle_of_confusion(w, h, coc)
     N = None if fstop is None else require_positive("f-stop", fstop, unit="")
     T = None if tstop is None else require_positive("T-stop", tstop, unit="")
-    D = None if focus_mm is None else require_positive("focus distance", focus_mm)
-    near_m = None if near_mm is None else require_positive("near limit", near_mm)
+    D = None if focus_mm is None else _require_distance("focus distance", focus_mm)
+    near_m = None if near_mm is None else _require_distance("near limit", near_mm)
     far_m = None
     if far_mm is not None:
         far_m = float(far_mm)
         if math.isnan(far_m) or far_m <= 0:
             raise InputError(f"far limit must be a positive distance (or inf), got {far_mm!r}")
+        if math.isfinite(far_m):
+            far_m = _require_distance("far limit", far_m)
     if near_m is not None and far_m is not None and not near_m < far_m:
         raise InputError(f"near limit {near_m:g} mm must be closer than far limit {far_m:g} mm")
 
@@ -358,7 +381,9 @@ def solve_lens_report(
     s_img = thinlens.image_distance(f, s)
 
     # --- inversions from measured limits ---------------------------------------------
-    if near_m is not None or far_m is not None:
+    # (a focus solved from one limit and the f-stop used that limit up: nothing is left to invert)
+    focus_from_one_limit = "focus_from_film_mm" in solved and (near_m is None or far_m is None)
+    if (near_m is not None or far_m is not None) and not focus_from_one_limit:
         hp_near = hp_far = None
         if near_m is not None:
             hp_near = _dof.hyperfocal_parameter_from_near(f, s, to_h1(near_m, s))
@@ -394,6 +419,9 @@ def solve_lens_report(
             )
     if N is None:
         raise InputError("give the f-stop (--fstop) or a measured near/far limit to solve it")
+    for name, v in (("f-stop", N), ("circle of confusion", c)):
+        if not (math.isfinite(v) and v > 0):
+            raise InputError(f"the measured limits give an impossible {name} ({v:g}); check --near, --far and --focus")
     if T is not None:
         solved["tstop_drift_stops"] = _dof.stops_between(N, T)
         if T < N - 1e-9:
@@ -409,6 +437,8 @@ def solve_lens_report(
     # --- focus error (technical) ------------------------------------------------
     if model == "technical":
         h1_film, h2_film = P1, P2
+        if P2 <= 0:
+            raise InputError(f"H2 must lie in front of the film plane, got {P2:g} mm; check --h2 and --reference")
         focus_error = P2 - s_img  # where the sharp image lies, in front of the film (+)
         if abs(focus_error) > 1e-6:
             notes.append(
@@ -426,9 +456,9 @@ def solve_lens_report(
         hfov_inf_deg=_fov_deg(wd, f),
         vfov_inf_deg=_fov_deg(h, f),
         dfov_inf_deg=_fov_deg(dg, f),
-        hfov_focus_deg=_fov_deg(wd, s_img),
-        vfov_focus_deg=_fov_deg(h, s_img),
-        dfov_focus_deg=_fov_deg(dg, s_img),
+        hfov_focus_deg=_fov_deg(wd, h2_film),
+        vfov_focus_deg=_fov_deg(h, h2_film),
+        dfov_focus_deg=_fov_deg(dg, h2_film),
     )
 
     # --- entrance pupil -----------------------------------------------------------
@@ -475,6 +505,17 @@ def solve_lens_report(
     return report
 
 
+#: Largest finite distance the report accepts (1000 km); beyond it use infinity.
+MAX_DISTANCE_MM = 1.0e9
+
+
+def _require_distance(name: str, value) -> float:
+    v = require_positive(name, value)
+    if v > MAX_DISTANCE_MM:
+        raise InputError(f"{name} {v:g} mm is beyond 1000 km; for a subject at infinity use a far limit of inf")
+    return v
+
+
 def _solve_focus_from_bracket(near_film, far_film, h1_at, f):
     p = f  # first guess for H1's distance from the film
     for _ in range(100):
@@ -495,7 +536,10 @@ def _solve_focus_from_one_limit(near_film, far_film, hp, f, h1_at):
         if near_film is not None:
             n = near_film - p
             if not 0 < n < hp:
-                raise InputError("the near limit lies beyond half the hyperfocal distance: no focus gives it")
+                raise InputError(
+                    "the near limit lies beyond the hyperfocal parameter f^2/(N c) (focus at infinity): "
+                    "no focus gives it; check the near limit, f-stop and CoC"
+                )
             s = n * (hp - f) / (hp - n)
         else:
             F = far_film - p

@@ -14,7 +14,7 @@ principal plane. Sources: Wikipedia, "Depth of field", section "Derivation of th
 DOF formulae" (the forms with the hyperfocal distance H = f²/(Nc) + f); S. Ray,
 *Applied Photographic Optics*, 3rd ed., §8.2; DOFMaster's calculator
 (dofmaster.com/equations.html) uses the same forms. The seed document paired
-H = f²/(Nc) + f with near/far forms that expect h: physcam does not (docs/dof.md).
+H = f²/(Nc) + f with near/far forms that expect h: physcam does not (docs/lens-report.md).
 
 The limits are reported from H1; the lens report converts them to the film plane.
 Everything broadcasts over numpy arrays; lengths in mm.
@@ -104,7 +104,7 @@ def hyperfocal_parameter_from_far(focal_length, object_distance, far):
         raise InputError(
             "an infinite far limit only says the focus is at or beyond the hyperfocal distance; give a near limit"
         )
-    return _out(F * (s - f) / (F - s))
+    return _out((s - f) / (1.0 - s / F))  # = F (s - f) / (F - s), without overflow for huge F
 
 
 def focus_for_dof_limits(near, far):

@@ -15,11 +15,30 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LINE_D_NM", "LINE_F_NM", "LINE_C_NM", "cauchy_coefficients", "refractive_index"]
+__all__ = ["LINE_D_NM", "LINE_F_NM", "LINE_C_NM", "WAVELENGTH_RANGE_NM", "cauchy_coefficients", "refractive_index",
+           "require_wavelength"]
 
 LINE_D_NM = 587.5618
 LINE_F_NM = 486.1327
 LINE_C_NM = 656.2725
+
+#: Wavelengths physcam traces (nm): near UV to near IR, where camera sensors respond and a
+#: two-term dispersion fit from (nd, Vd) still means something.
+WAVELENGTH_RANGE_NM = (300.0, 1100.0)
+
+
+def require_wavelength(wavelength_nm, name: str = "wavelength"):
+    """Raise :class:`~physcam.errors.InputError` unless every wavelength is finite and in
+    :data:`WAVELENGTH_RANGE_NM`; return it unchanged."""
+    from ..errors import InputError
+
+    lam = np.asarray(wavelength_nm, dtype=float)
+    lo, hi = WAVELENGTH_RANGE_NM
+    if not (np.all(np.isfinite(lam)) and np.all(lam >= lo) and np.all(lam <= hi)):
+        bad = lam[~(np.isfinite(lam) & (lam >= lo) & (lam <= hi))].ravel()
+        raise InputError(f"{name} must lie between {lo:g} and {hi:g} nm (visible light is 380-780 nm), "
+                         f"got {bad[0]:g} nm")
+    return wavelength_nm
 
 
 def cauchy_coefficients(nd, vd):

@@ -63,7 +63,9 @@ STOP_OPENING_TOLERANCE = 0.05
 def _wavelength(prescription: Prescription, wavelength_nm) -> float:
     if wavelength_nm is None:
         return float(prescription.wavelength_nm)
-    return require_positive("wavelength_nm", wavelength_nm, unit="nm")
+    from .glass import require_wavelength
+
+    return float(require_wavelength(require_positive("wavelength_nm", wavelength_nm, unit="nm")))
 
 
 def _axis(axis: str) -> str:

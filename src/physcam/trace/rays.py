@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from ..optics.glass import require_wavelength
 
 __all__ = ["OK", "MISSED", "CLIPPED", "TIR", "FLAG_NAMES", "RayBatch"]
 
@@ -63,8 +64,7 @@ class RayBatch:
         d = d / norm[:, None]
         n = p.shape[0]
         wl = np.broadcast_to(np.asarray(wavelength_nm, dtype=np.float64), (n,)).copy()
-        if not (np.isfinite(wl).all() and (wl > 0).all()):
-            raise InputError("wavelength_nm must be finite and > 0 nm")
+        require_wavelength(wl, "ray wavelength")
         w = np.broadcast_to(np.asarray(weight, dtype=np.float64), (n,)).copy()
         if not (np.isfinite(w).all() and (w >= 0).all()):
             raise InputError("ray weights must be finite and >= 0")

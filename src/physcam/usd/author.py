@@ -63,6 +63,8 @@ class CameraSpec:
     ``focus_mm`` is measured in front of the film plane (the on-set mark).
     ``entrance_pupil_mm``: the pupil in front of the film plane; ``None`` uses the thin
     lens (the pupil on the principal plane, s' in front of the film).
+    ``principal_planes_mm``: (H1, H2) in front of the film plane, from a datasheet or a
+    prescription (the technical model); ``None`` for a thin lens.
     ``clipping_mm``: near/far clipping from the eye, in mm (written in scene units).
     ``projection``: "perspective" (a pinhole/thin-lens model) or "orthographic"
     (a telecentric model imaging ``sensor / magnification`` of the scene).
@@ -76,6 +78,7 @@ class CameraSpec:
     coc_mm: float = 0.03
     squeeze: float = 1.0
     entrance_pupil_mm: float | None = None
+    principal_planes_mm: tuple[float, float] | None = None
     shift_mm: tuple[float, float] = (0.0, 0.0)
     iso: float = 100.0
     transmittance: float = 1.0
@@ -122,6 +125,9 @@ class CameraSpec:
             require_finite("sensor shift", v)
         if self.entrance_pupil_mm is not None:
             require_finite("entrance pupil distance", self.entrance_pupil_mm)
+        if self.principal_planes_mm is not None:
+            for v in self.principal_planes_mm:
+                require_finite("principal plane distance", v)
         if self.aperture_distance_mm is not None:
             require_finite("aperture distance", self.aperture_distance_mm)
         if self.projection not in ("perspective", "orthographic"):
@@ -130,7 +136,14 @@ class CameraSpec:
 
 
 def report_for_spec(spec: CameraSpec):
-    """The on-set :class:`~physcam.onset.report.LensReport` (practical thin-lens model) of ``spec``."""
+    """The on-set :class:`~physcam.onset.report.LensReport` of ``spec``.
+
+    With principal planes (written from a datasheet or a prescription) it is the technical
+    model with those planes and the pupil; otherwise the practical thin lens, keeping the
+    spec's entrance pupil when it has one.
+    """
+    import dataclasses
+
     from ..onset.report import solve_lens_report
     from ..onset.sensors import Sensor
 
@@ -140,15 +153,16 @@ def report_for_spec(spec: CameraSpec):
         width_mm=spec.sensor_width_mm,
         height_mm=spec.sensor_height_mm,
     )
-    return solve_lens_report(
-        focal_length_mm=spec.focal_length_mm,
-        sensor=sensor,
-        fstop=spec.fstop,
-        focus_mm=spec.focus_mm,
-        coc=spec.coc_mm,
-        squeeze=spec.squeeze,
-        lens_name=spec.lens_name,
-    )
+    common = dict(focal_length_mm=spec.focal_length_mm, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
+                  coc=spec.coc_mm, squeeze=spec.squeeze, lens_name=spec.lens_name)
+    if spec.principal_planes_mm is not None:
+        h1, h2 = spec.principal_planes_mm
+        return solve_lens_report(model="technical", h1_mm=h1, h2_mm=h2, pupil_mm=spec.entrance_pupil_mm, **common)
+    report = solve_lens_report(**common)
+    if spec.entrance_pupil_mm is not None:
+        report = dataclasses.replace(report, entrance_pupil_from_film_mm=spec.entrance_pupil_mm,
+                                     entrance_pupil_source="USD file")
+    return report
 
 
 def spec_from_report(report, **body) -> CameraSpec:
@@ -162,7 +176,10 @@ def spec_from_report(report, **body) -> CameraSpec:
         focus_mm=report.focus_from_film_mm,
         coc_mm=report.coc_mm,
         squeeze=report.squeeze,
-        entrance_pupil_mm=report.entrance_pupil_from_film_mm,
+        entrance_pupil_mm=(report.entrance_pupil_from_film_mm if report.entrance_pupil_from_film_mm is not None
+                           else report.h1_from_film_mm),
+        principal_planes_mm=((report.h1_from_film_mm, report.h2_from_film_mm) if report.model == "technical"
+                             else None),
         flange_distance_mm=body.pop("flange_distance_mm", report.flange_focal_distance_mm or 52.0),
         lens_name=report.lens_name,
         sensor_name=s.name,
@@ -188,8 +205,12 @@ def new_stage(meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "
     ensure_registered()
     from pxr import Usd, UsdGeom
 
-    mpu = require_positive("metersPerUnit", meters_per_unit, unit="")
+    from ..export.usdgeom import require_meters_per_unit
+
+    mpu = require_meters_per_unit(meters_per_unit)
     rate = require_positive("frames per second", fps, unit="")
+    if rate > 1000.0:
+        raise InputError(f"frames per second must be at most 1000, got {rate:g}")
     if up_axis not in ("Y", "Z"):
         raise InputError(f"up axis must be Y or Z, got {up_axis!r}")
     stage = Usd.Stage.CreateInMemory()
@@ -201,11 +222,16 @@ def new_stage(meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "
 
 
 def _eye_from_film(spec: CameraSpec, report) -> float:
+    """Where the camera (its centre of projection) sits, in front of the film: the entrance
+    pupil, or the front principal plane when no pupil is known (the thin-lens pupil), the same
+    fallback as :func:`physcam.export.usdgeom.focus_distance_from_pupil_mm`."""
     if spec.entrance_pupil_mm is not None:
         return spec.entrance_pupil_mm
-    if report is not None and report.entrance_pupil_from_film_mm is not None:
+    if report is None:
+        report = report_for_spec(spec)
+    if report.entrance_pupil_from_film_mm is not None:
         return report.entrance_pupil_from_film_mm
-    return 0.0
+    return report.h1_from_film_mm
 
 
 def _f32(x: float) -> float:
@@ -243,7 +269,21 @@ def _set(prim, name, type_name, value, custom=False):
     if not attr:
         attr = prim.CreateAttribute(name, type_name, custom)
     attr.Set(value)
+    _check_stored(prim, name, attr.Get())
     return attr
+
+
+def _check_stored(prim, name, stored) -> None:
+    """No NaN or inf leaves physcam: check the value as USD stored it (float attributes hold
+    32 bits, so a finite double can overflow there)."""
+    try:
+        values = list(stored) if hasattr(stored, "__len__") and not isinstance(stored, str) else [stored]
+    except TypeError:
+        return
+    for v in values:
+        if isinstance(v, float) and not math.isfinite(v):
+            raise InputError(f"{prim.GetPath()}.{name} would be stored as {v}: the value is out of range "
+                             "(check metersPerUnit and the distances)")
 
 
 ALL_PARTS = ("body", "sensor", "lens", "render")
@@ -346,6 +386,9 @@ def _author_lens(stage, cam, spec, eye, su):
     _set(cam, lp + "fStop", Sdf.ValueTypeNames.Float, spec.fstop)
     _set(cam, lp + "iris", Sdf.ValueTypeNames.Float, spec.focal_length_mm / spec.fstop)
     _set(cam, lp + "entrancePupilDistance", Sdf.ValueTypeNames.Float, eye)
+    if spec.principal_planes_mm is not None:
+        _set(cam, lp + "frontPrincipalPlaneDistance", Sdf.ValueTypeNames.Float, spec.principal_planes_mm[0])
+        _set(cam, lp + "rearPrincipalPlaneDistance", Sdf.ValueTypeNames.Float, spec.principal_planes_mm[1])
     _set(cam, lp + "apertureDistance", Sdf.ValueTypeNames.Float,
          eye if spec.aperture_distance_mm is None else spec.aperture_distance_mm)
     _set(cam, lp + "shutterBlades", Sdf.ValueTypeNames.UInt, int(spec.aperture_blades))

@@ -87,6 +87,18 @@ def _get(prim, name, what):
     return v
 
 
+def _principal_planes(prim, lp: str):
+    """(H1, H2) in front of the film when both are authored, else None (a thin lens)."""
+    a = prim.GetAttribute(lp + "frontPrincipalPlaneDistance")
+    b = prim.GetAttribute(lp + "rearPrincipalPlaneDistance")
+    h1 = a.Get() if a else None
+    h2 = b.Get() if b else None
+    if (h1 is None) != (h2 is None):
+        raise ExportError(f"{prim.GetPath()}: author both {lp}frontPrincipalPlaneDistance and "
+                          f"{lp}rearPrincipalPlaneDistance, or neither")
+    return None if h1 is None else (float(h1), float(h2))
+
+
 def _instance(prim, schema: str, preferred: str) -> str:
     names = [s.split(":", 1)[1] for s in prim.GetAppliedSchemas() if s.startswith(schema + ":")]
     if not names:
@@ -212,6 +224,7 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
         coc_mm=float(_get(prim, sp + "circleOfConfusion", "")),
         squeeze=float(_get(model, "squeeze", "")),
         entrance_pupil_mm=float(_get(prim, lp + "entrancePupilDistance", "")),
+        principal_planes_mm=_principal_planes(prim, lp),
         shift_mm=(float(shift[0]), float(shift[1])),
         iso=float(_get(prim, sp + "iso", "")),
         transmittance=float(_get(model, "transmittance", "")),
