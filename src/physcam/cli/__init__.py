@@ -22,6 +22,10 @@ from ..errors import PhysCamError
 __all__ = ["main", "build_parser"]
 
 
+#: Command modules in --help order; modules not listed follow alphabetically.
+COMMAND_ORDER = ("report", "sensors", "lens", "trace", "analyze", "usd", "demo")
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # usage errors: one line, exit 2 (argparse's own code)
         self.exit(2, f"physcam: error: {message}\n")
@@ -30,14 +34,17 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="physcam",
-        description="Physical cameras for film and VFX: lens reports, real lenses, USD/RenderMan/Blender/pbrt cameras.",
+        description="Physical cameras for film and VFX: on-set lens reports, real lens prescriptions, "
+        "real-ray analyses and USD cameras.",
+        epilog="Run `physcam COMMAND --help` for a command's options; `physcam demo` for a tour.",
     )
     parser.add_argument("--version", action="version", version=f"physcam {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
-    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-        if info.name.startswith("_"):
-            continue
-        module = importlib.import_module(f"{__name__}.{info.name}")
+    names = [m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")]
+    # --help lists commands in the order people use them: on set, lenses, rays, USD, the demo
+    order = {name: i for i, name in enumerate(COMMAND_ORDER)}
+    for name in sorted(names, key=lambda n: (order.get(n, len(order)), n)):
+        module = importlib.import_module(f"{__name__}.{name}")
         register = getattr(module, "register", None)
         if register is not None:
             register(sub)
