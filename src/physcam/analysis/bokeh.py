@@ -86,6 +86,7 @@ def bokeh_image(
     stop_semi_diameter: float | None = None,
     aperture=None,
     chunk: int = 1_000_000,
+    progress=None,
     seed: int = 0,
     backend: str = "auto",
 ) -> BokehImage:
@@ -93,6 +94,7 @@ def bokeh_image(
 
     ``aperture`` (a :class:`~physcam.trace.aperture.Aperture`: blades, angle, roundness,
     density) shapes the stop, so the bokeh shows the iris polygon and its brightness ramp.
+    ``progress`` (optional) is called as ``progress(rays_done, rays)`` after each chunk.
     """
     from ..trace import RayBatch, paraxial_image_z, trace_to_film
 
@@ -154,5 +156,7 @@ def bokeh_image(
         img += np.bincount(flat, weights=out.weight[inside], minlength=img.size)
         passed += int(ok.sum())
         done += n
+        if progress is not None:
+            progress(done, rays)
     img = img.reshape(pixels, pixels, len(wls)) * (np.pi * r_front**2 / (z_src * z_src) / rays)
     return BokehImage(lens.name, img, (x0, x1, y0, y1), tuple(wls), rays, passed, float(film_z))

@@ -48,3 +48,36 @@ def console(stderr: bool = False):
     from rich.console import Console
 
     return Console(stderr=stderr, markup=False, highlight=False, emoji=False)
+
+
+class progress_bar:
+    """A rich progress bar on stderr for long jobs, shown only to a person at a terminal.
+
+    Use as a context manager; the object is a ``progress(done, total)`` callback.
+    """
+
+    def __init__(self, description: str, enabled: bool = True):
+        self.enabled = enabled and sys.stderr.isatty()
+        self.description = description
+        self._progress = None
+        self._task = None
+
+    def __enter__(self):
+        if self.enabled:
+            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+            self._progress = Progress(TextColumn("{task.description}"), BarColumn(),
+                                      TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn(),
+                                      console=console(stderr=True), transient=True)
+            self._progress.__enter__()
+            self._task = self._progress.add_task(self.description, total=None)
+        return self
+
+    def __call__(self, done, total):
+        if self._progress is not None:
+            self._progress.update(self._task, completed=done, total=total)
+
+    def __exit__(self, *exc):
+        if self._progress is not None:
+            self._progress.__exit__(*exc)
+        return False

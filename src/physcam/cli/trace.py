@@ -84,8 +84,12 @@ def run_bokeh(args) -> int:
     if args.blades >= 3 or args.density != 0.0 or args.roundness != 0.0 or args.blade_angle != 0.0:
         aperture = Aperture(nsides=args.blades, angle_deg=args.blade_angle, roundness=args.roundness,
                             density=args.density)
-    res = bokeh_image(st.prescription, args.depth, args.x, args.y, film_z=st.film_z, rays=args.rays,
-                      pixels=args.pixels, spectral=args.spectral, stop_semi_diameter=stop, aperture=aperture)
+    from ._common import progress_bar
+
+    with progress_bar("tracing bokeh rays", enabled=not args.json) as bar:
+        res = bokeh_image(st.prescription, args.depth, args.x, args.y, film_z=st.film_z, rays=args.rays,
+                          pixels=args.pixels, spectral=args.spectral, stop_semi_diameter=stop, aperture=aperture,
+                          chunk=min(args.rays, 250_000) if args.rays >= 1000 else 1000, progress=bar)
     if args.output:
         res.plot(args.output, force=args.force)
     if args.json:
