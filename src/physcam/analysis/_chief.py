@@ -152,3 +152,27 @@ def aim_from_film(
     dirn = np.stack([u - p[:, 0], v - p[:, 1], np.full(p.shape[0], dz)], axis=1)
     dirn /= np.linalg.norm(dirn, axis=1)[:, None]
     return AimedRays(start, dirn, ok, err)
+
+
+def field_angles_deg(fields_deg, max_field_deg, n_fields: int, half_diagonal_mm: float, efl_mm: float) -> np.ndarray:
+    """The field angles (degrees) an analysis evaluates.
+
+    ``fields_deg`` as given (each within +-89 degrees), or else ``n_fields`` (at least 2) from
+    0 to ``max_field_deg``, by default the sensor corner: atan(half diagonal / EFL).
+    """
+    import math
+
+    from ..errors import InputError, require_finite
+
+    if fields_deg is not None:
+        fields = np.array([require_finite("field angle", f) for f in np.atleast_1d(fields_deg)], dtype=float)
+        if fields.size == 0 or (np.abs(fields) >= 89).any():
+            raise InputError("give field angles between -89 and 89 degrees")
+        return fields
+    top = max_field_deg
+    if top is None:
+        top = math.degrees(math.atan(half_diagonal_mm / abs(efl_mm)))
+    top = require_finite("max field", top)
+    if not 0 < top < 89:
+        raise InputError(f"max field must lie between 0 and 89 degrees, got {top:g}")
+    return np.linspace(0.0, top, max(2, int(n_fields)))

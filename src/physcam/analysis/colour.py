@@ -125,7 +125,7 @@ def chromatic_aberration(
     """
     from ..optics.paraxial import gaussian
     from ..trace import RayBatch, paraxial_image_z, trace_through
-    from ._chief import aim_from_infinity, field_direction
+    from ._chief import aim_from_infinity, field_angles_deg, field_direction
 
     ref = require_positive("reference wavelength", reference_nm, unit="nm")
     zone = require_finite("zone", zone)
@@ -148,18 +148,8 @@ def chromatic_aberration(
     z_ref = g_ref.z_rear_focal_point
     shift = [gaussian(lens, wavelength_nm=w).z_rear_focal_point - z_ref for w in curve]
 
-    if fields_deg is None:
-        top = max_field_deg
-        if top is None:
-            top = math.degrees(math.atan(0.5 * math.hypot(sensor_width_mm, sensor_height_mm) / g_ref.efl))
-        top = require_finite("max field", top)
-        if not 0 < top < 89:
-            raise InputError(f"max field must lie between 0 and 89 degrees, got {top:g}")
-        fields = np.linspace(0.0, top, max(2, int(n_fields)))
-    else:
-        fields = np.array([require_finite("field angle", f) for f in np.atleast_1d(fields_deg)], dtype=float)
-        if fields.size == 0 or (np.abs(fields) >= 89).any():
-            raise InputError("give field angles between -89 and 89 degrees")
+    fields = field_angles_deg(fields_deg, max_field_deg, n_fields,
+                              0.5 * math.hypot(sensor_width_mm, sensor_height_mm), g_ref.efl)
     dirs = field_direction(np.radians(fields), "y")
     heights = {}
     for w in wls:

@@ -165,7 +165,7 @@ def relative_illumination(
     """
     from ..optics.paraxial import gaussian_xy
     from ..trace import paraxial_image_z
-    from ._chief import field_direction
+    from ._chief import field_angles_deg, field_direction
 
     wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
     if not isinstance(grid, (int, np.integer)) or grid < 16:
@@ -184,18 +184,7 @@ def relative_illumination(
     e0 = a0 / m0[2]
     points = []
     for axis in axes:
-        if fields_deg is None:
-            top = max_field_deg
-            if top is None:
-                top = math.degrees(math.atan(0.5 * math.hypot(w, h) / abs(g[axis].efl)))
-            top = require_finite("max field", top)
-            if not 0 < top < 89:
-                raise InputError(f"max field must lie between 0 and 89 degrees, got {top:g}")
-            fields = np.linspace(0.0, top, max(2, int(n_fields)))
-        else:
-            fields = np.array([require_finite("field angle", f) for f in np.atleast_1d(fields_deg)], dtype=float)
-            if fields.size == 0 or (np.abs(fields) >= 89).any():
-                raise InputError("give field angles between -89 and 89 degrees")
+        fields = field_angles_deg(fields_deg, max_field_deg, n_fields, 0.5 * math.hypot(w, h), g[axis].efl)
         for fd in fields:
             d = field_direction(math.radians(fd), axis)[0]
             a = _beam_area(lens, d, wl, film_z, grid, fresnel, stop_semi_diameter, backend) if fd != 0 else a0
