@@ -22,7 +22,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
-from physcam.lens.formats import dumps_lens, read_lens, seedtoml, write_lens  # noqa: E402
+from physcam.lens.formats import read_lens, seedtoml, write_lens  # noqa: E402
 from physcam.lens.formats._common import json_text, parse_toml, read_text  # noqa: E402
 from physcam.lens.geometry import sag  # noqa: E402
 from physcam.lens.prescription import Medium, Prescription, Surface  # noqa: E402

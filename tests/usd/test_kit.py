@@ -12,7 +12,7 @@ from physcam.usd.kit import (PREVIS_SETUPS, write_body_file, write_lens_file, wr
 from physcam.usd.read import find_cameras, open_stage, read_camera
 from physcam.usd.validate import validation_errors
 
-from pxr import Gf, Usd, UsdGeom  # noqa: E402
+from pxr import Usd, UsdGeom  # noqa: E402
 
 
 def lens(focal, pupil, t=1.0):

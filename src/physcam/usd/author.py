@@ -308,7 +308,7 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
     if bad:
         raise InputError(f"unknown camera parts {sorted(bad)}; use {', '.join(ALL_PARTS)}")
     ensure_registered()
-    from pxr import Gf, Sdf, UsdGeom
+    from pxr import Sdf, UsdGeom
 
     from ..export.usdgeom import mm_to_scene_units
 

@@ -238,7 +238,7 @@ def prescription_distortion(prescription, sensor_width_mm: float = 36.0, sensor_
 
 
 def _author_prescription(stage, path, rx, focus_mm: float):
-    from pxr import Sdf, Vt
+    from pxr import Sdf
 
     prim = stage.DefinePrim(path, "PhysicalCameraLensModelPrescription")
     S = rx.surfaces

@@ -22,7 +22,7 @@ from ...errors import ExportError, LensFileError
 from ...io import atomic_write
 from ..prescription import Prescription
 from . import iset, pbrt, physcam_toml, seedtoml, zemax
-from ._common import decode, extra, parse_toml, read_text
+from ._common import extra, read_text
 
 __all__ = ["FORMATS", "extra", "read_lens", "loads_lens", "write_lens", "dumps_lens", "detect_format"]
 
