@@ -25,6 +25,12 @@ def check_writable(path, *, force: bool = False) -> Path:
     return p
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 def atomic_write(path, data: bytes | str, *, force: bool = False, encoding: str = "utf-8") -> Path:
     """Write ``data`` to ``path`` through a temporary file in the same folder, then rename.
 
@@ -44,6 +50,9 @@ def atomic_write(path, data: bytes | str, *, force: bool = False, encoding: str 
                 os.fsync(fh.fileno())
             if not force and p.exists():  # appeared while we wrote
                 raise ExportError(f"{p} already exists; pass --force (force=True) to overwrite it")
+            # mkstemp makes the file private (0600); give it the mode a plain open() would
+            # (0666 less the umask), or keep the mode of the file it replaces
+            os.chmod(tmp, (os.stat(p).st_mode & 0o7777) if p.exists() else (0o666 & ~_umask()))
             os.replace(tmp, p)
         except BaseException:
             if os.path.exists(tmp):
