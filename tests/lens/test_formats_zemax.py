@@ -63,7 +63,7 @@ def test_model_glass():
     "old, new, line, match",
     [
         ("TYPE EVENASPH", "TYPE TOROIDAL", 22, "TOROIDAL is not supported"),
-        ("GLAS N-BK7", "GLAS UNOBTAINIUM", 19, "unknown glass 'UNOBTAINIUM'"),
+        ("GLAS N-BK7 0 0 1.5168 64.17", "GLAS UNOBTAINIUM 0 0 0 0", 19, "unknown glass 'UNOBTAINIUM'"),
         ("GLAS N-BK7", "GLAS MIRROR", 19, "MIRROR"),
         ("UNIT MM", "UNIT IN", 4, "UNIT MM"),
         ("PARM 1 0", "PARM 1 0.5", 25, "PARM 1"),
@@ -102,3 +102,25 @@ class _nullcontext:
 
     def __exit__(self, *a):
         return False
+
+
+def test_catalogue_glass_line_carries_its_own_nd_vd(tmp_path):
+    # OpticStudio writes GLAS NAME 0 0 nd vd ...; a glass physcam's catalogue lacks is read from
+    # the line (here Schott SK16: nd 1.62041, Vd 60.32, from the Schott catalogue)
+    text = SINGLET.replace("GLAS N-BK7 0 0 1.5168 64.17", "GLAS SK16 0 0 1.62041 60.32")
+    p = loads_lens(text, "zemax", path="sk16.zmx")
+    m = p.surfaces[1].medium  # surface 0 is the stop
+    assert (m.nd, m.vd, m.glass) == (1.62041, 60.32, "SK16")
+
+
+def test_windows_code_page_file_is_read(tmp_path):
+    # OpticStudio's "ANSI" files are cp1252: a degree sign in a NOTE must not refuse the file
+    f = tmp_path / "ansi.zmx"
+    f.write_bytes(SINGLET.replace("UNIT MM", "NOTE 0 field 20\xb0 edge\nUNIT MM").encode("cp1252"))
+    from physcam.lens.formats import read_lens
+
+    assert read_lens(f).surfaces[1].medium.nd == 1.5168
+
+
+def test_writer_says_sequential_mode():
+    assert "MODE SEQ" in dumps_lens(loads_lens(SINGLET, "zemax", path="s.zmx"), "zemax").splitlines()[:3]

@@ -44,8 +44,11 @@ def decode(data: bytes, path: str | None) -> str:
         else:
             text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        line = data[: exc.start].count(b"\n") + 1
-        raise LensFileError("not a UTF-8 text file (binary data?)", path, line) from None
+        if path is not None and str(path).lower().endswith(".zmx") and b"\x00" not in data:
+            text = data.decode("cp1252", errors="replace")  # OpticStudio's "ANSI" files
+        else:
+            line = data[: exc.start].count(b"\n") + 1
+            raise LensFileError("not a UTF-8 text file (binary data?)", path, line) from None
     if "\x00" in text:
         raise LensFileError("contains NUL bytes; not a text lens file", path, text[: text.index("\x00")].count("\n") + 1)
     return text

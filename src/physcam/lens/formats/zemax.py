@@ -2,15 +2,17 @@
 
 Read: ``UNIT MM``, ``NAME``, ``NOTE``, and per ``SURF n`` block: ``TYPE STANDARD`` or
 ``TYPE EVENASPH``, ``CURV c`` (1/mm), ``DISZ t`` (mm, ``INFINITY`` on the object
-surface), ``GLAS`` (a model glass ``GLAS ___BLANK 1 0 nd vd ...`` or a catalogue name
-known to :mod:`physcam.lens.catalog`), ``DIAM`` (the **semi**-diameter), ``STOP``,
+surface), ``GLAS`` (a model glass ``GLAS ___BLANK 1 0 nd vd ...``, or a catalogue glass
+``GLAS NAME 0 0 nd vd ...`` whose nd and Vd are taken from the line, falling back to
+:mod:`physcam.lens.catalog` when the line has none), ``DIAM`` (the **semi**-diameter), ``STOP``,
 ``CONI k`` and ``PARM n a`` (EVENASPH: PARM 1 is the r^2 term, PARM 2..8 are
 A4..A16). Surface 0 is the object, the last surface the image; the gap before the
 image is the last lens thickness (distance to the film). Anything else that changes
 the optics (other surface types, tilts/decentres, MIRROR, other units, a curved stop,
 an r^2 asphere term, non-zero object-space index) is refused with file and line;
 bookkeeping lines (``VERS``, ``MODE``, ``FLOA``, ``WAVL``, ...) are ignored. Source:
-Zemax OpticStudio user manual, "ZMX file format" / "Even Asphere" surface.
+Zemax OpticStudio user manual, "ZMX file format" / "Even Asphere" surface. Files may be
+UTF-8, UTF-16 with a byte-order mark, or the Windows code page OpticStudio writes ("ANSI").
 
 The radius is read back as the shortest decimal whose reciprocal is the file's CURV,
 so a radius written by :func:`dumps` (``CURV`` = 1/R to 17 digits) reads back equal.
@@ -131,7 +133,9 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
         if not math.isfinite(b["disz"]):
             raise LensFileError("DISZ INFINITY is only allowed on the object surface", path, ln)
         if b["diam"] is None:
-            raise LensFileError(f"surface {i + 1} has no DIAM (clear semi-diameter)", path, ln)
+            raise LensFileError(
+                f"surface {i + 1} has no DIAM: its clear semi-diameter is automatic in OpticStudio; physcam needs "
+                "the real apertures (set the semi-diameters to fixed values before saving)", path, ln)
         medium = b["glass"] if b["glass"] is not None else AIR
         aspheric = ()
         if b["type"] == "EVENASPH":
@@ -181,10 +185,29 @@ def _glass(tok, path, lineno) -> Medium:
         nd = number(tok[4], "model glass nd", path, lineno, length=False)
         vd = number(tok[5], "model glass vd", path, lineno, length=False)
         return AIR if (nd == 1.0 and vd == 0.0) else Medium(nd, vd)
+    # A catalogue glass line carries the glass's own nd and Vd (GLAS NAME 0 0 nd vd ...); they are
+    # what OpticStudio used, so they win over physcam's small catalogue, which fills in only when
+    # the file gives none.
+    file_nd = file_vd = None
+    if len(tok) >= 6:
+        try:
+            file_nd, file_vd = float(tok[4]), float(tok[5])
+        except ValueError:
+            file_nd = file_vd = None
+    if file_nd is not None and math.isfinite(file_nd) and file_nd > 1.0 and math.isfinite(file_vd) and file_vd >= 0:
+        try:
+            cat = find_glass(g)
+        except InputError:
+            cat = None
+        if cat is not None and (abs(cat.nd - file_nd) > 5e-4 or abs(cat.vd - file_vd) > 0.5):
+            warnings.warn(f"{path}:{lineno}: glass {g} has nd {file_nd:g}, Vd {file_vd:g} in the file but "
+                          f"{cat.nd:g}, {cat.vd:g} in physcam's catalogue; using the file's", PhysCamWarning,
+                          stacklevel=2)
+        return Medium(file_nd, file_vd, g)
     try:
         cat = find_glass(g)
     except InputError as exc:
-        raise LensFileError(str(exc), path, lineno) from None
+        raise LensFileError(str(exc) + "; or give its nd and Vd on the GLAS line", path, lineno) from None
     return Medium(cat.nd, cat.vd, cat.name)
 
 
@@ -203,7 +226,7 @@ def dumps(p: Prescription) -> str:
         raise ExportError(f"lens {p.name!r} is anamorphic; write physcam TOML instead")
     if p.focus is not None:
         warnings.warn(f"Zemax writer drops the focus groups of lens {p.name!r}", PhysCamWarning, stacklevel=3)
-    out = ["VERS 190513 80 123457", "MODE SUDA", one_line(f"NAME {p.name}").rstrip(), "UNIT MM X W X CM MR CPMM"]
+    out = ["VERS 190513 80 123457", "MODE SEQ", one_line(f"NAME {p.name}").rstrip(), "UNIT MM X W X CM MR CPMM"]
     if p.metadata.notes:
         out += [one_line(f"NOTE 0 {line}").rstrip() for line in p.metadata.notes.splitlines()]
     out.append(f"WAVL {fmt(p.wavelength_nm / 1000.0)}")
