@@ -191,3 +191,21 @@ def test_round_trip(tmp_path):
         assert r0.dof.near_from_film_mm == pytest.approx(
             CameraSpec and __import__("physcam.usd.author", fromlist=["x"]).report_for_spec(spec).dof.near_from_film_mm,
             rel=1e-5)
+
+
+def test_shot_override_keeps_the_lens_switchable(tmp_path, library):
+    # overriding the f-stop and focus per shot must not freeze the rest of the lens: selecting an
+    # older characterization in the shot still brings that day's focal length and transmittance
+    body = tmp_path / "body.usda"
+    write_body_file(body, CameraSpec(sensor_width_mm=27.99, sensor_height_mm=19.22))
+    shot = tmp_path / "shot.usda"
+    write_shot(shot, body, library, overrides={"fstop": 2.8, "focus_mm": 2000.0})
+    stage = open_stage(shot)
+    prim = stage.GetPrimAtPath("/Cameras/Shot")
+    prim.GetVariantSets().GetVariantSet("characterization").SetVariantSelection("d2026_03_01")
+    r = read_camera(stage, "/Cameras/Shot")
+    assert r.spec.focal_length_mm == pytest.approx(24.1)   # from the 03-01 characterization
+    assert r.spec.transmittance == pytest.approx(0.90)
+    assert r.spec.fstop == pytest.approx(2.8) and r.spec.focus_mm == pytest.approx(2000.0)  # the shot's
+    layer_text = shot.read_text()
+    assert "focalLength" not in layer_text.split('def Camera "Camera"')[0]  # no frozen lens model values

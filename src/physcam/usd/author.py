@@ -352,13 +352,22 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
 
 
 def _author_body(cam, spec, position, rotate_xyz_deg, eye_su):
-    from pxr import Gf, Sdf, UsdGeom
+    from pxr import Gf, Sdf
 
     _set(cam, "flangeDistance", Sdf.ValueTypeNames.Float, spec.flange_distance_mm)
     _set(cam, "shutterOpen", Sdf.ValueTypeNames.Float, spec.shutter_open_s)
     _set(cam, "shutterDuration", Sdf.ValueTypeNames.Float, spec.shutter_duration_s)
     _set(cam, "shutterOpening", Sdf.ValueTypeNames.Float2, Gf.Vec2f(*spec.shutter_opening))
     _set(cam, "iris", Sdf.ValueTypeNames.Float, spec.focal_length_mm / spec.fstop)
+    author_transform(cam, position, rotate_xyz_deg, eye_su)
+
+
+def author_transform(cam, position, rotate_xyz_deg, eye_su: float) -> None:
+    """Place the body: translate to ``position`` (where the entrance pupil goes), rotate there,
+    then ``translate:pupilToFilm`` (0, 0, +eye) back to the film plane, so pans and tilts pivot
+    about the entrance pupil. ``eye_su`` is the pupil's distance in front of the film, in scene units."""
+    from pxr import Gf, UsdGeom
+
     xf = UsdGeom.Xformable(cam)
     xf.ClearXformOpOrder()
     xf.AddTranslateOp().Set(Gf.Vec3d(*map(float, position)))

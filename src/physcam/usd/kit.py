@@ -20,7 +20,7 @@ import math
 from dataclasses import replace
 
 from ..errors import ExportError, InputError
-from .author import LENS_INSTANCE, CameraSpec, author_camera, author_render_camera, new_stage, save_stage
+from .author import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec, author_camera, author_render_camera, new_stage, save_stage
 from .plugin import ensure_registered
 
 __all__ = [
@@ -164,16 +164,72 @@ def write_shot(file, body_file, lens_file, *, overrides: dict | None = None, len
             raise ExportError(f"{path}: lens file {lens_file} has no characterization variant {lens_variant!r}")
         vsets.GetVariantSet("characterization").SetVariantSelection(lens_variant)
     spec = replace(read_camera(stage, path).spec, **overrides).checked()
-    parts = {SHOT_OVERRIDES[k] for k in overrides}
-    if parts - {"body"}:
-        author_camera(stage, path, spec, parts=tuple(p for p in ("sensor", "lens") if p in parts))
-    # the shot places the camera: its transform (pivot at the entrance pupil) and shutter are shot-level
-    author_camera(stage, path, spec, position=position, rotate_xyz_deg=rotate_xyz_deg, parts=("body",))
+    # only what the shot overrides becomes a shot-layer opinion: everything else stays with the
+    # referenced body and lens files (and their variants), so switching a characterization in the
+    # shot still switches the lens
+    _author_overrides(stage, cam, spec, overrides)
+    # the shot places the camera: its transform pivots about the (composed) entrance pupil
+    _author_placement(cam, spec, position, rotate_xyz_deg)
     author_render_camera(stage, Sdf.Path(path), spec)
     try:
         return save_stage(stage, out, force=force)
     finally:
         layer.Clear()
+
+
+def _shot_attributes(spec, su):
+    """CameraSpec field -> [(on the lens model?, attribute, USD type name, value)] a shot may override."""
+    from pxr import Gf, Sdf
+
+    F, F2, U = Sdf.ValueTypeNames.Float, Sdf.ValueTypeNames.Float2, Sdf.ValueTypeNames.UInt
+    lp, sp = f"lens:{LENS_INSTANCE}:", f"sensor:{SENSOR_INSTANCE}:"
+    return {
+        "fstop": [(False, lp + "fStop", F, spec.fstop), (False, lp + "iris", F, spec.focal_length_mm / spec.fstop)],
+        "focus_mm": [(True, "focusDistance", F, spec.focus_mm)],
+        "transmittance": [(True, "transmittance", F, spec.transmittance)],
+        "aperture_blades": [(False, lp + "shutterBlades", U, int(spec.aperture_blades))],
+        "aperture_angle_deg": [(False, lp + "apertureAngle", F, spec.aperture_angle_deg)],
+        "aperture_roundness": [(False, lp + "apertureRoundness", F, spec.aperture_roundness)],
+        "aperture_density": [(False, lp + "apertureDensity", F, spec.aperture_density)],
+        "clipping_mm": [(False, lp + "clippingRange", F2, Gf.Vec2f(su(spec.clipping_mm[0]), su(spec.clipping_mm[1])))],
+        "shift_mm": [(False, sp + "shift", F2, Gf.Vec2f(*spec.shift_mm))],
+        "iso": [(False, sp + "iso", F, spec.iso)],
+        "coc_mm": [(False, sp + "circleOfConfusion", F, spec.coc_mm)],
+        "shutter_open_s": [(False, "shutterOpen", F, spec.shutter_open_s)],
+        "shutter_duration_s": [(False, "shutterDuration", F, spec.shutter_duration_s)],
+        "shutter_opening": [(False, "shutterOpening", F2, Gf.Vec2f(*spec.shutter_opening))],
+    }
+
+
+def _author_overrides(stage, cam, spec, overrides) -> None:
+    from pxr import UsdGeom
+
+    from ..export.usdgeom import mm_to_scene_units
+
+    mpu = UsdGeom.GetStageMetersPerUnit(stage)
+    table = _shot_attributes(spec, lambda mm: mm_to_scene_units(mm, mpu))
+    assert set(table) == set(SHOT_OVERRIDES)
+    targets = cam.GetRelationship(f"lens:{LENS_INSTANCE}:lensModel").GetTargets()
+    for field in overrides:
+        for on_model, name, type_name, value in table[field]:
+            if on_model:
+                if not targets:
+                    raise ExportError(f"{cam.GetPath()}: the lens has no lensModel to override {name} on")
+                prim = stage.OverridePrim(targets[0])
+            else:
+                prim = cam
+            attr = prim.GetAttribute(name) or prim.CreateAttribute(name, type_name)
+            attr.Set(value)
+
+
+def _author_placement(cam, spec, position, rotate_xyz_deg) -> None:
+    from pxr import UsdGeom
+
+    from ..export.usdgeom import mm_to_scene_units
+    from .author import _eye_from_film, author_transform
+
+    eye = mm_to_scene_units(_eye_from_film(spec, None), UsdGeom.GetStageMetersPerUnit(cam.GetStage()))
+    author_transform(cam, position, rotate_xyz_deg, eye)
 
 
 def _relpath(target, start) -> str:
