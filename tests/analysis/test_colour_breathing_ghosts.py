@@ -126,3 +126,14 @@ def test_lens_ghosts_ranked_coated_and_imaged(dgauss):
     with pytest.raises(InputError):
         trace_ghost(dgauss, RayBatch.from_arrays([[0, 0, -1.0]], [[0, 0, 1.0]]), 2, 5, 80.0)
     assert isinstance(_Tables(dgauss, "none", None).n, int)
+
+
+def test_colour_says_when_the_file_has_no_dispersion():
+    from physcam.analysis.colour import chromatic_aberration
+    from physcam.lens.library import load_lens
+
+    res = chromatic_aberration(load_lens("dgauss_50mm"))  # pbrt file: no Abbe numbers
+    assert res.longitudinal_paraxial_mm == 0.0
+    assert any("Abbe" in n for n in res.notes)
+    res = chromatic_aberration(load_lens("double_gauss_50mm_f2"))  # seed TOML with Abbe numbers
+    assert res.longitudinal_paraxial_mm != 0.0 and not res.notes

@@ -38,3 +38,14 @@ def test_cli_spot_and_bokeh(tmp_path, capsys):
     assert "--force" in capsys.readouterr().err
     assert main(["bokeh", "dgauss.50mm", "--depth", "1m", "--rays", "20000", "--pixels", "32", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["rays_passed"] > 0
+
+
+def test_stopping_down_shrinks_the_axial_spot():
+    # on axis, at the paraxial focus, spherical aberration grows with the aperture: every stop
+    # down shrinks the RMS spot, and every ray that passes lies within the stopped pupil
+    from physcam.analysis.spot import spot_diagram
+    from physcam.lens.library import load_lens
+
+    lens = load_lens("dgauss_50mm")
+    rms = [spot_diagram(lens, (0.0,), fstop=n, rings=20).fields[0].rms_radius_um for n in (2.1, 2.8, 4.0, 5.6, 8.0)]
+    assert all(a > b for a, b in zip(rms, rms[1:]))

@@ -166,8 +166,14 @@ def chromatic_aberration(
                            float((heights[LINE_F_NM][i] - heights[LINE_C_NM][i]) * 1e3))
         for i, f in enumerate(fields)
     ]
-    return ColourResult(
+    result = ColourResult(
         lens.name, ref, float(film_z), zone, wls, [float(v) for v in par], real,
         float(par[iC] - par[iF]), float(real[iC] - real[iF]),
         [float(v) for v in curve], [float(v) for v in shift], lateral, float(g_ref.efl),
     )
+    if all(s.medium.vd == 0.0 for s in lens.surfaces):
+        # pbrt and ISET files carry no Abbe numbers: every medium is non-dispersive, so zero colour
+        # says nothing about the real lens
+        result.notes.append("no glass in this lens file has an Abbe number (Vd = 0 everywhere): it is traced "
+                            "without dispersion, so the colour figures are zero by construction, not measured")
+    return result

@@ -98,12 +98,14 @@ def spot_diagram(
     rings: int = 40,
     overfill: float = 1.3,
     pupil_radius: float | None = None,
+    fstop: float | None = None,
     backend: str = "auto",
 ) -> SpotDiagram:
     """Spot diagram of ``lens`` at the given field angles (see module notes).
 
     ``pupil_radius`` (mm) replaces the overfilled entrance pupil by a disk of that radius on the
     entrance-pupil plane (e.g. to compare with a published figure at a given beam size).
+    ``fstop`` stops the lens down (the stop's semi-diameter scaled to that f-number).
     """
     from ..optics.paraxial import gaussian
     from ..trace import RayBatch, paraxial_image_z, trace_to_film
@@ -113,7 +115,12 @@ def spot_diagram(
         film_z = paraxial_image_z(lens, wl)
     if not 1 <= rings <= 2000:
         raise InputError(f"rings must lie between 1 and 2000 (3 n (n + 1) rays per field), got {rings}")
-    g = gaussian(lens, wavelength_nm=wl)
+    stop = None
+    if fstop is not None:
+        from ..optics.paraxial import stop_semi_diameter_for_fstop
+
+        stop = stop_semi_diameter_for_fstop(lens, fstop, wavelength_nm=wl)
+    g = gaussian(lens, wavelength_nm=wl, fstop=fstop)
     z_ep, r_ep = g.z_entrance_pupil, g.entrance_pupil_diameter / 2
     beam = r_ep * overfill if pupil_radius is None else require_finite("pupil_radius", pupil_radius)
     if beam <= 0:
@@ -130,7 +137,7 @@ def spot_diagram(
         back = (z_ep - z0) / d[2]
         start = np.stack([px, py - back * d[1], np.full(px.size, z0)], axis=1)
         rays = RayBatch.from_arrays(start, d[None, :], wl)
-        res = trace_to_film(lens, rays, film_z, backend=backend)
+        res = trace_to_film(lens, rays, film_z, stop_semi_diameter=stop, backend=backend)
         ok = res.ok
         if not ok.any():
             raise OpticsError(f"no ray at field {fd:g} deg passes through {lens.name!r}; choose a smaller field angle")

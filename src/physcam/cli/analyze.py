@@ -19,8 +19,27 @@ def _common(p, plot_help: str) -> None:
 
 
 def _sensor(p) -> None:
-    p.add_argument("--sensor-width", type=distance("sensor width"), default=36.0, metavar="MM")
-    p.add_argument("--sensor-height", type=distance("sensor height"), default=24.0, metavar="MM")
+    p.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (default full frame 36x24)')
+    p.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="MM")
+    p.add_argument("--sensor-height", type=distance("sensor height"), default=None, metavar="MM")
+
+
+def _resolve_sensor(args) -> None:
+    """Fill args.sensor_width/height (mm) from --sensor NAME, or the pair, or full frame 36x24."""
+    from ..errors import InputError
+    from ..onset.sensors import find_sensor
+
+    if not hasattr(args, "sensor_width"):
+        return
+    if args.sensor:
+        if args.sensor_width is not None or args.sensor_height is not None:
+            raise InputError("give either --sensor NAME or --sensor-width/--sensor-height, not both")
+        s = find_sensor(args.sensor)
+        args.sensor_width, args.sensor_height = s.width_mm, s.height_mm
+    elif args.sensor_width is None and args.sensor_height is None:
+        args.sensor_width, args.sensor_height = 36.0, 24.0
+    elif args.sensor_width is None or args.sensor_height is None:
+        raise InputError("give both --sensor-width and --sensor-height")
 
 
 def register(sub) -> None:
@@ -78,6 +97,7 @@ def _prepare(args):
 
     if args.output:
         check_writable(args.output, force=args.force)
+    _resolve_sensor(args)
     return load_lens(args.lens)
 
 
@@ -150,6 +170,8 @@ def run_colour(args) -> int:
         print("  lateral colour F - C on the film:")
         for p in res.lateral:
             print(f"    field {p.field_deg:7.3f} deg  {p.lateral_colour_um:9.3f} um")
+        for n in res.notes:
+            print(f"  note: {n}")
     _finish(args, res)
     return 0
 

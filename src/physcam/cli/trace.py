@@ -12,6 +12,7 @@ def register(sub) -> None:
                    help="field angle in degrees (repeat; default 0 and 5)")
     p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM")
     p.add_argument("--rings", type=int, default=40, help="equal-area pupil rings (3 n (n+1) rays per field)")
+    p.add_argument("--fstop", type=number("f-stop"), default=None, help="stop the lens down to this f-number")
     p.add_argument("--json", action="store_true", help="print as JSON")
     p.add_argument("-o", "--output", metavar="FILE.png", help="write the spot diagram plot")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
@@ -50,7 +51,8 @@ def run_spot(args) -> int:
     if args.output:
         check_writable(args.output, force=args.force)
     lens = load_lens(args.lens)
-    res = spot_diagram(lens, tuple(args.field or (0.0, 5.0)), wavelength_nm=args.wavelength, rings=args.rings)
+    res = spot_diagram(lens, tuple(args.field or (0.0, 5.0)), wavelength_nm=args.wavelength, rings=args.rings,
+                       fstop=args.fstop)
     if args.output:
         res.plot(args.output, force=args.force)
     if args.json:
