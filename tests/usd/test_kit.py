@@ -209,3 +209,12 @@ def test_shot_override_keeps_the_lens_switchable(tmp_path, library):
     assert r.spec.fstop == pytest.approx(2.8) and r.spec.focus_mm == pytest.approx(2000.0)  # the shot's
     layer_text = shot.read_text()
     assert "focalLength" not in layer_text.split('def Camera "Camera"')[0]  # no frozen lens model values
+
+
+def test_reading_a_lens_or_body_file_says_what_it_is(tmp_path, library):
+    with pytest.raises(ExportError, match="only a lens"):
+        read_camera(open_stage(library))
+    body = tmp_path / "body.usda"
+    write_body_file(body, CameraSpec())
+    with pytest.raises(ExportError, match="only a body"):
+        read_camera(open_stage(body))

@@ -132,6 +132,19 @@ def run_kit(args) -> int:
 
         path = kit.write_vendor_lens(args.file, load_lens(args.lens), focus_mm=args.focus, fstop=args.fstop,
                                      force=args.force, meters_per_unit=args.meters_per_unit, fps=args.fps)
+        if args.json:  # what the file says, read back: the matched pinhole, the variant, the distortion fit
+            from ..usd.read import open_stage, read_camera
+            from ._common import print_json
+
+            stage = open_stage(path)
+            geom = stage.GetPrimAtPath(f"{kit.LENS_PRIM}/Camera")
+            distortion = {a.GetName().split(":", 1)[1]: a.Get() for a in geom.GetAttributes()
+                          if a.GetName().startswith("lensDistortion:")} if geom else {}
+            distortion = {k: (list(v) if hasattr(v, "__len__") and not isinstance(v, str) else v)
+                          for k, v in distortion.items()}
+            print_json({"written": str(path), "usd": read_camera(stage, kit.LENS_PRIM).to_dict(),
+                        "lens_distortion": distortion})
+            return 0
     return _done(args, path)
 
 

@@ -259,14 +259,15 @@ def write_previs_kit(file, setups: dict | None = None, *, default: str = "OverTh
     return save_stage(stage, file, force=force)
 
 
-def best_match_pinhole(prescription, *, focus_mm: float, fstop: float, sensor_width_mm: float,
+def best_match_pinhole(prescription, *, focus_mm: float, fstop: float | None, sensor_width_mm: float,
                        sensor_height_mm: float, coc_mm: float = 0.03):
     """(CameraSpec of the pinhole, report of the real lens): the pinhole matches the lens's FOV at ``focus_mm``.
 
     The real lens's report (technical model from its own Gaussian optics focused at the
     mark) gives the horizontal field of view at that focus, breathing included; the
     pinhole's focal length is w / (2 tan(hfov / 2)), so a real-time renderer frames the
-    same picture. f-stop, focus mark, CoC and the entrance pupil are carried over.
+    same picture. f-stop (None: the lens wide open, as the lens report decides), focus mark,
+    CoC and the entrance pupil are carried over.
     """
     from ..onset.report import solve_lens_report
     from ..onset.sensors import Sensor
@@ -278,7 +279,7 @@ def best_match_pinhole(prescription, *, focus_mm: float, fstop: float, sensor_wi
     w = sensor_width_mm * report.squeeze
     f_match = w / (2.0 * math.tan(math.radians(report.hfov_focus_deg) / 2.0))
     spec = CameraSpec(focal_length_mm=f_match, sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm,
-                      fstop=fstop, focus_mm=focus_mm, coc_mm=coc_mm, squeeze=report.squeeze,
+                      fstop=report.fstop, focus_mm=focus_mm, coc_mm=coc_mm, squeeze=report.squeeze,
                       entrance_pupil_mm=report.entrance_pupil_from_film_mm, lens_name=prescription.name)
     return spec.checked(), report
 
@@ -341,9 +342,6 @@ def write_vendor_lens(file, prescription, *, focus_mm: float, fstop: float | Non
 
     if use not in ("pinhole", "prescription"):
         raise InputError(f"use must be pinhole or prescription, got {use!r}")
-    fstop = fstop or prescription.metadata.max_fstop
-    if fstop is None:
-        raise InputError(f"lens {prescription.name!r} has no maximum aperture on file; give the f-stop")
     spec, _report = best_match_pinhole(prescription, focus_mm=focus_mm, fstop=fstop,
                                        sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm,
                                        coc_mm=coc_mm)

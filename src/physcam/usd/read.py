@@ -182,6 +182,14 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
     if not prim.IsA(Usd.SchemaRegistry.GetTypeFromSchemaTypeName("PhysicalCamera")):
         kind = prim.GetTypeName() or "typeless prim"
         raise ExportError(f"{path}: is a {kind}, not a PhysicalCamera")
+    applied = {a.split(":", 1)[0] for a in prim.GetAppliedSchemas()}
+    has_sensor, has_lens = "PhysicalCameraSensorAPI" in applied, "PhysicalCameraLensAPI" in applied
+    if has_lens and not has_sensor:
+        raise ExportError(f"{prim.GetPath()} holds only a lens (no sensor): a lens file to reference from a shot "
+                          "with a body (physcam.usd.kit.write_shot), not a whole camera")
+    if has_sensor and not has_lens:
+        raise ExportError(f"{prim.GetPath()} holds only a body and sensor (no lens): a body file to reference from "
+                          "a shot with a lens (physcam.usd.kit.write_shot), not a whole camera")
     s = _instance(prim, "PhysicalCameraSensorAPI", SENSOR_INSTANCE)
     ln = _instance(prim, "PhysicalCameraLensAPI", LENS_INSTANCE)
     sp, lp = f"sensor:{s}:", f"lens:{ln}:"
