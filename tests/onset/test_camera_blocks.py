@@ -72,3 +72,23 @@ def test_focus_distance_is_measured_from_the_entrance_pupil():
                           model="technical", h1_mm=80.0, h2_mm=60.0, pupil_mm=95.0)
     assert usdgeom_camera_values(r, 0.01)["focusDistance"] == pytest.approx(190.5)
     assert renderman_camera_values(r, 1.0)["Projection"]["focalDistance"] == pytest.approx(1.905)
+
+
+@pytest.mark.parametrize("shift", [(3.0, -2.0), (-1.5, 0.75)])
+def test_sensor_shift_moves_the_usd_frustum_and_the_renderman_window_alike(shift):
+    # Gf.Camera's frustum window (tangents at unit distance) from the USD block must equal the
+    # RenderMan screen window scaled by tan(fov/2) of its unit side.
+    from pxr import Gf
+
+    r = solve_lens_report(focal_length_mm=50.0, sensor=Sensor("x", "x", 36.0, 24.0), fstop=2.0, focus_mm=3000.0)
+    v = usdgeom_camera_values(r, 0.01, shift_mm=shift)
+    cam = Gf.Camera()
+    cam.focalLength = v["focalLength"]
+    cam.horizontalAperture, cam.verticalAperture = v["horizontalAperture"], v["verticalAperture"]
+    cam.horizontalApertureOffset, cam.verticalApertureOffset = v["horizontalApertureOffset"], v["verticalApertureOffset"]
+    win = cam.frustum.GetWindow()
+    rm = renderman_camera_values(r, 0.01, shift_mm=shift)
+    t = math.tan(math.radians(rm["Projection"]["fov"]) / 2)
+    l, rr, b, top = (x * t for x in rm["ScreenWindow"])
+    assert (win.GetMin()[0], win.GetMax()[0], win.GetMin()[1], win.GetMax()[1]) == pytest.approx((l, rr, b, top),
+                                                                                                   abs=1e-6)

@@ -65,3 +65,20 @@ def test_camera_ray_weights_are_unbiased_and_match_the_pupil_solid_angle(dgauss)
     on_axis = camera_rays(dgauss, np.zeros((n, 2)), rng.random((n, 2)), film_z, bounds=pb).weight.mean()
     # (the f-number at infinity is the working f-number here: the film is at the focal plane)
     assert on_axis == pytest.approx(math.pi / (4 * g.f_number**2), rel=0.02)
+
+
+def test_camera_rays_to_world(dgauss):
+    # camera turned 90 deg about +Y (it looks down world -X) and placed at (100, 50, 0) cm: a ray
+    # leaving along camera -Z leaves along world -X, from a point offset accordingly
+    import math
+
+    from physcam.trace import paraxial_image_z
+
+    cr = camera_rays(dgauss, [[0.0, 0.0]], [[0.5, 0.5]], paraxial_image_z(dgauss))
+    c, s = math.cos(math.pi / 2), math.sin(math.pi / 2)
+    m = np.array([[c, 0, -s, 0], [0, 1, 0, 0], [s, 0, c, 0], [100, 50, 0, 1]])
+    o, d = cr.to_world(m, mm_per_unit=10.0)
+    ox, oy, oz = cr.origin[0] / 10.0
+    assert o[0] == pytest.approx([100 + oz, 50 + oy, -ox], abs=1e-9)
+    assert d[0] == pytest.approx([cr.direction[0][2], cr.direction[0][1], -cr.direction[0][0]], abs=1e-12)
+    assert d[0][0] == pytest.approx(-1.0, abs=1e-9)  # on axis: straight out along world -X

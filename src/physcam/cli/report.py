@@ -73,6 +73,10 @@ def add_report_arguments(p) -> None:
     g.add_argument("--meters-per-unit", type=number("metersPerUnit"), default=0.01,
                    help="scene unit for USD/RenderMan values (default 0.01 = cm)")
     g.add_argument("--shutter-angle", type=number("shutter angle"), default=180.0, help="degrees (default 180)")
+    g.add_argument("--shift-x", type=distance("horizontal sensor shift"), default=0.0,
+                   help="horizontal lens/sensor shift on the film (mm; + right): aperture offsets, screen window")
+    g.add_argument("--shift-y", type=distance("vertical sensor shift"), default=0.0,
+                   help="vertical lens/sensor shift on the film (mm; + up; write negative values as --shift-y=-2)")
 
 
 def resolve_sensor(args):
@@ -140,10 +144,11 @@ def camera_blocks(report, args) -> dict:
     from ..export.usdgeom import usdgeom_camera_values
 
     mpu = args.meters_per_unit
+    shift = (getattr(args, "shift_x", 0.0), getattr(args, "shift_y", 0.0))
     return {
         "meters_per_unit": mpu,
-        "usd_geom_camera": usdgeom_camera_values(report, mpu, shutter_angle_deg=args.shutter_angle),
-        "renderman": renderman_camera_values(report, mpu),
+        "usd_geom_camera": usdgeom_camera_values(report, mpu, shutter_angle_deg=args.shutter_angle, shift_mm=shift),
+        "renderman": renderman_camera_values(report, mpu, shift_mm=shift),
     }
 
 

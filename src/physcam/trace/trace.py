@@ -152,6 +152,22 @@ class CameraRays:
     def ok(self) -> np.ndarray:
         return self.lens_rays.flag == OK
 
+    def to_world(self, camera_to_world, mm_per_unit: float = 10.0):
+        """(origin, direction) in world space for a renderer: ``camera_to_world`` is a 4x4 matrix in
+        USD's row-vector convention (p_world = p_camera @ M, translation in the last row), in world
+        units; ``mm_per_unit`` converts camera-space millimetres to them (10 for centimetres).
+        Directions are rotated (and renormalised), not translated."""
+        m = np.asarray(camera_to_world, dtype=np.float64)
+        if m.shape != (4, 4) or not np.isfinite(m).all():
+            raise InputError("camera_to_world must be a finite 4x4 matrix")
+        mpu = require_finite("mm_per_unit", mm_per_unit)
+        if mpu <= 0:
+            raise InputError(f"mm_per_unit must be > 0, got {mpu:g}")
+        o = self.origin / mpu @ m[:3, :3] + m[3, :3]
+        d = self.direction @ m[:3, :3]
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        return o, d
+
 
 def camera_rays(
     lens: Prescription,
