@@ -87,9 +87,9 @@ def _json_float(v):
 
 
 def run_lenses(args) -> int:
-    from ..lens.library import list_lenses
+    from ..errors import PhysCamError
+    from ..lens.library import list_lenses, load_lens
     from ..optics.paraxial import gaussian
-    from ..lens.library import load_lens
     from ._common import console, print_json
 
     out = []
@@ -98,11 +98,7 @@ def run_lenses(args) -> int:
         try:
             g = gaussian(load_lens(rec.slug))
             d["efl_mm"], d["f_number"] = g.efl, g.f_number
-        except Exception as exc:  # noqa: BLE001 - a listing must not stop at one odd lens
-            from ..errors import PhysCamError
-
-            if not isinstance(exc, PhysCamError):
-                raise
+        except PhysCamError:  # a listing must not stop at one odd lens
             d["efl_mm"], d["f_number"] = None, None
         out.append(d)
     if args.json:
@@ -112,8 +108,10 @@ def run_lenses(args) -> int:
 
     t = Table(title="bundled lenses (paraxial EFL and f-number at the d line, stop as in the file)")
     t.add_column("name (for physcam lens)", no_wrap=True)
-    for col in ("lens", "nominal f", "EFL mm", "f/", "format", "notes"):
-        t.add_column(col)
+    for col in ("EFL mm", "f/"):
+        t.add_column(col, justify="right", no_wrap=True)
+    t.add_column("format", no_wrap=True)
+    t.add_column("lens and notes", overflow="fold")
     for d in out:
         notes = []
         if d["anamorphic"]:
@@ -122,8 +120,8 @@ def run_lenses(args) -> int:
             notes.append("internal focus")
         if d["corrected"]:
             notes.append("corrected")
-        t.add_row(d["slug"], d["name"], _fmt(d["focal_length"], 1), _fmt(d["efl_mm"], 2), _fmt(d["f_number"], 2),
-                  d["original_format"] or "-", ", ".join(notes))
+        t.add_row(d["slug"], _fmt(d["efl_mm"], 2), _fmt(d["f_number"], 2), d["original_format"] or "-",
+                  "; ".join([d["name"], *notes]))
     console().print(t)
     return 0
 
