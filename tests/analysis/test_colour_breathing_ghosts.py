@@ -59,8 +59,19 @@ def test_real_breathing_tends_to_the_paraxial_table(dgauss):
     table = breathing_table(dgauss, marks, sensor_width_mm=0.02)
     for row, par in zip(res.rows, table):
         assert row.hfov_real_deg == pytest.approx(par.hfov_deg, rel=1e-6)
-        assert row.hfov_paraxial_deg == par.hfov_deg
     assert res.rows[-1].change_real_pct < 0  # a unit-focusing lens narrows its view when focused close
+
+
+def test_paraxial_breathing_from_the_published_dgauss_figures(dgauss):
+    # Independent of physcam's engine: from the published dgauss.50mm figures (EFL 50.3582, BFL
+    # 36.1059, exit pupil 17.7714 before the last vertex, pupil magnification 1.06988, hiatus
+    # H1-H2 = -5.448), a unit-focusing lens focused at mark D extends by s' - f (s + s' + hiatus
+    # = D) and the chief ray from the film corner through the exit pupil gives
+    # HFOV = 2 atan(m_p (w/2) / (BFL + 17.7714 + ext)); for w = 36 mm: 39.338, 38.459, 37.526 and
+    # 35.455 deg at infinity, 2 m, 1 m and 0.5 m (worked in a separate script).
+    res = real_breathing(dgauss, (math.inf, 2000.0, 1000.0, 500.0), sensor_width_mm=36.0, sensor_height_mm=24.0)
+    for row, expect in zip(res.rows, (39.338, 38.459, 37.526, 35.455)):
+        assert row.hfov_paraxial_deg == pytest.approx(expect, abs=2e-3)
 
 
 def test_real_breathing_internal_focus_and_full_frame(dgauss):
@@ -125,7 +136,7 @@ def test_lens_ghosts_ranked_coated_and_imaged(dgauss):
         ghost_analysis(dgauss, 95.0)
     with pytest.raises(InputError):
         trace_ghost(dgauss, RayBatch.from_arrays([[0, 0, -1.0]], [[0, 0, 1.0]]), 2, 5, 80.0)
-    assert isinstance(_Tables(dgauss, "none", None).n, int)
+    assert _Tables(dgauss, "none", None).n == 11  # dgauss.50mm has 11 surfaces, the stop included
 
 
 def test_colour_says_when_the_file_has_no_dispersion():

@@ -42,6 +42,7 @@ def test_usd_units_hand_values():
     m = usdgeom_camera_values(r, 1.0)
     assert cm["focalLength"] == pytest.approx(50.0) and m["focalLength"] == pytest.approx(0.5)
     assert cm["horizontalAperture"] == pytest.approx(36.0) and m["horizontalAperture"] == pytest.approx(0.36)
+    # the default clipping range is 100 mm to 10 km (usdgeom_camera_values): 10 cm .. 1e6 cm, 0.1 m .. 1e4 m
     assert cm["clippingRange"] == pytest.approx((10.0, 1e6)) and m["clippingRange"] == pytest.approx((0.1, 1e4))
 
 

@@ -19,7 +19,8 @@ def test_dofmaster_50mm_f4_10ft():
 
 
 def test_army_field_manual_hyperfocal():
-    # US Army field manual (FM 24-40 / photography): a 2-inch (50 mm class) lens at f/8 with a
+    # The US Army field manual figure quoted in issue 2 (hand-worked here, as the manual itself was
+    # not at hand): a 2-inch (50 mm class) lens at f/8 with a
     # 0.002 in circle of confusion has a hyperfocal distance of about 20.8 ft, the f^2/(N c)
     # figure: (2 in)^2 / (8 x 0.002 in) = 250 in = 20.83 ft. physcam's H adds f.
     f = 2 * IN

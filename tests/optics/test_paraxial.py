@@ -126,7 +126,7 @@ def test_thin_lens_pair():
 
 
 def test_entrance_pupil_of_a_stop_behind_a_thin_lens():
-    # stop a behind a thin lens f < ... a < f: the entrance pupil is the lens's virtual image
+    # a stop a = 10 mm behind a thin lens of f = 50 mm (a < f): the entrance pupil is the lens's virtual image
     # of the stop, a f / (f - a) behind the lens, magnified f / (f - a)
     f, a, semi = 50.0, 10.0, 3.0
     g = gaussian(thin_lens(f, stop_gap=a, stop_semi=semi))

@@ -12,7 +12,7 @@ from physcam.errors import InputError
 
 
 def test_spot_diagram_reproduces_the_published_on_axis_rms(dgauss):
-    # issue 5 acceptance figure: 6.7099 um for an 11 mm beam at the paraxial image plane (d line)
+    # issue 5 acceptance figure: 6.7099 um for a beam of 11 mm radius at the paraxial image plane (d line)
     res = spot_diagram(dgauss, (0.0,), pupil_radius=11.0, rings=300)
     f = res.fields[0]
     assert f.rays_passed == f.rays_launched

@@ -140,7 +140,7 @@ def test_forward_then_backward_returns_to_start(backend, dgauss):
 
 def test_dgauss_on_axis_rms_spot_radius(dgauss):
     # Issue 5 acceptance: 6.7099 um +- 0.001 at the paraxial image plane, wavelength d,
-    # rays filling an 11 mm disk uniformly (deterministic equal-area sampling).
+    # rays filling a disk of 11 mm radius uniformly (deterministic equal-area sampling).
     x, y = equal_area_disk(11.0, 300)
     film = dgauss.vertex_z[-1] + DGAUSS_BFL
     out = trace_to_film(dgauss, RayBatch.collimated(x, y, -1.0, wavelength_nm=587.5618), film)

@@ -213,5 +213,9 @@ print('ok')
     assert res.returncode != 0 and "PhysicalCamera unknown" in res.stderr
 
 
-def test_errors_are_physcam_errors():
-    assert issubclass(ExportError, PhysCamError)
+def test_usd_errors_are_caught_as_physcam_errors(tmp_path):
+    # a pipeline catching PhysCamError catches USD problems too: an existing file, no --force
+    f = tmp_path / "a.usda"
+    write_camera(f, CameraSpec())
+    with pytest.raises(PhysCamError):
+        write_camera(f, CameraSpec())

@@ -2,7 +2,7 @@
 
 The table ``physcam/data/sensors.csv`` holds active-area (or camera-aperture)
 width and height in mm with their sources; the values were checked against the
-shared reference table ``sensor_formats.csv`` (see tests/onset/test_sensors.py,
+shared reference table ``sensor_formats.csv`` (see tests/onset/test_sensors_pupil.py,
 which also checks each diagonal). Lookup ignores case, spaces and punctuation;
 an unknown name raises :class:`~physcam.errors.SensorError` listing the closest names.
 """
