@@ -40,42 +40,42 @@ def add_report_arguments(p) -> None:
     g = p.add_argument_group("lens and sensor")
     g.add_argument("--lens", metavar="NAME_OR_FILE",
                    help="a real lens (bundled name or prescription file): fills the technical model from it")
-    g.add_argument("--focal", type=distance("focal length"), help="focal length (mm)")
-    g.add_argument("--fstop", type=number("f-stop"), help="f-stop (geometric f-number); solved if omitted")
-    g.add_argument("--tstop", type=number("T-stop"), help="marked T-stop, compared with the effective f-stop")
-    g.add_argument("--focus", type=distance("focus distance"), help="focus mark, film plane to subject")
-    g.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (see physcam sensors)')
-    g.add_argument("--sensor-width", type=distance("sensor width"), help="sensor width (mm)")
-    g.add_argument("--sensor-height", type=distance("sensor height"), help="sensor height (mm)")
-    g.add_argument("--squeeze", type=number("squeeze"), default=1.0, help="anamorphic squeeze (default 1)")
+    g.add_argument("--focal", metavar="MM", type=distance("focal length"), help="focal length (mm)")
+    g.add_argument("--fstop", metavar="N", type=number("f-stop"), help="f-stop (geometric f-number); solved from --near/--far if omitted (with --lens: wide open)")
+    g.add_argument("--tstop", metavar="T", type=number("T-stop"), help="marked T-stop, compared with the effective f-stop")
+    g.add_argument("--focus", metavar="DIST", type=distance("focus distance"), help="focus mark, film plane to subject")
+    g.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (see physcam sensors; default Super 35 4-perf)')
+    g.add_argument("--sensor-width", metavar="MM", type=distance("sensor width"), help="sensor width (mm)")
+    g.add_argument("--sensor-height", metavar="MM", type=distance("sensor height"), help="sensor height (mm)")
+    g.add_argument("--squeeze", metavar="S", type=number("squeeze"), default=1.0, help="anamorphic squeeze (default 1)")
     g.add_argument("--coc", default=None,
                    help="circle of confusion: d/1500 (default), d/1000, d/1730, cine (0.025 mm) or a value in mm")
     g = p.add_argument_group("measured depth of field (inverse solve)")
-    g.add_argument("--near", type=distance("near limit"), help="measured near limit, from the film plane")
-    g.add_argument("--far", type=distance("far limit", allow_inf=True), help="measured far limit (or inf)")
+    g.add_argument("--near", metavar="DIST", type=distance("near limit"), help="measured near limit, from the film plane")
+    g.add_argument("--far", metavar="DIST", type=distance("far limit", allow_inf=True), help="measured far limit (or inf)")
     g = p.add_argument_group("model")
     g.add_argument("--model", choices=("practical", "technical"), default="practical",
                    help="practical = thin lens; technical = datasheet principal planes")
-    g.add_argument("--h1", type=distance("H1 offset"), help="front principal plane, in front of the reference")
-    g.add_argument("--h2", type=distance("H2 offset"), help="rear principal plane, in front of the reference")
-    g.add_argument("--pupil", type=distance("entrance pupil offset"),
+    g.add_argument("--h1", metavar="DIST", type=distance("H1 offset"), help="front principal plane, in front of the reference")
+    g.add_argument("--h2", metavar="DIST", type=distance("H2 offset"), help="rear principal plane, in front of the reference")
+    g.add_argument("--pupil", metavar="DIST", type=distance("entrance pupil offset"),
                    help="entrance pupil, in front of the reference plane (technical)")
     g.add_argument("--reference", choices=("film", "flange"), default="film",
                    help="plane the datasheet offsets are measured from")
-    g.add_argument("--flange", type=distance("flange focal distance"),
+    g.add_argument("--flange", metavar="MM", type=distance("flange focal distance"),
                    help="flange focal distance (e.g. 52 for PL, 44 for LPL) when --reference flange")
-    g.add_argument("--sensor-front", type=distance("sensor-to-lens-front distance"),
+    g.add_argument("--sensor-front", metavar="DIST", type=distance("sensor-to-lens-front distance"),
                    help="tape measure: film mark to the front of the lens (practical pupil estimate)")
-    g.add_argument("--lens-length", type=distance("lens length"), help="physical lens length")
-    g.add_argument("--pupil-fraction", type=number("pupil fraction"), default=0.4,
+    g.add_argument("--lens-length", metavar="DIST", type=distance("lens length"), help="physical lens length")
+    g.add_argument("--pupil-fraction", metavar="F", type=number("pupil fraction"), default=0.4,
                    help="entrance pupil this fraction of the lens length behind its front (default 0.4)")
     g = p.add_argument_group("cameras")
-    g.add_argument("--meters-per-unit", type=number("metersPerUnit"), default=0.01,
+    g.add_argument("--meters-per-unit", metavar="MPU", type=number("metersPerUnit"), default=0.01,
                    help="scene unit for USD/RenderMan values (default 0.01 = cm)")
-    g.add_argument("--shutter-angle", type=number("shutter angle"), default=180.0, help="degrees (default 180)")
-    g.add_argument("--shift-x", type=distance("horizontal sensor shift"), default=0.0,
+    g.add_argument("--shutter-angle", metavar="DEG", type=number("shutter angle"), default=180.0, help="degrees (default 180)")
+    g.add_argument("--shift-x", metavar="MM", type=distance("horizontal sensor shift"), default=0.0,
                    help="horizontal lens/sensor shift on the film (mm; + right): aperture offsets, screen window")
-    g.add_argument("--shift-y", type=distance("vertical sensor shift"), default=0.0,
+    g.add_argument("--shift-y", metavar="MM", type=distance("vertical sensor shift"), default=0.0,
                    help="vertical lens/sensor shift on the film (mm; + up; write negative values as --shift-y=-2)")
 
 
