@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 
 from ...errors import LensFileError
-from ..prescription import Prescription
+from ..prescription import Focus, Prescription, VariableGap
 
 #: Files larger than this are refused before parsing (a lens file is a few kB).
 MAX_FILE_BYTES = 10 * 1024 * 1024
@@ -184,3 +184,33 @@ def text_field(d: dict, key: str, where: str, path, line=None) -> str | None:
 def one_line(s: str) -> str:
     """``s`` made safe for a single comment/header line: control characters become spaces."""
     return "".join(" " if (ord(c) < 32 and c != "\t") or ord(c) == 127 or c in "\x85\u2028\u2029" else c for c in s)
+
+
+def focus_table(f: dict, surfaces, text: str, path, rows_key: str) -> Focus:
+    """The ``[focus]`` table of the TOML formats: ``close_distance`` and ``[[focus.<rows_key>]]``
+    rows of ``surface`` (0-based) and ``thickness_close``; physcam's own rows may also carry
+    ``thickness_infinity`` (the seeds' take it from the surface)."""
+    unknown_keys(f, ("close_distance", rows_key), "[focus]", path)
+    if "close_distance" not in f:
+        raise LensFileError("[focus] needs close_distance (mm from the front vertex)", path)
+    close = number(f["close_distance"], "[focus] close_distance", path, None)
+    rows = f.get(rows_key, [])
+    header = f"focus.{rows_key}"
+    if not isinstance(rows, list):
+        raise LensFileError(f"[[{header}]] must be an array of tables", path)
+    row_keys = ("surface", "thickness_close") + (("thickness_infinity",) if rows_key == "gap" else ())
+    lines = table_lines(text, header, len(rows))
+    gaps = []
+    for j, g in enumerate(rows):
+        ln = lines[j]
+        g = table(g, f"focus {rows_key} {j}", path, ln)
+        unknown_keys(g, row_keys, f"[[{header}]]", path, ln)
+        s = g.get("surface")
+        if isinstance(s, bool) or not isinstance(s, int) or not 0 <= s < len(surfaces):
+            raise LensFileError(
+                f"focus {rows_key} {j}: surface must be a 0-based index below {len(surfaces)}, got {s!r}", path, ln)
+        if "thickness_close" not in g:
+            raise LensFileError(f"focus {rows_key} {j} has no thickness_close", path, ln)
+        t_inf = number(g.get("thickness_infinity", surfaces[s].thickness), "thickness_infinity", path, ln)
+        gaps.append(VariableGap(s, t_inf, number(g["thickness_close"], "thickness_close", path, ln)))
+    return Focus(close, tuple(gaps))

@@ -25,10 +25,11 @@ from pathlib import Path
 
 from ...errors import InputError, LensFileError
 from ..catalog import find_glass
-from ..prescription import AIR, SURFACE_KINDS, Focus, LensMetadata, Medium, Prescription, Surface, VariableGap
+from ..prescription import AIR, SURFACE_KINDS, Focus, LensMetadata, Medium, Prescription, Surface
 from ._common import (
     MAX_SURFACES,
     check_count,
+    focus_table,
     number,
     parse_toml,
     table,
@@ -164,27 +165,7 @@ def _json(v, where, path) -> str:
 
 
 def _focus(f: dict, surfaces, text, path) -> Focus:
-    unknown_keys(f, ("close_distance", "gap"), "[focus]", path)
-    if "close_distance" not in f:
-        raise LensFileError("[focus] needs close_distance (mm from the front vertex)", path)
-    close = number(f["close_distance"], "[focus] close_distance", path, None)
-    rows = f.get("gap", [])
-    if not isinstance(rows, list):
-        raise LensFileError("[[focus.gap]] must be an array of tables", path)
-    lines = table_lines(text, "focus.gap", len(rows))
-    gaps = []
-    for j, g in enumerate(rows):
-        ln = lines[j]
-        g = table(g, f"focus gap {j}", path, ln)
-        unknown_keys(g, ("surface", "thickness_infinity", "thickness_close"), "[[focus.gap]]", path, ln)
-        s = g.get("surface")
-        if isinstance(s, bool) or not isinstance(s, int) or not 0 <= s < len(surfaces):
-            raise LensFileError(f"focus gap {j}: surface must be a 0-based index below {len(surfaces)}, got {s!r}", path, ln)
-        if "thickness_close" not in g:
-            raise LensFileError(f"focus gap {j} has no thickness_close", path, ln)
-        t_inf = number(g.get("thickness_infinity", surfaces[s].thickness), "thickness_infinity", path, ln)
-        gaps.append(VariableGap(s, t_inf, number(g["thickness_close"], "thickness_close", path, ln)))
-    return Focus(close, tuple(gaps))
+    return focus_table(f, surfaces, text, path, "gap")
 
 
 def dumps(p: Prescription) -> str:

@@ -23,10 +23,11 @@ import warnings
 from pathlib import Path
 
 from ...errors import ExportError, LensFileError, PhysCamWarning
-from ..prescription import AIR, Focus, LensMetadata, Medium, Prescription, Surface, VariableGap
+from ..prescription import AIR, Focus, LensMetadata, Medium, Prescription, Surface
 from ._common import (
     MAX_SURFACES,
     check_count,
+    focus_table,
     number,
     one_line,
     parse_toml,
@@ -107,29 +108,7 @@ def loads_document(doc: dict, text: str, path=None, name: str | None = None) -> 
 
 
 def _focus(f: dict, surfaces, text, path) -> Focus:
-    unknown_keys(f, ("close_distance", "variable"), "[focus]", path)
-    if "close_distance" not in f:
-        raise LensFileError("[focus] needs close_distance (mm from the front vertex)", path)
-    close = number(f["close_distance"], "[focus] close_distance", path, None)
-    rows = f.get("variable", [])
-    if not isinstance(rows, list):
-        raise LensFileError("[[focus.variable]] must be an array of tables", path)
-    lines = table_lines(text, "focus.variable", len(rows))
-    gaps = []
-    for j, g in enumerate(rows):
-        ln = lines[j]
-        g = table(g, f"focus variable {j}", path, ln)
-        unknown_keys(g, ("surface", "thickness_close"), "[[focus.variable]]", path, ln)
-        s = g.get("surface")
-        if isinstance(s, bool) or not isinstance(s, int) or not 0 <= s < len(surfaces):
-            raise LensFileError(
-                f"focus variable {j}: surface must be a 0-based surface index below {len(surfaces)}, got {s!r}", path, ln
-            )
-        if "thickness_close" not in g:
-            raise LensFileError(f"focus variable {j} has no thickness_close", path, ln)
-        tc = number(g["thickness_close"], "thickness_close", path, ln)
-        gaps.append(VariableGap(s, surfaces[s].thickness, tc))
-    return Focus(close, tuple(gaps))
+    return focus_table(f, surfaces, text, path, "variable")
 
 
 def dumps(p: Prescription) -> str:
