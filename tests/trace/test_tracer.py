@@ -193,3 +193,20 @@ def test_no_image_and_bad_input_are_refused():
         RayBatch.from_arrays([[0.0, 0.0, float("nan")]], [[0, 0, 1]])
     with pytest.raises(InputError):
         RayBatch.from_arrays([[0.0, 0.0, 0.0]], [[0, 0, 0]])
+
+
+def test_trace_path_keeps_every_hit_and_ends_where_the_full_trace_ends(dgauss):
+    # surface-by-surface tracing must land where one full trace lands (same kernel, same
+    # numbers), and each recorded hit must sit on its surface (vertex z for the flat stop)
+    import numpy as np
+
+    from physcam.trace import trace_path
+
+    rays = RayBatch.collimated([0.0, 3.0, -5.0], [0.0, 4.0, 6.0], -5.0)
+    pts, out = trace_path(dgauss, rays, end_z=70.0)
+    full = trace_to_film(dgauss, rays, 70.0, backend="numpy")
+    assert pts.shape == (len(dgauss.surfaces) + 2, 3, 3)
+    np.testing.assert_allclose(pts[-1], np.stack([full.x, full.y, full.z], axis=1), atol=1e-12)
+    assert (out.flag == full.flag).all()
+    k = dgauss.stop_index
+    np.testing.assert_allclose(pts[k + 1, :, 2], dgauss.vertex_z[k], atol=1e-12)

@@ -29,66 +29,37 @@ __all__ = ["DIAGRAM_FORMATS", "trace_meridional_ray", "LensDiagram", "lens_diagr
 DIAGRAM_FORMATS = ("png", "svg", "pdf")
 
 
-def _sag_slope(surface, h: float, axis: str) -> float:
-    e = 1e-6 * max(1.0, abs(h))
-    return (sag(surface, h + e, axis) - sag(surface, h - e, axis)) / (2 * e)
-
-
 def trace_meridional_ray(prescription: Prescription, y0: float, z0: float, dy: float, dz: float, *, axis: str = "y",
                          wavelength_nm=None, film_z: float | None = None):
-    """Trace a real ray in the meridian plane; return its polyline [(z, y), ...].
+    """Trace a real ray in the meridian plane; return its polyline [(z, height), ...].
 
-    The ray starts at (z0, y0) with direction (dz, dy) in object space (air) and
-    is refracted at every surface; the stop clips it. It ends at the film plane
-    (``film_z``) or where it is vignetted, misses a surface or is totally reflected.
+    The ray starts at (z0, y0) with direction (dz, dy) in object space and goes through the
+    tracer (:func:`physcam.trace.trace_path`). The polyline ends at the film plane
+    (``film_z``), or at the surface whose clear aperture blocks the ray, or where it misses a
+    surface or is totally reflected.
     """
-    n = paraxial.media_indices(prescription, wavelength_nm)
-    norm = math.hypot(dy, dz)
-    dy, dz = dy / norm, dz / norm
-    z, y = float(z0), float(y0)
-    pts = [(z, y)]
-    zv = prescription.vertex_z
-    for i, s in enumerate(prescription.surfaces):
-        if abs(dz) < 1e-12:
-            return pts
-        # intersection: solve z + t dz = zv + sag(y + t dy) by Newton from the vertex plane
-        t = (zv[i] - z) / dz
-        for _ in range(30):
-            h = y + t * dy
-            f = z + t * dz - zv[i] - sag(s, h, axis)
-            fp = dz - _sag_slope(s, h, axis) * dy
-            if abs(fp) < 1e-12:
-                return pts
-            step = f / fp
-            t -= step
-            if abs(step) < 1e-10:
-                break
-        else:
-            return pts
-        h = y + t * dy
-        if not math.isfinite(h) or t < -1e-9:
-            return pts
-        z, y = z + t * dz, h
-        pts.append((z, y))
-        if abs(h) > s.semi_diameter * (1 + 1e-9):
-            return pts  # vignetted by this surface's clear aperture
-        if s.is_stop or s.kind == "flat" and n[i] == n[i + 1]:
-            continue
-        # unit normal (nz, ny) of z - sag(h) = const, pointing toward +z
-        m = _sag_slope(s, h, axis)
-        nz, ny = 1.0 / math.hypot(1.0, m), -m / math.hypot(1.0, m)
-        mu = n[i] / n[i + 1]
-        cos_i = dz * nz + dy * ny
-        k = 1.0 - mu * mu * (1.0 - cos_i * cos_i)
-        if k < 0:
-            return pts  # total internal reflection
-        g = math.sqrt(k) - mu * cos_i
-        dz, dy = mu * dz + g * nz, mu * dy + g * ny
-    if film_z is not None and abs(dz) > 1e-12:
-        t = (film_z - z) / dz
-        if t > 0:
-            pts.append((film_z, y + t * dy))
-    return pts
+    import numpy as np
+
+    from ..trace import OK, RayBatch, trace_path
+
+    wl = prescription.wavelength_nm if wavelength_nm is None else wavelength_nm
+    pos = [[0.0, y0, z0]] if axis == "y" else [[y0, 0.0, z0]]
+    d = [[0.0, dy, dz]] if axis == "y" else [[dy, 0.0, dz]]
+    rays = RayBatch.from_arrays(pos, d, wl)
+    # unclipped, to draw the ray up to the surface that stops it; a lost ray repeats its last point
+    pts, out = trace_path(prescription, rays, end_z=film_z, clip=False)
+    h = pts[:, 0, 1] if axis == "y" else pts[:, 0, 0]
+    z = pts[:, 0, 2]
+    poly = [(float(z[0]), float(h[0]))]
+    for k, surf in enumerate(prescription.surfaces, start=1):
+        if (z[k], h[k]) == (z[k - 1], h[k - 1]) and out.flag[0] != OK:
+            return poly  # missed or totally reflected here
+        poly.append((float(z[k]), float(h[k])))
+        if abs(h[k]) > surf.semi_diameter * (1 + 1e-9):
+            return poly  # vignetted by this surface's clear aperture
+    if film_z is not None and out.flag[0] == OK and np.isfinite(z[-1]):
+        poly.append((float(z[-1]), float(h[-1])))
+    return poly
 
 
 @dataclass

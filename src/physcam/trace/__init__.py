@@ -5,9 +5,9 @@ traces a :class:`.rays.RayBatch` (numba JIT or numpy), :mod:`.trace` is the publ
 """
 
 from .rays import CLIPPED, MISSED, OK, TIR, RayBatch
-from .trace import CameraRays, camera_rays, paraxial_image_z, trace_through, trace_to_film
+from .trace import CameraRays, camera_rays, paraxial_image_z, trace_path, trace_through, trace_to_film
 
 __all__ = [
     "OK", "MISSED", "CLIPPED", "TIR", "RayBatch",
-    "CameraRays", "camera_rays", "paraxial_image_z", "trace_through", "trace_to_film",
+    "CameraRays", "camera_rays", "paraxial_image_z", "trace_path", "trace_through", "trace_to_film",
 ]

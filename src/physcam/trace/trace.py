@@ -18,7 +18,8 @@ from .kernels._layout import pack, set_wavelength
 from .rays import CLIPPED, OK, RayBatch
 from .surfaces import surface_table
 
-__all__ = ["DEFAULT_CHUNK", "trace_to_film", "trace_through", "paraxial_image_z", "CameraRays", "camera_rays"]
+__all__ = ["DEFAULT_CHUNK", "trace_to_film", "trace_through", "trace_path", "paraxial_image_z", "CameraRays",
+           "camera_rays"]
 
 #: Rays per kernel call: bounds the numpy kernel's temporaries (about 40 arrays of this size).
 DEFAULT_CHUNK = 1 << 18
@@ -96,6 +97,41 @@ def trace_through(
     out.weight[blocked] = 0.0
     return trace_packed(kernel, out, S[k + 1 :], kinds[k + 1 :], clip=clip, fresnel=fresnel, end_z=end_z,
                 chunk_size=chunk_size)
+
+
+def trace_path(
+    lens: Prescription,
+    rays: RayBatch,
+    *,
+    end_z: float | None = None,
+    clip: bool = True,
+    stop_semi_diameter: float | None = None,
+    backend: str = "numpy",
+) -> tuple[np.ndarray, RayBatch]:
+    """Trace ``rays`` front to back one surface at a time, keeping every intersection.
+
+    Returns ``(points, rays)``: ``points`` has shape (surfaces + 1 [+ 1 with ``end_z``], n, 3),
+    the start and each hit point (a lost ray repeats its last point), and the rays as they
+    leave (flags tell which were lost, and :data:`OK` ones went through every surface). For a
+    handful of rays (diagrams), not for throughput: the kernel runs once per surface.
+    """
+    _check_lens(lens)
+    table = surface_table(lens, stop_semi_diameter=stop_semi_diameter)
+    S, kinds = pack(table)
+    kernel = get_kernel(backend)
+    out = rays.copy()
+    pts = [np.stack([out.x, out.y, out.z], axis=1)]
+    for k in range(S.shape[0]):
+        trace_packed(kernel, out, S[k:k + 1], kinds[k:k + 1], clip=clip, fresnel=False, end_z=None)
+        pts.append(np.stack([out.x, out.y, out.z], axis=1))
+    if end_z is not None:
+        live = out.flag == OK
+        end = out.take(live)
+        trace_packed(kernel, end, S[:0], kinds[:0], clip=clip, fresnel=False, end_z=require_finite("end_z", end_z))
+        last = pts[-1].copy()
+        last[live] = np.stack([end.x, end.y, end.z], axis=1)
+        pts.append(last)
+    return np.stack(pts), out
 
 
 def trace_to_film(
