@@ -214,3 +214,12 @@ def focus_table(f: dict, surfaces, text: str, path, rows_key: str) -> Focus:
         t_inf = number(g.get("thickness_infinity", surfaces[s].thickness), "thickness_infinity", path, ln)
         gaps.append(VariableGap(s, t_inf, number(g["thickness_close"], "thickness_close", path, ln)))
     return Focus(close, tuple(gaps))
+
+
+def surface_rows(doc: dict, text: str, path) -> tuple[list, list[int | None]]:
+    """The ``[[surface]]`` tables of a TOML lens and the file line of each (for error messages)."""
+    rows = doc.get("surface")
+    if not isinstance(rows, list):
+        raise LensFileError("no [[surface]] tables", path)
+    check_count(len(rows), path)
+    return rows, table_lines(text, "surface", len(rows))

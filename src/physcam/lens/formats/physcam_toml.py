@@ -28,12 +28,11 @@ from ..catalog import find_glass
 from ..prescription import AIR, SURFACE_KINDS, Focus, LensMetadata, Medium, Prescription, Surface
 from ._common import (
     MAX_SURFACES,
-    check_count,
     focus_table,
+    surface_rows,
     number,
     parse_toml,
     table,
-    table_lines,
     text_field,
     toml_key,
     toml_value,
@@ -87,11 +86,7 @@ def loads_document(doc: dict, text: str, path=None, name: str | None = None) -> 
         raise LensFileError(f"format {tag!r} is not {FORMAT_TAG!r}", path, 1)
     lens = table(doc.get("lens", {}), "[lens]", path)
     unknown_keys(lens, LENS_KEYS, "[lens]", path)
-    rows = doc.get("surface")
-    if not isinstance(rows, list):
-        raise LensFileError("no [[surface]] tables", path)
-    check_count(len(rows), path)
-    lines = table_lines(text, "surface", len(rows))
+    rows, lines = surface_rows(doc, text, path)
     surfaces = []
     for i, row in enumerate(rows):
         ln = lines[i]

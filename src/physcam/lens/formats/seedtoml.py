@@ -26,13 +26,12 @@ from ...errors import ExportError, LensFileError, PhysCamWarning
 from ..prescription import AIR, Focus, LensMetadata, Medium, Prescription, Surface
 from ._common import (
     MAX_SURFACES,
-    check_count,
     focus_table,
+    surface_rows,
     number,
     one_line,
     parse_toml,
     table,
-    table_lines,
     text_field,
     toml_value,
     unknown_keys,
@@ -55,11 +54,7 @@ def loads_document(doc: dict, text: str, path=None, name: str | None = None) -> 
     unknown_keys(doc, ("lens", "surface", "focus"), "top level", path)
     lens = table(doc.get("lens", {}), "[lens]", path)
     unknown_keys(lens, LENS_KEYS, "[lens]", path)
-    rows = doc.get("surface")
-    if not isinstance(rows, list):
-        raise LensFileError("no [[surface]] tables", path)
-    check_count(len(rows), path)
-    lines = table_lines(text, "surface", len(rows))
+    rows, lines = surface_rows(doc, text, path)
     surfaces = []
     for i, row in enumerate(rows):
         ln = lines[i]
