@@ -31,3 +31,32 @@ def test_kit_and_foreign_file(tmp_path, capsys):
     assert "found 0 PhysicalCamera prims" in capsys.readouterr().err
     assert main(["usd", "read", str(foreign), "--path", "/A"]) == 2
     assert "/A: is a Xform, not a PhysicalCamera" in capsys.readouterr().err
+
+
+def test_write_applies_sensor_shift_flags(tmp_path, capsys):
+    """Issue 8.1: --shift-x/--shift-y reach the file. A 2 mm right / -1.5 mm down shift on a
+    36 x 24 mm gate at metersPerUnit 0.01 is 2.0 / -1.5 tenths of a cm on the UsdGeomCamera
+    (docs/conventions.md), and the PhysicalCamera sensor shift is (2, -1.5) mm."""
+    from pxr import Usd, UsdGeom
+
+    f = tmp_path / "shift.usda"
+    assert main(["usd", "write", str(f), "--focal", "50", "--fstop", "2.8", "--focus", "3m",
+                 "--sensor-width", "36", "--sensor-height", "24", "--shift-x", "2", "--shift-y=-1.5"]) == 0
+    stage = Usd.Stage.Open(str(f))
+    geom = [UsdGeom.Camera(p) for p in stage.Traverse() if p.IsA(UsdGeom.Camera)]
+    assert len(geom) == 1
+    assert geom[0].GetHorizontalApertureOffsetAttr().Get() == 2.0
+    assert geom[0].GetVerticalApertureOffsetAttr().Get() == -1.5
+    capsys.readouterr()
+    assert main(["usd", "read", str(f), "--json"]) == 0
+    cam = json.loads(capsys.readouterr().out)["usd"]["camera"]
+    assert cam["shift_mm"] == [2.0, -1.5]
+
+
+def test_write_refuses_zero_fps_without_traceback(tmp_path, capsys):
+    """Issue 8: `usd write ... --fps 0` raised ZeroDivisionError; now one line and exit 2."""
+    f = tmp_path / "fps.usda"
+    assert main(["usd", "write", str(f), "--focal", "35", "--fstop", "2.8", "--focus", "3m", "--fps", "0"]) == 2
+    err = capsys.readouterr().err
+    assert "frames per second" in err and "Traceback" not in err
+    assert not f.exists()

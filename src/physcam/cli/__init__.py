@@ -6,6 +6,7 @@ adding a module. Handlers import heavy libraries (numpy, matplotlib, USD) inside
 their bodies so ``physcam --help`` and ``physcam report`` start fast.
 
 Errors: a :class:`~physcam.errors.PhysCamError` prints one line on stderr and exits 2;
+a failing standard output (disk full) prints one line and exits 2; a closed pipe exits 0;
 anything else is a bug and shows a traceback (exit 1).
 """
 
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import pkgutil
 import sys
 
@@ -51,14 +53,29 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush cannot fail a second time."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit status (0 done, 2 refused input or unwritable output)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, usage errors: argparse has printed its line
+        return exc.code if isinstance(exc.code, int) else 2
     if not getattr(args, "handler", None):
         parser.print_help()
         return 0
     try:
-        return int(args.handler(args) or 0)
+        rc = int(args.handler(args) or 0)
+        sys.stdout.flush()  # a full disk or closed pipe shows here, inside the error handling
+        return rc
     except PhysCamError as exc:
         msg = str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__
         print(f"physcam: error: {msg}", file=sys.stderr)
@@ -66,8 +83,16 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("physcam: interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:
+    except BrokenPipeError:  # `physcam lenses | head`: the reader has gone, nothing is wrong
+        _silence_stdout()
         return 0
+    except OSError as exc:
+        if exc.errno is None or getattr(exc, "filename", None) is not None:
+            raise
+        # the output stream itself failed (e.g. `physcam lenses > /dev/full`)
+        _silence_stdout()
+        print(f"physcam: error: cannot write the output: {exc.strerror or exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":  # pragma: no cover

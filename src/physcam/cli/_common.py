@@ -24,7 +24,9 @@ def distance(name: str, allow_inf: bool = False):
     return parse
 
 
-def number(name: str):
+def number(name: str, *, positive: bool = False, lo: float | None = None, hi: float | None = None):
+    """An argparse type reading a finite number; ``positive`` requires > 0, ``lo``/``hi`` bound it."""
+
     def parse(text):
         try:
             v = float(text)
@@ -32,6 +34,10 @@ def number(name: str):
             raise argparse.ArgumentTypeError(f"{name} must be a number, got {text!r}") from None
         if not math.isfinite(v):
             raise argparse.ArgumentTypeError(f"{name} must be a finite number, got {text!r}")
+        if positive and not v > 0:
+            raise argparse.ArgumentTypeError(f"{name} must be greater than 0, got {text!r}")
+        if (lo is not None and v < lo) or (hi is not None and v > hi):
+            raise argparse.ArgumentTypeError(f"{name} must lie between {lo:g} and {hi:g}, got {text!r}")
         return v
 
     parse.__name__ = name

@@ -27,10 +27,11 @@ def register(sub) -> None:
     lsub = lens.add_subparsers(dest="lens_command", metavar="ACTION")
     lens.set_defaults(handler=lambda args: (lens.print_help(), 0)[1])
 
-    def common(q, fstop=True):
+    def common(q, fstop=True, focus=True):
         q.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
-        q.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=float("inf"),
-                       help="focus mark from the film plane, e.g. 2m, 6ft, inf (default inf)")
+        if focus:
+            q.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=float("inf"),
+                           help="focus mark from the film plane, e.g. 2m, 6ft, inf (default inf)")
         if fstop:
             q.add_argument("--fstop", type=number("f-number"), default=None,
                            help="evaluate the pupils at this f-number (default: the stop in the file)")
@@ -56,10 +57,10 @@ def register(sub) -> None:
     d.set_defaults(handler=run_diagram)
 
     b = lsub.add_parser("breathing", help="focal length and field of view against focus (table, optional plot)")
-    common(b, fstop=False)
-    b.set_defaults(focus=None)
-    b.add_argument("--at", type=distance("focus distance", allow_inf=True), nargs="+", default=None, metavar="D",
-                   help="focus marks from the film plane (default: infinity down to the closest focus)")
+    common(b, fstop=False, focus=False)
+    b.add_argument("--at", "--focus", dest="at", type=distance("focus distance", allow_inf=True), nargs="+",
+                   default=None, metavar="D",
+                   help="focus marks from the film plane, one or more (default: infinity down to the closest focus)")
     g = b.add_mutually_exclusive_group()
     g.add_argument("--sensor", default=None, help="sensor name for the horizontal width (see `physcam sensors`)")
     g.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="W",

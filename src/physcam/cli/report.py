@@ -83,15 +83,17 @@ def resolve_sensor(args):
     from ..errors import InputError
     from ..onset.sensors import Sensor, find_sensor
 
-    if args.sensor and (args.sensor_width or args.sensor_height):
+    custom = args.sensor_width is not None or args.sensor_height is not None
+    if args.sensor is not None and custom:
         raise InputError("give either --sensor NAME or --sensor-width/--sensor-height, not both")
-    if args.sensor:
+    if args.sensor is not None:
         return find_sensor(args.sensor)
-    if args.sensor_width or args.sensor_height:
-        if not (args.sensor_width and args.sensor_height):
+    if custom:
+        if args.sensor_width is None or args.sensor_height is None:
             raise InputError("give both --sensor-width and --sensor-height")
-        if args.sensor_width <= 0 or args.sensor_height <= 0:
-            raise InputError("sensor width and height must be greater than 0 mm")
+        if not (0 < args.sensor_width <= 1000 and 0 < args.sensor_height <= 1000):
+            raise InputError(f"sensor width and height must lie between 0 and 1000 mm, got "
+                             f"{args.sensor_width:g} x {args.sensor_height:g} mm")
         return Sensor("custom", f"custom {args.sensor_width:g} x {args.sensor_height:g} mm",
                       args.sensor_width, args.sensor_height)
     return find_sensor("Super 35")

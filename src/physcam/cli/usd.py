@@ -61,7 +61,7 @@ def _stage_args(p, units: bool = True) -> None:
     if units:
         p.add_argument("--meters-per-unit", type=number("metersPerUnit"), default=0.01,
                        help="stage metersPerUnit (default 0.01: centimetres)")
-    p.add_argument("--fps", type=number("frames per second"), default=24.0, help="timeCodesPerSecond (default 24)")
+    p.add_argument("--fps", type=number("frames per second", positive=True), default=24.0, help="timeCodesPerSecond (default 24)")
     p.add_argument("--force", action="store_true", help="overwrite an existing file")
     p.add_argument("--json", action="store_true", help="print what was written as JSON")
 
@@ -76,7 +76,8 @@ def run_write(args) -> int:
     report = solve_from_args(args)
     spec = spec_from_report(report, projection="orthographic" if args.orthographic else "perspective",
                             magnification=args.magnification, aperture_blades=args.blades,
-                            shutter_duration_s=args.shutter_angle / 360.0 / args.fps)
+                            shutter_duration_s=args.shutter_angle / 360.0 / args.fps,
+                            shift_mm=(args.shift_x, args.shift_y))
     distortion = None
     if getattr(args, "lens", None) and not args.orthographic:  # a prescription-backed report: its real distortion
         from ..lens.library import load_lens

@@ -70,6 +70,23 @@ class DepthOfField:
         }
 
 
+#: The fastest f-number a lens in air can have: N = 1 / (2 n' sin u') with sin u' <= 1 and n' = 1
+#: (Abbe sine condition; Kingslake & Johnson, *Lens Design Fundamentals*, 2nd ed., 4.3).
+MIN_F_NUMBER = 0.5
+#: The slowest f-number accepted: pinhole cameras reach f/500 or so; beyond f/4096 a typo is likelier.
+MAX_F_NUMBER = 4096.0
+
+
+def _require_f_number(name: str, value) -> float:
+    """``value`` as a float between :data:`MIN_F_NUMBER` and :data:`MAX_F_NUMBER`, else InputError."""
+    v = require_positive(name, value, unit="")
+    if not MIN_F_NUMBER <= v <= MAX_F_NUMBER:
+        why = ("no lens in air is faster than f/0.5 (N = 1 / (2 sin u'), sin u' <= 1)" if v < MIN_F_NUMBER
+               else f"f-numbers above {MAX_F_NUMBER:g} are not camera apertures")
+        raise InputError(f"{name} {v:g} is out of range: {why}")
+    return v
+
+
 def _finite_or_none(v: float | None):
     return None if v is None or math.isinf(v) else v
 
@@ -245,7 +262,28 @@ def solve_lens_report(
     """
     notes: list[str] = []
     pupil_origin = "datasheet"
+    if not isinstance(sensor, Sensor):
+        raise InputError(f"sensor must be a physcam Sensor (physcam.onset.sensors.find_sensor), got "
+                         f"{type(sensor).__name__}")
+    if sensor_front_mm is not None and lens_length_mm is None:
+        raise InputError("the tape-measured sensor-to-lens-front distance needs the lens length too "
+                         "(--lens-length): the pupil estimate sits a fraction of the lens length behind its front")
+    if lens_length_mm is not None and sensor_front_mm is None:
+        raise InputError("the lens length is used only with the sensor-to-lens-front distance (--sensor-front)")
     if lens is not None:
+        from ..lens.prescription import Prescription
+
+        if not isinstance(lens, Prescription):
+            raise InputError(f"lens must be a physcam Prescription (physcam.lens.library.load_lens), got "
+                             f"{type(lens).__name__}")
+        given = [n for n, v in (("H1", h1_mm), ("H2", h2_mm), ("entrance pupil", pupil_mm),
+                                ("sensor-to-lens-front distance", sensor_front_mm)) if v is not None]
+        if given:
+            raise InputError(f"with a lens prescription the principal planes and the pupil come from the lens; "
+                             f"drop the {', '.join(given)} offset(s), or drop the lens to use a datasheet")
+        if reference_plane != "film" or flange_focal_distance_mm is not None:
+            raise InputError("with a lens prescription every plane is computed from the film; "
+                             "the flange reference applies to datasheet offsets only")
         pupil_origin = "prescription"
         from ..optics.focusing import technical_planes
 
@@ -293,8 +331,8 @@ def solve_lens_report(
     w, h = sensor.width_mm, sensor.height_mm
     coc_explicit = coc is not None
     c, coc_name = circle_of_confusion(w, h, coc)
-    N = None if fstop is None else require_positive("f-stop", fstop, unit="")
-    T = None if tstop is None else require_positive("T-stop", tstop, unit="")
+    N = None if fstop is None else _require_f_number("f-stop", fstop)
+    T = None if tstop is None else _require_f_number("T-stop", tstop)
     D = None if focus_mm is None else _require_distance("focus distance", focus_mm)
     near_m = None if near_mm is None else _require_distance("near limit", near_mm)
     far_m = None
@@ -317,6 +355,11 @@ def solve_lens_report(
         ffd = require_positive("flange focal distance", flange_focal_distance_mm)
     ref = ffd or 0.0
 
+    if model == "practical" and (h1_mm is not None or h2_mm is not None):
+        raise InputError("principal-plane offsets (--h1/--h2) belong to the technical model: add --model technical")
+    if pupil_mm is not None and sensor_front_mm is not None:
+        raise InputError("give the entrance pupil either as a datasheet offset (--pupil) or as a tape-measure "
+                         "estimate (--sensor-front/--lens-length), not both")
     if model == "technical":
         if h1_mm is None or h2_mm is None:
             raise InputError("the technical model needs --h1 and --h2 (principal planes from the reference plane)")
@@ -422,6 +465,9 @@ def solve_lens_report(
     for name, v in (("f-stop", N), ("circle of confusion", c)):
         if not (math.isfinite(v) and v > 0):
             raise InputError(f"the measured limits give an impossible {name} ({v:g}); check --near, --far and --focus")
+    if N < MIN_F_NUMBER:
+        raise InputError(f"the measured limits need f/{N:.3g}, faster than any lens in air can be "
+                         f"(f/{MIN_F_NUMBER:g}); check --near, --far, --focus and the CoC")
     if T is not None:
         solved["tstop_drift_stops"] = _dof.stops_between(N, T)
         if T < N - 1e-9:
@@ -463,7 +509,7 @@ def solve_lens_report(
 
     # --- entrance pupil -----------------------------------------------------------
     pupil, pupil_src = None, "unknown"
-    if model == "technical" and pupil_mm is not None:
+    if pupil_mm is not None:  # a datasheet pupil (either model), or the prescription's
         pupil, pupil_src = ref + require_finite("entrance pupil offset", pupil_mm), pupil_origin
     elif sensor_front_mm is not None and lens_length_mm is not None:
         pupil = entrance_pupil_practical(sensor_front_mm, lens_length_mm, pupil_fraction)

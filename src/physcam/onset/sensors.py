@@ -76,14 +76,30 @@ def _index() -> dict[str, Sensor]:
     return idx
 
 
+#: Names of camera families rather than of one sensor: refused with the family's members, so a
+#: bare "ALEXA" never quietly becomes the 2010 camera's 16:9 gate (issue 8).
+FAMILY_NAMES = {"alexa": "ALEXA", "arri": "ALEXA", "arriflex": "ALEXA"}
+
+
 def find_sensor(name: str) -> Sensor:
     """The sensor called ``name`` (key, full name or alias; case and punctuation ignored).
+
+    A camera family name ("ALEXA") is refused with the sensors of that family.
 
     >>> find_sensor("alexa 35").width_mm
     27.99
     """
+    if not isinstance(name, str):
+        raise SensorError(f"a sensor name must be text, got {type(name).__name__}")
     idx = _index()
     key = _norm(name)
+    if not key:
+        raise SensorError("the sensor name is empty. `physcam sensors` lists them all")
+    if key in FAMILY_NAMES:
+        fam = _norm(FAMILY_NAMES[key])
+        members = [s.name for s in sensors() if fam in _norm(s.name)]
+        raise SensorError(f"{name!r} names a camera family, not one sensor: give one of "
+                          + "; ".join(repr(m) for m in members))
     if key in idx:
         return idx[key]
     labels = {}

@@ -1,0 +1,96 @@
+"""Issue 8 ("trust first"): each reported crash or silently ignored input, reproduced through the
+real CLI. Every case must end with exit 0 (it acted) or exit 2 and one line on stderr saying why;
+never a traceback."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from physcam.cli import main
+
+
+def run_cli(*argv, stdout=subprocess.PIPE):
+    """Run ``python -m physcam`` as a user would; returns (rc, stdout, stderr)."""
+    p = subprocess.run([sys.executable, "-m", "physcam", *argv], stdout=stdout, stderr=subprocess.PIPE,
+                       text=True, env=dict(os.environ, COLUMNS="200"))
+    return p.returncode, p.stdout, p.stderr
+
+
+def one_line_error(rc, err):
+    assert rc == 2, err
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("physcam: error:"), err
+    return lines[0]
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="/dev/full exists on Linux only")
+def test_full_disk_on_stdout_is_one_line_and_exit_2():
+    with open("/dev/full", "w") as full:
+        rc, _, err = run_cli("lenses", stdout=full)
+    assert "No space left" in one_line_error(rc, err)
+
+
+def test_closed_pipe_is_not_an_error():
+    p1 = subprocess.Popen([sys.executable, "-m", "physcam", "lenses"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p1.stdout.read(10)
+    p1.stdout.close()
+    err = p1.stderr.read().decode()
+    assert p1.wait() == 0 and "Traceback" not in err and "Exception ignored" not in err
+
+
+def run_in(capsys, *argv):
+    rc = main(list(argv))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+@pytest.mark.parametrize("argv, says", [
+    # a zero sensor quietly became Super 35
+    (["--sensor-width", "0", "--sensor-height", "0"], "sensor width and height must lie between 0 and 1000"),
+    # --sensor-front without --lens-length was ignored
+    (["--sensor-front", "30cm"], "needs the lens length"),
+    (["--lens-length", "12cm"], "only with the sensor-to-lens-front"),
+    # practical-model --h1/--h2 were ignored
+    (["--h1", "80"], "--model technical"),
+    # f/0.1 was accepted without a word; 5e-324 crashed with ZeroDivisionError
+    (["--fstop", "0.1"], "f/0.5"),
+    (["--tstop", "0.2"], "T-stop 0.2 is out of range"),
+    # "ALEXA" resolved to the 2010 camera's 16:9 gate without saying so
+    (["--sensor", "ALEXA"], "camera family"),
+])
+def test_report_refuses_what_it_would_have_ignored(capsys, argv, says):
+    base = ["report", "--focal", "50", "--focus", "3m"] + ([] if "--fstop" in argv else ["--fstop", "2.8"])
+    rc, _, err = run_in(capsys, *base, *argv)
+    assert says in one_line_error(rc, err)
+
+
+def test_report_tiny_fstop_is_refused_not_a_traceback():
+    rc, _, err = run_cli("report", "--focal", "50", "--fstop", "5e-324", "--focus", "3m")
+    assert "out of range" in one_line_error(rc, err)
+
+
+def test_report_with_lens_refuses_datasheet_planes(capsys):
+    rc, _, err = run_in(capsys, "report", "--lens", "dgauss_50mm", "--focus", "2m", "--h1", "80", "--h2", "60",
+                        "--model", "technical")
+    assert "come from the lens" in one_line_error(rc, err)
+
+
+def test_lens_breathing_focus_acts(capsys):
+    """`lens breathing --focus` was parsed and dropped; it now gives the marks of the table.
+    Breathing at a mark must match `lens show --focus` at the same mark (the same optics)."""
+    import json
+
+    rc, out, _ = run_in(capsys, "lens", "breathing", "dgauss_50mm", "--focus", "2m", "--json")
+    assert rc == 0
+    rows = json.loads(out)["rows"] if isinstance(json.loads(out), dict) else json.loads(out)
+    assert len(rows) == 1
+    row = rows[0]
+    assert row["focus_from_film_mm"] == 2000.0
+    rc, out, _ = run_in(capsys, "lens", "show", "dgauss_50mm", "--focus", "2m", "--json")
+    show = json.loads(out)
+    assert row["back_focus_mm"] == pytest.approx(show["focus"]["back_focus_mm"], abs=1e-6)
