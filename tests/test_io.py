@@ -34,3 +34,36 @@ def test_no_clobber_and_no_temporary_left(tmp_path):
         atomic_write(p, "two")
     assert p.read_text() == "one"
     assert sorted(f.name for f in tmp_path.iterdir()) == ["a.txt"]
+
+
+def _race_writer(args):
+    """One of several processes writing the same new file at once (issue 8: no-clobber race)."""
+    import time
+
+    from physcam.errors import ExportError
+    from physcam.io import atomic_write
+
+    path, tag, start = args
+    while time.time() < start:  # all processes leave the gate together
+        pass
+    try:
+        atomic_write(path, f"written by {tag}\n" * 2000)
+        return tag
+    except ExportError as exc:
+        assert "already exists" in str(exc)
+        return None
+
+
+def test_concurrent_no_clobber_writers_have_exactly_one_winner(tmp_path):
+    import multiprocessing as mp
+    import time
+
+    ctx = mp.get_context("fork")
+    with ctx.Pool(8) as pool:
+        for trial in range(25):
+            path = tmp_path / f"race{trial}.usda"
+            start = time.time() + 0.05
+            winners = [w for w in pool.map(_race_writer, [(str(path), k, start) for k in range(8)]) if w is not None]
+            assert len(winners) == 1, f"trial {trial}: {len(winners)} writers reported success"
+            assert path.read_text() == f"written by {winners[0]}\n" * 2000
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]  # no temporary left behind
