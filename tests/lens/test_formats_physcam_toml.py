@@ -24,7 +24,7 @@ def lenses(draw):
         r = draw(st.floats(40.0, 1e4)) * draw(st.sampled_from([-1, 1]))
         kind = draw(st.sampled_from(["spherical", "aspheric", "cylindrical_x", "cylindrical_y", "flat"]))
         medium = draw(st.sampled_from([AIR, Medium(1.5168, 64.17, "N-BK7"),
-                                       Medium(draw(st.floats(1.0, 2.0)), draw(st.floats(0.0, 90.0)))]))
+                                       Medium(draw(st.floats(1.0, 2.0)), draw(st.just(0.0) | st.floats(15.0, 90.0)))]))
         conic, asph = 0.0, ()
         if kind == "aspheric":
             conic = draw(st.floats(-2.0, 0.5))

@@ -124,3 +124,23 @@ def test_windows_code_page_file_is_read(tmp_path):
 
 def test_writer_says_sequential_mode():
     assert "MODE SEQ" in dumps_lens(loads_lens(SINGLET, "zemax", path="s.zmx"), "zemax").splitlines()[:3]
+
+
+@pytest.mark.parametrize("slug", ["dgauss_50mm", "zeiss_distagon_35mm_f4", "canon_rf_85mm_f1_2"])
+def test_a_truncated_file_is_an_error_never_another_lens(slug):
+    """Issue 8.8: a .zmx cut anywhere (mid-surface, or before the image surface) loaded as a
+    different lens (EFL -53 mm). Cut a real lens's file after every line: each cut either
+    raises LensFileError or, when only lines after the image surface's data were lost, reads
+    back the very same surfaces."""
+    lens = load_lens(slug)
+    text = dumps_lens(lens, "zemax")
+    whole = loads_lens(text, "zemax").surfaces
+    lines = text.splitlines(keepends=True)
+    first_surf = next(i for i, ln in enumerate(lines) if ln.startswith("SURF"))
+    for cut in range(first_surf + 1, len(lines)):
+        part = "".join(lines[:cut])
+        try:
+            got = loads_lens(part, "zemax", "cut.zmx").surfaces
+        except LensFileError:
+            continue
+        assert got == whole, f"cut after line {cut} ({lines[cut - 1].strip()!r}) loads as another lens"

@@ -32,6 +32,14 @@ def test_good_lens_passes():
     (lambda s: s.__setitem__(0, Surface(float("nan"), 5.0, GLASS, 10.0)), "NaN"),
     (lambda s: s.__setitem__(0, Surface(50.0, 5.0, GLASS, 10.0, conic=-1.0)), "not marked aspheric"),
     (lambda s: s.__setitem__(0, Surface(0.0, 5.0, GLASS, 10.0, kind="cylindrical_x")), "needs a non-zero radius"),
+    # issue 8: physical bounds, so no huge number reaches the optics (index 1e20 in a pbrt file,
+    # 1e308 on a stop row printed nan and EFL 0)
+    (lambda s: s.__setitem__(0, Surface(50.0, 5.0, Medium(1e20, 0.0), 10.0)), "between 1 and 5"),
+    (lambda s: s.__setitem__(2, Surface(0.0, 40.0, Medium(1e308, 0.0), 5.0, kind="stop")), "between 1 and 5"),
+    (lambda s: s.__setitem__(0, Surface(50.0, 5.0, Medium(1.5, 1.0), 10.0)), "Abbe number"),
+    (lambda s: s.__setitem__(0, Surface(50.0, 1e6, GLASS, 10.0)), "beyond any camera lens"),
+    (lambda s: s.__setitem__(0, Surface(50.0, 5.0, GLASS, 10.0, "aspheric", conic=1e9)), "conic constant"),
+    (lambda s: s.__setitem__(0, Surface(50.0, 5.0, GLASS, 10.0, "aspheric", aspheric=(1e300,))), "sag at the rim"),
 ])
 def test_broken_lens_message(mutate, message):
     s = good()

@@ -37,6 +37,15 @@ SURFACE_KINDS = ("spherical", "flat", "stop", "aspheric", "cylindrical_x", "cyli
 #: Highest even-asphere term kept: A4, A6, ..., A16 (7 coefficients).
 MAX_ASPHERIC_TERMS = 7
 
+#: Physical bounds on a prescription's numbers (issue 8: no input may push NaN or inf through the
+#: optics). Refractive indices of transmitting media lie between 1 (vacuum) and about 4 (germanium
+#: in the infrared); optical glasses have Abbe numbers from about 17 to 95 (SCHOTT, OHARA
+#: catalogues), 0 marks a medium treated as non-dispersive; no camera lens part is 100 m long.
+MAX_INDEX = 5.0
+MIN_ABBE, MAX_ABBE = 5.0, 200.0
+MAX_LENGTH_MM = 1.0e5
+MAX_CONIC = 1.0e4
+
 
 @dataclass(frozen=True, slots=True)
 class Medium:
@@ -203,8 +212,9 @@ class Prescription:
         """Check the lens is buildable; raise :class:`LensFileError` naming the surface.
 
         ``lines`` (optional) maps each surface to the file line it came from, so the
-        error points there. Checks: at least one surface, finite numbers, exactly one
-        stop, positive semi-diameters that fit on their sphere, indices >= 1, no
+        error points there. Checks: at least one surface, finite numbers within physical
+        bounds (:data:`MAX_INDEX`, :data:`MIN_ABBE`..:data:`MAX_ABBE`, :data:`MAX_LENGTH_MM`,
+        :data:`MAX_CONIC`), exactly one stop, positive semi-diameters that fit on their sphere, no
         negative gaps, neighbouring surfaces that do not cross inside their apertures,
         focus gaps that exist and are air.
         """
@@ -231,10 +241,20 @@ class Prescription:
                 raise fail(f"unknown surface type {s.kind!r}; use one of {', '.join(SURFACE_KINDS)}", i)
             if s.semi_diameter <= 0:
                 raise fail(f"clear semi-diameter must be > 0 mm, got {s.semi_diameter:g}", i)
-            if s.medium.nd < 1.0:
-                raise fail(f"refractive index after the surface must be >= 1, got {s.medium.nd:g}", i)
-            if s.medium.vd < 0:
-                raise fail(f"Abbe number must be >= 0, got {s.medium.vd:g}", i)
+            if not 1.0 <= s.medium.nd <= MAX_INDEX:
+                raise fail(f"refractive index after the surface must lie between 1 and {MAX_INDEX:g} "
+                           f"(optical glass is below 2.2, germanium 4), got {s.medium.nd:g}", i)
+            if not (s.medium.vd == 0.0 or MIN_ABBE <= s.medium.vd <= MAX_ABBE):
+                raise fail(f"Abbe number must be 0 (no dispersion) or between {MIN_ABBE:g} and {MAX_ABBE:g}, "
+                           f"got {s.medium.vd:g}", i)
+            for what, v in (("radius", s.radius), ("thickness", s.thickness), ("semi-diameter", s.semi_diameter)):
+                if abs(v) > MAX_LENGTH_MM:
+                    raise fail(f"{what} {v:g} mm is beyond any camera lens (at most {MAX_LENGTH_MM:g} mm)", i)
+            if abs(s.conic) > MAX_CONIC:
+                raise fail(f"conic constant {s.conic:g} is beyond +-{MAX_CONIC:g}", i)
+            rim = [abs(a) * s.semi_diameter ** (2 * k + 4) for k, a in enumerate(s.aspheric)]
+            if any(not (v <= MAX_LENGTH_MM) for v in rim):
+                raise fail(f"an aspheric term adds more than {MAX_LENGTH_MM:g} mm of sag at the rim", i)
             if s.thickness < 0 and not (i == len(self.surfaces) - 1):
                 raise fail(f"negative axial gap {s.thickness:g} mm", i)
             if s.kind in ("cylindrical_x", "cylindrical_y", "aspheric") and s.radius == 0:

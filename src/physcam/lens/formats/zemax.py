@@ -13,6 +13,8 @@ an r^2 asphere term, non-zero object-space index) is refused with file and line;
 bookkeeping lines (``VERS``, ``MODE``, ``FLOA``, ``WAVL``, ...) are ignored. Source:
 Zemax OpticStudio user manual, "ZMX file format" / "Even Asphere" surface. Files may be
 UTF-8, UTF-16 with a byte-order mark, or the Windows code page OpticStudio writes ("ANSI").
+A file cut short (a block without CURV/DISZ, an "image" with a thickness or glass after it,
+glass before the image) is refused rather than read as a shorter, different lens.
 
 The radius is read back as the shortest decimal whose reciprocal is the file's CURV,
 so a radius written by :func:`dumps` (``CURV`` = 1/R to 17 digits) reads back equal.
@@ -67,7 +69,7 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
             if len(tok) < 2:
                 raise LensFileError("SURF needs a surface number", path, lineno)
             cur = {"line": lineno, "type": "STANDARD", "curv": 0.0, "disz": 0.0, "glass": None, "diam": None,
-                   "stop": False, "coni": 0.0, "parm": {}}
+                   "stop": False, "coni": 0.0, "parm": {}, "seen": set(), "number": tok[1]}
             blocks.append(cur)
             if len(blocks) > MAX_SURFACES + 2:
                 raise LensFileError(f"more than {MAX_SURFACES} surfaces is refused", path, lineno)
@@ -84,6 +86,7 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
             continue
         if cur is None:
             continue  # header lines before the first surface
+        cur["seen"].add(key)
         if key == "TYPE":
             t = tok[1].upper() if len(tok) > 1 else ""
             if t not in ("STANDARD", "EVENASPH"):
@@ -123,6 +126,7 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
             raise LensFileError(f"unrecognised line {raw.strip()[:40]!r}", path, lineno)
     if len(blocks) < 3:
         raise LensFileError("a sequential lens needs an object surface, lens surfaces and an image surface", path)
+    _check_complete(blocks, path)
     obj, lens_blocks = blocks[0], blocks[1:-1]
     if obj["glass"] is not None and obj["glass"] != AIR:
         raise LensFileError("the object space must be air", path, obj.get("glass_line", obj["line"]))
@@ -165,6 +169,29 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
         name = lens_name or (Path(path).stem if path is not None else "unnamed lens")
     meta = LensMetadata(name=name, notes="\n".join(notes) or None)
     return validated(Prescription(tuple(surfaces), meta), path, lines)
+
+
+def _check_complete(blocks, path) -> None:
+    """Refuse a file cut short: a truncated file must not load as another lens (issue 8).
+
+    OpticStudio writes ``CURV`` and ``DISZ`` in every ``SURF`` block, object and image included;
+    the image surface is the last block, in air, with nothing after it (``DISZ 0``); the light
+    reaches it through air. A block missing those lines, an "image" with a thickness or a glass
+    after it, or glass before it means the file ends inside the lens.
+    """
+    hint = "the file seems cut short (truncated); save the whole lens again"
+    for b in blocks:
+        missing = [k for k in ("CURV", "DISZ") if k not in b["seen"]]
+        if missing:
+            raise LensFileError(f"SURF {b['number']} has no {' or '.join(missing)} line: {hint}", path, b["line"])
+    image, last = blocks[-1], blocks[-2]
+    if image["disz"] != 0.0 or (image["glass"] is not None and image["glass"] != AIR):
+        raise LensFileError(f"the last surface, SURF {image['number']}, is not an image surface (it has "
+                            f"{'a thickness' if image['disz'] != 0.0 else 'glass'} after it): {hint}",
+                            path, image["line"])
+    if last["glass"] is not None and last["glass"] != AIR:
+        raise LensFileError(f"SURF {last['number']} is followed by glass, yet the next surface is the last "
+                            f"(the image cannot lie in glass): {hint}", path, last["line"])
 
 
 def _num(tok, k, what, path, lineno, *, length=True) -> float:
