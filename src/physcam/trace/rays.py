@@ -68,9 +68,11 @@ class RayBatch:
         w = np.broadcast_to(np.asarray(weight, dtype=np.float64), (n,)).copy()
         if not (np.isfinite(w).all() and (w >= 0).all()):
             raise InputError("ray weights must be finite and >= 0")
+        # own, writable, contiguous columns: a broadcast input (read-only, possibly one element,
+        # which ascontiguousarray would pass through as is) must never reach the kernels
         return cls(
-            np.ascontiguousarray(p[:, 0]), np.ascontiguousarray(p[:, 1]), np.ascontiguousarray(p[:, 2]),
-            np.ascontiguousarray(d[:, 0]), np.ascontiguousarray(d[:, 1]), np.ascontiguousarray(d[:, 2]),
+            np.array(p[:, 0], order="C"), np.array(p[:, 1], order="C"), np.array(p[:, 2], order="C"),
+            np.array(d[:, 0], order="C"), np.array(d[:, 1], order="C"), np.array(d[:, 2], order="C"),
             wl, w, np.zeros(n, dtype=np.uint8),
         )
 
