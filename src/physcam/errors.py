@@ -20,6 +20,8 @@ __all__ = [
     "ExportError",
     "BackendError",
     "PhysCamWarning",
+    "WrongTypeError",
+    "require_type",
     "require_finite",
     "require_positive",
 ]
@@ -68,6 +70,23 @@ class ExportError(PhysCamError):
 
 class BackendError(PhysCamError):
     """An array backend (numba, numpy) was asked for but cannot be used."""
+
+
+class WrongTypeError(PhysCamError, TypeError):
+    """An argument of the Python API has the wrong type (a name where a lens object is needed, ...).
+
+    Both a :class:`PhysCamError` and a :class:`TypeError`, so either ``except`` catches it.
+    """
+
+
+def require_type(name: str, value, cls, hint: str = ""):
+    """Return ``value`` if it is an instance of ``cls``, else raise :class:`WrongTypeError` saying what
+    was expected (``hint``: how to get one, e.g. "physcam.lens.library.load_lens(name)")."""
+    if not isinstance(value, cls):
+        want = cls.__name__ if isinstance(cls, type) else " or ".join(c.__name__ for c in cls)
+        extra = f" ({hint})" if hint else ""
+        raise WrongTypeError(f"{name} must be a {want}{extra}, got {type(value).__name__} {value!r:.60}")
+    return value
 
 
 class PhysCamWarning(UserWarning):

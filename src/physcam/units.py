@@ -39,6 +39,8 @@ _FEET_INCHES = re.compile(rf"^\s*({_NUMBER})\s*(?:ft|feet|foot|')\s*({_NUMBER})\
 
 def to_mm(value: float, unit: str) -> float:
     """``value`` in ``unit`` (a key of :data:`MM_PER_UNIT`) as millimetres."""
+    if not isinstance(unit, str):
+        raise UnitError(f"a unit is a name such as 'mm', 'm' or 'ft', got {unit!r}")
     try:
         return float(value) * MM_PER_UNIT[unit.lower() if unit not in ("'", '"') else unit]
     except KeyError:

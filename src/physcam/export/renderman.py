@@ -15,12 +15,14 @@ from __future__ import annotations
 
 import math
 
+from ..onset.report import takes_report
 from ..errors import InputError
 from .usdgeom import DEFAULT_METERS_PER_UNIT, focus_distance_from_pupil_mm, mm_to_scene_units
 
 __all__ = ["renderman_camera_values"]
 
 
+@takes_report
 def renderman_camera_values(
     report,
     meters_per_unit: float = DEFAULT_METERS_PER_UNIT,

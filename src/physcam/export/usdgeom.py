@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 
+from ..onset.report import takes_report
 from ..errors import InputError, require_positive
 
 __all__ = [
@@ -75,6 +76,7 @@ def shutter_interval(shutter_angle_deg: float = 180.0, phase: str = "start") -> 
     raise InputError(f"shutter phase must be start, centered or end, got {phase!r}")
 
 
+@takes_report
 def focus_distance_from_pupil_mm(report) -> float:
     """Distance (mm) from the entrance pupil to the plane of sharp focus; s from H1 without a pupil."""
     if report.entrance_pupil_from_film_mm is None:
@@ -82,6 +84,7 @@ def focus_distance_from_pupil_mm(report) -> float:
     return report.focus_from_film_mm - report.entrance_pupil_from_film_mm
 
 
+@takes_report
 def usdgeom_camera_values(
     report,
     meters_per_unit: float = DEFAULT_METERS_PER_UNIT,

@@ -16,10 +16,12 @@ def sag(surface, h: float, axis: str = "y") -> float:
 
     A cylinder in X has curvature only in the X-Z meridian; in Y it is flat.
     """
-    if axis == "x":
-        c = surface.curvature_x
-    else:
-        c = surface.curvature_y
+    try:
+        c = surface.curvature_x if axis == "x" else surface.curvature_y
+    except AttributeError:
+        from ..errors import WrongTypeError
+
+        raise WrongTypeError(f"surface must be a physcam Surface, got {type(surface).__name__}") from None
     if surface.kind == "aspheric":
         c = surface.curvature
     k = surface.conic

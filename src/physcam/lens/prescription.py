@@ -29,6 +29,8 @@ __all__ = [
     "Focus",
     "LensMetadata",
     "Prescription",
+    "require_prescription",
+    "takes_prescription",
 ]
 
 #: The surface types physcam understands, as stored in files.
@@ -298,3 +300,31 @@ class Prescription:
                 if not (math.isfinite(g.thickness_close) and g.thickness_close >= 0):
                     raise fail(f"focus gap at close distance must be >= 0 mm, got {g.thickness_close}", g.surface)
         return self
+
+
+def require_prescription(value, name: str = "lens") -> Prescription:
+    """``value`` if it is a :class:`Prescription`, else :class:`~physcam.errors.WrongTypeError`
+    saying how to get one (a lens name or file goes through ``load_lens``)."""
+    from ..errors import require_type
+
+    hint = "load one with physcam.lens.library.load_lens(name or file)"
+    return require_type(name, value, Prescription, hint)
+
+
+def takes_prescription(fn):
+    """Decorator: the function's first argument (``prescription`` or ``lens``) must be a
+    :class:`Prescription`; anything else is a :class:`~physcam.errors.WrongTypeError`, not an
+    AttributeError deep inside the optics."""
+    import functools
+
+    first = fn.__code__.co_varnames[0]
+
+    @functools.wraps(fn)
+    def checked(*args, **kwargs):
+        if args:
+            require_prescription(args[0], first)
+        elif first in kwargs:
+            require_prescription(kwargs[first], first)
+        return fn(*args, **kwargs)
+
+    return checked

@@ -26,7 +26,7 @@ from ..optics.coc import circle_of_confusion
 from .pupil import entrance_pupil_practical, pivot_camera_space
 from .sensors import Sensor
 
-__all__ = ["LensReport", "DepthOfField", "solve_lens_report", "REPORT_SCHEMA", "REPORT_VERSION"]
+__all__ = ["LensReport", "DepthOfField", "solve_lens_report", "takes_report", "REPORT_SCHEMA", "REPORT_VERSION"]
 
 REPORT_SCHEMA = "physcam.lens_report"
 REPORT_VERSION = 1
@@ -612,3 +612,17 @@ def _check_finite(report: LensReport) -> None:
                 walk(v, f"{path}[{i}]")
 
     walk(d, "")
+
+
+def takes_report(fn):
+    """Decorator: the first argument must be a :class:`LensReport` (else WrongTypeError with a sentence)."""
+    import functools
+
+    from ..errors import require_type
+
+    @functools.wraps(fn)
+    def checked(report, *args, **kwargs):
+        require_type("report", report, LensReport, "solve one with physcam.onset.report.solve_lens_report")
+        return fn(report, *args, **kwargs)
+
+    return checked

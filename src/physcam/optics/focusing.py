@@ -28,7 +28,7 @@ import math
 from dataclasses import asdict, dataclass
 
 from ..errors import InputError, OpticsError, require_positive
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 from . import paraxial
 
 __all__ = [
@@ -138,6 +138,7 @@ class BreathingRow:
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
 
 
+@takes_prescription
 def focus_method(prescription: Prescription, method: str = "auto") -> str:
     """The focusing method a lens uses: "auto" resolves to "internal" (focus groups) or "unit"."""
     if method not in FOCUS_METHODS:
@@ -156,6 +157,7 @@ def _mark(focus_from_film_mm) -> float:
     return d
 
 
+@takes_prescription
 def interpolated_gaps(prescription: Prescription, object_distance_mm: float) -> tuple[dict[int, float], float]:
     """Focus-group gaps for an object ``object_distance_mm`` in front of the first vertex.
 
@@ -169,6 +171,7 @@ def interpolated_gaps(prescription: Prescription, object_distance_mm: float) -> 
     return {g.surface: g.thickness_infinity + alpha * (g.thickness_close - g.thickness_infinity) for g in f.gaps}, alpha
 
 
+@takes_prescription
 def image_distance(prescription: Prescription, object_distance_mm: float, axis: str = "y", wavelength_nm=None) -> float:
     """Last vertex to the paraxial image (mm, + toward the film) of an axial object.
 
@@ -232,6 +235,7 @@ def _internal_state(p: Prescription, d_obj: float, axis: str, lam):
     return q, back, alpha
 
 
+@takes_prescription
 def closest_focus(prescription: Prescription, *, method: str = "auto", axis: str = "y", wavelength_nm=None) -> float:
     """Closest focus mark (mm from the film plane).
 
@@ -283,6 +287,7 @@ def _internal_focus(p: Prescription, mark: float, axis: str, lam) -> FocusState:
     return FocusState(mark, "internal", axis, q.with_thicknesses({len(p.surfaces) - 1: back}), d, back, b_inf, back - b_inf, alpha)
 
 
+@takes_prescription
 def focus(
     prescription: Prescription,
     focus_from_film_mm: float,
@@ -311,6 +316,7 @@ def focus(
     return _unit_focus(prescription, mark, axis, wavelength_nm, max_extension_mm)
 
 
+@takes_prescription
 def gaussian_at_focus(
     prescription: Prescription,
     focus_from_film_mm: float = math.inf,
@@ -335,6 +341,7 @@ def gaussian_at_focus(
     )
 
 
+@takes_prescription
 def technical_planes(
     prescription: Prescription,
     focus_from_film_mm: float,
@@ -392,6 +399,7 @@ def technical_planes(
     )
 
 
+@takes_prescription
 def breathing_table(
     prescription: Prescription,
     focus_marks_mm=None,
@@ -441,6 +449,7 @@ def breathing_table(
     return rows
 
 
+@takes_prescription
 def gaussian_hfov_infinity(prescription: Prescription, sensor_width_mm: float, method: str = "auto", wavelength_nm=None) -> float:
     """Horizontal field of view (degrees, X meridian) at infinity focus."""
     st = focus(prescription, math.inf, method=method, axis="y", wavelength_nm=wavelength_nm)

@@ -23,7 +23,7 @@ import math
 from dataclasses import asdict, dataclass, field
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = [
     "AXES",
@@ -74,6 +74,7 @@ def _axis(axis: str) -> str:
     return axis
 
 
+@takes_prescription
 def media_indices(prescription: Prescription, wavelength_nm=None) -> list[float]:
     """Refractive index of object space followed by the medium after each surface.
 
@@ -93,6 +94,7 @@ def media_indices(prescription: Prescription, wavelength_nm=None) -> list[float]
     return out
 
 
+@takes_prescription
 def surface_powers(prescription: Prescription, axis: str = "y", wavelength_nm=None) -> list[float]:
     """Paraxial power (1/mm) of each surface in the ``axis`` meridian: phi = c (n' - n)."""
     _axis(axis)
@@ -104,6 +106,7 @@ def surface_powers(prescription: Prescription, axis: str = "y", wavelength_nm=No
     return out
 
 
+@takes_prescription
 def paraxial_trace(prescription: Prescription, y0: float, nu0: float, axis: str = "y", wavelength_nm=None):
     """Trace one paraxial ray from the first vertex to the last.
 
@@ -135,6 +138,7 @@ def _mul(a, b):
     )
 
 
+@takes_prescription
 def system_matrix(prescription: Prescription, axis: str = "y", wavelength_nm=None, first: int = 0, last: int | None = None):
     """ABCD matrix (A, B, C, D) on (y, n u) from just before surface ``first`` to just after ``last``.
 
@@ -284,6 +288,7 @@ def _check_lens(prescription: Prescription) -> None:
                 raise InputError(f"surface {i}: {name} is {v}; fix the lens file")
 
 
+@takes_prescription
 def stop_semi_diameter_for_fstop(prescription: Prescription, fstop: float, axis: str = "y", wavelength_nm=None) -> float:
     """Stop semi-diameter (mm) that gives the f-number ``fstop`` (= EFL / entrance pupil diameter, object at infinity)."""
     base = gaussian(prescription, axis=axis, wavelength_nm=wavelength_nm)
@@ -298,6 +303,7 @@ def stop_semi_diameter_for_fstop(prescription: Prescription, fstop: float, axis:
     return file_stop * scale
 
 
+@takes_prescription
 def gaussian(
     prescription: Prescription,
     *,
@@ -441,11 +447,13 @@ def gaussian(
     )
 
 
+@takes_prescription
 def gaussian_xy(prescription: Prescription, **kwargs) -> dict[str, GaussianData]:
     """Gaussian data in both meridians: ``{"x": ..., "y": ...}`` (they differ for anamorphic lenses)."""
     return {a: gaussian(prescription, axis=a, **kwargs) for a in AXES}
 
 
+@takes_prescription
 def field_angle(prescription: Prescription, image_height: float, film_z: float, axis: str = "y", wavelength_nm=None) -> float:
     """Object-space field angle (radians) of the paraxial chief ray reaching ``image_height`` (mm) on the film.
 

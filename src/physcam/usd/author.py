@@ -32,8 +32,8 @@ import math
 import struct
 from dataclasses import dataclass
 
-from ..errors import ExportError, InputError, require_finite, require_positive
-from .plugin import ensure_registered
+from ..errors import ExportError, InputError, require_finite, require_positive, require_type
+from .plugin import ensure_registered, require_stage
 
 __all__ = [
     "CameraSpec",
@@ -147,6 +147,7 @@ def report_for_spec(spec: CameraSpec):
     from ..onset.report import solve_lens_report
     from ..onset.sensors import Sensor
 
+    require_type("spec", spec, CameraSpec, "build one with CameraSpec(...) or spec_from_report")
     sensor = Sensor(
         key=spec.sensor_name or "custom",
         name=spec.sensor_name or f"{spec.sensor_width_mm:g} x {spec.sensor_height_mm:g} mm",
@@ -167,6 +168,9 @@ def report_for_spec(spec: CameraSpec):
 
 def spec_from_report(report, **body) -> CameraSpec:
     """A :class:`CameraSpec` from a lens report plus body/shutter/aperture keywords of CameraSpec."""
+    from ..onset.report import LensReport
+
+    require_type("report", report, LensReport, "solve one with physcam.onset.report.solve_lens_report")
     s = report.sensor
     return CameraSpec(
         focal_length_mm=report.focal_length_mm,
@@ -312,7 +316,8 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
 
     from ..export.usdgeom import mm_to_scene_units
 
-    spec = spec.checked()
+    require_stage(stage)
+    spec = require_type("spec", spec, CameraSpec, "build one with CameraSpec(...) or spec_from_report").checked()
     try:
         sdf_path = Sdf.Path(path)
     except Exception:  # pxr raises Tf errors of several kinds for bad paths

@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from ..errors import ExportError, InputError
+from ..errors import ExportError, InputError, require_type
 from .author import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec, author_camera, author_render_camera, new_stage, save_stage
 from .plugin import ensure_registered
 
@@ -83,8 +83,10 @@ def write_lens_file(file, characterizations: dict, *, force: bool = False, meter
     date, selected by default. Returns the Path.
     """
     ensure_registered()
-    if not characterizations:
-        raise InputError("a lens file needs at least one characterization (date -> lens values)")
+    if not isinstance(characterizations, dict) or not characterizations:
+        raise InputError("a lens file needs a dict of at least one characterization (date -> CameraSpec)")
+    for date, spec in characterizations.items():
+        require_type(f"characterization {date!r}", spec, CameraSpec, "date -> CameraSpec of the lens that day")
     stage = _stage(meters_per_unit, fps)
     prim = stage.DefinePrim(LENS_PRIM, "PhysicalCamera")
     stage.SetDefaultPrim(prim)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["PLUGIN_DIR", "SCHEMA_TYPES", "ensure_registered"]
+__all__ = ["PLUGIN_DIR", "SCHEMA_TYPES", "ensure_registered", "require_stage", "require_prim"]
 
 #: Folder holding plugInfo.json and generatedSchema.usda (for PXR_PLUGINPATH_NAME).
 PLUGIN_DIR = Path(__file__).resolve().parent / "plugin"
@@ -70,3 +70,24 @@ def ensure_registered() -> None:
             f"PXR_PLUGINPATH_NAME={PLUGIN_DIR}"
         )
     _done = True
+
+
+def require_stage(stage):
+    """``stage`` if it is a ``Usd.Stage``, else :class:`~physcam.errors.WrongTypeError`."""
+    from pxr import Usd
+
+    from ..errors import require_type
+
+    return require_type("stage", stage, Usd.Stage, "open one with physcam.usd.read.open_stage(file)")
+
+
+def require_prim(prim, name: str = "prim"):
+    """``prim`` if it is a valid ``Usd.Prim``, else :class:`~physcam.errors.WrongTypeError`."""
+    from pxr import Usd
+
+    from ..errors import WrongTypeError, require_type
+
+    require_type(name, prim, Usd.Prim, "get one with stage.GetPrimAtPath(path)")
+    if not prim.IsValid():
+        raise WrongTypeError(f"{name} is not a valid prim (no prim at that path?)")
+    return prim

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 from ..errors import ExportError
 from .author import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec
-from .plugin import ensure_registered
+from .plugin import ensure_registered, require_prim, require_stage
 
 __all__ = ["CameraReading", "find_cameras", "open_stage", "read_camera", "read_prescription"]
 
@@ -71,6 +71,7 @@ def open_stage(file):
 def find_cameras(stage) -> list[str]:
     """Paths of every PhysicalCamera prim on ``stage`` (composed, active, defined)."""
     ensure_registered()
+    require_stage(stage)
     from pxr import Usd
 
     t = Usd.SchemaRegistry.GetTypeFromSchemaTypeName("PhysicalCamera")
@@ -111,6 +112,7 @@ def read_prescription(model_prim):
     from ..errors import LensFileError
     from ..lens.prescription import Focus, LensMetadata, Medium, Prescription, Surface, VariableGap
 
+    require_prim(model_prim, "model_prim")
     where = f"{model_prim.GetPath()}"
     arrays = {n: list(model_prim.GetAttribute(n).Get() or []) for n in
               ("radius", "thickness", "nd", "vd", "semiDiameter", "surfaceKind", "conic", "asphericCoefficients",
@@ -166,6 +168,7 @@ def read_prescription(model_prim):
 def read_camera(stage, path: str | None = None) -> CameraReading:
     """Read the PhysicalCamera at ``path`` (default: the only one on the stage)."""
     ensure_registered()
+    require_stage(stage)
     from pxr import Sdf, Usd, UsdGeom
 
     from ..export.usdgeom import mm_to_scene_units

@@ -10,7 +10,7 @@ raises :class:`~physcam.errors.ExportError` with them, naming the prims.
 from __future__ import annotations
 
 from ..errors import ExportError
-from .plugin import ensure_registered
+from .plugin import ensure_registered, require_stage
 
 __all__ = ["validation_errors", "check_stage"]
 
@@ -18,6 +18,7 @@ __all__ = ["validation_errors", "check_stage"]
 def validation_errors(stage, *, include_warnings: bool = False) -> list[str]:
     """Messages ``"<prim or layer>: <validator>: <message>"`` of usd-core's validators on ``stage``."""
     ensure_registered()
+    require_stage(stage)
     from pxr import UsdValidation
 
     registry = UsdValidation.ValidationRegistry()

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from ...errors import ExportError, LensFileError
 from ...io import atomic_write
-from ..prescription import Prescription
+from ..prescription import Prescription, takes_prescription
 from . import iset, pbrt, physcam_toml, seedtoml, zemax
 from ._common import extra, read_text
 
@@ -80,6 +80,7 @@ def read_lens(path, format: str | None = None) -> Prescription:
     return loads_lens(text, fmt, str(path))
 
 
+@takes_prescription
 def dumps_lens(p: Prescription, format: str = "physcam") -> str:
     """The text of ``p`` in ``format`` (:class:`ExportError` when the format cannot hold it)."""
     return _module(format).dumps(p)

@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 
 from ...errors import LensFileError
-from ..prescription import Focus, Prescription, VariableGap
+from ..prescription import Focus, Prescription, VariableGap, takes_prescription
 
 #: Files larger than this are refused before parsing (a lens file is a few kB).
 MAX_FILE_BYTES = 10 * 1024 * 1024
@@ -97,6 +97,7 @@ def fmt(v: float) -> str:
     return repr(float(v))
 
 
+@takes_prescription
 def extra(p: Prescription, key: str, default=None):
     """The decoded JSON value stored under ``key`` in ``p.extras``."""
     for k, v in p.extras:
@@ -223,3 +224,18 @@ def surface_rows(doc: dict, text: str, path) -> tuple[list, list[int | None]]:
         raise LensFileError("no [[surface]] tables", path)
     check_count(len(rows), path)
     return rows, table_lines(text, "surface", len(rows))
+
+
+def takes_text(fn):
+    """Decorator for a reader's ``loads(text, ...)``: ``text`` must be a str (the file's content),
+    else :class:`~physcam.errors.WrongTypeError` (a path or bytes goes through ``load_lens``)."""
+    import functools
+
+    from ...errors import require_type
+
+    @functools.wraps(fn)
+    def checked(text, *args, **kwargs):
+        require_type("text", text, str, "the file's content; read a file with physcam.lens.library.load_lens(path)")
+        return fn(text, *args, **kwargs)
+
+    return checked

@@ -27,8 +27,8 @@ import json
 import warnings
 
 from ...errors import ExportError, LensFileError, PhysCamWarning
-from ..prescription import AIR, LensMetadata, Medium, Prescription, Surface
-from ._common import MAX_SURFACES, check_count, json_text, number, validated
+from ..prescription import AIR, LensMetadata, Medium, Prescription, Surface, takes_prescription
+from ._common import MAX_SURFACES, check_count, json_text, number, validated, takes_text
 
 __all__ = ["loads", "dumps"]
 
@@ -52,6 +52,7 @@ def _refuse_constant(token: str):
     raise ValueError(f"{token} is not a finite number")
 
 
+@takes_text
 def loads(text: str, path=None, name: str | None = None) -> Prescription:
     """Parse ISET lens JSON into a validated :class:`Prescription`."""
     try:
@@ -108,6 +109,7 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
     return validated(p, path, lines)
 
 
+@takes_prescription
 def dumps(p: Prescription) -> str:
     """ISET lens JSON for ``p``; :class:`ExportError` for cylinders and the squeeze.
 

@@ -26,14 +26,15 @@ import warnings
 from pathlib import Path
 
 from ...errors import ExportError, LensFileError, PhysCamWarning
-from ..prescription import AIR, LensMetadata, Medium, Prescription, Surface
-from ._common import check_count, fmt, number, validated
+from ..prescription import AIR, LensMetadata, Medium, Prescription, Surface, takes_prescription
+from ._common import check_count, fmt, number, validated, takes_text
 
 __all__ = ["loads", "dumps", "HEADER"]
 
 HEADER = "radius thickness index aperture-diameter (mm; radius 0 = aperture stop, index 0 = air)"
 
 
+@takes_text
 def loads(text: str, path=None, name: str | None = None) -> Prescription:
     """Parse pbrt ``.dat`` text into a validated :class:`Prescription`."""
     if name is None:
@@ -79,6 +80,7 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
     return validated(Prescription(tuple(surfaces), meta), path, lines)
 
 
+@takes_prescription
 def dumps(p: Prescription) -> str:
     """pbrt ``.dat`` text for ``p``; :class:`ExportError` for what pbrt cannot hold.
 

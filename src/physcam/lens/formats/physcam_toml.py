@@ -25,8 +25,9 @@ from pathlib import Path
 
 from ...errors import InputError, LensFileError
 from ..catalog import find_glass
-from ..prescription import AIR, SURFACE_KINDS, Focus, LensMetadata, Medium, Prescription, Surface
+from ..prescription import AIR, SURFACE_KINDS, Focus, LensMetadata, Medium, Prescription, Surface, takes_prescription
 from ._common import (
+    takes_text,
     MAX_SURFACES,
     focus_table,
     surface_rows,
@@ -73,6 +74,7 @@ def _medium(v, where, path, ln) -> Medium:
     return Medium(nd, vd, glass)
 
 
+@takes_text
 def loads(text: str, path=None, name: str | None = None) -> Prescription:
     """Parse physcam lens TOML into a validated :class:`Prescription`."""
     doc = parse_toml(text, path)
@@ -163,6 +165,7 @@ def _focus(f: dict, surfaces, text, path) -> Focus:
     return focus_table(f, surfaces, text, path, "gap")
 
 
+@takes_prescription
 def dumps(p: Prescription) -> str:
     """physcam lens TOML for ``p`` (lossless: :func:`loads` gives back an equal Prescription)."""
     m = p.metadata

@@ -23,8 +23,9 @@ import warnings
 from pathlib import Path
 
 from ...errors import ExportError, LensFileError, PhysCamWarning
-from ..prescription import AIR, Focus, LensMetadata, Medium, Prescription, Surface
+from ..prescription import AIR, Focus, LensMetadata, Medium, Prescription, Surface, takes_prescription
 from ._common import (
+    takes_text,
     MAX_SURFACES,
     focus_table,
     surface_rows,
@@ -45,6 +46,7 @@ SURFACE_KEYS = ("radius", "thickness", "ior", "aperture", "abbe_v", "type", "con
 TYPES = ("stop", "aspheric", "cylindrical_x", "cylindrical_y", "spherical", "flat")
 
 
+@takes_text
 def loads(text: str, path=None, name: str | None = None) -> Prescription:
     """Parse seed-format lens TOML into a validated :class:`Prescription`."""
     return loads_document(parse_toml(text, path), text, path, name)
@@ -106,6 +108,7 @@ def _focus(f: dict, surfaces, text, path) -> Focus:
     return focus_table(f, surfaces, text, path, "variable")
 
 
+@takes_prescription
 def dumps(p: Prescription) -> str:
     """Seed-format TOML for ``p``. Maker, source and notes go to comments (not read back).
 

@@ -28,8 +28,8 @@ from pathlib import Path
 
 from ...errors import ExportError, InputError, LensFileError, PhysCamWarning
 from ..catalog import find_glass
-from ..prescription import AIR, LensMetadata, Medium, Prescription, Surface
-from ._common import MAX_SURFACES, check_count, fmt, number, one_line, validated
+from ..prescription import AIR, LensMetadata, Medium, Prescription, Surface, takes_prescription
+from ._common import MAX_SURFACES, check_count, fmt, number, one_line, validated, takes_text
 
 __all__ = ["loads", "dumps"]
 
@@ -55,6 +55,7 @@ def _radius(c: float) -> float:
     return r
 
 
+@takes_text
 def loads(text: str, path=None, name: str | None = None) -> Prescription:
     """Parse a sequential ``.zmx`` into a validated :class:`Prescription`."""
     blocks: list[dict] = []
@@ -238,6 +239,7 @@ def _glass(tok, path, lineno) -> Medium:
     return Medium(cat.nd, cat.vd, cat.name)
 
 
+@takes_prescription
 def dumps(p: Prescription) -> str:
     """Sequential ``.zmx`` text for ``p``; :class:`ExportError` for cylinders and the squeeze.
 
