@@ -546,6 +546,9 @@ def author_from_report(stage, path: str, report, *, position=(0.0, 0.0, 0.0), ro
 def save_stage(stage, file, *, force: bool = False):
     """Validate ``stage`` (usd-core's validators), then write its root layer to ``file`` atomically.
 
+    The root layer gets USD's ``fallbackPrimTypes`` for physcam's schema types, so the file
+    composes and places its cameras the same in a process without physcam's plugin.
+
     The layer is exported to text in memory and written with :func:`physcam.io.atomic_write`
     (temporary file in the same folder, then rename); an existing file is kept unless
     ``force``. Returns the Path. ``.usda`` writes text; ``.usd``/``.usdc`` write crate.
@@ -558,6 +561,10 @@ def save_stage(stage, file, *, force: bool = False):
     p = check_writable(file, force=force)
     if p.suffix not in (".usda", ".usd", ".usdc"):
         raise ExportError(f"{p}: a USD file name ends in .usda, .usd or .usdc")
+    # schema fallback types (the root layer's fallbackPrimTypes): a process without physcam's
+    # plugin reads a PhysicalCamera as an Xform, so the body's transform still places the
+    # companion UsdGeomCamera (docs/usd.md, "Without the plugin")
+    stage.WriteFallbackPrimTypes()
     check_stage(stage)
     if p.suffix == ".usda":
         return atomic_write(p, stage.GetRootLayer().ExportToString(), force=force)
