@@ -60,3 +60,60 @@ def test_write_refuses_zero_fps_without_traceback(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "frames per second" in err and "Traceback" not in err
     assert not f.exists()
+
+
+def _write_read(tmp_path, *flags, path=None):
+    from physcam.usd.read import open_stage, read_camera
+
+    f = tmp_path / f"w{abs(hash(flags))}.usda"
+    argv = ["usd", "write", str(f), *flags]
+    assert main(argv) == 0, argv
+    stage = open_stage(f)
+    return stage, read_camera(stage, path)
+
+
+BASE = ("--focal", "50", "--fstop", "4", "--focus", "3m")
+
+
+def test_every_usd_write_flag_reaches_the_file(tmp_path, capsys):
+    """Issue 9.2: each flag of `physcam usd write` is written and reads back (expected values are
+    the flags' own numbers, converted by hand: 3 m = 3000 mm, T = N / sqrt(t), 90 deg at 24 fps =
+    1/96 s, the practical pupil 300 - 0.5 * 120 = 240 mm in front of the film)."""
+    from pxr import UsdGeom
+
+    import pytest
+
+    s, r = _write_read(tmp_path, *BASE)
+    assert (r.spec.focal_length_mm, r.spec.fstop, r.spec.focus_mm) == (50.0, 4.0, 3000.0)
+    s, r = _write_read(tmp_path, *BASE, "--tstop", "4.5")
+    assert r.spec.transmittance == pytest.approx((4 / 4.5) ** 2, rel=1e-6)
+    geom = UsdGeom.Camera(s.GetPrimAtPath("/Cameras/Camera/Camera"))
+    assert geom.GetExposureFStopAttr().Get() == pytest.approx(4.5, rel=1e-6)
+    s, r = _write_read(tmp_path, *BASE, "--sensor", "ALEXA 35")
+    assert (r.spec.sensor_width_mm, r.spec.sensor_height_mm) == pytest.approx((27.99, 19.22))
+    s, r = _write_read(tmp_path, *BASE, "--sensor-width", "30", "--sensor-height", "20", "--squeeze", "2",
+                       "--coc", "0.02")
+    assert (r.spec.sensor_width_mm, r.spec.sensor_height_mm, r.spec.squeeze) == pytest.approx((30, 20, 2))
+    assert r.spec.coc_mm == pytest.approx(0.02)
+    s, r = _write_read(tmp_path, "--focal", "50", "--fstop", "4", "--near", "2.5m", "--far", "4m")
+    # thin lens, about H1: 1/s = (1/near + 1/far) / 2 -> the mark lies between the limits
+    assert 2500 < r.spec.focus_mm < 4000
+    s, r = _write_read(tmp_path, *BASE, "--model", "technical", "--reference", "flange", "--flange", "44",
+                       "--h1", "30", "--h2", "20", "--pupil", "50")
+    assert r.spec.principal_planes_mm == pytest.approx((74.0, 64.0))
+    assert r.spec.entrance_pupil_mm == pytest.approx(94.0) and r.spec.flange_distance_mm == 44.0
+    s, r = _write_read(tmp_path, *BASE, "--sensor-front", "300", "--lens-length", "120", "--pupil-fraction", "0.5")
+    assert r.spec.entrance_pupil_mm == pytest.approx(240.0)
+    s, r = _write_read(tmp_path, *BASE, "--meters-per-unit", "1", "--shutter-angle", "90", "--fps", "24")
+    assert UsdGeom.GetStageMetersPerUnit(s) == 1.0 and s.GetTimeCodesPerSecond() == 24.0
+    assert r.spec.shutter_duration_s == pytest.approx(1 / 96, rel=1e-6)
+    assert UsdGeom.Camera(s.GetPrimAtPath("/Cameras/Camera/Camera")).GetFocalLengthAttr().Get() == \
+        pytest.approx(0.5, rel=1e-5)  # float32, nudged to keep the FOV exact
+    s, r = _write_read(tmp_path, *BASE, "--path", "/Rig/Hero", "--blades", "9", path="/Rig/Hero")
+    assert r.spec.aperture_blades == 9
+    assert s.GetPrimAtPath("/Rig/Hero/Camera").GetAttribute("ri:apertureNSides").Get() == 9
+    s, r = _write_read(tmp_path, *BASE, "--orthographic", "--magnification", "0.5")
+    assert (r.spec.projection, r.spec.magnification) == ("orthographic", 0.5)
+    s, r = _write_read(tmp_path, "--lens", "dgauss_50mm", "--fstop", "4", "--focus", "3m")
+    assert r.spec.lens_name.startswith("Double Gauss 50mm")
+    assert s.GetPrimAtPath("/Cameras/Camera/Camera").GetAttribute("lensDistortion:k1")

@@ -185,10 +185,24 @@ def spec_from_report(report, **body) -> CameraSpec:
         principal_planes_mm=((report.h1_from_film_mm, report.h2_from_film_mm) if report.model == "technical"
                              else None),
         flange_distance_mm=body.pop("flange_distance_mm", report.flange_focal_distance_mm or 52.0),
+        # a marked T-stop is the photometric f-number: T = N / sqrt(transmittance)
+        transmittance=body.pop("transmittance", _transmittance(report.fstop, report.tstop)),
         lens_name=report.lens_name,
         sensor_name=s.name,
         **body,
     ).checked()
+
+
+def _transmittance(fstop: float, tstop: float | None) -> float:
+    """Transmittance from a geometric f-number and a marked T-stop, T = N / sqrt(t) (ASC Manual, "T-stops");
+    1 without a T-stop. A T-stop faster than the f-stop (t > 1) is refused."""
+    if tstop is None:
+        return 1.0
+    t = (fstop / tstop) ** 2
+    if t > 1.0 + 1e-12:
+        raise InputError(f"T-stop {tstop:g} is faster than the f-stop {fstop:g}: a lens cannot transmit more than "
+                         "all the light (T >= N)")
+    return min(t, 1.0)
 
 
 def shutter_opening_curve(opentime: float, closetime: float) -> list[float]:
