@@ -23,7 +23,11 @@ def test_report_json(capsys):
     d = json.loads(capsys.readouterr().out)
     assert d["focus_from_film_mm"] == pytest.approx(3048.0)
     assert d["coc_mm"] == 0.03
-    assert d["cameras"]["usd_geom_camera"]["focalLength"] == pytest.approx(50.0)
+    # the companion is the best-match pinhole: s' of the thin lens at its mark (tests/_thin_lens.py)
+    from _thin_lens import image_distance_at_mark
+
+    assert d["cameras"]["usd_geom_camera"]["focalLength"] == pytest.approx(
+        image_distance_at_mark(50.0, d["focus_from_film_mm"]))
 
 
 def test_report_table_and_plot(tmp_path, capsys):

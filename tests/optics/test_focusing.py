@@ -179,3 +179,55 @@ def test_internal_focus_solution_satisfies_the_mark(mark):
     assert stt.object_distance_mm + stt.prescription.total_track + stt.back_focus_mm == pytest.approx(mark, rel=1e-8)
     g = gaussian(stt.prescription, object_z=stt.object_z)
     assert g.z_image == pytest.approx(stt.film_z, abs=1e-6)
+
+
+# --- the best-match pinhole (issue 9.6): one definition, checked three independent ways ----------
+def test_pinhole_of_dgauss_at_1_5_m_is_the_issue_figure():
+    """The issue's oracle: with the eye at the entrance pupil the exact framing match of dgauss.50mm
+    focused 1.5 m from the film is a 52.048 mm pinhole (EFL 50.358 is 3.25 % wide)."""
+    from physcam.lens.library import load_lens
+
+    planes = focusing.technical_planes(load_lens("dgauss_50mm"), 1500.0)
+    assert planes.pinhole_focal_length_mm == pytest.approx(52.048, abs=1e-3)
+    assert focusing.technical_planes(load_lens("dgauss_50mm"), math.inf).pinhole_focal_length_mm == pytest.approx(
+        planes.efl_mm, rel=1e-12)
+
+
+def test_pinhole_equals_pupil_formula_and_breathing_focal_length():
+    """f_pin from the chief ray equals n (film - exit pupil) / (n' m_p) from the pupils, and the
+    breathing table's framing focal length (w/2) / tan(HFOV/2), three separate computations."""
+    from physcam.lens.library import load_lens
+
+    for slug, mark in (("dgauss_50mm", 1500.0), ("zeiss_distagon_35mm_f4", 800.0), ("canon_rf_85mm_f1_2", 2000.0)):
+        lens = load_lens(slug)
+        st = focusing.focus(lens, mark)
+        g = gaussian(st.prescription, object_z=st.object_z, film_z=st.film_z)
+        pupils = g.object_index * (g.z_film - g.z_exit_pupil) / (g.image_index * g.pupil_magnification)
+        assert g.pinhole_focal_length == pytest.approx(pupils, rel=1e-9), slug
+        row = focusing.breathing_table(lens, [mark], sensor_width_mm=36.0)[0]
+        assert g.pinhole_focal_length == pytest.approx(row.breathing_focal_length_mm, rel=1e-9), slug
+
+
+def test_pinhole_against_real_rays():
+    """Real rays: a point 5 mrad off axis at the 1.5 m mark, imaged by dgauss focused there, lands
+    at u * f_pin on the film, u the angle seen from the entrance pupil (small field: within 1e-3)."""
+    import numpy as np
+
+    from physcam.lens.library import load_lens
+    from physcam.trace import RayBatch, trace_to_film
+
+    lens = load_lens("dgauss_50mm")
+    st = focusing.focus(lens, 1500.0)
+    g = gaussian(st.prescription, object_z=st.object_z, film_z=st.film_z)
+    u = 0.005
+    y_obj = u * (g.z_entrance_pupil - st.object_z)
+    # a small pencil around the chief ray, through the entrance pupil's centre region
+    k = np.linspace(-0.5, 0.5, 11)
+    px, py = np.meshgrid(k, k)
+    aim = np.stack([px.ravel(), py.ravel(), np.full(px.size, g.z_entrance_pupil)], axis=1)
+    start = np.array([0.0, y_obj, st.object_z])
+    rays = RayBatch.from_arrays(np.broadcast_to(start, aim.shape), aim - start)
+    out = trace_to_film(st.prescription, rays, st.film_z, clip=False)
+    assert out.ok.all()
+    image_height = -float(np.mean(out.y))  # the image is inverted
+    assert image_height / u == pytest.approx(g.pinhole_focal_length, rel=1e-3)

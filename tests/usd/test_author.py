@@ -14,6 +14,8 @@ from physcam.usd import PLUGIN_DIR
 from physcam.usd.author import CameraSpec, author_camera, new_stage, shutter_opening_curve, write_camera
 from physcam.usd.validate import validation_errors
 
+from _thin_lens import image_distance_at_mark
+
 pxr = pytest.importorskip("pxr")
 from pxr import Gf, Usd, UsdGeom  # noqa: E402
 
@@ -36,7 +38,9 @@ def gf_camera(stage, path="/Cameras/Camera/Camera"):
      (50.0, 22.0, 18.6, 2.0), (40.0, 27.99, 19.22, 1.8)],
 )
 def test_gf_camera_reproduces_fov(mpu, focal, w, h, squeeze):
-    """Gf.Camera from the written UsdGeomCamera gives 2 atan(w / 2f) to 1e-6 degrees.
+    """Gf.Camera from the written UsdGeomCamera gives 2 atan(w / 2 s') to 1e-6 degrees: the
+    companion is the best-match pinhole, for a thin lens at the default 3 m mark the image
+    distance s' (hand-solved in tests/_thin_lens.py), not f.
 
     The frustum (double precision) is compared with the closed form on the exact numbers;
     Gf.Camera.GetFieldOfView returns a 32-bit float, so it is held to its own rounding.
@@ -44,6 +48,7 @@ def test_gf_camera_reproduces_fov(mpu, focal, w, h, squeeze):
     stage = new_stage(mpu)
     spec = CameraSpec(focal_length_mm=focal, sensor_width_mm=w, sensor_height_mm=h, squeeze=squeeze)
     author_camera(stage, "/Cameras/Camera", spec)
+    focal = image_distance_at_mark(focal, spec.focus_mm)
     cam = gf_camera(stage)
     window = cam.frustum.GetWindow()  # perspective window at unit distance: aperture / (2 focal length)
     hfov = math.degrees(2.0 * math.atan(window.GetMax()[0]))
@@ -63,8 +68,10 @@ def test_units_tenths_of_scene_unit(mpu, focal_expected):
     author_camera(stage, "/Cameras/Camera", CameraSpec(focal_length_mm=50.0, focus_mm=3000.0,
                                                        clipping_mm=(100.0, 1.0e6)))
     g = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
-    # float32 values chosen to keep aperture/focal exact stay within a few ulps (2e-6) of the exact ones
-    assert g.GetFocalLengthAttr().Get() == pytest.approx(focal_expected, rel=2e-6)
+    # float32 values chosen to keep aperture/focal exact stay within a few ulps (2e-6) of the exact ones;
+    # the focal length is the best-match pinhole, s' of the 50 mm thin lens at the 3 m mark
+    pin = image_distance_at_mark(50.0, 3000.0) / 50.0
+    assert g.GetFocalLengthAttr().Get() == pytest.approx(focal_expected * pin, rel=2e-6)
     assert g.GetHorizontalApertureAttr().Get() == pytest.approx(36.0 * focal_expected / 50.0, rel=2e-6)
     near, far = g.GetClippingRangeAttr().Get()
     assert near == pytest.approx(0.1 / mpu, rel=1e-7) and far == pytest.approx(1000.0 / mpu, rel=1e-7)
@@ -87,7 +94,9 @@ def test_dof_survives_unit_change():
         # focus plane (eye + focusDistance along -Z) is 2500 mm in front of the film plane
         plane = eye[2] - g.GetFocusDistanceAttr().Get()
         out[mpu] = (film[2] - plane) * 1000.0 * mpu
-        assert g.GetFStopAttr().Get() == pytest.approx(2.8, rel=1e-7)
+        # the aperture diameter focalLength / fStop stays the lens's f / N (50 / 2.8 mm) on the pinhole
+        pin = image_distance_at_mark(50.0, 2500.0)
+        assert g.GetFStopAttr().Get() == pytest.approx(2.8 * pin / 50.0, rel=1e-6)
     assert out[0.01] == pytest.approx(2500.0, rel=1e-6)
     assert out[1.0] == pytest.approx(2500.0, rel=1e-6)
 

@@ -17,9 +17,12 @@ def test_write_read_force(tmp_path, capsys):
     data = json.loads(capsys.readouterr().out)
     assert data["usd"]["camera"]["focal_length_mm"] == 50.0
     assert data["report"]["focal_length_mm"] == 50.0
-    # the pinhole model keeps 50 mm; the UsdGeomCamera holds 50 mm in tenths of a metre
+    # the pinhole model keeps the lens's 50 mm; the UsdGeomCamera holds the best-match pinhole, s' of
+    # the thin lens at the 3 m mark, in tenths of a metre
+    from _thin_lens import image_distance_at_mark
+
     focals = sorted(float(v) for v in re.findall(r"float focalLength = ([0-9.e-]+)", f.read_text()))
-    assert abs(focals[0] - 0.5) < 1e-6 and focals[1] == 50.0
+    assert abs(focals[0] - image_distance_at_mark(50.0, 3000.0) / 100.0) < 2e-6 and focals[1] == 50.0
 
 
 def test_kit_and_foreign_file(tmp_path, capsys):
@@ -107,8 +110,10 @@ def test_every_usd_write_flag_reaches_the_file(tmp_path, capsys):
     s, r = _write_read(tmp_path, *BASE, "--meters-per-unit", "1", "--shutter-angle", "90", "--fps", "24")
     assert UsdGeom.GetStageMetersPerUnit(s) == 1.0 and s.GetTimeCodesPerSecond() == 24.0
     assert r.spec.shutter_duration_s == pytest.approx(1 / 96, rel=1e-6)
+    from _thin_lens import image_distance_at_mark
+
     assert UsdGeom.Camera(s.GetPrimAtPath("/Cameras/Camera/Camera")).GetFocalLengthAttr().Get() == \
-        pytest.approx(0.5, rel=1e-5)  # float32, nudged to keep the FOV exact
+        pytest.approx(image_distance_at_mark(50.0, 3000.0) / 100.0, rel=1e-5)  # float32, nudged to keep the FOV
     s, r = _write_read(tmp_path, *BASE, "--path", "/Rig/Hero", "--blades", "9", path="/Rig/Hero")
     assert r.spec.aperture_blades == 9
     assert s.GetPrimAtPath("/Rig/Hero/Camera").GetAttribute("ri:apertureNSides").Get() == 9

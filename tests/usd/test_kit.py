@@ -14,6 +14,8 @@ from physcam.usd.validate import validation_errors
 
 from pxr import Usd, UsdGeom  # noqa: E402
 
+from _thin_lens import image_distance_at_mark  # noqa: E402
+
 
 def lens(focal, pupil, t=1.0):
     return CameraSpec(focal_length_mm=focal, entrance_pupil_mm=pupil, transmittance=t, lens_name="Darling 24")
@@ -62,8 +64,9 @@ def test_shot_composes_body_and_lens_with_override(tmp_path, library):
     hfov = math.degrees(2 * math.atan(g.frustum.GetWindow().GetMax()[0]))
     # (the physical camera stores 32-bit floats: the closed form on those values)
     f32 = lambda x: struct.unpack("f", struct.pack("f", x))[0]  # noqa: E731
-    assert hfov == pytest.approx(math.degrees(2 * math.atan(f32(27.99) / (2 * f32(24.3)))), abs=1e-6)
-    assert g.fStop == pytest.approx(2.8)
+    pin = image_distance_at_mark(f32(24.3), 2000.0)  # the thin lens's framing at the 2 m mark
+    assert hfov == pytest.approx(math.degrees(2 * math.atan(f32(27.99) / (2 * pin))), abs=1e-6)
+    assert g.fStop == pytest.approx(2.8 * pin / f32(24.3), rel=1e-6)  # aperture f / N kept
     # the eye sits at the lens's entrance pupil, placed where the shot said
     eye = UsdGeom.Xformable(stage.GetPrimAtPath("/Cameras/Shot/Camera")).ComputeLocalToWorldTransform(
         Usd.TimeCode.Default()).ExtractTranslation()
@@ -104,7 +107,9 @@ def test_previs_kit_eight_variants(tmp_path):
             assert r.spec.focal_length_mm == pytest.approx(spec.focal_length_mm)
             cam = g.GetCamera(Usd.TimeCode.Default())
             hfov = math.degrees(2 * math.atan(cam.frustum.GetWindow().GetMax()[0]))
-            exact = math.degrees(2 * math.atan(spec.sensor_width_mm * spec.squeeze / (2 * spec.focal_length_mm)))
+            # the best-match pinhole of the thin lens at the setup's mark: s' (hand-solved)
+            pin = image_distance_at_mark(spec.focal_length_mm, spec.focus_mm)
+            exact = math.degrees(2 * math.atan(spec.sensor_width_mm * spec.squeeze / (2 * pin)))
             assert hfov == pytest.approx(exact, abs=1e-6)
         else:
             # 36 mm at magnification 0.002 images 18 m = 1800 cm = 18000 tenths of a cm
@@ -137,10 +142,30 @@ def test_vendor_lens_prescription_and_best_match_pinhole(tmp_path):
 
     lens_report = solve_lens_report(focal_length_mm=None, sensor=Sensor("c", "c", 36.0, 24.0), fstop=4.0,
                                     focus_mm=1500.0, coc=0.03, lens=rx)
-    w = 36.0
-    assert math.degrees(2 * math.atan(w / (2 * pin.spec.focal_length_mm))) == pytest.approx(
-        lens_report.hfov_focus_deg, abs=5e-6)  # focal length stored as a 32-bit float
+    # issue 9.6: the best-match pinhole with the eye at the entrance pupil is 52.048 mm for dgauss
+    # focused at 1.5 m (the issue's oracle figure); the companion camera (mm at metersPerUnit 0.01)
+    # is that pinhole, and the read-back report keeps it
+    geom = UsdGeom.Camera(stage.GetPrimAtPath("/Lens/Camera"))
+    assert geom.GetFocalLengthAttr().Get() == pytest.approx(52.048, abs=1e-3)
+    assert pin.spec.pinhole_focal_length_mm == pytest.approx(52.048, abs=1e-3)
+    assert report_rx.pinhole[0] == pytest.approx(lens_report.pinhole[0], rel=1e-6)  # float32 storage
+    assert report_rx.hfov_focus_deg == pytest.approx(lens_report.hfov_focus_deg, abs=1e-5)
     assert report_rx.fstop == 4.0
+
+
+def test_usd_write_lens_and_vendor_kit_frame_alike(tmp_path, capsys):
+    """Issue 9.6: `usd write --lens` and `usd kit vendor` used two framings (EFL, 3.25 % wide, and
+    s', 0.23 % tight). Both now write the one best-match pinhole, 52.048 mm for dgauss at 1.5 m."""
+    from physcam.cli import main
+
+    a, b = tmp_path / "a.usda", tmp_path / "b.usda"
+    assert main(["usd", "write", str(a), "--lens", "dgauss_50mm", "--focus", "1.5m", "--fstop", "4",
+                 "--sensor-width", "36", "--sensor-height", "24"]) == 0
+    assert main(["usd", "kit", "vendor", str(b), "--lens", "dgauss_50mm", "--focus", "1.5m", "--fstop", "4"]) == 0
+    sa, sb = open_stage(a), open_stage(b)  # keep the stages alive while their prims are read
+    fa = UsdGeom.Camera(sa.GetPrimAtPath("/Cameras/Camera/Camera")).GetFocalLengthAttr().Get()
+    fb = UsdGeom.Camera(sb.GetPrimAtPath("/Lens/Camera")).GetFocalLengthAttr().Get()
+    assert fa == pytest.approx(52.048, abs=1e-3) and fb == pytest.approx(fa, rel=1e-6)
 
 
 def test_read_errors_name_the_prim(tmp_path):

@@ -17,7 +17,7 @@ import math
 
 from ..onset.report import takes_report
 from ..errors import InputError
-from .usdgeom import DEFAULT_METERS_PER_UNIT, focus_distance_from_pupil_mm, mm_to_scene_units
+from .usdgeom import DEFAULT_METERS_PER_UNIT, focus_distance_from_pupil_mm, mm_to_scene_units, pinhole_fstop
 
 __all__ = ["renderman_camera_values"]
 
@@ -33,13 +33,15 @@ def renderman_camera_values(
 ) -> dict:
     """Format, ScreenWindow, Clipping and PxrCamera parameters for ``report``.
 
+    The camera is the lens's best-match pinhole, as for UsdGeomCamera (``focalLength``, ``fov``,
+    and ``fStop`` such that focalLength / fStop is the entrance-pupil diameter).
     ``xres`` is the horizontal pixel count of the (squeezed) image; ``yres`` follows
     from the film aspect. ``shift_mm`` (sensor shift in film mm) moves the screen window.
     """
     if int(xres) < 1:
         raise InputError(f"xres must be a positive pixel count, got {xres}")
-    w, h, sq = report.sensor.width_mm, report.sensor.height_mm, report.squeeze
-    f = report.focal_length_mm
+    w, h = report.sensor.width_mm, report.sensor.height_mm
+    f, sq = report.pinhole  # the best-match pinhole (see usdgeom_camera_values)
     yres = max(1, round(int(xres) * h / w))
     aspect = (w * sq) / h  # de-squeezed frame aspect
     if aspect >= 1.0:
@@ -59,7 +61,7 @@ def renderman_camera_values(
         "Projection": {
             "name": "PxrCamera",
             "fov": fov,
-            "fStop": report.fstop,
+            "fStop": pinhole_fstop(report),
             "focalLength": su(f),
             "focalDistance": su(focus_distance_from_pupil_mm(report)),
         },

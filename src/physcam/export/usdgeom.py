@@ -25,6 +25,7 @@ __all__ = [
     "mm_to_tenths_of_scene_unit",
     "shutter_interval",
     "focus_distance_from_pupil_mm",
+    "pinhole_fstop",
     "usdgeom_camera_values",
 ]
 
@@ -85,6 +86,14 @@ def focus_distance_from_pupil_mm(report) -> float:
 
 
 @takes_report
+def pinhole_fstop(report) -> float:
+    """The f-number a renderer's camera needs beside the best-match pinhole's focal length so that
+    focalLength / fStop is the lens's entrance-pupil diameter (EFL / N): depth of field then
+    matches, since defocus blur seen from the pupil depends only on that diameter and the focus."""
+    return report.fstop * report.pinhole[0] / report.focal_length_mm
+
+
+@takes_report
 def usdgeom_camera_values(
     report,
     meters_per_unit: float = DEFAULT_METERS_PER_UNIT,
@@ -97,6 +106,11 @@ def usdgeom_camera_values(
 ) -> dict:
     """UsdGeomCamera attribute name -> value for a :class:`~physcam.onset.report.LensReport`.
 
+    The camera is the lens's **best-match pinhole** (``report.pinhole``; docs/lens-report.md):
+    ``focalLength`` frames like the lens at its focus (s' for a thin lens, breathing included for
+    a prescription), and ``fStop`` is set so that focalLength / fStop is the entrance-pupil
+    diameter EFL / N (:func:`pinhole_fstop`), so a renderer's thin-lens blur, which depends on
+    that aperture diameter and the focus distance, matches the lens's.
     Anamorphic lenses: the horizontal aperture is the *desqueezed* film width
     (width x squeeze), so a spherical CG camera sees the de-squeezed field of view;
     the squeeze itself is not an aperture offset (seed 000's note is wrong there).
@@ -114,17 +128,17 @@ def usdgeom_camera_values(
     su = lambda mm: mm_to_scene_units(mm, meters_per_unit)  # noqa: E731
     if projection not in ("perspective", "orthographic"):
         raise InputError(f"projection must be perspective or orthographic, got {projection!r}")
-    sq = report.squeeze
+    f_pin, sq = report.pinhole
     open_, close = shutter_interval(shutter_angle_deg, shutter_phase)
     values = {
         "projection": projection,
-        "focalLength": t(report.focal_length_mm),
+        "focalLength": t(f_pin),
         "horizontalAperture": t(report.sensor.width_mm * sq),
         "verticalAperture": t(report.sensor.height_mm),
         "horizontalApertureOffset": t(shift_mm[0] * sq),
         "verticalApertureOffset": t(shift_mm[1]),
         "focusDistance": su(focus_distance_from_pupil_mm(report)),
-        "fStop": report.fstop,
+        "fStop": pinhole_fstop(report),
         "clippingRange": (su(near_mm), su(far_mm)),
         "shutter:open": open_,
         "shutter:close": close,

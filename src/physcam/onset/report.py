@@ -130,8 +130,19 @@ class LensReport:
     reference_plane: str = "film"
     flange_focal_distance_mm: float | None = None
     tstop: float | None = None
+    #: the best-match pinhole: a pinhole at the entrance pupil with this focal length (and the
+    #: horizontal aperture widened by ``pinhole_squeeze``) frames like the lens at this focus.
+    #: None means the thin-lens value, the distance from H2 to the film.
+    pinhole_focal_length_mm: float | None = None
+    pinhole_squeeze: float | None = None
 
     # --- convenience --------------------------------------------------------
+    @property
+    def pinhole(self) -> tuple[float, float]:
+        """(focal length mm, squeeze) of the best-match pinhole (see the field notes)."""
+        f = self.h2_from_film_mm if self.pinhole_focal_length_mm is None else self.pinhole_focal_length_mm
+        return f, (self.squeeze if self.pinhole_squeeze is None else self.pinhole_squeeze)
+
     @property
     def aperture_diameter_mm(self) -> float:
         """Entrance-pupil diameter f / N."""
@@ -184,6 +195,9 @@ class LensReport:
             "magnification": self.magnification,
             "dof": self.dof.to_dict(),
             "dof_horizontal": None if self.dof_horizontal is None else self.dof_horizontal.to_dict(),
+            "pinhole": {"focal_length_mm": self.pinhole[0], "squeeze": self.pinhole[1],
+                        "definition": "the pinhole at the entrance pupil that frames like the lens at this focus: "
+                                      "f = (exit pupil to film) / pupil magnification; s' for a thin lens"},
             "fov_deg": {
                 "infinity": {"horizontal": self.hfov_inf_deg, "vertical": self.vfov_inf_deg,
                              "diagonal": self.dfov_inf_deg},
@@ -241,6 +255,8 @@ def solve_lens_report(
     pupil_fraction: float = 0.4,
     lens_name: str | None = None,
     lens=None,
+    pinhole_focal_length_mm: float | None = None,
+    pinhole_squeeze: float | None = None,
 ) -> LensReport:
     """Solve the lens report.
 
@@ -254,6 +270,10 @@ def solve_lens_report(
     or when both fstop and an explicit ``coc`` are given) or else the CoC. Without
     measured limits it is a forward report and ``fstop`` is required.
 
+    ``pinhole_focal_length_mm`` (and ``pinhole_squeeze``): the best-match pinhole when it is known
+    from elsewhere (a USD file written from a prescription); by default it is computed (see
+    :attr:`LensReport.pinhole`).
+
     ``lens`` (a :class:`~physcam.lens.prescription.Prescription`) fills the technical
     model from the lens itself: its Gaussian engine, focused at ``focus_mm`` (unit or
     internal focusing), gives the effective focal length, H1, H2 and the entrance pupil
@@ -262,6 +282,7 @@ def solve_lens_report(
     """
     notes: list[str] = []
     pupil_origin = "datasheet"
+    lens_pinhole = None  # (Y, X) best-match pinhole focal lengths from a prescription
     if not isinstance(sensor, Sensor):
         raise InputError(f"sensor must be a physcam Sensor (physcam.onset.sensors.find_sensor), got "
                          f"{type(sensor).__name__}")
@@ -306,11 +327,14 @@ def solve_lens_report(
             f"planes from the prescription focused at the mark ({planes.method} focusing): EFL {planes.efl_mm:.3f} mm, "
             f"back focus {planes.back_focus_mm:.3f} mm"
         )
+        lens_pinhole = (planes.pinhole_focal_length_mm, planes.pinhole_focal_length_mm)
         if lens.is_anamorphic and squeeze == 1.0:
             # the squeeze the lens really has at this focus: EFL in Y over EFL in X
             st = focusing.focus(lens, D_lens)
-            efl_x = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z).efl
+            gx = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z)
+            efl_x = gx.efl
             squeeze = planes.efl_mm / efl_x
+            lens_pinhole = (planes.pinhole_focal_length_mm, gx.pinhole_focal_length)
             notes.append(
                 f"anamorphic: EFL {planes.efl_mm:.3f} mm (Y) and {efl_x:.3f} mm (X), effective squeeze "
                 f"{squeeze:.4f} (nominal {lens.squeeze:g})"
@@ -495,16 +519,30 @@ def solve_lens_report(
         h1_film = h2_film = s_img
         focus_error = 0.0
 
-    # --- field of view -------------------------------------------------------------
+    # --- the best-match pinhole and the field of view -----------------------------------
+    # One definition (docs/lens-report.md, "The best-match pinhole"): the pinhole at the entrance
+    # pupil that frames like the lens at this focus, f_pin = n (film - exit pupil) / (n' m_p)
+    # (optics.paraxial.GaussianData.pinhole_focal_length). A prescription gives it exactly, per
+    # meridian; a thin lens or a datasheet (pupils taken on the principal planes, m_p = 1) gives the
+    # distance from H2 to the film, s' when the film is in focus.
+    pin_y, pin_x = lens_pinhole if lens_pinhole is not None else (h2_film, h2_film)
+    # an anamorphic prescription frames each meridian by its own pinhole; their ratio is the squeeze
+    pin_sq = pin_y / pin_x if pin_x != pin_y else sq
+    if pinhole_focal_length_mm is not None:
+        if lens is not None:
+            raise InputError("with a lens prescription the best-match pinhole is computed from the lens")
+        pin_y = require_positive("pinhole focal length", pinhole_focal_length_mm)
+        pin_sq = sq if pinhole_squeeze is None else require_positive("pinhole squeeze", pinhole_squeeze, unit="")
     wd = w * sq
     dg = math.hypot(wd, h)
+    wp = w * pin_sq
     fov = dict(
         hfov_inf_deg=_fov_deg(wd, f),
         vfov_inf_deg=_fov_deg(h, f),
         dfov_inf_deg=_fov_deg(dg, f),
-        hfov_focus_deg=_fov_deg(wd, h2_film),
-        vfov_focus_deg=_fov_deg(h, h2_film),
-        dfov_focus_deg=_fov_deg(dg, h2_film),
+        hfov_focus_deg=_fov_deg(wp, pin_y),
+        vfov_focus_deg=_fov_deg(h, pin_y),
+        dfov_focus_deg=_fov_deg(math.hypot(wp, h), pin_y),
     )
 
     # --- entrance pupil -----------------------------------------------------------
@@ -545,6 +583,8 @@ def solve_lens_report(
         reference_plane=reference_plane,
         flange_focal_distance_mm=ffd,
         tstop=T,
+        pinhole_focal_length_mm=pin_y,
+        pinhole_squeeze=pin_sq,
         **fov,
     )
     _check_finite(report)

@@ -54,6 +54,10 @@ def report_table(report):
     fi, ff = d["fov_deg"]["infinity"], d["fov_deg"]["focus"]
     add("FOV h / v / d (infinity)", f"{fi['horizontal']:.2f}° / {fi['vertical']:.2f}° / {fi['diagonal']:.2f}°", "")
     add("FOV h / v / d (at focus)", f"{ff['horizontal']:.2f}° / {ff['vertical']:.2f}° / {ff['diagonal']:.2f}°", "")
+    pin = d["pinhole"]
+    add("pinhole (render camera)", f"{pin['focal_length_mm']:.3f} mm" + (
+        f", squeeze {pin['squeeze']:.4g}" if pin["squeeze"] != 1.0 else "") + "  [frames like the lens at focus]",
+        "entrance pupil")
     if d["entrance_pupil_from_film_mm"] is not None:
         add("entrance pupil (pivot)", f"{d['entrance_pupil_from_film_mm']:.2f} mm  [{d['entrance_pupil_source']}]",
             "film plane")

@@ -111,6 +111,7 @@ class TechnicalPlanes:
     working_f_number: float
     magnification: float
     entrance_pupil_diameter_mm: float
+    pinhole_focal_length_mm: float | None = None  # the best-match pinhole at the entrance pupil (GaussianData)
     flange_focal_distance_mm: float | None = None
     h1_from_flange_mm: float | None = None
     h2_from_flange_mm: float | None = None
@@ -394,6 +395,7 @@ def technical_planes(
         working_f_number=g.working_f_number,
         magnification=g.magnification,
         entrance_pupil_diameter_mm=g.entrance_pupil_diameter,
+        pinhole_focal_length_mm=g.pinhole_focal_length,
         flange_focal_distance_mm=g.flange_focal_distance,
         **fl,
     )

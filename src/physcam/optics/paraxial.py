@@ -215,6 +215,15 @@ class GaussianData:
     object_index: float = 1.0
     image_index: float = 1.0
     thicknesses: tuple[float, ...] = field(default=(), repr=False)
+    #: The best-match pinhole (mm): a pinhole at the entrance pupil with this focal length frames
+    #: like the lens on the film at ``z_film``. The paraxial chief ray (through the stop centre)
+    #: leaves object space at reduced angle n u through the entrance pupil and meets the film at
+    #: height y; a pinhole at the pupil images the same ray at u f, so f_pin = |y / u|
+    #: (Smith, *Modern Optical Engineering*, 4th ed., 3.5). Equivalently n (z_film - z_X) /
+    #: (n' m_p) with m_p the signed pupil magnification (Lagrange invariant between the pupils).
+    #: A thin lens focused on its film gives s'; infinity focus gives the EFL; dgauss.50mm focused
+    #: 1.5 m from the film gives 52.048 mm. ``None`` when the film lies on the exit pupil.
+    pinhole_focal_length: float | None = None
 
     # ---- reference planes -------------------------------------------------
     def reference_z(self, reference: str) -> float:
@@ -408,6 +417,9 @@ def gaussian(
         raise OpticsError("the image is at infinity: no working f-number")
     working_n = 1.0 / (2.0 * abs(nu_img))
     z_film = z_img if film_z is None else require_finite("film plane z", film_z)
+    # the best-match pinhole: the chief ray (reduced object-space angle nu0) meets the film at y_film
+    y_film = y2 + nu2 / n_img * (z_film - z_last)
+    pinhole = abs(y_film * n_obj / nu0) if abs(y_film) > 1e-12 * abs(z_film - z_last + 1.0) else None
     for name, v in (("EFL", efl), ("BFL", bfl), ("entrance pupil", z_ep), ("exit pupil", z_xp), ("image", z_img)):
         if not math.isfinite(v):
             raise OpticsError(f"paraxial {name} position is not finite for lens {prescription.name!r}")
@@ -444,6 +456,7 @@ def gaussian(
         object_index=n_obj,
         image_index=n_img,
         thicknesses=tuple(s.thickness for s in surfaces),
+        pinhole_focal_length=pinhole,
     )
 
 

@@ -65,6 +65,9 @@ class CameraSpec:
     lens (the pupil on the principal plane, s' in front of the film).
     ``principal_planes_mm``: (H1, H2) in front of the film plane, from a datasheet or a
     prescription (the technical model); ``None`` for a thin lens.
+    ``pinhole_focal_length_mm``, ``pinhole_squeeze``: the best-match pinhole (the companion
+    camera's framing, docs/lens-report.md) when it is known from a prescription; ``None``
+    computes it from the model (s' for a thin lens, H2 to film for a datasheet).
     ``clipping_mm``: near/far clipping from the eye, in mm (written in scene units).
     ``projection``: "perspective" (a pinhole/thin-lens model) or "orthographic"
     (a telecentric model imaging ``sensor / magnification`` of the scene).
@@ -79,6 +82,8 @@ class CameraSpec:
     squeeze: float = 1.0
     entrance_pupil_mm: float | None = None
     principal_planes_mm: tuple[float, float] | None = None
+    pinhole_focal_length_mm: float | None = None
+    pinhole_squeeze: float | None = None
     shift_mm: tuple[float, float] = (0.0, 0.0)
     iso: float = 100.0
     transmittance: float = 1.0
@@ -130,6 +135,10 @@ class CameraSpec:
                 require_finite("principal plane distance", v)
         if self.aperture_distance_mm is not None:
             require_finite("aperture distance", self.aperture_distance_mm)
+        if self.pinhole_focal_length_mm is not None:
+            require_positive("pinhole focal length", self.pinhole_focal_length_mm)
+        if self.pinhole_squeeze is not None:
+            require_positive("pinhole squeeze", self.pinhole_squeeze, unit="")
         if self.projection not in ("perspective", "orthographic"):
             raise InputError(f"projection must be perspective or orthographic, got {self.projection!r}")
         return self
@@ -155,7 +164,8 @@ def report_for_spec(spec: CameraSpec):
         height_mm=spec.sensor_height_mm,
     )
     common = dict(focal_length_mm=spec.focal_length_mm, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
-                  coc=spec.coc_mm, squeeze=spec.squeeze, lens_name=spec.lens_name)
+                  coc=spec.coc_mm, squeeze=spec.squeeze, lens_name=spec.lens_name,
+                  pinhole_focal_length_mm=spec.pinhole_focal_length_mm, pinhole_squeeze=spec.pinhole_squeeze)
     if spec.principal_planes_mm is not None:
         h1, h2 = spec.principal_planes_mm
         return solve_lens_report(model="technical", h1_mm=h1, h2_mm=h2, pupil_mm=spec.entrance_pupil_mm, **common)
@@ -184,6 +194,10 @@ def spec_from_report(report, **body) -> CameraSpec:
                            else report.h1_from_film_mm),
         principal_planes_mm=((report.h1_from_film_mm, report.h2_from_film_mm) if report.model == "technical"
                              else None),
+        # a prescription's best-match pinhole is kept; a thin lens or datasheet recomputes its own
+        pinhole_focal_length_mm=report.pinhole_focal_length_mm if report.entrance_pupil_source == "prescription"
+        else None,
+        pinhole_squeeze=report.pinhole_squeeze if report.entrance_pupil_source == "prescription" else None,
         flange_distance_mm=body.pop("flange_distance_mm", report.flange_focal_distance_mm or 52.0),
         # a marked T-stop is the photometric f-number: T = N / sqrt(transmittance)
         transmittance=body.pop("transmittance", _transmittance(report.fstop, report.tstop)),
@@ -417,6 +431,10 @@ def _author_lens(stage, cam, spec, eye, su):
     if spec.principal_planes_mm is not None:
         _set(cam, lp + "frontPrincipalPlaneDistance", Sdf.ValueTypeNames.Float, spec.principal_planes_mm[0])
         _set(cam, lp + "rearPrincipalPlaneDistance", Sdf.ValueTypeNames.Float, spec.principal_planes_mm[1])
+    if spec.pinhole_focal_length_mm is not None:
+        _set(cam, lp + "pinholeFocalLength", Sdf.ValueTypeNames.Float, spec.pinhole_focal_length_mm)
+        _set(cam, lp + "pinholeSqueeze", Sdf.ValueTypeNames.Float,
+             spec.squeeze if spec.pinhole_squeeze is None else spec.pinhole_squeeze)
     _set(cam, lp + "apertureDistance", Sdf.ValueTypeNames.Float,
          eye if spec.aperture_distance_mm is None else spec.aperture_distance_mm)
     _set(cam, lp + "shutterBlades", Sdf.ValueTypeNames.UInt, int(spec.aperture_blades))

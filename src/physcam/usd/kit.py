@@ -263,27 +263,24 @@ def write_previs_kit(file, setups: dict | None = None, *, default: str = "OverTh
 
 def best_match_pinhole(prescription, *, focus_mm: float, fstop: float | None, sensor_width_mm: float,
                        sensor_height_mm: float, coc_mm: float = 0.03):
-    """(CameraSpec of the pinhole, report of the real lens): the pinhole matches the lens's FOV at ``focus_mm``.
+    """(CameraSpec, report of the real lens) for ``prescription`` focused at ``focus_mm``.
 
-    The real lens's report (technical model from its own Gaussian optics focused at the
-    mark) gives the horizontal field of view at that focus, breathing included; the
-    pinhole's focal length is w / (2 tan(hfov / 2)), so a real-time renderer frames the
-    same picture. f-stop (None: the lens wide open, as the lens report decides), focus mark,
-    CoC and the entrance pupil are carried over.
+    The same camera ``physcam usd write --lens`` writes (:func:`physcam.usd.author.spec_from_report`
+    of the lens report): the lens's EFL, principal planes and entrance pupil, and its
+    best-match pinhole, the one definition physcam uses everywhere (docs/lens-report.md):
+    a pinhole at the entrance pupil with focal length (exit pupil to film) / pupil
+    magnification frames like the lens at this focus, breathing included. The companion
+    UsdGeomCamera is that pinhole. f-stop None: the lens wide open, as the lens report decides.
     """
     from ..onset.report import solve_lens_report
     from ..onset.sensors import Sensor
+    from .author import spec_from_report
 
     sensor = Sensor(key="custom", name=f"{sensor_width_mm:g} x {sensor_height_mm:g} mm",
                     width_mm=sensor_width_mm, height_mm=sensor_height_mm)
     report = solve_lens_report(focal_length_mm=None, sensor=sensor, fstop=fstop, focus_mm=focus_mm, coc=coc_mm,
                                lens=prescription)
-    w = sensor_width_mm * report.squeeze
-    f_match = w / (2.0 * math.tan(math.radians(report.hfov_focus_deg) / 2.0))
-    spec = CameraSpec(focal_length_mm=f_match, sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm,
-                      fstop=report.fstop, focus_mm=focus_mm, coc_mm=coc_mm, squeeze=report.squeeze,
-                      entrance_pupil_mm=report.entrance_pupil_from_film_mm, lens_name=prescription.name)
-    return spec.checked(), report
+    return spec_from_report(report), report
 
 
 def prescription_distortion(prescription, sensor_width_mm: float = 36.0, sensor_height_mm: float = 24.0):

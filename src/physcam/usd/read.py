@@ -88,6 +88,12 @@ def _get(prim, name, what):
     return v
 
 
+def _optional(prim, name: str):
+    """An authored float attribute's value, or None when it is not authored."""
+    attr = prim.GetAttribute(name)
+    return float(attr.Get()) if attr and attr.HasAuthoredValue() else None
+
+
 def _principal_planes(prim, lp: str):
     """(H1, H2) in front of the film when both are authored, else None (a thin lens)."""
     a = prim.GetAttribute(lp + "frontPrincipalPlaneDistance")
@@ -236,6 +242,8 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
         squeeze=float(_get(model, "squeeze", "")),
         entrance_pupil_mm=float(_get(prim, lp + "entrancePupilDistance", "")),
         principal_planes_mm=_principal_planes(prim, lp),
+        pinhole_focal_length_mm=_optional(prim, lp + "pinholeFocalLength"),
+        pinhole_squeeze=_optional(prim, lp + "pinholeSqueeze"),
         shift_mm=(float(shift[0]), float(shift[1])),
         iso=float(_get(prim, sp + "iso", "")),
         transmittance=float(_get(model, "transmittance", "")),
