@@ -155,17 +155,11 @@ class DistortionResult:
 
 
 def _max_field_deg(lens, axis, wl, half_diag, efl, backend) -> float:
-    """Largest field (deg) up to the sensor corner whose chief ray reaches the film unclipped."""
-    lo, hi = 0.0, min(math.degrees(math.atan(half_diag / abs(efl))), 89.0)
-    if _chief_heights(lens, [hi], axis, wl, None, backend, clip=True)[1].all():
-        return hi
-    for _ in range(24):
-        mid = 0.5 * (lo + hi)
-        if _chief_heights(lens, [mid], axis, wl, None, backend, clip=True)[1].all():
-            lo = mid
-        else:
-            hi = mid
-    return lo
+    """Largest field (deg) up to the sensor corner whose chief ray reaches the film unclipped (to 0.01 deg)."""
+    from ._chief import field_limit_deg
+
+    return field_limit_deg(lens, axis, max_deg=min(math.degrees(math.atan(half_diag / abs(efl))), 89.0),
+                           wavelength_nm=wl, backend=backend)
 
 
 def _chief_heights(lens, fields_deg, axis, wl, film_z, backend, clip=True):
