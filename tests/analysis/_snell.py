@@ -7,27 +7,35 @@ Used by the analysis tests as an independent computation: one ray at a time, vec
 import math
 
 
-def trace_spherical(lens, start, direction, end_z=None, stop_at=None):
-    """Trace one ray; returns the list of hit points (and the end point), and the last direction.
+def trace_spherical(lens, start, direction, end_z=None, stop_at=None, reverse=False):
+    """Trace one ray; returns the list of hit points (and the end point) and the last direction,
+    or (None, None) when the ray misses a surface or is totally reflected.
 
-    ``stop_at``: trace only surfaces [0, stop_at] (inclusive). Indices are each medium's nd, so
-    the lens must have no dispersion (Vd = 0) or be traced at the d line only.
+    Forward (front to back) by default; ``reverse`` traces a ray travelling toward -z from the
+    back surface to the front one. ``stop_at``: the last surface index to trace (forward only).
+    Indices are each medium's nd: trace lenses without dispersion (Vd = 0) or at the d line.
     """
     p = list(map(float, start))
     n = math.sqrt(sum(c * c for c in direction))
     d = [c / n for c in direction]
-    n1 = 1.0
-    z = 0.0
+    zv = list(lens.vertex_z)
+    surfaces = list(lens.surfaces)
+    order = range(len(surfaces))
+    if reverse:
+        order = reversed(order)
+    elif stop_at is not None:
+        order = range(stop_at + 1)
+    media = [1.0] + [s.medium.nd for s in surfaces]  # media[i] before surface i, media[i + 1] after it
     hits = []
-    last = len(lens.surfaces) - 1 if stop_at is None else stop_at
-    for i, s in enumerate(lens.surfaces[: last + 1]):
-        zc = z
+    for i in order:
+        s = surfaces[i]
+        n1, n2 = (media[i + 1], media[i]) if reverse else (media[i], media[i + 1])
         if s.radius == 0.0:
-            t = (zc - p[2]) / d[2]
-            q = [p[0] + t * d[0], p[1] + t * d[1], zc]
+            t = (zv[i] - p[2]) / d[2]
+            q = [p[0] + t * d[0], p[1] + t * d[1], zv[i]]
             normal = [0.0, 0.0, 1.0]
         else:
-            c = [0.0, 0.0, zc + s.radius]
+            c = [0.0, 0.0, zv[i] + s.radius]
             oc = [p[0] - c[0], p[1] - c[1], p[2] - c[2]]
             b = sum(a * e for a, e in zip(oc, d))
             cc = sum(a * a for a in oc) - s.radius**2
@@ -35,11 +43,16 @@ def trace_spherical(lens, start, direction, end_z=None, stop_at=None):
             if disc < 0:
                 return None, None
             r = math.sqrt(disc)
-            # the vertex-side intersection: near the vertex for the hemisphere facing the ray
-            t = -b - r if s.radius > 0 else -b + r
-            q = [p[0] + t * d[0], p[1] + t * d[1], p[2] + t * d[2]]
-            normal = [(q[k] - c[k]) / s.radius for k in range(3)]  # points toward +z near the vertex
-        n2 = s.medium.nd
+            # the root on the hemisphere that holds the vertex: (q_z - centre_z) has the sign of -R
+            q = None
+            for t in (-b - r, -b + r):
+                cand = [p[0] + t * d[0], p[1] + t * d[1], p[2] + t * d[2]]
+                if t > -1e-9 and (cand[2] - c[2]) * s.radius < 0:
+                    q = cand
+                    break
+            if q is None:
+                return None, None
+            normal = [(q[k] - c[k]) / s.radius for k in range(3)]
         cos_i = sum(a * e for a, e in zip(normal, d))
         if cos_i < 0:
             normal = [-a for a in normal]
@@ -51,8 +64,8 @@ def trace_spherical(lens, start, direction, end_z=None, stop_at=None):
         d = [mu * d[j] + (math.sqrt(k) - mu * cos_i) * normal[j] for j in range(3)]
         hits.append(q)
         p = q
-        n1 = n2
-        z += s.thickness
+    if reverse:
+        hits.reverse()  # hits[i] is on surface i in either direction
     if end_z is not None:
         t = (end_z - p[2]) / d[2]
         hits.append([p[0] + t * d[0], p[1] + t * d[1], end_z])

@@ -72,22 +72,24 @@ def start_plane_z(lens: Prescription) -> float:
 def _newton(residual, u, v, scale, max_iter: int = AIM_MAX_ITER):
     """Solve residual(u, v) = (0, 0) per ray; returns u, v, ok, |residual|.
 
-    A step that would lose the ray (miss, total reflection) is halved, up to 8 times; a ray with
-    no step left that keeps it is given up.
+    The finite-difference Jacobian is traced together with each point (one tracer call of 3n
+    rays per iteration). A step that would lose the ray (miss, total reflection) is halved, up
+    to 8 times; a ray with no step left that keeps it is given up.
     """
     n = u.size
-    ok = np.ones(n, dtype=bool)
-    alive = np.ones(n, dtype=bool)
     eps = 1e-6 * scale
-    err = np.full(n, np.inf)
+
+    def probe(uu, vv):
+        rx, ry, g = residual(np.concatenate([uu, uu + eps, uu]), np.concatenate([vv, vv, vv + eps]))
+        return rx[:n], ry[:n], g[:n], rx[n:2 * n], ry[n:2 * n], g[n:2 * n], rx[2 * n:], ry[2 * n:], g[2 * n:]
+
+    rx, ry, good, ax, ay, ga, bx, by, gb = probe(u, v)
+    alive = good.copy()
+    err = np.where(good, np.hypot(rx, ry), np.inf)
     for _ in range(max_iter):
-        rx, ry, good = residual(u, v)
-        err = np.where(good, np.hypot(rx, ry), np.inf)
-        todo = alive & good & (err > AIM_TOL_MM)
+        todo = alive & (err > AIM_TOL_MM)
         if not todo.any():
             break
-        ax, ay, ga = residual(u + eps, v)
-        bx, by, gb = residual(u, v + eps)
         j11, j21 = (ax - rx) / eps, (ay - ry) / eps
         j12, j22 = (bx - rx) / eps, (by - ry) / eps
         det = j11 * j22 - j12 * j21
@@ -98,19 +100,23 @@ def _newton(residual, u, v, scale, max_iter: int = AIM_MAX_ITER):
         safe = np.where(usable, det, 1.0)
         du = np.where(usable, (j22 * rx - j12 * ry) / safe, 0.0)
         dv = np.where(usable, (-j21 * rx + j11 * ry) / safe, 0.0)
-        # backtrack while a step would lose the ray
         step = np.where(usable, 1.0, 0.0)
         pending = usable.copy()
-        for _ in range(9):
-            _, _, g2 = residual(u - step * du, v - step * dv)
-            pending &= ~g2
+        for _ in range(9):  # backtrack while a step would lose the ray
+            t = probe(u - step * du, v - step * dv)
+            took = pending & t[2]
+            if took.any():
+                u = np.where(took, u - step * du, u)
+                v = np.where(took, v - step * dv, v)
+                rx, ry, good, ax, ay, ga, bx, by, gb = (np.where(took, new, old) for new, old in
+                                                        zip(t, (rx, ry, good, ax, ay, ga, bx, by, gb)))
+            pending &= ~took
             if not pending.any():
                 break
             step = np.where(pending, 0.5 * step, step)
-        step = np.where(pending, 0.0, step)
         alive &= ~pending
-        u, v = u - step * du, v - step * dv
-    ok &= np.isfinite(err) & (err <= AIM_TOL_MM * 10)
+        err = np.where(good, np.hypot(rx, ry), np.inf)
+    ok = np.isfinite(err) & (err <= AIM_TOL_MM * 10)
     return u, v, ok, np.where(np.isfinite(err), err, 0.0)
 
 
@@ -133,7 +139,7 @@ def _continuation(residual_t, n: int, scale: float, *, min_step: float = 2e-3, m
         tt = np.minimum(t[act] + dt[act], 1.0)
         h = tt - t[act]
         u0, v0 = u[act] + su[act] * h, v[act] + sv[act] * h
-        uu, vv, good, e = _newton(lambda a, b: residual_t(a, b, tt, act), u0, v0, scale, max_iter=12)
+        uu, vv, good, e = _newton(lambda a, b: residual_t(a, b, tt, act), u0, v0, scale, max_iter=10)
         g, b = act[good], act[~good]
         su[g] = (uu[good] - u[g]) / h[good]
         sv[g] = (vv[good] - v[g]) / h[good]
@@ -164,7 +170,8 @@ def aim_from_infinity(
     u = -(g["x"].z_entrance_pupil - z0) * d[:, 0] / d[:, 2]
     v = -(g["y"].z_entrance_pupil - z0) * d[:, 1] / d[:, 2]
 
-    def trace(uu, vv, dd):
+    def trace(uu, vv, dd):  # uu, vv may hold several copies of the rays (Newton's probes)
+        dd = np.tile(dd, (uu.size // dd.shape[0], 1))
         pos = np.stack([uu, vv, np.full(uu.size, z0)], axis=1)
         out = trace_through(front, RayBatch.from_arrays(pos, dd, wavelength_nm), clip=False, backend=backend)
         return out.x, out.y, out.ok
@@ -207,7 +214,8 @@ def aim_from_film(
         z_aim = z_rear
     dz = z_aim - film_z
 
-    def trace(uu, vv, q):
+    def trace(uu, vv, q):  # uu, vv may hold several copies of the rays (Newton's probes)
+        q = np.tile(q, (uu.size // q.shape[0], 1))
         pos = np.stack([q[:, 0], q[:, 1], np.full(uu.size, film_z - zk)], axis=1)
         dirn = np.stack([uu - q[:, 0], vv - q[:, 1], np.full(uu.size, dz)], axis=1)
         out = trace_through(back, RayBatch.from_arrays(pos, dirn, wavelength_nm), reverse=True, clip=False,
