@@ -238,7 +238,7 @@ def aim_from_film(
 def field_angles_deg(fields_deg, max_field_deg, n_fields: int, half_diagonal_mm: float, efl_mm: float) -> np.ndarray:
     """The field angles (degrees) an analysis evaluates.
 
-    ``fields_deg`` as given (each within +-89 degrees), or else ``n_fields`` (at least 2) from
+    ``fields_deg`` as given (each within +-89 degrees), or else ``n_fields`` (2 to 200) from
     0 to ``max_field_deg``, by default the sensor corner: atan(half diagonal / EFL).
     """
     import math
@@ -250,13 +250,15 @@ def field_angles_deg(fields_deg, max_field_deg, n_fields: int, half_diagonal_mm:
         if fields.size == 0 or (np.abs(fields) >= 89).any():
             raise InputError("give field angles between -89 and 89 degrees")
         return fields
+    if isinstance(n_fields, bool) or not isinstance(n_fields, (int, np.integer)) or not 2 <= n_fields <= 200:
+        raise InputError(f"n_fields must be a whole number from 2 to 200, got {n_fields!r}")
     top = max_field_deg
     if top is None:
         top = math.degrees(math.atan(half_diagonal_mm / abs(efl_mm)))
     top = require_finite("max field", top)
     if not 0 < top < 89:
         raise InputError(f"max field must lie between 0 and 89 degrees, got {top:g}")
-    return np.linspace(0.0, top, max(2, int(n_fields)))
+    return np.linspace(0.0, top, int(n_fields))
 
 
 def chief_ray_passes(lens: Prescription, fields_deg, axis: str = "y", *, wavelength_nm: float,

@@ -199,6 +199,8 @@ def real_distortion(
     from ..trace import paraxial_image_z
 
     wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
+    if isinstance(n_fields, bool) or not isinstance(n_fields, (int, np.integer)) or not 3 <= n_fields <= 200:
+        raise InputError(f"n_fields must be a whole number from 3 to 200, got {n_fields!r}")
     w = require_positive("sensor width", sensor_width_mm)
     h = require_positive("sensor height", sensor_height_mm)
     if film_z is None:
@@ -219,8 +221,6 @@ def real_distortion(
             if top < corner - 1e-6:
                 notes.append(f"{axis.upper()} meridian: chief rays pass only up to {top:.2f} deg "
                              f"(sensor corner at {corner:.2f} deg)")
-            if n_fields < 3:
-                raise InputError(f"n_fields must be >= 3, got {n_fields}")
             fields = np.linspace(0.0, top, n_fields)
         else:
             fields = np.array([require_finite("field angle", f) for f in np.atleast_1d(fields_deg)], dtype=float)
