@@ -37,7 +37,7 @@ __all__ = ["AimedRays", "aim_from_infinity", "aim_from_film", "field_direction",
 
 #: Aiming stops when the ray meets the stop plane within this distance of its centre (mm).
 AIM_TOL_MM = 1e-9
-AIM_MAX_ITER = 40
+AIM_MAX_ITER = 20
 
 
 @dataclass
@@ -74,7 +74,8 @@ def _newton(residual, u, v, scale, max_iter: int = AIM_MAX_ITER):
 
     The finite-difference Jacobian is traced together with each point (one tracer call of 3n
     rays per iteration). A step that would lose the ray (miss, total reflection) is halved, up
-    to 8 times; a ray with no step left that keeps it is given up.
+    to 8 times; a ray with no step left that keeps it, or whose error has not halved in four
+    iterations in a row, is given up.
     """
     n = u.size
     eps = 1e-6 * scale
@@ -86,6 +87,7 @@ def _newton(residual, u, v, scale, max_iter: int = AIM_MAX_ITER):
     rx, ry, good, ax, ay, ga, bx, by, gb = probe(u, v)
     alive = good.copy()
     err = np.where(good, np.hypot(rx, ry), np.inf)
+    slow = np.zeros(n, dtype=int)  # iterations in a row that did not halve the error
     for _ in range(max_iter):
         todo = alive & (err > AIM_TOL_MM)
         if not todo.any():
@@ -115,7 +117,10 @@ def _newton(residual, u, v, scale, max_iter: int = AIM_MAX_ITER):
                 break
             step = np.where(pending, 0.5 * step, step)
         alive &= ~pending
-        err = np.where(good, np.hypot(rx, ry), np.inf)
+        new = np.where(good, np.hypot(rx, ry), np.inf)
+        slow = np.where(new > 0.5 * err, slow + 1, 0)
+        alive &= slow < 4  # not converging: give up (continuation takes over)
+        err = new
     ok = np.isfinite(err) & (err <= AIM_TOL_MM * 10)
     return u, v, ok, np.where(np.isfinite(err), err, 0.0)
 
@@ -139,7 +144,7 @@ def _continuation(residual_t, n: int, scale: float, *, min_step: float = 2e-3, m
         tt = np.minimum(t[act] + dt[act], 1.0)
         h = tt - t[act]
         u0, v0 = u[act] + su[act] * h, v[act] + sv[act] * h
-        uu, vv, good, e = _newton(lambda a, b: residual_t(a, b, tt, act), u0, v0, scale, max_iter=10)
+        uu, vv, good, e = _newton(lambda a, b: residual_t(a, b, tt, act), u0, v0, scale, max_iter=8)
         g, b = act[good], act[~good]
         su[g] = (uu[good] - u[g]) / h[good]
         sv[g] = (vv[good] - v[g]) / h[good]
