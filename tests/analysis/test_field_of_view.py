@@ -117,3 +117,15 @@ def test_bad_input():
         real_field_of_view(lens, 36.0, 24.0, focus_from_film_mm=3000.0, film_z=100.0)
     with pytest.raises(InputError):
         real_field_of_view(lens, 36.0, 24.0, film_z=1.0)  # in front of the last vertex
+
+
+def test_real_breathing_corner_beyond_ninety_degrees(nikkor):
+    # breathing-real measured the corner's angle with |N|, folding 90.13 deg back to 89.87; the
+    # independent Snell trace of the corner ray (test above) leaves at half of 180.26 deg
+    from physcam.analysis.breathing_real import real_breathing
+
+    row = real_breathing(nikkor, [math.inf], sensor_width_mm=36.0, sensor_height_mm=24.0).rows[0]
+    fov = real_field_of_view(nikkor, 36.0, 24.0)
+    assert row.dfov_real_deg == pytest.approx(fov.diagonal_deg, abs=1e-9)
+    assert row.dfov_real_deg > 180.0
+    assert row.hfov_real_deg == pytest.approx(fov.horizontal_deg, abs=1e-9)
