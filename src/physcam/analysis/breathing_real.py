@@ -86,7 +86,8 @@ def _real_half_angles(st, w, h, wl, backend):
             f"at focus {st.focus_from_film_mm:g} mm the chief ray from the sensor edge ({w / 2:g} mm) does not pass "
             f"{lens.name!r}: the lens does not cover a {w:g} mm wide sensor; give a smaller sensor"
         )
-    ang = np.degrees(np.arctan2(np.hypot(out.L, out.M), np.abs(out.N)))
+    # the angle to the axis toward the scene (-z): beyond 90 deg for a fisheye corner, not folded back
+    ang = np.degrees(np.arctan2(np.hypot(out.L, out.M), -out.N))
     return float(ang[0]), (float(ang[1]) if ok[1] else None)
 
 

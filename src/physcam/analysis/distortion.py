@@ -155,17 +155,11 @@ class DistortionResult:
 
 
 def _max_field_deg(lens, axis, wl, half_diag, efl, backend) -> float:
-    """Largest field (deg) up to the sensor corner whose chief ray reaches the film unclipped."""
-    lo, hi = 0.0, min(math.degrees(math.atan(half_diag / abs(efl))), 89.0)
-    if _chief_heights(lens, [hi], axis, wl, None, backend, clip=True)[1].all():
-        return hi
-    for _ in range(24):
-        mid = 0.5 * (lo + hi)
-        if _chief_heights(lens, [mid], axis, wl, None, backend, clip=True)[1].all():
-            lo = mid
-        else:
-            hi = mid
-    return lo
+    """Largest field (deg) up to the sensor corner whose chief ray reaches the film unclipped (to 0.01 deg)."""
+    from ._chief import field_limit_deg
+
+    return field_limit_deg(lens, axis, max_deg=min(math.degrees(math.atan(half_diag / abs(efl))), 89.0),
+                           wavelength_nm=wl, backend=backend)
 
 
 def _chief_heights(lens, fields_deg, axis, wl, film_z, backend, clip=True):
@@ -205,6 +199,8 @@ def real_distortion(
     from ..trace import paraxial_image_z
 
     wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
+    if isinstance(n_fields, bool) or not isinstance(n_fields, (int, np.integer)) or not 3 <= n_fields <= 200:
+        raise InputError(f"n_fields must be a whole number from 3 to 200, got {n_fields!r}")
     w = require_positive("sensor width", sensor_width_mm)
     h = require_positive("sensor height", sensor_height_mm)
     if film_z is None:
@@ -225,8 +221,6 @@ def real_distortion(
             if top < corner - 1e-6:
                 notes.append(f"{axis.upper()} meridian: chief rays pass only up to {top:.2f} deg "
                              f"(sensor corner at {corner:.2f} deg)")
-            if n_fields < 3:
-                raise InputError(f"n_fields must be >= 3, got {n_fields}")
             fields = np.linspace(0.0, top, n_fields)
         else:
             fields = np.array([require_finite("field angle", f) for f in np.atleast_1d(fields_deg)], dtype=float)

@@ -9,11 +9,12 @@ Systems for Engineers*, ch. 6; Kingslake & Johnson, *Lens Design Fundamentals*, 
 Siew, *Breaking down the cosine fourth power law*, 2019). Relative illumination
 RI(theta) = E(theta) / E(0). No cos^4 is put in: it emerges from the real rays.
 
-- A(theta): collimated rays on a fine square grid over the part of the front vertex plane that
-  a pilot grid found to pass (the pilot grid covers the whole front element), traced to the
-  film with clipping at every clear semi-diameter and the stop; each passing ray stands for its
-  grid cell's area times cos(theta) (the cell foreshortened as seen along the beam), times its
-  Fresnel transmission when ``fresnel``.
+- A(theta): collimated rays on a fine square grid on a plane in front of the whole front element,
+  over the part that a pilot grid found to pass (the pilot grid covers the projection of the
+  front element's clear aperture along the beam, so an oblique beam through a curved front
+  surface is sampled whole), traced to the film with clipping at every clear semi-diameter and
+  the stop; each passing ray stands for its grid cell's area times cos(theta) (the cell
+  foreshortened as seen along the beam), times its Fresnel transmission when ``fresnel``.
 - d(omega)/dA: the real chief rays (aimed through the stop centre) of the direction cosines
   (l, m) and of (l + e, m), (l, m + e); their film positions give the Jacobian J = d(x, y)/d(l, m),
   and d(omega) = dl dm / n, so dA/d(omega) = |J| n with n = cos(theta). This includes the
@@ -89,37 +90,74 @@ class IlluminationResult:
         return save(fig, path, force)
 
 
+#: Largest ``grid`` (rays per side of the fine sampling grid); the grid is traced in row chunks.
+MAX_GRID = 2000
+_CHUNK_RAYS = 1 << 18
+
+
+def _launch_window(lens, direction):
+    """Start plane z0 and the rectangle on it that holds every ray of ``direction`` that can meet
+    the front surface inside its clear aperture: the aperture's projection along the beam."""
+    from ..lens.geometry import sag
+    from ._chief import start_plane_z
+
+    s = lens.surfaces[0]
+    sd = s.semi_diameter
+    hs = np.linspace(0.0, sd, 33)
+    zs = [sag(s, float(hh), ax) for hh in hs for ax in ("x", "y")]
+    zmin, zmax = min(zs), max(zs)
+    z0 = start_plane_z(lens)
+    tx, ty = direction[0] / direction[2], direction[1] / direction[2]
+    margin = 0.02 * sd
+    sx = [-(z - z0) * tx for z in (zmin, zmax)]
+    sy = [-(z - z0) * ty for z in (zmin, zmax)]
+    return z0, (-sd + min(sx) - margin, sd + max(sx) + margin, -sd + min(sy) - margin, sd + max(sy) + margin)
+
+
 def _beam_area(lens, direction, wl, film_z, grid, fresnel, stop_sd, backend):
-    """Cross-section (mm^2, perpendicular to the beam) of the collimated beam that reaches the film."""
+    """Cross-section (mm^2, perpendicular to the beam) of the collimated beam that reaches the film.
+
+    Rays start on a plane in front of the whole front element, over the projection of its clear
+    aperture along the beam (every ray that can pass starts there); pilot grids zoom onto the
+    part that passes, then a ``grid`` x ``grid`` midpoint grid (traced in row chunks) sums it.
+    """
     from ..trace import RayBatch, trace_to_film
 
     n_z = direction[2]
+    z0, (x0, x1, y0, y1) = _launch_window(lens, direction)
 
-    def passing(x0, x1, y0, y1, n):
+    def passing(x0, x1, y0, y1, n, rows=None):
         xs = x0 + (np.arange(n) + 0.5) * (x1 - x0) / n
         ys = y0 + (np.arange(n) + 0.5) * (y1 - y0) / n
+        if rows is not None:
+            ys = ys[rows]
         X, Y = np.meshgrid(xs, ys)
-        pos = np.stack([X.ravel(), Y.ravel(), np.zeros(X.size)], axis=1)
+        pos = np.stack([X.ravel(), Y.ravel(), np.full(X.size, z0)], axis=1)
         out = trace_to_film(lens, RayBatch.from_arrays(pos, direction[None, :], wl), film_z, clip=True,
                             fresnel=fresnel, stop_semi_diameter=stop_sd, backend=backend)
         return X.ravel(), Y.ravel(), out.ok, out.weight
 
-    # pilot grids: the whole front element, then zoom on what passed until the beam is well resolved
-    r = 1.05 * lens.surfaces[0].semi_diameter
-    x0, x1, y0, y1 = -r, r, -r, r
+    # pilot grids: the whole projected front aperture, then zoom on what passed until the box
+    # is tight (it shrinks by less than 10 %), so the fine grid spends its rays on the beam
     npil = 64
-    for _ in range(4):
+    for _ in range(8):
         X, Y, ok, _ = passing(x0, x1, y0, y1, npil)
         if not ok.any():
             return 0.0
         cx, cy = (x1 - x0) / npil, (y1 - y0) / npil
-        x0, x1 = X[ok].min() - 2 * cx, X[ok].max() + 2 * cx
-        y0, y1 = Y[ok].min() - 2 * cy, Y[ok].max() + 2 * cy
-        if ok.sum() >= 400:
+        nx0, nx1 = X[ok].min() - 2 * cx, X[ok].max() + 2 * cx
+        ny0, ny1 = Y[ok].min() - 2 * cy, Y[ok].max() + 2 * cy
+        tight = (nx1 - nx0) > 0.9 * (x1 - x0) and (ny1 - ny0) > 0.9 * (y1 - y0)
+        x0, x1, y0, y1 = nx0, nx1, ny0, ny1
+        if tight and ok.sum() >= 400:
             break
-    X, Y, ok, w = passing(x0, x1, y0, y1, grid)
+    total = 0.0
+    step = max(1, _CHUNK_RAYS // grid)
+    for a in range(0, grid, step):
+        _, _, ok, w = passing(x0, x1, y0, y1, grid, slice(a, min(grid, a + step)))
+        total += float(w[ok].sum())
     dA = (x1 - x0) * (y1 - y0) / grid**2
-    return float(w[ok].sum() * dA * n_z)
+    return total * dA * n_z
 
 
 def _mapping(lens, l, m, wl, film_z, backend, eps=1e-5):
@@ -168,8 +206,10 @@ def relative_illumination(
     from ._chief import field_angles_deg, field_direction
 
     wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
-    if not isinstance(grid, (int, np.integer)) or grid < 16:
-        raise InputError(f"grid must be a whole number >= 16, got {grid!r}")
+    if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 16 <= grid <= MAX_GRID:
+        raise InputError(f"grid must be a whole number from 16 to {MAX_GRID} (rays per side), got {grid!r}")
+    if isinstance(n_fields, bool) or not isinstance(n_fields, (int, np.integer)) or not 2 <= n_fields <= 200:
+        raise InputError(f"n_fields must be a whole number from 2 to 200, got {n_fields!r}")
     if film_z is None:
         film_z = paraxial_image_z(lens, wl)
     film_z = require_finite("film_z", film_z)

@@ -1,23 +1,41 @@
 """Spot diagram: where rays from one field point land on the film, and how spread they are.
 
-For each field angle (degrees, in the Y-Z meridian) a collimated beam fills the paraxial entrance
-pupil (overfilled by ``overfill`` so real pupil shifts are covered; the stop and element rims
-clip what does not pass) with deterministic equal-area samples, and is traced to the film plane
-(``film_z``, mm in lens space; default the paraxial image plane at the design wavelength).
-RMS radius is about the centroid, sqrt(mean(dx^2 + dy^2)); geometric radius the largest
-distance from the centroid. Both in micrometres.
+For each field angle (degrees, in the Y-Z meridian) a collimated beam fills a disk on the
+paraxial entrance-pupil plane: the paraxial entrance pupil overfilled by ``overfill`` so real
+pupil shifts are covered (the stop and element rims clip what does not pass), or ``pupil_radius``.
+It is traced to the film plane (``film_z``, mm in lens space; default the paraxial image plane
+at the design wavelength). RMS radius is about the centroid, sqrt(mean(dx^2 + dy^2)); geometric
+radius the largest distance from the centroid. Both in micrometres.
+
+Sampling (area-weighted, deterministic): the disk is cut into equal-area cells on a regular grid
+in (rho^2, phi) -- ``rings`` divisions of rho^2 by about 3 ``rings`` of phi -- each traced at its
+area-median point. A beam clipped by a rim or the stop has an edge that crosses these cells; the
+RMS of an aberrated beam is dominated by its rim, so the edge is refined: a cell whose ray passes
+while a neighbour's does not (or the reverse) is split 2 x 2, for ``refine`` levels, each child
+weighing a quarter of its parent. The edge is thus resolved 2^refine times finer than the base
+grid (32 x by default), for a few times the base count of rays. The means above are weighted by
+cell area. Rays are counted by what stopped them: clipped by an aperture (a rim or the stop),
+missed a surface, or totally reflected (``physcam.trace`` flags). ``clip=False`` lets every ray
+that meets the surfaces through (no rim or stop clips): the beam is then the launched disk,
+by default the paraxial entrance pupil itself. When no ray reaches the film the spot is
+*undefined*: centroid and radii are ``None`` (``null`` in JSON) with a ``reason``.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_finite
+from ..errors import InputError, require_finite
 from ..lens.prescription import Prescription
 
-__all__ = ["equal_area_disk", "SpotField", "SpotDiagram", "spot_diagram"]
+__all__ = ["equal_area_disk", "SpotField", "SpotDiagram", "spot_diagram", "MAX_RINGS", "MAX_REFINE"]
+
+#: Largest ``rings`` (about 3 rings^2 base rays per field) and ``refine`` (levels of edge refinement).
+MAX_RINGS = 500
+MAX_REFINE = 8
 
 
 def equal_area_disk(radius: float, n_rings: int):
@@ -37,20 +55,34 @@ def equal_area_disk(radius: float, n_rings: int):
 
 @dataclass
 class SpotField:
+    """One field's spot: counts of rays by fate, and the area-weighted centroid and radii
+    (``None`` when no ray reaches the film: ``reason`` says why)."""
+
     field_deg: float
     rays_launched: int
     rays_passed: int
-    centroid_x_mm: float
-    centroid_y_mm: float
-    rms_radius_um: float
-    geometric_radius_um: float
+    rays_clipped: int  # stopped by a clear aperture (element rim) or the stop
+    rays_missed: int  # did not meet a surface
+    rays_tir: int  # totally reflected
+    passed_area_fraction: float  # area of the launched disk whose rays reach the film, 0..1
+    centroid_x_mm: float | None
+    centroid_y_mm: float | None
+    rms_radius_um: float | None
+    geometric_radius_um: float | None
     x_mm: np.ndarray = field(repr=False)
     y_mm: np.ndarray = field(repr=False)
+    weight: np.ndarray = field(repr=False)  # each passing ray's share of the launched disk's area
+    reason: str | None = None
+
+    @property
+    def defined(self) -> bool:
+        return self.rms_radius_um is not None
 
     def to_dict(self) -> dict:
         return {k: getattr(self, k) for k in (
-            "field_deg", "rays_launched", "rays_passed", "centroid_x_mm", "centroid_y_mm",
-            "rms_radius_um", "geometric_radius_um")}
+            "field_deg", "rays_launched", "rays_passed", "rays_clipped", "rays_missed", "rays_tir",
+            "passed_area_fraction", "centroid_x_mm", "centroid_y_mm", "rms_radius_um", "geometric_radius_um",
+            "reason")}
 
 
 @dataclass
@@ -59,10 +91,14 @@ class SpotDiagram:
     wavelength_nm: float
     film_z_mm: float
     fields: list[SpotField]
+    clip: bool = True
 
     def to_dict(self) -> dict:
         return {"lens": self.lens_name, "wavelength_nm": self.wavelength_nm, "film_z_mm": self.film_z_mm,
                 "film_z_reference": "lens space: mm from the first vertex, +z toward the film",
+                "clip": self.clip,
+                "definition": "area-weighted RMS and largest radius about the centroid, um; null = undefined "
+                              "(no ray reaches the film)",
                 "fields": [f.to_dict() for f in self.fields]}
 
     def plot(self, path=None, *, force: bool = False):
@@ -74,11 +110,17 @@ class SpotDiagram:
         n = len(self.fields)
         fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 3.4), squeeze=False)
         for ax, f in zip(axes[0], self.fields):
-            ax.scatter((f.x_mm - f.centroid_x_mm) * 1e3, (f.y_mm - f.centroid_y_mm) * 1e3, s=0.3, c="k", lw=0)
             ax.set_aspect("equal")
+            ax.set_xlabel("x (um)")
+            if not f.defined:
+                ax.text(0.5, 0.5, "undefined:\nno ray reaches the film", ha="center", va="center",
+                        transform=ax.transAxes, fontsize=8)
+                ax.set_title(f"{f.field_deg:g} deg\nRMS undefined", fontsize=8)
+                continue
+            size = 0.3 * f.weight / f.weight.max()  # refined rim rays weigh less: drawn smaller
+            ax.scatter((f.x_mm - f.centroid_x_mm) * 1e3, (f.y_mm - f.centroid_y_mm) * 1e3, s=size, c="k", lw=0)
             ax.set_title(f"{f.field_deg:g} deg\nRMS {f.rms_radius_um:.2f} um, GEO {f.geometric_radius_um:.2f} um",
                          fontsize=8)
-            ax.set_xlabel("x (um)")
         axes[0][0].set_ylabel("y (um)")
         fig.suptitle(f"{self.lens_name}: spot diagram at {self.wavelength_nm:g} nm", fontsize=9)
         fig.tight_layout()
@@ -89,32 +131,100 @@ class SpotDiagram:
         return save_figure(fig, path, force=force)
 
 
+def _whole(name: str, value, lo: int, hi: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not lo <= value <= hi:
+        raise InputError(f"{name} must be a whole number from {lo} to {hi}, got {value!r}")
+    return int(value)
+
+
+def _refined_samples(trace, rings: int, refine: int):
+    """Equal-area cells on the unit disk's (rho^2, phi) grid, refined at the edge of what passes.
+
+    ``trace(u, v)`` takes points on the unit disk and returns their tracer flags and film x, y.
+    Returns the leaf cells' weights (summing to 1), flags, and film x, y.
+    """
+    from ..trace import OK
+
+    ns, nphi = rings, 2 * math.ceil(1.5 * rings)
+
+    def points(i, j, level):
+        k = 2**level
+        s = (i + 0.5) / (ns * k)
+        phi = (j + 0.5) * 2.0 * np.pi / (nphi * k)
+        r = np.sqrt(s)
+        return r * np.cos(phi), r * np.sin(phi)
+
+    I, J = np.meshgrid(np.arange(ns), np.arange(nphi), indexing="ij")
+    idx = (I.ravel(), J.ravel())
+    flags, fx, fy = trace(*points(*idx, 0))
+    levels = [(idx, flags, fx, fy)]  # per level: the evaluated cells and their flags
+    status = (flags == OK).reshape(ns, nphi)
+    evaluated = np.ones((ns, nphi), dtype=bool)
+    refined = []  # per level: which evaluated cells were split
+    for level in range(1, refine + 1):
+        # a cell differs from a neighbour (8-connected; phi wraps, rho^2 does not)
+        pad = np.concatenate([status[:1], status, status[-1:]], axis=0)
+        diff = np.zeros_like(status)
+        for di in (-1, 0, 1):
+            for dj in (-1, 0, 1):
+                if di or dj:
+                    diff |= np.roll(pad, dj, axis=1)[1 + di:1 + di + status.shape[0]] != status
+        split = evaluated & diff
+        (pi, pj) = levels[-1][0]
+        refined.append(split[pi, pj])
+        si, sj = np.nonzero(split)
+        if si.size == 0:
+            break
+        ci = np.concatenate([2 * si, 2 * si, 2 * si + 1, 2 * si + 1])
+        cj = np.concatenate([2 * sj, 2 * sj + 1, 2 * sj, 2 * sj + 1])
+        f, fx, fy = trace(*points(ci, cj, level))
+        levels.append(((ci, cj), f, fx, fy))
+        status = np.repeat(np.repeat(status, 2, axis=0), 2, axis=1)
+        status[ci, cj] = f == OK
+        evaluated = np.zeros_like(status)
+        evaluated[ci, cj] = True
+    ws, fs, xs, ys = [], [], [], []
+    for level, ((i, j), f, fx, fy) in enumerate(levels):
+        leaf = ~refined[level] if level < len(refined) else np.ones(i.size, dtype=bool)
+        ws.append(np.full(int(leaf.sum()), 1.0 / (ns * nphi * 4**level)))
+        fs.append(f[leaf])
+        xs.append(fx[leaf])
+        ys.append(fy[leaf])
+    return np.concatenate(ws), np.concatenate(fs), np.concatenate(xs), np.concatenate(ys)
+
+
 def spot_diagram(
     lens: Prescription,
     fields_deg=(0.0,),
     *,
     wavelength_nm: float | None = None,
     film_z: float | None = None,
-    rings: int = 40,
+    rings: int = 64,
+    refine: int = 5,
     overfill: float = 1.3,
     pupil_radius: float | None = None,
     fstop: float | None = None,
+    clip: bool = True,
     backend: str = "auto",
 ) -> SpotDiagram:
     """Spot diagram of ``lens`` at the given field angles (see module notes).
 
-    ``pupil_radius`` (mm) replaces the overfilled entrance pupil by a disk of that radius on the
-    entrance-pupil plane (e.g. to compare with a published figure at a given beam size).
-    ``fstop`` stops the lens down (the stop's semi-diameter scaled to that f-number).
+    ``rings`` (1 to :data:`MAX_RINGS`) sets the base grid, ``refine`` (0 to :data:`MAX_REFINE`)
+    the levels of edge refinement. ``pupil_radius`` (mm) replaces the overfilled entrance pupil
+    by a disk of that radius on the entrance-pupil plane (e.g. to compare with a published figure
+    at a given beam size). ``fstop`` stops the lens down (the stop's semi-diameter scaled to that
+    f-number). ``clip=False``: no rim or stop clips (the default beam is then the paraxial
+    entrance pupil, not overfilled). A field where no ray reaches the film is undefined (module notes).
     """
     from ..optics.paraxial import gaussian
-    from ..trace import RayBatch, paraxial_image_z, trace_to_film
+    from ..trace import CLIPPED, MISSED, OK, TIR, RayBatch, paraxial_image_z, trace_to_film
+    from ._chief import start_plane_z
 
     wl = lens.wavelength_nm if wavelength_nm is None else require_finite("wavelength_nm", wavelength_nm)
+    rings = _whole("rings", rings, 1, MAX_RINGS)
+    refine = _whole("refine", refine, 0, MAX_REFINE)
     if film_z is None:
         film_z = paraxial_image_z(lens, wl)
-    if not 1 <= rings <= 2000:
-        raise InputError(f"rings must lie between 1 and 2000 (3 n (n + 1) rays per field), got {rings}")
     stop = None
     if fstop is not None:
         from ..optics.paraxial import stop_semi_diameter_for_fstop
@@ -122,28 +232,44 @@ def spot_diagram(
         stop = stop_semi_diameter_for_fstop(lens, fstop, wavelength_nm=wl)
     g = gaussian(lens, wavelength_nm=wl, fstop=fstop)
     z_ep, r_ep = g.z_entrance_pupil, g.entrance_pupil_diameter / 2
-    beam = r_ep * overfill if pupil_radius is None else require_finite("pupil_radius", pupil_radius)
+    if pupil_radius is not None:
+        beam = require_finite("pupil_radius", pupil_radius)
+    else:
+        beam = r_ep * (require_finite("overfill", overfill) if clip else 1.0)
     if beam <= 0:
-        raise InputError(f"pupil_radius must be > 0 mm, got {beam:g}")
-    px, py = equal_area_disk(beam, rings)
-    out = []
-    for fd in fields_deg:
-        fd = require_finite("field angle", fd)
+        raise InputError(f"pupil_radius (overfill) must be > 0, got {beam:g}")
+    fields = [require_finite("field angle", fd) for fd in np.atleast_1d(fields_deg)]
+    for fd in fields:
         if not -89.0 < fd < 89.0:
             raise InputError(f"field angle must lie between -89 and 89 degrees, got {fd:g}")
+    z0 = min(z_ep, start_plane_z(lens)) - 1.0
+    out = []
+    for fd in fields:
         th = np.radians(fd)
         d = np.array([0.0, np.sin(th), np.cos(th)])
-        z0 = min(z_ep, 0.0) - 1.0
         back = (z_ep - z0) / d[2]
-        start = np.stack([px, py - back * d[1], np.full(px.size, z0)], axis=1)
-        rays = RayBatch.from_arrays(start, d[None, :], wl)
-        res = trace_to_film(lens, rays, film_z, stop_semi_diameter=stop, backend=backend)
-        ok = res.ok
+
+        def trace(u, v):
+            start = np.stack([beam * u, beam * v - back * d[1], np.full(u.size, z0)], axis=1)
+            res = trace_to_film(lens, RayBatch.from_arrays(start, d[None, :], wl), film_z, clip=clip,
+                                stop_semi_diameter=stop, backend=backend)
+            return res.flag, res.x, res.y
+
+        w, flags, fx, fy = _refined_samples(trace, rings, refine)
+        ok = flags == OK
+        counts = {k: int((flags == k).sum()) for k in (OK, CLIPPED, MISSED, TIR)}
+        frac = float(w[ok].sum())
         if not ok.any():
-            raise OpticsError(f"no ray at field {fd:g} deg passes through {lens.name!r}; choose a smaller field angle")
-        x, y = res.x[ok], res.y[ok]
-        cx, cy = float(x.mean()), float(y.mean())
+            out.append(SpotField(float(fd), int(w.size), 0, counts[CLIPPED], counts[MISSED], counts[TIR], 0.0,
+                                 None, None, None, None, np.zeros(0), np.zeros(0), np.zeros(0),
+                                 f"no ray at field {fd:g} deg reaches the film through {lens.name!r} "
+                                 f"(clipped {counts[CLIPPED]}, missed {counts[MISSED]}, totally reflected "
+                                 f"{counts[TIR]}): the spot is undefined"))
+            continue
+        x, y, wk = fx[ok], fy[ok], w[ok]
+        cx, cy = float(np.average(x, weights=wk)), float(np.average(y, weights=wk))
         r2 = (x - cx) ** 2 + (y - cy) ** 2
-        out.append(SpotField(fd, int(len(rays)), int(ok.sum()), cx, cy, float(np.sqrt(r2.mean()) * 1e3),
-                             float(np.sqrt(r2.max()) * 1e3), x, y))
-    return SpotDiagram(lens.name, wl, float(film_z), out)
+        out.append(SpotField(float(fd), int(w.size), counts[OK], counts[CLIPPED], counts[MISSED], counts[TIR], frac,
+                             cx, cy, float(np.sqrt(np.average(r2, weights=wk)) * 1e3), float(np.sqrt(r2.max()) * 1e3),
+                             x, y, wk))
+    return SpotDiagram(lens.name, float(wl), float(film_z), out, bool(clip))

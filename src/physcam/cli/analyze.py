@@ -56,7 +56,7 @@ def register(sub) -> None:
     p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG")
     p.add_argument("--max-field", type=number("max field"), default=None, metavar="DEG")
     p.add_argument("--fstop", type=number("f-stop"), default=None, help="stop the lens down to this f-number")
-    p.add_argument("--grid", type=int, default=200, help="rays per side of the pupil grid (default 200)")
+    p.add_argument("--grid", type=int, default=200, help="rays per side of the sampling grid (16-2000, default 200)")
     p.add_argument("--fresnel", action="store_true", help="include Fresnel losses at every surface")
     _sensor(p)
     p.set_defaults(handler=run_illumination)

@@ -11,8 +11,12 @@ def register(sub) -> None:
     p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG",
                    help="field angle in degrees (repeat; default 0 and 5)")
     p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM")
-    p.add_argument("--rings", type=int, default=40, help="equal-area pupil rings (3 n (n+1) rays per field)")
+    p.add_argument("--rings", type=int, default=64,
+                   help="divisions of the pupil radius squared (1-500; about 3 n^2 equal-area rays per field, "
+                        "plus the refined beam edge; default 64)")
     p.add_argument("--fstop", type=number("f-stop"), default=None, help="stop the lens down to this f-number")
+    p.add_argument("--no-clip", dest="clip", action="store_false",
+                   help="no element rim or stop clips: trace the whole paraxial entrance pupil")
     p.add_argument("--json", action="store_true", help="print as JSON")
     p.add_argument("-o", "--output", metavar="FILE.png", help="write the spot diagram plot")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
@@ -52,16 +56,23 @@ def run_spot(args) -> int:
         check_writable(args.output, force=args.force)
     lens = load_lens(args.lens)
     res = spot_diagram(lens, tuple(args.field or (0.0, 5.0)), wavelength_nm=args.wavelength, rings=args.rings,
-                       fstop=args.fstop)
+                       fstop=args.fstop, clip=args.clip)
     if args.output:
         res.plot(args.output, force=args.force)
     if args.json:
         print_json(res.to_dict())
     else:
-        print(f"{res.lens_name}: spot diagram at {res.wavelength_nm:g} nm, film z = {res.film_z_mm:.4f} mm")
+        print(f"{res.lens_name}: spot diagram at {res.wavelength_nm:g} nm, film z = {res.film_z_mm:.4f} mm"
+              + ("" if res.clip else ", no clipping"))
+        print(f"  {'field deg':>9} {'RMS um':>10} {'GEO um':>10} {'passed':>7} {'clipped':>7} {'missed':>7} {'TIR':>7}")
         for f in res.fields:
-            print(f"  field {f.field_deg:6.2f} deg  RMS {f.rms_radius_um:9.3f} um  GEO {f.geometric_radius_um:9.3f} um"
-                  f"  rays {f.rays_passed}/{f.rays_launched}")
+            rms = "undefined" if f.rms_radius_um is None else f"{f.rms_radius_um:.3f}"
+            geo = "undefined" if f.geometric_radius_um is None else f"{f.geometric_radius_um:.3f}"
+            print(f"  {f.field_deg:9.2f} {rms:>10} {geo:>10} {f.rays_passed:7d} {f.rays_clipped:7d} {f.rays_missed:7d} "
+                  f"{f.rays_tir:7d}")
+        for f in res.fields:
+            if f.reason:
+                print(f"  note: {f.reason}")
         if args.output:
             print(f"wrote {args.output}")
     return 0
