@@ -195,3 +195,37 @@ def test_technical_fov_at_focus_uses_where_the_film_is():
     r = solve_lens_report(focal_length_mm=50.0, sensor=FF, fstop=2.0, focus_mm=2000.0, model="technical",
                           h1_mm=80.0, h2_mm=60.0)
     assert r.hfov_focus_deg == pytest.approx(math.degrees(2 * math.atan(36.0 / 120.0)))
+
+
+def test_fisheye_report_gives_the_real_ray_field_and_warns():
+    """Issue 8.2: `report --lens nikkor_fisheye_16mm_f2_8 --focus 3m --sensor FF` said 97.7 deg
+    horizontal; traced chief rays give about 140 deg (the issue's independent oracle). The report
+    now gives both, says which is which, and warns."""
+    import json
+
+    from physcam.errors import PhysCamWarning
+    from physcam.lens.library import load_lens
+
+    with pytest.warns(PhysCamWarning, match="real chief rays give 140"):
+        r = solve_lens_report(focal_length_mm=None, sensor=find_sensor("FF"), focus_mm=3000.0,
+                              lens=load_lens("nikkor_fisheye_16mm_f2_8"))
+    d = json.loads(json.dumps(r.to_dict()))
+    assert d["fov_deg"]["real"]["horizontal"] == pytest.approx(140.0, abs=0.5)
+    assert d["fov_deg"]["focus"]["horizontal"] == pytest.approx(97.6, abs=0.2)  # the pinhole's
+    assert d["fov_deg"]["real_differs"] is True and "definition" in d["fov_deg"]
+    assert any("real chief rays" in n for n in d["notes"])
+
+
+def test_rectilinear_lens_real_field_agrees_and_does_not_warn():
+    import warnings
+
+    from physcam.errors import PhysCamWarning
+    from physcam.lens.library import load_lens
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PhysCamWarning)
+        r = solve_lens_report(focal_length_mm=None, sensor=find_sensor("FF"), focus_mm=3000.0,
+                              lens=load_lens("dgauss_50mm"))
+    # barrel distortion of about 1 %: real and pinhole fields within the 2 % tolerance
+    assert r.real_fov["horizontal_deg"] == pytest.approx(r.hfov_focus_deg, rel=0.02)
+    assert not r.real_fov_differs

@@ -92,3 +92,20 @@ def test_report_json_imports_no_heavy_library():
             "print(','.join(heavy))")
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert p.stdout.strip() == ""
+
+
+def test_fisheye_camera_blocks_say_which_field_they_show(capsys, tmp_path):
+    """Issue 8.2: the camera blocks and the USD companion carry the real-ray field and a note."""
+    from pxr import Usd
+
+    assert main(["report", "--lens", "nikkor_fisheye_16mm_f2_8", "--focus", "3m", "--sensor", "FF", "--json"]) == 0
+    captured = capsys.readouterr()
+    assert "physcam: warning: real chief rays give 140" in captured.err
+    cams = json.loads(captured.out)["cameras"]
+    assert cams["fov_deg"]["real"]["horizontal"] == pytest.approx(140.0, abs=0.5)
+    assert cams["notes"] and "pinholes" in cams["notes"][0]
+    f = tmp_path / "fisheye.usda"
+    assert main(["usd", "write", str(f), "--lens", "nikkor_fisheye_16mm_f2_8", "--focus", "3m", "--sensor", "FF"]) == 0
+    stage = Usd.Stage.Open(str(f))
+    fov = stage.GetPrimAtPath("/Cameras/Camera/Camera").GetCustomDataByKey("physcam:fieldOfView")
+    assert fov["realChiefRaysDeg"][0] == pytest.approx(140.0, abs=0.5) and fov["realDiffers"]

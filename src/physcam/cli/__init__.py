@@ -19,7 +19,7 @@ import pkgutil
 import sys
 
 from .. import __version__
-from ..errors import PhysCamError
+from ..errors import PhysCamError, PhysCamWarning
 
 __all__ = ["main", "build_parser"]
 
@@ -62,8 +62,21 @@ def _silence_stdout() -> None:
         pass
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """physcam's warnings as one line for people: ``physcam: warning: ...`` on stderr."""
+    import warnings
+
+    if issubclass(category, PhysCamWarning):
+        print(f"physcam: warning: {message}", file=sys.stderr)
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 done, 2 refused input or unwritable output)."""
+    import warnings
+
+    warnings.showwarning = _show_warning
     parser = build_parser()
     try:
         args = parser.parse_args(argv)

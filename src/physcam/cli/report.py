@@ -147,11 +147,19 @@ def camera_blocks(report, args) -> dict:
 
     mpu = args.meters_per_unit
     shift = (getattr(args, "shift_x", 0.0), getattr(args, "shift_y", 0.0))
-    return {
+    d = report.to_dict()
+    blocks = {
         "meters_per_unit": mpu,
+        "camera": "the best-match pinhole at the entrance pupil (docs/lens-report.md)",
+        "fov_deg": {"pinhole": d["fov_deg"]["focus"], "real": d["fov_deg"]["real"]},
         "usd_geom_camera": usdgeom_camera_values(report, mpu, shutter_angle_deg=args.shutter_angle, shift_mm=shift),
         "renderman": renderman_camera_values(report, mpu, shift_mm=shift),
+        "notes": [],
     }
+    if report.real_fov_differs:
+        blocks["notes"].append("these cameras are pinholes: they show the pinhole field of view, not the real "
+                               "lens's (see fov_deg.real); distortion this strong needs a real-lens camera")
+    return blocks
 
 
 def run(args) -> int:

@@ -28,6 +28,11 @@ from .sensors import Sensor
 
 __all__ = ["LensReport", "DepthOfField", "solve_lens_report", "takes_report", "REPORT_SCHEMA", "REPORT_VERSION"]
 
+#: Real (chief-ray) and pinhole fields of view may differ by this much (percent, any of horizontal,
+#: vertical, diagonal) before the report warns: about what a fitted two-term radial distortion
+#: model on the render camera still corrects (dgauss.50mm, barrel: 1.0 % h, 1.5 % d).
+REAL_FOV_TOLERANCE_PCT = 2.0
+
 REPORT_SCHEMA = "physcam.lens_report"
 REPORT_VERSION = 1
 
@@ -135,8 +140,21 @@ class LensReport:
     #: None means the thin-lens value, the distance from H2 to the film.
     pinhole_focal_length_mm: float | None = None
     pinhole_squeeze: float | None = None
+    #: with a prescription: the field of view of real chief rays from the film edge, top and corner
+    #: (:func:`physcam.analysis.field_of_view.real_field_of_view`, as its ``to_dict``), beside the
+    #: paraxial pinhole's; None for the thin-lens and datasheet models.
+    real_fov: dict | None = None
 
     # --- convenience --------------------------------------------------------
+    @property
+    def real_fov_differs(self) -> bool:
+        """True when distortion makes the pinhole's field of view wrong by more than
+        :data:`REAL_FOV_TOLERANCE_PCT` in some direction, or the sensor is not covered."""
+        if not self.real_fov:
+            return False
+        diffs = [self.real_fov.get(f"{k}_difference_pct") for k in ("horizontal", "vertical", "diagonal")]
+        return any(d is None or abs(d) > REAL_FOV_TOLERANCE_PCT for d in diffs)
+
     @property
     def pinhole(self) -> tuple[float, float]:
         """(focal length mm, squeeze) of the best-match pinhole (see the field notes)."""
@@ -203,6 +221,15 @@ class LensReport:
                              "diagonal": self.dfov_inf_deg},
                 "focus": {"horizontal": self.hfov_focus_deg, "vertical": self.vfov_focus_deg,
                           "diagonal": self.dfov_focus_deg},
+                "definition": "infinity and focus: the paraxial (pinhole) field; real: chief rays traced through "
+                              "the prescription from the film edge, top and corner (null where not covered)",
+                "real": None if self.real_fov is None else {
+                    "horizontal": self.real_fov["horizontal_deg"], "vertical": self.real_fov["vertical_deg"],
+                    "diagonal": self.real_fov["diagonal_deg"],
+                    "difference_pct": {k: self.real_fov[f"{k}_difference_pct"]
+                                       for k in ("horizontal", "vertical", "diagonal")},
+                    "not_covered": list(self.real_fov["not_covered"]), "reason": self.real_fov["reason"]},
+                "real_differs": self.real_fov_differs,
             },
             "entrance_pupil_from_film_mm": self.entrance_pupil_from_film_mm,
             "entrance_pupil_source": self.entrance_pupil_source,
@@ -587,8 +614,41 @@ def solve_lens_report(
         pinhole_squeeze=pin_sq,
         **fov,
     )
+    if lens is not None:
+        report = _with_real_fov(report, lens)
     _check_finite(report)
     return report
+
+
+def _with_real_fov(report: LensReport, lens) -> LensReport:
+    """Add the real-ray field of view of ``lens`` (issue 8: a fisheye's paraxial field is 98 deg where
+    its chief rays reach 140 deg) and, when it differs from the pinhole's, a note and a warning."""
+    import dataclasses
+    import warnings
+
+    from ..analysis.field_of_view import real_field_of_view
+    from ..errors import PhysCamError, PhysCamWarning
+
+    s = report.sensor
+    try:
+        real = real_field_of_view(lens, s.width_mm, s.height_mm, focus_from_film_mm=report.focus_from_film_mm)
+    except PhysCamError as exc:
+        return dataclasses.replace(report, notes=report.notes + (f"real-ray field of view not available: {exc}",))
+    report = dataclasses.replace(report, real_fov=real.to_dict())
+    if not report.real_fov_differs:
+        return report
+
+    def deg(v):
+        return "not covered" if v is None else f"{v:.1f}°"
+
+    msg = (f"real chief rays give {deg(real.horizontal_deg)} x {deg(real.vertical_deg)} (diagonal "
+           f"{deg(real.diagonal_deg)}); the pinhole (paraxial) field is {report.hfov_focus_deg:.1f}° x "
+           f"{report.vfov_focus_deg:.1f}° (diagonal {report.dfov_focus_deg:.1f}°): distortion this strong is not a "
+           "pinhole, so the render camera frames the centre like the lens but not the edges")
+    if real.not_covered:
+        msg += f"; the sensor's {', '.join(real.not_covered)} lie outside the lens's image circle"
+    warnings.warn(msg, PhysCamWarning, stacklevel=3)
+    return dataclasses.replace(report, notes=report.notes + (msg,))
 
 
 #: Largest finite distance the report accepts (1000 km); beyond it use infinity.

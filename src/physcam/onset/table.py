@@ -54,6 +54,11 @@ def report_table(report):
     fi, ff = d["fov_deg"]["infinity"], d["fov_deg"]["focus"]
     add("FOV h / v / d (infinity)", f"{fi['horizontal']:.2f}° / {fi['vertical']:.2f}° / {fi['diagonal']:.2f}°", "")
     add("FOV h / v / d (at focus)", f"{ff['horizontal']:.2f}° / {ff['vertical']:.2f}° / {ff['diagonal']:.2f}°", "")
+    real = fi and d["fov_deg"].get("real")
+    if real:
+        fmt = lambda v: "not covered" if v is None else f"{v:.2f}°"  # noqa: E731
+        add("FOV h / v / d (real rays)", f"{fmt(real['horizontal'])} / {fmt(real['vertical'])} / "
+            f"{fmt(real['diagonal'])}" + ("  [differs from the pinhole]" if d["fov_deg"]["real_differs"] else ""), "")
     pin = d["pinhole"]
     add("pinhole (render camera)", f"{pin['focal_length_mm']:.3f} mm" + (
         f", squeeze {pin['squeeze']:.4g}" if pin["squeeze"] != 1.0 else "") + "  [frames like the lens at focus]",

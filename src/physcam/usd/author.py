@@ -532,6 +532,20 @@ def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None, lens
          shutter_opening_curve(*spec.shutter_opening), custom=True)
     if lens_distortion is not None:
         _author_lens_distortion(prim, lens_distortion)
+    if report is not None and report.real_fov is not None:
+        # say which field of view this camera shows, and what the real lens shows (issue 8)
+        real = {k: report.real_fov[f"{k}_deg"] for k in ("horizontal", "vertical", "diagonal")}
+        prim.SetCustomDataByKey("physcam:fieldOfView", {
+            "pinholeDeg": Gf.Vec3d(report.hfov_focus_deg, report.vfov_focus_deg, report.dfov_focus_deg),
+            "realChiefRaysDeg": Gf.Vec3d(*(-1.0 if v is None else v for v in real.values())),
+            "realDiffers": bool(report.real_fov_differs),
+        })
+        if report.real_fov_differs:
+            prim.SetDocumentation(
+                "A pinhole: it frames the lens's centre at this focus, not its edges. The real lens's chief rays "
+                f"cover {', '.join('not covered' if v is None else f'{v:.1f}' for v in real.values())} degrees "
+                "(horizontal, vertical, diagonal; -1 in customData means not covered); render with the "
+                "prescription for the real field.")
     xf = UsdGeom.Xformable(prim)
     xf.ClearXformOpOrder()
     xf.AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, -su(eye)))
