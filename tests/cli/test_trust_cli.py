@@ -51,7 +51,7 @@ def run_in(capsys, *argv):
 
 @pytest.mark.parametrize("argv, says", [
     # a zero sensor quietly became Super 35
-    (["--sensor-width", "0", "--sensor-height", "0"], "sensor width and height must lie between 0 and 1000"),
+    (["--sensor-width", "0", "--sensor-height", "0"], "sensor width and height must lie between 0.5 and 1000"),
     # --sensor-front without --lens-length was ignored
     (["--sensor-front", "30cm"], "needs the lens length"),
     (["--lens-length", "12cm"], "only with the sensor-to-lens-front"),
@@ -94,3 +94,17 @@ def test_lens_breathing_focus_acts(capsys):
     rc, out, _ = run_in(capsys, "lens", "show", "dgauss_50mm", "--focus", "2m", "--json")
     show = json.loads(out)
     assert row["back_focus_mm"] == pytest.approx(show["focus"]["back_focus_mm"], abs=1e-6)
+
+
+def test_ghosts_with_a_hair_thin_sensor_is_refused_before_allocating():
+    """Issue 8: `ghosts dgauss_50mm --sensor-width 0.001mm --sensor-height 24` grew to 24 GB (a
+    256 x 6e6 pixel image). A custom sensor is bounded in size and aspect before any allocation."""
+    rc, _, err = run_cli("ghosts", "dgauss_50mm", "--sensor-width", "0.001mm", "--sensor-height", "24", "-o", "g.png")
+    assert "sensor width and height must lie between" in one_line_error(rc, err)
+    rc, _, err = run_cli("ghosts", "dgauss_50mm", "--sensor-width", "36", "--sensor-height", "1", "-o", "g.png")
+    assert "36:1" in one_line_error(rc, err)
+
+
+def test_illumination_huge_grid_is_refused():
+    rc, _, err = run_cli("illumination", "dgauss_50mm", "--grid", "100000")
+    assert "grid" in one_line_error(rc, err)

@@ -27,7 +27,7 @@ def _sensor(p) -> None:
 def _resolve_sensor(args) -> None:
     """Fill args.sensor_width/height (mm) from --sensor NAME, or the pair, or full frame 36x24."""
     from ..errors import InputError
-    from ..onset.sensors import find_sensor
+    from ..onset.sensors import custom_sensor, find_sensor
 
     if not hasattr(args, "sensor_width"):
         return
@@ -40,6 +40,9 @@ def _resolve_sensor(args) -> None:
         args.sensor_width, args.sensor_height = 36.0, 24.0
     elif args.sensor_width is None or args.sensor_height is None:
         raise InputError("give both --sensor-width and --sensor-height")
+    else:
+        s = custom_sensor(args.sensor_width, args.sensor_height)  # bounded size and aspect
+        args.sensor_width, args.sensor_height = s.width_mm, s.height_mm
 
 
 def register(sub) -> None:
@@ -187,7 +190,7 @@ def run_breathing(args) -> int:
               f"{res.sensor_mm[0]:g} x {res.sensor_mm[1]:g} mm")
         print(f"  {'focus mm':>10} {'HFOV par':>9} {'HFOV real':>9} {'DFOV real':>9} {'chg par %':>9} {'chg real %':>10}")
         for r in res.rows:
-            f = "inf" if math.isinf(r.focus_from_film_mm) else f"{r.focus_from_film_mm:.0f}"
+            f = "∞" if math.isinf(r.focus_from_film_mm) else f"{r.focus_from_film_mm:.0f}"
             dfov = "-" if r.dfov_real_deg is None else f"{r.dfov_real_deg:.3f}"
             print(f"  {f:>10} {r.hfov_paraxial_deg:9.3f} {r.hfov_real_deg:9.3f} {dfov:>9} "
                   f"{r.change_paraxial_pct:9.3f} {r.change_real_pct:10.3f}")

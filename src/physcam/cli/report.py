@@ -81,7 +81,7 @@ def add_report_arguments(p) -> None:
 
 def resolve_sensor(args):
     from ..errors import InputError
-    from ..onset.sensors import Sensor, find_sensor
+    from ..onset.sensors import custom_sensor, find_sensor
 
     custom = args.sensor_width is not None or args.sensor_height is not None
     if args.sensor is not None and custom:
@@ -91,11 +91,7 @@ def resolve_sensor(args):
     if custom:
         if args.sensor_width is None or args.sensor_height is None:
             raise InputError("give both --sensor-width and --sensor-height")
-        if not (0 < args.sensor_width <= 1000 and 0 < args.sensor_height <= 1000):
-            raise InputError(f"sensor width and height must lie between 0 and 1000 mm, got "
-                             f"{args.sensor_width:g} x {args.sensor_height:g} mm")
-        return Sensor("custom", f"custom {args.sensor_width:g} x {args.sensor_height:g} mm",
-                      args.sensor_width, args.sensor_height)
+        return custom_sensor(args.sensor_width, args.sensor_height)
     return find_sensor("Super 35")
 
 

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from ..errors import SensorError
 
-__all__ = ["Sensor", "sensors", "find_sensor"]
+__all__ = ["Sensor", "sensors", "find_sensor", "custom_sensor", "SENSOR_SIZE_RANGE_MM", "SENSOR_MAX_ASPECT"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -41,6 +41,29 @@ class Sensor:
     @property
     def aspect(self) -> float:
         return self.width_mm / self.height_mm
+
+
+#: A custom sensor's width and height (mm): from a phone's sensor to beyond 15/70 IMAX film.
+SENSOR_SIZE_RANGE_MM = (0.5, 1000.0)
+#: The widest aspect ratio (either way) of a custom sensor: panoramic film is about 3:1, line
+#: sensors aside; a 36 x 0.001 mm "sensor" is a typo that would size a 24 GB image (issue 8).
+SENSOR_MAX_ASPECT = 20.0
+
+
+def custom_sensor(width_mm, height_mm) -> Sensor:
+    """A sensor measured by hand, ``width_mm`` x ``height_mm``, checked against
+    :data:`SENSOR_SIZE_RANGE_MM` and :data:`SENSOR_MAX_ASPECT` (else :class:`SensorError`)."""
+    from ..errors import require_finite
+
+    w = require_finite("sensor width", width_mm, error=SensorError)
+    h = require_finite("sensor height", height_mm, error=SensorError)
+    lo, hi = SENSOR_SIZE_RANGE_MM
+    if not (lo <= w <= hi and lo <= h <= hi):
+        raise SensorError(f"sensor width and height must lie between {lo:g} and {hi:g} mm, got {w:g} x {h:g} mm")
+    if max(w / h, h / w) > SENSOR_MAX_ASPECT:
+        raise SensorError(f"a {w:g} x {h:g} mm sensor is {max(w / h, h / w):.0f}:1; physcam accepts up to "
+                          f"{SENSOR_MAX_ASPECT:g}:1 (check the units)")
+    return Sensor("custom", f"custom {w:g} x {h:g} mm", w, h)
 
 
 def _norm(text: str) -> str:
