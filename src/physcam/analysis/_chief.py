@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..lens.geometry import sag
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["AimedRays", "aim_from_infinity", "aim_from_film", "field_direction", "start_plane_z", "chief_ray_passes",
            "field_limit_deg"]
@@ -63,6 +63,7 @@ def field_direction(angle_rad, axis: str = "y") -> np.ndarray:
     return d
 
 
+@takes_prescription
 def start_plane_z(lens: Prescription) -> float:
     """A plane in front of the first surface's whole clear aperture (mm, lens space)."""
     s = lens.surfaces[0]
@@ -156,6 +157,7 @@ def _continuation(residual_t, n: int, scale: float, *, min_step: float = 2e-3, m
     return u, v, done, err
 
 
+@takes_prescription
 def aim_from_infinity(
     lens: Prescription, directions, *, wavelength_nm: float, backend: str = "auto"
 ) -> AimedRays:
@@ -164,6 +166,8 @@ def aim_from_infinity(
     from ..trace import RayBatch, trace_through
 
     d = np.atleast_2d(np.asarray(directions, dtype=np.float64))
+    if d.ndim != 2 or d.shape[1] != 3 or not np.isfinite(d).all():
+        raise InputError(f"directions must be finite (n, 3) vectors, got shape {d.shape}")
     d = d / np.linalg.norm(d, axis=1)[:, None]
     if (d[:, 2] <= 1e-6).any():
         raise InputError("field directions must travel toward the film (field angle below 90 degrees)")
@@ -199,6 +203,7 @@ def aim_from_infinity(
     return AimedRays(start, d, ok, err)
 
 
+@takes_prescription
 def aim_from_film(
     lens: Prescription, film_xy, film_z: float, *, wavelength_nm: float, backend: str = "auto"
 ) -> AimedRays:
@@ -210,6 +215,8 @@ def aim_from_film(
     from ..trace import RayBatch, trace_through
 
     p = np.atleast_2d(np.asarray(film_xy, dtype=np.float64))
+    if p.ndim != 2 or p.shape[1] != 2 or not np.isfinite(p).all():
+        raise InputError(f"film points must be finite (n, 2) coordinates in mm, got shape {p.shape}")
     k = lens.stop_index
     back = lens.with_surfaces(lens.surfaces[k:])
     zk = lens.vertex_z[k]  # the cut lens has its first vertex (the stop) at z = 0
@@ -266,6 +273,7 @@ def field_angles_deg(fields_deg, max_field_deg, n_fields: int, half_diagonal_mm:
     return np.linspace(0.0, top, int(n_fields))
 
 
+@takes_prescription
 def chief_ray_passes(lens: Prescription, fields_deg, axis: str = "y", *, wavelength_nm: float,
                      backend: str = "auto") -> np.ndarray:
     """Whether the aimed chief ray of each field angle (degrees, ``axis``-Z meridian) goes through
@@ -279,6 +287,7 @@ def chief_ray_passes(lens: Prescription, fields_deg, axis: str = "y", *, wavelen
     return aimed.ok & out.ok
 
 
+@takes_prescription
 def field_limit_deg(lens: Prescription, axis: str = "y", *, max_deg: float = 89.0, wavelength_nm: float,
                     tol_deg: float = 0.01, backend: str = "auto") -> float:
     """The largest field angle (degrees, up to ``max_deg``) up to which the aimed chief rays pass.

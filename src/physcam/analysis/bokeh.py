@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["BokehImage", "bokeh_image", "RGB_WAVELENGTHS_NM"]
 
@@ -71,6 +71,7 @@ class BokehImage:
         return save_figure(fig, path, force=force)
 
 
+@takes_prescription
 def bokeh_image(
     lens: Prescription,
     depth_mm: float,

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, WrongTypeError
 
 __all__ = ["PLOT_FORMATS", "breathing_figure", "save_breathing_plot"]
 
@@ -22,6 +22,11 @@ def breathing_figure(rows, *, title: str = "focus breathing", sensor_width_mm: f
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    from ..optics.focusing import BreathingRow
+
+    rows = list(rows) if isinstance(rows, (list, tuple)) else rows
+    if not isinstance(rows, list) or not all(isinstance(r, BreathingRow) for r in rows):
+        raise WrongTypeError("rows must be a list of BreathingRow (physcam.optics.focusing.breathing_table)")
     if not rows:
         raise InputError("no breathing rows to plot")
     x = [0.0 if math.isinf(r.focus_from_film_mm) else 1000.0 / r.focus_from_film_mm for r in rows]

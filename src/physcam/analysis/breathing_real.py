@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import OpticsError, require_positive
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["RealBreathingRow", "RealBreathing", "real_breathing"]
 
@@ -91,6 +91,7 @@ def _real_half_angles(st, w, h, wl, backend):
     return float(ang[0]), (float(ang[1]) if ok[1] else None)
 
 
+@takes_prescription
 def real_breathing(
     lens: Prescription,
     focus_marks_mm=None,

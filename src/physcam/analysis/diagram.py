@@ -21,7 +21,7 @@ from pathlib import Path
 
 from ..errors import ExportError, InputError
 from ..lens.geometry import sag
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 from ..optics import focusing, paraxial
 
 __all__ = ["DIAGRAM_FORMATS", "trace_meridional_ray", "LensDiagram", "lens_diagram", "save_lens_diagram"]
@@ -29,6 +29,7 @@ __all__ = ["DIAGRAM_FORMATS", "trace_meridional_ray", "LensDiagram", "lens_diagr
 DIAGRAM_FORMATS = ("png", "svg", "pdf")
 
 
+@takes_prescription
 def trace_meridional_ray(prescription: Prescription, y0: float, z0: float, dy: float, dz: float, *, axis: str = "y",
                          wavelength_nm=None, film_z: float | None = None):
     """Trace a real ray in the meridian plane; return its polyline [(z, height), ...].
@@ -163,6 +164,7 @@ def _default_field(p: Prescription, g: paraxial.GaussianData, axis: str, wavelen
     return math.atan(min(u, 1.5))
 
 
+@takes_prescription
 def lens_diagram(prescription: Prescription, *, axis: str = "y", focus_from_film_mm: float = math.inf,
                  fstop=None, field_deg: float | None = None, wavelength_nm=None, rays: int = 3) -> LensDiagram:
     """Compute a :class:`LensDiagram` with the lens focused at ``focus_from_film_mm`` (from the film plane)."""
@@ -206,6 +208,7 @@ def lens_diagram(prescription: Prescription, *, axis: str = "y", focus_from_film
     return LensDiagram(p, g, axis, math.degrees(half), out)
 
 
+@takes_prescription
 def save_lens_diagram(prescription: Prescription, path, *, force: bool = False, **kwargs) -> Path:
     """Draw the diagram to ``path`` (.png, .svg or .pdf) through atomic_write; kwargs as :func:`lens_diagram`."""
     from ..figures import save_figure

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["DistortionPoint", "StandardDistortion", "DistortionResult", "real_distortion", "fit_standard_distortion"]
 
@@ -92,8 +92,12 @@ class StandardDistortion:
 
 def fit_standard_distortion(r_ideal_mm, distortion_pct, norm_radius_mm: float) -> StandardDistortion:
     """Least-squares k1, k2 of the standard model to (ideal radius, percent distortion) samples."""
-    r = np.asarray(r_ideal_mm, dtype=float)
-    d = np.asarray(distortion_pct, dtype=float) / 100.0
+    r = np.asarray(r_ideal_mm, dtype=float).ravel()
+    d = np.asarray(distortion_pct, dtype=float).ravel() / 100.0
+    if r.shape != d.shape:
+        raise InputError(f"give one distortion value per radius ({r.size} radii, {d.size} values)")
+    if not (np.isfinite(r).all() and np.isfinite(d).all()):
+        raise InputError("radii and distortion values must be finite numbers")
     norm = require_positive("normalising radius", norm_radius_mm)
     keep = r > 0
     if keep.sum() < 2:
@@ -177,6 +181,7 @@ def _chief_heights(lens, fields_deg, axis, wl, film_z, backend, clip=True):
     return np.where(ok, h, 0.0), ok
 
 
+@takes_prescription
 def real_distortion(
     lens: Prescription,
     fields_deg=None,

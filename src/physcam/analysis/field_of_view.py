@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, require_finite, require_positive
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["RealFieldOfView", "real_field_of_view", "chief_ray_field_limit", "DIFFERS_PCT"]
 
@@ -83,6 +83,7 @@ class RealFieldOfView:
         return d
 
 
+@takes_prescription
 def chief_ray_field_limit(
     lens: Prescription,
     axis: str = "y",
@@ -106,6 +107,7 @@ def chief_ray_field_limit(
                            tol_deg=require_finite("tol_deg", tol_deg), backend=backend)
 
 
+@takes_prescription
 def real_field_of_view(
     lens: Prescription,
     sensor_width_mm: float,

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["IlluminationPoint", "IlluminationResult", "relative_illumination"]
 
@@ -179,6 +179,7 @@ def _mapping(lens, l, m, wl, film_z, backend, eps=1e-5):
     return float(out.x[0]), float(out.y[0]), det * d[0, 2]
 
 
+@takes_prescription
 def relative_illumination(
     lens: Prescription,
     fields_deg=None,

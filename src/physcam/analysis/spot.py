@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, require_finite
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["equal_area_disk", "SpotField", "SpotDiagram", "spot_diagram", "MAX_RINGS", "MAX_REFINE"]
 
@@ -193,6 +193,7 @@ def _refined_samples(trace, rings: int, refine: int):
     return np.concatenate(ws), np.concatenate(fs), np.concatenate(xs), np.concatenate(ys)
 
 
+@takes_prescription
 def spot_diagram(
     lens: Prescription,
     fields_deg=(0.0,),
