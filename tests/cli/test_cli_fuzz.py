@@ -1,5 +1,5 @@
 """Fuzz every CLI subcommand (issue 8): hypothesis picks flags and extreme, empty and non-numeric
-values; each run is forked with an address-space limit and must end with exit 0 or 2, no
+values; each run is forked (from a clean fork server) with an address-space limit and must end with exit 0 or 2, no
 traceback, a single "physcam: error:" line when it refuses, no NaN/inf printed as a result, and
 a peak resident memory under 2 GB."""
 
@@ -8,17 +8,14 @@ from __future__ import annotations
 import argparse
 import os
 import re
-import resource
-import signal
 import sys
 import tempfile
-import time
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from physcam.cli import build_parser, main
+from physcam.cli import build_parser
 
 pytestmark = pytest.mark.slow
 
@@ -89,29 +86,33 @@ def _argv_strategy(path, parser):
     return build()
 
 
-def run_forked(argv, workdir):
-    """Run ``main(argv)`` in a forked child; returns (rc, stdout, stderr, peak RSS bytes)."""
-    out_path = os.path.join(workdir, ".stdout")
-    err_path = os.path.join(workdir, ".stderr")
+#: A fresh process that forks one child per run. Forking the pytest worker itself is unsafe once
+#: it has run numba's OpenMP kernels (GNU OpenMP aborts a forked child); this server only imports
+#: physcam, so its children start clean. One JSON request per line on stdin, one reply per line.
+FORK_SERVER = r"""
+import json, os, resource, sys, time, signal
+from physcam.cli import main
+
+limit, timeout = int(sys.argv[1]), float(sys.argv[2])
+for line in sys.stdin:
+    req = json.loads(line)
+    out_path, err_path = req["out"], req["err"]
     pid = os.fork()
-    if pid == 0:  # child
+    if pid == 0:
         rc = 99
         try:
-            resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE_BYTES, ADDRESS_SPACE_BYTES))
-            os.chdir(workdir)
+            resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+            os.chdir(req["cwd"])
             fo = os.open(out_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
             fe = os.open(err_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
-            sys.stdout.flush()
-            sys.stderr.flush()
             os.dup2(fo, 1)
             os.dup2(fe, 2)
             sys.stdout = os.fdopen(1, "w", closefd=False)
             sys.stderr = os.fdopen(2, "w", closefd=False)
             os.environ["COLUMNS"] = "200"
-            rc = main(argv)
-        except BaseException:  # noqa: BLE001 - a traceback is what the test looks for
+            rc = main(req["argv"])
+        except BaseException:
             import traceback
-
             traceback.print_exc()
             rc = 98
         finally:
@@ -121,21 +122,49 @@ def run_forked(argv, workdir):
             finally:
                 os._exit(rc if isinstance(rc, int) and 0 <= rc < 256 else 97)
     t0 = time.monotonic()
+    timed_out = False
     while True:
         done, status, usage = os.wait4(pid, os.WNOHANG)
         if done:
             break
-        if time.monotonic() - t0 > RUN_TIMEOUT_S:
+        if time.monotonic() - t0 > timeout:
             os.kill(pid, signal.SIGKILL)
-            os.wait4(pid, 0)
-            pytest.fail(f"physcam {' '.join(argv)} ran for more than {RUN_TIMEOUT_S} s")
+            _, status, usage = os.wait4(pid, 0)
+            timed_out = True
+            break
         time.sleep(0.005)
-    rc = os.waitstatus_to_exitcode(status)
-    with open(out_path, errors="replace") as f:
-        out = f.read()
-    with open(err_path, errors="replace") as f:
-        err = f.read()
-    return rc, out, err, usage.ru_maxrss * 1024
+    print(json.dumps({"rc": os.waitstatus_to_exitcode(status), "rss": usage.ru_maxrss * 1024,
+                      "timed_out": timed_out}), flush=True)
+"""
+
+
+class ForkServer:
+    def __init__(self):
+        import subprocess
+
+        self.proc = subprocess.Popen([sys.executable, "-c", FORK_SERVER, str(ADDRESS_SPACE_BYTES), str(RUN_TIMEOUT_S)],
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+
+    def run(self, argv, workdir):
+        """Run ``main(argv)`` in a forked child of the server; returns (rc, stdout, stderr, peak RSS bytes)."""
+        import json
+
+        out_path = os.path.join(workdir, ".stdout")
+        err_path = os.path.join(workdir, ".stderr")
+        self.proc.stdin.write(json.dumps({"argv": argv, "cwd": workdir, "out": out_path, "err": err_path}) + "\n")
+        self.proc.stdin.flush()
+        reply = json.loads(self.proc.stdout.readline())
+        if reply["timed_out"]:
+            pytest.fail(f"physcam {' '.join(argv)} ran for more than {RUN_TIMEOUT_S} s")
+        with open(out_path, errors="replace") as f:
+            out = f.read()
+        with open(err_path, errors="replace") as f:
+            err = f.read()
+        return reply["rc"], out, err, reply["rss"]
+
+    def close(self):
+        self.proc.stdin.close()
+        self.proc.wait(timeout=60)
 
 
 LEAVES = [pytest.param(path, parser, id=" ".join(path)) for path, parser in _leaf_parsers(build_parser())]
@@ -144,11 +173,12 @@ LEAVES = [pytest.param(path, parser, id=" ".join(path)) for path, parser in _lea
 @pytest.mark.parametrize("path, parser", LEAVES)
 def test_cli_fuzz(path, parser):
     workdir = tempfile.mkdtemp(prefix="physcam-fuzz-")
+    server = ForkServer()
 
     @settings(max_examples=12, database=None)
     @given(_argv_strategy(path, parser))
     def one(argv):
-        rc, out, err, rss = run_forked(argv, workdir)
+        rc, out, err, rss = server.run(argv, workdir)
         cmd = "physcam " + " ".join(repr(a) if not a or " " in a else a for a in argv)
         assert rc in (0, 2), f"{cmd}: exit {rc}\n{err[-2000:]}"
         assert "Traceback" not in err, f"{cmd}: traceback\n{err[-2000:]}"
@@ -160,4 +190,7 @@ def test_cli_fuzz(path, parser):
             assert bad is None, f"{cmd}: printed {bad.group(0)!r}: ...{out[max(0, bad.start() - 200):bad.end() + 50]}"
         assert rss < MAX_RSS_BYTES, f"{cmd}: peak memory {rss / 1024**3:.2f} GB"
 
-    one()
+    try:
+        one()
+    finally:
+        server.close()
