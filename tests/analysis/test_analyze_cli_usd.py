@@ -68,10 +68,13 @@ def test_vendor_lens_file_and_bad_values(tmp_path):
     from pxr import Usd
 
     from physcam.usd.author import CameraSpec, new_stage, author_camera
-    from physcam.usd.kit import write_vendor_lens
+    from physcam.usd.kit import write_body_file, write_shot, write_vendor_lens
 
+    # the vendor file holds the lens only; a shot with a body carries the fitted distortion
     path = write_vendor_lens(tmp_path / "v.usda", load_lens("dgauss.50mm"), focus_mm=3000.0, fstop=2.8)
-    stage = Usd.Stage.Open(str(path))
+    body = write_body_file(tmp_path / "b.usda", CameraSpec())
+    shot = write_shot(tmp_path / "s.usda", body, path)
+    stage = Usd.Stage.Open(str(shot))
     cams = [p for p in stage.Traverse() if p.GetTypeName() == "Camera"]
     assert cams and cams[0].GetAttribute("lensDistortion:k1").Get() < 0  # barrel
     with pytest.raises(ExportError):

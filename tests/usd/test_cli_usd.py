@@ -3,6 +3,8 @@
 import json
 import re
 
+import pytest
+
 from physcam.cli import main
 
 
@@ -122,3 +124,32 @@ def test_every_usd_write_flag_reaches_the_file(tmp_path, capsys):
     s, r = _write_read(tmp_path, "--lens", "dgauss_50mm", "--fstop", "4", "--focus", "3m")
     assert r.spec.lens_name.startswith("Double Gauss 50mm")
     assert s.GetPrimAtPath("/Cameras/Camera/Camera").GetAttribute("lensDistortion:k1")
+
+
+def test_kit_cli_builds_library_body_vendor_and_shot(tmp_path, capsys):
+    """Issue 9.7: the lens-library, body and shot kits have a CLI; usd check and refresh (9.5)."""
+    from pxr import UsdGeom
+
+    from physcam.usd.read import open_stage, read_camera
+
+    csv = tmp_path / "darling24.csv"
+    csv.write_text("date,focal_length_mm,fstop,entrance_pupil_mm,transmittance\n"
+                   "2026-03-01,24.1,2.8,80,0.9\n2026-03-02,24.3,2.8,81,0.88\n")
+    lens, body, vendor, shot = (tmp_path / n for n in ("lens.usda", "body.usda", "vendor.usda", "shot.usda"))
+    assert main(["usd", "kit", "lens", str(lens), "--characterizations", str(csv)]) == 0
+    assert main(["usd", "kit", "body", str(body), "--sensor", "ALEXA 35", "--flange", "44", "--iso", "800"]) == 0
+    assert main(["usd", "kit", "vendor", str(vendor), "--lens", "dgauss_50mm", "--focus", "1.5m",
+                 "--sensor", "S35"]) == 0
+    assert main(["usd", "kit", "shot", str(shot), "--body", str(body), "--lens", str(vendor), "--focus", "2m",
+                 "--fstop", "2.8", "--position", "0,150,500", "--rotate", "0,35,0"]) == 0
+    stage = open_stage(shot)
+    r = read_camera(stage)
+    assert (r.spec.sensor_width_mm, r.spec.flange_distance_mm, r.spec.iso) == pytest.approx((27.99, 44.0, 800.0))
+    assert (r.spec.focus_mm, r.spec.fstop) == pytest.approx((2000.0, 2.8))
+    eye = UsdGeom.Xformable(stage.GetPrimAtPath("/Cameras/Shot/Camera")).ComputeLocalToWorldTransform(0)
+    assert tuple(eye.ExtractTranslation()) == pytest.approx((0.0, 150.0, 500.0), abs=1e-6)
+    capsys.readouterr()
+    assert main(["usd", "check", str(shot), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["stale"] is False
+    assert main(["usd", "kit", "shot", str(shot), "--body", str(body), "--lens", str(lens), "--sensor", "FF"]) == 2
+    assert "does not use --sensor" in capsys.readouterr().err

@@ -118,39 +118,66 @@ def test_previs_kit_eight_variants(tmp_path):
 
 
 def test_vendor_lens_prescription_and_best_match_pinhole(tmp_path):
+    """The vendor lens file holds lens opinions only (issue 9.3): the lens API, a Pinhole model with
+    the lens's EFL and best-match pinhole, and the Prescription, switched by a lensModel variant."""
     from physcam.lens.library import load_lens
     from physcam.optics.paraxial import gaussian
+    from physcam.usd.read import read_prescription
 
     rx = load_lens("dgauss_50mm")
     f = tmp_path / "vendor" / "dgauss50.usda"
     write_vendor_lens(f, rx, focus_mm=1500.0, fstop=4.0)
     stage = open_stage(f)
     assert not validation_errors(stage)
-    assert find_cameras(stage) == ["/Lens"]
-    pin = read_camera(stage)
-    assert pin.lens_model_type == "PhysicalCameraLensModelPinhole"
-    # the pinhole frames what the real lens frames at the 1.5 m mark: its FOV equals the report's
-    report_rx = pin.report()
-    stage.GetPrimAtPath("/Lens").GetVariantSets().GetVariantSet("lensModel").SetVariantSelection("prescription")
-    real = read_camera(stage)
-    assert real.lens_model_type == "PhysicalCameraLensModelPrescription"
+    lens = stage.GetPrimAtPath("/Lens")
+    applied = {a.split(":")[0] for a in lens.GetAppliedSchemas()}
+    assert applied == {"PhysicalCameraLensAPI"}  # no sensor, no body
+    assert not lens.GetAttribute("xformOpOrder").HasAuthoredValue()
+    assert not lens.GetAttribute("flangeDistance").HasAuthoredValue()
+    assert not stage.GetPrimAtPath("/Lens/Camera")  # the shot makes the companion, for its body
+    pin = stage.GetPrimAtPath("/Lens/Pinhole")
+    assert pin.GetAttribute("focalLength").Get() == pytest.approx(gaussian(rx).efl, rel=1e-6)
+    # issue 9.6: the best-match pinhole, 52.048 mm for dgauss focused at 1.5 m (the issue's figure)
+    assert lens.GetAttribute("lens:main:pinholeFocalLength").Get() == pytest.approx(52.048, abs=1e-3)
+    rel = lens.GetRelationship("lens:main:lensModel")
+    assert [str(t) for t in rel.GetTargets()] == ["/Lens/Pinhole"]
+    lens.GetVariantSets().GetVariantSet("lensModel").SetVariantSelection("prescription")
+    assert [str(t) for t in rel.GetTargets()] == ["/Lens/Prescription"]
     # the prescription survives the round trip surface for surface
-    assert real.prescription.surfaces == rx.surfaces
-    assert real.spec.focal_length_mm == pytest.approx(gaussian(rx).efl, rel=1e-12)
-    from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import Sensor
+    assert read_prescription(stage.GetPrimAtPath("/Lens/Prescription")).surfaces == rx.surfaces
 
-    lens_report = solve_lens_report(focal_length_mm=None, sensor=Sensor("c", "c", 36.0, 24.0), fstop=4.0,
-                                    focus_mm=1500.0, coc=0.03, lens=rx)
-    # issue 9.6: the best-match pinhole with the eye at the entrance pupil is 52.048 mm for dgauss
-    # focused at 1.5 m (the issue's oracle figure); the companion camera (mm at metersPerUnit 0.01)
-    # is that pinhole, and the read-back report keeps it
-    geom = UsdGeom.Camera(stage.GetPrimAtPath("/Lens/Camera"))
-    assert geom.GetFocalLengthAttr().Get() == pytest.approx(52.048, abs=1e-3)
-    assert pin.spec.pinhole_focal_length_mm == pytest.approx(52.048, abs=1e-3)
-    assert report_rx.pinhole[0] == pytest.approx(lens_report.pinhole[0], rel=1e-6)  # float32 storage
-    assert report_rx.hfov_focus_deg == pytest.approx(lens_report.hfov_focus_deg, abs=1e-5)
-    assert report_rx.fstop == 4.0
+
+def test_body_and_vendor_lens_combine_in_a_shot(tmp_path):
+    """Issue 9.3, done when: a shot built from a body file and a vendor lens file has the body's
+    sensor, ISO, flange and placement and the lens's optics, at the body's sensor size; the lens
+    distortion is fitted for that sensor."""
+    from physcam.analysis.distortion import real_distortion
+    from physcam.lens.library import load_lens
+
+    rx = load_lens("dgauss_50mm")
+    lens_f = write_vendor_lens(tmp_path / "vendor.usda", rx, focus_mm=1500.0, fstop=4.0)
+    body_f = write_body_file(tmp_path / "body.usda", CameraSpec(sensor_width_mm=27.99, sensor_height_mm=19.22,
+                                                                flange_distance_mm=44.0, iso=800.0,
+                                                                sensor_name="ARRI ALEXA 35"))
+    shot = write_shot(tmp_path / "shot.usda", body_f, lens_f, position=(10.0, 150.0, 500.0))
+    stage = open_stage(shot)
+    assert not validation_errors(stage)
+    r = read_camera(stage, "/Cameras/Shot")
+    assert (r.spec.sensor_width_mm, r.spec.sensor_height_mm) == pytest.approx((27.99, 19.22))
+    assert (r.spec.flange_distance_mm, r.spec.iso) == (44.0, 800.0)
+    assert r.spec.pinhole_focal_length_mm == pytest.approx(52.048, abs=1e-3)
+    geom = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Shot/Camera"))
+    cam = geom.GetCamera(Usd.TimeCode.Default())
+    # the body's 27.99 mm sensor behind the 52.048 mm pinhole (the issue's figure)
+    hfov = math.degrees(2 * math.atan(cam.frustum.GetWindow().GetMax()[0]))
+    assert hfov == pytest.approx(math.degrees(2 * math.atan(27.99 / (2 * 52.048))), abs=2e-3)
+    eye = UsdGeom.Xformable(geom).ComputeLocalToWorldTransform(Usd.TimeCode.Default()).ExtractTranslation()
+    assert tuple(eye) == pytest.approx((10.0, 150.0, 500.0), abs=1e-6)
+    # distortion refitted for the body's sensor, not the vendor's 36 x 24 reference
+    fit = real_distortion(rx, sensor_width_mm=27.99, sensor_height_mm=19.22).fit
+    k1 = geom.GetPrim().GetAttribute("lensDistortion:k1").Get()
+    assert k1 == pytest.approx(fit.k1, rel=1e-5)
+    assert k1 != pytest.approx(real_distortion(rx, sensor_width_mm=36.0, sensor_height_mm=24.0).fit.k1, rel=1e-3)
 
 
 def test_usd_write_lens_and_vendor_kit_frame_alike(tmp_path, capsys):
@@ -162,9 +189,11 @@ def test_usd_write_lens_and_vendor_kit_frame_alike(tmp_path, capsys):
     assert main(["usd", "write", str(a), "--lens", "dgauss_50mm", "--focus", "1.5m", "--fstop", "4",
                  "--sensor-width", "36", "--sensor-height", "24"]) == 0
     assert main(["usd", "kit", "vendor", str(b), "--lens", "dgauss_50mm", "--focus", "1.5m", "--fstop", "4"]) == 0
-    sa, sb = open_stage(a), open_stage(b)  # keep the stages alive while their prims are read
+    body = write_body_file(tmp_path / "body.usda", CameraSpec(sensor_width_mm=36.0, sensor_height_mm=24.0))
+    shot = write_shot(tmp_path / "shot.usda", body, b)
+    sa, sb = open_stage(a), open_stage(shot)  # keep the stages alive while their prims are read
     fa = UsdGeom.Camera(sa.GetPrimAtPath("/Cameras/Camera/Camera")).GetFocalLengthAttr().Get()
-    fb = UsdGeom.Camera(sb.GetPrimAtPath("/Lens/Camera")).GetFocalLengthAttr().Get()
+    fb = UsdGeom.Camera(sb.GetPrimAtPath("/Cameras/Shot/Camera")).GetFocalLengthAttr().Get()
     assert fa == pytest.approx(52.048, abs=1e-3) and fb == pytest.approx(fa, rel=1e-6)
 
 
@@ -243,3 +272,49 @@ def test_reading_a_lens_or_body_file_says_what_it_is(tmp_path, library):
     write_body_file(body, CameraSpec())
     with pytest.raises(ExportError, match="only a body"):
         read_camera(open_stage(body))
+
+
+def test_metre_shot_composes_centimetre_files(tmp_path):
+    """Issue 9.4: a shot in metres referencing lens and body files in centimetres composed silently
+    wrong (near clip 10 m). The near clip is 100 mm = 0.1 m, the eye sits at the given position."""
+    from physcam.usd.kit import check_shot
+
+    lens_f = tmp_path / "lens_cm.usda"
+    write_lens_file(lens_f, {"2026-03-01": CameraSpec(focal_length_mm=24.0, entrance_pupil_mm=80.0,
+                                                      clipping_mm=(100.0, 1.0e6))}, meters_per_unit=0.01)
+    body_f = write_body_file(tmp_path / "body_cm.usda", CameraSpec(sensor_width_mm=27.99, sensor_height_mm=19.22),
+                             meters_per_unit=0.01)
+    shot = write_shot(tmp_path / "shot_m.usda", body_f, lens_f, meters_per_unit=1.0, position=(1.0, 1.5, 5.0))
+    stage = open_stage(shot)
+    geom = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Shot/Camera"))
+    near, far = geom.GetClippingRangeAttr().Get()
+    assert (near, far) == pytest.approx((0.1, 1000.0), rel=1e-6)
+    eye = UsdGeom.Xformable(geom).ComputeLocalToWorldTransform(Usd.TimeCode.Default()).ExtractTranslation()
+    assert tuple(eye) == pytest.approx((1.0, 1.5, 5.0), abs=1e-9)
+    # 80 mm from the pupil back to the film is 0.08 m in the shot's unit
+    film = UsdGeom.Xformable(stage.GetPrimAtPath("/Cameras/Shot")).ComputeLocalToWorldTransform(
+        Usd.TimeCode.Default()).ExtractTranslation()
+    assert film[2] - eye[2] == pytest.approx(0.08, abs=1e-9)
+    units = check_shot(shot)["units"]
+    assert {u["meters_per_unit"] for u in units} == {0.01} and len(units) == 2
+
+
+def test_stale_companion_is_detected_and_refreshed(tmp_path, library):
+    """Issue 9.5: when the lens file's `current` characterization changes, every shot's companion
+    went stale silently. `check_shot` says so from a stored hash; `refresh_shot` recomputes it."""
+    from physcam.usd.kit import check_shot, refresh_shot
+
+    body = write_body_file(tmp_path / "body.usda", CameraSpec(sensor_width_mm=36.0, sensor_height_mm=24.0))
+    shot = write_shot(tmp_path / "shot.usda", body, library)
+    assert check_shot(shot)["stale"] is False
+    # a new measuring day: the lens file is rewritten with a longer current focal length
+    write_lens_file(library, {"2026-03-01": lens(24.1, 80.0, 0.90), "2026-03-02": lens(24.3, 81.0, 0.88),
+                              "2026-04-01": lens(25.0, 82.0, 0.87)}, force=True)
+    assert check_shot(shot)["stale"] is True
+    after = refresh_shot(shot)
+    assert after["stale"] is False
+    stage = open_stage(shot)
+    stage.Reload()
+    f = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Shot/Camera")).GetFocalLengthAttr().Get()
+    # the companion follows the new 25 mm lens at the 3 m default mark (thin-lens s', by hand)
+    assert f == pytest.approx(image_distance_at_mark(25.0, 3000.0), rel=1e-5)

@@ -43,18 +43,78 @@ def register(sub) -> None:
     r.add_argument("--json", action="store_true", help="print JSON")
     r.set_defaults(handler=run_read)
 
-    k = s.add_parser("kit", help="the proposal's use cases: previs kit, vendor lens file")
-    k.add_argument("kind", choices=("previs", "vendor"))
+    k = s.add_parser("kit", help="the proposal's use cases: previs kit, vendor lens, lens library, body, shot",
+                     description="Write the files of the proposal's use cases (docs/usd.md).",
+                     epilog=KIT_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    k.add_argument("kind", choices=("previs", "vendor", "lens", "body", "shot"))
     k.add_argument("file")
-    k.add_argument("--lens", help="vendor: bundled lens name or prescription file")
-    k.add_argument("--focus", type=distance("focus distance"), help="vendor: focus mark for the best-match pinhole")
-    k.add_argument("--fstop", type=number("f-stop"), help="vendor: f-stop (default the lens's maximum)")
+    k.add_argument("--lens", help="vendor: bundled lens name or prescription file; shot: the lens file to reference")
+    k.add_argument("--body", help="shot: the body file to reference")
+    k.add_argument("--characterizations", metavar="CSV",
+                   help="lens: a CSV with a date column and CameraSpec lens columns (focal_length_mm, fstop, "
+                        "entrance_pupil_mm, transmittance, ...), one row per measuring day")
+    k.add_argument("--focus", type=distance("focus distance"), help="vendor, shot: focus mark from the film plane")
+    k.add_argument("--fstop", type=number("f-stop", positive=True), help="vendor, shot: f-stop (vendor default: wide open)")
+    k.add_argument("--sensor", help="vendor, body: sensor name (see physcam sensors)")
+    k.add_argument("--sensor-width", type=distance("sensor width"), help="vendor, body: sensor width")
+    k.add_argument("--sensor-height", type=distance("sensor height"), help="vendor, body: sensor height")
+    k.add_argument("--flange", type=distance("flange focal distance"), help="body: flange focal distance (default 52 mm)")
+    k.add_argument("--iso", type=number("ISO", positive=True), help="body: exposure index (default 100)")
+    k.add_argument("--shutter-angle", type=number("shutter angle", positive=True), default=None,
+                   help="body: degrees (default 180)")
+    k.add_argument("--position", type=_triple("position"), default=(0.0, 0.0, 0.0), metavar="X,Y,Z",
+                   help="shot: where the entrance pupil goes, in scene units")
+    k.add_argument("--rotate", type=_triple("rotation"), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ",
+                   help="shot: pan/tilt/roll about the entrance pupil, degrees (XYZ order)")
+    k.add_argument("--variant", help="shot: pin a lens characterization variant (default the lens file's current)")
     _stage_args(k)
     k.set_defaults(handler=run_kit)
+
+    c = s.add_parser("check", help="is a shot's companion camera current with its body and lens files?")
+    c.add_argument("file")
+    c.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
+    c.add_argument("--json", action="store_true", help="print JSON")
+    c.set_defaults(handler=run_check)
+
+    f = s.add_parser("refresh", help="recompute a shot's companion camera from its body and lens files (in place)")
+    f.add_argument("file")
+    f.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
+    f.add_argument("--json", action="store_true", help="print JSON")
+    f.set_defaults(handler=run_refresh)
 
     pp = s.add_parser("plugin-path", help="print the schema plugin folder for PXR_PLUGINPATH_NAME")
     pp.set_defaults(handler=run_plugin_path)
     p.set_defaults(handler=lambda args: (p.print_help(), 0)[1])
+
+
+KIT_EPILOG = """\
+examples:
+  physcam usd kit previs kit.usda
+  physcam usd kit vendor dgauss50.usda --lens dgauss_50mm --focus 1.5m --fstop 4
+  physcam usd kit lens darling24.usda --characterizations darling24.csv
+  physcam usd kit body alexa35.usda --sensor "ALEXA 35" --flange 44 --iso 800
+  physcam usd kit shot sh010.usda --body alexa35.usda --lens dgauss50.usda --focus 2m --fstop 2.8 \\
+      --position 0,150,500 --rotate 0,35,0
+  physcam usd check sh010.usda          # stale after a lens or body file changed?
+  physcam usd refresh sh010.usda        # recompute the companion camera
+"""
+
+
+def _triple(name: str):
+    import argparse
+    import math
+
+    def parse(text):
+        try:
+            v = tuple(float(x) for x in str(text).split(","))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be three numbers X,Y,Z, got {text!r}") from None
+        if len(v) != 3 or not all(math.isfinite(x) for x in v):
+            raise argparse.ArgumentTypeError(f"{name} must be three finite numbers X,Y,Z, got {text!r}")
+        return v
+
+    parse.__name__ = name
+    return parse
 
 
 def _stage_args(p, units: bool = True) -> None:
@@ -124,29 +184,168 @@ def run_kit(args) -> int:
     from ..errors import InputError
     from ..usd import kit
 
-    if args.kind == "previs":
-        path = kit.write_previs_kit(args.file, force=args.force, meters_per_unit=args.meters_per_unit, fps=args.fps)
-    else:
+    kind = args.kind
+    allowed = {
+        "previs": set(),
+        "vendor": {"lens", "focus", "fstop", "sensor", "sensor_width", "sensor_height"},
+        "lens": {"characterizations"},
+        "body": {"sensor", "sensor_width", "sensor_height", "flange", "iso", "shutter_angle"},
+        "shot": {"lens", "body", "focus", "fstop", "position", "rotate", "variant"},
+    }[kind]
+    given = {k for k in ("lens", "body", "characterizations", "focus", "fstop", "sensor", "sensor_width",
+                         "sensor_height", "flange", "iso", "shutter_angle", "variant")
+             if getattr(args, k) is not None}
+    given |= {k for k in ("position", "rotate") if getattr(args, k) != (0.0, 0.0, 0.0)}
+    if given - allowed:
+        flags = ", ".join("--" + k.replace("_", "-") for k in sorted(given - allowed))
+        raise InputError(f"usd kit {kind} does not use {flags}")
+    common = dict(force=args.force, meters_per_unit=args.meters_per_unit, fps=args.fps)
+    if kind == "previs":
+        path = kit.write_previs_kit(args.file, **common)
+    elif kind == "vendor":
         if not args.lens or args.focus is None:
             raise InputError("physcam usd kit vendor needs --lens and --focus")
         from ..lens.library import load_lens
 
+        sensor = _kit_sensor(args, default="Full Frame")
         path = kit.write_vendor_lens(args.file, load_lens(args.lens), focus_mm=args.focus, fstop=args.fstop,
-                                     force=args.force, meters_per_unit=args.meters_per_unit, fps=args.fps)
-        if args.json:  # what the file says, read back: the matched pinhole, the variant, the distortion fit
-            from ..usd.read import open_stage, read_camera
-            from ._common import print_json
+                                     sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm, **common)
+    elif kind == "lens":
+        if not args.characterizations:
+            raise InputError("physcam usd kit lens needs --characterizations CSV (date, focal_length_mm, ...)")
+        path = kit.write_lens_file(args.file, _read_characterizations(args.characterizations), **common)
+    elif kind == "body":
+        from ..usd.author import CameraSpec
 
-            stage = open_stage(path)
-            geom = stage.GetPrimAtPath(f"{kit.LENS_PRIM}/Camera")
-            distortion = {a.GetName().split(":", 1)[1]: a.Get() for a in geom.GetAttributes()
-                          if a.GetName().startswith("lensDistortion:")} if geom else {}
-            distortion = {k: (list(v) if hasattr(v, "__len__") and not isinstance(v, str) else v)
-                          for k, v in distortion.items()}
-            print_json({"written": str(path), "usd": read_camera(stage, kit.LENS_PRIM).to_dict(),
-                        "lens_distortion": distortion})
-            return 0
+        sensor = _kit_sensor(args, default="Super 35")
+        body = dict(sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm, sensor_name=sensor.name)
+        if args.flange is not None:
+            body["flange_distance_mm"] = args.flange
+        if args.iso is not None:
+            body["iso"] = args.iso
+        if args.shutter_angle is not None:
+            from ..export.usdgeom import shutter_interval
+
+            shutter_interval(args.shutter_angle)  # validates 0 < angle <= 360
+            body["shutter_duration_s"] = args.shutter_angle / 360.0 / args.fps
+        path = kit.write_body_file(args.file, CameraSpec(**body), **common)
+    else:
+        if not args.body or not args.lens:
+            raise InputError("physcam usd kit shot needs --body FILE and --lens FILE")
+        overrides = {}
+        if args.focus is not None:
+            overrides["focus_mm"] = args.focus
+        if args.fstop is not None:
+            overrides["fstop"] = args.fstop
+        path = kit.write_shot(args.file, args.body, args.lens, overrides=overrides, lens_variant=args.variant,
+                              position=args.position, rotate_xyz_deg=args.rotate, **common)
+    if kind == "vendor" and args.json:  # what the file says, read back: the lens and its best-match pinhole
+        from ..usd.read import open_stage
+        from ._common import print_json
+
+        stage = open_stage(path)
+        lens = stage.GetPrimAtPath(kit.LENS_PRIM)
+        values = {a.GetName(): a.Get() for a in lens.GetAttributes() if a.HasAuthoredValue()}
+        print_json({"written": str(path),
+                    "lens": {k: (list(v) if hasattr(v, "__len__") and not isinstance(v, str) else v)
+                             for k, v in values.items()},
+                    "variants": {n: lens.GetVariantSets().GetVariantSelection(n)
+                                 for n in lens.GetVariantSets().GetNames()}})
+        return 0
     return _done(args, path)
+
+
+def _kit_sensor(args, default: str):
+    from ..errors import InputError
+    from ..onset.sensors import custom_sensor, find_sensor
+
+    if args.sensor is not None:
+        if args.sensor_width is not None or args.sensor_height is not None:
+            raise InputError("give either --sensor NAME or --sensor-width/--sensor-height, not both")
+        return find_sensor(args.sensor)
+    if args.sensor_width is not None or args.sensor_height is not None:
+        if args.sensor_width is None or args.sensor_height is None:
+            raise InputError("give both --sensor-width and --sensor-height")
+        return custom_sensor(args.sensor_width, args.sensor_height)
+    return find_sensor(default)
+
+
+def _read_characterizations(csv_path) -> dict:
+    """date -> CameraSpec from a CSV: a ``date`` column and CameraSpec field columns (numbers)."""
+    import csv
+    import dataclasses
+    from pathlib import Path
+
+    from ..errors import InputError, LensFileError
+    from ..usd.author import CameraSpec
+
+    p = Path(csv_path)
+    try:
+        text = p.read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise InputError(f"cannot read {p}: {exc.strerror or exc}") from None
+    numeric = {f.name for f in dataclasses.fields(CameraSpec)
+               if f.name not in ("projection", "lens_name", "sensor_name") and not f.name.endswith("_mm")
+               or f.name in ("focal_length_mm", "entrance_pupil_mm", "focus_mm", "aperture_distance_mm",
+                             "pinhole_focal_length_mm")}
+    numeric -= {"principal_planes_mm", "shift_mm", "clipping_mm", "shutter_opening"}
+    out = {}
+    rows = csv.DictReader(text.splitlines())
+    if not rows.fieldnames or "date" not in rows.fieldnames:
+        raise LensFileError("the characterization CSV needs a 'date' column", str(p), 1)
+    unknown = set(rows.fieldnames) - numeric - {"date", "lens_name"}
+    if unknown:
+        raise LensFileError(f"unknown columns {sorted(unknown)}; use date, lens_name and lens fields such as "
+                            "focal_length_mm, fstop, entrance_pupil_mm, transmittance, focus_mm", str(p), 1)
+    for line, row in enumerate(rows, start=2):
+        values = {}
+        for k, v in row.items():
+            if k in ("date", "lens_name") or v in (None, ""):
+                continue
+            try:
+                values[k] = int(v) if k == "aperture_blades" else float(v)
+            except ValueError:
+                raise LensFileError(f"column {k}: {v!r} is not a number", str(p), line) from None
+        if not row.get("date"):
+            raise LensFileError("a row without a date", str(p), line)
+        try:
+            out[row["date"]] = CameraSpec(lens_name=row.get("lens_name") or None, **values).checked()
+        except InputError as exc:
+            raise LensFileError(str(exc), str(p), line) from None
+    if not out:
+        raise LensFileError("no characterization rows", str(p))
+    return out
+
+
+def run_check(args) -> int:
+    from ..usd.kit import check_shot
+
+    res = check_shot(args.file, args.path)
+    if args.json:
+        from ._common import print_json
+
+        print_json(res)
+        return 0
+    state = "STALE: its body or lens files changed; run physcam usd refresh " + str(args.file) if res["stale"] \
+        else "current"
+    print(f"{res['path']}: companion camera {state}")
+    for u in res["units"]:
+        print(f"  note: {u['file']} is in metersPerUnit {u['meters_per_unit']:g}, the shot in "
+              f"{res['meters_per_unit']:g} (composed in the shot's unit)")
+    return 0
+
+
+def run_refresh(args) -> int:
+    from ..usd.kit import refresh_shot
+
+    res = refresh_shot(args.file, args.path)
+    if args.json:
+        from ._common import print_json
+
+        print_json(res)
+    else:
+        print(f"{res['path']}: companion camera recomputed")
+    return 0
 
 
 def run_plugin_path(args) -> int:

@@ -32,6 +32,9 @@ __all__ = [
     "write_previs_kit",
     "write_shot",
     "write_vendor_lens",
+    "check_shot",
+    "refresh_shot",
+    "companion_inputs_hash",
 ]
 
 LENS_PRIM = "/Lens"
@@ -124,15 +127,22 @@ def write_shot(file, body_file, lens_file, *, overrides: dict | None = None, len
 
     The composed camera is read back, ``overrides`` (CameraSpec fields listed in
     :data:`SHOT_OVERRIDES`) are applied as shot-layer opinions, and the companion
-    UsdGeomCamera is written from the composed result. Re-run it when a referenced file
-    changes so the companion camera follows. ``lens_variant`` pins a characterization
+    UsdGeomCamera is written from the composed result (:func:`refresh_shot` recomputes it
+    later; :func:`check_shot` says when it is stale). ``lens_variant`` pins a characterization
     (for archiving); the default keeps the lens file's selection ("current").
+
+    Units: the referenced files may use other ``metersPerUnit`` than the shot. Every length in
+    physcam's schema is in mm except the lens's ``clippingRange`` and the transform; the shot
+    re-authors both in its own unit (the clipping range read from each file in that file's
+    unit), so a metre shot composes centimetre files correctly.
+
+    A lens with a prescription (a vendor lens file) is evaluated at the shot's focus and f-stop
+    on the body's sensor: EFL, principal planes, entrance pupil and best-match pinhole become
+    shot opinions, and the lens distortion is fitted for the body's sensor.
     """
     from pathlib import Path
 
     from pxr import Sdf, Usd, UsdGeom
-
-    from .read import read_camera
 
     overrides = dict(overrides or {})
     unknown = set(overrides) - set(SHOT_OVERRIDES)
@@ -141,6 +151,12 @@ def write_shot(file, body_file, lens_file, *, overrides: dict | None = None, len
     out = Path(file).resolve()
     if not Sdf.Path.IsValidPathString(path) or not Sdf.Path(path).IsAbsolutePath():
         raise ExportError(f"shot camera path {path!r} is not an absolute prim path such as /Cameras/Shot")
+    sources = {}
+    for f, prim_path in ((lens_file, LENS_PRIM), (body_file, BODY_PRIM)):
+        p = Path(f)
+        if not p.is_file():
+            raise ExportError(f"{p}: no such file to reference")
+        sources[prim_path] = _file_units(p, prim_path)
     # an in-memory layer that carries the output path, so relative references resolve from its folder
     layer = Sdf.Find(str(out)) or Sdf.Layer.New(Sdf.FileFormat.FindByExtension("usda"), str(out))
     layer.Clear()
@@ -155,28 +171,213 @@ def write_shot(file, body_file, lens_file, *, overrides: dict | None = None, len
     stage.SetDefaultPrim(stage.GetPrimAtPath(Sdf.Path(path).GetPrefixes()[0]))
     refs = cam.GetReferences()
     for f, prim_path in ((lens_file, LENS_PRIM), (body_file, BODY_PRIM)):  # lens listed first: stronger
-        p = Path(f)
-        if not p.is_file():
-            raise ExportError(f"{p}: no such file to reference")
-        refs.AddReference(Path(_relpath(p.resolve(), out.parent)).as_posix(), Sdf.Path(prim_path))
+        refs.AddReference(Path(_relpath(Path(f).resolve(), out.parent)).as_posix(), Sdf.Path(prim_path))
     if lens_variant is not None:
         vsets = cam.GetVariantSets()
         if "characterization" not in vsets.GetNames() or lens_variant not in \
                 vsets.GetVariantSet("characterization").GetVariantNames():
             raise ExportError(f"{path}: lens file {lens_file} has no characterization variant {lens_variant!r}")
         vsets.GetVariantSet("characterization").SetVariantSelection(lens_variant)
-    spec = replace(read_camera(stage, path).spec, **overrides).checked()
-    # only what the shot overrides becomes a shot-layer opinion: everything else stays with the
-    # referenced body and lens files (and their variants), so switching a characterization in the
-    # shot still switches the lens
-    _author_overrides(stage, cam, spec, overrides)
-    # the shot places the camera: its transform pivots about the (composed) entrance pupil
-    _author_placement(cam, spec, position, rotate_xyz_deg)
-    author_render_camera(stage, Sdf.Path(path), spec)
     try:
+        # the clipping range in mm, read from the lens file in its own unit (issue 9: a metre shot
+        # read a centimetre file's 10 cm near clip as 10 m)
+        lens_mpu, lens_clip_mm = sources[LENS_PRIM]
+        if lens_clip_mm is not None and lens_mpu != meters_per_unit and "clipping_mm" not in overrides:
+            overrides["clipping_mm"] = lens_clip_mm
+        spec = replace(_composed_spec(stage, path), **overrides).checked()
+        # only what the shot overrides becomes a shot-layer opinion: everything else stays with the
+        # referenced body and lens files (and their variants), so switching a characterization in the
+        # shot still switches the lens
+        _author_overrides(stage, cam, spec, overrides)
+        # the shot places the camera: its transform pivots about the (composed) entrance pupil
+        _author_placement(cam, spec, position, rotate_xyz_deg)
+        _author_shot_companion(stage, path)
         return save_stage(stage, out, force=force)
     finally:
         layer.Clear()
+
+
+def _file_units(p, prim_path):
+    """(metersPerUnit, clipping range in mm or None) of the camera prim ``prim_path`` in file ``p``."""
+    from pxr import Usd, UsdGeom
+
+    from ..export.usdgeom import mm_to_scene_units
+
+    stage = Usd.Stage.Open(str(p))
+    if stage is None:
+        raise ExportError(f"{p}: USD cannot open it")
+    mpu = UsdGeom.GetStageMetersPerUnit(stage)
+    prim = stage.GetPrimAtPath(prim_path)
+    if not prim:
+        raise ExportError(f"{p}: has no {prim_path} prim to reference (write it with physcam.usd.kit)")
+    clip = prim.GetAttribute(f"lens:{LENS_INSTANCE}:clippingRange")
+    clip_mm = None
+    if clip and clip.HasAuthoredValue():
+        v = clip.Get()
+        clip_mm = (float(v[0]) / mm_to_scene_units(1.0, mpu), float(v[1]) / mm_to_scene_units(1.0, mpu))
+    return mpu, clip_mm
+
+
+def _composed_spec(stage, path):
+    from .read import read_camera
+
+    return read_camera(stage, path).spec
+
+
+def _composed_prescription(stage, path):
+    """The prescription a composed camera's lens carries (its lens model, or a Prescription model
+    among its children, as in a vendor lens file shown through its pinhole), or None."""
+    from .read import read_prescription
+
+    prim = stage.GetPrimAtPath(path)
+    for child in prim.GetChildren():
+        if child.GetTypeName() == "PhysicalCameraLensModelPrescription":
+            return read_prescription(child)
+    return None
+
+
+def _author_shot_companion(stage, path) -> str:
+    """(Re)compute the shot's companion UsdGeomCamera from the composed camera; return the inputs hash.
+
+    With a prescription the lens is re-evaluated at the composed focus and f-stop on the composed
+    (body's) sensor; its derived lens values are written as shot opinions and its distortion is
+    fitted for that sensor. The hash of every input (:func:`companion_inputs_hash`) is stored
+    as ``customData physcam:companionInputs`` on the companion, for :func:`check_shot`.
+    """
+    from pxr import Sdf
+
+    from .author import spec_from_report
+
+    spec = _composed_spec(stage, path)
+    rx = _composed_prescription(stage, path)
+    report, distortion = None, None
+    if rx is not None and spec.projection == "perspective":
+        from ..onset.report import solve_lens_report
+        from ..onset.sensors import Sensor
+
+        sensor = Sensor(key="custom", name=spec.sensor_name or f"{spec.sensor_width_mm:g} x {spec.sensor_height_mm:g} mm",
+                        width_mm=spec.sensor_width_mm, height_mm=spec.sensor_height_mm)
+        report = solve_lens_report(focal_length_mm=None, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
+                                   coc=spec.coc_mm, lens=rx)
+        derived = spec_from_report(report)
+        cam = stage.GetPrimAtPath(path)
+        _author_lens_derived(stage, cam, derived)
+        _move_film_behind_pupil(cam, derived.entrance_pupil_mm)
+        spec = replace(spec, focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
+                       principal_planes_mm=derived.principal_planes_mm,
+                       pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
+                       pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze)
+        distortion = prescription_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm)
+    geom = author_render_camera(stage, Sdf.Path(path), spec, report=report, lens_distortion=distortion)
+    digest = _companion_inputs(stage, path)
+    geom.GetPrim().SetCustomDataByKey("physcam:companionInputs", digest)
+    return digest
+
+
+def _companion_inputs(stage, path) -> str:
+    """The hash of what the companion of ``path`` is computed from, as the stage composes now."""
+    return companion_inputs_hash(_composed_spec(stage, path), _composed_prescription(stage, path))
+
+
+def _move_film_behind_pupil(cam, pupil_mm: float) -> None:
+    """Keep the shot's placement (the entrance pupil where it was put) when the pupil's distance
+    from the film changed: rewrite the ``translate:pupilToFilm`` op in the shot's unit."""
+    from pxr import Gf, UsdGeom
+
+    from ..export.usdgeom import mm_to_scene_units
+
+    op = cam.GetAttribute("xformOp:translate:pupilToFilm")
+    if op:
+        op.Set(Gf.Vec3d(0.0, 0.0, mm_to_scene_units(pupil_mm, UsdGeom.GetStageMetersPerUnit(cam.GetStage()))))
+
+
+def _author_lens_derived(stage, cam, spec) -> None:
+    """Lens values a prescription gives at the shot's focus, as shot opinions."""
+    from pxr import Sdf
+
+    F = Sdf.ValueTypeNames.Float
+    lp = f"lens:{LENS_INSTANCE}:"
+    values = {lp + "entrancePupilDistance": spec.entrance_pupil_mm, lp + "iris": spec.focal_length_mm / spec.fstop,
+              lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze": spec.pinhole_squeeze}
+    if spec.principal_planes_mm is not None:
+        values[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]
+        values[lp + "rearPrincipalPlaneDistance"] = spec.principal_planes_mm[1]
+    for name, v in values.items():
+        if v is not None:
+            (cam.GetAttribute(name) or cam.CreateAttribute(name, F)).Set(float(v))
+
+
+def companion_inputs_hash(spec, prescription=None) -> str:
+    """SHA-256 of everything a companion camera is computed from: the composed camera's values
+    and, when the lens carries one, its prescription (hex digest)."""
+    import hashlib
+    import json
+    from dataclasses import asdict
+
+    doc = {"camera": asdict(spec)}
+    if prescription is not None:
+        doc["prescription"] = [asdict(s) for s in prescription.surfaces]
+        doc["focus"] = None if prescription.focus is None else asdict(prescription.focus)
+    text = json.dumps(doc, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def check_shot(file, path: str | None = None) -> dict:
+    """Is a shot's companion camera current? Returns ``{"path", "stale", "stored", "current", "units"}``.
+
+    ``stale`` is true when the companion was computed from other inputs than the composed camera
+    now has (a lens file's ``current`` characterization changed, a body file was edited, ...),
+    or carries no stored hash. ``units`` lists referenced files whose metersPerUnit differs from
+    the shot's (composed correctly by :func:`write_shot`, worth knowing).
+    """
+    from pxr import Sdf, UsdGeom
+
+    from .read import find_cameras, open_stage
+
+    stage = open_stage(file)
+    stage.Reload()  # the referenced files as they are on disk now, not as this process cached them
+    if path is None:
+        cams = find_cameras(stage)
+        if len(cams) != 1:
+            raise ExportError(f"{file}: found {len(cams)} PhysicalCamera prims; name the one to check")
+        path = cams[0]
+    geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
+    if not geom:
+        raise ExportError(f"{path}: has no companion camera to check")
+    current = _companion_inputs(stage, path)
+    stored = geom.GetCustomDataByKey("physcam:companionInputs")
+    mpu = UsdGeom.GetStageMetersPerUnit(stage)
+    units = []
+    for ref_layer in stage.GetUsedLayers():
+        if ref_layer == stage.GetRootLayer() or ref_layer.anonymous:
+            continue
+        lm = ref_layer.pseudoRoot.GetInfo("metersPerUnit") if ref_layer.pseudoRoot.HasInfo("metersPerUnit") else None
+        if lm is not None and float(lm) != mpu:
+            units.append({"file": ref_layer.identifier, "meters_per_unit": float(lm)})
+    return {"path": path, "stale": stored != current, "stored": stored, "current": current,
+            "meters_per_unit": mpu, "units": units}
+
+
+def refresh_shot(file, path: str | None = None) -> dict:
+    """Recompute a shot's companion camera from the composed camera, in place; return check_shot's answer after."""
+    from pxr import Sdf, Usd
+
+    from .read import find_cameras
+
+    ensure_registered()
+    layer = Sdf.Layer.FindOrOpen(str(file))
+    if layer is None:
+        raise ExportError(f"{file}: USD cannot open it")
+    stage = Usd.Stage.Open(layer)
+    stage.Reload()  # the shot and its referenced files as they are on disk now
+    if path is None:
+        cams = find_cameras(stage)
+        if len(cams) != 1:
+            raise ExportError(f"{file}: found {len(cams)} PhysicalCamera prims; name the one to refresh")
+        path = cams[0]
+    _author_shot_companion(stage, path)
+    save_stage(stage, file, force=True)
+    return check_shot(file, path)
 
 
 def _shot_attributes(spec, su):
@@ -333,9 +534,15 @@ def write_vendor_lens(file, prescription, *, focus_mm: float, fstop: float | Non
                       use: str = "pinhole", force: bool = False, meters_per_unit: float = 0.01, fps: float = 24.0):
     """A vendor lens file: ``/Lens`` with a Prescription model, its best-match Pinhole, and a ``lensModel`` variant.
 
+    The file holds **lens opinions only** (the lens API and the two lens models): no body, no
+    sensor, no transform and no companion camera, so a shot that references it beside a body
+    file (:func:`write_shot`) keeps the body's sensor, ISO, flange and placement, and computes
+    the companion camera and the lens distortion for that body's sensor. ``sensor_width_mm``
+    and ``sensor_height_mm`` only choose the sensor of the lens report the pinhole is solved
+    with (the best-match pinhole itself does not depend on the sensor).
+
     ``use`` ("pinhole" or "prescription") is the default variant: it sets the lens's
-    ``lensModel`` relationship, i.e. which model renders. The companion UsdGeomCamera
-    always shows the best-match pinhole.
+    ``lensModel`` relationship, i.e. which model renders.
     """
     from pxr import Sdf
 
@@ -345,8 +552,7 @@ def write_vendor_lens(file, prescription, *, focus_mm: float, fstop: float | Non
                                        sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm,
                                        coc_mm=coc_mm)
     stage = _stage(meters_per_unit, fps)
-    cam = author_camera(stage, LENS_PRIM, spec,
-                        lens_distortion=prescription_distortion(prescription, sensor_width_mm, sensor_height_mm))
+    cam = author_camera(stage, LENS_PRIM, spec, parts=("lens",))
     rx_prim = _author_prescription(stage, Sdf.Path(LENS_PRIM).AppendChild("Prescription"), prescription, focus_mm)
     pin = stage.GetPrimAtPath(Sdf.Path(LENS_PRIM).AppendChild("Pinhole"))
     rel_name = f"lens:{LENS_INSTANCE}:lensModel"
@@ -359,5 +565,3 @@ def write_vendor_lens(file, prescription, *, focus_mm: float, fstop: float | Non
             cam.GetRelationship(rel_name).SetTargets([target])
     vset.SetVariantSelection(use)
     return save_stage(stage, file, force=force)
-
-

@@ -1,0 +1,56 @@
+"""Wrong argument types in the Python API raise physcam's errors or TypeError with a sentence
+(issue 8), never a bare AttributeError/IndexError/KeyError from deep inside.
+
+Every public function (``__all__`` of every module) is called with each required argument in turn
+replaced by values of the wrong type, the others sensible. A ValueError is accepted too (Python's
+own word for "a number was expected": ``float('dgauss')``), as is any PhysCamError."""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import pkgutil
+import warnings
+
+import pytest
+
+import physcam
+from physcam.errors import PhysCamError
+from physcam.lens.library import load_lens
+
+WRONG = ["dgauss", None, [1, 2], {"a": 1}, object(), b"x", 3 + 2j]
+SKIP_MODULES = (".cli", "__main__", ".kernels")
+#: decorators and tiny helpers whose argument is a function, not data
+SKIP_FUNCTIONS = {"takes_prescription", "takes_text", "takes_report", "require_type"}
+
+
+def _public_functions():
+    out = []
+    for m in pkgutil.walk_packages(physcam.__path__, "physcam."):
+        if any(s in m.name for s in SKIP_MODULES):
+            continue
+        mod = importlib.import_module(m.name)
+        for name in getattr(mod, "__all__", []):
+            fn = getattr(mod, name, None)
+            if inspect.isfunction(fn) and name not in SKIP_FUNCTIONS and fn.__module__ == mod.__name__:
+                out.append(pytest.param(fn, id=f"{mod.__name__}.{name}"))
+    return out
+
+
+@pytest.mark.parametrize("fn", _public_functions())
+def test_wrong_types_get_a_sentence(fn):
+    lens = load_lens("dgauss_50mm")
+    params = [p for p in inspect.signature(fn).parameters.values()
+              if p.default is p.empty and p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+    for i, p in enumerate(params):
+        for bad in WRONG:
+            kwargs = {q.name: (bad if j == i else lens if q.name in ("lens", "prescription", "p") else 50.0)
+                      for j, q in enumerate(params)}
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    fn(**kwargs)
+            except (PhysCamError, TypeError, ValueError):
+                pass
+            except Exception as exc:  # noqa: BLE001 - the point of the test
+                pytest.fail(f"{fn.__name__}({p.name}={bad!r}) raised {type(exc).__name__}: {exc}")
