@@ -228,3 +228,53 @@ def test_usd_errors_are_caught_as_physcam_errors(tmp_path):
     write_camera(f, CameraSpec())
     with pytest.raises(PhysCamError):
         write_camera(f, CameraSpec())
+
+
+def test_enlarge_and_shift_render_a_tile():
+    """Issue 9.7: enlarge is applied. enlarge (2, 2) with shift (-w/4, +h/4) images the upper-left
+    quadrant: its Gf.Camera window is the upper-left quarter of the full frame's window."""
+    full_stage, tile_stage = new_stage(0.01), new_stage(0.01)
+    base = dict(focal_length_mm=50.0, sensor_width_mm=36.0, sensor_height_mm=24.0)
+    author_camera(full_stage, "/Cameras/Camera", CameraSpec(**base))
+    author_camera(tile_stage, "/Cameras/Camera", CameraSpec(**base, enlarge=(2.0, 2.0), shift_mm=(-9.0, 6.0)))
+    full, tile = gf_camera(full_stage).frustum.GetWindow(), gf_camera(tile_stage).frustum.GetWindow()
+    xm, ym = (full.GetMin()[0] + full.GetMax()[0]) / 2, (full.GetMin()[1] + full.GetMax()[1]) / 2
+    quadrant = (full.GetMin()[0], xm, ym, full.GetMax()[1])
+    got = (tile.GetMin()[0], tile.GetMax()[0], tile.GetMin()[1], tile.GetMax()[1])
+    assert got == pytest.approx(quadrant, abs=1e-6)
+
+
+def test_left_handed_camera_mirrors_the_image():
+    """handedness -1 (seed 001: a left-handed camera) mirrors the companion: its camera-to-world
+    matrix has a negative determinant and camera +X maps to world -X (body unrotated)."""
+    stage = new_stage(0.01)
+    author_camera(stage, "/Cameras/Camera", CameraSpec(handedness=-1.0))
+    m = UsdGeom.Xformable(stage.GetPrimAtPath("/Cameras/Camera/Camera")).ComputeLocalToWorldTransform(
+        Usd.TimeCode.Default())
+    assert m.GetDeterminant() == pytest.approx(-1.0)
+    assert m.TransformDir(Gf.Vec3d(1, 0, 0)) == pytest.approx(Gf.Vec3d(-1, 0, 0))
+    assert not validation_errors(stage)
+    with pytest.raises(InputError):
+        CameraSpec(handedness=0.5).checked()
+
+
+def test_aperture_distance_is_the_physical_stop():
+    """Issue 9.7: apertureDistance is the real stop position (the proposal's 'distance from image
+    plane to aperture'), not the entrance pupil: for dgauss focused at 2 m, film z minus the stop
+    vertex z of the focused lens, computed here from the focused prescription's own geometry."""
+    from physcam.lens.library import load_lens
+    from physcam.onset.report import solve_lens_report
+    from physcam.onset.sensors import find_sensor
+    from physcam.optics.focusing import focus
+    from physcam.usd.author import spec_from_report
+
+    lens = load_lens("dgauss_50mm")
+    st = focus(lens, 2000.0)
+    stop_z = st.prescription.vertex_z[st.prescription.stop_index]
+    r = solve_lens_report(focal_length_mm=None, sensor=find_sensor("FF"), focus_mm=2000.0, lens=lens)
+    spec = spec_from_report(r)
+    assert spec.aperture_distance_mm == pytest.approx(st.film_z - stop_z, rel=1e-12)
+    assert spec.aperture_distance_mm != pytest.approx(spec.entrance_pupil_mm, rel=1e-3)
+    stage = new_stage(0.01)
+    cam = author_camera(stage, "/Cameras/Camera", spec, report=r)
+    assert cam.GetAttribute("lens:main:apertureDistance").Get() == pytest.approx(st.film_z - stop_z, rel=1e-6)

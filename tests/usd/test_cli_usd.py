@@ -121,6 +121,14 @@ def test_every_usd_write_flag_reaches_the_file(tmp_path, capsys):
     assert s.GetPrimAtPath("/Rig/Hero/Camera").GetAttribute("ri:apertureNSides").Get() == 9
     s, r = _write_read(tmp_path, *BASE, "--orthographic", "--magnification", "0.5")
     assert (r.spec.projection, r.spec.magnification) == ("orthographic", 0.5)
+    s, r = _write_read(tmp_path, *BASE, "--enlarge", "2,2", "--handedness", "-1")
+    assert r.spec.enlarge == (2.0, 2.0) and r.spec.handedness == -1.0
+    # the companion images half the default Super 35 gate's 24.89 mm (enlarge 2) behind the 3 m thin lens's s'
+    from _thin_lens import image_distance_at_mark as sprime
+
+    g = UsdGeom.Camera(s.GetPrimAtPath("/Cameras/Camera/Camera"))
+    assert g.GetHorizontalApertureAttr().Get() / g.GetFocalLengthAttr().Get() == pytest.approx(
+        24.89 / 2 / sprime(50.0, 3000.0), rel=1e-6)
     s, r = _write_read(tmp_path, "--lens", "dgauss_50mm", "--fstop", "4", "--focus", "3m")
     assert r.spec.lens_name.startswith("Double Gauss 50mm")
     assert s.GetPrimAtPath("/Cameras/Camera/Camera").GetAttribute("lensDistortion:k1")
@@ -153,3 +161,16 @@ def test_kit_cli_builds_library_body_vendor_and_shot(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["stale"] is False
     assert main(["usd", "kit", "shot", str(shot), "--body", str(body), "--lens", str(lens), "--sensor", "FF"]) == 2
     assert "does not use --sensor" in capsys.readouterr().err
+
+
+def test_read_orthographic_says_orthographic(tmp_path, capsys):
+    """Issue 9.7: `usd read` printed a perspective FOV and DOF for orthographic cameras."""
+    f = tmp_path / "o.usda"
+    assert main(["usd", "write", str(f), "--focal", "50", "--fstop", "4", "--focus", "3m", "--orthographic",
+                 "--magnification", "0.5", "--sensor-width", "36", "--sensor-height", "24"]) == 0
+    capsys.readouterr()
+    assert main(["usd", "read", str(f)]) == 0
+    out = capsys.readouterr().out
+    assert "orthographic: magnification 0.5, images 72 x 48 mm" in out and "hfov" not in out
+    assert main(["usd", "read", str(f), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["report"] is None

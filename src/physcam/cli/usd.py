@@ -35,6 +35,10 @@ def register(sub) -> None:
     w.add_argument("--magnification", type=number("magnification"), default=1.0,
                    help="orthographic: image size / object size (default 1)")
     w.add_argument("--blades", type=int, default=7, help="iris blades (RenderMan apertureNSides; default 7)")
+    w.add_argument("--enlarge", type=_pair("enlarge"), default=(1.0, 1.0), metavar="EX,EY",
+                   help="image a region of the sensor enlarged EX,EY times (a tile: 2,2 with --shift-x/-y)")
+    w.add_argument("--handedness", type=int, choices=(1, -1), default=1,
+                   help="1 right-handed (default), -1 left-handed: a mirrored image")
     w.set_defaults(handler=run_write)
 
     r = s.add_parser("read", help="read a PhysicalCamera back into a lens report")
@@ -100,6 +104,23 @@ examples:
 """
 
 
+def _pair(name: str):
+    import argparse
+    import math
+
+    def parse(text):
+        try:
+            v = tuple(float(x) for x in str(text).split(","))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be two numbers X,Y, got {text!r}") from None
+        if len(v) != 2 or not all(math.isfinite(x) and x > 0 for x in v):
+            raise argparse.ArgumentTypeError(f"{name} must be two positive numbers X,Y, got {text!r}")
+        return v
+
+    parse.__name__ = name
+    return parse
+
+
 def _triple(name: str):
     import argparse
     import math
@@ -137,7 +158,8 @@ def run_write(args) -> int:
     spec = spec_from_report(report, projection="orthographic" if args.orthographic else "perspective",
                             magnification=args.magnification, aperture_blades=args.blades,
                             shutter_duration_s=args.shutter_angle / 360.0 / args.fps,
-                            shift_mm=(args.shift_x, args.shift_y))
+                            shift_mm=(args.shift_x, args.shift_y), enlarge=args.enlarge,
+                            handedness=float(args.handedness))
     distortion = None
     if getattr(args, "lens", None) and not args.orthographic:  # a prescription-backed report: its real distortion
         from ..lens.library import load_lens
@@ -167,14 +189,21 @@ def run_read(args) -> int:
     if args.json:
         from ._common import print_json
 
-        print_json({"usd": reading.to_dict(), "report": report.to_dict()})
+        print_json({"usd": reading.to_dict(),
+                    "report": report.to_dict() if reading.spec.projection == "perspective" else None})
         return 0
     s = reading.spec
     print(f"{reading.path}: {s.focal_length_mm:.4g} mm f/{s.fstop:.3g} focus {s.focus_mm:.6g} mm "
           f"sensor {s.sensor_width_mm:g} x {s.sensor_height_mm:g} mm ({reading.lens_model_type})")
-    print(f"  hfov {report.hfov_inf_deg:.4f} deg, vfov {report.vfov_inf_deg:.4f} deg; "
-          f"DOF from film {report.dof.near_from_film_mm:.1f} mm to "
-          f"{'inf' if report.dof.far_is_infinite else f'{report.dof.far_from_film_mm:.1f} mm'}")
+    if s.projection == "orthographic":
+        # a telecentric view: no field angle; the sensor images sensor / magnification of the scene
+        print(f"  orthographic: magnification {s.magnification:g}, images {s.sensor_width_mm * s.squeeze / s.magnification:g}"
+              f" x {s.sensor_height_mm / s.magnification:g} mm of the scene")
+    else:
+        pin, _ = report.pinhole
+        print(f"  pinhole {pin:.4f} mm: hfov {report.hfov_focus_deg:.4f} deg, vfov {report.vfov_focus_deg:.4f} deg "
+              f"at focus; DOF from film {report.dof.near_from_film_mm:.1f} mm to "
+              f"{'∞' if report.dof.far_is_infinite else f'{report.dof.far_from_film_mm:.1f} mm'}")
     for k, v in reading.variants.items():
         print(f"  variant {k} = {v}")
     return 0

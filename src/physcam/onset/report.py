@@ -144,6 +144,9 @@ class LensReport:
     #: (:func:`physcam.analysis.field_of_view.real_field_of_view`, as its ``to_dict``), beside the
     #: paraxial pinhole's; None for the thin-lens and datasheet models.
     real_fov: dict | None = None
+    #: the physical aperture stop (iris) in front of the film: a prescription's stop surface; the
+    #: lens plane for the thin lens; None when a datasheet does not say
+    stop_from_film_mm: float | None = None
 
     # --- convenience --------------------------------------------------------
     @property
@@ -232,6 +235,7 @@ class LensReport:
                 "real_differs": self.real_fov_differs,
             },
             "entrance_pupil_from_film_mm": self.entrance_pupil_from_film_mm,
+            "stop_from_film_mm": self.stop_from_film_mm,
             "entrance_pupil_source": self.entrance_pupil_source,
             "pivot_camera_space_mm": None if self.pivot_camera_space_mm is None else list(self.pivot_camera_space_mm),
             "solved": dict(self.solved),
@@ -355,6 +359,7 @@ def solve_lens_report(
             f"back focus {planes.back_focus_mm:.3f} mm"
         )
         lens_pinhole = (planes.pinhole_focal_length_mm, planes.pinhole_focal_length_mm)
+        lens_stop = planes.stop_from_film_mm
         if lens.is_anamorphic and squeeze == 1.0:
             # the squeeze the lens really has at this focus: EFL in Y over EFL in X
             st = focusing.focus(lens, D_lens)
@@ -612,6 +617,7 @@ def solve_lens_report(
         tstop=T,
         pinhole_focal_length_mm=pin_y,
         pinhole_squeeze=pin_sq,
+        stop_from_film_mm=(lens_stop if lens is not None else (h1_film if model == "practical" else None)),
         **fov,
     )
     if lens is not None:

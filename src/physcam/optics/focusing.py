@@ -112,6 +112,7 @@ class TechnicalPlanes:
     magnification: float
     entrance_pupil_diameter_mm: float
     pinhole_focal_length_mm: float | None = None  # the best-match pinhole at the entrance pupil (GaussianData)
+    stop_from_film_mm: float | None = None  # the physical aperture stop (iris), in front of the film
     flange_focal_distance_mm: float | None = None
     h1_from_flange_mm: float | None = None
     h2_from_flange_mm: float | None = None
@@ -396,6 +397,7 @@ def technical_planes(
         magnification=g.magnification,
         entrance_pupil_diameter_mm=g.entrance_pupil_diameter,
         pinhole_focal_length_mm=g.pinhole_focal_length,
+        stop_from_film_mm=g.z_film - g.z_stop,
         flange_focal_distance_mm=g.flange_focal_distance,
         **fl,
     )

@@ -69,6 +69,10 @@ class CameraSpec:
     camera's framing, docs/lens-report.md) when it is known from a prescription; ``None``
     computes it from the model (s' for a thin lens, H2 to film for a datasheet).
     ``clipping_mm``: near/far clipping from the eye, in mm (written in scene units).
+    ``enlarge`` (ex, ey): the imaged region is the sensor divided by it (a tile of the frame: enlarge
+    (2, 2) with ``shift_mm`` (-w/4, +h/4) renders the upper-left quadrant); ``handedness`` 1 for a
+    right-handed camera frame, -1 for a left-handed (mirrored) one (seed 001's sensor).
+    ``aperture_distance_mm``: the physical aperture stop (iris) in front of the film, when known.
     ``projection``: "perspective" (a pinhole/thin-lens model) or "orthographic"
     (a telecentric model imaging ``sensor / magnification`` of the scene).
     """
@@ -85,6 +89,8 @@ class CameraSpec:
     pinhole_focal_length_mm: float | None = None
     pinhole_squeeze: float | None = None
     shift_mm: tuple[float, float] = (0.0, 0.0)
+    enlarge: tuple[float, float] = (1.0, 1.0)
+    handedness: float = 1.0
     iso: float = 100.0
     transmittance: float = 1.0
     flange_distance_mm: float = 52.0
@@ -128,6 +134,11 @@ class CameraSpec:
             raise InputError(f"far clipping distance {far:g} mm must be beyond the near one {near:g} mm")
         for v in self.shift_mm:
             require_finite("sensor shift", v)
+        for v in self.enlarge:
+            if not 0.001 <= require_finite("enlarge", v) <= 1000.0:
+                raise InputError(f"enlarge must lie between 0.001 and 1000 (a magnification), got {v:g}")
+        if self.handedness not in (1.0, -1.0):
+            raise InputError(f"handedness is 1 (right-handed) or -1 (left-handed, mirrored), got {self.handedness!r}")
         if self.entrance_pupil_mm is not None:
             require_finite("entrance pupil distance", self.entrance_pupil_mm)
         if self.principal_planes_mm is not None:
@@ -194,6 +205,7 @@ def spec_from_report(report, **body) -> CameraSpec:
                            else report.h1_from_film_mm),
         principal_planes_mm=((report.h1_from_film_mm, report.h2_from_film_mm) if report.model == "technical"
                              else None),
+        aperture_distance_mm=report.stop_from_film_mm,
         # a prescription's best-match pinhole is kept; a thin lens or datasheet recomputes its own
         pinhole_focal_length_mm=report.pinhole_focal_length_mm if report.entrance_pupil_source == "prescription"
         else None,
@@ -414,6 +426,8 @@ def _author_sensor(cam, spec):
     sp = f"sensor:{SENSOR_INSTANCE}:"
     _set(cam, sp + "aperture", Sdf.ValueTypeNames.Float2, Gf.Vec2f(spec.sensor_width_mm, spec.sensor_height_mm))
     _set(cam, sp + "shift", Sdf.ValueTypeNames.Float2, Gf.Vec2f(*spec.shift_mm))
+    _set(cam, sp + "enlarge", Sdf.ValueTypeNames.Float2, Gf.Vec2f(*spec.enlarge))
+    _set(cam, sp + "handedness", Sdf.ValueTypeNames.Float, float(spec.handedness))
     _set(cam, sp + "circleOfConfusion", Sdf.ValueTypeNames.Float, spec.coc_mm)
     _set(cam, sp + "iso", Sdf.ValueTypeNames.Float, spec.iso)
     if spec.sensor_name:
@@ -435,8 +449,8 @@ def _author_lens(stage, cam, spec, eye, su):
         _set(cam, lp + "pinholeFocalLength", Sdf.ValueTypeNames.Float, spec.pinhole_focal_length_mm)
         _set(cam, lp + "pinholeSqueeze", Sdf.ValueTypeNames.Float,
              spec.squeeze if spec.pinhole_squeeze is None else spec.pinhole_squeeze)
-    _set(cam, lp + "apertureDistance", Sdf.ValueTypeNames.Float,
-         eye if spec.aperture_distance_mm is None else spec.aperture_distance_mm)
+    if spec.aperture_distance_mm is not None:  # the physical stop; unknown for a datasheet: not authored
+        _set(cam, lp + "apertureDistance", Sdf.ValueTypeNames.Float, spec.aperture_distance_mm)
     _set(cam, lp + "shutterBlades", Sdf.ValueTypeNames.UInt, int(spec.aperture_blades))
     _set(cam, lp + "apertureAngle", Sdf.ValueTypeNames.Float, spec.aperture_angle_deg)
     _set(cam, lp + "apertureRoundness", Sdf.ValueTypeNames.Float, spec.aperture_roundness)
@@ -497,6 +511,9 @@ def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None, lens
             "fStop": spec.fstop,
             "clippingRange": (su(spec.clipping_mm[0]), su(spec.clipping_mm[1])),
         }
+    # enlarge: the imaged region is the sensor divided by it (the shift stays in film mm)
+    values["horizontalAperture"] /= spec.enlarge[0]
+    values["verticalAperture"] /= spec.enlarge[1]
     if spec.projection == "perspective":
         values["focalLength"], values["horizontalAperture"], values["verticalAperture"] = fov_preserving_float32(
             values["focalLength"], values["horizontalAperture"], values["verticalAperture"])
@@ -549,6 +566,8 @@ def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None, lens
     xf = UsdGeom.Xformable(prim)
     xf.ClearXformOpOrder()
     xf.AddTranslateOp().Set(Gf.Vec3d(0.0, 0.0, -su(eye)))
+    if spec.handedness == -1.0:  # a left-handed frame: the image is mirrored left to right
+        xf.AddScaleOp(opSuffix="handedness").Set(Gf.Vec3f(-1.0, 1.0, 1.0))
     return geom
 
 

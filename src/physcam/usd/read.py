@@ -88,6 +88,12 @@ def _get(prim, name, what):
     return v
 
 
+def _pair(prim, name: str, default):
+    attr = prim.GetAttribute(name)
+    v = attr.Get() if attr else None
+    return default if v is None else (float(v[0]), float(v[1]))
+
+
 def _optional(prim, name: str):
     """An authored float attribute's value, or None when it is not authored."""
     attr = prim.GetAttribute(name)
@@ -248,7 +254,10 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
         iso=float(_get(prim, sp + "iso", "")),
         transmittance=float(_get(model, "transmittance", "")),
         flange_distance_mm=float(_get(prim, "flangeDistance", "")),
-        aperture_distance_mm=float(_get(prim, lp + "apertureDistance", "")),
+        aperture_distance_mm=_optional(prim, lp + "apertureDistance"),
+        enlarge=_pair(prim, sp + "enlarge", (1.0, 1.0)),
+        handedness=float(prim.GetAttribute(sp + "handedness").Get()) if prim.GetAttribute(sp + "handedness")
+        and prim.GetAttribute(sp + "handedness").Get() is not None else 1.0,
         shutter_open_s=float(_get(prim, "shutterOpen", "")),
         shutter_duration_s=float(_get(prim, "shutterDuration", "")),
         shutter_opening=(float(opening[0]), float(opening[1])),
