@@ -107,7 +107,10 @@ def unreal_lens_file(
         marks = [r.focus_from_film_mm for r in breathing_table(lens, None, sensor_width_mm=w, method=method,
                                                                 wavelength_nm=wl)]
     else:
-        marks = [float(m) for m in focus_marks_mm]
+        try:
+            marks = [float(m) for m in focus_marks_mm]
+        except (TypeError, ValueError):
+            raise InputError(f"focus marks must be numbers (mm from the film plane), got {focus_marks_mm!r}") from None
         if not marks or len(marks) > 64:
             raise InputError("give 1 to 64 focus marks")
         if any(math.isnan(m) or m <= 0 for m in marks):
@@ -180,8 +183,12 @@ def write_unreal_lens_file(path, lens: Prescription, sensor_width_mm: float, sen
 
 def read_unreal_lens_file(path) -> dict:
     """The tables of a ``.ulens`` file: ``{parameterName: (header, rows)}`` plus ``"_json"`` (the whole file)."""
+    import os
     from pathlib import Path
 
+    from ..errors import require_type
+
+    require_type("path", path, (str, os.PathLike))
     try:
         data = json.loads(Path(path).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
