@@ -1,0 +1,103 @@
+"""``physcam export``: lens data for other tools (Unreal lens files, OpenCV/Omniverse pinholes)."""
+
+from __future__ import annotations
+
+from ._common import distance, print_json
+
+
+def _common(p) -> None:
+    from .analyze import _sensor
+
+    p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    _sensor(p)
+    p.add_argument("--width-px", type=int, required=True, metavar="PX", help="image width in pixels")
+    p.add_argument("--height-px", type=int, required=True, metavar="PX", help="image height in pixels")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("export", help="lens data for Unreal (lens file) and OpenCV/Omniverse (pinhole + distortion)",
+                       description="Export a real lens as an Unreal Engine lens file (.ulens JSON) or as fitted "
+                                   "OpenCV pinhole intrinsics and distortion (Omniverse's opencvPinhole lens API).")
+    s = p.add_subparsers(dest="export_command", metavar="FORMAT")
+
+    u = s.add_parser("unreal", help="write an Unreal Engine lens file (.ulens JSON, Camera Calibration plugin)")
+    _common(u)
+    u.add_argument("-o", "--output", required=True, metavar="FILE", help="the lens file to write (.ulens or .json)")
+    u.add_argument("--focus", type=distance("focus distance", allow_inf=True), action="append", metavar="D",
+                   help="focus mark from the film plane (repeat; default: infinity to the closest focus)")
+    u.add_argument("--force", action="store_true", help="overwrite an existing file")
+    u.set_defaults(handler=run_unreal)
+
+    o = s.add_parser("opencv", help="print OpenCV pinhole intrinsics and distortion fitted to real rays")
+    _common(o)
+    o.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=float("inf"), metavar="D",
+                   help="focus mark from the film plane (default infinity)")
+    o.add_argument("--terms", choices=("k1", "k1k2", "k1k2k3", "rational"), default="k1k2k3",
+                   help="distortion terms to fit (default k1k2k3)")
+    o.set_defaults(handler=run_opencv)
+    p.set_defaults(handler=lambda args: (p.print_help(), 0)[1])
+
+
+def _prepare(args):
+    from ..lens.library import load_lens
+    from .analyze import _resolve_sensor
+
+    _resolve_sensor(args)
+    return load_lens(args.lens)
+
+
+def _mark(mm: float) -> str:
+    return "∞" if mm == float("inf") else f"{mm / 1000.0:g} m"
+
+
+def run_unreal(args) -> int:
+    from ..export.unreal import unreal_lens_file
+    from ..io import atomic_write, check_writable
+
+    check_writable(args.output, force=args.force)
+    lens = _prepare(args)
+    data = unreal_lens_file(lens, args.sensor_width, args.sensor_height, image_width_px=args.width_px,
+                            image_height_px=args.height_px, focus_marks_mm=args.focus)
+    import json
+
+    atomic_write(args.output, json.dumps(data, indent=2, allow_nan=False) + "\n", force=args.force)
+    if args.json:
+        print_json(data)
+        return 0
+    pc = data["physcam"]
+    print(f"wrote {args.output}: Unreal lens file of {pc['lens']} on {args.sensor_width:g} x {args.sensor_height:g} mm, "
+          f"{args.width_px} x {args.height_px} px")
+    print(f"  {'focus':>8} {'Fx':>8} {'Fy':>8} {'K1':>10} {'K2':>10} {'K3':>10} {'pupil cm':>9} {'resid px':>9}")
+    for m in pc["marks"]:
+        f = m["focus_from_film_mm"]
+        print(f"  {_mark(float('inf') if f is None else f):>8} {m['pinhole_focal_length_x_mm'] / args.sensor_width:8.5f} "
+              f"{m['pinhole_focal_length_y_mm'] / args.sensor_height:8.5f} {m['k1']:10.6f} {m['k2']:10.6f} "
+              f"{m['k3']:10.6f} {m['entrance_pupil_from_film_mm'] / 10.0:9.3f} {m['max_residual_px']:9.4f}")
+    notes = sorted({n for m in pc["marks"] for n in m["notes"]})
+    for n in notes:
+        print(f"  note: {n}")
+    return 0
+
+
+def run_opencv(args) -> int:
+    from ..export.opencv_distortion import OMNI_API_SCHEMA, fit_opencv_pinhole
+
+    lens = _prepare(args)
+    cam = fit_opencv_pinhole(lens, args.sensor_width, args.sensor_height, args.width_px, args.height_px,
+                             focus_from_film_mm=args.focus, terms=args.terms)
+    if args.json:
+        print_json(cam.to_dict())
+        return 0
+    print(f"{cam.lens_name}: OpenCV pinhole at focus {_mark(cam.focus_from_film_mm)} on "
+          f"{cam.sensor_width_mm:g} x {cam.sensor_height_mm:g} mm, {cam.image_width_px} x {cam.image_height_px} px")
+    print(f"  fx {cam.fx:.4f}  fy {cam.fy:.4f}  cx {cam.cx:.4f}  cy {cam.cy:.4f}  (px; pinhole "
+          f"{cam.pinhole_focal_length_x_mm:.4f} mm at the entrance pupil, {cam.entrance_pupil_from_film_mm:.3f} mm "
+          "in front of the film)")
+    print("  " + "  ".join(f"{k} {getattr(cam, k):.6g}" for k in ("k1", "k2", "k3", "k4", "k5", "k6", "p1", "p2")))
+    print(f"  fit ({cam.terms}) over {cam.n_points} traced points: max residual {cam.max_residual_px:.4f} px, "
+          f"rms {cam.rms_residual_px:.4f} px")
+    print(f"  Omniverse: apiSchemas = [\"{OMNI_API_SCHEMA}\"], omni:lensdistortion:opencvPinhole:* (--json for all)")
+    for n in cam.notes:
+        print(f"  note: {n}")
+    return 0
