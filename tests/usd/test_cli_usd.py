@@ -174,3 +174,51 @@ def test_read_orthographic_says_orthographic(tmp_path, capsys):
     assert "orthographic: magnification 0.5, images 72 x 48 mm" in out and "hfov" not in out
     assert main(["usd", "read", str(f), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["report"] is None
+
+
+def test_lens_camera_carries_omniverse_opencv_distortion(tmp_path):
+    """Issue 9 (Omniverse): a camera written from a prescription applies
+    OmniLensDistortionOpenCvPinholeAPI. Its fx (pixels) is the companion's own focal length on the
+    requested image width, and cv2.projectPoints with the authored values puts a 15-degree beam
+    where physcam's real chief ray lands (independent OpenCV oracle)."""
+    import math
+
+    import cv2
+    import numpy as np
+    from pxr import UsdGeom
+
+    from physcam.analysis._chief import aim_from_infinity, field_direction
+    from physcam.lens.library import load_lens
+    from physcam.optics.paraxial import gaussian
+    from physcam.trace import trace_to_film
+    from physcam.usd.read import open_stage
+
+    f = tmp_path / "omni.usda"
+    assert main(["usd", "write", str(f), "--lens", "dgauss_50mm", "--focus", "inf", "--sensor-width", "36",
+                 "--sensor-height", "24", "--resolution", "3600,2400"]) == 2  # the focus must be finite
+    assert main(["usd", "write", str(f), "--lens", "dgauss_50mm", "--focus", "1000m", "--sensor-width", "36",
+                 "--sensor-height", "24", "--resolution", "3600,2400"]) == 0
+    stage = open_stage(f)
+    prim = stage.GetPrimAtPath("/Cameras/Camera/Camera")
+    assert "OmniLensDistortionOpenCvPinholeAPI" in prim.GetMetadata("apiSchemas").GetAddedOrExplicitItems()
+    a = lambda n: prim.GetAttribute(f"omni:lensdistortion:opencvPinhole:{n}").Get()  # noqa: E731
+    assert prim.GetAttribute("omni:lensdistortion:model").Get() == "opencvPinhole"
+    assert tuple(a("imageSize")) == (3600, 2400)
+    focal_mm = UsdGeom.Camera(prim).GetFocalLengthAttr().Get()  # tenths of a cm = mm
+    assert a("fx") == pytest.approx(focal_mm * 3600 / 36.0, rel=1e-5)
+    K = np.array([[a("fx"), 0, a("cx")], [0, a("fy"), a("cy")], [0, 0, 1]], dtype=float)
+    dist = np.array([a("k1"), a("k2"), a("p1"), a("p2"), a("k3"), a("k4"), a("k5"), a("k6")], dtype=float)
+    lens = load_lens("dgauss_50mm")
+    theta = math.radians(15.0)
+    chief = aim_from_infinity(lens, field_direction(theta, "y"), wavelength_nm=lens.wavelength_nm)
+    from physcam.trace import RayBatch
+
+    film_z = gaussian(lens).z_rear_focal_point
+    out = trace_to_film(lens, RayBatch.from_arrays(chief.start, chief.direction), film_z, clip=False)
+    # OpenCV's object point (0, tan 15°, 1) lies below the axis (OpenCV's y points down), so its light
+    # travels toward physcam's +y; the film image (inverted) lies at +y, which the upright OpenCV
+    # image shows at v = cy + y px/mm (docs/unreal-omniverse.md)
+    assert out.y[0] > 0
+    v_real = a("cy") + out.y[0] * 2400 / 24.0
+    pts, _ = cv2.projectPoints(np.array([[0.0, math.tan(theta), 1.0]]), np.zeros(3), np.zeros(3), K, dist)
+    assert pts[0, 0, 1] == pytest.approx(v_real, abs=0.5)

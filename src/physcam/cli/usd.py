@@ -39,6 +39,9 @@ def register(sub) -> None:
                    help="image a region of the sensor enlarged EX,EY times (a tile: 2,2 with --shift-x/-y)")
     w.add_argument("--handedness", type=int, choices=(1, -1), default=1,
                    help="1 right-handed (default), -1 left-handed: a mirrored image")
+    w.add_argument("--resolution", type=_pixels, default=None, metavar="W[,H]",
+                   help="with --lens: image size in pixels for Omniverse's OpenCV distortion (default 4096 wide, "
+                        "height from the sensor's aspect)")
     w.set_defaults(handler=run_write)
 
     r = s.add_parser("read", help="read a PhysicalCamera back into a lens report")
@@ -104,6 +107,18 @@ examples:
 """
 
 
+def _pixels(text):
+    import argparse
+
+    try:
+        v = tuple(int(x) for x in str(text).split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"resolution must be W or W,H in whole pixels, got {text!r}") from None
+    if len(v) not in (1, 2) or not all(16 <= x <= 65536 for x in v):
+        raise argparse.ArgumentTypeError(f"resolution must be 16 to 65536 pixels, got {text!r}")
+    return v
+
+
 def _pair(name: str):
     import argparse
     import math
@@ -160,14 +175,18 @@ def run_write(args) -> int:
                             shutter_duration_s=args.shutter_angle / 360.0 / args.fps,
                             shift_mm=(args.shift_x, args.shift_y), enlarge=args.enlarge,
                             handedness=float(args.handedness))
-    distortion = None
+    distortion = opencv = None
     if getattr(args, "lens", None) and not args.orthographic:  # a prescription-backed report: its real distortion
         from ..lens.library import load_lens
-        from ..usd.kit import prescription_distortion
+        from ..usd.kit import prescription_distortion, prescription_opencv
 
-        distortion = prescription_distortion(load_lens(args.lens), report.sensor.width_mm, report.sensor.height_mm)
+        lens = load_lens(args.lens)
+        distortion = prescription_distortion(lens, report.sensor.width_mm, report.sensor.height_mm)
+        opencv = prescription_opencv(lens, report.sensor.width_mm, report.sensor.height_mm,
+                                     focus_mm=report.focus_from_film_mm, resolution=args.resolution)
     path = write_camera(args.file, spec, force=args.force, path=args.path, meters_per_unit=args.meters_per_unit,
-                        fps=args.fps, report=report if not args.orthographic else None, lens_distortion=distortion)
+                        fps=args.fps, report=report if not args.orthographic else None, lens_distortion=distortion,
+                        opencv_distortion=opencv)
     return _done(args, path)
 
 

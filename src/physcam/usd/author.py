@@ -334,7 +334,8 @@ ALL_PARTS = ("body", "sensor", "lens", "render")
 
 
 def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0),
-                  rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, parts=ALL_PARTS, lens_distortion=None):
+                  rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, parts=ALL_PARTS, lens_distortion=None,
+                  opencv_distortion=None):
     """Author ``spec`` at ``path`` on ``stage`` (its current edit target); return the PhysicalCamera prim.
 
     ``position``: where the entrance pupil is, in scene units in the parent's space;
@@ -392,7 +393,8 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
     if "lens" in parts:
         _author_lens(stage, cam, spec, eye, su)
     if "render" in parts:
-        author_render_camera(stage, sdf_path, spec, report=report, lens_distortion=lens_distortion)
+        author_render_camera(stage, sdf_path, spec, report=report, lens_distortion=lens_distortion,
+                             opencv_distortion=opencv_distortion)
     return cam
 
 
@@ -474,9 +476,33 @@ def _author_lens(stage, cam, spec, eye, su):
     cam.GetRelationship(lp + "lensModel").SetTargets([model.GetPath()])
 
 
-def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None, lens_distortion=None):
+#: Omniverse RTX's OpenCV-pinhole lens distortion API (docs/unreal-omniverse.md) and its attribute types.
+OMNI_OPENCV_API = "OmniLensDistortionOpenCvPinholeAPI"
+
+
+def _author_omni_opencv(prim, opencv) -> None:
+    """Apply Omniverse's OpenCV-pinhole distortion API with a fitted model's attributes
+    (:class:`physcam.export.opencv_distortion.OpenCvPinhole`)."""
+    from pxr import Gf, Sdf
+
+    prim.AddAppliedSchema(OMNI_OPENCV_API)
+    for name, value in opencv.usd_attributes().items():
+        if name.endswith(":model"):
+            _set(prim, name, Sdf.ValueTypeNames.Token, str(value), custom=True)
+        elif name.endswith(":imageSize"):
+            _set(prim, name, Sdf.ValueTypeNames.Int2, Gf.Vec2i(int(value[0]), int(value[1])), custom=True)
+        else:
+            _set(prim, name, Sdf.ValueTypeNames.Float, require_finite(name, value, error=ExportError), custom=True)
+
+
+def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None, lens_distortion=None,
+                         opencv_distortion=None):
     """Write ``<cam_path>/Camera``, the UsdGeomCamera that matches ``spec`` in the stage's units.
 
+    With ``opencv_distortion`` (an :class:`~physcam.export.opencv_distortion.OpenCvPinhole` fitted
+    to the lens at this focus and sensor) the camera gets Omniverse RTX's
+    ``OmniLensDistortionOpenCvPinholeAPI`` (fx, fy, cx, cy in pixels with the image size, k1..k6,
+    p1, p2; docs/unreal-omniverse.md).
     With ``lens_distortion`` (see :func:`author_camera`) the camera also gets Hydra's
     ``lensDistortion:type``/``k1``/``k2``/``center``/``anaSq``/``asym``/``scale`` attributes
     (``HdCameraTokens``; hdPrman passes them to PxrCamera). They are not UsdGeomCamera schema
@@ -549,6 +575,8 @@ def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None, lens
          shutter_opening_curve(*spec.shutter_opening), custom=True)
     if lens_distortion is not None:
         _author_lens_distortion(prim, lens_distortion)
+    if opencv_distortion is not None:
+        _author_omni_opencv(prim, opencv_distortion)
     if report is not None and report.real_fov is not None:
         # say which field of view this camera shows, and what the real lens shows (issue 8)
         real = {k: report.real_fov[f"{k}_deg"] for k in ("horizontal", "vertical", "diagonal")}
@@ -649,9 +677,10 @@ def save_stage(stage, file, *, force: bool = False):
 
 def write_camera(file, spec: CameraSpec, *, force: bool = False, path: str = DEFAULT_CAMERA_PATH,
                  meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y",
-                 position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, lens_distortion=None):
+                 position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, lens_distortion=None,
+                 opencv_distortion=None):
     """Write a one-camera layer to ``file`` (see :func:`author_camera`); return the Path."""
     stage = new_stage(meters_per_unit, fps, up_axis)
     author_camera(stage, path, spec, position=position, rotate_xyz_deg=rotate_xyz_deg, report=report,
-                  lens_distortion=lens_distortion)
+                  lens_distortion=lens_distortion, opencv_distortion=opencv_distortion)
     return save_stage(stage, file, force=force)

@@ -35,6 +35,7 @@ __all__ = [
     "check_shot",
     "refresh_shot",
     "companion_inputs_hash",
+    "prescription_opencv",
 ]
 
 LENS_PRIM = "/Lens"
@@ -250,7 +251,7 @@ def _author_shot_companion(stage, path) -> str:
 
     spec = _composed_spec(stage, path)
     rx = _composed_prescription(stage, path)
-    report, distortion = None, None
+    report, distortion, opencv = None, None, None
     if rx is not None and spec.projection == "perspective":
         from ..onset.report import solve_lens_report
         from ..onset.sensors import Sensor
@@ -268,7 +269,9 @@ def _author_shot_companion(stage, path) -> str:
                        pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
                        pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze)
         distortion = prescription_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm)
-    geom = author_render_camera(stage, Sdf.Path(path), spec, report=report, lens_distortion=distortion)
+        opencv = prescription_opencv(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
+    geom = author_render_camera(stage, Sdf.Path(path), spec, report=report, lens_distortion=distortion,
+                                opencv_distortion=opencv)
     digest = _companion_inputs(stage, path)
     geom.GetPrim().SetCustomDataByKey("physcam:companionInputs", digest)
     return digest
@@ -492,6 +495,20 @@ def prescription_distortion(prescription, sensor_width_mm: float = 36.0, sensor_
     from ..analysis.distortion import real_distortion
 
     return real_distortion(prescription, sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm).fit
+
+
+def prescription_opencv(prescription, sensor_width_mm: float, sensor_height_mm: float, *, focus_mm: float,
+                        resolution=None):
+    """The OpenCV pinhole + distortion fitted to ``prescription`` at ``focus_mm`` on this sensor
+    (:func:`physcam.export.opencv_distortion.fit_opencv_pinhole`), for Omniverse's distortion API.
+    ``resolution``: (W,) or (W, H) pixels; default 4096 wide, H from the sensor's aspect."""
+    from ..export.opencv_distortion import fit_opencv_pinhole
+
+    w_px = 4096 if not resolution else int(resolution[0])
+    h_px = int(resolution[1]) if resolution and len(resolution) > 1 else max(16, round(w_px * sensor_height_mm /
+                                                                                        sensor_width_mm))
+    return fit_opencv_pinhole(prescription, sensor_width_mm, sensor_height_mm, w_px, h_px,
+                              focus_from_film_mm=focus_mm)
 
 
 def _author_prescription(stage, path, rx, focus_mm: float):
