@@ -237,12 +237,12 @@ def run_breathing(args) -> int:
 
     t = Table(title=f"{p.name}: focus breathing, {sensor_name} sensor (horizontal field, X meridian)")
     for col in ("focus from film (mm)", "EFL (mm)", "HFOV (deg)", "framing focal length (mm)", "magnification",
-                "back focus (mm)", "FOV change (%)"):
+                "back focus (mm)", "entrance pupil from film (mm)", "FOV change (%)"):
         t.add_column(col, justify="right")
     for r in rows:
         t.add_row(_fmt(r.focus_from_film_mm, 0), _fmt(r.efl_mm, 3), _fmt(r.hfov_deg, 3),
                   _fmt(r.breathing_focal_length_mm, 3), _fmt(r.magnification, 4), _fmt(r.back_focus_mm, 3),
-                  _fmt(r.fov_change_pct, 2))
+                  _fmt(r.entrance_pupil_from_film_mm, 2), _fmt(r.fov_change_pct, 2))
     con = console()
     con.print(t)
     if path is not None:

@@ -77,6 +77,28 @@ def register(sub) -> None:
     _stage_args(k)
     k.set_defaults(handler=run_kit)
 
+    a = s.add_parser("animate", help="a focus (and iris) pull as time samples, breathing included",
+                     description="Write a camera whose focus and f-stop follow marks per frame (docs/usd.md).",
+                     epilog="example:\n  physcam usd animate pull.usda --lens dgauss_50mm --marks pull.csv "
+                            "--sensor \"ALEXA 35\" --fstop 2.8\n"
+                            "pull.csv has columns frame,focus[,fstop]; focus with units (5m, 16ft; bare = mm).",
+                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    a.add_argument("file")
+    a.add_argument("--marks", required=True, metavar="CSV", help="focus marks per frame: frame,focus[,fstop]")
+    a.add_argument("--lens", help="bundled lens name or prescription file (breathing from the real lens)")
+    a.add_argument("--focal", type=distance("focal length"), help="or a thin lens of this focal length")
+    a.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop for frames without one")
+    a.add_argument("--coc", default=None, help="circle of confusion convention or value in mm")
+    a.add_argument("--sensor", help="sensor name (default Super 35)")
+    a.add_argument("--sensor-width", type=distance("sensor width"))
+    a.add_argument("--sensor-height", type=distance("sensor height"))
+    a.add_argument("--shutter-angle", type=number("shutter angle", positive=True), default=180.0)
+    a.add_argument("--path", default="/Cameras/Camera", help="camera prim path")
+    a.add_argument("--position", type=_triple("position"), default=(0.0, 0.0, 0.0), metavar="X,Y,Z")
+    a.add_argument("--rotate", type=_triple("rotation"), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ")
+    _stage_args(a)
+    a.set_defaults(handler=run_animate)
+
     c = s.add_parser("check", help="is a shot's companion camera current with its body and lens files?")
     c.add_argument("file")
     c.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
@@ -363,6 +385,38 @@ def _read_characterizations(csv_path) -> dict:
     if not out:
         raise LensFileError("no characterization rows", str(p))
     return out
+
+
+def run_animate(args) -> int:
+    from ..errors import InputError
+    from ..usd.animate import read_focus_marks, write_animated_camera
+
+    if (args.lens is None) == (args.focal is None):
+        raise InputError("give the lens (--lens NAME) or a thin lens's focal length (--focal MM)")
+    lens = None
+    if args.lens:
+        from ..lens.library import load_lens
+
+        lens = load_lens(args.lens)
+    coc = args.coc
+    if coc is not None:
+        try:
+            coc = float(coc)
+        except ValueError:
+            pass
+    keys = read_focus_marks(args.marks)
+    path = write_animated_camera(args.file, keys, sensor=_kit_sensor(args, default="Super 35"), lens=lens,
+                                 focal_length_mm=args.focal, fstop=args.fstop, coc=coc, path=args.path,
+                                 meters_per_unit=args.meters_per_unit, fps=args.fps,
+                                 shutter_angle_deg=args.shutter_angle, position=args.position,
+                                 rotate_xyz_deg=args.rotate, force=args.force)
+    if args.json:
+        from ._common import print_json
+
+        print_json({"written": str(path), "frames": len(keys), "first": keys[0].frame, "last": keys[-1].frame})
+    else:
+        print(f"wrote {path} ({len(keys)} frames, {keys[0].frame:g} to {keys[-1].frame:g})")
+    return 0
 
 
 def run_check(args) -> int:

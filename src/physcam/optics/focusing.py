@@ -134,6 +134,7 @@ class BreathingRow:
     magnification: float
     back_focus_mm: float
     fov_change_pct: float  # HFOV change from infinity focus, percent
+    entrance_pupil_from_film_mm: float | None = None  # where the camera pivots at this mark
 
     def to_dict(self) -> dict:
         d = asdict(self)
@@ -448,6 +449,7 @@ def breathing_table(
                 magnification=gx.magnification,
                 back_focus_mm=st.back_focus_mm,
                 fov_change_pct=100.0 * (hfov / hfov0 - 1.0),
+                entrance_pupil_from_film_mm=gx.in_front_of("entrance_pupil"),
             )
         )
     return rows

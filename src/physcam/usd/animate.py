@@ -1,0 +1,180 @@
+"""Animated cameras: focus pulls and iris pulls as USD time samples, breathing included.
+
+A focus puller's marks per frame (a CSV, or a list of :class:`FocusKey`) become time samples on
+one camera. At every frame the lens is solved again at that mark (and f-stop): for a prescription
+its Gaussian optics focused there (unit or internal focusing, :mod:`physcam.optics.focusing`),
+for a thin lens the practical model. What changes with focus is time-sampled:
+
+* the lens model's ``focusDistance`` and ``focalLength`` (the EFL: it changes with internal
+  focusing), the lens's ``fStop``, ``iris``, ``entrancePupilDistance``, ``pinholeFocalLength``,
+  principal planes and ``apertureDistance`` (the stop moves with unit focusing);
+* the companion UsdGeomCamera's ``focalLength`` (the best-match pinhole: breathing), apertures
+  (float32 values that keep the field of view exact), ``fStop``, ``focusDistance`` and its
+  translate: the eye follows the entrance pupil while the body, and so the film plane, stays
+  where it was placed (the body's ``translate:pupilToFilm`` is the first frame's pupil).
+
+Frames are USD time codes; the stage's timeCodesPerSecond is the frame rate. Each key is one
+frame: USD interpolates linearly between samples, which breathing is not, so give a mark per
+frame (the CSV of a focus-pull recording is). Lengths in mm (docs/conventions.md).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import ExportError, InputError, LensFileError, PhysCamWarning, require_finite
+
+__all__ = ["FocusKey", "read_focus_marks", "write_animated_camera"]
+
+#: The most frames one animated camera holds (a 10-minute take at 48 fps), bounded before any work.
+MAX_FRAMES = 28_800
+
+
+@dataclass(frozen=True)
+class FocusKey:
+    """One frame: its number, the focus mark from the film plane (mm), and an f-stop (None: unchanged)."""
+
+    frame: float
+    focus_mm: float
+    fstop: float | None = None
+
+
+def read_focus_marks(path) -> list[FocusKey]:
+    """Keys from a CSV with columns ``frame``, ``focus`` (a distance with units, ``5m``, ``16ft``; bare
+    numbers are mm) and optionally ``fstop`` (an iris pull). Errors name the file and line."""
+    import csv
+
+    from ..units import parse_distance
+
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise LensFileError(f"cannot read the focus marks: {exc.strerror or exc}", str(p)) from None
+    rows = csv.DictReader(text.splitlines())
+    cols = set(rows.fieldnames or ())
+    if not {"frame", "focus"} <= cols:
+        raise LensFileError("the focus-mark CSV needs 'frame' and 'focus' columns (and optionally 'fstop')", str(p), 1)
+    unknown = cols - {"frame", "focus", "fstop"}
+    if unknown:
+        raise LensFileError(f"unknown columns {sorted(unknown)}; use frame, focus, fstop", str(p), 1)
+    keys = []
+    for line, row in enumerate(rows, start=2):
+        try:
+            frame = require_finite("frame", float(row["frame"]))
+            focus = parse_distance(row["focus"], name="focus mark")
+            fstop = None if not (row.get("fstop") or "").strip() else float(row["fstop"])
+        except (ValueError, TypeError, InputError) as exc:
+            raise LensFileError(str(exc) if isinstance(exc, InputError) else f"not a number: {exc}", str(p), line) \
+                from None
+        keys.append(FocusKey(frame, focus, fstop))
+        if len(keys) > MAX_FRAMES:
+            raise LensFileError(f"more than {MAX_FRAMES} frames in one camera", str(p), line)
+    if not keys:
+        raise LensFileError("no focus marks", str(p))
+    return keys
+
+
+def _check_keys(keys) -> list[FocusKey]:
+    keys = list(keys)
+    if not keys:
+        raise InputError("give at least one focus mark")
+    if len(keys) > MAX_FRAMES:
+        raise InputError(f"at most {MAX_FRAMES} frames in one camera, got {len(keys)}")
+    frames = [k.frame for k in keys]
+    if any(b <= a for a, b in zip(frames, frames[1:])):
+        raise InputError("frames must increase from one key to the next")
+    return keys
+
+
+def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: float | None = None,
+                          fstop: float | None = None, coc=None, path: str = "/Cameras/Camera",
+                          meters_per_unit: float = 0.01, fps: float = 24.0, shutter_angle_deg: float = 180.0,
+                          position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), force: bool = False):
+    """Write a camera whose focus (and iris) follow ``keys``, one time sample per key; return the Path.
+
+    ``lens`` (a Prescription) or ``focal_length_mm`` (a thin lens); ``sensor`` a
+    :class:`~physcam.onset.sensors.Sensor`; ``fstop`` for keys without their own (with a
+    prescription and no f-stop at all: wide open).
+    """
+    from pxr import Gf, Sdf, UsdGeom
+
+    from ..export.usdgeom import mm_to_scene_units, pinhole_fstop, require_meters_per_unit
+    from ..onset.report import solve_lens_report
+    from .author import author_camera, fov_preserving_float32, new_stage, save_stage, spec_from_report
+
+    keys = _check_keys(keys)
+    if (lens is None) == (focal_length_mm is None):
+        raise InputError("give either a lens prescription or a focal length")
+    if not 0.0 < require_finite("shutter angle", shutter_angle_deg) <= 360.0:
+        raise InputError(f"shutter angle must be in (0, 360] degrees, got {shutter_angle_deg:g}")
+    mpu = require_meters_per_unit(meters_per_unit)
+    su = lambda mm: mm_to_scene_units(mm, mpu)  # noqa: E731
+    rate = require_finite("frames per second", fps)
+    if rate <= 0:
+        raise InputError(f"frames per second must be > 0, got {rate:g}")
+
+    frames = []
+    seen_notes: set[str] = set()
+    for k in keys:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", PhysCamWarning)
+            report = solve_lens_report(focal_length_mm=focal_length_mm, sensor=sensor,
+                                       fstop=k.fstop if k.fstop is not None else fstop, focus_mm=k.focus_mm,
+                                       coc=coc, lens=lens)
+        for w in caught:  # say each approximation once, not once per frame
+            if str(w.message) not in seen_notes:
+                seen_notes.add(str(w.message))
+                warnings.warn(str(w.message), PhysCamWarning, stacklevel=2)
+        spec = spec_from_report(report, shutter_duration_s=shutter_angle_deg / 360.0 / rate)
+        frames.append((k.frame, report, spec))
+
+    stage = new_stage(mpu, rate)
+    stage.SetStartTimeCode(keys[0].frame)
+    stage.SetEndTimeCode(keys[-1].frame)
+    _, report0, spec0 = frames[0]
+    cam = author_camera(stage, path, spec0, report=report0, position=position, rotate_xyz_deg=rotate_xyz_deg)
+    model = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Pinhole"))
+    geom = UsdGeom.Camera(stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")))
+    translate = UsdGeom.Xformable(geom.GetPrim()).GetOrderedXformOps()[0]
+    lp = "lens:main:"
+
+    def sample(prim, name, value, time):
+        attr = prim.GetAttribute(name)
+        if not attr:
+            raise ExportError(f"{prim.GetPath()}.{name} was not authored on the first frame")
+        attr.Set(value, time)
+
+    for frame, report, spec in frames:
+        t = float(frame)
+        eye = spec.entrance_pupil_mm
+        sample(model, "focalLength", spec.focal_length_mm, t)
+        sample(model, "focusDistance", spec.focus_mm, t)
+        for prim, name, value in ((cam, lp + "fStop", spec.fstop), (cam, lp + "iris", spec.focal_length_mm / spec.fstop),
+                                  (cam, "iris", spec.focal_length_mm / spec.fstop),
+                                  (cam, lp + "entrancePupilDistance", eye)):
+            sample(prim, name, value, t)
+        optional = {lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "apertureDistance":
+                    spec.aperture_distance_mm}
+        if spec.principal_planes_mm is not None:
+            optional[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]
+            optional[lp + "rearPrincipalPlaneDistance"] = spec.principal_planes_mm[1]
+        for name, value in optional.items():
+            if value is not None and cam.GetAttribute(name):
+                sample(cam, name, value, t)
+        pin, sq = report.pinhole
+        focal, h_ap, v_ap = fov_preserving_float32(su(pin) * 10.0, su(spec0.sensor_width_mm * sq) * 10.0,
+                                                   su(spec0.sensor_height_mm) * 10.0)
+        geom.GetFocalLengthAttr().Set(focal, t)
+        geom.GetHorizontalApertureAttr().Set(h_ap / spec0.enlarge[0], t)
+        geom.GetVerticalApertureAttr().Set(v_ap / spec0.enlarge[1], t)
+        geom.GetFStopAttr().Set(pinhole_fstop(report), t)
+        geom.GetFocusDistanceAttr().Set(su(spec.focus_mm - eye), t)
+        translate.Set(Gf.Vec3d(0.0, 0.0, -su(eye)), t)
+        for v in (focal, h_ap, v_ap, su(spec.focus_mm - eye)):
+            if not math.isfinite(v):
+                raise ExportError(f"frame {frame:g}: the companion camera came out {v}; check the marks")
+    return save_stage(stage, file, force=force)

@@ -1,0 +1,77 @@
+"""Animated cameras (issue 9): a focus pull's time samples follow the lens's breathing."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from pxr import Usd, UsdGeom
+
+from physcam.cli import main
+from physcam.errors import InputError, LensFileError
+from physcam.usd.read import open_stage
+
+from _thin_lens import image_distance_at_mark
+
+MARKS = [5000.0 + (1000.0 - 5000.0) * i / 47 for i in range(48)]  # 5 m to 1 m over 48 frames
+
+
+def _csv(tmp_path, rows, header="frame,focus"):
+    f = tmp_path / "pull.csv"
+    f.write_text(header + "\n" + "\n".join(rows) + "\n")
+    return f
+
+
+def test_focus_pull_samples_match_lens_breathing(tmp_path, capsys):
+    """Done when: a focus pull from 5 m to 1 m over 48 frames writes time samples whose per-frame
+    focal length and pupil match `physcam lens breathing` at each mark."""
+    marks = _csv(tmp_path, [f"{i + 1},{m:.6f}mm" for i, m in enumerate(MARKS)])
+    out = tmp_path / "pull.usda"
+    assert main(["usd", "animate", str(out), "--lens", "dgauss_50mm", "--marks", str(marks), "--sensor", "FF",
+                 "--fstop", "2.8", "--position", "0,150,500"]) == 0
+    capsys.readouterr()
+    assert main(["lens", "breathing", "dgauss_50mm", "--focus", *[f"{m:.6f}mm" for m in MARKS], "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)["rows"]
+    stage = open_stage(out)
+    geom = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
+    cam = stage.GetPrimAtPath("/Cameras/Camera")
+    film = UsdGeom.Xformable(cam).ComputeLocalToWorldTransform(Usd.TimeCode(1)).ExtractTranslation()
+    assert geom.GetFocalLengthAttr().GetNumTimeSamples() == 48
+    for i, row in enumerate(rows):
+        t = Usd.TimeCode(i + 1)
+        assert row["focus_from_film_mm"] == pytest.approx(MARKS[i])
+        # mm at metersPerUnit 0.01; float32 storage
+        assert geom.GetFocalLengthAttr().Get(t) == pytest.approx(row["breathing_focal_length_mm"], rel=3e-6)  # float32, chosen within 24 ulps to keep the FOV exact
+        assert cam.GetAttribute("lens:main:entrancePupilDistance").Get(t) == pytest.approx(
+            row["entrance_pupil_from_film_mm"], rel=1e-6)
+        # the eye follows the pupil while the film stays put
+        eye = UsdGeom.Xformable(geom).ComputeLocalToWorldTransform(t).ExtractTranslation()
+        assert (film[2] - eye[2]) * 10.0 == pytest.approx(row["entrance_pupil_from_film_mm"], rel=1e-9)
+        assert UsdGeom.Xformable(cam).ComputeLocalToWorldTransform(t).ExtractTranslation() == pytest.approx(film)
+    # breathing: at 1 m the picture is tighter than at 5 m
+    assert geom.GetFocalLengthAttr().Get(48) > geom.GetFocalLengthAttr().Get(1)
+
+
+def test_thin_lens_iris_and_focus_pull(tmp_path):
+    """A thin 35 mm lens: the pinhole is s' at each mark (hand-solved), and an fstop column pulls the iris."""
+    marks = _csv(tmp_path, ["1,3m,2.8", "2,2.5m,4", "3,2m,5.6"], header="frame,focus,fstop")
+    out = tmp_path / "thin.usda"
+    assert main(["usd", "animate", str(out), "--focal", "35", "--marks", str(marks), "--sensor", "ALEXA 35"]) == 0
+    stage = open_stage(out)
+    geom = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
+    cam = stage.GetPrimAtPath("/Cameras/Camera")
+    for frame, mark, n in ((1, 3000.0, 2.8), (2, 2500.0, 4.0), (3, 2000.0, 5.6)):
+        assert geom.GetFocalLengthAttr().Get(frame) == pytest.approx(image_distance_at_mark(35.0, mark), rel=3e-6)  # float32, chosen within 24 ulps to keep the FOV exact
+        assert cam.GetAttribute("lens:main:fStop").Get(frame) == pytest.approx(n, rel=1e-6)
+
+
+def test_bad_marks_name_file_and_line(tmp_path):
+    from physcam.usd.animate import FocusKey, read_focus_marks, write_animated_camera
+    from physcam.onset.sensors import find_sensor
+
+    bad = _csv(tmp_path, ["1,3m", "2,three metres"])
+    with pytest.raises(LensFileError, match=r"pull.csv:3"):
+        read_focus_marks(bad)
+    with pytest.raises(InputError, match="increase"):
+        write_animated_camera(tmp_path / "x.usda", [FocusKey(2, 3000.0), FocusKey(1, 2000.0)],
+                              sensor=find_sensor("FF"), focal_length_mm=50.0, fstop=2.8)
