@@ -222,3 +222,45 @@ def test_lens_camera_carries_omniverse_opencv_distortion(tmp_path):
     v_real = a("cy") + out.y[0] * 2400 / 24.0
     pts, _ = cv2.projectPoints(np.array([[0.0, math.tan(theta), 1.0]]), np.zeros(3), np.zeros(3), K, dist)
     assert pts[0, 0, 1] == pytest.approx(v_real, abs=0.5)
+
+
+def test_renderman_settings_and_dof_aspect(tmp_path):
+    """Issue 9 (RenderMan via Hydra): ri:dofaspect for anamorphic lenses and a UsdRenderSettings
+    with pixelAspectRatio = squeeze and overscan. The settings' display aspect (resolution x
+    pixel aspect) equals the companion's desqueezed aperture aspect; the navarro anamorphic's
+    dofaspect is its entrance pupil's X / Y diameter, computed here from the paraxial engine."""
+    from pxr import UsdGeom, UsdRender
+
+    from physcam.lens.library import load_lens
+    from physcam.optics.focusing import focus
+    from physcam.optics.paraxial import gaussian
+    from physcam.usd.read import open_stage
+
+    f = tmp_path / "thin.usda"
+    assert main(["usd", "write", str(f), "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--sensor",
+                 "35mm anamorphic", "--squeeze", "2", "--overscan", "10", "--resolution", "2200"]) == 0
+    stage = open_stage(f)
+    settings = UsdRender.Settings(stage.GetPrimAtPath("/Render/Settings"))
+    assert settings.GetPixelAspectRatioAttr().Get() == 2.0
+    w, h = settings.GetResolutionAttr().Get()
+    assert w == 2200 and tuple(settings.GetDataWindowNDCAttr().Get()) == pytest.approx((-0.05, -0.05, 1.05, 1.05))
+    assert [str(t) for t in settings.GetCameraRel().GetTargets()] == ["/Cameras/Camera/Camera"]
+    g = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
+    assert w * 2.0 / h == pytest.approx(g.GetHorizontalApertureAttr().Get() / g.GetVerticalApertureAttr().Get(),
+                                        rel=1e-3)  # whole pixels
+    assert g.GetPrim().GetAttribute("ri:dofaspect").Get() == pytest.approx(0.5)  # a thin front anamorphic
+    aspects = {}
+    for slug in ("navarro_anamorphic_2x", "neil_front_anamorphic_2x"):
+        f2 = tmp_path / f"{slug}.usda"
+        assert main(["usd", "write", str(f2), "--lens", slug, "--focus", "3m", "--sensor", "35mm anamorphic"]) == 0
+        stage2 = open_stage(f2)
+        lens = load_lens(slug)
+        st = focus(lens, 3000.0)
+        gx = gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z)
+        gy = gaussian(st.prescription, axis="y", object_z=st.object_z, film_z=st.film_z)
+        aspects[slug] = stage2.GetPrimAtPath("/Cameras/Camera/Camera").GetAttribute("ri:dofaspect").Get()
+        assert aspects[slug] == pytest.approx(gx.entrance_pupil_diameter / gy.entrance_pupil_diameter, rel=1e-6)
+    # a rear anamorphic (cylinders behind the stop) has a round entrance pupil: round bokeh; a front
+    # anamorphic narrows the pupil in X by about its squeeze: oval bokeh, taller than wide
+    assert aspects["navarro_anamorphic_2x"] == pytest.approx(1.0)
+    assert aspects["neil_front_anamorphic_2x"] == pytest.approx(0.5, abs=0.01)

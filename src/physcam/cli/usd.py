@@ -40,8 +40,10 @@ def register(sub) -> None:
     w.add_argument("--handedness", type=int, choices=(1, -1), default=1,
                    help="1 right-handed (default), -1 left-handed: a mirrored image")
     w.add_argument("--resolution", type=_pixels, default=None, metavar="W[,H]",
-                   help="with --lens: image size in pixels for Omniverse's OpenCV distortion (default 4096 wide, "
-                        "height from the sensor's aspect)")
+                   help="image size in pixels for the render settings and, with --lens, Omniverse's OpenCV "
+                        "distortion (default 2048 and 4096 wide, height from the sensor's aspect)")
+    w.add_argument("--overscan", type=number("overscan", lo=0.0, hi=100.0), default=0.0, metavar="PCT",
+                   help="render beyond the frame by this percentage (UsdRenderSettings dataWindowNDC)")
     w.set_defaults(handler=run_write)
 
     r = s.add_parser("read", help="read a PhysicalCamera back into a lens report")
@@ -208,7 +210,7 @@ def run_write(args) -> int:
                                      focus_mm=report.focus_from_film_mm, resolution=args.resolution)
     path = write_camera(args.file, spec, force=args.force, path=args.path, meters_per_unit=args.meters_per_unit,
                         fps=args.fps, report=report if not args.orthographic else None, lens_distortion=distortion,
-                        opencv_distortion=opencv)
+                        opencv_distortion=opencv, resolution=args.resolution, overscan=args.overscan / 100.0)
     return _done(args, path)
 
 

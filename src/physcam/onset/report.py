@@ -147,6 +147,10 @@ class LensReport:
     #: the physical aperture stop (iris) in front of the film: a prescription's stop surface; the
     #: lens plane for the thin lens; None when a datasheet does not say
     stop_from_film_mm: float | None = None
+    #: width over height of a defocused point's blur in the desqueezed picture: the entrance
+    #: pupil's X over Y diameter (object-space blur angles scale with it); 1 for a spherical lens,
+    #: 1 / squeeze for a thin lens given a squeeze (a front anamorphic's cylinders narrow the pupil in X)
+    dof_aspect: float = 1.0
 
     # --- convenience --------------------------------------------------------
     @property
@@ -236,6 +240,7 @@ class LensReport:
             },
             "entrance_pupil_from_film_mm": self.entrance_pupil_from_film_mm,
             "stop_from_film_mm": self.stop_from_film_mm,
+            "dof_aspect": self.dof_aspect,
             "entrance_pupil_source": self.entrance_pupil_source,
             "pivot_camera_space_mm": None if self.pivot_camera_space_mm is None else list(self.pivot_camera_space_mm),
             "solved": dict(self.solved),
@@ -360,6 +365,7 @@ def solve_lens_report(
         )
         lens_pinhole = (planes.pinhole_focal_length_mm, planes.pinhole_focal_length_mm)
         lens_stop = planes.stop_from_film_mm
+        lens_dof_aspect = 1.0
         if lens.is_anamorphic and squeeze == 1.0:
             # the squeeze the lens really has at this focus: EFL in Y over EFL in X
             st = focusing.focus(lens, D_lens)
@@ -367,6 +373,9 @@ def solve_lens_report(
             efl_x = gx.efl
             squeeze = planes.efl_mm / efl_x
             lens_pinhole = (planes.pinhole_focal_length_mm, gx.pinhole_focal_length)
+            # one physical (round) stop seen through each meridian: the ratio does not depend on its size
+            gy = paraxial.gaussian(st.prescription, axis="y", object_z=st.object_z, film_z=st.film_z)
+            lens_dof_aspect = gx.entrance_pupil_diameter / gy.entrance_pupil_diameter
             notes.append(
                 f"anamorphic: EFL {planes.efl_mm:.3f} mm (Y) and {efl_x:.3f} mm (X), effective squeeze "
                 f"{squeeze:.4f} (nominal {lens.squeeze:g})"
@@ -618,6 +627,7 @@ def solve_lens_report(
         pinhole_focal_length_mm=pin_y,
         pinhole_squeeze=pin_sq,
         stop_from_film_mm=(lens_stop if lens is not None else (h1_film if model == "practical" else None)),
+        dof_aspect=lens_dof_aspect if lens is not None else 1.0 / sq,
         **fov,
     )
     if lens is not None:

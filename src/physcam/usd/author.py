@@ -48,6 +48,7 @@ __all__ = [
     "write_camera",
     "report_for_spec",
     "shutter_opening_curve",
+    "author_render_settings",
 ]
 
 DEFAULT_CAMERA_PATH = "/Cameras/Camera"
@@ -73,6 +74,8 @@ class CameraSpec:
     (2, 2) with ``shift_mm`` (-w/4, +h/4) renders the upper-left quadrant); ``handedness`` 1 for a
     right-handed camera frame, -1 for a left-handed (mirrored) one (seed 001's sensor).
     ``aperture_distance_mm``: the physical aperture stop (iris) in front of the film, when known.
+    ``dof_aspect``: width / height of the defocus blur in the desqueezed picture (RenderMan's
+    ``dofaspect``); None: 1 / squeeze (a front anamorphic), 1 for a spherical lens.
     ``projection``: "perspective" (a pinhole/thin-lens model) or "orthographic"
     (a telecentric model imaging ``sensor / magnification`` of the scene).
     """
@@ -91,6 +94,7 @@ class CameraSpec:
     shift_mm: tuple[float, float] = (0.0, 0.0)
     enlarge: tuple[float, float] = (1.0, 1.0)
     handedness: float = 1.0
+    dof_aspect: float | None = None
     iso: float = 100.0
     transmittance: float = 1.0
     flange_distance_mm: float = 52.0
@@ -137,6 +141,8 @@ class CameraSpec:
         for v in self.enlarge:
             if not 0.001 <= require_finite("enlarge", v) <= 1000.0:
                 raise InputError(f"enlarge must lie between 0.001 and 1000 (a magnification), got {v:g}")
+        if self.dof_aspect is not None and not 0.01 <= require_finite("dof aspect", self.dof_aspect) <= 100.0:
+            raise InputError(f"dof aspect must lie between 0.01 and 100, got {self.dof_aspect:g}")
         if self.handedness not in (1.0, -1.0):
             raise InputError(f"handedness is 1 (right-handed) or -1 (left-handed, mirrored), got {self.handedness!r}")
         if self.entrance_pupil_mm is not None:
@@ -206,6 +212,7 @@ def spec_from_report(report, **body) -> CameraSpec:
         principal_planes_mm=((report.h1_from_film_mm, report.h2_from_film_mm) if report.model == "technical"
                              else None),
         aperture_distance_mm=report.stop_from_film_mm,
+        dof_aspect=report.dof_aspect if report.entrance_pupil_source == "prescription" else None,
         # a prescription's best-match pinhole is kept; a thin lens or datasheet recomputes its own
         pinhole_focal_length_mm=report.pinhole_focal_length_mm if report.entrance_pupil_source == "prescription"
         else None,
@@ -565,6 +572,9 @@ def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None, lens
     geom.CreateExposureFStopAttr(spec.fstop / math.sqrt(spec.transmittance))  # photometric: the T-stop
     geom.CreateExposureIsoAttr(spec.iso)
     prim = geom.GetPrim()
+    # the defocus blur's aspect in the desqueezed picture (hdPrman reads ri:dofaspect off the camera)
+    dof_aspect = spec.dof_aspect if spec.dof_aspect is not None else 1.0 / spec.squeeze
+    _set(prim, "ri:dofaspect", Sdf.ValueTypeNames.Float, float(dof_aspect), custom=True)
     _set(prim, "ri:apertureNSides", Sdf.ValueTypeNames.Int, int(spec.aperture_blades), custom=True)
     _set(prim, "ri:apertureAngle", Sdf.ValueTypeNames.Float, spec.aperture_angle_deg, custom=True)
     _set(prim, "ri:apertureRoundness", Sdf.ValueTypeNames.Float, spec.aperture_roundness, custom=True)
@@ -636,6 +646,37 @@ def author_from_report(stage, path: str, report, *, position=(0.0, 0.0, 0.0), ro
                          rotate_xyz_deg=rotate_xyz_deg, report=report, lens_distortion=lens_distortion)
 
 
+RENDER_SETTINGS_PATH = "/Render/Settings"
+
+
+def author_render_settings(stage, camera_path, spec: CameraSpec, *, resolution=None, overscan: float = 0.0,
+                           path: str = RENDER_SETTINGS_PATH):
+    """A ``UsdRenderSettings`` prim for the companion camera at ``camera_path``.
+
+    ``pixelAspectRatio`` is the squeeze (the film's pixels are squeezed; the picture is shown
+    desqueezed), ``resolution`` the film's pixel grid (default 2048 wide, height from the sensor's
+    aspect), so resolution x pixelAspectRatio has the camera's desqueezed aperture aspect;
+    ``overscan`` (a fraction, 0.1 = 10 % wider and taller) becomes ``dataWindowNDC``
+    (-o/2, -o/2, 1 + o/2, 1 + o/2): pixels beyond the display window, for distortion and
+    stabilisation margins, without changing the camera's framing (UsdRender, "Render Settings").
+    """
+    from pxr import Gf, Sdf, UsdRender
+
+    o = require_finite("overscan", overscan)
+    if not 0.0 <= o <= 1.0:
+        raise InputError(f"overscan must lie between 0 and 1 (a fraction of the frame), got {o:g}")
+    w_px = 2048 if not resolution else int(resolution[0])
+    h_px = int(resolution[1]) if resolution and len(resolution) > 1 else max(
+        1, round(w_px * spec.sensor_height_mm / spec.sensor_width_mm))
+    settings = UsdRender.Settings.Define(stage, Sdf.Path(path))
+    settings.CreateResolutionAttr(Gf.Vec2i(w_px, h_px))
+    settings.CreatePixelAspectRatioAttr(float(spec.squeeze))
+    settings.CreateAspectRatioConformPolicyAttr(UsdRender.Tokens.expandAperture)
+    settings.CreateDataWindowNDCAttr(Gf.Vec4f(-o / 2, -o / 2, 1 + o / 2, 1 + o / 2))
+    settings.CreateCameraRel().SetTargets([Sdf.Path(str(camera_path))])
+    return settings
+
+
 def save_stage(stage, file, *, force: bool = False):
     """Validate ``stage`` (usd-core's validators), then write its root layer to ``file`` atomically.
 
@@ -678,9 +719,13 @@ def save_stage(stage, file, *, force: bool = False):
 def write_camera(file, spec: CameraSpec, *, force: bool = False, path: str = DEFAULT_CAMERA_PATH,
                  meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y",
                  position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, lens_distortion=None,
-                 opencv_distortion=None):
-    """Write a one-camera layer to ``file`` (see :func:`author_camera`); return the Path."""
+                 opencv_distortion=None, render_settings: bool = True, resolution=None, overscan: float = 0.0):
+    """Write a one-camera layer to ``file`` (see :func:`author_camera`), with a ``UsdRenderSettings``
+    for its companion camera (:func:`author_render_settings`) unless ``render_settings`` is false;
+    return the Path."""
     stage = new_stage(meters_per_unit, fps, up_axis)
     author_camera(stage, path, spec, position=position, rotate_xyz_deg=rotate_xyz_deg, report=report,
                   lens_distortion=lens_distortion, opencv_distortion=opencv_distortion)
+    if render_settings:
+        author_render_settings(stage, f"{path}/{RENDER_CAMERA_NAME}", spec, resolution=resolution, overscan=overscan)
     return save_stage(stage, file, force=force)
