@@ -44,6 +44,34 @@ def number(name: str, *, positive: bool = False, lo: float | None = None, hi: fl
     return parse
 
 
+def numbers(name: str, count: int, *, positive: bool = False):
+    """An argparse type reading ``count`` comma-separated finite numbers ("X,Y" or "X,Y,Z")."""
+    labels = ",".join("XYZW"[:count])
+
+    def parse(text):
+        try:
+            v = tuple(float(x) for x in str(text).split(","))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be {count} numbers {labels}, got {text!r}") from None
+        if len(v) != count or not all(math.isfinite(x) and (x > 0 or not positive) for x in v):
+            kind = "positive" if positive else "finite"
+            raise argparse.ArgumentTypeError(f"{name} must be {count} {kind} numbers {labels}, got {text!r}")
+        return v
+
+    parse.__name__ = name
+    return parse
+
+
+def coc_value(text):
+    """A --coc value: a convention name stays text, a number becomes a float (mm)."""
+    if text is None:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
 def print_json(obj) -> None:
     json.dump(obj, sys.stdout, indent=2, allow_nan=False)
     sys.stdout.write("\n")

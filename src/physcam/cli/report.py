@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import distance, number
+from ._common import coc_value, distance, number
 
 EPILOG = """\
 distances accept units as said on set: 3m, 10ft, 6in, 450mm, 10'6" (a bare number is mm).
@@ -108,12 +108,7 @@ def solve_from_args(args):
             raise InputError("give either --lens or --focal: the lens sets its own focal length")
     elif args.focal is None:
         raise InputError("give the focal length, e.g. --focal 50, or a lens with --lens NAME")
-    coc = args.coc
-    if coc is not None:
-        try:
-            coc = float(coc)
-        except ValueError:
-            pass
+    coc = coc_value(args.coc)
     return solve_lens_report(
         focal_length_mm=args.focal,
         sensor=resolve_sensor(args),

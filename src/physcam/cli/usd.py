@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import distance, number
+from ._common import coc_value, distance, number, numbers
 
 EPILOG = """\
 examples:
@@ -35,7 +35,7 @@ def register(sub) -> None:
     w.add_argument("--magnification", type=number("magnification"), default=1.0,
                    help="orthographic: image size / object size (default 1)")
     w.add_argument("--blades", type=int, default=7, help="iris blades (RenderMan apertureNSides; default 7)")
-    w.add_argument("--enlarge", type=_pair("enlarge"), default=(1.0, 1.0), metavar="EX,EY",
+    w.add_argument("--enlarge", type=numbers("enlarge", 2, positive=True), default=(1.0, 1.0), metavar="EX,EY",
                    help="image a region of the sensor enlarged EX,EY times (a tile: 2,2 with --shift-x/-y)")
     w.add_argument("--handedness", type=int, choices=(1, -1), default=1,
                    help="1 right-handed (default), -1 left-handed: a mirrored image")
@@ -71,9 +71,9 @@ def register(sub) -> None:
     k.add_argument("--iso", type=number("ISO", positive=True), help="body: exposure index (default 100)")
     k.add_argument("--shutter-angle", type=number("shutter angle", positive=True), default=None,
                    help="body: degrees (default 180)")
-    k.add_argument("--position", type=_triple("position"), default=(0.0, 0.0, 0.0), metavar="X,Y,Z",
+    k.add_argument("--position", type=numbers("position", 3), default=(0.0, 0.0, 0.0), metavar="X,Y,Z",
                    help="shot: where the entrance pupil goes, in scene units")
-    k.add_argument("--rotate", type=_triple("rotation"), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ",
+    k.add_argument("--rotate", type=numbers("rotation", 3), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ",
                    help="shot: pan/tilt/roll about the entrance pupil, degrees (XYZ order)")
     k.add_argument("--variant", help="shot: pin a lens characterization variant (default the lens file's current)")
     _stage_args(k)
@@ -96,8 +96,8 @@ def register(sub) -> None:
     a.add_argument("--sensor-height", type=distance("sensor height"))
     a.add_argument("--shutter-angle", type=number("shutter angle", positive=True), default=180.0)
     a.add_argument("--path", default="/Cameras/Camera", help="camera prim path")
-    a.add_argument("--position", type=_triple("position"), default=(0.0, 0.0, 0.0), metavar="X,Y,Z")
-    a.add_argument("--rotate", type=_triple("rotation"), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ")
+    a.add_argument("--position", type=numbers("position", 3), default=(0.0, 0.0, 0.0), metavar="X,Y,Z")
+    a.add_argument("--rotate", type=numbers("rotation", 3), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ")
     _stage_args(a)
     a.set_defaults(handler=run_animate)
 
@@ -141,40 +141,6 @@ def _pixels(text):
     if len(v) not in (1, 2) or not all(16 <= x <= 65536 for x in v):
         raise argparse.ArgumentTypeError(f"resolution must be 16 to 65536 pixels, got {text!r}")
     return v
-
-
-def _pair(name: str):
-    import argparse
-    import math
-
-    def parse(text):
-        try:
-            v = tuple(float(x) for x in str(text).split(","))
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be two numbers X,Y, got {text!r}") from None
-        if len(v) != 2 or not all(math.isfinite(x) and x > 0 for x in v):
-            raise argparse.ArgumentTypeError(f"{name} must be two positive numbers X,Y, got {text!r}")
-        return v
-
-    parse.__name__ = name
-    return parse
-
-
-def _triple(name: str):
-    import argparse
-    import math
-
-    def parse(text):
-        try:
-            v = tuple(float(x) for x in str(text).split(","))
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be three numbers X,Y,Z, got {text!r}") from None
-        if len(v) != 3 or not all(math.isfinite(x) for x in v):
-            raise argparse.ArgumentTypeError(f"{name} must be three finite numbers X,Y,Z, got {text!r}")
-        return v
-
-    parse.__name__ = name
-    return parse
 
 
 def _stage_args(p, units: bool = True) -> None:
@@ -400,12 +366,7 @@ def run_animate(args) -> int:
         from ..lens.library import load_lens
 
         lens = load_lens(args.lens)
-    coc = args.coc
-    if coc is not None:
-        try:
-            coc = float(coc)
-        except ValueError:
-            pass
+    coc = coc_value(args.coc)
     keys = read_focus_marks(args.marks)
     path = write_animated_camera(args.file, keys, sensor=_kit_sensor(args, default="Super 35"), lens=lens,
                                  focal_length_mm=args.focal, fstop=args.fstop, coc=coc, path=args.path,
