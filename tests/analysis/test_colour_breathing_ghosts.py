@@ -89,13 +89,13 @@ def test_real_breathing_internal_focus_and_full_frame(dgauss):
         real_breathing(dgauss, [math.inf], sensor_width_mm=80.0)
 
 
-def _fresnel_r(theta, n):
-    """Unpolarised reflectance of an air-glass surface, Hecht eqs. 4.42-4.43, by hand."""
+def _fresnel_rsp(theta, n):
+    """(R_s, R_p, refraction angle) of an air-glass surface, Hecht eqs. 4.42-4.43, by hand."""
     tp = math.asin(math.sin(theta) / n)
     ci, ct = math.cos(theta), math.cos(tp)
     rs = (ci - n * ct) / (ci + n * ct)
     rp = (n * ci - ct) / (n * ci + ct)
-    return 0.5 * (rs * rs + rp * rp), tp
+    return rs * rs, rp * rp, tp
 
 
 def test_plate_ghost_normal_incidence():
@@ -113,9 +113,16 @@ def test_plate_ghost_oblique_ray_by_hand(theta_deg):
     ray = RayBatch.from_arrays([[0.0, y0, -1.0]], [[0.0, math.sin(th), math.cos(th)]])
     direct = trace_to_film(lens, ray, 60.0, fresnel=True)
     ghost = trace_ghost(lens, ray, 2, 1, 60.0)
-    R, tp = _fresnel_r(th, 1.5)
+    Rs, Rp, tp = _fresnel_rsp(th, 1.5)
     assert ghost.ok.all()
-    assert ghost.weight[0] / direct.weight[0] == pytest.approx(R * R, rel=1e-10)
+    # The s and p halves of unpolarised light go their own way through T R R T (glass-air R and T
+    # equal air-glass ones at the refracted angle, Stokes relations, Hecht 4.6.3), so
+    # ghost / direct = (Ts^2 Rs^2 + Tp^2 Rp^2) / (Ts^2 + Tp^2), not ((Rs + Rp) / 2)^2.
+    Ts, Tp = 1.0 - Rs, 1.0 - Rp
+    expect = (Ts * Ts * Rs * Rs + Tp * Tp * Rp * Rp) / (Ts * Ts + Tp * Tp)
+    assert ghost.weight[0] / direct.weight[0] == pytest.approx(expect, rel=1e-10)
+    assert ghost.weight_s[0] == pytest.approx(Ts * Ts * Rs * Rs, rel=1e-10)  # unit starting weight
+    assert ghost.weight_p[0] == pytest.approx(Tp * Tp * Rp * Rp, rel=1e-10)
     # two extra passes through the plate: the ghost leaves parallel, shifted by 2 t tan(theta')
     assert ghost.y[0] - direct.y[0] == pytest.approx(2 * t * math.tan(tp), rel=1e-10)
     assert (ghost.L[0], ghost.M[0], ghost.N[0]) == pytest.approx((direct.L[0], direct.M[0], direct.N[0]), abs=1e-12)

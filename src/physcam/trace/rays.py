@@ -3,9 +3,16 @@
 A :class:`RayBatch` holds one float64 array per component: position ``x, y, z`` (mm, lens
 space: z = 0 at the first vertex, +z toward the film; docs/conventions.md), direction
 cosines ``L, M, N`` (unit vector, L^2 + M^2 + N^2 = 1), ``wavelength_nm``, ``weight``
-(radiometric throughput, 0 for a lost ray) and ``flag`` (uint8, one of :data:`OK`,
-:data:`MISSED`, :data:`CLIPPED`, :data:`TIR`). A lost ray keeps its last finite position
-and direction, never NaN.
+(radiometric throughput of unpolarised light, 0 for a lost ray), ``weight_sp`` and ``flag``
+(uint8, one of :data:`OK`, :data:`MISSED`, :data:`CLIPPED`, :data:`TIR`). A lost ray keeps its
+last finite position and direction, never NaN; a ray flagged OK has finite position, direction
+and weights (the kernels flag MISSED whatever overflows or divides 0 by 0).
+
+Polarisation (Fresnel): unpolarised light is half s- and half p-polarised, and the two are
+transmitted differently at each surface. With A and B the throughputs of the s and p halves
+(each starting at the ray's weight), ``weight`` = (A + B) / 2 and ``weight_sp`` = (A - B) / 2,
+so through several surfaces T = (prod Ts + prod Tp) / 2, not prod((Ts + Tp) / 2). Both columns
+scale together under any polarisation-blind factor (aperture density, cos^4, clipping to 0).
 """
 
 from __future__ import annotations
@@ -39,6 +46,12 @@ class RayBatch:
     wavelength_nm: np.ndarray
     weight: np.ndarray
     flag: np.ndarray
+    #: (s - p) / 2 throughput (module notes); zeros (unpolarised, no surface yet) when not given.
+    weight_sp: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.weight_sp is None:
+            self.weight_sp = np.zeros_like(self.weight)
 
     def __len__(self) -> int:
         return int(self.x.shape[0])
@@ -53,15 +66,20 @@ class RayBatch:
         d = np.atleast_2d(np.asarray(direction, dtype=np.float64))
         if p.ndim != 2 or p.shape[1] != 3:
             raise InputError(f"ray positions must have shape (n, 3), got {p.shape}")
-        p, d = np.broadcast_arrays(p, d)
+        try:
+            p, d = np.broadcast_arrays(p, d)
+        except ValueError:
+            raise InputError(f"ray directions must have shape {p.shape}, got {d.shape}") from None
         if d.shape != p.shape:
             raise InputError(f"ray directions must have shape {p.shape}, got {d.shape}")
         if not (np.isfinite(p).all() and np.isfinite(d).all()):
             raise InputError("ray positions and directions must be finite numbers (found NaN or inf)")
-        norm = np.sqrt((d * d).sum(axis=1))
-        if (norm == 0).any():
+        # normalise without overflow or underflow: scale by the largest component first
+        big = np.abs(d).max(axis=1)
+        if (big == 0).any():
             raise InputError("a ray direction is the zero vector; give a non-zero direction")
-        d = d / norm[:, None]
+        d = d / big[:, None]
+        d = d / np.sqrt((d * d).sum(axis=1))[:, None]
         n = p.shape[0]
         wl = np.broadcast_to(np.asarray(wavelength_nm, dtype=np.float64), (n,)).copy()
         require_wavelength(wl, "ray wavelength")
@@ -83,14 +101,39 @@ class RayBatch:
         return cls.from_arrays(p, np.asarray(direction, dtype=np.float64)[None, :], wavelength_nm)
 
     def copy(self) -> "RayBatch":
-        return RayBatch(*(np.array(a, copy=True) for a in self.columns()))
+        return RayBatch._from_columns([np.array(a, copy=True) for a in self.columns()])
 
     def columns(self):
-        return (self.x, self.y, self.z, self.L, self.M, self.N, self.wavelength_nm, self.weight, self.flag)
+        """The arrays in the kernels' order: x y z L M N wavelength_nm weight weight_sp flag."""
+        return (self.x, self.y, self.z, self.L, self.M, self.N, self.wavelength_nm, self.weight, self.weight_sp,
+                self.flag)
+
+    @classmethod
+    def _from_columns(cls, c) -> "RayBatch":
+        return cls(*c[:8], flag=c[9], weight_sp=c[8])
 
     def take(self, index) -> "RayBatch":
         """The rays selected by a boolean mask or index array."""
-        return RayBatch(*(a[index] for a in self.columns()))
+        return RayBatch._from_columns([a[index] for a in self.columns()])
+
+    @property
+    def weight_s(self) -> np.ndarray:
+        """Throughput of the s-polarised half (A; ``weight`` is the mean of s and p)."""
+        return self.weight + self.weight_sp
+
+    @property
+    def weight_p(self) -> np.ndarray:
+        """Throughput of the p-polarised half (B)."""
+        return self.weight - self.weight_sp
+
+    def scale_weight(self, factor, where=None) -> None:
+        """Multiply both weight columns by a polarisation-blind ``factor`` (at the mask ``where``)."""
+        if where is None:
+            self.weight *= factor
+            self.weight_sp *= factor
+        else:
+            self.weight[where] *= factor
+            self.weight_sp[where] *= factor
 
     @property
     def ok(self) -> np.ndarray:

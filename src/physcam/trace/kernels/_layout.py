@@ -43,7 +43,8 @@ def set_wavelength(S, wavelength_nm: float) -> None:
     Same arithmetic as the per-ray path (n = A + B * (1 / lambda^2), eta = n1 / n2), so both
     paths give bit-identical rays.
     """
-    il2 = 1.0 / (wavelength_nm * wavelength_nm)
-    S[:, N1] = S[:, NBA] + S[:, NBB] * il2
-    S[:, N2] = S[:, NAA] + S[:, NAB] * il2
-    S[:, ETA] = S[:, N1] / S[:, N2]
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        il2 = np.float64(1.0) / (np.float64(wavelength_nm) * np.float64(wavelength_nm))
+        S[:, N1] = S[:, NBA] + S[:, NBB] * il2
+        S[:, N2] = S[:, NAA] + S[:, NAB] * il2
+        S[:, ETA] = S[:, N1] / S[:, N2]

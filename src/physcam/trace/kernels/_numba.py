@@ -26,7 +26,7 @@ BLOCK = 256
 
 
 @nb.njit(parallel=True, fastmath=False, cache=True, nogil=True)
-def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
+def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
     """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``."""
     ns = S.shape[0]
     n = x.shape[0]
@@ -35,8 +35,17 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
         i0 = blk * BLOCK
         i1 = min(n, i0 + BLOCK)
         il2 = np.empty(i1 - i0)
-        if not mono:
-            for i in range(i0, i1):
+        for i in range(i0, i1):
+            # -- a live ray must start finite, with a usable wavelength (else MISSED, weight 0)
+            if flag[i] == 0 and not (
+                math.isfinite(x[i]) and math.isfinite(y[i]) and math.isfinite(z[i])
+                and math.isfinite(L[i]) and math.isfinite(M[i]) and math.isfinite(N[i])
+                and math.isfinite(w[i]) and math.isfinite(wd[i]) and wl[i] > 0.0 and math.isfinite(wl[i])
+            ):
+                flag[i] = MISSED
+                w[i] = 0.0
+                wd[i] = 0.0
+            if not mono:
                 il2[i - i0] = 1.0 / (wl[i] * wl[i])
         for s in range(ns):
             kd = kinds[s]
@@ -64,6 +73,7 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                     if dz == 0.0:
                         flag[i] = MISSED
                         w[i] = 0.0
+                        wd[i] = 0.0
                         continue
                     t = -qz / dz
                 else:
@@ -74,12 +84,14 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                     if disc < 0.0:
                         flag[i] = MISSED
                         w[i] = 0.0
+                        wd[i] = 0.0
                         continue
                     sq = math.sqrt(disc)
                     den = -b - sq if b >= 0.0 else -b + sq
                     if den == 0.0:
                         flag[i] = MISSED
                         w[i] = 0.0
+                        wd[i] = 0.0
                         continue
                     t = c / den
                     # nearest root on the far cap (back of a sphere): use the vertex branch,
@@ -88,11 +100,13 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                         if a == 0.0:
                             flag[i] = MISSED
                             w[i] = 0.0
+                            wd[i] = 0.0
                             continue
                         t = den / a
                         if not az * (qz + t * dz) < 1.0:
                             flag[i] = MISSED
                             w[i] = 0.0
+                            wd[i] = 0.0
                             continue
                 dsr = 0.0
                 if kd == _ASPHERE:
@@ -133,6 +147,7 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                     if not conv or arg < 0.0:
                         flag[i] = MISSED
                         w[i] = 0.0
+                        wd[i] = 0.0
                         continue
                     dsr = cv / math.sqrt(arg)
                     q = r2
@@ -142,10 +157,17 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                 hx = px + t * dx
                 hy = py + t * dy
                 hz = pz + t * dz
+                # -- overflow or 0/0 (huge or degenerate input): no usable hit point
+                if not (math.isfinite(hx) and math.isfinite(hy) and math.isfinite(hz)):
+                    flag[i] = MISSED
+                    w[i] = 0.0
+                    wd[i] = 0.0
+                    continue
                 # -- clip at the clear semi-diameter (and the stop)
                 if clip and hx * hx + hy * hy > sd2:
                     flag[i] = CLIPPED
                     w[i] = 0.0
+                    wd[i] = 0.0
                     continue
                 x[i] = hx
                 y[i] = hy
@@ -191,22 +213,42 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                 if kk < 0.0:
                     flag[i] = TIR
                     w[i] = 0.0
+                    wd[i] = 0.0
                     continue
                 ct = math.sqrt(kk)
+                f = ct - eta * ci
+                ox = eta * dx + f * gx
+                oy = eta * dy + f * gy
+                oz = eta * dz + f * gz
+                # -- a degenerate normal (0/0, inf/inf) gives no direction: MISSED
+                if not (math.isfinite(ox) and math.isfinite(oy) and math.isfinite(oz)):
+                    flag[i] = MISSED
+                    w[i] = 0.0
+                    wd[i] = 0.0
+                    continue
                 if fresnel:
+                    # s and p separately (see _numpy.py): w = (A + B) / 2, wd = (A - B) / 2
                     ec = eta * ci
                     et = eta * ct
                     sm = (ec - ct) * (ci + et)
                     pm = (ci - et) * (ec + ct)
                     sp = (ec + ct) * (ci + et)
-                    rr = 0.5 * (sm * sm + pm * pm) / (sp * sp) * rsc
-                    if rr > 1.0:
-                        rr = 1.0
-                    w[i] = w[i] * (1.0 - rr)
-                f = ct - eta * ci
-                L[i] = eta * dx + f * gx
-                M[i] = eta * dy + f * gy
-                N[i] = eta * dz + f * gz
+                    sp2 = sp * sp
+                    rs = sm * sm / sp2 * rsc
+                    if not rs < 1.0:
+                        rs = 1.0
+                    rp = pm * pm / sp2 * rsc
+                    if not rp < 1.0:
+                        rp = 1.0
+                    hsum = 1.0 - 0.5 * (rs + rp)
+                    hdif = 0.5 * (rp - rs)
+                    w0 = w[i]
+                    d0 = wd[i]
+                    w[i] = w0 * hsum + d0 * hdif
+                    wd[i] = w0 * hdif + d0 * hsum
+                L[i] = ox
+                M[i] = oy
+                N[i] = oz
         if has_end:
             for i in range(i0, i1):
                 if flag[i] != 0:
@@ -214,8 +256,16 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                 if N[i] == 0.0:
                     flag[i] = MISSED
                     w[i] = 0.0
+                    wd[i] = 0.0
                     continue
                 t = (end_z - z[i]) / N[i]
-                x[i] = x[i] + t * L[i]
-                y[i] = y[i] + t * M[i]
+                hx = x[i] + t * L[i]
+                hy = y[i] + t * M[i]
+                if not (math.isfinite(hx) and math.isfinite(hy)):
+                    flag[i] = MISSED
+                    w[i] = 0.0
+                    wd[i] = 0.0
+                    continue
+                x[i] = hx
+                y[i] = hy
                 z[i] = end_z
