@@ -155,3 +155,28 @@ def test_colour_says_when_the_file_has_no_dispersion():
     assert any("Abbe" in n for n in res.notes)
     res = chromatic_aberration(load_lens("double_gauss_50mm_f2"))  # seed TOML with Abbe numbers
     assert res.longitudinal_paraxial_mm != 0.0 and not res.notes
+
+
+def test_colour_names_each_glass_model_and_its_uncertainty():
+    # catalogue glass: exact (no uncertainty); the model is named
+    res = chromatic_aberration(plano_convex(f=100.0, thickness=1.0), [0.0])
+    assert [m["glass"] for m in res.media] == ["N-BK7"] and res.media[0]["maker"] == "SCHOTT"
+    assert res.longitudinal_uncertainty_mm == 0.0 and res.curve_uncertainty_mm == 0.0
+    # a glass known only by (nd, Vd): normal line, and the C - F uncertainty equals the closed form
+    # of a plano-convex lens (focus z = t + R/(n-1) - t/n) with P_gF moved by +-0.01
+    from physcam.lens.prescription import Medium, Prescription, Surface
+    from physcam.optics.glass import normal_line
+
+    nd, vd, R, t = 1.6, 40.0, 60.0, 1.0
+    lens = Prescription((Surface(0.0, 0.0, semi_diameter=4.0, kind="stop"), Surface(R, t, Medium(nd, vd), 6.0),
+                         Surface(0.0, 90.0, semi_diameter=6.0, kind="flat"))).validate()
+    res = chromatic_aberration(lens, [0.0])
+    assert res.media[0]["model"] == "normal-line" and res.media[0]["surfaces"] == [1]
+    z = lambda n: t + R / (n - 1.0) - t / n  # noqa: E731
+    p0 = 0.6438 - 0.001682 * vd
+    cf = []
+    for p in (p0 + 0.01, p0 - 0.01):
+        m = normal_line(nd, vd, p)
+        cf.append(z(float(m.index(LINE_C_NM))) - z(float(m.index(LINE_F_NM))))
+    assert res.longitudinal_uncertainty_mm == pytest.approx(abs(cf[0] - cf[1]) / 2, rel=1e-6)
+    assert res.to_dict()["uncertainty"]["longitudinal_paraxial_mm"] == res.longitudinal_uncertainty_mm

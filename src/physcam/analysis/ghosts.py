@@ -125,10 +125,11 @@ class _Tables:
     @staticmethod
     def _ending(S, kinds, a, b):
         """Rows a..b-1 of a packed table; the last row keeps the ray on its surface (no refraction)."""
-        from ..trace.kernels._layout import NAA, NAB, NBA, NBB
+        from ..trace.kernels._layout import NA, NB, SA, SB
 
         s = np.array(S[a:b], copy=True)
-        s[-1, NAA], s[-1, NAB] = s[-1, NBA], s[-1, NBB]
+        s[-1, NA:NA + 9] = s[-1, NB:NB + 9]
+        s[-1, SA] = s[-1, SB]
         return np.ascontiguousarray(s), np.ascontiguousarray(kinds[a:b])
 
 
@@ -165,9 +166,11 @@ def _reflect(rays, t, row, forward: bool):
     L, M, N = rays.L[live], rays.M[live], rays.N[live]
     nx, ny, nz = _normal(t, row, x, y, z)
     dn = L * nx + M * ny + N * nz
-    il2 = 1.0 / rays.wavelength_nm[live] ** 2
-    n1 = t.n_before_a[row] + t.n_before_b[row] * il2  # the medium the ray travels in (table order)
-    n2 = t.n_after_a[row] + t.n_after_b[row] * il2
+    from ..optics.glass import evaluate
+
+    wl = rays.wavelength_nm[live]
+    n1 = evaluate(t.disp_before[row], wl)  # the medium the ray travels in (table order)
+    n2 = evaluate(t.disp_after[row], wl)
     ts, tp = fresnel_transmittances(n1, n2, dn, t.r_scale[row])
     hsum = 1.0 - 0.5 * (ts + tp)  # (R_s + R_p) / 2
     hdif = 0.5 * (tp - ts)  # (R_s - R_p) / 2

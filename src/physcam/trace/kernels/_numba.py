@@ -16,13 +16,23 @@ import math
 import numba as nb
 import numpy as np
 
-from ._layout import A4, AX, AY, AZ, CK, CV, ETA, N1, N2, NAA, NAB, NBA, NBB, NEWTON_MAX_ITER, NEWTON_TOL
+from ._layout import A4, AX, AY, AZ, CK, CV, ETA, N1, N2, NA, NB, NEWTON_MAX_ITER, NEWTON_TOL, SA, SB
 from ._layout import CLIPPED, MISSED, RSC, SEMI, TIR, UNIT, VZ
 
 _FLAT, _STOP, _QUADRIC, _ASPHERE = 0, 1, 2, 3
 
 #: Rays per block: 9 float64 columns x 256 rays stay in the L1 cache.
 BLOCK = 256
+
+
+@nb.njit(inline="always", fastmath=False)
+def _index(S, s, c, flag, l2, u):
+    """physcam.optics.glass.evaluate, same order of operations (9 coefficients from column c)."""
+    n = S[s, c] + (S[s, c + 1] + S[s, c + 2] * u) * u
+    if S[s, flag] != 0.0:
+        n = n + math.sqrt(1.0 + S[s, c + 3] * l2 / (l2 - S[s, c + 6]) + S[s, c + 4] * l2 / (l2 - S[s, c + 7])
+                          + S[s, c + 5] * l2 / (l2 - S[s, c + 8]))
+    return n
 
 
 @nb.njit(parallel=True, fastmath=False, cache=True, nogil=True)
@@ -34,7 +44,8 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
     for blk in nb.prange(nblocks):
         i0 = blk * BLOCK
         i1 = min(n, i0 + BLOCK)
-        il2 = np.empty(i1 - i0)
+        uu = np.empty(i1 - i0)
+        ll = np.empty(i1 - i0)
         for i in range(i0, i1):
             # -- a live ray must start finite, with a usable wavelength (else MISSED, weight 0)
             if flag[i] == 0 and not (
@@ -46,7 +57,9 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                 w[i] = 0.0
                 wd[i] = 0.0
             if not mono:
-                il2[i - i0] = 1.0 / (wl[i] * wl[i])
+                l2 = (wl[i] / 1000.0) * (wl[i] / 1000.0)
+                ll[i - i0] = l2
+                uu[i - i0] = 1.0 / l2
         for s in range(ns):
             kd = kinds[s]
             vz = S[s, VZ]
@@ -179,8 +192,8 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                     n2 = S[s, N2]
                     eta = S[s, ETA]
                 else:
-                    n1 = S[s, NBA] + S[s, NBB] * il2[i - i0]
-                    n2 = S[s, NAA] + S[s, NAB] * il2[i - i0]
+                    n1 = _index(S, s, NB, SB, ll[i - i0], uu[i - i0])
+                    n2 = _index(S, s, NA, SA, ll[i - i0], uu[i - i0])
                     eta = n1 / n2
                 if n1 == n2:
                     continue

@@ -23,11 +23,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._layout import A4, AX, AY, AZ, CK, CV, NAA, NAB, NBA, NBB, NEWTON_MAX_ITER, NEWTON_TOL, RSC, SEMI, UNIT, VZ
+from ._layout import A4, AX, AY, AZ, CK, CV, NA, NB, NEWTON_MAX_ITER, NEWTON_TOL, RSC, SA, SB, SEMI, UNIT, VZ
 from ._layout import ETA, N1, N2
 from ._layout import CLIPPED, MISSED, TIR
 
 _FLAT, _STOP, _QUADRIC, _ASPHERE = 0, 1, 2, 3
+
+
+def _index(S, s, c, flag, l2, u):
+    """physcam.optics.glass.evaluate per ray, same order of operations (9 coefficients from column c)."""
+    n = S[s, c] + (S[s, c + 1] + S[s, c + 2] * u) * u
+    if S[s, flag] != 0.0:
+        n = n + np.sqrt(1.0 + S[s, c + 3] * l2 / (l2 - S[s, c + 6]) + S[s, c + 4] * l2 / (l2 - S[s, c + 7])
+                        + S[s, c + 5] * l2 / (l2 - S[s, c + 8]))
+    return n
 
 
 def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
@@ -45,12 +54,13 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
     px, py, pz = x[live], y[live], z[live]
     dx, dy, dz = L[live], M[live], N[live]
     with np.errstate(divide="ignore", over="ignore"):
-        il2 = 1.0 / (wl[live] * wl[live])
+        l2 = (wl[live] / 1000.0) * (wl[live] / 1000.0)
+        il2 = 1.0 / l2
     wt = w[live].copy()
     wdt = wd[live].copy()
 
     def fail(bad, code):
-        nonlocal live, px, py, pz, dx, dy, dz, il2, wt, wdt
+        nonlocal live, px, py, pz, dx, dy, dz, il2, l2, wt, wdt
         if not bad.any():
             return
         j = live[bad]
@@ -61,7 +71,8 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
         wd[j] = 0.0
         keep = ~bad
         live = live[keep]
-        px, py, pz, dx, dy, dz, il2, wt, wdt = (a[keep] for a in (px, py, pz, dx, dy, dz, il2, wt, wdt))
+        px, py, pz, dx, dy, dz, il2, l2, wt, wdt = (
+            a[keep] for a in (px, py, pz, dx, dy, dz, il2, l2, wt, wdt))
 
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         for s in range(S.shape[0]):
@@ -169,8 +180,8 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                 n2 = np.full_like(px, S[s, N2])
                 eta = np.full_like(px, S[s, ETA])
             else:
-                n1 = S[s, NBA] + S[s, NBB] * il2
-                n2 = S[s, NAA] + S[s, NAB] * il2
+                n1 = _index(S, s, NB, SB, l2, il2)
+                n2 = _index(S, s, NA, SA, l2, il2)
                 eta = n1 / n2
             if kd == _FLAT:
                 gx = np.zeros_like(px)
