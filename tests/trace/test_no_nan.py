@@ -45,7 +45,7 @@ def check(out):
     assert (out.weight_s[ok] >= -1e-12).all() and (out.weight_p[ok] >= -1e-12).all()
 
 
-SETTINGS = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 
 @SETTINGS
@@ -136,3 +136,19 @@ def test_from_arrays_normalises_huge_and_tiny_directions():
         RayBatch.from_arrays([[0, 0, 0]], [[0.0, 0.0, 0.0]])
     with pytest.raises(InputError):
         RayBatch.from_arrays([[0, math.inf, 0]], [[0.0, 0.0, 1.0]])
+
+
+@SETTINGS
+@given(slug=st.sampled_from(SLUGS),
+       rays=st.lists(st.tuples(coord(), coord(), coord(200.0), coord(1.0), coord(1.0), coord(1.0),
+                               st.floats(380.0, 780.0)), min_size=1, max_size=8),
+       clip=st.booleans(), fresnel=st.booleans())
+def test_both_kernels_flag_extreme_rays_alike(slug, rays, clip, fresnel):
+    r = np.array(rays)
+    assume((np.abs(r[:, 3:6]).max(axis=1) > 0).all())
+    batch = RayBatch.from_arrays(r[:, :3], r[:, 3:6], r[:, 6])
+    a, b = (trace_through(lens(slug), batch, clip=clip, fresnel=fresnel, end_z=250.0, backend=be)
+            for be in BACKENDS)
+    np.testing.assert_array_equal(a.flag, b.flag)
+    for u, v in zip(a.columns()[:9], b.columns()[:9]):
+        np.testing.assert_allclose(u, v, rtol=1e-12, atol=1e-9)

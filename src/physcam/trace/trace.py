@@ -44,7 +44,9 @@ def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chun
     for a in range(0, n, chunk_size):
         b = min(n, a + chunk_size)
         wl = rays.wavelength_nm[a:b]
-        mono = bool(wl.size) and bool(wl.min() == wl.max()) and bool(wl[0] > 0.0)
+        # one wavelength: indices per surface (set_wavelength); a wavelength the kernels cannot use
+        # (0, NaN, 1/l^2 overflowing) goes the per-ray way, where the kernel flags its rays MISSED
+        mono = bool(wl.size) and bool(wl.min() == wl.max()) and 1e-100 < float(wl[0]) < 1e100
         if mono:
             set_wavelength(S, float(wl[0]))
         kernel(*(c[a:b] for c in cols), S, kinds, bool(clip), bool(fresnel), ez, has_end, mono)

@@ -47,12 +47,12 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
         uu = np.empty(i1 - i0)
         ll = np.empty(i1 - i0)
         for i in range(i0, i1):
-            # -- a live ray must start finite, with a usable wavelength (else MISSED, weight 0)
-            if flag[i] == 0 and not (
-                math.isfinite(x[i]) and math.isfinite(y[i]) and math.isfinite(z[i])
-                and math.isfinite(L[i]) and math.isfinite(M[i]) and math.isfinite(N[i])
-                and math.isfinite(w[i]) and math.isfinite(wd[i]) and wl[i] > 0.0 and math.isfinite(wl[i])
-            ):
+            # -- a live ray's weights must be finite (else MISSED, weight 0). A NaN/inf position
+            # or direction needs no test here: it makes the first hit point or incidence cosine
+            # NaN/inf, which the surface loop flags. The wavelength of a mixed batch is checked
+            # below; a one-wavelength batch's in trace_packed.
+            v = w[i] + wd[i]
+            if flag[i] == 0 and not (v - v == 0.0):
                 flag[i] = MISSED
                 w[i] = 0.0
                 wd[i] = 0.0
@@ -60,6 +60,10 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                 l2 = (wl[i] / 1000.0) * (wl[i] / 1000.0)
                 ll[i - i0] = l2
                 uu[i - i0] = 1.0 / l2
+                if flag[i] == 0 and not (wl[i] > 0.0 and uu[i - i0] - uu[i - i0] == 0.0):
+                    flag[i] = MISSED
+                    w[i] = 0.0
+                    wd[i] = 0.0
         for s in range(ns):
             kd = kinds[s]
             vz = S[s, VZ]
@@ -170,18 +174,22 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                 hx = px + t * dx
                 hy = py + t * dy
                 hz = pz + t * dz
-                # -- overflow or 0/0 (huge or degenerate input): no usable hit point
-                if not (math.isfinite(hx) and math.isfinite(hy) and math.isfinite(hz)):
-                    flag[i] = MISSED
-                    w[i] = 0.0
-                    wd[i] = 0.0
-                    continue
-                # -- clip at the clear semi-diameter (and the stop)
-                if clip and hx * hx + hy * hy > sd2:
-                    flag[i] = CLIPPED
-                    w[i] = 0.0
-                    wd[i] = 0.0
-                    continue
+                # -- clip at the clear semi-diameter (and the stop). One comparison also catches a
+                # hit point that is not finite (overflow or 0/0 on huge or degenerate input): NaN
+                # fails every comparison. hz needs no test: a NaN/inf t makes hx NaN/inf too, and
+                # with a finite t, hz lies on the surface near its vertex.
+                r2 = hx * hx + hy * hy
+                if not (r2 <= sd2):
+                    if not (r2 - r2 == 0.0):
+                        flag[i] = MISSED
+                        w[i] = 0.0
+                        wd[i] = 0.0
+                        continue
+                    if clip:
+                        flag[i] = CLIPPED
+                        w[i] = 0.0
+                        wd[i] = 0.0
+                        continue
                 x[i] = hx
                 y[i] = hy
                 z[i] = hz
@@ -223,22 +231,14 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                     ci = -ci
                 # -- Snell's law in vector form; total internal reflection
                 kk = 1.0 - eta * eta * (1.0 - ci * ci)
-                if kk < 0.0:
-                    flag[i] = TIR
+                if not (kk >= 0.0):
+                    # kk < 0 with a finite normal: TIR; NaN/inf (a degenerate normal, 0/0): MISSED.
+                    # A finite normal and kk >= 0 give a finite refracted direction.
+                    flag[i] = TIR if (kk < 0.0 and ci - ci == 0.0) else MISSED
                     w[i] = 0.0
                     wd[i] = 0.0
                     continue
                 ct = math.sqrt(kk)
-                f = ct - eta * ci
-                ox = eta * dx + f * gx
-                oy = eta * dy + f * gy
-                oz = eta * dz + f * gz
-                # -- a degenerate normal (0/0, inf/inf) gives no direction: MISSED
-                if not (math.isfinite(ox) and math.isfinite(oy) and math.isfinite(oz)):
-                    flag[i] = MISSED
-                    w[i] = 0.0
-                    wd[i] = 0.0
-                    continue
                 if fresnel:
                     # s and p separately (see _numpy.py): w = (A + B) / 2, wd = (A - B) / 2
                     ec = eta * ci
@@ -259,9 +259,10 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                     d0 = wd[i]
                     w[i] = w0 * hsum + d0 * hdif
                     wd[i] = w0 * hdif + d0 * hsum
-                L[i] = ox
-                M[i] = oy
-                N[i] = oz
+                f = ct - eta * ci
+                L[i] = eta * dx + f * gx
+                M[i] = eta * dy + f * gy
+                N[i] = eta * dz + f * gz
         if has_end:
             for i in range(i0, i1):
                 if flag[i] != 0:

@@ -13,8 +13,9 @@ Same signature and answers as the JIT kernel. Per surface:
 5. Fresnel: s and p transmittances carried separately (see :mod:`physcam.trace.fresnel`):
    the weight is the mean of the s and p throughputs, ``wd`` half their difference.
 
-Rays that start non-finite, or whose hit point or refracted direction is not finite (overflow
-on huge inputs, a degenerate normal), are flagged MISSED.
+Rays that start non-finite, or whose hit point or incidence cosine is not finite (overflow on
+huge inputs, a degenerate normal), are flagged MISSED; the checks ride on the clipping and TIR
+comparisons (NaN fails every comparison), so the common path pays nothing extra.
 
 Rays that fail keep their last finite position and direction, get weight 0 and a flag.
 """
@@ -41,11 +42,13 @@ def _index(S, s, c, flag, l2, u):
 
 def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
     """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``."""
-    # a live ray must start finite, with a usable wavelength (else MISSED, weight 0)
-    unusable = (flag == 0) & ~(
-        np.isfinite(x) & np.isfinite(y) & np.isfinite(z) & np.isfinite(L) & np.isfinite(M) & np.isfinite(N)
-        & np.isfinite(w) & np.isfinite(wd) & (wl > 0.0) & np.isfinite(wl)
-    )
+    # a live ray must start with finite weights and a usable wavelength (else MISSED, weight 0)
+    # (the numba kernel's test: finite weights, a wavelength > 0 with a finite 1/l^2; a non-finite
+    # position or direction is caught at the first surface)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        v = w + wd
+        u = 1.0 / ((wl / 1000.0) * (wl / 1000.0))
+        unusable = (flag == 0) & ~((v - v == 0.0) & (wl > 0.0) & (u - u == 0.0))
     if unusable.any():
         flag[unusable] = MISSED
         w[unusable] = 0.0
@@ -153,11 +156,13 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
             nx_ = px + t * dx
             ny_ = py + t * dy
             nz_ = pz + t * dz
-            # overflow or 0/0 (huge or degenerate input): no usable hit point
-            bad = ~(np.isfinite(nx_) & np.isfinite(ny_) & np.isfinite(nz_))
+            # clip; the same comparison catches a hit point that is not finite (overflow or 0/0
+            # on huge or degenerate input): 0 * inf is NaN, which fails every comparison
+            r2 = nx_ * nx_ + ny_ * ny_  # (hz: see the numba kernel)
+            bad = ~(r2 - r2 == 0.0)
             if clip:
                 sd = S[s, SEMI]
-                clipped = ~bad & (nx_ * nx_ + ny_ * ny_ > sd * sd)
+                clipped = ~bad & ~(r2 <= sd * sd)
             if bad.any():
                 fail(bad, MISSED)
                 keep = ~bad
@@ -205,9 +210,17 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
             gx, gy, gz, ci = gx * sgn, gy * sgn, gz * sgn, ci * sgn
             kk = 1.0 - eta * eta * (1.0 - ci * ci)
             same = n1 == n2
-            bad = (kk < 0.0) & ~same
+            # kk < 0 with a finite normal: TIR; NaN/inf (a degenerate normal, 0/0): MISSED.
+            # A finite normal and kk >= 0 give a finite refracted direction.
+            bad = ~(kk >= 0.0) & ~same
             if bad.any():
-                fail(bad, TIR)
+                tir = bad & (kk < 0.0) & (ci - ci == 0.0)
+                fail(tir, TIR)
+                keep = ~tir
+                n1, n2, gx, gy, gz, ci, eta, kk, same, bad = (
+                    a[keep] for a in (n1, n2, gx, gy, gz, ci, eta, kk, same, bad)
+                )
+                fail(bad, MISSED)
                 keep = ~bad
                 n1, n2, gx, gy, gz, ci, eta, kk, same = (
                     a[keep] for a in (n1, n2, gx, gy, gz, ci, eta, kk, same)
@@ -217,12 +230,6 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
             ox = np.where(same, dx, eta * dx + f * gx)
             oy = np.where(same, dy, eta * dy + f * gy)
             oz = np.where(same, dz, eta * dz + f * gz)
-            # a degenerate normal (0/0, inf/inf) gives no direction: MISSED
-            bad = ~(np.isfinite(ox) & np.isfinite(oy) & np.isfinite(oz))
-            if bad.any():
-                fail(bad, MISSED)
-                keep = ~bad
-                ox, oy, oz, ci, ct, eta, same = (a[keep] for a in (ox, oy, oz, ci, ct, eta, same))
             if fresnel:
                 # s and p carried separately: with A, B the s- and p-polarised throughputs,
                 # wt = (A + B) / 2 and wdt = (A - B) / 2; per surface A *= Ts, B *= Tp, i.e.
