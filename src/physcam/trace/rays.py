@@ -46,12 +46,10 @@ class RayBatch:
     wavelength_nm: np.ndarray
     weight: np.ndarray
     flag: np.ndarray
-    #: (s - p) / 2 throughput (module notes); zeros (unpolarised, no surface yet) when not given.
+    #: (s - p) / 2 throughput (module notes). None means all zeros (unpolarised, no Fresnel
+    #: surface yet); :meth:`columns` then allocates it with ``np.zeros`` (calloc: pages are mapped
+    #: only where the kernels write), so batches traced without Fresnel do not pay for copying it.
     weight_sp: np.ndarray | None = None
-
-    def __post_init__(self):
-        if self.weight_sp is None:
-            self.weight_sp = np.zeros_like(self.weight)
 
     def __len__(self) -> int:
         return int(self.x.shape[0])
@@ -100,40 +98,45 @@ class RayBatch:
         p = np.stack([x, y, np.full_like(x, float(z0))], axis=1)
         return cls.from_arrays(p, np.asarray(direction, dtype=np.float64)[None, :], wavelength_nm)
 
+    def _base(self):
+        return (self.x, self.y, self.z, self.L, self.M, self.N, self.wavelength_nm, self.weight)
+
     def copy(self) -> "RayBatch":
-        return RayBatch._from_columns([np.array(a, copy=True) for a in self.columns()])
+        sp = None if self.weight_sp is None else np.array(self.weight_sp, copy=True)
+        return RayBatch(*(np.array(a, copy=True) for a in self._base()), flag=np.array(self.flag, copy=True),
+                        weight_sp=sp)
 
     def columns(self):
-        """The arrays in the kernels' order: x y z L M N wavelength_nm weight weight_sp flag."""
-        return (self.x, self.y, self.z, self.L, self.M, self.N, self.wavelength_nm, self.weight, self.weight_sp,
-                self.flag)
-
-    @classmethod
-    def _from_columns(cls, c) -> "RayBatch":
-        return cls(*c[:8], flag=c[9], weight_sp=c[8])
+        """The arrays in the kernels' order: x y z L M N wavelength_nm weight weight_sp flag
+        (``weight_sp`` allocated as zeros here if it was None)."""
+        if self.weight_sp is None:
+            self.weight_sp = np.zeros(self.weight.shape)
+        return self._base() + (self.weight_sp, self.flag)
 
     def take(self, index) -> "RayBatch":
         """The rays selected by a boolean mask or index array."""
-        return RayBatch._from_columns([a[index] for a in self.columns()])
+        sp = None if self.weight_sp is None else self.weight_sp[index]
+        return RayBatch(*(a[index] for a in self._base()), flag=self.flag[index], weight_sp=sp)
 
     @property
     def weight_s(self) -> np.ndarray:
         """Throughput of the s-polarised half (A; ``weight`` is the mean of s and p)."""
-        return self.weight + self.weight_sp
+        return self.weight + self.columns()[8]
 
     @property
     def weight_p(self) -> np.ndarray:
         """Throughput of the p-polarised half (B)."""
-        return self.weight - self.weight_sp
+        return self.weight - self.columns()[8]
 
     def scale_weight(self, factor, where=None) -> None:
         """Multiply both weight columns by a polarisation-blind ``factor`` (at the mask ``where``)."""
+        sp = self.columns()[8]
         if where is None:
             self.weight *= factor
-            self.weight_sp *= factor
+            sp *= factor
         else:
             self.weight[where] *= factor
-            self.weight_sp[where] *= factor
+            sp[where] *= factor
 
     @property
     def ok(self) -> np.ndarray:
