@@ -246,11 +246,11 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                     sm = (ec - ct) * (ci + et)
                     pm = (ci - et) * (ec + ct)
                     sp = (ec + ct) * (ci + et)
-                    sp2 = sp * sp
-                    rs = sm * sm / sp2 * rsc
+                    q = rsc / (sp * sp)
+                    rs = sm * sm * q
                     if not rs < 1.0:
                         rs = 1.0
-                    rp = pm * pm / sp2 * rsc
+                    rp = pm * pm * q
                     if not rp < 1.0:
                         rp = 1.0
                     hsum = 1.0 - 0.5 * (rs + rp)

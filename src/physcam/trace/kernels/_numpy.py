@@ -241,10 +241,10 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                 sm = (ec - ct) * (ci + et)
                 pm = (ci - et) * (ec + ct)
                 sp = (ec + ct) * (ci + et)
-                sp2 = sp * sp
-                rs = sm * sm / sp2 * S[s, RSC]
+                q = S[s, RSC] / (sp * sp)
+                rs = sm * sm * q
                 rs = np.where(rs < 1.0, rs, 1.0)
-                rp = pm * pm / sp2 * S[s, RSC]
+                rp = pm * pm * q
                 rp = np.where(rp < 1.0, rp, 1.0)
                 hsum = 1.0 - 0.5 * (rs + rp)
                 hdif = 0.5 * (rp - rs)
