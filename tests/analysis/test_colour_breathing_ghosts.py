@@ -89,13 +89,13 @@ def test_real_breathing_internal_focus_and_full_frame(dgauss):
         real_breathing(dgauss, [math.inf], sensor_width_mm=80.0)
 
 
-def _fresnel_r(theta, n):
-    """Unpolarised reflectance of an air-glass surface, Hecht eqs. 4.42-4.43, by hand."""
+def _fresnel_rsp(theta, n):
+    """(R_s, R_p, refraction angle) of an air-glass surface, Hecht eqs. 4.42-4.43, by hand."""
     tp = math.asin(math.sin(theta) / n)
     ci, ct = math.cos(theta), math.cos(tp)
     rs = (ci - n * ct) / (ci + n * ct)
     rp = (n * ci - ct) / (n * ci + ct)
-    return 0.5 * (rs * rs + rp * rp), tp
+    return rs * rs, rp * rp, tp
 
 
 def test_plate_ghost_normal_incidence():
@@ -113,9 +113,16 @@ def test_plate_ghost_oblique_ray_by_hand(theta_deg):
     ray = RayBatch.from_arrays([[0.0, y0, -1.0]], [[0.0, math.sin(th), math.cos(th)]])
     direct = trace_to_film(lens, ray, 60.0, fresnel=True)
     ghost = trace_ghost(lens, ray, 2, 1, 60.0)
-    R, tp = _fresnel_r(th, 1.5)
+    Rs, Rp, tp = _fresnel_rsp(th, 1.5)
     assert ghost.ok.all()
-    assert ghost.weight[0] / direct.weight[0] == pytest.approx(R * R, rel=1e-10)
+    # The s and p halves of unpolarised light go their own way through T R R T (glass-air R and T
+    # equal air-glass ones at the refracted angle, Stokes relations, Hecht 4.6.3), so
+    # ghost / direct = (Ts^2 Rs^2 + Tp^2 Rp^2) / (Ts^2 + Tp^2), not ((Rs + Rp) / 2)^2.
+    Ts, Tp = 1.0 - Rs, 1.0 - Rp
+    expect = (Ts * Ts * Rs * Rs + Tp * Tp * Rp * Rp) / (Ts * Ts + Tp * Tp)
+    assert ghost.weight[0] / direct.weight[0] == pytest.approx(expect, rel=1e-10)
+    assert ghost.weight_s[0] == pytest.approx(Ts * Ts * Rs * Rs, rel=1e-10)  # unit starting weight
+    assert ghost.weight_p[0] == pytest.approx(Tp * Tp * Rp * Rp, rel=1e-10)
     # two extra passes through the plate: the ghost leaves parallel, shifted by 2 t tan(theta')
     assert ghost.y[0] - direct.y[0] == pytest.approx(2 * t * math.tan(tp), rel=1e-10)
     assert (ghost.L[0], ghost.M[0], ghost.N[0]) == pytest.approx((direct.L[0], direct.M[0], direct.N[0]), abs=1e-12)
@@ -148,3 +155,28 @@ def test_colour_says_when_the_file_has_no_dispersion():
     assert any("Abbe" in n for n in res.notes)
     res = chromatic_aberration(load_lens("double_gauss_50mm_f2"))  # seed TOML with Abbe numbers
     assert res.longitudinal_paraxial_mm != 0.0 and not res.notes
+
+
+def test_colour_names_each_glass_model_and_its_uncertainty():
+    # catalogue glass: exact (no uncertainty); the model is named
+    res = chromatic_aberration(plano_convex(f=100.0, thickness=1.0), [0.0])
+    assert [m["glass"] for m in res.media] == ["N-BK7"] and res.media[0]["maker"] == "SCHOTT"
+    assert res.longitudinal_uncertainty_mm == 0.0 and res.curve_uncertainty_mm == 0.0
+    # a glass known only by (nd, Vd): normal line, and the C - F uncertainty equals the closed form
+    # of a plano-convex lens (focus z = t + R/(n-1) - t/n) with P_gF moved by +-0.01
+    from physcam.lens.prescription import Medium, Prescription, Surface
+    from physcam.optics.glass import normal_line
+
+    nd, vd, R, t = 1.6, 40.0, 60.0, 1.0
+    lens = Prescription((Surface(0.0, 0.0, semi_diameter=4.0, kind="stop"), Surface(R, t, Medium(nd, vd), 6.0),
+                         Surface(0.0, 90.0, semi_diameter=6.0, kind="flat"))).validate()
+    res = chromatic_aberration(lens, [0.0])
+    assert res.media[0]["model"] == "normal-line" and res.media[0]["surfaces"] == [1]
+    z = lambda n: t + R / (n - 1.0) - t / n  # noqa: E731
+    p0 = 0.6438 - 0.001682 * vd
+    cf = []
+    for p in (p0 + 0.01, p0 - 0.01):
+        m = normal_line(nd, vd, p)
+        cf.append(z(float(m.index(LINE_C_NM))) - z(float(m.index(LINE_F_NM))))
+    assert res.longitudinal_uncertainty_mm == pytest.approx(abs(cf[0] - cf[1]) / 2, rel=1e-6)
+    assert res.to_dict()["uncertainty"]["longitudinal_paraxial_mm"] == res.longitudinal_uncertainty_mm

@@ -11,9 +11,19 @@
   the real chief ray (aimed through the stop centre per wavelength) on the film plane
   ``film_z`` (default: paraxial focus at the reference wavelength), h_F - h_C, in micrometres.
 
-Indices per wavelength come from the glass model of :mod:`physcam.optics.glass` (two-term Cauchy
-from nd and Vd), so a lens file with Vd = 0 everywhere shows no colour at all. Fraunhofer lines:
-F 486.1327 nm, d 587.5618 nm, C 656.2725 nm.
+Indices per wavelength come from :func:`physcam.optics.glass.dispersion`: a catalogue glass's
+Sellmeier formula when the medium names or matches one, else the normal-line model from (nd, Vd);
+a lens file with Vd = 0 everywhere shows no colour at all. ``media`` lists, per distinct medium,
+which model was used. Fraunhofer lines: F 486.1327 nm, d 587.5618 nm, C 656.2725 nm.
+
+**Uncertainty.** A normal-line glass's nF - nC is fixed by its Vd, but its partial dispersion is
+not known: real glasses scatter about SCHOTT's normal line by about +-0.01 in P_gF (one sigma;
+derived from SCHOTT's catalogue in :mod:`physcam.optics.glass`). For each distinct normal-line
+medium the analysis refits it with P_gF +- 0.01, traces the paraxial rear focus again (a y-nu
+paraxial trace, Smith *Modern Optical Engineering* ch. 3) and takes half the spread; the glasses
+are independent, so the effects add in quadrature: ``longitudinal_uncertainty_mm`` (on C - F) and
+``curve_uncertainty_mm`` (largest over the 400-700 nm focus-shift curve). Catalogue glasses
+count as exact (their makers' formulas; melt-to-melt variation is not modelled).
 """
 
 from __future__ import annotations
@@ -25,7 +35,7 @@ import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription
-from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM
+from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM, PGF_UNCERTAINTY
 
 __all__ = ["LateralColourPoint", "ColourResult", "chromatic_aberration"]
 
@@ -57,6 +67,9 @@ class ColourResult:
     lateral: list[LateralColourPoint]
     efl_mm: float
     notes: list[str] = field(default_factory=list)
+    media: list[dict] = field(default_factory=list)  # per distinct dispersive medium: its model
+    longitudinal_uncertainty_mm: float = 0.0  # one sigma on C - F from the normal-line glasses' P_gF
+    curve_uncertainty_mm: float = 0.0  # one sigma, largest over the focus-shift curve
 
     def to_dict(self) -> dict:
         return {
@@ -67,6 +80,14 @@ class ColourResult:
             "longitudinal_real_mm": self.longitudinal_real_mm, "efl_mm": self.efl_mm,
             "curve": {"wavelength_nm": self.curve_nm, "focus_shift_mm": self.curve_shift_mm},
             "lateral": [p.to_dict() for p in self.lateral],
+            "media": list(self.media),
+            "uncertainty": {
+                "longitudinal_paraxial_mm": self.longitudinal_uncertainty_mm,
+                "curve_shift_mm": self.curve_uncertainty_mm,
+                "method": f"normal-line glasses refitted with P_gF +- {PGF_UNCERTAINTY} (one sigma of real glasses "
+                          "about SCHOTT's normal line), paraxial focus again, effects in quadrature; "
+                          "catalogue glasses exact",
+            },
             "conventions": "z in lens space (mm from the first vertex, + toward the film); longitudinal = z(C) - z(F); "
                            "lateral = h(F) - h(C) on the film",
             "notes": list(self.notes),
@@ -89,6 +110,55 @@ class ColourResult:
         a2.set_title("lateral colour on the film", fontsize=8)
         fig.suptitle(self.lens_name, fontsize=9)
         return save(fig, path, force)
+
+
+def _media(lens):
+    """Distinct dispersive media of ``lens``, in order: (key, Dispersion)."""
+    from ..optics.glass import dispersion
+
+    out = {}
+    for s in lens.surfaces:
+        m = s.medium
+        d = dispersion(m.nd, m.vd, m.glass)
+        if d.kind != "constant":
+            out.setdefault((m.nd, m.vd, m.glass), d)
+    return out
+
+
+def _rear_focus_z(lens, wavelength_nm, models):
+    """Paraxial rear focal point z (lens space) by a y-nu trace (Y meridian), indices from
+    ``models[(nd, vd, glass)]`` where given, else each medium's own model."""
+    from ..optics.glass import medium_index
+
+    y, nu, n = 1.0, 0.0, 1.0
+    for s in lens.surfaces:
+        key = (s.medium.nd, s.medium.vd, s.medium.glass)
+        n2 = float(models[key].index(wavelength_nm)) if key in models else float(medium_index(s.medium, wavelength_nm))
+        c = 0.0 if s.kind in ("stop", "flat", "cylindrical_x") or s.radius == 0 else 1.0 / s.radius
+        nu = nu - y * (n2 - n) * c
+        n = n2
+        y = y + s.thickness * nu / n
+    # y and nu after the last surface were advanced by its thickness: back up to the last vertex,
+    # then on to the axis crossing
+    y_last = y - lens.surfaces[-1].thickness * nu / n
+    return lens.vertex_z[-1] + (-y_last * n / nu)
+
+
+def _pgf_uncertainty(lens, wavelengths):
+    """One-sigma focus uncertainty (mm) per wavelength from the normal-line glasses' P_gF."""
+    from ..optics.glass import normal_line
+
+    wl = list(wavelengths)
+    var = np.zeros(len(wl))
+    for key, d in _media(lens).items():
+        if d.kind != "normal-line":
+            continue
+        p0 = float(d.pgf)
+        plus = {key: normal_line(d.nd, d.vd, p0 + PGF_UNCERTAINTY)}
+        minus = {key: normal_line(d.nd, d.vd, p0 - PGF_UNCERTAINTY)}
+        dz = np.array([0.5 * (_rear_focus_z(lens, w, plus) - _rear_focus_z(lens, w, minus)) for w in wl])
+        var += dz * dz
+    return np.sqrt(var)
 
 
 def _zone_focus(lens, height, wl, backend):
@@ -171,6 +241,28 @@ def chromatic_aberration(
         float(par[iC] - par[iF]), float(real[iC] - real[iF]),
         [float(v) for v in curve], [float(v) for v in shift], lateral, float(g_ref.efl),
     )
+    media = _media(lens)
+    result.media = [{"surfaces": [i for i, s in enumerate(lens.surfaces)
+                                  if (s.medium.nd, s.medium.vd, s.medium.glass) == k], **d.to_dict()}
+                    for k, d in media.items()]
+    if any(d.kind == "normal-line" for d in media.values()):
+        fc = _pgf_uncertainty(lens, [LINE_F_NM, LINE_C_NM] + list(curve))
+        # C - F: the perturbation moves F and C foci together; the uncertainty of their difference
+        # is computed per glass, not from the two RSS figures
+        from ..optics.glass import normal_line
+
+        dl = 0.0
+        for key, d in media.items():
+            if d.kind != "normal-line":
+                continue
+            p0 = float(d.pgf)
+            zs = []
+            for sign in (1.0, -1.0):
+                mod = {key: normal_line(d.nd, d.vd, p0 + sign * PGF_UNCERTAINTY)}
+                zs.append(_rear_focus_z(lens, LINE_C_NM, mod) - _rear_focus_z(lens, LINE_F_NM, mod))
+            dl += (0.5 * (zs[0] - zs[1])) ** 2
+        result.longitudinal_uncertainty_mm = float(math.sqrt(dl))
+        result.curve_uncertainty_mm = float(fc[2:].max())
     if all(s.medium.vd == 0.0 for s in lens.surfaces):
         # pbrt and ISET files carry no Abbe numbers: every medium is non-dispersive, so zero colour
         # says nothing about the real lens

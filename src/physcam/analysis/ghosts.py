@@ -3,10 +3,12 @@
 A ghost path (i, j), j < i, is: forward through surfaces 0..i-1, reflected at surface i, back
 through i-1..j+1, reflected at surface j, forward through j+1..N-1 to the film. Only surfaces
 with a change of index reflect (the stop and index-matched surfaces do not). Each reflection
-weighs the ray by the unpolarised Fresnel reflectance R = 1 - T of that surface at the ray's
-angle (Hecht, *Optics*, 5th ed., 4.6.2; beyond the critical angle R = 1), scaled by the coating
-model of :mod:`physcam.trace.fresnel` (``none``, ``single`` quarter-wave MgF2, ``multi``);
-every refraction weighs it by the Fresnel transmittance, as in the direct image.
+weighs the ray by the Fresnel reflectances R_s = 1 - T_s and R_p = 1 - T_p of that surface at
+the ray's angle (Hecht, *Optics*, 5th ed., 4.6.2; beyond the critical angle R = 1), scaled by
+the coating model of :mod:`physcam.trace.fresnel` (``none``, ``single`` quarter-wave MgF2,
+``multi``); every refraction weighs it by T_s and T_p, as in the direct image. The s and p
+halves of the unpolarised light are carried separately along the whole path (``RayBatch.weight``
+= (s + p) / 2, ``weight_sp`` = (s - p) / 2), so a ghost's flux is (prod s + prod p) / 2.
 
 What is reused: the tracer's kernels (:mod:`physcam.trace.kernels`) trace each leg, on slices
 of the packed surface table (:func:`physcam.trace.surfaces.surface_table`, forward for legs 1
@@ -14,8 +16,8 @@ and 3, reverse for leg 2): intersection (spheres, conics, cylinders, even aspher
 every clear semi-diameter and the stop, Snell refraction and Fresnel transmission. The
 surface where a leg ends is given the same index on both sides, so the kernel leaves the ray on
 that surface without refracting it; this module then reflects it: the unit normal from the
-same quadric/asphere gradient as the kernels, d' = d - 2 (d . n) n, and the Fresnel reflectance
-from :func:`physcam.trace.fresnel.fresnel_transmittance`. All arrays are structure-of-arrays
+same quadric/asphere gradient as the kernels, d' = d - 2 (d . n) n, and the Fresnel reflectances
+from :func:`physcam.trace.fresnel.fresnel_transmittances`. All arrays are structure-of-arrays
 (:class:`physcam.trace.RayBatch`), traced in chunks.
 
 The light is a point at infinity at field angle ``field_deg`` (Y meridian), filling the front
@@ -123,10 +125,11 @@ class _Tables:
     @staticmethod
     def _ending(S, kinds, a, b):
         """Rows a..b-1 of a packed table; the last row keeps the ray on its surface (no refraction)."""
-        from ..trace.kernels._layout import NAA, NAB, NBA, NBB
+        from ..trace.kernels._layout import NA, NB, SA, SB
 
         s = np.array(S[a:b], copy=True)
-        s[-1, NAA], s[-1, NAB] = s[-1, NBA], s[-1, NBB]
+        s[-1, NA:NA + 9] = s[-1, NB:NB + 9]
+        s[-1, SA] = s[-1, SB]
         return np.ascontiguousarray(s), np.ascontiguousarray(kinds[a:b])
 
 
@@ -153,8 +156,8 @@ def _normal(t, row, x, y, z):
 
 
 def _reflect(rays, t, row, forward: bool):
-    """Reflect live rays at row ``row`` of table ``t``, weighing them by the Fresnel reflectance."""
-    from ..trace.fresnel import fresnel_transmittance
+    """Reflect live rays at row ``row`` of table ``t``, weighing their s and p halves by R_s and R_p."""
+    from ..trace.fresnel import fresnel_transmittances
 
     live = rays.ok
     if not live.any():
@@ -163,12 +166,18 @@ def _reflect(rays, t, row, forward: bool):
     L, M, N = rays.L[live], rays.M[live], rays.N[live]
     nx, ny, nz = _normal(t, row, x, y, z)
     dn = L * nx + M * ny + N * nz
-    il2 = 1.0 / rays.wavelength_nm[live] ** 2
-    n1 = t.n_before_a[row] + t.n_before_b[row] * il2  # the medium the ray travels in (table order)
-    n2 = t.n_after_a[row] + t.n_after_b[row] * il2
-    R = 1.0 - fresnel_transmittance(n1, n2, dn, t.r_scale[row])
+    from ..optics.glass import evaluate
+
+    wl = rays.wavelength_nm[live]
+    n1 = evaluate(t.disp_before[row], wl)  # the medium the ray travels in (table order)
+    n2 = evaluate(t.disp_after[row], wl)
+    ts, tp = fresnel_transmittances(n1, n2, dn, t.r_scale[row])
+    hsum = 1.0 - 0.5 * (ts + tp)  # (R_s + R_p) / 2
+    hdif = 0.5 * (tp - ts)  # (R_s - R_p) / 2
     rays.L[live], rays.M[live], rays.N[live] = L - 2 * dn * nx, M - 2 * dn * ny, N - 2 * dn * nz
-    rays.weight[live] *= R
+    w, d = rays.weight[live], rays.weight_sp[live]
+    rays.weight[live] = w * hsum + d * hdif
+    rays.weight_sp[live] = w * hdif + d * hsum
 
 
 def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float, *, coating: str = "none",

@@ -168,6 +168,12 @@ def run_colour(args) -> int:
         print(f"{res.lens_name}: chromatic aberration (EFL {res.efl_mm:.3f} mm at {res.reference_nm:g} nm)")
         print(f"  longitudinal colour C - F: paraxial {res.longitudinal_paraxial_mm * 1e3:.2f} um, "
               f"real ({res.zone:.3g} zone) {res.longitudinal_real_mm * 1e3:.2f} um")
+        if res.media:
+            print(f"  uncertainty (one sigma, P_gF of normal-line glasses): C - F +-{res.longitudinal_uncertainty_mm * 1e3:.2f}"
+                  f" um, focus-shift curve 400-700 nm up to +-{res.curve_uncertainty_mm * 1e3:.1f} um")
+            print("  dispersion models:")
+            for m in res.media:
+                print(f"    surfaces {','.join(str(i) for i in m['surfaces'])}: {m['description']}")
         for w, zp, zr in zip(res.wavelengths_nm, res.paraxial_focus_z_mm, res.real_focus_z_mm):
             print(f"    {w:9.4f} nm  paraxial focus z {zp:10.4f} mm  real zone focus z {zr:10.4f} mm")
         print("  lateral colour F - C on the film:")

@@ -78,16 +78,16 @@ def _axis(axis: str) -> str:
 def media_indices(prescription: Prescription, wavelength_nm=None) -> list[float]:
     """Refractive index of object space followed by the medium after each surface.
 
-    Object space is air (n = 1). Indices come from (nd, Vd) through
-    :func:`physcam.optics.glass.refractive_index` at ``wavelength_nm``
-    (default: the prescription's design wavelength).
+    Object space is air (n = 1). Indices come from the medium's dispersion model
+    (:func:`physcam.optics.glass.medium_index`: catalogue Sellmeier or normal line) at
+    ``wavelength_nm`` (default: the prescription's design wavelength).
     """
-    from .glass import refractive_index
+    from .glass import medium_index
 
     lam = _wavelength(prescription, wavelength_nm)
     out = [1.0]
     for s in prescription.surfaces:
-        n = float(refractive_index(s.medium.nd, s.medium.vd, lam))
+        n = float(medium_index(s.medium, lam))
         if not (math.isfinite(n) and n > 0):
             raise OpticsError(f"medium after a surface has no usable index at {lam:g} nm (got {n})")
         out.append(n)

@@ -1,14 +1,21 @@
 """Fresnel transmission at a refracting surface, and three coating models.
 
-Uncoated: the Fresnel equations for a dielectric interface, unpolarised light taken as the
-average of the s and p reflectances (Hecht, *Optics*, 5th ed., §4.6.2, eqs. 4.42-4.43):
+Uncoated: the Fresnel equations for a dielectric interface (Hecht, *Optics*, 5th ed., §4.6.2,
+eqs. 4.42-4.43):
 
     r_s = (n1 cos i - n2 cos t) / (n1 cos i + n2 cos t)
     r_p = (n2 cos i - n1 cos t) / (n2 cos i + n1 cos t)
-    R = (r_s^2 + r_p^2) / 2,   T = 1 - R   (no absorption)
+    R_s = r_s^2, R_p = r_p^2,   T_s = 1 - R_s, T_p = 1 - R_p   (no absorption)
 
-Coatings are modelled as a factor on R that the tracer applies at every angle and wavelength
-(``R_coated(i) = min(1, s * R_uncoated(i))``), with ``s`` fixed per surface from normal
+One surface passes unpolarised light with T = (T_s + T_p) / 2. Through several surfaces the s
+and p halves stay separate (the planes of incidence of a centred lens's meridional ray coincide;
+for skew rays this is the usual scalar approximation that ignores the rotation between
+successive planes of incidence), so T = (prod T_s + prod T_p) / 2, which is larger than
+prod((T_s + T_p) / 2) at oblique incidence. The tracer carries both (``RayBatch.weight`` and
+``weight_sp``); :func:`fresnel_transmittances` gives (T_s, T_p) for one surface.
+
+Coatings are modelled as a factor on R that the tracer applies at every angle and wavelength,
+to each polarisation (``R_coated(i) = min(1, s * R_uncoated(i))`` for R_s and R_p), with ``s`` fixed per surface from normal
 incidence at the d line:
 
 - ``"none"``: s = 1.
@@ -30,7 +37,8 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["COATINGS", "MGF2_INDEX", "MULTI_RESIDUAL_REFLECTANCE", "reflectance_scale", "fresnel_transmittance"]
+__all__ = ["COATINGS", "MGF2_INDEX", "MULTI_RESIDUAL_REFLECTANCE", "reflectance_scale", "fresnel_transmittance",
+           "fresnel_transmittances"]
 
 COATINGS = ("none", "single", "multi")
 MGF2_INDEX = 1.38
@@ -56,10 +64,11 @@ def reflectance_scale(coating: str, n1: float, n2: float) -> float:
     return min(1.0, MULTI_RESIDUAL_REFLECTANCE / r0)
 
 
-def fresnel_transmittance(n1, n2, cos_i, r_scale=1.0):
-    """Unpolarised transmittance T = 1 - R of the n1 -> n2 surface at incidence cosine ``cos_i``.
+def fresnel_transmittances(n1, n2, cos_i, r_scale=1.0):
+    """(T_s, T_p): the s and p transmittances of the n1 -> n2 surface at incidence cosine ``cos_i``.
 
-    Returns 0 beyond the critical angle (total internal reflection). Broadcasts.
+    Each is 1 - min(1, r_scale R); both 0 beyond the critical angle (total internal
+    reflection). Broadcasts.
     """
     n1 = np.asarray(n1, dtype=float)
     n2 = np.asarray(n2, dtype=float)
@@ -67,7 +76,20 @@ def fresnel_transmittance(n1, n2, cos_i, r_scale=1.0):
     eta = n1 / n2
     k = 1.0 - eta * eta * (1.0 - ci * ci)
     ct = np.sqrt(np.maximum(k, 0.0))
-    rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct)
-    rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct)
-    r = np.minimum(1.0, 0.5 * (rs * rs + rp * rp) * r_scale)
-    return np.where(k < 0.0, 0.0, 1.0 - r)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct)
+        rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct)
+        Rs = rs * rs * r_scale
+        Rp = rp * rp * r_scale
+    Rs = np.where(Rs < 1.0, Rs, 1.0)  # NaN (0/0 at grazing incidence) -> 1
+    Rp = np.where(Rp < 1.0, Rp, 1.0)
+    tir = k < 0.0
+    return np.where(tir, 0.0, 1.0 - Rs), np.where(tir, 0.0, 1.0 - Rp)
+
+
+def fresnel_transmittance(n1, n2, cos_i, r_scale=1.0):
+    """Unpolarised transmittance (T_s + T_p) / 2 of the n1 -> n2 surface at incidence cosine
+    ``cos_i`` (one surface; see the module notes for several). 0 beyond the critical angle. Broadcasts.
+    """
+    ts, tp = fresnel_transmittances(n1, n2, cos_i, r_scale)
+    return 0.5 * (ts + tp)

@@ -3,9 +3,16 @@
 A :class:`RayBatch` holds one float64 array per component: position ``x, y, z`` (mm, lens
 space: z = 0 at the first vertex, +z toward the film; docs/conventions.md), direction
 cosines ``L, M, N`` (unit vector, L^2 + M^2 + N^2 = 1), ``wavelength_nm``, ``weight``
-(radiometric throughput, 0 for a lost ray) and ``flag`` (uint8, one of :data:`OK`,
-:data:`MISSED`, :data:`CLIPPED`, :data:`TIR`). A lost ray keeps its last finite position
-and direction, never NaN.
+(radiometric throughput of unpolarised light, 0 for a lost ray), ``weight_sp`` and ``flag``
+(uint8, one of :data:`OK`, :data:`MISSED`, :data:`CLIPPED`, :data:`TIR`). A lost ray keeps its
+last finite position and direction, never NaN; a ray flagged OK has finite position, direction
+and weights (the kernels flag MISSED whatever overflows or divides 0 by 0).
+
+Polarisation (Fresnel): unpolarised light is half s- and half p-polarised, and the two are
+transmitted differently at each surface. With A and B the throughputs of the s and p halves
+(each starting at the ray's weight), ``weight`` = (A + B) / 2 and ``weight_sp`` = (A - B) / 2,
+so through several surfaces T = (prod Ts + prod Tp) / 2, not prod((Ts + Tp) / 2). Both columns
+scale together under any polarisation-blind factor (aperture density, cos^4, clipping to 0).
 """
 
 from __future__ import annotations
@@ -39,6 +46,10 @@ class RayBatch:
     wavelength_nm: np.ndarray
     weight: np.ndarray
     flag: np.ndarray
+    #: (s - p) / 2 throughput (module notes). None means all zeros (unpolarised, no Fresnel
+    #: surface yet); :meth:`columns` then allocates it with ``np.zeros`` (calloc: pages are mapped
+    #: only where the kernels write), so batches traced without Fresnel do not pay for copying it.
+    weight_sp: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.x.shape[0])
@@ -53,15 +64,20 @@ class RayBatch:
         d = np.atleast_2d(np.asarray(direction, dtype=np.float64))
         if p.ndim != 2 or p.shape[1] != 3:
             raise InputError(f"ray positions must have shape (n, 3), got {p.shape}")
-        p, d = np.broadcast_arrays(p, d)
+        try:
+            p, d = np.broadcast_arrays(p, d)
+        except ValueError:
+            raise InputError(f"ray directions must have shape {p.shape}, got {d.shape}") from None
         if d.shape != p.shape:
             raise InputError(f"ray directions must have shape {p.shape}, got {d.shape}")
         if not (np.isfinite(p).all() and np.isfinite(d).all()):
             raise InputError("ray positions and directions must be finite numbers (found NaN or inf)")
-        norm = np.sqrt((d * d).sum(axis=1))
-        if (norm == 0).any():
+        # normalise without overflow or underflow: scale by the largest component first
+        big = np.abs(d).max(axis=1)
+        if (big == 0).any():
             raise InputError("a ray direction is the zero vector; give a non-zero direction")
-        d = d / norm[:, None]
+        d = d / big[:, None]
+        d = d / np.sqrt((d * d).sum(axis=1))[:, None]
         n = p.shape[0]
         wl = np.broadcast_to(np.asarray(wavelength_nm, dtype=np.float64), (n,)).copy()
         require_wavelength(wl, "ray wavelength")
@@ -84,15 +100,45 @@ class RayBatch:
         p = np.stack([x, y, np.full_like(x, float(z0))], axis=1)
         return cls.from_arrays(p, np.asarray(direction, dtype=np.float64)[None, :], wavelength_nm)
 
+    def _base(self):
+        return (self.x, self.y, self.z, self.L, self.M, self.N, self.wavelength_nm, self.weight)
+
     def copy(self) -> "RayBatch":
-        return RayBatch(*(np.array(a, copy=True) for a in self.columns()))
+        sp = None if self.weight_sp is None else np.array(self.weight_sp, copy=True)
+        return RayBatch(*(np.array(a, copy=True) for a in self._base()), flag=np.array(self.flag, copy=True),
+                        weight_sp=sp)
 
     def columns(self):
-        return (self.x, self.y, self.z, self.L, self.M, self.N, self.wavelength_nm, self.weight, self.flag)
+        """The arrays in the kernels' order: x y z L M N wavelength_nm weight weight_sp flag
+        (``weight_sp`` allocated as zeros here if it was None)."""
+        if self.weight_sp is None:
+            self.weight_sp = np.zeros(self.weight.shape)
+        return self._base() + (self.weight_sp, self.flag)
 
     def take(self, index) -> "RayBatch":
         """The rays selected by a boolean mask or index array."""
-        return RayBatch(*(a[index] for a in self.columns()))
+        sp = None if self.weight_sp is None else self.weight_sp[index]
+        return RayBatch(*(a[index] for a in self._base()), flag=self.flag[index], weight_sp=sp)
+
+    @property
+    def weight_s(self) -> np.ndarray:
+        """Throughput of the s-polarised half (A; ``weight`` is the mean of s and p)."""
+        return self.weight + self.columns()[8]
+
+    @property
+    def weight_p(self) -> np.ndarray:
+        """Throughput of the p-polarised half (B)."""
+        return self.weight - self.columns()[8]
+
+    def scale_weight(self, factor, where=None) -> None:
+        """Multiply both weight columns by a polarisation-blind ``factor`` (at the mask ``where``)."""
+        sp = self.columns()[8]
+        if where is None:
+            self.weight *= factor
+            sp *= factor
+        else:
+            self.weight[where] *= factor
+            sp[where] *= factor
 
     @property
     def ok(self) -> np.ndarray:

@@ -16,9 +16,10 @@ cylindrical_y   0       c       c                (curved in Y-Z only)
 c = 1 / radius. This is the sphere/conic sag equation z = c r^2 / (1 + sqrt(1 - (1+k) c^2 r^2))
 solved for z (Zemax OpticStudio manual, "Standard" and "Even Asphere" surfaces).
 
-Media are stored as Cauchy coefficients (A, B) of n = A + B / lambda^2 (lambda in nm) from
-:func:`physcam.optics.glass.cauchy_coefficients`, for the medium before and after each surface
-in the order the rays meet them, so the kernel computes the index per ray wavelength.
+Media are stored as the 9 dispersion coefficients of :func:`physcam.optics.glass.dispersion`
+(catalogue Sellmeier, normal-line Cauchy or constant, one shared form evaluated exactly by
+:func:`physcam.optics.glass.evaluate`), for the medium before and after each surface in the
+order the rays meet them, so the kernel computes the index per ray wavelength.
 ``r_scale`` multiplies the Fresnel reflectance (coating model, :mod:`physcam.trace.fresnel`).
 """
 
@@ -30,7 +31,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..lens.prescription import Prescription
-from ..optics.glass import cauchy_coefficients
+from ..optics.glass import Dispersion, dispersion, evaluate
 
 __all__ = ["KIND_FLAT", "KIND_STOP", "KIND_QUADRIC", "KIND_ASPHERE", "SurfaceTable", "surface_table"]
 
@@ -54,20 +55,23 @@ class SurfaceTable:
     aspheric: np.ndarray  # (n, 7): A4..A16
     semi_diameter: np.ndarray
     kind: np.ndarray  # int64 codes KIND_*
-    n_before_a: np.ndarray
-    n_before_b: np.ndarray
-    n_after_a: np.ndarray
-    n_after_b: np.ndarray
+    disp_before: np.ndarray  # (n, 9) dispersion coefficients of the medium before each row
+    disp_after: np.ndarray  # (n, 9) ... and after it
     r_scale: np.ndarray
     index: np.ndarray  # prescription surface index of each row
     reverse: bool
+    media: tuple = ()  # Dispersion of object space and of the medium after each surface (prescription order)
 
     def __len__(self) -> int:
         return int(self.vertex_z.shape[0])
 
     def index_after(self, wavelength_nm: float) -> np.ndarray:
         """Refractive index after each row at one wavelength (for checks and reports)."""
-        return self.n_after_a + self.n_after_b / wavelength_nm**2
+        return np.array([float(evaluate(c, wavelength_nm)) for c in self.disp_after])
+
+    def index_before(self, wavelength_nm: float) -> np.ndarray:
+        """Refractive index before each row at one wavelength."""
+        return np.array([float(evaluate(c, wavelength_nm)) for c in self.disp_before])
 
 
 def surface_table(
@@ -126,20 +130,18 @@ def surface_table(
                 asph[i, : len(s.aspheric)] = s.aspheric
     # medium after surface i is surfs[i].medium; before surface 0 is air (object space).
     nd = np.array([1.0] + [s.medium.nd for s in surfs])
-    vd = np.array([0.0] + [s.medium.vd for s in surfs])
-    ca, cb = cauchy_coefficients(nd, vd)
-    ca = np.asarray(ca, dtype=np.float64)
-    cb = np.asarray(cb, dtype=np.float64)
+    media: tuple[Dispersion, ...] = (dispersion(1.0, 0.0),) + tuple(
+        dispersion(s.medium.nd, s.medium.vd, s.medium.glass) for s in surfs)
+    co = np.array([m.coefficients for m in media], dtype=np.float64)  # (n + 1, 9)
     rs = np.array([reflectance_scale(coating, nd[i], nd[i + 1]) for i in range(n)])
     idx = np.arange(n)
     if not reverse:
-        before_a, before_b, after_a, after_b = ca[:-1], cb[:-1], ca[1:], cb[1:]
+        before, after = co[:-1], co[1:]
     else:
         idx = idx[::-1]
-        before_a, before_b = ca[1:][::-1], cb[1:][::-1]
-        after_a, after_b = ca[:-1][::-1], cb[:-1][::-1]
+        before, after = co[1:][::-1], co[:-1][::-1]
     c = np.ascontiguousarray
     return SurfaceTable(
         c(vz[idx]), c(ax[idx]), c(ay[idx]), c(az[idx]), c(cv[idx]), c(k[idx]), c(asph[idx]), c(semi[idx]),
-        c(kind[idx]), c(before_a), c(before_b), c(after_a), c(after_b), c(rs[idx]), c(idx), reverse,
+        c(kind[idx]), c(before), c(after), c(rs[idx]), c(idx), reverse, media,
     )

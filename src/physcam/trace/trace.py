@@ -44,7 +44,9 @@ def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chun
     for a in range(0, n, chunk_size):
         b = min(n, a + chunk_size)
         wl = rays.wavelength_nm[a:b]
-        mono = bool(wl.size) and bool(wl.min() == wl.max())
+        # one wavelength: indices per surface (set_wavelength); a wavelength the kernels cannot use
+        # (0, NaN, 1/l^2 overflowing) goes the per-ray way, where the kernel flags its rays MISSED
+        mono = bool(wl.size) and bool(wl.min() == wl.max()) and 1e-100 < float(wl[0]) < 1e100
         if mono:
             set_wavelength(S, float(wl[0]))
         kernel(*(c[a:b] for c in cols), S, kinds, bool(clip), bool(fresnel), ez, has_end, mono)
@@ -91,10 +93,11 @@ def trace_through(
     rstop = table.semi_diameter[k]
     dens = aperture.density_at(out.x / rstop, out.y / rstop)
     live = out.flag == OK
-    out.weight[live] *= dens[live]
-    blocked = live & (dens <= 0.0)
+    out.scale_weight(dens[live], live)  # polarisation-blind: scales the s and p halves alike
+    blocked = live & ~((dens > 0.0) & np.isfinite(out.weight) & np.isfinite(out.weight_sp))
     out.flag[blocked] = CLIPPED
     out.weight[blocked] = 0.0
+    out.weight_sp[blocked] = 0.0
     return trace_packed(kernel, out, S[k + 1 :], kinds[k + 1 :], clip=clip, fresnel=fresnel, end_z=end_z,
                 chunk_size=chunk_size)
 
@@ -264,7 +267,10 @@ def camera_rays(
     wl = lens.wavelength_nm if wavelength_nm is None else wavelength_nm
     rays = RayBatch.from_arrays(start, dirn, wl)
     cos_t = -rays.N
-    rays.weight[:] = cos_t**4 * area / (d * d)
+    with np.errstate(over="ignore", invalid="ignore"):
+        rays.weight[:] = cos_t**4 * area / (d * d)  # unpolarised at the film: weight_sp stays 0
+    # a weight that overflows (a film plane a hair behind the rear vertex) cannot be traced:
+    # the kernels flag such a ray MISSED with weight 0
 
     trace_through(lens, rays, reverse=True, clip=True, fresnel=fresnel, coating=coating,
                   stop_semi_diameter=stop_semi_diameter, aperture=aperture, backend=backend,

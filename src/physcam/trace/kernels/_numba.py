@@ -16,7 +16,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ._layout import A4, AX, AY, AZ, CK, CV, ETA, N1, N2, NAA, NAB, NBA, NBB, NEWTON_MAX_ITER, NEWTON_TOL
+from ._layout import A4, AX, AY, AZ, CK, CV, ETA, N1, N2, NA, NB, NEWTON_MAX_ITER, NEWTON_TOL, SA, SB
 from ._layout import CLIPPED, MISSED, RSC, SEMI, TIR, UNIT, VZ
 
 _FLAT, _STOP, _QUADRIC, _ASPHERE = 0, 1, 2, 3
@@ -25,8 +25,18 @@ _FLAT, _STOP, _QUADRIC, _ASPHERE = 0, 1, 2, 3
 BLOCK = 256
 
 
+@nb.njit(inline="always", fastmath=False)
+def _index(S, s, c, flag, l2, u):
+    """physcam.optics.glass.evaluate, same order of operations (9 coefficients from column c)."""
+    n = S[s, c] + (S[s, c + 1] + S[s, c + 2] * u) * u
+    if S[s, flag] != 0.0:
+        n = n + math.sqrt(1.0 + S[s, c + 3] * l2 / (l2 - S[s, c + 6]) + S[s, c + 4] * l2 / (l2 - S[s, c + 7])
+                          + S[s, c + 5] * l2 / (l2 - S[s, c + 8]))
+    return n
+
+
 @nb.njit(parallel=True, fastmath=False, cache=True, nogil=True)
-def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
+def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
     """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``."""
     ns = S.shape[0]
     n = x.shape[0]
@@ -34,10 +44,26 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
     for blk in nb.prange(nblocks):
         i0 = blk * BLOCK
         i1 = min(n, i0 + BLOCK)
-        il2 = np.empty(i1 - i0)
-        if not mono:
-            for i in range(i0, i1):
-                il2[i - i0] = 1.0 / (wl[i] * wl[i])
+        uu = np.empty(i1 - i0)
+        ll = np.empty(i1 - i0)
+        for i in range(i0, i1):
+            # -- a live ray's weights must be finite (else MISSED, weight 0). A NaN/inf position
+            # or direction needs no test here: it makes the first hit point or incidence cosine
+            # NaN/inf, which the surface loop flags. The wavelength of a mixed batch is checked
+            # below; a one-wavelength batch's in trace_packed.
+            v = w[i] + wd[i]
+            if flag[i] == 0 and not (v - v == 0.0):
+                flag[i] = MISSED
+                w[i] = 0.0
+                wd[i] = 0.0
+            if not mono:
+                l2 = (wl[i] / 1000.0) * (wl[i] / 1000.0)
+                ll[i - i0] = l2
+                uu[i - i0] = 1.0 / l2
+                if flag[i] == 0 and not (wl[i] > 0.0 and uu[i - i0] - uu[i - i0] == 0.0):
+                    flag[i] = MISSED
+                    w[i] = 0.0
+                    wd[i] = 0.0
         for s in range(ns):
             kd = kinds[s]
             vz = S[s, VZ]
@@ -64,6 +90,7 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                     if dz == 0.0:
                         flag[i] = MISSED
                         w[i] = 0.0
+                        wd[i] = 0.0
                         continue
                     t = -qz / dz
                 else:
@@ -74,12 +101,14 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                     if disc < 0.0:
                         flag[i] = MISSED
                         w[i] = 0.0
+                        wd[i] = 0.0
                         continue
                     sq = math.sqrt(disc)
                     den = -b - sq if b >= 0.0 else -b + sq
                     if den == 0.0:
                         flag[i] = MISSED
                         w[i] = 0.0
+                        wd[i] = 0.0
                         continue
                     t = c / den
                     # nearest root on the far cap (back of a sphere): use the vertex branch,
@@ -88,11 +117,13 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                         if a == 0.0:
                             flag[i] = MISSED
                             w[i] = 0.0
+                            wd[i] = 0.0
                             continue
                         t = den / a
                         if not az * (qz + t * dz) < 1.0:
                             flag[i] = MISSED
                             w[i] = 0.0
+                            wd[i] = 0.0
                             continue
                 dsr = 0.0
                 if kd == _ASPHERE:
@@ -133,6 +164,7 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                     if not conv or arg < 0.0:
                         flag[i] = MISSED
                         w[i] = 0.0
+                        wd[i] = 0.0
                         continue
                     dsr = cv / math.sqrt(arg)
                     q = r2
@@ -142,11 +174,22 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                 hx = px + t * dx
                 hy = py + t * dy
                 hz = pz + t * dz
-                # -- clip at the clear semi-diameter (and the stop)
-                if clip and hx * hx + hy * hy > sd2:
-                    flag[i] = CLIPPED
-                    w[i] = 0.0
-                    continue
+                # -- clip at the clear semi-diameter (and the stop). One comparison also catches a
+                # hit point that is not finite (overflow or 0/0 on huge or degenerate input): NaN
+                # fails every comparison. hz needs no test: a NaN/inf t makes hx NaN/inf too, and
+                # with a finite t, hz lies on the surface near its vertex.
+                r2 = hx * hx + hy * hy
+                if not (r2 <= sd2):
+                    if not (r2 - r2 == 0.0):
+                        flag[i] = MISSED
+                        w[i] = 0.0
+                        wd[i] = 0.0
+                        continue
+                    if clip:
+                        flag[i] = CLIPPED
+                        w[i] = 0.0
+                        wd[i] = 0.0
+                        continue
                 x[i] = hx
                 y[i] = hy
                 z[i] = hz
@@ -157,8 +200,8 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                     n2 = S[s, N2]
                     eta = S[s, ETA]
                 else:
-                    n1 = S[s, NBA] + S[s, NBB] * il2[i - i0]
-                    n2 = S[s, NAA] + S[s, NAB] * il2[i - i0]
+                    n1 = _index(S, s, NB, SB, ll[i - i0], uu[i - i0])
+                    n2 = _index(S, s, NA, SA, ll[i - i0], uu[i - i0])
                     eta = n1 / n2
                 if n1 == n2:
                     continue
@@ -188,21 +231,34 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                     ci = -ci
                 # -- Snell's law in vector form; total internal reflection
                 kk = 1.0 - eta * eta * (1.0 - ci * ci)
-                if kk < 0.0:
-                    flag[i] = TIR
+                if not (kk >= 0.0):
+                    # kk < 0 with a finite normal: TIR; NaN/inf (a degenerate normal, 0/0): MISSED.
+                    # A finite normal and kk >= 0 give a finite refracted direction.
+                    flag[i] = TIR if (kk < 0.0 and ci - ci == 0.0) else MISSED
                     w[i] = 0.0
+                    wd[i] = 0.0
                     continue
                 ct = math.sqrt(kk)
                 if fresnel:
+                    # s and p separately (see _numpy.py): w = (A + B) / 2, wd = (A - B) / 2
                     ec = eta * ci
                     et = eta * ct
                     sm = (ec - ct) * (ci + et)
                     pm = (ci - et) * (ec + ct)
                     sp = (ec + ct) * (ci + et)
-                    rr = 0.5 * (sm * sm + pm * pm) / (sp * sp) * rsc
-                    if rr > 1.0:
-                        rr = 1.0
-                    w[i] = w[i] * (1.0 - rr)
+                    q = rsc / (sp * sp)
+                    rs = sm * sm * q
+                    if not rs < 1.0:
+                        rs = 1.0
+                    rp = pm * pm * q
+                    if not rp < 1.0:
+                        rp = 1.0
+                    hsum = 1.0 - 0.5 * (rs + rp)
+                    hdif = 0.5 * (rp - rs)
+                    w0 = w[i]
+                    d0 = wd[i]
+                    w[i] = w0 * hsum + d0 * hdif
+                    wd[i] = w0 * hdif + d0 * hsum
                 f = ct - eta * ci
                 L[i] = eta * dx + f * gx
                 M[i] = eta * dy + f * gy
@@ -214,8 +270,16 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                 if N[i] == 0.0:
                     flag[i] = MISSED
                     w[i] = 0.0
+                    wd[i] = 0.0
                     continue
                 t = (end_z - z[i]) / N[i]
-                x[i] = x[i] + t * L[i]
-                y[i] = y[i] + t * M[i]
+                hx = x[i] + t * L[i]
+                hy = y[i] + t * M[i]
+                if not (math.isfinite(hx) and math.isfinite(hy)):
+                    flag[i] = MISSED
+                    w[i] = 0.0
+                    wd[i] = 0.0
+                    continue
+                x[i] = hx
+                y[i] = hy
                 z[i] = end_z

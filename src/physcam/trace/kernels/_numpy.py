@@ -10,7 +10,12 @@ Same signature and answers as the JIT kernel. Per surface:
 4. Refraction: Snell's law in vector form, t = eta d + (cos t - eta cos i) n with n the unit
    normal on the side the ray travels to (Hecht, *Optics*, §4.4; Welford, *Aberrations of Optical
    Systems*, §4.3); total internal reflection when 1 - eta^2 (1 - cos^2 i) < 0.
-5. Fresnel: unpolarised transmittance (see :mod:`physcam.trace.fresnel`).
+5. Fresnel: s and p transmittances carried separately (see :mod:`physcam.trace.fresnel`):
+   the weight is the mean of the s and p throughputs, ``wd`` half their difference.
+
+Rays that start non-finite, or whose hit point or incidence cosine is not finite (overflow on
+huge inputs, a degenerate normal), are flagged MISSED; the checks ride on the clipping and TIR
+comparisons (NaN fails every comparison), so the common path pays nothing extra.
 
 Rays that fail keep their last finite position and direction, get weight 0 and a flag.
 """
@@ -19,23 +24,46 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._layout import A4, AX, AY, AZ, CK, CV, NAA, NAB, NBA, NBB, NEWTON_MAX_ITER, NEWTON_TOL, RSC, SEMI, UNIT, VZ
+from ._layout import A4, AX, AY, AZ, CK, CV, NA, NB, NEWTON_MAX_ITER, NEWTON_TOL, RSC, SA, SB, SEMI, UNIT, VZ
 from ._layout import ETA, N1, N2
 from ._layout import CLIPPED, MISSED, TIR
 
 _FLAT, _STOP, _QUADRIC, _ASPHERE = 0, 1, 2, 3
 
 
-def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
+def _index(S, s, c, flag, l2, u):
+    """physcam.optics.glass.evaluate per ray, same order of operations (9 coefficients from column c)."""
+    n = S[s, c] + (S[s, c + 1] + S[s, c + 2] * u) * u
+    if S[s, flag] != 0.0:
+        n = n + np.sqrt(1.0 + S[s, c + 3] * l2 / (l2 - S[s, c + 6]) + S[s, c + 4] * l2 / (l2 - S[s, c + 7])
+                        + S[s, c + 5] * l2 / (l2 - S[s, c + 8]))
+    return n
+
+
+def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
     """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``."""
+    # a live ray must start with finite weights and a usable wavelength (else MISSED, weight 0)
+    # (the numba kernel's test: finite weights, a wavelength > 0 with a finite 1/l^2; a non-finite
+    # position or direction is caught at the first surface)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        v = w + wd
+        u = 1.0 / ((wl / 1000.0) * (wl / 1000.0))
+        unusable = (flag == 0) & ~((v - v == 0.0) & (wl > 0.0) & (u - u == 0.0))
+    if unusable.any():
+        flag[unusable] = MISSED
+        w[unusable] = 0.0
+        wd[unusable] = 0.0
     live = np.flatnonzero(flag == 0)
     px, py, pz = x[live], y[live], z[live]
     dx, dy, dz = L[live], M[live], N[live]
-    il2 = 1.0 / (wl[live] * wl[live])
+    with np.errstate(divide="ignore", over="ignore"):
+        l2 = (wl[live] / 1000.0) * (wl[live] / 1000.0)
+        il2 = 1.0 / l2
     wt = w[live].copy()
+    wdt = wd[live].copy()
 
     def fail(bad, code):
-        nonlocal live, px, py, pz, dx, dy, dz, il2, wt
+        nonlocal live, px, py, pz, dx, dy, dz, il2, l2, wt, wdt
         if not bad.any():
             return
         j = live[bad]
@@ -43,9 +71,11 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
         L[j], M[j], N[j] = dx[bad], dy[bad], dz[bad]
         flag[j] = code
         w[j] = 0.0
+        wd[j] = 0.0
         keep = ~bad
         live = live[keep]
-        px, py, pz, dx, dy, dz, il2, wt = (a[keep] for a in (px, py, pz, dx, dy, dz, il2, wt))
+        px, py, pz, dx, dy, dz, il2, l2, wt, wdt = (
+            a[keep] for a in (px, py, pz, dx, dy, dz, il2, l2, wt, wdt))
 
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         for s in range(S.shape[0]):
@@ -126,15 +156,27 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
             nx_ = px + t * dx
             ny_ = py + t * dy
             nz_ = pz + t * dz
+            # clip; the same comparison catches a hit point that is not finite (overflow or 0/0
+            # on huge or degenerate input): 0 * inf is NaN, which fails every comparison
+            r2 = nx_ * nx_ + ny_ * ny_  # (hz: see the numba kernel)
+            bad = ~(r2 - r2 == 0.0)
             if clip:
                 sd = S[s, SEMI]
-                bad = nx_ * nx_ + ny_ * ny_ > sd * sd
-                if bad.any():
-                    fail(bad, CLIPPED)
-                    keep = ~bad
-                    nx_, ny_, nz_ = nx_[keep], ny_[keep], nz_[keep]
-                    if kd == _ASPHERE:
-                        dsr = dsr[keep]
+                clipped = ~bad & ~(r2 <= sd * sd)
+            if bad.any():
+                fail(bad, MISSED)
+                keep = ~bad
+                nx_, ny_, nz_ = nx_[keep], ny_[keep], nz_[keep]
+                if kd == _ASPHERE:
+                    dsr = dsr[keep]
+                if clip:
+                    clipped = clipped[keep]
+            if clip and clipped.any():
+                fail(clipped, CLIPPED)
+                keep = ~clipped
+                nx_, ny_, nz_ = nx_[keep], ny_[keep], nz_[keep]
+                if kd == _ASPHERE:
+                    dsr = dsr[keep]
             px, py, pz = nx_, ny_, nz_
             if kd == _STOP:
                 continue
@@ -143,8 +185,8 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
                 n2 = np.full_like(px, S[s, N2])
                 eta = np.full_like(px, S[s, ETA])
             else:
-                n1 = S[s, NBA] + S[s, NBB] * il2
-                n2 = S[s, NAA] + S[s, NAB] * il2
+                n1 = _index(S, s, NB, SB, l2, il2)
+                n2 = _index(S, s, NA, SA, l2, il2)
                 eta = n1 / n2
             if kd == _FLAT:
                 gx = np.zeros_like(px)
@@ -168,34 +210,58 @@ def trace_rays(x, y, z, L, M, N, wl, w, flag, S, kinds, clip, fresnel, end_z, ha
             gx, gy, gz, ci = gx * sgn, gy * sgn, gz * sgn, ci * sgn
             kk = 1.0 - eta * eta * (1.0 - ci * ci)
             same = n1 == n2
-            bad = (kk < 0.0) & ~same
+            # kk < 0 with a finite normal: TIR; NaN/inf (a degenerate normal, 0/0): MISSED.
+            # A finite normal and kk >= 0 give a finite refracted direction.
+            bad = ~(kk >= 0.0) & ~same
             if bad.any():
-                fail(bad, TIR)
+                tir = bad & (kk < 0.0) & (ci - ci == 0.0)
+                fail(tir, TIR)
+                keep = ~tir
+                n1, n2, gx, gy, gz, ci, eta, kk, same, bad = (
+                    a[keep] for a in (n1, n2, gx, gy, gz, ci, eta, kk, same, bad)
+                )
+                fail(bad, MISSED)
                 keep = ~bad
                 n1, n2, gx, gy, gz, ci, eta, kk, same = (
                     a[keep] for a in (n1, n2, gx, gy, gz, ci, eta, kk, same)
                 )
             ct = np.sqrt(kk)
+            f = ct - eta * ci
+            ox = np.where(same, dx, eta * dx + f * gx)
+            oy = np.where(same, dy, eta * dy + f * gy)
+            oz = np.where(same, dz, eta * dz + f * gz)
             if fresnel:
-                # unpolarised R = (rs^2 + rp^2) / 2 over one common denominator
-                # r_s = (eta ci - ct) / (eta ci + ct), r_p = (ci - eta ct) / (ci + eta ct)
+                # s and p carried separately: with A, B the s- and p-polarised throughputs,
+                # wt = (A + B) / 2 and wdt = (A - B) / 2; per surface A *= Ts, B *= Tp, i.e.
+                # wt' = wt (Ts + Tp)/2 + wdt (Ts - Tp)/2 and wdt' = wt (Ts - Tp)/2 + wdt (Ts + Tp)/2.
+                # r_s = (eta ci - ct) / (eta ci + ct), r_p = (ci - eta ct) / (ci + eta ct) over one
+                # common denominator; R clipped to 1 (coating factor; 0/0 at grazing incidence).
                 ec = eta * ci
                 et = eta * ct
                 sm = (ec - ct) * (ci + et)
                 pm = (ci - et) * (ec + ct)
                 sp = (ec + ct) * (ci + et)
-                rr = np.minimum(0.5 * (sm * sm + pm * pm) / (sp * sp) * S[s, RSC], 1.0)
-                wt = np.where(same, wt, wt * (1.0 - rr))
-            f = ct - eta * ci
-            dx = np.where(same, dx, eta * dx + f * gx)
-            dy = np.where(same, dy, eta * dy + f * gy)
-            dz = np.where(same, dz, eta * dz + f * gz)
+                q = S[s, RSC] / (sp * sp)
+                rs = sm * sm * q
+                rs = np.where(rs < 1.0, rs, 1.0)
+                rp = pm * pm * q
+                rp = np.where(rp < 1.0, rp, 1.0)
+                hsum = 1.0 - 0.5 * (rs + rp)
+                hdif = 0.5 * (rp - rs)
+                wt, wdt = (np.where(same, wt, wt * hsum + wdt * hdif), np.where(same, wdt, wt * hdif + wdt * hsum))
+            dx, dy, dz = ox, oy, oz
         if has_end and live.size:
             fail(dz == 0.0, MISSED)
             t = (end_z - pz) / dz
-            px = px + t * dx
-            py = py + t * dy
+            nx_ = px + t * dx
+            ny_ = py + t * dy
+            bad = ~(np.isfinite(nx_) & np.isfinite(ny_))
+            if bad.any():
+                fail(bad, MISSED)
+                nx_, ny_ = nx_[~bad], ny_[~bad]
+            px, py = nx_, ny_
             pz = np.full_like(px, end_z)
     x[live], y[live], z[live] = px, py, pz
     L[live], M[live], N[live] = dx, dy, dz
     w[live] = wt
+    wd[live] = wdt
