@@ -53,7 +53,7 @@ def test_usd_units_hand_values():
     r = solve_lens_report(focal_length_mm=50.0, sensor=Sensor("x", "x", 36.0, 24.0), fstop=2.0, focus_mm=3000.0)
     cm = usdgeom_camera_values(r, 0.01)
     m = usdgeom_camera_values(r, 1.0)
-    pin = image_distance_at_mark(50.0, 3000.0)  # 50.848 mm: the thin lens's framing at 3 m
+    pin = image_distance_at_mark(50.0, 3000.0)  # 50.862 mm: the thin lens's framing at 3 m
     assert cm["focalLength"] == pytest.approx(pin) and m["focalLength"] == pytest.approx(pin / 100.0)
     assert cm["horizontalAperture"] == pytest.approx(36.0) and m["horizontalAperture"] == pytest.approx(0.36)
     # the default clipping range is 100 mm to 10 km (usdgeom_camera_values): 10 cm .. 1e6 cm, 0.1 m .. 1e4 m

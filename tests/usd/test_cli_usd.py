@@ -264,3 +264,36 @@ def test_renderman_settings_and_dof_aspect(tmp_path):
     # anamorphic narrows the pupil in X by about its squeeze: oval bokeh, taller than wide
     assert aspects["navarro_anamorphic_2x"] == pytest.approx(1.0)
     assert aspects["neil_front_anamorphic_2x"] == pytest.approx(0.5, abs=0.01)
+
+
+def test_review_findings_on_the_kit_cli(tmp_path, capsys):
+    """A new user's review: a body's CoC follows the sensor (d/1500 by default), a plan view looks
+    down, usd check can gate a script, report --force without --plot is refused, and reading a
+    file that is not USD says so in one clean line."""
+    from pxr import Usd, UsdGeom
+
+    from physcam.usd.read import open_stage
+
+    body = tmp_path / "s16.usda"
+    assert main(["usd", "kit", "body", str(body), "--sensor", "S16"]) == 0
+    body_stage = open_stage(body)
+    coc = body_stage.GetPrimAtPath("/Body").GetAttribute("sensor:main:circleOfConfusion").Get()
+    assert coc == pytest.approx((12.52**2 + 7.41**2) ** 0.5 / 1500, rel=1e-6)  # Super 16 diagonal / 1500
+    kit = tmp_path / "kit.usda"
+    assert main(["usd", "kit", "previs", str(kit)]) == 0
+    stage = open_stage(kit)
+    stage.GetPrimAtPath("/PrevisKit").GetVariantSets().GetVariantSet("setup").SetVariantSelection("TopDownPlan")
+    m = UsdGeom.Xformable(stage.GetPrimAtPath("/PrevisKit/Camera")).ComputeLocalToWorldTransform(Usd.TimeCode())
+    assert tuple(m.TransformDir((0, 0, -1))) == pytest.approx((0.0, -1.0, 0.0), abs=1e-9)  # looks down -Y
+    cam = tmp_path / "cam.usda"
+    assert main(["usd", "write", str(cam), "--focal", "50", "--fstop", "2.8", "--focus", "3m"]) == 0
+    capsys.readouterr()
+    assert main(["usd", "check", str(cam), "--exit-code"]) == 0
+    assert "current" in capsys.readouterr().out
+    assert main(["report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--force"]) == 2
+    csv = tmp_path / "notusd.csv"
+    csv.write_text("a,b\n1,2\n")
+    capsys.readouterr()
+    assert main(["usd", "read", str(csv)]) == 2
+    err = capsys.readouterr().err
+    assert "not a USD file" in err and len(err.strip().splitlines()) == 1

@@ -305,7 +305,8 @@ def test_stale_companion_is_detected_and_refreshed(tmp_path, library):
     from physcam.usd.kit import check_shot, refresh_shot
 
     body = write_body_file(tmp_path / "body.usda", CameraSpec(sensor_width_mm=36.0, sensor_height_mm=24.0))
-    shot = write_shot(tmp_path / "shot.usda", body, library)
+    shot = write_shot(tmp_path / "shot.usda", body, library, overrides={"fstop": 2.8}, position=(0.0, 150.0, 500.0),
+                      rotate_xyz_deg=(0.0, 30.0, 0.0))
     assert check_shot(shot)["stale"] is False
     # a new measuring day: the lens file is rewritten with a longer current focal length
     write_lens_file(library, {"2026-03-01": lens(24.1, 80.0, 0.90), "2026-03-02": lens(24.3, 81.0, 0.88),
@@ -318,3 +319,20 @@ def test_stale_companion_is_detected_and_refreshed(tmp_path, library):
     f = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Shot/Camera")).GetFocalLengthAttr().Get()
     # the companion follows the new 25 mm lens at the 3 m default mark (thin-lens s', by hand)
     assert f == pytest.approx(image_distance_at_mark(25.0, 3000.0), rel=1e-5)
+    # the new pupil (82 mm) stays where the shot placed it, and the iris is the new f / N
+    eye = UsdGeom.Xformable(stage.GetPrimAtPath("/Cameras/Shot/Camera")).ComputeLocalToWorldTransform(
+        Usd.TimeCode.Default()).ExtractTranslation()
+    assert tuple(eye) == pytest.approx((0.0, 150.0, 500.0), abs=1e-6)
+    assert stage.GetPrimAtPath("/Cameras/Shot").GetAttribute("lens:main:iris").Get() == pytest.approx(25.0 / 2.8)
+
+
+def test_check_says_current_for_every_file_physcam_writes(tmp_path):
+    """Review finding: `usd check` called every non-shot file stale. Each companion carries its inputs."""
+    from physcam.usd.author import write_camera
+    from physcam.usd.kit import check_shot
+
+    cam = write_camera(tmp_path / "cam.usda", CameraSpec(focal_length_mm=35.0, sensor_width_mm=27.99,
+                                                         sensor_height_mm=19.22))
+    assert check_shot(cam)["stale"] is False
+    kit = write_previs_kit(tmp_path / "kit.usda")
+    assert check_shot(kit)["stale"] is False

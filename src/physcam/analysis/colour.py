@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM, PGF_UNCERTAINTY
 
 __all__ = ["LateralColourPoint", "ColourResult", "chromatic_aberration"]
@@ -173,6 +173,7 @@ def _zone_focus(lens, height, wl, backend):
     return float(out.z[0] - out.y[0] * out.N[0] / out.M[0])
 
 
+@takes_prescription
 def chromatic_aberration(
     lens: Prescription,
     fields_deg=None,

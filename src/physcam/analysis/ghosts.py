@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["GhostPath", "GhostResult", "ghost_pairs", "ghost_analysis", "trace_ghost"]
 
@@ -102,6 +102,7 @@ class GhostResult:
         return save(fig, path, force)
 
 
+@takes_prescription
 def ghost_pairs(lens: Prescription) -> list[tuple[int, int]]:
     """All (i, j), j < i, of surfaces that reflect (index changes across them)."""
     media = [(1.0, 0.0)] + [(s.medium.nd, s.medium.vd) for s in lens.surfaces]
@@ -180,6 +181,7 @@ def _reflect(rays, t, row, forward: bool):
     rays.weight_sp[live] = w * hdif + d * hsum
 
 
+@takes_prescription
 def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float, *, coating: str = "none",
                 stop_semi_diameter=None, backend: str = "auto", _tables=None):
     """Trace object-space ``rays`` (a RayBatch, copied) along ghost path (i, j) to the film plane ``film_z``."""
@@ -228,6 +230,7 @@ def _beam(lens, field_deg, wl, n, rng=None):
     return RayBatch.from_arrays(pos, d[None, :], wl, area * d[2])
 
 
+@takes_prescription
 def ghost_analysis(
     lens: Prescription,
     field_deg: float = 10.0,

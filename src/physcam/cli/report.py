@@ -156,6 +156,10 @@ def camera_blocks(report, args) -> dict:
 def run(args) -> int:
     from ._common import console, print_json
 
+    if args.force and not args.plot:
+        from ..errors import InputError
+
+        raise InputError("--force overwrites the --plot file; without --plot there is nothing to overwrite")
     report = solve_from_args(args)
     cams = camera_blocks(report, args)
     if args.plot:

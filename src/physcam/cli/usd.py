@@ -69,6 +69,8 @@ def register(sub) -> None:
     k.add_argument("--sensor-height", type=distance("sensor height"), help="vendor, body: sensor height")
     k.add_argument("--flange", type=distance("flange focal distance"), help="body: flange focal distance (default 52 mm)")
     k.add_argument("--iso", type=number("ISO", positive=True), help="body: exposure index (default 100)")
+    k.add_argument("--coc", default=None,
+                   help="body: circle of confusion, d/1500 (default), d/1000, d/1730, cine or a value in mm")
     k.add_argument("--shutter-angle", type=number("shutter angle", positive=True), default=None,
                    help="body: degrees (default 180)")
     k.add_argument("--position", type=numbers("position", 3), default=(0.0, 0.0, 0.0), metavar="X,Y,Z",
@@ -105,6 +107,8 @@ def register(sub) -> None:
     c.add_argument("file")
     c.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
     c.add_argument("--json", action="store_true", help="print JSON")
+    c.add_argument("--exit-code", action="store_true",
+                   help="exit 1 when the companion is stale (for farm and CI scripts; 0 when current)")
     c.set_defaults(handler=run_check)
 
     f = s.add_parser("refresh", help="recompute a shot's companion camera from its body and lens files (in place)")
@@ -227,11 +231,11 @@ def run_kit(args) -> int:
         "previs": set(),
         "vendor": {"lens", "focus", "fstop", "sensor", "sensor_width", "sensor_height"},
         "lens": {"characterizations"},
-        "body": {"sensor", "sensor_width", "sensor_height", "flange", "iso", "shutter_angle"},
+        "body": {"sensor", "sensor_width", "sensor_height", "flange", "iso", "shutter_angle", "coc"},
         "shot": {"lens", "body", "focus", "fstop", "position", "rotate", "variant"},
     }[kind]
     given = {k for k in ("lens", "body", "characterizations", "focus", "fstop", "sensor", "sensor_width",
-                         "sensor_height", "flange", "iso", "shutter_angle", "variant")
+                         "sensor_height", "flange", "iso", "shutter_angle", "variant", "coc")
              if getattr(args, k) is not None}
     given |= {k for k in ("position", "rotate") if getattr(args, k) != (0.0, 0.0, 0.0)}
     if given - allowed:
@@ -241,8 +245,9 @@ def run_kit(args) -> int:
     if kind == "previs":
         path = kit.write_previs_kit(args.file, **common)
     elif kind == "vendor":
-        if not args.lens or args.focus is None:
-            raise InputError("physcam usd kit vendor needs --lens and --focus")
+        missing = [f for f, v in (("--lens", args.lens), ("--focus", args.focus)) if not v]
+        if missing:
+            raise InputError(f"physcam usd kit vendor needs {' and '.join(missing)}")
         from ..lens.library import load_lens
 
         sensor = _kit_sensor(args, default="Full Frame")
@@ -255,8 +260,12 @@ def run_kit(args) -> int:
     elif kind == "body":
         from ..usd.author import CameraSpec
 
+        from ..optics.coc import circle_of_confusion
+
         sensor = _kit_sensor(args, default="Super 35")
-        body = dict(sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm, sensor_name=sensor.name)
+        coc, _ = circle_of_confusion(sensor.width_mm, sensor.height_mm, coc_value(args.coc))
+        body = dict(sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm, sensor_name=sensor.name,
+                    coc_mm=coc)
         if args.flange is not None:
             body["flange_distance_mm"] = args.flange
         if args.iso is not None:
@@ -386,18 +395,18 @@ def run_check(args) -> int:
     from ..usd.kit import check_shot
 
     res = check_shot(args.file, args.path)
+    rc = 1 if (args.exit_code and res["stale"]) else 0
     if args.json:
         from ._common import print_json
 
         print_json(res)
-        return 0
-    state = "STALE: its body or lens files changed; run physcam usd refresh " + str(args.file) if res["stale"] \
-        else "current"
+        return rc
+    state = f"STALE: {res['reason']}; run physcam usd refresh {args.file}" if res["stale"] else "current"
     print(f"{res['path']}: companion camera {state}")
     for u in res["units"]:
         print(f"  note: {u['file']} is in metersPerUnit {u['meters_per_unit']:g}, the shot in "
               f"{res['meters_per_unit']:g} (composed in the shot's unit)")
-    return 0
+    return rc
 
 
 def run_refresh(args) -> int:

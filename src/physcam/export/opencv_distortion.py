@@ -75,6 +75,8 @@ def _sensor(name: str, value) -> float:
 def film_to_pixels(film_xy_mm, sensor_width_mm, sensor_height_mm, image_width_px, image_height_px) -> np.ndarray:
     """Film points (n, 2) in mm (lens space, y up) as pixels (n, 2) of the upright image (module notes)."""
     p = np.atleast_2d(np.asarray(film_xy_mm, dtype=float))
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise InputError(f"film points must have shape (n, 2) in mm, got {p.shape}")
     sx, sy = image_width_px / sensor_width_mm, image_height_px / sensor_height_mm
     return np.stack([image_width_px / 2.0 - p[:, 0] * sx, image_height_px / 2.0 + p[:, 1] * sy], axis=1)
 

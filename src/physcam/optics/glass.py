@@ -188,6 +188,10 @@ def dispersion(nd: float, vd: float, glass: str | None = None) -> Dispersion:
 
 def medium_index(medium, wavelength_nm):
     """Index of a :class:`~physcam.lens.prescription.Medium` at ``wavelength_nm`` (broadcasts)."""
+    from ..errors import require_type
+    from ..lens.prescription import Medium
+
+    require_type("medium", medium, Medium, "a lens surface's medium, e.g. lens.surfaces[0].medium")
     return dispersion(medium.nd, medium.vd, medium.glass).index(wavelength_nm)
 
 

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 from ..optics.glass import Dispersion, dispersion, evaluate
 
 __all__ = ["KIND_FLAT", "KIND_STOP", "KIND_QUADRIC", "KIND_ASPHERE", "SurfaceTable", "surface_table"]
@@ -74,6 +74,7 @@ class SurfaceTable:
         return np.array([float(evaluate(c, wavelength_nm)) for c in self.disp_before])
 
 
+@takes_prescription
 def surface_table(
     lens: Prescription,
     *,

@@ -400,8 +400,13 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
     if "lens" in parts:
         _author_lens(stage, cam, spec, eye, su)
     if "render" in parts:
-        author_render_camera(stage, sdf_path, spec, report=report, lens_distortion=lens_distortion,
-                             opencv_distortion=opencv_distortion)
+        geom = author_render_camera(stage, sdf_path, spec, report=report, lens_distortion=lens_distortion,
+                                    opencv_distortion=opencv_distortion)
+        if {"body", "sensor", "lens"} <= set(parts):
+            # what the companion was computed from, for `physcam usd check` (physcam.usd.kit.check_shot)
+            from .read import companion_inputs
+
+            geom.GetPrim().SetCustomDataByKey("physcam:companionInputs", companion_inputs(stage, str(sdf_path)))
     return cam
 
 

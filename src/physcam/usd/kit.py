@@ -21,6 +21,7 @@ from dataclasses import replace
 
 from ..errors import ExportError, InputError, require_type
 from .author import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec, author_camera, author_render_camera, new_stage, save_stage
+from .read import companion_inputs, companion_inputs_hash, composed_prescription
 from .plugin import ensure_registered
 
 __all__ = [
@@ -60,6 +61,12 @@ PREVIS_SETUPS: dict[str, CameraSpec] = {
     "TopDownPlan": CameraSpec(projection="orthographic", magnification=0.002, focal_length_mm=50.0,
                               focus_mm=10000.0, sensor_width_mm=36.0, sensor_height_mm=24.0,
                               clipping_mm=(100.0, 1.0e6)),
+}
+
+#: Where a previs setup's camera stands (mm, Y up) and how it turns (degrees, XYZ): the plan view
+#: looks straight down (-Y) from 10 m; the others stand at the origin looking down -Z.
+PREVIS_PLACEMENT: dict[str, tuple[tuple[float, float, float], tuple[float, float, float]]] = {
+    "TopDownPlan": ((0.0, 10000.0, 0.0), (-90.0, 0.0, 0.0)),
 }
 
 #: CameraSpec fields a shot may override, and the schema attributes each one writes.
@@ -185,7 +192,7 @@ def write_shot(file, body_file, lens_file, *, overrides: dict | None = None, len
         lens_mpu, lens_clip_mm = sources[LENS_PRIM]
         if lens_clip_mm is not None and lens_mpu != meters_per_unit and "clipping_mm" not in overrides:
             overrides["clipping_mm"] = lens_clip_mm
-        spec = replace(_composed_spec(stage, path), **overrides).checked()
+        spec = replace(_read_spec(stage, path), **overrides).checked()
         # only what the shot overrides becomes a shot-layer opinion: everything else stays with the
         # referenced body and lens files (and their variants), so switching a characterization in the
         # shot still switches the lens
@@ -219,22 +226,10 @@ def _file_units(p, prim_path):
     return mpu, clip_mm
 
 
-def _composed_spec(stage, path):
+def _read_spec(stage, path):
     from .read import read_camera
 
     return read_camera(stage, path).spec
-
-
-def _composed_prescription(stage, path):
-    """The prescription a composed camera's lens carries (its lens model, or a Prescription model
-    among its children, as in a vendor lens file shown through its pinhole), or None."""
-    from .read import read_prescription
-
-    prim = stage.GetPrimAtPath(path)
-    for child in prim.GetChildren():
-        if child.GetTypeName() == "PhysicalCameraLensModelPrescription":
-            return read_prescription(child)
-    return None
 
 
 def _author_shot_companion(stage, path) -> str:
@@ -247,10 +242,12 @@ def _author_shot_companion(stage, path) -> str:
     """
     from pxr import Sdf
 
-    from .author import spec_from_report
+    from .author import _eye_from_film, spec_from_report
+    from .read import read_camera
 
-    spec = _composed_spec(stage, path)
-    rx = _composed_prescription(stage, path)
+    spec = read_camera(stage, path).spec
+    rx = composed_prescription(stage, path)
+    cam = stage.GetPrimAtPath(path)
     report, distortion, opencv = None, None, None
     if rx is not None and spec.projection == "perspective":
         from ..onset.report import solve_lens_report
@@ -261,25 +258,23 @@ def _author_shot_companion(stage, path) -> str:
         report = solve_lens_report(focal_length_mm=None, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
                                    coc=spec.coc_mm, lens=rx)
         derived = spec_from_report(report)
-        cam = stage.GetPrimAtPath(path)
         _author_lens_derived(stage, cam, derived)
-        _move_film_behind_pupil(cam, derived.entrance_pupil_mm)
         spec = replace(spec, focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
                        principal_planes_mm=derived.principal_planes_mm,
                        pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
                        pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze)
         distortion = prescription_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm)
         opencv = prescription_opencv(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
+    # values derived from the composed lens, rewritten every time: the iris (f / N) and the film's
+    # place behind the pupil, so the pupil stays where the shot put it when the lens file changes
+    (cam.GetAttribute(f"lens:{LENS_INSTANCE}:iris") or cam.CreateAttribute(
+        f"lens:{LENS_INSTANCE}:iris", Sdf.ValueTypeNames.Float)).Set(spec.focal_length_mm / spec.fstop)
+    _move_film_behind_pupil(cam, _eye_from_film(spec, report))
     geom = author_render_camera(stage, Sdf.Path(path), spec, report=report, lens_distortion=distortion,
                                 opencv_distortion=opencv)
-    digest = _companion_inputs(stage, path)
+    digest = companion_inputs(stage, path)
     geom.GetPrim().SetCustomDataByKey("physcam:companionInputs", digest)
     return digest
-
-
-def _companion_inputs(stage, path) -> str:
-    """The hash of what the companion of ``path`` is computed from, as the stage composes now."""
-    return companion_inputs_hash(_composed_spec(stage, path), _composed_prescription(stage, path))
 
 
 def _move_film_behind_pupil(cam, pupil_mm: float) -> None:
@@ -310,21 +305,6 @@ def _author_lens_derived(stage, cam, spec) -> None:
             (cam.GetAttribute(name) or cam.CreateAttribute(name, F)).Set(float(v))
 
 
-def companion_inputs_hash(spec, prescription=None) -> str:
-    """SHA-256 of everything a companion camera is computed from: the composed camera's values
-    and, when the lens carries one, its prescription (hex digest)."""
-    import hashlib
-    import json
-    from dataclasses import asdict
-
-    doc = {"camera": asdict(spec)}
-    if prescription is not None:
-        doc["prescription"] = [asdict(s) for s in prescription.surfaces]
-        doc["focus"] = None if prescription.focus is None else asdict(prescription.focus)
-    text = json.dumps(doc, sort_keys=True, default=str)
-    return hashlib.sha256(text.encode()).hexdigest()
-
-
 def check_shot(file, path: str | None = None) -> dict:
     """Is a shot's companion camera current? Returns ``{"path", "stale", "stored", "current", "units"}``.
 
@@ -347,7 +327,7 @@ def check_shot(file, path: str | None = None) -> dict:
     geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
     if not geom:
         raise ExportError(f"{path}: has no companion camera to check")
-    current = _companion_inputs(stage, path)
+    current = companion_inputs(stage, path)
     stored = geom.GetCustomDataByKey("physcam:companionInputs")
     mpu = UsdGeom.GetStageMetersPerUnit(stage)
     units = []
@@ -358,7 +338,11 @@ def check_shot(file, path: str | None = None) -> dict:
         if lm is not None and float(lm) != mpu:
             units.append({"file": ref_layer.identifier, "meters_per_unit": float(lm)})
     return {"path": path, "stale": stored != current, "stored": stored, "current": current,
-            "meters_per_unit": mpu, "units": units}
+            "meters_per_unit": mpu, "units": units,
+            "reason": None if stored == current else (
+                "the companion carries no inputs hash (written by hand or by an older physcam)" if stored is None
+                else "the camera's composed values (its body, lens or shot opinions) changed since the companion "
+                     "was computed")}
 
 
 def refresh_shot(file, path: str | None = None) -> dict:
@@ -368,9 +352,10 @@ def refresh_shot(file, path: str | None = None) -> dict:
     from .read import find_cameras
 
     ensure_registered()
+    from .read import open_stage
+
+    open_stage(file)  # the same checks and messages as read and check
     layer = Sdf.Layer.FindOrOpen(str(file))
-    if layer is None:
-        raise ExportError(f"{file}: USD cannot open it")
     stage = Usd.Stage.Open(layer)
     stage.Reload()  # the shot and its referenced files as they are on disk now
     if path is None:
@@ -454,13 +439,17 @@ def write_previs_kit(file, setups: dict | None = None, *, default: str = "OverTh
     prim = stage.DefinePrim(path, "PhysicalCamera")
     stage.SetDefaultPrim(stage.GetPrimAtPath(prim.GetPath().GetPrefixes()[0]))
     vset = prim.GetVariantSets().AddVariantSet("setup")
+    from ..export.usdgeom import mm_to_scene_units
+
     for name, spec in setups.items():
         if not name.replace("_", "").isalnum():
             raise InputError(f"setup name {name!r} must be letters, digits and underscores")
         vset.AddVariant(name)
         vset.SetVariantSelection(name)
+        position, rotation = PREVIS_PLACEMENT.get(name, ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
         with vset.GetVariantEditContext():
-            author_camera(stage, path, spec)
+            author_camera(stage, path, spec, position=tuple(mm_to_scene_units(v, meters_per_unit) for v in position),
+                          rotate_xyz_deg=rotation)
     vset.SetVariantSelection(default)
     return save_stage(stage, file, force=force)
 

@@ -17,7 +17,8 @@ from ..errors import ExportError
 from .author import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec
 from .plugin import ensure_registered, require_prim, require_stage
 
-__all__ = ["CameraReading", "find_cameras", "open_stage", "read_camera", "read_prescription"]
+__all__ = ["CameraReading", "find_cameras", "open_stage", "read_camera", "read_prescription", "composed_prescription",
+           "companion_inputs", "companion_inputs_hash"]
 
 
 @dataclass(frozen=True)
@@ -59,10 +60,13 @@ def open_stage(file):
     p = Path(file)
     if not p.is_file():
         raise ExportError(f"{p}: no such USD file")
+    if p.suffix.lower() not in (".usda", ".usd", ".usdc", ".usdz"):
+        raise ExportError(f"{p}: not a USD file (a USD file name ends in .usda, .usd, .usdc or .usdz)")
     try:
         stage = Usd.Stage.Open(str(p))
     except Tf.ErrorException as exc:
-        raise ExportError(f"{p}: USD cannot open it: {str(exc).strip().splitlines()[-1]}") from None
+        last = " ".join(str(exc).strip().splitlines()[-1].split())
+        raise ExportError(f"{p}: USD cannot read it ({last[:160]})") from None
     if stage is None:
         raise ExportError(f"{p}: USD cannot open it")
     return stage
@@ -281,3 +285,34 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
         for name in vsets.GetNames():
             variants[name] = vsets.GetVariantSelection(name)
     return CameraReading(str(prim.GetPath()), spec, str(model.GetPath()), mtype, rx, variants)
+
+
+def composed_prescription(stage, path):
+    """The prescription a composed camera's lens carries (a PhysicalCameraLensModelPrescription
+    among its children, as in a vendor lens file shown through its pinhole), or None."""
+    prim = stage.GetPrimAtPath(path)
+    for child in prim.GetChildren():
+        if child.GetTypeName() == "PhysicalCameraLensModelPrescription":
+            return read_prescription(child)
+    return None
+
+
+def companion_inputs_hash(spec, prescription=None) -> str:
+    """SHA-256 (hex) of everything a companion camera is computed from: the composed camera's
+    values and, when the lens carries one, its prescription."""
+    import hashlib
+    import json
+    from dataclasses import asdict
+
+    doc = {"camera": asdict(spec)}
+    if prescription is not None:
+        doc["prescription"] = [asdict(s) for s in prescription.surfaces]
+        doc["focus"] = None if prescription.focus is None else asdict(prescription.focus)
+    text = json.dumps(doc, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def companion_inputs(stage, path) -> str:
+    """The hash of what the companion of the PhysicalCamera ``path`` is computed from, as the stage
+    composes now (read back, so float32 storage is what is hashed)."""
+    return companion_inputs_hash(read_camera(stage, path).spec, composed_prescription(stage, path))
