@@ -108,3 +108,16 @@ def test_ghosts_with_a_hair_thin_sensor_is_refused_before_allocating():
 def test_illumination_huge_grid_is_refused():
     rc, _, err = run_cli("illumination", "dgauss_50mm", "--grid", "100000")
     assert "grid" in one_line_error(rc, err)
+
+
+def test_ghost_image_sizes_are_bounded_in_the_api():
+    """Issue 8: the Python API bounds the ghost image before allocating, like the CLI."""
+    from physcam.analysis.ghosts import ghost_analysis
+    from physcam.errors import InputError, SensorError
+    from physcam.lens.library import load_lens
+
+    lens = load_lens("dgauss_50mm")
+    with pytest.raises(SensorError, match="between 0.5 and 1000"):
+        ghost_analysis(lens, 10.0, sensor_width_mm=0.001, sensor_height_mm=24.0)
+    with pytest.raises(InputError, match="pixels <= 4096"):
+        ghost_analysis(lens, 10.0, pixels=100_000, image_rays=1000)

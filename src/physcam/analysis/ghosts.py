@@ -264,9 +264,18 @@ def ghost_analysis(
     if coating is None:
         coating = lens.metadata.coating if lens.metadata.coating in ("none", "single", "multi") else "none"
     wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
-    w, h = require_positive("sensor width", sensor_width_mm), require_positive("sensor height", sensor_height_mm)
-    if rank_rays < 100 or image_rays < 0 or pixels < 8 or chunk < 1000:
-        raise InputError("ghosts need rank_rays >= 100, image_rays >= 0, pixels >= 8 and chunk >= 1000")
+    from ..onset.sensors import custom_sensor
+
+    sensor = custom_sensor(sensor_width_mm, sensor_height_mm)  # bounded size and aspect: the image stays small
+    w, h = sensor.width_mm, sensor.height_mm
+    for name, v in (("rank_rays", rank_rays), ("image_rays", image_rays), ("image_paths", image_paths),
+                    ("pixels", pixels), ("chunk", chunk)):
+        if isinstance(v, bool) or not isinstance(v, int):
+            raise InputError(f"{name} must be a whole number, got {v!r}")
+    if not (100 <= rank_rays <= 10**7 and 0 <= image_rays <= 10**10 and 1 <= image_paths <= 1000
+            and 8 <= pixels <= 4096 and 1000 <= chunk <= 10**7):
+        raise InputError("ghosts need 100 <= rank_rays <= 1e7, 0 <= image_rays <= 1e10, 1 <= image_paths <= 1000, "
+                         "8 <= pixels <= 4096 and 1000 <= chunk <= 1e7")
     if film_z is None:
         film_z = paraxial_image_z(lens, wl)
     film_z = require_finite("film_z", film_z)

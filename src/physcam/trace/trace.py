@@ -25,6 +25,12 @@ __all__ = ["DEFAULT_CHUNK", "trace_to_film", "trace_through", "trace_path", "par
 DEFAULT_CHUNK = 1 << 18
 
 
+def _check_rays(rays) -> RayBatch:
+    from ..errors import require_type
+
+    return require_type("rays", rays, RayBatch, "build them with physcam.trace.RayBatch.from_arrays")
+
+
 def _check_lens(lens) -> Prescription:
     if not isinstance(lens, Prescription):
         raise InputError(f"expected a physcam Prescription, got {type(lens).__name__}")
@@ -77,6 +83,7 @@ def trace_through(
     Returns the rays after the last surface (or on the end plane) with flags and weights.
     """
     _check_lens(lens)
+    _check_rays(rays)
     if chunk_size < 1:
         raise InputError(f"chunk_size must be >= 1, got {chunk_size}")
     if end_z is not None:
@@ -119,6 +126,7 @@ def trace_path(
     handful of rays (diagrams), not for throughput: the kernel runs once per surface.
     """
     _check_lens(lens)
+    _check_rays(rays)
     table = surface_table(lens, stop_semi_diameter=stop_semi_diameter)
     S, kinds = pack(table)
     kernel = get_kernel(backend)

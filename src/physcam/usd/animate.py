@@ -79,7 +79,13 @@ def read_focus_marks(path) -> list[FocusKey]:
 
 
 def _check_keys(keys) -> list[FocusKey]:
+    from ..errors import WrongTypeError
+
+    if isinstance(keys, (str, bytes)) or not hasattr(keys, "__iter__"):
+        raise WrongTypeError("keys must be a list of FocusKey (physcam.usd.animate.read_focus_marks)")
     keys = list(keys)
+    if not all(isinstance(k, FocusKey) for k in keys):
+        raise WrongTypeError("keys must be a list of FocusKey (physcam.usd.animate.read_focus_marks)")
     if not keys:
         raise InputError("give at least one focus mark")
     if len(keys) > MAX_FRAMES:

@@ -667,6 +667,8 @@ def author_render_settings(stage, camera_path, spec: CameraSpec, *, resolution=N
     """
     from pxr import Gf, Sdf, UsdRender
 
+    require_stage(stage)
+    spec = require_type("spec", spec, CameraSpec, "build one with CameraSpec(...)")
     o = require_finite("overscan", overscan)
     if not 0.0 <= o <= 1.0:
         raise InputError(f"overscan must lie between 0 and 1 (a fraction of the frame), got {o:g}")

@@ -290,7 +290,8 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
 def composed_prescription(stage, path):
     """The prescription a composed camera's lens carries (a PhysicalCameraLensModelPrescription
     among its children, as in a vendor lens file shown through its pinhole), or None."""
-    prim = stage.GetPrimAtPath(path)
+    require_stage(stage)
+    prim = stage.GetPrimAtPath(str(path))
     for child in prim.GetChildren():
         if child.GetTypeName() == "PhysicalCameraLensModelPrescription":
             return read_prescription(child)
