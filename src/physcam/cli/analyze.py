@@ -20,8 +20,10 @@ def _common(p, plot_help: str) -> None:
 
 def _sensor(p) -> None:
     p.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (default full frame 36x24)')
-    p.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="MM")
-    p.add_argument("--sensor-height", type=distance("sensor height"), default=None, metavar="MM")
+    p.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="MM",
+                   help="sensor width with --sensor-height (instead of --sensor)")
+    p.add_argument("--sensor-height", type=distance("sensor height"), default=None, metavar="MM",
+                   help="sensor height with --sensor-width")
 
 
 def _resolve_sensor(args) -> None:
@@ -51,13 +53,16 @@ def register(sub) -> None:
     p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG",
                    help="field angle in degrees (repeat; default: up to the sensor corner)")
     _sensor(p)
-    p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM")
+    p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM",
+                   help="wavelength in nm (default: the lens's design wavelength, the d line 587.56)")
     p.set_defaults(handler=run_distortion)
 
     p = sub.add_parser("illumination", help="relative illumination against field (vignetting, cos^4 from real rays)")
     _common(p, "write the relative illumination plot")
-    p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG")
-    p.add_argument("--max-field", type=number("max field"), default=None, metavar="DEG")
+    p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG",
+                   help="field angle in degrees (repeat; default: from the axis to the sensor corner)")
+    p.add_argument("--max-field", type=number("max field"), default=None, metavar="DEG",
+                   help="widest field angle in degrees (default: the sensor corner)")
     p.add_argument("--fstop", type=number("f-stop"), default=None, help="stop the lens down to this f-number")
     p.add_argument("--grid", type=int, default=200, help="rays per side of the sampling grid (16-2000, default 200)")
     p.add_argument("--fresnel", action="store_true", help="include Fresnel losses at every surface")
@@ -66,8 +71,10 @@ def register(sub) -> None:
 
     p = sub.add_parser("colour", aliases=["color"], help="longitudinal and lateral colour (F, d, C and more)")
     _common(p, "write the chromatic aberration plot")
-    p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG")
-    p.add_argument("--max-field", type=number("max field"), default=None, metavar="DEG")
+    p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG",
+                   help="field angle in degrees (repeat; default: from the axis to the sensor corner)")
+    p.add_argument("--max-field", type=number("max field"), default=None, metavar="DEG",
+                   help="widest field angle in degrees (default: the sensor corner)")
     p.add_argument("--wavelength", type=number("wavelength"), action="append", metavar="NM",
                    help="extra wavelength to report (repeat); F and C are always included")
     _sensor(p)
@@ -77,7 +84,8 @@ def register(sub) -> None:
     _common(p, "write the breathing plot")
     p.add_argument("--focus", type=distance("focus distance", allow_inf=True), action="append", metavar="DIST",
                    help="focus mark from the film (repeat; units ok: 2m, 6ft, inf)")
-    p.add_argument("--method", choices=("auto", "unit", "internal"), default="auto")
+    p.add_argument("--method", choices=("auto", "unit", "internal"), default="auto",
+                   help="focusing: unit (whole lens moves) or internal (focus groups); auto: internal when the lens has groups")
     _sensor(p)
     p.set_defaults(handler=run_breathing)
 
@@ -89,7 +97,7 @@ def register(sub) -> None:
                    help="coating model (default: the lens file's, else none)")
     p.add_argument("--rays", type=int, default=200_000, help="rays per ghost path for the image")
     p.add_argument("--top", type=int, default=10, help="how many ranked paths to print")
-    p.add_argument("--pixels", type=int, default=256)
+    p.add_argument("--pixels", type=int, default=256, help="ghost image width in pixels (8 to 4096; default 256)")
     _sensor(p)
     p.set_defaults(handler=run_ghosts)
 

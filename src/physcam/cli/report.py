@@ -13,7 +13,7 @@ examples:
   physcam report --focal 50 --fstop 2.8 --focus 3m --sensor "ALEXA 35"
   physcam report --focal 35 --focus 10ft --near 8ft --coc 0.025 --tstop 2.8   (solve f-stop)
   physcam report --focal 50 --near 2.5m --far 4m --fstop 4 --sensor S35         (solve focus)
-  physcam report --model technical --focal 50 --fstop 2 --focus 2m --h1 80 --h2 60 --pupil 95
+  physcam report --model technical --focal 50 --fstop 2 --focus 2m --h1 62 --h2 51.3 --pupil 92
   physcam report --lens dgauss.50mm --fstop 2.8 --focus 2m                     (planes from the lens)
 """
 

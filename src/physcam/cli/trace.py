@@ -10,7 +10,8 @@ def register(sub) -> None:
     p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
     p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG",
                    help="field angle in degrees (repeat; default 0 and 5)")
-    p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM")
+    p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM",
+                   help="wavelength in nm (default: the lens's design wavelength, the d line 587.56)")
     p.add_argument("--rings", type=int, default=64,
                    help="divisions of the pupil radius squared (1-500; about 3 n^2 equal-area rays per field, "
                         "plus the refined beam edge; default 64)")
@@ -28,8 +29,8 @@ def register(sub) -> None:
                    help="light distance in front of the film plane (units ok: 2m, 6ft; bare number = mm)")
     b.add_argument("--x", type=number("light x"), default=0.0, metavar="MM", help="light lateral x (mm)")
     b.add_argument("--y", type=number("light y"), default=0.0, metavar="MM", help="light lateral y (mm)")
-    b.add_argument("--rays", type=int, default=1_000_000)
-    b.add_argument("--pixels", type=int, default=256)
+    b.add_argument("--rays", type=int, default=1_000_000, help="rays to trace (1 to 1e11; default 1e6)")
+    b.add_argument("--pixels", type=int, default=256, help="image width and height in pixels (8 to 4096; default 256)")
     b.add_argument("--spectral", action="store_true", help="three wavelengths (620/550/460 nm) as RGB")
     b.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=None,
                    help="focus mark from the film plane (default infinity); the lens is focused there")

@@ -47,7 +47,7 @@ def register(sub) -> None:
     w.set_defaults(handler=run_write)
 
     r = s.add_parser("read", help="read a PhysicalCamera back into a lens report")
-    r.add_argument("file")
+    r.add_argument("file", help="a USD file (.usda, .usd, .usdc)")
     r.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
     r.add_argument("--json", action="store_true", help="print JSON")
     r.set_defaults(handler=run_read)
@@ -55,8 +55,8 @@ def register(sub) -> None:
     k = s.add_parser("kit", help="the proposal's use cases: previs kit, vendor lens, lens library, body, shot",
                      description="Write the files of the proposal's use cases (docs/usd.md).",
                      epilog=KIT_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    k.add_argument("kind", choices=("previs", "vendor", "lens", "body", "shot"))
-    k.add_argument("file")
+    k.add_argument("kind", choices=("previs", "vendor", "lens", "body", "shot"), help="which use case to write")
+    k.add_argument("file", help="output .usda/.usd/.usdc")
     k.add_argument("--lens", help="vendor: bundled lens name or prescription file; shot: the lens file to reference")
     k.add_argument("--body", help="shot: the body file to reference")
     k.add_argument("--characterizations", metavar="CSV",
@@ -87,24 +87,27 @@ def register(sub) -> None:
                             "--sensor \"ALEXA 35\" --fstop 2.8\n"
                             "pull.csv has columns frame,focus[,fstop]; focus with units (5m, 16ft; bare = mm).",
                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    a.add_argument("file")
+    a.add_argument("file", help="output .usda/.usd/.usdc")
     a.add_argument("--marks", required=True, metavar="CSV", help="focus marks per frame: frame,focus[,fstop]")
     a.add_argument("--lens", help="bundled lens name or prescription file (breathing from the real lens)")
     a.add_argument("--focal", type=distance("focal length"), help="or a thin lens of this focal length")
     a.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop for frames without one")
     a.add_argument("--coc", default=None, help="circle of confusion convention or value in mm")
     a.add_argument("--sensor", help="sensor name (default Super 35)")
-    a.add_argument("--sensor-width", type=distance("sensor width"))
-    a.add_argument("--sensor-height", type=distance("sensor height"))
-    a.add_argument("--shutter-angle", type=number("shutter angle", positive=True), default=180.0)
+    a.add_argument("--sensor-width", type=distance("sensor width"), help="sensor width, with --sensor-height")
+    a.add_argument("--sensor-height", type=distance("sensor height"), help="sensor height, with --sensor-width")
+    a.add_argument("--shutter-angle", type=number("shutter angle", positive=True), default=180.0,
+                   help="degrees (default 180)")
     a.add_argument("--path", default="/Cameras/Camera", help="camera prim path")
-    a.add_argument("--position", type=numbers("position", 3), default=(0.0, 0.0, 0.0), metavar="X,Y,Z")
-    a.add_argument("--rotate", type=numbers("rotation", 3), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ")
+    a.add_argument("--position", type=numbers("position", 3), default=(0.0, 0.0, 0.0), metavar="X,Y,Z",
+                   help="where the first frame's entrance pupil goes, in scene units (the film stays there)")
+    a.add_argument("--rotate", type=numbers("rotation", 3), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ",
+                   help="pan/tilt/roll about the entrance pupil, degrees (XYZ order)")
     _stage_args(a)
     a.set_defaults(handler=run_animate)
 
     c = s.add_parser("check", help="is a shot's companion camera current with its body and lens files?")
-    c.add_argument("file")
+    c.add_argument("file", help="a shot (or any camera file physcam wrote)")
     c.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
     c.add_argument("--json", action="store_true", help="print JSON")
     c.add_argument("--exit-code", action="store_true",
@@ -112,7 +115,7 @@ def register(sub) -> None:
     c.set_defaults(handler=run_check)
 
     f = s.add_parser("refresh", help="recompute a shot's companion camera from its body and lens files (in place)")
-    f.add_argument("file")
+    f.add_argument("file", help="a shot (or any camera file physcam wrote), rewritten in place")
     f.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
     f.add_argument("--json", action="store_true", help="print JSON")
     f.set_defaults(handler=run_refresh)
