@@ -6,8 +6,14 @@ PYTHON ?= python3
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.physcam-installed
+# Blender as a Python module (bpy) pins numpy < 2, while the test tools (OpenCV) need numpy 2:
+# Blender gets its own environment, with physcam installed in it; tests drive it in subprocesses.
+BLENDER_VENV  ?= .venv-blender
+BLENDER_PY    := $(BLENDER_VENV)/bin/python
+BLENDER_STAMP := $(BLENDER_VENV)/.physcam-installed
+BPY_VERSION   ?= 5.0.1
 
-.PHONY: demo test venv bench clean schema
+.PHONY: demo test venv blender bench clean schema
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -22,8 +28,17 @@ venv: $(STAMP)
 demo: $(STAMP)
 	$(VENV)/bin/physcam demo --out demo-output --force
 
-test: $(STAMP)
-	$(PY) -m pytest -n 2 -q
+$(BLENDER_STAMP): pyproject.toml
+	$(PYTHON) -m venv $(BLENDER_VENV)
+	$(BLENDER_PY) -m pip install --quiet --upgrade pip
+	$(BLENDER_PY) -m pip install --quiet "bpy==$(BPY_VERSION)"
+	$(BLENDER_PY) -m pip install --quiet -e .
+	touch $(BLENDER_STAMP)
+
+blender: $(BLENDER_STAMP)
+
+test: $(STAMP) $(BLENDER_STAMP)
+	PHYSCAM_BLENDER_PYTHON=$(abspath $(BLENDER_PY)) $(PY) -m pytest -n 2 -q
 
 bench: $(STAMP)
 	$(PY) benchmarks/startup.py
@@ -35,4 +50,4 @@ schema: $(STAMP)
 	$(PY) scripts/gen_usd_schema.py
 
 clean:
-	rm -rf $(VENV) demo-output build *.egg-info src/*.egg-info
+	rm -rf $(VENV) $(BLENDER_VENV) demo-output build *.egg-info src/*.egg-info
