@@ -66,6 +66,12 @@ def written(tmp_path_factory):
         write_previs_kit(d / "kit.usda"),
         write_vendor_lens(d / "vendor.usda", load_lens("dgauss_50mm"), focus_mm=1500.0, fstop=4.0),
     ]
+    from physcam.onset.sensors import find_sensor
+    from physcam.usd.animate import FocusKey, write_animated_camera
+
+    files.append(write_animated_camera(d / "pull.usda", [FocusKey(1, 5000.0), FocusKey(2, 3000.0), FocusKey(3, 1000.0)],
+                                       sensor=find_sensor("FF"), lens=load_lens("dgauss_50mm"), fstop=2.8,
+                                       position=(10.0, 160.0, 300.0), rotate_xyz_deg=(0.0, -20.0, 0.0)))
     body = write_body_file(d / "body.usda", CameraSpec(sensor_width_mm=27.99, sensor_height_mm=19.22))
     lens = write_lens_file(d / "lens.usda", {"2026-03-01": CameraSpec(focal_length_mm=24.0, entrance_pupil_mm=80.0)})
     files += [body, lens, write_shot(d / "shot.usda", body, lens, position=(300.0, 170.0, 500.0),
@@ -89,7 +95,7 @@ def test_camera_placement_is_the_same_without_the_plugin(written):
             assert b[path]["hfov"] == pytest.approx(a[path]["hfov"], rel=1e-9)
         # without the plugin the PhysicalCamera prims take their fallback type, one plain USD knows
         assert "PhysicalCamera" not in without[f]["types"].values() or not a, f
-    assert n >= 6  # camera, orthographic, crate, kit, two shots (body, lens and vendor files hold no camera)
+    assert n >= 7  # camera, orthographic, crate, kit, focus pull, two shots (body, lens, vendor files hold none)
 
 
 def test_placed_camera_is_not_at_the_origin_without_the_plugin(written):
