@@ -319,9 +319,9 @@ def solve_lens_report(
     notes: list[str] = []
     pupil_origin = "datasheet"
     lens_pinhole = None  # (Y, X) best-match pinhole focal lengths from a prescription
-    if not isinstance(sensor, Sensor):
-        raise InputError(f"sensor must be a physcam Sensor (physcam.onset.sensors.find_sensor), got "
-                         f"{type(sensor).__name__}")
+    from ..errors import require_type
+
+    require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name) or custom_sensor(w, h)")
     if sensor_front_mm is not None and lens_length_mm is None:
         raise InputError("the tape-measured sensor-to-lens-front distance needs the lens length too "
                          "(--lens-length): the pupil estimate sits a fraction of the lens length behind its front")
@@ -330,9 +330,7 @@ def solve_lens_report(
     if lens is not None:
         from ..lens.prescription import Prescription
 
-        if not isinstance(lens, Prescription):
-            raise InputError(f"lens must be a physcam Prescription (physcam.lens.library.load_lens), got "
-                             f"{type(lens).__name__}")
+        require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name or file)")
         given = [n for n, v in (("H1", h1_mm), ("H2", h2_mm), ("entrance pupil", pupil_mm),
                                 ("sensor-to-lens-front distance", sensor_front_mm)) if v is not None]
         if given:
