@@ -136,7 +136,8 @@ def scale_apertures(p: Prescription, factor: float) -> tuple[Prescription, Repai
     q = p.with_surfaces(replace(s, semi_diameter=s.semi_diameter * factor) for s in p.surfaces)
     n_max = stated_f_number(p)[0]
     what = "halved" if factor == 0.5 else f"scaled by {factor:g}"
-    msg = (f"all 'aperture' values {what}: the file's values are {1 / factor:g} times the clear diameters "
+    times = "twice" if factor == 0.5 else f"{1 / factor:g} times"
+    msg = (f"all 'aperture' values {what}: the file's values are {times} the clear diameters "
            f"(with them the paraxial f-number is f/{before:.2f} against the engraved f/{n_max:g}, and some "
            f"semi-diameters exceed their surface radius); {what}, f/{paraxial_f_number(q):.2f}")
     return q, Repair("scale_apertures", tuple(range(len(p.surfaces))), msg,
