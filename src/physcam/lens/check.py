@@ -442,8 +442,9 @@ def check(lens, *, format: str | None = None, probes: Iterable[Callable[[Prescri
         except (ArithmeticError, ValueError, LensFileError) as exc:
             c.add("note", "not_evaluated", f"check {fn.__name__.strip('_')} could not be evaluated ({exc})")
     if probes:
-        target = p
+        target, note = p, ""
         if any(f.severity == "error" for f in c.out):
+            note = " (traced on the lens as `physcam lens fix` repairs it)"
             from .repair import propose
 
             try:
@@ -455,8 +456,9 @@ def check(lens, *, format: str | None = None, probes: Iterable[Callable[[Prescri
             for probe in probes:
                 try:
                     for f in probe(target):
-                        c.out.append(f if raw is None else Finding(f.severity, f.code, f.message, f.implication,
-                                                                   f.surface, raw.line(f.surface), raw.path, f.values))
+                        c.out.append(Finding(f.severity, f.code, f.message + note, f.implication,
+                                             f.surface, raw.line(f.surface) if raw else None,
+                                             raw.path if raw else None, f.values))
                 except (PhysCamError, ArithmeticError, ValueError) as exc:
                     c.add("note", "not_evaluated", f"ray check could not be evaluated ({str(exc).splitlines()[0]})")
     order = {s: i for i, s in enumerate(SEVERITIES)}
