@@ -265,6 +265,10 @@ def run_breathing(args) -> int:
         s = find_sensor(args.sensor)
         width, sensor_name = s.width_mm, s.name
     elif args.sensor_width is not None:
+        if not args.sensor_width >= 0.1:
+            from ..errors import InputError
+
+            raise InputError(f"sensor width must be at least 0.1 mm, got {args.sensor_width:g} mm")
         width, sensor_name = args.sensor_width, f"{args.sensor_width:g} mm wide"
     rows = focusing.breathing_table(p, args.at, sensor_width_mm=width, method=args.focus_method,
                                     wavelength_nm=args.wavelength)

@@ -67,6 +67,7 @@ def _trace_y(surfaces, y, u, upto):
     return y, u
 
 
+@takes_prescription
 def paraxial_efl(p: Prescription) -> float:
     """Effective focal length (mm) in the Y meridian at nd; inf for an afocal lens."""
     y, u, n = 1.0, 0.0, 1.0
@@ -87,6 +88,7 @@ def _stop(p: Prescription) -> int:
     return stops[0]
 
 
+@takes_prescription
 def paraxial_f_number(p: Prescription) -> float:
     """Paraxial f/# = EFL / entrance-pupil diameter with the file's stop (infinity focus, Y meridian, nd)."""
     s = p.surfaces
@@ -102,6 +104,7 @@ _MM = re.compile(r"(\d+(?:\.\d+)?)\s*mm", re.I)
 _FNUM = re.compile(r"\bf\s*/\s*(\d+(?:\.\d+)?)|\bf(\d+(?:[._]\d+)?)\b", re.I)
 
 
+@takes_prescription
 def stated_focal_length(p: Prescription) -> tuple[float | None, str]:
     """The focal length the file states: ``[lens] focal_length`` or a number before "mm" in the name."""
     if p.metadata.focal_length:
@@ -110,6 +113,7 @@ def stated_focal_length(p: Prescription) -> tuple[float | None, str]:
     return (float(m[0]), f"the name {p.name!r}") if m else (None, "")
 
 
+@takes_prescription
 def stated_f_number(p: Prescription) -> tuple[float | None, str]:
     """The f-number the file states: ``[lens] max_fstop`` or "f/2.8" in the name."""
     if p.metadata.max_fstop:
@@ -211,6 +215,10 @@ def stop_from_fnumber(p: Prescription, n_max: float | None = None) -> tuple[Pres
 def crossing(a: Surface, b: Surface, h: float, clearance: float = 0.0) -> float:
     """How far (mm) surface ``b`` (the next one) lies in front of ``a`` at height ``h``, plus
     ``clearance``; > 0 means they cross there."""
+    from ..errors import require_type
+
+    require_type("a", a, Surface, "a physcam.lens.prescription.Surface")
+    require_type("b", b, Surface, "a physcam.lens.prescription.Surface")
     return max(sag(a, h, ax) - (a.thickness + sag(b, h, ax)) for ax in "xy") + clearance
 
 
@@ -238,6 +246,9 @@ def clip_pair(p: Prescription, i: int, clearance: float = CLEARANCE_MM) -> tuple
 
 def edge_height(s: Surface) -> float:
     """The largest height a sphere or conic reaches (inf for flat, paraboloid, hyperboloid)."""
+    from ..errors import require_type
+
+    require_type("s", s, Surface, "a physcam.lens.prescription.Surface")
     c = s.curvature
     if c == 0.0:
         return math.inf
@@ -270,6 +281,7 @@ def _crossing_pairs(p: Prescription) -> list[int]:
     return out
 
 
+@takes_prescription
 def aperture_factor(p: Prescription) -> float | None:
     """The factor stated f-number / paraxial f-number when it is 2 within 12 % (apertures written
     as diameters where semi-diameters were meant), else None."""
@@ -284,6 +296,7 @@ def aperture_factor(p: Prescription) -> float | None:
     return r if abs(r / 2.0 - 1.0) < 0.12 else None
 
 
+@takes_prescription
 def stop_is_entrance_pupil(p: Prescription, tolerance: float = 0.02) -> bool:
     """True when the stop diameter equals EFL/N (stated) within ``tolerance`` and the paraxial
     f-number misses the stated one by more than ``tolerance``: the file gave the entrance pupil."""
@@ -348,9 +361,15 @@ def propose(p: Prescription) -> tuple[Prescription, list[Repair]]:
     return q, repairs
 
 
+@takes_prescription
 def with_corrections(p: Prescription, repairs: list[Repair], key: str = "provenance.corrections") -> Prescription:
     """``p`` with the repairs' messages appended to ``[provenance] corrections`` (and their numbers
     to ``[provenance] repairs``)."""
+    from ..errors import WrongTypeError
+
+    if not isinstance(repairs, (list, tuple)) or not all(isinstance(r, Repair) for r in repairs):
+        raise WrongTypeError(f"repairs must be a list of physcam.lens.repair.Repair (from propose), got "
+                             f"{type(repairs).__name__}")
     if not repairs:
         return p
     extras = dict(p.extras)
