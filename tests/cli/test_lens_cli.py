@@ -125,3 +125,48 @@ def test_breathing_table_json_and_plot(capsys, tmp_path):
     assert plot.read_bytes()[:4] == b"\x89PNG"
     rc, out, _ = run(capsys, "lens", "breathing", "canon_rf_85mm_f1_2")
     assert rc == 0 and "breathing" in out
+
+
+# ---- issue 11: lens check, lens fix, --lenient ------------------------------------------------
+from pathlib import Path as _Path
+
+_TOML = _Path(__file__).resolve().parents[1] / "data" / "reference_lenses" / "physical-camera-toml"
+
+
+def test_lens_check_json_names_line_and_numbers(capsys):
+    rc, out, _ = run(capsys, "lens", "check", str(_TOML / "tessar_50mm_f2_8.toml"), "--json")
+    assert rc == 0
+    d = json.loads(out)
+    sag = next(f for f in d["findings"] if f["code"] == "stop_in_sag")
+    assert (sag["surface"], sag["line"], sag["severity"]) == (4, 36, "error")  # the stop row of the file
+    assert d["counts"]["error"] >= 1
+
+
+def test_lens_fix_apply_writes_the_library_copy(tmp_path, capsys):
+    from physcam.lens.formats import read_lens
+    from physcam.lens.library import load_lens
+    from physcam.optics.paraxial import gaussian
+
+    out_file = tmp_path / "cooke.toml"
+    rc, out, _ = run(capsys, "lens", "fix", str(_TOML / "cooke_triplet_50mm_f4_5.toml"), "-o", str(out_file))
+    assert rc == 0 and "dry run" in out and not out_file.exists()
+    rc, out, _ = run(capsys, "lens", "fix", str(_TOML / "cooke_triplet_50mm_f4_5.toml"), "-o", str(out_file), "--apply")
+    assert rc == 0 and "surface 2 (line 22): clear diameter 11.1 -> 9.058 mm" in out
+    fixed, lib = read_lens(out_file), load_lens("cooke_triplet_50mm_f4_5")
+    assert gaussian(fixed).efl == pytest.approx(gaussian(lib).efl, rel=1e-9)
+    assert gaussian(fixed).f_number == pytest.approx(gaussian(lib).f_number, rel=1e-9)
+    rc, _, err = run(capsys, "lens", "fix", str(_TOML / "cooke_triplet_50mm_f4_5.toml"), "-o", str(out_file), "--apply")
+    assert rc == 2 and err.count("\n") == 1  # no clobber without --force
+
+
+def test_refusal_names_the_way_forward_and_lenient_loads(capsys):
+    f = str(_TOML / "nikkor_fisheye_16mm_f2_8.toml")
+    rc, _, err = run(capsys, "lens", "show", f)
+    assert rc == 2 and "--lenient" in err and "physcam lens fix" in err and err.count("\n") == 1
+    rc, out, err = run(capsys, "lens", "show", f, "--lenient", "--json")
+    assert rc == 0
+    assert err.count("physcam: warning:") == 2  # halved apertures, clipped surfaces 1-2 (docs/lens-formats.md)
+    d = json.loads(out)
+    assert d["lens_repaired"] is True and len(d["lens_repairs"]) == 2
+    rc, out, err = run(capsys, "spot", f, "--lenient", "--json")
+    assert rc == 0 and err.count("physcam: warning:") == 2 and json.loads(out)["lens_repaired"] is True

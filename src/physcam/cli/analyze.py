@@ -9,10 +9,12 @@ from __future__ import annotations
 import math
 
 from ._common import distance, number, print_json
+from .lens import add_lenient, mark_repaired
 
 
 def _common(p, plot_help: str) -> None:
     p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    add_lenient(p)
     p.add_argument("--json", action="store_true", help="print as JSON")
     p.add_argument("-o", "--output", metavar="FILE.png", help=plot_help)
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
@@ -109,14 +111,15 @@ def _prepare(args):
     if args.output:
         check_writable(args.output, force=args.force)
     _resolve_sensor(args)
-    return load_lens(args.lens)
+    args.loaded_lens = load_lens(args.lens, lenient=args.lenient)
+    return args.loaded_lens
 
 
 def _finish(args, res) -> None:
     if args.output:
         res.plot(args.output, force=args.force)
     if args.json:
-        print_json(res.to_dict())
+        print_json(mark_repaired(res.to_dict(), args.loaded_lens))
     elif args.output:
         print(f"wrote {args.output}")
 

@@ -7,6 +7,8 @@ Examples::
   physcam lens show my_lens.zmx --json
   physcam lens diagram navarro_anamorphic_2x --axis x -o navarro_x.svg
   physcam lens breathing canon_rf_85mm_f1_2 --sensor "Super 35" -o breathing.png
+  physcam lens check my_lens.toml --sensor "Super 35"
+  physcam lens fix my_lens.toml -o my_lens_fixed.toml --apply
 
 Distances in the output are millimetres. ``show`` gives every cardinal point from
 the front vertex and rear vertex (signed, + toward the film) and from the film
@@ -15,6 +17,7 @@ plane and flange (distance in front, + toward the subject); see docs/conventions
 
 from __future__ import annotations
 
+from ..errors import PhysCamError
 from ._common import distance, number
 
 
@@ -39,6 +42,7 @@ def register(sub) -> None:
                        help="wavelength in nm (default: the lens's design wavelength, d line 587.56)")
         q.add_argument("--focus-method", choices=("auto", "unit", "internal"), default="auto",
                        help="unit (whole lens moves) or internal (focus groups); auto: internal when the lens has groups")
+        add_lenient(q)
 
     s = lsub.add_parser("show", help="print the Gaussian (paraxial) data of a lens")
     common(s)
@@ -69,6 +73,49 @@ def register(sub) -> None:
     b.add_argument("--force", action="store_true", help="overwrite an existing plot")
     b.add_argument("--json", action="store_true", help="print as JSON")
     b.set_defaults(handler=run_breathing)
+
+    c = lsub.add_parser("check", help="report what is inconsistent in a lens file (surface, file line, numbers)")
+    c.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name or a lens file (read without validation)")
+    c.add_argument("--sensor", default=None,
+                   help="also trace the on-axis beam, vignetting and image circle at this sensor's corner "
+                        "(see `physcam sensors`)")
+    c.add_argument("--json", action="store_true", help="print the findings as JSON")
+    c.set_defaults(handler=run_check)
+
+    f = lsub.add_parser("fix", help="propose (and with --apply write) the repairs of a lens file, with a diff")
+    f.add_argument("lens", metavar="FILE", help="lens file to repair (any supported format)")
+    f.add_argument("-o", "--output", required=True, metavar="FIXED",
+                   help="where to write the repaired lens (.toml: physcam's format; .dat, .json, .zmx also work)")
+    f.add_argument("--apply", action="store_true", help="write the repaired file (without it: only show the repairs)")
+    f.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    f.add_argument("--json", action="store_true", help="print the repairs as JSON")
+    f.set_defaults(handler=run_fix)
+
+
+def add_lenient(parser) -> None:
+    """The --lenient flag of every command that takes a lens."""
+    parser.add_argument("--lenient", action="store_true",
+                        help="load a lens file that is not buildable as written with its impossible parts repaired as "
+                             "`physcam lens fix` would (one warning line per repair; results marked as repaired)")
+
+
+def load_lens_arg(name, lenient: bool = False):
+    """The lens a command was given, loaded strictly or (``lenient``) repaired on load."""
+    from ..lens.library import load_lens
+
+    return load_lens(name, lenient=lenient)
+
+
+def mark_repaired(d, lens):
+    """JSON output ``d`` with ``lens_repaired`` and ``lens_repairs`` when ``lens`` was repaired on load."""
+    from ..lens.library import repairs_of
+
+    reps = repairs_of(lens)
+    if reps and isinstance(d, dict):
+        d = dict(d)
+        d["lens_repaired"] = True
+        d["lens_repairs"] = reps
+    return d
 
 
 def _fmt(v, nd=3):
@@ -127,10 +174,8 @@ def run_lenses(args) -> int:
     return 0
 
 
-def _load(name):
-    from ..lens.library import load_lens
-
-    return load_lens(name)
+def _load(args):
+    return load_lens_arg(args.lens, getattr(args, "lenient", False))
 
 
 def _meridians(p):
@@ -141,7 +186,7 @@ def run_show(args) -> int:
     from ..optics import focusing, paraxial
     from ._common import console, print_json
 
-    p = _load(args.lens)
+    p = _load(args)
     st = focusing.focus(p, args.focus, method=args.focus_method, wavelength_nm=args.wavelength)
     data = {
         a: paraxial.gaussian(st.prescription, axis=a, wavelength_nm=args.wavelength, fstop=args.fstop,
@@ -159,8 +204,8 @@ def run_show(args) -> int:
         "focused_meridian": st.axis,
     }
     if args.json:
-        print_json({"lens": p.name, "squeeze": p.squeeze, "focus": focus_info,
-                    "meridians": {a: g.to_dict() for a, g in data.items()}})
+        print_json(mark_repaired({"lens": p.name, "squeeze": p.squeeze, "focus": focus_info,
+                                  "meridians": {a: g.to_dict() for a, g in data.items()}}, p))
         return 0
     from rich.table import Table
 
@@ -201,7 +246,7 @@ def run_show(args) -> int:
 def run_diagram(args) -> int:
     from ..analysis.diagram import save_lens_diagram
 
-    p = _load(args.lens)
+    p = _load(args)
     path = save_lens_diagram(p, args.output, force=args.force, axis=args.axis, focus_from_film_mm=args.focus,
                              fstop=args.fstop, field_deg=args.field, wavelength_nm=args.wavelength)
     print(f"wrote {path}")
@@ -212,7 +257,7 @@ def run_breathing(args) -> int:
     from ..optics import focusing
     from ._common import console, print_json
 
-    p = _load(args.lens)
+    p = _load(args)
     width, sensor_name = 36.0, "36 mm wide"
     if args.sensor:
         from ..onset.sensors import find_sensor
@@ -220,6 +265,10 @@ def run_breathing(args) -> int:
         s = find_sensor(args.sensor)
         width, sensor_name = s.width_mm, s.name
     elif args.sensor_width is not None:
+        if not args.sensor_width >= 0.1:
+            from ..errors import InputError
+
+            raise InputError(f"sensor width must be at least 0.1 mm, got {args.sensor_width:g} mm")
         width, sensor_name = args.sensor_width, f"{args.sensor_width:g} mm wide"
     rows = focusing.breathing_table(p, args.at, sensor_width_mm=width, method=args.focus_method,
                                     wavelength_nm=args.wavelength)
@@ -230,8 +279,8 @@ def run_breathing(args) -> int:
         path = save_breathing_plot(rows, args.output, force=args.force, title=f"{p.name}: focus breathing",
                                    sensor_width_mm=width)
     if args.json:
-        print_json({"lens": p.name, "sensor_width_mm": width, "rows": [r.to_dict() for r in rows],
-                    "plot": None if path is None else str(path)})
+        print_json(mark_repaired({"lens": p.name, "sensor_width_mm": width, "rows": [r.to_dict() for r in rows],
+                                  "plot": None if path is None else str(path)}, p))
         return 0
     from rich.table import Table
 
@@ -248,3 +297,168 @@ def run_breathing(args) -> int:
     if path is not None:
         con.print(f"wrote {path}")
     return 0
+
+
+# ---- lens check / lens fix ----------------------------------------------------------------
+def ray_probes(sensor_name: str | None):
+    """Ray-traced checks for :func:`physcam.lens.check.check` (they need the trace and analysis layers):
+    the on-axis beam clipped by element rims at full aperture and, with a sensor, vignetting and the
+    image circle at its corner."""
+    import math
+
+    from ..lens.check import Finding
+
+    def beam(p):
+        import numpy as np
+
+        from ..optics.paraxial import gaussian
+        from ..trace import OK, RayBatch, trace_to_film
+
+        g = gaussian(p)
+        r = 0.5 * g.entrance_pupil_diameter
+        n = 101
+        u = np.linspace(-r, r, n)
+        x, y = np.meshgrid(u, u)
+        inside = x * x + y * y <= r * r
+        x, y = x[inside], y[inside]
+        out = trace_to_film(p, RayBatch.collimated(x, y, -1.0), backend="numpy")
+        frac = 1.0 - float(np.count_nonzero(out.flag == OK)) / len(x)
+        if frac > 0.01:
+            return [Finding("warning" if frac > 0.10 else "note", "beam_clipped",
+                            f"element rims clip {100 * frac:.1f} % of the on-axis beam at full aperture "
+                            f"(rays filling the paraxial entrance pupil, {2 * r:.3f} mm)",
+                            "the lens is slower on axis than its stop says; the working aperture is set by a rim, "
+                            "not the stop", p.stop_index, values={"clipped_fraction": frac})]
+        return []
+
+    def corner(p):
+        from ..analysis import _chief
+        from ..analysis.illumination import relative_illumination
+        from ..errors import OpticsError
+        from ..onset.sensors import find_sensor
+        from ..optics.paraxial import gaussian
+
+        s = find_sensor(sensor_name)
+        half = 0.5 * s.diagonal_mm
+        efl = gaussian(p).efl
+        corner_deg = float(_chief.field_angles_deg(None, None, 2, half, efl)[-1])
+        try:
+            res = relative_illumination(p, [corner_deg], sensor_width_mm=s.width_mm, sensor_height_mm=s.height_mm,
+                                        grid=64, backend="numpy")
+        except OpticsError as exc:
+            limit = _chief.field_limit_deg(p, "y", wavelength_nm=p.wavelength_nm)
+            circle = 2 * abs(efl) * math.tan(math.radians(limit))
+            return [Finding("warning", "image_circle",
+                            f"no chief ray reaches the corner of {s.name} ({s.diagonal_mm:.2f} mm diagonal, "
+                            f"{corner_deg:.2f} deg): chief rays pass up to {limit:.2f} deg, an image circle of about "
+                            f"{circle:.1f} mm", f"the corners of {s.name} stay dark ({str(exc).splitlines()[0]})",
+                            values={"sensor_diagonal_mm": s.diagonal_mm, "field_limit_deg": limit,
+                                    "image_circle_mm": circle})]
+        pt = res.points[-1]
+        out = []
+        sev = "warning" if pt.relative_illumination < 0.25 else "note"
+        out.append(Finding(sev, "corner_vignetting",
+                           f"at the corner of {s.name} ({corner_deg:.2f} deg) the relative illumination is "
+                           f"{100 * pt.relative_illumination:.1f} % (vignetting factor {pt.vignetting_factor:.3f}, "
+                           f"cos^4 {pt.cos4:.3f})", f"{-math.log2(max(pt.relative_illumination, 1e-9)):.2f} stops "
+                           "darker than the centre at full aperture",
+                           values={"relative_illumination": pt.relative_illumination,
+                                   "vignetting_factor": pt.vignetting_factor, "field_deg": corner_deg,
+                                   "sensor_diagonal_mm": s.diagonal_mm}))
+        return out
+
+    return [beam] + ([corner] if sensor_name else [])
+
+
+def run_check(args) -> int:
+    from ..lens.check import check
+    from ._common import console, print_json
+
+    if args.sensor:
+        from ..onset.sensors import find_sensor
+
+        find_sensor(args.sensor)  # an unknown name is refused before any work
+    findings = check(args.lens, probes=ray_probes(args.sensor))
+    if args.json:
+        print_json({"lens": args.lens, "findings": [f.to_dict() for f in findings],
+                    "counts": {s: sum(f.severity == s for f in findings) for s in ("error", "warning", "note")}})
+        return 0
+    con = console()
+    if not findings:
+        con.print(f"{args.lens}: no findings")
+        return 0
+    for f in findings:
+        con.print(str(f), soft_wrap=True)
+    counts = {s: sum(f.severity == s for f in findings) for s in ("error", "warning", "note")}
+    tail = ""
+    if counts["error"]:
+        tail = f"; `physcam lens fix {args.lens} -o FIXED.toml` proposes repairs"
+    con.print(f"{counts['error']} error(s), {counts['warning']} warning(s), {counts['note']} note(s){tail}",
+              soft_wrap=True)
+    return 0
+
+
+def _diff(a, b, lines) -> list[str]:
+    """Human-readable per-surface differences between two prescriptions of the same surfaces."""
+    out = []
+    for i, (s, t) in enumerate(zip(a.surfaces, b.surfaces)):
+        where = f"surface {i}" + (f" (line {lines[i]})" if i < len(lines) and lines[i] is not None else "")
+        if s.semi_diameter != t.semi_diameter:
+            out.append(f"{where}: clear diameter {2 * s.semi_diameter:g} -> {2 * t.semi_diameter:g} mm")
+        if s.thickness != t.thickness:
+            out.append(f"{where}: thickness {s.thickness:g} -> {t.thickness:g} mm")
+    return out
+
+
+def run_fix(args) -> int:
+    import dataclasses
+
+    from ..io import check_writable
+    from ..lens.check import read_raw
+    from ..lens.formats import write_lens
+    from ..lens.formats._common import json_text
+    from ..lens.repair import paraxial_f_number, propose, with_corrections
+    from ._common import console, print_json
+
+    if args.apply:
+        check_writable(args.output, force=args.force)
+    raw = read_raw(args.lens)
+    q, repairs = propose(raw.prescription)
+    diff = _diff(raw.prescription, q, raw.lines)
+    written = None
+    if repairs and args.apply:
+        q = with_corrections(q, repairs)
+        extras = dict(q.extras)
+        extras.setdefault("provenance.original_file", json_text(str(args.lens)))
+        extras.setdefault("provenance.original_format", json_text(raw.format))
+        q = dataclasses.replace(q, extras=tuple(sorted(extras.items())))
+        q.validate(str(args.lens), list(raw.lines))
+        written = str(write_lens(q, args.output, force=args.force))
+    elif not repairs:
+        raw.prescription.validate(str(args.lens), list(raw.lines))  # nothing to repair: say if still unbuildable
+    if args.json:
+        print_json({"lens": args.lens, "repairs": [r.to_dict() for r in repairs], "diff": diff,
+                    "f_number_before": _finite(paraxial_f_number, raw.prescription),
+                    "f_number_after": _finite(paraxial_f_number, q), "written": written})
+        return 0
+    con = console()
+    if not repairs:
+        con.print(f"{args.lens}: nothing to repair")
+        return 0
+    for n, r in enumerate(repairs, 1):
+        con.print(f"repair {n}: {r.message}", soft_wrap=True)
+    con.print("diff:")
+    for line in diff:
+        con.print(f"  {line}", soft_wrap=True)
+    con.print(f"wrote {written}" if written else f"dry run: add --apply to write {args.output}")
+    return 0
+
+
+def _finite(fn, p):
+    import math
+
+    try:
+        v = fn(p)
+    except (ArithmeticError, ValueError, LookupError, PhysCamError):
+        return None
+    return v if isinstance(v, float) and math.isfinite(v) else None

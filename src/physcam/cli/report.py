@@ -29,6 +29,9 @@ def register(sub) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_report_arguments(p)
+    from .lens import add_lenient
+
+    add_lenient(p)
     p.add_argument("--json", action="store_true", help="print the report as JSON (for pipelines)")
     p.add_argument("--cameras", action="store_true", help="also print the UsdGeomCamera and RenderMan blocks")
     p.add_argument("--plot", metavar="FILE", help="draw the depth-of-field zone to FILE (.png or .svg)")
@@ -103,7 +106,8 @@ def solve_from_args(args):
     if getattr(args, "lens", None):
         from ..lens.library import load_lens
 
-        lens = load_lens(args.lens)
+        lens = load_lens(args.lens, lenient=getattr(args, "lenient", False))
+        args.loaded_lens = lens
         if args.focal is not None:
             raise InputError("give either --lens or --focal: the lens sets its own focal length")
     elif args.focal is None:
@@ -169,6 +173,10 @@ def run(args) -> int:
     if args.json:
         d = report.to_dict()
         d["cameras"] = cams
+        if getattr(args, "loaded_lens", None) is not None:
+            from .lens import mark_repaired
+
+            d = mark_repaired(d, args.loaded_lens)
         print_json(d)
         return 0
     from ..onset.table import report_table

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 from ._common import distance, number, print_json
+from .lens import add_lenient, mark_repaired
 
 
 def register(sub) -> None:
     p = sub.add_parser("spot", help="spot diagram (RMS and geometric radius per field) by real ray tracing")
     p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    add_lenient(p)
     p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG",
                    help="field angle in degrees (repeat; default 0 and 5)")
     p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM",
@@ -25,6 +27,7 @@ def register(sub) -> None:
 
     b = sub.add_parser("bokeh", help="PSF / bokeh image of a point light by real ray tracing")
     b.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name or a lens file")
+    add_lenient(b)
     b.add_argument("--depth", type=distance("light depth"), default=1000.0,
                    help="light distance in front of the film plane (units ok: 2m, 6ft; bare number = mm)")
     b.add_argument("--x", type=number("light x"), default=0.0, metavar="MM", help="light lateral x (mm)")
@@ -55,13 +58,13 @@ def run_spot(args) -> int:
 
     if args.output:
         check_writable(args.output, force=args.force)
-    lens = load_lens(args.lens)
+    lens = load_lens(args.lens, lenient=args.lenient)
     res = spot_diagram(lens, tuple(args.field or (0.0, 5.0)), wavelength_nm=args.wavelength, rings=args.rings,
                        fstop=args.fstop, clip=args.clip)
     if args.output:
         res.plot(args.output, force=args.force)
     if args.json:
-        print_json(res.to_dict())
+        print_json(mark_repaired(res.to_dict(), lens))
     else:
         print(f"{res.lens_name}: spot diagram at {res.wavelength_nm:g} nm, film z = {res.film_z_mm:.4f} mm"
               + ("" if res.clip else ", no clipping"))
@@ -91,7 +94,7 @@ def run_bokeh(args) -> int:
     from ..optics import focusing, paraxial
     from ..trace.aperture import Aperture
 
-    lens = load_lens(args.lens)
+    lens = load_lens(args.lens, lenient=args.lenient)
     st = focusing.focus(lens, math.inf if args.focus is None else args.focus)
     stop = None if args.fstop is None else paraxial.stop_semi_diameter_for_fstop(st.prescription, args.fstop)
     aperture = None
@@ -107,7 +110,7 @@ def run_bokeh(args) -> int:
     if args.output:
         res.plot(args.output, force=args.force)
     if args.json:
-        print_json(res.to_dict())
+        print_json(mark_repaired(res.to_dict(), lens))
     else:
         d = res.to_dict()
         print(f"{res.lens_name}: bokeh of a light at {args.depth:g} mm from the film, "

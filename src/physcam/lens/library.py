@@ -18,10 +18,14 @@ from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, LensFileError
 from .prescription import Prescription
 
-__all__ = ["LensRecord", "list_lenses", "load_lens", "find_lens", "library_dir"]
+__all__ = ["LensRecord", "list_lenses", "load_lens", "find_lens", "library_dir", "load_repaired", "repairs_of",
+           "REPAIRED_KEY"]
+
+#: ``extras`` key of a lens loaded with ``lenient=True`` that needed repairs (JSON list of messages).
+REPAIRED_KEY = "provenance.repaired_on_load"
 
 _FILE_SUFFIXES = (".toml", ".dat", ".json", ".zmx")
 
@@ -118,11 +122,57 @@ def find_lens(name: str) -> LensRecord:
     raise InputError(f"no bundled lens called {name!r}{hint} (`physcam lenses` lists them; a file path also works)")
 
 
-def load_lens(name_or_path) -> Prescription:
+def repairs_of(p: Prescription) -> list[str]:
+    """The repairs made when ``p`` was loaded with ``lenient=True`` ([] for a lens loaded as written)."""
+    from .formats._common import extra
+
+    return list(extra(p, REPAIRED_KEY, []))
+
+
+def load_repaired(path, format: str | None = None):
+    """Read a lens file without validation and repair it as ``physcam lens fix`` would.
+
+    Returns ``(prescription, repairs)``; the prescription is validated and, when repairs were
+    made, named "<name> (repaired)" and carries them in ``extras`` (:data:`REPAIRED_KEY`) and in
+    ``[provenance] corrections``. Raises :class:`LensFileError` when no repair is defined.
+    """
+    import dataclasses
+
+    from .check import read_raw
+    from .formats._common import json_text
+    from .repair import propose, with_corrections
+
+    raw = read_raw(path, format)
+    try:
+        q, repairs = propose(raw.prescription)
+    except (ArithmeticError, ValueError) as exc:
+        raise LensFileError(f"no repair is defined for this lens ({exc})", str(path)) from None
+    if repairs:
+        q = with_corrections(q, repairs)
+        extras = dict(q.extras)
+        extras[REPAIRED_KEY] = json_text([r.message for r in repairs])
+        q = dataclasses.replace(q, metadata=dataclasses.replace(q.metadata, name=f"{q.metadata.name} (repaired)"),
+                                extras=tuple(sorted(extras.items())))
+    try:
+        q.validate(str(path), list(raw.lines))
+    except LensFileError as exc:
+        raise LensFileError(f"{exc.reason} (even after the repairs `physcam lens fix` knows: no repair is defined; "
+                            "`physcam lens check` lists every problem)", exc.path, exc.line) from None
+    except (ArithmeticError, ValueError) as exc:
+        raise LensFileError(f"lens geometry cannot be evaluated ({exc})", str(path)) from None
+    return q, repairs
+
+
+def load_lens(name_or_path, lenient: bool = False) -> Prescription:
     """A bundled lens by slug/name/alias, or any lens file by path (format from its extension).
 
     A string with a path separator or a lens-file extension that names an existing file
     is read as a file; otherwise it is looked up in the library.
+
+    A file that does not describe a buildable lens raises :class:`LensFileError` whose message
+    says how to get further. With ``lenient=True`` such a file is repaired as ``physcam lens fix``
+    would (:func:`load_repaired`): each repair is issued as a :class:`~physcam.errors.PhysCamWarning`
+    and the lens comes back named "<name> (repaired)" with the repairs in :func:`repairs_of`.
     """
     s = str(name_or_path)
     p = Path(s)
@@ -130,7 +180,22 @@ def load_lens(name_or_path) -> Prescription:
     if p.is_file() and looks_like_path:
         from .formats import read_lens
 
-        return read_lens(p)
+        try:
+            return read_lens(p)
+        except LensFileError as exc:
+            if not lenient:
+                raise LensFileError(
+                    f"{exc.reason}; `physcam lens check {s}` explains, `physcam lens fix {s} -o FIXED.toml --apply` "
+                    "writes a repaired copy, --lenient (Python: load_lens(path, lenient=True)) loads it repaired",
+                    exc.path, exc.line) from None
+            import warnings
+
+            from ..errors import PhysCamWarning
+
+            q, repairs = load_repaired(p)
+            for r in repairs:
+                warnings.warn(f"{s}: repaired on load: {r.message}", PhysCamWarning, stacklevel=2)
+            return q
     try:
         rec = find_lens(s)
     except InputError:

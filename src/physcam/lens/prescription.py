@@ -14,6 +14,8 @@ vertex to the next one (for the last surface: to the film plane at infinity focu
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
 from dataclasses import dataclass, field, replace
 from typing import Iterable
@@ -31,7 +33,27 @@ __all__ = [
     "Prescription",
     "require_prescription",
     "takes_prescription",
+    "unvalidated",
 ]
+
+#: Set inside :func:`unvalidated`: a list that ``validate`` appends ``(prescription, path, lines)``
+#: to instead of checking (readers then hand back raw rows for ``physcam.lens.check``).
+_RAW_SINK: contextvars.ContextVar[list | None] = contextvars.ContextVar("physcam_raw_sink", default=None)
+
+
+@contextlib.contextmanager
+def unvalidated():
+    """Inside this block :meth:`Prescription.validate` checks nothing and records what it was
+    given: ``with unvalidated() as seen: read_lens(f)`` returns the file's rows as written (the
+    reader's own syntax checks still apply) and ``seen[-1]`` is ``(prescription, path, lines)``,
+    ``lines`` mapping each surface to its file line. Used by :mod:`physcam.lens.check` and
+    :mod:`physcam.lens.repair` to report and repair what validation refuses."""
+    sink: list = []
+    token = _RAW_SINK.set(sink)
+    try:
+        yield sink
+    finally:
+        _RAW_SINK.reset(token)
 
 #: The surface types physcam understands, as stored in files.
 SURFACE_KINDS = ("spherical", "flat", "stop", "aspheric", "cylindrical_x", "cylindrical_y")
@@ -220,6 +242,11 @@ class Prescription:
         negative gaps, neighbouring surfaces that do not cross inside their apertures,
         focus gaps that exist and are air.
         """
+
+        sink = _RAW_SINK.get()
+        if sink is not None:  # inside unvalidated(): record, do not check
+            sink.append((self, path, None if lines is None else list(lines)))
+            return self
 
         def fail(msg: str, i: int | None = None) -> LensFileError:
             line = lines[i] if (lines is not None and i is not None and i < len(lines)) else None
