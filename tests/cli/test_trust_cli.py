@@ -143,3 +143,27 @@ def test_every_option_and_argument_has_help():
 
     walk(build_parser())
     assert not missing, "options without help:\n" + "\n".join(missing)
+
+
+def test_usd_commands_take_lenient_lenses(tmp_path, capsys):
+    """Issue 11 reaches the USD commands: an original that is not buildable as written is refused
+    with the way forward, and --lenient writes the camera from the repaired lens, one warning per repair."""
+    from pathlib import Path
+
+    original = Path(__file__).resolve().parents[2].parent / "shared/reference/lenses/physical-camera-toml/tessar_50mm_f2_8.toml"
+    if not original.is_file():
+        pytest.skip("shared/reference is not beside the checkout")
+    f = tmp_path / "t.usda"
+    rc, _, err = run_in(capsys, "usd", "write", str(f), "--lens", str(original), "--focus", "3m")
+    assert "--lenient" in one_line_error(rc, err)
+    rc, _, err = run_in(capsys, "usd", "write", str(f), "--lens", str(original), "--focus", "3m", "--lenient")
+    assert rc == 0 and f.is_file() and "physcam: warning:" in err
+
+
+def test_breathing_table_refuses_a_vanishing_sensor():
+    from physcam.errors import InputError
+    from physcam.lens.library import load_lens
+    from physcam.optics.focusing import breathing_table
+
+    with pytest.raises(InputError, match="sensor width"):
+        breathing_table(load_lens("dgauss_50mm"), [3000.0], sensor_width_mm=5e-324)

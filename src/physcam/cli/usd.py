@@ -29,6 +29,9 @@ def register(sub) -> None:
     from .report import add_report_arguments
 
     add_report_arguments(w)  # brings --meters-per-unit and --shutter-angle with it
+    from .lens import add_lenient
+
+    add_lenient(w)
     _stage_args(w, units=False)
     w.add_argument("--path", default="/Cameras/Camera", help="camera prim path (default /Cameras/Camera)")
     w.add_argument("--orthographic", action="store_true", help="orthographic (telecentric) camera")
@@ -79,6 +82,7 @@ def register(sub) -> None:
                    help="shot: pan/tilt/roll about the entrance pupil, degrees (XYZ order)")
     k.add_argument("--variant", help="shot: pin a lens characterization variant (default the lens file's current)")
     _stage_args(k)
+    add_lenient(k)
     k.set_defaults(handler=run_kit)
 
     a = s.add_parser("animate", help="a focus (and iris) pull as time samples, breathing included",
@@ -104,6 +108,7 @@ def register(sub) -> None:
     a.add_argument("--rotate", type=numbers("rotation", 3), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ",
                    help="pan/tilt/roll about the entrance pupil, degrees (XYZ order)")
     _stage_args(a)
+    add_lenient(a)
     a.set_defaults(handler=run_animate)
 
     c = s.add_parser("check", help="is a shot's companion camera current with its body and lens files?")
@@ -177,7 +182,7 @@ def run_write(args) -> int:
         from ..lens.library import load_lens
         from ..usd.kit import prescription_distortion, prescription_opencv
 
-        lens = load_lens(args.lens)
+        lens = load_lens(args.lens, lenient=args.lenient)
         distortion = prescription_distortion(lens, report.sensor.width_mm, report.sensor.height_mm)
         opencv = prescription_opencv(lens, report.sensor.width_mm, report.sensor.height_mm,
                                      focus_mm=report.focus_from_film_mm, resolution=args.resolution)
@@ -232,7 +237,7 @@ def run_kit(args) -> int:
     kind = args.kind
     allowed = {
         "previs": set(),
-        "vendor": {"lens", "focus", "fstop", "sensor", "sensor_width", "sensor_height"},
+        "vendor": {"lens", "focus", "fstop", "sensor", "sensor_width", "sensor_height", "lenient"},
         "lens": {"characterizations"},
         "body": {"sensor", "sensor_width", "sensor_height", "flange", "iso", "shutter_angle", "coc"},
         "shot": {"lens", "body", "focus", "fstop", "position", "rotate", "variant"},
@@ -241,6 +246,7 @@ def run_kit(args) -> int:
                          "sensor_height", "flange", "iso", "shutter_angle", "variant", "coc")
              if getattr(args, k) is not None}
     given |= {k for k in ("position", "rotate") if getattr(args, k) != (0.0, 0.0, 0.0)}
+    given |= {"lenient"} if args.lenient else set()
     if given - allowed:
         flags = ", ".join("--" + k.replace("_", "-") for k in sorted(given - allowed))
         raise InputError(f"usd kit {kind} does not use {flags}")
@@ -254,7 +260,8 @@ def run_kit(args) -> int:
         from ..lens.library import load_lens
 
         sensor = _kit_sensor(args, default="Full Frame")
-        path = kit.write_vendor_lens(args.file, load_lens(args.lens), focus_mm=args.focus, fstop=args.fstop,
+        path = kit.write_vendor_lens(args.file, load_lens(args.lens, lenient=args.lenient), focus_mm=args.focus,
+                                     fstop=args.fstop,
                                      sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm, **common)
     elif kind == "lens":
         if not args.characterizations:
@@ -377,7 +384,7 @@ def run_animate(args) -> int:
     if args.lens:
         from ..lens.library import load_lens
 
-        lens = load_lens(args.lens)
+        lens = load_lens(args.lens, lenient=args.lenient)
     coc = coc_value(args.coc)
     keys = read_focus_marks(args.marks)
     path = write_animated_camera(args.file, keys, sensor=_kit_sensor(args, default="Super 35"), lens=lens,
