@@ -510,7 +510,7 @@ def blender_setup_script(shader, *, sensor_width_mm, sensor_height_mm, resolutio
     that makes the scene camera the custom OSL camera.
 
     ``shader``: the OSL source (a ``str`` holding a ``shader`` declaration) embedded in the script,
-    or a path (``pathlib.Path``, or a one-line ``str``) read when the script runs, relative to
+    or a path (``pathlib.Path``, or a one-line ``str`` without a shader declaration) read when the script runs, relative to
     the script. ``resolution`` (w, h) px must have the sensor's aspect (1 %); default 1920 wide.
     """
     sw = require_positive("sensor width", sensor_width_mm)
@@ -518,10 +518,10 @@ def blender_setup_script(shader, *, sensor_width_mm, sensor_height_mm, resolutio
     res = _resolution(resolution, sw, sh)
     if isinstance(shader, Path):
         path, source = str(shader), None
-    elif isinstance(shader, str) and "\n" not in shader.strip():
-        path, source = shader.strip(), None
-    elif isinstance(shader, str) and re.search(r"\bshader\b", shader):
+    elif isinstance(shader, str) and re.search(r"\bshader\s+\w+\s*\(", shader):
         path, source = None, shader
+    elif isinstance(shader, str) and shader.strip() and "\n" not in shader.strip():
+        path, source = shader.strip(), None
     else:
         raise InputError("shader must be OSL source text (with a `shader` declaration) or a path to an .osl file")
     if not isinstance(text_name, str) or not text_name.strip():
