@@ -1,13 +1,18 @@
-"""``physcam export``: lens data for other tools (Unreal lens files, OpenCV/Omniverse pinholes)."""
+"""``physcam export``: lens data for other tools (Unreal lens files, OpenCV/Omniverse pinholes,
+Blender Cycles OSL lens cameras)."""
 
 from __future__ import annotations
 
-from ._common import distance, print_json
+from ._common import distance, number, print_json
+
+
+def _sensor(p) -> None:
+    from .analyze import _sensor as add
+
+    add(p)
 
 
 def _common(p) -> None:
-    from .analyze import _sensor
-
     p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
     _sensor(p)
     p.add_argument("--width-px", type=int, required=True, metavar="PX", help="image width in pixels")
@@ -36,6 +41,33 @@ def register(sub) -> None:
     o.add_argument("--terms", choices=("k1", "k1k2", "k1k2k3", "rational"), default="k1k2k3",
                    help="distortion terms to fit (default k1k2k3)")
     o.set_defaults(handler=run_opencv)
+
+    b = s.add_parser("blender", help="write a Blender Cycles OSL lens camera (shader + set-up script)",
+                     description="Write <lens>.osl, an OSL camera shader tracing real rays through the focused lens, "
+                                 "and setup_<lens>.py, which makes the scene camera use it "
+                                 "(`blender --python setup_<lens>.py`). See docs/blender.md.")
+    b.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    b.add_argument("--focus", type=distance("focus distance", allow_inf=True), required=True, metavar="D",
+                   help="focus mark from the film plane (e.g. 3m, 10ft, inf)")
+    b.add_argument("--fstop", type=number("f-number", positive=True), default=None, metavar="N",
+                   help="working f-number (default: the lens wide open)")
+    _sensor(b)
+    b.add_argument("--blades", type=number("blade count", lo=0, hi=64), default=None, metavar="N",
+                   help="iris blades (3 or more: a polygonal aperture; default round)")
+    b.add_argument("--blade-angle", type=number("blade angle"), default=0.0, metavar="DEG",
+                   help="angle of the first iris vertex from +x, degrees (default 0)")
+    b.add_argument("--roundness", type=number("roundness", lo=-1, hi=1), default=0.0, metavar="R",
+                   help="iris roundness, -1..1 (0 straight blades, 1 a circle)")
+    b.add_argument("--density", type=number("aperture density", lo=-1, hi=1), default=0.0, metavar="D",
+                   help="bokeh brightness slope across the aperture, -1..1 (0 flat, > 0 bright rim)")
+    b.add_argument("--dispersion", action="store_true", help="trace one wavelength per ray (chromatic aberration)")
+    b.add_argument("--fresnel", action="store_true", help="include unpolarised Fresnel losses (uncoated surfaces)")
+    b.add_argument("--width-px", type=int, default=1920, metavar="PX",
+                   help="render width in pixels (height follows the sensor aspect; default 1920)")
+    b.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write the shader and script into")
+    b.add_argument("--force", action="store_true", help="overwrite existing files")
+    b.add_argument("--json", action="store_true", help="print JSON instead of text")
+    b.set_defaults(handler=run_blender)
     p.set_defaults(handler=lambda args: (p.print_help(), 0)[1])
 
 
@@ -100,4 +132,41 @@ def run_opencv(args) -> int:
     print(f"  Omniverse: apiSchemas = [\"{OMNI_API_SCHEMA}\"], omni:lensdistortion:opencvPinhole:* (--json for all)")
     for n in cam.notes:
         print(f"  note: {n}")
+    return 0
+
+
+def run_blender(args) -> int:
+    import time
+    from pathlib import Path
+
+    from ..errors import InputError
+    from ..export.blender import write_blender_camera
+    from ..trace.aperture import Aperture
+
+    t0 = time.perf_counter()
+    lens = _prepare(args)
+    if not 16 <= args.width_px <= 65536:
+        raise InputError(f"--width-px must lie in 16..65536, got {args.width_px}")
+    if args.blades is not None and args.blades != int(args.blades):
+        raise InputError(f"--blades must be a whole number, got {args.blades:g}")
+    aperture = None
+    if args.blades is not None or args.roundness or args.density:
+        aperture = Aperture(int(args.blades or 0), args.blade_angle, args.roundness, args.density)
+    w = int(args.width_px)
+    h = max(1, int(round(w * args.sensor_height / args.sensor_width)))
+    osl, setup = write_blender_camera(args.output, lens, focus_mm=args.focus, fstop=args.fstop,
+                                      sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
+                                      aperture=aperture, dispersion=args.dispersion, fresnel=args.fresnel,
+                                      resolution=(w, h), name=Path(args.lens).stem, force=args.force)
+    data = {"lens": lens.name, "shader": str(osl), "setup": str(setup), "focus_from_film_mm": None
+            if args.focus == float("inf") else args.focus, "fstop": args.fstop, "sensor_mm": [args.sensor_width,
+            args.sensor_height], "resolution": [w, h], "dispersion": args.dispersion, "fresnel": args.fresnel,
+            "seconds": round(time.perf_counter() - t0, 3)}
+    if args.json:
+        print_json(data)
+        return 0
+    print(f"wrote {osl} and {setup}: {lens.name} focused at {_mark(args.focus)}"
+          f"{'' if args.fstop is None else f', f/{args.fstop:g}'} on {args.sensor_width:g} x {args.sensor_height:g} mm, "
+          f"{w} x {h} px")
+    print(f"  in Blender: blender your.blend --python {setup}  (Cycles, CPU, OSL)")
     return 0
