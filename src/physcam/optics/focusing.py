@@ -421,8 +421,8 @@ def breathing_table(
     chief ray reaching the sensor edge (``sensor_width_mm``/2 off axis).
     """
     w = require_positive("sensor width", sensor_width_mm)
-    if not 0.1 <= w <= 1000.0:  # a 5e-324 mm "sensor" has no field angle to divide by
-        raise InputError(f"sensor width must lie between 0.1 and 1000 mm, got {w:g}")
+    if not 1e-6 <= w <= 1000.0:  # a 5e-324 mm "sensor" has no field angle to divide by
+        raise InputError(f"sensor width must lie between 1e-6 and 1000 mm, got {w:g}")
     method = focus_method(prescription, method)
     if focus_marks_mm is None:
         near = closest_focus(prescription, method=method, wavelength_nm=wavelength_nm)
