@@ -133,3 +133,28 @@ def test_builtin_camera_shift_moves_the_frame_by_millimetres(tmp_path):
     px_per_mm = w / 36.0
     assert out["blobs"][0]["cx"] == pytest.approx(w / 2 - 3.0 * px_per_mm, abs=0.5)
     assert out["blobs"][0]["cy"] == pytest.approx(h / 2 - 2.0 * px_per_mm, abs=0.5)
+
+
+def test_export_blender_builtin_script_sets_the_lens_pinhole(tmp_path):
+    """`physcam export blender LENS --builtin` writes a script that gives Blender's camera the lens's
+    best-match pinhole at the mark (52.048 mm for dgauss.50mm at 1.5 m, issue 9.6's figure), and
+    the aperture that keeps the entrance pupil's diameter."""
+    from physcam.cli import main
+    from physcam.optics.focusing import technical_planes
+    from physcam.lens.library import load_lens
+
+    assert main(["export", "blender", "dgauss_50mm", "--focus", "1.5m", "--fstop", "4", "--sensor", "FF",
+                 "--builtin", "--blades", "6", "-o", str(tmp_path)]) == 0
+    out = run_blender('''
+import bpy, json, runpy, sys
+ns = runpy.run_path(sys.argv[1])
+cam = ns["apply"](bpy.context.scene)
+print(json.dumps({"lens": cam.lens, "fstop": cam.dof.aperture_fstop, "blades": cam.dof.aperture_blades,
+                  "focus": cam.dof.focus_distance, "w": cam.sensor_width}))
+''', tmp_path / "builtin_dgauss_50mm.py")
+    planes = technical_planes(load_lens("dgauss_50mm"), 1500.0, fstop=4.0)
+    assert out["lens"] == pytest.approx(52.048, abs=1e-3)
+    assert out["lens"] == pytest.approx(planes.pinhole_focal_length_mm, rel=1e-6)
+    assert out["lens"] / out["fstop"] == pytest.approx(planes.efl_mm / 4.0, rel=1e-6)  # entrance pupil EFL/N
+    assert out["blades"] == 6 and out["w"] == pytest.approx(36.0)
+    assert out["focus"] == pytest.approx((1500.0 - planes.entrance_pupil_from_film_mm) / 1000.0, rel=1e-6)

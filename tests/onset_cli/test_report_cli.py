@@ -79,6 +79,10 @@ def test_demo_writes_outputs(tmp_path, capsys):
     assert lens["gaussian"]["efl"] == pytest.approx(50.3582, abs=1e-3)  # published dgauss.50mm EFL
     assert all(os.path.exists(f) for f in files)
     assert json.loads((out / "report.json").read_text())["schema"] == "physcam.lens_report"
+    # issue 10: the demo writes the Blender cameras for the default lens
+    osl = (out / "blender" / "dgauss_50mm.osl").read_text()
+    assert "camera_shader_raster_position" in osl and (out / "blender" / "setup_dgauss_50mm.py").exists()
+    assert (out / "blender" / "builtin_dgauss_50mm.py").exists()
     assert main(["demo", "--out", str(out)]) == 2  # exists, no --force
 
 

@@ -9,7 +9,9 @@ folder and prints the report:
 - ``lens.json``: the lens's Gaussian data at that focus; ``lens_diagram.png``: elements, stop,
   rays and cardinal points; ``breathing.png``: field of view against focus distance;
 - ``camera.usda``: the PhysicalCamera and its companion UsdGeomCamera;
-- ``spot.png`` and ``bokeh.png``: real-ray spot diagram and bokeh of a point light.
+- ``spot.png`` and ``bokeh.png``: real-ray spot diagram and bokeh of a point light;
+- ``blender/``: the real-lens OSL camera shader and its set-up script for Blender Cycles, and a
+  script matching Blender's built-in camera to the report (docs/blender.md).
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ def _steps():
         ("Gaussian data and diagram", _lens_step),
         ("USD camera", _usd_step),
         ("spot diagram and bokeh", _trace_step),
+        ("Blender cameras", _blender_step),
     ]
 
 
@@ -127,6 +130,27 @@ def _trace_step(out, ctx, force):
     bokeh = bokeh_image(st.prescription, 1200.0, 250.0, 150.0, film_z=st.film_z, rays=400_000, pixels=160,
                         stop_semi_diameter=stop, aperture=Aperture(nsides=7, roundness=0.2), spectral=True)
     return [spot.plot(out / "spot.png", force=force), bokeh.plot(out / "bokeh.png", force=force)]
+
+
+def _blender_step(out, ctx, force):
+    """The real-lens OSL camera and its set-up script, and Blender's built-in camera matched to the report."""
+    from ..export.blender import write_blender_camera
+    from ..export.blender_camera import blender_camera_script, blender_camera_values
+    from ..io import atomic_write
+    from ..trace.aperture import Aperture
+
+    report = ctx["report"]
+    s = report.sensor
+    width = 1920
+    height = max(1, round(width * s.height_mm / s.width_mm))
+    osl, setup = write_blender_camera(out / "blender", ctx["lens"], focus_mm=DEFAULTS["focus"],
+                                      fstop=DEFAULTS["fstop"], sensor_width_mm=s.width_mm, sensor_height_mm=s.height_mm,
+                                      aperture=Aperture(nsides=7, roundness=0.2), resolution=(width, height),
+                                      name=DEFAULTS["lens"], force=force)
+    values = blender_camera_values(report, resolution_x=width, blades=7)
+    builtin = atomic_write(out / "blender" / f"builtin_{DEFAULTS['lens']}.py", blender_camera_script(values),
+                           force=force)
+    return [osl, setup, builtin]
 
 
 def run(args) -> int:

@@ -8,8 +8,10 @@ from ._common import distance, number, print_json
 
 def _sensor(p) -> None:
     from .analyze import _sensor as add
+    from .lens import add_lenient
 
     add(p)
+    add_lenient(p)  # every export takes a lens
 
 
 def _common(p) -> None:
@@ -67,6 +69,9 @@ def register(sub) -> None:
     b.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write the shader and script into")
     b.add_argument("--force", action="store_true", help="overwrite existing files")
     b.add_argument("--json", action="store_true", help="print JSON instead of text")
+    b.add_argument("--builtin", action="store_true",
+                   help="also write builtin_<lens>.py: Blender's own camera matched to the lens at this focus "
+                        "(best-match pinhole, aperture, focus distance; faster, no real-lens optics)")
     b.set_defaults(handler=run_blender)
     p.set_defaults(handler=lambda args: (p.print_help(), 0)[1])
 
@@ -76,7 +81,7 @@ def _prepare(args):
     from .analyze import _resolve_sensor
 
     _resolve_sensor(args)
-    return load_lens(args.lens)
+    return load_lens(args.lens, lenient=args.lenient)
 
 
 def _mark(mm: float) -> str:
@@ -158,7 +163,11 @@ def run_blender(args) -> int:
                                       sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
                                       aperture=aperture, dispersion=args.dispersion, fresnel=args.fresnel,
                                       resolution=(w, h), name=Path(args.lens).stem, force=args.force)
-    data = {"lens": lens.name, "shader": str(osl), "setup": str(setup), "focus_from_film_mm": None
+    builtin = None
+    if args.builtin:
+        builtin = _write_builtin(args, lens, w, Path(args.output) / f"builtin_{Path(args.lens).stem}.py")
+    data = {"lens": lens.name, "shader": str(osl), "setup": str(setup), "builtin": builtin and str(builtin),
+            "focus_from_film_mm": None
             if args.focus == float("inf") else args.focus, "fstop": args.fstop, "sensor_mm": [args.sensor_width,
             args.sensor_height], "resolution": [w, h], "dispersion": args.dispersion, "fresnel": args.fresnel,
             "seconds": round(time.perf_counter() - t0, 3)}
@@ -169,4 +178,27 @@ def run_blender(args) -> int:
           f"{'' if args.fstop is None else f', f/{args.fstop:g}'} on {args.sensor_width:g} x {args.sensor_height:g} mm, "
           f"{w} x {h} px")
     print(f"  in Blender: blender your.blend --python {setup}  (Cycles, CPU, OSL)")
+    if builtin is not None:
+        print(f"  or Blender's own camera, matched: blender your.blend --python {builtin}")
     return 0
+
+
+def _write_builtin(args, lens, width_px: int, path):
+    """Blender's built-in camera matched to the lens report at this focus (physcam.export.blender_camera)."""
+    import math
+
+    from ..errors import InputError
+    from ..export.blender_camera import blender_camera_script, blender_camera_values
+    from ..io import atomic_write
+    from ..onset.report import solve_lens_report
+    from ..onset.sensors import custom_sensor
+
+    if math.isinf(args.focus):
+        raise InputError("--builtin needs a finite focus mark (the built-in camera's focus distance); "
+                         "give e.g. --focus 1000m")
+    report = solve_lens_report(focal_length_mm=None, sensor=custom_sensor(args.sensor_width, args.sensor_height),
+                               fstop=args.fstop, focus_mm=args.focus, lens=lens)
+    blades = int(args.blades or 0)
+    values = blender_camera_values(report, resolution_x=width_px, blades=blades if blades >= 3 else 0,
+                                   blade_rotation_deg=args.blade_angle)
+    return atomic_write(path, blender_camera_script(values), force=args.force)
