@@ -479,6 +479,12 @@ def apply(scene=None):
         cam_obj = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
         scene.collection.objects.link(cam_obj)
         scene.camera = cam_obj
+    # Cycles with OSL first: Blender compiles a custom camera shader when it is assigned, and only
+    # when Cycles is the engine (assigned under another engine, it stays uncompiled and renders black)
+    r = scene.render
+    r.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.shading_system = True
     text = bpy.data.texts.get(TEXT_NAME) or bpy.data.texts.new(TEXT_NAME)
     text.clear()
     text.write(_source())
@@ -489,13 +495,9 @@ def apply(scene=None):
     cam.sensor_fit = "HORIZONTAL"
     cam.sensor_width = SENSOR_WIDTH_MM
     cam.sensor_height = SENSOR_HEIGHT_MM
-    r = scene.render
-    r.engine = "CYCLES"
     r.resolution_x, r.resolution_y = RESOLUTION
     r.resolution_percentage = 100
     r.pixel_aspect_x = r.pixel_aspect_y = 1.0
-    scene.cycles.device = "CPU"
-    scene.cycles.shading_system = True
     return cam_obj
 
 
