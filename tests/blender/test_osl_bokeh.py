@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 
 from _blender import run_blender
+from physcam.analysis.blob import blob_moments, polygon_corners
 from physcam.analysis.bokeh import bokeh_image
 from physcam.export.blender import blender_setup_script, osl_camera_shader
 from physcam.lens.library import load_lens
@@ -92,56 +93,6 @@ for job in jobs:
     out[job["name"]] = {"img": a.tolist(), "seconds": time.perf_counter() - t0}
 print(json.dumps(out))
 '''
-
-
-def _moments(img, pixel):
-    """Centroid (x, y) and second moment about it (same units as ``pixel``: the pixel pitch) of an
-    image whose row 0 is the bottom, coordinates about the image centre."""
-    h, w = img.shape
-    ys, xs = np.indices(img.shape)
-    X, Y = (xs + 0.5 - w / 2) * pixel, (ys + 0.5 - h / 2) * pixel
-    tot = img.sum()
-    cx, cy = (img * X).sum() / tot, (img * Y).sum() / tot
-    m2 = (img * ((X - cx) ** 2 + (Y - cy) ** 2)).sum() / tot
-    return cx, cy, m2
-
-
-def _rim_profile(img, n_angles=360):
-    """Boundary radius (pixels) of a bright blob against polar angle about its centroid: along each
-    ray, where the image (3 x 3 box-smoothed, bilinear) last exceeds half its central plateau."""
-    h, w = img.shape
-    p = np.pad(img, 1)
-    sm = sum(p[1 + i:1 + i + h, 1 + j:1 + j + w] for i in (-1, 0, 1) for j in (-1, 0, 1)) / 9.0
-    ys, xs = np.indices(img.shape)
-    tot = img.sum()
-    cx, cy = (img * xs).sum() / tot, (img * ys).sum() / tot
-    r_eq = math.sqrt(2.0 * (img * ((xs - cx) ** 2 + (ys - cy) ** 2)).sum() / tot)  # disk: E[r^2] = R^2/2
-    plateau = sm[(xs - cx) ** 2 + (ys - cy) ** 2 < (0.5 * r_eq) ** 2].mean()
-    rs = np.arange(0.0, 1.6 * r_eq, 0.05)
-    th = np.arange(n_angles) * 2 * math.pi / n_angles
-    X = cx + np.cos(th)[:, None] * rs[None, :]
-    Y = cy + np.sin(th)[:, None] * rs[None, :]
-    x0 = np.clip(np.floor(X).astype(int), 0, w - 2)
-    y0 = np.clip(np.floor(Y).astype(int), 0, h - 2)
-    fx, fy = X - x0, Y - y0
-    v = (sm[y0, x0] * (1 - fx) * (1 - fy) + sm[y0, x0 + 1] * fx * (1 - fy) + sm[y0 + 1, x0] * (1 - fx) * fy
-         + sm[y0 + 1, x0 + 1] * fx * fy)
-    above = v > 0.5 * plateau
-    last = above.shape[1] - 1 - np.argmax(above[:, ::-1], axis=1)
-    return th, rs[last]
-
-
-def _corners(th, r):
-    """(number of corners, angle of one corner in degrees modulo 360/number): the profile is
-    low-passed to its first 12 harmonics; the corners are its local maxima, and the dominant
-    harmonic must agree with their count."""
-    F = np.fft.rfft(r)
-    F[13:] = 0.0
-    smooth = np.fft.irfft(F, r.size)
-    peaks = np.flatnonzero((smooth > np.roll(smooth, 1)) & (smooth >= np.roll(smooth, -1)))
-    k = int(np.argmax(np.abs(F[1:13]))) + 1
-    phase = -np.angle(F[k]) / k  # a maximum of cos(k (theta - phase))
-    return len(peaks), k, math.degrees(phase) % (360.0 / k)
 
 
 @pytest.fixture(scope="module")
@@ -225,9 +176,9 @@ def test_sphere_on_the_focus_plane_renders_sharp(renders, predicted):
     0.25 px; a focus error of 0.4 mm on the film at f/2.8 would blur it to 1.5 px."""
     img = renders["focus"]
     assert img.shape == FOCUS_PX[::-1] and img.sum() > 0
-    cx, cy, m2 = _moments(img, 1.0)
+    cx, cy, m2 = blob_moments(img, 1.0)
     d = math.sqrt(8 * m2)
-    _, _, m2p = _moments(predicted["spot"], 0.3 / 64 * FOCUS_PX[0] / 36.0)
+    _, _, m2p = blob_moments(predicted["spot"], 0.3 / 64 * FOCUS_PX[0] / 36.0)
     print(f"in focus: centroid ({cx:+.3f}, {cy:+.3f}) px, diameter {d:.3f} px; physcam's spot {math.sqrt(8 * m2p):.3f} px")
     assert abs(cx) < 0.25 and abs(cy) < 0.25
     assert d < 1.5
@@ -239,10 +190,10 @@ def test_bokeh_disk_matches_physcam(renders, predicted):
     under convolution) matches physcam's bokeh_image of a point at that depth, measured the same
     way on the same pixel grid, within 3 %."""
     p = CROP_MM / CROP_PX
-    cx, cy, m2 = _moments(renders["bokeh"], p)
+    cx, cy, m2 = blob_moments(renders["bokeh"], p)
     e = 2 * NEAR_SPHERE_M * 1000 * predicted["mag_near"]  # the sphere's sharp image diameter, mm
     d_render = math.sqrt(8 * m2 - e**2)
-    _, _, m2p = _moments(predicted["near"], p)
+    _, _, m2p = blob_moments(predicted["near"], p)
     d_pred = math.sqrt(8 * m2p)
     print(f"bokeh: rendered {d_render:.4f} mm (raw {math.sqrt(8 * m2):.4f}, sphere image {e:.3f} mm), "
           f"physcam {d_pred:.4f} mm, ratio {d_render / d_pred:.4f}; centroid ({cx:+.4f}, {cy:+.4f}) mm")
@@ -255,8 +206,8 @@ def test_bokeh_is_the_six_blade_iris(renders, predicted):
     """The rendered bokeh's rim (radius against polar angle about its centroid, where the image
     falls below half its plateau) has 6 corners, as physcam's has, and the corners point the same
     way (the picture is the film turned 180 deg, which maps a hexagon onto itself) within 3 deg."""
-    got = _corners(*_rim_profile(renders["bokeh"]))
-    want = _corners(*_rim_profile(predicted["near"]))
+    got = polygon_corners(renders["bokeh"])
+    want = polygon_corners(predicted["near"])
     print(f"corners: rendered {got[0]} (dominant harmonic {got[1]}, a corner at {got[2]:.1f} deg mod 60), "
           f"physcam {want[0]} ({want[1]}, {want[2]:.1f} deg)")
     assert want[:2] == (6, 6)

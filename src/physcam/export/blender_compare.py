@@ -1,0 +1,135 @@
+"""Side by side: a point light's bokeh through physcam's own tracer and through Cycles.
+
+``physcam compare blender LENS`` renders one small emissive sphere at a known distance through
+the generated OSL camera in Blender (a crop of the film centre, the shader made for that crop) and
+traces the same light through the same focused, stopped-down prescription with physcam's numba
+tracer (:func:`physcam.analysis.bokeh.bokeh_image`), binned on the render's pixel grid. Both
+images are measured the same way (:mod:`physcam.analysis.blob`): centroid, equivalent diameter
+(the sphere's own image removed in quadrature) and iris corners. Blender runs in a Python that
+has ``bpy`` (``--blender-python``, ``PHYSCAM_BLENDER_PYTHON`` or ``./.venv-blender``, which
+``make blender`` builds).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError, OpticsError, require_positive
+from ..lens.prescription import Prescription, takes_prescription
+
+__all__ = ["find_blender_python", "compare_bokeh"]
+
+_SCRIPT = '''
+import glob, json, runpy, sys
+import bpy
+import numpy as np
+for _p in glob.glob(bpy.utils.resource_path("LOCAL") + "/python/lib/python3*/site-packages"):
+    sys.path.insert(0, _p)
+job = json.loads(sys.argv[1])
+scene = bpy.context.scene
+for o in list(bpy.data.objects):
+    if o.type != "CAMERA":
+        bpy.data.objects.remove(o)
+cam = scene.camera
+cam.location, cam.rotation_euler = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)   # the film centre, looking down -Z
+runpy.run_path(job["setup"], run_name="physcam_setup")["apply"](scene)
+world = bpy.data.worlds.new("black"); scene.world = world; world.use_nodes = True
+world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+mat = bpy.data.materials.new("glow"); mat.use_nodes = True
+nt = mat.node_tree; nt.nodes.clear()
+em = nt.nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = 1.0
+nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
+scene.cycles.use_denoising = False
+scene.cycles.max_bounces = 0
+scene.cycles.pixel_filter_type = "BOX"
+scene.cycles.filter_width = 1.0
+scene.cycles.samples = job["samples"]
+scene.view_settings.view_transform = "Standard"
+bpy.ops.mesh.primitive_uv_sphere_add(radius=job["radius_m"], location=(0.0, 0.0, -job["distance_m"]),
+                                     segments=64, ring_count=32)
+bpy.context.object.data.materials.append(mat)
+bpy.ops.object.shade_smooth()
+scene.render.image_settings.file_format = "OPEN_EXR"
+scene.render.filepath = job["exr"]
+bpy.ops.render.render(write_still=True)
+img = bpy.data.images.load(job["exr"])
+w, h = img.size
+np.save(job["npy"], np.array(img.pixels[:], dtype=np.float64).reshape(h, w, 4)[:, :, 0])
+print(json.dumps({"ok": True}))
+'''
+
+
+def find_blender_python(explicit: str | None = None) -> str:
+    """A Python interpreter with Blender's ``bpy``: ``explicit``, else ``PHYSCAM_BLENDER_PYTHON``, else
+    ``./.venv-blender/bin/python``; :class:`InputError` saying how to get one otherwise."""
+    for cand in (explicit, os.environ.get("PHYSCAM_BLENDER_PYTHON"), str(Path(".venv-blender") / "bin" / "python")):
+        if cand and Path(cand).is_file():
+            return str(cand)
+    raise InputError("comparing with Blender needs a Python with Blender's bpy module: run `make blender` "
+                     "(builds .venv-blender) or pass --blender-python PATH")
+
+
+@takes_prescription
+def compare_bokeh(lens: Prescription, *, focus_mm: float, fstop: float, light_mm: float, aperture=None,
+                  crop_mm: float = 3.0, pixels: int = 128, samples: int = 512, rays: int = 2_000_000,
+                  sphere_mm: float = 1.0, blender_python: str | None = None, timeout_s: float = 600.0) -> dict:
+    """Render and trace a point light ``light_mm`` in front of the film with ``lens`` focused at
+    ``focus_mm`` and stopped to ``fstop``; return both images and the measured agreement."""
+    from ..analysis.blob import blob_moments, equivalent_diameter, polygon_corners
+    from ..analysis.bokeh import bokeh_image
+    from ..optics.focusing import focus
+    from ..optics.paraxial import stop_semi_diameter_for_fstop
+    from .blender import blender_setup_script, osl_camera_shader
+
+    crop = require_positive("crop", crop_mm)
+    if isinstance(pixels, bool) or not isinstance(pixels, int) or not 32 <= pixels <= 1024:
+        raise InputError(f"pixels must be a whole number from 32 to 1024, got {pixels!r}")
+    if isinstance(samples, bool) or not isinstance(samples, int) or not 1 <= samples <= 100_000:
+        raise InputError(f"samples must be a whole number from 1 to 100000, got {samples!r}")
+    d_light = require_positive("light distance", light_mm)
+    sphere = require_positive("sphere diameter", sphere_mm)
+    exe = find_blender_python(blender_python)
+    st = focus(lens, focus_mm)
+    semi = stop_semi_diameter_for_fstop(lens, fstop)  # as the shader bakes it (physcam.export.blender)
+    src = osl_camera_shader(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=crop, sensor_height_mm=crop,
+                            aperture=aperture)
+    with tempfile.TemporaryDirectory(prefix="physcam-compare-") as tmp:
+        setup = Path(tmp) / "setup.py"
+        setup.write_text(blender_setup_script(src, sensor_width_mm=crop, sensor_height_mm=crop,
+                                              resolution=(pixels, pixels)))
+        job = {"setup": str(setup), "samples": samples, "radius_m": sphere / 2000.0, "distance_m": d_light / 1000.0,
+               "exr": str(Path(tmp) / "render.exr"), "npy": str(Path(tmp) / "render.npy")}
+        p = subprocess.run([exe, "-c", _SCRIPT, json.dumps(job)], capture_output=True, text=True, timeout=timeout_s)
+        if p.returncode != 0 or not Path(job["npy"]).is_file():
+            tail = (p.stderr or p.stdout).strip().splitlines()[-1:] or ["no output"]
+            raise OpticsError(f"Blender could not render the comparison: {tail[0][:200]}")
+        rendered = np.load(job["npy"])
+    h = crop / 2
+    kw = dict(film_z=st.film_z, fresnel=False, stop_semi_diameter=semi, aperture=aperture)
+    traced = bokeh_image(st.prescription, d_light, rays=rays, pixels=pixels, extent_mm=(-h, h, -h, h), **kw)
+    off = bokeh_image(st.prescription, d_light, 10.0, rays=200_000, pixels=64, **kw)  # the magnification there
+    mag = abs(off.to_dict()["centroid_mm"][0]) / 10.0
+    pitch = crop / pixels
+    image = traced.image[..., 0]
+    if not rendered.sum() > 0 or not image.sum() > 0:
+        raise OpticsError("no light reached the crop: choose a light nearer the axis or a larger --crop")
+    e = sphere * mag  # the sphere's own (sharp) image on the film
+    d_render = equivalent_diameter(rendered, pitch, e)
+    d_trace = equivalent_diameter(image, pitch)
+    c_r, c_t = blob_moments(rendered, pitch)[:2], blob_moments(image, pitch)[:2]
+    rows = {
+        "equivalent_diameter_mm": {"cycles": d_render, "physcam": d_trace, "ratio": d_render / d_trace},
+        "centroid_mm": {"cycles": list(c_r), "physcam": list(c_t)},
+    }
+    if aperture is not None and getattr(aperture, "nsides", 0) >= 3:
+        # the rim's dominant harmonic is the corner count (robust to render noise, unlike local maxima)
+        rows["corners"] = {"cycles": polygon_corners(rendered)[1], "physcam": polygon_corners(image)[1]}
+    return {"lens": lens.name, "focus_from_film_mm": focus_mm, "fstop": fstop, "light_from_film_mm": d_light,
+            "crop_mm": crop, "pixels": pixels, "samples": samples, "sphere_image_mm": e, "measured": rows,
+            "images": {"cycles": rendered, "physcam": image}}
