@@ -107,10 +107,10 @@ class _Grid:
                 out += (wy[:, a] * wx[:, b])[:, None] * self.p[iy + a, ix + b]
         return out
 
-    def on_pixels(self, width, height):
-        """Values (height, width, 2) at pixel centres (i + 0.5, j + 0.5), rows top first."""
-        mx = _matrix((np.arange(width) + 0.5 - self.x0) / self.dx, self.nx)
-        my = _matrix((np.arange(height) + 0.5 - self.y0) / self.dy, self.ny)[::-1]  # top row first
+    def on_pixels(self, width, height, origin=(0.0, 0.0)):
+        """Values (height, width, 2) at pixel centres origin + (i + 0.5, j + 0.5), rows top first."""
+        mx = _matrix((origin[0] + np.arange(width) + 0.5 - self.x0) / self.dx, self.nx)
+        my = _matrix((origin[1] + np.arange(height) + 0.5 - self.y0) / self.dy, self.ny)[::-1]  # top row first
         return np.stack([my @ self.p[:, :, c] @ mx.T for c in range(2)], axis=-1)
 
 
@@ -290,7 +290,7 @@ def distortion_field(
     kx, ky = np.meshgrid((np.arange(mx - 1) + 0.5) * ex - ox, (np.arange(my - 1) + 0.5) * ey - oy)
     back = fwd.at(*inv.at(kx.ravel(), ky.ravel()).T)
     inv_err = float(np.hypot(back[:, 0] - kx.ravel(), back[:, 1] - ky.ravel()).max())
-    real_px = inv.on_pixels(W2, H2)
+    real_px = inv.on_pixels(W2, H2, (-ox, -oy))
     umap = np.zeros((H2, W2, 3), dtype=np.float32)
     umap[..., 0] = real_px[..., 0] / w_px
     umap[..., 1] = real_px[..., 1] / h_px
