@@ -1,0 +1,382 @@
+"""Distortion over the full 2-D field at any focus, and ST-maps for compositing (docs/analyses.md).
+
+**The field.** The lens is focused at the mark ``focus_mm`` (mm from the film plane, as
+:func:`physcam.optics.focusing.focus` does it: unit or internal focusing). For film points on a
+coarse regular grid covering the sensor (about one node per 32 pixels, edges included), the real
+chief ray is traced backward from the film through the centre of the stop
+(:func:`physcam.analysis._chief.aim_from_film`) and out to the object plane at the focus distance
+(at infinity focus: its direction). The ideal image of that object point is the one of physcam's
+best-match pinhole at that focus: focal length ``GaussianData.pinhole_focal_length`` and centre
+of projection at the entrance pupil, per meridian (X and Y differ for anamorphic lenses)::
+
+    ideal (mm, upright picture) = f_pin,x X / (z_obj - z_ep,x),  f_pin,y Y / (z_obj - z_ep,y)   (signs: see code)
+
+Between the nodes the mapping is interpolated by cubic convolution (Keys 1981, a = -1/2, third
+order accurate, with Keys' boundary rule), separably on the regular grid. Its error is measured,
+not assumed: real chief rays are traced at every grid cell's centre and compared with the
+interpolant (``interpolation_error_px``); likewise the inverse map (``inverse_error_px``).
+
+**Pixels.** Plate pixel coordinates are continuous, x from the left edge, y from the bottom edge
+of the upright picture (the film image turned by 180 degrees); pixel (i, j) has its centre at
+(i + 0.5, j + 0.5). Scale: ``width_px / sensor_width_mm`` and ``height_px / sensor_height_mm``.
+
+**ST-maps** (compositing convention, Nuke's STMap node): an output pixel takes its colour from
+the input image at (R width_in, G height_in), R = u and G = v normalised 0..1, origin bottom-left,
+pixel centres at (i + 0.5) / width; B = 0.
+
+* The **undistortion map** turns the plate (distorted, width x height) into the undistorted image
+  of (width + 2 ox) x (height + 2 oy) pixels: the overscan ox, oy is the smallest symmetric
+  margin whose bounding box keeps the ideal position of every plate pixel. Its R, G are
+  normalised to the plate; outside the plate's ideal image they lie outside 0..1 (no source).
+* The **distortion map** (width x height) turns such an undistorted (overscanned) image back
+  into the plate; its R, G are normalised to the overscanned size.
+
+Map arrays are image arrays: row 0 is the top row (as in EXR and PNG files).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ExportError, InputError, OpticsError, require_positive
+from ..lens.prescription import Prescription, takes_prescription
+
+__all__ = ["DistortionField", "distortion_field", "apply_stmap", "write_stmaps", "MAX_SIDE_PX", "MAX_PIXELS"]
+
+#: Largest width or height (pixels) and largest frame (pixels) a map is made for.
+MAX_SIDE_PX = 8192
+MAX_PIXELS = 36_000_000
+#: Grid spacing (pixels) of the traced chief rays and of the inverse's nodes.
+NODE_SPACING_PX = 32.0
+
+
+def _keys_weights(s):
+    """Cubic-convolution weights (n, 4) for offsets s in a cell (a = -1/2)."""
+    s2, s3 = s * s, s * s * s
+    return 0.5 * np.stack([-s3 + 2 * s2 - s, 3 * s3 - 5 * s2 + 2, -3 * s3 + 4 * s2 + s, s3 - s2], axis=-1)
+
+
+def _pad(g, axis):
+    """Keys' boundary rule: one extra node each side along ``axis``, f(-1) = 3 f0 - 3 f1 + f2."""
+    g = np.moveaxis(g, axis, 0)
+    lo = 3 * g[0] - 3 * g[1] + g[2]
+    hi = 3 * g[-1] - 3 * g[-2] + g[-3]
+    return np.moveaxis(np.concatenate([lo[None], g, hi[None]]), 0, axis)
+
+
+def _cell(t, n):
+    """Cell index (into the padded nodes' first of four) and offset for node coordinates t (n nodes)."""
+    i = np.clip(np.floor(t), 0, n - 2).astype(int)
+    return i, t - i  # offsets beyond [0, 1] extrapolate with the edge cell's cubic
+
+
+def _matrix(t, n):
+    """(len(t), n + 2) interpolation matrix onto the padded nodes."""
+    i, s = _cell(np.asarray(t, dtype=float), n)
+    m = np.zeros((i.size, n + 2))
+    w = _keys_weights(s)
+    rows = np.arange(i.size)
+    for k in range(4):
+        m[rows, i + k] += w[:, k]
+    return m
+
+
+class _Grid:
+    """A vector field (ny, nx, 2) on a regular grid of nodes x0 + k dx, y0 + l dy, interpolated."""
+
+    def __init__(self, values, x0, dx, y0, dy):
+        self.ny, self.nx = values.shape[:2]
+        self.p = _pad(_pad(np.asarray(values, dtype=float), 0), 1)
+        self.x0, self.dx, self.y0, self.dy = x0, dx, y0, dy
+
+    def at(self, x, y):
+        """Values (n, 2) at scattered points."""
+        ix, sx = _cell((np.asarray(x, float) - self.x0) / self.dx, self.nx)
+        iy, sy = _cell((np.asarray(y, float) - self.y0) / self.dy, self.ny)
+        wx, wy = _keys_weights(sx), _keys_weights(sy)
+        out = np.zeros((ix.size, 2))
+        for a in range(4):
+            for b in range(4):
+                out += (wy[:, a] * wx[:, b])[:, None] * self.p[iy + a, ix + b]
+        return out
+
+    def on_pixels(self, width, height, origin=(0.0, 0.0)):
+        """Values (height, width, 2) at pixel centres origin + (i + 0.5, j + 0.5), rows top first."""
+        mx = _matrix((origin[0] + np.arange(width) + 0.5 - self.x0) / self.dx, self.nx)
+        my = _matrix((origin[1] + np.arange(height) + 0.5 - self.y0) / self.dy, self.ny)[::-1]  # top row first
+        return np.stack([my @ self.p[:, :, c] @ mx.T for c in range(2)], axis=-1)
+
+
+def _nodes(extent_px, spacing=NODE_SPACING_PX):
+    n = max(5, int(math.ceil(extent_px / spacing)) + 1)
+    return n, extent_px / (n - 1)
+
+
+@dataclass
+class DistortionField:
+    """Real against ideal pixel positions over the frame at one focus, and the two ST-maps."""
+
+    lens_name: str
+    focus_from_film_mm: float
+    wavelength_nm: float
+    sensor_mm: tuple[float, float]
+    size_px: tuple[int, int]  # plate width, height
+    pinhole_focal_length_mm: tuple[float, float]  # (x, y) meridians
+    entrance_pupil_from_film_mm: tuple[float, float]
+    overscan_px: tuple[int, int]  # ox, oy: the undistorted image is (w + 2 ox) x (h + 2 oy)
+    grid_nodes: tuple[int, int]
+    interpolation_error_px: float  # max |interpolated - traced| ideal position at the grid cells' centres
+    inverse_error_px: float  # max |D(U(q)) - q| at the inverse grid cells' centres
+    max_distortion_px: float  # largest |ideal - real| over the traced nodes
+    distortion_stmap: np.ndarray = field(repr=False)  # (h, w, 3) float32
+    undistortion_stmap: np.ndarray = field(repr=False)  # (h + 2 oy, w + 2 ox, 3) float32
+    notes: list[str] = field(default_factory=list)
+    _forward: _Grid | None = field(default=None, repr=False)
+
+    def ideal_from_real(self, xy_px) -> np.ndarray:
+        """Ideal (undistorted) plate pixel positions (n, 2) of real ones (interpolated field)."""
+        p = np.atleast_2d(np.asarray(xy_px, dtype=float))
+        return self._forward.at(p[:, 0], p[:, 1])
+
+    def to_dict(self) -> dict:
+        return {
+            "lens": self.lens_name,
+            "focus_from_film_mm": None if math.isinf(self.focus_from_film_mm) else self.focus_from_film_mm,
+            "wavelength_nm": self.wavelength_nm, "sensor_mm": list(self.sensor_mm), "size_px": list(self.size_px),
+            "pinhole_focal_length_mm": {"x": self.pinhole_focal_length_mm[0], "y": self.pinhole_focal_length_mm[1]},
+            "entrance_pupil_from_film_mm": {"x": self.entrance_pupil_from_film_mm[0],
+                                            "y": self.entrance_pupil_from_film_mm[1]},
+            "overscan_px": list(self.overscan_px),
+            "undistorted_size_px": [self.size_px[0] + 2 * self.overscan_px[0], self.size_px[1] + 2 * self.overscan_px[1]],
+            "grid_nodes": list(self.grid_nodes), "interpolation_error_px": self.interpolation_error_px,
+            "inverse_error_px": self.inverse_error_px, "max_distortion_px": self.max_distortion_px,
+            "convention": "ST-map: R = u, G = v, 0..1, origin bottom-left, pixel centres at (i + 0.5) / width; B = 0",
+            "notes": list(self.notes),
+        }
+
+
+def _size(name, v) -> int:
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 16 <= v <= MAX_SIDE_PX:
+        raise InputError(f"the {name} must be a whole number of pixels from 16 to {MAX_SIDE_PX}, got {v!r}")
+    return int(v)
+
+
+def _real_to_ideal(q, gx, gy, st, film_xy, wl, backend):
+    """Trace chief rays backward from film points (n, 2) mm; ideal upright picture mm (n, 2) and ok."""
+    from ..trace import RayBatch, trace_through
+    from ._chief import aim_from_film
+
+    aimed = aim_from_film(q, film_xy, st.film_z, wavelength_nm=wl, backend=backend)
+    out = trace_through(q, RayBatch.from_arrays(aimed.start, aimed.direction, wl), reverse=True, backend=backend)
+    ok = aimed.ok & out.ok & (out.N < -1e-9)
+    N = np.where(ok, out.N, -1.0)
+    if math.isinf(st.object_z):  # the object point lies along the ray: its tangents
+        tx, ty = out.L / -N, out.M / -N
+    else:
+        t = (st.object_z - out.z) / N
+        X, Y = out.x + t * out.L, out.y + t * out.M
+        tx = X / (gx.z_entrance_pupil - st.object_z)
+        ty = Y / (gy.z_entrance_pupil - st.object_z)
+    # the upright picture is the film image turned by 180 degrees: a scene point at +X lands at -x
+    # on the film and at +x in the picture, at f_pin tan(angle) from the centre
+    ideal = np.stack([gx.pinhole_focal_length * tx, gy.pinhole_focal_length * ty], axis=1)
+    return np.where(ok[:, None], ideal, 0.0), ok
+
+
+@takes_prescription
+def distortion_field(
+    lens: Prescription,
+    *,
+    focus_mm: float = math.inf,
+    sensor_width_mm: float,
+    sensor_height_mm: float,
+    width_px: int,
+    height_px: int,
+    wavelength_nm: float | None = None,
+    method: str = "auto",
+    backend: str = "auto",
+) -> DistortionField:
+    """Real distortion of ``lens`` focused at ``focus_mm`` over a ``width_px`` x ``height_px`` frame,
+    with its distortion and undistortion ST-maps (module notes)."""
+    from ..optics.focusing import focus
+    from ..optics.paraxial import gaussian
+
+    w_px, h_px = _size("width", width_px), _size("height", height_px)
+    if w_px * h_px > MAX_PIXELS:
+        raise InputError(f"a {w_px} x {h_px} frame has more than {MAX_PIXELS:,} pixels: give a smaller resolution")
+    W = require_positive("sensor width", sensor_width_mm)
+    H = require_positive("sensor height", sensor_height_mm)
+    wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
+    st = focus(lens, focus_mm, method=method, axis="y", wavelength_nm=wl)
+    q = st.prescription
+    g = {a: gaussian(q, axis=a, wavelength_nm=wl, object_z=st.object_z, film_z=st.film_z) for a in ("x", "y")}
+    for a in ("x", "y"):
+        if g[a].pinhole_focal_length is None or not g[a].efl > 0:
+            raise OpticsError(f"lens {lens.name!r} has no best-match pinhole in {a.upper()} at this focus")
+    sx, sy = w_px / W, h_px / H  # pixels per mm
+
+    def film_of(px, py):  # plate pixels -> film mm (the film image is the picture turned by 180 deg)
+        return np.stack([-(px - w_px / 2) / sx, -(py - h_px / 2) / sy], axis=1)
+
+    def trace(px, py):
+        ideal, ok = _real_to_ideal(q, g["x"], g["y"], st, film_of(px, py), wl, backend)
+        if not ok.all():
+            i = int(np.argmin(ok))
+            raise OpticsError(
+                f"at focus {st.focus_from_film_mm:g} mm no chief ray leaves {lens.name!r} from the film point "
+                f"({px[i]:.0f}, {py[i]:.0f}) px of a {W:g} x {H:g} mm sensor: the lens does not cover it; "
+                "give a smaller sensor")
+        return np.stack([ideal[:, 0] * sx + w_px / 2, ideal[:, 1] * sy + h_px / 2], axis=1)
+
+    # forward field: real plate position -> ideal plate position, traced at the nodes
+    nx, dx = _nodes(w_px)
+    ny, dy = _nodes(h_px)
+    X, Y = np.meshgrid(np.arange(nx) * dx, np.arange(ny) * dy)
+    nodes = trace(X.ravel(), Y.ravel()).reshape(ny, nx, 2)
+    fwd = _Grid(nodes, 0.0, dx, 0.0, dy)
+    cx, cy = np.meshgrid((np.arange(nx - 1) + 0.5) * dx, (np.arange(ny - 1) + 0.5) * dy)
+    exact = trace(cx.ravel(), cy.ravel())
+    interp_err = float(np.hypot(*(fwd.at(cx.ravel(), cy.ravel()) - exact).T).max())
+    max_dist = float(np.hypot(nodes[..., 0] - X, nodes[..., 1] - Y).max())
+
+    ideal_px = fwd.on_pixels(w_px, h_px)  # (h, w, 2), rows top first
+    # overscan: the symmetric margin whose box keeps the ideal position of every plate pixel
+    edges = np.concatenate([nodes[0], nodes[-1], nodes[:, 0], nodes[:, -1], ideal_px.reshape(-1, 2)])
+    ox = int(math.ceil(max(0.0, -edges[:, 0].min(), edges[:, 0].max() - w_px) - 1e-9))
+    oy = int(math.ceil(max(0.0, -edges[:, 1].min(), edges[:, 1].max() - h_px) - 1e-9))
+    W2, H2 = w_px + 2 * ox, h_px + 2 * oy
+    if W2 * H2 > 4 * MAX_PIXELS or W2 > 4 * MAX_SIDE_PX or H2 > 4 * MAX_SIDE_PX:
+        raise OpticsError(f"the undistorted frame would be {W2} x {H2} px: the distortion is too strong for an ST-map")
+    dmap = np.zeros((h_px, w_px, 3), dtype=np.float32)
+    dmap[..., 0] = (ideal_px[..., 0] + ox) / W2
+    dmap[..., 1] = (ideal_px[..., 1] + oy) / H2
+    del ideal_px
+
+    # inverse: ideal position -> real position, by Newton on the interpolated field at nodes over
+    # the overscanned frame (coordinates in plate pixels: -ox .. w + ox)
+    mx, ex = _nodes(W2)
+    my, ey = _nodes(H2)
+
+    def invert(qx, qy):
+        r = np.stack([qx, qy], axis=1).astype(float)
+        goal = r.copy()
+        h = 0.25
+        for _ in range(30):
+            f = fwd.at(r[:, 0], r[:, 1]) - goal
+            if np.abs(f).max() < 1e-7:
+                break
+            fx = (fwd.at(r[:, 0] + h, r[:, 1]) - fwd.at(r[:, 0] - h, r[:, 1])) / (2 * h)
+            fy = (fwd.at(r[:, 0], r[:, 1] + h) - fwd.at(r[:, 0], r[:, 1] - h)) / (2 * h)
+            det = fx[:, 0] * fy[:, 1] - fy[:, 0] * fx[:, 1]
+            if not (np.abs(det) > 1e-9).all():
+                raise OpticsError(f"the distortion of {lens.name!r} folds the picture over: it has no undistortion map")
+            step = np.stack([(fy[:, 1] * f[:, 0] - fy[:, 0] * f[:, 1]) / det,
+                             (-fx[:, 1] * f[:, 0] + fx[:, 0] * f[:, 1]) / det], axis=1)
+            r -= np.clip(step, -0.25 * max(w_px, h_px), 0.25 * max(w_px, h_px))
+        return r
+
+    QX, QY = np.meshgrid(np.arange(mx) * ex - ox, np.arange(my) * ey - oy)
+    inv_nodes = invert(QX.ravel(), QY.ravel()).reshape(my, mx, 2)
+    if not np.isfinite(inv_nodes).all():
+        raise OpticsError(f"the undistortion of {lens.name!r} did not converge: no map written")
+    inv = _Grid(inv_nodes, -ox, ex, -oy, ey)
+    kx, ky = np.meshgrid((np.arange(mx - 1) + 0.5) * ex - ox, (np.arange(my - 1) + 0.5) * ey - oy)
+    back = fwd.at(*inv.at(kx.ravel(), ky.ravel()).T)
+    inv_err = float(np.hypot(back[:, 0] - kx.ravel(), back[:, 1] - ky.ravel()).max())
+    real_px = inv.on_pixels(W2, H2, (-ox, -oy))
+    umap = np.zeros((H2, W2, 3), dtype=np.float32)
+    umap[..., 0] = real_px[..., 0] / w_px
+    umap[..., 1] = real_px[..., 1] / h_px
+    del real_px
+    if not (np.isfinite(dmap).all() and np.isfinite(umap).all()):
+        raise OpticsError(f"the ST-maps of {lens.name!r} have non-finite values: no map written")
+    notes = [f"pinhole focal length from GaussianData.pinhole_focal_length at this focus; camera at the entrance pupil"]
+    zf = st.film_z
+    return DistortionField(
+        lens.name, float(st.focus_from_film_mm), float(wl), (W, H), (w_px, h_px),
+        (float(g["x"].pinhole_focal_length), float(g["y"].pinhole_focal_length)),
+        (float(zf - g["x"].z_entrance_pupil), float(zf - g["y"].z_entrance_pupil)),
+        (ox, oy), (nx, ny), interp_err, inv_err, max_dist, dmap, umap, notes, fwd)
+
+
+def apply_stmap(image, stmap) -> np.ndarray:
+    """Resample ``image`` (h, w) or (h, w, c) through ``stmap`` (H, W, >= 2; R = u, G = v, module notes).
+
+    Output pixel (row, col) takes the bilinear sample of ``image`` at (u w, v h) (origin bottom-left,
+    pixel centres at half integers); samples outside the image are 0. Returns float64 (H, W[, c]).
+    """
+    img = np.asarray(image, dtype=float)
+    m = np.asarray(stmap, dtype=float)
+    if img.ndim not in (2, 3) or img.shape[0] < 1 or img.shape[1] < 1:
+        raise InputError(f"the image must be an (h, w) or (h, w, channels) array, got shape {img.shape}")
+    if m.ndim != 3 or m.shape[2] < 2:
+        raise InputError(f"the ST-map must be an (h, w, 2 or more) array, got shape {m.shape}")
+    if not np.isfinite(m[..., :2]).all():
+        raise InputError("the ST-map has non-finite values")
+    h, w = img.shape[:2]
+    flat = img.reshape(h, w, -1)
+    x = m[..., 0] * w - 0.5  # column coordinate of the sample
+    y = (1.0 - m[..., 1]) * h - 0.5  # row coordinate (rows top first)
+    x0, y0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
+    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
+    out = np.zeros(m.shape[:2] + (flat.shape[2],))
+    for dy_, wy in ((0, 1 - fy), (1, fy)):
+        for dx_, wx in ((0, 1 - fx), (1, fx)):
+            xi, yi = x0 + dx_, y0 + dy_
+            inside = (xi >= 0) & (xi < w) & (yi >= 0) & (yi < h)
+            v = flat[np.clip(yi, 0, h - 1), np.clip(xi, 0, w - 1)]
+            out += np.where(inside[..., None], wy * wx * v, 0.0)
+    return out if img.ndim == 3 else out[..., 0]
+
+
+def _exr_bytes(rgb: np.ndarray) -> bytes:
+    """A 32-bit float RGB scanline EXR (ZIP) of ``rgb`` (h, w, 3), as bytes."""
+    import OpenEXR
+
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    fd, tmp = tempfile.mkstemp(suffix=".exr")
+    os.close(fd)
+    try:
+        with OpenEXR.File(header, {"RGB": np.ascontiguousarray(rgb, dtype=np.float32)}) as f:
+            f.write(tmp)
+        return Path(tmp).read_bytes()
+    finally:
+        os.unlink(tmp)
+
+
+def _png_bytes(rgb: np.ndarray) -> bytes:
+    from matplotlib.image import imsave
+
+    buf = io.BytesIO()
+    imsave(buf, np.clip(rgb, 0.0, 1.0), format="png")
+    return buf.getvalue()
+
+
+def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> list[Path]:
+    """Write ``distortion.exr``, ``undistortion.exr`` and a PNG preview beside each into ``folder``.
+
+    Every name is checked before anything is written, so an existing file (without ``force``)
+    leaves the folder as it was. Returns the paths written.
+    """
+    from ..io import atomic_write, check_writable
+
+    if not isinstance(result, DistortionField):
+        raise InputError(f"write_stmaps takes a DistortionField, got {type(result).__name__}")
+    d = Path(folder)
+    if d.exists() and not d.is_dir():
+        raise ExportError(f"{str(d)!r} exists and is not a folder: give a folder for the ST-maps")
+    items = [("distortion", result.distortion_stmap), ("undistortion", result.undistortion_stmap)]
+    payload = []
+    for name, rgb in items:
+        payload.append((d / f"{name}.exr", _exr_bytes(rgb)))
+        payload.append((d / f"{name}.png", _png_bytes(rgb)))
+    for p, _ in payload:
+        check_writable(p, force=force)
+    return [atomic_write(p, data, force=force) for p, data in payload]

@@ -1,0 +1,204 @@
+"""ST-maps at a focus (physcam.analysis.stmap), checked against forward-traced object points.
+
+The oracle: object points on the plane of sharp focus, each placed where physcam's best-match
+pinhole (GaussianData at that focus, camera at the entrance pupil) sees a chosen ideal pixel;
+their chief rays are aimed *forward* here (a Newton iteration written in this file, from the
+object point through the centre of the stop) and traced to the film. That is independent of the
+module's backward chief rays from film points and of its interpolation and inversion.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from physcam.errors import PhysCamError
+from physcam.lens.library import load_lens
+from physcam.optics.focusing import focus
+from physcam.optics.paraxial import gaussian
+from physcam.trace import RayBatch, trace_through
+
+W_PX, H_PX = 2048, 1366
+SENSOR = (36.0, 24.0)
+FOCUS = 2000.0
+
+
+def _forward_chief_to_film(q, obj_pts, object_z, film_z, wl):
+    """Film (x, y) mm of chief rays from object points (n, 2) on z = object_z, aimed at the stop centre."""
+    k = q.stop_index
+    front = q.with_surfaces(q.surfaces[: k + 1])
+    z_ep = gaussian(q, wavelength_nm=wl, object_z=object_z, film_z=film_z).z_entrance_pupil
+    n = obj_pts.shape[0]
+
+    def at_stop(a, b):
+        P = np.tile(obj_pts, (a.size // n, 1))
+        pos = np.stack([P[:, 0], P[:, 1], np.full(a.size, object_z)], axis=1)
+        d = np.stack([a - P[:, 0], b - P[:, 1], np.full(a.size, z_ep - object_z)], axis=1)
+        out = trace_through(front, RayBatch.from_arrays(pos, d, wl), clip=False)
+        assert out.ok.all()
+        return np.stack([out.x, out.y], axis=1), pos, d
+
+    a = np.zeros(n)
+    b = np.zeros(n)
+    e = 1e-6
+    for _ in range(30):
+        s, _, _ = at_stop(np.concatenate([a, a + e, a]), np.concatenate([b, b, b + e]))
+        r, ra, rb = s[:n], (s[n:2 * n] - s[:n]) / e, (s[2 * n:] - s[:n]) / e
+        if np.abs(r).max() < 1e-10:
+            break
+        det = ra[:, 0] * rb[:, 1] - rb[:, 0] * ra[:, 1]
+        a = a - (rb[:, 1] * r[:, 0] - rb[:, 0] * r[:, 1]) / det
+        b = b - (-ra[:, 1] * r[:, 0] + ra[:, 0] * r[:, 1]) / det
+    assert np.abs(r).max() < 1e-8
+    _, pos, d = at_stop(a, b)
+    out = trace_through(q, RayBatch.from_arrays(pos, d, wl), end_z=film_z, clip=False)
+    assert out.ok.all()
+    return np.stack([out.x, out.y], axis=1)
+
+
+def _sample(stmap, xy_px, size):
+    """Bilinear sample of a map at plate-style pixel positions (n, 2) of an image ``size`` (w, h)."""
+    from physcam.analysis.stmap import apply_stmap
+
+    w, h = size
+    probe = np.zeros((1, xy_px.shape[0], 3))
+    probe[0, :, 0] = xy_px[:, 0] / w
+    probe[0, :, 1] = xy_px[:, 1] / h
+    return apply_stmap(stmap, probe)[0, :, :2]
+
+
+@pytest.fixture(scope="module", params=["zeiss_distagon_35mm_f4", "zuiko_18mm_f3_5"])
+def case(request):
+    from physcam.analysis.stmap import distortion_field
+
+    lens = load_lens(request.param)
+    res = distortion_field(lens, focus_mm=FOCUS, sensor_width_mm=SENSOR[0], sensor_height_mm=SENSOR[1],
+                           width_px=W_PX, height_px=H_PX)
+    return lens, res
+
+
+def _ideal_grid_and_real(lens, res):
+    """An ideal pixel grid inside the frame and the forward-traced real pixel of each point."""
+    wl = lens.wavelength_nm
+    st = focus(lens, FOCUS, axis="y", wavelength_nm=wl)
+    q = st.prescription
+    gx = gaussian(q, axis="x", wavelength_nm=wl, object_z=st.object_z, film_z=st.film_z)
+    gy = gaussian(q, axis="y", wavelength_nm=wl, object_z=st.object_z, film_z=st.film_z)
+    sx, sy = W_PX / SENSOR[0], H_PX / SENSOR[1]
+    X, Y = np.meshgrid(np.linspace(40, W_PX - 40, 11), np.linspace(30, H_PX - 30, 8))
+    ideal = np.stack([X.ravel(), Y.ravel()], axis=1)
+    # the object point the pinhole (focal length f, at the entrance pupil) images at the ideal pixel
+    Xo = (ideal[:, 0] - W_PX / 2) / sx / gx.pinhole_focal_length * (gx.z_entrance_pupil - st.object_z)
+    Yo = (ideal[:, 1] - H_PX / 2) / sy / gy.pinhole_focal_length * (gy.z_entrance_pupil - st.object_z)
+    film = _forward_chief_to_film(q, np.stack([Xo, Yo], axis=1), st.object_z, st.film_z, wl)
+    # the picture is the film image turned by 180 degrees; pixels from the bottom-left corner
+    real = np.stack([W_PX / 2 - film[:, 0] * sx, H_PX / 2 - film[:, 1] * sy], axis=1)
+    return ideal, real
+
+
+def test_undistortion_map_takes_traced_points_to_the_pinhole_grid(case):
+    lens, res = case
+    ideal, real = _ideal_grid_and_real(lens, res)
+    ox, oy = res.overscan_px
+    W2, H2 = W_PX + 2 * ox, H_PX + 2 * oy
+    assert res.undistortion_stmap.shape == (H2, W2, 3)
+    # the undistorted image's pixel at the ideal position fetches the plate at the traced position
+    src = _sample(res.undistortion_stmap, ideal + [ox, oy], (W2, H2)) * [W_PX, H_PX]
+    err = np.hypot(*(src - real).T)
+    assert err.max() < 0.1, err.max()
+    # the lens distorts visibly, so this is not passing by doing nothing
+    assert np.hypot(*(real - ideal).T).max() > 5.0
+
+
+def test_distortion_map_returns_the_undistorted_grid(case):
+    lens, res = case
+    ideal, real = _ideal_grid_and_real(lens, res)
+    ox, oy = res.overscan_px
+    W2, H2 = W_PX + 2 * ox, H_PX + 2 * oy
+    # distortion map at the traced (plate) position fetches the undistorted image at the ideal one
+    back = _sample(res.distortion_stmap, real, (W_PX, H_PX)) * [W2, H2] - [ox, oy]
+    assert np.hypot(*(back - ideal).T).max() < 0.1
+    # and the round trip through both maps
+    src = _sample(res.undistortion_stmap, ideal + [ox, oy], (W2, H2)) * [W_PX, H_PX]
+    again = _sample(res.distortion_stmap, src, (W_PX, H_PX)) * [W2, H2] - [ox, oy]
+    assert np.hypot(*(again - ideal).T).max() < 0.1
+
+
+def test_overscan_keeps_every_plate_pixel(case):
+    _, res = case
+    ox, oy = res.overscan_px
+    d = res.distortion_stmap
+    assert d.shape == (H_PX, W_PX, 3)
+    assert d[..., :2].min() >= 0.0 and d[..., :2].max() <= 1.0
+    assert (d[..., 2] == 0).all()
+    assert ox > 0 and oy > 0  # barrel at the corners: the ideal image is larger than the plate
+    assert res.interpolation_error_px < 0.05 and res.inverse_error_px < 0.05
+
+
+def test_image_round_trip_through_both_maps(case):
+    """A smooth image undistorted then distorted comes back (bilinear twice: small blur only)."""
+    from physcam.analysis.stmap import apply_stmap
+
+    _, res = case
+    yy, xx = np.mgrid[0:H_PX, 0:W_PX] + 0.5
+    img = np.sin(xx / 37.0) * np.cos(yy / 23.0)
+    und = apply_stmap(img, res.undistortion_stmap)
+    back = apply_stmap(und, res.distortion_stmap)
+    inner = (slice(20, -20), slice(20, -20))
+    assert np.abs(back - img)[inner].max() < 0.02
+
+
+def test_identity_map_and_bilinear_by_hand():
+    from physcam.analysis.stmap import apply_stmap
+
+    img = np.arange(12.0).reshape(3, 4)  # rows top first
+    h, w = img.shape
+    ident = np.zeros((h, w, 3))
+    ident[..., 0] = (np.arange(w) + 0.5) / w
+    ident[..., 1] = ((h - 1 - np.arange(h)) + 0.5)[:, None] / h
+    assert np.allclose(apply_stmap(img, ident), img)
+    # halfway between the centres of columns 1 and 2 of the middle row: (5 + 6) / 2
+    probe = np.array([[[2.0 / w, 1.5 / h]]])
+    assert apply_stmap(img, probe)[0, 0] == pytest.approx(5.5)
+
+
+def test_exr_files_open_as_float_rgb(tmp_path, case):
+    import OpenEXR
+
+    from physcam.analysis.stmap import write_stmaps
+
+    _, res = case
+    paths = write_stmaps(res, tmp_path / "maps")
+    assert sorted(p.name for p in paths) == ["distortion.exr", "distortion.png", "undistortion.exr", "undistortion.png"]
+    for name, arr in (("distortion", res.distortion_stmap), ("undistortion", res.undistortion_stmap)):
+        with OpenEXR.File(str(tmp_path / "maps" / f"{name}.exr"), separate_channels=True) as f:
+            ch = f.channels()
+            assert set(ch) >= {"R", "G", "B"}
+            for c in "RGB":
+                assert ch[c].type() == OpenEXR.FLOAT
+                assert ch[c].pixels.dtype == np.float32
+                assert ch[c].pixels.shape == arr.shape[:2]
+            assert np.array_equal(ch["R"].pixels, arr[..., 0])
+            assert np.array_equal(ch["G"].pixels, arr[..., 1])
+            assert (ch["B"].pixels == 0).all()
+    # no clobber without force, and nothing half written
+    before = {p.name: p.stat().st_mtime_ns for p in (tmp_path / "maps").iterdir()}
+    with pytest.raises(PhysCamError):
+        write_stmaps(res, tmp_path / "maps")
+    assert {p.name: p.stat().st_mtime_ns for p in (tmp_path / "maps").iterdir()} == before
+
+
+@pytest.mark.parametrize("kw", [dict(width_px=0, height_px=1366), dict(width_px=100000, height_px=1366),
+                                dict(width_px=8192, height_px=8192), dict(width_px=2048.0, height_px=1366),
+                                dict(width_px=2048, height_px=1366, focus_mm=50.0),
+                                dict(width_px=2048, height_px=1366, focus_mm=-3.0),
+                                dict(width_px=2048, height_px=1366, focus_mm=math.nan)])
+def test_bad_inputs_are_one_clear_error(kw):
+    from physcam.analysis.stmap import distortion_field
+
+    with pytest.raises(PhysCamError) as e:
+        distortion_field(load_lens("zeiss_distagon_35mm_f4"), sensor_width_mm=36, sensor_height_mm=24,
+                         **{"focus_mm": 2000.0, **kw})
+    assert str(e.value).strip().endswith((".", ")")) or len(str(e.value)) > 20
