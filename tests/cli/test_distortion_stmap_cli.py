@@ -44,3 +44,12 @@ def test_without_the_new_options_the_table_is_unchanged(capsys):
     assert main(["distortion", "zuiko_18mm_f3_5", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
     assert "points" in d and "overscan_px" not in d
+
+
+def test_plot_file_with_resolution_is_refused_not_ignored(tmp_path, capsys):
+    """-o (the table's plot) with --resolution was silently ignored: refused with the way forward."""
+    from physcam.cli import main
+
+    rc = main(["distortion", "zeiss_distagon_35mm_f4", "--resolution", "256x171", "-o", str(tmp_path / "d.png")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--stmap DIR" in err and not (tmp_path / "d.png").exists()

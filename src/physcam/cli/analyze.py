@@ -262,10 +262,13 @@ def run_ghosts(args) -> int:
 def _run_field(args, lens) -> int:
     from ..analysis.stmap import distortion_field, write_stmaps
 
-    if args.field:
-        from ..errors import InputError
+    from ..errors import InputError
 
+    if args.field:
         raise InputError("--field is for the field-angle table; the 2-D field (--resolution) covers the whole frame")
+    if args.output:
+        raise InputError("-o draws the field-angle table's plot; with --resolution the maps go to --stmap DIR "
+                         "(each EXR with a PNG preview)")
     res = distortion_field(lens, focus_mm=math.inf if args.focus is None else args.focus,
                            sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
                            width_px=args.resolution[0], height_px=args.resolution[1], wavelength_nm=args.wavelength)
