@@ -100,7 +100,10 @@ def main(argv: list[str] | None = None) -> int:
         _silence_stdout()
         return 0
     except OSError as exc:
-        if exc.errno is None or getattr(exc, "filename", None) is not None:
+        import errno
+
+        output_errors = {errno.ENOSPC, errno.EIO, errno.EDQUOT, errno.EFBIG}
+        if exc.errno not in output_errors or getattr(exc, "filename", None) is not None:
             raise
         # the output stream itself failed (e.g. `physcam lenses > /dev/full`)
         _silence_stdout()
