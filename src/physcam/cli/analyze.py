@@ -30,23 +30,12 @@ def _sensor(p) -> None:
 
 def _resolve_sensor(args) -> None:
     """Fill args.sensor_width/height (mm) from --sensor NAME, or the pair, or full frame 36x24."""
-    from ..errors import InputError
-    from ..onset.sensors import custom_sensor, find_sensor
+    from .report import resolve_sensor
 
     if not hasattr(args, "sensor_width"):
         return
-    if args.sensor:
-        if args.sensor_width is not None or args.sensor_height is not None:
-            raise InputError("give either --sensor NAME or --sensor-width/--sensor-height, not both")
-        s = find_sensor(args.sensor)
-        args.sensor_width, args.sensor_height = s.width_mm, s.height_mm
-    elif args.sensor_width is None and args.sensor_height is None:
-        args.sensor_width, args.sensor_height = 36.0, 24.0
-    elif args.sensor_width is None or args.sensor_height is None:
-        raise InputError("give both --sensor-width and --sensor-height")
-    else:
-        s = custom_sensor(args.sensor_width, args.sensor_height)  # bounded size and aspect
-        args.sensor_width, args.sensor_height = s.width_mm, s.height_mm
+    s = resolve_sensor(args, default="Full Frame")
+    args.sensor_width, args.sensor_height = s.width_mm, s.height_mm
 
 
 def register(sub) -> None:

@@ -82,7 +82,9 @@ def add_report_arguments(p) -> None:
                    help="vertical lens/sensor shift on the film (mm; + up; write negative values as --shift-y=-2)")
 
 
-def resolve_sensor(args):
+def resolve_sensor(args, default: str = "Super 35"):
+    """The sensor a command was given: --sensor NAME, or --sensor-width with --sensor-height (a
+    bounded custom sensor), else ``default``. One resolver for every command that takes a sensor."""
     from ..errors import InputError
     from ..onset.sensors import custom_sensor, find_sensor
 
@@ -95,7 +97,7 @@ def resolve_sensor(args):
         if args.sensor_width is None or args.sensor_height is None:
             raise InputError("give both --sensor-width and --sensor-height")
         return custom_sensor(args.sensor_width, args.sensor_height)
-    return find_sensor("Super 35")
+    return find_sensor(default)
 
 
 def solve_from_args(args):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ._common import coc_value, distance, number, numbers
+from .report import resolve_sensor
 
 EPILOG = """\
 examples:
@@ -259,7 +260,7 @@ def run_kit(args) -> int:
             raise InputError(f"physcam usd kit vendor needs {' and '.join(missing)}")
         from ..lens.library import load_lens
 
-        sensor = _kit_sensor(args, default="Full Frame")
+        sensor = resolve_sensor(args, default="Full Frame")
         path = kit.write_vendor_lens(args.file, load_lens(args.lens, lenient=args.lenient), focus_mm=args.focus,
                                      fstop=args.fstop,
                                      sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm, **common)
@@ -272,7 +273,7 @@ def run_kit(args) -> int:
 
         from ..optics.coc import circle_of_confusion
 
-        sensor = _kit_sensor(args, default="Super 35")
+        sensor = resolve_sensor(args, default="Super 35")
         coc, _ = circle_of_confusion(sensor.width_mm, sensor.height_mm, coc_value(args.coc))
         body = dict(sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm, sensor_name=sensor.name,
                     coc_mm=coc)
@@ -310,21 +311,6 @@ def run_kit(args) -> int:
                                  for n in lens.GetVariantSets().GetNames()}})
         return 0
     return _done(args, path)
-
-
-def _kit_sensor(args, default: str):
-    from ..errors import InputError
-    from ..onset.sensors import custom_sensor, find_sensor
-
-    if args.sensor is not None:
-        if args.sensor_width is not None or args.sensor_height is not None:
-            raise InputError("give either --sensor NAME or --sensor-width/--sensor-height, not both")
-        return find_sensor(args.sensor)
-    if args.sensor_width is not None or args.sensor_height is not None:
-        if args.sensor_width is None or args.sensor_height is None:
-            raise InputError("give both --sensor-width and --sensor-height")
-        return custom_sensor(args.sensor_width, args.sensor_height)
-    return find_sensor(default)
 
 
 def _read_characterizations(csv_path) -> dict:
@@ -387,7 +373,7 @@ def run_animate(args) -> int:
         lens = load_lens(args.lens, lenient=args.lenient)
     coc = coc_value(args.coc)
     keys = read_focus_marks(args.marks)
-    path = write_animated_camera(args.file, keys, sensor=_kit_sensor(args, default="Super 35"), lens=lens,
+    path = write_animated_camera(args.file, keys, sensor=resolve_sensor(args, default="Super 35"), lens=lens,
                                  focal_length_mm=args.focal, fstop=args.fstop, coc=coc, path=args.path,
                                  meters_per_unit=args.meters_per_unit, fps=args.fps,
                                  shutter_angle_deg=args.shutter_angle, position=args.position,
