@@ -20,7 +20,6 @@ frame (the CSV of a focus-pull recording is). Lengths in mm (docs/conventions.md
 
 from __future__ import annotations
 
-import math
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -108,9 +107,9 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     """
     from pxr import Gf, Sdf, UsdGeom
 
-    from ..export.usdgeom import mm_to_scene_units, pinhole_fstop, require_meters_per_unit
+    from ..export.usdgeom import mm_to_scene_units, require_meters_per_unit
     from ..onset.report import solve_lens_report
-    from .author import author_camera, fov_preserving_float32, new_stage, save_stage, spec_from_report
+    from .author import author_camera, new_stage, render_camera_values, save_stage, spec_from_report
 
     keys = _check_keys(keys)
     if (lens is None) == (focal_length_mm is None):
@@ -171,16 +170,11 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
         for name, value in optional.items():
             if value is not None and cam.GetAttribute(name):
                 sample(cam, name, value, t)
-        pin, sq = report.pinhole
-        focal, h_ap, v_ap = fov_preserving_float32(su(pin) * 10.0, su(spec0.sensor_width_mm * sq) * 10.0,
-                                                   su(spec0.sensor_height_mm) * 10.0)
-        geom.GetFocalLengthAttr().Set(focal, t)
-        geom.GetHorizontalApertureAttr().Set(h_ap / spec0.enlarge[0], t)
-        geom.GetVerticalApertureAttr().Set(v_ap / spec0.enlarge[1], t)
-        geom.GetFStopAttr().Set(pinhole_fstop(report), t)
-        geom.GetFocusDistanceAttr().Set(su(spec.focus_mm - eye), t)
+        values, eye = render_camera_values(spec, report, mpu, rate, where=path)
+        geom.GetFocalLengthAttr().Set(values["focalLength"], t)
+        geom.GetHorizontalApertureAttr().Set(values["horizontalAperture"], t)
+        geom.GetVerticalApertureAttr().Set(values["verticalAperture"], t)
+        geom.GetFStopAttr().Set(values["fStop"], t)
+        geom.GetFocusDistanceAttr().Set(values["focusDistance"], t)
         translate.Set(Gf.Vec3d(0.0, 0.0, -su(eye)), t)
-        for v in (focal, h_ap, v_ap, su(spec.focus_mm - eye)):
-            if not math.isfinite(v):
-                raise ExportError(f"frame {frame:g}: the companion camera came out {v}; check the marks")
     return save_stage(stage, file, force=force)

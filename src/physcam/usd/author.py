@@ -49,6 +49,7 @@ __all__ = [
     "report_for_spec",
     "shutter_opening_curve",
     "author_render_settings",
+    "render_camera_values",
 ]
 
 DEFAULT_CAMERA_PATH = "/Cameras/Camera"
@@ -488,6 +489,58 @@ def _author_lens(stage, cam, spec, eye, su):
     cam.GetRelationship(lp + "lensModel").SetTargets([model.GetPath()])
 
 
+def render_camera_values(spec: CameraSpec, report, meters_per_unit: float, time_codes_per_second: float, *,
+                         where: str = "camera") -> tuple[dict, float]:
+    """(UsdGeomCamera attribute -> value, eye distance in front of the film in mm) of ``spec``'s companion.
+
+    The one computation of the companion's numbers, shared by :func:`author_render_camera` and the
+    animated cameras (:mod:`physcam.usd.animate`, per frame): the best-match pinhole in the stage's
+    units, apertures divided by ``enlarge``, float32 values that keep the field of view exact,
+    focus distance from the eye, shutter in time codes.
+    """
+    from ..export.usdgeom import mm_to_scene_units, mm_to_tenths_of_scene_unit, usdgeom_camera_values
+
+    spec = require_type("spec", spec, CameraSpec, "build one with CameraSpec(...)")
+    mpu = meters_per_unit
+    su = lambda mm: mm_to_scene_units(mm, mpu)  # noqa: E731
+    tenths = lambda mm: mm_to_tenths_of_scene_unit(mm, mpu)  # noqa: E731
+    tcps = require_finite("time codes per second", time_codes_per_second)
+    if spec.projection == "perspective":
+        if report is None:
+            report = report_for_spec(spec)
+        values = usdgeom_camera_values(report, mpu, clipping_range_mm=spec.clipping_mm, shift_mm=spec.shift_mm)
+        eye = _eye_from_film(spec, report)
+        # from the eye (entrance pupil) to the plane of sharp focus, so that plane lands on the mark
+        values["focusDistance"] = su(spec.focus_mm - eye)
+    else:
+        eye = _eye_from_film(spec, None)
+        m, sq = spec.magnification, spec.squeeze
+        values = {
+            "projection": "orthographic",
+            "focalLength": tenths(spec.focal_length_mm),
+            "horizontalAperture": tenths(spec.sensor_width_mm * sq / m),
+            "verticalAperture": tenths(spec.sensor_height_mm / m),
+            "horizontalApertureOffset": tenths(spec.shift_mm[0] * sq / m),
+            "verticalApertureOffset": tenths(spec.shift_mm[1] / m),
+            "focusDistance": su(spec.focus_mm - eye),
+            "fStop": spec.fstop,
+            "clippingRange": (su(spec.clipping_mm[0]), su(spec.clipping_mm[1])),
+        }
+    # enlarge: the imaged region is the sensor divided by it (the shift stays in film mm)
+    values["horizontalAperture"] /= spec.enlarge[0]
+    values["verticalAperture"] /= spec.enlarge[1]
+    if spec.projection == "perspective":
+        values["focalLength"], values["horizontalAperture"], values["verticalAperture"] = fov_preserving_float32(
+            values["focalLength"], values["horizontalAperture"], values["verticalAperture"])
+    values["shutter:open"] = spec.shutter_open_s * tcps
+    values["shutter:close"] = (spec.shutter_open_s + spec.shutter_duration_s) * tcps
+    for k, v in values.items():
+        if isinstance(v, float) and not math.isfinite(v):
+            raise ExportError(f"{where}/{RENDER_CAMERA_NAME}: {k} came out {v}; check the camera's numbers")
+
+    return values, eye
+
+
 #: Omniverse RTX's OpenCV-pinhole lens distortion API (docs/unreal-omniverse.md) and its attribute types.
 OMNI_OPENCV_API = "OmniLensDistortionOpenCvPinholeAPI"
 
@@ -522,44 +575,13 @@ def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None, lens
     """
     from pxr import Gf, Sdf, UsdGeom
 
-    from ..export.usdgeom import mm_to_scene_units, mm_to_tenths_of_scene_unit, usdgeom_camera_values
+    from ..export.usdgeom import mm_to_scene_units
 
     mpu = UsdGeom.GetStageMetersPerUnit(stage)
     su = lambda mm: mm_to_scene_units(mm, mpu)  # noqa: E731
-    tenths = lambda mm: mm_to_tenths_of_scene_unit(mm, mpu)  # noqa: E731
-    tcps = stage.GetTimeCodesPerSecond()
-    if spec.projection == "perspective":
-        if report is None:
-            report = report_for_spec(spec)
-        values = usdgeom_camera_values(report, mpu, clipping_range_mm=spec.clipping_mm, shift_mm=spec.shift_mm)
-        eye = _eye_from_film(spec, report)
-        # from the eye (entrance pupil) to the plane of sharp focus, so that plane lands on the mark
-        values["focusDistance"] = su(spec.focus_mm - eye)
-    else:
-        eye = _eye_from_film(spec, None)
-        m, sq = spec.magnification, spec.squeeze
-        values = {
-            "projection": "orthographic",
-            "focalLength": tenths(spec.focal_length_mm),
-            "horizontalAperture": tenths(spec.sensor_width_mm * sq / m),
-            "verticalAperture": tenths(spec.sensor_height_mm / m),
-            "horizontalApertureOffset": tenths(spec.shift_mm[0] * sq / m),
-            "verticalApertureOffset": tenths(spec.shift_mm[1] / m),
-            "focusDistance": su(spec.focus_mm - eye),
-            "fStop": spec.fstop,
-            "clippingRange": (su(spec.clipping_mm[0]), su(spec.clipping_mm[1])),
-        }
-    # enlarge: the imaged region is the sensor divided by it (the shift stays in film mm)
-    values["horizontalAperture"] /= spec.enlarge[0]
-    values["verticalAperture"] /= spec.enlarge[1]
-    if spec.projection == "perspective":
-        values["focalLength"], values["horizontalAperture"], values["verticalAperture"] = fov_preserving_float32(
-            values["focalLength"], values["horizontalAperture"], values["verticalAperture"])
-    values["shutter:open"] = spec.shutter_open_s * tcps
-    values["shutter:close"] = (spec.shutter_open_s + spec.shutter_duration_s) * tcps
-    for k, v in values.items():
-        if isinstance(v, float) and not math.isfinite(v):
-            raise ExportError(f"{cam_path}/{RENDER_CAMERA_NAME}: {k} came out {v}; check the camera's numbers")
+    if spec.projection == "perspective" and report is None:
+        report = report_for_spec(spec)
+    values, eye = render_camera_values(spec, report, mpu, stage.GetTimeCodesPerSecond(), where=f"{cam_path}")
 
     geom = UsdGeom.Camera.Define(stage, Sdf.Path(str(cam_path)).AppendChild(RENDER_CAMERA_NAME))
     geom.CreateProjectionAttr(values["projection"])
