@@ -275,3 +275,10 @@ def test_bad_fit_inputs_are_clear_errors(distagon):
         fit_tde4_radial(s, max_residual_px=-1.0)
     with pytest.raises(PhysCamError):
         samples_from_field("not a field")
+
+
+def test_a_fisheye_on_a_large_sensor_is_refused_not_mapped():
+    """The Nikkor 16 mm fisheye covers 180 degrees on 36 x 24: a pinhole cannot hold the frame's corners."""
+    with pytest.raises(PhysCamError, match="fisheye"):
+        distortion_field(load_lens("nikkor_fisheye_16mm_f2_8"), focus_mm=FOCUS, sensor_width_mm=36,
+                         sensor_height_mm=24, width_px=512, height_px=342, maps=False)

@@ -48,12 +48,18 @@ class DistortionAcrossFocus:
         if inf:
             ax.axhline(inf[0]["corner_distortion_pct"], ls=":", color="0.4", label="at infinity")
         ax.set_xscale("log")
+        from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
+
+        ax.xaxis.set_major_locator(FixedLocator(x))
+        ax.xaxis.set_major_formatter(lambda v, _: f"{v:g}")
+        ax.xaxis.set_minor_locator(NullLocator())
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("focus from the film plane (m)")
         ax.set_ylabel("corner distortion (%)")
         ax2 = ax.twinx()
         ax2.plot(x, [r["pinhole_focal_length_mm"] for r in finite], "s--", color="C1", ms=3)
         ax2.set_ylabel("pinhole focal length (mm)", color="C1")
-        ax.legend(fontsize=7, loc="best")
+        ax.legend(fontsize=7, loc="center right")
         ax.set_title(f"{self.lens_name}: distortion across focus on {self.sensor_mm[0]:g} x {self.sensor_mm[1]:g} mm",
                      fontsize=8)
         return save(fig, path, force)

@@ -53,6 +53,8 @@ __all__ = ["DistortionField", "distortion_field", "apply_stmap", "write_stmaps",
 #: Largest width or height (pixels) and largest frame (pixels) a map is made for.
 MAX_SIDE_PX = 8192
 MAX_PIXELS = 36_000_000
+#: The farthest the ideal (pinhole) image of the frame may reach, in frame half-sizes from the centre.
+MAX_PINHOLE_REACH = 3.0
 #: Grid spacing (pixels) of the traced chief rays and of the inverse's nodes.
 NODE_SPACING_PX = 32.0
 
@@ -252,6 +254,16 @@ def distortion_field(
     fwd = _Grid(nodes, 0.0, dx, 0.0, dy)
     cx, cy = np.meshgrid((np.arange(nx - 1) + 0.5) * dx, (np.arange(ny - 1) + 0.5) * dy)
     exact = trace(cx.ravel(), cy.ravel())
+    # a fisheye on this sensor: the pinhole would put the frame's edge far outside it (at 90 degrees,
+    # infinitely far); no pinhole-based map or model represents that
+    reach = float(max(np.abs(nodes[..., 0] - w_px / 2).max() / (w_px / 2), np.abs(nodes[..., 1] - h_px / 2).max() / (h_px / 2)))
+    if reach > MAX_PINHOLE_REACH:
+        r_mm = float(np.hypot((nodes[..., 0] - w_px / 2) / sx, (nodes[..., 1] - h_px / 2) / sy).max())
+        angle = math.degrees(math.atan(r_mm / float(g["y"].pinhole_focal_length)))
+        raise OpticsError(
+            f"{lens.name!r} sees up to {angle:.1f} deg off axis on a {W:g} x {H:g} mm sensor: its pinhole image would "
+            f"reach {reach:.1f} times the frame's half-size, so no pinhole-based distortion map or model represents "
+            "it (a fisheye); give a smaller sensor")
     interp_err = float(np.hypot(*(fwd.at(cx.ravel(), cy.ravel()) - exact).T).max())
     max_dist = float(np.hypot(nodes[..., 0] - X, nodes[..., 1] - Y).max())
     traced_real = np.concatenate([np.stack([X.ravel(), Y.ravel()], axis=1), np.stack([cx.ravel(), cy.ravel()], axis=1)])
