@@ -1,5 +1,6 @@
 # physcam: two entry points for a fresh machine.
 #   make demo   create .venv if missing, install physcam, run the main job
+#   make shell  open your shell with .venv/bin first on PATH, so `physcam` runs (exit to leave)
 #   make test   create .venv if missing, install physcam with test tools, run every test
 #   make schema regenerate the USD schema plugin; make bench runs the benchmarks
 PYTHON ?= python3
@@ -13,7 +14,7 @@ BLENDER_PY    := $(BLENDER_VENV)/bin/python
 BLENDER_STAMP := $(BLENDER_VENV)/.physcam-installed
 BPY_VERSION   ?= 5.0.1
 
-.PHONY: demo test venv blender bench clean schema
+.PHONY: demo test venv blender bench clean schema shell
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -27,6 +28,13 @@ venv: $(STAMP)
 
 demo: $(STAMP)
 	$(VENV)/bin/physcam demo --out demo-output --force
+	@echo "physcam is installed in $(VENV): run it as $(VENV)/bin/physcam, or type 'make shell' for a shell where 'physcam' works"
+
+# A shell where `physcam` is on PATH (the virtual environment's bin first), for trying the README's
+# examples; `exit` returns. The same as `. .venv/bin/activate` in your own shell.
+shell: $(STAMP)
+	@echo "physcam $(abspath $(VENV)): type 'physcam --help'; 'exit' to leave"
+	@VIRTUAL_ENV="$(abspath $(VENV))" PATH="$(abspath $(VENV))/bin:$$PATH" $${SHELL:-/bin/sh}
 
 # Where bpy cannot be installed (another Python, another platform) the Blender tests skip and
 # pytest's summary says why; the rest of the suite runs.
