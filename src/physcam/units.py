@@ -2,7 +2,12 @@
 
 physcam works in millimetres inside (docs/conventions.md). At the edges (CLI,
 files) a distance may carry a unit: ``3m``, ``10ft``, ``6in``, ``450mm``,
-``2.5 cm``, ``10'6"`` (feet and inches). A bare number is millimetres.
+``2.5 cm``, ``10'6"``, ``9' 10 1/8"`` (feet and inches, fractional inches too). A bare
+number is millimetres.
+
+Printed distances follow a *unit system* (``--units``): ``m`` (metres, millimetres below one
+metre) or ``ft`` (feet and inches, to the nearest 1/8 inch below 10 feet and the nearest inch
+beyond, as focus marks are written on set): :func:`format_distance`.
 """
 
 from __future__ import annotations
@@ -12,7 +17,8 @@ import re
 
 from .errors import UnitError
 
-__all__ = ["MM_PER_UNIT", "parse_distance", "format_feet_inches", "mm_to", "to_mm"]
+__all__ = ["MM_PER_UNIT", "UNIT_SYSTEMS", "parse_distance", "format_feet_inches", "format_distance", "mm_to", "to_mm",
+           "inch_fraction_for"]
 
 #: Millimetres in one of each accepted unit.
 MM_PER_UNIT: dict[str, float] = {
@@ -34,7 +40,14 @@ MM_PER_UNIT: dict[str, float] = {
 
 _NUMBER = r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?"
 _SIMPLE = re.compile(rf"^\s*({_NUMBER})\s*([a-zA-Zµ'\"]*)\s*$")
-_FEET_INCHES = re.compile(rf"^\s*({_NUMBER})\s*(?:ft|feet|foot|')\s*({_NUMBER})\s*(?:in|inch|inches|\")?\s*$")
+#: inches as a number, a whole number and a fraction ("6 1/2") or a fraction alone ("3/8")
+_INCHES = r"(?:(\d+(?:\.\d*)?)(?:\s+(\d+)/(\d+))?|(\d+)/(\d+))"
+_FEET_INCHES = re.compile(
+    rf"^\s*(?:({_NUMBER})\s*(?:ft|feet|foot|'))?\s*(?:{_INCHES}\s*(?:in|inch|inches|\"))?\s*$")
+_FEET_BARE_INCHES = re.compile(rf"^\s*({_NUMBER})\s*(?:ft|feet|foot|')\s*{_INCHES}\s*$")
+
+#: The unit systems distances are printed in (``--units``): metric or feet and inches.
+UNIT_SYSTEMS = ("m", "ft")
 
 
 def to_mm(value: float, unit: str) -> float:
@@ -71,9 +84,14 @@ def parse_distance(text, *, name: str = "distance", allow_inf: bool = False) -> 
             if allow_inf:
                 return math.inf
             raise UnitError(f"{name} must be finite, got {s!r}")
-        m = _FEET_INCHES.match(s)
-        if m:
-            v = float(m.group(1)) * 304.8 + float(m.group(2)) * 25.4
+        m = _FEET_INCHES.match(s) if any(c in s for c in "'\"/") or re.search(r"\d\s*(ft|feet|foot)\s*\d", s) \
+            else None
+        m = m or (_FEET_BARE_INCHES.match(s) if "/" in s else None)
+        if m and (m.group(1) is not None or any(g is not None for g in m.groups()[1:])):
+            # a sign belongs to the whole distance: -1' 2" is -(1 foot 2 inches)
+            v = abs(float(m.group(1) or 0.0)) * 304.8 + _inches(*m.groups()[1:]) * 25.4
+            if s.lstrip().startswith("-"):
+                v = -v
         else:
             m = _SIMPLE.match(s)
             if not m:
@@ -87,11 +105,59 @@ def parse_distance(text, *, name: str = "distance", allow_inf: bool = False) -> 
     return v
 
 
-def format_feet_inches(value_mm: float) -> str:
-    """Millimetres as feet and inches to the nearest inch, e.g. ``8' 9\"``; ``inf`` as ``∞``."""
+def _inches(whole, num, den, fnum, fden) -> float:
+    """Inches from the groups of ``_INCHES`` (none given is 0)."""
+    v = float(whole) if whole is not None else 0.0
+    for n, d in ((num, den), (fnum, fden)):
+        if n is not None:
+            if int(d) == 0:
+                raise UnitError(f"a fraction of an inch needs a denominator above 0, got {n}/{d}")
+            v += int(n) / int(d)
+    return v
+
+
+def inch_fraction_for(value_mm: float) -> int:
+    """The inch fraction a distance is written to on set: 8 (1/8 inch) below 10 feet, else 1 (whole inches)."""
+    return 8 if abs(value_mm) < 10 * 304.8 else 1
+
+
+def format_feet_inches(value_mm: float, fraction: int = 1) -> str:
+    """Millimetres as feet and inches to the nearest ``1/fraction`` inch, e.g. ``8' 9\"`` or
+    ``4' 6 3/8\"`` (fraction 8); ``inf`` as ``∞``. Fractions are reduced (4/8 is 1/2).
+
+    >>> print(format_feet_inches(3048.0), format_feet_inches(1381.125, fraction=8))
+    10' 0" 4' 6 3/8"
+    """
+    import fractions
+
     if math.isinf(value_mm):
         return "∞"
-    total_in = round(value_mm / 25.4)
-    sign = "-" if total_in < 0 else ""
-    ft, inch = divmod(abs(total_in), 12)
-    return f"{sign}{ft}' {inch}\""
+    if isinstance(fraction, bool) or not isinstance(fraction, int) or fraction < 1:
+        raise UnitError(f"an inch fraction is a whole number >= 1 (8 for eighths), got {fraction!r}")
+    steps = round(value_mm / 25.4 * fraction)
+    sign = "-" if steps < 0 else ""
+    whole_in, part = divmod(abs(steps), fraction)
+    ft, inch = divmod(whole_in, 12)
+    frac = "" if part == 0 else f" {fractions.Fraction(part, fraction)}"
+    return f"{sign}{ft}' {inch}{frac}\""
+
+
+def format_distance(value_mm: float, units: str = "m", *, digits: int = 3) -> str:
+    """A distance for people in a unit system (:data:`UNIT_SYSTEMS`): ``m`` gives metres with
+    ``digits`` decimals from one metre up and whole millimetres (one decimal) below; ``ft``
+    gives feet and inches (:func:`format_feet_inches` with :func:`inch_fraction_for`).
+    Infinity is ``∞``.
+
+    >>> print(format_distance(2814.2), "|", format_distance(450.0), "|", format_distance(2814.2, "ft"))
+    2.814 m | 450.0 mm | 9' 2 3/4"
+    """
+    if units not in UNIT_SYSTEMS:
+        raise UnitError(f"units must be one of {', '.join(UNIT_SYSTEMS)}, got {units!r}")
+    v = float(value_mm)
+    if math.isinf(v):
+        return "∞"
+    if units == "ft":
+        return format_feet_inches(v, inch_fraction_for(v))
+    if abs(v) >= 1000.0:
+        return f"{v / 1000.0:.{digits}f} m"
+    return f"{v:.1f} mm"
