@@ -12,6 +12,13 @@ Depth of field uses the exact thin-lens forms (physcam.optics.dof) about H1 and 
 reported both from H1 and from the film plane. Inputs may be forward (f-stop, CoC)
 or inverse (near and/or far limits measured on a plate), in which case the report
 solves the effective f-stop, the CoC or the focus distance, and says what it solved.
+
+The focus may be infinite (``math.inf``: the far limit is infinite and the near limit is the
+hyperfocal parameter h = f^2/(N c) from H1) or :data:`HYPERFOCAL` (the mark that puts the
+subject plane at the hyperfocal distance H = h + f from H1, near limit H/2).
+
+Magnification is the signed lateral magnification m = image height / object height, negative
+for the inverted real image on the film (docs/conventions.md), as the Gaussian engine gives it.
 """
 
 from __future__ import annotations
@@ -26,7 +33,8 @@ from ..optics.coc import circle_of_confusion
 from .pupil import entrance_pupil_practical, pivot_camera_space
 from .sensors import Sensor
 
-__all__ = ["LensReport", "DepthOfField", "solve_lens_report", "takes_report", "REPORT_SCHEMA", "REPORT_VERSION"]
+__all__ = ["LensReport", "DepthOfField", "solve_lens_report", "takes_report", "REPORT_SCHEMA", "REPORT_VERSION",
+           "HYPERFOCAL"]
 
 #: Real (chief-ray) and pinhole fields of view may differ by this much (percent, any of horizontal,
 #: vertical, diagonal) before the report warns: about what a fitted two-term radial distortion
@@ -34,7 +42,11 @@ __all__ = ["LensReport", "DepthOfField", "solve_lens_report", "takes_report", "R
 REAL_FOV_TOLERANCE_PCT = 2.0
 
 REPORT_SCHEMA = "physcam.lens_report"
-REPORT_VERSION = 1
+#: 2: magnification is signed (negative: the inverted image), a focus at infinity is null with
+#: ``focus_is_infinite``, as is the object distance.
+REPORT_VERSION = 2
+#: ``focus_mm=HYPERFOCAL``: focus at the hyperfocal distance of this lens, f-stop and CoC.
+HYPERFOCAL = "hyperfocal"
 
 
 @dataclass(frozen=True)
@@ -184,6 +196,10 @@ class LensReport:
     def desqueezed_width_mm(self) -> float:
         return self.sensor.width_mm * self.squeeze
 
+    @property
+    def focus_is_infinite(self) -> bool:
+        return math.isinf(self.focus_from_film_mm)
+
     def to_dict(self) -> dict:
         """Versioned, JSON-ready dict with stable keys; infinities become null plus a flag."""
         s = self.sensor
@@ -209,8 +225,9 @@ class LensReport:
             },
             "coc_mm": self.coc_mm,
             "coc_convention": self.coc_convention,
-            "focus_from_film_mm": self.focus_from_film_mm,
-            "object_distance_mm": self.object_distance_mm,
+            "focus_from_film_mm": _finite_or_none(self.focus_from_film_mm),
+            "focus_is_infinite": self.focus_is_infinite,
+            "object_distance_mm": _finite_or_none(self.object_distance_mm),
             "image_distance_mm": self.image_distance_mm,
             "h1_from_film_mm": self.h1_from_film_mm,
             "h2_from_film_mm": self.h2_from_film_mm,
@@ -255,7 +272,8 @@ def _fov_deg(size, focal_or_image_distance):
 
 
 def _dof_block(f, n, c, s, h1_film_at) -> DepthOfField:
-    """DOF for object distance s (from H1); ``h1_film_at(s)`` gives H1's distance from the film."""
+    """DOF for object distance s (from H1, may be infinite); ``h1_film_at(s)`` gives H1's distance
+    from the film."""
     near, far = _dof.dof_limits(f, n, c, s)
     H = _dof.hyperfocal_distance(f, n, c)
     return DepthOfField(
@@ -346,13 +364,17 @@ def solve_lens_report(
 
         if focus_mm is None:
             raise InputError("with a lens prescription, give the focus mark (--focus)")
-        D_lens = _require_distance("focus distance", focus_mm)
         if fstop is None and near_mm is None and far_mm is None:
             # wide open: the engraved f-stop, unless the prescription's stop is slower
             file_n = paraxial.gaussian(lens).f_number
             fstop = max(file_n, lens.metadata.max_fstop or 0.0)
             notes.append(f"f-stop not given: wide open at f/{fstop:.3g}")
-        planes = technical_planes(lens, D_lens, fstop=fstop)
+        if focus_mm == HYPERFOCAL:
+            D_lens, planes = _lens_hyperfocal(lens, fstop, sensor, coc, near_mm, far_mm)
+        else:
+            D_lens = _require_focus(focus_mm)
+            planes = technical_planes(lens, D_lens, fstop=fstop)
+        focus_mm = D_lens
         focal_length_mm = planes.efl_mm
         model, reference_plane = "technical", "film"
         h1_mm, h2_mm, pupil_mm = planes.h1_from_film_mm, planes.h2_from_film_mm, planes.entrance_pupil_from_film_mm
@@ -394,9 +416,14 @@ def solve_lens_report(
     w, h = sensor.width_mm, sensor.height_mm
     coc_explicit = coc is not None
     c, coc_name = circle_of_confusion(w, h, coc)
+    c, coc_name = _named_coc(w, h, coc, c, coc_name)
     N = None if fstop is None else _require_f_number("f-stop", fstop)
     T = None if tstop is None else _require_f_number("T-stop", tstop)
-    D = None if focus_mm is None else _require_distance("focus distance", focus_mm)
+    hyperfocal = focus_mm == HYPERFOCAL
+    if hyperfocal and (N is None or near_mm is not None or far_mm is not None):
+        raise InputError("focus at the hyperfocal distance needs the f-stop (--fstop), and no measured near/far "
+                         "limits (they solve the focus themselves)")
+    D = None if (focus_mm is None or hyperfocal) else _require_focus(focus_mm)
     near_m = None if near_mm is None else _require_distance("near limit", near_mm)
     far_m = None
     if far_mm is not None:
@@ -448,13 +475,13 @@ def solve_lens_report(
         P1 = P2 = None
 
         def h1_at(s):
-            return thinlens.image_distance(f, s)
+            return f if math.isinf(s) else thinlens.image_distance(f, s)
 
         def s_for_mark(mark):
-            return thinlens.object_distance_for_marked(f, mark)
+            return math.inf if math.isinf(mark) else thinlens.object_distance_for_marked(f, mark)
 
         def mark_for_s(s):
-            return s + thinlens.image_distance(f, s)
+            return s + h1_at(s)
 
     def to_h1(d_film, s):
         """A film-plane distance as a distance from H1 (for the current focus s)."""
@@ -468,6 +495,10 @@ def solve_lens_report(
         measured["far_from_film_mm"] = far_m
 
     # --- focus ----------------------------------------------------------------
+    if hyperfocal:  # the subject plane at H = f^2/(N c) + f from H1 (Wikipedia "Hyperfocal distance")
+        D = mark_for_s(_dof.hyperfocal_distance(f, N, c))
+        solved["focus"] = HYPERFOCAL
+        notes.append(f"focus at the hyperfocal distance: mark {D:.6g} mm from the film")
     if D is None:
         if near_m is not None and far_m is not None:
             # 1/near + 1/far = 2/s about H1; H1 moves with focus in the practical model,
@@ -484,14 +515,21 @@ def solve_lens_report(
         D = mark_for_s(s)
         solved["focus_from_film_mm"] = D
     s = s_for_mark(D)
-    s_img = thinlens.image_distance(f, s)
+    s_img = f if math.isinf(s) else thinlens.image_distance(f, s)
+    if math.isinf(s) and (near_m is not None or far_m is not None) and "focus_from_film_mm" not in solved:
+        if far_m is not None and math.isfinite(far_m):
+            raise InputError("with the focus at infinity the far limit is infinite; a finite far limit is impossible")
 
     # --- inversions from measured limits ---------------------------------------------
     # (a focus solved from one limit and the f-stop used that limit up: nothing is left to invert)
     focus_from_one_limit = "focus_from_film_mm" in solved and (near_m is None or far_m is None)
     if (near_m is not None or far_m is not None) and not focus_from_one_limit:
         hp_near = hp_far = None
-        if near_m is not None:
+        if near_m is not None and math.isinf(s):
+            hp_near = to_h1(near_m, s)  # focused at infinity the near limit is h itself (s -> inf)
+            if not hp_near > 0:
+                raise InputError("the near limit must lie in front of the lens")
+        elif near_m is not None:
             hp_near = _dof.hyperfocal_parameter_from_near(f, s, to_h1(near_m, s))
         if far_m is not None and math.isfinite(far_m):
             hp_far = _dof.hyperfocal_parameter_from_far(f, s, to_h1(far_m, s))
@@ -610,7 +648,7 @@ def solve_lens_report(
         h1_from_film_mm=h1_film,
         h2_from_film_mm=h2_film,
         focus_error_mm=focus_error,
-        magnification=f / (s - f),
+        magnification=0.0 if math.isinf(s) else -f / (s - f),
         dof=dof,
         dof_horizontal=dof_h,
         entrance_pupil_from_film_mm=pupil,
@@ -667,6 +705,49 @@ def _with_real_fov(report: LensReport, lens) -> LensReport:
 
 #: Largest finite distance the report accepts (1000 km); beyond it use infinity.
 MAX_DISTANCE_MM = 1.0e9
+
+
+def _require_focus(value) -> float:
+    """A focus mark: a positive distance up to :data:`MAX_DISTANCE_MM`, or infinity."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and value == math.inf:
+        return math.inf
+    return _require_distance("focus distance", value)
+
+
+def _named_coc(w, h, given, c, name):
+    """A CoC value that is one of the named conventions for this sensor (to float32 precision, as a
+    USD file stores it) keeps that convention's name instead of "user"."""
+    from ..optics.coc import COC_CONVENTIONS
+
+    if name != "user" or not isinstance(given, (int, float)):
+        return c, name
+    for key, (_, rule) in COC_CONVENTIONS.items():
+        v = rule(w, h)
+        if abs(c - v) <= 1e-6 * v:
+            return c, key
+    return c, name
+
+
+def _lens_hyperfocal(lens, fstop, sensor, coc, near_mm, far_mm):
+    """(mark, planes): the focus mark of ``lens`` whose subject plane is at the hyperfocal distance
+    H = f^2/(N c) + f from H1, with f and H1 of the lens focused at that mark (fixed point; the
+    planes move little with focus, so a few steps converge to 1e-9 of the mark)."""
+    from ..optics.coc import circle_of_confusion
+    from ..optics.focusing import technical_planes
+
+    if near_mm is not None or far_mm is not None:
+        raise InputError("focus at the hyperfocal distance takes no measured near/far limits")
+    n = _require_f_number("f-stop", fstop)
+    c, _ = circle_of_confusion(sensor.width_mm, sensor.height_mm, coc)
+    mark = math.inf
+    for _ in range(50):
+        planes = technical_planes(lens, mark, fstop=n)
+        new = _dof.hyperfocal_distance(planes.efl_mm, n, c) + planes.h1_from_film_mm
+        new = _require_distance("hyperfocal focus mark", new)
+        if math.isfinite(mark) and abs(new - mark) <= 1e-9 * new:
+            return new, technical_planes(lens, new, fstop=n)
+        mark = new
+    raise OpticsError(f"the hyperfocal focus of {lens.name!r} did not settle; give the focus mark")
 
 
 def _require_distance(name: str, value) -> float:

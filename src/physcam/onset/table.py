@@ -1,28 +1,31 @@
-"""The lens report as a table for people (rich), from the same dict as ``--json``."""
+"""The lens report as a table for people, from the same dict as ``--json``.
+
+Scene distances (focus mark, object distance, near, far, hyperfocal, depth of field) are printed
+in the chosen unit system (``units``: ``m`` or ``ft``, :func:`physcam.units.format_distance`);
+lengths inside the camera (focal length, principal planes, pupil, CoC) stay in millimetres, as
+they are engraved and written on set.
+"""
 
 from __future__ import annotations
 
-from ..units import format_feet_inches
+from ..units import format_distance
 
 
-def _len(mm) -> str:
-    if mm is None:
-        return "∞"
-    if abs(mm) >= 1000:
-        return f"{mm / 1000:.3f} m  ({format_feet_inches(mm)})"
-    return f"{mm:.2f} mm"
+def report_title(report) -> str:
+    return f"physcam lens report — {report.model} model"
 
 
-def report_table(report):
-    """A rich Table of the report's main figures."""
-    from rich.table import Table
-
+def report_rows(report, units: str = "m", *, notes: bool = True) -> list[tuple[str, str, str]]:
+    """(quantity, value, measured from) rows of the report's main figures (and its notes)."""
     d = report.to_dict()
-    t = Table(title=f"physcam lens report — {d['model']} model", show_header=True, header_style="bold")
-    t.add_column("quantity")
-    t.add_column("value")
-    t.add_column("measured from")
-    add = t.add_row
+    rows: list[tuple[str, str, str]] = []
+
+    def add(*cells):
+        rows.append(tuple(cells))
+
+    def _len(mm) -> str:
+        return "∞" if mm is None else format_distance(mm, units)
+
     if d["lens"]:
         add("lens", d["lens"], "")
     add("focal length", f"{d['focal_length_mm']:.2f} mm", "")
@@ -35,14 +38,16 @@ def report_table(report):
     if d["squeeze"] != 1.0:
         add("anamorphic squeeze", f"{d['squeeze']:g}x", "")
     add("circle of confusion", f"{d['coc_mm']:.4f} mm  ({d['coc_convention']})", "")
-    add("focus mark", _len(d["focus_from_film_mm"]) + (" (solved)" if "focus_from_film_mm" in d["solved"] else ""),
-        "film plane")
+    how = " (solved)" if "focus_from_film_mm" in d["solved"] else (
+        " (hyperfocal)" if d["solved"].get("focus") == "hyperfocal" else "")
+    add("focus mark", _len(d["focus_from_film_mm"]) + how, "film plane")
     add("object distance s", _len(d["object_distance_mm"]), "H1")
-    add("image distance s'", _len(d["image_distance_mm"]), "H2")
+    add("image distance s'", f"{d['image_distance_mm']:.2f} mm", "H2")
     add("H1 / H2", f"{d['h1_from_film_mm']:.2f} / {d['h2_from_film_mm']:.2f} mm", "film plane")
     if d["model"] == "technical":
         add("focus error", f"{d['focus_error_mm']:+.3f} mm (+ = image in front of film)", "film plane")
-    add("magnification", f"{d['magnification']:.5f}  (1:{1 / d['magnification']:.1f})", "")
+    m = d["magnification"]
+    add("magnification", f"{m:.5f}  (1:{1 / abs(m):.1f}, inverted image)" if m else "0  (subject at infinity)", "")
     dof = d["dof"]
     add("hyperfocal", _len(dof["hyperfocal_from_film_mm"]), "film plane")
     add("near limit", _len(dof["near_from_film_mm"]), "film plane")
@@ -69,6 +74,18 @@ def report_table(report):
     for k in ("coc_mm", "consistency", "far_error_mm", "fstop_drift_stops"):
         if k in d["solved"] and d["solved"][k] is not None:
             add(f"solved {k}", f"{d['solved'][k]:.6g}", "")
-    for n in d["notes"]:
+    for n in d["notes"] if notes else ():
         add("note", n, "")
+    return rows
+
+
+def report_table(report, units: str = "m"):
+    """A rich Table of the report's main figures (:func:`report_rows`)."""
+    from rich.table import Table
+
+    t = Table(title=report_title(report), show_header=True, header_style="bold")
+    for col in ("quantity", "value", "measured from"):
+        t.add_column(col)
+    for r in report_rows(report, units):
+        t.add_row(*r)
     return t

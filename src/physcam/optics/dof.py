@@ -9,6 +9,9 @@ thin-lens limits are
     near = h s / (h + (s - f))
     far  = h s / (h - (s - f))            (infinite when s >= H)
 
+Focused at infinity (s -> inf) the far limit is infinite and the near limit tends to h itself:
+near = h / (1 + (h - f) / s) -> h. (Focused at H instead, near = H / 2.)
+
 These follow from similar triangles with the entrance pupil (diameter f/N) at the
 principal plane. Sources: Wikipedia, "Depth of field", section "Derivation of the
 DOF formulae" (the forms with the hyperfocal distance H = f²/(Nc) + f); S. Ray,
@@ -58,7 +61,8 @@ def hyperfocal_distance(focal_length, f_number, coc):
 def dof_limits(focal_length, f_number, coc, object_distance):
     """(near, far) limits of acceptable sharpness, in mm from H1 (exact thin-lens forms).
 
-    ``far`` is ``inf`` when the focus is at or beyond the hyperfocal distance.
+    ``far`` is ``inf`` when the focus is at or beyond the hyperfocal distance. ``object_distance``
+    may be ``inf`` (focus at infinity): then near = h = f²/(N c), the limit of the exact form.
     Raises :class:`OpticsError` if the subject is at or inside the focal length.
 
     DOFMaster's example, 50 mm f/4 focused 10 ft with c = 0.03 mm, gives near 8 ft 9 in
@@ -73,7 +77,7 @@ def dof_limits(focal_length, f_number, coc, object_distance):
     if nx.any_true(s <= f):
         raise OpticsError("focus distance is at or inside the focal length: no real image forms")
     h = f * f / (_arr(f_number) * _arr(coc))
-    near = h * s / (h + (s - f))
+    near = h / (1.0 + (h - f) / s)  # = h s / (h + s - f), and h at s = inf
     denom = h - (s - f)
     far = nx.where(denom > 0, h * s / nx.where(denom > 0, denom, 1.0), math.inf)
     return _out(near), _out(far)
