@@ -33,7 +33,7 @@ from ..lens.geometry import sag
 from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["AimedRays", "aim_from_infinity", "aim_from_film", "field_direction", "start_plane_z", "chief_ray_passes",
-           "field_limit_deg"]
+           "field_limit_deg", "widest_passing_deg", "clamp_note"]
 
 #: Aiming stops when the ray meets the stop plane within this distance of its centre (mm).
 AIM_TOL_MM = 1e-9
@@ -321,3 +321,27 @@ def field_limit_deg(lens: Prescription, axis: str = "y", *, max_deg: float = 89.
         else:
             hi = mid
     return lo
+
+
+def widest_passing_deg(passes, good_deg: float, bad_deg: float, *, tol_deg: float = 0.01) -> float:
+    """The widest field (degrees) between ``good_deg`` (where ``passes(field)`` is true) and
+    ``bad_deg`` (where it is false) at which ``passes`` still holds, bisected to ``tol_deg``.
+
+    The analyses share it to clamp their default field range to what the lens images, each with
+    its own test (a chief ray at every wavelength, light through the lens), and say so in a note
+    (:func:`clamp_note`).
+    """
+    lo, hi = float(good_deg), float(bad_deg)
+    while hi - lo > tol_deg:
+        mid = 0.5 * (lo + hi)
+        if passes(mid):
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+def clamp_note(axis: str, what: str, top_deg: float, asked_deg: float) -> str:
+    """The note an analysis adds when it clamps its default field range to what the lens images."""
+    return (f"{axis.upper()} meridian: {what} pass only up to {top_deg:.2f} deg (the default range reaches "
+            f"{asked_deg:.2f} deg, the sensor corner): fields clamped to {top_deg:.2f} deg")

@@ -221,17 +221,36 @@ def chromatic_aberration(
 
     fields = field_angles_deg(fields_deg, max_field_deg, n_fields,
                               0.5 * math.hypot(sensor_width_mm, sensor_height_mm), g_ref.efl)
-    dirs = field_direction(np.radians(fields), "y")
-    heights = {}
-    for w in wls:
-        aimed = aim_from_infinity(lens, dirs, wavelength_nm=w, backend=backend)
-        out = trace_through(lens, RayBatch.from_arrays(aimed.start, aimed.direction, w), end_z=film_z, backend=backend)
-        ok = aimed.ok & out.ok
-        if not ok.all():
-            bad = float(fields[~ok][0])
-            raise OpticsError(f"the chief ray at {bad:g} deg ({w:g} nm) does not pass {lens.name!r}; "
-                              "choose smaller fields (--max-field)")
-        heights[w] = out.y.copy()
+
+    def chief_heights(fields):
+        """Film heights per wavelength, or (field, wavelength) of the first chief ray that does not pass."""
+        dirs = field_direction(np.radians(fields), "y")
+        out_h = {}
+        for w in wls:
+            aimed = aim_from_infinity(lens, dirs, wavelength_nm=w, backend=backend)
+            out = trace_through(lens, RayBatch.from_arrays(aimed.start, aimed.direction, w), end_z=film_z,
+                                backend=backend)
+            ok = aimed.ok & out.ok
+            if not ok.all():
+                return float(np.asarray(fields)[~ok][0]), w
+            out_h[w] = out.y.copy()
+        return out_h
+
+    clamped = None
+    heights = chief_heights(fields)
+    if isinstance(heights, tuple) and fields_deg is None and max_field_deg is None and heights[0] > 0:
+        # the default range reaches the sensor corner; clamp it to the field every wavelength's chief ray passes
+        from ._chief import clamp_note, widest_passing_deg
+
+        good = max([0.0] + [f for f in fields if f < heights[0]])
+        top = widest_passing_deg(lambda f: not isinstance(chief_heights([f]), tuple), good, heights[0])
+        clamped = clamp_note("y", "chief rays at every wavelength", top, float(fields[-1]))
+        fields = field_angles_deg(None, top, n_fields, 0.0, 1.0)
+        heights = chief_heights(fields)
+    if isinstance(heights, tuple):
+        bad, w = heights
+        raise OpticsError(f"the chief ray at {bad:g} deg ({w:g} nm) does not pass {lens.name!r}; "
+                          "choose smaller fields (--max-field)")
     lateral = [
         LateralColourPoint(float(f), {f"{w:g}": float(heights[w][i]) for w in wls},
                            float((heights[LINE_F_NM][i] - heights[LINE_C_NM][i]) * 1e3))
@@ -264,6 +283,8 @@ def chromatic_aberration(
             dl += (0.5 * (zs[0] - zs[1])) ** 2
         result.longitudinal_uncertainty_mm = float(math.sqrt(dl))
         result.curve_uncertainty_mm = float(fc[2:].max())
+    if clamped:
+        result.notes.append(clamped)
     if all(s.medium.vd == 0.0 for s in lens.surfaces):
         # pbrt and ISET files carry no Abbe numbers: every medium is non-dispersive, so zero colour
         # says nothing about the real lens

@@ -66,13 +66,15 @@ class GhostResult:
     image: np.ndarray | None = field(default=None, repr=False)  # (ny, nx) ghost irradiance, relative
     image_paths: int = 0
     image_rays: int = 0
+    notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         d = {"lens": self.lens_name, "field_deg": self.field_deg, "coating": self.coating,
              "wavelength_nm": self.wavelength_nm, "film_z_mm": self.film_z_mm, "sensor_mm": list(self.sensor_mm),
              "direct_centroid_mm": list(self.direct_centroid_mm), "paths": [p.to_dict() for p in self.paths],
              "total_relative_flux": float(sum(p.relative_flux for p in self.paths)),
-             "definition": "path (i, j): reflect at surface i, then at surface j < i; flux relative to the direct image"}
+             "definition": "path (i, j): reflect at surface i, then at surface j < i; flux relative to the direct image",
+             "notes": list(self.notes)}
         if self.image is not None:
             d["image"] = {"pixels": list(self.image.shape), "paths": self.image_paths,
                           "rays_per_path": self.image_rays, "peak": float(self.image.max())}
@@ -230,10 +232,14 @@ def _beam(lens, field_deg, wl, n, rng=None):
     return RayBatch.from_arrays(pos, d[None, :], wl, area * d[2])
 
 
+#: The light's field angle when none is given (degrees): clamped to what the lens lets through.
+DEFAULT_FIELD_DEG = 10.0
+
+
 @takes_prescription
 def ghost_analysis(
     lens: Prescription,
-    field_deg: float = 10.0,
+    field_deg: float | None = None,
     *,
     coating: str | None = None,
     wavelength_nm: float | None = None,
@@ -255,10 +261,13 @@ def ghost_analysis(
     ``image_rays`` > 0, the ``image_paths`` strongest paths are traced again with that many
     random rays each (in chunks of ``chunk``) and binned into a ``pixels``-wide image of the sensor.
     ``coating``: "none", "single", "multi", or None for the lens file's coating (else "none").
+    ``field_deg`` None: :data:`DEFAULT_FIELD_DEG`, or the widest field below it that light passes
+    (with a note in the result) when none passes there.
     """
     from ..trace import paraxial_image_z, trace_to_film
 
-    fd = require_finite("field angle", field_deg)
+    default_field = field_deg is None
+    fd = require_finite("field angle", DEFAULT_FIELD_DEG if default_field else field_deg)
     if not -89 < fd < 89:
         raise InputError(f"field angle must lie between -89 and 89 degrees, got {fd:g}")
     if coating is None:
@@ -281,10 +290,27 @@ def ghost_analysis(
     film_z = require_finite("film_z", film_z)
     pairs = ghost_pairs(lens)
     T = _Tables(lens, coating, stop_semi_diameter)
-    beam = _beam(lens, fd, wl, rank_rays)
-    direct = trace_to_film(lens, beam, film_z, fresnel=True, coating=coating, stop_semi_diameter=stop_semi_diameter,
-                           backend=backend)
+    def direct_image(f):
+        b = _beam(lens, f, wl, rank_rays)
+        return b, trace_to_film(lens, b, film_z, fresnel=True, coating=coating, stop_semi_diameter=stop_semi_diameter,
+                                backend=backend)
+
+    notes = []
+    beam, direct = direct_image(fd)
     flux0 = float(direct.weight[direct.ok].sum())
+    if flux0 <= 0 and default_field:
+        from ._chief import widest_passing_deg
+
+        def passes(f):
+            d = direct_image(f)[1]
+            return float(d.weight[d.ok].sum()) > 0
+
+        top = widest_passing_deg(passes, 0.0, fd)
+        notes.append(f"no light passes at the default {fd:g} deg: the light is at {top:.2f} deg, the widest field "
+                     "the lens lets through")
+        fd = top
+        beam, direct = direct_image(fd)
+        flux0 = float(direct.weight[direct.ok].sum())
     if flux0 <= 0:
         raise OpticsError(f"no light at {fd:g} deg passes {lens.name!r}; choose a smaller field angle")
     wd = direct.weight[direct.ok]
@@ -304,7 +330,7 @@ def ghost_analysis(
         on = (np.abs(x) <= w / 2) & (np.abs(y) <= h / 2)
         paths.append(GhostPath(i, j, flux / flux0, float(wt[on].sum() / flux), cx, cy, rms))
     paths.sort(key=lambda p: -p.relative_flux)
-    res = GhostResult(lens.name, fd, coating, float(wl), float(film_z), (w, h), dc, paths)
+    res = GhostResult(lens.name, fd, coating, float(wl), float(film_z), (w, h), dc, paths, notes=notes)
     if image_rays > 0:
         nx = int(pixels)
         ny = max(8, int(round(pixels * h / w)))

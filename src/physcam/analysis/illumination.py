@@ -223,20 +223,38 @@ def relative_illumination(
     if a0 <= 0 or m0 is None:
         raise OpticsError(f"no on-axis light passes {lens.name!r}")
     e0 = a0 / m0[2]
-    points = []
+
+    def point(axis, fd):
+        """The illumination point at field ``fd``, or the reason no light reaches the film there."""
+        d = field_direction(math.radians(fd), axis)[0]
+        a = _beam_area(lens, d, wl, film_z, grid, fresnel, stop_semi_diameter, backend) if fd != 0 else a0
+        mp = _mapping(lens, d[0], d[1], wl, film_z, backend) if fd != 0 else m0
+        if a <= 0 or mp is None:
+            return "no light" if a <= 0 else "no chief ray"
+        c = math.cos(math.radians(fd))
+        return IlluminationPoint(axis, float(fd), float((a / mp[2]) / e0), c**4, a, a / (a0 * c), mp[2],
+                                 mp[0] if axis == "x" else mp[1])
+
+    from ._chief import clamp_note, widest_passing_deg
+
+    default_range = fields_deg is None and max_field_deg is None
+    points, notes = [], []
     for axis in axes:
         fields = field_angles_deg(fields_deg, max_field_deg, n_fields, 0.5 * math.hypot(w, h), g[axis].efl)
-        for fd in fields:
-            d = field_direction(math.radians(fd), axis)[0]
-            a = _beam_area(lens, d, wl, film_z, grid, fresnel, stop_semi_diameter, backend) if fd != 0 else a0
-            mp = _mapping(lens, d[0], d[1], wl, film_z, backend) if fd != 0 else m0
-            if a <= 0 or mp is None:
-                raise OpticsError(
-                    f"at {fd:g} deg ({axis.upper()} meridian) {'no light' if a <= 0 else 'no chief ray'} passes "
-                    f"{lens.name!r}; choose a smaller field (max_field_deg)"
-                )
-            c = math.cos(math.radians(fd))
-            points.append(IlluminationPoint(
-                axis, float(fd), float((a / mp[2]) / e0), c**4, a, a / (a0 * c), mp[2],
-                mp[0] if axis == "x" else mp[1]))
-    return IlluminationResult(lens.name, float(wl), float(film_z), bool(fresnel), int(grid), points)
+        got = []
+        for i, fd in enumerate(fields):
+            p = point(axis, fd)
+            if isinstance(p, str) and default_range and i > 0:
+                # the default range reaches the sensor corner; clamp it to what the lens images
+                top = widest_passing_deg(lambda f: not isinstance(point(axis, f), str), fields[i - 1], fd)
+                notes.append(clamp_note(axis, "light and chief rays", top, float(fields[-1])))
+                got = [point(axis, f) for f in field_angles_deg(None, top, n_fields, 0.0, 1.0)]
+                p = next((q for q in got if isinstance(q, str)), None)
+                if p is None:
+                    break
+            if isinstance(p, str):
+                raise OpticsError(f"at {fd:g} deg ({axis.upper()} meridian) {p} passes {lens.name!r}; "
+                                  "choose a smaller field (max_field_deg)")
+            got.append(p)
+        points += got
+    return IlluminationResult(lens.name, float(wl), float(film_z), bool(fresnel), int(grid), points, notes)
