@@ -1,33 +1,78 @@
-"""``physcam sensors``: the sensor and film-gate table."""
+"""``physcam sensors``: the sensor and film-gate table, filtered by maker, format and size."""
 
 from __future__ import annotations
 
+from ._common import distance
+
+EPILOG = """\
+examples:
+  physcam sensors                      # every sensor and film gate
+  physcam sensors ARRI                 # by maker (or any words of the name: "ALEXA 35", "open gate")
+  physcam sensors --maker Sony --min-width 30
+  physcam sensors --format 16:9 --csv  # for a spreadsheet
+  physcam sensors "Mini LF"            # one name or alias: that sensor
+"""
+
 
 def register(sub) -> None:
-    p = sub.add_parser("sensors", help="list known sensors and film gates (names usable with --sensor)")
-    p.add_argument("--json", action="store_true", help="print as JSON")
-    p.add_argument("name", nargs="?", help="show one sensor (name or alias)")
+    import argparse
+
+    from ._output import add_output_options
+
+    p = sub.add_parser("sensors", help="list known sensors and film gates (names usable with --sensor); filter them",
+                       description="The sensor and film-gate table (active area in mm); filter it by words of the "
+                                   "name, maker, format and width.", epilog=EPILOG,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("name", nargs="*", metavar="WORDS",
+                   help="a sensor name or alias (shows that sensor), or words every listed sensor's name, maker or "
+                        "aliases contain, e.g. ARRI, \"open gate\"")
+    p.add_argument("--maker", metavar="MAKER", help="only this maker: ARRI, RED, Sony, or film (film gates)")
+    p.add_argument("--format", dest="fmt", metavar="TEXT",
+                   help="only names containing this format text, e.g. \"open gate\", 16:9, 4-perf")
+    p.add_argument("--min-width", type=distance("minimum width"), default=None, metavar="MM",
+                   help="only sensors at least this wide (mm; units ok)")
+    p.add_argument("--max-width", type=distance("maximum width"), default=None, metavar="MM",
+                   help="only sensors at most this wide (mm; units ok)")
+    add_output_options(p, csv=True, what="the sensors")
     p.set_defaults(handler=run)
 
 
+def select(args) -> list:
+    """The sensors ``args`` ask for: one exact name or alias, else every match of the filters."""
+    from ..errors import SensorError
+    from ..onset.sensors import filter_sensors, find_sensor
+
+    query = " ".join(args.name or ())
+    filters = (args.maker, args.fmt, args.min_width, args.max_width)
+    if query and all(f is None for f in filters):
+        try:
+            return [find_sensor(query)]  # an exact name or alias
+        except SensorError:
+            pass
+    rows = filter_sensors(query, maker=args.maker, fmt=args.fmt, min_width_mm=args.min_width,
+                          max_width_mm=args.max_width)
+    if not rows:
+        if query and all(f is None for f in filters):
+            find_sensor(query)  # raises with the closest names
+        raise SensorError("no sensor matches; `physcam sensors` lists them all (makers: ARRI, RED, Sony, film)")
+    return rows
+
+
 def run(args) -> int:
-    from ..onset.sensors import find_sensor, sensors
-    from ._common import console, print_json
+    from ._output import Table, document, emit_json, print_csv, print_table
 
-    rows = [find_sensor(args.name)] if args.name else list(sensors())
+    rows = select(args)
     if args.json:
-        print_json([
-            {"key": s.key, "name": s.name, "width_mm": s.width_mm, "height_mm": s.height_mm,
-             "diagonal_mm": s.diagonal_mm, "aliases": list(s.aliases), "kind": s.kind, "source": s.source}
-            for s in rows
-        ])
+        emit_json(document("sensors", {"sensors": [s.to_dict() for s in rows]}, units={"length": "mm"}))
         return 0
-    from rich.table import Table
-
-    t = Table(title="sensors and film gates (mm)")
-    for col in ("name", "width", "height", "diagonal", "aliases"):
-        t.add_column(col)
+    if args.csv:
+        print_csv([s.to_dict() for s in rows])
+        return 0
+    t = Table("sensors and film gates (active area, mm)", ("name", "maker", "width", "height", "diagonal", "aspect",
+                                                            "aliases"),
+              justify=("left", "left", "right", "right", "right", "right", "left"))
     for s in rows:
-        t.add_row(s.name, f"{s.width_mm:.2f}", f"{s.height_mm:.2f}", f"{s.diagonal_mm:.2f}", ", ".join(s.aliases))
-    console().print(t)
+        t.add_row(s.name, s.maker, f"{s.width_mm:.2f}", f"{s.height_mm:.2f}", f"{s.diagonal_mm:.2f}",
+                  f"{s.aspect:.3f}", ", ".join(s.aliases))
+    print_table(t)
     return 0

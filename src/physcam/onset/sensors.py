@@ -19,7 +19,11 @@ from pathlib import Path
 
 from ..errors import SensorError
 
-__all__ = ["Sensor", "sensors", "find_sensor", "custom_sensor", "SENSOR_SIZE_RANGE_MM", "SENSOR_MAX_ASPECT"]
+__all__ = ["Sensor", "sensors", "find_sensor", "filter_sensors", "custom_sensor", "SENSOR_SIZE_RANGE_MM",
+           "SENSOR_MAX_ASPECT", "MAKERS"]
+
+#: Camera makers in the table (a digital sensor's name starts with its maker); film gates are "film".
+MAKERS = ("ARRI", "RED", "Sony")
 
 
 @dataclass(frozen=True, slots=True)
@@ -41,6 +45,19 @@ class Sensor:
     @property
     def aspect(self) -> float:
         return self.width_mm / self.height_mm
+
+    @property
+    def maker(self) -> str:
+        """The camera maker (ARRI, RED, Sony), "film" for a film gate, "" when neither."""
+        if self.kind == "film":
+            return "film"
+        first = self.name.split()[0] if self.name else ""
+        return first if first in MAKERS else ""
+
+    def to_dict(self) -> dict:
+        return {"key": self.key, "name": self.name, "maker": self.maker, "kind": self.kind,
+                "width_mm": self.width_mm, "height_mm": self.height_mm, "diagonal_mm": self.diagonal_mm,
+                "aspect": self.aspect, "aliases": list(self.aliases), "source": self.source}
 
 
 #: A custom sensor's width and height (mm): from a phone's sensor to beyond 15/70 IMAX film.
@@ -102,6 +119,36 @@ def _index() -> dict[str, Sensor]:
 #: Names of camera families rather than of one sensor: refused with the family's members, so a
 #: bare "ALEXA" never quietly becomes the 2010 camera's 16:9 gate (issue 8).
 FAMILY_NAMES = {"alexa": "ALEXA", "arri": "ALEXA", "arriflex": "ALEXA"}
+
+
+def filter_sensors(query: str = "", *, maker: str | None = None, fmt: str | None = None,
+                   min_width_mm: float | None = None, max_width_mm: float | None = None) -> list[Sensor]:
+    """Sensors matching every word of ``query`` (in the name, key, aliases or maker; case and
+    punctuation ignored), the ``maker`` (ARRI, RED, Sony or film), the ``fmt`` text in the name
+    ("open gate", "16:9", "4-perf") and a width between ``min_width_mm`` and ``max_width_mm``.
+
+    >>> [s.key for s in filter_sensors("ARRI", fmt="16:9")]
+    ['alexa35-169', 'alexa-lf-uhd', 'alexa-s35-169']
+    """
+    for name, v in (("query", query), ("maker", maker), ("format", fmt)):
+        if v is not None and not isinstance(v, str):
+            raise SensorError(f"a sensor {name} is text, got {type(v).__name__}")
+    words = [_norm(w) for w in (query or "").split() if _norm(w)]
+    out = []
+    for s in sensors():
+        text = " ".join(_norm(t) for t in (s.key, s.name, s.maker, s.kind, *s.aliases))
+        if not all(w in text for w in words):
+            continue
+        if maker is not None and _norm(maker) != _norm(s.maker):
+            continue
+        if fmt is not None and _norm(fmt) not in _norm(s.name) + " " + " ".join(_norm(a) for a in s.aliases):
+            continue
+        if min_width_mm is not None and s.width_mm < min_width_mm:
+            continue
+        if max_width_mm is not None and s.width_mm > max_width_mm:
+            continue
+        out.append(s)
+    return out
 
 
 def find_sensor(name: str) -> Sensor:
