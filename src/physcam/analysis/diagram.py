@@ -72,9 +72,15 @@ class LensDiagram:
     axis: str
     field_deg: float
     rays: list[tuple[str, list[tuple[float, float]]]]
+    focus_from_film_mm: float = math.inf
+    fstop: float | None = None
 
-    def figure(self, *, width_in: float = 10.0):
-        """A matplotlib Figure (Agg canvas)."""
+    def figure(self, *, width_in: float = 10.0, units: str = "m"):
+        """A matplotlib Figure (Agg canvas). The view spans the lens and film; an object closer than
+        infinity is marked by where its rays enter the view (its distance is in the title, in
+        ``units``: m or ft)."""
+        from ..units import format_distance
+
         from matplotlib.figure import Figure
         from matplotlib.backends.backend_agg import FigureCanvasAgg
 
@@ -119,21 +125,26 @@ class LensDiagram:
         for label, zp, d in (("EP", g.z_entrance_pupil, g.entrance_pupil_diameter), ("XP", g.z_exit_pupil, g.exit_pupil_diameter)):
             ax.plot([zp, zp], [-d / 2, d / 2], color="#e67e22", linewidth=1.2, linestyle="--")
             ax.annotate(label, (zp, d / 2), textcoords="offset points", xytext=(0, 3), ha="center", fontsize=8, color="#e67e22")
-        # the view: the rays' start to just past the film; points outside are listed below the plot
-        z_lo = min(min(q[0] for _, pts in self.rays for q in pts), -0.05 * g.z_film)
+        # the view: the lens and film (rays from a near object enter from the left); points outside are
+        # listed below the plot
+        z_view = -max(0.3 * p.total_track, 10.0)
+        z_lo = max(min(min(q[0] for _, pts in self.rays for q in pts), -0.05 * g.z_film), z_view)
         z_hi = 1.08 * g.z_film if g.z_film > 0 else p.total_track + 10.0
         ax.set_xlim(z_lo, z_hi)
         ax.set_ylim(-1.6 * hmax, 1.6 * hmax)
         outside = [f"{lbl} at z = {zp:.1f} mm" for lbl, zp in marks + [("EP", g.z_entrance_pupil), ("XP", g.z_exit_pupil)]
                    if not z_lo <= zp <= z_hi]
+        if math.isfinite(g.z_object) and g.z_object < z_lo:
+            outside.insert(0, f"object at z = {g.z_object:.0f} mm")
         if outside:
             ax.text(0.01, 0.02, "outside the view: " + ", ".join(outside), transform=ax.transAxes, fontsize=7, color="0.3")
         ax.set_aspect("equal", adjustable="box")
         ax.set_xlabel("z from the first vertex (mm, + toward the film)")
         ax.set_ylabel(f"{axis} (mm)")
+        fnum = g.f_number if self.fstop is None else self.fstop
         ax.set_title(
-            f"{p.name}: EFL {g.efl:.2f} mm, f/{g.f_number:.2f}, half-field {self.field_deg:.1f}° "
-            f"({axis.upper()} meridian)",
+            f"{p.name}: EFL {g.efl:.2f} mm, f/{fnum:.3g}, focus {format_distance(self.focus_from_film_mm, units)}, "
+            f"half-field {self.field_deg:.1f}° ({axis.upper()} meridian)",
             fontsize=10,
         )
         fig.tight_layout()
@@ -205,12 +216,14 @@ def lens_diagram(prescription: Prescription, *, axis: str = "y", focus_from_film
         y_start = h - tu * (ep - z_start)
         out.append((kind, trace_meridional_ray(p, y_start, z_start, tu, 1.0, axis=axis, wavelength_nm=wavelength_nm,
                                                film_z=g.z_film)))
-    return LensDiagram(p, g, axis, math.degrees(half), out)
+    return LensDiagram(p, g, axis, math.degrees(half), out, float(focus_from_film_mm),
+                       None if fstop is None else float(fstop))
 
 
 @takes_prescription
 def save_lens_diagram(prescription: Prescription, path, *, force: bool = False, **kwargs) -> Path:
-    """Draw the diagram to ``path`` (.png, .svg or .pdf) through atomic_write; kwargs as :func:`lens_diagram`."""
+    """Draw the diagram to ``path`` (.png, .svg or .pdf) through atomic_write; kwargs as :func:`lens_diagram`,
+    and ``units`` (m or ft) for the focus in the title."""
     from ..figures import save_figure
     from ..io import check_writable
 
@@ -218,4 +231,5 @@ def save_lens_diagram(prescription: Prescription, path, *, force: bool = False, 
     if p.suffix.lower().lstrip(".") not in DIAGRAM_FORMATS:
         raise ExportError(f"cannot draw a diagram to {p.name!r}: use a .png, .svg or .pdf file name")
     check_writable(p, force=force)  # before the work of drawing
-    return save_figure(lens_diagram(prescription, **kwargs).figure(), p, force=force, dpi=150)
+    units = kwargs.pop("units", "m")
+    return save_figure(lens_diagram(prescription, **kwargs).figure(units=units), p, force=force, dpi=150)
