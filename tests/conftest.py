@@ -1,6 +1,16 @@
 """Test-session set-up shared by every test module."""
 
+import os
+import tempfile
+
 from hypothesis import HealthCheck, settings
+
+# Tests never read the real user's physcam config (~/.config/physcam/config.toml): every process of
+# the session, subprocesses included, reads an empty config file of its own. A test of the config
+# points PHYSCAM_CONFIG elsewhere with monkeypatch.
+_fd, _EMPTY_CONFIG = tempfile.mkstemp(prefix="physcam-test-config-", suffix=".toml")
+os.close(_fd)
+os.environ["PHYSCAM_CONFIG"] = _EMPTY_CONFIG
 
 # USD builds its schema registry once per process: register physcam's PhysicalCamera plugin
 # before any test (in any xdist worker, in any order) creates a stage.

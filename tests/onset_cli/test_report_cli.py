@@ -63,7 +63,7 @@ def test_version_and_sensors(capsys):
     assert main(["--version"]) == 0
     assert capsys.readouterr().out.startswith("physcam ")
     assert main(["sensors", "--json"]) == 0
-    names = [s["name"] for s in json.loads(capsys.readouterr().out)]
+    names = [s["name"] for s in json.loads(capsys.readouterr().out)["sensors"]]
     assert "ARRI ALEXA 35 4.6K 3:2 Open Gate" in names
 
 

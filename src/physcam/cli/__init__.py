@@ -5,6 +5,9 @@ Each subcommand lives in its own module of this package and exposes
 adding a module. Handlers import heavy libraries (numpy, matplotlib, USD) inside
 their bodies so ``physcam --help`` and ``physcam report`` start fast.
 
+Shared rules (sensors, focus, units, notes, JSON documents, tables, CSV, the user config) live
+in :mod:`physcam.cli._common`, :mod:`physcam.cli._output` and :mod:`physcam.cli._config`.
+
 Errors: a :class:`~physcam.errors.PhysCamError` prints one line on stderr and exits 2;
 a failing standard output (disk full) prints one line and exits 2; a closed pipe exits 0;
 anything else is a bug and shows a traceback (exit 1).
@@ -25,7 +28,13 @@ __all__ = ["main", "build_parser"]
 
 
 #: Command modules in --help order; modules not listed follow alphabetically.
-COMMAND_ORDER = ("report", "sensors", "lens", "trace", "analyze", "distortion", "usd", "demo")
+COMMAND_ORDER = ("report", "dof_table", "sensors", "lens", "trace", "analyze", "distortion", "compare", "usd", "demo",
+                 "config")
+
+#: Option destinations that name files a command writes: a relative path there goes into the user
+#: config's ``output_dir`` when it sets one. A command whose positional argument is an output file
+#: lists it with ``parser.set_defaults(output_args=("file",))``.
+OUTPUT_DESTS = ("output", "plot", "stmap", "out")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -72,11 +81,27 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
         sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
 
 
+def _into_output_dir(args) -> None:
+    """Relative output paths go into the user config's ``output_dir`` (when it sets one)."""
+    from ._config import load_config
+
+    folder = load_config().output_dir
+    if folder is None:
+        return
+    for dest in OUTPUT_DESTS + tuple(getattr(args, "output_args", ())):
+        v = getattr(args, dest, None)
+        if isinstance(v, str) and v and not os.path.isabs(v):
+            setattr(args, dest, str(folder / v))
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 done, 2 refused input or unwritable output)."""
     import warnings
 
+    from ._common import take_notes
+
     warnings.showwarning = _show_warning
+    take_notes()  # a fresh list for this run (tests call main() repeatedly in one process)
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -86,8 +111,11 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 0
     try:
+        _into_output_dir(args)
         rc = int(args.handler(args) or 0)
         sys.stdout.flush()  # a full disk or closed pipe shows here, inside the error handling
+        for n in take_notes():  # defaults taken, ranges clamped: said once the command has worked
+            print(f"physcam: note: {n}", file=sys.stderr)
         return rc
     except PhysCamError as exc:
         msg = str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__

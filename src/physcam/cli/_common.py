@@ -1,4 +1,18 @@
-"""Helpers shared by the CLI commands: unit parsing types, JSON and table output."""
+"""Helpers shared by the CLI commands: the rules every command keeps, one place each.
+
+A new command complies by using these (docs/cli.md, "Writing a command"):
+
+- distances: :func:`distance` (units as said on set; a bare number is mm);
+- a focus: :func:`focus` as the option's type (distances, ``hyperfocal``, ``infinity``) and
+  :func:`resolve_focus` in the handler, which turns ``hyperfocal`` into a mark;
+- printed distances: :func:`add_units_option` and :func:`units_of` with
+  :func:`physcam.units.format_distance` (``--units m|ft``, default from the user config);
+- a sensor: :func:`add_sensor_options` and :func:`resolve_sensor` (one default, said in a note);
+- a circle of confusion: :func:`coc_value` as the type and :func:`coc_of` (config default);
+- a renamed option: :func:`hidden_alias` keeps the old spelling working, unlisted;
+- notes for people: :func:`note` (printed on stderr after the command succeeds);
+- JSON, tables and CSV: :mod:`physcam.cli._output`.
+"""
 
 from __future__ import annotations
 
@@ -8,7 +22,16 @@ import math
 import sys
 
 from ..errors import PhysCamError
-from ..units import parse_distance
+from ..units import UNIT_SYSTEMS, parse_distance
+
+#: The sensor every command uses when none is given (and the user config names none).
+DEFAULT_SENSOR = "Super 35"
+#: ``--focus hyperfocal``: the value :func:`focus` returns for it (resolved by :func:`resolve_focus`).
+HYPERFOCAL = "hyperfocal"
+#: Words read as an infinite focus.
+INFINITY_WORDS = ("inf", "infinity", "∞")
+#: What every focus option's help ends with.
+FOCUS_HELP = "units ok: 2m, 6ft, 10'6\"; or hyperfocal, infinity"
 
 
 def distance(name: str, allow_inf: bool = False):
@@ -62,14 +85,188 @@ def numbers(name: str, count: int, *, positive: bool = False):
     return parse
 
 
+def focus(name: str = "focus distance", *, allow_inf: bool = True, hyperfocal: bool = True):
+    """An argparse type for a focus mark: a distance with units, ``infinity`` (``inf``) and
+    ``hyperfocal`` (returned as :data:`HYPERFOCAL`, for :func:`resolve_focus`)."""
+
+    def parse(text):
+        t = str(text).strip().lower()
+        if hyperfocal and t in (HYPERFOCAL, "hyper", "hyperfocal distance"):
+            return HYPERFOCAL
+        if t in INFINITY_WORDS:
+            if not allow_inf:
+                raise argparse.ArgumentTypeError(f"{name} must be finite here, got {text!r}")
+            return math.inf
+        try:
+            return parse_distance(text, name=name)
+        except PhysCamError as exc:
+            raise argparse.ArgumentTypeError(f"{exc}; or hyperfocal, infinity" if hyperfocal else str(exc)) from None
+
+    parse.__name__ = name
+    return parse
+
+
+def focus_list(name: str = "focus distances"):
+    """An argparse type for comma-separated focus marks (each as :func:`focus`)."""
+    one = focus(name)
+
+    def parse(text):
+        parts = [t.strip() for t in str(text).split(",") if t.strip()]
+        if not parts:
+            raise argparse.ArgumentTypeError(f"give {name} separated by commas, e.g. 1m,2m,5m,hyperfocal,inf")
+        return [one(t) for t in parts]
+
+    parse.__name__ = name
+    return parse
+
+
+def resolve_focus(value, *, lens=None, focal_length_mm=None, fstop=None, sensor=None, coc=None, args=None):
+    """A focus option's value as a mark in mm from the film (``inf`` stays ``inf``).
+
+    :data:`HYPERFOCAL` becomes the hyperfocal mark of the lens (a prescription, focused there)
+    or thin lens of ``focal_length_mm`` at ``fstop`` (a lens: wide open when None) for the
+    circle of confusion of ``sensor`` (default: :func:`resolve_sensor` of ``args``) and ``coc``
+    (default: the user config's). A list is resolved element by element.
+    """
+    if isinstance(value, (list, tuple)):
+        return [resolve_focus(v, lens=lens, focal_length_mm=focal_length_mm, fstop=fstop, sensor=sensor, coc=coc,
+                              args=args) for v in value]
+    if value != HYPERFOCAL:
+        return value
+    from ..errors import InputError
+    from ..onset.report import solve_lens_report
+
+    if lens is None and focal_length_mm is None:
+        raise InputError("--focus hyperfocal needs a lens or a focal length")
+    if sensor is None:
+        sensor = resolve_sensor(args)
+    r = solve_lens_report(focal_length_mm=None if lens is not None else focal_length_mm, lens=lens, sensor=sensor,
+                          fstop=fstop, focus_mm=HYPERFOCAL, coc=coc if coc is not None else coc_of(args))
+    from ..units import format_distance
+
+    note(f"hyperfocal focus: {format_distance(r.focus_from_film_mm, units_of(args))} from the film at f/{r.fstop:.3g}, "
+         f"CoC {r.coc_mm:.4g} mm ({r.coc_convention}, {sensor.name})")
+    return r.focus_from_film_mm
+
+
 def coc_value(text):
-    """A --coc value: a convention name stays text, a number becomes a float (mm)."""
+    """A --coc value: a convention name (d/1500, cine, ...) stays text; a number with an optional
+    unit (0.025, 25um, 0.025mm) becomes a float in mm (a bare number is mm)."""
     if text is None:
         return None
     try:
         return float(text)
     except ValueError:
-        return text
+        pass
+    t = str(text).strip()
+    if t and (t[0].isdigit() or t[0] in ".+-") and "/" not in t:
+        try:
+            return parse_distance(t, name="circle of confusion")
+        except PhysCamError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+def coc_of(args):
+    """The circle of confusion a command was given (--coc), else the user config's, else None."""
+    v = getattr(args, "coc", None)
+    if v is not None:
+        return v
+    from ._config import load_config
+
+    return load_config().coc
+
+
+# ---- units -----------------------------------------------------------------------------------
+def add_units_option(p) -> None:
+    """``--units m|ft``: the unit system distances are printed in (tables, CSV, plots)."""
+    p.add_argument("--units", choices=UNIT_SYSTEMS, default=None,
+                   help="print distances in metres (m) or feet and inches (ft: to 1/8 inch below 10 ft); "
+                        "default m, or `units` in the user config (physcam config show); JSON stays in mm")
+
+
+def units_of(args) -> str:
+    """The unit system for printed distances: --units, else the user config's, else metres."""
+    u = getattr(args, "units", None)
+    if u is not None:
+        return u
+    from ._config import load_config
+
+    return load_config().units or "m"
+
+
+# ---- sensors ---------------------------------------------------------------------------------
+def add_sensor_options(p, *, what: str = "") -> None:
+    """--sensor NAME or --sensor-width/--sensor-height: the one set of sensor options."""
+    g = p.add_argument_group("sensor") if what == "" else p
+    g.add_argument("--sensor", metavar="NAME",
+                   help=f'sensor or gate name, e.g. "ALEXA 35" or S35 (see `physcam sensors`); default {DEFAULT_SENSOR}, '
+                        "or `sensor` in the user config")
+    g.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="MM",
+                   help="a custom sensor's width, with --sensor-height (instead of --sensor)")
+    g.add_argument("--sensor-height", type=distance("sensor height"), default=None, metavar="MM",
+                   help="a custom sensor's height, with --sensor-width")
+
+
+def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):
+    """The sensor a command was given: --sensor NAME, or --sensor-width with --sensor-height (a
+    bounded custom sensor), else the default (the user config's ``sensor``, else
+    :data:`DEFAULT_SENSOR`), which a note on stderr names (unless ``quiet``: the command says it
+    itself). Sets ``args.sensor_defaulted``."""
+    from ..errors import InputError
+    from ..onset.sensors import custom_sensor, find_sensor
+
+    name = getattr(args, "sensor", None)
+    sw, sh = getattr(args, "sensor_width", None), getattr(args, "sensor_height", None)
+    custom = sw is not None or sh is not None
+    if name is not None and custom:
+        raise InputError("give either --sensor NAME or --sensor-width/--sensor-height, not both")
+    if args is not None:
+        args.sensor_defaulted = False
+    if name is not None:
+        return find_sensor(name)
+    if custom:
+        if sw is None or sh is None:
+            raise InputError("give both --sensor-width and --sensor-height")
+        return custom_sensor(sw, sh)
+    from ._config import load_config
+
+    cfg = load_config()
+    chosen = default or cfg.sensor or DEFAULT_SENSOR
+    s = find_sensor(chosen)
+    where = "the user config's sensor" if (default is None and cfg.sensor) else "the default"
+    if args is not None:
+        args.sensor_defaulted = True
+        args.sensor_default_source = where
+    how = "give --sensor to change it" if hasattr(args, "sensor") else "`sensor` in the user config changes it"
+    if not quiet:
+        note(f"no --sensor given: {s.name}, {s.width_mm:g} x {s.height_mm:g} mm ({where}; {how})")
+    return s
+
+
+# ---- option names ----------------------------------------------------------------------------
+def hidden_alias(p, flag: str, dest: str, **kwargs) -> None:
+    """Keep an old option spelling working without listing it in --help (scripts that use it
+    keep running); ``kwargs`` as the option it stands for (type, choices, action...)."""
+    p.add_argument(flag, dest=dest, default=argparse.SUPPRESS, help=argparse.SUPPRESS, **kwargs)
+
+
+# ---- notes -----------------------------------------------------------------------------------
+_NOTES: list[str] = []
+
+
+def note(message: str) -> None:
+    """A remark for people (a default taken, a range clamped): printed on stderr as
+    ``physcam: note: ...`` once the command has succeeded; dropped when it fails."""
+    if message not in _NOTES:
+        _NOTES.append(message)
+
+
+def take_notes() -> list[str]:
+    """The notes so far, emptying the list."""
+    out = list(_NOTES)
+    _NOTES.clear()
+    return out
 
 
 def print_json(obj) -> None:

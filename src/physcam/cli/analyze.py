@@ -2,53 +2,61 @@
 
 ``physcam distortion`` lives in :mod:`physcam.cli.distortion` and shares this module's options.
 
-Top-level commands, like ``physcam spot`` and ``physcam bokeh``. Each prints a table, or JSON
-with ``--json``, and writes a plot with ``-o FILE.png`` (never over a file unless ``--force``).
+Top-level commands, like ``physcam spot`` and ``physcam bokeh``. Each prints a table (``--csv``
+for its rows), or JSON with ``--json``, and writes a plot with ``-o FILE.png`` (never over a file
+unless ``--force``). The sensor is the one default (Super 35) unless given. Without ``--field``
+or ``--max-field`` the fields reach the sensor corner, clamped (with a note) to what the lens
+images, as ``physcam distortion`` does.
 """
 
 from __future__ import annotations
 
 import math
 
-from ._common import distance, number, print_json
-from .lens import add_lenient, mark_repaired
+from ._common import FOCUS_HELP, add_sensor_options, add_units_option, focus, hidden_alias, number
+from ._output import add_output_options, document, emit_json, print_csv
+from .lens import WAVE_UNITS, add_lenient, mark_repaired
+
+#: How each analysis names its document (``physcam.NAME``), its rows (for --csv) and its units.
+DOCS = {"illumination": ("illumination", "points"), "colour": ("colour", "lateral"),
+        "breathing-real": ("breathing_real", "rows"), "ghosts": ("ghosts", "paths"),
+        "distortion": ("distortion", "points")}
 
 
 def _common(p, plot_help: str) -> None:
     p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
     add_lenient(p)
-    p.add_argument("--json", action="store_true", help="print as JSON")
+    add_output_options(p, csv=True, what="the analysis")
     p.add_argument("-o", "--output", metavar="FILE.png", help=plot_help)
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
 
 
 def _sensor(p) -> None:
-    p.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (default full frame 36x24)')
-    p.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="MM",
-                   help="sensor width with --sensor-height (instead of --sensor)")
-    p.add_argument("--sensor-height", type=distance("sensor height"), default=None, metavar="MM",
-                   help="sensor height with --sensor-width")
+    add_sensor_options(p)
 
 
 def _resolve_sensor(args) -> None:
-    """Fill args.sensor_width/height (mm) from --sensor NAME, or the pair, or full frame 36x24."""
-    from .report import resolve_sensor
+    """Fill args.sensor_width/height (mm) from --sensor NAME, or the pair, or the default sensor."""
+    from ._common import resolve_sensor
 
     if not hasattr(args, "sensor_width"):
         return
-    s = resolve_sensor(args, default="Full Frame")
+    s = resolve_sensor(args)
     args.sensor_width, args.sensor_height = s.width_mm, s.height_mm
+    args.sensor_name = s.name
 
 
 def register(sub) -> None:
     p = sub.add_parser("illumination", help="relative illumination against field (vignetting, cos^4 from real rays)")
     _common(p, "write the relative illumination plot")
     p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG",
-                   help="field angle in degrees (repeat; default: from the axis to the sensor corner)")
+                   help="field angle in degrees (repeat; default: from the axis to the sensor corner, clamped to "
+                        "what the lens images)")
     p.add_argument("--max-field", type=number("max field"), default=None, metavar="DEG",
-                   help="widest field angle in degrees (default: the sensor corner)")
+                   help="widest field angle in degrees (default: the sensor corner, clamped to what the lens images)")
     p.add_argument("--fstop", type=number("f-stop"), default=None, help="stop the lens down to this f-number")
-    p.add_argument("--grid", type=int, default=200, help="rays per side of the sampling grid (16-2000, default 200)")
+    p.add_argument("--grid", type=int, default=200, metavar="N",
+                   help="rays per side of the sampling grid (16-2000, default 200)")
     p.add_argument("--fresnel", action="store_true", help="include Fresnel losses at every surface")
     _sensor(p)
     p.set_defaults(handler=run_illumination)
@@ -56,9 +64,10 @@ def register(sub) -> None:
     p = sub.add_parser("colour", aliases=["color"], help="longitudinal and lateral colour (F, d, C and more)")
     _common(p, "write the chromatic aberration plot")
     p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG",
-                   help="field angle in degrees (repeat; default: from the axis to the sensor corner)")
+                   help="field angle in degrees (repeat; default: from the axis to the sensor corner, clamped to "
+                        "what the lens images)")
     p.add_argument("--max-field", type=number("max field"), default=None, metavar="DEG",
-                   help="widest field angle in degrees (default: the sensor corner)")
+                   help="widest field angle in degrees (default: the sensor corner, clamped to what the lens images)")
     p.add_argument("--wavelength", type=number("wavelength"), action="append", metavar="NM",
                    help="extra wavelength to report (repeat); F and C are always included")
     _sensor(p)
@@ -66,22 +75,28 @@ def register(sub) -> None:
 
     p = sub.add_parser("breathing-real", help="focus breathing from real chief rays against the paraxial table")
     _common(p, "write the breathing plot")
-    p.add_argument("--focus", type=distance("focus distance", allow_inf=True), action="append", metavar="DIST",
-                   help="focus mark from the film (repeat; units ok: 2m, 6ft, inf)")
-    p.add_argument("--method", choices=("auto", "unit", "internal"), default="auto",
+    p.add_argument("--focus", type=focus("focus distance"), action="append", metavar="DIST",
+                   help=f"focus mark from the film (repeat; default: infinity to the closest focus; {FOCUS_HELP}; "
+                        "hyperfocal wide open)")
+    p.add_argument("--focus-method", choices=("auto", "unit", "internal"), default="auto",
                    help="focusing: unit (whole lens moves) or internal (focus groups); auto: internal when the lens has groups")
+    hidden_alias(p, "--method", "focus_method", choices=("auto", "unit", "internal"))
     _sensor(p)
+    add_units_option(p)
     p.set_defaults(handler=run_breathing)
 
     p = sub.add_parser("ghosts", help="double-bounce ghost paths ranked by intensity, and a ghost image")
     _common(p, "write the ghost image of a point light")
-    p.add_argument("--field", type=number("field angle"), default=10.0, metavar="DEG",
-                   help="field angle of the light (degrees, Y meridian; default 10)")
+    p.add_argument("--field", type=number("field angle"), default=None, metavar="DEG",
+                   help="field angle of the light (degrees, Y meridian; default 10, clamped to what the lens lets "
+                        "through)")
     p.add_argument("--coating", choices=("none", "single", "multi"), default=None,
                    help="coating model (default: the lens file's, else none)")
-    p.add_argument("--rays", type=int, default=200_000, help="rays per ghost path for the image")
-    p.add_argument("--top", type=int, default=10, help="how many ranked paths to print")
-    p.add_argument("--pixels", type=int, default=256, help="ghost image width in pixels (8 to 4096; default 256)")
+    p.add_argument("--rays", type=int, default=200_000, metavar="N",
+                   help="rays per ghost path for the image (with -o; default 200000)")
+    p.add_argument("--top", type=int, default=10, metavar="N", help="how many ranked paths to print (default 10)")
+    p.add_argument("--pixels", type=int, default=256, metavar="PX",
+                   help="ghost image width in pixels (8 to 4096; default 256)")
     _sensor(p)
     p.set_defaults(handler=run_ghosts)
 
@@ -97,13 +112,31 @@ def _prepare(args):
     return args.loaded_lens
 
 
-def _finish(args, res) -> None:
+def _finish(args, res, command: str) -> None:
+    """The plot (-o), then JSON, CSV or the notes and the written file for people."""
+    name, rows = DOCS[command]
     if args.output:
         res.plot(args.output, force=args.force)
+    d = mark_repaired(res.to_dict(), args.loaded_lens)
+    if getattr(args, "sensor_name", None):
+        d["sensor"] = args.sensor_name
     if args.json:
-        print_json(mark_repaired(res.to_dict(), args.loaded_lens))
-    elif args.output:
+        emit_json(document(name, d, units=WAVE_UNITS))
+        return
+    if args.csv:
+        return
+    for n in d.get("notes", ()):
+        print(f"note: {n}")
+    if args.output:
         print(f"wrote {args.output}")
+
+
+def _csv(args, res, command: str) -> bool:
+    """With --csv: print the analysis's rows (as in its JSON) and say so."""
+    if args.csv and not args.json:
+        print_csv(res.to_dict()[DOCS[command][1]])
+        return True
+    return False
 
 
 def _resolution(text: str):
@@ -121,33 +154,37 @@ def _resolution(text: str):
 def run_illumination(args) -> int:
     from ..analysis.illumination import relative_illumination
     from ..optics.paraxial import stop_semi_diameter_for_fstop
+    from ._output import Table, print_table
 
     lens = _prepare(args)
     sd = None if args.fstop is None else stop_semi_diameter_for_fstop(lens, args.fstop)
     res = relative_illumination(lens, args.field, max_field_deg=args.max_field, grid=args.grid, fresnel=args.fresnel,
                                 stop_semi_diameter=sd, sensor_width_mm=args.sensor_width,
                                 sensor_height_mm=args.sensor_height)
-    if not args.json:
-        print(f"{res.lens_name}: relative illumination at {res.wavelength_nm:g} nm"
-              + (f", f/{args.fstop:g}" if args.fstop else ""))
-        print(f"  {'axis':>4} {'field deg':>9} {'RI':>7} {'cos^4':>7} {'vignet.':>7} {'height mm':>9}")
+    if not (args.json or _csv(args, res, "illumination")):
+        t = Table(f"{res.lens_name}: relative illumination at {res.wavelength_nm:g} nm"
+                  + (f", f/{args.fstop:g}" if args.fstop else "") + f", {args.sensor_name}",
+                  ("axis", "field deg", "RI", "cos^4", "vignet.", "height mm"), justify=["right"] * 6)
         for p in res.points:
-            print(f"  {p.axis:>4} {p.field_deg:9.3f} {p.relative_illumination:7.4f} {p.cos4:7.4f} "
-                  f"{p.vignetting_factor:7.4f} {p.film_height_mm:9.3f}")
-    _finish(args, res)
+            t.add_row(p.axis, f"{p.field_deg:.3f}", f"{p.relative_illumination:.4f}", f"{p.cos4:.4f}",
+                      f"{p.vignetting_factor:.4f}", f"{p.film_height_mm:.3f}")
+        print_table(t)
+    _finish(args, res, "illumination")
     return 0
 
 
 def run_colour(args) -> int:
     from ..analysis.colour import chromatic_aberration
     from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM
+    from ._output import Table, print_table
 
     lens = _prepare(args)
     wls = (LINE_F_NM, LINE_D_NM, LINE_C_NM) + tuple(args.wavelength or ())
     res = chromatic_aberration(lens, args.field, wavelengths_nm=wls, max_field_deg=args.max_field,
                                sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height)
-    if not args.json:
-        print(f"{res.lens_name}: chromatic aberration (EFL {res.efl_mm:.3f} mm at {res.reference_nm:g} nm)")
+    if not (args.json or _csv(args, res, "colour")):
+        print(f"{res.lens_name}: chromatic aberration (EFL {res.efl_mm:.3f} mm at {res.reference_nm:g} nm), "
+              f"{args.sensor_name}")
         print(f"  longitudinal colour C - F: paraxial {res.longitudinal_paraxial_mm * 1e3:.2f} um, "
               f"real ({res.zone:.3g} zone) {res.longitudinal_real_mm * 1e3:.2f} um")
         if res.media:
@@ -156,49 +193,61 @@ def run_colour(args) -> int:
             print("  dispersion models:")
             for m in res.media:
                 print(f"    surfaces {','.join(str(i) for i in m['surfaces'])}: {m['description']}")
+        t = Table("focus per wavelength (lens space z, mm)", ("wavelength nm", "paraxial focus z", "real zone focus z"),
+                  justify=["right"] * 3)
         for w, zp, zr in zip(res.wavelengths_nm, res.paraxial_focus_z_mm, res.real_focus_z_mm):
-            print(f"    {w:9.4f} nm  paraxial focus z {zp:10.4f} mm  real zone focus z {zr:10.4f} mm")
-        print("  lateral colour F - C on the film:")
+            t.add_row(f"{w:.4f}", f"{zp:.4f}", f"{zr:.4f}")
+        print_table(t)
+        t = Table("lateral colour F - C on the film", ("field deg", "lateral colour um"), justify=["right"] * 2)
         for p in res.lateral:
-            print(f"    field {p.field_deg:7.3f} deg  {p.lateral_colour_um:9.3f} um")
-        for n in res.notes:
-            print(f"  note: {n}")
-    _finish(args, res)
+            t.add_row(f"{p.field_deg:.3f}", f"{p.lateral_colour_um:.3f}")
+        print_table(t)
+    _finish(args, res, "colour")
     return 0
 
 
 def run_breathing(args) -> int:
     from ..analysis.breathing_real import real_breathing
+    from ..units import format_distance
+    from ._common import resolve_focus, units_of
+    from ._output import Table, print_table
 
     lens = _prepare(args)
-    res = real_breathing(lens, args.focus, sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
-                         method=args.method)
-    if not args.json:
-        print(f"{res.lens_name}: focus breathing ({res.method} focusing), sensor "
-              f"{res.sensor_mm[0]:g} x {res.sensor_mm[1]:g} mm")
-        print(f"  {'focus mm':>10} {'HFOV par':>9} {'HFOV real':>9} {'DFOV real':>9} {'chg par %':>9} {'chg real %':>10}")
+    from ..onset.sensors import custom_sensor
+
+    marks = None if args.focus is None else resolve_focus(
+        args.focus, lens=lens, sensor=custom_sensor(args.sensor_width, args.sensor_height), args=args)
+    res = real_breathing(lens, marks, sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
+                         method=args.focus_method)
+    if not (args.json or _csv(args, res, "breathing-real")):
+        units = units_of(args)
+        t = Table(f"{res.lens_name}: focus breathing ({res.method} focusing), {args.sensor_name} "
+                  f"{res.sensor_mm[0]:g} x {res.sensor_mm[1]:g} mm",
+                  ("focus", "HFOV par", "HFOV real", "DFOV real", "chg par %", "chg real %"), justify=["right"] * 6)
         for r in res.rows:
-            f = "∞" if math.isinf(r.focus_from_film_mm) else f"{r.focus_from_film_mm:.0f}"
             dfov = "-" if r.dfov_real_deg is None else f"{r.dfov_real_deg:.3f}"
-            print(f"  {f:>10} {r.hfov_paraxial_deg:9.3f} {r.hfov_real_deg:9.3f} {dfov:>9} "
-                  f"{r.change_paraxial_pct:9.3f} {r.change_real_pct:10.3f}")
-    _finish(args, res)
+            t.add_row(format_distance(r.focus_from_film_mm, units), f"{r.hfov_paraxial_deg:.3f}",
+                      f"{r.hfov_real_deg:.3f}", dfov, f"{r.change_paraxial_pct:.3f}", f"{r.change_real_pct:.3f}")
+        print_table(t)
+    _finish(args, res, "breathing-real")
     return 0
 
 
 def run_ghosts(args) -> int:
     from ..analysis.ghosts import ghost_analysis
+    from ._output import Table, print_table
 
     lens = _prepare(args)
     res = ghost_analysis(lens, args.field, coating=args.coating, image_rays=args.rays if args.output else 0,
                          pixels=args.pixels, sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height)
-    if not args.json:
-        print(f"{res.lens_name}: {len(res.paths)} double-bounce ghost paths, light at {res.field_deg:g} deg, "
-              f"coating {res.coating}")
-        print(f"  {'rank':>4} {'surfaces':>9} {'rel. flux':>10} {'RMS r mm':>9} {'centroid y mm':>13}")
+    if not (args.json or _csv(args, res, "ghosts")):
+        t = Table(f"{res.lens_name}: {len(res.paths)} double-bounce ghost paths, light at {res.field_deg:g} deg, "
+                  f"coating {res.coating}", ("rank", "surfaces", "rel. flux", "RMS r mm", "centroid y mm"),
+                  justify=["right"] * 5)
         for n, g in enumerate(res.paths[: args.top], start=1):
             c = "-" if g.centroid_y_mm is None else f"{g.centroid_y_mm:.3f}"
             r = "-" if g.rms_radius_mm is None else f"{g.rms_radius_mm:.3f}"
-            print(f"  {n:4d} {g.i:4d}->{g.j:<4d} {g.relative_flux:10.3e} {r:>9} {c:>13}")
-    _finish(args, res)
+            t.add_row(str(n), f"{g.i}->{g.j}", f"{g.relative_flux:.3e}", r, c)
+        print_table(t)
+    _finish(args, res, "ghosts")
     return 0

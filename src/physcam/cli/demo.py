@@ -26,9 +26,14 @@ DEFAULTS = {
 
 def register(sub) -> None:
     p = sub.add_parser("demo", help="run the main job on the default lens and sensor, writing a folder of outputs")
-    p.add_argument("--out", default="demo-output", help="folder to write (default demo-output)")
+    from ._common import hidden_alias
+    from ._output import add_output_options
+
+    p.add_argument("-o", "--output", dest="out", default="demo-output", metavar="DIR",
+                   help="folder to write (default demo-output)")
+    hidden_alias(p, "--out", "out")
     p.add_argument("--force", action="store_true", help="overwrite files already in the folder")
-    p.add_argument("--json", action="store_true", help="print the list of written files as JSON")
+    add_output_options(p, what="the list of written files")
     p.set_defaults(handler=run)
 
 
@@ -156,7 +161,8 @@ def _blender_step(out, ctx, force):
 def run(args) -> int:
     from pathlib import Path
 
-    from ._common import console, print_json
+    from ._common import console
+    from ._output import document, emit_json
 
     out = Path(args.out)
     ctx: dict = {}
@@ -168,7 +174,7 @@ def run(args) -> int:
         if not args.json:
             err.print(f"{name}: " + ", ".join(str(p) for p in paths))
     if args.json:
-        print_json({"out": str(out), "files": [str(p) for p in written]})
+        emit_json(document("demo", {"out": str(out), "files": [str(p) for p in written]}))
         return 0
     print(ctx["table"], end="")
     return 0

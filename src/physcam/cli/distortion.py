@@ -12,28 +12,16 @@ from __future__ import annotations
 
 import math
 
-from ._common import distance, number, print_json
-from .lens import mark_repaired
+from ._common import FOCUS_HELP, add_units_option, focus, focus_list, number
+from ._output import document, emit_json, print_csv
+from .lens import WAVE_UNITS, mark_repaired
 
 #: Names of the files the fits write into --stmap DIR.
 FIT_FILES = {"brown": "brown_conrady.json", "3de4": "3de4_radial_standard_degree_4.txt",
              "usd": "usd_lens_distortion.json", "nuke": "physcam_stmap.nk"}
 
 
-def _focus_list(text: str):
-    """Comma-separated focus marks with units (argparse type)."""
-    import argparse
-
-    from ..errors import PhysCamError
-    from ..units import parse_distance
-
-    parts = [t.strip() for t in str(text).split(",") if t.strip()]
-    if not parts:
-        raise argparse.ArgumentTypeError("give focus marks separated by commas, e.g. 0.5m,1m,2m,inf")
-    try:
-        return [parse_distance(t, name="focus distance", allow_inf=True) for t in parts]
-    except PhysCamError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+_focus_list = focus_list("focus marks")
 
 
 def register(sub) -> None:
@@ -47,9 +35,9 @@ def register(sub) -> None:
     _sensor(p)
     p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM",
                    help="wavelength in nm (default: the lens's design wavelength, the d line 587.56)")
-    p.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=None, metavar="D",
-                   help="focus mark from the film plane (e.g. 2m, 6ft; default infinity) for the 2-D field; "
-                        "needs --resolution")
+    p.add_argument("--focus", type=focus("focus distance"), default=None, metavar="D",
+                   help=f"focus mark from the film plane for the 2-D field (default infinity; {FOCUS_HELP}; "
+                        "hyperfocal wide open); needs --resolution")
     p.add_argument("--resolution", type=_resolution, default=None, metavar="WxH",
                    help="frame size in pixels, e.g. 2048x1366: the full 2-D distortion field at --focus")
     p.add_argument("--stmap", metavar="DIR", default=None,
@@ -66,7 +54,9 @@ def register(sub) -> None:
     p.add_argument("--plate", default="plate.####.exr", metavar="PATH",
                    help="the plate the Nuke script reads (default plate.####.exr)")
     p.add_argument("--across-focus", type=_focus_list, default=None, metavar="LIST",
-                   help="a table of distortion across focus marks, e.g. 0.5m,1m,2m,inf; needs --resolution")
+                   help="a table of distortion across focus marks, e.g. 0.5m,1m,2m,inf (hyperfocal too); "
+                        "needs --resolution")
+    add_units_option(p)
     p.set_defaults(handler=run_distortion)
 
 
@@ -83,7 +73,17 @@ def run_distortion(args) -> int:
                          "and --fit")
     if args.fit and "nuke" in args.fit and args.stmap is None:
         raise InputError("--fit nuke writes a Nuke script beside the ST-maps: give --stmap DIR")
+    if args.csv and args.resolution is not None and args.across_focus is None:
+        raise InputError("--csv prints a table's rows: the field-angle table (without --resolution) or "
+                         "--across-focus; the 2-D field writes --stmap files")
     lens = _prepare(args)
+    if args.focus is not None or args.across_focus is not None:
+        from ..onset.sensors import custom_sensor
+        from ._common import resolve_focus
+
+        sensor = custom_sensor(args.sensor_width, args.sensor_height)
+        args.focus = resolve_focus(args.focus, lens=lens, sensor=sensor, args=args)
+        args.across_focus = resolve_focus(args.across_focus, lens=lens, sensor=sensor, args=args)
     if args.across_focus is not None:
         return _run_across_focus(args, lens)
     if args.resolution is not None:
@@ -92,20 +92,23 @@ def run_distortion(args) -> int:
 
     res = real_distortion(lens, args.field, sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
                           wavelength_nm=args.wavelength)
-    if not args.json:
-        print(f"{res.lens_name}: real distortion at {res.wavelength_nm:g} nm (chief ray vs f tan theta), "
-              f"EFL {res.efl_y_mm:.3f} mm")
-        print(f"  {'axis':>4} {'field deg':>9} {'real mm':>10} {'f tan mm':>10} {'dist %':>8}")
+    if args.csv and not args.json:
+        print_csv(res.to_dict()["points"])
+    elif not args.json:
+        from ._output import Table, print_table
+
+        t = Table(f"{res.lens_name}: real distortion at {res.wavelength_nm:g} nm (chief ray vs f tan theta), "
+                  f"EFL {res.efl_y_mm:.3f} mm, {args.sensor_name}",
+                  ("axis", "field deg", "real mm", "f tan mm", "dist %"), justify=["right"] * 5)
         for p in res.points:
-            print(f"  {p.axis:>4} {p.field_deg:9.3f} {p.real_height_mm:10.4f} {p.paraxial_height_mm:10.4f} "
-                  f"{p.distortion_pct:8.3f}")
+            t.add_row(p.axis, f"{p.field_deg:.3f}", f"{p.real_height_mm:.4f}", f"{p.paraxial_height_mm:.4f}",
+                      f"{p.distortion_pct:.3f}")
+        print_table(t)
         f = res.fit
         if f is not None:
-            print(f"  standard model: k1 {f.k1:.6f}, k2 {f.k2:.6f} (rho = r / {f.norm_radius_mm:g} mm), "
+            print(f"standard model: k1 {f.k1:.6f}, k2 {f.k2:.6f} (rho = r / {f.norm_radius_mm:g} mm), "
                   f"max residual {f.max_residual_pct:.4f} %")
-        for n in res.notes:
-            print(f"  note: {n}")
-    _finish(args, res)
+    _finish(args, res, "distortion")
     return 0
 
 
@@ -121,18 +124,31 @@ def _run_across_focus(args, lens) -> int:
     if args.output:
         tab.plot(args.output, force=args.force)
     if args.json:
-        print_json(mark_repaired(tab.to_dict(), args.loaded_lens))
+        emit_json(document("distortion_across_focus", mark_repaired(tab.to_dict(), args.loaded_lens),
+                           units=dict(WAVE_UNITS, image="pixel")))
         return 0
-    print(f"{tab.lens_name}: distortion across focus, {tab.sensor_mm[0]:g} x {tab.sensor_mm[1]:g} mm at "
-          f"{tab.size_px[0]}x{tab.size_px[1]} px (against the pinhole at each focus)")
-    print(f"  {'focus m':>8} {'pinhole mm':>10} {'corner %':>9} {'max px':>7} {'BC k1':>9} {'BC k2':>9} "
-          f"{'BC max px':>9} {'3DE c2':>9} {'3DE c4':>9} {'3DE max px':>10}")
-    for r in tab.rows:
-        f = "inf" if r["focus_from_film_mm"] is None else f"{r['focus_from_film_mm'] / 1000:.3g}"
-        b, t = r["brown_du"], r["tde4"]
-        print(f"  {f:>8} {r['pinhole_focal_length_mm']:10.3f} {r['corner_distortion_pct']:9.3f} "
-              f"{r['max_distortion_px']:7.2f} {b['k1']:9.5f} {b['k2']:9.5f} {b['max_px']:9.3f} "
-              f"{t['Distortion - Degree 2']:9.5f} {t['Quartic Distortion - Degree 4']:9.5f} {t['max_px']:10.3f}")
+    rows = [dict(r, brown_du_k1=r["brown_du"]["k1"], brown_du_k2=r["brown_du"]["k2"],
+                 brown_du_max_px=r["brown_du"]["max_px"], tde4_c2=r["tde4"]["Distortion - Degree 2"],
+                 tde4_c4=r["tde4"]["Quartic Distortion - Degree 4"], tde4_max_px=r["tde4"]["max_px"]) for r in tab.rows]
+    if args.csv:
+        print_csv(rows)
+        return 0
+    from ..units import format_distance
+    from ._common import units_of
+    from ._output import Table, print_table
+
+    units = units_of(args)
+    t = Table(f"{tab.lens_name}: distortion across focus, {tab.sensor_mm[0]:g} x {tab.sensor_mm[1]:g} mm at "
+              f"{tab.size_px[0]}x{tab.size_px[1]} px (against the pinhole at each focus)",
+              ("focus", "pinhole mm", "corner %", "max px", "BC k1", "BC k2", "BC max px", "3DE c2", "3DE c4",
+               "3DE max px"), justify=["right"] * 10)
+    for r in rows:
+        f = r["focus_from_film_mm"]
+        t.add_row(format_distance(float("inf") if f is None else f, units), f"{r['pinhole_focal_length_mm']:.3f}",
+                  f"{r['corner_distortion_pct']:.3f}", f"{r['max_distortion_px']:.2f}", f"{r['brown_du_k1']:.5f}",
+                  f"{r['brown_du_k2']:.5f}", f"{r['brown_du_max_px']:.3f}", f"{r['tde4_c2']:.5f}",
+                  f"{r['tde4_c4']:.5f}", f"{r['tde4_max_px']:.3f}")
+    print_table(t)
     if args.output:
         print(f"wrote {args.output}")
     return 0
@@ -215,7 +231,8 @@ def _run_field(args, lens) -> int:
     d["fits"] = [f.to_dict() for f in fits]
     if args.json:
         d["written"] = [str(p) for p in written]
-        print_json(mark_repaired(d, args.loaded_lens))
+        emit_json(document("distortion_field", mark_repaired(d, args.loaded_lens),
+                           units=dict(WAVE_UNITS, image="pixel")))
         return 0
     f = "infinity" if d["focus_from_film_mm"] is None else f"{d['focus_from_film_mm']:g} mm"
     print(f"{res.lens_name}: distortion field at focus {f}, {res.size_px[0]}x{res.size_px[1]} px, "

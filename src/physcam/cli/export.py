@@ -3,7 +3,8 @@ Blender Cycles OSL lens cameras)."""
 
 from __future__ import annotations
 
-from ._common import distance, number, print_json
+from ._common import FOCUS_HELP, add_units_option, focus, number
+from ._output import add_output_options, document, emit_json, print_csv
 
 
 def _sensor(p) -> None:
@@ -19,7 +20,6 @@ def _common(p) -> None:
     _sensor(p)
     p.add_argument("--width-px", type=int, required=True, metavar="PX", help="image width in pixels")
     p.add_argument("--height-px", type=int, required=True, metavar="PX", help="image height in pixels")
-    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
 
 
 def register(sub) -> None:
@@ -31,17 +31,22 @@ def register(sub) -> None:
     u = s.add_parser("unreal", help="write an Unreal Engine lens file (.ulens JSON, Camera Calibration plugin)")
     _common(u)
     u.add_argument("-o", "--output", required=True, metavar="FILE", help="the lens file to write (.ulens or .json)")
-    u.add_argument("--focus", type=distance("focus distance", allow_inf=True), action="append", metavar="D",
-                   help="focus mark from the film plane (repeat; default: infinity to the closest focus)")
+    u.add_argument("--focus", type=focus("focus distance"), action="append", metavar="D",
+                   help=f"focus mark from the film plane (repeat; default: infinity to the closest focus; {FOCUS_HELP}; "
+                        "hyperfocal wide open)")
     u.add_argument("--force", action="store_true", help="overwrite an existing file")
+    add_units_option(u)
+    add_output_options(u, csv=True, what="the lens file's marks")
     u.set_defaults(handler=run_unreal)
 
     o = s.add_parser("opencv", help="print OpenCV pinhole intrinsics and distortion fitted to real rays")
     _common(o)
-    o.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=float("inf"), metavar="D",
-                   help="focus mark from the film plane (default infinity)")
+    o.add_argument("--focus", type=focus("focus distance"), default=float("inf"), metavar="D",
+                   help=f"focus mark from the film plane (default infinity; {FOCUS_HELP}; hyperfocal wide open)")
     o.add_argument("--terms", choices=("k1", "k1k2", "k1k2k3", "rational"), default="k1k2k3",
                    help="distortion terms to fit (default k1k2k3)")
+    add_units_option(o)
+    add_output_options(o, what="the fitted camera")
     o.set_defaults(handler=run_opencv)
 
     b = s.add_parser("blender", help="write a Blender Cycles OSL lens camera (shader + set-up script)",
@@ -49,8 +54,8 @@ def register(sub) -> None:
                                  "and setup_<lens>.py, which makes the scene camera use it "
                                  "(`blender --python setup_<lens>.py`). See docs/blender.md.")
     b.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
-    b.add_argument("--focus", type=distance("focus distance", allow_inf=True), required=True, metavar="D",
-                   help="focus mark from the film plane (e.g. 3m, 10ft, inf)")
+    b.add_argument("--focus", type=focus("focus distance"), required=True, metavar="D",
+                   help=f"focus mark from the film plane ({FOCUS_HELP})")
     b.add_argument("--fstop", type=number("f-number", positive=True), default=None, metavar="N",
                    help="working f-number (default: the lens wide open)")
     _sensor(b)
@@ -68,7 +73,8 @@ def register(sub) -> None:
                    help="render width in pixels (height follows the sensor aspect; default 1920)")
     b.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write the shader and script into")
     b.add_argument("--force", action="store_true", help="overwrite existing files")
-    b.add_argument("--json", action="store_true", help="print JSON instead of text")
+    add_output_options(b, what="what was written")
+    add_units_option(b)
     b.add_argument("--builtin", action="store_true",
                    help="also write builtin_<lens>.py: Blender's own camera matched to the lens at this focus "
                         "(best-match pinhole, aperture, focus distance; faster, no real-lens optics)")
@@ -77,15 +83,25 @@ def register(sub) -> None:
 
 
 def _prepare(args):
+    """Resolve the sensor (args.sensor_width/height), load the lens and resolve --focus (hyperfocal:
+    the lens at --fstop, or wide open)."""
     from ..lens.library import load_lens
+    from ..onset.sensors import custom_sensor
+    from ._common import resolve_focus
     from .analyze import _resolve_sensor
 
     _resolve_sensor(args)
-    return load_lens(args.lens, lenient=args.lenient)
+    lens = load_lens(args.lens, lenient=args.lenient)
+    if getattr(args, "focus", None) is not None:
+        args.focus = resolve_focus(args.focus, lens=lens, fstop=getattr(args, "fstop", None),
+                                   sensor=custom_sensor(args.sensor_width, args.sensor_height), args=args)
+    return lens
 
 
-def _mark(mm: float) -> str:
-    return "∞" if mm == float("inf") else f"{mm / 1000.0:g} m"
+def _mark(mm: float, units: str = "m") -> str:
+    from ..units import format_distance
+
+    return format_distance(mm, units)
 
 
 def run_unreal(args) -> int:
@@ -99,21 +115,29 @@ def run_unreal(args) -> int:
     import json
 
     atomic_write(args.output, json.dumps(data, indent=2, allow_nan=False) + "\n", force=args.force)
-    if args.json:
-        print_json(data)
-        return 0
     pc = data["physcam"]
+    if args.json:
+        emit_json(document("export_unreal", {"written": str(args.output), "lens_file": data}))
+        return 0
+    if args.csv:
+        print_csv(pc["marks"])
+        return 0
+    from ._common import units_of
+    from ._output import Table, print_table
+
+    units = units_of(args)
     print(f"wrote {args.output}: Unreal lens file of {pc['lens']} on {args.sensor_width:g} x {args.sensor_height:g} mm, "
           f"{args.width_px} x {args.height_px} px")
-    print(f"  {'focus':>8} {'Fx':>8} {'Fy':>8} {'K1':>10} {'K2':>10} {'K3':>10} {'pupil cm':>9} {'resid px':>9}")
+    t = Table(None, ("focus", "Fx", "Fy", "K1", "K2", "K3", "pupil cm", "resid px"), justify=["right"] * 8)
     for m in pc["marks"]:
         f = m["focus_from_film_mm"]
-        print(f"  {_mark(float('inf') if f is None else f):>8} {m['pinhole_focal_length_x_mm'] / args.sensor_width:8.5f} "
-              f"{m['pinhole_focal_length_y_mm'] / args.sensor_height:8.5f} {m['k1']:10.6f} {m['k2']:10.6f} "
-              f"{m['k3']:10.6f} {m['entrance_pupil_from_film_mm'] / 10.0:9.3f} {m['max_residual_px']:9.4f}")
+        t.add_row(_mark(float("inf") if f is None else f, units), f"{m['pinhole_focal_length_x_mm'] / args.sensor_width:.5f}",
+                  f"{m['pinhole_focal_length_y_mm'] / args.sensor_height:.5f}", f"{m['k1']:.6f}", f"{m['k2']:.6f}",
+                  f"{m['k3']:.6f}", f"{m['entrance_pupil_from_film_mm'] / 10.0:.3f}", f"{m['max_residual_px']:.4f}")
+    print_table(t)
     notes = sorted({n for m in pc["marks"] for n in m["notes"]})
     for n in notes:
-        print(f"  note: {n}")
+        print(f"note: {n}")
     return 0
 
 
@@ -124,9 +148,11 @@ def run_opencv(args) -> int:
     cam = fit_opencv_pinhole(lens, args.sensor_width, args.sensor_height, args.width_px, args.height_px,
                              focus_from_film_mm=args.focus, terms=args.terms)
     if args.json:
-        print_json(cam.to_dict())
+        emit_json(document("export_opencv", cam.to_dict(), units={"length": "mm", "image": "pixel"}))
         return 0
-    print(f"{cam.lens_name}: OpenCV pinhole at focus {_mark(cam.focus_from_film_mm)} on "
+    from ._common import units_of
+
+    print(f"{cam.lens_name}: OpenCV pinhole at focus {_mark(cam.focus_from_film_mm, units_of(args))} on "
           f"{cam.sensor_width_mm:g} x {cam.sensor_height_mm:g} mm, {cam.image_width_px} x {cam.image_height_px} px")
     print(f"  fx {cam.fx:.4f}  fy {cam.fy:.4f}  cx {cam.cx:.4f}  cy {cam.cy:.4f}  (px; pinhole "
           f"{cam.pinhole_focal_length_x_mm:.4f} mm at the entrance pupil, {cam.entrance_pupil_from_film_mm:.3f} mm "
@@ -172,9 +198,11 @@ def run_blender(args) -> int:
             args.sensor_height], "resolution": [w, h], "dispersion": args.dispersion, "fresnel": args.fresnel,
             "seconds": round(time.perf_counter() - t0, 3)}
     if args.json:
-        print_json(data)
+        emit_json(document("export_blender", data, units={"length": "mm", "time": "s", "image": "pixel"}))
         return 0
-    print(f"wrote {osl} and {setup}: {lens.name} focused at {_mark(args.focus)}"
+    from ._common import units_of
+
+    print(f"wrote {osl} and {setup}: {lens.name} focused at {_mark(args.focus, units_of(args))}"
           f"{'' if args.fstop is None else f', f/{args.fstop:g}'} on {args.sensor_width:g} x {args.sensor_height:g} mm, "
           f"{w} x {h} px")
     print(f"  in Blender: blender your.blend --python {setup}  (Cycles, CPU, OSL)")

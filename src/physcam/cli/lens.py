@@ -3,10 +3,10 @@
 Examples::
 
   physcam lenses
-  physcam lens show dgauss.50mm --focus 2m --fstop 2.8 --flange 52
+  physcam lens show dgauss_50mm --focus 2m --fstop 2.8 --flange 52
   physcam lens show my_lens.zmx --json
   physcam lens diagram navarro_anamorphic_2x --axis x -o navarro_x.svg
-  physcam lens breathing canon_rf_85mm_f1_2 --sensor "Super 35" -o breathing.png
+  physcam lens breathing canon_rf_85mm_f1_2 --sensor "Super 35" -o breathing.png --units ft
   physcam lens check my_lens.toml --sensor "Super 35"
   physcam lens fix my_lens.toml -o my_lens_fixed.toml --apply
 
@@ -18,23 +18,24 @@ plane and flange (distance in front, + toward the subject); see docs/conventions
 from __future__ import annotations
 
 from ..errors import PhysCamError
-from ._common import distance, number
+from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number
+from ._output import add_output_options
 
 
 def register(sub) -> None:
     p = sub.add_parser("lenses", help="list the bundled lens library (focal length, f-number, format)")
-    p.add_argument("--json", action="store_true", help="print as JSON")
+    add_output_options(p, csv=True, what="the library")
     p.set_defaults(handler=run_lenses)
 
     lens = sub.add_parser("lens", help="Gaussian data, diagram and focus breathing of one lens (bundled name or file)")
     lsub = lens.add_subparsers(dest="lens_command", metavar="ACTION")
     lens.set_defaults(handler=lambda args: (lens.print_help(), 0)[1])
 
-    def common(q, fstop=True, focus=True):
+    def common(q, fstop=True, with_focus=True):
         q.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
-        if focus:
-            q.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=float("inf"),
-                           help="focus mark from the film plane, e.g. 2m, 6ft, inf (default inf)")
+        if with_focus:
+            q.add_argument("--focus", type=focus("focus distance"), default=float("inf"),
+                           help=f"focus mark from the film plane (default infinity; {FOCUS_HELP})")
         if fstop:
             q.add_argument("--fstop", type=number("f-number"), default=None,
                            help="evaluate the pupils at this f-number (default: the stop in the file)")
@@ -48,7 +49,8 @@ def register(sub) -> None:
     common(s)
     s.add_argument("--flange", type=distance("flange focal distance"), default=None, metavar="FFD",
                    help="flange focal distance (e.g. 52mm for PL) to give positions from the flange too")
-    s.add_argument("--json", action="store_true", help="print as JSON")
+    add_units_option(s)
+    add_output_options(s, what="the Gaussian data")
     s.set_defaults(handler=run_show)
 
     d = lsub.add_parser("diagram", help="draw elements, stop, rays and cardinal points to PNG/SVG/PDF")
@@ -58,20 +60,20 @@ def register(sub) -> None:
     d.add_argument("--field", type=number("field angle"), default=None, metavar="DEG",
                    help="half field angle of the off-axis rays in degrees (default: widest unvignetted)")
     d.add_argument("--force", action="store_true", help="overwrite an existing file")
+    add_units_option(d)
     d.set_defaults(handler=run_diagram)
 
     b = lsub.add_parser("breathing", help="focal length and field of view against focus (table, optional plot)")
-    common(b, fstop=False, focus=False)
-    b.add_argument("--at", "--focus", dest="at", type=distance("focus distance", allow_inf=True), nargs="+",
-                   default=None, metavar="D",
-                   help="focus marks from the film plane, one or more (default: infinity down to the closest focus)")
-    g = b.add_mutually_exclusive_group()
-    g.add_argument("--sensor", default=None, help="sensor name for the horizontal width (see `physcam sensors`)")
-    g.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="W",
-                   help="sensor width (default 36mm)")
+    common(b, fstop=False, with_focus=False)
+    b.add_argument("--focus", dest="at", type=focus("focus distance"), nargs="+", default=None, metavar="D",
+                   help=f"focus marks from the film plane, one or more (default: infinity down to the closest focus; "
+                        f"{FOCUS_HELP}; hyperfocal wide open)")
+    hidden_alias(b, "--at", "at", type=focus("focus distance"), nargs="+")
+    add_sensor_options(b)
     b.add_argument("-o", "--output", default=None, metavar="FILE", help="also plot to this file (.png, .svg, .pdf)")
     b.add_argument("--force", action="store_true", help="overwrite an existing plot")
-    b.add_argument("--json", action="store_true", help="print as JSON")
+    add_units_option(b)
+    add_output_options(b, csv=True, what="the breathing table")
     b.set_defaults(handler=run_breathing)
 
     c = lsub.add_parser("check", help="report what is inconsistent in a lens file (surface, file line, numbers)")
@@ -79,7 +81,7 @@ def register(sub) -> None:
     c.add_argument("--sensor", default=None,
                    help="also trace the on-axis beam, vignetting and image circle at this sensor's corner "
                         "(see `physcam sensors`)")
-    c.add_argument("--json", action="store_true", help="print the findings as JSON")
+    add_output_options(c, what="the findings")
     c.set_defaults(handler=run_check)
 
     f = lsub.add_parser("fix", help="propose (and with --apply write) the repairs of a lens file, with a diff")
@@ -88,8 +90,12 @@ def register(sub) -> None:
                    help="where to write the repaired lens (.toml: physcam's format; .dat, .json, .zmx also work)")
     f.add_argument("--apply", action="store_true", help="write the repaired file (without it: only show the repairs)")
     f.add_argument("--force", action="store_true", help="overwrite an existing output file")
-    f.add_argument("--json", action="store_true", help="print the repairs as JSON")
+    add_output_options(f, what="the repairs")
     f.set_defaults(handler=run_fix)
+
+
+#: Units of documents that carry wavelengths too.
+WAVE_UNITS = {"length": "mm", "angle": "degree", "wavelength": "nm"}
 
 
 def add_lenient(parser) -> None:
@@ -138,7 +144,7 @@ def run_lenses(args) -> int:
     from ..errors import PhysCamError
     from ..lens.library import list_lenses, load_lens
     from ..optics.paraxial import gaussian
-    from ._common import console, print_json
+    from ._output import Table, document, emit_json, print_csv, print_table
 
     out = []
     for rec in list_lenses():
@@ -150,16 +156,14 @@ def run_lenses(args) -> int:
             d["efl_mm"], d["f_number"] = None, None
         out.append(d)
     if args.json:
-        print_json(out)
+        emit_json(document("lenses", {"lenses": out}))
         return 0
-    from rich.table import Table
-
-    t = Table(title="bundled lenses (paraxial EFL and f-number at the d line, stop as in the file)")
-    t.add_column("name (for physcam lens)", no_wrap=True)
-    for col in ("EFL mm", "f/"):
-        t.add_column(col, justify="right", no_wrap=True)
-    t.add_column("format", no_wrap=True)
-    t.add_column("lens and notes", overflow="fold")
+    if args.csv:
+        print_csv(out)
+        return 0
+    t = Table("bundled lenses (paraxial EFL and f-number at the d line, stop as in the file)",
+              ("name (for physcam lens)", "EFL mm", "f/", "format", "lens and notes"),
+              justify=("left", "right", "right", "left", "left"))
     for d in out:
         notes = []
         if d["anamorphic"]:
@@ -170,7 +174,7 @@ def run_lenses(args) -> int:
             notes.append("corrected")
         t.add_row(d["slug"], _fmt(d["efl_mm"], 2), _fmt(d["f_number"], 2), d["original_format"] or "-",
                   "; ".join([d["name"], *notes]))
-    console().print(t)
+    print_table(t)
     return 0
 
 
@@ -184,9 +188,12 @@ def _meridians(p):
 
 def run_show(args) -> int:
     from ..optics import focusing, paraxial
-    from ._common import console, print_json
+    from ..units import format_distance
+    from ._common import resolve_focus, units_of
+    from ._output import Table, document, emit_json, print_table
 
     p = _load(args)
+    args.focus = resolve_focus(args.focus, lens=p, fstop=args.fstop, args=args)
     st = focusing.focus(p, args.focus, method=args.focus_method, wavelength_nm=args.wavelength)
     data = {
         a: paraxial.gaussian(st.prescription, axis=a, wavelength_nm=args.wavelength, fstop=args.fstop,
@@ -204,17 +211,14 @@ def run_show(args) -> int:
         "focused_meridian": st.axis,
     }
     if args.json:
-        print_json(mark_repaired({"lens": p.name, "squeeze": p.squeeze, "focus": focus_info,
-                                  "meridians": {a: g.to_dict() for a, g in data.items()}}, p))
+        emit_json(document("lens_show", mark_repaired(
+            {"lens": p.name, "squeeze": p.squeeze, "focus": focus_info,
+             "meridians": {a: g.to_dict() for a, g in data.items()}}, p), units=WAVE_UNITS))
         return 0
-    from rich.table import Table
-
-    con = console()
     g0 = data["y"]
-    con.print(f"{p.name}  (wavelength {g0.wavelength_nm:g} nm, focus {_fmt(st.focus_from_film_mm, 0)} mm from the film, "
-              f"{st.method} focusing, back focus {st.back_focus_mm:.3f} mm)")
-    t = Table(title="first-order data (mm)")
-    t.add_column("quantity")
+    print(f"{p.name}  (wavelength {g0.wavelength_nm:g} nm, focus {format_distance(st.focus_from_film_mm, units_of(args))} "
+          f"from the film, {st.method} focusing, back focus {st.back_focus_mm:.3f} mm)")
+    t = Table("first-order data (mm; magnification < 0: an inverted image)", ["quantity"])
     for a in data:
         t.add_column(f"{a.upper()} meridian", justify="right")
     rows = [
@@ -226,76 +230,80 @@ def run_show(args) -> int:
     ]
     for label, attr in rows:
         t.add_row(label, *[_fmt(getattr(g, attr), 4) for g in data.values()])
-    con.print(t)
+    print_table(t)
     refs = [("front_vertex", "from front vertex (+ toward film)"), ("rear_vertex", "from rear vertex (+ toward film)"),
             ("film", "in front of film (+ toward subject)")]
     if args.flange is not None:
         refs.append(("flange", "in front of flange (+ toward subject)"))
     for a, g in data.items():
-        t = Table(title=f"positions, {a.upper()} meridian (mm)")
-        t.add_column("point")
+        t = Table(f"positions, {a.upper()} meridian (mm)", ["point"])
         for _, label in refs:
             t.add_column(label, justify="right")
         pos = {ref: g.positions(ref) for ref, _ in refs}
         for point in paraxial.CARDINAL_POINTS:
             t.add_row(point.replace("_", " "), *[_fmt(pos[ref][point]) for ref, _ in refs])
-        con.print(t)
+        print_table(t)
     return 0
 
 
 def run_diagram(args) -> int:
     from ..analysis.diagram import save_lens_diagram
+    from ._common import resolve_focus, units_of
 
     p = _load(args)
+    args.focus = resolve_focus(args.focus, lens=p, fstop=args.fstop, args=args)
     path = save_lens_diagram(p, args.output, force=args.force, axis=args.axis, focus_from_film_mm=args.focus,
-                             fstop=args.fstop, field_deg=args.field, wavelength_nm=args.wavelength)
+                             fstop=args.fstop, field_deg=args.field, wavelength_nm=args.wavelength,
+                             units=units_of(args))
     print(f"wrote {path}")
     return 0
 
 
 def run_breathing(args) -> int:
     from ..optics import focusing
-    from ._common import console, print_json
+    from ..units import format_distance
+    from ._common import resolve_focus, resolve_sensor, units_of
+    from ._output import Table, document, emit_json, print_csv, print_table
 
     p = _load(args)
-    width, sensor_name = 36.0, "36 mm wide"
-    if args.sensor:
-        from ..onset.sensors import find_sensor
-
-        s = find_sensor(args.sensor)
-        width, sensor_name = s.width_mm, s.name
-    elif args.sensor_width is not None:
-        if not args.sensor_width >= 0.1:
+    if args.sensor_width is not None and args.sensor_height is None and args.sensor is None:
+        if not args.sensor_width >= 0.1:  # the table needs only the width (scripts give it alone)
             from ..errors import InputError
 
             raise InputError(f"sensor width must be at least 0.1 mm, got {args.sensor_width:g} mm")
-        width, sensor_name = args.sensor_width, f"{args.sensor_width:g} mm wide"
-    rows = focusing.breathing_table(p, args.at, sensor_width_mm=width, method=args.focus_method,
+        width, sensor_name, sensor = args.sensor_width, f"{args.sensor_width:g} mm wide", None
+    else:
+        sensor = resolve_sensor(args)
+        width, sensor_name = sensor.width_mm, sensor.name
+    marks = resolve_focus(args.at, lens=p, sensor=sensor, args=args) if args.at is not None else None
+    rows = focusing.breathing_table(p, marks, sensor_width_mm=width, method=args.focus_method,
                                     wavelength_nm=args.wavelength)
+    units = units_of(args)
     path = None
     if args.output:
         from ..analysis.breathing_plot import save_breathing_plot
 
-        path = save_breathing_plot(rows, args.output, force=args.force, title=f"{p.name}: focus breathing",
-                                   sensor_width_mm=width)
+        path = save_breathing_plot(rows, args.output, force=args.force,
+                                   title=f"{p.name}: focus breathing, {sensor_name} ({width:g} mm wide)",
+                                   sensor_width_mm=width, units=units)
     if args.json:
-        print_json(mark_repaired({"lens": p.name, "sensor_width_mm": width, "rows": [r.to_dict() for r in rows],
-                                  "plot": None if path is None else str(path)}, p))
+        emit_json(document("lens_breathing", mark_repaired(
+            {"lens": p.name, "sensor": sensor_name, "sensor_width_mm": width, "rows": [r.to_dict() for r in rows],
+             "plot": None if path is None else str(path)}, p)))
         return 0
-    from rich.table import Table
-
-    t = Table(title=f"{p.name}: focus breathing, {sensor_name} sensor (horizontal field, X meridian)")
-    for col in ("focus from film (mm)", "EFL (mm)", "HFOV (deg)", "framing focal length (mm)", "magnification",
-                "back focus (mm)", "entrance pupil from film (mm)", "FOV change (%)"):
-        t.add_column(col, justify="right")
+    if args.csv:
+        print_csv([r.to_dict() for r in rows])
+        return 0
+    t = Table(f"{p.name}: focus breathing, {sensor_name} sensor (horizontal field, X meridian)",
+              ("focus from film", "EFL (mm)", "HFOV (deg)", "framing focal length (mm)", "magnification",
+               "back focus (mm)", "entrance pupil from film (mm)", "FOV change (%)"), justify=["right"] * 8)
     for r in rows:
-        t.add_row(_fmt(r.focus_from_film_mm, 0), _fmt(r.efl_mm, 3), _fmt(r.hfov_deg, 3),
+        t.add_row(format_distance(r.focus_from_film_mm, units), _fmt(r.efl_mm, 3), _fmt(r.hfov_deg, 3),
                   _fmt(r.breathing_focal_length_mm, 3), _fmt(r.magnification, 4), _fmt(r.back_focus_mm, 3),
                   _fmt(r.entrance_pupil_from_film_mm, 2), _fmt(r.fov_change_pct, 2))
-    con = console()
-    con.print(t)
+    print_table(t)
     if path is not None:
-        con.print(f"wrote {path}")
+        print(f"wrote {path}")
     return 0
 
 
@@ -372,7 +380,8 @@ def ray_probes(sensor_name: str | None):
 
 def run_check(args) -> int:
     from ..lens.check import check
-    from ._common import console, print_json
+    from ._common import console
+    from ._output import document, emit_json
 
     if args.sensor:
         from ..onset.sensors import find_sensor
@@ -380,8 +389,9 @@ def run_check(args) -> int:
         find_sensor(args.sensor)  # an unknown name is refused before any work
     findings = check(args.lens, probes=ray_probes(args.sensor))
     if args.json:
-        print_json({"lens": args.lens, "findings": [f.to_dict() for f in findings],
-                    "counts": {s: sum(f.severity == s for f in findings) for s in ("error", "warning", "note")}})
+        emit_json(document("lens_check", {
+            "lens": args.lens, "findings": [f.to_dict() for f in findings],
+            "counts": {s: sum(f.severity == s for f in findings) for s in ("error", "warning", "note")}}))
         return 0
     con = console()
     if not findings:
@@ -418,7 +428,8 @@ def run_fix(args) -> int:
     from ..lens.formats import write_lens
     from ..lens.formats._common import json_text
     from ..lens.repair import paraxial_f_number, propose, with_corrections
-    from ._common import console, print_json
+    from ._common import console
+    from ._output import document, emit_json
 
     if args.apply:
         check_writable(args.output, force=args.force)
@@ -437,9 +448,10 @@ def run_fix(args) -> int:
     elif not repairs:
         raw.prescription.validate(str(args.lens), list(raw.lines))  # nothing to repair: say if still unbuildable
     if args.json:
-        print_json({"lens": args.lens, "repairs": [r.to_dict() for r in repairs], "diff": diff,
-                    "f_number_before": _finite(paraxial_f_number, raw.prescription),
-                    "f_number_after": _finite(paraxial_f_number, q), "written": written})
+        emit_json(document("lens_fix", {
+            "lens": args.lens, "repairs": [r.to_dict() for r in repairs], "diff": diff,
+            "f_number_before": _finite(paraxial_f_number, raw.prescription),
+            "f_number_after": _finite(paraxial_f_number, q), "written": written}))
         return 0
     con = console()
     if not repairs:

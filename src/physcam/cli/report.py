@@ -2,19 +2,21 @@
 
 from __future__ import annotations
 
-from ._common import coc_value, distance, number
+from ._common import FOCUS_HELP, coc_value, distance, focus, number
 
 EPILOG = """\
-distances accept units as said on set: 3m, 10ft, 6in, 450mm, 10'6" (a bare number is mm).
-Focus, near, far and --sensor-front are measured from the film plane; --h1/--h2/--pupil are
-distances in front of the reference plane (--reference film|flange).
+distances accept units as said on set: 3m, 10ft, 6in, 450mm, 10'6" (a bare number is mm);
+--focus also takes hyperfocal and infinity. Focus, near, far and --sensor-front are measured
+from the film plane; --h1/--h2/--pupil are distances in front of the reference plane
+(--reference film|flange). --units ft prints scene distances in feet and inches.
 
 examples:
   physcam report --focal 50 --fstop 2.8 --focus 3m --sensor "ALEXA 35"
+  physcam report --focal 35 --fstop 4 --focus hyperfocal --units ft
   physcam report --focal 35 --focus 10ft --near 8ft --coc 0.025 --tstop 2.8   (solve f-stop)
   physcam report --focal 50 --near 2.5m --far 4m --fstop 4 --sensor S35         (solve focus)
-  physcam report --model technical --focal 50 --fstop 2 --focus 2m --h1 62 --h2 51.3 --pupil 92
-  physcam report --lens dgauss.50mm --fstop 2.8 --focus 2m                     (planes from the lens)
+  physcam report --model technical --focal 50 --fstop 2 --focus 2m --h1 51.2 --h2 51.3 --pupil 60
+  physcam report --lens dgauss_50mm --fstop 2.8 --focus 2m                     (planes from the lens)
 """
 
 
@@ -32,9 +34,14 @@ def register(sub) -> None:
     from .lens import add_lenient
 
     add_lenient(p)
-    p.add_argument("--json", action="store_true", help="print the report as JSON (for pipelines)")
+    from ._common import add_units_option
+    from ._output import add_output_options
+
+    add_units_option(p)
+    add_output_options(p, what="the report")
     p.add_argument("--cameras", action="store_true", help="also print the UsdGeomCamera and RenderMan blocks")
-    p.add_argument("--plot", metavar="FILE", help="draw the depth-of-field zone to FILE (.png or .svg)")
+    p.add_argument("--plot", metavar="FILE", help="draw the depth-of-field zone to FILE (.png, .svg or .pdf; "
+                                                  "in feet with --units ft)")
     p.add_argument("--force", action="store_true", help="overwrite an existing --plot file")
     p.set_defaults(handler=run)
 
@@ -46,13 +53,13 @@ def add_report_arguments(p) -> None:
     g.add_argument("--focal", metavar="MM", type=distance("focal length"), help="focal length (mm)")
     g.add_argument("--fstop", metavar="N", type=number("f-stop"), help="f-stop (geometric f-number); solved from --near/--far if omitted (with --lens: wide open)")
     g.add_argument("--tstop", metavar="T", type=number("T-stop"), help="marked T-stop, compared with the effective f-stop")
-    g.add_argument("--focus", metavar="DIST", type=distance("focus distance"), help="focus mark, film plane to subject")
-    g.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (see physcam sensors; default Super 35 4-perf)')
-    g.add_argument("--sensor-width", metavar="MM", type=distance("sensor width"), help="sensor width (mm)")
-    g.add_argument("--sensor-height", metavar="MM", type=distance("sensor height"), help="sensor height (mm)")
+    g.add_argument("--focus", metavar="DIST", type=focus("focus distance"),
+                   help=f"focus mark, film plane to subject ({FOCUS_HELP})")
+    from ._common import add_sensor_options
+
+    add_sensor_options(g, what="group")
     g.add_argument("--squeeze", metavar="S", type=number("squeeze"), default=1.0, help="anamorphic squeeze (default 1)")
-    g.add_argument("--coc", default=None,
-                   help="circle of confusion: d/1500 (default), d/1000, d/1730, cine (0.025 mm) or a value in mm")
+    add_coc_option(g)
     g = p.add_argument_group("measured depth of field (inverse solve)")
     g.add_argument("--near", metavar="DIST", type=distance("near limit"), help="measured near limit, from the film plane")
     g.add_argument("--far", metavar="DIST", type=distance("far limit", allow_inf=True), help="measured far limit (or inf)")
@@ -82,22 +89,18 @@ def add_report_arguments(p) -> None:
                    help="vertical lens/sensor shift on the film (mm; + up; write negative values as --shift-y=-2)")
 
 
-def resolve_sensor(args, default: str = "Super 35"):
-    """The sensor a command was given: --sensor NAME, or --sensor-width with --sensor-height (a
-    bounded custom sensor), else ``default``. One resolver for every command that takes a sensor."""
-    from ..errors import InputError
-    from ..onset.sensors import custom_sensor, find_sensor
+def add_coc_option(p, extra: str = "") -> None:
+    """--coc: a convention name or a value with units (the one definition)."""
+    p.add_argument("--coc", type=coc_value, default=None, metavar="COC",
+                   help=f"{extra}circle of confusion: d/1500 (default, or `coc` in the user config), d/1000, d/1730, "
+                        "cine (0.025 mm) or a value (0.025, 25um, 0.025mm; a bare number is mm)")
 
-    custom = args.sensor_width is not None or args.sensor_height is not None
-    if args.sensor is not None and custom:
-        raise InputError("give either --sensor NAME or --sensor-width/--sensor-height, not both")
-    if args.sensor is not None:
-        return find_sensor(args.sensor)
-    if custom:
-        if args.sensor_width is None or args.sensor_height is None:
-            raise InputError("give both --sensor-width and --sensor-height")
-        return custom_sensor(args.sensor_width, args.sensor_height)
-    return find_sensor(default)
+
+def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):
+    """The sensor a command was given (:func:`physcam.cli._common.resolve_sensor`)."""
+    from ._common import resolve_sensor as resolve
+
+    return resolve(args, default, quiet=quiet)
 
 
 def solve_from_args(args):
@@ -114,10 +117,13 @@ def solve_from_args(args):
             raise InputError("give either --lens or --focal: the lens sets its own focal length")
     elif args.focal is None:
         raise InputError("give the focal length, e.g. --focal 50, or a lens with --lens NAME")
-    coc = coc_value(args.coc)
-    return solve_lens_report(
+    from ._common import coc_of
+
+    coc = coc_of(args)
+    sensor = resolve_sensor(args, quiet=True)  # the report says it in its notes
+    report = solve_lens_report(
         focal_length_mm=args.focal,
-        sensor=resolve_sensor(args),
+        sensor=sensor,
         fstop=args.fstop,
         focus_mm=args.focus,
         coc=coc,
@@ -136,6 +142,13 @@ def solve_from_args(args):
         pupil_fraction=args.pupil_fraction,
         lens=lens,
     )
+    if getattr(args, "sensor_defaulted", False):
+        import dataclasses
+
+        report = dataclasses.replace(report, notes=report.notes + (
+            f"sensor not given: {sensor.name}, {sensor.width_mm:g} x {sensor.height_mm:g} mm "
+            f"({args.sensor_default_source}; give --sensor)",))
+    return report
 
 
 def camera_blocks(report, args) -> dict:
@@ -145,17 +158,29 @@ def camera_blocks(report, args) -> dict:
     mpu = args.meters_per_unit
     shift = (getattr(args, "shift_x", 0.0), getattr(args, "shift_y", 0.0))
     d = report.to_dict()
+    calc = report
+    if report.focus_is_infinite:  # every value but the focus distance is that of a far, finite focus
+        import dataclasses
+
+        from ..onset.report import MAX_DISTANCE_MM
+
+        calc = dataclasses.replace(report, focus_from_film_mm=MAX_DISTANCE_MM, object_distance_mm=MAX_DISTANCE_MM)
     blocks = {
         "meters_per_unit": mpu,
         "camera": "the best-match pinhole at the entrance pupil (docs/lens-report.md)",
         "fov_deg": {"pinhole": d["fov_deg"]["focus"], "real": d["fov_deg"]["real"]},
-        "usd_geom_camera": usdgeom_camera_values(report, mpu, shutter_angle_deg=args.shutter_angle, shift_mm=shift),
-        "renderman": renderman_camera_values(report, mpu, shift_mm=shift),
+        "usd_geom_camera": usdgeom_camera_values(calc, mpu, shutter_angle_deg=args.shutter_angle, shift_mm=shift),
+        "renderman": renderman_camera_values(calc, mpu, shift_mm=shift),
         "notes": [],
     }
     if report.real_fov_differs:
         blocks["notes"].append("these cameras are pinholes: they show the pinhole field of view, not the real "
                                "lens's (see fov_deg.real); distortion this strong needs a real-lens camera")
+    if report.focus_is_infinite:
+        blocks["usd_geom_camera"]["focusDistance"] = None
+        blocks["renderman"]["focalDistance"] = None
+        blocks["notes"].append("focus at infinity: the cameras' focus distance is infinite (null here); "
+                               "a renderer that needs a number takes its largest focus distance")
     return blocks
 
 
@@ -166,12 +191,15 @@ def run(args) -> int:
         from ..errors import InputError
 
         raise InputError("--force overwrites the --plot file; without --plot there is nothing to overwrite")
+    from ._common import units_of
+
     report = solve_from_args(args)
     cams = camera_blocks(report, args)
+    units = units_of(args)
     if args.plot:
         from ..onset.dof_plot import plot_dof_zone
 
-        plot_dof_zone(report, args.plot, force=args.force)
+        plot_dof_zone(report, args.plot, force=args.force, units=units)
     if args.json:
         d = report.to_dict()
         d["cameras"] = cams
@@ -181,10 +209,15 @@ def run(args) -> int:
             d = mark_repaired(d, args.loaded_lens)
         print_json(d)
         return 0
-    from ..onset.table import report_table
+    from ..onset.table import report_rows, report_title
+    from ._output import Table, print_table
 
-    out = console()
-    out.print(report_table(report))
+    t = Table(report_title(report), ("quantity", "value", "measured from"))
+    for r in report_rows(report, units, notes=False):
+        t.add_row(*r)
+    print_table(t)
+    for n in report.notes:
+        print(f"note: {n}")
     if args.cameras:
         print_json(cams)
     if args.plot:

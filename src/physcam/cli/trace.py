@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from ._common import distance, number, print_json
-from .lens import add_lenient, mark_repaired
+from ._common import FOCUS_HELP, add_units_option, distance, focus, hidden_alias, number
+from ._output import add_output_options, document, emit_json, print_csv
+from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
 
 def register(sub) -> None:
@@ -14,13 +15,13 @@ def register(sub) -> None:
                    help="field angle in degrees (repeat; default 0 and 5)")
     p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM",
                    help="wavelength in nm (default: the lens's design wavelength, the d line 587.56)")
-    p.add_argument("--rings", type=int, default=64,
+    p.add_argument("--rings", type=int, default=64, metavar="N",
                    help="divisions of the pupil radius squared (1-500; about 3 n^2 equal-area rays per field, "
                         "plus the refined beam edge; default 64)")
     p.add_argument("--fstop", type=number("f-stop"), default=None, help="stop the lens down to this f-number")
     p.add_argument("--no-clip", dest="clip", action="store_false",
                    help="no element rim or stop clips: trace the whole paraxial entrance pupil")
-    p.add_argument("--json", action="store_true", help="print as JSON")
+    add_output_options(p, csv=True, what="the spot sizes")
     p.add_argument("-o", "--output", metavar="FILE.png", help="write the spot diagram plot")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(handler=run_spot)
@@ -28,24 +29,28 @@ def register(sub) -> None:
     b = sub.add_parser("bokeh", help="PSF / bokeh image of a point light by real ray tracing")
     b.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name or a lens file")
     add_lenient(b)
-    b.add_argument("--depth", type=distance("light depth"), default=1000.0,
-                   help="light distance in front of the film plane (units ok: 2m, 6ft; bare number = mm)")
+    b.add_argument("--light", dest="depth", type=distance("light distance"), default=1000.0, metavar="D",
+                   help="the point light's distance in front of the film plane (default 1m; units ok: 2m, 6ft; "
+                        "bare number = mm)")
+    hidden_alias(b, "--depth", "depth", type=distance("light distance"))
     b.add_argument("--x", type=number("light x"), default=0.0, metavar="MM", help="light lateral x (mm)")
     b.add_argument("--y", type=number("light y"), default=0.0, metavar="MM", help="light lateral y (mm)")
-    b.add_argument("--rays", type=int, default=1_000_000, help="rays to trace (1 to 1e11; default 1e6)")
-    b.add_argument("--pixels", type=int, default=256, help="image width and height in pixels (8 to 4096; default 256)")
+    b.add_argument("--rays", type=int, default=1_000_000, metavar="N", help="rays to trace (1 to 1e11; default 1e6)")
+    b.add_argument("--pixels", type=int, default=256, metavar="PX",
+                   help="image width and height in pixels (8 to 4096; default 256)")
     b.add_argument("--spectral", action="store_true", help="three wavelengths (620/550/460 nm) as RGB")
-    b.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=None,
-                   help="focus mark from the film plane (default infinity); the lens is focused there")
+    b.add_argument("--focus", type=focus("focus distance"), default=None, metavar="D",
+                   help=f"focus mark from the film plane; the lens is focused there (default infinity; {FOCUS_HELP})")
     b.add_argument("--fstop", type=number("f-stop"), default=None, help="stop the lens down to this f-number")
-    b.add_argument("--blades", type=int, default=0, help="iris blades (< 3: circular; seed 002 nsides)")
+    b.add_argument("--blades", type=int, default=0, metavar="N", help="iris blades (< 3: circular; seed 002 nsides)")
     b.add_argument("--blade-angle", type=number("blade angle"), default=0.0, metavar="DEG",
                    help="rotation of the iris polygon (degrees)")
     b.add_argument("--roundness", type=number("roundness"), default=0.0,
                    help="-1..1: 0 straight blades, 1 bowed out to a circle, -1 bowed in (star)")
     b.add_argument("--density", type=number("density"), default=0.0,
                    help="-1..1: brightness ramp across the aperture (+ brighter rim, - brighter centre)")
-    b.add_argument("--json", action="store_true", help="print as JSON")
+    add_output_options(b, what="the bokeh measurements")
+    add_units_option(b)
     b.add_argument("-o", "--output", metavar="FILE.png", help="write the bokeh image")
     b.add_argument("--force", action="store_true", help="overwrite an existing output file")
     b.set_defaults(handler=run_bokeh)
@@ -64,19 +69,24 @@ def run_spot(args) -> int:
     if args.output:
         res.plot(args.output, force=args.force)
     if args.json:
-        print_json(mark_repaired(res.to_dict(), lens))
+        emit_json(document("spot", mark_repaired(res.to_dict(), lens), units=dict(WAVE_UNITS, spot="um")))
+    elif args.csv:
+        print_csv(res.to_dict()["fields"])
     else:
-        print(f"{res.lens_name}: spot diagram at {res.wavelength_nm:g} nm, film z = {res.film_z_mm:.4f} mm"
-              + ("" if res.clip else ", no clipping"))
-        print(f"  {'field deg':>9} {'RMS um':>10} {'GEO um':>10} {'passed':>7} {'clipped':>7} {'missed':>7} {'TIR':>7}")
+        from ._output import Table, print_table
+
+        t = Table(f"{res.lens_name}: spot diagram at {res.wavelength_nm:g} nm, film z = {res.film_z_mm:.4f} mm"
+                  + ("" if res.clip else ", no clipping"),
+                  ("field deg", "RMS um", "GEO um", "passed", "clipped", "missed", "TIR"), justify=["right"] * 7)
         for f in res.fields:
             rms = "undefined" if f.rms_radius_um is None else f"{f.rms_radius_um:.3f}"
             geo = "undefined" if f.geometric_radius_um is None else f"{f.geometric_radius_um:.3f}"
-            print(f"  {f.field_deg:9.2f} {rms:>10} {geo:>10} {f.rays_passed:7d} {f.rays_clipped:7d} {f.rays_missed:7d} "
-                  f"{f.rays_tir:7d}")
+            t.add_row(f"{f.field_deg:.2f}", rms, geo, str(f.rays_passed), str(f.rays_clipped), str(f.rays_missed),
+                      str(f.rays_tir))
+        print_table(t)
         for f in res.fields:
             if f.reason:
-                print(f"  note: {f.reason}")
+                print(f"note: {f.reason}")
         if args.output:
             print(f"wrote {args.output}")
     return 0
@@ -95,6 +105,9 @@ def run_bokeh(args) -> int:
     from ..trace.aperture import Aperture
 
     lens = load_lens(args.lens, lenient=args.lenient)
+    from ._common import resolve_focus
+
+    args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, args=args)
     st = focusing.focus(lens, math.inf if args.focus is None else args.focus)
     stop = None if args.fstop is None else paraxial.stop_semi_diameter_for_fstop(st.prescription, args.fstop)
     aperture = None
@@ -110,11 +123,20 @@ def run_bokeh(args) -> int:
     if args.output:
         res.plot(args.output, force=args.force)
     if args.json:
-        print_json(mark_repaired(res.to_dict(), lens))
-    else:
         d = res.to_dict()
-        print(f"{res.lens_name}: bokeh of a light at {args.depth:g} mm from the film, "
-              f"{d['rays_passed']}/{d['rays_traced']} rays reach the film, centroid {d['centroid_mm']} mm")
+        d.update(light_from_film_mm=args.depth, focus_from_film_mm=None if args.focus in (None, math.inf) else args.focus,
+                 fstop=args.fstop)
+        emit_json(document("bokeh", mark_repaired(d, lens), units=WAVE_UNITS))
+    else:
+        from ..units import format_distance
+        from ._common import units_of
+
+        d = res.to_dict()
+        u = units_of(args)
+        focus_txt = format_distance(math.inf if args.focus is None else args.focus, u)
+        print(f"{res.lens_name}: bokeh of a light at {format_distance(args.depth, u)} from the film, focus {focus_txt}"
+              + (f", f/{args.fstop:g}" if args.fstop else "")
+              + f", {d['rays_passed']}/{d['rays_traced']} rays reach the film, centroid {d['centroid_mm']} mm")
         if args.output:
             print(f"wrote {args.output}")
     return 0

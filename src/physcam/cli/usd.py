@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from ._common import coc_value, distance, number, numbers
-from .report import resolve_sensor
+from ._common import FOCUS_HELP, add_sensor_options, add_units_option, coc_of, distance, focus, number, numbers
+from ._output import add_output_options, document, emit_json
+from .report import add_coc_option, resolve_sensor
 
 EPILOG = """\
 examples:
@@ -48,12 +49,13 @@ def register(sub) -> None:
                         "distortion (default 2048 and 4096 wide, height from the sensor's aspect)")
     w.add_argument("--overscan", type=number("overscan", lo=0.0, hi=100.0), default=0.0, metavar="PCT",
                    help="render beyond the frame by this percentage (UsdRenderSettings dataWindowNDC)")
-    w.set_defaults(handler=run_write)
+    w.set_defaults(handler=run_write, output_args=("file",))
 
     r = s.add_parser("read", help="read a PhysicalCamera back into a lens report")
     r.add_argument("file", help="a USD file (.usda, .usd, .usdc)")
     r.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
-    r.add_argument("--json", action="store_true", help="print JSON")
+    add_units_option(r)
+    add_output_options(r, what="the camera and its lens report (values as written in the file)")
     r.set_defaults(handler=run_read)
 
     k = s.add_parser("kit", help="the proposal's use cases: previs kit, vendor lens, lens library, body, shot",
@@ -66,15 +68,13 @@ def register(sub) -> None:
     k.add_argument("--characterizations", metavar="CSV",
                    help="lens: a CSV with a date column and CameraSpec lens columns (focal_length_mm, fstop, "
                         "entrance_pupil_mm, transmittance, ...), one row per measuring day")
-    k.add_argument("--focus", type=distance("focus distance"), help="vendor, shot: focus mark from the film plane")
+    k.add_argument("--focus", type=focus("focus distance"),
+                   help=f"vendor, shot: focus mark from the film plane ({FOCUS_HELP}; a USD focus is finite)")
     k.add_argument("--fstop", type=number("f-stop", positive=True), help="vendor, shot: f-stop (vendor default: wide open)")
-    k.add_argument("--sensor", help="vendor, body: sensor name (see physcam sensors)")
-    k.add_argument("--sensor-width", type=distance("sensor width"), help="vendor, body: sensor width")
-    k.add_argument("--sensor-height", type=distance("sensor height"), help="vendor, body: sensor height")
+    add_sensor_options(k)
     k.add_argument("--flange", type=distance("flange focal distance"), help="body: flange focal distance (default 52 mm)")
     k.add_argument("--iso", type=number("ISO", positive=True), help="body: exposure index (default 100)")
-    k.add_argument("--coc", default=None,
-                   help="body: circle of confusion, d/1500 (default), d/1000, d/1730, cine or a value in mm")
+    add_coc_option(k, "body: ")
     k.add_argument("--shutter-angle", type=number("shutter angle", positive=True), default=None,
                    help="body: degrees (default 180)")
     k.add_argument("--position", type=numbers("position", 3), default=(0.0, 0.0, 0.0), metavar="X,Y,Z",
@@ -84,7 +84,7 @@ def register(sub) -> None:
     k.add_argument("--variant", help="shot: pin a lens characterization variant (default the lens file's current)")
     _stage_args(k)
     add_lenient(k)
-    k.set_defaults(handler=run_kit)
+    k.set_defaults(handler=run_kit, output_args=("file",))
 
     a = s.add_parser("animate", help="a focus (and iris) pull as time samples, breathing included",
                      description="Write a camera whose focus and f-stop follow marks per frame (docs/usd.md).",
@@ -97,10 +97,8 @@ def register(sub) -> None:
     a.add_argument("--lens", help="bundled lens name or prescription file (breathing from the real lens)")
     a.add_argument("--focal", type=distance("focal length"), help="or a thin lens of this focal length")
     a.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop for frames without one")
-    a.add_argument("--coc", default=None, help="circle of confusion convention or value in mm")
-    a.add_argument("--sensor", help="sensor name (default Super 35)")
-    a.add_argument("--sensor-width", type=distance("sensor width"), help="sensor width, with --sensor-height")
-    a.add_argument("--sensor-height", type=distance("sensor height"), help="sensor height, with --sensor-width")
+    add_coc_option(a)
+    add_sensor_options(a)
     a.add_argument("--shutter-angle", type=number("shutter angle", positive=True), default=180.0,
                    help="degrees (default 180)")
     a.add_argument("--path", default="/Cameras/Camera", help="camera prim path")
@@ -110,12 +108,12 @@ def register(sub) -> None:
                    help="pan/tilt/roll about the entrance pupil, degrees (XYZ order)")
     _stage_args(a)
     add_lenient(a)
-    a.set_defaults(handler=run_animate)
+    a.set_defaults(handler=run_animate, output_args=("file",))
 
     c = s.add_parser("check", help="is a shot's companion camera current with its body and lens files?")
     c.add_argument("file", help="a shot (or any camera file physcam wrote)")
     c.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
-    c.add_argument("--json", action="store_true", help="print JSON")
+    add_output_options(c, what="the check")
     c.add_argument("--exit-code", action="store_true",
                    help="exit 1 when the companion is stale (for farm and CI scripts; 0 when current)")
     c.set_defaults(handler=run_check)
@@ -123,7 +121,7 @@ def register(sub) -> None:
     f = s.add_parser("refresh", help="recompute a shot's companion camera from its body and lens files (in place)")
     f.add_argument("file", help="a shot (or any camera file physcam wrote), rewritten in place")
     f.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
-    f.add_argument("--json", action="store_true", help="print JSON")
+    add_output_options(f, what="what was recomputed")
     f.set_defaults(handler=run_refresh)
 
     pp = s.add_parser("plugin-path", help="print the schema plugin folder for PXR_PLUGINPATH_NAME")
@@ -162,7 +160,7 @@ def _stage_args(p, units: bool = True) -> None:
                        help="stage metersPerUnit (default 0.01: centimetres)")
     p.add_argument("--fps", type=number("frames per second", positive=True), default=24.0, help="timeCodesPerSecond (default 24)")
     p.add_argument("--force", action="store_true", help="overwrite an existing file")
-    p.add_argument("--json", action="store_true", help="print what was written as JSON")
+    add_output_options(p, what="what was written")
 
 
 def run_write(args) -> int:
@@ -173,6 +171,7 @@ def run_write(args) -> int:
 
     shutter_interval(args.shutter_angle)  # validates 0 < angle <= 360
     report = solve_from_args(args)
+    _finite_focus(report.focus_from_film_mm)
     spec = spec_from_report(report, projection="orthographic" if args.orthographic else "perspective",
                             magnification=args.magnification, aperture_blades=args.blades,
                             shutter_duration_s=args.shutter_angle / 360.0 / args.fps,
@@ -194,29 +193,66 @@ def run_write(args) -> int:
     return _done(args, path)
 
 
-def _done(args, path) -> int:
-    if getattr(args, "json", False):
-        from ._common import print_json
+def _finite_focus(mm) -> None:
+    """USD cameras carry a finite focus distance (PhysicalCamera's focusDistance, UsdGeomCamera's)."""
+    import math
 
-        print_json({"written": str(path)})
+    from ..errors import InputError
+
+    if mm is not None and math.isinf(mm):
+        raise InputError("a USD camera's focus distance is finite: give the focus mark (e.g. --focus 1000m) "
+                         "or --focus hyperfocal")
+
+
+def _done(args, path, name: str = "usd_written") -> int:
+    if getattr(args, "json", False):
+        emit_json(document(name, {"written": str(path)}))
     else:
         print(f"wrote {path}")
     return 0
 
 
-def run_read(args) -> int:
-    from ..usd.read import open_stage, read_camera
+def as_written(v):
+    """A value read from a USD float attribute as its author wrote it: the shortest decimal that is the
+    same float32 (2.8, not 2.799999952316284). Values that are not float32 numbers pass unchanged."""
+    import math
 
-    reading = read_camera(open_stage(args.file), args.path)
+    if isinstance(v, (tuple, list)):
+        return type(v)(as_written(x) for x in v)
+    if isinstance(v, float) and math.isfinite(v):
+        import numpy as np
+
+        f32 = np.float32(v)
+        if float(f32) == v:
+            return float(np.format_float_positional(f32, unique=True, trim="-"))
+    return v
+
+
+def reading_as_written(reading):
+    """A :class:`~physcam.usd.read.CameraReading` whose camera values print as written (:func:`as_written`)."""
+    import dataclasses
+
+    spec = reading.spec
+    clean = {f.name: as_written(getattr(spec, f.name)) for f in dataclasses.fields(spec)
+             if isinstance(getattr(spec, f.name), (float, tuple))}
+    return dataclasses.replace(reading, spec=dataclasses.replace(spec, **clean))
+
+
+def run_read(args) -> int:
+    from ..units import format_distance
+    from ..usd.read import open_stage, read_camera
+    from ._common import units_of
+
+    reading = reading_as_written(read_camera(open_stage(args.file), args.path))
     report = reading.report()
     if args.json:
-        from ._common import print_json
-
-        print_json({"usd": reading.to_dict(),
-                    "report": report.to_dict() if reading.spec.projection == "perspective" else None})
+        emit_json(document("usd_read", {
+            "usd": reading.to_dict(),
+            "report": report.to_dict() if reading.spec.projection == "perspective" else None}))
         return 0
     s = reading.spec
-    print(f"{reading.path}: {s.focal_length_mm:.4g} mm f/{s.fstop:.3g} focus {s.focus_mm:.6g} mm "
+    units = units_of(args)
+    print(f"{reading.path}: {s.focal_length_mm:.4g} mm f/{s.fstop:.3g} focus {format_distance(s.focus_mm, units)} "
           f"sensor {s.sensor_width_mm:g} x {s.sensor_height_mm:g} mm ({reading.lens_model_type})")
     if s.projection == "orthographic":
         # a telecentric view: no field angle; the sensor images sensor / magnification of the scene
@@ -225,8 +261,9 @@ def run_read(args) -> int:
     else:
         pin, _ = report.pinhole
         print(f"  pinhole {pin:.4f} mm: hfov {report.hfov_focus_deg:.4f} deg, vfov {report.vfov_focus_deg:.4f} deg "
-              f"at focus; DOF from film {report.dof.near_from_film_mm:.1f} mm to "
-              f"{'∞' if report.dof.far_is_infinite else f'{report.dof.far_from_film_mm:.1f} mm'}")
+              f"at focus; DOF from film {format_distance(report.dof.near_from_film_mm, units)} to "
+              f"{format_distance(report.dof.far_from_film_mm, units)}; CoC {report.coc_mm:.4g} mm "
+              f"({report.coc_convention})")
     for k, v in reading.variants.items():
         print(f"  variant {k} = {v}")
     return 0
@@ -261,8 +298,13 @@ def run_kit(args) -> int:
             raise InputError(f"physcam usd kit vendor needs {' and '.join(missing)}")
         from ..lens.library import load_lens
 
-        sensor = resolve_sensor(args, default="Full Frame")
-        path = kit.write_vendor_lens(args.file, load_lens(args.lens, lenient=args.lenient), focus_mm=args.focus,
+        sensor = resolve_sensor(args)
+        lens = load_lens(args.lens, lenient=args.lenient)
+        from ._common import resolve_focus
+
+        args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
+        _finite_focus(args.focus)
+        path = kit.write_vendor_lens(args.file, lens, focus_mm=args.focus,
                                      fstop=args.fstop,
                                      sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm, **common)
     elif kind == "lens":
@@ -274,8 +316,8 @@ def run_kit(args) -> int:
 
         from ..optics.coc import circle_of_confusion
 
-        sensor = resolve_sensor(args, default="Super 35")
-        coc, _ = circle_of_confusion(sensor.width_mm, sensor.height_mm, coc_value(args.coc))
+        sensor = resolve_sensor(args)
+        coc, _ = circle_of_confusion(sensor.width_mm, sensor.height_mm, coc_of(args))
         body = dict(sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm, sensor_name=sensor.name,
                     coc_mm=coc)
         if args.flange is not None:
@@ -293,6 +335,10 @@ def run_kit(args) -> int:
             raise InputError("physcam usd kit shot needs --body FILE and --lens FILE")
         overrides = {}
         if args.focus is not None:
+            if isinstance(args.focus, str):  # hyperfocal: the shot's lens and body are in the files
+                raise InputError("usd kit shot takes a focus mark (the lens and body are files); "
+                                 "`physcam report --lens ... --focus hyperfocal` gives the mark")
+            _finite_focus(args.focus)
             overrides["focus_mm"] = args.focus
         if args.fstop is not None:
             overrides["fstop"] = args.fstop
@@ -300,16 +346,15 @@ def run_kit(args) -> int:
                               position=args.position, rotate_xyz_deg=args.rotate, **common)
     if kind == "vendor" and args.json:  # what the file says, read back: the lens and its best-match pinhole
         from ..usd.read import open_stage
-        from ._common import print_json
 
         stage = open_stage(path)
         lens = stage.GetPrimAtPath(kit.LENS_PRIM)
         values = {a.GetName(): a.Get() for a in lens.GetAttributes() if a.HasAuthoredValue()}
-        print_json({"written": str(path),
-                    "lens": {k: (list(v) if hasattr(v, "__len__") and not isinstance(v, str) else v)
-                             for k, v in values.items()},
-                    "variants": {n: lens.GetVariantSets().GetVariantSelection(n)
-                                 for n in lens.GetVariantSets().GetNames()}})
+        emit_json(document("usd_kit_vendor", {
+            "written": str(path),
+            "lens": {k: (as_written(list(v)) if hasattr(v, "__len__") and not isinstance(v, str) else as_written(v))
+                     for k, v in values.items()},
+            "variants": {n: lens.GetVariantSets().GetVariantSelection(n) for n in lens.GetVariantSets().GetNames()}}))
         return 0
     return _done(args, path)
 
@@ -372,17 +417,16 @@ def run_animate(args) -> int:
         from ..lens.library import load_lens
 
         lens = load_lens(args.lens, lenient=args.lenient)
-    coc = coc_value(args.coc)
+    coc = coc_of(args)
     keys = read_focus_marks(args.marks)
-    path = write_animated_camera(args.file, keys, sensor=resolve_sensor(args, default="Super 35"), lens=lens,
+    path = write_animated_camera(args.file, keys, sensor=resolve_sensor(args), lens=lens,
                                  focal_length_mm=args.focal, fstop=args.fstop, coc=coc, path=args.path,
                                  meters_per_unit=args.meters_per_unit, fps=args.fps,
                                  shutter_angle_deg=args.shutter_angle, position=args.position,
                                  rotate_xyz_deg=args.rotate, force=args.force)
     if args.json:
-        from ._common import print_json
-
-        print_json({"written": str(path), "frames": len(keys), "first": keys[0].frame, "last": keys[-1].frame})
+        emit_json(document("usd_animate", {"written": str(path), "frames": len(keys), "first": keys[0].frame,
+                                           "last": keys[-1].frame}))
     else:
         print(f"wrote {path} ({len(keys)} frames, {keys[0].frame:g} to {keys[-1].frame:g})")
     return 0
@@ -394,9 +438,9 @@ def run_check(args) -> int:
     res = check_shot(args.file, args.path)
     rc = 1 if (args.exit_code and res["stale"]) else 0
     if args.json:
-        from ._common import print_json
-
-        print_json(res)
+        d = dict(res)
+        d["file_units"] = d.pop("units")  # the layers' metersPerUnit notes (the document's own "units" say mm)
+        emit_json(document("usd_check", d))
         return rc
     state = f"STALE: {res['reason']}; run physcam usd refresh {args.file}" if res["stale"] else "current"
     print(f"{res['path']}: companion camera {state}")
@@ -411,9 +455,9 @@ def run_refresh(args) -> int:
 
     res = refresh_shot(args.file, args.path)
     if args.json:
-        from ._common import print_json
-
-        print_json(res)
+        d = dict(res)
+        d["file_units"] = d.pop("units")  # as usd check
+        emit_json(document("usd_refresh", d))
     else:
         print(f"{res['path']}: companion camera recomputed")
     return 0

@@ -1,0 +1,133 @@
+"""The user config: defaults a person sets once (``physcam config show`` prints them).
+
+The file is TOML, read from ``$PHYSCAM_CONFIG`` when that variable is set (an empty value means
+no config file), else ``$XDG_CONFIG_HOME/physcam/config.toml``, else
+``~/.config/physcam/config.toml``. Every key is optional; an option given on the command line
+always wins::
+
+    sensor = "ALEXA 35"      # the sensor when no --sensor is given (default Super 35)
+    coc = "d/1500"           # circle of confusion: d/1500, d/1000, d/1730, cine, or a value (25um)
+    units = "ft"             # distances printed in ft (feet and inches) or m (default m)
+    output_dir = "~/shots"   # relative output files (-o, --plot, --stmap, usd files) go here
+
+An unknown key, a value of the wrong kind or a file that is not TOML is refused with the file's
+name, so a typo never silently falls back to a default.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import InputError
+
+__all__ = ["Config", "config_path", "load_config", "KEYS"]
+
+#: The keys a config may set, with what each means (``physcam config show`` lists them).
+KEYS = {
+    "sensor": "the sensor when no --sensor is given (a name from `physcam sensors`)",
+    "coc": "the circle of confusion when no --coc is given: d/1500, d/1000, d/1730, cine or a value (0.025, 25um)",
+    "units": "the unit system distances are printed in: m or ft",
+    "output_dir": "the folder relative output files are written into",
+}
+
+
+@dataclass(frozen=True)
+class Config:
+    """The user's defaults; None where the file does not set them."""
+
+    path: Path | None = None
+    exists: bool = False
+    sensor: str | None = None
+    coc: str | float | None = None
+    units: str | None = None
+    output_dir: Path | None = None
+    source: dict = field(default_factory=dict)  # key -> where its value came from
+
+    def to_dict(self) -> dict:
+        return {"path": None if self.path is None else str(self.path), "exists": self.exists,
+                "sensor": self.sensor, "coc": self.coc, "units": self.units,
+                "output_dir": None if self.output_dir is None else str(self.output_dir)}
+
+
+def config_path() -> Path | None:
+    """Where the config is read from (see the module notes); None when ``PHYSCAM_CONFIG`` is empty."""
+    env = os.environ.get("PHYSCAM_CONFIG")
+    if env is not None:
+        return Path(env).expanduser() if env.strip() else None
+    base = os.environ.get("XDG_CONFIG_HOME") or os.path.join(os.path.expanduser("~"), ".config")
+    return Path(base) / "physcam" / "config.toml"
+
+
+_CACHE: dict = {}
+
+
+def load_config() -> Config:
+    """The user config (cached per file and modification time)."""
+    path = config_path()
+    if path is None or not path.is_file():
+        return Config(path=path, exists=False)
+    try:
+        stamp = path.stat().st_mtime_ns
+    except OSError:
+        stamp = None
+    key = (str(path), stamp)
+    if key not in _CACHE:
+        _CACHE.clear()
+        _CACHE[key] = _read(path)
+    return _CACHE[key]
+
+
+def _read(path: Path) -> Config:
+    import tomllib
+
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise InputError(f"cannot read the physcam config {path}: {exc.strerror or exc}") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"the physcam config {path} is not valid TOML: {exc}") from None
+    unknown = sorted(set(data) - set(KEYS))
+    if unknown:
+        raise InputError(f"the physcam config {path} has unknown key(s) {', '.join(unknown)}; "
+                         f"it may set {', '.join(KEYS)}")
+    values: dict = {}
+    for k, v in data.items():
+        if k == "coc" and isinstance(v, (int, float)) and not isinstance(v, bool):
+            values[k] = float(v)
+            continue
+        if not isinstance(v, str) or not v.strip():
+            raise InputError(f"the physcam config {path}: {k} must be text, e.g. {k} = \"...\", got {v!r}")
+        values[k] = v.strip()
+    if "sensor" in values:
+        from ..onset.sensors import find_sensor
+
+        try:
+            find_sensor(values["sensor"])
+        except InputError as exc:
+            raise InputError(f"the physcam config {path}: sensor: {exc}") from None
+    if "coc" in values and isinstance(values["coc"], str):
+        from ._common import coc_value
+
+        try:
+            values["coc"] = coc_value(values["coc"])
+        except Exception as exc:  # argparse's ArgumentTypeError: a bad number with a unit
+            raise InputError(f"the physcam config {path}: coc: {exc}") from None
+        if isinstance(values["coc"], str):
+            from ..optics.coc import circle_of_confusion
+
+            try:
+                circle_of_confusion(36.0, 24.0, values["coc"])
+            except InputError as exc:
+                raise InputError(f"the physcam config {path}: coc: {exc}") from None
+    if "units" in values:
+        from ..units import UNIT_SYSTEMS
+
+        if values["units"] not in UNIT_SYSTEMS:
+            raise InputError(f"the physcam config {path}: units must be one of {', '.join(UNIT_SYSTEMS)}, "
+                             f"got {values['units']!r}")
+    out = values.get("output_dir")
+    return Config(path=path, exists=True, sensor=values.get("sensor"), coc=values.get("coc"),
+                  units=values.get("units"), output_dir=None if out is None else Path(out).expanduser(),
+                  source={k: str(path) for k in values})

@@ -1,0 +1,170 @@
+"""What commands print: versioned JSON documents, tables for people, CSV for spreadsheets.
+
+- **JSON** (``--json``): :func:`document` wraps a command's payload with ``schema``
+  (``physcam.NAME``), ``version`` and ``units``; a JSON Schema for every document ships in
+  ``physcam/cli/schemas/NAME.schema.json`` (:func:`schema_file`), and
+  ``tests/cli/test_cli_contract.py`` validates each command's output against it.
+- **Tables**: :class:`Table` renders as a rich table at a terminal and as plain, complete,
+  aligned text when piped or redirected (never cut at 80 columns).
+- **CSV** (``--csv``): :func:`print_csv` writes the rows of the JSON document (numbers at full
+  precision, an empty cell for null, lists joined with ``;``), so CSV and JSON agree cell by cell.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+__all__ = ["document", "emit_json", "schema_file", "SCHEMA_DIR", "Table", "print_table", "print_csv",
+           "csv_text", "add_output_options", "LENGTH_UNITS"]
+
+SCHEMA_DIR = Path(__file__).resolve().parent / "schemas"
+#: The units most documents use: lengths in mm, angles in degrees.
+LENGTH_UNITS = {"length": "mm", "angle": "degree"}
+
+
+def document(name: str, payload: dict, *, version: int = 1, units: dict | None = None) -> dict:
+    """``payload`` as a versioned document: ``{"schema": "physcam.NAME", "version", "units", ...}``.
+
+    ``units`` says the unit of each kind of number in the payload (default :data:`LENGTH_UNITS`).
+    Raise a new ``version`` when a key changes meaning or goes; adding keys keeps it.
+    """
+    if not isinstance(payload, dict):
+        raise TypeError(f"a document's payload is a dict, got {type(payload).__name__}")
+    clash = {"schema", "version", "units"} & set(payload)
+    if clash:
+        raise ValueError(f"the payload of {name} already has {sorted(clash)}: rename them")
+    return {"schema": f"physcam.{name}", "version": int(version), "units": dict(units or LENGTH_UNITS), **payload}
+
+
+def schema_file(schema: str) -> Path:
+    """The JSON Schema file of a document's ``schema`` name (``physcam.NAME``)."""
+    name = schema.removeprefix("physcam.")
+    return SCHEMA_DIR / f"{name}.schema.json"
+
+
+def emit_json(doc: dict) -> None:
+    """Print a :func:`document` (or a document with the same envelope) as JSON on stdout."""
+    from ._common import print_json
+
+    if not (isinstance(doc, dict) and {"schema", "version", "units"} <= set(doc)):
+        raise ValueError("emit_json prints documents: build one with physcam.cli._output.document")
+    print_json(doc)
+
+
+def add_output_options(p, *, json: bool = True, csv: bool = False, what: str = "the result") -> None:
+    """``--json`` (and ``--csv``) with the same help everywhere."""
+    if json:
+        p.add_argument("--json", action="store_true",
+                       help=f"print {what} as JSON (versioned: schema, version, units; lengths in mm)")
+    if csv:
+        p.add_argument("--csv", action="store_true",
+                       help="print the table as CSV (the JSON rows: full precision, empty cell for none)")
+
+
+# ---- tables -----------------------------------------------------------------------------------
+class Table:
+    """A table of text cells: rich at a terminal, plain aligned text otherwise."""
+
+    def __init__(self, title: str | None = None, columns=(), *, justify=None):
+        self.title = title
+        self.columns = [str(c) for c in columns]
+        self.justify = list(justify) if justify is not None else ["left"] * len(self.columns)
+        self.rows: list[list[str]] = []
+
+    def add_column(self, header: str, justify: str = "left") -> None:
+        self.columns.append(str(header))
+        self.justify.append(justify)
+
+    def add_row(self, *cells) -> None:
+        if len(cells) != len(self.columns):
+            raise ValueError(f"a row of {len(cells)} cells in a table of {len(self.columns)} columns")
+        self.rows.append(["" if c is None else str(c) for c in cells])
+
+    def rich(self):
+        from rich.table import Table as RichTable
+
+        t = RichTable(title=self.title, show_header=True, header_style="bold")
+        for c, j in zip(self.columns, self.justify):
+            t.add_column(c, justify=j, overflow="fold")
+        for r in self.rows:
+            t.add_row(*r)
+        return t
+
+    def plain(self) -> str:
+        """Aligned columns separated by two spaces, every cell whole; the title on the first line."""
+        cols = len(self.columns)
+        widths = [max([len(self.columns[i])] + [len(r[i]) for r in self.rows]) for i in range(cols)]
+
+        def line(cells):
+            out = []
+            for i, c in enumerate(cells):
+                last = i == cols - 1
+                if self.justify[i] == "right":
+                    out.append(c.rjust(widths[i]))
+                else:
+                    out.append(c if last else c.ljust(widths[i]))
+            return "  ".join(out).rstrip()
+
+        lines = [self.title] if self.title else []
+        lines.append(line(self.columns))
+        lines += [line(r) for r in self.rows]
+        return "\n".join(lines) + "\n"
+
+
+def print_table(table: Table) -> None:
+    """At a terminal a rich table; piped or redirected, :meth:`Table.plain` (complete, no box)."""
+    if sys.stdout.isatty():
+        from ._common import console
+
+        console().print(table.rich())
+    else:
+        sys.stdout.write(table.plain())
+
+
+# ---- CSV --------------------------------------------------------------------------------------
+def _cell(v) -> str:
+    if v is None:
+        return ""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float):
+        return repr(v) if math.isfinite(v) else ""
+    if isinstance(v, (list, tuple)):
+        return ";".join(_cell(x) for x in v)
+    return str(v)
+
+
+def _scalar(v) -> bool:
+    if isinstance(v, (list, tuple)):
+        return all(_scalar(x) and not isinstance(x, (list, tuple)) for x in v)
+    return v is None or isinstance(v, (str, int, float, bool))
+
+
+def csv_text(rows, columns=None) -> str:
+    """Rows (dicts) as CSV text: ``columns`` (default: every key whose values are scalars or lists of
+    scalars, in order of first appearance), numbers at full precision (``repr``), an empty cell for
+    None, lists joined with ``;``."""
+    import csv
+    import io
+
+    rows = list(rows)
+    if columns is None:
+        columns = []
+        for r in rows:
+            for k, v in r.items():
+                if k not in columns and _scalar(v):
+                    columns.append(k)
+        columns = [k for k in columns if all(_scalar(r.get(k)) for r in rows)]
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(columns)
+    for r in rows:
+        w.writerow([_cell(r.get(k)) for k in columns])
+    return buf.getvalue()
+
+
+def print_csv(rows, columns=None) -> None:
+    """Write :func:`csv_text` to stdout."""
+    sys.stdout.write(csv_text(rows, columns))
