@@ -1,8 +1,13 @@
-"""``physcam compare blender``: the same point light through physcam's tracer and through Cycles."""
+"""``physcam compare LENS_A LENS_B ...``: lenses side by side (field of view, depth of field,
+breathing, distortion, illumination, bokeh) in one table and one figure; ``physcam compare
+blender``: the same point light through physcam's tracer and through Cycles."""
 
 from __future__ import annotations
 
-from ._common import distance, number, print_json
+import argparse
+import math
+
+from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number
 
 EPILOG = """\
 example:
@@ -11,20 +16,53 @@ Writes cmp/compare.png (the two images side by side) and cmp/compare.json (the m
 Needs a Python with Blender's bpy: `make blender` builds .venv-blender (or --blender-python PATH).
 """
 
+LENSES_EPILOG = """\
+examples:
+  physcam compare dgauss_50mm sonnar_50mm_f1_5 tessar_50mm_f2_8 --focus 2m --fstop 2.8 --sensor S35
+  physcam compare zeiss_distagon_35mm_f4 zuiko_18mm_f3_5 --focus hyperfocal --fstop 5.6 -o compare.png --units ft
+  physcam compare dgauss_50mm canon_rf_85mm_f1_2 --focus 3m --csv
+Each lens is measured alike: the lens report at the focus and f-stop (fields of view, depth of field),
+the breathing table (field of view from infinity to the focus and to the closest focus), real
+distortion and relative illumination at the widest field the sensor asks for (clamped to what the lens
+images) and the bokeh of a point light on the axis at twice the focus distance (1 m when focused at
+infinity). A lens slower than --fstop is compared wide open, with a note.
+"""
+
+
+class _LensesByDefault(argparse._SubParsersAction):
+    """``physcam compare A B ...`` means ``physcam compare lenses A B ...``; ``compare blender`` stays."""
+
+    class _AnyName(dict):
+        accept_any = False  # set once the subcommands are added (add_parser checks for duplicates)
+
+        def __contains__(self, key):  # then any first word is accepted: a lens name goes to `lenses`
+            return self.accept_any or dict.__contains__(self, key)
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._name_parser_map = self._AnyName()
+        self.choices = self._name_parser_map
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        if values and not dict.__contains__(self._name_parser_map, values[0]):
+            values = ["lenses", *values]
+        super().__call__(parser, namespace, values, option_string)
+
 
 def register(sub) -> None:
-    import argparse
-
-    p = sub.add_parser("compare", help="side by side: physcam's own tracer against a renderer (Blender)",
-                       description="Render one point light through physcam's OSL camera in Blender and trace it "
-                                   "with physcam; measure both (docs/blender.md).", epilog=EPILOG,
+    p = sub.add_parser("compare", help="lenses side by side (FOV, DOF, breathing, distortion, illumination, bokeh), "
+                                       "or physcam against a renderer (compare blender)",
+                       description="Compare lenses side by side (`physcam compare LENS_A LENS_B ...`), or render one "
+                                   "point light through physcam's OSL camera in Blender and trace it with physcam "
+                                   "(`physcam compare blender`, docs/blender.md).", epilog=LENSES_EPILOG + EPILOG,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    s = p.add_subparsers(dest="compare_command", metavar="RENDERER")
+    s = p.add_subparsers(dest="compare_command", metavar="LENS_A LENS_B ... | blender", action=_LensesByDefault)
+    _register_lenses(s)
     b = s.add_parser("blender", help="Cycles through physcam's OSL lens camera", epilog=EPILOG,
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     b.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
-    b.add_argument("--focus", type=distance("focus distance"), required=True, metavar="D",
-                   help="focus mark from the film plane (e.g. 2m)")
+    b.add_argument("--focus", type=focus("focus distance", allow_inf=False), required=True, metavar="D",
+                   help=f"focus mark from the film plane (e.g. 2m; or hyperfocal at --fstop)")
     b.add_argument("--fstop", type=number("f-number", positive=True), required=True, metavar="N", help="f-number")
     b.add_argument("--light", type=distance("light distance"), required=True, metavar="D",
                    help="the point light's distance from the film plane, on the axis (e.g. 0.7m)")
@@ -40,9 +78,13 @@ def register(sub) -> None:
     b.add_argument("--lenient", action="store_true", help="load a lens file that is not buildable as written, repaired")
     b.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for compare.png and compare.json")
     b.add_argument("--force", action="store_true", help="overwrite existing files")
-    b.add_argument("--json", action="store_true", help="print the measured table as JSON")
+    from ._output import add_output_options
+
+    add_output_options(b, what="the measured table")
+    add_units_option(b)
     b.set_defaults(handler=run_blender)
     p.set_defaults(handler=lambda args: (p.print_help(), 0)[1])
+    s._name_parser_map.accept_any = True
 
 
 def run_blender(args) -> int:
@@ -63,6 +105,9 @@ def run_blender(args) -> int:
         raise InputError(f"--blades must be 0 (round) or 3 to 64, got {args.blades}")
     aperture = Aperture(args.blades, args.blade_angle) if args.blades else None
     lens = load_lens(args.lens, lenient=args.lenient)
+    from ._common import resolve_focus
+
+    args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, args=args)
     res = compare_bokeh(lens, focus_mm=args.focus, fstop=args.fstop, light_mm=args.light, aperture=aperture,
                         crop_mm=args.crop, pixels=args.pixels, samples=args.samples,
                         blender_python=args.blender_python)
@@ -70,12 +115,18 @@ def run_blender(args) -> int:
     atomic_write(js, json.dumps(table, indent=2, allow_nan=False) + "\n", force=args.force)
     _figure(res, png, force=args.force)
     if args.json:
-        print_json(dict(table, files=[str(png), str(js)]))
+        from ._output import document, emit_json
+
+        emit_json(document("compare_blender", dict(table, files=[str(png), str(js)])))
         return 0
+    from ..units import format_distance
+    from ._common import units_of
+
+    u = units_of(args)
     m = table["measured"]
     d = m["equivalent_diameter_mm"]
-    print(f"{res['lens']}: light {res['light_from_film_mm'] / 1000:g} m from the film, focus "
-          f"{res['focus_from_film_mm'] / 1000:g} m, f/{res['fstop']:g}")
+    print(f"{res['lens']}: light {format_distance(res['light_from_film_mm'], u)} from the film, focus "
+          f"{format_distance(res['focus_from_film_mm'], u)}, f/{res['fstop']:g}")
     print(f"  bokeh diameter: Cycles {d['cycles']:.4f} mm, physcam {d['physcam']:.4f} mm, ratio {d['ratio']:.4f}")
     if "corners" in m:
         print(f"  iris corners: Cycles {m['corners']['cycles']}, physcam {m['corners']['physcam']}")
@@ -101,4 +152,265 @@ def _figure(res, path, *, force):
     axes[0].set_ylabel("film y (mm)")
     fig.suptitle(f"{res['lens']}: light {res['light_from_film_mm'] / 1000:g} m, focus "
                  f"{res['focus_from_film_mm'] / 1000:g} m, f/{res['fstop']:g}", fontsize=10)
+    return save_figure(fig, path, force=force)
+
+
+# ---- physcam compare LENS_A LENS_B ... ------------------------------------------------------------
+def _register_lenses(s) -> None:
+    from ._output import add_output_options
+    from .lens import add_lenient
+    from .report import add_coc_option
+
+    c = s.add_parser("lenses", help="lenses side by side: FOV, DOF, breathing, distortion, illumination, bokeh "
+                                    "(the default: `physcam compare A B` is `physcam compare lenses A B`)",
+                     epilog=LENSES_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    c.add_argument("lenses", nargs="+", metavar="LENS", help="bundled lens names (see `physcam lenses`) or lens files")
+    c.add_argument("--focus", type=focus("focus distance"), default=2000.0, metavar="D",
+                   help=f"focus mark from the film plane for every lens (default 2m; {FOCUS_HELP})")
+    c.add_argument("--fstop", type=number("f-stop", positive=True), default=None, metavar="N",
+                   help="f-stop for every lens (default: each wide open; a slower lens stays wide open, with a note)")
+    add_sensor_options(c)
+    add_coc_option(c)
+    c.add_argument("--light", type=distance("light distance"), default=None, metavar="D",
+                   help="the bokeh light's distance from the film (default twice the focus; 1m at infinity focus)")
+    c.add_argument("--rays", type=int, default=100_000, metavar="N",
+                   help="rays per bokeh image (1000 to 1e7; default 100000)")
+    add_lenient(c)
+    add_units_option(c)
+    add_output_options(c, csv=True, what="the comparison")
+    c.add_argument("-o", "--output", metavar="FIGURE", help="draw the comparison figure (.png, .svg or .pdf)")
+    c.add_argument("--force", action="store_true", help="overwrite an existing figure")
+    c.set_defaults(handler=run_lenses)
+
+
+def measure_lens(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays, units="m"):
+    """Everything ``physcam compare`` shows of one lens, as a flat dict (lengths mm, angles degrees),
+    with the curves for the figure under ``_curves``."""
+    import warnings
+
+    import numpy as np
+
+    from ..analysis.blob import equivalent_diameter
+    from ..analysis.bokeh import bokeh_image
+    from ..analysis.distortion import real_distortion
+    from ..analysis.illumination import relative_illumination
+    from ..errors import PhysCamError, PhysCamWarning
+    from ..onset.report import solve_lens_report
+    from ..optics import focusing, paraxial
+    from ._common import resolve_focus
+
+    notes = []
+    wide = max(paraxial.gaussian(lens).f_number, lens.metadata.max_fstop or 0.0)
+    n = fstop
+    if n is None:
+        n = wide
+    elif n < wide * (1 - 0.01):  # 1 %: the engraved f-stop of a lens whose file gives f/2.8003 is f/2.8
+        notes.append(f"opens only to f/{wide:.3g}: compared wide open (asked f/{fstop:g})")
+        n = wide
+    mark = resolve_focus(focus_mm, lens=lens, fstop=n, sensor=sensor, coc=coc)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", PhysCamWarning)
+        r = solve_lens_report(focal_length_mm=None, lens=lens, sensor=sensor, fstop=n, focus_mm=mark, coc=coc)
+    notes += [str(w.message) for w in caught if issubclass(w.category, PhysCamWarning)]
+    d = r.to_dict()
+    real = d["fov_deg"]["real"] or {}
+    out = {
+        "lens": lens.name, "efl_mm": r.focal_length_mm, "fstop": r.fstop,
+        "focus_from_film_mm": None if math.isinf(mark) else mark,
+        "hfov_deg": r.hfov_focus_deg, "vfov_deg": r.vfov_focus_deg, "dfov_deg": r.dfov_focus_deg,
+        "hfov_real_deg": real.get("horizontal"),
+        "near_from_film_mm": r.dof.near_from_film_mm,
+        "far_from_film_mm": None if r.dof.far_is_infinite else r.dof.far_from_film_mm,
+        "dof_total_mm": None if r.dof.far_is_infinite else r.dof.total_mm,
+        "hyperfocal_from_film_mm": r.dof.hyperfocal_from_film_mm,
+        "entrance_pupil_from_film_mm": r.entrance_pupil_from_film_mm,
+    }
+    curves = {}
+    # breathing: horizontal field of view from infinity to the closest focus, and at this focus
+    closest = focusing.closest_focus(lens)
+    marks = [m for m in focusing.DEFAULT_BREATHING_MARKS if m > closest] + [closest]
+    rows = focusing.breathing_table(lens, marks, sensor_width_mm=sensor.width_mm)
+    out["closest_focus_mm"] = closest
+    out["breathing_closest_pct"] = rows[-1].fov_change_pct
+    at = focusing.breathing_table(lens, [math.inf, mark], sensor_width_mm=sensor.width_mm)
+    out["breathing_at_focus_pct"] = at[-1].fov_change_pct
+    curves["breathing"] = ([r_.focus_from_film_mm for r_ in rows], [r_.fov_change_pct for r_ in rows])
+    # distortion at the widest field the sensor asks for (clamped to what the lens images)
+    try:
+        dist = real_distortion(lens, sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm)
+        pts = [p for p in dist.points if p.axis == "y"]
+        out["distortion_field_deg"], out["distortion_pct"] = pts[-1].field_deg, pts[-1].distortion_pct
+        curves["distortion"] = ([p.field_deg for p in pts], [p.distortion_pct for p in pts])
+        notes += dist.notes
+    except PhysCamError as exc:
+        out["distortion_field_deg"] = out["distortion_pct"] = None
+        notes.append(f"distortion not measured: {exc}")
+    # relative illumination at that f-stop, to the sensor corner (clamped likewise)
+    try:
+        sd = paraxial.stop_semi_diameter_for_fstop(lens, n)
+        ri = relative_illumination(lens, grid=64, stop_semi_diameter=sd, sensor_width_mm=sensor.width_mm,
+                                   sensor_height_mm=sensor.height_mm)
+        pts = [p for p in ri.points if p.axis == "y"]
+        out["illumination_field_deg"], out["illumination_corner"] = pts[-1].field_deg, pts[-1].relative_illumination
+        out["illumination_corner_stops"] = -math.log2(max(pts[-1].relative_illumination, 1e-12))
+        curves["illumination"] = ([p.field_deg for p in pts], [p.relative_illumination for p in pts])
+        notes += ri.notes
+    except PhysCamError as exc:
+        out["illumination_field_deg"] = out["illumination_corner"] = out["illumination_corner_stops"] = None
+        notes.append(f"illumination not measured: {exc}")
+    # bokeh of a point light on the axis
+    light = light_mm if light_mm is not None else (1000.0 if math.isinf(mark) else 2.0 * mark)
+    out["bokeh_light_from_film_mm"] = light
+    try:
+        st = focusing.focus(lens, mark)
+        stop = paraxial.stop_semi_diameter_for_fstop(st.prescription, n)
+        img = bokeh_image(st.prescription, light, film_z=st.film_z, rays=rays, pixels=96, stop_semi_diameter=stop,
+                          chunk=min(max(rays, 1000), 250_000))
+        mono = img.image.sum(axis=2) if img.image.ndim == 3 else img.image
+        x0, x1, _, _ = img.extent_mm
+        out["bokeh_diameter_mm"] = equivalent_diameter(mono, pixel=(x1 - x0) / mono.shape[1])
+        curves["bokeh"] = (np.asarray(mono), img.extent_mm)
+    except PhysCamError as exc:
+        out["bokeh_diameter_mm"] = None
+        notes.append(f"bokeh not measured: {exc}")
+    out["notes"] = notes
+    out["_curves"] = curves
+    return out
+
+
+#: (key, label, kind) of the comparison table's rows; kind: "dist" (a scene distance), or a format.
+ROWS = [
+    ("efl_mm", "EFL (mm)", "{:.2f}"), ("fstop", "f-stop", "f/{:.3g}"), ("focus_from_film_mm", "focus", "dist"),
+    ("hfov_deg", "HFOV at focus (deg)", "{:.2f}"), ("vfov_deg", "VFOV at focus (deg)", "{:.2f}"),
+    ("dfov_deg", "DFOV at focus (deg)", "{:.2f}"), ("hfov_real_deg", "HFOV real rays (deg)", "{:.2f}"),
+    ("near_from_film_mm", "near limit", "dist"), ("far_from_film_mm", "far limit", "dist"),
+    ("dof_total_mm", "depth of field", "dist"), ("hyperfocal_from_film_mm", "hyperfocal", "dist"),
+    ("breathing_at_focus_pct", "HFOV change inf -> focus (%)", "{:+.2f}"),
+    ("breathing_closest_pct", "HFOV change inf -> closest (%)", "{:+.2f}"),
+    ("closest_focus_mm", "closest focus", "dist"),
+    ("distortion_pct", "distortion at widest field (%)", "{:+.2f}"),
+    ("distortion_field_deg", "  at field (deg)", "{:.2f}"),
+    ("illumination_corner", "relative illumination at corner", "{:.3f}"),
+    ("illumination_corner_stops", "  corner falloff (stops)", "{:.2f}"),
+    ("bokeh_diameter_mm", "bokeh diameter (mm, on film)", "{:.3f}"),
+    ("bokeh_light_from_film_mm", "  of a light at", "dist"),
+    ("entrance_pupil_from_film_mm", "entrance pupil from film (mm)", "{:.1f}"),
+]
+
+
+def _cell(v, kind, units) -> str:
+    from ..units import format_distance
+
+    if kind == "dist":
+        return format_distance(math.inf if v is None else v, units)
+    return "-" if v is None else kind.format(v)
+
+
+def run_lenses(args) -> int:
+    from ..errors import InputError
+    from ..io import check_writable
+    from ..lens.library import load_lens
+    from ._common import coc_of, resolve_sensor, units_of
+    from ._output import Table, document, emit_json, print_csv, print_table
+
+    if len(args.lenses) > 8:
+        raise InputError(f"compare takes up to 8 lenses, got {len(args.lenses)}")
+    if not 1000 <= args.rays <= 10**7:
+        raise InputError(f"--rays must lie in 1000..1e7, got {args.rays}")
+    if args.output:
+        check_writable(args.output, force=args.force)
+    sensor = resolve_sensor(args)
+    units = units_of(args)
+    lenses = [load_lens(name, lenient=args.lenient) for name in args.lenses]
+    rows = [measure_lens(lens, focus_mm=args.focus, fstop=args.fstop, sensor=sensor, coc=coc_of(args),
+                         light_mm=args.light, rays=args.rays) for lens in lenses]
+    curves = [r.pop("_curves") for r in rows]
+    for name, r in zip(args.lenses, rows):
+        r["name"] = name
+    if args.output:
+        compare_figure(rows, curves, args.output, sensor=sensor, units=units, force=args.force)
+    d = {"sensor": {"name": sensor.name, "width_mm": sensor.width_mm, "height_mm": sensor.height_mm},
+         "focus": args.focus if isinstance(args.focus, str) else (None if math.isinf(args.focus) else args.focus),
+         "fstop": args.fstop, "lenses": rows,
+         "definition": "each lens at the same focus mark and f-stop (wide open when slower) on the same sensor; "
+                       "distances from the film plane; distortion and illumination at the widest field measured "
+                       "(Y meridian); bokeh: equivalent diameter of a point light on the axis"}
+    if args.json:
+        emit_json(document("compare", d))
+        return 0
+    if args.csv:
+        print_csv(rows)
+        return 0
+    t = Table(f"lenses compared on {sensor.name} ({sensor.width_mm:g} x {sensor.height_mm:g} mm)",
+              ["", *args.lenses], justify=["left"] + ["right"] * len(rows))
+    for key, label, kind in ROWS:
+        t.add_row(label, *(_cell(r[key], kind, units) for r in rows))
+    print_table(t)
+    for name, r in zip(args.lenses, rows):
+        for n in r["notes"]:
+            print(f"note: {name}: {n}")
+    if args.output:
+        print(f"wrote {args.output}")
+    return 0
+
+
+def compare_figure(rows, curves, path, *, sensor, units="m", force=False):
+    """One figure: breathing, distortion and illumination curves of every lens, and their bokeh."""
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from ..figures import save_figure
+    from ..units import format_distance
+
+    n = len(rows)
+    fig = Figure(figsize=(11.0, 7.0))
+    FigureCanvasAgg(fig)
+    gs = fig.add_gridspec(2, max(3, n))
+    cols = max(3, n)
+    ax_b = fig.add_subplot(gs[0, : cols // 3])
+    ax_d = fig.add_subplot(gs[0, cols // 3: 2 * cols // 3])
+    ax_i = fig.add_subplot(gs[0, 2 * cols // 3:])
+    per = 1000.0 if units == "m" else 304.8
+    for r, c in zip(rows, curves):
+        if "breathing" in c:
+            marks, chg = c["breathing"]
+            x = [0.0 if math.isinf(m) else per / m for m in marks]
+            ax_b.plot(x, chg, marker="o", ms=3, label=r["name"])
+        if "distortion" in c:
+            ax_d.plot(*c["distortion"], marker="o", ms=2, label=r["name"])
+        if "illumination" in c:
+            ax_i.plot(*c["illumination"], marker="o", ms=2, label=r["name"])
+    ax_b.set_xlabel(f"1 / focus mark (1/{'m' if units == 'm' else 'ft'}; 0 = infinity)")
+    ax_b.set_ylabel("HFOV change from infinity (%)")
+    ax_b.set_title("focus breathing", fontsize=9)
+    ax_d.set_xlabel("field angle (deg)")
+    ax_d.set_ylabel("real distortion (%)")
+    ax_d.set_title("distortion", fontsize=9)
+    ax_i.set_xlabel("field angle (deg)")
+    ax_i.set_ylabel("relative illumination")
+    ax_i.set_ylim(0, 1.05)
+    ax_i.set_title("illumination", fontsize=9)
+    for ax in (ax_b, ax_d, ax_i):
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=6)
+    for k, (r, c) in enumerate(zip(rows, curves)):
+        ax = fig.add_subplot(gs[1, k])
+        if "bokeh" in c:
+            img, ext = c["bokeh"]
+            top = float(np.percentile(img[img > 0], 95)) if (img > 0).any() else 1.0
+            ax.imshow(np.clip(img / top, 0, 1), origin="lower", extent=ext, cmap="magma")
+            ax.set_title(f"{r['name']}\nbokeh {r['bokeh_diameter_mm']:.3f} mm", fontsize=7)
+        else:
+            ax.set_axis_off()
+            ax.set_title(f"{r['name']}\n(no bokeh)", fontsize=7)
+        ax.set_xlabel("film x (mm)", fontsize=7)
+        ax.tick_params(labelsize=6)
+    r0 = rows[0]
+    focus = format_distance(math.inf if r0["focus_from_film_mm"] is None else r0["focus_from_film_mm"], units)
+    stops = ", ".join(dict.fromkeys(f"f/{r['fstop']:.3g}" for r in rows))
+    fig.suptitle(f"focus {focus} ({rows[0]['name']}), {stops}, {sensor.name} ({sensor.width_mm:g} x "
+                 f"{sensor.height_mm:g} mm); bokeh: light at {format_distance(r0['bokeh_light_from_film_mm'], units)}",
+                 fontsize=9)
+    fig.tight_layout()
     return save_figure(fig, path, force=force)
