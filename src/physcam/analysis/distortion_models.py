@@ -61,9 +61,7 @@ __all__ = [
     "MODEL_CHOICES", "DEFAULT_MAX_RESIDUAL_PX",
 ]
 
-DEFAULT_MAX_RESIDUAL_PX = 0.5
-#: ``--fit`` names and what each fits.
-MODEL_CHOICES = ("brown", "3de4", "usd", "nuke")
+from .distortion_names import DEFAULT_MAX_RESIDUAL_PX, MODEL_CHOICES  # noqa: E402  (re-exported)
 
 
 @dataclass(frozen=True)
@@ -210,10 +208,9 @@ def _finish(fit: FittedDistortion, s: DistortionSamples) -> FittedDistortion:
     """Fill the residual of ``fit`` over the samples, in the model's own direction."""
     if fit.direction == "D-U":
         pred, target = fit.formula(s.distorted_mm), s.undistorted_mm
-        where = s.distorted_mm
     else:
         pred, target = fit.formula(s.undistorted_mm), s.distorted_mm
-        where = s.distorted_mm
+    where = s.distorted_mm  # the residual is drawn where the point is on the plate
     res = s.residual_px(pred, target)
     if not np.isfinite(res).all():
         raise OpticsError(f"the {fit.model} fit gives non-finite positions: no fit")
