@@ -139,15 +139,23 @@ def pan_tilt_roll(matrix) -> tuple[float, float, float]:
     return math.degrees(p), math.degrees(t), math.degrees(r)
 
 
+def _pair(name, value) -> tuple[float, float]:
+    if not isinstance(value, (tuple, list)) or len(value) != 2:
+        raise InputError(f"{name} must be a pair of numbers, got {value!r:.60}")
+    return require_finite(name, value[0]), require_finite(name, value[1])
+
+
 def _vec(obj, keys, default=0.0):
-    return tuple(float(obj.get(k, default)) for k in keys) if isinstance(obj, dict) else (default,) * len(keys)
+    if not isinstance(obj, dict):
+        return (default,) * len(keys)
+    return tuple(require_finite(k, obj.get(k, default)) for k in keys)
 
 
 def compose_transforms(transforms) -> tuple[tuple, tuple, tuple[str, ...]]:
     """(translation m, (pan, tilt, roll) deg, notes) of the camera from an OpenTrackIO ``transforms``
     list (module notes). One transform is read as it is, exactly; a chain is composed as 4 x 4 matrices."""
-    if not isinstance(transforms, list) or not transforms:
-        raise InputError("transforms must be a non-empty list")
+    if not isinstance(transforms, list) or not transforms or not all(isinstance(t, dict) for t in transforms):
+        raise InputError("transforms must be a non-empty list of transform objects")
     if len(transforms) == 1 and "scale" not in transforms[0]:
         t = transforms[0]
         return _vec(t.get("translation"), "xyz"), _vec(t.get("rotation"), ("pan", "tilt", "roll")), ()
@@ -218,7 +226,7 @@ def static_block(*, sensor_mm, rate, lens_name=None, nominal_focal_length_mm=Non
     and tracker identification (physcam sends as the tracker)."""
     from .. import __version__
 
-    w, h = (require_finite("sensor width", sensor_mm[0]), require_finite("sensor height", sensor_mm[1]))
+    w, h = _pair("sensor size (mm)", sensor_mm)
     cam = {"activeSensorPhysicalDimensions": {"width": w, "height": h}, "captureFrameRate": rational(rate)}
     sq = Fraction(require_finite("squeeze", squeeze)).limit_denominator(100)
     cam["anamorphicSqueeze"] = {"num": sq.numerator, "denom": sq.denominator}

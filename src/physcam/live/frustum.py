@@ -101,7 +101,9 @@ def frustum_directions(f_pin_mm, sensor_mm, samples_per_edge: int = 8, widen=(1.
     f = require_finite("pinhole focal length", f_pin_mm)
     if f <= 0:
         raise InputError(f"pinhole focal length must be > 0 mm, got {f:g}")
-    w, h = (require_finite("sensor width", sensor_mm[0]), require_finite("sensor height", sensor_mm[1]))
+    from .frames import _pair
+
+    w, h = _pair("sensor size (mm)", sensor_mm)
     if isinstance(samples_per_edge, bool) or not isinstance(samples_per_edge, int) \
             or not 1 <= samples_per_edge <= MAX_SAMPLES_PER_EDGE:
         raise InputError(f"samples per edge must be 1..{MAX_SAMPLES_PER_EDGE}, got {samples_per_edge!r}")
@@ -116,9 +118,15 @@ def frustum_directions(f_pin_mm, sensor_mm, samples_per_edge: int = 8, widen=(1.
 def intersect_mesh(origin, directions, triangles) -> np.ndarray:
     """Distance t (k,) along each ray ``origin + t d`` to its first hit on ``triangles`` (n, 3, 3);
     inf where a ray misses (Möller-Trumbore, module notes)."""
-    o = np.asarray(origin, dtype=float)
-    d = np.atleast_2d(np.asarray(directions, dtype=float))
-    tri = np.asarray(triangles, dtype=float)
+    try:
+        o = np.asarray(origin, dtype=float)
+        d = np.atleast_2d(np.asarray(directions, dtype=float))
+        tri = np.asarray(triangles, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("origin (3,), directions (k, 3) and triangles (n, 3, 3) must be arrays of numbers") from None
+    if o.shape != (3,) or d.ndim != 2 or d.shape[1] != 3 or tri.ndim != 3 or tri.shape[1:] != (3, 3):
+        raise InputError(f"origin (3,), directions (k, 3) and triangles (n, 3, 3), got {o.shape}, {d.shape}, "
+                         f"{tri.shape}")
     v0, e1, e2 = tri[:, 0], tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
     out = np.full(len(d), np.inf)
     tvec = o - v0  # (n, 3)

@@ -27,6 +27,9 @@ def camera_prim_path(stage, path: str | None = None) -> str:
     """``path``, or the only PhysicalCamera on the stage."""
     from pxr import Sdf
 
+    from ..usd.plugin import require_stage
+
+    require_stage(stage)
     if path is not None:
         prim = stage.GetPrimAtPath(Sdf.Path(path)) if Sdf.Path.IsValidPathString(path) else None
         if not prim or prim.GetTypeName() != "PhysicalCamera":
