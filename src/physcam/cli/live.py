@@ -328,7 +328,7 @@ def run_record(args) -> int:
         print(f"recorded {len(solved)} frames to {out}" + (f" and {rep}" if rep else "")
               + f" ({summary['first_timecode'] or '-'} to {summary['last_timecode'] or '-'})")
         print("  " + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counters.items()))
-    return 130 if interrupted else 0
+    return 0  # Ctrl-C is how a recording is ended: the file is written and that is success
 
 
 # --- send and play ---------------------------------------------------------------------------
