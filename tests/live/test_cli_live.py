@@ -71,3 +71,39 @@ def test_record_a_sent_take(tmp_path):
     rows = list(csv.DictReader(rep.open()))
     assert [float(r["focus_from_film_mm"]) for r in rows] == pytest.approx(
         [s["lens"]["focusDistance"] * 1000 for s in samples], rel=1e-12)
+
+
+def test_a_json_lens_report_plays_back_as_valid_samples(tmp_path):
+    from physcam.cli.live import _frames_from_report
+    from physcam.live.record import solve_frames, write_lens_report
+    from physcam.live.sample import validate_sample
+
+    frames = camera_frames(sensor=find_sensor("ALEXA 35"), frames=5, rate=23.976, focus_mm=2000.0, fstop=2.0,
+                           focal_length_mm=50.0)
+    rep = write_lens_report(tmp_path / "r.json", solve_frames(frames))
+    back = _frames_from_report(rep)
+    samples = list(frames_to_samples(back))
+    for s in samples:
+        validate_sample(s)
+    assert samples[0]["timing"]["sampleRate"] == {"num": 24000, "denom": 1001}
+    assert samples[0]["static"]["camera"]["activeSensorPhysicalDimensions"] == {"width": 27.99, "height": 19.22}
+    assert [s["lens"]["focusDistance"] for s in samples] == [2.0] * 5
+
+
+@pytest.mark.slow
+def test_multicast_on_loopback():
+    from physcam.live.receiver import Receiver, multicast_group
+
+    frames = camera_frames(sensor=find_sensor("ALEXA 35"), frames=50, rate=48, focus_mm=2000.0, fstop=2.0,
+                           focal_length_mm=50.0)
+    samples = list(frames_to_samples(frames))
+    group = multicast_group(1)
+    with Receiver(0, group=group, interface="127.0.0.1") as rx, Sender(group, rx.port, encoding="cbor") as tx:
+        tx.stream(samples, 1000)
+        got, deadline = [], time.monotonic() + 10
+        while len(got) < 50 and time.monotonic() < deadline:
+            item = rx.get(timeout=0.1)
+            if item is not None:
+                got.append(item)
+    assert [g.sample["sampleId"] for g in got] == [s["sampleId"] for s in samples]
+    assert {g.encoding for g in got} == {"cbor"}

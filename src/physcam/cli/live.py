@@ -403,8 +403,10 @@ def _frames_from_report(path):
     out = []
     rows = doc["frames"]
     try:
-        codes = [float(r["time_code"]) for r in rows]
-        rate = rate_fraction(doc.get("rate") or 24)
+        r = doc.get("rate")
+        rate = rate_fraction(Fraction(int(r["num"]), int(r["denom"])) if isinstance(r, dict) else 24)
+        sensor = doc.get("sensor_mm")
+        sensor = (float(sensor[0]), float(sensor[1])) if isinstance(sensor, list) and len(sensor) == 2 else None
         for r in rows:
             out.append(TrackedFrame(
                 time_ns=int(round(float(r["time_code"]) / float(rate) * 1e9)), rate=Fraction(rate),
@@ -415,10 +417,9 @@ def _frames_from_report(path):
                 focus_from_film_mm=float(r["focus_from_film_mm"]), fstop=float(r["fstop"]),
                 tstop=None if r.get("tstop") is None else float(r["tstop"]),
                 entrance_pupil_mm=None if r.get("entrance_pupil_from_film_mm") is None
-                else float(r["entrance_pupil_from_film_mm"])))
+                else float(r["entrance_pupil_from_film_mm"]), sensor_mm=sensor))
     except (KeyError, TypeError, ValueError) as exc:
         raise InputError(f"{path}: a frame lacks {exc}") from None
-    _ = codes
     return out
 
 

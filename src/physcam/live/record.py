@@ -332,7 +332,14 @@ def write_lens_report(file, solved, *, force: bool = False):
         return atomic_write(p, buf.getvalue(), force=force)
     if p.suffix.lower() != ".json":
         raise ExportError(f"{p}: the lens report is written as .csv or .json")
-    doc = {"schema": "physcam.live_lens_report", "version": 1,
+    try:
+        _, fr = time_codes([s.frame for s in solved])
+        rate = {"num": fr.numerator, "denom": fr.denominator}
+    except InputError:
+        rate = None
+    sensor = solved[0].report.sensor
+    doc = {"schema": "physcam.live_lens_report", "version": 1, "rate": rate,
+           "sensor_mm": [sensor.width_mm, sensor.height_mm],
            "units": {"length": "mm", "angle": "degree", "position": "m (OpenTrackIO stage, Z up)"},
            "reference": "distances *_from_film_mm are in front of the film plane; far_from_film_mm null = infinity",
            "frames": rows}
