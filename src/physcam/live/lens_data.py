@@ -24,9 +24,10 @@ Unreal's Brown-Conrady models number them. OpenLensIO's own equation (17) number
 model's coefficients alternately (k1, k3, k5 above, k2, k4, k6 below); physcam sends only the
 polynomial k1-k3 (the fit's ``k1k2k3`` terms), so no denominator term is ever sent.
 
-The coefficients come from ONE function, :func:`distortion_for_sample`, fitted today by
-:func:`physcam.export.opencv_distortion.fit_opencv_pinhole` to the lens's real chief rays; a better
-fitted Brown-Conrady model replaces it there and nowhere else.
+The coefficients come from ONE function, :func:`distortion_for_sample`: the Brown-Conrady U-D model
+fitted over the whole frame to the lens's real chief rays at the frame's focus
+(:func:`physcam.analysis.distortion_models.fit_brown_conrady`, docs/distortion.md), whose
+``opentrackio()`` makes this same conversion (y down turns the sign of p1).
 """
 
 from __future__ import annotations
@@ -81,11 +82,12 @@ def distortion_for_sample(lens: Prescription, sensor_width_mm, sensor_height_mm,
     """(OpenTrackIO distortion object, the pinhole focal length F in mm it is normalised by) of ``lens``
     focused at ``focus_from_film_mm`` (mm in front of the film; inf allowed) on a sensor of the given size.
 
-    The one source of the sample's distortion (module notes): today OpenCV's k1-k3 fitted to real
-    chief rays, converted to millimetres. ``image_size`` (W, H pixels; H None from the sensor's
-    aspect) only sets the fit's pixel weighting.
+    The one source of the sample's distortion (module notes): Brown-Conrady U-D fitted to real chief
+    rays over the frame, in millimetres. ``image_size`` (W, H pixels; H None from the sensor's
+    aspect) sets the fit's pixel weighting and the density of traced rays.
     """
-    from ..export.opencv_distortion import fit_opencv_pinhole
+    from ..analysis.distortion_models import fit_brown_conrady, samples_from_field
+    from ..analysis.stmap import MAX_SIDE_PX, distortion_field
 
     w = require_positive("sensor width", sensor_width_mm)
     h = require_positive("sensor height", sensor_height_mm)
@@ -94,7 +96,8 @@ def distortion_for_sample(lens: Prescription, sensor_width_mm, sensor_height_mm,
     if not isinstance(image_size, (tuple, list)) or len(image_size) != 2:
         raise InputError("image_size is (width, height) in pixels; height may be None")
     W = image_size[0]
-    H = image_size[1] if image_size[1] is not None else max(16, round(W * h / w))
-    fit = fit_opencv_pinhole(lens, w, h, W, H, focus_from_film_mm=focus, terms="k1k2k3")
-    f = fit.pinhole_focal_length_x_mm
-    return opencv_to_opentrackio(fit.k1, fit.k2, fit.k3, fit.p1, fit.p2, f), f
+    H = image_size[1] if image_size[1] is not None else max(16, min(MAX_SIDE_PX, round(W * h / w)))
+    field = distortion_field(lens, focus_mm=focus, sensor_width_mm=w, sensor_height_mm=h, width_px=W, height_px=H,
+                             maps=False)
+    fit = fit_brown_conrady(samples_from_field(field), "U-D", max_residual_px=math.inf)
+    return fit.opentrackio(), float(fit.coefficients["fy_mm"])
