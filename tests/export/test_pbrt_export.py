@@ -231,7 +231,9 @@ def test_internal_focus_lens_is_written_at_its_focus_gaps(tmp_path, capsys):
     (["--lens", "navarro_anamorphic_2x", "--focus", "2m"], ["pbrt", "cylinder", "export rib"]),
     (["--lens", "sonnar_50mm_f1_5", "--focus", "2m"], ["pbrt", "flat", "radius of 0", "--camera perspective"]),
     (["--focal", "50", "--fstop", "2", "--focus", "2m", "--camera", "realistic"], ["realistic", "prescription"]),
-    (["--focal", "50", "--fstop", "2", "--focus", "2m", "--squeeze", "2"], ["pbrt", "squeeze", "export rib"]),
+    (["--lens", "neil_front_anamorphic_2x", "--focus", "2m", "--camera", "perspective"], ["pbrt", "export rib"]),
+    (["--lens", "dgauss_50mm", "--focal", "50", "--focus", "2m"], ["--lens", "--focal"]),
+    (["--lens", "nikkor_fisheye_16mm_f2_8", "--focus", "2m"], ["pbrt", "flat"]),  # no warning line before it
     (["--lens", "dgauss_50mm", "--fstop", "1.4", "--focus", "2m"], ["faster"]),
     (["--lens", "dgauss_50mm", "--focus", "15cm"], ["cannot focus"]),
     (["--focal", "50", "--fstop", "2"], ["--focus"]),

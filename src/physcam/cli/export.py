@@ -281,24 +281,28 @@ def run_rib(args) -> int:
         raise InputError(f"--resolution must lie in 16..65536 pixels, got {args.resolution}")
     if args.blades != int(args.blades):
         raise InputError(f"--blades must be a whole number, got {args.blades:g}")
-    report = _report(args)
-    values = rib_camera_values(report, args.meters_per_unit, xres=args.resolution, shift_mm=(args.shift_x, args.shift_y),
-                               shutter_angle_deg=args.shutter_angle, shutter_opening=args.shutter_opening,
-                               aperture=(int(args.blades), args.blade_angle, args.roundness, args.density))
-    lens = report.lens_name or f"{report.focal_length_mm:g} mm thin lens"
-    pupil = report.entrance_pupil_from_film_mm if report.entrance_pupil_from_film_mm is not None \
-        else report.h1_from_film_mm
-    mpu = args.meters_per_unit
-    comments = [
-        f"physcam: {'legacy (RenderMan 13-20)' if args.legacy else 'PxrCamera (RenderMan 22+)'} camera for {lens}, "
-        f"f/{report.fstop:.3g}, focus mark {report.focus_from_film_mm / 1000.0:g} m from the film, on "
-        f"{report.sensor.name} ({report.sensor.width_mm:g} x {report.sensor.height_mm:g} mm), squeeze {report.squeeze:g}",
-        f"scene unit = {mpu:g} m; the camera is the lens's best-match pinhole ({report.pinhole[0]:.6g} mm) at the entrance "
-        f"pupil, {pupil / (1000.0 * mpu):.6g} units in front of the film; focalDistance is measured from there",
-        "fov spans the screen window's shorter side (the ScreenWindow unit); Shutter is in frames",
-    ]
-    text = rib_camera_block(values, legacy=args.legacy, comments=comments)
-    path = atomic_write(args.output, text, force=args.force)
+    with _warnings_after_success():
+        report = _report(args)
+        values = rib_camera_values(report, args.meters_per_unit, xres=args.resolution,
+                                   shift_mm=(args.shift_x, args.shift_y), shutter_angle_deg=args.shutter_angle,
+                                   shutter_opening=args.shutter_opening,
+                                   aperture=(int(args.blades), args.blade_angle, args.roundness, args.density))
+        lens = report.lens_name or f"{report.focal_length_mm:g} mm thin lens"
+        pupil = report.entrance_pupil_from_film_mm if report.entrance_pupil_from_film_mm is not None \
+            else report.h1_from_film_mm
+        mpu = args.meters_per_unit
+        comments = [
+            f"physcam: {'legacy (RenderMan 13-20)' if args.legacy else 'PxrCamera (RenderMan 22+)'} camera for {lens}, "
+            f"f/{report.fstop:.3g}, focus mark {report.focus_from_film_mm / 1000.0:g} m from the film, on "
+            f"{report.sensor.name} ({report.sensor.width_mm:g} x {report.sensor.height_mm:g} mm), squeeze "
+            f"{report.squeeze:g}",
+            f"scene unit = {mpu:g} m; the camera is the lens's best-match pinhole ({report.pinhole[0]:.6g} mm) at the "
+            f"entrance pupil, {pupil / (1000.0 * mpu):.6g} units in front of the film; focalDistance is measured "
+            "from there",
+            "fov spans the screen window's shorter side (the ScreenWindow unit); Shutter is in frames",
+        ]
+        text = rib_camera_block(values, legacy=args.legacy, comments=comments)
+        path = atomic_write(args.output, text, force=args.force)
     proj = values["Projection"]
     if args.json:
         print_json({"written": str(path), "form": "legacy" if args.legacy else "PxrCamera", "meters_per_unit": mpu,
@@ -318,7 +322,6 @@ def _register_pbrt(s) -> None:
     import argparse
 
     from .lens import add_lenient
-    from .report import add_report_arguments
 
     b = s.add_parser("pbrt", help="write pbrt-v4 cameras: the lens .dat with a realistic camera, and the thin lens",
                      description="Write pbrt-v4 files for a lens report: <lens>.dat (the lens focused at the mark) and "
@@ -327,7 +330,18 @@ def _register_pbrt(s) -> None:
                                  "focusing will choose next to physcam's. Scene in metres. See docs/renderman-pbrt.md.",
                      epilog=PBRT_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     b.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write the files into")
-    add_report_arguments(b)
+    b.add_argument("--lens", metavar="NAME_OR_FILE", help="a real lens (bundled name or prescription file)")
+    b.add_argument("--focal", metavar="MM", type=distance("focal length"),
+                   help="or a thin lens of this focal length (mm): the perspective camera only")
+    b.add_argument("--fstop", metavar="N", type=number("f-stop", positive=True),
+                   help="f-stop (geometric f-number; with --lens default wide open)")
+    b.add_argument("--focus", metavar="DIST", type=distance("focus distance"), required=True,
+                   help="focus mark, film plane to subject (e.g. 2m, 7ft)")
+    b.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (default Super 35 4-perf)')
+    b.add_argument("--sensor-width", metavar="MM", type=distance("sensor width"), help="sensor width (mm)")
+    b.add_argument("--sensor-height", metavar="MM", type=distance("sensor height"), help="sensor height (mm)")
+    b.add_argument("--coc", default=None,
+                   help="circle of confusion for the DOF comparison: d/1500 (default), d/1000, cine or mm")
     add_lenient(b)
     b.add_argument("--camera", choices=("both", "realistic", "perspective"), default="both",
                    help="which pbrt camera to write (default both; a thin lens --focal has only perspective)")
@@ -336,6 +350,30 @@ def _register_pbrt(s) -> None:
     b.add_argument("--force", action="store_true", help="overwrite existing files")
     b.add_argument("--json", action="store_true", help="print the written paths and pbrt's numbers as JSON")
     b.set_defaults(handler=run_pbrt)
+
+
+class _warnings_after_success:
+    """Hold physcam's warnings until the command has succeeded: a refusal stays one line on stderr."""
+
+    def __enter__(self):
+        import warnings
+
+        self._ctx = warnings.catch_warnings(record=True)
+        self._caught = self._ctx.__enter__()
+        warnings.simplefilter("always")
+        return self
+
+    def __exit__(self, *exc):
+        import warnings
+
+        self._ctx.__exit__(*exc)
+        if exc[0] is None:
+            seen = set()
+            for w in self._caught:
+                if str(w.message) not in seen:
+                    seen.add(str(w.message))
+                    warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+        return False
 
 
 def _slug(text: str) -> str:
@@ -350,13 +388,15 @@ def _slug(text: str) -> str:
 
 def run_pbrt(args) -> int:
     from ..errors import InputError
-    from ..export.pbrt import write_pbrt_camera
+    from ..export.pbrt import check_pbrt_lens, write_pbrt_camera
+    from ..onset.report import solve_lens_report
+    from ._common import coc_value
+    from .report import resolve_sensor
 
     if not 16 <= args.resolution <= 65536:
         raise InputError(f"--resolution must lie in 16..65536 pixels, got {args.resolution}")
-    if args.squeeze != 1.0:
-        raise InputError("pbrt-v4's cameras have no anamorphic squeeze (pixel aspect) or oval bokeh; "
-                         "`physcam export rib` (PxrCamera) has both")
+    if (args.lens is None) == (args.focal is None):
+        raise InputError("give a lens (--lens NAME) or a thin lens's focal length (--focal MM), one of them")
     lens = None
     if args.lens:
         from ..lens.library import load_lens
@@ -364,10 +404,19 @@ def run_pbrt(args) -> int:
         lens = load_lens(args.lens, lenient=args.lenient)
     cameras = {"both": ("realistic", "perspective") if lens is not None else ("perspective",),
                "realistic": ("realistic",), "perspective": ("perspective",)}[args.camera]
-    report = _report(args)
-    name = _slug(args.lens) if args.lens else f"thin_{report.focal_length_mm:g}mm".replace(".", "_")
-    out = write_pbrt_camera(report, args.output, lens, name=name, xres=args.resolution, cameras=cameras,
-                            force=args.force)
+    if lens is not None and ("realistic" in cameras or lens.is_anamorphic):
+        check_pbrt_lens(lens)  # before anything is solved: what pbrt cannot hold is refused first
+    if "realistic" in cameras and lens is None:
+        raise InputError("pbrt-v4's realistic camera traces a lens prescription: give a lens (--lens NAME); "
+                         "a thin lens (--focal) has only the perspective camera (--camera perspective)")
+    with _warnings_after_success():
+        if lens is None and args.fstop is None:
+            raise InputError("give the f-stop of the thin lens (--fstop)")
+        report = solve_lens_report(focal_length_mm=args.focal, sensor=resolve_sensor(args), fstop=args.fstop,
+                                   focus_mm=args.focus, coc=coc_value(args.coc), lens=lens)
+        name = _slug(args.lens) if args.lens else f"thin_{report.focal_length_mm:g}mm".replace(".", "_")
+        out = write_pbrt_camera(report, args.output, lens, name=name, xres=args.resolution, cameras=cameras,
+                                force=args.force)
     if args.json:
         print_json(out)
         return 0
