@@ -1,4 +1,5 @@
-"""RenderMan camera parameters (Format, ScreenWindow, PxrCamera) for a lens report.
+"""RenderMan camera parameters (Format, ScreenWindow, PxrCamera) for a lens report, and RIB
+camera blocks (:func:`rib_camera_values`, :func:`rib_camera_block`; docs/renderman-pbrt.md).
 
 RenderMan's perspective projection is field-of-view driven: ``fov`` spans the
 screen window's shorter side, whose default is [-a, a, -1, 1] for a frame aspect
