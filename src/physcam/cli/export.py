@@ -23,9 +23,10 @@ def _common(p) -> None:
 
 
 def register(sub) -> None:
-    p = sub.add_parser("export", help="lens data for Unreal (lens file) and OpenCV/Omniverse (pinhole + distortion)",
-                       description="Export a real lens as an Unreal Engine lens file (.ulens JSON) or as fitted "
-                                   "OpenCV pinhole intrinsics and distortion (Omniverse's opencvPinhole lens API).")
+    p = sub.add_parser("export", help="lens data for Unreal, OpenCV/Omniverse, Blender, RenderMan (RIB) and pbrt-v4",
+                       description="Export a real lens as an Unreal Engine lens file (.ulens JSON), fitted OpenCV "
+                                   "pinhole intrinsics and distortion (Omniverse's opencvPinhole lens API), a Blender "
+                                   "Cycles OSL camera, a RenderMan RIB camera block or pbrt-v4 cameras.")
     s = p.add_subparsers(dest="export_command", metavar="FORMAT")
 
     u = s.add_parser("unreal", help="write an Unreal Engine lens file (.ulens JSON, Camera Calibration plugin)")
@@ -262,11 +263,9 @@ def _camera_look(p, blades_default) -> None:
 
 
 def _report(args):
-    from ..errors import InputError
+    """The lens report of the command's arguments (a focus mark, or one solved from --near/--far)."""
     from .report import solve_from_args
 
-    if getattr(args, "focus", None) is None:
-        raise InputError("give the focus mark (--focus), film plane to subject: the camera's focus distance")
     return solve_from_args(args)
 
 
