@@ -34,6 +34,12 @@ FILES = ["out.usda", "out.png", "out.svg", "out.txt", "", "missing_dir/out.usda"
 #: senders run for a bounded time instead of until Ctrl-C
 BOUNDED = {("live", "record"): ["--duration=0.3"], ("live", "send"): ["--duration=0.3"],
            ("live", "play"): ["--duration=0.3"]}
+#: A valid command line some leaves start from, so that the fuzzed flags reach the handler instead of
+#: stopping at a missing required option (argparse keeps the last of a repeated option).
+BASE_ARGV = {
+    ("export", "rib"): ["-o", "out.rib", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--force"],
+    ("export", "pbrt"): ["-o", "pbrt_out", "--lens", "dgauss_50mm", "--focus", "3m", "--force"],
+}
 NAN_OR_INF = re.compile(r"(?<![A-Za-z_])(nan|NaN|inf|Infinity)(?![A-Za-z_])")
 
 
@@ -72,7 +78,7 @@ def _argv_strategy(path, parser):
 
     @st.composite
     def build(draw):
-        argv = list(path)
+        argv = list(path) + BASE_ARGV.get(tuple(path), [])
         for a in positionals:
             n = 1 if a.nargs in (None, 1) else draw(st.integers(1, 2))
             argv += [draw(_value_strategy(a)) for _ in range(n)]
