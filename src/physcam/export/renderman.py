@@ -85,7 +85,7 @@ def shutter_opening_curve(opentime: float, closetime: float) -> list[float]:
     draws the opening as a cubic Bezier from (0, 0) to (opentime, 1) with control points (c1, c2),
     (d1, d2), and the closing from (closetime, 1) to (1, 0) with (e1, e2), (f1, f2) (RenderMan
     "Shutter" page, rmanwiki REN22/REN24). Control points at the thirds of each ramp make the
-    Bezier exactly that straight ramp. The same numbers as ``physcam.usd.author``'s ri:shutteropening.
+    Bezier exactly that straight ramp. ``physcam.usd.author`` writes these as ri:shutteropening.
     """
     o = require_finite("shutter opening time", opentime)
     c = require_finite("shutter closing time", closetime)

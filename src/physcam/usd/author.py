@@ -33,6 +33,7 @@ import struct
 from dataclasses import dataclass
 
 from ..errors import ExportError, InputError, require_finite, require_positive, require_type
+from ..export.renderman import shutter_opening_curve  # re-exported: the one copy of seed 002's ramps
 from .plugin import ensure_registered, require_stage
 
 __all__ = [
@@ -237,19 +238,6 @@ def _transmittance(fstop: float, tstop: float | None) -> float:
         raise InputError(f"T-stop {tstop:g} is faster than the f-stop {fstop:g}: a lens cannot transmit more than "
                          "all the light (T >= N)")
     return min(t, 1.0)
-
-
-def shutter_opening_curve(opentime: float, closetime: float) -> list[float]:
-    """RenderMan's ``shutteropening`` control points [c1 c2 d1 d2 e1 e2 f1 f2] for seed 002's linear ramps.
-
-    Seed 002: the shutter opens linearly from 0 to ``opentime`` (fractions of the
-    exposure), is fully open until ``closetime`` and closes linearly until 1. The two
-    interior points of each ramp are placed at its thirds, so the curve is exactly
-    those straight ramps.
-    """
-    o, c = float(opentime), float(closetime)
-    return [o / 3.0, 1.0 / 3.0, 2.0 * o / 3.0, 2.0 / 3.0,
-            c + (1.0 - c) / 3.0, 2.0 / 3.0, c + 2.0 * (1.0 - c) / 3.0, 1.0 / 3.0]
 
 
 def new_stage(meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y"):
