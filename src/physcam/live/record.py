@@ -4,7 +4,7 @@ Each :class:`~physcam.live.frames.TrackedFrame` is solved as an on-set lens repo
 (:func:`physcam.onset.report.solve_lens_report`, the practical model with the streamed entrance
 pupil and best-match pinhole) and written as one USD time sample through physcam's own authoring
 (:func:`physcam.usd.author.author_camera` for the first frame, then
-:func:`physcam.usd.author.render_camera_values` per frame, as :mod:`physcam.usd.animate` does for
+:func:`physcam.usd.author.sample_render_camera` per frame, as :mod:`physcam.usd.animate` does for
 a focus pull):
 
 * the PhysicalCamera body's transform: ``translate`` (where the entrance pupil is),
@@ -175,7 +175,7 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
     from pxr import Gf, Sdf, UsdGeom, Vt
 
     from ..export.usdgeom import mm_to_scene_units, require_meters_per_unit
-    from ..usd.author import author_camera, new_stage, render_camera_values, save_stage, spec_from_report
+    from ..usd.author import author_camera, new_stage, sample_render_camera, save_stage, spec_from_report
     from .frames import rotation_matrix
 
     if isinstance(solved, (str, bytes)) or not hasattr(solved, "__iter__"):
@@ -204,7 +204,6 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
     cam.SetCustomDataByKey("physcam:source", "OpenTrackIO stream recorded by physcam live record")
     model = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Pinhole"))
     geom = UsdGeom.Camera(stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")))
-    geom_translate = UsdGeom.Xformable(geom.GetPrim()).GetOrderedXformOps()[0]
     # the body: pupil position, OpenTrackIO's rotation as rotateZXY, back to the film plane
     body = UsdGeom.Xformable(cam)
     body.ClearXformOpOrder()
@@ -240,14 +239,8 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
         names["entrancePupilDistance"].Set(eye, t)
         if names["pinholeFocalLength"]:
             names["pinholeFocalLength"].Set(report.pinhole[0], t)
-        values, eye = render_camera_values(spec, report, mpu, tcps, where=path)
-        geom.GetFocalLengthAttr().Set(values["focalLength"], t)
-        geom.GetHorizontalApertureAttr().Set(values["horizontalAperture"], t)
-        geom.GetVerticalApertureAttr().Set(values["verticalAperture"], t)
-        geom.GetFStopAttr().Set(values["fStop"], t)
-        geom.GetFocusDistanceAttr().Set(values["focusDistance"], t)
+        sample_render_camera(geom, spec, report, mpu, tcps, t, where=path)
         geom.GetExposureFStopAttr().Set(spec.fstop / math.sqrt(spec.transmittance), t)
-        geom_translate.Set(Gf.Vec3d(0.0, 0.0, -su(eye)), t)
         if f.sequence_number is not None:
             a_seq.Set(int(f.sequence_number), t)
         if f.timecode is not None:

@@ -51,6 +51,7 @@ __all__ = [
     "shutter_opening_curve",
     "author_render_settings",
     "render_camera_values",
+    "sample_render_camera",
 ]
 
 DEFAULT_CAMERA_PATH = "/Cameras/Camera"
@@ -475,6 +476,26 @@ def _author_lens(stage, cam, spec, eye, su):
         model.SetCustomDataByKey("physcam:lensName", spec.lens_name)
     cam.GetRelationship(lp + "lensModel") or cam.CreateRelationship(lp + "lensModel", False)
     cam.GetRelationship(lp + "lensModel").SetTargets([model.GetPath()])
+
+
+def sample_render_camera(geom, spec: CameraSpec, report, meters_per_unit: float, time_codes_per_second: float,
+                         time: float, *, where: str = "camera") -> float:
+    """Time-sample a companion UsdGeomCamera ``geom`` at ``time`` from ``spec`` (one frame of a moving
+    camera): focal length, apertures, f-stop, focus distance and its translate (the eye, in front of
+    the film), from :func:`render_camera_values`. Returns the eye distance (mm from the film)."""
+    from pxr import Gf, UsdGeom
+
+    from ..export.usdgeom import mm_to_scene_units
+
+    values, eye = render_camera_values(spec, report, meters_per_unit, time_codes_per_second, where=where)
+    geom.GetFocalLengthAttr().Set(values["focalLength"], time)
+    geom.GetHorizontalApertureAttr().Set(values["horizontalAperture"], time)
+    geom.GetVerticalApertureAttr().Set(values["verticalAperture"], time)
+    geom.GetFStopAttr().Set(values["fStop"], time)
+    geom.GetFocusDistanceAttr().Set(values["focusDistance"], time)
+    translate = UsdGeom.Xformable(geom.GetPrim()).GetOrderedXformOps()[0]
+    translate.Set(Gf.Vec3d(0.0, 0.0, -mm_to_scene_units(eye, meters_per_unit)), time)
+    return eye
 
 
 def render_camera_values(spec: CameraSpec, report, meters_per_unit: float, time_codes_per_second: float, *,
