@@ -81,7 +81,7 @@ def test_distortion_across_focus_table(capsys):
     from physcam.lens.library import load_lens
 
     rc = main(["distortion", "zuiko_18mm_f3_5", "--resolution", "1024x683", "--across-focus", "0.4m,1m,inf",
-               "--json"])
+               "--sensor", "FF", "--json"])
     assert rc == 0
     d = json.loads(capsys.readouterr().out)
     rows = d["rows"]
@@ -90,7 +90,8 @@ def test_distortion_across_focus_table(capsys):
     assert rows[0]["corner_distortion_pct"] < rows[1]["corner_distortion_pct"] < rows[2]["corner_distortion_pct"] < 0
     # at infinity the corner figure agrees with the field-angle table's (a separate 1-D code path, chief rays
     # from infinity): its distortion where the real chief ray reaches the corner radius, 21.633 mm
-    assert main(["distortion", "dgauss_50mm", "--resolution", "1024x683", "--across-focus", "inf", "--json"]) == 0
+    assert main(["distortion", "dgauss_50mm", "--resolution", "1024x683", "--across-focus", "inf", "--sensor", "FF",
+                 "--json"]) == 0
     corner = json.loads(capsys.readouterr().out)["rows"][0]["corner_distortion_pct"]
     pts = real_distortion(load_lens("dgauss_50mm"), np.linspace(0.0, 24.0, 97), sensor_width_mm=36,
                           sensor_height_mm=24).points

@@ -25,7 +25,7 @@ def run(capsys, *argv):
 def test_lenses_lists_the_library_with_paraxial_data(capsys):
     rc, out, _ = run(capsys, "lenses", "--json")
     assert rc == 0
-    rows = {r["slug"]: r for r in json.loads(out)}
+    rows = {r["slug"]: r for r in json.loads(out)["lenses"]}
     # pbrt dgauss.50mm: the published EFL; f-number = EFL / entrance pupil diameter (published figures)
     assert rows["dgauss_50mm"]["efl_mm"] == pytest.approx(50.3582, abs=1e-3)
     assert rows["dgauss_50mm"]["f_number"] == pytest.approx(50.3582 / 24.8051, abs=1e-4)
@@ -68,7 +68,7 @@ def test_show_at_a_focus_and_fstop(capsys):
     assert y["positions"]["film"]["rear_principal_plane"] == pytest.approx(s2, abs=2e-3)
     assert d["focus"]["method"] == "unit"
     rc, out, _ = run(capsys, "lens", "show", "dgauss.50mm", "--focus", "6ft")
-    assert rc == 0 and "focus 1829 mm from the film" in out
+    assert rc == 0 and "focus 1.829 m from the film" in out
 
 
 def test_anamorphic_lens_reports_both_meridians(capsys):

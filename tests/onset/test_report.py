@@ -100,7 +100,8 @@ def test_anamorphic_horizontal_fov_and_coc():
     (dict(focus_mm=3000.0, fstop=0.0), InputError),
     (dict(focus_mm=3000.0, fstop=-2.0), InputError),
     (dict(focus_mm=3000.0, fstop=float("nan")), InputError),
-    (dict(focus_mm=float("inf"), fstop=2.0), InputError),
+    (dict(focus_mm=-float("inf"), fstop=2.0), InputError),
+    (dict(focus_mm="hyperfocal"), InputError),  # the hyperfocal distance needs the f-stop
     (dict(focus_mm=3000.0, fstop=2.0, coc=0.0), InputError),
     (dict(focus_mm=3000.0, near_mm=3500.0), InputError),
     (dict(focus_mm=3000.0, far_mm=2500.0, fstop=2.0, coc=0.03), InputError),
@@ -121,7 +122,7 @@ def test_json_is_strict_and_versioned():
     r = solve_lens_report(focal_length_mm=24.0, sensor=FF, fstop=11.0, focus_mm=5000.0, coc=0.03)
     assert r.dof.far_is_infinite
     d = json.loads(json.dumps(r.to_dict(), allow_nan=False))
-    assert d["schema"] == "physcam.lens_report" and d["version"] == 1
+    assert d["schema"] == "physcam.lens_report" and d["version"] == 2
     assert d["dof"]["far_mm"] is None and d["dof"]["far_is_infinite"] is True
 
 
