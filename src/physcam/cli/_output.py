@@ -35,7 +35,8 @@ def document(name: str, payload: dict, *, version: int = 1, units: dict | None =
     clash = {"schema", "version", "units"} & set(payload)
     if clash:
         raise ValueError(f"the payload of {name} already has {sorted(clash)}: rename them")
-    return {"schema": f"physcam.{name}", "version": int(version), "units": dict(units or LENGTH_UNITS), **payload}
+    return {"schema": f"physcam.{name}", "version": int(version),
+            "units": dict(LENGTH_UNITS if units is None else units), **payload}
 
 
 def schema_file(schema: str) -> Path:
