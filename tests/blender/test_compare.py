@@ -18,6 +18,9 @@ def test_compare_blender_writes_figure_and_agreeing_table(tmp_path, monkeypatch,
     assert main(["compare", "blender", "dgauss_50mm", "--focus", "2m", "--fstop", "2.8", "--light", "0.7m",
                  "--blades", "6", "--blade-angle", "15", "-o", str(out), "--json"]) == 0
     table = json.loads(capsys.readouterr().out)
+    from _documents import check_document
+
+    assert check_document(table) == "physcam.compare_blender"
     d = table["measured"]["equivalent_diameter_mm"]
     assert d["ratio"] == pytest.approx(1.0, abs=0.03)  # the 3 % on the bokeh size
     assert table["measured"]["corners"] == {"cycles": 6, "physcam": 6}

@@ -64,6 +64,9 @@ def test_record_a_sent_take(tmp_path):
     stdout, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 0, stderr
     summary = json.loads(stdout)
+    from _documents import check_document
+
+    assert check_document(summary) == "physcam.live_record"
     assert summary["frames"] == 30 and summary["counters"]["delivered"] >= 30
     stage = Usd.Stage.Open(str(out))
     cam = stage.GetPrimAtPath("/Cameras/Camera")

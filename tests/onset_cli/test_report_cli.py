@@ -70,7 +70,11 @@ def test_version_and_sensors(capsys):
 def test_demo_writes_outputs(tmp_path, capsys):
     out = tmp_path / "demo"
     assert main(["demo", "--out", str(out), "--json"]) == 0
-    files = json.loads(capsys.readouterr().out)["files"]
+    doc = json.loads(capsys.readouterr().out)
+    from _documents import check_document
+
+    assert check_document(doc) == "physcam.demo"
+    files = doc["files"]
     for name in ("report.json", "report.txt", "dof.png", "lens.json", "lens_diagram.png", "breathing.png",
                  "camera.usda", "spot.png", "bokeh.png"):
         assert (out / name).exists(), name

@@ -103,6 +103,7 @@ def focus(name: str = "focus distance", *, allow_inf: bool = True, hyperfocal: b
             raise argparse.ArgumentTypeError(f"{exc}; or hyperfocal, infinity" if hyperfocal else str(exc)) from None
 
     parse.__name__ = name
+    parse.physcam_focus = {"infinity": allow_inf, "hyperfocal": hyperfocal}  # the contract test finds focus options
     return parse
 
 
@@ -117,6 +118,7 @@ def focus_list(name: str = "focus distances"):
         return [one(t) for t in parts]
 
     parse.__name__ = name
+    parse.physcam_focus = dict(one.physcam_focus, list=True)
     return parse
 
 

@@ -131,7 +131,7 @@ def _cell(v) -> str:
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, float):
-        return repr(v) if math.isfinite(v) else ""
+        return repr(float(v)) if math.isfinite(v) else ""
     if isinstance(v, (list, tuple)):
         return ";".join(_cell(x) for x in v)
     return str(v)

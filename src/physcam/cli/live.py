@@ -103,7 +103,9 @@ def register(sub) -> None:
     se = s.add_parser("send", help="stream physcam's camera and lens as OpenTrackIO (a focus pull, a pan)")
     se.add_argument("--lens", help="bundled lens name or prescription file (breathing, pupil, distortion)")
     se.add_argument("--focal", type=distance("focal length"), help="or a thin lens of this focal length")
-    _sensor_args(se)
+    from ._common import add_sensor_options
+
+    add_sensor_options(se)
     se.add_argument("--focus", type=focus("focus distance", allow_inf=False), default=3000.0,
                     help="focus mark (default 3m; units ok; or hyperfocal at --fstop)")
     se.add_argument("--focus-to", type=focus("focus distance to pull to", allow_inf=False),

@@ -1,0 +1,304 @@
+"""The rules every command keeps (issue 15), checked by walking the parser, so a new command is held
+to them the day it arrives (docs/cli.md, "Writing a command"):
+
+- every ``--json`` prints a versioned document (schema, version, units) that validates against the
+  JSON Schema shipped for it in physcam/cli/schemas; every command with ``--json`` has a run here;
+- every ``--csv`` prints the rows of that document, cell for cell (CSV round-trips to the JSON);
+- every focus option reads distances, ``hyperfocal`` and ``infinity``, and a command taking a
+  focus prints distances in ``--units m|ft``;
+- every command taking a sensor takes the shared sensor options and says its default;
+- tables piped or redirected are plain and complete (no box, no ellipsis).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+import math
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+from _documents import check_document
+from physcam.cli import build_parser, main
+from physcam.cli._common import HYPERFOCAL
+from physcam.cli._output import SCHEMA_DIR
+
+pytestmark = pytest.mark.slow
+
+REPO = Path(__file__).resolve().parents[2]
+LIVE_SAMPLE = REPO / "tests" / "live" / "data" / "recommended_static_example.json"
+
+
+def leaves(parser=None, prefix=()):
+    """(path, parser) of every runnable subcommand."""
+    parser = parser or build_parser()
+    subs = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    if not subs:
+        yield prefix, parser
+        return
+    seen = set()
+    for name, p in subs[0].choices.items():
+        if id(p) not in seen:
+            seen.add(id(p))
+            yield from leaves(p, prefix + (name,))
+
+
+def options(parser) -> set[str]:
+    return {o for a in parser._actions for o in a.option_strings}
+
+
+LEAVES = dict(leaves())
+
+#: One quick run of every command that has --json (run in a folder the `workdir` fixture prepares).
+JSON_RUNS = {
+    ("report",): ["report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--cameras"],
+    ("dof-table",): ["dof-table", "--focal", "35", "--fstops", "2,4", "--focus", "1m,hyperfocal,inf"],
+    ("sensors",): ["sensors", "ARRI"],
+    ("lenses",): ["lenses"],
+    ("lens", "show"): ["lens", "show", "dgauss_50mm", "--focus", "2m"],
+    ("lens", "breathing"): ["lens", "breathing", "dgauss_50mm", "--focus", "1m", "2m", "inf"],
+    ("lens", "check"): ["lens", "check", "dgauss_50mm"],
+    ("lens", "fix"): ["lens", "fix", "dgauss_50mm.toml", "-o", "fixed.toml"],
+    ("spot",): ["spot", "dgauss_50mm", "--rings", "8"],
+    ("bokeh",): ["bokeh", "dgauss_50mm", "--rays", "2000", "--pixels", "32", "--focus", "2m", "--light", "1m"],
+    ("illumination",): ["illumination", "dgauss_50mm", "--grid", "16"],
+    ("colour",): ["colour", "dgauss_50mm", "--field", "0", "--field", "5"],
+    ("breathing-real",): ["breathing-real", "dgauss_50mm", "--focus", "inf", "--focus", "2m"],
+    ("ghosts",): ["ghosts", "dgauss_50mm", "--top", "3"],
+    ("distortion",): ["distortion", "dgauss_50mm"],
+    ("compare", "lenses"): ["compare", "dgauss_50mm", "tessar_50mm_f2_8", "--rays", "2000"],
+    ("usd", "write"): ["usd", "write", "w.usda", "--focal", "35", "--fstop", "2.8", "--focus", "3m"],
+    ("usd", "read"): ["usd", "read", "shot.usda"],
+    ("usd", "kit"): ["usd", "kit", "vendor", "v2.usda", "--lens", "dgauss_50mm", "--focus", "1.5m"],
+    ("usd", "animate"): ["usd", "animate", "pull.usda", "--lens", "dgauss_50mm", "--marks", "pull.csv"],
+    ("usd", "check"): ["usd", "check", "shot2.usda"],
+    ("usd", "refresh"): ["usd", "refresh", "shot2.usda"],
+    ("config", "show"): ["config", "show"],
+    ("export", "unreal"): ["export", "unreal", "dgauss_50mm", "-o", "d.ulens", "--width-px", "1024", "--height-px", "683",
+                           "--focus", "inf", "--focus", "2m"],
+    ("export", "opencv"): ["export", "opencv", "dgauss_50mm", "--width-px", "1024", "--height-px", "683"],
+    ("export", "blender"): ["export", "blender", "dgauss_50mm", "--focus", "2m", "-o", "cams"],
+    ("export", "rib"): ["export", "rib", "-o", "c.rib", "--focal", "40", "--fstop", "2.8", "--focus", "2.5m"],
+    ("export", "pbrt"): ["export", "pbrt", "-o", "pbrt", "--lens", "dgauss_50mm", "--fstop", "2.8", "--focus", "2m"],
+    ("live", "validate"): ["live", "validate", str(LIVE_SAMPLE)],
+    ("live", "frustum"): ["live", "frustum", "shot.usda", "frustum.usda", "--wall", "wall.usda"],
+}
+#: Further runs of documents a command prints in other modes.
+EXTRA_JSON_RUNS = {
+    "distortion_field": ["distortion", "dgauss_50mm", "--resolution", "256x171", "--focus", "2m", "--fit", "brown"],
+    "distortion_across_focus": ["distortion", "dgauss_50mm", "--resolution", "256x171", "--across-focus", "1m,inf"],
+    "report_at_infinity": ["report", "--lens", "dgauss_50mm", "--fstop", "2.8", "--focus", "inf", "--cameras"],
+}
+#: Commands with --json this test does not run, and why (each is covered where named).
+JSON_NOT_RUN = {
+    ("compare", "blender"): "needs Blender's bpy (tests/blender/test_compare.py validates its document)",
+    ("live", "record"): "needs a UDP stream (tests/live/test_cli_live.py records one and validates the document)",
+    ("demo",): "writes the whole demo (tests/onset_cli/test_report_cli.py::test_demo_writes_outputs validates it)",
+}
+#: Where the rows of each --csv command's document are.
+CSV_ROWS = {
+    ("dof-table",): "rows", ("sensors",): "sensors", ("lenses",): "lenses", ("lens", "breathing"): "rows",
+    ("spot",): "fields", ("illumination",): "points", ("colour",): "lateral",
+    ("breathing-real",): "rows", ("ghosts",): "paths", ("distortion",): "points", ("compare", "lenses"): "lenses",
+    ("export", "unreal"): "lens_file.physcam.marks",
+}
+#: Commands that take a focus but print no distance (so no --units), and why.
+NO_UNITS = {
+    ("usd", "write"): "prints the file written; the file holds millimetres and scene units",
+    ("usd", "kit"): "prints the file written",
+    ("live", "record"): "prints frame counts and timecodes",
+    ("live", "send"): "prints the samples sent (OpenTrackIO's own units)",
+}
+#: Commands whose --sensor has another default than the one default sensor, and why.
+OTHER_SENSOR_DEFAULT = {
+    ("live", "record"): "the stream's sensor, when it carries one",
+    ("live", "play"): "the recording's sensor",
+    ("lens", "check"): "optional: with a sensor the check adds a corner probe",
+}
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory):
+    """A folder with what the runs read: a camera, a shot with body and lens, a focus pull, a wall."""
+    from physcam.lens.library import library_dir
+
+    d = tmp_path_factory.mktemp("contract")
+    old = os.getcwd()
+    os.chdir(d)
+    try:
+        shutil.copy(library_dir() / "dgauss_50mm.toml", d / "dgauss_50mm.toml")
+        (d / "pull.csv").write_text("frame,focus\n1,2m\n24,3m\n")
+        for argv in (["usd", "write", "shot.usda", "--focal", "35", "--fstop", "2.8", "--focus", "3m", "--sensor",
+                      "ALEXA 35"],
+                     ["usd", "kit", "body", "body.usda", "--sensor", "ALEXA 35"],
+                     ["usd", "kit", "vendor", "v.usda", "--lens", "dgauss_50mm", "--focus", "1.5m"],
+                     ["usd", "kit", "shot", "shot2.usda", "--body", "body.usda", "--lens", "v.usda", "--focus", "2m"],
+                     ["live", "wall", "wall.usda"]):
+            assert main(argv) == 0, argv
+    finally:
+        os.chdir(old)
+    return d
+
+
+def run_json(capsys, workdir, argv):
+    old = os.getcwd()
+    os.chdir(workdir)
+    try:
+        capsys.readouterr()
+        rc = main([*argv, "--json", *_force(argv)])
+        out, err = capsys.readouterr()
+    finally:
+        os.chdir(old)
+    assert rc == 0, f"physcam {' '.join(argv)} --json: exit {rc}\n{err}"
+    return json.loads(out)
+
+
+def _force(argv):
+    """--force where the run writes a file (the module's folder is shared, runs repeat)."""
+    writes = any(a in ("-o", "--plot") or a.endswith((".usda", ".ulens", ".rib")) for a in argv)
+    return ["--force"] if writes and "--force" in _opts_of(argv) else []
+
+
+def _opts_of(argv):
+    for n in (2, 1):
+        if tuple(argv[:n]) in LEAVES:
+            return options(LEAVES[tuple(argv[:n])])
+    if argv[:1] == ["compare"]:
+        return options(LEAVES[("compare", "lenses")])
+    return set()
+
+
+def test_every_json_command_is_run_here():
+    with_json = {path for path, p in LEAVES.items() if "--json" in options(p)}
+    missing = with_json - set(JSON_RUNS) - set(JSON_NOT_RUN)
+    assert not missing, f"commands with --json but no run in JSON_RUNS (add one): {sorted(missing)}"
+    assert not (set(JSON_RUNS) | set(JSON_NOT_RUN)) - with_json, "JSON_RUNS names a command without --json"
+
+
+@pytest.mark.parametrize("path", sorted(JSON_RUNS), ids=" ".join)
+def test_json_validates_against_its_shipped_schema(capsys, workdir, path):
+    doc = run_json(capsys, workdir, JSON_RUNS[path])
+    check_document(doc)
+
+
+@pytest.mark.parametrize("name", sorted(EXTRA_JSON_RUNS))
+def test_other_documents_validate(capsys, workdir, name):
+    check_document(run_json(capsys, workdir, EXTRA_JSON_RUNS[name]))
+
+
+def test_every_schema_file_is_a_schema_named_for_its_document():
+    import jsonschema
+
+    files = sorted(SCHEMA_DIR.glob("*.schema.json"))
+    assert len(files) >= 30
+    for f in files:
+        s = json.loads(f.read_text())
+        jsonschema.Draft202012Validator.check_schema(s)
+        name = f.name.removesuffix(".schema.json")
+        assert s["properties"]["schema"]["const"] == f"physcam.{name}", f.name
+        assert {"schema", "version", "units"} <= set(s["required"]) or name == "lens_report", f.name
+
+
+def _rows(doc, key):
+    for part in key.split("."):
+        doc = doc[part]
+    return doc
+
+
+def _same(cell: str, value) -> bool:
+    """A CSV cell against the JSON value it came from (numbers exactly: CSV carries repr)."""
+    if value is None:
+        return cell == ""
+    if isinstance(value, bool):
+        return cell == ("true" if value else "false")
+    if isinstance(value, (int, float)):
+        return cell != "" and float(cell) == float(value)
+    if isinstance(value, list):
+        return cell == ";".join("" if v is None else str(v) for v in value)
+    return cell == str(value)
+
+
+@pytest.mark.parametrize("path", sorted(CSV_ROWS), ids=" ".join)
+def test_csv_round_trips_to_the_json_rows(capsys, workdir, path):
+    assert "--csv" in options(LEAVES[path])
+    argv = JSON_RUNS[path]
+    rows = _rows(run_json(capsys, workdir, argv), CSV_ROWS[path])
+    old = os.getcwd()
+    os.chdir(workdir)
+    try:
+        rc = main([*argv, "--csv", *_force(argv)])
+        out, err = capsys.readouterr()
+    finally:
+        os.chdir(old)
+    assert rc == 0, err
+    table = list(csv.DictReader(io.StringIO(out)))
+    assert len(table) == len(rows) > 0
+    assert table and set(table[0]) <= set(rows[0]), f"CSV columns that are not JSON keys: {set(table[0]) - set(rows[0])}"
+    for got, want in zip(table, rows):
+        for k, cell in got.items():
+            assert _same(cell, want[k]), f"{' '.join(path)} row {want}: {k} CSV {cell!r} != JSON {want[k]!r}"
+
+
+def test_every_csv_command_has_its_rows_named():
+    with_csv = {path for path, p in LEAVES.items() if "--csv" in options(p)}
+    assert with_csv == set(CSV_ROWS), f"add their rows to CSV_ROWS: {sorted(with_csv ^ set(CSV_ROWS))}"
+
+
+def _focus_actions(p):
+    return [a for a in p._actions if getattr(a.type, "physcam_focus", None)]
+
+
+def test_every_focus_option_reads_hyperfocal_and_infinity():
+    """Every option that takes a focus mark is built with physcam.cli._common.focus (or focus_list)."""
+    named = []
+    for path, p in LEAVES.items():
+        for a in p._actions:
+            if a.option_strings and (a.dest in ("focus", "focus_to", "at", "across_focus")) and a.type is not None:
+                named.append((path, a))
+    assert len(named) >= 15
+    for path, a in named:
+        spec = getattr(a.type, "physcam_focus", None)
+        assert spec is not None, f"{' '.join(path)} {a.option_strings}: build its type with _common.focus()"
+        got = a.type("hyperfocal")
+        assert got == HYPERFOCAL or got == [HYPERFOCAL], (path, a.option_strings)
+        if spec["infinity"]:
+            got = a.type("infinity")
+            assert got == math.inf or got == [math.inf], (path, a.option_strings)
+        else:
+            with pytest.raises(argparse.ArgumentTypeError, match="finite"):
+                a.type("infinity")
+
+
+def test_commands_taking_a_focus_print_distances_in_units():
+    for path, p in LEAVES.items():
+        if _focus_actions(p) and path not in NO_UNITS:
+            assert "--units" in options(p), f"{' '.join(path)} takes a focus: add add_units_option (or NO_UNITS)"
+
+
+def test_commands_taking_a_sensor_share_the_options_and_the_default():
+    for path, p in LEAVES.items():
+        if "--sensor" not in options(p) or path in OTHER_SENSOR_DEFAULT:
+            continue
+        assert {"--sensor-width", "--sensor-height"} <= options(p), path
+        helps = {a.option_strings[0]: a.help for a in p._actions if a.option_strings}
+        assert "default Super 35" in helps["--sensor"], f"{' '.join(path)}: use _common.add_sensor_options"
+
+
+@pytest.mark.parametrize("argv, whole", [
+    (["lenses"], "Double Gauss 50mm f/2 (pbrt dgauss.50mm)"),
+    (["sensors", "ARRI"], "ARRI ALEXA Mini LF / LF 4.5K LF Open Gate 3:2"),
+    (["report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--lens-length", "12cm", "--sensor-front", "30cm"],
+     "estimate: 0.4 of the lens length behind its front"),
+    (["lens", "show", "dgauss_50mm"], "front focal length (F to first vertex)"),
+    (["dof-table", "--focal", "35", "--fstops", "2,2.8,4,5.6,8,11,16", "--focus", "1m,2m"], "f/16 near - far"),
+])
+def test_piped_tables_are_plain_and_complete(capsys, argv, whole):
+    assert main(argv) == 0  # captured: not a terminal
+    out = capsys.readouterr().out
+    assert whole in out
+    assert not set("┃│━┏┡└…") & set(out), "a piped table keeps no box drawing and no ellipsis"
