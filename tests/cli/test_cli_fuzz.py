@@ -39,7 +39,12 @@ BOUNDED = {("live", "record"): ["--duration=0.3"], ("live", "send"): ["--duratio
 BASE_ARGV = {
     ("export", "rib"): ["-o", "out.rib", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--force"],
     ("export", "pbrt"): ["-o", "pbrt_out", "--lens", "dgauss_50mm", "--focus", "3m", "--force"],
+    ("dof-table",): ["--focal", "35", "--fstops", "2.8,4"],
+    ("compare", "lenses"): ["--rays", "2000"],
 }
+#: what a focus option is given: distances, the focus words and lists of them
+FOCUS_VALUES = NUMBERS + ["hyperfocal", "infinity", "Hyperfocal", "1m,hyperfocal,inf", "2m,", ",", "9' 10 1/8\"",
+                          "1/0\""]
 NAN_OR_INF = re.compile(r"(?<![A-Za-z_])(nan|NaN|inf|Infinity)(?![A-Za-z_])")
 
 
@@ -67,7 +72,9 @@ def _value_strategy(action):
     if dest in ("sensor",):
         return st.sampled_from(["FF", "ALEXA 35", "ALEXA", "", "nope", "S35"])
     if dest in ("coc",):
-        return st.sampled_from(["cine", "d/1500", "0.025", "0", "-1", "nan", "abc", ""])
+        return st.sampled_from(["cine", "d/1500", "0.025", "0", "-1", "nan", "abc", "", "25um", "1e300um"])
+    if dest in ("focus", "focus_to", "at", "across_focus"):
+        return st.sampled_from(FOCUS_VALUES)
     return st.sampled_from(NUMBERS)
 
 

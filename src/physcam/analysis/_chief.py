@@ -331,7 +331,12 @@ def widest_passing_deg(passes, good_deg: float, bad_deg: float, *, tol_deg: floa
     its own test (a chief ray at every wavelength, light through the lens), and say so in a note
     (:func:`clamp_note`).
     """
-    lo, hi = float(good_deg), float(bad_deg)
+    from ..errors import require_finite, require_positive
+
+    if not callable(passes):
+        raise InputError(f"passes must be a function of the field angle, got {type(passes).__name__}")
+    lo, hi = require_finite("good field", good_deg), require_finite("bad field", bad_deg)
+    tol_deg = require_positive("tolerance", tol_deg, unit="deg")
     while hi - lo > tol_deg:
         mid = 0.5 * (lo + hi)
         if passes(mid):
@@ -343,5 +348,10 @@ def widest_passing_deg(passes, good_deg: float, bad_deg: float, *, tol_deg: floa
 
 def clamp_note(axis: str, what: str, top_deg: float, asked_deg: float) -> str:
     """The note an analysis adds when it clamps its default field range to what the lens images."""
+    from ..errors import require_finite
+
+    if axis not in ("x", "y") or not isinstance(what, str):
+        raise InputError(f"clamp_note takes a meridian 'x' or 'y' and a text, got {axis!r}, {what!r}")
+    top_deg, asked_deg = require_finite("field", top_deg), require_finite("field", asked_deg)
     return (f"{axis.upper()} meridian: {what} pass only up to {top_deg:.2f} deg (the default range reaches "
             f"{asked_deg:.2f} deg, the sensor corner): fields clamped to {top_deg:.2f} deg")

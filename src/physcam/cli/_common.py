@@ -142,8 +142,14 @@ def resolve_focus(value, *, lens=None, focal_length_mm=None, fstop=None, sensor=
         raise InputError("--focus hyperfocal needs a lens or a focal length")
     if sensor is None:
         sensor = resolve_sensor(args)
-    r = solve_lens_report(focal_length_mm=None if lens is not None else focal_length_mm, lens=lens, sensor=sensor,
-                          fstop=fstop, focus_mm=HYPERFOCAL, coc=coc if coc is not None else coc_of(args))
+    import warnings
+
+    from ..errors import PhysCamWarning
+
+    with warnings.catch_warnings():  # the command's own work warns where it matters, once
+        warnings.simplefilter("ignore", PhysCamWarning)
+        r = solve_lens_report(focal_length_mm=None if lens is not None else focal_length_mm, lens=lens, sensor=sensor,
+                              fstop=fstop, focus_mm=HYPERFOCAL, coc=coc if coc is not None else coc_of(args))
     from ..units import format_distance
 
     note(f"hyperfocal focus: {format_distance(r.focus_from_film_mm, units_of(args))} from the film at f/{r.fstop:.3g}, "

@@ -185,16 +185,26 @@ def _register_lenses(s) -> None:
 
 def measure_lens(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays, units="m"):
     """Everything ``physcam compare`` shows of one lens, as a flat dict (lengths mm, angles degrees),
-    with the curves for the figure under ``_curves``."""
+    with the curves for the figure under ``_curves``; the warnings of its analyses become its notes."""
     import warnings
 
+    from ..errors import PhysCamWarning
+
+    with warnings.catch_warnings(record=True) as caught:  # warnings become this lens's notes
+        warnings.simplefilter("always", PhysCamWarning)
+        out = _measure(lens, focus_mm=focus_mm, fstop=fstop, sensor=sensor, coc=coc, light_mm=light_mm, rays=rays)
+    out["notes"] += list(dict.fromkeys(str(w.message) for w in caught if issubclass(w.category, PhysCamWarning)))
+    return out
+
+
+def _measure(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays):
     import numpy as np
 
     from ..analysis.blob import equivalent_diameter
     from ..analysis.bokeh import bokeh_image
     from ..analysis.distortion import real_distortion
     from ..analysis.illumination import relative_illumination
-    from ..errors import PhysCamError, PhysCamWarning
+    from ..errors import PhysCamError
     from ..onset.report import solve_lens_report
     from ..optics import focusing, paraxial
     from ._common import resolve_focus
@@ -208,10 +218,7 @@ def measure_lens(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays, units="m
         notes.append(f"opens only to f/{wide:.3g}: compared wide open (asked f/{fstop:g})")
         n = wide
     mark = resolve_focus(focus_mm, lens=lens, fstop=n, sensor=sensor, coc=coc)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", PhysCamWarning)
-        r = solve_lens_report(focal_length_mm=None, lens=lens, sensor=sensor, fstop=n, focus_mm=mark, coc=coc)
-    notes += [str(w.message) for w in caught if issubclass(w.category, PhysCamWarning)]
+    r = solve_lens_report(focal_length_mm=None, lens=lens, sensor=sensor, fstop=n, focus_mm=mark, coc=coc)
     d = r.to_dict()
     real = d["fov_deg"]["real"] or {}
     out = {
