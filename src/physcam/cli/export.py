@@ -477,10 +477,7 @@ def run_pbrt(args) -> int:
         if landed is None:
             print("  pbrt's film lies inside the focal length: its plane of focus is beyond infinity")
         else:
-            from ._common import units_of
-
-            print(f"  pbrt's plane of focus lands {_mark(landed, units_of(args))} from the film "
-                  f"({c['focus_shift_mm']:+.3f} mm); "
+            print(f"  pbrt's plane of focus lands {landed / 1000.0:.6f} m from the film ({c['focus_shift_mm']:+.3f} mm); "
                   f"near limit {_shift(c['near_shift_mm'])}, far limit {_shift(c['far_shift_mm'])}")
         if c["unit_focus_film_distance_mm"] is not None:
             print(f"  given this lens at its infinity gaps pbrt would extend it instead: film "
