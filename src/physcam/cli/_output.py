@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 __all__ = ["document", "emit_json", "schema_file", "SCHEMA_DIR", "Table", "print_table", "print_csv",
-           "csv_text", "add_output_options", "LENGTH_UNITS"]
+           "csv_text", "add_output_options", "LENGTH_UNITS", "save_plot"]
 
 SCHEMA_DIR = Path(__file__).resolve().parent / "schemas"
 #: The units most documents use: lengths in mm, angles in degrees.
@@ -169,3 +169,16 @@ def csv_text(rows, columns=None) -> str:
 def print_csv(rows, columns=None) -> None:
     """Write :func:`csv_text` to stdout."""
     sys.stdout.write(csv_text(rows, columns))
+
+
+# ---- plots ------------------------------------------------------------------------------------
+def save_plot(result, path, *, force: bool = False, context: str = ""):
+    """Save an analysis result's figure (``result.plot(None)``) with ``context`` (the shot: f-stop,
+    focus, sensor) as a line under it, so a plot says what it is of."""
+    from ..figures import save_figure
+
+    fig = result.plot(None)
+    if context:
+        fig.text(0.5, 0.01, context, ha="center", va="bottom", fontsize=7, color="0.3")
+        fig.tight_layout(rect=(0.0, 0.05, 1.0, 1.0))
+    return save_figure(fig, path, force=force)

@@ -116,7 +116,9 @@ def _finish(args, res, command: str) -> None:
     """The plot (-o), then JSON, CSV or the notes and the written file for people."""
     name, rows = DOCS[command]
     if args.output:
-        res.plot(args.output, force=args.force)
+        from ._output import save_plot
+
+        save_plot(res, args.output, force=args.force, context=plot_context(args))
     d = mark_repaired(res.to_dict(), args.loaded_lens)
     if getattr(args, "sensor_name", None):
         d["sensor"] = args.sensor_name
@@ -129,6 +131,22 @@ def _finish(args, res, command: str) -> None:
         print(f"note: {n}")
     if args.output:
         print(f"wrote {args.output}")
+
+
+def plot_context(args) -> str:
+    """What a plot is of, for its footer: f-stop, focus, sensor (those the command was given)."""
+    from ..units import format_distance
+    from ._common import units_of
+
+    parts = []
+    if getattr(args, "fstop", None):
+        parts.append(f"f/{args.fstop:g}")
+    focus = getattr(args, "focus", None)
+    if isinstance(focus, float):
+        parts.append(f"focus {format_distance(focus, units_of(args))}")
+    if getattr(args, "sensor_name", None):
+        parts.append(f"{args.sensor_name} ({args.sensor_width:g} x {args.sensor_height:g} mm)")
+    return ", ".join(parts)
 
 
 def _csv(args, res, command: str) -> bool:

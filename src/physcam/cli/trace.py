@@ -67,7 +67,10 @@ def run_spot(args) -> int:
     res = spot_diagram(lens, tuple(args.field or (0.0, 5.0)), wavelength_nm=args.wavelength, rings=args.rings,
                        fstop=args.fstop, clip=args.clip)
     if args.output:
-        res.plot(args.output, force=args.force)
+        from ._output import save_plot
+
+        save_plot(res, args.output, force=args.force,
+                  context=(f"f/{args.fstop:g}" if args.fstop else "wide open") + ", focused at infinity")
     if args.json:
         emit_json(document("spot", mark_repaired(res.to_dict(), lens), units=dict(WAVE_UNITS, spot="um")))
     elif args.csv:
@@ -121,7 +124,15 @@ def run_bokeh(args) -> int:
                           pixels=args.pixels, spectral=args.spectral, stop_semi_diameter=stop, aperture=aperture,
                           chunk=min(args.rays, 250_000) if args.rays >= 1000 else 1000, progress=bar)
     if args.output:
-        res.plot(args.output, force=args.force)
+        from ..units import format_distance
+        from ._common import units_of
+        from ._output import save_plot
+
+        u = units_of(args)
+        save_plot(res, args.output, force=args.force,
+                  context=f"light at {format_distance(args.depth, u)}, focus "
+                          f"{format_distance(math.inf if args.focus is None else args.focus, u)}, "
+                          + (f"f/{args.fstop:g}" if args.fstop else "wide open"))
     if args.json:
         d = res.to_dict()
         d.update(light_from_film_mm=args.depth, focus_from_film_mm=None if args.focus in (None, math.inf) else args.focus,
