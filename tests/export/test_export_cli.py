@@ -20,7 +20,8 @@ def run(capsys, *argv):
 
 
 def test_opencv_json_and_table(capsys):
-    rc, out, _ = run(capsys, "export", "opencv", "dgauss_50mm", "--width-px", "4096", "--height-px", "2731", "--json")
+    rc, out, _ = run(capsys, "export", "opencv", "dgauss_50mm", "--sensor", "FF", "--width-px", "4096", "--height-px",
+                     "2731", "--json")
     assert rc == 0
     d = json.loads(out)
     cam = fit_opencv_pinhole(load_lens("dgauss_50mm"), 36.0, 24.0, 4096, 2731)
@@ -44,7 +45,8 @@ def test_unreal_writes_a_lens_file(capsys, tmp_path):
     rc, _, err = run(capsys, *argv)  # exists: refused, one line
     assert rc == 2 and err.startswith("physcam: error:") and err.count("\n") == 1
     rc, out, _ = run(capsys, *argv, "--force", "--json")
-    assert rc == 0 and json.loads(out)["metadata"]["type"] == "LensFile"
+    doc = json.loads(out)
+    assert rc == 0 and doc["schema"] == "physcam.export_unreal" and doc["lens_file"]["metadata"]["type"] == "LensFile"
 
 
 @pytest.mark.parametrize("extra", [["--width-px", "0", "--height-px", "100"],

@@ -15,7 +15,7 @@ examples:
   physcam report --focal 35 --fstop 4 --focus hyperfocal --units ft
   physcam report --focal 35 --focus 10ft --near 8ft --coc 0.025 --tstop 2.8   (solve f-stop)
   physcam report --focal 50 --near 2.5m --far 4m --fstop 4 --sensor S35         (solve focus)
-  physcam report --model technical --focal 50 --fstop 2 --focus 2m --h1 51.2 --h2 51.3 --pupil 60
+  physcam report --model technical --focal 50.36 --fstop 2 --focus 2m --h1 46.24 --h2 51.69 --pupil 49.53
   physcam report --lens dgauss_50mm --fstop 2.8 --focus 2m                     (planes from the lens)
 """
 
