@@ -314,6 +314,20 @@ def field_for_image_height(st: Setup, height_mm: float, wavelength_nm: float) ->
     return math.degrees(math.atan2(-y_obj, st.z_ep - st.object_z))
 
 
+def image_circle_radius(st: Setup, wavelength_nm: float, outside_mm: float, tol_mm: float = 0.05) -> float:
+    """Largest image height (mm, below ``outside_mm``, which has no chief ray) whose chief ray
+    passes out of the lens (:func:`field_for_image_height`), by bisection to ``tol_mm``."""
+    lo, hi = 0.0, float(outside_mm)
+    while hi - lo > tol_mm:
+        mid = 0.5 * (lo + hi)
+        try:
+            field_for_image_height(st, mid, wavelength_nm)
+            lo = mid
+        except OpticsError:
+            hi = mid
+    return lo
+
+
 def _starts(st: Setup, fl: Field, n_object: float, gx: np.ndarray, gy: np.ndarray):
     """Start points, directions and starting optical paths of rays aimed at (gx, gy) on the entrance-pupil plane."""
     from ._chief import start_plane_z

@@ -130,7 +130,9 @@ def fields_pupils(lens, fields_deg, *, wavelengths_nm=None, weights=None, fstop=
     todo = list(range(len(angles)))
     for _ in range(6):
         jobs = [(per_wl[w][i], ns[i], boxes[i]) for i in todo for w in range(len(wls))]
-        traces = P.trace_pupils(st, jobs, tracer)
+        traces = []
+        for chunk in _chunks(jobs, lambda job: job[1] ** 2, RAYS_PER_BATCH):  # bounded memory per batch
+            traces += P.trace_pupils(st, chunk, tracer)
         again = []
         for k, i in enumerate(todo):
             fp = FieldPupils(st, per_wl[0][i], [per_wl[w][i] for w in range(len(wls))],
@@ -153,6 +155,24 @@ def fields_pupils(lens, fields_deg, *, wavelengths_nm=None, weights=None, fstop=
             return result
         todo = again
     raise OpticsError("could not find a pupil sampling that meets the sampling rules")  # pragma: no cover
+
+
+#: Cell-centre rays traced in one batch at most (bounds the memory of a chart with fine grids).
+RAYS_PER_BATCH = 1_500_000
+
+
+def _chunks(items, size, budget):
+    """Consecutive runs of ``items`` whose ``size`` sums stay within ``budget`` (at least one item each)."""
+    run, total = [], 0
+    for it in items:
+        s = size(it)
+        if run and total + s > budget:
+            yield run
+            run, total = [], 0
+        run.append(it)
+        total += s
+    if run:
+        yield run
 
 
 def field_pupils(lens, field_deg, **kwargs) -> FieldPupils:

@@ -513,22 +513,40 @@ def mtf_chart(
     if (hs < 0).any() or (hs > 500).any():
         raise InputError("image heights must lie between 0 and 500 mm from the centre")
     wls, wts = _sampling.wavelengths_and_weights(lens, wavelengths_nm, weights)
+    cap = _sampling.pupil_samples_arg(max_pupil_samples)
+    n_user = _sampling.pupil_samples_arg(pupil_samples)
+    if n_user is not None and cap is not None and n_user > cap:
+        raise InputError(f"pupil_samples {n_user} exceeds the chart's max_pupil_samples {cap}")
     st = P.setup(lens, fstop=fstop, focus_mm=focus_mm, aperture=aperture, backend=backend)
     fmin = float(freqs[freqs > 0].min()) if (freqs > 0).any() else None
-    angles = np.array([P.field_for_image_height(st, float(h), wls[0]) for h in hs])
+    angles = np.zeros(hs.size)
+    for i, h in enumerate(hs):
+        try:
+            angles[i] = P.field_for_image_height(st, float(h), wls[0])
+        except OpticsError as exc:
+            edge = P.image_circle_radius(st, wls[0], float(h))
+            raise OpticsError(f"{exc}; the image circle ends near {edge:.1f} mm: chart up to there "
+                              f"(max_image_height_mm, --max-height)") from None
     if progress is not None:
         progress(0, hs.size)
-    fps = _sampling.fields_pupils(lens, angles, wavelengths_nm=wls, weights=wts, pupil_samples=pupil_samples,
-                                  min_frequency=fmin, waves_per_cell=_sampling.WAVES_PER_CELL_MTF, st=st,
-                                  max_pupil_samples=max_pupil_samples)
     sag = np.zeros((hs.size, freqs.size))
     tan = np.zeros((hs.size, freqs.size))
-    ns = np.array([fp.n for fp in fps])
-    for i in range(len(fps)):
-        tan[i] = np.abs(_otf(fps[i], freqs, 0, 0.0))
-        sag[i] = np.abs(_otf(fps[i], freqs, 1, 0.0))
-        fps[i] = None  # its sub-cell arrays are large: free them before the next field's
-        if progress is not None:
-            progress(i + 1, hs.size)
+    ns = np.zeros(hs.size, dtype=int)
+    n_guess = pupil_samples if isinstance(pupil_samples, (int, np.integer)) and pupil_samples > 0 else 64
+    per_field = n_guess ** 2 * len(wls)
+    done = 0
+    # fields in runs that fit one tracing batch; each run's pupils are freed before the next
+    for run in _sampling._chunks(list(range(hs.size)), lambda i: per_field, _sampling.RAYS_PER_BATCH):
+        fps = _sampling.fields_pupils(lens, angles[run], wavelengths_nm=wls, weights=wts, pupil_samples=pupil_samples,
+                                      min_frequency=fmin, waves_per_cell=_sampling.WAVES_PER_CELL_MTF, st=st,
+                                      max_pupil_samples=max_pupil_samples)
+        for k, i in enumerate(run):
+            tan[i] = np.abs(_otf(fps[k], freqs, 0, 0.0))
+            sag[i] = np.abs(_otf(fps[k], freqs, 1, 0.0))
+            ns[i] = fps[k].n
+            fps[k] = None  # its sub-cell arrays are large: free them before the next field's
+            done += 1
+            if progress is not None:
+                progress(done, hs.size)
     return MTFChart(st.lens_name, st.fstop, st.focus_from_film_mm, tuple(wls), tuple(wts),
                     tuple(float(f) for f in freqs), hs, angles, np.clip(sag, 0, 1), np.clip(tan, 0, 1), ns)

@@ -54,7 +54,8 @@ def register(sub) -> None:
     p.add_argument("--field", type=number("field angle"), default=None, metavar="DEG",
                    help="report one field angle (degrees, Y meridian) instead of the chart")
     p.add_argument("--pupil-samples", type=int, default=None, metavar="N",
-                   help=f"pupil grid cells across (16-{CLI_MAX_PUPIL_SAMPLES}; default chosen by the sampling rules)")
+                   help=f"pupil grid cells across (16-{CHART_MAX_PUPIL_SAMPLES} for the chart, to {CLI_MAX_PUPIL_SAMPLES} "
+                        "with --field; default chosen by the sampling rules)")
     p.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (default full frame 36x24)')
     p.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="MM",
                    help="sensor width with --sensor-height (instead of --sensor)")
@@ -104,7 +105,7 @@ def run(args) -> int:
     with progress_bar("MTF chart", enabled=not args.json) as bar:
         chart = mtf_chart(lens, max_image_height_mm=top, n_fields=args.fields, frequencies=freqs, wavelengths_nm=wls,
                           weights=weights, fstop=args.fstop, focus_mm=focus, pupil_samples=args.pupil_samples,
-                          max_pupil_samples=max(CHART_MAX_PUPIL_SAMPLES, args.pupil_samples or 0), progress=bar)
+                          max_pupil_samples=CHART_MAX_PUPIL_SAMPLES, progress=bar)
     if args.output:
         chart.plot(args.output, force=args.force)
     if args.json:
