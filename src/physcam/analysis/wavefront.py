@@ -106,6 +106,7 @@ class WavefrontMap:
     chief_image_height_mm: float = 0.0
     reference_radius_mm: float = 0.0
     lit_fraction: float = 1.0  # lit pupil area over the paraxial entrance pupil's
+    cell: float = 0.0  # side of a pupil grid cell, normalised (edge samples stand for a quarter of it)
 
     @property
     def strehl_marechal(self) -> float:
@@ -133,13 +134,20 @@ class WavefrontMap:
         from ._plot import figure, save
 
         fig, ax = figure(5.2, 4.4)
+        lim = 1.05 * max(1.0, float(np.abs(self.x).max()), float(np.abs(self.y).max()))
+        ax.set_xlim(-lim, lim)
+        ax.set_ylim(-lim, lim)
+        ax.set_aspect("equal")
+        fig.tight_layout()
+        # square markers one cell (a quarter cell at the edge) across, in points
+        pts_per_unit = ax.get_window_extent().width / fig.dpi * 72.0 / (2 * lim)
         big = self.weight >= self.weight.max() * 0.99
-        sc = ax.scatter(self.x[big], self.y[big], c=self.opd_waves[big], s=6, marker="s", cmap="RdBu_r", lw=0)
-        ax.scatter(self.x[~big], self.y[~big], c=self.opd_waves[~big], s=1.5, marker="s", cmap="RdBu_r", lw=0,
-                   vmin=sc.get_clim()[0], vmax=sc.get_clim()[1])
+        lo, hi = float(self.opd_waves.min()), float(self.opd_waves.max())
+        for sel, side in ((big, self.cell), (~big, self.cell / 4)):
+            sc = ax.scatter(self.x[sel], self.y[sel], c=self.opd_waves[sel], s=(1.15 * side * pts_per_unit) ** 2,
+                            marker="s", cmap="RdBu_r", lw=0, vmin=lo, vmax=hi)
         t = np.linspace(0, 2 * np.pi, 200)
         ax.plot(np.cos(t), np.sin(t), color="0.6", lw=0.6, ls=":")
-        ax.set_aspect("equal")
         ax.set_xlabel("pupil x (normalised)")
         ax.set_ylabel("pupil y (normalised)")
         fig.colorbar(sc, ax=ax, label="OPD (waves)")
@@ -216,4 +224,4 @@ def wavefront(
     lit = float((pt.weight * pt.rays.amplitude).sum() * pt.cell_mm ** 2 / (math.pi * st.r_ep ** 2))
     return WavefrontMap(st.lens_name, fp.field.field_deg, pt.wavelength_nm, st.fstop, st.focus_from_film_mm,
                         st.film_z + dz, dz, pt.n, x, y, w, wgt, rms, pv, rms_c, zernike_fit(x, y, w, wgt, terms),
-                        ws.chief_film_xy[1], ws.radius_mm, lit)
+                        ws.chief_film_xy[1], ws.radius_mm, lit, pt.cell_mm / st.r_ep)
