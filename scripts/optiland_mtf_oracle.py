@@ -74,7 +74,8 @@ def build(fstop: float, fields=FIELDS, wavelengths_um=(WAVELENGTH_UM,)):
     efl = float(op.paraxial.f2())
     op.set_aperture(aperture_type="EPD", value=efl / fstop)
     op.image_solve()
-    # the stop's own rim at this f-stop: the paraxial stop radius
+    # iterative aiming maps the unit pupil onto the stop radius the EPD sets; the file's f/2 rim on the
+    # stop is removed so it can neither clip nor differ from it
     stop = next(s for s in op.surfaces if getattr(s, "is_stop", False))
     stop.aperture = None
     op.ray_tracer.set_aiming("iterative")
