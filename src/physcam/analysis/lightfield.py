@@ -53,7 +53,7 @@ from ..trace.microlens import PlenopticCamera, subimage_centres, trace_from_sens
 from ..trace.rays import OK, RayBatch
 
 __all__ = ["LightField", "render_point", "render_plane", "render_planes", "subaperture_views", "refocus", "view_disparity",
-           "checkerboard", "light_field_figure"]
+           "view_mask", "checkerboard", "light_field_figure"]
 
 #: rays per traced chunk (bounds the memory of a render)
 CHUNK = 1 << 18
@@ -317,24 +317,46 @@ def subaperture_views(camera, raw, *, centres=None) -> np.ndarray:
     return views
 
 
-def refocus(views, slope: float, *, aperture: float | None = None) -> np.ndarray:
+def view_mask(camera) -> np.ndarray:
+    """(n, n) booleans: the sub-aperture views whose pixel (with its bilinear neighbours) lies wholly
+    inside every sub-image, the exit pupil's image of diameter XP b / D (paraxial, at the camera's
+    stop). Views outside it mix in the neighbouring lenslet's sub-image or see no pupil at all."""
+    from ..optics.paraxial import gaussian
+
+    cam = _camera(camera)
+    g = gaussian(cam.main, film_z=cam.z_array)
+    stop = cam.main.surfaces[cam.main.stop_index].semi_diameter
+    xp = g.exit_pupil_diameter * cam.stop_semi_diameter / stop
+    D = cam.z_array - g.z_exit_pupil
+    if not D > 0:
+        raise OpticsError("the main lens's exit pupil lies behind the microlens array")
+    r_px = 0.5 * xp * cam.array.sensor_offset_mm / D / max(cam.pixel_size)
+    n = cam.pixels_per_lenslet
+    c = (n - 1) / 2.0
+    j, i = np.indices((n, n))
+    return np.hypot(i - c, j - c) + 1.0 <= r_px
+
+
+def refocus(views, slope: float, *, mask=None) -> np.ndarray:
     """Shift-and-add refocusing: the mean over views of view (i, j) sampled at (row + slope (j - c),
     column + slope (i - c)), c the central view (module notes). ``slope`` in lenslets per view step:
     :func:`view_disparity` of the distance to bring into focus (0 keeps the array's focus).
-    ``aperture`` (0..1] keeps only views within that fraction of the pupil radius."""
+    ``mask`` ((n, n) booleans, e.g. :func:`view_mask`) keeps only those views."""
     v = np.asarray(views, dtype=np.float64) if not isinstance(views, (str, bytes)) else None
     if v is None or v.ndim != 4 or v.shape[0] != v.shape[1] or v.shape[0] < 1:
         raise InputError("views must be an (n, n, rows, columns) array from subaperture_views")
     sl = require_finite("slope", slope)
     n = v.shape[0]
     c = (n - 1) / 2.0
-    lim = None if aperture is None else require_positive("aperture", aperture, unit="") * max(c, 0.5)
+    keep = np.ones((n, n), dtype=bool) if mask is None else np.asarray(mask)
+    if keep.shape != (n, n) or keep.dtype != bool or not keep.any():
+        raise InputError(f"mask must be an ({n}, {n}) array of booleans keeping at least one view")
     rows, cols = np.indices(v.shape[2:], dtype=np.float64)
     acc = np.zeros(v.shape[2:])
     used = 0
     for j in range(n):
         for i in range(n):
-            if lim is not None and math.hypot(i - c, j - c) > lim + 1e-9:
+            if not keep[j, i]:
                 continue
             acc += _bilinear(v[j, i], rows + sl * (j - c), cols + sl * (i - c))
             used += 1
@@ -370,6 +392,9 @@ def light_field_figure(field_, *, views_shown: int = 3, refocus_slopes=(), path=
     plt = pyplot()
     cam = lf.camera
     views = lf.views()
+    mask = view_mask(cam)
+    if not mask.any():
+        mask = None
     n = cam.pixels_per_lenslet
     c = (n - 1) // 2
     picks = sorted({int(round(c + (t - (k - 1) / 2.0) * (c / max((k - 1) / 2.0, 1.0) * 0.75))) for t in range(k)})
@@ -395,7 +420,7 @@ def light_field_figure(field_, *, views_shown: int = 3, refocus_slopes=(), path=
         axes[1, t].imshow(up(views[c, i]), cmap="gray", interpolation="nearest")
         axes[1, t].set_title(f"view {i - c:+d} px", fontsize=8)
     for t, (label, s) in enumerate(slopes):
-        axes[2, t].imshow(up(refocus(views, s)), cmap="gray", interpolation="nearest")
+        axes[2, t].imshow(up(refocus(views, s, mask=mask)), cmap="gray", interpolation="nearest")
         axes[2, t].set_title(str(label), fontsize=8)
     fig.suptitle(f"{cam.main.name}:\n{lf.subject} (upright, gamma 1/2)", fontsize=8)
     fig.tight_layout()
