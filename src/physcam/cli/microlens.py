@@ -167,7 +167,8 @@ def run_insert(args) -> int:
         raise InputError(f"lens {main.name!r} focuses internally: give --film-to-lens for its infinity gaps instead "
                          "of --focus (ISET keeps one set of gaps)")
     out = iset.with_microlens(main, lenslet, count_x=args.xdim, count_y=args.ydim, film_width_mm=args.film_width,
-                              film_height_mm=args.film_height, film_to_lens_mm=cam.film_to_lens_mm,
+                              film_height_mm=args.film_height,
+                              film_to_lens_mm=cam.film_to_lens_mm if args.film_to_lens is None else args.film_to_lens,
                               sensor_offset_mm=array.sensor_offset_mm, thin_focal_length_mm=args.microlens_focal)
     text = iset.dumps(out)
     atomic_write(args.output, text, force=args.force)

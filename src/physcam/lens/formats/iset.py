@@ -252,6 +252,9 @@ def with_microlens(main: Prescription, microlens: Prescription | None = None, *,
     for name, v in (("count_x", count_x), ("count_y", count_y)):
         if isinstance(v, bool) or not isinstance(v, int) or not 1 <= v <= 4096:
             raise InputError(f"{name} must be a whole number of lenslets from 1 to 4096, got {v!r}")
+    if count_x * count_y > 500_000:
+        raise InputError(f"{count_x} x {count_y} lenslets is more than physcam writes (500000: the file would "
+                         "pass the 10 MB lens file limit)")
     nums = {}
     for name, v in (("film width", film_width_mm), ("film height", film_height_mm),
                     ("film-to-lens distance", film_to_lens_mm)):
@@ -328,6 +331,8 @@ def microlens_of(p: Prescription) -> dict | None:
             or not all(isinstance(d, int) and not isinstance(d, bool) and 1 <= d <= 4096 for d in dims)):
         raise LensFileError(f"{where}: 'dimensions' must be two whole numbers of lenslets (1 to 4096), got {dims!r}")
     nx, ny = dims
+    if nx * ny > 500_000:
+        raise LensFileError(f"{where}: {nx} x {ny} lenslets is more than 500000")
     offsets = block.get("offsets")
     if offsets is None:
         offsets = [[0.0, 0.0]] * (nx * ny)
