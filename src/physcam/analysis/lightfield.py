@@ -82,13 +82,15 @@ def _z_of(camera: PlenopticCamera, distance_mm) -> float:
 
 @dataclass
 class LightField:
-    """A raw light-field image (``raw``: rows x columns, see module notes) and where it came from."""
+    """A raw light-field image (``raw``: rows x columns, see module notes) and where it came from;
+    ``rays_used`` counts the rays that reached the sensor (a point, traced forward) or met the
+    subject (planes, traced backward)."""
 
     camera: PlenopticCamera
     raw: np.ndarray
     subject: str
     rays_traced: int
-    rays_on_sensor: int
+    rays_used: int
     notes: list = field(default_factory=list)
 
     def views(self, centres=None) -> np.ndarray:
@@ -103,7 +105,7 @@ class LightField:
                 "resolution": list(c.resolution), "sensor_offset_mm": a.sensor_offset_mm,
                 "film_to_lens_mm": c.film_to_lens_mm,
                 "lenslet": a.lenslet.name if a.lenslet is not None else f"thin, f = {a.focal_length_mm:g} mm",
-                "rays_traced": self.rays_traced, "rays_on_sensor": self.rays_on_sensor,
+                "rays_traced": self.rays_traced, "rays_used": self.rays_used,
                 "total": float(self.raw.sum()), "notes": list(self.notes)}
 
 

@@ -231,7 +231,7 @@ def run_render(args) -> int:
             else:
                 field.raw += lf.raw
                 field.rays_traced += lf.rays_traced
-                field.rays_on_sensor += lf.rays_on_sensor
+                field.rays_used += lf.rays_used
             slopes.append((f"refocused at {d / 1000:g} m", view_disparity(cam, d)))
         if len(args.point) > 1:
             field.subject = "points at " + ", ".join(f"{d / 1000:g} m" for d in args.point) + " from the sensor"
@@ -253,7 +253,8 @@ def run_render(args) -> int:
     if args.json:
         print_json(data)
         return 0
-    print(f"{field.subject}: {data['rays_traced']} rays traced, {data['rays_on_sensor']} on the sensor "
+    used = "on the sensor" if args.point else "met the plane"
+    print(f"{field.subject}: {data['rays_traced']} rays traced, {data['rays_used']} {used} "
           f"({data['resolution'][0]} x {data['resolution'][1]} px, {n} per lenslet)")
     for lab, s in slopes:
         print(f"  {lab}: views shift {s:+.4f} lenslets per view step (closed form)")
