@@ -291,6 +291,12 @@ def refract_through_array(camera: PlenopticCamera, rays: RayBatch, *, reverse: b
         getattr(rays, name)[live] = getattr(sub, name)
     if sub.weight_sp is not None and rays.weight_sp is not None:
         rays.weight_sp[live] = sub.weight_sp
+    # end every ray on the array's far plane (a curved last surface ends short of it), so both
+    # directions judge the cell at the same two planes and a ray reverses exactly
+    sub_end = rays.take(live)
+    _propagate(sub_end, camera.z_array_front if reverse else camera.z_array)
+    for name in ("x", "y", "z", "flag"):
+        getattr(rays, name)[live] = getattr(sub_end, name)
     # opaque cell walls: a ray that left its cell inside the lenslet is clipped
     ok = rays.flag[live] == OK
     jx, jy, ins = a.index_at(rays.x[live], rays.y[live])
