@@ -49,7 +49,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from ..errors import ExportError, OpticsError, PhysCamError
+from ..errors import ExportError, OpticsError, PhysCamError, require_type
 from .grid import PSF_INFINITY_STANDIN_MM, Cell, Grid, focus_label
 
 __all__ = ["run_cell", "compute_cell", "INDEX_SCHEMA_FIELDS", "read_row", "cell_lock"]
@@ -162,6 +162,7 @@ def _illumination_cell(lens, grid: Grid, cell: Cell):
 
 def psf_light_position(lens, grid: Grid, cell: Cell):
     """(focus state, depth of the light from the film mm, light x, y mm in lens space, film target x, y mm)."""
+    _check(lens, grid, cell)
     from ..optics.focusing import focus
     from ..optics.paraxial import gaussian
 
@@ -214,10 +215,20 @@ def _json_bytes(doc) -> bytes:
     return (json.dumps(doc, indent=1, allow_nan=False) + "\n").encode()
 
 
+def _check(lens, grid, cell) -> None:
+    from ..lens.prescription import Prescription
+
+    require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name)")
+    require_type("grid", grid, Grid, "physcam.characterize.Grid")
+    require_type("cell", cell, Cell, "physcam.characterize.build_cells")
+
+
 def compute_cell(lens, grid: Grid, cell: Cell, dest: Path):
     """Compute one cell; returns (bytes of its result file, extra index columns).
 
     A ``distortion`` cell publishes its folder ``dest`` itself and returns its ``fits.json``."""
+    _check(lens, grid, cell)
+    require_type("dest", dest, Path, "the result's path")
     if cell.kind == "lens":
         return _lens_cell(lens, grid)
     if cell.kind == "distortion":
@@ -234,7 +245,7 @@ class cell_lock:
     """An exclusive ``flock`` on ``path`` (created if missing); the kernel drops it if the process dies."""
 
     def __init__(self, path: Path):
-        self.path = Path(path)
+        self.path = Path(require_type("lock path", path, (str, Path)))
         self.fd = None
 
     def __enter__(self):
@@ -255,9 +266,13 @@ class cell_lock:
 
 def read_row(path) -> dict:
     """One index row file as a dict."""
+    require_type("row file", path, (str, Path), "a .parquet path")
     import pyarrow.parquet as pq
 
-    return pq.read_table(path).to_pylist()[0]
+    try:
+        return pq.read_table(path).to_pylist()[0]
+    except (OSError, IndexError) as exc:
+        raise ExportError(f"cannot read the index row {path}: {exc}") from None
 
 
 def _row_bytes(row: dict) -> bytes:
@@ -279,6 +294,11 @@ def run_cell(lens_toml: str, lens_digest: str, cell: Cell, grid: Grid, root: str
     """
     from ..io import atomic_write
 
+    for name, v in (("lens TOML", lens_toml), ("lens hash", lens_digest), ("root", root), ("run id", run_id),
+                    ("version", version)):
+        require_type(name, v, str)
+    require_type("cell", cell, Cell, "physcam.characterize.build_cells")
+    require_type("grid", grid, Grid, "physcam.characterize.Grid")
     base = Path(root)
     row_path = base / cell.index_name
     if row_path.is_file():

@@ -38,7 +38,7 @@ import re
 from dataclasses import dataclass, replace
 from dataclasses import field as _dc_field
 
-from ..errors import InputError, require_type
+from ..errors import InputError, require_positive, require_type
 from ..units import parse_distance
 
 __all__ = [
@@ -214,12 +214,14 @@ class Grid:
 
 
 def focus_label(mark_mm: float) -> str:
-    """A focus mark as a file-name-safe label: ``inf``, ``0.5833m``."""
-    return "inf" if math.isinf(mark_mm) else f"{mark_mm / 1000.0:.4g}m"
+    """A focus mark as a file-name-safe label: ``infinity``, ``0.5833m``."""
+    mark_mm = float(require_type("focus mark", mark_mm, (int, float), "mm from the film plane"))
+    return "infinity" if math.isinf(mark_mm) else f"{mark_mm / 1000.0:.4g}m"
 
 
 def lens_slug(name: str) -> str:
     """A lens name as a folder name (letters, digits, ``.``, ``_``, ``-``)."""
+    require_type("lens name", name, str)
     s = re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._") or "lens"
     return s[:80]
 
@@ -227,13 +229,15 @@ def lens_slug(name: str) -> str:
 def lens_hash(lens) -> str:
     """SHA-256 of the lens's physcam TOML text (its surfaces, focus groups, glass, metadata)."""
     from ..lens.formats.physcam_toml import dumps
+    from ..lens.prescription import Prescription
 
+    require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name)")
     return hashlib.sha256(dumps(lens).encode()).hexdigest()
 
 
 def _json_num(v):
     if isinstance(v, float) and math.isinf(v):
-        return "inf"
+        return "infinity"
     return v
 
 
@@ -293,6 +297,11 @@ def _settings(kind: str, grid: Grid, design_nm: float) -> dict:
 
 def build_cells(lens_name: str, lens_digest: str, grid: Grid, design_wavelength_nm: float, version: str) -> list[Cell]:
     """Every cell of ``grid`` for one lens, each with its input hash (module notes)."""
+    require_type("lens name", lens_name, str)
+    require_type("lens hash", lens_digest, str)
+    require_type("grid", grid, Grid, "physcam.characterize.Grid")
+    require_type("version", version, str)
+    design_wavelength_nm = require_positive("design wavelength", design_wavelength_nm, unit="nm")
     wls = grid.wavelengths_nm or (float(design_wavelength_nm),)
     axes = {
         "lens": [dict()],

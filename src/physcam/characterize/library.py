@@ -10,7 +10,7 @@ proposal's "Interesting Looking Models" use case asks). The variant holds, on ``
   widest f-stop of the grid);
 * ``physcam:characterization:*`` arrays, one value per focus mark in the grid's order:
   ``focusDioptres`` (1000 / mark in mm, 0 = infinity: no infinite value is written) and
-  ``focusLabels``; from the ``lens`` cell: ``effectiveFocalLengths``, ``pinholeFocalLengths``,
+  ``focusLabels`` (``0.5m``, ``infinity``); from the ``lens`` cell: ``effectiveFocalLengths``, ``pinholeFocalLengths``,
   ``entrancePupilDistances``, ``exitPupilDistances`` (mm in front of the film plane),
   ``hfovRealDeg``, ``hfovParaxialDeg``, ``hfovChangeRealPct`` (breathing); from the ``distortion``
   cells at the wavelength nearest the lens's design wavelength: ``distortionK1``, ``distortionK2``
@@ -32,7 +32,7 @@ import time
 from pathlib import Path
 
 from .cells import cell_lock
-from .grid import PSF_INFINITY_STANDIN_MM
+from .grid import PSF_INFINITY_STANDIN_MM, focus_label
 
 __all__ = ["lens_usd_update", "lens_usd_path", "grid_hash"]
 
@@ -50,7 +50,11 @@ def grid_hash(cells) -> str:
     """SHA-256 of the sorted input hashes of ``cells`` (one lens's grid)."""
     from ..errors import require_type
 
+    from .grid import Cell
+
     require_type("cells", cells, (list, tuple), "the lens's cells")
+    for c in cells:
+        require_type("cell", c, Cell, "physcam.characterize.build_cells")
     return hashlib.sha256("\n".join(sorted(c.input_hash for c in cells)).encode()).hexdigest()
 
 
@@ -60,7 +64,7 @@ def _measured(rx, slug, cells, grid, out: Path, run_id: str, version: str, usd_f
         by_kind.setdefault(c.kind, []).append(c)
     marks = list(grid.focus_mm)
     m = {"focusDioptres": [0.0 if math.isinf(f) else 1000.0 / f for f in marks],
-         "focusLabels": [c for c in (("inf" if math.isinf(f) else f"{f / 1000:.4g}m") for f in marks)],
+         "focusLabels": [focus_label(f) for f in marks],
          "run": run_id, "date": time.strftime("%Y-%m-%d", time.gmtime()), "gridHash": grid_hash(cells),
          "physcamVersion": version, "indexFolder": os.path.relpath(out / "index", usd_file.parent),
          "sensorMm": list(grid.sensor_mm)}

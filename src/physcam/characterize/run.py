@@ -130,23 +130,31 @@ def _check_lens(lens: Prescription, grid: Grid) -> None:
 
 
 def _load_lenses(lenses):
+    """{slug: Prescription} from names, files, Prescriptions, or a dict name -> Prescription."""
     from ..lens.library import load_lens
 
     if isinstance(lenses, (str, Path, Prescription)):
         lenses = [lenses]
-    require_type("lenses", lenses, (list, tuple), "lens names, files or Prescriptions")
+    require_type("lenses", lenses, (list, tuple, dict), "lens names, files or Prescriptions")
     if not lenses:
         raise InputError("give at least one lens: the grid is empty")
+    items = list(lenses.items()) if isinstance(lenses, dict) else [(None, v) for v in lenses]
     out = {}
-    for item in lenses:
+    for key, item in items:
         if isinstance(item, Prescription):
             rx = item
-        elif isinstance(item, (str, Path)):
+        elif isinstance(item, (str, Path)) and key is None:
             rx = load_lens(item)
         else:
             raise WrongTypeError(f"a lens is a name, a file path or a Prescription, got {type(item).__name__}")
-        slug = lens_slug(Path(str(item)).stem if isinstance(item, Path) or (isinstance(item, str) and "/" in item)
-                         else (item if isinstance(item, str) else rx.name))
+        if key is not None:
+            require_type("lens name", key, str, "the lens's folder name")
+            name = key
+        elif isinstance(item, Path) or (isinstance(item, str) and ("/" in item or "\\" in item)):
+            name = Path(str(item)).stem
+        else:
+            name = item if isinstance(item, str) else rx.name
+        slug = lens_slug(name)
         if slug in out:
             raise InputError(f"lens {slug!r} is given twice")
         out[slug] = rx
@@ -299,7 +307,7 @@ def _compute(summary, plan, todo, grid, out, scheduler, workers, retries, connec
         for c in todo:
             toml, digest, _ = plan[c.lens]
             futures.append(client.submit(run_cell, toml, digest, c, grid, str(out.resolve()), summary.run_id,
-                                         version, key=f"physcam-cell-{c.input_hash}", retries=retries, pure=False))
+                                         version, key=f"physcam-{summary.run_id}-{c.input_hash[:24]}", retries=retries, pure=False))
         done = 0
         try:
             for fut in as_completed(futures, loop=client.loop):
