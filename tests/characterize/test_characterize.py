@@ -245,3 +245,41 @@ def test_cli_json_summary_on_an_existing_cluster(cluster, tmp_path, capsys):
     assert main(argv + ["--dry-run"]) == 0
     plan = json.loads(capsys.readouterr().out)
     assert plan["dry_run"] and plan["skipped"] == 3 and plan["computed"] == 0
+
+
+@pytest.mark.slow
+def test_a_local_cluster_by_default(tmp_path):
+    """No --scheduler: the job starts its own LocalCluster (here one worker) and closes it."""
+    s = characterize(["dgauss_50mm"], tiny(kinds=("illumination",)), tmp_path, workers=1, usd=False)
+    assert (s.computed, s.workers, s.failed) == (2, 1, [])
+    assert s.scheduler.startswith("tcp://127.0.0.1:") and s.dashboard.startswith("http")
+
+
+def test_a_lens_file_of_dated_variants_gains_a_run_and_keeps_them(tmp_path):
+    """add_characterization on a file written by write_lens_file: its date variants stay as they were."""
+    from physcam.usd.author import CameraSpec
+    from physcam.usd.kit import add_characterization, best_match_pinhole, read_characterizations, write_lens_file
+
+    def dated(file):  # every authored value of /Lens and its children with the dated variant selected
+        from pxr import Sdf, Usd
+
+        stage = Usd.Stage.Open(Sdf.Layer.OpenAsAnonymous(str(file)))
+        stage.GetPrimAtPath("/Lens").GetVariantSets().GetVariantSet("characterization").SetVariantSelection(
+            "d2026_03_01")
+        return {str(a.GetPath()): a.Get() for p in stage.Traverse() for a in p.GetAttributes() if a.HasAuthoredValue()}
+
+    f = write_lens_file(tmp_path / "lens.usda", {"2026-03-01": CameraSpec(focal_length_mm=24.0, fstop=2.0)})
+    before = dated(f)
+    assert before["/Lens.lens:main:fStop"] == pytest.approx(2.0)
+    spec, _ = best_match_pinhole(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_width_mm=36.0,
+                                 sensor_height_mm=24.0)
+    add_characterization(f, "run_x", spec, {"focusDioptres": [0.5], "focusLabels": ["2m"], "run": "run_x"})
+    got = read_characterizations(f)
+    assert got["current_is"] == "run_x" and got["selection"] == "current"
+    assert got["variants"]["current"] == got["variants"]["run_x"] == {"focusDioptres": [0.5], "focusLabels": ["2m"],
+                                                                        "run": "run_x"}
+    assert dated(f) == before  # the dated variant unchanged
+    with pytest.raises(ExportError, match="already has"):
+        add_characterization(f, "run_x", spec, {"run": "again"})
+    with pytest.raises(InputError, match="not 'current'"):
+        add_characterization(f, "current", spec, {})

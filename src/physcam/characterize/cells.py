@@ -30,8 +30,10 @@ What each kind computes (lengths mm from the film plane, docs/conventions.md):
   sensor corner.
 * ``psf``: :func:`physcam.analysis.bokeh.bokeh_image` of a point light at the focus distance (a
   point 1 km away stands for infinity), placed so that the best-match pinhole at that focus images
-  it at the field fraction of the way from the centre to the top-right corner of the upright
-  picture; the kernel (normalised to sum 1) with its extent on the film in an NPZ.
+  it at the film point (k w/2, k h/2), k the field fraction (lens-space film coordinates: the upright
+  picture is the film turned by 180 degrees, so this is toward the picture's bottom-left corner);
+  the kernel (normalised to sum 1) with its extent on the film in an NPZ. The real image lies
+  off that point by the lens's distortion: the kernel's centroid says where.
 """
 
 from __future__ import annotations
@@ -202,7 +204,7 @@ def _psf_cell(lens, grid: Grid, cell: Cell):
             "light_xy_mm": [x, y], "wavelength_nm": cell.wavelength_nm, "extent_mm": list(img.extent_mm),
             "centroid_mm": d["centroid_mm"], "rays_traced": img.rays_traced, "rays_passed": img.rays_passed,
             "kernel": "rows bottom to top (film y up), columns film x; sums to 1",
-            "film": "film coordinates: the image of the top-right of the picture lies at -x, -y"}
+            "film": "lens-space film coordinates x, y (mm); the upright picture is the film turned by 180 degrees"}
     buf = io.BytesIO()
     np.savez_compressed(buf, kernel=(e / total).astype(np.float32), extent_mm=np.asarray(img.extent_mm),
                         relative_flux=np.asarray(total * (img.extent_mm[1] - img.extent_mm[0])
