@@ -282,3 +282,21 @@ def test_a_fisheye_on_a_large_sensor_is_refused_not_mapped():
     with pytest.raises(PhysCamError, match="fisheye"):
         distortion_field(load_lens("nikkor_fisheye_16mm_f2_8"), focus_mm=FOCUS, sensor_width_mm=36,
                          sensor_height_mm=24, width_px=512, height_px=342, maps=False)
+
+
+def test_opentrackio_entry_is_the_same_map_in_millimetres_y_down():
+    """OpenLensIO's reading (mm on the sensor, y down, for the pinhole F) of the U-D entry moves points
+    where the fitted model (normalised, y up) does."""
+    m = _brown(dict(k1=-0.12, k2=0.03, k3=-0.004, p1=0.002, p2=-0.001), direction="U-D", f=35.0)
+    e = m.opentrackio()
+    assert e["model"] == "Brown-Conrady U-D"
+    up = np.array([[6.0, 4.0], [-10.0, 7.5], [3.0, -9.0]])  # picture mm, y up
+    expect = m.formula(up)
+    x, y = up[:, 0], -up[:, 1]  # y down
+    r2 = x * x + y * y
+    k1, k2, k3 = e["radial"]
+    p1, p2 = e["tangential"]
+    radial = 1 + k1 * r2 + k2 * r2 ** 2 + k3 * r2 ** 3
+    xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
+    yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
+    assert np.column_stack([xd, -yd]) == pytest.approx(expect, abs=1e-12)

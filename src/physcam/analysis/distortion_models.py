@@ -61,9 +61,7 @@ __all__ = [
     "MODEL_CHOICES", "DEFAULT_MAX_RESIDUAL_PX",
 ]
 
-DEFAULT_MAX_RESIDUAL_PX = 0.5
-#: ``--fit`` names and what each fits.
-MODEL_CHOICES = ("brown", "3de4", "usd", "nuke")
+from .distortion_names import DEFAULT_MAX_RESIDUAL_PX, MODEL_CHOICES  # noqa: E402  (re-exported)
 
 
 @dataclass(frozen=True)
@@ -210,10 +208,9 @@ def _finish(fit: FittedDistortion, s: DistortionSamples) -> FittedDistortion:
     """Fill the residual of ``fit`` over the samples, in the model's own direction."""
     if fit.direction == "D-U":
         pred, target = fit.formula(s.distorted_mm), s.undistorted_mm
-        where = s.distorted_mm
     else:
         pred, target = fit.formula(s.undistorted_mm), s.distorted_mm
-        where = s.distorted_mm
+    where = s.distorted_mm  # the residual is drawn where the point is on the plate
     res = s.residual_px(pred, target)
     if not np.isfinite(res).all():
         raise OpticsError(f"the {fit.model} fit gives non-finite positions: no fit")
@@ -270,10 +267,23 @@ class BrownConrady(FittedDistortion):
         return np.stack([q[:, 0] + ax @ k, q[:, 1] + ay @ k], axis=1) * f
 
     def opentrackio(self) -> dict:
-        """The OpenTrackIO 1.0.1 ``lens.distortion`` entry."""
+        """The OpenTrackIO 1.0.1 ``lens.distortion`` entry, in OpenLensIO's units.
+
+        OpenLensIO (v1.0.1, sections 1.1 and 4.1; the lens model OpenTrackIO's distortion follows)
+        writes the polynomial on the sensor in millimetres from the centre, y down, for the pinhole
+        of focal length F (``pinholeFocalLength``, the Y pinhole here). With x_mm = F x and y down::
+
+            radial k_n / F^(2n) (n = 1, 2, 3),  tangential [-p1 / F, p2 / F]
+
+        (the p1 terms change sign with y). For an anamorphic lens (f_x != f_y) one F cannot carry
+        both meridians: the entry is then only the Y meridian's reading, as OpenTrackIO 1.0.1 has
+        no anamorphic distortion model.
+        """
         c = self.coefficients
-        return {"model": f"Brown-Conrady {self.direction}", "radial": [c["k1"], c["k2"], c["k3"]],
-                "tangential": [c["p1"], c["p2"]]}
+        f = c["fy_mm"]
+        return {"model": f"Brown-Conrady {self.direction}",
+                "radial": [c["k1"] / f ** 2, c["k2"] / f ** 4, c["k3"] / f ** 6],
+                "tangential": [-c["p1"] / f, c["p2"] / f]}
 
 
 def fit_brown_conrady(samples: DistortionSamples, direction: str = "D-U", *,

@@ -38,7 +38,7 @@ def _focus_list(text: str):
 
 def register(sub) -> None:
     from .analyze import _common, _resolution, _sensor
-    from ..analysis.distortion_models import DEFAULT_MAX_RESIDUAL_PX, MODEL_CHOICES
+    from ..analysis.distortion_names import DEFAULT_MAX_RESIDUAL_PX, MODEL_CHOICES
 
     p = sub.add_parser("distortion", help="real distortion: against field, ST-maps and fitted models at any focus")
     _common(p, "write the distortion plot (field-angle table; with --across-focus the table's plot)")
