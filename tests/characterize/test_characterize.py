@@ -283,3 +283,22 @@ def test_a_lens_file_of_dated_variants_gains_a_run_and_keeps_them(tmp_path):
         add_characterization(f, "run_x", spec, {"run": "again"})
     with pytest.raises(InputError, match="not 'current'"):
         add_characterization(f, "current", spec, {})
+
+
+@pytest.mark.slow
+def test_a_cell_the_optics_refuse_fails_alone(cluster, tmp_path, capsys):
+    """A fisheye has no pinhole ST-map (docs/distortion.md): its distortion cells fail with that reason,
+    the other cells finish, the lens gets no USD variant, and the command says so on one line (exit 2)."""
+    from physcam.cli import main
+
+    grid = tiny(kinds=("lens", "distortion"))
+    s = characterize(["nikkor_fisheye_16mm_f2_8"], grid, tmp_path, scheduler=cluster.scheduler_address)
+    assert [f["kind"] for f in s.failed] == ["distortion", "distortion"] and "fisheye" in s.failed[0]["error"]
+    assert s.computed == 1 and s.usd == [] and not (tmp_path / "nikkor_fisheye_16mm_f2_8" /
+                                                    "nikkor_fisheye_16mm_f2_8.usda").exists()
+    assert [r["kind"] for r in _index_rows(tmp_path)] == ["lens"]  # no failed cell counted as done
+    argv = ["characterize", "nikkor_fisheye_16mm_f2_8", "--focus", "1m,inf", "--kinds", "lens,distortion",
+            "--resolution", "64x43", "-o", str(tmp_path), "--scheduler", cluster.scheduler_address, "--json"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("physcam: error: 2 of 3 cells failed"), err
