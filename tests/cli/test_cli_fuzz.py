@@ -33,7 +33,9 @@ FILES = ["out.usda", "out.png", "out.svg", "out.txt", "", "missing_dir/out.usda"
 #: flags appended to every fuzzed run of a command (after the drawn ones, so they win): receivers and
 #: senders run for a bounded time instead of until Ctrl-C
 BOUNDED = {("live", "record"): ["--duration=0.3"], ("live", "send"): ["--duration=0.3"],
-           ("live", "play"): ["--duration=0.3"]}
+           ("live", "play"): ["--duration=0.3"],
+           # characterize only validates and plans: the fuzzer never starts a Dask cluster or traces a grid
+           ("characterize",): ["--dry-run"]}
 #: A valid command line some leaves start from, so that the fuzzed flags reach the handler instead of
 #: stopping at a missing required option (argparse keeps the last of a repeated option).
 BASE_ARGV = {
@@ -43,6 +45,7 @@ BASE_ARGV = {
                             "64", "--force"],
     ("microlens", "insert"): ["--microlens-focal", "0.5", "--xdim", "21", "--ydim", "21", "--film-width", "4.2",
                               "--film-height", "4.2", "--focus", "1m", "-o", "lf.json", "--force"],
+    ("characterize",): ["-o", "lib", "--focus", "2m"],
 }
 NAN_OR_INF = re.compile(r"(?<![A-Za-z_])(nan|NaN|inf|Infinity)(?![A-Za-z_])")
 
