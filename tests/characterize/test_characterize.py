@@ -298,7 +298,8 @@ def test_a_cell_the_optics_refuse_fails_alone(cluster, tmp_path, capsys):
                                                     "nikkor_fisheye_16mm_f2_8.usda").exists()
     assert [r["kind"] for r in _index_rows(tmp_path)] == ["lens"]  # no failed cell counted as done
     argv = ["characterize", "nikkor_fisheye_16mm_f2_8", "--focus", "1m,inf", "--kinds", "lens,distortion",
-            "--resolution", "64x43", "-o", str(tmp_path), "--scheduler", cluster.scheduler_address, "--json"]
+            "--resolution", "64x43", "--sensor", "FF", "-o", str(tmp_path), "--scheduler", cluster.scheduler_address,
+            "--json"]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("physcam: error: 2 of 3 cells failed"), err

@@ -14,7 +14,7 @@ pytestmark = pytest.mark.slow
 
 def test_vendor_chart_table_text_chart_and_png(tmp_path, capsys):
     out = tmp_path / "chart.png"
-    rc = main(["mtf", "dgauss_50mm", "--fstop", "4", "--focus", "3m", "-o", str(out)])
+    rc = main(["mtf", "dgauss_50mm", "--fstop", "4", "--focus", "3m", "--sensor", "FF", "-o", str(out)])
     text = capsys.readouterr().out
     assert rc == 0
     lines = text.splitlines()
@@ -48,7 +48,7 @@ def test_chart_json_and_a_named_sensor(capsys):
 def test_one_field_report(capsys):
     assert main(["mtf", "dgauss_50mm", "--fstop", "8", "--field", "14", "--wavelength", "587.5618", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert set(d) == {"wavefront", "psf", "mtf"}
+    assert set(d) == {"schema", "version", "units", "wavefront", "psf", "mtf"} and d["schema"] == "physcam.mtf_field"
     assert d["wavefront"]["field_deg"] == 14.0 and 0 < d["psf"]["strehl"] < 1
     assert d["wavefront"]["zernike_ordering"].startswith("Noll")
     assert main(["mtf", "dgauss_50mm", "--fstop", "8", "--field", "14"]) == 0

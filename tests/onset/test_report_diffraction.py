@@ -51,7 +51,7 @@ def test_thin_lens_airy_disk_against_coc_and_pitch():
 def test_film_gate_has_no_pitch_and_json_keeps_version_one_keys():
     r = solve_lens_report(focal_length_mm=35.0, fstop=2.8, focus_mm=2000.0, sensor=find_sensor("S35"))
     d = r.to_dict()
-    assert d["version"] == REPORT_VERSION == 2
+    assert d["version"] == REPORT_VERSION == 3  # 2: diffraction; 3: signed magnification, infinite focus
     assert d["sensor"]["photosite_pitch_mm"] is None
     assert d["diffraction"]["airy_in_photosites"] is None and d["diffraction"]["fstop_airy_exceeds_two_photosites"] is None
     for key in ("schema", "units", "dof", "fov_deg", "pinhole", "notes", "entrance_pupil_from_film_mm"):

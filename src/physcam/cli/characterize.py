@@ -9,7 +9,7 @@ Examples::
 
 from __future__ import annotations
 
-from ._common import print_json
+from ._output import add_output_options, document, emit_json
 
 
 def _whole(name: str, lo: int, hi: int):
@@ -75,7 +75,7 @@ def register(sub) -> None:
                    help="validate and print the plan (cells to make, cells already done); start no cluster, write "
                         "nothing")
     p.add_argument("--no-usd", action="store_true", help="do not add a characterization variant to the lens USD files")
-    p.add_argument("--json", action="store_true", help="print the run's summary as JSON")
+    add_output_options(p, what="the run's summary")
     p.set_defaults(handler=run_characterize)
 
 
@@ -130,7 +130,7 @@ def run_characterize(args) -> int:
                                usd=not args.no_usd, progress=bar, on_start=started)
     d = summary.to_dict()
     if args.json:
-        print_json(d)
+        emit_json(document("characterize", d))
     else:
         _print(summary, d)
     if summary.failed:

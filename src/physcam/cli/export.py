@@ -513,7 +513,8 @@ def _register_mitsuba(s) -> None:
     m.add_argument("--name", default="camera", help="file name stem of the two files (default camera)")
     m.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write <name>.xml and <name>.json into")
     m.add_argument("--force", action="store_true", help="overwrite existing files")
-    m.add_argument("--json", action="store_true", help="print what was written as JSON")
+    add_output_options(m, what="what was written")
+    add_units_option(m)
     m.set_defaults(handler=run_mitsuba)
 
 
@@ -535,17 +536,23 @@ def run_mitsuba(args) -> int:
     for path in (xml_path, json_path):
         check_writable(path, force=args.force)
     report = solve_from_args(args)
+    if report.focus_is_infinite:
+        raise InputError("a Mitsuba thinlens sensor's focus_distance is finite: give the focus mark (e.g. --focus "
+                         "1000m) or --focus hyperfocal")
     values = mitsuba_camera_values(report, width_px=args.width_px, meters_per_unit=args.meters_per_unit,
                                    spp=args.spp, shutter_angle_deg=args.shutter_angle, fps=args.fps,
                                    shift_mm=(args.shift_x, args.shift_y))
     atomic_write(xml_path, mitsuba_scene_xml(values), force=args.force)
     atomic_write(json_path, json.dumps(mitsuba_scene_dict(values), indent=2, allow_nan=False) + "\n", force=args.force)
     if args.json:
-        print_json({"xml": str(xml_path), "json": str(json_path), **values})
+        emit_json(document("export_mitsuba", {"xml": str(xml_path), "json": str(json_path), **values},
+                           units={"length": "mm", "angle": "degree", "sensor": "scene units of meters_per_unit m"}))
         return 0
+    from ._common import units_of
+
     sn, pc = values["sensor"], values["physcam"]
     print(f"wrote {xml_path} and {json_path}: Mitsuba 3 thinlens for {pc['lens'] or 'a thin lens'} "
-          f"({pc['focal_length_mm']:g} mm f/{pc['fstop']:g}) at {_mark(pc['focus_from_film_mm'])}")
+          f"({pc['focal_length_mm']:g} mm f/{pc['fstop']:g}) at {_mark(pc['focus_from_film_mm'], units_of(args))}")
     print(f"  fov {sn['fov']:.4f} deg (x; infinity focus would be {pc['hfov_infinity_deg']:.4f}), aperture_radius "
           f"{sn['aperture_radius']:.6g}, focus_distance {sn['focus_distance']:.6g} (scene units of "
           f"{pc['meters_per_unit']:g} m), film {sn['film']['width']} x {sn['film']['height']} px")

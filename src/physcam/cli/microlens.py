@@ -4,7 +4,8 @@ field, sub-aperture views and refocused pictures (docs/microlens.md)."""
 
 from __future__ import annotations
 
-from ._common import distance, number, print_json
+from ._common import add_units_option, distance, focus, number
+from ._output import add_output_options, document, emit_json
 
 EPILOG = """\
 examples:
@@ -64,14 +65,15 @@ def register(sub) -> None:
     i.add_argument("--film-to-lens", type=distance("film-to-lens distance"), default=None, metavar="MM",
                    help="main lens rear vertex to the film (sensor) (lenstool's --filmtolens; default 50 mm "
                         "unless --focus)")
-    i.add_argument("--focus", type=distance("focus distance"), default=None, metavar="D",
+    i.add_argument("--focus", type=focus("focus distance", allow_inf=False), default=None, metavar="D",
                    help="instead of --film-to-lens: focus the main lens so a subject D in front of the sensor is "
                         "sharp on the array")
     i.add_argument("--sensor-offset", type=distance("sensor offset"), default=None, metavar="MM",
                    help="lenslet rear vertex to the sensor (default: the lenslet's back focal distance)")
     i.add_argument("-o", "--output", required=True, metavar="FILE", help="the ISET lens JSON to write")
     i.add_argument("--force", action="store_true", help="overwrite an existing file")
-    i.add_argument("--json", action="store_true", help="print a summary as JSON")
+    add_output_options(i, what="a summary")
+    add_units_option(i)
     add_lenient(i)
     i.set_defaults(handler=run_insert)
 
@@ -83,7 +85,7 @@ def register(sub) -> None:
     r.add_argument("lens", metavar="LENS_WITH_MICROLENS", help="an ISET lens JSON with a microlens block")
     r.add_argument("--fstop", type=number("f-number", positive=True), default=None,
                    help="stop the main lens to this f-number (default: its file's stop)")
-    r.add_argument("--focus", type=distance("focus distance"), default=None, metavar="D",
+    r.add_argument("--focus", type=focus("focus distance", allow_inf=False), default=None, metavar="D",
                    help="refocus the main lens on a subject D in front of the sensor (default: the file's "
                         "film-to-lens distance)")
     r.add_argument("--pixels-per-lenslet", type=_count("--pixels-per-lenslet", 1, 32), default=9, metavar="N",
@@ -101,7 +103,8 @@ def register(sub) -> None:
     r.add_argument("--seed", type=_count("--seed", 0, 2**31 - 1), default=0, help="random seed (default 0)")
     r.add_argument("-o", "--output", metavar="FILE", help="draw the figure to FILE (.png, .svg or .pdf)")
     r.add_argument("--force", action="store_true", help="overwrite an existing figure")
-    r.add_argument("--json", action="store_true", help="print the numbers as JSON")
+    add_output_options(r, what="the numbers")
+    add_units_option(r)
     add_lenient(r)
     r.set_defaults(handler=run_render)
     p.set_defaults(handler=lambda args: (p.print_help(), 0)[1])
@@ -160,6 +163,11 @@ def run_insert(args) -> int:
     array = microlens_array(args.xdim, args.ydim, args.film_width, args.film_height, focal_length_mm=args.microlens_focal,
                             lenslet=lenslet, sensor_offset_mm=args.sensor_offset)
     if args.focus is not None:
+        from ..onset.sensors import custom_sensor
+        from ._common import resolve_focus
+
+        args.focus = resolve_focus(args.focus, lens=main, sensor=custom_sensor(args.film_width, args.film_height),
+                                   args=args)
         cam = plenoptic_camera(main, array, focus_mm=args.focus)
     else:
         cam = plenoptic_camera(main, array, film_to_lens_mm=50.0 if args.film_to_lens is None else args.film_to_lens)
@@ -174,7 +182,7 @@ def run_insert(args) -> int:
     atomic_write(args.output, text, force=args.force)
     info = {"written": str(args.output), **_summary(cam)}
     if args.json:
-        print_json(info)
+        emit_json(document("microlens_insert", info))
         return 0
     print(f"wrote {args.output}: {out.name}")
     print(f"  {args.xdim} x {args.ydim} lenslets, pitch {array.pitch_x * 1000:.4g} x {array.pitch_y * 1000:.4g} um, "
@@ -215,12 +223,21 @@ def run_render(args) -> int:
         raise InputError(f"{array.count_x * n} x {array.count_y * n} sensor pixels is more than {MAX_CLI_PIXELS}; "
                          "lower --pixels-per-lenslet")
     if args.focus is not None:
+        from ..onset.sensors import custom_sensor
+        from ._common import resolve_focus
+
+        args.focus = resolve_focus(args.focus, lens=p, fstop=args.fstop, args=args,
+                                   sensor=custom_sensor(array.film_width_mm, array.film_height_mm))
         cam = plenoptic_camera(p, array, focus_mm=args.focus, fstop=args.fstop, pixels_per_lenslet=n)
     else:
         if info["film_to_lens_mm"] is None:
             raise InputError(f"lens {p.name!r} does not say its film-to-lens distance; give --focus")
         cam = plenoptic_camera(p, array, film_to_lens_mm=info["film_to_lens_mm"], fstop=args.fstop,
                                pixels_per_lenslet=n)
+    from ..units import format_distance
+    from ._common import units_of
+
+    units = units_of(args)
     slopes = []
     if args.point:
         field = None
@@ -232,9 +249,9 @@ def run_render(args) -> int:
                 field.raw += lf.raw
                 field.rays_traced += lf.rays_traced
                 field.rays_used += lf.rays_used
-            slopes.append((f"refocused at {d / 1000:g} m", view_disparity(cam, d)))
+            slopes.append((f"refocused at {format_distance(d, units)}", view_disparity(cam, d)))
         if len(args.point) > 1:
-            field.subject = "points at " + ", ".join(f"{d / 1000:g} m" for d in args.point) + " from the sensor"
+            field.subject = "points at " + ", ".join(format_distance(d, units) for d in args.point) + " from the sensor"
     else:
         width = args.plane_width
         if width is None:  # what the sensor sees at that distance, through the main lens's EFL
@@ -243,7 +260,7 @@ def run_render(args) -> int:
             g = gaussian(cam.main)
             width = 1.2 * array.film_width_mm * max(args.plane - cam.z_sensor + g.z_front_principal_plane, g.efl) / g.efl
         field = render_plane(cam, checkerboard(8, 16), args.plane, width, spp=args.spp, seed=args.seed)
-        slopes.append((f"refocused at {args.plane / 1000:g} m", view_disparity(cam, args.plane)))
+        slopes.append((f"refocused at {format_distance(args.plane, units)}", view_disparity(cam, args.plane)))
     data = {**_summary(cam), **field.to_dict(),
             "refocus": [{"label": lab, "slope_lenslets_per_view": s} for lab, s in slopes]}
     if not math.isfinite(data["total"]):
@@ -251,7 +268,7 @@ def run_render(args) -> int:
     if args.output:
         light_field_figure(field, refocus_slopes=slopes, path=args.output, force=args.force)
     if args.json:
-        print_json(data)
+        emit_json(document("microlens_render", data))
         return 0
     used = "on the sensor" if args.point else "met the plane"
     print(f"{field.subject}: {data['rays_traced']} rays traced, {data['rays_used']} {used} "

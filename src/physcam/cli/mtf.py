@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import math
 
-from ._common import distance, number, print_json
-from .lens import add_lenient, mark_repaired
+from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number
+from ._output import add_output_options, document, emit_json
+from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
 #: The CLI's largest pupil grids (the Python API goes to 1024): bound a chart's time and memory
 #: (15 fields x 3 wavelengths), and one field's.
@@ -21,7 +22,7 @@ CHART_MAX_PUPIL_SAMPLES = 256
 
 EPILOG = """\
 examples:
-  physcam mtf dgauss_50mm --fstop 4 --focus 3m                  (the vendor chart, full frame)
+  physcam mtf dgauss_50mm --fstop 4 --focus 3m --sensor FF      (the vendor chart, full frame)
   physcam mtf dgauss_50mm --fstop 2.8 --sensor "ALEXA 35" -o mtf.png
   physcam mtf dgauss_50mm --fstop 8 --field 14                  (one field: RMS, Strehl, MTF)
   physcam mtf dgauss_50mm --wavelength 550 --frequency 10 --frequency 30 --json
@@ -39,8 +40,8 @@ def register(sub) -> None:
     add_lenient(p)
     p.add_argument("--fstop", type=number("f-stop", positive=True), default=None,
                    help="stop the lens down to this f-number (default: the stop in the lens file)")
-    p.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=None, metavar="DIST",
-                   help="focus mark from the film plane (e.g. 3m, 10ft; default infinity)")
+    p.add_argument("--focus", type=focus("focus distance"), default=None, metavar="DIST",
+                   help=f"focus mark from the film plane (default infinity; {FOCUS_HELP})")
     p.add_argument("--frequency", type=number("frequency"), action="append", metavar="LPMM",
                    help="spatial frequency in line pairs per mm (repeat; default 10, 20 and 40)")
     p.add_argument("--wavelength", type=number("wavelength"), action="append", metavar="NM",
@@ -56,12 +57,9 @@ def register(sub) -> None:
     p.add_argument("--pupil-samples", type=int, default=None, metavar="N",
                    help=f"pupil grid cells across (16-{CHART_MAX_PUPIL_SAMPLES} for the chart, to {CLI_MAX_PUPIL_SAMPLES} "
                         "with --field; default chosen by the sampling rules)")
-    p.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (default full frame 36x24)')
-    p.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="MM",
-                   help="sensor width with --sensor-height (instead of --sensor)")
-    p.add_argument("--sensor-height", type=distance("sensor height"), default=None, metavar="MM",
-                   help="sensor height with --sensor-width")
-    p.add_argument("--json", action="store_true", help="print as JSON")
+    add_sensor_options(p)
+    add_units_option(p)
+    add_output_options(p, what="the chart (or the field's figures)")
     p.add_argument("-o", "--output", metavar="FILE.png", help="write the chart (or the field's MTF curve) as PNG/SVG/PDF")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(handler=run)
@@ -89,8 +87,11 @@ def run(args) -> int:
         raise InputError(f"--pupil-samples must lie between 16 and {CLI_MAX_PUPIL_SAMPLES}, got {args.pupil_samples}")
     if args.output:
         check_writable(args.output, force=args.force)
-    sensor = resolve_sensor(args, default="Full Frame")
+    sensor = resolve_sensor(args)
     lens = load_lens(args.lens, lenient=args.lenient)
+    from ._common import resolve_focus
+
+    args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
     wls, weights = _spectrum(args)
     freqs = tuple(args.frequency) if args.frequency else (10.0, 20.0, 40.0)
     focus = None if args.focus is None or math.isinf(args.focus) else args.focus
@@ -111,9 +112,12 @@ def run(args) -> int:
     if args.json:
         d = chart.to_dict()
         d["sensor"] = {"name": sensor.name, "width_mm": sensor.width_mm, "height_mm": sensor.height_mm}
-        print_json(mark_repaired(d, lens))
+        emit_json(document("mtf_chart", mark_repaired(d, lens), units=dict(WAVE_UNITS, frequency="lp/mm")))
         return 0
-    foc = "infinity" if focus is None else f"{focus / 1000:g} m"
+    from ..units import format_distance
+    from ._common import units_of
+
+    foc = format_distance(math.inf if focus is None else focus, units_of(args))
     wl = ", ".join(f"{w:g}" for w in chart.wavelengths_nm)
     print(f"{chart.lens_name}: MTF at f/{chart.fstop:.3g}, focus {foc} from the film, {wl} nm "
           f"({sensor.name}, corner at {sensor.diagonal_mm / 2:.2f} mm)")
@@ -143,7 +147,9 @@ def _one_field(args, lens, wls, weights, freqs, focus) -> int:
                     max_pupil_samples=CLI_MAX_PUPIL_SAMPLES, **kw)
         curve.plot(args.output, force=args.force)
     if args.json:
-        print_json(mark_repaired({"wavefront": wf.to_dict(), "psf": ps.to_dict(), "mtf": m.to_dict()}, lens))
+        emit_json(document("mtf_field", mark_repaired({"wavefront": wf.to_dict(), "psf": ps.to_dict(),
+                                                        "mtf": m.to_dict()}, lens),
+                           units=dict(WAVE_UNITS, wavefront="waves", frequency="lp/mm", psf="um")))
         return 0
     print(f"{wf.lens_name}: field {wf.field_deg:g} deg (chief ray at {wf.chief_image_height_mm:.3f} mm), "
           f"f/{wf.fstop:.3g}")
