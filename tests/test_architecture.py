@@ -19,9 +19,10 @@ LAYER = {
     "analysis": 6, "onset": 6,
     "export": 7,
     "usd": 8,
-    "cli": 9,
+    "serve": 9,
+    "cli": 10,
     "": 0,  # the root package only re-exports errors and the version
-    "__main__": 10,
+    "__main__": 11,
 }
 
 

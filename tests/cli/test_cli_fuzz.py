@@ -61,6 +61,11 @@ def _value_strategy(action):
     return st.sampled_from(NUMBERS)
 
 
+#: Flags added to every fuzzed run of a command that would otherwise not return: `serve` binds its
+#: address, answers one report in-process and exits with --check (its flags are fuzzed around it).
+ALWAYS = {("serve",): ["--check"]}
+
+
 def _argv_strategy(path, parser):
     positionals = [a for a in parser._actions if not a.option_strings and not isinstance(a, argparse._HelpAction)]
     options = [a for a in parser._actions if a.option_strings and not isinstance(a, (argparse._HelpAction,
@@ -81,7 +86,7 @@ def _argv_strategy(path, parser):
                 n = 1 if a.nargs in (None, 1, "?") else draw(st.integers(1, 2))
                 for _ in range(n):
                     argv.append(f"{flag}={draw(_value_strategy(a))}")
-        return argv
+        return argv + ALWAYS.get(tuple(path), [])
 
     return build()
 
