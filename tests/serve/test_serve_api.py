@@ -113,7 +113,7 @@ def test_page_and_its_files_ship_in_the_package(server):
 
 LONG = "5" * 100
 REFUSALS = [
-    ("/api/report?focal=abc&fstop=2&focus=3m", 422, "cannot read focal length"),
+    ("/api/report?focal=abc&fstop=2&focus=3m", 422, "focal: cannot read focal length 'abc'"),
     ("/api/report?focal=50&fstop=0.3&focus=3m", 422, "out of range"),
     ("/api/report?focal=50&fstop=2&focus=3m&bogus=1", 422, "unknown parameter 'bogus'"),
     ("/api/report?focal=50&fstop=2&focus=3m&plot=x.svg", 422, "unknown parameter 'plot'"),

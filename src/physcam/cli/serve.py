@@ -64,9 +64,12 @@ def _port(text):
 
 # --------------------------------------------------------------------------------------------
 def _refuse(message):
+    """argparse's error, raised instead of exiting; "argument --focus: ..." reads "focus: ..." (the query name)."""
+    import re
+
     from ..errors import InputError
 
-    raise InputError(message)
+    raise InputError(re.sub(r"^argument --([a-z0-9-]+)(/-\w)?: ", r"\1: ", str(message)))
 
 
 def _leaf(parser, *path):

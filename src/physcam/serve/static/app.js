@@ -227,6 +227,7 @@ async function table(d, api, my) {
   const body = $("marks").tBodies[0];
   const rows = res.body.map((row, k) => {
     const tr = document.createElement("tr");
+    tr.dataset.focus = marks[k];
     const label = document.createElement("td");
     label.textContent = marks[k].replace(/^(.*)ft$/, "$1'").replace(/^(.*)m$/, "$1 m");
     tr.append(label);
