@@ -115,9 +115,18 @@ def _options(q, skip=()) -> list[str]:
     return [f"--{k}={v}" for k, v in q.items() if k not in skip]
 
 
+def _svg(fig, dpi: int = 130) -> bytes:
+    """A figure as SVG with its text kept as text (a third of the size, quicker to draw and send)."""
+    import matplotlib
+
+    from ..figures import figure_bytes
+
+    with matplotlib.rc_context({"svg.fonttype": "none"}):
+        return figure_bytes(fig, "svg", dpi=dpi)
+
+
 def cli_backend():
     """A :class:`physcam.serve.Backend` answering with the CLI's functions and parsers."""
-    from ..figures import figure_bytes
     from ..serve import Backend
     from . import build_parser
     from .lens import diagram_options, lenses_document, show_document
@@ -149,7 +158,7 @@ def cli_backend():
         from ..onset.dof_plot import dof_zone_figure
 
         rep, _ = solved(q)
-        return figure_bytes(dof_zone_figure(rep, size_in=(6.0, 2.6)), "svg")
+        return _svg(dof_zone_figure(rep, size_in=(6.0, 2.6)))
 
     def sensors(q):
         from ..onset.sensors import find_sensor
@@ -168,7 +177,7 @@ def cli_backend():
 
         args = parsers["diagram"].parse_args([*_options(q), "--output=diagram.svg", "--", _bundled(name)])
         fig = lens_diagram(load_lens(args.lens), **diagram_options(args)).figure()
-        return figure_bytes(fig, "svg", dpi=150)
+        return _svg(fig, dpi=150)
 
     return Backend(report=report, dof_svg=dof_svg, sensors=sensors, lenses=lenses_document, lens=lens,
                    diagram_svg=diagram_svg, parameters=params)

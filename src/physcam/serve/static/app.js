@@ -3,7 +3,8 @@
 "use strict";
 
 const $ = (id) => document.getElementById(id);
-const DEBOUNCE_MS = 60;
+const DEBOUNCE_MS = 25; // the numbers: as soon as typing pauses for a moment
+const SETTLE_MS = 250; // the table, the chart and the diagram: once the setup has settled
 const DEFAULT_SENSOR = "s35-4perf";
 const DEFAULT_COC = "d/1500";
 const COCS = ["d/1500", "d/1000", "d/1730", "cine"];
@@ -16,6 +17,7 @@ const DEFAULTS = { focal: "50", fstop: "2.8", focus: "3m" };
 const st = { units: "metric", lensmode: "focal", solve: "dof", report: null };
 let SENSORS = [];
 let timer = null;
+let settle = null;
 let seq = 0;
 const controllers = {};
 
@@ -157,9 +159,13 @@ async function update() {
   setStale(false);
   st.report = res.body;
   render(res.body);
-  chart(api);
-  table(res.body, api, my);
-  diagram(res.body);
+  clearTimeout(settle);
+  settle = setTimeout(() => {
+    if (my !== seq) return;
+    chart(api);
+    table(res.body, api, my);
+    diagram(res.body);
+  }, SETTLE_MS);
 }
 
 // --- what comes back -------------------------------------------------------------------------
