@@ -262,3 +262,13 @@ def test_check_on_every_interface_prints_a_qr_for_phones(capsys):
     url = lines[i].split("open ", 1)[1].split()[0]
     end = next(j for j in range(i + 1, len(lines)) if not set(lines[j]) <= set("█▀▄ "))
     assert _decode_terminal_qr("\n".join(lines[i + 1:end])) == url
+
+
+def test_ctrl_c_stops_the_server_cleanly():
+    import signal
+
+    with running_server() as (_, port, proc):
+        assert request(port, "/api/health")[0] == 200
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=30) == 0
+        assert "Traceback" not in "".join(proc.stderr_lines)

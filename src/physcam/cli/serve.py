@@ -225,7 +225,10 @@ def run(args) -> int:
             return 0
         print("Ctrl-C stops the server", flush=True)
         warnings.simplefilter("ignore", PhysCamWarning)  # the reports carry these in their notes
-        run_server(app, sock, log_requests=args.log_requests)
+        try:
+            run_server(app, sock, log_requests=args.log_requests)
+        except KeyboardInterrupt:  # uvicorn has shut down cleanly and passes Ctrl-C on
+            print("physcam serve: stopped", flush=True)
     finally:
         sock.close()
     return 0
