@@ -162,6 +162,7 @@ def test_shared_url_reproduces_the_setup(page, browser, server, capsys):
     page.select_option("#squeeze", "1.5")
     d = cli_report(capsys, *SETUP, "--coc", "cine", "--squeeze", "1.5")
     wait_mm(page, "out-near", d["dof"]["near_from_film_mm"])
+    page.wait_for_selector("#out-horizontal:not([hidden])")  # the squeeze's answer is in too
     shared = page.url
     assert page.input_value("#share-url") == shared
     ctx = browser.new_context(viewport={"width": 375, "height": 812})
