@@ -194,6 +194,9 @@ def run(args) -> int:
     app = create_app(cli_backend(), limits)
     sock = bind_socket(args.host, args.port)
     try:
+        if not args.check:
+            # the lens library (read once, ~0.5 s) before the first phone asks: every page load lists it
+            asgi_get(app, "/api/lenses")
         host, port = sock.getsockname()[:2]
         urls = url_for(sock)
         try:
