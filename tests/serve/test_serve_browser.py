@@ -146,7 +146,8 @@ def test_imperial_switch(page, server, capsys):
     assert page.text_content("#out-near") == imperial(near) == format_feet_inches(near)
     assert float(page.get_attribute("#out-near", "data-mm")) == near  # the switch keeps 2.5 meaning metres
     assert page.input_value("#focus") == "2.5m"
-    page.wait_for_function("() => document.querySelector('#marks tbody td').textContent === \"2'\"")
+    page.wait_for_function("() => { const td = document.querySelector('#marks tbody td');"
+                           " return td !== null && td.textContent === \"2'\"; }")
     # a bare number now means feet: 10 -> 10 ft
     page.fill("#focus", "10")
     d = cli_report(capsys, *SETUP[:-1], "10ft")
