@@ -158,7 +158,7 @@ def cli_backend():
         from ..onset.dof_plot import dof_zone_figure
 
         rep, _ = solved(q)
-        return _svg(dof_zone_figure(rep, size_in=(6.0, 2.6)))
+        return _svg(dof_zone_figure(rep, size_in=(4.5, 2.6)))
 
     def sensors(q):
         from ..onset.sensors import find_sensor
