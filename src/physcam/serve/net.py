@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import ipaddress
 import socket
-import sys
 
 from ..errors import InputError, WrongTypeError
 
