@@ -19,6 +19,8 @@ LAYER = {
     "analysis": 6, "onset": 6,
     "export": 7,
     "usd": 8,
+    "live": 8.5,
+    "characterize": 9,
     "serve": 9,
     "cli": 10,
     "": 0,  # the root package only re-exports errors and the version

@@ -30,6 +30,25 @@ NUMBERS = ["0", "-1", "1", "2.8", "50", "1e308", "-1e308", "5e-324", "1e12", "na
 LENSES = ["dgauss_50mm", "nikkor_fisheye_16mm_f2_8", "navarro_anamorphic_2x", "fisheye_10mm", "no_such_lens", "",
           "/dev/null"]
 FILES = ["out.usda", "out.png", "out.svg", "out.txt", "", "missing_dir/out.usda", "out.usdc"]
+#: flags appended to every fuzzed run of a command (after the drawn ones, so they win): receivers and
+#: senders run for a bounded time instead of until Ctrl-C
+BOUNDED = {("live", "record"): ["--duration=0.3"], ("live", "send"): ["--duration=0.3"],
+           ("live", "play"): ["--duration=0.3"],
+           # characterize only validates and plans: the fuzzer never starts a Dask cluster or traces a grid
+           ("characterize",): ["--dry-run"],
+           # serve binds its address, answers one report in-process and exits instead of serving
+           ("serve",): ["--check"]}
+#: A valid command line some leaves start from, so that the fuzzed flags reach the handler instead of
+#: stopping at a missing required option (argparse keeps the last of a repeated option).
+BASE_ARGV = {
+    ("export", "rib"): ["-o", "out.rib", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--force"],
+    ("export", "pbrt"): ["-o", "pbrt_out", "--lens", "dgauss_50mm", "--focus", "3m", "--force"],
+    ("export", "mitsuba"): ["-o", "mitsuba_out", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--width-px",
+                            "64", "--force"],
+    ("microlens", "insert"): ["--microlens-focal", "0.5", "--xdim", "21", "--ydim", "21", "--film-width", "4.2",
+                              "--film-height", "4.2", "--focus", "1m", "-o", "lf.json", "--force"],
+    ("characterize",): ["-o", "lib", "--focus", "2m"],
+}
 NAN_OR_INF = re.compile(r"(?<![A-Za-z_])(nan|NaN|inf|Infinity)(?![A-Za-z_])")
 
 
@@ -61,11 +80,6 @@ def _value_strategy(action):
     return st.sampled_from(NUMBERS)
 
 
-#: Flags added to every fuzzed run of a command that would otherwise not return: `serve` binds its
-#: address, answers one report in-process and exits with --check (its flags are fuzzed around it).
-ALWAYS = {("serve",): ["--check"]}
-
-
 def _argv_strategy(path, parser):
     positionals = [a for a in parser._actions if not a.option_strings and not isinstance(a, argparse._HelpAction)]
     options = [a for a in parser._actions if a.option_strings and not isinstance(a, (argparse._HelpAction,
@@ -73,7 +87,7 @@ def _argv_strategy(path, parser):
 
     @st.composite
     def build(draw):
-        argv = list(path)
+        argv = list(path) + BASE_ARGV.get(tuple(path), [])
         for a in positionals:
             n = 1 if a.nargs in (None, 1) else draw(st.integers(1, 2))
             argv += [draw(_value_strategy(a)) for _ in range(n)]
@@ -86,7 +100,7 @@ def _argv_strategy(path, parser):
                 n = 1 if a.nargs in (None, 1, "?") else draw(st.integers(1, 2))
                 for _ in range(n):
                     argv.append(f"{flag}={draw(_value_strategy(a))}")
-        return argv + ALWAYS.get(tuple(path), [])
+        return argv + BOUNDED.get(tuple(path), [])
 
     return build()
 
