@@ -77,6 +77,10 @@ def _value_strategy(action):
         return st.sampled_from(["FF", "ALEXA 35", "ALEXA", "", "nope", "S35"])
     if dest in ("coc",):
         return st.sampled_from(["cine", "d/1500", "0.025", "0", "-1", "nan", "abc", ""])
+    if dest == "fields":  # physcam mtf: image heights on the chart (valid counts too, up to the largest)
+        return st.sampled_from(["2", "3", "41", "1", "0", "-1", "abc", "", "1e12"])
+    if dest == "pupil_samples":  # physcam mtf: pupil grid (valid sizes too, small enough that 41 fields run in seconds)
+        return st.sampled_from(["16", "32", "64", "8", "0", "100000", "abc", ""])
     return st.sampled_from(NUMBERS)
 
 
