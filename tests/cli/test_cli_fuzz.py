@@ -35,7 +35,9 @@ FILES = ["out.usda", "out.png", "out.svg", "out.txt", "", "missing_dir/out.usda"
 BOUNDED = {("live", "record"): ["--duration=0.3"], ("live", "send"): ["--duration=0.3"],
            ("live", "play"): ["--duration=0.3"],
            # characterize only validates and plans: the fuzzer never starts a Dask cluster or traces a grid
-           ("characterize",): ["--dry-run"]}
+           ("characterize",): ["--dry-run"],
+           # serve binds its address, answers one report in-process and exits instead of serving
+           ("serve",): ["--check"]}
 #: A valid command line some leaves start from, so that the fuzzed flags reach the handler instead of
 #: stopping at a missing required option (argparse keeps the last of a repeated option).
 BASE_ARGV = {

@@ -140,11 +140,11 @@ def _json_float(v):
     return None if (v is None or (isinstance(v, float) and not math.isfinite(v))) else v
 
 
-def run_lenses(args) -> int:
+def lenses_document() -> list[dict]:
+    """The bundled lenses as ``physcam lenses --json`` prints them (and ``physcam serve`` answers)."""
     from ..errors import PhysCamError
     from ..lens.library import list_lenses, load_lens
     from ..optics.paraxial import gaussian
-    from ._output import Table, document, emit_json, print_csv, print_table
 
     out = []
     for rec in list_lenses():
@@ -155,6 +155,13 @@ def run_lenses(args) -> int:
         except PhysCamError:  # a listing must not stop at one odd lens
             d["efl_mm"], d["f_number"] = None, None
         out.append(d)
+    return out
+
+
+def run_lenses(args) -> int:
+    from ._output import Table, document, emit_json, print_csv, print_table
+
+    out = lenses_document()
     if args.json:
         emit_json(document("lenses", {"lenses": out}))
         return 0
@@ -186,11 +193,10 @@ def _meridians(p):
     return ("x", "y") if p.is_anamorphic else ("y",)
 
 
-def run_show(args) -> int:
+def show_data(args):
+    """What ``physcam lens show`` computes: (lens, focus state, {meridian: GaussianData}, focus block)."""
     from ..optics import focusing, paraxial
-    from ..units import format_distance
-    from ._common import resolve_focus, units_of
-    from ._output import Table, document, emit_json, print_table
+    from ._common import resolve_focus
 
     p = _load(args)
     args.focus = resolve_focus(args.focus, lens=p, fstop=args.fstop, args=args)
@@ -210,10 +216,32 @@ def run_show(args) -> int:
         "focus_group_travel_fraction": st.alpha,
         "focused_meridian": st.axis,
     }
+    return p, st, data, focus_info
+
+
+def show_document(args) -> dict:
+    """The document ``physcam lens show --json`` prints (and ``physcam serve`` answers)."""
+    p, _, data, focus_info = show_data(args)
+    return _show_document(p, data, focus_info)
+
+
+def _show_document(p, data, focus_info) -> dict:
+    from ._output import document
+
+    return document("lens_show", mark_repaired({"lens": p.name, "squeeze": p.squeeze, "focus": focus_info,
+                                                "meridians": {a: g.to_dict() for a, g in data.items()}}, p),
+                    units=WAVE_UNITS)
+
+
+def run_show(args) -> int:
+    from ..optics import paraxial
+    from ..units import format_distance
+    from ._common import units_of
+    from ._output import Table, emit_json, print_table
+
+    p, st, data, focus_info = show_data(args)
     if args.json:
-        emit_json(document("lens_show", mark_repaired(
-            {"lens": p.name, "squeeze": p.squeeze, "focus": focus_info,
-             "meridians": {a: g.to_dict() for a, g in data.items()}}, p), units=WAVE_UNITS))
+        emit_json(_show_document(p, data, focus_info))
         return 0
     g0 = data["y"]
     print(f"{p.name}  (wavelength {g0.wavelength_nm:g} nm, focus {format_distance(st.focus_from_film_mm, units_of(args))} "
@@ -246,15 +274,23 @@ def run_show(args) -> int:
     return 0
 
 
+def diagram_options(args) -> dict:
+    """The keyword arguments ``physcam lens diagram`` gives :func:`physcam.analysis.diagram.lens_diagram`
+    (``--focus hyperfocal`` resolved to its mark for the lens and f-stop)."""
+    from ._common import HYPERFOCAL, resolve_focus
+
+    if args.focus == HYPERFOCAL:
+        args.focus = resolve_focus(args.focus, lens=_load(args), fstop=args.fstop, args=args)
+    return dict(axis=args.axis, focus_from_film_mm=args.focus, fstop=args.fstop, field_deg=args.field,
+                wavelength_nm=args.wavelength)
+
+
 def run_diagram(args) -> int:
     from ..analysis.diagram import save_lens_diagram
-    from ._common import resolve_focus, units_of
+    from ._common import units_of
 
     p = _load(args)
-    args.focus = resolve_focus(args.focus, lens=p, fstop=args.fstop, args=args)
-    path = save_lens_diagram(p, args.output, force=args.force, axis=args.axis, focus_from_film_mm=args.focus,
-                             fstop=args.fstop, field_deg=args.field, wavelength_nm=args.wavelength,
-                             units=units_of(args))
+    path = save_lens_diagram(p, args.output, force=args.force, units=units_of(args), **diagram_options(args))
     print(f"wrote {path}")
     return 0
 

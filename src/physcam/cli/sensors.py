@@ -37,20 +37,25 @@ def register(sub) -> None:
     p.set_defaults(handler=run)
 
 
+def sensor_document(s) -> dict:
+    """One sensor as ``physcam sensors --json`` lists it (and ``physcam serve`` answers)."""
+    return s.to_dict()
+
+
 def select(args) -> list:
     """The sensors ``args`` ask for: one exact name or alias, else every match of the filters."""
     from ..errors import SensorError
     from ..onset.sensors import filter_sensors, find_sensor
 
-    query = " ".join(args.name or ())
-    filters = (args.maker, args.fmt, args.min_width, args.max_width)
+    query = " ".join(args.name or ()) if isinstance(args.name, (list, tuple)) else (args.name or "")
+    filters = (getattr(args, "maker", None), getattr(args, "fmt", None), getattr(args, "min_width", None),
+               getattr(args, "max_width", None))
     if query and all(f is None for f in filters):
         try:
             return [find_sensor(query)]  # an exact name or alias
         except SensorError:
             pass
-    rows = filter_sensors(query, maker=args.maker, fmt=args.fmt, min_width_mm=args.min_width,
-                          max_width_mm=args.max_width)
+    rows = filter_sensors(query, maker=filters[0], fmt=filters[1], min_width_mm=filters[2], max_width_mm=filters[3])
     if not rows:
         if query and all(f is None for f in filters):
             find_sensor(query)  # raises with the closest names
@@ -63,7 +68,7 @@ def run(args) -> int:
 
     rows = select(args)
     if args.json:
-        emit_json(document("sensors", {"sensors": [s.to_dict() for s in rows]}, units={"length": "mm"}))
+        emit_json(document("sensors", {"sensors": [sensor_document(s) for s in rows]}, units={"length": "mm"}))
         return 0
     if args.csv:
         print_csv([s.to_dict() for s in rows])

@@ -32,7 +32,9 @@ def plot_title(report, units: str = "m") -> str:
 
 
 def dof_zone_figure(report, *, size_in=(9.0, 2.6), units: str = "m"):
-    """The figure :func:`plot_dof_zone` saves (a matplotlib Figure on its own Agg canvas)."""
+    """The figure :func:`plot_dof_zone` saves, as a matplotlib Figure on its own Agg canvas (no pyplot
+    state, so a server can draw it in memory with :func:`physcam.figures.figure_bytes`); ``size_in``
+    is (width, height) in inches (a phone screen reads a narrower one); ``units`` m or ft."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.ticker import FuncFormatter, LogLocator
