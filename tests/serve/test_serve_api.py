@@ -62,9 +62,11 @@ def test_far_at_infinity_is_null(server):
 
 def test_lists_and_lens_are_the_cli_json(server, capsys):
     port, _ = server
-    assert get_json(port, "/api/sensors") == (200, cli_json(capsys, ["sensors"]))
-    assert get_json(port, "/api/sensors?name=" + quote("ALEXA 35")) == (200, cli_json(capsys, ["sensors", "ALEXA 35"]))
-    assert get_json(port, "/api/lenses") == (200, cli_json(capsys, ["lenses"]))
+    # the lists are the rows of the CLI's documents (physcam sensors|lenses --json: {"sensors": [...]})
+    assert get_json(port, "/api/sensors") == (200, cli_json(capsys, ["sensors"])["sensors"])
+    assert get_json(port, "/api/sensors?name=" + quote("ALEXA 35")) == (
+        200, cli_json(capsys, ["sensors", "ALEXA 35"])["sensors"])
+    assert get_json(port, "/api/lenses") == (200, cli_json(capsys, ["lenses"])["lenses"])
     assert get_json(port, "/api/lens/dgauss_50mm?focus=2m&fstop=2.8") == (
         200, cli_json(capsys, ["lens", "show", "dgauss_50mm", "--focus", "2m", "--fstop", "2.8"]))
     # an alias names the same bundled lens

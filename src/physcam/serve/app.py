@@ -7,8 +7,8 @@ Routes (GET or HEAD only; every answer is JSON, SVG or the page):
 ``/api/report?focal=50&fstop=2.8...``  ``physcam report ... --json``
 ``/api/focus-table?...&marks=1m,2m``   ``physcam report ... --json`` once per focus mark
 ``/api/dof.svg?...``                   ``physcam report ... --plot dof.svg``, drawn in memory
-``/api/sensors[?name=S35]``            ``physcam sensors [NAME] --json``
-``/api/lenses``                        ``physcam lenses --json``
+``/api/sensors[?name=S35]``            ``physcam sensors [NAME] --json``'s ``sensors`` list
+``/api/lenses``                        ``physcam lenses --json``'s ``lenses`` list
 ``/api/lens/{name}?focus=2m...``       ``physcam lens show NAME ... --json``
 ``/api/lens/{name}/diagram.svg?...``   ``physcam lens diagram NAME ... -o diagram.svg``
 ``/api/health``                        ``{"ok": true, "version": ...}``
