@@ -29,11 +29,14 @@ REPO = Path(__file__).resolve().parents[2]
 PAGES = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
 FENCE = re.compile(r"^\s*```\s*([\w-]*)")
 
-#: Commands that run as a plan here (``--dry-run`` added), and why: what they compute is tested apart.
-DRY_RUN = {
-    "characterize": "starts a Dask cluster and computes hundreds of cells (minutes); the plan checks the command "
-                    "line, the grid and every lens against it, and tests/characterize/test_characterize.py computes "
-                    "small grids",
+#: Commands that run bounded here (the flags added), and why: what they do at length is tested apart.
+BOUNDED = {
+    "characterize": (["--dry-run"], "starts a Dask cluster and computes hundreds of cells (minutes); the plan checks "
+                                  "the command line, the grid and every lens against it, and "
+                                  "tests/characterize/test_characterize.py computes small grids"),
+    "serve": (["--check", "--port", "0"], "serves until Ctrl-C; --check binds the address (any free port here), "
+                                          "answers the page and one report in-process and exits (tests/serve drives "
+                                          "a running server)"),
 }
 #: Commands that cannot run in a test, and why.
 SKIP = {
@@ -165,8 +168,7 @@ def test_every_command_of_the_page_runs(page, tmp_path, capsys):
             for a in argv:  # folders a command writes into (lenses/x.usda)
                 if "/" in a and a.endswith((".usda", ".usd", ".usdc")) and not Path(a).exists():
                     Path(a).parent.mkdir(parents=True, exist_ok=True)
-            if argv[1] in DRY_RUN and "--dry-run" not in argv:
-                argv = [*argv, "--dry-run"]
+            argv = [*argv, *BOUNDED.get(argv[1], ([],))[0]]
             rc = main(argv[1:])
             out, err = capsys.readouterr()
             if rc != want:
