@@ -14,9 +14,9 @@ import numpy as np
 from ..errors import InputError, OpticsError, require_finite
 from ..lens.prescription import Prescription
 from .kernels import get_kernel
-from .kernels._layout import pack, set_wavelength
+from .kernels._layout import set_wavelength
 from .rays import CLIPPED, OK, RayBatch
-from .surfaces import surface_table
+from .tables import PackedTable, packed_table
 
 __all__ = ["DEFAULT_CHUNK", "trace_to_film", "trace_through", "trace_path", "paraxial_image_z", "CameraRays",
            "camera_rays"]
@@ -37,11 +37,24 @@ def _check_lens(lens) -> Prescription:
     return lens
 
 
+def _is_mono(wl) -> bool:
+    """One wavelength the kernels can precompute indices for (else each ray computes its own; a
+    wavelength they cannot use, 0, NaN or one whose 1/l^2 overflows, goes that way too and its rays
+    are flagged MISSED by the kernel)."""
+    if wl.size == 0:
+        return False
+    w0 = wl[0]
+    if wl.size > 1 and not bool(wl.min() == wl.max()):
+        return False
+    return 1e-100 < float(w0) < 1e100
+
+
 def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chunk_size=DEFAULT_CHUNK):
     """Trace ``rays`` in place through rows of a packed surface table (``kernels._layout.pack``).
 
     The low-level step under :func:`trace_through`, public for analyses that trace a lens in
     legs (ghost paths reflect between legs). ``kernel`` comes from ``kernels.get_kernel``.
+    ``S`` is not modified (a one-wavelength batch gets its indices on a copy).
     """
     has_end = end_z is not None
     ez = float(end_z) if has_end else 0.0
@@ -50,13 +63,39 @@ def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chun
     for a in range(0, n, chunk_size):
         b = min(n, a + chunk_size)
         wl = rays.wavelength_nm[a:b]
-        # one wavelength: indices per surface (set_wavelength); a wavelength the kernels cannot use
-        # (0, NaN, 1/l^2 overflowing) goes the per-ray way, where the kernel flags its rays MISSED
-        mono = bool(wl.size) and bool(wl.min() == wl.max()) and 1e-100 < float(wl[0]) < 1e100
+        mono = _is_mono(wl)
+        Sw = S
         if mono:
-            set_wavelength(S, float(wl[0]))
-        kernel(*(c[a:b] for c in cols), S, kinds, bool(clip), bool(fresnel), ez, has_end, mono)
+            Sw = np.array(S, dtype=np.float64)
+            set_wavelength(Sw, float(wl[0]))
+            if S.dtype != np.float64:
+                Sw = np.ascontiguousarray(Sw, dtype=S.dtype)
+        kernel(*(c[a:b] for c in cols), Sw, kinds, bool(clip), bool(fresnel), ez, has_end, mono)
     return rays
+
+
+def _run(kernel, rays: RayBatch, packed: PackedTable, rows: slice, clip: bool, fresnel: bool, end_z, chunk_size):
+    """Trace ``rays`` in place through rows ``rows`` of a cached table (one-wavelength indices cached too)."""
+    has_end = end_z is not None
+    ez = float(end_z) if has_end else 0.0
+    kinds = packed.kinds[rows]
+    n = len(rays)
+    cols = rays.columns()
+    if n <= chunk_size:
+        mono = _is_mono(rays.wavelength_nm)
+        S = packed.at_wavelength(rays.wavelength_nm[0]) if mono else packed.S
+        kernel(*cols, S[rows], kinds, clip, fresnel, ez, has_end, mono)
+        return rays
+    for a in range(0, n, chunk_size):
+        b = min(n, a + chunk_size)
+        wl = rays.wavelength_nm[a:b]
+        mono = _is_mono(wl)
+        S = packed.at_wavelength(wl[0]) if mono else packed.S
+        kernel(*(c[a:b] for c in cols), S[rows], kinds, clip, fresnel, ez, has_end, mono)
+    return rays
+
+
+_ALL = slice(None)
 
 
 def trace_through(
@@ -80,24 +119,29 @@ def trace_through(
     ``aperture`` (an :class:`~physcam.trace.aperture.Aperture`, seed 002) shapes the stop: rays
     are traced to the stop, masked and weighted there by the aperture density on the stop's
     unit disk, then traced on. ``in_place`` traces ``rays`` itself instead of a copy.
+    Rays in float32 (:meth:`RayBatch.astype`) are traced in single precision (docs/ray-tracing.md).
     Returns the rays after the last surface (or on the end plane) with flags and weights.
     """
-    _check_lens(lens)
-    _check_rays(rays)
+    if type(lens) is not Prescription:
+        _check_lens(lens)
+    if type(rays) is not RayBatch:
+        _check_rays(rays)
     if chunk_size < 1:
         raise InputError(f"chunk_size must be >= 1, got {chunk_size}")
     if end_z is not None:
         end_z = require_finite("end_z", end_z)
-    table = surface_table(lens, reverse=reverse, stop_semi_diameter=stop_semi_diameter, coating=coating)
-    S, kinds = pack(table)
+    packed = packed_table(lens, reverse=reverse, stop_semi_diameter=stop_semi_diameter, coating=coating,
+                          dtype=rays.x.dtype)
     out = rays if in_place else rays.copy()
     kernel = get_kernel(backend)
+    clip = bool(clip)
+    fresnel = bool(fresnel)
     if aperture is None:
-        return trace_packed(kernel, out, S, kinds, clip=clip, fresnel=fresnel, end_z=end_z, chunk_size=chunk_size)
+        return _run(kernel, out, packed, _ALL, clip, fresnel, end_z, chunk_size)
     # trace to the stop, weigh by the aperture shape there, then on through the rest
-    k = int(np.flatnonzero(table.index == lens.stop_index)[0])
-    trace_packed(kernel, out, S[: k + 1], kinds[: k + 1], clip=clip, fresnel=fresnel, end_z=None, chunk_size=chunk_size)
-    rstop = table.semi_diameter[k]
+    k = packed.stop_row
+    _run(kernel, out, packed, slice(0, k + 1), clip, fresnel, None, chunk_size)
+    rstop = packed.table.semi_diameter[k]
     dens = aperture.density_at(out.x / rstop, out.y / rstop)
     live = out.flag == OK
     out.scale_weight(dens[live], live)  # polarisation-blind: scales the s and p halves alike
@@ -105,8 +149,7 @@ def trace_through(
     out.flag[blocked] = CLIPPED
     out.weight[blocked] = 0.0
     out.weight_sp[blocked] = 0.0
-    return trace_packed(kernel, out, S[k + 1 :], kinds[k + 1 :], clip=clip, fresnel=fresnel, end_z=end_z,
-                chunk_size=chunk_size)
+    return _run(kernel, out, packed, slice(k + 1, None), clip, fresnel, end_z, chunk_size)
 
 
 def trace_path(
@@ -127,18 +170,17 @@ def trace_path(
     """
     _check_lens(lens)
     _check_rays(rays)
-    table = surface_table(lens, stop_semi_diameter=stop_semi_diameter)
-    S, kinds = pack(table)
+    packed = packed_table(lens, stop_semi_diameter=stop_semi_diameter, dtype=rays.x.dtype)
     kernel = get_kernel(backend)
     out = rays.copy()
     pts = [np.stack([out.x, out.y, out.z], axis=1)]
-    for k in range(S.shape[0]):
-        trace_packed(kernel, out, S[k:k + 1], kinds[k:k + 1], clip=clip, fresnel=False, end_z=None)
+    for k in range(packed.S.shape[0]):
+        _run(kernel, out, packed, slice(k, k + 1), bool(clip), False, None, DEFAULT_CHUNK)
         pts.append(np.stack([out.x, out.y, out.z], axis=1))
     if end_z is not None:
         live = out.flag == OK
         end = out.take(live)
-        trace_packed(kernel, end, S[:0], kinds[:0], clip=clip, fresnel=False, end_z=require_finite("end_z", end_z))
+        _run(kernel, end, packed, slice(0, 0), bool(clip), False, require_finite("end_z", end_z), DEFAULT_CHUNK)
         last = pts[-1].copy()
         last[live] = np.stack([end.x, end.y, end.z], axis=1)
         pts.append(last)
