@@ -87,6 +87,7 @@ def clear_table_cache() -> None:
     with _lock:
         _by_value.clear()
         _by_id.clear()
+        _fast.clear()
 
 
 def _entry(lens: Prescription) -> _LensEntry:
@@ -112,10 +113,35 @@ def _entry(lens: Prescription) -> _LensEntry:
         return e
 
 
+#: (id(lens), arguments as given) -> (weak reference to the lens, PackedTable): the per-call fast path
+_fast: dict = {}
+_FAST_MAX = 4096
+
+
 def packed_table(lens: Prescription, *, reverse: bool = False, stop_semi_diameter: float | None = None,
                  coating: str | None = "none", dtype=np.float64) -> PackedTable:
     """The packed table of ``lens`` for the kernels (cached; module notes). Arguments as
     :func:`~physcam.trace.surfaces.surface_table`; ``dtype`` float64 or float32."""
+    try:
+        fkey = (id(lens), reverse, stop_semi_diameter, coating, dtype)
+        hit = _fast.get(fkey)
+    except TypeError:  # an unhashable argument: the slow path says what is wrong with it
+        fkey = hit = None
+    if hit is not None and hit[0]() is lens:
+        return hit[1]
+    p = _packed_table(lens, reverse, stop_semi_diameter, coating, dtype)
+    if fkey is not None:
+        try:
+            ref = weakref.ref(lens)
+        except TypeError:
+            return p
+        if len(_fast) >= _FAST_MAX:
+            _fast.clear()
+        _fast[fkey] = (ref, p)
+    return p
+
+
+def _packed_table(lens, reverse, stop_semi_diameter, coating, dtype) -> PackedTable:
     if coating is None:
         mc = lens.metadata.coating
         coating = mc if mc in ("none", "single", "multi") else "none"

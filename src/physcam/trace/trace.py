@@ -41,12 +41,12 @@ def _is_mono(wl) -> bool:
     """One wavelength the kernels can precompute indices for (else each ray computes its own; a
     wavelength they cannot use, 0, NaN or one whose 1/l^2 overflows, goes that way too and its rays
     are flagged MISSED by the kernel)."""
-    if wl.size == 0:
+    n = wl.shape[0]
+    if n == 0:
         return False
-    w0 = wl[0]
-    if wl.size > 1 and not bool(wl.min() == wl.max()):
+    if n > 1 and not wl.min() == wl.max():
         return False
-    return 1e-100 < float(w0) < 1e100
+    return 1e-100 < float(wl[0]) < 1e100
 
 
 def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chunk_size=DEFAULT_CHUNK):
@@ -74,18 +74,25 @@ def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chun
     return rays
 
 
-def _run(kernel, rays: RayBatch, packed: PackedTable, rows: slice, clip: bool, fresnel: bool, end_z, chunk_size):
-    """Trace ``rays`` in place through rows ``rows`` of a cached table (one-wavelength indices cached too)."""
+def _run(kernel, rays: RayBatch, packed: PackedTable, rows, clip: bool, fresnel: bool, end_z, chunk_size):
+    """Trace ``rays`` in place through rows ``rows`` (a slice, or None for all) of a cached table
+    (one-wavelength indices cached too)."""
     has_end = end_z is not None
-    ez = float(end_z) if has_end else 0.0
-    kinds = packed.kinds[rows]
-    n = len(rays)
+    ez = end_z if has_end else 0.0
+    n = rays.x.shape[0]
     cols = rays.columns()
     if n <= chunk_size:
-        mono = _is_mono(rays.wavelength_nm)
-        S = packed.at_wavelength(rays.wavelength_nm[0]) if mono else packed.S
-        kernel(*cols, S[rows], kinds, clip, fresnel, ez, has_end, mono)
+        wl = rays.wavelength_nm
+        mono = _is_mono(wl)
+        S = packed.at_wavelength(wl[0]) if mono else packed.S
+        if rows is None:
+            kernel(*cols, S, packed.kinds, clip, fresnel, ez, has_end, mono)
+        else:
+            kernel(*cols, S[rows], packed.kinds[rows], clip, fresnel, ez, has_end, mono)
         return rays
+    if rows is None:
+        rows = _ALL
+    kinds = packed.kinds[rows]
     for a in range(0, n, chunk_size):
         b = min(n, a + chunk_size)
         wl = rays.wavelength_nm[a:b]
@@ -126,9 +133,9 @@ def trace_through(
         _check_lens(lens)
     if type(rays) is not RayBatch:
         _check_rays(rays)
-    if chunk_size < 1:
+    if chunk_size != DEFAULT_CHUNK and chunk_size < 1:
         raise InputError(f"chunk_size must be >= 1, got {chunk_size}")
-    if end_z is not None:
+    if end_z is not None and not (type(end_z) is float and -1e308 < end_z < 1e308):
         end_z = require_finite("end_z", end_z)
     packed = packed_table(lens, reverse=reverse, stop_semi_diameter=stop_semi_diameter, coating=coating,
                           dtype=rays.x.dtype)
@@ -137,7 +144,7 @@ def trace_through(
     clip = bool(clip)
     fresnel = bool(fresnel)
     if aperture is None:
-        return _run(kernel, out, packed, _ALL, clip, fresnel, end_z, chunk_size)
+        return _run(kernel, out, packed, None, clip, fresnel, end_z, chunk_size)
     # trace to the stop, weigh by the aperture shape there, then on through the rest
     k = packed.stop_row
     _run(kernel, out, packed, slice(0, k + 1), clip, fresnel, None, chunk_size)

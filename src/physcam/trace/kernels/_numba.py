@@ -71,6 +71,24 @@ def _like_impl(value, arr):
     return lambda value, arr: np.float64(value)
 
 
+def _newton_rel_tol(arr):  # pragma: no cover - replaced by the overload inside jitted code
+    """Relative part of the Newton step tolerance: 0 in float64 (the reference's absolute
+    NEWTON_TOL), 8 float32 ulps of t in float32, whose t cannot resolve 1e-12 mm."""
+    raise NotImplementedError
+
+
+@overload(_newton_rel_tol, inline="always")
+def _newton_rel_tol_impl(arr):
+    dt = arr.dtype if isinstance(arr, types.Array) else arr
+    if dt == types.float32:
+        return lambda arr: np.float32(8.0 * 2.0**-23)
+    return lambda arr: np.float64(0.0)
+
+
+#: absolute Newton tolerance in float32 (mm), where NEWTON_TOL is below one ulp of any t
+NEWTON_TOL_F32 = 1e-6
+
+
 # ---- intersection ----------------------------------------------------------------------------
 
 @nb.njit(**_OPTS)
@@ -159,7 +177,8 @@ def _newton_asphere(buf, m, S, s, vz):
     B = BLOCK
     zero = _like(0.0, buf)
     one = _like(1.0, buf)
-    tol = _like(NEWTON_TOL, buf)
+    rel = _newton_rel_tol(buf)
+    tol = _like(NEWTON_TOL, buf) if rel == zero else _like(NEWTON_TOL_F32, buf)
     miss = _like(MISSED, buf)
     cv = S[s, CV]
     ck1 = (one + S[s, CK]) * cv * cv
@@ -237,7 +256,7 @@ def _newton_asphere(buf, m, S, s, vz):
             step = act & (not broken)
             dt = g / gp
             dt = dt if step else zero
-            conv = step & (abs(dt) < tol)
+            conv = step & (abs(dt) < tol + rel * abs(t))
             buf[_T * B + k] = t - dt
             still = step & (not conv)
             buf[_ACT * B + k] = one if still else zero
