@@ -49,12 +49,15 @@ def _is_mono(wl) -> bool:
     return 1e-100 < float(wl[0]) < 1e100
 
 
-def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chunk_size=DEFAULT_CHUNK):
+def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chunk_size=DEFAULT_CHUNK,
+                 indexed: bool = False):
     """Trace ``rays`` in place through rows of a packed surface table (``kernels._layout.pack``).
 
     The low-level step under :func:`trace_through`, public for analyses that trace a lens in
     legs (ghost paths reflect between legs). ``kernel`` comes from ``kernels.get_kernel``.
-    ``S`` is not modified (a one-wavelength batch gets its indices on a copy).
+    ``S`` is not modified (a one-wavelength batch gets its indices on a copy), unless ``indexed``
+    says its index columns already hold the batch's one wavelength
+    (:meth:`physcam.trace.tables.PackedTable.at_wavelength`).
     """
     has_end = end_z is not None
     ez = float(end_z) if has_end else 0.0
@@ -65,7 +68,7 @@ def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chun
         wl = rays.wavelength_nm[a:b]
         mono = _is_mono(wl)
         Sw = S
-        if mono:
+        if mono and not indexed:
             Sw = np.array(S, dtype=np.float64)
             set_wavelength(Sw, float(wl[0]))
             if S.dtype != np.float64:
