@@ -182,16 +182,16 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
     def status(f, i, j, level):
         """Pass/fail of cells (f, i, j) at ``level``: their own, else their finest traced ancestor's."""
         out = np.zeros(i.size, dtype=bool)
-        todo = np.ones(i.size, dtype=bool)
+        todo = np.arange(i.size)
         for lv in range(level, -1, -1):
             sh = level - lv
-            k = keys(f, i >> sh, j >> sh, lv)
+            k = keys(f[todo], i[todo] >> sh, j[todo] >> sh, lv)
             ks, st = lookup[lv]
             pos = np.minimum(np.searchsorted(ks, k), ks.size - 1)
-            found = todo & (ks[pos] == k)
-            out[found] = st[pos[found]]
-            todo &= ~found
-            if not todo.any():
+            found = ks[pos] == k
+            out[todo[found]] = st[pos[found]]
+            todo = todo[~found]
+            if todo.size == 0:
                 break
         return out
 
@@ -200,12 +200,18 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
         F, I, J, fl = levels[-1][:4]
         lv = level - 1
         ni, nj = ns << lv, nphi << lv
-        st = fl == OK
-        diff = np.zeros(I.size, dtype=bool)
+        # visit the cells in key order: each direction's neighbour keys then come nearly sorted,
+        # which numpy's binary search exploits
+        order = np.argsort(keys(F, I, J, lv), kind="stable")
+        Fs, Is, Js = F[order], I[order], J[order]
+        st = (fl == OK)[order]
+        diff_s = np.zeros(I.size, dtype=bool)
         for di in (-1, 0, 1):
             for dj in (-1, 0, 1):
                 if di or dj:
-                    diff |= status(F, np.clip(I + di, 0, ni - 1), (J + dj) % nj, lv) != st
+                    diff_s |= status(Fs, np.clip(Is + di, 0, ni - 1), (Js + dj) % nj, lv) != st
+        diff = np.empty_like(diff_s)
+        diff[order] = diff_s
         refined.append(diff)
         if not diff.any():
             break
@@ -291,12 +297,18 @@ def spot_diagram(
     dirs = np.stack([np.zeros(th.size), np.sin(th), np.cos(th)], axis=1)  # one beam direction per field
     back = (z_ep - z0) / dirs[:, 2]
 
+    # the beams' unit directions exactly as RayBatch.from_arrays normalises them, once per field
+    unit = RayBatch.from_arrays(np.zeros((th.size, 3)), dirs, wl) if th.size else None
+
     def trace(f, u, v):
-        # every field's rays in one batch (one tracer call per refinement level)
-        d = dirs[f]
-        start = np.stack([beam * u, beam * v - back[f] * d[:, 1], np.full(u.size, z0)], axis=1)
-        res = trace_to_film(lens, RayBatch.from_arrays(start, d, wl), film_z, clip=clip,
-                            stop_semi_diameter=stop, backend=backend)
+        # every field's rays in one batch (one tracer call per refinement level), built column by
+        # column: the numbers RayBatch.from_arrays(start, dirs[f], wl) would hold
+        n = u.size
+        y = beam * v
+        y -= back[f] * dirs[f, 1]
+        rays = RayBatch(beam * u, y, np.full(n, float(z0)), unit.L[f], unit.M[f], unit.N[f], np.full(n, float(wl)),
+                        np.ones(n), np.zeros(n, dtype=np.uint8))
+        res = trace_to_film(lens, rays, film_z, clip=clip, stop_semi_diameter=stop, backend=backend, in_place=True)
         return res.flag, res.x, res.y
 
     samples = _refined_samples(trace, rings, refine, len(fields)) if fields else []

@@ -282,6 +282,7 @@ def camera_rays(
     stop_semi_diameter: float | None = None,
     backend: str = "auto",
     chunk_size: int = DEFAULT_CHUNK,
+    precision: str = "double",
 ) -> CameraRays:
     """Film point + pupil sample -> ray leaving the front of the lens, and its weight.
 
@@ -294,8 +295,12 @@ def camera_rays(
     Weight (pbrt-v4 ``RealisticCamera``): E = T cos^4(theta) A / d^2, with theta the ray's angle
     to the axis at the film, A the sampled rectangle's area and d the film-to-rear-vertex
     distance; T the Fresnel transmittance when ``fresnel``, times the aperture density.
+    ``precision="single"`` traces in float32 (renderers' camera rays; error against double in
+    docs/ray-tracing.md) and returns float32 arrays.
     """
     _check_lens(lens)
+    if precision not in ("double", "single"):
+        raise InputError(f"precision must be 'double' or 'single', got {precision!r}")
     fxy = np.atleast_2d(np.asarray(film_xy, dtype=np.float64))
     uv = np.atleast_2d(np.asarray(pupil_samples, dtype=np.float64))
     if fxy.shape[-1] != 2 or uv.shape[-1] != 2:
@@ -331,6 +336,8 @@ def camera_rays(
         rays.weight[:] = cos_t**4 * area / (d * d)  # unpolarised at the film: weight_sp stays 0
     # a weight that overflows (a film plane a hair behind the rear vertex) cannot be traced:
     # the kernels flag such a ray MISSED with weight 0
+    if precision == "single":
+        rays = rays.astype(np.float32)
 
     trace_through(lens, rays, reverse=True, clip=True, fresnel=fresnel, coating=coating,
                   stop_semi_diameter=stop_semi_diameter, aperture=aperture, backend=backend,

@@ -35,14 +35,13 @@ def _load_numba():
             from . import _jitcache
 
             _jitcache.install()
-            from ._numba import trace_rays, trace_rays_serial
+            from ._numba import trace_rays
 
             def trace_rays_auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
-                k = trace_rays_serial if x.shape[0] < SERIAL_BELOW else trace_rays
-                k(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono)
+                trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono,
+                           SERIAL_BELOW)
 
-            trace_rays_auto.parallel = trace_rays
-            trace_rays_auto.serial = trace_rays_serial
+            trace_rays_auto.jit = trace_rays
             _numba_kernel = trace_rays_auto
         except Exception as exc:  # ImportError, or numba failing to initialise
             _numba_error = f"{type(exc).__name__}: {exc}"

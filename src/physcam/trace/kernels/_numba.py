@@ -18,9 +18,9 @@ Two rare cases are handled per block, not per ray: the far root of a quadric (th
 sphere met first; a fix-up pass runs only when some lane needs it) and the Newton iteration of an
 even asphere (all lanes step together; it stops when no lane of the block still moves).
 
-``trace_rays`` runs the blocks in parallel (``prange``); ``trace_rays_serial`` does the same work
-on the calling thread, for small batches where waking the thread pool costs more than the rays
-(:data:`physcam.trace.kernels.SERIAL_BELOW`). Both take float64 or float32 rays and table: the
+``trace_rays`` runs the blocks in parallel (``prange``), or, below ``serial_below`` rays, on the
+calling thread: for small batches waking the thread pool costs more than the rays
+(:data:`physcam.trace.kernels.SERIAL_BELOW`). It takes float64 or float32 rays and table: the
 working precision follows the arrays.
 """
 
@@ -614,23 +614,23 @@ def _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end
 
 
 @nb.njit(parallel=True, **_OPTS)
-def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
-    """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``;
-    blocks of :data:`BLOCK` rays in parallel."""
+def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, serial_below):
+    """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``.
+
+    Blocks of :data:`BLOCK` rays run in parallel on numba's thread pool, or, for fewer than
+    ``serial_below`` rays, one after the other on the calling thread (one compiled function for
+    both, so a cold start loads one kernel from the cache)."""
     n = x.shape[0]
     nblocks = (n + BLOCK - 1) // BLOCK
+    if n < serial_below:
+        buf = np.empty(_NCOL * BLOCK, dtype=x.dtype)
+        for blk in range(nblocks):
+            i0 = blk * BLOCK
+            _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, i0,
+                         min(BLOCK, n - i0), buf)
+        return
     for blk in nb.prange(nblocks):
         i0 = blk * BLOCK
         buf = np.empty(_NCOL * BLOCK, dtype=x.dtype)
-        _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, i0,
-                     min(BLOCK, n - i0), buf)
-
-
-@nb.njit(**_OPTS)
-def trace_rays_serial(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
-    """:func:`trace_rays` on the calling thread (small batches)."""
-    n = x.shape[0]
-    buf = np.empty(_NCOL * BLOCK, dtype=x.dtype)
-    for i0 in range(0, n, BLOCK):
         _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, i0,
                      min(BLOCK, n - i0), buf)
