@@ -160,8 +160,14 @@ def bokeh_image(
         def const(v):
             return np.full(n, v, dtype=dt)
 
-        b = RayBatch(const(x_mm), const(y_mm), const(z_src), col(dx), col(dy), col(dzn), col(wl), col(w),
-                     np.zeros(n, dtype=np.uint8))
+        if dt is np.float64:
+            b = RayBatch(const(x_mm), const(y_mm), const(z_src), dx, dy, dzn, wl, w, np.zeros(n, dtype=np.uint8))
+        else:
+            # single precision: start each ray where it crosses the front vertex plane (its target
+            # point, exact) rather than at the light: intersecting the first surface from a light
+            # a metre away would cost float32 the digits that 1 - c^2 h^2 keeps out of c^2 z^2
+            b = RayBatch(col(r * np.cos(phi)), col(r * np.sin(phi)), const(0.0), col(dx), col(dy), col(dzn),
+                         col(wl), col(w), np.zeros(n, dtype=np.uint8))
         return b, ch
 
     if extent_mm is None:  # a pilot trace sizes the window (in double: it sets the image's frame)
