@@ -9,7 +9,10 @@ reported: rays whose flag differs, the largest film-position difference of a ray
 both, and the change of the RMS spot radius and of the centroid. Bokeh: ``bokeh_image`` of a
 light 1 m from the film, on axis and at 60 % of the half-diagonal of a full-frame gate, with
 ``precision="single"`` against ``"double"`` (same random rays); reported: the relative L1
-difference of the images, passed-ray counts and the centroid shift.
+difference of the images, passed-ray counts and the centroid shift. Camera rays: ``camera_rays``
+from 1e5 random film points (within 12 mm of the centre) and pupil samples, with Fresnel;
+reported: the largest angle between the float32 and float64 directions, origin and weight
+differences.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from physcam.analysis.bokeh import bokeh_image
 from physcam.analysis.spot import equal_area_disk
 from physcam.lens.library import list_lenses, load_lens
 from physcam.optics.paraxial import gaussian
-from physcam.trace import RayBatch, paraxial_image_z, trace_to_film
+from physcam.trace import RayBatch, camera_rays, paraxial_image_z, trace_to_film
 
 
 def rms(out, ok):
@@ -81,6 +84,19 @@ def bokeh_errors(lens, film, y_mm, rays):
                 dcen_um=1e3 * math.hypot(ca[0] - cb[0], ca[1] - cb[1])), None
 
 
+def camera_errors(lens, film, n=100_000):
+    rng = np.random.default_rng(0)
+    fxy, uv = rng.uniform(-12, 12, (n, 2)), rng.random((n, 2))
+    a = camera_rays(lens, fxy, uv, film, fresnel=True)
+    b = camera_rays(lens, fxy, uv, film, fresnel=True, precision="single")
+    ok = a.ok & b.ok
+    da, db = a.direction[ok], b.direction[ok].astype(np.float64)
+    sin = np.linalg.norm(np.cross(da, db), axis=1) / np.linalg.norm(db, axis=1)  # not arccos of a dot near 1
+    return dict(flags=int((a.ok != b.ok).sum()), n=n, arcsec=float(np.degrees(sin.max()) * 3600) if ok.any() else 0.0,
+                dpos_um=float(np.linalg.norm(a.origin[ok] - b.origin[ok], axis=1).max() * 1e3) if ok.any() else 0.0,
+                dw=float(np.abs(a.weight[ok] - b.weight[ok]).max() / a.weight[ok].max()) if ok.any() else 0.0)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rings", type=int, default=48)
@@ -119,8 +135,15 @@ def main() -> None:
                 worst["l1"] = max(worst["l1"], bo["l1"])
                 worst["bcen"] = max(worst["bcen"], bo["dcen_um"])
             print(line)
+        c = camera_errors(lens, film)
+        print(f"{'':28s} camera rays: flags differing {c['flags']}/{c['n']}, direction {c['arcsec']:.3f} arcsec, "
+              f"origin {c['dpos_um']:.4f} um, weight {c['dw']:.1e} (relative to the largest)")
+        worst["cam_arcsec"] = max(worst.get("cam_arcsec", 0.0), c["arcsec"])
+        worst["cam_um"] = max(worst.get("cam_um", 0.0), c["dpos_um"])
+        worst["cam_flags"] = max(worst.get("cam_flags", 0), c["flags"])
     print(f"worst: spot ray position {worst['dpos']:.4f} um, RMS change {worst['drms']:.5f} um, flags differing "
-          f"{100 * worst['flags']:.3f} % of rays; bokeh image L1 {worst['l1']:.2e}, centroid {worst['bcen']:.4f} um")
+          f"{100 * worst['flags']:.3f} % of rays; bokeh image L1 {worst['l1']:.2e}, centroid {worst['bcen']:.4f} um; "
+          f"camera rays {worst['cam_arcsec']:.3f} arcsec, {worst['cam_um']:.4f} um, flags differing {worst['cam_flags']}")
 
 
 if __name__ == "__main__":

@@ -337,6 +337,11 @@ def camera_rays(
     # a weight that overflows (a film plane a hair behind the rear vertex) cannot be traced:
     # the kernels flag such a ray MISSED with weight 0
     if precision == "single":
+        # start where the ray crosses the rear vertex plane (its aim point, exact), so float32
+        # meets the first surface from close by (docs/ray-tracing.md, "Single precision")
+        rays.x[:] = px
+        rays.y[:] = py
+        rays.z[:] = z_rear
         rays = rays.astype(np.float32)
 
     trace_through(lens, rays, reverse=True, clip=True, fresnel=fresnel, coating=coating,
