@@ -51,7 +51,7 @@ class _AggPlot:
     @staticmethod
     def close(fig=None) -> None:
         """Figures made here belong to no figure manager: dropping the last reference frees them."""
-        if fig is not None and getattr(fig.canvas, "manager", None) is not None:
+        if getattr(getattr(fig, "canvas", None), "manager", None) is not None:
             _real_pyplot().close(fig)
 
     def __getattr__(self, name):

@@ -142,10 +142,17 @@ def packed_table(lens: Prescription, *, reverse: bool = False, stop_semi_diamete
 
 
 def _packed_table(lens, reverse, stop_semi_diameter, coating, dtype) -> PackedTable:
+    from ..errors import InputError, require_type
+
+    require_type("lens", lens, Prescription, "load one with physcam.lens.library.load_lens(name)")
+    if not isinstance(coating, (str, type(None))):
+        raise InputError(f"coating must be 'none', 'single', 'multi' or None, got {coating!r}")
     if coating is None:
         mc = lens.metadata.coating
         coating = mc if mc in ("none", "single", "multi") else "none"
     dt = np.dtype(dtype)
+    if dt not in (np.dtype(np.float64), np.dtype(np.float32)):
+        raise InputError(f"packed tables are float64 or float32, not {dt}")
     stop = None if stop_semi_diameter is None else float(stop_semi_diameter)
     key = (bool(reverse), stop, coating, dt.char)
     e = _entry(lens)
