@@ -61,12 +61,11 @@ def timed(fn, rounds) -> tuple[float, float]:
 
 
 def overhead(lens, film) -> None:
-    from physcam.trace.kernels import get_kernel
+    from physcam.trace.kernels import jit_kernel
     from physcam.trace.tables import packed_table
 
     ray = RayBatch.collimated([1.0], [0.5], -1.0)
-    kernel = get_kernel("auto")
-    jit = getattr(kernel, "jit", None)
+    jit = jit_kernel()  # loads numba: from here on "auto" uses the JIT kernel
     t_film = per_call(lambda: trace_to_film(lens, ray, film))
     work = ray.copy()
     t_inplace = per_call(lambda: trace_through(lens, work, end_z=film, in_place=True))
@@ -86,7 +85,7 @@ def crossover(lens, film) -> None:
     from physcam.trace import kernels
     from physcam.trace.tables import packed_table
 
-    jit = getattr(kernels.get_kernel("auto"), "jit", None)
+    jit = kernels.jit_kernel()
     if jit is None:
         print("  (no serial/parallel switch in this physcam)")
         return
@@ -120,6 +119,12 @@ def main() -> None:
     args = ap.parse_args()
     lens = load_lens("dgauss_50mm")
     film = paraxial_image_z(lens)
+    try:  # a warm process: numba loaded ("auto" starts on numpy until numba pays for its loading)
+        from physcam.trace.kernels import numba_available
+
+        numba_available()
+    except ImportError:
+        pass
     trace_to_film(lens, RayBatch.collimated([1.0], [0.5], -1.0), film)
     print(f"physcam small calls, dgauss_50mm; load average {load()}")
     for label, busy in (("machine as it is", 0), (f"with {args.busy} busy process(es) beside it", args.busy)):

@@ -9,7 +9,7 @@ import pytest
 
 from physcam.lens.library import list_lenses, load_lens
 from physcam.trace import RayBatch, camera_rays, paraxial_image_z, trace_through
-from physcam.trace.kernels import get_kernel, numba_available
+from physcam.trace.kernels import numba_available
 
 pytestmark = pytest.mark.skipif(not numba_available(), reason="numba is not installed")
 
@@ -50,8 +50,9 @@ def test_geometry_is_bitwise_the_reference_and_fresnel_weights_within_a_few_ulps
 
 
 def test_serial_and_parallel_paths_agree_bit_for_bit_at_block_edges():
-    kernel = get_kernel("numba")
-    jit = kernel.jit
+    from physcam.trace.kernels import jit_kernel
+
+    jit = jit_kernel()
     from physcam.trace.kernels._numba import BLOCK
     from physcam.trace.tables import packed_table
 

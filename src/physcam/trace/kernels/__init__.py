@@ -1,10 +1,17 @@
 """Kernel dispatch: ``backend="auto" | "numba" | "numpy"``.
 
-The only module that imports numba (lazily: on the first trace that needs it, so commands that
-never trace do not pay the ~0.1 s import). "auto" uses the JIT kernel when numba imports, else
-the numpy kernel; both have the signature of :func:`._numpy.trace_rays` and give the same answers
-to the tolerance in docs/ray-tracing.md (tests/trace/test_backends.py). Set
-``PHYSCAM_BACKEND=numpy`` to force the fallback.
+The only module that imports numba. Both kernels have the signature of :func:`._numpy.trace_rays`
+and give the same rays: identical flags, positions and directions, Fresnel weights within a few
+units in the last place (docs/ray-tracing.md, tests/trace/test_simd_kernel.py). Set
+``PHYSCAM_BACKEND=numpy`` (or ``numba``) to force one.
+
+"auto" loads numba lazily, when it pays: importing numba and loading the cached JIT kernel cost
+about 0.2 s once per process, more than a short command's whole tracing work in the numpy kernel
+(a spot diagram, a distortion curve: 10-40 ms). So "auto" runs the numpy kernel while the work it
+has done (estimated from rays x surfaces, :data:`NUMPY_RAY_SURFACE_S`, :data:`NUMPY_SURFACE_S`)
+stays under :data:`NUMPY_BUDGET_S` and the call at hand under :data:`NUMPY_CALL_MAX_S`; the first
+call past either loads numba, and from then on (or whenever numba is already loaded) every call
+uses the JIT kernel. Since the kernels agree, the answer does not depend on which one ran.
 
 The JIT kernel runs on the calling thread below :data:`SERIAL_BELOW` rays and on numba's thread
 pool above: waking the pool costs a few microseconds on an idle machine and, on a busy one,
@@ -19,13 +26,21 @@ import os
 
 from ...errors import BackendError
 
-__all__ = ["BACKENDS", "SERIAL_BELOW", "get_kernel", "resolve_backend", "numba_available"]
+__all__ = ["BACKENDS", "SERIAL_BELOW", "get_kernel", "resolve_backend", "numba_available", "jit_kernel"]
 
 BACKENDS = ("auto", "numba", "numpy")
 #: Batches smaller than this run the JIT kernel serially (measured crossover, docs/performance.md).
 SERIAL_BELOW = 4096
+#: "auto" before numba is loaded: the numpy kernel's cost per ray and surface, and per surface and
+#: call (dgauss_50mm on this machine: 1.3-2.2 M rays/s through 11 surfaces; ~25 us of numpy calls
+#: per surface), the numpy work allowed in all (about half of what loading numba costs) and in one call
+NUMPY_RAY_SURFACE_S = 60e-9
+NUMPY_SURFACE_S = 30e-6
+NUMPY_BUDGET_S = 0.1
+NUMPY_CALL_MAX_S = 0.04
 _numba_kernel = None
 _numba_error: str | None = None
+_numpy_spent = 0.0
 
 
 def _load_numba():
@@ -52,6 +67,32 @@ def numba_available() -> bool:
     return _load_numba() is not None
 
 
+def jit_kernel():
+    """The numba dispatcher itself (``trace_rays`` with the trailing ``serial_below`` argument),
+    loading numba; None when numba is unavailable. For benchmarks and tests."""
+    k = _load_numba()
+    return None if k is None else k.jit
+
+
+def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
+    """The "auto" kernel: numpy until numba pays for its loading, then the JIT kernel (module notes)."""
+    global _numpy_spent
+    k = _numba_kernel
+    if k is None:
+        if _numba_error is None:
+            est = (kinds.shape[0] + 1) * (NUMPY_SURFACE_S + x.shape[0] * NUMPY_RAY_SURFACE_S)
+            if est < NUMPY_CALL_MAX_S and _numpy_spent + est < NUMPY_BUDGET_S:
+                _numpy_spent += est
+                k = None
+            else:
+                k = _load_numba()
+        if k is None:
+            from ._numpy import trace_rays
+
+            return trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono)
+    return k(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono)
+
+
 def resolve_backend(backend: str = "auto") -> str:
     """The concrete backend name ("numba" or "numpy") for ``backend``."""
     if backend not in BACKENDS:
@@ -68,9 +109,12 @@ def resolve_backend(backend: str = "auto") -> str:
 
 
 def get_kernel(backend: str = "auto"):
-    """The ``trace_rays`` function of ``backend``."""
-    if backend == "auto" and _numba_kernel is not None and "PHYSCAM_BACKEND" not in os.environ:
-        return _numba_kernel  # the common case, without the checks (per-call overhead)
+    """The ``trace_rays`` function of ``backend`` ("auto": numpy until numba pays, module notes)."""
+    if backend == "auto":
+        env = os.environ.get("PHYSCAM_BACKEND", "auto")
+        if env == "auto":
+            return _numba_kernel if _numba_kernel is not None else _auto
+        backend = env
     if resolve_backend(backend) == "numba":
         return _load_numba()
     from ._numpy import trace_rays
