@@ -150,6 +150,8 @@ def trace_through(
         return _run(kernel, out, packed, None, clip, fresnel, end_z, chunk_size)
     # trace to the stop, weigh by the aperture shape there, then on through the rest
     k = packed.stop_row
+    if k < 0:
+        lens.stop_index  # raises LensFileError: no aperture stop to shape
     _run(kernel, out, packed, slice(0, k + 1), clip, fresnel, None, chunk_size)
     rstop = packed.table.semi_diameter[k]
     dens = aperture.density_at(out.x / rstop, out.y / rstop)
