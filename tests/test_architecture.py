@@ -19,6 +19,7 @@ LAYER = {
     "analysis": 6, "onset": 6,
     "export": 7,
     "usd": 8,
+    "live": 8.5,
     "cli": 9,
     "": 0,  # the root package only re-exports errors and the version
     "__main__": 10,

@@ -1,10 +1,9 @@
 """ST-maps at a focus (physcam.analysis.stmap), checked against forward-traced object points.
 
-The oracle: object points on the plane of sharp focus, each placed where physcam's best-match
-pinhole (GaussianData at that focus, camera at the entrance pupil) sees a chosen ideal pixel;
-their chief rays are aimed *forward* here (a Newton iteration written in this file, from the
-object point through the centre of the stop) and traced to the film. That is independent of the
-module's backward chief rays from film points and of its interpolation and inversion.
+The oracle (tests/analysis/_forward_chief.py): object points on the plane of sharp focus, each
+placed where physcam's best-match pinhole sees a chosen ideal pixel, their chief rays aimed
+*forward* through the centre of the stop and traced to the film; independent of the module's
+backward chief rays from film points, its interpolation and its inversion.
 """
 
 from __future__ import annotations
@@ -16,46 +15,11 @@ import pytest
 
 from physcam.errors import PhysCamError
 from physcam.lens.library import load_lens
-from physcam.optics.focusing import focus
-from physcam.optics.paraxial import gaussian
-from physcam.trace import RayBatch, trace_through
+from _forward_chief import ideal_grid_and_real
 
 W_PX, H_PX = 2048, 1366
 SENSOR = (36.0, 24.0)
 FOCUS = 2000.0
-
-
-def _forward_chief_to_film(q, obj_pts, object_z, film_z, wl):
-    """Film (x, y) mm of chief rays from object points (n, 2) on z = object_z, aimed at the stop centre."""
-    k = q.stop_index
-    front = q.with_surfaces(q.surfaces[: k + 1])
-    z_ep = gaussian(q, wavelength_nm=wl, object_z=object_z, film_z=film_z).z_entrance_pupil
-    n = obj_pts.shape[0]
-
-    def at_stop(a, b):
-        P = np.tile(obj_pts, (a.size // n, 1))
-        pos = np.stack([P[:, 0], P[:, 1], np.full(a.size, object_z)], axis=1)
-        d = np.stack([a - P[:, 0], b - P[:, 1], np.full(a.size, z_ep - object_z)], axis=1)
-        out = trace_through(front, RayBatch.from_arrays(pos, d, wl), clip=False)
-        assert out.ok.all()
-        return np.stack([out.x, out.y], axis=1), pos, d
-
-    a = np.zeros(n)
-    b = np.zeros(n)
-    e = 1e-6
-    for _ in range(30):
-        s, _, _ = at_stop(np.concatenate([a, a + e, a]), np.concatenate([b, b, b + e]))
-        r, ra, rb = s[:n], (s[n:2 * n] - s[:n]) / e, (s[2 * n:] - s[:n]) / e
-        if np.abs(r).max() < 1e-10:
-            break
-        det = ra[:, 0] * rb[:, 1] - rb[:, 0] * ra[:, 1]
-        a = a - (rb[:, 1] * r[:, 0] - rb[:, 0] * r[:, 1]) / det
-        b = b - (-ra[:, 1] * r[:, 0] + ra[:, 0] * r[:, 1]) / det
-    assert np.abs(r).max() < 1e-8
-    _, pos, d = at_stop(a, b)
-    out = trace_through(q, RayBatch.from_arrays(pos, d, wl), end_z=film_z, clip=False)
-    assert out.ok.all()
-    return np.stack([out.x, out.y], axis=1)
 
 
 def _sample(stmap, xy_px, size):
@@ -80,22 +44,7 @@ def case(request):
 
 
 def _ideal_grid_and_real(lens, res):
-    """An ideal pixel grid inside the frame and the forward-traced real pixel of each point."""
-    wl = lens.wavelength_nm
-    st = focus(lens, FOCUS, axis="y", wavelength_nm=wl)
-    q = st.prescription
-    gx = gaussian(q, axis="x", wavelength_nm=wl, object_z=st.object_z, film_z=st.film_z)
-    gy = gaussian(q, axis="y", wavelength_nm=wl, object_z=st.object_z, film_z=st.film_z)
-    sx, sy = W_PX / SENSOR[0], H_PX / SENSOR[1]
-    X, Y = np.meshgrid(np.linspace(40, W_PX - 40, 11), np.linspace(30, H_PX - 30, 8))
-    ideal = np.stack([X.ravel(), Y.ravel()], axis=1)
-    # the object point the pinhole (focal length f, at the entrance pupil) images at the ideal pixel
-    Xo = (ideal[:, 0] - W_PX / 2) / sx / gx.pinhole_focal_length * (gx.z_entrance_pupil - st.object_z)
-    Yo = (ideal[:, 1] - H_PX / 2) / sy / gy.pinhole_focal_length * (gy.z_entrance_pupil - st.object_z)
-    film = _forward_chief_to_film(q, np.stack([Xo, Yo], axis=1), st.object_z, st.film_z, wl)
-    # the picture is the film image turned by 180 degrees; pixels from the bottom-left corner
-    real = np.stack([W_PX / 2 - film[:, 0] * sx, H_PX / 2 - film[:, 1] * sy], axis=1)
-    return ideal, real
+    return ideal_grid_and_real(lens, FOCUS, SENSOR, (W_PX, H_PX))
 
 
 def test_undistortion_map_takes_traced_points_to_the_pinhole_grid(case):

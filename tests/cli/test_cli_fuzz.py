@@ -30,6 +30,16 @@ NUMBERS = ["0", "-1", "1", "2.8", "50", "1e308", "-1e308", "5e-324", "1e12", "na
 LENSES = ["dgauss_50mm", "nikkor_fisheye_16mm_f2_8", "navarro_anamorphic_2x", "fisheye_10mm", "no_such_lens", "",
           "/dev/null"]
 FILES = ["out.usda", "out.png", "out.svg", "out.txt", "", "missing_dir/out.usda", "out.usdc"]
+#: flags appended to every fuzzed run of a command (after the drawn ones, so they win): receivers and
+#: senders run for a bounded time instead of until Ctrl-C
+BOUNDED = {("live", "record"): ["--duration=0.3"], ("live", "send"): ["--duration=0.3"],
+           ("live", "play"): ["--duration=0.3"]}
+#: A valid command line some leaves start from, so that the fuzzed flags reach the handler instead of
+#: stopping at a missing required option (argparse keeps the last of a repeated option).
+BASE_ARGV = {
+    ("export", "rib"): ["-o", "out.rib", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--force"],
+    ("export", "pbrt"): ["-o", "pbrt_out", "--lens", "dgauss_50mm", "--focus", "3m", "--force"],
+}
 NAN_OR_INF = re.compile(r"(?<![A-Za-z_])(nan|NaN|inf|Infinity)(?![A-Za-z_])")
 
 
@@ -68,7 +78,7 @@ def _argv_strategy(path, parser):
 
     @st.composite
     def build(draw):
-        argv = list(path)
+        argv = list(path) + BASE_ARGV.get(tuple(path), [])
         for a in positionals:
             n = 1 if a.nargs in (None, 1) else draw(st.integers(1, 2))
             argv += [draw(_value_strategy(a)) for _ in range(n)]
@@ -81,7 +91,7 @@ def _argv_strategy(path, parser):
                 n = 1 if a.nargs in (None, 1, "?") else draw(st.integers(1, 2))
                 for _ in range(n):
                     argv.append(f"{flag}={draw(_value_strategy(a))}")
-        return argv
+        return argv + BOUNDED.get(tuple(path), [])
 
     return build()
 

@@ -53,3 +53,60 @@ def test_plot_file_with_resolution_is_refused_not_ignored(tmp_path, capsys):
     rc = main(["distortion", "zeiss_distagon_35mm_f4", "--resolution", "256x171", "-o", str(tmp_path / "d.png")])
     err = capsys.readouterr().err
     assert rc == 2 and "--stmap DIR" in err and not (tmp_path / "d.png").exists()
+
+
+def test_fits_in_json_and_their_files(tmp_path, capsys):
+    """The issue's command: maps, 3DE4, Brown-Conrady and Nuke files, and --json of the fits."""
+    out = tmp_path / "out"
+    rc = main(["distortion", "dgauss_50mm", "--focus", "2m", "--sensor", "ALEXA 35", "--resolution", "1152x791",
+               "--stmap", str(out), "--fit", "3de4", "--fit", "brown", "--fit", "nuke", "--json"])
+    assert rc == 0
+    d = json.loads(capsys.readouterr().out)
+    models = [f["model"] for f in d["fits"]]
+    assert models == ["3DE4 Radial - Standard, Degree 4", "Brown-Conrady D-U", "Brown-Conrady U-D"]
+    for f in d["fits"]:
+        assert f["acceptable"] and 0 <= f["residual_px"]["rms"] <= f["residual_px"]["max"] <= 0.5
+    names = {p.rsplit("/", 1)[-1] for p in d["written"]}
+    assert {"3de4_radial_standard_degree_4.txt", "brown_conrady.json", "physcam_stmap.nk", "residual_3de4.png",
+            "distortion.exr", "undistortion.exr"} <= names
+    brown = json.loads((out / "brown_conrady.json").read_text())
+    entries = brown["opentrackio_lens_distortion"]
+    assert [e["model"] for e in entries] == ["Brown-Conrady D-U", "Brown-Conrady U-D"]
+    assert all(len(e["radial"]) == 3 and len(e["tangential"]) == 2 for e in entries)
+    assert entries[0]["radial"][0] > 0 > entries[1]["radial"][0]  # barrel: D-U grows the radius, U-D shrinks it
+
+
+def test_distortion_across_focus_table(capsys):
+    from physcam.analysis.distortion import real_distortion
+    from physcam.lens.library import load_lens
+
+    rc = main(["distortion", "zuiko_18mm_f3_5", "--resolution", "1024x683", "--across-focus", "0.4m,1m,inf",
+               "--json"])
+    assert rc == 0
+    d = json.loads(capsys.readouterr().out)
+    rows = d["rows"]
+    assert [r["focus_from_film_mm"] for r in rows] == [400.0, 1000.0, None]
+    # distortion breathes: the barrel deepens as the lens focuses close
+    assert rows[0]["corner_distortion_pct"] < rows[1]["corner_distortion_pct"] < rows[2]["corner_distortion_pct"] < 0
+    # at infinity the corner figure agrees with the field-angle table's (a separate 1-D code path, chief rays
+    # from infinity): its distortion where the real chief ray reaches the corner radius, 21.633 mm
+    assert main(["distortion", "dgauss_50mm", "--resolution", "1024x683", "--across-focus", "inf", "--json"]) == 0
+    corner = json.loads(capsys.readouterr().out)["rows"][0]["corner_distortion_pct"]
+    pts = real_distortion(load_lens("dgauss_50mm"), np.linspace(0.0, 24.0, 97), sensor_width_mm=36,
+                          sensor_height_mm=24).points
+    h = np.array([p.real_height_mm for p in pts])
+    pct = np.array([p.distortion_pct for p in pts])
+    ref = np.interp(np.hypot(18.0, 12.0), np.abs(h), pct)
+    assert corner < -1.0 and abs(corner - ref) < 0.01
+    # text table for people
+    assert main(["distortion", "zuiko_18mm_f3_5", "--resolution", "1024x683", "--across-focus", "0.5m,inf"]) == 0
+    assert "pinhole mm" in capsys.readouterr().out
+
+
+def test_fit_options_need_their_partners(tmp_path, capsys):
+    for argv in (["--fit", "brown"], ["--across-focus", "1m"], ["--resolution", "512x342", "--fit", "nuke"],
+                 ["--resolution", "512x342", "--across-focus", "1m", "--focus", "2m"],
+                 ["--resolution", "512x342", "--fit", "brown", "--max-residual", "0"]):
+        rc = main(["distortion", "dgauss_50mm", *argv])
+        err = capsys.readouterr().err
+        assert rc == 2 and err.startswith("physcam: error:") and err.count("\n") == 1, (argv, err)

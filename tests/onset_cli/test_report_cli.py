@@ -83,6 +83,10 @@ def test_demo_writes_outputs(tmp_path, capsys):
     osl = (out / "blender" / "dgauss_50mm.osl").read_text()
     assert "camera_shader_raster_position" in osl and (out / "blender" / "setup_dgauss_50mm.py").exists()
     assert (out / "blender" / "builtin_dgauss_50mm.py").exists()
+    # issue 12: ST-maps of the default lens at 3 m on the ALEXA 35, its fitted models and a Nuke script
+    for name in ("distortion.exr", "undistortion.exr", "brown_conrady.json", "3de4_radial_standard_degree_4.txt",
+                 "physcam_stmap.nk"):
+        assert (out / "distortion" / name).exists(), name
     assert main(["demo", "--out", str(out)]) == 2  # exists, no --force
 
 

@@ -53,6 +53,8 @@ __all__ = ["DistortionField", "distortion_field", "apply_stmap", "write_stmaps",
 #: Largest width or height (pixels) and largest frame (pixels) a map is made for.
 MAX_SIDE_PX = 8192
 MAX_PIXELS = 36_000_000
+#: The farthest the ideal (pinhole) image of the frame may reach, in frame half-sizes from the centre.
+MAX_PINHOLE_REACH = 3.0
 #: Grid spacing (pixels) of the traced chief rays and of the inverse's nodes.
 NODE_SPACING_PX = 32.0
 
@@ -135,10 +137,13 @@ class DistortionField:
     interpolation_error_px: float  # max |interpolated - traced| ideal position at the grid cells' centres
     inverse_error_px: float  # max |D(U(q)) - q| at the inverse grid cells' centres
     max_distortion_px: float  # largest |ideal - real| over the traced nodes
-    distortion_stmap: np.ndarray = field(repr=False)  # (h, w, 3) float32
-    undistortion_stmap: np.ndarray = field(repr=False)  # (h + 2 oy, w + 2 ox, 3) float32
+    distortion_stmap: np.ndarray | None = field(repr=False)  # (h, w, 3) float32; None when made without maps
+    undistortion_stmap: np.ndarray | None = field(repr=False)  # (h + 2 oy, w + 2 ox, 3) float32; or None
     notes: list[str] = field(default_factory=list)
     _forward: _Grid | None = field(default=None, repr=False)
+    #: Every traced chief ray (grid nodes and cell centres): real and ideal plate pixels (n, 2) each
+    traced_real_px: np.ndarray | None = field(default=None, repr=False)
+    traced_ideal_px: np.ndarray | None = field(default=None, repr=False)
 
     def ideal_from_real(self, xy_px) -> np.ndarray:
         """Ideal (undistorted) plate pixel positions (n, 2) of real ones (interpolated field)."""
@@ -156,7 +161,8 @@ class DistortionField:
             "overscan_px": list(self.overscan_px),
             "undistorted_size_px": [self.size_px[0] + 2 * self.overscan_px[0], self.size_px[1] + 2 * self.overscan_px[1]],
             "grid_nodes": list(self.grid_nodes), "interpolation_error_px": self.interpolation_error_px,
-            "inverse_error_px": self.inverse_error_px, "max_distortion_px": self.max_distortion_px,
+            "inverse_error_px": None if math.isnan(self.inverse_error_px) else self.inverse_error_px,
+            "maps": self.distortion_stmap is not None, "max_distortion_px": self.max_distortion_px,
             "convention": "ST-map: R = u, G = v, 0..1, origin bottom-left, pixel centres at (i + 0.5) / width; B = 0",
             "notes": list(self.notes),
         }
@@ -202,9 +208,14 @@ def distortion_field(
     wavelength_nm: float | None = None,
     method: str = "auto",
     backend: str = "auto",
+    maps: bool = True,
 ) -> DistortionField:
     """Real distortion of ``lens`` focused at ``focus_mm`` over a ``width_px`` x ``height_px`` frame,
-    with its distortion and undistortion ST-maps (module notes)."""
+    with its distortion and undistortion ST-maps (module notes).
+
+    ``maps=False`` traces the same chief rays but makes no ST-maps (the map fields and the overscan
+    are then None and (0, 0)): what fitting models and tables across focus need.
+    """
     from ..optics.focusing import focus
     from ..optics.paraxial import gaussian
 
@@ -243,8 +254,28 @@ def distortion_field(
     fwd = _Grid(nodes, 0.0, dx, 0.0, dy)
     cx, cy = np.meshgrid((np.arange(nx - 1) + 0.5) * dx, (np.arange(ny - 1) + 0.5) * dy)
     exact = trace(cx.ravel(), cy.ravel())
+    # a fisheye on this sensor: the pinhole would put the frame's edge far outside it (at 90 degrees,
+    # infinitely far); no pinhole-based map or model represents that
+    reach = float(max(np.abs(nodes[..., 0] - w_px / 2).max() / (w_px / 2), np.abs(nodes[..., 1] - h_px / 2).max() / (h_px / 2)))
+    if reach > MAX_PINHOLE_REACH:
+        r_mm = float(np.hypot((nodes[..., 0] - w_px / 2) / sx, (nodes[..., 1] - h_px / 2) / sy).max())
+        angle = math.degrees(math.atan(r_mm / float(g["y"].pinhole_focal_length)))
+        raise OpticsError(
+            f"{lens.name!r} sees up to {angle:.1f} deg off axis on a {W:g} x {H:g} mm sensor: its pinhole image would "
+            f"reach {reach:.1f} times the frame's half-size, so no pinhole-based distortion map or model represents "
+            "it (a fisheye); give a smaller sensor")
     interp_err = float(np.hypot(*(fwd.at(cx.ravel(), cy.ravel()) - exact).T).max())
     max_dist = float(np.hypot(nodes[..., 0] - X, nodes[..., 1] - Y).max())
+    traced_real = np.concatenate([np.stack([X.ravel(), Y.ravel()], axis=1), np.stack([cx.ravel(), cy.ravel()], axis=1)])
+    traced_ideal = np.concatenate([nodes.reshape(-1, 2), exact])
+    notes = ["pinhole focal length: the paraxial one at this focus (GaussianData.pinhole_focal_length), "
+             "camera at the entrance pupil"]
+    if not maps:
+        return DistortionField(
+            lens.name, float(st.focus_from_film_mm), float(wl), (W, H), (w_px, h_px),
+            (float(g["x"].pinhole_focal_length), float(g["y"].pinhole_focal_length)),
+            (float(st.film_z - g["x"].z_entrance_pupil), float(st.film_z - g["y"].z_entrance_pupil)),
+            (0, 0), (nx, ny), interp_err, math.nan, max_dist, None, None, notes, fwd, traced_real, traced_ideal)
 
     ideal_px = fwd.on_pixels(w_px, h_px)  # (h, w, 2), rows top first
     # overscan: the symmetric margin whose box keeps the ideal position of every plate pixel
@@ -297,13 +328,12 @@ def distortion_field(
     del real_px
     if not (np.isfinite(dmap).all() and np.isfinite(umap).all()):
         raise OpticsError(f"the ST-maps of {lens.name!r} have non-finite values: no map written")
-    notes = [f"pinhole focal length from GaussianData.pinhole_focal_length at this focus; camera at the entrance pupil"]
     zf = st.film_z
     return DistortionField(
         lens.name, float(st.focus_from_film_mm), float(wl), (W, H), (w_px, h_px),
         (float(g["x"].pinhole_focal_length), float(g["y"].pinhole_focal_length)),
         (float(zf - g["x"].z_entrance_pupil), float(zf - g["y"].z_entrance_pupil)),
-        (ox, oy), (nx, ny), interp_err, inv_err, max_dist, dmap, umap, notes, fwd)
+        (ox, oy), (nx, ny), interp_err, inv_err, max_dist, dmap, umap, notes, fwd, traced_real, traced_ideal)
 
 
 def apply_stmap(image, stmap) -> np.ndarray:
@@ -369,6 +399,8 @@ def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> lis
 
     if not isinstance(result, DistortionField):
         raise InputError(f"write_stmaps takes a DistortionField, got {type(result).__name__}")
+    if result.distortion_stmap is None:
+        raise InputError("this distortion field was made without maps (maps=False): nothing to write")
     d = Path(folder)
     if d.exists() and not d.is_dir():
         raise ExportError(f"{str(d)!r} exists and is not a folder: give a folder for the ST-maps")

@@ -25,7 +25,7 @@ __all__ = ["main", "build_parser"]
 
 
 #: Command modules in --help order; modules not listed follow alphabetically.
-COMMAND_ORDER = ("report", "sensors", "lens", "trace", "analyze", "usd", "demo")
+COMMAND_ORDER = ("report", "sensors", "lens", "trace", "analyze", "distortion", "usd", "demo")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -1,4 +1,6 @@
-"""``physcam distortion|illumination|colour|breathing-real|ghosts LENS``: real-ray analyses (docs/analyses.md).
+"""``physcam illumination|colour|breathing-real|ghosts LENS``: real-ray analyses (docs/analyses.md).
+
+``physcam distortion`` lives in :mod:`physcam.cli.distortion` and shares this module's options.
 
 Top-level commands, like ``physcam spot`` and ``physcam bokeh``. Each prints a table, or JSON
 with ``--json``, and writes a plot with ``-o FILE.png`` (never over a file unless ``--force``).
@@ -39,23 +41,6 @@ def _resolve_sensor(args) -> None:
 
 
 def register(sub) -> None:
-    p = sub.add_parser("distortion", help="real distortion against field and a fitted lensDistortion model")
-    _common(p, "write the distortion plot")
-    p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG",
-                   help="field angle in degrees (repeat; default: up to the sensor corner)")
-    _sensor(p)
-    p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM",
-                   help="wavelength in nm (default: the lens's design wavelength, the d line 587.56)")
-    p.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=None, metavar="D",
-                   help="focus mark from the film plane (e.g. 2m, 6ft; default infinity) for the 2-D field; "
-                        "needs --resolution")
-    p.add_argument("--resolution", type=_resolution, default=None, metavar="WxH",
-                   help="frame size in pixels, e.g. 2048x1366: the full 2-D distortion field at --focus")
-    p.add_argument("--stmap", metavar="DIR", default=None,
-                   help="write distortion.exr and undistortion.exr (32-bit float ST-maps) and PNG previews "
-                        "into DIR; needs --resolution")
-    p.set_defaults(handler=run_distortion)
-
     p = sub.add_parser("illumination", help="relative illumination against field (vignetting, cos^4 from real rays)")
     _common(p, "write the relative illumination plot")
     p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG",
@@ -131,35 +116,6 @@ def _resolution(text: str):
     except ValueError:
         raise argparse.ArgumentTypeError(f"resolution must be WIDTHxHEIGHT in pixels, e.g. 2048x1366, got {text!r}")
     return w, h
-
-
-def run_distortion(args) -> int:
-    from ..analysis.distortion import real_distortion
-
-    if args.resolution is None and (args.focus is not None or args.stmap is not None):
-        from ..errors import InputError
-
-        raise InputError("--focus and --stmap need --resolution WxH (the frame size in pixels)")
-    lens = _prepare(args)
-    if args.resolution is not None:
-        return _run_field(args, lens)
-    res = real_distortion(lens, args.field, sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
-                          wavelength_nm=args.wavelength)
-    if not args.json:
-        print(f"{res.lens_name}: real distortion at {res.wavelength_nm:g} nm (chief ray vs f tan theta), "
-              f"EFL {res.efl_y_mm:.3f} mm")
-        print(f"  {'axis':>4} {'field deg':>9} {'real mm':>10} {'f tan mm':>10} {'dist %':>8}")
-        for p in res.points:
-            print(f"  {p.axis:>4} {p.field_deg:9.3f} {p.real_height_mm:10.4f} {p.paraxial_height_mm:10.4f} "
-                  f"{p.distortion_pct:8.3f}")
-        f = res.fit
-        if f is not None:
-            print(f"  standard model: k1 {f.k1:.6f}, k2 {f.k2:.6f} (rho = r / {f.norm_radius_mm:g} mm), "
-                  f"max residual {f.max_residual_pct:.4f} %")
-        for n in res.notes:
-            print(f"  note: {n}")
-    _finish(args, res)
-    return 0
 
 
 def run_illumination(args) -> int:
@@ -245,35 +201,4 @@ def run_ghosts(args) -> int:
             r = "-" if g.rms_radius_mm is None else f"{g.rms_radius_mm:.3f}"
             print(f"  {n:4d} {g.i:4d}->{g.j:<4d} {g.relative_flux:10.3e} {r:>9} {c:>13}")
     _finish(args, res)
-    return 0
-
-
-def _run_field(args, lens) -> int:
-    from ..analysis.stmap import distortion_field, write_stmaps
-
-    from ..errors import InputError
-
-    if args.field:
-        raise InputError("--field is for the field-angle table; the 2-D field (--resolution) covers the whole frame")
-    if args.output:
-        raise InputError("-o draws the field-angle table's plot; with --resolution the maps go to --stmap DIR "
-                         "(each EXR with a PNG preview)")
-    res = distortion_field(lens, focus_mm=math.inf if args.focus is None else args.focus,
-                           sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
-                           width_px=args.resolution[0], height_px=args.resolution[1], wavelength_nm=args.wavelength)
-    written = write_stmaps(res, args.stmap, force=args.force) if args.stmap is not None else []
-    d = res.to_dict()
-    if args.json:
-        d["written"] = [str(p) for p in written]
-        print_json(mark_repaired(d, args.loaded_lens))
-        return 0
-    f = "infinity" if d["focus_from_film_mm"] is None else f"{d['focus_from_film_mm']:g} mm"
-    print(f"{res.lens_name}: distortion field at focus {f}, {res.size_px[0]}x{res.size_px[1]} px, "
-          f"pinhole f {res.pinhole_focal_length_mm[1]:.3f} mm (Y) at the entrance pupil")
-    print(f"  largest distortion {res.max_distortion_px:.2f} px; overscan {res.overscan_px[0]} x {res.overscan_px[1]} px "
-          f"(undistorted frame {d['undistorted_size_px'][0]}x{d['undistorted_size_px'][1]})")
-    print(f"  interpolation error {res.interpolation_error_px:.4f} px, inverse {res.inverse_error_px:.4f} px "
-          f"({res.grid_nodes[0]}x{res.grid_nodes[1]} traced chief rays)")
-    for p in written:
-        print(f"wrote {p}")
     return 0

@@ -10,6 +10,9 @@ folder and prints the report:
   rays and cardinal points; ``breathing.png``: field of view against focus distance;
 - ``camera.usda``: the PhysicalCamera and its companion UsdGeomCamera;
 - ``spot.png`` and ``bokeh.png``: real-ray spot diagram and bokeh of a point light;
+- ``distortion/``: ST-maps (EXR, with PNG previews) of the lens at that focus on that sensor, its
+  fitted Brown-Conrady (OpenTrackIO) and 3DE4 models, and a Nuke script applying the maps
+  (docs/distortion.md);
 - ``blender/``: the real-lens OSL camera shader and its set-up script for Blender Cycles, and a
   script matching Blender's built-in camera to the report (docs/blender.md).
 """
@@ -50,6 +53,7 @@ def _steps():
         ("Gaussian data and diagram", _lens_step),
         ("USD camera", _usd_step),
         ("spot diagram and bokeh", _trace_step),
+        ("distortion maps and models", _distortion_step),
         ("Blender cameras", _blender_step),
     ]
 
@@ -130,6 +134,38 @@ def _trace_step(out, ctx, force):
     bokeh = bokeh_image(st.prescription, 1200.0, 250.0, 150.0, film_z=st.film_z, rays=400_000, pixels=160,
                         stop_semi_diameter=stop, aperture=Aperture(nsides=7, roundness=0.2), spectral=True)
     return [spot.plot(out / "spot.png", force=force), bokeh.plot(out / "bokeh.png", force=force)]
+
+
+def _distortion_step(out, ctx, force):
+    """ST-maps at the demo's focus and sensor, the fitted models' files and the Nuke script."""
+    import json
+
+    from .. import __version__
+    from ..analysis.distortion_models import fit_brown_conrady, fit_tde4_radial, samples_from_field
+    from ..analysis.stmap import distortion_field, write_stmaps
+    from ..export.nuke import nuke_stmap_script
+    from ..export.tde4 import tde4_lens_text
+    from ..io import atomic_write
+
+    s = ctx["report"].sensor
+    w = 1920
+    h = max(16, round(w * s.height_mm / s.width_mm))
+    res = distortion_field(ctx["lens"], focus_mm=DEFAULTS["focus"], sensor_width_mm=s.width_mm,
+                           sensor_height_mm=s.height_mm, width_px=w, height_px=h)
+    d = out / "distortion"
+    paths = write_stmaps(res, d, force=force)
+    smp = samples_from_field(res)
+    brown = [fit_brown_conrady(smp, "D-U"), fit_brown_conrady(smp, "U-D")]
+    tde4 = fit_tde4_radial(smp)
+    doc = {"schema": "physcam.distortion.brown_conrady/1", "lens": res.lens_name,
+           "opentrackio_lens_distortion": [f.opentrackio() for f in brown], "fits": [f.to_dict() for f in brown]}
+    ox, oy = res.overscan_px
+    nk = nuke_stmap_script(d.resolve() / "undistortion.exr", d.resolve() / "distortion.exr", plate_size=(w, h),
+                           undistorted_size=(w + 2 * ox, h + 2 * oy), version=__version__)
+    paths += [atomic_write(d / "brown_conrady.json", json.dumps(doc, indent=2) + "\n", force=force),
+              atomic_write(d / "3de4_radial_standard_degree_4.txt", tde4_lens_text(tde4, res.lens_name), force=force),
+              atomic_write(d / "physcam_stmap.nk", nk, force=force)]
+    return paths
 
 
 def _blender_step(out, ctx, force):

@@ -1,9 +1,9 @@
 """``physcam export``: lens data for other tools (Unreal lens files, OpenCV/Omniverse pinholes,
-Blender Cycles OSL lens cameras)."""
+Blender Cycles OSL lens cameras, RenderMan RIB camera blocks, pbrt-v4 cameras)."""
 
 from __future__ import annotations
 
-from ._common import distance, number, print_json
+from ._common import distance, number, numbers, print_json
 
 
 def _sensor(p) -> None:
@@ -23,9 +23,10 @@ def _common(p) -> None:
 
 
 def register(sub) -> None:
-    p = sub.add_parser("export", help="lens data for Unreal (lens file) and OpenCV/Omniverse (pinhole + distortion)",
-                       description="Export a real lens as an Unreal Engine lens file (.ulens JSON) or as fitted "
-                                   "OpenCV pinhole intrinsics and distortion (Omniverse's opencvPinhole lens API).")
+    p = sub.add_parser("export", help="lens data for Unreal, OpenCV/Omniverse, Blender, RenderMan (RIB) and pbrt-v4",
+                       description="Export a real lens as an Unreal Engine lens file (.ulens JSON), fitted OpenCV "
+                                   "pinhole intrinsics and distortion (Omniverse's opencvPinhole lens API), a Blender "
+                                   "Cycles OSL camera, a RenderMan RIB camera block or pbrt-v4 cameras.")
     s = p.add_subparsers(dest="export_command", metavar="FORMAT")
 
     u = s.add_parser("unreal", help="write an Unreal Engine lens file (.ulens JSON, Camera Calibration plugin)")
@@ -73,6 +74,8 @@ def register(sub) -> None:
                    help="also write builtin_<lens>.py: Blender's own camera matched to the lens at this focus "
                         "(best-match pinhole, aperture, focus distance; faster, no real-lens optics)")
     b.set_defaults(handler=run_blender)
+    _register_rib(s)
+    _register_pbrt(s)
     p.set_defaults(handler=lambda args: (p.print_help(), 0)[1])
 
 
@@ -202,3 +205,250 @@ def _write_builtin(args, lens, width_px: int, path):
     values = blender_camera_values(report, resolution_x=width_px, blades=blades if blades >= 3 else 0,
                                    blade_rotation_deg=args.blade_angle)
     return atomic_write(path, blender_camera_script(values), force=args.force)
+
+
+# --- RenderMan RIB and pbrt-v4 (issue 13; docs/renderman-pbrt.md) ---------------------------------------------
+RIB_EPILOG = """\
+examples:
+  physcam export rib -o cam.rib --focal 40 --fstop 2.8 --focus 2.5m --sensor "35mm anamorphic" --squeeze 2
+  physcam export rib -o cam.rib --lens dgauss_50mm --fstop 4 --focus 2m --sensor "ALEXA 35" --meters-per-unit 1
+  physcam export rib -o old.rib --focal 50 --fstop 2 --focus 3m --legacy --blades 6 --shutter-opening 0.25,0.75
+"""
+
+PBRT_EPILOG = """\
+examples:
+  physcam export pbrt -o pbrt/ --lens dgauss_50mm --fstop 2.8 --focus 2m --sensor "ALEXA 35"
+  physcam export pbrt -o pbrt/ --focal 35 --fstop 2 --focus 3m --camera perspective
+"""
+
+
+def _register_rib(s) -> None:
+    import argparse
+
+    from .lens import add_lenient
+    from .report import add_report_arguments
+
+    r = s.add_parser("rib", help="write a RenderMan RIB camera block (PxrCamera, or the legacy Hider form)",
+                     description="Write the RIB camera of a lens report: Format (pixel aspect = squeeze), "
+                                 "ScreenWindow (with the sensor shift), Clipping, Shutter and Projection "
+                                 "\"PxrCamera\" (fov, fStop, focalLength, focalDistance in scene units, dofaspect, "
+                                 "aperture shape, shutter opening); --legacy writes RenderMan 13-20's form "
+                                 "(Projection \"perspective\", DepthOfField, Hider \"hidden\"). See docs/renderman-pbrt.md.",
+                     epilog=RIB_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    r.add_argument("-o", "--output", required=True, metavar="FILE", help="the RIB file to write (.rib)")
+    add_report_arguments(r)  # --lens or --focal, the sensor, --meters-per-unit, --shutter-angle, --shift-x/-y
+    add_lenient(r)
+    _camera_look(r, blades_default=7)
+    r.add_argument("--resolution", type=int, default=2048, metavar="PX",
+                   help="image width in pixels (the squeezed plate; height from the sensor aspect; default 2048)")
+    r.add_argument("--legacy", action="store_true",
+                   help='RenderMan 13-20: Projection "perspective", DepthOfField and Hider "hidden" (seed 002)')
+    r.add_argument("--force", action="store_true", help="overwrite an existing file")
+    r.add_argument("--json", action="store_true", help="print the written path and the RIB numbers as JSON")
+    r.set_defaults(handler=run_rib)
+
+
+def _camera_look(p, blades_default) -> None:
+    p.add_argument("--blades", type=number("blade count", lo=0, hi=64), default=blades_default, metavar="N",
+                   help=f"iris blades (apertureNSides; below 3 round; default {blades_default})")
+    p.add_argument("--blade-angle", type=number("blade angle"), default=0.0, metavar="DEG",
+                   help="aperture polygon angle, degrees (apertureAngle; default 0)")
+    p.add_argument("--roundness", type=number("roundness", lo=-1, hi=1), default=0.0, metavar="R",
+                   help="iris roundness -1..1 (0 straight blades, 1 a circle; default 0)")
+    p.add_argument("--density", type=number("aperture density", lo=-1, hi=1), default=0.0, metavar="D",
+                   help="bokeh brightness slope -1..1 (0 flat, > 0 bright rim; default 0)")
+    p.add_argument("--shutter-opening", type=numbers("shutter opening", 2), default=(0.0, 1.0), metavar="OPEN,CLOSE",
+                   help="fractions of the shutter interval where the shutter is fully open and starts closing "
+                        "(seed 002; default 0,1: instantaneous)")
+
+
+def _report(args):
+    """The lens report of the command's arguments (a focus mark, or one solved from --near/--far)."""
+    from .report import solve_from_args
+
+    return solve_from_args(args)
+
+
+def run_rib(args) -> int:
+    from ..errors import InputError
+    from ..export.renderman import rib_camera_block, rib_camera_values
+    from ..export.usdgeom import focus_distance_from_pupil_mm
+    from ..io import atomic_write, check_writable
+
+    check_writable(args.output, force=args.force)
+    if not 16 <= args.resolution <= 65536:
+        raise InputError(f"--resolution must lie in 16..65536 pixels, got {args.resolution}")
+    if args.blades != int(args.blades):
+        raise InputError(f"--blades must be a whole number, got {args.blades:g}")
+    with _warnings_after_success():
+        report = _report(args)
+        values = rib_camera_values(report, args.meters_per_unit, xres=args.resolution,
+                                   shift_mm=(args.shift_x, args.shift_y), shutter_angle_deg=args.shutter_angle,
+                                   shutter_opening=args.shutter_opening,
+                                   aperture=(int(args.blades), args.blade_angle, args.roundness, args.density))
+        lens = report.lens_name or f"{report.focal_length_mm:g} mm thin lens"
+        pupil = report.entrance_pupil_from_film_mm if report.entrance_pupil_from_film_mm is not None \
+            else report.h1_from_film_mm
+        mpu = args.meters_per_unit
+        comments = [
+            f"physcam: {'legacy (RenderMan 13-20)' if args.legacy else 'PxrCamera (RenderMan 22+)'} camera for {lens}, "
+            f"f/{report.fstop:.3g}, focus mark {report.focus_from_film_mm / 1000.0:g} m from the film, on "
+            f"{report.sensor.name} ({report.sensor.width_mm:g} x {report.sensor.height_mm:g} mm), squeeze "
+            f"{report.squeeze:g}",
+            f"scene unit = {mpu:g} m; the camera is the lens's best-match pinhole ({report.pinhole[0]:.6g} mm) at the "
+            f"entrance pupil, {pupil / (1000.0 * mpu):.6g} units in front of the film; focalDistance is measured "
+            "from there",
+            "fov spans the screen window's shorter side (the ScreenWindow unit); Shutter is in frames",
+        ]
+        text = rib_camera_block(values, legacy=args.legacy, comments=comments)
+        path = atomic_write(args.output, text, force=args.force)
+    proj = values["Projection"]
+    if args.json:
+        print_json({"written": str(path), "form": "legacy" if args.legacy else "PxrCamera", "meters_per_unit": mpu,
+                    "rib": values, "focus_from_pupil_mm": focus_distance_from_pupil_mm(report),
+                    "fov_deg": {"horizontal": report.hfov_focus_deg, "vertical": report.vfov_focus_deg}})
+        return 0
+    print(f"wrote {path}: {'legacy RIB' if args.legacy else 'PxrCamera'} for {lens} at f/{report.fstop:.3g}, "
+          f"focus {report.focus_from_film_mm / 1000.0:g} m")
+    f = values["Format"]
+    print(f"  Format {f['xres']} x {f['yres']} pixel aspect {f['pixelaspect']:g}; fov {proj['fov']:.4f} deg "
+          f"(shorter side); fStop {proj['fStop']:.4g}, focalLength {proj['focalLength']:.6g}, focalDistance "
+          f"{proj['focalDistance']:.6g} (units of {mpu:g} m); dofaspect {proj['dofaspect']:.4g}")
+    return 0
+
+
+def _register_pbrt(s) -> None:
+    import argparse
+
+    from .lens import add_lenient
+
+    b = s.add_parser("pbrt", help="write pbrt-v4 cameras: the lens .dat with a realistic camera, and the thin lens",
+                     description="Write pbrt-v4 files for a lens report: <lens>.dat (the lens focused at the mark) and "
+                                 "<lens>_realistic.pbrt (Film + Camera \"realistic\"), <lens>_perspective.pbrt (the thin "
+                                 "lens: fov, lensradius, focaldistance). Reports the film distance pbrt's own thick-lens "
+                                 "focusing will choose next to physcam's. Scene in metres. See docs/renderman-pbrt.md.",
+                     epilog=PBRT_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    b.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write the files into")
+    b.add_argument("--lens", metavar="NAME_OR_FILE", help="a real lens (bundled name or prescription file)")
+    b.add_argument("--focal", metavar="MM", type=distance("focal length"),
+                   help="or a thin lens of this focal length (mm): the perspective camera only")
+    b.add_argument("--fstop", metavar="N", type=number("f-stop", positive=True),
+                   help="f-stop (geometric f-number; with --lens default wide open)")
+    b.add_argument("--focus", metavar="DIST", type=distance("focus distance"), required=True,
+                   help="focus mark, film plane to subject (e.g. 2m, 7ft)")
+    b.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (default Super 35 4-perf)')
+    b.add_argument("--sensor-width", metavar="MM", type=distance("sensor width"), help="sensor width (mm)")
+    b.add_argument("--sensor-height", metavar="MM", type=distance("sensor height"), help="sensor height (mm)")
+    b.add_argument("--coc", default=None,
+                   help="circle of confusion for the DOF comparison: d/1500 (default), d/1000, cine or mm")
+    add_lenient(b)
+    b.add_argument("--camera", choices=("both", "realistic", "perspective"), default="both",
+                   help="which pbrt camera to write (default both; a thin lens --focal has only perspective)")
+    b.add_argument("--resolution", type=int, default=1920, metavar="PX",
+                   help="film width in pixels (height from the sensor aspect; default 1920)")
+    b.add_argument("--force", action="store_true", help="overwrite existing files")
+    b.add_argument("--json", action="store_true", help="print the written paths and pbrt's numbers as JSON")
+    b.set_defaults(handler=run_pbrt)
+
+
+class _warnings_after_success:
+    """Hold physcam's warnings until the command has succeeded: a refusal stays one line on stderr."""
+
+    def __enter__(self):
+        import warnings
+
+        self._ctx = warnings.catch_warnings(record=True)
+        self._caught = self._ctx.__enter__()
+        warnings.simplefilter("always")
+        return self
+
+    def __exit__(self, *exc):
+        import warnings
+
+        self._ctx.__exit__(*exc)
+        if exc[0] is None:
+            seen = set()
+            for w in self._caught:
+                if str(w.message) not in seen:
+                    seen.add(str(w.message))
+                    warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+        return False
+
+
+def _slug(text: str) -> str:
+    import re
+    from pathlib import Path
+
+    p = Path(text)
+    stem = p.stem if p.suffix.lower() in (".toml", ".dat", ".json", ".zmx", ".txt", ".seq") else p.name
+    slug = re.sub(r"[^A-Za-z0-9_+-]+", "_", stem).strip("_")
+    return slug[:80] or "lens"
+
+
+def run_pbrt(args) -> int:
+    from ..errors import InputError
+    from ..export.pbrt import check_pbrt_lens, write_pbrt_camera
+    from ..onset.report import solve_lens_report
+    from ._common import coc_value
+    from .report import resolve_sensor
+
+    if not 16 <= args.resolution <= 65536:
+        raise InputError(f"--resolution must lie in 16..65536 pixels, got {args.resolution}")
+    if (args.lens is None) == (args.focal is None):
+        raise InputError("give a lens (--lens NAME) or a thin lens's focal length (--focal MM), one of them")
+    lens = None
+    if args.lens:
+        from ..lens.library import load_lens
+
+        lens = load_lens(args.lens, lenient=args.lenient)
+    cameras = {"both": ("realistic", "perspective") if lens is not None else ("perspective",),
+               "realistic": ("realistic",), "perspective": ("perspective",)}[args.camera]
+    if lens is not None and ("realistic" in cameras or lens.is_anamorphic):
+        check_pbrt_lens(lens)  # before anything is solved: what pbrt cannot hold is refused first
+    if "realistic" in cameras and lens is None:
+        raise InputError("pbrt-v4's realistic camera traces a lens prescription: give a lens (--lens NAME); "
+                         "a thin lens (--focal) has only the perspective camera (--camera perspective)")
+    with _warnings_after_success():
+        if lens is None and args.fstop is None:
+            raise InputError("give the f-stop of the thin lens (--fstop)")
+        report = solve_lens_report(focal_length_mm=args.focal, sensor=resolve_sensor(args), fstop=args.fstop,
+                                   focus_mm=args.focus, coc=coc_value(args.coc), lens=lens)
+        name = _slug(args.lens) if args.lens else f"thin_{report.focal_length_mm:g}mm".replace(".", "_")
+        out = write_pbrt_camera(report, args.output, lens, name=name, xres=args.resolution, cameras=cameras,
+                                force=args.force)
+    if args.json:
+        print_json(out)
+        return 0
+    print(f"wrote {', '.join(out['written'].values())}")
+    v = out["values"]
+    film = v["film"]
+    print(f"  Film {film['xresolution']} x {film['yresolution']}, diagonal {film['diagonal']:.4f} mm "
+          f"({film['width_mm']:.4g} x {film['height_mm']:.4g} mm); scene in metres")
+    if "perspective" in v:
+        p = v["perspective"]
+        print(f"  perspective: fov {p['fov']:.4f} deg ({p['fov_axis']}), lensradius {p['lensradius']:.6g} m, "
+              f"focaldistance {p['focaldistance']:.6g} m (from the entrance pupil)")
+    if "realistic" in v:
+        r = v["realistic"]
+        c = out["focus"]
+        print(f"  realistic: aperturediameter {r['aperturediameter']:.4f} mm (the stop at f/{report.fstop:.3g}), "
+              f"focusdistance {r['focusdistance']:.6g} m (from the film)")
+        print(f"  film distance (last vertex to film): physcam {c['physcam_film_distance_mm']:.6f} mm, pbrt's thick "
+              f"lens {c['pbrt_film_distance_mm']:.6f} mm, difference {c['difference_mm']:+.2e} mm")
+        landed = c["pbrt_focus_from_film_mm"]
+        if landed is None:
+            print("  pbrt's film lies inside the focal length: its plane of focus is beyond infinity")
+        else:
+            print(f"  pbrt's plane of focus lands {landed / 1000.0:.6f} m from the film ({c['focus_shift_mm']:+.3f} mm); "
+                  f"near limit {_shift(c['near_shift_mm'])}, far limit {_shift(c['far_shift_mm'])}")
+        if c["unit_focus_film_distance_mm"] is not None:
+            print(f"  given this lens at its infinity gaps pbrt would extend it instead: film "
+                  f"{c['unit_focus_film_distance_mm']:.4f} mm behind the lens, EFL {c['unit_focus_efl_mm']:.4f} mm "
+                  f"(focus groups: {c['efl_mm']:.4f} mm)")
+    for n in out["notes"]:
+        print(f"  note: {n}")
+    return 0
+
+
+def _shift(v) -> str:
+    return "unchanged (at infinity)" if v is None else f"{v:+.3f} mm"

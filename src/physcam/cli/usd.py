@@ -184,7 +184,8 @@ def run_write(args) -> int:
         from ..usd.kit import prescription_distortion, prescription_opencv
 
         lens = load_lens(args.lens, lenient=args.lenient)
-        distortion = prescription_distortion(lens, report.sensor.width_mm, report.sensor.height_mm)
+        distortion = prescription_distortion(lens, report.sensor.width_mm, report.sensor.height_mm,
+                                             focus_mm=report.focus_from_film_mm)
         opencv = prescription_opencv(lens, report.sensor.width_mm, report.sensor.height_mm,
                                      focus_mm=report.focus_from_film_mm, resolution=args.resolution)
     path = write_camera(args.file, spec, force=args.force, path=args.path, meters_per_unit=args.meters_per_unit,

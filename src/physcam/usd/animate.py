@@ -105,11 +105,11 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     :class:`~physcam.onset.sensors.Sensor`; ``fstop`` for keys without their own (with a
     prescription and no f-stop at all: wide open).
     """
-    from pxr import Gf, Sdf, UsdGeom
+    from pxr import Sdf, UsdGeom
 
-    from ..export.usdgeom import mm_to_scene_units, require_meters_per_unit
+    from ..export.usdgeom import require_meters_per_unit
     from ..onset.report import solve_lens_report
-    from .author import author_camera, new_stage, render_camera_values, save_stage, spec_from_report
+    from .author import author_camera, new_stage, sample_render_camera, save_stage, spec_from_report
 
     keys = _check_keys(keys)
     if (lens is None) == (focal_length_mm is None):
@@ -117,7 +117,6 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     if not 0.0 < require_finite("shutter angle", shutter_angle_deg) <= 360.0:
         raise InputError(f"shutter angle must be in (0, 360] degrees, got {shutter_angle_deg:g}")
     mpu = require_meters_per_unit(meters_per_unit)
-    su = lambda mm: mm_to_scene_units(mm, mpu)  # noqa: E731
     rate = require_finite("frames per second", fps)
     if rate <= 0:
         raise InputError(f"frames per second must be > 0, got {rate:g}")
@@ -144,7 +143,6 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     cam = author_camera(stage, path, spec0, report=report0, position=position, rotate_xyz_deg=rotate_xyz_deg)
     model = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Pinhole"))
     geom = UsdGeom.Camera(stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")))
-    translate = UsdGeom.Xformable(geom.GetPrim()).GetOrderedXformOps()[0]
     lp = "lens:main:"
 
     def sample(prim, name, value, time):
@@ -170,11 +168,5 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
         for name, value in optional.items():
             if value is not None and cam.GetAttribute(name):
                 sample(cam, name, value, t)
-        values, eye = render_camera_values(spec, report, mpu, rate, where=path)
-        geom.GetFocalLengthAttr().Set(values["focalLength"], t)
-        geom.GetHorizontalApertureAttr().Set(values["horizontalAperture"], t)
-        geom.GetVerticalApertureAttr().Set(values["verticalAperture"], t)
-        geom.GetFStopAttr().Set(values["fStop"], t)
-        geom.GetFocusDistanceAttr().Set(values["focusDistance"], t)
-        translate.Set(Gf.Vec3d(0.0, 0.0, -su(eye)), t)
+        sample_render_camera(geom, spec, report, mpu, rate, t, where=path)
     return save_stage(stage, file, force=force)

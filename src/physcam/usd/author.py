@@ -33,6 +33,7 @@ import struct
 from dataclasses import dataclass
 
 from ..errors import ExportError, InputError, require_finite, require_positive, require_type
+from ..export.renderman import shutter_opening_curve  # re-exported: the one copy of seed 002's ramps
 from .plugin import ensure_registered, require_stage
 
 __all__ = [
@@ -50,6 +51,7 @@ __all__ = [
     "shutter_opening_curve",
     "author_render_settings",
     "render_camera_values",
+    "sample_render_camera",
 ]
 
 DEFAULT_CAMERA_PATH = "/Cameras/Camera"
@@ -237,19 +239,6 @@ def _transmittance(fstop: float, tstop: float | None) -> float:
         raise InputError(f"T-stop {tstop:g} is faster than the f-stop {fstop:g}: a lens cannot transmit more than "
                          "all the light (T >= N)")
     return min(t, 1.0)
-
-
-def shutter_opening_curve(opentime: float, closetime: float) -> list[float]:
-    """RenderMan's ``shutteropening`` control points [c1 c2 d1 d2 e1 e2 f1 f2] for seed 002's linear ramps.
-
-    Seed 002: the shutter opens linearly from 0 to ``opentime`` (fractions of the
-    exposure), is fully open until ``closetime`` and closes linearly until 1. The two
-    interior points of each ramp are placed at its thirds, so the curve is exactly
-    those straight ramps.
-    """
-    o, c = float(opentime), float(closetime)
-    return [o / 3.0, 1.0 / 3.0, 2.0 * o / 3.0, 2.0 / 3.0,
-            c + (1.0 - c) / 3.0, 2.0 / 3.0, c + 2.0 * (1.0 - c) / 3.0, 1.0 / 3.0]
 
 
 def new_stage(meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y"):
@@ -487,6 +476,26 @@ def _author_lens(stage, cam, spec, eye, su):
         model.SetCustomDataByKey("physcam:lensName", spec.lens_name)
     cam.GetRelationship(lp + "lensModel") or cam.CreateRelationship(lp + "lensModel", False)
     cam.GetRelationship(lp + "lensModel").SetTargets([model.GetPath()])
+
+
+def sample_render_camera(geom, spec: CameraSpec, report, meters_per_unit: float, time_codes_per_second: float,
+                         time: float, *, where: str = "camera") -> float:
+    """Time-sample a companion UsdGeomCamera ``geom`` at ``time`` from ``spec`` (one frame of a moving
+    camera): focal length, apertures, f-stop, focus distance and its translate (the eye, in front of
+    the film), from :func:`render_camera_values`. Returns the eye distance (mm from the film)."""
+    from pxr import Gf, UsdGeom
+
+    from ..export.usdgeom import mm_to_scene_units
+
+    values, eye = render_camera_values(spec, report, meters_per_unit, time_codes_per_second, where=where)
+    geom.GetFocalLengthAttr().Set(values["focalLength"], time)
+    geom.GetHorizontalApertureAttr().Set(values["horizontalAperture"], time)
+    geom.GetVerticalApertureAttr().Set(values["verticalAperture"], time)
+    geom.GetFStopAttr().Set(values["fStop"], time)
+    geom.GetFocusDistanceAttr().Set(values["focusDistance"], time)
+    translate = UsdGeom.Xformable(geom.GetPrim()).GetOrderedXformOps()[0]
+    translate.Set(Gf.Vec3d(0.0, 0.0, -mm_to_scene_units(eye, meters_per_unit)), time)
+    return eye
 
 
 def render_camera_values(spec: CameraSpec, report, meters_per_unit: float, time_codes_per_second: float, *,

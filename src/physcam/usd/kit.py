@@ -263,7 +263,7 @@ def _author_shot_companion(stage, path) -> str:
                        principal_planes_mm=derived.principal_planes_mm,
                        pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
                        pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze)
-        distortion = prescription_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm)
+        distortion = prescription_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
         opencv = prescription_opencv(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
     # values derived from the composed lens, rewritten every time: the iris (f / N) and the film's
     # place behind the pupil, so the pupil stays where the shot put it when the lens file changes
@@ -476,14 +476,35 @@ def best_match_pinhole(prescription, *, focus_mm: float, fstop: float | None, se
     return spec_from_report(report), report
 
 
-def prescription_distortion(prescription, sensor_width_mm: float = 36.0, sensor_height_mm: float = 24.0):
-    """The standard radial distortion model fitted to ``prescription``'s traced chief rays (object at infinity).
-
-    See :mod:`physcam.analysis.distortion`; written as ``lensDistortion:*`` on the companion camera.
+def prescription_distortion(prescription, sensor_width_mm: float = 36.0, sensor_height_mm: float = 24.0, *,
+                            focus_mm: float = math.inf):
+    """Hydra's "standard" lensDistortion fitted to ``prescription``'s real chief rays over the whole
+    frame at the shot's focus ``focus_mm`` (:func:`physcam.analysis.distortion_models.fit_usd_standard`
+    on a 2048-pixel-wide frame). Where the lens does not cover the frame's corners, the radial fit of
+    :mod:`physcam.analysis.distortion` (object at infinity, fields up to what passes) is used, with a warning.
     """
-    from ..analysis.distortion import real_distortion
+    import warnings
 
-    return real_distortion(prescription, sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm).fit
+    from ..analysis.distortion_models import fit_usd_standard, samples_from_field
+    from ..analysis.stmap import distortion_field
+    from ..errors import OpticsError, PhysCamWarning
+
+    w_px = 2048
+    h_px = max(16, min(8192, round(w_px * sensor_height_mm / sensor_width_mm)))
+    try:
+        field = distortion_field(prescription, focus_mm=focus_mm, sensor_width_mm=sensor_width_mm,
+                                 sensor_height_mm=sensor_height_mm, width_px=w_px, height_px=h_px, maps=False)
+    except OpticsError as e:
+        from ..analysis.distortion import real_distortion
+
+        warnings.warn(f"lensDistortion: {e}; fitted radially at infinity instead", PhysCamWarning, stacklevel=2)
+        return real_distortion(prescription, sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm).fit
+    fit = fit_usd_standard(samples_from_field(field))
+    if not fit.acceptable:
+        warnings.warn(f"lensDistortion: the standard model misses the traced rays by up to {fit.max_residual_px:.2g} px "
+                      f"on a {w_px}-pixel-wide frame (written anyway; ST-maps are exact: physcam distortion --stmap)",
+                      PhysCamWarning, stacklevel=2)
+    return fit
 
 
 def prescription_opencv(prescription, sensor_width_mm: float, sensor_height_mm: float, *, focus_mm: float,

@@ -1,0 +1,120 @@
+"""Benchmark: the sustained OpenTrackIO sample rate physcam's receiver records without a drop.
+
+Goal (issue 17): at least 10 x a 240 fps stream (2,400 samples/s). A sender in another process
+streams physcam's own per-frame samples (pinhole focal length, focus, f-stop, T-stop, pupil,
+distortion, transform, timing; JSON, one packet each) over loopback UDP at a paced rate for a few
+seconds; this process receives them (header, Fletcher-16, decode, schema validation, ordering) and
+records each as a frame (:func:`physcam.live.frames.frame_from_sample`). The rate doubles, then is
+bisected, to the highest one with no sample lost (received = sent, nothing missing or dropped).
+Plain script, prints figures:
+
+    .venv/bin/python benchmarks/live.py [--seconds 3] [--cbor]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+GOAL = 2400.0
+
+SENDER = r"""
+import json, sys, time
+from physcam.live.sender import Sender
+port, rate, seconds, enc, path = int(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3]), sys.argv[4], sys.argv[5]
+samples = [json.loads(line) for line in open(path)]
+n = int(rate * seconds)
+with Sender("127.0.0.1", port, encoding=enc) as tx:
+    t0 = time.monotonic()
+    sent = tx.stream((samples[i % len(samples)] for i in range(n)), rate)
+    print(sent, time.monotonic() - t0, flush=True)
+"""
+
+
+def _samples(path: str, count: int = 2400) -> int:
+    import dataclasses
+
+    from physcam.live.camera import CameraMove, camera_frames, frames_to_samples
+    from physcam.onset.sensors import find_sensor
+
+    frames = camera_frames(sensor=find_sensor("ALEXA 35"), frames=count, rate=240, focus_mm=1500.0,
+                           focus_to_mm=6000.0, fstop=2.8, tstop=3.0, focal_length_mm=35.0,
+                           move=CameraMove(rate_deg_s=(20.0, 1.0, 0.0), velocity_m_s=(0.5, 0.2, 0.0)))
+    frames = [dataclasses.replace(f, distortion={"model": "Brown-Conrady U-D", "radial": [-2e-5, 1e-8, 0.0],
+                                                 "tangential": [0.0, 0.0]}) for f in frames]
+    samples = list(frames_to_samples(frames, static_every=240))
+    with open(path, "w") as fh:
+        for s in samples:
+            fh.write(json.dumps(s) + "\n")
+    return len(json.dumps(samples[1]).encode())
+
+
+def trial(rate: float, seconds: float, enc: str, path: str) -> dict:
+    from physcam.live.frames import frame_from_sample
+    from physcam.live.receiver import Receiver
+
+    recorded = 0
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    with Receiver(0, host="127.0.0.1", queue_size=4096) as rx:
+        proc = subprocess.Popen([sys.executable, "-c", SENDER, str(rx.port), str(rate), str(seconds), enc, path],
+                                stdout=subprocess.PIPE, text=True, env=env)
+        t0 = time.perf_counter()
+        while proc.poll() is None or rx.counters()["received"] < int(rate * seconds):
+            item = rx.get(timeout=0.05)
+            if item is not None:
+                frame_from_sample(item.sample)
+                recorded += 1
+            elif proc.poll() is not None and time.perf_counter() - t0 > seconds + 2.0:
+                break  # the sender has finished and nothing more arrives
+        while (item := rx.get(timeout=0.2)) is not None:
+            frame_from_sample(item.sample)
+            recorded += 1
+        elapsed = time.perf_counter() - t0
+        sent, send_s = proc.stdout.read().split()
+        c = rx.counters()
+    return {"rate": rate, "sent": int(sent), "recorded": recorded, "send_s": float(send_s), "elapsed_s": elapsed,
+            "lost": int(sent) - recorded, "counters": c}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seconds", type=float, default=3.0, help="length of each trial")
+    ap.add_argument("--cbor", action="store_true", help="CBOR payloads (default JSON)")
+    args = ap.parse_args()
+    enc = "cbor" if args.cbor else "json"
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), ".live_samples.jsonl")
+    size = _samples(path)
+    print(f"sample: {size} bytes of JSON ({enc} on the wire), one packet each; {args.seconds:g} s per trial")
+    good, bad = 0.0, None
+    rate = GOAL / 2
+    try:
+        while bad is None and rate <= 64 * GOAL:  # double until a trial loses samples
+            r = trial(rate, args.seconds, enc, path)
+            print(f"  {rate:8.0f}/s: sent {r['sent']}, recorded {r['recorded']}, lost {r['lost']} "
+                  f"(send took {r['send_s']:.2f} s)")
+            if r["lost"] == 0 and r["send_s"] <= args.seconds * 1.05:
+                good = rate
+                rate *= 2
+            else:
+                bad = rate
+        for _ in range(4 if bad else 0):  # bisect between the last good and the first bad rate
+            mid = (good + bad) / 2
+            r = trial(mid, args.seconds, enc, path)
+            print(f"  {mid:8.0f}/s: sent {r['sent']}, recorded {r['recorded']}, lost {r['lost']} "
+                  f"(send took {r['send_s']:.2f} s)")
+            if r["lost"] == 0 and r["send_s"] <= args.seconds * 1.05:
+                good = mid
+            else:
+                bad = mid
+    finally:
+        os.unlink(path)
+    print(f"sustained without a drop: {good:.0f} samples/s = {good / 240:.1f} x a 240 fps stream "
+          f"(goal {GOAL / 240:.0f} x: {'met' if good >= GOAL else 'NOT met'})")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,490 @@
+"""``physcam live``: OpenTrackIO camera tracking in and out, recording to USD, the LED-wall frustum (docs/live.md)."""
+
+from __future__ import annotations
+
+import sys
+
+from ._common import distance, number, numbers
+
+EPILOG = """\
+examples:
+  physcam live validate take.json sample.cbor
+  physcam live record --port 55555 --duration 30 take.usda --report take.csv
+  physcam live send --lens dgauss_50mm --sensor "ALEXA 35" --focus 2m --focus-to 5m --fstop 2.8 --frames 96
+  physcam live play take.usda --port 55555
+  physcam live wall wall.usda --kind curved --radius 8 --width 14
+  physcam live frustum take.usda --wall wall.usda frustum.usda --overscan 10 --latency-ms 40
+Receivers stop after --duration seconds or --count samples, or on Ctrl-C; the file is written then.
+"""
+
+
+def _port(text):
+    import argparse
+
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"port must be a whole number 0..65535, got {text!r}") from None
+    if not 0 <= v <= 65535:
+        raise argparse.ArgumentTypeError(f"port must be a whole number 0..65535, got {text!r}")
+    return v
+
+
+def _count(text):
+    import argparse
+
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"count must be a whole number >= 1, got {text!r}") from None
+    if not 1 <= v <= 10_000_000:
+        raise argparse.ArgumentTypeError(f"count must be a whole number 1..10000000, got {text!r}")
+    return v
+
+
+def _network_args(p, *, receive: bool) -> None:
+    p.add_argument("--port", type=_port, default=55555, help="UDP port (default 55555, OpenTrackIO's)")
+    p.add_argument("--multicast", type=int, default=None, metavar="N",
+                   help="use the multicast group 239.135.1.N of source number N instead of unicast")
+    p.add_argument("--interface", default="127.0.0.1",
+                   help="network interface address for multicast (default 127.0.0.1, the loopback)")
+    if receive:
+        p.add_argument("--host", default="0.0.0.0", help="unicast address to listen on (default all)")
+        p.add_argument("--modulus", choices=("256", "255", "auto"), default="256",
+                       help="Fletcher-16 modulus: 256 (current reference code, default), 255 (1.0.0 page), auto")
+    else:
+        p.add_argument("--host", default="127.0.0.1", help="unicast destination (default 127.0.0.1)")
+        p.add_argument("--cbor", action="store_true", help="send CBOR payloads (default JSON)")
+    p.add_argument("--duration", type=number("duration", lo=0.0, hi=86400.0), default=None, metavar="S",
+                   help="stop after S seconds (default: receivers run until Ctrl-C or --count)")
+
+
+def _sensor_args(p) -> None:
+    p.add_argument("--sensor", help="sensor name (see physcam sensors)")
+    p.add_argument("--sensor-width", type=distance("sensor width"), help="sensor width, with --sensor-height")
+    p.add_argument("--sensor-height", type=distance("sensor height"), help="sensor height, with --sensor-width")
+
+
+def register(sub) -> None:
+    import argparse
+
+    p = sub.add_parser("live", help="OpenTrackIO camera tracking: validate, record to USD, send, LED-wall frustum",
+                       description="Live camera metadata (OpenTrackIO 1.0.1): validate samples, record a stream "
+                                   "as a time-sampled USD camera with a per-frame lens report, send physcam's camera "
+                                   "or a recording out, and the LED wall's inner frustum (docs/live.md).",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    s = p.add_subparsers(dest="live_command", metavar="ACTION")
+
+    v = s.add_parser("validate", help="validate OpenTrackIO samples (JSON or CBOR files) against the 1.0.1 schema")
+    v.add_argument("files", nargs="+", help="sample files: .json (one sample, or one per line) or .cbor")
+    v.add_argument("--json", action="store_true", help="print JSON")
+    v.set_defaults(handler=run_validate)
+
+    r = s.add_parser("record", help="record a stream into a time-sampled USD camera (and a lens report)")
+    r.add_argument("file", help="output .usda/.usd/.usdc")
+    _network_args(r, receive=True)
+    r.add_argument("--count", type=_count, default=None, help="stop after this many samples")
+    r.add_argument("--report", metavar="FILE", help="also write the per-frame lens report (.csv or .json)")
+    _sensor_args(r)
+    r.add_argument("--focal", type=distance("focal length"), help="pinhole focal length when the stream has none")
+    r.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop when the stream has none")
+    r.add_argument("--focus", type=distance("focus distance"), help="focus mark when the stream has none")
+    r.add_argument("--fps", type=number("frame rate", positive=True, hi=1000.0),
+                   help="time codes per second (default: the stream's sample rate)")
+    r.add_argument("--meters-per-unit", type=number("meters per unit", positive=True), default=0.01,
+                   help="stage unit (default 0.01: centimetres)")
+    r.add_argument("--path", default="/Cameras/Camera", help="camera prim path")
+    r.add_argument("--force", action="store_true", help="overwrite existing files")
+    r.add_argument("--json", action="store_true", help="print the summary as JSON")
+    r.set_defaults(handler=run_record)
+
+    se = s.add_parser("send", help="stream physcam's camera and lens as OpenTrackIO (a focus pull, a pan)")
+    se.add_argument("--lens", help="bundled lens name or prescription file (breathing, pupil, distortion)")
+    se.add_argument("--focal", type=distance("focal length"), help="or a thin lens of this focal length")
+    _sensor_args(se)
+    se.add_argument("--focus", type=distance("focus distance"), default=3000.0, help="focus mark (default 3m)")
+    se.add_argument("--focus-to", type=distance("focus distance to pull to"), help="pull focus to this mark")
+    se.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop (a lens: default wide open)")
+    se.add_argument("--tstop", type=number("T-stop", positive=True), help="marked T-stop")
+    se.add_argument("--fps", type=number("frame rate", positive=True, hi=1000.0), default=24.0,
+                    help="sample rate (default 24; 23.976 is 24000/1001)")
+    se.add_argument("--frames", type=_count, default=48, help="samples in the take (default 48)")
+    se.add_argument("--position", type=numbers("position", 3), default=(0.0, 0.0, 1.5), metavar="X,Y,Z",
+                    help="film plane on the stage, metres, Z up (default 0,0,1.5)")
+    se.add_argument("--pan-rate", type=number("pan rate", lo=-3600.0, hi=3600.0), default=0.0,
+                    help="degrees per second")
+    se.add_argument("--print", action="store_true", help="print the samples as JSON lines instead of sending")
+    _network_args(se, receive=False)
+    se.set_defaults(handler=run_send)
+
+    pl = s.add_parser("play", help="send a recorded USD camera or a lens report back out as OpenTrackIO")
+    pl.add_argument("file", help="a USD file with a PhysicalCamera, or a lens report .json written by record")
+    pl.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
+    pl.add_argument("--rate", type=number("rate", lo=0.0, hi=100000.0), default=None,
+                    help="samples per second (default the file's rate; 0 as fast as possible)")
+    _sensor_args(pl)
+    _network_args(pl, receive=False)
+    pl.set_defaults(handler=run_play)
+
+    w = s.add_parser("wall", help="write an LED wall mesh (flat or curved) for the frustum")
+    w.add_argument("file", help="output .usda/.usd/.usdc")
+    w.add_argument("--kind", choices=("flat", "curved"), default="flat", help="flat plane or cylinder arc")
+    w.add_argument("--width", type=number("width", positive=True, hi=1000.0), default=12.0,
+                   help="metres (a curved wall: arc length)")
+    w.add_argument("--height", type=number("height", positive=True, hi=1000.0), default=5.0, help="metres")
+    w.add_argument("--distance", type=number("distance", positive=True, hi=1000.0), default=6.0,
+                   help="flat: metres in front of the stage origin (+Y)")
+    w.add_argument("--radius", type=number("radius", positive=True, hi=1000.0), default=8.0,
+                   help="curved: metres from the stage origin")
+    w.add_argument("--segments", type=_count, default=96, help="curved: facets along the arc (default 96)")
+    w.add_argument("--meters-per-unit", type=number("meters per unit", positive=True), default=0.01,
+                   help="stage unit (default 0.01)")
+    w.add_argument("--force", action="store_true", help="overwrite")
+    w.set_defaults(handler=run_wall)
+
+    f = s.add_parser("frustum", help="the LED wall's inner frustum per frame of a tracked camera")
+    f.add_argument("camera", help="a USD file with the tracked PhysicalCamera (e.g. from live record)")
+    f.add_argument("output", help="output .usda/.usd/.usdc (projection camera and footprint polygon)")
+    f.add_argument("--wall", required=True, help="USD file with the LED wall mesh")
+    f.add_argument("--wall-path", default=None, help="the wall's Mesh prim path (default: the only Mesh)")
+    f.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
+    f.add_argument("--overscan", type=number("overscan", lo=0.0, hi=1000.0), default=10.0, metavar="PCT",
+                   help="inner frustum margin, percent of the half-widths (default 10)")
+    f.add_argument("--latency-ms", type=number("latency", lo=0.0, hi=10000.0), default=0.0,
+                   help="tracking latency: half-angles widen by the camera's turn in this time")
+    f.add_argument("--samples-per-edge", type=_count, default=8, help="footprint points per frame edge (1..256)")
+    f.add_argument("--force", action="store_true", help="overwrite")
+    f.add_argument("--json", action="store_true", help="print the per-frame footprints as JSON")
+    f.set_defaults(handler=run_frustum)
+
+    p.set_defaults(handler=lambda args: p.print_help() or 0)
+
+
+# --- validate ------------------------------------------------------------------------------
+def _read_samples(path):
+    """(label, payload bytes, encoding) of each sample in a file: .cbor one CBOR item; JSON one
+    object, or one per line."""
+    from pathlib import Path
+
+    from ..errors import InputError
+
+    p = Path(path)
+    try:
+        data = p.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read {p}: {exc.strerror or exc}") from None
+    if len(data) > 64 * 1024 * 1024:
+        raise InputError(f"{p}: larger than 64 MiB")
+    if p.suffix.lower() == ".cbor":
+        return [(str(p), data, "cbor")]
+    text = data.strip()
+    lines = text.splitlines()
+    if len(lines) > 1 and all(x.strip().startswith(b"{") and x.strip().endswith(b"}") for x in lines if x.strip()):
+        return [(f"{p}:{i}", x, "json") for i, x in enumerate(lines, start=1) if x.strip()]
+    return [(str(p), data, "json")]
+
+
+def run_validate(args) -> int:
+    from ..errors import InputError
+    from ..live.sample import SampleError, decode_sample
+    from ._common import print_json
+
+    results = []
+    for f in args.files:
+        for label, payload, enc in _read_samples(f):
+            try:
+                decode_sample(payload, enc)
+                results.append({"sample": label, "valid": True, "problems": []})
+            except SampleError as exc:
+                results.append({"sample": label, "valid": False, "problems": [p.to_dict() for p in exc.problems]})
+    bad = sum(not r["valid"] for r in results)
+    if args.json:
+        print_json({"samples": results, "invalid": bad})
+    else:
+        for r in results:
+            print(f"{r['sample']}: {'valid' if r['valid'] else 'INVALID'}")
+            for pr in r["problems"]:
+                print(f"  {pr['path']}: {pr['message']} (rule: {pr['rule']})")
+    if bad:
+        raise InputError(f"{bad} of {len(results)} samples are not valid OpenTrackIO 1.0.1")
+    return 0
+
+
+# --- record --------------------------------------------------------------------------------
+class _Status:
+    """Rate, counters and last timecode on stderr, redrawn a few times a second at a terminal."""
+
+    def __init__(self, enabled: bool):
+        self.enabled = enabled and sys.stderr.isatty()
+        self._live = None
+
+    def __enter__(self):
+        if self.enabled:
+            from rich.live import Live
+
+            from ._common import console
+
+            self._live = Live(console=console(stderr=True), refresh_per_second=4, transient=True)
+            self._live.__enter__()
+        return self
+
+    def update(self, frames: int, rate: float, counters: dict, timecode, elapsed: float) -> None:
+        if self._live is None:
+            return
+        from rich.table import Table
+
+        t = Table(title="physcam live record", show_header=False, box=None)
+        t.add_row("elapsed", f"{elapsed:.1f} s")
+        t.add_row("recorded", f"{frames} samples ({rate:.1f}/s)")
+        t.add_row("last timecode", str(timecode or "-"))
+        for k, v in counters.items():
+            t.add_row(k.replace("_", " "), str(v))
+        self._live.update(t)
+
+    def __exit__(self, *exc):
+        if self._live is not None:
+            self._live.__exit__(*exc)
+        return False
+
+
+def _resolve_sensor_opt(args):
+    if args.sensor is None and args.sensor_width is None and args.sensor_height is None:
+        return None
+    from .report import resolve_sensor
+
+    return resolve_sensor(args)
+
+
+def run_record(args) -> int:
+    import time
+
+    from ..errors import InputError
+    from ..io import check_writable
+    from ..live.frames import frame_from_sample
+    from ..live.receiver import Receiver, multicast_group
+    from ..live.record import MAX_RECORDED_FRAMES, solve_frames, write_lens_report, write_recording_usd
+    from ._common import print_json
+
+    sensor = _resolve_sensor_opt(args)
+    check_writable(args.file, force=args.force)
+    if args.report:
+        check_writable(args.report, force=args.force)
+        if not args.report.lower().endswith((".csv", ".json")):
+            raise InputError("--report is written as .csv or .json")
+    if not args.file.lower().endswith((".usda", ".usd", ".usdc")):
+        raise InputError(f"{args.file}: a USD file name ends in .usda, .usd or .usdc")
+    group = multicast_group(args.multicast) if args.multicast is not None else None
+    receiver = Receiver(args.port, host=args.host, group=group, interface=args.interface,
+                        modulus=args.modulus if args.modulus == "auto" else int(args.modulus))
+    frames, static = [], None
+    t0 = time.monotonic()
+    last_tc = None
+    interrupted = False
+    with receiver, _Status(not args.json) as status:
+        next_draw = 0.0
+        try:
+            while True:
+                now = time.monotonic()
+                if args.duration is not None and now - t0 >= args.duration:
+                    break
+                if args.count is not None and len(frames) >= args.count:
+                    break
+                item = receiver.get(timeout=0.05)
+                if item is not None:
+                    if "static" in item.sample:
+                        static = item.sample["static"]
+                    fr = frame_from_sample(item.sample, static=static)
+                    frames.append(fr)
+                    last_tc = fr.timecode or last_tc
+                    if len(frames) >= MAX_RECORDED_FRAMES:
+                        break
+                if now >= next_draw:
+                    el = now - t0
+                    status.update(len(frames), len(frames) / el if el > 0 else 0.0, receiver.counters(), last_tc, el)
+                    next_draw = now + 0.25
+        except KeyboardInterrupt:
+            interrupted = True  # stop recording and write what was received
+    while True:  # samples still queued when the receiver stopped
+        item = receiver.get()
+        if item is None or (args.count is not None and len(frames) >= args.count):
+            break
+        frames.append(frame_from_sample(item.sample, static=static or item.sample.get("static")))
+    counters = receiver.counters()
+    elapsed = time.monotonic() - t0
+    if not frames:
+        raise InputError(f"no valid samples arrived on port {receiver.port} in {elapsed:.1f} s "
+                         f"(received {counters['received']} packets); nothing written")
+    solved = solve_frames(frames, sensor=sensor, rate=args.fps, focal_length_mm=args.focal, fstop=args.fstop,
+                          focus_mm=args.focus)
+    out = write_recording_usd(args.file, solved, rate=args.fps, meters_per_unit=args.meters_per_unit,
+                              path=args.path, force=args.force)
+    rep = write_lens_report(args.report, solved, force=args.force) if args.report else None
+    summary = {"file": str(out), "report": None if rep is None else str(rep), "frames": len(solved),
+               "seconds": round(elapsed, 3), "interrupted": interrupted, "counters": counters,
+               "first_timecode": solved[0].frame.timecode, "last_timecode": solved[-1].frame.timecode}
+    if args.json:
+        print_json(summary)
+    else:
+        print(f"recorded {len(solved)} frames to {out}" + (f" and {rep}" if rep else "")
+              + f" ({summary['first_timecode'] or '-'} to {summary['last_timecode'] or '-'})")
+        print("  " + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counters.items()))
+    return 0  # Ctrl-C is how a recording is ended: the file is written and that is success
+
+
+# --- send and play ---------------------------------------------------------------------------
+def _sender(args):
+    from ..live.receiver import multicast_group
+    from ..live.sender import Sender
+
+    host = multicast_group(args.multicast) if args.multicast is not None else args.host
+    return Sender(host, args.port, encoding="cbor" if args.cbor else "json", interface=args.interface)
+
+
+def _stream(args, samples, rate) -> int:
+    import json
+
+    from ._common import print_json  # noqa: F401
+
+    if getattr(args, "print", False):
+        n = 0
+        for sm in samples:
+            sys.stdout.write(json.dumps(sm, separators=(",", ":"), allow_nan=False) + "\n")
+            n += 1
+        return n
+    if args.port == 0:
+        from ..errors import InputError
+
+        raise InputError("the destination port must be 1..65535")
+    with _sender(args) as snd:
+        n = snd.stream(samples, rate, duration_s=args.duration)
+    print(f"sent {n} samples to {snd.host}:{snd.port}", file=sys.stderr)
+    return n
+
+
+def run_send(args) -> int:
+    from ..errors import InputError
+    from ..live.camera import CameraMove, camera_frames, frames_to_samples
+    from .report import resolve_sensor
+
+    if (args.lens is None) == (args.focal is None):
+        raise InputError("give either --lens or --focal")
+    lens = None
+    if args.lens:
+        from ..lens.library import load_lens
+
+        lens = load_lens(args.lens)
+    if args.duration is not None:  # do not build frames that would never be sent
+        args.frames = max(1, min(args.frames, int(args.duration * args.fps) + 1))
+    if args.frames > 100_000:
+        raise InputError("at most 100000 frames per take from the command line")
+    move = CameraMove(start_m=args.position, rate_deg_s=(args.pan_rate, 0.0, 0.0))
+    frames = camera_frames(sensor=resolve_sensor(args), frames=args.frames, rate=args.fps, focus_mm=args.focus,
+                           focus_to_mm=args.focus_to, fstop=args.fstop, tstop=args.tstop, lens=lens,
+                           focal_length_mm=args.focal, move=move)
+    samples = frames_to_samples(frames, lens_name=getattr(lens, "name", None))
+    _stream(args, samples, float(frames[0].rate))
+    return 0
+
+
+def _frames_from_report(path):
+    import json
+    from fractions import Fraction
+
+    from ..errors import InputError
+    from ..live.frames import TrackedFrame, rate_fraction
+
+    try:
+        doc = json.loads(open(path, encoding="utf-8").read())
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: not a lens report JSON ({exc})") from None
+    if not isinstance(doc, dict) or doc.get("schema") != "physcam.live_lens_report" or not isinstance(
+            doc.get("frames"), list) or not doc["frames"]:
+        raise InputError(f"{path}: not a lens report written by physcam live record")
+    out = []
+    rows = doc["frames"]
+    try:
+        r = doc.get("rate")
+        rate = rate_fraction(Fraction(int(r["num"]), int(r["denom"])) if isinstance(r, dict) else 24)
+        sensor = doc.get("sensor_mm")
+        sensor = (float(sensor[0]), float(sensor[1])) if isinstance(sensor, list) and len(sensor) == 2 else None
+        for r in rows:
+            out.append(TrackedFrame(
+                time_ns=int(round(float(r["time_code"]) / float(rate) * 1e9)), rate=Fraction(rate),
+                timecode=r.get("timecode"), sequence_number=r.get("sequence_number"),
+                translation_m=(float(r["x_m"]), float(r["y_m"]), float(r["z_m"])),
+                rotation_deg=(float(r["pan_deg"]), float(r["tilt_deg"]), float(r["roll_deg"])),
+                pinhole_focal_length_mm=float(r["pinhole_focal_length_mm"]),
+                focus_from_film_mm=float(r["focus_from_film_mm"]), fstop=float(r["fstop"]),
+                tstop=None if r.get("tstop") is None else float(r["tstop"]),
+                entrance_pupil_mm=None if r.get("entrance_pupil_from_film_mm") is None
+                else float(r["entrance_pupil_from_film_mm"]), sensor_mm=sensor))
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"{path}: a frame lacks {exc}") from None
+    return out
+
+
+def run_play(args) -> int:
+    import dataclasses
+
+    from ..errors import InputError
+    from ..live.camera import frames_to_samples
+
+    name = str(args.file).lower()
+    if name.endswith((".usda", ".usd", ".usdc")):
+        from ..live.usd_io import frames_from_usd
+
+        frames = frames_from_usd(args.file, args.path)
+    elif name.endswith(".json"):
+        frames = _frames_from_report(args.file)
+    else:
+        raise InputError(f"{args.file}: play reads a USD camera (.usda/.usd/.usdc) or a lens report (.json)")
+    sensor = _resolve_sensor_opt(args)
+    if sensor is not None:
+        frames = [dataclasses.replace(f, sensor_mm=(sensor.width_mm, sensor.height_mm)) for f in frames]
+    rate = float(frames[0].rate or 24) if args.rate is None else args.rate
+    _stream(args, frames_to_samples(frames), rate)
+    return 0
+
+
+# --- wall and frustum -------------------------------------------------------------------------
+def run_wall(args) -> int:
+    from ..live.frustum import write_wall
+
+    if args.segments > 4096:
+        from ..errors import InputError
+
+        raise InputError("at most 4096 segments")
+    out = write_wall(args.file, kind=args.kind, width_m=args.width, height_m=args.height, distance_m=args.distance,
+                     radius_m=args.radius, segments=args.segments, meters_per_unit=args.meters_per_unit,
+                     force=args.force)
+    print(f"wrote {out}")
+    return 0
+
+
+def run_frustum(args) -> int:
+    from ..errors import InputError
+    from ..live.frustum import MAX_SAMPLES_PER_EDGE, frustum_frames, wall_from_usd, write_frustum_usd
+    from ..live.usd_io import frames_from_usd
+    from ._common import print_json
+
+    if args.samples_per_edge > MAX_SAMPLES_PER_EDGE:
+        raise InputError(f"at most {MAX_SAMPLES_PER_EDGE} samples per edge")
+    from ..io import check_writable
+
+    check_writable(args.output, force=args.force)
+    frames = frames_from_usd(args.camera, args.path)
+    wall = wall_from_usd(args.wall, args.wall_path)
+    fr = frustum_frames(frames, wall, overscan=args.overscan / 100.0, latency_s=args.latency_ms / 1000.0,
+                        samples_per_edge=args.samples_per_edge)
+    rate = float(frames[0].rate or 24)
+    out = write_frustum_usd(args.output, fr, meters_per_unit=wall.meters_per_unit, fps=min(rate, 1000.0),
+                            force=args.force)
+    missed = sum(f.missed for f in fr)
+    if args.json:
+        print_json({"file": str(out), "frames": [{"time_code": f.time_code, "widen": list(f.widen),
+                                                   "latency_margin_deg": f.pad_deg, "missed_rays": f.missed,
+                                                   "footprint": f.footprint.tolist()} for f in fr]})
+    else:
+        print(f"wrote the inner frustum of {len(fr)} frames to {out}"
+              + (f"; {missed} edge rays missed the wall" if missed else ""))
+    return 0

@@ -1,0 +1,50 @@
+"""A Nuke script that applies physcam's ST-maps to a plate, and redistorts CG (docs/distortion.md).
+
+Two branches, each a ``Read`` of the map (raw, so no colour transform touches the numbers), a
+``Read`` of the image and an ``STMap`` (``uv rgb``): *undistort* turns the plate into the
+undistorted, overscanned picture; *redistort* turns a render of that picture back into the plate.
+In a ``.nk`` file a node with ``inputs 2`` takes its inputs from the node stack, the top of the
+stack as input 0: the image is written last, so it is the STMap's ``src`` (input 0) and the map
+its ``stmap`` input (input 1). No Nuke was run to check the script; the maps themselves are
+checked end to end by :func:`physcam.analysis.stmap.apply_stmap`.
+"""
+
+from __future__ import annotations
+
+from ..errors import InputError
+
+__all__ = ["nuke_stmap_script"]
+
+
+def _path(p) -> str:
+    s = str(p).replace("\\", "/")
+    if any(c in s for c in '{}"[]$\n'):
+        raise InputError(f"the path {s!r} has characters a Nuke script cannot quote ({{}}\"[]$ or a newline)")
+    return s
+
+
+def nuke_stmap_script(undistortion_map, distortion_map, *, plate="plate.####.exr", render="render.####.exr",
+                      plate_size=(2048, 1080), undistorted_size=(2048, 1080), version: str = "") -> str:
+    """The ``.nk`` text (module notes); sizes in pixels (width, height)."""
+    for n, s in (("plate", plate_size), ("undistorted", undistorted_size)):
+        if len(s) != 2 or not all(isinstance(v, int) and v > 0 for v in s):
+            raise InputError(f"the {n} size must be two whole numbers of pixels, got {s!r}")
+    (w, h), (W, H) = plate_size, undistorted_size
+
+    def node(kind, **knobs):
+        body = "".join(f" {k} {v}\n" for k, v in knobs.items())
+        return f"{kind} {{\n{body}}}\n"
+
+    parts = [
+        f"# physcam {version}: apply the undistortion and distortion ST-maps (R = u, G = v, origin bottom left)\n",
+        node("Root", inputs=0, format=f'"{w} {h} 0 0 {w} {h} 1 physcam_plate"'),
+        node("Read", inputs=0, file=f'"{_path(undistortion_map)}"', raw="true",
+             format=f'"{W} {H} 0 0 {W} {H} 1 physcam_undistorted"', name="physcam_undistortion_map"),
+        node("Read", inputs=0, file=f'"{_path(plate)}"', name="physcam_plate"),
+        node("STMap", inputs=2, channels="rgba", uv="rgb", name="physcam_undistort"),
+        node("Read", inputs=0, file=f'"{_path(distortion_map)}"', raw="true",
+             format=f'"{w} {h} 0 0 {w} {h} 1 physcam_plate"', name="physcam_distortion_map"),
+        node("Read", inputs=0, file=f'"{_path(render)}"', name="physcam_undistorted_render"),
+        node("STMap", inputs=2, channels="rgba", uv="rgb", name="physcam_redistort"),
+    ]
+    return "".join(parts)

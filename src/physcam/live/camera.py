@@ -1,0 +1,111 @@
+"""OpenTrackIO samples from physcam's own camera and lens: a take, frame by frame.
+
+For each frame the lens is solved at that frame's focus mark and f-stop
+(:func:`physcam.onset.report.solve_lens_report`; with a prescription its Gaussian optics focused
+there, so the pinhole focal length breathes and the entrance pupil moves) and the sample carries:
+``pinholeFocalLength`` (the best-match pinhole, mm), ``focusDistance`` (the mark from the film plane,
+m), ``fStop`` and ``tStop``, ``entrancePupilOffset`` (m in front of the film), the distortion of a
+prescription at that focus (:func:`physcam.live.lens_data.distortion_for_sample`), timing (exact
+timestamps at the frame rate, timecode, sequence number) and the camera transform. The ``static``
+block (sensor size, capture rate, lens, tracker) rides on the first sample and once a second after.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+from ..errors import InputError, require_finite, require_type
+from .frames import TrackedFrame, new_source_id, rate_fraction, sample_from_frame, static_block, with_time
+
+__all__ = ["CameraMove", "camera_frames", "camera_samples", "frames_to_samples"]
+
+#: the most frames one generated take holds (an hour at 240 fps is 864,000; a demo needs far fewer)
+MAX_TAKE_FRAMES = 1_000_000
+
+
+@dataclass(frozen=True)
+class CameraMove:
+    """A simple move, linear in time: the film plane starts at ``start_m`` (OpenTrackIO stage, metres,
+    Z up) and travels at ``velocity_m_s``; the camera starts at ``start_deg`` (pan, tilt, roll) and
+    turns at ``rate_deg_s``."""
+
+    start_m: tuple[float, float, float] = (0.0, 0.0, 1.5)
+    velocity_m_s: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    start_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rate_deg_s: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def at(self, t_s: float):
+        pos = tuple(float(a + v * t_s) for a, v in zip(self.start_m, self.velocity_m_s))
+        rot = tuple(float(a + v * t_s) for a, v in zip(self.start_deg, self.rate_deg_s))
+        return pos, rot
+
+
+def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None, focal_length_mm=None,
+                  focus_to_mm=None, tstop=None, move: CameraMove | None = None, distortion: bool = True,
+                  t0_ns: int | None = None) -> list[TrackedFrame]:
+    """The take's frames (module notes): ``frames`` frames at ``rate``, focus pulled linearly from
+    ``focus_mm`` to ``focus_to_mm`` (mm from the film; default: held), ``lens`` (a Prescription) or a
+    thin lens of ``focal_length_mm``; ``t0_ns`` the first timestamp (default now)."""
+    from ..onset.report import solve_lens_report
+    from ..onset.sensors import Sensor
+
+    require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
+    if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= MAX_TAKE_FRAMES:
+        raise InputError(f"frames must be a whole number 1..{MAX_TAKE_FRAMES}, got {frames!r}")
+    fr = rate_fraction(rate)
+    move = CameraMove() if move is None else require_type("move", move, CameraMove)
+    if (lens is None) == (focal_length_mm is None):
+        raise InputError("give either a lens prescription or a focal length")
+    f0 = require_finite("focus distance", focus_mm)
+    f1 = f0 if focus_to_mm is None else require_finite("focus distance to pull to", focus_to_mm)
+    t0 = time.time_ns() if t0_ns is None else int(t0_ns)
+    out: list[TrackedFrame] = []
+    cache: dict = {}
+    for i in range(frames):
+        u = i / (frames - 1) if frames > 1 else 0.0
+        mark = f0 + (f1 - f0) * u
+        report = cache.get(mark)
+        if report is None:
+            report = solve_lens_report(focal_length_mm=focal_length_mm, sensor=sensor, fstop=fstop, focus_mm=mark,
+                                       tstop=tstop, lens=lens)
+            dist = None
+            if lens is not None and distortion:
+                from .lens_data import distortion_for_sample
+
+                dist, _ = distortion_for_sample(lens, sensor.width_mm, sensor.height_mm, mark)
+            report = cache[mark] = (report, dist)
+        rep, dist = report
+        pos, rot = move.at(i / float(fr))
+        pupil = rep.entrance_pupil_from_film_mm
+        out.append(with_time(TrackedFrame(
+            rate=fr, translation_m=pos, rotation_deg=rot, pinhole_focal_length_mm=rep.pinhole[0],
+            focus_from_film_mm=rep.focus_from_film_mm, fstop=rep.fstop, tstop=rep.tstop,
+            entrance_pupil_mm=pupil if pupil is not None else rep.h1_from_film_mm, distortion=dist,
+            sensor_mm=(sensor.width_mm, sensor.height_mm),
+            nominal_focal_length_mm=rep.focal_length_mm), t0, i))
+    return out
+
+
+def frames_to_samples(frames, *, source_id: str | None = None, static_every: int | None = None,
+                      lens_name: str | None = None, shutter_angle_deg: float | None = None):
+    """Yield an OpenTrackIO sample per frame (:func:`physcam.live.frames.sample_from_frame`), with the
+    ``static`` block on the first and every ``static_every``-th sample (default: once a second)."""
+    sid = new_source_id() if source_id is None else source_id
+    for i, f in enumerate(frames):
+        require_type("frame", f, TrackedFrame)
+        every = static_every if static_every is not None else max(1, math.ceil(float(f.rate or 24)))
+        static = None
+        if i % every == 0 and f.sensor_mm is not None:
+            static = static_block(sensor_mm=f.sensor_mm, rate=f.rate or 24, lens_name=lens_name,
+                                  nominal_focal_length_mm=f.nominal_focal_length_mm,
+                                  shutter_angle_deg=shutter_angle_deg)
+        yield sample_from_frame(f, source_id=sid, sequence_number=i % 2**32, frame_index=i, static=static)
+
+
+def camera_samples(**kwargs) -> list[dict]:
+    """The samples of :func:`camera_frames` (same keywords) as a list of dicts."""
+    lens = kwargs.get("lens")
+    name = getattr(lens, "name", None)
+    return list(frames_to_samples(camera_frames(**kwargs), lens_name=name))

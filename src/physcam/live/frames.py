@@ -1,0 +1,299 @@
+"""One tracked frame in physcam's units, to and from an OpenTrackIO sample.
+
+:class:`TrackedFrame` is what a sample says about the camera at one instant, in physcam's units
+(mm, degrees, seconds as integer nanoseconds); :func:`frame_from_sample` reads it out of a
+validated sample and :func:`sample_from_frame` writes one. OpenTrackIO's units (schema 1.0.1
+descriptions): ``focusDistance`` and ``entrancePupilOffset`` in metres, ``pinholeFocalLength`` in mm,
+transforms in metres and degrees.
+
+Reference planes (docs/conventions.md): ``entrancePupilOffset`` is measured from the nominal image
+plane (the film), positive toward the object, i.e. physcam's ``entrance_pupil_from_film_mm``;
+``focusDistance`` is read as the focus mark, from the film plane (the schema says only "focus
+distance/position of the lens"; the image plane is the reference it gives the pupil offset).
+
+Transforms: OpenTrackIO's stage is right-handed and Z-up, Y forward (toward the LED wall), X to
+camera right; rotations are intrinsic Z-X-Y, ``[pan, tilt, roll]`` in degrees, each by the right-hand
+rule (pan turns +X toward +Y, tilt +Y toward +Z, roll +Z toward +X; camdkit's axis figure). A list
+of transforms composes in order, the last placing the camera sensor (film plane centre). Scales
+are composed too; the camera's orientation is the rotation left after removing them.
+"""
+
+from __future__ import annotations
+
+import math
+import uuid
+from dataclasses import dataclass, field, replace
+from fractions import Fraction
+
+import numpy as np
+
+from ..errors import InputError, require_finite, require_type
+from .sample import PROTOCOL_VERSION
+
+__all__ = ["TrackedFrame", "rate_fraction", "rational", "timecode_fields", "rotation_matrix", "pan_tilt_roll",
+           "compose_transforms", "frame_from_sample", "sample_from_frame", "static_block", "new_source_id"]
+
+
+@dataclass(frozen=True)
+class TrackedFrame:
+    """The camera at one instant (module notes). ``time_ns``: PTP-style timestamp in nanoseconds
+    (None when the sample has none); ``translation_m`` (x, y, z) of the film plane centre on the
+    Z-up stage; ``rotation_deg`` (pan, tilt, roll); lens values in mm; ``None`` where not sent."""
+
+    time_ns: int | None = None
+    sequence_number: int | None = None
+    timecode: str | None = None
+    rate: Fraction | None = None
+    translation_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rotation_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    pinhole_focal_length_mm: float | None = None
+    focus_from_film_mm: float | None = None
+    fstop: float | None = None
+    tstop: float | None = None
+    entrance_pupil_mm: float | None = None
+    distortion: dict | None = None
+    sensor_mm: tuple[float, float] | None = None
+    nominal_focal_length_mm: float | None = None
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+
+def rate_fraction(rate) -> Fraction:
+    """A frame rate as an exact fraction: NTSC rates (23.976, 29.97, 59.94, 119.88) become
+    N*1000/1001, others the nearest fraction with a denominator up to 1001.
+
+    >>> rate_fraction(23.976), rate_fraction(25), rate_fraction(Fraction(30000, 1001))
+    (Fraction(24000, 1001), Fraction(25, 1), Fraction(30000, 1001))
+    """
+    if isinstance(rate, Fraction):
+        fr = rate
+    else:
+        r = require_finite("frame rate", rate)
+        if r <= 0:
+            raise InputError(f"frame rate must be > 0, got {r:g}")
+        ntsc = round(r * 1.001)
+        fr = Fraction(ntsc * 1000, 1001) if abs(r * 1.001 - ntsc) < 5e-4 and abs(r - ntsc) > 1e-6 \
+            else Fraction(r).limit_denominator(1001)
+    if not 0 < fr <= 10000:
+        raise InputError(f"frame rate must lie in (0, 10000] fps, got {float(fr):g}")
+    return fr
+
+
+def rational(rate) -> dict:
+    """OpenTrackIO's rational ``{"num", "denom"}`` of a frame rate."""
+    fr = rate_fraction(rate)
+    return {"num": fr.numerator, "denom": fr.denominator}
+
+
+def timecode_fields(frame: int, rate) -> dict:
+    """SMPTE timecode of the ``frame``-th sample (from 00:00:00:00) at ``rate``, non-drop-frame.
+
+    The timecode counts at the nominal integer rate; above 60 fps it counts frame pairs (or larger
+    groups) and ``subFrame`` numbers the samples within one (the schema allows 120 frames a second).
+    """
+    fr = rate_fraction(rate)
+    if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) or frame < 0:
+        raise InputError(f"frame must be a whole number >= 0, got {frame!r}")
+    nominal = math.ceil(fr - Fraction(1, 10**6))
+    k = max(1, math.ceil(nominal / 60))  # samples per timecode frame
+    tc_rate = fr / k
+    per_s = math.ceil(nominal / k)
+    f, sub = divmod(int(frame), k)
+    total_s, frames = divmod(f, per_s)
+    out = {"hours": (total_s // 3600) % 24, "minutes": (total_s // 60) % 60, "seconds": total_s % 60,
+           "frames": frames, "frameRate": {"num": tc_rate.numerator, "denom": tc_rate.denominator}}
+    if k > 1:
+        out["subFrame"] = sub
+    return out
+
+
+def _timecode_text(tc: dict) -> str:
+    text = f"{tc['hours']:02d}:{tc['minutes']:02d}:{tc['seconds']:02d}:{tc['frames']:02d}"
+    return text + (f".{tc['subFrame']}" if "subFrame" in tc else "")
+
+
+def rotation_matrix(pan_deg, tilt_deg, roll_deg) -> np.ndarray:
+    """3 x 3 rotation of intrinsic Z-X-Y angles (pan about Z, tilt about X, roll about Y; right-hand
+    rule): R = Rz(pan) Rx(tilt) Ry(roll), columns the camera's axes on the Z-up stage."""
+    p, t, r = (math.radians(require_finite(n, v)) for n, v in (("pan", pan_deg), ("tilt", tilt_deg),
+                                                                 ("roll", roll_deg)))
+    cp, sp, ct, st, cr, sr = math.cos(p), math.sin(p), math.cos(t), math.sin(t), math.cos(r), math.sin(r)
+    rz = np.array([[cp, -sp, 0.0], [sp, cp, 0.0], [0.0, 0.0, 1.0]])
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, ct, -st], [0.0, st, ct]])
+    ry = np.array([[cr, 0.0, sr], [0.0, 1.0, 0.0], [-sr, 0.0, cr]])
+    return rz @ rx @ ry
+
+
+def pan_tilt_roll(matrix) -> tuple[float, float, float]:
+    """(pan, tilt, roll) degrees of a rotation matrix, the inverse of :func:`rotation_matrix`
+    (tilt in [-90, 90]; at +-90 the pan takes the whole turn and roll is 0)."""
+    m = np.asarray(matrix, dtype=float)
+    if m.shape != (3, 3) or not np.all(np.isfinite(m)):
+        raise InputError("a rotation is a finite 3 x 3 matrix")
+    t = math.asin(max(-1.0, min(1.0, m[2, 1])))
+    if abs(m[2, 1]) < 1.0 - 1e-12:
+        p = math.atan2(-m[0, 1], m[1, 1])
+        r = math.atan2(-m[2, 0], m[2, 2])
+    else:  # gimbal lock: pan and roll turn about the same axis
+        p = math.atan2(m[1, 0], m[0, 0])
+        r = 0.0
+    return math.degrees(p), math.degrees(t), math.degrees(r)
+
+
+def _pair(name, value) -> tuple[float, float]:
+    if not isinstance(value, (tuple, list)) or len(value) != 2:
+        raise InputError(f"{name} must be a pair of numbers, got {value!r:.60}")
+    return require_finite(name, value[0]), require_finite(name, value[1])
+
+
+def _vec(obj, keys, default=0.0):
+    if not isinstance(obj, dict):
+        return (default,) * len(keys)
+    return tuple(require_finite(k, obj.get(k, default)) for k in keys)
+
+
+def compose_transforms(transforms) -> tuple[tuple, tuple, tuple[str, ...]]:
+    """(translation m, (pan, tilt, roll) deg, notes) of the camera from an OpenTrackIO ``transforms``
+    list (module notes). One transform is read as it is, exactly; a chain is composed as 4 x 4 matrices."""
+    if not isinstance(transforms, list) or not transforms or not all(isinstance(t, dict) for t in transforms):
+        raise InputError("transforms must be a non-empty list of transform objects")
+    if len(transforms) == 1 and "scale" not in transforms[0]:
+        t = transforms[0]
+        return _vec(t.get("translation"), "xyz"), _vec(t.get("rotation"), ("pan", "tilt", "roll")), ()
+    m = np.eye(4)
+    for t in transforms:
+        a = np.eye(4)
+        a[:3, :3] = rotation_matrix(*_vec(t.get("rotation"), ("pan", "tilt", "roll")))
+        a[:3, :3] = a[:3, :3] @ np.diag(_vec(t.get("scale"), "xyz", 1.0))
+        a[:3, 3] = _vec(t.get("translation"), "xyz")
+        m = m @ a
+    rot = m[:3, :3]
+    u, s, vt = np.linalg.svd(rot)
+    notes = ()
+    if np.linalg.det(rot) <= 0 or not np.all(np.isfinite(s)) or s.min() <= 0:
+        raise InputError("the composed transforms do not give a right-handed camera orientation")
+    if np.ptp(s) > 1e-9:
+        notes = (f"the transforms scale the camera by {', '.join(f'{v:g}' for v in s)}; its orientation is "
+                 "the rotation without the scale",)
+    return tuple(float(v) for v in m[:3, 3]), pan_tilt_roll(u @ vt), notes
+
+
+def frame_from_sample(sample, *, static=None) -> TrackedFrame:
+    """The :class:`TrackedFrame` of a validated OpenTrackIO sample (module notes for units and planes).
+
+    ``static``: the last ``static`` block seen on the stream, for the sensor size and nominal focal
+    length when this sample carries none.
+    """
+    require_type("sample", sample, dict)
+    timing = sample.get("timing", {})
+    lens = sample.get("lens", {})
+    st = sample.get("static") or static or {}
+    time_ns = None
+    if "sampleTimestamp" in timing:
+        ts = timing["sampleTimestamp"]
+        time_ns = int(ts["seconds"]) * 1_000_000_000 + int(ts["nanoseconds"])
+    rate = None
+    if "sampleRate" in timing:
+        rate = Fraction(timing["sampleRate"]["num"], timing["sampleRate"]["denom"])
+    tc = _timecode_text(timing["timecode"]) if "timecode" in timing else None
+    translation, rotation, notes = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), ())
+    if "transforms" in sample:
+        translation, rotation, notes = compose_transforms(sample["transforms"])
+    dims = st.get("camera", {}).get("activeSensorPhysicalDimensions")
+    mm = lambda v: None if v is None else float(v) * 1000.0  # noqa: E731 - metres to mm
+    distortion = None
+    if lens.get("distortion"):
+        distortion = dict(lens["distortion"][0])
+    return TrackedFrame(
+        time_ns=time_ns, sequence_number=timing.get("sequenceNumber"), timecode=tc, rate=rate,
+        translation_m=translation, rotation_deg=rotation,
+        pinhole_focal_length_mm=lens.get("pinholeFocalLength"), focus_from_film_mm=mm(lens.get("focusDistance")),
+        fstop=lens.get("fStop"), tstop=lens.get("tStop"), entrance_pupil_mm=mm(lens.get("entrancePupilOffset")),
+        distortion=distortion,
+        sensor_mm=None if not dims else (float(dims["width"]), float(dims["height"])),
+        nominal_focal_length_mm=st.get("lens", {}).get("nominalFocalLength"),
+        notes=notes,
+    )
+
+
+def new_source_id() -> str:
+    """A fresh ``urn:uuid:`` for a stream's ``sourceId``."""
+    return f"urn:uuid:{uuid.uuid4()}"
+
+
+def static_block(*, sensor_mm, rate, lens_name=None, nominal_focal_length_mm=None, squeeze: float = 1.0,
+                 shutter_angle_deg: float | None = None, resolution=None, label: str | None = None) -> dict:
+    """OpenTrackIO's ``static`` object for physcam's camera: sensor size (mm), capture rate, lens
+    and tracker identification (physcam sends as the tracker)."""
+    from .. import __version__
+
+    w, h = _pair("sensor size (mm)", sensor_mm)
+    cam = {"activeSensorPhysicalDimensions": {"width": w, "height": h}, "captureFrameRate": rational(rate)}
+    sq = Fraction(require_finite("squeeze", squeeze)).limit_denominator(100)
+    cam["anamorphicSqueeze"] = {"num": sq.numerator, "denom": sq.denominator}
+    if shutter_angle_deg is not None:
+        cam["shutterAngle"] = require_finite("shutter angle", shutter_angle_deg)
+    if resolution is not None:
+        cam["activeSensorResolution"] = {"width": int(resolution[0]), "height": int(resolution[1])}
+    if label:
+        cam["label"] = str(label)[:1023]
+    out = {"camera": cam, "tracker": {"make": "physcam", "model": "physcam live", "firmwareVersion": __version__}}
+    lens = {}
+    if lens_name:
+        lens["model"] = str(lens_name)[:1023]
+    if nominal_focal_length_mm is not None:
+        lens["nominalFocalLength"] = require_finite("nominal focal length", nominal_focal_length_mm)
+    if lens:
+        out["lens"] = lens
+    return out
+
+
+def sample_from_frame(frame: TrackedFrame, *, source_id: str, sequence_number: int, frame_index: int | None = None,
+                      source_number: int = 1, static: dict | None = None, status: str = "physcam") -> dict:
+    """An OpenTrackIO sample carrying ``frame`` (module notes); ``frame_index`` numbers the timecode
+    (default ``sequence_number``), ``static`` is included when given."""
+    require_type("frame", frame, TrackedFrame, "build one with TrackedFrame(...)")
+    if isinstance(sequence_number, bool) or not isinstance(sequence_number, int) or not 0 <= sequence_number < 2**32:
+        raise InputError(f"sequence number must be a whole number 0..2^32-1, got {sequence_number!r}")
+    timing = {"mode": "internal", "sequenceNumber": sequence_number}
+    if frame.time_ns is not None:
+        timing["sampleTimestamp"] = {"seconds": frame.time_ns // 1_000_000_000,
+                                     "nanoseconds": frame.time_ns % 1_000_000_000}
+    if frame.rate is not None:
+        timing["sampleRate"] = rational(frame.rate)
+        timing["timecode"] = timecode_fields(sequence_number if frame_index is None else frame_index, frame.rate)
+    lens = {}
+    m = lambda v: v / 1000.0  # noqa: E731 - mm to metres
+    if frame.pinhole_focal_length_mm is not None:
+        lens["pinholeFocalLength"] = float(frame.pinhole_focal_length_mm)
+    if frame.focus_from_film_mm is not None and math.isfinite(frame.focus_from_film_mm):
+        lens["focusDistance"] = m(float(frame.focus_from_film_mm))
+    if frame.fstop is not None:
+        lens["fStop"] = float(frame.fstop)
+    if frame.tstop is not None:
+        lens["tStop"] = float(frame.tstop)
+    if frame.entrance_pupil_mm is not None:
+        lens["entrancePupilOffset"] = m(float(frame.entrance_pupil_mm))
+    if frame.distortion is not None:
+        lens["distortion"] = [dict(frame.distortion)]
+    x, y, z = (float(v) for v in frame.translation_m)
+    pan, tilt, roll = (float(v) for v in frame.rotation_deg)
+    out = {
+        "protocol": {"name": "OpenTrackIO", "version": list(PROTOCOL_VERSION)},
+        "sampleId": f"urn:uuid:{uuid.uuid4()}",
+        "sourceId": source_id,
+        "sourceNumber": int(source_number),
+        "tracker": {"status": status, "recording": False},
+        "timing": timing,
+        "lens": lens,
+        "transforms": [{"id": "Camera", "translation": {"x": x, "y": y, "z": z},
+                        "rotation": {"pan": pan, "tilt": tilt, "roll": roll}}],
+    }
+    if static:
+        out["static"] = static
+    return out
+
+
+def with_time(frame: TrackedFrame, t0_ns: int, index: int) -> TrackedFrame:
+    """``frame`` stamped as the ``index``-th sample after ``t0_ns`` at its rate (exact nanoseconds)."""
+    rate = frame.rate or Fraction(24)
+    return replace(frame, time_ns=int(t0_ns) + (index * 1_000_000_000 * rate.denominator) // rate.numerator)

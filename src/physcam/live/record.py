@@ -1,0 +1,339 @@
+"""A recorded stream as a time-sampled USD camera and a per-frame lens report.
+
+Each :class:`~physcam.live.frames.TrackedFrame` is solved as an on-set lens report
+(:func:`physcam.onset.report.solve_lens_report`, the practical model with the streamed entrance
+pupil and best-match pinhole) and written as one USD time sample through physcam's own authoring
+(:func:`physcam.usd.author.author_camera` for the first frame, then
+:func:`physcam.usd.author.sample_render_camera` per frame, as :mod:`physcam.usd.animate` does for
+a focus pull):
+
+* the PhysicalCamera body's transform: ``translate`` (where the entrance pupil is),
+  ``rotateZXY`` = (tilt, pan, -roll) and ``translate:pupilToFilm``, so the film plane lands where
+  the tracker put the sensor. The stage is Y-up: OpenTrackIO's Z-up stage (x, y, z) is USD's
+  (x, z, -y), which turns its intrinsic pan-tilt-roll into USD's ``rotateZXY`` op exactly, and a
+  camera at zero rotation looks along the stage's +Y (OpenTrackIO) = USD's -Z, a USD camera's own
+  view direction;
+* the lens: ``fStop``, ``iris``, ``entrancePupilDistance``, ``pinholeFocalLength``, the lens model's
+  ``focalLength`` and ``focusDistance`` (mm, from the film plane);
+* the companion UsdGeomCamera: ``focalLength`` (the best-match pinhole), apertures, ``fStop``,
+  ``focusDistance`` (from the pupil), ``exposure:fStop`` (the T-stop) and its eye on the pupil;
+* distortion: the streamed Brown-Conrady coefficients as custom attributes on the PhysicalCamera
+  (``physcam:live:distortion*``, OpenTrackIO's millimetre form) and, on the companion, Omniverse's
+  ``OmniLensDistortionOpenCvPinholeAPI`` (OpenCV's normalised form, :mod:`physcam.live.lens_data`);
+* ``physcam:live:sequenceNumber`` and ``physcam:live:timecode`` say which sample each time came from.
+
+Times: a sample's time code is (its timestamp - the first's) x the stage's timeCodesPerSecond (the
+stream's sample rate), computed with exact fractions; samples without timestamps use their
+sequence numbers. The file is written once, atomically, when the recording ends.
+
+The focal length that drives depth of field is the lens's nominal focal length when the stream's
+static data gives one, else the pinhole focal length (a thin lens focused at D frames with s', a
+few per cent more than f at portrait distances; the report says which it used).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import warnings
+from dataclasses import dataclass
+from fractions import Fraction
+
+from ..errors import ExportError, InputError, PhysCamError, PhysCamWarning, require_type
+from .frames import TrackedFrame
+from .lens_data import opentrackio_to_opencv
+
+__all__ = ["MAX_RECORDED_FRAMES", "SolvedFrame", "solve_frames", "time_codes", "write_recording_usd",
+           "lens_report_rows", "write_lens_report"]
+
+#: the most frames one recording keeps (ten minutes at 240 fps)
+MAX_RECORDED_FRAMES = 144_000
+REPORT_COLUMNS = ("frame", "time_code", "timecode", "sequence_number", "focus_from_film_mm",
+                  "pinhole_focal_length_mm", "dof_focal_length_mm", "fstop", "tstop", "entrance_pupil_from_film_mm",
+                  "near_from_film_mm", "far_from_film_mm", "hyperfocal_from_film_mm", "hfov_deg", "vfov_deg",
+                  "dfov_deg", "coc_mm", "x_m", "y_m", "z_m", "pan_deg", "tilt_deg", "roll_deg")
+
+
+@dataclass(frozen=True)
+class SolvedFrame:
+    """A tracked frame, its USD time code and its lens report."""
+
+    frame: TrackedFrame
+    time_code: float
+    report: object
+
+
+def _frames(frames) -> list[TrackedFrame]:
+    if isinstance(frames, (str, bytes)) or not hasattr(frames, "__iter__"):
+        from ..errors import WrongTypeError
+
+        raise WrongTypeError("frames must be a list of TrackedFrame (physcam.live.frames.frame_from_sample)")
+    frames = list(frames)
+    for f in frames:
+        require_type("frame", f, TrackedFrame, "physcam.live.frames.frame_from_sample(sample)")
+    if not frames:
+        raise InputError("no frames were recorded")
+    if len(frames) > MAX_RECORDED_FRAMES:
+        raise InputError(f"at most {MAX_RECORDED_FRAMES} frames in one recording, got {len(frames)}")
+    return frames
+
+
+def time_codes(frames, rate=None) -> tuple[list[float], Fraction]:
+    """(USD time code of each frame, time codes per second): from timestamps when every frame has one,
+    else from sequence numbers, else frame order; ``rate`` overrides the stream's sample rate."""
+    from .frames import rate_fraction
+
+    frames = _frames(frames)
+    fr = rate_fraction(rate) if rate is not None else next((f.rate for f in frames if f.rate is not None), None)
+    if fr is None:
+        raise InputError("the stream gives no sample rate; give the frame rate (--fps)")
+    if all(f.time_ns is not None for f in frames):
+        t0 = frames[0].time_ns
+        # integer-nanosecond stamps of a rational rate land within 1e-6 of a frame: snap to 1e-6
+        codes = [round(float(Fraction(f.time_ns - t0, 1_000_000_000) * fr), 6) for f in frames]
+    elif all(f.sequence_number is not None for f in frames):
+        s0 = frames[0].sequence_number
+        codes = [float(f.sequence_number - s0) for f in frames]
+    else:
+        codes = [float(i) for i in range(len(frames))]
+    return codes, fr
+
+
+def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=None, focus_mm=None,
+                 coc=None) -> list[SolvedFrame]:
+    """Each frame with its time code and lens report (module notes).
+
+    Values a frame does not carry come from the frame before it, else from these defaults:
+    ``sensor`` (a :class:`~physcam.onset.sensors.Sensor`) when the stream's static data gives no
+    sensor size, ``focal_length_mm`` (pinhole), ``fstop``, ``focus_mm`` (from the film plane).
+    Frames whose time code does not increase are dropped with a warning.
+    """
+    from ..onset.report import solve_lens_report
+    from ..onset.sensors import Sensor, custom_sensor
+
+    frames = _frames(frames)
+    if sensor is not None:
+        require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
+    codes, _ = time_codes(frames, rate)
+    last = {"pinhole": focal_length_mm, "fstop": fstop, "focus": focus_mm, "tstop": None, "pupil": None,
+            "sensor": None if sensor is None else (sensor.width_mm, sensor.height_mm), "nominal": None}
+    sensors: dict = {}
+    out: list[SolvedFrame] = []
+    previous = -math.inf
+    skipped = 0
+    for f, t in zip(frames, codes):
+        for key, value in (("pinhole", f.pinhole_focal_length_mm), ("fstop", f.fstop),
+                           ("focus", f.focus_from_film_mm), ("tstop", f.tstop), ("pupil", f.entrance_pupil_mm),
+                           ("sensor", f.sensor_mm), ("nominal", f.nominal_focal_length_mm)):
+            if value is not None:
+                last[key] = value
+        if t <= previous:
+            skipped += 1
+            continue
+        previous = t
+        missing = [n for n, k in (("a pinhole focal length (pinholeFocalLength, --focal)", "pinhole"),
+                                  ("an f-stop (fStop, --fstop)", "fstop"),
+                                  ("a focus distance (focusDistance, --focus)", "focus"),
+                                  ("a sensor size (static.camera.activeSensorPhysicalDimensions, --sensor)", "sensor"))
+                   if last[k] is None]
+        if missing:
+            raise InputError(f"the stream does not give {', '.join(missing)}; give it on the command line")
+        key = tuple(last["sensor"])
+        if key not in sensors:
+            sensors[key] = sensor if sensor is not None and (sensor.width_mm, sensor.height_mm) == key \
+                else custom_sensor(*key)
+        pin = float(last["pinhole"])
+        f_dof = float(last["nominal"]) if last["nominal"] is not None else pin
+        tstop = last["tstop"]
+        if tstop is not None and tstop < last["fstop"]:
+            tstop = None  # a T-stop faster than the f-stop is not physical; the report would refuse it
+        try:
+            report = solve_lens_report(focal_length_mm=f_dof, sensor=sensors[key], fstop=float(last["fstop"]),
+                                       focus_mm=float(last["focus"]), coc=coc, tstop=tstop,
+                                       pupil_mm=None if last["pupil"] is None else float(last["pupil"]),
+                                       pinhole_focal_length_mm=pin)
+        except PhysCamError as exc:
+            where = f"frame {len(out)} (timecode {f.timecode})" if f.timecode else f"frame {len(out)}"
+            raise type(exc)(f"{where}: {exc}") from None
+        out.append(SolvedFrame(f, t, report))
+    if skipped:
+        warnings.warn(f"{skipped} samples did not advance in time and were left out", PhysCamWarning, stacklevel=2)
+    return out
+
+
+def _usd_from_stage(v, mpu):
+    """OpenTrackIO stage metres (x, y, z; Z-up) as USD scene units on a Y-up stage: (x, z, -y)."""
+    return (v[0] / mpu, v[2] / mpu, -v[1] / mpu)
+
+
+def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.01, path: str = "/Cameras/Camera",
+                        resolution=(4096, None), force: bool = False):
+    """Write the solved frames (:func:`solve_frames`) as one time-sampled camera (module notes); return the Path."""
+    import numpy as np
+    from pxr import Gf, Sdf, UsdGeom, Vt
+
+    from ..export.usdgeom import mm_to_scene_units, require_meters_per_unit
+    from ..usd.author import author_camera, new_stage, sample_render_camera, save_stage, spec_from_report
+    from .frames import rotation_matrix
+
+    if isinstance(solved, (str, bytes)) or not hasattr(solved, "__iter__"):
+        from ..errors import WrongTypeError
+
+        raise WrongTypeError("solved must be a list of SolvedFrame (physcam.live.record.solve_frames)")
+    solved = list(solved)
+    for s in solved:
+        require_type("solved frame", s, SolvedFrame, "physcam.live.record.solve_frames(frames)")
+    if not solved:
+        raise InputError("no frames to write")
+    _, fr = time_codes([s.frame for s in solved], rate)
+    tcps = float(fr)
+    if tcps > 1000.0:  # new_stage's bound; record at a lower rate would misplace samples
+        raise InputError(f"the stream's sample rate {tcps:g} fps is above USD stage rates physcam writes (1000)")
+    mpu = require_meters_per_unit(meters_per_unit)
+    su = lambda mm: mm_to_scene_units(mm, mpu)  # noqa: E731
+    shutter = 0.5 / tcps
+
+    stage = new_stage(mpu, tcps, up_axis="Y")
+    stage.SetStartTimeCode(solved[0].time_code)
+    stage.SetEndTimeCode(solved[-1].time_code)
+    s0 = solved[0]
+    spec0 = spec_from_report(s0.report, shutter_duration_s=shutter)
+    cam = author_camera(stage, path, spec0, report=s0.report)
+    cam.SetCustomDataByKey("physcam:source", "OpenTrackIO stream recorded by physcam live record")
+    model = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Pinhole"))
+    geom = UsdGeom.Camera(stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")))
+    # the body: pupil position, OpenTrackIO's rotation as rotateZXY, back to the film plane
+    body = UsdGeom.Xformable(cam)
+    body.ClearXformOpOrder()
+    op_pupil = body.AddTranslateOp()
+    op_rot = body.AddRotateZXYOp()
+    op_film = body.AddTranslateOp(opSuffix="pupilToFilm")
+    lp = "lens:main:"
+    names = {n: cam.GetAttribute(lp + n) for n in ("fStop", "iris", "entrancePupilDistance", "pinholeFocalLength")}
+    body_iris = cam.GetAttribute("iris")
+    a_seq = cam.CreateAttribute("physcam:live:sequenceNumber", Sdf.ValueTypeNames.Int64, True)
+    a_tc = cam.CreateAttribute("physcam:live:timecode", Sdf.ValueTypeNames.String, True)
+    a_model = cam.CreateAttribute("physcam:live:distortionModel", Sdf.ValueTypeNames.String, True)
+    a_radial = cam.CreateAttribute("physcam:live:distortionRadial", Sdf.ValueTypeNames.DoubleArray, True)
+    a_tang = cam.CreateAttribute("physcam:live:distortionTangential", Sdf.ValueTypeNames.DoubleArray, True)
+    omni = None
+    c = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])  # OpenTrackIO stage -> USD Y-up
+    for s in solved:
+        f, t, report = s.frame, s.time_code, s.report
+        spec = spec_from_report(report, shutter_duration_s=shutter)
+        eye = spec.entrance_pupil_mm
+        rot = c @ rotation_matrix(*f.rotation_deg) @ c.T
+        film = np.array(_usd_from_stage(f.translation_m, mpu))
+        pupil = film + rot @ np.array([0.0, 0.0, -su(eye)])
+        op_pupil.Set(Gf.Vec3d(*map(float, pupil)), t)
+        pan, tilt, roll = f.rotation_deg
+        op_rot.Set(Gf.Vec3f(tilt, pan, -roll), t)
+        op_film.Set(Gf.Vec3d(0.0, 0.0, su(eye)), t)
+        model.GetAttribute("focalLength").Set(spec.focal_length_mm, t)
+        model.GetAttribute("focusDistance").Set(spec.focus_mm, t)
+        names["fStop"].Set(spec.fstop, t)
+        names["iris"].Set(spec.focal_length_mm / spec.fstop, t)
+        body_iris.Set(spec.focal_length_mm / spec.fstop, t)
+        names["entrancePupilDistance"].Set(eye, t)
+        if names["pinholeFocalLength"]:
+            names["pinholeFocalLength"].Set(report.pinhole[0], t)
+        sample_render_camera(geom, spec, report, mpu, tcps, t, where=path)
+        geom.GetExposureFStopAttr().Set(spec.fstop / math.sqrt(spec.transmittance), t)
+        if f.sequence_number is not None:
+            a_seq.Set(int(f.sequence_number), t)
+        if f.timecode is not None:
+            a_tc.Set(f.timecode, t)
+        if f.distortion is not None:
+            d = f.distortion
+            a_model.Set(str(d.get("model", "Brown-Conrady D-U")), t)
+            a_radial.Set(Vt.DoubleArray([float(v) for v in d.get("radial", [])]), t)
+            a_tang.Set(Vt.DoubleArray([float(v) for v in d.get("tangential", [])]), t)
+            omni = _omni_sample(geom.GetPrim(), omni, d, report, resolution, t)
+    return save_stage(stage, file, force=force)
+
+
+def _omni_sample(prim, attrs, distortion, report, resolution, t):
+    """One time sample of Omniverse's OpenCV-pinhole distortion on the companion camera (normalised
+    coefficients, pixels of a ``resolution`` image); skipped for models it cannot express."""
+    from pxr import Gf, Sdf
+
+    from ..usd.author import OMNI_OPENCV_API
+
+    f_pin = report.pinhole[0]
+    try:
+        cv = opentrackio_to_opencv(distortion, f_pin)
+    except InputError:
+        return attrs
+    s = report.sensor
+    w_px = int(resolution[0])
+    h_px = int(resolution[1]) if resolution[1] is not None else max(16, round(w_px * s.height_mm / s.width_mm))
+    pfx = "omni:lensdistortion:opencvPinhole:"
+    if attrs is None:
+        prim.AddAppliedSchema(OMNI_OPENCV_API)
+        prim.CreateAttribute("omni:lensdistortion:model", Sdf.ValueTypeNames.Token, True).Set("opencvPinhole")
+        prim.CreateAttribute(pfx + "imageSize", Sdf.ValueTypeNames.Int2, True).Set(Gf.Vec2i(w_px, h_px))
+        attrs = {k: prim.CreateAttribute(pfx + k, Sdf.ValueTypeNames.Float, True)
+                 for k in ("fx", "fy", "cx", "cy", "k1", "k2", "k3", "p1", "p2")}
+    values = dict(cv, fx=f_pin * w_px / s.width_mm, fy=f_pin * h_px / s.height_mm, cx=w_px / 2.0, cy=h_px / 2.0)
+    for k, a in attrs.items():
+        a.Set(float(values[k]), t)
+    return attrs
+
+
+def _num(v):
+    return None if v is None or (isinstance(v, float) and not math.isfinite(v)) else v
+
+
+def lens_report_rows(solved) -> list[dict]:
+    """One dict per solved frame with :data:`REPORT_COLUMNS` (mm, degrees; a far limit at infinity is None)."""
+    rows = []
+    for i, s in enumerate(solved):
+        require_type("solved frame", s, SolvedFrame, "physcam.live.record.solve_frames(frames)")
+        f, r = s.frame, s.report
+        rows.append({
+            "frame": i, "time_code": s.time_code, "timecode": f.timecode, "sequence_number": f.sequence_number,
+            "focus_from_film_mm": r.focus_from_film_mm, "pinhole_focal_length_mm": r.pinhole[0],
+            "dof_focal_length_mm": r.focal_length_mm, "fstop": r.fstop, "tstop": r.tstop,
+            "entrance_pupil_from_film_mm": r.entrance_pupil_from_film_mm,
+            "near_from_film_mm": r.dof.near_from_film_mm, "far_from_film_mm": _num(r.dof.far_from_film_mm),
+            "hyperfocal_from_film_mm": r.dof.hyperfocal_from_film_mm, "hfov_deg": r.hfov_focus_deg,
+            "vfov_deg": r.vfov_focus_deg, "dfov_deg": r.dfov_focus_deg, "coc_mm": r.coc_mm,
+            "x_m": f.translation_m[0], "y_m": f.translation_m[1], "z_m": f.translation_m[2],
+            "pan_deg": f.rotation_deg[0], "tilt_deg": f.rotation_deg[1], "roll_deg": f.rotation_deg[2],
+        })
+    return rows
+
+
+def write_lens_report(file, solved, *, force: bool = False):
+    """The per-frame lens report as CSV (``.csv``) or JSON (any other suffix); written atomically."""
+    from pathlib import Path
+
+    from ..io import atomic_write
+
+    p = Path(file) if isinstance(file, (str, Path)) else None
+    if p is None:
+        raise InputError(f"the lens report needs a file name, got {file!r}")
+    rows = lens_report_rows(solved)
+    if p.suffix.lower() == ".csv":
+        buf = io.StringIO()
+        w = csv.DictWriter(buf, fieldnames=REPORT_COLUMNS, lineterminator="\n")
+        w.writeheader()
+        for row in rows:
+            w.writerow({k: ("" if v is None else v) for k, v in row.items()})
+        return atomic_write(p, buf.getvalue(), force=force)
+    if p.suffix.lower() != ".json":
+        raise ExportError(f"{p}: the lens report is written as .csv or .json")
+    try:
+        _, fr = time_codes([s.frame for s in solved])
+        rate = {"num": fr.numerator, "denom": fr.denominator}
+    except InputError:
+        rate = None
+    sensor = solved[0].report.sensor
+    doc = {"schema": "physcam.live_lens_report", "version": 1, "rate": rate,
+           "sensor_mm": [sensor.width_mm, sensor.height_mm],
+           "units": {"length": "mm", "angle": "degree", "position": "m (OpenTrackIO stage, Z up)"},
+           "reference": "distances *_from_film_mm are in front of the film plane; far_from_film_mm null = infinity",
+           "frames": rows}
+    return atomic_write(p, json.dumps(doc, indent=1, allow_nan=False) + "\n", force=force)

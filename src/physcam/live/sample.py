@@ -1,0 +1,185 @@
+"""OpenTrackIO samples: decode (JSON or CBOR) and validate against the shipped 1.0.1 JSON schema.
+
+The schema is SMPTE RIS-OSVP's ``opentrackio-schema-1.0.1.json`` (draft 2020-12), shipped as
+``physcam/data/opentrackio-schema-1.0.1.json`` and checked by :mod:`jsonschema`'s
+``Draft202012Validator``, a complete implementation of the draft (docs/live.md says why this
+library). A sample that fails is reported by its JSON path (``$.lens.fStop``) and the schema rule it
+broke (``exclusiveMinimum``), the first problem first in document order.
+
+Numbers that JSON cannot carry (NaN, Infinity) and CBOR can are refused too, with their path: no
+NaN or infinity enters physcam from a stream.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+from ..errors import InputError, require_type
+
+__all__ = ["SCHEMA_FILE", "PROTOCOL_VERSION", "SampleError", "SampleProblem", "schema", "sample_problems",
+           "validate_sample", "decode_sample", "encode_sample", "json_path"]
+
+SCHEMA_FILE = "opentrackio-schema-1.0.1.json"
+PROTOCOL_VERSION = (1, 0, 1)
+#: nesting deeper than this is refused before validation (the schema's deepest path is 6 levels)
+MAX_DEPTH = 32
+
+
+@dataclass(frozen=True)
+class SampleProblem:
+    """One reason a sample is not valid: where (a JSON path, ``$`` the sample), which rule, and a sentence."""
+
+    path: str
+    rule: str
+    message: str
+
+    def __str__(self) -> str:
+        return f"{self.path}: {self.message} (rule: {self.rule})"
+
+    def to_dict(self) -> dict:
+        return {"path": self.path, "rule": self.rule, "message": self.message}
+
+
+class SampleError(InputError):
+    """A sample that does not decode or does not validate; ``problems`` lists every reason, the first
+    is in the message."""
+
+    def __init__(self, problems):
+        self.problems = tuple(problems)
+        first = self.problems[0]
+        more = f" (and {len(self.problems) - 1} more)" if len(self.problems) > 1 else ""
+        super().__init__(f"invalid OpenTrackIO sample: {first}{more}")
+
+
+def json_path(parts) -> str:
+    """A JSON path from keys and indices: ``("lens", "distortion", 0, "radial")`` -> ``$.lens.distortion[0].radial``."""
+    out = "$"
+    for p in parts:
+        if isinstance(p, int) and not isinstance(p, bool):
+            out += f"[{p}]"
+        elif isinstance(p, str) and p.isidentifier():
+            out += f".{p}"
+        else:
+            out += "[" + json.dumps(str(p)) + "]"
+    return out
+
+
+@lru_cache(maxsize=1)
+def schema() -> dict:
+    """The OpenTrackIO 1.0.1 JSON schema (a dict; do not modify it)."""
+    from importlib.resources import files
+
+    return json.loads(files("physcam.data").joinpath(SCHEMA_FILE).read_text(encoding="utf-8"))
+
+
+@lru_cache(maxsize=1)
+def _validator():
+    import jsonschema
+
+    s = schema()
+    cls = jsonschema.validators.validator_for(s)
+    cls.check_schema(s)
+    return cls(s)
+
+
+def _non_finite(obj, parts, depth=0):
+    """The path of the first NaN/inf number, or of nesting beyond MAX_DEPTH, else None."""
+    if depth > MAX_DEPTH:
+        return SampleProblem(json_path(parts), "maxDepth", f"nested deeper than {MAX_DEPTH} levels")
+    if isinstance(obj, float):
+        if not math.isfinite(obj):
+            return SampleProblem(json_path(parts), "finite", f"{obj} is not a finite number")
+    elif isinstance(obj, dict):
+        for k, v in obj.items():
+            if isinstance(v, (dict, list, float)):
+                bad = _non_finite(v, parts + (k,), depth + 1)
+                if bad:
+                    return bad
+    elif isinstance(obj, list):
+        for i, v in enumerate(obj):
+            if isinstance(v, (dict, list, float)):
+                bad = _non_finite(v, parts + (i,), depth + 1)
+                if bad:
+                    return bad
+    return None
+
+
+def _order_key(error):
+    return tuple((0, p) if isinstance(p, int) else (1, str(p)) for p in error.absolute_path)
+
+
+def sample_problems(sample) -> list[SampleProblem]:
+    """Every reason ``sample`` (a decoded dict) breaks the schema, sorted by path; empty when valid."""
+    if not isinstance(sample, dict):
+        return [SampleProblem("$", "type", f"a sample is a JSON object, got {type(sample).__name__}")]
+    bad = _non_finite(sample, ())
+    if bad:
+        return [bad]
+    v = _validator()
+    if v.is_valid(sample):
+        return []
+    out = []
+    for e in sorted(v.iter_errors(sample), key=_order_key):
+        # anyOf/oneOf name the branch that came closest; report it where it is more precise
+        best = e
+        if e.context:
+            import jsonschema.exceptions
+
+            best = jsonschema.exceptions.best_match([e]) or e
+        out.append(SampleProblem(json_path(best.absolute_path), str(best.validator), best.message))
+    return out
+
+
+def validate_sample(sample) -> dict:
+    """Return ``sample`` when it is a valid OpenTrackIO 1.0.1 sample, else raise :class:`SampleError`."""
+    problems = sample_problems(sample)
+    if problems:
+        raise SampleError(problems)
+    return sample
+
+
+def _reject_constant(name):
+    raise ValueError(f"{name} is not a JSON number")
+
+
+def decode_sample(payload, encoding: str = "json", *, validate: bool = True) -> dict:
+    """Decode one sample from ``payload`` bytes (``encoding`` "json" or "cbor") and validate it.
+
+    Undecodable bytes raise :class:`SampleError` with the path ``$`` and the rule ``json``/``cbor``.
+    """
+    if not isinstance(payload, (bytes, bytearray, memoryview)):
+        require_type("payload", payload, (bytes, bytearray, memoryview))
+    if encoding not in ("json", "cbor"):
+        raise InputError(f"encoding must be json or cbor, got {encoding!r}")
+    try:
+        if encoding == "json":
+            obj = json.loads(bytes(payload).decode("utf-8"), parse_constant=_reject_constant)
+        else:
+            import cbor2
+
+            obj = cbor2.loads(bytes(payload))
+    except (ValueError, UnicodeDecodeError, RecursionError) as exc:
+        raise SampleError([SampleProblem("$", encoding, f"not {encoding.upper()}: {str(exc)[:120]}")]) from None
+    except Exception as exc:  # noqa: BLE001 - cbor2's decoder raises its own classes (CBORDecodeError, ...)
+        raise SampleError([SampleProblem("$", encoding, f"not {encoding.upper()}: {str(exc)[:120]}")]) from None
+    if validate:
+        validate_sample(obj)
+    return obj
+
+
+def encode_sample(sample, encoding: str = "json") -> bytes:
+    """``sample`` as compact JSON (UTF-8) or CBOR bytes (no validation; see :func:`validate_sample`)."""
+    require_type("sample", sample, dict)
+    if encoding == "json":
+        try:
+            return json.dumps(sample, separators=(",", ":"), allow_nan=False).encode("utf-8")
+        except ValueError as exc:
+            raise InputError(f"the sample holds a number JSON cannot carry: {exc}") from None
+    if encoding == "cbor":
+        import cbor2
+
+        return cbor2.dumps(sample)
+    raise InputError(f"encoding must be json or cbor, got {encoding!r}")

@@ -1,0 +1,109 @@
+"""`physcam live` from the command line: validate, and a record run fed by the sender."""
+
+from __future__ import annotations
+
+import csv
+import json
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from physcam.cli import main
+from physcam.live.camera import camera_frames, frames_to_samples
+from physcam.live.sender import Sender
+from physcam.onset.sensors import find_sensor
+
+DATA = Path(__file__).parent / "data"
+
+
+def test_validate_examples_and_a_broken_sample(tmp_path, capsys):
+    assert main(["live", "validate", *map(str, sorted(DATA.glob("*.json")))]) == 0
+    broken = json.loads((DATA / "recommended_dynamic_example.json").read_text())
+    broken["lens"]["fStop"] = 0
+    (tmp_path / "b.json").write_text(json.dumps(broken))
+    capsys.readouterr()
+    assert main(["live", "validate", str(tmp_path / "b.json"), "--json"]) == 2
+    out = json.loads(capsys.readouterr().out)
+    assert out["samples"][0]["problems"][0] == {"path": "$.lens.fStop", "rule": "exclusiveMinimum",
+                                                "message": "0 is less than or equal to the minimum of 0.0"}
+
+
+def _free_port() -> int:
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+@pytest.mark.slow
+def test_record_a_sent_take(tmp_path):
+    pytest.importorskip("pxr")
+    from pxr import Usd
+
+    port = _free_port()
+    out, rep = tmp_path / "take.usda", tmp_path / "take.csv"
+    proc = subprocess.Popen([sys.executable, "-m", "physcam", "live", "record", str(out), "--port", str(port),
+                             "--host", "127.0.0.1", "--count", "30", "--duration", "60", "--report", str(rep),
+                             "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    frames = camera_frames(sensor=find_sensor("ALEXA 35"), frames=30, rate=24, focus_mm=2000.0, focus_to_mm=3000.0,
+                           fstop=4.0, focal_length_mm=32.0)
+    samples = list(frames_to_samples(frames))
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and proc.poll() is None:  # until the recorder holds the port
+        with open("/proc/net/udp") as f:  # local_address is ADDR:PORT in hex
+            if any(line.split()[1].endswith(f":{port:04X}") for line in f.readlines()[1:]):
+                break
+        time.sleep(0.1)
+    with Sender("127.0.0.1", port, encoding="cbor") as tx:
+        tx.stream(samples, 240)
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 0, stderr
+    summary = json.loads(stdout)
+    assert summary["frames"] == 30 and summary["counters"]["delivered"] >= 30
+    stage = Usd.Stage.Open(str(out))
+    cam = stage.GetPrimAtPath("/Cameras/Camera")
+    assert cam.GetAttribute("physcam:live:sequenceNumber").GetTimeSamples() == [float(i) for i in range(30)]
+    rows = list(csv.DictReader(rep.open()))
+    assert [float(r["focus_from_film_mm"]) for r in rows] == pytest.approx(
+        [s["lens"]["focusDistance"] * 1000 for s in samples], rel=1e-12)
+
+
+def test_a_json_lens_report_plays_back_as_valid_samples(tmp_path):
+    from physcam.cli.live import _frames_from_report
+    from physcam.live.record import solve_frames, write_lens_report
+    from physcam.live.sample import validate_sample
+
+    frames = camera_frames(sensor=find_sensor("ALEXA 35"), frames=5, rate=23.976, focus_mm=2000.0, fstop=2.0,
+                           focal_length_mm=50.0)
+    rep = write_lens_report(tmp_path / "r.json", solve_frames(frames))
+    back = _frames_from_report(rep)
+    samples = list(frames_to_samples(back))
+    for s in samples:
+        validate_sample(s)
+    assert samples[0]["timing"]["sampleRate"] == {"num": 24000, "denom": 1001}
+    assert samples[0]["static"]["camera"]["activeSensorPhysicalDimensions"] == {"width": 27.99, "height": 19.22}
+    assert [s["lens"]["focusDistance"] for s in samples] == [2.0] * 5
+
+
+@pytest.mark.slow
+def test_multicast_on_loopback():
+    from physcam.live.receiver import Receiver, multicast_group
+
+    frames = camera_frames(sensor=find_sensor("ALEXA 35"), frames=50, rate=48, focus_mm=2000.0, fstop=2.0,
+                           focal_length_mm=50.0)
+    samples = list(frames_to_samples(frames))
+    group = multicast_group(1)
+    with Receiver(0, group=group, interface="127.0.0.1") as rx, Sender(group, rx.port, encoding="cbor") as tx:
+        tx.stream(samples, 1000)
+        got, deadline = [], time.monotonic() + 10
+        while len(got) < 50 and time.monotonic() < deadline:
+            item = rx.get(timeout=0.1)
+            if item is not None:
+                got.append(item)
+    assert [g.sample["sampleId"] for g in got] == [s["sampleId"] for s in samples]
+    assert {g.encoding for g in got} == {"cbor"}
