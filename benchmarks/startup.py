@@ -9,6 +9,7 @@ OS file cache and numba's on-disk kernel cache warm: one untimed run first). Pla
 
 import argparse
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -41,14 +42,20 @@ def main() -> None:
             argv, goal = COMMANDS[name]
             argv = [a.replace("{tmp}", tmp) for a in argv]
             subprocess.run(argv, check=True, capture_output=True)  # warm the OS file cache and the JIT cache
-            times = []
+            times, cpu = [], []
             for _ in range(args.runs):
+                r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
                 t0 = time.perf_counter()
                 subprocess.run(argv, check=True, capture_output=True)
                 times.append(time.perf_counter() - t0)
+                r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+                cpu.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
             med = statistics.median(times)
+            # CPU time (user + system, all threads) is what a command costs on a quiet machine, less
+            # disturbed by other jobs than the wall clock
             line = (f"physcam {name}: median {med * 1000:.0f} ms, min {min(times) * 1000:.0f} ms, "
-                    f"max {max(times) * 1000:.0f} ms over {args.runs} runs")
+                    f"max {max(times) * 1000:.0f} ms over {args.runs} runs (CPU median "
+                    f"{statistics.median(cpu) * 1000:.0f} ms)")
             if goal is not None:
                 line += f"; goal {goal * 1000:.0f} ms: ratio {med / goal:.2f} ({'met' if med < goal else 'NOT met'})"
             print(line + f" (load {load()})")
