@@ -105,8 +105,10 @@ class RayBatch:
 
     def copy(self) -> "RayBatch":
         sp = None if self.weight_sp is None else np.array(self.weight_sp, copy=True)
-        return RayBatch(*(np.array(a, copy=True) for a in self._base()), flag=np.array(self.flag, copy=True),
-                        weight_sp=sp)
+        return RayBatch(np.array(self.x, copy=True), np.array(self.y, copy=True), np.array(self.z, copy=True),
+                        np.array(self.L, copy=True), np.array(self.M, copy=True), np.array(self.N, copy=True),
+                        np.array(self.wavelength_nm, copy=True), np.array(self.weight, copy=True),
+                        np.array(self.flag, copy=True), sp)
 
     def columns(self):
         """The arrays in the kernels' order: x y z L M N wavelength_nm weight weight_sp flag
