@@ -34,6 +34,7 @@ import numpy as np
 
 from physcam.lens.prescription import LensMetadata, Medium, Prescription, Surface
 from physcam.trace import RayBatch, paraxial_image_z, trace_to_film
+from physcam.trace import kernels
 from physcam.trace.kernels import numba_available
 
 ROWS = [  # radius thickness index aperture-diameter (pbrt-v4 scenes/lenses/dgauss.50mm.dat)
@@ -140,6 +141,7 @@ def main() -> None:
     colour = mono.copy()
     colour.wavelength_nm[:] = rng.uniform(400.0, 700.0, args.rays)
     numba_available()  # load numba now ("auto" would start small calls on the numpy kernel)
+    kernels.LOAD_AWARE = False  # the thread counts below are the ones asked for, busy machine or not
     for b in (mono, colour, mono.astype(np.float32)):  # warm the JIT (or load it from the cache)
         trace_to_film(lens, b.take(slice(0, 5000)), film, fresnel=True)
         trace_to_film(lens, b.take(slice(0, 5000)), film)

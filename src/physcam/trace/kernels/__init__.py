@@ -13,10 +13,11 @@ stays under :data:`NUMPY_BUDGET_S` and the call at hand under :data:`NUMPY_CALL_
 call past either loads numba, and from then on (or whenever numba is already loaded) every call
 uses the JIT kernel. Since the kernels agree, the answer does not depend on which one ran.
 
-The JIT kernel runs on the calling thread below :data:`SERIAL_BELOW` rays and on numba's thread
-pool above: waking the pool costs a few microseconds on an idle machine and, on a busy one,
-up to a scheduler time slice (milliseconds) while a worker waits for a core
-(benchmarks/small_calls.py). Compiled kernels are cached on disk under a key that includes
+The JIT kernel runs on the calling thread below :data:`SERIAL_BELOW` rays (and, with
+:data:`LOAD_AWARE`, at any size while the machine is busy) and on numba's thread pool otherwise:
+waking the pool costs a few microseconds on an idle machine and, on a busy one, up to a scheduler
+time slice (milliseconds) while a worker waits for a core (benchmarks/small_calls.py). Serial and
+parallel give identical rays. Compiled kernels are cached on disk under a key that includes
 physcam's version and a hash of the kernel sources (:mod:`._jitcache`).
 """
 
@@ -38,9 +39,32 @@ NUMPY_RAY_SURFACE_S = 60e-9
 NUMPY_SURFACE_S = 30e-6
 NUMPY_BUDGET_S = 0.1
 NUMPY_CALL_MAX_S = 0.04
+#: Large batches too run serially while the machine is busy (1-minute load average above the
+#: cores numba uses, plus 0.5): numba's parallel loop splits the blocks statically, so with other
+#: processes on the cores it waits for its slowest thread (benchmarks/small_calls.py measured the
+#: parallel kernel 2-5x slower than the serial one under load, up to 1e6 rays).
+LOAD_AWARE = True
 _numba_kernel = None
 _numba_error: str | None = None
 _numpy_spent = 0.0
+_load_seen = (-1.0, False)  # (monotonic time of the last look, busy then)
+
+
+def _busy() -> bool:
+    """Whether other work occupies the cores (looked up at most once a second)."""
+    global _load_seen
+    import time
+
+    now = time.monotonic()
+    if now - _load_seen[0] > 1.0:
+        try:
+            import numba
+
+            busy = os.getloadavg()[0] > numba.get_num_threads() + 0.5
+        except (OSError, AttributeError):  # no load average on this platform
+            busy = False
+        _load_seen = (now, busy)
+    return _load_seen[1]
 
 
 def _load_numba():
@@ -53,8 +77,10 @@ def _load_numba():
             from ._numba import trace_rays
 
             def trace_rays_auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
-                trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono,
-                           SERIAL_BELOW)
+                below = SERIAL_BELOW
+                if x.shape[0] >= below and LOAD_AWARE and _busy():
+                    below = x.shape[0] + 1
+                trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, below)
 
             trace_rays_auto.jit = trace_rays
             _numba_kernel = trace_rays_auto
