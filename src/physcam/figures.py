@@ -76,6 +76,20 @@ def pyplot():
     return _PLOT
 
 
+def _skip_layout_rerun(fig) -> None:
+    """After ``fig.tight_layout()`` matplotlib leaves a do-nothing placeholder layout engine, and
+    ``savefig`` then draws the whole figure once more (without rendering) just to run it: for a
+    spot diagram's scatter of 1e5 points that is a third of the save. Drop the placeholder; the
+    layout already applied stays, and the image is the same."""
+    try:
+        from matplotlib.layout_engine import PlaceHolderLayoutEngine
+
+        if isinstance(fig.get_layout_engine(), PlaceHolderLayoutEngine):
+            fig._layout_engine = None
+    except (ImportError, AttributeError):  # another matplotlib: it draws as it always did
+        pass
+
+
 def save_figure(fig, path, *, force: bool = False, dpi: int = 130) -> Path:
     """Write ``fig`` to ``path`` (.png, .svg or .pdf, from the extension) and close it.
 
@@ -91,6 +105,7 @@ def save_figure(fig, path, *, force: bool = False, dpi: int = 130) -> Path:
         _PLOT.close(fig)
         raise ExportError(f"cannot save a figure as {p.name!r}: use a .png, .svg or .pdf file name")
     check_writable(p, force=force)
+    _skip_layout_rerun(fig)
     buf = io.BytesIO()
     fig.savefig(buf, format=fmt, dpi=dpi)
     _PLOT.close(fig)
