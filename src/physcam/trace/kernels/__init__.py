@@ -31,7 +31,7 @@ __all__ = ["BACKENDS", "SERIAL_BELOW", "get_kernel", "resolve_backend", "numba_a
 
 BACKENDS = ("auto", "numba", "numpy")
 #: Batches smaller than this run the JIT kernel serially (measured crossover, docs/performance.md).
-SERIAL_BELOW = 4096
+SERIAL_BELOW = 1024
 #: "auto" before numba is loaded: the numpy kernel's cost per ray and surface, and per surface and
 #: call (dgauss_50mm on this machine: 1.3-2.2 M rays/s through 11 surfaces; ~25 us of numpy calls
 #: per surface), the numpy work allowed in all (about half of what loading numba costs) and in one call
