@@ -145,6 +145,7 @@ def main() -> None:
     for b in (mono, colour, mono.astype(np.float32)):  # warm the JIT (or load it from the cache)
         trace_to_film(lens, b.take(slice(0, 5000)), film, fresnel=True)
         trace_to_film(lens, b.take(slice(0, 5000)), film)
+    mono32 = mono.astype(np.float32)
     exe = None if args.no_c else build_c(C_SOURCE)
     print(f"dgauss.50mm, {args.rays:,} rays, beam radius {BEAM_MM} mm, film at z = {film:.4f} mm")
     print(f"machine: {os.cpu_count()} cores, load average {load()} at start")
@@ -166,6 +167,8 @@ def main() -> None:
         if exe is not None:
             line += f" | C simd {best_c / 1e6:6.2f} M rays/s (RMS {rms_c:.4f} um) | ratio {best_p / best_c:.2f}"
         line += f" | {best_p / threads / 25e6:.2f} x the 25 M/s-per-core stretch"
+        r32, _ = rate(lens, mono32, film, args.repeat)
+        line += f" | float32 {r32 / 1e6:.2f} M rays/s"
         print(line)
     if exe is None and not args.no_c:
         print(f"  (no C reference: gcc or {C_SOURCE} missing)")
