@@ -5,13 +5,16 @@ a kernel whose constants come from another module (the column layout in :mod:`._
 load stale machine code after that module changed, and an upgrade that keeps file contents
 but changes the package could do the same. physcam's locator keys every cache entry with a hash
 of physcam's version and of all kernel sources (this package's ``.py`` files), so a cache written
-by any other version or source is never used: it is recompiled and overwritten.
+by any other version or source is never used: it is recompiled and overwritten. Should a numba
+release not accept the locator, the kernels are compiled without a disk cache (slow to start,
+never stale) rather than cached under numba's weaker key.
 
 Entries go to ``__pycache__/physcam-jit`` beside the kernels, or, where the package directory is
 not writable (a system install), to the user cache (``$NUMBA_CACHE_DIR`` if set, else
-``$XDG_CACHE_HOME`` or ``~/.cache``, under ``physcam/jit``). The locator is numba's documented
-extension point for cache placement (``numba.core.caching._CacheLocator``), registered ahead of
-numba's own for functions defined in this directory only; other numba users are unaffected.
+``$XDG_CACHE_HOME`` or ``~/.cache``, under ``physcam/jit``). The locator subclasses numba's cache
+locator class (``numba.core.caching._CacheLocator``, the class ``NUMBA_CACHE_LOCATOR_CLASSES``
+names; an internal of numba) and is registered ahead of numba's own, for functions defined in
+this directory only: other numba users are unaffected.
 """
 
 from __future__ import annotations
@@ -48,12 +51,25 @@ def _user_dir() -> str:
     return os.path.join(base, "physcam", "jit", tag)
 
 
-def install() -> None:
-    """Register the locator with numba (idempotent; call before the kernels are defined)."""
+def install() -> bool:
+    """Register the locator with numba (idempotent; call before the kernels are defined).
+    Returns False where this numba does not take it (then do not cache)."""
     global _installed
     if _installed:
-        return
-    from numba.core import caching
+        return True
+    try:
+        _register()
+    except Exception:  # noqa: BLE001 - another numba: compile without the disk cache instead
+        return False
+    _installed = True
+    return True
+
+
+def _register() -> None:
+    from numba.core import caching, config
+
+    if getattr(config, "CACHE_LOCATOR_CLASSES", None):  # the user's locators replace ours: no cache
+        raise RuntimeError("NUMBA_CACHE_LOCATOR_CLASSES is set")
 
     class PhysCamLocator(caching._CacheLocator):
         def __init__(self, py_func, py_file, path):
@@ -83,7 +99,5 @@ def install() -> None:
                 return self
             return None
 
-    if PhysCamLocator not in caching.CacheImpl._locator_classes:
-        caching.CacheImpl._locator_classes.insert(0, PhysCamLocator)
-    _installed = True
+    caching.CacheImpl._locator_classes.insert(0, PhysCamLocator)
     sys.modules[__name__].PhysCamLocator = PhysCamLocator

@@ -35,7 +35,7 @@ from numba.extending import overload
 
 from . import _jitcache
 
-_jitcache.install()  # before any @njit(cache=True) below: cache keyed by version and sources
+_CACHE = _jitcache.install()  # before any @njit below: cache keyed by version and sources (else none)
 
 from ._layout import A4, AX, AY, AZ, CK, CV, ETA, N1, N2, NA, NB, NEWTON_MAX_ITER, NEWTON_TOL, SA, SB  # noqa: E402
 from ._layout import CLIPPED, MISSED, RSC, SEMI, TIR, UNIT, VZ  # noqa: E402
@@ -53,9 +53,9 @@ _ACT, _CONV, _DS = _CI, _CT, _UPD
 
 #: every kernel function: IEEE arithmetic (no contraction, no reassociation), no Python error
 #: checks (a division by zero gives inf in a masked lane instead of raising), GIL released
-_OPTS = dict(fastmath=False, error_model="numpy", nogil=True, cache=True)
+_OPTS = dict(fastmath=False, error_model="numpy", nogil=True, cache=_CACHE)
 #: the Fresnel weights only: contraction to FMA allowed
-_FMA_OPTS = dict(fastmath={"contract"}, error_model="numpy", nogil=True, cache=True)
+_FMA_OPTS = dict(fastmath={"contract"}, error_model="numpy", nogil=True, cache=_CACHE)
 
 
 def _like(value, arr):  # pragma: no cover - replaced by the overload inside jitted code
