@@ -13,7 +13,7 @@ BLENDER_PY    := $(BLENDER_VENV)/bin/python
 BLENDER_STAMP := $(BLENDER_VENV)/.physcam-installed
 BPY_VERSION   ?= 5.0.1
 
-.PHONY: demo test venv blender bench clean schema
+.PHONY: demo test venv blender bench clean schema chromium
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -41,12 +41,26 @@ $(BLENDER_STAMP): pyproject.toml
 
 blender: $(BLENDER_STAMP)
 
-test: $(STAMP) $(BLENDER_STAMP)
+# The `physcam serve` page tests drive Debian's chromium (tests/serve/test_serve_browser.py). CI runs
+# as root on a fresh Debian machine: install it there when missing, at the version tested, or at the
+# current one when Debian's security archive has moved on. Not root or no apt-get: nothing is
+# installed and the browser tests skip, saying why.
+CHROMIUM_VERSION ?= 156.0.8078.79-1~deb12u1
+chromium:
+	@if ! command -v chromium >/dev/null 2>&1 && [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	  ( apt-get update -qq \
+	    && { DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium=$(CHROMIUM_VERSION) \
+	         || DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; } ) >/dev/null \
+	  || echo "physcam: chromium could not be installed; the browser tests will be skipped" >&2; \
+	fi
+
+test: $(STAMP) $(BLENDER_STAMP) chromium
 	PHYSCAM_BLENDER_PYTHON=$(abspath $(BLENDER_PY)) $(PY) -m pytest -n 2 -q
 
 bench: $(STAMP)
 	$(PY) benchmarks/startup.py
 	$(PY) benchmarks/trace.py
+	$(PY) benchmarks/serve.py
 
 # Regenerate the USD schema plugin (plugInfo.json, generatedSchema.usda) from
 # src/physcam/usd/schema/schema.usda with usd-core's own usdGenSchema.

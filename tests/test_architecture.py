@@ -20,9 +20,11 @@ LAYER = {
     "export": 7,
     "usd": 8,
     "live": 8.5,
-    "cli": 9,
+    "characterize": 9,
+    "serve": 9,
+    "cli": 10,
     "": 0,  # the root package only re-exports errors and the version
-    "__main__": 10,
+    "__main__": 11,
 }
 
 

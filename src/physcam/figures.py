@@ -16,7 +16,7 @@ from __future__ import annotations
 import io
 from pathlib import Path
 
-__all__ = ["pyplot", "subplots", "new_figure", "save_figure"]
+__all__ = ["pyplot", "subplots", "new_figure", "save_figure", "figure_bytes"]
 
 _FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 
@@ -105,8 +105,23 @@ def save_figure(fig, path, *, force: bool = False, dpi: int = 130) -> Path:
         _PLOT.close(fig)
         raise ExportError(f"cannot save a figure as {p.name!r}: use a .png, .svg or .pdf file name")
     check_writable(p, force=force)
+    return atomic_write(p, figure_bytes(fig, fmt, dpi=dpi), force=force)
+
+
+def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130) -> bytes:
+    """``fig`` drawn in memory as ``fmt`` ("png", "svg" or "pdf") and closed: what :func:`save_figure`
+    writes, for a caller that sends it elsewhere (``physcam serve``)."""
+    from .errors import ExportError, WrongTypeError
+
+    if not callable(getattr(fig, "savefig", None)):
+        raise WrongTypeError(f"fig must be a matplotlib Figure, got {type(fig).__name__}")
+    if fmt not in _FORMATS.values():
+        _PLOT.close(fig)
+        raise ExportError(f"cannot draw a figure as {fmt!r}: use one of png, svg, pdf")
     _skip_layout_rerun(fig)
     buf = io.BytesIO()
-    fig.savefig(buf, format=fmt, dpi=dpi)
-    _PLOT.close(fig)
-    return atomic_write(p, buf.getvalue(), force=force)
+    try:
+        fig.savefig(buf, format=fmt, dpi=dpi)
+    finally:
+        _PLOT.close(fig)
+    return buf.getvalue()

@@ -33,12 +33,21 @@ FILES = ["out.usda", "out.png", "out.svg", "out.txt", "", "missing_dir/out.usda"
 #: flags appended to every fuzzed run of a command (after the drawn ones, so they win): receivers and
 #: senders run for a bounded time instead of until Ctrl-C
 BOUNDED = {("live", "record"): ["--duration=0.3"], ("live", "send"): ["--duration=0.3"],
-           ("live", "play"): ["--duration=0.3"]}
+           ("live", "play"): ["--duration=0.3"],
+           # characterize only validates and plans: the fuzzer never starts a Dask cluster or traces a grid
+           ("characterize",): ["--dry-run"],
+           # serve binds its address, answers one report in-process and exits instead of serving
+           ("serve",): ["--check"]}
 #: A valid command line some leaves start from, so that the fuzzed flags reach the handler instead of
 #: stopping at a missing required option (argparse keeps the last of a repeated option).
 BASE_ARGV = {
     ("export", "rib"): ["-o", "out.rib", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--force"],
     ("export", "pbrt"): ["-o", "pbrt_out", "--lens", "dgauss_50mm", "--focus", "3m", "--force"],
+    ("export", "mitsuba"): ["-o", "mitsuba_out", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--width-px",
+                            "64", "--force"],
+    ("microlens", "insert"): ["--microlens-focal", "0.5", "--xdim", "21", "--ydim", "21", "--film-width", "4.2",
+                              "--film-height", "4.2", "--focus", "1m", "-o", "lf.json", "--force"],
+    ("characterize",): ["-o", "lib", "--focus", "2m"],
 }
 NAN_OR_INF = re.compile(r"(?<![A-Za-z_])(nan|NaN|inf|Infinity)(?![A-Za-z_])")
 
@@ -68,6 +77,10 @@ def _value_strategy(action):
         return st.sampled_from(["FF", "ALEXA 35", "ALEXA", "", "nope", "S35"])
     if dest in ("coc",):
         return st.sampled_from(["cine", "d/1500", "0.025", "0", "-1", "nan", "abc", ""])
+    if dest == "fields":  # physcam mtf: image heights on the chart (valid counts too, up to the largest)
+        return st.sampled_from(["2", "3", "41", "1", "0", "-1", "abc", "", "1e12"])
+    if dest == "pupil_samples":  # physcam mtf: pupil grid (valid sizes too, small enough that 41 fields run in seconds)
+        return st.sampled_from(["16", "32", "64", "8", "0", "100000", "abc", ""])
     return st.sampled_from(NUMBERS)
 
 

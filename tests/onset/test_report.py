@@ -121,7 +121,7 @@ def test_json_is_strict_and_versioned():
     r = solve_lens_report(focal_length_mm=24.0, sensor=FF, fstop=11.0, focus_mm=5000.0, coc=0.03)
     assert r.dof.far_is_infinite
     d = json.loads(json.dumps(r.to_dict(), allow_nan=False))
-    assert d["schema"] == "physcam.lens_report" and d["version"] == 1
+    assert d["schema"] == "physcam.lens_report" and d["version"] == 2
     assert d["dof"]["far_mm"] is None and d["dof"]["far_is_infinite"] is True
 
 

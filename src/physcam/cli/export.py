@@ -76,6 +76,7 @@ def register(sub) -> None:
     b.set_defaults(handler=run_blender)
     _register_rib(s)
     _register_pbrt(s)
+    _register_mitsuba(s)
     p.set_defaults(handler=lambda args: (p.print_help(), 0)[1])
 
 
@@ -452,3 +453,64 @@ def run_pbrt(args) -> int:
 
 def _shift(v) -> str:
     return "unchanged (at infinity)" if v is None else f"{v:+.3f} mm"
+
+
+# --- physcam export mitsuba (Mitsuba 3 thinlens sensor; docs/mitsuba.md) ----------------------------
+def _register_mitsuba(s) -> None:
+    from .lens import add_lenient
+    from .report import add_report_arguments
+
+    m = s.add_parser("mitsuba", help="write a Mitsuba 3 thinlens sensor (scene XML and dict JSON) matching the lens report",
+                     description="Write <name>.xml (a Mitsuba 3 scene holding the sensor; <include> it or load it with "
+                                 "mi.load_file) and <name>.json (the same sensor as a mi.load_dict dictionary) for the "
+                                 "lens report of these options: the field of view of the focused lens and its "
+                                 "entrance pupil, so framing and defocus match the real lens (docs/mitsuba.md).")
+    add_report_arguments(m)  # --lens/--focal, --fstop, --focus, the sensor, --meters-per-unit, --shutter-angle
+    add_lenient(m)
+    m.add_argument("--width-px", type=int, default=1920, metavar="PX",
+                   help="film width in pixels (height follows the sensor aspect; default 1920)")
+    m.add_argument("--spp", type=int, default=64, metavar="N", help="samples per pixel of the sampler (default 64)")
+    m.add_argument("--fps", type=number("frames per second", positive=True), default=24.0,
+                   help="frame rate for the shutter interval in seconds (default 24)")
+    m.add_argument("--name", default="camera", help="file name stem of the two files (default camera)")
+    m.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write <name>.xml and <name>.json into")
+    m.add_argument("--force", action="store_true", help="overwrite existing files")
+    m.add_argument("--json", action="store_true", help="print what was written as JSON")
+    m.set_defaults(handler=run_mitsuba)
+
+
+def run_mitsuba(args) -> int:
+    import json
+    from pathlib import Path
+
+    from ..errors import InputError
+    from ..export.mitsuba import mitsuba_camera_values, mitsuba_scene_dict, mitsuba_scene_xml
+    from ..io import atomic_write, check_writable
+    from .report import solve_from_args
+
+    name = str(args.name)
+    if not name or name in (".", "..") or "/" in name or "\\" in name or "\0" in name:
+        raise InputError(f"--name must be a plain file name stem, got {name!r}")
+    if not str(args.output):
+        raise InputError("--output must name a folder")
+    xml_path, json_path = Path(args.output) / f"{name}.xml", Path(args.output) / f"{name}.json"
+    for path in (xml_path, json_path):
+        check_writable(path, force=args.force)
+    report = solve_from_args(args)
+    values = mitsuba_camera_values(report, width_px=args.width_px, meters_per_unit=args.meters_per_unit,
+                                   spp=args.spp, shutter_angle_deg=args.shutter_angle, fps=args.fps,
+                                   shift_mm=(args.shift_x, args.shift_y))
+    atomic_write(xml_path, mitsuba_scene_xml(values), force=args.force)
+    atomic_write(json_path, json.dumps(mitsuba_scene_dict(values), indent=2, allow_nan=False) + "\n", force=args.force)
+    if args.json:
+        print_json({"xml": str(xml_path), "json": str(json_path), **values})
+        return 0
+    sn, pc = values["sensor"], values["physcam"]
+    print(f"wrote {xml_path} and {json_path}: Mitsuba 3 thinlens for {pc['lens'] or 'a thin lens'} "
+          f"({pc['focal_length_mm']:g} mm f/{pc['fstop']:g}) at {_mark(pc['focus_from_film_mm'])}")
+    print(f"  fov {sn['fov']:.4f} deg (x; infinity focus would be {pc['hfov_infinity_deg']:.4f}), aperture_radius "
+          f"{sn['aperture_radius']:.6g}, focus_distance {sn['focus_distance']:.6g} (scene units of "
+          f"{pc['meters_per_unit']:g} m), film {sn['film']['width']} x {sn['film']['height']} px")
+    for n in pc["notes"]:
+        print(f"  note: {n}")
+    return 0

@@ -134,11 +134,11 @@ def _json_float(v):
     return None if (v is None or (isinstance(v, float) and not math.isfinite(v))) else v
 
 
-def run_lenses(args) -> int:
+def lenses_document() -> list[dict]:
+    """The bundled lenses as ``physcam lenses --json`` prints them (and ``physcam serve`` answers)."""
     from ..errors import PhysCamError
     from ..lens.library import list_lenses, load_lens
     from ..optics.paraxial import gaussian
-    from ._common import console, print_json
 
     out = []
     for rec in list_lenses():
@@ -149,6 +149,13 @@ def run_lenses(args) -> int:
         except PhysCamError:  # a listing must not stop at one odd lens
             d["efl_mm"], d["f_number"] = None, None
         out.append(d)
+    return out
+
+
+def run_lenses(args) -> int:
+    from ._common import console, print_json
+
+    out = lenses_document()
     if args.json:
         print_json(out)
         return 0
@@ -182,9 +189,9 @@ def _meridians(p):
     return ("x", "y") if p.is_anamorphic else ("y",)
 
 
-def run_show(args) -> int:
+def show_data(args):
+    """What ``physcam lens show`` computes: (lens, focus state, {meridian: GaussianData}, focus block)."""
     from ..optics import focusing, paraxial
-    from ._common import console, print_json
 
     p = _load(args)
     st = focusing.focus(p, args.focus, method=args.focus_method, wavelength_nm=args.wavelength)
@@ -203,9 +210,27 @@ def run_show(args) -> int:
         "focus_group_travel_fraction": st.alpha,
         "focused_meridian": st.axis,
     }
+    return p, st, data, focus_info
+
+
+def show_document(args) -> dict:
+    """The document ``physcam lens show --json`` prints (and ``physcam serve`` answers)."""
+    p, _, data, focus_info = show_data(args)
+    return _show_document(p, data, focus_info)
+
+
+def _show_document(p, data, focus_info) -> dict:
+    return mark_repaired({"lens": p.name, "squeeze": p.squeeze, "focus": focus_info,
+                          "meridians": {a: g.to_dict() for a, g in data.items()}}, p)
+
+
+def run_show(args) -> int:
+    from ..optics import paraxial
+    from ._common import console, print_json
+
+    p, st, data, focus_info = show_data(args)
     if args.json:
-        print_json(mark_repaired({"lens": p.name, "squeeze": p.squeeze, "focus": focus_info,
-                                  "meridians": {a: g.to_dict() for a, g in data.items()}}, p))
+        print_json(_show_document(p, data, focus_info))
         return 0
     from rich.table import Table
 
@@ -243,12 +268,17 @@ def run_show(args) -> int:
     return 0
 
 
+def diagram_options(args) -> dict:
+    """The keyword arguments ``physcam lens diagram`` gives :func:`physcam.analysis.diagram.lens_diagram`."""
+    return dict(axis=args.axis, focus_from_film_mm=args.focus, fstop=args.fstop, field_deg=args.field,
+                wavelength_nm=args.wavelength)
+
+
 def run_diagram(args) -> int:
     from ..analysis.diagram import save_lens_diagram
 
     p = _load(args)
-    path = save_lens_diagram(p, args.output, force=args.force, axis=args.axis, focus_from_film_mm=args.focus,
-                             fstop=args.fstop, field_deg=args.field, wavelength_nm=args.wavelength)
+    path = save_lens_diagram(p, args.output, force=args.force, **diagram_options(args))
     print(f"wrote {path}")
     return 0
 

@@ -159,6 +159,18 @@ def camera_blocks(report, args) -> dict:
     return blocks
 
 
+def report_document(report, cams, args) -> dict:
+    """The document ``physcam report --json`` prints (and ``physcam serve`` answers): the report's
+    ``to_dict()`` with the camera blocks, marked when the lens was repaired on load."""
+    d = report.to_dict()
+    d["cameras"] = cams
+    if getattr(args, "loaded_lens", None) is not None:
+        from .lens import mark_repaired
+
+        d = mark_repaired(d, args.loaded_lens)
+    return d
+
+
 def run(args) -> int:
     from ._common import console, print_json
 
@@ -173,13 +185,7 @@ def run(args) -> int:
 
         plot_dof_zone(report, args.plot, force=args.force)
     if args.json:
-        d = report.to_dict()
-        d["cameras"] = cams
-        if getattr(args, "loaded_lens", None) is not None:
-            from .lens import mark_repaired
-
-            d = mark_repaired(d, args.loaded_lens)
-        print_json(d)
+        print_json(report_document(report, cams, args))
         return 0
     from ..onset.table import report_table
 

@@ -10,17 +10,19 @@ def register(sub) -> None:
     p.set_defaults(handler=run)
 
 
+def sensor_document(s) -> dict:
+    """One sensor as ``physcam sensors --json`` prints it (and ``physcam serve`` answers)."""
+    return {"key": s.key, "name": s.name, "width_mm": s.width_mm, "height_mm": s.height_mm,
+            "diagonal_mm": s.diagonal_mm, "aliases": list(s.aliases), "kind": s.kind, "source": s.source}
+
+
 def run(args) -> int:
     from ..onset.sensors import find_sensor, sensors
     from ._common import console, print_json
 
     rows = [find_sensor(args.name)] if args.name else list(sensors())
     if args.json:
-        print_json([
-            {"key": s.key, "name": s.name, "width_mm": s.width_mm, "height_mm": s.height_mm,
-             "diagonal_mm": s.diagonal_mm, "aliases": list(s.aliases), "kind": s.kind, "source": s.source}
-            for s in rows
-        ])
+        print_json([sensor_document(s) for s in rows])
         return 0
     from rich.table import Table
 

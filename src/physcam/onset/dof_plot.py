@@ -8,18 +8,28 @@ def plot_dof_zone(report, path, *, force: bool = False):
 
     Written atomically through :func:`physcam.io.atomic_write`.
     """
-    from ..figures import pyplot, save_figure
+    from ..figures import save_figure
     from ..io import check_writable
 
-    plt = pyplot()
-
     check_writable(path, force=force)
+    return save_figure(dof_zone_figure(report), path, force=force)
+
+
+def dof_zone_figure(report, *, size_in=(9.0, 2.6)):
+    """The figure :func:`plot_dof_zone` saves, as a matplotlib Figure on its own Agg canvas (no pyplot
+    state, so a server can draw it in memory with :func:`physcam.figures.figure_bytes`); ``size_in``
+    is (width, height) in inches (a phone screen reads a narrower one)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
     d = report.dof
     near, focus, far = d.near_from_film_mm / 1000, report.focus_from_film_mm / 1000, d.far_from_film_mm / 1000
     hyper = d.hyperfocal_from_film_mm / 1000
     right = max(hyper, focus) * 1.3 if far == float("inf") else max(far, focus) * 1.4
     right = max(right, near * 2)
-    fig, ax = plt.subplots(figsize=(9, 2.6), dpi=120)
+    fig = Figure(figsize=tuple(size_in), dpi=120)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 1, 1)
     ax.axvspan(near, min(far, right), color="#9fd3a8", alpha=0.7, label="acceptably sharp")
     if report.dof_horizontal is not None:
         dh = report.dof_horizontal
@@ -49,4 +59,4 @@ def plot_dof_zone(report, path, *, force: bool = False):
     ax.set_title(title, fontsize=9)
     ax.legend(loc="lower right", fontsize=7)
     fig.tight_layout()
-    return save_figure(fig, path, force=force)
+    return fig

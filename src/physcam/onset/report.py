@@ -12,6 +12,12 @@ Depth of field uses the exact thin-lens forms (physcam.optics.dof) about H1 and 
 reported both from H1 and from the film plane. Inputs may be forward (f-stop, CoC)
 or inverse (near and/or far limits measured on a plate), in which case the report
 solves the effective f-stop, the CoC or the focus distance, and says what it solved.
+
+Diffraction: the Airy disk's diameter to its first dark ring, 2.44 lambda N_w (Born & Wolf,
+*Principles of Optics*, 8.5.2), with N_w the working f-number N (1 + m) at the focus (the
+pupils taken as equal; a prescription gives its own paraxial working f-number), compared with
+the CoC and the sensor's photosite pitch, and the f-stop past which the Airy disk is larger
+than the CoC: N = c / (2.44 lambda (N_w / N)). Scalars only (no numpy), like the rest.
 """
 
 from __future__ import annotations
@@ -26,7 +32,8 @@ from ..optics.coc import circle_of_confusion
 from .pupil import entrance_pupil_practical, pivot_camera_space
 from .sensors import Sensor
 
-__all__ = ["LensReport", "DepthOfField", "solve_lens_report", "takes_report", "REPORT_SCHEMA", "REPORT_VERSION"]
+__all__ = ["LensReport", "DepthOfField", "solve_lens_report", "takes_report", "REPORT_SCHEMA", "REPORT_VERSION",
+           "DIFFRACTION_WAVELENGTH_NM", "airy_diameter_mm", "fstop_airy_equals"]
 
 #: Real (chief-ray) and pinhole fields of view may differ by this much (percent, any of horizontal,
 #: vertical, diagonal) before the report warns: about what a fitted two-term radial distortion
@@ -34,7 +41,13 @@ __all__ = ["LensReport", "DepthOfField", "solve_lens_report", "takes_report", "R
 REAL_FOV_TOLERANCE_PCT = 2.0
 
 REPORT_SCHEMA = "physcam.lens_report"
-REPORT_VERSION = 1
+#: 2: adds ``diffraction`` and ``sensor.photosite_pitch_mm`` (every key of version 1 kept).
+REPORT_VERSION = 2
+#: Wavelength of the report's diffraction figures: 550 nm, near the peak of the eye's photopic
+#: sensitivity (CIE V(lambda) peaks at 555 nm), the usual choice of diffraction-limit tables.
+DIFFRACTION_WAVELENGTH_NM = 550.0
+#: The Airy disk's diameter to its first dark ring is AIRY_FACTOR lambda N (2 x 1.22).
+AIRY_FACTOR = 2.44
 
 
 @dataclass(frozen=True)
@@ -96,6 +109,22 @@ def _finite_or_none(v: float | None):
     return None if v is None or math.isinf(v) else v
 
 
+def airy_diameter_mm(working_f_number, wavelength_nm=DIFFRACTION_WAVELENGTH_NM) -> float:
+    """Diameter (mm) of the Airy disk to its first dark ring: 2.44 lambda N_w (Born & Wolf, 8.5.2)."""
+    n = require_positive("working f-number", working_f_number, unit="")
+    lam = require_positive("wavelength", wavelength_nm, unit="nm")
+    return AIRY_FACTOR * lam * 1e-6 * n
+
+
+def fstop_airy_equals(size_mm, wavelength_nm=DIFFRACTION_WAVELENGTH_NM, bellows_factor=1.0) -> float:
+    """The f-stop N whose Airy disk (at working f-number N x ``bellows_factor``) is ``size_mm`` across:
+    past it diffraction blurs more than ``size_mm`` (a CoC, two photosites)."""
+    c = require_positive("size", size_mm)
+    lam = require_positive("wavelength", wavelength_nm, unit="nm")
+    k = require_positive("bellows factor", bellows_factor, unit="")
+    return c / (AIRY_FACTOR * lam * 1e-6 * k)
+
+
 @dataclass(frozen=True)
 class LensReport:
     """Everything the lens report knows. Lengths in mm, angles in degrees.
@@ -151,6 +180,11 @@ class LensReport:
     #: pupil's X over Y diameter (object-space blur angles scale with it); 1 for a spherical lens,
     #: 1 / squeeze for a thin lens given a squeeze (a front anamorphic's cylinders narrow the pupil in X)
     dof_aspect: float = 1.0
+    #: wavelength (nm) of the diffraction figures
+    diffraction_wavelength_nm: float = DIFFRACTION_WAVELENGTH_NM
+    #: working over geometric f-number at this focus: a prescription's paraxial ratio; None: 1 + m
+    #: (pupils taken as equal)
+    bellows_factor: float | None = None
 
     # --- convenience --------------------------------------------------------
     @property
@@ -184,6 +218,56 @@ class LensReport:
     def desqueezed_width_mm(self) -> float:
         return self.sensor.width_mm * self.squeeze
 
+    # --- diffraction ------------------------------------------------------------
+    @property
+    def working_f_number(self) -> float:
+        """N_w = N x (the bellows factor, or 1 + m)."""
+        k = self.bellows_factor if self.bellows_factor is not None else 1.0 + abs(self.magnification)
+        return self.fstop * k
+
+    @property
+    def airy_diameter_mm(self) -> float:
+        """The Airy disk's diameter (first dark ring) on the film at the working f-number."""
+        return airy_diameter_mm(self.working_f_number, self.diffraction_wavelength_nm)
+
+    @property
+    def fstop_airy_exceeds_coc(self) -> float:
+        """The f-stop past which the Airy disk is larger than the circle of confusion."""
+        return fstop_airy_equals(self.coc_mm, self.diffraction_wavelength_nm, self.working_f_number / self.fstop)
+
+    def diffraction_dict(self) -> dict:
+        pitch = self.sensor.pitch_um
+        k = self.working_f_number / self.fstop
+        airy = self.airy_diameter_mm
+        p_mm = None if pitch is None else pitch * 1e-3
+        return {
+            "wavelength_nm": self.diffraction_wavelength_nm,
+            "working_f_number": self.working_f_number,
+            "airy_diameter_mm": airy,
+            "coc_mm": self.coc_mm,
+            "airy_to_coc": airy / self.coc_mm,
+            "exceeds_coc": airy > self.coc_mm,
+            "fstop_airy_exceeds_coc": self.fstop_airy_exceeds_coc,
+            "photosite_pitch_mm": p_mm,
+            "airy_in_photosites": None if p_mm is None else airy / p_mm,
+            "fstop_airy_exceeds_two_photosites": None if p_mm is None else fstop_airy_equals(
+                2 * p_mm, self.diffraction_wavelength_nm, k),
+            "definition": "Airy diameter to the first dark ring, 2.44 lambda N_w; N_w the working f-number at "
+                          "this focus (N (1 + m), or a prescription's own); fstop_airy_exceeds_coc: the f-stop past "
+                          "which it is larger than the CoC; photosite pitch from the sensor table (null: unknown)",
+        }
+
+    def diffraction_note(self) -> str:
+        d = self.diffraction_dict()
+        um = 1000.0
+        text = (f"diffraction ({d['wavelength_nm']:g} nm): Airy disk {d['airy_diameter_mm'] * um:.1f} um across at "
+                f"f/{self.fstop:.3g} (working f/{d['working_f_number']:.3g}), {d['airy_to_coc']:.2f} of the CoC "
+                f"({self.coc_mm * um:.1f} um)")
+        if d["photosite_pitch_mm"] is not None:
+            text += f" and {d['airy_in_photosites']:.1f} photosites ({d['photosite_pitch_mm'] * um:.2f} um)"
+        verb = "exceeds" if d["exceeds_coc"] else "would exceed"
+        return text + f"; it {verb} the CoC past f/{d['fstop_airy_exceeds_coc']:.3g}"
+
     def to_dict(self) -> dict:
         """Versioned, JSON-ready dict with stable keys; infinities become null plus a flag."""
         s = self.sensor
@@ -206,6 +290,7 @@ class LensReport:
                 "width_mm": s.width_mm,
                 "height_mm": s.height_mm,
                 "diagonal_mm": s.diagonal_mm,
+                "photosite_pitch_mm": None if s.pitch_um is None else s.pitch_um * 1e-3,
             },
             "coc_mm": self.coc_mm,
             "coc_convention": self.coc_convention,
@@ -246,6 +331,7 @@ class LensReport:
             "solved": dict(self.solved),
             "measured": {k: _finite_or_none(v) if isinstance(v, float) else v for k, v in self.measured.items()},
             "notes": list(self.notes),
+            "diffraction": self.diffraction_dict(),
         }
 
 
@@ -293,6 +379,7 @@ def solve_lens_report(
     lens=None,
     pinhole_focal_length_mm: float | None = None,
     pinhole_squeeze: float | None = None,
+    diffraction_wavelength_nm: float = DIFFRACTION_WAVELENGTH_NM,
 ) -> LensReport:
     """Solve the lens report.
 
@@ -315,9 +402,16 @@ def solve_lens_report(
     internal focusing), gives the effective focal length, H1, H2 and the entrance pupil
     in front of the film, so no datasheet is needed; ``focal_length_mm`` may then be None
     and ``fstop`` defaults to the lens's maximum aperture.
+
+    ``diffraction_wavelength_nm`` (default 550): the wavelength of the diffraction figures
+    (Airy disk against the CoC and the photosite pitch; see the module notes).
     """
     notes: list[str] = []
     pupil_origin = "datasheet"
+    lam_diff = require_positive("diffraction wavelength", diffraction_wavelength_nm, unit="nm")
+    if not 200.0 <= lam_diff <= 20000.0:
+        raise InputError(f"diffraction wavelength must lie between 200 and 20000 nm, got {lam_diff:g}")
+    bellows = None
     lens_pinhole = None  # (Y, X) best-match pinhole focal lengths from a prescription
     from ..errors import require_type
 
@@ -364,6 +458,7 @@ def solve_lens_report(
         lens_pinhole = (planes.pinhole_focal_length_mm, planes.pinhole_focal_length_mm)
         lens_stop = planes.stop_from_film_mm
         lens_dof_aspect = 1.0
+        bellows = planes.working_f_number / planes.f_number
         if lens.is_anamorphic and squeeze == 1.0:
             # the squeeze the lens really has at this focus: EFL in Y over EFL in X
             st = focusing.focus(lens, D_lens)
@@ -626,8 +721,13 @@ def solve_lens_report(
         pinhole_squeeze=pin_sq,
         stop_from_film_mm=(lens_stop if lens is not None else (h1_film if model == "practical" else None)),
         dof_aspect=lens_dof_aspect if lens is not None else 1.0 / sq,
+        diffraction_wavelength_nm=lam_diff,
+        bellows_factor=bellows,
         **fov,
     )
+    import dataclasses
+
+    report = dataclasses.replace(report, notes=report.notes + (report.diffraction_note(),))
     if lens is not None:
         report = _with_real_fov(report, lens)
     _check_finite(report)

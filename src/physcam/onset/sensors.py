@@ -3,7 +3,10 @@
 The table ``physcam/data/sensors.csv`` holds active-area (or camera-aperture)
 width and height in mm with their sources; the values were checked against the
 shared reference table ``sensor_formats.csv`` (see tests/onset/test_sensors_pupil.py,
-which also checks each diagonal). Lookup ignores case, spaces and punctuation;
+which also checks each diagonal). Digital sensors of one camera also carry the photosite
+pitch (``pitch_um``, micrometres): the width over the photosites across it
+(``photosites_across``), each count with its source (``pitch_source``; abbreviations in
+``physcam/data/SENSORS.md``). Film gates and the generic full-frame format have none. Lookup ignores case, spaces and punctuation;
 an unknown name raises :class:`~physcam.errors.SensorError` listing the closest names.
 """
 
@@ -19,12 +22,14 @@ from pathlib import Path
 
 from ..errors import SensorError
 
-__all__ = ["Sensor", "sensors", "find_sensor", "custom_sensor", "SENSOR_SIZE_RANGE_MM", "SENSOR_MAX_ASPECT"]
+__all__ = ["Sensor", "sensors", "find_sensor", "custom_sensor", "SENSOR_SIZE_RANGE_MM", "SENSOR_MAX_ASPECT",
+           "PITCH_RANGE_UM"]
 
 
 @dataclass(frozen=True, slots=True)
 class Sensor:
-    """A sensor or film gate: active area ``width_mm`` x ``height_mm``."""
+    """A sensor or film gate: active area ``width_mm`` x ``height_mm``; ``pitch_um`` the photosite
+    pitch (micrometres) where one camera's sensor is meant, else None."""
 
     key: str
     name: str
@@ -33,6 +38,8 @@ class Sensor:
     aliases: tuple[str, ...] = ()
     kind: str = "digital"
     source: str = ""
+    pitch_um: float | None = None
+    pitch_source: str = ""
 
     @property
     def diagonal_mm(self) -> float:
@@ -50,9 +57,14 @@ SENSOR_SIZE_RANGE_MM = (0.5, 1000.0)
 SENSOR_MAX_ASPECT = 20.0
 
 
-def custom_sensor(width_mm, height_mm) -> Sensor:
-    """A sensor measured by hand, ``width_mm`` x ``height_mm``, checked against
-    :data:`SENSOR_SIZE_RANGE_MM` and :data:`SENSOR_MAX_ASPECT` (else :class:`SensorError`)."""
+#: Photosite pitches a custom sensor may have (micrometres): phone sensors to large-pixel cameras.
+PITCH_RANGE_UM = (0.5, 50.0)
+
+
+def custom_sensor(width_mm, height_mm, pitch_um=None) -> Sensor:
+    """A sensor measured by hand, ``width_mm`` x ``height_mm`` (and optionally its photosite
+    ``pitch_um``), checked against :data:`SENSOR_SIZE_RANGE_MM`, :data:`SENSOR_MAX_ASPECT` and
+    :data:`PITCH_RANGE_UM` (else :class:`SensorError`)."""
     from ..errors import require_finite
 
     w = require_finite("sensor width", width_mm, error=SensorError)
@@ -63,7 +75,13 @@ def custom_sensor(width_mm, height_mm) -> Sensor:
     if max(w / h, h / w) > SENSOR_MAX_ASPECT:
         raise SensorError(f"a {w:g} x {h:g} mm sensor is {max(w / h, h / w):.0f}:1; physcam accepts up to "
                           f"{SENSOR_MAX_ASPECT:g}:1 (check the units)")
-    return Sensor("custom", f"custom {w:g} x {h:g} mm", w, h)
+    p = None
+    if pitch_um is not None:
+        p = require_finite("photosite pitch", pitch_um, error=SensorError)
+        if not PITCH_RANGE_UM[0] <= p <= PITCH_RANGE_UM[1]:
+            raise SensorError(f"photosite pitch must lie between {PITCH_RANGE_UM[0]:g} and {PITCH_RANGE_UM[1]:g} um, "
+                              f"got {p:g}")
+    return Sensor("custom", f"custom {w:g} x {h:g} mm", w, h, pitch_um=p, pitch_source="given" if p else "")
 
 
 def _norm(text: str) -> str:
@@ -85,6 +103,8 @@ def sensors() -> tuple[Sensor, ...]:
                 aliases=tuple(a.strip() for a in row["aliases"].split(";") if a.strip()),
                 kind=row["kind"],
                 source=row["source"],
+                pitch_um=float(row["pitch_um"]) if row.get("pitch_um") else None,
+                pitch_source=row.get("pitch_source", ""),
             )
         )
     return tuple(out)

@@ -592,3 +592,137 @@ def write_vendor_lens(file, prescription, *, focus_mm: float, fstop: float | Non
             cam.GetRelationship(rel_name).SetTargets([target])
     vset.SetVariantSelection(use)
     return save_stage(stage, file, force=force)
+
+
+# ------------------------------------------------------------------ characterization variants (issue 18)
+#: Namespace of the measured data a characterization variant holds on ``/Lens`` (docs/characterize.md).
+CHARACTERIZATION_NS = "physcam:characterization:"
+
+
+def _variant_identifier(name) -> str:
+    import re
+
+    require_type("variant name", name, str, "letters, digits and underscores, e.g. run_20260301T080000Z_3fa2c1")
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]{0,127}", name) or name == "current":
+        raise InputError(f"a characterization variant name is letters, digits and underscores, starting with a "
+                         f"letter, and not 'current'; got {name!r}")
+    return name
+
+
+def _open_detached(file):
+    """A stage on an anonymous copy of ``file``'s layer: edits stay in memory until saved, and no
+    layer this process (or USD's registry) holds open for ``file`` is touched or reused."""
+    from pxr import Sdf, Usd
+
+    layer = Sdf.Layer.OpenAsAnonymous(str(file))
+    if layer is None:
+        raise ExportError(f"{file}: USD cannot open it")
+    return Usd.Stage.Open(layer)
+
+
+def _author_measured(prim, measured: dict) -> None:
+    """``measured`` name -> finite numbers (double[]), texts (string[]) or one text (string)."""
+    from pxr import Sdf
+
+    T = Sdf.ValueTypeNames
+    for name, values in measured.items():
+        if isinstance(values, str):
+            prim.CreateAttribute(CHARACTERIZATION_NS + name, T.String, True).Set(values)
+            continue
+        values = list(values)
+        if all(isinstance(v, str) for v in values) and values:
+            prim.CreateAttribute(CHARACTERIZATION_NS + name, T.StringArray, True).Set(values)
+            continue
+        nums = []
+        for v in values:
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise InputError(f"measured value {name!r} must be finite numbers or texts, got {v!r}")
+            nums.append(float(v))
+        prim.CreateAttribute(CHARACTERIZATION_NS + name, T.DoubleArray, True).Set(nums)
+
+
+def add_characterization(file, variant: str, spec: CameraSpec, measured: dict, *, meters_per_unit: float = 0.01,
+                         fps: float = 24.0):
+    """Add variant ``variant`` to the ``characterization`` set of the lens file ``file`` and make ``current``
+    a copy of it ("Interesting Looking Models": new values become a variant, current is set to the latest).
+
+    The file is created (as :func:`write_lens_file` lays it out) when missing. Inside the variant:
+    the lens of ``spec`` (lens API and model, as :func:`write_lens_file` writes it) and, on ``/Lens``,
+    the custom attributes ``physcam:characterization:NAME`` of ``measured`` (NAME -> finite numbers
+    (double[]), texts (string[]) or one text (string); file names are texts, relative to the lens
+    file, not asset paths: USD's validator resolves asset paths and the files may move with the
+    library). Earlier variants are not touched; ``current`` is rewritten and stays
+    selected; ``customData physcam:currentIs`` names ``variant``. A variant of that name already in
+    the file is an :class:`ExportError`. Returns the Path.
+    """
+    from pathlib import Path
+
+    require_type("lens file", file, (str, Path), "a .usda/.usdc path")
+    variant = _variant_identifier(variant)
+    require_type("spec", spec, CameraSpec, "the lens's CameraSpec (best_match_pinhole)")
+    require_type("measured", measured, dict, "name -> list of numbers or texts")
+    for name in measured:
+        if not isinstance(name, str) or not name.replace("_", "").isalnum():
+            raise InputError(f"a measured value's name is letters, digits and underscores, got {name!r}")
+    ensure_registered()
+    p = Path(file)
+    if p.exists():
+        stage = _open_detached(p)
+        prim = stage.GetPrimAtPath(LENS_PRIM)
+        if not prim or prim.GetTypeName() != "PhysicalCamera":
+            raise ExportError(f"{p}: has no PhysicalCamera {LENS_PRIM} (not a physcam lens file)")
+    else:
+        stage = _stage(meters_per_unit, fps)
+        prim = stage.DefinePrim(LENS_PRIM, "PhysicalCamera")
+        stage.SetDefaultPrim(prim)
+    vset = prim.GetVariantSets().AddVariantSet("characterization")
+    if variant in vset.GetVariantNames():
+        raise ExportError(f"{p}: already has a characterization variant {variant!r}; earlier variants are kept as "
+                          "they are")
+    layer = stage.GetRootLayer()
+    if "current" in vset.GetVariantNames():  # the old copy goes; the new one is a copy of the new variant
+        vs_spec = layer.GetPrimAtPath(LENS_PRIM).variantSets.get("characterization")
+        if vs_spec is not None and "current" in vs_spec.variants:
+            vs_spec.RemoveVariant(vs_spec.variants["current"])
+    for name in (variant, "current"):
+        vset.AddVariant(name)
+        vset.SetVariantSelection(name)
+        with vset.GetVariantEditContext():
+            author_camera(stage, LENS_PRIM, spec, parts=("lens",))
+            _author_measured(stage.GetPrimAtPath(LENS_PRIM), measured)
+    vset.SetVariantSelection("current")
+    prim.SetCustomDataByKey("physcam:currentIs", variant)
+    return save_stage(stage, p, force=True)
+
+
+def read_characterizations(file) -> dict:
+    """The characterization variants of a lens file: ``{"current_is": name, "selection": name, "variants":
+    {name: {measured name: value}}}`` (``current`` included), read from a detached copy of the file."""
+    from pathlib import Path
+
+    require_type("lens file", file, (str, Path), "a .usda/.usdc path")
+    ensure_registered()
+    if not Path(file).is_file():
+        raise ExportError(f"{file}: no such lens file")
+    stage = _open_detached(file)
+    prim = stage.GetPrimAtPath(LENS_PRIM)
+    if not prim:
+        raise ExportError(f"{file}: has no {LENS_PRIM} prim (not a physcam lens file)")
+    vset = prim.GetVariantSets().GetVariantSet("characterization")
+    names = list(vset.GetVariantNames()) if prim.GetVariantSets().HasVariantSet("characterization") else []
+    selection = vset.GetVariantSelection() if names else None
+    out = {}
+    for name in names:
+        vset.SetVariantSelection(name)
+        vals = {}
+        for attr in prim.GetAttributes():
+            if attr.GetName().startswith(CHARACTERIZATION_NS) and attr.HasAuthoredValue():
+                v = attr.Get()
+                if hasattr(v, "__len__") and not isinstance(v, str):
+                    v = list(v)
+                vals[attr.GetName()[len(CHARACTERIZATION_NS):]] = v
+        out[name] = vals
+    return {"current_is": prim.GetCustomDataByKey("physcam:currentIs"), "selection": selection, "variants": out}
+
+
+__all__ += ["add_characterization", "read_characterizations", "CHARACTERIZATION_NS"]

@@ -1,0 +1,161 @@
+"""``physcam mtf LENS``: the lens maker's MTF chart, or one field's wavefront, Strehl and MTF (docs/image-quality.md).
+
+The chart: sagittal and tangential MTF at 10, 20 and 40 lp/mm against image height, white
+light (d, F, C), the lens focused at ``--focus`` and stopped to ``--fstop``; printed as a table
+and drawn in characters, ``-o FILE.png`` for the picture, ``--json`` for pipelines.
+``--field DEG`` reports one field instead: RMS and peak-to-valley wavefront, Strehl ratio and
+the MTF at the frequencies (``-o`` draws its MTF curve).
+"""
+
+from __future__ import annotations
+
+import math
+
+from ._common import distance, number, print_json
+from .lens import add_lenient, mark_repaired
+
+#: The CLI's largest pupil grids (the Python API goes to 1024): bound a chart's time and memory
+#: (15 fields x 3 wavelengths), and one field's.
+CLI_MAX_PUPIL_SAMPLES = 512
+CHART_MAX_PUPIL_SAMPLES = 256
+
+EPILOG = """\
+examples:
+  physcam mtf dgauss_50mm --fstop 4 --focus 3m                  (the vendor chart, full frame)
+  physcam mtf dgauss_50mm --fstop 2.8 --sensor "ALEXA 35" -o mtf.png
+  physcam mtf dgauss_50mm --fstop 8 --field 14                  (one field: RMS, Strehl, MTF)
+  physcam mtf dgauss_50mm --wavelength 550 --frequency 10 --frequency 30 --json
+"""
+
+
+def register(sub) -> None:
+    import argparse
+
+    p = sub.add_parser("mtf", help="MTF chart at 10/20/40 lp/mm against image height (lens makers' style), "
+                                   "or one field's wavefront, Strehl and MTF",
+                       description="Diffraction MTF from real rays: the vendor chart, or one field with --field.",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    add_lenient(p)
+    p.add_argument("--fstop", type=number("f-stop", positive=True), default=None,
+                   help="stop the lens down to this f-number (default: the stop in the lens file)")
+    p.add_argument("--focus", type=distance("focus distance", allow_inf=True), default=None, metavar="DIST",
+                   help="focus mark from the film plane (e.g. 3m, 10ft; default infinity)")
+    p.add_argument("--frequency", type=number("frequency"), action="append", metavar="LPMM",
+                   help="spatial frequency in line pairs per mm (repeat; default 10, 20 and 40)")
+    p.add_argument("--wavelength", type=number("wavelength"), action="append", metavar="NM",
+                   help="wavelength in nm (repeat; the first is the primary; default the d, F and C lines)")
+    p.add_argument("--weight", type=number("wavelength weight"), action="append", metavar="W",
+                   help="weight of each --wavelength, in the same order (repeat; default equal)")
+    p.add_argument("--fields", type=int, default=15, metavar="N",
+                   help="image heights on the chart, from the centre to --max-height (2-41; default 15)")
+    p.add_argument("--max-height", type=distance("largest image height"), default=None, metavar="MM",
+                   help="largest image height of the chart (default: the sensor's half diagonal)")
+    p.add_argument("--field", type=number("field angle"), default=None, metavar="DEG",
+                   help="report one field angle (degrees, Y meridian) instead of the chart")
+    p.add_argument("--pupil-samples", type=int, default=None, metavar="N",
+                   help=f"pupil grid cells across (16-{CHART_MAX_PUPIL_SAMPLES} for the chart, to {CLI_MAX_PUPIL_SAMPLES} "
+                        "with --field; default chosen by the sampling rules)")
+    p.add_argument("--sensor", metavar="NAME", help='sensor or gate name, e.g. "ALEXA 35" (default full frame 36x24)')
+    p.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="MM",
+                   help="sensor width with --sensor-height (instead of --sensor)")
+    p.add_argument("--sensor-height", type=distance("sensor height"), default=None, metavar="MM",
+                   help="sensor height with --sensor-width")
+    p.add_argument("--json", action="store_true", help="print as JSON")
+    p.add_argument("-o", "--output", metavar="FILE.png", help="write the chart (or the field's MTF curve) as PNG/SVG/PDF")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.set_defaults(handler=run)
+
+
+def _spectrum(args):
+    from ..analysis.mtf import WHITE_LIGHT_NM
+    from ..errors import InputError
+
+    wls = tuple(args.wavelength) if args.wavelength else WHITE_LIGHT_NM
+    if args.weight and len(args.weight) != len(wls):
+        raise InputError(f"give one --weight per wavelength: {len(wls)} wavelengths, {len(args.weight)} weights")
+    return wls, (tuple(args.weight) if args.weight else None)
+
+
+def run(args) -> int:
+    from ..errors import InputError
+    from ..io import check_writable
+    from ..lens.library import load_lens
+    from .report import resolve_sensor
+
+    if args.force and not args.output:
+        raise InputError("--force overwrites the -o file; without -o there is nothing to overwrite")
+    if args.pupil_samples is not None and not 16 <= args.pupil_samples <= CLI_MAX_PUPIL_SAMPLES:
+        raise InputError(f"--pupil-samples must lie between 16 and {CLI_MAX_PUPIL_SAMPLES}, got {args.pupil_samples}")
+    if args.output:
+        check_writable(args.output, force=args.force)
+    sensor = resolve_sensor(args, default="Full Frame")
+    lens = load_lens(args.lens, lenient=args.lenient)
+    wls, weights = _spectrum(args)
+    freqs = tuple(args.frequency) if args.frequency else (10.0, 20.0, 40.0)
+    focus = None if args.focus is None or math.isinf(args.focus) else args.focus
+    if args.field is not None:
+        if args.max_height is not None or args.fields != 15:
+            raise InputError("--fields and --max-height set the chart; with --field one field is reported")
+        return _one_field(args, lens, wls, weights, freqs, focus)
+    from ..analysis.mtf import mtf_chart
+    from ._common import progress_bar
+
+    top = sensor.diagonal_mm / 2 if args.max_height is None else args.max_height
+    with progress_bar("MTF chart", enabled=not args.json) as bar:
+        chart = mtf_chart(lens, max_image_height_mm=top, n_fields=args.fields, frequencies=freqs, wavelengths_nm=wls,
+                          weights=weights, fstop=args.fstop, focus_mm=focus, pupil_samples=args.pupil_samples,
+                          max_pupil_samples=CHART_MAX_PUPIL_SAMPLES, progress=bar)
+    if args.output:
+        chart.plot(args.output, force=args.force)
+    if args.json:
+        d = chart.to_dict()
+        d["sensor"] = {"name": sensor.name, "width_mm": sensor.width_mm, "height_mm": sensor.height_mm}
+        print_json(mark_repaired(d, lens))
+        return 0
+    foc = "infinity" if focus is None else f"{focus / 1000:g} m"
+    wl = ", ".join(f"{w:g}" for w in chart.wavelengths_nm)
+    print(f"{chart.lens_name}: MTF at f/{chart.fstop:.3g}, focus {foc} from the film, {wl} nm "
+          f"({sensor.name}, corner at {sensor.diagonal_mm / 2:.2f} mm)")
+    print("  S = sagittal (lines radial), T = tangential (lines tangential to circles about the centre)")
+    for line in chart.table().splitlines():
+        print("  " + line)
+    print()
+    print(chart.text_chart())
+    if args.output:
+        print(f"wrote {args.output}")
+    return 0
+
+
+def _one_field(args, lens, wls, weights, freqs, focus) -> int:
+    from ..analysis.mtf import mtf
+    from ..analysis.psf import psf
+    from ..analysis.wavefront import wavefront
+
+    kw = dict(fstop=args.fstop, focus_mm=focus)
+    wf = wavefront(lens, args.field, wavelength_nm=wls[0], pupil_samples=args.pupil_samples, **kw)
+    ps = psf(lens, args.field, wavelength_nm=wls[0], pupil_samples=args.pupil_samples,
+             max_pupil_samples=CLI_MAX_PUPIL_SAMPLES, **kw)
+    m = mtf(lens, args.field, frequencies=freqs, wavelengths_nm=wls, weights=weights, pupil_samples=args.pupil_samples,
+            max_pupil_samples=CLI_MAX_PUPIL_SAMPLES, **kw)
+    if args.output:
+        curve = mtf(lens, args.field, wavelengths_nm=wls, weights=weights, pupil_samples=args.pupil_samples,
+                    max_pupil_samples=CLI_MAX_PUPIL_SAMPLES, **kw)
+        curve.plot(args.output, force=args.force)
+    if args.json:
+        print_json(mark_repaired({"wavefront": wf.to_dict(), "psf": ps.to_dict(), "mtf": m.to_dict()}, lens))
+        return 0
+    print(f"{wf.lens_name}: field {wf.field_deg:g} deg (chief ray at {wf.chief_image_height_mm:.3f} mm), "
+          f"f/{wf.fstop:.3g}")
+    print(f"  wavefront at {wf.wavelength_nm:g} nm: RMS {wf.rms_waves:.4f} waves (to centroid "
+          f"{wf.rms_to_centroid_waves:.4f}), PV {wf.pv_waves:.4f} waves")
+    print(f"  Strehl ratio {ps.strehl:.4f} (Marechal estimate {wf.strehl_marechal:.4f}); Airy radius "
+          f"{ps.airy_radius_um:.2f} um")
+    z = wf.zernike
+    print("  Zernike (Noll, waves): " + ", ".join(f"Z{j + 1} {c:+.4f}" for j, c in enumerate(z[:11])))
+    wl = ", ".join(f"{w:g}" for w in m.wavelengths_nm)
+    print(f"  MTF ({wl} nm): " + ", ".join(f"{f:g} lp/mm S {s:.3f} T {t:.3f}" for f, s, t in
+                                         zip(m.frequencies_lpmm, m.sagittal, m.tangential)))
+    if args.output:
+        print(f"wrote {args.output}")
+    return 0

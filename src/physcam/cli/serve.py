@@ -1,0 +1,237 @@
+"""``physcam serve``: the on-set calculator in a browser (a phone page and a JSON API).
+
+The server (physcam.serve) answers with the CLI's own functions: :func:`cli_backend` parses each
+query with the very argparse parser of ``physcam report`` / ``lens show`` / ``lens diagram`` /
+``sensors`` (so the query names are the flags and every value is read and bounded as on the
+command line) and builds the documents with the functions their ``--json`` paths call.
+"""
+
+from __future__ import annotations
+
+from ._common import number
+
+EPILOG = """\
+examples:
+  physcam serve                         this machine only: open http://127.0.0.1:8765/
+  physcam serve --host 0.0.0.0          every phone on the set's network: prints the address and a QR code
+  physcam serve --port 0 --check        bind a free port, answer one report in-process, exit (scripts, CI)
+
+API (payloads are the CLI's --json; parameters are its flags without dashes; docs/serve.md):
+  /api/report?focal=50&fstop=2.8&focus=3m&sensor=S35     /api/dof.svg?...   /api/focus-table?...&marks=1m,2m
+  /api/sensors   /api/lenses   /api/lens/dgauss_50mm?focus=2m   /api/lens/dgauss_50mm/diagram.svg?fstop=4
+"""
+
+#: Flags of the CLI's parsers that choose output, files or file reading: never query parameters.
+OUTPUT_FLAGS = frozenset({"json", "cameras", "plot", "force", "lenient", "output", "help"})
+
+
+def register(sub) -> None:
+    import argparse
+
+    p = sub.add_parser(
+        "serve",
+        help="the on-set calculator in a browser: a phone page and a JSON API (the CLI's --json) for the set",
+        description="Serve the lens report to browsers: one phone-first page and a JSON API whose payloads are "
+        "the CLI's --json documents. Localhost by default; --host 0.0.0.0 opens it to the network.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--host", default="127.0.0.1",
+                   help="address to listen on: 127.0.0.1 (default, this machine only) or 0.0.0.0 (every device on "
+                        "the network; prints this machine's addresses and a QR code for phones)")
+    p.add_argument("--port", type=_port, default=8765, help="TCP port (default 8765; 0 picks a free one)")
+    p.add_argument("--rate-limit", metavar="N", type=number("rate limit", lo=1, hi=100000), default=60.0,
+                   help="requests per second per client address, in bursts of up to twice that (default 60); "
+                        "more are answered 429")
+    p.add_argument("--log-requests", action="store_true", help="print one line per request")
+    p.add_argument("--check", action="store_true",
+                   help="bind the address, print what would be served, answer one report in-process and exit "
+                        "without serving (for scripts and tests)")
+    p.set_defaults(handler=run)
+
+
+def _port(text):
+    import argparse
+
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"port must be a whole number from 0 to 65535, got {text!r}") from None
+    if not 0 <= v <= 65535:
+        raise argparse.ArgumentTypeError(f"port must be a whole number from 0 to 65535, got {text!r}")
+    return v
+
+
+# --------------------------------------------------------------------------------------------
+def _refuse(message):
+    """argparse's error, raised instead of exiting; "argument --focus: ..." reads "focus: ..." (the query name)."""
+    import re
+
+    from ..errors import InputError
+
+    raise InputError(re.sub(r"^argument --([a-z0-9-]+)(/-\w)?: ", r"\1: ", str(message)))
+
+
+def _leaf(parser, *path):
+    """The sub-parser of ``physcam PATH...`` in ``parser``, made to raise InputError instead of exiting."""
+    import argparse
+
+    p = parser
+    for name in path:
+        sub = next(a for a in p._actions if isinstance(a, argparse._SubParsersAction))
+        p = sub.choices[name]
+    p.error = _refuse  # an instance attribute: argparse calls self.error(message)
+    return p
+
+
+def _names(parser) -> frozenset[str]:
+    """Query names of a parser: its long flags without dashes (and positionals by dest), less OUTPUT_FLAGS."""
+    out = set()
+    for a in parser._actions:
+        if a.option_strings:
+            if a.nargs == 0:
+                continue
+            name = max(a.option_strings, key=len).lstrip("-")
+        else:
+            name = a.dest
+        if name not in OUTPUT_FLAGS:
+            out.add(name)
+    return frozenset(out)
+
+
+def _bundled(name: str) -> str:
+    """The slug of the bundled lens ``name``: the server reads no lens file, only the library."""
+    from ..errors import InputError
+    from ..lens.library import find_lens
+
+    try:
+        return find_lens(name).slug
+    except InputError as exc:
+        hint = str(exc).split(" (`physcam lenses`")[0]
+        raise InputError(f"{hint} (the server offers the bundled lenses: /api/lenses lists them)") from None
+
+
+def _options(q, skip=()) -> list[str]:
+    return [f"--{k}={v}" for k, v in q.items() if k not in skip]
+
+
+def _svg(fig, dpi: int = 130) -> bytes:
+    """A figure as SVG with its text kept as text (a third of the size, quicker to draw and send)."""
+    import matplotlib
+
+    from ..figures import figure_bytes
+
+    with matplotlib.rc_context({"svg.fonttype": "none"}):
+        return figure_bytes(fig, "svg", dpi=dpi)
+
+
+def cli_backend():
+    """A :class:`physcam.serve.Backend` answering with the CLI's functions and parsers."""
+    from ..serve import Backend
+    from . import build_parser
+    from .lens import diagram_options, lenses_document, show_document
+    from .report import camera_blocks, report_document, solve_from_args
+    from .sensors import sensor_document
+
+    root = build_parser()
+    parsers = {"report": _leaf(root, "report"), "sensors": _leaf(root, "sensors"),
+               "lens": _leaf(root, "lens", "show"), "diagram": _leaf(root, "lens", "diagram")}
+    params = {k: _names(p) for k, p in parsers.items()}
+    params["lens"] = params["lens"] - {"lens"}  # the lens is the path: /api/lens/{name}
+    params["diagram"] = params["diagram"] - {"lens"}
+    params["lenses"] = frozenset()
+    params["health"] = frozenset()
+
+    def solved(q):
+        q = dict(q)
+        if "lens" in q:
+            q["lens"] = _bundled(q["lens"])
+        args = parsers["report"].parse_args(_options(q))
+        rep = solve_from_args(args)
+        return rep, args
+
+    def report(q):
+        rep, args = solved(q)
+        return report_document(rep, camera_blocks(rep, args), args)
+
+    def dof_svg(q):
+        from ..onset.dof_plot import dof_zone_figure
+
+        rep, _ = solved(q)
+        return _svg(dof_zone_figure(rep, size_in=(4.5, 2.6)))
+
+    def sensors(q):
+        from ..onset.sensors import find_sensor
+        from ..onset.sensors import sensors as all_sensors
+
+        args = parsers["sensors"].parse_args(["--", q["name"]] if "name" in q else [])
+        rows = [find_sensor(args.name)] if args.name else list(all_sensors())
+        return [sensor_document(s) for s in rows]
+
+    def lens(name, q):
+        return show_document(parsers["lens"].parse_args([*_options(q), "--", _bundled(name)]))
+
+    def diagram_svg(name, q):
+        from ..analysis.diagram import lens_diagram
+        from ..lens.library import load_lens
+
+        args = parsers["diagram"].parse_args([*_options(q), "--output=diagram.svg", "--", _bundled(name)])
+        fig = lens_diagram(load_lens(args.lens), **diagram_options(args)).figure()
+        return _svg(fig, dpi=150)
+
+    return Backend(report=report, dof_svg=dof_svg, sensors=sensors, lenses=lenses_document, lens=lens,
+                   diagram_svg=diagram_svg, parameters=params)
+
+
+def run(args) -> int:
+    import ipaddress
+    import warnings
+
+    from ..errors import PhysCamError, PhysCamWarning
+    from ..serve import Limits, asgi_get, bind_socket, create_app, qr_text, run_server, url_for
+
+    limits = Limits(rate=args.rate_limit, burst=max(2, int(2 * args.rate_limit)))
+    app = create_app(cli_backend(), limits)
+    sock = bind_socket(args.host, args.port)
+    try:
+        if not args.check:
+            # the lens library (read once, ~0.5 s) before the first phone asks: every page load lists it
+            asgi_get(app, "/api/lenses")
+        host, port = sock.getsockname()[:2]
+        urls = url_for(sock)
+        try:
+            wildcard = ipaddress.ip_address(host).is_unspecified
+        except ValueError:
+            wildcard = False
+        if wildcard:
+            print(f"physcam serve: listening on every network interface, port {port}", flush=True)
+            lan = [u for u in urls if "127.0.0.1" not in u]
+            if lan:
+                print(f"on a phone on this network open {lan[0]}  (or scan the code)", flush=True)
+                print(qr_text(lan[0]), end="", flush=True)
+                for u in lan[1:]:
+                    print(f"also: {u}", flush=True)
+            else:
+                print("no network address found on this machine's interfaces; phones cannot reach it yet",
+                      flush=True)
+            print(f"on this machine: {urls[-1]}", flush=True)
+        else:
+            print(f"physcam serve: listening on {urls[0]}", flush=True)
+        if args.check:
+            status, _, body = asgi_get(app, "/api/report?focal=50&fstop=2.8&focus=3m&sensor=S35")
+            if status != 200:
+                raise PhysCamError(f"the server's own check failed: HTTP {status} {body[:200]!r}")
+            status, _, _ = asgi_get(app, "/")
+            if status != 200:
+                raise PhysCamError(f"the server's own check failed: the page answered HTTP {status}")
+            print("check: the page and /api/report answer; not serving (--check)", flush=True)
+            return 0
+        print("Ctrl-C stops the server", flush=True)
+        warnings.simplefilter("ignore", PhysCamWarning)  # the reports carry these in their notes
+        try:
+            run_server(app, sock, log_requests=args.log_requests)
+        except KeyboardInterrupt:  # uvicorn has shut down cleanly and passes Ctrl-C on
+            print("physcam serve: stopped", flush=True)
+    finally:
+        sock.close()
+    return 0

@@ -1,0 +1,440 @@
+"""The ASGI application of ``physcam serve``: routes, validation, limits, caching.
+
+Routes (GET or HEAD only; every answer is JSON, SVG or the page):
+
+=====================================  =============================================================
+``/``                                  the page (``static/index.html``, ``app.js``, ``app.css``)
+``/api/report?focal=50&fstop=2.8...``  ``physcam report ... --json``
+``/api/focus-table?...&marks=1m,2m``   ``physcam report ... --json`` once per focus mark
+``/api/dof.svg?...``                   ``physcam report ... --plot dof.svg``, drawn in memory
+``/api/sensors[?name=S35]``            ``physcam sensors [NAME] --json``
+``/api/lenses``                        ``physcam lenses --json``
+``/api/lens/{name}?focus=2m...``       ``physcam lens show NAME ... --json``
+``/api/lens/{name}/diagram.svg?...``   ``physcam lens diagram NAME ... -o diagram.svg``
+``/api/health``                        ``{"ok": true, "version": ...}``
+=====================================  =============================================================
+
+Query parameters are the CLI flags without their dashes (``sensor-width=24.89``); which ones an
+endpoint takes comes from the backend (the CLI's own parsers). Safety, all in
+:class:`Limits`: a bounded URL, a bounded number and length of parameters, printable values only,
+no request body, a token bucket per client address (429 with ``Retry-After``), a bounded queue
+for the slow work (503), and one JSON line ``{"error": "..."}`` for every refusal (422 for bad
+input), never a traceback. An unexpected exception answers 500 with its class name and is
+logged as one line; the server keeps serving.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import sys
+import time
+from collections import OrderedDict
+from collections.abc import Callable, Mapping
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from importlib import resources
+from urllib.parse import parse_qsl
+
+from .. import __version__
+from ..errors import PhysCamError, WrongTypeError
+
+__all__ = ["Backend", "Limits", "create_app", "STATIC_FILES"]
+
+#: The page's files (package data, ``physcam/serve/static``) and their media types.
+STATIC_FILES = {
+    "index.html": "text/html; charset=utf-8",
+    "app.js": "text/javascript; charset=utf-8",
+    "app.css": "text/css; charset=utf-8",
+    "icon.svg": "image/svg+xml",
+}
+
+#: Headers on every answer: no framing, no sniffing, only this server's own scripts and styles.
+SECURITY_HEADERS = [
+    (b"x-content-type-options", b"nosniff"),
+    (b"referrer-policy", b"no-referrer"),
+    (b"x-frame-options", b"DENY"),
+    (b"content-security-policy",
+     b"default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self'; connect-src 'self'; "
+     b"manifest-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'"),
+]
+
+
+@dataclass(frozen=True)
+class Backend:
+    """What the server answers with. Each function takes the validated query (name -> text, names
+    as the CLI's flags without dashes) and raises a :class:`~physcam.errors.PhysCamError` with a
+    one-line message for input it refuses. ``parameters`` names, per endpoint ("report",
+    "sensors", "lens", "diagram"), the query names it accepts. ``physcam.cli.serve.cli_backend``
+    builds the one physcam uses from the CLI's own functions."""
+
+    report: Callable[[Mapping[str, str]], dict]
+    dof_svg: Callable[[Mapping[str, str]], bytes]
+    sensors: Callable[[Mapping[str, str]], list]
+    lenses: Callable[[], list]
+    lens: Callable[[str, Mapping[str, str]], dict]
+    diagram_svg: Callable[[str, Mapping[str, str]], bytes]
+    parameters: Mapping[str, frozenset[str]]
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The server's bounds. ``rate`` is requests per second per client address (a token bucket of
+    ``burst`` requests); ``queue`` bounds the slow requests (lenses, SVG) waiting for the worker."""
+
+    rate: float = 60.0
+    burst: int = 120
+    max_url: int = 2048
+    max_params: int = 32
+    max_value: int = 64
+    max_marks: int = 16
+    queue: int = 32
+    cache_bytes: int = 32 * 1024 * 1024
+    clients: int = 4096
+
+    def __post_init__(self):
+        import math
+
+        for name in ("rate", "burst", "max_url", "max_params", "max_value", "max_marks", "queue", "cache_bytes",
+                     "clients"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
+                raise WrongTypeError(f"Limits.{name} must be a positive number, got {v!r}")
+
+
+class Refused(Exception):
+    """An answer other than 200, with its status and one line of reason."""
+
+    def __init__(self, status: int, reason: str, headers: list | None = None):
+        super().__init__(reason)
+        self.status, self.reason, self.headers = status, one_line(reason), headers or []
+
+
+def one_line(text) -> str:
+    """The first line of ``text``, at most 300 characters."""
+    lines = str(text).strip().splitlines()
+    line = lines[0] if lines else "refused"
+    return line if len(line) <= 300 else line[:297] + "..."
+
+
+def _error_body(reason: str) -> bytes:
+    return json.dumps({"error": reason}, ensure_ascii=False).encode()
+
+
+async def _send(send, status: int, body: bytes, media: str, headers=(), head: bool = False):
+    hdrs = [(b"content-type", media.encode()), (b"content-length", str(len(body)).encode()),
+            (b"cache-control", b"no-store"), *headers]
+    await send({"type": "http.response.start", "status": status, "headers": hdrs})
+    await send({"type": "http.response.body", "body": b"" if head else body})
+
+
+class _TokenBuckets:
+    """One token bucket per client address, at most ``clients`` of them (the idlest go first)."""
+
+    def __init__(self, rate: float, burst: int, clients: int):
+        self.rate, self.burst, self.clients = float(rate), float(burst), int(clients)
+        self._b: OrderedDict[str, tuple[float, float]] = OrderedDict()
+
+    def take(self, who: str) -> float:
+        """0 when ``who`` may go now, else the seconds until a token is there."""
+        now = time.monotonic()
+        tokens, last = self._b.pop(who, (self.burst, now))
+        tokens = min(self.burst, tokens + (now - last) * self.rate)
+        wait = 0.0
+        if tokens >= 1.0:
+            tokens -= 1.0
+        else:
+            wait = (1.0 - tokens) / self.rate
+        self._b[who] = (tokens, now)
+        while len(self._b) > self.clients:
+            self._b.popitem(last=False)
+        return wait
+
+
+class _Cache:
+    """Answers by (route, arguments), least recently used first out, bounded in bytes."""
+
+    def __init__(self, budget: int):
+        self.budget, self.size = int(budget), 0
+        self._d: OrderedDict = OrderedDict()
+
+    def get(self, key):
+        hit = self._d.get(key)
+        if hit is not None:
+            self._d.move_to_end(key)
+        return hit
+
+    def put(self, key, value):
+        n = len(value[1]) + 200
+        if n > self.budget // 4:
+            return
+        old = self._d.pop(key, None)
+        if old is not None:
+            self.size -= len(old[1]) + 200
+        self._d[key] = value
+        self.size += n
+        while self.size > self.budget:
+            _, v = self._d.popitem(last=False)
+            self.size -= len(v[1]) + 200
+
+
+class _Guard:
+    """Pure ASGI middleware in front of the routes: method, URL and body limits, the rate limit,
+    security headers, and a one-line 500 for anything unexpected (the server keeps serving)."""
+
+    def __init__(self, app, limits: Limits, log):
+        self.app, self.limits, self.log = app, limits, log
+        self.buckets = _TokenBuckets(limits.rate, limits.burst, limits.clients)
+
+    async def __call__(self, scope, receive, send):
+        if scope["type"] == "lifespan":
+            return await self.app(scope, receive, send)
+        if scope["type"] != "http":
+            return  # no websockets: the connection closes
+        started = False
+
+        async def guarded_send(message):
+            nonlocal started
+            if message["type"] == "http.response.start":
+                started = True
+                message = dict(message)
+                message["headers"] = list(message.get("headers", [])) + SECURITY_HEADERS
+            await send(message)
+
+        head = scope.get("method") == "HEAD"
+        try:
+            self._check(scope)
+            await self.app(scope, receive, guarded_send)
+        except Refused as r:
+            if not started:
+                await _send(guarded_send, r.status, _error_body(r.reason), "application/json", r.headers, head)
+        except Exception as exc:  # noqa: BLE001 - a bug must not take the server down nor show a traceback
+            where = f"{scope.get('method')} {scope.get('path')}"
+            self.log(f"physcam serve: internal error on {where}: {type(exc).__name__}: {one_line(exc)}")
+            if not started:
+                await _send(guarded_send, 500, _error_body(f"internal error ({type(exc).__name__}); the server "
+                                                           "keeps running"), "application/json", (), head)
+
+    def _check(self, scope):
+        lim = self.limits
+        if scope.get("method") not in ("GET", "HEAD"):
+            raise Refused(405, f"method {scope.get('method')} is not allowed: this server answers GET only",
+                          [(b"allow", b"GET, HEAD")])
+        if len(scope.get("raw_path") or b"") + len(scope.get("query_string") or b"") > lim.max_url:
+            raise Refused(414, f"the URL is longer than {lim.max_url} characters")
+        for k, v in scope.get("headers", []):
+            if k == b"transfer-encoding" or (k == b"content-length" and v.strip() not in (b"", b"0")):
+                raise Refused(413, "this server takes no request body")
+        client = scope.get("client")
+        wait = self.buckets.take(client[0] if client else "?")
+        if wait > 0:
+            raise Refused(429, f"too many requests from this address (limit {lim.rate:g} per second); "
+                          f"wait {wait:.2f} s", [(b"retry-after", str(max(1, round(wait + 0.5))).encode())])
+
+
+class _App:
+    """The routes' work: query validation, the cache, fast work inline and slow work on one thread."""
+
+    def __init__(self, backend: Backend, limits: Limits):
+        self.backend, self.limits = backend, limits
+        self.cache = _Cache(limits.cache_bytes)
+        # One worker: the lens tracer (numba) and matplotlib are not to be entered from two threads
+        # at once; the GIL would serialise the work anyway.
+        self.pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="physcam-serve")
+        self.pending = 0
+        self.static = {}
+        root = resources.files(__package__) / "static"
+        for name, media in STATIC_FILES.items():
+            self.static[name] = (media, (root / name).read_bytes())
+
+    # --- the query --------------------------------------------------------------------
+    def query(self, scope, endpoint: str, extra: tuple[str, ...] = ()) -> dict[str, str]:
+        lim = self.limits
+        raw = scope.get("query_string") or b""
+        try:
+            text = raw.decode("ascii")
+            pairs = parse_qsl(text, keep_blank_values=True, strict_parsing=False, encoding="utf-8",
+                              errors="strict", max_num_fields=lim.max_params)
+        except UnicodeDecodeError:
+            raise Refused(422, "the query is not valid UTF-8 text") from None
+        except ValueError:
+            raise Refused(422, f"more than {lim.max_params} query parameters") from None
+        allowed = self.backend.parameters.get(endpoint, frozenset()) | set(extra)
+        out: dict[str, str] = {}
+        for name, value in pairs:
+            if name not in allowed:
+                shown = name if len(name) <= 40 and name.isprintable() else name[:40].encode("unicode_escape").decode()
+                names = ", ".join(sorted(allowed)) or "none"
+                raise Refused(422, f"unknown parameter {shown!r}; this endpoint takes: {names}")
+            if name in out:
+                raise Refused(422, f"parameter {name!r} is given twice")
+            if len(value) > lim.max_value:
+                raise Refused(422, f"parameter {name!r} is longer than {lim.max_value} characters")
+            if not value.isprintable():
+                raise Refused(422, f"parameter {name!r} holds a control character")
+            out[name] = value
+        return out
+
+    # --- answers ---------------------------------------------------------------------------
+    async def answer(self, key, fn, *, heavy: bool, media: str):
+        """Compute ``fn()`` (inline when light, on the worker when heavy), cached by ``key``; a
+        :class:`PhysCamError` becomes 422 with its first line."""
+        hit = self.cache.get(key)
+        if hit is None:
+            if heavy:
+                if self.pending >= self.limits.queue:
+                    raise Refused(503, "the server is busy with slow requests (lenses, charts); try again",
+                                  [(b"retry-after", b"1")])
+                self.pending += 1
+                try:
+                    hit = await asyncio.get_running_loop().run_in_executor(self.pool, _computed, fn, media)
+                finally:
+                    self.pending -= 1
+            else:
+                hit = _computed(fn, media)
+            self.cache.put(key, hit)
+        status, body = hit
+        if status != 200:
+            raise Refused(status, body.decode())
+        return body
+
+
+def _computed(fn, media):
+    """(200, body bytes) or (422, reason bytes)."""
+    try:
+        obj = fn()
+    except PhysCamError as exc:
+        return 422, one_line(exc).encode()
+    if media == "application/json":
+        return 200, json.dumps(obj, ensure_ascii=False, allow_nan=False, separators=(",", ":")).encode()
+    return 200, obj
+
+
+def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
+    """The ASGI application serving ``backend`` within ``limits`` (default :class:`Limits`).
+
+    ``log`` takes one line per unexpected error (default: standard error).
+    """
+    from starlette.applications import Starlette
+    from starlette.exceptions import HTTPException
+    from starlette.middleware import Middleware
+    from starlette.responses import Response
+    from starlette.routing import Route
+
+    if not isinstance(backend, Backend):
+        raise WrongTypeError(f"backend must be a physcam.serve.Backend, got {type(backend).__name__}")
+    limits = Limits() if limits is None else limits
+    if not isinstance(limits, Limits):
+        raise WrongTypeError(f"limits must be a physcam.serve.Limits, got {type(limits).__name__}")
+    log = log or (lambda line: print(line, file=sys.stderr, flush=True))
+    core = _App(backend, limits)
+
+    def ok(body: bytes, media: str) -> Response:
+        return Response(body, media_type=media, headers={"cache-control": "no-store"})
+
+    def static(name: str):
+        media, body = core.static[name]
+
+        async def endpoint(request):
+            return Response(body, media_type=media, headers={"cache-control": "no-cache"})
+
+        return endpoint
+
+    def heavy_report(q) -> bool:
+        return "lens" in q
+
+    async def report(request):
+        q = core.query(request.scope, "report")
+        body = await core.answer(("report", tuple(sorted(q.items()))), lambda: backend.report(q),
+                                 heavy=heavy_report(q), media="application/json")
+        return ok(body, "application/json")
+
+    async def focus_table(request):
+        q = core.query(request.scope, "report", extra=("marks",))
+        marks = [m.strip() for m in q.pop("marks", "").split(",") if m.strip()]
+        if not marks:
+            raise Refused(422, "give the focus marks, e.g. marks=1m,2m,3m (or 3ft,5ft,10ft)")
+        if len(marks) > limits.max_marks:
+            raise Refused(422, f"at most {limits.max_marks} focus marks, got {len(marks)}")
+
+        def table():
+            rows = []
+            for m in marks:
+                try:
+                    rows.append({"focus": m, "report": backend.report({**q, "focus": m})})
+                except PhysCamError as exc:
+                    rows.append({"focus": m, "error": one_line(exc)})
+            return rows
+
+        key = ("focus-table", tuple(marks), tuple(sorted(q.items())))
+        body = await core.answer(key, table, heavy=heavy_report(q), media="application/json")
+        return ok(body, "application/json")
+
+    async def dof_svg(request):
+        q = core.query(request.scope, "report")
+        body = await core.answer(("dof.svg", tuple(sorted(q.items()))), lambda: backend.dof_svg(q),
+                                 heavy=True, media="image/svg+xml")
+        return ok(body, "image/svg+xml")
+
+    async def sensors(request):
+        q = core.query(request.scope, "sensors")
+        body = await core.answer(("sensors", tuple(sorted(q.items()))), lambda: backend.sensors(q),
+                                 heavy=False, media="application/json")
+        return ok(body, "application/json")
+
+    async def lenses(request):
+        core.query(request.scope, "lenses")
+        body = await core.answer(("lenses",), backend.lenses, heavy=True, media="application/json")
+        return ok(body, "application/json")
+
+    def _name(request) -> str:
+        name = request.path_params["name"]
+        if len(name) > limits.max_value or not name.isprintable():
+            raise Refused(422, "a lens name is at most 64 printable characters (see /api/lenses)")
+        return name
+
+    async def lens(request):
+        name = _name(request)
+        q = core.query(request.scope, "lens")
+        body = await core.answer(("lens", name, tuple(sorted(q.items()))), lambda: backend.lens(name, q),
+                                 heavy=True, media="application/json")
+        return ok(body, "application/json")
+
+    async def diagram(request):
+        name = _name(request)
+        q = core.query(request.scope, "diagram")
+        body = await core.answer(("diagram", name, tuple(sorted(q.items()))), lambda: backend.diagram_svg(name, q),
+                                 heavy=True, media="image/svg+xml")
+        return ok(body, "image/svg+xml")
+
+    async def health(request):
+        core.query(request.scope, "health")
+        return ok(json.dumps({"ok": True, "version": __version__}).encode(), "application/json")
+
+    async def favicon(request):
+        return Response(status_code=204)
+
+    async def http_error(request, exc):
+        reason = {404: f"no such page: {request.url.path[:80]} (the API is under /api/, see docs/serve.md)",
+                  405: "method not allowed: this server answers GET only"}.get(exc.status_code, str(exc.detail))
+        raise Refused(exc.status_code, reason)
+
+    routes = [
+        Route("/", static("index.html")),
+        Route("/static/app.js", static("app.js")),
+        Route("/static/app.css", static("app.css")),
+        Route("/static/icon.svg", static("icon.svg")),
+        Route("/favicon.ico", favicon),
+        Route("/api/report", report),
+        Route("/api/focus-table", focus_table),
+        Route("/api/dof.svg", dof_svg),
+        Route("/api/sensors", sensors),
+        Route("/api/lenses", lenses),
+        Route("/api/lens/{name}", lens),
+        Route("/api/lens/{name}/diagram.svg", diagram),
+        Route("/api/health", health),
+    ]
+    app = Starlette(routes=routes, exception_handlers={HTTPException: http_error},
+                    middleware=[Middleware(_Guard, limits=limits, log=log)])
+    app.state.core = core
+    return app

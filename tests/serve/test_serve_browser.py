@@ -1,0 +1,270 @@
+"""The `physcam serve` page in a real browser: Debian's Chromium, headless, driven by Playwright.
+
+`make test` installs `chromium` when it is missing (as root, on CI's fresh Debian machine); where
+there is no Chromium these tests skip and say why. Playwright is pointed at the system browser
+(`executable_path`): it never downloads one of its own.
+
+Every number the page shows is checked against the CLI's --json for the same setup, and the
+near limit also against the thin-lens closed form worked by hand (tests/_thin_lens.py).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import struct
+from pathlib import Path
+
+import pytest
+from _serve_helpers import running_server
+from _thin_lens import image_distance_at_mark
+
+from physcam.cli import main
+from physcam.units import format_feet_inches
+
+pytestmark = pytest.mark.slow
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+if CHROMIUM is None:
+    pytest.skip("Debian's chromium is not installed here (`make test` installs it when run as root: "
+                "apt-get install chromium); the browser tests need it", allow_module_level=True)
+sync_api = pytest.importorskip("playwright.sync_api", reason="playwright (the test extra) is not installed")
+
+DOCS_SCREENSHOT = Path(__file__).resolve().parents[2] / "docs" / "img" / "serve_phone.png"
+
+
+@pytest.fixture(scope="module")
+def server():
+    with running_server() as (url, port, proc):
+        yield url
+        log = "".join(proc.stderr_lines)
+        assert "Traceback" not in log and "internal error" not in log, log[-3000:]
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with sync_api.sync_playwright() as p:
+        # root (CI) needs --no-sandbox; a container's small /dev/shm needs the other flag
+        b = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"])
+        yield b
+        b.close()
+
+
+@pytest.fixture
+def page(browser):
+    ctx = browser.new_context(viewport={"width": 375, "height": 812}, device_scale_factor=1, is_mobile=True,
+                              has_touch=True)
+    pg = ctx.new_page()
+    pg.set_default_timeout(30_000)
+    errors: list[str] = []
+    pg.on("pageerror", lambda e: errors.append(str(e)))
+    yield pg
+    ctx.close()
+    assert not errors, errors
+
+
+def open_page(pg, url):
+    pg.goto(url)
+    pg.wait_for_selector("body[data-ready='1']")
+
+
+def cli_report(capsys, *argv):
+    capsys.readouterr()
+    assert main(["report", *argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def wait_mm(pg, element_id, mm):
+    """Wait until the element shows the length ``mm`` (its data-mm; "inf" for None)."""
+    pg.wait_for_function("([id, v]) => { const e = document.getElementById(id);"
+                         " return v === null ? e.dataset.mm === 'inf' : Number(e.dataset.mm) === v; }",
+                         arg=[element_id, mm])
+
+
+def metric(mm):
+    """How the page writes a length in metric (docs/serve.md): cm with one decimal under 1 m, else m."""
+    return "∞" if mm is None else (f"{mm / 10:.1f} cm" if abs(mm) < 1000 else f"{mm / 1000:.2f} m")
+
+
+def imperial(mm):
+    """... and in imperial: inches with one decimal under a foot, else feet and inches (units.py)."""
+    return "∞" if mm is None else (f'{mm / 25.4:.1f}"' if abs(mm) < 304.8 else format_feet_inches(mm))
+
+
+SETUP = ("--focal", "35", "--sensor", "alexa35-og", "--fstop", "2", "--focus", "2.5m")
+
+
+def type_setup(pg):
+    pg.fill("#focal", "35")
+    pg.fill("#sensor-search", "alexa 35")  # the search narrows the picker; its first match is chosen
+    pg.fill("#fstop", "2")
+    pg.fill("#focus", "2.5")  # a bare number is metres in metric
+
+
+def test_typed_setup_shows_the_cli_numbers(page, server, capsys):
+    open_page(page, server)
+    type_setup(page)
+    d = cli_report(capsys, *SETUP)
+    dof = d["dof"]
+    wait_mm(page, "out-near", dof["near_from_film_mm"])
+    assert page.input_value("#sensor") == "alexa35-og"
+    assert float(page.get_attribute("#out-far", "data-mm")) == dof["far_from_film_mm"]
+    assert float(page.get_attribute("#out-hyperfocal", "data-mm")) == dof["hyperfocal_from_film_mm"]
+    assert float(page.get_attribute("#out-total", "data-mm")) == dof["total_mm"]
+    for el, mm in (("out-near", dof["near_from_film_mm"]), ("out-far", dof["far_from_film_mm"]),
+                   ("out-total", dof["total_mm"])):
+        assert page.text_content(f"#{el}") == metric(mm)
+    # the thin-lens closed form worked by hand: s + s' = D from the film, H = f^2 / (N c) + f from H1
+    f, n, mark = 35.0, 2.0, 2500.0
+    c = math.hypot(27.99, 19.22) / 1500  # ALEXA 35 open gate, d/1500
+    s_img = image_distance_at_mark(f, mark)
+    s = mark - s_img
+    hyper = f * f / (n * c) + f
+    assert dof["near_from_film_mm"] == pytest.approx(s * (hyper - f) / (hyper + s - 2 * f) + s_img, rel=1e-9)
+    f_txt = page.text_content("#out-fov")
+    fov = d["fov_deg"]["focus"]
+    assert f_txt == f"{fov['horizontal']:.1f}° / {fov['vertical']:.1f}° / {fov['diagonal']:.1f}°"
+    assert page.text_content("#out-pupil").startswith(f"{d['entrance_pupil_from_film_mm']:.1f} mm")
+    # the table of focus marks: the 3 m row is the CLI's report focused at 3 m
+    at3 = cli_report(capsys, *SETUP[:-1], "3m")["dof"]
+    page.wait_for_function("v => { const r = document.querySelector('#marks tr[data-focus=\"3m\"]');"
+                           " return r && Number(r.cells[1].dataset.mm) === v; }", arg=at3["near_from_film_mm"])
+    row = page.locator('#marks tr[data-focus="3m"]')
+    assert row.locator("td").nth(1).text_content() == metric(at3["near_from_film_mm"])
+    assert row.locator("td").nth(2).text_content() == metric(at3["far_from_film_mm"])
+
+
+def test_imperial_switch(page, server, capsys):
+    open_page(page, server)
+    type_setup(page)
+    near = cli_report(capsys, *SETUP)["dof"]["near_from_film_mm"]
+    wait_mm(page, "out-near", near)
+    page.click("#units-imperial")
+    page.wait_for_function("() => document.getElementById('out-near').textContent.includes(\"'\")")
+    assert page.text_content("#out-near") == imperial(near) == format_feet_inches(near)
+    assert float(page.get_attribute("#out-near", "data-mm")) == near  # the switch keeps 2.5 meaning metres
+    assert page.input_value("#focus") == "2.5m"
+    page.wait_for_function("() => { const td = document.querySelector('#marks tbody td');"
+                           " return td !== null && td.textContent === \"2'\"; }")
+    # a bare number now means feet: 10 -> 10 ft
+    page.fill("#focus", "10")
+    d = cli_report(capsys, *SETUP[:-1], "10ft")
+    wait_mm(page, "out-near", d["dof"]["near_from_film_mm"])
+    assert page.text_content("#out-far") == imperial(d["dof"]["far_from_film_mm"])
+
+
+def test_shared_url_reproduces_the_setup(page, browser, server, capsys):
+    open_page(page, server)
+    type_setup(page)
+    page.click("#units-imperial")
+    page.select_option("#coc", "cine")
+    page.select_option("#squeeze", "1.5")
+    d = cli_report(capsys, *SETUP, "--coc", "cine", "--squeeze", "1.5")
+    wait_mm(page, "out-near", d["dof"]["near_from_film_mm"])
+    page.wait_for_selector("#out-horizontal:not([hidden])")  # the squeeze's answer is in too
+    shared = page.url
+    assert page.input_value("#share-url") == shared
+    ctx = browser.new_context(viewport={"width": 375, "height": 812})
+    other = ctx.new_page()
+    try:
+        open_page(other, shared)
+        wait_mm(other, "out-near", d["dof"]["near_from_film_mm"])
+        for sel in ("#focal", "#sensor", "#fstop", "#focus", "#coc", "#squeeze"):
+            assert other.input_value(sel) == page.input_value(sel), sel
+        assert other.get_attribute("#units-imperial", "aria-pressed") == "true"
+        for el in ("#out-near", "#out-far", "#out-total", "#out-hyperfocal", "#out-horizontal", "#out-fov"):
+            assert other.text_content(el) == page.text_content(el), el
+        h = d["dof_horizontal"]
+        assert other.text_content("#out-horizontal") == (f"{imperial(h['near_from_film_mm'])} / "
+                                                         f"{imperial(h['far_from_film_mm'])}")
+    finally:
+        ctx.close()
+
+
+def test_impossible_input_shows_its_message_and_the_page_keeps_working(page, server, capsys):
+    open_page(page, server)
+    type_setup(page)
+    page.fill("#fstop", "0.3")
+    page.wait_for_selector("#message:not([hidden])")
+    assert "out of range" in page.text_content("#message")
+    assert "stale" in page.get_attribute("#summary", "class")
+    page.fill("#focus", "3 parsecs")
+    page.wait_for_function("() => document.getElementById('message').textContent.startsWith('focus: unknown unit')")
+    page.fill("#focus", "2.5")
+    page.fill("#fstop", "4")
+    d = cli_report(capsys, *SETUP[:-3], "4", "--focus", "2.5m")
+    wait_mm(page, "out-near", d["dof"]["near_from_film_mm"])
+    assert page.is_hidden("#message")
+    assert "stale" not in page.get_attribute("#summary", "class")
+
+
+def test_inversions_on_the_page(page, server, capsys):
+    open_page(page, server)
+    # effective f-stop from a measured near/far (the report's own example in `physcam report --help`)
+    page.fill("#focal", "35")
+    page.fill("#focus", "10ft")
+    page.click("#solve-fstop")
+    assert page.is_hidden("#field-fstop")
+    page.fill("#near", "8ft")
+    page.fill("#far", "14ft")
+    page.select_option("#coc", "cine")
+    page.fill("#tstop", "T2.8")
+    d = cli_report(capsys, "--focal", "35", "--focus", "10ft", "--near", "8ft", "--far", "14ft", "--coc", "cine",
+                   "--tstop", "2.8")
+    wait_mm(page, "out-near", d["dof"]["near_from_film_mm"])
+    n = d["solved"]["fstop"]
+    assert page.text_content("#out-fstop").startswith(f"f/{float(f'{n:.2f}'):g} (solved from near/far)")
+    # focus from a bracket
+    page.click("#solve-focus")
+    page.fill("#fstop", "4")
+    page.fill("#near", "2.5")
+    page.fill("#far", "4")
+    page.select_option("#coc", "d/1500")
+    page.fill("#tstop", "")
+    d = cli_report(capsys, "--focal", "35", "--near", "2.5m", "--far", "4m", "--fstop", "4")
+    wait_mm(page, "out-focus", d["solved"]["focus_from_film_mm"])
+    assert page.text_content("#out-focus") == metric(d["focus_from_film_mm"]) + " (solved from near/far)"
+
+
+def test_library_lens_and_its_diagram(page, server, capsys):
+    open_page(page, server)
+    page.click("#lensmode-library")
+    page.wait_for_function("() => document.getElementById('lens').options.length > 5")
+    page.select_option("#lens", "dgauss_50mm")
+    page.fill("#fstop", "2.8")
+    page.fill("#focus", "2")
+    d = cli_report(capsys, "--lens", "dgauss_50mm", "--fstop", "2.8", "--focus", "2m")
+    wait_mm(page, "out-near", d["dof"]["near_from_film_mm"])
+    assert "prescription" in page.text_content("#out-pupil")
+    page.wait_for_function("() => { const i = document.getElementById('diagram');"
+                           " return i.complete && i.naturalWidth > 0 && i.src.includes('dgauss_50mm'); }")
+
+
+def _png_size(path):
+    with open(path, "rb") as f:
+        head = f.read(24)
+    assert head[:8] == b"\x89PNG\r\n\x1a\n"
+    return struct.unpack(">II", head[16:24])
+
+
+def test_phone_screenshot_and_touch_targets(page, server, tmp_path):
+    open_page(page, server)
+    page.wait_for_function("() => { const i = document.getElementById('dof-chart');"
+                           " return i.complete && i.naturalWidth > 0; }")
+    page.wait_for_selector("#marks tbody tr")
+    # phone first: nothing wider than the 375 px screen, every control at least 44 px tall (Apple HIG)
+    assert page.evaluate("document.documentElement.scrollWidth") <= 375
+    small = page.evaluate("""() => [...document.querySelectorAll('button, input, select')]
+        .filter((e) => e.offsetParent !== null)
+        .map((e) => [e.id, e.getBoundingClientRect().height])
+        .filter(([, h]) => h < 44)""")
+    assert not small, small
+    shot = tmp_path / "serve_phone.png"
+    page.screenshot(path=str(shot))
+    assert _png_size(shot) == (375, 812)
+    if os.environ.get("PHYSCAM_WRITE_DOCS_SCREENSHOT") == "1":  # refresh the picture in docs/serve.md
+        from physcam.io import atomic_write
+
+        atomic_write(DOCS_SCREENSHOT, shot.read_bytes(), force=True)
