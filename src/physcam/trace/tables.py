@@ -39,6 +39,7 @@ __all__ = ["PackedTable", "packed_table", "clear_table_cache", "MAX_LENSES", "MA
 #: Lenses (by value) whose tables are kept; wavelengths kept per table.
 MAX_LENSES = 64
 MAX_WAVELENGTHS = 16
+MAX_TABLES_PER_LENS = 64  # directions x stop overrides x coatings x precisions
 
 
 @dataclass
@@ -164,7 +165,7 @@ def _packed_table(lens, reverse, stop_semi_diameter, coating, dtype) -> PackedTa
         row = int(np.flatnonzero(table.index == lens.stop_index)[0]) if stops.size else -1
         S = S64 if dt == np.float64 else np.ascontiguousarray(S64, dtype=dt)
         p = PackedTable(table, S, kinds, row, dt, S64)
-        if len(e.tables) > 32:
-            e.tables.clear()
+        if len(e.tables) >= MAX_TABLES_PER_LENS:
+            e.tables.pop(next(iter(e.tables)))  # the oldest (dicts keep insertion order)
         e.tables[key] = p
     return p
