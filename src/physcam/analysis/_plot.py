@@ -1,12 +1,12 @@
-"""Matplotlib helpers for the analyses (see :mod:`physcam.figures`)."""
+"""Matplotlib helpers for the analyses (see :mod:`physcam.figures`): Agg canvases, no pyplot."""
 
 from __future__ import annotations
 
-from ..figures import pyplot, save_figure
+from ..figures import save_figure, subplots
 
 
 def figure(width: float = 5.0, height: float = 3.6, ncols: int = 1):
-    fig, axes = pyplot().subplots(1, ncols, figsize=(width, height), squeeze=True)
+    fig, axes = subplots(1, ncols, figsize=(width, height), squeeze=True)
     return fig, axes
 
 

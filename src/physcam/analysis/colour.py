@@ -161,16 +161,25 @@ def _pgf_uncertainty(lens, wavelengths):
     return np.sqrt(var)
 
 
-def _zone_focus(lens, height, wl, backend):
+def _zone_focus(lens, height, wls, backend):
+    """Axis crossing z of the zone ray at ``height`` for each wavelength: one ray per wavelength, all
+    in one tracer call (a mixed-wavelength batch gives each ray the indices of its own wavelength,
+    bit for bit those of a one-wavelength trace)."""
     from ..trace import RayBatch, trace_through
 
-    out = trace_through(lens, RayBatch.collimated([0.0], [height], -1.0, wavelength_nm=wl), backend=backend)
-    if not out.ok.all() or out.M[0] >= 0:
-        raise OpticsError(
-            f"the zone ray at {height:.3g} mm does not reach a real focus through {lens.name!r} at {wl:g} nm; "
-            "use a smaller zone"
-        )
-    return float(out.z[0] - out.y[0] * out.N[0] / out.M[0])
+    wl = np.asarray(wls, dtype=float)
+    rays = RayBatch.collimated(np.zeros(wl.size), np.full(wl.size, height), -1.0)
+    rays.wavelength_nm[:] = wl
+    out = trace_through(lens, rays, backend=backend)
+    zs = []
+    for k, w in enumerate(wls):
+        if not out.ok[k] or out.M[k] >= 0:
+            raise OpticsError(
+                f"the zone ray at {height:.3g} mm does not reach a real focus through {lens.name!r} at {w:g} nm; "
+                "use a smaller zone"
+            )
+        zs.append(float(out.z[k] - out.y[k] * out.N[k] / out.M[k]))
+    return zs
 
 
 @takes_prescription
@@ -213,7 +222,7 @@ def chromatic_aberration(
     film_z = require_finite("film_z", film_z)
     par = [gaussian(lens, wavelength_nm=w).z_rear_focal_point for w in wls]
     r_ep = 0.5 * g_ref.entrance_pupil_diameter
-    real = [_zone_focus(lens, zone * r_ep, w, backend) for w in wls]
+    real = _zone_focus(lens, zone * r_ep, wls, backend)
     iF, iC = wls.index(LINE_F_NM), wls.index(LINE_C_NM)
     curve = list(np.arange(400.0, 701.0, 10.0))
     z_ref = g_ref.z_rear_focal_point
@@ -225,16 +234,21 @@ def chromatic_aberration(
     def chief_heights(fields):
         """Film heights per wavelength, or (field, wavelength) of the first chief ray that does not pass."""
         dirs = field_direction(np.radians(fields), "y")
-        out_h = {}
-        for w in wls:
-            aimed = aim_from_infinity(lens, dirs, wavelength_nm=w, backend=backend)
-            out = trace_through(lens, RayBatch.from_arrays(aimed.start, aimed.direction, w), end_z=film_z,
-                                backend=backend)
-            ok = aimed.ok & out.ok
+        aims = [aim_from_infinity(lens, dirs, wavelength_nm=w, backend=backend) for w in wls]
+        n = len(dirs)
+        # every wavelength's chief rays to the film in one call (per-ray indices: module notes of _zone_focus)
+        out = trace_through(lens, RayBatch.from_arrays(np.concatenate([a.start for a in aims]),
+                                                       np.concatenate([a.direction for a in aims]),
+                                                       np.repeat(np.asarray(wls, dtype=float), n)),
+                            end_z=film_z, backend=backend)
+        found = {}
+        for k, (w, aimed) in enumerate(zip(wls, aims)):
+            part = slice(k * n, (k + 1) * n)
+            ok = aimed.ok & out.ok[part]
             if not ok.all():
                 return float(np.asarray(fields)[~ok][0]), w
-            out_h[w] = out.y.copy()
-        return out_h
+            found[w] = out.y[part].copy()
+        return found
 
     clamped = None
     heights = chief_heights(fields)

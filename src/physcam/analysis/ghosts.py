@@ -113,26 +113,30 @@ def ghost_pairs(lens: Prescription) -> list[tuple[int, int]]:
 
 
 class _Tables:
-    """Forward and reverse packed surface tables of one lens, built once."""
+    """Forward and reverse packed surface tables of one lens (the tracer's cached tables), and
+    their index columns per wavelength."""
 
     def __init__(self, lens, coating, stop_sd):
-        from ..trace.kernels._layout import pack
-        from ..trace.surfaces import surface_table
+        from ..trace.tables import packed_table
 
         self.n = len(lens.surfaces)
-        self.fwd = surface_table(lens, coating=coating, stop_semi_diameter=stop_sd)
-        self.rev = surface_table(lens, reverse=True, coating=coating, stop_semi_diameter=stop_sd)
-        self.Sf, self.kf = pack(self.fwd)
-        self.Sr, self.kr = pack(self.rev)
+        self.pf = packed_table(lens, coating=coating, stop_semi_diameter=stop_sd)
+        self.pr = packed_table(lens, reverse=True, coating=coating, stop_semi_diameter=stop_sd)
+        self.fwd, self.rev = self.pf.table, self.pr.table
+        self.Sf, self.kf = self.pf.S, self.pf.kinds
+        self.Sr, self.kr = self.pr.S, self.pr.kinds
 
     @staticmethod
     def _ending(S, kinds, a, b):
-        """Rows a..b-1 of a packed table; the last row keeps the ray on its surface (no refraction)."""
-        from ..trace.kernels._layout import NA, NB, SA, SB
+        """Rows a..b-1 of a packed table; the last row keeps the ray on its surface (no refraction).
+        Where ``S`` holds one wavelength's indices, the last row's index after is its index before."""
+        from ..trace.kernels._layout import ETA, N1, N2, NA, NB, SA, SB
 
         s = np.array(S[a:b], copy=True)
         s[-1, NA:NA + 9] = s[-1, NB:NB + 9]
         s[-1, SA] = s[-1, SB]
+        s[-1, N2] = s[-1, N1]
+        s[-1, ETA] = 1.0
         return np.ascontiguousarray(s), np.ascontiguousarray(kinds[a:b])
 
 
@@ -196,16 +200,21 @@ def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float, *, coat
     T = _tables or _Tables(lens, coating, stop_semi_diameter)
     kern = get_kernel(backend)
     r = rays.copy()
+    wl = r.wavelength_nm
+    # one wavelength (the usual beam): the tables' index columns for it, computed once per lens
+    one = wl.size > 0 and bool(wl.min() == wl.max()) and 1e-100 < float(wl[0]) < 1e100
+    Sf = T.pf.at_wavelength(float(wl[0])) if one else T.Sf
+    Sr = T.pr.at_wavelength(float(wl[0])) if one else T.Sr
     run = lambda S, K, end=None: trace_packed(kern, r, S, K, clip=True, fresnel=True, end_z=end,  # noqa: E731
-                                      chunk_size=DEFAULT_CHUNK)
+                                      chunk_size=DEFAULT_CHUNK, indexed=one)
     # leg 1: forward through 0..i-1, stop on surface i; reflect there
-    run(*T._ending(T.Sf, T.kf, 0, i + 1))
+    run(*T._ending(Sf, T.kf, 0, i + 1))
     _reflect(r, T.fwd, i, True)
     # leg 2: backward through i-1..j+1 (reverse table rows n-i .. n-1-j), stop on surface j; reflect
-    run(*T._ending(T.Sr, T.kr, n - i, n - j))
+    run(*T._ending(Sr, T.kr, n - i, n - j))
     _reflect(r, T.rev, n - 1 - j, False)
     # leg 3: forward through j+1..n-1 to the film
-    run(np.ascontiguousarray(T.Sf[j + 1:]), np.ascontiguousarray(T.kf[j + 1:]), float(film_z))
+    run(Sf[j + 1:], T.kf[j + 1:], float(film_z))
     return r
 
 

@@ -114,69 +114,111 @@ def _launch_window(lens, direction):
     return z0, (-sd + min(sx) - margin, sd + max(sx) + margin, -sd + min(sy) - margin, sd + max(sy) + margin)
 
 
-def _beam_area(lens, direction, wl, film_z, grid, fresnel, stop_sd, backend):
-    """Cross-section (mm^2, perpendicular to the beam) of the collimated beam that reaches the film.
+def _beam_areas(lens, directions, wl, film_z, grid, fresnel, stop_sd, backend):
+    """Cross-section (mm^2, perpendicular to the beam) of each collimated beam (one per direction)
+    that reaches the film.
 
     Rays start on a plane in front of the whole front element, over the projection of its clear
     aperture along the beam (every ray that can pass starts there); pilot grids zoom onto the
     part that passes, then a ``grid`` x ``grid`` midpoint grid (traced in row chunks) sums it.
+    Every beam still zooming is traced in the same tracer call, and the fine grids of several
+    beams share a call too; each beam's rays and sums are those it would get alone.
     """
     from ..trace import RayBatch, trace_to_film
 
-    n_z = direction[2]
-    z0, (x0, x1, y0, y1) = _launch_window(lens, direction)
+    nb = len(directions)
+    z0s, boxes = [], []
+    for d in directions:
+        z0, box = _launch_window(lens, d)
+        z0s.append(z0)
+        boxes.append(box)
 
-    def passing(x0, x1, y0, y1, n, rows=None):
+    def grid_points(k, box, n, rows=None):
+        x0, x1, y0, y1 = box
         xs = x0 + (np.arange(n) + 0.5) * (x1 - x0) / n
         ys = y0 + (np.arange(n) + 0.5) * (y1 - y0) / n
         if rows is not None:
             ys = ys[rows]
         X, Y = np.meshgrid(xs, ys)
-        pos = np.stack([X.ravel(), Y.ravel(), np.full(X.size, z0)], axis=1)
-        out = trace_to_film(lens, RayBatch.from_arrays(pos, direction[None, :], wl), film_z, clip=True,
+        return X.ravel(), Y.ravel()
+
+    def passing(jobs):
+        """jobs: (beam k, X, Y); one tracer call for all; per job (ok, weight)."""
+        pos = np.concatenate([np.stack([X, Y, np.full(X.size, z0s[k])], axis=1) for k, X, Y in jobs])
+        dirs = np.concatenate([np.broadcast_to(directions[k], (X.size, 3)) for k, X, _ in jobs])
+        out = trace_to_film(lens, RayBatch.from_arrays(pos, dirs, wl), film_z, clip=True,
                             fresnel=fresnel, stop_semi_diameter=stop_sd, backend=backend)
-        return X.ravel(), Y.ravel(), out.ok, out.weight
+        res, a = [], 0
+        for _k, X, _ in jobs:
+            res.append((out.ok[a:a + X.size], out.weight[a:a + X.size]))
+            a += X.size
+        return res
 
     # pilot grids: the whole projected front aperture, then zoom on what passed until the box
     # is tight (it shrinks by less than 10 %), so the fine grid spends its rays on the beam
     npil = 64
+    area = [None] * nb
+    zooming = list(range(nb))
     for _ in range(8):
-        X, Y, ok, _ = passing(x0, x1, y0, y1, npil)
-        if not ok.any():
-            return 0.0
-        cx, cy = (x1 - x0) / npil, (y1 - y0) / npil
-        nx0, nx1 = X[ok].min() - 2 * cx, X[ok].max() + 2 * cx
-        ny0, ny1 = Y[ok].min() - 2 * cy, Y[ok].max() + 2 * cy
-        tight = (nx1 - nx0) > 0.9 * (x1 - x0) and (ny1 - ny0) > 0.9 * (y1 - y0)
-        x0, x1, y0, y1 = nx0, nx1, ny0, ny1
-        if tight and ok.sum() >= 400:
+        if not zooming:
             break
-    total = 0.0
+        jobs = [(k, *grid_points(k, boxes[k], npil)) for k in zooming]
+        still = []
+        for (k, X, Y), (ok, _w) in zip(jobs, passing(jobs)):
+            if not ok.any():
+                area[k] = 0.0
+                continue
+            x0, x1, y0, y1 = boxes[k]
+            cx, cy = (x1 - x0) / npil, (y1 - y0) / npil
+            nx0, nx1 = X[ok].min() - 2 * cx, X[ok].max() + 2 * cx
+            ny0, ny1 = Y[ok].min() - 2 * cy, Y[ok].max() + 2 * cy
+            tight = (nx1 - nx0) > 0.9 * (x1 - x0) and (ny1 - ny0) > 0.9 * (y1 - y0)
+            boxes[k] = (nx0, nx1, ny0, ny1)
+            if not (tight and ok.sum() >= 400):
+                still.append(k)
+        zooming = still
+    # fine grids in row chunks of about _CHUNK_RAYS rays, as many beams' chunks per call as fit
     step = max(1, _CHUNK_RAYS // grid)
-    for a in range(0, grid, step):
-        _, _, ok, w = passing(x0, x1, y0, y1, grid, slice(a, min(grid, a + step)))
-        total += float(w[ok].sum())
-    dA = (x1 - x0) * (y1 - y0) / grid**2
-    return total * dA * n_z
+    chunks = [(k, a) for k in range(nb) if area[k] is None for a in range(0, grid, step)]
+    total = {k: 0.0 for k in range(nb) if area[k] is None}
+    per_call = max(1, _CHUNK_RAYS // (step * grid))
+    for c in range(0, len(chunks), per_call):
+        jobs = [(k, *grid_points(k, boxes[k], grid, slice(a, min(grid, a + step)))) for k, a in chunks[c:c + per_call]]
+        for (k, _X, _Y), (ok, w) in zip(jobs, passing(jobs)):
+            total[k] += float(w[ok].sum())
+    for k, tot in total.items():
+        x0, x1, y0, y1 = boxes[k]
+        dA = (x1 - x0) * (y1 - y0) / grid**2
+        area[k] = tot * dA * directions[k][2]
+    return area
 
 
-def _mapping(lens, l, m, wl, film_z, backend, eps=1e-5):
-    """Film position of the chief ray of direction cosines (l, m) and dA/d(omega) there (mm^2/sr)."""
+def _mappings(lens, lm, wl, film_z, backend, eps=1e-5):
+    """Per chief ray of direction cosines (l, m): its film position and dA/d(omega) there (mm^2/sr),
+    or None where it (or a neighbour of the finite-difference stencil) does not pass. All the
+    stencils are aimed and traced in one batch (each ray is aimed independently)."""
     from ..trace import RayBatch, trace_through
     from ._chief import aim_from_infinity
 
-    L = np.array([l, l + eps, l - eps, l, l])
-    M = np.array([m, m, m, m + eps, m - eps])
+    n = len(lm)
+    L = np.concatenate([np.array([l, l + eps, l - eps, l, l]) for l, _m in lm])
+    M = np.concatenate([np.array([m, m, m, m + eps, m - eps]) for _l, m in lm])
     d = np.stack([L, M, np.sqrt(1.0 - L * L - M * M)], axis=1)
     aimed = aim_from_infinity(lens, d, wavelength_nm=wl, backend=backend)
     out = trace_through(lens, RayBatch.from_arrays(aimed.start, aimed.direction, wl), end_z=film_z, clip=False,
                         backend=backend)
-    if not (aimed.ok.all() and out.ok.all()):
-        return None
-    jxl, jyl = (out.x[1] - out.x[2]) / (2 * eps), (out.y[1] - out.y[2]) / (2 * eps)
-    jxm, jym = (out.x[3] - out.x[4]) / (2 * eps), (out.y[3] - out.y[4]) / (2 * eps)
-    det = abs(jxl * jym - jxm * jyl)
-    return float(out.x[0]), float(out.y[0]), det * d[0, 2]
+    res = []
+    for k in range(n):
+        s = slice(5 * k, 5 * k + 5)
+        if not (aimed.ok[s].all() and out.ok[s].all()):
+            res.append(None)
+            continue
+        x, y = out.x[s], out.y[s]
+        jxl, jyl = (x[1] - x[2]) / (2 * eps), (y[1] - y[2]) / (2 * eps)
+        jxm, jym = (x[3] - x[4]) / (2 * eps), (y[3] - y[4]) / (2 * eps)
+        det = abs(jxl * jym - jxm * jyl)
+        res.append((float(x[0]), float(y[0]), det * d[5 * k, 2]))
+    return res
 
 
 @takes_prescription
@@ -218,17 +260,28 @@ def relative_illumination(
     axes = ("y", "x") if lens.is_anamorphic else ("y",)
     w, h = require_positive("sensor width", sensor_width_mm), require_positive("sensor height", sensor_height_mm)
     d0 = np.array([0.0, 0.0, 1.0])
-    a0 = _beam_area(lens, d0, wl, film_z, grid, fresnel, stop_semi_diameter, backend)
-    m0 = _mapping(lens, 0.0, 0.0, wl, film_z, backend)
+    # every field's beam and chief-ray stencil traced together (module notes: each is computed as alone)
+    todo = [(axis, float(fd)) for axis in axes
+            for fd in field_angles_deg(fields_deg, max_field_deg, n_fields, 0.5 * math.hypot(w, h), g[axis].efl)]
+    off = [(axis, fd) for axis, fd in todo if fd != 0]
+    dirs = [d0] + [field_direction(math.radians(fd), axis)[0] for axis, fd in off]
+    areas = _beam_areas(lens, dirs, wl, film_z, grid, fresnel, stop_semi_diameter, backend)
+    maps = _mappings(lens, [(d[0], d[1]) if k else (0.0, 0.0) for k, d in enumerate(dirs)], wl, film_z, backend)
+    a0, m0 = areas[0], maps[0]
     if a0 <= 0 or m0 is None:
         raise OpticsError(f"no on-axis light passes {lens.name!r}")
     e0 = a0 / m0[2]
+    found = {key: (areas[k + 1], maps[k + 1]) for k, key in enumerate(off)}
 
-    def point(axis, fd):
+    def measure(pairs):
+        """(beam area, mapping) of more (axis, field) pairs, traced together."""
+        ds = [field_direction(math.radians(fd), axis)[0] for axis, fd in pairs]
+        ar = _beam_areas(lens, ds, wl, film_z, grid, fresnel, stop_semi_diameter, backend)
+        mps = _mappings(lens, [(d[0], d[1]) for d in ds], wl, film_z, backend)
+        return {key: (ar[k], mps[k]) for k, key in enumerate(pairs)}
+
+    def point(axis, fd, a, mp):
         """The illumination point at field ``fd``, or the reason no light reaches the film there."""
-        d = field_direction(math.radians(fd), axis)[0]
-        a = _beam_area(lens, d, wl, film_z, grid, fresnel, stop_semi_diameter, backend) if fd != 0 else a0
-        mp = _mapping(lens, d[0], d[1], wl, film_z, backend) if fd != 0 else m0
         if a <= 0 or mp is None:
             return "no light" if a <= 0 else "no chief ray"
         c = math.cos(math.radians(fd))
@@ -240,15 +293,20 @@ def relative_illumination(
     default_range = fields_deg is None and max_field_deg is None
     points, notes = [], []
     for axis in axes:
-        fields = field_angles_deg(fields_deg, max_field_deg, n_fields, 0.5 * math.hypot(w, h), g[axis].efl)
+        fields = [fd for ax, fd in todo if ax == axis]
         got = []
         for i, fd in enumerate(fields):
-            p = point(axis, fd)
+            p = point(axis, fd, *(found[axis, fd] if fd != 0 else (a0, m0)))
             if isinstance(p, str) and default_range and i > 0:
                 # the default range reaches the sensor corner; clamp it to what the lens images
-                top = widest_passing_deg(lambda f: not isinstance(point(axis, f), str), fields[i - 1], fd)
+                def passes(f, axis=axis):
+                    return not isinstance(point(axis, f, *measure([(axis, f)])[axis, f]), str)
+
+                top = widest_passing_deg(passes, fields[i - 1], fd)
                 notes.append(clamp_note(axis, "light and chief rays", top, float(fields[-1])))
-                got = [point(axis, f) for f in field_angles_deg(None, top, n_fields, 0.0, 1.0)]
+                new = [float(f) for f in field_angles_deg(None, top, n_fields, 0.0, 1.0)]
+                more = measure([(axis, f) for f in new if f != 0])
+                got = [point(axis, f, *(more[axis, f] if f != 0 else (a0, m0))) for f in new]
                 p = next((q for q in got if isinstance(q, str)), None)
                 if p is None:
                     break

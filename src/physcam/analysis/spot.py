@@ -137,11 +137,18 @@ def _whole(name: str, value, lo: int, hi: int) -> int:
     return int(value)
 
 
-def _refined_samples(trace, rings: int, refine: int):
+def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
     """Equal-area cells on the unit disk's (rho^2, phi) grid, refined at the edge of what passes.
 
-    ``trace(u, v)`` takes points on the unit disk and returns their tracer flags and film x, y.
-    Returns the leaf cells' weights (summing to 1), flags, and film x, y.
+    ``trace(f, u, v)`` takes field indices and points on the unit disk (all fields in one call,
+    one call per refinement level) and returns their tracer flags and film x, y. Returns, per
+    field, the leaf cells' weights (summing to 1), flags, and film x, y.
+
+    A cell is split when its ray passes and an 8-connected neighbour's does not, or the reverse
+    (phi wraps, rho^2 does not: beyond the first and last ring the ring itself stands in). A
+    neighbour at the current level that was not traced has the status of its finest traced
+    ancestor. Cells are kept sparse (sorted integer keys per level), so the bookkeeping grows with
+    the rays traced, not with the 4^level fine grid.
     """
     from ..trace import OK
 
@@ -154,43 +161,85 @@ def _refined_samples(trace, rings: int, refine: int):
         r = np.sqrt(s)
         return r * np.cos(phi), r * np.sin(phi)
 
+    def keys(f, i, j, level):
+        ni, nj = ns << level, nphi << level
+        return (f.astype(np.int64) * ni + i) * nj + j
+
     I, J = np.meshgrid(np.arange(ns), np.arange(nphi), indexing="ij")
-    idx = (I.ravel(), J.ravel())
-    flags, fx, fy = trace(*points(*idx, 0))
-    levels = [(idx, flags, fx, fy)]  # per level: the evaluated cells and their flags
-    status = (flags == OK).reshape(ns, nphi)
-    evaluated = np.ones((ns, nphi), dtype=bool)
-    refined = []  # per level: which evaluated cells were split
+    i0, j0 = I.ravel(), J.ravel()
+    F = np.repeat(np.arange(n_fields), i0.size)
+    I, J = np.tile(i0, n_fields), np.tile(j0, n_fields)
+    flags, fx, fy = trace(F, *points(I, J, 0))
+    levels = [(F, I, J, flags, fx, fy)]  # per level: the traced cells (field, i, j) and results
+    lookup = []  # per level: sorted keys of the traced cells and their pass/fail status
+    refined = []  # per level: which traced cells were split
+
+    def remember(f, i, j, level, st):
+        k = keys(f, i, j, level)
+        order = np.argsort(k, kind="stable")
+        lookup.append((k[order], st[order]))
+
+    def status(f, i, j, level):
+        """Pass/fail of cells (f, i, j) at ``level``: their own, else their finest traced ancestor's."""
+        out = np.zeros(i.size, dtype=bool)
+        todo = np.arange(i.size)
+        for lv in range(level, -1, -1):
+            sh = level - lv
+            k = keys(f[todo], i[todo] >> sh, j[todo] >> sh, lv)
+            ks, st = lookup[lv]
+            pos = np.minimum(np.searchsorted(ks, k), ks.size - 1)
+            found = ks[pos] == k
+            out[todo[found]] = st[pos[found]]
+            todo = todo[~found]
+            if todo.size == 0:
+                break
+        return out
+
+    remember(F, I, J, 0, flags == OK)
     for level in range(1, refine + 1):
-        # a cell differs from a neighbour (8-connected; phi wraps, rho^2 does not)
-        pad = np.concatenate([status[:1], status, status[-1:]], axis=0)
-        diff = np.zeros_like(status)
+        F, I, J, fl = levels[-1][:4]
+        lv = level - 1
+        ni, nj = ns << lv, nphi << lv
+        # visit the cells in key order: each direction's neighbour keys then come nearly sorted,
+        # which numpy's binary search exploits
+        order = np.argsort(keys(F, I, J, lv), kind="stable")
+        Fs, Is, Js = F[order], I[order], J[order]
+        st = (fl == OK)[order]
+        diff_s = np.zeros(I.size, dtype=bool)
         for di in (-1, 0, 1):
             for dj in (-1, 0, 1):
                 if di or dj:
-                    diff |= np.roll(pad, dj, axis=1)[1 + di:1 + di + status.shape[0]] != status
-        split = evaluated & diff
-        (pi, pj) = levels[-1][0]
-        refined.append(split[pi, pj])
-        si, sj = np.nonzero(split)
-        if si.size == 0:
+                    diff_s |= status(Fs, np.clip(Is + di, 0, ni - 1), (Js + dj) % nj, lv) != st
+        diff = np.empty_like(diff_s)
+        diff[order] = diff_s
+        refined.append(diff)
+        if not diff.any():
             break
+        # split cells in raster order per field (the order a dense grid's np.nonzero gives)
+        sf, si, sj = F[diff], I[diff], J[diff]
+        order = np.lexsort((sj, si, sf))
+        sf, si, sj = sf[order], si[order], sj[order]
+        cf = np.concatenate([sf, sf, sf, sf])
         ci = np.concatenate([2 * si, 2 * si, 2 * si + 1, 2 * si + 1])
         cj = np.concatenate([2 * sj, 2 * sj + 1, 2 * sj, 2 * sj + 1])
-        f, fx, fy = trace(*points(ci, cj, level))
-        levels.append(((ci, cj), f, fx, fy))
-        status = np.repeat(np.repeat(status, 2, axis=0), 2, axis=1)
-        status[ci, cj] = f == OK
-        evaluated = np.zeros_like(status)
-        evaluated[ci, cj] = True
-    ws, fs, xs, ys = [], [], [], []
-    for level, ((i, j), f, fx, fy) in enumerate(levels):
-        leaf = ~refined[level] if level < len(refined) else np.ones(i.size, dtype=bool)
-        ws.append(np.full(int(leaf.sum()), 1.0 / (ns * nphi * 4**level)))
-        fs.append(f[leaf])
-        xs.append(fx[leaf])
-        ys.append(fy[leaf])
-    return np.concatenate(ws), np.concatenate(fs), np.concatenate(xs), np.concatenate(ys)
+        # per field, children in the order [top-left..., top-right..., bottom-left..., bottom-right...]
+        order = np.argsort(cf, kind="stable")
+        cf, ci, cj = cf[order], ci[order], cj[order]
+        f, x, y = trace(cf, *points(ci, cj, level))
+        levels.append((cf, ci, cj, f, x, y))
+        remember(cf, ci, cj, level, f == OK)
+    out = []
+    for fi in range(n_fields):
+        ws, fs, xs, ys = [], [], [], []
+        for level, (F, _i, _j, f, x, y) in enumerate(levels):
+            mine = F == fi
+            leaf = mine & ~refined[level] if level < len(refined) else mine
+            ws.append(np.full(int(leaf.sum()), 1.0 / (ns * nphi * 4**level)))
+            fs.append(f[leaf])
+            xs.append(x[leaf])
+            ys.append(y[leaf])
+        out.append((np.concatenate(ws), np.concatenate(fs), np.concatenate(xs), np.concatenate(ys)))
+    return out
 
 
 @takes_prescription
@@ -244,19 +293,27 @@ def spot_diagram(
         if not -89.0 < fd < 89.0:
             raise InputError(f"field angle must lie between -89 and 89 degrees, got {fd:g}")
     z0 = min(z_ep, start_plane_z(lens)) - 1.0
+    th = np.radians(np.asarray(fields, dtype=float))
+    dirs = np.stack([np.zeros(th.size), np.sin(th), np.cos(th)], axis=1)  # one beam direction per field
+    back = (z_ep - z0) / dirs[:, 2]
+
+    # the beams' unit directions exactly as RayBatch.from_arrays normalises them, once per field
+    unit = RayBatch.from_arrays(np.zeros((th.size, 3)), dirs, wl) if th.size else None
+
+    def trace(f, u, v):
+        # every field's rays in one batch (one tracer call per refinement level), built column by
+        # column: the numbers RayBatch.from_arrays(start, dirs[f], wl) would hold
+        n = u.size
+        y = beam * v
+        y -= back[f] * dirs[f, 1]
+        rays = RayBatch(beam * u, y, np.full(n, float(z0)), unit.L[f], unit.M[f], unit.N[f], np.full(n, float(wl)),
+                        np.ones(n), np.zeros(n, dtype=np.uint8))
+        res = trace_to_film(lens, rays, film_z, clip=clip, stop_semi_diameter=stop, backend=backend, in_place=True)
+        return res.flag, res.x, res.y
+
+    samples = _refined_samples(trace, rings, refine, len(fields)) if fields else []
     out = []
-    for fd in fields:
-        th = np.radians(fd)
-        d = np.array([0.0, np.sin(th), np.cos(th)])
-        back = (z_ep - z0) / d[2]
-
-        def trace(u, v):
-            start = np.stack([beam * u, beam * v - back * d[1], np.full(u.size, z0)], axis=1)
-            res = trace_to_film(lens, RayBatch.from_arrays(start, d[None, :], wl), film_z, clip=clip,
-                                stop_semi_diameter=stop, backend=backend)
-            return res.flag, res.x, res.y
-
-        w, flags, fx, fy = _refined_samples(trace, rings, refine)
+    for fd, (w, flags, fx, fy) in zip(fields, samples):
         ok = flags == OK
         counts = {k: int((flags == k).sum()) for k in (OK, CLIPPED, MISSED, TIR)}
         frac = float(w[ok].sum())

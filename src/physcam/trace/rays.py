@@ -105,15 +105,36 @@ class RayBatch:
 
     def copy(self) -> "RayBatch":
         sp = None if self.weight_sp is None else np.array(self.weight_sp, copy=True)
-        return RayBatch(*(np.array(a, copy=True) for a in self._base()), flag=np.array(self.flag, copy=True),
-                        weight_sp=sp)
+        return RayBatch(np.array(self.x, copy=True), np.array(self.y, copy=True), np.array(self.z, copy=True),
+                        np.array(self.L, copy=True), np.array(self.M, copy=True), np.array(self.N, copy=True),
+                        np.array(self.wavelength_nm, copy=True), np.array(self.weight, copy=True),
+                        np.array(self.flag, copy=True), sp)
 
     def columns(self):
         """The arrays in the kernels' order: x y z L M N wavelength_nm weight weight_sp flag
         (``weight_sp`` allocated as zeros here if it was None)."""
         if self.weight_sp is None:
-            self.weight_sp = np.zeros(self.weight.shape)
+            self.weight_sp = np.zeros(self.weight.shape, dtype=self.weight.dtype)
         return self._base() + (self.weight_sp, self.flag)
+
+    @property
+    def dtype(self) -> np.dtype:
+        """The precision of the float columns: float64, or float32 for rendering-style work."""
+        return self.x.dtype
+
+    def astype(self, dtype) -> "RayBatch":
+        """The rays with float columns in ``dtype`` (``np.float64`` or ``np.float32``), copied.
+
+        A float32 batch is traced in single precision (about 2x the rays per second; errors
+        against double measured in docs/ray-tracing.md): for images and renderer camera rays, not
+        for analyses. Flags are kept.
+        """
+        dt = np.dtype(dtype)
+        if dt not in (np.dtype(np.float64), np.dtype(np.float32)):
+            raise InputError(f"rays are traced in float64 or float32, not {dt}")
+        sp = None if self.weight_sp is None else np.array(self.weight_sp, dtype=dt)
+        return RayBatch(*(np.array(a, dtype=dt) for a in self._base()), flag=np.array(self.flag, copy=True),
+                        weight_sp=sp)
 
     def take(self, index) -> "RayBatch":
         """The rays selected by a boolean mask or index array."""

@@ -14,9 +14,9 @@ import numpy as np
 from ..errors import InputError, OpticsError, require_finite
 from ..lens.prescription import Prescription
 from .kernels import get_kernel
-from .kernels._layout import pack, set_wavelength
+from .kernels._layout import set_wavelength
 from .rays import CLIPPED, OK, RayBatch
-from .surfaces import surface_table
+from .tables import PackedTable, packed_table
 
 __all__ = ["DEFAULT_CHUNK", "trace_to_film", "trace_through", "trace_path", "paraxial_image_z", "CameraRays",
            "camera_rays"]
@@ -37,11 +37,27 @@ def _check_lens(lens) -> Prescription:
     return lens
 
 
-def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chunk_size=DEFAULT_CHUNK):
+def _is_mono(wl) -> bool:
+    """One wavelength the kernels can precompute indices for (else each ray computes its own; a
+    wavelength they cannot use, 0, NaN or one whose 1/l^2 overflows, goes that way too and its rays
+    are flagged MISSED by the kernel)."""
+    n = wl.shape[0]
+    if n == 0:
+        return False
+    if n > 1 and not wl.min() == wl.max():
+        return False
+    return 1e-100 < float(wl[0]) < 1e100
+
+
+def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chunk_size=DEFAULT_CHUNK,
+                 indexed: bool = False):
     """Trace ``rays`` in place through rows of a packed surface table (``kernels._layout.pack``).
 
     The low-level step under :func:`trace_through`, public for analyses that trace a lens in
     legs (ghost paths reflect between legs). ``kernel`` comes from ``kernels.get_kernel``.
+    ``S`` is not modified (a one-wavelength batch gets its indices on a copy), unless ``indexed``
+    says its index columns already hold the batch's one wavelength
+    (:meth:`physcam.trace.tables.PackedTable.at_wavelength`).
     """
     has_end = end_z is not None
     ez = float(end_z) if has_end else 0.0
@@ -50,13 +66,46 @@ def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chun
     for a in range(0, n, chunk_size):
         b = min(n, a + chunk_size)
         wl = rays.wavelength_nm[a:b]
-        # one wavelength: indices per surface (set_wavelength); a wavelength the kernels cannot use
-        # (0, NaN, 1/l^2 overflowing) goes the per-ray way, where the kernel flags its rays MISSED
-        mono = bool(wl.size) and bool(wl.min() == wl.max()) and 1e-100 < float(wl[0]) < 1e100
-        if mono:
-            set_wavelength(S, float(wl[0]))
-        kernel(*(c[a:b] for c in cols), S, kinds, bool(clip), bool(fresnel), ez, has_end, mono)
+        mono = _is_mono(wl)
+        Sw = S
+        if mono and not indexed:
+            Sw = np.array(S, dtype=np.float64)
+            set_wavelength(Sw, float(wl[0]))
+            if S.dtype != np.float64:
+                Sw = np.ascontiguousarray(Sw, dtype=S.dtype)
+        kernel(*(c[a:b] for c in cols), Sw, kinds, bool(clip), bool(fresnel), ez, has_end, mono)
     return rays
+
+
+def _run(kernel, rays: RayBatch, packed: PackedTable, rows, clip: bool, fresnel: bool, end_z, chunk_size):
+    """Trace ``rays`` in place through rows ``rows`` (a slice, or None for all) of a cached table
+    (one-wavelength indices cached too)."""
+    has_end = end_z is not None
+    ez = end_z if has_end else 0.0
+    n = rays.x.shape[0]
+    cols = rays.columns()
+    if n <= chunk_size:
+        wl = rays.wavelength_nm
+        mono = _is_mono(wl)
+        S = packed.at_wavelength(wl[0]) if mono else packed.S
+        if rows is None:
+            kernel(*cols, S, packed.kinds, clip, fresnel, ez, has_end, mono)
+        else:
+            kernel(*cols, S[rows], packed.kinds[rows], clip, fresnel, ez, has_end, mono)
+        return rays
+    if rows is None:
+        rows = _ALL
+    kinds = packed.kinds[rows]
+    for a in range(0, n, chunk_size):
+        b = min(n, a + chunk_size)
+        wl = rays.wavelength_nm[a:b]
+        mono = _is_mono(wl)
+        S = packed.at_wavelength(wl[0]) if mono else packed.S
+        kernel(*(c[a:b] for c in cols), S[rows], kinds, clip, fresnel, ez, has_end, mono)
+    return rays
+
+
+_ALL = slice(None)
 
 
 def trace_through(
@@ -80,24 +129,31 @@ def trace_through(
     ``aperture`` (an :class:`~physcam.trace.aperture.Aperture`, seed 002) shapes the stop: rays
     are traced to the stop, masked and weighted there by the aperture density on the stop's
     unit disk, then traced on. ``in_place`` traces ``rays`` itself instead of a copy.
+    Rays in float32 (:meth:`RayBatch.astype`) are traced in single precision (docs/ray-tracing.md).
     Returns the rays after the last surface (or on the end plane) with flags and weights.
     """
-    _check_lens(lens)
-    _check_rays(rays)
-    if chunk_size < 1:
+    if type(lens) is not Prescription:
+        _check_lens(lens)
+    if type(rays) is not RayBatch:
+        _check_rays(rays)
+    if chunk_size != DEFAULT_CHUNK and chunk_size < 1:
         raise InputError(f"chunk_size must be >= 1, got {chunk_size}")
-    if end_z is not None:
+    if end_z is not None and not (type(end_z) is float and -1e308 < end_z < 1e308):
         end_z = require_finite("end_z", end_z)
-    table = surface_table(lens, reverse=reverse, stop_semi_diameter=stop_semi_diameter, coating=coating)
-    S, kinds = pack(table)
+    packed = packed_table(lens, reverse=reverse, stop_semi_diameter=stop_semi_diameter, coating=coating,
+                          dtype=rays.x.dtype)
     out = rays if in_place else rays.copy()
     kernel = get_kernel(backend)
+    clip = bool(clip)
+    fresnel = bool(fresnel)
     if aperture is None:
-        return trace_packed(kernel, out, S, kinds, clip=clip, fresnel=fresnel, end_z=end_z, chunk_size=chunk_size)
+        return _run(kernel, out, packed, None, clip, fresnel, end_z, chunk_size)
     # trace to the stop, weigh by the aperture shape there, then on through the rest
-    k = int(np.flatnonzero(table.index == lens.stop_index)[0])
-    trace_packed(kernel, out, S[: k + 1], kinds[: k + 1], clip=clip, fresnel=fresnel, end_z=None, chunk_size=chunk_size)
-    rstop = table.semi_diameter[k]
+    k = packed.stop_row
+    if k < 0:
+        lens.stop_index  # raises LensFileError: no aperture stop to shape
+    _run(kernel, out, packed, slice(0, k + 1), clip, fresnel, None, chunk_size)
+    rstop = packed.table.semi_diameter[k]
     dens = aperture.density_at(out.x / rstop, out.y / rstop)
     live = out.flag == OK
     out.scale_weight(dens[live], live)  # polarisation-blind: scales the s and p halves alike
@@ -105,8 +161,7 @@ def trace_through(
     out.flag[blocked] = CLIPPED
     out.weight[blocked] = 0.0
     out.weight_sp[blocked] = 0.0
-    return trace_packed(kernel, out, S[k + 1 :], kinds[k + 1 :], clip=clip, fresnel=fresnel, end_z=end_z,
-                chunk_size=chunk_size)
+    return _run(kernel, out, packed, slice(k + 1, None), clip, fresnel, end_z, chunk_size)
 
 
 def trace_path(
@@ -127,18 +182,17 @@ def trace_path(
     """
     _check_lens(lens)
     _check_rays(rays)
-    table = surface_table(lens, stop_semi_diameter=stop_semi_diameter)
-    S, kinds = pack(table)
+    packed = packed_table(lens, stop_semi_diameter=stop_semi_diameter, dtype=rays.x.dtype)
     kernel = get_kernel(backend)
     out = rays.copy()
     pts = [np.stack([out.x, out.y, out.z], axis=1)]
-    for k in range(S.shape[0]):
-        trace_packed(kernel, out, S[k:k + 1], kinds[k:k + 1], clip=clip, fresnel=False, end_z=None)
+    for k in range(packed.S.shape[0]):
+        _run(kernel, out, packed, slice(k, k + 1), bool(clip), False, None, DEFAULT_CHUNK)
         pts.append(np.stack([out.x, out.y, out.z], axis=1))
     if end_z is not None:
         live = out.flag == OK
         end = out.take(live)
-        trace_packed(kernel, end, S[:0], kinds[:0], clip=clip, fresnel=False, end_z=require_finite("end_z", end_z))
+        _run(kernel, end, packed, slice(0, 0), bool(clip), False, require_finite("end_z", end_z), DEFAULT_CHUNK)
         last = pts[-1].copy()
         last[live] = np.stack([end.x, end.y, end.z], axis=1)
         pts.append(last)
@@ -230,6 +284,7 @@ def camera_rays(
     stop_semi_diameter: float | None = None,
     backend: str = "auto",
     chunk_size: int = DEFAULT_CHUNK,
+    precision: str = "double",
 ) -> CameraRays:
     """Film point + pupil sample -> ray leaving the front of the lens, and its weight.
 
@@ -242,8 +297,12 @@ def camera_rays(
     Weight (pbrt-v4 ``RealisticCamera``): E = T cos^4(theta) A / d^2, with theta the ray's angle
     to the axis at the film, A the sampled rectangle's area and d the film-to-rear-vertex
     distance; T the Fresnel transmittance when ``fresnel``, times the aperture density.
+    ``precision="single"`` traces in float32 (renderers' camera rays; error against double in
+    docs/ray-tracing.md) and returns float32 arrays.
     """
     _check_lens(lens)
+    if precision not in ("double", "single"):
+        raise InputError(f"precision must be 'double' or 'single', got {precision!r}")
     fxy = np.atleast_2d(np.asarray(film_xy, dtype=np.float64))
     uv = np.atleast_2d(np.asarray(pupil_samples, dtype=np.float64))
     if fxy.shape[-1] != 2 or uv.shape[-1] != 2:
@@ -279,6 +338,13 @@ def camera_rays(
         rays.weight[:] = cos_t**4 * area / (d * d)  # unpolarised at the film: weight_sp stays 0
     # a weight that overflows (a film plane a hair behind the rear vertex) cannot be traced:
     # the kernels flag such a ray MISSED with weight 0
+    if precision == "single":
+        # start where the ray crosses the rear vertex plane (its aim point, exact), so float32
+        # meets the first surface from close by (docs/ray-tracing.md, "Single precision")
+        rays.x[:] = px
+        rays.y[:] = py
+        rays.z[:] = z_rear
+        rays = rays.astype(np.float32)
 
     trace_through(lens, rays, reverse=True, clip=True, fresnel=fresnel, coating=coating,
                   stop_semi_diameter=stop_semi_diameter, aperture=aperture, backend=backend,

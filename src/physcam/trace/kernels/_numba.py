@@ -1,12 +1,27 @@
-"""The JIT kernel: rays in blocks, each block traced surface by surface.
+"""The JIT kernel: blocks of rays, surfaces in the outer loop, rays in branch-free inner loops.
 
-Same algorithm, order of operations and answers as :mod:`._numpy` (see that module and
-docs/ray-tracing.md for the maths). Imported only through :mod:`physcam.trace.kernels`.
+Same algorithm, order of operations and answers as :mod:`._numpy` (the reference; see that
+module and docs/ray-tracing.md for the maths). The geometry keeps IEEE semantics, so rays agree
+with the reference bit for bit; only the Fresnel weights are contracted to fused multiply-adds,
+where a last-bit difference stays one (docs/ray-tracing.md, "The SIMD kernel", has the error
+analysis). Imported only through :mod:`physcam.trace.kernels`.
 
-Layout: ``prange`` over blocks of :data:`BLOCK` rays; for each surface an inner loop over the
-block's rays. One ray through eleven surfaces is a long chain of dependent square roots and
-divisions (latency-bound); looping over independent rays innermost lets the CPU overlap them,
-which measured about 2x faster than one ray through all surfaces per iteration.
+Layout (structure of arrays, like the branch-free C loop of docs/performance.md): a block of
+:data:`BLOCK` rays is copied into a scratch array of columns (position, direction, weights,
+flag, intersection parameter, normal ...) small enough for the L1 cache. For each surface a few
+passes run over the block, each a loop in which every lane does the same operations: a lost ray
+is not skipped but masked (its lane computes like the others and a select keeps its last state),
+so LLVM compiles the loops to packed AVX2/AVX-512 instructions (``vsqrtpd``, ``vdivpd`` on 4 or 8
+rays at once). Whatever depends on the surface only (its kind, whether its normal needs
+normalising, clipping, Fresnel, the wavelength mode) picks which passes run, outside the ray loops.
+Two rare cases are handled per block, not per ray: the far root of a quadric (the back of a
+sphere met first; a fix-up pass runs only when some lane needs it) and the Newton iteration of an
+even asphere (all lanes step together; it stops when no lane of the block still moves).
+
+``trace_rays`` runs the blocks in parallel (``prange``), or, below ``serial_below`` rays, on the
+calling thread: for small batches waking the thread pool costs more than the rays
+(:data:`physcam.trace.kernels.SERIAL_BELOW`). It takes float64 or float32 rays and table: the
+working precision follows the arrays.
 """
 
 from __future__ import annotations
@@ -15,271 +30,607 @@ import math
 
 import numba as nb
 import numpy as np
+from numba.core import types
+from numba.extending import overload
 
-from ._layout import A4, AX, AY, AZ, CK, CV, ETA, N1, N2, NA, NB, NEWTON_MAX_ITER, NEWTON_TOL, SA, SB
-from ._layout import CLIPPED, MISSED, RSC, SEMI, TIR, UNIT, VZ
+from . import _jitcache
+
+_CACHE = _jitcache.install()  # before any @njit below: cache keyed by version and sources (else none)
+
+from ._layout import A4, AX, AY, AZ, CK, CV, ETA, N1, N2, NA, NB, NEWTON_MAX_ITER, NEWTON_TOL, SA, SB  # noqa: E402
+from ._layout import CLIPPED, MISSED, RSC, SEMI, TIR, UNIT, VZ  # noqa: E402
 
 _FLAT, _STOP, _QUADRIC, _ASPHERE = 0, 1, 2, 3
 
-#: Rays per block: 9 float64 columns x 256 rays stay in the L1 cache.
+#: Rays per block: 21 scratch columns x 256 rays x 8 bytes = 42 KiB (float64), inside a 48 KiB L1.
 BLOCK = 256
+# Scratch columns, each BLOCK long. Newton's state (ACT, CONV) reuses CI, CT, and dz/dr of an
+# asphere (DS) reuses UPD: each is consumed before the pass that writes the other.
+(_PX, _PY, _PZ, _DX, _DY, _DZ, _W, _WD, _CD, _T, _L2, _U, _N1, _N2, _ETA, _GX, _GY, _GZ, _CI, _CT,
+ _UPD) = range(21)
+_NCOL = 21
+_ACT, _CONV, _DS = _CI, _CT, _UPD
+
+#: every kernel function: IEEE arithmetic (no contraction, no reassociation), no Python error
+#: checks (a division by zero gives inf in a masked lane instead of raising), GIL released
+_OPTS = dict(fastmath=False, error_model="numpy", nogil=True, cache=_CACHE)
+#: the Fresnel weights only: contraction to FMA allowed
+_FMA_OPTS = dict(fastmath={"contract"}, error_model="numpy", nogil=True, cache=_CACHE)
 
 
-@nb.njit(inline="always", fastmath=False)
-def _index(S, s, c, flag, l2, u):
-    """physcam.optics.glass.evaluate, same order of operations (9 coefficients from column c)."""
-    n = S[s, c] + (S[s, c + 1] + S[s, c + 2] * u) * u
+def _like(value, arr):  # pragma: no cover - replaced by the overload inside jitted code
+    """``value`` in the element type of ``arr`` (float64 or float32), so float32 kernels stay float32."""
+    raise NotImplementedError
+
+
+@overload(_like, inline="always")
+def _like_impl(value, arr):
+    dt = arr.dtype if isinstance(arr, types.Array) else arr
+    if dt == types.float32:
+        return lambda value, arr: np.float32(value)
+    return lambda value, arr: np.float64(value)
+
+
+def _newton_rel_tol(arr):  # pragma: no cover - replaced by the overload inside jitted code
+    """Relative part of the Newton step tolerance: 0 in float64 (the reference's absolute
+    NEWTON_TOL), 8 float32 ulps of t in float32, whose t cannot resolve 1e-12 mm."""
+    raise NotImplementedError
+
+
+@overload(_newton_rel_tol, inline="always")
+def _newton_rel_tol_impl(arr):
+    dt = arr.dtype if isinstance(arr, types.Array) else arr
+    if dt == types.float32:
+        return lambda arr: np.float32(8.0 * 2.0**-23)
+    return lambda arr: np.float64(0.0)
+
+
+#: absolute Newton tolerance in float32 (mm), where NEWTON_TOL is below one ulp of any t
+NEWTON_TOL_F32 = 1e-6
+
+
+# ---- intersection ----------------------------------------------------------------------------
+
+@nb.njit(**_OPTS)
+def _intersect_plane(buf, m, vz):
+    """t to the plane z = vz into column T; a live ray parallel to it misses."""
+    B = BLOCK
+    zero = _like(0.0, buf)
+    miss = _like(MISSED, buf)
+    for k in range(m):
+        dz = buf[_DZ * B + k]
+        cd = buf[_CD * B + k]
+        buf[_T * B + k] = -(buf[_PZ * B + k] - vz) / dz
+        buf[_CD * B + k] = miss if ((cd == zero) & (dz == zero)) else cd
+
+
+@nb.njit(**_OPTS)
+def _intersect_quadric(buf, m, vz, ax, ay, az):
+    """Root nearest the vertex of ax x^2 + ay y^2 + az z^2 - 2 z = 0 into column T,
+    t = c / (-b - sign(b) sqrt(b^2 - a c)) (exact as the curvature goes to 0); returns how many
+    live lanes met the far cap instead and need :func:`_far_cap`."""
+    B = BLOCK
+    zero = _like(0.0, buf)
+    one = _like(1.0, buf)
+    two = _like(2.0, buf)
+    miss = _like(MISSED, buf)
+    nfar = np.int32(0)
+    for k in range(m):
+        px = buf[_PX * B + k]
+        py = buf[_PY * B + k]
+        qz = buf[_PZ * B + k] - vz
+        dx = buf[_DX * B + k]
+        dy = buf[_DY * B + k]
+        dz = buf[_DZ * B + k]
+        cd = buf[_CD * B + k]
+        a = ax * dx * dx + ay * dy * dy + az * dz * dz
+        b = ax * px * dx + ay * py * dy + az * qz * dz - dz
+        c = ax * px * px + ay * py * py + az * qz * qz - two * qz
+        disc = b * b - a * c
+        sq = math.sqrt(max(disc, zero))
+        den = -b - sq if b >= zero else -b + sq
+        t = c / den
+        live = cd == zero
+        bad = (disc < zero) | (den == zero)
+        far = az * (qz + t * dz) >= one
+        buf[_T * B + k] = t
+        buf[_CD * B + k] = miss if (live & bad) else cd
+        nfar += np.int32(live & (not bad) & far)
+    return nfar
+
+
+@nb.njit(**_OPTS)
+def _far_cap(buf, m, vz, ax, ay, az):
+    """The vertex branch t = den / a for live lanes whose nearest root lies on the far cap of the
+    quadric (az z >= 1: the back of a sphere met first by a ray starting far from the vertex)."""
+    B = BLOCK
+    zero = _like(0.0, buf)
+    one = _like(1.0, buf)
+    two = _like(2.0, buf)
+    miss = _like(MISSED, buf)
+    for k in range(m):
+        px = buf[_PX * B + k]
+        py = buf[_PY * B + k]
+        qz = buf[_PZ * B + k] - vz
+        dx = buf[_DX * B + k]
+        dy = buf[_DY * B + k]
+        dz = buf[_DZ * B + k]
+        t = buf[_T * B + k]
+        cd = buf[_CD * B + k]
+        far = (cd == zero) & (az * (qz + t * dz) >= one)
+        a = ax * dx * dx + ay * dy * dy + az * dz * dz
+        b = ax * px * dx + ay * py * dy + az * qz * dz - dz
+        c = ax * px * px + ay * py * py + az * qz * qz - two * qz
+        sq = math.sqrt(max(b * b - a * c, zero))
+        den = -b - sq if b >= zero else -b + sq
+        t2 = den / a
+        bad = (a == zero) | (not (az * (qz + t2 * dz) < one))
+        buf[_T * B + k] = t2 if far else t
+        buf[_CD * B + k] = miss if (far & bad) else cd
+
+
+@nb.njit(**_OPTS)
+def _newton_asphere(buf, m, S, s, vz):
+    """Refine t on an even asphere: Newton on g(t) = z(t) - sag(r(t)) from the conic root, all
+    lanes in step (a lane stops moving once converged or broken); then dz/dr at the hit point into
+    column DS, and lanes that did not converge flagged MISSED (as the numpy kernel)."""
+    B = BLOCK
+    zero = _like(0.0, buf)
+    one = _like(1.0, buf)
+    rel = _newton_rel_tol(buf)
+    tol = _like(NEWTON_TOL, buf) if rel == zero else _like(NEWTON_TOL_F32, buf)
+    miss = _like(MISSED, buf)
+    cv = S[s, CV]
+    ck1 = (one + S[s, CK]) * cv * cv
+    a4 = S[s, A4]
+    a6 = S[s, A4 + 1]
+    a8 = S[s, A4 + 2]
+    a10 = S[s, A4 + 3]
+    a12 = S[s, A4 + 4]
+    a14 = S[s, A4 + 5]
+    a16 = S[s, A4 + 6]
+    # (2 j + 4) A_(2j+4): the products of the numpy kernel's ((2.0 * j + 4.0) * coef[j])
+    c4 = _like(4.0, buf) * a4
+    c6 = _like(6.0, buf) * a6
+    c8 = _like(8.0, buf) * a8
+    c10 = _like(10.0, buf) * a10
+    c12 = _like(12.0, buf) * a12
+    c14 = _like(14.0, buf) * a14
+    c16 = _like(16.0, buf) * a16
+    nact = np.int32(0)
+    for k in range(m):
+        live = buf[_CD * B + k] == zero
+        buf[_ACT * B + k] = one if live else zero
+        buf[_CONV * B + k] = zero
+        nact += np.int32(live)
+    for _it in range(NEWTON_MAX_ITER):
+        if nact == 0:
+            break
+        nact = np.int32(0)
+        for k in range(m):
+            act = buf[_ACT * B + k] != zero
+            dx = buf[_DX * B + k]
+            dy = buf[_DY * B + k]
+            dz = buf[_DZ * B + k]
+            t = buf[_T * B + k]
+            X = buf[_PX * B + k] + t * dx
+            Y = buf[_PY * B + k] + t * dy
+            Z = (buf[_PZ * B + k] - vz) + t * dz
+            r2 = X * X + Y * Y
+            arg = one - ck1 * r2
+            sa = math.sqrt(arg)
+            sag = cv * r2 / (one + sa)
+            dsr = cv / sa
+            # sum A_2i r^2i and its derivative, term by term as the numpy kernel
+            p = r2 * r2
+            q = r2
+            sag = sag + a4 * p
+            dsr = dsr + c4 * q
+            p = p * r2
+            q = q * r2
+            sag = sag + a6 * p
+            dsr = dsr + c6 * q
+            p = p * r2
+            q = q * r2
+            sag = sag + a8 * p
+            dsr = dsr + c8 * q
+            p = p * r2
+            q = q * r2
+            sag = sag + a10 * p
+            dsr = dsr + c10 * q
+            p = p * r2
+            q = q * r2
+            sag = sag + a12 * p
+            dsr = dsr + c12 * q
+            p = p * r2
+            q = q * r2
+            sag = sag + a14 * p
+            dsr = dsr + c14 * q
+            p = p * r2
+            q = q * r2
+            sag = sag + a16 * p
+            dsr = dsr + c16 * q
+            g = Z - sag
+            gp = dz - dsr * (X * dx + Y * dy)
+            broken = (arg < zero) | (gp == zero)
+            step = act & (not broken)
+            dt = g / gp
+            dt = dt if step else zero
+            conv = step & (abs(dt) < tol + rel * abs(t))
+            buf[_T * B + k] = t - dt
+            still = step & (not conv)
+            buf[_ACT * B + k] = one if still else zero
+            buf[_CONV * B + k] = one if conv else buf[_CONV * B + k]
+            nact += np.int32(still)
+    for k in range(m):
+        t = buf[_T * B + k]
+        X = buf[_PX * B + k] + t * buf[_DX * B + k]
+        Y = buf[_PY * B + k] + t * buf[_DY * B + k]
+        r2 = X * X + Y * Y
+        arg = one - ck1 * r2
+        dsr = cv / math.sqrt(arg)
+        q = r2
+        dsr = dsr + c4 * q
+        q = q * r2
+        dsr = dsr + c6 * q
+        q = q * r2
+        dsr = dsr + c8 * q
+        q = q * r2
+        dsr = dsr + c10 * q
+        q = q * r2
+        dsr = dsr + c12 * q
+        q = q * r2
+        dsr = dsr + c14 * q
+        q = q * r2
+        dsr = dsr + c16 * q
+        buf[_DS * B + k] = dsr
+        cd = buf[_CD * B + k]
+        bad = (cd == zero) & ((buf[_CONV * B + k] == zero) | (arg < zero))
+        buf[_CD * B + k] = miss if bad else cd
+
+
+# ---- hit point, clipping -------------------------------------------------------------------
+
+@nb.njit(**_OPTS)
+def _move_and_clip(buf, m, sd2, clip):
+    """Live lanes to their hit point p + t d; clip outside the semi-diameter. The same comparison
+    catches a hit point that is not finite (overflow, 0/0): NaN fails it (MISSED, not CLIPPED)."""
+    B = BLOCK
+    zero = _like(0.0, buf)
+    miss = _like(MISSED, buf)
+    clipped = _like(CLIPPED, buf)
+    for k in range(m):
+        cd = buf[_CD * B + k]
+        live = cd == zero
+        t = buf[_T * B + k]
+        px = buf[_PX * B + k]
+        py = buf[_PY * B + k]
+        pz = buf[_PZ * B + k]
+        hx = px + t * buf[_DX * B + k]
+        hy = py + t * buf[_DY * B + k]
+        hz = pz + t * buf[_DZ * B + k]
+        r2 = hx * hx + hy * hy
+        finite = r2 - r2 == zero
+        ok = live & finite & ((r2 <= sd2) | (not clip))
+        buf[_PX * B + k] = hx if ok else px
+        buf[_PY * B + k] = hy if ok else py
+        buf[_PZ * B + k] = hz if ok else pz
+        buf[_CD * B + k] = cd if (ok | (not live)) else (clipped if finite else miss)
+
+
+# ---- surface normals (pointing to -z at the vertex) ----------------------------------------
+
+@nb.njit(**_OPTS)
+def _normal_flat(buf, m):
+    B = BLOCK
+    zero = _like(0.0, buf)
+    one = _like(1.0, buf)
+    for k in range(m):
+        buf[_GX * B + k] = zero
+        buf[_GY * B + k] = zero
+        buf[_GZ * B + k] = -one
+
+
+@nb.njit(**_OPTS)
+def _normal_quadric(buf, m, vz, ax, ay, az):
+    """Gradient (ax x, ay y, az z - 1) of the quadric: already a unit vector on spheres and cylinders."""
+    B = BLOCK
+    one = _like(1.0, buf)
+    for k in range(m):
+        buf[_GX * B + k] = ax * buf[_PX * B + k]
+        buf[_GY * B + k] = ay * buf[_PY * B + k]
+        buf[_GZ * B + k] = az * (buf[_PZ * B + k] - vz) - one
+
+
+@nb.njit(**_OPTS)
+def _normal_asphere(buf, m):
+    """(dz/dr x, dz/dr y, -1) with dz/dr (per unit r) from the Newton pass."""
+    B = BLOCK
+    one = _like(1.0, buf)
+    for k in range(m):
+        ds = buf[_DS * B + k]
+        buf[_GX * B + k] = ds * buf[_PX * B + k]
+        buf[_GY * B + k] = ds * buf[_PY * B + k]
+        buf[_GZ * B + k] = -one
+
+
+@nb.njit(**_OPTS)
+def _normalise(buf, m):
+    B = BLOCK
+    one = _like(1.0, buf)
+    for k in range(m):
+        gx = buf[_GX * B + k]
+        gy = buf[_GY * B + k]
+        gz = buf[_GZ * B + k]
+        inv = one / math.sqrt(gx * gx + gy * gy + gz * gz)
+        buf[_GX * B + k] = gx * inv
+        buf[_GY * B + k] = gy * inv
+        buf[_GZ * B + k] = gz * inv
+
+
+# ---- refractive indices ---------------------------------------------------------------------
+
+@nb.njit(**_OPTS)
+def _fill_const(buf, m, n1, n2, eta):
+    """One wavelength: the surface's indices for every lane."""
+    B = BLOCK
+    for k in range(m):
+        buf[_N1 * B + k] = n1
+        buf[_N2 * B + k] = n2
+        buf[_ETA * B + k] = eta
+
+
+@nb.njit(inline="always", **_OPTS)
+def _fill_index(buf, col, S, s, c, flag, m):
+    """Index of one medium per lane into column ``col``: the arithmetic and order of
+    :func:`physcam.optics.glass.evaluate` and ``_layout.index_rows``, so a mixed-wavelength batch
+    gets bit for bit the indices of the one-wavelength path."""
+    B = BLOCK
+    a0 = S[s, c]
+    a1 = S[s, c + 1]
+    a2 = S[s, c + 2]
+    one = _like(1.0, buf)
     if S[s, flag] != 0.0:
-        n = n + math.sqrt(1.0 + S[s, c + 3] * l2 / (l2 - S[s, c + 6]) + S[s, c + 4] * l2 / (l2 - S[s, c + 7])
-                          + S[s, c + 5] * l2 / (l2 - S[s, c + 8]))
-    return n
+        b1 = S[s, c + 3]
+        b2 = S[s, c + 4]
+        b3 = S[s, c + 5]
+        c1 = S[s, c + 6]
+        c2 = S[s, c + 7]
+        c3 = S[s, c + 8]
+        for k in range(m):
+            u = buf[_U * B + k]
+            l2 = buf[_L2 * B + k]
+            buf[col * B + k] = (a0 + (a1 + a2 * u) * u) + math.sqrt(
+                one + b1 * l2 / (l2 - c1) + b2 * l2 / (l2 - c2) + b3 * l2 / (l2 - c3))
+    else:
+        for k in range(m):
+            u = buf[_U * B + k]
+            buf[col * B + k] = a0 + (a1 + a2 * u) * u
 
 
-@nb.njit(parallel=True, fastmath=False, cache=True, nogil=True)
-def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
-    """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``."""
-    ns = S.shape[0]
+@nb.njit(**_OPTS)
+def _fill_n1(buf, S, s, m):
+    """Index before the surface per lane (the column is a constant here, so LLVM sees that the
+    loop's reads and writes do not overlap and vectorises it)."""
+    _fill_index(buf, _N1, S, s, NB, SB, m)
+
+
+@nb.njit(**_OPTS)
+def _fill_n2(buf, S, s, m):
+    """Index after the surface per lane."""
+    _fill_index(buf, _N2, S, s, NA, SA, m)
+
+
+@nb.njit(**_OPTS)
+def _fill_eta(buf, m):
+    B = BLOCK
+    for k in range(m):
+        buf[_ETA * B + k] = buf[_N1 * B + k] / buf[_N2 * B + k]
+
+
+# ---- refraction, Fresnel --------------------------------------------------------------------
+
+@nb.njit(**_OPTS)
+def _refract(buf, m):
+    """Snell's law in vector form, t = eta d + (cos t - eta cos i) n, with the normal turned to the
+    side the ray travels to; TIR where 1 - eta^2 (1 - cos^2 i) < 0 (a NaN there, from a degenerate
+    normal, is MISSED). Leaves cos i, cos t and whether the lane refracted for :func:`_fresnel_pass`."""
+    B = BLOCK
+    zero = _like(0.0, buf)
+    one = _like(1.0, buf)
+    miss = _like(MISSED, buf)
+    tir_code = _like(TIR, buf)
+    for k in range(m):
+        cd = buf[_CD * B + k]
+        live = cd == zero
+        dx = buf[_DX * B + k]
+        dy = buf[_DY * B + k]
+        dz = buf[_DZ * B + k]
+        gx = buf[_GX * B + k]
+        gy = buf[_GY * B + k]
+        gz = buf[_GZ * B + k]
+        eta = buf[_ETA * B + k]
+        same = buf[_N1 * B + k] == buf[_N2 * B + k]
+        ci = dx * gx + dy * gy + dz * gz
+        flip = ci < zero
+        gx = -gx if flip else gx
+        gy = -gy if flip else gy
+        gz = -gz if flip else gz
+        ci = -ci if flip else ci
+        kk = one - eta * eta * (one - ci * ci)
+        good = (kk >= zero) | same
+        tir = live & (not good) & (kk < zero) & (ci - ci == zero)
+        upd = live & good & (not same)
+        ct = math.sqrt(max(kk, zero))
+        f = ct - eta * ci
+        buf[_DX * B + k] = eta * dx + f * gx if upd else dx
+        buf[_DY * B + k] = eta * dy + f * gy if upd else dy
+        buf[_DZ * B + k] = eta * dz + f * gz if upd else dz
+        buf[_CD * B + k] = tir_code if tir else (miss if (live & (not good)) else cd)
+        buf[_CI * B + k] = ci
+        buf[_CT * B + k] = ct
+        buf[_UPD * B + k] = one if upd else zero
+
+
+@nb.njit(**_FMA_OPTS)
+def _fresnel_pass(buf, m, rsc):
+    """Fresnel s and p transmission of one surface on the weights of the lanes that refracted
+    (numpy kernel): with A, B the s and p throughputs, w = (A + B) / 2 and wd = (A - B) / 2; R
+    clipped to 1. Contracted to FMA: no decision depends on these numbers (docs/ray-tracing.md)."""
+    B = BLOCK
+    zero = _like(0.0, buf)
+    one = _like(1.0, buf)
+    half = _like(0.5, buf)
+    for k in range(m):
+        eta = buf[_ETA * B + k]
+        ci = buf[_CI * B + k]
+        ct = buf[_CT * B + k]
+        upd = buf[_UPD * B + k] != zero
+        ec = eta * ci
+        et = eta * ct
+        sm = (ec - ct) * (ci + et)
+        pm = (ci - et) * (ec + ct)
+        sp = (ec + ct) * (ci + et)
+        qq = rsc / (sp * sp)
+        rs = sm * sm * qq
+        rs = rs if rs < one else one
+        rp = pm * pm * qq
+        rp = rp if rp < one else one
+        hsum = one - half * (rs + rp)
+        hdif = half * (rp - rs)
+        w0 = buf[_W * B + k]
+        d0 = buf[_WD * B + k]
+        buf[_W * B + k] = w0 * hsum + d0 * hdif if upd else w0
+        buf[_WD * B + k] = w0 * hdif + d0 * hsum if upd else d0
+
+
+@nb.njit(**_OPTS)
+def _to_plane(buf, m, end_z):
+    """Live lanes on to the plane z = end_z; a ray parallel to it, or landing at inf/NaN, misses."""
+    B = BLOCK
+    zero = _like(0.0, buf)
+    miss = _like(MISSED, buf)
+    for k in range(m):
+        cd = buf[_CD * B + k]
+        live = cd == zero
+        px = buf[_PX * B + k]
+        py = buf[_PY * B + k]
+        pz = buf[_PZ * B + k]
+        dz = buf[_DZ * B + k]
+        t = (end_z - pz) / dz
+        hx = px + t * buf[_DX * B + k]
+        hy = py + t * buf[_DY * B + k]
+        ok = live & (dz != zero) & (hx - hx == zero) & (hy - hy == zero)
+        buf[_PX * B + k] = hx if ok else px
+        buf[_PY * B + k] = hy if ok else py
+        buf[_PZ * B + k] = end_z if ok else pz
+        buf[_CD * B + k] = miss if (live & (not ok)) else cd
+
+
+# ---- one block, all surfaces -------------------------------------------------------------------
+
+@nb.njit(**_OPTS)
+def _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, i0, m, buf):
+    """Trace rays i0 .. i0 + m (m <= BLOCK) through every row of ``S`` using the scratch ``buf``."""
+    B = BLOCK
+    zero = _like(0.0, buf)
+    one = _like(1.0, buf)
+    thousand = _like(1000.0, buf)
+    miss = _like(MISSED, buf)
+    ez = _like(end_z, buf)
+    for k in range(m):
+        buf[_PX * B + k] = x[i0 + k]
+        buf[_PY * B + k] = y[i0 + k]
+        buf[_PZ * B + k] = z[i0 + k]
+        buf[_DX * B + k] = L[i0 + k]
+        buf[_DY * B + k] = M[i0 + k]
+        buf[_DZ * B + k] = N[i0 + k]
+        buf[_W * B + k] = w[i0 + k]
+        buf[_WD * B + k] = wd[i0 + k]
+        buf[_CD * B + k] = flag[i0 + k]
+    # a live ray must start with finite weights (and, mixed wavelengths, a usable wavelength: > 0
+    # with a finite 1/l^2); a NaN/inf position or direction makes the first hit point or
+    # incidence cosine NaN/inf, which the passes flag
+    for k in range(m):
+        v = buf[_W * B + k] + buf[_WD * B + k]
+        cd = buf[_CD * B + k]
+        good = v - v == zero
+        if not mono:
+            lam = wl[i0 + k] / thousand
+            l2 = lam * lam
+            u = one / l2
+            buf[_L2 * B + k] = l2
+            buf[_U * B + k] = u
+            good = good & (wl[i0 + k] > zero) & (u - u == zero)
+        buf[_CD * B + k] = miss if ((cd == zero) & (not good)) else cd
+    for s in range(S.shape[0]):
+        kd = kinds[s]
+        vz = S[s, VZ]
+        ax = S[s, AX]
+        ay = S[s, AY]
+        az = S[s, AZ]
+        if kd <= _STOP:
+            _intersect_plane(buf, m, vz)
+        else:
+            if _intersect_quadric(buf, m, vz, ax, ay, az) > 0:
+                _far_cap(buf, m, vz, ax, ay, az)
+            if kd == _ASPHERE:
+                _newton_asphere(buf, m, S, s, vz)
+        _move_and_clip(buf, m, S[s, SEMI] * S[s, SEMI], clip)
+        # the stop, and in one-wavelength batches a surface between equal media, bend nothing
+        if kd == _STOP or (mono and S[s, N1] == S[s, N2]):
+            continue
+        if mono:
+            _fill_const(buf, m, S[s, N1], S[s, N2], S[s, ETA])
+        else:
+            _fill_n1(buf, S, s, m)
+            _fill_n2(buf, S, s, m)
+            _fill_eta(buf, m)
+        if kd == _FLAT:
+            _normal_flat(buf, m)
+        elif kd == _QUADRIC:
+            _normal_quadric(buf, m, vz, ax, ay, az)
+        else:
+            _normal_asphere(buf, m)
+        if S[s, UNIT] == zero:
+            _normalise(buf, m)
+        _refract(buf, m)
+        if fresnel:
+            _fresnel_pass(buf, m, S[s, RSC])
+    if has_end:
+        _to_plane(buf, m, ez)
+    for k in range(m):
+        cd = buf[_CD * B + k]
+        lost = (cd != zero) & (flag[i0 + k] == 0)
+        x[i0 + k] = buf[_PX * B + k]
+        y[i0 + k] = buf[_PY * B + k]
+        z[i0 + k] = buf[_PZ * B + k]
+        L[i0 + k] = buf[_DX * B + k]
+        M[i0 + k] = buf[_DY * B + k]
+        N[i0 + k] = buf[_DZ * B + k]
+        w[i0 + k] = zero if lost else buf[_W * B + k]
+        wd[i0 + k] = zero if lost else buf[_WD * B + k]
+        flag[i0 + k] = np.uint8(cd)
+
+
+@nb.njit(parallel=True, **_OPTS)
+def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, serial_below):
+    """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``.
+
+    Blocks of :data:`BLOCK` rays run in parallel on numba's thread pool, or, for fewer than
+    ``serial_below`` rays, one after the other on the calling thread (one compiled function for
+    both, so a cold start loads one kernel from the cache)."""
     n = x.shape[0]
     nblocks = (n + BLOCK - 1) // BLOCK
+    if n < serial_below:
+        buf = np.empty(_NCOL * BLOCK, dtype=x.dtype)
+        for blk in range(nblocks):
+            i0 = blk * BLOCK
+            _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, i0,
+                         min(BLOCK, n - i0), buf)
+        return
     for blk in nb.prange(nblocks):
         i0 = blk * BLOCK
-        i1 = min(n, i0 + BLOCK)
-        uu = np.empty(i1 - i0)
-        ll = np.empty(i1 - i0)
-        for i in range(i0, i1):
-            # -- a live ray's weights must be finite (else MISSED, weight 0). A NaN/inf position
-            # or direction needs no test here: it makes the first hit point or incidence cosine
-            # NaN/inf, which the surface loop flags. The wavelength of a mixed batch is checked
-            # below; a one-wavelength batch's in trace_packed.
-            v = w[i] + wd[i]
-            if flag[i] == 0 and not (v - v == 0.0):
-                flag[i] = MISSED
-                w[i] = 0.0
-                wd[i] = 0.0
-            if not mono:
-                l2 = (wl[i] / 1000.0) * (wl[i] / 1000.0)
-                ll[i - i0] = l2
-                uu[i - i0] = 1.0 / l2
-                if flag[i] == 0 and not (wl[i] > 0.0 and uu[i - i0] - uu[i - i0] == 0.0):
-                    flag[i] = MISSED
-                    w[i] = 0.0
-                    wd[i] = 0.0
-        for s in range(ns):
-            kd = kinds[s]
-            vz = S[s, VZ]
-            ax = S[s, AX]
-            ay = S[s, AY]
-            az = S[s, AZ]
-            sd2 = S[s, SEMI] * S[s, SEMI]
-            unit = S[s, UNIT] != 0.0
-            rsc = S[s, RSC]
-            cv = S[s, CV]
-            ck1 = (1.0 + S[s, CK]) * cv * cv
-            for i in range(i0, i1):
-                if flag[i] != 0:
-                    continue
-                px = x[i]
-                py = y[i]
-                pz = z[i]
-                dx = L[i]
-                dy = M[i]
-                dz = N[i]
-                qz = pz - vz
-                # -- intersection: nearest-vertex root of ax x^2 + ay y^2 + az z^2 - 2 z = 0
-                if kd <= _STOP:
-                    if dz == 0.0:
-                        flag[i] = MISSED
-                        w[i] = 0.0
-                        wd[i] = 0.0
-                        continue
-                    t = -qz / dz
-                else:
-                    a = ax * dx * dx + ay * dy * dy + az * dz * dz
-                    b = ax * px * dx + ay * py * dy + az * qz * dz - dz
-                    c = ax * px * px + ay * py * py + az * qz * qz - 2.0 * qz
-                    disc = b * b - a * c
-                    if disc < 0.0:
-                        flag[i] = MISSED
-                        w[i] = 0.0
-                        wd[i] = 0.0
-                        continue
-                    sq = math.sqrt(disc)
-                    den = -b - sq if b >= 0.0 else -b + sq
-                    if den == 0.0:
-                        flag[i] = MISSED
-                        w[i] = 0.0
-                        wd[i] = 0.0
-                        continue
-                    t = c / den
-                    # nearest root on the far cap (back of a sphere): use the vertex branch,
-                    # where az * z < 1 (see the numpy kernel)
-                    if az * (qz + t * dz) >= 1.0:
-                        if a == 0.0:
-                            flag[i] = MISSED
-                            w[i] = 0.0
-                            wd[i] = 0.0
-                            continue
-                        t = den / a
-                        if not az * (qz + t * dz) < 1.0:
-                            flag[i] = MISSED
-                            w[i] = 0.0
-                            wd[i] = 0.0
-                            continue
-                dsr = 0.0
-                if kd == _ASPHERE:
-                    # -- Newton iteration on g(t) = z(t) - sag(r(t)), started at the conic root
-                    conv = False
-                    for _it in range(NEWTON_MAX_ITER):
-                        X = px + t * dx
-                        Y = py + t * dy
-                        Z = qz + t * dz
-                        r2 = X * X + Y * Y
-                        arg = 1.0 - ck1 * r2
-                        if arg < 0.0:
-                            break
-                        sa = math.sqrt(arg)
-                        sag = cv * r2 / (1.0 + sa)
-                        dsr = cv / sa
-                        p = r2 * r2
-                        q = r2
-                        for j in range(7):
-                            aj = S[s, A4 + j]
-                            sag = sag + aj * p
-                            dsr = dsr + (2.0 * j + 4.0) * aj * q
-                            p = p * r2
-                            q = q * r2
-                        g = Z - sag
-                        gp = dz - dsr * (X * dx + Y * dy)
-                        if gp == 0.0:
-                            break
-                        dt = g / gp
-                        t = t - dt
-                        if abs(dt) < NEWTON_TOL:
-                            conv = True
-                            break
-                    X = px + t * dx
-                    Y = py + t * dy
-                    r2 = X * X + Y * Y
-                    arg = 1.0 - ck1 * r2
-                    if not conv or arg < 0.0:
-                        flag[i] = MISSED
-                        w[i] = 0.0
-                        wd[i] = 0.0
-                        continue
-                    dsr = cv / math.sqrt(arg)
-                    q = r2
-                    for j in range(7):
-                        dsr = dsr + (2.0 * j + 4.0) * S[s, A4 + j] * q
-                        q = q * r2
-                hx = px + t * dx
-                hy = py + t * dy
-                hz = pz + t * dz
-                # -- clip at the clear semi-diameter (and the stop). One comparison also catches a
-                # hit point that is not finite (overflow or 0/0 on huge or degenerate input): NaN
-                # fails every comparison. hz needs no test: a NaN/inf t makes hx NaN/inf too, and
-                # with a finite t, hz lies on the surface near its vertex.
-                r2 = hx * hx + hy * hy
-                if not (r2 <= sd2):
-                    if not (r2 - r2 == 0.0):
-                        flag[i] = MISSED
-                        w[i] = 0.0
-                        wd[i] = 0.0
-                        continue
-                    if clip:
-                        flag[i] = CLIPPED
-                        w[i] = 0.0
-                        wd[i] = 0.0
-                        continue
-                x[i] = hx
-                y[i] = hy
-                z[i] = hz
-                if kd == _STOP:
-                    continue
-                if mono:
-                    n1 = S[s, N1]
-                    n2 = S[s, N2]
-                    eta = S[s, ETA]
-                else:
-                    n1 = _index(S, s, NB, SB, ll[i - i0], uu[i - i0])
-                    n2 = _index(S, s, NA, SA, ll[i - i0], uu[i - i0])
-                    eta = n1 / n2
-                if n1 == n2:
-                    continue
-                # -- unit surface normal, pointing to -z at the vertex
-                if kd == _FLAT:
-                    gx = 0.0
-                    gy = 0.0
-                    gz = -1.0
-                elif kd == _QUADRIC:
-                    gx = ax * hx
-                    gy = ay * hy
-                    gz = az * (hz - vz) - 1.0
-                else:
-                    gx = dsr * hx
-                    gy = dsr * hy
-                    gz = -1.0
-                if not unit:
-                    inv = 1.0 / math.sqrt(gx * gx + gy * gy + gz * gz)
-                    gx = gx * inv
-                    gy = gy * inv
-                    gz = gz * inv
-                ci = dx * gx + dy * gy + dz * gz
-                if ci < 0.0:
-                    gx = -gx
-                    gy = -gy
-                    gz = -gz
-                    ci = -ci
-                # -- Snell's law in vector form; total internal reflection
-                kk = 1.0 - eta * eta * (1.0 - ci * ci)
-                if not (kk >= 0.0):
-                    # kk < 0 with a finite normal: TIR; NaN/inf (a degenerate normal, 0/0): MISSED.
-                    # A finite normal and kk >= 0 give a finite refracted direction.
-                    flag[i] = TIR if (kk < 0.0 and ci - ci == 0.0) else MISSED
-                    w[i] = 0.0
-                    wd[i] = 0.0
-                    continue
-                ct = math.sqrt(kk)
-                if fresnel:
-                    # s and p separately (see _numpy.py): w = (A + B) / 2, wd = (A - B) / 2
-                    ec = eta * ci
-                    et = eta * ct
-                    sm = (ec - ct) * (ci + et)
-                    pm = (ci - et) * (ec + ct)
-                    sp = (ec + ct) * (ci + et)
-                    q = rsc / (sp * sp)
-                    rs = sm * sm * q
-                    if not rs < 1.0:
-                        rs = 1.0
-                    rp = pm * pm * q
-                    if not rp < 1.0:
-                        rp = 1.0
-                    hsum = 1.0 - 0.5 * (rs + rp)
-                    hdif = 0.5 * (rp - rs)
-                    w0 = w[i]
-                    d0 = wd[i]
-                    w[i] = w0 * hsum + d0 * hdif
-                    wd[i] = w0 * hdif + d0 * hsum
-                f = ct - eta * ci
-                L[i] = eta * dx + f * gx
-                M[i] = eta * dy + f * gy
-                N[i] = eta * dz + f * gz
-        if has_end:
-            for i in range(i0, i1):
-                if flag[i] != 0:
-                    continue
-                if N[i] == 0.0:
-                    flag[i] = MISSED
-                    w[i] = 0.0
-                    wd[i] = 0.0
-                    continue
-                t = (end_z - z[i]) / N[i]
-                hx = x[i] + t * L[i]
-                hy = y[i] + t * M[i]
-                if not (math.isfinite(hx) and math.isfinite(hy)):
-                    flag[i] = MISSED
-                    w[i] = 0.0
-                    wd[i] = 0.0
-                    continue
-                x[i] = hx
-                y[i] = hy
-                z[i] = end_z
+        buf = np.empty(_NCOL * BLOCK, dtype=x.dtype)
+        _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, i0,
+                     min(BLOCK, n - i0), buf)

@@ -1,0 +1,103 @@
+"""Where numba caches the compiled kernels, and when a cached kernel is fresh.
+
+numba's own cache (``cache=True``) checks only the source file of the function it compiled:
+a kernel whose constants come from another module (the column layout in :mod:`._layout`) would
+load stale machine code after that module changed, and an upgrade that keeps file contents
+but changes the package could do the same. physcam's locator keys every cache entry with a hash
+of physcam's version and of all kernel sources (this package's ``.py`` files), so a cache written
+by any other version or source is never used: it is recompiled and overwritten. Should a numba
+release not accept the locator, the kernels are compiled without a disk cache (slow to start,
+never stale) rather than cached under numba's weaker key.
+
+Entries go to ``__pycache__/physcam-jit`` beside the kernels, or, where the package directory is
+not writable (a system install), to the user cache (``$NUMBA_CACHE_DIR`` if set, else
+``$XDG_CACHE_HOME`` or ``~/.cache``, under ``physcam/jit``). The locator subclasses numba's cache
+locator class (``numba.core.caching._CacheLocator``, the class ``NUMBA_CACHE_LOCATOR_CLASSES``
+names; an internal of numba) and is registered ahead of numba's own, for functions defined in
+this directory only: other numba users are unaffected.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import sys
+
+_HERE = os.path.dirname(os.path.abspath(__file__))
+_installed = False
+_stamp: str | None = None
+
+
+def source_stamp() -> str:
+    """sha256 of physcam's version and every kernel source file (sorted by name)."""
+    global _stamp
+    if _stamp is None:
+        from ... import __version__
+
+        h = hashlib.sha256(f"physcam {__version__}\n".encode())
+        for name in sorted(os.listdir(_HERE)):
+            if name.endswith(".py"):
+                h.update(name.encode())
+                with open(os.path.join(_HERE, name), "rb") as f:
+                    h.update(hashlib.sha256(f.read()).digest())
+        _stamp = h.hexdigest()
+    return _stamp
+
+
+def _user_dir() -> str:
+    base = os.environ.get("NUMBA_CACHE_DIR") or os.environ.get("XDG_CACHE_HOME") or os.path.join(
+        os.path.expanduser("~"), ".cache")
+    tag = hashlib.sha1(_HERE.encode()).hexdigest()[:16]
+    return os.path.join(base, "physcam", "jit", tag)
+
+
+def install() -> bool:
+    """Register the locator with numba (idempotent; call before the kernels are defined).
+    Returns False where this numba does not take it (then do not cache)."""
+    global _installed
+    if _installed:
+        return True
+    try:
+        _register()
+    except Exception:  # noqa: BLE001 - another numba: compile without the disk cache instead
+        return False
+    _installed = True
+    return True
+
+
+def _register() -> None:
+    from numba.core import caching, config
+
+    if getattr(config, "CACHE_LOCATOR_CLASSES", None):  # the user's locators replace ours: no cache
+        raise RuntimeError("NUMBA_CACHE_LOCATOR_CLASSES is set")
+
+    class PhysCamLocator(caching._CacheLocator):
+        def __init__(self, py_func, py_file, path):
+            self._py_file = py_file
+            self._lineno = py_func.__code__.co_firstlineno
+            self._path = path
+
+        def get_cache_path(self):
+            return self._path
+
+        def get_source_stamp(self):
+            return source_stamp()
+
+        def get_disambiguator(self):
+            return str(self._lineno)
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            if os.path.dirname(os.path.abspath(py_file)) != _HERE:
+                return None
+            for path in (os.path.join(_HERE, "__pycache__", "physcam-jit"), _user_dir()):
+                self = cls(py_func, py_file, path)
+                try:
+                    self.ensure_cache_path()
+                except OSError:
+                    continue
+                return self
+            return None
+
+    caching.CacheImpl._locator_classes.insert(0, PhysCamLocator)
+    sys.modules[__name__].PhysCamLocator = PhysCamLocator
