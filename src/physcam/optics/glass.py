@@ -70,8 +70,10 @@ def require_wavelength(wavelength_nm, name: str = "wavelength"):
     :data:`WAVELENGTH_RANGE_NM`; return it unchanged."""
     from ..errors import InputError
 
-    lam = np.asarray(wavelength_nm, dtype=float)
     lo, hi = WAVELENGTH_RANGE_NM
+    if type(wavelength_nm) is float and lo <= wavelength_nm <= hi:  # the common scalar case, without numpy
+        return wavelength_nm
+    lam = np.asarray(wavelength_nm, dtype=float)
     if not (np.all(np.isfinite(lam)) and np.all(lam >= lo) and np.all(lam <= hi)):
         bad = lam[~(np.isfinite(lam) & (lam >= lo) & (lam <= hi))].ravel()
         raise InputError(f"{name} must lie between {lo:g} and {hi:g} nm (visible light is 380-780 nm), "
