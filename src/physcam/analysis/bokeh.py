@@ -184,10 +184,10 @@ def bokeh_image(
 
     from ..trace.kernels import backend_for_job
 
-    backend = backend_for_job(backend, (rays + (0 if extent_mm is not None else min(20_000, rays)))
+    backend = backend_for_job(backend, (rays + (0 if extent_mm is not None else 20_000))
                               * (len(lens.surfaces) + 1))
     if extent_mm is None:  # a pilot trace sizes the window (in double: it sets the image's frame)
-        pilot, _ = batch(min(20_000, rays), 0, np.float64)
+        pilot, _ = batch(20_000, 0, np.float64)
         pr = trace_to_film(lens, pilot, film_z, stop_semi_diameter=stop_semi_diameter, aperture=aperture,
                            backend=backend)
         if not pr.ok.any():
