@@ -106,18 +106,20 @@ def bokeh_image(
     from ..trace import RayBatch, paraxial_image_z, trace_to_film
     from ..trace.lowdiscrepancy import kronecker_points, random_shift
 
-    depth = require_positive("depth", depth_mm)
+    depth = require_positive("light distance (depth_mm, --light)", depth_mm)
     x_mm = require_finite("light x", x_mm)
     y_mm = require_finite("light y", y_mm)
-    if not (1 <= rays <= 10**11 and 8 <= pixels <= 4096 and 1000 <= chunk <= 10**7):
-        raise InputError("bokeh needs 1 <= rays <= 1e11, 8 <= pixels <= 4096 and 1000 <= chunk <= 1e7")
+    for name, v, lo, hi, span in (("rays", rays, 1, 10**11, "1 and 1e11"), ("pixels", pixels, 8, 4096, "8 and 4096"),
+                                  ("chunk", chunk, 1000, 10**7, "1000 and 1e7")):
+        if not lo <= v <= hi:
+            raise InputError(f"bokeh {name} must lie between {span}, got {v:g}")
     if film_z is None:
         film_z = paraxial_image_z(lens)
     z_src = film_z - depth
     if z_src >= -1e-9:
         raise InputError(
             f"the light at {depth:g} mm from the film is not in front of the lens (front vertex is "
-            f"{film_z:g} mm from the film); give a larger depth"
+            f"{film_z:g} mm from the film); give a larger light distance"
         )
     if precision not in ("double", "single"):
         raise InputError(f"precision must be 'double' or 'single', got {precision!r}")

@@ -47,7 +47,7 @@ def _args():
         lens=DEFAULTS["lens"], focal=None, fstop=DEFAULTS["fstop"], tstop=None, focus=DEFAULTS["focus"],
         sensor=DEFAULTS["sensor"], sensor_width=None, sensor_height=None, squeeze=1.0, coc=None,
         near=None, far=None, model="technical", h1=None, h2=None, pupil=None, reference="film", flange=None,
-        sensor_front=None, lens_length=None, pupil_fraction=0.4, meters_per_unit=0.01, shutter_angle=180.0,
+        sensor_front=None, lens_length=None, pupil_fraction=None, meters_per_unit=0.01, shutter_angle=180.0,
     )
 
 

@@ -77,8 +77,9 @@ def add_report_arguments(p) -> None:
     g.add_argument("--sensor-front", metavar="DIST", type=distance("sensor-to-lens-front distance"),
                    help="tape measure: film mark to the front of the lens (practical pupil estimate)")
     g.add_argument("--lens-length", metavar="DIST", type=distance("lens length"), help="physical lens length")
-    g.add_argument("--pupil-fraction", metavar="F", type=number("pupil fraction"), default=0.4,
-                   help="entrance pupil this fraction of the lens length behind its front (default 0.4)")
+    g.add_argument("--pupil-fraction", metavar="F", type=number("pupil fraction"), default=None,
+                   help="with --sensor-front: entrance pupil this fraction of the lens length behind its front "
+                        "(default 0.4)")
     g = p.add_argument_group("cameras")
     g.add_argument("--meters-per-unit", metavar="MPU", type=number("metersPerUnit"), default=0.01,
                    help="scene unit for USD/RenderMan values (default 0.01 = cm)")
@@ -117,6 +118,9 @@ def solve_from_args(args):
             raise InputError("give either --lens or --focal: the lens sets its own focal length")
     elif args.focal is None:
         raise InputError("give the focal length, e.g. --focal 50, or a lens with --lens NAME")
+    if getattr(args, "pupil_fraction", None) is not None and getattr(args, "sensor_front", None) is None:
+        raise InputError("--pupil-fraction places the tape-measure pupil estimate: it needs --sensor-front and "
+                         "--lens-length")
     from ._common import coc_of
 
     coc = coc_of(args)
@@ -139,7 +143,7 @@ def solve_from_args(args):
         flange_focal_distance_mm=args.flange,
         sensor_front_mm=args.sensor_front,
         lens_length_mm=args.lens_length,
-        pupil_fraction=args.pupil_fraction,
+        pupil_fraction=0.4 if getattr(args, "pupil_fraction", None) is None else args.pupil_fraction,
         lens=lens,
     )
     if getattr(args, "sensor_defaulted", False):

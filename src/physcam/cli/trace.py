@@ -149,7 +149,9 @@ def run_bokeh(args) -> int:
         focus_txt = format_distance(math.inf if args.focus is None else args.focus, u)
         print(f"{res.lens_name}: bokeh of a light at {format_distance(args.depth, u)} from the film, focus {focus_txt}"
               + (f", f/{args.fstop:g}" if args.fstop else "")
-              + f", {d['rays_passed']}/{d['rays_traced']} rays reach the film, centroid {d['centroid_mm']} mm")
+              + f", {d['rays_passed']}/{d['rays_traced']} rays reach the film"
+              + ("" if None in d["centroid_mm"] else
+                 ", centroid ({:.4f}, {:.4f}) mm on the film".format(*d["centroid_mm"])))
         if args.output:
             print(f"wrote {args.output}")
     return 0
