@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import OpticsError, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
@@ -96,13 +97,16 @@ def real_breathing(
     lens: Prescription,
     focus_marks_mm=None,
     *,
-    sensor_width_mm: float = 36.0,
-    sensor_height_mm: float = 24.0,
+    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
+    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM,
     method: str = "auto",
     wavelength_nm: float | None = None,
     backend: str = "auto",
 ) -> RealBreathing:
-    """Real against paraxial breathing of ``lens`` (module notes); marks default as in the breathing table."""
+    """Real against paraxial breathing of ``lens`` (module notes); marks default as in the breathing table.
+
+    The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
+    """
     from ..optics.focusing import breathing_table, focus, focus_method
 
     w = require_positive("sensor width", sensor_width_mm)

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..data.default_sensor import DEFAULT_SENSOR_HALF_DIAGONAL_MM
 from ..errors import InputError, OpticsError, require_finite
 from ..lens.prescription import Prescription, takes_prescription
 
@@ -472,7 +473,7 @@ class MTFChart:
 def mtf_chart(
     lens: Prescription,
     *,
-    max_image_height_mm=21.63,
+    max_image_height_mm=DEFAULT_SENSOR_HALF_DIAGONAL_MM,
     n_fields: int = 15,
     image_heights_mm=None,
     frequencies=CHART_FREQUENCIES,
@@ -488,7 +489,8 @@ def mtf_chart(
 ) -> MTFChart:
     """The vendor MTF chart of ``lens``: sagittal and tangential MTF at ``frequencies`` (default 10,
     20, 40 lp/mm) against image height, ``n_fields`` heights from 0 to ``max_image_height_mm``
-    (default 21.63 mm, the full-frame corner) or the ``image_heights_mm`` given; white light by
+    (default 15.55 mm, the corner of the default sensor, Super 35 24.89 x 18.66 mm:
+    :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, as the CLI; 21.63 mm is a 36 x 24 mm corner) or the ``image_heights_mm`` given; white light by
     default. The pupil grids follow the MTF sampling rules up to ``max_pupil_samples`` (default 256,
     so a chart takes seconds). ``progress(done, total)`` is called after each field."""
     from . import _pupil as P

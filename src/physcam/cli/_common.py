@@ -21,11 +21,12 @@ import json
 import math
 import sys
 
+from ..data.default_sensor import DEFAULT_SENSOR
 from ..errors import PhysCamError
 from ..units import UNIT_SYSTEMS, parse_distance
 
-#: The sensor every command uses when none is given (and the user config names none).
-DEFAULT_SENSOR = "Super 35"
+# DEFAULT_SENSOR: the sensor every command uses when none is given (and the user config names none);
+# one constant with the Python API's defaults (physcam.data.default_sensor).
 #: ``--focus hyperfocal``: the value :func:`focus` returns for it (resolved by :func:`resolve_focus`).
 HYPERFOCAL = "hyperfocal"
 #: Words read as an infinite focus.

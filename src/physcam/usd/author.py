@@ -32,6 +32,7 @@ import math
 import struct
 from dataclasses import dataclass
 
+from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import ExportError, InputError, require_finite, require_positive, require_type
 from ..export.renderman import shutter_opening_curve  # re-exported: the one copy of seed 002's ramps
 from .plugin import ensure_registered, require_stage
@@ -84,8 +85,8 @@ class CameraSpec:
     """
 
     focal_length_mm: float = 50.0
-    sensor_width_mm: float = 36.0
-    sensor_height_mm: float = 24.0
+    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM  # Super 35 (24.89 x 18.66 mm), as the CLI
+    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM
     fstop: float = 8.0
     focus_mm: float = 3000.0
     coc_mm: float = 0.03
