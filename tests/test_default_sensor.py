@@ -112,3 +112,12 @@ def test_dataclass_defaults_are_the_clis_too():
     assert (spec.sensor_width_mm, spec.sensor_height_mm) == (s.width_mm, s.height_mm)
     assert Grid(focus_mm=(1000.0,), fstops=(2.8,)).sensor_mm == (s.width_mm, s.height_mm)
     assert {f.name for f in dataclasses.fields(Grid)} >= {"sensor_mm"}
+
+
+def test_the_docs_python_example_runs():
+    """docs/cli.md's Python example of the default sensor (its ``>>>`` lines) gives what it shows."""
+    import doctest
+
+    res = doctest.testfile(str(Path(__file__).resolve().parents[1] / "docs" / "cli.md"), module_relative=False,
+                           optionflags=doctest.ELLIPSIS)
+    assert res.attempted >= 5 and res.failed == 0
