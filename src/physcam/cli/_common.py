@@ -21,7 +21,7 @@ import json
 import math
 import sys
 
-from ..data.default_sensor import DEFAULT_SENSOR
+from ..data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_LABEL
 from ..errors import PhysCamError
 from ..units import UNIT_SYSTEMS, parse_distance
 
@@ -209,7 +209,7 @@ def add_sensor_options(p, *, what: str = "") -> None:
     """--sensor NAME or --sensor-width/--sensor-height: the one set of sensor options."""
     g = p.add_argument_group("sensor") if what == "" else p
     g.add_argument("--sensor", metavar="NAME",
-                   help=f'sensor or gate name, e.g. "ALEXA 35" or S35 (see `physcam sensors`); default {DEFAULT_SENSOR}, '
+                   help=f'sensor or gate name, e.g. "ALEXA 35" or S35 (see `physcam sensors`); default {DEFAULT_SENSOR_LABEL}, '
                         "or `sensor` in the user config")
     g.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="MM",
                    help="a custom sensor's width, with --sensor-height (instead of --sensor)")
