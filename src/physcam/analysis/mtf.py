@@ -445,9 +445,13 @@ class MTFChart:
         out.append(f"      {keys} (upper case sagittal, lower case tangential)")
         return "\n".join(out)
 
-    def plot(self, path=None, *, force: bool = False):
-        """The vendor chart: solid sagittal, dashed tangential, thicker lines for lower frequencies."""
-        from ._plot import figure, save
+    def plot(self, path=None, *, force: bool = False, units: str = "m"):
+        """The vendor chart: solid sagittal, dashed tangential, thicker lines for lower frequencies; the
+        focus in the title in ``units`` (m, or ft for feet and inches; image heights stay in mm)."""
+        from ..units import format_distance
+        from ._plot import figure, per_unit, save
+
+        per_unit(units)
 
         fig, ax = figure(6.0, 4.0)
         nf = len(self.frequencies_lpmm)
@@ -462,7 +466,7 @@ class MTFChart:
         ax.set_ylabel("MTF")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, ncol=2, loc="lower left")
-        foc = "infinity" if math.isinf(self.focus_from_film_mm) else f"{self.focus_from_film_mm / 1000:g} m"
+        foc = "infinity" if math.isinf(self.focus_from_film_mm) else format_distance(self.focus_from_film_mm, units)
         wl = ", ".join(f"{w:g}" for w in self.wavelengths_nm)
         ax.set_title(f"{self.lens_name}\nMTF at f/{self.fstop:.3g}, focus {foc}, {wl} nm "
                      "(solid sagittal, dashed tangential)", fontsize=8)

@@ -118,7 +118,9 @@ def _finish(args, res, command: str) -> None:
     if args.output:
         from ._output import save_plot
 
-        save_plot(res, args.output, force=args.force, context=plot_context(args))
+        from ._common import units_of
+
+        save_plot(res, args.output, force=args.force, context=plot_context(args), units=units_of(args))
     d = mark_repaired(res.to_dict(), args.loaded_lens)
     if getattr(args, "sensor_name", None):
         d["sensor"] = args.sensor_name

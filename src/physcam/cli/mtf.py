@@ -108,7 +108,9 @@ def run(args) -> int:
                           weights=weights, fstop=args.fstop, focus_mm=focus, pupil_samples=args.pupil_samples,
                           max_pupil_samples=CHART_MAX_PUPIL_SAMPLES, progress=bar)
     if args.output:
-        chart.plot(args.output, force=args.force)
+        from ._common import units_of
+
+        chart.plot(args.output, force=args.force, units=units_of(args))
     if args.json:
         d = chart.to_dict()
         d["sensor"] = {"name": sensor.name, "width_mm": sensor.width_mm, "height_mm": sensor.height_mm}
