@@ -406,11 +406,21 @@ class MTFChart:
                       "tangential": {f"{f:g}": float(v) for f, v in zip(self.frequencies_lpmm, t)}}
                      for h, a, n, s, t in zip(self.image_heights_mm, self.fields_deg, self.pupil_samples,
                                               self.sagittal, self.tangential)],
+            "points": self.points(),
             "notes": list(self.notes),
             "definition": "diffraction MTF at the film plane focused at the mark; sagittal: lines radial, "
                           "tangential: lines tangential to circles about the centre; image height of the real "
                           "chief ray at the primary wavelength",
         }
+
+    def points(self) -> list[dict]:
+        """The chart as flat rows, one per image height and frequency (what ``physcam mtf --csv`` prints):
+        ``image_height_mm``, ``field_deg``, ``frequency_lpmm``, ``sagittal``, ``tangential``, ``pupil_samples``."""
+        return [{"image_height_mm": float(h), "field_deg": float(a), "frequency_lpmm": float(f), "sagittal": float(sv),
+                 "tangential": float(tv), "pupil_samples": int(n)}
+                for h, a, n, s, t in zip(self.image_heights_mm, self.fields_deg, self.pupil_samples, self.sagittal,
+                                         self.tangential)
+                for f, sv, tv in zip(self.frequencies_lpmm, s, t)]
 
     def table(self) -> str:
         """The chart as a text table (one row per image height)."""
