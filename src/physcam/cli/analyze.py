@@ -4,7 +4,7 @@
 
 Top-level commands, like ``physcam spot`` and ``physcam bokeh``. Each prints a table (``--csv``
 for its rows), or JSON with ``--json``, and writes a plot with ``-o FILE.png`` (never over a file
-unless ``--force``). The sensor is the one default (Super 35) unless given. Without ``--field``
+unless ``--force``). The sensor is the one default (Super 35, 24.89 x 18.66 mm) unless given. Without ``--field``
 or ``--max-field`` the fields reach the sensor corner, clamped (with a note) to what the lens
 images, as ``physcam distortion`` does.
 """
