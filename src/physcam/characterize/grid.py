@@ -149,7 +149,11 @@ DEFAULT_STMAP_WIDTH_PX = 2048
 
 @dataclass(frozen=True)
 class Grid:
-    """What to measure on every lens (module notes). Lengths mm, wavelengths nm."""
+    """What to measure on every lens (module notes). Lengths mm, wavelengths nm.
+
+    ``sensor_mm``: default sensor Super 35 (24.89 x 18.66 mm), the CLI's
+    (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`); ``resolution`` None: the ST-map frame
+    2048 pixels wide with square pixels on that sensor (:attr:`frame_px`)."""
 
     focus_mm: tuple[float, ...]
     fstops: tuple[float, ...]

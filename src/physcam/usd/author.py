@@ -66,6 +66,8 @@ class CameraSpec:
     """A physical camera as plain numbers (mm, seconds, degrees), what the schema stores.
 
     ``focus_mm`` is measured in front of the film plane (the on-set mark).
+    ``sensor_width_mm`` x ``sensor_height_mm``: default sensor Super 35 (24.89 x 18.66 mm), the CLI's
+    (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`).
     ``entrance_pupil_mm``: the pupil in front of the film plane; ``None`` uses the thin
     lens (the pupil on the principal plane, s' in front of the film).
     ``principal_planes_mm``: (H1, H2) in front of the film plane, from a datasheet or a
