@@ -3,8 +3,10 @@
 Run:  .venv/bin/python benchmarks/characterize.py [--lens dgauss_50mm] [--rays 200000]
 
 Each worker count gets its own ``LocalCluster`` (single-threaded worker processes, numba on one
-thread each, as ``physcam characterize`` starts them), warmed by a small run (imports, numba's
-cache) into a scratch folder, then the grid is characterized into a fresh folder. Reported:
+thread each, as ``physcam characterize`` starts them), warmed by a small run into a scratch folder
+and by :func:`warm_worker` on every worker (imports, numba's load and first call: what a worker
+pays once per process, and which a small warm-up grid alone leaves to the timed run on a worker
+that got no cell of a kind), then the grid is characterized into a fresh folder. Reported:
 
 * wall: from the first task submitted to the last result (cluster start-up shown apart);
 * compute: the sum of the cells' own compute times (measured inside each task);
@@ -30,6 +32,29 @@ import time
 from physcam.characterize import Grid, characterize, parse_focus_marks
 
 
+def warm_worker(lens: str) -> None:
+    """What a worker pays once: imports (matplotlib, OpenEXR, pyarrow, the analyses) and numba's load
+    and first call. Run on every worker before timing, so neither worker count's figures include it
+    (a small warm-up grid alone leaves a worker cold when the scheduler gives it no cell of a kind)."""
+    import OpenEXR  # noqa: F401
+    import matplotlib.image  # noqa: F401
+    import numpy as np
+    import pyarrow.parquet  # noqa: F401
+
+    import physcam.analysis.distortion_models  # noqa: F401
+    import physcam.analysis.illumination  # noqa: F401
+    import physcam.analysis.stmap  # noqa: F401
+    import physcam.characterize.cells  # noqa: F401
+    from physcam.lens.library import load_lens
+    from physcam.trace import RayBatch, paraxial_image_z, trace_to_film
+
+    rx = load_lens(lens)
+    n = 2000
+    b = RayBatch(np.zeros(n), np.linspace(-1, 1, n), np.full(n, -100.0), np.zeros(n), np.zeros(n), np.ones(n),
+                 np.full(n, rx.wavelength_nm), np.ones(n), np.zeros(n, dtype=np.uint8))
+    trace_to_film(rx, b, paraxial_image_z(rx), backend="numba")
+
+
 def run(n_workers: int, grid: Grid, lens: str) -> dict:
     from distributed import LocalCluster
 
@@ -43,6 +68,10 @@ def run(n_workers: int, grid: Grid, lens: str) -> dict:
         warm = Grid(focus_mm=(2000.0,), fstops=grid.fstops[:1], fields=2, resolution=(64, 43), psf_rays=20_000,
                     psf_pixels=16, illumination_grid=16, sensor_mm=grid.sensor_mm)
         characterize([lens], warm, scratch, scheduler=cluster.scheduler_address, usd=False)
+        from distributed import Client
+
+        with Client(cluster, set_as_default=False) as client:
+            client.run(warm_worker, lens)
         s = characterize([lens], grid, out, scheduler=cluster.scheduler_address, usd=False)
         assert not s.failed, s.failed
         return {"workers": s.workers, "cells": s.cells, "cluster_start_s": start, "wall_s": s.wall_s,

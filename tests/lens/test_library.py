@@ -60,3 +60,17 @@ def test_unknown_name_suggests_the_closest():
         load_lens("tesar 50")
     with pytest.raises(InputError, match="no such lens file"):
         load_lens("missing/lens.dat")
+
+
+def test_a_slug_loads_the_lens_the_index_finds():
+    # load_lens reads a bare slug's file directly (fast path): that must be the very lens the name
+    # lookup gives, so no slug may also be another lens's name or alias
+    from physcam.lens.library import _key
+
+    recs = list_lenses()
+    for rec in recs:
+        assert find_lens(rec.slug).slug == rec.slug
+        assert load_lens(rec.slug) is load_lens(rec.name)
+        for other in recs:
+            if other.slug != rec.slug:
+                assert _key(rec.slug) not in {_key(other.name), *map(_key, other.aliases)}

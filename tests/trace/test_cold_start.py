@@ -18,3 +18,48 @@ def test_plotting_commands_do_not_import_pyplot(tmp_path):
     assert p.stdout.split() == ["False", "True"]
     for name in ("s.png", "b.png", "d.png"):
         assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def _run(code: str) -> subprocess.CompletedProcess:
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k != "PHYSCAM_BACKEND"}
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+
+
+def test_default_bokeh_stays_in_numpy_and_a_large_one_loads_numba():
+    # the whole job is known ahead: 250,000 rays cost the numpy kernel less than loading numba
+    # (kernels.backend_for_job), 1e6 rays do not
+    code = ("import sys, io, contextlib\nfrom physcam.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    assert main(['bokeh', 'dgauss_50mm', '--json']) == 0\n"
+            "a = 'numba' in sys.modules\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    assert main(['bokeh', 'dgauss_50mm', '--rays', '1000000', '--pixels', '32', '--json']) == 0\n"
+            "print(a, 'numba' in sys.modules)")
+    p = _run(code)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.split() == ["False", "True"]
+
+
+def test_the_program_exits_cleanly_after_numba_was_loaded(tmp_path):
+    # physcam.cli.run skips the interpreter's teardown once numba is loaded: exit handlers still
+    # run, output is complete, the status is main()'s
+    import json
+
+    flag = tmp_path / "atexit.txt"
+    code = ("import atexit, sys\nimport numba\n"
+            f"atexit.register(lambda: open({str(flag)!r}, 'w').write('ran'))\n"
+            "sys.argv = ['physcam'] + sys.argv[1:]\nfrom physcam.cli import run\nrun()\n")
+    out = tmp_path / "b.png"
+    p = subprocess.run([sys.executable, "-c", code, "bokeh", "dgauss_50mm", "--rays", "5000", "--pixels", "16",
+                        "--json", "-o", str(out)], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert json.loads(p.stdout)["rays_traced"] == 5000
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert flag.read_text() == "ran"
+    flag.unlink()
+    p = subprocess.run([sys.executable, "-c", code, "bokeh", "dgauss_50mm", "--rays", "0"], capture_output=True,
+                       text=True)
+    assert p.returncode == 2 and p.stderr.startswith("physcam: error:") and "Traceback" not in p.stderr
+    assert flag.read_text() == "ran"

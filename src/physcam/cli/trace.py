@@ -35,7 +35,9 @@ def register(sub) -> None:
     hidden_alias(b, "--depth", "depth", type=distance("light distance"))
     b.add_argument("--x", type=number("light x"), default=0.0, metavar="MM", help="light lateral x (mm)")
     b.add_argument("--y", type=number("light y"), default=0.0, metavar="MM", help="light lateral y (mm)")
-    b.add_argument("--rays", type=int, default=1_000_000, metavar="N", help="rays to trace (1 to 1e11; default 1e6)")
+    b.add_argument("--rays", type=int, default=250_000, metavar="N",
+                   help="rays to trace (1 to 1e11; default 250000, low-discrepancy: as clean an image as 1e6 "
+                        "random rays; 1000000 gives one three times cleaner)")
     b.add_argument("--pixels", type=int, default=256, metavar="PX",
                    help="image width and height in pixels (8 to 4096; default 256)")
     b.add_argument("--spectral", action="store_true", help="three wavelengths (620/550/460 nm) as RGB")

@@ -65,14 +65,21 @@ def _key(s: str) -> str:
     return re.sub(r"[^a-z0-9]+", "_", s.lower()).strip("_")
 
 
+@lru_cache(maxsize=None)
+def _bundled(slug: str) -> Prescription:
+    """The bundled lens in ``<slug>.toml`` (read once per process)."""
+    from .formats import read_lens
+
+    return read_lens(library_dir() / f"{slug}.toml", "physcam")
+
+
 @lru_cache(maxsize=1)
 def _index() -> tuple[tuple[LensRecord, Prescription], ...]:
-    from .formats import read_lens
     from .formats._common import extra
 
     out = []
     for path in sorted(library_dir().glob("*.toml")):
-        p = read_lens(path, "physcam")
+        p = _bundled(path.stem)
         m = p.metadata
         corrections = extra(p, "provenance.corrections", [])
         rec = LensRecord(
@@ -196,6 +203,11 @@ def load_lens(name_or_path, lenient: bool = False) -> Prescription:
             for r in repairs:
                 warnings.warn(f"{s}: repaired on load: {r.message}", PhysCamWarning, stacklevel=2)
             return q
+    if not looks_like_path and (library_dir() / f"{s}.toml").is_file():
+        # a slug, as the CLI is usually given it: read that one file, not the whole library (the
+        # index reads every bundled lens, 25 ms). The same object the index holds;
+        # tests/lens/test_library.py checks that no slug is another lens's name or alias.
+        return _bundled(s)
     try:
         rec = find_lens(s)
     except InputError:

@@ -27,7 +27,7 @@ import os
 
 from ...errors import BackendError
 
-__all__ = ["BACKENDS", "SERIAL_BELOW", "get_kernel", "resolve_backend", "numba_available", "jit_kernel"]
+__all__ = ["BACKENDS", "SERIAL_BELOW", "backend_for_job", "get_kernel", "resolve_backend", "numba_available", "jit_kernel"]
 
 BACKENDS = ("auto", "numba", "numpy")
 #: Batches smaller than this run the JIT kernel serially (measured crossover, docs/performance.md).
@@ -39,6 +39,9 @@ NUMPY_RAY_SURFACE_S = 60e-9
 NUMPY_SURFACE_S = 30e-6
 NUMPY_BUDGET_S = 0.1
 NUMPY_CALL_MAX_S = 0.04
+#: What loading numba costs a process before its first traced ray: ``import numba`` and the first
+#: call's target initialisation (0.115 s + 0.14 s on this machine, idle; docs/performance.md)
+NUMBA_LOAD_S = 0.25
 #: Large batches too run serially while the machine is busy (1-minute load average above the
 #: cores numba uses, plus 0.5): numba's parallel loop splits the blocks statically, so with other
 #: processes on the cores it waits for its slowest thread (benchmarks/small_calls.py measured the
@@ -117,6 +120,20 @@ def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has
 
             return trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono)
     return k(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono)
+
+
+def backend_for_job(backend: str, ray_surfaces: float) -> str:
+    """The backend for a job whose whole size is known before it starts: ``ray_surfaces`` ray-surface
+    intersections in all (a bokeh: its rays times the surfaces plus the film).
+
+    "numpy" when ``backend`` is "auto" (and ``PHYSCAM_BACKEND`` does not say otherwise), numba is
+    not loaded yet and the numpy kernel would do the whole job (:data:`NUMPY_RAY_SURFACE_S` per
+    intersection) in less time than loading numba takes (:data:`NUMBA_LOAD_S`); ``backend``
+    unchanged otherwise. Either way the rays are the same (module notes).
+    """
+    if backend != "auto" or os.environ.get("PHYSCAM_BACKEND", "auto") != "auto" or _numba_kernel is not None:
+        return backend
+    return "numpy" if ray_surfaces * NUMPY_RAY_SURFACE_S < NUMBA_LOAD_S else backend
 
 
 def resolve_backend(backend: str = "auto") -> str:
