@@ -72,7 +72,43 @@ def test_hyperfocal_of_a_real_lens_is_a_fixed_point():
     again = solve_lens_report(focal_length_mm=None, lens=lens, sensor=S35, fstop=4.0, focus_mm=r.focus_from_film_mm)
     H = hyperfocal_distance(again.focal_length_mm, 4.0, again.coc_mm)
     assert again.focus_from_film_mm - again.h1_from_film_mm == pytest.approx(H, rel=1e-8)
-    assert again.dof.far_is_infinite or again.dof.far_from_film_mm > 1e8
+    assert again.dof.far_is_infinite and r.dof.far_is_infinite
+
+
+@pytest.mark.parametrize("f, n", [(18.0, 2.0), (24.0, 2.8), (50.0, 16.0), (85.0, 4.0), (135.0, 11.0)])
+def test_far_limit_at_the_hyperfocal_focus_is_infinite(f, n):
+    """Found by a reviewer: the solved mark landed ~1e-12 short of H and the exact form gave a far limit
+    of 6.7e16 m. A focus within HYPERFOCAL_RTOL of H counts as H."""
+    r = solve_lens_report(focal_length_mm=f, sensor=S35, fstop=n, focus_mm=HYPERFOCAL)
+    assert r.dof.far_is_infinite and r.dof.to_dict()["far_from_film_mm"] is None
+
+
+def test_far_limit_next_to_the_hyperfocal_distance():
+    """Within a millionth of H the far limit is infinite; beyond that, the exact form h s / (H - s)."""
+    from physcam.optics.dof import HYPERFOCAL_RTOL
+
+    f, n, c = 50.0, 4.0, 0.025
+    h = f * f / (n * c)
+    H = h + f
+    for gap in (1e-12, 1e-9, 6e-8, 0.9 * HYPERFOCAL_RTOL):  # 6e-8: a float32 focus distance
+        assert math.isinf(dof_limits(f, n, c, H * (1 - gap))[1])
+    for gap in (2 * HYPERFOCAL_RTOL, 1e-3, 0.1):
+        s = H * (1 - gap)
+        assert dof_limits(f, n, c, s)[1] == pytest.approx(h * s / (H - s), rel=1e-6)
+
+
+@pytest.mark.parametrize("fstop", [5.6, 8.0, 11.0])
+def test_a_real_lens_reports_one_hyperfocal_mark_at_every_focus(fstop):
+    """The hyperfocal mark of a real lens is the fixed point that --focus hyperfocal sets, whatever
+    focus the report is for (reviewer: three values 0.2-1.3 mm apart for one lens and f-stop)."""
+    from physcam.lens.library import load_lens
+
+    lens = load_lens("dgauss_50mm")
+    hyp = solve_lens_report(focal_length_mm=None, lens=lens, sensor=S35, fstop=fstop, focus_mm=HYPERFOCAL)
+    assert hyp.dof.far_is_infinite
+    for mark in (600.0, 2000.0, math.inf):
+        r = solve_lens_report(focal_length_mm=None, lens=lens, sensor=S35, fstop=fstop, focus_mm=mark)
+        assert r.dof.hyperfocal_from_film_mm == hyp.focus_from_film_mm
 
 
 def test_magnification_has_the_gaussian_engines_sign():

@@ -297,3 +297,16 @@ def test_review_findings_on_the_kit_cli(tmp_path, capsys):
     assert main(["usd", "read", str(csv)]) == 2
     err = capsys.readouterr().err
     assert "not a USD file" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("focal, fstop", [("50", "2.8"), ("24", "4"), ("85", "4")])
+def test_hyperfocal_focus_reads_back_with_an_infinite_far_limit(tmp_path, capsys, focal, fstop):
+    # the focus distance is a float32 attribute: read back it lies up to 6e-8 short of H, where the
+    # exact far limit was 1e9-4e10 m (review finding); within HYPERFOCAL_RTOL it is H
+    f = tmp_path / "h.usda"
+    assert main(["usd", "write", str(f), "--focal", focal, "--fstop", fstop, "--focus", "hyperfocal",
+                 "--sensor", "S35"]) == 0
+    capsys.readouterr()
+    assert main(["usd", "read", str(f), "--json"]) == 0
+    dof = json.loads(capsys.readouterr().out)["report"]["dof"]
+    assert dof["far_is_infinite"] is True and dof["far_from_film_mm"] is None

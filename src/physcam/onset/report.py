@@ -674,6 +674,15 @@ def solve_lens_report(
     if sq != 1.0:
         dof_h = _dof_block(f, N, c / sq, s, h1_at)
         notes.append(f"anamorphic {sq:g}x: horizontal CoC is c / squeeze = {c / sq:.4g} mm")
+    if lens is not None:
+        # a real lens's principal planes move as it focuses: the hyperfocal *mark* is the one focus
+        # whose subject plane lies at H from H1 with the lens focused there (the fixed point that
+        # --focus hyperfocal sets), the same whatever the report's own focus
+        import dataclasses
+
+        dof = dataclasses.replace(dof, hyperfocal_from_film_mm=_lens_hyperfocal_mark(lens, N, c)[0])
+        if dof_h is not None:
+            dof_h = dataclasses.replace(dof_h, hyperfocal_from_film_mm=_lens_hyperfocal_mark(lens, N, c / sq)[0])
 
     # --- focus error (technical) ------------------------------------------------
     if model == "technical":
@@ -832,12 +841,18 @@ def _lens_hyperfocal(lens, fstop, sensor, coc, near_mm, far_mm):
     H = f^2/(N c) + f from H1, with f and H1 of the lens focused at that mark (fixed point; the
     planes move little with focus, so a few steps converge to 1e-9 of the mark)."""
     from ..optics.coc import circle_of_confusion
-    from ..optics.focusing import technical_planes
 
     if near_mm is not None or far_mm is not None:
         raise InputError("focus at the hyperfocal distance takes no measured near/far limits")
     n = _require_f_number("f-stop", fstop)
     c, _ = circle_of_confusion(sensor.width_mm, sensor.height_mm, coc)
+    return _lens_hyperfocal_mark(lens, n, c)
+
+
+def _lens_hyperfocal_mark(lens, n: float, c: float):
+    """(mark, planes) of :func:`_lens_hyperfocal` for f-number ``n`` and CoC ``c`` (mm)."""
+    from ..optics.focusing import technical_planes
+
     mark = math.inf
     for _ in range(50):
         planes = technical_planes(lens, mark, fstop=n)

@@ -7,7 +7,7 @@ thin-lens limits are
     h = f^2 / (N c)                       (the "hyperfocal parameter")
     H = h + f                             (hyperfocal distance, from H1)
     near = h s / (h + (s - f))
-    far  = h s / (h - (s - f))            (infinite when s >= H)
+    far  = h s / (h - (s - f))            (infinite when s >= H (1 - HYPERFOCAL_RTOL))
 
 Focused at infinity (s -> inf) the far limit is infinite and the near limit tends to h itself:
 near = h / (1 + (h - f) / s) -> h. (Focused at H instead, near = H / 2.)
@@ -31,6 +31,7 @@ from ..errors import InputError, OpticsError
 from . import _num as nx
 
 __all__ = [
+    "HYPERFOCAL_RTOL",
     "hyperfocal_distance",
     "dof_limits",
     "hyperfocal_parameter_from_near",
@@ -43,6 +44,13 @@ __all__ = [
 
 _arr = nx.value
 _out = nx.out
+
+#: A focus within this fraction of the hyperfocal distance H counts as H: the far limit is
+#: infinite. Focus marks solved to 1e-9 or read back from a float32 USD attribute (6e-8) land a
+#: hair short of H, where the exact form gives a far limit of H / (relative gap), 1e8 H and more:
+#: no scene is that deep, and printing it as a distance misleads. Within 1e-6 the far limit would be
+#: over a million times H.
+HYPERFOCAL_RTOL = 1e-6
 
 
 def hyperfocal_distance(focal_length, f_number, coc):
@@ -61,7 +69,8 @@ def hyperfocal_distance(focal_length, f_number, coc):
 def dof_limits(focal_length, f_number, coc, object_distance):
     """(near, far) limits of acceptable sharpness, in mm from H1 (exact thin-lens forms).
 
-    ``far`` is ``inf`` when the focus is at or beyond the hyperfocal distance. ``object_distance``
+    ``far`` is ``inf`` when the focus is at or beyond the hyperfocal distance H, or within
+    :data:`HYPERFOCAL_RTOL` of it. ``object_distance``
     may be ``inf`` (focus at infinity): then near = h = f²/(N c), the limit of the exact form.
     Raises :class:`OpticsError` if the subject is at or inside the focal length.
 
@@ -78,8 +87,9 @@ def dof_limits(focal_length, f_number, coc, object_distance):
         raise OpticsError("focus distance is at or inside the focal length: no real image forms")
     h = f * f / (_arr(f_number) * _arr(coc))
     near = h / (1.0 + (h - f) / s)  # = h s / (h + s - f), and h at s = inf
-    denom = h - (s - f)
-    far = nx.where(denom > 0, h * s / nx.where(denom > 0, denom, 1.0), math.inf)
+    denom = h - (s - f)  # = H - s
+    finite = denom > HYPERFOCAL_RTOL * (h + f)
+    far = nx.where(finite, h * s / nx.where(finite, denom, 1.0), math.inf)
     return _out(near), _out(far)
 
 
