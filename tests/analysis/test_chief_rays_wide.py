@@ -50,7 +50,7 @@ def test_fisheye_field_limit_is_at_least_the_corner(fisheye):
     from physcam.analysis.field_of_view import chief_ray_field_limit
 
     assert chief_ray_field_limit(fisheye) >= 65.2
-    r = real_distortion(fisheye)  # 15 fields to the full-frame corner, 65.21 deg
+    r = real_distortion(fisheye, sensor_width_mm=36.0, sensor_height_mm=24.0)  # 15 fields to the full-frame corner, 65.21 deg
     assert r.points[-1].field_deg == pytest.approx(math.degrees(math.atan(math.hypot(18, 12) / r.efl_y_mm)), abs=1e-9)
     assert not r.notes[:1] or "pass only" not in r.notes[0]
 

@@ -24,8 +24,9 @@ INF = math.inf
 
 
 def tiny(**kw) -> Grid:
-    base = dict(focus_mm=(1000.0, INF), fstops=(2.8,), fields=2, resolution=(64, 43), psf_rays=4000, psf_pixels=16,
-                illumination_grid=16, backend="numpy")
+    # a full-frame sensor (64 x 43 px keeps its pixels square; the fisheye covers its corners only there)
+    base = dict(focus_mm=(1000.0, INF), fstops=(2.8,), fields=2, sensor_mm=(36.0, 24.0), resolution=(64, 43),
+                psf_rays=4000, psf_pixels=16, illumination_grid=16, backend="numpy")
     base.update(kw)
     return Grid(**base)
 
@@ -71,6 +72,15 @@ def test_focus_marks_are_even_in_dioptres():
     assert list(marks[:-1]) == pytest.approx(want[:-1], rel=1e-12)
     assert parse_focus_marks("1m,2m,inf") == (1000.0, 2000.0, INF)
     assert parse_focus_marks("1m:2m:3") == pytest.approx((1000.0, 4000.0 / 3, 2000.0))  # 1, 0.75, 0.5 per m
+
+
+def test_the_grid_defaults_to_the_one_default_sensor_with_square_pixels():
+    # Super 35 4-perf is 24.89 x 18.66 mm (0.980 x 0.735 in, Nuke's Film/Super35); 2048 px across it
+    # keeps pixels square at 2048 x 18.66 / 24.89 = 1535.39 -> 1535 rows
+    g = Grid(focus_mm=(1000.0,), fstops=(2.8,)).checked()
+    assert g.sensor_mm == (24.89, 18.66) and g.resolution == (2048, 1535)
+    assert Grid(focus_mm=(1000.0,), fstops=(2.8,), sensor_mm=(36.0, 24.0)).checked().resolution == (2048, 1365)
+    assert Grid(focus_mm=(1000.0,), fstops=(2.8,), resolution=(512, 341)).checked().resolution == (512, 341)
 
 
 def test_bad_inputs_give_one_clear_error(tmp_path):

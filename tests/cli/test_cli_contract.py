@@ -114,7 +114,8 @@ CSV_ROWS = {
     ("dof-table",): "rows", ("sensors",): "sensors", ("lenses",): "lenses", ("lens", "breathing"): "rows",
     ("spot",): "fields", ("illumination",): "points", ("colour",): "lateral",
     ("breathing-real",): "rows", ("ghosts",): "paths", ("distortion",): "points", ("compare", "lenses"): "lenses",
-    ("export", "unreal"): "lens_file.physcam.marks",
+    ("export", "unreal"): "lens_file.physcam.marks", ("mtf",): "points", ("lens", "show"): "points",
+    ("config", "show"): "rows",
 }
 #: Commands that take a focus but print no distance (so no --units), and why.
 NO_UNITS = {

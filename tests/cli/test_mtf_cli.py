@@ -48,12 +48,47 @@ def test_chart_json_and_a_named_sensor(capsys):
 def test_one_field_report(capsys):
     assert main(["mtf", "dgauss_50mm", "--fstop", "8", "--field", "14", "--wavelength", "587.5618", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
-    assert set(d) == {"schema", "version", "units", "wavefront", "psf", "mtf"} and d["schema"] == "physcam.mtf_field"
+    assert set(d) == {"schema", "version", "units", "wavefront", "psf", "mtf", "points"} \
+        and d["schema"] == "physcam.mtf_field"
     assert d["wavefront"]["field_deg"] == 14.0 and 0 < d["psf"]["strehl"] < 1
     assert d["wavefront"]["zernike_ordering"].startswith("Noll")
     assert main(["mtf", "dgauss_50mm", "--fstop", "8", "--field", "14"]) == 0
     text = capsys.readouterr().out
     assert "Strehl ratio" in text and "RMS" in text and "Zernike (Noll" in text
+
+
+def _csv_rows(capsys, argv):
+    import csv
+    import io
+
+    capsys.readouterr()
+    assert main([*argv, "--csv"]) == 0
+    return list(csv.DictReader(io.StringIO(capsys.readouterr().out)))
+
+
+def test_csv_round_trips_to_the_json(capsys):
+    """--csv prints one row per image height and frequency (one per frequency with --field); parsed back
+    with the csv module, every cell is the JSON's number (repr: exact), and the rows are the JSON's rows."""
+    chart = ["mtf", "dgauss_50mm", "--fstop", "8", "--fields", "3", "--pupil-samples", "32", "--frequency", "10",
+             "--frequency", "30", "--wavelength", "587.5618"]
+    table = _csv_rows(capsys, chart)
+    assert main([*chart, "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert len(table) == 3 * 2 and list(table[0]) == ["image_height_mm", "field_deg", "frequency_lpmm", "sagittal",
+                                                       "tangential", "pupil_samples"]
+    for row, (r, f) in zip(table, [(r, f) for r in d["rows"] for f in d["frequencies_lpmm"]]):
+        assert float(row["image_height_mm"]) == r["image_height_mm"] and float(row["field_deg"]) == r["field_deg"]
+        assert float(row["frequency_lpmm"]) == f and int(row["pupil_samples"]) == r["pupil_samples"]
+        assert float(row["sagittal"]) == r["sagittal"][f"{f:g}"] and float(row["tangential"]) == r["tangential"][f"{f:g}"]
+    field = ["mtf", "dgauss_50mm", "--fstop", "8", "--field", "14", "--pupil-samples", "32", "--wavelength", "587.5618"]
+    table = _csv_rows(capsys, field)
+    assert main([*field, "--json"]) == 0
+    m = json.loads(capsys.readouterr().out)["mtf"]
+    assert [float(r["frequency_lpmm"]) for r in table] == m["frequencies_lpmm"] == [10.0, 20.0, 40.0]
+    assert [float(r["sagittal"]) for r in table] == m["sagittal"]
+    assert [float(r["tangential"]) for r in table] == m["tangential"]
+    assert [float(r["diffraction_limit_tangential"]) for r in table] == m["diffraction_limit_tangential"]
+    assert all(float(r["field_deg"]) == 14.0 for r in table)
 
 
 @pytest.mark.parametrize("argv", [

@@ -145,6 +145,9 @@ def test_imperial_switch(page, server, capsys):
     page.wait_for_function("() => document.getElementById('out-near').textContent.includes(\"'\")")
     assert page.text_content("#out-near") == imperial(near) == format_feet_inches(near)
     assert float(page.get_attribute("#out-near", "data-mm")) == near  # the switch keeps 2.5 meaning metres
+    # the DOF chart is drawn in feet too (physcam serve's /api/dof.svg?...&units=ft)
+    page.wait_for_function("() => (document.getElementById('dof-chart').getAttribute('src') || '')"
+                           ".endsWith('&units=ft')")
     assert page.input_value("#focus") == "2.5m"
     page.wait_for_function("() => { const td = document.querySelector('#marks tbody td');"
                            " return td !== null && td.textContent === \"2'\"; }")

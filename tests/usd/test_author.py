@@ -65,8 +65,8 @@ def test_gf_camera_reproduces_fov(mpu, focal, w, h, squeeze):
 def test_units_tenths_of_scene_unit(mpu, focal_expected):
     """50 mm is 50 tenths of a cm, 0.5 tenths of a metre, 19.685 tenths of an inch (2.54 mm each)."""
     stage = new_stage(mpu)
-    author_camera(stage, "/Cameras/Camera", CameraSpec(focal_length_mm=50.0, focus_mm=3000.0,
-                                                       clipping_mm=(100.0, 1.0e6)))
+    author_camera(stage, "/Cameras/Camera", CameraSpec(focal_length_mm=50.0, focus_mm=3000.0, sensor_width_mm=36.0,
+                                                       sensor_height_mm=24.0, clipping_mm=(100.0, 1.0e6)))
     g = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
     # float32 values chosen to keep aperture/focal exact stay within a few ulps (2e-6) of the exact ones;
     # the focal length is the best-match pinhole, s' of the 50 mm thin lens at the 3 m mark
@@ -146,7 +146,8 @@ def test_shutter_curve_points_lie_on_the_ramps(o, c):
 
 def test_orthographic_camera():
     stage = new_stage(1.0)
-    author_camera(stage, "/Cameras/Camera", CameraSpec(projection="orthographic", magnification=0.01))
+    author_camera(stage, "/Cameras/Camera", CameraSpec(projection="orthographic", magnification=0.01,
+                                                       sensor_width_mm=36.0, sensor_height_mm=24.0))
     g = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
     assert g.GetProjectionAttr().Get() == "orthographic"
     # 36 mm / 0.01 = 3.6 m wide = 36 tenths of a metre

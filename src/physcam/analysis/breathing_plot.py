@@ -2,7 +2,8 @@
 
 The x axis is the reciprocal of the focus mark (1/m, dioptres of the mark measured
 from the film plane; 1/ft in feet), so infinity sits at 0 and close focus spreads out; tick
-labels give the marks in metres, or feet and inches with ``units="ft"``. Rows come from
+labels give the marks in metres, or feet and inches with ``units="ft"`` (to 1/8 inch below 10 ft, as
+everywhere: :func:`physcam.units.format_distance`). Rows come from
 :func:`physcam.optics.focusing.breathing_table`.
 """
 
@@ -26,7 +27,8 @@ def breathing_figure(rows, *, title: str = "focus breathing", sensor_width_mm: f
     from matplotlib.figure import Figure
 
     from ..optics.focusing import BreathingRow
-    from ..units import UNIT_SYSTEMS, format_feet_inches
+    from ..units import UNIT_SYSTEMS
+    from ._plot import tick_label
 
     if units not in UNIT_SYSTEMS:
         raise InputError(f"units must be one of {', '.join(UNIT_SYSTEMS)}, got {units!r}")
@@ -46,8 +48,7 @@ def breathing_figure(rows, *, title: str = "focus breathing", sensor_width_mm: f
     ax.set_xlabel(f"focus mark from the film plane ({'m' if units == 'm' else 'feet and inches'})")
     ticks = [r for r in rows if not math.isinf(r.focus_from_film_mm)]
     ax.set_xticks([0.0] + [per / r.focus_from_film_mm for r in ticks])
-    ax.set_xticklabels(["∞"] + [f"{r.focus_from_film_mm / 1000.0:.2g}" if units == "m"
-                                else format_feet_inches(r.focus_from_film_mm) for r in ticks], fontsize=7)
+    ax.set_xticklabels(["∞"] + [tick_label(r.focus_from_film_mm, units) for r in ticks], fontsize=7)
     ax2 = ax.twinx()
     ax2.plot(x, [r.efl_mm for r in rows], marker="s", linestyle="--", color="#c0392b", label="EFL")
     ax2.set_ylabel("effective focal length (mm)")

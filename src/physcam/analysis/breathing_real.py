@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import OpticsError, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
@@ -54,18 +55,22 @@ class RealBreathing:
                 "conventions": "focus marks in mm in front of the film plane (null = infinity); "
                                "changes relative to the first row"}
 
-    def plot(self, path=None, *, force: bool = False):
-        from ._plot import figure, save
+    def plot(self, path=None, *, force: bool = False, units: str = "m"):
+        """HFOV change against the focus mark (log axis, a tick at each mark in ``units``: m, or ft for
+        feet and inches; infinity at the right); PNG/SVG/PDF if ``path``, else the Figure."""
+        from ._plot import distance_ticks, figure, per_unit, save, unit_words
 
+        per = per_unit(units)
         fig, ax = figure(5.2, 3.6)
         marks = [r.focus_from_film_mm for r in self.rows]
         finite = [m for m in marks if math.isfinite(m)]
-        x_inf = 2 * max(finite) if finite else 1.0
-        xs = [m / 1000.0 if math.isfinite(m) else x_inf / 1000.0 for m in marks]
+        x_inf = 2 * max(finite) / per if finite else 1.0
+        ax.set_xscale("log")
+        xs = distance_ticks(ax, marks, units, x_of_inf=x_inf)
         ax.plot(xs, [r.change_paraxial_pct for r in self.rows], "o--", ms=3, label="paraxial HFOV")
         ax.plot(xs, [r.change_real_pct for r in self.rows], "s-", ms=3, label="real chief ray HFOV")
-        ax.set_xscale("log")
-        ax.set_xlabel("focus mark from the film (m; rightmost point = infinity)")
+        ax.tick_params(axis="x", labelsize=7)
+        ax.set_xlabel(f"focus mark from the film ({unit_words(units)}; rightmost point = infinity)")
         ax.set_ylabel("HFOV change (%)")
         ax.set_title(f"{self.lens_name}: focus breathing, {self.sensor_mm[0]:g} x {self.sensor_mm[1]:g} mm",
                      fontsize=8)
@@ -96,13 +101,16 @@ def real_breathing(
     lens: Prescription,
     focus_marks_mm=None,
     *,
-    sensor_width_mm: float = 36.0,
-    sensor_height_mm: float = 24.0,
+    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
+    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM,
     method: str = "auto",
     wavelength_nm: float | None = None,
     backend: str = "auto",
 ) -> RealBreathing:
-    """Real against paraxial breathing of ``lens`` (module notes); marks default as in the breathing table."""
+    """Real against paraxial breathing of ``lens`` (module notes); marks default as in the breathing table.
+
+    The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
+    """
     from ..optics.focusing import breathing_table, focus, focus_method
 
     w = require_positive("sensor width", sensor_width_mm)

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM, PGF_UNCERTAINTY
@@ -191,8 +192,8 @@ def chromatic_aberration(
     reference_nm: float = LINE_D_NM,
     zone: float = math.sqrt(0.5),
     max_field_deg: float | None = None,
-    sensor_width_mm: float = 36.0,
-    sensor_height_mm: float = 24.0,
+    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
+    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM,
     n_fields: int = 8,
     film_z: float | None = None,
     backend: str = "auto",
@@ -202,6 +203,7 @@ def chromatic_aberration(
     ``wavelengths_nm`` are reported; F and C are always added for the F-C figures. ``zone``
     (0-1] is the real ray's height as a fraction of the entrance-pupil radius. Fields in degrees
     (default: ``n_fields`` up to the sensor corner or ``max_field_deg``).
+    The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
     from ..optics.paraxial import gaussian
     from ..trace import RayBatch, paraxial_image_z, trace_through

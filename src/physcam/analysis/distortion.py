@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
@@ -186,8 +187,8 @@ def real_distortion(
     lens: Prescription,
     fields_deg=None,
     *,
-    sensor_width_mm: float = 36.0,
-    sensor_height_mm: float = 24.0,
+    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
+    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM,
     n_fields: int = 15,
     wavelength_nm: float | None = None,
     film_z: float | None = None,
@@ -199,6 +200,7 @@ def real_distortion(
     paraxial image reaches the sensor corner, or the widest field whose chief ray passes the
     lens when that is smaller). Anamorphic lenses are measured in both meridians. A field whose
     chief ray misses or is clipped raises :class:`OpticsError` naming the widest field that passes.
+    The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
     from ..optics.paraxial import gaussian_xy
     from ..trace import paraxial_image_z

@@ -36,25 +36,21 @@ class DistortionAcrossFocus:
                 "corner_distortion_definition": "100 (r_real - r_ideal) / r_ideal at the frame corner; negative = barrel",
                 "rows": [dict(r) for r in self.rows], "notes": list(self.notes)}
 
-    def plot(self, path=None, *, force: bool = False):
-        """Corner distortion and pinhole focal length against focus; PNG/SVG if ``path``."""
-        from ._plot import figure, save
+    def plot(self, path=None, *, force: bool = False, units: str = "m"):
+        """Corner distortion and pinhole focal length against focus, a tick at each mark in ``units``
+        (m, or ft for feet and inches); PNG/SVG if ``path``, else the Figure."""
+        from ._plot import distance_ticks, figure, save, unit_words
 
         fig, ax = figure(5.6, 3.6)
         finite = [r for r in self.rows if r["focus_from_film_mm"] is not None]
-        x = [r["focus_from_film_mm"] / 1000.0 for r in finite]
+        ax.set_xscale("log")
+        x = distance_ticks(ax, [r["focus_from_film_mm"] for r in finite], units)
         ax.plot(x, [r["corner_distortion_pct"] for r in finite], "o-", label="corner distortion (%)")
         inf = [r for r in self.rows if r["focus_from_film_mm"] is None]
         if inf:
             ax.axhline(inf[0]["corner_distortion_pct"], ls=":", color="0.4", label="at infinity")
-        ax.set_xscale("log")
-        from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
-
-        ax.xaxis.set_major_locator(FixedLocator(x))
-        ax.xaxis.set_major_formatter(lambda v, _: f"{v:g}")
-        ax.xaxis.set_minor_locator(NullLocator())
-        ax.xaxis.set_minor_formatter(NullFormatter())
-        ax.set_xlabel("focus from the film plane (m)")
+        ax.tick_params(axis="x", labelsize=7)
+        ax.set_xlabel(f"focus from the film plane ({unit_words(units)})")
         ax.set_ylabel("corner distortion (%)")
         ax2 = ax.twinx()
         ax2.plot(x, [r["pinhole_focal_length_mm"] for r in finite], "s--", color="C1", ms=3)

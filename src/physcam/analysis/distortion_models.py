@@ -183,9 +183,13 @@ class FittedDistortion:
             "notes": list(self.notes),
         }
 
-    def plot_residual(self, path=None, *, force: bool = False):
-        """Residual (pixels) over the frame at every traced ray, with its RMS and max; PNG/SVG if ``path``."""
-        from ._plot import figure, save
+    def plot_residual(self, path=None, *, force: bool = False, units: str = "m"):
+        """Residual (pixels) over the frame at every traced ray, with its RMS and max; the focus in the
+        title in ``units`` (m, or ft for feet and inches); PNG/SVG if ``path``."""
+        from ..units import format_distance
+        from ._plot import figure, per_unit, save
+
+        per_unit(units)
 
         w, h = self.size_px
         fig, ax = figure(6.0, 6.0 * h / w + 0.8)
@@ -197,7 +201,7 @@ class FittedDistortion:
         ax.set_aspect("equal")
         ax.set_xlabel("x (px from the left)")
         ax.set_ylabel("y (px from the bottom)")
-        focus = "infinity" if math.isinf(self.focus_from_film_mm) else f"{self.focus_from_film_mm / 1000:g} m"
+        focus = "infinity" if math.isinf(self.focus_from_film_mm) else format_distance(self.focus_from_film_mm, units)
         verdict = "acceptable" if self.acceptable else f"NOT acceptable (> {self.max_residual_allowed_px:g} px)"
         ax.set_title(f"{self.model} ({self.direction}) at focus {focus}\nresidual RMS {self.rms_residual_px:.3f} px, "
                      f"max {self.max_residual_px:.3f} px: {verdict}", fontsize=8)

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
@@ -259,8 +260,8 @@ def ghost_analysis(
     image_paths: int = 20,
     pixels: int = 256,
     chunk: int = 250_000,
-    sensor_width_mm: float = 36.0,
-    sensor_height_mm: float = 24.0,
+    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
+    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM,
     seed: int = 0,
     backend: str = "auto",
 ) -> GhostResult:
@@ -272,6 +273,7 @@ def ghost_analysis(
     ``coating``: "none", "single", "multi", or None for the lens file's coating (else "none").
     ``field_deg`` None: :data:`DEFAULT_FIELD_DEG`, or the widest field below it that light passes
     (with a note in the result) when none passes there.
+    The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
     from ..trace import paraxial_image_z, trace_to_film
 

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
@@ -228,8 +229,8 @@ def relative_illumination(
     *,
     max_field_deg: float | None = None,
     n_fields: int = 10,
-    sensor_width_mm: float = 36.0,
-    sensor_height_mm: float = 24.0,
+    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
+    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM,
     grid: int = 200,
     fresnel: bool = False,
     stop_semi_diameter: float | None = None,
@@ -243,6 +244,7 @@ def relative_illumination(
     Anamorphic lenses are evaluated in both meridians. ``grid``: rays per side of the sampling
     grid (``grid``^2 per field). ``stop_semi_diameter`` (mm) stops the lens down. A field where no
     ray passes, or whose chief ray does not, raises :class:`OpticsError`.
+    The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
     from ..optics.paraxial import gaussian_xy
     from ..trace import paraxial_image_z

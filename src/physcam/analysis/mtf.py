@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..data.default_sensor import DEFAULT_SENSOR_HALF_DIAGONAL_MM
 from ..errors import InputError, OpticsError, require_finite
 from ..lens.prescription import Prescription, takes_prescription
 
@@ -405,11 +406,21 @@ class MTFChart:
                       "tangential": {f"{f:g}": float(v) for f, v in zip(self.frequencies_lpmm, t)}}
                      for h, a, n, s, t in zip(self.image_heights_mm, self.fields_deg, self.pupil_samples,
                                               self.sagittal, self.tangential)],
+            "points": self.points(),
             "notes": list(self.notes),
             "definition": "diffraction MTF at the film plane focused at the mark; sagittal: lines radial, "
                           "tangential: lines tangential to circles about the centre; image height of the real "
                           "chief ray at the primary wavelength",
         }
+
+    def points(self) -> list[dict]:
+        """The chart as flat rows, one per image height and frequency (what ``physcam mtf --csv`` prints):
+        ``image_height_mm``, ``field_deg``, ``frequency_lpmm``, ``sagittal``, ``tangential``, ``pupil_samples``."""
+        return [{"image_height_mm": float(h), "field_deg": float(a), "frequency_lpmm": float(f), "sagittal": float(sv),
+                 "tangential": float(tv), "pupil_samples": int(n)}
+                for h, a, n, s, t in zip(self.image_heights_mm, self.fields_deg, self.pupil_samples, self.sagittal,
+                                         self.tangential)
+                for f, sv, tv in zip(self.frequencies_lpmm, s, t)]
 
     def table(self) -> str:
         """The chart as a text table (one row per image height)."""
@@ -444,9 +455,13 @@ class MTFChart:
         out.append(f"      {keys} (upper case sagittal, lower case tangential)")
         return "\n".join(out)
 
-    def plot(self, path=None, *, force: bool = False):
-        """The vendor chart: solid sagittal, dashed tangential, thicker lines for lower frequencies."""
-        from ._plot import figure, save
+    def plot(self, path=None, *, force: bool = False, units: str = "m"):
+        """The vendor chart: solid sagittal, dashed tangential, thicker lines for lower frequencies; the
+        focus in the title in ``units`` (m, or ft for feet and inches; image heights stay in mm)."""
+        from ..units import format_distance
+        from ._plot import figure, per_unit, save
+
+        per_unit(units)
 
         fig, ax = figure(6.0, 4.0)
         nf = len(self.frequencies_lpmm)
@@ -461,7 +476,7 @@ class MTFChart:
         ax.set_ylabel("MTF")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, ncol=2, loc="lower left")
-        foc = "infinity" if math.isinf(self.focus_from_film_mm) else f"{self.focus_from_film_mm / 1000:g} m"
+        foc = "infinity" if math.isinf(self.focus_from_film_mm) else format_distance(self.focus_from_film_mm, units)
         wl = ", ".join(f"{w:g}" for w in self.wavelengths_nm)
         ax.set_title(f"{self.lens_name}\nMTF at f/{self.fstop:.3g}, focus {foc}, {wl} nm "
                      "(solid sagittal, dashed tangential)", fontsize=8)
@@ -472,7 +487,7 @@ class MTFChart:
 def mtf_chart(
     lens: Prescription,
     *,
-    max_image_height_mm=21.63,
+    max_image_height_mm=DEFAULT_SENSOR_HALF_DIAGONAL_MM,
     n_fields: int = 15,
     image_heights_mm=None,
     frequencies=CHART_FREQUENCIES,
@@ -488,7 +503,8 @@ def mtf_chart(
 ) -> MTFChart:
     """The vendor MTF chart of ``lens``: sagittal and tangential MTF at ``frequencies`` (default 10,
     20, 40 lp/mm) against image height, ``n_fields`` heights from 0 to ``max_image_height_mm``
-    (default 21.63 mm, the full-frame corner) or the ``image_heights_mm`` given; white light by
+    (default 15.55 mm, the corner of the default sensor, Super 35 24.89 x 18.66 mm:
+    :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, as the CLI; 21.63 mm is a 36 x 24 mm corner) or the ``image_heights_mm`` given; white light by
     default. The pupil grids follow the MTF sampling rules up to ``max_pupil_samples`` (default 256,
     so a chart takes seconds). ``progress(done, total)`` is called after each field."""
     from . import _pupil as P

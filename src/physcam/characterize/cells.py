@@ -125,7 +125,7 @@ def _distortion_cell(lens, grid: Grid, cell: Cell, dest: Path):
         return (dest / "fits.json").read_bytes()
     w, h = grid.sensor_mm
     res = distortion_field(lens, focus_mm=cell.focus_mm, sensor_width_mm=w, sensor_height_mm=h,
-                           width_px=grid.resolution[0], height_px=grid.resolution[1],
+                           width_px=grid.frame_px[0], height_px=grid.frame_px[1],
                            wavelength_nm=cell.wavelength_nm, backend=grid.backend)
     fits = fit_models(samples_from_field(res))
     dest.parent.mkdir(parents=True, exist_ok=True)

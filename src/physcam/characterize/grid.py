@@ -38,6 +38,7 @@ import re
 from dataclasses import dataclass, replace
 from dataclasses import field as _dc_field
 
+from ..data.default_sensor import DEFAULT_SENSOR_MM
 from ..errors import InputError, require_positive, require_type
 from ..units import parse_distance
 
@@ -142,16 +143,24 @@ def _whole(name, v, lo, hi) -> int:
     return v
 
 
+#: The ST-map frame's width (pixels) when the grid gives no resolution; the height keeps pixels square.
+DEFAULT_STMAP_WIDTH_PX = 2048
+
+
 @dataclass(frozen=True)
 class Grid:
-    """What to measure on every lens (module notes). Lengths mm, wavelengths nm."""
+    """What to measure on every lens (module notes). Lengths mm, wavelengths nm.
+
+    ``sensor_mm``: default sensor Super 35 (24.89 x 18.66 mm), the CLI's
+    (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`); ``resolution`` None: the ST-map frame
+    2048 pixels wide with square pixels on that sensor (:attr:`frame_px`)."""
 
     focus_mm: tuple[float, ...]
     fstops: tuple[float, ...]
     fields: int = 5
     wavelengths_nm: tuple[float, ...] | None = None  # None: each lens's design wavelength
-    sensor_mm: tuple[float, float] = (36.0, 24.0)
-    resolution: tuple[int, int] = (2048, 1366)  # ST-map frame, pixels
+    sensor_mm: tuple[float, float] = DEFAULT_SENSOR_MM  # Super 35 (24.89 x 18.66), as the CLI
+    resolution: tuple[int, int] | None = None  # ST-map frame, pixels; None: 2048 wide, square pixels on the sensor
     psf_rays: int = 200_000
     psf_pixels: int = 64
     illumination_grid: int = 100
@@ -179,11 +188,12 @@ class Grid:
         if len(self.sensor_mm) != 2 or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
                                                and math.isfinite(v) and 1.0 <= v <= 100.0 for v in self.sensor_mm):
             raise InputError(f"the sensor is (width, height) between 1 and 100 mm, got {self.sensor_mm!r}")
-        require_type("resolution", self.resolution, (tuple, list), "(width, height) pixels")
-        if len(self.resolution) != 2:
-            raise InputError(f"the ST-map resolution is (width, height) pixels, got {self.resolution!r}")
-        _whole("ST-map width", self.resolution[0], 16, 8192)
-        _whole("ST-map height", self.resolution[1], 16, 8192)
+        res = self.frame_px
+        require_type("resolution", res, (tuple, list), "(width, height) pixels")
+        if len(res) != 2:
+            raise InputError(f"the ST-map resolution is (width, height) pixels, got {res!r}")
+        _whole("ST-map width", res[0], 16, 8192)
+        _whole("ST-map height", res[1], 16, 8192)
         _whole("rays per PSF", self.psf_rays, 1000, 10**9)
         _whole("PSF kernel pixels", self.psf_pixels, 8, 1024)
         _whole("illumination grid", self.illumination_grid, 16, 2000)
@@ -196,7 +206,16 @@ class Grid:
         if self.backend not in ("auto", "numba", "numpy"):
             raise InputError(f"backend is auto, numba or numpy, got {self.backend!r}")
         return replace(self, focus_mm=marks, fstops=stops, wavelengths_nm=wl, kinds=kinds,
-                       sensor_mm=(float(self.sensor_mm[0]), float(self.sensor_mm[1])))
+                       sensor_mm=(float(self.sensor_mm[0]), float(self.sensor_mm[1])), resolution=tuple(res))
+
+    @property
+    def frame_px(self) -> tuple[int, int]:
+        """The ST-map frame (width, height) in pixels: ``resolution``, or 2048 wide with square pixels on the
+        sensor (2048 x 1535 on Super 35) when it is None."""
+        if self.resolution is not None:
+            return self.resolution
+        w, h = self.sensor_mm
+        return DEFAULT_STMAP_WIDTH_PX, max(16, min(8192, round(DEFAULT_STMAP_WIDTH_PX * h / w)))
 
     def field_fractions(self) -> tuple[float, ...]:
         """Field positions as fractions of the half-diagonal: 0 (centre) .. 1 (corner)."""
@@ -209,7 +228,7 @@ class Grid:
                 "focus_spacing": "as given (NEAR:FAR:N spaces the marks evenly in 1/distance)",
                 "fstops": list(self.fstops), "fields": self.fields, "field_fractions": list(self.field_fractions()),
                 "wavelengths_nm": None if self.wavelengths_nm is None else list(self.wavelengths_nm),
-                "sensor_mm": list(self.sensor_mm), "resolution": list(self.resolution), "psf_rays": self.psf_rays,
+                "sensor_mm": list(self.sensor_mm), "resolution": list(self.frame_px), "psf_rays": self.psf_rays,
                 "psf_pixels": self.psf_pixels, "illumination_grid": self.illumination_grid, "kinds": list(self.kinds)}
 
 
@@ -287,7 +306,7 @@ def _settings(kind: str, grid: Grid, design_nm: float) -> dict:
     if kind == "lens":
         s.update(focus_mm=[_json_num(m) for m in grid.focus_mm], fstops=list(grid.fstops), design_nm=design_nm)
     elif kind == "distortion":
-        s.update(resolution=list(grid.resolution))
+        s.update(resolution=list(grid.frame_px))
     elif kind == "illumination":
         s.update(grid=grid.illumination_grid, fields=max(grid.fields, 2))
     elif kind == "psf":

@@ -21,11 +21,12 @@ import json
 import math
 import sys
 
+from ..data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_LABEL
 from ..errors import PhysCamError
 from ..units import UNIT_SYSTEMS, parse_distance
 
-#: The sensor every command uses when none is given (and the user config names none).
-DEFAULT_SENSOR = "Super 35"
+# DEFAULT_SENSOR: the sensor every command uses when none is given (and the user config names none);
+# one constant with the Python API's defaults (physcam.data.default_sensor).
 #: ``--focus hyperfocal``: the value :func:`focus` returns for it (resolved by :func:`resolve_focus`).
 HYPERFOCAL = "hyperfocal"
 #: Words read as an infinite focus.
@@ -208,7 +209,7 @@ def add_sensor_options(p, *, what: str = "") -> None:
     """--sensor NAME or --sensor-width/--sensor-height: the one set of sensor options."""
     g = p.add_argument_group("sensor") if what == "" else p
     g.add_argument("--sensor", metavar="NAME",
-                   help=f'sensor or gate name, e.g. "ALEXA 35" or S35 (see `physcam sensors`); default {DEFAULT_SENSOR}, '
+                   help=f'sensor or gate name, e.g. "ALEXA 35" or S35 (see `physcam sensors`); default {DEFAULT_SENSOR_LABEL}, '
                         "or `sensor` in the user config")
     g.add_argument("--sensor-width", type=distance("sensor width"), default=None, metavar="MM",
                    help="a custom sensor's width, with --sensor-height (instead of --sensor)")

@@ -172,12 +172,17 @@ def print_csv(rows, columns=None) -> None:
 
 
 # ---- plots ------------------------------------------------------------------------------------
-def save_plot(result, path, *, force: bool = False, context: str = ""):
+def save_plot(result, path, *, force: bool = False, context: str = "", units: str | None = None):
     """Save an analysis result's figure (``result.plot(None)``) with ``context`` (the shot: f-stop,
-    focus, sensor) as a line under it, so a plot says what it is of."""
+    focus, sensor) as a line under it, so a plot says what it is of. ``units`` (m or ft) reaches
+    every plot that draws scene distances (its ``plot`` takes ``units``); image-side millimetres
+    (film coordinates, spot sizes, lp/mm) stay metric."""
+    import inspect
+
     from ..figures import save_figure
 
-    fig = result.plot(None)
+    takes_units = units is not None and "units" in inspect.signature(result.plot).parameters
+    fig = result.plot(None, units=units) if takes_units else result.plot(None)
     if context:
         fig.text(0.5, 0.01, context, ha="center", va="bottom", fontsize=7, color="0.3")
         fig.tight_layout(rect=(0.0, 0.05, 1.0, 1.0))

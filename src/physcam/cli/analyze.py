@@ -4,7 +4,7 @@
 
 Top-level commands, like ``physcam spot`` and ``physcam bokeh``. Each prints a table (``--csv``
 for its rows), or JSON with ``--json``, and writes a plot with ``-o FILE.png`` (never over a file
-unless ``--force``). The sensor is the one default (Super 35) unless given. Without ``--field``
+unless ``--force``). The sensor is the one default (Super 35, 24.89 x 18.66 mm) unless given. Without ``--field``
 or ``--max-field`` the fields reach the sensor corner, clamped (with a note) to what the lens
 images, as ``physcam distortion`` does.
 """
@@ -118,7 +118,9 @@ def _finish(args, res, command: str) -> None:
     if args.output:
         from ._output import save_plot
 
-        save_plot(res, args.output, force=args.force, context=plot_context(args))
+        from ._common import units_of
+
+        save_plot(res, args.output, force=args.force, context=plot_context(args), units=units_of(args))
     d = mark_repaired(res.to_dict(), args.loaded_lens)
     if getattr(args, "sensor_name", None):
         d["sensor"] = args.sensor_name

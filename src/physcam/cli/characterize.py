@@ -50,8 +50,9 @@ def register(sub) -> None:
                    help="cell kinds to make: lens (breathing, pupils), distortion (ST-maps, fits), illumination, "
                         "psf (default all)")
     _sensor(p)
-    p.add_argument("--resolution", type=_resolution, default=(2048, 1366), metavar="WxH",
-                   help="ST-map frame size in pixels (default 2048x1366)")
+    p.add_argument("--resolution", type=_resolution, default=None, metavar="WxH",
+                   help="ST-map frame size in pixels (default 2048 wide with square pixels on the sensor: "
+                        "2048x1535 on Super 35)")
     p.add_argument("--rays", type=_whole("rays", 1000, 10**9), default=200_000, metavar="N",
                    help="rays per PSF kernel (default 200000)")
     p.add_argument("--psf-pixels", type=_whole("PSF pixels", 8, 1024), default=64, metavar="PX",
@@ -89,7 +90,7 @@ def _grid(args):
                 fields=args.fields,
                 wavelengths_nm=None if args.wavelengths is None else parse_numbers(
                     args.wavelengths, "wavelengths (nm)", lo=300.0, hi=1100.0, most=MAX_WAVELENGTHS),
-                sensor_mm=(args.sensor_width, args.sensor_height), resolution=tuple(args.resolution),
+                sensor_mm=(args.sensor_width, args.sensor_height), resolution=None if args.resolution is None else tuple(args.resolution),
                 psf_rays=args.rays, psf_pixels=args.psf_pixels, illumination_grid=args.grid,
                 kinds=tuple(k.strip() for k in str(args.kinds).split(",") if k.strip())).checked()
 

@@ -113,7 +113,9 @@ def run_blender(args) -> int:
                         blender_python=args.blender_python)
     table = {k: v for k, v in res.items() if k != "images"}
     atomic_write(js, json.dumps(table, indent=2, allow_nan=False) + "\n", force=args.force)
-    _figure(res, png, force=args.force)
+    from ._common import units_of
+
+    _figure(res, png, force=args.force, units=units_of(args))
     if args.json:
         from ._output import document, emit_json
 
@@ -134,13 +136,15 @@ def run_blender(args) -> int:
     return 0
 
 
-def _figure(res, path, *, force):
+def _figure(res, path=None, *, force=False, units="m"):
+    """physcam's and Cycles' bokeh side by side; the light and focus distances in the title in ``units``
+    (m, or ft for feet and inches; film coordinates stay in mm). Saved to ``path``, or the Figure."""
     import numpy as np
 
-    from ..figures import pyplot, save_figure
+    from ..figures import save_figure, subplots
+    from ..units import format_distance
 
-    plt = pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(7.4, 3.8))
+    fig, axes = subplots(1, 2, figsize=(7.4, 3.8))
     h = res["crop_mm"] / 2
     for ax, key, title in zip(axes, ("physcam", "cycles"), ("physcam (numba tracer)", "Cycles (OSL camera)")):
         img = res["images"][key]
@@ -150,9 +154,9 @@ def _figure(res, path, *, force):
         ax.set_title(f"{title}\nequivalent diameter {d:.4f} mm", fontsize=9)
         ax.set_xlabel("film x (mm)")
     axes[0].set_ylabel("film y (mm)")
-    fig.suptitle(f"{res['lens']}: light {res['light_from_film_mm'] / 1000:g} m, focus "
-                 f"{res['focus_from_film_mm'] / 1000:g} m, f/{res['fstop']:g}", fontsize=10)
-    return save_figure(fig, path, force=force)
+    fig.suptitle(f"{res['lens']}: light {format_distance(res['light_from_film_mm'], units)}, focus "
+                 f"{format_distance(res['focus_from_film_mm'], units)}, f/{res['fstop']:g}", fontsize=10)
+    return fig if path is None else save_figure(fig, path, force=force)
 
 
 # ---- physcam compare LENS_A LENS_B ... ------------------------------------------------------------
@@ -361,8 +365,10 @@ def run_lenses(args) -> int:
     return 0
 
 
-def compare_figure(rows, curves, path, *, sensor, units="m", force=False):
-    """One figure: breathing, distortion and illumination curves of every lens, and their bokeh."""
+def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False):
+    """One figure: breathing, distortion and illumination curves of every lens, and their bokeh; the focus
+    and light distances in the title and the breathing axis (1 / mark) in ``units`` (m, or ft for feet
+    and inches; film coordinates and bokeh sizes stay in mm). Saved to ``path``, or the Figure."""
     import numpy as np
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -420,4 +426,4 @@ def compare_figure(rows, curves, path, *, sensor, units="m", force=False):
                  f"{sensor.height_mm:g} mm); bokeh: light at {format_distance(r0['bokeh_light_from_film_mm'], units)}",
                  fontsize=9)
     fig.tight_layout()
-    return save_figure(fig, path, force=force)
+    return fig if path is None else save_figure(fig, path, force=force)

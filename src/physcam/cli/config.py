@@ -24,7 +24,7 @@ def register(sub) -> None:
     s = p.add_subparsers(dest="config_command", metavar="ACTION")
     show = s.add_parser("show", help="print the config file's path and every default (its value and where it comes from)",
                         epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_output_options(show, what="the config")
+    add_output_options(show, csv=True, what="the config")
     show.set_defaults(handler=run_show)
     p.set_defaults(handler=lambda args: (p.print_help(), 0)[1])
 
@@ -42,21 +42,28 @@ def effective() -> dict:
         given = v is not None
         out[key] = {"value": (str(v) if key == "output_dir" and given else v) if given else default,
                     "source": str(cfg.path) if given else "default"}
-    return {"path": None if cfg.path is None else str(cfg.path), "exists": cfg.exists, "settings": out}
+    from ._config import KEYS
+
+    rows = [{"key": k, "value": v["value"], "source": v["source"], "meaning": KEYS[k]} for k, v in out.items()]
+    return {"path": None if cfg.path is None else str(cfg.path), "exists": cfg.exists, "settings": out, "rows": rows}
 
 
 def run_show(args) -> int:
-    from ._config import KEYS
     from ._output import Table, document, emit_json, print_table
 
     d = effective()
     if args.json:
         emit_json(document("config", d, units={}))
         return 0
+    if args.csv:
+        from ._output import print_csv
+
+        print_csv(d["rows"])
+        return 0
     where = d["path"] or "(none: PHYSCAM_CONFIG is empty)"
     print(f"config file: {where}" + ("" if d["exists"] else "  (not there: physcam's defaults apply)"))
     t = Table(None, ("key", "value", "from", "meaning"))
-    for key, s in d["settings"].items():
-        t.add_row(key, "-" if s["value"] is None else str(s["value"]), s["source"], KEYS[key])
+    for r in d["rows"]:
+        t.add_row(r["key"], "-" if r["value"] is None else str(r["value"]), r["source"], r["meaning"])
     print_table(t)
     return 0

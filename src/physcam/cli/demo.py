@@ -36,6 +36,9 @@ def register(sub) -> None:
                    help="folder to write (default demo-output)")
     hidden_alias(p, "--out", "out")
     p.add_argument("--force", action="store_true", help="overwrite files already in the folder")
+    from ._common import add_units_option
+
+    add_units_option(p)
     add_output_options(p, what="the list of written files")
     p.set_defaults(handler=run)
 
@@ -79,12 +82,12 @@ def _report_step(out, ctx, force):
     d["cameras"] = camera_blocks(report, ns)
     con = console()
     with con.capture() as cap:
-        con.print(report_table(report))
+        con.print(report_table(report, ctx.get("units", "m")))
     ctx["table"] = cap.get()
     return [
         atomic_write(out / "report.json", json.dumps(d, indent=2, allow_nan=False) + "\n", force=force),
         atomic_write(out / "report.txt", ctx["table"], force=force),
-        plot_dof_zone(report, out / "dof.png", force=force),
+        plot_dof_zone(report, out / "dof.png", force=force, units=ctx.get("units", "m")),
     ]
 
 
@@ -110,9 +113,10 @@ def _lens_step(out, ctx, force):
     rows = focusing.breathing_table(lens, [600.0, 1000.0, 2000.0, 5000.0, math.inf], sensor_width_mm=sensor.width_mm)
     return [
         atomic_write(out / "lens.json", text + "\n", force=force),
-        save_lens_diagram(lens, out / "lens_diagram.png", force=force, fstop=DEFAULTS["fstop"]),
+        save_lens_diagram(lens, out / "lens_diagram.png", force=force, fstop=DEFAULTS["fstop"],
+                          units=ctx.get("units", "m")),
         save_breathing_plot(rows, out / "breathing.png", force=force, title=f"focus breathing: {lens.name}",
-                            sensor_width_mm=sensor.width_mm),
+                            sensor_width_mm=sensor.width_mm, units=ctx.get("units", "m")),
     ]
 
 
@@ -200,8 +204,10 @@ def run(args) -> int:
     from ._common import console
     from ._output import document, emit_json
 
+    from ._common import units_of
+
     out = Path(args.out)
-    ctx: dict = {}
+    ctx: dict = {"units": units_of(args)}  # scene distances on the plots: --units, else the user config's
     written = []
     err = console(stderr=True)
     for name, step in _steps():

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from ._common import FOCUS_HELP, add_units_option, focus, focus_list, number
+from ._common import FOCUS_HELP, add_units_option, focus, focus_list, number, units_of
 from ._output import document, emit_json, print_csv
 from .lens import WAVE_UNITS, mark_repaired
 
@@ -122,7 +122,9 @@ def _run_across_focus(args, lens) -> int:
                                   sensor_height_mm=args.sensor_height, width_px=args.resolution[0],
                                   height_px=args.resolution[1], wavelength_nm=args.wavelength)
     if args.output:
-        tab.plot(args.output, force=args.force)
+        from ._common import units_of
+
+        tab.plot(args.output, force=args.force, units=units_of(args))
     if args.json:
         emit_json(document("distortion_across_focus", mark_repaired(tab.to_dict(), args.loaded_lens),
                            units=dict(WAVE_UNITS, image="pixel")))
@@ -163,6 +165,7 @@ def _fit_payloads(args, res, fits, folder):
     from ..analysis.distortion_models import BrownConrady, TDE4RadialStandard, USDStandard
     from ..export.nuke import nuke_stmap_script
     from ..export.tde4 import tde4_lens_text
+    from ._common import units_of
 
     d = Path(folder)
     out = []
@@ -184,7 +187,7 @@ def _fit_payloads(args, res, fits, folder):
         slug = {"D-U": "_du", "U-D": "_ud"}.get(f.direction, "") if isinstance(f, BrownConrady) else ""
         stem = ("brown_conrady" + slug if isinstance(f, BrownConrady)
                 else "3de4" if isinstance(f, TDE4RadialStandard) else "usd")
-        out.append((d / f"residual_{stem}.png", _png(f)))
+        out.append((d / f"residual_{stem}.png", _png(f, units_of(args))))
     if "nuke" in args.fit:
         w, h = res.size_px
         ox, oy = res.overscan_px
@@ -194,13 +197,13 @@ def _fit_payloads(args, res, fits, folder):
     return out
 
 
-def _png(fit) -> bytes:
+def _png(fit, units: str = "m") -> bytes:
     import tempfile
     from pathlib import Path
 
     with tempfile.TemporaryDirectory() as tmp:
         p = Path(tmp) / "r.png"
-        fit.plot_residual(p)
+        fit.plot_residual(p, units=units)
         return p.read_bytes()
 
 
@@ -234,7 +237,9 @@ def _run_field(args, lens) -> int:
         emit_json(document("distortion_field", mark_repaired(d, args.loaded_lens),
                            units=dict(WAVE_UNITS, image="pixel")))
         return 0
-    f = "infinity" if d["focus_from_film_mm"] is None else f"{d['focus_from_film_mm']:g} mm"
+    from ..units import format_distance
+
+    f = format_distance(res.focus_from_film_mm, units_of(args))
     print(f"{res.lens_name}: distortion field at focus {f}, {res.size_px[0]}x{res.size_px[1]} px, "
           f"pinhole f {res.pinhole_focal_length_mm[1]:.3f} mm (Y; the paraxial one at this focus) at the entrance pupil")
     print(f"  largest distortion {res.max_distortion_px:.2f} px; interpolation error {res.interpolation_error_px:.4f} px "

@@ -50,7 +50,7 @@ def register(sub) -> None:
     s.add_argument("--flange", type=distance("flange focal distance"), default=None, metavar="FFD",
                    help="flange focal distance (e.g. 52mm for PL) to give positions from the flange too")
     add_units_option(s)
-    add_output_options(s, what="the Gaussian data")
+    add_output_options(s, csv=True, what="the Gaussian data")
     s.set_defaults(handler=run_show)
 
     d = lsub.add_parser("diagram", help="draw elements, stop, rays and cardinal points to PNG/SVG/PDF")
@@ -229,8 +229,32 @@ def _show_document(p, data, focus_info) -> dict:
     from ._output import document
 
     return document("lens_show", mark_repaired({"lens": p.name, "squeeze": p.squeeze, "focus": focus_info,
-                                                "meridians": {a: g.to_dict() for a, g in data.items()}}, p),
+                                                "meridians": {a: g.to_dict() for a, g in data.items()},
+                                                "points": show_points(data)}, p),
                     units=WAVE_UNITS)
+
+
+#: The columns of ``physcam lens show --csv``: (key, reference plane of GaussianData.positions).
+POINT_COLUMNS = (("from_front_vertex_mm", "front_vertex"), ("from_rear_vertex_mm", "rear_vertex"),
+                 ("in_front_of_film_mm", "film"), ("in_front_of_flange_mm", "flange"))
+
+
+def show_points(data) -> list[dict]:
+    """The positions table of ``lens show`` as flat rows (``--csv``; ``points`` in its JSON): one per meridian
+    and cardinal point, its distance from each reference plane (from the front vertex it is lens-space z;
+    vertices: + toward the film; film and flange: in front, + toward the subject; ``None`` at infinity or
+    without --flange)."""
+    from ..optics import paraxial
+
+    out = []
+    for a, g in data.items():
+        pos = {ref: g.positions(ref) for _, ref in POINT_COLUMNS if ref != "flange" or g.flange_focal_distance is not None}
+        for point in paraxial.CARDINAL_POINTS:
+            row = {"meridian": a, "point": point}
+            for key, ref in POINT_COLUMNS:
+                row[key] = pos[ref][point] if ref in pos else None
+            out.append(row)
+    return out
 
 
 def run_show(args) -> int:
@@ -242,6 +266,11 @@ def run_show(args) -> int:
     p, st, data, focus_info = show_data(args)
     if args.json:
         emit_json(_show_document(p, data, focus_info))
+        return 0
+    if args.csv:
+        from ._output import print_csv
+
+        print_csv(show_points(data))
         return 0
     g0 = data["y"]
     print(f"{p.name}  (wavelength {g0.wavelength_nm:g} nm, focus {format_distance(st.focus_from_film_mm, units_of(args))} "

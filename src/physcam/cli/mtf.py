@@ -2,7 +2,8 @@
 
 The chart: sagittal and tangential MTF at 10, 20 and 40 lp/mm against image height, white
 light (d, F, C), the lens focused at ``--focus`` and stopped to ``--fstop``; printed as a table
-and drawn in characters, ``-o FILE.png`` for the picture, ``--json`` for pipelines.
+and drawn in characters, ``-o FILE.png`` for the picture, ``--json`` and ``--csv`` (one row per
+image height and frequency) for pipelines.
 ``--field DEG`` reports one field instead: RMS and peak-to-valley wavefront, Strehl ratio and
 the MTF at the frequencies (``-o`` draws its MTF curve).
 """
@@ -12,7 +13,7 @@ from __future__ import annotations
 import math
 
 from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number
-from ._output import add_output_options, document, emit_json
+from ._output import add_output_options, document, emit_json, print_csv
 from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
 #: The CLI's largest pupil grids (the Python API goes to 1024): bound a chart's time and memory
@@ -26,6 +27,7 @@ examples:
   physcam mtf dgauss_50mm --fstop 2.8 --sensor "ALEXA 35" -o mtf.png
   physcam mtf dgauss_50mm --fstop 8 --field 14                  (one field: RMS, Strehl, MTF)
   physcam mtf dgauss_50mm --wavelength 550 --frequency 10 --frequency 30 --json
+  physcam mtf dgauss_50mm --fstop 4 --csv > mtf.csv                 (one row per image height and frequency)
 """
 
 
@@ -59,7 +61,7 @@ def register(sub) -> None:
                         "with --field; default chosen by the sampling rules)")
     add_sensor_options(p)
     add_units_option(p)
-    add_output_options(p, what="the chart (or the field's figures)")
+    add_output_options(p, csv=True, what="the chart (or the field's figures)")
     p.add_argument("-o", "--output", metavar="FILE.png", help="write the chart (or the field's MTF curve) as PNG/SVG/PDF")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(handler=run)
@@ -103,16 +105,21 @@ def run(args) -> int:
     from ._common import progress_bar
 
     top = sensor.diagonal_mm / 2 if args.max_height is None else args.max_height
-    with progress_bar("MTF chart", enabled=not args.json) as bar:
+    with progress_bar("MTF chart", enabled=not (args.json or args.csv)) as bar:
         chart = mtf_chart(lens, max_image_height_mm=top, n_fields=args.fields, frequencies=freqs, wavelengths_nm=wls,
                           weights=weights, fstop=args.fstop, focus_mm=focus, pupil_samples=args.pupil_samples,
                           max_pupil_samples=CHART_MAX_PUPIL_SAMPLES, progress=bar)
     if args.output:
-        chart.plot(args.output, force=args.force)
+        from ._common import units_of
+
+        chart.plot(args.output, force=args.force, units=units_of(args))
     if args.json:
         d = chart.to_dict()
         d["sensor"] = {"name": sensor.name, "width_mm": sensor.width_mm, "height_mm": sensor.height_mm}
         emit_json(document("mtf_chart", mark_repaired(d, lens), units=dict(WAVE_UNITS, frequency="lp/mm")))
+        return 0
+    if args.csv:
+        print_csv(chart.points())
         return 0
     from ..units import format_distance
     from ._common import units_of
@@ -131,6 +138,18 @@ def run(args) -> int:
     return 0
 
 
+def _field_points(m) -> list[dict]:
+    """One field's MTF as flat rows, one per frequency (``--csv`` with ``--field``; ``points`` in its JSON)."""
+
+    def at(a, i):
+        return None if a is None else float(a[i])
+
+    return [{"field_deg": float(m.field_deg), "frequency_lpmm": float(f), "sagittal": float(m.sagittal[i]),
+             "tangential": float(m.tangential[i]), "diffraction_limit_sagittal": at(m.diffraction_limit_sagittal, i),
+             "diffraction_limit_tangential": at(m.diffraction_limit_tangential, i)}
+            for i, f in enumerate(m.frequencies_lpmm)]
+
+
 def _one_field(args, lens, wls, weights, freqs, focus) -> int:
     from ..analysis.mtf import mtf
     from ..analysis.psf import psf
@@ -146,10 +165,14 @@ def _one_field(args, lens, wls, weights, freqs, focus) -> int:
         curve = mtf(lens, args.field, wavelengths_nm=wls, weights=weights, pupil_samples=args.pupil_samples,
                     max_pupil_samples=CLI_MAX_PUPIL_SAMPLES, **kw)
         curve.plot(args.output, force=args.force)
+    points = _field_points(m)
     if args.json:
         emit_json(document("mtf_field", mark_repaired({"wavefront": wf.to_dict(), "psf": ps.to_dict(),
-                                                        "mtf": m.to_dict()}, lens),
+                                                        "mtf": m.to_dict(), "points": points}, lens),
                            units=dict(WAVE_UNITS, wavefront="waves", frequency="lp/mm", psf="um")))
+        return 0
+    if args.csv:
+        print_csv(points)
         return 0
     print(f"{wf.lens_name}: field {wf.field_deg:g} deg (chief ray at {wf.chief_image_height_mm:.3f} mm), "
           f"f/{wf.fstop:.3g}")

@@ -157,8 +157,8 @@ def cli_backend():
     def dof_svg(q):
         from ..onset.dof_plot import dof_zone_figure
 
-        rep, _ = solved(q)
-        return _svg(dof_zone_figure(rep, size_in=(4.5, 2.6)))
+        rep, args = solved(q)  # the page asks for feet with units=ft (never the server's user config)
+        return _svg(dof_zone_figure(rep, size_in=(4.5, 2.6), units=args.units or "m"))
 
     def sensors(q):
         from ..onset.sensors import sensors as all_sensors
@@ -177,7 +177,7 @@ def cli_backend():
         from ..lens.library import load_lens
 
         args = parsers["diagram"].parse_args([*_options(q), "--output=diagram.svg", "--", _bundled(name)])
-        fig = lens_diagram(load_lens(args.lens), **diagram_options(args)).figure()
+        fig = lens_diagram(load_lens(args.lens), **diagram_options(args)).figure(units=args.units or "m")
         return _svg(fig, dpi=150)
 
     return Backend(report=report, dof_svg=dof_svg, sensors=sensors, lenses=lenses_document, lens=lens,

@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+from ..data.default_sensor import DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 from . import paraxial
@@ -409,7 +410,7 @@ def breathing_table(
     prescription: Prescription,
     focus_marks_mm=None,
     *,
-    sensor_width_mm: float = 36.0,
+    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
     method: str = "auto",
     wavelength_nm=None,
 ) -> list[BreathingRow]:
@@ -418,7 +419,8 @@ def breathing_table(
     ``focus_marks_mm``: marks from the film plane (default: infinity, 10 m, 5 m, ...
     down to the closest focus). The horizontal field uses the X meridian (the squeezed one of
     an anamorphic) with the lens focused in Y; HFOV = 2 atan(...) of the paraxial
-    chief ray reaching the sensor edge (``sensor_width_mm``/2 off axis).
+    chief ray reaching the sensor edge (``sensor_width_mm``/2 off axis; default the width of Super 35,
+    24.89 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, as the CLI).
     """
     w = require_positive("sensor width", sensor_width_mm)
     if not 1e-6 <= w <= 1000.0:  # a 5e-324 mm "sensor" has no field angle to divide by

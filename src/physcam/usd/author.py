@@ -32,6 +32,7 @@ import math
 import struct
 from dataclasses import dataclass
 
+from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import ExportError, InputError, require_finite, require_positive, require_type
 from ..export.renderman import shutter_opening_curve  # re-exported: the one copy of seed 002's ramps
 from .plugin import ensure_registered, require_stage
@@ -65,6 +66,8 @@ class CameraSpec:
     """A physical camera as plain numbers (mm, seconds, degrees), what the schema stores.
 
     ``focus_mm`` is measured in front of the film plane (the on-set mark).
+    ``sensor_width_mm`` x ``sensor_height_mm``: default sensor Super 35 (24.89 x 18.66 mm), the CLI's
+    (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`).
     ``entrance_pupil_mm``: the pupil in front of the film plane; ``None`` uses the thin
     lens (the pupil on the principal plane, s' in front of the film).
     ``principal_planes_mm``: (H1, H2) in front of the film plane, from a datasheet or a
@@ -84,8 +87,8 @@ class CameraSpec:
     """
 
     focal_length_mm: float = 50.0
-    sensor_width_mm: float = 36.0
-    sensor_height_mm: float = 24.0
+    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM  # Super 35 (24.89 x 18.66 mm), as the CLI
+    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM
     fstop: float = 8.0
     focus_mm: float = 3000.0
     coc_mm: float = 0.03

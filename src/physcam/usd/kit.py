@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import ExportError, InputError, require_type
 from .author import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec, author_camera, author_render_camera, new_stage, save_stage
 from .read import companion_inputs, companion_inputs_hash, composed_prescription
@@ -476,11 +477,13 @@ def best_match_pinhole(prescription, *, focus_mm: float, fstop: float | None, se
     return spec_from_report(report), report
 
 
-def prescription_distortion(prescription, sensor_width_mm: float = 36.0, sensor_height_mm: float = 24.0, *,
+def prescription_distortion(prescription, sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
+                            sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM, *,
                             focus_mm: float = math.inf):
     """Hydra's "standard" lensDistortion fitted to ``prescription``'s real chief rays over the whole
     frame at the shot's focus ``focus_mm`` (:func:`physcam.analysis.distortion_models.fit_usd_standard`
-    on a 2048-pixel-wide frame). Where the lens does not cover the frame's corners, the radial fit of
+    on a 2048-pixel-wide frame of the sensor, default Super 35, 24.89 x 18.66 mm). Where the lens
+    does not cover the frame's corners, the radial fit of
     :mod:`physcam.analysis.distortion` (object at infinity, fields up to what passes) is used, with a warning.
     """
     import warnings
@@ -557,7 +560,8 @@ def _author_prescription(stage, path, rx, focus_mm: float):
 
 
 def write_vendor_lens(file, prescription, *, focus_mm: float, fstop: float | None = None,
-                      sensor_width_mm: float = 36.0, sensor_height_mm: float = 24.0, coc_mm: float = 0.03,
+                      sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM, sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM,
+                      coc_mm: float = 0.03,
                       use: str = "pinhole", force: bool = False, meters_per_unit: float = 0.01, fps: float = 24.0):
     """A vendor lens file: ``/Lens`` with a Prescription model, its best-match Pinhole, and a ``lensModel`` variant.
 
@@ -566,7 +570,8 @@ def write_vendor_lens(file, prescription, *, focus_mm: float, fstop: float | Non
     file (:func:`write_shot`) keeps the body's sensor, ISO, flange and placement, and computes
     the companion camera and the lens distortion for that body's sensor. ``sensor_width_mm``
     and ``sensor_height_mm`` only choose the sensor of the lens report the pinhole is solved
-    with (the best-match pinhole itself does not depend on the sensor).
+    with (the best-match pinhole itself does not depend on the sensor; default Super 35, 24.89 x 18.66 mm,
+    :data:`physcam.data.default_sensor.DEFAULT_SENSOR`).
 
     ``use`` ("pinhole" or "prescription") is the default variant: it sets the lens's
     ``lensModel`` relationship, i.e. which model renders.

@@ -209,7 +209,7 @@ function render(d) {
 
 function chart(api) {
   const img = $("dof-chart");
-  const src = `/api/dof.svg?${api}`;
+  const src = `/api/dof.svg?${api}${st.units === "imperial" ? "&units=ft" : ""}`;
   if (img.getAttribute("src") !== src) {
     img.hidden = false;
     img.setAttribute("src", src);
@@ -266,6 +266,7 @@ function diagram(d) {
   }
   sec.hidden = false;
   const q = new URLSearchParams({ focus: String(d.focus_from_film_mm), fstop: String(d.fstop) });
+  if (st.units === "imperial") q.set("units", "ft");
   const src = `/api/lens/${encodeURIComponent(val("lens"))}/diagram.svg?${q}`;
   const img = $("diagram");
   if (img.getAttribute("src") !== src) {
