@@ -204,3 +204,20 @@ def test_focus_hyperfocal_on_lens_commands(capsys):
     assert rc == 0 and "hyperfocal focus" in err
     assert json.loads(out)["focus"]["focus_from_film_mm"] == pytest.approx(r["focus_from_film_mm"], rel=1e-12)
     assert math.isfinite(r["focus_from_film_mm"])
+
+
+# ---- review findings (2026-11-23): options that did nothing, lists with holes, messages -------------
+@pytest.mark.parametrize("argv, says", [
+    (["dof-table", "--focal", "50", "--fstops", "2,,4"], "'2,,4' has an empty item"),
+    (["dof-table", "--focal", "50", "--fstops", "2", "--focus", "1m,,2m"], "'1m,,2m' has an empty item"),
+    (["report", "--focal", "50", "--fstop", "2", "--focus", "2m", "--pupil-fraction", "5"],
+     "--pupil-fraction places the tape-measure pupil estimate"),
+    (["bokeh", "dgauss_50mm", "--rays", "0"], "bokeh rays must lie between 1 and 1e11, got 0"),
+    (["bokeh", "dgauss_50mm", "--pixels", "4"], "bokeh pixels must lie between 8 and 4096, got 4"),
+    (["bokeh", "dgauss_50mm", "--light", "0"], "light distance"),
+    (["distortion", "dgauss_50mm", "--fit", "brown"], "--fit needs --resolution"),
+])
+def test_refusals_name_what_is_wrong(capsys, argv, says):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("physcam: error:") and says in err[0], err

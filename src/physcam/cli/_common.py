@@ -113,9 +113,11 @@ def focus_list(name: str = "focus distances"):
     one = focus(name)
 
     def parse(text):
-        parts = [t.strip() for t in str(text).split(",") if t.strip()]
-        if not parts:
+        parts = [t.strip() for t in str(text).split(",")]
+        if not any(parts):
             raise argparse.ArgumentTypeError(f"give {name} separated by commas, e.g. 1m,2m,5m,hyperfocal,inf")
+        if not all(parts):
+            raise argparse.ArgumentTypeError(f"{text!r} has an empty item: give {name} separated by single commas")
         return [one(t) for t in parts]
 
     parse.__name__ = name

@@ -67,7 +67,8 @@ def run_distortion(args) -> int:
     needs = [n for n, v in (("--focus", args.focus), ("--stmap", args.stmap), ("--fit", args.fit),
                             ("--across-focus", args.across_focus)) if v is not None]
     if args.resolution is None and needs:
-        raise InputError(f"{', '.join(needs)} need --resolution WxH (the frame size in pixels)")
+        raise InputError(f"{', '.join(needs)} {'needs' if len(needs) == 1 else 'need'} --resolution WxH "
+                         "(the frame size in pixels)")
     if args.across_focus is not None and (args.focus is not None or args.stmap or args.fit):
         raise InputError("--across-focus makes a table of its own focus marks: give it without --focus, --stmap "
                          "and --fit")

@@ -30,9 +30,11 @@ def _fstops(text):
     import argparse
 
     one = number("f-stop", positive=True)
-    parts = [t.strip() for t in str(text).split(",") if t.strip()]
-    if not parts:
+    parts = [t.strip() for t in str(text).split(",")]
+    if not any(parts):
         raise argparse.ArgumentTypeError("give f-stops separated by commas, e.g. 2,2.8,4,5.6")
+    if not all(parts):
+        raise argparse.ArgumentTypeError(f"{text!r} has an empty item: give f-stops separated by single commas")
     if len(parts) > 24:
         raise argparse.ArgumentTypeError(f"a table takes up to 24 f-stops, got {len(parts)}")
     return [one(t.removeprefix("f/").removeprefix("T")) for t in parts]
