@@ -145,11 +145,10 @@ def test_technical_examples_are_physically_consistent(capsys):
         assert abs(d["focus_error_mm"]) < 0.05, (argv, d["focus_error_mm"])
 
 
-@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+@pytest.mark.parametrize("page", [p for p in PAGES if doc_commands(p)], ids=lambda p: p.name)
 def test_every_command_of_the_page_runs(page, tmp_path, capsys):
+    # pages that show no command (architecture, conventions, ...) have nothing to run: not parametrized
     cmds = doc_commands(page)
-    if not cmds:
-        pytest.skip(f"{page.name} shows no physcam command")
     for make in INPUTS:
         make(tmp_path)
     old = os.getcwd()
