@@ -41,8 +41,8 @@ def test_the_picture_does_not_depend_on_the_chunk_size():
 
 
 def test_spectral_rays_split_evenly_between_the_wavelengths():
-    # the third R_3 coordinate picks the wavelength: with no colour-dependent losses to speak of on
-    # the axis, each channel gets a third of the flux (random choice would be off by ~1/sqrt(n/3))
+    # ray i goes to wavelength i mod 3, each wavelength with its own Sobol sequence: with no
+    # colour-dependent losses to speak of on the axis, each channel gets a third of the flux
     lens, film_z = _scene()
     img = bokeh_image(lens, 1000.0, film_z=film_z, rays=30_000, pixels=32, spectral=True, fresnel=False)
     share = img.image.sum(axis=(0, 1)) / img.image.sum()

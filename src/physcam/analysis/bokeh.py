@@ -2,11 +2,11 @@
 
 The light sits at lateral position (``x_mm``, ``y_mm``) and ``depth_mm`` in front of the film
 plane (docs/conventions.md: lens-space z = film_z - depth). Rays leave it toward points spread
-uniformly over the front element's clear disk, low-discrepancy points (randomly shifted R_2,
-:mod:`physcam.trace.lowdiscrepancy`; ``seed`` sets the shift) mapped to the disk by
-r = R sqrt(u), phi = 2 pi v: an image binned from them is as clean as one from about four times
-as many independent random rays (docs/ray-tracing.md, "Bokeh sampling"); each carries the solid
-angle it stands for, dA cos^3(theta) / dz^2 (dz the axial distance from the light to the front
+uniformly over the front element's clear disk: shuffled Owen-scrambled Sobol points
+(:mod:`physcam.trace.lowdiscrepancy`; ``seed`` sets the scrambling; one sequence per wavelength)
+mapped to the disk by r = R sqrt(u), phi = 2 pi v. An image binned from them is as clean as one
+from several times as many independent random rays (docs/ray-tracing.md, "Bokeh sampling").
+Each ray carries the solid angle it stands for, dA cos^3(theta) / dz^2 (dz the axial distance from the light to the front
 vertex plane), times Fresnel transmission. Rays are traced to the film in chunks of ``chunk``
 and binned into a ``pixels`` x ``pixels`` image, so memory stays bounded (about 0.2 KB per ray
 in a chunk: 1e8 rays in chunks of 1e6 use well under 1 GB). The image shows cat's-eye
@@ -104,7 +104,7 @@ def bokeh_image(
     bundled lens is in docs/ray-tracing.md); the image is accumulated in double either way.
     """
     from ..trace import RayBatch, paraxial_image_z, trace_to_film
-    from ..trace.lowdiscrepancy import kronecker_points, random_shift
+    from ..trace.lowdiscrepancy import owen_sobol_2d, random_seed
 
     depth = require_positive("light distance (depth_mm, --light)", depth_mm)
     x_mm = require_finite("light x", x_mm)
@@ -126,19 +126,34 @@ def bokeh_image(
     dtype = np.float64 if precision == "double" else np.float32
     r_front = lens.surfaces[0].semi_diameter
     wls = RGB_WAVELENGTHS_NM if spectral else (lens.wavelength_nm,)
-    # R_2 points on the front element (R_3 with the third coordinate choosing the wavelength when
-    # spectral), randomly shifted by the seed: module notes
-    shift = random_shift(np.random.default_rng(seed), 3 if len(wls) > 1 else 2)
+    # Owen-scrambled Sobol points on the front element, one sequence per wavelength (ray i goes to
+    # wavelength i mod k, as point i // k of that wavelength's sequence): module notes
+    rng = np.random.default_rng(seed)
+    seeds = [random_seed(rng) for _ in wls]
     wl_of = np.asarray(wls, dtype=np.float64)
+    k = len(wls)
+
+    def points(n, start):
+        if k == 1:
+            u, v = owen_sobol_2d(n, start, seeds[0])
+            return u, v, np.zeros(n, dtype=np.intp)
+        u, v, ch = np.empty(n), np.empty(n), np.empty(n, dtype=np.intp)
+        for c in range(k):
+            i0 = start + (c - start) % k  # the first ray of this chunk that goes to wavelength c
+            cnt = len(range(i0, start + n, k))
+            if cnt:
+                sl = slice(i0 - start, None, k)
+                u[sl], v[sl] = owen_sobol_2d(cnt, i0 // k, seeds[c])
+                ch[sl] = c
+        return u, v, ch
 
     def batch(n, start, dt=dtype):
         # Rays from the light to points uniform on the front element's disk, built column by column
         # (the arithmetic of RayBatch.from_arrays, without its checks: every number here is finite
         # and every direction has dz = -z_src > 0), in one pass per column.
-        u = kronecker_points(n, start, shift)
-        r = np.sqrt(u[0])
+        u, phi, ch = points(n, start)
+        r = np.sqrt(u)
         r *= r_front
-        phi = u[1]
         phi *= 2 * np.pi
         px = np.cos(phi)
         px *= r
@@ -161,12 +176,7 @@ def bokeh_image(
         dy /= s2
         dzn /= s2
         w = dzn**3  # cos^3 of the ray's angle to the axis
-        if len(wls) > 1:
-            ch = np.minimum((u[2] * len(wls)).astype(np.intp), len(wls) - 1)
-            wl = wl_of[ch]
-        else:
-            ch = np.zeros(n, dtype=np.intp)
-            wl = np.full(n, wl_of[0])
+        wl = wl_of[ch] if k > 1 else np.full(n, wl_of[0])
 
         def col(a):
             return a if dt is np.float64 else np.asarray(a, dtype=dt)
