@@ -107,3 +107,15 @@ def test_bad_input_is_one_line(argv, capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1 and err.startswith("physcam: error:")
+
+
+def test_one_field_does_not_claim_a_defaulted_sensor(capsys):
+    # one field's MTF does not use the sensor: no "no --sensor given" note (the chart, which takes
+    # its corner from the sensor, and a hyperfocal focus, which takes its CoC, still say it)
+    from physcam.cli import main
+
+    assert main(["mtf", "dgauss_50mm", "--field", "5", "--fstop", "4", "--frequency", "20", "--json"]) == 0
+    assert "no --sensor given" not in capsys.readouterr().err
+    assert main(["mtf", "dgauss_50mm", "--field", "5", "--fstop", "4", "--frequency", "20", "--focus", "hyperfocal",
+                 "--json"]) == 0
+    assert "no --sensor given" in capsys.readouterr().err

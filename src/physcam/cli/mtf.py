@@ -89,7 +89,12 @@ def run(args) -> int:
         raise InputError(f"--pupil-samples must lie between 16 and {CLI_MAX_PUPIL_SAMPLES}, got {args.pupil_samples}")
     if args.output:
         check_writable(args.output, force=args.force)
-    sensor = resolve_sensor(args)
+    from ._common import HYPERFOCAL
+
+    # the sensor sets the chart's corner and the hyperfocal CoC; one field (--field) or a given
+    # --max-height without --focus hyperfocal does not use it, so a defaulted sensor goes unsaid there
+    unused = (args.field is not None or args.max_height is not None) and args.focus != HYPERFOCAL
+    sensor = resolve_sensor(args, quiet=unused)
     lens = load_lens(args.lens, lenient=args.lenient)
     from ._common import resolve_focus
 
