@@ -55,7 +55,7 @@ def test_the_default_sensor_is_super_35_and_said(capsys):
     assert "physcam: note: no --sensor given: Super 35" in err
     rc, out, _ = run(capsys, "report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--json")
     d = json.loads(out)
-    assert d["sensor"]["key"] == "s35-4perf" and any("sensor not given" in n for n in d["notes"])
+    assert d["sensor"]["key"] == "s35-4perf" and any("no --sensor given" in n for n in d["notes"])
     rc, out, _ = run(capsys, "lens", "breathing", "dgauss_50mm", "--focus", "inf", "--json")
     assert json.loads(out)["sensor_width_mm"] == pytest.approx(24.89)
     # a refusal stays one line: no note before it

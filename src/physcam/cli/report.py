@@ -150,8 +150,8 @@ def solve_from_args(args):
         import dataclasses
 
         report = dataclasses.replace(report, notes=report.notes + (
-            f"sensor not given: {sensor.name}, {sensor.width_mm:g} x {sensor.height_mm:g} mm "
-            f"({args.sensor_default_source}; give --sensor)",))
+            f"no --sensor given: {sensor.name}, {sensor.width_mm:g} x {sensor.height_mm:g} mm "
+            f"({args.sensor_default_source}; give --sensor to change it)",))
     return report
 
 
