@@ -70,6 +70,9 @@ def test_fits_in_json_and_their_files(tmp_path, capsys):
     assert {"3de4_radial_standard_degree_4.txt", "brown_conrady.json", "physcam_stmap.nk", "residual_3de4.png",
             "distortion.exr", "undistortion.exr"} <= names
     brown = json.loads((out / "brown_conrady.json").read_text())
+    from _documents import check_document
+
+    assert check_document(brown) == "physcam.distortion_brown_conrady"
     entries = brown["opentrackio_lens_distortion"]
     assert [e["model"] for e in entries] == ["Brown-Conrady D-U", "Brown-Conrady U-D"]
     assert all(len(e["radial"]) == 3 and len(e["tangential"]) == 2 for e in entries)
@@ -111,3 +114,13 @@ def test_fit_options_need_their_partners(tmp_path, capsys):
         rc = main(["distortion", "dgauss_50mm", *argv])
         err = capsys.readouterr().err
         assert rc == 2 and err.startswith("physcam: error:") and err.count("\n") == 1, (argv, err)
+
+
+def test_the_usd_fit_file_is_a_document(tmp_path, capsys):
+    from _documents import check_document
+
+    out = tmp_path / "usd"
+    assert main(["distortion", "dgauss_50mm", "--resolution", "512x384", "--stmap", str(out), "--fit", "usd"]) == 0
+    doc = json.loads((out / "usd_lens_distortion.json").read_text())
+    assert check_document(doc) == "physcam.distortion_usd"
+    assert doc["usd"]["lensDistortion:k1"] == doc["coefficients"]["k1"]

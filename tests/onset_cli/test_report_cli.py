@@ -91,6 +91,8 @@ def test_demo_writes_outputs(tmp_path, capsys):
     for name in ("distortion.exr", "undistortion.exr", "brown_conrady.json", "3de4_radial_standard_degree_4.txt",
                  "physcam_stmap.nk"):
         assert (out / "distortion" / name).exists(), name
+    assert check_document(json.loads((out / "distortion" / "brown_conrady.json").read_text())) == \
+        "physcam.distortion_brown_conrady"
     assert main(["demo", "--out", str(out)]) == 2  # exists, no --force
 
 

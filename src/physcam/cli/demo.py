@@ -166,8 +166,9 @@ def _distortion_step(out, ctx, force):
     smp = samples_from_field(res)
     brown = [fit_brown_conrady(smp, "D-U"), fit_brown_conrady(smp, "U-D")]
     tde4 = fit_tde4_radial(smp)
-    doc = {"schema": "physcam.distortion.brown_conrady/1", "lens": res.lens_name,
-           "opentrackio_lens_distortion": [f.opentrackio() for f in brown], "fits": [f.to_dict() for f in brown]}
+    from .distortion import brown_conrady_document
+
+    doc = brown_conrady_document(res.lens_name, brown)
     ox, oy = res.overscan_px
     nk = nuke_stmap_script(d.resolve() / "undistortion.exr", d.resolve() / "distortion.exr", plate_size=(w, h),
                            undistorted_size=(w + 2 * ox, h + 2 * oy), version=__version__)

@@ -157,6 +157,31 @@ def _run_across_focus(args, lens) -> int:
     return 0
 
 
+
+#: Units of the fit files' numbers (their coefficients are dimensionless: normalised coordinates)
+FIT_UNITS = {"coefficients": "dimensionless (coordinates normalised as each fit's notes say)",
+             "fx_mm": "mm", "fy_mm": "mm", "focal_length_mm": "mm", "residual_px": "px", "sensor_mm": "mm",
+             "focus_from_film_mm": "mm from the film plane (null: infinity)",
+             "opentrackio_lens_distortion": "OpenLensIO: mm on the sensor from its centre, y down"}
+
+
+def brown_conrady_document(lens_name: str, fits) -> dict:
+    """``brown_conrady.json``: both Brown-Conrady fits and their OpenTrackIO ``lens.distortion``
+    entries, as a versioned document (schema ``physcam.distortion_brown_conrady``)."""
+    from ._output import document
+
+    return document("distortion_brown_conrady", {
+        "lens": lens_name, "opentrackio_lens_distortion": [f.opentrackio() for f in fits],
+        "fits": [f.to_dict() for f in fits]}, units=FIT_UNITS)
+
+
+def usd_distortion_document(lens_name: str, fit) -> dict:
+    """``usd_lens_distortion.json``: the USD ``lensDistortion`` standard fit and its attributes, as a
+    versioned document (schema ``physcam.distortion_usd``)."""
+    from ._output import document
+
+    return document("distortion_usd", {"lens": lens_name, **fit.to_dict()}, units=FIT_UNITS)
+
 def _fit_payloads(args, res, fits, folder):
     """(path, bytes) of every fit file, after checking each fit may be written."""
     import json
@@ -175,15 +200,14 @@ def _fit_payloads(args, res, fits, folder):
         f.require_acceptable(FIT_FILES["brown" if f in brown else "3de4" if isinstance(f, TDE4RadialStandard)
                                         else "usd"])
     if brown:
-        doc = {"schema": "physcam.distortion.brown_conrady/1", "lens": res.lens_name,
-               "opentrackio_lens_distortion": [f.opentrackio() for f in brown],
-               "fits": [f.to_dict() for f in brown]}
-        out.append((d / FIT_FILES["brown"], json.dumps(doc, indent=2).encode()))
+        out.append((d / FIT_FILES["brown"], (json.dumps(brown_conrady_document(res.lens_name, brown), indent=2)
+                                             + "\n").encode()))
     for f in fits:
         if isinstance(f, TDE4RadialStandard):
             out.append((d / FIT_FILES["3de4"], tde4_lens_text(f, res.lens_name).encode()))
         elif isinstance(f, USDStandard):
-            out.append((d / FIT_FILES["usd"], json.dumps(f.to_dict(), indent=2).encode()))
+            out.append((d / FIT_FILES["usd"], (json.dumps(usd_distortion_document(res.lens_name, f), indent=2)
+                                               + "\n").encode()))
     for f in fits:
         slug = {"D-U": "_du", "U-D": "_ud"}.get(f.direction, "") if isinstance(f, BrownConrady) else ""
         stem = ("brown_conrady" + slug if isinstance(f, BrownConrady)
