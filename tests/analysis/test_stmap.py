@@ -132,6 +132,12 @@ def test_exr_files_open_as_float_rgb(tmp_path, case):
             assert np.array_equal(ch["R"].pixels, arr[..., 0])
             assert np.array_equal(ch["G"].pixels, arr[..., 1])
             assert (ch["B"].pixels == 0).all()
+        # the PNG preview (read back by matplotlib's reader): the same map in 8 bits, row 0 on top
+        from matplotlib.image import imread
+
+        png = imread(tmp_path / "maps" / f"{name}.png")
+        assert png.shape[:2] == arr.shape[:2]
+        assert np.abs(png[..., :3] - np.clip(arr, 0, 1)).max() <= 0.5 / 255 + 1e-6
     # no clobber without force, and nothing half written
     before = {p.name: p.stat().st_mtime_ns for p in (tmp_path / "maps").iterdir()}
     with pytest.raises(PhysCamError):

@@ -382,10 +382,13 @@ def _exr_bytes(rgb: np.ndarray) -> bytes:
 
 
 def _png_bytes(rgb: np.ndarray) -> bytes:
-    from matplotlib.image import imsave
+    """An 8-bit RGB PNG preview of ``rgb`` (h, w, 3) in 0..1, row 0 on top. Pillow directly (what
+    matplotlib's imsave calls, less its colour-mapping pass and alpha channel: 2-3x faster on a
+    2048-pixel map, which a characterization run writes by the hundred)."""
+    from PIL import Image
 
     buf = io.BytesIO()
-    imsave(buf, np.clip(rgb, 0.0, 1.0), format="png")
+    Image.fromarray((np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8), "RGB").save(buf, format="png")
     return buf.getvalue()
 
 
