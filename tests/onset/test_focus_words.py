@@ -109,6 +109,47 @@ def test_a_real_lens_reports_one_hyperfocal_mark_at_every_focus(fstop):
     for mark in (600.0, 2000.0, math.inf):
         r = solve_lens_report(focal_length_mm=None, lens=lens, sensor=S35, fstop=fstop, focus_mm=mark)
         assert r.dof.hyperfocal_from_film_mm == hyp.focus_from_film_mm
+        # the pair is consistent: H from H1 of the lens focused at the mark, plus that H1
+        assert r.dof.hyperfocal_mm + hyp.h1_from_film_mm == pytest.approx(hyp.focus_from_film_mm, rel=1e-12)
+
+
+def test_an_anamorphic_lens_reports_one_horizontal_hyperfocal_mark_at_every_focus():
+    """The horizontal limits use c / (the squeeze at the focus); their hyperfocal mark is the fixed point
+    with the squeeze at the mark, so it too is the same at every focus (review finding)."""
+    from physcam.lens.library import load_lens
+
+    lens = load_lens("navarro_anamorphic_2x")
+    marks = [solve_lens_report(focal_length_mm=None, lens=lens, sensor=S35, fstop=8.0, focus_mm=m).dof_horizontal
+             for m in (1500.0, 3000.0, 10000.0, math.inf)]
+    assert len({d.hyperfocal_from_film_mm for d in marks}) == 1
+    v = solve_lens_report(focal_length_mm=None, lens=lens, sensor=S35, fstop=8.0, focus_mm=3000.0).dof
+    assert marks[0].hyperfocal_from_film_mm > 1.8 * v.hyperfocal_from_film_mm  # c / ~2: about twice as far
+
+
+@pytest.mark.parametrize("kw", [
+    # an f-number solved from measured limits, faster than the lens opens (f/1.34 on an f/2 lens)
+    dict(lens="dgauss_50mm", focus_mm=2000.0, near_mm=1960.0, far_mm=2042.0),
+    # a hyperfocal mark closer than the lens can focus (479 mm; closest focus 562 mm)
+    dict(lens="nikkor_fisheye_16mm_f2_8", fstop=22.0, focus_mm=2000.0, sensor="FF"),
+])
+def test_reports_that_worked_before_the_fixed_point_still_work(kw):
+    """Review finding: the hyperfocal mark's side computation must not fail a report. Where the lens has
+    no hyperfocal mark the report says so and gives H + H1 at its focus, as before."""
+    import warnings
+
+    from physcam.lens.library import load_lens
+    from physcam.onset.sensors import find_sensor
+
+    kw = dict(kw)
+    lens = load_lens(kw.pop("lens"))
+    sensor = find_sensor(kw.pop("sensor", "Super 35"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = solve_lens_report(focal_length_mm=None, lens=lens, sensor=sensor, **kw)
+    assert math.isfinite(r.dof.hyperfocal_from_film_mm) and r.dof.hyperfocal_from_film_mm > 0
+    if "fstop" in kw:
+        assert any("no hyperfocal mark here" in n for n in r.notes)
+        assert r.dof.hyperfocal_from_film_mm == pytest.approx(r.dof.hyperfocal_mm + r.h1_from_film_mm, rel=1e-12)
 
 
 def test_magnification_has_the_gaussian_engines_sign():

@@ -74,6 +74,13 @@ def _bundled(slug: str) -> Prescription:
 
 
 @lru_cache(maxsize=1)
+def _slugs() -> frozenset[str]:
+    """The bundled lenses' slugs, exactly as their files are named (so a differently cased name on a
+    case-insensitive file system never takes the slug path)."""
+    return frozenset(p.stem for p in library_dir().glob("*.toml"))
+
+
+@lru_cache(maxsize=1)
 def _index() -> tuple[tuple[LensRecord, Prescription], ...]:
     from .formats._common import extra
 
@@ -203,7 +210,7 @@ def load_lens(name_or_path, lenient: bool = False) -> Prescription:
             for r in repairs:
                 warnings.warn(f"{s}: repaired on load: {r.message}", PhysCamWarning, stacklevel=2)
             return q
-    if not looks_like_path and (library_dir() / f"{s}.toml").is_file():
+    if not looks_like_path and s in _slugs():
         # a slug, as the CLI is usually given it: read that one file, not the whole library (the
         # index reads every bundled lens, 25 ms). The same object the index holds;
         # tests/lens/test_library.py checks that no slug is another lens's name or alias.

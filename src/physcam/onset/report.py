@@ -438,6 +438,7 @@ def solve_lens_report(
                          "(--lens-length): the pupil estimate sits a fraction of the lens length behind its front")
     if lens_length_mm is not None and sensor_front_mm is None:
         raise InputError("the lens length is used only with the sensor-to-lens-front distance (--sensor-front)")
+    squeeze_from_lens = False
     if lens is not None:
         from ..lens.prescription import Prescription
 
@@ -481,6 +482,7 @@ def solve_lens_report(
         lens_dof_aspect = 1.0
         bellows = planes.working_f_number / planes.f_number
         if lens.is_anamorphic and squeeze == 1.0:
+            squeeze_from_lens = True
             # the squeeze the lens really has at this focus: EFL in Y over EFL in X
             st = focusing.focus(lens, D_lens)
             gx = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z)
@@ -677,12 +679,21 @@ def solve_lens_report(
     if lens is not None:
         # a real lens's principal planes move as it focuses: the hyperfocal *mark* is the one focus
         # whose subject plane lies at H from H1 with the lens focused there (the fixed point that
-        # --focus hyperfocal sets), the same whatever the report's own focus
+        # --focus hyperfocal sets), the same whatever the report's own focus; H is given from H1
+        # of the lens focused there. A lens that cannot focus there keeps H + H1 at this focus.
         import dataclasses
 
-        dof = dataclasses.replace(dof, hyperfocal_from_film_mm=_lens_hyperfocal_mark(lens, N, c)[0])
-        if dof_h is not None:
-            dof_h = dataclasses.replace(dof_h, hyperfocal_from_film_mm=_lens_hyperfocal_mark(lens, N, c / sq)[0])
+        try:
+            mark, planes_h = _lens_hyperfocal_mark(lens, N, c)
+            dof = dataclasses.replace(dof, hyperfocal_mm=mark - planes_h.h1_from_film_mm,
+                                      hyperfocal_from_film_mm=mark)
+            if dof_h is not None:
+                mark, planes_h = _lens_hyperfocal_mark(lens, N, c, squeeze=None if squeeze_from_lens else sq)
+                dof_h = dataclasses.replace(dof_h, hyperfocal_mm=mark - planes_h.h1_from_film_mm,
+                                            hyperfocal_from_film_mm=mark)
+        except (OpticsError, InputError) as exc:
+            notes.append(f"hyperfocal distance given as H plus H1 at this focus: the lens has no hyperfocal mark "
+                         f"here ({str(exc).splitlines()[0]})")
 
     # --- focus error (technical) ------------------------------------------------
     if model == "technical":
@@ -841,27 +852,43 @@ def _lens_hyperfocal(lens, fstop, sensor, coc, near_mm, far_mm):
     H = f^2/(N c) + f from H1, with f and H1 of the lens focused at that mark (fixed point; the
     planes move little with focus, so a few steps converge to 1e-9 of the mark)."""
     from ..optics.coc import circle_of_confusion
+    from ..optics.focusing import technical_planes
 
     if near_mm is not None or far_mm is not None:
         raise InputError("focus at the hyperfocal distance takes no measured near/far limits")
     n = _require_f_number("f-stop", fstop)
     c, _ = circle_of_confusion(sensor.width_mm, sensor.height_mm, coc)
-    return _lens_hyperfocal_mark(lens, n, c)
+    mark, _ = _lens_hyperfocal_mark(lens, n, c)
+    return mark, technical_planes(lens, mark, fstop=n)
 
 
-def _lens_hyperfocal_mark(lens, n: float, c: float):
-    """(mark, planes) of :func:`_lens_hyperfocal` for f-number ``n`` and CoC ``c`` (mm)."""
+def _lens_hyperfocal_mark(lens, n: float, c: float, *, squeeze: float | None = 1.0):
+    """(mark, planes at the mark) of :func:`_lens_hyperfocal` for f-number ``n`` and CoC ``c`` (mm).
+
+    The planes (EFL, H1) do not depend on the f-number, so they are found without it (any f-number
+    the lens can or cannot open to gives the same mark). ``squeeze``: the CoC is ``c / squeeze`` (an
+    anamorphic's horizontal limits); None takes the lens's effective squeeze at each mark (EFL in Y
+    over EFL in X, as the report does), so the horizontal mark too is a fixed point."""
     from ..optics.focusing import technical_planes
 
     mark = math.inf
     for _ in range(50):
-        planes = technical_planes(lens, mark, fstop=n)
-        new = _dof.hyperfocal_distance(planes.efl_mm, n, c) + planes.h1_from_film_mm
+        planes = technical_planes(lens, mark)
+        sq = _effective_squeeze(lens, mark, planes.efl_mm) if squeeze is None else squeeze
+        new = _dof.hyperfocal_distance(planes.efl_mm, n, c / sq) + planes.h1_from_film_mm
         new = _require_distance("hyperfocal focus mark", new)
         if math.isfinite(mark) and abs(new - mark) <= 1e-9 * new:
-            return new, technical_planes(lens, new, fstop=n)
+            return new, technical_planes(lens, new)
         mark = new
     raise OpticsError(f"the hyperfocal focus of {lens.name!r} did not settle; give the focus mark")
+
+
+def _effective_squeeze(lens, mark: float, efl_y: float) -> float:
+    """An anamorphic lens's squeeze at focus ``mark``: EFL in Y over EFL in X."""
+    from ..optics import focusing, paraxial
+
+    st = focusing.focus(lens, mark)
+    return efl_y / paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z).efl
 
 
 def _require_distance(name: str, value) -> float:
