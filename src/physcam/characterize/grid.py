@@ -301,6 +301,10 @@ class Cell:
         return f"index/{self.lens}/{self.kind}/{self.stem}.parquet"
 
 
+#: How a PSF cell's rays are sampled (physcam.analysis.bokeh): in every PSF cell's input hash
+PSF_SAMPLING = "owen-scrambled-sobol-1"
+
+
 def _settings(kind: str, grid: Grid, design_nm: float) -> dict:
     s = {"sensor_mm": list(grid.sensor_mm)}
     if kind == "lens":
@@ -310,7 +314,10 @@ def _settings(kind: str, grid: Grid, design_nm: float) -> dict:
     elif kind == "illumination":
         s.update(grid=grid.illumination_grid, fields=max(grid.fields, 2))
     elif kind == "psf":
-        s.update(rays=grid.psf_rays, pixels=grid.psf_pixels, infinity_standin_mm=PSF_INFINITY_STANDIN_MM)
+        # the ray sampling is part of the input: kernels made with another sampler (independent random
+        # rays, before 2026-11-23) are not reused as if they were these
+        s.update(rays=grid.psf_rays, pixels=grid.psf_pixels, infinity_standin_mm=PSF_INFINITY_STANDIN_MM,
+                 sampling=PSF_SAMPLING)
     return s
 
 

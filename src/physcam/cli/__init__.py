@@ -30,7 +30,7 @@ import sys
 from .. import __version__
 from ..errors import PhysCamError, PhysCamWarning
 
-__all__ = ["main", "run", "build_parser"]
+__all__ = ["main", "build_parser"]
 
 
 #: Command modules in --help order; modules not listed follow alphabetically.
@@ -146,7 +146,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def run() -> None:
-    """The ``physcam`` program: :func:`main`, then exit with its status (module notes)."""
+    """The ``physcam`` program: :func:`main`, then exit with its status (module notes). It ends the
+    process: from Python, call :func:`main` instead."""
     code = main()
     if "numba" in sys.modules:
         _exit_without_teardown(code)
