@@ -22,7 +22,6 @@ kind: 1 lens cell, 4 distortion (ST-maps 2048 x 1366 px on a 36 x 24 mm gate), 8
 from __future__ import annotations
 
 import argparse
-import logging
 import os
 import shutil
 import subprocess
@@ -30,6 +29,7 @@ import tempfile
 import time
 
 from physcam.characterize import Grid, characterize, parse_focus_marks
+from physcam.characterize.run import local_cluster
 
 #: The grid's gate: full frame, as when the figures in docs/performance.md were first taken (the
 #: library's default sensor is Super 35 since; 2048 x 1366 px are square pixels on 36 x 24 mm)
@@ -60,11 +60,9 @@ def warm_worker(lens: str) -> None:
 
 
 def run(n_workers: int, grid: Grid, lens: str) -> dict:
-    from distributed import LocalCluster
 
     t0 = time.perf_counter()
-    cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=":0",
-                           silence_logs=logging.ERROR, env={"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"})
+    cluster = local_cluster(n_workers)  # as `physcam characterize` starts it
     start = time.perf_counter() - t0
     scratch = tempfile.mkdtemp(prefix="physcam-bench-warm-")
     out = tempfile.mkdtemp(prefix="physcam-bench-")

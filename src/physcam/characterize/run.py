@@ -182,10 +182,8 @@ def read_index(folder):
 
 def _connect(scheduler, workers, connect_timeout):
     """(client, cluster or None, dashboard link, seconds to start)."""
-    import logging
-
     t0 = time.perf_counter()
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     if scheduler is not None:
         try:
@@ -194,15 +192,36 @@ def _connect(scheduler, workers, connect_timeout):
             raise InputError(f"cannot reach the Dask scheduler at {scheduler} within {connect_timeout:g} s "
                              f"({type(exc).__name__}); is it running, and is the address right?") from None
         return client, None, _dashboard(client), time.perf_counter() - t0
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0",
-                           silence_logs=logging.ERROR,
-                           env={"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"})
+    cluster = local_cluster(workers)
     try:
         client = Client(cluster, set_as_default=False)
     except BaseException:
         cluster.close()
         raise
     return client, cluster, _dashboard(client), time.perf_counter() - t0
+
+
+#: Worker environment of physcam's local cluster: one thread per worker for numba and the BLAS
+WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+def local_cluster(workers: int):
+    """A ``LocalCluster`` of ``workers`` single-threaded worker processes, with its dashboard.
+
+    Dask's nannies start workers with ``MALLOC_TRIM_THRESHOLD_=65536`` (to hand memory back to the
+    system early); that fixed threshold turns off glibc's adaptive one, so every large numpy
+    temporary is unmapped when freed and faulted in again when the next is made: a 1e6-ray PSF
+    cell took 0.25 s instead of 0.10 s (docs/performance.md). physcam's cells keep their memory
+    bounded by chunking, so its cluster leaves the variable unset.
+    """
+    import logging
+
+    import dask
+    from distributed import LocalCluster
+
+    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+        return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0",
+                            silence_logs=logging.ERROR, env=dict(WORKER_ENV))
 
 
 def _dashboard(client):
