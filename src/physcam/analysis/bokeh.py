@@ -6,8 +6,8 @@ uniformly over the front element's clear disk: shuffled Owen-scrambled Sobol poi
 (:mod:`physcam.trace.lowdiscrepancy`; ``seed`` sets the scrambling; one sequence per wavelength)
 mapped to the disk by r = R sqrt(u), phi = 2 pi v. An image binned from them is as clean as one
 from several times as many independent random rays (docs/ray-tracing.md, "Bokeh sampling").
-Each ray carries the solid angle it stands for, dA cos^3(theta) / dz^2 (dz the axial distance from the light to the front
-vertex plane), times Fresnel transmission. Rays are traced to the film in chunks of ``chunk``
+Each ray carries the solid angle it stands for, dA cos^3(theta) / dz^2 (dz the axial distance
+from the light to the front vertex plane), times Fresnel transmission. Rays are traced to the film in chunks of ``chunk``
 and binned into a ``pixels`` x ``pixels`` image, so memory stays bounded (about 0.2 KB per ray
 in a chunk: 1e8 rays in chunks of 1e6 use well under 1 GB). The image shows cat's-eye
 vignetting off axis, the aperture shape (``aperture`` at the stop) and, with ``spectral``,
