@@ -335,3 +335,21 @@ def test_local_cluster_workers_start_without_dasks_malloc_trim(monkeypatch):
         cluster.close()
     assert "MALLOC_TRIM_THRESHOLD_" not in env
     assert env["NUMBA_NUM_THREADS"] == "1"
+
+
+def test_light_cells_share_a_task_per_lens():
+    """A lens's millisecond cells (breathing and pupils, illumination) are one Dask task, so scheduling
+    does not outweigh them; ST-map and PSF cells are a task each (benchmarks/characterize.py)."""
+    from physcam.characterize.grid import build_cells
+    from physcam.characterize.run import task_groups
+    from physcam.lens.library import load_lens
+
+    grid = tiny(kinds=("lens", "illumination", "psf", "distortion")).checked()
+    cells = []
+    for name in ("dgauss_50mm", "tessar_50mm_f2_8"):
+        cells += build_cells(name, name, grid, load_lens(name).wavelength_nm, "0")
+    groups = task_groups(cells)
+    assert sorted(c.stem + c.lens for g in groups for c in g) == sorted(c.stem + c.lens for c in cells)
+    light = [g for g in groups if g[0].kind in ("lens", "illumination")]
+    assert len(light) == 2 and all(len({c.lens for c in g}) == 1 for g in light)
+    assert all(len(g) == 1 for g in groups if g not in light)

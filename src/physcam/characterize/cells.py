@@ -1,6 +1,8 @@
 """One cell of the grid: compute it with physcam's analyses, write its result and its index row.
 
-:func:`run_cell` is the Dask task. It runs in a worker process and does, for one cell:
+:func:`run_cell` makes one cell; :func:`run_cells`, the Dask task, makes a few (a lens's light
+cells share one task: :func:`physcam.characterize.run.task_groups`). In a worker process, for one
+cell:
 
 1. if the cell's row is in the index already (another run made it), nothing;
 2. take the cell's **lock** (``fcntl.flock`` on ``.locks/...``, released by the kernel when the
@@ -54,7 +56,7 @@ from pathlib import Path
 from ..errors import ExportError, OpticsError, PhysCamError, require_type
 from .grid import PSF_INFINITY_STANDIN_MM, Cell, Grid, focus_label
 
-__all__ = ["run_cell", "compute_cell", "INDEX_SCHEMA_FIELDS", "read_row", "cell_lock"]
+__all__ = ["run_cell", "run_cells", "compute_cell", "INDEX_SCHEMA_FIELDS", "read_row", "cell_lock"]
 
 #: Columns of the Parquet index (one row per cell; None where a kind has no such axis).
 INDEX_SCHEMA_FIELDS = (
@@ -286,8 +288,16 @@ def _row_bytes(row: dict) -> bytes:
     return buf.getvalue()
 
 
+def run_cells(lens_toml: str, lens_digest: str, cells, grid: Grid, root: str, run_id: str, version: str) -> list[dict]:
+    """The Dask task: :func:`run_cell` for each of ``cells`` (one lens's), in order. An exception other
+    than a :class:`~physcam.errors.PhysCamError` ends the task, and Dask's retry then finds the cells
+    done before it in the index ("present")."""
+    require_type("cells", cells, (list, tuple), "physcam.characterize.run.task_groups")
+    return [run_cell(lens_toml, lens_digest, c, grid, root, run_id, version) for c in cells]
+
+
 def run_cell(lens_toml: str, lens_digest: str, cell: Cell, grid: Grid, root: str, run_id: str, version: str) -> dict:
-    """The Dask task: make ``cell`` under the library folder ``root`` (module notes).
+    """Make ``cell`` under the library folder ``root`` (module notes).
 
     Returns ``{"status": "computed" | "present" | "failed", "row": {...} | None, "error": str | None,
     "cell": cell}``. A :class:`~physcam.errors.PhysCamError` (the lens does not cover the corner,

@@ -10,7 +10,8 @@
 2. **Plan**: the cells of every lens (:func:`~physcam.characterize.grid.build_cells`); a cell whose
    row is in the index (same input hash: the hash is in the file name) is skipped. ``limit``
    computes at most that many of the rest (a run in parts; the next run resumes).
-3. **Compute** the cells as one Dask task each (:func:`~physcam.characterize.cells.run_cell`,
+3. **Compute** the cells as Dask tasks (:func:`~physcam.characterize.cells.run_cells`; one task per
+   ST-map or PSF cell, one per lens for its light cells, :func:`task_groups`,
    ``retries`` for a task whose worker raised, and Dask's own rescheduling when a worker dies),
    on a ``LocalCluster`` of ``workers`` single-threaded worker processes (default: one per core;
    numba in each worker runs one thread, so the workers do not fight for the cores) or, with
@@ -306,11 +307,30 @@ def characterize(lenses, grid: Grid, output, *, scheduler: str | None = None, wo
     return summary
 
 
+#: Cell kinds that take milliseconds (a lens's breathing and pupils, relative illumination): one
+#: Dask task computes all of a lens's cells of these kinds, so scheduling does not outweigh them
+LIGHT_KINDS = ("lens", "illumination")
+
+
+def task_groups(cells) -> list[list]:
+    """The Dask tasks for ``cells``: each lens's light cells (:data:`LIGHT_KINDS`) together in one
+    task, first; every other cell (ST-maps, PSF kernels: a tenth of a second and more) a task of its
+    own, in the order given."""
+    light: dict[str, list] = {}
+    heavy = []
+    for c in cells:
+        if c.kind in LIGHT_KINDS:
+            light.setdefault(c.lens, []).append(c)
+        else:
+            heavy.append([c])
+    return list(light.values()) + heavy
+
+
 def _compute(summary, plan, todo, grid, out, scheduler, workers, retries, connect_timeout, progress, on_start,
              version):
     from distributed import as_completed
 
-    from .cells import run_cell
+    from .cells import run_cells
 
     nworkers = workers or os.cpu_count() or 1
     client, cluster, dash, started = _connect(scheduler, nworkers, connect_timeout)
@@ -322,23 +342,24 @@ def _compute(summary, plan, todo, grid, out, scheduler, workers, retries, connec
         if on_start is not None:
             on_start(summary)
         t0 = time.perf_counter()
-        futures = []
-        for c in todo:
-            toml, digest, _ = plan[c.lens]
-            futures.append(client.submit(run_cell, toml, digest, c, grid, str(out.resolve()), summary.run_id,
-                                         version, key=f"physcam-{summary.run_id}-{c.input_hash[:24]}", retries=retries, pure=False))
+        futures, groups = [], task_groups(todo)
+        for g in groups:
+            toml, digest, _ = plan[g[0].lens]
+            futures.append(client.submit(run_cells, toml, digest, g, grid, str(out.resolve()), summary.run_id,
+                                         version, key=f"physcam-{summary.run_id}-{g[0].input_hash[:24]}",
+                                         retries=retries, pure=False))
         done = 0
         try:
             for fut in as_completed(futures, loop=client.loop):
+                group = groups[futures.index(fut)]
                 try:
-                    res = fut.result()
+                    results = fut.result()
                 except PhysCamError:
                     raise
                 except Exception as exc:  # noqa: BLE001 - a task that failed after its retries, or KilledWorker
-                    c = todo[futures.index(fut)]
-                    summary.failed.append({"lens": c.lens, "kind": c.kind, "cell": c.stem,
-                                           "error": f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"})
-                else:
+                    why = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+                    results = [{"status": "failed", "cell": c, "error": why} for c in group]
+                for res in results:
                     if res["status"] == "computed":
                         summary.computed += 1
                         summary.compute_s += float(res["row"]["compute_s"])
@@ -347,9 +368,9 @@ def _compute(summary, plan, todo, grid, out, scheduler, workers, retries, connec
                     else:
                         c = res["cell"]
                         summary.failed.append({"lens": c.lens, "kind": c.kind, "cell": c.stem, "error": res["error"]})
-                done += 1
+                done += len(group)
                 if progress is not None:
-                    progress(done, len(futures))
+                    progress(done, len(todo))
         except BaseException:
             client.cancel(futures)
             raise
