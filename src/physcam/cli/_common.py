@@ -108,17 +108,23 @@ def focus(name: str = "focus distance", *, allow_inf: bool = True, hyperfocal: b
     return parse
 
 
+def list_items(text, what: str, example: str) -> list[str]:
+    """The comma-separated items of an option's ``text``, stripped; an empty list or an empty item
+    (``2,,4``) is an argparse error naming ``what`` (with ``example`` of a good list)."""
+    parts = [t.strip() for t in str(text).split(",")]
+    if not any(parts):
+        raise argparse.ArgumentTypeError(f"give {what} separated by commas, e.g. {example}")
+    if not all(parts):
+        raise argparse.ArgumentTypeError(f"{text!r} has an empty item: give {what} separated by single commas")
+    return parts
+
+
 def focus_list(name: str = "focus distances"):
     """An argparse type for comma-separated focus marks (each as :func:`focus`)."""
     one = focus(name)
 
     def parse(text):
-        parts = [t.strip() for t in str(text).split(",")]
-        if not any(parts):
-            raise argparse.ArgumentTypeError(f"give {name} separated by commas, e.g. 1m,2m,5m,hyperfocal,inf")
-        if not all(parts):
-            raise argparse.ArgumentTypeError(f"{text!r} has an empty item: give {name} separated by single commas")
-        return [one(t) for t in parts]
+        return [one(t) for t in list_items(text, name, "1m,2m,5m,hyperfocal,inf")]
 
     parse.__name__ = name
     parse.physcam_focus = dict(one.physcam_focus, list=True)

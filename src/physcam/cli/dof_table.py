@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus_list, number
+from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus_list, list_items, number
 
 EPILOG = """\
 examples:
@@ -30,11 +30,7 @@ def _fstops(text):
     import argparse
 
     one = number("f-stop", positive=True)
-    parts = [t.strip() for t in str(text).split(",")]
-    if not any(parts):
-        raise argparse.ArgumentTypeError("give f-stops separated by commas, e.g. 2,2.8,4,5.6")
-    if not all(parts):
-        raise argparse.ArgumentTypeError(f"{text!r} has an empty item: give f-stops separated by single commas")
+    parts = list_items(text, "f-stops", "2,2.8,4,5.6")
     if len(parts) > 24:
         raise argparse.ArgumentTypeError(f"a table takes up to 24 f-stops, got {len(parts)}")
     return [one(t.removeprefix("f/").removeprefix("T")) for t in parts]
