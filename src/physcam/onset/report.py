@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..optics import dof as _dof
@@ -862,6 +863,7 @@ def _lens_hyperfocal(lens, fstop, sensor, coc, near_mm, far_mm):
     return mark, technical_planes(lens, mark, fstop=n)
 
 
+@lru_cache(maxsize=64)  # a hyperfocal focus solves it, and its report's DOF block asks again
 def _lens_hyperfocal_mark(lens, n: float, c: float, *, squeeze: float | None = 1.0):
     """(mark, planes at the mark) of :func:`_lens_hyperfocal` for f-number ``n`` and CoC ``c`` (mm).
 
