@@ -7,14 +7,12 @@ own word for "a number was expected": ``float('dgauss')``), as is any PhysCamErr
 
 from __future__ import annotations
 
-import importlib
 import inspect
-import pkgutil
 import warnings
 
 import pytest
 
-import physcam
+from _public_api import public_objects
 from physcam.errors import PhysCamError
 from physcam.lens.library import load_lens
 
@@ -25,16 +23,8 @@ SKIP_FUNCTIONS = {"takes_prescription", "takes_text", "takes_report", "require_t
 
 
 def _public_functions():
-    out = []
-    for m in pkgutil.walk_packages(physcam.__path__, "physcam."):
-        if any(s in m.name for s in SKIP_MODULES):
-            continue
-        mod = importlib.import_module(m.name)
-        for name in getattr(mod, "__all__", []):
-            fn = getattr(mod, name, None)
-            if inspect.isfunction(fn) and name not in SKIP_FUNCTIONS and fn.__module__ == mod.__name__:
-                out.append(pytest.param(fn, id=f"{mod.__name__}.{name}"))
-    return out
+    return [pytest.param(fn, id=f"{mod}.{name}") for mod, name, fn in public_objects(SKIP_MODULES)
+            if inspect.isfunction(fn) and name not in SKIP_FUNCTIONS]
 
 
 @pytest.mark.parametrize("fn", _public_functions())

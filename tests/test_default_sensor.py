@@ -11,15 +11,13 @@ from __future__ import annotations
 import argparse
 import csv
 import dataclasses
-import importlib
 import inspect
 import math
-import pkgutil
 from pathlib import Path
 
 import pytest
 
-import physcam
+from _public_api import public_objects
 from physcam.cli._common import DEFAULT_SENSOR, resolve_sensor
 from physcam.data import default_sensor
 
@@ -38,19 +36,14 @@ def _cli_default_sensor():
 def _signatures():
     """(qualified name, signature) of every public function and class (``__all__``) of the library."""
     out = []
-    for m in pkgutil.walk_packages(physcam.__path__, "physcam."):
-        if any(s in m.name for s in SKIP_MODULES):
+    for mod, name, obj in public_objects(SKIP_MODULES):
+        if not (inspect.isfunction(obj) or inspect.isclass(obj)):
             continue
-        mod = importlib.import_module(m.name)
-        for name in getattr(mod, "__all__", []):
-            obj = getattr(mod, name, None)
-            if not (inspect.isfunction(obj) or inspect.isclass(obj)) or getattr(obj, "__module__", "") != mod.__name__:
-                continue
-            try:
-                sig = inspect.signature(obj)
-            except (TypeError, ValueError):
-                continue
-            out.append((f"{mod.__name__}.{name}", sig))
+        try:
+            sig = inspect.signature(obj)
+        except (TypeError, ValueError):
+            continue
+        out.append((f"{mod}.{name}", sig))
     return out
 
 
