@@ -149,10 +149,11 @@ def test_every_rib_reads_back_and_agrees_with_the_report(tmp_path, capsys, label
     assert math.degrees(2 * math.atan((r - l) / 2 * tan_half)) == pytest.approx(report.hfov_focus_deg, abs=1e-9)
     assert math.degrees(2 * math.atan((t - b) / 2 * tan_half)) == pytest.approx(report.vfov_focus_deg, abs=1e-9)
 
-    # depth of field: focalLength in scene units, focalLength / fStop the entrance pupil f / N, focalDistance
-    # from the entrance pupil (a thin lens's pupil is on the lens, s' in front of the film)
+    # depth of field: focalLength in scene units, focalLength / fStop the entrance pupil at this focus (f / N
+    # for a thin lens; an internal-focus lens's iris seen through its focused front, tests/export/test_iris_rule.py),
+    # focalDistance from the entrance pupil (a thin lens's pupil is on the lens, s' in front of the film)
     assert focal_len * mm == pytest.approx(f_pin, rel=1e-12)
-    assert focal_len * mm / fstop == pytest.approx(report.focal_length_mm / report.fstop, rel=1e-12)
+    assert focal_len * mm / fstop == pytest.approx(report.aperture_diameter_mm, rel=1e-12)
     if "f" in known:
         assert focal_len * mm / fstop == pytest.approx(known["f"] / known["N"], rel=1e-12)
         assert focal_dist * mm == pytest.approx(known["D"] - f_pin_hand, rel=1e-12)

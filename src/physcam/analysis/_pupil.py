@@ -5,7 +5,7 @@ reference sphere.
 Configuration (:func:`setup`): the lens is focused at a mark from the film
 (:func:`physcam.optics.focusing.focus`; infinity keeps the prescription and puts the film at
 the paraxial image of infinity) and stopped down to an f-number (the stop's semi-diameter
-scaled as :func:`physcam.optics.paraxial.stop_semi_diameter_for_fstop`). Pupil positions come
+sized by :func:`physcam.optics.focusing.iris_semi_diameter`). Pupil positions come
 from the Gaussian engine of the focused lens: the paraxial entrance pupil (plane ``z_ep``,
 radius ``r_ep`` at that stop) and exit pupil (``z_xp``).
 
@@ -85,6 +85,7 @@ def setup(lens: Prescription, *, fstop=None, focus_mm=None, aperture=None, backe
     """Focus ``lens`` at ``focus_mm`` (mark from the film; None or inf: infinity) and stop it to ``fstop``."""
     from ..optics import paraxial
     from ..optics.focusing import focus as focus_lens
+    from ..optics.focusing import iris_semi_diameter
     from ..trace import paraxial_image_z
     from ..trace.aperture import Aperture
 
@@ -100,7 +101,7 @@ def setup(lens: Prescription, *, fstop=None, focus_mm=None, aperture=None, backe
         fstop = require_finite("f-stop", fstop)
         if not 0.5 <= fstop <= 4096.0:
             raise InputError(f"f-stop must lie between 0.5 and 4096, got {fstop:g}")
-        stop = paraxial.stop_semi_diameter_for_fstop(lens, fstop)
+        stop = iris_semi_diameter(lens, fstop)
     if focus_mm is None or (isinstance(focus_mm, (int, float)) and math.isinf(focus_mm) and focus_mm > 0):
         focused, object_z, film_z, mark = lens, -math.inf, paraxial_image_z(lens, backend=backend), math.inf
     else:

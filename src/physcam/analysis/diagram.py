@@ -183,7 +183,9 @@ def lens_diagram(prescription: Prescription, *, axis: str = "y", focus_from_film
         raise InputError(f"meridian must be 'x' or 'y', got {axis!r}")
     st = focusing.focus(prescription, focus_from_film_mm, axis="y", wavelength_nm=wavelength_nm)
     p = st.prescription
-    g = paraxial.gaussian(p, axis=axis, wavelength_nm=wavelength_nm, fstop=fstop, object_z=st.object_z, film_z=st.film_z)
+    iris = None if fstop is None else focusing.iris_semi_diameter(prescription, fstop)
+    g = paraxial.gaussian(p, axis=axis, wavelength_nm=wavelength_nm, stop_semi_diameter=iris, object_z=st.object_z,
+                          film_z=st.film_z)
     if fstop is not None:  # draw the stop at the asked opening
         from dataclasses import replace
 

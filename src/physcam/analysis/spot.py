@@ -276,11 +276,11 @@ def spot_diagram(
     if film_z is None:
         film_z = paraxial_image_z(lens, wl)
     stop = None
-    if fstop is not None:
-        from ..optics.paraxial import stop_semi_diameter_for_fstop
+    if fstop is not None:  # the iris sized by the one rule (at infinity focus, design wavelength)
+        from ..optics.focusing import iris_semi_diameter
 
-        stop = stop_semi_diameter_for_fstop(lens, fstop, wavelength_nm=wl)
-    g = gaussian(lens, wavelength_nm=wl, fstop=fstop)
+        stop = iris_semi_diameter(lens, fstop)
+    g = gaussian(lens, wavelength_nm=wl, stop_semi_diameter=stop)
     z_ep, r_ep = g.z_entrance_pupil, g.entrance_pupil_diameter / 2
     if pupil_radius is not None:
         beam = require_finite("pupil_radius", pupil_radius)

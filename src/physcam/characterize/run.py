@@ -115,8 +115,7 @@ def _check_folder(out: Path, dry_run: bool) -> Path:
 
 def _check_lens(lens: Prescription, grid: Grid) -> None:
     """Every mark reachable, every f-stop within the lens's range: the errors a run would hit per cell."""
-    from ..optics.focusing import focus
-    from ..optics.paraxial import stop_semi_diameter_for_fstop
+    from ..optics.focusing import focus, iris_semi_diameter
 
     for m in grid.focus_mm:
         try:
@@ -125,7 +124,7 @@ def _check_lens(lens: Prescription, grid: Grid) -> None:
             raise InputError(f"lens {lens.name!r}: {exc}") from None
     for n in grid.fstops:
         try:
-            stop_semi_diameter_for_fstop(lens, n)
+            iris_semi_diameter(lens, n)
         except OpticsError as exc:
             raise InputError(f"lens {lens.name!r}: {exc}") from None
 

@@ -173,11 +173,11 @@ def _resolution(text: str):
 
 def run_illumination(args) -> int:
     from ..analysis.illumination import relative_illumination
-    from ..optics.paraxial import stop_semi_diameter_for_fstop
+    from ..optics.focusing import iris_semi_diameter
     from ._output import Table, print_table
 
     lens = _prepare(args)
-    sd = None if args.fstop is None else stop_semi_diameter_for_fstop(lens, args.fstop)
+    sd = None if args.fstop is None else iris_semi_diameter(lens, args.fstop)
     res = relative_illumination(lens, args.field, max_field_deg=args.max_field, grid=args.grid, fresnel=args.fresnel,
                                 stop_semi_diameter=sd, sensor_width_mm=args.sensor_width,
                                 sensor_height_mm=args.sensor_height)

@@ -258,7 +258,7 @@ def _measure(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays):
         notes.append(f"distortion not measured: {exc}")
     # relative illumination at that f-stop, to the sensor corner (clamped likewise)
     try:
-        sd = paraxial.stop_semi_diameter_for_fstop(lens, n)
+        sd = focusing.iris_semi_diameter(lens, n)
         ri = relative_illumination(lens, grid=64, stop_semi_diameter=sd, sensor_width_mm=sensor.width_mm,
                                    sensor_height_mm=sensor.height_mm)
         pts = [p for p in ri.points if p.axis == "y"]
@@ -274,7 +274,7 @@ def _measure(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays):
     out["bokeh_light_from_film_mm"] = light
     try:
         st = focusing.focus(lens, mark)
-        stop = paraxial.stop_semi_diameter_for_fstop(st.prescription, n)
+        stop = focusing.iris_semi_diameter(lens, n)
         img = bokeh_image(st.prescription, light, film_z=st.film_z, rays=rays, pixels=96, stop_semi_diameter=stop,
                           chunk=min(max(rays, 1000), 250_000))
         mono = img.image.sum(axis=2) if img.image.ndim == 3 else img.image

@@ -104,7 +104,7 @@ def _lens_step(out, ctx, force):
     lens = load_lens(DEFAULTS["lens"])
     ctx["lens"] = lens
     st = focusing.focus(lens, DEFAULTS["focus"])
-    g = paraxial.gaussian(st.prescription, fstop=DEFAULTS["fstop"], object_z=st.object_z, film_z=st.film_z)
+    g = focusing.gaussian_at_focus(lens, DEFAULTS["focus"], fstop=DEFAULTS["fstop"])
     data = {"lens": lens.name, "focus_from_film_mm": DEFAULTS["focus"], "fstop": DEFAULTS["fstop"],
             "back_focus_mm": st.back_focus_mm, "gaussian": g.to_dict()}
     text = json.dumps(data, indent=2, allow_nan=False, default=lambda v: None if isinstance(v, float)
@@ -139,7 +139,7 @@ def _trace_step(out, ctx, force):
     # a point light 1.2 m from the film, off axis, with the lens focused at 3 m and stopped to
     # f/2.8 by a 7-blade iris: the defocus blur shows the iris and cat's-eye vignetting
     st = focusing.focus(lens, DEFAULTS["focus"])
-    stop = paraxial.stop_semi_diameter_for_fstop(st.prescription, DEFAULTS["fstop"])
+    stop = focusing.iris_semi_diameter(lens, DEFAULTS["fstop"])
     bokeh = bokeh_image(st.prescription, 1200.0, 250.0, 150.0, film_z=st.film_z, rays=400_000, pixels=160,
                         stop_semi_diameter=stop, aperture=Aperture(nsides=7, roundness=0.2), spectral=True)
     return [spot.plot(out / "spot.png", force=force), bokeh.plot(out / "bokeh.png", force=force)]

@@ -201,8 +201,9 @@ def show_data(args):
     p = _load(args)
     args.focus = resolve_focus(args.focus, lens=p, fstop=args.fstop, args=args)
     st = focusing.focus(p, args.focus, method=args.focus_method, wavelength_nm=args.wavelength)
+    iris = None if args.fstop is None else focusing.iris_semi_diameter(p, args.fstop, method=args.focus_method)
     data = {
-        a: paraxial.gaussian(st.prescription, axis=a, wavelength_nm=args.wavelength, fstop=args.fstop,
+        a: paraxial.gaussian(st.prescription, axis=a, wavelength_nm=args.wavelength, stop_semi_diameter=iris,
                              object_z=st.object_z, film_z=st.film_z, flange_focal_distance_mm=args.flange)
         for a in _meridians(p)
     }

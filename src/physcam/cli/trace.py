@@ -114,7 +114,7 @@ def run_bokeh(args) -> int:
 
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, args=args)
     st = focusing.focus(lens, math.inf if args.focus is None else args.focus)
-    stop = None if args.fstop is None else paraxial.stop_semi_diameter_for_fstop(st.prescription, args.fstop)
+    stop = None if args.fstop is None else focusing.iris_semi_diameter(lens, args.fstop)
     aperture = None
     if args.blades >= 3 or args.density != 0.0 or args.roundness != 0.0 or args.blade_angle != 0.0:
         aperture = Aperture(nsides=args.blades, angle_deg=args.blade_angle, roundness=args.roundness,

@@ -91,8 +91,7 @@ def bake_camera(lens: Prescription, *, focus_mm, fstop=None, sensor_width_mm, se
     internal focusing when the lens has focus groups, else unit focusing), stop it to ``fstop``,
     and tabulate what the OSL camera needs. Raises :class:`~physcam.errors.OpticsError` for a
     focus closer than the lens reaches or an f-number faster than it opens."""
-    from ..optics.focusing import focus
-    from ..optics.paraxial import stop_semi_diameter_for_fstop
+    from ..optics.focusing import focus, iris_semi_diameter
     from ..trace.pupil_bounds import exit_pupil_bounds
     from ..trace.surfaces import surface_table
     from ..trace.trace import camera_rays
@@ -110,7 +109,7 @@ def bake_camera(lens: Prescription, *, focus_mm, fstop=None, sensor_width_mm, se
     state = focus(lens, f)
     q = state.prescription
     if fstop is not None:
-        semi = stop_semi_diameter_for_fstop(lens, fstop)
+        semi = iris_semi_diameter(lens, fstop)
         k = q.stop_index
         s = list(q.surfaces)
         s[k] = dataclasses.replace(s[k], semi_diameter=float(semi))

@@ -83,8 +83,7 @@ def compare_bokeh(lens: Prescription, *, focus_mm: float, fstop: float, light_mm
     ``focus_mm`` and stopped to ``fstop``; return both images and the measured agreement."""
     from ..analysis.blob import blob_moments, equivalent_diameter, polygon_corners
     from ..analysis.bokeh import bokeh_image
-    from ..optics.focusing import focus
-    from ..optics.paraxial import stop_semi_diameter_for_fstop
+    from ..optics.focusing import focus, iris_semi_diameter
     from .blender import blender_setup_script, osl_camera_shader
 
     crop = require_positive("crop", crop_mm)
@@ -96,7 +95,7 @@ def compare_bokeh(lens: Prescription, *, focus_mm: float, fstop: float, light_mm
     sphere = require_positive("sphere diameter", sphere_mm)
     exe = find_blender_python(blender_python)
     st = focus(lens, focus_mm)
-    semi = stop_semi_diameter_for_fstop(lens, fstop)  # as the shader bakes it (physcam.export.blender)
+    semi = iris_semi_diameter(lens, fstop)  # as the shader bakes it (physcam.export.blender)
     src = osl_camera_shader(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=crop, sensor_height_mm=crop,
                             aperture=aperture)
     with tempfile.TemporaryDirectory(prefix="physcam-compare-") as tmp:

@@ -309,7 +309,7 @@ def pbrt_focus_comparison(report, lens, *, film_diagonal_mm: float | None = None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             pbrt_lens = dat.loads(dat.dumps(st.prescription), name=lens.name)
-    ap = 2.0 * paraxial.stop_semi_diameter_for_fstop(st.prescription, report.fstop)
+    ap = 2.0 * focusing.iris_semi_diameter(lens, report.fstop)
     tl = pbrt_thick_lens(pbrt_lens, mark, film_diagonal_mm=diag, aperture_diameter_mm=ap)
     d_pbrt, efl_pbrt, h1_pbrt = _conjugate_from_film(pbrt_lens, tl.film_distance_mm)
     dof = report.dof
@@ -397,7 +397,7 @@ def pbrt_camera_values(report, lens=None, *, xres: int = 1920, cameras=PBRT_CAME
         if not math.isfinite(mark):
             raise InputError("pbrt's focusdistance is a finite distance from the film; give a focus mark")
         st = focusing.focus(lens, mark)
-        stop = 2.0 * paraxial.stop_semi_diameter_for_fstop(st.prescription, report.fstop)
+        stop = 2.0 * focusing.iris_semi_diameter(lens, report.fstop)
         out["realistic"] = {"lensfile": str(lensfile), "aperturediameter": stop,
                             "focusdistance": mark / MM_PER_SCENE_UNIT, "film_distance_mm": st.back_focus_mm}
     if "perspective" in cameras:

@@ -89,8 +89,9 @@ def focus_distance_from_pupil_mm(report) -> float:
 def pinhole_fstop(report) -> float:
     """The f-number a renderer's camera needs beside the best-match pinhole's focal length so that
     focalLength / fStop is the lens's entrance-pupil diameter (EFL / N): depth of field then
-    matches, since defocus blur seen from the pupil depends only on that diameter and the focus."""
-    return report.fstop * report.pinhole[0] / report.focal_length_mm
+    matches, since defocus blur seen from the pupil depends only on that diameter and the focus. The
+    diameter is the one at this focus (an internal-focus lens's iris seen through its focused front)."""
+    return report.pinhole[0] / report.aperture_diameter_mm
 
 
 @takes_report

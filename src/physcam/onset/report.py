@@ -197,6 +197,9 @@ class LensReport:
     #: working over geometric f-number at this focus: a prescription's paraxial ratio; None: 1 + m
     #: (pupils taken as equal)
     bellows_factor: float | None = None
+    #: the f-number at this focus for the iris set to ``fstop`` at infinity (see f_number_at_focus);
+    #: None: ``fstop`` (no focusing changes it)
+    fstop_at_focus: float | None = None
 
     # --- convenience --------------------------------------------------------
     @property
@@ -216,8 +219,15 @@ class LensReport:
 
     @property
     def aperture_diameter_mm(self) -> float:
-        """Entrance-pupil diameter f / N."""
-        return self.focal_length_mm / self.fstop
+        """Entrance-pupil diameter at this focus, f / N at focus (:attr:`fstop_at_focus`)."""
+        return self.focal_length_mm / self.f_number_at_focus
+
+    @property
+    def f_number_at_focus(self) -> float:
+        """EFL over entrance-pupil diameter at this focus, with the iris set to ``fstop`` at infinity: the
+        f-number depth of field uses. ``fstop`` itself for a thin lens, a datasheet or a unit-focusing
+        lens; an internal-focus prescription's own (physcam.optics.focusing.f_number_ratio)."""
+        return self.fstop if self.fstop_at_focus is None else self.fstop_at_focus
 
     @property
     def pivot_camera_space_mm(self):
@@ -299,6 +309,7 @@ class LensReport:
             "fstop": self.fstop,
             "tstop": self.tstop,
             "aperture_diameter_mm": self.aperture_diameter_mm,
+            "fstop_at_focus": self.f_number_at_focus,
             "squeeze": self.squeeze,
             "sensor": {
                 "key": s.key,
@@ -398,6 +409,7 @@ def solve_lens_report(
     pinhole_focal_length_mm: float | None = None,
     pinhole_squeeze: float | None = None,
     diffraction_wavelength_nm: float = DIFFRACTION_WAVELENGTH_NM,
+    fstop_at_focus: float | None = None,
 ) -> LensReport:
     """Solve the lens report.
 
@@ -423,6 +435,11 @@ def solve_lens_report(
 
     ``diffraction_wavelength_nm`` (default 550): the wavelength of the diffraction figures
     (Airy disk against the CoC and the photosite pitch; see the module notes).
+
+    The f-stop is the iris's setting, defined at infinity focus (one rule for every consumer:
+    :func:`physcam.optics.focusing.iris_semi_diameter`). Depth of field uses the f-number at the
+    focus (:attr:`LensReport.f_number_at_focus`): an internal-focus prescription's own, or
+    ``fstop_at_focus`` when it is known from elsewhere (a USD file written from a prescription).
     """
     notes: list[str] = []
     pupil_origin = "datasheet"
@@ -431,6 +448,7 @@ def solve_lens_report(
         raise InputError(f"diffraction wavelength must lie between 200 and 20000 nm, got {lam_diff:g}")
     bellows = None
     lens_pinhole = None  # (Y, X) best-match pinhole focal lengths from a prescription
+    n_ratio = 1.0  # f-number at this focus over the iris's f-stop (internal focusing)
     from ..errors import require_type
 
     require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name) or custom_sensor(w, h)")
@@ -480,19 +498,22 @@ def solve_lens_report(
         )
         lens_pinhole = (planes.pinhole_focal_length_mm, planes.pinhole_focal_length_mm)
         lens_stop = planes.stop_from_film_mm
-        lens_dof_aspect = 1.0
-        bellows = planes.working_f_number / planes.f_number
-        if lens.is_anamorphic and squeeze == 1.0:
-            squeeze_from_lens = True
+        n_ratio = focusing.f_number_ratio(lens, D_lens)
+        # the blur's width over height on the film, desqueezed by the lens's own squeeze: 1 for a
+        # spherical lens; an anamorphic's entrance pupil X over Y (see _pupil_aspect)
+        lens_dof_aspect, lens_squeeze = 1.0, 1.0
+        bellows = planes.working_f_number / planes.f_number * n_ratio  # working f-number over the f-stop
+        if lens.is_anamorphic:
             # the squeeze the lens really has at this focus: EFL in Y over EFL in X
             st = focusing.focus(lens, D_lens)
             gx = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z)
+            lens_squeeze = planes.efl_mm / gx.efl
+            lens_dof_aspect = _pupil_aspect(lens, D_lens)
+        if lens.is_anamorphic and squeeze == 1.0:
+            squeeze_from_lens = True
             efl_x = gx.efl
-            squeeze = planes.efl_mm / efl_x
+            squeeze = lens_squeeze
             lens_pinhole = (planes.pinhole_focal_length_mm, gx.pinhole_focal_length)
-            # one physical (round) stop seen through each meridian: the ratio does not depend on its size
-            gy = paraxial.gaussian(st.prescription, axis="y", object_z=st.object_z, film_z=st.film_z)
-            lens_dof_aspect = gx.entrance_pupil_diameter / gy.entrance_pupil_diameter
             notes.append(
                 f"anamorphic: EFL {planes.efl_mm:.3f} mm (Y) and {efl_x:.3f} mm (X), effective squeeze "
                 f"{squeeze:.4f} (nominal {lens.squeeze:g})"
@@ -515,6 +536,12 @@ def solve_lens_report(
     c, coc_name = circle_of_confusion(w, h, coc)
     c, coc_name = _named_coc(w, h, coc, c, coc_name)
     N = None if fstop is None else _require_f_number("f-stop", fstop)
+    if fstop_at_focus is not None:
+        if lens is not None:
+            raise InputError("with a lens prescription the f-number at the focus is computed from the lens")
+        if N is None:
+            raise InputError("the f-number at the focus needs the f-stop it belongs to")
+        n_ratio = _require_f_number("f-number at the focus", fstop_at_focus) / N
     T = None if tstop is None else _require_f_number("T-stop", tstop)
     hyperfocal = focus_mm == HYPERFOCAL
     if hyperfocal and (N is None or near_mm is not None or far_mm is not None):
@@ -593,7 +620,7 @@ def solve_lens_report(
 
     # --- focus ----------------------------------------------------------------
     if hyperfocal:  # the subject plane at H = f^2/(N c) + f from H1 (Wikipedia "Hyperfocal distance")
-        D = mark_for_s(_dof.hyperfocal_distance(f, N, c))
+        D = mark_for_s(_dof.hyperfocal_distance(f, N * n_ratio, c))
         solved["focus"] = HYPERFOCAL
         notes.append(f"focus at the hyperfocal distance: mark {D:.6g} mm from the film")
     if D is None:
@@ -602,7 +629,7 @@ def solve_lens_report(
             # so iterate the film->H1 conversion (converges in a few steps: s' ~ f).
             s = _solve_focus_from_bracket(near_m, far_m, h1_at, f)
         elif N is not None and (near_m is not None or far_m is not None):
-            hp = f * f / (N * c)
+            hp = f * f / (N * n_ratio * c)
             s = _solve_focus_from_one_limit(near_m, far_m, hp, f, h1_at)
         else:
             raise InputError(
@@ -642,16 +669,16 @@ def solve_lens_report(
             )
         if N is None or coc_explicit:
             marked = N
-            N = _dof.f_number_for_dof(f, c, hp)
+            N = _dof.f_number_for_dof(f, c, hp) / n_ratio  # the iris's setting (at infinity)
             solved["fstop"] = N
             if marked is not None:
                 solved["fstop_drift_stops"] = _dof.stops_between(N, marked)
         else:
-            c = _dof.coc_for_dof(f, N, hp)
+            c = _dof.coc_for_dof(f, N * n_ratio, hp)
             coc_name = "solved"
             solved["coc_mm"] = c
         if far_m is not None and hp_near is not None:
-            _, far_pred = _dof.dof_limits(f, N, c, s)
+            _, far_pred = _dof.dof_limits(f, N * n_ratio, c, s)
             pred_film = far_pred + h1_at(s)
             solved["far_predicted_from_film_mm"] = _finite_or_none(pred_film)
             solved["far_error_mm"] = (
@@ -672,11 +699,20 @@ def solve_lens_report(
             notes.append("the T-stop is faster than the f-stop: a T-stop is never below the f-number")
 
     # --- depth of field --------------------------------------------------------
-    dof = _dof_block(f, N, c, s, h1_at)
+    n_focus = N * n_ratio  # the f-number at this focus: what depth of field depends on
+    if abs(n_ratio - 1.0) > 0.005:
+        notes.append(f"the iris set to f/{N:.3g} (at infinity) makes the lens f/{n_focus:.3g} at this focus "
+                     f"(internal focusing changes its EFL and entrance pupil); depth of field uses f/{n_focus:.3g}")
+    dof = _dof_block(f, n_focus, c, s, h1_at)
     dof_h = None
+    # desqueezing by sq where the lens squeezes by lens_squeeze stretches its blur by sq / lens_squeeze
+    blur_aspect = lens_dof_aspect * sq / lens_squeeze if lens is not None else 1.0 / sq
     if sq != 1.0:
-        dof_h = _dof_block(f, N, c / sq, s, h1_at)
-        notes.append(f"anamorphic {sq:g}x: horizontal CoC is c / squeeze = {c / sq:.4g} mm")
+        # A defocused point is blur_aspect as wide as tall in the desqueezed picture, so the
+        # horizontal limits are where the vertical blur reaches c / blur_aspect (docs/lens-report.md,
+        # "Anamorphic depth of field"): deeper for a front anamorphic, the same for a rear one.
+        dof_h = _dof_block(f, n_focus, c / blur_aspect, s, h1_at)
+        notes.append(_anamorphic_dof_note(sq, blur_aspect, c, from_lens=lens is not None))
     if lens is not None:
         # a real lens's principal planes move as it focuses: the hyperfocal *mark* is the one focus
         # whose subject plane lies at H from H1 with the lens focused there (the fixed point that
@@ -689,7 +725,8 @@ def solve_lens_report(
             dof = dataclasses.replace(dof, hyperfocal_mm=mark - planes_h.h1_from_film_mm,
                                       hyperfocal_from_film_mm=mark)
             if dof_h is not None:
-                mark, planes_h = _lens_hyperfocal_mark(lens, N, c, squeeze=None if squeeze_from_lens else sq)
+                mark, planes_h = _lens_hyperfocal_mark(lens, N, c, blur_aspect=None if squeeze_from_lens
+                                                       else blur_aspect)
                 dof_h = dataclasses.replace(dof_h, hyperfocal_mm=mark - planes_h.h1_from_film_mm,
                                             hyperfocal_from_film_mm=mark)
         except (OpticsError, InputError) as exc:
@@ -778,9 +815,10 @@ def solve_lens_report(
         pinhole_focal_length_mm=pin_y,
         pinhole_squeeze=pin_sq,
         stop_from_film_mm=(lens_stop if lens is not None else (h1_film if model == "practical" else None)),
-        dof_aspect=lens_dof_aspect if lens is not None else 1.0 / sq,
+        dof_aspect=blur_aspect,
         diffraction_wavelength_nm=lam_diff,
         bellows_factor=bellows,
+        fstop_at_focus=None if n_ratio == 1.0 else n_focus,
         **fov,
     )
     import dataclasses
@@ -864,20 +902,24 @@ def _lens_hyperfocal(lens, fstop, sensor, coc, near_mm, far_mm):
 
 
 @lru_cache(maxsize=64)  # a hyperfocal focus solves it, and its report's DOF block asks again
-def _lens_hyperfocal_mark(lens, n: float, c: float, *, squeeze: float | None = 1.0):
+def _lens_hyperfocal_mark(lens, n: float, c: float, *, blur_aspect: float | None = 1.0):
     """(mark, planes at the mark) of :func:`_lens_hyperfocal` for f-number ``n`` and CoC ``c`` (mm).
 
     The planes (EFL, H1) do not depend on the f-number, so they are found without it (any f-number
-    the lens can or cannot open to gives the same mark). ``squeeze``: the CoC is ``c / squeeze`` (an
-    anamorphic's horizontal limits); None takes the lens's effective squeeze at each mark (EFL in Y
-    over EFL in X, as the report does), so the horizontal mark too is a fixed point."""
-    from ..optics.focusing import technical_planes
+    the lens can or cannot open to gives the same mark); ``n`` is the iris's setting at infinity, and
+    the f-number at each candidate mark is n times the lens's f-number ratio there (internal focusing).
+    ``blur_aspect``: the CoC is ``c / blur_aspect`` (an anamorphic's horizontal limits, the blur's
+    width over height in the desqueezed picture); None takes the lens's own blur aspect at each mark
+    (its entrance pupil's X over Y diameter, as the report does), so the horizontal mark too is a
+    fixed point."""
+    from ..optics.focusing import f_number_ratio, technical_planes
 
     mark = math.inf
     for _ in range(50):
         planes = technical_planes(lens, mark)
-        sq = _effective_squeeze(lens, mark, planes.efl_mm) if squeeze is None else squeeze
-        new = _dof.hyperfocal_distance(planes.efl_mm, n, c / sq) + planes.h1_from_film_mm
+        aspect = _pupil_aspect(lens, mark) if blur_aspect is None else blur_aspect
+        n_at = n * f_number_ratio(lens, mark)
+        new = _dof.hyperfocal_distance(planes.efl_mm, n_at, c / aspect) + planes.h1_from_film_mm
         new = _require_distance("hyperfocal focus mark", new)
         if math.isfinite(mark) and abs(new - mark) <= 1e-9 * new:
             return new, technical_planes(lens, new)
@@ -885,12 +927,22 @@ def _lens_hyperfocal_mark(lens, n: float, c: float, *, squeeze: float | None = 1
     raise OpticsError(f"the hyperfocal focus of {lens.name!r} did not settle; give the focus mark")
 
 
-def _effective_squeeze(lens, mark: float, efl_y: float) -> float:
-    """An anamorphic lens's squeeze at focus ``mark``: EFL in Y over EFL in X."""
+def _pupil_aspect(lens, mark: float) -> float:
+    """An anamorphic lens's blur aspect at focus ``mark``: its entrance pupil's X over Y diameter
+    (one round stop seen through each meridian; the ratio does not depend on the stop's size)."""
     from ..optics import focusing, paraxial
 
     st = focusing.focus(lens, mark)
-    return efl_y / paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z).efl
+    gx, gy = (paraxial.gaussian(st.prescription, axis=a, object_z=st.object_z, film_z=st.film_z) for a in "xy")
+    return gx.entrance_pupil_diameter / gy.entrance_pupil_diameter
+
+
+def _anamorphic_dof_note(sq: float, aspect: float, c: float, *, from_lens: bool) -> str:
+    """Why the horizontal limits differ from the vertical ones (or do not)."""
+    source = ("the lens's entrance pupil, X over Y" if from_lens else
+              "a front anamorphic's narrowed pupil, 1 / squeeze; a rear anamorphic's blur is round: give --lens")
+    return (f"anamorphic {sq:g}x: a defocused point is {aspect:.3g} as wide as tall in the desqueezed picture "
+            f"({source}), so the horizontal limits take the CoC c / {aspect:.3g} = {c / aspect:.4g} mm")
 
 
 def _require_distance(name: str, value) -> float:

@@ -41,6 +41,8 @@ __all__ = [
     "image_distance",
     "focus",
     "closest_focus",
+    "iris_semi_diameter",
+    "f_number_ratio",
     "gaussian_at_focus",
     "technical_planes",
     "breathing_table",
@@ -321,6 +323,33 @@ def focus(
 
 
 @takes_prescription
+def iris_semi_diameter(prescription: Prescription, fstop: float, *, method: str = "auto") -> float:
+    """The iris (aperture stop) semi-diameter, mm, of ``prescription`` set to f/``fstop``.
+
+    The one rule every consumer follows (report, tracer, pbrt, Blender, Mitsuba, USD): the f-number
+    engraved on a lens is its EFL over its entrance pupil diameter with the lens focused at infinity
+    (ISO 517; Kingslake, *Lens Design Fundamentals*, 2nd ed., 6.1), in the Y meridian at the design
+    wavelength. A real iris keeps its size when the lens focuses; an internal-focus lens's EFL and
+    pupils change instead, so its working f-number (and its f-number at that focus) differ from
+    ``fstop``. Raises :class:`OpticsError` for an f-stop faster than the lens opens."""
+    inf_state = focus(prescription, math.inf, method=method)
+    return paraxial.stop_semi_diameter_for_fstop(inf_state.prescription, fstop)
+
+
+@takes_prescription
+def f_number_ratio(prescription: Prescription, focus_from_film_mm: float, *, method: str = "auto") -> float:
+    """The lens's f-number at a focus mark over its f-number at infinity, for one iris.
+
+    With the iris fixed (:func:`iris_semi_diameter`), f/N at infinity becomes f/(N x this ratio) at the
+    mark: EFL over entrance pupil diameter of the lens focused there. Exactly 1 for unit focusing
+    (the lens moves whole; its EFL and pupils do not change); an internal-focus lens's EFL and
+    entrance pupil change with the gaps. The ratio does not depend on the iris's size (paraxial
+    pupils scale with the stop)."""
+    at_infinity = gaussian_at_focus(prescription, math.inf, method=method).f_number
+    return gaussian_at_focus(prescription, focus_from_film_mm, method=method).f_number / at_infinity
+
+
+@takes_prescription
 def gaussian_at_focus(
     prescription: Prescription,
     focus_from_film_mm: float = math.inf,
@@ -332,13 +361,15 @@ def gaussian_at_focus(
     fstop=None,
     flange_focal_distance_mm=None,
 ) -> paraxial.GaussianData:
-    """Gaussian data in the ``axis`` meridian with the lens focused (in ``focus_axis``) at the mark."""
+    """Gaussian data in the ``axis`` meridian with the lens focused (in ``focus_axis``) at the mark;
+    ``fstop`` sizes the iris by :func:`iris_semi_diameter` (at infinity focus, kept at every focus)."""
     st = focus(prescription, focus_from_film_mm, method=method, axis=focus_axis, wavelength_nm=wavelength_nm)
+    stop = None if fstop is None else iris_semi_diameter(prescription, fstop, method=method)
     return paraxial.gaussian(
         st.prescription,
         axis=axis,
         wavelength_nm=wavelength_nm,
-        fstop=fstop,
+        stop_semi_diameter=stop,
         object_z=st.object_z,
         film_z=st.film_z,
         flange_focal_distance_mm=flange_focal_distance_mm,

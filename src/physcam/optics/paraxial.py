@@ -307,7 +307,12 @@ def _check_lens(prescription: Prescription) -> None:
 
 @takes_prescription
 def stop_semi_diameter_for_fstop(prescription: Prescription, fstop: float, axis: str = "y", wavelength_nm=None) -> float:
-    """Stop semi-diameter (mm) that gives the f-number ``fstop`` (= EFL / entrance pupil diameter, object at infinity)."""
+    """Stop semi-diameter (mm) that makes ``prescription``, exactly as given, f/``fstop`` (EFL over entrance
+    pupil diameter, object at infinity).
+
+    For a lens that focuses, the iris is sized once, at infinity focus, and keeps that size at every
+    focus: use :func:`physcam.optics.focusing.iris_semi_diameter`, the one rule every consumer
+    follows, rather than this function on a focused state."""
     base = gaussian(prescription, axis=axis, wavelength_nm=wavelength_nm)
     fstop = require_positive("f-number", fstop, unit="")
     scale = base.f_number / fstop
@@ -330,6 +335,7 @@ def gaussian(
     object_z: float = -math.inf,
     film_z: float | None = None,
     flange_focal_distance_mm: float | None = None,
+    stop_semi_diameter: float | None = None,
 ) -> GaussianData:
     """Gaussian data of ``prescription`` in the ``axis`` meridian.
 
@@ -337,7 +343,9 @@ def gaussian(
     vertex; ``-inf`` for infinity). ``film_z``: lens-space z of the film (sensor)
     plane; default the paraxial image of the object (F' at infinity).
     ``fstop``: evaluate the pupils at this f-number by scaling the stop
-    semi-diameter (default: the stop as given in the file).
+    semi-diameter (default: the stop as given in the file) so that this prescription, as given, is
+    f/``fstop`` at infinity. ``stop_semi_diameter`` sets the stop's size directly instead (the iris of
+    :func:`physcam.optics.focusing.iris_semi_diameter` for a focused state of a focusing lens).
     ``flange_focal_distance_mm``: the flange lies this far in front of the film.
     Raises :class:`OpticsError` for an afocal lens or an object at the front focal point.
     """
@@ -376,8 +384,12 @@ def gaussian(
     k = prescription.stop_index
     z_stop = zv[k]
     stop_semi = surfaces[k].semi_diameter
+    if fstop is not None and stop_semi_diameter is not None:
+        raise InputError("give the f-stop or the stop's semi-diameter, not both")
     if fstop is not None:
         stop_semi = stop_semi_diameter_for_fstop(prescription, fstop, axis, lam)
+    elif stop_semi_diameter is not None:
+        stop_semi = require_positive("stop semi-diameter", stop_semi_diameter)
     # front group: first vertex -> stop vertex (the stop has no power)
     front = _mul((1.0, surfaces[k - 1].thickness / n[k], 0.0, 1.0), system_matrix(prescription, axis, lam, 0, k - 1)) if k > 0 else (1.0, 0.0, 0.0, 1.0)
     back = system_matrix(prescription, axis, lam, k, len(surfaces) - 1)

@@ -202,11 +202,11 @@ def plenoptic_camera(main: Prescription, array: MicrolensArray, *, focus_mm: flo
         raise InputError(f"main lens {main.name!r} is anamorphic; the light-field camera takes a spherical lens")
     if (focus_mm is None) == (film_to_lens_mm is None):
         raise InputError("place the sensor either by a focus distance or by the film-to-lens distance, not both")
-    from ..optics.paraxial import stop_semi_diameter_for_fstop
+    from ..optics.focusing import iris_semi_diameter
 
     stop = main.surfaces[main.stop_index].semi_diameter
     if fstop is not None:
-        stop = stop_semi_diameter_for_fstop(main, require_positive("f-number", fstop, unit=""))
+        stop = iris_semi_diameter(main, require_positive("f-number", fstop, unit=""))
     b = array.sensor_offset_mm
     if focus_mm is not None:
         from ..optics.focusing import focus

@@ -82,6 +82,9 @@ class CameraSpec:
     ``aperture_distance_mm``: the physical aperture stop (iris) in front of the film, when known.
     ``dof_aspect``: width / height of the defocus blur in the desqueezed picture (RenderMan's
     ``dofaspect``); None: 1 / squeeze (a front anamorphic), 1 for a spherical lens.
+    ``fstop_at_focus``: the f-number at this focus of an internal-focus lens whose iris is set to
+    ``fstop`` at infinity (:attr:`physcam.onset.report.LensReport.f_number_at_focus`); the lens's
+    ``iris`` (entrance pupil diameter) is focal length / it. None: ``fstop``.
     ``projection``: "perspective" (a pinhole/thin-lens model) or "orthographic"
     (a telecentric model imaging ``sensor / magnification`` of the scene).
     """
@@ -101,6 +104,7 @@ class CameraSpec:
     enlarge: tuple[float, float] = (1.0, 1.0)
     handedness: float = 1.0
     dof_aspect: float | None = None
+    fstop_at_focus: float | None = None
     iso: float = 100.0
     transmittance: float = 1.0
     flange_distance_mm: float = 52.0
@@ -188,7 +192,8 @@ def report_for_spec(spec: CameraSpec):
     )
     common = dict(focal_length_mm=spec.focal_length_mm, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
                   coc=spec.coc_mm, squeeze=spec.squeeze, lens_name=spec.lens_name,
-                  pinhole_focal_length_mm=spec.pinhole_focal_length_mm, pinhole_squeeze=spec.pinhole_squeeze)
+                  pinhole_focal_length_mm=spec.pinhole_focal_length_mm, pinhole_squeeze=spec.pinhole_squeeze,
+                  fstop_at_focus=spec.fstop_at_focus)
     if spec.principal_planes_mm is not None:
         h1, h2 = spec.principal_planes_mm
         return solve_lens_report(model="technical", h1_mm=h1, h2_mm=h2, pupil_mm=spec.entrance_pupil_mm, **common)
@@ -219,6 +224,7 @@ def spec_from_report(report, **body) -> CameraSpec:
                              else None),
         aperture_distance_mm=report.stop_from_film_mm,
         dof_aspect=report.dof_aspect if report.entrance_pupil_source == "prescription" else None,
+        fstop_at_focus=report.fstop_at_focus,
         # a prescription's best-match pinhole is kept; a thin lens or datasheet recomputes its own
         pinhole_focal_length_mm=report.pinhole_focal_length_mm if report.entrance_pupil_source == "prescription"
         else None,
@@ -410,8 +416,13 @@ def _author_body(cam, spec, position, rotate_xyz_deg, eye_su):
     _set(cam, "shutterOpen", Sdf.ValueTypeNames.Float, spec.shutter_open_s)
     _set(cam, "shutterDuration", Sdf.ValueTypeNames.Float, spec.shutter_duration_s)
     _set(cam, "shutterOpening", Sdf.ValueTypeNames.Float2, Gf.Vec2f(*spec.shutter_opening))
-    _set(cam, "iris", Sdf.ValueTypeNames.Float, spec.focal_length_mm / spec.fstop)
+    _set(cam, "iris", Sdf.ValueTypeNames.Float, _iris_mm(spec))
     author_transform(cam, position, rotate_xyz_deg, eye_su)
+
+
+def _iris_mm(spec) -> float:
+    """The schema's ``iris``: the entrance pupil's diameter at this focus, focal length / f-number there."""
+    return spec.focal_length_mm / (spec.fstop if spec.fstop_at_focus is None else spec.fstop_at_focus)
 
 
 def author_transform(cam, position, rotate_xyz_deg, eye_su: float) -> None:
@@ -447,7 +458,7 @@ def _author_lens(stage, cam, spec, eye, su):
     sdf_path = cam.GetPath()
     lp = f"lens:{LENS_INSTANCE}:"
     _set(cam, lp + "fStop", Sdf.ValueTypeNames.Float, spec.fstop)
-    _set(cam, lp + "iris", Sdf.ValueTypeNames.Float, spec.focal_length_mm / spec.fstop)
+    _set(cam, lp + "iris", Sdf.ValueTypeNames.Float, _iris_mm(spec))
     _set(cam, lp + "entrancePupilDistance", Sdf.ValueTypeNames.Float, eye)
     if spec.principal_planes_mm is not None:
         _set(cam, lp + "frontPrincipalPlaneDistance", Sdf.ValueTypeNames.Float, spec.principal_planes_mm[0])

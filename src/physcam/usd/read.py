@@ -104,6 +104,16 @@ def _optional(prim, name: str):
     return float(attr.Get()) if attr and attr.HasAuthoredValue() else None
 
 
+def _fstop_at_focus(prim, lp: str, focal_mm: float):
+    """The f-number at the focus from the lens's ``iris`` (focal length / iris) when it differs from its
+    ``fStop`` beyond float32 rounding (an internal-focus lens: physcam.onset.report), else None."""
+    iris, n = _optional(prim, lp + "iris"), _optional(prim, lp + "fStop")
+    if iris is None or n is None or not iris > 0:
+        return None
+    at_focus = focal_mm / iris
+    return at_focus if abs(at_focus - n) > 1e-5 * n else None
+
+
 def _principal_planes(prim, lp: str):
     """(H1, H2) in front of the film when both are authored, else None (a thin lens)."""
     a = prim.GetAttribute(lp + "frontPrincipalPlaneDistance")
@@ -254,6 +264,7 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
         principal_planes_mm=_principal_planes(prim, lp),
         pinhole_focal_length_mm=_optional(prim, lp + "pinholeFocalLength"),
         pinhole_squeeze=_optional(prim, lp + "pinholeSqueeze"),
+        fstop_at_focus=_fstop_at_focus(prim, lp, focal),
         shift_mm=(float(shift[0]), float(shift[1])),
         iso=float(_get(prim, sp + "iso", "")),
         transmittance=float(_get(model, "transmittance", "")),
