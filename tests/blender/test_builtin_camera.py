@@ -6,6 +6,7 @@ out-of-focus point blurs; Blender renders the camera physcam authored, and the i
 
 from __future__ import annotations
 
+import json
 import math
 
 import pytest
@@ -70,10 +71,12 @@ print(json.dumps({"size": [w, h], "blobs": blobs}))
 
 
 def _render(tmp_path, values, spheres, windows, samples, filter_width):
-    """Render emissive spheres (x, y, z, radius in metres, camera at the origin looking down -Z) and
-    return each window's (pixel columns) intensity centroid and second moment (pixels)."""
-    import json
-
+    """Render emissive spheres (x, y, z, radius in metres from the **entrance pupil**, looking down -Z) and
+    return each window's (pixel columns) intensity centroid and second moment (pixels). The scene camera
+    starts at the origin, which the script reads as the film plane: it must move the camera forward to the
+    pupil, where the spheres are placed from (issue 24: it used to stay at the film, 1.5 % wider)."""
+    p = values["entrance_pupil_from_film_mm"] / 1000.0
+    spheres = [(x, y, z - p, r) for x, y, z, r in spheres]
     spec = {"script": blender_camera_script(values), "spheres": spheres, "windows": windows, "samples": samples,
             "filter_width": filter_width, "out": str(tmp_path / "render.exr")}
     return run_blender(SCENE, json.dumps(spec))
@@ -158,3 +161,36 @@ print(json.dumps({"lens": cam.lens, "fstop": cam.dof.aperture_fstop, "blades": c
     assert out["lens"] / out["fstop"] == pytest.approx(planes.efl_mm / 4.0, rel=1e-6)  # entrance pupil EFL/N
     assert out["blades"] == 6 and out["w"] == pytest.approx(36.0)
     assert out["focus"] == pytest.approx((1500.0 - planes.entrance_pupil_from_film_mm) / 1000.0, rel=1e-6)
+
+
+def test_builtin_iris_corners_where_physcam_puts_them(tmp_path):
+    """A 6-blade iris with a corner 15 degrees from +x (physcam's and RenderMan's apertureAngle) renders a
+    hexagonal bokeh with a corner at 15 degrees (mod 60; a near light's blur is the iris turned 180 degrees,
+    which maps a hexagon onto itself). Blender's polygon has a flat side toward +x at rotation 0: without
+    the 180/N the corners came out at 45 degrees (issue 24 item 3)."""
+    import numpy as np
+
+    from physcam.analysis.blob import polygon_corners
+
+    r = solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("FF"), fstop=2.0, focus_mm=2000.0)
+    v = blender_camera_values(r, resolution_x=512, blades=6, blade_rotation_deg=15.0)
+    v["camera"].update({"sensor_width": 4.0, "sensor_height": 4.0})  # a 4 mm crop: the blur is ~2.5 mm
+    v["render"].update({"resolution_x": 160, "resolution_y": 160})
+    scene = SCENE.replace('print(json.dumps({"size": [w, h], "blobs": blobs}))',
+                          'print(json.dumps({"img": a[::-1].tolist()}))')  # row 0 at the bottom
+    p = r.entrance_pupil_from_film_mm / 1000.0
+    out = run_blender(scene, json.dumps({"script": blender_camera_script(v), "windows": [],
+                                         "spheres": [(0.0, 0.0, -0.5 - p, 0.001)], "samples": 256,
+                                         "filter_width": 0.01, "out": str(tmp_path / "iris.exr")}))
+    img = np.array(out["img"])
+    n, harmonic, corner = polygon_corners(img)
+    assert (n, harmonic) == (6, 6)
+    assert abs((corner - 15.0 + 30.0) % 60.0 - 30.0) < 3.0
+
+
+def test_blender_blade_rotation_adds_half_a_sector():
+    from physcam.export.blender_camera import blender_blade_rotation_deg
+
+    assert blender_blade_rotation_deg(6, 0.0) == 30.0  # Cycles: corners at +-180/N at rotation 0
+    assert blender_blade_rotation_deg(5, 10.0) == 46.0
+    assert blender_blade_rotation_deg(0, 10.0) == 10.0  # a round iris has no corners

@@ -193,14 +193,14 @@ def run_blender(args) -> int:
                                       sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
                                       aperture=aperture, dispersion=args.dispersion, fresnel=args.fresnel,
                                       resolution=(w, h), name=Path(args.lens).stem, force=args.force)
-    builtin = None
+    builtin = gap = None
     if args.builtin:
-        builtin = _write_builtin(args, lens, w, Path(args.output) / f"builtin_{Path(args.lens).stem}.py")
+        builtin, gap = _write_builtin(args, lens, w, Path(args.output) / f"builtin_{Path(args.lens).stem}.py")
     data = {"lens": lens.name, "shader": str(osl), "setup": str(setup), "builtin": builtin and str(builtin),
             "focus_from_film_mm": None
             if args.focus == float("inf") else args.focus, "fstop": args.fstop, "sensor_mm": [args.sensor_width,
             args.sensor_height], "resolution": [w, h], "dispersion": args.dispersion, "fresnel": args.fresnel,
-            "seconds": round(time.perf_counter() - t0, 3)}
+            "thin_lens_gap": gap and gap.to_dict(), "seconds": round(time.perf_counter() - t0, 3)}
     if args.json:
         emit_json(document("export_blender", data, units={"length": "mm", "time": "s", "image": "pixel"}))
         return 0
@@ -212,6 +212,7 @@ def run_blender(args) -> int:
     print(f"  in Blender: blender your.blend --python {setup}  (Cycles, CPU, OSL)")
     if builtin is not None:
         print(f"  or Blender's own camera, matched: blender your.blend --python {builtin}")
+        print(f"  note: {gap.summary()}")
     return 0
 
 
@@ -228,12 +229,17 @@ def _write_builtin(args, lens, width_px: int, path):
     if math.isinf(args.focus):
         raise InputError("--builtin needs a finite focus mark (the built-in camera's focus distance); "
                          "give e.g. --focus 1000m")
+    from ..analysis.thin_lens_gap import thin_lens_gap
+
     report = solve_lens_report(focal_length_mm=None, sensor=custom_sensor(args.sensor_width, args.sensor_height),
                                fstop=args.fstop, focus_mm=args.focus, lens=lens)
     blades = int(args.blades or 0)
     values = blender_camera_values(report, resolution_x=width_px, blades=blades if blades >= 3 else 0,
                                    blade_rotation_deg=args.blade_angle)
-    return atomic_write(path, blender_camera_script(values), force=args.force)
+    gap = thin_lens_gap(report, lens)
+    values["thin_lens_gap"] = gap.to_dict()
+    path = atomic_write(path, blender_camera_script(values, comments=[gap.summary()]), force=args.force)
+    return path, gap
 
 
 # --- RenderMan RIB and pbrt-v4 (issue 13; docs/renderman-pbrt.md) ---------------------------------------------
@@ -292,6 +298,12 @@ def _camera_look(p, blades_default) -> None:
                         "(seed 002; default 0,1: instantaneous)")
 
 
+def _thin_lens_gap(args, report):
+    from .report import thin_lens_gap_from_args
+
+    return thin_lens_gap_from_args(args, report)
+
+
 def _report(args):
     """The lens report of the command's arguments (a focus mark, or one solved from --near/--far)."""
     from .report import solve_from_args
@@ -333,6 +345,9 @@ def run_rib(args) -> int:
             "from there",
             "fov spans the screen window's shorter side (the ScreenWindow unit); Shutter is in frames",
         ]
+        gap = _thin_lens_gap(args, report)
+        if gap is not None:
+            comments.append(gap.summary())
         text = rib_camera_block(values, legacy=args.legacy, comments=comments)
         path = atomic_write(args.output, text, force=args.force)
     proj = values["Projection"]
@@ -340,7 +355,8 @@ def run_rib(args) -> int:
         emit_json(document("export_rib", {
             "written": str(path), "form": "legacy" if args.legacy else "PxrCamera", "meters_per_unit": mpu,
             "rib": values, "focus_from_pupil_mm": focus_distance_from_pupil_mm(report),
-            "fov_deg": {"horizontal": report.hfov_focus_deg, "vertical": report.vfov_focus_deg}},
+            "fov_deg": {"horizontal": report.hfov_focus_deg, "vertical": report.vfov_focus_deg},
+            "thin_lens_gap": gap and gap.to_dict()},
             units={"length": "mm", "angle": "degree", "rib": "scene units of meters_per_unit m"}))
         return 0
     from ._common import units_of
@@ -351,6 +367,8 @@ def run_rib(args) -> int:
     print(f"  Format {f['xres']} x {f['yres']} pixel aspect {f['pixelaspect']:g}; fov {proj['fov']:.4f} deg "
           f"(shorter side); fStop {proj['fStop']:.4g}, focalLength {proj['focalLength']:.6g}, focalDistance "
           f"{proj['focalDistance']:.6g} (units of {mpu:g} m); dofaspect {proj['dofaspect']:.4g}")
+    if gap is not None:
+        print(f"  note: {gap.summary()}")
     return 0
 
 
@@ -542,6 +560,10 @@ def run_mitsuba(args) -> int:
     values = mitsuba_camera_values(report, width_px=args.width_px, meters_per_unit=args.meters_per_unit,
                                    spp=args.spp, shutter_angle_deg=args.shutter_angle, fps=args.fps,
                                    shift_mm=(args.shift_x, args.shift_y))
+    gap = _thin_lens_gap(args, report)
+    values["thin_lens_gap"] = gap and gap.to_dict()
+    if gap is not None:
+        values["physcam"]["notes"].append(gap.summary())
     atomic_write(xml_path, mitsuba_scene_xml(values), force=args.force)
     atomic_write(json_path, json.dumps(mitsuba_scene_dict(values), indent=2, allow_nan=False) + "\n", force=args.force)
     if args.json:

@@ -155,6 +155,17 @@ def solve_from_args(args):
     return report
 
 
+def thin_lens_gap_from_args(args, report):
+    """How far a renderer's thin-lens camera of ``report`` is from the prescription the command loaded
+    (:func:`physcam.analysis.thin_lens_gap.thin_lens_gap`), or None for a thin lens or a datasheet."""
+    lens = getattr(args, "loaded_lens", None)
+    if lens is None:
+        return None
+    from ..analysis.thin_lens_gap import thin_lens_gap
+
+    return thin_lens_gap(report, lens)
+
+
 def camera_blocks(report, args) -> dict:
     from ..export.renderman import renderman_camera_values
     from ..export.usdgeom import usdgeom_camera_values

@@ -187,10 +187,16 @@ def run_write(args) -> int:
                                              focus_mm=report.focus_from_film_mm)
         opencv = prescription_opencv(lens, report.sensor.width_mm, report.sensor.height_mm,
                                      focus_mm=report.focus_from_film_mm, resolution=args.resolution)
+    from .report import thin_lens_gap_from_args
+
+    gap = None if args.orthographic else thin_lens_gap_from_args(args, report)
     path = write_camera(args.file, spec, force=args.force, path=args.path, meters_per_unit=args.meters_per_unit,
                         fps=args.fps, report=report if not args.orthographic else None, lens_distortion=distortion,
-                        opencv_distortion=opencv, resolution=args.resolution, overscan=args.overscan / 100.0)
-    return _done(args, path)
+                        opencv_distortion=opencv, resolution=args.resolution, overscan=args.overscan / 100.0,
+                        thin_lens_gap=gap and gap.to_dict())
+    if gap is not None and not getattr(args, "json", False):
+        print(f"note: {gap.summary()}")
+    return _done(args, path, extra={"thin_lens_gap": gap and gap.to_dict()})
 
 
 def _finite_focus(mm) -> None:
@@ -204,9 +210,9 @@ def _finite_focus(mm) -> None:
                          "or --focus hyperfocal")
 
 
-def _done(args, path, name: str = "usd_written") -> int:
+def _done(args, path, name: str = "usd_written", extra=None) -> int:
     if getattr(args, "json", False):
-        emit_json(document(name, {"written": str(path)}))
+        emit_json(document(name, {"written": str(path), **(extra or {})}))
     else:
         print(f"wrote {path}")
     return 0

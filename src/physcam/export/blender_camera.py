@@ -14,13 +14,20 @@ camera (Blender manual, "Cameras": Lens, Sensor, Depth of Field). physcam author
   EFL / N: the blur angle seen from the camera, A |1/d - 1/s|, is the lens's, and on the film
   f_pin A |1/d - 1/s| is the thin lens's exact blur (``physcam.export.usdgeom.pinhole_fstop``);
 * ``focus_distance``: from the camera, which physcam places at the entrance pupil: the focus
-  mark minus the pupil's distance from the film, in metres;
+  mark minus the pupil's distance from the film, in metres. The script's ``apply`` reads the scene
+  camera's place as the **film plane** (as physcam's PhysicalCamera body does) and moves the camera
+  object forward to the pupil under an Empty "<camera> film plane" that keeps the film's place (run
+  again, it only updates the offset); ``apply(scene, camera_at="pupil")`` leaves a camera that is
+  already at the pupil where it is;
 * ``sensor_width``/``sensor_height`` with ``sensor_fit`` "HORIZONTAL" (the desqueezed width for an
   anamorphic) and the render resolution of the same aspect; ``shift_x``/``shift_y`` as fractions
   of the sensor width (Blender's shift is relative to the larger frame side, the width here);
-* ``aperture_blades``, ``aperture_rotation`` (radians) and ``aperture_ratio``: Blender's ratio
-  above 1 stretches the bokeh vertically, so it is 1 / ``report.dof_aspect`` (2 for a front 2x
-  anamorphic's tall oval bokeh, 1 for a rear anamorphic's round one).
+* ``aperture_blades``, ``aperture_rotation`` (radians) and ``aperture_ratio``: Cycles' polygon has a
+  flat side, not a corner, toward +x at rotation 0 (its corners at +-180/N degrees: kernel
+  ``regular_polygon_sample``), so a corner ``blade_rotation_deg`` from +x (physcam's and RenderMan's
+  apertureAngle) is a rotation of blade_rotation_deg + 180/N; Blender's ratio above 1 stretches the
+  bokeh vertically, so it is 1 / ``report.dof_aspect`` (2 for a front 2x anamorphic's tall oval
+  bokeh, 1 for a rear anamorphic's round one).
 """
 
 from __future__ import annotations
@@ -31,7 +38,14 @@ from ..errors import InputError, require_finite
 from ..onset.report import takes_report
 from .usdgeom import focus_distance_from_pupil_mm, pinhole_fstop
 
-__all__ = ["blender_camera_values", "blender_camera_script"]
+__all__ = ["blender_camera_values", "blender_camera_script", "blender_blade_rotation_deg"]
+
+
+def blender_blade_rotation_deg(blades: int, corner_angle_deg: float) -> float:
+    """Blender's ``aperture_rotation`` (degrees) that puts a corner of an N-blade iris ``corner_angle_deg``
+    from +x: Cycles draws its polygon with a flat side toward +x at rotation 0 (module notes)."""
+    a = require_finite("blade rotation", corner_angle_deg)
+    return a + 180.0 / blades if blades >= 3 else a
 
 
 @takes_report
@@ -60,34 +74,66 @@ def blender_camera_values(report, *, resolution_x: int = 1920, shift_mm=(0.0, 0.
             "dof.focus_distance": focus_distance_from_pupil_mm(report) / 1000.0,
             "dof.aperture_fstop": pinhole_fstop(report),
             "dof.aperture_blades": blades,
-            "dof.aperture_rotation": math.radians(require_finite("blade rotation", blade_rotation_deg)),
+            "dof.aperture_rotation": math.radians(blender_blade_rotation_deg(blades, blade_rotation_deg)),
             "dof.aperture_ratio": 1.0 / report.dof_aspect,
         },
         "render": {"resolution_x": resolution_x, "resolution_y": res_y, "pixel_aspect_x": 1.0,
                    "pixel_aspect_y": 1.0},
         "entrance_pupil_from_film_mm": report.entrance_pupil_from_film_mm,
-        "notes": ["the camera object sits at the entrance pupil; the film plane is "
-                  f"{(report.entrance_pupil_from_film_mm or 0.0):.2f} mm behind it"],
+        "notes": ["the camera object sits at the entrance pupil, "
+                  f"{(report.entrance_pupil_from_film_mm or 0.0):.2f} mm in front of the film plane: apply() reads the "
+                  "camera's place as the film plane and moves it there (camera_at='pupil' keeps it)"],
     }
 
 
-def blender_camera_script(values: dict) -> str:
+def blender_camera_script(values: dict, *, comments=()) -> str:
     """A Python script applying :func:`blender_camera_values` to a Blender scene's camera.
 
-    Run as ``blender --python camera.py`` or import it and call ``apply(scene)``.
+    Run as ``blender --python camera.py`` or import it and call ``apply(scene)``; ``comments`` (lines)
+    go into its docstring.
     """
     import json
 
-    return f'''"""Made by physcam: Blender's built-in camera matched to a lens report (docs/blender.md)."""
+    head = "".join("\n" + str(c).replace("\\", "/").replace('"' * 3, "'" * 3) for c in comments)
+    return f'''"""Made by physcam: Blender's built-in camera matched to a lens report (docs/blender.md).{head}
+"""
 import json
 
 VALUES = json.loads({json.dumps(json.dumps(values))})
+FILM_PLANE = "physcam_film_plane"  # custom property marking the Empty that keeps the film plane's place
 
 
-def apply(scene=None):
+def _to_pupil(obj, scene):
+    """The camera object forward of the film plane by the entrance pupil's distance (module notes)."""
+    import bpy
+
+    pupil_mm = VALUES["entrance_pupil_from_film_mm"] or 0.0
+    bpy.context.view_layer.update()  # matrix_world is stale until the depsgraph updates
+    film = obj.parent if obj.parent is not None and obj.parent.get(FILM_PLANE) else None
+    if film is None:
+        film = bpy.data.objects.new(obj.name + " film plane", None)
+        film[FILM_PLANE] = True
+        for coll in obj.users_collection:
+            coll.objects.link(film)
+        film_matrix = obj.matrix_world.copy()
+        film.parent = obj.parent  # the film plane takes the camera's place in its hierarchy
+        film.matrix_world = film_matrix
+        obj.parent = film
+        obj.matrix_parent_inverse.identity()
+    obj.location = (0.0, 0.0, -pupil_mm / 1000.0 / (scene.unit_settings.scale_length or 1.0))
+    obj.rotation_euler = (0.0, 0.0, 0.0)
+    obj.scale = (1.0, 1.0, 1.0)
+
+
+def apply(scene=None, camera_at="film"):
+    """Set the scene camera; ``camera_at="film"``: its place is the film plane (moved to the pupil)."""
     import bpy
 
     scene = scene or bpy.context.scene
+    if camera_at not in ("film", "pupil"):
+        raise ValueError("camera_at is 'film' (the camera marks the film plane) or 'pupil'")
+    if camera_at == "film":
+        _to_pupil(scene.camera, scene)
     cam = scene.camera.data
     for key, value in VALUES["camera"].items():
         target = cam

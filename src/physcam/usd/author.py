@@ -59,6 +59,9 @@ DEFAULT_CAMERA_PATH = "/Cameras/Camera"
 SENSOR_INSTANCE = "main"
 LENS_INSTANCE = "main"
 RENDER_CAMERA_NAME = "Camera"
+#: the namespace of the companion camera's properties for importers that keep USD's userProperties
+#: (Blender imports ``userProperties:physcam:apertureBlades`` as the custom property ``physcam:apertureBlades``)
+BLENDER_PROPERTY = "userProperties:physcam:"
 
 
 @dataclass(frozen=True)
@@ -633,6 +636,11 @@ def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None, lens
     _set(prim, "ri:shutterCloseTime", Sdf.ValueTypeNames.Float, spec.shutter_opening[1], custom=True)
     _set(prim, "ri:shutteropening", Sdf.ValueTypeNames.FloatArray,
          shutter_opening_curve(*spec.shutter_opening), custom=True)
+    # Blender's USD importer reads no iris from a UsdGeomCamera (and no UsdRenderSettings); it keeps
+    # userProperties:* as custom properties on the camera, where a script or physcam's extension reads them
+    _set(prim, BLENDER_PROPERTY + "apertureBlades", Sdf.ValueTypeNames.Int, int(spec.aperture_blades), custom=True)
+    _set(prim, BLENDER_PROPERTY + "apertureAngle", Sdf.ValueTypeNames.Float, spec.aperture_angle_deg, custom=True)
+    _set(prim, BLENDER_PROPERTY + "dofAspect", Sdf.ValueTypeNames.Float, float(dof_aspect), custom=True)
     if lens_distortion is not None:
         _author_lens_distortion(prim, lens_distortion)
     if opencv_distortion is not None:
@@ -726,7 +734,26 @@ def author_render_settings(stage, camera_path, spec: CameraSpec, *, resolution=N
     settings.CreateAspectRatioConformPolicyAttr(UsdRender.Tokens.expandAperture)
     settings.CreateDataWindowNDCAttr(Gf.Vec4f(-o / 2, -o / 2, 1 + o / 2, 1 + o / 2))
     settings.CreateCameraRel().SetTargets([Sdf.Path(str(camera_path))])
+    camera = stage.GetPrimAtPath(str(camera_path))
+    if camera:  # for importers that read no UsdRenderSettings (Blender: docs/blender.md)
+        _set(camera, BLENDER_PROPERTY + "resolution", Sdf.ValueTypeNames.Int2, Gf.Vec2i(w_px, h_px), custom=True)
     return settings
+
+
+def _usd_dict(d: dict) -> dict:
+    """A JSON-like dict as USD customData can hold it: None dropped, lists of dicts as numbered sub-dicts."""
+    out = {}
+    for k, v in d.items():
+        if v is None or (isinstance(v, list) and not v):
+            continue
+        if isinstance(v, dict):
+            v = _usd_dict(v)
+        elif isinstance(v, list) and v and isinstance(v[0], dict):
+            v = {str(i): _usd_dict(x) for i, x in enumerate(v)}
+        elif isinstance(v, list):
+            v = [str(x) for x in v] if any(isinstance(x, str) for x in v) else [float(x) for x in v]
+        out[k] = v
+    return out
 
 
 def save_stage(stage, file, *, force: bool = False):
@@ -771,13 +798,18 @@ def save_stage(stage, file, *, force: bool = False):
 def write_camera(file, spec: CameraSpec, *, force: bool = False, path: str = DEFAULT_CAMERA_PATH,
                  meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y",
                  position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, lens_distortion=None,
-                 opencv_distortion=None, render_settings: bool = True, resolution=None, overscan: float = 0.0):
+                 opencv_distortion=None, render_settings: bool = True, resolution=None, overscan: float = 0.0,
+                 thin_lens_gap: dict | None = None):
     """Write a one-camera layer to ``file`` (see :func:`author_camera`), with a ``UsdRenderSettings``
     for its companion camera (:func:`author_render_settings`) unless ``render_settings`` is false;
-    return the Path."""
+    return the Path. ``thin_lens_gap`` (:meth:`physcam.analysis.thin_lens_gap.ThinLensGap.to_dict`) is kept
+    in the companion camera's customData ``physcam:thinLensGap``: how far it is from the real lens."""
     stage = new_stage(meters_per_unit, fps, up_axis)
     author_camera(stage, path, spec, position=position, rotate_xyz_deg=rotate_xyz_deg, report=report,
                   lens_distortion=lens_distortion, opencv_distortion=opencv_distortion)
+    if thin_lens_gap is not None:
+        companion = stage.GetPrimAtPath(f"{path}/{RENDER_CAMERA_NAME}")
+        companion.SetCustomDataByKey("physcam:thinLensGap", _usd_dict(thin_lens_gap))
     if render_settings:
         author_render_settings(stage, f"{path}/{RENDER_CAMERA_NAME}", spec, resolution=resolution, overscan=overscan)
     return save_stage(stage, file, force=force)
