@@ -16,6 +16,17 @@ order accurate, with Keys' boundary rule), separably on the regular grid. Its er
 not assumed: real chief rays are traced at every grid cell's centre and compared with the
 interpolant (``interpolation_error_px``); likewise the inverse map (``inverse_error_px``).
 
+**At a stop.** A chief ray is where a small stop images a point. With ``fstop`` the field is the
+lens's **centroid** distortion at that f-stop (the iris sized by
+:func:`physcam.optics.focusing.iris_semi_diameter`): each node's real position is the energy
+centroid of its object point's blur (:func:`physcam.analysis.centroid.image_centroids`), found by
+aiming the chief ray from the node, measuring the centroid's offset from the node and aiming again
+from the node moved back by that offset (the offset changes slowly across the field, so one step
+leaves a residual of its square). Every field says which stop it is for (``fstop``, None: chief
+rays) and its **residual there**: RMS and largest distance, in plate pixels, between the
+interpolated field and independently traced positions at every grid cell's centre (chief rays for a
+chief-ray field, centroids at the stop for a centroid field), ``residual_px``.
+
 **Pixels.** Plate pixel coordinates are continuous, x from the left edge, y from the bottom edge
 of the upright picture (the film image turned by 180 degrees); pixel (i, j) has its centre at
 (i + 0.5, j + 0.5). Scale: ``width_px / sensor_width_mm`` and ``height_px / sensor_height_mm``.
@@ -137,6 +148,8 @@ class DistortionField:
     interpolation_error_px: float  # max |interpolated - traced| ideal position at the grid cells' centres
     inverse_error_px: float  # max |D(U(q)) - q| at the inverse grid cells' centres
     max_distortion_px: float  # largest |ideal - real| over the traced nodes
+    fstop: float | None  # the stop whose centroids the field maps; None: chief rays (a small stop)
+    residual_px: tuple[float, float]  # (RMS, max) |field - traced| at the cell centres, at that stop
     distortion_stmap: np.ndarray | None = field(repr=False)  # (h, w, 3) float32; None when made without maps
     undistortion_stmap: np.ndarray | None = field(repr=False)  # (h + 2 oy, w + 2 ox, 3) float32; or None
     notes: list[str] = field(default_factory=list)
@@ -163,6 +176,10 @@ class DistortionField:
             "grid_nodes": list(self.grid_nodes), "interpolation_error_px": self.interpolation_error_px,
             "inverse_error_px": None if math.isnan(self.inverse_error_px) else self.inverse_error_px,
             "maps": self.distortion_stmap is not None, "max_distortion_px": self.max_distortion_px,
+            "fstop": self.fstop,
+            "map_for": "chief rays (a small stop)" if self.fstop is None else
+            f"the blur centroids at f/{self.fstop:g}",
+            "residual_px": {"rms": self.residual_px[0], "max": self.residual_px[1]},
             "convention": "ST-map: R = u, G = v, 0..1, origin bottom-left, pixel centres at (i + 0.5) / width; B = 0",
             "notes": list(self.notes),
         }
@@ -174,8 +191,10 @@ def _size(name, v) -> int:
     return int(v)
 
 
-def _real_to_ideal(q, gx, gy, st, film_xy, wl, backend):
-    """Trace chief rays backward from film points (n, 2) mm; ideal upright picture mm (n, 2) and ok."""
+def _real_to_ideal(q, gx, gy, st, film_xy, wl, backend, objects=False):
+    """Trace chief rays backward from film points (n, 2) mm; ideal upright picture mm (n, 2) and ok.
+    With ``objects``, also the object points (or light directions at infinity) and where the chief
+    rays cross the Y meridian's entrance-pupil plane (for :func:`physcam.analysis.centroid.image_centroids`)."""
     from ..trace import RayBatch, trace_through
     from ._chief import aim_from_film
 
@@ -193,7 +212,15 @@ def _real_to_ideal(q, gx, gy, st, film_xy, wl, backend):
     # the upright picture is the film image turned by 180 degrees: a scene point at +X lands at -x
     # on the film and at +x in the picture, at f_pin tan(angle) from the centre
     ideal = np.stack([gx.pinhole_focal_length * tx, gy.pinhole_focal_length * ty], axis=1)
-    return np.where(ok[:, None], ideal, 0.0), ok
+    if not objects:
+        return np.where(ok[:, None], ideal, 0.0), ok
+    s = (gy.z_entrance_pupil - out.z) / N  # the backward ray's parameter at the pupil plane
+    crossing = np.stack([out.x + s * out.L, out.y + s * out.M], axis=1)
+    if math.isinf(st.object_z):
+        obj = -np.stack([out.L, out.M, N], axis=1)  # the light travels the other way
+    else:
+        obj = np.stack([X, Y, np.full(X.shape, st.object_z)], axis=1)
+    return np.where(ok[:, None], ideal, 0.0), ok, np.where(ok[:, None], obj, 0.0), crossing
 
 
 @takes_prescription
@@ -209,14 +236,16 @@ def distortion_field(
     method: str = "auto",
     backend: str = "auto",
     maps: bool = True,
+    fstop: float | None = None,
 ) -> DistortionField:
     """Real distortion of ``lens`` focused at ``focus_mm`` over a ``width_px`` x ``height_px`` frame,
     with its distortion and undistortion ST-maps (module notes).
 
     ``maps=False`` traces the same chief rays but makes no ST-maps (the map fields and the overscan
-    are then None and (0, 0)): what fitting models and tables across focus need.
+    are then None and (0, 0)): what fitting models and tables across focus need. ``fstop``: the
+    centroid distortion at that f-stop instead of the chief rays' (module notes, "At a stop").
     """
-    from ..optics.focusing import focus
+    from ..optics.focusing import focus, iris_semi_diameter
     from ..optics.paraxial import gaussian
 
     w_px, h_px = _size("width", width_px), _size("height", height_px)
@@ -232,19 +261,48 @@ def distortion_field(
         if g[a].pinhole_focal_length is None or not g[a].efl > 0:
             raise OpticsError(f"lens {lens.name!r} has no best-match pinhole in {a.upper()} at this focus")
     sx, sy = w_px / W, h_px / H  # pixels per mm
+    iris = None if fstop is None else iris_semi_diameter(lens, fstop, method=method)
 
     def film_of(px, py):  # plate pixels -> film mm (the film image is the picture turned by 180 deg)
         return np.stack([-(px - w_px / 2) / sx, -(py - h_px / 2) / sy], axis=1)
 
-    def trace(px, py):
-        ideal, ok = _real_to_ideal(q, g["x"], g["y"], st, film_of(px, py), wl, backend)
+    def chief(px, py):
+        ideal, ok, obj, crossing = _real_to_ideal(q, g["x"], g["y"], st, film_of(px, py), wl, backend, objects=True)
         if not ok.all():
             i = int(np.argmin(ok))
             raise OpticsError(
                 f"at focus {st.focus_from_film_mm:g} mm no chief ray leaves {lens.name!r} from the film point "
                 f"({px[i]:.0f}, {py[i]:.0f}) px of a {W:g} x {H:g} mm sensor: the lens does not cover it; "
                 "give a smaller sensor")
-        return np.stack([ideal[:, 0] * sx + w_px / 2, ideal[:, 1] * sy + h_px / 2], axis=1)
+        return np.stack([ideal[:, 0] * sx + w_px / 2, ideal[:, 1] * sy + h_px / 2], axis=1), obj, crossing
+
+    def centroid_px(obj, crossing):  # where the stopped-down lens images the object points, plate px
+        from .centroid import image_centroids
+
+        r_ep = g["y"].entrance_pupil_diameter / 2 * iris / q.surfaces[q.stop_index].semi_diameter
+        c = image_centroids(q, st.film_z, obj, at_infinity=math.isinf(st.object_z), crossing=crossing,
+                            z_ep=g["y"].z_entrance_pupil, pupil_radius=r_ep, iris_semi_diameter=iris,
+                            wavelength_nm=wl, backend=backend)
+        return np.stack([-c[:, 0] * sx + w_px / 2, -c[:, 1] * sy + h_px / 2], axis=1)
+
+    def trace(px, py):
+        ideal, obj, crossing = chief(px, py)
+        if iris is None:
+            return ideal
+        # aim again from the node moved back by its centroid's offset: the centroid then lands on the node
+        off = centroid_px(obj, crossing) - np.stack([px, py], axis=1)
+        return chief(px - off[:, 0], py - off[:, 1])[0]
+
+    def residual(px, py, ideal_at):
+        """(RMS, max) plate px between the field and traced positions at the stop (module notes)."""
+        if iris is None:
+            d = ideal_at(px, py) - trace(px, py)
+        else:  # independent of the aiming above: each object point's own centroid, mapped by the field
+            ideal, obj, crossing = chief(px, py)
+            c = centroid_px(obj, crossing)
+            d = ideal_at(c[:, 0], c[:, 1]) - ideal
+        e = np.hypot(d[:, 0], d[:, 1])
+        return float(np.sqrt(np.mean(e * e))), float(e.max())
 
     # forward field: real plate position -> ideal plate position, traced at the nodes
     nx, dx = _nodes(w_px)
@@ -265,17 +323,23 @@ def distortion_field(
             f"reach {reach:.1f} times the frame's half-size, so no pinhole-based distortion map or model represents "
             "it (a fisheye); give a smaller sensor")
     interp_err = float(np.hypot(*(fwd.at(cx.ravel(), cy.ravel()) - exact).T).max())
+    resid = residual(cx.ravel(), cy.ravel(), lambda x, y: fwd.at(x, y))
+    n_stop = None if fstop is None else float(fstop)
     max_dist = float(np.hypot(nodes[..., 0] - X, nodes[..., 1] - Y).max())
     traced_real = np.concatenate([np.stack([X.ravel(), Y.ravel()], axis=1), np.stack([cx.ravel(), cy.ravel()], axis=1)])
     traced_ideal = np.concatenate([nodes.reshape(-1, 2), exact])
     notes = ["pinhole focal length: the paraxial one at this focus (GaussianData.pinhole_focal_length), "
-             "camera at the entrance pupil"]
+             "camera at the entrance pupil",
+             "real positions: chief rays (a small stop); at a working aperture give the f-stop (centroids)"
+             if fstop is None else f"real positions: the blur centroids at f/{fstop:g} (the iris sized at infinity "
+             "focus)"]
     if not maps:
         return DistortionField(
             lens.name, float(st.focus_from_film_mm), float(wl), (W, H), (w_px, h_px),
             (float(g["x"].pinhole_focal_length), float(g["y"].pinhole_focal_length)),
             (float(st.film_z - g["x"].z_entrance_pupil), float(st.film_z - g["y"].z_entrance_pupil)),
-            (0, 0), (nx, ny), interp_err, math.nan, max_dist, None, None, notes, fwd, traced_real, traced_ideal)
+            (0, 0), (nx, ny), interp_err, math.nan, max_dist, n_stop, resid, None, None, notes, fwd, traced_real,
+            traced_ideal)
 
     ideal_px = fwd.on_pixels(w_px, h_px)  # (h, w, 2), rows top first
     # overscan: the symmetric margin whose box keeps the ideal position of every plate pixel
@@ -333,7 +397,8 @@ def distortion_field(
         lens.name, float(st.focus_from_film_mm), float(wl), (W, H), (w_px, h_px),
         (float(g["x"].pinhole_focal_length), float(g["y"].pinhole_focal_length)),
         (float(zf - g["x"].z_entrance_pupil), float(zf - g["y"].z_entrance_pupil)),
-        (ox, oy), (nx, ny), interp_err, inv_err, max_dist, dmap, umap, notes, fwd, traced_real, traced_ideal)
+        (ox, oy), (nx, ny), interp_err, inv_err, max_dist, n_stop, resid, dmap, umap, notes, fwd, traced_real,
+        traced_ideal)
 
 
 def apply_stmap(image, stmap) -> np.ndarray:
@@ -366,11 +431,12 @@ def apply_stmap(image, stmap) -> np.ndarray:
     return out if img.ndim == 3 else out[..., 0]
 
 
-def _exr_bytes(rgb: np.ndarray) -> bytes:
-    """A 32-bit float RGB scanline EXR (ZIP) of ``rgb`` (h, w, 3), as bytes."""
+def _exr_bytes(rgb: np.ndarray, attributes=None) -> bytes:
+    """A 32-bit float RGB scanline EXR (ZIP) of ``rgb`` (h, w, 3), as bytes; ``attributes``: extra
+    header entries (strings and floats)."""
     import OpenEXR
 
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage, **(attributes or {})}
     fd, tmp = tempfile.mkstemp(suffix=".exr")
     os.close(fd)
     try:
@@ -395,6 +461,10 @@ def _png_bytes(rgb: np.ndarray) -> bytes:
 def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> list[Path]:
     """Write ``distortion.exr``, ``undistortion.exr`` and a PNG preview beside each into ``folder``.
 
+    Each EXR's header says which stop the map is for and its residual there: ``physcamMapFor`` (text),
+    ``physcamFStop`` (0 for a chief-ray map), ``physcamResidualRmsPx``, ``physcamResidualMaxPx``,
+    ``physcamLens``.
+
     Every name is checked before anything is written, so an existing file (without ``force``)
     leaves the folder as it was. Returns the paths written.
     """
@@ -408,9 +478,13 @@ def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> lis
     if d.exists() and not d.is_dir():
         raise ExportError(f"{str(d)!r} exists and is not a folder: give a folder for the ST-maps")
     items = [("distortion", result.distortion_stmap), ("undistortion", result.undistortion_stmap)]
+    said = result.to_dict()
+    attributes = {"physcamMapFor": said["map_for"], "physcamFStop": float(result.fstop or 0.0),
+                  "physcamResidualRmsPx": float(result.residual_px[0]),
+                  "physcamResidualMaxPx": float(result.residual_px[1]), "physcamLens": result.lens_name}
     payload = []
     for name, rgb in items:
-        payload.append((d / f"{name}.exr", _exr_bytes(rgb)))
+        payload.append((d / f"{name}.exr", _exr_bytes(rgb, attributes)))
         payload.append((d / f"{name}.png", _png_bytes(rgb)))
     for p, _ in payload:
         check_writable(p, force=force)

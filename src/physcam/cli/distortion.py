@@ -53,6 +53,9 @@ def register(sub) -> None:
                         f"(default {DEFAULT_MAX_RESIDUAL_PX:g})")
     p.add_argument("--plate", default="plate.####.exr", metavar="PATH",
                    help="the plate the Nuke script reads (default plate.####.exr)")
+    p.add_argument("--fstop", type=number("f-stop", positive=True), default=None, metavar="N",
+                   help="map the lens's blur centroids at this f-stop (the plate's stop) instead of its chief rays "
+                        "(a small stop); needs --resolution")
     p.add_argument("--across-focus", type=_focus_list, default=None, metavar="LIST",
                    help="a table of distortion across focus marks, e.g. 0.5m,1m,2m,inf (hyperfocal too); "
                         "needs --resolution")
@@ -65,13 +68,16 @@ def run_distortion(args) -> int:
     from .analyze import _finish, _prepare
 
     needs = [n for n, v in (("--focus", args.focus), ("--stmap", args.stmap), ("--fit", args.fit),
-                            ("--across-focus", args.across_focus)) if v is not None]
+                            ("--across-focus", args.across_focus), ("--fstop", args.fstop)) if v is not None]
     if args.resolution is None and needs:
         raise InputError(f"{', '.join(needs)} {'needs' if len(needs) == 1 else 'need'} --resolution WxH "
                          "(the frame size in pixels)")
     if args.across_focus is not None and (args.focus is not None or args.stmap or args.fit):
         raise InputError("--across-focus makes a table of its own focus marks: give it without --focus, --stmap "
                          "and --fit")
+    if args.across_focus is not None and args.fstop is not None:
+        raise InputError("--across-focus tables chief-ray distortion; centroid distortion at a stop (--fstop) is "
+                         "made for one focus (--focus) at a time")
     if args.fit and "nuke" in args.fit and args.stmap is None:
         raise InputError("--fit nuke writes a Nuke script beside the ST-maps: give --stmap DIR")
     if args.csv and args.resolution is not None and args.across_focus is None:
@@ -246,7 +252,7 @@ def _run_field(args, lens) -> int:
     res = distortion_field(lens, focus_mm=math.inf if args.focus is None else args.focus,
                            sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
                            width_px=args.resolution[0], height_px=args.resolution[1], wavelength_nm=args.wavelength,
-                           maps=args.stmap is not None)
+                           maps=args.stmap is not None, fstop=args.fstop)
     fits = fit_models(samples_from_field(res), args.fit or (), max_residual_px=args.max_residual)
     written = []
     if args.stmap is not None:
@@ -269,6 +275,8 @@ def _run_field(args, lens) -> int:
           f"pinhole f {res.pinhole_focal_length_mm[1]:.3f} mm (Y; the paraxial one at this focus) at the entrance pupil")
     print(f"  largest distortion {res.max_distortion_px:.2f} px; interpolation error {res.interpolation_error_px:.4f} px "
           f"({res.grid_nodes[0]}x{res.grid_nodes[1]} traced chief rays)")
+    print(f"  the map is for {d['map_for']}; its residual there: RMS {res.residual_px[0]:.3f} px, "
+          f"max {res.residual_px[1]:.3f} px")
     if res.distortion_stmap is not None:
         print(f"  overscan {res.overscan_px[0]} x {res.overscan_px[1]} px (undistorted frame "
               f"{d['undistorted_size_px'][0]}x{d['undistorted_size_px'][1]}), inverse error {res.inverse_error_px:.4f} px")
