@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import OpticsError
 
-__all__ = ["image_centroids", "PUPIL_GRID"]
+__all__ = ["image_centroids", "image_moments", "PUPIL_GRID"]
 
 #: Pupil samples per side of the square grid laid over each beam's own box on the pupil plane.
 PUPIL_GRID = 32
@@ -84,20 +84,24 @@ def _beam_boxes(q, film_z, objects, at_infinity, crossing, z_ep, radius, iris, w
     return crossing + half * (lo + hi) / 2, half * (hi - lo) / 2
 
 
-def image_centroids(q, film_z: float, objects, *, at_infinity: bool, crossing, z_ep: float, pupil_radius: float,
-                    iris_semi_diameter: float, wavelength_nm: float, backend: str = "auto",
-                    overfill: float = 2.0) -> np.ndarray:
-    """Film centroids (n, 2) mm of object points imaged by ``q`` (a focused lens) with its stop at
-    ``iris_semi_diameter`` (module notes).
+def image_moments(q, film_z: float, objects, *, at_infinity: bool, crossing, z_ep: float, pupil_radius: float,
+                  iris_semi_diameter: float, wavelength_nm: float, backend: str = "auto", overfill: float = 2.0,
+                  grid: int = PUPIL_GRID, energy_fraction: float | None = None):
+    """(centroids (n, 2) mm, second moments E[r^2] (n,) mm^2 about them) of the blurs of object points
+    imaged on the film by ``q`` (a focused lens) with its stop at ``iris_semi_diameter`` (module notes).
 
     ``objects``: (n, 3) object points in lens space, or with ``at_infinity`` unit directions of the
     light; ``crossing``: (n, 2) where each point's real chief ray crosses the entrance-pupil plane
-    ``z_ep``; ``pupil_radius``: the paraxial entrance pupil's radius at that iris. Raises
-    :class:`OpticsError` for a point no ray of which reaches the film."""
+    ``z_ep``; ``pupil_radius``: the paraxial entrance pupil's radius at that iris; ``grid``: pupil
+    samples per side of each beam's box. With ``energy_fraction`` a third array: the radius (mm) about
+    each centroid that holds that fraction of the rays. Raises :class:`OpticsError` for a point no ray
+    of which reaches the film."""
     objects = np.atleast_2d(np.asarray(objects, dtype=float))
     crossing = np.atleast_2d(np.asarray(crossing, dtype=float))
-    fine = _grid(PUPIL_GRID)
-    out = np.empty((len(objects), 2))
+    fine = _grid(grid)
+    cen = np.empty((len(objects), 2))
+    m2 = np.empty(len(objects))
+    radius = np.empty(len(objects))
     for i0 in range(0, len(objects), POINTS_PER_CALL):
         sl = slice(i0, i0 + POINTS_PER_CALL)
         args = (q, film_z, objects[sl], at_infinity)
@@ -107,5 +111,16 @@ def image_centroids(q, film_z: float, objects, *, at_infinity: bool, crossing, z
         count = ok.sum(axis=1)
         if not (count > 0).all():
             raise OpticsError("no ray of an object point passes the stop at this f-stop: the field is vignetted there")
-        out[sl] = np.where(ok[..., None], film, 0.0).sum(axis=1) / count[:, None]
-    return out
+        c = np.where(ok[..., None], film, 0.0).sum(axis=1) / count[:, None]
+        d2 = ((film - c[:, None, :]) ** 2).sum(axis=2)
+        cen[sl], m2[sl] = c, np.where(ok, d2, 0.0).sum(axis=1) / count
+        if energy_fraction is not None:
+            r = np.sort(np.where(ok, np.sqrt(d2), np.inf), axis=1)
+            k = np.maximum(np.ceil(energy_fraction * count).astype(int) - 1, 0)
+            radius[sl] = r[np.arange(len(k)), k]
+    return (cen, m2) if energy_fraction is None else (cen, m2, radius)
+
+
+def image_centroids(q, film_z: float, objects, **kwargs) -> np.ndarray:
+    """Film centroids (n, 2) mm of object points (arguments as :func:`image_moments`)."""
+    return image_moments(q, film_z, objects, **kwargs)[0]

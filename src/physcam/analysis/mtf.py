@@ -394,10 +394,22 @@ class MTFChart:
     tangential: np.ndarray = field(repr=False)
     pupil_samples: np.ndarray = field(repr=False)
     notes: tuple[str, ...] = ()
+    #: the film's place: moved this far (mm, + away from the lens) from the paraxial image plane of the
+    #: focus mark, by ``focus_rule``
+    defocus_mm: float = 0.0
+    focus_rule: str = "the paraxial image plane of the focus mark"
+
+    def focus_words(self) -> str:
+        """Which focus the chart is at, in words (its title and its JSON's ``film``)."""
+        if self.defocus_mm == 0.0:
+            return self.focus_rule
+        return f"{self.focus_rule}, {self.defocus_mm * 1e3:+.1f} um from the paraxial image plane"
 
     def to_dict(self) -> dict:
         return {
             "lens": self.lens_name, "fstop": self.fstop,
+            "film": {"defocus_mm": self.defocus_mm, "shift_um": self.defocus_mm * 1e3, "rule": self.focus_rule,
+                     "words": self.focus_words()},
             "focus_from_film_mm": None if math.isinf(self.focus_from_film_mm) else self.focus_from_film_mm,
             "wavelengths_nm": list(self.wavelengths_nm), "weights": list(self.weights),
             "frequencies_lpmm": list(self.frequencies_lpmm),
@@ -478,7 +490,8 @@ class MTFChart:
         ax.legend(fontsize=7, ncol=2, loc="lower left")
         foc = "infinity" if math.isinf(self.focus_from_film_mm) else format_distance(self.focus_from_film_mm, units)
         wl = ", ".join(f"{w:g}" for w in self.wavelengths_nm)
-        ax.set_title(f"{self.lens_name}\nMTF at f/{self.fstop:.3g}, focus {foc}, {wl} nm "
+        shift = "" if self.defocus_mm == 0.0 else f", film {self.defocus_mm * 1e3:+.1f} um (best focus)"
+        ax.set_title(f"{self.lens_name}\nMTF at f/{self.fstop:.3g}, focus {foc}{shift}, {wl} nm "
                      "(solid sagittal, dashed tangential)", fontsize=8)
         return save(fig, path, force)
 
@@ -500,13 +513,24 @@ def mtf_chart(
     backend: str = "auto",
     max_pupil_samples=256,
     progress=None,
+    best_focus=None,
+    best_focus_rule: str = "axis",
+    method: str = "fft",
 ) -> MTFChart:
     """The vendor MTF chart of ``lens``: sagittal and tangential MTF at ``frequencies`` (default 10,
     20, 40 lp/mm) against image height, ``n_fields`` heights from 0 to ``max_image_height_mm``
     (default 15.55 mm, the corner of the default sensor, Super 35 24.89 x 18.66 mm:
     :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, as the CLI; 21.63 mm is a 36 x 24 mm corner) or the ``image_heights_mm`` given; white light by
     default. The pupil grids follow the MTF sampling rules up to ``max_pupil_samples`` (default 256,
-    so a chart takes seconds). ``progress(done, total)`` is called after each field."""
+    so a chart takes seconds). ``progress(done, total)`` is called after each field.
+
+    The film is at the paraxial image plane of the focus mark unless ``best_focus`` (a frequency,
+    lp/mm) moves it to where the MTF there is highest (:func:`best_focus_mm`): ``best_focus_rule``
+    "axis" (the mean of S and T on the axis) or "field" (that mean averaged over the image, each
+    height weighted by the area of its ring, as lens makers weigh a chart). The chart says which
+    (``focus_rule``, ``defocus_mm``). ``method`` "huygens" computes each field's MTF from its Huygens PSF
+    (:func:`physcam.analysis.huygens.huygens_mtf`; slower, no pupil-to-direction map) instead of the
+    pupil's autocorrelation ("fft")."""
     from . import _pupil as P
     from . import _sampling
 
@@ -535,6 +559,8 @@ def mtf_chart(
     n_user = _sampling.pupil_samples_arg(pupil_samples)
     if n_user is not None and cap is not None and n_user > cap:
         raise InputError(f"pupil_samples {n_user} exceeds the chart's max_pupil_samples {cap}")
+    if method not in ("fft", "huygens"):
+        raise InputError(f"the MTF method is 'fft' or 'huygens', got {method!r}")
     st = P.setup(lens, fstop=fstop, focus_mm=focus_mm, aperture=aperture, backend=backend)
     fmin = float(freqs[freqs > 0].min()) if (freqs > 0).any() else None
     angles = np.zeros(hs.size)
@@ -545,6 +571,10 @@ def mtf_chart(
             edge = P.image_circle_radius(st, wls[0], float(h))
             raise OpticsError(f"{exc}; the image circle ends near {edge:.1f} mm: chart up to there "
                               f"(max_image_height_mm, --max-height)") from None
+    dz, rule = 0.0, "the paraxial image plane of the focus mark"
+    if best_focus is not None:
+        dz, rule = best_focus_mm(lens, best_focus, heights_mm=hs, angles_deg=angles, rule=best_focus_rule,
+                                 wavelengths_nm=wls, weights=wts, st=st, max_pupil_samples=max_pupil_samples)
     if progress is not None:
         progress(0, hs.size)
     sag = np.zeros((hs.size, freqs.size))
@@ -553,18 +583,102 @@ def mtf_chart(
     n_guess = pupil_samples if isinstance(pupil_samples, (int, np.integer)) and pupil_samples > 0 else 64
     per_field = n_guess ** 2 * len(wls)
     done = 0
+    if method == "huygens":
+        from .huygens import huygens_mtf
+
+        for i, a in enumerate(angles):
+            tan[i], sag[i], p = huygens_mtf(lens, float(a), frequencies=freqs, wavelengths_nm=wls, weights=wts,
+                                            fstop=st.fstop, focus_mm=focus_mm, defocus_mm=dz, aperture=aperture,
+                                            backend=backend)
+            ns[i] = p.pupil_samples
+            if progress is not None:
+                progress(i + 1, hs.size)
+        return MTFChart(st.lens_name, st.fstop, st.focus_from_film_mm, tuple(wls), tuple(wts),
+                        tuple(float(f) for f in freqs), hs, angles, np.clip(sag, 0, 1), np.clip(tan, 0, 1), ns,
+                        ("method: Huygens PSF per field (physcam.analysis.huygens)",), float(dz), rule)
     # fields in runs that fit one tracing batch; each run's pupils are freed before the next
     for run in _sampling._chunks(list(range(hs.size)), lambda i: per_field, _sampling.RAYS_PER_BATCH):
         fps = _sampling.fields_pupils(lens, angles[run], wavelengths_nm=wls, weights=wts, pupil_samples=pupil_samples,
                                       min_frequency=fmin, waves_per_cell=_sampling.WAVES_PER_CELL_MTF, st=st,
-                                      max_pupil_samples=max_pupil_samples)
+                                      max_pupil_samples=max_pupil_samples, defocus_mm=[dz])
         for k, i in enumerate(run):
-            tan[i] = np.abs(_otf(fps[k], freqs, 0, 0.0))
-            sag[i] = np.abs(_otf(fps[k], freqs, 1, 0.0))
+            tan[i] = np.abs(_otf(fps[k], freqs, 0, dz))
+            sag[i] = np.abs(_otf(fps[k], freqs, 1, dz))
             ns[i] = fps[k].n
             fps[k] = None  # its sub-cell arrays are large: free them before the next field's
             done += 1
             if progress is not None:
                 progress(done, hs.size)
     return MTFChart(st.lens_name, st.fstop, st.focus_from_film_mm, tuple(wls), tuple(wts),
-                    tuple(float(f) for f in freqs), hs, angles, np.clip(sag, 0, 1), np.clip(tan, 0, 1), ns)
+                    tuple(float(f) for f in freqs), hs, angles, np.clip(sag, 0, 1), np.clip(tan, 0, 1), ns,
+                    defocus_mm=float(dz), focus_rule=rule)
+
+
+#: Fields the field-weighted best focus averages over, as fractions of the chart's largest height.
+BEST_FOCUS_HEIGHTS = (0.0, 0.3, 0.55, 0.75, 0.9)
+
+
+def _least_spread_mm(fps) -> float:
+    """The film shift (mm) of the smallest second moment of the rays' film positions about their centroid,
+    summed over the pupils given: each ray's film point moves by its slope times the shift, so the moment
+    is a quadratic in the shift and its minimum is closed-form (Smith, *Modern Optical Engineering*, 11.2)."""
+    num = den = 0.0
+    for fp in fps:
+        for i in range(len(fp.traces)):
+            pt = fp.traces[i]
+            w = pt.weight * pt.rays.amplitude ** 2
+            w = w / w.sum()
+            ws = fp.samples(i, 0.0)
+            for pos, slope in ((ws.film_x, pt.rays.L / pt.rays.N), (ws.film_y, pt.rays.M / pt.rays.N)):
+                p0, sl = pos - w @ pos, slope - w @ slope
+                num += float(w @ (p0 * sl))
+                den += float(w @ (sl * sl))
+    return -num / den if den > 0 else 0.0
+
+
+def best_focus_mm(lens, frequency, *, heights_mm, angles_deg, rule, wavelengths_nm, weights, st,
+                  max_pupil_samples=256) -> tuple[float, str]:
+    """(film shift mm, its rule in words): where the mean of S and T MTF at ``frequency`` is highest,
+    on the axis (``rule`` "axis") or averaged over the image with ring-area weights ("field"). The
+    search scans 41 film positions over +-20 lambda N^2 (ten Rayleigh depths of focus) about the
+    film shift of the least geometric spread (:func:`_least_spread_mm`, closed form), then 21 between
+    the best one's neighbours; the pupils are traced once per stage and each film position costs
+    only their last leg."""
+    from . import _pupil as P
+    from . import _sampling
+
+    nu = _frequencies([frequency], "best-focus frequency")
+    if not nu[0] > 0:
+        raise InputError("the best-focus frequency must be above 0 lp/mm")
+    if rule not in ("axis", "field"):
+        raise InputError(f"the best-focus rule is 'axis' or 'field', got {rule!r}")
+    if rule == "axis":
+        ws = np.array([1.0])
+        angles = [0.0]
+    else:
+        top = float(np.max(heights_mm))
+        hs = np.array(BEST_FOCUS_HEIGHTS) * top
+        edges = np.concatenate([[0.0], 0.5 * (hs[1:] + hs[:-1]), [top]])
+        ws = edges[1:] ** 2 - edges[:-1] ** 2  # the area of each height's ring
+        angles = [0.0] + [P.field_for_image_height(st, float(h), wavelengths_nm[0]) for h in hs[1:]]
+    kw = dict(wavelengths_nm=wavelengths_nm, weights=weights, st=st)
+
+    def merit(fps, dz):
+        m = [0.5 * (abs(_otf(fp, nu, 0, dz)[0]) + abs(_otf(fp, nu, 1, dz)[0])) for fp in fps]
+        return float(np.dot(ws, m) / ws.sum())
+
+    lam_n2 = wavelengths_nm[0] * 1e-6 * st.fstop ** 2
+    # 1. the scan: 41 film positions over +-20 lambda N^2 about the least geometric spread, on a 64-cell
+    #    grid whose sampling is not checked so far from focus (it is where the MTF matters: step 2)
+    coarse_fps = _sampling.fields_pupils(lens, angles, pupil_samples=64, check=False, **kw)
+    centre = _least_spread_mm(coarse_fps)
+    coarse = centre + np.linspace(-20.0, 20.0, 41) * lam_n2
+    k = int(np.argmax([merit(coarse_fps, d) for d in coarse]))
+    # 2. 21 positions between the best one's neighbours, on grids that meet the sampling rules there
+    lo, hi = coarse[max(k - 1, 0)], coarse[min(k + 1, coarse.size - 1)]
+    fps = _sampling.fields_pupils(lens, angles, min_frequency=float(nu[0]), waves_per_cell=_sampling.WAVES_PER_CELL_MTF,
+                                  defocus_mm=[lo, hi], max_pupil_samples=max_pupil_samples, **kw)
+    fine = np.linspace(lo, hi, 21)
+    best = float(fine[int(np.argmax([merit(fps, d) for d in fine]))])
+    where = "on the axis" if rule == "axis" else "averaged over the image by ring area"
+    return best, f"best focus for {nu[0]:g} lp/mm {where}"

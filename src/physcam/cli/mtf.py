@@ -28,6 +28,8 @@ examples:
   physcam mtf dgauss_50mm --fstop 8 --field 14                  (one field: RMS, Strehl, MTF)
   physcam mtf dgauss_50mm --wavelength 550 --frequency 10 --frequency 30 --json
   physcam mtf dgauss_50mm --fstop 4 --csv > mtf.csv                 (one row per image height and frequency)
+  physcam mtf dgauss_50mm --fstop 2.8 --best-focus 40                 (the film at the best focus for 40 lp/mm)
+  physcam mtf dgauss_50mm --fstop 4 --field 14 --method huygens      (MTF from the Huygens PSF)
 """
 
 
@@ -59,6 +61,15 @@ def register(sub) -> None:
     p.add_argument("--pupil-samples", type=int, default=None, metavar="N",
                    help=f"pupil grid cells across (16-{CHART_MAX_PUPIL_SAMPLES} for the chart, to {CLI_MAX_PUPIL_SAMPLES} "
                         "with --field; default chosen by the sampling rules)")
+    p.add_argument("--method", choices=("fft", "huygens"), default="fft",
+                   help="fft: autocorrelation of the pupil function (default); huygens: the Fourier transform of the "
+                        "Huygens PSF, wavelets summed from the exit-pupil wavefront (slower; docs/image-quality.md)")
+    p.add_argument("--best-focus", type=number("best-focus frequency", positive=True), default=None, metavar="LPMM",
+                   help="put the chart's film at the best focus for this frequency instead of the paraxial image plane "
+                        "of --focus (the shift is printed in um)")
+    p.add_argument("--best-focus-rule", choices=("axis", "field"), default="axis",
+                   help="best focus on the axis (default) or averaged over the image by ring area, as makers weigh "
+                        "a chart")
     add_sensor_options(p)
     add_units_option(p)
     add_output_options(p, csv=True, what="the chart (or the field's figures)")
@@ -105,6 +116,8 @@ def run(args) -> int:
     if args.field is not None:
         if args.max_height is not None or args.fields != 15:
             raise InputError("--fields and --max-height set the chart; with --field one field is reported")
+        if args.best_focus is not None:
+            raise InputError("--best-focus places the chart's film; with --field the film stays at the focus mark")
         return _one_field(args, lens, wls, weights, freqs, focus)
     from ..analysis.mtf import mtf_chart
     from ._common import progress_bar
@@ -113,7 +126,8 @@ def run(args) -> int:
     with progress_bar("MTF chart", enabled=not (args.json or args.csv)) as bar:
         chart = mtf_chart(lens, max_image_height_mm=top, n_fields=args.fields, frequencies=freqs, wavelengths_nm=wls,
                           weights=weights, fstop=args.fstop, focus_mm=focus, pupil_samples=args.pupil_samples,
-                          max_pupil_samples=CHART_MAX_PUPIL_SAMPLES, progress=bar)
+                          max_pupil_samples=CHART_MAX_PUPIL_SAMPLES, progress=bar, best_focus=args.best_focus,
+                          best_focus_rule=args.best_focus_rule, method=args.method)
     if args.output:
         from ._common import units_of
 
@@ -132,7 +146,8 @@ def run(args) -> int:
     foc = format_distance(math.inf if focus is None else focus, units_of(args))
     wl = ", ".join(f"{w:g}" for w in chart.wavelengths_nm)
     print(f"{chart.lens_name}: MTF at f/{chart.fstop:.3g}, focus {foc} from the film, {wl} nm "
-          f"({sensor.name}, corner at {sensor.diagonal_mm / 2:.2f} mm)")
+          f"({sensor.name}, corner at {sensor.diagonal_mm / 2:.2f} mm), {args.method.upper()} method")
+    print(f"  film: {chart.focus_words()}")
     print("  S = sagittal (lines radial), T = tangential (lines tangential to circles about the centre)")
     for line in chart.table().splitlines():
         print("  " + line)
@@ -166,6 +181,17 @@ def _one_field(args, lens, wls, weights, freqs, focus) -> int:
              max_pupil_samples=CLI_MAX_PUPIL_SAMPLES, **kw)
     m = mtf(lens, args.field, frequencies=freqs, wavelengths_nm=wls, weights=weights, pupil_samples=args.pupil_samples,
             max_pupil_samples=CLI_MAX_PUPIL_SAMPLES, **kw)
+    if args.method == "huygens":  # the MTF from the Huygens PSF; the Strehl ratio from the monochromatic one
+        import dataclasses
+
+        import numpy as np
+
+        from ..analysis.huygens import huygens_mtf, huygens_psf
+
+        t, s, _ = huygens_mtf(lens, args.field, frequencies=freqs, wavelengths_nm=wls, weights=weights, **kw)
+        m = dataclasses.replace(m, method="huygens", tangential=np.asarray(t), sagittal=np.asarray(s))
+        hp = huygens_psf(lens, args.field, wavelengths_nm=[wls[0]], **kw)
+        ps = dataclasses.replace(ps, strehl=float(hp.strehl))
     if args.output:
         curve = mtf(lens, args.field, wavelengths_nm=wls, weights=weights, pupil_samples=args.pupil_samples,
                     max_pupil_samples=CLI_MAX_PUPIL_SAMPLES, **kw)

@@ -17,6 +17,7 @@ examples:
   physcam report --focal 50 --near 2.5m --far 4m --fstop 4 --sensor S35         (solve focus)
   physcam report --model technical --focal 50.36 --fstop 2 --focus 2m --h1 46.24 --h2 51.69 --pupil 49.53
   physcam report --lens dgauss_50mm --fstop 2.8 --focus 2m                     (planes from the lens)
+  physcam report --lens dgauss_50mm --fstop 2.8 --focus 3m --dof real           (and limits from real rays)
 """
 
 
@@ -40,6 +41,17 @@ def register(sub) -> None:
     add_units_option(p)
     add_output_options(p, what="the report")
     p.add_argument("--cameras", action="store_true", help="also print the UsdGeomCamera and RenderMan blocks")
+    g = p.add_argument_group("depth of field from real rays (with --lens)")
+    g.add_argument("--dof", choices=("model", "real"), default="model",
+                   help="real: also find near and far by tracing the lens (where its blur reaches the CoC), at the "
+                        "centre and at a field point, beside the model's (docs/lens-report.md)")
+    g.add_argument("--dof-field", metavar="MM", type=distance("field image height"), default=None,
+                   help="the field point's image height on the film, mm (default half the sensor's half diagonal)")
+    g.add_argument("--blur", choices=("moment", "energy"), default="energy",
+                   help="the real blur's size: energy = the diameter holding --energy-fraction of the light "
+                        "(default), moment = the second-moment diameter sqrt(8 E[r^2])")
+    g.add_argument("--energy-fraction", metavar="F", type=number("energy fraction"), default=0.8,
+                   help="fraction of the light within the blur diameter (default 0.8)")
     p.add_argument("--plot", metavar="FILE", help="draw the depth-of-field zone to FILE (.png, .svg or .pdf; "
                                                   "in feet with --units ft)")
     p.add_argument("--force", action="store_true", help="overwrite an existing --plot file")
@@ -199,6 +211,60 @@ def camera_blocks(report, args) -> dict:
     return blocks
 
 
+def real_dof_block(report, args) -> dict:
+    """The real-ray depth of field (:func:`physcam.analysis.real_dof.real_depth_of_field`) at the centre and
+    at a field point, beside the model's, for ``physcam report --dof real``."""
+    from ..analysis.real_dof import real_depth_of_field
+    from ..errors import InputError, OpticsError
+
+    lens = getattr(args, "loaded_lens", None)
+    if lens is None:
+        raise InputError("--dof real traces a prescription: give the lens (--lens NAME or file)")
+    if report.focus_is_infinite:
+        raise InputError("--dof real needs a finite focus mark (the limits of a lens focused at infinity are its "
+                         "hyperfocal parameter and infinity)")
+    h = report.sensor.diagonal_mm / 4 if args.dof_field is None else args.dof_field
+    model = report.dof
+    out = {"measure": args.blur, "energy_fraction": args.energy_fraction if args.blur == "energy" else None,
+           "model": {"near_from_film_mm": model.near_from_film_mm,
+                     "far_from_film_mm": None if model.far_is_infinite else model.far_from_film_mm}}
+    for key, height in (("centre", 0.0), ("field", h)):
+        try:
+            r = real_depth_of_field(lens, focus_mm=report.focus_from_film_mm, fstop=report.fstop,
+                                    coc_mm=report.coc_mm, image_height_mm=height, measure=args.blur,
+                                    energy_fraction=args.energy_fraction)
+            d = r.to_dict()
+            if not (r.far_is_infinite or model.far_is_infinite):
+                d["model_deeper_pct"] = (model.total_mm / r.total_mm - 1.0) * 100.0
+            out[key] = d
+        except OpticsError as exc:
+            out[key] = {"image_height_mm": height, "error": str(exc)}
+    out["definition"] = ("near and far where the traced blur (measure) on the film equals the CoC; model_deeper_pct: "
+                         "the model's total depth of field over the real one, minus 1, in percent")
+    return out
+
+
+def _real_rows(real, units) -> list[tuple]:
+    """Table rows of :func:`real_dof_block` (none without ``--dof real``)."""
+    if real is None:
+        return []
+    from ..units import format_distance
+
+    rows = []
+    for key in ("centre", "field"):
+        d = real[key]
+        where = "centre" if key == "centre" else f"field {d['image_height_mm']:.1f} mm"
+        if "error" in d:
+            rows.append((f"real-ray DOF ({where})", "none: " + d["error"].split(": ")[-1], ""))
+            continue
+        far = "infinity" if d["far_is_infinite"] else format_distance(d["far_from_film_mm"], units)
+        value = f"{format_distance(d['near_from_film_mm'], units)} / {far}"
+        if d.get("model_deeper_pct") is not None:
+            value += f"  (model {d['model_deeper_pct']:+.1f} % deeper)"
+        rows.append((f"real-ray near / far ({where})", value, "film plane"))
+    return rows
+
+
 def report_document(report, cams, args) -> dict:
     """The document ``physcam report --json`` prints (and ``physcam serve`` answers): the report's
     ``to_dict()`` with the camera blocks, marked when the lens was repaired on load."""
@@ -223,18 +289,24 @@ def run(args) -> int:
     report = solve_from_args(args)
     cams = camera_blocks(report, args)
     units = units_of(args)
+    real = real_dof_block(report, args) if args.dof == "real" else None
     if args.plot:
         from ..onset.dof_plot import plot_dof_zone
 
         plot_dof_zone(report, args.plot, force=args.force, units=units)
     if args.json:
-        print_json(report_document(report, cams, args))
+        doc = report_document(report, cams, args)
+        if real is not None:
+            doc["dof_real"] = real
+        print_json(doc)
         return 0
     from ..onset.table import report_rows, report_title
     from ._output import Table, print_table
 
     t = Table(report_title(report), ("quantity", "value", "measured from"))
     for r in report_rows(report, units, notes=False):
+        t.add_row(*r)
+    for r in _real_rows(real, units):
         t.add_row(*r)
     print_table(t)
     for n in report.notes:

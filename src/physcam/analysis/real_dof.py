@@ -1,0 +1,192 @@
+"""Depth of field from real rays: where a prescription's blur spot on the film reaches the CoC.
+
+The on-set report's near and far limits come from a principal-plane (thin-lens) model: the blur
+is the entrance pupil's image, growing as |1/d - 1/s|. A real lens adds its own blur (spherical
+aberration, coma, field curvature at a field point) and focuses best a little away from the
+paraxial image plane, so its limits differ (docs/lens-report.md, "Depth of field from real rays").
+
+Method: the lens is focused at the mark (:func:`physcam.optics.focusing.focus`) and its iris set to
+the f-stop (:func:`physcam.optics.focusing.iris_semi_diameter`); the film stays where focusing
+put it. An object point at distance d in front of the film lies on the real chief ray that reaches
+the film at ``image_height_mm`` (on the axis by default), so a field point keeps its direction as d
+changes. Its blur is measured by tracing a grid of rays over its beam
+(:func:`physcam.analysis.centroid.image_moments`) as one of
+
+* ``"moment"``: the second-moment diameter sqrt(8 E[r^2]) about the centroid (a uniform disk of
+  diameter c has exactly c), or
+* ``"energy"``: the diameter of the circle about the centroid that holds ``energy_fraction`` of
+  the rays (of the power: each ray stands for the same area of the beam).
+
+The blur against reciprocal distance u = 1/d is V-shaped (the thin lens's is |u - 1/s| times a
+constant), so the sharpest distance is found by golden-section search on u and each limit by
+bisection on u between it and the lens front (near) or infinity (far): to 1e-6 of the distance.
+
+Lengths in mm, distances from the film plane (docs/conventions.md).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError, OpticsError, require_finite, require_positive
+from ..lens.prescription import Prescription, takes_prescription
+
+__all__ = ["RealDepthOfField", "real_depth_of_field", "blur_diameter_mm", "MEASURES"]
+
+MEASURES = ("moment", "energy")
+#: The farthest object distance tried (mm): beyond it the far limit counts as infinite.
+FAR_AWAY_MM = 1.0e9
+
+
+@dataclass(frozen=True)
+class RealDepthOfField:
+    """Near and far limits (mm from the film) where the real blur reaches ``coc_mm`` (module notes)."""
+
+    lens_name: str
+    fstop: float
+    focus_from_film_mm: float
+    coc_mm: float
+    image_height_mm: float
+    measure: str  # "moment" or "energy 80 %"
+    sharpest_from_film_mm: float  # the object distance of the smallest blur
+    sharpest_blur_mm: float
+    near_from_film_mm: float
+    far_from_film_mm: float  # inf when the blur stays below the CoC out to infinity
+
+    @property
+    def far_is_infinite(self) -> bool:
+        return math.isinf(self.far_from_film_mm)
+
+    @property
+    def total_mm(self) -> float:
+        return self.far_from_film_mm - self.near_from_film_mm
+
+    def to_dict(self) -> dict:
+        fin = lambda v: None if math.isinf(v) else v  # noqa: E731
+        return {"lens": self.lens_name, "fstop": self.fstop, "focus_from_film_mm": fin(self.focus_from_film_mm),
+                "coc_mm": self.coc_mm, "image_height_mm": self.image_height_mm, "measure": self.measure,
+                "sharpest_from_film_mm": fin(self.sharpest_from_film_mm), "sharpest_blur_mm": self.sharpest_blur_mm,
+                "near_from_film_mm": self.near_from_film_mm, "far_from_film_mm": fin(self.far_from_film_mm),
+                "far_is_infinite": self.far_is_infinite, "total_mm": fin(self.total_mm),
+                "definition": "object distances from the film where the real blur (measure) equals the CoC, on the "
+                              "real chief ray of image_height_mm; the lens focused at the mark, the iris at the f-stop"}
+
+
+class _Blur:
+    """The blur diameter on the film of object points along one chief ray, for one focused lens."""
+
+    def __init__(self, lens, mark, fstop, image_height_mm, measure, energy_fraction, backend):
+        from ..optics import focusing
+        from ..optics.paraxial import gaussian
+        from ..trace import RayBatch, trace_through
+        from ._chief import aim_from_film
+
+        st = focusing.focus(lens, mark)
+        self.q, self.film_z, self.backend = st.prescription, st.film_z, backend
+        self.wl = float(lens.wavelength_nm)
+        self.iris = focusing.iris_semi_diameter(lens, fstop)
+        g = gaussian(self.q, object_z=st.object_z, film_z=st.film_z)
+        self.z_ep = g.z_entrance_pupil
+        self.r_ep = g.entrance_pupil_diameter / 2 * self.iris / self.q.surfaces[self.q.stop_index].semi_diameter
+        self.front = st.film_z  # the front vertex (z = 0) lies film_z in front of the film
+        self.measure, self.fraction = measure, energy_fraction
+        aimed = aim_from_film(self.q, [[0.0, -image_height_mm]], st.film_z, wavelength_nm=self.wl, backend=backend)
+        out = trace_through(self.q, RayBatch.from_arrays(aimed.start, aimed.direction, self.wl), reverse=True,
+                            backend=backend)
+        if not (bool(aimed.ok[0]) and bool(out.ok[0]) and out.N[0] < 0):
+            raise OpticsError(f"no chief ray of {lens.name!r} reaches the film {image_height_mm:g} mm from the centre")
+        self.ray = np.array([out.x[0], out.y[0], out.z[0], out.L[0], out.M[0], out.N[0]])
+
+    def __call__(self, d_from_film: float) -> float:
+        from .centroid import image_moments
+
+        x, y, z, L, M, N = self.ray
+        z_obj = self.film_z - d_from_film
+        t, s = (z_obj - z) / N, (self.z_ep - z) / N
+        obj = np.array([[x + t * L, y + t * M, z_obj]])
+        crossing = np.array([[x + s * L, y + s * M]])
+        out = image_moments(self.q, self.film_z, obj, at_infinity=False, crossing=crossing, z_ep=self.z_ep,
+                            pupil_radius=self.r_ep, iris_semi_diameter=self.iris, wavelength_nm=self.wl,
+                            backend=self.backend, energy_fraction=self.fraction)
+        return float(math.sqrt(8.0 * out[1][0])) if self.measure == "moment" else float(2.0 * out[2][0])
+
+
+def _measure(measure, energy_fraction):
+    if measure not in MEASURES:
+        raise InputError(f"the blur measure is one of {', '.join(MEASURES)}, got {measure!r}")
+    if measure == "moment":
+        return None
+    f = require_finite("energy fraction", energy_fraction)
+    if not 0.05 <= f <= 0.99:
+        raise InputError(f"the energy fraction must lie between 0.05 and 0.99, got {f:g}")
+    return f
+
+
+@takes_prescription
+def blur_diameter_mm(lens: Prescription, light_from_film_mm: float, *, focus_mm: float, fstop: float,
+                     image_height_mm: float = 0.0, measure: str = "moment", energy_fraction: float = 0.8,
+                     backend: str = "auto") -> float:
+    """The real blur diameter (mm, module notes) of a point ``light_from_film_mm`` in front of the film."""
+    f = _measure(measure, energy_fraction)
+    blur = _Blur(lens, require_positive("focus mark", focus_mm), fstop, require_finite("image height", image_height_mm),
+                 measure, f, backend)
+    d = require_positive("light distance", light_from_film_mm)
+    if not d > blur.front:
+        raise InputError(f"the light at {d:g} mm from the film is not in front of the lens ({blur.front:g} mm)")
+    return blur(d)
+
+
+@takes_prescription
+def real_depth_of_field(lens: Prescription, *, focus_mm: float, fstop: float, coc_mm: float,
+                        image_height_mm: float = 0.0, measure: str = "moment", energy_fraction: float = 0.8,
+                        backend: str = "auto") -> RealDepthOfField:
+    """Near and far limits of ``lens`` focused at ``focus_mm`` (mark from the film) at ``fstop`` where the
+    real blur reaches ``coc_mm`` (module notes). Raises :class:`OpticsError` when the lens's own blur at
+    its sharpest already exceeds the CoC."""
+    mark = require_positive("focus mark", focus_mm)
+    c = require_positive("circle of confusion", coc_mm)
+    h = require_finite("image height", image_height_mm)
+    frac = _measure(measure, energy_fraction)
+    blur = _Blur(lens, mark, fstop, h, measure, frac, backend)
+    u_front = 1.0 / (blur.front + 1.0)  # 1 mm in front of the front vertex
+    b = lambda u: blur(1.0 / u) if u > 0 else blur(FAR_AWAY_MM)  # noqa: E731
+    # the sharpest distance: golden-section search on u = 1/d between infinity and the lens front
+    lo, hi = 0.0, u_front
+    r = (math.sqrt(5.0) - 1.0) / 2.0
+    a, bb = hi - r * (hi - lo), lo + r * (hi - lo)
+    fa, fb = b(a), b(bb)
+    while hi - lo > 1e-7 * u_front:
+        if fa < fb:
+            hi, bb, fb = bb, a, fa
+            a = hi - r * (hi - lo)
+            fa = b(a)
+        else:
+            lo, a, fa = a, bb, fb
+            bb = lo + r * (hi - lo)
+            fb = b(bb)
+    u_best = 0.5 * (lo + hi)
+    best = b(u_best)
+    what = "second-moment diameter" if measure == "moment" else f"{frac:.0%} energy diameter"
+    if best >= c:
+        raise OpticsError(f"{lens.name!r} at f/{fstop:g} blurs a point to {best * 1e3:.1f} um ({what}) even at its "
+                          f"sharpest distance: more than the {c * 1e3:.1f} um CoC, so no depth of field")
+
+    def limit(u_in, u_out):  # bisection on u: blur(u_in) < c <= blur(u_out)
+        for _ in range(200):
+            mid = 0.5 * (u_in + u_out)
+            if b(mid) < c:
+                u_in = mid
+            else:
+                u_out = mid
+            if abs(u_out - u_in) <= 1e-6 * max(u_in, u_out):
+                break
+        return 0.5 * (u_in + u_out)
+
+    near = 1.0 / limit(u_best, u_front) if b(u_front) >= c else 1.0 / u_front
+    far = math.inf if b(0.0) < c else 1.0 / limit(u_best, 0.0)
+    return RealDepthOfField(lens.name, float(fstop), mark, c, h,
+                            "moment" if measure == "moment" else f"energy {frac:.0%}", 1.0 / u_best if u_best > 0
+                            else math.inf, best, near, far)
