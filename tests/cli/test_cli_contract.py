@@ -88,6 +88,7 @@ JSON_RUNS = {
     ("live", "validate"): ["live", "validate", str(LIVE_SAMPLE)],
     ("live", "frustum"): ["live", "frustum", "shot.usda", "frustum.usda", "--wall", "wall.usda"],
     ("mtf",): ["mtf", "dgauss_50mm", "--fstop", "4", "--fields", "3", "--pupil-samples", "32", "--frequency", "20"],
+    ("psf",): ["psf", "dgauss_50mm", "--fstop", "8", "--field", "5", "--method", "huygens", "--samples", "33"],
     ("microlens", "insert"): ["microlens", "insert", "dgauss_50mm", "--microlens-focal", "0.5", "--xdim", "21", "--ydim",
                               "21", "--film-width", "4.2", "--film-height", "4.2", "--focus", "1m", "-o", "lf.json"],
     ("microlens", "render"): ["microlens", "render", "lf0.json", "--fstop", "5.6", "--point", "1m", "--rays", "2000",
@@ -98,6 +99,10 @@ JSON_RUNS = {
 }
 #: Further runs of documents a command prints in other modes.
 EXTRA_JSON_RUNS = {
+    "psf_fft": ["psf", "dgauss_50mm", "--fstop", "8"],
+    "mtf_chart_best_focus": ["mtf", "dgauss_50mm", "--fstop", "4", "--fields", "3", "--pupil-samples", "32",
+                             "--frequency", "20", "--best-focus", "20"],
+    "report_dof_real": ["report", "--lens", "dgauss_50mm", "--fstop", "5.6", "--focus", "3m", "--dof", "real"],
     "distortion_field": ["distortion", "dgauss_50mm", "--resolution", "256x171", "--focus", "2m", "--fit", "brown"],
     "distortion_across_focus": ["distortion", "dgauss_50mm", "--resolution", "256x171", "--across-focus", "1m,inf"],
     "report_at_infinity": ["report", "--lens", "dgauss_50mm", "--fstop", "2.8", "--focus", "inf", "--cameras"],
@@ -119,6 +124,7 @@ CSV_ROWS = {
 }
 #: Commands that take a focus but print no distance (so no --units), and why.
 NO_UNITS = {
+    ("psf",): "prints a Strehl ratio and micrometres on the film (the focus mark is an input only)",
     ("usd", "write"): "prints the file written; the file holds millimetres and scene units",
     ("usd", "kit"): "prints the file written",
     ("live", "record"): "prints frame counts and timecodes",

@@ -158,3 +158,17 @@ def test_sensor_to_scene_and_back_agree(dgauss):
     home = trace_to_sensor(cam, back)
     assert home.ok.all()
     assert np.stack([home.x, home.y], 1) == pytest.approx(start[ok, :2], abs=1e-7)
+
+
+@pytest.mark.parametrize("thin", [True, False], ids=["thin", "prescription"])
+def test_a_ray_entering_on_a_cell_wall_reverses(dgauss, thin):
+    """The example hypothesis found: a ray parallel to the axis entering exactly on the wall between two
+    cells (y = 0.25 mm, pitch 0.1 mm) is refracted by one of them; reversed, it returns to the wall, which
+    rounding put a hair outside that cell, and it was clipped."""
+    cam = _lenslet_camera(dgauss, thin)
+    r = RayBatch.from_arrays([[0.0, 0.25, cam.z_array_front - 0.5]], [[0.0, 0.0, 1.0]])
+    refract_through_array(cam, r)
+    assert r.ok.all()
+    back = RayBatch.from_arrays(np.stack([r.x, r.y, r.z], 1), -np.stack([r.L, r.M, r.N], 1))
+    refract_through_array(cam, back, reverse=True)
+    assert back.ok.all() and back.y[0] == pytest.approx(0.25, abs=1e-9)

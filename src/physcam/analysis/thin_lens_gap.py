@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ..errors import OpticsError, PhysCamError
+from ..errors import OpticsError, PhysCamError, require_type
 
 __all__ = ["ThinLensGap", "thin_lens_gap"]
 
@@ -108,6 +108,11 @@ def thin_lens_gap(report, lens) -> ThinLensGap:
     ``report`` must come from :func:`physcam.onset.report.solve_lens_report` with ``lens``. A bokeh
     that cannot be traced (the light inside the lens's closest focus, everything vignetted) is left
     out with a note."""
+    from ..lens.prescription import Prescription
+    from ..onset.report import LensReport
+
+    require_type("report", report, LensReport, "solve one with physcam.onset.report.solve_lens_report")
+    require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name or file)")
     hfov = None if report.real_fov is None else report.real_fov.get("horizontal_deg")
     hfov_pct = None if not hfov else (report.hfov_focus_deg - hfov) / hfov * 100.0
     rows, notes = [], []

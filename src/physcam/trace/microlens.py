@@ -297,10 +297,14 @@ def refract_through_array(camera: PlenopticCamera, rays: RayBatch, *, reverse: b
     _propagate(sub_end, camera.z_array_front if reverse else camera.z_array)
     for name in ("x", "y", "z", "flag"):
         getattr(rays, name)[live] = getattr(sub_end, name)
-    # opaque cell walls: a ray that left its cell inside the lenslet is clipped
+    # opaque cell walls: a ray that left its cell inside the lenslet is clipped; one that ends on its own
+    # cell's wall (to rounding: a ray that entered on the wall, reversed) is still inside it
     ok = rays.flag[live] == OK
-    jx, jy, ins = a.index_at(rays.x[live], rays.y[live])
-    _lose(rays, live[ok & ~(ins & (jx == ix) & (jy == iy))], CLIPPED)
+    cx0, cy0 = a.cell_centres(ix, iy)
+    tol = 1e-9 * max(a.pitch_x, a.pitch_y, 1.0)
+    own = ((np.abs(rays.x[live] - cx0) <= 0.5 * a.pitch_x + tol)
+           & (np.abs(rays.y[live] - cy0) <= 0.5 * a.pitch_y + tol))
+    _lose(rays, live[ok & ~own], CLIPPED)
     return rays
 
 
