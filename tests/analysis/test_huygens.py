@@ -141,3 +141,39 @@ def test_fft_and_huygens_agree_through_the_field(name, fstop, field_deg):
     assert p.energy_in_grid > 0.99
     assert np.abs(t - f.tangential).max() < 0.01
     assert np.abs(s - f.sagittal).max() < 0.01
+
+
+def test_a_weak_cylinder_spreads_the_point_into_a_line_as_hopkins_says():
+    """The stigmatic singlet behind a plano-cylindrical plate at the stop (power in Y only, one wave of
+    sag at the pupil's rim: R_c = (n - 1) h^2 / (2 lambda)). The film sits at the Y meridian's focus, so
+    the X meridian is defocused by exactly the plate's OPD, W = (n - 1)(R_c - sqrt(R_c^2 - x^2)) (one
+    wave at the rim): the PSF is a short line along x. Shearing along x, the phase difference of
+    W = w x^2 is 4 w s x whatever y is, so the sagittal OTF is Hopkins' defocused one (the same
+    integral as rotational defocus); the tangential is the textbook curve."""
+    from physcam.lens.prescription import LensMetadata, Medium, Prescription, Surface
+
+    from _image_quality import N_GLASS
+
+    n16 = 16.0
+    h = F_MM / (2 * n16)
+    rc = (N_GLASS - 1) * h * h / (2 * LAM)
+    w = (N_GLASS - 1) * (rc - math.sqrt(rc * rc - h * h)) / LAM  # 1.0000001 wave
+    lens = Prescription((
+        Surface(0.0, 0.0, semi_diameter=h, kind="stop"),
+        Surface(0.0, 1.0, Medium(N_GLASS, 0.0), 20.0, kind="flat"),
+        Surface(-rc, 4.0, semi_diameter=20.0, kind="cylindrical_y"),
+        Surface(0.0, 5.0, Medium(N_GLASS, 0.0), 20.0, kind="flat"),
+        Surface(-(N_GLASS - 1.0) * F_MM, F_MM, semi_diameter=20.0, kind="aspheric", conic=-N_GLASS ** 2)),
+        LensMetadata(name="stigmatic singlet behind a weak cylinder")).validate()
+    cutoff = 2 * float(sin_u(h)) / LAM
+    nu = np.linspace(0.0, 0.9 * cutoff, 10)
+    t, s, p = huygens_mtf(lens, 0.0, frequencies=nu, wavelengths_nm=[WL])
+    # 0.015: the line's tails reach past the grid (it holds 99.6 %), most at the first, steepest frequency
+    assert np.abs(s - np.array([abs(defocus_otf(v / cutoff, w)) for v in nu])).max() < 0.015
+    assert np.abs(t - textbook_mtf(nu / cutoff)).max() < 0.01
+    # a short line: the PSF spreads along x (second moment 1.6 times that along y, which is the Airy core)
+    img = p.image
+    c = (np.arange(img.shape[0]) - img.shape[0] // 2) * p.pixel_um
+    mx = (img.sum(axis=0) * c * c).sum() / img.sum()
+    my = (img.sum(axis=1) * c * c).sum() / img.sum()
+    assert mx > 1.4 * my
