@@ -153,6 +153,7 @@ def test_the_overlap_attack_over_udp_keeps_every_good_sample_in_bounded_memory()
     good = _samples(120)
     attack = list(_overlap_attack([5000, 5001, 5002, 5003], 600))
     got = []
+    decode_sample(encode_sample(good[0]))  # the schema validator is built once per process: not measured here
     tracemalloc.start()
     try:
         base, _ = tracemalloc.get_traced_memory()
@@ -443,3 +444,32 @@ def test_a_source_missing_a_value_it_never_sent_is_refused_not_filled_from_anoth
     assert [s.frame.source_id for s in solved] == [SID_A, SID_A]
     assert [r[0] for r in refused] == [1, 3] and "f-stop" in refused[0][1]
     assert math.isclose(solved[1].report.fstop, 2.8)
+
+
+def test_a_frame_keeps_at_most_16_distortion_coefficients():
+    """A recording holds every frame: a 64 KiB sample's thousands of coefficients are refused, not kept."""
+    from physcam.errors import InputError
+
+    s = copy.deepcopy(_samples(1)[0])
+    s["lens"]["distortion"] = [{"model": "Brown-Conrady U-D", "radial": [1e-9] * 5000}]
+    decode_sample(encode_sample(s))  # schema-valid
+    with pytest.raises(InputError, match="5000 coefficients"):
+        frame_from_sample(s)
+    s["lens"]["distortion"][0]["radial"] = [1e-9] * 16
+    assert len(frame_from_sample(s).distortion["radial"]) == 16
+
+
+def test_after_a_restart_a_stray_sample_within_the_old_numbers_is_still_off_the_stream():
+    """Once a restart has been followed, the old run's numbers no longer count as the stream's: a lone
+    sample numbered between the new and the old stays out, pauses or not."""
+    good = _samples(61)
+    stray, good = good[60], good[:60]
+    plan = [("run1", _datagrams(s, 5000 + i)) for i, s in enumerate(good[:30])]
+    plan += [("run2", _datagrams(s, i)) for i, s in enumerate(good[30:])]
+    plan.insert(35, ("run2", _datagrams(stray, 3000)))
+    with Receiver(0, host="127.0.0.1") as rx:
+        got = _stream(rx, plan, pause_after=(35, 36))
+        _drain(rx, got, len(good))
+        c = rx.counters()
+    assert _ids(got) == [s["sampleId"] for s in good], c
+    assert c["resync"] == 1 and c["stray"] == 1

@@ -30,6 +30,10 @@ import numpy as np
 from ..errors import InputError, require_finite, require_type
 from .sample import PROTOCOL_VERSION
 
+#: the most radial (and tangential) distortion coefficients a frame keeps: a recording holds each
+#: frame, and a 64 KiB sample could otherwise carry thousands
+MAX_DISTORTION_TERMS = 16
+
 __all__ = ["TrackedFrame", "rate_fraction", "rational", "timecode_fields", "rotation_matrix", "pan_tilt_roll",
            "compose_transforms", "frame_from_sample", "sample_from_frame", "static_block", "new_source_id"]
 
@@ -219,6 +223,10 @@ def frame_from_sample(sample, *, static=None) -> TrackedFrame:
     distortion = None
     if lens.get("distortion"):
         distortion = dict(lens["distortion"][0])
+        for key in ("radial", "tangential"):
+            if len(distortion.get(key, ())) > MAX_DISTORTION_TERMS:
+                raise InputError(f"lens.distortion[0].{key} has {len(distortion[key])} coefficients; physcam keeps "
+                                 f"at most {MAX_DISTORTION_TERMS} (no lens model uses more)")
     return TrackedFrame(
         time_ns=time_ns, sequence_number=timing.get("sequenceNumber"), timecode=tc, rate=rate,
         translation_m=translation, rotation_deg=rotation,

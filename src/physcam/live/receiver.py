@@ -321,9 +321,13 @@ class Receiver:
                 st.top = max(st.top, ext)
                 self.high_water["window"] = max(self.high_water["window"], len(st.window))
             self._flush(st, now)
-            return
-        # off the stream: a straggler older than what was handed on is late at once (and taken back
-        # should its run resynchronise after all: a sender replaying old timestamps)
+        elif item is not None:  # an invalid sample off the stream is no evidence of anything
+            self._off_stream(st, seq, ext, item, now)
+
+    def _off_stream(self, st: "_Stream", seq: int, ext: int, item, now: float) -> None:
+        """Start or extend the source's off-stream run; resynchronise when it shows a new stream.
+        A straggler older than what was handed on is late at once (and taken back should its run
+        resynchronise after all: a sender replaying old timestamps)."""
         stamp = _stamp(item)
         stale = ext < st.next and stamp is not None and st.stamp is not None and stamp <= st.stamp
         if stale:
@@ -350,6 +354,7 @@ class Receiver:
         run, st.run = st.run, []
         first = run[0][0]
         st.next = st.next + (first - st.next + 32768) % 65536 - 32768
+        st.top = st.next - 1  # the old run's numbers are no longer the stream's
         for seq, _, arrived, item, counted in run:
             if counted:
                 self._count("late", -1)
