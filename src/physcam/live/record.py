@@ -44,7 +44,7 @@ import warnings
 from dataclasses import dataclass
 from fractions import Fraction
 
-from ..errors import ExportError, InputError, PhysCamError, PhysCamWarning, require_type
+from ..errors import ExportError, InputError, PhysCamError, PhysCamWarning, require_finite, require_type
 from .frames import TrackedFrame
 from .lens_data import opentrackio_to_opencv
 
@@ -93,6 +93,9 @@ _FLOAT32_MAX = 3.4028234663852886e38
 def frame_problem(frame: TrackedFrame, pinhole_mm=None) -> str | None:
     """Why ``frame`` cannot be recorded (a value beyond the limits above, a distortion whose
     normalised OpenCV form overflows a 32-bit float), or None."""
+    require_type("frame", frame, TrackedFrame, "physcam.live.frames.frame_from_sample(sample)")
+    if pinhole_mm is not None:
+        pinhole_mm = require_finite("pinhole focal length", pinhole_mm)
     lengths = (("pinholeFocalLength", frame.pinhole_focal_length_mm), ("focusDistance", frame.focus_from_film_mm),
                ("entrancePupilOffset", frame.entrance_pupil_mm), ("nominalFocalLength", frame.nominal_focal_length_mm))
     lengths += tuple(("activeSensorPhysicalDimensions", v) for v in (frame.sensor_mm or ()))
