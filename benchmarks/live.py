@@ -6,9 +6,14 @@ distortion, transform, timing; JSON, one packet each) over loopback UDP at a pac
 seconds; this process receives them (header, Fletcher-16, decode, schema validation, ordering) and
 records each as a frame (:func:`physcam.live.frames.frame_from_sample`). The rate doubles, then is
 bisected, to the highest one with no sample lost (received = sent, nothing missing or dropped).
-Plain script, prints figures:
 
-    .venv/bin/python benchmarks/live.py [--seconds 3] [--cbor]
+``--attack``: a second process attacks the receiver during every trial (issue 24): overlapping
+32 KB segments of never-finished samples (``--attack-rate`` datagrams/s), and ten times a second a
+packet with a valid checksum that is no sample and a valid sample of the stream's source far off its
+sequence. The trial also reports the receiver's reassembly high water and the process's peak RSS
+growth (``/proc/self/status`` VmHWM, reset before each trial). Plain script, prints figures:
+
+    .venv/bin/python benchmarks/live.py [--seconds 3] [--cbor] [--attack [--attack-rate 2000]]
 """
 
 from __future__ import annotations
@@ -34,6 +39,50 @@ with Sender("127.0.0.1", port, encoding=enc) as tx:
     print(sent, time.monotonic() - t0, flush=True)
 """
 
+ATTACKER = r"""
+import json, random, socket, sys, time
+from physcam.live.protocol import ENCODING_JSON, build_packet, packetize
+from physcam.live.sample import encode_sample
+port, rate, seconds, path = int(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
+sample = json.loads(open(path).readline())
+rnd = random.Random(7)
+body = b"\x7f" * 32000
+sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 4 * 1024 * 1024)
+t0, n, k = time.monotonic(), 0, 0
+while time.monotonic() - t0 < seconds:
+    due = t0 + n / rate
+    if due > time.monotonic():
+        time.sleep(due - time.monotonic())
+    sock.sendto(build_packet(body, encoding=ENCODING_JSON, sequence=40000 + n % 64, offset=k % 30000, last=False),
+                ("127.0.0.1", port))
+    n, k = n + 1, k + 1
+    if n % max(1, int(rate / 10)) == 0:  # ten times a second: a lying packet and a stray sample
+        far = rnd.randrange(65536)
+        sock.sendto(build_packet(b"\xde\xad", encoding=ENCODING_JSON, sequence=far), ("127.0.0.1", port))
+        for d in packetize(encode_sample(sample), encoding=ENCODING_JSON, sequence=(far + 7919) % 65536):
+            sock.sendto(d, ("127.0.0.1", port))
+print(n, flush=True)
+"""
+
+
+def _reset_peak_rss() -> int:
+    """Reset the process's peak RSS (Linux: write 5 to clear_refs) and return the current RSS in bytes."""
+    try:
+        with open("/proc/self/clear_refs", "w") as f:
+            f.write("5")
+    except OSError:
+        pass
+    return _status_kib("VmRSS") * 1024
+
+
+def _status_kib(field: str) -> int:
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith(field + ":"):
+                return int(line.split()[1])
+    return 0
+
 
 def _samples(path: str, count: int = 2400) -> int:
     import dataclasses
@@ -53,13 +102,18 @@ def _samples(path: str, count: int = 2400) -> int:
     return len(json.dumps(samples[1]).encode())
 
 
-def trial(rate: float, seconds: float, enc: str, path: str) -> dict:
+def trial(rate: float, seconds: float, enc: str, path: str, attack_rate: float = 0.0) -> dict:
     from physcam.live.frames import frame_from_sample
     from physcam.live.receiver import Receiver
 
     recorded = 0
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    rss0 = _reset_peak_rss()
     with Receiver(0, host="127.0.0.1", queue_size=4096) as rx:
+        attacker = None
+        if attack_rate > 0:
+            attacker = subprocess.Popen([sys.executable, "-c", ATTACKER, str(rx.port), str(attack_rate),
+                                         str(seconds), path], stdout=subprocess.PIPE, text=True, env=env)
         proc = subprocess.Popen([sys.executable, "-c", SENDER, str(rx.port), str(rate), str(seconds), enc, path],
                                 stdout=subprocess.PIPE, text=True, env=env)
         t0 = time.perf_counter()
@@ -75,27 +129,47 @@ def trial(rate: float, seconds: float, enc: str, path: str) -> dict:
             recorded += 1
         elapsed = time.perf_counter() - t0
         sent, send_s = proc.stdout.read().split()
+        attacks = int(attacker.stdout.read().split()[0]) if attacker is not None else 0
+        if attacker is not None:
+            attacker.wait()
         c = rx.counters()
+        high = dict(rx.high_water)
+    peak = _status_kib("VmHWM") * 1024 - rss0
     return {"rate": rate, "sent": int(sent), "recorded": recorded, "send_s": float(send_s), "elapsed_s": elapsed,
-            "lost": int(sent) - recorded, "counters": c}
+            "lost": int(sent) - recorded, "counters": c, "attacks": attacks, "high_water": high,
+            "peak_rss_growth": peak}
+
+
+def _report(rate: float, r: dict) -> None:
+    line = (f"  {rate:8.0f}/s: sent {r['sent']}, recorded {r['recorded']}, lost {r['lost']} "
+            f"(send took {r['send_s']:.2f} s)")
+    if r["attacks"]:
+        c = r["counters"]
+        line += (f"; {r['attacks']} attack segments, malformed {c['malformed']}, stray+late {c['stray'] + c['late']}, "
+                 f"reassembly high water {r['high_water']['reassembly_bytes'] / 1024:.0f} KiB, "
+                 f"peak RSS +{r['peak_rss_growth'] / 2**20:.1f} MiB")
+    print(line)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=3.0, help="length of each trial")
     ap.add_argument("--cbor", action="store_true", help="CBOR payloads (default JSON)")
+    ap.add_argument("--attack", action="store_true", help="attack the receiver during every trial (module notes)")
+    ap.add_argument("--attack-rate", type=float, default=2000.0, help="overlapping 32 KB segments per second")
     args = ap.parse_args()
+    attack = args.attack_rate if args.attack else 0.0
     enc = "cbor" if args.cbor else "json"
     path = os.path.join(os.path.dirname(os.path.abspath(__file__)), ".live_samples.jsonl")
     size = _samples(path)
-    print(f"sample: {size} bytes of JSON ({enc} on the wire), one packet each; {args.seconds:g} s per trial")
+    print(f"sample: {size} bytes of JSON ({enc} on the wire), one packet each; {args.seconds:g} s per trial"
+          + (f"; under attack, {attack:g} overlapping 32 KB segments/s" if attack else ""))
     good, bad = 0.0, None
     rate = GOAL / 2
     try:
         while bad is None and rate <= 64 * GOAL:  # double until a trial loses samples
-            r = trial(rate, args.seconds, enc, path)
-            print(f"  {rate:8.0f}/s: sent {r['sent']}, recorded {r['recorded']}, lost {r['lost']} "
-                  f"(send took {r['send_s']:.2f} s)")
+            r = trial(rate, args.seconds, enc, path, attack)
+            _report(rate, r)
             if r["lost"] == 0 and r["send_s"] <= args.seconds * 1.05:
                 good = rate
                 rate *= 2
@@ -103,9 +177,8 @@ def main() -> None:
                 bad = rate
         for _ in range(4 if bad else 0):  # bisect between the last good and the first bad rate
             mid = (good + bad) / 2
-            r = trial(mid, args.seconds, enc, path)
-            print(f"  {mid:8.0f}/s: sent {r['sent']}, recorded {r['recorded']}, lost {r['lost']} "
-                  f"(send took {r['send_s']:.2f} s)")
+            r = trial(mid, args.seconds, enc, path, attack)
+            _report(mid, r)
             if r["lost"] == 0 and r["send_s"] <= args.seconds * 1.05:
                 good = mid
             else:

@@ -110,3 +110,49 @@ def test_multicast_on_loopback():
                 got.append(item)
     assert [g.sample["sampleId"] for g in got] == [s["sampleId"] for s in samples]
     assert {g.encoding for g in got} == {"cbor"}
+
+
+def _wait_for_port(proc, port):
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and proc.poll() is None:  # until the recorder holds the port
+        with open("/proc/net/udp") as f:  # local_address is ADDR:PORT in hex
+            if any(line.split()[1].endswith(f":{port:04X}") for line in f.readlines()[1:]):
+                return
+        time.sleep(0.1)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP", "SIGINT"])
+def test_a_signal_ends_the_recording_and_the_take_is_written(tmp_path, sig):
+    """`physcam live record` stopped by SIGTERM (a process manager), SIGHUP (the terminal closed) or
+    SIGINT (Ctrl-C) writes what it received. Two of the 20 samples sent are out of range (fStop 1e308,
+    and 1e5000 as a CBOR decimal fraction): they are refused, the other 18 recorded."""
+    import signal
+    from decimal import Decimal
+
+    pytest.importorskip("pxr")
+    from pxr import Usd
+
+    port = _free_port()
+    out = tmp_path / "take.usda"
+    proc = subprocess.Popen([sys.executable, "-m", "physcam", "live", "record", str(out), "--port", str(port),
+                             "--host", "127.0.0.1", "--duration", "120", "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    frames = camera_frames(sensor=find_sensor("ALEXA 35"), frames=20, rate=24, focus_mm=2000.0, fstop=4.0,
+                           focal_length_mm=32.0)
+    samples = list(frames_to_samples(frames))
+    samples[5]["lens"]["fStop"] = 1e308
+    samples[9]["lens"]["fStop"] = Decimal("1e5000")
+    _wait_for_port(proc, port)
+    with Sender("127.0.0.1", port, encoding="cbor") as tx:
+        tx.stream(samples, 240)
+    time.sleep(1.5)
+    proc.send_signal(getattr(signal, sig))
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 0, stderr
+    summary = json.loads(stdout)
+    assert summary["interrupted"] is True and summary["frames"] == 18
+    assert summary["counters"]["invalid"] == 1 and summary["counters"]["refused"] == 1
+    stage = Usd.Stage.Open(str(out))
+    seq = stage.GetPrimAtPath("/Cameras/Camera").GetAttribute("physcam:live:sequenceNumber")
+    assert [seq.Get(t) for t in seq.GetTimeSamples()] == [i for i in range(20) if i not in (5, 9)]

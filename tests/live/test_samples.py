@@ -136,6 +136,14 @@ def test_fletcher16_closed_form_equals_the_byte_recurrence(data, m):
     assert fletcher16(data, m) == _recurrence(data, m)
 
 
+@given(st.integers(8000, 40000), st.integers(0, 2**32 - 1), st.sampled_from([255, 256]))
+def test_fletcher16_over_several_8_kib_chunks_equals_the_byte_recurrence(n, seed, m):
+    data = np.random.default_rng(seed).integers(0, 256, n, dtype=np.uint8).tobytes()
+    assert fletcher16(data, m) == _recurrence(data, m)
+    pk = build_packet(data[:30000], encoding=ENCODING_CBOR, sequence=seed % 65536, offset=3, last=False, modulus=m)
+    assert parse_packet(pk, m)[1] == data[:30000]  # the header's sums and the piece's, combined without a copy
+
+
 # --- packets ------------------------------------------------------------------------------------
 def test_header_layout_by_hand():
     pk = build_packet(b"{}", encoding=ENCODING_JSON, sequence=0x1234, offset=0, last=True)

@@ -15,7 +15,7 @@ examples:
   physcam live play take.usda --port 55555
   physcam live wall wall.usda --kind curved --radius 8 --width 14
   physcam live frustum take.usda --wall wall.usda frustum.usda --overscan 10 --latency-ms 40
-Receivers stop after --duration seconds or --count samples, or on Ctrl-C; the file is written then.
+Receivers stop after --duration seconds or --count samples, or on Ctrl-C, SIGTERM or SIGHUP; the file is\nwritten then.
 """
 
 
@@ -259,14 +259,67 @@ def _resolve_sensor_opt(args):
     return resolve_sensor(args)
 
 
+class _StopSignals:
+    """While recording, SIGINT (Ctrl-C), SIGTERM (a process manager) and SIGHUP (the terminal closed)
+    end the recording, which is then written; :meth:`restore` and leaving give the old handlers back."""
+
+    NAMES = ("SIGINT", "SIGTERM", "SIGHUP")
+
+    def __init__(self):
+        self.received = None
+        self._old: dict = {}
+
+    def _handle(self, signum, frame) -> None:
+        self.received = signum
+
+    def __enter__(self):
+        import signal
+        import threading
+
+        if threading.current_thread() is threading.main_thread():  # only the main thread may set handlers
+            for name in self.NAMES:
+                sig = getattr(signal, name, None)  # Windows has no SIGHUP
+                if sig is not None:
+                    self._old[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def restore(self, name: str) -> None:
+        import signal
+
+        sig = getattr(signal, name, None)
+        if sig in self._old:
+            signal.signal(sig, self._old.pop(sig))
+
+    def __exit__(self, *exc) -> bool:
+        for name in self.NAMES:
+            self.restore(name)
+        return False
+
+
+def _take(item, statics: dict, frames: list, refusals: list) -> None:
+    """Add a received sample to the take as a frame; the static block is remembered per source, and
+    a sample physcam cannot read (a transform chain with no camera orientation, a distance beyond
+    millimetres) is refused with its reason, never ending the recording."""
+    from ..errors import PhysCamError
+    from ..live.frames import frame_from_sample
+
+    sample = item.sample
+    source = (sample.get("sourceId"), sample.get("sourceNumber"))
+    if "static" in sample:
+        statics[source] = sample["static"]
+    try:
+        frames.append(frame_from_sample(sample, static=statics.get(source)))
+    except PhysCamError as exc:
+        refusals.append(f"sample {sample.get('timing', {}).get('sequenceNumber', item.sequence)}: {exc}")
+
+
 def run_record(args) -> int:
     import time
 
     from ..errors import InputError
     from ..io import check_writable
-    from ..live.frames import frame_from_sample
     from ..live.receiver import Receiver, multicast_group
-    from ..live.record import MAX_RECORDED_FRAMES, solve_frames, write_lens_report, write_recording_usd
+    from ..live.record import MAX_RECORDED_FRAMES
 
     sensor = _resolve_sensor_opt(args)
     if args.focus is not None:
@@ -285,46 +338,67 @@ def run_record(args) -> int:
     group = multicast_group(args.multicast) if args.multicast is not None else None
     receiver = Receiver(args.port, host=args.host, group=group, interface=args.interface,
                         modulus=args.modulus if args.modulus == "auto" else int(args.modulus))
-    frames, static = [], None
+    frames, statics, refusals = [], {}, []
     t0 = time.monotonic()
     last_tc = None
     interrupted = False
-    with receiver, _Status(not args.json) as status:
-        next_draw = 0.0
-        try:
-            while True:
-                now = time.monotonic()
-                if args.duration is not None and now - t0 >= args.duration:
-                    break
-                if args.count is not None and len(frames) >= args.count:
-                    break
-                item = receiver.get(timeout=0.05)
-                if item is not None:
-                    if "static" in item.sample:
-                        static = item.sample["static"]
-                    fr = frame_from_sample(item.sample, static=static)
-                    frames.append(fr)
-                    last_tc = fr.timecode or last_tc
-                    if len(frames) >= MAX_RECORDED_FRAMES:
+    with _StopSignals() as stop:
+        with receiver, _Status(not args.json) as status:
+            next_draw = 0.0
+            try:
+                while stop.received is None:
+                    now = time.monotonic()
+                    if args.duration is not None and now - t0 >= args.duration:
                         break
-                if now >= next_draw:
-                    el = now - t0
-                    status.update(len(frames), len(frames) / el if el > 0 else 0.0, receiver.counters(), last_tc, el)
-                    next_draw = now + 0.25
-        except KeyboardInterrupt:
-            interrupted = True  # stop recording and write what was received
-    while True:  # samples still queued when the receiver stopped
-        item = receiver.get()
-        if item is None or (args.count is not None and len(frames) >= args.count):
-            break
-        frames.append(frame_from_sample(item.sample, static=static or item.sample.get("static")))
+                    if args.count is not None and len(frames) >= args.count:
+                        break
+                    item = receiver.get(timeout=0.05)
+                    if item is not None:
+                        _take(item, statics, frames, refusals)
+                        last_tc = (frames[-1].timecode if frames else None) or last_tc
+                        if len(frames) >= MAX_RECORDED_FRAMES:
+                            break
+                    if now >= next_draw:
+                        el = now - t0
+                        status.update(len(frames), len(frames) / el if el > 0 else 0.0, receiver.counters(), last_tc,
+                                      el)
+                        next_draw = now + 0.25
+            except KeyboardInterrupt:
+                interrupted = True  # Ctrl-C where no handler could be set: write what was received
+        stop.restore("SIGINT")  # a second Ctrl-C while writing aborts; SIGTERM and SIGHUP still wait for the file
+        while len(frames) < MAX_RECORDED_FRAMES:  # samples still queued when the receiver stopped
+            item = receiver.get()
+            if item is None or (args.count is not None and len(frames) >= args.count):
+                break
+            _take(item, statics, frames, refusals)
+        interrupted = interrupted or stop.received is not None
+        return _write_take(args, receiver, frames, refusals, sensor, t0, interrupted)
+
+
+def _write_take(args, receiver, frames, refusals, sensor, t0, interrupted) -> int:
+    """Solve and write the recorded frames; a frame that cannot be solved is refused, the take kept."""
+    import time
+
+    from ..errors import InputError
+    from ..live.record import solve_frames, write_lens_report, write_recording_usd
+
     counters = receiver.counters()
     elapsed = time.monotonic() - t0
     if not frames:
+        why = f" ({refusals[0]})" if refusals else ""
         raise InputError(f"no valid samples arrived on port {receiver.port} in {elapsed:.1f} s "
-                         f"(received {counters['received']} packets); nothing written")
+                         f"(received {counters['received']} packets){why}; nothing written")
+    refused: list = []
     solved = solve_frames(frames, sensor=sensor, rate=args.fps, focal_length_mm=args.focal, fstop=args.fstop,
-                          focus_mm=args.focus)
+                          focus_mm=args.focus, refused=refused)
+    refusals = refusals + [reason for _, reason in refused]
+    if not solved:
+        raise InputError(f"no frame of the take could be recorded: {refusals[0]}; nothing written")
+    counters["refused"] = len(refusals)
+    for reason in refusals[:10]:
+        print(f"physcam: refused {reason}", file=sys.stderr)
+    if len(refusals) > 10:
+        print(f"physcam: refused {len(refusals) - 10} more samples", file=sys.stderr)
     out = write_recording_usd(args.file, solved, rate=args.fps, meters_per_unit=args.meters_per_unit,
                               path=args.path, force=args.force)
     rep = write_lens_report(args.report, solved, force=args.force) if args.report else None
@@ -337,7 +411,7 @@ def run_record(args) -> int:
         print(f"recorded {len(solved)} frames to {out}" + (f" and {rep}" if rep else "")
               + f" ({summary['first_timecode'] or '-'} to {summary['last_timecode'] or '-'})")
         print("  " + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counters.items()))
-    return 0  # Ctrl-C is how a recording is ended: the file is written and that is success
+    return 0  # a signal is how a recording is ended: the file is written and that is success
 
 
 # --- send and play ---------------------------------------------------------------------------

@@ -30,6 +30,10 @@ import numpy as np
 from ..errors import InputError, require_finite, require_type
 from .sample import PROTOCOL_VERSION
 
+#: the most radial (and tangential) distortion coefficients a frame keeps: a recording holds each
+#: frame, and a 64 KiB sample could otherwise carry thousands
+MAX_DISTORTION_TERMS = 16
+
 __all__ = ["TrackedFrame", "rate_fraction", "rational", "timecode_fields", "rotation_matrix", "pan_tilt_roll",
            "compose_transforms", "frame_from_sample", "sample_from_frame", "static_block", "new_source_id"]
 
@@ -38,7 +42,8 @@ __all__ = ["TrackedFrame", "rate_fraction", "rational", "timecode_fields", "rota
 class TrackedFrame:
     """The camera at one instant (module notes). ``time_ns``: PTP-style timestamp in nanoseconds
     (None when the sample has none); ``translation_m`` (x, y, z) of the film plane centre on the
-    Z-up stage; ``rotation_deg`` (pan, tilt, roll); lens values in mm; ``None`` where not sent."""
+    Z-up stage; ``rotation_deg`` (pan, tilt, roll); lens values in mm; ``None`` where not sent;
+    ``source_id`` and ``source_number``: the sample's ``sourceId`` and ``sourceNumber``."""
 
     time_ns: int | None = None
     sequence_number: int | None = None
@@ -55,6 +60,13 @@ class TrackedFrame:
     sensor_mm: tuple[float, float] | None = None
     nominal_focal_length_mm: float | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
+    source_id: str | None = None
+    source_number: int | None = None
+
+    @property
+    def source(self) -> tuple:
+        """The stream this frame came from: (``sourceId``, ``sourceNumber``)."""
+        return (self.source_id, self.source_number)
 
 
 def rate_fraction(rate) -> Fraction:
@@ -199,19 +211,31 @@ def frame_from_sample(sample, *, static=None) -> TrackedFrame:
     if "transforms" in sample:
         translation, rotation, notes = compose_transforms(sample["transforms"])
     dims = st.get("camera", {}).get("activeSensorPhysicalDimensions")
-    mm = lambda v: None if v is None else float(v) * 1000.0  # noqa: E731 - metres to mm
+
+    def mm(name):  # metres to mm; a value the conversion overflows is refused, never made infinite
+        v = lens.get(name)
+        if v is None:
+            return None
+        out = float(v) * 1000.0
+        if not math.isfinite(out):
+            raise InputError(f"lens.{name} {v!r} m is beyond any distance in millimetres")
+        return out
     distortion = None
     if lens.get("distortion"):
         distortion = dict(lens["distortion"][0])
+        for key in ("radial", "tangential"):
+            if len(distortion.get(key, ())) > MAX_DISTORTION_TERMS:
+                raise InputError(f"lens.distortion[0].{key} has {len(distortion[key])} coefficients; physcam keeps "
+                                 f"at most {MAX_DISTORTION_TERMS} (no lens model uses more)")
     return TrackedFrame(
         time_ns=time_ns, sequence_number=timing.get("sequenceNumber"), timecode=tc, rate=rate,
         translation_m=translation, rotation_deg=rotation,
-        pinhole_focal_length_mm=lens.get("pinholeFocalLength"), focus_from_film_mm=mm(lens.get("focusDistance")),
-        fstop=lens.get("fStop"), tstop=lens.get("tStop"), entrance_pupil_mm=mm(lens.get("entrancePupilOffset")),
+        pinhole_focal_length_mm=lens.get("pinholeFocalLength"), focus_from_film_mm=mm("focusDistance"),
+        fstop=lens.get("fStop"), tstop=lens.get("tStop"), entrance_pupil_mm=mm("entrancePupilOffset"),
         distortion=distortion,
         sensor_mm=None if not dims else (float(dims["width"]), float(dims["height"])),
         nominal_focal_length_mm=st.get("lens", {}).get("nominalFocalLength"),
-        notes=notes,
+        notes=notes, source_id=sample.get("sourceId"), source_number=sample.get("sourceNumber"),
     )
 
 

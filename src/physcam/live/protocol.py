@@ -16,8 +16,10 @@ Source: the OpenTrackIO documentation's transport section, as summarised in
 ``shared/reference/opentrackio/README.md``. The checksum's modulus is 256 in the current reference
 code and was 255 on the 1.0.0 page; :func:`fletcher16` takes either (``modulus``), 256 by default.
 
-Reassembly keeps a bounded number of unfinished samples (:class:`Reassembler`): a sample whose
-pieces never all arrive is dropped when newer ones push it out, so memory never grows with bad input.
+Reassembly keeps a bounded number of unfinished samples (:class:`Reassembler`), each in one buffer
+of the largest sample (64 KiB) with a bit map of the bytes that have arrived: a piece overlapping
+bytes already held is refused, a sample whose pieces never all arrive is dropped when newer ones
+push it out, so memory never grows with bad input (16 x 72 KiB by default).
 """
 
 from __future__ import annotations
@@ -84,7 +86,8 @@ def fletcher16(data, modulus: int = 256) -> int:
     Commun. 30(1), 1982).
 
     Computed in closed form: ``sum1 = sum(d_i)`` and ``sum2 = sum((n - i) d_i)`` reduced once at
-    the end, equal to the byte-by-byte recurrence because reduction modulo m commutes with sums.
+    the end, equal to the byte-by-byte recurrence because reduction modulo m commutes with sums
+    (summed 8 KiB at a time, :func:`_sums`).
 
     Wikipedia's test vectors ("Fletcher's checksum", modulus 255) and the same sums modulo 256:
 
@@ -96,13 +99,32 @@ def fletcher16(data, modulus: int = 256) -> int:
     if not isinstance(data, (bytes, bytearray, memoryview)):
         raise InputError(f"data must be bytes, got {type(data).__name__}")
     m = _modulus(modulus)
-    d = np.frombuffer(data, dtype=np.uint8)
-    n = d.size
-    if n == 0:
-        return 0
-    s1 = int(d.sum(dtype=np.int64))
-    s2 = int(np.dot(np.arange(n, 0, -1, dtype=np.int64), d.astype(np.int64)))
+    s1, s2 = _sums((data,))
     return ((s2 % m) << 8) | (s1 % m)
+
+
+_CHUNK = 8192  # bytes summed at a time: the working arrays stay at 128 KiB whatever the packet's size
+_WEIGHTS = np.arange(_CHUNK, 0, -1, dtype=np.int64)  # a chunk of n bytes weighs them n, n-1, ..., 1
+
+
+def _sums(parts) -> tuple[int, int]:
+    """Fletcher's running sums (unreduced) over the concatenation of ``parts``, without joining them:
+    appending m bytes with sums (t1, t2) to a prefix with (s1, s2) gives (s1 + t1, s2 + m s1 + t2)."""
+    s1 = s2 = 0
+    for part in parts:
+        if len(part) <= 64:  # a header: plain Python beats numpy's call overhead
+            b = bytes(part)
+            n = len(b)
+            s1, s2 = s1 + sum(b), s2 + n * s1 + sum((n - i) * v for i, v in enumerate(b))
+            continue
+        d = np.frombuffer(part, dtype=np.uint8)
+        for start in range(0, d.size, _CHUNK):
+            c = d[start:start + _CHUNK]
+            n = c.size
+            t1 = int(c.sum(dtype=np.int64))
+            t2 = int(np.dot(_WEIGHTS[_CHUNK - n:], c.astype(np.int64)))
+            s1, s2 = s1 + t1, s2 + n * s1 + t2
+    return s1, s2
 
 
 def build_packet(piece: bytes, *, encoding: int, sequence: int, offset: int = 0, last: bool = True,
@@ -163,81 +185,107 @@ def parse_packet(datagram, modulus: int | str = 256) -> tuple[PacketHeader, byte
     if offset + length > MAX_SAMPLE_BYTES:
         raise PacketError(f"segment ends at byte {offset + length}: beyond the {MAX_SAMPLE_BYTES}-byte sample limit")
     (checksum,) = _CHECKSUM.unpack_from(data, 14)
-    covered = bytes(data[:14]) + bytes(data[HEADER_SIZE:])
     moduli = (255, 256) if modulus == "auto" else (_modulus(modulus),)
-    if all(fletcher16(covered, m) != checksum for m in moduli):
+    s1, s2 = _sums((data[:14], data[HEADER_SIZE:]))
+    if all(((s2 % m) << 8) | (s1 % m) != checksum for m in moduli):
         raise PacketError("Fletcher-16 checksum does not match", kind="checksum")
     header = PacketHeader(encoding, seq, offset, bool(lflag & 0x8000), length, checksum)
     return header, bytes(data[HEADER_SIZE:])
 
 
-class Reassembler:
-    """Collect the pieces of segmented samples; bounded (module notes).
+class _Unfinished:
+    """One segmented sample being put together: a 64 KiB buffer and a bit map of the bytes it holds."""
 
-    :meth:`add` returns ``(encoding, payload)`` when a sample is complete, else None; it raises
-    :class:`PacketError` for pieces that contradict each other (two encodings, overlapping or
-    mismatched pieces, two last pieces). At most ``max_pending`` unfinished samples are kept: a newer
-    one pushes the oldest out, counted in :attr:`dropped`.
+    __slots__ = ("encoding", "buffer", "have", "bytes", "end", "top")
+
+    def __init__(self, encoding: int, size: int):
+        self.encoding = encoding
+        self.buffer = bytearray(size)
+        self.have = 0  # bit i set: byte i has arrived (a Python int of at most size bits)
+        self.bytes = 0  # bytes held; the pieces never overlap, so the sample is whole when bytes == end
+        self.end = None  # the sample's length, known from its last piece
+        self.top = 0  # the furthest byte any piece reached
+
+
+class Reassembler:
+    """Collect the pieces of segmented samples, in bounded memory (module notes).
+
+    :meth:`add` returns ``(encoding, payload)`` when a sample is complete, else None. It raises
+    :class:`PacketError` for a piece it refuses: one that overlaps bytes already held (kind
+    ``duplicate`` when it repeats them exactly, else ``malformed``; the sample keeps what it had), and
+    for pieces that contradict the sample (two encodings, two different last pieces, a piece beyond
+    the end; the sample is dropped).
+
+    Bound: at most ``max_pending`` unfinished samples (a newer one pushes the oldest out, counted in
+    :attr:`dropped`), each one buffer of ``max_sample_bytes`` and a bit map of as many bits, whatever
+    arrives: 16 x (64 KiB + 8 KiB) = 1.125 MiB by default. Samples are keyed by the packet's sequence
+    number and ``source`` (the sender's address), so two senders never mix their pieces.
     """
 
     def __init__(self, max_pending: int = 16, max_sample_bytes: int = MAX_SAMPLE_BYTES):
         if isinstance(max_pending, bool) or not isinstance(max_pending, int) or not 1 <= max_pending <= 4096:
             raise InputError(f"max_pending must be 1..4096, got {max_pending!r}")
+        if isinstance(max_sample_bytes, bool) or not isinstance(max_sample_bytes, int) \
+                or not 1 <= max_sample_bytes <= MAX_SAMPLE_BYTES:
+            raise InputError(f"max_sample_bytes must be 1..{MAX_SAMPLE_BYTES}, got {max_sample_bytes!r}")
         self.max_pending = max_pending
-        self.max_sample_bytes = int(max_sample_bytes)
-        self._pending: dict[int, dict] = {}
+        self.max_sample_bytes = max_sample_bytes
+        self._pending: dict[tuple, _Unfinished] = {}
         self.dropped = 0
         self.high_water_bytes = 0
 
     @property
     def pending_bytes(self) -> int:
-        return sum(p["bytes"] for p in self._pending.values())
+        """Payload bytes held in unfinished samples."""
+        return sum(p.bytes for p in self._pending.values())
 
-    def discard(self, sequence: int) -> None:
-        self._pending.pop(sequence, None)
+    @property
+    def allocated_bytes(self) -> int:
+        """Bytes of the unfinished samples' buffers (each ``max_sample_bytes``; the bit maps add 1/8)."""
+        return len(self._pending) * self.max_sample_bytes
 
-    def add(self, header: PacketHeader, piece: bytes):
+    def discard(self, sequence: int, source=None) -> None:
+        self._pending.pop((source, sequence), None)
+
+    def add(self, header: PacketHeader, piece: bytes, source=None):
+        key = (source, header.sequence)
         if header.offset == 0 and header.last:  # the common case: one packet, one sample
-            self._pending.pop(header.sequence, None)
+            self._pending.pop(key, None)
             return header.encoding, piece
-        entry = self._pending.get(header.sequence)
+        end = header.offset + header.length
+        if end > self.max_sample_bytes:
+            raise PacketError(f"segment ends at byte {end}: beyond the {self.max_sample_bytes}-byte sample limit")
+        entry = self._pending.get(key)
         if entry is None:
             if len(self._pending) >= self.max_pending:  # the oldest unfinished sample gives way
                 del self._pending[next(iter(self._pending))]
                 self.dropped += 1
-            entry = self._pending[header.sequence] = {"encoding": header.encoding, "pieces": {}, "end": None,
-                                                      "bytes": 0}
-        if entry["encoding"] != header.encoding:
-            del self._pending[header.sequence]
+            entry = self._pending[key] = _Unfinished(header.encoding, self.max_sample_bytes)
+        if entry.encoding != header.encoding:
+            del self._pending[key]
             raise PacketError("segments of one sample announce different encodings")
-        if header.offset in entry["pieces"]:
-            if entry["pieces"][header.offset] == piece:
-                raise PacketError("the same segment twice", kind="duplicate")
-            del self._pending[header.sequence]
-            raise PacketError("two different segments at the same offset")
-        end = header.offset + header.length
         if header.last:
-            if entry["end"] is not None and entry["end"] != end:
-                del self._pending[header.sequence]
+            if entry.end is not None and entry.end != end:
+                del self._pending[key]
                 raise PacketError("two last segments of one sample")
-            entry["end"] = end
-        if entry["end"] is not None and end > entry["end"]:
-            del self._pending[header.sequence]
+            if entry.top > end:
+                del self._pending[key]
+                raise PacketError("a segment beyond the last one")
+            entry.end = end
+        elif entry.end is not None and end > entry.end:
+            del self._pending[key]
             raise PacketError("a segment beyond the last one")
-        entry["pieces"][header.offset] = piece
-        entry["bytes"] += len(piece)
+        mask = ((1 << header.length) - 1) << header.offset
+        if entry.have & mask:
+            if entry.have & mask == mask and entry.buffer[header.offset:end] == piece:
+                raise PacketError("the same segment twice", kind="duplicate")
+            raise PacketError("a segment overlaps bytes already received: refused")
+        entry.buffer[header.offset:end] = piece
+        entry.have |= mask
+        entry.bytes += header.length
+        entry.top = max(entry.top, end)
         self.high_water_bytes = max(self.high_water_bytes, self.pending_bytes)
-        if entry["end"] is None or entry["bytes"] < entry["end"]:
+        if entry.end is None or entry.bytes < entry.end:
             return None
-        # all bytes present when the pieces tile [0, end) without gaps or overlaps
-        pos, parts = 0, []
-        for off in sorted(entry["pieces"]):
-            if off != pos:
-                del self._pending[header.sequence]
-                raise PacketError("segments overlap or leave a gap")
-            parts.append(entry["pieces"][off])
-            pos += len(entry["pieces"][off])
-        del self._pending[header.sequence]
-        if pos != entry["end"]:
-            raise PacketError("segments do not add up to the sample's length")
-        return entry["encoding"], b"".join(parts)
+        del self._pending[key]  # the pieces are disjoint and inside [0, end): all bytes are here
+        return entry.encoding, bytes(entry.buffer[:entry.end])

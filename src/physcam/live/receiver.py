@@ -1,25 +1,40 @@
-"""A UDP receiver for OpenTrackIO: packets in, validated samples out, in order, with bounded memory.
+"""A UDP receiver for OpenTrackIO: packets in, validated samples out, in order per source, with bounded memory.
 
 A background thread reads datagrams (unicast, or a multicast group joined on one interface) and,
 for each: checks the header and the Fletcher-16 checksum (:mod:`physcam.live.protocol`), puts
-segmented samples back together, decodes JSON or CBOR and validates the sample against the
-OpenTrackIO schema (:mod:`physcam.live.sample`), then hands samples on **in sequence order**
-through a bounded queue.
+segmented samples back together (per sender address), decodes JSON or CBOR and validates the
+sample against the OpenTrackIO schema (:mod:`physcam.live.sample`), then hands samples on **in
+sequence order per source** through a bounded queue.
 
-Order: packet sequence numbers (16 bits, wrapping) are unwrapped into a running count. A sample
-waits in a reorder window of ``reorder_window`` samples (and at most ``reorder_timeout_s``) for the
-ones before it; a number the window has already passed is **late**, one already seen a
-**duplicate**; both are dropped. Gaps the window gives up on are counted as **missing**.
+Sources: a stream is a sample's (``sourceId``, ``sourceNumber``); each has its own sequence numbers.
+Source numbers outside 1..200 (OpenTrackIO's transport: multicast groups 239.135.1.1-200) are
+discarded, as the transport asks of consumers, although the schema allows 0..2^32-1.
+
+Order: a source's 16-bit packet sequence numbers are unwrapped into a running count. A sample waits
+in a reorder window for the ones before it: a missing number is given up (counted **missing**)
+once ``reorder_window`` (8) later samples wait, or the oldest of them has waited
+``reorder_timeout_s`` (50 ms). A sample is on its stream when its number lies between the next one
+due and ``reorder_window`` past the highest seen; anything else starts or extends an off-stream
+**run**. A run **resynchronises** the source (the window is handed on, the run becomes the stream;
+counted in ``resync``) when two samples in a row follow each other and are newer (by
+``sampleTimestamp``, when both have one) than what was handed on, or when ``reorder_window`` samples
+do: a restarted sender (numbers back to 0) or a jump is followed, and one packet far off the
+sequence never moves it. A run that the stream's own samples interrupt is dropped: **late** if it
+lay behind, **stray** if ahead.
 
 Counters (:meth:`Receiver.counters`): ``received`` datagrams; ``malformed`` (not OpenTrackIO,
-truncated, oversized, contradictory segments, undecodable payload); ``wrong_checksum``;
-``duplicate``; ``late``; ``invalid`` (decoded but not a valid sample); ``dropped`` (unfinished
-segmented samples pushed out, or samples the consumer did not take before the queue filled);
-``missing`` (sequence numbers never seen); ``delivered`` samples.
+truncated, oversized, contradictory or overlapping segments, undecodable payload); ``wrong_checksum``;
+``duplicate`` (a datagram received again, byte for byte; a second sample for a number already held);
+``late``; ``stray``; ``invalid`` (decoded but not a valid sample, or a source number outside
+1..200); ``dropped`` (unfinished segmented samples pushed out, or samples the consumer did not take
+before the queue filled); ``missing`` (sequence numbers given up); ``resync``; ``delivered``.
 
-Memory is bounded whatever arrives: one receive buffer, at most ``max_pending`` unfinished samples
-of at most 64 KiB, ``reorder_window`` decoded samples and ``queue_size`` samples in the queue.
-:meth:`Receiver.stop` (or leaving the ``with`` block) ends the thread and closes the socket.
+Memory is bounded whatever arrives: one 64 KiB receive buffer; reassembly of at most
+``max_pending`` (16) unfinished samples of 64 KiB each with an 8 KiB map (1.125 MiB,
+:class:`~physcam.live.protocol.Reassembler`); the keys of the last 4,096 datagrams (duplicates);
+at most 16 sources, each holding ``reorder_window`` samples in its window and as many in a run; and
+``queue_size`` samples in the queue. :meth:`Receiver.stop` (or leaving the ``with`` block) ends the
+thread and closes the socket.
 """
 
 from __future__ import annotations
@@ -34,20 +49,27 @@ from dataclasses import dataclass
 
 from ..errors import InputError, PhysCamError
 from .protocol import ENCODINGS, PacketError, Reassembler, parse_packet
-from .sample import SampleError, decode_sample
+from .sample import SampleError, decode_sample, sample_problems
 
-__all__ = ["Receiver", "ReceivedSample", "COUNTERS", "DEFAULT_PORT", "multicast_group"]
+__all__ = ["Receiver", "ReceivedSample", "COUNTERS", "DEFAULT_PORT", "SOURCE_NUMBERS", "MAX_SOURCES", "multicast_group"]
 
 DEFAULT_PORT = 55555
-COUNTERS = ("received", "malformed", "wrong_checksum", "duplicate", "late", "invalid", "dropped", "missing",
-            "delivered")
+COUNTERS = ("received", "malformed", "wrong_checksum", "duplicate", "late", "stray", "invalid", "dropped",
+            "missing", "resync", "delivered")
+#: OpenTrackIO's source numbers (the transport's multicast groups 239.135.1.1 to 239.135.1.200)
+SOURCE_NUMBERS = (1, 200)
+#: sources followed at once; a new one beyond this pushes out the one heard from longest ago
+MAX_SOURCES = 16
 _RECV_BUFFER = 65536  # the largest UDP datagram fits
+_DUPLICATE_MEMORY = 4096  # keys of the last datagrams accepted, to know a repeated one
+_EXPIRE_EVERY_S = 0.005
 
 
 def multicast_group(source_number: int = 1) -> str:
     """OpenTrackIO's multicast group for a source number: 239.135.1.N (current documentation)."""
-    if isinstance(source_number, bool) or not isinstance(source_number, int) or not 1 <= source_number <= 200:
-        raise InputError(f"source number must be 1..200, got {source_number!r}")
+    lo, hi = SOURCE_NUMBERS
+    if isinstance(source_number, bool) or not isinstance(source_number, int) or not lo <= source_number <= hi:
+        raise InputError(f"source number must be {lo}..{hi}, got {source_number!r}")
     return f"239.135.1.{source_number}"
 
 
@@ -71,7 +93,8 @@ def check_address(name: str, text) -> str:
 
 @dataclass(frozen=True)
 class ReceivedSample:
-    """A validated sample, its packet sequence number (unwrapped), encoding and arrival time (monotonic s)."""
+    """A validated sample, its packet sequence number (unwrapped per source: it goes back when the
+    source restarts), encoding and arrival time (monotonic s)."""
 
     sample: dict
     sequence: int
@@ -117,14 +140,12 @@ class Receiver:
         self._thread: threading.Thread | None = None
         self._sock: socket.socket | None = None
         self._error: BaseException | None = None
-        # ordering state
-        self._top: int | None = None  # highest unwrapped sequence seen
-        self._next: int | None = None  # next sequence to hand on
-        self._window: dict[int, ReceivedSample | None] = {}
-        self._window_since = 0.0
-        self._seen = deque(maxlen=4096)
-        self._seen_set: set[int] = set()
-        self.high_water = {"window": 0, "queue": 0, "reassembly_bytes": 0}
+        # ordering state: one _Stream per source, least recently heard first
+        self._streams: dict[tuple, _Stream] = {}
+        self._recent = deque(maxlen=_DUPLICATE_MEMORY)
+        self._recent_set: set[int] = set()
+        self._expired_at = 0.0
+        self.high_water = {"window": 0, "queue": 0, "reassembly_bytes": 0, "sources": 0}
         self.port = None
 
     # --- life cycle ----------------------------------------------------------------
@@ -156,14 +177,18 @@ class Receiver:
         return self
 
     def stop(self) -> None:
-        """End the receiving thread and close the socket; samples already in the queue stay readable."""
+        """End the receiving thread and close the socket; the windows are handed on, and samples
+        already in the queue stay readable."""
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)
         if self._sock is not None:
             self._sock.close()
             self._sock = None
-        self._flush(skip_all=True)
+        now = time.monotonic()
+        for st in self._streams.values():
+            self._flush(st, now, skip_all=True)
+            self._drop_run(st)
 
     def __enter__(self) -> "Receiver":
         return self.start()
@@ -208,42 +233,44 @@ class Receiver:
         try:
             while not self._stop.is_set():
                 try:
-                    n = sock.recv_into(buf)
+                    n, addr = sock.recvfrom_into(buf)
                 except socket.timeout:
-                    self._flush(skip_all=True)
+                    self._expire(time.monotonic())
                     continue
                 except OSError:
                     if self._stop.is_set():
                         break
                     raise
                 self._count("received")
-                self._handle(view[:n])
-                if self._window and time.monotonic() - self._window_since > self.reorder_timeout_s:
-                    self._flush(skip_all=True)
+                self._handle(view[:n], addr)
+                now = time.monotonic()
+                if now - self._expired_at > _EXPIRE_EVERY_S:
+                    self._expire(now)
         except BaseException as exc:  # noqa: BLE001 - handed to the consumer, never lost in the thread
             self._error = exc
 
-    def _unwrap(self, seq: int) -> int:
-        if self._top is None:
-            return seq
-        delta = (seq - self._top + 32768) % 65536 - 32768
-        return self._top + delta
+    # --- packets to samples --------------------------------------------------------------------
+    def _repeated(self, key: int) -> bool:
+        """True when a datagram with this key was accepted lately; else remember it."""
+        if key in self._recent_set:
+            return True
+        if len(self._recent) == self._recent.maxlen:
+            self._recent_set.discard(self._recent[0])
+        self._recent.append(key)
+        self._recent_set.add(key)
+        return False
 
-    def _handle(self, datagram) -> None:
+    def _handle(self, datagram, addr=None) -> None:
         try:
             header, piece = parse_packet(datagram, self.modulus)
         except PacketError as exc:
             self._count("wrong_checksum" if exc.kind == "checksum" else "malformed")
             return
-        ext = self._unwrap(header.sequence)
-        if ext in self._seen_set or ext in self._window:
+        if self._repeated(hash((header.encoding, header.sequence, header.offset, header.last, piece))):
             self._count("duplicate")
             return
-        if self._next is not None and ext < self._next:
-            self._count("late")
-            return
         try:
-            done = self._reassembler.add(header, piece)
+            done = self._reassembler.add(header, piece, source=addr)
         except PacketError as exc:
             self._count("duplicate" if exc.kind == "duplicate" else "malformed")
             return
@@ -251,51 +278,157 @@ class Receiver:
         if done is None:
             return
         encoding, payload = done
-        self._top = ext if self._top is None else max(self._top, ext)
-        if self._next is None:
-            self._next = ext
+        enc = ENCODINGS[encoding]
         try:
-            sample = decode_sample(payload, ENCODINGS[encoding])
-            item = ReceivedSample(sample, ext, ENCODINGS[encoding], time.monotonic())
-        except SampleError as exc:
-            self._count("malformed" if exc.problems[0].rule in ("json", "cbor") else "invalid")
-            item = None  # the number is used up: the window moves past it
-        if not self._window:
-            self._window_since = time.monotonic()
-        self._window[ext] = item
-        self.high_water["window"] = max(self.high_water["window"], len(self._window))
-        self._flush()
+            obj = decode_sample(payload, enc, validate=False)
+        except SampleError:
+            self._count("malformed")  # no sample, no source: the streams do not hear of it
+            return
+        now = time.monotonic()
+        key = _source_key(obj)
+        lo, hi = SOURCE_NUMBERS
+        if sample_problems(obj) or (key[1] is not None and not lo <= key[1] <= hi):
+            self._count("invalid")
+            if key in self._streams:  # its number is used up: the window need not wait for it
+                self._place(key, header.sequence, None, now)
+            return
+        self._place(key, header.sequence, ReceivedSample(obj, 0, enc, now), now)
 
-    def _remember(self, ext: int) -> None:
-        if len(self._seen) == self._seen.maxlen:
-            self._seen_set.discard(self._seen[0])
-        self._seen.append(ext)
-        self._seen_set.add(ext)
+    # --- ordering, per source ----------------------------------------------------------------------
+    def _place(self, key, seq: int, item, now: float) -> None:
+        st = self._streams.pop(key, None)
+        if st is None:
+            if item is None:
+                return
+            if len(self._streams) >= MAX_SOURCES:  # the source heard from longest ago gives way
+                old = self._streams.pop(next(iter(self._streams)))
+                self._flush(old, now, skip_all=True)
+                self._drop_run(old)
+            st = _Stream(seq)
+        self._streams[key] = st  # most recently heard last
+        self.high_water["sources"] = max(self.high_water["sources"], len(self._streams))
+        ext = st.next + (seq - st.next + 32768) % 65536 - 32768
+        if st.next <= ext <= st.top + self.reorder_window:
+            self._drop_run(st)  # the stream's own sample: an off-stream run was no restart
+            if ext in st.window:
+                held = st.window[ext]
+                if held[1] is None and item is not None:  # a valid sample beats an invalid one's placeholder
+                    st.window[ext] = (held[0], item)
+                else:
+                    self._count("duplicate")
+            else:
+                st.window[ext] = (now, item)
+                st.top = max(st.top, ext)
+                self.high_water["window"] = max(self.high_water["window"], len(st.window))
+            self._flush(st, now)
+        elif item is not None:  # an invalid sample off the stream is no evidence of anything
+            self._off_stream(st, seq, ext, item, now)
 
-    def _deliver(self, ext: int) -> None:
-        item = self._window.pop(ext)
-        self._remember(ext)
-        self._next = ext + 1
+    def _off_stream(self, st: "_Stream", seq: int, ext: int, item, now: float) -> None:
+        """Start or extend the source's off-stream run; resynchronise when it shows a new stream.
+        A straggler older than what was handed on is late at once (and taken back should its run
+        resynchronise after all: a sender replaying old timestamps)."""
+        stamp = _stamp(item)
+        stale = ext < st.next and stamp is not None and st.stamp is not None and stamp <= st.stamp
+        if stale:
+            self._count("late")
+        entry = (seq, ext, now, item, stale)
+        if st.run and 1 <= (seq - st.run[-1][0]) % 65536 <= self.reorder_window:
+            st.run.append(entry)
+        else:
+            self._drop_run(st)
+            st.run = [entry]
+        fresh = all(_stamp(r[3]) is None or st.stamp is None or _stamp(r[3]) > st.stamp for r in st.run)
+        if (len(st.run) >= 2 and fresh) or len(st.run) >= max(2, self.reorder_window):
+            self._resync(st, now)
+
+    def _drop_run(self, st: "_Stream") -> None:
+        for _, ext, _, item, counted in st.run:
+            if item is not None and not counted:
+                self._count("late" if ext < st.next else "stray")
+        st.run = []
+
+    def _resync(self, st: "_Stream", now: float) -> None:
+        """The run becomes the stream: hand on what the window holds, then number from the run's first."""
+        self._flush(st, now, skip_all=True)
+        run, st.run = st.run, []
+        first = run[0][0]
+        st.next = st.next + (first - st.next + 32768) % 65536 - 32768
+        st.top = st.next - 1  # the old run's numbers are no longer the stream's
+        for seq, _, arrived, item, counted in run:
+            if counted:
+                self._count("late", -1)
+            ext = st.next + (seq - first) % 65536
+            st.window[ext] = (arrived, item)
+            st.top = max(st.top, ext)
+        self._count("resync")
+        self._flush(st, now)
+
+    def _deliver(self, st: "_Stream", ext: int) -> None:
+        _, item = st.window.pop(ext)
+        st.next = ext + 1
         if item is None:
             return
+        stamp = _stamp(item)
+        if stamp is not None:
+            st.stamp = stamp if st.stamp is None else max(st.stamp, stamp)
         try:
-            self._queue.put_nowait(item)
+            self._queue.put_nowait(ReceivedSample(item.sample, ext, item.encoding, item.arrival_s))
         except queue.Full:
             self._count("dropped")
             return
         self._count("delivered")
         self.high_water["queue"] = max(self.high_water["queue"], self._queue.qsize())
 
-    def _flush(self, skip_all: bool = False) -> None:
-        """Hand on the window's samples that are next in order. Past a gap: wait while the window has
-        room, else (or with ``skip_all``: timed out, stopping) give the gap up as missing."""
-        while self._window:
-            if self._next in self._window:
-                self._deliver(self._next)
-            elif skip_all or len(self._window) > self.reorder_window:
-                ext = min(self._window)
-                self._count("missing", ext - self._next)
-                self._next = ext
-                self._window_since = time.monotonic()
+    def _flush(self, st: "_Stream", now: float, skip_all: bool = False) -> None:
+        """Hand on the window's samples that are next in order. Past a gap: wait while fewer than
+        ``reorder_window`` samples wait and the oldest has waited less than the timeout, else (or with
+        ``skip_all``: stopping, resynchronising) give the gap up as missing."""
+        while st.window:
+            if st.next in st.window:
+                self._deliver(st, st.next)
+            elif skip_all or len(st.window) >= self.reorder_window \
+                    or now - min(a for a, _ in st.window.values()) > self.reorder_timeout_s:
+                ext = min(st.window)
+                self._count("missing", ext - st.next)
+                st.next = ext
             else:
                 break
+
+    def _expire(self, now: float) -> None:
+        """Windows whose oldest sample has waited the timeout give their gaps up."""
+        self._expired_at = now
+        for st in self._streams.values():
+            if st.window:
+                self._flush(st, now)
+
+
+class _Stream:
+    """One source's ordering state (module notes)."""
+
+    __slots__ = ("next", "top", "window", "run", "stamp")
+
+    def __init__(self, first: int):
+        self.next = first  # the next (unwrapped) sequence number to hand on
+        self.top = first - 1  # the highest number seen on the stream
+        self.window: dict[int, tuple] = {}  # number -> (arrival, ReceivedSample or None for an invalid one)
+        self.run: list[tuple] = []  # off-stream samples that follow each other:
+        # (seq, number, arrival, item, counted late already)
+        self.stamp: int | None = None  # the newest sampleTimestamp handed on (ns)
+
+
+def _source_key(obj) -> tuple:
+    """(sourceId, sourceNumber) of a decoded sample; None for either one missing or of the wrong type."""
+    if not isinstance(obj, dict):
+        return (None, None)
+    sid, num = obj.get("sourceId"), obj.get("sourceNumber")
+    return (sid if isinstance(sid, str) else None,
+            num if isinstance(num, int) and not isinstance(num, bool) else None)
+
+
+def _stamp(item) -> int | None:
+    """A handed-on sample's ``timing.sampleTimestamp`` in ns (validated), or None."""
+    if item is None:
+        return None
+    ts = item.sample.get("timing", {}).get("sampleTimestamp")
+    return None if ts is None else ts["seconds"] * 1_000_000_000 + ts["nanoseconds"]

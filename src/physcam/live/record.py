@@ -20,7 +20,10 @@ a focus pull):
 * distortion: the streamed Brown-Conrady coefficients as custom attributes on the PhysicalCamera
   (``physcam:live:distortion*``, OpenTrackIO's millimetre form) and, on the companion, Omniverse's
   ``OmniLensDistortionOpenCvPinholeAPI`` (OpenCV's normalised form, :mod:`physcam.live.lens_data`);
-* ``physcam:live:sequenceNumber`` and ``physcam:live:timecode`` say which sample each time came from.
+* ``physcam:live:sequenceNumber``, ``physcam:live:timecode`` and ``physcam:live:sourceId`` say which
+  sample each time came from; ``physcam:live:carriedOver`` names the values that sample left out and
+  took from an earlier sample of the same source, ``physcam:live:defaulted`` those taken from the
+  command line (:func:`solve_frames`; the camera's customData ``physcam:live:carryOver`` says so).
 
 Times: a sample's time code is (its timestamp - the first's) x the stage's timeCodesPerSecond (the
 stream's sample rate), computed with exact fractions; samples without timestamps use their
@@ -41,28 +44,78 @@ import warnings
 from dataclasses import dataclass
 from fractions import Fraction
 
-from ..errors import ExportError, InputError, PhysCamError, PhysCamWarning, require_type
+from ..errors import ExportError, InputError, PhysCamError, PhysCamWarning, require_finite, require_type
 from .frames import TrackedFrame
 from .lens_data import opentrackio_to_opencv
 
-__all__ = ["MAX_RECORDED_FRAMES", "SolvedFrame", "solve_frames", "time_codes", "write_recording_usd",
-           "lens_report_rows", "write_lens_report"]
+__all__ = ["MAX_RECORDED_FRAMES", "SolvedFrame", "solve_frames", "frame_problem", "time_codes",
+           "write_recording_usd", "lens_report_rows", "write_lens_report", "CARRIED_VALUES"]
 
 #: the most frames one recording keeps (ten minutes at 240 fps)
 MAX_RECORDED_FRAMES = 144_000
 REPORT_COLUMNS = ("frame", "time_code", "timecode", "sequence_number", "focus_from_film_mm",
                   "pinhole_focal_length_mm", "dof_focal_length_mm", "fstop", "tstop", "entrance_pupil_from_film_mm",
                   "near_from_film_mm", "far_from_film_mm", "hyperfocal_from_film_mm", "hfov_deg", "vfov_deg",
-                  "dfov_deg", "coc_mm", "x_m", "y_m", "z_m", "pan_deg", "tilt_deg", "roll_deg")
+                  "dfov_deg", "coc_mm", "x_m", "y_m", "z_m", "pan_deg", "tilt_deg", "roll_deg", "source_id",
+                  "carried_over", "defaulted")
 
 
 @dataclass(frozen=True)
 class SolvedFrame:
-    """A tracked frame, its USD time code and its lens report."""
+    """A tracked frame, its USD time code and its lens report; ``carried``: the OpenTrackIO values the
+    frame left out and took from an earlier sample of the same source; ``defaulted``: those it took
+    from the caller's defaults (the command line) because its source never sent them."""
 
     frame: TrackedFrame
     time_code: float
     report: object
+    carried: tuple[str, ...] = ()
+    defaulted: tuple[str, ...] = ()
+
+
+#: the values a frame may leave out: (key, OpenTrackIO name, TrackedFrame attribute)
+CARRIED_VALUES = (("pinhole", "pinholeFocalLength", "pinhole_focal_length_mm"), ("fstop", "fStop", "fstop"),
+                  ("focus", "focusDistance", "focus_from_film_mm"), ("tstop", "tStop", "tstop"),
+                  ("pupil", "entrancePupilOffset", "entrance_pupil_mm"),
+                  ("sensor", "activeSensorPhysicalDimensions", "sensor_mm"),
+                  ("nominal", "nominalFocalLength", "nominal_focal_length_mm"))
+CARRY_OVER_NOTE = ("a value a sample leaves out is carried over from the latest earlier sample of the same source "
+                   "(sourceId, sourceNumber), never from another source; physcam:live:carriedOver names them per "
+                   "time sample, physcam:live:defaulted those given on the command line")
+#: the largest values a recorded frame may hold: lengths 1000 km (mm), positions 1000 km (m), a
+#: million degrees; USD keeps the lens and rotations as 32-bit floats, far above these
+MAX_LENGTH_MM = 1e9
+MAX_POSITION_M = 1e6
+MAX_ANGLE_DEG = 1e6
+_FLOAT32_MAX = 3.4028234663852886e38
+
+
+def frame_problem(frame: TrackedFrame, pinhole_mm=None) -> str | None:
+    """Why ``frame`` cannot be recorded (a value beyond the limits above, a distortion whose
+    normalised OpenCV form overflows a 32-bit float), or None."""
+    require_type("frame", frame, TrackedFrame, "physcam.live.frames.frame_from_sample(sample)")
+    if pinhole_mm is not None:
+        pinhole_mm = require_finite("pinhole focal length", pinhole_mm)
+    lengths = (("pinholeFocalLength", frame.pinhole_focal_length_mm), ("focusDistance", frame.focus_from_film_mm),
+               ("entrancePupilOffset", frame.entrance_pupil_mm), ("nominalFocalLength", frame.nominal_focal_length_mm))
+    lengths += tuple(("activeSensorPhysicalDimensions", v) for v in (frame.sensor_mm or ()))
+    for name, v in lengths:
+        if v is not None and not abs(v) <= MAX_LENGTH_MM:
+            return f"{name} {v:g} mm is beyond {MAX_LENGTH_MM / 1e6:g} km"
+    for v in frame.translation_m:
+        if not abs(v) <= MAX_POSITION_M:
+            return f"a translation of {v:g} m is beyond {MAX_POSITION_M / 1e3:g} km from the stage origin"
+    for v in frame.rotation_deg:
+        if not abs(v) <= MAX_ANGLE_DEG:
+            return f"a rotation of {v:g} degrees is beyond {MAX_ANGLE_DEG:g} degrees"
+    if frame.distortion is not None and pinhole_mm is not None:
+        try:
+            cv = opentrackio_to_opencv(frame.distortion, pinhole_mm)
+        except InputError:
+            return None  # a model OpenCV's form cannot express: the companion camera gets none
+        if any(not abs(v) <= _FLOAT32_MAX for v in cv.values()):
+            return "the distortion's OpenCV coefficients overflow a 32-bit float"
+    return None
 
 
 def _frames(frames) -> list[TrackedFrame]:
@@ -102,13 +155,19 @@ def time_codes(frames, rate=None) -> tuple[list[float], Fraction]:
 
 
 def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=None, focus_mm=None,
-                 coc=None) -> list[SolvedFrame]:
+                 coc=None, refused: list | None = None) -> list[SolvedFrame]:
     """Each frame with its time code and lens report (module notes).
 
-    Values a frame does not carry come from the frame before it, else from these defaults:
-    ``sensor`` (a :class:`~physcam.onset.sensors.Sensor`) when the stream's static data gives no
-    sensor size, ``focal_length_mm`` (pinhole), ``fstop``, ``focus_mm`` (from the film plane).
-    Frames whose time code does not increase are dropped with a warning.
+    Values a frame does not carry come from the latest earlier frame **of the same source** (its
+    ``sourceId`` and ``sourceNumber``), else from these defaults: ``sensor`` (a
+    :class:`~physcam.onset.sensors.Sensor`) when the stream's static data gives no sensor size,
+    ``focal_length_mm`` (pinhole), ``fstop``, ``focus_mm`` (from the film plane); each
+    :class:`SolvedFrame` names them (``carried``, ``defaulted``). Frames whose time code does not
+    increase are dropped with a warning.
+
+    A frame that cannot be solved (a value out of range, :func:`frame_problem`, or one its source
+    never gave) raises, unless ``refused`` is a list: then it is left out, ``(index, reason)`` is
+    appended there, and its values are not carried over to later frames.
     """
     from ..onset.report import solve_lens_report
     from ..onset.sensors import Sensor, custom_sensor
@@ -116,51 +175,73 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     frames = _frames(frames)
     if sensor is not None:
         require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
+    if refused is not None and not isinstance(refused, list):
+        raise InputError(f"refused must be a list to append the refused frames to, got {type(refused).__name__}")
     codes, _ = time_codes(frames, rate)
-    last = {"pinhole": focal_length_mm, "fstop": fstop, "focus": focus_mm, "tstop": None, "pupil": None,
-            "sensor": None if sensor is None else (sensor.width_mm, sensor.height_mm), "nominal": None}
+    defaults = {"pinhole": focal_length_mm, "fstop": fstop, "focus": focus_mm, "tstop": None, "pupil": None,
+                "sensor": None if sensor is None else (sensor.width_mm, sensor.height_mm), "nominal": None}
+    held: dict = {}  # per source: the values its frames sent, the latest of each
     sensors: dict = {}
     out: list[SolvedFrame] = []
     previous = -math.inf
     skipped = 0
-    for f, t in zip(frames, codes):
-        for key, value in (("pinhole", f.pinhole_focal_length_mm), ("fstop", f.fstop),
-                           ("focus", f.focus_from_film_mm), ("tstop", f.tstop), ("pupil", f.entrance_pupil_mm),
-                           ("sensor", f.sensor_mm), ("nominal", f.nominal_focal_length_mm)):
-            if value is not None:
-                last[key] = value
+    for i, (f, t) in enumerate(zip(frames, codes)):
+        mine = held.setdefault(f.source, {})
+        sent = {key: getattr(f, attr) for key, _, attr in CARRIED_VALUES if getattr(f, attr) is not None}
         if t <= previous:
             skipped += 1
+            mine.update(sent)
             continue
-        previous = t
-        missing = [n for n, k in (("a pinhole focal length (pinholeFocalLength, --focal)", "pinhole"),
-                                  ("an f-stop (fStop, --fstop)", "fstop"),
-                                  ("a focus distance (focusDistance, --focus)", "focus"),
-                                  ("a sensor size (static.camera.activeSensorPhysicalDimensions, --sensor)", "sensor"))
-                   if last[k] is None]
-        if missing:
-            raise InputError(f"the stream does not give {', '.join(missing)}; give it on the command line")
-        key = tuple(last["sensor"])
-        if key not in sensors:
-            sensors[key] = sensor if sensor is not None and (sensor.width_mm, sensor.height_mm) == key \
-                else custom_sensor(*key)
-        pin = float(last["pinhole"])
-        f_dof = float(last["nominal"]) if last["nominal"] is not None else pin
-        tstop = last["tstop"]
-        if tstop is not None and tstop < last["fstop"]:
-            tstop = None  # a T-stop faster than the f-stop is not physical; the report would refuse it
+        last, carried, defaulted = dict(defaults), [], []
+        for key, name, _ in CARRIED_VALUES:
+            if key in sent:
+                last[key] = sent[key]
+            elif key in mine:
+                last[key] = mine[key]
+                carried.append(name)
+            elif defaults[key] is not None:
+                defaulted.append(name)
         try:
-            report = solve_lens_report(focal_length_mm=f_dof, sensor=sensors[key], fstop=float(last["fstop"]),
-                                       focus_mm=float(last["focus"]), coc=coc, tstop=tstop,
-                                       pupil_mm=None if last["pupil"] is None else float(last["pupil"]),
-                                       pinhole_focal_length_mm=pin)
+            report = _solve_one(f, last, sensor, sensors, coc, solve_lens_report, custom_sensor)
         except PhysCamError as exc:
-            where = f"frame {len(out)} (timecode {f.timecode})" if f.timecode else f"frame {len(out)}"
-            raise type(exc)(f"{where}: {exc}") from None
-        out.append(SolvedFrame(f, t, report))
+            where = f"frame {i} (timecode {f.timecode})" if f.timecode else f"frame {i}"
+            if refused is None:
+                raise type(exc)(f"{where}: {exc}") from None
+            refused.append((i, f"{where}: {exc}"))
+            continue
+        mine.update(sent)
+        previous = t
+        out.append(SolvedFrame(f, t, report, tuple(carried), tuple(defaulted)))
     if skipped:
         warnings.warn(f"{skipped} samples did not advance in time and were left out", PhysCamWarning, stacklevel=2)
     return out
+
+
+def _solve_one(f, last, sensor, sensors, coc, solve_lens_report, custom_sensor):
+    """The lens report of frame ``f`` with the values ``last`` (its own, carried over or defaults)."""
+    missing = [n for n, k in (("a pinhole focal length (pinholeFocalLength, --focal)", "pinhole"),
+                              ("an f-stop (fStop, --fstop)", "fstop"),
+                              ("a focus distance (focusDistance, --focus)", "focus"),
+                              ("a sensor size (static.camera.activeSensorPhysicalDimensions, --sensor)", "sensor"))
+               if last[k] is None]
+    if missing:
+        raise InputError(f"the stream does not give {', '.join(missing)}; give it on the command line")
+    problem = frame_problem(f, float(last["pinhole"]))
+    if problem:
+        raise InputError(problem)
+    key = tuple(last["sensor"])
+    if key not in sensors:
+        sensors[key] = sensor if sensor is not None and (sensor.width_mm, sensor.height_mm) == key \
+            else custom_sensor(*key)
+    pin = float(last["pinhole"])
+    f_dof = float(last["nominal"]) if last["nominal"] is not None else pin
+    tstop = last["tstop"]
+    if tstop is not None and tstop < last["fstop"]:
+        tstop = None  # a T-stop faster than the f-stop is not physical; the report would refuse it
+    return solve_lens_report(focal_length_mm=f_dof, sensor=sensors[key], fstop=float(last["fstop"]),
+                             focus_mm=float(last["focus"]), coc=coc, tstop=tstop,
+                             pupil_mm=None if last["pupil"] is None else float(last["pupil"]),
+                             pinhole_focal_length_mm=pin)
 
 
 def _usd_from_stage(v, mpu):
@@ -202,6 +283,7 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
     spec0 = spec_from_report(s0.report, shutter_duration_s=shutter)
     cam = author_camera(stage, path, spec0, report=s0.report)
     cam.SetCustomDataByKey("physcam:source", "OpenTrackIO stream recorded by physcam live record")
+    cam.SetCustomDataByKey("physcam:live:carryOver", CARRY_OVER_NOTE)
     model = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Pinhole"))
     geom = UsdGeom.Camera(stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")))
     # the body: pupil position, OpenTrackIO's rotation as rotateZXY, back to the film plane
@@ -215,6 +297,9 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
     body_iris = cam.GetAttribute("iris")
     a_seq = cam.CreateAttribute("physcam:live:sequenceNumber", Sdf.ValueTypeNames.Int64, True)
     a_tc = cam.CreateAttribute("physcam:live:timecode", Sdf.ValueTypeNames.String, True)
+    a_src = cam.CreateAttribute("physcam:live:sourceId", Sdf.ValueTypeNames.String, True)
+    a_carried = cam.CreateAttribute("physcam:live:carriedOver", Sdf.ValueTypeNames.StringArray, True)
+    a_default = cam.CreateAttribute("physcam:live:defaulted", Sdf.ValueTypeNames.StringArray, True)
     a_model = cam.CreateAttribute("physcam:live:distortionModel", Sdf.ValueTypeNames.String, True)
     a_radial = cam.CreateAttribute("physcam:live:distortionRadial", Sdf.ValueTypeNames.DoubleArray, True)
     a_tang = cam.CreateAttribute("physcam:live:distortionTangential", Sdf.ValueTypeNames.DoubleArray, True)
@@ -245,6 +330,10 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
             a_seq.Set(int(f.sequence_number), t)
         if f.timecode is not None:
             a_tc.Set(f.timecode, t)
+        if f.source_id is not None:
+            a_src.Set(str(f.source_id), t)
+        a_carried.Set(Vt.StringArray(list(s.carried)), t)
+        a_default.Set(Vt.StringArray(list(s.defaulted)), t)
         if f.distortion is not None:
             d = f.distortion
             a_model.Set(str(d.get("model", "Brown-Conrady D-U")), t)
@@ -302,6 +391,7 @@ def lens_report_rows(solved) -> list[dict]:
             "vfov_deg": r.vfov_focus_deg, "dfov_deg": r.dfov_focus_deg, "coc_mm": r.coc_mm,
             "x_m": f.translation_m[0], "y_m": f.translation_m[1], "z_m": f.translation_m[2],
             "pan_deg": f.rotation_deg[0], "tilt_deg": f.rotation_deg[1], "roll_deg": f.rotation_deg[2],
+            "source_id": f.source_id, "carried_over": list(s.carried), "defaulted": list(s.defaulted),
         })
     return rows
 
@@ -321,7 +411,7 @@ def write_lens_report(file, solved, *, force: bool = False):
         w = csv.DictWriter(buf, fieldnames=REPORT_COLUMNS, lineterminator="\n")
         w.writeheader()
         for row in rows:
-            w.writerow({k: ("" if v is None else v) for k, v in row.items()})
+            w.writerow({k: ("" if v is None else ";".join(v) if isinstance(v, list) else v) for k, v in row.items()})
         return atomic_write(p, buf.getvalue(), force=force)
     if p.suffix.lower() != ".json":
         raise ExportError(f"{p}: the lens report is written as .csv or .json")
@@ -335,5 +425,6 @@ def write_lens_report(file, solved, *, force: bool = False):
            "sensor_mm": [sensor.width_mm, sensor.height_mm],
            "units": {"length": "mm", "angle": "degree", "position": "m (OpenTrackIO stage, Z up)"},
            "reference": "distances *_from_film_mm are in front of the film plane; far_from_film_mm null = infinity",
+           "carry_over": CARRY_OVER_NOTE,
            "frames": rows}
     return atomic_write(p, json.dumps(doc, indent=1, allow_nan=False) + "\n", force=force)

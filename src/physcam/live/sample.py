@@ -6,14 +6,18 @@ The schema is SMPTE RIS-OSVP's ``opentrackio-schema-1.0.1.json`` (draft 2020-12)
 library). A sample that fails is reported by its JSON path (``$.lens.fStop``) and the schema rule it
 broke (``exclusiveMinimum``), the first problem first in document order.
 
-Numbers that JSON cannot carry (NaN, Infinity) and CBOR can are refused too, with their path: no
-NaN or infinity enters physcam from a stream.
+Numbers that JSON cannot carry (NaN, Infinity) and CBOR can are refused too, with their path, and so
+are numbers beyond a 64-bit float (JSON's ``1e5000`` reads as infinity; CBOR's decimal fraction
+``1e5000`` or a 400-digit bignum): no NaN or infinity enters physcam from a stream. CBOR's other
+numbers (decimal fractions, bigfloats, rationals) are read as floats.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import numbers
+import sys
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -85,25 +89,44 @@ def _validator():
     return cls(s)
 
 
+def _number(v, parts):
+    """(v as an int or a finite float, None) or (None, the problem): CBOR's decimal fractions,
+    bigfloats and rationals become floats; numbers no 64-bit float holds (1e5000, 10**400) are refused."""
+    if isinstance(v, int) and not isinstance(v, bool):
+        if abs(v) <= _FLOAT_MAX_INT:
+            return v, None
+        return None, SampleProblem(json_path(parts), "finite", f"{str(v)[:20]}... is beyond what a 64-bit float holds")
+    try:
+        f = float(v)
+    except (OverflowError, ValueError, TypeError):
+        f = math.inf
+    if not math.isfinite(f):
+        return None, SampleProblem(json_path(parts), "finite", f"{str(v)[:40]} is not a finite number")
+    return f, None
+
+
+_FLOAT_MAX_INT = int(sys.float_info.max)
+
+
 def _non_finite(obj, parts, depth=0):
-    """The path of the first NaN/inf number, or of nesting beyond MAX_DEPTH, else None."""
+    """The path of the first number that is not finite (NaN, inf, or beyond a 64-bit float), or of
+    nesting beyond MAX_DEPTH, else None. Numbers that are not int or float (CBOR's Decimal and
+    Fraction) are replaced by floats in place."""
     if depth > MAX_DEPTH:
         return SampleProblem(json_path(parts), "maxDepth", f"nested deeper than {MAX_DEPTH} levels")
-    if isinstance(obj, float):
-        if not math.isfinite(obj):
-            return SampleProblem(json_path(parts), "finite", f"{obj} is not a finite number")
-    elif isinstance(obj, dict):
-        for k, v in obj.items():
-            if isinstance(v, (dict, list, float)):
-                bad = _non_finite(v, parts + (k,), depth + 1)
-                if bad:
-                    return bad
-    elif isinstance(obj, list):
-        for i, v in enumerate(obj):
-            if isinstance(v, (dict, list, float)):
-                bad = _non_finite(v, parts + (i,), depth + 1)
-                if bad:
-                    return bad
+    items = obj.items() if isinstance(obj, dict) else enumerate(obj) if isinstance(obj, list) else ()
+    for k, v in items:
+        if isinstance(v, (dict, list)):
+            bad = _non_finite(v, parts + (k,), depth + 1)
+            if bad:
+                return bad
+        elif isinstance(v, numbers.Number) and not isinstance(v, bool) \
+                and not (isinstance(v, float) and math.isfinite(v)) \
+                and not (isinstance(v, int) and abs(v) <= _FLOAT_MAX_INT):
+            value, bad = _number(v, parts + (k,))
+            if bad:
+                return bad
+            obj[k] = value
     return None
 
 
