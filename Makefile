@@ -3,6 +3,8 @@
 #   make shell  open your shell with .venv/bin first on PATH, so `physcam` runs (exit to leave)
 #   make test   create .venv if missing, install physcam with test tools, run every test
 #   make schema regenerate the USD schema plugin; make bench runs the benchmarks
+#   make test-latest  the suite's core against the newest versions pyproject.toml's ranges allow
+#   make wheel  build the wheel and sdist into dist/ (what `pip install physcam` installs)
 PYTHON ?= python3
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
@@ -14,14 +16,16 @@ BLENDER_PY    := $(BLENDER_VENV)/bin/python
 BLENDER_STAMP := $(BLENDER_VENV)/.physcam-installed
 BPY_VERSION   ?= 5.0.1
 
-.PHONY: demo test venv blender bench clean schema chromium shell
+.PHONY: demo test venv blender bench clean schema chromium shell test-latest wheel
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 
-$(STAMP): $(PY) pyproject.toml
-	$(PY) -m pip install --quiet -e '.[test]'
+# The test environment gets the exact versions of constraints.txt (reproducible CI); the library's own
+# dependencies are ranges (pyproject.toml), so a studio can install physcam into its environment.
+$(STAMP): $(PY) pyproject.toml constraints.txt
+	$(PY) -m pip install --quiet -c constraints.txt -e '.[test]'
 	touch $(STAMP)
 
 venv: $(STAMP)
@@ -64,6 +68,24 @@ chromium:
 
 test: $(STAMP) $(BLENDER_STAMP) chromium
 	PHYSCAM_BLENDER_PYTHON=$(abspath $(BLENDER_PY)) $(PY) -m pytest -n 2 -q
+	$(MAKE) --no-print-directory test-latest
+
+# The newest versions the ranges allow, not constraints.txt: a fresh environment each run (pip's
+# cache makes it quick), the core and extras' tests that need no Blender, browser or renderer.
+LATEST_VENV ?= .venv-latest
+test-latest:
+	rm -rf $(LATEST_VENV)
+	$(PYTHON) -m venv $(LATEST_VENV)
+	$(LATEST_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(LATEST_VENV)/bin/python -m pip install --quiet --upgrade -e '.[all]' pytest pytest-xdist hypothesis opencv-python-headless
+	@$(LATEST_VENV)/bin/python -m pip list --format=freeze 2>/dev/null \
+	  | grep -i -E '^(numpy|numba|matplotlib|usd-core|openexr|jsonschema|cbor2|dask|pyarrow|starlette|uvicorn)=' \
+	  | tr '\n' ' ' | sed 's/^/physcam: newest versions tested: /'; echo
+	$(LATEST_VENV)/bin/python -m pytest -n 2 -q -m "not slow" -p no:cacheprovider tests/onset tests/optics \
+	  tests/lens tests/usd tests/live tests/trace/test_tracer.py tests/analysis/test_image_quality_closed_forms.py
+
+wheel: $(STAMP)
+	$(PY) -m build --outdir dist .
 
 bench: $(STAMP)
 	$(PY) benchmarks/startup.py
@@ -76,4 +98,4 @@ schema: $(STAMP)
 	$(PY) scripts/gen_usd_schema.py
 
 clean:
-	rm -rf $(VENV) $(BLENDER_VENV) demo-output build *.egg-info src/*.egg-info
+	rm -rf $(VENV) $(BLENDER_VENV) $(LATEST_VENV) demo-output build dist *.egg-info src/*.egg-info

@@ -72,6 +72,12 @@ class BackendError(PhysCamError):
     """An array backend (numba, numpy) was asked for but cannot be used."""
 
 
+class MissingExtraError(PhysCamError, ImportError):
+    """A feature needs one of physcam's optional extras (``pip install 'physcam[usd]'``...), and it is
+    not installed: :func:`physcam.extras.require_extra`. Both a :class:`PhysCamError` (the CLI's one
+    line and exit 2) and an :class:`ImportError`."""
+
+
 class WrongTypeError(PhysCamError, TypeError):
     """An argument of the Python API has the wrong type (a name where a lens object is needed, ...).
 

@@ -1,10 +1,11 @@
 """Run code in Blender (bpy) from the test suite.
 
 Blender as a Python module pins numpy < 2, so it lives in its own environment that the Makefile
-builds (``.venv-blender``, with physcam installed in it); tests drive it in a subprocess.
-:func:`blender_python` finds that interpreter (``PHYSCAM_BLENDER_PYTHON``, else the
-repository's ``.venv-blender``); tests skip with the reason when it is not there, which happens
-only outside ``make test``.
+builds (``.venv-blender``, with physcam installed in it); tests drive it in subprocesses.
+Blender is found the way physcam finds it (:func:`physcam.export.blender_runner.find_blender`:
+``PHYSCAM_BLENDER_PYTHON``, the user config, ``blender`` on PATH, this checkout's
+``.venv-blender``), so the tests run under a Python with bpy or under a Blender program; they skip
+with the reason when there is none, which happens only outside ``make test``.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from __future__ import annotations
 import json
 import os
 import subprocess
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -19,21 +21,29 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def blender_python() -> str | None:
-    exe = os.environ.get("PHYSCAM_BLENDER_PYTHON") or str(ROOT / ".venv-blender" / "bin" / "python")
-    return exe if Path(exe).is_file() else None
+def blender_runner():
+    """physcam's runner for this machine's Blender, or None."""
+    from physcam.errors import InputError
+    from physcam.export.blender_runner import find_blender
+
+    try:
+        return find_blender(None)
+    except InputError:
+        return None
 
 
-def require_blender() -> str:
-    exe = blender_python()
-    if exe is None:
+def require_blender():
+    runner = blender_runner()
+    if runner is None:
         pytest.skip("Blender (bpy) is not installed: `make test` builds .venv-blender with it")
-    return exe
+    return runner
 
 
-#: Put Blender's bundled oslquery on sys.path (Cycles needs it to compile OSL camera shaders).
+#: Put Blender's bundled oslquery on sys.path (Cycles needs it to compile OSL camera shaders), and give
+#: the script its own arguments as sys.argv[1:] however Blender was started.
 OSL_PATH_PRELUDE = """
 import sys, glob, bpy
+sys.argv = [sys.argv[0]] + (sys.argv[sys.argv.index('--') + 1:] if '--' in sys.argv else sys.argv[1:])
 for _p in glob.glob(bpy.utils.resource_path("LOCAL") + "/python/lib/python3*/site-packages"):
     if _p not in sys.path:
         sys.path.insert(0, _p)
@@ -41,12 +51,15 @@ for _p in glob.glob(bpy.utils.resource_path("LOCAL") + "/python/lib/python3*/sit
 
 
 def run_blender(script: str, *args, timeout: float = 300.0) -> dict:
-    """Run ``script`` (Python source) in the Blender environment; it must print one JSON object on
-    its last stdout line, which is returned. The source tree under test comes first on sys.path."""
-    exe = require_blender()
+    """Run ``script`` (Python source) in Blender; it must print one JSON object on its last stdout line,
+    which is returned. The source tree under test comes first on sys.path."""
+    runner = require_blender()
     env = dict(os.environ, PYTHONPATH=str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    p = subprocess.run([exe, "-c", OSL_PATH_PRELUDE + script, *map(str, args)], capture_output=True, text=True,
-                       timeout=timeout, env=env)
+    with tempfile.TemporaryDirectory(prefix="physcam-blender-") as tmp:
+        path = Path(tmp) / "script.py"
+        path.write_text(OSL_PATH_PRELUDE + script)
+        p = subprocess.run(runner.command(path, *map(str, args)), capture_output=True, text=True, timeout=timeout,
+                           env=env)
     if p.returncode != 0:
         raise AssertionError(f"Blender script failed (exit {p.returncode}):\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}")
     lines = [ln for ln in p.stdout.strip().splitlines() if ln.startswith("{")]

@@ -13,7 +13,7 @@ pytestmark = pytest.mark.slow
 
 
 def test_compare_blender_writes_figure_and_agreeing_table(tmp_path, monkeypatch, capsys):
-    monkeypatch.setenv("PHYSCAM_BLENDER_PYTHON", require_blender())
+    monkeypatch.setenv("PHYSCAM_BLENDER_PYTHON", require_blender().path)
     out = tmp_path / "cmp"
     assert main(["compare", "blender", "dgauss_50mm", "--focus", "2m", "--fstop", "2.8", "--light", "0.7m",
                  "--blades", "6", "--blade-angle", "15", "-o", str(out), "--json"]) == 0

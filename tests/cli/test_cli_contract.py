@@ -7,7 +7,9 @@ to them the day it arrives (docs/cli.md, "Writing a command"):
 - every focus option reads distances, ``hyperfocal`` and ``infinity``, and a command taking a
   focus prints distances in ``--units m|ft``;
 - every command taking a sensor takes the shared sensor options and says its default;
-- tables piped or redirected are plain and complete (no box, no ellipsis).
+- tables piped or redirected are plain and complete (no box, no ellipsis);
+- one grammar (issue 26): a lens is always ``--lens NAME_OR_FILE`` (the old positional spelling is
+  hidden and says it is deprecated), and every single-value option given twice is an error naming it.
 """
 
 from __future__ import annotations
@@ -326,3 +328,59 @@ def test_piped_tables_are_plain_and_complete(capsys, argv, whole):
     out = capsys.readouterr().out
     assert whole in out
     assert not set("┃│━┏┡└…") & set(out), "a piped table keeps no box drawing and no ellipsis"
+
+
+# ---- one grammar (issue 26) ------------------------------------------------------------------------
+LENS_DESTS = ("lens", "lenses")
+
+
+def test_every_command_takes_its_lens_as_an_option():
+    with_lens = 0
+    for path, p in LEAVES.items():
+        for a in p._actions:
+            if a.dest in LENS_DESTS:
+                with_lens += 1
+                assert a.option_strings == ["--lens"], f"{' '.join(path)}: the lens is --lens NAME_OR_FILE"
+            if not a.option_strings and a.dest not in ("help", "_lens_positional"):
+                assert "lens" not in a.dest, f"{' '.join(path)}: a positional lens ({a.dest}); use add_lens_argument"
+            if a.dest == "_lens_positional":
+                assert a.help == argparse.SUPPRESS, f"{' '.join(path)}: the deprecated positional lens is hidden"
+    assert with_lens >= 25
+
+
+def _value_that_parses(path, parser, action):
+    """A value argparse accepts for ``action`` (its choices, its default, or a common shape), else None."""
+    candidates = list(action.choices or []) + [action.default, "1", "0.5", "2m", "1,2", "64x48", "a", "S35"]
+    for v in candidates:
+        if v is None or isinstance(v, bool) or v == argparse.SUPPRESS:
+            continue
+        v = v if isinstance(v, str) else (",".join(map(str, v)) if isinstance(v, (tuple, list)) else str(v))
+        try:
+            action(parser, argparse.Namespace(), action.type(v) if callable(action.type) else v, action.option_strings[0])
+            return v
+        except (argparse.ArgumentTypeError, argparse.ArgumentError, ValueError, TypeError, SystemExit):
+            continue
+    return None
+
+
+def test_every_single_value_option_given_twice_is_an_error(capsys):
+    from physcam.cli import _StoreOnce
+
+    checked = 0
+    for path, p in LEAVES.items():
+        for a in p._actions:
+            if not a.option_strings or a.nargs not in (None, "?"):
+                continue
+            if type(a) is argparse._StoreAction:
+                pytest.fail(f"{' '.join(path)} {a.option_strings[0]}: a single-value option that may be repeated")
+            if not isinstance(a, _StoreOnce):
+                continue
+            v = _value_that_parses(path, p, a)
+            if v is None:
+                continue
+            opt = a.option_strings[0]
+            assert main([*path, opt, v, opt, v]) == 2, f"{' '.join(path)} {opt} twice"
+            err = capsys.readouterr().err
+            assert f"{opt} was given twice" in err, (path, opt, err)
+            checked += 1
+    assert checked > 100

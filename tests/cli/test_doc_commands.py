@@ -40,7 +40,7 @@ BOUNDED = {
 }
 #: Commands that cannot run in a test, and why.
 SKIP = {
-    "physcam compare blender dgauss_50mm --focus 2m --fstop 2.8 --light 0.7m --blades 6 -o cmp/":
+    "physcam compare blender --lens dgauss_50mm --focus 2m --fstop 2.8 --light 0.7m --blades 6 -o cmp/":
         "needs Blender's bpy (tests/blender/test_compare.py runs it where Blender is installed)",
     "physcam live record --port 55555 --duration 30 take.usda --report take.csv":
         "listens 30 s for a stream (tests/live/test_cli_live.py records one sent by a second process)",

@@ -434,6 +434,9 @@ def apply_stmap(image, stmap) -> np.ndarray:
 def _exr_bytes(rgb: np.ndarray, attributes=None) -> bytes:
     """A 32-bit float RGB scanline EXR (ZIP) of ``rgb`` (h, w, 3), as bytes; ``attributes``: extra
     header entries (strings and floats)."""
+    from ..extras import require_extra
+
+    require_extra("exr", "writing ST-maps as EXR")
     import OpenEXR
 
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage, **(attributes or {})}

@@ -8,8 +8,12 @@ done and adds a characterization variant to each complete lens's USD file (:mod:
 below ``cli``; ``pxr`` is never imported here.
 """
 
-from .grid import KINDS, MAX_CELLS, Cell, Grid, build_cells, parse_focus_marks, parse_numbers
-from .run import CharacterizeSummary, characterize, check_scheduler_address, read_index
+from ..extras import require_extra
+
+require_extra("dask", "characterizing on Dask (physcam characterize)")
+
+from .grid import KINDS, MAX_CELLS, Cell, Grid, build_cells, parse_focus_marks, parse_numbers  # noqa: E402
+from .run import CharacterizeSummary, characterize, check_scheduler_address, read_index  # noqa: E402
 
 __all__ = ["Grid", "Cell", "KINDS", "MAX_CELLS", "parse_focus_marks", "parse_numbers", "build_cells",
            "characterize", "CharacterizeSummary", "check_scheduler_address", "read_index"]

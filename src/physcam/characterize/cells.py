@@ -5,8 +5,9 @@ cells share one task: :func:`physcam.characterize.run.task_groups`). In a worker
 cell:
 
 1. if the cell's row is in the index already (another run made it), nothing;
-2. take the cell's **lock** (``fcntl.flock`` on ``.locks/...``, released by the kernel when the
-   process dies, so a killed worker never leaves a stale lock): a second run into the same
+2. take the cell's **lock** (``fcntl.flock``, or ``msvcrt.locking`` without fcntl, on ``.locks/...``,
+   released by the kernel when the process dies, so a killed worker never leaves a stale lock): a
+   second run into the same
    folder waits for the cell instead of computing it twice, then finds it done;
 3. compute (the analyses below; no optics is re-implemented here);
 4. write the result **atomically** (:func:`physcam.io.atomic_write`: a temporary file, then a
@@ -252,19 +253,30 @@ class cell_lock:
         self.fd = None
 
     def __enter__(self):
-        import fcntl
-
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
-        fcntl.flock(self.fd, fcntl.LOCK_EX)
+        _lock_file(self.fd, True)
         return self
 
     def __exit__(self, *exc):
-        import fcntl
-
-        fcntl.flock(self.fd, fcntl.LOCK_UN)
+        _lock_file(self.fd, False)
         os.close(self.fd)
         return False
+
+
+def _lock_file(fd: int, lock: bool) -> None:
+    """Take (or release) an exclusive lock on the open file ``fd``, waiting for it: ``fcntl.flock`` on
+    POSIX, ``msvcrt.locking`` of its first byte where there is no fcntl (Windows). Either is released
+    by the operating system when the process dies."""
+    try:
+        import fcntl
+    except ImportError:  # no fcntl: Windows
+        import msvcrt
+
+        os.lseek(fd, 0, os.SEEK_SET)
+        msvcrt.locking(fd, msvcrt.LK_LOCK if lock else msvcrt.LK_UNLCK, 1)
+        return
+    fcntl.flock(fd, fcntl.LOCK_EX if lock else fcntl.LOCK_UN)
 
 
 def read_row(path) -> dict:

@@ -48,6 +48,32 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"physcam: error: {message}\n")
 
 
+class _StoreOnce(argparse._StoreAction):
+    """A single-value option: given twice, it is a usage error naming it (argparse would keep the last
+    silently: `physcam mtf --field 0 --field 14` reported 14 degrees alone)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        seen = getattr(namespace, "_options_given", None)
+        if seen is None:
+            seen = set()
+            setattr(namespace, "_options_given", seen)
+        if self.dest in seen:
+            parser.error(f"{option_string} was given twice: give it once (options that take several values "
+                         "say so in --help)")
+        seen.add(self.dest)
+        super().__call__(parser, namespace, values, option_string)
+
+
+def _single_value_options_once(parser) -> None:
+    """Make every single-value option of ``parser`` and its subcommands a :class:`_StoreOnce`."""
+    for action in parser._actions:
+        if type(action) is argparse._StoreAction and action.option_strings:
+            action.__class__ = _StoreOnce
+        elif isinstance(action, argparse._SubParsersAction):
+            for sub in dict.values(action._name_parser_map):
+                _single_value_options_once(sub)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="physcam",
@@ -65,6 +91,7 @@ def build_parser() -> argparse.ArgumentParser:
         register = getattr(module, "register", None)
         if register is not None:
             register(sub)
+    _single_value_options_once(parser)
     return parser
 
 
@@ -109,8 +136,14 @@ def main(argv: list[str] | None = None) -> int:
     warnings.showwarning = _show_warning
     take_notes()  # a fresh list for this run (tests call main() repeatedly in one process)
     parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if len(argv) > 1 and argv[0] == "compare" and argv[1].startswith("-") and argv[1] not in ("-h", "--help"):
+        argv.insert(1, "lenses")  # `physcam compare --lens A --lens B` is `compare lenses ...` (as `compare A B`)
     try:
         args = parser.parse_args(argv)
+        from ._common import merge_lens_argument
+
+        merge_lens_argument(args, parser)
     except SystemExit as exc:  # --help, --version, usage errors: argparse has printed its line
         return exc.code if isinstance(exc.code, int) else 2
     if not getattr(args, "handler", None):

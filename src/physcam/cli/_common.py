@@ -268,6 +268,44 @@ def hidden_alias(p, flag: str, dest: str, **kwargs) -> None:
     p.add_argument(flag, dest=dest, default=argparse.SUPPRESS, help=argparse.SUPPRESS, **kwargs)
 
 
+# ---- the lens: one grammar ---------------------------------------------------------------------
+#: A command's lens, everywhere: ``--lens NAME_OR_FILE`` (repeated for commands that take several).
+LENS_HELP = "bundled lens name (see `physcam lenses`) or a lens file"
+#: The release that drops the positional lens (docs/CHANGELOG.md).
+POSITIONAL_LENS_REMOVED_IN = "0.3"
+
+
+def add_lens_argument(p, *, dest: str = "lens", many: bool = False, metavar: str = "NAME_OR_FILE",
+                      help: str = LENS_HELP) -> None:
+    """``--lens`` for a command that needs a lens (``many``: one or more, ``--lens A --lens B``). The old
+    positional spelling keeps working for one release, with a note (:func:`merge_lens_argument`)."""
+    p.add_argument("--lens", dest=dest, action="append" if many else "store", default=None, metavar=metavar,
+                   help=help + (" (repeat for several)" if many else "") + "; required")
+    p.add_argument("_lens_positional", nargs="*", default=[], help=argparse.SUPPRESS, metavar="")
+    p.set_defaults(_lens_dest=dest, _lens_many=many)
+
+
+def merge_lens_argument(args, parser) -> None:
+    """After parsing: a positional lens (the old spelling) becomes ``--lens`` with a note; a command that
+    needs a lens and got none is a usage error naming ``--lens``."""
+    dest = getattr(args, "_lens_dest", None)
+    if dest is None:
+        return
+    old = list(getattr(args, "_lens_positional", []) or [])
+    given = getattr(args, dest)
+    many = getattr(args, "_lens_many", False)
+    if old:
+        if given:
+            parser.error("give the lens once, with --lens NAME_OR_FILE")
+        if len(old) > 1 and not many:
+            parser.error(f"unrecognized arguments: {' '.join(old[1:])}")
+        setattr(args, dest, old if many else old[0])
+        note(f"a lens named without --lens is deprecated: write --lens {old[0]} "
+             f"(physcam {POSITIONAL_LENS_REMOVED_IN} will refuse the old form)")
+    elif not given:
+        parser.error("give the lens: --lens NAME_OR_FILE (a bundled name from `physcam lenses`, or a lens file)")
+
+
 # ---- notes -----------------------------------------------------------------------------------
 _NOTES: list[str] = []
 

@@ -9,6 +9,7 @@ always wins::
     coc = "d/1500"           # circle of confusion: d/1500, d/1000, d/1730, cine, or a value (25um)
     units = "ft"             # distances printed in ft (feet and inches) or m (default m)
     output_dir = "~/shots"   # relative output files (-o, --plot, --stmap, usd files) go here
+    blender_python = "/opt/blender/4.2/python/bin/python3.11"   # or a blender executable
 
 An unknown key, a value of the wrong kind or a file that is not TOML is refused with the file's
 name, so a typo never silently falls back to a default.
@@ -30,6 +31,8 @@ KEYS = {
     "coc": "the circle of confusion when no --coc is given: d/1500, d/1000, d/1730, cine or a value (0.025, 25um)",
     "units": "the unit system distances are printed in: m or ft",
     "output_dir": "the folder relative output files are written into",
+    "blender_python": "Blender for `compare blender` and the Blender tests: a Python with bpy, or a blender "
+                      "executable (run with --background --python)",
 }
 
 
@@ -43,12 +46,14 @@ class Config:
     coc: str | float | None = None
     units: str | None = None
     output_dir: Path | None = None
+    blender_python: str | None = None
     source: dict = field(default_factory=dict)  # key -> where its value came from
 
     def to_dict(self) -> dict:
         return {"path": None if self.path is None else str(self.path), "exists": self.exists,
                 "sensor": self.sensor, "coc": self.coc, "units": self.units,
-                "output_dir": None if self.output_dir is None else str(self.output_dir)}
+                "output_dir": None if self.output_dir is None else str(self.output_dir),
+                "blender_python": self.blender_python}
 
 
 def config_path() -> Path | None:
@@ -130,4 +135,6 @@ def _read(path: Path) -> Config:
     out = values.get("output_dir")
     return Config(path=path, exists=True, sensor=values.get("sensor"), coc=values.get("coc"),
                   units=values.get("units"), output_dir=None if out is None else Path(out).expanduser(),
+                  blender_python=None if "blender_python" not in values
+                  else str(Path(values["blender_python"]).expanduser()),
                   source={k: str(path) for k in values})

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from ._common import FOCUS_HELP, add_sensor_options, add_units_option, focus, hidden_alias, number
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, focus, hidden_alias, number
 from ._output import add_output_options, document, emit_json, print_csv
 from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
@@ -24,7 +24,7 @@ DOCS = {"illumination": ("illumination", "points"), "colour": ("colour", "latera
 
 
 def _common(p, plot_help: str) -> None:
-    p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    add_lens_argument(p)
     add_lenient(p)
     add_output_options(p, csv=True, what="the analysis")
     p.add_argument("-o", "--output", metavar="FILE.png", help=plot_help)

@@ -1,13 +1,15 @@
-"""``physcam characterize LENS...``: characterize lenses over a grid on Dask (docs/characterize.md).
+"""``physcam characterize --lens LENS ...``: characterize lenses over a grid on Dask (docs/characterize.md).
 
 Examples::
 
-  physcam characterize dgauss_50mm zeiss_distagon_35mm_f4 --focus 0.5m:inf:8 --fstop 2.8,4 --fields 5 -o library/
-  physcam characterize dgauss_50mm --focus 1m,2m,inf --fstop 2.8 -o library/ --scheduler tcp://10.0.0.5:8786
-  physcam characterize dgauss_50mm --focus 0.5m:inf:8 --fstop 2,2.8,4 -o library/ --dry-run --json
+  physcam characterize --lens dgauss_50mm --lens zeiss_distagon_35mm_f4 --focus 0.5m:inf:8 --fstop 2.8,4 --fields 5 -o library/
+  physcam characterize --lens dgauss_50mm --focus 1m,2m,inf --fstop 2.8 -o library/ --scheduler tcp://10.0.0.5:8786
+  physcam characterize --lens dgauss_50mm --focus 0.5m:inf:8 --fstop 2,2.8,4 -o library/ --dry-run --json
 """
 
 from __future__ import annotations
+
+from ._common import add_lens_argument
 
 from ._output import add_output_options, document, emit_json
 
@@ -35,7 +37,7 @@ def register(sub) -> None:
     p = sub.add_parser("characterize", help="characterize lenses over a grid of focus, f-stop, field and wavelength "
                                             "on Dask: PSF kernels, ST-maps and fitted distortion, breathing, "
                                             "illumination; a Parquet index and USD variants")
-    p.add_argument("lens", nargs="+", metavar="LENS", help="bundled lens names (see `physcam lenses`) or lens files")
+    add_lens_argument(p, many=True, metavar="LENS", help="bundled lens names (see `physcam lenses`) or lens files")
     add_lenient(p)
     p.add_argument("--focus", required=True, metavar="MARKS",
                    help="focus marks from the film plane: NEAR:FAR:N = N marks evenly in 1/distance "

@@ -1,4 +1,4 @@
-"""``physcam compare LENS_A LENS_B ...``: lenses side by side (field of view, depth of field,
+"""``physcam compare --lens LENS_A --lens LENS_B ...``: lenses side by side (field of view, depth of field,
 breathing, distortion, illumination, bokeh) in one table and one figure; ``physcam compare
 blender``: the same point light through physcam's tracer and through Cycles."""
 
@@ -7,20 +7,21 @@ from __future__ import annotations
 import argparse
 import math
 
-from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number
 
 EPILOG = """\
 example:
-  physcam compare blender dgauss_50mm --focus 2m --fstop 2.8 --light 0.7m --blades 6 -o cmp/
+  physcam compare blender --lens dgauss_50mm --focus 2m --fstop 2.8 --light 0.7m --blades 6 -o cmp/
 Writes cmp/compare.png (the two images side by side) and cmp/compare.json (the measured table).
-Needs a Python with Blender's bpy: `make blender` builds .venv-blender (or --blender-python PATH).
+Blender: --blender-python PATH (a Python with bpy, or a blender executable), else $PHYSCAM_BLENDER_PYTHON, else
+the user config's blender_python, else `blender` on PATH, else a source checkout's .venv-blender (make blender).
 """
 
 LENSES_EPILOG = """\
 examples:
-  physcam compare dgauss_50mm sonnar_50mm_f1_5 tessar_50mm_f2_8 --focus 2m --fstop 2.8 --sensor S35
-  physcam compare zeiss_distagon_35mm_f4 zuiko_18mm_f3_5 --focus hyperfocal --fstop 5.6 -o compare.png --units ft
-  physcam compare dgauss_50mm canon_rf_85mm_f1_2 --focus 3m --csv
+  physcam compare --lens dgauss_50mm --lens sonnar_50mm_f1_5 --lens tessar_50mm_f2_8 --focus 2m --fstop 2.8 --sensor S35
+  physcam compare --lens zeiss_distagon_35mm_f4 --lens zuiko_18mm_f3_5 --focus hyperfocal --fstop 5.6 -o compare.png --units ft
+  physcam compare --lens dgauss_50mm --lens canon_rf_85mm_f1_2 --focus 3m --csv
 Each lens is measured alike: the lens report at the focus and f-stop (fields of view, depth of field),
 the breathing table (field of view from infinity to the focus and to the closest focus), real
 distortion and relative illumination at the widest field the sensor asks for (clamped to what the lens
@@ -30,7 +31,8 @@ infinity). A lens slower than --fstop is compared wide open, with a note.
 
 
 class _LensesByDefault(argparse._SubParsersAction):
-    """``physcam compare A B ...`` means ``physcam compare lenses A B ...``; ``compare blender`` stays."""
+    """``physcam compare A B ...`` (the old spelling) means ``physcam compare lenses A B ...``; ``compare blender``
+    stays. ``physcam compare --lens A --lens B`` is routed to ``lenses`` by :func:`physcam.cli.main`."""
 
     class _AnyName(dict):
         accept_any = False  # set once the subcommands are added (add_parser checks for duplicates)
@@ -52,15 +54,16 @@ class _LensesByDefault(argparse._SubParsersAction):
 def register(sub) -> None:
     p = sub.add_parser("compare", help="lenses side by side (FOV, DOF, breathing, distortion, illumination, bokeh), "
                                        "or physcam against a renderer (compare blender)",
-                       description="Compare lenses side by side (`physcam compare LENS_A LENS_B ...`), or render one "
-                                   "point light through physcam's OSL camera in Blender and trace it with physcam "
-                                   "(`physcam compare blender`, docs/blender.md).", epilog=LENSES_EPILOG + EPILOG,
+                       description="Compare lenses side by side (`physcam compare --lens LENS_A --lens LENS_B ...`), "
+                                   "or render one point light through physcam's OSL camera in Blender and trace it "
+                                   "with physcam (`physcam compare blender --lens LENS`, docs/blender.md).",
+                       epilog=LENSES_EPILOG + EPILOG,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    s = p.add_subparsers(dest="compare_command", metavar="LENS_A LENS_B ... | blender", action=_LensesByDefault)
+    s = p.add_subparsers(dest="compare_command", metavar="--lens A --lens B ... | blender", action=_LensesByDefault)
     _register_lenses(s)
     b = s.add_parser("blender", help="Cycles through physcam's OSL lens camera", epilog=EPILOG,
                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    b.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    add_lens_argument(b)
     b.add_argument("--focus", type=focus("focus distance", allow_inf=False), required=True, metavar="D",
                    help=f"focus mark from the film plane (e.g. 2m; or hyperfocal at --fstop)")
     b.add_argument("--fstop", type=number("f-number", positive=True), required=True, metavar="N", help="f-number")
@@ -110,7 +113,7 @@ def run_blender(args) -> int:
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, args=args)
     res = compare_bokeh(lens, focus_mm=args.focus, fstop=args.fstop, light_mm=args.light, aperture=aperture,
                         crop_mm=args.crop, pixels=args.pixels, samples=args.samples,
-                        blender_python=args.blender_python)
+                        blender_python=args.blender_python, config_blender=_config_blender())
     table = {k: v for k, v in res.items() if k != "images"}
     atomic_write(js, json.dumps(table, indent=2, allow_nan=False) + "\n", force=args.force)
     from ._common import units_of
@@ -132,6 +135,7 @@ def run_blender(args) -> int:
     print(f"  bokeh diameter: Cycles {d['cycles']:.4f} mm, physcam {d['physcam']:.4f} mm, ratio {d['ratio']:.4f}")
     if "corners" in m:
         print(f"  iris corners: Cycles {m['corners']['cycles']}, physcam {m['corners']['physcam']}")
+    print(f"  rendered by {res['blender']}")
     print(f"wrote {png} and {js}")
     return 0
 
@@ -159,16 +163,16 @@ def _figure(res, path=None, *, force=False, units="m"):
     return fig if path is None else save_figure(fig, path, force=force)
 
 
-# ---- physcam compare LENS_A LENS_B ... ------------------------------------------------------------
+# ---- physcam compare --lens LENS_A --lens LENS_B --lens ... ------------------------------------------------------------
 def _register_lenses(s) -> None:
     from ._output import add_output_options
     from .lens import add_lenient
     from .report import add_coc_option
 
     c = s.add_parser("lenses", help="lenses side by side: FOV, DOF, breathing, distortion, illumination, bokeh "
-                                    "(the default: `physcam compare A B` is `physcam compare lenses A B`)",
+                                    "(the default: `physcam compare --lens A --lens B` is `physcam compare lenses --lens A --lens B`)",
                      epilog=LENSES_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    c.add_argument("lenses", nargs="+", metavar="LENS", help="bundled lens names (see `physcam lenses`) or lens files")
+    add_lens_argument(c, dest="lenses", many=True, metavar="LENS", help="bundled lens names (see `physcam lenses`) or lens files")
     c.add_argument("--focus", type=focus("focus distance"), default=2000.0, metavar="D",
                    help=f"focus mark from the film plane for every lens (default 2m; {FOCUS_HELP})")
     c.add_argument("--fstop", type=number("f-stop", positive=True), default=None, metavar="N",
@@ -427,3 +431,9 @@ def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False):
                  fontsize=9)
     fig.tight_layout()
     return fig if path is None else save_figure(fig, path, force=force)
+
+
+def _config_blender():
+    from ._config import load_config
+
+    return load_config().blender_python

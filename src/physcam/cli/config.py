@@ -35,7 +35,7 @@ def effective() -> dict:
     from ._config import load_config
 
     cfg = load_config()
-    builtin = {"sensor": DEFAULT_SENSOR, "coc": "d/1500", "units": "m", "output_dir": None}
+    builtin = {"sensor": DEFAULT_SENSOR, "coc": "d/1500", "units": "m", "output_dir": None, "blender_python": None}
     out = {}
     for key, default in builtin.items():
         v = getattr(cfg, key)

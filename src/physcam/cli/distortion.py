@@ -1,11 +1,11 @@
-"""``physcam distortion LENS``: real distortion, ST-maps and fitted models at any focus (docs/distortion.md).
+"""``physcam distortion --lens LENS``: real distortion, ST-maps and fitted models at any focus (docs/distortion.md).
 
 Examples::
 
-  physcam distortion dgauss_50mm                                  # against field angle, at infinity
-  physcam distortion zeiss_distagon_35mm_f4 --focus 2m --sensor "ALEXA 35" --resolution 4608x3164 \\
+  physcam distortion --lens dgauss_50mm                           # against field angle, at infinity
+  physcam distortion --lens zeiss_distagon_35mm_f4 --focus 2m --sensor "ALEXA 35" --resolution 4608x3164 \\
       --stmap out/ --fit 3de4 --fit brown --fit nuke              # maps, fitted models, a Nuke script
-  physcam distortion zuiko_18mm_f3_5 --resolution 2048x1366 --across-focus 0.3m,0.5m,1m,2m,inf
+  physcam distortion --lens zuiko_18mm_f3_5 --resolution 2048x1366 --across-focus 0.3m,0.5m,1m,2m,inf
 """
 
 from __future__ import annotations

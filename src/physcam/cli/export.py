@@ -3,7 +3,7 @@ Blender Cycles OSL lens cameras, RenderMan RIB camera blocks, pbrt-v4 cameras)."
 
 from __future__ import annotations
 
-from ._common import FOCUS_HELP, add_units_option, distance, focus, number, numbers
+from ._common import add_lens_argument, FOCUS_HELP, add_units_option, distance, focus, number, numbers
 from ._output import add_output_options, document, emit_json, print_csv
 
 
@@ -16,7 +16,7 @@ def _sensor(p) -> None:
 
 
 def _common(p) -> None:
-    p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    add_lens_argument(p)
     _sensor(p)
     p.add_argument("--width-px", type=int, required=True, metavar="PX", help="image width in pixels")
     p.add_argument("--height-px", type=int, required=True, metavar="PX", help="image height in pixels")
@@ -54,7 +54,7 @@ def register(sub) -> None:
                      description="Write <lens>.osl, an OSL camera shader tracing real rays through the focused lens, "
                                  "and setup_<lens>.py, which makes the scene camera use it "
                                  "(`blender --python setup_<lens>.py`). See docs/blender.md.")
-    b.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    add_lens_argument(b)
     b.add_argument("--focus", type=focus("focus distance"), required=True, metavar="D",
                    help=f"focus mark from the film plane ({FOCUS_HELP})")
     b.add_argument("--fstop", type=number("f-number", positive=True), default=None, metavar="N",

@@ -3,12 +3,12 @@
 Examples::
 
   physcam lenses
-  physcam lens show dgauss_50mm --focus 2m --fstop 2.8 --flange 52
-  physcam lens show my_lens.zmx --json
-  physcam lens diagram navarro_anamorphic_2x --axis x -o navarro_x.svg
-  physcam lens breathing canon_rf_85mm_f1_2 --sensor "Super 35" -o breathing.png --units ft
-  physcam lens check my_lens.toml --sensor "Super 35"
-  physcam lens fix my_lens.toml -o my_lens_fixed.toml --apply
+  physcam lens show --lens dgauss_50mm --focus 2m --fstop 2.8 --flange 52
+  physcam lens show --lens my_lens.zmx --json
+  physcam lens diagram --lens navarro_anamorphic_2x --axis x -o navarro_x.svg
+  physcam lens breathing --lens canon_rf_85mm_f1_2 --sensor "Super 35" -o breathing.png --units ft
+  physcam lens check --lens my_lens.toml --sensor "Super 35"
+  physcam lens fix --lens my_lens.toml -o my_lens_fixed.toml --apply
 
 Distances in the output are millimetres. ``show`` gives every cardinal point from
 the front vertex and rear vertex (signed, + toward the film) and from the film
@@ -18,7 +18,7 @@ plane and flange (distance in front, + toward the subject); see docs/conventions
 from __future__ import annotations
 
 from ..errors import PhysCamError
-from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number
 from ._output import add_output_options
 
 
@@ -32,7 +32,7 @@ def register(sub) -> None:
     lens.set_defaults(handler=lambda args: (lens.print_help(), 0)[1])
 
     def common(q, fstop=True, with_focus=True):
-        q.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+        add_lens_argument(q)
         if with_focus:
             q.add_argument("--focus", type=focus("focus distance"), default=float("inf"),
                            help=f"focus mark from the film plane (default infinity; {FOCUS_HELP})")
@@ -77,7 +77,7 @@ def register(sub) -> None:
     b.set_defaults(handler=run_breathing)
 
     c = lsub.add_parser("check", help="report what is inconsistent in a lens file (surface, file line, numbers)")
-    c.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name or a lens file (read without validation)")
+    add_lens_argument(c, help="bundled lens name or a lens file (read without validation)")
     c.add_argument("--sensor", default=None,
                    help="also trace the on-axis beam, vignetting and image circle at this sensor's corner "
                         "(see `physcam sensors`)")
@@ -85,7 +85,7 @@ def register(sub) -> None:
     c.set_defaults(handler=run_check)
 
     f = lsub.add_parser("fix", help="propose (and with --apply write) the repairs of a lens file, with a diff")
-    f.add_argument("lens", metavar="FILE", help="lens file to repair (any supported format)")
+    add_lens_argument(f, metavar="FILE", help="lens file to repair (any supported format)")
     f.add_argument("-o", "--output", required=True, metavar="FIXED",
                    help="where to write the repaired lens (.toml: physcam's format; .dat, .json, .zmx also work)")
     f.add_argument("--apply", action="store_true", help="write the repaired file (without it: only show the repairs)")
@@ -468,7 +468,7 @@ def run_check(args) -> int:
     counts = {s: sum(f.severity == s for f in findings) for s in ("error", "warning", "note")}
     tail = ""
     if counts["error"]:
-        tail = f"; `physcam lens fix {args.lens} -o FIXED.toml` proposes repairs"
+        tail = f"; `physcam lens fix --lens {args.lens} -o FIXED.toml` proposes repairs"
     con.print(f"{counts['error']} error(s), {counts['warning']} warning(s), {counts['note']} note(s){tail}",
               soft_wrap=True)
     return 0

@@ -4,15 +4,15 @@ field, sub-aperture views and refocused pictures (docs/microlens.md)."""
 
 from __future__ import annotations
 
-from ._common import add_units_option, distance, focus, number
+from ._common import add_lens_argument, add_units_option, distance, focus, number
 from ._output import add_output_options, document, emit_json
 
 EPILOG = """\
 examples:
-  physcam microlens insert dgauss_50mm --microlens-focal 0.224 --xdim 77 --ydim 77 \\
+  physcam microlens insert --lens dgauss_50mm --microlens-focal 0.224 --xdim 77 --ydim 77 \\
       --film-width 3.08 --film-height 3.08 --focus 0.8m -o dgauss_lf.json
-  physcam microlens render dgauss_lf.json --fstop 5.6 --point 0.5m --point 5m -o points.png
-  physcam microlens render dgauss_lf.json --fstop 5.6 --plane 0.8m --plane-width 120mm -o plane.png
+  physcam microlens render --lens dgauss_lf.json --fstop 5.6 --point 0.5m --point 5m -o points.png
+  physcam microlens render --lens dgauss_lf.json --fstop 5.6 --plane 0.8m --plane-width 120mm -o plane.png
 """
 
 #: limits of a render asked for on the command line (memory and time stay bounded)
@@ -52,7 +52,7 @@ def register(sub) -> None:
                      description="Write ISET lens JSON holding the main lens and a 'microlens' block "
                                  "(dimensions, lenslet surfaces, offsets), as lenstool insertmicrolens does, plus "
                                  "physcam's record of the film size, film-to-lens distance and sensor offset.")
-    i.add_argument("lens", metavar="MAIN_LENS", help="the main lens: bundled name or lens file")
+    add_lens_argument(i, metavar="MAIN_LENS", help="the main lens: bundled name or lens file")
     i.add_argument("--microlens", metavar="NAME_OR_FILE", help="the lenslet as a prescription (lens file, mm)")
     i.add_argument("--microlens-focal", type=distance("lenslet focal length"), metavar="MM",
                    help="or an ideal thin lenslet of this focal length")
@@ -82,7 +82,7 @@ def register(sub) -> None:
                      description="Trace a lens with a microlens array (the ISET JSON of `physcam microlens insert`) "
                                  "and draw the raw light field, sub-aperture views and, per point, the picture "
                                  "refocused on it (shift-and-add).")
-    r.add_argument("lens", metavar="LENS_WITH_MICROLENS", help="an ISET lens JSON with a microlens block")
+    add_lens_argument(r, metavar="LENS_WITH_MICROLENS", help="an ISET lens JSON with a microlens block")
     r.add_argument("--fstop", type=number("f-number", positive=True), default=None,
                    help="stop the main lens to this f-number (default: its file's stop)")
     r.add_argument("--focus", type=focus("focus distance", allow_inf=False), default=None, metavar="D",

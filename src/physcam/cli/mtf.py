@@ -1,4 +1,4 @@
-"""``physcam mtf LENS``: the lens maker's MTF chart, or one field's wavefront, Strehl and MTF (docs/image-quality.md).
+"""``physcam mtf --lens LENS``: the lens maker's MTF chart, or one field's wavefront, Strehl and MTF (docs/image-quality.md).
 
 The chart: sagittal and tangential MTF at 10, 20 and 40 lp/mm against image height, white
 light (d, F, C), the lens focused at ``--focus`` and stopped to ``--fstop``; printed as a table
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number
 from ._output import add_output_options, document, emit_json, print_csv
 from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
@@ -23,13 +23,13 @@ CHART_MAX_PUPIL_SAMPLES = 256
 
 EPILOG = """\
 examples:
-  physcam mtf dgauss_50mm --fstop 4 --focus 3m --sensor FF      (the vendor chart, full frame)
-  physcam mtf dgauss_50mm --fstop 2.8 --sensor "ALEXA 35" -o mtf.png
-  physcam mtf dgauss_50mm --fstop 8 --field 14                  (one field: RMS, Strehl, MTF)
-  physcam mtf dgauss_50mm --wavelength 550 --frequency 10 --frequency 30 --json
-  physcam mtf dgauss_50mm --fstop 4 --csv > mtf.csv                 (one row per image height and frequency)
-  physcam mtf dgauss_50mm --fstop 2.8 --best-focus 40                 (the film at the best focus for 40 lp/mm)
-  physcam mtf dgauss_50mm --fstop 4 --field 14 --method huygens      (MTF from the Huygens PSF)
+  physcam mtf --lens dgauss_50mm --fstop 4 --focus 3m --sensor FF  (the vendor chart, full frame)
+  physcam mtf --lens dgauss_50mm --fstop 2.8 --sensor "ALEXA 35" -o mtf.png
+  physcam mtf --lens dgauss_50mm --fstop 8 --field 14             (one field: RMS, Strehl, MTF)
+  physcam mtf --lens dgauss_50mm --wavelength 550 --frequency 10 --frequency 30 --json
+  physcam mtf --lens dgauss_50mm --fstop 4 --csv > mtf.csv        (one row per image height and frequency)
+  physcam mtf --lens dgauss_50mm --fstop 2.8 --best-focus 40      (the film at the best focus for 40 lp/mm)
+  physcam mtf --lens dgauss_50mm --fstop 4 --field 14 --method huygens  (MTF from the Huygens PSF)
 """
 
 
@@ -40,7 +40,7 @@ def register(sub) -> None:
                                    "or one field's wavefront, Strehl and MTF",
                        description="Diffraction MTF from real rays: the vendor chart, or one field with --field.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    add_lens_argument(p)
     add_lenient(p)
     p.add_argument("--fstop", type=number("f-stop", positive=True), default=None,
                    help="stop the lens down to this f-number (default: the stop in the lens file)")

@@ -1,17 +1,17 @@
-"""``physcam psf LENS``: one field's point spread function, by FFT of the pupil or by Huygens
+"""``physcam psf --lens LENS``: one field's point spread function, by FFT of the pupil or by Huygens
 summation (docs/image-quality.md)."""
 
 from __future__ import annotations
 
-from ._common import FOCUS_HELP, focus, number
+from ._common import add_lens_argument, FOCUS_HELP, focus, number
 from ._output import add_output_options, document, emit_json
 from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
 EPILOG = """\
 examples:
-  physcam psf dgauss_50mm --field 14 --fstop 4 --method huygens -o psf.png
-  physcam psf dgauss_50mm --fstop 8 --json                 (on axis, FFT: Strehl ratio and pixel size)
-  physcam psf zuiko_18mm_f3_5 --field 20 --fstop 5.6 --method huygens --tilt 0,1.5
+  physcam psf --lens dgauss_50mm --field 14 --fstop 4 --method huygens -o psf.png
+  physcam psf --lens dgauss_50mm --fstop 8 --json                 (on axis, FFT: Strehl ratio and pixel size)
+  physcam psf --lens zuiko_18mm_f3_5 --field 20 --fstop 5.6 --method huygens --tilt 0,1.5
 """
 
 
@@ -23,7 +23,7 @@ def register(sub) -> None:
                                    "or the Huygens sum of wavelets from the exit-pupil wavefront (--method huygens), "
                                    "which also takes a tilted film.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    add_lens_argument(p)
     add_lenient(p)
     p.add_argument("--field", type=number("field angle"), default=0.0, metavar="DEG",
                    help="field angle in degrees, Y meridian (default 0: on the axis)")

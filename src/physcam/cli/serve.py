@@ -137,8 +137,8 @@ def cli_backend():
     parsers = {"report": _leaf(root, "report"), "sensors": _leaf(root, "sensors"),
                "lens": _leaf(root, "lens", "show"), "diagram": _leaf(root, "lens", "diagram")}
     params = {k: _names(p) for k, p in parsers.items()}
-    params["lens"] = params["lens"] - {"lens"}  # the lens is the path: /api/lens/{name}
-    params["diagram"] = params["diagram"] - {"lens"}
+    params["lens"] = params["lens"] - {"lens", "_lens_positional"}  # the lens is the path: /api/lens/{name}
+    params["diagram"] = params["diagram"] - {"lens", "_lens_positional"}
     params["lenses"] = frozenset()
     params["health"] = frozenset()
 
@@ -170,13 +170,13 @@ def cli_backend():
         return [sensor_document(s) for s in rows]
 
     def lens(name, q):
-        return show_document(parsers["lens"].parse_args([*_options(q), "--", _bundled(name)]))
+        return show_document(parsers["lens"].parse_args([*_options(q), f"--lens={_bundled(name)}"]))
 
     def diagram_svg(name, q):
         from ..analysis.diagram import lens_diagram
         from ..lens.library import load_lens
 
-        args = parsers["diagram"].parse_args([*_options(q), "--output=diagram.svg", "--", _bundled(name)])
+        args = parsers["diagram"].parse_args([*_options(q), "--output=diagram.svg", f"--lens={_bundled(name)}"])
         fig = lens_diagram(load_lens(args.lens), **diagram_options(args)).figure(units=args.units or "m")
         return _svg(fig, dpi=150)
 

@@ -1,15 +1,15 @@
-"""``physcam spot LENS`` and ``physcam bokeh LENS``: real-ray analyses (see docs/ray-tracing.md)."""
+"""``physcam spot --lens LENS`` and ``physcam bokeh --lens LENS``: real-ray analyses (see docs/ray-tracing.md)."""
 
 from __future__ import annotations
 
-from ._common import FOCUS_HELP, add_units_option, distance, focus, hidden_alias, number
+from ._common import add_lens_argument, FOCUS_HELP, add_units_option, distance, focus, hidden_alias, number
 from ._output import add_output_options, document, emit_json, print_csv
 from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
 
 def register(sub) -> None:
     p = sub.add_parser("spot", help="spot diagram (RMS and geometric radius per field) by real ray tracing")
-    p.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name (see `physcam lenses`) or a lens file")
+    add_lens_argument(p)
     add_lenient(p)
     p.add_argument("--field", type=number("field angle"), action="append", metavar="DEG",
                    help="field angle in degrees (repeat; default 0 and 5)")
@@ -27,7 +27,7 @@ def register(sub) -> None:
     p.set_defaults(handler=run_spot)
 
     b = sub.add_parser("bokeh", help="PSF / bokeh image of a point light by real ray tracing")
-    b.add_argument("lens", metavar="NAME_OR_FILE", help="bundled lens name or a lens file")
+    add_lens_argument(b)
     add_lenient(b)
     b.add_argument("--light", dest="depth", type=distance("light distance"), default=1000.0, metavar="D",
                    help="the point light's distance in front of the film plane (default 1m; units ok: 2m, 6ft; "

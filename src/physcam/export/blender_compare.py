@@ -5,15 +5,14 @@ the generated OSL camera in Blender (a crop of the film centre, the shader made 
 traces the same light through the same focused, stopped-down prescription with physcam's numba
 tracer (:func:`physcam.analysis.bokeh.bokeh_image`), binned on the render's pixel grid. Both
 images are measured the same way (:mod:`physcam.analysis.blob`): centroid, equivalent diameter
-(the sphere's own image removed in quadrature) and iris corners. Blender runs in a Python that
-has ``bpy`` (``--blender-python``, ``PHYSCAM_BLENDER_PYTHON`` or ``./.venv-blender``, which
-``make blender`` builds).
+(the sphere's own image removed in quadrature) and iris corners. Blender is found by
+:func:`physcam.export.blender_runner.find_blender` (``--blender-python``, ``PHYSCAM_BLENDER_PYTHON``,
+the user config, ``blender`` on PATH, a checkout's ``.venv-blender``), and the result says which.
 """
 
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import tempfile
 from pathlib import Path
@@ -22,16 +21,17 @@ import numpy as np
 
 from ..errors import InputError, OpticsError, require_positive
 from ..lens.prescription import Prescription, takes_prescription
+from .blender_runner import SCRIPT_ARGS, find_blender
 
-__all__ = ["find_blender_python", "compare_bokeh"]
+__all__ = ["compare_bokeh"]
 
-_SCRIPT = '''
+_SCRIPT = SCRIPT_ARGS + '''
 import glob, json, runpy, sys
 import bpy
 import numpy as np
 for _p in glob.glob(bpy.utils.resource_path("LOCAL") + "/python/lib/python3*/site-packages"):
     sys.path.insert(0, _p)
-job = json.loads(sys.argv[1])
+job = json.loads(ARGS[0])
 scene = bpy.context.scene
 for o in list(bpy.data.objects):
     if o.type != "CAMERA":
@@ -65,20 +65,11 @@ print(json.dumps({"ok": True}))
 '''
 
 
-def find_blender_python(explicit: str | None = None) -> str:
-    """A Python interpreter with Blender's ``bpy``: ``explicit``, else ``PHYSCAM_BLENDER_PYTHON``, else
-    ``./.venv-blender/bin/python``; :class:`InputError` saying how to get one otherwise."""
-    for cand in (explicit, os.environ.get("PHYSCAM_BLENDER_PYTHON"), str(Path(".venv-blender") / "bin" / "python")):
-        if cand and Path(cand).is_file():
-            return str(cand)
-    raise InputError("comparing with Blender needs a Python with Blender's bpy module: run `make blender` "
-                     "(builds .venv-blender) or pass --blender-python PATH")
-
-
 @takes_prescription
 def compare_bokeh(lens: Prescription, *, focus_mm: float, fstop: float, light_mm: float, aperture=None,
                   crop_mm: float = 3.0, pixels: int = 128, samples: int = 512, rays: int = 2_000_000,
-                  sphere_mm: float = 1.0, blender_python: str | None = None, timeout_s: float = 600.0) -> dict:
+                  sphere_mm: float = 1.0, blender_python: str | None = None, timeout_s: float = 600.0,
+                  config_blender: str | None = None) -> dict:
     """Render and trace a point light ``light_mm`` in front of the film with ``lens`` focused at
     ``focus_mm`` and stopped to ``fstop``; return both images and the measured agreement."""
     from ..analysis.blob import blob_moments, equivalent_diameter, polygon_corners
@@ -93,7 +84,7 @@ def compare_bokeh(lens: Prescription, *, focus_mm: float, fstop: float, light_mm
         raise InputError(f"samples must be a whole number from 1 to 100000, got {samples!r}")
     d_light = require_positive("light distance", light_mm)
     sphere = require_positive("sphere diameter", sphere_mm)
-    exe = find_blender_python(blender_python)
+    runner = find_blender(blender_python, config_value=config_blender)
     st = focus(lens, focus_mm)
     semi = iris_semi_diameter(lens, fstop)  # as the shader bakes it (physcam.export.blender)
     src = osl_camera_shader(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=crop, sensor_height_mm=crop,
@@ -104,7 +95,9 @@ def compare_bokeh(lens: Prescription, *, focus_mm: float, fstop: float, light_mm
                                               resolution=(pixels, pixels)))
         job = {"setup": str(setup), "samples": samples, "radius_m": sphere / 2000.0, "distance_m": d_light / 1000.0,
                "exr": str(Path(tmp) / "render.exr"), "npy": str(Path(tmp) / "render.npy")}
-        p = subprocess.run([exe, "-c", _SCRIPT, json.dumps(job)], capture_output=True, text=True, timeout=timeout_s)
+        script = Path(tmp) / "render.py"
+        script.write_text(_SCRIPT)
+        p = subprocess.run(runner.command(script, json.dumps(job)), capture_output=True, text=True, timeout=timeout_s)
         if p.returncode != 0 or not Path(job["npy"]).is_file():
             tail = (p.stderr or p.stdout).strip().splitlines()[-1:] or ["no output"]
             raise OpticsError(f"Blender could not render the comparison: {tail[0][:200]}")
@@ -130,5 +123,5 @@ def compare_bokeh(lens: Prescription, *, focus_mm: float, fstop: float, light_mm
         # the rim's dominant harmonic is the corner count (robust to render noise, unlike local maxima)
         rows["corners"] = {"cycles": polygon_corners(rendered)[1], "physcam": polygon_corners(image)[1]}
     return {"lens": lens.name, "focus_from_film_mm": focus_mm, "fstop": fstop, "light_from_film_mm": d_light,
-            "crop_mm": crop, "pixels": pixels, "samples": samples, "sphere_image_mm": e, "measured": rows,
+            "blender": runner.describe(), "crop_mm": crop, "pixels": pixels, "samples": samples, "sphere_image_mm": e, "measured": rows,
             "images": {"cycles": rendered, "physcam": image}}

@@ -7,3 +7,7 @@ camera and lens), ``receiver`` and ``sender`` (UDP), ``record`` (time-sampled US
 lens report), ``usd_io`` (frames read back from a PhysicalCamera), ``frustum`` (the LED wall's inner
 frustum). Layer 8.5: above ``usd`` (whose authoring it uses), below ``cli``.
 """
+
+from ..extras import require_extra
+
+require_extra("live", "OpenTrackIO (physcam live)")

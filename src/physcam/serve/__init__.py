@@ -12,8 +12,12 @@ command line cannot disagree.
 
 from __future__ import annotations
 
-from .app import Backend, Limits, create_app
-from .net import asgi_get, bind_socket, lan_addresses, qr_text, run_server, url_for
+from ..extras import require_extra
+
+require_extra("serve", "the phone page (physcam serve)")
+
+from .app import Backend, Limits, create_app  # noqa: E402
+from .net import asgi_get, bind_socket, lan_addresses, qr_text, run_server, url_for  # noqa: E402
 
 __all__ = ["Backend", "Limits", "create_app", "asgi_get", "bind_socket", "lan_addresses", "qr_text", "run_server",
            "url_for"]

@@ -7,7 +7,11 @@ the process creates its first stage; see :mod:`physcam.usd.plugin`). Modules:
 ``validate`` (usd-core's validators). Reference: docs/usd.md.
 """
 
-from .plugin import PLUGIN_DIR, SCHEMA_TYPES, ensure_registered
+from ..extras import require_extra
+
+require_extra("usd", "physcam's USD cameras")
+
+from .plugin import PLUGIN_DIR, SCHEMA_TYPES, ensure_registered  # noqa: E402
 
 ensure_registered()
 

@@ -1,0 +1,127 @@
+"""physcam as a studio installs it: the wheel and sdist built from this tree, the wheel installed
+into a fresh virtual environment in a temporary folder (no source tree on the path, no physcam
+environment variables), first alone (the light core), then with every extra (issue 26).
+
+It needs pip to reach the package index (CI does; the versions come from constraints.txt, so pip's
+cache serves them). The sizes and times it measures are printed (pytest -s) and recorded in
+docs/install.md.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+pytestmark = pytest.mark.slow
+
+
+def _run(cmd, cwd, *, env, check=True, timeout=900):
+    p = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+    if check and p.returncode != 0:
+        raise AssertionError(f"{' '.join(map(str, cmd))} exited {p.returncode}:\n{p.stdout[-2000:]}\n{p.stderr[-3000:]}")
+    return p
+
+
+def _size_mb(folder: Path) -> float:
+    return sum(f.stat().st_size for f in folder.rglob("*") if f.is_file() and not f.is_symlink()) / 1e6
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("installed")
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("PHYSCAM_", "PYTHON", "VIRTUAL_ENV"))}
+    env["PIP_DISABLE_PIP_VERSION_CHECK"] = "1"
+    dist = tmp / "dist"
+    _run([sys.executable, "-m", "build", "--outdir", str(dist), str(ROOT)], tmp, env=env)
+    wheels, sdists = sorted(dist.glob("physcam-*.whl")), sorted(dist.glob("physcam-*.tar.gz"))
+    assert len(wheels) == 1 and len(sdists) == 1
+    venv = tmp / "venv"
+    _run([sys.executable, "-m", "venv", str(venv)], tmp, env=env)
+    py = venv / "bin" / "python"
+    work = tmp / "work"
+    work.mkdir()
+    _run([py, "-m", "pip", "install", "--quiet", "-c", str(ROOT / "constraints.txt"), str(wheels[0])], work, env=env)
+    site = Path(_run([py, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"], work, env=env)
+                .stdout.strip())
+    return {"tmp": tmp, "py": py, "bin": venv / "bin", "work": work, "env": env, "wheel": wheels[0],
+            "site": site, "core_mb": _size_mb(site)}
+
+
+def _physcam(inst, *args, check=True):
+    return _run([inst["bin"] / "physcam", *map(str, args)], inst["work"], env=inst["env"], check=check)
+
+
+def test_the_core_installs_light_and_runs_the_report(installed):
+    inst = installed
+    # nothing from the source tree: physcam comes from the installed wheel
+    where = _run([inst["py"], "-c", "import physcam; print(physcam.__file__)"], inst["work"], env=inst["env"]).stdout
+    assert str(inst["site"]) in where and str(ROOT) not in where
+    assert _physcam(inst, "--version").stdout.strip() == "physcam 0.2.0"
+    doc = json.loads(_physcam(inst, "report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--json").stdout)
+    import jsonschema
+
+    schema = json.loads((ROOT / "src/physcam/cli/schemas/lens_report.schema.json").read_text())
+    jsonschema.validate(doc, schema)
+    # the installed wheel computes what this tree computes
+    from physcam.onset.report import solve_lens_report
+    from physcam.onset.sensors import find_sensor
+
+    here = solve_lens_report(focal_length_mm=50.0, fstop=2.8, focus_mm=3000.0, sensor=find_sensor("Super 35"))
+    assert doc["dof"]["near_from_film_mm"] == pytest.approx(here.dof.near_from_film_mm, rel=1e-12)
+    # bundled lenses, sensors and the JSON schemas came with the wheel
+    lenses = json.loads(_physcam(inst, "lenses", "--json").stdout)
+    assert len(lenses["lenses"]) >= 19
+    assert "ALEXA 35" in _physcam(inst, "sensors", "ARRI").stdout
+    shipped = _run([inst["py"], "-c", "import importlib.resources as r; print(len(list(r.files('physcam.cli.schemas')"
+                                      ".iterdir())))"], inst["work"], env=inst["env"]).stdout
+    assert int(shipped) == len(list((ROOT / "src/physcam/cli/schemas").glob("*.json")))
+    # the tracer and an analysis figure
+    _physcam(inst, "mtf", "dgauss_50mm", "--fstop", "8", "--field", "5", "--pupil-samples", "32", "-o", "mtf.png")
+    assert (inst["work"] / "mtf.png").stat().st_size > 10_000
+    # the measured figures of docs/install.md
+    t0 = time.perf_counter()
+    _run([inst["py"], "-c", "import physcam"], inst["work"], env=inst["env"])
+    print(f"\ncore install: {inst['core_mb']:.0f} MB in site-packages; `python -c 'import physcam'` "
+          f"{(time.perf_counter() - t0) * 1e3:.0f} ms")
+
+
+@pytest.mark.parametrize("extra, args", [
+    ("usd", ["usd", "write", "cam.usda", "--focal", "50", "--fstop", "2.8", "--focus", "3m"]),
+    ("exr", ["distortion", "dgauss_50mm", "--resolution", "64x48", "--stmap", "maps"]),
+    ("live", ["live", "validate", "sample.json"]),
+    ("dask", ["characterize", "dgauss_50mm", "-o", "char", "--focus", "2m", "--fstop", "4"]),
+    ("serve", ["serve", "--port", "0", "--check"]),
+])
+def test_a_missing_extra_is_one_line_naming_its_install(installed, extra, args):
+    (installed["work"] / "sample.json").write_text("{}")
+    p = _physcam(installed, *args, check=False)
+    assert p.returncode == 2
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and f"pip install 'physcam[{extra}]'" in lines[0], p.stderr
+    assert "Traceback" not in p.stderr
+
+
+def test_with_every_extra_the_demo_usd_plugin_and_serve_work(installed):
+    inst = installed
+    _run([inst["py"], "-m", "pip", "install", "--quiet", "-c", str(ROOT / "constraints.txt"),
+          f"{inst['wheel']}[all]"], inst["work"], env=inst["env"])
+    print(f"\nwith every extra: {_size_mb(inst['site']):.0f} MB in site-packages")
+    _physcam(inst, "demo", "--out", "demo")
+    assert (inst["work"] / "demo").is_dir()
+    # the PhysicalCamera schema plugin registers from the installed wheel, in a plain process
+    code = ("import physcam.usd\n"
+            "from pxr import Usd, Sdf\n"
+            "from physcam.usd.author import CameraSpec, author_camera, new_stage\n"
+            "stage = new_stage()\n"
+            "prim = author_camera(stage, '/Cam', CameraSpec(focal_length_mm=35.0, fstop=2.8, focus_mm=2000.0))\n"
+            "print(prim.GetTypeName(), Usd.SchemaRegistry().FindConcretePrimDefinition('PhysicalCamera') is not None)\n")
+    out = _run([inst["py"], "-c", code], inst["work"], env=inst["env"]).stdout.split()
+    assert out == ["PhysicalCamera", "True"]
+    assert "answer" in _physcam(inst, "serve", "--port", "0", "--check").stdout
