@@ -106,15 +106,16 @@ def _intersect_plane(buf, m, vz):
 
 @nb.njit(**_OPTS)
 def _intersect_quadric(buf, m, vz, ax, ay, az):
-    """Root nearest the vertex of ax x^2 + ay y^2 + az z^2 - 2 z = 0 into column T,
-    t = c / (-b - sign(b) sqrt(b^2 - a c)) (exact as the curvature goes to 0); returns how many
-    live lanes met the far cap instead and need :func:`_far_cap`."""
+    """The forward-crossing root of ax x^2 + ay y^2 + az z^2 - 2 z = 0 into column T (module notes,
+    "Which root"): f = that quadric along the ray, a t^2 + 2 b t + c, falls through zero (the ray goes
+    from the medium before the surface into the one after it) at t = (-b - s sq) / a with s the sign
+    of the ray's dz, computed without cancellation as c / (-b + s sq) when b s < 0. A crossing on the
+    far cap (az z >= 1, the back of a sphere) is no crossing of the surface: MISSED."""
     B = BLOCK
     zero = _like(0.0, buf)
     one = _like(1.0, buf)
     two = _like(2.0, buf)
     miss = _like(MISSED, buf)
-    nfar = np.int32(0)
     for k in range(m):
         px = buf[_PX * B + k]
         py = buf[_PY * B + k]
@@ -128,45 +129,15 @@ def _intersect_quadric(buf, m, vz, ax, ay, az):
         c = ax * px * px + ay * py * py + az * qz * qz - two * qz
         disc = b * b - a * c
         sq = math.sqrt(max(disc, zero))
-        den = -b - sq if b >= zero else -b + sq
-        t = c / den
+        sgn = one if dz >= zero else -one
+        same = b * sgn >= zero
+        num = -b - sgn * sq if same else c
+        den = a if same else -b + sgn * sq
+        t = num / den
         live = cd == zero
-        bad = (disc < zero) | (den == zero)
-        far = az * (qz + t * dz) >= one
+        bad = (disc < zero) | (den == zero) | (not (az * (qz + t * dz) < one))
         buf[_T * B + k] = t
         buf[_CD * B + k] = miss if (live & bad) else cd
-        nfar += np.int32(live & (not bad) & far)
-    return nfar
-
-
-@nb.njit(**_OPTS)
-def _far_cap(buf, m, vz, ax, ay, az):
-    """The vertex branch t = den / a for live lanes whose nearest root lies on the far cap of the
-    quadric (az z >= 1: the back of a sphere met first by a ray starting far from the vertex)."""
-    B = BLOCK
-    zero = _like(0.0, buf)
-    one = _like(1.0, buf)
-    two = _like(2.0, buf)
-    miss = _like(MISSED, buf)
-    for k in range(m):
-        px = buf[_PX * B + k]
-        py = buf[_PY * B + k]
-        qz = buf[_PZ * B + k] - vz
-        dx = buf[_DX * B + k]
-        dy = buf[_DY * B + k]
-        dz = buf[_DZ * B + k]
-        t = buf[_T * B + k]
-        cd = buf[_CD * B + k]
-        far = (cd == zero) & (az * (qz + t * dz) >= one)
-        a = ax * dx * dx + ay * dy * dy + az * dz * dz
-        b = ax * px * dx + ay * py * dy + az * qz * dz - dz
-        c = ax * px * px + ay * py * py + az * qz * qz - two * qz
-        sq = math.sqrt(max(b * b - a * c, zero))
-        den = -b - sq if b >= zero else -b + sq
-        t2 = den / a
-        bad = (a == zero) | (not (az * (qz + t2 * dz) < one))
-        buf[_T * B + k] = t2 if far else t
-        buf[_CD * B + k] = miss if (far & bad) else cd
 
 
 @nb.njit(**_OPTS)
@@ -572,8 +543,7 @@ def _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end
         if kd <= _STOP:
             _intersect_plane(buf, m, vz)
         else:
-            if _intersect_quadric(buf, m, vz, ax, ay, az) > 0:
-                _far_cap(buf, m, vz, ax, ay, az)
+            _intersect_quadric(buf, m, vz, ax, ay, az)
             if kd == _ASPHERE:
                 _newton_asphere(buf, m, S, s, vz)
         _move_and_clip(buf, m, S[s, SEMI] * S[s, SEMI], clip)

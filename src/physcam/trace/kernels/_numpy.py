@@ -94,14 +94,13 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                 c = ax * px * px + ay * py * py + az * qz * qz - 2.0 * qz
                 disc = b * b - a * c
                 sq = np.sqrt(np.maximum(disc, 0.0))
-                den = np.where(b >= 0.0, -b - sq, -b + sq)
-                t = c / den
-                # The root nearest in t may lie on the far cap of the quadric (the back of a
-                # sphere met first by a ray starting far from the vertex): the surface is the
-                # branch through the vertex, where az * z < 1; take the other root there.
-                far_side = az * (qz + t * dz) >= 1.0
-                t = np.where(far_side, den / a, t)
-                bad = (disc < 0.0) | (den == 0.0) | (far_side & ((a == 0.0) | ~(az * (qz + t * dz) < 1.0)))
+                # the forward crossing (numba kernel, _intersect_quadric): f falls through zero
+                sgn = np.where(dz >= 0.0, 1.0, -1.0)
+                same = b * sgn >= 0.0
+                num = np.where(same, -b - sgn * sq, c)
+                den = np.where(same, a, -b + sgn * sq)
+                t = num / den
+                bad = (disc < 0.0) | (den == 0.0) | ~(az * (qz + t * dz) < 1.0)
                 if bad.any():
                     fail(bad, MISSED)
                     t = t[~bad]
