@@ -20,7 +20,9 @@ DOF formulae" (the forms with the hyperfocal distance H = f²/(Nc) + f); S. Ray,
 H = f²/(Nc) + f with near/far forms that expect h: physcam does not (docs/lens-report.md).
 
 The limits are reported from H1; the lens report converts them to the film plane.
-Everything broadcasts over numpy arrays; lengths in mm.
+Everything broadcasts over numpy arrays; lengths in mm. Every function answers with a finite
+number (infinity only for a far limit, as documented) or raises a
+:class:`~physcam.errors.PhysCamError`: focal length, f-number, CoC and limits above 0.
 """
 
 from __future__ import annotations
@@ -53,6 +55,13 @@ _out = nx.out
 HYPERFOCAL_RTOL = 1e-6
 
 
+def _h(f, a, b):
+    """f^2 / (a b) for positive inputs, as (f / a)(f / b) so no product underflows to 0; a quotient too
+    large for a float is an OpticsError (raised by :func:`_num.out` on the infinity)."""
+    with nx.float_errors_ignored():
+        return (f / a) * (f / b)
+
+
 def hyperfocal_distance(focal_length, f_number, coc):
     """Hyperfocal distance H = f²/(N c) + f, in mm from the front principal plane H1.
 
@@ -62,8 +71,10 @@ def hyperfocal_distance(focal_length, f_number, coc):
     >>> round(float(hyperfocal_distance(35.0, 11.0, 0.03)), 2)
     3747.12
     """
-    f = _arr(focal_length)
-    return _out(f * f / (_arr(f_number) * _arr(coc)) + f)
+    f = nx.positive("focal length", focal_length)
+    n = nx.positive("f-number", f_number, unit="")
+    c = nx.positive("circle of confusion", coc)
+    return _out(_h(f, n, c) + f, what="the hyperfocal distance")
 
 
 def dof_limits(focal_length, f_number, coc, object_distance):
@@ -81,16 +92,18 @@ def dof_limits(focal_length, f_number, coc, object_distance):
     >>> round(n / 304.8, 3), round(f / 304.8, 3)
     (8.742, 11.681)
     """
-    f = _arr(focal_length)
-    s = _arr(object_distance)
+    f = nx.positive("focal length", focal_length)
+    n = nx.positive("f-number", f_number, unit="")
+    c = nx.positive("circle of confusion", coc)
+    s = nx.positive("focus distance", object_distance, allow_inf=True)
     if nx.any_true(s <= f):
         raise OpticsError("focus distance is at or inside the focal length: no real image forms")
-    h = f * f / (_arr(f_number) * _arr(coc))
+    h = _out(_h(f, n, c), what="the hyperfocal parameter")
     near = h / (1.0 + (h - f) / s)  # = h s / (h + s - f), and h at s = inf
     denom = h - (s - f)  # = H - s
     finite = denom > HYPERFOCAL_RTOL * (h + f)
     far = nx.where(finite, h * s / nx.where(finite, denom, 1.0), math.inf)
-    return _out(near), _out(far)
+    return _out(near, what="the near limit"), _out(far, allow_inf=True, what="the far limit")
 
 
 def hyperfocal_parameter_from_near(focal_length, object_distance, near):
@@ -98,12 +111,14 @@ def hyperfocal_parameter_from_near(focal_length, object_distance, near):
 
     Distances from H1. Requires near < s.
     """
-    f, s, n = _arr(focal_length), _arr(object_distance), _arr(near)
+    f = nx.positive("focal length", focal_length)
+    s = nx.positive("focus distance", object_distance, allow_inf=True)
+    n = _arr(near)
+    if nx.any_true(n <= 0) or not nx.all_true(nx.isfinite(n)):
+        raise InputError("the near limit must be in front of the lens (> 0) and finite")
     if nx.any_true(n >= s):
         raise InputError("the near limit must be closer than the focus distance")
-    if nx.any_true(n <= 0):
-        raise InputError("the near limit must be in front of the lens (> 0)")
-    return _out(n * (s - f) / (s - n))
+    return _out(n * (1.0 - f / s) / (1.0 - n / s), what="the hyperfocal parameter")  # = n (s - f) / (s - n)
 
 
 def hyperfocal_parameter_from_far(focal_length, object_distance, far):
@@ -111,14 +126,16 @@ def hyperfocal_parameter_from_far(focal_length, object_distance, far):
 
     Distances from H1. Requires far > s; an infinite far limit gives no finite h.
     """
-    f, s, F = _arr(focal_length), _arr(object_distance), _arr(far)
+    f = nx.positive("focal length", focal_length)
+    s = nx.positive("focus distance", object_distance)
+    F = nx.positive("far limit", far, allow_inf=True)
     if nx.any_true(F <= s):
         raise InputError("the far limit must be beyond the focus distance")
     if not nx.all_true(nx.isfinite(F)):
         raise InputError(
             "an infinite far limit only says the focus is at or beyond the hyperfocal distance; give a near limit"
         )
-    return _out((s - f) / (1.0 - s / F))  # = F (s - f) / (F - s), without overflow for huge F
+    return _out((s - f) / (1.0 - s / F), what="the hyperfocal parameter")  # = F (s - f) / (F - s), no overflow
 
 
 def focus_for_dof_limits(near, far):
@@ -127,25 +144,28 @@ def focus_for_dof_limits(near, far):
     From the exact forms, 1/near + 1/far = 2/s, so s is their harmonic mean
     2 near far / (near + far) whatever f, N and c are. An infinite far gives s = 2 near.
     """
-    n, F = _arr(near), _arr(far)
-    if nx.any_true(n <= 0) or nx.any_true(F <= n):
+    n = nx.positive("near limit", near)
+    F = nx.positive("far limit", far, allow_inf=True)
+    if nx.any_true(F <= n):
         raise InputError("need 0 < near limit < far limit")
     fin = nx.isfinite(F)
     Ff = nx.where(fin, F, 0.0)
-    s = nx.where(fin, 2.0 * n * Ff / (n + Ff), 2.0 * n)
-    return _out(s)
+    s = nx.where(fin, 2.0 * n / (1.0 + n / nx.where(fin, Ff, 1.0)), 2.0 * n)  # = 2 n F / (n + F)
+    return _out(s, what="the focus distance")
 
 
 def f_number_for_dof(focal_length, coc, h):
     """N = f² / (c h) for a hyperfocal parameter h (see the ``*_from_near`` helpers)."""
-    f = _arr(focal_length)
-    return _out(f * f / (_arr(coc) * _arr(h)))
+    f = nx.positive("focal length", focal_length)
+    return _out(_h(f, nx.positive("circle of confusion", coc), nx.positive("hyperfocal parameter", h)),
+                what="the f-number")
 
 
 def coc_for_dof(focal_length, f_number, h):
     """c = f² / (N h) for a hyperfocal parameter h."""
-    f = _arr(focal_length)
-    return _out(f * f / (_arr(f_number) * _arr(h)))
+    f = nx.positive("focal length", focal_length)
+    return _out(_h(f, nx.positive("f-number", f_number, unit=""), nx.positive("hyperfocal parameter", h)),
+                what="the circle of confusion")
 
 
 def stops_between(n_effective: float, n_marked: float) -> float:
@@ -153,4 +173,6 @@ def stops_between(n_effective: float, n_marked: float) -> float:
 
     Positive means the effective aperture is smaller (more DOF) than marked.
     """
-    return 2.0 * math.log2(n_effective / n_marked)
+    e = nx.positive("effective f-number", n_effective, unit="")
+    m = nx.positive("marked f-number", n_marked, unit="")
+    return _out(2.0 * (nx.log2(e) - nx.log2(m)), what="the stops between")

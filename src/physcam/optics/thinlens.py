@@ -7,10 +7,14 @@ equation) and §5.2.3 Eq. 5.26 (transverse magnification m = -s'/s; physcam repo
 its magnitude, the image is inverted).
 
 All functions broadcast over numpy arrays; lengths in mm, angles in radians unless
-the name says ``_deg``.
+the name says ``_deg``. Every one answers with a finite number (infinity only where the
+docstring says) or raises a :class:`~physcam.errors.PhysCamError`: a focal length must be above
+0, a distance above 0 (or infinite, a subject at infinity).
 """
 
 from __future__ import annotations
+
+import math
 
 from ..errors import OpticsError
 from . import _num as nx
@@ -29,16 +33,19 @@ def image_distance(focal_length, object_distance):
     """s' = s f / (s - f): image distance behind H2 for an object ``object_distance`` in front of H1.
 
     Raises :class:`OpticsError` when the object is at or inside the focal length
-    (no real image).
+    (no real image). An object at infinity images at the focal length, s' = f (the form
+    f / (1 - f/s), which needs no special case).
 
     >>> float(image_distance(50.0, 100.0))
     100.0
+    >>> float(image_distance(50.0, float("inf")))
+    50.0
     """
-    f = nx.value(focal_length)
-    s = nx.value(object_distance)
+    f = nx.positive("focal length", focal_length)
+    s = nx.positive("object distance", object_distance, allow_inf=True)
     if nx.any_true(s <= f):
         raise OpticsError("the subject is at or inside the focal length: no real image forms on the film")
-    return nx.out(s * f / (s - f))
+    return nx.out(f / (1.0 - f / s), what="the image distance")
 
 
 def object_distance(focal_length, image_distance_):
@@ -47,12 +54,12 @@ def object_distance(focal_length, image_distance_):
 
 
 def magnification(focal_length, object_distance):
-    """|m| = s'/s = f / (s - f), the size on the film over the size of the subject."""
-    f = nx.value(focal_length)
-    s = nx.value(object_distance)
+    """|m| = s'/s = f / (s - f), the size on the film over the size of the subject (0 at infinity)."""
+    f = nx.positive("focal length", focal_length)
+    s = nx.positive("object distance", object_distance, allow_inf=True)
     if nx.any_true(s <= f):
         raise OpticsError("the subject is at or inside the focal length: no real image forms on the film")
-    return nx.out(f / (s - f))
+    return nx.out(f / (s - f), what="the magnification")
 
 
 def minimum_marked_distance(focal_length, hiatus=0.0):
@@ -60,7 +67,8 @@ def minimum_marked_distance(focal_length, hiatus=0.0):
 
     At that distance s = s' = 2f and the magnification is 1 (Hecht §5.2.3).
     """
-    return nx.out(4.0 * nx.value(focal_length) + hiatus)
+    f = nx.positive("focal length", focal_length)
+    return nx.out(4.0 * f + nx.finite("hiatus", hiatus), what="the closest mark")
 
 
 def object_distance_for_marked(focal_length, marked_distance, hiatus=0.0):
@@ -74,9 +82,14 @@ def object_distance_for_marked(focal_length, marked_distance, hiatus=0.0):
 
     >>> round(float(object_distance_for_marked(50.0, 200.0)), 6)  # 1:1 macro: s = s' = 2f
     100.0
+
+    A mark at infinity is a subject at infinity (s = inf).
     """
-    f = nx.value(focal_length)
-    D = nx.value(marked_distance)
+    f = nx.positive("focal length", focal_length)
+    D = nx.positive("focus mark", marked_distance, allow_inf=True)
+    hiatus = nx.finite("hiatus", hiatus)
+    if nx.is_scalar(D) and math.isinf(D):
+        return math.inf
     L = D - hiatus
     disc = L * L - 4.0 * L * f
     if nx.any_true(disc < -1e-9 * L * L) or nx.any_true(L <= 0):
@@ -86,7 +99,7 @@ def object_distance_for_marked(focal_length, marked_distance, hiatus=0.0):
             f"focus mark {dmin:.6g} mm is closer than this lens can focus: "
             f"the closest mark for a {fmax:g} mm thin lens is {4.0 * fmax + hiatus:.6g} mm from the film plane (4f)"
         )
-    return nx.out(0.5 * (L + nx.sqrt(nx.maximum(disc, 0.0))))
+    return nx.out(0.5 * (L + nx.sqrt(nx.maximum(disc, 0.0))), allow_inf=True, what="the object distance")
 
 
 def field_of_view(size, focal_length, object_distance=None):
@@ -100,6 +113,7 @@ def field_of_view(size, focal_length, object_distance=None):
     >>> import math; round(math.degrees(field_of_view(36.0, 50.0)), 4)
     39.5978
     """
-    size = nx.value(size)
-    d = nx.value(focal_length) if object_distance is None else image_distance(focal_length, object_distance)
-    return nx.out(2.0 * nx.atan(size / (2.0 * d)))
+    size = nx.positive("film size", size)
+    d = nx.positive("focal length", focal_length) if object_distance is None else \
+        image_distance(focal_length, object_distance)
+    return nx.out(2.0 * nx.atan(size / (2.0 * d)), what="the field of view")
