@@ -100,7 +100,10 @@ def doc_commands(path: Path):
                 while s.endswith("\\") and i + 1 < len(lines):
                     i += 1
                     s = s[:-1].rstrip() + " " + lines[i].strip()
-                out.append([start, s, {k: "\n".join(v) + "\n" for k, v in files.items()}, 0])
+                # a checker that finds a problem exits 1: the page says so on the line, `# exits 1`
+                code = re.search(r"#\s*exits (\d)\s*$", s)
+                out.append([start, s, {k: "\n".join(v) + "\n" for k, v in files.items()},
+                            int(code.group(1)) if code else 0])
         i += 1
     return out
 

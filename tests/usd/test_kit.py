@@ -327,6 +327,26 @@ def test_stale_companion_is_detected_and_refreshed(tmp_path, library):
     assert stage.GetPrimAtPath("/Cameras/Shot").GetAttribute("lens:main:iris").Get() == pytest.approx(25.0 / 2.8)
 
 
+def test_usd_check_exits_1_on_a_stale_shot(tmp_path, library, capsys):
+    """Issue 24 item 13: `physcam usd check` exited 0 on a stale companion unless --exit-code was given.
+    A checker exits 1 when it finds a problem, 0 when current, 2 for a file that is not USD."""
+    from physcam.cli import main
+
+    body = write_body_file(tmp_path / "body.usda", CameraSpec(sensor_width_mm=36.0, sensor_height_mm=24.0))
+    shot = write_shot(tmp_path / "shot.usda", body, library, overrides={"fstop": 2.8})
+    assert main(["usd", "check", str(shot)]) == 0
+    write_lens_file(library, {"2026-03-01": lens(24.1, 80.0, 0.90), "2026-04-01": lens(25.0, 82.0, 0.87)},
+                    force=True)
+    assert main(["usd", "check", str(shot)]) == 1
+    assert main(["usd", "check", str(shot), "--json"]) == 1
+    assert main(["usd", "check", str(shot), "--exit-code"]) == 1  # the pre-0.2 flag changes nothing
+    assert main(["usd", "refresh", str(shot)]) == 0
+    assert main(["usd", "check", str(shot)]) == 0
+    (tmp_path / "not.usda").write_text("a,b\n1,2\n")
+    assert main(["usd", "check", str(tmp_path / "not.usda")]) == 2
+    capsys.readouterr()
+
+
 def test_check_says_current_for_every_file_physcam_writes(tmp_path):
     """Review finding: `usd check` called every non-shot file stale. Each companion carries its inputs."""
     from physcam.usd.author import write_camera

@@ -81,6 +81,8 @@ def register(sub) -> None:
     c.add_argument("--sensor", default=None,
                    help="also trace the on-axis beam, vignetting and image circle at this sensor's corner "
                         "(see `physcam sensors`)")
+    c.add_argument("--strict", action="store_true",
+                   help="exit 1 on warnings too (default: exit 1 only when the lens has an error)")
     add_output_options(c, what="the findings")
     c.set_defaults(handler=run_check)
 
@@ -445,6 +447,7 @@ def ray_probes(sensor_name: str | None):
 
 
 def run_check(args) -> int:
+    from ..errors import LensFileError
     from ..lens.check import check
     from ._common import console
     from ._output import document, emit_json
@@ -454,11 +457,17 @@ def run_check(args) -> int:
 
         find_sensor(args.sensor)  # an unknown name is refused before any work
     findings = check(args.lens, probes=ray_probes(args.sensor))
+    unreadable = next((f for f in findings if f.code == "unreadable"), None)
+    if unreadable is not None:  # no such lens, or not a lens file at all: bad input (exit 2), not a finding
+        raise LensFileError(unreadable.message, path=None, line=None)
+    # a checker: exit 1 when it finds an error in the lens (docs/cli.md, "Exit status"); warnings too with --strict
+    failing = ("error", "warning") if args.strict else ("error",)
+    rc = 1 if any(f.severity in failing for f in findings) else 0
     if args.json:
         emit_json(document("lens_check", {
             "lens": args.lens, "findings": [f.to_dict() for f in findings],
             "counts": {s: sum(f.severity == s for f in findings) for s in ("error", "warning", "note")}}))
-        return 0
+        return rc
     con = console()
     if not findings:
         con.print(f"{args.lens}: no findings")
@@ -471,7 +480,7 @@ def run_check(args) -> int:
         tail = f"; `physcam lens fix --lens {args.lens} -o FIXED.toml` proposes repairs"
     con.print(f"{counts['error']} error(s), {counts['warning']} warning(s), {counts['note']} note(s){tail}",
               soft_wrap=True)
-    return 0
+    return rc
 
 
 def _diff(a, b, lines) -> list[str]:

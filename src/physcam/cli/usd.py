@@ -114,8 +114,8 @@ def register(sub) -> None:
     c.add_argument("file", help="a shot (or any camera file physcam wrote)")
     c.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
     add_output_options(c, what="the check")
-    c.add_argument("--exit-code", action="store_true",
-                   help="exit 1 when the companion is stale (for farm and CI scripts; 0 when current)")
+    # exit 1 when stale is the default now (docs/cli.md, "Exit status"); the old flag keeps scripts running
+    c.add_argument("--exit-code", action="store_true", help=argparse.SUPPRESS)
     c.set_defaults(handler=run_check)
 
     f = s.add_parser("refresh", help="recompute a shot's companion camera from its body and lens files (in place)")
@@ -442,7 +442,7 @@ def run_check(args) -> int:
     from ..usd.kit import check_shot
 
     res = check_shot(args.file, args.path)
-    rc = 1 if (args.exit_code and res["stale"]) else 0
+    rc = 1 if res["stale"] else 0  # a checker: 1 when it finds a problem (docs/cli.md, "Exit status")
     if args.json:
         d = dict(res)
         d["file_units"] = d.pop("units")  # the layers' metersPerUnit notes (the document's own "units" say mm)
