@@ -110,3 +110,21 @@ def test_custom_sensor_pitch():
     assert custom_sensor(36, 24).pitch_um is None
     with pytest.raises(SensorError):
         custom_sensor(36, 24, pitch_um=0.01)
+
+
+def test_diffraction_formulas_answer_with_a_number_or_an_optics_error():
+    """Issue 24 item 7 (review): a wavelength of 5e-324 nm raised ZeroDivisionError and huge inputs came
+    back as inf. Hand values: 2.44 x 550e-6 mm x 8 = 0.010736 mm; 0.025 / (2.44 x 550e-6) = 18.629."""
+    import pytest
+
+    from physcam.errors import OpticsError
+    from physcam.onset.report import airy_diameter_mm, fstop_airy_equals
+
+    assert airy_diameter_mm(8.0, 550.0) == pytest.approx(0.010736, rel=1e-12)
+    assert fstop_airy_equals(0.025, 550.0) == pytest.approx(0.025 / (2.44 * 550e-6), rel=1e-12)
+    with pytest.raises(OpticsError):
+        fstop_airy_equals(0.025, 5e-324)
+    with pytest.raises(OpticsError):
+        fstop_airy_equals(1e300, 1e-10)
+    with pytest.raises(OpticsError):
+        airy_diameter_mm(1e300, 1e300)

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
+from ..optics import _num
 from ..optics import dof as _dof
 from ..optics import thinlens
 from ..optics.coc import circle_of_confusion
@@ -125,7 +126,7 @@ def airy_diameter_mm(working_f_number, wavelength_nm=DIFFRACTION_WAVELENGTH_NM) 
     """Diameter (mm) of the Airy disk to its first dark ring: 2.44 lambda N_w (Born & Wolf, 8.5.2)."""
     n = require_positive("working f-number", working_f_number, unit="")
     lam = require_positive("wavelength", wavelength_nm, unit="nm")
-    return AIRY_FACTOR * lam * 1e-6 * n
+    return _num.out(AIRY_FACTOR * lam * 1e-6 * n, what="the Airy diameter")
 
 
 def fstop_airy_equals(size_mm, wavelength_nm=DIFFRACTION_WAVELENGTH_NM, bellows_factor=1.0) -> float:
@@ -134,7 +135,11 @@ def fstop_airy_equals(size_mm, wavelength_nm=DIFFRACTION_WAVELENGTH_NM, bellows_
     c = require_positive("size", size_mm)
     lam = require_positive("wavelength", wavelength_nm, unit="nm")
     k = require_positive("bellows factor", bellows_factor, unit="")
-    return c / (AIRY_FACTOR * lam * 1e-6 * k)
+    airy_per_stop = AIRY_FACTOR * lam * 1e-6 * k  # mm of Airy disk per unit of f-number
+    if airy_per_stop == 0.0:  # the wavelength times the bellows factor underflowed a float
+        raise OpticsError(f"a wavelength of {wavelength_nm} nm (x bellows {bellows_factor}) is too small "
+                          "for a float: no f-stop makes its Airy disk the given size")
+    return _num.out(c / airy_per_stop, what="the f-stop whose Airy disk equals the size")
 
 
 @dataclass(frozen=True)
