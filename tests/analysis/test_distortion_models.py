@@ -231,7 +231,11 @@ def test_nuke_script_feeds_the_image_to_src_and_the_map_to_stmap(tmp_path):
     kind, ins, knobs = wiring["physcam_undistort"]
     assert kind == "STMap" and ins == ["physcam_plate", "physcam_undistortion_map"] and knobs["uv"] == "rgb"
     assert wiring["physcam_undistortion_map"][2]["raw"] == "true"
-    assert wiring["physcam_undistortion_map"][2]["format"] == '"2100 1400 0 0 2100 1400 1 physcam_undistorted"'
+    # the maps carry their own frames (EXR display window = the plate, data window = the overscan):
+    # a format knob on their Reads would override them
+    assert "format" not in wiring["physcam_undistortion_map"][2]
+    assert "format" not in wiring["physcam_distortion_map"][2]
+    assert "bounding box 2100 x 1400 (26, 17 px of overscan" in text
     assert wiring["physcam_redistort"][1] == ["physcam_undistorted_render", "physcam_distortion_map"]
     with pytest.raises(PhysCamError):
         nuke_stmap_script('bad"name.exr', "d.exr")

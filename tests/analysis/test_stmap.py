@@ -67,11 +67,12 @@ def test_distortion_map_returns_the_undistorted_grid(case):
     ox, oy = res.overscan_px
     W2, H2 = W_PX + 2 * ox, H_PX + 2 * oy
     # distortion map at the traced (plate) position fetches the undistorted image at the ideal one
-    back = _sample(res.distortion_stmap, real, (W_PX, H_PX)) * [W2, H2] - [ox, oy]
+    # (normalised to the undistorted image's frame, the plate's: its display window)
+    back = _sample(res.distortion_stmap, real, (W_PX, H_PX)) * [W_PX, H_PX]
     assert np.hypot(*(back - ideal).T).max() < 0.1
     # and the round trip through both maps
     src = _sample(res.undistortion_stmap, ideal + [ox, oy], (W2, H2)) * [W_PX, H_PX]
-    again = _sample(res.distortion_stmap, src, (W_PX, H_PX)) * [W2, H2] - [ox, oy]
+    again = _sample(res.distortion_stmap, src, (W_PX, H_PX)) * [W_PX, H_PX]
     assert np.hypot(*(again - ideal).T).max() < 0.1
 
 
@@ -80,7 +81,9 @@ def test_overscan_keeps_every_plate_pixel(case):
     ox, oy = res.overscan_px
     d = res.distortion_stmap
     assert d.shape == (H_PX, W_PX, 3)
-    assert d[..., :2].min() >= 0.0 and d[..., :2].max() <= 1.0
+    # every plate pixel's ideal position lies inside the overscanned frame (plate-normalised)
+    assert d[..., 0].min() >= -ox / W_PX and d[..., 0].max() <= 1.0 + ox / W_PX
+    assert d[..., 1].min() >= -oy / H_PX and d[..., 1].max() <= 1.0 + oy / H_PX
     assert (d[..., 2] == 0).all()
     assert ox > 0 and oy > 0  # barrel at the corners: the ideal image is larger than the plate
     assert res.interpolation_error_px < 0.05 and res.inverse_error_px < 0.05
@@ -94,7 +97,7 @@ def test_image_round_trip_through_both_maps(case):
     yy, xx = np.mgrid[0:H_PX, 0:W_PX] + 0.5
     img = np.sin(xx / 37.0) * np.cos(yy / 23.0)
     und = apply_stmap(img, res.undistortion_stmap)
-    back = apply_stmap(und, res.distortion_stmap)
+    back = apply_stmap(und, res.distortion_stmap, overscan=res.overscan_px)
     inner = (slice(20, -20), slice(20, -20))
     assert np.abs(back - img)[inner].max() < 0.02
 

@@ -39,8 +39,13 @@ pixel centres at (i + 0.5) / width; B = 0.
   of (width + 2 ox) x (height + 2 oy) pixels: the overscan ox, oy is the smallest symmetric
   margin whose bounding box keeps the ideal position of every plate pixel. Its R, G are
   normalised to the plate; outside the plate's ideal image they lie outside 0..1 (no source).
-* The **distortion map** (width x height) turns such an undistorted (overscanned) image back
-  into the plate; its R, G are normalised to the overscanned size.
+  Its EXR file carries its own frame (the OpenEXR and Nuke convention): display window = the
+  plate's frame (0, 0)-(width - 1, height - 1), data window = the overscanned region
+  (-ox, -oy)-(width + ox - 1, height + oy - 1).
+* The **distortion map** (width x height) turns such an undistorted image back into the plate;
+  its R, G are normalised to the undistorted image's frame, which is the plate's (its display
+  window): values below 0 and above 1 reach into the overscan (its data window). OpenImageIO's
+  ``st_warp`` and Nuke's STMap read a source's coordinates so (tests/analysis/test_stmap_windows.py).
 
 Map arrays are image arrays: row 0 is the top row (as in EXR and PNG files).
 """
@@ -350,8 +355,8 @@ def distortion_field(
     if W2 * H2 > 4 * MAX_PIXELS or W2 > 4 * MAX_SIDE_PX or H2 > 4 * MAX_SIDE_PX:
         raise OpticsError(f"the undistorted frame would be {W2} x {H2} px: the distortion is too strong for an ST-map")
     dmap = np.zeros((h_px, w_px, 3), dtype=np.float32)
-    dmap[..., 0] = (ideal_px[..., 0] + ox) / W2
-    dmap[..., 1] = (ideal_px[..., 1] + oy) / H2
+    dmap[..., 0] = ideal_px[..., 0] / w_px  # normalised to the plate's frame (module notes)
+    dmap[..., 1] = ideal_px[..., 1] / h_px
     del ideal_px
 
     # inverse: ideal position -> real position, by Newton on the interpolated field at nodes over
@@ -401,11 +406,14 @@ def distortion_field(
         traced_ideal)
 
 
-def apply_stmap(image, stmap) -> np.ndarray:
+def apply_stmap(image, stmap, *, overscan=(0, 0)) -> np.ndarray:
     """Resample ``image`` (h, w) or (h, w, c) through ``stmap`` (H, W, >= 2; R = u, G = v, module notes).
 
-    Output pixel (row, col) takes the bilinear sample of ``image`` at (u w, v h) (origin bottom-left,
-    pixel centres at half integers); samples outside the image are 0. Returns float64 (H, W[, c]).
+    ``overscan`` (ox, oy): the image is a frame of (w - 2 ox) x (h - 2 oy) pixels with that margin
+    around it (an undistorted image, its data window larger than its display window), and u, v are
+    normalised to the frame. Output pixel (row, col) takes the bilinear sample of ``image`` at
+    (u fw + ox, v fh + oy), fw, fh the frame's size (origin bottom-left, pixel centres at half
+    integers); samples outside the image are 0. Returns float64 (H, W[, c]).
     """
     img = np.asarray(image, dtype=float)
     m = np.asarray(stmap, dtype=float)
@@ -416,9 +424,14 @@ def apply_stmap(image, stmap) -> np.ndarray:
     if not np.isfinite(m[..., :2]).all():
         raise InputError("the ST-map has non-finite values")
     h, w = img.shape[:2]
+    ox, oy = (int(v) for v in overscan)
+    if ox < 0 or oy < 0 or 2 * ox >= w or 2 * oy >= h:
+        raise InputError(f"the overscan {overscan!r} must be whole pixels >= 0 leaving a frame inside the "
+                         f"{w} x {h} image")
+    fw, fh = w - 2 * ox, h - 2 * oy
     flat = img.reshape(h, w, -1)
-    x = m[..., 0] * w - 0.5  # column coordinate of the sample
-    y = (1.0 - m[..., 1]) * h - 0.5  # row coordinate (rows top first)
+    x = m[..., 0] * fw + ox - 0.5  # column coordinate of the sample
+    y = h - (m[..., 1] * fh + oy) - 0.5  # row coordinate (rows top first)
     x0, y0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
     fx, fy = (x - x0)[..., None], (y - y0)[..., None]
     out = np.zeros(m.shape[:2] + (flat.shape[2],))
@@ -431,15 +444,21 @@ def apply_stmap(image, stmap) -> np.ndarray:
     return out if img.ndim == 3 else out[..., 0]
 
 
-def _exr_bytes(rgb: np.ndarray, attributes=None) -> bytes:
+def _exr_bytes(rgb: np.ndarray, attributes=None, overscan=(0, 0)) -> bytes:
     """A 32-bit float RGB scanline EXR (ZIP) of ``rgb`` (h, w, 3), as bytes; ``attributes``: extra
-    header entries (strings and floats)."""
+    header entries (strings and floats). ``overscan`` (ox, oy): ``rgb`` is a frame with that margin
+    around it; the display window is the frame, the data window the whole array (OpenEXR's
+    "Technical Introduction", data and display windows; y grows downward)."""
     from ..extras import require_extra
 
     require_extra("exr", "writing ST-maps as EXR")
     import OpenEXR
 
-    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage, **(attributes or {})}
+    h, w = rgb.shape[:2]
+    ox, oy = overscan
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage, **(attributes or {}),
+              "displayWindow": (np.array([0, 0], np.int32), np.array([w - 2 * ox - 1, h - 2 * oy - 1], np.int32)),
+              "dataWindow": (np.array([-ox, -oy], np.int32), np.array([w - ox - 1, h - oy - 1], np.int32))}
     fd, tmp = tempfile.mkstemp(suffix=".exr")
     os.close(fd)
     try:
@@ -464,6 +483,9 @@ def _png_bytes(rgb: np.ndarray) -> bytes:
 def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> list[Path]:
     """Write ``distortion.exr``, ``undistortion.exr`` and a PNG preview beside each into ``folder``.
 
+    ``undistortion.exr``'s display window is the plate's frame and its data window the overscanned
+    region (module notes); ``distortion.exr`` is the plate's size, both windows alike.
+
     Each EXR's header says which stop the map is for and its residual there: ``physcamMapFor`` (text),
     ``physcamFStop`` (0 for a chief-ray map), ``physcamResidualRmsPx``, ``physcamResidualMaxPx``,
     ``physcamLens``.
@@ -480,14 +502,15 @@ def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> lis
     d = Path(folder)
     if d.exists() and not d.is_dir():
         raise ExportError(f"{str(d)!r} exists and is not a folder: give a folder for the ST-maps")
-    items = [("distortion", result.distortion_stmap), ("undistortion", result.undistortion_stmap)]
+    items = [("distortion", result.distortion_stmap, (0, 0)),
+             ("undistortion", result.undistortion_stmap, tuple(result.overscan_px))]
     said = result.to_dict()
     attributes = {"physcamMapFor": said["map_for"], "physcamFStop": float(result.fstop or 0.0),
                   "physcamResidualRmsPx": float(result.residual_px[0]),
                   "physcamResidualMaxPx": float(result.residual_px[1]), "physcamLens": result.lens_name}
     payload = []
-    for name, rgb in items:
-        payload.append((d / f"{name}.exr", _exr_bytes(rgb, attributes)))
+    for name, rgb, overscan in items:
+        payload.append((d / f"{name}.exr", _exr_bytes(rgb, attributes, overscan)))
         payload.append((d / f"{name}.png", _png_bytes(rgb)))
     for p, _ in payload:
         check_writable(p, force=force)

@@ -3,6 +3,10 @@
 Two branches, each a ``Read`` of the map (raw, so no colour transform touches the numbers), a
 ``Read`` of the image and an ``STMap`` (``uv rgb``): *undistort* turns the plate into the
 undistorted, overscanned picture; *redistort* turns a render of that picture back into the plate.
+The maps carry their own frames (:func:`physcam.analysis.stmap.write_stmaps`): the undistorted
+picture's format is the plate's and its bounding box the overscan (EXR display and data windows),
+so the render to redistort is an EXR of that frame too (display window = the plate, data window =
+the overscan, as renderers write overscan).
 In a ``.nk`` file a node with ``inputs 2`` takes its inputs from the node stack, the top of the
 stack as input 0: the image is written last, so it is the STMap's ``src`` (input 0) and the map
 its ``stmap`` input (input 1). No Nuke was run to check the script; the maps themselves are
@@ -36,14 +40,14 @@ def nuke_stmap_script(undistortion_map, distortion_map, *, plate="plate.####.exr
         return f"{kind} {{\n{body}}}\n"
 
     parts = [
-        f"# physcam {version}: apply the undistortion and distortion ST-maps (R = u, G = v, origin bottom left)\n",
+        f"# physcam {version}: apply the undistortion and distortion ST-maps (R = u, G = v, origin bottom left)\n"
+        f"# the undistorted picture: the plate's format {w} x {h}, bounding box {W} x {H} "
+        f"({(W - w) // 2}, {(H - h) // 2} px of overscan each side; the maps' EXR windows say so)\n",
         node("Root", inputs=0, format=f'"{w} {h} 0 0 {w} {h} 1 physcam_plate"'),
-        node("Read", inputs=0, file=f'"{_path(undistortion_map)}"', raw="true",
-             format=f'"{W} {H} 0 0 {W} {H} 1 physcam_undistorted"', name="physcam_undistortion_map"),
+        node("Read", inputs=0, file=f'"{_path(undistortion_map)}"', raw="true", name="physcam_undistortion_map"),
         node("Read", inputs=0, file=f'"{_path(plate)}"', name="physcam_plate"),
         node("STMap", inputs=2, channels="rgba", uv="rgb", name="physcam_undistort"),
-        node("Read", inputs=0, file=f'"{_path(distortion_map)}"', raw="true",
-             format=f'"{w} {h} 0 0 {w} {h} 1 physcam_plate"', name="physcam_distortion_map"),
+        node("Read", inputs=0, file=f'"{_path(distortion_map)}"', raw="true", name="physcam_distortion_map"),
         node("Read", inputs=0, file=f'"{_path(render)}"', name="physcam_undistorted_render"),
         node("STMap", inputs=2, channels="rgba", uv="rgb", name="physcam_redistort"),
     ]
