@@ -30,19 +30,23 @@ than the CoC: N = c / (2.44 lambda (N_w / N)). Scalars only (no numpy), like the
 from __future__ import annotations
 
 import math
+import dataclasses
 from dataclasses import dataclass, field
-from functools import lru_cache
 
-from ..errors import InputError, OpticsError, require_finite, require_positive
+from ..errors import OpticsError, require_positive
 from ..optics import _num
 from ..optics import dof as _dof
-from ..optics import thinlens
 from ..optics.coc import circle_of_confusion
-from .pupil import entrance_pupil_practical, pivot_camera_space
+from .pupil import pivot_camera_space
+from .request import (DIFFRACTION_WAVELENGTH_NM, HYPERFOCAL, MAX_DISTANCE_MM, MAX_F_NUMBER, MIN_F_NUMBER,
+                      ReportRequest)
 from .sensors import Sensor
+from .solvers import (DepthOfField, depth_of_field, entrance_pupil, field_of_view, finite_or_none, focus_error,
+                      invert_limits, lens_at_mark, principal_planes, solve_focus)
 
-__all__ = ["LensReport", "DepthOfField", "solve_lens_report", "takes_report", "REPORT_SCHEMA", "REPORT_VERSION",
-           "HYPERFOCAL", "DIFFRACTION_WAVELENGTH_NM", "airy_diameter_mm", "fstop_airy_equals"]
+__all__ = ["LensReport", "DepthOfField", "ReportRequest", "solve_report", "solve_lens_report", "takes_report",
+           "REPORT_SCHEMA", "REPORT_VERSION", "HYPERFOCAL", "DIFFRACTION_WAVELENGTH_NM", "MIN_F_NUMBER",
+           "MAX_F_NUMBER", "MAX_DISTANCE_MM", "airy_diameter_mm", "fstop_airy_equals"]
 
 #: Real (chief-ray) and pinhole fields of view may differ by this much (percent, any of horizontal,
 #: vertical, diagonal) before the report warns: about what a fitted two-term radial distortion
@@ -54,72 +58,8 @@ REPORT_SCHEMA = "physcam.lens_report"
 #: 3: magnification is signed (negative: the inverted image); a focus at infinity is null with
 #: ``focus_is_infinite``, as is the object distance (issue 15).
 REPORT_VERSION = 3
-#: ``focus_mm=HYPERFOCAL``: focus at the hyperfocal distance of this lens, f-stop and CoC.
-HYPERFOCAL = "hyperfocal"
-#: Wavelength of the report's diffraction figures: 550 nm, near the peak of the eye's photopic
-#: sensitivity (CIE V(lambda) peaks at 555 nm), the usual choice of diffraction-limit tables.
-DIFFRACTION_WAVELENGTH_NM = 550.0
 #: The Airy disk's diameter to its first dark ring is AIRY_FACTOR lambda N (2 x 1.22).
 AIRY_FACTOR = 2.44
-
-
-@dataclass(frozen=True)
-class DepthOfField:
-    """Limits of acceptable sharpness for one circle of confusion.
-
-    ``*_mm`` are from the front principal plane H1, ``*_from_film_mm`` from the film plane;
-    ``far`` is ``inf`` when focused at or beyond the hyperfocal distance.
-    """
-
-    coc_mm: float
-    hyperfocal_mm: float
-    hyperfocal_from_film_mm: float
-    near_mm: float
-    far_mm: float
-    near_from_film_mm: float
-    far_from_film_mm: float
-
-    @property
-    def total_mm(self) -> float:
-        return self.far_mm - self.near_mm
-
-    @property
-    def far_is_infinite(self) -> bool:
-        return math.isinf(self.far_mm)
-
-    def to_dict(self) -> dict:
-        return {
-            "coc_mm": self.coc_mm,
-            "hyperfocal_mm": self.hyperfocal_mm,
-            "hyperfocal_from_film_mm": self.hyperfocal_from_film_mm,
-            "near_mm": self.near_mm,
-            "far_mm": _finite_or_none(self.far_mm),
-            "total_mm": _finite_or_none(self.total_mm),
-            "near_from_film_mm": self.near_from_film_mm,
-            "far_from_film_mm": _finite_or_none(self.far_from_film_mm),
-            "far_is_infinite": self.far_is_infinite,
-        }
-
-
-#: The fastest f-number a lens in air can have: N = 1 / (2 n' sin u') with sin u' <= 1 and n' = 1
-#: (Abbe sine condition; Kingslake & Johnson, *Lens Design Fundamentals*, 2nd ed., 4.3).
-MIN_F_NUMBER = 0.5
-#: The slowest f-number accepted: pinhole cameras reach f/500 or so; beyond f/4096 a typo is likelier.
-MAX_F_NUMBER = 4096.0
-
-
-def _require_f_number(name: str, value) -> float:
-    """``value`` as a float between :data:`MIN_F_NUMBER` and :data:`MAX_F_NUMBER`, else InputError."""
-    v = require_positive(name, value, unit="")
-    if not MIN_F_NUMBER <= v <= MAX_F_NUMBER:
-        why = ("no lens in air is faster than f/0.5 (N = 1 / (2 sin u'), sin u' <= 1)" if v < MIN_F_NUMBER
-               else f"f-numbers above {MAX_F_NUMBER:g} are not camera apertures")
-        raise InputError(f"{name} {v:g} is out of range: {why}")
-    return v
-
-
-def _finite_or_none(v: float | None):
-    return None if v is None or math.isinf(v) else v
 
 
 def airy_diameter_mm(working_f_number, wavelength_nm=DIFFRACTION_WAVELENGTH_NM) -> float:
@@ -326,9 +266,9 @@ class LensReport:
             },
             "coc_mm": self.coc_mm,
             "coc_convention": self.coc_convention,
-            "focus_from_film_mm": _finite_or_none(self.focus_from_film_mm),
+            "focus_from_film_mm": finite_or_none(self.focus_from_film_mm),
             "focus_is_infinite": self.focus_is_infinite,
-            "object_distance_mm": _finite_or_none(self.object_distance_mm),
+            "object_distance_mm": finite_or_none(self.object_distance_mm),
             "image_distance_mm": self.image_distance_mm,
             "h1_from_film_mm": self.h1_from_film_mm,
             "h2_from_film_mm": self.h2_from_film_mm,
@@ -362,477 +302,78 @@ class LensReport:
             "entrance_pupil_source": self.entrance_pupil_source,
             "pivot_camera_space_mm": None if self.pivot_camera_space_mm is None else list(self.pivot_camera_space_mm),
             "solved": dict(self.solved),
-            "measured": {k: _finite_or_none(v) if isinstance(v, float) else v for k, v in self.measured.items()},
+            "measured": {k: finite_or_none(v) if isinstance(v, float) else v for k, v in self.measured.items()},
             "notes": list(self.notes),
             "diffraction": self.diffraction_dict(),
         }
 
 
 # --------------------------------------------------------------------------------------
-def _fov_deg(size, focal_or_image_distance):
-    return math.degrees(2.0 * math.atan(size / (2.0 * focal_or_image_distance)))
+def solve_report(request: ReportRequest) -> LensReport:
+    """Solve the lens report for a :class:`ReportRequest` (checked when it was made): a composition of
+    the solvers of :mod:`physcam.onset.solvers`, in the order the optics needs them.
 
-
-def _dof_block(f, n, c, s, h1_film_at) -> DepthOfField:
-    """DOF for object distance s (from H1, may be infinite); ``h1_film_at(s)`` gives H1's distance
-    from the film."""
-    near, far = _dof.dof_limits(f, n, c, s)
-    H = _dof.hyperfocal_distance(f, n, c)
-    return DepthOfField(
-        coc_mm=c,
-        hyperfocal_mm=H,
-        hyperfocal_from_film_mm=H + h1_film_at(H),
-        near_mm=near,
-        far_mm=far,
-        near_from_film_mm=near + h1_film_at(s),
-        far_from_film_mm=far + h1_film_at(s),
-    )
-
-
-def solve_lens_report(
-    *,
-    focal_length_mm: float,
-    sensor: Sensor,
-    fstop: float | None = None,
-    focus_mm: float | None = None,
-    coc: str | float | None = None,
-    near_mm: float | None = None,
-    far_mm: float | None = None,
-    tstop: float | None = None,
-    squeeze: float = 1.0,
-    model: str = "practical",
-    h1_mm: float | None = None,
-    h2_mm: float | None = None,
-    pupil_mm: float | None = None,
-    reference_plane: str = "film",
-    flange_focal_distance_mm: float | None = None,
-    sensor_front_mm: float | None = None,
-    lens_length_mm: float | None = None,
-    pupil_fraction: float = 0.4,
-    lens_name: str | None = None,
-    lens=None,
-    pinhole_focal_length_mm: float | None = None,
-    pinhole_squeeze: float | None = None,
-    diffraction_wavelength_nm: float = DIFFRACTION_WAVELENGTH_NM,
-    fstop_at_focus: float | None = None,
-) -> LensReport:
-    """Solve the lens report.
-
-    Distances measured on set (``focus_mm``, ``near_mm``, ``far_mm``, ``sensor_front_mm``)
-    are from the film plane. Technical offsets (``h1_mm``, ``h2_mm``, ``pupil_mm``) are
-    in front of ``reference_plane`` ("film" or "flange"; the flange lies
-    ``flange_focal_distance_mm`` in front of the film).
-
-    Solving rules: with a near and/or far limit measured, the report solves the focus
-    (when ``focus_mm`` is missing), then the effective f-stop (when ``fstop`` is missing,
-    or when both fstop and an explicit ``coc`` are given) or else the CoC. Without
-    measured limits it is a forward report and ``fstop`` is required.
-
-    ``pinhole_focal_length_mm`` (and ``pinhole_squeeze``): the best-match pinhole when it is known
-    from elsewhere (a USD file written from a prescription); by default it is computed (see
-    :attr:`LensReport.pinhole`).
-
-    ``lens`` (a :class:`~physcam.lens.prescription.Prescription`) fills the technical
-    model from the lens itself: its Gaussian engine, focused at ``focus_mm`` (unit or
-    internal focusing), gives the effective focal length, H1, H2 and the entrance pupil
-    in front of the film, so no datasheet is needed; ``focal_length_mm`` may then be None
-    and ``fstop`` defaults to the lens's maximum aperture.
-
-    ``diffraction_wavelength_nm`` (default 550): the wavelength of the diffraction figures
-    (Airy disk against the CoC and the photosite pitch; see the module notes).
-
-    The f-stop is the iris's setting, defined at infinity focus (one rule for every consumer:
-    :func:`physcam.optics.focusing.iris_semi_diameter`). Depth of field uses the f-number at the
-    focus (:attr:`LensReport.f_number_at_focus`): an internal-focus prescription's own, or
-    ``fstop_at_focus`` when it is known from elsewhere (a USD file written from a prescription).
+    Solving rules: with a near and/or far limit measured, the report solves the focus (when none is
+    given), then the effective f-stop (when none is given, or when both an f-stop and a CoC are) or
+    else the CoC. Without measured limits it is a forward report and needs an f-stop (a prescription
+    defaults to wide open). The f-stop is the iris's setting, defined at infinity focus
+    (:func:`physcam.optics.focusing.iris_semi_diameter`); depth of field uses the f-number at the
+    focus (:attr:`LensReport.f_number_at_focus`).
     """
-    notes: list[str] = []
-    pupil_origin = "datasheet"
-    lam_diff = require_positive("diffraction wavelength", diffraction_wavelength_nm, unit="nm")
-    if not 200.0 <= lam_diff <= 20000.0:
-        raise InputError(f"diffraction wavelength must lie between 200 and 20000 nm, got {lam_diff:g}")
-    bellows = None
-    lens_pinhole = None  # (Y, X) best-match pinhole focal lengths from a prescription
-    n_ratio = 1.0  # f-number at this focus over the iris's f-stop (internal focusing)
-    from ..errors import require_type
-
-    require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name) or custom_sensor(w, h)")
-    if sensor_front_mm is not None and lens_length_mm is None:
-        raise InputError("the tape-measured sensor-to-lens-front distance needs the lens length too "
-                         "(--lens-length): the pupil estimate sits a fraction of the lens length behind its front")
-    if lens_length_mm is not None and sensor_front_mm is None:
-        raise InputError("the lens length is used only with the sensor-to-lens-front distance (--sensor-front)")
-    squeeze_from_lens = False
-    if lens is not None:
-        from ..lens.prescription import Prescription
-
-        require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name or file)")
-        given = [n for n, v in (("H1", h1_mm), ("H2", h2_mm), ("entrance pupil", pupil_mm),
-                                ("sensor-to-lens-front distance", sensor_front_mm)) if v is not None]
-        if given:
-            raise InputError(f"with a lens prescription the principal planes and the pupil come from the lens; "
-                             f"drop the {', '.join(given)} offset(s), or drop the lens to use a datasheet")
-        if reference_plane != "film" or flange_focal_distance_mm is not None:
-            raise InputError("with a lens prescription every plane is computed from the film; "
-                             "the flange reference applies to datasheet offsets only")
-        pupil_origin = "prescription"
-        from ..optics.focusing import technical_planes
-
-        from ..optics import focusing, paraxial
-
-        if focus_mm is None:
-            raise InputError("with a lens prescription, give the focus mark (--focus)")
-        if fstop is None and near_mm is None and far_mm is None:
-            # wide open: the engraved f-stop, unless the prescription's stop is slower
-            file_n = paraxial.gaussian(lens).f_number
-            fstop = max(file_n, lens.metadata.max_fstop or 0.0)
-            notes.append(f"f-stop not given: wide open at f/{fstop:.3g}")
-        if focus_mm == HYPERFOCAL:
-            D_lens, planes = _lens_hyperfocal(lens, fstop, sensor, coc, near_mm, far_mm)
-        else:
-            D_lens = _require_focus(focus_mm)
-            planes = technical_planes(lens, D_lens, fstop=fstop)
-        focus_mm = D_lens
-        focal_length_mm = planes.efl_mm
-        model, reference_plane = "technical", "film"
-        h1_mm, h2_mm, pupil_mm = planes.h1_from_film_mm, planes.h2_from_film_mm, planes.entrance_pupil_from_film_mm
-        lens_name = lens_name or lens.name
-        notes.append(
-            f"planes from the prescription focused at the mark ({planes.method} focusing): EFL {planes.efl_mm:.3f} mm, "
-            f"back focus {planes.back_focus_mm:.3f} mm"
-        )
-        lens_pinhole = (planes.pinhole_focal_length_mm, planes.pinhole_focal_length_mm)
-        lens_stop = planes.stop_from_film_mm
-        n_ratio = focusing.f_number_ratio(lens, D_lens)
-        # the blur's width over height on the film, desqueezed by the lens's own squeeze: 1 for a
-        # spherical lens; an anamorphic's entrance pupil X over Y (see _pupil_aspect)
-        lens_dof_aspect, lens_squeeze = 1.0, 1.0
-        bellows = planes.working_f_number / planes.f_number * n_ratio  # working f-number over the f-stop
-        if lens.is_anamorphic:
-            # the squeeze the lens really has at this focus: EFL in Y over EFL in X
-            st = focusing.focus(lens, D_lens)
-            gx = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z)
-            lens_squeeze = planes.efl_mm / gx.efl
-            lens_dof_aspect = _pupil_aspect(lens, D_lens)
-        if lens.is_anamorphic and squeeze == 1.0:
-            squeeze_from_lens = True
-            efl_x = gx.efl
-            squeeze = lens_squeeze
-            lens_pinhole = (planes.pinhole_focal_length_mm, gx.pinhole_focal_length)
-            notes.append(
-                f"anamorphic: EFL {planes.efl_mm:.3f} mm (Y) and {efl_x:.3f} mm (X), effective squeeze "
-                f"{squeeze:.4f} (nominal {lens.squeeze:g})"
-            )
-    if focal_length_mm is None:
-        raise InputError("give the focal length (--focal) or a lens (--lens)")
-    f = require_positive("focal length", focal_length_mm)
-    if f > 1.0e5:
-        raise InputError(f"focal length {f:g} mm is beyond any camera lens; give it in mm (e.g. --focal 50)")
-    sq = require_positive("anamorphic squeeze", squeeze, unit="")
-    if not 0.1 <= sq <= 10.0:
-        raise InputError(f"anamorphic squeeze must lie between 0.1 and 10, got {sq:g}")
-    for name, v in (("sensor width", sensor.width_mm), ("sensor height", sensor.height_mm)):
-        if not 0.0 < v <= 1000.0:
-            raise InputError(f"{name} must lie between 0 and 1000 mm, got {v:g}")
-    if model not in ("practical", "technical"):
-        raise InputError(f"model must be 'practical' or 'technical', got {model!r}")
-    w, h = sensor.width_mm, sensor.height_mm
-    coc_explicit = coc is not None
-    c, coc_name = circle_of_confusion(w, h, coc)
-    c, coc_name = _named_coc(w, h, coc, c, coc_name)
-    N = None if fstop is None else _require_f_number("f-stop", fstop)
-    if fstop_at_focus is not None:
-        if lens is not None:
-            raise InputError("with a lens prescription the f-number at the focus is computed from the lens")
-        if N is None:
-            raise InputError("the f-number at the focus needs the f-stop it belongs to")
-        n_ratio = _require_f_number("f-number at the focus", fstop_at_focus) / N
-    T = None if tstop is None else _require_f_number("T-stop", tstop)
-    hyperfocal = focus_mm == HYPERFOCAL
-    if hyperfocal and (N is None or near_mm is not None or far_mm is not None):
-        raise InputError("focus at the hyperfocal distance needs the f-stop (--fstop), and no measured near/far "
-                         "limits (they solve the focus themselves)")
-    D = None if (focus_mm is None or hyperfocal) else _require_focus(focus_mm)
-    near_m = None if near_mm is None else _require_distance("near limit", near_mm)
-    far_m = None
-    if far_mm is not None:
-        far_m = float(far_mm)
-        if math.isnan(far_m) or far_m <= 0:
-            raise InputError(f"far limit must be a positive distance (or inf), got {far_mm!r}")
-        if math.isfinite(far_m):
-            far_m = _require_distance("far limit", far_m)
-    if near_m is not None and far_m is not None and not near_m < far_m:
-        raise InputError(f"near limit {near_m:g} mm must be closer than far limit {far_m:g} mm")
-
-    # --- where H1, H2 and the pupil sit, and how a mark maps to s --------------------
-    ffd = None
-    if reference_plane not in ("film", "flange"):
-        raise InputError(f"reference plane must be 'film' or 'flange', got {reference_plane!r}")
-    if reference_plane == "flange":
-        if flange_focal_distance_mm is None:
-            raise InputError("a flange reference needs the flange focal distance (e.g. 52 mm for PL, 44 mm for LPL)")
-        ffd = require_positive("flange focal distance", flange_focal_distance_mm)
-    ref = ffd or 0.0
-
-    if model == "practical" and (h1_mm is not None or h2_mm is not None):
-        raise InputError("principal-plane offsets (--h1/--h2) belong to the technical model: add --model technical")
-    if pupil_mm is not None and sensor_front_mm is not None:
-        raise InputError("give the entrance pupil either as a datasheet offset (--pupil) or as a tape-measure "
-                         "estimate (--sensor-front/--lens-length), not both")
-    if model == "technical":
-        if h1_mm is None or h2_mm is None:
-            raise InputError("the technical model needs --h1 and --h2 (principal planes from the reference plane)")
-        P1 = ref + require_finite("H1 offset", h1_mm)
-        P2 = ref + require_finite("H2 offset", h2_mm)
-
-        def h1_at(_s):
-            return P1
-
-        def s_for_mark(mark):
-            s = mark - P1
-            if s <= f:
-                raise OpticsError(
-                    f"focus mark {mark:g} mm puts the subject {s:g} mm in front of H1, at or inside the "
-                    f"{f:g} mm focal length: no real image"
-                )
-            return s
-
-        def mark_for_s(s):
-            return s + P1
-
-    else:
-        P1 = P2 = None
-
-        def h1_at(s):
-            return f if math.isinf(s) else thinlens.image_distance(f, s)
-
-        def s_for_mark(mark):
-            return math.inf if math.isinf(mark) else thinlens.object_distance_for_marked(f, mark)
-
-        def mark_for_s(s):
-            return s + h1_at(s)
-
-    def to_h1(d_film, s):
-        """A film-plane distance as a distance from H1 (for the current focus s)."""
-        return d_film - h1_at(s)
-
-    solved: dict = {}
-    measured: dict = {}
-    if near_m is not None:
-        measured["near_from_film_mm"] = near_m
-    if far_m is not None:
-        measured["far_from_film_mm"] = far_m
-
-    # --- focus ----------------------------------------------------------------
-    if hyperfocal:  # the subject plane at H = f^2/(N c) + f from H1 (Wikipedia "Hyperfocal distance")
-        D = mark_for_s(_dof.hyperfocal_distance(f, N * n_ratio, c))
-        solved["focus"] = HYPERFOCAL
-        notes.append(f"focus at the hyperfocal distance: mark {D:.6g} mm from the film")
-    if D is None:
-        if near_m is not None and far_m is not None:
-            # 1/near + 1/far = 2/s about H1; H1 moves with focus in the practical model,
-            # so iterate the film->H1 conversion (converges in a few steps: s' ~ f).
-            s = _solve_focus_from_bracket(near_m, far_m, h1_at, f)
-        elif N is not None and (near_m is not None or far_m is not None):
-            hp = f * f / (N * n_ratio * c)
-            s = _solve_focus_from_one_limit(near_m, far_m, hp, f, h1_at)
-        else:
-            raise InputError(
-                "give a focus distance (--focus), or measured near and far limits (--near, --far), "
-                "or one limit with the f-stop"
-            )
-        D = mark_for_s(s)
-        solved["focus_from_film_mm"] = D
-    s = s_for_mark(D)
-    s_img = f if math.isinf(s) else thinlens.image_distance(f, s)
-    if math.isinf(s) and (near_m is not None or far_m is not None) and "focus_from_film_mm" not in solved:
-        if far_m is not None and math.isfinite(far_m):
-            raise InputError("with the focus at infinity the far limit is infinite; a finite far limit is impossible")
-
-    # --- inversions from measured limits ---------------------------------------------
-    # (a focus solved from one limit and the f-stop used that limit up: nothing is left to invert)
-    focus_from_one_limit = "focus_from_film_mm" in solved and (near_m is None or far_m is None)
-    if (near_m is not None or far_m is not None) and not focus_from_one_limit:
-        hp_near = hp_far = None
-        if near_m is not None and math.isinf(s):
-            hp_near = to_h1(near_m, s)  # focused at infinity the near limit is h itself (s -> inf)
-            if not hp_near > 0:
-                raise InputError("the near limit must lie in front of the lens")
-        elif near_m is not None:
-            hp_near = _dof.hyperfocal_parameter_from_near(f, s, to_h1(near_m, s))
-        if far_m is not None and math.isfinite(far_m):
-            hp_far = _dof.hyperfocal_parameter_from_far(f, s, to_h1(far_m, s))
-        hp = hp_near if hp_near is not None else hp_far
-        if hp is None:
-            raise InputError("an infinite far limit alone cannot give the aperture; measure the near limit too")
-        if hp_near is not None and hp_far is not None:
-            solved["hyperfocal_parameter_from_near_mm"] = hp_near
-            solved["hyperfocal_parameter_from_far_mm"] = hp_far
-            solved["consistency"] = abs(hp_far - hp_near) / hp_near
-            notes.append(
-                "near and far limits agree to {:.1%} in the hyperfocal parameter".format(solved["consistency"])
-            )
-        if N is None or coc_explicit:
-            marked = N
-            N = _dof.f_number_for_dof(f, c, hp) / n_ratio  # the iris's setting (at infinity)
-            solved["fstop"] = N
-            if marked is not None:
-                solved["fstop_drift_stops"] = _dof.stops_between(N, marked)
-        else:
-            c = _dof.coc_for_dof(f, N * n_ratio, hp)
-            coc_name = "solved"
-            solved["coc_mm"] = c
-        if far_m is not None and hp_near is not None:
-            _, far_pred = _dof.dof_limits(f, N * n_ratio, c, s)
-            pred_film = far_pred + h1_at(s)
-            solved["far_predicted_from_film_mm"] = _finite_or_none(pred_film)
-            solved["far_error_mm"] = (
-                0.0 if math.isinf(pred_film) and math.isinf(far_m)
-                else (None if math.isinf(pred_film) or math.isinf(far_m) else pred_film - far_m)
-            )
-    if N is None:
-        raise InputError("give the f-stop (--fstop) or a measured near/far limit to solve it")
-    for name, v in (("f-stop", N), ("circle of confusion", c)):
-        if not (math.isfinite(v) and v > 0):
-            raise InputError(f"the measured limits give an impossible {name} ({v:g}); check --near, --far and --focus")
-    if N < MIN_F_NUMBER:
-        raise InputError(f"the measured limits need f/{N:.3g}, faster than any lens in air can be "
-                         f"(f/{MIN_F_NUMBER:g}); check --near, --far, --focus and the CoC")
-    if T is not None:
-        solved["tstop_drift_stops"] = _dof.stops_between(N, T)
-        if T < N - 1e-9:
+    req = request
+    state = lens_at_mark(req)  # a prescription focused at the mark, or the thin lens / datasheet
+    planes = principal_planes(state)
+    w, h = req.sensor.width_mm, req.sensor.height_mm
+    c, coc_name = _named_coc(w, h, req.coc, *circle_of_confusion(w, h, req.coc))
+    focus = solve_focus(req, state, planes, c)
+    ap = invert_limits(req, state, planes, focus, c, coc_name)
+    solved, notes = {**focus.solved, **ap.solved}, [*state.notes, *focus.notes, *ap.notes]
+    if req.tstop is not None:
+        solved["tstop_drift_stops"] = _dof.stops_between(ap.fstop, req.tstop)
+        if req.tstop < ap.fstop - 1e-9:
             notes.append("the T-stop is faster than the f-stop: a T-stop is never below the f-number")
-
-    # --- depth of field --------------------------------------------------------
-    n_focus = N * n_ratio  # the f-number at this focus: what depth of field depends on
-    if abs(n_ratio - 1.0) > 0.005:
-        notes.append(f"the iris set to f/{N:.3g} (at infinity) makes the lens f/{n_focus:.3g} at this focus "
-                     f"(internal focusing changes its EFL and entrance pupil); depth of field uses f/{n_focus:.3g}")
-    dof = _dof_block(f, n_focus, c, s, h1_at)
-    dof_h = None
-    # desqueezing by sq where the lens squeezes by lens_squeeze stretches its blur by sq / lens_squeeze
-    blur_aspect = lens_dof_aspect * sq / lens_squeeze if lens is not None else 1.0 / sq
-    if sq != 1.0:
-        # A defocused point is blur_aspect as wide as tall in the desqueezed picture, so the
-        # horizontal limits are where the vertical blur reaches c / blur_aspect (docs/lens-report.md,
-        # "Anamorphic depth of field"): deeper for a front anamorphic, the same for a rear one.
-        dof_h = _dof_block(f, n_focus, c / blur_aspect, s, h1_at)
-        notes.append(_anamorphic_dof_note(sq, blur_aspect, c, from_lens=lens is not None))
-    if lens is not None:
-        # a real lens's principal planes move as it focuses: the hyperfocal *mark* is the one focus
-        # whose subject plane lies at H from H1 with the lens focused there (the fixed point that
-        # --focus hyperfocal sets), the same whatever the report's own focus; H is given from H1
-        # of the lens focused there. A lens that cannot focus there keeps H + H1 at this focus.
-        import dataclasses
-
-        try:
-            mark, planes_h = _lens_hyperfocal_mark(lens, N, c)
-            dof = dataclasses.replace(dof, hyperfocal_mm=mark - planes_h.h1_from_film_mm,
-                                      hyperfocal_from_film_mm=mark)
-            if dof_h is not None:
-                mark, planes_h = _lens_hyperfocal_mark(lens, N, c, blur_aspect=None if squeeze_from_lens
-                                                       else blur_aspect)
-                dof_h = dataclasses.replace(dof_h, hyperfocal_mm=mark - planes_h.h1_from_film_mm,
-                                            hyperfocal_from_film_mm=mark)
-        except (OpticsError, InputError) as exc:
-            notes.append(f"hyperfocal distance given as H plus H1 at this focus: the lens has no hyperfocal mark "
-                         f"here ({str(exc).splitlines()[0]})")
-
-    # --- focus error (technical) ------------------------------------------------
-    if model == "technical":
-        h1_film, h2_film = P1, P2
-        if P2 <= 0:
-            raise InputError(f"H2 must lie in front of the film plane, got {P2:g} mm; check --h2 and --reference")
-        focus_error = P2 - s_img  # where the sharp image lies, in front of the film (+)
-        if abs(focus_error) > 1e-6:
-            notes.append(
-                f"with these principal planes the sharp image lies {abs(focus_error):.3f} mm "
-                f"{'in front of' if focus_error > 0 else 'behind'} the film plane"
-            )
-    else:
-        h1_film = h2_film = s_img
-        focus_error = 0.0
-
-    # --- the best-match pinhole and the field of view -----------------------------------
-    # One definition (docs/lens-report.md, "The best-match pinhole"): the pinhole at the entrance
-    # pupil that frames like the lens at this focus, f_pin = n (film - exit pupil) / (n' m_p)
-    # (optics.paraxial.GaussianData.pinhole_focal_length). A prescription gives it exactly, per
-    # meridian; a thin lens or a datasheet (pupils taken on the principal planes, m_p = 1) gives the
-    # distance from H2 to the film, s' when the film is in focus.
-    pin_y, pin_x = lens_pinhole if lens_pinhole is not None else (h2_film, h2_film)
-    # an anamorphic prescription frames each meridian by its own pinhole; their ratio is the squeeze
-    pin_sq = pin_y / pin_x if pin_x != pin_y else sq
-    if pinhole_focal_length_mm is not None:
-        if lens is not None:
-            raise InputError("with a lens prescription the best-match pinhole is computed from the lens")
-        pin_y = require_positive("pinhole focal length", pinhole_focal_length_mm)
-        pin_sq = sq if pinhole_squeeze is None else require_positive("pinhole squeeze", pinhole_squeeze, unit="")
-    wd = w * sq
-    dg = math.hypot(wd, h)
-    wp = w * pin_sq
-    fov = dict(
-        hfov_inf_deg=_fov_deg(wd, f),
-        vfov_inf_deg=_fov_deg(h, f),
-        dfov_inf_deg=_fov_deg(dg, f),
-        hfov_focus_deg=_fov_deg(wp, pin_y),
-        vfov_focus_deg=_fov_deg(h, pin_y),
-        dfov_focus_deg=_fov_deg(math.hypot(wp, h), pin_y),
-    )
-
-    # --- entrance pupil -----------------------------------------------------------
-    pupil, pupil_src = None, "unknown"
-    if pupil_mm is not None:  # a datasheet pupil (either model), or the prescription's
-        pupil, pupil_src = ref + require_finite("entrance pupil offset", pupil_mm), pupil_origin
-    elif sensor_front_mm is not None and lens_length_mm is not None:
-        pupil = entrance_pupil_practical(sensor_front_mm, lens_length_mm, pupil_fraction)
-        pupil_src = f"estimate: {pupil_fraction:g} of the lens length behind its front"
-    elif model == "practical":
-        pupil, pupil_src = h1_film, "thin lens: at the principal plane"
-    if pupil is None:
-        notes.append("no entrance pupil: give --pupil (technical) or --sensor-front and --lens-length")
-
+    dof = depth_of_field(req, state, planes, focus, ap)
+    h1_film, h2_film, error, error_notes = focus_error(planes, focus)
+    pupil, pupil_src, pupil_notes = entrance_pupil(req, state, h1_film)
+    s, n_focus = focus.object_distance, ap.fstop * state.n_ratio
     report = LensReport(
-        model=model,
-        focal_length_mm=f,
-        fstop=N,
-        sensor=sensor,
-        squeeze=sq,
-        coc_mm=c,
-        coc_convention=coc_name,
-        focus_from_film_mm=D,
-        object_distance_mm=s,
-        image_distance_mm=s_img,
-        h1_from_film_mm=h1_film,
-        h2_from_film_mm=h2_film,
-        focus_error_mm=focus_error,
-        magnification=0.0 if math.isinf(s) else -f / (s - f),
-        dof=dof,
-        dof_horizontal=dof_h,
-        entrance_pupil_from_film_mm=pupil,
-        entrance_pupil_source=pupil_src,
-        solved=solved,
-        measured=measured,
-        notes=tuple(notes),
-        lens_name=lens_name,
-        reference_plane=reference_plane,
-        flange_focal_distance_mm=ffd,
-        tstop=T,
-        pinhole_focal_length_mm=pin_y,
-        pinhole_squeeze=pin_sq,
-        stop_from_film_mm=(lens_stop if lens is not None else (h1_film if model == "practical" else None)),
-        dof_aspect=blur_aspect,
-        diffraction_wavelength_nm=lam_diff,
-        bellows_factor=bellows,
-        fstop_at_focus=None if n_ratio == 1.0 else n_focus,
-        **fov,
-    )
-    import dataclasses
-
+        model=state.model, focal_length_mm=state.focal_length_mm, fstop=ap.fstop, sensor=req.sensor,
+        squeeze=state.squeeze, coc_mm=ap.coc_mm, coc_convention=ap.coc_convention, focus_from_film_mm=focus.mark,
+        object_distance_mm=s, image_distance_mm=focus.image_distance, h1_from_film_mm=h1_film,
+        h2_from_film_mm=h2_film, focus_error_mm=error,
+        magnification=0.0 if math.isinf(s) else -state.focal_length_mm / (s - state.focal_length_mm),
+        dof=dof.dof, dof_horizontal=dof.horizontal, entrance_pupil_from_film_mm=pupil,
+        entrance_pupil_source=pupil_src, solved=solved, measured=_measured(req),
+        notes=(*notes, *dof.notes, *error_notes, *pupil_notes), lens_name=state.lens_name,
+        reference_plane="film" if req.lens is not None else req.reference_plane,
+        flange_focal_distance_mm=req.flange_focal_distance_mm, tstop=req.tstop,
+        stop_from_film_mm=state.stop_from_film_mm if req.lens is not None else (
+            h1_film if state.model == "practical" else None),
+        dof_aspect=dof.blur_aspect, diffraction_wavelength_nm=req.diffraction_wavelength_nm,
+        bellows_factor=state.bellows, fstop_at_focus=None if state.n_ratio == 1.0 else n_focus,
+        **field_of_view(req, state, h2_film))
     report = dataclasses.replace(report, notes=report.notes + (report.diffraction_note(),))
-    if lens is not None:
-        report = _with_real_fov(report, lens)
+    if req.lens is not None:
+        report = _with_real_fov(report, req.lens)
     _check_finite(report)
     return report
+
+
+def solve_lens_report(**inputs) -> LensReport:
+    """``solve_report(ReportRequest(**inputs))``: the report from keyword inputs (the fields of
+    :class:`ReportRequest`; distances on set from the film plane, datasheet offsets from the
+    reference plane). Front ends build the request themselves."""
+    return solve_report(ReportRequest(**inputs))
+
+
+def _measured(req: ReportRequest) -> dict:
+    """The limits measured on set, from the film plane."""
+    out = {}
+    if req.near_mm is not None:
+        out["near_from_film_mm"] = req.near_mm
+    if req.far_mm is not None:
+        out["far_from_film_mm"] = req.far_mm
+    return out
 
 
 def _with_real_fov(report: LensReport, lens) -> LensReport:
@@ -862,19 +403,18 @@ def _with_real_fov(report: LensReport, lens) -> LensReport:
            "pinhole, so the render camera frames the centre like the lens but not the edges")
     if real.not_covered:
         msg += f"; the sensor's {', '.join(real.not_covered)} lie outside the lens's image circle"
-    warnings.warn(msg, PhysCamWarning, stacklevel=3)
+    warnings.warn(msg, PhysCamWarning, stacklevel=_caller_level())
     return dataclasses.replace(report, notes=report.notes + (msg,))
 
 
-#: Largest finite distance the report accepts (1000 km); beyond it use infinity.
-MAX_DISTANCE_MM = 1.0e9
+def _caller_level() -> int:
+    """The warnings stack level of the first caller outside ``physcam.onset`` (the user's line)."""
+    import sys
 
-
-def _require_focus(value) -> float:
-    """A focus mark: a positive distance up to :data:`MAX_DISTANCE_MM`, or infinity."""
-    if isinstance(value, (int, float)) and not isinstance(value, bool) and value == math.inf:
-        return math.inf
-    return _require_distance("focus distance", value)
+    frame, level = sys._getframe(1), 1
+    while frame.f_back is not None and frame.f_globals.get("__name__", "").startswith("physcam.onset"):
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 def _named_coc(w, h, given, c, name):
@@ -889,107 +429,6 @@ def _named_coc(w, h, given, c, name):
         if abs(c - v) <= 1e-6 * v:
             return c, key
     return c, name
-
-
-def _lens_hyperfocal(lens, fstop, sensor, coc, near_mm, far_mm):
-    """(mark, planes): the focus mark of ``lens`` whose subject plane is at the hyperfocal distance
-    H = f^2/(N c) + f from H1, with f and H1 of the lens focused at that mark (fixed point; the
-    planes move little with focus, so a few steps converge to 1e-9 of the mark)."""
-    from ..optics.coc import circle_of_confusion
-    from ..optics.focusing import technical_planes
-
-    if near_mm is not None or far_mm is not None:
-        raise InputError("focus at the hyperfocal distance takes no measured near/far limits")
-    n = _require_f_number("f-stop", fstop)
-    c, _ = circle_of_confusion(sensor.width_mm, sensor.height_mm, coc)
-    mark, _ = _lens_hyperfocal_mark(lens, n, c)
-    return mark, technical_planes(lens, mark, fstop=n)
-
-
-@lru_cache(maxsize=64)  # a hyperfocal focus solves it, and its report's DOF block asks again
-def _lens_hyperfocal_mark(lens, n: float, c: float, *, blur_aspect: float | None = 1.0):
-    """(mark, planes at the mark) of :func:`_lens_hyperfocal` for f-number ``n`` and CoC ``c`` (mm).
-
-    The planes (EFL, H1) do not depend on the f-number, so they are found without it (any f-number
-    the lens can or cannot open to gives the same mark); ``n`` is the iris's setting at infinity, and
-    the f-number at each candidate mark is n times the lens's f-number ratio there (internal focusing).
-    ``blur_aspect``: the CoC is ``c / blur_aspect`` (an anamorphic's horizontal limits, the blur's
-    width over height in the desqueezed picture); None takes the lens's own blur aspect at each mark
-    (its entrance pupil's X over Y diameter, as the report does), so the horizontal mark too is a
-    fixed point."""
-    from ..optics.focusing import f_number_ratio, technical_planes
-
-    mark = math.inf
-    for _ in range(50):
-        planes = technical_planes(lens, mark)
-        aspect = _pupil_aspect(lens, mark) if blur_aspect is None else blur_aspect
-        n_at = n * f_number_ratio(lens, mark)
-        new = _dof.hyperfocal_distance(planes.efl_mm, n_at, c / aspect) + planes.h1_from_film_mm
-        new = _require_distance("hyperfocal focus mark", new)
-        if math.isfinite(mark) and abs(new - mark) <= 1e-9 * new:
-            return new, technical_planes(lens, new)
-        mark = new
-    raise OpticsError(f"the hyperfocal focus of {lens.name!r} did not settle; give the focus mark")
-
-
-def _pupil_aspect(lens, mark: float) -> float:
-    """An anamorphic lens's blur aspect at focus ``mark``: its entrance pupil's X over Y diameter
-    (one round stop seen through each meridian; the ratio does not depend on the stop's size)."""
-    from ..optics import focusing, paraxial
-
-    st = focusing.focus(lens, mark)
-    gx, gy = (paraxial.gaussian(st.prescription, axis=a, object_z=st.object_z, film_z=st.film_z) for a in "xy")
-    return gx.entrance_pupil_diameter / gy.entrance_pupil_diameter
-
-
-def _anamorphic_dof_note(sq: float, aspect: float, c: float, *, from_lens: bool) -> str:
-    """Why the horizontal limits differ from the vertical ones (or do not)."""
-    source = ("the lens's entrance pupil, X over Y" if from_lens else
-              "a front anamorphic's narrowed pupil, 1 / squeeze; a rear anamorphic's blur is round: give --lens")
-    return (f"anamorphic {sq:g}x: a defocused point is {aspect:.3g} as wide as tall in the desqueezed picture "
-            f"({source}), so the horizontal limits take the CoC c / {aspect:.3g} = {c / aspect:.4g} mm")
-
-
-def _require_distance(name: str, value) -> float:
-    v = require_positive(name, value)
-    if v > MAX_DISTANCE_MM:
-        raise InputError(f"{name} {v:g} mm is beyond 1000 km; for a subject at infinity use a far limit of inf")
-    return v
-
-
-def _solve_focus_from_bracket(near_film, far_film, h1_at, f):
-    p = f  # first guess for H1's distance from the film
-    for _ in range(100):
-        n, F = near_film - p, far_film - p
-        if n <= f:
-            raise OpticsError("the measured near limit is inside the focal length")
-        s = float(_dof.focus_for_dof_limits(n, F))
-        p_new = h1_at(s)
-        if abs(p_new - p) < 1e-10 * max(1.0, p):
-            return s
-        p = p_new
-    raise OpticsError("could not solve the focus distance from the near/far bracket")
-
-
-def _solve_focus_from_one_limit(near_film, far_film, hp, f, h1_at):
-    p = f
-    for _ in range(100):
-        if near_film is not None:
-            n = near_film - p
-            if not 0 < n < hp:
-                raise InputError(
-                    "the near limit lies beyond the hyperfocal parameter f^2/(N c) (focus at infinity): "
-                    "no focus gives it; check the near limit, f-stop and CoC"
-                )
-            s = n * (hp - f) / (hp - n)
-        else:
-            F = far_film - p
-            s = F * (hp + f) / (hp + F)
-        p_new = h1_at(s)
-        if abs(p_new - p) < 1e-10 * max(1.0, p):
-            return s
-        p = p_new
-    raise OpticsError("could not solve the focus distance from the measured limit")
 
 
 def _check_finite(report: LensReport) -> None:

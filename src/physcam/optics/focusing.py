@@ -24,6 +24,7 @@ Focus breathing: the effective focal length and the horizontal field of view
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import asdict, dataclass
 
@@ -46,6 +47,8 @@ __all__ = [
     "gaussian_at_focus",
     "technical_planes",
     "breathing_table",
+    "pupil_aspect",
+    "hyperfocal_mark",
 ]
 
 FOCUS_METHODS = ("auto", "unit", "internal")
@@ -495,3 +498,45 @@ def gaussian_hfov_infinity(prescription: Prescription, sensor_width_mm: float, m
     """Horizontal field of view (degrees, X meridian) at infinity focus."""
     st = focus(prescription, math.inf, method=method, axis="y", wavelength_nm=wavelength_nm)
     return math.degrees(2.0 * abs(paraxial.field_angle(st.prescription, sensor_width_mm / 2.0, st.film_z, "x", wavelength_nm)))
+
+
+def pupil_aspect(prescription: Prescription, focus_from_film_mm: float) -> float:
+    """An anamorphic lens's blur aspect at a focus mark: its entrance pupil's X over Y diameter (one
+    round stop seen through each meridian; the ratio does not depend on the stop's size). 1 for a
+    rotationally symmetric lens."""
+    st = focus(prescription, focus_from_film_mm)
+    gx, gy = (paraxial.gaussian(st.prescription, axis=a, object_z=st.object_z, film_z=st.film_z) for a in "xy")
+    return gx.entrance_pupil_diameter / gy.entrance_pupil_diameter
+
+
+#: The farthest hyperfocal mark solved (1000 km, the on-set report's largest distance).
+_MAX_MARK_MM = 1.0e9
+
+
+@functools.lru_cache(maxsize=64)  # a hyperfocal focus solves it, and its report's DOF block asks again
+def hyperfocal_mark(prescription: Prescription, fstop: float, coc_mm: float, *, blur_aspect: float | None = 1.0):
+    """(mark, planes at the mark): the focus mark whose subject plane lies at the hyperfocal distance
+    H = f^2/(N c) + f from H1 (Wikipedia, "Hyperfocal distance"), with f and H1 of the lens focused at
+    that mark: a fixed point (the planes move little with focus; a few steps reach 1e-9 of the mark).
+
+    ``fstop`` is the iris's setting at infinity; the f-number at each candidate mark is ``fstop``
+    times :func:`f_number_ratio` there (internal focusing). ``blur_aspect``: the CoC is ``coc_mm /
+    blur_aspect`` (an anamorphic's horizontal limits); None takes the lens's own :func:`pupil_aspect`
+    at each mark, so the horizontal mark too is a fixed point."""
+    from . import dof
+
+    n = require_positive("f-stop", fstop, unit="")
+    c = require_positive("circle of confusion", coc_mm)
+    mark = math.inf
+    for _ in range(50):
+        planes = technical_planes(prescription, mark)
+        aspect = pupil_aspect(prescription, mark) if blur_aspect is None else blur_aspect
+        new = dof.hyperfocal_distance(planes.efl_mm, n * f_number_ratio(prescription, mark), c / aspect)
+        new += planes.h1_from_film_mm
+        if not 0.0 < new <= _MAX_MARK_MM:
+            raise InputError(f"hyperfocal focus mark {new:g} mm is beyond 1000 km; for a subject at infinity use a "
+                             "far limit of inf")
+        if math.isfinite(mark) and abs(new - mark) <= 1e-9 * new:
+            return new, technical_planes(prescription, new)
+        mark = new
+    raise OpticsError(f"the hyperfocal focus of {prescription.name!r} did not settle; give the focus mark")
