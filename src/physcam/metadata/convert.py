@@ -79,25 +79,48 @@ def solve(record, *, sensor=None, lens=None, coc=None, focal_length_mm=None, fst
     ``sensor``: when the file gives no sensor area; ``lens``: a Prescription (its breathing),
     else a thin lens of the recorded focal length (``focal_length_mm`` when the file has none);
     ``fstop``: when the file has no stop. A frame without a focus distance is refused."""
-    from dataclasses import replace
-
-    from ..live.record import SolvedFrame
     from ..onset.report import solve_lens_report
 
     record = _record(record)
     s = _sensor_of(record, sensor)
     frames = tracked_frames(record, rate=rate)
     squeeze = record.squeeze if record.squeeze else 1.0
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        out = _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze, solve_lens_report)
+    _warn_once(caught)
+    return out
+
+
+def _warn_once(caught) -> None:
+    """Re-issue the warnings of many frames once each kind (the first 40 characters), with a count."""
+    import warnings
+
+    kinds: dict = {}
+    for w in caught:
+        kinds.setdefault((w.category, str(w.message)[:40]), []).append(w)
+    for (cat, _), ws in kinds.items():
+        more = f" (and {len(ws) - 1} more frames like it)" if len(ws) > 1 else ""
+        warnings.warn(f"{ws[0].message}{more}", cat, stacklevel=3)
+
+
+def _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze, solve_lens_report):
+    from dataclasses import replace
+
+    from ..live.record import SolvedFrame
+
     cache: dict = {}
     out = []
     for i, (f, tf) in enumerate(zip(record.frames, frames)):
         where = f"{record.files[0]}: frame {i} (line {f.line})"
         n, note = dof_stop(f, fstop)
         focal = None if lens is not None else (f.focal_length_mm or record.nominal_focal_length_mm or focal_length_mm)
-        missing = [w for w, v in (("a focus distance", f.focus_mm), ("a stop (--fstop)", n),
-                                  ("a focal length (--focal or --lens)", focal if lens is None else 1.0)) if v is None]
+        missing = [w for w, v in (("focus distance", f.focus_mm), ("stop (give --fstop)", n),
+                                  ("focal length (give --focal or --lens)", focal if lens is None else 1.0)) if v is None]
         if missing:
-            raise MetadataError(f"frame {i} gives no {' and no '.join(missing)}", record.files[0],
+            raise MetadataError(f"frame {i} records no {' and no '.join(missing)}", record.files[0],
                                 f.line if record.source != "mosys" else None)
         tstop = f.tstop if f.tstop is not None and f.tstop >= n else None
         key = (f.focus_mm, n, tstop, focal, f.entrance_pupil_mm)
