@@ -23,7 +23,7 @@ from __future__ import annotations
 import re
 from fractions import Fraction
 
-from ..errors import MetadataError
+from ..errors import MetadataError, require_type
 from ._text import FOOT_MM, number, read_text, require_columns, rows, stop_from_marking, timecode
 from .record import ClipRecord, FrameSample
 
@@ -38,6 +38,7 @@ _FT_IN = re.compile(r"""^\s*(\d+(?:\.\d+)?)\s*'\s*(?:(\d+(?:\.\d+)?)\s*"?)?\s*$"
 
 def sniff(head: str) -> bool:
     """True when ``head`` (the file's first line) is an AME header."""
+    require_type("head", head, str, "the first bytes of a metadata file")
     cols = head.split("\t")
     return "Master TC" in cols and "Lens Focus Distance" in cols
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import re
 from fractions import Fraction
 
-from ..errors import MetadataError
+from ..errors import MetadataError, require_type
 from ._text import number, read_text, timecode
 from .record import ClipRecord, FrameSample
 
@@ -25,6 +25,7 @@ _LINE = re.compile(r"^([^:]+): ?(.*)$")
 
 
 def sniff(head: str) -> bool:
+    require_type("head", head, str, "the first bytes of a metadata file")
     return any(line.strip() == "Clip Metadata" for line in head.splitlines()[:5]) or \
         any(_FRAME.match(line.strip()) for line in head.splitlines()[:5])
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import struct
 
-from ..errors import MetadataError
+from ..errors import MetadataError, require_type
 from ._text import number, read_text, require_columns, rows, timecode
 from .record import ClipRecord, FrameSample
 
@@ -28,6 +28,7 @@ SQUEEZE = {0: 1.0, 1: 1.33, 2: 2.0, 3: 1.8}
 
 
 def sniff(head: str) -> str | None:
+    require_type("head", head, str, "the first bytes of a metadata file")
     cols = head.split(",")
     if "FocusPosition" in cols and "ApertureNumber" in cols:
         return "frames"

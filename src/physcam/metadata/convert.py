@@ -37,6 +37,9 @@ def _record(record) -> ClipRecord:
 
 def dof_stop(sample, default=None) -> tuple[float | None, str | None]:
     """(f-number for depth of field, note): the f-stop, else the T-stop (noted), else ``default``."""
+    from .record import FrameSample
+
+    require_type("sample", sample, FrameSample, "a frame of physcam.metadata.load(paths).frames")
     if sample.fstop is not None:
         return sample.fstop, None
     if sample.tstop is not None:

@@ -25,7 +25,7 @@ agrees (its focus 424 mm beside REDline's own 410 mm column, its near and far 41
 
 from __future__ import annotations
 
-from ..errors import MetadataError
+from ..errors import MetadataError, require_type
 from .record import CookeData
 
 __all__ = ["decode", "parse_hex"]
@@ -47,6 +47,7 @@ def _distance(b: bytes, start: int) -> float | None:
 
 def parse_hex(path, line, text: str) -> bytes:
     """REDline's "64/40/40/..." as bytes."""
+    require_type("text", text, str, 'slash-separated hex bytes, "64/40/..."')
     try:
         return bytes(int(x, 16) for x in text.strip().split("/"))
     except ValueError:
@@ -55,6 +56,7 @@ def parse_hex(path, line, text: str) -> bytes:
 
 def decode(data: bytes, path=None, line=None) -> CookeData:
     """The :class:`CookeData` of one ``Kd`` response (module notes)."""
+    require_type("data", data, (bytes, bytearray), "the bytes of a Cooke /i Kd response")
     if len(data) < 29 or data[0] != ord("d"):
         raise MetadataError(f"Cooke /i data of {len(data)} bytes is not a 'd' lens-data response", path, line)
     sign = -1 if data[25] & 0b0010_0000 else 1

@@ -25,7 +25,7 @@ import struct
 from fractions import Fraction
 from pathlib import Path
 
-from ..errors import MetadataError
+from ..errors import MetadataError, require_type
 from .record import ClipRecord, FrameSample, TrackerPose
 
 __all__ = ["sniff", "read"]
@@ -39,6 +39,7 @@ MAX_PACKETS = 1_000_000
 
 def sniff(head: bytes) -> bool:
     """True when ``head`` starts with one well-formed F4 packet."""
+    require_type("head", head, bytes, "the first bytes of a metadata file")
     return _packet_size(head, 0) is not None
 
 

@@ -133,6 +133,12 @@ class ClipRecord:
 def timecode_frames(timecode: str, rate) -> int:
     """Frames since 00:00:00:00 of a non-drop-frame ``HH:MM:SS:FF`` timecode at ``rate`` fps
     (the nominal integer rate counts the frames: 23.976 counts 24)."""
-    h, m, s, f = (int(p) for p in timecode.replace(";", ":").split(":"))
+    from ..errors import InputError, require_type
+
+    require_type("timecode", timecode, str, '"HH:MM:SS:FF"')
+    try:
+        h, m, s, f = (int(p) for p in timecode.replace(";", ":").split(":"))
+    except ValueError:
+        raise InputError(f"timecode {timecode!r} is not HH:MM:SS:FF") from None
     nominal = math.ceil(Fraction(rate) - Fraction(1, 10**6))
     return ((h * 60 + m) * 60 + s) * nominal + f

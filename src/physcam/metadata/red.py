@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from ..errors import MetadataError
+from ..errors import MetadataError, require_type
 from . import cooke
 from ._text import number, read_text, require_columns, rows, timecode
 from .record import ClipRecord, FrameSample
@@ -34,6 +34,7 @@ PITCH_UM = {"MONSTRO 8K VV": 5.0, "HELIUM 8K S35": 3.65, "GEMINI 5K S35": 6.0, "
 
 def sniff(head: str) -> str | None:
     """"frames" or "static" when ``head`` is a REDline header, else None."""
+    require_type("head", head, str, "the first bytes of a metadata file")
     cols = head.split(",")
     if "FrameNo" in cols and "Focus Distance" in cols:
         return "frames"

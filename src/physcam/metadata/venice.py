@@ -18,7 +18,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from fractions import Fraction
 
-from ..errors import MetadataError
+from ..errors import MetadataError, require_type
 from ._text import FOOT_MM, number, read_text, rows, stop_from_marking, timecode
 from .record import ClipRecord, FrameSample
 
@@ -30,6 +30,7 @@ COLUMNS = ("Timecode", "Focal Length (mm)", "Aperture")
 
 def sniff(head: str) -> str | None:
     """"csv" or "xml" when ``head`` (the first 2 kB) is a VENICE export, else None."""
+    require_type("head", head, str, "the first bytes of a metadata file")
     if "NonRealTimeMeta" in head:
         return "xml"
     first = head.splitlines()[0] if head else ""
