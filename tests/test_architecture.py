@@ -19,7 +19,7 @@ LAYER = {
     "analysis": 6, "onset": 6,
     "export": 7,
     "usd": 8,
-    "live": 8.5,
+    "live": 8.5, "metadata": 8.5,
     "characterize": 9,
     "serve": 9,
     "cli": 10,

@@ -17,6 +17,7 @@ __all__ = [
     "OpticsError",
     "SensorError",
     "LensFileError",
+    "MetadataError",
     "ExportError",
     "BackendError",
     "PhysCamWarning",
@@ -60,6 +61,30 @@ class LensFileError(PhysCamError):
         where = ""
         if self.path is not None:
             where = self.path if line is None else f"{self.path}:{line}"
+            where += ": "
+        super().__init__(where + message)
+
+
+class MetadataError(InputError):
+    """A camera metadata file (physcam.metadata) could not be read: truncated, an unknown layout, not
+    the format it claims, a unit other than the one expected.
+
+    ``path`` and ``line`` (1-based; for a binary file the byte offset, ``line`` None) say where.
+    """
+
+    def __init__(self, message: str, path: str | None = None, line: int | None = None,
+                 offset: int | None = None):
+        self.path = None if path is None else str(path)
+        self.line = line
+        self.offset = offset
+        self.reason = message
+        where = ""
+        if self.path is not None:
+            where = self.path
+            if line is not None:
+                where += f":{line}"
+            elif offset is not None:
+                where += f": byte {offset}"
             where += ": "
         super().__init__(where + message)
 

@@ -96,6 +96,12 @@ JSON_RUNS = {
     ("microlens", "render"): ["microlens", "render", "lf0.json", "--fstop", "5.6", "--point", "1m", "--rays", "2000",
                               "--pixels-per-lenslet", "3"],
     ("characterize",): ["characterize", "dgauss_50mm", "--focus", "1m,inf", "--fstop", "2.8", "-o", "lib", "--dry-run"],
+    ("metadata", "show"): ["metadata", "show", str(REPO / "tests/data/camera-metadata/red/A001_C066_0303LZ_001.frames.csv"),
+                           str(REPO / "tests/data/camera-metadata/red/A001_C066_0303LZ_001.static.csv")],
+    ("metadata", "report"): ["metadata", "report", str(REPO / "tests/data/camera-metadata/red/A001_C066_0303LZ_001.frames.csv"),
+                             str(REPO / "tests/data/camera-metadata/red/A001_C066_0303LZ_001.static.csv")],
+    ("metadata", "usd"): ["metadata", "usd", str(REPO / "tests/data/camera-metadata/bmd/metadata.txt"), "-o", "clip.usda",
+                          "--plate", "plate.mov", "--plate-frames", "1-1"],
     ("export", "mitsuba"): ["export", "mitsuba", "-o", "mit", "--focal", "50", "--fstop", "2.8", "--focus", "3m",
                             "--width-px", "64"],
 }
@@ -123,6 +129,7 @@ CSV_ROWS = {
     ("breathing-real",): "rows", ("ghosts",): "paths", ("distortion",): "points", ("compare", "lenses"): "lenses",
     ("export", "unreal"): "lens_file.physcam.marks", ("mtf",): "points", ("lens", "show"): "points",
     ("config", "show"): "rows",
+    ("metadata", "show"): "frames", ("metadata", "report"): "frames",
 }
 #: Commands that take a focus but print no distance (so no --units), and why.
 NO_UNITS = {
@@ -142,6 +149,8 @@ OTHER_SENSOR_DEFAULT = {
     ("live", "record"): "the stream's sensor, when it carries one",
     ("live", "play"): "the recording's sensor",
     ("lens", "check"): "optional: with a sensor the check adds a corner probe",
+    ("metadata", "report"): "the clip's recorded sensor area when the file gives it",
+    ("metadata", "usd"): "the clip's recorded sensor area when the file gives it",
 }
 
 

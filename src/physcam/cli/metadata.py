@@ -1,0 +1,235 @@
+"""``physcam metadata``: camera metadata recorded with real clips (docs/camera-metadata.md)."""
+
+from __future__ import annotations
+
+from ._common import LENS_HELP, add_sensor_options, add_units_option, distance, number
+from ._output import add_output_options, document, emit_json
+from .report import add_coc_option
+
+EPILOG = """\
+examples:
+  physcam metadata show B001C001_180327_R1ZA.mov.csv
+  physcam metadata show A001_C066_0303LZ_001.frames.csv A001_C066_0303LZ_001.static.csv --json
+  physcam metadata report B001C001_180327_R1ZA.mov.csv --csv
+  physcam metadata usd B001C001_180327_R1ZA.mov.csv -o shot.usda --plate plates/B001C001.####.exr --plate-frames 1001-1500
+  physcam metadata opentrackio B001C001_180327_R1ZA.mov.csv -o take.jsonl
+Formats are told from the files' content: ARRI Meta Extract, REDline, Sony VENICE, Canon,
+Blackmagic RAW ExtractMetadata, Mo-Sys F4. Give the files of one clip together.
+"""
+
+
+def _frame_range(text):
+    import argparse
+
+    a, sep, b = str(text).partition("-")
+    try:
+        first, last = int(a), int(b)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"plate frames must be FIRST-LAST (1001-1500), got {text!r}") from None
+    if not sep or first < 0 or last < first:
+        raise argparse.ArgumentTypeError(f"plate frames must be FIRST-LAST with FIRST <= LAST, got {text!r}")
+    return first, last
+
+
+def _clip_args(p) -> None:
+    p.add_argument("clip", nargs="+", metavar="FILE",
+                   help="the clip's metadata file(s): one export, or the files of one clip together")
+
+
+def _solve_args(p) -> None:
+    p.add_argument("--lens", default=None, metavar="NAME_OR_FILE",
+                   help=LENS_HELP + "; optional: without it a thin lens of the recorded focal length")
+    add_sensor_options(p)
+    p.add_argument("--focal", type=distance("focal length"), default=None,
+                   help="focal length when the file records none (mm, or with units)")
+    p.add_argument("--fstop", type=number("f-stop", positive=True), default=None,
+                   help="f-stop when the file records no stop")
+    p.add_argument("--fps", type=number("frame rate", positive=True, hi=1000.0), default=None,
+                   help="frame rate when the file records none")
+    add_coc_option(p)
+
+
+def register(sub) -> None:
+    import argparse
+
+    p = sub.add_parser("metadata", help="camera metadata of real clips: show, lens report, USD, OpenTrackIO",
+                       description="Read the per-frame lens metadata cameras record (ARRI, RED with Cooke /i, Sony "
+                                   "VENICE, Canon, Blackmagic RAW, Mo-Sys F4) and turn it into lens reports, an "
+                                   "animated USD camera or OpenTrackIO samples (docs/camera-metadata.md).",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    s = p.add_subparsers(dest="metadata_command", metavar="ACTION")
+
+    sh = s.add_parser("show", help="the clip's static values and per-frame samples")
+    _clip_args(sh)
+    add_output_options(sh, csv=True, what="the clip")
+    sh.set_defaults(handler=run_show)
+
+    r = s.add_parser("report", help="the on-set lens report of every frame (DOF, hyperfocal, FOV with breathing)")
+    _clip_args(r)
+    _solve_args(r)
+    add_units_option(r)
+    add_output_options(r, csv=True, what="the report")
+    r.set_defaults(handler=run_report)
+
+    u = s.add_parser("usd", help="one animated PhysicalCamera (focus and iris pulls, breathing, tracker pose)")
+    _clip_args(u)
+    u.add_argument("-o", "--output", dest="file", required=True, help="output .usda/.usd/.usdc")
+    _solve_args(u)
+    u.add_argument("--plate", default=None, metavar="PATH", help="the plate (image sequence or movie) shot with it")
+    u.add_argument("--plate-frames", type=_frame_range, default=None, metavar="FIRST-LAST",
+                   help="the plate's frame range (one plate frame per clip frame; the first at time code 0)")
+    u.add_argument("--meters-per-unit", type=number("meters per unit", positive=True), default=0.01,
+                   help="stage unit (default 0.01: centimetres)")
+    u.add_argument("--force", action="store_true", help="overwrite an existing file")
+    add_output_options(u, what="the file written")
+    u.set_defaults(handler=run_usd, output_args=("file",))
+
+    o = s.add_parser("opentrackio", help="the samples as OpenTrackIO 1.0.1 JSON, validated")
+    _clip_args(o)
+    o.add_argument("-o", "--output", dest="file", default=None,
+                   help="write the samples here, one JSON sample per line (default: standard output)")
+    o.add_argument("--fps", type=number("frame rate", positive=True, hi=1000.0), default=None,
+                   help="frame rate when the file records none")
+    o.add_argument("--force", action="store_true", help="overwrite an existing file")
+    o.set_defaults(handler=run_opentrackio, output_args=("file",))
+    p.set_defaults(handler=lambda args: p.print_help() or 0)
+
+
+def _load(args):
+    from ..metadata import load
+
+    return load(args.clip)
+
+
+def _m(v, units):
+    from ..units import format_distance
+
+    return "inf" if v is None else format_distance(v, units)
+
+
+def run_show(args) -> int:
+    from ._output import Table, print_csv, print_table
+
+    rec = _load(args)
+    static, rows = rec.static_dict(), rec.frame_rows()
+    if args.json:
+        emit_json(document("metadata_show", {"clip": static, "frames": rows},
+                           units={"length": "mm", "angle": "degree", "time": "s", "rate": "frames per second"}))
+        return 0
+    if args.csv:
+        print_csv(rows)
+        return 0
+    t = Table(f"{rec.source} clip {rec.clip_name or ''}".rstrip(), ["value", "recorded"])
+    for k, v in static.items():
+        if k not in ("frame_rate_exact",):
+            t.add_row(k, "-" if v is None else (", ".join(map(str, v)) if isinstance(v, list) else v))
+    print_table(t)
+    cols = ["frame", "timecode", "focus_mm", "tstop", "fstop", "focal_length_mm"]
+    f = Table(f"{len(rows)} frames", cols, justify=["right", "left"] + ["right"] * 4)
+    for row in rows:
+        f.add_row(*("-" if row[c] is None else (f"{row[c]:.4g}" if isinstance(row[c], float) else row[c])
+                    for c in cols))
+    print_table(f)
+    return 0
+
+
+def _solve(args, rec):
+    from ..errors import InputError
+    from ..metadata.convert import solve
+    from .report import resolve_sensor
+
+    lens = None
+    if args.lens is not None:
+        from ..lens.library import load_lens
+
+        lens = load_lens(args.lens)
+    given = args.sensor is not None or args.sensor_width is not None or args.sensor_height is not None
+    sensor = None
+    if rec.active_area_mm is None or given:
+        sensor = resolve_sensor(args)
+    if given and rec.active_area_mm is not None:
+        raise InputError(f"the {rec.source} file gives the sensor area "
+                         f"({rec.active_area_mm[0]:g} x {rec.active_area_mm[1]:g} mm); drop --sensor")
+    return solve(rec, sensor=sensor, lens=lens, coc=args.coc, focal_length_mm=args.focal, fstop=args.fstop,
+                 rate=args.fps), lens
+
+
+def run_report(args) -> int:
+    from ..live.record import lens_report_rows
+    from ._common import units_of
+    from ._output import Table, print_csv, print_table
+
+    rec = _load(args)
+    solved, lens = _solve(args, rec)
+    rows = lens_report_rows(solved)
+    s = solved[0].report.sensor
+    notes = sorted({n for x in solved for n in x.report.notes})
+    if args.json:
+        emit_json(document("metadata_report", {
+            "clip": rec.static_dict(), "lens": args.lens, "model": "prescription" if lens is not None else "thin lens",
+            "sensor_mm": [s.width_mm, s.height_mm], "notes": notes, "frames": rows}))
+        return 0
+    if args.csv:
+        print_csv(rows)
+        return 0
+    u = units_of(args)
+    what = f"lens {args.lens}" if lens is not None else "a thin lens of the recorded focal length"
+    cols = ["frame", "timecode", "focus", "stop", "near", "far", "hyperfocal", "hfov_deg"]
+    t = Table(f"{rec.source} clip {rec.clip_name or ''}: {what}, sensor {s.width_mm:g} x {s.height_mm:g} mm", cols,
+              justify=["right", "left"] + ["right"] * 6)
+    for r in rows:
+        t.add_row(r["frame"], r["timecode"] or "-", _m(r["focus_from_film_mm"], u), f"{r['fstop']:.3g}",
+                  _m(r["near_from_film_mm"], u), _m(r["far_from_film_mm"], u), _m(r["hyperfocal_from_film_mm"], u),
+                  f"{r['hfov_deg']:.2f}")
+    print_table(t)
+    for n in notes[:3]:
+        print(f"note: {n}")
+    if len(notes) > 3:
+        print(f"note: and {len(notes) - 3} more notes (--json lists them)")
+    return 0
+
+
+def run_usd(args) -> int:
+    from ..extras import require_extra
+    from ..io import check_writable
+
+    require_extra("usd", "USD cameras (physcam metadata usd)")
+    check_writable(args.file, force=args.force)
+    rec = _load(args)
+    solved, _ = _solve(args, rec)
+    from ..metadata.convert import write_usd
+
+    out = write_usd(args.file, rec, solved, plate=args.plate, plate_frames=args.plate_frames,
+                    meters_per_unit=args.meters_per_unit, force=args.force)
+    summary = {"file": str(out), "frames": len(solved), "source": rec.source, "clip_name": rec.clip_name,
+               "first_timecode": rec.frames[0].timecode, "last_timecode": rec.frames[-1].timecode,
+               "plate": args.plate, "plate_frames": None if args.plate_frames is None else list(args.plate_frames),
+               "tracker_pose": any(f.tracker is not None for f in rec.frames)}
+    if args.json:
+        emit_json(document("metadata_usd", summary))
+    else:
+        print(f"wrote {out}: {len(solved)} frames of {rec.source} clip {rec.clip_name or ''}".rstrip()
+              + (f", plate {args.plate}" if args.plate else ""))
+    return 0
+
+
+def run_opentrackio(args) -> int:
+    import json
+    import sys
+
+    from ..extras import require_extra
+
+    require_extra("live", "OpenTrackIO samples (physcam metadata opentrackio)")
+    from ..io import atomic_write, check_writable
+    from ..metadata.convert import opentrackio_samples
+
+    if args.file is not None:
+        check_writable(args.file, force=args.force)
+    samples = opentrackio_samples(_load(args), rate=args.fps)
+    text = "".join(json.dumps(s, allow_nan=False, separators=(",", ":")) + "\n" for s in samples)
+    if args.file is None:
+        sys.stdout.write(text)
+    else:
+        atomic_write(args.file, text, force=args.force)
+        print(f"wrote {len(samples)} OpenTrackIO 1.0.1 samples to {args.file} (validated)")
+    return 0

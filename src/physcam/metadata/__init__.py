@@ -1,0 +1,109 @@
+"""physcam.metadata: camera metadata recorded with real clips, read into one :class:`ClipRecord`.
+
+One module per source (``arri``, ``red`` with ``cooke``, ``venice``, ``canon``, ``bmd``, ``mosys``);
+:func:`detect` tells the format of each file from its content (never its name), :func:`load`
+reads the files of one clip (RED's static and frames CSVs, VENICE's CSV and XML, Canon's two
+CSVs) into a :class:`ClipRecord`. ``convert`` turns a record into tracked frames, lens reports,
+an animated USD camera (through ``physcam.live.record``) and OpenTrackIO samples.
+Layer 8.5, beside ``live`` (docs/architecture.md); the readers need no optional extra.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import MetadataError
+from .record import ClipRecord, CookeData, FrameSample, TrackerPose
+
+__all__ = ["ClipRecord", "CookeData", "FrameSample", "TrackerPose", "detect", "detect_file", "load", "FORMATS"]
+
+#: the sources physcam reads, and what each is
+FORMATS = {"arri": "ARRI Meta Extract CSV (tab-separated, one row per frame)",
+           "red": "REDline --printMeta 5 frames CSV (+ --printMeta 3 static CSV)",
+           "venice": "Sony VENICE per-frame CSV (+ NonRealTimeMeta XML)",
+           "canon": "Canon per-frame CSV (+ static CSV)",
+           "bmd": "Blackmagic RAW SDK ExtractMetadata text",
+           "mosys": "Mo-Sys StarTracker F4 recording (binary)"}
+
+
+def detect_file(path) -> tuple[str, str]:
+    """(format, role) of one file from its first bytes: role "frames" (the per-frame file),
+    "static" (RED's or Canon's static CSV) or "xml" (VENICE's). Unknown content is a MetadataError."""
+    from . import arri, bmd, canon, mosys, red, venice
+
+    p = Path(path)
+    try:
+        with open(p, "rb") as fh:
+            head = fh.read(4096)
+    except OSError as exc:
+        raise MetadataError(f"cannot read it ({exc.strerror or exc})", p) from None
+    if not head:
+        raise MetadataError("the file is empty", p, 1)
+    if mosys.sniff(head):
+        return "mosys", "frames"
+    try:
+        text = head.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        if exc.start < len(head) - 4:  # not a character cut at the 4 kB boundary: binary
+            raise MetadataError("a binary file that is not a Mo-Sys F4 recording (no 0xF4 packet with a valid "
+                                "checksum at its start)", p, offset=0) from None
+        text = head[: exc.start].decode("utf-8-sig")
+    if "\0" in text:
+        raise MetadataError("a binary file that is not a Mo-Sys F4 recording (no 0xF4 packet with a valid "
+                            "checksum at its start)", p, offset=0)
+    first = text.splitlines()[0] if text.splitlines() else ""
+    if arri.sniff(first):
+        return "arri", "frames"
+    for name, mod in (("red", red), ("canon", canon)):
+        role = mod.sniff(first)
+        if role:
+            return name, role
+    role = venice.sniff(text)
+    if role:
+        return "venice", "frames" if role == "csv" else "xml"
+    if bmd.sniff(text):
+        return "bmd", "frames"
+    raise MetadataError("unknown column layout: not an ARRI Meta Extract, REDline, VENICE, Canon, Blackmagic "
+                        "ExtractMetadata or Mo-Sys F4 file", p, 1)
+
+
+def detect(paths) -> str:
+    """The one format of the files of a clip (each detected from its content)."""
+    found = {detect_file(p)[0] for p in _paths(paths)}
+    if len(found) > 1:
+        raise MetadataError(f"the files are of different formats ({', '.join(sorted(found))}); give one clip's files")
+    return found.pop()
+
+
+def _paths(paths) -> list[Path]:
+    if isinstance(paths, (str, Path)):
+        paths = [paths]
+    out = [Path(p) for p in paths]
+    if not out:
+        raise MetadataError("no metadata file given")
+    return out
+
+
+def load(paths) -> ClipRecord:
+    """Read one clip's metadata files (one path or several) into a :class:`ClipRecord`."""
+    from . import arri, bmd, canon, mosys, red, venice
+
+    files = _paths(paths)
+    roles: dict = {}
+    fmt = None
+    for p in files:
+        f, role = detect_file(p)
+        if fmt is not None and f != fmt:
+            raise MetadataError(f"{p} is a {f} file, the others {fmt}; give one clip's files")
+        fmt = f
+        if role in roles:
+            raise MetadataError(f"two {f} {role} files ({roles[role]} and {p}); give one clip's files")
+        roles[role] = p
+    if "frames" not in roles:
+        raise MetadataError(f"only the {fmt} {', '.join(roles)} file: give the per-frame file too", files[0])
+    single = {"arri": arri.read, "bmd": bmd.read, "mosys": mosys.read}
+    if fmt in single:
+        return single[fmt](roles["frames"])
+    if fmt == "venice":
+        return venice.read(roles["frames"], roles.get("xml"))
+    return {"red": red.read, "canon": canon.read}[fmt](roles["frames"], roles.get("static"))

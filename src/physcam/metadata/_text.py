@@ -1,0 +1,116 @@
+"""Reading metadata text with file and line numbers: delimited rows, numbers, stop notations."""
+
+from __future__ import annotations
+
+import csv
+import math
+import re
+from fractions import Fraction
+from pathlib import Path
+
+from ..errors import MetadataError
+
+#: the largest metadata file physcam reads (an hour of 240 fps AME rows is ~1 GB; refuse more)
+MAX_BYTES = 2_000_000_000
+FOOT_MM = 304.8  # international foot (1959), exact
+
+
+def read_text(path) -> str:
+    """A metadata file as text (UTF-8, a BOM dropped); a binary file or a missing one is a MetadataError."""
+    p = Path(path)
+    try:
+        if p.stat().st_size > MAX_BYTES:
+            raise MetadataError(f"the file is larger than {MAX_BYTES // 10**9} GB", p)
+        data = p.read_bytes()
+    except OSError as exc:
+        raise MetadataError(f"cannot read it ({exc.strerror or exc})", p) from None
+    if b"\0" in data[:4096]:
+        raise MetadataError("a binary file, not a metadata text export", p, 1)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        raise MetadataError("not UTF-8 text", p, line) from None
+
+
+def rows(path, text: str, delimiter: str = ",") -> tuple[list[str], list[tuple[int, dict]]]:
+    """(header, [(line, {column: cell})]) of a delimited file; a row whose field count differs from
+    the header's (a truncated file) is an error naming its line. Duplicate columns keep the first."""
+    reader = csv.reader(text.splitlines(), delimiter=delimiter)
+    try:
+        header = next(reader)
+    except StopIteration:
+        raise MetadataError("the file is empty", path, 1) from None
+    except csv.Error as exc:
+        raise MetadataError(f"cannot read the header ({exc})", path, 1) from None
+    header = [h.strip() for h in header]
+    out = []
+    try:
+        for cells in reader:
+            line = reader.line_num
+            if not cells or (len(cells) == 1 and not cells[0].strip()):
+                continue
+            if len(cells) != len(header):
+                raise MetadataError(f"{len(cells)} fields where the header has {len(header)}: the file is truncated "
+                                    "or its rows do not match its header", path, line)
+            row: dict = {}
+            for h, c in zip(header, cells):
+                row.setdefault(h, c.strip())
+            out.append((line, row))
+    except csv.Error as exc:
+        raise MetadataError(f"cannot read the row ({exc})", path, reader.line_num) from None
+    return header, out
+
+
+def require_columns(path, header, columns, what: str) -> None:
+    missing = [c for c in columns if c not in header]
+    if missing:
+        raise MetadataError(f"unknown column layout for {what}: no {', '.join(repr(c) for c in missing)} column",
+                            path, 1)
+
+
+def number(path, line, name, text, *, empty_none: bool = True) -> float | None:
+    """A finite number from a cell; empty or "--" (not recorded) is None; anything else an error."""
+    t = (text or "").strip()
+    if empty_none and t in ("", "--", "n.a.", "-"):
+        return None
+    try:
+        v = float(Fraction(t)) if "/" in t else float(t)
+    except (ValueError, ZeroDivisionError):
+        raise MetadataError(f"{name} {t!r} is not a number", path, line) from None
+    if not math.isfinite(v):
+        raise MetadataError(f"{name} {t!r} is not a finite number", path, line)
+    return v
+
+
+_STOP = re.compile(r"^\s*T?\s*(\d+(?:\.\d+)?)\s*(?:\+?\s*(\d+)\s*/\s*10)?\s*$")
+
+
+def stop_from_marking(path, line, name, text) -> float | None:
+    """A stop written as a full-stop marking plus tenths of a stop ("1.4 + 7/10", "T 2 3/10"):
+    the marking N is the nearest whole stop AV = round(2 log2 N) (1, 1.4, 2, 2.8 ... are AV 0..),
+    and N = 2^((AV + tenths/10) / 2) (a stop is a factor of sqrt 2 in N)."""
+    t = (text or "").strip()
+    if t in ("", "--"):
+        return None
+    m = _STOP.match(t)
+    if not m:
+        raise MetadataError(f"{name} {t!r} is not a stop (like 'T 2 3/10' or '1.4 + 7/10')", path, line)
+    marking = float(m.group(1))
+    if marking <= 0:
+        raise MetadataError(f"{name} {t!r} is not a stop", path, line)
+    av = round(2 * math.log2(marking))
+    tenths = int(m.group(2) or 0)
+    return 2.0 ** ((av + tenths / 10.0) / 2.0)
+
+
+_TC = re.compile(r"^\d{1,2}:\d{2}:\d{2}[:;.]\d{2}$")
+
+
+def timecode(path, line, text) -> str | None:
+    t = (text or "").strip()
+    if t in ("", "--"):
+        return None
+    if not _TC.match(t):
+        raise MetadataError(f"timecode {t!r} is not HH:MM:SS:FF", path, line)
+    return t if len(t.split(":")[0]) == 2 else "0" + t

@@ -1,0 +1,106 @@
+"""ARRI Meta Extract (AME) CSV: one tab-separated row per frame of an ALEXA clip.
+
+Fields read (AME 4.4 column names; one row per recorded frame):
+
+* ``Master TC`` (HH:MM:SS:FF; the column appears twice, the first is read), ``Index``;
+* ``Lens Distance Unit`` ("Meter" or "Feet") and ``Lens Focus Distance`` in that unit, the lens
+  data system's (LDS) focus mark from the film plane; converted to mm (1 ft = 304.8 mm).
+  A value in feet-and-inches notation (``12'6"``) under "Meter" is refused;
+* ``Lens Iris``: the T-stop as a whole-stop marking plus tenths ("1.4 + 7/10" = T1.4 and 7/10
+  of a stop = T1.80); ``Lens Linear Iris``, the same in 1/1000 stop with 1000 = T1
+  (T = 2^((L - 1000) / 2000), camdkit's reading), is preferred when present (finer);
+* ``Lens Focal Length`` (mm), ``Lens Model``, ``Lens Serial Number``, ``Lens Squeeze``;
+* ``Camera Model``, ``Camera Serial Number``, ``Camera Family``, ``Project FPS``, ``Shutter Angle``
+  (degrees), ``Exposure Time`` ("20.000 ms"), ``Exposure Index ASA``, ``Image Width`` / ``Height``.
+
+The sensor area the recorded pixels cover is not in the file; for ALEXA LF it comes from ARRI's
+published formats table (LF 16:9 HD and UHD: 31.68 x 17.82 mm, LF Open Gate: 36.70 x 25.54 mm) and
+``active_area_source`` says so; other cameras leave it None.
+"""
+
+from __future__ import annotations
+
+import re
+from fractions import Fraction
+
+from ..errors import MetadataError, require_type
+from ._text import FOOT_MM, number, read_text, require_columns, rows, stop_from_marking, timecode
+from .record import ClipRecord, FrameSample
+
+__all__ = ["sniff", "read"]
+
+REQUIRED = ("Master TC", "Lens Distance Unit", "Lens Focus Distance", "Lens Iris", "Lens Focal Length")
+#: (camera family, recorded width, height) -> active area (mm), ARRI ALEXA LF formats and resolutions
+ACTIVE_AREA_MM = {("ALEXALF", 1920, 1080): (31.68, 17.82), ("ALEXALF", 3840, 2160): (31.68, 17.82),
+                  ("ALEXALF", 4448, 3096): (36.70, 25.54)}
+_FT_IN = re.compile(r"""^\s*(\d+(?:\.\d+)?)\s*'\s*(?:(\d+(?:\.\d+)?)\s*"?)?\s*$""")
+
+
+def sniff(head: str) -> bool:
+    """True when ``head`` (the file's first line) is an AME header."""
+    require_type("head", head, str, "the first bytes of a metadata file")
+    cols = head.split("\t")
+    return "Master TC" in cols and "Lens Focus Distance" in cols
+
+
+def _focus_mm(path, line, unit, text):
+    t = (text or "").strip()
+    if t in ("", "--"):
+        return None
+    ft_in = _FT_IN.match(t) or ('"' in t and re.match(r'^\s*(\d+(?:\.\d+)?)\s*"\s*$', t))
+    if unit == "Meter":
+        if ft_in or "'" in t or '"' in t:
+            raise MetadataError(f"focus {t!r} is in feet and inches where the Lens Distance Unit says metres",
+                                path, line)
+        return number(path, line, "focus distance", t) * 1000.0
+    if ft_in and "'" in t:
+        return (float(ft_in.group(1)) * 12 + float(ft_in.group(2) or 0)) * 25.4
+    return number(path, line, "focus distance", t) * FOOT_MM
+
+
+def _tstop(path, line, row):
+    lin = row.get("Lens Linear Iris", "")
+    if lin not in ("", "--"):
+        v = number(path, line, "Lens Linear Iris", lin)
+        return 2.0 ** ((v - 1000.0) / 2000.0)
+    return stop_from_marking(path, line, "Lens Iris", row["Lens Iris"])
+
+
+def read(path) -> ClipRecord:
+    """The clip of one AME CSV (module notes)."""
+    text = read_text(path)
+    header, data = rows(path, text, "\t")
+    require_columns(path, header, REQUIRED, "an ARRI Meta Extract CSV")
+    if not data:
+        raise MetadataError("no frame rows after the header", path, 2)
+    frames = []
+    for line, r in data:
+        unit = r["Lens Distance Unit"]
+        if unit not in ("Meter", "Feet"):
+            raise MetadataError(f"Lens Distance Unit {unit!r} is neither Meter nor Feet", path, line)
+        frames.append(FrameSample(line=line, timecode=timecode(path, line, r["Master TC"]),
+                                  focus_mm=_focus_mm(path, line, unit, r["Lens Focus Distance"]),
+                                  tstop=_tstop(path, line, r),
+                                  focal_length_mm=number(path, line, "focal length", r["Lens Focal Length"])))
+    line, first = data[0]
+    g = lambda k: (first.get(k) or "").strip() or None  # noqa: E731
+    num = lambda k: number(path, line, k, first.get(k, ""))  # noqa: E731
+    w, h = num("Image Width"), num("Image Height")
+    res = (int(w), int(h)) if w and h else None
+    area = ACTIVE_AREA_MM.get((g("Camera Family"), *res)) if res else None
+    fps = num("Project FPS")
+    exp = g("Exposure Time")
+    exposure_s = number(path, line, "Exposure Time", exp.split()[0]) / 1000.0 if exp and exp.endswith("ms") else None
+    lens_model = g("Lens Model")
+    iso = num("Exposure Index ASA")
+    return ClipRecord(
+        source="arri", files=(str(path),), frames=tuple(frames), clip_name=g("Camera Clip Name"),
+        camera_make="ARRI", camera_model=g("Camera Model"), camera_serial=g("Camera Serial Number"),
+        sensor_name=g("Camera Family"), resolution_px=res, active_area_mm=area,
+        active_area_source="ARRI ALEXA LF formats and resolutions table" if area else None,
+        lens_make="ARRI" if lens_model and lens_model.startswith("ARRI ") else None, lens_model=lens_model,
+        lens_serial=g("Lens Serial Number"),
+        squeeze=num("Lens Squeeze"), frame_rate=Fraction(str(fps)).limit_denominator(1001) if fps else None,
+        shutter_angle_deg=num("Shutter Angle"), exposure_time_s=exposure_s,
+        iso=int(iso) if iso is not None else None,
+        notes=(f"focus distances recorded in {first['Lens Distance Unit']}s, converted to mm",))

@@ -1,0 +1,135 @@
+"""The clip as an animated USD camera, OpenTrackIO samples and CLI output (issue 30)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from physcam.cli import main
+from physcam.metadata import load
+
+from test_metadata_readers import ARRI, CANON, MOSYS, RED, VENICE
+
+FT = 304.8
+
+
+def _samples(attr):
+    return {t: attr.Get(t) for t in attr.GetTimeSamples()}
+
+
+def test_arri_usd_has_one_time_sample_per_frame_with_the_files_focus_and_tstop(tmp_path, capsys):
+    pytest.importorskip("pxr")
+    from pxr import Usd
+
+    out = tmp_path / "shot.usda"
+    assert main(["metadata", "usd", str(ARRI), "-o", str(out), "--plate", "plates/B001C001.####.exr",
+                 "--plate-frames", "1001-1500"]) == 0
+    stage = Usd.Stage.Open(str(out))
+    focus = _samples(stage.GetPrimAtPath("/Cameras/Camera/Pinhole").GetAttribute("focusDistance"))
+    tstop = _samples(stage.GetPrimAtPath("/Cameras/Camera/Camera").GetAttribute("exposure:fStop"))
+    tc = _samples(stage.GetPrimAtPath("/Cameras/Camera").GetAttribute("physcam:live:timecode"))
+    assert sorted(focus) == sorted(tstop) == [float(i) for i in range(500)]  # one sample per row
+    rows = ARRI.read_text(encoding="utf-8").splitlines()
+    header = rows[0].split("\t")
+    i_focus, i_iris, i_tc = header.index("Lens Focus Distance"), header.index("Lens Linear Iris"), header.index("Master TC")
+    for t in range(500):
+        cells = rows[t + 1].split("\t")
+        assert focus[t] == pytest.approx(float(cells[i_focus]) * 1000, rel=1e-6)  # metres in the file, mm in USD
+        assert tstop[t] == pytest.approx(2 ** ((int(cells[i_iris]) - 1000) / 2000), rel=1e-6)
+        assert tc[t] == cells[i_tc]
+    plate = stage.GetPrimAtPath("/Cameras/Camera").GetCustomDataByKey("physcam:plate")
+    assert dict(plate) == {"path": "plates/B001C001.####.exr", "firstFrame": 1001, "lastFrame": 1500}
+    assert stage.GetTimeCodesPerSecond() == 24
+
+
+def test_tracker_pose_reaches_usd(tmp_path):
+    pytest.importorskip("pxr")
+    from pxr import Usd
+
+    out = tmp_path / "track.usda"
+    assert main(["metadata", "usd", str(MOSYS), "-o", str(out), "--fstop", "2.8", "--focal", "25",
+                 "--sensor", "S35"]) == 0
+    stage = Usd.Stage.Open(str(out))
+    cam = stage.GetPrimAtPath("/Cameras/Camera")
+    rot = cam.GetAttribute("xformOp:rotateZXY")
+    r0 = rot.Get(0.0)
+    rec = load(MOSYS)
+    pan, tilt, roll = rec.frames[0].tracker.rotation_deg
+    assert tuple(r0) == pytest.approx((tilt, pan, -roll), abs=1e-4)  # live.record's rotateZXY convention
+    assert len(rot.GetTimeSamples()) == len(rec.frames)
+
+
+def test_opentrackio_output_validates_and_keeps_the_values(tmp_path):
+    pytest.importorskip("jsonschema")
+    from physcam.live.sample import validate_sample
+
+    out = tmp_path / "red.jsonl"
+    assert main(["metadata", "opentrackio", *map(str, RED), "-o", str(out)]) == 0
+    samples = [json.loads(line) for line in out.read_text().splitlines()]
+    assert len(samples) == 2
+    for s in samples:
+        validate_sample(s)
+    a = samples[0]
+    assert a["lens"]["focusDistance"] == pytest.approx(0.410)  # frames.csv line 2: 410 mm
+    assert a["lens"]["tStop"] == 5.6 and a["lens"]["entrancePupilOffset"] == pytest.approx(0.127)
+    assert a["timing"]["timecode"] == {"hours": 23, "minutes": 17, "seconds": 21, "frames": 8,
+                                       "frameRate": {"num": 24, "denom": 1}}
+    assert a["static"]["lens"]["serialNumber"] == "G53599764"
+
+
+def test_opentrackio_of_every_source_validates(capsys):
+    pytest.importorskip("jsonschema")
+    for files in ([ARRI], VENICE, CANON, [MOSYS]):
+        assert main(["metadata", "opentrackio", *map(str, files), "--fps", "24"]) == 0
+        lines = capsys.readouterr().out.splitlines()
+        assert len(lines) == len(load(files).frames)
+
+
+def test_report_thin_lens_matches_the_closed_form(capsys):
+    """Frame 0 of the RED clip: focus 410 mm, f/5.6, 40 mm, on its 20.48 mm wide area; near and far
+    from the thin-lens formulas s(H - f)/(H + s - 2f) and s(H - f)/(H - s) with H = f^2/(N c) + f,
+    the distances from the lens (the report's from the film: s = D - image distance, D = 410)."""
+    assert main(["metadata", "report", *map(str, RED), "--json", "--coc", "0.02"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    row = d["frames"][0]
+    f, n, c, D = 40.0, 5.6, 0.02, 410.0
+    # thin lens: object distance s and image distance v with s + v = D and 1/s + 1/v = 1/f
+    s = (D + (D * D - 4 * f * D) ** 0.5) / 2
+    v = D - s
+    H = f * f / (n * c) + f
+    near = s * (H - f) / (H + s - 2 * f)
+    far = s * (H - f) / (H - s)
+    assert row["near_from_film_mm"] == pytest.approx(near + v, rel=1e-6)
+    assert row["far_from_film_mm"] == pytest.approx(far + v, rel=1e-6)
+    assert d["model"] == "thin lens" and d["sensor_mm"] == pytest.approx([20.48, 10.8])
+
+
+def test_report_with_a_lens_breathes(capsys):
+    assert main(["metadata", "report", *map(str, RED), "--lens", "sonnar_50mm_f1_5", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)["frames"]
+    assert rows[0]["hfov_deg"] != rows[1]["hfov_deg"]  # 410 and 420 mm: the field of view changes with focus
+
+
+@pytest.mark.parametrize("argv, where", [
+    (["metadata", "show", "{tmp}/cut.csv"], "cut.csv:3: "),
+    (["metadata", "show", "{tmp}/x.bin"], "x.bin: byte 0: "),
+    (["metadata", "report", "{tmp}/layout.csv"], "layout.csv:1: unknown column layout"),
+])
+def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys, argv, where):
+    lines = ARRI.read_text(encoding="utf-8").splitlines(keepends=True)
+    (tmp_path / "cut.csv").write_text("".join(lines[:2]) + lines[2][:300])
+    (tmp_path / "x.bin").write_bytes(b"\x00\xff" * 300)
+    (tmp_path / "layout.csv").write_text("a,b\n1,2\n")
+    assert main([a.format(tmp=tmp_path) for a in argv]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("physcam: error: ") and where in err
+
+
+def test_show_csv_rows_equal_json_rows(capsys):
+    assert main(["metadata", "show", str(CANON[0]), str(CANON[1]), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["frames"][0]["focus_mm"] == 500.0 and d["clip"]["frame_count"] == 1
+    assert main(["metadata", "show", str(CANON[0]), "--csv"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("frame,line,timecode,focus_mm,tstop") and len(out) == 2
