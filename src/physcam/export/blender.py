@@ -173,8 +173,9 @@ def _emit(b: BakedCamera, *, dispersion: bool, fresnel: bool) -> str:
     head = [f"// {b.lens.name}: focus {focus_txt} from the film, {fno}; sensor {b.sensor_width_mm:g} x "
             f"{b.sensor_height_mm:g} mm; dispersion {'on' if dispersion else 'off'}, Fresnel "
             f"{'on' if fresnel else 'off'}."]
-    defines, data = lens_data(b.table, b.aperture, b.wavelength_nm, b.sensor_width_mm, b.sensor_height_mm,
-                              b.bounds, dispersion=dispersion, fresnel=fresnel)
+    defines, data = lens_data(b.table, b.aperture, b.wavelength_nm, b.bounds, dispersion=dispersion, fresnel=fresnel)
+    defines += [f"#define {k} {_num(v)}" for k, v in (("HALF_W", b.sensor_width_mm / 2), ("HALF_H", b.sensor_height_mm / 2),
+                                                   ("GRID_HW", b.sensor_width_mm / 2), ("GRID_HH", b.sensor_height_mm / 2))]
     data = [f"    float FILM_Z = {_num(b.film_z)};", f"    float REAR_Z = {_num(b.bounds.z_plane)};",
             f"    float NORM = {_num(b.norm)};", _arr("VZ", b.table.vertex_z, "N_SURF"),
             _arr("SEMI", b.table.semi_diameter, "N_SURF"), _arr("RECT", b.bounds.rects, "N_RECT"), *data]

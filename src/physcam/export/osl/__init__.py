@@ -92,11 +92,10 @@ def render_template(defines: list[str], data: list[str]) -> str:
     return "\n".join(_resolve(out, on)) + "\n"
 
 
-def lens_data(table, aperture, wavelength_nm: float, sensor_width_mm: float, sensor_height_mm: float, bounds, *,
-              dispersion: bool, fresnel: bool) -> tuple[list[str], list[str]]:
+def lens_data(table, aperture, wavelength_nm: float, bounds, *, dispersion: bool, fresnel: bool) -> tuple[list[str], list[str]]:
     """The defines and the data lines that do not change with focus: surface kinds, quadric and
-    asphere coefficients, indices (or dispersion coefficients), Fresnel scales, the sensor and the
-    iris shape. ``table``: a :func:`physcam.trace.surfaces.surface_table` (film side first)."""
+    asphere coefficients, indices (or dispersion coefficients), Fresnel scales and the iris shape
+    (``aperture``; in a focus-table shader the iris is the shader's parameters, pass None). ``table``: a :func:`physcam.trace.surfaces.surface_table` (film side first)."""
     from ...trace.kernels._layout import NA, NB, SA, SB, index_rows, pack
 
     n = len(table)
@@ -105,8 +104,7 @@ def lens_data(table, aperture, wavelength_nm: float, sensor_width_mm: float, sen
     defines = [f"#define N_SURF {n}", f"#define STOP_ROW {int(np.flatnonzero(table.kind == 1)[0])}",
                f"#define N_BX {nx}", f"#define N_BY {ny}", f"#define N_RECT {nx * ny * 4}",
                f"#define N_ASPH {n * 7}  // OSL array sizes must be plain integer literals",
-               f"#define N_DISP {n * 9}", f"#define HALF_W {osl_number(sensor_width_mm / 2)}",
-               f"#define HALF_H {osl_number(sensor_height_mm / 2)}"]
+               f"#define N_DISP {n * 9}"]
     data = [osl_array("KIND", kinds, "N_SURF", "int")]
     for name, col in (("AX", table.ax), ("AY", table.ay), ("AZ", table.az), ("CV", table.curvature),
                       ("CK", table.conic)):
