@@ -72,10 +72,10 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
 
     if isinstance(n_focus, bool) or not isinstance(n_focus, int) or n_focus < 2:
         raise InputError(f"a focus table needs at least 2 states, got {n_focus!r}")
-    near = closest_focus(lens)
+    near = closest_focus(lens) * (1 + 1e-6)  # a hair beyond: rounding must not ask for closer than it reaches
     step = 1000.0 / near / (n_focus - 1)  # 1/m
     marks = np.array([math.inf] + [1000.0 / (step * i) for i in range(1, n_focus)])
-    marks[-1] = max(marks[-1], near)  # rounding must not ask for closer than the lens reaches
+    marks[-1] = max(marks[-1], near)
     film_z, vz, rects, norm = [], [], [], []
     nx, ny = _GRID
     for mk in marks:
