@@ -238,7 +238,7 @@ def run_blender_extension(args) -> int:
     if args.json:
         emit_json(document("export_blender_extension", data, units={"time": "s"}))
         return 0
-    print(f"wrote {path}: {len(names)} lenses")
+    print(f"wrote {path}: {len(names)} lens{'' if len(names) == 1 else 'es'}")
     print(f"  install: blender --command extension install-file -r user_default -e {path}")
     return 0
 
