@@ -16,7 +16,7 @@ BLENDER_PY    := $(BLENDER_VENV)/bin/python
 BLENDER_STAMP := $(BLENDER_VENV)/.physcam-installed
 BPY_VERSION   ?= 5.0.1
 
-.PHONY: demo test venv blender bench clean schema chromium shell test-latest wheel
+.PHONY: demo test venv blender blender-extension bench clean schema chromium shell test-latest wheel
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -50,6 +50,10 @@ $(BLENDER_STAMP): pyproject.toml
 	  && touch $(BLENDER_STAMP) ) \
 	|| ( echo "physcam: Blender (bpy==$(BPY_VERSION)) could not be installed here; the Blender tests will be skipped" >&2; \
 	     rm -rf $(BLENDER_VENV) )
+
+# the physcam Blender extension zip (docs/blender.md)
+blender-extension: $(STAMP)
+	$(VENV)/bin/physcam export blender-extension -o dist --force
 
 blender: $(BLENDER_STAMP)
 

@@ -50,11 +50,11 @@ for _p in glob.glob(bpy.utils.resource_path("LOCAL") + "/python/lib/python3*/sit
 """
 
 
-def run_blender(script: str, *args, timeout: float = 300.0) -> dict:
+def run_blender(script: str, *args, timeout: float = 300.0, env: dict | None = None) -> dict:
     """Run ``script`` (Python source) in Blender; it must print one JSON object on its last stdout line,
-    which is returned. The source tree under test comes first on sys.path."""
+    which is returned. The source tree under test comes first on sys.path; ``env`` adds variables."""
     runner = require_blender()
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""), **(env or {}))
     with tempfile.TemporaryDirectory(prefix="physcam-blender-") as tmp:
         path = Path(tmp) / "script.py"
         path.write_text(OSL_PATH_PRELUDE + script)

@@ -85,6 +85,7 @@ JSON_RUNS = {
                            "--focus", "inf", "--focus", "2m"],
     ("export", "opencv"): ["export", "opencv", "dgauss_50mm", "--width-px", "1024", "--height-px", "683"],
     ("export", "blender"): ["export", "blender", "dgauss_50mm", "--focus", "2m", "-o", "cams"],
+    ("export", "blender-extension"): ["export", "blender-extension", "-o", "ext", "--lens", "dgauss_50mm"],
     ("export", "rib"): ["export", "rib", "-o", "c.rib", "--focal", "40", "--fstop", "2.8", "--focus", "2.5m"],
     ("export", "pbrt"): ["export", "pbrt", "-o", "pbrt", "--lens", "dgauss_50mm", "--fstop", "2.8", "--focus", "2m"],
     ("live", "validate"): ["live", "validate", str(LIVE_SAMPLE)],

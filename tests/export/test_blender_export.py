@@ -73,11 +73,13 @@ def test_aperture_and_features_are_emitted():
     lens = load_lens("dgauss_50mm")
     src = osl_camera_shader(lens, focus_mm=3000.0, sensor_width_mm=36.0, sensor_height_mm=24.0,
                             aperture=dict(nsides=6, angle_deg=30.0, roundness=0.25, density=-0.5))
-    assert f"float wedge = {2 * math.pi / 6!r};" in src
-    assert f"- {math.radians(30.0)!r}, wedge)" in src
-    assert "0.25 * (1.0 - pg)" in src and "-0.5 * (2.0 * sr - 1.0)" in src
+    # the iris's numbers in the data block (the template's code reads them by name)
+    assert f"#define AP_WEDGE {2 * math.pi / 6!r}\n" in src
+    assert f"#define AP_ANGLE {math.radians(30.0)!r}\n" in src
+    assert "#define AP_ROUNDNESS 0.25\n" in src and "#define AP_DENSITY -0.5\n" in src
+    assert "AP_ROUNDNESS * (1.0 - pg)" in src and "AP_DENSITY * (2.0 * sr - 1.0)" in src
     plain = osl_camera_shader(lens, focus_mm=3000.0, sensor_width_mm=36.0, sensor_height_mm=24.0)
-    assert "wedge" not in plain and "Ts *=" not in plain
+    assert "AP_WEDGE" not in plain and "Ts *=" not in plain
 
 
 def test_bad_input_is_a_clear_error(tmp_path):

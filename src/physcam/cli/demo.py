@@ -14,7 +14,8 @@ folder and prints the report:
   fitted Brown-Conrady (OpenTrackIO) and 3DE4 models, and a Nuke script applying the maps
   (docs/distortion.md);
 - ``blender/``: the real-lens OSL camera shader and its set-up script for Blender Cycles, and a
-  script matching Blender's built-in camera to the report (docs/blender.md).
+  script matching Blender's built-in camera to the report, and the physcam Blender extension
+  (``physcam-<version>.zip``, every bundled lens; docs/blender.md).
 """
 
 from __future__ import annotations
@@ -196,7 +197,9 @@ def _blender_step(out, ctx, force):
     values = blender_camera_values(report, resolution_x=width, blades=7)
     builtin = atomic_write(out / "blender" / f"builtin_{DEFAULTS['lens']}.py", blender_camera_script(values),
                            force=force)
-    return [osl, setup, builtin]
+    from ..export.blender_extension import build_extension
+
+    return [osl, setup, builtin, build_extension(out / "blender", force=force)]
 
 
 def run(args) -> int:

@@ -80,6 +80,16 @@ def register(sub) -> None:
                    help="also write builtin_<lens>.py: Blender's own camera matched to the lens at this focus "
                         "(best-match pinhole, aperture, focus distance; faster, no real-lens optics)")
     b.set_defaults(handler=run_blender)
+    e = s.add_parser("blender-extension", help="write the physcam Blender extension (physcam-<version>.zip)",
+                     description="Write DIR/physcam-<version>.zip, a Blender 4.2+ extension: a Camera Properties "
+                                 "panel with real lenses whose focus and f-stop animate in Cycles. Install it with "
+                                 "`blender --command extension install-file -r user_default -e ZIP`. See docs/blender.md.")
+    e.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write the zip into")
+    e.add_argument("--lens", action="append", default=None, metavar="LENS",
+                   help="a lens to ship (bundled name or a lens file; repeat; default every bundled lens)")
+    e.add_argument("--force", action="store_true", help="overwrite an existing zip")
+    add_output_options(e, what="what was written")
+    e.set_defaults(handler=run_blender_extension)
     _register_rib(s)
     _register_pbrt(s)
     _register_mitsuba(s)
@@ -213,6 +223,23 @@ def run_blender(args) -> int:
     if builtin is not None:
         print(f"  or Blender's own camera, matched: blender your.blend --python {builtin}")
         print(f"  note: {gap.summary()}")
+    return 0
+
+
+def run_blender_extension(args) -> int:
+    import time
+
+    from ..export.blender_extension import build_extension
+
+    t0 = time.perf_counter()
+    names = []
+    path = build_extension(args.output, lenses=args.lens, force=args.force, progress=names.append)
+    data = {"zip": str(path), "lenses": names, "seconds": round(time.perf_counter() - t0, 3)}
+    if args.json:
+        emit_json(document("export_blender_extension", data, units={"time": "s"}))
+        return 0
+    print(f"wrote {path}: {len(names)} lens{'' if len(names) == 1 else 'es'}")
+    print(f"  install: blender --command extension install-file -r user_default -e {path}")
     return 0
 
 

@@ -1,0 +1,128 @@
+"""The physcam Blender extension (Blender 4.2+ format, id ``physcam``): a zip that artists install.
+
+Inside Blender's own Python (numpy, no physcam) the add-on needs only numbers, so physcam computes
+them here, at build time, and the zip carries **precomputed data** (docs/blender.md says why):
+
+- per lens, four OSL camera shaders (dispersion and Fresnel on/off) from the template with the
+  lens's focus table (:func:`physcam.export.blender_focus.focus_table_shader`): focus, f-stop,
+  sensor and iris are shader parameters, so a keyframed pull renders with no rebuild;
+- per lens, a JSON table of physcam's lens report at each focus state of that table
+  (:func:`physcam.onset.report.solve_lens_report` at f/``REFERENCE_FSTOP``): EFL, best-match pinhole,
+  entrance pupil, H1, CoC, and the closest focus and widest f-stop the panel checks against;
+- the add-on itself (``blender_addon.py.in``, written for this project), which interpolates those
+  tables for the panel's numbers and Blender's built-in camera.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import warnings
+import zipfile
+from importlib import resources
+from pathlib import Path
+
+from ..errors import InputError
+
+__all__ = ["build_extension", "lens_payload", "extension_manifest", "REFERENCE_FSTOP", "REPORT_SENSOR_MM"]
+
+#: f-number the per-focus reports are solved at (the numbers stored do not depend on it).
+REFERENCE_FSTOP = 8.0
+#: Sensor (mm) of the stored reports' CoC and field of view: full frame, the pupil table's span.
+REPORT_SENSOR_MM = (36.0, 24.0)
+
+
+def extension_manifest(version: str) -> str:
+    """``blender_manifest.toml`` (Blender's extension format 1.0.0)."""
+    return f'''schema_version = "1.0.0"
+id = "physcam"
+version = "{version}"
+name = "physcam real lenses"
+tagline = "Cycles cameras traced through real lens prescriptions"
+maintainer = "physcam"
+type = "add-on"
+tags = ["Camera", "Render"]
+blender_version_min = "4.2.0"
+license = ["SPDX:Apache-2.0"]
+'''
+
+
+def _report_rows(lens, marks_mm) -> list[dict]:
+    from ..onset.report import solve_lens_report
+    from ..onset.sensors import custom_sensor
+
+    sensor = custom_sensor(*REPORT_SENSOR_MM)
+    rows = []
+    for m in marks_mm:
+        mark = 1.0e7 if math.isinf(m) else float(m)  # the report's infinity: 10 km
+        with warnings.catch_warnings():  # a fisheye's field warnings, once per state: the panel has no use for them
+            warnings.simplefilter("ignore")
+            r = solve_lens_report(focal_length_mm=None, sensor=sensor, fstop=REFERENCE_FSTOP, focus_mm=mark,
+                                  lens=lens)
+        rows.append({"mark_mm": mark, "efl_mm": r.focal_length_mm, "pinhole_mm": r.pinhole[0],
+                     "pinhole_squeeze": r.pinhole[1], "pupil_from_film_mm": r.entrance_pupil_from_film_mm or 0.0,
+                     "h1_from_film_mm": r.h1_from_film_mm, "coc_mm": r.coc_mm,
+                     "pupil_diameter_x_n": r.aperture_diameter_mm * REFERENCE_FSTOP})
+    return rows
+
+
+def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
+    """(the lens's JSON table, its four shaders by file name) for the zip."""
+    from .blender_focus import focus_table, focus_table_shader
+
+    ft = focus_table(lens)
+    shaders = {}
+    for disp in (False, True):
+        for fres in (False, True):
+            shaders[f"{slug}__d{int(disp)}f{int(fres)}.osl"] = focus_table_shader(ft, dispersion=disp, fresnel=fres)
+    data = {"slug": slug, "name": lens.name, "closest_m": ft.closest_mm / 1000.0, "fstop_min": ft.fstop_min,
+            "inv_step_per_m": ft.inv_step_per_m, "anamorphic": bool(lens.is_anamorphic),
+            "report_fstop": REFERENCE_FSTOP, "report_sensor_mm": list(REPORT_SENSOR_MM),
+            "rows": _report_rows(lens, ft.marks_mm)}
+    return data, shaders
+
+
+def _sensor_presets() -> list[dict]:
+    """physcam's sensor table, those a full-frame pupil table covers (:data:`GRID_HALF_MM`)."""
+    from ..onset.sensors import sensors
+    from .blender_focus import GRID_HALF_MM
+
+    return [{"name": s.name, "width_mm": s.width_mm, "height_mm": s.height_mm} for s in sensors()
+            if math.hypot(s.width_mm, s.height_mm) / 2 <= GRID_HALF_MM]
+
+
+def _addon_source() -> str:
+    return resources.files(__package__).joinpath("blender_addon.py.in").read_text(encoding="utf-8")
+
+
+def build_extension(out_dir, *, lenses=None, force: bool = False, progress=None) -> Path:
+    """Write ``out_dir/physcam-<version>.zip`` (module notes) through :func:`physcam.io.atomic_write`.
+    ``lenses``: bundled slugs or lens files physcam reads (default: every bundled lens)."""
+    from .. import __version__
+    from ..io import atomic_write, check_writable
+    from ..lens.library import list_lenses, load_lens
+
+    out = Path(out_dir) / f"physcam-{__version__}.zip"
+    check_writable(out, force=force)
+    names = [r.slug for r in list_lenses()] if lenses is None else list(lenses)
+    if not names:
+        raise InputError("the extension needs at least one lens")
+    buf = io.BytesIO()
+    index = []
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("blender_manifest.toml", extension_manifest(__version__))
+        z.writestr("__init__.py", _addon_source())
+        for name in names:
+            lens = load_lens(name)
+            slug = Path(str(name)).stem
+            data, shaders = lens_payload(lens, slug)
+            z.writestr(f"lenses/{slug}.json", json.dumps(data))
+            for fname, text in shaders.items():
+                z.writestr(f"shaders/{fname}", text)
+            index.append({"slug": slug, "name": lens.name})
+            if progress:
+                progress(slug)
+        z.writestr("lenses/index.json", json.dumps(index))
+        z.writestr("sensors.json", json.dumps(_sensor_presets()))
+    return atomic_write(out, buf.getvalue(), force=force)

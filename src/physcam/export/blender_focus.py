@@ -1,0 +1,133 @@
+"""A Blender OSL camera whose focus, f-stop, sensor and iris are shader parameters.
+
+:func:`focus_table` tabulates physcam's focus states of a lens (:func:`physcam.optics.focusing.focus`:
+unit focusing moves the film, internal focusing the groups; breathing comes with them) at marks
+uniform in 1/distance from infinity to the closest focus; :func:`focus_table_shader` writes the
+template ``osl/physcam_lens.osl.in`` with that table, and the shader blends the two states that
+bracket its ``focus_distance`` parameter (metres from the film plane), linearly in 1/distance. The
+iris follows physcam's one rule (:func:`~physcam.optics.focusing.iris_semi_diameter`, sized at
+infinity focus): paraxial, so its semi-diameter is K / N with K tabulated here. The exit-pupil
+rectangles are those of the open lens over a film square of :data:`GRID_HALF_MM` (any sensor that
+fits it), the weight normalised at the film centre of each state (the centre renders 1 at every
+stop; with Fresnel on, the centre's transmission at infinity is divided out too). Keyframing the parameters renders a focus pull or an iris change with no rebuild.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..errors import InputError, OpticsError
+from ..lens.prescription import Prescription, takes_prescription
+from .osl import lens_data, osl_array, osl_number, render_template
+
+__all__ = ["FocusTable", "focus_table", "focus_table_shader", "N_FOCUS", "GRID_HALF_MM"]
+
+#: Focus states tabulated (uniform in 1/distance, infinity first).
+N_FOCUS = 32
+#: Half size (mm) of the film square the exit-pupil table covers: a full-frame 36 x 24 mm gate's
+#: half diagonal, so every sensor up to full frame (any aspect) fits.
+GRID_HALF_MM = 21.7
+_GRID = (9, 9)
+
+
+@dataclasses.dataclass
+class FocusTable:
+    """physcam's focus states of one lens, film side first (the tracing order)."""
+
+    lens: Prescription
+    marks_mm: np.ndarray  # focus marks from the film plane, inf first
+    inv_step_per_m: float  # spacing of the marks in 1/metres
+    film_z: np.ndarray  # (n,) film plane z, lens space
+    vertex_z: np.ndarray  # (n, surfaces)
+    rects: np.ndarray  # (n, ny, nx, 4) exit-pupil rectangles of the open lens
+    norm: np.ndarray  # (n,) mean weight at the film centre, open
+    table: object  # SurfaceTable at infinity (the rows that do not move)
+    bounds: object  # PupilBounds at infinity (the grid)
+    iris_k: float  # iris semi-diameter x f-number (mm)
+    fstop_min: float  # the lens wide open
+    closest_mm: float
+    fresnel_loss: float  # Fresnel transmission at the film centre at infinity (uncoated)
+
+
+def _centre_norm(q, film_z, bounds, fresnel: bool = False) -> float:
+    from ..trace.trace import camera_rays
+
+    m = 64
+    u = (np.arange(m) + 0.5) / m
+    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
+    cr = camera_rays(q, np.zeros((uu.size, 2)), np.stack([uu, vv], axis=1), film_z, bounds=bounds, fresnel=fresnel)
+    return float(np.mean(cr.weight))
+
+
+@takes_prescription
+def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: float = GRID_HALF_MM) -> FocusTable:
+    """Tabulate ``lens``'s focus states (module notes). Raises OpticsError when the lens passes no
+    ray at the film centre."""
+    from ..optics.focusing import closest_focus, focus, gaussian_at_focus, iris_semi_diameter
+    from ..trace.pupil_bounds import exit_pupil_bounds
+    from ..trace.surfaces import surface_table
+
+    if isinstance(n_focus, bool) or not isinstance(n_focus, int) or n_focus < 2:
+        raise InputError(f"a focus table needs at least 2 states, got {n_focus!r}")
+    near = closest_focus(lens) * (1 + 1e-6)  # a hair beyond: rounding must not ask for closer than it reaches
+    step = 1000.0 / near / (n_focus - 1)  # 1/m
+    marks = np.array([math.inf] + [1000.0 / (step * i) for i in range(1, n_focus)])
+    marks[-1] = max(marks[-1], near)
+    film_z, vz, rects, norm = [], [], [], []
+    nx, ny = _GRID
+    for mk in marks:
+        st = focus(lens, float(mk))
+        q = st.prescription
+        t = surface_table(q, reverse=True, coating="none")
+        b = exit_pupil_bounds(q, grid_half_mm, grid_half_mm, st.film_z, nx=nx, ny=ny, samples=48)
+        film_z.append(st.film_z)
+        vz.append(t.vertex_z)
+        rects.append(b.rects)
+        norm.append(_centre_norm(q, st.film_z, b))
+        if mk == marks[0]:
+            table0, bounds0 = t, b
+            loss = _centre_norm(q, st.film_z, b, fresnel=True) / norm[0]
+    if not all(v > 0 for v in norm):
+        raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some focus")
+    n_open = gaussian_at_focus(lens, math.inf).f_number * (1 + 1e-9)
+    k = iris_semi_diameter(lens, n_open) * n_open
+    return FocusTable(lens, marks, step, np.array(film_z), np.array(vz), np.array(rects), np.array(norm), table0,
+                      bounds0, float(k), float(n_open), float(near), float(loss))
+
+
+def _num32(x) -> str:
+    """Nine significant digits: a float32 exactly (OSL computes in float32)."""
+    return osl_number(float(format(float(x), ".9g")))
+
+
+def _arr32(name, values, size) -> str:
+    return f"    float {name}[{size}] = {{{', '.join(_num32(v) for v in np.asarray(values, float).ravel())}}};"
+
+
+def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: bool = False, focus_m: float = 3.0,
+                       fstop: float = 0.0, sensor_mm=(36.0, 24.0)) -> str:
+    """The template with ``ft``'s focus table: focus, f-stop, sensor and iris are shader parameters
+    (defaults from the keywords; ``fstop`` 0 is wide open)."""
+    n_focus = len(ft.marks_mm)
+    n = len(ft.table)
+    defines, data = lens_data(ft.table, None, ft.lens.wavelength_nm, ft.bounds, dispersion=dispersion,
+                              fresnel=fresnel)
+    defines += ["#define PHYSCAM_FOCUS_TABLE 1", "#define PHYSCAM_APERTURE 1", "#define PHYSCAM_POLYGON 1",
+                f"#define N_FOCUS {n_focus}", f"#define N_VZ_TAB {n_focus * n}",
+                f"#define N_RECT_TAB {ft.rects[0].size * n_focus}",
+                f"#define FOCUS_INV_STEP {_num32(ft.inv_step_per_m)}", f"#define IRIS_K {_num32(ft.iris_k)}",
+                f"#define FSTOP_MIN {_num32(ft.fstop_min)}", f"#define FOCUS_DEFAULT_M {osl_number(focus_m)}",
+                f"#define FSTOP_DEFAULT {osl_number(fstop)}", f"#define SENSOR_W_DEFAULT {osl_number(sensor_mm[0])}",
+                f"#define SENSOR_H_DEFAULT {osl_number(sensor_mm[1])}",
+                f"#define GRID_HW {osl_number(ft.bounds.xs[-1])}", f"#define GRID_HH {osl_number(ft.bounds.ys[-1])}"]
+    # with Fresnel on, the centre's transmission at infinity is in the norm (it hardly changes with focus)
+    norm = ft.norm * (ft.fresnel_loss if fresnel else 1.0)
+    data += [_arr32("FILM_Z_TAB", ft.film_z, "N_FOCUS"), _arr32("NORM_TAB", norm, "N_FOCUS"),
+             _arr32("VZ_TAB", ft.vertex_z, "N_VZ_TAB"), osl_array("SEMI_OPEN", ft.table.semi_diameter, "N_SURF"),
+             _arr32("RECT_TAB", ft.rects, "N_RECT_TAB")]
+    head = [f"// {ft.lens.name}: {n_focus} focus states from infinity to {ft.closest_mm / 1000:.3g} m "
+            f"(uniform in 1/distance); dispersion {'on' if dispersion else 'off'}, Fresnel {'on' if fresnel else 'off'}."]
+    return render_template(head + defines, data)

@@ -1,0 +1,141 @@
+"""The OSL camera template (``physcam_lens.osl.in``) and the lens-data block physcam writes into it.
+
+The template holds the optics as OSL; physcam fills two lines: ``@PHYSCAM_DEFINES@`` (array sizes
+and the feature switches) and ``@PHYSCAM_LENS_DATA@`` (the lens's arrays, inside the shader body:
+OSL has no global arrays). The feature switches (:data:`FEATURES`) are resolved here, so the
+written shader holds only the code it runs; every other preprocessor line is left to OSL.
+Used by :mod:`physcam.export.blender` (one baked focus) and :mod:`physcam.export.blender_focus`
+(the focus table of the Blender extension).
+"""
+
+from __future__ import annotations
+
+import math
+from importlib import resources
+
+import numpy as np
+
+from ...errors import InputError
+
+__all__ = ["FEATURES", "template_text", "render_template", "lens_data", "osl_number", "osl_array"]
+
+#: The template's feature switches: a data block that defines one keeps that code, else it goes.
+FEATURES = ("PHYSCAM_FOCUS_TABLE", "HAS_ASPHERE", "PHYSCAM_DISPERSION", "PHYSCAM_FRESNEL", "PHYSCAM_APERTURE",
+            "PHYSCAM_POLYGON")
+#: Wavelengths sampled per ray when dispersion is on (uniform).
+WAVELENGTH_RANGE_NM = (400.0, 700.0)
+
+
+def template_text() -> str:
+    """The template's text (package data)."""
+    return resources.files(__package__).joinpath("physcam_lens.osl.in").read_text(encoding="utf-8")
+
+
+def osl_number(x) -> str:
+    """A finite float as an OSL literal (round-trips: ``repr``)."""
+    x = float(x)
+    if not math.isfinite(x):
+        raise InputError(f"cannot write the non-finite number {x} into an OSL shader")
+    r = repr(x)
+    return r if ("." in r or "e" in r) else r + ".0"
+
+
+def osl_array(name: str, values, size: str, kind: str = "float") -> str:
+    """``    float NAME[SIZE] = {...};`` (one line of the data block)."""
+    if kind == "int":
+        vals = ", ".join(str(int(v)) for v in np.asarray(values).ravel())
+    else:
+        vals = ", ".join(osl_number(v) for v in np.asarray(values, dtype=float).ravel())
+    return f"    {kind} {name}[{size}] = {{{vals}}};"
+
+
+def _resolve(lines: list[str], on: set[str]) -> list[str]:
+    """Keep the code of the switched-on features, drop the rest (nested #ifdef/#else/#endif of
+    :data:`FEATURES` only; other directives are OSL's)."""
+    out, stack = [], []  # stack: (is ours, keeping) per open #if
+    for line in lines:
+        word = line.strip().split()
+        head = word[0] if word else ""
+        keeping = all(k for _, k in stack)
+        if head in ("#ifdef", "#ifndef") and len(word) > 1 and word[1] in FEATURES:
+            want = (word[1] in on) == (head == "#ifdef")
+            stack.append((True, want))
+            continue
+        if head in ("#if", "#ifdef", "#ifndef"):
+            stack.append((False, True))
+        elif head == "#else" and stack and stack[-1][0]:
+            stack[-1] = (True, not stack[-1][1])
+            continue
+        elif head == "#endif" and stack:
+            ours, _ = stack.pop()
+            if ours:
+                continue
+        if keeping:
+            out.append(line)
+    if stack:
+        raise InputError("the OSL template has an #ifdef without #endif")
+    return out
+
+
+def render_template(defines: list[str], data: list[str]) -> str:
+    """The shader: the template with ``defines`` and ``data`` in place and its switches resolved
+    (a ``#define NAME`` line in ``defines`` switches NAME on)."""
+    on = {ln.split()[1] for ln in defines if ln.startswith("#define ") and ln.split()[1] in FEATURES}
+    out = []
+    for line in template_text().splitlines():
+        if line.strip() == "@PHYSCAM_DEFINES@":
+            out.extend(defines)
+        elif line.strip() == "@PHYSCAM_LENS_DATA@":
+            out.extend(data)
+        else:
+            out.append(line)
+    return "\n".join(_resolve(out, on)) + "\n"
+
+
+def lens_data(table, aperture, wavelength_nm: float, bounds, *, dispersion: bool, fresnel: bool) -> tuple[list[str], list[str]]:
+    """The defines and the data lines that do not change with focus: surface kinds, quadric and
+    asphere coefficients, indices (or dispersion coefficients), Fresnel scales and the iris shape
+    (``aperture``; in a focus-table shader the iris is the shader's parameters, pass None). ``table``: a :func:`physcam.trace.surfaces.surface_table` (film side first)."""
+    from ...trace.kernels._layout import NA, NB, SA, SB, index_rows, pack
+
+    n = len(table)
+    S, kinds = pack(table)
+    nx, ny = len(bounds.xs), len(bounds.ys)
+    defines = [f"#define N_SURF {n}", f"#define STOP_ROW {int(np.flatnonzero(table.kind == 1)[0])}",
+               f"#define N_BX {nx}", f"#define N_BY {ny}", f"#define N_RECT {nx * ny * 4}",
+               f"#define N_ASPH {n * 7}  // OSL array sizes must be plain integer literals",
+               f"#define N_DISP {n * 9}"]
+    data = [osl_array("KIND", kinds, "N_SURF", "int")]
+    for name, col in (("AX", table.ax), ("AY", table.ay), ("AZ", table.az), ("CV", table.curvature),
+                      ("CK", table.conic)):
+        data.append(osl_array(name, col, "N_SURF"))
+    if np.any(table.aspheric != 0.0):
+        defines.append("#define HAS_ASPHERE 1")
+        data.append(osl_array("ASPH", table.aspheric, "N_ASPH"))
+    if dispersion:
+        lo, hi = WAVELENGTH_RANGE_NM
+        defines += ["#define PHYSCAM_DISPERSION 1", f"#define WAVELENGTH_LO {osl_number(lo)}",
+                    f"#define WAVELENGTH_HI {osl_number(hi)}"]
+        data += [osl_array("DB", table.disp_before, "N_DISP"), osl_array("DA", table.disp_after, "N_DISP")]
+    else:
+        with np.errstate(all="ignore"):
+            data += [osl_array("N1", index_rows(S, NB, SB, wavelength_nm), "N_SURF"),
+                     osl_array("N2", index_rows(S, NA, SA, wavelength_nm), "N_SURF")]
+    if fresnel:
+        defines.append("#define PHYSCAM_FRESNEL 1")
+        data.append(osl_array("RSC", table.r_scale, "N_SURF"))
+    return defines + _aperture_defines(aperture), data
+
+
+def _aperture_defines(ap) -> list[str]:
+    """The iris shape (physcam.trace.aperture.Aperture) as constants; none for the round stop."""
+    if ap is None:
+        return []
+    out = ["#define PHYSCAM_APERTURE 1", f"#define AP_ROUNDNESS {osl_number(ap.roundness)}",
+           f"#define AP_DENSITY {osl_number(ap.density)}"]
+    if int(ap.nsides) >= 3:
+        wedge = 2 * math.pi / int(ap.nsides)
+        out += ["#define PHYSCAM_POLYGON 1", f"#define AP_WEDGE {osl_number(wedge)}",
+                f"#define AP_ANGLE {osl_number(math.radians(ap.angle_deg))}",
+                f"#define AP_COS_HALF_WEDGE {osl_number(math.cos(wedge / 2))}"]
+    return out
