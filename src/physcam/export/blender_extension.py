@@ -18,7 +18,6 @@ from __future__ import annotations
 import io
 import json
 import math
-import warnings
 import zipfile
 from importlib import resources
 from pathlib import Path
@@ -49,21 +48,26 @@ license = ["SPDX:Apache-2.0"]
 
 
 def _report_rows(lens, marks_mm) -> list[dict]:
-    from ..onset.report import solve_lens_report
+    """The on-set numbers the panel shows, per focus state: only the report's solvers it needs (the
+    lens at the mark and its pinhole; no real-ray field of view, which the panel does not show)."""
+    from ..onset.request import ReportRequest
     from ..onset.sensors import custom_sensor
+    from ..onset.solvers import field_of_view, lens_at_mark
+    from ..optics.coc import circle_of_confusion
 
     sensor = custom_sensor(*REPORT_SENSOR_MM)
+    coc_mm, _ = circle_of_confusion(sensor.width_mm, sensor.height_mm, None)
     rows = []
     for m in marks_mm:
         mark = 1.0e7 if math.isinf(m) else float(m)  # the report's infinity: 10 km
-        with warnings.catch_warnings():  # a fisheye's field warnings, once per state: the panel has no use for them
-            warnings.simplefilter("ignore")
-            r = solve_lens_report(focal_length_mm=None, sensor=sensor, fstop=REFERENCE_FSTOP, focus_mm=mark,
-                                  lens=lens)
-        rows.append({"mark_mm": mark, "efl_mm": r.focal_length_mm, "pinhole_mm": r.pinhole[0],
-                     "pinhole_squeeze": r.pinhole[1], "pupil_from_film_mm": r.entrance_pupil_from_film_mm or 0.0,
-                     "h1_from_film_mm": r.h1_from_film_mm, "coc_mm": r.coc_mm,
-                     "pupil_diameter_x_n": r.aperture_diameter_mm * REFERENCE_FSTOP})
+        req = ReportRequest(sensor=sensor, fstop=REFERENCE_FSTOP, focus_mm=mark, lens=lens)
+        state = lens_at_mark(req)
+        fov = field_of_view(req, state, state.h2_from_film_mm)
+        rows.append({"mark_mm": mark, "efl_mm": state.focal_length_mm, "pinhole_mm": fov["pinhole_focal_length_mm"],
+                     "pinhole_squeeze": fov["pinhole_squeeze"], "pupil_from_film_mm": state.pupil_from_film_mm or 0.0,
+                     "h1_from_film_mm": state.h1_from_film_mm, "coc_mm": coc_mm,
+                     # the entrance pupil at this focus times N: EFL / (N x f-number ratio) x N
+                     "pupil_diameter_x_n": state.focal_length_mm / state.n_ratio})
     return rows
 
 
