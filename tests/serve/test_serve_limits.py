@@ -30,7 +30,7 @@ HEAD_TIMEOUT = 5.0  # the documented header timeout (Limits.head_timeout)
 
 @pytest.fixture(scope="module")
 def server():
-    with running_server() as (url, port, proc):  # the default limits, as on set
+    with running_server() as (_, port, proc):  # the default limits, as on set
         yield port, proc
 
 
@@ -219,7 +219,7 @@ async def _flood(port, rate, seconds, statuses, stop):
             line = await asyncio.wait_for(r.readline(), 30)
             statuses.append(int(line.split()[1]) if line else None)
             w.close()
-        except (OSError, asyncio.TimeoutError, ValueError, IndexError):
+        except (TimeoutError, OSError, ValueError, IndexError):
             statuses.append(None)
 
     tasks, t0 = [], time.monotonic()

@@ -17,8 +17,9 @@ Routes (GET or HEAD only; every answer is JSON, SVG or the page):
 Query parameters are the CLI flags without their dashes (``sensor-width=24.89``); which ones an
 endpoint takes comes from the backend (the CLI's own parsers). Safety, all in
 :class:`Limits`: a bounded URL, a bounded number and length of parameters, printable values only,
-no request body, a token bucket per client address (429 with ``Retry-After``), a bounded queue
-for the slow work (503), and one JSON line ``{"error": "..."}`` for every refusal (422 for bad
+no request body, a token bucket per client address (429 with ``Retry-After``), the slow work
+shared between client addresses in turn with bounded queues (worker.py: 429 for one address's
+share, 503 in all), and one JSON line ``{"error": "..."}`` for every refusal (422 for bad
 input), never a traceback. An unexpected exception answers 500 with its class name and is
 logged as one line; the server keeps serving.
 """
@@ -421,8 +422,8 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
     async def diagram(request):
         name = _name(request)
         q = core.query(request.scope, "diagram")
-        body = await core.answer(request.scope, ("diagram", name, tuple(sorted(q.items()))), lambda: backend.diagram_svg(name, q),
-                                 heavy=True, media="image/svg+xml")
+        body = await core.answer(request.scope, ("diagram", name, tuple(sorted(q.items()))),
+                                 lambda: backend.diagram_svg(name, q), heavy=True, media="image/svg+xml")
         return ok(body, "image/svg+xml")
 
     async def health(request):

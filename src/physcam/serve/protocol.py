@@ -39,7 +39,7 @@ from uvicorn.protocols.http.h11_impl import H11Protocol
 
 from .app import SECURITY_HEADERS, Limits, one_line
 
-__all__ = ["protocol_class", "LINGER_S"]
+__all__ = ["LINGER_S", "protocol_class"]
 
 #: Seconds a refused connection that has sent something is read (and its input discarded) before it closes.
 LINGER_S = 2.0
