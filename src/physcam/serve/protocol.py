@@ -150,8 +150,9 @@ class LimitedH11Protocol(H11Protocol):
         if self._refused or self.transport.is_closing():
             return
         conn, lim = self.conn, self.limits
-        if conn.their_state is h11.DONE and conn.our_state is h11.SEND_RESPONSE:
-            return  # the request is in; the server is answering (the answer starts the next phase)
+        if conn.their_state not in (h11.IDLE, h11.SEND_BODY):
+            return  # the request is in (DONE, or MUST_CLOSE after "Connection: close"): the server is
+            # answering, and its answer starts the next phase
         elapsed = self.loop.time() - self._phase_start
         idle = conn.their_state is h11.IDLE and not conn.trailing_data[0]
         if idle and elapsed >= lim.keep_alive:
