@@ -11,8 +11,12 @@ from __future__ import annotations
 
 import ipaddress
 import socket
+from typing import TYPE_CHECKING
 
 from ..errors import InputError, WrongTypeError
+
+if TYPE_CHECKING:
+    from .app import Limits
 
 __all__ = ["bind_socket", "lan_addresses", "qr_text", "run_server", "asgi_get", "url_for"]
 
@@ -116,7 +120,7 @@ def qr_text(url: str) -> str:
     return buf.getvalue()
 
 
-def run_server(app, sock: socket.socket, *, log_requests: bool = False, limits=None) -> None:
+def run_server(app, sock: socket.socket, *, log_requests: bool = False, limits: Limits | None = None) -> None:
     """Serve ``app`` on the listening ``sock`` with uvicorn until interrupted (Ctrl-C, SIGTERM),
     each connection bounded by ``limits`` (default :class:`~physcam.serve.app.Limits`): the head
     cap, the header timeout and the connection caps of :mod:`physcam.serve.protocol`."""
