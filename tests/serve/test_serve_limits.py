@@ -12,7 +12,6 @@ import asyncio
 import http.client
 import json
 import socket
-import statistics
 import sys
 import threading
 import time
@@ -235,7 +234,7 @@ async def _flood(port, rate, seconds, statuses, stop):
 def test_a_flood_of_slow_work_from_one_address_does_not_starve_another(server):
     """40 distinct charts per second from one address (the worker draws about 20): a chart asked by
     another address waits at most the chart being drawn and one of the flood's, not the flood's
-    queue. Bound: 0.5 s + 5 x the chart's time with the server to itself."""
+    queue. Bound: 0.5 s + 5 x the chart's time with the server to itself (before: 503, or ~32 charts)."""
     port, proc = server
     assert get(port, _chart(1000))[0] == 200  # the first chart imports matplotlib
     alone = []
@@ -243,7 +242,7 @@ def test_a_flood_of_slow_work_from_one_address_does_not_starve_another(server):
         t0 = time.monotonic()
         assert get(port, _chart(1100 + k))[0] == 200
         alone.append(time.monotonic() - t0)
-    t_alone = statistics.median(alone)
+    t_alone = max(alone)  # the slowest of three: a loaded machine varies (the queue before took ~32 of them)
     bound = 0.5 + 5 * t_alone
     statuses, stop = [], threading.Event()
     flood = threading.Thread(target=lambda: asyncio.run(_flood(port, 40, 5, statuses, stop)))

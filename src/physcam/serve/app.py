@@ -94,9 +94,9 @@ class Limits:
     max_value: int = 64
     max_marks: int = 16
     queue: int = 32
-    client_queue: int = 8
     cache_bytes: int = 32 * 1024 * 1024
     clients: int = 4096
+    client_queue: int = 8  # the fields from here on were added later: keyword use, old positions kept
     connections: int = 256
     client_connections: int = 32
     head_bytes: int = 16 * 1024
