@@ -19,7 +19,12 @@ omission). Runs:
 3. page updates (``--page-rate`` per second, default 4, no latency goal): what the page asks
    once a setup has settled, report + focus table (14 marks) + DOF chart (SVG), with setups drawn
    from a small set as people on set revisit them; the chart is drawn by matplotlib on the one
-   worker thread (tens of ms each), so this run shows that worker's capacity.
+   worker thread (tens of ms each), so this run shows that worker's capacity;
+4. fairness (``--flood-rate`` per second, default 40; Linux, which routes all of 127.0.0.0/8 to
+   loopback): one address (127.0.0.2) floods distinct DOF charts, one connection each, faster
+   than the worker draws them, while another (127.0.0.1) asks for 2 distinct charts a second;
+   the second address's chart latency beside the flood, against the same charts with the server
+   to itself (the worker takes one job from each address in turn: docs/serve.md).
 
 The last section, when Debian's chromium and Playwright are there, measures the page itself:
 from a keystroke in the focus field to the new near limit on screen (goal: 100 ms).
@@ -60,13 +65,14 @@ def start_server():
 class Conn:
     """One keep-alive HTTP/1.1 connection (reconnects when the server closes it)."""
 
-    def __init__(self, port):
-        self.port, self.r, self.w = port, None, None
+    def __init__(self, port, source=None):
+        self.port, self.r, self.w, self.source = port, None, None, source
 
     async def request(self, path, method="GET", body=b""):
         for attempt in range(2):
             if self.w is None:
-                self.r, self.w = await asyncio.open_connection("127.0.0.1", self.port)
+                local = (self.source, 0) if self.source else None
+                self.r, self.w = await asyncio.open_connection("127.0.0.1", self.port, local_addr=local)
             head = f"{method} {path} HTTP/1.1\r\nHost: bench\r\n"
             if body:
                 head += f"Content-Length: {len(body)}\r\nContent-Type: application/x-www-form-urlencoded\r\n"
@@ -193,6 +199,63 @@ def report(name, lat, statuses, wall, rate, goal=True):
     return five
 
 
+def chart(focus_mm):
+    return "/api/dof.svg?" + urlencode({"focal": 50, "fstop": 2.8, "focus": f"{focus_mm}mm", "sensor": "S35"})
+
+
+async def fairness(port, flood_rate, seconds, first_mm, victim_rate=2.0):
+    """Latencies of ``victim_rate`` distinct charts per second from 127.0.0.1, beside a flood of
+    ``flood_rate`` distinct charts per second from 127.0.0.2 (none when 0); (latencies, victim
+    statuses, flood statuses)."""
+    flood_statuses, lat, statuses = {}, [], {}
+
+    async def flood_one(i):
+        conn = Conn(port, "127.0.0.2")
+        try:
+            status = await conn.request(chart(10000 + i))
+        except (ConnectionError, OSError, asyncio.IncompleteReadError):
+            status = "reset"
+        finally:
+            await conn.close()
+        flood_statuses[status] = flood_statuses.get(status, 0) + 1
+
+    async def flood():
+        t0, tasks = time.perf_counter(), []
+        for i in range(int(flood_rate * seconds)):
+            await asyncio.sleep(max(0.0, t0 + i / flood_rate - time.perf_counter()))
+            tasks.append(asyncio.ensure_future(flood_one(i)))
+        await asyncio.gather(*tasks)
+
+    async def victim():
+        conn, t0 = Conn(port, "127.0.0.1"), time.perf_counter() + 1.0  # after the flood's first second
+        for i in range(int(victim_rate * (seconds - 1))):
+            due = t0 + i / victim_rate
+            await asyncio.sleep(max(0.0, due - time.perf_counter()))
+            status = await conn.request(chart(first_mm + i))
+            lat.append(time.perf_counter() - due)
+            statuses[status] = statuses.get(status, 0) + 1
+        await conn.close()
+
+    await asyncio.gather(victim(), *([flood()] if flood_rate > 0 else []))
+    return lat, statuses, flood_statuses
+
+
+def fairness_report(port, flood_rate, seconds):
+    if not sys.platform.startswith("linux"):
+        print("fairness: skipped (needs 127.0.0.0/8 on loopback, Linux, for two client addresses)")
+        return 0
+    alone, s_alone, _ = asyncio.run(fairness(port, 0, seconds, 2000))
+    lat, statuses, flood = asyncio.run(fairness(port, flood_rate, seconds, 4000))
+    for name, v, st in (("alone", alone, s_alone), (f"beside a flood of {flood_rate:g} charts/s from another address",
+                                                     lat, statuses)):
+        codes = ", ".join(f"{s}: {c}" for s, c in sorted(st.items(), key=str))
+        print(f"fairness, 2 charts/s from 127.0.0.1 {name}: chart latency p50 {pct(v, 50) * 1000:.0f} ms, "
+              f"max {max(v) * 1000:.0f} ms; status {codes}")
+    codes = ", ".join(f"{s}: {c}" for s, c in sorted(flood.items(), key=str))
+    print(f"  the flood (127.0.0.2): status {codes}")
+    return sum(c for s, c in statuses.items() if isinstance(s, int) and s >= 500)
+
+
 def keystroke_latency(port, keys=25):
     """From a keystroke in the focus field to the new near limit on the page (headless Chromium)."""
     exe = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -235,10 +298,13 @@ def main():
     ap.add_argument("--clients", type=int, default=16, help="concurrent keep-alive connections (default 16)")
     ap.add_argument("--page-rate", type=float, default=4.0,
                     help="settled page updates per second in the page-update run (default 4)")
+    ap.add_argument("--flood-rate", type=float, default=40.0,
+                    help="distinct charts per second one address floods in the fairness run (default 40)")
     args = ap.parse_args()
     if not (0 < args.rate <= 5000 and 0 < args.page_rate <= 500 and 0 < args.seconds <= 120
-            and 1 <= args.clients <= 256):
-        raise SystemExit("bounded runs only: rate 0-5000 req/s, page rate 0-500/s, 0-120 s, 1-256 clients")
+            and 1 <= args.clients <= 256 and 0 < args.flood_rate <= 500):
+        raise SystemExit("bounded runs only: rate 0-5000 req/s, page rate 0-500/s, flood rate 0-500/s, 0-120 s, "
+                         "1-256 clients")
     print(f"load: {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f} (1/5/15 min), "
           f"{os.cpu_count()} cores")
     proc, port = start_server()
@@ -253,6 +319,7 @@ def main():
         lat, statuses, wall = asyncio.run(run(port, page_update, rate, args.seconds, args.clients, 2))
         five += report(f"page updates ({args.page_rate:g}/s: report + focus table + chart each)", lat, statuses,
                        wall, rate, goal=False)
+        five += fairness_report(port, args.flood_rate, args.seconds)
         keystroke_latency(port)
         alive = proc.poll() is None
         print(f"server still running: {alive}; 5xx answers in all runs: {five}")

@@ -230,7 +230,7 @@ def run(args) -> int:
         print("Ctrl-C stops the server", flush=True)
         warnings.simplefilter("ignore", PhysCamWarning)  # the reports carry these in their notes
         try:
-            run_server(app, sock, log_requests=args.log_requests)
+            run_server(app, sock, log_requests=args.log_requests, limits=limits)
         except KeyboardInterrupt:  # uvicorn has shut down cleanly and passes Ctrl-C on
             print("physcam serve: stopped", flush=True)
     finally:

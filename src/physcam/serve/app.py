@@ -17,8 +17,9 @@ Routes (GET or HEAD only; every answer is JSON, SVG or the page):
 Query parameters are the CLI flags without their dashes (``sensor-width=24.89``); which ones an
 endpoint takes comes from the backend (the CLI's own parsers). Safety, all in
 :class:`Limits`: a bounded URL, a bounded number and length of parameters, printable values only,
-no request body, a token bucket per client address (429 with ``Retry-After``), a bounded queue
-for the slow work (503), and one JSON line ``{"error": "..."}`` for every refusal (422 for bad
+no request body, a token bucket per client address (429 with ``Retry-After``), the slow work
+shared between client addresses in turn with bounded queues (worker.py: 429 for one address's
+share, 503 in all), and one JSON line ``{"error": "..."}`` for every refusal (422 for bad
 input), never a traceback. An unexpected exception answers 500 with its class name and is
 logged as one line; the server keeps serving.
 """
@@ -31,13 +32,13 @@ import sys
 import time
 from collections import OrderedDict
 from collections.abc import Callable, Mapping
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from importlib import resources
 from urllib.parse import parse_qsl
 
 from .. import __version__
 from ..errors import PhysCamError, WrongTypeError
+from .worker import FairWorker, Full
 
 __all__ = ["Backend", "Limits", "create_app", "STATIC_FILES"]
 
@@ -79,8 +80,12 @@ class Backend:
 
 @dataclass(frozen=True)
 class Limits:
-    """The server's bounds. ``rate`` is requests per second per client address (a token bucket of
-    ``burst`` requests); ``queue`` bounds the slow requests (lenses, SVG) waiting for the worker."""
+    """The server's bounds (docs/serve.md, "What it refuses"). Per client address: ``rate``
+    requests per second (a token bucket of ``burst``), ``client_queue`` slow requests (lenses,
+    charts) pending for the worker, ``client_connections`` open connections. In all: ``queue`` slow
+    requests, ``connections`` connections. Per request: a head (request line and headers) of at
+    most ``head_bytes``, complete within ``head_timeout`` seconds of the connection opening or of
+    the previous answer; a connection idle ``keep_alive`` seconds between requests is closed."""
 
     rate: float = 60.0
     burst: int = 120
@@ -91,15 +96,25 @@ class Limits:
     queue: int = 32
     cache_bytes: int = 32 * 1024 * 1024
     clients: int = 4096
+    client_queue: int = 8  # the fields from here on were added later: keyword use, old positions kept
+    connections: int = 256
+    client_connections: int = 32
+    head_bytes: int = 16 * 1024
+    head_timeout: float = 5.0
+    keep_alive: float = 5.0
 
     def __post_init__(self):
         import math
 
-        for name in ("rate", "burst", "max_url", "max_params", "max_value", "max_marks", "queue", "cache_bytes",
-                     "clients"):
+        for name in ("rate", "burst", "max_url", "max_params", "max_value", "max_marks", "queue", "client_queue",
+                     "cache_bytes", "clients", "connections", "client_connections", "head_bytes", "head_timeout",
+                     "keep_alive"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
                 raise WrongTypeError(f"Limits.{name} must be a positive number, got {v!r}")
+        for name in ("queue", "client_queue", "connections", "client_connections", "head_bytes"):
+            if not isinstance(getattr(self, name), int):
+                raise WrongTypeError(f"Limits.{name} must be a whole number, got {getattr(self, name)!r}")
 
 
 class Refused(Exception):
@@ -115,6 +130,12 @@ def one_line(text) -> str:
     lines = str(text).strip().splitlines()
     line = lines[0] if lines else "refused"
     return line if len(line) <= 300 else line[:297] + "..."
+
+
+def client_address(scope) -> str:
+    """The client's IP address (the socket's peer: no proxy headers are trusted), "?" when unknown."""
+    client = scope.get("client")
+    return client[0] if client else "?"
 
 
 def _error_body(reason: str) -> bytes:
@@ -225,8 +246,7 @@ class _Guard:
         for k, v in scope.get("headers", []):
             if k == b"transfer-encoding" or (k == b"content-length" and v.strip() not in (b"", b"0")):
                 raise Refused(413, "this server takes no request body")
-        client = scope.get("client")
-        wait = self.buckets.take(client[0] if client else "?")
+        wait = self.buckets.take(client_address(scope))
         if wait > 0:
             raise Refused(429, f"too many requests from this address (limit {lim.rate:g} per second); "
                           f"wait {wait:.2f} s", [(b"retry-after", str(max(1, round(wait + 0.5))).encode())])
@@ -238,10 +258,9 @@ class _App:
     def __init__(self, backend: Backend, limits: Limits):
         self.backend, self.limits = backend, limits
         self.cache = _Cache(limits.cache_bytes)
-        # One worker: the lens tracer (numba) and matplotlib are not to be entered from two threads
-        # at once; the GIL would serialise the work anyway.
-        self.pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="physcam-serve")
-        self.pending = 0
+        # One worker thread (numba's tracer and matplotlib are not to be entered from two threads at
+        # once), shared between client addresses in turn (worker.py).
+        self.worker = FairWorker(limits.client_queue, limits.queue)
         self.static = {}
         root = resources.files(__package__) / "static"
         for name, media in STATIC_FILES.items():
@@ -276,20 +295,20 @@ class _App:
         return out
 
     # --- answers ---------------------------------------------------------------------------
-    async def answer(self, key, fn, *, heavy: bool, media: str):
-        """Compute ``fn()`` (inline when light, on the worker when heavy), cached by ``key``; a
-        :class:`PhysCamError` becomes 422 with its first line."""
+    async def answer(self, scope, key, fn, *, heavy: bool, media: str):
+        """Compute ``fn()`` (inline when light, on the worker in ``client``'s turn when heavy),
+        cached by ``key``; a :class:`PhysCamError` becomes 422 with its first line."""
         hit = self.cache.get(key)
         if hit is None:
             if heavy:
-                if self.pending >= self.limits.queue:
-                    raise Refused(503, "the server is busy with slow requests (lenses, charts); try again",
-                                  [(b"retry-after", b"1")])
-                self.pending += 1
                 try:
-                    hit = await asyncio.get_running_loop().run_in_executor(self.pool, _computed, fn, media)
-                finally:
-                    self.pending -= 1
+                    future = self.worker.submit(client_address(scope), lambda: _computed(fn, media))
+                except Full as full:
+                    raise Refused(503 if full.everyone else 429,
+                                  f"{'the server is busy with' if full.everyone else 'this address has'} "
+                                  f"{full.limit} slow requests (lenses, charts) waiting; try again",
+                                  [(b"retry-after", b"1")]) from None
+                hit = await asyncio.wrap_future(future)
             else:
                 hit = _computed(fn, media)
             self.cache.put(key, hit)
@@ -345,7 +364,7 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
 
     async def report(request):
         q = core.query(request.scope, "report")
-        body = await core.answer(("report", tuple(sorted(q.items()))), lambda: backend.report(q),
+        body = await core.answer(request.scope, ("report", tuple(sorted(q.items()))), lambda: backend.report(q),
                                  heavy=heavy_report(q), media="application/json")
         return ok(body, "application/json")
 
@@ -367,24 +386,24 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
             return rows
 
         key = ("focus-table", tuple(marks), tuple(sorted(q.items())))
-        body = await core.answer(key, table, heavy=heavy_report(q), media="application/json")
+        body = await core.answer(request.scope, key, table, heavy=heavy_report(q), media="application/json")
         return ok(body, "application/json")
 
     async def dof_svg(request):
         q = core.query(request.scope, "report")
-        body = await core.answer(("dof.svg", tuple(sorted(q.items()))), lambda: backend.dof_svg(q),
+        body = await core.answer(request.scope, ("dof.svg", tuple(sorted(q.items()))), lambda: backend.dof_svg(q),
                                  heavy=True, media="image/svg+xml")
         return ok(body, "image/svg+xml")
 
     async def sensors(request):
         q = core.query(request.scope, "sensors")
-        body = await core.answer(("sensors", tuple(sorted(q.items()))), lambda: backend.sensors(q),
+        body = await core.answer(request.scope, ("sensors", tuple(sorted(q.items()))), lambda: backend.sensors(q),
                                  heavy=False, media="application/json")
         return ok(body, "application/json")
 
     async def lenses(request):
         core.query(request.scope, "lenses")
-        body = await core.answer(("lenses",), backend.lenses, heavy=True, media="application/json")
+        body = await core.answer(request.scope, ("lenses",), backend.lenses, heavy=True, media="application/json")
         return ok(body, "application/json")
 
     def _name(request) -> str:
@@ -396,15 +415,15 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
     async def lens(request):
         name = _name(request)
         q = core.query(request.scope, "lens")
-        body = await core.answer(("lens", name, tuple(sorted(q.items()))), lambda: backend.lens(name, q),
+        body = await core.answer(request.scope, ("lens", name, tuple(sorted(q.items()))), lambda: backend.lens(name, q),
                                  heavy=True, media="application/json")
         return ok(body, "application/json")
 
     async def diagram(request):
         name = _name(request)
         q = core.query(request.scope, "diagram")
-        body = await core.answer(("diagram", name, tuple(sorted(q.items()))), lambda: backend.diagram_svg(name, q),
-                                 heavy=True, media="image/svg+xml")
+        body = await core.answer(request.scope, ("diagram", name, tuple(sorted(q.items()))),
+                                 lambda: backend.diagram_svg(name, q), heavy=True, media="image/svg+xml")
         return ok(body, "image/svg+xml")
 
     async def health(request):

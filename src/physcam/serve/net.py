@@ -11,8 +11,12 @@ from __future__ import annotations
 
 import ipaddress
 import socket
+from typing import TYPE_CHECKING
 
 from ..errors import InputError, WrongTypeError
+
+if TYPE_CHECKING:
+    from .app import Limits
 
 __all__ = ["bind_socket", "lan_addresses", "qr_text", "run_server", "asgi_get", "url_for"]
 
@@ -116,18 +120,28 @@ def qr_text(url: str) -> str:
     return buf.getvalue()
 
 
-def run_server(app, sock: socket.socket, *, log_requests: bool = False) -> None:
-    """Serve ``app`` on the listening ``sock`` with uvicorn until interrupted (Ctrl-C, SIGTERM)."""
+def run_server(app, sock: socket.socket, *, log_requests: bool = False, limits: Limits | None = None) -> None:
+    """Serve ``app`` on the listening ``sock`` with uvicorn until interrupted (Ctrl-C, SIGTERM),
+    each connection bounded by ``limits`` (default :class:`~physcam.serve.app.Limits`): the head
+    cap, the header timeout and the connection caps of :mod:`physcam.serve.protocol`."""
+    from .app import Limits
+
     if not callable(app):
         raise WrongTypeError(f"app must be an ASGI application, got {type(app).__name__}")
     if not isinstance(sock, socket.socket):
         raise WrongTypeError(f"sock must be a listening socket, got {type(sock).__name__}")
+    limits = Limits() if limits is None else limits
+    if not isinstance(limits, Limits):
+        raise WrongTypeError(f"limits must be a physcam.serve.Limits, got {type(limits).__name__}")
     import uvicorn
 
+    from .protocol import protocol_class
+
     config = uvicorn.Config(
-        app, http="h11", loop="asyncio", lifespan="off", ws="none", interface="asgi3",
+        app, http=protocol_class(limits), loop="asyncio", lifespan="off", ws="none", interface="asgi3",
         log_level="warning", access_log=bool(log_requests), server_header=False, proxy_headers=False,
-        timeout_keep_alive=5, limit_concurrency=256, backlog=128, h11_max_incomplete_event_size=16 * 1024,
+        timeout_keep_alive=limits.keep_alive, limit_concurrency=None, backlog=128,
+        h11_max_incomplete_event_size=limits.head_bytes,
     )
     uvicorn.Server(config).run(sockets=[sock])
 

@@ -1,0 +1,110 @@
+"""The one thread that does ``physcam serve``'s slow work, shared fairly between client addresses.
+
+The lens tracer (numba) and matplotlib are not to be entered from two threads at once, and the
+GIL would serialise them anyway, so one thread draws every chart and traces every lens. A
+single first-in first-out queue let one address that asks faster than the thread draws fill the
+queue and starve everyone else (issue 24 item 11). Here each address has its own queue and the
+thread takes one job from each address in turn (round robin, addresses in order of arrival), so
+a chart asked by a second address waits for at most the job being done and one job of each other
+address with work waiting. Each address may have ``per_client`` jobs pending (waiting or
+running) and all of them together ``total``; beyond either, :meth:`FairWorker.submit` raises
+:class:`Full` and the server answers 429 or 503 (docs/serve.md).
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import OrderedDict, deque
+from concurrent.futures import Future
+
+from ..errors import WrongTypeError
+
+__all__ = ["FairWorker", "Full"]
+
+
+class Full(Exception):
+    """No room for another job: ``everyone`` is True when all addresses together have ``total``
+    pending (503), False when this address has its ``per_client`` (429)."""
+
+    def __init__(self, everyone: bool, limit: int):
+        super().__init__(f"{limit} slow requests are pending" + (" in all" if everyone else " from this address"))
+        self.everyone, self.limit = everyone, limit
+
+
+class FairWorker:
+    """One daemon thread running submitted functions, one per client address in turn."""
+
+    def __init__(self, per_client: int, total: int, name: str = "physcam-serve"):
+        for label, v in (("per_client", per_client), ("total", total)):
+            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+                raise WrongTypeError(f"FairWorker {label} must be a positive integer, got {v!r}")
+        self.per_client, self.total, self.name = per_client, total, name
+        self._cv = threading.Condition()
+        self._queues: OrderedDict[str, deque] = OrderedDict()  # the turn order: first key goes next
+        self._pending: dict[str, int] = {}  # waiting + running, per address
+        self._closed = False
+        self._thread: threading.Thread | None = None
+
+    def pending(self, client: str | None = None) -> int:
+        """Jobs waiting or running: of ``client``, or of everyone."""
+        with self._cv:
+            return sum(self._pending.values()) if client is None else self._pending.get(client, 0)
+
+    def submit(self, client: str, fn) -> Future:
+        """Queue ``fn()`` for ``client``; its future holds the result (or the exception)."""
+        with self._cv:
+            if self._closed:
+                raise RuntimeError("the worker is closed")
+            if sum(self._pending.values()) >= self.total:
+                raise Full(True, self.total)
+            if self._pending.get(client, 0) >= self.per_client:
+                raise Full(False, self.per_client)
+            future: Future = Future()
+            self._queues.setdefault(client, deque()).append((future, fn))
+            self._pending[client] = self._pending.get(client, 0) + 1
+            if self._thread is None:
+                self._thread = threading.Thread(target=self._run, name=self.name, daemon=True)
+                self._thread.start()
+            self._cv.notify()
+        return future
+
+    def close(self) -> None:
+        """Stop taking jobs; the thread ends once the queued ones are done."""
+        with self._cv:
+            self._closed = True
+            self._cv.notify()
+
+    def _next(self):
+        """The next (client, future, fn) in turn, or None when closed and empty. Holds the lock."""
+        while not self._queues:
+            if self._closed:
+                return None
+            self._cv.wait()
+        client, queue = next(iter(self._queues.items()))
+        future, fn = queue.popleft()
+        if queue:
+            self._queues.move_to_end(client)  # its next job waits for every other address's turn
+        else:
+            del self._queues[client]
+        return client, future, fn
+
+    def _run(self) -> None:
+        while True:
+            with self._cv:
+                job = self._next()
+            if job is None:
+                return
+            client, future, fn = job
+            try:
+                if future.set_running_or_notify_cancel():
+                    try:
+                        future.set_result(fn())
+                    except BaseException as exc:  # noqa: BLE001 - handed to the waiting request
+                        future.set_exception(exc)
+            finally:
+                with self._cv:
+                    left = self._pending[client] - 1
+                    if left:
+                        self._pending[client] = left
+                    else:
+                        del self._pending[client]

@@ -1,0 +1,291 @@
+"""`physcam serve` against abusive clients, over real sockets to the real process (issue 24 item 11).
+
+One client address abuses the server (127.0.0.2, ...: Linux routes all of 127.0.0.0/8 to the
+loopback interface, so a test can be several clients), another (127.0.0.1) uses it normally:
+half-sent requests, a flood of slow work and oversized heads from the first must not lock out,
+starve or slip past the bounds for the second (docs/serve.md, "Limits per address").
+"""
+
+from __future__ import annotations
+
+import asyncio
+import http.client
+import json
+import socket
+import sys
+import threading
+import time
+from urllib.parse import urlencode
+
+import pytest
+from _serve_helpers import running_server
+
+LINUX = sys.platform.startswith("linux")
+needs_loopback_net = pytest.mark.skipif(not LINUX, reason="needs 127.0.0.0/8 on loopback (Linux) for two client "
+                                                          "addresses on one machine")
+NORMAL, ABUSER = "127.0.0.1", "127.0.0.2"
+HEAD_TIMEOUT = 5.0  # the documented header timeout (Limits.head_timeout)
+
+
+@pytest.fixture(scope="module")
+def server():
+    with running_server() as (_, port, proc):  # the default limits, as on set
+        yield port, proc
+
+
+def connect(port, source, timeout=10.0):
+    return socket.create_connection(("127.0.0.1", port), timeout=timeout, source_address=(source, 0))
+
+
+def read_answer(sock):
+    """(status, headers, body) of the answer on ``sock``; (None, {}, b"") when it closes without one."""
+    r = http.client.HTTPResponse(sock)
+    try:
+        r.begin()
+    except http.client.RemoteDisconnected:
+        return None, {}, b""
+    return r.status, {k.lower(): v for k, v in r.getheaders()}, r.read()
+
+
+def get(port, path, source=NORMAL, timeout=10.0):
+    c = http.client.HTTPConnection("127.0.0.1", port, timeout=timeout, source_address=(source, 0))
+    try:
+        c.request("GET", path)
+        r = c.getresponse()
+        return r.status, {k.lower(): v for k, v in r.getheaders()}, r.read()
+    finally:
+        c.close()
+
+
+def assert_refusal(status, headers, body, expected):
+    assert status == expected, (status, body[:200])
+    assert headers["content-type"].startswith("application/json") and headers["connection"] == "close"
+    assert body.count(b"\n") == 0 and json.loads(body)["error"]
+
+
+def _trickle(port, source, out):
+    """A head sent one header line each 0.5 s, never finished: when does the server answer?"""
+    with connect(port, source) as s:
+        t0 = time.monotonic()
+        s.sendall(b"GET /api/health HTTP/1.1\r\nHost: x\r\n")
+        s.settimeout(0.5)
+        for i in range(30):
+            try:
+                first = s.recv(1)
+            except TimeoutError:
+                try:
+                    s.sendall(f"X-Slow-{i}: {i}\r\n".encode())
+                except OSError:
+                    pass
+                continue
+            out["after"] = time.monotonic() - t0
+            s.settimeout(5)
+            rest = b""
+            while chunk := s.recv(4096):
+                rest += chunk
+            out["answer"] = first + rest
+            return
+
+
+def _silent(port, source, out):
+    """A connection that sends nothing: when is it closed, and with what?"""
+    with connect(port, source) as s:
+        t0 = time.monotonic()
+        s.settimeout(15)
+        data = b""
+        try:
+            while chunk := s.recv(4096):
+                data += chunk
+        except TimeoutError:
+            return
+        out["after"], out["answer"] = time.monotonic() - t0, data
+
+
+@needs_loopback_net
+def test_half_sent_requests_from_one_address_do_not_lock_out_another(server):
+    """300 connections from one address, each with a head never finished: another address is
+    answered at once; the first keeps 32 connections (the 33rd on is answered 429 and closed), and
+    each of those is answered 408 five seconds after it opened, however slowly it trickles bytes."""
+    port, proc = server
+    trickled, silent = {}, {}
+    threads = [threading.Thread(target=_trickle, args=(port, "127.0.0.3", trickled)),
+               threading.Thread(target=_silent, args=(port, "127.0.0.4", silent))]
+    for t in threads:
+        t.start()
+    socks, opened = [], []
+    try:
+        for _ in range(300):
+            s = connect(port, ABUSER)
+            s.sendall(b"GET /api/health HTTP/1.1\r\nHost: x\r\nX-Half: ")
+            socks.append(s)
+            opened.append(time.monotonic())
+        for _ in range(20):
+            t0 = time.monotonic()
+            status, _, body = get(port, "/api/health", timeout=10)
+            took = time.monotonic() - t0
+            assert status == 200, (status, body)
+            assert took < 2.0, f"the normal client waited {took:.2f} s"
+        answers = []
+        for s, t_open in zip(socks, opened):
+            s.settimeout(HEAD_TIMEOUT + 5)
+            status, headers, body = read_answer(s)
+            answers.append(status)
+            if status == 408:
+                assert_refusal(status, headers, body, 408)
+                waited = time.monotonic() - t_open
+                assert HEAD_TIMEOUT - 0.5 < waited < HEAD_TIMEOUT + 2.5, waited
+            else:
+                assert_refusal(status, headers, body, 429)
+        assert answers.count(408) == 32 and answers.count(429) == 268, {a: answers.count(a) for a in set(answers)}
+    finally:
+        for s in socks:
+            s.close()
+        for t in threads:
+            t.join(30)
+    # the clock does not restart when bytes trickle in; a connection that sends nothing is closed unanswered
+    assert trickled and trickled["answer"].startswith(b"HTTP/1.1 408 "), trickled
+    assert HEAD_TIMEOUT - 0.5 < trickled["after"] < HEAD_TIMEOUT + 2.0, trickled
+    assert silent == {"after": pytest.approx(HEAD_TIMEOUT, abs=2.0), "answer": b""}, silent
+    assert proc.poll() is None and get(port, "/api/health")[0] == 200
+
+
+@needs_loopback_net
+def test_connections_are_capped_in_all(server):
+    """256 open connections in all (32 from each of 8 addresses): the next is answered 503."""
+    port, _ = server
+    socks = []
+    try:
+        for k in range(8):
+            for _ in range(32):
+                socks.append(connect(port, f"127.0.1.{k + 1}"))
+        time.sleep(0.3)  # let the server accept them all
+        with connect(port, "127.0.2.1") as s:
+            s.sendall(b"GET /api/health HTTP/1.1\r\nHost: x\r\n\r\n")
+            assert_refusal(*read_answer(s), 503)
+    finally:
+        for s in socks:
+            s.close()
+    time.sleep(0.3)
+    assert get(port, "/api/health")[0] == 200
+
+
+def _head(extra_bytes: int) -> bytes:
+    head = b"GET /api/health HTTP/1.1\r\nHost: x\r\nX-Big: " + b"a" * extra_bytes + b"\r\n\r\n"
+    return head
+
+
+def test_request_head_is_capped_at_16_kib_whole_or_in_pieces(server):
+    port, _ = server
+    big = _head(20_000)  # 20 KB of header, in one piece: h11 alone only bounds an incomplete head
+    with connect(port, NORMAL) as s:
+        s.sendall(big)
+        assert_refusal(*read_answer(s), 431)
+    with connect(port, NORMAL) as s:  # the same in 1 KB pieces
+        for i in range(0, len(big), 1024):
+            try:
+                s.sendall(big[i:i + 1024])
+            except OSError:  # refused part way: the answer is already there
+                break
+            time.sleep(0.002)
+        assert_refusal(*read_answer(s), 431)
+    ok = _head(15 * 1024)  # a 15 KiB header: the whole head is under 16 KiB
+    assert len(ok) < 16 * 1024
+    with connect(port, NORMAL) as s:
+        s.sendall(ok)
+        status, _, body = read_answer(s)
+        assert status == 200 and json.loads(body)["ok"] is True
+
+
+def test_malformed_http_is_one_json_line(server):
+    port, _ = server
+    with connect(port, NORMAL) as s:
+        s.sendall(b"GET /api/health HTTP/1.1\r\nHost x no colon\r\n\r\n")
+        assert_refusal(*read_answer(s), 400)
+
+
+# --- sharing the slow work ---------------------------------------------------------------------
+def _chart(focus_mm: int) -> str:
+    return "/api/dof.svg?" + urlencode({"focal": 50, "fstop": 2.8, "focus": f"{focus_mm}mm", "sensor": "S35"})
+
+
+async def _flood(port, rate, seconds, statuses, stop):
+    """Distinct charts from ABUSER at ``rate`` per second, open loop, one connection each."""
+
+    async def one(path):
+        try:
+            r, w = await asyncio.open_connection("127.0.0.1", port, local_addr=(ABUSER, 0))
+            w.write(f"GET {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n".encode())
+            line = await asyncio.wait_for(r.readline(), 30)
+            statuses.append(int(line.split()[1]) if line else None)
+            w.close()
+        except (TimeoutError, OSError, ValueError, IndexError):
+            statuses.append(None)
+
+    tasks, t0 = [], time.monotonic()
+    for i in range(int(rate * seconds)):
+        if stop.is_set():
+            break
+        await asyncio.sleep(max(0.0, t0 + i / rate - time.monotonic()))
+        tasks.append(asyncio.ensure_future(one(_chart(3000 + i))))
+    await asyncio.gather(*tasks)
+
+
+@needs_loopback_net
+def test_a_flood_of_slow_work_from_one_address_does_not_starve_another(server):
+    """40 distinct charts per second from one address (the worker draws about 20): a chart asked by
+    another address waits at most the chart being drawn and one of the flood's, not the flood's
+    queue. Bound: 0.5 s + 5 x the chart's time with the server to itself (before: 503, or ~32 charts)."""
+    port, proc = server
+    assert get(port, _chart(1000))[0] == 200  # the first chart imports matplotlib
+    alone = []
+    for k in range(3):
+        t0 = time.monotonic()
+        assert get(port, _chart(1100 + k))[0] == 200
+        alone.append(time.monotonic() - t0)
+    t_alone = max(alone)  # the slowest of three: a loaded machine varies (the queue before took ~32 of them)
+    bound = 0.5 + 5 * t_alone
+    statuses, stop = [], threading.Event()
+    flood = threading.Thread(target=lambda: asyncio.run(_flood(port, 40, 5, statuses, stop)))
+    flood.start()
+    try:
+        time.sleep(2.0)  # the flood has filled whatever queue it can
+        waits = []
+        for k in range(2):
+            t0 = time.monotonic()
+            status, _, body = get(port, _chart(1200 + k), timeout=30)
+            waits.append(time.monotonic() - t0)
+            assert status == 200, (status, body[:200])
+        assert max(waits) < bound, f"waited {waits} s; alone a chart takes {t_alone:.3f} s (bound {bound:.2f} s)"
+    finally:
+        stop.set()
+        flood.join(60)
+    # the flood was refused (429, its address's share is full), never a 5xx
+    assert set(statuses) <= {200, 429} and 429 in statuses, {s: statuses.count(s) for s in set(statuses)}
+    assert proc.poll() is None
+
+
+def test_the_worker_takes_one_job_from_each_address_in_turn():
+    """Jobs queued while A0 holds the worker: A1 A2 (A3 refused: A has 3 pending with A0), B1,
+    C1 C2, D1 (E refused: 7 pending in all). Round robin over the addresses in order of arrival,
+    one job each per turn, worked by hand: A1 B1 C1 D1, then A2 C2."""
+    from physcam.serve.worker import FairWorker, Full
+
+    done, gate = [], threading.Event()
+    w = FairWorker(per_client=3, total=7)
+    futures = [w.submit("A", gate.wait)]  # A0 holds the worker until the queue is built
+    time.sleep(0.05)
+    for who, name in [("A", "A1"), ("A", "A2"), ("B", "B1"), ("C", "C1"), ("C", "C2")]:
+        futures.append(w.submit(who, lambda n=name: done.append(n)))
+    with pytest.raises(Full) as over:  # A has three pending (A0 runs, A1 and A2 wait)
+        w.submit("A", lambda: done.append("A3"))
+    assert over.value.everyone is False
+    futures.append(w.submit("D", lambda: done.append("D1")))  # 7 pending in all
+    with pytest.raises(Full) as full:
+        w.submit("E", lambda: None)
+    assert full.value.everyone is True
+    gate.set()
+    for f in futures:
+        f.result(timeout=10)
+    assert done == ["A1", "B1", "C1", "D1", "A2", "C2"]
+    assert w.pending() == 0
+    w.close()
