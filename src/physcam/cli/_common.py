@@ -101,8 +101,8 @@ def _finite(name: str, text) -> float:
     if not math.isfinite(v):
         raise argparse.ArgumentTypeError(f"{name} must be a finite number, got {_shown(text)}")
     if v != 0.0 and abs(v) < sys.float_info.min:
-        raise argparse.ArgumentTypeError(f"{name} must be 0 or at least {sys.float_info.min:.3g} in size, "
-                                         f"got {_shown(text)}")
+        raise argparse.ArgumentTypeError(f"{name} is out of range: it must be 0 or at least {sys.float_info.min:.3g} "
+                                         f"in size, got {_shown(text)}")
     return v
 
 
