@@ -67,3 +67,52 @@ def test_concurrent_no_clobber_writers_have_exactly_one_winner(tmp_path):
             assert len(winners) == 1, f"trial {trial}: {len(winners)} writers reported success"
             assert path.read_text() == f"written by {winners[0]}\n" * 2000
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]  # no temporary left behind
+
+
+# ---- temporaries a killed writer leaves (issue 24 item 12) ------------------------------------------
+def _dead_pid() -> int:
+    """The id of a process that has ended (a child reaped here; ids are not reused at once)."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-c", "pass"])
+    proc.wait()
+    return proc.pid
+
+
+def _litter(folder, target, host, pid, suffix=".tmp"):
+    from physcam.io import TEMP_MARK
+
+    p = folder / f".{target}{TEMP_MARK}{host}.{pid}.0badc0de{suffix}"
+    p.write_bytes(b"half a file")
+    return p
+
+
+def test_the_next_write_removes_only_dead_local_writers_temporaries(tmp_path):
+    import socket
+    import subprocess
+    import sys
+
+    from physcam.io import _host
+
+    assert _host() == "".join(c if c.isalnum() or c in "-_" else "-" for c in socket.gethostname())[:64]
+    running = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        dead = _litter(tmp_path, "shot.usda", _host(), _dead_pid())
+        dead_crate = _litter(tmp_path, "shot.usda", _host(), _dead_pid(), suffix=".usdc")
+        alive = _litter(tmp_path, "shot.usda", _host(), running.pid)
+        elsewhere = _litter(tmp_path, "shot.usda", "render-node-7", _dead_pid())
+        other_target = _litter(tmp_path, "shot2.usda", _host(), _dead_pid())
+        atomic_write(tmp_path / "shot.usda", "new")
+        left = {p.name for p in tmp_path.iterdir()}
+        assert dead.name not in left and dead_crate.name not in left
+        assert {alive.name, elsewhere.name, other_target.name, "shot.usda"} == left
+    finally:
+        running.kill()
+        running.wait()
+
+
+def test_a_temporary_of_a_long_target_name_fits_the_file_system(tmp_path):
+    name = "x" * 250 + ".usda"  # 255 bytes: the longest name most file systems take
+    p = atomic_write(tmp_path / name, "ok")
+    assert p.read_text() == "ok" and [f.name for f in tmp_path.iterdir()] == [name]

@@ -1,19 +1,37 @@
 """Files written safely: atomically, and never over an existing file unless asked.
 
-Every writer in physcam goes through :func:`atomic_write` so a crash leaves
-either the old file or the new one, never half of one.
+Every writer in physcam goes through :func:`atomic_write` (or :func:`staged`, for a library
+that writes the file itself) so a crash leaves either the old file or the new one, never half
+of one.
+
+The temporary file is hidden next to the target and named for it, this host and this process:
+``.<target>.physcam-tmp.<host>.<pid>.<random><suffix>``. A process killed mid-write (SIGKILL,
+power loss) leaves its temporary behind; the next write of the same target removes those of
+processes on this host that no longer run (:func:`remove_stale_temporaries`). Temporaries of
+running processes, and of other hosts sharing the folder (whose processes cannot be seen from
+here), are left alone.
 """
 
 from __future__ import annotations
 
+import contextlib
 import errno
+import hashlib
 import os
-import tempfile
+import re
+import secrets
+import socket
 from pathlib import Path
 
 from .errors import ExportError
 
-__all__ = ["atomic_write", "check_writable"]
+__all__ = ["atomic_write", "check_writable", "remove_stale_temporaries", "staged"]
+
+#: What marks a physcam temporary file's name, after the hidden target name.
+TEMP_MARK = ".physcam-tmp."
+#: A target name longer than this (bytes) is shortened in its temporary's name (start and a hash),
+#: so that the temporary stays within the file system's 255-byte limit.
+_TEMP_NAME_BYTES = 120
 
 
 def check_writable(path, *, force: bool = False) -> Path:
@@ -59,37 +77,115 @@ def _publish_new(tmp: str, p: Path) -> None:
     os.unlink(tmp)
 
 
+def _host() -> str:
+    """This machine's name as it goes into a temporary's name (letters, digits, - and _)."""
+    return re.sub(r"[^A-Za-z0-9_-]", "-", socket.gethostname() or "host")[:64]
+
+
+def _temp_prefix(p: Path) -> str:
+    """``.<target>.physcam-tmp.``: what every temporary of target ``p`` starts with."""
+    name = p.name
+    raw = name.encode("utf-8", "surrogateescape")
+    if len(raw) > _TEMP_NAME_BYTES:
+        digest = hashlib.sha1(raw).hexdigest()[:12]
+        name = raw[:60].decode("utf-8", "ignore") + "~" + digest
+    return f".{name}{TEMP_MARK}"
+
+
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` exists on this host (signal 0 checks without sending anything)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError):
+        return pid > 0  # another user's process: running
+    return True
+
+
+def remove_stale_temporaries(path) -> list[Path]:
+    """Remove the temporaries of ``path`` that processes of this host left when killed mid-write;
+    return them. Those of running processes and of other hosts are kept."""
+    p = Path(path)
+    prefix, host, removed = _temp_prefix(p), _host(), []
+    try:
+        entries = list(os.scandir(p.parent if str(p.parent) else "."))
+    except OSError:
+        return removed
+    for entry in entries:
+        if not entry.name.startswith(prefix):
+            continue
+        parts = entry.name[len(prefix):].split(".")
+        if len(parts) < 3 or parts[0] != host or not parts[1].isdigit() or _running(int(parts[1])):
+            continue
+        try:
+            if entry.is_file(follow_symlinks=False):
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+        except OSError:  # gone already (another writer cleaned it) or not ours to remove
+            pass
+    return removed
+
+
+def _new_temporary(p: Path, suffix: str) -> str:
+    """Create (exclusively, mode 0600) a fresh temporary for ``p`` in its folder; return its path."""
+    name = f"{_temp_prefix(p)}{_host()}.{os.getpid()}.{secrets.token_hex(4)}{suffix}"
+    tmp = os.path.join(p.parent, name)
+    os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
+    return tmp
+
+
+def _make_folder(p: Path) -> None:
+    try:
+        p.parent.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        raise ExportError(f"cannot write {p}: a part of its folder {p.parent} is a file, not a folder") from None
+
+
+@contextlib.contextmanager
+def staged(path, *, force: bool = False, suffix: str = ".tmp"):
+    """Write a file in place atomically: yields a temporary path (ending in ``suffix``, for
+    libraries that pick a format by extension) next to ``path``; fill it, and on leaving the
+    block it is synced and renamed to ``path`` (see :func:`atomic_write` for ``force``). On an
+    error the temporary is removed; stale temporaries of ``path`` are removed first (module notes)."""
+    p = check_writable(path, force=force)
+    try:
+        _make_folder(p)
+        remove_stale_temporaries(p)
+        tmp = _new_temporary(p, suffix)
+    except OSError as exc:
+        raise ExportError(f"cannot write {p}: {exc.strerror or exc}") from None
+    try:
+        yield Path(tmp)
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        # the temporary is private (0600); give it the mode a plain open() would (0666 less the
+        # umask), or keep the mode of the file it replaces
+        replaced = force and p.exists()
+        os.chmod(tmp, (os.stat(p).st_mode & 0o7777) if replaced else (0o666 & ~_umask()))
+        if force:
+            os.replace(tmp, p)
+        else:
+            _publish_new(tmp, p)
+    except OSError as exc:
+        raise ExportError(f"cannot write {p}: {exc.strerror or exc}") from None
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
 def atomic_write(path, data: bytes | str, *, force: bool = False, encoding: str = "utf-8") -> Path:
     """Write ``data`` to ``path`` through a temporary file in the same folder, then rename.
 
     Creates missing parent folders. Raises :class:`ExportError` when ``path`` exists and
     ``force`` is false (checked before writing, and again atomically when the file is put in
     place, so of several writers racing for one new name exactly one succeeds), or when the
-    folder cannot be written.
+    folder cannot be written. Temporaries a killed writer left for ``path`` are removed (module notes).
     """
-    p = check_writable(path, force=force)
     if isinstance(data, str):
         data = data.encode(encoding)
-    try:
-        p.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
-            # mkstemp makes the file private (0600); give it the mode a plain open() would
-            # (0666 less the umask), or keep the mode of the file it replaces
-            replaced = force and p.exists()
-            os.chmod(tmp, (os.stat(p).st_mode & 0o7777) if replaced else (0o666 & ~_umask()))
-            if force:
-                os.replace(tmp, p)
-            else:
-                _publish_new(tmp, p)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
-    except OSError as exc:
-        raise ExportError(f"cannot write {p}: {exc.strerror or exc}") from None
-    return p
+    with staged(path, force=force) as tmp, open(tmp, "wb") as fh:
+        fh.write(data)
+    return Path(path)

@@ -9,7 +9,10 @@ to them the day it arrives (docs/cli.md, "Writing a command"):
 - every command taking a sensor takes the shared sensor options and says its default;
 - tables piped or redirected are plain and complete (no box, no ellipsis);
 - one grammar (issue 26): a lens is always ``--lens NAME_OR_FILE`` (the old positional spelling is
-  hidden and says it is deprecated), and every single-value option given twice is an error naming it.
+  hidden and says it is deprecated), and every single-value option given twice is an error naming it;
+- hostile numbers (issue 24 item 12): no option reads its value with bare ``int`` or ``float`` (a
+  400-digit count or 1e-320 reached the handlers and overflowed there): integers are
+  ``_common.whole`` (bounded), real numbers ``_common.number`` (finite, no subnormals).
 """
 
 from __future__ import annotations
@@ -394,3 +397,29 @@ def test_every_single_value_option_given_twice_is_an_error(capsys):
             assert f"{opt} was given twice" in err, (path, opt, err)
             checked += 1
     assert checked > 100
+
+
+# ---- hostile numbers (issue 24 item 12) -------------------------------------------------------------
+def test_no_option_reads_a_bare_int_or_float():
+    """Every integer option is bounded (``_common.whole``); no option is ``type=int`` or ``type=float``."""
+    bare, wholes = [], 0
+    for path, p in LEAVES.items():
+        for a in p._actions:
+            if a.type in (int, float):
+                bare.append(f"{' '.join(path)} {a.option_strings[0] if a.option_strings else a.dest}")
+            wholes += getattr(a.type, "physcam_whole", None) is not None
+    assert not bare, f"use _common.whole (integers) or _common.number (reals): {bare}"
+    assert wholes >= 25
+
+
+def test_whole_options_refuse_a_400_digit_number():
+    """A 400-digit count is refused by every integer option's type (bounds at most 2**53: a float holds it)."""
+    huge = "9" * 400
+    for path, p in LEAVES.items():
+        for a in p._actions:
+            bounds = getattr(a.type, "physcam_whole", None)
+            if bounds is None:
+                continue
+            assert -(2**53) <= bounds[0] <= bounds[1] <= 2**53, (path, a.option_strings)
+            with pytest.raises(argparse.ArgumentTypeError, match="whole number from"):
+                a.type(huge)

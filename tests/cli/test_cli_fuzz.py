@@ -1,7 +1,11 @@
 """Fuzz every CLI subcommand (issue 8): hypothesis picks flags and extreme, empty and non-numeric
 values; each run is forked (from a clean fork server) with an address-space limit and must end with exit 0 or 2, no
 traceback, a single "physcam: error:" line when it refuses, no NaN/inf printed as a result, and
-a peak resident memory under 2 GB."""
+a peak resident memory under 2 GB.
+
+Hostile values too (issue 24 item 12): names and paths of 300 characters (past the system's 255),
+400-digit integers, subnormals (1e-320), 1e400, a lens file and a user config nested 5000 deep.
+The lens is given as ``--lens`` (the grammar of issue 26), drawn for every command that takes one."""
 
 from __future__ import annotations
 
@@ -25,11 +29,19 @@ MAX_RSS_BYTES = 2 * 1024**3
 ADDRESS_SPACE_BYTES = 6 * 1024**3
 RUN_TIMEOUT_S = 180
 
+LONG = "n" * 300  # a file name longer than NAME_MAX (255 bytes)
+HUGE = "9" * 400
+#: written into each fuzz folder: TOML nested deeper than Python's recursion limit
+DEEP_LENS, DEEP_CONFIG = "deep_lens.toml", "deep_config.toml"
+DEEP = 5000
 NUMBERS = ["0", "-1", "1", "2.8", "50", "1e308", "-1e308", "5e-324", "1e12", "nan", "inf", "-inf", "", "abc",
-           "3m", "10ft", "0.001mm", "100000", "-0"]
+           "3m", "10ft", "0.001mm", "100000", "-0", "1e-320", "1e400", HUGE, "-" + HUGE]
 LENSES = ["dgauss_50mm", "nikkor_fisheye_16mm_f2_8", "navarro_anamorphic_2x", "fisheye_10mm", "no_such_lens", "",
-          "/dev/null"]
-FILES = ["out.usda", "out.png", "out.svg", "out.txt", "", "missing_dir/out.usda", "out.usdc"]
+          "/dev/null", LONG, LONG + ".toml", f"{LONG}/lens.toml", DEEP_LENS]
+FILES = ["out.usda", "out.png", "out.svg", "out.txt", "", "missing_dir/out.usda", "out.usdc", LONG + ".usda",
+         f"{LONG}/out.usda", LONG]
+#: the user config of a run: none, a good one, one nested 5000 deep
+CONFIGS = ["", "good_config.toml", DEEP_CONFIG]
 #: flags appended to every fuzzed run of a command (after the drawn ones, so they win): receivers and
 #: senders run for a bounded time instead of until Ctrl-C
 BOUNDED = {("live", "record"): ["--duration=0.3"], ("live", "send"): ["--duration=0.3"],
@@ -74,7 +86,7 @@ def _value_strategy(action):
     if action.choices is not None:
         return st.sampled_from([str(c) for c in action.choices] + ["bogus"])
     dest = action.dest.lower()
-    if dest in ("lens",) or "lens" in dest and action.option_strings == []:
+    if dest in ("lens", "lenses") or "lens" in dest and action.option_strings == []:
         return st.sampled_from(LENSES)
     if dest in ("file", "output", "plot", "out", "body", "lens_file") or "file" in dest:
         return st.sampled_from(FILES)
@@ -99,10 +111,17 @@ def _argv_strategy(path, parser):
     @st.composite
     def build(draw):
         argv = list(path) + BASE_ARGV.get(tuple(path), [])
+        lens = [a for a in options if a.option_strings == ["--lens"]]
+        if lens and draw(st.integers(0, 9)):  # the lens, as --lens (one run in ten without: refused)
+            n = draw(st.integers(1, 2)) if isinstance(lens[0], argparse._AppendAction) else 1
+            argv += [f"--lens={draw(st.sampled_from(LENSES))}" for _ in range(n)]
         for a in positionals:
+            if a.dest == "_lens_positional":  # the deprecated spelling: --lens above
+                continue
             n = 1 if a.nargs in (None, 1) else draw(st.integers(1, 2))
             argv += [draw(_value_strategy(a)) for _ in range(n)]
-        chosen = draw(st.lists(st.sampled_from(options), max_size=4, unique_by=id)) if options else []
+        others = [a for a in options if a not in lens]
+        chosen = draw(st.lists(st.sampled_from(others), max_size=4, unique_by=id)) if others else []
         for a in chosen:
             flag = a.option_strings[-1]
             if a.nargs == 0:
@@ -111,7 +130,7 @@ def _argv_strategy(path, parser):
                 n = 1 if a.nargs in (None, 1, "?") else draw(st.integers(1, 2))
                 for _ in range(n):
                     argv.append(f"{flag}={draw(_value_strategy(a))}")
-        return argv + BOUNDED.get(tuple(path), [])
+        return argv + BOUNDED.get(tuple(path), []), draw(st.sampled_from(CONFIGS))
 
     return build()
 
@@ -140,6 +159,7 @@ for line in sys.stdin:
             sys.stdout = os.fdopen(1, "w", closefd=False)
             sys.stderr = os.fdopen(2, "w", closefd=False)
             os.environ["COLUMNS"] = "200"
+            os.environ["PHYSCAM_CONFIG"] = req["config"]
             rc = main(req["argv"])
         except BaseException:
             import traceback
@@ -175,13 +195,14 @@ class ForkServer:
         self.proc = subprocess.Popen([sys.executable, "-c", FORK_SERVER, str(ADDRESS_SPACE_BYTES), str(RUN_TIMEOUT_S)],
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
 
-    def run(self, argv, workdir):
+    def run(self, argv, workdir, config=""):
         """Run ``main(argv)`` in a forked child of the server; returns (rc, stdout, stderr, peak RSS bytes)."""
         import json
 
         out_path = os.path.join(workdir, ".stdout")
         err_path = os.path.join(workdir, ".stderr")
-        self.proc.stdin.write(json.dumps({"argv": argv, "cwd": workdir, "out": out_path, "err": err_path}) + "\n")
+        self.proc.stdin.write(json.dumps({"argv": argv, "cwd": workdir, "out": out_path, "err": err_path,
+                                          "config": config}) + "\n")
         self.proc.stdin.flush()
         reply = json.loads(self.proc.stdout.readline())
         if reply["timed_out"]:
@@ -200,19 +221,33 @@ class ForkServer:
 #: checkers exit 1 when they find a problem (docs/cli.md, "Exit status")
 CHECKERS = {("lens", "check"), ("usd", "check")}
 
+
+def _hostile_files(workdir) -> None:
+    """The files the drawn values name: a good config, and a config and a lens nested 5000 deep."""
+    with open(os.path.join(workdir, "good_config.toml"), "w") as f:
+        f.write('sensor = "ALEXA 35"\nunits = "ft"\n')
+    with open(os.path.join(workdir, DEEP_CONFIG), "w") as f:
+        f.write("sensor = " + "[" * DEEP + "]" * DEEP + "\n")
+    with open(os.path.join(workdir, DEEP_LENS), "w") as f:
+        f.write("name = " + "{a = " * DEEP + "1" + "}" * DEEP + "\n")
+
+
 LEAVES = [pytest.param(path, parser, id=" ".join(path)) for path, parser in _leaf_parsers(build_parser())]
 
 
 @pytest.mark.parametrize("path, parser", LEAVES)
 def test_cli_fuzz(path, parser):
     workdir = tempfile.mkdtemp(prefix="physcam-fuzz-")
+    _hostile_files(workdir)
     server = ForkServer()
 
     @settings(max_examples=12, database=None)
     @given(_argv_strategy(path, parser))
-    def one(argv):
-        rc, out, err, rss = server.run(argv, workdir)
+    def one(drawn):
+        argv, config = drawn
+        rc, out, err, rss = server.run(argv, workdir, config)
         cmd = "physcam " + " ".join(repr(a) if not a or " " in a else a for a in argv)
+        cmd = (f"PHYSCAM_CONFIG={config} " if config else "") + cmd
         assert rc in ((0, 1, 2) if tuple(path) in CHECKERS else (0, 2)), f"{cmd}: exit {rc}\n{err[-2000:]}"
         assert "Traceback" not in err, f"{cmd}: traceback\n{err[-2000:]}"
         if rc == 2:

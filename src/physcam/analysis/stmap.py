@@ -52,10 +52,7 @@ Map arrays are image arrays: row 0 is the top row (as in EXR and PNG files).
 
 from __future__ import annotations
 
-import io
 import math
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -73,6 +70,8 @@ MAX_PIXELS = 36_000_000
 MAX_PINHOLE_REACH = 3.0
 #: Grid spacing (pixels) of the traced chief rays and of the inverse's nodes.
 NODE_SPACING_PX = 32.0
+#: Rows of a map computed at once (an 8K map is built and encoded in blocks: docs/performance.md).
+ROW_BLOCK = 256
 
 
 def _keys_weights(s):
@@ -125,11 +124,21 @@ class _Grid:
                 out += (wy[:, a] * wx[:, b])[:, None] * self.p[iy + a, ix + b]
         return out
 
-    def on_pixels(self, width, height, origin=(0.0, 0.0)):
-        """Values (height, width, 2) at pixel centres origin + (i + 0.5, j + 0.5), rows top first."""
+    def row_blocks(self, width, height, origin=(0.0, 0.0), rows=ROW_BLOCK):
+        """Values at pixel centres origin + (i + 0.5, j + 0.5), rows top first, as (first row, values
+        (n, width, 2)) for blocks of ``rows`` rows: a full 8K frame of float64 pairs would be 0.5 GB."""
         mx = _matrix((origin[0] + np.arange(width) + 0.5 - self.x0) / self.dx, self.nx)
         my = _matrix((origin[1] + np.arange(height) + 0.5 - self.y0) / self.dy, self.ny)[::-1]  # top row first
-        return np.stack([my @ self.p[:, :, c] @ mx.T for c in range(2)], axis=-1)
+        for r0 in range(0, height, rows):
+            m = my[r0:r0 + rows]
+            yield r0, np.stack([m @ self.p[:, :, c] @ mx.T for c in range(2)], axis=-1)
+
+    def fill(self, out, scale, offset=(0.0, 0.0), origin=(0.0, 0.0)):
+        """Write (value + offset) / scale into channels 0 and 1 of the image ``out`` (h, w, >= 2), block by block."""
+        h, w = out.shape[:2]
+        for r0, v in self.row_blocks(w, h, origin):
+            for c in range(2):
+                out[r0:r0 + v.shape[0], :, c] = (v[..., c] + offset[c]) / scale[c]
 
 
 def _nodes(extent_px, spacing=NODE_SPACING_PX):
@@ -346,18 +355,20 @@ def distortion_field(
             (0, 0), (nx, ny), interp_err, math.nan, max_dist, n_stop, resid, None, None, notes, fwd, traced_real,
             traced_ideal)
 
-    ideal_px = fwd.on_pixels(w_px, h_px)  # (h, w, 2), rows top first
-    # overscan: the symmetric margin whose box keeps the ideal position of every plate pixel
-    edges = np.concatenate([nodes[0], nodes[-1], nodes[:, 0], nodes[:, -1], ideal_px.reshape(-1, 2)])
-    ox = int(math.ceil(max(0.0, -edges[:, 0].min(), edges[:, 0].max() - w_px) - 1e-9))
-    oy = int(math.ceil(max(0.0, -edges[:, 1].min(), edges[:, 1].max() - h_px) - 1e-9))
+    # overscan: the symmetric margin whose box keeps the ideal position of every plate pixel (the
+    # pixels' ideal positions in blocks of rows, then again into the map: never a float64 frame whole)
+    edges = np.concatenate([nodes[0], nodes[-1], nodes[:, 0], nodes[:, -1]])
+    lo, hi = edges.min(axis=0), edges.max(axis=0)
+    for _, block in fwd.row_blocks(w_px, h_px):
+        lo = np.minimum(lo, block.reshape(-1, 2).min(axis=0))
+        hi = np.maximum(hi, block.reshape(-1, 2).max(axis=0))
+    ox = int(math.ceil(max(0.0, -lo[0], hi[0] - w_px) - 1e-9))
+    oy = int(math.ceil(max(0.0, -lo[1], hi[1] - h_px) - 1e-9))
     W2, H2 = w_px + 2 * ox, h_px + 2 * oy
     if W2 * H2 > 4 * MAX_PIXELS or W2 > 4 * MAX_SIDE_PX or H2 > 4 * MAX_SIDE_PX:
         raise OpticsError(f"the undistorted frame would be {W2} x {H2} px: the distortion is too strong for an ST-map")
     dmap = np.zeros((h_px, w_px, 3), dtype=np.float32)
-    dmap[..., 0] = ideal_px[..., 0] / w_px  # normalised to the plate's frame (module notes)
-    dmap[..., 1] = ideal_px[..., 1] / h_px
-    del ideal_px
+    fwd.fill(dmap, (w_px, h_px))  # normalised to the plate's frame (module notes)
 
     # inverse: ideal position -> real position, by Newton on the interpolated field at nodes over
     # the overscanned frame (coordinates in plate pixels: -ox .. w + ox)
@@ -390,11 +401,8 @@ def distortion_field(
     kx, ky = np.meshgrid((np.arange(mx - 1) + 0.5) * ex - ox, (np.arange(my - 1) + 0.5) * ey - oy)
     back = fwd.at(*inv.at(kx.ravel(), ky.ravel()).T)
     inv_err = float(np.hypot(back[:, 0] - kx.ravel(), back[:, 1] - ky.ravel()).max())
-    real_px = inv.on_pixels(W2, H2, (-ox, -oy))
     umap = np.zeros((H2, W2, 3), dtype=np.float32)
-    umap[..., 0] = real_px[..., 0] / w_px
-    umap[..., 1] = real_px[..., 1] / h_px
-    del real_px
+    inv.fill(umap, (w_px, h_px), origin=(-ox, -oy))
     if not (np.isfinite(dmap).all() and np.isfinite(umap).all()):
         raise OpticsError(f"the ST-maps of {lens.name!r} have non-finite values: no map written")
     zf = st.film_z
@@ -444,12 +452,14 @@ def apply_stmap(image, stmap, *, overscan=(0, 0)) -> np.ndarray:
     return out if img.ndim == 3 else out[..., 0]
 
 
-def _exr_bytes(rgb: np.ndarray, attributes=None, overscan=(0, 0)) -> bytes:
-    """A 32-bit float RGB scanline EXR (ZIP) of ``rgb`` (h, w, 3), as bytes; ``attributes``: extra
-    header entries (strings and floats). ``overscan`` (ox, oy): ``rgb`` is a frame with that margin
-    around it; the display window is the frame, the data window the whole array (OpenEXR's
-    "Technical Introduction", data and display windows; y grows downward)."""
+def _write_exr(rgb: np.ndarray, path, attributes=None, *, overscan=(0, 0), force: bool = False) -> Path:
+    """``rgb`` (h, w, 3) as a 32-bit float RGB scanline EXR (ZIP) at ``path``, written by OpenEXR into
+    the atomic write's temporary (never held encoded in memory); ``attributes``: extra header entries
+    (strings and floats). ``overscan`` (ox, oy): ``rgb`` is a frame with that margin around it; the
+    display window is the frame, the data window the whole array (OpenEXR's "Technical Introduction",
+    data and display windows; y grows downward)."""
     from ..extras import require_extra
+    from ..io import staged
 
     require_extra("exr", "writing ST-maps as EXR")
     import OpenEXR
@@ -459,25 +469,31 @@ def _exr_bytes(rgb: np.ndarray, attributes=None, overscan=(0, 0)) -> bytes:
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage, **(attributes or {}),
               "displayWindow": (np.array([0, 0], np.int32), np.array([w - 2 * ox - 1, h - 2 * oy - 1], np.int32)),
               "dataWindow": (np.array([-ox, -oy], np.int32), np.array([w - ox - 1, h - oy - 1], np.int32))}
-    fd, tmp = tempfile.mkstemp(suffix=".exr")
-    os.close(fd)
-    try:
-        with OpenEXR.File(header, {"RGB": np.ascontiguousarray(rgb, dtype=np.float32)}) as f:
-            f.write(tmp)
-        return Path(tmp).read_bytes()
-    finally:
-        os.unlink(tmp)
+    with staged(path, force=force, suffix=".exr") as tmp, \
+            OpenEXR.File(header, {"RGB": np.ascontiguousarray(rgb, dtype=np.float32)}) as f:
+        f.write(str(tmp))
+    return Path(path)
 
 
-def _png_bytes(rgb: np.ndarray) -> bytes:
-    """An 8-bit RGB PNG preview of ``rgb`` (h, w, 3) in 0..1, row 0 on top. Pillow directly (what
-    matplotlib's imsave calls, less its colour-mapping pass and alpha channel: 2-3x faster on a
+def _preview(rgb: np.ndarray) -> np.ndarray:
+    """``rgb`` (h, w, 3) in 0..1 as 8-bit values, converted in blocks of rows (no float copy of the frame)."""
+    out = np.empty(rgb.shape, dtype=np.uint8)
+    for r0 in range(0, rgb.shape[0], ROW_BLOCK):
+        out[r0:r0 + ROW_BLOCK] = np.clip(rgb[r0:r0 + ROW_BLOCK], 0.0, 1.0) * 255.0 + 0.5
+    return out
+
+
+def _write_png(rgb: np.ndarray, path, *, force: bool = False) -> Path:
+    """An 8-bit RGB PNG preview of ``rgb`` (h, w, 3) in 0..1, row 0 on top, at ``path``. Pillow directly
+    (what matplotlib's imsave calls, less its colour-mapping pass and alpha channel: 2-3x faster on a
     2048-pixel map, which a characterization run writes by the hundred)."""
     from PIL import Image
 
-    buf = io.BytesIO()
-    Image.fromarray((np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8), "RGB").save(buf, format="png")
-    return buf.getvalue()
+    from ..io import staged
+
+    with staged(path, force=force, suffix=".png") as tmp:
+        Image.fromarray(_preview(rgb), "RGB").save(tmp, format="png")
+    return Path(path)
 
 
 def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> list[Path]:
@@ -491,9 +507,11 @@ def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> lis
     ``physcamLens``.
 
     Every name is checked before anything is written, so an existing file (without ``force``)
-    leaves the folder as it was. Returns the paths written.
+    leaves the folder as it was. Each file is encoded straight into its atomic write's temporary
+    and put in place before the next is encoded (an 8K pair peaks under 2 GiB: docs/performance.md).
+    Returns the paths written.
     """
-    from ..io import atomic_write, check_writable
+    from ..io import check_writable
 
     if not isinstance(result, DistortionField):
         raise InputError(f"write_stmaps takes a DistortionField, got {type(result).__name__}")
@@ -508,10 +526,11 @@ def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> lis
     attributes = {"physcamMapFor": said["map_for"], "physcamFStop": float(result.fstop or 0.0),
                   "physcamResidualRmsPx": float(result.residual_px[0]),
                   "physcamResidualMaxPx": float(result.residual_px[1]), "physcamLens": result.lens_name}
-    payload = []
-    for name, rgb, overscan in items:
-        payload.append((d / f"{name}.exr", _exr_bytes(rgb, attributes, overscan)))
-        payload.append((d / f"{name}.png", _png_bytes(rgb)))
-    for p, _ in payload:
-        check_writable(p, force=force)
-    return [atomic_write(p, data, force=force) for p, data in payload]
+    for name, _, _ in items:
+        for ext in ("exr", "png"):
+            check_writable(d / f"{name}.{ext}", force=force)
+    written = []
+    for name, rgb, overscan in items:  # each file written before the next is encoded: one in memory at a time
+        written.append(_write_exr(rgb, d / f"{name}.exr", attributes, overscan=overscan, force=force))
+        written.append(_write_png(rgb, d / f"{name}.png", force=force))
+    return written

@@ -9,8 +9,10 @@ Shared rules (sensors, focus, units, notes, JSON documents, tables, CSV, the use
 in :mod:`physcam.cli._common`, :mod:`physcam.cli._output` and :mod:`physcam.cli._config`.
 
 Errors: a :class:`~physcam.errors.PhysCamError` prints one line on stderr and exits 2;
-a failing standard output (disk full) prints one line and exits 2; a closed pipe exits 0;
-anything else is a bug and shows a traceback (exit 1).
+a failing standard output (disk full) prints one line and exits 2; a path the system refuses (a
+name too long, a folder where a file was wanted, no permission) prints one line naming it
+(shortened) and exits 2; input nested too deeply to read (RecursionError) prints one line and
+exits 2; a closed pipe exits 0; anything else is a bug and shows a traceback (exit 1).
 
 The ``physcam`` program is :func:`run`: :func:`main`, then the exit. Once numba's compiler has
 been initialised (a command that traced enough rays to load the JIT kernel), the interpreter's
@@ -166,16 +168,48 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # `physcam lenses | head`: the reader has gone, nothing is wrong
         _silence_stdout()
         return 0
+    except RecursionError:
+        print("physcam: error: the input is nested too deeply to read (a file or value inside a file)",
+              file=sys.stderr)
+        return 2
     except OSError as exc:
         import errno
 
+        if getattr(exc, "filename", None) is not None:  # a path the system refused
+            print(f"physcam: error: {_refused_path(exc)}", file=sys.stderr)
+            return 2
         output_errors = {errno.ENOSPC, errno.EIO, errno.EDQUOT, errno.EFBIG}
-        if exc.errno not in output_errors or getattr(exc, "filename", None) is not None:
+        if exc.errno not in output_errors:
             raise
         # the output stream itself failed (e.g. `physcam lenses > /dev/full`)
         _silence_stdout()
         print(f"physcam: error: cannot write the output: {exc.strerror or exc}", file=sys.stderr)
         return 2
+
+
+#: Longest file name shown whole in an error line; longer ones are shortened (start ... end).
+SHOWN_NAME_CHARS = 80
+
+
+def short_name(name) -> str:
+    """``name`` for an error line: whole up to :data:`SHOWN_NAME_CHARS`, else its start and end with
+    the count of characters left out (a 300-character path stays readable on one line)."""
+    text = os.fsdecode(name) if isinstance(name, (bytes, os.PathLike)) else str(name)
+    text = text.encode("utf-8", "backslashreplace").decode("utf-8")  # undecodable bytes shown, not raised
+    if len(text) <= SHOWN_NAME_CHARS:
+        return text
+    head, tail = SHOWN_NAME_CHARS // 2, SHOWN_NAME_CHARS // 4
+    return f"{text[:head]}...{text[-tail:]} ({len(text)} characters)"
+
+
+def _refused_path(exc: OSError) -> str:
+    """One line for an OSError about a path: which path, and the system's reason."""
+    import errno
+
+    why = exc.strerror or exc.__class__.__name__
+    if exc.errno == errno.ENAMETOOLONG:
+        why += " (a file name is at most 255 bytes, a path 4096)"
+    return f"cannot use {short_name(exc.filename)}: {why}"
 
 
 def run() -> None:

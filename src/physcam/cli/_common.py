@@ -48,20 +48,76 @@ def distance(name: str, allow_inf: bool = False):
     return parse
 
 
-def number(name: str, *, positive: bool = False, lo: float | None = None, hi: float | None = None):
-    """An argparse type reading a finite number; ``positive`` requires > 0, ``lo``/``hi`` bound it."""
+#: Whole-number options take at most this many characters (a 400-digit count is refused by length
+#: before Python builds the integer, and no count overflows a float downstream).
+WHOLE_MAX_CHARS = 19
+#: The default bounds of :func:`whole`: every integer a float64 holds exactly.
+WHOLE_LIMIT = 2**53
+
+
+def _shown(text) -> str:
+    """A refused value as an error shows it: repr, shortened past 40 characters."""
+    r = repr(text)
+    return r if len(r) <= 40 else f"{r[:28]}...{r[-8:]} ({len(str(text))} characters)"
+
+
+def _bound(v: int) -> str:
+    return "2**53" if v == WHOLE_LIMIT else "-2**53" if v == -WHOLE_LIMIT else str(v)
+
+
+def whole(name: str, *, lo: int | None = None, hi: int | None = None):
+    """An argparse type reading a whole number (``12``, ``1_000``) within ``lo``..``hi`` (default:
+    the integers a float holds exactly, +-2**53). Every integer option uses it, never bare ``int``:
+    ``int`` reads a 400-digit count that later overflows a float (issue 24 item 12)."""
+    lo_, hi_ = (-WHOLE_LIMIT if lo is None else lo), (WHOLE_LIMIT if hi is None else hi)
+    span = f"a whole number from {_bound(lo_)} to {_bound(hi_)}"
 
     def parse(text):
+        t = str(text).strip()
         try:
-            v = float(text)
+            if len(t) > WHOLE_MAX_CHARS:
+                raise ValueError
+            v = int(t, 10)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number, got {text!r}") from None
-        if not math.isfinite(v):
-            raise argparse.ArgumentTypeError(f"{name} must be a finite number, got {text!r}")
+            if t.lstrip("+-").replace("_", "").isdigit():
+                raise argparse.ArgumentTypeError(f"{name} must be {span}, got {_shown(text)}") from None
+            raise argparse.ArgumentTypeError(f"{name} must be {span}, got {_shown(text)}") from None
+        if not lo_ <= v <= hi_:
+            raise argparse.ArgumentTypeError(f"{name} must be {span}, got {_shown(text)}")
+        return v
+
+    parse.__name__ = name
+    parse.physcam_whole = (lo_, hi_)  # the contract test finds integer options by this
+    return parse
+
+
+def _finite(name: str, text) -> float:
+    """``text`` as a finite, normal float (or 0): NaN, infinities and subnormals (``1e-320``, below
+    2.2e-308, where 1/x overflows and precision is lost) are refused."""
+    try:
+        v = float(text)
+    except (ValueError, TypeError):
+        raise argparse.ArgumentTypeError(f"{name} must be a number, got {_shown(text)}") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"{name} must be a finite number, got {_shown(text)}")
+    if v != 0.0 and abs(v) < sys.float_info.min:
+        raise argparse.ArgumentTypeError(f"{name} is out of range: it must be 0 or at least {sys.float_info.min:.3g} "
+                                         f"in size, got {_shown(text)}")
+    return v
+
+
+def number(name: str, *, positive: bool = False, lo: float | None = None, hi: float | None = None):
+    """An argparse type reading a finite number (no subnormals: :func:`_finite`); ``positive`` requires
+    > 0, ``lo``/``hi`` bound it."""
+
+    def parse(text):
+        v = _finite(name, text)
         if positive and not v > 0:
-            raise argparse.ArgumentTypeError(f"{name} must be greater than 0, got {text!r}")
+            raise argparse.ArgumentTypeError(f"{name} must be greater than 0, got {_shown(text)}")
         if (lo is not None and v < lo) or (hi is not None and v > hi):
-            raise argparse.ArgumentTypeError(f"{name} must lie between {lo:g} and {hi:g}, got {text!r}")
+            bound = (f"lie between {lo:g} and {hi:g}" if lo is not None and hi is not None
+                     else f"be at least {lo:g}" if lo is not None else f"be at most {hi:g}")
+            raise argparse.ArgumentTypeError(f"{name} must {bound}, got {_shown(text)}")
         return v
 
     parse.__name__ = name
@@ -74,10 +130,11 @@ def numbers(name: str, count: int, *, positive: bool = False):
 
     def parse(text):
         try:
-            v = tuple(float(x) for x in str(text).split(","))
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be {count} numbers {labels}, got {text!r}") from None
-        if len(v) != count or not all(math.isfinite(x) and (x > 0 or not positive) for x in v):
+            v = tuple(_finite(name, x) for x in str(text).split(","))
+        except argparse.ArgumentTypeError:
+            raise argparse.ArgumentTypeError(f"{name} must be {count} finite numbers {labels}, got {_shown(text)}") \
+                from None
+        if len(v) != count or not all(x > 0 or not positive for x in v):
             kind = "positive" if positive else "finite"
             raise argparse.ArgumentTypeError(f"{name} must be {count} {kind} numbers {labels}, got {text!r}")
         return v

@@ -11,8 +11,8 @@ always wins::
     output_dir = "~/shots"   # relative output files (-o, --plot, --stmap, usd files) go here
     blender_python = "/opt/blender/4.2/python/bin/python3.11"   # or a blender executable
 
-An unknown key, a value of the wrong kind or a file that is not TOML is refused with the file's
-name, so a typo never silently falls back to a default.
+An unknown key, a value of the wrong kind, a file that is not TOML or one nested too deeply to
+read is refused with the file's name, so a typo never silently falls back to a default.
 """
 
 from __future__ import annotations
@@ -93,6 +93,9 @@ def _read(path: Path) -> Config:
         raise InputError(f"cannot read the physcam config {path}: {exc.strerror or exc}") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"the physcam config {path} is not valid TOML: {exc}") from None
+    except RecursionError:  # tomllib recurses once per level of nested arrays or tables
+        raise InputError(f"the physcam config {path} nests arrays or tables too deeply to read; "
+                         f"it is a flat list of keys (physcam config show)") from None
     unknown = sorted(set(data) - set(KEYS))
     if unknown:
         raise InputError(f"the physcam config {path} has unknown key(s) {', '.join(unknown)}; "

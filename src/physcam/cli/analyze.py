@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, focus, hidden_alias, number
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, focus, hidden_alias, number, whole
 from ._output import add_output_options, document, emit_json, print_csv
 from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
@@ -55,7 +55,7 @@ def register(sub) -> None:
     p.add_argument("--max-field", type=number("max field"), default=None, metavar="DEG",
                    help="widest field angle in degrees (default: the sensor corner, clamped to what the lens images)")
     p.add_argument("--fstop", type=number("f-stop"), default=None, help="stop the lens down to this f-number")
-    p.add_argument("--grid", type=int, default=200, metavar="N",
+    p.add_argument("--grid", type=whole("grid", lo=0), default=200, metavar="N",
                    help="rays per side of the sampling grid (16-2000, default 200)")
     p.add_argument("--fresnel", action="store_true", help="include Fresnel losses at every surface")
     _sensor(p)
@@ -92,10 +92,10 @@ def register(sub) -> None:
                         "through)")
     p.add_argument("--coating", choices=("none", "single", "multi"), default=None,
                    help="coating model (default: the lens file's, else none)")
-    p.add_argument("--rays", type=int, default=200_000, metavar="N",
+    p.add_argument("--rays", type=whole("rays", lo=0), default=200_000, metavar="N",
                    help="rays per ghost path for the image (with -o; default 200000)")
-    p.add_argument("--top", type=int, default=10, metavar="N", help="how many ranked paths to print (default 10)")
-    p.add_argument("--pixels", type=int, default=256, metavar="PX",
+    p.add_argument("--top", type=whole("top", lo=0), default=10, metavar="N", help="how many ranked paths to print (default 10)")
+    p.add_argument("--pixels", type=whole("pixels", lo=0), default=256, metavar="PX",
                    help="ghost image width in pixels (8 to 4096; default 256)")
     _sensor(p)
     p.set_defaults(handler=run_ghosts)

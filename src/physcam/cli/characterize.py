@@ -9,25 +9,14 @@ Examples::
 
 from __future__ import annotations
 
-from ._common import add_lens_argument
+from ._common import add_lens_argument, whole
 
 from ._output import add_output_options, document, emit_json
 
 
 def _whole(name: str, lo: int, hi: int):
-    import argparse
-
-    def parse(text):
-        try:
-            v = int(str(text))
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a whole number, got {text!r}") from None
-        if not lo <= v <= hi:
-            raise argparse.ArgumentTypeError(f"{name} must lie between {lo:,} and {hi:,}, got {text!r}")
-        return v
-
-    parse.__name__ = name
-    return parse
+    """A bounded whole number (:func:`physcam.cli._common.whole`)."""
+    return whole(name, lo=lo, hi=hi)
 
 
 def register(sub) -> None:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number, whole
 
 EPILOG = """\
 example:
@@ -69,13 +69,13 @@ def register(sub) -> None:
     b.add_argument("--fstop", type=number("f-number", positive=True), required=True, metavar="N", help="f-number")
     b.add_argument("--light", type=distance("light distance"), required=True, metavar="D",
                    help="the point light's distance from the film plane, on the axis (e.g. 0.7m)")
-    b.add_argument("--blades", type=int, default=0, metavar="N", help="iris blades (0: round; 3 or more: a polygon)")
+    b.add_argument("--blades", type=whole("blade count", lo=0), default=0, metavar="N", help="iris blades (0: round; 3 or more: a polygon)")
     b.add_argument("--blade-angle", type=number("blade angle"), default=0.0, metavar="DEG",
                    help="angle of the first iris corner, degrees")
     b.add_argument("--crop", type=distance("crop"), default=3.0, metavar="MM",
                    help="width of the film crop around the axis that both images cover (default 3 mm)")
-    b.add_argument("--pixels", type=int, default=128, help="image width and height in pixels (32 to 1024)")
-    b.add_argument("--samples", type=int, default=512, help="Cycles samples per pixel (default 512)")
+    b.add_argument("--pixels", type=whole("pixels", lo=0), default=128, help="image width and height in pixels (32 to 1024)")
+    b.add_argument("--samples", type=whole("samples", lo=0), default=512, help="Cycles samples per pixel (default 512)")
     b.add_argument("--blender-python", metavar="PATH",
                    help="a Python with Blender's bpy (default: $PHYSCAM_BLENDER_PYTHON or ./.venv-blender)")
     b.add_argument("--lenient", action="store_true", help="load a lens file that is not buildable as written, repaired")
@@ -181,7 +181,7 @@ def _register_lenses(s) -> None:
     add_coc_option(c)
     c.add_argument("--light", type=distance("light distance"), default=None, metavar="D",
                    help="the bokeh light's distance from the film (default twice the focus; 1m at infinity focus)")
-    c.add_argument("--rays", type=int, default=100_000, metavar="N",
+    c.add_argument("--rays", type=whole("rays", lo=0), default=100_000, metavar="N",
                    help="rays per bokeh image (1000 to 1e7; default 100000)")
     add_lenient(c)
     add_units_option(c)

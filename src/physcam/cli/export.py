@@ -3,7 +3,7 @@ Blender Cycles OSL lens cameras, RenderMan RIB camera blocks, pbrt-v4 cameras)."
 
 from __future__ import annotations
 
-from ._common import add_lens_argument, FOCUS_HELP, add_units_option, distance, focus, number, numbers
+from ._common import add_lens_argument, FOCUS_HELP, add_units_option, distance, focus, number, numbers, whole
 from ._output import add_output_options, document, emit_json, print_csv
 
 
@@ -18,8 +18,8 @@ def _sensor(p) -> None:
 def _common(p) -> None:
     add_lens_argument(p)
     _sensor(p)
-    p.add_argument("--width-px", type=int, required=True, metavar="PX", help="image width in pixels")
-    p.add_argument("--height-px", type=int, required=True, metavar="PX", help="image height in pixels")
+    p.add_argument("--width-px", type=whole("width in pixels", lo=0), required=True, metavar="PX", help="image width in pixels")
+    p.add_argument("--height-px", type=whole("height in pixels", lo=0), required=True, metavar="PX", help="image height in pixels")
 
 
 def register(sub) -> None:
@@ -70,7 +70,7 @@ def register(sub) -> None:
                    help="bokeh brightness slope across the aperture, -1..1 (0 flat, > 0 bright rim)")
     b.add_argument("--dispersion", action="store_true", help="trace one wavelength per ray (chromatic aberration)")
     b.add_argument("--fresnel", action="store_true", help="include unpolarised Fresnel losses (uncoated surfaces)")
-    b.add_argument("--width-px", type=int, default=1920, metavar="PX",
+    b.add_argument("--width-px", type=whole("width in pixels", lo=0), default=1920, metavar="PX",
                    help="render width in pixels (height follows the sensor aspect; default 1920)")
     b.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write the shader and script into")
     b.add_argument("--force", action="store_true", help="overwrite existing files")
@@ -301,7 +301,7 @@ def _register_rib(s) -> None:
     add_report_arguments(r)  # --lens or --focal, the sensor, --meters-per-unit, --shutter-angle, --shift-x/-y
     add_lenient(r)
     _camera_look(r, blades_default=7)
-    r.add_argument("--resolution", type=int, default=2048, metavar="PX",
+    r.add_argument("--resolution", type=whole("resolution", lo=0), default=2048, metavar="PX",
                    help="image width in pixels (the squeezed plate; height from the sensor aspect; default 2048)")
     r.add_argument("--legacy", action="store_true",
                    help='RenderMan 13-20: Projection "perspective", DepthOfField and Hider "hidden" (seed 002)')
@@ -426,7 +426,7 @@ def _register_pbrt(s) -> None:
     add_lenient(b)
     b.add_argument("--camera", choices=("both", "realistic", "perspective"), default="both",
                    help="which pbrt camera to write (default both; a thin lens --focal has only perspective)")
-    b.add_argument("--resolution", type=int, default=1920, metavar="PX",
+    b.add_argument("--resolution", type=whole("resolution", lo=0), default=1920, metavar="PX",
                    help="film width in pixels (height from the sensor aspect; default 1920)")
     b.add_argument("--force", action="store_true", help="overwrite existing files")
     add_output_options(b, what="the written paths and pbrt's numbers")
@@ -550,9 +550,9 @@ def _register_mitsuba(s) -> None:
                                  "entrance pupil, so framing and defocus match the real lens (docs/mitsuba.md).")
     add_report_arguments(m)  # --lens/--focal, --fstop, --focus, the sensor, --meters-per-unit, --shutter-angle
     add_lenient(m)
-    m.add_argument("--width-px", type=int, default=1920, metavar="PX",
+    m.add_argument("--width-px", type=whole("width in pixels", lo=0), default=1920, metavar="PX",
                    help="film width in pixels (height follows the sensor aspect; default 1920)")
-    m.add_argument("--spp", type=int, default=64, metavar="N", help="samples per pixel of the sampler (default 64)")
+    m.add_argument("--spp", type=whole("samples per pixel", lo=0), default=64, metavar="N", help="samples per pixel of the sampler (default 64)")
     m.add_argument("--fps", type=number("frames per second", positive=True), default=24.0,
                    help="frame rate for the shutter interval in seconds (default 24)")
     m.add_argument("--name", default="camera", help="file name stem of the two files (default camera)")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from ._common import distance, focus, number, numbers
+from ._common import distance, focus, number, numbers, whole
 from ._output import add_output_options, document, emit_json
 
 EPILOG = """\
@@ -45,7 +45,7 @@ def _count(text):
 
 def _network_args(p, *, receive: bool) -> None:
     p.add_argument("--port", type=_port, default=55555, help="UDP port (default 55555, OpenTrackIO's)")
-    p.add_argument("--multicast", type=int, default=None, metavar="N",
+    p.add_argument("--multicast", type=whole("multicast source number", lo=0), default=None, metavar="N",
                    help="use the multicast group 239.135.1.N of source number N instead of unicast")
     p.add_argument("--interface", default="127.0.0.1",
                    help="network interface address for multicast (default 127.0.0.1, the loopback)")

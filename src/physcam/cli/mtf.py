@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number, whole
 from ._output import add_output_options, document, emit_json, print_csv
 from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
@@ -52,13 +52,13 @@ def register(sub) -> None:
                    help="wavelength in nm (repeat; the first is the primary; default the d, F and C lines)")
     p.add_argument("--weight", type=number("wavelength weight"), action="append", metavar="W",
                    help="weight of each --wavelength, in the same order (repeat; default equal)")
-    p.add_argument("--fields", type=int, default=15, metavar="N",
+    p.add_argument("--fields", type=whole("fields", lo=0), default=15, metavar="N",
                    help="image heights on the chart, from the centre to --max-height (2-41; default 15)")
     p.add_argument("--max-height", type=distance("largest image height"), default=None, metavar="MM",
                    help="largest image height of the chart (default: the sensor's half diagonal)")
     p.add_argument("--field", type=number("field angle"), default=None, metavar="DEG",
                    help="report one field angle (degrees, Y meridian) instead of the chart")
-    p.add_argument("--pupil-samples", type=int, default=None, metavar="N",
+    p.add_argument("--pupil-samples", type=whole("pupil samples", lo=0), default=None, metavar="N",
                    help=f"pupil grid cells across (16-{CHART_MAX_PUPIL_SAMPLES} for the chart, to {CLI_MAX_PUPIL_SAMPLES} "
                         "with --field; default chosen by the sampling rules)")
     p.add_argument("--method", choices=("fft", "huygens"), default="fft",

@@ -3,7 +3,7 @@ summation (docs/image-quality.md)."""
 
 from __future__ import annotations
 
-from ._common import add_lens_argument, FOCUS_HELP, focus, number
+from ._common import add_lens_argument, FOCUS_HELP, focus, number, whole
 from ._output import add_output_options, document, emit_json
 from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
@@ -40,7 +40,7 @@ def register(sub) -> None:
                         "exit-pupil wavefront")
     p.add_argument("--tilt", type=_tilt, default=(0.0, 0.0), metavar="X,Y",
                    help="film tilt about x and y in degrees (Huygens only; default 0,0)")
-    p.add_argument("--samples", type=int, default=None, metavar="N",
+    p.add_argument("--samples", type=whole("samples", lo=0), default=None, metavar="N",
                    help="Huygens image grid points per side (8-1024; default 129)")
     p.add_argument("--pixel", type=number("pixel size", positive=True), default=None, metavar="UM",
                    help="Huygens image pixel in micrometres (default a quarter of lambda N)")

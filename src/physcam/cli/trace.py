@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import add_lens_argument, FOCUS_HELP, add_units_option, distance, focus, hidden_alias, number
+from ._common import add_lens_argument, FOCUS_HELP, add_units_option, distance, focus, hidden_alias, number, whole
 from ._output import add_output_options, document, emit_json, print_csv
 from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
@@ -15,7 +15,7 @@ def register(sub) -> None:
                    help="field angle in degrees (repeat; default 0 and 5)")
     p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM",
                    help="wavelength in nm (default: the lens's design wavelength, the d line 587.56)")
-    p.add_argument("--rings", type=int, default=64, metavar="N",
+    p.add_argument("--rings", type=whole("rings", lo=0), default=64, metavar="N",
                    help="divisions of the pupil radius squared (1-500; about 3 n^2 equal-area rays per field, "
                         "plus the refined beam edge; default 64)")
     p.add_argument("--fstop", type=number("f-stop"), default=None, help="stop the lens down to this f-number")
@@ -35,16 +35,16 @@ def register(sub) -> None:
     hidden_alias(b, "--depth", "depth", type=distance("light distance"))
     b.add_argument("--x", type=number("light x"), default=0.0, metavar="MM", help="light lateral x (mm)")
     b.add_argument("--y", type=number("light y"), default=0.0, metavar="MM", help="light lateral y (mm)")
-    b.add_argument("--rays", type=int, default=250_000, metavar="N",
+    b.add_argument("--rays", type=whole("rays", lo=0), default=250_000, metavar="N",
                    help="rays to trace (1 to 1e11; default 250000, low-discrepancy: as clean an image as 1e6 "
                         "random rays; 1000000 gives one three times cleaner)")
-    b.add_argument("--pixels", type=int, default=256, metavar="PX",
+    b.add_argument("--pixels", type=whole("pixels", lo=0), default=256, metavar="PX",
                    help="image width and height in pixels (8 to 4096; default 256)")
     b.add_argument("--spectral", action="store_true", help="three wavelengths (620/550/460 nm) as RGB")
     b.add_argument("--focus", type=focus("focus distance"), default=None, metavar="D",
                    help=f"focus mark from the film plane; the lens is focused there (default infinity; {FOCUS_HELP})")
     b.add_argument("--fstop", type=number("f-stop"), default=None, help="stop the lens down to this f-number")
-    b.add_argument("--blades", type=int, default=0, metavar="N", help="iris blades (< 3: circular; seed 002 nsides)")
+    b.add_argument("--blades", type=whole("blade count", lo=0), default=0, metavar="N", help="iris blades (< 3: circular; seed 002 nsides)")
     b.add_argument("--blade-angle", type=number("blade angle"), default=0.0, metavar="DEG",
                    help="rotation of the iris polygon (degrees)")
     b.add_argument("--roundness", type=number("roundness"), default=0.0,

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import FOCUS_HELP, add_sensor_options, add_units_option, coc_of, distance, focus, number, numbers
+from ._common import FOCUS_HELP, add_sensor_options, add_units_option, coc_of, distance, focus, number, numbers, whole
 from ._output import add_output_options, document, emit_json
 from .report import add_coc_option, resolve_sensor
 
@@ -39,10 +39,10 @@ def register(sub) -> None:
     w.add_argument("--orthographic", action="store_true", help="orthographic (telecentric) camera")
     w.add_argument("--magnification", type=number("magnification"), default=1.0,
                    help="orthographic: image size / object size (default 1)")
-    w.add_argument("--blades", type=int, default=7, help="iris blades (RenderMan apertureNSides; default 7)")
+    w.add_argument("--blades", type=whole("blade count", lo=0), default=7, help="iris blades (RenderMan apertureNSides; default 7)")
     w.add_argument("--enlarge", type=numbers("enlarge", 2, positive=True), default=(1.0, 1.0), metavar="EX,EY",
                    help="image a region of the sensor enlarged EX,EY times (a tile: 2,2 with --shift-x/-y)")
-    w.add_argument("--handedness", type=int, choices=(1, -1), default=1,
+    w.add_argument("--handedness", type=whole("handedness"), choices=(1, -1), default=1,
                    help="1 right-handed (default), -1 left-handed: a mirrored image")
     w.add_argument("--resolution", type=_pixels, default=None, metavar="W[,H]",
                    help="image size in pixels for the render settings and, with --lens, Omniverse's OpenCV "

@@ -763,12 +763,11 @@ def save_stage(stage, file, *, force: bool = False):
     composes and places its cameras the same in a process without physcam's plugin.
 
     The layer is exported to text in memory and written with :func:`physcam.io.atomic_write`
-    (temporary file in the same folder, then rename); an existing file is kept unless
-    ``force``. Returns the Path. ``.usda`` writes text; ``.usd``/``.usdc`` write crate.
+    (temporary file in the same folder, then rename; crate is exported by USD into such a
+    temporary, :func:`physcam.io.staged`); an existing file is kept unless ``force``. Returns the
+    Path. ``.usda`` writes text; ``.usd``/``.usdc`` write crate.
     """
-    from pathlib import Path
-
-    from ..io import atomic_write, check_writable
+    from ..io import atomic_write, check_writable, staged
     from .validate import check_stage
 
     p = check_writable(file, force=force)
@@ -781,18 +780,12 @@ def save_stage(stage, file, *, force: bool = False):
     check_stage(stage)
     if p.suffix == ".usda":
         return atomic_write(p, stage.GetRootLayer().ExportToString(), force=force)
-    # binary crate: export next to the target, then move it into place through atomic_write's checks
-    import os
-    import tempfile
-
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".usdc", dir=p.parent if p.parent.exists() else None)
-    os.close(fd)
-    try:
-        if not stage.GetRootLayer().Export(tmp):
+    # binary crate: USD exports into a temporary next to the target (named for it, this host and this
+    # process: a killed writer's is removed by the next write, physcam.io), which is then renamed
+    with staged(p, force=force, suffix=".usdc") as tmp:
+        if not stage.GetRootLayer().Export(str(tmp)):
             raise ExportError(f"USD could not write {p}")
-        return atomic_write(p, Path(tmp).read_bytes(), force=force)
-    finally:
-        os.unlink(tmp)
+    return p
 
 
 def write_camera(file, spec: CameraSpec, *, force: bool = False, path: str = DEFAULT_CAMERA_PATH,

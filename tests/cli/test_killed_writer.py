@@ -1,0 +1,86 @@
+"""A writer killed mid-write leaves no litter for good (issue 24 item 12): a real ``physcam usd
+refresh`` of a shot, in place, SIGKILLed while its temporary file is being written (text and
+crate), leaves that hidden temporary behind; the next refresh of the same shot removes it, so
+the folder holds the shot alone again. The shot carries a 12 MB plate array so the write
+lasts long enough to be caught."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from physcam.cli import main
+
+pytestmark = pytest.mark.slow
+
+#: the documented naming (docs/cli.md): .<target>.physcam-tmp.<host>.<pid>.<random><suffix>
+TEMP_MARK = ".physcam-tmp."
+PLATE_SAMPLES = 1_000_000  # floats: about 12 MB of .usda text, 4 MB of crate
+
+
+def _shot(folder, suffix):
+    """A shot (lens and body referenced) with a large plate array, written as ``shot<suffix>``."""
+    import numpy as np
+    from pxr import Sdf, Usd, Vt
+
+    os.chdir(folder)
+    assert main(["usd", "kit", "vendor", "lens.usda", "--lens", "dgauss_50mm", "--focus", "1.5m", "--fstop", "4"]) == 0
+    assert main(["usd", "kit", "body", "body.usda", "--sensor", "ALEXA 35", "--flange", "44"]) == 0
+    assert main(["usd", "kit", "shot", "draft.usda", "--body", "body.usda", "--lens", "lens.usda", "--focus", "2m",
+                 "--fstop", "2.8"]) == 0
+    layer = Sdf.Layer.FindOrOpen(str(folder / "draft.usda"))
+    stage = Usd.Stage.Open(layer)
+    plate = stage.DefinePrim("/Plate", "Scope").CreateAttribute("samples", Sdf.ValueTypeNames.FloatArray)
+    plate.Set(Vt.FloatArray.FromNumpy(np.random.default_rng(1).random(PLATE_SAMPLES, dtype=np.float32)))
+    assert layer.Export(str(folder / f"shot{suffix}"))
+    os.unlink(folder / "draft.usda")
+    return folder / f"shot{suffix}"
+
+
+def _temporaries(folder):
+    """The hidden files of ``folder`` (a writer's temporaries)."""
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith("."))
+
+
+def _refresh(shot):
+    return [sys.executable, "-m", "physcam", "usd", "refresh", str(shot)]
+
+
+def _kill_while_writing(shot, timeout_s=120.0):
+    """Start a refresh of ``shot`` and SIGKILL it once its temporary file exists; return the litter."""
+    proc = subprocess.Popen(_refresh(shot), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    t0 = time.monotonic()
+    try:
+        while not _temporaries(shot.parent):
+            if proc.poll() is not None:
+                pytest.fail(f"the refresh ended (exit {proc.returncode}) before it was caught writing: "
+                            f"{proc.stderr.read().decode()[-500:]}")
+            if time.monotonic() - t0 > timeout_s:
+                pytest.fail("the refresh never started writing")
+            time.sleep(0.0005)
+        os.kill(proc.pid, signal.SIGKILL)
+    finally:
+        proc.wait(timeout=60)
+        proc.stderr.close()
+    assert proc.returncode == -signal.SIGKILL
+    return _temporaries(shot.parent)
+
+
+@pytest.mark.parametrize("suffix", [".usda", ".usdc"])
+def test_a_refresh_killed_mid_write_is_cleaned_by_the_next(tmp_path, monkeypatch, suffix):
+    monkeypatch.chdir(tmp_path)
+    shot = _shot(tmp_path, suffix)
+    before = shot.read_bytes()
+    litter = _kill_while_writing(shot)
+    assert litter, "the killed writer's temporary file"
+    assert shot.read_bytes() == before  # the old shot is whole: the temporary was never renamed
+    done = subprocess.run(_refresh(shot), capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["body.usda", "lens.usda", shot.name])
+    host, pid = litter[0][len(f".{shot.name}{TEMP_MARK}"):].split(".")[:2]  # named for target, host, process
+    assert litter[0].startswith(f".{shot.name}{TEMP_MARK}") and pid.isdigit() and host, litter
