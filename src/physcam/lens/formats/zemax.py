@@ -236,7 +236,7 @@ def _design_wavelength(head, path) -> float:
         um = head["wavl"][min(max(head["pwav"], 1), len(head["wavl"])) - 1]
     if um is None:
         return Prescription.__dataclass_fields__["wavelength_nm"].default
-    return um * 1000.0
+    return round(um * 1000.0, 9)
 
 
 def _check_complete(blocks, path, goes_on: bool = False) -> None:
