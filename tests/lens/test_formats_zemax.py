@@ -77,10 +77,14 @@ def test_refuses_clearly(old, new, line, match):
     assert exc.value.line == line and exc.value.path == "s.zmx"
 
 
-def test_curved_stop_refused():
+def test_stop_on_a_lens_face_becomes_a_flat_stop_at_its_vertex():
+    # issue 25: most real files put STOP on a lens face; it was refused
     text = SINGLET.replace("  STOP\n", "").replace("SURF 2\n", "SURF 2\n  STOP\n")
-    with pytest.raises(LensFileError, match="STOP is on a curved surface"):
-        loads_lens(text, "zemax")
+    p = loads_lens(text, "zemax")
+    stop, face = p.surfaces[1], p.surfaces[2]
+    assert (stop.kind, stop.radius, stop.thickness, stop.semi_diameter) == ("stop", 0.0, 0.0, 10.0)
+    assert stop.medium.is_air and face.radius == 100.0 and p.stop_index == 1
+    assert p.surfaces[0].kind == "flat"
 
 
 @pytest.mark.parametrize("name", ["canon_rf_85mm_f1_2", "dgauss_50mm", "zeiss_planar_80mm_f2_8"])
@@ -104,13 +108,12 @@ class _nullcontext:
         return False
 
 
-def test_catalogue_glass_line_carries_its_own_nd_vd(tmp_path):
-    # OpticStudio writes GLAS NAME 0 0 nd vd ...; a glass physcam's catalogue lacks is read from
-    # the line (here Schott SK16: nd 1.62041, Vd 60.32, from the Schott catalogue)
-    text = SINGLET.replace("GLAS N-BK7 0 0 1.5168 64.17", "GLAS SK16 0 0 1.62041 60.32")
-    p = loads_lens(text, "zemax", path="sk16.zmx")
-    m = p.surfaces[1].medium  # surface 0 is the stop
-    assert (m.nd, m.vd, m.glass) == (1.62041, 60.32, "SK16")
+def test_catalogue_glass_numbers_on_the_line_are_placeholders():
+    # issue 25 item 2: OpticStudio ignores nd/Vd on a catalogue glass's GLAS line; N-BK7 is
+    # nd 1.51680, Vd 64.17 (SCHOTT data sheet), whatever the line says
+    text = SINGLET.replace("GLAS N-BK7 0 0 1.5168 64.17", "GLAS N-BK7 0 0 1.5 40")
+    m = loads_lens(text, "zemax", path="bk7.zmx").surfaces[1].medium  # surface 0 is the stop
+    assert (m.nd, m.vd, m.glass, m.catalog) == (1.5168, 64.17, "N-BK7", "SCHOTT")
 
 
 def test_windows_code_page_file_is_read(tmp_path):

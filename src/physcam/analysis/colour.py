@@ -115,12 +115,12 @@ class ColourResult:
 
 def _media(lens):
     """Distinct dispersive media of ``lens``, in order: (key, Dispersion)."""
-    from ..optics.glass import dispersion
+    from ..optics.glass import medium_dispersion
 
     out = {}
     for s in lens.surfaces:
         m = s.medium
-        d = dispersion(m.nd, m.vd, m.glass)
+        d = medium_dispersion(m)
         if d.kind != "constant":
             out.setdefault((m.nd, m.vd, m.glass), d)
     return out

@@ -153,6 +153,9 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     try:
         _into_output_dir(args)
+        from ._common import use_glass_catalogs
+
+        use_glass_catalogs(args)
         rc = int(args.handler(args) or 0)
         sys.stdout.flush()  # a full disk or closed pipe shows here, inside the error handling
         for n in take_notes():  # defaults taken, ranges clamped: said once the command has worked

@@ -339,7 +339,20 @@ def add_lens_argument(p, *, dest: str = "lens", many: bool = False, metavar: str
     p.add_argument("--lens", dest=dest, action="append" if many else "store", default=None, metavar=metavar,
                    help=help + (" (repeat for several)" if many else "") + "; required")
     p.add_argument("_lens_positional", nargs="*", default=[], help=argparse.SUPPRESS, metavar="")
+    p.add_argument("--glass-catalog", dest="glass_catalog", action="append", default=None, metavar="FILE.agf",
+                   help="a Zemax .agf glass catalogue searched after the lens file's own (repeat for several; "
+                        "adds to the config's glass_catalogs)")
     p.set_defaults(_lens_dest=dest, _lens_many=many)
+
+
+def use_glass_catalogs(args) -> list[str]:
+    """Make the config's ``glass_catalogs`` and the run's ``--glass-catalog`` files the user glass
+    catalogues, in that order (every run starts with none left over); their names."""
+    from ..lens.catalog import use_catalog_files
+    from ._config import load_config
+
+    paths = list(load_config().glass_catalogs or ()) + list(getattr(args, "glass_catalog", None) or ())
+    return use_catalog_files(paths)
 
 
 def merge_lens_argument(args, parser) -> None:

@@ -10,6 +10,7 @@ always wins::
     units = "ft"             # distances printed in ft (feet and inches) or m (default m)
     output_dir = "~/shots"   # relative output files (-o, --plot, --stmap, usd files) go here
     blender_python = "/opt/blender/4.2/python/bin/python3.11"   # or a blender executable
+    glass_catalogs = ["~/zemax/glasscat/CORNING.AGF"]   # Zemax .agf catalogues searched for glasses
 
 An unknown key, a value of the wrong kind, a file that is not TOML or one nested too deeply to
 read is refused with the file's name, so a typo never silently falls back to a default.
@@ -33,6 +34,8 @@ KEYS = {
     "output_dir": "the folder relative output files are written into",
     "blender_python": "Blender for `compare blender` and the Blender tests: a Python with bpy, or a blender "
                       "executable (run with --background --python)",
+    "glass_catalogs": "Zemax .agf glass catalogues (a list of paths, or one) searched after a lens file's own "
+                      "catalogues, as --glass-catalog does",
 }
 
 
@@ -47,13 +50,15 @@ class Config:
     units: str | None = None
     output_dir: Path | None = None
     blender_python: str | None = None
+    glass_catalogs: tuple | None = None
     source: dict = field(default_factory=dict)  # key -> where its value came from
 
     def to_dict(self) -> dict:
         return {"path": None if self.path is None else str(self.path), "exists": self.exists,
                 "sensor": self.sensor, "coc": self.coc, "units": self.units,
                 "output_dir": None if self.output_dir is None else str(self.output_dir),
-                "blender_python": self.blender_python}
+                "blender_python": self.blender_python,
+                "glass_catalogs": None if self.glass_catalogs is None else list(self.glass_catalogs)}
 
 
 def config_path() -> Path | None:
@@ -105,6 +110,13 @@ def _read(path: Path) -> Config:
         if k == "coc" and isinstance(v, (int, float)) and not isinstance(v, bool):
             values[k] = float(v)
             continue
+        if k == "glass_catalogs":
+            v = [v] if isinstance(v, str) else v
+            if not isinstance(v, list) or not all(isinstance(x, str) and x.strip() for x in v):
+                raise InputError(f"the physcam config {path}: glass_catalogs must be a list of .agf paths, "
+                                 f"e.g. glass_catalogs = [\"~/CORNING.AGF\"], got {v!r}")
+            values[k] = tuple(str(Path(x.strip()).expanduser()) for x in v)
+            continue
         if not isinstance(v, str) or not v.strip():
             raise InputError(f"the physcam config {path}: {k} must be text, e.g. {k} = \"...\", got {v!r}")
         values[k] = v.strip()
@@ -140,4 +152,4 @@ def _read(path: Path) -> Config:
                   units=values.get("units"), output_dir=None if out is None else Path(out).expanduser(),
                   blender_python=None if "blender_python" not in values
                   else str(Path(values["blender_python"]).expanduser()),
-                  source={k: str(path) for k in values})
+                  glass_catalogs=values.get("glass_catalogs"), source={k: str(path) for k in values})

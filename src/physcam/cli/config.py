@@ -35,11 +35,13 @@ def effective() -> dict:
     from ._config import load_config
 
     cfg = load_config()
-    builtin = {"sensor": DEFAULT_SENSOR, "coc": "d/1500", "units": "m", "output_dir": None, "blender_python": None}
+    builtin = {"sensor": DEFAULT_SENSOR, "coc": "d/1500", "units": "m", "output_dir": None, "blender_python": None,
+               "glass_catalogs": None}
     out = {}
     for key, default in builtin.items():
         v = getattr(cfg, key)
         given = v is not None
+        v = list(v) if isinstance(v, tuple) else v
         out[key] = {"value": (str(v) if key == "output_dir" and given else v) if given else default,
                     "source": str(cfg.path) if given else "default"}
     from ._config import KEYS

@@ -77,12 +77,17 @@ class Medium:
 
     ``nd`` is the refractive index at the helium d line (587.5618 nm); ``vd`` the
     Abbe number (nd - 1) / (nF - nC), 0 for a medium treated as non-dispersive
-    (air). ``glass`` is an optional catalogue name (e.g. ``"N-BK7"``).
+    (air). ``glass`` is an optional catalogue name (e.g. ``"N-BK7"``), ``catalog`` the catalogue
+    it comes from (e.g. ``"SCHOTT"``; None: the default search order of
+    :func:`physcam.lens.catalog.find_glass`), ``dpgf`` a model glass's deviation of P_gF from the
+    normal line (Zemax's model glass).
     """
 
     nd: float = 1.0
     vd: float = 0.0
     glass: str | None = None
+    catalog: str | None = None
+    dpgf: float = 0.0
 
     @property
     def is_air(self) -> bool:
@@ -263,7 +268,8 @@ class Prescription:
         if len(stops) > 1:
             raise fail(f"{len(stops)} aperture stops (surfaces {stops}); a lens has exactly one")
         for i, s in enumerate(self.surfaces):
-            nums = (s.radius, s.thickness, s.semi_diameter, s.medium.nd, s.medium.vd, s.conic, *s.aspheric)
+            nums = (s.radius, s.thickness, s.semi_diameter, s.medium.nd, s.medium.vd, s.medium.dpgf, s.conic,
+                    *s.aspheric)
             if not all(math.isfinite(v) for v in nums):
                 raise fail("contains NaN or infinity", i)
             if s.kind not in SURFACE_KINDS:

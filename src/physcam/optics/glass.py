@@ -47,7 +47,8 @@ import numpy as np
 
 __all__ = ["LINE_D_NM", "LINE_F_NM", "LINE_C_NM", "LINE_G_NM", "WAVELENGTH_RANGE_NM", "MATCH_TOL_ND",
            "MATCH_TOL_VD", "PGF_NORMAL_LINE", "PGF_UNCERTAINTY", "Dispersion", "dispersion", "normal_line",
-           "normal_line_pgf", "cauchy_coefficients", "refractive_index", "medium_index", "require_wavelength"]
+           "normal_line_pgf", "cauchy_coefficients", "refractive_index", "medium_index", "require_wavelength",
+           "medium_dispersion", "glass_index", "FIT_TOLERANCE"]
 
 LINE_D_NM = 587.5618
 LINE_F_NM = 486.1327
@@ -116,7 +117,8 @@ class Dispersion:
     coefficients: tuple  # a0 a1 a2 B1 B2 B3 C1 C2 C3 (see :func:`evaluate`)
     glass: str | None = None  # catalogue name (sellmeier)
     maker: str | None = None
-    matched_by: str | None = None  # "name" or "nd/Vd" (sellmeier)
+    matched_by: str | None = None  # "name" or "nd/Vd" (catalogue glasses)
+    fit_error: float = 0.0  # max |n - n_formula| of a catalogue formula refitted (kind "catalogue-fit")
 
     def index(self, wavelength_nm):
         """Refractive index at ``wavelength_nm`` (broadcasts)."""
@@ -129,9 +131,11 @@ class Dispersion:
         return (ng - nf) / (nf - nc) if nf != nc else math.nan
 
     def describe(self) -> str:
+        how = "named in the lens file" if self.matched_by == "name" else "identified by nd/Vd"
         if self.kind == "sellmeier":
-            how = "named in the lens file" if self.matched_by == "name" else "identified by nd/Vd"
             return f"{self.maker} {self.glass} (maker's Sellmeier formula, {how})"
+        if self.kind == "catalogue-fit":
+            return f"{self.maker} {self.glass} (maker's formula, refitted to {self.fit_error:.1e}, {how})"
         if self.kind == "normal-line":
             return (f"normal-line model from nd {self.nd:.5f}, Vd {self.vd:.2f} "
                     f"(3-term Cauchy, P_gF {float(normal_line_pgf(self.vd)):.4f} +- {PGF_UNCERTAINTY})")
@@ -162,30 +166,85 @@ def normal_line(nd: float, vd: float, pgf: float | None = None) -> Dispersion:
     return Dispersion("normal-line", nd, vd, (float(a), b, c, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
 
 
-def _sellmeier(nd, vd, g, matched_by) -> Dispersion:
-    b1, b2, b3, c1, c2, c3 = g.sellmeier
-    base = (0.0, 0.0, 0.0, b1, b2, b3, c1, c2, c3)
+#: Largest |n_fit - n_formula| accepted for a catalogue formula refitted into the tracer's form
+#: (:mod:`physcam.optics.glassfit`); above it a lens still loads, with a :class:`PhysCamWarning`.
+FIT_TOLERANCE = 2e-5
+
+
+def _traced_band(g) -> tuple[float, float]:
+    lo, hi = g.range_nm or WAVELENGTH_RANGE_NM
+    return max(lo, WAVELENGTH_RANGE_NM[0]), min(hi, WAVELENGTH_RANGE_NM[1])
+
+
+def _catalogue(nd, vd, g, matched_by) -> Dispersion:
+    """A catalogue glass's formula in the shared 9-coefficient form, shifted to the medium's nd."""
+    if g.sellmeier is not None:
+        b1, b2, b3, c1, c2, c3 = g.sellmeier
+        base, kind, err = (0.0, 0.0, 0.0, b1, b2, b3, c1, c2, c3), "sellmeier", 0.0
+    else:
+        from .glassfit import tracer_form
+
+        base, err = tracer_form(g.formula, tuple(g.coefficients), _traced_band(g))
+        kind = "catalogue-fit"
+        if err > FIT_TOLERANCE:
+            import warnings
+
+            from ..errors import PhysCamWarning
+
+            warnings.warn(f"{g.maker} {g.name}: its {_formula_name(g.formula)} formula differs from the tracer's "
+                          f"dispersion form by up to {err:.1e} between {_traced_band(g)[0]:g} and "
+                          f"{_traced_band(g)[1]:g} nm (tolerance {FIT_TOLERANCE:g})", PhysCamWarning, stacklevel=3)
     offset = nd - float(evaluate(base, LINE_D_NM))
-    return Dispersion("sellmeier", nd, vd, (offset,) + base[1:], g.name, g.maker, matched_by)
+    return Dispersion(kind, nd, vd, (base[0] + offset,) + tuple(base[1:]), g.name, g.maker, matched_by, err)
+
+
+def _formula_name(f) -> str:
+    from ..lens.glassformulas import FORMULA_NAMES
+
+    return FORMULA_NAMES.get(f, f"formula {f}")
 
 
 @lru_cache(maxsize=4096)
-def dispersion(nd: float, vd: float, glass: str | None = None) -> Dispersion:
-    """The dispersion model of a medium (module notes): catalogue Sellmeier by name or by a unique
-    (nd, Vd) match, else the normal-line model, else (Vd = 0, no name) non-dispersive."""
-    from ..lens.catalog import GLASSES, match_glass
+def dispersion(nd: float, vd: float, glass: str | None = None, catalog: str | None = None,
+               dpgf: float = 0.0) -> Dispersion:
+    """The dispersion model of a medium (module notes): the catalogue formula of ``glass`` (searched
+    in ``catalog`` first, then the default order), or of a unique (nd, Vd) match among the common
+    glasses, else the normal-line model with P_gF moved by ``dpgf``, else (Vd = 0, no name)
+    non-dispersive."""
+    from ..lens.catalog import InputError, find_glass, match_glass
 
     nd, vd = float(nd), float(vd)
     if glass:
-        g = GLASSES.get(str(glass).strip().upper())
-        if g is not None and g.sellmeier is not None:
-            return _sellmeier(nd, vd if vd else g.vd, g, "name")
+        try:
+            g = find_glass(glass, [catalog] if catalog else None)
+        except InputError:
+            g = None
+        if g is not None and g.formula is not None:
+            return _catalogue(nd, vd if vd else g.vd, g, "name")
     if vd == 0.0:
         return normal_line(nd, 0.0)
-    g = match_glass(nd, vd, MATCH_TOL_ND, MATCH_TOL_VD)
-    if g is not None:
-        return _sellmeier(nd, vd, g, "nd/Vd")
-    return normal_line(nd, vd)
+    if dpgf == 0.0:
+        g = match_glass(nd, vd, MATCH_TOL_ND, MATCH_TOL_VD)
+        if g is not None:
+            return _catalogue(nd, vd, g, "nd/Vd")
+    return normal_line(nd, vd, float(normal_line_pgf(vd)) + dpgf if dpgf else None)
+
+
+def medium_dispersion(medium) -> Dispersion:
+    """:func:`dispersion` of a :class:`~physcam.lens.prescription.Medium` (all its fields)."""
+    return dispersion(medium.nd, medium.vd, medium.glass, medium.catalog, medium.dpgf)
+
+
+def glass_index(name: str, wavelength_nm, catalog: str | None = None):
+    """Index of the catalogue glass ``name`` at ``wavelength_nm`` from its maker's own formula
+    (:class:`~physcam.lens.catalog.GlassNotFound` if unknown).
+
+    >>> round(float(glass_index("N-BK7", 486.1327)), 5)
+    1.52238
+    """
+    from ..lens.catalog import find_glass
+
+    return find_glass(name, [catalog] if catalog else None).index(np.asarray(wavelength_nm, dtype=float))
 
 
 def medium_index(medium, wavelength_nm):
@@ -194,7 +253,7 @@ def medium_index(medium, wavelength_nm):
     from ..lens.prescription import Medium
 
     require_type("medium", medium, Medium, "a lens surface's medium, e.g. lens.surfaces[0].medium")
-    return dispersion(medium.nd, medium.vd, medium.glass).index(wavelength_nm)
+    return medium_dispersion(medium).index(wavelength_nm)
 
 
 def refractive_index(nd, vd, wavelength_nm, glass: str | None = None):

@@ -31,7 +31,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..lens.prescription import Prescription, takes_prescription
-from ..optics.glass import Dispersion, dispersion, evaluate
+from ..optics.glass import Dispersion, dispersion, evaluate, medium_dispersion
 
 __all__ = ["KIND_FLAT", "KIND_STOP", "KIND_QUADRIC", "KIND_ASPHERE", "SurfaceTable", "surface_table"]
 
@@ -132,7 +132,7 @@ def surface_table(
     # medium after surface i is surfs[i].medium; before surface 0 is air (object space).
     nd = np.array([1.0] + [s.medium.nd for s in surfs])
     media: tuple[Dispersion, ...] = (dispersion(1.0, 0.0),) + tuple(
-        dispersion(s.medium.nd, s.medium.vd, s.medium.glass) for s in surfs)
+        medium_dispersion(s.medium) for s in surfs)
     co = np.array([m.coefficients for m in media], dtype=np.float64)  # (n + 1, 9)
     rs = np.array([reflectance_scale(coating, nd[i], nd[i + 1]) for i in range(n)])
     idx = np.arange(n)

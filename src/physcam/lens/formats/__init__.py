@@ -29,11 +29,17 @@ __all__ = ["FORMATS", "extra", "read_lens", "loads_lens", "write_lens", "dumps_l
 #: Format name -> module with ``loads(text, path=None, name=None)`` and ``dumps(p)``.
 FORMATS = {"physcam": physcam_toml, "seed-toml": seedtoml, "pbrt": pbrt, "iset": iset, "zemax": zemax}
 _EXT = {".dat": "pbrt", ".json": "iset", ".zmx": "zemax", ".toml": "physcam"}
+#: Other programs' lens files physcam recognises but does not read.
+_NOT_READ = {".seq": "CODE V sequence files (.seq)", ".len": "OSLO lens files (.len)",
+             ".zos": "Zemax OpticStudio session files (.zos)", ".zar": "Zemax archives (.zar)"}
 
 
 def detect_format(path, text: str | None = None) -> str:
     """The format of ``path`` from its extension (and, for ``.toml``, its content)."""
     ext = Path(path).suffix.lower()
+    if ext in _NOT_READ:
+        raise LensFileError(f"{_NOT_READ[ext]} are not read (yet); save the lens from that program as "
+                            "a Zemax .zmx (sequential) file", str(path))
     fmt = _EXT.get(ext)
     if fmt is None and text is not None:
         head = text.lstrip()[:2000]

@@ -8,14 +8,16 @@ Layout (docs/lens-formats.md)::
     [provenance]  source?, notes?, and any further keys (original_file, original_format,
                   corrections, aliases) kept in Prescription.extras as "provenance.<key>"
     [[surface]]   kind, radius, thickness, semi_diameter, medium, conic?, aspheric?
-                  medium = "air" | { nd = 1.5168, vd = 64.17, glass? = "N-BK7" } | { glass = "N-BK7" }
+                  medium = "air" | { nd = 1.5168, vd = 64.17, glass? = "N-BK7", catalog? = "SCHOTT",
+                                     dpgf? = 0.0 } | { glass = "N-BK7", catalog? = "SCHOTT" }
     [focus]       close_distance (mm from the front vertex)
     [[focus.gap]] surface (0-based), thickness_infinity?, thickness_close
     [extras]      "key" = "JSON text"  (blocks of other formats, e.g. ISET's microlens)
 
 ``semi_diameter`` is the clear semi-diameter (half the clear aperture), all lengths in
 mm. A medium given only by a glass name takes nd and Vd from
-:mod:`physcam.lens.catalog`; an unknown name is an error.
+:mod:`physcam.lens.catalog` (searched in ``catalog`` first when given); an unknown name is an
+error. ``dpgf`` is a model glass's P_gF deviation from the normal line.
 """
 
 from __future__ import annotations
@@ -54,16 +56,17 @@ def _medium(v, where, path, ln) -> Medium:
         return AIR
     if not isinstance(v, dict):
         raise LensFileError(f"{where}: medium must be \"air\" or a table {{ nd, vd, glass }}", path, ln)
-    unknown_keys(v, ("nd", "vd", "glass"), f"{where} medium", path, ln)
-    glass = v.get("glass")
-    if glass is not None and not isinstance(glass, str):
-        raise LensFileError(f"{where}: glass must be a name (string)", path, ln)
+    unknown_keys(v, ("nd", "vd", "glass", "catalog", "dpgf"), f"{where} medium", path, ln)
+    glass, cat = v.get("glass"), v.get("catalog")
+    if (glass is not None and not isinstance(glass, str)) or (cat is not None and not isinstance(cat, str)):
+        raise LensFileError(f"{where}: glass and catalog must be names (strings)", path, ln)
+    dpgf = number(v.get("dpgf", 0.0), f"{where} dpgf", path, ln, length=False)
     if "nd" in v:
         nd = number(v["nd"], f"{where} nd", path, ln, length=False)
         vd = number(v.get("vd", 0.0), f"{where} vd", path, ln, length=False)
     elif glass is not None:
         try:
-            g = find_glass(glass)
+            g = find_glass(glass, [cat] if cat else None)
         except InputError as exc:
             raise LensFileError(f"{where}: {exc}", path, ln) from None
         nd, vd = g.nd, g.vd
@@ -71,7 +74,7 @@ def _medium(v, where, path, ln) -> Medium:
             vd = number(v["vd"], f"{where} vd", path, ln, length=False)
     else:
         raise LensFileError(f"{where}: medium needs nd (and vd) or a catalogue glass name", path, ln)
-    return Medium(nd, vd, glass)
+    return Medium(nd, vd, glass, cat, dpgf)
 
 
 @takes_text
@@ -202,6 +205,10 @@ def dumps(p: Prescription) -> str:
             parts = [f"nd = {toml_value(float(s.medium.nd))}", f"vd = {toml_value(float(s.medium.vd))}"]
             if s.medium.glass is not None:
                 parts.append(f"glass = {toml_value(s.medium.glass)}")
+            if s.medium.catalog is not None:
+                parts.append(f"catalog = {toml_value(s.medium.catalog)}")
+            if s.medium.dpgf != 0.0:
+                parts.append(f"dpgf = {toml_value(float(s.medium.dpgf))}")
             out.append("medium = { " + ", ".join(parts) + " }")
         if s.conic != 0.0 or s.kind == "aspheric":
             out.append(f"conic = {toml_value(float(s.conic))}")

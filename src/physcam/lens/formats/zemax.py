@@ -2,19 +2,27 @@
 
 Read: ``UNIT MM``, ``NAME``, ``NOTE``, and per ``SURF n`` block: ``TYPE STANDARD`` or
 ``TYPE EVENASPH``, ``CURV c`` (1/mm), ``DISZ t`` (mm, ``INFINITY`` on the object
-surface), ``GLAS`` (a model glass ``GLAS ___BLANK 1 0 nd vd ...``, or a catalogue glass
-``GLAS NAME 0 0 nd vd ...`` whose nd and Vd are taken from the line, falling back to
-:mod:`physcam.lens.catalog` when the line has none), ``DIAM`` (the **semi**-diameter), ``STOP``,
-``CONI k`` and ``PARM n a`` (EVENASPH: PARM 1 is the r^2 term, PARM 2..8 are
-A4..A16). Surface 0 is the object, the last surface the image; the gap before the
-image is the last lens thickness (distance to the film). Anything else that changes
-the optics (other surface types, tilts/decentres, MIRROR, other units, a curved stop,
-an r^2 asphere term, non-zero object-space index) is refused with file and line;
-bookkeeping lines (``VERS``, ``MODE``, ``FLOA``, ``WAVL``, ...) are ignored. Source:
-Zemax OpticStudio user manual, "ZMX file format" / "Even Asphere" surface. Files may be
-UTF-8, UTF-16 with a byte-order mark, or the Windows code page OpticStudio writes ("ANSI").
+surface), ``GLAS``, ``DIAM`` (the **semi**-diameter), ``STOP``, ``CONI k`` and ``PARM n a``
+(EVENASPH: PARM 1 is the r^2 term, PARM 2..8 are A4..A16). Surface 0 is the object, the last
+surface the image; the gap before the image is the last lens thickness (distance to the film).
+
+Glasses as OpticStudio reads them: ``GCAT A B C`` lists the catalogues searched, in order
+(:func:`physcam.lens.catalog.find_glass`, plus the user's ``--glass-catalog`` files);
+``GLAS NAME 0 ...`` is that catalogue glass, its data from the catalogue (the nd and Vd on the
+line are placeholders OpticStudio ignores, and so does physcam; glass substitution flags too);
+``GLAS ___BLANK 1 0 nd vd dPgF`` or any ``GLAS NAME 1 0 nd vd dPgF`` is a model glass. ``WAVM``
+(or ``WAVL``) and ``PWAV`` give the design wavelength (the primary). A stop on a lens face
+becomes a flat stop at that face's vertex, with the face's semi-diameter. Lines read past
+without effect on a refracting lens are listed in :data:`SKIPPED` with the reason.
+
+Anything else that changes the optics (other surface types, tilts/decentres, MIRROR, other
+units, an r^2 asphere term, non-zero object-space index) is refused with file and line. Source:
+Zemax OpticStudio user manual, "ZMX file format" / "Even Asphere" surface / "Glass catalogs".
+Files may be UTF-8, UTF-16 with a byte-order mark, or the Windows code page ("ANSI").
 A file cut short (a block without CURV/DISZ, an "image" with a thickness or glass after it,
-glass before the image) is refused rather than read as a shorter, different lens.
+glass before the image and nothing after the last surface) is refused rather than read as a
+shorter, different lens; an image space in a liquid is accepted when the file goes on past the
+last surface (``TOL``, ``MNUM``, ``MOFF``, ``BLNK``... lines, as OpticStudio writes them).
 
 The radius is read back as the shortest decimal whose reciprocal is the file's CURV,
 so a radius written by :func:`dumps` (``CURV`` = 1/R to 17 digits) reads back equal.
@@ -27,11 +35,33 @@ import warnings
 from pathlib import Path
 
 from ...errors import ExportError, InputError, LensFileError, PhysCamWarning
-from ..catalog import find_glass
+from ..catalog import GlassNotFound, find_glass
 from ..prescription import AIR, LensMetadata, Medium, Prescription, Surface, takes_prescription
 from ._common import MAX_SURFACES, check_count, fmt, number, one_line, validated, takes_text
 
-__all__ = ["loads", "dumps"]
+__all__ = ["loads", "dumps", "SKIPPED"]
+
+#: Lines read past, with the reason (docs/lens-formats.md lists them).
+SKIPPED = {
+    "MIRR": "mirror substrate drawing data, not a mirror surface (GLAS MIRROR is refused)",
+    "HIDE": "layout visibility only",
+    "POPS": "physical-optics propagation settings",
+    "FLAP": "flat-aperture drawing data",
+    "MEMA": "mechanical semi-aperture (drawing); physcam keeps the clear semi-diameter DIAM",
+    "COAT": "coating name: physcam's coating model is per lens (Prescription.coating)",
+    "FLOA": "floating stop: the file's stop surface and its DIAM are kept",
+    "ENPD": "entrance-pupil size: the stop's DIAM is kept",
+    "FNUM": "f-number aperture: the stop's DIAM is kept",
+    "OBNA": "object-space NA aperture: the stop's DIAM is kept",
+    "XFLN": "field points: physcam analyses its own fields",
+    "YFLN": "field points: physcam analyses its own fields",
+    "TOL": "tolerance data",
+    "MNUM": "multi-configuration data",
+    "MOFF": "multi-configuration data",
+    "BLNK": "spacer line after the surfaces",
+}
+# Lines after the last surface that show the file goes on (it was not cut short there).
+_TAIL = {"TOL", "TOLE", "MNUM", "MOFF", "BLNK", "CONF", "MCOP", "MCOM", "DMFS", "TCED"}
 
 # Lines that do not change a sequential lens's first- or third-order optics.
 _IGNORED = {
@@ -40,6 +70,7 @@ _IGNORED = {
     "NSCD", "COFN", "SUMM", "BLNK", "RAIM", "PUSH", "SDMA", "FTYP", "HIDE", "SLAB", "MAZH", "CLAP", "POPS",
     "TOL", "MNUM", "MOFF", "TOLE", "COAT", "FLAP", "XFIE", "YFIE", "ZVDX", "ZVDY", "ZVCX", "ZVCY", "ZVAN",
     "MIRR", "MAZP", "DMFS", "OPDX", "RWRE", "EFFL", "CONF", "MCOP", "ENVD", "TCED", "OBSC", "SQAP",
+    "MEMA",
 }
 
 
@@ -60,13 +91,20 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
     """Parse a sequential ``.zmx`` into a validated :class:`Prescription`."""
     blocks: list[dict] = []
     lens_name, notes = None, []
+    head = {"gcat": [], "wavm": {}, "wavl": [], "pwav": 1, "tail": False}
     cur = None
     for lineno, raw in enumerate(text.splitlines(), start=1):
         tok = raw.split()
         if not tok:
             continue
         key = tok[0].upper()
+        if key in ("GCAT", "WAVM", "WAVL", "PWAV"):
+            _header(key, tok, head, path, lineno)
+            continue
+        if key in _TAIL:
+            head["tail"] = True
         if key == "SURF":
+            head["tail"] = False
             if len(tok) < 2:
                 raise LensFileError("SURF needs a surface number", path, lineno)
             cur = {"line": lineno, "type": "STANDARD", "curv": 0.0, "disz": 0.0, "glass": None, "diam": None,
@@ -115,7 +153,7 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
                 raise LensFileError(f"PARM {int(n)} is not supported (physcam keeps A4..A16 = PARM 2..8; "
                                     "fold an r^2 term into CURV)", path, lineno)
         elif key == "GLAS":
-            cur["glass"] = _glass(tok, path, lineno)
+            cur["glass"] = tok
             cur["glass_line"] = lineno
         elif key in ("DECX", "DECY", "TILTX", "TILTY", "COORD", "CBRK"):
             raise LensFileError(f"{key} (decentre/tilt) is not supported in a rotationally symmetric lens", path, lineno)
@@ -127,7 +165,10 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
             raise LensFileError(f"unrecognised line {raw.strip()[:40]!r}", path, lineno)
     if len(blocks) < 3:
         raise LensFileError("a sequential lens needs an object surface, lens surfaces and an image surface", path)
-    _check_complete(blocks, path)
+    for b in blocks:
+        if b["glass"] is not None:
+            b["glass"] = _glass(b["glass"], head["gcat"], path, b["glass_line"])
+    _check_complete(blocks, path, head["tail"])
     obj, lens_blocks = blocks[0], blocks[1:-1]
     if obj["glass"] is not None and obj["glass"] != AIR:
         raise LensFileError("the object space must be air", path, obj.get("glass_line", obj["line"]))
@@ -151,11 +192,13 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
             top = max([k for k in b["parm"] if b["parm"][k] != 0.0] + [1])
             aspheric = tuple(b["parm"].get(k, 0.0) for k in range(2, top + 1))
         radius = _radius(b["curv"])
+        if b["stop"] and (radius != 0.0 or aspheric or b["coni"] != 0.0):
+            # a stop on a lens face: a flat stop at the face's vertex, in the medium before it
+            before = surfaces[-1].medium if surfaces else AIR
+            surfaces.append(Surface(0.0, 0.0, before, b["diam"], "stop"))
+            lines.append(ln)
+            b["stop"] = False
         if b["stop"]:
-            if radius != 0.0 or aspheric or b["coni"] != 0.0:
-                raise LensFileError(
-                    "the STOP is on a curved surface; physcam needs the stop as its own flat surface "
-                    "(insert a dummy surface with STOP)", path, ln)
             kind = "stop"
         elif b["type"] == "EVENASPH" and (aspheric or b["coni"] != 0.0):
             kind = "aspheric"
@@ -169,16 +212,41 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
     if name is None:
         name = lens_name or (Path(path).stem if path is not None else "unnamed lens")
     meta = LensMetadata(name=name, notes="\n".join(notes) or None)
-    return validated(Prescription(tuple(surfaces), meta), path, lines)
+    wl = _design_wavelength(head, path)
+    return validated(Prescription(tuple(surfaces), meta, wavelength_nm=wl), path, lines)
 
 
-def _check_complete(blocks, path) -> None:
+def _header(key, tok, head, path, lineno) -> None:
+    """GCAT (catalogues in search order), WAVM n um weight / WAVL um ... (wavelengths), PWAV n."""
+    if key == "GCAT":
+        head["gcat"] = [t.upper() for t in tok[1:]]
+    elif key == "WAVM" and len(tok) >= 3:
+        n = _num(tok, 1, "WAVM number", path, lineno, length=False)
+        head["wavm"][int(n)] = _num(tok, 2, "WAVM wavelength (um)", path, lineno)
+    elif key == "WAVL":
+        head["wavl"] = [number(t, "WAVL wavelength (um)", path, lineno) for t in tok[1:]]
+    elif key == "PWAV" and len(tok) >= 2:
+        head["pwav"] = int(_num(tok, 1, "PWAV", path, lineno, length=False))
+
+
+def _design_wavelength(head, path) -> float:
+    """The primary wavelength (nm): WAVM[PWAV], else the PWAV-th WAVL value, else the d line."""
+    um = head["wavm"].get(head["pwav"])
+    if um is None and head["wavl"]:
+        um = head["wavl"][min(max(head["pwav"], 1), len(head["wavl"])) - 1]
+    if um is None:
+        return Prescription.__dataclass_fields__["wavelength_nm"].default
+    return round(um * 1000.0, 9)
+
+
+def _check_complete(blocks, path, goes_on: bool = False) -> None:
     """Refuse a file cut short: a truncated file must not load as another lens (issue 8).
 
     OpticStudio writes ``CURV`` and ``DISZ`` in every ``SURF`` block, object and image included;
-    the image surface is the last block, in air, with nothing after it (``DISZ 0``); the light
-    reaches it through air. A block missing those lines, an "image" with a thickness or a glass
-    after it, or glass before it means the file ends inside the lens.
+    the image surface is the last block, with nothing after it (``DISZ 0``). A block missing
+    those lines or an "image" with a thickness or a glass after it means the file ends inside the
+    lens; so does glass before the image, unless the file goes on past the last surface
+    (``goes_on``: TOL, MNUM, MOFF, BLNK... lines), which makes it an image space in a medium.
     """
     hint = "the file seems cut short (truncated); save the whole lens again"
     for b in blocks:
@@ -190,9 +258,9 @@ def _check_complete(blocks, path) -> None:
         raise LensFileError(f"the last surface, SURF {image['number']}, is not an image surface (it has "
                             f"{'a thickness' if image['disz'] != 0.0 else 'glass'} after it): {hint}",
                             path, image["line"])
-    if last["glass"] is not None and last["glass"] != AIR:
+    if last["glass"] is not None and last["glass"] != AIR and not goes_on:
         raise LensFileError(f"SURF {last['number']} is followed by glass, yet the next surface is the last "
-                            f"(the image cannot lie in glass): {hint}", path, last["line"])
+                            f"and nothing follows it (an image in a medium is accepted when the file goes on past the last surface, as OpticStudio writes it): {hint}", path, last["line"])
 
 
 def _num(tok, k, what, path, lineno, *, length=True) -> float:
@@ -201,50 +269,34 @@ def _num(tok, k, what, path, lineno, *, length=True) -> float:
     return number(tok[k], what, path, lineno, length=length)
 
 
-def _glass(tok, path, lineno) -> Medium:
+def _glass(tok, gcat, path, lineno) -> Medium:
+    """The medium of a GLAS line: a model glass (___BLANK, or solve code 1) from nd, Vd, dPgF;
+    else the catalogue glass, searched in the GCAT order (the line's numbers are placeholders)."""
     if len(tok) < 2:
         raise LensFileError("GLAS needs a glass name", path, lineno)
     g = tok[1]
     if g.upper() == "MIRROR":
         raise LensFileError("MIRROR surfaces are not supported (refracting lenses only)", path, lineno)
-    if g == "___BLANK":
+    if g == "___BLANK" or (len(tok) > 2 and tok[2] == "1"):
         if len(tok) < 6:
-            raise LensFileError("model glass needs 'GLAS ___BLANK 1 0 nd vd'", path, lineno)
+            raise LensFileError("model glass needs 'GLAS ___BLANK 1 0 nd vd [dPgF]'", path, lineno)
         nd = number(tok[4], "model glass nd", path, lineno, length=False)
         vd = number(tok[5], "model glass vd", path, lineno, length=False)
-        return AIR if (nd == 1.0 and vd == 0.0) else Medium(nd, vd)
-    # A catalogue glass line carries the glass's own nd and Vd (GLAS NAME 0 0 nd vd ...); they are
-    # what OpticStudio used, so they win over physcam's small catalogue, which fills in only when
-    # the file gives none.
-    file_nd = file_vd = None
-    if len(tok) >= 6:
-        try:
-            file_nd, file_vd = float(tok[4]), float(tok[5])
-        except ValueError:
-            file_nd = file_vd = None
-    if file_nd is not None and math.isfinite(file_nd) and file_nd > 1.0 and math.isfinite(file_vd) and file_vd >= 0:
-        try:
-            cat = find_glass(g)
-        except InputError:
-            cat = None
-        if cat is not None and (abs(cat.nd - file_nd) > 5e-4 or abs(cat.vd - file_vd) > 0.5):
-            warnings.warn(f"{path}:{lineno}: glass {g} has nd {file_nd:g}, Vd {file_vd:g} in the file but "
-                          f"{cat.nd:g}, {cat.vd:g} in physcam's catalogue; using the file's", PhysCamWarning,
-                          stacklevel=2)
-        return Medium(file_nd, file_vd, g)
+        dpgf = number(tok[6], "model glass dPgF", path, lineno, length=False) if len(tok) > 6 else 0.0
+        return AIR if (nd == 1.0 and vd == 0.0) else Medium(nd, vd, dpgf=dpgf if vd else 0.0)
     try:
-        cat = find_glass(g)
-    except InputError as exc:
-        raise LensFileError(str(exc) + "; or give its nd and Vd on the GLAS line", path, lineno) from None
-    return Medium(cat.nd, cat.vd, cat.name)
+        cat = find_glass(g, gcat)
+    except GlassNotFound as exc:
+        raise LensFileError(str(exc), path, lineno) from None
+    return Medium(cat.nd, cat.vd, cat.name, cat.maker)
 
 
 @takes_prescription
 def dumps(p: Prescription) -> str:
     """Sequential ``.zmx`` text for ``p``; :class:`ExportError` for cylinders and the squeeze.
 
-    Catalogue glasses are written by name when nd and Vd match the catalogue, other media
-    as model glasses. Focus groups and metadata other than the name and notes are dropped
+    Catalogue glasses are written by name (with a GCAT line naming their catalogues) when nd
+    and Vd match the catalogue, other media as model glasses with their dPgF. Focus groups and metadata other than the name and notes are dropped
     with a :class:`PhysCamWarning`.
     """
     for i, s in enumerate(p.surfaces):
@@ -259,6 +311,8 @@ def dumps(p: Prescription) -> str:
     if p.metadata.notes:
         out += [one_line(f"NOTE 0 {line}").rstrip() for line in p.metadata.notes.splitlines()]
     out.append(f"WAVL {fmt(p.wavelength_nm / 1000.0)}")
+    gcat_at = len(out)
+    cats: list[str] = []
     out += ["SURF 0", "  TYPE STANDARD", "  CURV 0.0", "  DISZ INFINITY"]
     for i, s in enumerate(p.surfaces, start=1):
         out.append(f"SURF {i}")
@@ -274,17 +328,27 @@ def dumps(p: Prescription) -> str:
         out.append(f"  DISZ {fmt(s.thickness)}")
         m = s.medium
         if m != AIR:
-            named = None
-            if m.glass is not None:
-                try:
-                    g = find_glass(m.glass)
-                    named = g.name if (g.nd, g.vd, g.name) == (m.nd, m.vd, m.glass) else None
-                except InputError:
-                    named = None
-            if named:
-                out.append(f"  GLAS {named} 0 0 {fmt(m.nd)} {fmt(m.vd)} 0 0 0 0 0 0")
+            g = _named(m)
+            if g is not None:
+                out.append(f"  GLAS {g.name} 0 0 {fmt(m.nd)} {fmt(m.vd)} 0 0 0 0 0 0")
+                cats.append(g.maker)
             else:
-                out.append(f"  GLAS ___BLANK 1 0 {fmt(m.nd)} {fmt(m.vd)} 0 0 0 0 0 0")
+                out.append(f"  GLAS ___BLANK 1 0 {fmt(m.nd)} {fmt(m.vd)} {fmt(m.dpgf)} 0 0 0 0 0")
         out.append(f"  DIAM {fmt(s.semi_diameter)} 1 0 0 1 \"\"")
     out += [f"SURF {len(p.surfaces) + 1}", "  TYPE STANDARD", "  CURV 0.0", "  DISZ 0.0"]
+    if cats:
+        out.insert(gcat_at, "GCAT " + " ".join(dict.fromkeys(cats)))
+    if p.surfaces[-1].medium != AIR:
+        out.append("BLNK")  # the file goes on past the image surface: an image space in a medium
     return "\n".join(out) + "\n"
+
+
+def _named(m: Medium):
+    """The catalogue glass a medium names, when its nd and Vd are that glass's; else None."""
+    if m.glass is None:
+        return None
+    try:
+        g = find_glass(m.glass, [m.catalog] if m.catalog else None)
+    except GlassNotFound:
+        return None
+    return g if (g.nd, g.vd) == (m.nd, m.vd) else None
