@@ -23,9 +23,8 @@ from physcam.cli import main
 from physcam.errors import InputError
 from physcam.lens.library import load_lens
 from physcam.live.camera import camera_samples
-from physcam.live.frames import TrackedFrame, frame_from_sample, parse_timecode, timecode_fields
+from physcam.live.frames import TrackedFrame, frame_from_sample, timecode_fields
 from physcam.live.frustum import frustum_frames, wall_from_usd, write_wall
-from physcam.live.lens_data import focus_for_consumer
 from physcam.live.record import lens_report_rows, solve_frames, write_recording_usd
 from physcam.live.sample import decode_sample, encode_sample, sample_problems
 from physcam.live.usd_io import frames_from_usd
@@ -170,6 +169,24 @@ def test_a_shifted_lens_moves_the_frustum_by_its_offset(tmp_path, capsys):
     assert (got[1, 0] + got[0, 0]) / 2 == pytest.approx((6.0 - pupil) * 1.5 / f, rel=1e-6)
 
 
+def test_record_and_frustum_read_a_streams_squeeze_and_projection_offset(tmp_path):
+    """Another tracker's stream (values set by hand, not physcam's sender): squeeze 2 and a projection
+    offset of (0.9, -0.6) mm reach the lens report and the wall."""
+    sample = camera_samples(sensor=S35, frames=1, rate=24, focus_mm=3000.0, focal_length_mm=50.0, fstop=2.8,
+                            distortion=False)[0]
+    sample["static"]["camera"]["anamorphicSqueeze"] = {"num": 2, "denom": 1}
+    sample["lens"].update(projectionOffset={"x": 0.9, "y": -0.6}, distortionOffset={"x": 0.1, "y": 0.2})
+    sample = decode_sample(encode_sample(sample))
+    solved, frames = _record(tmp_path, [sample])
+    f, pupil = sample["lens"]["pinholeFocalLength"], sample["lens"]["entrancePupilOffset"]
+    w, h = S35.width_mm, S35.height_mm
+    assert lens_report_rows(solved)[0]["hfov_deg"] == pytest.approx(2 * math.degrees(math.atan(w / f)), abs=1e-4)
+    assert frames[0].distortion_offset_mm == pytest.approx((0.1, 0.2))
+    hand = _hand_corners(pupil, 1.5, (2 * (-w / 2 - 0.9) / f, 2 * (w / 2 - 0.9) / f),
+                         ((-h / 2 - 0.6) / f, (h / 2 - 0.6) / f))
+    assert np.abs(_flat_wall_corners(tmp_path, frames, overscan=0.0) - hand).max() < 1e-3
+
+
 def test_ndisplay_overscan_multiplies_the_angle(tmp_path):
     frame = TrackedFrame(rate=Fraction(24), translation_m=(0.0, 0.0, 5.0), pinhole_focal_length_mm=35.0,
                          focus_from_film_mm=3000.0, fstop=2.8, entrance_pupil_mm=0.0, sensor_mm=(24.89, 18.66))
@@ -239,6 +256,8 @@ def test_a_bad_fiz_table_names_file_and_line(tmp_path):
 
 # --- focus distance plane ---------------------------------------------------------------------------
 def test_unreal_focus_is_measured_from_the_entrance_pupil(capsys):
+    from physcam.live.lens_data import focus_for_consumer
+
     oracle = _lens_breathing(capsys, "dgauss_50mm", "1m")
     pupil = oracle["entrance_pupil_from_film_mm"]
     assert focus_for_consumer(1000.0, pupil) == 1.0  # OpenTrackIO: the mark, metres from the film
@@ -256,6 +275,8 @@ def test_a_timecode_frame_beyond_the_rate_is_refused():
 
 
 def test_drop_frame_timecode_follows_smpte_12():
+    from physcam.live.frames import parse_timecode
+
     r = Fraction(30000, 1001)
     label = lambda n: timecode_fields(n, r, drop_frame=True)  # noqa: E731
     assert (label(1800)["minutes"], label(1800)["frames"]) == (1, 2)  # ;00 and ;01 skipped
