@@ -20,7 +20,7 @@ Overscan, stated per frame in the output, about the centre of the frame's view i
   **tangent** by (1 + overscan), the image plane grown by that factor (OpenLensIO's overscan factor Ω,
   section 2.1); ``"ndisplay"`` multiplies the half-**angle** by (1 + overscan), as Unreal's nDisplay
   inner-frustum overscan scales the camera's field of view (Epic, "In-Camera VFX" camera settings). At
-  10 % on a 40° view the two differ by about 0.2°; at 90° by over 2°;
+  10 % on a 40° view the two give 44.0° and 43.6°;
 * ``latency_s``: tracking latency. The camera turns ω rad/s (measured from this frame to the next)
   while the wall still shows the old view; each edge's angle is widened by ω x latency, so the picture
   the camera sees ``latency_s`` later is still inside the inner frustum.
