@@ -168,3 +168,29 @@ def test_a_corrupt_file_is_refused(tmp_path, capsys):
     bad.write_bytes(b"\x89PNG\r\n\x1a\n" + b"not really" * 10)
     _refused(capsys, ["calibrate", str(bad), *CHARUCO_ARGS, "-o", str(tmp_path / "o")], tmp_path / "o",
              "not an image OpenCV can read")
+
+
+@pytest.mark.slow
+def test_flat_field_and_a_lens_that_is_not_this_camera(photos, tmp_path, capsys):
+    """A flat field falling off as cos^4 of the field angle about the true principal point reads back as
+    cos^4(atan(h / f)) (a closed form); compared with dgauss_50mm (a 50 mm lens, not this 11.5 mm
+    camera) the focal length is said to differ."""
+    w, h = SIZE
+    y, x = np.mgrid[0:h, 0:w]
+    tan2 = ((x - K_TRUE[0, 2]) ** 2 + (y - K_TRUE[1, 2]) ** 2) / K_TRUE[0, 0] ** 2
+    flat = tmp_path / "flat.png"
+    cv2.imwrite(str(flat), np.round(60000.0 / (1 + tan2) ** 2).astype(np.uint16))
+    rc = main(["calibrate", str(photos), *CHARUCO_ARGS, "--focus", "2m", "-o", str(tmp_path / "o"), "--bootstrap",
+               "4", "--flat", str(flat), "--lens", "dgauss_50mm", "--json"])
+    assert rc == 0, capsys.readouterr().err
+    doc = json.loads(capsys.readouterr().out)
+    pts = doc["illumination"]["points"]
+    f_mm = K_TRUE[0, 0] * PITCH_MM
+    for p in pts[1:]:  # each ring's mean of cos^4 over its width: within 2 % of the value at its middle
+        # (a ring spans 1/12 of the corner height; cos^4 curves across it, most in the corner rings)
+        assert p["relative_illumination"] == pytest.approx(np.cos(np.arctan(p["image_height_mm"] / f_mm)) ** 4,
+                                                           rel=0.02)
+    rows = {r["figure"]: r for r in doc["comparison"]["rows"]}
+    f_row = rows["pinhole focal length at 2000 mm"]
+    assert not f_row["agrees"] and f_row["predicted"] > 40.0
+    assert doc["comparison"]["agrees"] is False

@@ -106,19 +106,26 @@ def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K
         p = 100.0 * (pred_f[r.mark_mm] / pred_f[ref.mark_mm] - 1.0)
         rows.append(_row(f"breathing {r.mark_mm:g} mm against {ref.mark_mm:g} mm", r.change_pct, p,
                          r.change_std_pct, "%", k))
+    notes = []
     if calibration.illumination is not None:
-        rows += _illumination_rows(calibration, lens, k, fstop)
-    return Comparison(lens.name, k, rows)
+        from ..errors import OpticsError
+
+        try:
+            rows += _illumination_rows(calibration, lens, k, fstop, pred_f[calibration.marks[0].mark_mm])
+        except OpticsError as e:
+            notes.append(f"relative illumination not predicted: {e}")
+            rows.append(_row("relative illumination (the lens does not cover the frame)", 1.0, 0.0, 0.0, "ratio", k))
+    return Comparison(lens.name, k, rows, notes)
 
 
-def _illumination_rows(calibration, lens, k, fstop) -> list[dict]:
+def _illumination_rows(calibration, lens, k, fstop, f_pred) -> list[dict]:
     """Each ring of the measured relative illumination against the lens's, interpolated at its image height."""
     from ..optics.focusing import iris_semi_diameter
     from .illumination import relative_illumination
 
     ill, m = calibration.illumination, calibration.marks[0]
     heights = ill.height_mm[1:]
-    top = math.degrees(math.atan(1.02 * heights.max() / m.focal_length_mm[1]))
+    top = math.degrees(math.atan(1.02 * heights.max() / f_pred))  # the lens's own pinhole at the mark
     sd = None if fstop is None else iris_semi_diameter(lens, fstop)
     res = relative_illumination(lens, list(np.linspace(0.0, top, 12)), sensor_width_mm=m.sensor_mm[0],
                                 sensor_height_mm=m.sensor_mm[1], grid=64, stop_semi_diameter=sd)
