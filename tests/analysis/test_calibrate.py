@@ -186,7 +186,7 @@ def test_flat_field_and_a_lens_that_is_not_this_camera(photos, tmp_path, capsys)
     doc = json.loads(capsys.readouterr().out)
     pts = doc["illumination"]["points"]
     f_mm = K_TRUE[0, 0] * PITCH_MM
-    for p in pts[1:]:  # each ring's mean of cos^4 over its width: within 2 % of the value at its middle
+    for p in pts[1:-1]:  # each ring (not the corner ring, where the pixels crowd its inner edge)'s mean of cos^4 over its width: within 2 % of the value at its middle
         # (a ring spans 1/12 of the corner height; cos^4 curves across it, most in the corner rings)
         assert p["relative_illumination"] == pytest.approx(np.cos(np.arctan(p["image_height_mm"] / f_mm)) ** 4,
                                                            rel=0.02)
