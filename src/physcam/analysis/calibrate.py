@@ -237,7 +237,8 @@ def calibrate_mark(views, sensor_mm, *, fix_aspect: bool = True, bootstrap: int 
                    lens_name: str = "measured") -> MarkCalibration:
     """Calibrate the views of one focus mark on a sensor of ``sensor_mm`` (width, height; the images'
     recorded area) and fit physcam's models to the measured field (module notes)."""
-    views = list(views)
+    views = _check_views(views)
+    sensor_mm = _pair("sensor_mm", sensor_mm)
     if len(views) < MIN_VIEWS:
         raise InputError(f"{len(views)} view{'s' if len(views) != 1 else ''} of the chart"
                          f"{_at(views)}: calibrating needs {MIN_VIEWS} or more, at several angles")
@@ -259,6 +260,21 @@ def calibrate_mark(views, sensor_mm, *, fix_aspect: bool = True, bootstrap: int 
     cal.notes.append("physcam's models are about the measured principal point "
                      f"({cal.principal_offset_mm[0]:+.4f}, {cal.principal_offset_mm[1]:+.4f}) mm from the frame centre")
     return cal
+
+
+def _check_views(views) -> list:
+    if isinstance(views, (str, bytes)) or not hasattr(views, "__iter__"):
+        raise InputError(f"give the chart views (detect_views), got {type(views).__name__}")
+    views = list(views)
+    if not all(isinstance(v, ChartView) for v in views):
+        raise InputError("give the chart views (physcam.analysis.calibrate_chart.detect_views)")
+    return views
+
+
+def _pair(name, v) -> tuple[float, float]:
+    if isinstance(v, (str, bytes)) or not hasattr(v, "__len__") or len(v) != 2:
+        raise InputError(f"{name} is (width, height) in mm, got {v!r}")
+    return (require_positive(f"{name} width", v[0], unit="mm"), require_positive(f"{name} height", v[1], unit="mm"))
 
 
 def _at(views) -> str:
@@ -322,8 +338,9 @@ def _breathing(marks) -> list[BreathingRow]:
 def calibrate_views(views, sensor_mm, *, lens_name: str = "measured", **kwargs) -> Calibration:
     """Group ``views`` by their focus mark, calibrate each (:func:`calibrate_mark`; ``kwargs`` passed on)
     and tabulate the breathing between the marks (module notes)."""
-    views = list(views)
-    if not views or not all(isinstance(v, ChartView) for v in views):
+    views = _check_views(views)
+    sensor_mm = _pair("sensor_mm", sensor_mm)
+    if not views:
         raise InputError("give the chart views (physcam.analysis.calibrate_chart.detect_views)")
     sizes = {v.size_px for v in views}
     if len(sizes) > 1:

@@ -107,8 +107,14 @@ class ChartView:
 
 def image_files(items) -> list[Path]:
     """The image files of ``items``: files as given, folders as their images (sorted)."""
+    if isinstance(items, (str, Path)):
+        items = [items]
+    if not hasattr(items, "__iter__"):
+        raise InputError(f"give image files or folders, got {type(items).__name__}")
     out: list[Path] = []
     for it in items:
+        if not isinstance(it, (str, Path)):
+            raise InputError(f"an image is a file name, got {type(it).__name__}")
         p = Path(it)
         if p.is_dir():
             found = sorted(q for q in p.iterdir() if q.suffix.lower() in IMAGE_SUFFIXES)
@@ -124,6 +130,8 @@ def image_files(items) -> list[Path]:
 
 def read_gray(path) -> np.ndarray:
     """The image at ``path`` as a 2-D array (8 or 16 bit kept); a file OpenCV cannot read is an InputError."""
+    if not isinstance(path, (str, Path)):
+        raise InputError(f"an image is a file name, got {type(path).__name__}")
     cv2 = _cv2()
     img = cv2.imread(str(path), cv2.IMREAD_ANYDEPTH | cv2.IMREAD_GRAYSCALE)
     if img is None or img.ndim != 2 or min(img.shape) < 16:
@@ -140,8 +148,13 @@ def _to8(img: np.ndarray) -> np.ndarray:
 
 def detect_chart(image: np.ndarray, chart: ChartSpec):
     """(image points (n, 2) OpenCV px, chart points (n, 3) mm) of ``chart`` in ``image``, or None."""
+    if not isinstance(chart, ChartSpec):
+        raise InputError(f"give a ChartSpec, got {type(chart).__name__}")
+    image = np.asarray(image)
+    if image.ndim != 2 or image.dtype.kind not in "uif" or min(image.shape) < 16:
+        raise InputError(f"the image is a 2-D grey array of 16 px or more each way, got shape {image.shape}")
     cv2 = _cv2()
-    img = _to8(np.asarray(image))
+    img = _to8(image)
     if chart.kind == "checkerboard":
         flags = cv2.CALIB_CB_EXHAUSTIVE | cv2.CALIB_CB_ACCURACY | cv2.CALIB_CB_NORMALIZE_IMAGE
         ok, corners = cv2.findChessboardCornersSB(img, chart.inner, flags=flags)
@@ -166,7 +179,9 @@ def detect_views(paths, chart: ChartSpec, marks=None) -> list[ChartView]:
     naming the file. ``marks``: the focus mark (mm from the film) of each path, or None."""
     if not isinstance(chart, ChartSpec):
         raise InputError(f"give a ChartSpec, got {type(chart).__name__}")
-    paths = list(paths)
+    paths = image_files(paths)
+    if marks is not None and (isinstance(marks, (str, bytes)) or not hasattr(marks, "__len__")):
+        raise InputError(f"marks is one focus mark (mm) per image, got {type(marks).__name__}")
     marks = [None] * len(paths) if marks is None else list(marks)
     views: list[ChartView] = []
     for path, mark in zip(paths, marks):

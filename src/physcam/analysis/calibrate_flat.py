@@ -46,7 +46,15 @@ class MeasuredIllumination:
 def measure_illumination(paths, size_px, sensor_mm, principal_point_px, *, rings: int = RINGS) -> MeasuredIllumination:
     """Relative illumination of the flat-field frames ``paths`` (module notes); ``principal_point_px``
     in OpenCV pixels (x right, y down, pixel centres at whole numbers)."""
+    from .calibrate import _pair
+
+    if isinstance(paths, (str, bytes)) or not hasattr(paths, "__iter__"):
+        raise InputError(f"give the flat-field frames' file names, got {type(paths).__name__}")
     paths = [str(p) for p in paths]
+    sensor_mm = _pair("sensor_mm", sensor_mm)
+    for name, v in (("size_px", size_px), ("principal_point_px", principal_point_px)):
+        if isinstance(v, (str, bytes)) or not hasattr(v, "__len__") or len(v) != 2:
+            raise InputError(f"{name} is a pair of numbers, got {v!r}")
     if not paths:
         raise InputError("give one or more flat-field frames")
     imgs = []

@@ -60,6 +60,11 @@ def _text(m, cal) -> str:
 def calibration_sheet(calibration, path=None, *, force: bool = False):
     """The sheet of ``calibration`` (a :class:`~physcam.analysis.calibrate.Calibration`); written to
     ``path`` (.png, .svg, .pdf) through :func:`physcam.figures.save_figure`, else returned."""
+    from ..errors import InputError
+    from .calibrate import Calibration
+
+    if not isinstance(calibration, Calibration):
+        raise InputError(f"give a Calibration (calibrate_views), got {type(calibration).__name__}")
     m = calibration.marks[0]
     fig = new_figure(figsize=(11.69, 8.27))
     gs = fig.add_gridspec(2, 3)
