@@ -15,11 +15,11 @@ cv2 = pytest.importorskip("cv2")
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1]))
 
-import _charts  # noqa: E402
-from _charts import CHARUCO, DIST_TRUE, K_TRUE, SENSOR_MM, SIZE  # noqa: E402
+import _charts
+from _charts import CHARUCO, DIST_TRUE, K_TRUE, SENSOR_MM, SIZE
 
-from physcam.analysis.calibrate import calibrate_mark  # noqa: E402
-from physcam.cli import main  # noqa: E402
+from physcam.analysis.calibrate import calibrate_mark
+from physcam.cli import main
 
 PITCH_MM = SENSOR_MM[0] / SIZE[0]
 
@@ -72,6 +72,7 @@ CHARUCO_ARGS = ["--sensor-width", "12.8", "--sensor-height", "9.6", "--chart", "
 @pytest.mark.slow
 def test_photographs_give_the_camera_back_and_every_deliverable(photos, tmp_path, capsys):
     from _documents import check_document
+
     from physcam.usd.kit import read_characterizations
 
     out = tmp_path / "calib"

@@ -35,9 +35,14 @@ import numpy as np
 
 from ..errors import InputError, OpticsError, require_positive
 from .calibrate_chart import ChartView, _cv2
-from .distortion_models import DEFAULT_MAX_RESIDUAL_PX, DistortionSamples, FittedDistortion, fit_models
+from .distortion_models import (
+    DEFAULT_MAX_RESIDUAL_PX,
+    DistortionSamples,
+    FittedDistortion,
+    fit_models,
+)
 
-__all__ = ["MarkCalibration", "Calibration", "calibrate_views", "calibrate_mark", "MIN_VIEWS", "BreathingRow"]
+__all__ = ["MIN_VIEWS", "BreathingRow", "Calibration", "MarkCalibration", "calibrate_mark", "calibrate_views"]
 
 #: Fewest views a focus mark is calibrated from (the pinhole and five coefficients need several poses)
 MIN_VIEWS = 5
@@ -189,7 +194,7 @@ class MarkCalibration:
             "opencv": {"k1": k1, "k2": k2, "p1": p1, "p2": p2, "k3": k3,
                        "convention": "OpenCV calib3d: undistorted to distorted, pixels y down"},
             "residual_px": {"rms": self.rms_px, "allowed": self.max_residual_px,
-                            "views": [{"image": v.path, "rms": r, "corners": int(len(v.image_points))}
+                            "views": [{"image": v.path, "rms": r, "corners": len(v.image_points)}
                                       for v, r in zip(self.views, self.view_rms_px)]},
             "coverage": self.coverage,
             "uncertainty": {k: v for k, v in self.uncertainty.items() if k != "field_std_px"}, "opencv_std": dict(self.opencv_std),

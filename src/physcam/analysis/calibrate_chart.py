@@ -23,8 +23,18 @@ import numpy as np
 
 from ..errors import InputError, require_positive
 
-__all__ = ["ChartSpec", "ChartView", "parse_corners", "read_gray", "detect_chart", "detect_views",
-           "image_files", "CHARTS", "IMAGE_SUFFIXES", "CHARUCO_DICTIONARY"]
+__all__ = [
+    "CHARTS",
+    "CHARUCO_DICTIONARY",
+    "IMAGE_SUFFIXES",
+    "ChartSpec",
+    "ChartView",
+    "detect_chart",
+    "detect_views",
+    "image_files",
+    "parse_corners",
+    "read_gray",
+]
 
 CHARTS = ("checkerboard", "charuco")
 #: Image files a folder given as IMAGES contributes (OpenCV reads them)

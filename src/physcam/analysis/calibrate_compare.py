@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import InputError
 from ..lens.prescription import Prescription
 
-__all__ = ["Comparison", "compare_with_lens", "AGREEMENT_K"]
+__all__ = ["AGREEMENT_K", "Comparison", "compare_with_lens"]
 
 #: Coverage factor: a difference within AGREEMENT_K standard uncertainties agrees
 AGREEMENT_K = 2.0
@@ -35,7 +35,7 @@ AGREEMENT_K = 2.0
 
 def _row(name, measured, predicted, std, unit, k):
     diff = measured - predicted
-    agrees = bool(abs(diff) <= k * std) if std == std else False
+    agrees = bool(abs(diff) <= k * std) if not math.isnan(std) else False
     return {"figure": name, "measured": float(measured), "predicted": float(predicted), "difference": float(diff),
             "std": float(std), "unit": unit, "agrees": agrees}
 
@@ -75,7 +75,7 @@ def _distortion_difference(mark, field_) -> np.ndarray:
     return ((meas.reshape(-1, 2) - pred) * f_px)[inside]
 
 
-def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K, fstop: float | None = None) -> "Comparison":
+def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K, fstop: float | None = None) -> Comparison:
     """Every measured figure of ``calibration`` against ``lens``'s prediction (module notes); ``fstop``: the
     stop the flat fields were shot at (None: wide open)."""
     from .calibrate import Calibration

@@ -38,14 +38,14 @@ def _text(m, cal) -> str:
     fs = (u.get("focal_length_mm") or {}).get("y", math.nan)
     pp = u.get("principal_point_px", [math.nan, math.nan])
     k1, k2, p1, p2, k3 = m.distortion
-    lines = [f"{cal.lens_name}: {len(m.views)} views, {m.size_px[0]}x{m.size_px[1]} px, "
-             f"sensor {m.sensor_mm[0]:g} x {m.sensor_mm[1]:g} mm",
+    lines = [(f"{cal.lens_name}: {len(m.views)} views, {m.size_px[0]}x{m.size_px[1]} px, "
+              f"sensor {m.sensor_mm[0]:g} x {m.sensor_mm[1]:g} mm"),
              f"pinhole focal length {m.focal_length_mm[1]:.4f} mm +- {fs:.4f} (1 sigma)",
-             f"principal point ({m.principal_point_px[0]:.2f}, {m.principal_point_px[1]:.2f}) px +- "
-             f"({pp[0]:.2f}, {pp[1]:.2f})",
+             (f"principal point ({m.principal_point_px[0]:.2f}, {m.principal_point_px[1]:.2f}) px +- "
+              f"({pp[0]:.2f}, {pp[1]:.2f})"),
              f"OpenCV k1 {k1:.5f} k2 {k2:.5f} k3 {k3:.5f} p1 {p1:.6f} p2 {p2:.6f}",
-             f"residual {m.rms_px:.3f} px RMS; field uncertainty {u.get('field_rms_px', math.nan):.3f} px RMS; "
-             f"coverage {100 * m.coverage:.0f} %"]
+             (f"residual {m.rms_px:.3f} px RMS; field uncertainty {u.get('field_rms_px', math.nan):.3f} px RMS; "
+              f"coverage {100 * m.coverage:.0f} %")]
     lines += [f"{f.model}: max {f.max_residual_px:.3f} px {'good' if f.acceptable else 'NOT good'}" for f in m.fits]
     lines.append("verdict: " + ("good" if good else "NOT good: " + "; ".join(why)))
     if cal.comparison is not None:

@@ -48,8 +48,8 @@ def measured_field(m, lens_name: str) -> MeasuredField:
     edge = np.array([[x, y] for x in np.linspace(-0.5, w - 0.5, 65) for y in (-0.5, h - 0.5)]
                     + [[x, y] for y in np.linspace(-0.5, h - 0.5, 49) for x in (-0.5, w - 0.5)])
     u = m.undistort_px(edge)
-    ox = max(0, int(math.ceil(max(-0.5 - u[:, 0].min(), u[:, 0].max() - (w - 0.5)))))
-    oy = max(0, int(math.ceil(max(-0.5 - u[:, 1].min(), u[:, 1].max() - (h - 0.5)))))
+    ox = max(0, (math.ceil(max(-0.5 - u[:, 0].min(), u[:, 0].max() - (w - 0.5)))))
+    oy = max(0, (math.ceil(max(-0.5 - u[:, 1].min(), u[:, 1].max() - (h - 0.5)))))
     dm = _coarse_then_bilinear(m.undistort_px, w, h)  # plate pixel (col, row) -> undistorted OpenCV px
     um = _coarse_then_bilinear(lambda p: m.distort_px(p - [ox, oy]), w + 2 * ox, h + 2 * oy)
     dmap = np.dstack([(dm[..., 0] + 0.5) / w, (h - dm[..., 1] - 0.5) / h, np.zeros((h, w))]).astype(np.float32)
@@ -79,7 +79,11 @@ def opentrackio_lens(m) -> dict:
 
 
 def _mark_files(m, folder: Path, name: str, notes: list) -> list:
-    from ..analysis.distortion_models import BrownConrady, TDE4RadialStandard, USDStandard
+    from ..analysis.distortion_models import (
+        BrownConrady,
+        TDE4RadialStandard,
+        USDStandard,
+    )
     from ..analysis.stmap import _exr_bytes, _png_bytes
     from ..export.tde4 import tde4_lens_text
     from .distortion import FIT_FILES, brown_conrady_document, usd_distortion_document
@@ -121,10 +125,10 @@ def _folder(out: Path, m, several: bool) -> Path:
 
 def deliverables(cal, args):
     """([(path, bytes or a function making them)], USD plan or None), every name checked."""
+    from ..analysis.calibrate_sheet import calibration_sheet
     from ..errors import ExportError
     from ..figures import figure_bytes
     from ..io import check_writable
-    from ..analysis.calibrate_sheet import calibration_sheet
     from ._output import document
     from .calibrate import UNITS
 
@@ -149,7 +153,7 @@ def _usd_plan(cal, args):
     from ..errors import ExportError
     from ..usd.kit import read_characterizations
 
-    variant = args.variant or "calibration_" + _dt.datetime.now(_dt.timezone.utc).strftime("%Y%m%d")
+    variant = args.variant or "calibration_" + _dt.datetime.now(_dt.UTC).strftime("%Y%m%d")
     p = Path(args.usd)
     if p.exists() and variant in read_characterizations(p)["variants"]:
         raise ExportError(f"{p}: already has a characterization variant {variant!r}: give another --variant")

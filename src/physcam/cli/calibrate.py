@@ -15,7 +15,14 @@ from __future__ import annotations
 
 import math
 
-from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number
+from ._common import (
+    FOCUS_HELP,
+    add_sensor_options,
+    add_units_option,
+    distance,
+    focus,
+    number,
+)
 from ._output import add_output_options, document, emit_json
 
 #: The files written into -o DIR (per focus mark, in a sub-folder when there are several marks)
@@ -79,6 +86,7 @@ def register(sub) -> None:
 
 def _read_marks(path, args) -> dict:
     """image path (as written) -> mark mm, from a CSV of image,mark."""
+    import argparse
     import csv
     from pathlib import Path
 
@@ -97,7 +105,7 @@ def _read_marks(path, args) -> dict:
                 raise InputError(f"{p}, line {n}: give image,mark (two cells), got {len(row)}")
             try:
                 mark = one(row[1])
-            except Exception as e:  # argparse.ArgumentTypeError carries the sentence
+            except argparse.ArgumentTypeError as e:  # it carries the sentence
                 raise InputError(f"{p}, line {n}: {e}") from None
             out[str(Path(row[0].strip()))] = mark
     if not out:
@@ -174,7 +182,7 @@ def compute(args):
 def run_calibrate(args) -> int:
     from ._calibrate_files import deliverables, write_all
 
-    cal, lens = compute(args)
+    cal, _lens = compute(args)
     payload, usd = deliverables(cal, args)
     written = write_all(payload, usd, cal, args)
     d = cal.to_dict()
