@@ -14,6 +14,7 @@ exr        OpenEXR                               ST-maps and images as EXR
 live       jsonschema, cbor2                     OpenTrackIO samples (physcam live)
 dask       dask[distributed], bokeh, pyarrow     physcam characterize on a cluster
 serve      starlette, uvicorn, segno             physcam serve, the phone page
+calibrate  opencv-python-headless                physcam calibrate: charts found in photographs
 all        all of the above
 =========  ====================================  ============================================
 """
@@ -33,6 +34,7 @@ EXTRAS = {
     "live": (("jsonschema", "jsonschema"), ("cbor2", "cbor2")),
     "dask": (("distributed", "dask[distributed]"), ("bokeh", "bokeh"), ("pyarrow", "pyarrow")),
     "serve": (("starlette", "starlette"), ("uvicorn", "uvicorn"), ("segno", "segno")),
+    "calibrate": (("cv2", "opencv-python-headless"),),
 }
 
 

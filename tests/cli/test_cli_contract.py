@@ -124,6 +124,7 @@ EXTRA_JSON_RUNS = {
 JSON_NOT_RUN = {
     ("compare", "blender"): "needs Blender's bpy (tests/blender/test_compare.py validates its document)",
     ("live", "record"): "needs a UDP stream (tests/live/test_cli_live.py records one and validates the document)",
+    ("calibrate",): "needs chart photographs (tests/analysis/test_calibrate.py renders them and validates its document)",
     ("demo",): "writes the whole demo (tests/onset_cli/test_report_cli.py::test_demo_writes_outputs validates it)",
 }
 #: Where the rows of each --csv command's document are.

@@ -61,7 +61,7 @@ import numpy as np
 from ..errors import ExportError, InputError, OpticsError, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
-__all__ = ["DistortionField", "distortion_field", "apply_stmap", "write_stmaps", "MAX_SIDE_PX", "MAX_PIXELS"]
+__all__ = ["DistortionField", "distortion_field", "apply_stmap", "write_stmaps", "write_map_exr", "write_map_png", "MAX_SIDE_PX", "MAX_PIXELS"]
 
 #: Largest width or height (pixels) and largest frame (pixels) a map is made for.
 MAX_SIDE_PX = 8192
@@ -452,7 +452,7 @@ def apply_stmap(image, stmap, *, overscan=(0, 0)) -> np.ndarray:
     return out if img.ndim == 3 else out[..., 0]
 
 
-def _write_exr(rgb: np.ndarray, path, attributes=None, *, overscan=(0, 0), force: bool = False) -> Path:
+def write_map_exr(rgb: np.ndarray, path, attributes=None, *, overscan=(0, 0), force: bool = False) -> Path:
     """``rgb`` (h, w, 3) as a 32-bit float RGB scanline EXR (ZIP) at ``path``, written by OpenEXR into
     the atomic write's temporary (never held encoded in memory); ``attributes``: extra header entries
     (strings and floats). ``overscan`` (ox, oy): ``rgb`` is a frame with that margin around it; the
@@ -461,6 +461,7 @@ def _write_exr(rgb: np.ndarray, path, attributes=None, *, overscan=(0, 0), force
     from ..extras import require_extra
     from ..io import staged
 
+    rgb = _map_array(rgb)
     require_extra("exr", "writing ST-maps as EXR")
     import OpenEXR
 
@@ -475,6 +476,16 @@ def _write_exr(rgb: np.ndarray, path, attributes=None, *, overscan=(0, 0), force
     return Path(path)
 
 
+def _map_array(rgb) -> np.ndarray:
+    """``rgb`` checked as an (h, w, 3) map of finite numbers (a sentence, not an AttributeError)."""
+    a = rgb if isinstance(rgb, np.ndarray) else None
+    if a is None or a.ndim != 3 or a.shape[2] != 3 or min(a.shape[:2]) < 1:
+        from ..errors import WrongTypeError
+
+        raise WrongTypeError(f"an ST-map is an (h, w, 3) numpy array, got {rgb!r:.60}")
+    return a
+
+
 def _preview(rgb: np.ndarray) -> np.ndarray:
     """``rgb`` (h, w, 3) in 0..1 as 8-bit values, converted in blocks of rows (no float copy of the frame)."""
     out = np.empty(rgb.shape, dtype=np.uint8)
@@ -483,7 +494,7 @@ def _preview(rgb: np.ndarray) -> np.ndarray:
     return out
 
 
-def _write_png(rgb: np.ndarray, path, *, force: bool = False) -> Path:
+def write_map_png(rgb: np.ndarray, path, *, force: bool = False) -> Path:
     """An 8-bit RGB PNG preview of ``rgb`` (h, w, 3) in 0..1, row 0 on top, at ``path``. Pillow directly
     (what matplotlib's imsave calls, less its colour-mapping pass and alpha channel: 2-3x faster on a
     2048-pixel map, which a characterization run writes by the hundred)."""
@@ -491,6 +502,7 @@ def _write_png(rgb: np.ndarray, path, *, force: bool = False) -> Path:
 
     from ..io import staged
 
+    rgb = _map_array(rgb)
     with staged(path, force=force, suffix=".png") as tmp:
         Image.fromarray(_preview(rgb), "RGB").save(tmp, format="png")
     return Path(path)
@@ -531,6 +543,6 @@ def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> lis
             check_writable(d / f"{name}.{ext}", force=force)
     written = []
     for name, rgb, overscan in items:  # each file written before the next is encoded: one in memory at a time
-        written.append(_write_exr(rgb, d / f"{name}.exr", attributes, overscan=overscan, force=force))
-        written.append(_write_png(rgb, d / f"{name}.png", force=force))
+        written.append(write_map_exr(rgb, d / f"{name}.exr", attributes, overscan=overscan, force=force))
+        written.append(write_map_png(rgb, d / f"{name}.png", force=force))
     return written

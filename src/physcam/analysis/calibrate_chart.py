@@ -1,0 +1,208 @@
+"""Finding a planar calibration chart in photographs (docs/calibrate.md), with OpenCV (``calibrate`` extra).
+
+A **checkerboard** of ``corners`` = (columns, rows) *inner* corners and ``square_mm`` squares is
+found by OpenCV's sector-based detector (``cv2.findChessboardCornersSB``, Duda & Frese 2018,
+"Accurate Detection and Localization of Checkerboard Corners for Calibration", BMVC), whose corners
+are sub-pixel by construction; the whole board must be in the picture. A **ChArUco** board
+(Garrido-Jurado et al. 2014, *Pattern Recognition* 47(6)) of (columns, rows) *squares* carries an
+ArUco marker in every white square, so each corner is identified on its own and partial views
+(the chart cut by the frame's edge, which is where the distortion is largest) count:
+``cv2.aruco.CharucoDetector``, then the corners refined to sub-pixel accuracy.
+
+Pixel coordinates here are OpenCV's: x to the right, y down, the centre of the top-left pixel
+at (0, 0). The chart's points are in millimetres on the chart (z = 0).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError, require_positive
+
+__all__ = [
+    "CHARTS",
+    "CHARUCO_DICTIONARY",
+    "IMAGE_SUFFIXES",
+    "ChartSpec",
+    "ChartView",
+    "detect_chart",
+    "detect_views",
+    "image_files",
+    "parse_corners",
+    "read_gray",
+]
+
+CHARTS = ("checkerboard", "charuco")
+#: Image files a folder given as IMAGES contributes (OpenCV reads them)
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
+#: The ArUco dictionary of a ChArUco board unless told (OpenCV's tutorial board)
+CHARUCO_DICTIONARY = "DICT_5X5_100"
+#: A view is kept when at least this many corners are found in it
+MIN_CORNERS_PER_VIEW = 8
+
+
+def _cv2():
+    from ..extras import require_extra
+
+    require_extra("calibrate", "calibrating a camera from chart photographs")
+    import cv2
+
+    return cv2
+
+
+def parse_corners(text) -> tuple[int, int]:
+    """``"9x6"`` -> (9, 6): columns x rows."""
+    m = re.fullmatch(r"\s*(\d{1,3})\s*[xX]\s*(\d{1,3})\s*", str(text))
+    if not m or min(int(m.group(1)), int(m.group(2))) < 2:
+        raise InputError(f"give the chart's corners as COLUMNSxROWS, each 2 or more, e.g. 9x6; got {text!r}")
+    return int(m.group(1)), int(m.group(2))
+
+
+@dataclass(frozen=True)
+class ChartSpec:
+    """A planar chart: ``kind`` checkerboard (``corners`` = inner corners) or charuco (``corners`` =
+    squares, columns x rows); squares ``square_mm``; ChArUco markers ``marker_mm`` (default 3/4 of
+    a square) from ``dictionary``."""
+
+    kind: str
+    corners: tuple[int, int]
+    square_mm: float
+    marker_mm: float | None = None
+    dictionary: str = CHARUCO_DICTIONARY
+
+    def __post_init__(self):
+        if self.kind not in CHARTS:
+            raise InputError(f"the chart must be one of {', '.join(CHARTS)}, got {self.kind!r}")
+        require_positive("chart square", self.square_mm, unit="mm")
+        if self.kind == "charuco" and min(self.corners) < 3:
+            raise InputError(f"a ChArUco board needs 3 or more squares each way, got {self.corners}")
+        if self.marker_mm is not None and not 0 < self.marker_mm < self.square_mm:
+            raise InputError(f"the ChArUco marker ({self.marker_mm!r} mm) must be smaller than a square "
+                             f"({self.square_mm:g} mm)")
+
+    @property
+    def inner(self) -> tuple[int, int]:
+        """Inner corners (columns, rows)."""
+        return self.corners if self.kind == "checkerboard" else (self.corners[0] - 1, self.corners[1] - 1)
+
+    def object_points(self) -> np.ndarray:
+        """(n, 3) chart mm of every inner corner, row by row (OpenCV's order; ChArUco ids in it)."""
+        cols, rows = self.inner
+        j, i = np.mgrid[0:rows, 0:cols]
+        return np.stack([i.ravel() * self.square_mm, j.ravel() * self.square_mm, np.zeros(i.size)], axis=1)
+
+    def charuco_board(self):
+        cv2 = _cv2()
+        if not hasattr(cv2.aruco, self.dictionary):
+            raise InputError(f"unknown ArUco dictionary {self.dictionary!r}, e.g. {CHARUCO_DICTIONARY}")
+        d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary))
+        marker = self.marker_mm if self.marker_mm is not None else 0.75 * self.square_mm
+        return cv2.aruco.CharucoBoard(self.corners, self.square_mm, marker, d)
+
+
+@dataclass
+class ChartView:
+    """One photograph's chart: the corners found (OpenCV px, (n, 2)) and their chart mm (n, 3)."""
+
+    path: str
+    size_px: tuple[int, int]  # width, height
+    image_points: np.ndarray
+    object_points: np.ndarray
+    mark_mm: float | None = None  # the focus mark it was shot at (mm from the film)
+
+
+def image_files(items) -> list[Path]:
+    """The image files of ``items``: files as given, folders as their images (sorted)."""
+    if isinstance(items, (str, Path)):
+        items = [items]
+    if not hasattr(items, "__iter__"):
+        raise InputError(f"give image files or folders, got {type(items).__name__}")
+    out: list[Path] = []
+    for it in items:
+        if not isinstance(it, (str, Path)):
+            raise InputError(f"an image is a file name, got {type(it).__name__}")
+        p = Path(it)
+        if p.is_dir():
+            found = sorted(q for q in p.iterdir() if q.suffix.lower() in IMAGE_SUFFIXES)
+            if not found:
+                raise InputError(f"{p}: a folder with no images ({', '.join(IMAGE_SUFFIXES)})")
+            out += found
+        elif p.is_file():
+            out.append(p)
+        else:
+            raise InputError(f"{p}: no such image file or folder")
+    return out
+
+
+def read_gray(path) -> np.ndarray:
+    """The image at ``path`` as a 2-D array (8 or 16 bit kept); a file OpenCV cannot read is an InputError."""
+    if not isinstance(path, (str, Path)):
+        raise InputError(f"an image is a file name, got {type(path).__name__}")
+    cv2 = _cv2()
+    img = cv2.imread(str(path), cv2.IMREAD_ANYDEPTH | cv2.IMREAD_GRAYSCALE)
+    if img is None or img.ndim != 2 or min(img.shape) < 16:
+        raise InputError(f"{path}: not an image OpenCV can read (corrupt, or not an image file)")
+    return img
+
+
+def _to8(img: np.ndarray) -> np.ndarray:
+    if img.dtype == np.uint8:
+        return img
+    a = img.astype(np.float64)
+    return np.clip(255.0 * (a - a.min()) / max(a.max() - a.min(), 1e-12), 0, 255).astype(np.uint8)
+
+
+def detect_chart(image: np.ndarray, chart: ChartSpec):
+    """(image points (n, 2) OpenCV px, chart points (n, 3) mm) of ``chart`` in ``image``, or None."""
+    if not isinstance(chart, ChartSpec):
+        raise InputError(f"give a ChartSpec, got {type(chart).__name__}")
+    image = np.asarray(image)
+    if image.ndim != 2 or image.dtype.kind not in "uif" or min(image.shape) < 16:
+        raise InputError(f"the image is a 2-D grey array of 16 px or more each way, got shape {image.shape}")
+    cv2 = _cv2()
+    img = _to8(image)
+    if chart.kind == "checkerboard":
+        flags = cv2.CALIB_CB_EXHAUSTIVE | cv2.CALIB_CB_ACCURACY | cv2.CALIB_CB_NORMALIZE_IMAGE
+        ok, corners = cv2.findChessboardCornersSB(img, chart.inner, flags=flags)
+        if not ok:
+            return None
+        return corners.reshape(-1, 2).astype(np.float64), chart.object_points()
+    board = chart.charuco_board()
+    params = cv2.aruco.CharucoParameters()
+    detector = cv2.aruco.CharucoDetector(board, params)
+    corners, ids, _, _ = detector.detectBoard(img)
+    if ids is None or len(ids) < MIN_CORNERS_PER_VIEW:
+        return None
+    pts = corners.reshape(-1, 1, 2).astype(np.float32)
+    crit = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 50, 1e-4)
+    pts = cv2.cornerSubPix(img, pts, (5, 5), (-1, -1), crit)
+    obj = np.asarray(board.getChessboardCorners(), np.float64).reshape(-1, 3)
+    return pts.reshape(-1, 2).astype(np.float64), obj[ids.ravel()]
+
+
+def detect_views(paths, chart: ChartSpec, marks=None) -> list[ChartView]:
+    """Every image's chart; an image without one, a corrupt file or mixed sizes is an InputError
+    naming the file. ``marks``: the focus mark (mm from the film) of each path, or None."""
+    if not isinstance(chart, ChartSpec):
+        raise InputError(f"give a ChartSpec, got {type(chart).__name__}")
+    paths = image_files(paths)
+    if marks is not None and (isinstance(marks, (str, bytes)) or not hasattr(marks, "__len__")):
+        raise InputError(f"marks is one focus mark (mm) per image, got {type(marks).__name__}")
+    marks = [None] * len(paths) if marks is None else list(marks)
+    views: list[ChartView] = []
+    for path, mark in zip(paths, marks):
+        img = read_gray(path)
+        size = (int(img.shape[1]), int(img.shape[0]))
+        if views and size != views[0].size_px:
+            raise InputError(f"{path}: {size[0]}x{size[1]} px, but {views[0].path} is "
+                             f"{views[0].size_px[0]}x{views[0].size_px[1]}: give images of one camera mode")
+        found = detect_chart(img, chart)
+        if found is None:
+            raise InputError(f"{path}: no {chart.kind} of {chart.corners[0]}x{chart.corners[1]} "
+                             f"{'inner corners' if chart.kind == 'checkerboard' else 'squares'} found in it")
+        views.append(ChartView(str(path), size, found[0], found[1], mark))
+    return views

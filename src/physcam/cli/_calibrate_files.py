@@ -1,0 +1,224 @@
+"""The deliverables of ``physcam calibrate`` (docs/calibrate.md): per focus mark the ST-maps, the fitted
+models' files (as ``physcam distortion --fit`` writes them), an OpenTrackIO lens block, the
+calibration document and sheet; and the day's characterization variant in the lens's USD file.
+Everything is made in memory and every name checked before the first file is written."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.stmap import DistortionField
+
+#: Spacing (px) of the exactly computed ST-map nodes; bilinear between (the maps are smooth)
+MAP_STEP_PX = 4
+
+
+class MeasuredField(DistortionField):
+    """A :class:`DistortionField` measured from a chart (its maps say so in their EXR headers)."""
+
+    def to_dict(self) -> dict:
+        d = super().to_dict()
+        d["map_for"] = "a chart calibration (OpenCV Brown-Conrady, measured)"
+        return d
+
+
+def _coarse_then_bilinear(fn, width, height, step=MAP_STEP_PX):
+    """``fn`` (n, 2) -> (n, 2) evaluated at nodes every ``step`` px of a width x height grid of pixel
+    indices, then bilinear at every pixel: (height, width, 2)."""
+    xs = np.arange(0, width + step, step, dtype=float)
+    ys = np.arange(0, height + step, step, dtype=float)
+    X, Y = np.meshgrid(xs, ys)
+    v = fn(np.column_stack([X.ravel(), Y.ravel()])).reshape(len(ys), len(xs), 2)
+    fx, fy = np.arange(width) / step, np.arange(height) / step
+    i, j = np.minimum(fx.astype(int), len(xs) - 2), np.minimum(fy.astype(int), len(ys) - 2)
+    tx, ty = (fx - i)[None, :, None], (fy - j)[:, None, None]
+    a, b = v[j][:, i], v[j][:, i + 1]
+    c, d = v[j + 1][:, i], v[j + 1][:, i + 1]
+    return (1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d)
+
+
+def measured_field(m, lens_name: str) -> MeasuredField:
+    """The ST-maps of a :class:`~physcam.analysis.calibrate.MarkCalibration` (conventions of
+    :mod:`physcam.analysis.stmap`: R = u, G = v from the bottom-left, rows top first)."""
+    w, h = m.size_px
+    edge = np.array([[x, y] for x in np.linspace(-0.5, w - 0.5, 65) for y in (-0.5, h - 0.5)]
+                    + [[x, y] for y in np.linspace(-0.5, h - 0.5, 49) for x in (-0.5, w - 0.5)])
+    u = m.undistort_px(edge)
+    ox = max(0, (math.ceil(max(-0.5 - u[:, 0].min(), u[:, 0].max() - (w - 0.5)))))
+    oy = max(0, (math.ceil(max(-0.5 - u[:, 1].min(), u[:, 1].max() - (h - 0.5)))))
+    dm = _coarse_then_bilinear(m.undistort_px, w, h)  # plate pixel (col, row) -> undistorted OpenCV px
+    um = _coarse_then_bilinear(lambda p: m.distort_px(p - [ox, oy]), w + 2 * ox, h + 2 * oy)
+    dmap = np.dstack([(dm[..., 0] + 0.5) / w, (h - dm[..., 1] - 0.5) / h, np.zeros((h, w))]).astype(np.float32)
+    umap = np.dstack([(um[..., 0] + 0.5) / w, (h - um[..., 1] - 0.5) / h,
+                      np.zeros(um.shape[:2])]).astype(np.float32)
+    from ..analysis.calibrate import displacement_px
+
+    disp = np.hypot(*displacement_px(m.camera_matrix, m.distortion, m.size_px).T)
+    focus = math.inf if m.mark_mm is None else float(m.mark_mm)
+    return MeasuredField(lens_name, focus, math.nan, tuple(m.sensor_mm), (w, h), tuple(m.focal_length_mm),
+                         (math.nan, math.nan), (ox, oy), (0, 0), 0.0, math.nan, float(disp.max()), None,
+                         (m.rms_px, max(m.view_rms_px)), dmap, umap,
+                         ["measured from chart photographs; residual = the corners' reprojection residual"])
+
+
+def opentrackio_lens(m) -> dict:
+    """OpenTrackIO 1.0.1 ``lens`` fields of a measured mark (OpenLensIO: mm on the sensor, y down)."""
+    from ..analysis.distortion_models import BrownConrady
+
+    out = {"pinholeFocalLength": float(m.focal_length_mm[1]),
+           "distortion": [f.opentrackio() for f in m.fits if isinstance(f, BrownConrady)],
+           "projectionOffset": {"x": float(m.principal_offset_mm[0]), "y": float(-m.principal_offset_mm[1])},
+           "distortionOffset": {"x": float(m.principal_offset_mm[0]), "y": float(-m.principal_offset_mm[1])}}
+    if m.mark_mm is not None and math.isfinite(m.mark_mm):
+        out["focusDistance"] = float(m.mark_mm) / 1000.0
+    return {"lens": out}
+
+
+class WritesItself:
+    """A payload entry whose file is written by its own writer ``write(path, force)`` (an ST-map:
+    OpenEXR writes it into the atomic write's temporary), not held as bytes."""
+
+    def __init__(self, write):
+        self.write = write
+
+
+#: The units of the ``physcam calibrate --json`` document.
+UNITS = {"length": "mm", "image": "pixel (OpenCV: x right, y down, pixel centres at whole numbers)",
+         "focus_mark_mm": "mm from the film plane (null: not given)", "breathing": "percent",
+         "uncertainty": "one standard deviation"}
+
+
+def _mark_files(m, folder: Path, name: str, notes: list) -> list:
+    from ..analysis.distortion_models import (
+        BrownConrady,
+        TDE4RadialStandard,
+        USDStandard,
+    )
+    from ..analysis.stmap import write_map_exr, write_map_png
+    from ..export.tde4 import tde4_lens_text
+    from .distortion import FIT_FILES, brown_conrady_document, usd_distortion_document
+
+    out = []
+    fld = measured_field(m, name)
+    said = fld.to_dict()
+    attrs = {"physcamMapFor": said["map_for"], "physcamFStop": 0.0, "physcamResidualRmsPx": float(m.rms_px),
+             "physcamResidualMaxPx": float(max(m.view_rms_px)), "physcamLens": name}
+    for stem, rgb, over in (("distortion", fld.distortion_stmap, (0, 0)),
+                            ("undistortion", fld.undistortion_stmap, fld.overscan_px)):
+        # a map is written by its writer (OpenEXR into the atomic write's temporary), not held as bytes
+        out += [(folder / f"{stem}.exr", WritesItself(lambda path, force, rgb=rgb, over=over:
+                                                      write_map_exr(rgb, path, attrs, overscan=over, force=force))),
+                (folder / f"{stem}.png", WritesItself(lambda path, force, rgb=rgb:
+                                                      write_map_png(rgb, path, force=force)))]
+    good = [f for f in m.fits if f.acceptable]
+    notes += [f"{f.model}: not written (misses the measured field by up to {f.max_residual_px:.3g} px)"
+              for f in m.fits if not f.acceptable]
+    brown = [f for f in good if isinstance(f, BrownConrady)]
+    if brown:
+        out.append((folder / FIT_FILES["brown"], _json(brown_conrady_document(name, brown))))
+    for f in good:
+        if isinstance(f, TDE4RadialStandard):
+            out.append((folder / FIT_FILES["3de4"], tde4_lens_text(f, name).encode()))
+        elif isinstance(f, USDStandard):
+            out.append((folder / FIT_FILES["usd"], _json(usd_distortion_document(name, f))))
+    out.append((folder / "opentrackio_lens.json", _json(opentrackio_lens(m))))
+    return out
+
+
+def _json(doc) -> bytes:
+    return (json.dumps(doc, indent=2) + "\n").encode()
+
+
+def _folder(out: Path, m, several: bool) -> Path:
+    if not several:
+        return out
+    return out / ("focus_unknown" if m.mark_mm is None else "focus_infinity" if math.isinf(m.mark_mm)
+                  else f"focus_{m.mark_mm:.0f}mm")
+
+
+def deliverables(cal, args):
+    """([(path, bytes or a function making them)], USD plan or None), every name checked."""
+    from ..analysis.calibrate_sheet import calibration_sheet
+    from ..errors import ExportError
+    from ..figures import figure_bytes
+    from ..io import check_writable
+    from ._output import document
+
+    out = Path(args.output)
+    if out.exists() and not out.is_dir():
+        raise ExportError(f"{out} exists and is not a folder: give a folder for the deliverables (-o DIR)")
+    payload = []
+    for m in cal.marks:
+        payload += _mark_files(m, _folder(out, m, len(cal.marks) > 1), cal.lens_name, cal.notes)
+    payload.append((out / "calibration_sheet.png", lambda: figure_bytes(calibration_sheet(cal), "png")))
+    payload.append((out / "calibration.json", lambda: _json(document("calibrate", dict(cal.to_dict(), written=[]),
+                                                                      units=UNITS))))
+    for p, _ in payload:
+        check_writable(p, force=args.force)
+    usd = _usd_plan(cal, args) if args.usd else None
+    return payload, usd
+
+
+def _usd_plan(cal, args):
+    import datetime as _dt
+
+    from ..errors import ExportError
+    from ..usd.kit import read_characterizations
+
+    variant = args.variant or "calibration_" + _dt.datetime.now(_dt.UTC).strftime("%Y%m%d")
+    p = Path(args.usd)
+    if p.exists() and variant in read_characterizations(p)["variants"]:
+        raise ExportError(f"{p}: already has a characterization variant {variant!r}: give another --variant")
+    return p, variant
+
+
+def _measured(cal, out: Path, usd_file: Path) -> dict:
+    import os
+
+    marks = cal.marks
+    rel = os.path.relpath(out.resolve(), usd_file.resolve().parent)
+    return {
+        "source": "physcam calibrate: chart photographs",
+        "focusMarksMm": [m.mark_mm if m.mark_mm is not None and math.isfinite(m.mark_mm) else -1.0 for m in marks],
+        "pinholeFocalLengthMm": [m.focal_length_mm[1] for m in marks],
+        "pinholeFocalLengthStdMm": [(m.uncertainty.get("focal_length_mm") or {}).get("y", 0.0) for m in marks],
+        "principalPointOffsetMm": [v for m in marks for v in m.principal_offset_mm],
+        "opencvBrownConrady": [float(v) for m in marks for v in m.distortion],
+        "residualRmsPx": [m.rms_px for m in marks],
+        "verdict": ["good" if m.verdict[0] else "not good: " + "; ".join(m.verdict[1]) for m in marks],
+        "files": [rel],
+    }
+
+
+def write_all(payload, usd, cal, args) -> list:
+    """Write the payload, then the USD variant; returns the paths written."""
+    from dataclasses import replace
+
+    from ..io import atomic_write
+
+    written = []
+    for p, data in payload:
+        if isinstance(data, WritesItself):
+            written.append(data.write(p, args.force))
+        else:
+            written.append(atomic_write(p, data() if callable(data) else data, force=args.force))
+    if usd is not None:
+        from ..usd.author import CameraSpec
+        from ..usd.kit import add_characterization, best_match_pinhole
+
+        m = cal.marks[0]
+        focus = 1.0e7 if m.mark_mm is None or math.isinf(m.mark_mm) else float(m.mark_mm)
+        f = float(m.focal_length_mm[1])
+        if getattr(args, "loaded_lens", None) is not None:
+            spec, _ = best_match_pinhole(args.loaded_lens, focus_mm=focus, fstop=args.fstop,
+                                         sensor_width_mm=m.sensor_mm[0], sensor_height_mm=m.sensor_mm[1])
+            spec = replace(spec, pinhole_focal_length_mm=f)
+        else:
+            spec = CameraSpec(focal_length_mm=f, pinhole_focal_length_mm=f, focus_mm=focus,
+                              sensor_width_mm=m.sensor_mm[0], sensor_height_mm=m.sensor_mm[1])
+        written.append(add_characterization(usd[0], usd[1], spec, _measured(cal, Path(args.output), usd[0])))
+    return written

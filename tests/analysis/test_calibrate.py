@@ -1,0 +1,197 @@
+"""physcam calibrate against an independent ground truth: chart corners and photographs made with
+OpenCV's own projection (tests/analysis/_charts.py) of a known pinhole, principal point and
+Brown-Conrady distortion; and its refusals of bad input (issue 33)."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+cv2 = pytest.importorskip("cv2")
+sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).parents[1]))
+
+import _charts
+from _charts import CHARUCO, DIST_TRUE, K_TRUE, SENSOR_MM, SIZE
+
+from physcam.analysis.calibrate import calibrate_mark
+from physcam.cli import main
+
+PITCH_MM = SENSOR_MM[0] / SIZE[0]
+
+
+def test_corners_with_0_3px_noise_give_the_camera_back():
+    """15 poses, partial views, 0.3 px Gaussian noise on every corner (seed 1): f within 0.1 %,
+    principal point within 2 px, distortion field within 0.1 px RMS over the frame."""
+    cal = calibrate_mark(_charts.point_views(noise_px=0.3, seed=1), SENSOR_MM, bootstrap=8)
+    K = cal.camera_matrix
+    assert cal.focal_length_mm[1] == pytest.approx(K_TRUE[1, 1] * PITCH_MM, rel=1e-3)
+    assert np.hypot(K[0, 2] - K_TRUE[0, 2], K[1, 2] - K_TRUE[1, 2]) < 2.0
+    err = _charts.field_error_px(K, cal.distortion)
+    assert err < 0.1
+    assert err < 3 * cal.uncertainty["field_rms_px"]  # the stated uncertainty covers the error
+    assert cal.rms_px == pytest.approx(0.3 * np.sqrt(2), rel=0.1)  # 0.3 px per axis: a 2-D RMS of 0.3 sqrt 2
+    assert any(len(v.image_points) < 391 for v in cal.views)  # partial views are in
+
+
+def test_physcam_brown_ud_is_opencvs_model_with_y_up():
+    """OpenCV's Brown-Conrady (y down) and physcam's U-D fit (y up) are one model: k1, k2, k3 and p2
+    equal, p1 of opposite sign (y -> -y in the tangential terms), fitted without residual."""
+    cal = calibrate_mark(_charts.point_views(noise_px=0.0, seed=2), SENSOR_MM, bootstrap=0)
+    ud = next(f for f in cal.fits if f.model == "Brown-Conrady U-D")
+    k1, k2, p1, p2, k3 = cal.distortion
+    c = ud.coefficients
+    assert (c["k1"], c["k2"], c["k3"], c["p2"]) == pytest.approx((k1, k2, k3, p2), rel=1e-6, abs=1e-12)
+    assert c["p1"] == pytest.approx(-p1, rel=1e-6)
+    assert ud.max_residual_px < 1e-6
+    # noiseless corners: OpenCV's fit is the truth
+    assert cal.distortion == pytest.approx(DIST_TRUE, rel=1e-4, abs=1e-7)
+
+
+def _write_views(folder: Path, n=15, seed=1):
+    folder.mkdir(parents=True, exist_ok=True)
+    board = _charts.board_image(CHARUCO, 12.0)
+    for k, (r, t) in enumerate(_charts.poses(n, seed)):
+        cv2.imwrite(str(folder / f"chart_{k:02d}.png"), _charts.render(CHARUCO, r, t, board=board, seed=k))
+    return folder
+
+
+@pytest.fixture(scope="module")
+def photos(tmp_path_factory):
+    return _write_views(tmp_path_factory.mktemp("charts") / "day1")
+
+
+CHARUCO_ARGS = ["--sensor-width", "12.8", "--sensor-height", "9.6", "--chart", "charuco", "--corners", "24x18",
+                "--square", "15mm", "--marker", "11mm", "--dictionary", "DICT_5X5_250"]
+
+
+@pytest.mark.slow
+def test_photographs_give_the_camera_back_and_every_deliverable(photos, tmp_path, capsys):
+    from _documents import check_document
+
+    from physcam.usd.kit import read_characterizations
+
+    out = tmp_path / "calib"
+    rc = main(["calibrate", str(photos), *CHARUCO_ARGS, "--focus", "2m", "-o", str(out), "--bootstrap", "8",
+               "--usd", str(tmp_path / "lens.usda"), "--variant", "day_1", "--json"])
+    assert rc == 0, capsys.readouterr().err
+    doc = json.loads(capsys.readouterr().out)
+    check_document(doc)
+    m = doc["marks"][0]
+    assert m["focal_length_mm"]["y"] == pytest.approx(K_TRUE[1, 1] * PITCH_MM, rel=1e-3)
+    assert np.hypot(*(np.array(m["principal_point_px"]) - K_TRUE[:2, 2])) < 2.0
+    K = np.array([[m["focal_length_px"]["x"], 0, m["principal_point_px"][0]],
+                  [0, m["focal_length_px"]["y"], m["principal_point_px"][1]], [0, 0, 1.0]])
+    o = m["opencv"]
+    assert _charts.field_error_px(K, np.array([o["k1"], o["k2"], o["p1"], o["p2"], o["k3"]])) < 0.1
+    names = {Path(p).name for p in doc["written"]}
+    assert {"distortion.exr", "undistortion.exr", "brown_conrady.json", "opentrackio_lens.json",
+            "calibration_sheet.png", "calibration.json", "lens.usda"} <= names
+    check_document(json.loads((out / "calibration.json").read_text()))
+    got = read_characterizations(tmp_path / "lens.usda")
+    assert got["current_is"] == "day_1" and {"day_1", "current"} <= set(got["variants"])
+    _check_distortion_map(out / "distortion.exr")
+    _check_opentrackio(out / "opentrackio_lens.json")
+
+
+def _check_distortion_map(path):
+    """The distortion ST-map at plate pixels holds OpenCV's own undistortion of the truth (within 0.1 px)."""
+    import OpenEXR
+
+    with OpenEXR.File(str(path)) as f:
+        rgb = f.channels()["RGB"].pixels
+    w, h = SIZE
+    rows, cols = np.array([10, 480, 900]), np.array([15, 640, 1250])
+    pts = np.array([[c, r] for r in rows for c in cols], float)
+    truth = cv2.undistortPointsIter(pts.reshape(-1, 1, 2), K_TRUE, DIST_TRUE, None, K_TRUE,
+                                    (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 100, 1e-12)).reshape(-1, 2)
+    got = np.array([[rgb[r, c, 0] * w - 0.5, h - rgb[r, c, 1] * h - 0.5] for r in rows for c in cols])
+    assert np.abs(got - truth).max() < 0.15
+
+
+def _check_opentrackio(path):
+    """The lens block validates against OpenTrackIO 1.0.1's own schema of ``lens``."""
+    import jsonschema
+
+    from physcam.data import __path__ as data_path
+
+    schema = json.loads((Path(data_path[0]) / "opentrackio-schema-1.0.1.json").read_text())
+    lens = json.loads(path.read_text())["lens"]
+    jsonschema.Draft202012Validator(schema["properties"]["lens"]).validate(lens)
+    assert lens["focusDistance"] == pytest.approx(2.0)
+
+
+# ---- bad input: one sentence, exit 2, nothing written -------------------------------------------------
+def _refused(capsys, argv, out: Path, words: str):
+    rc = main(argv)
+    err = capsys.readouterr().err.strip()
+    assert rc == 2, err
+    assert len(err.splitlines()) == 1 and words in err, err
+    assert not out.exists()
+
+
+def _few(tmp_path, n):
+    board = _charts.board_image(CHARUCO, 12.0)
+    d = tmp_path / f"few{n}"
+    d.mkdir()
+    for k, (r, t) in enumerate(_charts.poses(n, 3, partial=False)):
+        cv2.imwrite(str(d / f"c{k}.png"), _charts.render(CHARUCO, r, t, board=board, seed=k))
+    return d
+
+
+def test_an_image_without_a_chart_is_refused(tmp_path, capsys):
+    blank = tmp_path / "blank.png"
+    cv2.imwrite(str(blank), np.full((480, 640), 128, np.uint8))
+    _refused(capsys, ["calibrate", str(blank), *CHARUCO_ARGS, "-o", str(tmp_path / "o")], tmp_path / "o",
+             "no charuco of 24x18 squares found in it")
+
+
+def test_too_few_views_are_refused(tmp_path, capsys):
+    d = _few(tmp_path, 3)
+    _refused(capsys, ["calibrate", str(d), *CHARUCO_ARGS, "-o", str(tmp_path / "o")], tmp_path / "o",
+             "3 views of the chart: calibrating needs 5 or more")
+
+
+def test_mixed_resolutions_are_refused(tmp_path, capsys):
+    d = _few(tmp_path, 1)
+    small = tmp_path / "small.png"
+    cv2.imwrite(str(small), cv2.resize(cv2.imread(str(d / "c0.png")), (640, 480)))
+    _refused(capsys, ["calibrate", str(d / "c0.png"), str(small), *CHARUCO_ARGS, "-o", str(tmp_path / "o")],
+             tmp_path / "o", "give images of one camera mode")
+
+
+def test_a_corrupt_file_is_refused(tmp_path, capsys):
+    bad = tmp_path / "bad.png"
+    bad.write_bytes(b"\x89PNG\r\n\x1a\n" + b"not really" * 10)
+    _refused(capsys, ["calibrate", str(bad), *CHARUCO_ARGS, "-o", str(tmp_path / "o")], tmp_path / "o",
+             "not an image OpenCV can read")
+
+
+@pytest.mark.slow
+def test_flat_field_and_a_lens_that_is_not_this_camera(photos, tmp_path, capsys):
+    """A flat field falling off as cos^4 of the field angle about the true principal point reads back as
+    cos^4(atan(h / f)) (a closed form); compared with dgauss_50mm (a 50 mm lens, not this 11.5 mm
+    camera) the focal length is said to differ."""
+    w, h = SIZE
+    y, x = np.mgrid[0:h, 0:w]
+    tan2 = ((x - K_TRUE[0, 2]) ** 2 + (y - K_TRUE[1, 2]) ** 2) / K_TRUE[0, 0] ** 2
+    flat = tmp_path / "flat.png"
+    cv2.imwrite(str(flat), np.round(60000.0 / (1 + tan2) ** 2).astype(np.uint16))
+    rc = main(["calibrate", str(photos), *CHARUCO_ARGS, "--focus", "2m", "-o", str(tmp_path / "o"), "--bootstrap",
+               "4", "--flat", str(flat), "--lens", "dgauss_50mm", "--json"])
+    assert rc == 0, capsys.readouterr().err
+    doc = json.loads(capsys.readouterr().out)
+    pts = doc["illumination"]["points"]
+    f_mm = K_TRUE[0, 0] * PITCH_MM
+    for p in pts[1:-1]:  # each ring (not the corner ring, where the pixels crowd its inner edge)'s mean of cos^4 over its width: within 2 % of the value at its middle
+        # (a ring spans 1/12 of the corner height; cos^4 curves across it, most in the corner rings)
+        assert p["relative_illumination"] == pytest.approx(np.cos(np.arctan(p["image_height_mm"] / f_mm)) ** 4,
+                                                           rel=0.02)
+    rows = {r["figure"]: r for r in doc["comparison"]["rows"]}
+    f_row = rows["pinhole focal length at 2000 mm"]
+    assert not f_row["agrees"] and f_row["predicted"] > 40.0
+    assert doc["comparison"]["agrees"] is False
