@@ -198,3 +198,31 @@ def test_design_index_chooses_the_dispersion_model_as_the_optics_layer_does(nm):
              Medium(1.5168, 64.17), Medium(1.333, 0.0), Medium(1.88300, 40.76, "S-LAH58", "OHARA")]
     for m in media:
         assert design_index(m, nm) == pytest.approx(float(medium_index(m, nm)), abs=1e-12), m
+
+
+def test_camera_commands_refuse_a_finite_conjugate_design_in_one_line(tmp_path, capsys):
+    relay = str(DATA / "zemax" / "relay_obna.zmx")
+    for argv in (["report", "--lens", relay, "--focus", "2m"],
+                 ["usd", "write", str(tmp_path / "cam.usda"), "--lens", relay, "--focus", "2m"],
+                 ["dof-table", "--lens", relay, "--fstops", "4", "--focus", "1m"]):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and f"{relay} is a finite-conjugate design (object 150 mm in front)" in err
+    assert not (tmp_path / "cam.usda").exists()
+    # what a finite-conjugate design is good for still works: paraxial data, and the Python API loads it
+    assert main(["lens", "show", "--lens", relay]) == 0
+    capsys.readouterr()
+    assert main(["report", "--lens", str(DATA / "zemax" / "asphere_780nm.zmx"), "--focus", "2m"]) == 0
+    capsys.readouterr()
+
+
+def test_camera_use_and_object_distance_in_the_python_api():
+    from physcam.errors import InputError
+    from physcam.lens.library import camera_use, load_lens, require_camera_lens
+
+    relay = DATA / "zemax" / "relay_obna.zmx"
+    lens = load_lens(relay)
+    assert lens.object_distance_mm == 150.0 and math.isinf(load_lens("dgauss_50mm").object_distance_mm)
+    with camera_use("a test camera"), pytest.raises(InputError, match="a test camera needs an infinite-conjugate"):
+        load_lens(relay)
+    assert require_camera_lens(load_lens("dgauss_50mm")) is load_lens("dgauss_50mm")

@@ -11,7 +11,10 @@ source, and any correction made, with the reason) in the ``[provenance]`` table.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import difflib
+import math
 import re
 from dataclasses import dataclass
 from functools import lru_cache
@@ -22,12 +25,39 @@ from ..errors import InputError, LensFileError
 from .prescription import Prescription
 
 __all__ = ["LensRecord", "list_lenses", "load_lens", "find_lens", "library_dir", "load_repaired", "repairs_of",
-           "REPAIRED_KEY"]
+           "REPAIRED_KEY", "camera_use", "require_camera_lens"]
 
 #: ``extras`` key of a lens loaded with ``lenient=True`` that needed repairs (JSON list of messages).
 REPAIRED_KEY = "provenance.repaired_on_load"
 
 _FILE_SUFFIXES = (".toml", ".dat", ".json", ".zmx")
+
+#: Set inside :func:`camera_use`: what the lenses loaded there are for ("a camera lens report").
+_CAMERA_USE: contextvars.ContextVar[str | None] = contextvars.ContextVar("physcam_camera_use", default=None)
+
+
+@contextlib.contextmanager
+def camera_use(what: str):
+    """Inside this block :func:`load_lens` refuses a finite-conjugate design (:func:`require_camera_lens`,
+    ``what`` saying what needs a camera lens). The CLI runs its camera commands (report, USD
+    cameras, DOF tables, exports, live, metadata) inside it: one place instead of one per command."""
+    token = _CAMERA_USE.set(what)
+    try:
+        yield
+    finally:
+        _CAMERA_USE.reset(token)
+
+
+def require_camera_lens(p: Prescription, label: str | None = None, what: str = "a camera lens") -> Prescription:
+    """``p`` when it images an object at infinity, as a camera lens does; else :class:`InputError`
+    in one line: a finite-conjugate design (a relay, a microscope objective: its file gives an
+    object distance, :attr:`Prescription.object_distance_mm`) has no depth of field, focus marks
+    or camera. ``label`` names it (the file), ``what`` what needs the camera lens."""
+    d = p.object_distance_mm
+    if math.isinf(d):
+        return p
+    raise InputError(f"{label or repr(p.name)} is a finite-conjugate design (object {d:g} mm in front): {what} needs "
+                     "an infinite-conjugate lens (`physcam lens show` and `physcam trace` read it)")
 
 
 @dataclass(frozen=True, slots=True)
@@ -187,7 +217,14 @@ def load_lens(name_or_path, lenient: bool = False) -> Prescription:
     says how to get further. With ``lenient=True`` such a file is repaired as ``physcam lens fix``
     would (:func:`load_repaired`): each repair is issued as a :class:`~physcam.errors.PhysCamWarning`
     and the lens comes back named "<name> (repaired)" with the repairs in :func:`repairs_of`.
+    Inside :func:`camera_use` a finite-conjugate design is refused (:func:`require_camera_lens`).
     """
+    what = _CAMERA_USE.get()
+    lens = _load(name_or_path, lenient)
+    return lens if what is None else require_camera_lens(lens, str(name_or_path), what)
+
+
+def _load(name_or_path, lenient: bool) -> Prescription:
     s = str(name_or_path)
     p = Path(s)
     looks_like_path = isinstance(name_or_path, Path) or "/" in s or "\\" in s or p.suffix.lower() in _FILE_SUFFIXES
@@ -208,7 +245,7 @@ def load_lens(name_or_path, lenient: bool = False) -> Prescription:
 
             q, repairs = load_repaired(p)
             for r in repairs:
-                warnings.warn(f"{s}: repaired on load: {r.message}", PhysCamWarning, stacklevel=2)
+                warnings.warn(f"{s}: repaired on load: {r.message}", PhysCamWarning, stacklevel=3)
             return q
     if not looks_like_path and s in _slugs():
         # a slug, as the CLI is usually given it: read that one file, not the whole library (the

@@ -37,14 +37,10 @@ from pathlib import Path
 from ...errors import ExportError, InputError, LensFileError, PhysCamWarning
 from ..aperture import size_stop
 from ..catalog import GlassNotFound, find_glass
-from ..prescription import AIR, LensMetadata, Medium, Prescription, Surface, takes_prescription
+from ..prescription import AIR, OBJECT_DISTANCE_KEY, LensMetadata, Medium, Prescription, Surface, takes_prescription
 from ._common import MAX_SURFACES, check_count, extra, fmt, json_text, number, one_line, validated, takes_text
 
-__all__ = ["loads", "dumps", "SKIPPED", "OBJECT_DISTANCE_KEY"]
-
-#: ``Prescription.extras`` key of a finite object distance (mm, object to first vertex: the
-#: object surface's DISZ); absent when the object is at infinity.
-OBJECT_DISTANCE_KEY = "zemax.object_distance_mm"
+__all__ = ["loads", "dumps", "SKIPPED"]
 
 #: Lines read past, with the reason (docs/lens-formats.md lists them).
 SKIPPED = {
