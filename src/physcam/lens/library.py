@@ -207,6 +207,29 @@ def load_repaired(path, format: str | None = None):
     return q, repairs
 
 
+def _way_forward(path: Path, s: str) -> str:
+    """What to suggest after ``path`` failed to load: ``lens fix`` and ``--lenient`` only when
+    :func:`load_repaired` does repair it; ``lens check`` alone when the reader read the rows but no
+    repair is defined; nothing more when the reader itself refused the file (its message says why)."""
+    import warnings
+
+    from ..errors import PhysCamError
+    from .check import read_raw
+
+    try:
+        read_raw(path)
+    except PhysCamError:
+        return ""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            load_repaired(path)
+    except PhysCamError:
+        return f"; no repair is defined for it (`physcam lens check {s}` lists every problem)"
+    return (f"; `physcam lens check {s}` explains, `physcam lens fix {s} -o FIXED.toml --apply` writes a repaired "
+            "copy, --lenient (Python: load_lens(path, lenient=True)) loads it repaired")
+
+
 def load_lens(name_or_path, lenient: bool = False) -> Prescription:
     """A bundled lens by slug/name/alias, or any lens file by path (format from its extension).
 
@@ -214,7 +237,7 @@ def load_lens(name_or_path, lenient: bool = False) -> Prescription:
     is read as a file; otherwise it is looked up in the library.
 
     A file that does not describe a buildable lens raises :class:`LensFileError` whose message
-    says how to get further. With ``lenient=True`` such a file is repaired as ``physcam lens fix``
+    says how to get further (``physcam lens fix`` and ``lenient`` only where a repair is defined). With ``lenient=True`` such a file is repaired as ``physcam lens fix``
     would (:func:`load_repaired`): each repair is issued as a :class:`~physcam.errors.PhysCamWarning`
     and the lens comes back named "<name> (repaired)" with the repairs in :func:`repairs_of`.
     Inside :func:`camera_use` a finite-conjugate design is refused (:func:`require_camera_lens`).
@@ -235,10 +258,7 @@ def _load(name_or_path, lenient: bool) -> Prescription:
             return read_lens(p)
         except LensFileError as exc:
             if not lenient:
-                raise LensFileError(
-                    f"{exc.reason}; `physcam lens check {s}` explains, `physcam lens fix {s} -o FIXED.toml --apply` "
-                    "writes a repaired copy, --lenient (Python: load_lens(path, lenient=True)) loads it repaired",
-                    exc.path, exc.line) from None
+                raise LensFileError(f"{exc.reason}{_way_forward(p, s)}", exc.path, exc.line) from None
             import warnings
 
             from ..errors import PhysCamWarning
