@@ -22,7 +22,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..errors import InputError, LensFileError
-from .prescription import Prescription
+from .prescription import Prescription, takes_prescription
 
 __all__ = ["LensRecord", "list_lenses", "load_lens", "find_lens", "library_dir", "load_repaired", "repairs_of",
            "REPAIRED_KEY", "camera_use", "require_camera_lens"]
@@ -48,6 +48,7 @@ def camera_use(what: str):
         _CAMERA_USE.reset(token)
 
 
+@takes_prescription
 def require_camera_lens(p: Prescription, label: str | None = None, what: str = "a camera lens") -> Prescription:
     """``p`` when it images an object at infinity, as a camera lens does; else :class:`InputError`
     in one line: a finite-conjugate design (a relay, a microscope objective: its file gives an
