@@ -72,3 +72,79 @@ def test_pxr_and_numba_stay_in_their_modules():
         top_level_pxr = any(line.startswith(("from pxr", "import pxr")) for line in text.splitlines())
         if top_level_pxr:
             assert rel.startswith("usd/"), rel
+
+
+def _module_graph():
+    """physcam's modules and the physcam modules each imports, at any depth of its code (a deferred,
+    function-level import is an edge too: it hides a cycle, it does not break one). ``from pkg import
+    name`` is an edge to ``pkg.name`` when that is a module, else to ``pkg``."""
+    mods = {}
+    for path in (SRC / "physcam").rglob("*.py"):
+        parts = path.relative_to(SRC).with_suffix("").parts
+        mods[".".join(p for p in parts if p != "__init__")] = path
+    graph = {}
+    for module, path in mods.items():
+        edges = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom):
+                base = next(_imports_of(node, path, module))
+                edges.update(f"{base}.{a.name}" if f"{base}.{a.name}" in mods else base for a in node.names)
+            elif isinstance(node, ast.Import):
+                edges.update(a.name for a in node.names)
+        graph[module] = {t for t in edges if t in mods and t != module}
+    return graph
+
+
+def _imports_of(node, path, module):
+    """The module a ``from ... import`` names, relative imports resolved against ``module``."""
+    if node.level:
+        base = module.split(".")
+        if path.name != "__init__.py":
+            base = base[:-1]
+        base = base[: len(base) - (node.level - 1)]
+        yield ".".join(base + ([node.module] if node.module else []))
+    else:
+        yield node.module or ""
+
+
+def test_no_import_cycles_deferred_imports_included():
+    """Issue 28: no two modules import each other, directly or round a longer circle, counting the
+    imports inside functions (Tarjan's strongly connected components, iteratively)."""
+    graph = _module_graph()
+    index, low, on, stack, cycles, counter = {}, {}, set(), [], [], [0]
+    for root in graph:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = counter[0]
+        counter[0] += 1
+        stack.append(root)
+        on.add(root)
+        while work:
+            v, it = work[-1]
+            w = next(it, None)
+            if w is not None:
+                if w not in index:
+                    index[w] = low[w] = counter[0]
+                    counter[0] += 1
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(sorted(graph[w]))))
+                elif w in on:
+                    low[v] = min(low[v], index[w])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                comp = []
+                while True:
+                    w = stack.pop()
+                    on.discard(w)
+                    comp.append(w)
+                    if w == v:
+                        break
+                if len(comp) > 1:
+                    cycles.append(" <-> ".join(sorted(comp)))
+    assert not cycles, "import cycles (move what both sides need to the module that owns the concept):\n" + \
+        "\n".join(cycles)

@@ -16,6 +16,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from physcam.errors import InputError
 from physcam.live.frames import (
     TrackedFrame, frame_from_sample, pan_tilt_roll, rotation_matrix, sample_from_frame, timecode_fields,
 )
@@ -265,24 +266,30 @@ def test_a_chain_of_transforms_composes_in_order():
 
 # --- distortion: OpenCV's normalised coefficients in OpenLensIO millimetres ------------------------
 def test_the_millimetre_coefficients_distort_like_opencv():
+    """OpenLensIO's order (l1..l6 alternating numerator and denominator, camdkit's conversion note)
+    against OpenCV's rational model (k1-k6) itself."""
     cv2 = pytest.importorskip("cv2")
     k1, k2, k3, p1, p2, f = -0.12, 0.03, -0.004, 3e-4, -2e-4, 35.0
-    dist = opencv_to_opentrackio(k1, k2, k3, p1, p2, f)
+    k4, k5, k6 = 0.01, -0.002, 0.0005
+    dist = opencv_to_opentrackio(k1, k2, k3, p1, p2, f, k4, k5, k6)
     assert dist["model"] == "Brown-Conrady U-D"
     # points in front of a pinhole: OpenCV projects them with K = f (mm as "pixels"), centre 0
     xy = np.stack(np.meshgrid(np.linspace(-0.5, 0.5, 7), np.linspace(-0.35, 0.35, 5)), -1).reshape(-1, 2)
     obj = np.c_[xy, np.ones(len(xy))]
     K = np.array([[f, 0, 0], [0, f, 0], [0, 0, 1.0]])
-    img, _ = cv2.projectPoints(obj, np.zeros(3), np.zeros(3), K, np.array([k1, k2, p1, p2, k3]))
+    img, _ = cv2.projectPoints(obj, np.zeros(3), np.zeros(3), K, np.array([k1, k2, p1, p2, k3, k4, k5, k6]))
     img = img.reshape(-1, 2)
-    # OpenLensIO's form in mm (eq. 16-17 with the numerator terms), applied to eps_u = F x'
+    # OpenLensIO's rational form in mm, applied to eps_u = F x'
     e = f * xy
     r2 = (e ** 2).sum(1)
-    a, b, c = dist["radial"]
+    l1, l2, l3, l4, l5, l6 = dist["radial"]
     q1, q2 = dist["tangential"]
-    R = 1 + a * r2 + b * r2 ** 2 + c * r2 ** 3
+    R = (1 + l1 * r2 + l3 * r2 ** 2 + l5 * r2 ** 3) / (1 + l2 * r2 + l4 * r2 ** 2 + l6 * r2 ** 3)
     ex = e[:, 0] * R + 2 * q1 * e[:, 0] * e[:, 1] + q2 * (r2 + 2 * e[:, 0] ** 2)
     ey = e[:, 1] * R + 2 * q2 * e[:, 0] * e[:, 1] + q1 * (r2 + 2 * e[:, 1] ** 2)
     assert np.allclose(np.c_[ex, ey], img, atol=1e-9)
-    back = opentrackio_to_opencv(dist, f)
-    assert back == pytest.approx({"k1": k1, "k2": k2, "k3": k3, "p1": p1, "p2": p2}, rel=1e-12)
+    back = opentrackio_to_opencv(dist, f, rational=True)
+    assert back == pytest.approx({"k1": k1, "k2": k2, "k3": k3, "p1": p1, "p2": p2, "k4": k4, "k5": k5, "k6": k6},
+                                 rel=1e-12)
+    with pytest.raises(InputError, match="denominator"):
+        opentrackio_to_opencv(dist, f)  # OpenCV's five coefficients cannot hold k4-k6

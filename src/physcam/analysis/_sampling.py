@@ -204,3 +204,23 @@ def _needed(fp: FieldPupils, defocus, min_frequency, waves_per_cell):
         return None
     n_req = int(math.ceil(fp.n * worst_ratio * 1.1 / 8.0) * 8)
     return max(n_req, fp.n + 8), why
+
+
+MAX_FREQUENCIES = 512
+
+
+def spatial_frequencies(frequencies, name="frequency"):
+    """Spatial frequencies in lp/mm as a float array: 1 to :data:`MAX_FREQUENCIES` finite numbers from
+    0 to 100000 (the MTF's and the Huygens MTF's one check)."""
+    if isinstance(frequencies, (str, bytes)):
+        raise InputError(f"frequencies must be numbers in lp/mm, got {frequencies!r:.60}")
+    try:
+        seq = np.atleast_1d(np.asarray(frequencies, dtype=object)).ravel().tolist()
+    except Exception:  # noqa: BLE001 - anything that is not a sequence of numbers
+        raise InputError(f"frequencies must be numbers in lp/mm, got {frequencies!r:.60}") from None
+    f = [require_finite(name, v) for v in seq]
+    if not 1 <= len(f) <= MAX_FREQUENCIES:
+        raise InputError(f"give 1 to {MAX_FREQUENCIES} frequencies, got {len(f)}")
+    if any(v < 0 or v > 1e5 for v in f):
+        raise InputError("frequencies must lie between 0 and 100000 lp/mm")
+    return np.array(f, dtype=float)

@@ -373,9 +373,9 @@ def huygens_mtf(lens: Prescription, field_deg=0.0, *, frequencies, image_samples
     The PSF's grid is ``image_samples`` of ``pixel_um`` (default 0.45 lambda N_w): the MTF is accurate to
     about the power the grid misses (``psf.energy_in_grid``; 0.3 % for a perfect lens's Airy pattern)."""
     from . import _sampling
-    from .mtf import _frequencies
+    from ._sampling import spatial_frequencies
 
-    nu = _frequencies(frequencies)
+    nu = spatial_frequencies(frequencies)
     if pixel_um is None:  # from a coarse trace of the same field: the beam's f-number and the spot's size
         probe = _sampling.field_pupils(lens, field_deg, pupil_samples=32, check=False,
                                        **{k: kwargs[k] for k in ("wavelengths_nm", "weights", "fstop", "focus_mm",

@@ -37,6 +37,7 @@ import numpy as np
 from ..data.default_sensor import DEFAULT_SENSOR_HALF_DIAGONAL_MM
 from ..errors import InputError, OpticsError, require_finite
 from ..lens.prescription import Prescription, takes_prescription
+from ._sampling import MAX_FREQUENCIES, spatial_frequencies
 
 __all__ = ["MTFCurve", "ThroughFocusMTF", "MTFChart", "mtf", "geometric_mtf", "through_focus_mtf", "mtf_chart",
            "diffraction_limited_mtf", "CHART_FREQUENCIES", "WHITE_LIGHT_NM"]
@@ -46,7 +47,6 @@ CHART_FREQUENCIES = (10.0, 20.0, 40.0)
 #: White light for charts: the d, F and C lines, equal weights (d first: the primary, whose chief ray
 #: is the reference of the polychromatic OTF).
 WHITE_LIGHT_NM = (587.5618, 486.1327, 656.2725)
-MAX_FREQUENCIES = 512
 MAX_FIELDS = 41
 
 
@@ -60,21 +60,6 @@ def diffraction_limited_mtf(frequency, cutoff):
     x = np.clip(np.abs(nu) / c, 0.0, 1.0)
     out = (2.0 / np.pi) * (np.arccos(x) - x * np.sqrt(1.0 - x * x))
     return float(out) if out.ndim == 0 else out
-
-
-def _frequencies(frequencies, name="frequency"):
-    if isinstance(frequencies, (str, bytes)):
-        raise InputError(f"frequencies must be numbers in lp/mm, got {frequencies!r:.60}")
-    try:
-        seq = np.atleast_1d(np.asarray(frequencies, dtype=object)).ravel().tolist()
-    except Exception:  # noqa: BLE001 - anything that is not a sequence of numbers
-        raise InputError(f"frequencies must be numbers in lp/mm, got {frequencies!r:.60}") from None
-    f = [require_finite(name, v) for v in seq]
-    if not 1 <= len(f) <= MAX_FREQUENCIES:
-        raise InputError(f"give 1 to {MAX_FREQUENCIES} frequencies, got {len(f)}")
-    if any(v < 0 or v > 1e5 for v in f):
-        raise InputError("frequencies must lie between 0 and 100000 lp/mm")
-    return np.array(f, dtype=float)
 
 
 def _otf(fp, freqs, axis: int, dz: float, *, aberrated: bool = True) -> np.ndarray:
@@ -207,7 +192,7 @@ def mtf(
     stop's shape), ``max_pupil_samples`` (cap on the grid the rules may choose, default 1024).
     Also returns the diffraction limit of the same (vignetted) pupil.
     """
-    freqs = None if frequencies is None else _frequencies(frequencies)
+    freqs = None if frequencies is None else spatial_frequencies(frequencies)
     pts = _points(points)
     fmin = None if freqs is None or not (freqs > 0).any() else float(freqs[freqs > 0].min())
     fp, dz = _common(lens, field_deg, wavelengths_nm, weights, fstop, focus_mm, defocus_mm, pupil_samples, aperture,
@@ -247,7 +232,7 @@ def geometric_mtf(
     Arguments as :func:`mtf`; the default frequencies run to the diffraction cut-off."""
     from . import _sampling
 
-    freqs = None if frequencies is None else _frequencies(frequencies)
+    freqs = None if frequencies is None else spatial_frequencies(frequencies)
     pts = _points(points)
     dz = require_finite("defocus_mm", defocus_mm)
     n = _sampling.pupil_samples_arg(pupil_samples) or 64
@@ -344,7 +329,7 @@ def through_focus_mtf(
     arguments as :func:`mtf`."""
     from . import _sampling
 
-    freqs = _frequencies(frequencies)
+    freqs = spatial_frequencies(frequencies)
     st = None
     if defocus_mm is None:
         from . import _pupil as P
@@ -534,7 +519,7 @@ def mtf_chart(
     from . import _pupil as P
     from . import _sampling
 
-    freqs = _frequencies(frequencies)
+    freqs = spatial_frequencies(frequencies)
     if image_heights_mm is not None:
         if isinstance(image_heights_mm, (str, bytes)):
             raise InputError(f"image heights must be numbers in mm, got {image_heights_mm!r:.60}")
@@ -647,7 +632,7 @@ def best_focus_mm(lens, frequency, *, heights_mm, angles_deg, rule, wavelengths_
     from . import _pupil as P
     from . import _sampling
 
-    nu = _frequencies([frequency], "best-focus frequency")
+    nu = spatial_frequencies([frequency], "best-focus frequency")
     if not nu[0] > 0:
         raise InputError("the best-focus frequency must be above 0 lp/mm")
     if rule not in ("axis", "field"):

@@ -226,21 +226,14 @@ def resolve_focus(value, *, lens=None, focal_length_mm=None, fstop=None, sensor=
 
 
 def coc_value(text):
-    """A --coc value: a convention name (d/1500, cine, ...) stays text; a number with an optional
-    unit (0.025, 25um, 0.025mm) becomes a float in mm (a bare number is mm)."""
-    if text is None:
-        return None
+    """A --coc value (:func:`physcam.optics.coc.parse_coc`): a convention name stays text, a length
+    becomes a float in mm; a malformed length is argparse's error."""
+    from ..optics.coc import parse_coc
+
     try:
-        return float(text)
-    except ValueError:
-        pass
-    t = str(text).strip()
-    if t and (t[0].isdigit() or t[0] in ".+-") and "/" not in t:
-        try:
-            return parse_distance(t, name="circle of confusion")
-        except PhysCamError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
-    return text
+        return parse_coc(text)
+    except PhysCamError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def coc_of(args):

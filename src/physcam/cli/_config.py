@@ -128,11 +128,11 @@ def _read(path: Path) -> Config:
         except InputError as exc:
             raise InputError(f"the physcam config {path}: sensor: {exc}") from None
     if "coc" in values and isinstance(values["coc"], str):
-        from ._common import coc_value
+        from ..optics.coc import parse_coc
 
         try:
-            values["coc"] = coc_value(values["coc"])
-        except Exception as exc:  # argparse's ArgumentTypeError: a bad number with a unit
+            values["coc"] = parse_coc(values["coc"])
+        except InputError as exc:  # a bad number with a unit
             raise InputError(f"the physcam config {path}: coc: {exc}") from None
         if isinstance(values["coc"], str):
             from ..optics.coc import circle_of_confusion

@@ -12,9 +12,12 @@ examples:
   physcam live validate take.json sample.cbor
   physcam live record --port 55555 --duration 30 take.usda --report take.csv
   physcam live send --lens dgauss_50mm --sensor "ALEXA 35" --focus 2m --focus-to 5m --fstop 2.8 --frames 96
+  physcam live send --lens navarro_anamorphic_2x --focus 3m --fps 29.97 --timecode "01:00:00;00" --print
+  physcam live record take.usda --lens dgauss_50mm --fiz fiz.csv --count 48
   physcam live play take.usda --port 55555
   physcam live wall wall.usda --kind curved --radius 8 --width 14
   physcam live frustum take.usda --wall wall.usda frustum.usda --overscan 10 --latency-ms 40
+  physcam live frustum take.usda --wall wall.usda frustum.usda --overscan 10 --overscan-mode ndisplay
 Receivers stop after --duration seconds or --count samples, or on Ctrl-C, SIGTERM or SIGHUP; the file is\nwritten then.
 """
 
@@ -88,6 +91,10 @@ def register(sub) -> None:
     r.add_argument("--report", metavar="FILE", help="also write the per-frame lens report (.csv or .json)")
     _sensor_args(r)
     r.add_argument("--focal", type=distance("focal length"), help="pinhole focal length when the stream has none")
+    r.add_argument("--lens", help="bundled lens name or prescription file: a frame without a pinhole focal length "
+                                  "is solved through it at its focus (breathing, entrance pupil, squeeze)")
+    r.add_argument("--fiz", metavar="CSV", help="encoder calibration table (axis,encoder,value rows; docs/live.md): "
+                                                "lens.encoders to focus, f-stop and focal length")
     r.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop when the stream has none")
     r.add_argument("--focus", type=focus("focus distance", allow_inf=False),
                    help="focus mark when the stream has none (units ok; hyperfocal with --focal and --fstop)")
@@ -119,6 +126,14 @@ def register(sub) -> None:
                     help="film plane on the stage, metres, Z up (default 0,0,1.5)")
     se.add_argument("--pan-rate", type=number("pan rate", lo=-3600.0, hi=3600.0), default=0.0,
                     help="degrees per second")
+    se.add_argument("--shift-x", metavar="MM", type=distance("horizontal lens shift"), default=0.0,
+                    help="lens shift on the film (mm; + right), sent as projectionOffset")
+    se.add_argument("--shift-y", metavar="MM", type=distance("vertical lens shift"), default=0.0,
+                    help="lens shift on the film (mm; + up; write negative values as --shift-y=-0.8)")
+    se.add_argument("--timecode", default="00:00:00:00", metavar="HH:MM:SS:FF",
+                    help="timecode of the first sample (default 00:00:00:00; ';' before FF for drop-frame)")
+    se.add_argument("--drop-frame", action="store_true",
+                    help="drop-frame timecode (29.97 and 59.94 fps; sets timecode.dropFrame)")
     se.add_argument("--print", action="store_true", help="print the samples as JSON lines instead of sending")
     _network_args(se, receive=False)
     se.set_defaults(handler=run_send)
@@ -156,6 +171,9 @@ def register(sub) -> None:
     f.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
     f.add_argument("--overscan", type=number("overscan", lo=0.0, hi=1000.0), default=10.0, metavar="PCT",
                    help="inner frustum margin, percent of the half-widths (default 10)")
+    f.add_argument("--overscan-mode", choices=("tangent", "ndisplay"), default="tangent",
+                   help="tangent: the half-widths' tangents grow by the overscan (OpenLensIO's image-plane "
+                        "overscan, default); ndisplay: the half-angles grow by it, as Unreal's nDisplay does")
     f.add_argument("--latency-ms", type=number("latency", lo=0.0, hi=10000.0), default=0.0,
                    help="tracking latency: half-angles widen by the camera's turn in this time")
     f.add_argument("--samples-per-edge", type=_count, default=8, help="footprint points per frame edge (1..256)")
@@ -389,8 +407,17 @@ def _write_take(args, receiver, frames, refusals, sensor, t0, interrupted) -> in
         raise InputError(f"no valid samples arrived on port {receiver.port} in {elapsed:.1f} s "
                          f"(received {counters['received']} packets){why}; nothing written")
     refused: list = []
+    lens = fiz = None
+    if args.lens:
+        from ..lens.library import load_lens
+
+        lens = load_lens(args.lens)
+    if args.fiz:
+        from ..live.fiz import read_fiz_table
+
+        fiz = read_fiz_table(args.fiz)
     solved = solve_frames(frames, sensor=sensor, rate=args.fps, focal_length_mm=args.focal, fstop=args.fstop,
-                          focus_mm=args.focus, refused=refused)
+                          focus_mm=args.focus, refused=refused, lens=lens, fiz=fiz)
     refusals = refusals + [reason for _, reason in refused]
     if not solved:
         raise InputError(f"no frame of the take could be recorded: {refusals[0]}; nothing written")
@@ -464,10 +491,15 @@ def run_send(args) -> int:
 
     args.focus, args.focus_to = (resolve_focus(v, lens=lens, focal_length_mm=args.focal, fstop=args.fstop,
                                                sensor=sensor, args=args) for v in (args.focus, args.focus_to))
+    from ..live.frames import parse_timecode
+
+    drop = args.drop_frame or ";" in args.timecode
+    start = parse_timecode(args.timecode, args.fps, drop)
     frames = camera_frames(sensor=sensor, frames=args.frames, rate=args.fps, focus_mm=args.focus,
                            focus_to_mm=args.focus_to, fstop=args.fstop, tstop=args.tstop, lens=lens,
-                           focal_length_mm=args.focal, move=move)
-    samples = frames_to_samples(frames, lens_name=getattr(lens, "name", None))
+                           focal_length_mm=args.focal, move=move, shift_mm=(args.shift_x, args.shift_y),
+                           drop_frame=drop)
+    samples = frames_to_samples(frames, lens_name=getattr(lens, "name", None), start_timecode=start)
     _stream(args, samples, float(frames[0].rate))
     return 0
 
@@ -560,14 +592,15 @@ def run_frustum(args) -> int:
     frames = frames_from_usd(args.camera, args.path)
     wall = wall_from_usd(args.wall, args.wall_path)
     fr = frustum_frames(frames, wall, overscan=args.overscan / 100.0, latency_s=args.latency_ms / 1000.0,
-                        samples_per_edge=args.samples_per_edge)
+                        samples_per_edge=args.samples_per_edge, overscan_mode=args.overscan_mode)
     rate = float(frames[0].rate or 24)
     out = write_frustum_usd(args.output, fr, meters_per_unit=wall.meters_per_unit, fps=min(rate, 1000.0),
                             force=args.force)
     missed = sum(f.missed for f in fr)
     if args.json:
         emit_json(document("live_frustum", {
-            "file": str(out), "frames": [{"time_code": f.time_code, "widen": list(f.widen),
+            "file": str(out), "overscan_mode": args.overscan_mode,
+            "frames": [{"time_code": f.time_code, "widen": list(f.widen),
                                           "latency_margin_deg": f.pad_deg, "missed_rays": f.missed,
                                           "footprint": f.footprint.tolist()} for f in fr]},
             units={"length": "scene units of the wall's stage", "angle": "degree"}))

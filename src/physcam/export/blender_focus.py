@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from ..errors import InputError, OpticsError
+from ..errors import InputError, OpticsError, require_type
 from ..lens.prescription import Prescription, takes_prescription
 from .osl import lens_data, osl_array, osl_number, render_template
 
@@ -111,6 +111,7 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
                        fstop: float = 0.0, sensor_mm=(36.0, 24.0)) -> str:
     """The template with ``ft``'s focus table: focus, f-stop, sensor and iris are shader parameters
     (defaults from the keywords; ``fstop`` 0 is wide open)."""
+    require_type("ft", ft, FocusTable, "physcam.export.blender_focus.focus_table(lens)")
     n_focus = len(ft.marks_mm)
     n = len(ft.table)
     defines, data = lens_data(ft.table, None, ft.lens.wavelength_nm, ft.bounds, dispersion=dispersion,

@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import LensFileError
-from .catalog import CatalogGlass
+from .catalog_glass import CatalogGlass
 from .glassformulas import COEFFICIENT_COUNT, formula_index
 
 __all__ = ["read_agf", "loads_agf"]
@@ -48,6 +48,10 @@ def _floats(tok, path, lineno, what):
 
 def loads_agf(text: str, name: str, path=None) -> dict[str, CatalogGlass]:
     """Parse ``.agf`` text of catalogue ``name``."""
+    from ..errors import require_type
+
+    require_type("text", text, str, "the .agf file's text (physcam.lens.agf.read_agf reads a file)")
+    require_type("name", name, str, "the catalogue's name, e.g. 'MYGLASS'")
     rows: list[dict] = []
     for lineno, raw in enumerate(text.splitlines(), start=1):
         tok = raw.split()

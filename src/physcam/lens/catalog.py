@@ -27,48 +27,16 @@ from __future__ import annotations
 import difflib
 import json
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+
 from importlib import resources
 
 from ..errors import InputError
-from .glassformulas import formula_index, is_sellmeier3
+from .catalog_glass import CatalogGlass
 
 __all__ = ["CatalogGlass", "GlassNotFound", "BUILTIN_CATALOGS", "GLASSES", "find_glass", "glass_names",
            "match_glass", "catalog", "use_catalog_files", "user_catalogs", "register_catalog"]
 
 BUILTIN_CATALOGS = ("SCHOTT", "OHARA", "HOYA", "CDGM", "HIKARI", "SUMITA", "MISC")
-
-
-@dataclass(frozen=True, slots=True)
-class CatalogGlass:
-    """One catalogue glass: ``nd`` at 587.5618 nm, Abbe number ``vd``, its catalogue (``maker``),
-    Zemax ``formula`` number and ``coefficients`` (wavelength in um), span ``range_nm``."""
-
-    name: str
-    nd: float
-    vd: float
-    maker: str
-    formula: int | None = None
-    coefficients: tuple = ()
-    range_nm: tuple | None = None
-    published: dict | None = field(default=None, compare=False)
-    transmission_10mm: tuple = field(default=(), compare=False)
-    previous: bool = False
-    dpgf: float = 0.0
-
-    @property
-    def sellmeier(self):
-        """(B1, B2, B3, C1, C2, C3) when the formula is a 3-term Sellmeier, else None."""
-        if self.formula is None or not is_sellmeier3(self.formula, self.coefficients):
-            return None
-        c = tuple(self.coefficients) + (0.0,) * 6
-        return (c[0], c[2], c[4], c[1], c[3], c[5])
-
-    def index(self, wavelength_nm):
-        """n at ``wavelength_nm`` from the catalogue's own formula (no fit); needs a formula."""
-        if self.formula is None:
-            raise InputError(f"glass {self.name} has no dispersion formula in its catalogue")
-        return formula_index(self.formula, self.coefficients, wavelength_nm / 1000.0)
 
 
 class GlassNotFound(InputError):

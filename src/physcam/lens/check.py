@@ -27,7 +27,8 @@ from typing import Callable, Iterable
 
 from ..errors import LensFileError, PhysCamError
 from .geometry import sag
-from .prescription import MAX_ABBE, MAX_INDEX, MIN_ABBE, Prescription, unvalidated
+from .prescription import MAX_ABBE, MAX_INDEX, MIN_ABBE, Prescription
+from .raw import RawLens, read_raw
 from .repair import (
     CLEARANCE_MM,
     aperture_factor,
@@ -69,33 +70,6 @@ class Finding:
         surf = f"surface {self.surface}: " if self.surface is not None else ""
         tail = f" -> {self.implication}" if self.implication else ""
         return f"{where}: {self.severity}: {surf}{self.message}{tail}"
-
-
-@dataclass(frozen=True)
-class RawLens:
-    """A lens file's rows as written (not validated), with the file line of each surface."""
-
-    prescription: Prescription
-    path: str | None
-    lines: tuple[int | None, ...]
-    format: str | None = None
-
-    def line(self, i: int | None) -> int | None:
-        return self.lines[i] if (i is not None and 0 <= i < len(self.lines)) else None
-
-
-def read_raw(path, format: str | None = None) -> RawLens:
-    """Read a lens file without validating the prescription (the reader's syntax checks still
-    apply: a file that is not a lens raises :class:`LensFileError` with file and line)."""
-    from .formats import detect_format, loads_lens
-    from .formats._common import read_text
-
-    text = read_text(path)
-    fmt = format or detect_format(path, text)
-    with unvalidated() as seen:
-        p = loads_lens(text, fmt, str(path))
-    lines = seen[-1][2] if seen and seen[-1][2] is not None else [None] * len(p.surfaces)
-    return RawLens(p, str(path), tuple(lines), fmt)
 
 
 # ---- small paraxial helpers (Y or X meridian, nd) ------------------------------------

@@ -183,7 +183,7 @@ def load_repaired(path, format: str | None = None):
     """
     import dataclasses
 
-    from .check import read_raw
+    from .raw import read_raw
     from .formats._common import json_text
     from .repair import propose, with_corrections
 

@@ -6,8 +6,19 @@ there, so the pinhole focal length breathes and the entrance pupil moves) and th
 ``pinholeFocalLength`` (the best-match pinhole, mm), ``focusDistance`` (the mark from the film plane,
 m), ``fStop`` and ``tStop``, ``entrancePupilOffset`` (m in front of the film), the distortion of a
 prescription at that focus (:func:`physcam.live.lens_data.distortion_for_sample`), timing (exact
-timestamps at the frame rate, timecode, sequence number) and the camera transform. The ``static``
-block (sensor size, capture rate, lens, tracker) rides on the first sample and once a second after.
+timestamps at the frame rate, timecode from a start label, drop-frame when asked, sequence number) and
+the camera transform. The ``static`` block (sensor size, capture rate, anamorphic squeeze, lens,
+tracker) rides on the first sample, once a second after, and whenever the squeeze changes.
+
+Anamorphic lenses: ``pinholeFocalLength`` is the **vertical** pinhole F (the unsqueezed meridian) and
+``static.camera.anamorphicSqueeze`` the lens's effective squeeze at that focus (F_y / F_x, which
+breathes a little), so the horizontal focal length a consumer computes, F / squeeze, frames the
+width as :func:`physcam.analysis.breathing` does (Unreal's CineCamera takes the filmback width times
+its squeeze factor over the focal length). Lens shift: ``shift_mm`` (physcam's convention, + right
+and + up: the view moves that way, as ``report --shift-x/--shift-y``) is sent as
+``lens.projectionOffset`` = (-shift_x, +shift_y), OpenLensIO's perspective offset ΔP: where the
+optical axis lands on the sensor, mm from the centre, x right, y down (OpenLensIO 1.0.1 section
+1.5); ``distortionOffset`` (ΔC) is 0 because physcam's distortion is centred on that axis.
 """
 
 from __future__ import annotations
@@ -44,10 +55,11 @@ class CameraMove:
 
 def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None, focal_length_mm=None,
                   focus_to_mm=None, tstop=None, move: CameraMove | None = None, distortion: bool = True,
-                  t0_ns: int | None = None) -> list[TrackedFrame]:
+                  t0_ns: int | None = None, shift_mm=(0.0, 0.0), drop_frame: bool = False) -> list[TrackedFrame]:
     """The take's frames (module notes): ``frames`` frames at ``rate``, focus pulled linearly from
     ``focus_mm`` to ``focus_to_mm`` (mm from the film; default: held), ``lens`` (a Prescription) or a
-    thin lens of ``focal_length_mm``; ``t0_ns`` the first timestamp (default now)."""
+    thin lens of ``focal_length_mm``; ``t0_ns`` the first timestamp (default now); ``shift_mm`` the
+    lens shift (+ right, + up); ``drop_frame``: drop-frame timecode (29.97, 59.94)."""
     from ..onset.report import solve_lens_report
     from ..onset.sensors import Sensor
 
@@ -60,6 +72,12 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
         raise InputError("give either a lens prescription or a focal length")
     f0 = require_finite("focus distance", focus_mm)
     f1 = f0 if focus_to_mm is None else require_finite("focus distance to pull to", focus_to_mm)
+    from .frames import _pair, timecode_fields
+
+    sx, sy = _pair("lens shift (mm)", shift_mm)
+    offsets = {} if sx == 0.0 and sy == 0.0 else {"projection_offset_mm": (-sx, sy), "distortion_offset_mm": (0.0, 0.0)}
+    if drop_frame:
+        timecode_fields(0, fr, drop_frame=True)  # refuses a rate without drop-frame counting
     t0 = time.time_ns() if t0_ns is None else int(t0_ns)
     out: list[TrackedFrame] = []
     cache: dict = {}
@@ -80,7 +98,7 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
         pos, rot = move.at(i / float(fr))
         pupil = rep.entrance_pupil_from_film_mm
         out.append(with_time(TrackedFrame(
-            rate=fr, translation_m=pos, rotation_deg=rot, pinhole_focal_length_mm=rep.pinhole[0],
+            squeeze=float(rep.pinhole[1]), drop_frame=bool(drop_frame), **offsets, rate=fr, translation_m=pos, rotation_deg=rot, pinhole_focal_length_mm=rep.pinhole[0],
             focus_from_film_mm=rep.focus_from_film_mm, fstop=rep.fstop, tstop=rep.tstop,
             entrance_pupil_mm=pupil if pupil is not None else rep.h1_from_film_mm, distortion=dist,
             sensor_mm=(sensor.width_mm, sensor.height_mm),
@@ -89,23 +107,30 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
 
 
 def frames_to_samples(frames, *, source_id: str | None = None, static_every: int | None = None,
-                      lens_name: str | None = None, shutter_angle_deg: float | None = None):
+                      lens_name: str | None = None, shutter_angle_deg: float | None = None, start_timecode: int = 0):
     """Yield an OpenTrackIO sample per frame (:func:`physcam.live.frames.sample_from_frame`), with the
-    ``static`` block on the first and every ``static_every``-th sample (default: once a second)."""
+    ``static`` block on the first and every ``static_every``-th sample (default: once a second) and
+    whenever the frame's anamorphic squeeze differs from the last one sent; the timecode starts
+    ``start_timecode`` timecode frames after midnight (:func:`physcam.live.frames.parse_timecode`)."""
     sid = new_source_id() if source_id is None else source_id
+    sent_squeeze = None
     for i, f in enumerate(frames):
         require_type("frame", f, TrackedFrame)
         every = static_every if static_every is not None else max(1, math.ceil(float(f.rate or 24)))
         static = None
-        if i % every == 0 and f.sensor_mm is not None:
+        squeeze = 1.0 if f.squeeze is None else f.squeeze
+        if (i % every == 0 or squeeze != sent_squeeze) and f.sensor_mm is not None:
             static = static_block(sensor_mm=f.sensor_mm, rate=f.rate or 24, lens_name=lens_name,
-                                  nominal_focal_length_mm=f.nominal_focal_length_mm,
+                                  nominal_focal_length_mm=f.nominal_focal_length_mm, squeeze=squeeze,
                                   shutter_angle_deg=shutter_angle_deg)
-        yield sample_from_frame(f, source_id=sid, sequence_number=i % 2**32, frame_index=i, static=static)
+            sent_squeeze = squeeze
+        yield sample_from_frame(f, source_id=sid, sequence_number=i % 2**32, frame_index=i, static=static,
+                                start_timecode=start_timecode)
 
 
 def camera_samples(**kwargs) -> list[dict]:
     """The samples of :func:`camera_frames` (same keywords) as a list of dicts."""
     lens = kwargs.get("lens")
     name = getattr(lens, "name", None)
-    return list(frames_to_samples(camera_frames(**kwargs), lens_name=name))
+    start = kwargs.pop("start_timecode", 0)
+    return list(frames_to_samples(camera_frames(**kwargs), lens_name=name, start_timecode=start))

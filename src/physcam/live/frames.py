@@ -35,7 +35,7 @@ from .sample import PROTOCOL_VERSION
 MAX_DISTORTION_TERMS = 16
 
 __all__ = ["TrackedFrame", "rate_fraction", "rational", "timecode_fields", "rotation_matrix", "pan_tilt_roll",
-           "compose_transforms", "frame_from_sample", "sample_from_frame", "static_block", "new_source_id"]
+           "compose_transforms", "frame_from_sample", "parse_timecode", "sample_from_frame", "static_block", "new_source_id"]
 
 
 @dataclass(frozen=True)
@@ -62,6 +62,16 @@ class TrackedFrame:
     notes: tuple[str, ...] = field(default_factory=tuple)
     source_id: str | None = None
     source_number: int | None = None
+    #: ``static.camera.anamorphicSqueeze`` (1 spherical): the horizontal focal length is F / squeeze
+    squeeze: float | None = None
+    #: ``lens.projectionOffset`` and ``lens.distortionOffset`` (mm on the sensor, OpenLensIO's x right,
+    #: y down): where the optical axis and the distortion centre land relative to the frame centre
+    projection_offset_mm: tuple[float, float] | None = None
+    distortion_offset_mm: tuple[float, float] | None = None
+    #: ``lens.encoders`` (normalised 0-1: focus 0 infinity, iris 0 open, zoom 0 wide), keys present only
+    encoders: dict | None = None
+    #: the sample's ``timing.timecode.dropFrame``
+    drop_frame: bool = False
 
     @property
     def source(self) -> tuple:
@@ -96,8 +106,46 @@ def rational(rate) -> dict:
     return {"num": fr.numerator, "denom": fr.denominator}
 
 
-def timecode_fields(frame: int, rate) -> dict:
-    """SMPTE timecode of the ``frame``-th sample (from 00:00:00:00) at ``rate``, non-drop-frame.
+def _drop_count(tc_rate: Fraction) -> int:
+    """Frame numbers a drop-frame timecode skips each minute (SMPTE ST 12-1: 2 at 30000/1001, 4 at
+    60000/1001); 0 where the rate has no drop-frame form."""
+    return {Fraction(30000, 1001): 2, Fraction(60000, 1001): 4}.get(tc_rate, 0)
+
+
+def _timecode_rate(fr: Fraction) -> tuple[int, Fraction, int]:
+    """(samples per timecode frame k, the timecode's rate, its nominal frames per second)."""
+    nominal = math.ceil(fr - Fraction(1, 10**6))
+    k = max(1, math.ceil(nominal / 60))  # samples per timecode frame
+    return k, fr / k, math.ceil(nominal / k)
+
+
+def parse_timecode(text, rate, drop_frame: bool = False) -> int:
+    """The timecode frame count of ``text`` ("HH:MM:SS:FF", ";" before FF for drop-frame) at ``rate``:
+    the number of timecode frames since 00:00:00:00 (a drop-frame label's skipped numbers not counted)."""
+    import re
+
+    fr = rate_fraction(rate)
+    _, tc_rate, per_s = _timecode_rate(fr)
+    m = re.fullmatch(r"(\d{1,2}):(\d{2}):(\d{2})([:;.])(\d{1,3})", str(text).strip())
+    if not m:
+        raise InputError(f"a timecode is HH:MM:SS:FF, got {text!r:.40}")
+    h, mi, se, ff = (int(m.group(i)) for i in (1, 2, 3, 5))
+    drop = drop_frame or m.group(4) == ";"
+    if h > 23 or mi > 59 or se > 59 or ff >= per_s:
+        raise InputError(f"timecode {text} is out of range at {per_s} frames a second")
+    d = _drop_count(tc_rate) if drop else 0
+    if drop and not d:
+        raise InputError(f"drop-frame timecode exists at 30000/1001 and 60000/1001 fps, not {tc_rate}")
+    if d and se == 0 and ff < d and mi % 10:
+        raise InputError(f"timecode {text} names a frame drop-frame counting skips")
+    minutes = 60 * h + mi
+    return (minutes * 60 + se) * per_s + ff - d * (minutes - minutes // 10)
+
+
+def timecode_fields(frame: int, rate, *, start: int = 0, drop_frame: bool = False) -> dict:
+    """SMPTE timecode of the ``frame``-th sample at ``rate``, ``start`` timecode frames after
+    00:00:00:00 (:func:`parse_timecode`), drop-frame counting when ``drop_frame`` (SMPTE ST 12-1:
+    the first 2 (4 at 59.94) frame numbers of each minute not divisible by ten are skipped).
 
     The timecode counts at the nominal integer rate; above 60 fps it counts frame pairs (or larger
     groups) and ``subFrame`` numbers the samples within one (the schema allows 120 frames a second).
@@ -105,21 +153,31 @@ def timecode_fields(frame: int, rate) -> dict:
     fr = rate_fraction(rate)
     if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) or frame < 0:
         raise InputError(f"frame must be a whole number >= 0, got {frame!r}")
-    nominal = math.ceil(fr - Fraction(1, 10**6))
-    k = max(1, math.ceil(nominal / 60))  # samples per timecode frame
-    tc_rate = fr / k
-    per_s = math.ceil(nominal / k)
+    if isinstance(start, bool) or not isinstance(start, (int, np.integer)) or start < 0:
+        raise InputError(f"the start timecode must be a whole number of frames >= 0, got {start!r}")
+    k, tc_rate, per_s = _timecode_rate(fr)
+    d = _drop_count(tc_rate) if drop_frame else 0
+    if drop_frame and not d:
+        raise InputError(f"drop-frame timecode exists at 30000/1001 and 60000/1001 fps, not {tc_rate}")
     f, sub = divmod(int(frame), k)
+    f += int(start)
+    if d:  # a drop-frame count to the label's frame number (skipped numbers added back)
+        per_10 = per_s * 600 - 9 * d
+        tens, rest = divmod(f, per_10)
+        f += 9 * d * tens + (d * ((rest - d) // (per_s * 60 - d)) if rest >= d else 0)
     total_s, frames = divmod(f, per_s)
     out = {"hours": (total_s // 3600) % 24, "minutes": (total_s // 60) % 60, "seconds": total_s % 60,
            "frames": frames, "frameRate": {"num": tc_rate.numerator, "denom": tc_rate.denominator}}
     if k > 1:
         out["subFrame"] = sub
+    if drop_frame:
+        out["dropFrame"] = True
     return out
 
 
 def _timecode_text(tc: dict) -> str:
-    text = f"{tc['hours']:02d}:{tc['minutes']:02d}:{tc['seconds']:02d}:{tc['frames']:02d}"
+    sep = ";" if tc.get("dropFrame") else ":"
+    text = f"{tc['hours']:02d}:{tc['minutes']:02d}:{tc['seconds']:02d}{sep}{tc['frames']:02d}"
     return text + (f".{tc['subFrame']}" if "subFrame" in tc else "")
 
 
@@ -227,7 +285,19 @@ def frame_from_sample(sample, *, static=None) -> TrackedFrame:
             if len(distortion.get(key, ())) > MAX_DISTORTION_TERMS:
                 raise InputError(f"lens.distortion[0].{key} has {len(distortion[key])} coefficients; physcam keeps "
                                  f"at most {MAX_DISTORTION_TERMS} (no lens model uses more)")
+    sq = st.get("camera", {}).get("anamorphicSqueeze")
+    squeeze = None if not sq else require_finite("anamorphicSqueeze", sq["num"] / sq["denom"])
+    if squeeze is not None and not 0.1 <= squeeze <= 10.0:
+        raise InputError(f"static.camera.anamorphicSqueeze {squeeze:g} is outside 0.1 to 10")
+
+    def offset(name):
+        v = lens.get(name)
+        return None if v is None else (require_finite(name, v["x"]), require_finite(name, v["y"]))
+    encoders = {k: float(v) for k, v in lens["encoders"].items()} if lens.get("encoders") else None
     return TrackedFrame(
+        squeeze=squeeze, projection_offset_mm=offset("projectionOffset"),
+        distortion_offset_mm=offset("distortionOffset"), encoders=encoders,
+        drop_frame=bool(timing.get("timecode", {}).get("dropFrame", False)),
         time_ns=time_ns, sequence_number=timing.get("sequenceNumber"), timecode=tc, rate=rate,
         translation_m=translation, rotation_deg=rotation,
         pinhole_focal_length_mm=lens.get("pinholeFocalLength"), focus_from_film_mm=mm("focusDistance"),
@@ -252,7 +322,8 @@ def static_block(*, sensor_mm, rate, lens_name=None, nominal_focal_length_mm=Non
 
     w, h = _pair("sensor size (mm)", sensor_mm)
     cam = {"activeSensorPhysicalDimensions": {"width": w, "height": h}, "captureFrameRate": rational(rate)}
-    sq = Fraction(require_finite("squeeze", squeeze)).limit_denominator(100)
+    # the effective squeeze of a real anamorphic breathes (1.9645 for a 2x at 3 m): kept to 1e-6
+    sq = Fraction(require_finite("squeeze", squeeze)).limit_denominator(1_000_000)
     cam["anamorphicSqueeze"] = {"num": sq.numerator, "denom": sq.denominator}
     if shutter_angle_deg is not None:
         cam["shutterAngle"] = require_finite("shutter angle", shutter_angle_deg)
@@ -272,9 +343,11 @@ def static_block(*, sensor_mm, rate, lens_name=None, nominal_focal_length_mm=Non
 
 
 def sample_from_frame(frame: TrackedFrame, *, source_id: str, sequence_number: int, frame_index: int | None = None,
-                      source_number: int = 1, static: dict | None = None, status: str = "physcam") -> dict:
+                      source_number: int = 1, static: dict | None = None, status: str = "physcam",
+                      start_timecode: int = 0) -> dict:
     """An OpenTrackIO sample carrying ``frame`` (module notes); ``frame_index`` numbers the timecode
-    (default ``sequence_number``), ``static`` is included when given."""
+    (default ``sequence_number``) from ``start_timecode`` (timecode frames, :func:`parse_timecode`;
+    drop-frame when ``frame.drop_frame``), ``static`` is included when given."""
     require_type("frame", frame, TrackedFrame, "build one with TrackedFrame(...)")
     if isinstance(sequence_number, bool) or not isinstance(sequence_number, int) or not 0 <= sequence_number < 2**32:
         raise InputError(f"sequence number must be a whole number 0..2^32-1, got {sequence_number!r}")
@@ -284,7 +357,8 @@ def sample_from_frame(frame: TrackedFrame, *, source_id: str, sequence_number: i
                                      "nanoseconds": frame.time_ns % 1_000_000_000}
     if frame.rate is not None:
         timing["sampleRate"] = rational(frame.rate)
-        timing["timecode"] = timecode_fields(sequence_number if frame_index is None else frame_index, frame.rate)
+        timing["timecode"] = timecode_fields(sequence_number if frame_index is None else frame_index, frame.rate,
+                                             start=start_timecode, drop_frame=frame.drop_frame)
     lens = {}
     m = lambda v: v / 1000.0  # noqa: E731 - mm to metres
     if frame.pinhole_focal_length_mm is not None:
@@ -299,6 +373,11 @@ def sample_from_frame(frame: TrackedFrame, *, source_id: str, sequence_number: i
         lens["entrancePupilOffset"] = m(float(frame.entrance_pupil_mm))
     if frame.distortion is not None:
         lens["distortion"] = [dict(frame.distortion)]
+    for key, v in (("projectionOffset", frame.projection_offset_mm), ("distortionOffset", frame.distortion_offset_mm)):
+        if v is not None:
+            lens[key] = {"x": float(v[0]), "y": float(v[1])}
+    if frame.encoders:
+        lens["encoders"] = {k: float(v) for k, v in frame.encoders.items()}
     x, y, z = (float(v) for v in frame.translation_m)
     pan, tilt, roll = (float(v) for v in frame.rotation_deg)
     out = {

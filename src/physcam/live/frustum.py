@@ -8,12 +8,21 @@ point (u, v) of the upright image (mm on the sensor, u right, v up) has the came
 edges (``samples_per_edge`` each, corners included) first hit the wall mesh (Möller-Trumbore ray /
 triangle intersection over every triangle, Möller & Trumbore, J. Graphics Tools 2(1), 1997).
 
-Overscan, stated per frame in the output:
+The frame's edges: OpenLensIO's screen point ε (mm on the sensor, x right, y down) looks along
+x/z = squeeze (ε_x - ΔP_x) / F and y/z = (ε_y - ΔP_y) / F (OpenLensIO 1.0.1 eq. 3 with the projection
+offset ΔP = ``projectionOffset``; an anamorphic's horizontal focal length is F / squeeze,
+``static.camera.anamorphicSqueeze``). The distortion offset ΔC moves only the distortion centre, not
+the frame, so the pinhole frustum does not use it.
 
-* ``overscan`` (a fraction): the inner frustum's half-widths are (1 + overscan) times the lens's
-  (``tan`` of the half-angle scales), the usual margin an LED stage renders around the camera view;
+Overscan, stated per frame in the output, about the centre of the frame's view in each axis:
+
+* ``overscan`` (a fraction) with ``overscan_mode``: ``"tangent"`` (default) widens each half-width's
+  **tangent** by (1 + overscan), the image plane grown by that factor (OpenLensIO's overscan factor Ω,
+  section 2.1); ``"ndisplay"`` multiplies the half-**angle** by (1 + overscan), as Unreal's nDisplay
+  inner-frustum overscan scales the camera's field of view (Epic, "In-Camera VFX" camera settings). At
+  10 % on a 40° view the two give 44.0° and 43.6°;
 * ``latency_s``: tracking latency. The camera turns ω rad/s (measured from this frame to the next)
-  while the wall still shows the old view; each half-angle is widened by ω x latency, so the picture
+  while the wall still shows the old view; each edge's angle is widened by ω x latency, so the picture
   the camera sees ``latency_s`` later is still inside the inner frustum.
 
 Coordinates: the wall and the camera are read in USD world space (scene units); the footprint is
@@ -32,7 +41,7 @@ import numpy as np
 
 from ..errors import InputError, require_finite
 
-__all__ = ["WallMesh", "wall_from_usd", "frustum_directions", "intersect_mesh", "FrustumFrame", "frustum_frames",
+__all__ = ["WallMesh", "wall_from_usd", "frustum_directions", "edge_directions", "frame_tangents", "intersect_mesh", "FrustumFrame", "frustum_frames",
            "write_frustum_usd", "write_wall"]
 
 #: a footprint polygon's points per frame edge: from 1 (corners only) to this
@@ -93,6 +102,53 @@ def wall_from_usd(file, path: str | None = None) -> WallMesh:
     if not np.all(np.isfinite(tri)):
         raise InputError(f"{p}: the wall mesh has points that are not finite")
     return WallMesh(tri, UsdGeom.GetStageMetersPerUnit(stage))
+
+
+def edge_directions(tan_u, tan_v, samples_per_edge: int = 8) -> np.ndarray:
+    """Camera-space directions (k, 3), z = -1, around the frame whose edges lie at the tangents
+    ``tan_u`` = (left, right) and ``tan_v`` = (bottom, top), counter-clockwise from the bottom-left."""
+    if isinstance(samples_per_edge, bool) or not isinstance(samples_per_edge, int) \
+            or not 1 <= samples_per_edge <= MAX_SAMPLES_PER_EDGE:
+        raise InputError(f"samples per edge must be 1..{MAX_SAMPLES_PER_EDGE}, got {samples_per_edge!r}")
+    (u0, u1), (v0, v1) = tan_u, tan_v
+    s = (np.linspace(-1.0, 1.0, samples_per_edge + 1)[:-1] + 1.0) / 2.0
+    edges = [np.c_[u0 + s * (u1 - u0), np.full_like(s, v0)], np.c_[np.full_like(s, u1), v0 + s * (v1 - v0)],
+             np.c_[u1 - s * (u1 - u0), np.full_like(s, v1)], np.c_[np.full_like(s, u0), v1 - s * (v1 - v0)]]
+    uv = np.concatenate(edges)
+    return np.c_[uv, np.full(len(uv), -1.0)]
+
+
+def frame_tangents(f_pin_mm, sensor_mm, squeeze: float = 1.0, projection_offset_mm=(0.0, 0.0)):
+    """((left, right), (bottom, top)) tangents of the frame's edges seen from the pupil (module notes:
+    squeeze (ε_x - ΔP_x) / F across, (ε_up + ΔP_y) / F up, ΔP in OpenLensIO's y-down screen)."""
+    from .frames import _pair
+
+    f = require_finite("pinhole focal length", f_pin_mm)
+    if f <= 0:
+        raise InputError(f"pinhole focal length must be > 0 mm, got {f:g}")
+    w, h = _pair("sensor size (mm)", sensor_mm)
+    dx, dy = _pair("projection offset (mm)", projection_offset_mm)
+    sq = require_finite("anamorphic squeeze", squeeze)
+    if not 0.1 <= sq <= 10.0:
+        raise InputError(f"anamorphic squeeze must lie between 0.1 and 10, got {sq:g}")
+    return ((sq * (-w / 2 - dx) / f, sq * (w / 2 - dx) / f), ((-h / 2 + dy) / f, (h / 2 + dy) / f))
+
+
+def _overscan(lo_hi, pad, o, mode):
+    """Edge tangents (lo, hi) widened by the latency margin ``pad`` (rad, each edge) and the overscan
+    ``o`` about the view's centre, by tangent or by angle (module notes)."""
+    a_lo, a_hi = math.atan(lo_hi[0]) - pad, math.atan(lo_hi[1]) + pad
+    if mode == "ndisplay":
+        c, half = (a_lo + a_hi) / 2, (a_hi - a_lo) / 2 * (1 + o)
+        a_lo, a_hi = c - half, c + half
+        if a_lo <= -math.pi / 2 or a_hi >= math.pi / 2:
+            return None
+        return math.tan(a_lo), math.tan(a_hi)
+    if a_lo <= -math.pi / 2 or a_hi >= math.pi / 2:
+        return None
+    t_lo, t_hi = math.tan(a_lo), math.tan(a_hi)
+    c, half = (t_lo + t_hi) / 2, (t_hi - t_lo) / 2 * (1 + o)
+    return c - half, c + half
 
 
 def frustum_directions(f_pin_mm, sensor_mm, samples_per_edge: int = 8, widen=(1.0, 1.0)) -> np.ndarray:
@@ -159,6 +215,8 @@ class FrustumFrame:
     pad_deg: float
     footprint: np.ndarray
     missed: int
+    #: ((left, right), (bottom, top)) tangents of the widened frustum's edges (camera space)
+    tangents: tuple = ((0.0, 0.0), (0.0, 0.0))
 
 
 def _angle_between(r0, r1) -> float:
@@ -167,9 +225,11 @@ def _angle_between(r0, r1) -> float:
 
 
 def frustum_frames(frames, wall: WallMesh, *, overscan: float = 0.1, latency_s: float = 0.0,
-                   samples_per_edge: int = 8, meters_per_unit: float | None = None) -> list[FrustumFrame]:
+                   samples_per_edge: int = 8, meters_per_unit: float | None = None,
+                   overscan_mode: str = "tangent") -> list[FrustumFrame]:
     """The inner frustum of each tracked frame (:class:`~physcam.live.frames.TrackedFrame`, e.g. from
-    :func:`physcam.live.usd_io.frames_from_usd`) on ``wall`` (module notes)."""
+    :func:`physcam.live.usd_io.frames_from_usd`) on ``wall`` (module notes); ``overscan_mode``
+    "tangent" or "ndisplay"."""
     from .frames import TrackedFrame, rotation_matrix
 
     if not isinstance(wall, WallMesh):
@@ -185,6 +245,8 @@ def frustum_frames(frames, wall: WallMesh, *, overscan: float = 0.1, latency_s: 
     lat = require_finite("latency", latency_s)
     if not 0.0 <= o <= 10.0 or not 0.0 <= lat <= 10.0:
         raise InputError("overscan must lie in [0, 10] (a fraction) and latency in [0, 10] s")
+    if overscan_mode not in ("tangent", "ndisplay"):
+        raise InputError(f"overscan mode is tangent or ndisplay, got {overscan_mode!r}")
     mpu = wall.meters_per_unit if meters_per_unit is None else require_finite("meters per unit", meters_per_unit)
     c = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])  # OpenTrackIO stage -> USD Y-up
     rots = [c @ rotation_matrix(*f.rotation_deg) @ c.T for f in frames]
@@ -201,21 +263,23 @@ def frustum_frames(frames, wall: WallMesh, *, overscan: float = 0.1, latency_s: 
         omega = _angle_between(rots[k], rots[j]) / dt if j != k else 0.0
         pad = omega * lat
         f_pin, (w, h) = f.pinhole_focal_length_mm, f.sensor_mm
-        half_u, half_v = math.atan(w / 2 / f_pin), math.atan(h / 2 / f_pin)
-        if half_u + pad >= math.pi / 2 or half_v + pad >= math.pi / 2:
-            raise InputError(f"frame {i}: the latency margin opens the frustum past 180 degrees")
-        widen = ((1 + o) * math.tan(half_u + pad) / math.tan(half_u), (1 + o) * math.tan(half_v + pad) / math.tan(half_v))
+        tu, tv = frame_tangents(f_pin, (w, h), 1.0 if f.squeeze is None else f.squeeze,
+                                f.projection_offset_mm or (0.0, 0.0))
+        tu_w, tv_w = _overscan(tu, pad, o, overscan_mode), _overscan(tv, pad, o, overscan_mode)
+        if tu_w is None or tv_w is None:
+            raise InputError(f"frame {i}: the overscan and latency margin open the frustum past 180 degrees")
+        widen = ((tu_w[1] - tu_w[0]) / (tu[1] - tu[0]), (tv_w[1] - tv_w[0]) / (tv[1] - tv[0]))
         film = c @ np.asarray(f.translation_m) / mpu
         eye_mm = f.entrance_pupil_mm or 0.0
         pupil = film + rots[i] @ np.array([0.0, 0.0, -eye_mm / 1000.0 / mpu])
-        dirs = frustum_directions(f_pin, (w, h), samples_per_edge, widen) @ rots[i].T
+        dirs = edge_directions(tu_w, tv_w, samples_per_edge) @ rots[i].T
         dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
         t = intersect_mesh(pupil, dirs, wall.triangles)
         missed = int(np.isinf(t).sum())
         t = np.where(np.isinf(t), wall.size, t)
         fc = round(float(times[i] * rate), 6)
         out.append(FrustumFrame(fc, pupil, rots[i], f_pin, (w, h), widen, math.degrees(pad),
-                                pupil + t[:, None] * dirs, missed))
+                                pupil + t[:, None] * dirs, missed, (tu_w, tv_w)))
     return out
 
 
@@ -258,8 +322,11 @@ def write_frustum_usd(file, frustum, *, meters_per_unit: float, fps: float, forc
         q = Gf.Matrix3d(*fr.rotation.T.flatten().tolist()).ExtractRotation().GetQuat()
         op_m.Set(Gf.Quatd(q.GetReal(), Gf.Vec3d(q.GetImaginary())), t)
         cam.GetFocalLengthAttr().Set(tenths(fr.f_pin_mm), t)
-        cam.GetHorizontalApertureAttr().Set(tenths(fr.sensor_mm[0] * fr.widen[0]), t)
-        cam.GetVerticalApertureAttr().Set(tenths(fr.sensor_mm[1] * fr.widen[1]), t)
+        (u0, u1), (v0, v1) = fr.tangents
+        cam.GetHorizontalApertureAttr().Set(tenths((u1 - u0) * fr.f_pin_mm), t)
+        cam.GetVerticalApertureAttr().Set(tenths((v1 - v0) * fr.f_pin_mm), t)
+        cam.GetHorizontalApertureOffsetAttr().Set(tenths((u0 + u1) / 2 * fr.f_pin_mm), t)
+        cam.GetVerticalApertureOffsetAttr().Set(tenths((v0 + v1) / 2 * fr.f_pin_mm), t)
         curve.GetPointsAttr().Set(Vt.Vec3fArray([Gf.Vec3f(*map(float, p)) for p in fr.footprint]), t)
         a_miss.Set(int(fr.missed), t)
         a_widen.Set(Gf.Vec2d(*fr.widen), t)

@@ -17,6 +17,11 @@ a focus pull):
   ``focalLength`` and ``focusDistance`` (mm, from the film plane);
 * the companion UsdGeomCamera: ``focalLength`` (the best-match pinhole), apertures, ``fStop``,
   ``focusDistance`` (from the pupil), ``exposure:fStop`` (the T-stop) and its eye on the pupil;
+* the anamorphic squeeze and lens shift: ``physcam:live:anamorphicSqueeze`` (the lens model's
+  ``squeeze`` too), ``physcam:live:projectionOffset`` and ``physcam:live:distortionOffset``
+  (OpenLensIO's ΔP and ΔC, mm, x right, y down, as streamed), and the PhysicalCamera's
+  ``sensor:main:shift`` / the companion's aperture offsets (physcam's shift, + right, + up:
+  (-ΔPx, ΔPy));
 * distortion: the streamed Brown-Conrady coefficients as custom attributes on the PhysicalCamera
   (``physcam:live:distortion*``, OpenTrackIO's millimetre form) and, on the companion, Omniverse's
   ``OmniLensDistortionOpenCvPinholeAPI`` (OpenCV's normalised form, :mod:`physcam.live.lens_data`);
@@ -57,7 +62,8 @@ REPORT_COLUMNS = ("frame", "time_code", "timecode", "sequence_number", "focus_fr
                   "pinhole_focal_length_mm", "dof_focal_length_mm", "fstop", "tstop", "entrance_pupil_from_film_mm",
                   "near_from_film_mm", "far_from_film_mm", "hyperfocal_from_film_mm", "hfov_deg", "vfov_deg",
                   "dfov_deg", "coc_mm", "x_m", "y_m", "z_m", "pan_deg", "tilt_deg", "roll_deg", "source_id",
-                  "carried_over", "defaulted")
+                  "carried_over", "defaulted", "squeeze", "projection_offset_x_mm", "projection_offset_y_mm",
+                  "focus_from_pupil_mm", "from_encoders")
 
 
 @dataclass(frozen=True)
@@ -71,6 +77,12 @@ class SolvedFrame:
     report: object
     carried: tuple[str, ...] = ()
     defaulted: tuple[str, ...] = ()
+    #: the values this frame's lens encoders gave through the FIZ table (OpenTrackIO names)
+    from_encoders: tuple[str, ...] = ()
+    #: (anamorphic squeeze, projection offset mm (x right, y down), distortion offset mm) it used
+    squeeze: float = 1.0
+    projection_offset_mm: tuple[float, float] = (0.0, 0.0)
+    distortion_offset_mm: tuple[float, float] = (0.0, 0.0)
 
 
 #: the values a frame may leave out: (key, OpenTrackIO name, TrackedFrame attribute)
@@ -78,7 +90,9 @@ CARRIED_VALUES = (("pinhole", "pinholeFocalLength", "pinhole_focal_length_mm"), 
                   ("focus", "focusDistance", "focus_from_film_mm"), ("tstop", "tStop", "tstop"),
                   ("pupil", "entrancePupilOffset", "entrance_pupil_mm"),
                   ("sensor", "activeSensorPhysicalDimensions", "sensor_mm"),
-                  ("nominal", "nominalFocalLength", "nominal_focal_length_mm"))
+                  ("nominal", "nominalFocalLength", "nominal_focal_length_mm"),
+                  ("squeeze", "anamorphicSqueeze", "squeeze"), ("projection", "projectionOffset", "projection_offset_mm"),
+                  ("distortion_offset", "distortionOffset", "distortion_offset_mm"))
 CARRY_OVER_NOTE = ("a value a sample leaves out is carried over from the latest earlier sample of the same source "
                    "(sourceId, sourceNumber), never from another source; physcam:live:carriedOver names them per "
                    "time sample, physcam:live:defaulted those given on the command line")
@@ -155,7 +169,7 @@ def time_codes(frames, rate=None) -> tuple[list[float], Fraction]:
 
 
 def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=None, focus_mm=None,
-                 coc=None, refused: list | None = None) -> list[SolvedFrame]:
+                 coc=None, refused: list | None = None, lens=None, fiz=None) -> list[SolvedFrame]:
     """Each frame with its time code and lens report (module notes).
 
     Values a frame does not carry come from the latest earlier frame **of the same source** (its
@@ -164,6 +178,14 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     ``focal_length_mm`` (pinhole), ``fstop``, ``focus_mm`` (from the film plane); each
     :class:`SolvedFrame` names them (``carried``, ``defaulted``). Frames whose time code does not
     increase are dropped with a warning.
+
+    ``fiz`` (a :class:`~physcam.live.fiz.FizTable`) turns a frame's ``lens.encoders`` into the focus
+    mark, f-stop and focal length it does not send itself (``from_encoders`` names them); ``lens`` (a
+    :class:`~physcam.lens.prescription.Prescription`) solves a frame that sends no pinhole focal
+    length through the named lens at its focus: breathing pinhole, entrance pupil and squeeze from
+    the prescription, as ``physcam lens breathing`` computes them. The anamorphic squeeze
+    (``static.camera.anamorphicSqueeze``) widens the horizontal field: F / squeeze is the horizontal
+    focal length.
 
     A frame that cannot be solved (a value out of range, :func:`frame_problem`, or one its source
     never gave) raises, unless ``refused`` is a list: then it is left out, ``(index, reason)`` is
@@ -179,7 +201,16 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
         raise InputError(f"refused must be a list to append the refused frames to, got {type(refused).__name__}")
     codes, _ = time_codes(frames, rate)
     defaults = {"pinhole": focal_length_mm, "fstop": fstop, "focus": focus_mm, "tstop": None, "pupil": None,
-                "sensor": None if sensor is None else (sensor.width_mm, sensor.height_mm), "nominal": None}
+                "sensor": None if sensor is None else (sensor.width_mm, sensor.height_mm), "nominal": None,
+                "squeeze": None, "projection": None, "distortion_offset": None}
+    if lens is not None:
+        from ..lens.prescription import Prescription
+
+        require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name)")
+    if fiz is not None:
+        from .fiz import FizTable
+
+        require_type("fiz", fiz, FizTable, "physcam.live.fiz.read_fiz_table(file)")
     held: dict = {}  # per source: the values its frames sent, the latest of each
     sensors: dict = {}
     out: list[SolvedFrame] = []
@@ -188,6 +219,14 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     for i, (f, t) in enumerate(zip(frames, codes)):
         mine = held.setdefault(f.source, {})
         sent = {key: getattr(f, attr) for key, _, attr in CARRIED_VALUES if getattr(f, attr) is not None}
+        try:
+            encoded = _from_encoders(f, fiz, sent)
+        except PhysCamError as exc:
+            if refused is None:
+                raise type(exc)(f"frame {i}: {exc}") from None
+            refused.append((i, f"frame {i}: {exc}"))
+            continue
+        sent.update(encoded)
         if t <= previous:
             skipped += 1
             mine.update(sent)
@@ -202,7 +241,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
             elif defaults[key] is not None:
                 defaulted.append(name)
         try:
-            report = _solve_one(f, last, sensor, sensors, coc, solve_lens_report, custom_sensor)
+            report = _solve_one(f, last, sensor, sensors, coc, solve_lens_report, custom_sensor, lens)
         except PhysCamError as exc:
             where = f"frame {i} (timecode {f.timecode})" if f.timecode else f"frame {i}"
             if refused is None:
@@ -211,37 +250,64 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
             continue
         mine.update(sent)
         previous = t
-        out.append(SolvedFrame(f, t, report, tuple(carried), tuple(defaulted)))
+        names = dict((k, n) for k, n, _ in CARRIED_VALUES)
+        out.append(SolvedFrame(f, t, report, tuple(carried), tuple(defaulted),
+                               tuple(names[k] for k in encoded), float(report.pinhole[1]),
+                               tuple(last["projection"] or (0.0, 0.0)), tuple(last["distortion_offset"] or (0.0, 0.0))))
     if skipped:
         warnings.warn(f"{skipped} samples did not advance in time and were left out", PhysCamWarning, stacklevel=2)
     return out
 
 
-def _solve_one(f, last, sensor, sensors, coc, solve_lens_report, custom_sensor):
-    """The lens report of frame ``f`` with the values ``last`` (its own, carried over or defaults)."""
-    missing = [n for n, k in (("a pinhole focal length (pinholeFocalLength, --focal)", "pinhole"),
+def _from_encoders(f, fiz, sent) -> dict:
+    """The values frame ``f``'s encoders give through the FIZ table ``fiz`` that it does not send."""
+    if fiz is None or not f.encoders:
+        return {}
+    out = {}
+    enc = f.encoders
+    if "focus" in enc and "focus" not in sent and fiz.has("focus"):
+        mark = fiz.focus_mm(enc["focus"])
+        if not math.isfinite(mark):
+            raise InputError("the focus encoder reads infinity; physcam records a focus mark in front of the film")
+        out["focus"] = mark
+    if "iris" in enc and "fstop" not in sent and fiz.has("iris"):
+        out["fstop"] = fiz.fstop(enc["iris"])
+    if "zoom" in enc and "nominal" not in sent and fiz.has("zoom"):
+        out["nominal"] = fiz.focal_length_mm(enc["zoom"])
+    return out
+
+
+def _solve_one(f, last, sensor, sensors, coc, solve_lens_report, custom_sensor, lens=None):
+    """The lens report of frame ``f`` with the values ``last`` (its own, carried over or defaults);
+    with ``lens`` and no streamed pinhole, the prescription's at the frame's focus."""
+    need_pinhole = lens is None or last["pinhole"] is not None
+    missing = [n for n, k in (("a pinhole focal length (pinholeFocalLength, --focal, --lens)", "pinhole"),
                               ("an f-stop (fStop, --fstop)", "fstop"),
                               ("a focus distance (focusDistance, --focus)", "focus"),
                               ("a sensor size (static.camera.activeSensorPhysicalDimensions, --sensor)", "sensor"))
-               if last[k] is None]
+               if last[k] is None and (k != "pinhole" or need_pinhole)]
     if missing:
         raise InputError(f"the stream does not give {', '.join(missing)}; give it on the command line")
-    problem = frame_problem(f, float(last["pinhole"]))
+    problem = frame_problem(f, None if last["pinhole"] is None else float(last["pinhole"]))
     if problem:
         raise InputError(problem)
     key = tuple(last["sensor"])
     if key not in sensors:
         sensors[key] = sensor if sensor is not None and (sensor.width_mm, sensor.height_mm) == key \
             else custom_sensor(*key)
-    pin = float(last["pinhole"])
-    f_dof = float(last["nominal"]) if last["nominal"] is not None else pin
     tstop = last["tstop"]
     if tstop is not None and tstop < last["fstop"]:
         tstop = None  # a T-stop faster than the f-stop is not physical; the report would refuse it
+    if last["pinhole"] is None:  # the named lens at this focus: its breathing, pupil and squeeze
+        return solve_lens_report(focal_length_mm=None, sensor=sensors[key], fstop=float(last["fstop"]),
+                                 focus_mm=float(last["focus"]), coc=coc, tstop=tstop, lens=lens)
+    pin = float(last["pinhole"])
+    sq = 1.0 if last["squeeze"] is None else float(last["squeeze"])
+    f_dof = float(last["nominal"]) if last["nominal"] is not None else pin
     return solve_lens_report(focal_length_mm=f_dof, sensor=sensors[key], fstop=float(last["fstop"]),
                              focus_mm=float(last["focus"]), coc=coc, tstop=tstop,
                              pupil_mm=None if last["pupil"] is None else float(last["pupil"]),
-                             pinhole_focal_length_mm=pin)
+                             pinhole_focal_length_mm=pin, squeeze=sq, pinhole_squeeze=sq)
 
 
 def _usd_from_stage(v, mpu):
@@ -280,7 +346,7 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
     stage.SetStartTimeCode(solved[0].time_code)
     stage.SetEndTimeCode(solved[-1].time_code)
     s0 = solved[0]
-    spec0 = spec_from_report(s0.report, shutter_duration_s=shutter)
+    spec0 = spec_from_report(s0.report, shutter_duration_s=shutter, shift_mm=_shift(s0))
     cam = author_camera(stage, path, spec0, report=s0.report)
     cam.SetCustomDataByKey("physcam:source", "OpenTrackIO stream recorded by physcam live record")
     cam.SetCustomDataByKey("physcam:live:carryOver", CARRY_OVER_NOTE)
@@ -303,12 +369,22 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
     a_model = cam.CreateAttribute("physcam:live:distortionModel", Sdf.ValueTypeNames.String, True)
     a_radial = cam.CreateAttribute("physcam:live:distortionRadial", Sdf.ValueTypeNames.DoubleArray, True)
     a_tang = cam.CreateAttribute("physcam:live:distortionTangential", Sdf.ValueTypeNames.DoubleArray, True)
+    a_squeeze = cam.CreateAttribute("physcam:live:anamorphicSqueeze", Sdf.ValueTypeNames.Double, True)
+    a_proj = cam.CreateAttribute("physcam:live:projectionOffset", Sdf.ValueTypeNames.Double2, True)
+    a_doff = cam.CreateAttribute("physcam:live:distortionOffset", Sdf.ValueTypeNames.Double2, True)
+    a_shift = cam.GetAttribute("sensor:main:shift")
     omni = None
     c = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])  # OpenTrackIO stage -> USD Y-up
     for s in solved:
         f, t, report = s.frame, s.time_code, s.report
-        spec = spec_from_report(report, shutter_duration_s=shutter)
+        spec = spec_from_report(report, shutter_duration_s=shutter, shift_mm=_shift(s))
         eye = spec.entrance_pupil_mm
+        a_squeeze.Set(float(s.squeeze), t)
+        a_proj.Set(Gf.Vec2d(*s.projection_offset_mm), t)
+        a_doff.Set(Gf.Vec2d(*s.distortion_offset_mm), t)
+        if a_shift:
+            a_shift.Set(Gf.Vec2f(*spec.shift_mm), t)
+        model.GetAttribute("squeeze").Set(float(spec.squeeze), t)
         rot = c @ rotation_matrix(*f.rotation_deg) @ c.T
         film = np.array(_usd_from_stage(f.translation_m, mpu))
         pupil = film + rot @ np.array([0.0, 0.0, -su(eye)])
@@ -341,6 +417,13 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
             a_tang.Set(Vt.DoubleArray([float(v) for v in d.get("tangential", [])]), t)
             omni = _omni_sample(geom.GetPrim(), omni, d, report, resolution, t)
     return save_stage(stage, file, force=force)
+
+
+def _shift(solved: SolvedFrame) -> tuple[float, float]:
+    """physcam's lens shift (mm, + right, + up: the view moves) of OpenLensIO's projection offset
+    ΔP (where the optical axis lands, x right, y down): (-ΔPx, ΔPy)."""
+    dx, dy = solved.projection_offset_mm
+    return (-dx + 0.0, dy + 0.0)
 
 
 def _omni_sample(prim, attrs, distortion, report, resolution, t):
@@ -392,6 +475,11 @@ def lens_report_rows(solved) -> list[dict]:
             "x_m": f.translation_m[0], "y_m": f.translation_m[1], "z_m": f.translation_m[2],
             "pan_deg": f.rotation_deg[0], "tilt_deg": f.rotation_deg[1], "roll_deg": f.rotation_deg[2],
             "source_id": f.source_id, "carried_over": list(s.carried), "defaulted": list(s.defaulted),
+            "squeeze": s.squeeze, "projection_offset_x_mm": s.projection_offset_mm[0],
+            "projection_offset_y_mm": s.projection_offset_mm[1],
+            "focus_from_pupil_mm": None if r.entrance_pupil_from_film_mm is None
+            else r.focus_from_film_mm - r.entrance_pupil_from_film_mm,
+            "from_encoders": list(s.from_encoders),
         })
     return rows
 

@@ -3,7 +3,8 @@
 The schema is SMPTE RIS-OSVP's ``opentrackio-schema-1.0.1.json`` (draft 2020-12), shipped as
 ``physcam/data/opentrackio-schema-1.0.1.json`` and checked by :mod:`jsonschema`'s
 ``Draft202012Validator``, a complete implementation of the draft (docs/live.md says why this
-library). A sample that fails is reported by its JSON path (``$.lens.fStop``) and the schema rule it
+library), plus one rule the schema cannot state and camdkit's model checks: a timecode's ``frames``
+is below its ``frameRate`` (rounded up). A sample that fails is reported by its JSON path (``$.lens.fStop``) and the schema rule it
 broke (``exclusiveMinimum``), the first problem first in document order.
 
 Numbers that JSON cannot carry (NaN, Infinity) and CBOR can are refused too, with their path, and so
@@ -143,7 +144,7 @@ def sample_problems(sample) -> list[SampleProblem]:
         return [bad]
     v = _validator()
     if v.is_valid(sample):
-        return []
+        return _timecode_problems(sample)
     out = []
     for e in sorted(v.iter_errors(sample), key=_order_key):
         # anyOf/oneOf name the branch that came closest; report it where it is more precise
@@ -154,6 +155,21 @@ def sample_problems(sample) -> list[SampleProblem]:
             best = jsonschema.exceptions.best_match([e]) or e
         out.append(SampleProblem(json_path(best.absolute_path), str(best.validator), best.message))
     return out
+
+
+def _timecode_problems(sample) -> list[SampleProblem]:
+    """A valid sample's timecode counting a frame its own rate never reaches: frames must be below
+    ceil(frameRate) (camdkit's ``Timecode`` model refuses the rest; the schema alone allows 0-119)."""
+    from fractions import Fraction
+
+    tc = sample.get("timing", {}).get("timecode")
+    if not tc:
+        return []
+    limit = math.ceil(Fraction(tc["frameRate"]["num"], tc["frameRate"]["denom"]))
+    if tc["frames"] >= limit:
+        return [SampleProblem("$.timing.timecode.frames", "frameRate",
+                              f"frame {tc['frames']} does not exist at {limit} frames a second (0 to {limit - 1})")]
+    return []
 
 
 def validate_sample(sample) -> dict:

@@ -7,7 +7,9 @@ docs/usd.md), turned into OpenTrackIO's Z-up stage ((x, y, z) = USD's (x, -z, y)
 a Z-up stage is read as it is) and into pan/tilt/roll. Lens values are the PhysicalCamera's own
 (mm): ``lens:main:pinholeFocalLength`` (else the lens model's focal length), the lens model's
 ``focusDistance``, ``lens:main:fStop``, ``lens:main:entrancePupilDistance``, the sensor aperture,
-and the recorded ``physcam:live:*`` attributes when present.
+and the recorded ``physcam:live:*`` attributes when present: ``anamorphicSqueeze`` (else the lens
+model's ``squeeze``), ``projectionOffset`` and ``distortionOffset`` (else the projection offset of the
+PhysicalCamera's ``sensor:main:shift``: (-shift x, shift y), docs/live.md).
 """
 
 from __future__ import annotations
@@ -89,6 +91,10 @@ def frames_from_usd(file, path: str | None = None, *, max_frames: int = 144_000)
     a_seq, a_tc = get("physcam:live:sequenceNumber"), get("physcam:live:timecode")
     a_model, a_rad, a_tan = (get("physcam:live:distortionModel"), get("physcam:live:distortionRadial"),
                              get("physcam:live:distortionTangential"))
+    a_sq, a_proj, a_doff = (get("physcam:live:anamorphicSqueeze"), get("physcam:live:projectionOffset"),
+                            get("physcam:live:distortionOffset"))
+    a_model_sq = model.GetAttribute("squeeze") if model else None
+    a_shift = get("sensor:main:shift")
     times = _times(cam, [a_pin, a_fstop, a_pupil, a_focal, a_focus, a_seq])
     if len(times) > max_frames:
         raise InputError(f"{p}: {len(times)} time samples; at most {max_frames}")
@@ -123,6 +129,14 @@ def frames_from_usd(file, path: str | None = None, *, max_frames: int = 144_000)
                 dist["tangential"] = [float(v) for v in tang]
         ap = val(a_ap, t)
         seq = val(a_seq, t)
+        sq = val(a_sq, t)
+        sq = val(a_model_sq, t) if sq is None else sq
+        proj, doff = val(a_proj, t), val(a_doff, t)
+        if proj is None and val(a_shift, t) is not None:
+            shift = val(a_shift, t)
+            proj = (-float(shift[0]), float(shift[1])) if any(shift) else None
+        proj = None if proj is None else (float(proj[0]) + 0.0, float(proj[1]) + 0.0)
+        doff = None if doff is None else (float(doff[0]), float(doff[1]))
         out.append(TrackedFrame(
             time_ns=int(round((t - t0) / tcps * 1e9)), sequence_number=None if seq is None else int(seq),
             timecode=val(a_tc, t) or None, rate=rate,
@@ -132,5 +146,6 @@ def frames_from_usd(file, path: str | None = None, *, max_frames: int = 144_000)
             fstop=None if val(a_fstop, t) is None else float(val(a_fstop, t)),
             entrance_pupil_mm=None if val(a_pupil, t) is None else float(val(a_pupil, t)),
             distortion=dist, sensor_mm=None if ap is None else (float(ap[0]), float(ap[1])),
-            nominal_focal_length_mm=None if val(a_focal, t) is None else float(val(a_focal, t))))
+            nominal_focal_length_mm=None if val(a_focal, t) is None else float(val(a_focal, t)),
+            squeeze=None if sq is None else float(sq), projection_offset_mm=proj, distortion_offset_mm=doff))
     return out

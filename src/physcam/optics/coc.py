@@ -20,7 +20,7 @@ import math
 
 from ..errors import InputError, require_positive
 
-__all__ = ["COC_CONVENTIONS", "DEFAULT_COC_CONVENTION", "circle_of_confusion"]
+__all__ = ["COC_CONVENTIONS", "DEFAULT_COC_CONVENTION", "circle_of_confusion", "parse_coc"]
 
 #: name -> (description, function of (width_mm, height_mm) -> coc_mm)
 COC_CONVENTIONS = {
@@ -65,3 +65,22 @@ def circle_of_confusion(width_mm: float, height_mm: float, convention: str | flo
             f"use one of {', '.join(COC_CONVENTIONS)} or a value in mm"
         ) from None
     return require_positive("circle of confusion", value), "user"
+
+
+def parse_coc(text):
+    """A circle of confusion as written by a person: a convention name (``d/1500``, ``cine``, ...)
+    stays text (checked by :func:`circle_of_confusion` against the sensor); a number with an
+    optional unit (``0.025``, ``25um``, ``0.025mm``; a bare number is mm) becomes a float in mm.
+    A malformed length is an InputError; None stays None."""
+    from ..units import parse_distance
+
+    if text is None:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    t = str(text).strip()
+    if t and (t[0].isdigit() or t[0] in ".+-") and "/" not in t:
+        return parse_distance(t, name="circle of confusion")
+    return text

@@ -232,6 +232,10 @@ def dispersion(nd: float, vd: float, glass: str | None = None, catalog: str | No
 
 def medium_dispersion(medium) -> Dispersion:
     """:func:`dispersion` of a :class:`~physcam.lens.prescription.Medium` (all its fields)."""
+    from ..errors import require_type
+    from ..lens.prescription import Medium
+
+    require_type("medium", medium, Medium, "a Medium(nd, vd, glass=...) of a prescription's surface")
     return dispersion(medium.nd, medium.vd, medium.glass, medium.catalog, medium.dpgf)
 
 

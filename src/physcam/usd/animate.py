@@ -26,7 +26,7 @@ from pathlib import Path
 
 from ..errors import ExportError, InputError, LensFileError, PhysCamWarning, require_finite
 
-__all__ = ["FocusKey", "read_focus_marks", "write_animated_camera"]
+__all__ = ["FocusKey", "read_focus_marks", "write_animated_camera", "ntsc_rate"]
 
 #: The most frames one animated camera holds (a 10-minute take at 48 fps), bounded before any work.
 MAX_FRAMES = 28_800
@@ -95,6 +95,20 @@ def _check_keys(keys) -> list[FocusKey]:
     return keys
 
 
+def ntsc_rate(fps) -> float:
+    """``fps`` as the stage's timeCodesPerSecond: an NTSC rate given to three decimals (23.976,
+    29.97, 59.94, 119.88) is the exact N x 1000/1001 (24000/1001 = 23.976023...), as a recording of a
+    stream at that rate writes it (:func:`physcam.live.frames.rate_fraction`), so the two line up frame
+    for frame; other rates are kept as given."""
+    rate = require_finite("frames per second", fps)
+    if rate <= 0:
+        raise InputError(f"frames per second must be > 0, got {rate:g}")
+    n = round(rate * 1.001)
+    if abs(rate * 1.001 - n) < 5e-4 and abs(rate - n) > 1e-6:
+        return n * 1000 / 1001
+    return rate
+
+
 def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: float | None = None,
                           fstop: float | None = None, coc=None, path: str = "/Cameras/Camera",
                           meters_per_unit: float = 0.01, fps: float = 24.0, shutter_angle_deg: float = 180.0,
@@ -117,9 +131,7 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     if not 0.0 < require_finite("shutter angle", shutter_angle_deg) <= 360.0:
         raise InputError(f"shutter angle must be in (0, 360] degrees, got {shutter_angle_deg:g}")
     mpu = require_meters_per_unit(meters_per_unit)
-    rate = require_finite("frames per second", fps)
-    if rate <= 0:
-        raise InputError(f"frames per second must be > 0, got {rate:g}")
+    rate = ntsc_rate(fps)
 
     frames = []
     seen_notes: set[str] = set()

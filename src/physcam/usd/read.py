@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..errors import ExportError
-from .author import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec
+from .spec import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec
 from .plugin import ensure_registered, require_prim, require_stage
 
 __all__ = ["CameraReading", "find_cameras", "open_stage", "read_camera", "read_prescription", "composed_prescription",
@@ -34,7 +34,7 @@ class CameraReading:
 
     def report(self):
         """The on-set lens report of this camera (practical thin-lens model)."""
-        from .author import report_for_spec
+        from .spec import report_for_spec
 
         return report_for_spec(self.spec)
 

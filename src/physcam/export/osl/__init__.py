@@ -80,6 +80,11 @@ def _resolve(lines: list[str], on: set[str]) -> list[str]:
 def render_template(defines: list[str], data: list[str]) -> str:
     """The shader: the template with ``defines`` and ``data`` in place and its switches resolved
     (a ``#define NAME`` line in ``defines`` switches NAME on)."""
+    for name, lines in (("defines", defines), ("data", data)):
+        if isinstance(lines, str) or not all(isinstance(ln, str) for ln in lines):
+            from ...errors import WrongTypeError
+
+            raise WrongTypeError(f"{name} must be a list of OSL lines (text), got {lines!r:.60}")
     on = {ln.split()[1] for ln in defines if ln.startswith("#define ") and ln.split()[1] in FEATURES}
     out = []
     for line in template_text().splitlines():
@@ -96,7 +101,11 @@ def lens_data(table, aperture, wavelength_nm: float, bounds, *, dispersion: bool
     """The defines and the data lines that do not change with focus: surface kinds, quadric and
     asphere coefficients, indices (or dispersion coefficients), Fresnel scales and the iris shape
     (``aperture``; in a focus-table shader the iris is the shader's parameters, pass None). ``table``: a :func:`physcam.trace.surfaces.surface_table` (film side first)."""
+    from ...errors import require_type
     from ...trace.kernels._layout import NA, NB, SA, SB, index_rows, pack
+    from ...trace.surfaces import SurfaceTable
+
+    require_type("table", table, SurfaceTable, "physcam.trace.surfaces.surface_table(lens)")
 
     n = len(table)
     S, kinds = pack(table)
