@@ -215,7 +215,7 @@ def _way_forward(path: Path, s: str) -> str:
     import warnings
 
     from ..errors import PhysCamError
-    from .check import read_raw
+    from .raw import read_raw
 
     try:
         read_raw(path)
