@@ -10,8 +10,10 @@ The lenses are built here from the same numbers as tests/data/zemax/*.zmx (radii
 thicknesses, semi-diameters, the stop surface), with optiland's own glass data
 (refractiveindex.info, SCHOTT and OHARA pages) for the catalogue glasses and its Abbe
 model for the model glasses, so nothing of physcam's glass data or Zemax reader is shared.
-The stop on a lens face is optiland's stop on that same face. The aperture floats by the stop
-size (the stop's DIAM). optiland's F2 is the rear focal point from the image surface, divided
+The stop on a lens face is optiland's stop on that same face. The aperture is each file's own
+(ENPD -> optiland "EPD", FNUM n 0 -> "imageFNO", OBNA na 0 -> "objectNA"), with the object
+at the file's distance (the object surface's DISZ), so optiland sizes the pupil itself; "epd_mm"
+is optiland's entrance-pupil diameter. optiland's F2 is the rear focal point from the image surface, divided
 by the image-space index (a reduced distance); it is multiplied back and the last thickness
 added: the BFL from the last lens vertex that physcam reports.
 """
@@ -25,9 +27,9 @@ from optiland.optic import Optic
 OUT = Path(__file__).resolve().parents[1] / "tests" / "data" / "optiland_zemax.json"
 
 
-def build(surfaces, wavelength_um, stop_diameter):
+def build(surfaces, wavelength_um, aperture, object_distance=float("inf")):
     o = Optic()
-    o.add_surface(index=0, radius=float("inf"), thickness=float("inf"))
+    o.add_surface(index=0, radius=float("inf"), thickness=object_distance)
     for i, s in enumerate(surfaces, start=1):
         kw = dict(index=i, radius=s["r"], thickness=s.get("t", 0.0), material=s.get("m", "air"),
                   is_stop=s.get("stop", False))
@@ -35,7 +37,7 @@ def build(surfaces, wavelength_um, stop_diameter):
             kw.update(surface_type="even_asphere", conic=s["k"], coefficients=[0.0] + s["a"])
         o.add_surface(**kw)
     o.add_surface(index=len(surfaces) + 1)
-    o.set_aperture(aperture_type="float_by_stop_size", value=stop_diameter)
+    o.set_aperture(aperture_type=aperture[0], value=aperture[1])
     o.set_field_type(field_type="angle")
     o.add_field(y=0)
     o.add_wavelength(value=wavelength_um, is_primary=True)
@@ -54,9 +56,13 @@ def lenses():
     water = AbbeMaterial(1.333, 55.8)
     doublet = [dict(r=inf, t=2.0, stop=True), dict(r=1 / 0.0325, t=4.0, m=AbbeMaterial(1.62, 60.3)),
                dict(r=1 / -0.0410, t=2.0, m=AbbeMaterial(1.72, 29.5)), dict(r=1 / -0.0080, t=38.0, m=water)]
-    return {"cooke_triplet": (cooke, 0.5875618, 2 * 4.6, 1.0),
-            "asphere_780nm": (asphere, 0.78, 2 * 3.0, 1.0),
-            "water_doublet": (doublet, 0.5875618, 2 * 4.0, 1.333)}
+    bk7 = Material("N-BK7", reference="SCHOTT")
+    relay = [dict(r=60.0, t=5.0, m=bk7), dict(r=-45.0, t=2.0, m=AbbeMaterial(1.6, 50.0)), dict(r=-200.0, t=5.0),
+             dict(r=inf, t=318.0, stop=True)]
+    return {"cooke_triplet": (cooke, 0.5875618, ("EPD", 10.0), 1.0, inf),
+            "asphere_780nm": (asphere, 0.78, ("imageFNO", 2.5), 1.0, inf),
+            "water_doublet": (doublet, 0.5875618, ("EPD", 8.0), 1.333, inf),
+            "relay_obna": (relay, 0.6328, ("objectNA", 0.02), 1.0, 150.0)}
 
 
 def _f(v) -> float:
@@ -69,11 +75,12 @@ def main():
     from importlib.metadata import version
 
     out = {"tool": f"optiland {version('optiland')}", "lenses": {}}
-    for name, (surfaces, wl, stop_d, n_image) in lenses().items():
-        o = build(surfaces, wl, stop_d)
+    for name, (surfaces, wl, aperture, n_image, distance) in lenses().items():
+        o = build(surfaces, wl, aperture, distance)
         p = o.paraxial
         out["lenses"][name] = {"wavelength_um": wl, "efl_mm": _f(p.f2()), "bfl_mm": _f(p.F2()) * n_image + surfaces[-1]["t"],
-                               "f_number": _f(p.FNO()), "epd_mm": _f(p.EPD()), "image_index": n_image}
+                               "f_number": _f(p.FNO()), "epd_mm": _f(p.EPD()), "image_index": n_image,
+                               "aperture": list(aperture), "object_distance_mm": None if distance == float("inf") else distance}
         print(name, out["lenses"][name])
     OUT.write_text(json.dumps(out, indent=1) + "\n", encoding="utf-8")
 

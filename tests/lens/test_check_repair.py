@@ -140,6 +140,23 @@ def test_unrepairable_file_says_so(tmp_path):
     with pytest.raises(LensFileError, match="no repair is defined"):
         load_lens(f, lenient=True)
     assert check(tmp_path / "missing.dat")[0].code == "unreadable"
+    # loaded as written, it is not offered a repair that does not exist (issue 25)
+    with pytest.raises(LensFileError) as exc:
+        load_lens(f)
+    msg = str(exc.value)
+    assert "no repair is defined" in msg and "lens check" in msg
+    assert "lens fix" not in msg and "lenient" not in msg
+
+
+def test_reader_refusal_offers_no_repair(tmp_path):
+    # the reader itself refuses (a glass in no catalogue): neither check nor fix can read it further
+    f = tmp_path / "unknown_glass.zmx"
+    f.write_text(Path(__file__).resolve().parents[1].joinpath("data", "zemax", "asphere_780nm.zmx").read_text()
+                 .replace("S-LAH64", "NO-SUCH-GLASS"))
+    with pytest.raises(LensFileError) as exc:
+        load_lens(f)
+    msg = str(exc.value)
+    assert "NO-SUCH-GLASS" in msg and "lens fix" not in msg and "lenient" not in msg and "lens check" not in msg
 
 
 FUZZ = settings(max_examples=80, deadline=None,

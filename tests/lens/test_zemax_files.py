@@ -4,6 +4,7 @@ tests/data/optiland_zemax.json), glass data against the makers' printed indices,
 unknown glasses, truncation, .agf catalogues, --glass-catalog and the config key."""
 
 import json
+import math
 from pathlib import Path
 
 import pytest
@@ -29,6 +30,8 @@ def test_efl_bfl_fnumber_against_optiland(name):
     assert g.efl == pytest.approx(want["efl_mm"], rel=1e-3)
     assert g.bfl == pytest.approx(want["bfl_mm"], rel=1e-3)
     assert g.f_number == pytest.approx(want["f_number"], rel=1e-3)
+    # the file's aperture (ENPD, FNUM, OBNA) sized the stop as optiland sizes the pupil
+    assert g.entrance_pupil_diameter == pytest.approx(want["epd_mm"], rel=1e-4)
 
 
 def test_cooke_triplet_utf16_placeholders_and_stop_on_a_face():
@@ -38,7 +41,8 @@ def test_cooke_triplet_utf16_placeholders_and_stop_on_a_face():
     assert {(m.glass, m.catalog, m.nd, m.vd) for m in media} == {("N-SK16", "SCHOTT", 1.62041, 60.32),
                                                                  ("F2", "SCHOTT", 1.62004, 36.37)}
     stop = lens.surfaces[lens.stop_index]
-    assert (stop.kind, stop.radius, stop.semi_diameter) == ("stop", 0.0, 4.6)
+    assert (stop.kind, stop.radius) == ("stop", 0.0)
+    assert lens.surfaces[lens.stop_index + 1].semi_diameter == 4.6  # the face keeps its DIAM; ENPD 10 sizes the stop
 
 
 def test_image_space_in_water_is_accepted_but_a_cut_file_is_not():
@@ -152,3 +156,73 @@ def test_non_sellmeier_catalogue_glass_in_the_tracer_form():
     g = find_glass("FC5", ["HOYA"])
     for nm in (LINE_C_NM, LINE_D_NM, LINE_F_NM):
         assert float(d.index(nm)) == pytest.approx(float(g.index(nm)), abs=max(d.fit_error, 1e-6))
+
+
+RELAY = (DATA / "zemax" / "relay_obna.zmx").read_text()
+
+
+def test_finite_object_distance_is_kept_and_written_back():
+    lens = loads_lens(RELAY, "zemax")
+    assert dict(lens.extras)["zemax.object_distance_mm"] == "150.0"
+    again = loads_lens(dumps_lens(lens, "zemax"), "zemax")
+    assert (again.surfaces, again.extras) == (lens.surfaces, lens.extras)  # FLOA written: the stop as sized
+
+
+def test_working_f_number_and_cone_angle_apertures():
+    # FNUM N 1: the paraxial working F/# 1 / (2 n'u') at the file's own conjugate (object 150 mm in front)
+    lens = loads_lens(RELAY.replace("OBNA 0.02 0", "FNUM 20 1"), "zemax")
+    assert gaussian(lens, object_z=-150.0).working_f_number == pytest.approx(20.0, rel=1e-9)
+    # OBNA a 1: a cone half-angle a = asin(0.02) in degrees gives the same marginal ray as NA 0.02
+    na = loads_lens(RELAY, "zemax")
+    cone = loads_lens(RELAY.replace("OBNA 0.02 0", f"OBNA {math.degrees(math.asin(0.02))!r} 1"), "zemax")
+    assert cone.surfaces[cone.stop_index].semi_diameter == pytest.approx(na.surfaces[na.stop_index].semi_diameter,
+                                                                           rel=1e-12)
+    # FLOA: the stop's own DIAM
+    floa = loads_lens(RELAY.replace("OBNA 0.02 0", "FLOA"), "zemax")
+    assert floa.surfaces[floa.stop_index].semi_diameter == 5.0
+
+
+def test_object_na_needs_a_finite_object():
+    text = (DATA / "zemax" / "asphere_780nm.zmx").read_text().replace("FNUM 2.5 0", "OBNA 0.1 0")
+    with pytest.raises(LensFileError, match=r"a\.zmx:5: .*finite distance"):
+        loads_lens(text, "zemax", "a.zmx")
+
+
+@pytest.mark.parametrize("nm", [450.0, 632.8, 780.0, 1550.0])
+def test_design_index_chooses_the_dispersion_model_as_the_optics_layer_does(nm):
+    from physcam.lens.aperture import design_index
+    from physcam.lens.prescription import Medium
+    from physcam.optics.glass import medium_index
+
+    media = [Medium(1.62041, 60.32, "N-SK16", "SCHOTT"), Medium(1.6, 50.0), Medium(1.62, 60.3, dpgf=0.0012),
+             Medium(1.5168, 64.17), Medium(1.333, 0.0), Medium(1.88300, 40.76, "S-LAH58", "OHARA")]
+    for m in media:
+        assert design_index(m, nm) == pytest.approx(float(medium_index(m, nm)), abs=1e-12), m
+
+
+def test_camera_commands_refuse_a_finite_conjugate_design_in_one_line(tmp_path, capsys):
+    relay = str(DATA / "zemax" / "relay_obna.zmx")
+    for argv in (["report", "--lens", relay, "--focus", "2m"],
+                 ["usd", "write", str(tmp_path / "cam.usda"), "--lens", relay, "--focus", "2m"],
+                 ["dof-table", "--lens", relay, "--fstops", "4", "--focus", "1m"]):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and f"{relay} is a finite-conjugate design (object 150 mm in front)" in err
+    assert not (tmp_path / "cam.usda").exists()
+    # what a finite-conjugate design is good for still works: paraxial data, and the Python API loads it
+    assert main(["lens", "show", "--lens", relay]) == 0
+    capsys.readouterr()
+    assert main(["report", "--lens", str(DATA / "zemax" / "asphere_780nm.zmx"), "--focus", "2m"]) == 0
+    capsys.readouterr()
+
+
+def test_camera_use_and_object_distance_in_the_python_api():
+    from physcam.errors import InputError
+    from physcam.lens.library import camera_use, load_lens, require_camera_lens
+
+    relay = DATA / "zemax" / "relay_obna.zmx"
+    lens = load_lens(relay)
+    assert lens.object_distance_mm == 150.0 and math.isinf(load_lens("dgauss_50mm").object_distance_mm)
+    with camera_use("a test camera"), pytest.raises(InputError, match="a test camera needs an infinite-conjugate"):
+        load_lens(relay)
+    assert require_camera_lens(load_lens("dgauss_50mm")) is load_lens("dgauss_50mm")

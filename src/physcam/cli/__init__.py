@@ -153,10 +153,11 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     try:
         _into_output_dir(args)
-        from ._common import use_glass_catalogs
+        from ._common import lens_use, use_glass_catalogs
 
         use_glass_catalogs(args)
-        rc = int(args.handler(args) or 0)
+        with lens_use(args):  # a camera command refuses a finite-conjugate lens
+            rc = int(args.handler(args) or 0)
         sys.stdout.flush()  # a full disk or closed pipe shows here, inside the error handling
         for n in take_notes():  # defaults taken, ranges clamped: said once the command has worked
             print(f"physcam: note: {n}", file=sys.stderr)

@@ -10,6 +10,8 @@ A new command complies by using these (docs/cli.md, "Writing a command"):
 - a sensor: :func:`add_sensor_options` and :func:`resolve_sensor` (one default, said in a note);
 - a circle of confusion: :func:`coc_value` as the type and :func:`coc_of` (config default);
 - a renamed option: :func:`hidden_alias` keeps the old spelling working, unlisted;
+- a command that uses its lens as a camera's: list it in :data:`CAMERA_COMMANDS` (a
+  finite-conjugate design is then refused in one line when loaded, :func:`lens_use`);
 - notes for people: :func:`note` (printed on stderr after the command succeeds);
 - JSON, tables and CSV: :mod:`physcam.cli._output`.
 """
@@ -336,6 +338,28 @@ def add_lens_argument(p, *, dest: str = "lens", many: bool = False, metavar: str
                    help="a Zemax .agf glass catalogue searched after the lens file's own (repeat for several; "
                         "adds to the config's glass_catalogs)")
     p.set_defaults(_lens_dest=dest, _lens_many=many)
+
+
+#: Commands that use their lens as a camera's (focus marks from the film, depth of field, a camera
+#: to render, record or export), and what for: a finite-conjugate design (a relay, a microscope
+#: objective) is refused when they load it (:func:`physcam.lens.library.require_camera_lens`).
+CAMERA_COMMANDS = {
+    "report": "a camera lens report", "dof-table": "a depth-of-field table", "usd": "a USD camera",
+    "export": "a camera export", "live": "a tracked camera", "metadata": "a per-frame lens report",
+    "compare": "a camera lens comparison", "characterize": "a camera lens characterization",
+    "distortion": "distortion against the film (ST-maps, fitted camera models)",
+}
+
+
+def lens_use(args):
+    """The context the command's handler runs in: :func:`physcam.lens.library.camera_use` for a
+    :data:`CAMERA_COMMANDS` command, so every lens it loads must be a camera lens; else none."""
+    import contextlib
+
+    from ..lens.library import camera_use
+
+    what = CAMERA_COMMANDS.get(getattr(args, "command", None))
+    return contextlib.nullcontext() if what is None else camera_use(what)
 
 
 def use_glass_catalogs(args) -> list[str]:

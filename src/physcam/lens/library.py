@@ -11,7 +11,10 @@ source, and any correction made, with the reason) in the ``[provenance]`` table.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import difflib
+import math
 import re
 from dataclasses import dataclass
 from functools import lru_cache
@@ -19,15 +22,43 @@ from importlib import resources
 from pathlib import Path
 
 from ..errors import InputError, LensFileError
-from .prescription import Prescription
+from .prescription import Prescription, takes_prescription
 
 __all__ = ["LensRecord", "list_lenses", "load_lens", "find_lens", "library_dir", "load_repaired", "repairs_of",
-           "REPAIRED_KEY"]
+           "REPAIRED_KEY", "camera_use", "require_camera_lens"]
 
 #: ``extras`` key of a lens loaded with ``lenient=True`` that needed repairs (JSON list of messages).
 REPAIRED_KEY = "provenance.repaired_on_load"
 
 _FILE_SUFFIXES = (".toml", ".dat", ".json", ".zmx")
+
+#: Set inside :func:`camera_use`: what the lenses loaded there are for ("a camera lens report").
+_CAMERA_USE: contextvars.ContextVar[str | None] = contextvars.ContextVar("physcam_camera_use", default=None)
+
+
+@contextlib.contextmanager
+def camera_use(what: str):
+    """Inside this block :func:`load_lens` refuses a finite-conjugate design (:func:`require_camera_lens`,
+    ``what`` saying what needs a camera lens). The CLI runs its camera commands (report, USD
+    cameras, DOF tables, exports, live, metadata) inside it: one place instead of one per command."""
+    token = _CAMERA_USE.set(what)
+    try:
+        yield
+    finally:
+        _CAMERA_USE.reset(token)
+
+
+@takes_prescription
+def require_camera_lens(p: Prescription, label: str | None = None, what: str = "a camera lens") -> Prescription:
+    """``p`` when it images an object at infinity, as a camera lens does; else :class:`InputError`
+    in one line: a finite-conjugate design (a relay, a microscope objective: its file gives an
+    object distance, :attr:`Prescription.object_distance_mm`) has no depth of field, focus marks
+    or camera. ``label`` names it (the file), ``what`` what needs the camera lens."""
+    d = p.object_distance_mm
+    if math.isinf(d):
+        return p
+    raise InputError(f"{label or repr(p.name)} is a finite-conjugate design (object {d:g} mm in front): {what} needs "
+                     "an infinite-conjugate lens (`physcam lens show` and `physcam trace` read it)")
 
 
 @dataclass(frozen=True, slots=True)
@@ -177,6 +208,29 @@ def load_repaired(path, format: str | None = None):
     return q, repairs
 
 
+def _way_forward(path: Path, s: str) -> str:
+    """What to suggest after ``path`` failed to load: ``lens fix`` and ``--lenient`` only when
+    :func:`load_repaired` does repair it; ``lens check`` alone when the reader read the rows but no
+    repair is defined; nothing more when the reader itself refused the file (its message says why)."""
+    import warnings
+
+    from ..errors import PhysCamError
+    from .raw import read_raw
+
+    try:
+        read_raw(path)
+    except PhysCamError:
+        return ""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            load_repaired(path)
+    except PhysCamError:
+        return f"; no repair is defined for it (`physcam lens check {s}` lists every problem)"
+    return (f"; `physcam lens check {s}` explains, `physcam lens fix {s} -o FIXED.toml --apply` writes a repaired "
+            "copy, --lenient (Python: load_lens(path, lenient=True)) loads it repaired")
+
+
 def load_lens(name_or_path, lenient: bool = False) -> Prescription:
     """A bundled lens by slug/name/alias, or any lens file by path (format from its extension).
 
@@ -184,10 +238,17 @@ def load_lens(name_or_path, lenient: bool = False) -> Prescription:
     is read as a file; otherwise it is looked up in the library.
 
     A file that does not describe a buildable lens raises :class:`LensFileError` whose message
-    says how to get further. With ``lenient=True`` such a file is repaired as ``physcam lens fix``
+    says how to get further (``physcam lens fix`` and ``lenient`` only where a repair is defined). With ``lenient=True`` such a file is repaired as ``physcam lens fix``
     would (:func:`load_repaired`): each repair is issued as a :class:`~physcam.errors.PhysCamWarning`
     and the lens comes back named "<name> (repaired)" with the repairs in :func:`repairs_of`.
+    Inside :func:`camera_use` a finite-conjugate design is refused (:func:`require_camera_lens`).
     """
+    what = _CAMERA_USE.get()
+    lens = _load(name_or_path, lenient)
+    return lens if what is None else require_camera_lens(lens, str(name_or_path), what)
+
+
+def _load(name_or_path, lenient: bool) -> Prescription:
     s = str(name_or_path)
     p = Path(s)
     looks_like_path = isinstance(name_or_path, Path) or "/" in s or "\\" in s or p.suffix.lower() in _FILE_SUFFIXES
@@ -198,17 +259,14 @@ def load_lens(name_or_path, lenient: bool = False) -> Prescription:
             return read_lens(p)
         except LensFileError as exc:
             if not lenient:
-                raise LensFileError(
-                    f"{exc.reason}; `physcam lens check {s}` explains, `physcam lens fix {s} -o FIXED.toml --apply` "
-                    "writes a repaired copy, --lenient (Python: load_lens(path, lenient=True)) loads it repaired",
-                    exc.path, exc.line) from None
+                raise LensFileError(f"{exc.reason}{_way_forward(p, s)}", exc.path, exc.line) from None
             import warnings
 
             from ..errors import PhysCamWarning
 
             q, repairs = load_repaired(p)
             for r in repairs:
-                warnings.warn(f"{s}: repaired on load: {r.message}", PhysCamWarning, stacklevel=2)
+                warnings.warn(f"{s}: repaired on load: {r.message}", PhysCamWarning, stacklevel=3)
             return q
     if not looks_like_path and s in _slugs():
         # a slug, as the CLI is usually given it: read that one file, not the whole library (the

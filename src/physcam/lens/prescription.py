@@ -34,7 +34,12 @@ __all__ = [
     "require_prescription",
     "takes_prescription",
     "unvalidated",
+    "OBJECT_DISTANCE_KEY",
 ]
+
+#: ``Prescription.extras`` key of the object distance a finite-conjugate design images (mm, object
+#: to first vertex; a Zemax file's object-surface DISZ). Absent for a lens working from infinity.
+OBJECT_DISTANCE_KEY = "zemax.object_distance_mm"
 
 #: Set inside :func:`unvalidated`: a list that ``validate`` appends ``(prescription, path, lines)``
 #: to instead of checking (readers then hand back raw rows for ``physcam.lens.check``).
@@ -221,6 +226,18 @@ class Prescription:
     def total_track(self) -> float:
         """First vertex to last vertex, mm (the glass length, without the back focus)."""
         return sum(s.thickness for s in self.surfaces[:-1])
+
+    @property
+    def object_distance_mm(self) -> float:
+        """Object to first vertex (mm) of the conjugate the lens was designed for (``extras``
+        :data:`OBJECT_DISTANCE_KEY`); ``inf`` for a lens designed for an object at infinity, as a
+        camera lens is."""
+        import json
+
+        for k, v in self.extras:
+            if k == OBJECT_DISTANCE_KEY:
+                return float(json.loads(v))
+        return math.inf
 
     @property
     def is_anamorphic(self) -> bool:

@@ -35,9 +35,10 @@ import warnings
 from pathlib import Path
 
 from ...errors import ExportError, InputError, LensFileError, PhysCamWarning
+from ..aperture import size_stop
 from ..catalog import GlassNotFound, find_glass
-from ..prescription import AIR, LensMetadata, Medium, Prescription, Surface, takes_prescription
-from ._common import MAX_SURFACES, check_count, fmt, number, one_line, validated, takes_text
+from ..prescription import AIR, OBJECT_DISTANCE_KEY, LensMetadata, Medium, Prescription, Surface, takes_prescription
+from ._common import MAX_SURFACES, check_count, extra, fmt, json_text, number, one_line, validated, takes_text
 
 __all__ = ["loads", "dumps", "SKIPPED"]
 
@@ -49,10 +50,6 @@ SKIPPED = {
     "FLAP": "flat-aperture drawing data",
     "MEMA": "mechanical semi-aperture (drawing); physcam keeps the clear semi-diameter DIAM",
     "COAT": "coating name: physcam's coating model is per lens (Prescription.coating)",
-    "FLOA": "floating stop: the file's stop surface and its DIAM are kept",
-    "ENPD": "entrance-pupil size: the stop's DIAM is kept",
-    "FNUM": "f-number aperture: the stop's DIAM is kept",
-    "OBNA": "object-space NA aperture: the stop's DIAM is kept",
     "XFLN": "field points: physcam analyses its own fields",
     "YFLN": "field points: physcam analyses its own fields",
     "TOL": "tolerance data",
@@ -65,7 +62,7 @@ _TAIL = {"TOL", "TOLE", "MNUM", "MOFF", "BLNK", "CONF", "MCOP", "MCOM", "DMFS", 
 
 # Lines that do not change a sequential lens's first- or third-order optics.
 _IGNORED = {
-    "VERS", "MODE", "GFAC", "GCAT", "FLOA", "FNUM", "ENPD", "OBNA", "FTYP", "ROPD", "PICB", "XFLN", "YFLN",
+    "VERS", "MODE", "GFAC", "GCAT", "FTYP", "ROPD", "PICB", "XFLN", "YFLN",
     "FWGN", "VDXN", "VDYN", "VCXN", "VCYN", "VANN", "WAVM", "PWAV", "WAVL", "WWGT", "POLS", "GLRS", "GSTD",
     "NSCD", "COFN", "SUMM", "BLNK", "RAIM", "PUSH", "SDMA", "FTYP", "HIDE", "SLAB", "MAZH", "CLAP", "POPS",
     "TOL", "MNUM", "MOFF", "TOLE", "COAT", "FLAP", "XFIE", "YFIE", "ZVDX", "ZVDY", "ZVCX", "ZVCY", "ZVAN",
@@ -91,14 +88,14 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
     """Parse a sequential ``.zmx`` into a validated :class:`Prescription`."""
     blocks: list[dict] = []
     lens_name, notes = None, []
-    head = {"gcat": [], "wavm": {}, "wavl": [], "pwav": 1, "tail": False}
+    head = {"gcat": [], "wavm": {}, "wavl": [], "pwav": 1, "tail": False, "aperture": None}
     cur = None
     for lineno, raw in enumerate(text.splitlines(), start=1):
         tok = raw.split()
         if not tok:
             continue
         key = tok[0].upper()
-        if key in ("GCAT", "WAVM", "WAVL", "PWAV"):
+        if key in ("GCAT", "WAVM", "WAVL", "PWAV", "ENPD", "FNUM", "OBNA", "FLOA"):
             _header(key, tok, head, path, lineno)
             continue
         if key in _TAIL:
@@ -212,8 +209,21 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
     if name is None:
         name = lens_name or (Path(path).stem if path is not None else "unnamed lens")
     meta = LensMetadata(name=name, notes="\n".join(notes) or None)
-    wl = _design_wavelength(head, path)
-    return validated(Prescription(tuple(surfaces), meta, wavelength_nm=wl), path, lines)
+    extras = () if math.isinf(obj["disz"]) else ((OBJECT_DISTANCE_KEY, json_text(obj["disz"])),)
+    p = Prescription(tuple(surfaces), meta, wavelength_nm=_design_wavelength(head, path), extras=extras)
+    return validated(_sized(p, head["aperture"], obj["disz"], path), path, lines)
+
+
+def _sized(p: Prescription, aperture, object_distance: float, path) -> Prescription:
+    """``p`` with its stop sized by the file's aperture line (:func:`physcam.lens.aperture.size_stop`);
+    unchanged without one (as FLOA) or when the stop is not one surface (validation says so)."""
+    if aperture is None or sum(s.is_stop for s in p.surfaces) != 1:
+        return p
+    kind, value, lineno = aperture
+    try:
+        return size_stop(p, kind, value, object_distance)
+    except (InputError, ArithmeticError) as exc:
+        raise LensFileError(str(exc), path, lineno) from None
 
 
 def _header(key, tok, head, path, lineno) -> None:
@@ -227,6 +237,22 @@ def _header(key, tok, head, path, lineno) -> None:
         head["wavl"] = [number(t, "WAVL wavelength (um)", path, lineno) for t in tok[1:]]
     elif key == "PWAV" and len(tok) >= 2:
         head["pwav"] = int(_num(tok, 1, "PWAV", path, lineno, length=False))
+    else:
+        head["aperture"] = _aperture(key, tok, path, lineno)
+
+
+def _aperture(key, tok, path, lineno) -> tuple[str, float, int]:
+    """(kind, value, line) of an aperture line: ENPD D, FNUM N flag, OBNA NA flag or FLOA
+    (:data:`physcam.lens.aperture.APERTURE_KINDS`; the flag 0 when absent)."""
+    if key == "FLOA":
+        return "FLOA", 0.0, lineno
+    value = _num(tok, 1, key, path, lineno, length=False)
+    if key == "ENPD":
+        return "ENPD", value, lineno
+    flag = tok[2] if len(tok) > 2 else "0"
+    if flag not in ("0", "1"):
+        raise LensFileError(f"{key} flag {flag!r} is not 0 or 1", path, lineno)
+    return f"{key} {flag}", value, lineno
 
 
 def _design_wavelength(head, path) -> float:
@@ -310,10 +336,11 @@ def dumps(p: Prescription) -> str:
     out = ["VERS 190513 80 123457", "MODE SEQ", one_line(f"NAME {p.name}").rstrip(), "UNIT MM X W X CM MR CPMM"]
     if p.metadata.notes:
         out += [one_line(f"NOTE 0 {line}").rstrip() for line in p.metadata.notes.splitlines()]
-    out.append(f"WAVL {fmt(p.wavelength_nm / 1000.0)}")
+    out += ["FLOA", f"WAVL {fmt(p.wavelength_nm / 1000.0)}"]
     gcat_at = len(out)
     cats: list[str] = []
-    out += ["SURF 0", "  TYPE STANDARD", "  CURV 0.0", "  DISZ INFINITY"]
+    d = extra(p, OBJECT_DISTANCE_KEY)
+    out += ["SURF 0", "  TYPE STANDARD", "  CURV 0.0", f"  DISZ {'INFINITY' if d is None else fmt(d)}"]
     for i, s in enumerate(p.surfaces, start=1):
         out.append(f"SURF {i}")
         if s.is_stop:
