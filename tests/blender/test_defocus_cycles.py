@@ -83,8 +83,9 @@ def settings(samples):
     scene.cycles.samples = samples
     scene.cycles.seed = 1
 
-def render(path, fmt="OPEN_EXR"):
-    scene.render.image_settings.file_format = fmt
+def render(path, layers=False):
+    scene.render.image_settings.media_type = "MULTI_LAYER_IMAGE" if layers else "IMAGE"
+    scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER" if layers else "OPEN_EXR"
     scene.render.image_settings.color_depth = "32"
     scene.render.filepath = path
     bpy.ops.render.render(write_still=True)
@@ -96,6 +97,7 @@ settings(job["samples_osl"])
 plane.hide_render = True
 render(job["out"] + "/truth_spheres.exr")
 plane.hide_render = False
+scene.cycles.samples = job["samples_osl_full"]
 render(job["out"] + "/truth.exr")
 # 2. a pinhole at the entrance pupil, the best-match focal length, with a Z pass
 cam.data.type = "PERSP"
@@ -106,26 +108,26 @@ cam.location = (0.0, 0.0, -job["pupil_m"])
 scene.cycles.shading_system = False
 scene.view_layers[0].use_pass_z = True
 settings(job["samples_pinhole"])
-plane.hide_render = True
-render(job["out"] + "/pinhole_spheres.exr", "OPEN_EXR_MULTILAYER")
-plane.hide_render = False
-render(job["out"] + "/pinhole.exr", "OPEN_EXR_MULTILAYER")
-# 3. Blender's compositor Defocus of the same pinhole render
 cam.data.dof.focus_distance = job["focus_m"]
-tree = bpy.data.node_groups.new("defocus", "CompositorNodeTree")
+# the compositor gives each output: the picture, its Z pass (planar depth from the camera, metres;
+# this Blender writes no passes into a multilayer EXR from a script), and its own Defocus node's result
+tree = bpy.data.node_groups.new("outputs", "CompositorNodeTree")
+tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
 rl = tree.nodes.new("CompositorNodeRLayers")
 df = tree.nodes.new("CompositorNodeDefocus")
 df.bokeh = "HEXAGON"; df.f_stop = job["fstop"]; df.use_zbuffer = True
 out = tree.nodes.new("NodeGroupOutput")
-tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
 tree.links.new(rl.outputs["Image"], df.inputs["Image"])
 tree.links.new(rl.outputs["Depth"], df.inputs["Z"])
-tree.links.new(df.outputs["Image"], out.inputs[0])
 scene.compositing_node_group = tree
 scene.render.use_compositing = True
-for name, hide in (("blender_spheres", True), ("blender", False)):
-    plane.hide_render = hide
-    render(job["out"] + "/" + name + ".exr")
+for name, socket in (("pinhole", rl.outputs["Image"]), ("depth", rl.outputs["Depth"]), ("blender", df.outputs["Image"])):
+    for link in list(out.inputs[0].links):
+        tree.links.remove(link)
+    tree.links.new(socket, out.inputs[0])
+    for tag, hide in (("_spheres", True), ("", False)):
+        plane.hide_render = hide
+        render(job["out"] + "/" + name + tag + ".exr")
 print(json.dumps({"ok": True}))
 '''
 
@@ -149,15 +151,15 @@ def scene(tmp_path_factory):
     job = {"setup": str(tmp / "setup.py"), "out": str(tmp), "spheres": spheres, "strength": 20.0,
            "plane": [-(ep + PLANE_MM) / 1000, 2.4 * PLANE_MM * SW / 2 / cam.pinhole_mm / 1000],
            "pinhole_mm": cam.pinhole_mm, "sensor_mm": [SW, sh], "pupil_m": ep / 1000,
-           "focus_m": (MARK_MM - ep) / 1000, "fstop": FSTOP, "samples_osl": 256, "samples_pinhole": 16}
+           "focus_m": (MARK_MM - ep) / 1000, "fstop": FSTOP, "samples_osl": 256, "samples_osl_full": 64, "samples_pinhole": 16}
     run_blender(SCRIPT, json.dumps(job), timeout=600)
     cache = KernelCache(cam)
     out = {}
     for name in ("spheres", ""):
         tag = f"_{name}" if name else ""
         pin = read_exr(tmp / f"pinhole{tag}.exr")
-        rgb = np.stack([pin.channels[f"ViewLayer.Combined.{c}"] for c in "RGB"], axis=2)
-        u = inverse_depth(pin.channels["ViewLayer.Depth.Z"], cam, kind="planar", unit="m")
+        rgb = np.stack([pin.channels[c] for c in "RGB"], axis=2)
+        u = inverse_depth(read_exr(tmp / f"depth{tag}.exr").channels["R"], cam, kind="planar", unit="m")
         out["physcam" + tag] = defocus(rgb, u, cache)
         out["pinhole" + tag] = rgb
         for kind in ("truth", "blender"):

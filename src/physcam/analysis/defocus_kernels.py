@@ -145,7 +145,7 @@ class DefocusCamera:
         x0, x1, y0, y1 = pilot.extent_mm
         p = self.pitch_mm
         reach = max(abs(x0 + sx), abs(x1 + sx), abs(y0 + sy), abs(y1 + sy)) / 1.2 * 1.05  # pilot pads 1.2x
-        r = max(2, math.ceil(reach / p - 0.5) + 1)
+        r = max(4, math.ceil(reach / p - 0.5) + 1)  # bokeh_image bins at least 8 px a side
         if r > 2048:
             raise OpticsError(f"the blur at depth {d:g} mm is over 4096 pixels across: give a nearer depth limit")
         h = (r + 0.5) * p
@@ -160,7 +160,7 @@ class DefocusCamera:
         trans = tuple(float(t / a * cos_t) if a > 0 else 0.0 for t, a in zip(tot, axis))
         with np.errstate(invalid="ignore", divide="ignore"):
             img = np.where(tot > 0, img / np.where(tot > 0, tot, 1.0) * np.array(trans), 0.0)
-        k = Kernel(np.ascontiguousarray(img, dtype=np.float32), trans, d, (x_px, y_px))
+        k = Kernel(np.ascontiguousarray(_trim(img), dtype=np.float32), trans, d, (x_px, y_px))
         self._memory[mkey] = k
         return k
 
@@ -173,6 +173,16 @@ class DefocusCamera:
             b = bokeh_image(self.focused, self.pupil_from_film_mm + d, rays=40_000, pixels=8, **kw)
             self._memory[key] = b.image.sum(axis=(0, 1))
         return self._memory[key]
+
+
+def _trim(img: np.ndarray) -> np.ndarray:
+    """``img`` cut to the smallest centred square holding all its light."""
+    r = img.shape[0] // 2
+    ys, xs = np.nonzero(img.sum(axis=2))
+    if len(ys) == 0:
+        return img[r:r + 1, r:r + 1]
+    e = int(max(np.abs(ys - r).max(), np.abs(xs - r).max()))
+    return img[r - e:r + e + 1, r - e:r + e + 1]
 
 
 @takes_prescription
