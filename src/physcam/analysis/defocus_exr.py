@@ -9,6 +9,8 @@ frame the pinhole imaged (OpenEXR "Technical Introduction": data and display win
 
 from __future__ import annotations
 
+import json
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,7 +18,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["ExrImage", "read_exr", "write_exr", "colour_channels", "depth_channel", "defocus_file"]
+__all__ = ["ExrImage", "read_exr", "write_exr", "colour_channels", "depth_channel", "defocus_file", "write_kernel_stack"]
 
 
 @dataclass
@@ -173,3 +175,52 @@ def defocus_file(image_path, output, lens, *, focus_mm: float, fstop: float, sen
             "depth_channel": zname, "depth_kind": kind, "depth_unit": depth_unit,
             "pinhole_focal_length_mm": cam.pinhole_mm, "entrance_pupil_from_film_mm": cam.pupil_from_film_mm,
             "kernels_traced": cache.traced - traced, "seconds": time.perf_counter() - t0}
+
+
+def write_kernel_stack(folder, camera, *, field_grid=(5, 3), depths_mm=(500.0, 1000.0, 2000.0, 4000.0, math.inf),
+                       force: bool = False) -> dict:
+    """The PSF stack of ``camera`` (a :class:`~physcam.analysis.defocus_kernels.DefocusCamera`):
+    for each of ``field_grid`` (nx, ny) picture positions (spread corner to corner, at pixel
+    centres) and each planar depth from the entrance pupil, one EXR (R, G, B: the kernel per
+    channel; mono kernels repeat) and ``index.json`` describing them. Kernels are on the picture's
+    pixel grid, rows down, the pinhole's image of the point at the centre pixel, each channel
+    summing to the relative transmission (vignetting x cos, 1 on the axis)."""
+    from ..io import atomic_write, check_writable
+
+    nx, ny = (int(v) for v in field_grid)
+    if not (1 <= nx <= 33 and 1 <= ny <= 33):
+        raise InputError(f"the field grid must be 1 to 33 positions a side, got {nx} x {ny}")
+    if not depths_mm or len(depths_mm) > 64:
+        raise InputError("give 1 to 64 depths")
+    folder = Path(folder)
+    index_path = folder / "index.json"
+    check_writable(index_path, force=force)
+    entries = []
+    for j in range(ny):
+        for i in range(nx):
+            x = 0.5 + (camera.width - 1) * (i / (nx - 1) if nx > 1 else 0.5)
+            y = 0.5 + (camera.height - 1) * (j / (ny - 1) if ny > 1 else 0.5)
+            for k, d in enumerate(depths_mm):
+                from .defocus_kernels import FAR_MM
+
+                kern = camera.kernel(x, y, FAR_MM if math.isinf(d) else float(d))
+                img = kern.image if kern.image.shape[2] == 3 else np.repeat(kern.image, 3, axis=2)
+                name = f"psf_x{i}_y{j}_d{k}.exr"
+                n = img.shape[0]
+                header = {
+                          "physcam/kernel": f"field ({x:g}, {y:g}) px, depth {d:g} mm from the entrance pupil"}
+                fake = ExrImage(name, {**header, "dataWindow": (np.array([0, 0], np.int32), np.array([n - 1, n - 1], np.int32)),
+                                       "displayWindow": (np.array([0, 0], np.int32), np.array([n - 1, n - 1], np.int32))}, {})
+                write_exr(folder / name, fake, {c: img[..., m] for m, c in enumerate("RGB")}, force=force)
+                entries.append({"file": name, "field_px": [x, y], "field_mm": list(camera.film_point(x, y)),
+                                "depth_from_pupil_mm": None if math.isinf(d) else float(d),
+                                "size_px": n, "centre_px": [n // 2, n // 2], "transmission": list(kern.transmission)})
+    index = {"lens": camera.lens.name, "focus_from_film_mm": camera.focus_mm, "fstop": camera.fstop,
+             "sensor_width_mm": camera.sensor_width_mm, "pixels": [camera.width, camera.height],
+             "pixel_pitch_mm": camera.pitch_mm, "pinhole_focal_length_mm": camera.pinhole_mm,
+             "entrance_pupil_from_film_mm": camera.pupil_from_film_mm, "wavelengths_nm": list(camera.wavelengths_nm),
+             "convention": "picture grid, row 0 on top, x right; the pinhole's image of the point at centre_px; "
+                           "depth planar from the entrance pupil (null: infinity)",
+             "kernels": entries}
+    atomic_write(index_path, json.dumps(index, indent=1), force=force)
+    return index

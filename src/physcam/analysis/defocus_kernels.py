@@ -144,7 +144,10 @@ class DefocusCamera:
         pilot = bokeh_image(self.focused, depth_film, X, Y, rays=1000, pixels=8, **kw)
         x0, x1, y0, y1 = pilot.extent_mm
         p = self.pitch_mm
-        reach = max(abs(x0 + sx), abs(x1 + sx), abs(y0 + sy), abs(y1 + sy)) / 1.2 * 1.05  # pilot pads 1.2x
+        # the pilot's window is the hits' box centre +- 1.2 x its larger half-span: the farthest hit
+        # from the pinhole's image (-sx, -sy) lies within |centre offset| + that half-span
+        half = 0.5 * (x1 - x0) / 1.2
+        reach = 1.05 * max(abs(0.5 * (x0 + x1) + sx), abs(0.5 * (y0 + y1) + sy)) + 1.05 * half
         r = max(4, math.ceil(reach / p - 0.5) + 1)  # bokeh_image bins at least 8 px a side
         if r > 2048:
             raise OpticsError(f"the blur at depth {d:g} mm is over 4096 pixels across: give a nearer depth limit")
