@@ -127,3 +127,26 @@ def test_cli_bad_input_exits_2_with_one_line(tmp_path, case):
     lines = [ln for ln in p.stderr.strip().splitlines() if not ln.startswith("note")]
     assert len(lines) == 1 and "Traceback" not in p.stderr
     assert not (tmp_path / "out.exr").exists()
+
+
+def test_cli_defocus_json_document(tmp_path):
+    """A render with a Z channel defocuses through the CLI; the --json document meets its schema and
+    the EXR keeps the header's windows and the colour channels."""
+    import json
+
+    import jsonschema
+
+    from physcam.analysis.defocus_exr import read_exr
+    from physcam.cli._output import schema_file
+
+    _exr(tmp_path / "in.exr", {**{c: np.ones((H, W)) for c in "RGB"}, "Z": np.full((H, W), 1.0)})
+    p = subprocess.run([sys.executable, "-m", "physcam", "defocus", str(tmp_path / "in.exr"), "--lens", "dgauss_50mm",
+                        "--focus", "2m", "--fstop", "2.8", "--sensor-width", "36", "--sensor-height", "20.25",
+                        "--tile", "32", "-o", str(tmp_path / "out.exr"), "--json"], capture_output=True, text=True,
+                       timeout=300)
+    assert p.returncode == 0, p.stderr
+    doc = json.loads(p.stdout)
+    jsonschema.validate(doc, json.loads(schema_file(doc["schema"]).read_text()))
+    assert doc["depth_channel"] == "Z" and doc["depth_kind"] == "planar"
+    out = read_exr(tmp_path / "out.exr")
+    assert set(out.channels) == {"R", "G", "B"} and out.display_size == (W, H)

@@ -60,8 +60,8 @@ def register(sub) -> None:
 
 def _camera_options(p) -> None:
     add_lens_argument(p)
-    p.add_argument("--focus", type=focus("focus distance", hyperfocal=False), required=True, metavar="MARK",
-                   help="focus mark from the film plane (e.g. 2m, inf)")
+    p.add_argument("--focus", type=focus("focus distance"), required=True, metavar="MARK",
+                   help="focus mark from the film plane (e.g. 2m, inf, hyperfocal)")
     p.add_argument("--fstop", type=number("f-stop", positive=True), required=True, help="the iris's f-stop")
     p.add_argument("--blades", type=int, default=0, metavar="N", help="iris blades (default 0: round)")
     p.add_argument("--dispersion", action="store_true", help="trace R, G, B at 620, 550, 460 nm (colour fringes)")
@@ -97,10 +97,11 @@ def _aperture(args):
 def run(args) -> int:
     from ..analysis.defocus_exr import defocus_file
     from ..lens.library import load_lens
-    from ._common import resolve_sensor
+    from ._common import resolve_focus, resolve_sensor
 
     lens = load_lens(args.lens)
     sensor = resolve_sensor(args)
+    args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
     res = defocus_file(args.image, args.output, lens, focus_mm=args.focus, fstop=args.fstop,
                        sensor_width_mm=sensor.width_mm, depth=args.depth, depth_kind=args.depth_kind,
                        depth_unit=args.depth_unit, aperture=_aperture(args), dispersion=args.dispersion, tile=args.tile,
@@ -122,10 +123,11 @@ def run_kernels(args) -> int:
     from ..analysis.defocus_kernels import defocus_camera
     from ..lens.library import load_lens
     from ..units import parse_distance
-    from ._common import list_items, resolve_sensor
+    from ._common import list_items, resolve_focus, resolve_sensor
 
     lens = load_lens(args.lens)
     sensor = resolve_sensor(args)
+    args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
     depths = [parse_distance(t, name="depth", allow_inf=True) for t in list_items(args.depths, "the depths", "1m,4m,inf")]
     cam = defocus_camera(lens, focus_mm=args.focus, fstop=args.fstop, sensor_width_mm=sensor.width_mm,
                          width=args.resolution[0], height=args.resolution[1], aperture=_aperture(args),
