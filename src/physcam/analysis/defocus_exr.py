@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, require_type
 
 __all__ = ["ExrImage", "read_exr", "write_exr", "colour_channels", "depth_channel", "defocus_file", "write_kernel_stack"]
 
@@ -66,6 +66,7 @@ def read_exr(path) -> ExrImage:
 def colour_channels(img: ExrImage) -> list[str]:
     """The colour channels (R, G, B, A in that order, with or without a layer prefix; Blender's
     ``Combined`` layer preferred); else every channel that is not a depth."""
+    require_type("image", img, ExrImage, "physcam.analysis.defocus_exr.read_exr(path)")
     names = list(img.channels)
     for prefix in ("", "ViewLayer.Combined.", "RenderLayer.Combined."):
         got = [prefix + c for c in "RGBA" if prefix + c in names]
@@ -83,6 +84,9 @@ def colour_channels(img: ExrImage) -> list[str]:
 def depth_channel(img: ExrImage, name: str | None = None) -> str:
     """The named depth channel, or the one depth channel the file has (``Z``, ``*.Depth.Z``,
     ``depth.Z``, or a file's only channel)."""
+    require_type("image", img, ExrImage, "physcam.analysis.defocus_exr.read_exr(path)")
+    if name is not None:
+        require_type("depth channel", name, str, "a channel name such as 'Z'")
     names = list(img.channels)
     if name is not None:
         if name not in img.channels:
@@ -105,6 +109,8 @@ def write_exr(path, img: ExrImage, planes: dict, *, attributes=None, force: bool
     import os
     import tempfile
 
+    require_type("image", img, ExrImage, "physcam.analysis.defocus_exr.read_exr(path)")
+    require_type("planes", planes, dict, "{channel name: (h, w) array}")
     import OpenEXR
 
     from ..io import atomic_write, check_writable
@@ -186,7 +192,9 @@ def write_kernel_stack(folder, camera, *, field_grid=(5, 3), depths_mm=(500.0, 1
     pixel grid, rows down, the pinhole's image of the point at the centre pixel, each channel
     summing to the relative transmission (vignetting x cos, 1 on the axis)."""
     from ..io import atomic_write, check_writable
+    from .defocus_kernels import DefocusCamera
 
+    require_type("camera", camera, DefocusCamera, "physcam.analysis.defocus_kernels.defocus_camera(lens, ...)")
     nx, ny = (int(v) for v in field_grid)
     if not (1 <= nx <= 33 and 1 <= ny <= 33):
         raise InputError(f"the field grid must be 1 to 33 positions a side, got {nx} x {ny}")
