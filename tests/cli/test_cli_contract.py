@@ -61,6 +61,8 @@ LEAVES = dict(leaves())
 
 #: One quick run of every command that has --json (run in a folder the `workdir` fixture prepares).
 JSON_RUNS = {
+    ("defocus-kernels",): ["defocus-kernels", "--lens", "dgauss_50mm", "--focus", "2m", "--fstop", "2.8",
+                           "--resolution", "64x36", "--field-grid", "2x1", "--depths", "1m", "-o", "kernels"],
     ("report",): ["report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--cameras"],
     ("dof-table",): ["dof-table", "--focal", "35", "--fstops", "2,4", "--focus", "1m,hyperfocal,inf"],
     ("sensors",): ["sensors", "ARRI"],
@@ -122,6 +124,7 @@ EXTRA_JSON_RUNS = {
 }
 #: Commands with --json this test does not run, and why (each is covered where named).
 JSON_NOT_RUN = {
+    ("defocus",): "needs an EXR render with depth (tests/analysis/test_defocus.py runs it and validates the document)",
     ("compare", "blender"): "needs Blender's bpy (tests/blender/test_compare.py validates its document)",
     ("live", "record"): "needs a UDP stream (tests/live/test_cli_live.py records one and validates the document)",
     ("calibrate",): "needs chart photographs (tests/analysis/test_calibrate.py renders them and validates its document)",
@@ -138,6 +141,8 @@ CSV_ROWS = {
 }
 #: Commands that take a focus but print no distance (so no --units), and why.
 NO_UNITS = {
+    ("defocus",): "prints the file written; depths are read in --depth-unit",
+    ("defocus-kernels",): "prints the files written; the index holds millimetres",
     ("psf",): "prints a Strehl ratio and micrometres on the film (the focus mark is an input only)",
     ("usd", "write"): "prints the file written; the file holds millimetres and scene units",
     ("usd", "kit"): "prints the file written",

@@ -1,0 +1,206 @@
+"""Depth of field from the real lens, applied to a pinhole render with depth (``physcam defocus``).
+
+Method (docs/defocus.md): each pixel is a point of the scene, at the inverse depth ``u`` its
+depth pass gives; it is split linearly in ``u`` between the two bracketing depth nodes of
+:mod:`physcam.analysis.defocus_kernels` (so the blur grows smoothly, with no banding). The
+picture is cut into depth **layers**, one per node, and each layer is *scattered*: every
+``tile`` x ``tile`` block of it is convolved (FFT; a direct sum for kernels up to 7 px) with the
+lens's own PSF traced for that tile's centre and that node's depth (field- and depth-dependent:
+size, cat's eye, iris, vignetting; per wavelength with dispersion), colour and coverage (alpha)
+alike. The blurred layers are composited **back to front** with "over",
+``C = C_k + (1 - A_k) C``, ``A = A_k + (1 - A_k) A``, so a blurred foreground covers what lies
+behind it in proportion to its own blurred coverage (occlusion at depth edges), and the result is
+``C / A`` (Kraus and Strengert, "Depth-of-Field Rendering by Pyramidal Image Processing",
+Eurographics 2007, section 3: layers, matting, normalisation).
+
+Known limits: (1) what the pinhole did not see (the background behind a foreground edge) is not
+invented: where a blurred foreground turns partly transparent, the background's own blurred
+layer, renormalised by ``C / A``, fills in; (2) within one layer there is no self-occlusion;
+(3) the kernel is constant over a tile (field sampled every ``tile`` px) and linear in ``u``
+between nodes ``step_px`` of blur apart; (4) light from outside the frame is missing, so the
+frame's edge is renormalised like (1); (5) the image must be linear light (scene-referred EXR).
+
+Cost: each (tile, layer) pair that holds pixels costs one FFT convolution of
+(tile + 2R)^2 (R the kernel radius), ``channels + 1`` images: about
+``pairs x (tile + 2R)^2 log(tile + 2R) x (channels + 2)``; compositing costs the layers' blurred
+areas. Kernels are traced once per (tile, node) and kept in the :class:`KernelCache`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import InputError
+from .defocus_kernels import DefocusCamera, KernelCache
+
+__all__ = ["DEPTH_KINDS", "DEPTH_UNITS_MM", "inverse_depth", "defocus"]
+
+#: planar: along the optical axis from the plane of the entrance pupil (Blender's Z pass of a camera
+#: at the pupil); ray: along the pixel's ray from the pupil's centre; inverse: 1 / planar (Nuke's depth.Z)
+DEPTH_KINDS = ("planar", "ray", "inverse")
+DEPTH_UNITS_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "ft": 304.8}
+
+
+def inverse_depth(depth, camera: DefocusCamera, *, kind: str = "planar", unit: str = "m",
+                  origin=(0, 0)) -> np.ndarray:
+    """Inverse planar depth ``u`` (1/mm, 0 at infinity) of each pixel of a depth pass.
+
+    ``depth`` (h, w) in ``unit`` (``inverse``: 1/``unit``), ``origin`` the data window's corner in
+    the display window (x, y). A value of 1e9 m or more (Blender's empty background: 1e10) is
+    infinity. NaN, negative and zero depths, and points inside the lens, are refused."""
+    if kind not in DEPTH_KINDS:
+        raise InputError(f"the depth kind must be one of {', '.join(DEPTH_KINDS)}, got {kind!r}")
+    if unit not in DEPTH_UNITS_MM:
+        raise InputError(f"the depth unit must be one of {', '.join(DEPTH_UNITS_MM)}, got {unit!r}")
+    z = np.asarray(depth, dtype=np.float64)
+    if z.ndim != 2:
+        raise InputError(f"the depth pass must be one channel (h, w), got shape {z.shape}")
+    bad = ~np.isfinite(z) & ~(np.isposinf(z) & (kind != "inverse"))
+    if bad.any():
+        y, x = np.argwhere(bad)[0]
+        raise InputError(f"the depth pass has {int(bad.sum())} NaN or infinite value(s), the first at pixel "
+                         f"({x}, {y}): every pixel needs a depth")
+    neg = z < 0 if kind == "inverse" else z <= 0
+    if neg.any():
+        y, x = np.argwhere(neg)[0]
+        raise InputError(f"the depth pass has {int(neg.sum())} {'negative' if kind == 'inverse' else 'zero or negative'} "
+                         f"value(s), the first {z[y, x]:g} at pixel ({x}, {y}): depths lie in front of the camera")
+    scale = DEPTH_UNITS_MM[unit]
+    with np.errstate(divide="ignore", over="ignore"):
+        if kind == "inverse":
+            u = z / scale
+        else:
+            u = np.where(z * scale >= 1e12, 0.0, 1.0 / (z * scale))
+            if kind == "ray":
+                h, w = z.shape
+                xs = (origin[0] + np.arange(w) + 0.5 - camera.width / 2) * camera.pitch_mm
+                ys = (camera.height / 2 - origin[1] - np.arange(h) - 0.5) * camera.pitch_mm
+                f = camera.pinhole_mm
+                u = u * np.sqrt(f * f + xs[None, :] ** 2 + ys[:, None] ** 2) / f  # 1/planar = (1/ray) / cos
+    near = 1.0 / max(camera.front_from_film_mm - camera.pupil_from_film_mm + 1.0, 1.0)
+    if (u > near).any():
+        y, x = np.argwhere(u > near)[0]
+        raise InputError(f"pixel ({x}, {y}) is {1 / u[y, x]:.4g} mm from the entrance pupil, inside or against the "
+                         f"lens (its front is {1 / near - 1:.4g} mm from the pupil): check the depth unit (--depth-unit)")
+    return u
+
+
+def _node_weights(u: np.ndarray, cam: DefocusCamera):
+    """Each pixel's lower depth node and its weight on the node above (linear in u)."""
+    n_far = cam.node_far()
+    lo = np.maximum(np.floor((u - cam.focus_u) / cam.du + 1e-9), n_far).astype(np.int64)
+    u_lo, u_hi = cam.node_u(lo), cam.node_u(lo + 1)
+    w_hi = np.clip((u - u_lo) / (u_hi - u_lo), 0.0, 1.0)
+    return lo, w_hi.astype(np.float32)
+
+
+def _fast_len(n: int) -> int:
+    """The smallest 2^a 3^b 5^c >= n (a quick FFT length)."""
+    best = 1 << (n - 1).bit_length()
+    p5 = 1
+    while p5 < best:
+        p35 = p5
+        while p35 < best:
+            q = p35
+            while q < n:
+                q *= 2
+            best = min(best, q)
+            p35 *= 3
+        p5 *= 5
+    return best
+
+
+def _convolve(src: np.ndarray, ker: np.ndarray) -> np.ndarray:
+    """Full 2-D convolution of each plane of ``src`` (k, h, w) with ``ker`` (n, n) or, per plane,
+    (k, n, n): (k, h + n - 1, w + n - 1). Direct for small kernels, else FFT (float32)."""
+    k, h, w = src.shape
+    n = ker.shape[-1]
+    kers = np.broadcast_to(ker, (k, n, n)) if ker.ndim == 2 else ker
+    if n <= 7:
+        out = np.zeros((k, h + n - 1, w + n - 1), dtype=np.float32)
+        for dy in range(n):
+            for dx in range(n):
+                c = kers[:, dy, dx]
+                if c.any():
+                    out[:, dy:dy + h, dx:dx + w] += c[:, None, None] * src
+        return out
+    sy, sx = _fast_len(h + n - 1), _fast_len(w + n - 1)
+    fs = np.fft.rfft2(src, s=(sy, sx))
+    fk = np.fft.rfft2(kers if ker.ndim == 3 else ker, s=(sy, sx))
+    return np.fft.irfft2(fs * fk, s=(sy, sx))[:, : h + n - 1, : w + n - 1].astype(np.float32, copy=False)
+
+
+def _tile_layer(img, wgt, kernel, colour_channels):
+    """One tile of one layer blurred: planes (colour..., alpha) convolved with the kernel; colour
+    scaled by the transmission (vignetting), alpha by a kernel of unit sum."""
+    k = kernel.image
+    tr = np.asarray(kernel.transmission, dtype=np.float32)
+    g = 1 if k.shape[2] == 3 else 0
+    unit = k[..., g] / tr[g] if tr[g] > 0 else np.zeros_like(k[..., g])
+    c = img.shape[2]
+    src = np.concatenate([np.moveaxis(img * wgt[..., None], 2, 0), wgt[None]], axis=0).astype(np.float32)
+    if k.shape[2] == 1 or colour_channels < 3:
+        out = _convolve(src, unit)
+        out[:c] *= tr[g]
+        return out
+    kers = np.empty((c + 1,) + unit.shape, dtype=np.float32)
+    for i in range(c):
+        kers[i] = k[..., i] if i < 3 else unit * tr[g]
+    kers[c] = unit
+    return _convolve(src, kers)
+
+
+def defocus(image, u, cache: KernelCache, *, origin=(0, 0), progress=None) -> np.ndarray:
+    """``image`` (h, w, channels; linear light) defocused through the cache's camera, given each
+    pixel's inverse planar depth ``u`` (1/mm, :func:`inverse_depth`). ``origin``: the data
+    window's corner in the display window. Returns a float32 array of the image's shape (method
+    and limits in the module notes)."""
+    img = np.asarray(image, dtype=np.float32)
+    if img.ndim == 2:
+        img = img[..., None]
+    if img.ndim != 3 or img.shape[:2] != np.shape(u):
+        raise InputError(f"the depth pass is {np.shape(u)[::-1]} pixels and the image {img.shape[:2][::-1]}: "
+                         "they must be the same size")
+    if not np.isfinite(img).all():
+        raise InputError("the image has NaN or infinite pixels: defocus needs finite linear light")
+    cam = cache.camera
+    h, w, c = img.shape
+    lo, w_hi = _node_weights(np.asarray(u, dtype=np.float64), cam)
+    t = cam.tile
+    layers: dict[int, list] = {}
+    for ty in range(math.ceil(h / t)):
+        for tx in range(math.ceil(w / t)):
+            sl = (slice(ty * t, (ty + 1) * t), slice(tx * t, (tx + 1) * t))
+            for n in np.unique(np.concatenate([lo[sl].ravel(), lo[sl].ravel() + 1])):
+                wt = np.where(lo[sl] == n, 1.0 - w_hi[sl], 0.0) + np.where(lo[sl] + 1 == n, w_hi[sl], 0.0)
+                if wt.max() > 1e-6:
+                    layers.setdefault(int(n), []).append((tx, ty, sl, wt.astype(np.float32)))
+    acc_c = np.zeros((h, w, c), dtype=np.float32)
+    acc_a = np.zeros((h, w), dtype=np.float32)
+    done = 0
+    for n in sorted(layers):  # far (small u) first: back to front
+        lay_c = np.zeros((h, w, c), dtype=np.float32)
+        lay_a = np.zeros((h, w), dtype=np.float32)
+        y_lo, y_hi, x_lo, x_hi = h, 0, w, 0
+        for tx, ty, sl, wt in layers[n]:
+            kern = cache.get(cache.node_centre(tx, ty, (h, w), origin), n)
+            out = _tile_layer(img[sl], wt, kern, c)
+            r = kern.radius
+            ya, xa = sl[0].start - r, sl[1].start - r
+            yb, xb = ya + out.shape[1], xa + out.shape[2]
+            cy0, cx0, cy1, cx1 = max(ya, 0), max(xa, 0), min(yb, h), min(xb, w)
+            part = out[:, cy0 - ya: cy1 - ya, cx0 - xa: cx1 - xa]
+            lay_c[cy0:cy1, cx0:cx1] += np.moveaxis(part[:c], 0, 2)
+            lay_a[cy0:cy1, cx0:cx1] += part[c]
+            y_lo, y_hi, x_lo, x_hi = min(y_lo, cy0), max(y_hi, cy1), min(x_lo, cx0), max(x_hi, cx1)
+        bb = (slice(y_lo, y_hi), slice(x_lo, x_hi))
+        a = np.clip(lay_a[bb], 0.0, 1.0)
+        acc_c[bb] = lay_c[bb] + (1.0 - a)[..., None] * acc_c[bb]
+        acc_a[bb] = a + (1.0 - a) * acc_a[bb]
+        done += 1
+        if progress is not None:
+            progress(done, len(layers))
+    out = acc_c / np.maximum(acc_a, 1e-6)[..., None]
+    return out if np.ndim(image) == 3 else out[..., 0]

