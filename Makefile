@@ -17,7 +17,7 @@ BLENDER_PY    := $(BLENDER_VENV)/bin/python
 BLENDER_STAMP := $(BLENDER_VENV)/.physcam-installed
 BPY_VERSION   ?= 5.0.1
 
-.PHONY: demo test venv blender blender-extension bench clean schema chromium shell test-latest wheel usd-min
+.PHONY: demo test venv blender blender-extension bench clean schema chromium shell test-latest wheel usd-min lint
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -71,7 +71,7 @@ chromium:
 	  || echo "physcam: chromium could not be installed; the browser tests will be skipped" >&2; \
 	fi
 
-test: $(STAMP) $(BLENDER_STAMP) chromium
+test: $(STAMP) $(BLENDER_STAMP) chromium lint
 	PHYSCAM_BLENDER_PYTHON=$(abspath $(BLENDER_PY)) $(PY) -m pytest -n 2 -q
 	$(MAKE) --no-print-directory usd-min
 	$(MAKE) --no-print-directory test-latest
@@ -106,6 +106,10 @@ test-latest:
 	  | tr '\n' ' ' | sed 's/^/physcam: newest versions tested: /'; echo
 	$(LATEST_VENV)/bin/python -m pytest -n 2 -q -m "not slow" -p no:cacheprovider tests/onset tests/optics \
 	  tests/lens tests/usd tests/live tests/trace/test_tracer.py tests/analysis/test_image_quality_closed_forms.py
+
+# ruff (pyproject.toml [tool.ruff]): unused imports and variables, undefined names, pycodestyle errors
+lint: $(STAMP)
+	$(VENV)/bin/ruff check src tests scripts benchmarks
 
 wheel: $(STAMP)
 	$(PY) -m build --outdir dist .

@@ -25,7 +25,6 @@ import numpy as np
 import pytest
 
 from _blender import run_blender
-from physcam.analysis.blob import blob_moments
 from physcam.analysis.defocus import defocus, inverse_depth
 from physcam.analysis.defocus_exr import read_exr
 from physcam.analysis.defocus_kernels import KernelCache, defocus_camera

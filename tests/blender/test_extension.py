@@ -15,7 +15,7 @@ import pytest
 from _blender import run_blender
 from physcam.cli import main
 from physcam.lens.library import list_lenses, load_lens
-from physcam.optics.focusing import breathing_table, focus
+from physcam.optics.focusing import breathing_table
 from physcam.trace.rays import RayBatch
 from physcam.trace.trace import trace_to_film
 

@@ -3,7 +3,6 @@ gives, and the command that runs a script under a Python with bpy or under the b
 
 from __future__ import annotations
 
-import os
 import stat
 import subprocess
 import sys

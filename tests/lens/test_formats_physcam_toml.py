@@ -57,7 +57,9 @@ def test_seed_toml_keeps_the_geometry(p):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         q = loads_lens(dumps_lens(p, "seed-toml"), "seed-toml")
-    strip = lambda s: (s.radius, s.thickness, s.semi_diameter, s.kind, s.conic, s.aspheric, s.medium.nd, s.medium.vd)
+    def strip(s):
+        return (s.radius, s.thickness, s.semi_diameter, s.kind, s.conic, s.aspheric, s.medium.nd, s.medium.vd)
+
     assert [strip(s) for s in q.surfaces] == [strip(s) for s in p.surfaces]
     assert q.focus == p.focus and q.squeeze == p.squeeze
 

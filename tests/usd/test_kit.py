@@ -9,7 +9,7 @@ from physcam.errors import ExportError, InputError
 from physcam.usd.author import CameraSpec
 from physcam.usd.kit import (PREVIS_SETUPS, write_body_file, write_lens_file, write_previs_kit, write_shot,
                              write_vendor_lens)
-from physcam.usd.read import find_cameras, open_stage, read_camera
+from physcam.usd.read import open_stage, read_camera
 from physcam.usd.validate import validation_errors
 
 from pxr import Usd, UsdGeom  # noqa: E402

@@ -285,10 +285,6 @@ def make_fields(st: Setup, fields_deg, wavelength_nm: float) -> list[Field]:
     return out
 
 
-def make_field(st: Setup, field_deg, wavelength_nm: float) -> Field:
-    return make_fields(st, [field_deg], wavelength_nm)[0]
-
-
 def field_for_image_height(st: Setup, height_mm: float, wavelength_nm: float) -> float:
     """The field angle (degrees, Y meridian) whose chief ray meets the film at ``height_mm`` on the y axis:
     the chief ray is aimed back from the film through the centre of the stop (:func:`._chief.aim_from_film`)
@@ -503,14 +499,6 @@ def trace_pupils(st: Setup, jobs, tracer: _Tracer) -> list[PupilTrace]:
     return out
 
 
-def trace_pupil(st: Setup, fl: Field, wavelength_nm: float, n: int, box=None, tracer: _Tracer | None = None) -> PupilTrace:
-    """One field at one wavelength (``fl`` must have been made at ``wavelength_nm``)."""
-    tracer = tracer or _Tracer(st)
-    if box is None:
-        box = pupil_box(st, fl, tracer)
-    return trace_pupils(st, [(fl, n, box)], tracer)[0]
-
-
 # --------------------------------------------------------------------------------------------
 # the wavefront on a film plane
 @dataclass
@@ -562,7 +550,7 @@ def wavefront_on(pt: PupilTrace, film_z: float, reference=None) -> WavefrontSamp
     lam_mm = pt.wavelength_nm * 1e-6
     w = ((pt.chief.opl[0] + pt.n_image * tc[0]) - (r.opl + pt.n_image * t)) / lam_mm
     # the ray's point on the sphere and the direction from it to the centre
-    sx, sy, sz = r.x + t * r.L, r.y + t * r.M, r.z + t * r.N
+    sx, sy = r.x + t * r.L, r.y + t * r.M
     tf = (film_z - r.z) / r.N
     return WavefrontSamples(w, r.x + tf * r.L, r.y + tf * r.M, (C[0] - sx) / R, (C[1] - sy) / R,
                             (float(C[0]), float(C[1]), float(C[2])), R, (cp[0], cp[1]))

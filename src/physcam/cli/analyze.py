@@ -11,7 +11,6 @@ images, as ``physcam distortion`` does.
 
 from __future__ import annotations
 
-import math
 
 from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, focus, hidden_alias, number, whole
 from ._output import add_output_options, document, emit_json, print_csv

@@ -65,7 +65,7 @@ def register(sub) -> None:
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     add_lens_argument(b)
     b.add_argument("--focus", type=focus("focus distance", allow_inf=False), required=True, metavar="D",
-                   help=f"focus mark from the film plane (e.g. 2m; or hyperfocal at --fstop)")
+                   help="focus mark from the film plane (e.g. 2m; or hyperfocal at --fstop)")
     b.add_argument("--fstop", type=number("f-number", positive=True), required=True, metavar="N", help="f-number")
     b.add_argument("--light", type=distance("light distance"), required=True, metavar="D",
                    help="the point light's distance from the film plane, on the axis (e.g. 0.7m)")

@@ -100,7 +100,7 @@ def _lens_step(out, ctx, force):
     from ..analysis.diagram import save_lens_diagram
     from ..io import atomic_write
     from ..lens.library import load_lens
-    from ..optics import focusing, paraxial
+    from ..optics import focusing
 
     lens = load_lens(DEFAULTS["lens"])
     ctx["lens"] = lens
@@ -132,7 +132,7 @@ def _usd_step(out, ctx, force):
 def _trace_step(out, ctx, force):
     from ..analysis.bokeh import bokeh_image
     from ..analysis.spot import spot_diagram
-    from ..optics import focusing, paraxial
+    from ..optics import focusing
     from ..trace.aperture import Aperture
 
     lens = ctx["lens"]

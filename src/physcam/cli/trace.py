@@ -106,7 +106,7 @@ def run_bokeh(args) -> int:
         check_writable(args.output, force=args.force)
     import math
 
-    from ..optics import focusing, paraxial
+    from ..optics import focusing
     from ..trace.aperture import Aperture
 
     lens = load_lens(args.lens, lenient=args.lenient)

@@ -367,7 +367,7 @@ def pbrt_camera_values(report, lens=None, *, xres: int = 1920, cameras=PBRT_CAME
     from the entrance pupil). ``realistic`` (needs ``lens``): ``lensfile``, ``aperturediameter`` (the
     stop's diameter for the report's f-number, mm) and ``focusdistance`` (the mark, metres from the film).
     """
-    from ..optics import focusing, paraxial
+    from ..optics import focusing
     from .usdgeom import focus_distance_from_pupil_mm
 
     xres = _whole("xres", xres, 16, 65536)
@@ -485,7 +485,6 @@ def write_pbrt_camera(report, folder, lens=None, *, name: str = "lens", xres: in
             "units: the scene in metres (pbrt divides the lens file's mm by 1000); diagonal and aperture in mm",
             "Include this before WorldBegin; the camera transform (LookAt ...) comes first"]
     if "realistic" in cameras:
-        r = values["realistic"]
         st = focusing.focus(lens, report.focus_from_film_mm)
         text, notes = pbrt_lens_text(st.prescription, comments=[
             f"{lens.name}: physcam's {st.method} focus at {report.focus_from_film_mm:g} mm from the film; "

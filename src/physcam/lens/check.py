@@ -30,7 +30,6 @@ from .geometry import sag
 from .prescription import MAX_ABBE, MAX_INDEX, MIN_ABBE, Prescription
 from .raw import RawLens, read_raw
 from .repair import (
-    CLEARANCE_MM,
     aperture_factor,
     crossing,
     edge_height,

@@ -208,7 +208,7 @@ def _timecode(tc: str, rate: Fraction) -> dict | None:
 def opentrackio_samples(record, *, rate=None) -> list[dict]:
     """The clip as OpenTrackIO 1.0.1 samples (the first with the static block), each validated
     against the shipped schema; the file's timecodes, its lens encoders (Mo-Sys) and its identity."""
-    from ..live.frames import sample_from_frame, static_block
+    from ..live.frames import sample_from_frame
     from ..live.sample import validate_sample
 
     record = _record(record)

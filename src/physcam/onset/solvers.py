@@ -133,7 +133,10 @@ def lens_at_mark(req: ReportRequest) -> LensState:
     H2 and entrance pupil replace a datasheet's; without an f-stop or limits it is wide open."""
     if req.lens is None:
         ref = req.flange_focal_distance_mm or 0.0
-        at = (lambda v: None if v is None else ref + v)  # datasheet offsets, from the film
+
+        def at(v):  # a datasheet offset, from the film
+            return None if v is None else ref + v
+
         return LensState(req.focal_length_mm, req.fstop, req.focus_mm, req.model, at(req.h1_mm), at(req.h2_mm),
                          at(req.pupil_mm), req.squeeze, req.lens_name,
                          n_ratio=1.0 if req.fstop_at_focus is None else req.fstop_at_focus / req.fstop)
