@@ -9,6 +9,12 @@ Figures are ``matplotlib.figure.Figure`` objects on an Agg canvas, made without
 machine) costs 0.1-0.3 s of a command's cold start and nothing here needs it (docs/performance.md).
 :func:`pyplot` returns a small stand-in with pyplot's ``subplots``, ``figure`` and ``close``;
 any other attribute loads the real pyplot (Agg backend).
+
+One style for every figure (:data:`STYLE`, applied by :func:`new_figure`): DejaVu Sans at sizes
+that stay legible on a phone and a printed page, the Okabe-Ito colours (:data:`PALETTE`, told apart
+by readers with any common colour-vision deficiency: Okabe & Ito 2008, "Color Universal Design"),
+units in every axis label, and titles that fit (:func:`fit_title`). :func:`figure_problems` lists
+what breaks those rules in a drawn figure (tests/test_figures_style.py runs it on every figure).
 """
 
 from __future__ import annotations
@@ -16,16 +22,68 @@ from __future__ import annotations
 import io
 from pathlib import Path
 
-__all__ = ["pyplot", "subplots", "new_figure", "save_figure", "figure_bytes"]
+__all__ = ["pyplot", "subplots", "new_figure", "save_figure", "figure_bytes", "PALETTE", "STYLE", "apply_style",
+           "fit_title", "figure_problems", "UNITLESS_WORDS"]
 
 _FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 
+#: The Okabe-Ito palette (blue, vermillion, bluish green, orange, reddish purple, sky blue, yellow,
+#: black): distinguishable with protanopia, deuteranopia and tritanopia (Okabe & Ito 2008).
+PALETTE = ("#0072B2", "#D55E00", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#F0E442", "#000000")
+
+#: matplotlib settings of every physcam figure (:func:`apply_style`).
+STYLE = {
+    "font.family": "sans-serif",
+    "font.sans-serif": ["DejaVu Sans"],
+    "font.size": 8.5,
+    "axes.titlesize": 9.0,
+    "axes.labelsize": 8.5,
+    "xtick.labelsize": 7.5,
+    "ytick.labelsize": 7.5,
+    "legend.fontsize": 7.0,
+    "legend.framealpha": 0.85,
+    "figure.titlesize": 10.0,
+    "axes.grid": False,
+    "grid.alpha": 0.3,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "lines.linewidth": 1.4,
+    "image.cmap": "viridis",
+    "savefig.facecolor": "white",
+    "figure.facecolor": "white",
+}
+
+#: Words that mark an axis of a dimensionless quantity (a ratio): such a label needs no unit.
+UNITLESS_WORDS = ("MTF", "relative", "ratio", "fraction", "normalised", "normalized", "contrast", "count", "f-stop",
+                  "f-number", "weight", "transmission")
+
+
+def apply_style() -> None:
+    """Set :data:`STYLE` and the :data:`PALETTE` colour cycle in matplotlib's rcParams (what every
+    physcam figure is drawn with; :func:`new_figure` calls it)."""
+    import matplotlib
+    from cycler import cycler
+
+    matplotlib.rcParams.update(STYLE)
+    matplotlib.rcParams["axes.prop_cycle"] = cycler(color=list(PALETTE))
+
+
+def fit_title(text: str, width_in: float, *, fontsize: float | None = None) -> str:
+    """``text`` wrapped at word boundaries so that each line fits ``width_in`` inches at ``fontsize``
+    points (default: the style's title size); DejaVu Sans averages 0.55 em per character."""
+    import textwrap
+
+    size = fontsize or STYLE["axes.titlesize"]
+    per_line = max(16, int(width_in * 72.0 / (0.55 * size)))
+    return "\n".join(textwrap.fill(line, per_line, break_long_words=False) for line in str(text).split("\n"))
+
 
 def new_figure(figsize=None, dpi=None, **kwargs):
-    """A ``Figure`` attached to an Agg canvas (no pyplot)."""
+    """A ``Figure`` attached to an Agg canvas (no pyplot), in physcam's style (:func:`apply_style`)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    apply_style()
     fig = Figure(figsize=figsize, dpi=dpi, **kwargs)
     FigureCanvasAgg(fig)
     return fig
@@ -125,3 +183,39 @@ def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130) -> bytes:
     finally:
         _PLOT.close(fig)
     return buf.getvalue()
+
+
+def _has_unit(label: str) -> bool:
+    """An axis label names its unit in parentheses, or is of a ratio (:data:`UNITLESS_WORDS`)."""
+    import re
+
+    return bool(re.search(r"\([^)]*\S[^)]*\)", label)) or any(w.lower() in label.lower() for w in UNITLESS_WORDS)
+
+
+def figure_problems(fig) -> list[str]:
+    """What breaks the figure style in ``fig``, drawn: text (titles, labels, ticks, legends) reaching
+    outside the figure, and axes with ticks but no label or a label without a unit. Empty when none."""
+    from matplotlib.text import Text
+
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    box = fig.bbox
+    problems = []
+    for t in fig.findobj(Text):
+        if not t.get_visible() or not t.get_text().strip():
+            continue
+        b = t.get_window_extent(renderer)
+        if b.x0 < box.x0 - 1 or b.y0 < box.y0 - 1 or b.x1 > box.x1 + 1 or b.y1 > box.y1 + 1:
+            problems.append(f"text {t.get_text()[:50]!r} reaches outside the figure")
+    for ax in fig.axes:
+        if not ax.get_visible() or not ax.axison:
+            continue
+        for name, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
+            if not axis.get_visible() or not [t for t in axis.get_ticklabels() if t.get_text()]:
+                continue
+            label = axis.get_label_text()
+            if not label.strip():
+                problems.append(f"{name} axis of {ax.get_title()[:40]!r} has tick labels but no label")
+            elif not _has_unit(label):
+                problems.append(f"{name} axis label {label!r} names no unit")
+    return problems
