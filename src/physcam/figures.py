@@ -69,13 +69,30 @@ def apply_style() -> None:
 
 
 def fit_title(text: str, width_in: float, *, fontsize: float | None = None) -> str:
-    """``text`` wrapped at word boundaries so that each line fits ``width_in`` inches at ``fontsize``
-    points (default: the style's title size); DejaVu Sans averages 0.55 em per character."""
-    import textwrap
+    """``text`` wrapped at word boundaries so that each line, set in the style's font at ``fontsize``
+    points (default the title size), is at most ``width_in`` inches wide (measured by matplotlib)."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import text_to_path
 
-    size = fontsize or STYLE["axes.titlesize"]
-    per_line = max(16, int(width_in * 72.0 / (0.55 * size)))
-    return "\n".join(textwrap.fill(line, per_line, break_long_words=False) for line in str(text).split("\n"))
+    apply_style()
+    prop = FontProperties(family=STYLE["font.sans-serif"], size=fontsize or STYLE["axes.titlesize"])
+    limit = width_in * 72.0
+
+    def width(s: str) -> float:
+        return text_to_path.get_text_width_height_descent(s, prop, ismath=False)[0]
+
+    out = []
+    for para in str(text).split("\n"):
+        line = ""
+        for word in para.split(" "):
+            trial = f"{line} {word}" if line else word
+            if line and width(trial) > limit:
+                out.append(line)
+                line = word
+            else:
+                line = trial
+        out.append(line)
+    return "\n".join(out)
 
 
 def new_figure(figsize=None, dpi=None, **kwargs):
@@ -166,9 +183,10 @@ def save_figure(fig, path, *, force: bool = False, dpi: int = 130) -> Path:
     return atomic_write(p, figure_bytes(fig, fmt, dpi=dpi), force=force)
 
 
-def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130) -> bytes:
+def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130, description: str | None = None) -> bytes:
     """``fig`` drawn in memory as ``fmt`` ("png", "svg" or "pdf") and closed: what :func:`save_figure`
-    writes, for a caller that sends it elsewhere (``physcam serve``)."""
+    writes, for a caller that sends it elsewhere (``physcam serve``). ``description`` (SVG and PDF)
+    goes into the file's metadata (SVG: ``dc:description``), e.g. numbers a web page reads."""
     from .errors import ExportError, WrongTypeError
 
     if not callable(getattr(fig, "savefig", None)):
@@ -179,7 +197,9 @@ def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130) -> bytes:
     _skip_layout_rerun(fig)
     buf = io.BytesIO()
     try:
-        fig.savefig(buf, format=fmt, dpi=dpi)
+        meta = None if description is None or fmt == "png" else {"Description" if fmt == "svg" else "Subject":
+                                                                     description}
+        fig.savefig(buf, format=fmt, dpi=dpi, metadata=meta)
     finally:
         _PLOT.close(fig)
     return buf.getvalue()
