@@ -16,6 +16,7 @@ colour fringes (three channels at 620, 550 and 460 nm).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,7 +24,7 @@ import numpy as np
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
-__all__ = ["BokehImage", "bokeh_image", "RGB_WAVELENGTHS_NM"]
+__all__ = ["BokehImage", "bokeh_image", "RGB_WAVELENGTHS_NM", "tone_map", "scale_bar_pixels", "write_bokeh_photo"]
 
 RGB_WAVELENGTHS_NM = (620.0, 550.0, 460.0)
 
@@ -54,7 +55,8 @@ class BokehImage:
                 "rays_passed": self.rays_passed, "film_z_mm": self.film_z_mm, "centroid_mm": [cx, cy]}
 
     def plot(self, path=None, *, force: bool = False):
-        from ..figures import pyplot
+        """The film-millimetre plot: the image (peak white) on film x and y axes."""
+        from ..figures import fit_title, pyplot
 
         plt = pyplot()
 
@@ -65,7 +67,7 @@ class BokehImage:
         ax.imshow(img, origin="lower", extent=self.extent_mm, interpolation="nearest")
         ax.set_xlabel("film x (mm)")
         ax.set_ylabel("film y (mm)")
-        ax.set_title(f"{self.lens_name}: bokeh", fontsize=9)
+        ax.set_title(fit_title(f"{self.lens_name}: bokeh", 3.6))
         fig.tight_layout()
         if path is None:
             return fig
@@ -268,3 +270,85 @@ def _accumulate(lens, src, trace, extent, rays, pixels, chunk, fresnel, progress
         if progress is not None:
             progress(done, rays)
     return img, passed
+
+
+# ---- bokeh as a photograph -----------------------------------------------------------------------
+def tone_map(rgb: np.ndarray, *, exposure: float = 1.0) -> np.ndarray:
+    """Linear relative irradiance (h, w, 3) as sRGB-encoded values in 0..1 for a PNG: scaled so the
+    99.5th percentile of the lit pixels is 1 (times ``exposure``), rolled off as 1 - exp(-x) (highlights
+    saturate as on film, nothing clips hard) and encoded with the sRGB transfer function (IEC 61966-2-1)."""
+    lit = rgb[rgb > 0]
+    ref = float(np.percentile(lit, 99.5)) if lit.size else 1.0
+    x = rgb * (exposure / max(ref, 1e-300))
+    y = 1.0 - np.exp(-2.0 * x)
+    return np.where(y <= 0.0031308, 12.92 * y, 1.055 * np.power(np.clip(y, 0.0, 1.0), 1 / 2.4) - 0.055)
+
+
+def scale_bar_pixels(image_width_mm: float, pixel_pitch_um: float) -> int:
+    """A round length (1, 2 or 5 times a power of ten) in sensor pixels of ``pixel_pitch_um`` for a
+    scale bar about a quarter as wide as an image ``image_width_mm`` wide on the film."""
+    across = image_width_mm * 1000.0 / pixel_pitch_um
+    target = max(across / 4.0, 1.0)
+    p = 10 ** math.floor(math.log10(target))
+    return int(max(m * p for m in (1, 2, 5) if m * p <= target) if p >= 1 else 1)
+
+
+def write_bokeh_photo(img: BokehImage, path, *, pixel_pitch_um: float, sensor_name: str = "", exposure: float = 1.0,
+                      force: bool = False) -> list:
+    """The bokeh as a photograph of the highlight: ``path`` with ``.exr`` (linear relative irradiance,
+    RGB: the three wavelengths of a spectral image, else grey; 32-bit float, the film extent and pixel
+    size in its header) and ``.png`` (:func:`tone_map`, with a scale bar in pixels of a sensor of
+    ``pixel_pitch_um``). Returns both paths. Rows top first: film +y up, as the camera sees it."""
+    from pathlib import Path
+
+    from ..errors import require_positive
+    from ..io import check_writable
+    from .stmap import _write_exr
+
+    pitch = require_positive("pixel pitch", pixel_pitch_um, unit="um")
+    base = Path(path)
+    base = base.with_suffix("") if base.suffix.lower() in (".exr", ".png") else base
+    exr, png = base.with_name(base.name + ".exr"), base.with_name(base.name + ".png")
+    for p in (exr, png):
+        check_writable(p, force=force)
+    rgb = img.image if img.image.shape[2] == 3 else np.repeat(img.image, 3, axis=2)
+    rgb = np.ascontiguousarray(rgb[::-1])  # row 0 on top
+    x0, x1, y0, y1 = img.extent_mm
+    attrs = {"physcam_film_extent_mm": " ".join(f"{v:.6g}" for v in img.extent_mm),
+             "physcam_pixel_mm": float((x1 - x0) / rgb.shape[1]), "physcam_lens": img.lens_name,
+             "physcam_wavelengths_nm": " ".join(f"{w:g}" for w in img.wavelengths_nm)}
+    _write_exr(rgb, exr, attrs, force=force)
+    _write_photo_png(tone_map(rgb, exposure=exposure), png, x1 - x0, pitch, sensor_name, force)
+    return [exr, png]
+
+
+def _write_photo_png(srgb, path, width_mm, pitch_um, sensor_name, force):
+    """``srgb`` (0..1) as an 8-bit PNG, enlarged to at least 512 pixels, with the scale bar and its label."""
+    from PIL import Image, ImageDraw
+
+    from ..io import staged
+
+    im = Image.fromarray((np.clip(srgb, 0, 1) * 255 + 0.5).astype(np.uint8), "RGB")
+    k = max(1, math.ceil(512 / im.width))
+    im = im.resize((im.width * k, im.height * k), Image.NEAREST)
+    n = scale_bar_pixels(width_mm, pitch_um)
+    bar = n * pitch_um / 1000.0 / width_mm * im.width
+    d = ImageDraw.Draw(im)
+    y = im.height - 24
+    d.rectangle([16, y, 16 + round(bar), y + 5], fill=(255, 255, 255))
+    label = f"{n} px" + (f" of {sensor_name}" if sensor_name else "") + f" ({pitch_um:g} µm pitch)"
+    d.text((16, y - 20), label, fill=(255, 255, 255), font=_label_font())
+    with staged(path, force=force, suffix=".png") as tmp:
+        im.save(tmp, format="png")
+    return path
+
+
+def _label_font():
+    """The figures' font (DejaVu Sans, shipped with matplotlib) at 14 px for the PNG's scale bar label."""
+    from matplotlib.font_manager import findfont
+    from PIL import ImageFont
+
+    try:
+        return ImageFont.truetype(findfont("DejaVu Sans"), 14)
+    except OSError:  # no TrueType support in this Pillow: its own bitmap font
+        return ImageFont.load_default()
