@@ -194,6 +194,7 @@ def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130, description: str | No
     if fmt not in _FORMATS.values():
         _PLOT.close(fig)
         raise ExportError(f"cannot draw a figure as {fmt!r}: use one of png, svg, pdf")
+    _check_style(fig)
     _skip_layout_rerun(fig)
     buf = io.BytesIO()
     try:
@@ -203,6 +204,24 @@ def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130, description: str | No
     finally:
         _PLOT.close(fig)
     return buf.getvalue()
+
+
+#: Set to "1" (tests/test_figures_style.py), every figure physcam saves is checked by
+#: :func:`figure_problems` first, and one that breaks the style raises ExportError.
+STRICT_ENV = "PHYSCAM_STRICT_FIGURES"
+
+
+def _check_style(fig) -> None:
+    import os
+
+    if os.environ.get(STRICT_ENV) != "1":
+        return
+    problems = figure_problems(fig)
+    if problems:
+        from .errors import ExportError
+
+        _PLOT.close(fig)
+        raise ExportError("the figure breaks physcam's figure style: " + "; ".join(problems))
 
 
 def _has_unit(label: str) -> bool:
@@ -215,14 +234,23 @@ def _has_unit(label: str) -> bool:
 def figure_problems(fig) -> list[str]:
     """What breaks the figure style in ``fig``, drawn: text (titles, labels, ticks, legends) reaching
     outside the figure, and axes with ticks but no label or a label without a unit. Empty when none."""
+    import re
+
     from matplotlib.text import Text
 
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
     box = fig.bbox
     problems = []
+    hidden = set()  # tick labels of ticks outside the view: matplotlib keeps them but does not draw them
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            lo, hi = sorted(axis.get_view_interval())
+            for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+                if not lo - 1e-9 * abs(hi - lo) <= tick.get_loc() <= hi + 1e-9 * abs(hi - lo):
+                    hidden.update({id(tick.label1), id(tick.label2)})
     for t in fig.findobj(Text):
-        if not t.get_visible() or not t.get_text().strip():
+        if not t.get_visible() or not t.get_text().strip() or id(t) in hidden:
             continue
         b = t.get_window_extent(renderer)
         if b.x0 < box.x0 - 1 or b.y0 < box.y0 - 1 or b.x1 > box.x1 + 1 or b.y1 > box.y1 + 1:
@@ -238,4 +266,6 @@ def figure_problems(fig) -> list[str]:
                 problems.append(f"{name} axis of {ax.get_title()[:40]!r} has tick labels but no label")
             elif not _has_unit(label):
                 problems.append(f"{name} axis label {label!r} names no unit")
+            elif re.search(r"\bum\b", label):
+                problems.append(f"{name} axis label {label!r} writes um for µm")
     return problems

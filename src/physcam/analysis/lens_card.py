@@ -71,7 +71,7 @@ class LensCard:
 
         w, h = PAGES[self.page]
         fig = new_figure(figsize=(w, h), dpi=dpi)
-        gs = fig.add_gridspec(5, 6, left=0.08, right=0.93, top=0.93, bottom=0.05, hspace=0.75, wspace=1.6,
+        gs = fig.add_gridspec(5, 6, left=0.08, right=0.9, top=0.93, bottom=0.05, hspace=0.75, wspace=1.6,
                               height_ratios=(1.25, 1.0, 1.0, 1.0, 0.8))
         fig.suptitle(self._title(), fontsize=11, fontweight="bold", y=0.985)
         fig.text(0.5, 0.955, self._subtitle(units), ha="center", va="center", fontsize=7.5, color="0.25")

@@ -103,26 +103,7 @@ def run_spot(args) -> int:
                 print(f"note: {f.reason}")
         if args.output:
             print(f"wrote {args.output}")
-        if photo is not None:
-            print(f"wrote {photo['exr']} and {photo['png']} (scale bar {photo['scale_bar_px']} px of "
-                  f"{photo['sensor']}, {photo['pixel_pitch_um']:g} um pitch)")
     return 0
-
-
-def _bokeh_photo(res, args) -> dict:
-    """``physcam bokeh --image``: the EXR and PNG photograph, and what its scale bar means."""
-    from ..analysis.bokeh import scale_bar_pixels, write_bokeh_photo
-    from ._common import resolve_sensor
-
-    sensor = resolve_sensor(args)
-    pitch = args.pixel_pitch or sensor.pitch_um or sensor.width_mm * 1000.0 / 4096
-    exr, png = write_bokeh_photo(res, args.image, pixel_pitch_um=pitch, sensor_name=sensor.name,
-                                 exposure=args.exposure, force=args.force)
-    x0, x1 = res.extent_mm[:2]
-    return {"exr": str(exr), "png": str(png), "sensor": sensor.name, "pixel_pitch_um": pitch,
-            "pitch_source": "--pixel-pitch" if args.pixel_pitch else ("sensor" if sensor.pitch_um else
-                                                                       "sensor width / 4096"),
-            "scale_bar_px": scale_bar_pixels(x1 - x0, pitch), "image_width_px_of_sensor": (x1 - x0) * 1000.0 / pitch}
 
 
 def run_bokeh(args) -> int:
@@ -187,7 +168,7 @@ def run_bokeh(args) -> int:
             print(f"wrote {args.output}")
         if photo is not None:
             print(f"wrote {photo['exr']} and {photo['png']} (scale bar {photo['scale_bar_px']} px of "
-                  f"{photo['sensor']}, {photo['pixel_pitch_um']:g} um pitch)")
+                  f"{photo['sensor']}, {photo['pixel_pitch_um']:g} µm pitch)")
     return 0
 
 
