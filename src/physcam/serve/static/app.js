@@ -219,7 +219,7 @@ function chart(api) {
     fetch(src).then((r) => (r.ok ? r.text() : "")).then((text) => {
       if (img.getAttribute("src") !== src) return;
       const doc = new DOMParser().parseFromString(text, "image/svg+xml");
-      const desc = doc.getElementsByTagNameNS("http://purl.org/dc/elements/1.1/", "description")[0];
+      const desc = doc.getElementsByTagName("dc:description")[0]; // (matplotlib writes the dc: prefix)
       st.chart = desc ? JSON.parse(desc.textContent) : null;
     }).catch(() => { st.chart = null; });
   }
