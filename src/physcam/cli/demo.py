@@ -11,6 +11,8 @@ folder and prints the report:
   rays and cardinal points; ``breathing.png``: field of view against focus distance;
 - ``camera.usda``: the PhysicalCamera and its companion UsdGeomCamera;
 - ``spot.png`` and ``bokeh.png``: real-ray spot diagram and bokeh of a point light;
+  ``bokeh_photo.exr`` / ``.png``: that bokeh as a photograph (linear, and tone-mapped with a scale
+  bar in the sensor's pixels);
 - ``lens_card.pdf``: the lens's one-page card (section, MTF, distortion, illumination, breathing,
   bokeh, key numbers; docs/lens-card.md);
 - ``distortion/``: ST-maps (EXR, with PNG previews) of the lens at that focus on that sensor, its
@@ -148,7 +150,12 @@ def _trace_step(out, ctx, force):
     stop = focusing.iris_semi_diameter(lens, DEFAULTS["fstop"])
     bokeh = bokeh_image(st.prescription, 1200.0, 250.0, 150.0, film_z=st.film_z, rays=400_000, pixels=160,
                         stop_semi_diameter=stop, aperture=Aperture(nsides=7, roundness=0.2), spectral=True)
-    return [spot.plot(out / "spot.png", force=force), bokeh.plot(out / "bokeh.png", force=force)]
+    from ..analysis.bokeh import write_bokeh_photo
+
+    s = ctx["report"].sensor
+    photo = write_bokeh_photo(bokeh, out / "bokeh_photo", pixel_pitch_um=s.pitch_um or s.width_mm * 1000.0 / 4096,
+                              sensor_name=s.name, force=force)
+    return [spot.plot(out / "spot.png", force=force), bokeh.plot(out / "bokeh.png", force=force), *photo]
 
 
 def _card_step(out, ctx, force):
