@@ -9,6 +9,12 @@ Figures are ``matplotlib.figure.Figure`` objects on an Agg canvas, made without
 machine) costs 0.1-0.3 s of a command's cold start and nothing here needs it (docs/performance.md).
 :func:`pyplot` returns a small stand-in with pyplot's ``subplots``, ``figure`` and ``close``;
 any other attribute loads the real pyplot (Agg backend).
+
+One style for every figure (:data:`STYLE`, applied by :func:`new_figure`): DejaVu Sans at sizes
+that stay legible on a phone and a printed page, the Okabe-Ito colours (:data:`PALETTE`, told apart
+by readers with any common colour-vision deficiency: Okabe & Ito 2008, "Color Universal Design"),
+units in every axis label, and titles that fit (:func:`fit_title`). :func:`figure_problems` lists
+what breaks those rules in a drawn figure (tests/test_figures_style.py runs it on every figure).
 """
 
 from __future__ import annotations
@@ -16,16 +22,85 @@ from __future__ import annotations
 import io
 from pathlib import Path
 
-__all__ = ["pyplot", "subplots", "new_figure", "save_figure", "figure_bytes"]
+__all__ = ["pyplot", "subplots", "new_figure", "save_figure", "figure_bytes", "PALETTE", "STYLE", "apply_style",
+           "fit_title", "figure_problems", "UNITLESS_WORDS"]
 
 _FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 
+#: The Okabe-Ito palette (blue, vermillion, bluish green, orange, reddish purple, sky blue, yellow,
+#: black): distinguishable with protanopia, deuteranopia and tritanopia (Okabe & Ito 2008).
+PALETTE = ("#0072B2", "#D55E00", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#F0E442", "#000000")
+
+#: matplotlib settings of every physcam figure (:func:`apply_style`).
+STYLE = {
+    "font.family": "sans-serif",
+    "font.sans-serif": ["DejaVu Sans"],
+    "font.size": 8.5,
+    "axes.titlesize": 9.0,
+    "axes.labelsize": 8.5,
+    "xtick.labelsize": 7.5,
+    "ytick.labelsize": 7.5,
+    "legend.fontsize": 7.0,
+    "legend.framealpha": 0.85,
+    "figure.titlesize": 10.0,
+    "axes.grid": False,
+    "grid.alpha": 0.3,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "lines.linewidth": 1.4,
+    "image.cmap": "viridis",
+    "savefig.facecolor": "white",
+    "figure.facecolor": "white",
+}
+
+#: Words that mark an axis of a dimensionless quantity (a ratio): such a label needs no unit.
+UNITLESS_WORDS = ("MTF", "relative", "ratio", "fraction", "normalised", "normalized", "contrast", "count", "f-stop",
+                  "f-number", "weight", "transmission")
+
+
+def apply_style() -> None:
+    """Set :data:`STYLE` and the :data:`PALETTE` colour cycle in matplotlib's rcParams (what every
+    physcam figure is drawn with; :func:`new_figure` calls it)."""
+    import matplotlib
+    from cycler import cycler
+
+    matplotlib.rcParams.update(STYLE)
+    matplotlib.rcParams["axes.prop_cycle"] = cycler(color=list(PALETTE))
+
+
+def fit_title(text: str, width_in: float, *, fontsize: float | None = None) -> str:
+    """``text`` wrapped at word boundaries so that each line, set in the style's font at ``fontsize``
+    points (default the title size), is at most ``width_in`` inches wide (measured by matplotlib)."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import text_to_path
+
+    apply_style()
+    prop = FontProperties(family=STYLE["font.sans-serif"], size=fontsize or STYLE["axes.titlesize"])
+    limit = width_in * 72.0
+
+    def width(s: str) -> float:
+        return text_to_path.get_text_width_height_descent(s, prop, ismath=False)[0]
+
+    out = []
+    for para in str(text).split("\n"):
+        line = ""
+        for word in para.split(" "):
+            trial = f"{line} {word}" if line else word
+            if line and width(trial) > limit:
+                out.append(line)
+                line = word
+            else:
+                line = trial
+        out.append(line)
+    return "\n".join(out)
+
 
 def new_figure(figsize=None, dpi=None, **kwargs):
-    """A ``Figure`` attached to an Agg canvas (no pyplot)."""
+    """A ``Figure`` attached to an Agg canvas (no pyplot), in physcam's style (:func:`apply_style`)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    apply_style()
     fig = Figure(figsize=figsize, dpi=dpi, **kwargs)
     FigureCanvasAgg(fig)
     return fig
@@ -108,9 +183,10 @@ def save_figure(fig, path, *, force: bool = False, dpi: int = 130) -> Path:
     return atomic_write(p, figure_bytes(fig, fmt, dpi=dpi), force=force)
 
 
-def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130) -> bytes:
+def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130, description: str | None = None) -> bytes:
     """``fig`` drawn in memory as ``fmt`` ("png", "svg" or "pdf") and closed: what :func:`save_figure`
-    writes, for a caller that sends it elsewhere (``physcam serve``)."""
+    writes, for a caller that sends it elsewhere (``physcam serve``). ``description`` (SVG and PDF)
+    goes into the file's metadata (SVG: ``dc:description``), e.g. numbers a web page reads."""
     from .errors import ExportError, WrongTypeError
 
     if not callable(getattr(fig, "savefig", None)):
@@ -118,10 +194,82 @@ def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130) -> bytes:
     if fmt not in _FORMATS.values():
         _PLOT.close(fig)
         raise ExportError(f"cannot draw a figure as {fmt!r}: use one of png, svg, pdf")
+    _check_style(fig)
     _skip_layout_rerun(fig)
     buf = io.BytesIO()
     try:
-        fig.savefig(buf, format=fmt, dpi=dpi)
+        meta = None if description is None or fmt == "png" else {"Description" if fmt == "svg" else "Subject":
+                                                                     description}
+        fig.savefig(buf, format=fmt, dpi=dpi, metadata=meta)
     finally:
         _PLOT.close(fig)
     return buf.getvalue()
+
+
+#: Set to "1" (tests/test_figures_style.py), every figure physcam saves is checked by
+#: :func:`figure_problems` first, and one that breaks the style raises ExportError.
+STRICT_ENV = "PHYSCAM_STRICT_FIGURES"
+
+
+def _check_style(fig) -> None:
+    import os
+
+    if os.environ.get(STRICT_ENV) != "1":
+        return
+    problems = figure_problems(fig)
+    if problems:
+        from .errors import ExportError
+
+        _PLOT.close(fig)
+        raise ExportError("the figure breaks physcam's figure style: " + "; ".join(problems))
+
+
+def _has_unit(label: str) -> bool:
+    """An axis label names its unit in parentheses, or is of a ratio (:data:`UNITLESS_WORDS`)."""
+    import re
+
+    return bool(re.search(r"\([^)]*\S[^)]*\)", label)) or any(w.lower() in label.lower() for w in UNITLESS_WORDS)
+
+
+def figure_problems(fig) -> list[str]:
+    """What breaks the figure style in ``fig``, drawn: text (titles, labels, ticks, legends) reaching
+    outside the figure, and axes with ticks but no label or a label without a unit. Empty when none."""
+    import re
+
+    from matplotlib.figure import Figure
+    from matplotlib.text import Text
+
+    from .errors import require_type
+
+    require_type("fig", fig, Figure, "a matplotlib Figure (physcam's figures return one)")
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    box = fig.bbox
+    problems = []
+    hidden = set()  # tick labels of ticks outside the view: matplotlib keeps them but does not draw them
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            lo, hi = sorted(axis.get_view_interval())
+            for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+                if not lo - 1e-9 * abs(hi - lo) <= tick.get_loc() <= hi + 1e-9 * abs(hi - lo):
+                    hidden.update({id(tick.label1), id(tick.label2)})
+    for t in fig.findobj(Text):
+        if not t.get_visible() or not t.get_text().strip() or id(t) in hidden:
+            continue
+        b = t.get_window_extent(renderer)
+        if b.x0 < box.x0 - 1 or b.y0 < box.y0 - 1 or b.x1 > box.x1 + 1 or b.y1 > box.y1 + 1:
+            problems.append(f"text {t.get_text()[:50]!r} reaches outside the figure")
+    for ax in fig.axes:
+        if not ax.get_visible() or not ax.axison:
+            continue
+        for name, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
+            if not axis.get_visible() or not [t for t in axis.get_ticklabels() if t.get_text()]:
+                continue
+            label = axis.get_label_text()
+            if not label.strip():
+                problems.append(f"{name} axis of {ax.get_title()[:40]!r} has tick labels but no label")
+            elif not _has_unit(label):
+                problems.append(f"{name} axis label {label!r} names no unit")
+            elif re.search(r"\bum\b", label):
+                problems.append(f"{name} axis label {label!r} writes um for µm")
+    return problems

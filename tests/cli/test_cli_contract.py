@@ -70,6 +70,7 @@ JSON_RUNS = {
     ("lens", "show"): ["lens", "show", "dgauss_50mm", "--focus", "2m"],
     ("lens", "breathing"): ["lens", "breathing", "dgauss_50mm", "--focus", "1m", "2m", "inf"],
     ("lens", "check"): ["lens", "check", "dgauss_50mm"],
+    ("lens", "card"): ["lens", "card", "--lens", "dgauss_50mm", "--draft", "--dpi", "30", "-o", "card.png"],
     ("lens", "fix"): ["lens", "fix", "dgauss_50mm.toml", "-o", "fixed.toml"],
     ("spot",): ["spot", "dgauss_50mm", "--rings", "8"],
     ("bokeh",): ["bokeh", "dgauss_50mm", "--rays", "2000", "--pixels", "32", "--focus", "2m", "--light", "1m"],

@@ -271,3 +271,53 @@ def test_phone_screenshot_and_touch_targets(page, server, tmp_path):
         from physcam.io import atomic_write
 
         atomic_write(DOCS_SCREENSHOT, shot.read_bytes(), force=True)
+
+
+DOCS_CHART_SCREENSHOT = DOCS_SCREENSHOT.with_name("serve_phone_dof_chart.png")
+
+
+def test_dof_chart_fits_the_phone_and_marks_the_cursor(page, server, capsys, tmp_path):
+    """The chart fits the 375 px screen (no side scroll, the picture inside its section), and the
+    mark under a finger reads the near and far limits of the CLI's report at that focus mark."""
+    open_page(page, server)
+    type_setup(page)
+    wait_mm(page, "out-near", cli_report(capsys, *SETUP)["dof"]["near_from_film_mm"])
+    page.wait_for_function("() => { const i = document.getElementById('dof-chart');"
+                           " return i.complete && i.naturalWidth > 0; }")
+    page.wait_for_function("() => document.getElementById('dof-readout') && window.getComputedStyle("
+                           "document.getElementById('dof-chart')).display !== 'none'")
+    page.locator("#dof-wrap").scroll_into_view_if_needed()
+    box = page.locator("#dof-chart").bounding_box()
+    assert box["x"] >= 0 and box["x"] + box["width"] <= 375
+    assert page.evaluate("document.documentElement.scrollWidth") <= 375
+    # the SVG's own numbers say where its axes are: point at the middle of the x axis
+    meta = page.evaluate("""async () => {
+        const t = await (await fetch(document.getElementById('dof-chart').getAttribute('src'))).text();
+        const d = new DOMParser().parseFromString(t, 'image/svg+xml');
+        return JSON.parse(d.getElementsByTagNameNS('http://purl.org/dc/elements/1.1/', 'description')[0].textContent);
+    }""")
+    x0, y0, w, h = meta["axes"]
+    fx = x0 + 0.3 * w
+    page.wait_for_function("() => document.getElementById('dof-chart').getBoundingClientRect().width > 0")
+    page.mouse.move(box["x"] + fx * box["width"], box["y"] + (1 - y0 - h / 2) * box["height"])
+    page.wait_for_function("() => document.getElementById('dof-readout').dataset.mm !== undefined")
+    mark = float(page.get_attribute("#dof-readout", "data-mm"))
+    lo, hi = meta["x_mm"]
+    assert mark == pytest.approx(lo * (hi / lo) ** 0.3, rel=0.01)  # the log axis, read back
+    assert page.is_visible("#dof-cursor")
+    text = page.text_content("#dof-readout")
+    # f/2 at that mark, from the CLI's report itself: the chart interpolates between its rows (2 %)
+    d = cli_report(capsys, *SETUP[:-1], f"{mark:.0f}mm")["dof"]
+    part = next(p for p in text.split(" · ") if p.startswith("f/2:"))
+    near_txt = part.split(": ")[1].split(" – ")[0]
+    assert near_txt.endswith(" m") or near_txt.endswith(" cm")
+    near = float(near_txt.split()[0]) * (1000.0 if near_txt.endswith(" m") else 10.0)
+    assert near == pytest.approx(d["near_from_film_mm"], rel=0.02, abs=6.0)
+    shot = tmp_path / "chart.png"
+    page.locator("#dof-wrap").screenshot(path=str(shot))
+    assert _png_size(shot)[0] <= 375
+    if os.environ.get("PHYSCAM_WRITE_DOCS_SCREENSHOT") == "1":  # refresh the picture in docs/serve.md
+        from physcam.io import atomic_write
+
+        page.screenshot(path=str(shot))
+        atomic_write(DOCS_CHART_SCREENSHOT, shot.read_bytes(), force=True)

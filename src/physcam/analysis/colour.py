@@ -107,7 +107,7 @@ class ColourResult:
             a2.plot([p.field_deg for p in self.lateral], [p.lateral_colour_um for p in self.lateral], "o-", ms=3)
         a2.axhline(0.0, color="0.6", lw=0.6)
         a2.set_xlabel("field angle (deg)")
-        a2.set_ylabel("lateral colour F - C (um)")
+        a2.set_ylabel("lateral colour F - C (µm)")
         a2.set_title("lateral colour on the film", fontsize=8)
         fig.suptitle(self.lens_name, fontsize=9)
         return save(fig, path, force)

@@ -79,18 +79,24 @@ class LensDiagram:
         """A matplotlib Figure (Agg canvas). The view spans the lens and film; an object closer than
         infinity is marked by where its rays enter the view (its distance is in the title, in
         ``units``: m or ft)."""
-        from ..units import format_distance
+        from ..figures import new_figure
 
-        from matplotlib.figure import Figure
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        fig = new_figure(figsize=(width_in, width_in * 0.45))
+        ax = fig.add_subplot(1, 1, 1)
+        self.draw(ax, units=units, width_in=width_in)
+        fig.tight_layout()
+        return fig
+
+    def draw(self, ax, *, units: str = "m", width_in: float = 10.0, title: bool = True) -> None:
+        """Draw the diagram on matplotlib axes ``ax`` (what :meth:`figure` shows; the lens card's
+        section); ``width_in`` is the width the title is wrapped to."""
+        from ..figures import PALETTE, fit_title
+        from ..units import format_distance
 
         p, g, axis = self.prescription, self.gaussian, self.axis
         zv = p.vertex_z
         sds = [s.semi_diameter for s in p.surfaces]
         hmax = max(sds)
-        fig = Figure(figsize=(width_in, width_in * 0.45))
-        FigureCanvasAgg(fig)
-        ax = fig.add_subplot(1, 1, 1)
         # elements: glass between surface i and i+1
         for i in range(len(p.surfaces) - 1):
             a, b = p.surfaces[i], p.surfaces[i + 1]
@@ -100,7 +106,7 @@ class LensDiagram:
             front = [(zv[i] + sag(a, a.semi_diameter * (2 * j / k - 1), axis), a.semi_diameter * (2 * j / k - 1)) for j in range(k + 1)]
             back = [(zv[i + 1] + sag(b, b.semi_diameter * (1 - 2 * j / k), axis), b.semi_diameter * (1 - 2 * j / k)) for j in range(k + 1)]
             poly = front + back
-            ax.fill([q[0] for q in poly], [q[1] for q in poly], facecolor="#cfe3f5", edgecolor="#1f4e79", linewidth=1.0)
+            ax.fill([q[0] for q in poly], [q[1] for q in poly], facecolor="#cfe3f5", edgecolor=PALETTE[0], linewidth=1.0)
         # the aperture stop
         k = p.stop_index
         r = g.stop_semi_diameter
@@ -108,7 +114,7 @@ class LensDiagram:
             ax.plot([zv[k], zv[k]], [sgn * r, sgn * (r + 0.25 * hmax)], color="black", linewidth=2.5)
         ax.text(zv[k], 1.3 * hmax, "stop", ha="center", fontsize=8)
         # rays
-        colours = {"marginal": "#c0392b", "chief": "#27ae60", "rim": "#7fbf7f"}
+        colours = {"marginal": PALETTE[1], "chief": PALETTE[2], "rim": PALETTE[5]}
         for kind, pts in self.rays:
             ax.plot([q[0] for q in pts], [q[1] for q in pts], color=colours[kind], linewidth=0.9 if kind != "rim" else 0.6)
         # film plane
@@ -119,12 +125,12 @@ class LensDiagram:
         marks = [("F", g.z_front_focal_point), ("F'", g.z_rear_focal_point), ("H", g.z_front_principal_plane),
                  ("H'", g.z_rear_principal_plane)]
         for label, zp in marks:
-            ax.plot([zp], [0.0], marker="o", color="#8e44ad", markersize=4)
+            ax.plot([zp], [0.0], marker="o", color=PALETTE[4], markersize=4)
             ax.annotate(label, (zp, 0.0), textcoords="offset points", xytext=(0, 6 if "H" in label else -12),
-                        ha="center", fontsize=8, color="#8e44ad")
+                        ha="center", fontsize=8, color=PALETTE[4])
         for label, zp, d in (("EP", g.z_entrance_pupil, g.entrance_pupil_diameter), ("XP", g.z_exit_pupil, g.exit_pupil_diameter)):
-            ax.plot([zp, zp], [-d / 2, d / 2], color="#e67e22", linewidth=1.2, linestyle="--")
-            ax.annotate(label, (zp, d / 2), textcoords="offset points", xytext=(0, 3), ha="center", fontsize=8, color="#e67e22")
+            ax.plot([zp, zp], [-d / 2, d / 2], color=PALETTE[3], linewidth=1.2, linestyle="--")
+            ax.annotate(label, (zp, d / 2), textcoords="offset points", xytext=(0, 3), ha="center", fontsize=8, color=PALETTE[3])
         # the view: the lens and film (rays from a near object enter from the left); points outside are
         # listed below the plot
         z_view = -max(0.3 * p.total_track, 10.0)
@@ -142,13 +148,10 @@ class LensDiagram:
         ax.set_xlabel("z from the first vertex (mm, + toward the film)")
         ax.set_ylabel(f"{axis} (mm)")
         fnum = g.f_number if self.fstop is None else self.fstop
-        ax.set_title(
-            f"{p.name}: EFL {g.efl:.2f} mm, f/{fnum:.3g}, focus {format_distance(self.focus_from_film_mm, units)}, "
-            f"half-field {self.field_deg:.1f}° ({axis.upper()} meridian)",
-            fontsize=10,
-        )
-        fig.tight_layout()
-        return fig
+        if title:
+            ax.set_title(fit_title(
+                f"{p.name}: EFL {g.efl:.2f} mm, f/{fnum:.3g}, focus {format_distance(self.focus_from_film_mm, units)}, "
+                f"half-field {self.field_deg:.1f}° ({axis.upper()} meridian)", width_in))
 
 
 def _default_field(p: Prescription, g: paraxial.GaussianData, axis: str, wavelength_nm) -> float:

@@ -124,8 +124,8 @@ class HuygensPSF:
         im = ax.imshow(np.maximum(img, top * 1e-5), origin="lower", cmap="magma", norm=LogNorm(top * 1e-5, top),
                        extent=(-half, half, -half, half))
         fig.colorbar(im, ax=ax, label="power per pixel (fraction)")
-        ax.set_xlabel("film x from the grid centre (um)")
-        ax.set_ylabel("film y from the grid centre (um)")
+        ax.set_xlabel("film x from the grid centre (µm)")
+        ax.set_ylabel("film y from the grid centre (µm)")
         wl = ", ".join(f"{w:g}" for w in self.wavelengths_nm)
         ax.set_title(f"{self.lens_name}\nHuygens PSF {self.field_deg:g} deg, {wl} nm, f/{self.fstop:.3g}", fontsize=8)
         return save(fig, path, force)

@@ -299,7 +299,7 @@ class ThroughFocusMTF:
             ax.plot(self.defocus_mm * 1e3, self.tangential[k], color=f"C{k}", ls="--", label=f"{f:g} lp/mm T")
             ax.plot(self.defocus_mm * 1e3, self.sagittal[k], color=f"C{k}", ls="-", label=f"{f:g} lp/mm S")
         ax.set_ylim(0, 1.02)
-        ax.set_xlabel("film shift from focus (um, + away from the lens)")
+        ax.set_xlabel("film shift from focus (µm, + away from the lens)")
         ax.set_ylabel("MTF")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)

@@ -119,8 +119,8 @@ class PointSpreadFunction:
         im = ax.imshow(np.maximum(sub, top * 1e-5), origin="lower", cmap="magma", norm=LogNorm(top * 1e-5, top),
                        extent=(-(hx + 0.5) * px, (hx + 0.5) * px, -(hy + 0.5) * py, (hy + 0.5) * py))
         fig.colorbar(im, ax=ax, label="relative intensity (unaberrated peak = 1)")
-        ax.set_xlabel("x on the film (um)")
-        ax.set_ylabel("y on the film (um)")
+        ax.set_xlabel("x on the film (µm)")
+        ax.set_ylabel("y on the film (µm)")
         ax.set_title(f"{self.lens_name}\nPSF {self.field_deg:g} deg, {self.wavelength_nm:g} nm, f/{self.fstop:.3g}: "
                      f"Strehl {self.strehl:.3f}", fontsize=8)
         return save(fig, path, force)

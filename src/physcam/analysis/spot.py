@@ -103,7 +103,7 @@ class SpotDiagram:
 
     def plot(self, path=None, *, force: bool = False):
         """Draw one panel per field (positions relative to the centroid, um); write it to ``path`` (PNG/SVG/PDF) and return the path, else return the figure."""
-        from ..figures import pyplot
+        from ..figures import fit_title, pyplot
 
         plt = pyplot()
 
@@ -111,7 +111,8 @@ class SpotDiagram:
         fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 3.4), squeeze=False)
         for ax, f in zip(axes[0], self.fields):
             ax.set_aspect("equal")
-            ax.set_xlabel("x (um)")
+            ax.set_xlabel("x from the centroid (µm)")
+            ax.set_ylabel("y from the centroid (µm)")
             if not f.defined:
                 ax.text(0.5, 0.5, "undefined:\nno ray reaches the film", ha="center", va="center",
                         transform=ax.transAxes, fontsize=8)
@@ -119,10 +120,9 @@ class SpotDiagram:
                 continue
             size = 0.3 * f.weight / f.weight.max()  # refined rim rays weigh less: drawn smaller
             ax.scatter((f.x_mm - f.centroid_x_mm) * 1e3, (f.y_mm - f.centroid_y_mm) * 1e3, s=size, c="k", lw=0)
-            ax.set_title(f"{f.field_deg:g} deg\nRMS {f.rms_radius_um:.2f} um, GEO {f.geometric_radius_um:.2f} um",
+            ax.set_title(f"{f.field_deg:g}°: RMS {f.rms_radius_um:.2f} µm,\nGEO {f.geometric_radius_um:.2f} µm",
                          fontsize=8)
-        axes[0][0].set_ylabel("y (um)")
-        fig.suptitle(f"{self.lens_name}: spot diagram at {self.wavelength_nm:g} nm", fontsize=9)
+        fig.suptitle(fit_title(f"{self.lens_name}: spot diagram at {self.wavelength_nm:g} nm", 3.0 * n), fontsize=9)
         fig.tight_layout()
         if path is None:
             return fig

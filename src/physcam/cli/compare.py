@@ -157,7 +157,8 @@ def _figure(res, path=None, *, force=False, units="m"):
         d = res["measured"]["equivalent_diameter_mm"][key]
         ax.set_title(f"{title}\nequivalent diameter {d:.4f} mm", fontsize=9)
         ax.set_xlabel("film x (mm)")
-    axes[0].set_ylabel("film y (mm)")
+    for ax in axes:
+        ax.set_ylabel("film y (mm)")
     fig.suptitle(f"{res['lens']}: light {format_distance(res['light_from_film_mm'], units)}, focus "
                  f"{format_distance(res['focus_from_film_mm'], units)}, f/{res['fstop']:g}", fontsize=10)
     return fig if path is None else save_figure(fig, path, force=force)
@@ -422,6 +423,7 @@ def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False):
             ax.set_axis_off()
             ax.set_title(f"{r['name']}\n(no bokeh)", fontsize=7)
         ax.set_xlabel("film x (mm)", fontsize=7)
+        ax.set_ylabel("film y (mm)", fontsize=7)
         ax.tick_params(labelsize=6)
     r0 = rows[0]
     focus = format_distance(math.inf if r0["focus_from_film_mm"] is None else r0["focus_from_film_mm"], units)

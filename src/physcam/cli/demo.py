@@ -5,11 +5,16 @@ ARRI ALEXA 35 open gate at f/2.8, focused 3 m from the film plane. The demo writ
 folder and prints the report:
 
 - ``report.json`` / ``report.txt``: the lens report, technical model filled from the lens
-  itself, with its UsdGeomCamera and RenderMan blocks; ``dof.png``: the depth-of-field zone;
+  itself, with its UsdGeomCamera and RenderMan blocks; ``dof.png``: the depth-of-field chart (near
+  and far against focus, a band per stop);
 - ``lens.json``: the lens's Gaussian data at that focus; ``lens_diagram.png``: elements, stop,
   rays and cardinal points; ``breathing.png``: field of view against focus distance;
 - ``camera.usda``: the PhysicalCamera and its companion UsdGeomCamera;
 - ``spot.png`` and ``bokeh.png``: real-ray spot diagram and bokeh of a point light;
+  ``bokeh_photo.exr`` / ``.png``: that bokeh as a photograph (linear, and tone-mapped with a scale
+  bar in the sensor's pixels);
+- ``lens_card.pdf``: the lens's one-page card (section, MTF, distortion, illumination, breathing,
+  bokeh, key numbers; docs/lens-card.md);
 - ``distortion/``: ST-maps (EXR, with PNG previews) of the lens at that focus on that sensor, its
   fitted Brown-Conrady (OpenTrackIO) and 3DE4 models, and a Nuke script applying the maps
   (docs/distortion.md);
@@ -62,6 +67,7 @@ def _steps():
         ("Gaussian data and diagram", _lens_step),
         ("USD camera", _usd_step),
         ("spot diagram and bokeh", _trace_step),
+        ("lens card", _card_step),
         ("distortion maps and models", _distortion_step),
         ("Blender cameras", _blender_step),
     ]
@@ -71,10 +77,10 @@ def _report_step(out, ctx, force):
     import json
 
     from ..io import atomic_write
-    from ..onset.dof_plot import plot_dof_zone
+    from ..onset.dof_plot import plot_dof_chart
     from ..onset.table import report_table
     from ._common import console
-    from .report import camera_blocks, solve_from_args
+    from .report import camera_blocks, dof_chart_solver, solve_from_args
 
     ns = _args()
     report = solve_from_args(ns)
@@ -88,7 +94,8 @@ def _report_step(out, ctx, force):
     return [
         atomic_write(out / "report.json", json.dumps(d, indent=2, allow_nan=False) + "\n", force=force),
         atomic_write(out / "report.txt", ctx["table"], force=force),
-        plot_dof_zone(report, out / "dof.png", force=force, units=ctx.get("units", "m")),
+        plot_dof_chart(report, dof_chart_solver(ns, report), out / "dof.png", force=force,
+                       units=ctx.get("units", "m")),
     ]
 
 
@@ -143,7 +150,21 @@ def _trace_step(out, ctx, force):
     stop = focusing.iris_semi_diameter(lens, DEFAULTS["fstop"])
     bokeh = bokeh_image(st.prescription, 1200.0, 250.0, 150.0, film_z=st.film_z, rays=400_000, pixels=160,
                         stop_semi_diameter=stop, aperture=Aperture(nsides=7, roundness=0.2), spectral=True)
-    return [spot.plot(out / "spot.png", force=force), bokeh.plot(out / "bokeh.png", force=force)]
+    from ..analysis.bokeh import write_bokeh_photo
+
+    s = ctx["report"].sensor
+    photo = write_bokeh_photo(bokeh, out / "bokeh_photo", pixel_pitch_um=s.pitch_um or s.width_mm * 1000.0 / 4096,
+                              sensor_name=s.name, force=force)
+    return [spot.plot(out / "spot.png", force=force), bokeh.plot(out / "bokeh.png", force=force), *photo]
+
+
+def _card_step(out, ctx, force):
+    """The default lens's one-page card (A4) on the demo's sensor, focused at infinity."""
+    from ..analysis.lens_card import lens_card, save_lens_card
+
+    s = ctx["report"].sensor
+    card = lens_card(ctx["lens"], sensor_width_mm=s.width_mm, sensor_height_mm=s.height_mm, sensor_name=s.name)
+    return [save_lens_card(card, out / "lens_card.pdf", force=force, units=ctx.get("units", "m"))]
 
 
 def _distortion_step(out, ctx, force):

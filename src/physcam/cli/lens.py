@@ -18,7 +18,7 @@ plane and flange (distance in front, + toward the subject); see docs/conventions
 from __future__ import annotations
 
 from ..errors import PhysCamError
-from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number, whole
 from ._output import add_output_options
 
 
@@ -75,6 +75,30 @@ def register(sub) -> None:
     add_units_option(b)
     add_output_options(b, csv=True, what="the breathing table")
     b.set_defaults(handler=run_breathing)
+
+    k = lsub.add_parser("card", help="one page per lens (A4 or Letter): section, MTF, distortion, illumination, "
+                                     "breathing, bokeh, key numbers",
+                        description="The lens card: one printed page (A4 or US Letter, portrait) with the lens section "
+                                    "and rays, the MTF chart at 10/20/40 lp/mm (sagittal and tangential) wide open and "
+                                    "stopped down, distortion and relative illumination against image height, focus "
+                                    "breathing, bokeh at the centre, middle and corner of the sensor wide open, and the "
+                                    "key numbers (docs/lens-card.md).")
+    add_lens_argument(k)
+    k.add_argument("--focus", type=focus("focus distance"), default=float("inf"),
+                   help=f"focus mark from the film plane for the section, MTF, distortion, illumination and bokeh "
+                        f"(default infinity; {FOCUS_HELP})")
+    k.add_argument("--stopped", type=number("f-number", positive=True), default=8.0, metavar="FSTOP",
+                   help="the stopped-down MTF chart's f-number (default 8)")
+    add_sensor_options(k)
+    k.add_argument("--page", choices=("a4", "letter"), default="a4", help="page size, portrait (default a4)")
+    k.add_argument("--draft", action="store_true", help="fewer fields and rays: a quick look (seconds)")
+    k.add_argument("--dpi", type=whole("dpi", lo=30, hi=600), default=150, help="resolution of a PNG (default 150)")
+    k.add_argument("-o", "--output", required=True, metavar="FILE", help="output file (.pdf, .png or .svg)")
+    k.add_argument("--force", action="store_true", help="overwrite an existing file")
+    add_units_option(k)
+    add_lenient(k)
+    add_output_options(k, what="the card's numbers")
+    k.set_defaults(handler=run_card)
 
     c = lsub.add_parser("check", help="report what is inconsistent in a lens file (surface, file line, numbers)")
     add_lens_argument(c, help="bundled lens name or a lens file (read without validation)")
@@ -323,6 +347,28 @@ def run_diagram(args) -> int:
 
     p = _load(args)
     path = save_lens_diagram(p, args.output, force=args.force, units=units_of(args), **diagram_options(args))
+    print(f"wrote {path}")
+    return 0
+
+
+def run_card(args) -> int:
+    """``physcam lens card``: the one-page lens card (:mod:`physcam.analysis.lens_card`)."""
+    from ..analysis.lens_card import lens_card, save_lens_card
+    from ..io import check_writable
+    from ._common import resolve_focus, resolve_sensor, units_of
+    from ._output import document, emit_json
+
+    check_writable(args.output, force=args.force)  # before the seconds of work
+    p = _load(args)
+    sensor = resolve_sensor(args)
+    (mark,) = resolve_focus([args.focus], lens=p, sensor=sensor, args=args)
+    card = lens_card(p, focus_mm=mark, sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm,
+                     sensor_name=sensor.name, stopped_fstop=args.stopped, page=args.page,
+                     quality="draft" if args.draft else "full")
+    path = save_lens_card(card, args.output, force=args.force, units=units_of(args), dpi=args.dpi)
+    if args.json:
+        emit_json(document("lens_card", {**card.to_dict(), "output": str(path)}))
+        return 0
     print(f"wrote {path}")
     return 0
 

@@ -52,8 +52,8 @@ def register(sub) -> None:
                         "(default), moment = the second-moment diameter sqrt(8 E[r^2])")
     g.add_argument("--energy-fraction", metavar="F", type=number("energy fraction"), default=0.8,
                    help="fraction of the light within the blur diameter (default 0.8)")
-    p.add_argument("--plot", metavar="FILE", help="draw the depth-of-field zone to FILE (.png, .svg or .pdf; "
-                                                  "in feet with --units ft)")
+    p.add_argument("--plot", metavar="FILE", help="draw the depth-of-field chart (near and far against focus, a band per "
+                                                  "stop) to FILE (.png, .svg or .pdf; in feet with --units ft)")
     p.add_argument("--force", action="store_true", help="overwrite an existing --plot file")
     p.set_defaults(handler=run)
 
@@ -137,7 +137,35 @@ def solve_from_args(args):
 
     coc = coc_of(args)
     sensor = resolve_sensor(args, quiet=True)  # the report says it in its notes
-    report = solve_lens_report(
+    report = solve_lens_report(**_request_inputs(args, lens, sensor, coc))
+    if getattr(args, "sensor_defaulted", False):
+        import dataclasses
+
+        report = dataclasses.replace(report, notes=report.notes + (
+            f"no --sensor given: {sensor.name}, {sensor.width_mm:g} x {sensor.height_mm:g} mm "
+            f"({args.sensor_default_source}; give --sensor to change it)",))
+    return report
+
+
+def dof_chart_solver(args, report):
+    """``solve(fstop, focus_mm)`` for :func:`physcam.onset.dof_plot.dof_chart_figure`: the report of
+    ``args`` (after :func:`solve_from_args`) at another stop and focus mark, with the report's CoC and
+    sensor and no measured limits, so that the chart and the report agree at the report's own cell."""
+    from ..onset.report import solve_lens_report
+
+    lens = getattr(args, "loaded_lens", None)
+
+    def solve(fstop, focus_mm):
+        inputs = _request_inputs(args, lens, report.sensor, report.coc_mm)
+        inputs.update(fstop=fstop, focus_mm=focus_mm, near_mm=None, far_mm=None, tstop=None)
+        return solve_lens_report(**inputs)
+
+    return solve
+
+
+def _request_inputs(args, lens, sensor, coc) -> dict:
+    """The report's inputs from the parsed options (the fields of ReportRequest)."""
+    return dict(
         focal_length_mm=args.focal,
         sensor=sensor,
         fstop=args.fstop,
@@ -158,13 +186,6 @@ def solve_from_args(args):
         pupil_fraction=0.4 if getattr(args, "pupil_fraction", None) is None else args.pupil_fraction,
         lens=lens,
     )
-    if getattr(args, "sensor_defaulted", False):
-        import dataclasses
-
-        report = dataclasses.replace(report, notes=report.notes + (
-            f"no --sensor given: {sensor.name}, {sensor.width_mm:g} x {sensor.height_mm:g} mm "
-            f"({args.sensor_default_source}; give --sensor to change it)",))
-    return report
 
 
 def thin_lens_gap_from_args(args, report):
@@ -291,9 +312,9 @@ def run(args) -> int:
     units = units_of(args)
     real = real_dof_block(report, args) if args.dof == "real" else None
     if args.plot:
-        from ..onset.dof_plot import plot_dof_zone
+        from ..onset.dof_plot import plot_dof_chart
 
-        plot_dof_zone(report, args.plot, force=args.force, units=units)
+        plot_dof_chart(report, dof_chart_solver(args, report), args.plot, force=args.force, units=units)
     if args.json:
         doc = report_document(report, cams, args)
         if real is not None:

@@ -115,14 +115,14 @@ def _options(q, skip=()) -> list[str]:
     return [f"--{k}={v}" for k, v in q.items() if k not in skip]
 
 
-def _svg(fig, dpi: int = 130) -> bytes:
+def _svg(fig, dpi: int = 130, description: str | None = None) -> bytes:
     """A figure as SVG with its text kept as text (a third of the size, quicker to draw and send)."""
     import matplotlib
 
     from ..figures import figure_bytes
 
     with matplotlib.rc_context({"svg.fonttype": "none"}):
-        return figure_bytes(fig, "svg", dpi=dpi)
+        return figure_bytes(fig, "svg", dpi=dpi, description=description)
 
 
 def cli_backend():
@@ -155,10 +155,15 @@ def cli_backend():
         return report_document(rep, camera_blocks(rep, args), args)
 
     def dof_svg(q):
-        from ..onset.dof_plot import dof_zone_figure
+        import json
+
+        from ..onset.dof_plot import dof_chart_figure
+        from .report import dof_chart_solver
 
         rep, args = solved(q)  # the page asks for feet with units=ft (never the server's user config)
-        return _svg(dof_zone_figure(rep, size_in=(4.5, 2.6), units=args.units or "m"))
+        fig = dof_chart_figure(rep, dof_chart_solver(args, rep), size_in=(4.4, 3.9), units=args.units or "m")
+        # the chart's axes and curves, for the page's mark under the cursor (app.js)
+        return _svg(fig, description=json.dumps(fig.physcam_chart, separators=(",", ":")))
 
     def sensors(q):
         from ..onset.sensors import sensors as all_sensors

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import add_lens_argument, FOCUS_HELP, add_units_option, distance, focus, hidden_alias, number, whole
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number, whole
 from ._output import add_output_options, document, emit_json, print_csv
 from .lens import WAVE_UNITS, add_lenient, mark_repaired
 
@@ -53,7 +53,16 @@ def register(sub) -> None:
                    help="-1..1: brightness ramp across the aperture (+ brighter rim, - brighter centre)")
     add_output_options(b, what="the bokeh measurements")
     add_units_option(b)
-    b.add_argument("-o", "--output", metavar="FILE.png", help="write the bokeh image")
+    b.add_argument("-o", "--output", metavar="FILE.png", help="write the bokeh plot (film millimetre axes)")
+    b.add_argument("--image", metavar="NAME", default=None,
+                   help="write the bokeh as a photograph: NAME.exr (linear, RGB with --spectral) and NAME.png "
+                        "(tone-mapped, with a scale bar in sensor pixels)")
+    add_sensor_options(b)
+    b.add_argument("--pixel-pitch", type=number("pixel pitch", positive=True), default=None, metavar="UM",
+                   help="sensor pixel pitch for --image's scale bar (micrometres; default the sensor's own, or its "
+                        "width over 4096 pixels)")
+    b.add_argument("--exposure", type=number("exposure", positive=True), default=1.0,
+                   help="--image PNG exposure: 1 puts the brightest lit pixels at the shoulder (default 1)")
     b.add_argument("--force", action="store_true", help="overwrite an existing output file")
     b.set_defaults(handler=run_bokeh)
 
@@ -135,8 +144,11 @@ def run_bokeh(args) -> int:
                   context=f"light at {format_distance(args.depth, u)}, focus "
                           f"{format_distance(math.inf if args.focus is None else args.focus, u)}, "
                           + (f"f/{args.fstop:g}" if args.fstop else "wide open"))
+    photo = _bokeh_photo(res, args) if args.image else None
     if args.json:
         d = res.to_dict()
+        if photo is not None:
+            d["image"] = photo
         d.update(light_from_film_mm=args.depth, focus_from_film_mm=None if args.focus in (None, math.inf) else args.focus,
                  fstop=args.fstop)
         emit_json(document("bokeh", mark_repaired(d, lens), units=WAVE_UNITS))
@@ -154,4 +166,23 @@ def run_bokeh(args) -> int:
                  ", centroid ({:.4f}, {:.4f}) mm on the film".format(*d["centroid_mm"])))
         if args.output:
             print(f"wrote {args.output}")
+        if photo is not None:
+            print(f"wrote {photo['exr']} and {photo['png']} (scale bar {photo['scale_bar_px']} px of "
+                  f"{photo['sensor']}, {photo['pixel_pitch_um']:g} µm pitch)")
     return 0
+
+
+def _bokeh_photo(res, args) -> dict:
+    """``physcam bokeh --image``: the EXR and PNG photograph, and what its scale bar means."""
+    from ..analysis.bokeh import scale_bar_pixels, write_bokeh_photo
+    from ._common import resolve_sensor
+
+    sensor = resolve_sensor(args)
+    pitch = args.pixel_pitch or sensor.pitch_um or sensor.width_mm * 1000.0 / 4096
+    exr, png = write_bokeh_photo(res, args.image, pixel_pitch_um=pitch, sensor_name=sensor.name,
+                                 exposure=args.exposure, force=args.force)
+    x0, x1 = res.extent_mm[:2]
+    return {"exr": str(exr), "png": str(png), "sensor": sensor.name, "pixel_pitch_um": pitch,
+            "pitch_source": "--pixel-pitch" if args.pixel_pitch else ("sensor" if sensor.pitch_um else
+                                                                       "sensor width / 4096"),
+            "scale_bar_px": scale_bar_pixels(x1 - x0, pitch), "image_width_px_of_sensor": (x1 - x0) * 1000.0 / pitch}

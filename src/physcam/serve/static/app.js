@@ -213,7 +213,61 @@ function chart(api) {
   if (img.getAttribute("src") !== src) {
     img.hidden = false;
     img.setAttribute("src", src);
+    st.chart = null;
+    $("dof-cursor").hidden = true;
+    // the chart's axes and curves ride in the SVG's metadata (physcam serve caches the drawing)
+    fetch(src).then((r) => (r.ok ? r.text() : "")).then((text) => {
+      if (img.getAttribute("src") !== src) return;
+      const doc = new DOMParser().parseFromString(text, "image/svg+xml");
+      const desc = doc.getElementsByTagName("dc:description")[0]; // (matplotlib writes the dc: prefix)
+      st.chart = desc ? JSON.parse(desc.textContent) : null;
+    }).catch(() => { st.chart = null; });
   }
+}
+
+// the value of a chart curve at distance x (mm): linear in log distance between its rows
+function logInterp(rows, x, k) {
+  for (let i = 1; i < rows.length; i++) {
+    const [x0, x1] = [rows[i - 1][0], rows[i][0]];
+    if (x0 <= x && x <= x1) {
+      const [a, b] = [rows[i - 1][k], rows[i][k]];
+      if (a === null || b === null) return x - x0 < x1 - x ? a : b;
+      const t = Math.log(x / x0) / Math.log(x1 / x0);
+      return Math.exp(Math.log(a) + t * (Math.log(b) - Math.log(a)));
+    }
+  }
+  return undefined;
+}
+
+// the mark under the cursor: a line on the chart and, under it, near / far per stop at that focus mark
+function chartCursor(ev) {
+  const c = st.chart;
+  const img = $("dof-chart");
+  if (!c || img.hidden) return;
+  const r = img.getBoundingClientRect();
+  const fx = (ev.clientX - r.left) / r.width;
+  const [ax0, ay0, aw, ah] = c.axes;
+  const t = (fx - ax0) / aw;
+  const line = $("dof-cursor");
+  if (t < 0 || t > 1) {
+    line.hidden = true;
+    return;
+  }
+  const [lo, hi] = c.x_mm;
+  const x = lo * Math.pow(hi / lo, t);
+  line.hidden = false;
+  line.style.left = `${fx * 100}%`;
+  line.style.top = `${(1 - ay0 - ah) * 100}%`;
+  line.style.height = `${ah * 100}%`;
+  const parts = c.stops.map((s) => {
+    const near = logInterp(s.rows, x, 1);
+    if (near === undefined) return null;
+    const far = s.hyperfocal_mm !== null && x >= s.hyperfocal_mm ? null : logInterp(s.rows, x, 2);
+    return `f/${num(s.fstop, 1)}: ${fmtLen(near)} – ${fmtLen(far)}`;
+  }).filter(Boolean);
+  const out = $("dof-readout");
+  out.dataset.mm = String(Math.round(x));
+  out.textContent = `focus ${fmtLen(x)} · ${parts.join(" · ")}`;
 }
 
 async function table(d, api, my) {
@@ -441,6 +495,8 @@ function wire() {
     $("share").textContent = "copied";
     setTimeout(() => { $("share").textContent = "copy link"; }, 1500);
   });
+  for (const kind of ["pointermove", "pointerdown"]) $("dof-wrap").addEventListener(kind, chartCursor);
+  $("dof-wrap").addEventListener("pointerleave", () => { $("dof-cursor").hidden = true; });
   for (const img of [$("dof-chart"), $("diagram")]) {
     img.addEventListener("error", () => { img.hidden = true; });
   }

@@ -1,0 +1,372 @@
+"""The lens card: one printed page per lens, like a lens maker's data sheet.
+
+One A4 or US Letter page (portrait) with the lens section and its rays
+(:mod:`physcam.analysis.diagram`), the vendor MTF chart at 10, 20 and 40 lp/mm, sagittal and
+tangential, at full aperture and stopped down (:func:`physcam.analysis.mtf.mtf_chart`), real
+distortion and relative illumination against image height (:mod:`~physcam.analysis.distortion`,
+:mod:`~physcam.analysis.illumination`), focus breathing against the focus mark
+(:func:`physcam.optics.focusing.breathing_table`), bokeh of point lights at the centre, middle and
+corner of the sensor at full aperture (:func:`physcam.analysis.bokeh.bokeh_image`: the corner's
+cat's eye is the mechanical vignetting), and the key numbers (EFL, f-number, entrance pupil, close
+focus, image circle). Every number is computed by those functions as they are; this module only
+chooses their inputs and draws. Image heights and film sizes in mm; scene distances from the film
+plane (docs/conventions.md).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from ..errors import InputError, OpticsError
+from ..lens.prescription import Prescription, takes_prescription
+
+__all__ = ["PAGES", "PANELS", "LensCard", "lens_card", "save_lens_card"]
+
+#: Page sizes (width, height) in inches, portrait: ISO A4 (210 x 297 mm) and US Letter (8.5 x 11 in).
+PAGES = {"a4": (210.0 / 25.4, 297.0 / 25.4), "letter": (8.5, 11.0)}
+
+#: The panels of a card, by the label their axes carry (``Axes.get_label()``).
+PANELS = ("diagram", "key numbers", "mtf open", "mtf stopped", "distortion", "illumination", "breathing",
+          "bokeh centre", "bokeh mid", "bokeh corner")
+
+#: Work per card: fields of the MTF chart and of distortion / illumination, the MTF pupil-grid cap,
+#: rays and pixels of each bokeh image, and the illumination grid.
+_QUALITY = {"full": dict(mtf_fields=8, curve_fields=12, pupil_cap=256, rays=120_000, pixels=112, grid=96),
+            "draft": dict(mtf_fields=4, curve_fields=6, pupil_cap=96, rays=20_000, pixels=48, grid=32)}
+
+
+@dataclass
+class LensCard:
+    """What a lens card shows, computed once; :meth:`figure` draws the page."""
+
+    lens_name: str
+    focus_from_film_mm: float
+    sensor_name: str
+    sensor_mm: tuple[float, float]
+    key: dict
+    diagram: object
+    mtf: list  # (label, MTFChart or None, note)
+    distortion: object
+    illumination: object
+    breathing: list
+    bokeh: list  # (label, image height mm, BokehImage)
+    page: str = "a4"
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        """The card's numbers (what ``physcam lens card --json`` prints besides the file)."""
+        return {"lens": self.lens_name, "page": self.page, "page_inches": list(PAGES[self.page]),
+                "focus_from_film_mm": None if math.isinf(self.focus_from_film_mm) else self.focus_from_film_mm,
+                "sensor": {"name": self.sensor_name, "width_mm": self.sensor_mm[0], "height_mm": self.sensor_mm[1]},
+                "key": self.key, "panels": list(PANELS),
+                "mtf": [{"label": lab, "fstop": None if c is None else c.fstop, "note": note}
+                        for lab, c, note in self.mtf],
+                "bokeh": [{"label": lab, "image_height_mm": h, **b.to_dict()} for lab, h, b in self.bokeh],
+                "notes": list(self.notes)}
+
+    def figure(self, *, units: str = "m", dpi: int | None = None):
+        """The page as a matplotlib Figure (Agg canvas), one axes per :data:`PANELS` entry."""
+        from ..figures import new_figure
+
+        w, h = PAGES[self.page]
+        fig = new_figure(figsize=(w, h), dpi=dpi)
+        gs = fig.add_gridspec(5, 6, left=0.08, right=0.9, top=0.93, bottom=0.05, hspace=0.75, wspace=1.6,
+                              height_ratios=(1.25, 1.0, 1.0, 1.0, 0.8))
+        fig.suptitle(self._title(), fontsize=11, fontweight="bold", y=0.985)
+        fig.text(0.5, 0.955, self._subtitle(units), ha="center", va="center", fontsize=7.5, color="0.25")
+        _draw_diagram(fig.add_subplot(gs[0, :4], label="diagram"), self, units)
+        _draw_key(fig.add_subplot(gs[0, 4:], label="key numbers"), self.key, units)
+        for k, (lab, chart, note) in enumerate(self.mtf):
+            _draw_mtf(fig.add_subplot(gs[1, 3 * k:3 * k + 3], label=("mtf open", "mtf stopped")[k]), chart, lab, note)
+        _draw_distortion(fig.add_subplot(gs[2, :3], label="distortion"), self.distortion)
+        _draw_illumination(fig.add_subplot(gs[2, 3:], label="illumination"), self.illumination)
+        _draw_breathing(fig.add_subplot(gs[3, :], label="breathing"), self, units)
+        for k, (lab, hgt, img) in enumerate(self.bokeh):
+            _draw_bokeh(fig.add_subplot(gs[4, 2 * k:2 * k + 2], label=f"bokeh {lab}"), img, lab, hgt)
+        foot = "physcam lens card · " + ("; ".join(self.notes) if self.notes else "all numbers from the prescription")
+        fig.text(0.5, 0.012, _wrap(foot, 150), ha="center", va="bottom", fontsize=6, color="0.35")
+        return fig
+
+    def _title(self) -> str:
+        return f"{self.lens_name}"
+
+    def _subtitle(self, units: str) -> str:
+        from ..units import format_distance
+
+        foc = "infinity" if math.isinf(self.focus_from_film_mm) else format_distance(self.focus_from_film_mm, units)
+        w, h = self.sensor_mm
+        page = "A4" if self.page == "a4" else "US Letter"
+        return _wrap(f"focused at {foc} from the film plane · sensor {self.sensor_name} ({w:.2f} x {h:.2f} mm) · "
+                     f"{page} page", 140)
+
+
+def _wrap(text: str, n: int) -> str:
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, n)) or text
+
+
+# ---- computing ------------------------------------------------------------------------------------
+@takes_prescription
+def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm: float | None = None,
+              sensor_height_mm: float | None = None, sensor_name: str | None = None, stopped_fstop: float = 8.0,
+              page: str = "a4", quality: str = "full", backend: str = "auto") -> LensCard:
+    """Compute the card of ``lens`` focused ``focus_mm`` from the film plane (default infinity) on a
+    ``sensor_width_mm`` x ``sensor_height_mm`` sensor (default Super 35). The MTF chart is drawn
+    wide open and at ``stopped_fstop`` (default f/8; skipped when not slower than wide open).
+    ``page``: "a4" or "letter"; ``quality``: "full" or "draft" (fewer fields and rays: tests)."""
+    from ..data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
+    from ..errors import require_positive
+    from ..optics import focusing
+
+    if page not in PAGES:
+        raise InputError(f"page must be one of {', '.join(PAGES)}, got {page!r}")
+    if quality not in _QUALITY:
+        raise InputError(f"quality must be one of {', '.join(_QUALITY)}, got {quality!r}")
+    q = _QUALITY[quality]
+    w = require_positive("sensor width", DEFAULT_SENSOR_WIDTH_MM if sensor_width_mm is None else sensor_width_mm)
+    h = require_positive("sensor height", DEFAULT_SENSOR_HEIGHT_MM if sensor_height_mm is None else sensor_height_mm)
+    name = sensor_name or (DEFAULT_SENSOR if sensor_width_mm is None else f"{w:g} x {h:g} mm")
+    focus_mm = float(focus_mm)
+    notes: list[str] = []
+    st = focusing.focus(lens, focus_mm)
+    diagram = _diagram(lens, focus_mm)
+    key = key_numbers(lens, focus_mm, 0.5 * math.hypot(w, h), backend=backend)
+    dist = _distortion(st, w, h, q, backend, notes)
+    ill = _illumination(st, w, h, q, backend, notes)
+    wide = key["f_number"]
+    stops = [("full aperture", None)] + ([("stopped down", stopped_fstop)] if stopped_fstop > wide * 1.05
+                                         else [])
+    mtf = [_mtf(lens, focus_mm, lab, n, min(0.5 * math.hypot(w, h), key["image_circle_mm"] / 2), q, backend)
+           for lab, n in stops]
+    if len(mtf) == 1:
+        mtf.append(("stopped down", None, f"the lens is f/{wide:.2g} wide open: no stopped-down chart"))
+    try:
+        rows = focusing.breathing_table(lens, sensor_width_mm=w)
+    except OpticsError as exc:
+        rows = []
+        notes.append(f"breathing: {exc}")
+    bokeh = _bokeh(st, key, focus_mm, w, h, q, backend, notes)
+    return LensCard(lens.name, focus_mm, name, (w, h), key, diagram, mtf, dist, ill, rows, bokeh, page, notes)
+
+
+def key_numbers(lens: Prescription, focus_mm: float, half_diagonal_mm: float, *, backend: str = "auto") -> dict:
+    """EFL, wide-open f-number (paraxial, infinity), T-stop when the file gives one, the entrance pupil
+    (diameter, and place in front of the film at ``focus_mm``), close focus (from the film plane),
+    the image circle (twice the film height of the widest chief ray that passes the lens; mm) and
+    whether it covers a sensor of ``half_diagonal_mm``."""
+    from ..optics import focusing, paraxial
+    from ._chief import field_limit_deg
+    from .distortion import _chief_heights
+
+    g = paraxial.gaussian(lens)
+    ga = focusing.gaussian_at_focus(lens, focus_mm)
+    try:
+        close = focusing.closest_focus(lens)
+    except OpticsError:
+        close = None
+    limit = field_limit_deg(lens, "y", max_deg=89.0, wavelength_nm=lens.wavelength_nm, backend=backend)
+    import numpy as np
+
+    heights, ok = _chief_heights(lens, np.array([0.0, 0.995 * limit]), "y", lens.wavelength_nm, None, backend)
+    circle = 2.0 * abs(float(heights[-1])) if ok[-1] else 2.0 * abs(g.efl) * math.tan(math.radians(limit))
+    return {"efl_mm": g.efl, "f_number": g.f_number, "nominal_focal_length_mm": lens.metadata.focal_length,
+            "max_fstop": lens.metadata.max_fstop, "tstop": None,
+            "entrance_pupil_diameter_mm": g.entrance_pupil_diameter,
+            "entrance_pupil_from_film_mm": ga.in_front_of("entrance_pupil"),
+            "close_focus_from_film_mm": close, "image_circle_mm": circle, "field_limit_deg": limit,
+            "covers_sensor": circle >= 2.0 * half_diagonal_mm, "total_track_mm": lens.total_track,
+            "squeeze": lens.squeeze, "maker": lens.metadata.maker, "source": lens.metadata.source}
+
+
+def _diagram(lens, focus_mm):
+    from .diagram import lens_diagram
+
+    try:
+        return lens_diagram(lens, focus_from_film_mm=focus_mm, rays=5)
+    except OpticsError:
+        return lens_diagram(lens, rays=5)
+
+
+def _distortion(st, w, h, q, backend, notes):
+    from .distortion import real_distortion
+
+    try:
+        return real_distortion(st.prescription, n_fields=q["curve_fields"], sensor_width_mm=w, sensor_height_mm=h,
+                               film_z=st.film_z, backend=backend)
+    except OpticsError as exc:
+        notes.append(f"distortion: {exc}")
+        return None
+
+
+def _illumination(st, w, h, q, backend, notes):
+    from .illumination import relative_illumination
+
+    try:
+        return relative_illumination(st.prescription, n_fields=q["curve_fields"], sensor_width_mm=w,
+                                     sensor_height_mm=h, grid=q["grid"], film_z=st.film_z, backend=backend)
+    except OpticsError as exc:
+        notes.append(f"relative illumination: {exc}")
+        return None
+
+
+def _mtf(lens, focus_mm, label, fstop, top_mm, q, backend):
+    """(label, chart or None, note): the diffraction chart, or why there is none."""
+    from .mtf import mtf_chart
+
+    try:
+        chart = mtf_chart(lens, max_image_height_mm=max(top_mm, 0.5), n_fields=q["mtf_fields"], fstop=fstop,
+                          focus_mm=None if math.isinf(focus_mm) else focus_mm, max_pupil_samples=q["pupil_cap"],
+                          backend=backend)
+    except OpticsError as exc:
+        return (label, None, str(exc).split(";")[0])
+    return (label, chart, "")
+
+
+def _bokeh(st, key, focus_mm, w, h, q, backend, notes):
+    """Point lights in front of the focus (half the focus distance; 15 focal lengths when focused at
+    infinity) imaged at the centre, half the half-diagonal and 90 % of it (or of the image circle), wide open."""
+    from .bokeh import bokeh_image
+
+    efl = key["efl_mm"]
+    depth = 15.0 * efl if math.isinf(focus_mm) else 0.5 * focus_mm
+    pupil = key["entrance_pupil_from_film_mm"]
+    corner = 0.9 * min(0.5 * math.hypot(w, h), 0.5 * key["image_circle_mm"])
+    out = []
+    for lab, hgt in (("centre", 0.0), ("mid", 0.5 * corner / 0.9), ("corner", corner)):
+        # the light's lateral place whose chief ray lands near image height hgt (paraxial angle)
+        x = -math.tan(math.atan(hgt / efl)) * max(depth - pupil, efl)
+        try:
+            img = bokeh_image(st.prescription, depth, x, 0.0, film_z=st.film_z, rays=q["rays"], pixels=q["pixels"],
+                              backend=backend)
+        except (OpticsError, InputError) as exc:
+            notes.append(f"bokeh {lab}: {exc}")
+            img = None
+        out.append((lab, hgt, img))
+    return out
+
+
+# ---- drawing --------------------------------------------------------------------------------------
+def _draw_diagram(ax, card, units):
+    card.diagram.draw(ax, units=units, width_in=5.0, title=False)
+    ax.set_title("lens section, rays from the axis and the widest unvignetted field", loc="left")
+
+
+def _draw_key(ax, key, units):
+    from ..units import format_distance
+
+    ax.set_axis_off()
+
+    def dist(v):
+        return "–" if v is None else format_distance(v, units)
+
+    rows = [("EFL", f"{key['efl_mm']:.2f} mm"), ("f-number (wide open)", f"f/{key['f_number']:.2f}"),
+            ("T-stop", "not given" if key["tstop"] is None else f"T{key['tstop']:.2f}"),
+            ("entrance pupil", f"Ø {key['entrance_pupil_diameter_mm']:.1f} mm"),
+            ("  in front of film", dist(key["entrance_pupil_from_film_mm"])),
+            ("close focus", dist(key["close_focus_from_film_mm"])),
+            ("image circle", f"Ø {key['image_circle_mm']:.1f} mm"), ("total track", f"{key['total_track_mm']:.1f} mm")]
+    if key["squeeze"] != 1.0:
+        rows.append(("squeeze", f"{key['squeeze']:g}x"))
+    ax.set_title("key numbers", loc="left")
+    for i, (k, v) in enumerate(rows):
+        y = 0.95 - i * 0.115
+        ax.text(0.0, y, k, transform=ax.transAxes, fontsize=7.5, va="top")
+        ax.text(1.0, y, v, transform=ax.transAxes, fontsize=7.5, va="top", ha="right", fontweight="bold")
+
+
+def _no_data(ax, text):
+    ax.set_axis_off()
+    ax.text(0.5, 0.5, _wrap(text, 60), transform=ax.transAxes, ha="center", va="center", fontsize=7, color="0.3")
+
+
+def _draw_mtf(ax, chart, label, note):
+    if chart is None:
+        ax.set_title(f"MTF, {label}", loc="left")
+        _no_data(ax, note)
+        return
+    for k, f in enumerate(chart.frequencies_lpmm):
+        lw = 2.0 - 1.2 * k / max(1, len(chart.frequencies_lpmm) - 1)
+        ax.plot(chart.image_heights_mm, chart.sagittal[:, k], color=f"C{k}", lw=lw, label=f"{f:g} lp/mm S")
+        ax.plot(chart.image_heights_mm, chart.tangential[:, k], color=f"C{k}", lw=lw, ls="--", label=f"{f:g} T")
+    ax.set_xlim(0, float(chart.image_heights_mm.max()))
+    ax.set_ylim(0, 1.0)
+    ax.grid(True)
+    ax.set_xlabel("image height (mm)")
+    ax.set_ylabel("MTF")
+    ax.set_title(f"MTF at f/{chart.fstop:.3g} ({label}), white light", loc="left")
+    ax.legend(ncol=3, loc="lower left", fontsize=5.5, handlelength=1.6, columnspacing=0.8)
+
+
+def _draw_distortion(ax, res):
+    ax.set_title("distortion (− barrel, + pincushion)", loc="left")
+    if res is None:
+        _no_data(ax, "no distortion: see the notes")
+        return
+    for axis, style in (("y", "-"), ("x", "--")):
+        pts = res.meridian(axis)
+        if pts:
+            ax.plot([abs(p.real_height_mm) for p in pts], [p.distortion_pct for p in pts], style, color="C0",
+                    label=f"{axis.upper()} meridian")
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.grid(True)
+    ax.set_xlabel("image height (mm)")
+    ax.set_ylabel("distortion (%)")
+    if len({p.axis for p in res.points}) > 1:  # an anamorphic: both meridians
+        ax.legend()
+
+
+def _draw_illumination(ax, res):
+    ax.set_title("relative illumination, full aperture", loc="left")
+    if res is None:
+        _no_data(ax, "no relative illumination: see the notes")
+        return
+    pts = [p for p in res.points if p.axis == "y"]
+    hs = [abs(p.film_height_mm) for p in pts]
+    ax.plot(hs, [p.relative_illumination for p in pts], "-", color="C0", label="relative illumination")
+    ax.plot(hs, [p.cos4 for p in pts], ":", color="0.4", label="cos⁴ of the field angle")
+    ax.set_ylim(0, 1.05)
+    ax.grid(True)
+    ax.set_xlabel("image height (mm)")
+    ax.set_ylabel("relative illumination (fraction)")
+    ax.legend(loc="lower left")
+
+
+def _draw_breathing(ax, card, units):
+    from .breathing_plot import draw_breathing
+
+    ax.set_title(f"focus breathing: horizontal field of view ({card.sensor_mm[0]:g} mm wide sensor) and focal length "
+                 "against the focus mark", loc="left")
+    if not card.breathing:
+        _no_data(ax, "no breathing table: see the notes")
+        return
+    draw_breathing(ax, card.breathing, units=units, legend_loc="upper right")
+
+
+def _draw_bokeh(ax, img, label, height_mm):
+    import numpy as np
+
+    ax.set_title(f"bokeh, {label} ({height_mm:.1f} mm)", loc="left", fontsize=7.5)
+    if img is None:
+        _no_data(ax, "no light reaches the film")
+        return
+    x0, x1, y0, y1 = img.extent_mm
+    a = img.image.sum(axis=2)
+    a = a / max(float(a.max()), 1e-300)
+    ax.imshow(np.sqrt(a), origin="lower", extent=(0, x1 - x0, 0, y1 - y0), cmap="gray", interpolation="bilinear")
+    ax.set_xlabel("film (mm)", fontsize=6.5)
+    ax.tick_params(labelsize=6)
+    ax.set_yticks([])
+
+
+# ---- writing --------------------------------------------------------------------------------------
+def save_lens_card(card: LensCard, path, *, force: bool = False, units: str = "m", dpi: int = 150):
+    """Write ``card`` as one page to ``path`` (.pdf, .png or .svg) through :func:`physcam.figures.save_figure`."""
+    from ..errors import require_type
+    from ..figures import save_figure
+    from ..io import check_writable
+
+    require_type("card", card, LensCard, "physcam.analysis.lens_card.lens_card(lens)")
+    check_writable(path, force=force)
+    return save_figure(card.figure(units=units), path, force=force, dpi=dpi)

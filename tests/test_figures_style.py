@@ -1,0 +1,76 @@
+"""Every figure physcam makes keeps one style (issue 32 item 4): no text outside the figure (a cut-off
+title or tick label) and a unit in every axis label with ticks (physcam.figures.figure_problems).
+
+Each command that draws a figure is run once, small, with PHYSCAM_STRICT_FIGURES=1: then
+physcam.figures checks every figure before it is written and raises on a problem. The checker itself
+is tested on figures made to break it.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from physcam.cli import main
+from physcam.figures import STRICT_ENV, figure_problems, fit_title, new_figure
+
+pytestmark = pytest.mark.slow
+
+L = ["--lens", "dgauss_50mm"]
+#: (name, argv) of every command that draws a figure, small enough to run in seconds.
+FIGURE_RUNS = [
+    ("report plot", ["report", "--focal", "35", "--fstop", "2.8", "--focus", "3m", "--plot", "dof.png"]),
+    ("report plot ft, lens", ["report", *L, "--fstop", "4", "--focus", "10ft", "--units", "ft", "--plot", "d.svg"]),
+    ("dof-table card", ["dof-table", "--focal", "35", "--fstops", "2,4", "--focus", "1m,3m,inf", "-o", "c.png"]),
+    ("lens diagram", ["lens", "diagram", *L, "-o", "diag.png"]),
+    ("lens breathing", ["lens", "breathing", *L, "-o", "br.png"]),
+    ("lens card", ["lens", "card", *L, "--draft", "--dpi", "30", "-o", "card.png"]),
+    ("spot", ["spot", *L, "--rings", "6", "-o", "spot.png"]),
+    ("bokeh", ["bokeh", *L, "--rays", "3000", "--pixels", "32", "--focus", "2m", "--light", "1m", "-o", "b.png"]),
+    ("illumination", ["illumination", *L, "--grid", "16", "-o", "ill.png"]),
+    ("colour", ["colour", *L, "--field", "0", "--field", "5", "-o", "col.png"]),
+    ("breathing-real", ["breathing-real", *L, "--focus", "inf", "--focus", "2m", "-o", "brr.png"]),
+    ("ghosts", ["ghosts", *L, "--top", "3", "-o", "gh.png"]),
+    ("distortion", ["distortion", *L, "-o", "dist.png"]),
+    ("mtf chart", ["mtf", *L, "--fstop", "4", "--fields", "3", "--pupil-samples", "32", "-o", "mtf.png"]),
+    ("mtf field", ["mtf", *L, "--fstop", "8", "--field", "10", "--pupil-samples", "32", "-o", "mtff.png"]),
+    ("psf", ["psf", *L, "--fstop", "8", "-o", "psf.png"]),
+    ("psf huygens", ["psf", *L, "--fstop", "8", "--field", "5", "--method", "huygens", "--samples", "33",
+                     "-o", "psfh.png"]),
+    ("compare lenses", ["compare", "dgauss_50mm", "tessar_50mm_f2_8", "--rays", "2000", "-o", "cmp.png"]),
+]
+
+
+@pytest.mark.parametrize("argv", [a for _, a in FIGURE_RUNS], ids=[n for n, _ in FIGURE_RUNS])
+def test_every_figure_keeps_the_style(argv, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(STRICT_ENV, "1")
+    rc = main(argv)
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    assert "figure style" not in err
+
+
+def test_the_checker_sees_a_cut_off_title_and_a_label_without_unit():
+    fig = new_figure(figsize=(3.0, 2.0))
+    ax = fig.add_subplot(1, 1, 1)
+    ax.plot([0, 1], [0, 1])
+    ax.set_title("a title far too long for a figure three inches wide, running off both of its edges")
+    ax.set_xlabel("distance")
+    ax.set_ylabel("height (mm)")
+    fig.tight_layout()
+    problems = figure_problems(fig)
+    assert any("reaches outside the figure" in p for p in problems)
+    assert any("'distance' names no unit" in p for p in problems)
+    assert not any("height" in p for p in problems)
+
+
+def test_fit_title_wraps_to_the_width():
+    text = "Double Gauss 50mm f/2  f/2.8  focus 3.000 m  CoC 0.02264 mm (d/1500)  ARRI ALEXA 35 4.6K 3:2 Open Gate"
+    fig = new_figure(figsize=(4.0, 3.0))
+    ax = fig.add_subplot(1, 1, 1)
+    ax.set_title(fit_title(text, 3.2))
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    fig.tight_layout()
+    assert figure_problems(fig) == []
+    assert fit_title(text, 3.2).replace("\n", " ") == text  # only wrapped, never cut
