@@ -204,7 +204,7 @@ def resolve_focus(value, *, lens=None, focal_length_mm=None, fstop=None, sensor=
     if value != HYPERFOCAL:
         return value
     from ..errors import InputError
-    from ..onset.report import solve_lens_report
+    from ..onset.report import ReportRequest, solve_report
 
     if lens is None and focal_length_mm is None:
         raise InputError("--focus hyperfocal needs a lens or a focal length")
@@ -216,8 +216,8 @@ def resolve_focus(value, *, lens=None, focal_length_mm=None, fstop=None, sensor=
 
     with warnings.catch_warnings():  # the command's own work warns where it matters, once
         warnings.simplefilter("ignore", PhysCamWarning)
-        r = solve_lens_report(focal_length_mm=None if lens is not None else focal_length_mm, lens=lens, sensor=sensor,
-                              fstop=fstop, focus_mm=HYPERFOCAL, coc=coc if coc is not None else coc_of(args))
+        r = solve_report(ReportRequest(focal_length_mm=None if lens is not None else focal_length_mm, lens=lens, sensor=sensor,
+                              fstop=fstop, focus_mm=HYPERFOCAL, coc=coc if coc is not None else coc_of(args)))
     from ..units import format_distance
 
     note(f"hyperfocal focus: {format_distance(r.focus_from_film_mm, units_of(args))} from the film at f/{r.fstop:.3g}, "

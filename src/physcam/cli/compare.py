@@ -214,7 +214,7 @@ def _measure(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays):
     from ..analysis.distortion import real_distortion
     from ..analysis.illumination import relative_illumination
     from ..errors import PhysCamError
-    from ..onset.report import solve_lens_report
+    from ..onset.report import ReportRequest, solve_report
     from ..optics import focusing, paraxial
     from ._common import resolve_focus
 
@@ -227,7 +227,7 @@ def _measure(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays):
         notes.append(f"opens only to f/{wide:.3g}: compared wide open (asked f/{fstop:g})")
         n = wide
     mark = resolve_focus(focus_mm, lens=lens, fstop=n, sensor=sensor, coc=coc)
-    r = solve_lens_report(focal_length_mm=None, lens=lens, sensor=sensor, fstop=n, focus_mm=mark, coc=coc)
+    r = solve_report(ReportRequest(focal_length_mm=None, lens=lens, sensor=sensor, fstop=n, focus_mm=mark, coc=coc))
     d = r.to_dict()
     real = d["fov_deg"]["real"] or {}
     out = {

@@ -68,11 +68,11 @@ def register(sub) -> None:
 
 def cell_report(args, lens, sensor, fstop, focus):
     """The lens report of one cell: what `physcam report` gives for these options."""
-    from ..onset.report import solve_lens_report
+    from ..onset.report import ReportRequest, solve_report
     from ._common import coc_of
 
-    return solve_lens_report(focal_length_mm=None if lens is not None else args.focal, lens=lens, sensor=sensor,
-                             fstop=fstop, focus_mm=focus, coc=coc_of(args))
+    return solve_report(ReportRequest(focal_length_mm=None if lens is not None else args.focal, lens=lens, sensor=sensor,
+                             fstop=fstop, focus_mm=focus, coc=coc_of(args)))
 
 
 def build(args) -> dict:

@@ -250,7 +250,7 @@ def _write_builtin(args, lens, width_px: int, path):
     from ..errors import InputError
     from ..export.blender_camera import blender_camera_script, blender_camera_values
     from ..io import atomic_write
-    from ..onset.report import solve_lens_report
+    from ..onset.report import ReportRequest, solve_report
     from ..onset.sensors import custom_sensor
 
     if math.isinf(args.focus):
@@ -258,8 +258,8 @@ def _write_builtin(args, lens, width_px: int, path):
                          "give e.g. --focus 1000m")
     from ..analysis.thin_lens_gap import thin_lens_gap
 
-    report = solve_lens_report(focal_length_mm=None, sensor=custom_sensor(args.sensor_width, args.sensor_height),
-                               fstop=args.fstop, focus_mm=args.focus, lens=lens)
+    report = solve_report(ReportRequest(focal_length_mm=None, sensor=custom_sensor(args.sensor_width, args.sensor_height),
+                               fstop=args.fstop, focus_mm=args.focus, lens=lens))
     blades = int(args.blades or 0)
     values = blender_camera_values(report, resolution_x=width_px, blades=blades if blades >= 3 else 0,
                                    blade_rotation_deg=args.blade_angle)
@@ -471,7 +471,7 @@ def _slug(text: str) -> str:
 def run_pbrt(args) -> int:
     from ..errors import InputError
     from ..export.pbrt import check_pbrt_lens, write_pbrt_camera
-    from ..onset.report import solve_lens_report
+    from ..onset.report import ReportRequest, solve_report
     from ._common import coc_of
     from .report import resolve_sensor
 
@@ -494,8 +494,8 @@ def run_pbrt(args) -> int:
     with _warnings_after_success():
         if lens is None and args.fstop is None:
             raise InputError("give the f-stop of the thin lens (--fstop)")
-        report = solve_lens_report(focal_length_mm=args.focal, sensor=resolve_sensor(args), fstop=args.fstop,
-                                   focus_mm=args.focus, coc=coc_of(args), lens=lens)
+        report = solve_report(ReportRequest(focal_length_mm=args.focal, sensor=resolve_sensor(args), fstop=args.fstop,
+                                   focus_mm=args.focus, coc=coc_of(args), lens=lens))
         name = _slug(args.lens) if args.lens else f"thin_{report.focal_length_mm:g}mm".replace(".", "_")
         out = write_pbrt_camera(report, args.output, lens, name=name, xres=args.resolution, cameras=cameras,
                                 force=args.force)

@@ -118,7 +118,7 @@ def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):
 
 def solve_from_args(args):
     from ..errors import InputError
-    from ..onset.report import solve_lens_report
+    from ..onset.report import ReportRequest, solve_report
 
     lens = None
     if getattr(args, "lens", None):
@@ -137,7 +137,7 @@ def solve_from_args(args):
 
     coc = coc_of(args)
     sensor = resolve_sensor(args, quiet=True)  # the report says it in its notes
-    report = solve_lens_report(**_request_inputs(args, lens, sensor, coc))
+    report = solve_report(ReportRequest(**_request_inputs(args, lens, sensor, coc)))
     if getattr(args, "sensor_defaulted", False):
         import dataclasses
 
@@ -151,14 +151,14 @@ def dof_chart_solver(args, report):
     """``solve(fstop, focus_mm)`` for :func:`physcam.onset.dof_plot.dof_chart_figure`: the report of
     ``args`` (after :func:`solve_from_args`) at another stop and focus mark, with the report's CoC and
     sensor and no measured limits, so that the chart and the report agree at the report's own cell."""
-    from ..onset.report import solve_lens_report
+    from ..onset.report import ReportRequest, solve_report
 
     lens = getattr(args, "loaded_lens", None)
 
     def solve(fstop, focus_mm):
         inputs = _request_inputs(args, lens, report.sensor, report.coc_mm)
         inputs.update(fstop=fstop, focus_mm=focus_mm, near_mm=None, far_mm=None, tstop=None)
-        return solve_lens_report(**inputs)
+        return solve_report(ReportRequest(**inputs))
 
     return solve
 

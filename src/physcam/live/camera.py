@@ -60,7 +60,7 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
     ``focus_mm`` to ``focus_to_mm`` (mm from the film; default: held), ``lens`` (a Prescription) or a
     thin lens of ``focal_length_mm``; ``t0_ns`` the first timestamp (default now); ``shift_mm`` the
     lens shift (+ right, + up); ``drop_frame``: drop-frame timecode (29.97, 59.94)."""
-    from ..onset.report import solve_lens_report
+    from ..onset.report import ReportRequest, solve_report
     from ..onset.sensors import Sensor
 
     require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
@@ -86,8 +86,8 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
         mark = f0 + (f1 - f0) * u
         report = cache.get(mark)
         if report is None:
-            report = solve_lens_report(focal_length_mm=focal_length_mm, sensor=sensor, fstop=fstop, focus_mm=mark,
-                                       tstop=tstop, lens=lens)
+            report = solve_report(ReportRequest(focal_length_mm=focal_length_mm, sensor=sensor, fstop=fstop, focus_mm=mark,
+                                       tstop=tstop, lens=lens))
             dist = None
             if lens is not None and distortion:
                 from .lens_data import distortion_for_sample

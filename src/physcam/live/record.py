@@ -191,7 +191,6 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     never gave) raises, unless ``refused`` is a list: then it is left out, ``(index, reason)`` is
     appended there, and its values are not carried over to later frames.
     """
-    from ..onset.report import solve_lens_report
     from ..onset.sensors import Sensor, custom_sensor
 
     frames = _frames(frames)
@@ -241,7 +240,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
             elif defaults[key] is not None:
                 defaulted.append(name)
         try:
-            report = _solve_one(f, last, sensor, sensors, coc, solve_lens_report, custom_sensor, lens)
+            report = _solve_one(f, last, sensor, sensors, coc, custom_sensor, lens)
         except PhysCamError as exc:
             where = f"frame {i} (timecode {f.timecode})" if f.timecode else f"frame {i}"
             if refused is None:
@@ -277,9 +276,11 @@ def _from_encoders(f, fiz, sent) -> dict:
     return out
 
 
-def _solve_one(f, last, sensor, sensors, coc, solve_lens_report, custom_sensor, lens=None):
+def _solve_one(f, last, sensor, sensors, coc, custom_sensor, lens=None):
     """The lens report of frame ``f`` with the values ``last`` (its own, carried over or defaults);
     with ``lens`` and no streamed pinhole, the prescription's at the frame's focus."""
+    from ..onset.report import ReportRequest, solve_report
+
     need_pinhole = lens is None or last["pinhole"] is not None
     missing = [n for n, k in (("a pinhole focal length (pinholeFocalLength, --focal, --lens)", "pinhole"),
                               ("an f-stop (fStop, --fstop)", "fstop"),
@@ -299,15 +300,15 @@ def _solve_one(f, last, sensor, sensors, coc, solve_lens_report, custom_sensor, 
     if tstop is not None and tstop < last["fstop"]:
         tstop = None  # a T-stop faster than the f-stop is not physical; the report would refuse it
     if last["pinhole"] is None:  # the named lens at this focus: its breathing, pupil and squeeze
-        return solve_lens_report(focal_length_mm=None, sensor=sensors[key], fstop=float(last["fstop"]),
-                                 focus_mm=float(last["focus"]), coc=coc, tstop=tstop, lens=lens)
+        return solve_report(ReportRequest(focal_length_mm=None, sensor=sensors[key], fstop=float(last["fstop"]),
+                                 focus_mm=float(last["focus"]), coc=coc, tstop=tstop, lens=lens))
     pin = float(last["pinhole"])
     sq = 1.0 if last["squeeze"] is None else float(last["squeeze"])
     f_dof = float(last["nominal"]) if last["nominal"] is not None else pin
-    return solve_lens_report(focal_length_mm=f_dof, sensor=sensors[key], fstop=float(last["fstop"]),
+    return solve_report(ReportRequest(focal_length_mm=f_dof, sensor=sensors[key], fstop=float(last["fstop"]),
                              focus_mm=float(last["focus"]), coc=coc, tstop=tstop,
                              pupil_mm=None if last["pupil"] is None else float(last["pupil"]),
-                             pinhole_focal_length_mm=pin, squeeze=sq, pinhole_squeeze=sq)
+                             pinhole_focal_length_mm=pin, squeeze=sq, pinhole_squeeze=sq))
 
 
 def _usd_from_stage(v, mpu):

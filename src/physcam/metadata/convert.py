@@ -82,8 +82,6 @@ def solve(record, *, sensor=None, lens=None, coc=None, focal_length_mm=None, fst
     ``sensor``: when the file gives no sensor area; ``lens``: a Prescription (its breathing),
     else a thin lens of the recorded focal length (``focal_length_mm`` when the file has none);
     ``fstop``: when the file has no stop. A frame without a focus distance is refused."""
-    from ..onset.report import solve_lens_report
-
     record = _record(record)
     s = _sensor_of(record, sensor)
     frames = tracked_frames(record, rate=rate)
@@ -92,7 +90,7 @@ def solve(record, *, sensor=None, lens=None, coc=None, focal_length_mm=None, fst
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        out = _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze, solve_lens_report)
+        out = _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze)
     _warn_once(caught)
     return out
 
@@ -109,7 +107,9 @@ def _warn_once(caught) -> None:
         warnings.warn(f"{ws[0].message}{more}", cat, stacklevel=3)
 
 
-def _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze, solve_lens_report):
+def _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze):
+    from ..onset.report import ReportRequest, solve_report
+
     from dataclasses import replace
 
     from ..live.record import SolvedFrame
@@ -129,10 +129,10 @@ def _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze,
         key = (f.focus_mm, n, tstop, focal, f.entrance_pupil_mm)
         if key not in cache:
             try:
-                cache[key] = solve_lens_report(
+                cache[key] = solve_report(ReportRequest(
                     focal_length_mm=focal, sensor=s, fstop=n, focus_mm=f.focus_mm, coc=coc, tstop=tstop,
                     squeeze=squeeze, lens=lens,
-                    pupil_mm=None if lens is not None else f.entrance_pupil_mm)
+                    pupil_mm=None if lens is not None else f.entrance_pupil_mm))
             except (InputError, OpticsError) as exc:
                 raise type(exc)(f"{where}: {exc}") from None
         report = cache[key]

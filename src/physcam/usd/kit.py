@@ -251,13 +251,13 @@ def _author_shot_companion(stage, path) -> str:
     cam = stage.GetPrimAtPath(path)
     report, distortion, opencv = None, None, None
     if rx is not None and spec.projection == "perspective":
-        from ..onset.report import solve_lens_report
+        from ..onset.report import ReportRequest, solve_report
         from ..onset.sensors import Sensor
 
         sensor = Sensor(key="custom", name=spec.sensor_name or f"{spec.sensor_width_mm:g} x {spec.sensor_height_mm:g} mm",
                         width_mm=spec.sensor_width_mm, height_mm=spec.sensor_height_mm)
-        report = solve_lens_report(focal_length_mm=None, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
-                                   coc=spec.coc_mm, lens=rx)
+        report = solve_report(ReportRequest(focal_length_mm=None, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
+                                   coc=spec.coc_mm, lens=rx))
         derived = spec_from_report(report)
         _author_lens_derived(stage, cam, derived)
         spec = replace(spec, focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
@@ -466,14 +466,14 @@ def best_match_pinhole(prescription, *, focus_mm: float, fstop: float | None, se
     magnification frames like the lens at this focus, breathing included. The companion
     UsdGeomCamera is that pinhole. f-stop None: the lens wide open, as the lens report decides.
     """
-    from ..onset.report import solve_lens_report
+    from ..onset.report import ReportRequest, solve_report
     from ..onset.sensors import Sensor
     from .author import spec_from_report
 
     sensor = Sensor(key="custom", name=f"{sensor_width_mm:g} x {sensor_height_mm:g} mm",
                     width_mm=sensor_width_mm, height_mm=sensor_height_mm)
-    report = solve_lens_report(focal_length_mm=None, sensor=sensor, fstop=fstop, focus_mm=focus_mm, coc=coc_mm,
-                               lens=prescription)
+    report = solve_report(ReportRequest(focal_length_mm=None, sensor=sensor, fstop=fstop, focus_mm=focus_mm, coc=coc_mm,
+                               lens=prescription))
     return spec_from_report(report), report
 
 

@@ -172,7 +172,7 @@ def spec_from_report(report, **body) -> CameraSpec:
     """A :class:`CameraSpec` from a lens report plus body/shutter/aperture keywords of CameraSpec."""
     from ..onset.report import LensReport
 
-    require_type("report", report, LensReport, "solve one with physcam.onset.report.solve_lens_report")
+    require_type("report", report, LensReport, "solve one with physcam.onset.report.solve_report(ReportRequest(...))")
     s = report.sensor
     return CameraSpec(
         focal_length_mm=report.focal_length_mm,
