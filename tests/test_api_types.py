@@ -19,7 +19,7 @@ from physcam.lens.library import load_lens
 WRONG = ["dgauss", None, [1, 2], {"a": 1}, object(), b"x", 3 + 2j]
 SKIP_MODULES = (".cli", "__main__", ".kernels")
 #: decorators and tiny helpers whose argument is a function, not data
-SKIP_FUNCTIONS = {"takes_prescription", "takes_text", "takes_report", "require_type"}
+SKIP_FUNCTIONS = {"takes_prescription", "takes_text", "takes_report", "takes_camera", "require_type"}
 
 
 def _public_functions():

@@ -85,7 +85,7 @@ def test_every_public_default_sensor_is_the_clis():
                  "physcam.analysis.colour.chromatic_aberration", "physcam.analysis.ghosts.ghost_analysis",
                  "physcam.analysis.breathing_real.real_breathing", "physcam.analysis.mtf.mtf_chart",
                  "physcam.optics.focusing.breathing_table", "physcam.characterize.grid.Grid",
-                 "physcam.usd.author.CameraSpec", "physcam.usd.kit.write_vendor_lens"):
+                 "physcam.usd.spec.CameraSpec", "physcam.usd.kit.write_vendor_lens"):
         assert must in names, f"{must} has no sensor default (or is no longer public)"
     wrong = []
     for qual, name, value in found:

@@ -41,13 +41,14 @@ Lengths in mm, lens space (docs/conventions.md); wavelengths in nm.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite
-from ..lens.prescription import Prescription
+from ..optics.state import CameraState, camera_state
 
 #: Smallest and largest pupil grids (cells across the pupil's bounding square).
 MIN_PUPIL_SAMPLES = 16
@@ -60,62 +61,45 @@ EDGE_SUBSAMPLES = 4
 
 @dataclass(frozen=True)
 class Setup:
-    """A lens focused and stopped down for an image-quality analysis (see module notes)."""
+    """The pupil engine's view of a :class:`~physcam.optics.state.CameraState` (the lens focused and
+    stopped once, in the optics layer), plus how to trace it (``backend``)."""
 
-    lens: Prescription  # focused
-    lens_name: str
-    fstop: float
-    focus_from_film_mm: float  # inf at infinity
-    object_z: float  # -inf at infinity
-    film_z: float  # the film plane (focus plane) in lens space
-    stop_semi_diameter: float
-    z_ep: float
-    r_ep: float
-    z_xp: float
-    aperture: object | None
+    state: CameraState
     backend: str
-    design_wavelength_nm: float
 
-    @property
-    def at_infinity(self) -> bool:
-        return math.isinf(self.object_z)
+    # the names the pupil engine reads, each from the one state
+    lens = property(lambda self: self.state.focused)  # focused
+    lens_name = property(lambda self: self.state.lens_name)
+    fstop = property(lambda self: self.state.fstop)
+    focus_from_film_mm = property(lambda self: self.state.focus_from_film_mm)  # inf at infinity
+    object_z = property(lambda self: self.state.object_z)  # -inf at infinity
+    film_z = property(lambda self: self.state.film_z)  # the film plane (focus plane) in lens space
+    stop_semi_diameter = property(lambda self: self.state.stop_semi_diameter)
+    z_ep = property(lambda self: self.state.entrance_pupil_z)
+    r_ep = property(lambda self: self.state.entrance_pupil_radius)
+    z_xp = property(lambda self: self.state.exit_pupil_z)
+    aperture = property(lambda self: self.state.aperture)
+    design_wavelength_nm = property(lambda self: float(self.state.lens.wavelength_nm))
+    at_infinity = property(lambda self: self.state.at_infinity)
 
 
-def setup(lens: Prescription, *, fstop=None, focus_mm=None, aperture=None, backend: str = "auto") -> Setup:
-    """Focus ``lens`` at ``focus_mm`` (mark from the film; None or inf: infinity) and stop it to ``fstop``."""
-    from ..optics import paraxial
-    from ..optics.focusing import focus as focus_lens
-    from ..optics.focusing import iris_semi_diameter
-    from ..trace import paraxial_image_z
+def setup(lens, *, fstop=None, focus_mm=None, aperture=None, backend: str = "auto") -> Setup:
+    """The pupil engine's setup of ``lens``: a :class:`~physcam.optics.state.CameraState` as it is, or a
+    Prescription focused at ``focus_mm`` (mark from the film; None or inf: infinity) and stopped to
+    ``fstop`` by :func:`physcam.optics.state.camera_state` (one place for both)."""
     from ..trace.aperture import Aperture
 
     if aperture is not None and not isinstance(aperture, Aperture):
         from ..errors import require_type
 
         require_type("aperture", aperture, Aperture, "physcam.trace.aperture.Aperture(nsides, ...)")
-    base = paraxial.gaussian(lens)
-    if fstop is None:
-        fstop = base.f_number
-        stop = lens.surfaces[lens.stop_index].semi_diameter
+    if isinstance(lens, CameraState):
+        if fstop is not None or focus_mm is not None:
+            raise InputError("a CameraState carries its own focus and f-stop: give them to camera_state(), not here")
+        state = lens if aperture is None else dataclasses.replace(lens, aperture=aperture)
     else:
-        fstop = require_finite("f-stop", fstop)
-        if not 0.5 <= fstop <= 4096.0:
-            raise InputError(f"f-stop must lie between 0.5 and 4096, got {fstop:g}")
-        stop = iris_semi_diameter(lens, fstop)
-    if focus_mm is None or (isinstance(focus_mm, (int, float)) and math.isinf(focus_mm) and focus_mm > 0):
-        focused, object_z, film_z, mark = lens, -math.inf, paraxial_image_z(lens, backend=backend), math.inf
-    else:
-        mark = require_finite("focus distance", focus_mm)
-        st = focus_lens(lens, mark)
-        focused, object_z, film_z = st.prescription, st.object_z, st.film_z
-    g = paraxial.gaussian(focused, object_z=object_z, film_z=film_z)
-    file_stop = focused.surfaces[focused.stop_index].semi_diameter
-    r_ep = 0.5 * g.entrance_pupil_diameter * stop / file_stop
-    if not object_z < g.z_entrance_pupil:
-        raise OpticsError(f"the object lies behind the entrance pupil of {lens.name!r}: no real pupil to sample")
-    return Setup(focused, lens.name, float(fstop), float(mark), float(object_z), float(film_z), float(stop),
-                 float(g.z_entrance_pupil), float(r_ep), float(g.z_exit_pupil), aperture, backend,
-                 float(lens.wavelength_nm))
+        state = camera_state(lens, focus_mm=focus_mm, fstop=fstop, aperture=aperture)
+    return Setup(state, backend)
 
 
 # --------------------------------------------------------------------------------------------

@@ -24,14 +24,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite
-from ..lens.prescription import Prescription
 from . import _pupil as P
 
 
-def wavelengths_and_weights(lens: Prescription, wavelengths_nm, weights):
-    """Validated wavelengths (nm) and weights normalised to sum 1; the first wavelength is the primary."""
+def wavelengths_and_weights(lens, wavelengths_nm, weights):
+    """Validated wavelengths (nm) and weights normalised to sum 1; the first wavelength is the primary.
+    ``lens``: a Prescription (default: its design wavelength) or a CameraState (default: its own)."""
     from ..optics.glass import require_wavelength
+    from ..optics.state import CameraState
 
+    if isinstance(lens, CameraState):
+        if wavelengths_nm is None:
+            wavelengths_nm, weights = lens.wavelengths_nm, lens.weights
+        lens = lens.lens
     if wavelengths_nm is None:
         wls = [float(lens.wavelength_nm)]
     else:

@@ -52,7 +52,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
+from ..optics.state import takes_camera
 
 __all__ = ["HuygensPSF", "huygens_psf", "huygens_mtf", "DEFAULT_IMAGE_SAMPLES"]
 
@@ -258,7 +259,7 @@ def _centroid(fp, dz, ref):
     return float(np.average(ws.film_x, weights=w)), float(np.average(ws.film_y, weights=w))
 
 
-@takes_prescription
+@takes_camera
 def huygens_psf(
     lens: Prescription,
     field_deg=0.0,
@@ -365,7 +366,7 @@ MTF_IMAGE_SAMPLES = 257
 MTF_PIXEL_OVER_LAMBDA_N = 0.45
 
 
-@takes_prescription
+@takes_camera
 def huygens_mtf(lens: Prescription, field_deg=0.0, *, frequencies, image_samples: int = MTF_IMAGE_SAMPLES,
                 pixel_um=None, **kwargs):
     """(tangential, sagittal, psf): the MTF at ``frequencies`` (lp/mm) from :func:`huygens_psf` (module notes).

@@ -36,7 +36,8 @@ import numpy as np
 
 from ..data.default_sensor import DEFAULT_SENSOR_HALF_DIAGONAL_MM
 from ..errors import InputError, OpticsError, require_finite
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
+from ..optics.state import takes_camera
 from ._sampling import MAX_FREQUENCIES, spatial_frequencies
 
 __all__ = ["MTFCurve", "ThroughFocusMTF", "MTFChart", "mtf", "geometric_mtf", "through_focus_mtf", "mtf_chart",
@@ -166,7 +167,7 @@ def _points(points):
     return int(points)
 
 
-@takes_prescription
+@takes_camera
 def mtf(
     lens: Prescription,
     field_deg=0.0,
@@ -211,7 +212,7 @@ def mtf(
                     np.clip(dt, 0, 1), np.clip(ds, 0, 1), ct, cs)
 
 
-@takes_prescription
+@takes_camera
 def geometric_mtf(
     lens: Prescription,
     field_deg=0.0,
@@ -307,7 +308,7 @@ class ThroughFocusMTF:
         return save(fig, path, force)
 
 
-@takes_prescription
+@takes_camera
 def through_focus_mtf(
     lens: Prescription,
     field_deg=0.0,
@@ -481,7 +482,7 @@ class MTFChart:
         return save(fig, path, force)
 
 
-@takes_prescription
+@takes_camera
 def mtf_chart(
     lens: Prescription,
     *,

@@ -25,7 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, require_finite
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
+from ..optics.state import takes_camera
 
 __all__ = ["PointSpreadFunction", "psf", "strehl_of_pupil"]
 
@@ -126,7 +127,7 @@ class PointSpreadFunction:
         return save(fig, path, force)
 
 
-@takes_prescription
+@takes_camera
 def psf(
     lens: Prescription,
     field_deg=0.0,

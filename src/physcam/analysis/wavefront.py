@@ -33,7 +33,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, require_finite
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
+from ..optics.state import takes_camera
 
 __all__ = ["WavefrontMap", "wavefront", "noll_indices", "zernike_noll", "ZERNIKE_ORDERING"]
 
@@ -180,7 +181,7 @@ def _terms(zernike_terms) -> int:
     return int(zernike_terms)
 
 
-@takes_prescription
+@takes_camera
 def wavefront(
     lens: Prescription,
     field_deg=0.0,

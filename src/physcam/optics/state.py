@@ -1,0 +1,167 @@
+"""A camera state: this lens, focused here, stopped to this f-stop, on this sensor, at these
+wavelengths. Made once, checked once, then handed to every analysis that needs it.
+
+Focus is the mark's distance in front of the film plane (``focus_from_film_mm``; ``inf`` at
+infinity), through the lens's own focusing (:func:`physcam.optics.focusing.focus`: unit or internal,
+with breathing). The f-stop is the iris's setting, defined at infinity focus, and sizes the stop by
+the one iris rule (:func:`physcam.optics.focusing.iris_semi_diameter`); the iris keeps that size at
+every focus, so an internal-focus lens's f-number at the focus differs
+(:attr:`CameraState.f_number_at_focus`). Lens-space positions ``*_z`` are along the axis from the
+first vertex (docs/conventions.md).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+
+from ..errors import InputError, OpticsError, require_finite, require_type
+from ..lens.prescription import Prescription
+
+__all__ = ["CameraState", "camera_state", "takes_camera", "MIN_F_NUMBER", "MAX_F_NUMBER"]
+
+#: The f-stops a camera state accepts (the on-set report's range: f/0.5 is the fastest a lens in air
+#: can be, N = 1 / (2 sin u'); beyond f/4096 a typo is likelier).
+MIN_F_NUMBER, MAX_F_NUMBER = 0.5, 4096.0
+
+
+@dataclass(frozen=True, eq=False)
+class CameraState:
+    """A lens at one focus and one stop (module notes). Build it with :func:`camera_state`."""
+
+    lens: Prescription  # as designed (its file's infinity focus)
+    focused: Prescription  # with the focused gaps and back focus
+    focus_from_film_mm: float  # the mark from the film plane; inf at infinity
+    object_z: float  # lens space; -inf at infinity
+    film_z: float  # lens space: the film plane
+    fstop: float  # the iris's setting, at infinity focus (the file's paraxial f-number when none was given)
+    stop_semi_diameter: float  # mm, the iris by the one rule, the same at every focus
+    wavelengths_nm: tuple[float, ...] = ()
+    weights: tuple[float, ...] = ()
+    sensor_mm: tuple[float, float] | None = None  # width, height
+    aperture: object = None  # an iris shape (physcam.trace.aperture.Aperture); None: round
+    notes: tuple[str, ...] = field(default=())
+
+    @property
+    def lens_name(self) -> str:
+        return self.lens.name
+
+    @property
+    def at_infinity(self) -> bool:
+        return math.isinf(self.object_z)
+
+    @cached_property
+    def gaussian(self):
+        """The focused lens's Gaussian data at this object and film (physcam.optics.paraxial), the
+        file's stop: scale pupil diameters by :attr:`stop_scale`."""
+        from . import paraxial
+
+        return paraxial.gaussian(self.focused, object_z=self.object_z, film_z=self.film_z)
+
+    @property
+    def stop_scale(self) -> float:
+        """The iris's semi-diameter over the file's stop semi-diameter."""
+        return self.stop_semi_diameter / self.focused.surfaces[self.focused.stop_index].semi_diameter
+
+    @property
+    def entrance_pupil_z(self) -> float:
+        return float(self.gaussian.z_entrance_pupil)
+
+    @property
+    def entrance_pupil_radius(self) -> float:
+        """mm: the paraxial entrance pupil of the iris at this focus."""
+        return float(0.5 * self.gaussian.entrance_pupil_diameter * self.stop_scale)
+
+    @property
+    def exit_pupil_z(self) -> float:
+        return float(self.gaussian.z_exit_pupil)
+
+    @property
+    def f_number_at_focus(self) -> float:
+        """EFL at this focus over the entrance pupil's diameter (the iris set to :attr:`fstop`)."""
+        return float(self.gaussian.efl / (2.0 * self.entrance_pupil_radius))
+
+
+def _fstop_and_stop(lens: Prescription, fstop) -> tuple[float, float]:
+    from . import paraxial
+    from .focusing import iris_semi_diameter
+
+    if fstop is None:  # the lens as its file stops it
+        return float(paraxial.gaussian(lens).f_number), float(lens.surfaces[lens.stop_index].semi_diameter)
+    n = require_finite("f-stop", fstop)
+    if not MIN_F_NUMBER <= n <= MAX_F_NUMBER:
+        raise InputError(f"f-stop must lie between {MIN_F_NUMBER:g} and {MAX_F_NUMBER:g}, got {n:g}")
+    return float(n), float(iris_semi_diameter(lens, n))
+
+
+def _focused(lens: Prescription, focus_mm) -> tuple[Prescription, float, float, float]:
+    """(focused lens, object z, film z, mark); None or +inf: the file's infinity focus, film at the
+    paraxial image of an axial object at infinity."""
+    from . import paraxial
+    from .focusing import focus
+
+    if focus_mm is None or (isinstance(focus_mm, (int, float)) and not isinstance(focus_mm, bool)
+                            and math.isinf(focus_mm) and focus_mm > 0):
+        g = paraxial.gaussian(lens)
+        return lens, -math.inf, float(g.z_rear_focal_point), math.inf
+    mark = require_finite("focus distance", focus_mm)
+    st = focus(lens, mark)
+    return st.prescription, float(st.object_z), float(st.film_z), float(mark)
+
+
+def _wavelengths(lens: Prescription, wavelengths_nm, weights) -> tuple[tuple, tuple]:
+    if wavelengths_nm is None:
+        wls = (float(lens.wavelength_nm),)
+    else:
+        seq = [wavelengths_nm] if isinstance(wavelengths_nm, (int, float)) else list(wavelengths_nm)
+        wls = tuple(require_finite("wavelength", w) for w in seq)
+        if not wls or any(not 200.0 <= w <= 20000.0 for w in wls):
+            raise InputError(f"wavelengths must lie between 200 and 20000 nm, got {wavelengths_nm!r:.60}")
+    if weights is None:
+        return wls, (1.0,) * len(wls)
+    ws = tuple(require_finite("weight", w) for w in weights)
+    if len(ws) != len(wls) or any(w < 0 for w in ws) or not sum(ws) > 0:
+        raise InputError("give one weight >= 0 per wavelength, not all zero")
+    return wls, ws
+
+
+def camera_state(lens: Prescription, *, focus_mm=None, fstop=None, sensor_mm=None, wavelengths_nm=None,
+                 weights=None, aperture=None) -> CameraState:
+    """``lens`` focused at ``focus_mm`` (the mark from the film plane; None or inf: infinity), its
+    iris set to ``fstop`` (None: as the file stops it), on a sensor ``sensor_mm`` (width, height; None:
+    not needed), at ``wavelengths_nm`` (None: the lens's design wavelength) with ``weights``.
+    Every argument is checked here, once (InputError or OpticsError with a sentence)."""
+    require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name or file)")
+    stop_n, stop = _fstop_and_stop(lens, fstop)
+    focused, object_z, film_z, mark = _focused(lens, focus_mm)
+    if sensor_mm is not None:
+        w, h = (require_finite("sensor size", v) for v in sensor_mm)
+        if not (0.0 < w <= 1000.0 and 0.0 < h <= 1000.0):
+            raise InputError(f"the sensor must measure between 0 and 1000 mm a side, got {w:g} x {h:g}")
+        sensor_mm = (float(w), float(h))
+    wls, ws = _wavelengths(lens, wavelengths_nm, weights)
+    state = CameraState(lens, focused, mark, object_z, film_z, stop_n, stop, wls, ws, sensor_mm, aperture)
+    if not object_z < state.entrance_pupil_z:
+        raise OpticsError(f"the object lies behind the entrance pupil of {lens.name!r}: no real pupil to sample")
+    return state
+
+
+def takes_camera(fn):
+    """Decorator: the first argument is a :class:`CameraState` or a
+    :class:`~physcam.lens.prescription.Prescription` (then focused and stopped from the function's
+    own ``focus_mm`` and ``fstop``); anything else is a WrongTypeError with a sentence."""
+    import functools
+
+    first = fn.__code__.co_varnames[0]
+
+    @functools.wraps(fn)
+    def checked(*args, **kwargs):
+        value = args[0] if args else kwargs.get(first)
+        if not isinstance(value, CameraState):
+            require_type(first, value, Prescription,
+                         "a CameraState (physcam.optics.state.camera_state(lens, focus_mm=..., fstop=...)) or a lens "
+                         "(physcam.lens.library.load_lens(name or file))")
+        return fn(*args, **kwargs)
+
+    return checked
