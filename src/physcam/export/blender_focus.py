@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_type
 from ..lens.prescription import Prescription, takes_prescription
 from .osl import lens_data, osl_array, osl_number, render_template
@@ -108,7 +109,7 @@ def _arr32(name, values, size) -> str:
 
 
 def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: bool = False, focus_m: float = 3.0,
-                       fstop: float = 0.0, sensor_mm=(36.0, 24.0)) -> str:
+                       fstop: float = 0.0, sensor_mm=(DEFAULT_SENSOR_WIDTH_MM, DEFAULT_SENSOR_HEIGHT_MM)) -> str:
     """The template with ``ft``'s focus table: focus, f-stop, sensor and iris are shader parameters
     (defaults from the keywords; ``fstop`` 0 is wide open)."""
     require_type("ft", ft, FocusTable, "physcam.export.blender_focus.focus_table(lens)")
