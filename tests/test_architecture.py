@@ -148,3 +148,22 @@ def test_no_import_cycles_deferred_imports_included():
                     cycles.append(" <-> ".join(sorted(comp)))
     assert not cycles, "import cycles (move what both sides need to the module that owns the concept):\n" + \
         "\n".join(cycles)
+
+
+MAX_FUNCTION_LINES = 120  # issue 28: functions readable in one screen, split where a name explains a step
+
+
+def test_no_function_outside_the_trace_kernels_is_longer_than_120_lines():
+    """Every function (nested ones and methods included) in src/physcam, outside trace/kernels/ (where one
+    vectorised or jitted pass per surface may stay whole), spans at most 120 lines, def to last line."""
+    kernels = SRC / "physcam" / "trace" / "kernels"
+    long = []
+    for path in sorted((SRC / "physcam").rglob("*.py")):
+        if kernels in path.parents:
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                n = node.end_lineno - node.lineno + 1
+                if n > MAX_FUNCTION_LINES:
+                    long.append(f"{path.relative_to(SRC)}:{node.lineno} {node.name} ({n} lines)")
+    assert not long, "functions over 120 lines (split where a name explains a step):\n" + "\n".join(long)

@@ -183,6 +183,81 @@ def _zone_focus(lens, height, wls, backend):
     return zs
 
 
+def _chief_heights(lens: Prescription, fields, wls, film_z: float, backend: str):
+    """Film heights of the chief rays per wavelength, or (field, wavelength) of the first that does not pass."""
+    from ..trace import RayBatch, trace_through
+    from ._chief import aim_from_infinity, field_direction
+
+    dirs = field_direction(np.radians(fields), "y")
+    aims = [aim_from_infinity(lens, dirs, wavelength_nm=w, backend=backend) for w in wls]
+    n = len(dirs)
+    # every wavelength's chief rays to the film in one call (per-ray indices: module notes of _zone_focus)
+    out = trace_through(lens, RayBatch.from_arrays(np.concatenate([a.start for a in aims]),
+                                                   np.concatenate([a.direction for a in aims]),
+                                                   np.repeat(np.asarray(wls, dtype=float), n)),
+                        end_z=film_z, backend=backend)
+    found = {}
+    for k, (w, aimed) in enumerate(zip(wls, aims)):
+        part = slice(k * n, (k + 1) * n)
+        ok = aimed.ok & out.ok[part]
+        if not ok.all():
+            return float(np.asarray(fields)[~ok][0]), w
+        found[w] = out.y[part].copy()
+    return found
+
+
+def _lateral_colour(lens: Prescription, fields, wls, film_z: float, backend: str, *, clamp: bool, n_fields: int):
+    """Lateral colour at the fields (chief-ray heights per wavelength, F - C in um) and the clamp note or None.
+
+    ``clamp``: the fields are the default range to the sensor corner, so clamp it to the field every
+    wavelength's chief ray passes instead of refusing.
+    """
+    from ._chief import field_angles_deg
+
+    clamped = None
+    heights = _chief_heights(lens, fields, wls, film_z, backend)
+    if isinstance(heights, tuple) and clamp and heights[0] > 0:
+        from ._chief import clamp_note, widest_passing_deg
+
+        good = max([0.0] + [f for f in fields if f < heights[0]])
+        top = widest_passing_deg(lambda f: not isinstance(_chief_heights(lens, [f], wls, film_z, backend), tuple),
+                                 good, heights[0])
+        clamped = clamp_note("y", "chief rays at every wavelength", top, float(fields[-1]))
+        fields = field_angles_deg(None, top, n_fields, 0.0, 1.0)
+        heights = _chief_heights(lens, fields, wls, film_z, backend)
+    if isinstance(heights, tuple):
+        bad, w = heights
+        raise OpticsError(f"the chief ray at {bad:g} deg ({w:g} nm) does not pass {lens.name!r}; "
+                          "choose smaller fields (--max-field)")
+    lateral = [
+        LateralColourPoint(float(f), {f"{w:g}": float(heights[w][i]) for w in wls},
+                           float((heights[LINE_F_NM][i] - heights[LINE_C_NM][i]) * 1e3))
+        for i, f in enumerate(fields)
+    ]
+    return lateral, clamped
+
+
+def _glass_model_uncertainty(result: ColourResult, lens: Prescription, media: dict, curve) -> None:
+    """Set the longitudinal and curve uncertainties from the normal-line glasses' P_gF +- PGF_UNCERTAINTY."""
+    from ..optics.glass import normal_line
+
+    fc = _pgf_uncertainty(lens, [LINE_F_NM, LINE_C_NM] + list(curve))
+    # C - F: the perturbation moves F and C foci together; the uncertainty of their difference
+    # is computed per glass, not from the two RSS figures
+    dl = 0.0
+    for key, d in media.items():
+        if d.kind != "normal-line":
+            continue
+        p0 = float(d.pgf)
+        zs = []
+        for sign in (1.0, -1.0):
+            mod = {key: normal_line(d.nd, d.vd, p0 + sign * PGF_UNCERTAINTY)}
+            zs.append(_rear_focus_z(lens, LINE_C_NM, mod) - _rear_focus_z(lens, LINE_F_NM, mod))
+        dl += (0.5 * (zs[0] - zs[1])) ** 2
+    result.longitudinal_uncertainty_mm = float(math.sqrt(dl))
+    result.curve_uncertainty_mm = float(fc[2:].max())
+
+
 @takes_prescription
 def chromatic_aberration(
     lens: Prescription,
@@ -206,8 +281,8 @@ def chromatic_aberration(
     The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
     from ..optics.paraxial import gaussian
-    from ..trace import RayBatch, paraxial_image_z, trace_through
-    from ._chief import aim_from_infinity, field_angles_deg, field_direction
+    from ..trace import paraxial_image_z
+    from ._chief import field_angles_deg
 
     ref = require_positive("reference wavelength", reference_nm, unit="nm")
     zone = require_finite("zone", zone)
@@ -232,46 +307,8 @@ def chromatic_aberration(
 
     fields = field_angles_deg(fields_deg, max_field_deg, n_fields,
                               0.5 * math.hypot(sensor_width_mm, sensor_height_mm), g_ref.efl)
-
-    def chief_heights(fields):
-        """Film heights per wavelength, or (field, wavelength) of the first chief ray that does not pass."""
-        dirs = field_direction(np.radians(fields), "y")
-        aims = [aim_from_infinity(lens, dirs, wavelength_nm=w, backend=backend) for w in wls]
-        n = len(dirs)
-        # every wavelength's chief rays to the film in one call (per-ray indices: module notes of _zone_focus)
-        out = trace_through(lens, RayBatch.from_arrays(np.concatenate([a.start for a in aims]),
-                                                       np.concatenate([a.direction for a in aims]),
-                                                       np.repeat(np.asarray(wls, dtype=float), n)),
-                            end_z=film_z, backend=backend)
-        found = {}
-        for k, (w, aimed) in enumerate(zip(wls, aims)):
-            part = slice(k * n, (k + 1) * n)
-            ok = aimed.ok & out.ok[part]
-            if not ok.all():
-                return float(np.asarray(fields)[~ok][0]), w
-            found[w] = out.y[part].copy()
-        return found
-
-    clamped = None
-    heights = chief_heights(fields)
-    if isinstance(heights, tuple) and fields_deg is None and max_field_deg is None and heights[0] > 0:
-        # the default range reaches the sensor corner; clamp it to the field every wavelength's chief ray passes
-        from ._chief import clamp_note, widest_passing_deg
-
-        good = max([0.0] + [f for f in fields if f < heights[0]])
-        top = widest_passing_deg(lambda f: not isinstance(chief_heights([f]), tuple), good, heights[0])
-        clamped = clamp_note("y", "chief rays at every wavelength", top, float(fields[-1]))
-        fields = field_angles_deg(None, top, n_fields, 0.0, 1.0)
-        heights = chief_heights(fields)
-    if isinstance(heights, tuple):
-        bad, w = heights
-        raise OpticsError(f"the chief ray at {bad:g} deg ({w:g} nm) does not pass {lens.name!r}; "
-                          "choose smaller fields (--max-field)")
-    lateral = [
-        LateralColourPoint(float(f), {f"{w:g}": float(heights[w][i]) for w in wls},
-                           float((heights[LINE_F_NM][i] - heights[LINE_C_NM][i]) * 1e3))
-        for i, f in enumerate(fields)
-    ]
+    lateral, clamped = _lateral_colour(lens, fields, wls, film_z, backend,
+                                       clamp=fields_deg is None and max_field_deg is None, n_fields=n_fields)
     result = ColourResult(
         lens.name, ref, float(film_z), zone, wls, [float(v) for v in par], real,
         float(par[iC] - par[iF]), float(real[iC] - real[iF]),
@@ -282,23 +319,7 @@ def chromatic_aberration(
                                   if (s.medium.nd, s.medium.vd, s.medium.glass) == k], **d.to_dict()}
                     for k, d in media.items()]
     if any(d.kind == "normal-line" for d in media.values()):
-        fc = _pgf_uncertainty(lens, [LINE_F_NM, LINE_C_NM] + list(curve))
-        # C - F: the perturbation moves F and C foci together; the uncertainty of their difference
-        # is computed per glass, not from the two RSS figures
-        from ..optics.glass import normal_line
-
-        dl = 0.0
-        for key, d in media.items():
-            if d.kind != "normal-line":
-                continue
-            p0 = float(d.pgf)
-            zs = []
-            for sign in (1.0, -1.0):
-                mod = {key: normal_line(d.nd, d.vd, p0 + sign * PGF_UNCERTAINTY)}
-                zs.append(_rear_focus_z(lens, LINE_C_NM, mod) - _rear_focus_z(lens, LINE_F_NM, mod))
-            dl += (0.5 * (zs[0] - zs[1])) ** 2
-        result.longitudinal_uncertainty_mm = float(math.sqrt(dl))
-        result.curve_uncertainty_mm = float(fc[2:].max())
+        _glass_model_uncertainty(result, lens, media, curve)
     if clamped:
         result.notes.append(clamped)
     if all(s.medium.vd == 0.0 for s in lens.surfaces):

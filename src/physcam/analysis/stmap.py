@@ -237,6 +237,164 @@ def _real_to_ideal(q, gx, gy, st, film_xy, wl, backend, objects=False):
     return np.where(ok[:, None], ideal, 0.0), ok, np.where(ok[:, None], obj, 0.0), crossing
 
 
+@dataclass
+class _PlateRays:
+    """Backward chief rays from plate pixels of a focused lens, or blur centroids at a stop (module notes)."""
+
+    name: str
+    q: Prescription
+    gx: object
+    gy: object
+    st: object
+    wl: float
+    backend: str
+    w_px: int
+    h_px: int
+    sensor: tuple
+    iris: float | None
+
+    @property
+    def sx(self):
+        return self.w_px / self.sensor[0]  # pixels per mm
+
+    @property
+    def sy(self):
+        return self.h_px / self.sensor[1]
+
+    def film_of(self, px, py):
+        """Plate pixels -> film mm (the film image is the picture turned by 180 deg)."""
+        return np.stack([-(px - self.w_px / 2) / self.sx, -(py - self.h_px / 2) / self.sy], axis=1)
+
+    def chief(self, px, py):
+        """Ideal plate px of the chief rays from plate pixels, with their object points and stop crossings."""
+        ideal, ok, obj, crossing = _real_to_ideal(self.q, self.gx, self.gy, self.st, self.film_of(px, py), self.wl,
+                                                  self.backend, objects=True)
+        if not ok.all():
+            i = int(np.argmin(ok))
+            W, H = self.sensor
+            raise OpticsError(
+                f"at focus {self.st.focus_from_film_mm:g} mm no chief ray leaves {self.name!r} from the film point "
+                f"({px[i]:.0f}, {py[i]:.0f}) px of a {W:g} x {H:g} mm sensor: the lens does not cover it; "
+                "give a smaller sensor")
+        return (np.stack([ideal[:, 0] * self.sx + self.w_px / 2, ideal[:, 1] * self.sy + self.h_px / 2], axis=1),
+                obj, crossing)
+
+    def centroid_px(self, obj, crossing):
+        """Where the stopped-down lens images the object points, plate px."""
+        from .centroid import image_centroids
+
+        q, g, st, iris = self.q, self.gy, self.st, self.iris
+        r_ep = g.entrance_pupil_diameter / 2 * iris / q.surfaces[q.stop_index].semi_diameter
+        c = image_centroids(q, st.film_z, obj, at_infinity=math.isinf(st.object_z), crossing=crossing,
+                            z_ep=g.z_entrance_pupil, pupil_radius=r_ep, iris_semi_diameter=iris,
+                            wavelength_nm=self.wl, backend=self.backend)
+        return np.stack([-c[:, 0] * self.sx + self.w_px / 2, -c[:, 1] * self.sy + self.h_px / 2], axis=1)
+
+    def trace(self, px, py):
+        """Ideal plate px of the real positions at plate pixels: chief rays, or centroids at the stop."""
+        ideal, obj, crossing = self.chief(px, py)
+        if self.iris is None:
+            return ideal
+        # aim again from the node moved back by its centroid's offset: the centroid then lands on the node
+        off = self.centroid_px(obj, crossing) - np.stack([px, py], axis=1)
+        return self.chief(px - off[:, 0], py - off[:, 1])[0]
+
+    def residual(self, px, py, ideal_at):
+        """(RMS, max) plate px between the field and traced positions at the stop (module notes)."""
+        if self.iris is None:
+            d = ideal_at(px, py) - self.trace(px, py)
+        else:  # independent of the aiming above: each object point's own centroid, mapped by the field
+            ideal, obj, crossing = self.chief(px, py)
+            c = self.centroid_px(obj, crossing)
+            d = ideal_at(c[:, 0], c[:, 1]) - ideal
+        e = np.hypot(d[:, 0], d[:, 1])
+        return float(np.sqrt(np.mean(e * e))), float(e.max())
+
+
+def _require_pinhole_reach(rays: _PlateRays, nodes) -> None:
+    """Refuse a fisheye on this sensor: its pinhole image would put the frame's edge far outside it.
+
+    At 90 degrees off axis the pinhole image is infinitely far; no pinhole-based map or model represents that.
+    """
+    w_px, h_px = rays.w_px, rays.h_px
+    reach = float(max(np.abs(nodes[..., 0] - w_px / 2).max() / (w_px / 2), np.abs(nodes[..., 1] - h_px / 2).max() / (h_px / 2)))
+    if reach > MAX_PINHOLE_REACH:
+        W, H = rays.sensor
+        r_mm = float(np.hypot((nodes[..., 0] - w_px / 2) / rays.sx, (nodes[..., 1] - h_px / 2) / rays.sy).max())
+        angle = math.degrees(math.atan(r_mm / float(rays.gy.pinhole_focal_length)))
+        raise OpticsError(
+            f"{rays.name!r} sees up to {angle:.1f} deg off axis on a {W:g} x {H:g} mm sensor: its pinhole image would "
+            f"reach {reach:.1f} times the frame's half-size, so no pinhole-based distortion map or model represents "
+            "it (a fisheye); give a smaller sensor")
+
+
+def _overscan_px(fwd: _Grid, nodes, w_px: int, h_px: int) -> tuple[int, int]:
+    """The symmetric margin (ox, oy) whose box keeps the ideal position of every plate pixel.
+
+    The pixels' ideal positions in blocks of rows, then again into the map: never a float64 frame whole.
+    """
+    edges = np.concatenate([nodes[0], nodes[-1], nodes[:, 0], nodes[:, -1]])
+    lo, hi = edges.min(axis=0), edges.max(axis=0)
+    for _, block in fwd.row_blocks(w_px, h_px):
+        lo = np.minimum(lo, block.reshape(-1, 2).min(axis=0))
+        hi = np.maximum(hi, block.reshape(-1, 2).max(axis=0))
+    ox = int(math.ceil(max(0.0, -lo[0], hi[0] - w_px) - 1e-9))
+    oy = int(math.ceil(max(0.0, -lo[1], hi[1] - h_px) - 1e-9))
+    W2, H2 = w_px + 2 * ox, h_px + 2 * oy
+    if W2 * H2 > 4 * MAX_PIXELS or W2 > 4 * MAX_SIDE_PX or H2 > 4 * MAX_SIDE_PX:
+        raise OpticsError(f"the undistorted frame would be {W2} x {H2} px: the distortion is too strong for an ST-map")
+    return ox, oy
+
+
+def _invert_field(fwd: _Grid, qx, qy, w_px: int, h_px: int, name: str):
+    """Real plate px whose ideal positions are (qx, qy): Newton on the interpolated forward field."""
+    r = np.stack([qx, qy], axis=1).astype(float)
+    goal = r.copy()
+    h = 0.25
+    for _ in range(30):
+        f = fwd.at(r[:, 0], r[:, 1]) - goal
+        if np.abs(f).max() < 1e-7:
+            break
+        fx = (fwd.at(r[:, 0] + h, r[:, 1]) - fwd.at(r[:, 0] - h, r[:, 1])) / (2 * h)
+        fy = (fwd.at(r[:, 0], r[:, 1] + h) - fwd.at(r[:, 0], r[:, 1] - h)) / (2 * h)
+        det = fx[:, 0] * fy[:, 1] - fy[:, 0] * fx[:, 1]
+        if not (np.abs(det) > 1e-9).all():
+            raise OpticsError(f"the distortion of {name!r} folds the picture over: it has no undistortion map")
+        step = np.stack([(fy[:, 1] * f[:, 0] - fy[:, 0] * f[:, 1]) / det,
+                         (-fx[:, 1] * f[:, 0] + fx[:, 0] * f[:, 1]) / det], axis=1)
+        r -= np.clip(step, -0.25 * max(w_px, h_px), 0.25 * max(w_px, h_px))
+    return r
+
+
+def _undistortion_map(fwd: _Grid, overscan, w_px: int, h_px: int, name: str):
+    """(undistortion ST-map, its worst round-trip error in px): the inverse field at nodes over the
+    overscanned frame (coordinates in plate pixels: -ox .. w + ox)."""
+    ox, oy = overscan
+    W2, H2 = w_px + 2 * ox, h_px + 2 * oy
+    mx, ex = _nodes(W2)
+    my, ey = _nodes(H2)
+    QX, QY = np.meshgrid(np.arange(mx) * ex - ox, np.arange(my) * ey - oy)
+    inv_nodes = _invert_field(fwd, QX.ravel(), QY.ravel(), w_px, h_px, name).reshape(my, mx, 2)
+    if not np.isfinite(inv_nodes).all():
+        raise OpticsError(f"the undistortion of {name!r} did not converge: no map written")
+    inv = _Grid(inv_nodes, -ox, ex, -oy, ey)
+    kx, ky = np.meshgrid((np.arange(mx - 1) + 0.5) * ex - ox, (np.arange(my - 1) + 0.5) * ey - oy)
+    back = fwd.at(*inv.at(kx.ravel(), ky.ravel()).T)
+    inv_err = float(np.hypot(back[:, 0] - kx.ravel(), back[:, 1] - ky.ravel()).max())
+    umap = np.zeros((H2, W2, 3), dtype=np.float32)
+    inv.fill(umap, (w_px, h_px), origin=(-ox, -oy))
+    return umap, inv_err
+
+
+def _field_notes(fstop) -> list[str]:
+    """What the field's pinhole and real positions are, for the result's notes."""
+    return ["pinhole focal length: the paraxial one at this focus (GaussianData.pinhole_focal_length), "
+            "camera at the entrance pupil",
+            "real positions: chief rays (a small stop); at a working aperture give the f-stop (centroids)"
+            if fstop is None else f"real positions: the blur centroids at f/{fstop:g} (the iris sized at infinity "
+            "focus)"]
+
+
 @takes_prescription
 def distortion_field(
     lens: Prescription,
@@ -274,144 +432,40 @@ def distortion_field(
     for a in ("x", "y"):
         if g[a].pinhole_focal_length is None or not g[a].efl > 0:
             raise OpticsError(f"lens {lens.name!r} has no best-match pinhole in {a.upper()} at this focus")
-    sx, sy = w_px / W, h_px / H  # pixels per mm
     iris = None if fstop is None else iris_semi_diameter(lens, fstop, method=method)
-
-    def film_of(px, py):  # plate pixels -> film mm (the film image is the picture turned by 180 deg)
-        return np.stack([-(px - w_px / 2) / sx, -(py - h_px / 2) / sy], axis=1)
-
-    def chief(px, py):
-        ideal, ok, obj, crossing = _real_to_ideal(q, g["x"], g["y"], st, film_of(px, py), wl, backend, objects=True)
-        if not ok.all():
-            i = int(np.argmin(ok))
-            raise OpticsError(
-                f"at focus {st.focus_from_film_mm:g} mm no chief ray leaves {lens.name!r} from the film point "
-                f"({px[i]:.0f}, {py[i]:.0f}) px of a {W:g} x {H:g} mm sensor: the lens does not cover it; "
-                "give a smaller sensor")
-        return np.stack([ideal[:, 0] * sx + w_px / 2, ideal[:, 1] * sy + h_px / 2], axis=1), obj, crossing
-
-    def centroid_px(obj, crossing):  # where the stopped-down lens images the object points, plate px
-        from .centroid import image_centroids
-
-        r_ep = g["y"].entrance_pupil_diameter / 2 * iris / q.surfaces[q.stop_index].semi_diameter
-        c = image_centroids(q, st.film_z, obj, at_infinity=math.isinf(st.object_z), crossing=crossing,
-                            z_ep=g["y"].z_entrance_pupil, pupil_radius=r_ep, iris_semi_diameter=iris,
-                            wavelength_nm=wl, backend=backend)
-        return np.stack([-c[:, 0] * sx + w_px / 2, -c[:, 1] * sy + h_px / 2], axis=1)
-
-    def trace(px, py):
-        ideal, obj, crossing = chief(px, py)
-        if iris is None:
-            return ideal
-        # aim again from the node moved back by its centroid's offset: the centroid then lands on the node
-        off = centroid_px(obj, crossing) - np.stack([px, py], axis=1)
-        return chief(px - off[:, 0], py - off[:, 1])[0]
-
-    def residual(px, py, ideal_at):
-        """(RMS, max) plate px between the field and traced positions at the stop (module notes)."""
-        if iris is None:
-            d = ideal_at(px, py) - trace(px, py)
-        else:  # independent of the aiming above: each object point's own centroid, mapped by the field
-            ideal, obj, crossing = chief(px, py)
-            c = centroid_px(obj, crossing)
-            d = ideal_at(c[:, 0], c[:, 1]) - ideal
-        e = np.hypot(d[:, 0], d[:, 1])
-        return float(np.sqrt(np.mean(e * e))), float(e.max())
+    rays = _PlateRays(lens.name, q, g["x"], g["y"], st, wl, backend, w_px, h_px, (W, H), iris)
 
     # forward field: real plate position -> ideal plate position, traced at the nodes
     nx, dx = _nodes(w_px)
     ny, dy = _nodes(h_px)
     X, Y = np.meshgrid(np.arange(nx) * dx, np.arange(ny) * dy)
-    nodes = trace(X.ravel(), Y.ravel()).reshape(ny, nx, 2)
+    nodes = rays.trace(X.ravel(), Y.ravel()).reshape(ny, nx, 2)
     fwd = _Grid(nodes, 0.0, dx, 0.0, dy)
     cx, cy = np.meshgrid((np.arange(nx - 1) + 0.5) * dx, (np.arange(ny - 1) + 0.5) * dy)
-    exact = trace(cx.ravel(), cy.ravel())
-    # a fisheye on this sensor: the pinhole would put the frame's edge far outside it (at 90 degrees,
-    # infinitely far); no pinhole-based map or model represents that
-    reach = float(max(np.abs(nodes[..., 0] - w_px / 2).max() / (w_px / 2), np.abs(nodes[..., 1] - h_px / 2).max() / (h_px / 2)))
-    if reach > MAX_PINHOLE_REACH:
-        r_mm = float(np.hypot((nodes[..., 0] - w_px / 2) / sx, (nodes[..., 1] - h_px / 2) / sy).max())
-        angle = math.degrees(math.atan(r_mm / float(g["y"].pinhole_focal_length)))
-        raise OpticsError(
-            f"{lens.name!r} sees up to {angle:.1f} deg off axis on a {W:g} x {H:g} mm sensor: its pinhole image would "
-            f"reach {reach:.1f} times the frame's half-size, so no pinhole-based distortion map or model represents "
-            "it (a fisheye); give a smaller sensor")
+    exact = rays.trace(cx.ravel(), cy.ravel())
+    _require_pinhole_reach(rays, nodes)
     interp_err = float(np.hypot(*(fwd.at(cx.ravel(), cy.ravel()) - exact).T).max())
-    resid = residual(cx.ravel(), cy.ravel(), lambda x, y: fwd.at(x, y))
+    resid = rays.residual(cx.ravel(), cy.ravel(), lambda x, y: fwd.at(x, y))
     n_stop = None if fstop is None else float(fstop)
     max_dist = float(np.hypot(nodes[..., 0] - X, nodes[..., 1] - Y).max())
     traced_real = np.concatenate([np.stack([X.ravel(), Y.ravel()], axis=1), np.stack([cx.ravel(), cy.ravel()], axis=1)])
     traced_ideal = np.concatenate([nodes.reshape(-1, 2), exact])
-    notes = ["pinhole focal length: the paraxial one at this focus (GaussianData.pinhole_focal_length), "
-             "camera at the entrance pupil",
-             "real positions: chief rays (a small stop); at a working aperture give the f-stop (centroids)"
-             if fstop is None else f"real positions: the blur centroids at f/{fstop:g} (the iris sized at infinity "
-             "focus)"]
-    if not maps:
-        return DistortionField(
-            lens.name, float(st.focus_from_film_mm), float(wl), (W, H), (w_px, h_px),
-            (float(g["x"].pinhole_focal_length), float(g["y"].pinhole_focal_length)),
-            (float(st.film_z - g["x"].z_entrance_pupil), float(st.film_z - g["y"].z_entrance_pupil)),
-            (0, 0), (nx, ny), interp_err, math.nan, max_dist, n_stop, resid, None, None, notes, fwd, traced_real,
-            traced_ideal)
 
-    # overscan: the symmetric margin whose box keeps the ideal position of every plate pixel (the
-    # pixels' ideal positions in blocks of rows, then again into the map: never a float64 frame whole)
-    edges = np.concatenate([nodes[0], nodes[-1], nodes[:, 0], nodes[:, -1]])
-    lo, hi = edges.min(axis=0), edges.max(axis=0)
-    for _, block in fwd.row_blocks(w_px, h_px):
-        lo = np.minimum(lo, block.reshape(-1, 2).min(axis=0))
-        hi = np.maximum(hi, block.reshape(-1, 2).max(axis=0))
-    ox = int(math.ceil(max(0.0, -lo[0], hi[0] - w_px) - 1e-9))
-    oy = int(math.ceil(max(0.0, -lo[1], hi[1] - h_px) - 1e-9))
-    W2, H2 = w_px + 2 * ox, h_px + 2 * oy
-    if W2 * H2 > 4 * MAX_PIXELS or W2 > 4 * MAX_SIDE_PX or H2 > 4 * MAX_SIDE_PX:
-        raise OpticsError(f"the undistorted frame would be {W2} x {H2} px: the distortion is too strong for an ST-map")
-    dmap = np.zeros((h_px, w_px, 3), dtype=np.float32)
-    fwd.fill(dmap, (w_px, h_px))  # normalised to the plate's frame (module notes)
-
-    # inverse: ideal position -> real position, by Newton on the interpolated field at nodes over
-    # the overscanned frame (coordinates in plate pixels: -ox .. w + ox)
-    mx, ex = _nodes(W2)
-    my, ey = _nodes(H2)
-
-    def invert(qx, qy):
-        r = np.stack([qx, qy], axis=1).astype(float)
-        goal = r.copy()
-        h = 0.25
-        for _ in range(30):
-            f = fwd.at(r[:, 0], r[:, 1]) - goal
-            if np.abs(f).max() < 1e-7:
-                break
-            fx = (fwd.at(r[:, 0] + h, r[:, 1]) - fwd.at(r[:, 0] - h, r[:, 1])) / (2 * h)
-            fy = (fwd.at(r[:, 0], r[:, 1] + h) - fwd.at(r[:, 0], r[:, 1] - h)) / (2 * h)
-            det = fx[:, 0] * fy[:, 1] - fy[:, 0] * fx[:, 1]
-            if not (np.abs(det) > 1e-9).all():
-                raise OpticsError(f"the distortion of {lens.name!r} folds the picture over: it has no undistortion map")
-            step = np.stack([(fy[:, 1] * f[:, 0] - fy[:, 0] * f[:, 1]) / det,
-                             (-fx[:, 1] * f[:, 0] + fx[:, 0] * f[:, 1]) / det], axis=1)
-            r -= np.clip(step, -0.25 * max(w_px, h_px), 0.25 * max(w_px, h_px))
-        return r
-
-    QX, QY = np.meshgrid(np.arange(mx) * ex - ox, np.arange(my) * ey - oy)
-    inv_nodes = invert(QX.ravel(), QY.ravel()).reshape(my, mx, 2)
-    if not np.isfinite(inv_nodes).all():
-        raise OpticsError(f"the undistortion of {lens.name!r} did not converge: no map written")
-    inv = _Grid(inv_nodes, -ox, ex, -oy, ey)
-    kx, ky = np.meshgrid((np.arange(mx - 1) + 0.5) * ex - ox, (np.arange(my - 1) + 0.5) * ey - oy)
-    back = fwd.at(*inv.at(kx.ravel(), ky.ravel()).T)
-    inv_err = float(np.hypot(back[:, 0] - kx.ravel(), back[:, 1] - ky.ravel()).max())
-    umap = np.zeros((H2, W2, 3), dtype=np.float32)
-    inv.fill(umap, (w_px, h_px), origin=(-ox, -oy))
-    if not (np.isfinite(dmap).all() and np.isfinite(umap).all()):
-        raise OpticsError(f"the ST-maps of {lens.name!r} have non-finite values: no map written")
+    overscan, inv_err, dmap, umap = (0, 0), math.nan, None, None
+    if maps:
+        overscan = _overscan_px(fwd, nodes, w_px, h_px)
+        dmap = np.zeros((h_px, w_px, 3), dtype=np.float32)
+        fwd.fill(dmap, (w_px, h_px))  # normalised to the plate's frame (module notes)
+        umap, inv_err = _undistortion_map(fwd, overscan, w_px, h_px, lens.name)
+        if not (np.isfinite(dmap).all() and np.isfinite(umap).all()):
+            raise OpticsError(f"the ST-maps of {lens.name!r} have non-finite values: no map written")
     zf = st.film_z
     return DistortionField(
         lens.name, float(st.focus_from_film_mm), float(wl), (W, H), (w_px, h_px),
         (float(g["x"].pinhole_focal_length), float(g["y"].pinhole_focal_length)),
         (float(zf - g["x"].z_entrance_pupil), float(zf - g["y"].z_entrance_pupil)),
-        (ox, oy), (nx, ny), interp_err, inv_err, max_dist, n_stop, resid, dmap, umap, notes, fwd, traced_real,
-        traced_ideal)
+        overscan, (nx, ny), interp_err, inv_err, max_dist, n_stop, resid, dmap, umap, _field_notes(fstop), fwd,
+        traced_real, traced_ideal)
 
 
 def apply_stmap(image, stmap, *, overscan=(0, 0)) -> np.ndarray:

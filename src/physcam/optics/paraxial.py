@@ -325,6 +325,117 @@ def stop_semi_diameter_for_fstop(prescription: Prescription, fstop: float, axis:
     return file_stop * scale
 
 
+def _cardinal_points(prescription: Prescription, axis: str, lam: float, n_obj: float, n_img: float) -> dict:
+    """Focal lengths, focal, principal and nodal points from the system matrix (Smith 3.3), as GaussianData fields."""
+    z_last = prescription.vertex_z[-1]
+    A, B, C, D = system_matrix(prescription, axis, lam)
+    phi = -C
+    if abs(phi) < 1e-12:
+        raise OpticsError(f"lens {prescription.name!r} is afocal in the {axis.upper()} meridian (no focal length)")
+    efl = 1.0 / phi
+    f_front = n_obj / phi
+    f_rear = n_img / phi
+    bfl = n_img * A / phi  # last vertex -> F'
+    ffl = n_obj * D / phi  # F -> first vertex
+    z_F = -ffl
+    z_F2 = z_last + bfl
+    return dict(
+        efl=efl, front_focal_length=f_front, rear_focal_length=f_rear, ffl=ffl, bfl=bfl,
+        z_front_focal_point=z_F, z_rear_focal_point=z_F2,
+        z_front_principal_plane=z_F + f_front, z_rear_principal_plane=z_F2 - f_rear,
+        # nodal points: N is f' behind F, N' is f in front of F'
+        z_front_nodal_point=z_F + f_rear, z_rear_nodal_point=z_F2 - f_front,
+    )
+
+
+def _stop_semi(prescription: Prescription, axis: str, lam: float, fstop, stop_semi_diameter) -> float:
+    """The stop's semi-diameter: as in the file, scaled to ``fstop`` at infinity, or given directly."""
+    stop_semi = prescription.surfaces[prescription.stop_index].semi_diameter
+    if fstop is not None and stop_semi_diameter is not None:
+        raise InputError("give the f-stop or the stop's semi-diameter, not both")
+    if fstop is not None:
+        stop_semi = stop_semi_diameter_for_fstop(prescription, fstop, axis, lam)
+    elif stop_semi_diameter is not None:
+        stop_semi = require_positive("stop semi-diameter", stop_semi_diameter)
+    return stop_semi
+
+
+@dataclass(frozen=True)
+class _Pupils:
+    """The entrance and exit pupils (images of the stop) and the chief ray that defines them."""
+
+    z_ep: float
+    ep_semi: float
+    z_xp: float
+    xp_semi: float
+    chief_nu_object: float  # reduced object-space angle of the chief ray leaving the stop centre at unit slope
+    chief_y_last: float  # its height at the last vertex
+    chief_nu_image: float  # its reduced image-space angle
+
+
+def _pupils(prescription: Prescription, axis: str, lam: float, n: tuple, stop_semi: float) -> _Pupils:
+    """Images of the stop through the front and back groups (paraxial chief and stop-edge rays)."""
+    surfaces = prescription.surfaces
+    n_obj, n_img = n[0], n[-1]
+    z_last = prescription.vertex_z[-1]
+    k = prescription.stop_index
+    # front group: first vertex -> stop vertex (the stop has no power)
+    front = _mul((1.0, surfaces[k - 1].thickness / n[k], 0.0, 1.0), system_matrix(prescription, axis, lam, 0, k - 1)) if k > 0 else (1.0, 0.0, 0.0, 1.0)
+    back = system_matrix(prescription, axis, lam, k, len(surfaces) - 1)
+    inv = _inverse(front)
+    # chief ray: through the stop centre; in object space it crosses the axis at the EP
+    y0, nu0 = _propagate(inv, 0.0, 1.0)
+    if abs(nu0) < 1e-15:
+        raise OpticsError("the entrance pupil is at infinity (object-space telecentric lens)")
+    z_ep = -y0 * n_obj / nu0
+    # a ray from the stop edge, parallel to the axis at the stop: its object-space
+    # line passes through the image of the edge point, at the EP plane
+    y1, nu1 = _propagate(inv, stop_semi, 0.0)
+    ep_semi = abs(y1 + nu1 / n_obj * z_ep)
+    y2, nu2 = _propagate(back, 0.0, 1.0)
+    if abs(nu2) < 1e-15:
+        raise OpticsError("the exit pupil is at infinity (image-space telecentric lens)")
+    z_xp = z_last - y2 * n_img / nu2
+    y3, nu3 = _propagate(back, stop_semi, 0.0)
+    xp_semi = abs(y3 + nu3 / n_img * (z_xp - z_last))
+    if ep_semi <= 0 or xp_semi <= 0:
+        raise OpticsError("the pupils have no size (stop of zero semi-diameter)")
+    return _Pupils(z_ep, ep_semi, z_xp, xp_semi, nu0, y2, nu2)
+
+
+def _conjugate(prescription: Prescription, axis: str, lam: float, n: tuple, object_z: float, pupils: _Pupils,
+               z_rear_focal_point: float) -> tuple[float, float, float]:
+    """(image z, lateral magnification, image-space reduced angle of the marginal ray) of the object plane."""
+    n_obj, n_img = n[0], n[-1]
+    z_last = prescription.vertex_z[-1]
+    z_ep, ep_semi = pupils.z_ep, pupils.ep_semi
+    if math.isinf(object_z):
+        z_img = z_rear_focal_point
+        mag = 0.0
+        # marginal ray from infinity at the EP edge
+        ys, nus = paraxial_trace(prescription, ep_semi, 0.0, axis, lam)
+    else:
+        if object_z >= 0:
+            raise InputError(f"the object must lie in front of the first vertex (z < 0), got z = {object_z:g} mm")
+        # ray from the axial object point to the EP edge
+        u = ep_semi / (z_ep - object_z)
+        y_first = u * (0.0 - object_z)
+        ys, nus = paraxial_trace(prescription, y_first, n_obj * u, axis, lam)
+        if abs(nus[-1]) < 1e-15:
+            raise OpticsError("the object is at the front focal point: its image is at infinity")
+        z_img = z_last - ys[-1] * n_img / nus[-1]
+        # lateral magnification = (n u) / (n' u') for the axial ray (Lagrange invariant)
+        mag = (n_obj * u) / nus[-1]
+    return z_img, mag, nus[-1]
+
+
+def _pinhole_focal_length(pupils: _Pupils, n_obj: float, n_img: float, z_last: float, z_film: float):
+    """The best-match pinhole: the chief ray (reduced object-space angle nu0) meets the film at y_film; None on axis."""
+    y2, nu2, nu0 = pupils.chief_y_last, pupils.chief_nu_image, pupils.chief_nu_object
+    y_film = y2 + nu2 / n_img * (z_film - z_last)
+    return abs(y_film * n_obj / nu0) if abs(y_film) > 1e-12 * abs(z_film - z_last + 1.0) else None
+
+
 @takes_prescription
 def gaussian(
     prescription: Prescription,
@@ -357,116 +468,38 @@ def gaussian(
         raise InputError(f"object plane must be in front of the lens (z < 0) or at -inf, got {object_z}")
     if flange_focal_distance_mm is not None:
         flange_focal_distance_mm = require_positive("flange focal distance", flange_focal_distance_mm)
-    surfaces = prescription.surfaces
     n = media_indices(prescription, lam)
     n_obj, n_img = n[0], n[-1]
-    zv = prescription.vertex_z
-    z_last = zv[-1]
+    z_last = prescription.vertex_z[-1]
 
-    # ---- focal and principal points from the system matrix (Smith 3.3) ----
-    A, B, C, D = system_matrix(prescription, axis, lam)
-    phi = -C
-    if abs(phi) < 1e-12:
-        raise OpticsError(f"lens {prescription.name!r} is afocal in the {axis.upper()} meridian (no focal length)")
-    efl = 1.0 / phi
-    f_front = n_obj / phi
-    f_rear = n_img / phi
-    bfl = n_img * A / phi  # last vertex -> F'
-    ffl = n_obj * D / phi  # F -> first vertex
-    z_F = -ffl
-    z_F2 = z_last + bfl
-    z_H = z_F + f_front
-    z_H2 = z_F2 - f_rear
-    z_N = z_F + f_rear  # nodal points: N is f' behind F, N' is f in front of F'
-    z_N2 = z_F2 - f_front
-
-    # ---- the stop and the pupils (images of the stop) ---------------------
-    k = prescription.stop_index
-    z_stop = zv[k]
-    stop_semi = surfaces[k].semi_diameter
-    if fstop is not None and stop_semi_diameter is not None:
-        raise InputError("give the f-stop or the stop's semi-diameter, not both")
-    if fstop is not None:
-        stop_semi = stop_semi_diameter_for_fstop(prescription, fstop, axis, lam)
-    elif stop_semi_diameter is not None:
-        stop_semi = require_positive("stop semi-diameter", stop_semi_diameter)
-    # front group: first vertex -> stop vertex (the stop has no power)
-    front = _mul((1.0, surfaces[k - 1].thickness / n[k], 0.0, 1.0), system_matrix(prescription, axis, lam, 0, k - 1)) if k > 0 else (1.0, 0.0, 0.0, 1.0)
-    back = system_matrix(prescription, axis, lam, k, len(surfaces) - 1)
-    inv = _inverse(front)
-    # chief ray: through the stop centre; in object space it crosses the axis at the EP
-    y0, nu0 = _propagate(inv, 0.0, 1.0)
-    if abs(nu0) < 1e-15:
-        raise OpticsError("the entrance pupil is at infinity (object-space telecentric lens)")
-    z_ep = -y0 * n_obj / nu0
-    # a ray from the stop edge, parallel to the axis at the stop: its object-space
-    # line passes through the image of the edge point, at the EP plane
-    y1, nu1 = _propagate(inv, stop_semi, 0.0)
-    ep_semi = abs(y1 + nu1 / n_obj * z_ep)
-    y2, nu2 = _propagate(back, 0.0, 1.0)
-    if abs(nu2) < 1e-15:
-        raise OpticsError("the exit pupil is at infinity (image-space telecentric lens)")
-    z_xp = z_last - y2 * n_img / nu2
-    y3, nu3 = _propagate(back, stop_semi, 0.0)
-    xp_semi = abs(y3 + nu3 / n_img * (z_xp - z_last))
-    if ep_semi <= 0 or xp_semi <= 0:
-        raise OpticsError("the pupils have no size (stop of zero semi-diameter)")
-    f_number = abs(efl) / (2.0 * ep_semi)
-    m_p = xp_semi / ep_semi
-
-    # ---- the conjugate: object plane -> paraxial image plane ----------------
-    if math.isinf(object_z):
-        z_img = z_F2
-        mag = 0.0
-        # marginal ray from infinity at the EP edge
-        ys, nus = paraxial_trace(prescription, ep_semi, 0.0, axis, lam)
-    else:
-        if object_z >= 0:
-            raise InputError(f"the object must lie in front of the first vertex (z < 0), got z = {object_z:g} mm")
-        # ray from the axial object point to the EP edge
-        u = ep_semi / (z_ep - object_z)
-        y_first = u * (0.0 - object_z)
-        ys, nus = paraxial_trace(prescription, y_first, n_obj * u, axis, lam)
-        if abs(nus[-1]) < 1e-15:
-            raise OpticsError("the object is at the front focal point: its image is at infinity")
-        z_img = z_last - ys[-1] * n_img / nus[-1]
-        # lateral magnification = (n u) / (n' u') for the axial ray (Lagrange invariant)
-        mag = (n_obj * u) / nus[-1]
-    nu_img = nus[-1]
+    cardinal = _cardinal_points(prescription, axis, lam, n_obj, n_img)
+    efl, bfl = cardinal["efl"], cardinal["bfl"]
+    stop_semi = _stop_semi(prescription, axis, lam, fstop, stop_semi_diameter)
+    pupils = _pupils(prescription, axis, lam, n, stop_semi)
+    z_img, mag, nu_img = _conjugate(prescription, axis, lam, n, object_z, pupils, cardinal["z_rear_focal_point"])
     if abs(nu_img) < 1e-15:
         raise OpticsError("the image is at infinity: no working f-number")
     working_n = 1.0 / (2.0 * abs(nu_img))
     z_film = z_img if film_z is None else require_finite("film plane z", film_z)
-    # the best-match pinhole: the chief ray (reduced object-space angle nu0) meets the film at y_film
-    y_film = y2 + nu2 / n_img * (z_film - z_last)
-    pinhole = abs(y_film * n_obj / nu0) if abs(y_film) > 1e-12 * abs(z_film - z_last + 1.0) else None
-    for name, v in (("EFL", efl), ("BFL", bfl), ("entrance pupil", z_ep), ("exit pupil", z_xp), ("image", z_img)):
+    pinhole = _pinhole_focal_length(pupils, n_obj, n_img, z_last, z_film)
+    for name, v in (("EFL", efl), ("BFL", bfl), ("entrance pupil", pupils.z_ep), ("exit pupil", pupils.z_xp),
+                    ("image", z_img)):
         if not math.isfinite(v):
             raise OpticsError(f"paraxial {name} position is not finite for lens {prescription.name!r}")
     return GaussianData(
         axis=axis,
         wavelength_nm=lam,
-        efl=efl,
-        front_focal_length=f_front,
-        rear_focal_length=f_rear,
-        ffl=ffl,
-        bfl=bfl,
+        **cardinal,
         z_front_vertex=0.0,
         z_rear_vertex=z_last,
-        z_front_focal_point=z_F,
-        z_rear_focal_point=z_F2,
-        z_front_principal_plane=z_H,
-        z_rear_principal_plane=z_H2,
-        z_front_nodal_point=z_N,
-        z_rear_nodal_point=z_N2,
-        z_stop=z_stop,
+        z_stop=prescription.vertex_z[prescription.stop_index],
         stop_semi_diameter=stop_semi,
-        z_entrance_pupil=z_ep,
-        entrance_pupil_diameter=2.0 * ep_semi,
-        z_exit_pupil=z_xp,
-        exit_pupil_diameter=2.0 * xp_semi,
-        pupil_magnification=m_p,
-        f_number=f_number,
+        z_entrance_pupil=pupils.z_ep,
+        entrance_pupil_diameter=2.0 * pupils.ep_semi,
+        z_exit_pupil=pupils.z_xp,
+        exit_pupil_diameter=2.0 * pupils.xp_semi,
+        pupil_magnification=pupils.xp_semi / pupils.ep_semi,
+        f_number=abs(efl) / (2.0 * pupils.ep_semi),
         z_object=object_z,
         z_image=z_img,
         magnification=mag,
@@ -475,7 +508,7 @@ def gaussian(
         flange_focal_distance=flange_focal_distance_mm,
         object_index=n_obj,
         image_index=n_img,
-        thicknesses=tuple(s.thickness for s in surfaces),
+        thicknesses=tuple(s.thickness for s in prescription.surfaces),
         pinhole_focal_length=pinhole,
     )
 

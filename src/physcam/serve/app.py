@@ -329,35 +329,27 @@ def _computed(fn, media):
     return 200, obj
 
 
-def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
-    """The ASGI application serving ``backend`` within ``limits`` (default :class:`Limits`).
-
-    ``log`` takes one line per unexpected error (default: standard error).
-    """
-    from starlette.applications import Starlette
-    from starlette.exceptions import HTTPException
-    from starlette.middleware import Middleware
+def _no_store(body: bytes, media: str):
+    """A computed answer: never cached by the browser."""
     from starlette.responses import Response
-    from starlette.routing import Route
 
-    if not isinstance(backend, Backend):
-        raise WrongTypeError(f"backend must be a physcam.serve.Backend, got {type(backend).__name__}")
-    limits = Limits() if limits is None else limits
-    if not isinstance(limits, Limits):
-        raise WrongTypeError(f"limits must be a physcam.serve.Limits, got {type(limits).__name__}")
-    log = log or (lambda line: print(line, file=sys.stderr, flush=True))
-    core = _App(backend, limits)
+    return Response(body, media_type=media, headers={"cache-control": "no-store"})
 
-    def ok(body: bytes, media: str) -> Response:
-        return Response(body, media_type=media, headers={"cache-control": "no-store"})
 
-    def static(name: str):
-        media, body = core.static[name]
+def _static_page(core: _App, name: str):
+    """The endpoint serving the bundled page file ``name`` (revalidated by the browser)."""
+    from starlette.responses import Response
 
-        async def endpoint(request):
-            return Response(body, media_type=media, headers={"cache-control": "no-cache"})
+    media, body = core.static[name]
 
-        return endpoint
+    async def endpoint(request):
+        return Response(body, media_type=media, headers={"cache-control": "no-cache"})
+
+    return endpoint
+
+
+def _report_endpoints(core: _App, backend: Backend, limits: Limits) -> dict:
+    """The on-set report, the table across focus marks and the DOF chart, by route path."""
 
     def heavy_report(q) -> bool:
         return "lens" in q
@@ -366,7 +358,7 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
         q = core.query(request.scope, "report")
         body = await core.answer(request.scope, ("report", tuple(sorted(q.items()))), lambda: backend.report(q),
                                  heavy=heavy_report(q), media="application/json")
-        return ok(body, "application/json")
+        return _no_store(body, "application/json")
 
     async def focus_table(request):
         q = core.query(request.scope, "report", extra=("marks",))
@@ -387,24 +379,30 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
 
         key = ("focus-table", tuple(marks), tuple(sorted(q.items())))
         body = await core.answer(request.scope, key, table, heavy=heavy_report(q), media="application/json")
-        return ok(body, "application/json")
+        return _no_store(body, "application/json")
 
     async def dof_svg(request):
         q = core.query(request.scope, "report")
         body = await core.answer(request.scope, ("dof.svg", tuple(sorted(q.items()))), lambda: backend.dof_svg(q),
                                  heavy=True, media="image/svg+xml")
-        return ok(body, "image/svg+xml")
+        return _no_store(body, "image/svg+xml")
+
+    return {"/api/report": report, "/api/focus-table": focus_table, "/api/dof.svg": dof_svg}
+
+
+def _catalogue_endpoints(core: _App, backend: Backend, limits: Limits) -> dict:
+    """The sensor and lens catalogues, one lens's data and its diagram, by route path."""
 
     async def sensors(request):
         q = core.query(request.scope, "sensors")
         body = await core.answer(request.scope, ("sensors", tuple(sorted(q.items()))), lambda: backend.sensors(q),
                                  heavy=False, media="application/json")
-        return ok(body, "application/json")
+        return _no_store(body, "application/json")
 
     async def lenses(request):
         core.query(request.scope, "lenses")
         body = await core.answer(request.scope, ("lenses",), backend.lenses, heavy=True, media="application/json")
-        return ok(body, "application/json")
+        return _no_store(body, "application/json")
 
     def _name(request) -> str:
         name = request.path_params["name"]
@@ -417,43 +415,64 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
         q = core.query(request.scope, "lens")
         body = await core.answer(request.scope, ("lens", name, tuple(sorted(q.items()))), lambda: backend.lens(name, q),
                                  heavy=True, media="application/json")
-        return ok(body, "application/json")
+        return _no_store(body, "application/json")
 
     async def diagram(request):
         name = _name(request)
         q = core.query(request.scope, "diagram")
         body = await core.answer(request.scope, ("diagram", name, tuple(sorted(q.items()))),
                                  lambda: backend.diagram_svg(name, q), heavy=True, media="image/svg+xml")
-        return ok(body, "image/svg+xml")
+        return _no_store(body, "image/svg+xml")
+
+    return {"/api/sensors": sensors, "/api/lenses": lenses, "/api/lens/{name}": lens,
+            "/api/lens/{name}/diagram.svg": diagram}
+
+
+async def _http_error(request, exc):
+    """Starlette's own 404 and 405 as the API's one-line JSON refusals."""
+    reason = {404: f"no such page: {request.url.path[:80]} (the API is under /api/, see docs/serve.md)",
+              405: "method not allowed: this server answers GET only"}.get(exc.status_code, str(exc.detail))
+    raise Refused(exc.status_code, reason)
+
+
+def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
+    """The ASGI application serving ``backend`` within ``limits`` (default :class:`Limits`).
+
+    ``log`` takes one line per unexpected error (default: standard error).
+    """
+    from starlette.applications import Starlette
+    from starlette.exceptions import HTTPException
+    from starlette.middleware import Middleware
+    from starlette.responses import Response
+    from starlette.routing import Route
+
+    if not isinstance(backend, Backend):
+        raise WrongTypeError(f"backend must be a physcam.serve.Backend, got {type(backend).__name__}")
+    limits = Limits() if limits is None else limits
+    if not isinstance(limits, Limits):
+        raise WrongTypeError(f"limits must be a physcam.serve.Limits, got {type(limits).__name__}")
+    log = log or (lambda line: print(line, file=sys.stderr, flush=True))
+    core = _App(backend, limits)
 
     async def health(request):
         core.query(request.scope, "health")
-        return ok(json.dumps({"ok": True, "version": __version__}).encode(), "application/json")
+        return _no_store(json.dumps({"ok": True, "version": __version__}).encode(), "application/json")
 
     async def favicon(request):
         return Response(status_code=204)
 
-    async def http_error(request, exc):
-        reason = {404: f"no such page: {request.url.path[:80]} (the API is under /api/, see docs/serve.md)",
-                  405: "method not allowed: this server answers GET only"}.get(exc.status_code, str(exc.detail))
-        raise Refused(exc.status_code, reason)
-
+    api = {**_report_endpoints(core, backend, limits), **_catalogue_endpoints(core, backend, limits)}
     routes = [
-        Route("/", static("index.html")),
-        Route("/static/app.js", static("app.js")),
-        Route("/static/app.css", static("app.css")),
-        Route("/static/icon.svg", static("icon.svg")),
+        Route("/", _static_page(core, "index.html")),
+        Route("/static/app.js", _static_page(core, "app.js")),
+        Route("/static/app.css", _static_page(core, "app.css")),
+        Route("/static/icon.svg", _static_page(core, "icon.svg")),
         Route("/favicon.ico", favicon),
-        Route("/api/report", report),
-        Route("/api/focus-table", focus_table),
-        Route("/api/dof.svg", dof_svg),
-        Route("/api/sensors", sensors),
-        Route("/api/lenses", lenses),
-        Route("/api/lens/{name}", lens),
-        Route("/api/lens/{name}/diagram.svg", diagram),
+        *(Route(path, api[path]) for path in ("/api/report", "/api/focus-table", "/api/dof.svg", "/api/sensors",
+                                              "/api/lenses", "/api/lens/{name}", "/api/lens/{name}/diagram.svg")),
         Route("/api/health", health),
     ]
-    app = Starlette(routes=routes, exception_handlers={HTTPException: http_error},
+    app = Starlette(routes=routes, exception_handlers={HTTPException: _http_error},
                     middleware=[Middleware(_Guard, limits=limits, log=log)])
     app.state.core = core
     return app

@@ -83,9 +83,50 @@ def _radius(c: float) -> float:
     return r
 
 
-@takes_text
-def loads(text: str, path=None, name: str | None = None) -> Prescription:
-    """Parse a sequential ``.zmx`` into a validated :class:`Prescription`."""
+def _surface_line(cur: dict, key: str, tok: list, raw: str, path, lineno: int) -> None:
+    """Read one line of a ``SURF`` block into ``cur`` (refusing what changes the optics and physcam lacks)."""
+    cur["seen"].add(key)
+    if key == "TYPE":
+        t = tok[1].upper() if len(tok) > 1 else ""
+        if t not in ("STANDARD", "EVENASPH"):
+            raise LensFileError(f"surface type {t or '?'} is not supported (only STANDARD and EVENASPH)", path, lineno)
+        cur["type"] = t
+    elif key == "CURV":
+        cur["curv"] = _num(tok, 1, "CURV", path, lineno, length=False)
+    elif key == "DISZ":
+        if len(tok) > 1 and tok[1].upper() == "INFINITY":
+            cur["disz"] = math.inf
+        else:
+            cur["disz"] = _num(tok, 1, "DISZ", path, lineno)
+    elif key == "DIAM":
+        cur["diam"] = _num(tok, 1, "DIAM (semi-diameter)", path, lineno)
+    elif key == "STOP":
+        cur["stop"] = True
+    elif key == "CONI":
+        cur["coni"] = _num(tok, 1, "CONI", path, lineno, length=False)
+    elif key == "PARM":
+        n = _num(tok, 1, "PARM number", path, lineno, length=False)
+        if n != int(n) or not 0 <= n <= 16:
+            raise LensFileError(f"PARM number {tok[1]} is not 0..16", path, lineno)
+        cur["parm"][int(n)] = _num(tok, 2, f"PARM {int(n)}", path, lineno, length=False)
+        if cur["parm"][int(n)] != 0.0 and (n == 1 or n > 8):
+            raise LensFileError(f"PARM {int(n)} is not supported (physcam keeps A4..A16 = PARM 2..8; "
+                                "fold an r^2 term into CURV)", path, lineno)
+    elif key == "GLAS":
+        cur["glass"] = tok
+        cur["glass_line"] = lineno
+    elif key in ("DECX", "DECY", "TILTX", "TILTY", "COORD", "CBRK"):
+        raise LensFileError(f"{key} (decentre/tilt) is not supported in a rotationally symmetric lens", path, lineno)
+    elif key in _IGNORED or key in ("COMM", "NAME", "NOTE", "DISZ"):
+        return
+    elif len(key) == 4 and key.isalpha() and key.isupper():
+        return  # other bookkeeping keywords
+    else:
+        raise LensFileError(f"unrecognised line {raw.strip()[:40]!r}", path, lineno)
+
+
+def _read_blocks(text: str, path):
+    """The file's lines as (surface blocks, lens name, notes, header: catalogues, wavelengths, aperture)."""
     blocks: list[dict] = []
     lens_name, notes = None, []
     head = {"gcat": [], "wavm": {}, "wavl": [], "pwav": 1, "tail": False, "aperture": None}
@@ -122,54 +163,25 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
             continue
         if cur is None:
             continue  # header lines before the first surface
-        cur["seen"].add(key)
-        if key == "TYPE":
-            t = tok[1].upper() if len(tok) > 1 else ""
-            if t not in ("STANDARD", "EVENASPH"):
-                raise LensFileError(f"surface type {t or '?'} is not supported (only STANDARD and EVENASPH)", path, lineno)
-            cur["type"] = t
-        elif key == "CURV":
-            cur["curv"] = _num(tok, 1, "CURV", path, lineno, length=False)
-        elif key == "DISZ":
-            if len(tok) > 1 and tok[1].upper() == "INFINITY":
-                cur["disz"] = math.inf
-            else:
-                cur["disz"] = _num(tok, 1, "DISZ", path, lineno)
-        elif key == "DIAM":
-            cur["diam"] = _num(tok, 1, "DIAM (semi-diameter)", path, lineno)
-        elif key == "STOP":
-            cur["stop"] = True
-        elif key == "CONI":
-            cur["coni"] = _num(tok, 1, "CONI", path, lineno, length=False)
-        elif key == "PARM":
-            n = _num(tok, 1, "PARM number", path, lineno, length=False)
-            if n != int(n) or not 0 <= n <= 16:
-                raise LensFileError(f"PARM number {tok[1]} is not 0..16", path, lineno)
-            cur["parm"][int(n)] = _num(tok, 2, f"PARM {int(n)}", path, lineno, length=False)
-            if cur["parm"][int(n)] != 0.0 and (n == 1 or n > 8):
-                raise LensFileError(f"PARM {int(n)} is not supported (physcam keeps A4..A16 = PARM 2..8; "
-                                    "fold an r^2 term into CURV)", path, lineno)
-        elif key == "GLAS":
-            cur["glass"] = tok
-            cur["glass_line"] = lineno
-        elif key in ("DECX", "DECY", "TILTX", "TILTY", "COORD", "CBRK"):
-            raise LensFileError(f"{key} (decentre/tilt) is not supported in a rotationally symmetric lens", path, lineno)
-        elif key in _IGNORED or key in ("COMM", "NAME", "NOTE", "DISZ"):
-            continue
-        elif len(key) == 4 and key.isalpha() and key.isupper():
-            continue  # other bookkeeping keywords
-        else:
-            raise LensFileError(f"unrecognised line {raw.strip()[:40]!r}", path, lineno)
-    if len(blocks) < 3:
-        raise LensFileError("a sequential lens needs an object surface, lens surfaces and an image surface", path)
-    for b in blocks:
-        if b["glass"] is not None:
-            b["glass"] = _glass(b["glass"], head["gcat"], path, b["glass_line"])
-    _check_complete(blocks, path, head["tail"])
-    obj, lens_blocks = blocks[0], blocks[1:-1]
-    if obj["glass"] is not None and obj["glass"] != AIR:
-        raise LensFileError("the object space must be air", path, obj.get("glass_line", obj["line"]))
-    check_count(len(lens_blocks), path)
+        _surface_line(cur, key, tok, raw, path, lineno)
+    return blocks, lens_name, notes, head
+
+
+def _asphere_terms(b: dict, path, ln: int) -> tuple:
+    """A4.. of an EVENASPH block (PARM 2..8), trailing zeros dropped; () for a STANDARD surface."""
+    if b["type"] != "EVENASPH":
+        return ()
+    if b["parm"].get(1, 0.0) != 0.0:
+        raise LensFileError("PARM 1 (r^2 asphere term) is not supported; fold it into CURV", path, ln)
+    if any(k > 8 for k in b["parm"] if b["parm"][k] != 0.0):
+        raise LensFileError("asphere terms beyond PARM 8 (A16) are not supported", path, ln)
+    top = max([k for k in b["parm"] if b["parm"][k] != 0.0] + [1])
+    return tuple(b["parm"].get(k, 0.0) for k in range(2, top + 1))
+
+
+def _lens_surfaces(lens_blocks: list, path) -> tuple[list, list]:
+    """(surfaces, their file lines) of the blocks between object and image; a stop on a lens face becomes a flat
+    stop at the face's vertex."""
     surfaces, lines = [], []
     for i, b in enumerate(lens_blocks):
         ln = b["line"]
@@ -180,14 +192,7 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
                 f"surface {i + 1} has no DIAM: its clear semi-diameter is automatic in OpticStudio; physcam needs "
                 "the real apertures (set the semi-diameters to fixed values before saving)", path, ln)
         medium = b["glass"] if b["glass"] is not None else AIR
-        aspheric = ()
-        if b["type"] == "EVENASPH":
-            if b["parm"].get(1, 0.0) != 0.0:
-                raise LensFileError("PARM 1 (r^2 asphere term) is not supported; fold it into CURV", path, ln)
-            if any(k > 8 for k in b["parm"] if b["parm"][k] != 0.0):
-                raise LensFileError("asphere terms beyond PARM 8 (A16) are not supported", path, ln)
-            top = max([k for k in b["parm"] if b["parm"][k] != 0.0] + [1])
-            aspheric = tuple(b["parm"].get(k, 0.0) for k in range(2, top + 1))
+        aspheric = _asphere_terms(b, path, ln)
         radius = _radius(b["curv"])
         if b["stop"] and (radius != 0.0 or aspheric or b["coni"] != 0.0):
             # a stop on a lens face: a flat stop at the face's vertex, in the medium before it
@@ -206,6 +211,24 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
         surfaces.append(Surface(radius, b["disz"], medium, b["diam"], kind, b["coni"] if kind == "aspheric" else 0.0,
                                 aspheric))
         lines.append(ln)
+    return surfaces, lines
+
+
+@takes_text
+def loads(text: str, path=None, name: str | None = None) -> Prescription:
+    """Parse a sequential ``.zmx`` into a validated :class:`Prescription`."""
+    blocks, lens_name, notes, head = _read_blocks(text, path)
+    if len(blocks) < 3:
+        raise LensFileError("a sequential lens needs an object surface, lens surfaces and an image surface", path)
+    for b in blocks:
+        if b["glass"] is not None:
+            b["glass"] = _glass(b["glass"], head["gcat"], path, b["glass_line"])
+    _check_complete(blocks, path, head["tail"])
+    obj, lens_blocks = blocks[0], blocks[1:-1]
+    if obj["glass"] is not None and obj["glass"] != AIR:
+        raise LensFileError("the object space must be air", path, obj.get("glass_line", obj["line"]))
+    check_count(len(lens_blocks), path)
+    surfaces, lines = _lens_surfaces(lens_blocks, path)
     if name is None:
         name = lens_name or (Path(path).stem if path is not None else "unnamed lens")
     meta = LensMetadata(name=name, notes="\n".join(notes) or None)

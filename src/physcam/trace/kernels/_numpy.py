@@ -42,6 +42,10 @@ def _index(S, s, c, flag, l2, u):
 
 def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
     """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``."""
+    # One piece on purpose (issue 28): one pass per surface over the whole batch of live rays, the
+    # steps (module notes 1-5) in the numba kernel's order so that the two backends give
+    # the same answers. The steps share ten live-ray arrays that shrink as rays fail (``fail``
+    # rebinds them); helpers would have to take and hand back all ten at every step.
     # a live ray must start with finite weights and a usable wavelength (else MISSED, weight 0)
     # (the numba kernel's test: finite weights, a wavelength > 0 with a finite 1/l^2; a non-finite
     # position or direction is caught at the first surface)
