@@ -15,13 +15,13 @@ at (0, 0). The chart's points are in millimetres on the chart (z = 0).
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError, require_positive
+from .calibrate_names import CHARTS, CHARUCO_DICTIONARY, parse_corners  # noqa: F401 (re-exported)
 
 __all__ = [
     "CHARTS",
@@ -36,11 +36,8 @@ __all__ = [
     "read_gray",
 ]
 
-CHARTS = ("checkerboard", "charuco")
 #: Image files a folder given as IMAGES contributes (OpenCV reads them)
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
-#: The ArUco dictionary of a ChArUco board unless told (OpenCV's tutorial board)
-CHARUCO_DICTIONARY = "DICT_5X5_100"
 #: A view is kept when at least this many corners are found in it
 MIN_CORNERS_PER_VIEW = 8
 
@@ -52,14 +49,6 @@ def _cv2():
     import cv2
 
     return cv2
-
-
-def parse_corners(text) -> tuple[int, int]:
-    """``"9x6"`` -> (9, 6): columns x rows."""
-    m = re.fullmatch(r"\s*(\d{1,3})\s*[xX]\s*(\d{1,3})\s*", str(text))
-    if not m or min(int(m.group(1)), int(m.group(2))) < 2:
-        raise InputError(f"give the chart's corners as COLUMNSxROWS, each 2 or more, e.g. 9x6; got {text!r}")
-    return int(m.group(1)), int(m.group(2))
 
 
 @dataclass(frozen=True)

@@ -33,7 +33,7 @@ FILES = {"calibration": "calibration.json", "sheet": "calibration_sheet.png", "b
 
 
 def register(sub) -> None:
-    from ..analysis.calibrate_chart import CHARTS, CHARUCO_DICTIONARY, parse_corners
+    from ..analysis.calibrate_names import CHARTS, CHARUCO_DICTIONARY, parse_corners
     from ..analysis.distortion_names import DEFAULT_MAX_RESIDUAL_PX
 
     def corners(text):
