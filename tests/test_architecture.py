@@ -167,3 +167,54 @@ def test_no_function_outside_the_trace_kernels_is_longer_than_120_lines():
                 if n > MAX_FUNCTION_LINES:
                     long.append(f"{path.relative_to(SRC)}:{node.lineno} {node.name} ({n} lines)")
     assert not long, "functions over 120 lines (split where a name explains a step):\n" + "\n".join(long)
+
+
+def test_the_report_diagram_is_drawn_from_the_code():
+    """docs/architecture.md's diagram of the on-set report (front ends -> ReportRequest -> solvers) is
+    what scripts/gen_architecture_diagram.py draws from the code now."""
+    import subprocess
+    import sys
+
+    root = SRC.parent
+    p = subprocess.run([sys.executable, str(root / "scripts" / "gen_architecture_diagram.py"), "--check"],
+                       capture_output=True, text=True)
+    assert p.returncode == 0, p.stdout + p.stderr
+
+
+#: One name per concept in the public API's parameters (issue 28): a parameter whose name speaks of
+#: the concept must be one of its names. Focus marks are distances from the film plane.
+CONCEPT_NAMES = {
+    "f-stop (the iris's setting)": (r"^(f_?stop|aperture_fstop|n_stop)$", {"fstop"}),
+    "f-number (EFL over the entrance pupil, the thin-lens formulas' N)": (r"^(f_?number|fnum)$",
+                                                                          {"f_number"}),
+    "focus mark from the film": (r"^(focus|focus_distance.*|focus_from_.*|focus_mm|mark_mm|focus_mark.*)$",
+                                 {"focus_mm", "focus_from_film_mm", "focus_marks_mm"}),
+    "stop size": (r"^(stop_.*|iris.*)$", {"stop_semi_diameter"}),
+    # (Zemax's dispersion formulas are written in micrometres: lens.glassformulas keeps their unit)
+    "wavelength": (r"^(wavelength.*|lambda.*|wl.*)$", {"wavelength_nm", "wavelengths_nm", "wavelength_um"}),
+    "camera state": (r"^(camera_state|state|cam_state)$", {"state"}),
+}
+
+
+def test_one_name_per_concept_in_public_parameters():
+    import importlib
+    import inspect
+    import re
+
+    wrong = set()
+    for path in (SRC / "physcam").rglob("*.py"):
+        parts = path.relative_to(SRC).with_suffix("").parts
+        module = ".".join(p for p in parts if p != "__init__")
+        if any(p.startswith("_") and p != "__init__" for p in parts) or module.startswith(("physcam.cli",
+                                                                                          "physcam.__main__")):
+            continue
+        mod = importlib.import_module(module)
+        for name in getattr(mod, "__all__", ()):
+            fn = getattr(mod, name, None)
+            if not inspect.isfunction(fn):
+                continue
+            for p in inspect.signature(fn).parameters:
+                for concept, (pattern, allowed) in CONCEPT_NAMES.items():
+                    if re.match(pattern, p) and p not in allowed:
+                        wrong.add(f"{module}.{name}({p}): {concept} is spelled {sorted(allowed)}")
+    assert not wrong, "\n".join(sorted(wrong))

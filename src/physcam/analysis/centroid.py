@@ -85,10 +85,10 @@ def _beam_boxes(q, film_z, objects, at_infinity, crossing, z_ep, radius, iris, w
 
 
 def image_moments(q, film_z: float, objects, *, at_infinity: bool, crossing, z_ep: float, pupil_radius: float,
-                  iris_semi_diameter: float, wavelength_nm: float, backend: str = "auto", overfill: float = 2.0,
+                  stop_semi_diameter: float, wavelength_nm: float, backend: str = "auto", overfill: float = 2.0,
                   grid: int = PUPIL_GRID, energy_fraction: float | None = None):
     """(centroids (n, 2) mm, second moments E[r^2] (n,) mm^2 about them) of the blurs of object points
-    imaged on the film by ``q`` (a focused lens) with its stop at ``iris_semi_diameter`` (module notes).
+    imaged on the film by ``q`` (a focused lens) with its stop at ``stop_semi_diameter`` (module notes).
 
     ``objects``: (n, 3) object points in lens space, or with ``at_infinity`` unit directions of the
     light; ``crossing``: (n, 2) where each point's real chief ray crosses the entrance-pupil plane
@@ -105,9 +105,9 @@ def image_moments(q, film_z: float, objects, *, at_infinity: bool, crossing, z_e
     for i0 in range(0, len(objects), POINTS_PER_CALL):
         sl = slice(i0, i0 + POINTS_PER_CALL)
         args = (q, film_z, objects[sl], at_infinity)
-        centre, half = _beam_boxes(*args, crossing[sl], z_ep, pupil_radius * overfill, iris_semi_diameter,
+        centre, half = _beam_boxes(*args, crossing[sl], z_ep, pupil_radius * overfill, stop_semi_diameter,
                                    wavelength_nm, backend)
-        film, ok = _trace(*args, centre, half, z_ep, iris_semi_diameter, wavelength_nm, backend, fine)
+        film, ok = _trace(*args, centre, half, z_ep, stop_semi_diameter, wavelength_nm, backend, fine)
         count = ok.sum(axis=1)
         if not (count > 0).all():
             raise OpticsError("no ray of an object point passes the stop at this f-stop: the field is vignetted there")

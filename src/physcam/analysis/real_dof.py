@@ -109,7 +109,7 @@ class _Blur:
         obj = np.array([[x + t * L, y + t * M, z_obj]])
         crossing = np.array([[x + s * L, y + s * M]])
         out = image_moments(self.q, self.film_z, obj, at_infinity=False, crossing=crossing, z_ep=self.z_ep,
-                            pupil_radius=self.r_ep, iris_semi_diameter=self.iris, wavelength_nm=self.wl,
+                            pupil_radius=self.r_ep, stop_semi_diameter=self.iris, wavelength_nm=self.wl,
                             backend=self.backend, energy_fraction=self.fraction)
         return float(math.sqrt(8.0 * out[1][0])) if self.measure == "moment" else float(2.0 * out[2][0])
 

@@ -286,7 +286,7 @@ class _PlateRays:
         q, g, st, iris = self.q, self.gy, self.st, self.iris
         r_ep = g.entrance_pupil_diameter / 2 * iris / q.surfaces[q.stop_index].semi_diameter
         c = image_centroids(q, st.film_z, obj, at_infinity=math.isinf(st.object_z), crossing=crossing,
-                            z_ep=g.z_entrance_pupil, pupil_radius=r_ep, iris_semi_diameter=iris,
+                            z_ep=g.z_entrance_pupil, pupil_radius=r_ep, stop_semi_diameter=iris,
                             wavelength_nm=self.wl, backend=self.backend)
         return np.stack([-c[:, 0] * self.sx + self.w_px / 2, -c[:, 1] * self.sy + self.h_px / 2], axis=1)
 

@@ -232,10 +232,10 @@ class Grid:
                 "psf_pixels": self.psf_pixels, "illumination_grid": self.illumination_grid, "kinds": list(self.kinds)}
 
 
-def focus_label(mark_mm: float) -> str:
+def focus_label(focus_mm: float) -> str:
     """A focus mark as a file-name-safe label: ``infinity``, ``0.5833m``."""
-    mark_mm = float(require_type("focus mark", mark_mm, (int, float), "mm from the film plane"))
-    return "infinity" if math.isinf(mark_mm) else f"{mark_mm / 1000.0:.4g}m"
+    focus_mm = float(require_type("focus mark", focus_mm, (int, float), "mm from the film plane"))
+    return "infinity" if math.isinf(focus_mm) else f"{focus_mm / 1000.0:.4g}m"
 
 
 def lens_slug(name: str) -> str:

@@ -40,7 +40,7 @@ __all__ = ["DepthOfField", "LensState", "PrincipalPlanes", "lens_at_mark", "prin
 _MADE_BY = {"req": ("ReportRequest", "physcam.onset.request.ReportRequest(sensor=..., ...)"),
             "state": ("LensState", "physcam.onset.solvers.lens_at_mark(request)"),
             "planes": ("PrincipalPlanes", "physcam.onset.solvers.principal_planes(state)"),
-            "focus": ("Focus", "physcam.onset.solvers.solve_focus(...)"),
+            "focus_solution": ("Focus", "physcam.onset.solvers.solve_focus(...)"),
             "ap": ("Aperture", "physcam.onset.solvers.invert_limits(...)")}
 
 
@@ -310,13 +310,13 @@ class Aperture:
 
 
 @_typed
-def invert_limits(req: ReportRequest, state: LensState, planes: PrincipalPlanes, focus: Focus, c: float,
+def invert_limits(req: ReportRequest, state: LensState, planes: PrincipalPlanes, focus_solution: Focus, c: float,
                   coc_name: str) -> Aperture:
     """The effective f-stop (when none is given, or the CoC is) or else the CoC from the measured
     near and/or far limits: the hyperfocal parameter h = f^2/(N c) from either limit
     (physcam.optics.dof), checked against the other when both are measured."""
-    near, far, s, N, solved, notes = req.near_mm, req.far_mm, focus.object_distance, state.fstop, {}, []
-    one_limit_focus = "focus_from_film_mm" in focus.solved and (near is None or far is None)
+    near, far, s, N, solved, notes = req.near_mm, req.far_mm, focus_solution.object_distance, state.fstop, {}, []
+    one_limit_focus = "focus_from_film_mm" in focus_solution.solved and (near is None or far is None)
     if (near is not None or far is not None) and not one_limit_focus:  # one limit and N made the focus
         hp_near, hp_far = _hyperfocal_parameters(planes, s, near, far)
         hp = hp_near if hp_near is not None else hp_far
@@ -389,7 +389,7 @@ class DepthOfFieldResult:
 
 
 @_typed
-def depth_of_field(req: ReportRequest, state: LensState, planes: PrincipalPlanes, focus: Focus,
+def depth_of_field(req: ReportRequest, state: LensState, planes: PrincipalPlanes, focus_solution: Focus,
                    ap: Aperture) -> DepthOfFieldResult:
     """Near, far and hyperfocal at the f-number at this focus; an anamorphic's horizontal limits take
     c / blur aspect (docs/lens-report.md, "Anamorphic depth of field"): deeper for a front
@@ -398,12 +398,12 @@ def depth_of_field(req: ReportRequest, state: LensState, planes: PrincipalPlanes
     if abs(state.n_ratio - 1.0) > 0.005:
         notes.append(f"the iris set to f/{ap.fstop:.3g} (at infinity) makes the lens f/{n_focus:.3g} at this focus "
                      f"(internal focusing changes its EFL and entrance pupil); depth of field uses f/{n_focus:.3g}")
-    dof = dof_block(planes.f, n_focus, c, focus.object_distance, planes.h1_at)
+    dof = dof_block(planes.f, n_focus, c, focus_solution.object_distance, planes.h1_at)
     # desqueezing by sq where the lens squeezes by lens_squeeze stretches its blur by sq / lens_squeeze
     aspect = state.blur_aspect * sq / state.lens_squeeze if req.lens is not None else 1.0 / sq
     dof_h = None
     if sq != 1.0:
-        dof_h = dof_block(planes.f, n_focus, c / aspect, focus.object_distance, planes.h1_at)
+        dof_h = dof_block(planes.f, n_focus, c / aspect, focus_solution.object_distance, planes.h1_at)
         notes.append(_anamorphic_dof_note(sq, aspect, c, from_lens=req.lens is not None))
     if req.lens is not None:
         dof, dof_h = _hyperfocal_marks(req.lens, state, ap, dof, dof_h, aspect, notes)
@@ -439,15 +439,15 @@ def _anamorphic_dof_note(sq: float, aspect: float, c: float, *, from_lens: bool)
 
 # --- focus error, field of view, entrance pupil -----------------------------------------------
 @_typed
-def focus_error(planes: PrincipalPlanes, focus: Focus) -> tuple[float, float, float, tuple[str, ...]]:
+def focus_error(planes: PrincipalPlanes, focus_solution: Focus) -> tuple[float, float, float, tuple[str, ...]]:
     """(H1, H2 from the film, focus error, notes): where the sharp image lies in front of the film
     (+) with a datasheet's planes, H2 - s'; 0 for the thin lens, whose H2 is s' from the film."""
     if planes.h1_from_film is None:
-        return focus.image_distance, focus.image_distance, 0.0, ()
+        return focus_solution.image_distance, focus_solution.image_distance, 0.0, ()
     P2 = planes.h2_from_film
     if P2 <= 0:
         raise InputError(f"H2 must lie in front of the film plane, got {P2:g} mm; check --h2 and --reference")
-    err = P2 - focus.image_distance
+    err = P2 - focus_solution.image_distance
     notes = () if abs(err) <= 1e-6 else (f"with these principal planes the sharp image lies {abs(err):.3f} mm "
                                          f"{'in front of' if err > 0 else 'behind'} the film plane",)
     return planes.h1_from_film, P2, err, notes
