@@ -356,19 +356,24 @@ def lens_use(args):
     :data:`CAMERA_COMMANDS` command, so every lens it loads must be a camera lens; else none."""
     import contextlib
 
+    what = CAMERA_COMMANDS.get(getattr(args, "command", None))
+    if what is None or not getattr(args, getattr(args, "_lens_dest", None) or "lens", None):
+        return contextlib.nullcontext()  # no lens named: nothing to refuse (and no lens code at start-up)
     from ..lens.library import camera_use
 
-    what = CAMERA_COMMANDS.get(getattr(args, "command", None))
-    return contextlib.nullcontext() if what is None else camera_use(what)
+    return camera_use(what)
 
 
 def use_glass_catalogs(args) -> list[str]:
     """Make the config's ``glass_catalogs`` and the run's ``--glass-catalog`` files the user glass
     catalogues, in that order (every run starts with none left over); their names."""
-    from ..lens.catalog import use_catalog_files
     from ._config import load_config
 
     paths = list(load_config().glass_catalogs or ()) + list(getattr(args, "glass_catalog", None) or ())
+    if not paths and "physcam.lens.catalog" not in sys.modules:
+        return []  # nothing to add and nothing left over: the report starts without the glass code
+    from ..lens.catalog import use_catalog_files
+
     return use_catalog_files(paths)
 
 

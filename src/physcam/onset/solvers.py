@@ -22,9 +22,9 @@ Distances ``*_from_film`` are in front of the film plane; object distances s are
 from __future__ import annotations
 
 import functools
-import inspect
 import math
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 from ..errors import InputError, OpticsError, require_type
 from ..optics import dof as _dof
@@ -46,11 +46,11 @@ _MADE_BY = {"req": ("ReportRequest", "physcam.onset.request.ReportRequest(sensor
 
 def _typed(fn):
     """Decorator: each argument named in :data:`_MADE_BY` must be of its type (WrongTypeError)."""
-    sig = inspect.signature(fn)
+    names = fn.__code__.co_varnames[:fn.__code__.co_argcount]  # positional parameters, in order
 
     @functools.wraps(fn)
     def checked(*args, **kwargs):
-        for name, value in sig.bind_partial(*args, **kwargs).arguments.items():
+        for name, value in (*zip(names, args), *kwargs.items()):
             if name in _MADE_BY:
                 cls, hint = _MADE_BY[name]
                 require_type(name, value, globals()[cls], hint)
@@ -102,8 +102,7 @@ class DepthOfField:
 
 
 # --- the lens at the mark ----------------------------------------------------------------
-@dataclass(frozen=True)
-class LensState:
+class LensState(NamedTuple):  # a NamedTuple: made at every report, cheap to define at start-up
     """What the report's model takes from the lens at the mark (planes in front of the film): the
     request's own values for a thin lens or a datasheet; a prescription's focused Gaussian data."""
 
@@ -162,7 +161,7 @@ def lens_at_mark(req: ReportRequest) -> LensState:
                       planes.working_f_number / planes.f_number * n_ratio, pupil_origin="prescription")
     if lens.is_anamorphic:
         state = _anamorphic_state(req.lens, state, planes, notes)
-    return replace(state, notes=tuple(notes))
+    return state._replace(notes=tuple(notes))
 
 
 def _anamorphic_state(lens, state: LensState, planes, notes: list) -> LensState:
@@ -173,18 +172,17 @@ def _anamorphic_state(lens, state: LensState, planes, notes: list) -> LensState:
     st = focusing.focus(lens, state.focus_mm)
     gx = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z)
     lens_squeeze = planes.efl_mm / gx.efl
-    state = replace(state, lens_squeeze=lens_squeeze, blur_aspect=focusing.pupil_aspect(lens, state.focus_mm))
+    state = state._replace(lens_squeeze=lens_squeeze, blur_aspect=focusing.pupil_aspect(lens, state.focus_mm))
     if state.squeeze != 1.0:
         return state
     notes.append(f"anamorphic: EFL {planes.efl_mm:.3f} mm (Y) and {gx.efl:.3f} mm (X), effective squeeze "
                  f"{lens_squeeze:.4f} (nominal {lens.squeeze:g})")
-    return replace(state, squeeze=lens_squeeze, squeeze_from_lens=True,
+    return state._replace(squeeze=lens_squeeze, squeeze_from_lens=True,
                    pinhole=(planes.pinhole_focal_length_mm, gx.pinhole_focal_length))
 
 
 # --- principal planes ------------------------------------------------------------------------
-@dataclass(frozen=True)
-class PrincipalPlanes:
+class PrincipalPlanes(NamedTuple):  # a NamedTuple: made at every report, cheap to define at start-up
     """Where H1 sits in front of the film, and how a focus mark D maps to the object distance s from
     H1. Thin lens (H1 = H2 = s' in front of the film): s + s' = D. Datasheet: H1 fixed, s = D - H1."""
 
@@ -223,8 +221,7 @@ def principal_planes(state: LensState) -> PrincipalPlanes:
 
 
 # --- focus --------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Focus:
+class Focus(NamedTuple):  # a NamedTuple: made at every report, cheap to define at start-up
     """The focus: its mark from the film, the object distance s from H1 and the image distance s'
     from H2 (thin-lens s'), what was solved and said."""
 
@@ -298,8 +295,7 @@ def _solve_focus_from_one_limit(near_film, far_film, hp, f, h1_at):
 
 
 # --- inversions from measured limits ----------------------------------------------------------
-@dataclass(frozen=True)
-class Aperture:
+class Aperture(NamedTuple):  # a NamedTuple: made at every report, cheap to define at start-up
     """The f-stop (the iris's setting, at infinity) and the CoC, given or solved from limits."""
 
     fstop: float
@@ -380,8 +376,7 @@ def dof_block(f, n, c, s, h1_film_at) -> DepthOfField:
                         far_mm=far, near_from_film_mm=near + h1_film_at(s), far_from_film_mm=far + h1_film_at(s))
 
 
-@dataclass(frozen=True)
-class DepthOfFieldResult:
+class DepthOfFieldResult(NamedTuple):  # a NamedTuple: made at every report, cheap to define at start-up
     dof: DepthOfField
     horizontal: DepthOfField | None  # an anamorphic's horizontal limits
     blur_aspect: float  # a defocused point's width over height in the desqueezed picture
