@@ -430,3 +430,27 @@ def test_whole_options_refuse_a_400_digit_number():
             assert -(2**53) <= bounds[0] <= bounds[1] <= 2**53, (path, a.option_strings)
             with pytest.raises(argparse.ArgumentTypeError, match="whole number from"):
                 a.type(huge)
+
+
+def test_the_command_table_names_every_command_and_its_module():
+    """physcam.cli.COMMAND_MODULES lets a run build only its own command's parser (start-up): it must
+    name exactly the commands the modules register, each with the module that registers it."""
+    import importlib
+    import pkgutil
+
+    import physcam.cli as cli
+
+    found = {}
+    for m in pkgutil.iter_modules(cli.__path__):
+        if m.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"physcam.cli.{m.name}")
+        if getattr(module, "register", None) is None:
+            continue
+        parser = cli._Parser(prog="physcam")
+        sub = parser.add_subparsers(dest="command", parser_class=cli._Parser)
+        module.register(sub)
+        found.update({name: m.name for name in sub.choices})
+    assert found == cli.COMMAND_MODULES
+    # a lone command's parser answers as the full one does
+    assert cli.build_parser(["report"]).parse_args(["report", "--focal", "50", "--fstop", "2"]).focal == 50.0

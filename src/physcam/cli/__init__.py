@@ -76,7 +76,21 @@ def _single_value_options_once(parser) -> None:
                 _single_value_options_once(sub)
 
 
-def build_parser() -> argparse.ArgumentParser:
+#: Each command and the module that registers it: a run of one command builds only its parser (the
+#: start-up goal, docs/performance.md); ``physcam --help`` and anything else build them all.
+#: tests/cli/test_cli_contract.py checks this table against what the modules register.
+COMMAND_MODULES = {
+    "report": "report", "dof-table": "dof_table", "sensors": "sensors", "lenses": "lens", "lens": "lens",
+    "spot": "trace", "bokeh": "trace", "illumination": "analyze", "colour": "analyze", "color": "analyze",
+    "breathing-real": "analyze", "ghosts": "analyze", "distortion": "distortion", "compare": "compare",
+    "usd": "usd", "demo": "demo", "config": "config", "calibrate": "calibrate", "characterize": "characterize",
+    "defocus": "defocus", "defocus-kernels": "defocus", "export": "export", "live": "live",
+    "metadata": "metadata", "microlens": "microlens", "mtf": "mtf", "psf": "psf", "serve": "serve",
+}
+
+
+def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
+    """physcam's parser: every command's, or (``argv`` naming a command first) only that command's."""
     parser = _Parser(
         prog="physcam",
         description="Physical cameras for film and VFX: on-set lens reports, real lens prescriptions, "
@@ -85,7 +99,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"physcam {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
-    names = [m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")]
+    first = argv[0] if argv else None
+    if first in COMMAND_MODULES:
+        names = [COMMAND_MODULES[first]]
+    else:
+        names = [m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")]
     # --help lists commands in the order people use them: on set, lenses, rays, USD, the demo
     order = {name: i for i, name in enumerate(COMMAND_ORDER)}
     for name in sorted(names, key=lambda n: (order.get(n, len(order)), n)):
@@ -137,8 +155,8 @@ def main(argv: list[str] | None = None) -> int:
 
     warnings.showwarning = _show_warning
     take_notes()  # a fresh list for this run (tests call main() repeatedly in one process)
-    parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(argv)
     if len(argv) > 1 and argv[0] == "compare" and argv[1].startswith("-") and argv[1] not in ("-h", "--help"):
         argv.insert(1, "lenses")  # `physcam compare --lens A --lens B` is `compare lenses ...` (as `compare A B`)
     try:
