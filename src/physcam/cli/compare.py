@@ -207,90 +207,15 @@ def measure_lens(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays, units="m
 
 
 def _measure(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays):
-    import numpy as np
-
-    from ..analysis.blob import equivalent_diameter
-    from ..analysis.bokeh import bokeh_image
-    from ..analysis.distortion import real_distortion
-    from ..analysis.illumination import relative_illumination
-    from ..errors import PhysCamError
-    from ..onset.report import ReportRequest, solve_report
-    from ..optics import focusing, paraxial
+    """physcam.analysis.lens_compare's measurements at the command's focus (``hyperfocal`` resolved here,
+    with its note)."""
+    from ..analysis.lens_compare import fstop_for_comparison, lens_measurements
     from ._common import resolve_focus
 
-    notes = []
-    wide = max(paraxial.gaussian(lens).f_number, lens.metadata.max_fstop or 0.0)
-    n = fstop
-    if n is None:
-        n = wide
-    elif n < wide * (1 - 0.01):  # 1 %: the engraved f-stop of a lens whose file gives f/2.8003 is f/2.8
-        notes.append(f"opens only to f/{wide:.3g}: compared wide open (asked f/{fstop:g})")
-        n = wide
+    n, notes = fstop_for_comparison(lens, fstop)
     mark = resolve_focus(focus_mm, lens=lens, fstop=n, sensor=sensor, coc=coc)
-    r = solve_report(ReportRequest(focal_length_mm=None, lens=lens, sensor=sensor, fstop=n, focus_mm=mark, coc=coc))
-    d = r.to_dict()
-    real = d["fov_deg"]["real"] or {}
-    out = {
-        "lens": lens.name, "efl_mm": r.focal_length_mm, "fstop": r.fstop,
-        "focus_from_film_mm": None if math.isinf(mark) else mark,
-        "hfov_deg": r.hfov_focus_deg, "vfov_deg": r.vfov_focus_deg, "dfov_deg": r.dfov_focus_deg,
-        "hfov_real_deg": real.get("horizontal"),
-        "near_from_film_mm": r.dof.near_from_film_mm,
-        "far_from_film_mm": None if r.dof.far_is_infinite else r.dof.far_from_film_mm,
-        "dof_total_mm": None if r.dof.far_is_infinite else r.dof.total_mm,
-        "hyperfocal_from_film_mm": r.dof.hyperfocal_from_film_mm,
-        "entrance_pupil_from_film_mm": r.entrance_pupil_from_film_mm,
-    }
-    curves = {}
-    # breathing: horizontal field of view from infinity to the closest focus, and at this focus
-    closest = focusing.closest_focus(lens)
-    marks = [m for m in focusing.DEFAULT_BREATHING_MARKS if m > closest] + [closest]
-    rows = focusing.breathing_table(lens, marks, sensor_width_mm=sensor.width_mm)
-    out["closest_focus_mm"] = closest
-    out["breathing_closest_pct"] = rows[-1].fov_change_pct
-    at = focusing.breathing_table(lens, [math.inf, mark], sensor_width_mm=sensor.width_mm)
-    out["breathing_at_focus_pct"] = at[-1].fov_change_pct
-    curves["breathing"] = ([r_.focus_from_film_mm for r_ in rows], [r_.fov_change_pct for r_ in rows])
-    # distortion at the widest field the sensor asks for (clamped to what the lens images)
-    try:
-        dist = real_distortion(lens, sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm)
-        pts = [p for p in dist.points if p.axis == "y"]
-        out["distortion_field_deg"], out["distortion_pct"] = pts[-1].field_deg, pts[-1].distortion_pct
-        curves["distortion"] = ([p.field_deg for p in pts], [p.distortion_pct for p in pts])
-        notes += dist.notes
-    except PhysCamError as exc:
-        out["distortion_field_deg"] = out["distortion_pct"] = None
-        notes.append(f"distortion not measured: {exc}")
-    # relative illumination at that f-stop, to the sensor corner (clamped likewise)
-    try:
-        sd = focusing.iris_semi_diameter(lens, n)
-        ri = relative_illumination(lens, grid=64, stop_semi_diameter=sd, sensor_width_mm=sensor.width_mm,
-                                   sensor_height_mm=sensor.height_mm)
-        pts = [p for p in ri.points if p.axis == "y"]
-        out["illumination_field_deg"], out["illumination_corner"] = pts[-1].field_deg, pts[-1].relative_illumination
-        out["illumination_corner_stops"] = -math.log2(max(pts[-1].relative_illumination, 1e-12))
-        curves["illumination"] = ([p.field_deg for p in pts], [p.relative_illumination for p in pts])
-        notes += ri.notes
-    except PhysCamError as exc:
-        out["illumination_field_deg"] = out["illumination_corner"] = out["illumination_corner_stops"] = None
-        notes.append(f"illumination not measured: {exc}")
-    # bokeh of a point light on the axis
-    light = light_mm if light_mm is not None else (1000.0 if math.isinf(mark) else 2.0 * mark)
-    out["bokeh_light_from_film_mm"] = light
-    try:
-        st = focusing.focus(lens, mark)
-        stop = focusing.iris_semi_diameter(lens, n)
-        img = bokeh_image(st.prescription, light, film_z=st.film_z, rays=rays, pixels=96, stop_semi_diameter=stop,
-                          chunk=min(max(rays, 1000), 250_000))
-        mono = img.image.sum(axis=2) if img.image.ndim == 3 else img.image
-        x0, x1, _, _ = img.extent_mm
-        out["bokeh_diameter_mm"] = equivalent_diameter(mono, pixel=(x1 - x0) / mono.shape[1])
-        curves["bokeh"] = (np.asarray(mono), img.extent_mm)
-    except PhysCamError as exc:
-        out["bokeh_diameter_mm"] = None
-        notes.append(f"bokeh not measured: {exc}")
-    out["notes"] = notes
-    out["_curves"] = curves
+    out = lens_measurements(lens, focus_mm=mark, fstop=n, sensor=sensor, coc=coc, light_mm=light_mm, rays=rays)
+    out["notes"] = notes + out["notes"]
     return out
 
 

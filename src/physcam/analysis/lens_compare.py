@@ -1,0 +1,133 @@
+"""Lenses side by side (``physcam compare``): what one lens does at a focus and f-stop on a sensor.
+
+Field of view, depth of field and hyperfocal from the on-set report; breathing from infinity to the
+closest focus (physcam.optics.focusing.breathing_table); real distortion and relative illumination at
+the sensor's widest field (clamped to what the lens images); the bokeh of a point light on the axis
+(its equivalent diameter). Each measurement that cannot be made says why in ``notes``.
+"""
+
+from __future__ import annotations
+
+import math
+
+__all__ = ["fstop_for_comparison", "lens_measurements"]
+
+#: How far below its widest f-number a lens may be asked to open before it is compared wide open: 1 %
+#: (the engraved f-stop of a lens whose file gives f/2.8003 is f/2.8).
+FSTOP_SLACK = 0.01
+
+
+def fstop_for_comparison(lens, fstop) -> tuple[float, list[str]]:
+    """(the f-stop to compare at, notes): ``fstop``, or wide open when None or faster than the lens."""
+    from ..optics import paraxial
+
+    wide = max(paraxial.gaussian(lens).f_number, lens.metadata.max_fstop or 0.0)
+    if fstop is None:
+        return wide, []
+    if fstop < wide * (1 - FSTOP_SLACK):
+        return wide, [f"opens only to f/{wide:.3g}: compared wide open (asked f/{fstop:g})"]
+    return fstop, []
+
+
+def lens_measurements(lens, *, focus_mm, fstop, sensor, coc=None, light_mm=None, rays=200_000) -> dict:
+    """The comparison's figures of ``lens`` focused at ``focus_mm`` (a mark from the film, inf allowed)
+    at ``fstop`` on ``sensor``; curves for the figure under ``_curves``; ``notes``."""
+    from ..onset.report import ReportRequest, solve_report
+
+    r = solve_report(ReportRequest(focal_length_mm=None, lens=lens, sensor=sensor, fstop=fstop, focus_mm=focus_mm,
+                                   coc=coc))
+    real = r.to_dict()["fov_deg"]["real"] or {}
+    out = {
+        "lens": lens.name, "efl_mm": r.focal_length_mm, "fstop": r.fstop,
+        "focus_from_film_mm": None if math.isinf(focus_mm) else focus_mm,
+        "hfov_deg": r.hfov_focus_deg, "vfov_deg": r.vfov_focus_deg, "dfov_deg": r.dfov_focus_deg,
+        "hfov_real_deg": real.get("horizontal"),
+        "near_from_film_mm": r.dof.near_from_film_mm,
+        "far_from_film_mm": None if r.dof.far_is_infinite else r.dof.far_from_film_mm,
+        "dof_total_mm": None if r.dof.far_is_infinite else r.dof.total_mm,
+        "hyperfocal_from_film_mm": r.dof.hyperfocal_from_film_mm,
+        "entrance_pupil_from_film_mm": r.entrance_pupil_from_film_mm,
+    }
+    curves, notes = {}, []
+    _breathing(lens, focus_mm, sensor, out, curves)
+    _distortion(lens, sensor, out, curves, notes)
+    _illumination(lens, fstop, sensor, out, curves, notes)
+    _bokeh(lens, focus_mm, fstop, light_mm, rays, out, curves, notes)
+    out["notes"] = notes
+    out["_curves"] = curves
+    return out
+
+
+def _breathing(lens, mark, sensor, out, curves) -> None:
+    """Horizontal field of view from infinity to the closest focus, and at this focus."""
+    from ..optics import focusing
+
+    closest = focusing.closest_focus(lens)
+    marks = [m for m in focusing.DEFAULT_BREATHING_MARKS if m > closest] + [closest]
+    rows = focusing.breathing_table(lens, marks, sensor_width_mm=sensor.width_mm)
+    out["closest_focus_mm"] = closest
+    out["breathing_closest_pct"] = rows[-1].fov_change_pct
+    at = focusing.breathing_table(lens, [math.inf, mark], sensor_width_mm=sensor.width_mm)
+    out["breathing_at_focus_pct"] = at[-1].fov_change_pct
+    curves["breathing"] = ([r_.focus_from_film_mm for r_ in rows], [r_.fov_change_pct for r_ in rows])
+
+
+def _distortion(lens, sensor, out, curves, notes) -> None:
+    """Real distortion at the widest field the sensor asks for (clamped to what the lens images)."""
+    from ..errors import PhysCamError
+    from .distortion import real_distortion
+
+    try:
+        dist = real_distortion(lens, sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm)
+        pts = [p for p in dist.points if p.axis == "y"]
+        out["distortion_field_deg"], out["distortion_pct"] = pts[-1].field_deg, pts[-1].distortion_pct
+        curves["distortion"] = ([p.field_deg for p in pts], [p.distortion_pct for p in pts])
+        notes += dist.notes
+    except PhysCamError as exc:
+        out["distortion_field_deg"] = out["distortion_pct"] = None
+        notes.append(f"distortion not measured: {exc}")
+
+
+def _illumination(lens, fstop, sensor, out, curves, notes) -> None:
+    """Relative illumination at ``fstop`` to the sensor corner (clamped likewise)."""
+    from ..errors import PhysCamError
+    from ..optics import focusing
+    from .illumination import relative_illumination
+
+    try:
+        sd = focusing.iris_semi_diameter(lens, fstop)
+        ri = relative_illumination(lens, grid=64, stop_semi_diameter=sd, sensor_width_mm=sensor.width_mm,
+                                   sensor_height_mm=sensor.height_mm)
+        pts = [p for p in ri.points if p.axis == "y"]
+        out["illumination_field_deg"], out["illumination_corner"] = pts[-1].field_deg, pts[-1].relative_illumination
+        out["illumination_corner_stops"] = -math.log2(max(pts[-1].relative_illumination, 1e-12))
+        curves["illumination"] = ([p.field_deg for p in pts], [p.relative_illumination for p in pts])
+        notes += ri.notes
+    except PhysCamError as exc:
+        out["illumination_field_deg"] = out["illumination_corner"] = out["illumination_corner_stops"] = None
+        notes.append(f"illumination not measured: {exc}")
+
+
+def _bokeh(lens, mark, fstop, light_mm, rays, out, curves, notes) -> None:
+    """The bokeh of a point light on the axis (default: twice the focus, or 1 m focused at infinity)."""
+    import numpy as np
+
+    from ..errors import PhysCamError
+    from ..optics import focusing
+    from .blob import equivalent_diameter
+    from .bokeh import bokeh_image
+
+    light = light_mm if light_mm is not None else (1000.0 if math.isinf(mark) else 2.0 * mark)
+    out["bokeh_light_from_film_mm"] = light
+    try:
+        st = focusing.focus(lens, mark)
+        stop = focusing.iris_semi_diameter(lens, fstop)
+        img = bokeh_image(st.prescription, light, film_z=st.film_z, rays=rays, pixels=96, stop_semi_diameter=stop,
+                          chunk=min(max(rays, 1000), 250_000))
+        mono = img.image.sum(axis=2) if img.image.ndim == 3 else img.image
+        x0, x1, _, _ = img.extent_mm
+        out["bokeh_diameter_mm"] = equivalent_diameter(mono, pixel=(x1 - x0) / mono.shape[1])
+        curves["bokeh"] = (np.asarray(mono), img.extent_mm)
+    except PhysCamError as exc:
+        out["bokeh_diameter_mm"] = None
+        notes.append(f"bokeh not measured: {exc}")
