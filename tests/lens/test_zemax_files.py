@@ -226,3 +226,26 @@ def test_camera_use_and_object_distance_in_the_python_api():
     with camera_use("a test camera"), pytest.raises(InputError, match="a test camera needs an infinite-conjugate"):
         load_lens(relay)
     assert require_camera_lens(load_lens("dgauss_50mm")) is load_lens("dgauss_50mm")
+
+
+def test_a_1550_nm_design_loads_and_its_index_is_the_makers(tmp_path):
+    """Issue 25: a 1550 nm lens was refused (the paraxial engine stopped at 1100 nm). The 780 nm
+    S-LAH64 asphere re-declared at 1550 nm loads, keeps its wavelength, and its glass index there is
+    OHARA's own Sellmeier formula (physcam.optics.glass.glass_index, evaluated from the catalogue's
+    coefficients, not the tracer's form)."""
+    import re
+
+    from physcam.lens.library import load_lens
+    from physcam.optics.glass import glass_index
+    from physcam.optics.paraxial import gaussian, media_indices
+
+    text = (DATA / "zemax" / "asphere_780nm.zmx").read_text(encoding="utf-8")
+    f = tmp_path / "asphere_1550nm.zmx"
+    f.write_text(re.sub(r"(WAVM 1 )0\.78\S*", r"\g<1>1.55", text), encoding="utf-8")
+    lens = load_lens(str(f))
+    assert lens.wavelength_nm == pytest.approx(1550.0)
+    n = media_indices(lens, 1550.0)
+    glass = next(s.medium for s in lens.surfaces if s.medium.glass and "LAH64" in s.medium.glass)
+    assert max(n) == pytest.approx(float(glass_index(glass.glass, 1550.0, catalog=glass.catalog)), abs=1e-6)
+    g780, g1550 = gaussian(load_lens(str(DATA / "zemax" / "asphere_780nm.zmx"))), gaussian(lens)
+    assert g1550.efl > g780.efl  # a lower index in the infrared: a longer focal length

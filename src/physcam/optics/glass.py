@@ -48,15 +48,20 @@ import numpy as np
 __all__ = ["LINE_D_NM", "LINE_F_NM", "LINE_C_NM", "LINE_G_NM", "WAVELENGTH_RANGE_NM", "MATCH_TOL_ND",
            "MATCH_TOL_VD", "PGF_NORMAL_LINE", "PGF_UNCERTAINTY", "Dispersion", "dispersion", "normal_line",
            "normal_line_pgf", "cauchy_coefficients", "refractive_index", "medium_index", "require_wavelength",
-           "medium_dispersion", "glass_index", "FIT_TOLERANCE"]
+           "medium_dispersion", "glass_index", "FIT_TOLERANCE", "FIT_BAND_NM"]
 
 LINE_D_NM = 587.5618
 LINE_F_NM = 486.1327
 LINE_C_NM = 656.2725
 LINE_G_NM = 435.8343
 
-#: Wavelengths physcam traces (nm): near UV to near IR, where camera sensors respond.
-WAVELENGTH_RANGE_NM = (300.0, 1100.0)
+#: Wavelengths physcam traces (nm): near UV to the short-wave infrared (a 1550 nm design loads and
+#: traces; issue 25). Beyond :data:`FIT_BAND_NM` a glass known only by nd and Vd, or a catalogue
+#: formula refitted into the tracer's form, is extrapolated (docs/lens-formats.md).
+WAVELENGTH_RANGE_NM = (300.0, 2500.0)
+#: The band a catalogue formula is refitted over (:mod:`physcam.optics.glassfit`): where camera sensors
+#: respond, near UV to near IR.
+FIT_BAND_NM = (300.0, 1100.0)
 #: (nd, Vd) tolerance for identifying a catalogue glass (module notes).
 MATCH_TOL_ND = 5e-5
 MATCH_TOL_VD = 0.05
@@ -172,8 +177,8 @@ FIT_TOLERANCE = 2e-5
 
 
 def _traced_band(g) -> tuple[float, float]:
-    lo, hi = g.range_nm or WAVELENGTH_RANGE_NM
-    return max(lo, WAVELENGTH_RANGE_NM[0]), min(hi, WAVELENGTH_RANGE_NM[1])
+    lo, hi = g.range_nm or FIT_BAND_NM
+    return max(lo, FIT_BAND_NM[0]), min(hi, FIT_BAND_NM[1])
 
 
 def _catalogue(nd, vd, g, matched_by) -> Dispersion:

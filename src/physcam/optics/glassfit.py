@@ -5,7 +5,7 @@ n(l) = a0 + a1 u + a2 u^2 + sqrt(1 + sum_i B_i l^2 / (l^2 - C_i)), u = 1/l^2, l 
 Sellmeier catalogue formula (SCHOTT, OHARA; Zemax formula 2) is this form exactly. Any other
 formula (the Schott power series of HOYA, CDGM and Sumita, HIKARI's 9-term series, an .agf
 Conrady...) is fitted into it over the wavelengths the tracer uses where the catalogue gives
-the formula (:data:`~physcam.optics.glass.WAVELENGTH_RANGE_NM` within the formula's range):
+the formula (:data:`~physcam.optics.glass.FIT_BAND_NM` within the formula's range):
 
 1. poles C_i by Levenberg-Marquardt (Marquardt 1963) on log C, the B_i for given poles by
    linear least squares on n^2 - 1 (variable projection, Golub & Pereyra 1973);
