@@ -300,15 +300,12 @@ def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False):
     and light distances in the title and the breathing axis (1 / mark) in ``units`` (m, or ft for feet
     and inches; film coordinates and bokeh sizes stay in mm). Saved to ``path``, or the Figure."""
     import numpy as np
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
 
-    from ..figures import save_figure
+    from ..figures import new_figure, save_figure
     from ..units import format_distance
 
     n = len(rows)
-    fig = Figure(figsize=(11.0, 7.0))
-    FigureCanvasAgg(fig)
+    fig = new_figure(figsize=(11.0, 7.0))
     gs = fig.add_gridspec(2, max(3, n))
     cols = max(3, n)
     ax_b = fig.add_subplot(gs[0, : cols // 3])

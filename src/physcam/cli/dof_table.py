@@ -224,16 +224,13 @@ def run(args) -> int:
 def card(d, path, *, units: str = "m", force: bool = False):
     """A printable depth-of-field card (A5 landscape): focus marks down, f-stops across, near / far /
     total in each cell, hyperfocal at the foot; PDF, PNG or SVG through :func:`physcam.figures.save_figure`."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
 
-    from ..figures import save_figure
+    from ..figures import new_figure, save_figure
     from ..units import format_distance
 
     labels, heads, cells = grid(d, units)
     nrow, ncol = len(labels) + 2, len(heads) + 1
-    fig = Figure(figsize=(8.27, min(11.0, max(3.0, 0.5 * nrow + 0.9))))  # A5 landscape width, taller for long tables
-    FigureCanvasAgg(fig)
+    fig = new_figure(figsize=(8.27, min(11.0, max(3.0, 0.5 * nrow + 0.9))))  # A5 landscape width, taller for long tables
     ax = fig.add_axes((0.03, 0.06, 0.94, 0.86))
     ax.set_axis_off()
     text = [["focus", *heads]]
