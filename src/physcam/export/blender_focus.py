@@ -23,7 +23,7 @@ from ..errors import InputError, OpticsError
 from ..lens.prescription import Prescription, takes_prescription
 from .osl import lens_data, osl_array, osl_number, render_template
 
-__all__ = ["FocusTable", "focus_table", "focus_table_shader", "N_FOCUS", "GRID_HALF_MM"]
+__all__ = ["FocusTable", "focus_table", "focus_table_shader", "ghost_rows", "N_FOCUS", "GRID_HALF_MM"]
 
 #: Focus states tabulated (uniform in 1/distance, infinity first).
 N_FOCUS = 32
@@ -107,10 +107,22 @@ def _arr32(name, values, size) -> str:
     return f"    float {name}[{size}] = {{{', '.join(_num32(v) for v in np.asarray(values, float).ravel())}}};"
 
 
+def ghost_rows(ft: FocusTable) -> tuple[list[int], list[int]]:
+    """The lens's ghost paths (:func:`physcam.analysis.ghosts.ghost_pairs` order) as the shader's rows
+    (film side first): path (i, j) reflects first, from the film, at row N-1-j, then at row N-1-i."""
+    from ..analysis.ghosts import ghost_pairs
+
+    n = len(ft.table)
+    pairs = ghost_pairs(ft.lens)
+    return [n - 1 - j for _, j in pairs], [n - 1 - i for i, _ in pairs]
+
+
 def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: bool = False, focus_m: float = 3.0,
-                       fstop: float = 0.0, sensor_mm=(36.0, 24.0)) -> str:
-    """The template with ``ft``'s focus table: focus, f-stop, sensor and iris are shader parameters
-    (defaults from the keywords; ``fstop`` 0 is wide open)."""
+                       fstop: float = 0.0, sensor_mm=(36.0, 24.0), pupil_mm=None) -> str:
+    """The template with ``ft``'s focus table: focus, f-stop, sensor, iris and ghosts are shader
+    parameters (defaults from the keywords; ``fstop`` 0 is wide open). ``pupil_mm``: the entrance
+    pupil's distance in front of the film at each focus state; given, the camera's origin is the
+    entrance pupil (the film behind it), else the film plane."""
     n_focus = len(ft.marks_mm)
     n = len(ft.table)
     defines, data = lens_data(ft.table, None, ft.lens.wavelength_nm, ft.bounds, dispersion=dispersion,
@@ -125,6 +137,16 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
                 f"#define GRID_HW {osl_number(ft.bounds.xs[-1])}", f"#define GRID_HH {osl_number(ft.bounds.ys[-1])}"]
     # with Fresnel on, the centre's transmission at infinity is in the norm (it hardly changes with focus)
     norm = ft.norm * (ft.fresnel_loss if fresnel else 1.0)
+    ga, gb = ghost_rows(ft)
+    if ga:
+        defines += ["#define PHYSCAM_GHOSTS 1", f"#define N_GHOST {len(ga)}",
+                    f"#define FRESNEL_LOSS {_num32(ft.fresnel_loss)}"]
+        data += [osl_array("GHOST_A", ga, "N_GHOST", "int"), osl_array("GHOST_B", gb, "N_GHOST", "int")]
+    if pupil_mm is not None:
+        if len(pupil_mm) != n_focus:
+            raise InputError(f"pupil_mm needs one distance per focus state ({n_focus}), got {len(pupil_mm)}")
+        defines.append("#define PHYSCAM_PUPIL_ORIGIN 1")
+        data.append(_arr32("PUPIL_TAB", pupil_mm, "N_FOCUS"))
     data += [_arr32("FILM_Z_TAB", ft.film_z, "N_FOCUS"), _arr32("NORM_TAB", norm, "N_FOCUS"),
              _arr32("VZ_TAB", ft.vertex_z, "N_VZ_TAB"), osl_array("SEMI_OPEN", ft.table.semi_diameter, "N_SURF"),
              _arr32("RECT_TAB", ft.rects, "N_RECT_TAB")]
