@@ -94,7 +94,7 @@ for loc in json.loads(sys.argv[8]):
 W, H = int(sys.argv[4]), int(sys.argv[5])
 scene.render.resolution_x, scene.render.resolution_y = W, H
 scene.render.resolution_percentage = 100
-scene.cycles.samples = 24
+scene.cycles.samples = 64; scene.cycles.use_adaptive_sampling = False
 out = {"frames": {}}
 for frame in (1, 2):
     scene.frame_set(frame)
