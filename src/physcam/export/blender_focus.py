@@ -140,7 +140,7 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
     ga, gb = ghost_rows(ft)
     if ga:
         defines += ["#define PHYSCAM_GHOSTS 1", f"#define N_GHOST {len(ga)}",
-                    f"#define FRESNEL_LOSS {_num32(ft.fresnel_loss)}"]
+                    f"#define FRESNEL_LOSS {_num32(ft.fresnel_loss)}"] + ([] if fresnel else ["#define PHYSCAM_SP 1"])
         data += [osl_array("GHOST_A", ga, "N_GHOST", "int"), osl_array("GHOST_B", gb, "N_GHOST", "int")]
     if pupil_mm is not None:
         if len(pupil_mm) != n_focus:
