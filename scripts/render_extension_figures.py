@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Render the physcam Blender extension's pictures in docs/blender.md from the tests' scenes:
-docs/img/blender_ext_pull_1m.png and _5m.png (a focus pull keyframed 1 m -> 5 m through the Zeiss
-Distagon 35 mm at f/4: lights 1 m away on the left, 5 m away on the right) and
+docs/img/blender_ext_pull_1m.png and _5m.png (a focus pull keyframed 1 m -> 5 m through the double
+Gauss 50 mm at f/2.1 with a 6-blade iris: lights 1 m away on the left, 5 m away on the right) and
 docs/img/blender_ext_ghosts.png (a bright light 8 degrees below the axis through the double Gauss
-50 mm at f/2.8, focused at infinity, Ghosts on: fraction 0.3, intensity 30 to show them).
+50 mm at f/2.8, focused at infinity, Ghosts on: fraction 0.5, intensity 10 to show them).
 
 The extension is built for those two lenses and installed by Blender's own installer into a
 temporary user folder. Run in the Blender environment (make blender):
@@ -61,6 +61,7 @@ def _reset(bpy, scene, samples, w, h):
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=int, default=256)
+    ap.add_argument("--ghost-samples", type=int, default=2048)
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="physcam-figures-"))
     os.environ["BLENDER_USER_RESOURCES"] = str(tmp / "user")  # before bpy starts: a fresh user folder
@@ -76,14 +77,14 @@ def main() -> None:
 
     # the pull: 3 x 3 lights 1 m away on the left, 3 x 3 lights 5 m away on the right
     cam = _reset(bpy, scene, args.samples, 384, 256)
-    mat = _emitter(bpy, 4.0)
+    mat = _emitter(bpy, 2.0)
     for i in range(3):
         for j in range(3):
-            _sphere(bpy, mat, (-0.32 + 0.08 * i, -0.08 + 0.08 * j, -1.0), 0.006)
-            _sphere(bpy, mat, (0.4 + 0.4 * i, -0.4 + 0.4 * j, -5.0), 0.03)
+            _sphere(bpy, mat, (-0.3 + 0.07 * i, -0.07 + 0.07 * j, -1.0), 0.004)
+            _sphere(bpy, mat, (0.45 + 0.35 * i, -0.35 + 0.35 * j, -5.0), 0.02)
     p = cam.physcam
-    p.lens = "zeiss_distagon_35mm_f4"
-    p.fstop = 4.0
+    p.lens = "dgauss_50mm"
+    p.fstop = 2.1
     p.blades = 6
     p.focus_distance = 1.0
     p.enabled = True
@@ -96,17 +97,17 @@ def main() -> None:
         bpy.ops.render.render(write_still=True)
 
     # ghosts: a bright light 8 degrees below the axis, 1 km away
-    cam = _reset(bpy, scene, args.samples, 384, 256)
+    cam = _reset(bpy, scene, args.ghost_samples, 320, 214)
     cam.clip_end = 1.0e5
     th = math.radians(8.0)
-    _sphere(bpy, _emitter(bpy, 10.0), (0.0, -math.sin(th) * 1000.0, -math.cos(th) * 1000.0), 10.0)
+    _sphere(bpy, _emitter(bpy, 10.0), (0.0, -math.sin(th) * 1000.0, -math.cos(th) * 1000.0), 20.0)
     p = cam.physcam
     p.lens = "dgauss_50mm"
     p.fstop = 2.8
     p.focus_distance = 1.0e4
     p.ghosts = True
-    p.ghost_fraction = 0.3
-    p.ghost_intensity = 30.0
+    p.ghost_fraction = 0.5
+    p.ghost_intensity = 10.0
     p.enabled = True
     scene.render.filepath = str(IMG / "blender_ext_ghosts.png")
     bpy.ops.render.render(write_still=True)
