@@ -59,10 +59,14 @@ out = {"message": p.message}
 for name, view, path, on in (("direct", "NONE", -1, False), ("one", "GHOSTS", int(sys.argv[10]), False),
                              ("all", "GHOSTS", -1, False), ("picture", "NONE", -1, True)):
     p.debug_view = view; p.ghost_path = path; p.ghosts = on; p.ghost_fraction = 0.5
+    # every path at once is the noisiest estimate: 8 x the samples (the sums need no resolution)
+    scene.render.resolution_percentage = 50 if name == "all" else 100
+    scene.cycles.samples = 512 if name == "all" else 64
     scene.render.filepath = sys.argv[2] + "/" + name + ".exr"
     bpy.ops.render.render(write_still=True)
     img = bpy.data.images.load(scene.render.filepath)
-    out[name] = np.array(img.pixels[:], dtype=np.float64).reshape(H, W, 4)[..., 0].tolist()
+    w, h = img.size
+    out[name] = np.array(img.pixels[:], dtype=np.float64).reshape(h, w, 4)[..., 0].tolist()
     bpy.data.images.remove(img)
 print(json.dumps(out))
 '''
@@ -81,10 +85,11 @@ def _centroid(a):
 def test_ghost_lands_where_the_ghost_analysis_puts_it(extension_zip, tmp_path):
     """One ghost path (a compact one, wholly on the sensor): its rendered centroid within 0.05 mm
     (0.7 px at 512 px; the ghost's rms radius is 1.8 mm) and its flux / the direct image's within
-    5 % of ghost_analysis's (seen 0.03 mm and 0.6 %); all paths together (the "Ghosts only" image)
-    carry the sum of the paths' on-sensor fluxes within 10 % (seen 9 % low at 64 samples, 5 % at
-    256: a noisy estimate), and the picture with ghosts on at fraction 0.5 holds that same ghost
-    image away from the direct light (within 10 %)."""
+    5 % of ghost_analysis's (seen 0.03 mm and 0.6 %); all paths together (the "Ghosts only" image,
+    half the resolution at 512 samples: the noisiest estimate) carry the sum of the paths'
+    on-sensor fluxes within 10 % (seen 2.6 % low; 9-12 % low at 64 samples), and the picture with
+    ghosts on at fraction 0.5 holds that same ghost image away from the direct light (within 10 %,
+    seen 7 %)."""
     lens = load_lens(SLUG)
     st = focus(lens, math.inf)
     res = ghost_analysis(st.prescription, FIELD_DEG, coating="none", film_z=st.film_z, sensor_width_mm=SW,
@@ -108,10 +113,13 @@ def test_ghost_lands_where_the_ghost_analysis_puts_it(extension_zip, tmp_path):
     print("ghost flux / direct", ratio, "analysis", ghost.relative_flux)
     assert ratio == pytest.approx(ghost.relative_flux, rel=0.05)
     on_sensor = sum(g.relative_flux * g.on_sensor_fraction for g in res.paths)
-    print("all ghosts / direct", every.sum() / direct.sum(), "analysis", on_sensor)
-    assert every.sum() / direct.sum() == pytest.approx(on_sensor, rel=0.10)
+    every_ratio = every.sum() * 4 / direct.sum()  # half the resolution: a quarter of the pixels
+    print("all ghosts / direct", every_ratio, "analysis", on_sensor)
+    assert every_ratio == pytest.approx(on_sensor, rel=0.10)
     yy, xx = np.mgrid[0:H, 0:W]
     c = _pixel(*res.direct_centroid_mm)
     away = np.hypot(xx - c[0], yy - c[1]) > 12  # the direct light's image is 4 px across
-    print("picture's ghosts / ghost image, away from the light", picture[away].sum() / every[away].sum())
-    assert picture[away].sum() == pytest.approx(every[away].sum(), rel=0.10)
+    yy2, xx2 = np.mgrid[0:H // 2, 0:W // 2]
+    away2 = np.hypot(2 * xx2 + 0.5 - c[0], 2 * yy2 + 0.5 - c[1]) > 12
+    print("picture's ghosts / ghost image, away from the light", picture[away].sum() / (4 * every[away2].sum()))
+    assert picture[away].sum() == pytest.approx(4 * every[away2].sum(), rel=0.10)

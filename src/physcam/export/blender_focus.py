@@ -157,7 +157,12 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
     norm = ft.norm * (ft.fresnel_loss if fresnel else 1.0)
     ga, gb = ghost_rows(ft)
     if ga:
+        from ..lens.geometry import sag
+
+        rear = ft.lens.surfaces[-1]  # the film side's first surface: its rim's depth (ghost samples aim at it)
+        sags = [sag(rear, rear.semi_diameter, ax) for ax in ("x", "y")]
         defines += ["#define PHYSCAM_GHOSTS 1", f"#define N_GHOST {len(ga)}",
+                    f"#define REAR_SAG_LO {_num32(min(sags + [0.0]))}", f"#define REAR_SAG_HI {_num32(max(sags + [0.0]))}",
                     f"#define FRESNEL_LOSS {_num32(ft.fresnel_loss)}"] + ([] if fresnel else ["#define PHYSCAM_SP 1"])
         data += [osl_array("GHOST_A", ga, "N_GHOST", "int"), osl_array("GHOST_B", gb, "N_GHOST", "int")]
     if pupil_mm is not None:
