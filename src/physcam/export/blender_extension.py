@@ -76,14 +76,17 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
     from .blender_focus import focus_table, focus_table_shader
 
     ft = focus_table(lens)
+    rows = _report_rows(lens, ft.marks_mm)
+    pupil = [r["pupil_from_film_mm"] for r in rows]  # the camera object is the entrance pupil
     shaders = {}
     for disp in (False, True):
         for fres in (False, True):
-            shaders[f"{slug}__d{int(disp)}f{int(fres)}.osl"] = focus_table_shader(ft, dispersion=disp, fresnel=fres)
+            shaders[f"{slug}__d{int(disp)}f{int(fres)}.osl"] = focus_table_shader(ft, dispersion=disp, fresnel=fres,
+                                                                               pupil_mm=pupil)
     data = {"slug": slug, "name": lens.name, "closest_m": ft.closest_mm / 1000.0, "fstop_min": ft.fstop_min,
             "inv_step_per_m": ft.inv_step_per_m, "anamorphic": bool(lens.is_anamorphic),
             "report_fstop": REFERENCE_FSTOP, "report_sensor_mm": list(REPORT_SENSOR_MM),
-            "rows": _report_rows(lens, ft.marks_mm)}
+            "rows": rows}
     return data, shaders
 
 

@@ -21,7 +21,7 @@ __all__ = ["FEATURES", "template_text", "render_template", "lens_data", "osl_num
 
 #: The template's feature switches: a data block that defines one keeps that code, else it goes.
 FEATURES = ("PHYSCAM_FOCUS_TABLE", "HAS_ASPHERE", "PHYSCAM_DISPERSION", "PHYSCAM_FRESNEL", "PHYSCAM_APERTURE",
-            "PHYSCAM_POLYGON")
+            "PHYSCAM_POLYGON", "PHYSCAM_GHOSTS", "PHYSCAM_PUPIL_ORIGIN", "PHYSCAM_SP")
 #: Wavelengths sampled per ray when dispersion is on (uniform).
 WAVELENGTH_RANGE_NM = (400.0, 700.0)
 
@@ -131,8 +131,8 @@ def lens_data(table, aperture, wavelength_nm: float, bounds, *, dispersion: bool
             data += [osl_array("N1", index_rows(S, NB, SB, wavelength_nm), "N_SURF"),
                      osl_array("N2", index_rows(S, NA, SA, wavelength_nm), "N_SURF")]
     if fresnel:
-        defines.append("#define PHYSCAM_FRESNEL 1")
-        data.append(osl_array("RSC", table.r_scale, "N_SURF"))
+        defines += ["#define PHYSCAM_FRESNEL 1", "#define PHYSCAM_SP 1"]
+    data.append(osl_array("RSC", table.r_scale, "N_SURF"))  # Fresnel, and ghosts' reflectances
     return defines + _aperture_defines(aperture), data
 
 

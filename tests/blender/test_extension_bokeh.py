@@ -1,0 +1,110 @@
+"""Bokeh through the physcam extension (its focus-table shader, iris and sensor as the panel's
+parameters) against physcam's :func:`physcam.analysis.bokeh.bokeh_image`, as
+tests/blender/test_osl_bokeh.py does for the baked shader: the double Gauss 50 mm focused at a 2 m
+mark, f/2.8 by physcam's one iris rule, 6 straight blades with a corner 15 degrees from +x; a 1 mm
+emissive sphere 0.7 m from the film, rendered on a 3 x 3 mm crop of the film centre (the panel's
+custom sensor) and traced by physcam's tracer onto the same pixel grid."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from _blender import run_blender
+from physcam.analysis.blob import blob_moments, polygon_corners
+from physcam.analysis.bokeh import bokeh_image
+from physcam.lens.library import load_lens
+from physcam.optics.focusing import focus, iris_semi_diameter
+from physcam.trace.aperture import Aperture
+
+pytestmark = pytest.mark.slow
+
+LENS, MARK_MM, FSTOP, BLADES, CORNER_DEG = "dgauss_50mm", 2000.0, 2.8, 6, 15.0
+NEAR_MM, SPHERE_M = 700.0, 0.001  # the sphere: mm from the film, radius (m)
+CROP_MM, CROP_PX = 3.0, 128
+
+BOKEH = '''
+import json, sys
+import numpy as np
+bpy.ops.extensions.package_install_files(filepath=sys.argv[1], repo="user_default", enable_on_install=True)
+scene = bpy.context.scene
+scene.render.engine = "CYCLES"; scene.cycles.device = "CPU"; scene.cycles.use_denoising = False
+scene.render.threads_mode = "FIXED"; scene.render.threads = 2
+scene.view_settings.view_transform = "Standard"
+scene.render.image_settings.file_format = "OPEN_EXR"
+scene.cycles.max_bounces = 0
+scene.cycles.pixel_filter_type = "BOX"; scene.cycles.filter_width = 1.0
+for o in list(bpy.data.objects):
+    if o.type != "CAMERA":
+        bpy.data.objects.remove(o)
+scene.world = None
+cam_obj = scene.camera
+cam_obj.location = (0.0, 0.0, 0.0); cam_obj.rotation_euler = (0.0, 0.0, 0.0)  # the entrance pupil
+p = cam_obj.data.physcam
+crop = float(sys.argv[4])
+p.lens = sys.argv[3]; p.sensor = "CUSTOM"; p.sensor_width = crop; p.sensor_height = crop
+p.focus_distance = float(sys.argv[5]); p.fstop = float(sys.argv[6]); p.blades = int(sys.argv[7])
+p.blade_rotation = float(sys.argv[8]); p.roundness = 0.0; p.enabled = True
+mat = bpy.data.materials.new("E"); mat.use_nodes = True
+nt = mat.node_tree; nt.nodes.clear()
+em = nt.nodes.new("ShaderNodeEmission")
+nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
+bpy.ops.mesh.primitive_uv_sphere_add(radius=float(sys.argv[10]), location=(0.0, 0.0, -float(sys.argv[9])),
+                                     segments=64, ring_count=32)
+bpy.ops.object.shade_smooth()
+bpy.context.object.data.materials.append(mat)
+n = int(sys.argv[11])
+scene.render.resolution_x = scene.render.resolution_y = n
+scene.render.resolution_percentage = 100
+scene.cycles.samples = 512; scene.cycles.use_adaptive_sampling = False
+scene.render.filepath = sys.argv[2] + "/bokeh.exr"
+bpy.ops.render.render(write_still=True)
+img = bpy.data.images.load(scene.render.filepath)
+a = np.array(img.pixels[:], dtype=np.float64).reshape(n, n, 4)[..., 0]
+print(json.dumps({"message": p.message, "img": a.tolist()}))
+'''
+
+
+def _pupil_from_film(lens, mark_mm):
+    """The entrance pupil's distance in front of the film at mark_mm (physcam's report)."""
+    from physcam.onset.request import ReportRequest
+    from physcam.onset.sensors import custom_sensor
+    from physcam.onset.solvers import lens_at_mark
+
+    return lens_at_mark(ReportRequest(sensor=custom_sensor(36.0, 24.0), fstop=FSTOP, focus_mm=mark_mm,
+                                      lens=lens)).pupil_from_film_mm
+
+
+def test_bokeh_diameter_and_iris_corners_match_bokeh_image(extension_zip, tmp_path):
+    """The rendered bokeh's second-moment diameter (the sphere's own image removed in quadrature)
+    is physcam's within 3 %, and its rim has 6 corners pointing where physcam's do within 3 deg."""
+    lens = load_lens(LENS)
+    st = focus(lens, MARK_MM)
+    iris = Aperture(BLADES, CORNER_DEG)
+    h = CROP_MM / 2
+    kw = dict(film_z=st.film_z, fresnel=False, stop_semi_diameter=iris_semi_diameter(lens, FSTOP), aperture=iris)
+    near = bokeh_image(st.prescription, NEAR_MM, rays=2_000_000, pixels=CROP_PX, extent_mm=(-h, h, -h, h), **kw)
+    off = bokeh_image(st.prescription, NEAR_MM, 10.0, rays=200_000, pixels=64, **kw)
+    mag = abs(off.to_dict()["centroid_mm"][0]) / 10.0  # the sphere's own image: lateral magnification
+    # the camera object is the entrance pupil: the sphere NEAR_MM from the film is that less the
+    # pupil's distance in front of the camera
+    depth_m = (NEAR_MM - _pupil_from_film(lens, MARK_MM)) / 1000.0
+    out = run_blender(BOKEH, extension_zip, tmp_path, LENS, CROP_MM, MARK_MM / 1000.0, FSTOP, BLADES, CORNER_DEG,
+                      depth_m, SPHERE_M, CROP_PX, env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
+    assert out["message"] == ""
+    img = np.array(out["img"])
+    px = CROP_MM / CROP_PX
+    cx, cy, m2 = blob_moments(img, px)
+    e = 2 * SPHERE_M * 1000 * mag
+    d_render = math.sqrt(8 * m2 - e**2)
+    d_pred = math.sqrt(8 * blob_moments(near.image[..., 0], px)[2])
+    got, want = polygon_corners(img), polygon_corners(near.image[..., 0])
+    print(f"bokeh: rendered {d_render:.4f} mm, physcam {d_pred:.4f} mm, ratio {d_render / d_pred:.4f}; "
+          f"centroid ({cx:+.4f}, {cy:+.4f}) mm; corners rendered {got}, physcam {want}")
+    assert d_pred > 0.5
+    assert abs(cx) < 2 * px and abs(cy) < 2 * px
+    assert d_render == pytest.approx(d_pred, rel=0.03)
+    assert want[:2] == (6, 6) and got[:2] == (6, 6)
+    assert abs((got[2] - want[2] + 30) % 60 - 30) < 3.0

@@ -1,0 +1,99 @@
+"""Stopped down, the extension's shader samples a smaller exit-pupil table (the smallest tabulated
+iris that holds the set one: :data:`physcam.export.blender_focus.STOP_LEVELS`) instead of the open
+lens's. Sampling a smaller region must change the noise only, not the picture: a uniform white
+world through the double Gauss at f/2.8 (open table), f/4.5 (the 0.5 table) and f/8 (the 0.35
+table) falls off from the centre to the edge and the corner as physcam's ``camera_rays`` weight
+predicts for the lens stopped to that f-number (its mean over the pupil, float64)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from _blender import run_blender
+from physcam.export.blender import bake_camera
+from physcam.lens.library import load_lens
+from physcam.trace.trace import camera_rays
+
+pytestmark = pytest.mark.slow
+
+LENS, SW, SH, W, H = "dgauss_50mm", 36.0, 24.0, 36, 24
+FSTOPS = (2.8, 4.5, 8.0)
+BLOCKS = {"centre": (10, 14, 16, 20), "right": (10, 14, 31, 35), "corner": (0, 3, 0, 3)}
+
+WHITE = '''
+import json, sys
+import numpy as np
+bpy.ops.extensions.package_install_files(filepath=sys.argv[1], repo="user_default", enable_on_install=True)
+scene = bpy.context.scene
+scene.render.engine = "CYCLES"; scene.cycles.device = "CPU"; scene.cycles.use_denoising = False
+scene.render.threads_mode = "FIXED"; scene.render.threads = 2
+scene.view_settings.view_transform = "Standard"
+scene.render.image_settings.file_format = "OPEN_EXR"
+scene.cycles.filter_width = 0.01  # a pixel averages its own film area
+for o in list(bpy.data.objects):
+    if o.type != "CAMERA":
+        bpy.data.objects.remove(o)
+world = bpy.data.worlds.new("W"); scene.world = world; world.use_nodes = True
+bg = world.node_tree.nodes["Background"]
+bg.inputs["Strength"].default_value = 1.0; bg.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+p = scene.camera.data.physcam
+p.lens = sys.argv[3]; p.sensor = "CUSTOM"; p.sensor_width = float(sys.argv[4]); p.sensor_height = float(sys.argv[5])
+p.focus_distance = 1.0e4; p.fstop = 8.0; p.enabled = True
+W, H = int(sys.argv[6]), int(sys.argv[7])
+scene.render.resolution_x, scene.render.resolution_y = W, H
+scene.render.resolution_percentage = 100
+scene.cycles.samples = 1024; scene.cycles.use_adaptive_sampling = False
+blocks = json.loads(sys.argv[8])
+out = {}
+for n in json.loads(sys.argv[9]):
+    p.fstop = n
+    scene.render.filepath = sys.argv[2] + f"/white{n}.exr"
+    bpy.ops.render.render(write_still=True)
+    img = bpy.data.images.load(scene.render.filepath)
+    a = np.array(img.pixels[:], dtype=np.float64).reshape(H, W, 4)
+    bpy.data.images.remove(img)
+    out[str(n)] = {k: float(a[r0:r1, c0:c1, :3].mean()) for k, (r0, r1, c0, c1) in blocks.items()}
+out["message"] = p.message
+print(json.dumps(out))
+'''
+
+
+def _predicted(lens, fstop):
+    """camera_rays' mean weight per block, relative to the centre block's (the lens at infinity,
+    stopped by physcam's iris rule)."""
+    b = bake_camera(lens, focus_mm=math.inf, fstop=fstop, sensor_width_mm=SW, sensor_height_mm=SH)
+    m = 64
+    u = (np.arange(m) + 0.5) / m
+    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
+    got = {}
+    for k, (r0, r1, c0, c1) in BLOCKS.items():
+        vals = []
+        for r in range(r0, r1):
+            for c in range(c0, c1):
+                fx, fy = -(2 * (c + 0.5) / W - 1) * SW / 2, -(2 * (r + 0.5) / H - 1) * SH / 2
+                cr = camera_rays(b.lens, np.tile([fx, fy], (uu.size, 1)), np.stack([uu, vv], 1), b.film_z,
+                                 bounds=b.bounds)
+                vals.append(cr.weight.mean())
+        got[k] = float(np.mean(vals))
+    return {k: v / got["centre"] for k, v in got.items()}
+
+
+def test_stopped_down_pupil_tables_keep_the_picture(extension_zip, tmp_path):
+    """Edge and corner over centre within 0.02 of camera_rays' at each f-number, the centre within
+    3 % of 1 (the shader's normalisation)."""
+    lens = load_lens(LENS)
+    out = run_blender(WHITE, extension_zip, tmp_path, LENS, SW, SH, W, H, json.dumps(BLOCKS), json.dumps(FSTOPS),
+                      env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
+    assert out["message"] == ""
+    for n in FSTOPS:
+        want = _predicted(lens, n)
+        got = out[str(n)]
+        print(f"f/{n}: " + ", ".join(f"{k} {got[k] / got['centre']:.4f} (physcam {want[k]:.4f})" for k in BLOCKS)
+              + f"; centre {got['centre']:.4f}")
+        assert got["centre"] == pytest.approx(1.0, abs=0.03)
+        for k in ("right", "corner"):
+            assert abs(got[k] / got["centre"] - want[k]) < 0.02, (n, k)
