@@ -119,8 +119,8 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
     :func:`camera_frames` sends them: ``pinholeFocalLength``, ``entrancePupilOffset``, the lens's
     distortion and (a lens) its squeeze (``static`` re-sent when it changes). The sensor is the
     stream's ``static.camera.activeSensorPhysicalDimensions``; a sample without a focus distance is
-    passed on as it is. The pinhole and pupil do not depend on the stop: a sample with no stop is
-    solved at f/8 (a lens: wide open) and no stop is added to it."""
+    passed on as it is. The pinhole and pupil do not depend on the stop: the lens is solved wide
+    open (a thin lens at f/8) and the sample's own stops are sent unchanged."""
     from ..onset.sensors import custom_sensor
 
     if (lens is None) == (focal_length_mm is None):
@@ -134,11 +134,10 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
             yield s
             continue
         mark = lens_d["focusDistance"] * 1000.0
-        stop = lens_d.get("fStop") or lens_d.get("tStop") or (None if lens is not None else 8.0)
-        key = (dims["width"], dims["height"], mark, stop)
-        if key not in cache:
+        key = (dims["width"], dims["height"], mark)
+        if key not in cache:  # a lens wide open, a thin lens at f/8: the stop changes neither pinhole nor pupil
             cache[key] = _optics_at(custom_sensor(dims["width"], dims["height"]), mark, lens, focal_length_mm,
-                                    stop, None, distortion)
+                                    None if lens is not None else 8.0, None, distortion)
         rep, dist = cache[key]
         out = dict(s, lens=dict(lens_d, pinholeFocalLength=float(rep.pinhole[0])))
         pupil = rep.entrance_pupil_from_film_mm if rep.entrance_pupil_from_film_mm is not None else rep.h1_from_film_mm
