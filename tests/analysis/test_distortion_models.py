@@ -298,9 +298,39 @@ def test_opentrackio_entry_is_the_same_map_in_millimetres_y_down():
     expect = m.formula(up)
     x, y = up[:, 0], -up[:, 1]  # y down
     r2 = x * x + y * y
-    k1, k2, k3 = e["radial"]
+    k1, _, k2, _, k3, _ = e["radial"]  # OpenLensIO's order: l1, l3, l5 the numerator's r^2, r^4, r^6
     p1, p2 = e["tangential"]
     radial = 1 + k1 * r2 + k2 * r2 ** 2 + k3 * r2 ** 3
     xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
     yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
     assert np.column_stack([xd, -yd]) == pytest.approx(expect, abs=1e-12)
+
+
+@pytest.mark.parametrize("reader", ["camdkit", "unreal"])
+def test_distortions_opentrackio_block_reads_right_in_camdkit_and_unreal(reader):
+    """`physcam distortion`'s OpenTrackIO block (brown_conrady.json) is the entry `physcam live` sends:
+    six radial terms in OpenLensIO's order, which camdkit's note and Unreal's receiver
+    (tests/_opentrackio_readers.py) both read back to the fitted map at the 4K corners within 0.1 px."""
+    from _opentrackio_readers import READERS, opencv_rational
+
+    from physcam.analysis.distortion_models import samples_from_field
+    from physcam.cli.distortion import brown_conrady_document
+    from physcam.live.lens_data import distortion_for_sample
+
+    lens = load_lens("dgauss_50mm")
+    w, h, W = 24.89, 18.66, 4096
+    field = distortion_field(lens, focus_mm=2000.0, sensor_width_mm=w, sensor_height_mm=h, width_px=W,
+                             height_px=round(W * h / w), maps=False)
+    fits = [fit_brown_conrady(samples_from_field(field), d, max_residual_px=math.inf) for d in ("D-U", "U-D")]
+    block = brown_conrady_document("dgauss_50mm", fits)["opentrackio_lens_distortion"]
+    assert [e["model"] for e in block] == ["Brown-Conrady D-U", "Brown-Conrady U-D"]
+    assert all(len(e["radial"]) == 6 for e in block)
+    ud, f = block[1], fits[1].coefficients["fy_mm"]
+    live, f_live = distortion_for_sample(lens, w, h, 2000.0)
+    assert ud == live and f == f_live  # one conversion: what live sends
+    corners = np.array([[w / 2, h / 2], [-w / 2, h / 2], [w / 2, -h / 2], [-w / 2, -h / 2]])
+    px = W / w
+    own = fits[1].formula(corners) * px
+    theirs = opencv_rational(corners / f, READERS[reader](ud, f)) * f * px
+    assert np.abs(own - corners * px).max() > 2.0  # the corners move (a reader that reads nothing fails)
+    assert np.abs(theirs - own).max() < 0.1

@@ -1,11 +1,8 @@
 """What virtual-production consumers read from physcam's stream (issue 31).
 
-Distortion is decoded with two readers written here from their public documentation, not from
-physcam: camdkit's note "Conversion of OpenCV to OpenTrackIO (OpenLensIO) lens calibration
-parameters" (SMPTE ris-osvp-metadata-camdkit, corrected 2025-09-02: l1 = k1/F^2, l2 = k4/F^2,
-l3 = k2/F^4, l4 = k5/F^4, l5 = k3/F^6, l6 = k6/F^6, OpenCV's rational model) and Unreal's Live Link
-OpenTrackIO receiver (K1 = l1 F^2, K2 = l3 F^4, K3 = l5 F^6 into its OpenCV-style spherical model;
-fewer than six radial terms read as none). Frustum corners are worked by hand on a flat wall; the
+Distortion is decoded with two readers written from their public documentation, not from physcam
+(tests/_opentrackio_readers.py: camdkit's conversion note and Unreal's Live Link OpenTrackIO
+receiver). Frustum corners are worked by hand on a flat wall; the
 anamorphic and breathing values come from ``physcam lens breathing``; timecodes from SMPTE ST 12-1's
 drop-frame rule (107,892 labels an hour at 29.97).
 """
@@ -30,33 +27,13 @@ from physcam.live.sample import decode_sample, encode_sample, sample_problems
 from physcam.live.usd_io import frames_from_usd
 from physcam.onset.sensors import find_sensor
 
+from _opentrackio_readers import camdkit_reader, opencv_rational, unreal_reader
+
 S35 = find_sensor("Super 35")
 WIDTH_PX = 4096
 
 
-# --- independent readers ---------------------------------------------------------------------------
-def _opencv_rational(xy, k, p1=0.0, p2=0.0):
-    """OpenCV's distortion of normalised points (its documented rational model)."""
-    x, y = xy[:, 0], xy[:, 1]
-    r2 = x * x + y * y
-    rad = (1 + k[0] * r2 + k[1] * r2**2 + k[2] * r2**3) / (1 + k[3] * r2 + k[4] * r2**2 + k[5] * r2**3)
-    return np.c_[x * rad + 2 * p1 * x * y + p2 * (r2 + 2 * x * x), y * rad + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y]
-
-
-def camdkit_reader(dist, f):
-    """OpenCV k1..k6 from an OpenTrackIO radial list as camdkit's conversion note numbers it."""
-    l_ = list(dist["radial"]) + [0.0] * (6 - len(dist["radial"]))
-    return [l_[0] * f**2, l_[2] * f**4, l_[4] * f**6, l_[1] * f**2, l_[3] * f**4, l_[5] * f**6]
-
-
-def unreal_reader(dist, f):
-    """Unreal's spherical K1-K3 (no denominator) from an OpenTrackIO radial list: none below six terms."""
-    l_ = dist["radial"]
-    if len(l_) < 6:
-        return [0.0] * 6
-    return [l_[0] * f**2, l_[2] * f**4, l_[4] * f**6, 0.0, 0.0, 0.0]
-
-
+# --- independent readers (tests/_opentrackio_readers.py) -------------------------------------------
 def _corners(w, h, f):
     return np.array([[w / 2, h / 2], [-w / 2, h / 2], [w / 2, -h / 2], [-w / 2, -h / 2]]) / f
 
@@ -84,8 +61,8 @@ def test_both_readers_get_physcams_distortion_at_the_4k_corners(name, focus_mm, 
     own_k, f_own = _physcam_fit(lens, focus_mm)
     xy = _corners(S35.width_mm, S35.height_mm, f_own)
     px = WIDTH_PX / S35.width_mm  # pixels per mm on the sensor
-    own = _opencv_rational(xy, own_k) * f_own * px
-    theirs = _opencv_rational(xy * f_own / f, reader(dist, f)) * f * px
+    own = opencv_rational(xy, own_k) * f_own * px
+    theirs = opencv_rational(xy * f_own / f, reader(dist, f)) * f * px
     # the corner moves by pixels (so a reader that reads nothing fails), and both land within 0.1 px
     assert np.abs(own - xy * f_own * px).max() > 2.0
     assert np.abs(theirs - own).max() < 0.1

@@ -271,23 +271,20 @@ class BrownConrady(FittedDistortion):
         return np.stack([q[:, 0] + ax @ k, q[:, 1] + ay @ k], axis=1) * f
 
     def opentrackio(self) -> dict:
-        """The OpenTrackIO 1.0.1 ``lens.distortion`` entry, in OpenLensIO's units.
-
-        OpenLensIO (v1.0.1, sections 1.1 and 4.1; the lens model OpenTrackIO's distortion follows)
-        writes the polynomial on the sensor in millimetres from the centre, y down, for the pinhole
-        of focal length F (``pinholeFocalLength``, the Y pinhole here). With x_mm = F x and y down::
-
-            radial k_n / F^(2n) (n = 1, 2, 3),  tangential [-p1 / F, p2 / F]
-
-        (the p1 terms change sign with y). For an anamorphic lens (f_x != f_y) one F cannot carry
-        both meridians: the entry is then only the Y meridian's reading, as OpenTrackIO 1.0.1 has
-        no anamorphic distortion model.
+        """The OpenTrackIO 1.0.1 ``lens.distortion`` entry in OpenLensIO's units and order, as
+        ``physcam live`` sends it (:func:`physcam.analysis.openlensio.opencv_to_opentrackio`):
+        millimetres on the sensor from the centre, y down, for the pinhole of focal length F
+        (``pinholeFocalLength``, the Y pinhole here); ``radial`` six terms [k1/F^2, 0, k2/F^4, 0,
+        k3/F^6, 0] (OpenLensIO's l1-l6, the denominator's l2, l4, l6 zero), ``tangential``
+        [-p1/F, p2/F] (the p1 terms change sign with y). For an anamorphic lens (f_x != f_y) one F
+        cannot carry both meridians: the entry is then only the Y meridian's reading, as
+        OpenTrackIO 1.0.1 has no anamorphic distortion model.
         """
+        from .openlensio import opencv_to_opentrackio
+
         c = self.coefficients
-        f = c["fy_mm"]
-        return {"model": f"Brown-Conrady {self.direction}",
-                "radial": [c["k1"] / f ** 2, c["k2"] / f ** 4, c["k3"] / f ** 6],
-                "tangential": [-c["p1"] / f, c["p2"] / f]}
+        return opencv_to_opentrackio(c["k1"], c["k2"], c["k3"], -c["p1"], c["p2"], c["fy_mm"],
+                                     direction=self.direction)
 
 
 def fit_brown_conrady(samples: DistortionSamples, direction: str = "D-U", *,

@@ -15,6 +15,8 @@ examples:
   physcam live send --lens navarro_anamorphic_2x --focus 3m --fps 29.97 --timecode "01:00:00;00" --print
   physcam live record take.usda --lens dgauss_50mm --fiz fiz.csv --count 48
   physcam live play take.usda --port 55555
+  physcam live send --clip tests/data/camera-metadata/arri/B001C001_180327_R1ZA.mov.csv --frames 2 --print
+  physcam live play --clip tests/data/camera-metadata/arri/B001C001_180327_R1ZA.mov.csv --rate 0
   physcam live wall wall.usda --kind curved --radius 8 --width 14
   physcam live frustum take.usda --wall wall.usda frustum.usda --overscan 10 --latency-ms 40
   physcam live frustum take.usda --wall wall.usda frustum.usda --overscan 10 --overscan-mode ndisplay
@@ -69,6 +71,12 @@ def _sensor_args(p) -> None:
     p.add_argument("--sensor-height", type=distance("sensor height"), help="sensor height, with --sensor-width")
 
 
+def _clip_arg(p) -> None:
+    p.add_argument("--clip", nargs="+", metavar="FILE",
+                   help="a recorded clip's camera metadata files (ARRI, RED, VENICE, Canon, Blackmagic, Mo-Sys; "
+                        "docs/camera-metadata.md), sent frame by frame at its frame rate with its timecodes")
+
+
 def register(sub) -> None:
     import argparse
 
@@ -107,21 +115,24 @@ def register(sub) -> None:
     add_output_options(r, what="the summary")
     r.set_defaults(handler=run_record, output_args=("file", "report"))
 
-    se = s.add_parser("send", help="stream physcam's camera and lens as OpenTrackIO (a focus pull, a pan)")
+    se = s.add_parser("send", help="stream physcam's camera and lens as OpenTrackIO (a focus pull, a pan), or a "
+                                   "recorded clip's camera metadata")
+    _clip_arg(se)
     se.add_argument("--lens", help="bundled lens name or prescription file (breathing, pupil, distortion)")
     se.add_argument("--focal", type=distance("focal length"), help="or a thin lens of this focal length")
     from ._common import add_sensor_options
 
     add_sensor_options(se)
-    se.add_argument("--focus", type=focus("focus distance", allow_inf=False), default=3000.0,
+    se.add_argument("--focus", type=focus("focus distance", allow_inf=False), default=None,
                     help="focus mark (default 3m; units ok; or hyperfocal at --fstop)")
     se.add_argument("--focus-to", type=focus("focus distance to pull to", allow_inf=False),
                     help="pull focus to this mark (units ok; or hyperfocal)")
     se.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop (a lens: default wide open)")
     se.add_argument("--tstop", type=number("T-stop", positive=True), help="marked T-stop")
-    se.add_argument("--fps", type=number("frame rate", positive=True, hi=1000.0), default=24.0,
-                    help="sample rate (default 24; 23.976 is 24000/1001)")
-    se.add_argument("--frames", type=_count, default=48, help="samples in the take (default 48)")
+    se.add_argument("--fps", type=number("frame rate", positive=True, hi=1000.0), default=None,
+                    help="sample rate (default 24, a clip's own; 23.976 is 24000/1001)")
+    se.add_argument("--frames", type=_count, default=None,
+                    help="samples in the take (default 48; a clip: all its frames, or its first N)")
     se.add_argument("--position", type=numbers("position", 3), default=(0.0, 0.0, 1.5), metavar="X,Y,Z",
                     help="film plane on the stage, metres, Z up (default 0,0,1.5)")
     se.add_argument("--pan-rate", type=number("pan rate", lo=-3600.0, hi=3600.0), default=0.0,
@@ -130,7 +141,7 @@ def register(sub) -> None:
                     help="lens shift on the film (mm; + right), sent as projectionOffset")
     se.add_argument("--shift-y", metavar="MM", type=distance("vertical lens shift"), default=0.0,
                     help="lens shift on the film (mm; + up; write negative values as --shift-y=-0.8)")
-    se.add_argument("--timecode", default="00:00:00:00", metavar="HH:MM:SS:FF",
+    se.add_argument("--timecode", default=None, metavar="HH:MM:SS:FF",
                     help="timecode of the first sample (default 00:00:00:00; ';' before FF for drop-frame)")
     se.add_argument("--drop-frame", action="store_true",
                     help="drop-frame timecode (29.97 and 59.94 fps; sets timecode.dropFrame)")
@@ -139,7 +150,11 @@ def register(sub) -> None:
     se.set_defaults(handler=run_send)
 
     pl = s.add_parser("play", help="send a recorded USD camera or a lens report back out as OpenTrackIO")
-    pl.add_argument("file", help="a USD file with a PhysicalCamera, or a lens report .json written by record")
+    pl.add_argument("file", nargs="?", help="a USD file with a PhysicalCamera, or a lens report .json written by "
+                                           "record (or --clip)")
+    _clip_arg(pl)
+    pl.add_argument("--lens", help="with --clip: bundled lens name or prescription file (breathing, pupil, distortion)")
+    pl.add_argument("--focal", type=distance("focal length"), help="with --clip: or a thin lens of this focal length")
     pl.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
     pl.add_argument("--rate", type=number("rate", lo=0.0, hi=100000.0), default=None,
                     help="samples per second (default the file's rate; 0 as fast as possible)")
@@ -469,11 +484,71 @@ def _stream(args, samples, rate) -> int:
     return n
 
 
+def _clip_samples(args) -> tuple[list, float]:
+    """(samples, frame rate) of the ``--clip`` files (:func:`physcam.metadata.convert.opentrackio_samples`),
+    with the optics of ``--lens`` or a thin lens of ``--focal`` (else of the clip's nominal focal
+    length) at each frame's focus (:func:`physcam.live.camera.with_optics`)."""
+    import dataclasses
+
+    from ..errors import InputError
+    from ..live.camera import with_optics
+    from ..metadata import load
+    from ..metadata.convert import opentrackio_samples
+
+    if args.lens is not None and args.focal is not None:
+        raise InputError("give either --lens or --focal, not both")
+    record = load(args.clip)
+    sensor = _resolve_sensor_opt(args)
+    if record.active_area_mm is None and sensor is not None:
+        record = dataclasses.replace(record, active_area_mm=(sensor.width_mm, sensor.height_mm))
+    samples = opentrackio_samples(record, rate=getattr(args, "fps", None))
+    rate = samples[0]["timing"].get("sampleRate") if samples else None
+    if rate is None:
+        raise InputError(f"the {record.source} clip gives no frame rate; give it (--fps)")
+    if getattr(args, "frames", None) is not None:
+        samples = samples[: args.frames]
+    lens = focal = None
+    if args.lens:
+        from ..lens.library import load_lens
+
+        lens = load_lens(args.lens)
+    else:
+        focal = args.focal or samples[0].get("static", {}).get("lens", {}).get("nominalFocalLength")
+    if lens is not None or focal is not None:
+        samples = with_optics(samples, lens=lens, focal_length_mm=focal)
+    return samples, rate["num"] / rate["denom"]
+
+
+#: send's options that describe a generated take: a clip brings its own
+_TAKE_OPTIONS = (("focus", "--focus"), ("focus_to", "--focus-to"), ("fstop", "--fstop"), ("tstop", "--tstop"),
+                 ("timecode", "--timecode"), ("drop_frame", "--drop-frame"), ("pan_rate", "--pan-rate"),
+                 ("shift_x", "--shift-x"), ("shift_y", "--shift-y"))
+
+
+def _send_clip(args) -> int:
+    from ..errors import InputError
+
+    given = [flag for name, flag in _TAKE_OPTIONS if getattr(args, name) not in (None, False, 0.0)]
+    if args.position != (0.0, 0.0, 1.5):
+        given.append("--position")
+    if given:
+        raise InputError(f"{', '.join(given)} describe a generated take; --clip sends the clip's own values")
+    samples, rate = _clip_samples(args)
+    _stream(args, samples, rate)
+    return 0
+
+
 def run_send(args) -> int:
     from ..errors import InputError
     from ..live.camera import CameraMove, camera_frames, frames_to_samples
     from .report import resolve_sensor
 
+    if args.clip:
+        return _send_clip(args)
+    args.focus = 3000.0 if args.focus is None else args.focus
+    args.fps = 24.0 if args.fps is None else args.fps
+    args.frames = 48 if args.frames is None else args.frames
+    args.timecode = "00:00:00:00" if args.timecode is None else args.timecode
     if (args.lens is None) == (args.focal is None):
         raise InputError("give either --lens or --focal")
     lens = None
@@ -547,6 +622,14 @@ def run_play(args) -> int:
     from ..errors import InputError
     from ..live.camera import frames_to_samples
 
+    if (args.file is None) == (args.clip is None):
+        raise InputError("give the file to play, or a clip's metadata files with --clip")
+    if args.clip:
+        samples, rate = _clip_samples(args)
+        _stream(args, samples, rate if args.rate is None else args.rate)
+        return 0
+    if args.lens is not None or args.focal is not None:
+        raise InputError("--lens and --focal go with --clip: a recording carries its own lens values")
     name = str(args.file).lower()
     if name.endswith((".usda", ".usd", ".usdc")):
         from ..live.usd_io import frames_from_usd

@@ -26,11 +26,12 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from fractions import Fraction
 
 from ..errors import InputError, require_finite, require_type
 from .frames import TrackedFrame, new_source_id, rate_fraction, sample_from_frame, static_block, with_time
 
-__all__ = ["CameraMove", "camera_frames", "camera_samples", "frames_to_samples"]
+__all__ = ["CameraMove", "camera_frames", "camera_samples", "frames_to_samples", "with_optics"]
 
 #: the most frames one generated take holds (an hour at 240 fps is 864,000; a demo needs far fewer)
 MAX_TAKE_FRAMES = 1_000_000
@@ -60,7 +61,6 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
     ``focus_mm`` to ``focus_to_mm`` (mm from the film; default: held), ``lens`` (a Prescription) or a
     thin lens of ``focal_length_mm``; ``t0_ns`` the first timestamp (default now); ``shift_mm`` the
     lens shift (+ right, + up); ``drop_frame``: drop-frame timecode (29.97, 59.94)."""
-    from ..onset.report import ReportRequest, solve_report
     from ..onset.sensors import Sensor
 
     require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
@@ -84,17 +84,9 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
     for i in range(frames):
         u = i / (frames - 1) if frames > 1 else 0.0
         mark = f0 + (f1 - f0) * u
-        report = cache.get(mark)
-        if report is None:
-            report = solve_report(ReportRequest(focal_length_mm=focal_length_mm, sensor=sensor, fstop=fstop, focus_mm=mark,
-                                       tstop=tstop, lens=lens))
-            dist = None
-            if lens is not None and distortion:
-                from .lens_data import distortion_for_sample
-
-                dist, _ = distortion_for_sample(lens, sensor.width_mm, sensor.height_mm, mark)
-            report = cache[mark] = (report, dist)
-        rep, dist = report
+        if mark not in cache:
+            cache[mark] = _optics_at(sensor, mark, lens, focal_length_mm, fstop, tstop, distortion)
+        rep, dist = cache[mark]
         pos, rot = move.at(i / float(fr))
         pupil = rep.entrance_pupil_from_film_mm
         out.append(with_time(TrackedFrame(
@@ -104,6 +96,61 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
             sensor_mm=(sensor.width_mm, sensor.height_mm),
             nominal_focal_length_mm=rep.focal_length_mm), t0, i))
     return out
+
+
+def _optics_at(sensor, mark, lens, focal_length_mm, fstop, tstop, distortion):
+    """(lens report, OpenTrackIO distortion or None) of the lens (or thin lens) focused at ``mark``."""
+    from ..onset.report import ReportRequest, solve_report
+
+    rep = solve_report(ReportRequest(focal_length_mm=focal_length_mm, sensor=sensor, fstop=fstop, focus_mm=mark,
+                                     tstop=tstop, lens=lens))
+    dist = None
+    if lens is not None and distortion:
+        from .lens_data import distortion_for_sample
+
+        dist, _ = distortion_for_sample(lens, sensor.width_mm, sensor.height_mm, mark)
+    return rep, dist
+
+
+def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = True):
+    """Yield ``samples`` (OpenTrackIO dicts, e.g. a recorded clip's,
+    :func:`physcam.metadata.convert.opentrackio_samples`) with the optics of ``lens`` (a
+    Prescription) or a thin lens of ``focal_length_mm`` at each sample's ``focusDistance``, as
+    :func:`camera_frames` sends them: ``pinholeFocalLength``, ``entrancePupilOffset``, the lens's
+    distortion and (a lens) its squeeze (``static`` re-sent when it changes). The sensor is the
+    stream's ``static.camera.activeSensorPhysicalDimensions``; a sample without a focus distance is
+    passed on as it is. The pinhole and pupil do not depend on the stop: the lens is solved wide
+    open (a thin lens at f/8) and the sample's own stops are sent unchanged."""
+    from ..onset.sensors import custom_sensor
+
+    if (lens is None) == (focal_length_mm is None):
+        raise InputError("give either a lens prescription or a focal length")
+    static, sent_squeeze, cache = None, None, {}
+    for s in samples:
+        static = s.get("static") or static
+        dims = ((static or {}).get("camera") or {}).get("activeSensorPhysicalDimensions")
+        lens_d = s.get("lens") or {}
+        if dims is None or "focusDistance" not in lens_d:
+            yield s
+            continue
+        mark = lens_d["focusDistance"] * 1000.0
+        key = (dims["width"], dims["height"], mark)
+        if key not in cache:  # a lens wide open, a thin lens at f/8: the stop changes neither pinhole nor pupil
+            cache[key] = _optics_at(custom_sensor(dims["width"], dims["height"]), mark, lens, focal_length_mm,
+                                    None if lens is not None else 8.0, None, distortion)
+        rep, dist = cache[key]
+        out = dict(s, lens=dict(lens_d, pinholeFocalLength=float(rep.pinhole[0])))
+        pupil = rep.entrance_pupil_from_film_mm if rep.entrance_pupil_from_film_mm is not None else rep.h1_from_film_mm
+        out["lens"]["entrancePupilOffset"] = float(pupil) / 1000.0
+        if dist is not None:
+            out["lens"]["distortion"] = [dist]
+        sq = Fraction(float(rep.pinhole[1])).limit_denominator(1_000_000)  # as static_block keeps it
+        squeeze = {"num": sq.numerator, "denom": sq.denominator}
+        if lens is not None and squeeze != sent_squeeze:  # a thin lens keeps the stream's squeeze
+            cam = dict(static["camera"], anamorphicSqueeze=squeeze)
+            out["static"] = dict(out.get("static") or static, camera=cam)
+            static, sent_squeeze = out["static"], squeeze
+        yield out
 
 
 def frames_to_samples(frames, *, source_id: str | None = None, static_every: int | None = None,
