@@ -12,6 +12,19 @@ chief rays (:func:`physcam.analysis.stmap.distortion_field`).
 The far mark's chart is the near one scaled by the ratio of the marks (a bigger board, so that it
 fills the frame as well): a chart's size enters only the poses OpenCV fits, never the pinhole or the
 distortion, so one ``--square`` serves both marks.
+
+Measured (2 shared CPU cores, 16 renders of 640 x 427 px at 8 samples, about 65 s of rendering; the
+test about 75 s): pinhole 36.677 +- 0.071 mm at 600 mm (predicted 36.635) and 35.878 +- 0.235 mm at
+1500 mm (predicted 35.746); distortion field 0.13 and 0.23 px RMS from the prediction (stated
+uncertainty 0.58 and 0.32 px); breathing 2.23 +- 0.70 % (predicted 2.49 %; another pose draw gave
+2.34 +- 0.50 %). So the pinhole, distortion and breathing agree within the stated uncertainty, but
+the issue's 0.2 % on the breathing is *not* shown: it is below what these images measure. The limit
+is the pinhole's uncertainty, not render noise (corner residuals 0.3-0.4 px RMS): the chart covers a
+quarter of the frame per view and is tilted at most 30 degrees (more tilt puts it out of the f/11
+depth of field at 600 mm), so the focal length trades against the chart's distance; the far
+mark's std (0.2 mm, 0.65 %) dominates. A larger chart filling the frame (tried: 48 mm squares)
+loses corners off the frame and defocuses at the tilted edge (views at 1.4-1.6 px), worse.
+Reaching 0.2 % needs larger images or more views (each view costs ~4 s here).
 """
 
 from __future__ import annotations
@@ -38,7 +51,7 @@ SIZE = (640, 427)
 SENSOR_MM = (36.0, 36.0 * SIZE[1] / SIZE[0])  # square photosites, 56.25 um
 SQUARES, SQUARE_MM, MARKER_MM, DICTIONARY = (10, 7), 35.0, 26.0, "DICT_4X4_50"
 POSES = 8  # per mark
-SAMPLES = 16
+SAMPLES = 8
 
 #: Renders one textured emissive plane per job through each mark's physcam setup script into PNG.
 SCENE = '''
@@ -143,3 +156,31 @@ def photographs(tmp_path_factory):
     t0 = time.perf_counter()
     run_blender(SCENE, str(jobs), timeout=600)
     return tmp, time.perf_counter() - t0
+
+
+def test_the_rendered_lens_measures_as_its_prescription(photographs, tmp_path, capsys):
+    from physcam.cli import main
+
+    tmp, seconds = photographs
+    images = sorted(str(p) for p in tmp.glob("m*_*.png"))
+    rc = main(["calibrate", *images, "--marks", str(tmp / "marks.csv"), "--sensor-width", f"{SENSOR_MM[0]}",
+               "--sensor-height", f"{SENSOR_MM[1]}", "--chart", "charuco", "--corners", f"{SQUARES[0]}x{SQUARES[1]}",
+               "--square", f"{SQUARE_MM}mm", "--marker", f"{MARKER_MM}mm", "--dictionary", DICTIONARY,
+               "--lens", LENS, "--bootstrap", "20", "-o", str(tmp_path / "calib"), "--json"])
+    assert rc == 0, capsys.readouterr().err
+    doc = json.loads(capsys.readouterr().out)
+    rows = {r["figure"]: r for r in doc["comparison"]["rows"]}
+    print(f"rendered in {seconds:.0f} s;", json.dumps(rows, indent=1))
+    for mark in MARKS_MM:
+        f = rows[f"pinhole focal length at {mark:g} mm"]
+        assert f["agrees"], f  # within 2 standard uncertainties of the paraxial pinhole at the mark
+        d = rows[f"distortion field at {mark:g} mm (RMS difference)"]
+        assert d["agrees"], d
+    b = rows[f"breathing {MARKS_MM[0]:g} mm against {MARKS_MM[1]:g} mm"]
+    assert b["agrees"], b  # within 2 stated standard uncertainties (percent)
+    # the issue's 0.2 % is not met: at 640 x 427 px, 8 views, the far mark's pinhole is known to only
+    # ~0.5 % (module notes), so the breathing's stated uncertainty is ~0.5-0.7 %; assert it is said so
+    assert 0.1 < b["std"] < 1.5, b
+    # the corners sit on the fitted camera to the render's noise (the verdict may still reject USD's
+    # lensDistortion at 600 mm: it misses this Distagon's field by ~0.8 px, a limit of that model)
+    assert all(m["residual_px"]["rms"] < 0.5 for m in doc["marks"]), [m["residual_px"]["rms"] for m in doc["marks"]]
