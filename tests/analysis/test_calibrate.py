@@ -195,3 +195,20 @@ def test_flat_field_and_a_lens_that_is_not_this_camera(photos, tmp_path, capsys)
     f_row = rows["pinhole focal length at 2000 mm"]
     assert not f_row["agrees"] and f_row["predicted"] > 40.0
     assert doc["comparison"]["agrees"] is False
+
+
+def test_breathing_between_two_marks_is_the_ratio_of_the_focal_lengths():
+    """Views at 2 m through K_TRUE and at 500 mm through a pinhole 2 % longer (f 1173 px): the breathing
+    table says +2 % at 500 mm against the farthest mark (hand value 100 (1173 / 1150 - 1))."""
+    from physcam.analysis.calibrate import calibrate_views
+
+    K_near = K_TRUE.copy()
+    K_near[0, 0] = K_near[1, 1] = 1173.0
+    views = _charts.point_views(noise_px=0.0, seed=1, mark=2000.0) + \
+        _charts.point_views(noise_px=0.0, seed=4, mark=500.0, K=K_near)
+    cal = calibrate_views(views, SENSOR_MM, bootstrap=0)
+    far, near = cal.breathing
+    assert (far.mark_mm, far.change_pct) == (2000.0, 0.0)
+    assert near.mark_mm == 500.0
+    assert near.change_pct == pytest.approx(2.0, abs=1e-3)
+    assert near.focal_length_mm == pytest.approx(1173.0 * PITCH_MM, rel=1e-5)

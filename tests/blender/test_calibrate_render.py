@@ -1,0 +1,186 @@
+"""Issue 33, render proof of ``physcam calibrate``: a ChArUco chart photographed through physcam's own
+OSL real-lens camera of ``zeiss_distagon_35mm_f4`` (Blender Cycles, traced through the prescription)
+at two focus marks, calibrated by ``physcam calibrate --lens``, agrees with physcam's prediction from
+the prescription: the pinhole focal length and the distortion field within the stated uncertainty,
+and the breathing between the marks within 0.2 %.
+
+The two sides are independent: Cycles renders through the OSL shader's float32 ray trace (film to
+scene, the chart a textured emissive plane), the chart is found by OpenCV and fitted by OpenCV's
+calibration; the prediction is physcam's numpy tracer's paraxial pinhole at the mark and its real
+chief rays (:func:`physcam.analysis.stmap.distortion_field`).
+
+The far mark's chart is the near one scaled by the ratio of the marks (a bigger board, so that it
+fills the frame as well): a chart's size enters only the poses OpenCV fits, never the pinhole or the
+distortion, so one ``--square`` serves both marks.
+
+Measured (2 shared CPU cores, 16 renders of 640 x 427 px at 8 samples, about 65 s of rendering; the
+test about 75 s): pinhole 36.677 +- 0.071 mm at 600 mm (predicted 36.635) and 35.878 +- 0.235 mm at
+1500 mm (predicted 35.746); distortion field 0.13 and 0.23 px RMS from the prediction (stated
+uncertainty 0.58 and 0.32 px); breathing 2.23 +- 0.70 % (predicted 2.49 %; another pose draw gave
+2.34 +- 0.50 %). So the pinhole, distortion and breathing agree within the stated uncertainty, but
+the issue's 0.2 % on the breathing is *not* shown: it is below what these images measure. The limit
+is the pinhole's uncertainty, not render noise (corner residuals 0.3-0.4 px RMS): the chart covers a
+quarter of the frame per view and is tilted at most 30 degrees (more tilt puts it out of the f/11
+depth of field at 600 mm), so the focal length trades against the chart's distance; the far
+mark's std (0.2 mm, 0.65 %) dominates. A larger chart filling the frame (tried: 48 mm squares)
+loses corners off the frame and defocuses at the tilted edge (views at 1.4-1.6 px), worse.
+Reaching 0.2 % needs larger images or more views (each view costs ~4 s here).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import time
+
+import numpy as np
+import pytest
+
+from _blender import run_blender
+from physcam.export.blender import blender_setup_script, osl_camera_shader
+from physcam.lens.library import load_lens
+
+cv2 = pytest.importorskip("cv2")
+pytestmark = pytest.mark.slow
+
+LENS = "zeiss_distagon_35mm_f4"
+MARKS_MM = (600.0, 1500.0)  # focus marks, mm from the film
+FSTOP = 11.0  # depth of field for the tilted chart: blur <= 0.7 px over +-100 mm at 600 mm
+SIZE = (640, 427)
+SENSOR_MM = (36.0, 36.0 * SIZE[1] / SIZE[0])  # square photosites, 56.25 um
+SQUARES, SQUARE_MM, MARKER_MM, DICTIONARY = (10, 7), 35.0, 26.0, "DICT_4X4_50"
+POSES = 8  # per mark
+SAMPLES = 8
+
+#: Renders one textured emissive plane per job through each mark's physcam setup script into PNG.
+SCENE = '''
+import json, runpy, sys
+jobs = json.loads(open(sys.argv[1]).read())
+scene = bpy.context.scene
+for o in list(bpy.data.objects):
+    if o.type != "CAMERA":
+        bpy.data.objects.remove(o)
+cam_obj = scene.camera
+cam_obj.location = (0.0, 0.0, 0.0)       # the film centre
+cam_obj.rotation_euler = (0.0, 0.0, 0.0)  # looks down world -Z, +Y up
+world = bpy.data.worlds.new("black"); scene.world = world; world.use_nodes = True
+world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+mat = bpy.data.materials.new("chart"); mat.use_nodes = True
+nt = mat.node_tree; nt.nodes.clear()
+tex = nt.nodes.new("ShaderNodeTexImage"); tex.image = bpy.data.images.load(jobs["board"])
+tex.interpolation = "Linear"; tex.extension = "CLIP"
+em = nt.nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = 1.0
+nt.links.new(tex.outputs["Color"], em.inputs["Color"])
+nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
+setup = None
+for job in jobs["renders"]:
+    if job["setup"] != setup:
+        runpy.run_path(job["setup"], run_name="physcam_setup")["apply"](scene)
+        setup = job["setup"]
+    scene.cycles.use_denoising = False
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = 2
+    scene.view_settings.view_transform = "Standard"
+    scene.cycles.max_bounces = 0
+    scene.cycles.samples = jobs["samples"]
+    for o in list(bpy.data.objects):
+        if o.type == "MESH":
+            bpy.data.objects.remove(o)
+    me = bpy.data.meshes.new("chart")
+    me.from_pydata(job["corners"], [], [(0, 1, 2, 3)])
+    uv = me.uv_layers.new()
+    for li, loop in enumerate(me.loops):
+        uv.data[li].uv = job["uv"][loop.vertex_index]
+    ob = bpy.data.objects.new("chart", me); scene.collection.objects.link(ob)
+    me.materials.append(mat)
+    scene.render.image_settings.file_format = "PNG"
+    scene.render.image_settings.color_mode = "BW"
+    scene.render.filepath = job["out"]
+    bpy.ops.render.render(write_still=True)
+print(json.dumps({"rendered": len(jobs["renders"])}))
+'''
+
+
+def _poses(mark, n, seed):
+    """``n`` chart poses (R, t) in OpenCV's camera frame (mm), the chart about ``mark`` from the film,
+    tilted up to 30 degrees, pushed toward every corner of the frame in turn."""
+    rng = np.random.default_rng(seed)
+    scale = mark / MARKS_MM[0]
+    centre = scale * SQUARE_MM * np.array([SQUARES[0] / 2, SQUARES[1] / 2, 0.0])
+    out = []
+    for i in range(n):
+        ax, ay = np.radians(rng.uniform(-30, 30, 2))
+        az = np.radians(rng.uniform(-10, 10))
+        R = cv2.Rodrigues(np.array([ax, 0, 0]))[0] @ cv2.Rodrigues(np.array([0, ay, 0]))[0] @ \
+            cv2.Rodrigues(np.array([0, 0, az]))[0]
+        z = mark * rng.uniform(0.97, 1.03)
+        corner = np.array([(-1) ** i, (-1) ** (i // 2)]) * ([0.16, 0.12] if i < n - 2 else [0.0, 0.0])
+        shift = (corner + rng.uniform(-0.03, 0.03, 2)) * z
+        out.append((R, np.array([shift[0], shift[1], z]) - R @ centre, scale))
+    return out
+
+
+def _job(R, t, scale, out):
+    """The chart's four corners in Blender's camera frame (m; OpenCV's y and z negated) and their UVs."""
+    w, h = SQUARES[0] * SQUARE_MM * scale, SQUARES[1] * SQUARE_MM * scale
+    chart = np.array([[0, 0, 0], [w, 0, 0], [w, h, 0], [0, h, 0]], float)
+    cam = (chart @ R.T + t) * [1.0, -1.0, -1.0] / 1000.0
+    return {"corners": cam.tolist(), "uv": [[0, 1], [1, 1], [1, 0], [0, 0]], "out": str(out)}
+
+
+@pytest.fixture(scope="module")
+def photographs(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("calibrate_render")
+    lens = load_lens(LENS)
+    d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, DICTIONARY))
+    board = cv2.aruco.CharucoBoard(SQUARES, SQUARE_MM, MARKER_MM, d)
+    px_per_mm = 8
+    cv2.imwrite(str(tmp / "board.png"), board.generateImage((int(SQUARES[0] * SQUARE_MM * px_per_mm),
+                                                             int(SQUARES[1] * SQUARE_MM * px_per_mm)), marginSize=0))
+    renders, rows = [], []
+    for k, mark in enumerate(MARKS_MM):
+        src = osl_camera_shader(lens, focus_mm=mark, fstop=FSTOP, sensor_width_mm=SENSOR_MM[0],
+                                sensor_height_mm=SENSOR_MM[1])
+        setup = tmp / f"mark{k}.py"
+        setup.write_text(blender_setup_script(src, sensor_width_mm=SENSOR_MM[0], sensor_height_mm=SENSOR_MM[1],
+                                              resolution=SIZE, text_name=f"mark{k}.osl"))
+        for i, (R, t, scale) in enumerate(_poses(mark, POSES, seed=k + 1)):
+            out = tmp / f"m{k}_{i:02d}.png"
+            renders.append(dict(_job(R, t, scale, out), setup=str(setup)))
+            rows.append([out.name, f"{mark:g}mm"])
+    jobs = tmp / "jobs.json"
+    jobs.write_text(json.dumps({"board": str(tmp / "board.png"), "samples": SAMPLES, "renders": renders}))
+    with (tmp / "marks.csv").open("w", newline="") as f:
+        csv.writer(f).writerows([["image", "mark"], *rows])
+    t0 = time.perf_counter()
+    run_blender(SCENE, str(jobs), timeout=600)
+    return tmp, time.perf_counter() - t0
+
+
+def test_the_rendered_lens_measures_as_its_prescription(photographs, tmp_path, capsys):
+    from physcam.cli import main
+
+    tmp, seconds = photographs
+    images = sorted(str(p) for p in tmp.glob("m*_*.png"))
+    rc = main(["calibrate", *images, "--marks", str(tmp / "marks.csv"), "--sensor-width", f"{SENSOR_MM[0]}",
+               "--sensor-height", f"{SENSOR_MM[1]}", "--chart", "charuco", "--corners", f"{SQUARES[0]}x{SQUARES[1]}",
+               "--square", f"{SQUARE_MM}mm", "--marker", f"{MARKER_MM}mm", "--dictionary", DICTIONARY,
+               "--lens", LENS, "--bootstrap", "20", "-o", str(tmp_path / "calib"), "--json"])
+    assert rc == 0, capsys.readouterr().err
+    doc = json.loads(capsys.readouterr().out)
+    rows = {r["figure"]: r for r in doc["comparison"]["rows"]}
+    print(f"rendered in {seconds:.0f} s;", json.dumps(rows, indent=1))
+    for mark in MARKS_MM:
+        f = rows[f"pinhole focal length at {mark:g} mm"]
+        assert f["agrees"], f  # within 2 standard uncertainties of the paraxial pinhole at the mark
+        d = rows[f"distortion field at {mark:g} mm (RMS difference)"]
+        assert d["agrees"], d
+    b = rows[f"breathing {MARKS_MM[0]:g} mm against {MARKS_MM[1]:g} mm"]
+    assert b["agrees"], b  # within 2 stated standard uncertainties (percent)
+    # the issue's 0.2 % is not met: at 640 x 427 px, 8 views, the far mark's pinhole is known to only
+    # ~0.5 % (module notes), so the breathing's stated uncertainty is ~0.5-0.7 %; assert it is said so
+    assert 0.1 < b["std"] < 1.5, b
+    # the corners sit on the fitted camera to the render's noise (the verdict may still reject USD's
+    # lensDistortion at 600 mm: it misses this Distagon's field by ~0.8 px, a limit of that model)
+    assert all(m["residual_px"]["rms"] < 0.5 for m in doc["marks"]), [m["residual_px"]["rms"] for m in doc["marks"]]
