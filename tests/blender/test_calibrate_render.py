@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import csv
 import json
-import math
 import time
 
 import numpy as np

@@ -93,6 +93,15 @@ def test_demo_writes_outputs(tmp_path, capsys):
         assert (out / "distortion" / name).exists(), name
     assert check_document(json.loads((out / "distortion" / "brown_conrady.json").read_text())) == \
         "physcam.distortion_brown_conrady"
+    # issue 30: a clip's recorded metadata (the bundled ARRI excerpt: 49 lines, a header and 48 frames) as one
+    # animated USD camera with a time sample per frame (tests/metadata checks the values against the file)
+    from pxr import Usd
+
+    stage = Usd.Stage.Open(str(out / "clip_camera.usda"))
+    cams = [p for p in stage.Traverse() if p.GetTypeName() == "PhysicalCamera"]
+    assert len(cams) == 1
+    focus = stage.GetPrimAtPath(cams[0].GetPath().AppendChild("Pinhole")).GetAttribute("focusDistance")
+    assert len(focus.GetTimeSamples()) == 48 and len(cams[0].GetAttribute("lens:main:fStop").GetTimeSamples()) == 48
     assert main(["demo", "--out", str(out)]) == 2  # exists, no --force
 
 

@@ -67,6 +67,7 @@ def _steps():
         ("lens report", _report_step),
         ("Gaussian data and diagram", _lens_step),
         ("USD camera", _usd_step),
+        ("a clip's recorded metadata as a USD camera", _metadata_step),
         ("spot diagram and bokeh", _trace_step),
         ("lens card", _card_step),
         ("distortion maps and models", _distortion_step),
@@ -135,6 +136,20 @@ def _usd_step(out, ctx, force):
     stage = new_stage(0.01)
     author_from_report(stage, "/Camera", ctx["report"])
     return [save_stage(stage, out / "camera.usda", force=force)]
+
+
+def _metadata_step(out, ctx, force):
+    """The camera metadata a cinema camera recorded (a 48-frame excerpt of an ARRI ALEXA LF clip, bundled;
+    docs/camera-metadata.md) as one animated USD camera: its focus, iris and focal length per frame."""
+    from importlib import resources
+
+    from ..metadata import load
+    from ..metadata.convert import solve, write_usd
+
+    clip = resources.files("physcam.data").joinpath("samples/arri_alexa_lf_B001C001_first48.csv")
+    with resources.as_file(clip) as path:
+        record = load(path)
+    return [write_usd(out / "clip_camera.usda", record, solve(record), force=force)]
 
 
 def _trace_step(out, ctx, force):
