@@ -34,6 +34,9 @@ def register(sub) -> None:
                    help="the depth pass's unit (default m, Blender's scene unit)")
     _camera_options(p)
     p.add_argument("-o", "--output", metavar="OUT.exr", required=True, help="the defocused EXR")
+    p.add_argument("--edge-px", type=whole("edge px", lo=0, hi=8), default=1, metavar="N",
+                   help="give pixels within N of a nearer one its depth (default 1): a render's antialiased edge "
+                        "pixels hold foreground light under the background's depth; 0 keeps the depth as given")
     p.add_argument("--kernel-cache", metavar="DIR", default=None,
                    help="keep traced kernels in DIR, shared by later frames of the shot")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
@@ -105,7 +108,8 @@ def run(args) -> int:
     res = defocus_file(args.image, args.output, lens, focus_mm=args.focus, fstop=args.fstop,
                        sensor_width_mm=sensor.width_mm, depth=args.depth, depth_kind=args.depth_kind,
                        depth_unit=args.depth_unit, aperture=_aperture(args), dispersion=args.dispersion, tile=args.tile,
-                       step_px=args.depth_step, kernel_folder=args.kernel_cache, force=args.force)
+                       step_px=args.depth_step, kernel_folder=args.kernel_cache, edge_px=args.edge_px,
+                       force=args.force)
     if args.json:
         emit_json(document("defocus", res, units={"length": "mm", "time": "s"}))
         return 0
