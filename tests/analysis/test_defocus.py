@@ -191,3 +191,18 @@ def test_near_edges_is_a_max_filter_of_inverse_depth():
     assert (one[2:5, 2:5] == 2.0).all() and (one == 2.0).sum() == 9
     assert (near_edges(u, 2) == 2.0).sum() == 25
     assert near_edges(u, 0) is u
+
+
+def test_depth_nodes_step_grows_with_the_blur(cache):
+    """Hand-worked node spacing: with b_n = step (e^(rel n) - 1) / rel the blur difference between
+    nodes n and n + 1 is (step + rel b_n) (e^rel - 1) / rel, i.e. the step grows by ``rel`` of the
+    blur; the thin-lens blur D_ep f_pin |u - u_focus| / p is computed here from the pupil."""
+    cam = cache.camera
+    k = cam.pupil_diameter_mm * cam.pinhole_mm / cam.pitch_mm
+    s, rel = cam.step_px, cam.step_rel
+    assert rel == 0.05 and s == 1.0
+    n = np.arange(0, 40)
+    b = k * (cam.node_u(n) - cam.focus_u)
+    np.testing.assert_allclose(np.diff(b), (s + rel * b[:-1]) * math.expm1(rel) / rel, rtol=1e-9)
+    np.testing.assert_allclose(cam.node_index(cam.node_u(n)), n, atol=1e-9)
+    assert cam.node_u(cam.node_far()) == 0.0 and cam.node_u(cam.node_far() + 1) > 0.0

@@ -26,7 +26,7 @@ Known limits: (1) what the pinhole did not see (the background behind a foregrou
 invented: it is the background layer's mean colour over the tile; where no layer is behind
 (outside the tiles the background has pixels in) the result is renormalised by ``C / A``; (2) within one layer there is no self-occlusion;
 (3) the kernel is constant over a tile (field sampled every ``tile`` px) and linear in ``u``
-between nodes ``step_px`` of blur apart; (4) light from outside the frame is missing, so the
+between nodes ``step_px + step_rel b`` of blur apart; (4) light from outside the frame is missing, so the
 frame's edge is renormalised like (1); (5) the image must be linear light (scene-referred EXR).
 
 Cost: each (tile, layer) pair that holds pixels costs one FFT convolution of
@@ -117,7 +117,7 @@ def near_edges(u: np.ndarray, px: int = 1) -> np.ndarray:
 def _node_weights(u: np.ndarray, cam: DefocusCamera):
     """Each pixel's lower depth node and its weight on the node above (linear in u)."""
     n_far = cam.node_far()
-    lo = np.maximum(np.floor((u - cam.focus_u) / cam.du + 1e-9), n_far).astype(np.int64)
+    lo = np.maximum(np.floor(cam.node_index(u) + 1e-9), n_far).astype(np.int64)
     u_lo, u_hi = cam.node_u(lo), cam.node_u(lo + 1)
     w_hi = np.clip((u - u_lo) / (u_hi - u_lo), 0.0, 1.0)
     return lo, w_hi.astype(np.float32)

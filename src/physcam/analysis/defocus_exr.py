@@ -131,7 +131,8 @@ def write_exr(path, img: ExrImage, planes: dict, *, attributes=None, force: bool
 
 def defocus_file(image_path, output, lens, *, focus_mm: float, fstop: float, sensor_width_mm: float,
                  depth: str | None = None, depth_kind: str | None = None, depth_unit: str = "m", aperture=None,
-                 dispersion: bool = False, tile: int = 64, step_px: float = 1.0, cache=None, kernel_folder=None,
+                 dispersion: bool = False, tile: int = 64, step_px: float = 1.0, step_rel: float = 0.05, cache=None,
+                 kernel_folder=None,
                  edge_px: int = 1, force: bool = False) -> dict:
     """Defocus the EXR ``image_path`` through ``lens`` into ``output`` (see
     :mod:`physcam.analysis.defocus`). ``depth``: a channel of the image, or a separate EXR file
@@ -164,7 +165,8 @@ def defocus_file(image_path, output, lens, *, focus_mm: float, fstop: float, sen
     w, h = img.display_size
     if cache is None:
         cam = defocus_camera(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=sensor_width_mm, width=w, height=h,
-                             aperture=aperture, dispersion=dispersion, tile=tile, step_px=step_px)
+                             aperture=aperture, dispersion=dispersion, tile=tile, step_px=step_px,
+                             step_rel=step_rel)
         cache = KernelCache(cam, kernel_folder)
     cam = cache.camera
     if (cam.width, cam.height) != (w, h):

@@ -70,7 +70,9 @@ def _camera_options(p) -> None:
     p.add_argument("--dispersion", action="store_true", help="trace R, G, B at 620, 550, 460 nm (colour fringes)")
     p.add_argument("--tile", type=whole("tile", lo=0), default=64, metavar="PX", help="pixels between field nodes (default 64)")
     p.add_argument("--depth-step", type=number("depth step", positive=True), default=1.0, metavar="PX",
-                   help="blur-diameter step between depth nodes (default 1 px)")
+                   help="blur-diameter step between depth nodes near focus (default 1 px)")
+    p.add_argument("--depth-step-rel", type=number("relative depth step", lo=0, hi=0.5), default=0.05, metavar="F",
+                   help="the step grows by F times the blur diameter (default 0.05: 4 px at 60 px of blur; 0: uniform)")
     add_sensor_options(p)
 
 
@@ -108,7 +110,8 @@ def run(args) -> int:
     res = defocus_file(args.image, args.output, lens, focus_mm=args.focus, fstop=args.fstop,
                        sensor_width_mm=sensor.width_mm, depth=args.depth, depth_kind=args.depth_kind,
                        depth_unit=args.depth_unit, aperture=_aperture(args), dispersion=args.dispersion, tile=args.tile,
-                       step_px=args.depth_step, kernel_folder=args.kernel_cache, edge_px=args.edge_px,
+                       step_px=args.depth_step, step_rel=args.depth_step_rel, kernel_folder=args.kernel_cache,
+                       edge_px=args.edge_px,
                        force=args.force)
     if args.json:
         emit_json(document("defocus", res, units={"length": "mm", "time": "s"}))
@@ -135,7 +138,8 @@ def run_kernels(args) -> int:
     depths = [parse_distance(t, name="depth", allow_inf=True) for t in list_items(args.depths, "the depths", "1m,4m,inf")]
     cam = defocus_camera(lens, focus_mm=args.focus, fstop=args.fstop, sensor_width_mm=sensor.width_mm,
                          width=args.resolution[0], height=args.resolution[1], aperture=_aperture(args),
-                         dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step)
+                         dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step,
+                         step_rel=args.depth_step_rel)
     index = write_kernel_stack(args.output, cam, field_grid=args.field_grid, depths_mm=depths, force=args.force)
     if args.json:
         emit_json(document("defocus_kernels", index, units={"length": "mm"}))
