@@ -65,3 +65,26 @@ def test_patterns_are_checked(shot):
         sequence_frames(str(shot / "in.exr"))
     with pytest.raises(InputError, match="no frames match"):
         sequence_frames(str(shot / "in.#####.exr"))
+
+
+def test_cli_sequence_json_document(shot):
+    """``physcam defocus IN.####.exr -o OUT.####.exr --json``: the document validates against its
+    schema and names the frames; a second run skips them all."""
+    import json
+    import subprocess
+    import sys
+
+    import jsonschema
+
+    from physcam.cli._output import schema_file
+
+    args = [sys.executable, "-m", "physcam", "defocus", str(shot / "in.####.exr"), "--lens", "dgauss_50mm", "--focus",
+            "2m", "--fstop", "2.8", "--sensor-width", "36", "--sensor-height", "24", "--tile", "16", "--workers", "1",
+            "-o", str(shot / "o" / "d.####.exr"), "--json"]
+    (shot / "o").mkdir()
+    for done, skipped in (([7, 8, 9], []), ([], [7, 8, 9])):
+        p = subprocess.run(args, capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0, p.stderr
+        doc = json.loads(p.stdout)
+        jsonschema.validate(doc, json.loads(schema_file(doc["schema"]).read_text()))
+        assert (doc["frames_done"], doc["frames_skipped"]) == (done, skipped)
