@@ -39,8 +39,8 @@ def shot(tmp_path):
 
 
 def test_frames_match_one_by_one_and_rerun_skips(shot):
+    """Frames equal the one-by-one defocus; the output folder is made; reruns skip what exists."""
     out = str(shot / "out" / "dof.####.exr")
-    (shot / "out").mkdir()
     s = defocus_sequence(str(shot / "in.####.exr"), out, LENS, workers=1, **OPTS)
     assert s.done == [7, 8, 9] and s.skipped == []
     kernels = sorted((shot / "out" / "kernels").rglob("*.npz"))

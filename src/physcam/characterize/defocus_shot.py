@@ -86,6 +86,7 @@ def defocus_sequence(pattern: str, output_pattern: str, lens, *, kernel_folder=N
             todo[-1] = (number, path, target)
     if not todo:
         return out
+    todo[0][2].parent.mkdir(parents=True, exist_ok=True)
     first, rest = todo[0], todo[1:]
     _one_frame(str(first[1]), str(first[2]), lens, str(folder), force, options)  # traces the kernels once
     out.done.append(first[0])
