@@ -30,8 +30,8 @@ between nodes ``step_px + step_rel b`` of blur apart; (4) light from outside the
 frame's edge is renormalised like (1); (5) the image must be linear light (scene-referred EXR).
 
 Cost: each (tile, layer) pair that holds pixels costs one FFT convolution of
-(tile + 2R)^2 (R the kernel radius), ``channels + 1`` images: about
-``pairs x (tile + 2R)^2 log(tile + 2R) x (channels + 2)``; compositing costs the layers' blurred
+(tile + 2R)^2 (R the kernel radius), ``channels + 2`` images: about
+``pairs x (tile + 2R)^2 log(tile + 2R) x (channels + 3)``; compositing costs the layers' blurred
 areas. Kernels are traced once per (tile, node) and kept in the :class:`KernelCache`.
 """
 
