@@ -186,8 +186,6 @@ def _diameter_and_aspect(win):
     return math.sqrt(8 * (cxx + cyy)), math.sqrt(ev[0] / ev[1])
 
 
-@pytest.mark.xfail(reason="not yet within 3 %: measured centre 13.75 px vs 13.34 (+3.1 %), corner 11.62 vs 12.50 "
-                          "(-7 %); the cause is not found yet (docs/defocus.md, 'Not done')", strict=False)
 @pytest.mark.parametrize("where", ["centre", "corner"])
 def test_bokeh_diameter_matches_the_real_lens_render(scene, where):
     """The defocused pinhole render's bokeh of a sphere 0.45 m from the pupil has the diameter of

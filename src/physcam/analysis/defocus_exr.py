@@ -131,13 +131,15 @@ def write_exr(path, img: ExrImage, planes: dict, *, attributes=None, force: bool
 
 def defocus_file(image_path, output, lens, *, focus_mm: float, fstop: float, sensor_width_mm: float,
                  depth: str | None = None, depth_kind: str | None = None, depth_unit: str = "m", aperture=None,
-                 dispersion: bool = False, tile: int = 64, step_px: float = 1.0, cache=None, kernel_folder=None,
-                 force: bool = False) -> dict:
+                 dispersion: bool = False, tile: int = 64, step_px: float = 1.0, step_rel: float = 0.05, cache=None,
+                 kernel_folder=None,
+                 edge_px: int = 1, force: bool = False) -> dict:
     """Defocus the EXR ``image_path`` through ``lens`` into ``output`` (see
     :mod:`physcam.analysis.defocus`). ``depth``: a channel of the image, or a separate EXR file
     (its one depth channel) over the same data window; ``depth_kind`` defaults to ``inverse`` for a
     channel named ``depth.Z`` (Nuke) and ``planar`` otherwise (Blender's Z). ``cache``: a
-    :class:`~physcam.analysis.defocus_kernels.KernelCache` to share between frames. Returns a summary."""
+    :class:`~physcam.analysis.defocus_kernels.KernelCache` to share between frames; ``edge_px``: see
+    :func:`~physcam.analysis.defocus.defocus`. Returns a summary."""
     import time
 
     from .defocus import defocus, inverse_depth
@@ -163,7 +165,8 @@ def defocus_file(image_path, output, lens, *, focus_mm: float, fstop: float, sen
     w, h = img.display_size
     if cache is None:
         cam = defocus_camera(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=sensor_width_mm, width=w, height=h,
-                             aperture=aperture, dispersion=dispersion, tile=tile, step_px=step_px)
+                             aperture=aperture, dispersion=dispersion, tile=tile, step_px=step_px,
+                             step_rel=step_rel)
         cache = KernelCache(cam, kernel_folder)
     cam = cache.camera
     if (cam.width, cam.height) != (w, h):
@@ -172,7 +175,7 @@ def defocus_file(image_path, output, lens, *, focus_mm: float, fstop: float, sen
     rgb = np.stack([img.channels[n] for n in names], axis=2).astype(np.float32)
     u = inverse_depth(z, cam, kind=kind, unit=depth_unit, origin=img.origin)
     traced = cache.traced
-    out = defocus(rgb, u, cache, origin=img.origin)
+    out = defocus(rgb, u, cache, origin=img.origin, edge_px=edge_px)
     attrs = {"physcam/defocus": f"{lens.name} focus {focus_mm:g} mm from the film, f/{fstop:g}, sensor "
                                 f"{sensor_width_mm:g} mm wide; depth {zname} ({kind}, {depth_unit})"}
     write_exr(output, img, {n: out[..., i] for i, n in enumerate(names)}, attributes=attrs, force=force)

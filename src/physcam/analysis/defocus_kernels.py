@@ -20,9 +20,11 @@ a uniform wall renders 1 at the centre and its relative illumination elsewhere, 
 normalises it.
 
 Depth nodes are uniform in inverse depth ``u = 1/d`` (the blur diameter is linear in u), anchored
-at the focus and spaced so the blur diameter steps by ``step_px`` pixels:
-``du = step_px p / (D_ep f_pin)`` (p the pixel pitch, D_ep the entrance pupil diameter); the node
-below u = 0 is infinity. Field nodes are the centres of ``tile`` x ``tile`` pixel tiles.
+at the focus and spaced so the blur diameter ``b = k (u - u_focus)``, ``k = D_ep f_pin / p`` (p
+the pixel pitch, D_ep the entrance pupil diameter), steps by ``step_px + step_rel |b|`` pixels:
+node n sits at ``b_n = sign(n) step_px (exp(step_rel |n|) - 1) / step_rel`` (``n step_px`` when
+``step_rel`` is 0), so large blurs, where one pixel more is invisible, need few nodes. The node
+nearest u = 0 from above stands for infinity. Field nodes are the centres of ``tile`` x ``tile`` pixel tiles.
 """
 
 from __future__ import annotations
@@ -35,15 +37,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_positive
+from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["DefocusCamera", "defocus_camera", "Kernel", "KernelCache"]
 
 #: rays traced per kernel pixel (Owen-scrambled Sobol points: a clean histogram at a few dozen per bin)
 RAYS_PER_PIXEL = 48
-#: the depth of the "infinity" node, mm (1000 km: its blur equals infinity's to 1e-6 px)
-FAR_MM = 1.0e9
+#: the depth of the "infinity" node, mm (10 km: its blur differs from infinity's by
+#: D_ep f_pin 1e-7 / p, 0.001 px for a 50 mm f/2.8 on 0.1 mm pixels). Not farther: from 1e9 mm the
+#: traced rays lose precision and the kernel grows a halo tens of pixels wide
+FAR_MM = 1.0e7
 
 
 @dataclass
@@ -75,6 +79,7 @@ class DefocusCamera:
     dispersion: bool = False
     tile: int = 64
     step_px: float = 1.0
+    step_rel: float = 0.05
     # derived
     film_z: float = 0.0
     stop_semi: float = 0.0
@@ -96,30 +101,39 @@ class DefocusCamera:
         return 1.0 / (self.focus_mm - self.pupil_from_film_mm) if math.isfinite(self.focus_mm) else 0.0
 
     @property
-    def du(self) -> float:
-        """Inverse-depth spacing (1/mm) of the depth nodes."""
-        return self.step_px * self.pitch_mm / (self.pupil_diameter_mm * self.pinhole_mm)
+    def blur_per_u(self) -> float:
+        """k: blur diameter (px) per unit of inverse depth (1/mm), thin lens at the entrance pupil."""
+        return self.pupil_diameter_mm * self.pinhole_mm / self.pitch_mm
 
     def blur_px(self, depth_mm):
         """Thin-lens estimate of the blur diameter (px) at planar depth ``depth_mm`` from the pupil."""
         u = 1.0 / np.asarray(depth_mm, dtype=float)
-        return self.pupil_diameter_mm * self.pinhole_mm * np.abs(u - self.focus_u) / self.pitch_mm
+        return self.blur_per_u * np.abs(u - self.focus_u)
+
+    def node_index(self, u):
+        """The continuous node index t of inverse depth(s) ``u`` (nodes at whole t; module notes)."""
+        b = self.blur_per_u * (np.asarray(u, dtype=float) - self.focus_u)
+        if self.step_rel <= 0:
+            return b / self.step_px
+        return np.sign(b) * np.log1p(self.step_rel * np.abs(b) / self.step_px) / self.step_rel
 
     def node_far(self) -> int:
         """Index of the farthest node (it stands for infinity)."""
-        return -math.floor(self.focus_u / self.du + 1e-12) if self.focus_u > 0 else 0
+        return -math.floor(-float(self.node_index(0.0)) + 1e-12) if self.focus_u > 0 else 0
 
     def node_u(self, n):
         """Inverse depth (1/mm) of node(s) ``n``; the farthest node is infinity (0)."""
         n = np.asarray(n)
-        return np.where(n <= self.node_far(), 0.0, self.focus_u + n * self.du)
+        t = np.abs(n).astype(float)
+        b = self.step_px * (np.expm1(self.step_rel * t) / self.step_rel if self.step_rel > 0 else t)
+        return np.where(n <= self.node_far(), 0.0, self.focus_u + np.sign(n) * b / self.blur_per_u)
 
     def key(self) -> str:
         """A digest of everything the kernels depend on (the disk cache's folder name)."""
         ap = self.aperture
         ap = None if ap is None else [getattr(ap, k, None) for k in ("nsides", "angle_deg", "roundness", "density")]
         text = json.dumps([repr(self.lens), self.focus_mm, self.fstop, self.sensor_width_mm, self.width,
-                           self.height, ap, self.dispersion, self.tile, self.step_px, RAYS_PER_PIXEL], default=str)
+                           self.height, ap, self.dispersion, self.tile, self.step_px, self.step_rel, RAYS_PER_PIXEL], default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
     def film_point(self, x_px: float, y_px: float) -> tuple[float, float]:
@@ -191,10 +205,11 @@ def _trim(img: np.ndarray) -> np.ndarray:
 @takes_prescription
 def defocus_camera(lens: Prescription, *, focus_mm: float, fstop: float, sensor_width_mm: float, width: int,
                    height: int, aperture=None, dispersion: bool = False, tile: int = 64,
-                   step_px: float = 1.0) -> DefocusCamera:
+                   step_px: float = 1.0, step_rel: float = 0.05) -> DefocusCamera:
     """The :class:`DefocusCamera` for ``lens`` focused at the mark ``focus_mm`` (from the film) at
     f/``fstop``, a sensor ``sensor_width_mm`` wide imaged on ``width`` x ``height`` pixels (the
-    display window); ``tile`` px per field node, ``step_px`` the blur step between depth nodes."""
+    display window); ``tile`` px per field node; the blur step between depth nodes is
+    ``step_px + step_rel x`` the blur diameter (module notes)."""
     from ..optics.focusing import focus, iris_semi_diameter, technical_planes
     from .bokeh import RGB_WAVELENGTHS_NM
 
@@ -208,6 +223,9 @@ def defocus_camera(lens: Prescription, *, focus_mm: float, fstop: float, sensor_
     step = require_positive("depth step", step_px, unit="px")
     if not 0.1 <= step <= 16:
         raise InputError(f"the depth step must lie between 0.1 and 16 px of blur, got {step:g}")
+    rel = require_finite("relative depth step", step_rel)
+    if not 0 <= rel <= 0.5:
+        raise InputError(f"the relative depth step must lie between 0 and 0.5 of the blur, got {rel:g}")
     st = focus(lens, focus_mm)
     tp = technical_planes(lens, focus_mm, fstop=fstop)
     if tp.pinhole_focal_length_mm is None:
@@ -215,7 +233,7 @@ def defocus_camera(lens: Prescription, *, focus_mm: float, fstop: float, sensor_
     ap = _as_aperture(aperture)
     return DefocusCamera(lens=lens, focus_mm=float(focus_mm), fstop=float(fstop), sensor_width_mm=sw,
                          width=int(width), height=int(height), aperture=ap, dispersion=bool(dispersion),
-                         tile=int(tile), step_px=step, film_z=st.film_z, stop_semi=iris_semi_diameter(lens, fstop),
+                         tile=int(tile), step_px=step, step_rel=rel, film_z=st.film_z, stop_semi=iris_semi_diameter(lens, fstop),
                          focused=st.prescription, pupil_from_film_mm=tp.entrance_pupil_from_film_mm,
                          front_from_film_mm=tp.front_vertex_from_film_mm, pinhole_mm=tp.pinhole_focal_length_mm,
                          pupil_diameter_mm=tp.entrance_pupil_diameter_mm,

@@ -10,6 +10,11 @@ EPILOG = """\
 examples:
   physcam defocus render.exr --depth ViewLayer.Depth.Z --lens dgauss_50mm --focus 2m --fstop 2.8 -o dof.exr
   physcam defocus plate.exr --depth plate_depth.exr --depth-kind inverse --lens dgauss_50mm --focus 3m --fstop 4 -o dof.exr
+  physcam defocus shot/render.####.exr --lens dgauss_50mm --focus 2m --fstop 2.8 -o dof/dof.####.exr --workers 4
+
+A sequence (one run of # in IMAGE and OUT) runs frame-parallel on Dask (a local cluster, or
+--scheduler), the kernels shared in --kernel-cache (default OUT's folder/kernels); frames whose
+output exists are skipped unless --force.
 
 The render must be a pinhole at the lens's entrance pupil with the lens's best-match pinhole focal
 length at this focus (physcam report --lens L --focus F --json: pinhole) on the same sensor width.
@@ -24,7 +29,7 @@ def register(sub) -> None:
                                    "(field- and depth-dependent: size, cat's eye, iris, vignetting), depth layers "
                                    "composited back to front for occlusion, in linear light.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("image", metavar="IMAGE.exr", help="the pinhole render (linear light)")
+    p.add_argument("image", metavar="IMAGE.exr", help="the pinhole render (linear light), or a sequence IN.####.exr")
     p.add_argument("--depth", metavar="CHANNEL|DEPTH.exr", default=None,
                    help="the depth channel of IMAGE (default: its one Z / *.Depth.Z / depth.Z channel) or an EXR file")
     p.add_argument("--depth-kind", choices=("planar", "ray", "inverse"), default=None,
@@ -33,7 +38,15 @@ def register(sub) -> None:
     p.add_argument("--depth-unit", choices=("mm", "cm", "m", "in", "ft"), default="m",
                    help="the depth pass's unit (default m, Blender's scene unit)")
     _camera_options(p)
-    p.add_argument("-o", "--output", metavar="OUT.exr", required=True, help="the defocused EXR")
+    p.add_argument("-o", "--output", metavar="OUT.exr", required=True,
+                   help="the defocused EXR (OUT.####.exr for a sequence)")
+    p.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
+                   help="a sequence: run on an existing Dask cluster (default: a local cluster on this machine)")
+    p.add_argument("--workers", type=whole("workers", lo=1, hi=256), default=None, metavar="N",
+                   help="a sequence: worker processes of the local cluster (default: one per core)")
+    p.add_argument("--edge-px", type=whole("edge px", lo=0, hi=8), default=1, metavar="N",
+                   help="give pixels within N of a nearer one its depth (default 1): a render's antialiased edge "
+                        "pixels hold foreground light under the background's depth; 0 keeps the depth as given")
     p.add_argument("--kernel-cache", metavar="DIR", default=None,
                    help="keep traced kernels in DIR, shared by later frames of the shot")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
@@ -67,7 +80,9 @@ def _camera_options(p) -> None:
     p.add_argument("--dispersion", action="store_true", help="trace R, G, B at 620, 550, 460 nm (colour fringes)")
     p.add_argument("--tile", type=whole("tile", lo=0), default=64, metavar="PX", help="pixels between field nodes (default 64)")
     p.add_argument("--depth-step", type=number("depth step", positive=True), default=1.0, metavar="PX",
-                   help="blur-diameter step between depth nodes (default 1 px)")
+                   help="blur-diameter step between depth nodes near focus (default 1 px)")
+    p.add_argument("--depth-step-rel", type=number("relative depth step", lo=0, hi=0.5), default=0.05, metavar="F",
+                   help="the step grows by F times the blur diameter (default 0.05: 4 px at 60 px of blur; 0: uniform)")
     add_sensor_options(p)
 
 
@@ -102,10 +117,13 @@ def run(args) -> int:
     lens = load_lens(args.lens)
     sensor = resolve_sensor(args)
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
-    res = defocus_file(args.image, args.output, lens, focus_mm=args.focus, fstop=args.fstop,
-                       sensor_width_mm=sensor.width_mm, depth=args.depth, depth_kind=args.depth_kind,
-                       depth_unit=args.depth_unit, aperture=_aperture(args), dispersion=args.dispersion, tile=args.tile,
-                       step_px=args.depth_step, kernel_folder=args.kernel_cache, force=args.force)
+    opts = dict(focus_mm=args.focus, fstop=args.fstop, sensor_width_mm=sensor.width_mm, depth=args.depth,
+                depth_kind=args.depth_kind, depth_unit=args.depth_unit, aperture=_aperture(args),
+                dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step, step_rel=args.depth_step_rel,
+                edge_px=args.edge_px)
+    if "#" in args.image:
+        return _run_sequence(args, lens, opts)
+    res = defocus_file(args.image, args.output, lens, kernel_folder=args.kernel_cache, force=args.force, **opts)
     if args.json:
         emit_json(document("defocus", res, units={"length": "mm", "time": "s"}))
         return 0
@@ -113,6 +131,24 @@ def run(args) -> int:
           f"({res['kernels_traced']} kernels traced, {res['seconds']:.1f} s); pinhole {res['pinhole_focal_length_mm']:.3f} mm "
           f"at the entrance pupil, {res['entrance_pupil_from_film_mm']:.3f} mm in front of the film")
     print(f"wrote {res['output']}")
+    return 0
+
+
+def _run_sequence(args, lens, opts) -> int:
+    from ..extras import require_extra
+
+    require_extra("dask", "a sequence on Dask (physcam defocus IN.####.exr)")
+    from ..characterize.defocus_shot import defocus_sequence
+
+    s = defocus_sequence(args.image, args.output, lens, kernel_folder=args.kernel_cache, scheduler=args.scheduler,
+                         workers=args.workers, force=args.force, **opts)
+    res = {"images": args.image, "outputs": args.output, "lens": lens.name, "frames_done": s.done,
+           "frames_skipped": s.skipped, "kernel_cache": s.kernel_folder, "dashboard": s.dashboard}
+    if args.json:
+        emit_json(document("defocus_sequence", res, units={"length": "mm"}))
+        return 0
+    print(f"{lens.name}: {len(s.done)} frame(s) defocused, {len(s.skipped)} skipped (output there; --force redoes "
+          f"them); kernels in {s.kernel_folder}")
     return 0
 
 
@@ -131,7 +167,8 @@ def run_kernels(args) -> int:
     depths = [parse_distance(t, name="depth", allow_inf=True) for t in list_items(args.depths, "the depths", "1m,4m,inf")]
     cam = defocus_camera(lens, focus_mm=args.focus, fstop=args.fstop, sensor_width_mm=sensor.width_mm,
                          width=args.resolution[0], height=args.resolution[1], aperture=_aperture(args),
-                         dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step)
+                         dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step,
+                         step_rel=args.depth_step_rel)
     index = write_kernel_stack(args.output, cam, field_grid=args.field_grid, depths_mm=depths, force=args.force)
     if args.json:
         emit_json(document("defocus_kernels", index, units={"length": "mm"}))
