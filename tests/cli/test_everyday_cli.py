@@ -221,3 +221,15 @@ def test_refusals_name_what_is_wrong(capsys, argv, says):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("physcam: error:") and says in err[0], err
+
+
+def test_the_dof_card_carries_the_dof_chart(tmp_path, capsys):
+    """Issue 32: the dof-table card draws the DOF chart of the set's apps under its table (the chart of
+    `report --plot`), a band per stop of the table; tests/test_figures_style.py checks its text fits."""
+    card = tmp_path / "card.svg"
+    assert main(["dof-table", "--focal", "35", "--fstops", "2.8,5.6", "--focus", "2m", "--sensor", "ALEXA 35",
+                 "-o", str(card)]) == 0
+    capsys.readouterr()
+    text = card.read_text(encoding="utf-8")
+    assert "focus mark from the film plane" in text and "near and far limits" in text
+    assert "H f/2.8" in text and "H f/5.6" in text  # each stop's hyperfocal marked on the chart

@@ -197,7 +197,7 @@ def run(args) -> int:
 
         d = mark_repaired(d, args.loaded_lens)
     if args.output:
-        card(d, args.output, units=units, force=args.force)
+        card(d, args.output, units=units, force=args.force, chart=_card_chart(args))
     if args.json:
         emit_json(document("dof_table", d))
         return 0
@@ -221,17 +221,45 @@ def run(args) -> int:
     return 0
 
 
-def card(d, path, *, units: str = "m", force: bool = False):
+def _card_chart(args):
+    """(report, chart data) of the DOF chart under the card's table: the table's stops (up to six; else
+    the chart's own around the first) against focus, every cell a report as the table's."""
+    import warnings
+
+    from ..errors import PhysCamWarning
+    from ..onset.dof_plot import chart_fstops, dof_chart_data
+    from ._common import resolve_sensor
+
+    lens, sensor = getattr(args, "loaded_lens", None), resolve_sensor(args)
+    marks = [m for m in (args.focus or []) if isinstance(m, float) and math.isfinite(m)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PhysCamWarning)
+        report = cell_report(args, lens, sensor, args.fstops[0], marks[len(marks) // 2] if marks else 3000.0)
+        stops = list(args.fstops) if len(args.fstops) <= 6 else chart_fstops(report.fstop)
+        data = dof_chart_data(report, lambda n, m: cell_report(args, lens, sensor, n, m), fstops=stops)
+    return report, data
+
+
+def card(d, path, *, units: str = "m", force: bool = False, chart=None):
     """A printable depth-of-field card (A5 landscape): focus marks down, f-stops across, near / far /
-    total in each cell, hyperfocal at the foot; PDF, PNG or SVG through :func:`physcam.figures.save_figure`."""
+    total in each cell, hyperfocal at the foot; with ``chart`` (a report and its
+    :func:`physcam.onset.dof_plot.dof_chart_data`), the DOF chart of the set's apps below the table;
+    PDF, PNG or SVG through :func:`physcam.figures.save_figure`."""
 
     from ..figures import new_figure, save_figure
     from ..units import format_distance
 
     labels, heads, cells = grid(d, units)
     nrow, ncol = len(labels) + 2, len(heads) + 1
-    fig = new_figure(figsize=(8.27, min(11.0, max(3.0, 0.5 * nrow + 0.9))))  # A5 landscape width, taller for long tables
-    ax = fig.add_axes((0.03, 0.06, 0.94, 0.86))
+    table_in = min(11.0, max(3.0, 0.5 * nrow + 0.9))  # A5 landscape width, taller for long tables
+    chart_in = 4.2 if chart is not None else 0.0
+    fig = new_figure(figsize=(8.27, table_in + chart_in))
+    h = table_in + chart_in
+    ax = fig.add_axes((0.03, (chart_in + 0.06 * table_in) / h, 0.94, (0.86 * table_in - 0.25) / h))  # 2 title lines
+    if chart is not None:
+        from ..onset.dof_plot import draw_dof_chart
+
+        draw_dof_chart(fig.add_axes((0.09, 0.75 / h, 0.88, (chart_in - 1.1) / h)), *chart, units=units)
     ax.set_axis_off()
     text = [["focus", *heads]]
     for lab, row in zip(labels, cells):
@@ -245,7 +273,9 @@ def card(d, path, *, units: str = "m", force: bool = False):
         if r in (0, nrow - 1) or c == 0:
             cell.set_facecolor("#e8eef5")
             cell.set_text_props(weight="bold")
-    fig.suptitle(_title(d, units), fontsize=8)
-    fig.text(0.5, 0.015, "each cell: near / far / (total depth of field); physcam dof-table", ha="center", fontsize=6,
+    from ..figures import fit_title
+
+    fig.suptitle(fit_title(_title(d, units), 0.95 * 8.27, fontsize=8), fontsize=8)
+    fig.text(0.5, 0.08 / h, "each cell: near / far / (total depth of field); physcam dof-table", ha="center", fontsize=6,
              color="0.35")
     return save_figure(fig, path, force=force)

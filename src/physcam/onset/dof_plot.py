@@ -180,16 +180,28 @@ def dof_chart_figure(report, solve, *, fstops=None, size_in=(7.0, 4.6), units: s
     (or pass ``data`` from :func:`dof_chart_data`). A matplotlib Figure on an Agg canvas; the chart's
     numbers are in ``fig.physcam_chart`` (what the web page's cursor reads)."""
     from ..errors import UnitError
-    from ..figures import PALETTE, fit_title, new_figure
-    from ..units import format_distance
+    from ..figures import fit_title, new_figure
 
     if units not in _AXIS:
         raise UnitError(f"units must be one of {', '.join(_AXIS)}, got {units!r}")
     data = dof_chart_data(report, solve, fstops=fstops) if data is None else data
-    lo, hi = data["range_mm"]
-    top = hi * 1.6  # far limits at infinity are drawn to the top edge
     fig = new_figure(figsize=tuple(size_in), dpi=120)
     ax = fig.add_subplot(1, 1, 1)
+    draw_dof_chart(ax, report, data, units=units)
+    ax.set_title(fit_title(plot_title(report, units), 0.8 * size_in[0]))
+    fig.tight_layout()
+    fig.physcam_chart = _chart_numbers(ax, data, units)
+    return fig
+
+
+def draw_dof_chart(ax, report, data, *, units: str = "m") -> None:
+    """Draw the chart (:func:`dof_chart_figure`) of :func:`dof_chart_data` ``data`` into ``ax``: a band per
+    stop, each hyperfocal, the report's focus and limits; log axes with ticks a person reads."""
+    from ..figures import PALETTE
+    from ..units import format_distance
+
+    lo, hi = data["range_mm"]
+    top = hi * 1.6  # far limits at infinity are drawn to the top edge
     colours = [PALETTE[i] for i in (0, 2, 3, 4, 5, 1)]
     order = {n: k for k, n in enumerate(data["fstops"])}
     for n in reversed(data["fstops"]):  # slowest (widest band) first, underneath
@@ -229,10 +241,6 @@ def dof_chart_figure(report, solve, *, fstops=None, size_in=(7.0, 4.6), units: s
     handles, labels = ax.get_legend_handles_labels()
     by_stop = sorted(zip(handles, labels), key=lambda hl: float(hl[1][2:]) if hl[1].startswith("f/") else 1e9)
     ax.legend([h for h, _ in by_stop], [lab for _, lab in by_stop], loc="upper left", ncol=2, fontsize=6.5, title="bands: sharp from near to far", title_fontsize=6.5)
-    ax.set_title(fit_title(plot_title(report, units), 0.8 * size_in[0]))
-    fig.tight_layout()
-    fig.physcam_chart = _chart_numbers(ax, data, units)
-    return fig
 
 
 def _chart_numbers(ax, data, units: str) -> dict:
