@@ -3,6 +3,7 @@
 import os
 import tempfile
 
+import pytest
 from hypothesis import HealthCheck, settings
 
 # Tests never read the real user's physcam config (~/.config/physcam/config.toml): every process of
@@ -21,3 +22,17 @@ import physcam.usd  # noqa: F401  (registers the PhysicalCamera plugin on import
 settings.register_profile("physcam", deadline=None, suppress_health_check=[HealthCheck.too_slow],
                           derandomize=True)
 settings.load_profile("physcam")
+
+
+@pytest.fixture(scope="session")
+def extension_zip(tmp_path_factory):
+    """``physcam export blender-extension`` of every bundled lens, built once per test session and shared
+    by the Blender extension's tests (building it solves every bundled lens's focus table, the slowest
+    step). Here, not in tests/blender/conftest.py: with --doctest-modules two conftest modules of one
+    name collide."""
+    from physcam.cli import main
+
+    out = tmp_path_factory.mktemp("ext")
+    assert main(["export", "blender-extension", "-o", str(out)]) == 0
+    (zp,) = out.glob("physcam-*.zip")
+    return zp

@@ -303,7 +303,11 @@ def test_a_cell_the_optics_refuse_fails_alone(cluster, tmp_path, capsys):
 
     grid = tiny(kinds=("lens", "distortion"))
     s = characterize(["nikkor_fisheye_16mm_f2_8"], grid, tmp_path, scheduler=cluster.scheduler_address)
-    assert [f["kind"] for f in s.failed] == ["distortion", "distortion"] and "fisheye" in s.failed[0]["error"]
+    # the cells finish in any order on the cluster: one refuses the fisheye's pinhole reach, the other (a
+    # focus where no chief ray reaches the frame's corner) says the lens does not cover the sensor
+    assert [f["kind"] for f in s.failed] == ["distortion", "distortion"]
+    assert any("fisheye" in f["error"] for f in s.failed)
+    assert all("fisheye" in f["error"] or "does not cover" in f["error"] for f in s.failed)
     assert s.computed == 1 and s.usd == [] and not (tmp_path / "nikkor_fisheye_16mm_f2_8" /
                                                     "nikkor_fisheye_16mm_f2_8.usda").exists()
     assert [r["kind"] for r in _index_rows(tmp_path)] == ["lens"]  # no failed cell counted as done

@@ -75,7 +75,8 @@ def test_fits_in_json_and_their_files(tmp_path, capsys):
     assert check_document(brown) == "physcam.distortion_brown_conrady"
     entries = brown["opentrackio_lens_distortion"]
     assert [e["model"] for e in entries] == ["Brown-Conrady D-U", "Brown-Conrady U-D"]
-    assert all(len(e["radial"]) == 3 and len(e["tangential"]) == 2 for e in entries)
+    # six radial terms in OpenLensIO order, what Unreal and camdkit read (issue 31; tests/live/test_interop.py)
+    assert all(len(e["radial"]) == 6 and len(e["tangential"]) == 2 for e in entries)
     assert entries[0]["radial"][0] > 0 > entries[1]["radial"][0]  # barrel: D-U grows the radius, U-D shrinks it
 
 

@@ -103,6 +103,10 @@ def near_edges(u: np.ndarray, px: int = 1) -> np.ndarray:
     so a bright foreground's edge light would be blurred as background; taking the nearer depth
     blurs it with the foreground instead (the background's part of that pixel then moves with the
     foreground: an error of at most ``px`` pixels along the edge)."""
+    if not isinstance(u, np.ndarray) or u.ndim != 2:
+        from ..errors import WrongTypeError
+
+        raise WrongTypeError(f"near_edges takes an (h, w) numpy array of inverse depths, got {u!r:.60}")
     if px <= 0:
         return u
     h, w = u.shape

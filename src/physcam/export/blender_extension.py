@@ -73,6 +73,9 @@ def _report_rows(lens, marks_mm) -> list[dict]:
 
 def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
     """(the lens's JSON table, its four shaders by file name) for the zip."""
+    from ..errors import require_type
+
+    require_type("slug", slug, str, "the lens's name in the zip, e.g. 'dgauss_50mm'")
     from .blender_focus import focus_table, focus_table_shader
 
     ft = focus_table(lens)
