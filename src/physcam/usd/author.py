@@ -170,10 +170,10 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
 
     require_stage(stage)
     spec = require_type("spec", spec, CameraSpec, "build one with CameraSpec(...) or spec_from_report").checked()
-    try:
+    sdf_path = Sdf.Path()
+    # checked as text first: Sdf.Path() of an ill-formed string prints USD's own warning on stderr
+    if isinstance(path, str) and Sdf.Path.IsValidPathString(path)[0]:
         sdf_path = Sdf.Path(path)
-    except Exception:  # pxr raises Tf errors of several kinds for bad paths
-        sdf_path = Sdf.Path()
     if sdf_path.isEmpty or not sdf_path.IsAbsolutePath() or not sdf_path.IsPrimPath():
         raise ExportError(f"camera path {path!r} is not an absolute prim path such as /Cameras/Hero")
     existing = stage.GetPrimAtPath(sdf_path)
