@@ -232,3 +232,19 @@ def test_rectilinear_lens_real_field_agrees_and_does_not_warn():
     # barrel distortion of about 1 %: real and pinhole fields within the 2 % tolerance
     assert r.real_fov["horizontal_deg"] == pytest.approx(r.hfov_focus_deg, rel=0.02)
     assert not r.real_fov_differs
+
+
+def test_a_flange_distance_only_moves_offsets_given_from_the_flange():
+    """Datasheet offsets are in front of their reference plane (docs/conventions.md): from the film, a
+    flange focal distance given beside them changes nothing; from the flange, H1 = FFD + offset (by hand:
+    52 + 10 = 62 mm). The request and solvers of issue 28 keep this."""
+    from physcam.onset.report import solve_lens_report
+    from physcam.onset.sensors import find_sensor
+
+    s = find_sensor("ALEXA 35")
+    film = solve_lens_report(focal_length_mm=50, fstop=2.8, focus_mm=3000, sensor=s, model="technical", h1_mm=60,
+                             h2_mm=45, flange_focal_distance_mm=52)
+    assert film.h1_from_film_mm == 60.0 and film.flange_focal_distance_mm is None
+    flange = solve_lens_report(focal_length_mm=50, fstop=2.8, focus_mm=3000, sensor=s, model="technical", h1_mm=10,
+                               h2_mm=-5, flange_focal_distance_mm=52, reference_plane="flange")
+    assert flange.h1_from_film_mm == 62.0 and flange.h2_from_film_mm == 47.0 and flange.flange_focal_distance_mm == 52

@@ -346,7 +346,8 @@ def solve_report(request: ReportRequest) -> LensReport:
         entrance_pupil_source=pupil_src, solved=solved, measured=_measured(req),
         notes=(*notes, *dof.notes, *error_notes, *pupil_notes), lens_name=state.lens_name,
         reference_plane="film" if req.lens is not None else req.reference_plane,
-        flange_focal_distance_mm=req.flange_focal_distance_mm, tstop=req.tstop,
+        flange_focal_distance_mm=req.flange_focal_distance_mm if req.reference_plane == "flange" else None,
+        tstop=req.tstop,
         stop_from_film_mm=state.stop_from_film_mm if req.lens is not None else (
             h1_film if state.model == "practical" else None),
         dof_aspect=dof.blur_aspect, diffraction_wavelength_nm=req.diffraction_wavelength_nm,

@@ -131,7 +131,7 @@ def lens_at_mark(req: ReportRequest) -> LensState:
     """The lens at the mark. A prescription is focused there (physcam.optics.focusing): its EFL, H1,
     H2 and entrance pupil replace a datasheet's; without an f-stop or limits it is wide open."""
     if req.lens is None:
-        ref = req.flange_focal_distance_mm or 0.0
+        ref = req.flange_focal_distance_mm if req.reference_plane == "flange" else 0.0  # offsets' plane
 
         def at(v):  # a datasheet offset, from the film
             return None if v is None else ref + v
