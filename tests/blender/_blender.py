@@ -50,6 +50,20 @@ for _p in glob.glob(bpy.utils.resource_path("LOCAL") + "/python/lib/python3*/sit
 """
 
 
+#: The start of a script run through the installed physcam extension (argv[1]: its zip): installed with
+#: Blender's own installer, Cycles on the CPU with 2 threads, no denoising, linear EXR out.
+INSTALLED_EXTENSION_SCENE = """
+import json, math, sys
+import numpy as np
+bpy.ops.extensions.package_install_files(filepath=sys.argv[1], repo="user_default", enable_on_install=True)
+scene = bpy.context.scene
+scene.render.engine = "CYCLES"; scene.cycles.device = "CPU"; scene.cycles.use_denoising = False
+scene.render.threads_mode = "FIXED"; scene.render.threads = 2
+scene.view_settings.view_transform = "Standard"
+scene.render.image_settings.file_format = "OPEN_EXR"
+"""
+
+
 def run_blender(script: str, *args, timeout: float = 300.0, env: dict | None = None) -> dict:
     """Run ``script`` (Python source) in Blender; it must print one JSON object on its last stdout line,
     which is returned. The source tree under test comes first on sys.path; ``env`` adds variables."""

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from _blender import run_blender
+from _blender import INSTALLED_EXTENSION_SCENE, run_blender
 from physcam.analysis.blob import blob_moments, polygon_corners
 from physcam.analysis.bokeh import bokeh_image
 from physcam.lens.library import load_lens
@@ -25,15 +25,7 @@ LENS, MARK_MM, FSTOP, BLADES, CORNER_DEG = "dgauss_50mm", 2000.0, 2.8, 6, 15.0
 NEAR_MM, SPHERE_M = 700.0, 0.001  # the sphere: mm from the film, radius (m)
 CROP_MM, CROP_PX = 3.0, 128
 
-BOKEH = '''
-import json, sys
-import numpy as np
-bpy.ops.extensions.package_install_files(filepath=sys.argv[1], repo="user_default", enable_on_install=True)
-scene = bpy.context.scene
-scene.render.engine = "CYCLES"; scene.cycles.device = "CPU"; scene.cycles.use_denoising = False
-scene.render.threads_mode = "FIXED"; scene.render.threads = 2
-scene.view_settings.view_transform = "Standard"
-scene.render.image_settings.file_format = "OPEN_EXR"
+BOKEH = INSTALLED_EXTENSION_SCENE + '''
 scene.cycles.max_bounces = 0
 scene.cycles.pixel_filter_type = "BOX"; scene.cycles.filter_width = 1.0
 for o in list(bpy.data.objects):

@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pytest
 
-from _blender import run_blender
+from _blender import INSTALLED_EXTENSION_SCENE, run_blender
 from physcam.analysis.colour import chromatic_aberration
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus
@@ -26,15 +26,7 @@ SLUG, FSTOP, FIELD_DEG = "zuiko_18mm_f3_5", 8.0, 48.0
 SW, W, H = 36.0, 512, 342
 SH = SW * H / W
 
-COLOUR = '''
-import json, math, sys
-import numpy as np
-bpy.ops.extensions.package_install_files(filepath=sys.argv[1], repo="user_default", enable_on_install=True)
-scene = bpy.context.scene
-scene.render.engine = "CYCLES"; scene.cycles.device = "CPU"; scene.cycles.use_denoising = False
-scene.render.threads_mode = "FIXED"; scene.render.threads = 2
-scene.view_settings.view_transform = "Standard"
-scene.render.image_settings.file_format = "OPEN_EXR"
+COLOUR = INSTALLED_EXTENSION_SCENE + '''
 for o in list(bpy.data.objects):
     if o.type != "CAMERA":
         bpy.data.objects.remove(o)

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from _blender import run_blender
+from _blender import INSTALLED_EXTENSION_SCENE, run_blender
 from physcam.export.blender import bake_camera
 from physcam.lens.library import load_lens
 from physcam.trace.trace import camera_rays
@@ -24,15 +24,7 @@ LENS, SW, SH, W, H = "dgauss_50mm", 36.0, 24.0, 36, 24
 FSTOPS = (2.8, 4.5, 8.0)
 BLOCKS = {"centre": (10, 14, 16, 20), "right": (10, 14, 31, 35), "corner": (0, 3, 0, 3)}
 
-WHITE = '''
-import json, sys
-import numpy as np
-bpy.ops.extensions.package_install_files(filepath=sys.argv[1], repo="user_default", enable_on_install=True)
-scene = bpy.context.scene
-scene.render.engine = "CYCLES"; scene.cycles.device = "CPU"; scene.cycles.use_denoising = False
-scene.render.threads_mode = "FIXED"; scene.render.threads = 2
-scene.view_settings.view_transform = "Standard"
-scene.render.image_settings.file_format = "OPEN_EXR"
+WHITE = INSTALLED_EXTENSION_SCENE + '''
 scene.cycles.filter_width = 0.01  # a pixel averages its own film area
 for o in list(bpy.data.objects):
     if o.type != "CAMERA":

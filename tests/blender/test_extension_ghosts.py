@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from _blender import run_blender
+from _blender import INSTALLED_EXTENSION_SCENE, run_blender
 from physcam.analysis.ghosts import ghost_analysis, ghost_pairs
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus, iris_semi_diameter
@@ -22,15 +22,7 @@ SLUG, FSTOP, FIELD_DEG = "dgauss_50mm", 2.8, 8.0
 SW, W, H = 36.0, 256, 171
 SH = SW * H / W
 
-GHOSTS = '''
-import json, math, sys
-import numpy as np
-bpy.ops.extensions.package_install_files(filepath=sys.argv[1], repo="user_default", enable_on_install=True)
-scene = bpy.context.scene
-scene.render.engine = "CYCLES"; scene.cycles.device = "CPU"; scene.cycles.use_denoising = False
-scene.render.threads_mode = "FIXED"; scene.render.threads = 2
-scene.view_settings.view_transform = "Standard"
-scene.render.image_settings.file_format = "OPEN_EXR"
+GHOSTS = INSTALLED_EXTENSION_SCENE + '''
 for o in list(bpy.data.objects):
     if o.type != "CAMERA":
         bpy.data.objects.remove(o)
