@@ -80,3 +80,30 @@ def run_blender(script: str, *args, timeout: float = 300.0, env: dict | None = N
     if not lines:
         raise AssertionError(f"Blender script printed no JSON:\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}")
     return json.loads(lines[-1])
+
+
+def predicted_block_brightness(b, blocks: dict, w_px: int, h_px: int, sensor_mm, samples: int = 96) -> dict:
+    """physcam's own prediction of a white world's brightness in pixel ``blocks`` ({name: (row0, row1,
+    col0, col1)}, rows from the bottom) of a ``w_px`` x ``h_px`` render through the baked camera ``b``
+    (physcam.export.blender.bake_camera): the mean camera_rays weight over a ``samples``^2 pupil grid at
+    each pixel's film point, over the shader's normalisation. The picture is upright, so pixel (c, r)
+    reads the film at (-(2u - 1) w/2, -(2v - 1) h/2)."""
+    import numpy as np
+
+    from physcam.trace.trace import camera_rays
+
+    sw, sh = sensor_mm
+    u = (np.arange(samples) + 0.5) / samples
+    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
+    predicted = {}
+    for k, (r0, r1, c0, c1) in blocks.items():
+        vals = []
+        for r in range(r0, r1):
+            for c in range(c0, c1):
+                fx = -(2 * (c + 0.5) / w_px - 1) * sw / 2
+                fy = -(2 * (r + 0.5) / h_px - 1) * sh / 2
+                cr = camera_rays(b.lens, np.tile([fx, fy], (uu.size, 1)), np.stack([uu, vv], 1), b.film_z,
+                                 bounds=b.bounds)
+                vals.append(cr.weight.mean() / b.norm)
+        predicted[k] = float(np.mean(vals))
+    return predicted

@@ -15,12 +15,12 @@ import time
 import numpy as np
 import pytest
 
-from _blender import run_blender
+from _blender import predicted_block_brightness, run_blender
 from physcam.export.blender import bake_camera, blender_setup_script, osl_camera_shader
 from physcam.lens.library import list_lenses, load_lens
 from physcam.optics.paraxial import gaussian
 from physcam.trace.rays import RayBatch
-from physcam.trace.trace import camera_rays, trace_to_film
+from physcam.trace.trace import trace_to_film
 
 pytestmark = pytest.mark.slow
 
@@ -205,20 +205,7 @@ def test_exposure_follows_physcams_relative_illumination(tmp_path):
     # so pixel (c, r) reads the film at (-(2u - 1) w/2, -(2v - 1) h/2)
     blocks = {"centre": (10, 14, 16, 20), "right": (10, 14, 31, 35), "top": (19, 23, 16, 20),
               "corner": (0, 3, 0, 3)}
-    m = 96
-    u = (np.arange(m) + 0.5) / m
-    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
-    predicted = {}
-    for k, (r0, r1, c0, c1) in blocks.items():
-        vals = []
-        for r in range(r0, r1):
-            for c in range(c0, c1):
-                fx = -(2 * (c + 0.5) / W - 1) * sw / 2
-                fy = -(2 * (r + 0.5) / H - 1) * sh / 2
-                cr = camera_rays(b.lens, np.tile([fx, fy], (uu.size, 1)), np.stack([uu, vv], 1), b.film_z,
-                                 bounds=b.bounds)
-                vals.append(cr.weight.mean() / b.norm)
-        predicted[k] = float(np.mean(vals))
+    predicted = predicted_block_brightness(b, blocks, W, H, (sw, sh))
     out = run_blender(SCENE + '''
 set_world(1.0)
 scene.cycles.shading_system = True

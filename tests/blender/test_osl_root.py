@@ -16,14 +16,12 @@ from __future__ import annotations
 import json
 import math
 
-import numpy as np
 import pytest
 
-from _blender import run_blender
+from _blender import predicted_block_brightness, run_blender
 from test_blender_camera import SCENE
 from physcam.export.blender import bake_camera, osl_camera_shader
 from physcam.lens.library import load_lens
-from physcam.trace.trace import camera_rays
 
 pytestmark = pytest.mark.slow
 
@@ -70,20 +68,7 @@ def test_rays_from_beside_a_deep_bowl_pass_as_in_the_tracer(tmp_path):
     b = bake_camera(lens, focus_mm=math.inf, sensor_width_mm=sw, sensor_height_mm=sh)
     src = osl_camera_shader(lens, focus_mm=math.inf, sensor_width_mm=sw, sensor_height_mm=sh)
     blocks = {"centre": (10, 14, 16, 20), "left": (10, 14, 0, 3), "right": (10, 14, 33, 36)}
-    m = 96
-    u = (np.arange(m) + 0.5) / m
-    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
-    predicted = {}
-    for k, (r0, r1, c0, c1) in blocks.items():
-        vals = []
-        for r in range(r0, r1):
-            for c in range(c0, c1):
-                fx = -(2 * (c + 0.5) / W - 1) * sw / 2
-                fy = -(2 * (r + 0.5) / H - 1) * sh / 2
-                cr = camera_rays(b.lens, np.tile([fx, fy], (uu.size, 1)), np.stack([uu, vv], 1), b.film_z,
-                                 bounds=b.bounds)
-                vals.append(cr.weight.mean() / b.norm)
-        predicted[k] = float(np.mean(vals))
+    predicted = predicted_block_brightness(b, blocks, W, H, (sw, sh))
     (tmp_path / "cam.osl").write_text(src)
     out = run_blender(SCENE + '''
 set_world(1.0)

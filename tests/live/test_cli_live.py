@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import csv
 import json
-import socket
 import subprocess
 import sys
 import time
@@ -16,6 +15,7 @@ from physcam.cli import main
 from physcam.live.camera import camera_frames, frames_to_samples
 from physcam.live.sender import Sender
 from physcam.onset.sensors import find_sensor
+from _udp import free_port, wait_for_port
 
 DATA = Path(__file__).parent / "data"
 
@@ -32,20 +32,12 @@ def test_validate_examples_and_a_broken_sample(tmp_path, capsys):
                                                 "message": "0 is less than or equal to the minimum of 0.0"}
 
 
-def _free_port() -> int:
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
 @pytest.mark.slow
 def test_record_a_sent_take(tmp_path):
     pytest.importorskip("pxr")
     from pxr import Usd
 
-    port = _free_port()
+    port = free_port()
     out, rep = tmp_path / "take.usda", tmp_path / "take.csv"
     proc = subprocess.Popen([sys.executable, "-m", "physcam", "live", "record", str(out), "--port", str(port),
                              "--host", "127.0.0.1", "--count", "30", "--duration", "60", "--report", str(rep),
@@ -112,15 +104,6 @@ def test_multicast_on_loopback():
     assert {g.encoding for g in got} == {"cbor"}
 
 
-def _wait_for_port(proc, port):
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline and proc.poll() is None:  # until the recorder holds the port
-        with open("/proc/net/udp") as f:  # local_address is ADDR:PORT in hex
-            if any(line.split()[1].endswith(f":{port:04X}") for line in f.readlines()[1:]):
-                return
-        time.sleep(0.1)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP", "SIGINT"])
 def test_a_signal_ends_the_recording_and_the_take_is_written(tmp_path, sig):
@@ -133,7 +116,7 @@ def test_a_signal_ends_the_recording_and_the_take_is_written(tmp_path, sig):
     pytest.importorskip("pxr")
     from pxr import Usd
 
-    port = _free_port()
+    port = free_port()
     out = tmp_path / "take.usda"
     proc = subprocess.Popen([sys.executable, "-m", "physcam", "live", "record", str(out), "--port", str(port),
                              "--host", "127.0.0.1", "--duration", "120", "--json"],
@@ -143,7 +126,7 @@ def test_a_signal_ends_the_recording_and_the_take_is_written(tmp_path, sig):
     samples = list(frames_to_samples(frames))
     samples[5]["lens"]["fStop"] = 1e308
     samples[9]["lens"]["fStop"] = Decimal("1e5000")
-    _wait_for_port(proc, port)
+    wait_for_port(proc, port)
     with Sender("127.0.0.1", port, encoding="cbor") as tx:
         tx.stream(samples, 240)
     time.sleep(1.5)

@@ -20,6 +20,7 @@ import pytest
 
 from physcam.cli import main
 from physcam.live.sample import decode_sample
+from _udp import free_port, wait_for_port
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "camera-metadata"
 ARRI = DATA / "arri" / "B001C001_180327_R1ZA.mov.csv"
@@ -40,36 +41,15 @@ def _red_columns():
                                                                                       for r in rows]
 
 
-def _free_port() -> int:
-    import socket
-
-    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
-def _wait_for_port(proc, port):
-    import time
-
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline and proc.poll() is None:  # until the recorder holds the port
-        with open("/proc/net/udp") as f:  # local_address is ADDR:PORT in hex
-            if any(line.split()[1].endswith(f":{port:04X}") for line in f.readlines()[1:]):
-                return
-        time.sleep(0.1)
-
-
 def _record(tmp_path, count, send_args, *record_args):
     """Start `live record` for ``count`` samples, run ``send_args`` (a physcam command line, in this
     process) at its port, and return the lens report's rows."""
-    port = _free_port()
+    port = free_port()
     out, rep = tmp_path / "take.usda", tmp_path / "take.csv"
     proc = subprocess.Popen([sys.executable, "-m", "physcam", "live", "record", str(out), "--port", str(port),
                              "--host", "127.0.0.1", "--count", str(count), "--duration", "60", "--report", str(rep),
                              "--json", *record_args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    _wait_for_port(proc, port)
+    wait_for_port(proc, port)
     assert main([*send_args, "--port", str(port), "--cbor"]) == 0
     stdout, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 0, stderr
