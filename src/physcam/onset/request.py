@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass, fields
 
 from ..errors import InputError, require_finite, require_positive, require_type
+from ..optics.thinlens import MAX_F_NUMBER, MIN_F_NUMBER, require_f_number
 from .sensors import Sensor
 
 __all__ = ["ReportRequest", "HYPERFOCAL", "DIFFRACTION_WAVELENGTH_NM", "MIN_F_NUMBER", "MAX_F_NUMBER",
@@ -27,23 +28,8 @@ HYPERFOCAL = "hyperfocal"
 #: Wavelength of the report's diffraction figures: 550 nm, near the peak of the eye's photopic
 #: sensitivity (CIE V(lambda) peaks at 555 nm), the usual choice of diffraction-limit tables.
 DIFFRACTION_WAVELENGTH_NM = 550.0
-#: The fastest f-number a lens in air can have: N = 1 / (2 n' sin u') with sin u' <= 1 and n' = 1
-#: (Abbe sine condition; Kingslake & Johnson, *Lens Design Fundamentals*, 2nd ed., 4.3).
-MIN_F_NUMBER = 0.5
-#: The slowest f-number accepted: pinhole cameras reach f/500 or so; beyond f/4096 a typo is likelier.
-MAX_F_NUMBER = 4096.0
 #: Largest finite distance the report accepts (1000 km); beyond it use infinity.
 MAX_DISTANCE_MM = 1.0e9
-
-
-def require_f_number(name: str, value) -> float:
-    """``value`` as a float between :data:`MIN_F_NUMBER` and :data:`MAX_F_NUMBER`, else InputError."""
-    v = require_positive(name, value, unit="")
-    if not MIN_F_NUMBER <= v <= MAX_F_NUMBER:
-        why = ("no lens in air is faster than f/0.5 (N = 1 / (2 sin u'), sin u' <= 1)" if v < MIN_F_NUMBER
-               else f"f-numbers above {MAX_F_NUMBER:g} are not camera apertures")
-        raise InputError(f"{name} {v:g} is out of range: {why}")
-    return v
 
 
 def require_distance(name: str, value) -> float:

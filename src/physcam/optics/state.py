@@ -18,13 +18,9 @@ from functools import cached_property
 
 from ..errors import InputError, OpticsError, require_finite, require_type
 from ..lens.prescription import Prescription
+from .thinlens import MAX_F_NUMBER, MIN_F_NUMBER, require_f_number
 
-__all__ = ["CameraState", "camera_state", "takes_camera", "MIN_F_NUMBER", "MAX_F_NUMBER"]
-
-#: The f-stops a camera state accepts (the on-set report's range: f/0.5 is the fastest a lens in air
-#: can be, N = 1 / (2 sin u'); beyond f/4096 a typo is likelier).
-MIN_F_NUMBER, MAX_F_NUMBER = 0.5, 4096.0
-
+__all__ = ["CameraState", "camera_state", "takes_camera", "require_f_number", "MIN_F_NUMBER", "MAX_F_NUMBER"]
 
 @dataclass(frozen=True, eq=False)
 class CameraState:
@@ -89,9 +85,7 @@ def _fstop_and_stop(lens: Prescription, fstop) -> tuple[float, float]:
 
     if fstop is None:  # the lens as its file stops it
         return float(paraxial.gaussian(lens).f_number), float(lens.surfaces[lens.stop_index].semi_diameter)
-    n = require_finite("f-stop", fstop)
-    if not MIN_F_NUMBER <= n <= MAX_F_NUMBER:
-        raise InputError(f"f-stop must lie between {MIN_F_NUMBER:g} and {MAX_F_NUMBER:g}, got {n:g}")
+    n = require_f_number("f-stop", fstop)
     return float(n), float(iris_semi_diameter(lens, n))
 
 

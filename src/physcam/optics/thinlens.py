@@ -20,6 +20,9 @@ from ..errors import OpticsError
 from . import _num as nx
 
 __all__ = [
+    "MIN_F_NUMBER",
+    "MAX_F_NUMBER",
+    "require_f_number",
     "image_distance",
     "object_distance",
     "magnification",
@@ -27,6 +30,26 @@ __all__ = [
     "minimum_marked_distance",
     "field_of_view",
 ]
+
+
+#: The fastest f-number a lens in air can have: N = 1 / (2 n' sin u') with sin u' <= 1 and n' = 1
+#: (Abbe sine condition; Kingslake & Johnson, *Lens Design Fundamentals*, 2nd ed., 4.3).
+MIN_F_NUMBER = 0.5
+#: The slowest f-number accepted: pinhole cameras reach f/500 or so; beyond f/4096 a typo is likelier.
+MAX_F_NUMBER = 4096.0
+
+
+def require_f_number(name: str, value) -> float:
+    """``value`` as a float between :data:`MIN_F_NUMBER` and :data:`MAX_F_NUMBER`, else InputError (the
+    one f-number range of the camera state and the on-set report)."""
+    from ..errors import InputError, require_positive
+
+    v = require_positive(name, value, unit="")
+    if not MIN_F_NUMBER <= v <= MAX_F_NUMBER:
+        why = ("no lens in air is faster than f/0.5 (N = 1 / (2 sin u'), sin u' <= 1)" if v < MIN_F_NUMBER
+               else f"f-numbers above {MAX_F_NUMBER:g} are not camera apertures")
+        raise InputError(f"{name} {v:g} is out of range: {why}")
+    return v
 
 
 def image_distance(focal_length, object_distance):
