@@ -25,43 +25,7 @@ import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite
 from . import _pupil as P
-
-
-def wavelengths_and_weights(lens, wavelengths_nm, weights):
-    """Validated wavelengths (nm) and weights normalised to sum 1; the first wavelength is the primary.
-    ``lens``: a Prescription (default: its design wavelength) or a CameraState (default: its own)."""
-    from ..optics.glass import require_wavelength
-    from ..optics.state import CameraState
-
-    if isinstance(lens, CameraState):
-        if wavelengths_nm is None:
-            wavelengths_nm, weights = lens.wavelengths_nm, lens.weights
-        lens = lens.lens
-    if wavelengths_nm is None:
-        wls = [float(lens.wavelength_nm)]
-    else:
-        if isinstance(wavelengths_nm, (str, bytes)) or np.ndim(wavelengths_nm) > 1:
-            raise InputError(f"wavelengths must be numbers in nm, got {wavelengths_nm!r:.60}")
-        seq = np.atleast_1d(np.asarray(wavelengths_nm, dtype=object)).tolist()
-        wls = [require_finite("wavelength_nm", w) for w in seq]
-    if not 1 <= len(wls) <= 24:
-        raise InputError(f"give 1 to 24 wavelengths, got {len(wls)}")
-    for w in wls:
-        if not 200.0 <= w <= 20000.0:
-            raise InputError(f"wavelength {w:g} nm is outside 200-20000 nm")
-        require_wavelength(w, "wavelength")
-    if weights is None:
-        ws = [1.0] * len(wls)
-    else:
-        if isinstance(weights, (str, bytes)) or np.ndim(weights) > 1:
-            raise InputError(f"weights must be numbers, got {weights!r:.60}")
-        ws = [require_finite("wavelength weight", w) for w in np.atleast_1d(np.asarray(weights, dtype=object)).tolist()]
-        if len(ws) != len(wls):
-            raise InputError(f"give one weight per wavelength: {len(wls)} wavelengths, {len(ws)} weights")
-        if any(w < 0 for w in ws) or not sum(ws) > 0:
-            raise InputError("wavelength weights must be >= 0 with a positive sum")
-    tot = sum(ws)
-    return wls, [w / tot for w in ws]
+from ..optics.state import wavelengths_and_weights  # noqa: F401 (the analyses call it from here)
 
 
 def pupil_samples_arg(value):

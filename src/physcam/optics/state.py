@@ -20,7 +20,7 @@ from ..errors import InputError, OpticsError, require_finite, require_type
 from ..lens.prescription import Prescription
 from .thinlens import MAX_F_NUMBER, MIN_F_NUMBER, require_f_number
 
-__all__ = ["CameraState", "camera_state", "takes_camera", "require_f_number", "MIN_F_NUMBER", "MAX_F_NUMBER"]
+__all__ = ["CameraState", "camera_state", "takes_camera", "wavelengths_and_weights", "require_f_number", "MIN_F_NUMBER", "MAX_F_NUMBER"]
 
 @dataclass(frozen=True, eq=False)
 class CameraState:
@@ -104,20 +104,42 @@ def _focused(lens: Prescription, focus_mm) -> tuple[Prescription, float, float, 
     return st.prescription, float(st.object_z), float(st.film_z), float(mark)
 
 
-def _wavelengths(lens: Prescription, wavelengths_nm, weights) -> tuple[tuple, tuple]:
+def wavelengths_and_weights(lens, wavelengths_nm, weights):
+    """Validated wavelengths (nm) and weights normalised to sum 1; the first wavelength is the primary.
+    ``lens``: a Prescription (default: its design wavelength) or a CameraState (default: its own)."""
+    import numpy as np
+
+    from .glass import require_wavelength
+
+    if isinstance(lens, CameraState):
+        if wavelengths_nm is None:
+            wavelengths_nm, weights = lens.wavelengths_nm, lens.weights
+        lens = lens.lens
     if wavelengths_nm is None:
-        wls = (float(lens.wavelength_nm),)
+        wls = [float(lens.wavelength_nm)]
     else:
-        seq = [wavelengths_nm] if isinstance(wavelengths_nm, (int, float)) else list(wavelengths_nm)
-        wls = tuple(require_finite("wavelength", w) for w in seq)
-        if not wls or any(not 200.0 <= w <= 20000.0 for w in wls):
-            raise InputError(f"wavelengths must lie between 200 and 20000 nm, got {wavelengths_nm!r:.60}")
+        if isinstance(wavelengths_nm, (str, bytes)) or np.ndim(wavelengths_nm) > 1:
+            raise InputError(f"wavelengths must be numbers in nm, got {wavelengths_nm!r:.60}")
+        seq = np.atleast_1d(np.asarray(wavelengths_nm, dtype=object)).tolist()
+        wls = [require_finite("wavelength_nm", w) for w in seq]
+    if not 1 <= len(wls) <= 24:
+        raise InputError(f"give 1 to 24 wavelengths, got {len(wls)}")
+    for w in wls:
+        if not 200.0 <= w <= 20000.0:
+            raise InputError(f"wavelength {w:g} nm is outside 200-20000 nm")
+        require_wavelength(w, "wavelength")
     if weights is None:
-        return wls, (1.0,) * len(wls)
-    ws = tuple(require_finite("weight", w) for w in weights)
-    if len(ws) != len(wls) or any(w < 0 for w in ws) or not sum(ws) > 0:
-        raise InputError("give one weight >= 0 per wavelength, not all zero")
-    return wls, ws
+        ws = [1.0] * len(wls)
+    else:
+        if isinstance(weights, (str, bytes)) or np.ndim(weights) > 1:
+            raise InputError(f"weights must be numbers, got {weights!r:.60}")
+        ws = [require_finite("wavelength weight", w) for w in np.atleast_1d(np.asarray(weights, dtype=object)).tolist()]
+        if len(ws) != len(wls):
+            raise InputError(f"give one weight per wavelength: {len(wls)} wavelengths, {len(ws)} weights")
+        if any(w < 0 for w in ws) or not sum(ws) > 0:
+            raise InputError("wavelength weights must be >= 0 with a positive sum")
+    tot = sum(ws)
+    return wls, [w / tot for w in ws]
 
 
 def camera_state(lens: Prescription, *, focus_mm=None, fstop=None, sensor_mm=None, wavelengths_nm=None,
@@ -134,7 +156,7 @@ def camera_state(lens: Prescription, *, focus_mm=None, fstop=None, sensor_mm=Non
         if not (0.0 < w <= 1000.0 and 0.0 < h <= 1000.0):
             raise InputError(f"the sensor must measure between 0 and 1000 mm a side, got {w:g} x {h:g}")
         sensor_mm = (float(w), float(h))
-    wls, ws = _wavelengths(lens, wavelengths_nm, weights)
+    wls, ws = (tuple(v) for v in wavelengths_and_weights(lens, wavelengths_nm, weights))
     state = CameraState(lens, focused, mark, object_z, film_z, stop_n, stop, wls, ws, sensor_mm, aperture)
     if not object_z < state.entrance_pupil_z:
         raise OpticsError(f"the object lies behind the entrance pupil of {lens.name!r}: no real pupil to sample")
