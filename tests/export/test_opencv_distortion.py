@@ -74,7 +74,7 @@ def test_opencv_lands_on_real_rays_at_a_finite_focus(dgauss):
     from physcam.trace import RayBatch, trace_through
 
     mark = 1500.0
-    cam = fit_opencv_pinhole(dgauss, W_MM, H_MM, W_PX, H_PX, focus_from_film_mm=mark)
+    cam = fit_opencv_pinhole(dgauss, W_MM, H_MM, W_PX, H_PX, focus_mm=mark)
     assert cam.max_residual_px < 0.1
     # fx is physcam's best-match pinhole: 52.048 mm at 1.5 m (GaussianData's documented figure)
     assert cam.fx * W_MM / W_PX == pytest.approx(52.048, abs=1e-3)

@@ -160,7 +160,7 @@ def run_opencv(args) -> int:
 
     lens = _prepare(args)
     cam = fit_opencv_pinhole(lens, args.sensor_width, args.sensor_height, args.width_px, args.height_px,
-                             focus_from_film_mm=args.focus, terms=args.terms)
+                             focus_mm=args.focus, terms=args.terms)
     if args.json:
         emit_json(document("export_opencv", cam.to_dict(), units={"length": "mm", "image": "pixel"}))
         return 0
