@@ -79,6 +79,8 @@ def compare_bokeh(lens, *, focus_mm: float | None = None, fstop: float | None = 
     from ..analysis.bokeh import bokeh_image
     from .blender import _state, blender_setup_script, osl_camera_shader
 
+    if isinstance(lens, CameraState) and (focus_mm is not None or fstop is not None):
+        raise InputError("a CameraState carries its own focus and f-stop: give them to camera_state(), not here")
     if not isinstance(lens, CameraState) and fstop is None:
         raise InputError("the comparison needs an f-stop (fstop=N)")
     crop = require_positive("crop", crop_mm)
