@@ -127,7 +127,7 @@ def _fstop_label(state: CameraState) -> float | None:
 
 
 @takes_camera
-def bake_camera(lens, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_height_mm=None, aperture=None,
+def bake_camera(lens: CameraState | Prescription, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_height_mm=None, aperture=None,
                 fresnel: bool = False) -> BakedCamera:
     """Tabulate what the OSL camera needs for ``lens``: a :class:`~physcam.optics.state.CameraState`
     with a sensor, or a Prescription with ``focus_mm``, ``fstop`` and the sensor (see :func:`osl_camera_shader`;
@@ -180,7 +180,7 @@ def _ident(name: str) -> str:
 
 
 @takes_camera
-def osl_camera_shader(lens, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_height_mm=None,
+def osl_camera_shader(lens: CameraState | Prescription, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_height_mm=None,
                       aperture=None, dispersion: bool = False, fresnel: bool = False) -> str:
     """OSL source of a Cycles camera shader that traces real rays through ``lens``: a
     :class:`~physcam.optics.state.CameraState` with a sensor (then leave ``focus_mm``, ``fstop`` and
@@ -339,7 +339,7 @@ def blender_setup_script(shader, *, sensor_width_mm, sensor_height_mm, resolutio
                          path=path, source=source)
 
 
-def write_blender_camera(out_dir, lens, *, focus_mm=None, fstop=None, sensor_width_mm=None,
+def write_blender_camera(out_dir, lens: CameraState | Prescription, *, focus_mm=None, fstop=None, sensor_width_mm=None,
                          sensor_height_mm=None, aperture=None, dispersion: bool = False, fresnel: bool = False,
                          resolution=None, name: str | None = None, force: bool = False) -> tuple[Path, Path]:
     """Write ``<name>.osl`` (:func:`osl_camera_shader` of ``lens``: a CameraState or a Prescription

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_positive
+from ..lens.prescription import Prescription
 from ..optics.state import CameraState, takes_camera
 from .blender_runner import SCRIPT_ARGS, find_blender
 
@@ -67,7 +68,7 @@ print(json.dumps({"ok": True}))
 
 
 @takes_camera
-def compare_bokeh(lens, *, focus_mm: float | None = None, fstop: float | None = None, light_mm: float,
+def compare_bokeh(lens: CameraState | Prescription, *, focus_mm: float | None = None, fstop: float | None = None, light_mm: float,
                   aperture=None, crop_mm: float = 3.0, pixels: int = 128, samples: int = 512, rays: int = 2_000_000,
                   sphere_mm: float = 1.0, blender_python: str | None = None, timeout_s: float = 600.0,
                   config_blender: str | None = None) -> dict:

@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_positive
+from ..lens.prescription import Prescription
 from ..optics.state import CameraState, takes_camera
 from ._renamed import renamed_keyword
 
@@ -241,7 +242,7 @@ def _unpack(lens, sensor_width_mm, sensor_height_mm, focus_mm, method, wavelengt
 @renamed_keyword("focus_from_film_mm", "focus_mm", removed_in="0.3.0")
 @takes_camera
 def fit_opencv_pinhole(
-    lens,
+    lens: CameraState | Prescription,
     sensor_width_mm: float | None = None,
     sensor_height_mm: float | None = None,
     image_width_px: int | None = None,

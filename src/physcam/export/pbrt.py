@@ -186,7 +186,7 @@ def _pbrt_reads(lens, focus_mm, aperture_diameter_mm, film_diagonal_mm):
 
 @renamed_keyword("focus_from_film_mm", "focus_mm", removed_in="0.3.0")
 @takes_camera
-def pbrt_thick_lens(lens, focus_mm: float | None = None, *, film_diagonal_mm: float | None = None,
+def pbrt_thick_lens(lens: CameraState | Prescription, focus_mm: float | None = None, *, film_diagonal_mm: float | None = None,
                     aperture_diameter_mm: float | None = None) -> PbrtThickLens:
     """The film distance pbrt-v4 chooses for ``lens`` focused ``focus_mm`` from the film.
 
