@@ -124,3 +124,15 @@ def test_fit_opencv_pinhole_of_a_state_is_the_fit_at_its_mark_and_sensor():
     state = camera_state(lens, focus_mm=4000.0, sensor_mm=(24.0, 18.0))
     assert fit_opencv_pinhole(state, image_width_px=960, image_height_px=720) == \
         fit_opencv_pinhole(lens, 24.0, 18.0, 960, 720, focus_mm=4000.0)
+
+
+def test_the_iris_shape_in_the_state_or_beside_it_is_the_same_iris():
+    """A number of blades (the shader's shorthand) in the state, or given with a round state, or with
+    the lens: one six-blade iris in the shader."""
+    lens = load_lens("dgauss_50mm")
+    kw = dict(focus_mm=2000.0, sensor_mm=(36.0, 24.0))
+    texts = {osl_camera_shader(camera_state(lens, aperture=6, **kw)),
+             osl_camera_shader(camera_state(lens, **kw), aperture=6),
+             osl_camera_shader(lens, focus_mm=2000.0, sensor_width_mm=36.0, sensor_height_mm=24.0, aperture=6)}
+    assert len(texts) == 1
+    assert f"#define AP_WEDGE {2 * math.pi / 6!r}\n" in texts.pop()

@@ -97,7 +97,6 @@ def _state(lens, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_heig
     front of the film plane; ``math.inf`` for infinity), stopped to ``fstop`` (None: as its file
     stops it) on the ``sensor_width_mm`` x ``sensor_height_mm`` sensor by
     :func:`physcam.optics.state.camera_state`. ``aperture`` as in :func:`osl_camera_shader`."""
-    ap = _aperture(aperture)
     if isinstance(lens, CameraState):
         given = [k for k, v in (("focus_mm", focus_mm), ("fstop", fstop), ("sensor_width_mm", sensor_width_mm),
                                 ("sensor_height_mm", sensor_height_mm)) if v is not None]
@@ -106,8 +105,10 @@ def _state(lens, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_heig
                              "camera_state(), not here")
         if lens.sensor_mm is None:
             raise InputError("the Blender camera needs a sensor: camera_state(lens, ..., sensor_mm=(width, height))")
-        return lens if ap is None else dataclasses.replace(lens, aperture=ap)
+        ap = _aperture(lens.aperture if aperture is None else aperture)
+        return lens if ap is lens.aperture else dataclasses.replace(lens, aperture=ap)
     require_prescription(lens)
+    ap = _aperture(aperture)
     sw = require_positive("sensor width", sensor_width_mm)
     sh = require_positive("sensor height", sensor_height_mm)
     if sw > 1000 or sh > 1000:
@@ -127,12 +128,12 @@ def _fstop_label(state: CameraState) -> float | None:
 
 
 @takes_camera
-def bake_camera(lens: CameraState | Prescription, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_height_mm=None, aperture=None,
-                fresnel: bool = False) -> BakedCamera:
+def bake_camera(lens: CameraState | Prescription, *, focus_mm=None, fstop=None, sensor_width_mm=None,
+                sensor_height_mm=None, aperture=None, fresnel: bool = False) -> BakedCamera:
     """Tabulate what the OSL camera needs for ``lens``: a :class:`~physcam.optics.state.CameraState`
-    with a sensor, or a Prescription with ``focus_mm``, ``fstop`` and the sensor (see :func:`osl_camera_shader`;
-    physcam's focus, :func:`physcam.optics.focusing.focus`: internal focusing when the lens has focus
-    groups, else unit focusing). Raises :class:`~physcam.errors.OpticsError` for a focus closer than
+    with a sensor, or a Prescription with ``focus_mm``, ``fstop`` and the sensor (see
+    :func:`osl_camera_shader`; physcam's focus, :func:`physcam.optics.focusing.focus`: internal
+    focusing when the lens has focus groups, else unit focusing). Raises :class:`~physcam.errors.OpticsError` for a focus closer than
     the lens reaches or an f-number faster than it opens."""
     state = _state(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=sensor_width_mm,
                    sensor_height_mm=sensor_height_mm, aperture=aperture)
