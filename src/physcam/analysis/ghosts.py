@@ -36,6 +36,7 @@ import numpy as np
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
+from ..optics.state import takes_camera
 
 __all__ = ["GhostPath", "GhostResult", "ghost_pairs", "ghost_analysis", "trace_ghost"]
 
@@ -246,7 +247,7 @@ def _beam(lens, field_deg, wl, n, rng=None):
 DEFAULT_FIELD_DEG = 10.0
 
 
-@takes_prescription
+@takes_camera
 def ghost_analysis(
     lens: Prescription,
     field_deg: float | None = None,
@@ -267,15 +268,28 @@ def ghost_analysis(
 ) -> GhostResult:
     """Rank every double-bounce path of ``lens`` for a light at ``field_deg`` (module notes).
 
+    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, round iris,
+    primary wavelength and sensor; the light stays at infinity) or a Prescription as it is (``film_z``
+    default the paraxial image at the wavelength, ``stop_semi_diameter`` default the file's stop).
+
     ``rank_rays`` rays (a deterministic grid over the front element) rank the paths; with
     ``image_rays`` > 0, the ``image_paths`` strongest paths are traced again with that many
     random rays each (in chunks of ``chunk``) and binned into a ``pixels``-wide image of the sensor.
     ``coating``: "none", "single", "multi", or None for the lens file's coating (else "none").
     ``field_deg`` None: :data:`DEFAULT_FIELD_DEG`, or the widest field below it that light passes
     (with a note in the result) when none passes there.
-    The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
+    The sensor is the state's when it has one, else ``sensor_width_mm`` x ``sensor_height_mm`` (default
+    Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
     from ..trace import paraxial_image_z, trace_to_film
+    from ._camera import camera_of, sensor_size
+
+    cam = camera_of(lens, film_z=film_z, stop_semi_diameter=stop_semi_diameter, wavelength_nm=wavelength_nm,
+                    sensor_mm=sensor_size(sensor_width_mm, sensor_height_mm))
+    if cam.aperture is not None:
+        raise InputError("the ghost tracer models a round iris: give a CameraState without an aperture shape")
+    lens, film_z, stop_semi_diameter, wavelength_nm = cam.lens, cam.film_z, cam.stop_semi_diameter, cam.wavelength_nm
+    sensor_width_mm, sensor_height_mm = cam.sensor_mm or (sensor_width_mm, sensor_height_mm)
 
     default_field = field_deg is None
     fd = require_finite("field angle", DEFAULT_FIELD_DEG if default_field else field_deg)
