@@ -357,23 +357,30 @@ def ghost_analysis(
     paths.sort(key=lambda p: -p.relative_flux)
     res = GhostResult(lens.name, fd, coating, float(wl), float(film_z), (w, h), dc, paths, notes=notes)
     if image_rays > 0:
-        nx = int(pixels)
-        ny = max(8, int(round(pixels * h / w)))
-        img = np.zeros(nx * ny)
-        rng = np.random.default_rng(seed)
         chosen = [p for p in paths if p.relative_flux > 0][:image_paths]
-        for p in chosen:
-            done = 0
-            while done < image_rays:
-                m = min(chunk, image_rays - done)
-                b = _beam(lens, fd, wl, m, rng)
-                g = trace_ghost(lens, b, p.i, p.j, film_z, backend=backend, _tables=T)
-                ix = np.floor((g.x + w / 2) / w * nx).astype(np.int64)
-                iy = np.floor((g.y + h / 2) / h * ny).astype(np.int64)
-                inside = g.ok & (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)
-                img += np.bincount(iy[inside] * nx + ix[inside], weights=g.weight[inside], minlength=img.size)
-                done += m
-        pix_area = (w / nx) * (h / ny)
-        res.image = img.reshape(ny, nx) / (flux0 * pix_area)
+        img, pix_area = _ghost_image(lens, chosen, fd, wl, film_z, T, (w, h), pixels, image_rays, chunk, seed, backend)
+        res.image = img / (flux0 * pix_area)
         res.image_paths, res.image_rays = len(chosen), int(image_rays)
     return res
+
+
+def _ghost_image(lens, chosen, fd, wl, film_z, T, sensor, pixels, image_rays, chunk, seed, backend):
+    """The ``chosen`` paths' flux binned over the sensor, ``pixels`` wide, and a pixel's area (mm^2): each
+    path traced with ``image_rays`` random rays, in chunks (module notes)."""
+    w, h = sensor
+    nx = int(pixels)
+    ny = max(8, int(round(pixels * h / w)))
+    img = np.zeros(nx * ny)
+    rng = np.random.default_rng(seed)
+    for p in chosen:
+        done = 0
+        while done < image_rays:
+            m = min(chunk, image_rays - done)
+            b = _beam(lens, fd, wl, m, rng)
+            g = trace_ghost(lens, b, p.i, p.j, film_z, backend=backend, _tables=T)
+            ix = np.floor((g.x + w / 2) / w * nx).astype(np.int64)
+            iy = np.floor((g.y + h / 2) / h * ny).astype(np.int64)
+            inside = g.ok & (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)
+            img += np.bincount(iy[inside] * nx + ix[inside], weights=g.weight[inside], minlength=img.size)
+            done += m
+    return img.reshape(ny, nx), (w / nx) * (h / ny)
