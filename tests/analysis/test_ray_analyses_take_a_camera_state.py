@@ -18,7 +18,7 @@ import pytest
 
 from physcam.analysis.bokeh import bokeh_image
 from physcam.analysis.colour import chromatic_aberration
-from physcam.analysis.ghosts import ghost_analysis
+from physcam.analysis.ghosts import ghost_analysis, trace_ghost
 from physcam.analysis.illumination import relative_illumination
 from physcam.analysis.spot import spot_diagram
 from physcam.errors import InputError, WrongTypeError
@@ -127,8 +127,23 @@ def test_ghosts_refuse_a_shaped_iris():
 
 
 @pytest.mark.parametrize("fn, args", [(spot_diagram, ()), (bokeh_image, (1000.0,)), (relative_illumination, ()),
-                                      (chromatic_aberration, ()), (ghost_analysis, ())])
+                                      (chromatic_aberration, ()), (ghost_analysis, ()), (trace_ghost, (None, 1, 0))])
 @pytest.mark.parametrize("bad", ["dgauss_50mm", 50.0, None])
 def test_anything_but_a_state_or_a_lens_first_is_a_wrong_type_error(fn, args, bad):
     with pytest.raises(WrongTypeError, match="CameraState"):
         fn(bad, *args)
+
+
+def test_one_ghost_path_traced_from_a_state_is_the_path_of_its_lens_stop_and_film():
+    from physcam.analysis.ghosts import _beam
+
+    s = camera_state(DGAUSS, focus_mm=2000.0, fstop=2.8)
+    lens, film, iris = _by_hand(DGAUSS, 2000.0, 2.8)
+    rays = _beam(lens, 5.0, DGAUSS.wavelength_nm, 400)
+    a = trace_ghost(s, rays, 10, 6)
+    b = trace_ghost(lens, rays, 10, 6, film, stop_semi_diameter=iris)
+    assert np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y) and np.array_equal(a.weight, b.weight)
+    with pytest.raises(InputError, match="CameraState carries its own"):
+        trace_ghost(s, rays, 10, 6, film)
+    with pytest.raises(InputError, match="film plane"):
+        trace_ghost(lens, rays, 10, 6)

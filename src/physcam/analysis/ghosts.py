@@ -189,13 +189,27 @@ def _reflect(rays, t, row, forward: bool):
     rays.weight_sp[live] = w * hdif + d * hsum
 
 
-@takes_prescription
-def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float, *, coating: str = "none",
+def _round_iris(cam) -> None:
+    if cam.aperture is not None:
+        raise InputError("the ghost tracer models a round iris: give a CameraState without an aperture shape")
+
+
+@takes_camera
+def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float | None = None, *, coating: str = "none",
                 stop_semi_diameter=None, backend: str = "auto", _tables=None):
-    """Trace object-space ``rays`` (a RayBatch, copied) along ghost path (i, j) to the film plane ``film_z``."""
+    """Trace object-space ``rays`` (a RayBatch, copied) along ghost path (i, j) to the film plane ``film_z``.
+
+    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane and iris) or a
+    Prescription with the film plane ``film_z`` (lens space, mm; required) and ``stop_semi_diameter``."""
     from ..trace.kernels import get_kernel
     from ..trace.trace import DEFAULT_CHUNK, trace_packed
+    from ._camera import camera_of
 
+    cam = camera_of(lens, film_z=film_z, stop_semi_diameter=stop_semi_diameter)
+    _round_iris(cam)
+    if cam.film_z is None:
+        raise InputError("give the film plane: film_z (mm, lens space), or a CameraState")
+    lens, film_z, stop_semi_diameter = cam.lens, cam.film_z, cam.stop_semi_diameter
     n = len(lens.surfaces)
     if not (0 <= j < i < n):
         raise InputError(f"a ghost path needs 0 <= j < i < {n} surfaces, got i={i}, j={j}")
@@ -286,8 +300,7 @@ def ghost_analysis(
 
     cam = camera_of(lens, film_z=film_z, stop_semi_diameter=stop_semi_diameter, wavelength_nm=wavelength_nm,
                     sensor_mm=sensor_size(sensor_width_mm, sensor_height_mm))
-    if cam.aperture is not None:
-        raise InputError("the ghost tracer models a round iris: give a CameraState without an aperture shape")
+    _round_iris(cam)
     lens, film_z, stop_semi_diameter, wavelength_nm = cam.lens, cam.film_z, cam.stop_semi_diameter, cam.wavelength_nm
     sensor_width_mm, sensor_height_mm = cam.sensor_mm or (sensor_width_mm, sensor_height_mm)
 
