@@ -36,8 +36,8 @@ import numpy as np
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription
-from ..optics.state import takes_camera
 from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM, PGF_UNCERTAINTY
+from ..optics.state import takes_camera
 
 __all__ = ["LateralColourPoint", "ColourResult", "chromatic_aberration"]
 

@@ -4,7 +4,9 @@ For each field angle (degrees, in the Y-Z meridian) a collimated beam fills a di
 paraxial entrance-pupil plane: the paraxial entrance pupil overfilled by ``overfill`` so real
 pupil shifts are covered (the stop and element rims clip what does not pass), or ``pupil_radius``.
 It is traced to the film plane (``film_z``, mm in lens space; default the paraxial image plane
-at the design wavelength). RMS radius is about the centroid, sqrt(mean(dx^2 + dy^2)); geometric
+at the design wavelength). From a :class:`~physcam.optics.state.CameraState` focused closer than
+infinity the rays come instead from the object point at its focus, aimed at the same disk, and land
+on the state's film plane. RMS radius is about the centroid, sqrt(mean(dx^2 + dy^2)); geometric
 radius the largest distance from the centroid. Both in micrometres.
 
 Sampling (area-weighted, deterministic): the disk is cut into equal-area cells on a regular grid
