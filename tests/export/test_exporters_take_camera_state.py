@@ -109,10 +109,10 @@ def test_focus_from_film_mm_still_works_with_a_deprecation_warning():
     with pytest.warns(DeprecationWarning, match="focus_mm"):
         old = pbrt_thick_lens(lens, focus_from_film_mm=2000.0)
     assert old == new == pbrt_thick_lens(lens, 2000.0)
-    with pytest.warns(DeprecationWarning, match="focus_from_film_mm goes in physcam 0.3.0"):
+    with pytest.warns(DeprecationWarning, match="focus_from_film_mm goes in physcam 0.3"):
         cam_old = fit_opencv_pinhole(lens, 36.0, 24.0, 960, 640, focus_from_film_mm=3000.0)
     assert cam_old == fit_opencv_pinhole(lens, 36.0, 24.0, 960, 640, focus_mm=3000.0)
-    with pytest.raises(InputError, match="give focus_mm only"):
+    with pytest.raises(InputError, match="give focus_mm, not both"):
         pbrt_thick_lens(lens, focus_mm=2000.0, focus_from_film_mm=2000.0)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the new name warns about nothing

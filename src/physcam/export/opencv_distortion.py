@@ -40,10 +40,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_positive
+from ..errors import InputError, OpticsError, renamed_parameter, require_positive
 from ..lens.prescription import Prescription
 from ..optics.state import CameraState, takes_camera
-from ._renamed import renamed_keyword
 
 __all__ = ["TERMS", "OMNI_API_SCHEMA", "OMNI_PREFIX", "OpenCvPinhole", "fit_opencv_pinhole", "film_to_pixels"]
 
@@ -239,7 +238,7 @@ def _unpack(lens, sensor_width_mm, sensor_height_mm, focus_mm, method, wavelengt
     return lens.lens, *lens.sensor_mm, lens.focus_from_film_mm, lens.wavelengths_nm[0]
 
 
-@renamed_keyword("focus_from_film_mm", "focus_mm", removed_in="0.3.0")
+@renamed_parameter("focus_from_film_mm", "focus_mm")
 @takes_camera
 def fit_opencv_pinhole(
     lens: CameraState | Prescription,

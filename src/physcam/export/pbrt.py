@@ -42,11 +42,10 @@ import warnings
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from ..errors import ExportError, InputError, OpticsError, require_positive
+from ..errors import ExportError, InputError, OpticsError, renamed_parameter, require_positive
 from ..lens.prescription import Prescription, require_prescription
 from ..onset.report import takes_report
 from ..optics.state import CameraState, camera_state, takes_camera
-from ._renamed import renamed_keyword
 
 __all__ = [
     "PBRT_CAMERAS",
@@ -184,7 +183,7 @@ def _pbrt_reads(lens, focus_mm, aperture_diameter_mm, film_diagonal_mm):
     return lens.focused, lens.focus_from_film_mm, 2.0 * lens.stop_semi_diameter, film_diagonal_mm
 
 
-@renamed_keyword("focus_from_film_mm", "focus_mm", removed_in="0.3.0")
+@renamed_parameter("focus_from_film_mm", "focus_mm")
 @takes_camera
 def pbrt_thick_lens(lens: CameraState | Prescription, focus_mm: float | None = None, *, film_diagonal_mm: float | None = None,
                     aperture_diameter_mm: float | None = None) -> PbrtThickLens:
