@@ -4,7 +4,7 @@
 
 from __future__ import annotations
 
-from ..errors import InputError
+from ..errors import InputError, require_type
 from .state import CameraState, camera_state
 
 __all__ = ["as_camera", "iris_set"]
@@ -23,4 +23,5 @@ def as_camera(lens, *, focus_mm=None, fstop=None, **state) -> CameraState:
 def iris_set(state: CameraState) -> bool:
     """Whether the state's iris was set to an f-stop; False: the lens as its file stops it
     (``camera_state(fstop=None)`` keeps the file's stop semi-diameter exactly)."""
+    require_type("state", state, CameraState, "physcam.optics.state.camera_state(lens, focus_mm=..., fstop=...)")
     return state.stop_semi_diameter != float(state.lens.surfaces[state.lens.stop_index].semi_diameter)
