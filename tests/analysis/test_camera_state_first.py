@@ -85,7 +85,7 @@ def test_lens_diagram_is_the_same_through_either_door():
     from physcam.analysis.diagram import lens_diagram
 
     a = lens_diagram(STATE, rays=3)
-    b = lens_diagram(DGAUSS, focus_from_film_mm=MARK, fstop=N, rays=3)
+    b = lens_diagram(DGAUSS, focus_mm=MARK, fstop=N, rays=3)
     assert (a.fstop, a.focus_from_film_mm) == (b.fstop, b.focus_from_film_mm) == (N, MARK)
     assert a.rays == b.rays
     assert a.prescription.surfaces[DGAUSS.stop_index].semi_diameter == pytest.approx(iris_semi_diameter(DGAUSS, N),
@@ -93,7 +93,9 @@ def test_lens_diagram_is_the_same_through_either_door():
     c = lens_diagram(camera_state(DGAUSS), rays=3)  # no f-stop: the stop as in the file
     assert c.fstop is None and math.isinf(c.focus_from_film_mm) and c.rays == lens_diagram(DGAUSS, rays=3).rays
     with pytest.raises(InputError, match="carries its own"):
-        lens_diagram(STATE, focus_from_film_mm=MARK)
+        lens_diagram(STATE, focus_mm=MARK)
+    with pytest.warns(DeprecationWarning, match="focus_mm"):  # the old name, for one version
+        assert lens_diagram(DGAUSS, focus_from_film_mm=MARK, fstop=N, rays=3).rays == b.rays
     with pytest.raises(WrongTypeError):
         lens_diagram("dgauss_50mm")
 

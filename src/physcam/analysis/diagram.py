@@ -19,7 +19,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import ExportError, InputError
+from ..errors import ExportError, InputError, renamed_parameter
 from ..lens.geometry import sag
 from ..lens.prescription import Prescription, takes_prescription
 from ..optics import focusing, paraxial
@@ -179,20 +179,21 @@ def _default_field(p: Prescription, g: paraxial.GaussianData, axis: str, wavelen
     return math.atan(min(u, 1.5))
 
 
+@renamed_parameter("focus_from_film_mm", "focus_mm")
 @takes_camera
-def lens_diagram(prescription: CameraState | Prescription, *, axis: str = "y", focus_from_film_mm: float | None = None,
+def lens_diagram(prescription: CameraState | Prescription, *, axis: str = "y", focus_mm: float | None = None,
                  fstop=None, field_deg: float | None = None, wavelength_nm=None, rays: int = 3) -> LensDiagram:
     """Compute a :class:`LensDiagram` of a :class:`~physcam.optics.state.CameraState`, or of a
-    Prescription focused at ``focus_from_film_mm`` (from the film plane; None: infinity) with its iris
+    Prescription focused at ``focus_mm`` (the mark from the film plane; None: infinity) with its iris
     at ``fstop`` (None: the stop as in its file); focused at ``wavelength_nm`` (None: the design one)."""
     from ..optics._camera import as_camera, iris_set
 
     if axis not in paraxial.AXES:
         raise InputError(f"meridian must be 'x' or 'y', got {axis!r}")
-    cam = as_camera(prescription, focus_mm=focus_from_film_mm, fstop=fstop)
-    prescription, focus_from_film_mm = cam.lens, cam.focus_from_film_mm
+    cam = as_camera(prescription, focus_mm=focus_mm, fstop=fstop)
+    prescription, focus_mm = cam.lens, cam.focus_from_film_mm
     fstop = cam.fstop if iris_set(cam) else None
-    st = focusing.focus(prescription, focus_from_film_mm, axis="y", wavelength_nm=wavelength_nm)
+    st = focusing.focus(prescription, focus_mm, axis="y", wavelength_nm=wavelength_nm)
     p = st.prescription
     iris = cam.stop_semi_diameter if iris_set(cam) else None
     g = paraxial.gaussian(p, axis=axis, wavelength_nm=wavelength_nm, stop_semi_diameter=iris, object_z=st.object_z,
@@ -229,7 +230,7 @@ def lens_diagram(prescription: CameraState | Prescription, *, axis: str = "y", f
         y_start = h - tu * (ep - z_start)
         out.append((kind, trace_meridional_ray(p, y_start, z_start, tu, 1.0, axis=axis, wavelength_nm=wavelength_nm,
                                                film_z=g.z_film)))
-    return LensDiagram(p, g, axis, math.degrees(half), out, float(focus_from_film_mm),
+    return LensDiagram(p, g, axis, math.degrees(half), out, float(focus_mm),
                        None if fstop is None else float(fstop))
 
 

@@ -338,7 +338,7 @@ def diagram_options(args) -> dict:
 
     if args.focus == HYPERFOCAL:
         args.focus = resolve_focus(args.focus, lens=_load(args), fstop=args.fstop, args=args)
-    return dict(axis=args.axis, focus_from_film_mm=args.focus, fstop=args.fstop, field_deg=args.field,
+    return dict(axis=args.axis, focus_mm=args.focus, fstop=args.fstop, field_deg=args.field,
                 wavelength_nm=args.wavelength)
 
 
@@ -349,7 +349,7 @@ def run_diagram(args) -> int:
 
     p = _load(args)
     opts = diagram_options(args)
-    cam = camera_state(p, focus_mm=opts.pop("focus_from_film_mm"), fstop=opts.pop("fstop"))  # the one camera state
+    cam = camera_state(p, focus_mm=opts.pop("focus_mm"), fstop=opts.pop("fstop"))  # the one camera state
     path = save_lens_diagram(cam, args.output, force=args.force, units=units_of(args), **opts)
     print(f"wrote {path}")
     return 0
