@@ -73,6 +73,12 @@ def test_defocus_camera_is_the_same_through_either_door():
     assert (a.film_z, a.stop_semi, a.pinhole_mm, a.pupil_from_film_mm) == (b.film_z, b.stop_semi, b.pinhole_mm,
                                                                            b.pupil_from_film_mm)
     assert a.stop_semi == iris_semi_diameter(DGAUSS, 2.8)  # the one rule
+    from physcam.trace.aperture import Aperture
+
+    six = defocus_camera(camera_state(DGAUSS, focus_mm=MARK, fstop=2.8, sensor_mm=(36.0, 24.0), aperture=Aperture(6)),
+                         width=128, height=72)  # the state's iris shape
+    assert six.key() == defocus_camera(DGAUSS, focus_mm=MARK, fstop=2.8, sensor_width_mm=36.0, width=128, height=72,
+                                       aperture=6).key() != a.key()
     with pytest.raises(InputError, match="carries its own"):
         defocus_camera(s, fstop=2.8, width=128, height=72)
     with pytest.raises(InputError, match="sensor"):

@@ -211,8 +211,9 @@ def defocus_camera(lens: CameraState | Prescription, *, focus_mm: float | None =
     """The :class:`DefocusCamera` for ``lens``: a :class:`~physcam.optics.state.CameraState`, or a
     Prescription focused at the mark ``focus_mm`` (from the film) at f/``fstop`` (both needed); a
     sensor ``sensor_width_mm`` wide (default: the state's) imaged on ``width`` x ``height`` pixels
-    (the display window); ``tile`` px per field node; the blur step between depth nodes is
-    ``step_px + step_rel x`` the blur diameter (module notes)."""
+    (the display window); ``aperture``: the iris's shape (default: the state's, else round);
+    ``tile`` px per field node; the blur step between depth nodes is ``step_px + step_rel x`` the
+    blur diameter (module notes)."""
     from ..optics._camera import as_camera
     from ..optics.focusing import technical_planes
     from .bokeh import RGB_WAVELENGTHS_NM
@@ -242,7 +243,7 @@ def defocus_camera(lens: CameraState | Prescription, *, focus_mm: float | None =
     tp = technical_planes(lens, focus_mm, fstop=fstop)
     if tp.pinhole_focal_length_mm is None:
         raise OpticsError(f"{lens.name} has no best-match pinhole at this focus (its chief ray does not reach the film)")
-    ap = _as_aperture(aperture)
+    ap = _as_aperture(cam.aperture if aperture is None else aperture)
     return DefocusCamera(lens=lens, focus_mm=float(focus_mm), fstop=float(fstop), sensor_width_mm=sw,
                          width=int(width), height=int(height), aperture=ap, dispersion=bool(dispersion),
                          tile=int(tile), step_px=step, step_rel=rel, film_z=cam.film_z, stop_semi=cam.stop_semi_diameter,

@@ -118,8 +118,7 @@ def run(args) -> int:
     sensor = resolve_sensor(args)
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
     cam = _camera(args, lens, sensor)
-    opts = dict(depth=args.depth,
-                depth_kind=args.depth_kind, depth_unit=args.depth_unit, aperture=_aperture(args),
+    opts = dict(depth=args.depth, depth_kind=args.depth_kind, depth_unit=args.depth_unit,
                 dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step, step_rel=args.depth_step_rel,
                 edge_px=args.edge_px)
     if "#" in args.image:
@@ -136,10 +135,12 @@ def run(args) -> int:
 
 
 def _camera(args, lens, sensor):
-    """The one camera state of a defocus command: the lens at the mark and f-stop on the sensor."""
+    """The one camera state of a defocus command: the lens at the mark, its iris at the f-stop and of
+    its blades, on the sensor."""
     from ..optics.state import camera_state
 
-    return camera_state(lens, focus_mm=args.focus, fstop=args.fstop, sensor_mm=(sensor.width_mm, sensor.height_mm))
+    return camera_state(lens, focus_mm=args.focus, fstop=args.fstop, sensor_mm=(sensor.width_mm, sensor.height_mm),
+                        aperture=_aperture(args))
 
 
 def _run_sequence(args, cam, opts) -> int:
@@ -174,7 +175,7 @@ def run_kernels(args) -> int:
     sensor = resolve_sensor(args)
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
     depths = [parse_distance(t, name="depth", allow_inf=True) for t in list_items(args.depths, "the depths", "1m,4m,inf")]
-    cam = defocus_camera(_camera(args, lens, sensor), width=args.resolution[0], height=args.resolution[1], aperture=_aperture(args),
+    cam = defocus_camera(_camera(args, lens, sensor), width=args.resolution[0], height=args.resolution[1],
                          dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step,
                          step_rel=args.depth_step_rel)
     index = write_kernel_stack(args.output, cam, field_grid=args.field_grid, depths_mm=depths, force=args.force)
