@@ -7,9 +7,9 @@ paraxial image plane, so its limits differ (docs/lens-report.md, "Depth of field
 
 Method: the camera state (:func:`physcam.optics.state.camera_state`) focuses the lens at the mark
 (:func:`physcam.optics.focusing.focus`) and sets its iris to the f-stop (the one iris rule,
-``CameraState.stop_semi_diameter``); the film stays where focusing put it. An object point at distance d in front of the film lies on the real chief ray that reaches
-the film at ``image_height_mm`` (on the axis by default), so a field point keeps its direction as d
-changes. Its blur is measured by tracing a grid of rays over its beam
+``CameraState.stop_semi_diameter``); the film stays where focusing put it. An object point at
+distance d in front of the film lies on the real chief ray that reaches the film at
+``image_height_mm`` (on the axis by default), so a field point keeps its direction as d changes. Its blur is measured by tracing a grid of rays over its beam
 (:func:`physcam.analysis.centroid.image_moments`) as one of
 
 * ``"moment"``: the second-moment diameter sqrt(8 E[r^2]) about the centroid (a uniform disk of
@@ -83,19 +83,18 @@ class _Blur:
         from ..trace import RayBatch, trace_through
         from ._chief import aim_from_film
 
-        lens, st = cam.lens, cam
         self.q, self.film_z, self.backend = cam.focused, cam.film_z, backend
         self.wl = float(cam.wavelengths_nm[0])  # the state's primary (default: the design wavelength)
         self.iris = cam.stop_semi_diameter
         self.z_ep = cam.entrance_pupil_z
         self.r_ep = cam.gaussian.entrance_pupil_diameter / 2 * self.iris / self.q.surfaces[self.q.stop_index].semi_diameter
-        self.front = st.film_z  # the front vertex (z = 0) lies film_z in front of the film
+        self.front = cam.film_z  # the front vertex (z = 0) lies film_z in front of the film
         self.measure, self.fraction = measure, energy_fraction
-        aimed = aim_from_film(self.q, [[0.0, -image_height_mm]], st.film_z, wavelength_nm=self.wl, backend=backend)
+        aimed = aim_from_film(self.q, [[0.0, -image_height_mm]], cam.film_z, wavelength_nm=self.wl, backend=backend)
         out = trace_through(self.q, RayBatch.from_arrays(aimed.start, aimed.direction, self.wl), reverse=True,
                             backend=backend)
         if not (bool(aimed.ok[0]) and bool(out.ok[0]) and out.N[0] < 0):
-            raise OpticsError(f"no chief ray of {lens.name!r} reaches the film {image_height_mm:g} mm from the centre")
+            raise OpticsError(f"no chief ray of {cam.lens_name!r} reaches the film {image_height_mm:g} mm from the centre")
         self.ray = np.array([out.x[0], out.y[0], out.z[0], out.L[0], out.M[0], out.N[0]])
 
     def __call__(self, d_from_film: float) -> float:

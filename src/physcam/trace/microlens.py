@@ -31,11 +31,12 @@ import numpy as np
 
 from ..errors import InputError, OpticsError, require_positive, require_type
 from ..lens.prescription import Prescription
+from ..optics.state import CameraState, camera_state
 from .rays import CLIPPED, MISSED, OK, RayBatch
 from .trace import trace_through
 
-__all__ = ["MicrolensArray", "PlenopticCamera", "microlens_array", "main_lens_state", "plenoptic_camera", "refract_through_array",
-           "trace_to_sensor", "trace_from_sensor", "subimage_centres"]
+__all__ = ["MicrolensArray", "PlenopticCamera", "microlens_array", "main_lens_state", "plenoptic_camera",
+           "refract_through_array", "trace_to_sensor", "trace_from_sensor", "subimage_centres"]
 
 #: most lenslets along one side and in all (a Lytro Illum has about 540 x 430; 500000 zero offsets
 #: in ISET JSON stay under the 10 MB lens file limit), and pixels under one lenslet along one side
@@ -182,12 +183,11 @@ class PlenopticCamera:
         return self.array.pitch_x / self.pixels_per_lenslet, self.array.pitch_y / self.pixels_per_lenslet
 
 
-def main_lens_state(main: Prescription, array: MicrolensArray, *, focus_mm: float, fstop: float | None = None):
+def main_lens_state(main: Prescription, array: MicrolensArray, *, focus_mm: float,
+                    fstop: float | None = None) -> CameraState:
     """The main lens's :class:`~physcam.optics.state.CameraState` focused (unit or internal) so that a
     subject ``focus_mm`` in front of the **sensor** is imaged on the array plane, its film (plenoptic
     1.0); its iris at ``fstop`` (None: the stop as in its file)."""
-    from ..optics.state import camera_state
-
     require_type("main", main, Prescription, "load one with physcam.lens.library.load_lens")
     require_type("array", array, MicrolensArray, "build one with physcam.trace.microlens.microlens_array")
     b = array.sensor_offset_mm
@@ -208,8 +208,6 @@ def plenoptic_camera(main, array: MicrolensArray, *, focus_mm: float | None = No
     or by ``film_to_lens_mm``: the sensor lies this far behind the main lens's rear vertex, as
     lenstool and ISET3D set it. ``fstop`` stops a Prescription down (default: the stop as in its file).
     """
-    from ..optics.state import CameraState, camera_state
-
     if not isinstance(main, CameraState):
         require_type("main", main, Prescription, "load one with physcam.lens.library.load_lens, or a CameraState "
                      "(physcam.trace.microlens.main_lens_state)")
