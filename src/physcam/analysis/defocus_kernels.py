@@ -214,7 +214,7 @@ def defocus_camera(lens: CameraState | Prescription, *, focus_mm: float | None =
     (the display window); ``aperture``: the iris's shape (default: the state's, else round);
     ``tile`` px per field node; the blur step between depth nodes is ``step_px + step_rel x`` the
     blur diameter (module notes)."""
-    from ..optics._camera import as_camera
+    from ..optics.state import as_camera_state
     from ..optics.focusing import technical_planes
     from .bokeh import RGB_WAVELENGTHS_NM
 
@@ -238,7 +238,7 @@ def defocus_camera(lens: CameraState | Prescription, *, focus_mm: float | None =
     rel = require_finite("relative depth step", step_rel)
     if not 0 <= rel <= 0.5:
         raise InputError(f"the relative depth step must lie between 0 and 0.5 of the blur, got {rel:g}")
-    cam = as_camera(lens, focus_mm=focus_mm, fstop=fstop)
+    cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
     lens, focus_mm, fstop = cam.lens, cam.focus_from_film_mm, cam.fstop
     tp = technical_planes(lens, focus_mm, fstop=fstop)
     if tp.pinhole_focal_length_mm is None:

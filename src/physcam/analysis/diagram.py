@@ -186,16 +186,16 @@ def lens_diagram(prescription: CameraState | Prescription, *, axis: str = "y", f
     """Compute a :class:`LensDiagram` of a :class:`~physcam.optics.state.CameraState`, or of a
     Prescription focused at ``focus_mm`` (the mark from the film plane; None: infinity) with its iris
     at ``fstop`` (None: the stop as in its file); focused at ``wavelength_nm`` (None: the design one)."""
-    from ..optics._camera import as_camera, iris_set
+    from ..optics.state import as_camera_state
 
     if axis not in paraxial.AXES:
         raise InputError(f"meridian must be 'x' or 'y', got {axis!r}")
-    cam = as_camera(prescription, focus_mm=focus_mm, fstop=fstop)
+    cam = as_camera_state(prescription, focus_mm=focus_mm, fstop=fstop)
     prescription, focus_mm = cam.lens, cam.focus_from_film_mm
-    fstop = cam.fstop if iris_set(cam) else None
+    fstop = cam.fstop if cam.iris_set else None
     st = focusing.focus(prescription, focus_mm, axis="y", wavelength_nm=wavelength_nm)
     p = st.prescription
-    iris = cam.stop_semi_diameter if iris_set(cam) else None
+    iris = cam.stop_semi_diameter if cam.iris_set else None
     g = paraxial.gaussian(p, axis=axis, wavelength_nm=wavelength_nm, stop_semi_diameter=iris, object_z=st.object_z,
                           film_z=st.film_z)
     if fstop is not None:  # draw the stop at the asked opening

@@ -35,14 +35,14 @@ def _camera(lens, focus_mm, fstop):
     """(the lens, its mark, its f-stop, a function giving its camera state): the state is made when a
     measurement asks for it, so a Prescription's stop the lens cannot open to is that measurement's note."""
     from ..errors import InputError
-    from ..optics._camera import as_camera
+    from ..optics.state import as_camera_state
 
     if isinstance(lens, CameraState):
-        cam = as_camera(lens, focus_mm=focus_mm, fstop=fstop)
+        cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
         return cam.lens, cam.focus_from_film_mm, cam.fstop, lambda: cam
     if focus_mm is None or fstop is None:
         raise InputError("give focus_mm and fstop with a lens (or a CameraState: physcam.optics.state.camera_state)")
-    return lens, focus_mm, fstop, lambda: as_camera(lens, focus_mm=focus_mm, fstop=fstop)
+    return lens, focus_mm, fstop, lambda: as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
 
 
 @takes_camera

@@ -125,13 +125,13 @@ def _measure(measure, energy_fraction):
 def _camera(lens, focus_mm, fstop) -> CameraState:
     """The camera state: ``lens`` as it is, or a Prescription focused at ``focus_mm`` and set to ``fstop``
     (both needed); its mark must be finite."""
-    from ..optics._camera import as_camera
+    from ..optics.state import as_camera_state
 
     if not isinstance(lens, CameraState):
         if focus_mm is None or fstop is None:
             raise InputError("give focus_mm and fstop with a lens (or a CameraState: physcam.optics.state.camera_state)")
         focus_mm = require_positive("focus mark", focus_mm)
-    cam = as_camera(lens, focus_mm=focus_mm, fstop=fstop)
+    cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
     require_positive("focus mark", cam.focus_from_film_mm)
     return cam
 

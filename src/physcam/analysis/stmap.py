@@ -433,14 +433,14 @@ def distortion_field(
     are then None and (0, 0)): what fitting models and tables across focus need. An iris set to an
     f-stop gives the centroid distortion there instead of the chief rays' (module notes, "At a stop").
     """
-    from ..optics._camera import as_camera, iris_set
+    from ..optics.state import as_camera_state
     from ..optics.focusing import focus
     from ..optics.paraxial import gaussian
 
     w_px, h_px = _size("width", width_px), _size("height", height_px)
     if w_px * h_px > MAX_PIXELS:
         raise InputError(f"a {w_px} x {h_px} frame has more than {MAX_PIXELS:,} pixels: give a smaller resolution")
-    cam = as_camera(lens, focus_mm=focus_mm, fstop=fstop)
+    cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
     W, H = _sensor(cam, sensor_width_mm, sensor_height_mm)
     lens = cam.lens
     wl = cam.wavelengths_nm[0] if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
@@ -450,8 +450,8 @@ def distortion_field(
     for a in ("x", "y"):
         if g[a].pinhole_focal_length is None or not g[a].efl > 0:
             raise OpticsError(f"lens {lens.name!r} has no best-match pinhole in {a.upper()} at this focus")
-    fstop = cam.fstop if iris_set(cam) else None
-    iris = cam.stop_semi_diameter if iris_set(cam) else None
+    fstop = cam.fstop if cam.iris_set else None
+    iris = cam.stop_semi_diameter if cam.iris_set else None
     rays = _PlateRays(lens.name, q, g["x"], g["y"], st, wl, backend, w_px, h_px, (W, H), iris)
 
     # forward field: real plate position -> ideal plate position, traced at the nodes

@@ -123,8 +123,7 @@ def _state(lens, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_heig
 
 def _fstop_label(state: CameraState) -> float | None:
     """The f-stop the shader's header names: None ("open") when the iris is the file's own stop."""
-    file_stop = state.lens.surfaces[state.lens.stop_index].semi_diameter
-    return None if state.stop_semi_diameter == file_stop else state.fstop
+    return state.fstop if state.iris_set else None
 
 
 @takes_camera
