@@ -102,6 +102,12 @@ def test_the_core_installs_light_and_runs_the_report(installed):
     ("live", ["live", "validate", "sample.json"]),
     ("dask", ["characterize", "dgauss_50mm", "-o", "char", "--focus", "2m", "--fstop", "4"]),
     ("serve", ["serve", "--port", "0", "--check"]),
+    # found by a review of the core install: each used to end in a traceback, or after the work
+    ("exr", ["defocus-kernels", "--lens", "dgauss_50mm", "--focus", "2m", "--fstop", "2.8", "--resolution", "64x36",
+             "--depths", "1m", "-o", "psf"]),
+    ("exr", ["distortion", "--lens", "dgauss_50mm", "--resolution", "640x480", "--stmap", "maps2"]),
+    ("usd", ["live", "wall", "wall.usda", "--kind", "flat"]),
+    ("usd", ["demo", "--out", "demo-core"]),
 ])
 def test_a_missing_extra_is_one_line_naming_its_install(installed, extra, args):
     (installed["work"] / "sample.json").write_text("{}")
@@ -110,6 +116,26 @@ def test_a_missing_extra_is_one_line_naming_its_install(installed, extra, args):
     lines = p.stderr.strip().splitlines()
     assert len(lines) == 1 and f"pip install 'physcam[{extra}]'" in lines[0], p.stderr
     assert "Traceback" not in p.stderr
+    # said before any work: nothing written
+    assert not any((installed["work"] / name).exists() for name in ("psf", "maps2", "wall.usda", "demo-core"))
+
+
+def test_the_core_reads_camera_metadata_and_a_take_needs_usd_before_it_is_received(installed):
+    inst = installed
+    clip = inst["site"] / "physcam" / "data" / "samples" / "arri_alexa_lf_B001C001_first48.csv"
+    p = _physcam(inst, "metadata", "report", clip, "--json")
+    assert len(json.loads(p.stdout)["frames"]) == 48
+    # with the 'live' extra but not 'usd' (its two packages on a side path), a recording stops at once
+    side = inst["tmp"] / "live-only"
+    _run([inst["py"], "-m", "pip", "install", "--quiet", "-c", str(ROOT / "constraints.txt"), "--target", str(side),
+          "jsonschema", "cbor2"], inst["work"], env=inst["env"])
+    env = dict(inst["env"], PYTHONPATH=str(side))
+    t0 = time.perf_counter()
+    p = _run([inst["bin"] / "physcam", "live", "record", "take.usda", "--port", "55631", "--duration", "30"],
+             inst["work"], env=env, check=False)
+    assert time.perf_counter() - t0 < 20.0  # not after the 30 s take
+    assert p.returncode == 2 and "pip install 'physcam[usd]'" in p.stderr and len(p.stderr.strip().splitlines()) == 1
+    assert not (inst["work"] / "take.usda").exists()
 
 
 def test_the_jit_kernels_missing_is_one_line_naming_the_fast_extra(installed):

@@ -111,6 +111,9 @@ def write_exr(path, img: ExrImage, planes: dict, *, attributes=None, force: bool
 
     require_type("image", img, ExrImage, "physcam.analysis.defocus_exr.read_exr(path)")
     require_type("planes", planes, dict, "{channel name: (h, w) array}")
+    from ..extras import require_extra
+
+    require_extra("exr", "writing EXR images")
     import OpenEXR
 
     from ..io import atomic_write, check_writable

@@ -169,8 +169,10 @@ def run_kernels(args) -> int:
     from ..analysis.defocus_kernels import defocus_camera
     from ..lens.library import load_lens
     from ..units import parse_distance
+    from ..extras import require_extra
     from ._common import list_items, resolve_focus, resolve_sensor
 
+    require_extra("exr", "the PSF stack as EXR (physcam defocus-kernels)")
     lens = load_lens(args.lens)
     sensor = resolve_sensor(args)
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)

@@ -242,11 +242,12 @@ def _blender_step(out, ctx, force):
 def run(args) -> int:
     from pathlib import Path
 
-    from ._common import console
+    from ._common import console, units_of
     from ._output import document, emit_json
 
-    from ._common import units_of
+    from ..extras import require_extra
 
+    require_extra("usd", "the demo's USD cameras (physcam demo)")  # before any file is written
     out = Path(args.out)
     ctx: dict = {"units": units_of(args)}  # scene distances on the plots: --units, else the user config's
     written = []

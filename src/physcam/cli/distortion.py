@@ -248,6 +248,10 @@ def _run_field(args, lens) -> int:
     if args.output:
         raise InputError("-o draws the field-angle table's plot; with --resolution the maps go to --stmap DIR "
                          "(each EXR with a PNG preview)")
+    if args.stmap is not None:  # say so before the tracing, not after it
+        from ..extras import require_extra
+
+        require_extra("exr", "writing ST-maps as EXR (physcam distortion --stmap)")
     cam = camera_state(lens, focus_mm=args.focus, fstop=args.fstop, sensor_mm=(args.sensor_width, args.sensor_height))
     res = distortion_field(cam, width_px=args.resolution[0], height_px=args.resolution[1], wavelength_nm=args.wavelength,
                            maps=args.stmap is not None)

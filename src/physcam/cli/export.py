@@ -3,6 +3,8 @@ Blender Cycles OSL lens cameras, RenderMan RIB camera blocks, pbrt-v4 cameras)."
 
 from __future__ import annotations
 
+import sys
+
 from ._common import add_lens_argument, FOCUS_HELP, add_units_option, distance, focus, number, numbers, whole
 from ._output import add_output_options, document, emit_json, print_csv
 
@@ -236,7 +238,12 @@ def run_blender_extension(args) -> int:
 
     t0 = time.perf_counter()
     names = []
-    path = build_extension(args.output, lenses=args.lens, force=args.force, progress=names.append)
+
+    def progress(name):  # one line per lens on stderr: the whole library takes minutes
+        names.append(name)
+        print(f"  {name}: {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
+
+    path = build_extension(args.output, lenses=args.lens, force=args.force, progress=progress)
     data = {"zip": str(path), "lenses": names, "seconds": round(time.perf_counter() - t0, 3)}
     if args.json:
         emit_json(document("export_blender_extension", data, units={"time": "s"}))

@@ -224,6 +224,7 @@ def _read_samples(path):
 
 
 def run_validate(args) -> int:
+    _needs_live()
     from ..errors import InputError
     from ..live.sample import SampleError, decode_sample
     results = []
@@ -346,6 +347,21 @@ def _take(item, statics: dict, frames: list, refusals: list) -> None:
         refusals.append(f"sample {sample.get('timing', {}).get('sequenceNumber', item.sequence)}: {exc}")
 
 
+def _needs_live() -> None:
+    """The OpenTrackIO commands need the 'live' extra (schema validation, CBOR): say so up front."""
+    from ..extras import require_extra
+
+    require_extra("live", "OpenTrackIO (physcam live)")
+
+
+def _needs_usd(what: str) -> None:
+    """Say up front, in one line, that a command writing or reading USD needs the 'usd' extra (before a
+    take is received or any work is done)."""
+    from ..extras import require_extra
+
+    require_extra("usd", what)
+
+
 def run_record(args) -> int:
     import time
 
@@ -354,6 +370,8 @@ def run_record(args) -> int:
     from ..live.receiver import Receiver, multicast_group
     from ..live.record import MAX_RECORDED_FRAMES
 
+    _needs_live()
+    _needs_usd("recording a take to USD (physcam live record)")
     sensor = _resolve_sensor_opt(args)
     if args.focus is not None:
         from ._common import resolve_focus
@@ -539,6 +557,7 @@ def _send_clip(args) -> int:
 
 
 def run_send(args) -> int:
+    _needs_live()
     from ..errors import InputError
     from ..live.camera import CameraMove, camera_frames, frames_to_samples
     from .report import resolve_sensor
@@ -617,6 +636,7 @@ def _frames_from_report(path):
 
 
 def run_play(args) -> int:
+    _needs_live()
     import dataclasses
 
     from ..errors import InputError
@@ -649,6 +669,7 @@ def run_play(args) -> int:
 
 # --- wall and frustum -------------------------------------------------------------------------
 def run_wall(args) -> int:
+    _needs_usd("an LED wall mesh (physcam live wall)")
     from ..live.frustum import write_wall
 
     if args.segments > 4096:
@@ -663,6 +684,7 @@ def run_wall(args) -> int:
 
 
 def run_frustum(args) -> int:
+    _needs_usd("the inner frustum (physcam live frustum)")
     from ..errors import InputError
     from ..live.frustum import MAX_SAMPLES_PER_EDGE, frustum_frames, wall_from_usd, write_frustum_usd
     from ..live.usd_io import frames_from_usd

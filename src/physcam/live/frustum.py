@@ -65,6 +65,8 @@ def wall_from_usd(file, path: str | None = None) -> WallMesh:
     """The LED wall: the Mesh at ``path`` (default the only Mesh) of a USD file, triangulated in world space."""
     from pathlib import Path
 
+    from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
+
     from pxr import Usd, UsdGeom
 
     p = Path(file) if isinstance(file, (str, Path)) else None
@@ -285,6 +287,7 @@ def frustum_frames(frames, wall: WallMesh, *, overscan: float = 0.1, latency_s: 
 
 def write_frustum_usd(file, frustum, *, meters_per_unit: float, fps: float, force: bool = False):
     """The frames' projection camera and footprint polygon as time-sampled USD (module notes)."""
+    from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
     from pxr import Gf, Sdf, UsdGeom, Vt
 
     from ..export.usdgeom import mm_to_tenths_of_scene_unit
@@ -339,6 +342,7 @@ def write_wall(file, *, kind: str = "flat", width_m: float = 12.0, height_m: flo
     """An LED wall mesh for examples and tests: ``flat`` (a plane ``distance_m`` in front of the stage
     origin along OpenTrackIO's +Y, centred, from the floor up) or ``curved`` (an arc of a vertical
     cylinder of ``radius_m`` about the origin, ``width_m`` of arc length)."""
+    from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
     from pxr import Gf, UsdGeom, Vt
 
     from ..usd.author import new_stage, save_stage

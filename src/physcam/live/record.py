@@ -320,6 +320,7 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
                         resolution=(4096, None), force: bool = False):
     """Write the solved frames (:func:`solve_frames`) as one time-sampled camera (module notes); return the Path."""
     import numpy as np
+    from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
     from pxr import Gf, Sdf, UsdGeom, Vt
 
     from ..export.usdgeom import mm_to_scene_units, require_meters_per_unit
@@ -430,6 +431,7 @@ def _shift(solved: SolvedFrame) -> tuple[float, float]:
 def _omni_sample(prim, attrs, distortion, report, resolution, t):
     """One time sample of Omniverse's OpenCV-pinhole distortion on the companion camera (normalised
     coefficients, pixels of a ``resolution`` image); skipped for models it cannot express."""
+    from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
     from pxr import Gf, Sdf
 
     from ..usd.author import OMNI_OPENCV_API

@@ -72,6 +72,12 @@ def json_path(parts) -> str:
     return out
 
 
+def _needs_live(what: str) -> None:
+    from ..extras import require_extra
+
+    require_extra("live", f"{what} (physcam live)")
+
+
 @lru_cache(maxsize=1)
 def schema() -> dict:
     """The OpenTrackIO 1.0.1 JSON schema (a dict; do not modify it)."""
@@ -82,6 +88,7 @@ def schema() -> dict:
 
 @lru_cache(maxsize=1)
 def _validator():
+    _needs_live("validating OpenTrackIO samples")
     import jsonschema
 
     s = schema()
@@ -197,6 +204,7 @@ def decode_sample(payload, encoding: str = "json", *, validate: bool = True) -> 
         if encoding == "json":
             obj = json.loads(bytes(payload).decode("utf-8"), parse_constant=_reject_constant)
         else:
+            _needs_live("CBOR samples")
             import cbor2
 
             obj = cbor2.loads(bytes(payload))
@@ -218,6 +226,7 @@ def encode_sample(sample, encoding: str = "json") -> bytes:
         except ValueError as exc:
             raise InputError(f"the sample holds a number JSON cannot carry: {exc}") from None
     if encoding == "cbor":
+        _needs_live("CBOR samples")
         import cbor2
 
         return cbor2.dumps(sample)

@@ -27,6 +27,7 @@ __all__ = ["frames_from_usd", "camera_prim_path"]
 
 def camera_prim_path(stage, path: str | None = None) -> str:
     """``path``, or the only PhysicalCamera on the stage."""
+    from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
     from pxr import Sdf
 
     from ..usd.plugin import require_stage
@@ -48,6 +49,7 @@ def _times(prim, attrs) -> list[float]:
     for a in attrs:
         if a:
             times.update(a.GetTimeSamples())
+    from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
     from pxr import UsdGeom
 
     xf = UsdGeom.Xformable(prim)
@@ -62,6 +64,7 @@ def frames_from_usd(file, path: str | None = None, *, max_frames: int = 144_000)
     from pathlib import Path
 
     import physcam.usd  # noqa: F401 - registers the schema
+    from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
     from pxr import Usd, UsdGeom
 
     p = Path(file) if isinstance(file, (str, Path)) else None

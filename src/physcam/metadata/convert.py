@@ -167,6 +167,8 @@ def write_usd(file, record, solved, *, plate=None, plate_frames=None, meters_per
     import tempfile
     from pathlib import Path
 
+    from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
+
     from pxr import Usd
 
     from ..io import check_writable

@@ -9,7 +9,7 @@ the process creates its first stage; see :mod:`physcam.usd.plugin`). Modules:
 
 from ..extras import require_extra
 
-require_extra("usd", "physcam's USD cameras")
+require_extra("usd", "physcam.usd (USD cameras)")
 
 from .plugin import PLUGIN_DIR, SCHEMA_TYPES, ensure_registered  # noqa: E402
 

@@ -149,7 +149,8 @@ def resolve_backend(backend: str = "auto") -> str:
     if backend == "numba" and not numba_available():
         if _numba_error.startswith(("ModuleNotFoundError", "ImportError")) and "numba" in _numba_error:
             raise BackendError("the numba backend needs physcam's 'fast' extra (numba is not installed): "
-                               "pip install 'physcam[fast]', or use backend='numpy' (the same rays, slower)")
+                               "pip install 'physcam[fast]', or trace with the numpy kernels (the same rays, slower: "
+                               "backend='numpy' or PHYSCAM_BACKEND=numpy)")
         raise BackendError(f"the numba backend is unavailable ({_numba_error}); use backend='numpy'")
     return backend
 
@@ -160,7 +161,7 @@ def get_kernel(backend: str = "auto"):
         env = os.environ.get("PHYSCAM_BACKEND", "auto")
         if env == "auto":
             return _numba_kernel if _numba_kernel is not None else _auto
-        backend = env
+        backend = resolve_backend(backend)  # PHYSCAM_BACKEND, checked (its message names the variable)
     if resolve_backend(backend) == "numba":
         return _load_numba()
     from ._numpy import trace_rays
