@@ -63,6 +63,16 @@ def test_the_default_sensor_is_super_35_and_said(capsys):
     one_line_error(rc, err)
 
 
+def test_the_exports_say_the_default_sensor_too(capsys, tmp_path):
+    # found by a review: export rib and mitsuba used Super 35 without a word (the report kept the note)
+    for args in (("rib", "-o", str(tmp_path / "cam.rib")), ("mitsuba", "-o", str(tmp_path / "mts"))):
+        rc, _, err = run(capsys, "export", *args, "--lens", "dgauss_50mm", "--focus", "2m", "--fstop", "4")
+        assert rc == 0 and "physcam: note: no --sensor given: Super 35" in err, args
+        rc, _, err = run(capsys, "export", *args, "--lens", "dgauss_50mm", "--focus", "2m", "--fstop", "4",
+                         "--sensor", "ALEXA 35", "--force")
+        assert rc == 0 and "no --sensor given" not in err, args
+
+
 # ---- the user config ---------------------------------------------------------------------------
 def test_user_config_sets_sensor_units_coc_and_output_folder(capsys, tmp_path, monkeypatch):
     out_dir = tmp_path / "shots"

@@ -343,9 +343,13 @@ def _thin_lens_gap(args, report):
 
 def _report(args):
     """The lens report of the command's arguments (a focus mark, or one solved from --near/--far)."""
+    from ._common import note
     from .report import solve_from_args
 
-    return solve_from_args(args)
+    report = solve_from_args(args)
+    if getattr(args, "sensor_defaulted", False):  # the report keeps it in its notes; an export says it on stderr
+        note(next(n for n in report.notes if n.startswith("no --sensor given")))
+    return report
 
 
 def run_rib(args) -> int:
@@ -580,7 +584,6 @@ def run_mitsuba(args) -> int:
     from ..errors import InputError
     from ..export.mitsuba import mitsuba_camera_values, mitsuba_scene_dict, mitsuba_scene_xml
     from ..io import atomic_write, check_writable
-    from .report import solve_from_args
 
     name = str(args.name)
     if not name or name in (".", "..") or "/" in name or "\\" in name or "\0" in name:
@@ -590,7 +593,7 @@ def run_mitsuba(args) -> int:
     xml_path, json_path = Path(args.output) / f"{name}.xml", Path(args.output) / f"{name}.json"
     for path in (xml_path, json_path):
         check_writable(path, force=args.force)
-    report = solve_from_args(args)
+    report = _report(args)
     if report.focus_is_infinite:
         raise InputError("a Mitsuba thinlens sensor's focus_distance is finite: give the focus mark (e.g. --focus "
                          "1000m) or --focus hyperfocal")
