@@ -25,8 +25,9 @@ of what passes (a neighbour differs) is traced again at 4 x 4 sub-cell centres, 
 edge (the real aperture shape, vignetting by rims) is resolved to 1/16 of a cell's area. Each
 traced ray carries its cell-area share (1 or 1/16) as a quadrature weight.
 
-Optical path: the kernels are run one surface at a time (:func:`physcam.trace.trace.trace_packed`)
-and each leg adds n (p' - p) . d, signed, so virtual legs of sequential tracing count negative.
+Optical path: the kernels add each leg's n (p' - p) . d, signed, so virtual legs of sequential
+tracing count negative (:func:`physcam.trace.trace.trace_packed` with ``opl``; one call through
+every surface, two around a shaped stop).
 At infinity a ray starts with n (d . (p - p_chief)), the path from the plane wavefront through
 the chief ray's start. Optical path difference (Welford, *Aberrations of Optical Systems*, 9.2;
 the convention of optiland 0.6.3, see docs/image-quality.md): the reference sphere is centred
@@ -131,9 +132,9 @@ def _concat(parts) -> Traced:
 class _Tracer:
     """One focused, stopped-down lens: the packed table, reused for every batch.
 
-    A batch may mix wavelengths (the kernels take each ray's own); the kernels run one surface
-    at a time so each leg's optical path can be added, so every batch of the analyses is made as
-    large as it can be (all wavelengths, all fields of a chart) to call them few times."""
+    A batch may mix wavelengths (the kernels take each ray's own, and add each leg's optical path
+    in the same call); every batch of the analyses is made as large as it can be (all wavelengths,
+    all fields of a chart) to call them few times."""
 
     def __init__(self, st: Setup):
         from ..trace.kernels import get_kernel
@@ -170,22 +171,23 @@ class _Tracer:
         from ..trace.trace import trace_packed
 
         wl = np.broadcast_to(np.asarray(wavelengths, dtype=float), (np.shape(start)[0],))
-        uniq, inv = np.unique(wl, return_inverse=True)
-        nb = np.stack([self.indices(w)[0] for w in uniq])[inv]  # (n, rows)
+        for w in np.unique(wl):
+            self.indices(w)  # every medium usable at every wavelength
         rays = RayBatch.from_arrays(start, direction, wl)
         opl = np.array(opl0, dtype=np.float64, copy=True)
         amp = np.ones(len(rays))
-        for k in range(self.S.shape[0]):
-            x0, y0, z0, L0, M0, N0 = (a.copy() for a in (rays.x, rays.y, rays.z, rays.L, rays.M, rays.N))
-            trace_packed(self.kernel, rays, self.S[k:k + 1], self.kinds[k:k + 1], clip=clip, fresnel=False,
-                         end_z=None)
-            opl += nb[:, k] * ((rays.x - x0) * L0 + (rays.y - y0) * M0 + (rays.z - z0) * N0)
-            if k == self.stop_row and clip and self.st.aperture is not None:
-                r = self.S[k, 6]  # SEMI: the stop's semi-diameter at this f-stop
-                dens = self.st.aperture.density_at(rays.x / r, rays.y / r)
-                blocked = (rays.flag == OK) & ~(dens > 0.0)
-                rays.flag[blocked] = 2  # CLIPPED
-                amp = np.sqrt(np.maximum(dens, 0.0))
+        # the kernel adds each leg's optical path: one call through every row, or two around a shaped stop
+        shaped = clip and self.st.aperture is not None
+        cut = self.stop_row + 1 if shaped else self.S.shape[0]
+        trace_packed(self.kernel, rays, self.S[:cut], self.kinds[:cut], clip=clip, fresnel=False, end_z=None, opl=opl)
+        if shaped:
+            r = self.S[self.stop_row, 6]  # SEMI: the stop's semi-diameter at this f-stop
+            dens = self.st.aperture.density_at(rays.x / r, rays.y / r)
+            blocked = (rays.flag == OK) & ~(dens > 0.0)
+            rays.flag[blocked] = 2  # CLIPPED
+            amp = np.sqrt(np.maximum(dens, 0.0))
+            trace_packed(self.kernel, rays, self.S[cut:], self.kinds[cut:], clip=clip, fresnel=False, end_z=None,
+                         opl=opl)
         ok = (rays.flag == OK) & np.isfinite(opl)
         return Traced(rays.x, rays.y, rays.z, rays.L, rays.M, rays.N, opl, ok, np.where(ok, amp, 0.0))
 

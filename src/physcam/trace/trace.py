@@ -50,14 +50,16 @@ def _is_mono(wl) -> bool:
 
 
 def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chunk_size=DEFAULT_CHUNK,
-                 indexed: bool = False):
+                 indexed: bool = False, opl=None):
     """Trace ``rays`` in place through rows of a packed surface table (``kernels._layout.pack``).
 
     The low-level step under :func:`trace_through`, public for analyses that trace a lens in
     legs (ghost paths reflect between legs). ``kernel`` comes from ``kernels.get_kernel``.
     ``S`` is not modified (a one-wavelength batch gets its indices on a copy), unless ``indexed``
     says its index columns already hold the batch's one wavelength
-    (:meth:`physcam.trace.tables.PackedTable.at_wavelength`).
+    (:meth:`physcam.trace.tables.PackedTable.at_wavelength`). ``opl``: a float64 array, one per
+    ray, to which each leg's optical path n (p' - p) . d up to each row is added in place (rays
+    that stop at a row get no leg for it; the leg to ``end_z`` is not added).
     """
     has_end = end_z is not None
     ez = float(end_z) if has_end else 0.0
@@ -73,7 +75,8 @@ def trace_packed(kernel, rays: RayBatch, S, kinds, *, clip, fresnel, end_z, chun
             set_wavelength(Sw, float(wl[0]))
             if S.dtype != np.float64:
                 Sw = np.ascontiguousarray(Sw, dtype=S.dtype)
-        kernel(*(c[a:b] for c in cols), Sw, kinds, bool(clip), bool(fresnel), ez, has_end, mono)
+        kernel(*(c[a:b] for c in cols), Sw, kinds, bool(clip), bool(fresnel), ez, has_end, mono,
+               None if opl is None else opl[a:b])
     return rays
 
 

@@ -1,7 +1,8 @@
 """Kernel dispatch: ``backend="auto" | "numba" | "numpy"``.
 
 The only module that imports numba. Both kernels have the signature of :func:`._numpy.trace_rays`
-and give the same rays: identical flags, positions and directions, Fresnel weights within a few
+(its optional ``opl``: each leg's optical path added to a float64 array, the same in both
+kernels, for the wavefront analyses) and give the same rays: identical flags, positions and directions, Fresnel weights within a few
 units in the last place (docs/ray-tracing.md, tests/trace/test_simd_kernel.py). Set
 ``PHYSCAM_BACKEND=numpy`` (or ``numba``) to force one.
 
@@ -77,13 +78,19 @@ def _load_numba():
             from . import _jitcache
 
             _jitcache.install()
+            import numpy as np
+
             from ._numba import trace_rays
 
-            def trace_rays_auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
+            no_opl = np.empty(0)
+
+            def trace_rays_auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono,
+                                opl=None):
                 below = SERIAL_BELOW
                 if x.shape[0] >= below and LOAD_AWARE and _busy():
                     below = x.shape[0] + 1
-                trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, below)
+                trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, below,
+                           no_opl if opl is None else opl)
 
             trace_rays_auto.jit = trace_rays
             _numba_kernel = trace_rays_auto
@@ -97,13 +104,14 @@ def numba_available() -> bool:
 
 
 def jit_kernel():
-    """The numba dispatcher itself (``trace_rays`` with the trailing ``serial_below`` argument),
-    loading numba; None when numba is unavailable. For benchmarks and tests."""
+    """The numba dispatcher itself (``trace_rays`` with the trailing ``serial_below`` and ``opl``
+    arguments: an empty float64 array for no optical path), loading numba; None when numba is
+    unavailable. For benchmarks and tests."""
     k = _load_numba()
     return None if k is None else k.jit
 
 
-def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
+def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
     """The "auto" kernel: numpy until numba pays for its loading, then the JIT kernel (module notes)."""
     global _numpy_spent
     k = _numba_kernel
@@ -118,8 +126,8 @@ def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has
         if k is None:
             from ._numpy import trace_rays
 
-            return trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono)
-    return k(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono)
+            return trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl)
+    return k(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl)
 
 
 def backend_for_job(backend: str, ray_surfaces: float) -> str:

@@ -40,8 +40,13 @@ def _index(S, s, c, flag, l2, u):
     return n
 
 
-def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
-    """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``."""
+def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
+    """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``.
+
+    ``opl`` (float64, one per ray), if given: each leg's optical path n (p' - p) . d = n t |d|^2
+    to each row of ``S`` (n the index before it; t < 0 on a virtual leg counts negative) is added
+    to it in place, for the rays that reach the row inside its clear aperture (not the leg to
+    ``end_z``)."""
     # One piece on purpose (issue 28): one pass per surface over the whole batch of live rays, the
     # steps (module notes 1-5) in the numba kernel's order so that the two backends give
     # the same answers. The steps share ten live-ray arrays that shrink as rays fail (``fail``
@@ -159,6 +164,8 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
             nx_ = px + t * dx
             ny_ = py + t * dy
             nz_ = pz + t * dz
+            if opl is not None:
+                leg = t * (dx * dx + dy * dy + dz * dz)
             # clip; the same comparison catches a hit point that is not finite (overflow or 0/0
             # on huge or degenerate input): 0 * inf is NaN, which fails every comparison
             r2 = nx_ * nx_ + ny_ * ny_  # (hz: see the numba kernel)
@@ -172,6 +179,8 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                 nx_, ny_, nz_ = nx_[keep], ny_[keep], nz_[keep]
                 if kd == _ASPHERE:
                     dsr = dsr[keep]
+                if opl is not None:
+                    leg = leg[keep]
                 if clip:
                     clipped = clipped[keep]
             if clip and clipped.any():
@@ -180,7 +189,12 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                 nx_, ny_, nz_ = nx_[keep], ny_[keep], nz_[keep]
                 if kd == _ASPHERE:
                     dsr = dsr[keep]
+                if opl is not None:
+                    leg = leg[keep]
             px, py, pz = nx_, ny_, nz_
+            if opl is not None:
+                n1 = np.full_like(px, S[s, N1]) if mono else _index(S, s, NB, SB, l2, il2)
+                opl[live] += n1 * leg
             if kd == _STOP:
                 continue
             if mono:
@@ -188,7 +202,8 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
                 n2 = np.full_like(px, S[s, N2])
                 eta = np.full_like(px, S[s, ETA])
             else:
-                n1 = _index(S, s, NB, SB, l2, il2)
+                if opl is None:
+                    n1 = _index(S, s, NB, SB, l2, il2)
                 n2 = _index(S, s, NA, SA, l2, il2)
                 eta = n1 / n2
             if kd == _FLAT:
