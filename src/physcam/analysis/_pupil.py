@@ -148,6 +148,14 @@ class _Tracer:
         self.kernel = get_kernel(st.backend)
         self._n = {}
 
+    def plan(self, rays: float) -> None:
+        """Pick the kernel for a job of about ``rays`` rays through every surface, known ahead:
+        the numpy kernel where it does the whole job in less time than loading numba takes
+        (:func:`physcam.trace.kernels.backend_for_job`; both kernels give the same rays)."""
+        from ..trace.kernels import backend_for_job, get_kernel
+
+        self.kernel = get_kernel(backend_for_job(self.st.backend, rays * (self.S.shape[0] + 1)))
+
     def indices(self, wavelength_nm: float) -> tuple[np.ndarray, float]:
         """(index before each row, index of image space) at one wavelength."""
         w = float(wavelength_nm)
@@ -439,6 +447,8 @@ def trace_pupils(st: Setup, jobs, tracer: _Tracer) -> list[PupilTrace]:
         xs, ys = _grid_centres(n, cell, cx, cy)
         GX, GY = np.meshgrid(xs, ys)
         grids.append((n, cell, cx, cy, xs, ys, GX.ravel(), GY.ravel()))
+    # the job ahead: every cell centre, and the edge of a round pupil (about 7 n cells) at q x q sub-cells
+    tracer.plan(sum(n * n + 7 * n * q * q for _, n, _ in jobs))
     centres = _trace_groups(tracer, [(fl, g[6], g[7]) for (fl, _, _), g in zip(jobs, grids)])
     edges, subs = [], []
     off = ((np.arange(q) + 0.5) / q - 0.5)
@@ -656,13 +666,15 @@ def _fine_arrays(pt: PupilTrace, ws: WavefrontSamples, mask: np.ndarray, wmean: 
     i0 = np.clip(np.floor(c).astype(int), 0, n - 1)
     i1 = np.clip(i0 + 1, 0, n - 1)
     f = np.clip(c - np.floor(c), 0.0, 1.0)
-    num = np.zeros((n * q, n * q))
-    den = np.zeros((n * q, n * q))
-    for ri, wr in ((i0, 1.0 - f), (i1, f)):
-        for ci, wc in ((i0, 1.0 - f), (i1, f)):
-            wgt = wr[:, None] * wc[None, :] * mask[np.ix_(ri, ci)]
-            num += wgt * wmean[np.ix_(ri, ci)]
-            den += wgt
+    g = 1.0 - f
+
+    def lerp2(a):  # separable: along rows, then along columns
+        rows = g[:, None] * a[i0] + f[:, None] * a[i1]
+        return rows[:, i0] * g[None, :] + rows[:, i1] * f[None, :]
+
+    lit = mask.astype(float)
+    num = lerp2(lit * wmean)
+    den = lerp2(lit)
     fine_opd = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
     e = ~centre
     er, ec = pt.row[e] * q + pt.sub[e] // q, pt.col[e] * q + pt.sub[e] % q
@@ -683,6 +695,21 @@ def max_waves_per_cell(pf: PupilFunction) -> float:
     return worst
 
 
+#: Whole sub-cell lags a pupil sums one by one (a product summed over the overlap each, about
+#: 0.1 ms at 256 sub-cells across) before :func:`otf_lags` computes them all by FFT (1.5-4 ms per
+#: axis): a chart reads 2 per frequency.
+DIRECT_LAGS_MAX = 16
+
+
+def _complex_pupil(pf: PupilFunction, aberrated: bool) -> np.ndarray:
+    """P = A exp(-2 pi i W) over the sub-cells (cached per pupil); ``aberrated=False``: A alone."""
+    key = ("P", aberrated)
+    if key not in pf._lags:
+        A = pf.fine_amp * pf.fine_mask
+        pf._lags[key] = A * np.exp(-2j * np.pi * pf.fine_opd) if aberrated else A.astype(complex)
+    return pf._lags[key]
+
+
 def otf_lags(pf: PupilFunction, axis: int, *, aberrated: bool = True) -> np.ndarray:
     """Normalised OTF at every whole sub-cell shear 0, 1, ... along ``axis`` (0: y, the tangential
     direction of a Y-meridian field; 1: x, sagittal): R[k] = sum P(u) conj(P(u - k)) / sum |P|^2 over
@@ -693,8 +720,7 @@ def otf_lags(pf: PupilFunction, axis: int, *, aberrated: bool = True) -> np.ndar
     key = (axis, aberrated)
     cache = pf._lags
     if key not in cache:
-        A = pf.fine_amp * pf.fine_mask
-        P = A * np.exp(-2j * np.pi * pf.fine_opd) if aberrated else A.astype(complex)
+        P = _complex_pupil(pf, aberrated)
         if axis == 1:
             P = P.T
         n = P.shape[0]
@@ -706,17 +732,38 @@ def otf_lags(pf: PupilFunction, axis: int, *, aberrated: bool = True) -> np.ndar
     return cache[key]
 
 
+def _lag(pf: PupilFunction, k: int, axis: int, aberrated: bool) -> complex:
+    """R[k] of :func:`otf_lags` (k < the sub-cells across), summed directly over the overlap of P and
+    P shifted by k while a pupil has been asked for few lags, from the FFT of all lags after."""
+    full = pf._lags.get((axis, aberrated))
+    if full is not None:
+        return complex(full[k])
+    direct = pf._lags.setdefault(("direct", axis, aberrated), {})
+    if k not in direct:
+        if len(direct) >= DIRECT_LAGS_MAX:
+            return complex(otf_lags(pf, axis, aberrated=aberrated)[k])
+        P = _complex_pupil(pf, aberrated)
+        if axis == 1:
+            P = P.T
+        n = P.shape[0]
+        norm = pf._lags.get(("norm", aberrated))
+        if norm is None:
+            norm = pf._lags["norm", aberrated] = float((P.real * P.real + P.imag * P.imag).sum())
+        direct[k] = complex((P[k:] * P[:n - k].conj()).sum()) / norm if norm > 0 else 0j
+    return direct[k]
+
+
 def shear_otf(pf: PupilFunction, shift_cells: float, axis: int, *, aberrated: bool = True) -> complex:
     """Normalised OTF at a pupil shear of ``shift_cells`` (>= 0, in cells) along ``axis``: :func:`otf_lags`
     interpolated linearly between whole sub-cell shears (a quarter cell apart, where the OTF is
     smooth: its curvature times (1/4 cell)^2 / 8 is the interpolation error)."""
-    lags = otf_lags(pf, axis, aberrated=aberrated)
+    size = pf.fine_mask.shape[axis]  # sub-cells across along the shear
     s = float(shift_cells) * pf.q
     k = int(math.floor(s))
-    if k >= lags.size - 1:
-        return 0j if k >= lags.size else complex(lags[-1] * (k + 1 - s))
+    if k >= size - 1:
+        return 0j if k >= size else _lag(pf, size - 1, axis, aberrated) * (k + 1 - s)
     f = s - k
-    return complex((1.0 - f) * lags[k] + f * lags[k + 1])
+    return (1.0 - f) * _lag(pf, k, axis, aberrated) + f * _lag(pf, k + 1, axis, aberrated)
 
 
 def cutoff_cells(pf: PupilFunction, axis: int) -> float:

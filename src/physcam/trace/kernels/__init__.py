@@ -34,15 +34,17 @@ BACKENDS = ("auto", "numba", "numpy")
 #: Batches smaller than this run the JIT kernel serially (measured crossover, docs/performance.md).
 SERIAL_BELOW = 1024
 #: "auto" before numba is loaded: the numpy kernel's cost per ray and surface, and per surface and
-#: call (dgauss_50mm on this machine: 1.3-2.2 M rays/s through 11 surfaces; ~25 us of numpy calls
-#: per surface), the numpy work allowed in all (about half of what loading numba costs) and in one call
-NUMPY_RAY_SURFACE_S = 60e-9
+#: call (dgauss_50mm on this machine, 5e5 rays in slices of 2^14: 32-38 ns per ray and surface, one
+#: wavelength or three with the optical path, at load 3.5; ~25 us of numpy calls per surface), the
+#: numpy work allowed in all (about half of what loading numba costs) and in one call
+NUMPY_RAY_SURFACE_S = 40e-9
 NUMPY_SURFACE_S = 30e-6
 NUMPY_BUDGET_S = 0.1
 NUMPY_CALL_MAX_S = 0.04
 #: What loading numba costs a process before its first traced ray: ``import numba`` and the first
-#: call's target initialisation (0.115 s + 0.14 s on this machine, idle; docs/performance.md)
-NUMBA_LOAD_S = 0.25
+#: call's target initialisation (0.115 s + 0.14 s on this machine, idle, 2026-11-23; 0.33-0.38 s of
+#: CPU at load 3.9, 2026-11-26; docs/performance.md)
+NUMBA_LOAD_S = 0.3
 #: Large batches too run serially while the machine is busy (1-minute load average above the
 #: cores numba uses, plus 0.5): numba's parallel loop splits the blocks statically, so with other
 #: processes on the cores it waits for its slowest thread (benchmarks/small_calls.py measured the
