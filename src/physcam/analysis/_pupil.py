@@ -179,8 +179,10 @@ class _Tracer:
         from ..trace.trace import trace_packed
 
         wl = np.broadcast_to(np.asarray(wavelengths, dtype=float), (np.shape(start)[0],))
-        for w in np.unique(wl):
-            self.indices(w)  # every medium usable at every wavelength
+        rest = wl  # every medium usable at every wavelength (a batch has a few; np.unique imports numpy.ma)
+        while rest.size:
+            self.indices(rest[0])
+            rest = rest[rest != rest[0]]
         rays = RayBatch.from_arrays(start, direction, wl)
         opl = np.array(opl0, dtype=np.float64, copy=True)
         amp = np.ones(len(rays))
@@ -743,13 +745,14 @@ def _lag(pf: PupilFunction, k: int, axis: int, aberrated: bool) -> complex:
         if len(direct) >= DIRECT_LAGS_MAX:
             return complex(otf_lags(pf, axis, aberrated=aberrated)[k])
         P = _complex_pupil(pf, aberrated)
+        if ("conj", aberrated) not in pf._lags:
+            pf._lags["conj", aberrated] = P.conj()
+            pf._lags["norm", aberrated] = float((P.real * P.real + P.imag * P.imag).sum())
+        Pc, norm = pf._lags["conj", aberrated], pf._lags["norm", aberrated]
         if axis == 1:
-            P = P.T
+            P, Pc = P.T, Pc.T
         n = P.shape[0]
-        norm = pf._lags.get(("norm", aberrated))
-        if norm is None:
-            norm = pf._lags["norm", aberrated] = float((P.real * P.real + P.imag * P.imag).sum())
-        direct[k] = complex((P[k:] * P[:n - k].conj()).sum()) / norm if norm > 0 else 0j
+        direct[k] = complex(np.einsum("ij,ij->", P[k:], Pc[:n - k])) / norm if norm > 0 else 0j
     return direct[k]
 
 
