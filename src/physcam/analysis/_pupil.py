@@ -343,8 +343,10 @@ def _trace_groups(tracer: _Tracer, groups, *, clip=True) -> list[Traced]:
     """Trace several (field, gx, gy) groups in one batch; returns one :class:`Traced` per group."""
     if not groups:
         return []
+    # by wavelength, so that the kernels see a few runs of one wavelength (trace.trace_packed)
+    order = sorted(range(len(groups)), key=lambda i: groups[i][0].wavelength_nm)
     starts, dirs, opls, wls, sizes = [], [], [], [], []
-    for fl, gx, gy in groups:
+    for fl, gx, gy in (groups[i] for i in order):
         s, d, o = _starts(tracer.st, fl, tracer.n_object(fl.wavelength_nm), gx, gy)
         starts.append(s)
         dirs.append(d)
@@ -354,7 +356,10 @@ def _trace_groups(tracer: _Tracer, groups, *, clip=True) -> list[Traced]:
     res = tracer.trace(np.concatenate(starts), np.concatenate(dirs), np.concatenate(opls), np.concatenate(wls),
                        clip=clip)
     cut = np.cumsum([0] + sizes)
-    return [res.take(slice(cut[i], cut[i + 1])) for i in range(len(groups))]
+    out: list = [None] * len(groups)
+    for j, i in enumerate(order):
+        out[i] = res.take(slice(cut[j], cut[j + 1]))
+    return out
 
 
 # --------------------------------------------------------------------------------------------
