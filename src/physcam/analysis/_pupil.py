@@ -286,25 +286,38 @@ def field_for_image_height(st: Setup, height_mm: float, wavelength_nm: float) ->
     the chief ray is aimed back from the film through the centre of the stop (:func:`._chief.aim_from_film`)
     and traced out of the lens; at infinity its direction is the field, at a finite object the point
     where it meets the object plane, seen from the paraxial entrance pupil."""
+    return float(fields_for_image_heights(st, [height_mm], wavelength_nm)[0])
+
+
+def fields_for_image_heights(st: Setup, heights_mm, wavelength_nm: float) -> np.ndarray:
+    """:func:`field_for_image_height` of several heights at once (one aiming, one trace: each ray's
+    Newton iteration is its own, so the angles are those of one height at a time); the error names
+    the first height outside the image circle."""
     from ..trace import RayBatch, trace_through
     from ._chief import aim_from_film
 
-    h = require_finite("image height", height_mm)
-    if h == 0.0:
-        return 0.0
-    aimed = aim_from_film(st.lens, [[0.0, h]], st.film_z, wavelength_nm=wavelength_nm, backend=st.backend)
-    out = None
-    if bool(aimed.ok[0]):
-        out = trace_through(st.lens, RayBatch.from_arrays(aimed.start, aimed.direction, wavelength_nm), reverse=True,
-                            clip=False, backend=st.backend)
-    if out is None or not bool(out.ok[0]) or not out.N[0] < 0:
+    hs = np.array([require_finite("image height", h) for h in heights_mm], dtype=float)
+    out = np.zeros(hs.size)
+    idx = np.flatnonzero(hs != 0.0)
+    if idx.size == 0:
+        return out
+    aimed = aim_from_film(st.lens, np.stack([np.zeros(idx.size), hs[idx]], axis=1), st.film_z,
+                          wavelength_nm=wavelength_nm, backend=st.backend)
+    ok = aimed.ok.copy()
+    if ok.any():
+        rays = trace_through(st.lens, RayBatch.from_arrays(aimed.start[ok], aimed.direction[ok], wavelength_nm),
+                             reverse=True, clip=False, backend=st.backend)
+        ok[ok] = rays.ok & (rays.N < 0)
+    if not ok.all():
+        h = hs[idx[np.flatnonzero(~ok)[0]]]
         raise OpticsError(f"image height {h:g} mm lies outside the image circle of {st.lens_name!r}: no chief ray "
                           f"from there passes through the centre of the stop and out of the lens")
     if st.at_infinity:
-        return math.degrees(math.atan2(-float(out.M[0]), -float(out.N[0])))
-    t = (st.object_z - out.z[0]) / out.N[0]
-    y_obj = float(out.y[0] + t * out.M[0])
-    return math.degrees(math.atan2(-y_obj, st.z_ep - st.object_z))
+        out[idx] = np.degrees(np.arctan2(-rays.M, -rays.N))
+        return out
+    t = (st.object_z - rays.z) / rays.N
+    out[idx] = np.degrees(np.arctan2(-(rays.y + t * rays.M), st.z_ep - st.object_z))
+    return out
 
 
 def image_circle_radius(st: Setup, wavelength_nm: float, outside_mm: float, tol_mm: float = 0.05) -> float:
