@@ -30,7 +30,8 @@ from ._layout import CLIPPED, MISSED, TIR
 
 _FLAT, _STOP, _QUADRIC, _ASPHERE = 0, 1, 2, 3
 #: Rays per slice: the per-surface temporaries (a few dozen arrays of this length, 128 KiB each)
-#: stay in the L2 cache; measured 1.4x faster than slices of 2^18 rays (docs/performance.md).
+#: stay in the L2 cache: 5e5 rays through dgauss_50mm, 32 ns per ray and surface against 62 in
+#: slices of 2^18 (docs/ray-tracing.md).
 SLICE = 1 << 14
 
 
