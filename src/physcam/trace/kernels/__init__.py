@@ -138,12 +138,19 @@ def backend_for_job(backend: str, ray_surfaces: float) -> str:
 
     "numpy" when ``backend`` is "auto" (and ``PHYSCAM_BACKEND`` does not say otherwise), numba is
     not loaded yet and the numpy kernel would do the whole job (:data:`NUMPY_RAY_SURFACE_S` per
-    intersection) in less time than loading numba takes (:data:`NUMBA_LOAD_S`); ``backend``
-    unchanged otherwise. Either way the rays are the same (module notes).
+    intersection), with the numpy work this process has done so far, in less time than loading
+    numba takes (:data:`NUMBA_LOAD_S`); ``backend`` unchanged otherwise, so a process that keeps
+    tracing pays for numba once its numpy work would have paid for it. Either way the rays are the
+    same (module notes).
     """
+    global _numpy_spent
     if backend != "auto" or os.environ.get("PHYSCAM_BACKEND", "auto") != "auto" or _numba_kernel is not None:
         return backend
-    return "numpy" if ray_surfaces * NUMPY_RAY_SURFACE_S < NUMBA_LOAD_S else backend
+    est = ray_surfaces * NUMPY_RAY_SURFACE_S
+    if _numpy_spent + est < NUMBA_LOAD_S:
+        _numpy_spent += est
+        return "numpy"
+    return backend
 
 
 def resolve_backend(backend: str = "auto") -> str:
