@@ -312,11 +312,12 @@ def fields_for_image_heights(st: Setup, heights_mm, wavelength_nm: float) -> np.
         h = hs[idx[np.flatnonzero(~ok)[0]]]
         raise OpticsError(f"image height {h:g} mm lies outside the image circle of {st.lens_name!r}: no chief ray "
                           f"from there passes through the centre of the stop and out of the lens")
-    if st.at_infinity:
-        out[idx] = np.degrees(np.arctan2(-rays.M, -rays.N))
-        return out
-    t = (st.object_z - rays.z) / rays.N
-    out[idx] = np.degrees(np.arctan2(-(rays.y + t * rays.M), st.z_ep - st.object_z))
+    for i, x, y, z, M, N in zip(idx, rays.x, rays.y, rays.z, rays.M, rays.N):  # math.atan2: libm's rounding
+        if st.at_infinity:
+            out[i] = math.degrees(math.atan2(-float(M), -float(N)))
+        else:
+            t = (st.object_z - z) / N
+            out[i] = math.degrees(math.atan2(-float(y + t * M), st.z_ep - st.object_z))
     return out
 
 
@@ -722,11 +723,15 @@ DIRECT_LAGS_MAX = 16
 
 
 def _complex_pupil(pf: PupilFunction, aberrated: bool) -> np.ndarray:
-    """P = A exp(-2 pi i W) over the sub-cells (cached per pupil); ``aberrated=False``: A alone."""
+    """P = A exp(-2 pi i W) over the sub-cells (cached per pupil); ``aberrated=False``: A alone. Only
+    the bounding box of the lit sub-cells: the rows and columns outside it add nothing to any lag."""
     key = ("P", aberrated)
     if key not in pf._lags:
         A = pf.fine_amp * pf.fine_mask
-        pf._lags[key] = A * np.exp(-2j * np.pi * pf.fine_opd) if aberrated else A.astype(complex)
+        rows, cols = np.flatnonzero(A.any(axis=1)), np.flatnonzero(A.any(axis=0))
+        box = np.s_[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1] if rows.size else np.s_[:0, :0]
+        A = A[box]
+        pf._lags[key] = A * np.exp(-2j * np.pi * pf.fine_opd[box]) if aberrated else A.astype(complex)
     return pf._lags[key]
 
 
@@ -743,12 +748,13 @@ def otf_lags(pf: PupilFunction, axis: int, *, aberrated: bool = True) -> np.ndar
         P = _complex_pupil(pf, aberrated)
         if axis == 1:
             P = P.T
-        n = P.shape[0]
+        n, size = P.shape[0], pf.fine_mask.shape[axis]
         norm = float((np.abs(P) ** 2).sum())
         F = np.fft.fft(P, n=2 * n, axis=0)
-        r = np.fft.ifft((F * F.conj()).sum(axis=1))[:n]
+        r = np.zeros(size, dtype=complex)  # no overlap past the lit box: 0
+        r[:n] = np.fft.ifft((F * F.conj()).sum(axis=1))[:n]
         # r[k] = sum P(u + k) conj(P(u)); the shear convention here is P(u) conj(P(u - k)): the same sum
-        cache[key] = r / norm if norm > 0 else np.zeros(n, dtype=complex)
+        cache[key] = r / norm if norm > 0 else np.zeros(size, dtype=complex)
     return cache[key]
 
 
@@ -770,7 +776,8 @@ def _lag(pf: PupilFunction, k: int, axis: int, aberrated: bool) -> complex:
         if axis == 1:
             P, Pc = P.T, Pc.T
         n = P.shape[0]
-        direct[k] = complex(np.einsum("ij,ij->", P[k:], Pc[:n - k])) / norm if norm > 0 else 0j
+        lit = norm > 0 and k < n  # past the lit box the shifted pupil does not overlap
+        direct[k] = complex(np.einsum("ij,ij->", P[k:], Pc[:n - k])) / norm if lit else 0j
     return direct[k]
 
 
