@@ -312,7 +312,7 @@ def fields_for_image_heights(st: Setup, heights_mm, wavelength_nm: float) -> np.
         h = hs[idx[np.flatnonzero(~ok)[0]]]
         raise OpticsError(f"image height {h:g} mm lies outside the image circle of {st.lens_name!r}: no chief ray "
                           f"from there passes through the centre of the stop and out of the lens")
-    for i, x, y, z, M, N in zip(idx, rays.x, rays.y, rays.z, rays.M, rays.N):  # math.atan2: libm's rounding
+    for i, y, z, M, N in zip(idx, rays.y, rays.z, rays.M, rays.N):  # math.atan2: libm's rounding, as before
         if st.at_infinity:
             out[i] = math.degrees(math.atan2(-float(M), -float(N)))
         else:
