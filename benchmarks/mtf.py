@@ -9,6 +9,7 @@ the real stop ("iterative", the convention physcam's chief rays follow and the o
 with its default paraxial aiming. optiland is too heavy for physcam's environment, so it runs in
 its own (``--optiland-python``, see scripts/optiland_mtf_oracle.py for the set-up); without it
 only physcam is timed. Best of ``--repeat`` runs after a warm-up (numba compiles on first use).
+The CLI chart cold, in fresh processes (goal 1 s, issue 27): ``benchmarks/startup.py --only mtf``.
 
     .venv/bin/python benchmarks/mtf.py --repeat 3 --optiland-python /tmp/optiland-venv/bin/python
 """

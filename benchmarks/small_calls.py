@@ -32,6 +32,8 @@ from physcam.analysis.spot import spot_diagram
 from physcam.lens.library import load_lens
 from physcam.trace import RayBatch, paraxial_image_z, trace_through, trace_to_film
 
+NO_OPL = np.empty(0)  # the JIT kernel's last argument: no optical path
+
 
 def load() -> str:
     return ", ".join(f"{v:.2f}" for v in os.getloadavg())
@@ -75,7 +77,7 @@ def overhead(lens, film) -> None:
         p = packed_table(lens)
         S = p.at_wavelength(ray.wavelength_nm[0])
         cols = work.columns()
-        t_k = per_call(lambda: jit(*cols, S, p.kinds, True, False, film, True, True, 1 << 30))
+        t_k = per_call(lambda: jit(*cols, S, p.kinds, True, False, film, True, True, 1 << 30, NO_OPL))
         line += (f", kernel alone {t_k:.2f} us -> overhead {t_film - t_k:.2f} / {t_inplace - t_k:.2f} us "
                  f"(goal 10 us)")
     print(line)
@@ -100,7 +102,7 @@ def crossover(lens, film) -> None:
         for below in (1 << 30, 0):
             def call():
                 c = b.copy().columns()
-                jit(*c, S, p.kinds, True, False, film, True, True, below)
+                jit(*c, S, p.kinds, True, False, film, True, True, below, NO_OPL)
             copy_cost = per_call(lambda: b.copy().columns(), n=max(20, 20000 // n))
             res.append(per_call(call, n=max(20, 20000 // n)) - copy_cost)
         print(f"  {n:7d} {res[0]:10.1f} {res[1]:12.1f}")

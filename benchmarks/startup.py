@@ -1,7 +1,8 @@
 """Benchmark: wall time of CLI commands from process start to answer (cold processes).
 
 Goals: `physcam report` under 0.3 s (issue 2); `physcam spot`, `physcam bokeh` and
-`physcam distortion` under 0.5 s (issue 14). Each command runs in a fresh Python process (the
+`physcam distortion` under 0.5 s (issue 14); the vendor MTF chart (`physcam mtf`) under 1 s
+(issue 27). Each command runs in a fresh Python process (the
 OS file cache, numba's on-disk kernel cache and Python's bytecode cache warm: one untimed run
 first). The bytecode cache is what every installed Python program has after its first run; an
 environment with PYTHONDONTWRITEBYTECODE set (some CI images, this project's sandbox) would
@@ -28,6 +29,8 @@ COMMANDS = {
     "distortion": (PY + ["distortion", "dgauss_50mm"], 0.5),
     "bokeh --rays 1000000": (PY + ["bokeh", "dgauss_50mm", "--rays", "1000000"], None),
     "spot -o png": (PY + ["spot", "dgauss_50mm", "-o", "{tmp}/spot.png", "--force"], None),
+    # the vendor MTF chart (issue 27 item 5): 15 fields x 3 wavelengths, goal 1 s cold
+    "mtf": (PY + ["mtf", "--lens", "dgauss_50mm", "--fstop", "4", "--focus", "3m", "--sensor", "FF"], 1.0),
 }
 
 

@@ -42,6 +42,22 @@ def test_default_bokeh_stays_in_numpy_and_a_large_one_loads_numba():
     assert p.stdout.split() == ["False", "True"]
 
 
+def test_vendor_mtf_chart_stays_in_numpy_and_a_second_one_loads_numba():
+    # a chart's pupils (15 fields x 3 wavelengths, about 5e5 rays) cost the numpy kernel less than
+    # loading numba; a process that draws a second chart has spent that much and loads it
+    code = ("import sys, io, contextlib\nfrom physcam.cli import main\n"
+            "argv = ['mtf', '--lens', 'dgauss_50mm', '--fstop', '4', '--focus', '3m', '--sensor', 'FF', '--json']\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    assert main(argv) == 0\n"
+            "a = sorted({'numba', 'scipy', 'matplotlib', 'numpy.ma'} & set(sys.modules))\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    assert main(argv) == 0\n"
+            "print(a, 'numba' in sys.modules)")
+    p = _run(code)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.split() == ["[]", "True"]
+
+
 def test_the_program_exits_cleanly_after_numba_was_loaded(tmp_path):
     # physcam.cli.run skips the interpreter's teardown once numba is loaded: exit handlers still
     # run, output is complete, the status is main()'s

@@ -63,9 +63,10 @@ def test_serial_and_parallel_paths_agree_bit_for_bit_at_block_edges():
         outs = []
         for serial_below in (1 << 40, 0):
             r = rays.copy()
-            jit(*r.columns(), p.S, p.kinds, True, True, 120.0, True, False, serial_below)
-            outs.append(r)
-        for u, v in zip(outs[0].columns(), outs[1].columns()):
+            opl = np.zeros(n)
+            jit(*r.columns(), p.S, p.kinds, True, True, 120.0, True, False, serial_below, opl)
+            outs.append((r, opl))
+        for u, v in zip(outs[0][0].columns() + (outs[0][1],), outs[1][0].columns() + (outs[1][1],)):
             np.testing.assert_array_equal(u, v)
 
 

@@ -25,8 +25,9 @@ of what passes (a neighbour differs) is traced again at 4 x 4 sub-cell centres, 
 edge (the real aperture shape, vignetting by rims) is resolved to 1/16 of a cell's area. Each
 traced ray carries its cell-area share (1 or 1/16) as a quadrature weight.
 
-Optical path: the kernels are run one surface at a time (:func:`physcam.trace.trace.trace_packed`)
-and each leg adds n (p' - p) . d, signed, so virtual legs of sequential tracing count negative.
+Optical path: the kernels add each leg's n (p' - p) . d, signed, so virtual legs of sequential
+tracing count negative (:func:`physcam.trace.trace.trace_packed` with ``opl``; one call through
+every surface, two around a shaped stop).
 At infinity a ray starts with n (d . (p - p_chief)), the path from the plane wavefront through
 the chief ray's start. Optical path difference (Welford, *Aberrations of Optical Systems*, 9.2;
 the convention of optiland 0.6.3, see docs/image-quality.md): the reference sphere is centred
@@ -130,9 +131,9 @@ def _concat(parts) -> Traced:
 class _Tracer:
     """One focused, stopped-down lens: the packed table, reused for every batch.
 
-    A batch may mix wavelengths (the kernels take each ray's own); the kernels run one surface
-    at a time so each leg's optical path can be added, so every batch of the analyses is made as
-    large as it can be (all wavelengths, all fields of a chart) to call them few times."""
+    A batch may mix wavelengths (the kernels take each ray's own, and add each leg's optical path
+    in the same call); every batch of the analyses is made as large as it can be (all wavelengths,
+    all fields of a chart) to call them few times."""
 
     def __init__(self, st: Setup):
         from ..trace.kernels import get_kernel
@@ -145,6 +146,14 @@ class _Tracer:
         self.stop_row = int(np.flatnonzero(self.table.index == st.lens.stop_index)[0])
         self.kernel = get_kernel(st.backend)
         self._n = {}
+
+    def plan(self, rays: float) -> None:
+        """Pick the kernel for a job of about ``rays`` rays through every surface, known ahead:
+        the numpy kernel where it does the whole job in less time than loading numba takes
+        (:func:`physcam.trace.kernels.backend_for_job`; both kernels give the same rays)."""
+        from ..trace.kernels import backend_for_job, get_kernel
+
+        self.kernel = get_kernel(backend_for_job(self.st.backend, rays * (self.S.shape[0] + 1)))
 
     def indices(self, wavelength_nm: float) -> tuple[np.ndarray, float]:
         """(index before each row, index of image space) at one wavelength."""
@@ -169,22 +178,25 @@ class _Tracer:
         from ..trace.trace import trace_packed
 
         wl = np.broadcast_to(np.asarray(wavelengths, dtype=float), (np.shape(start)[0],))
-        uniq, inv = np.unique(wl, return_inverse=True)
-        nb = np.stack([self.indices(w)[0] for w in uniq])[inv]  # (n, rows)
+        rest = wl  # every medium usable at every wavelength (a batch has a few; np.unique imports numpy.ma)
+        while rest.size:
+            self.indices(rest[0])
+            rest = rest[rest != rest[0]]
         rays = RayBatch.from_arrays(start, direction, wl)
         opl = np.array(opl0, dtype=np.float64, copy=True)
         amp = np.ones(len(rays))
-        for k in range(self.S.shape[0]):
-            x0, y0, z0, L0, M0, N0 = (a.copy() for a in (rays.x, rays.y, rays.z, rays.L, rays.M, rays.N))
-            trace_packed(self.kernel, rays, self.S[k:k + 1], self.kinds[k:k + 1], clip=clip, fresnel=False,
-                         end_z=None)
-            opl += nb[:, k] * ((rays.x - x0) * L0 + (rays.y - y0) * M0 + (rays.z - z0) * N0)
-            if k == self.stop_row and clip and self.st.aperture is not None:
-                r = self.S[k, 6]  # SEMI: the stop's semi-diameter at this f-stop
-                dens = self.st.aperture.density_at(rays.x / r, rays.y / r)
-                blocked = (rays.flag == OK) & ~(dens > 0.0)
-                rays.flag[blocked] = 2  # CLIPPED
-                amp = np.sqrt(np.maximum(dens, 0.0))
+        # the kernel adds each leg's optical path: one call through every row, or two around a shaped stop
+        shaped = clip and self.st.aperture is not None
+        cut = self.stop_row + 1 if shaped else self.S.shape[0]
+        trace_packed(self.kernel, rays, self.S[:cut], self.kinds[:cut], clip=clip, fresnel=False, end_z=None, opl=opl)
+        if shaped:
+            r = self.S[self.stop_row, 6]  # SEMI: the stop's semi-diameter at this f-stop
+            dens = self.st.aperture.density_at(rays.x / r, rays.y / r)
+            blocked = (rays.flag == OK) & ~(dens > 0.0)
+            rays.flag[blocked] = 2  # CLIPPED
+            amp = np.sqrt(np.maximum(dens, 0.0))
+            trace_packed(self.kernel, rays, self.S[cut:], self.kinds[cut:], clip=clip, fresnel=False, end_z=None,
+                         opl=opl)
         ok = (rays.flag == OK) & np.isfinite(opl)
         return Traced(rays.x, rays.y, rays.z, rays.L, rays.M, rays.N, opl, ok, np.where(ok, amp, 0.0))
 
@@ -273,25 +285,39 @@ def field_for_image_height(st: Setup, height_mm: float, wavelength_nm: float) ->
     the chief ray is aimed back from the film through the centre of the stop (:func:`._chief.aim_from_film`)
     and traced out of the lens; at infinity its direction is the field, at a finite object the point
     where it meets the object plane, seen from the paraxial entrance pupil."""
+    return float(fields_for_image_heights(st, [height_mm], wavelength_nm)[0])
+
+
+def fields_for_image_heights(st: Setup, heights_mm, wavelength_nm: float) -> np.ndarray:
+    """:func:`field_for_image_height` of several heights at once (one aiming, one trace: each ray's
+    Newton iteration is its own, so the angles are those of one height at a time); the error names
+    the first height outside the image circle."""
     from ..trace import RayBatch, trace_through
     from ._chief import aim_from_film
 
-    h = require_finite("image height", height_mm)
-    if h == 0.0:
-        return 0.0
-    aimed = aim_from_film(st.lens, [[0.0, h]], st.film_z, wavelength_nm=wavelength_nm, backend=st.backend)
-    out = None
-    if bool(aimed.ok[0]):
-        out = trace_through(st.lens, RayBatch.from_arrays(aimed.start, aimed.direction, wavelength_nm), reverse=True,
-                            clip=False, backend=st.backend)
-    if out is None or not bool(out.ok[0]) or not out.N[0] < 0:
+    hs = np.array([require_finite("image height", h) for h in heights_mm], dtype=float)
+    out = np.zeros(hs.size)
+    idx = np.flatnonzero(hs != 0.0)
+    if idx.size == 0:
+        return out
+    aimed = aim_from_film(st.lens, np.stack([np.zeros(idx.size), hs[idx]], axis=1), st.film_z,
+                          wavelength_nm=wavelength_nm, backend=st.backend)
+    ok = aimed.ok.copy()
+    if ok.any():
+        rays = trace_through(st.lens, RayBatch.from_arrays(aimed.start[ok], aimed.direction[ok], wavelength_nm),
+                             reverse=True, clip=False, backend=st.backend)
+        ok[ok] = rays.ok & (rays.N < 0)
+    if not ok.all():
+        h = hs[idx[np.flatnonzero(~ok)[0]]]
         raise OpticsError(f"image height {h:g} mm lies outside the image circle of {st.lens_name!r}: no chief ray "
                           f"from there passes through the centre of the stop and out of the lens")
-    if st.at_infinity:
-        return math.degrees(math.atan2(-float(out.M[0]), -float(out.N[0])))
-    t = (st.object_z - out.z[0]) / out.N[0]
-    y_obj = float(out.y[0] + t * out.M[0])
-    return math.degrees(math.atan2(-y_obj, st.z_ep - st.object_z))
+    for i, y, z, M, N in zip(idx, rays.y, rays.z, rays.M, rays.N):  # math.atan2: libm's rounding, as before
+        if st.at_infinity:
+            out[i] = math.degrees(math.atan2(-float(M), -float(N)))
+        else:
+            t = (st.object_z - z) / N
+            out[i] = math.degrees(math.atan2(-float(y + t * M), st.z_ep - st.object_z))
+    return out
 
 
 def image_circle_radius(st: Setup, wavelength_nm: float, outside_mm: float, tol_mm: float = 0.05) -> float:
@@ -330,8 +356,10 @@ def _trace_groups(tracer: _Tracer, groups, *, clip=True) -> list[Traced]:
     """Trace several (field, gx, gy) groups in one batch; returns one :class:`Traced` per group."""
     if not groups:
         return []
+    # by wavelength, so that the kernels see a few runs of one wavelength (trace.trace_packed)
+    order = sorted(range(len(groups)), key=lambda i: groups[i][0].wavelength_nm)
     starts, dirs, opls, wls, sizes = [], [], [], [], []
-    for fl, gx, gy in groups:
+    for fl, gx, gy in (groups[i] for i in order):
         s, d, o = _starts(tracer.st, fl, tracer.n_object(fl.wavelength_nm), gx, gy)
         starts.append(s)
         dirs.append(d)
@@ -341,7 +369,10 @@ def _trace_groups(tracer: _Tracer, groups, *, clip=True) -> list[Traced]:
     res = tracer.trace(np.concatenate(starts), np.concatenate(dirs), np.concatenate(opls), np.concatenate(wls),
                        clip=clip)
     cut = np.cumsum([0] + sizes)
-    return [res.take(slice(cut[i], cut[i + 1])) for i in range(len(groups))]
+    out: list = [None] * len(groups)
+    for j, i in enumerate(order):
+        out[i] = res.take(slice(cut[j], cut[j + 1]))
+    return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -436,6 +467,8 @@ def trace_pupils(st: Setup, jobs, tracer: _Tracer) -> list[PupilTrace]:
         xs, ys = _grid_centres(n, cell, cx, cy)
         GX, GY = np.meshgrid(xs, ys)
         grids.append((n, cell, cx, cy, xs, ys, GX.ravel(), GY.ravel()))
+    # the job ahead: every cell centre, and the edge of a round pupil (about 7 n cells) at q x q sub-cells
+    tracer.plan(sum(n * n + 7 * n * q * q for _, n, _ in jobs))
     centres = _trace_groups(tracer, [(fl, g[6], g[7]) for (fl, _, _), g in zip(jobs, grids)])
     edges, subs = [], []
     off = ((np.arange(q) + 0.5) / q - 0.5)
@@ -653,13 +686,15 @@ def _fine_arrays(pt: PupilTrace, ws: WavefrontSamples, mask: np.ndarray, wmean: 
     i0 = np.clip(np.floor(c).astype(int), 0, n - 1)
     i1 = np.clip(i0 + 1, 0, n - 1)
     f = np.clip(c - np.floor(c), 0.0, 1.0)
-    num = np.zeros((n * q, n * q))
-    den = np.zeros((n * q, n * q))
-    for ri, wr in ((i0, 1.0 - f), (i1, f)):
-        for ci, wc in ((i0, 1.0 - f), (i1, f)):
-            wgt = wr[:, None] * wc[None, :] * mask[np.ix_(ri, ci)]
-            num += wgt * wmean[np.ix_(ri, ci)]
-            den += wgt
+    g = 1.0 - f
+
+    def lerp2(a):  # separable: along rows, then along columns
+        rows = g[:, None] * a[i0] + f[:, None] * a[i1]
+        return rows[:, i0] * g[None, :] + rows[:, i1] * f[None, :]
+
+    lit = mask.astype(float)
+    num = lerp2(lit * wmean)
+    den = lerp2(lit)
     fine_opd = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
     e = ~centre
     er, ec = pt.row[e] * q + pt.sub[e] // q, pt.col[e] * q + pt.sub[e] % q
@@ -680,6 +715,25 @@ def max_waves_per_cell(pf: PupilFunction) -> float:
     return worst
 
 
+#: Whole sub-cell lags a pupil sums one by one (a product summed over the overlap each, about
+#: 0.1 ms at 256 sub-cells across) before :func:`otf_lags` computes them all by FFT (1.5-4 ms per
+#: axis): a chart reads 2 per frequency.
+DIRECT_LAGS_MAX = 16
+
+
+def _complex_pupil(pf: PupilFunction, aberrated: bool) -> np.ndarray:
+    """P = A exp(-2 pi i W) over the sub-cells (cached per pupil); ``aberrated=False``: A alone. Only
+    the bounding box of the lit sub-cells: the rows and columns outside it add nothing to any lag."""
+    key = ("P", aberrated)
+    if key not in pf._lags:
+        A = pf.fine_amp * pf.fine_mask
+        rows, cols = np.flatnonzero(A.any(axis=1)), np.flatnonzero(A.any(axis=0))
+        box = np.s_[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1] if rows.size else np.s_[:0, :0]
+        A = A[box]
+        pf._lags[key] = A * np.exp(-2j * np.pi * pf.fine_opd[box]) if aberrated else A.astype(complex)
+    return pf._lags[key]
+
+
 def otf_lags(pf: PupilFunction, axis: int, *, aberrated: bool = True) -> np.ndarray:
     """Normalised OTF at every whole sub-cell shear 0, 1, ... along ``axis`` (0: y, the tangential
     direction of a Y-meridian field; 1: x, sagittal): R[k] = sum P(u) conj(P(u - k)) / sum |P|^2 over
@@ -690,30 +744,53 @@ def otf_lags(pf: PupilFunction, axis: int, *, aberrated: bool = True) -> np.ndar
     key = (axis, aberrated)
     cache = pf._lags
     if key not in cache:
-        A = pf.fine_amp * pf.fine_mask
-        P = A * np.exp(-2j * np.pi * pf.fine_opd) if aberrated else A.astype(complex)
+        P = _complex_pupil(pf, aberrated)
         if axis == 1:
             P = P.T
-        n = P.shape[0]
+        n, size = P.shape[0], pf.fine_mask.shape[axis]
         norm = float((np.abs(P) ** 2).sum())
         F = np.fft.fft(P, n=2 * n, axis=0)
-        r = np.fft.ifft((F * F.conj()).sum(axis=1))[:n]
+        r = np.zeros(size, dtype=complex)  # no overlap past the lit box: 0
+        r[:n] = np.fft.ifft((F * F.conj()).sum(axis=1))[:n]
         # r[k] = sum P(u + k) conj(P(u)); the shear convention here is P(u) conj(P(u - k)): the same sum
-        cache[key] = r / norm if norm > 0 else np.zeros(n, dtype=complex)
+        cache[key] = r / norm if norm > 0 else np.zeros(size, dtype=complex)
     return cache[key]
+
+
+def _lag(pf: PupilFunction, k: int, axis: int, aberrated: bool) -> complex:
+    """R[k] of :func:`otf_lags` (k < the sub-cells across), summed directly over the overlap of P and
+    P shifted by k while a pupil has been asked for few lags, from the FFT of all lags after."""
+    full = pf._lags.get((axis, aberrated))
+    if full is not None:
+        return complex(full[k])
+    direct = pf._lags.setdefault(("direct", axis, aberrated), {})
+    if k not in direct:
+        if len(direct) >= DIRECT_LAGS_MAX:
+            return complex(otf_lags(pf, axis, aberrated=aberrated)[k])
+        P = _complex_pupil(pf, aberrated)
+        if ("conj", aberrated) not in pf._lags:
+            pf._lags["conj", aberrated] = P.conj()
+            pf._lags["norm", aberrated] = float((P.real * P.real + P.imag * P.imag).sum())
+        Pc, norm = pf._lags["conj", aberrated], pf._lags["norm", aberrated]
+        if axis == 1:
+            P, Pc = P.T, Pc.T
+        n = P.shape[0]
+        lit = norm > 0 and k < n  # past the lit box the shifted pupil does not overlap
+        direct[k] = complex(np.einsum("ij,ij->", P[k:], Pc[:n - k])) / norm if lit else 0j
+    return direct[k]
 
 
 def shear_otf(pf: PupilFunction, shift_cells: float, axis: int, *, aberrated: bool = True) -> complex:
     """Normalised OTF at a pupil shear of ``shift_cells`` (>= 0, in cells) along ``axis``: :func:`otf_lags`
     interpolated linearly between whole sub-cell shears (a quarter cell apart, where the OTF is
     smooth: its curvature times (1/4 cell)^2 / 8 is the interpolation error)."""
-    lags = otf_lags(pf, axis, aberrated=aberrated)
+    size = pf.fine_mask.shape[axis]  # sub-cells across along the shear
     s = float(shift_cells) * pf.q
     k = int(math.floor(s))
-    if k >= lags.size - 1:
-        return 0j if k >= lags.size else complex(lags[-1] * (k + 1 - s))
+    if k >= size - 1:
+        return 0j if k >= size else _lag(pf, size - 1, axis, aberrated) * (k + 1 - s)
     f = s - k
-    return complex((1.0 - f) * lags[k] + f * lags[k + 1])
+    return (1.0 - f) * _lag(pf, k, axis, aberrated) + f * _lag(pf, k + 1, axis, aberrated)
 
 
 def cutoff_cells(pf: PupilFunction, axis: int) -> float:

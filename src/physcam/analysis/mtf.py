@@ -549,14 +549,17 @@ def mtf_chart(
         raise InputError(f"the MTF method is 'fft' or 'huygens', got {method!r}")
     st = P.setup(lens, fstop=fstop, focus_mm=focus_mm, aperture=aperture, backend=backend)
     fmin = float(freqs[freqs > 0].min()) if (freqs > 0).any() else None
-    angles = np.zeros(hs.size)
-    for i, h in enumerate(hs):
-        try:
-            angles[i] = P.field_for_image_height(st, float(h), wls[0])
-        except OpticsError as exc:
-            edge = P.image_circle_radius(st, wls[0], float(h))
-            raise OpticsError(f"{exc}; the image circle ends near {edge:.1f} mm: chart up to there "
-                              f"(max_image_height_mm, --max-height)") from None
+    try:  # every height at once; past the image circle, one at a time to say where it ends
+        angles = P.fields_for_image_heights(st, hs, wls[0])
+    except OpticsError:
+        angles = np.zeros(hs.size)
+        for i, h in enumerate(hs):
+            try:
+                angles[i] = P.field_for_image_height(st, float(h), wls[0])
+            except OpticsError as exc:
+                edge = P.image_circle_radius(st, wls[0], float(h))
+                raise OpticsError(f"{exc}; the image circle ends near {edge:.1f} mm: chart up to there "
+                                  f"(max_image_height_mm, --max-height)") from None
     dz, rule = 0.0, "the paraxial image plane of the focus mark"
     if best_focus is not None:
         dz, rule = best_focus_mm(lens, best_focus, heights_mm=hs, angles_deg=angles, rule=best_focus_rule,

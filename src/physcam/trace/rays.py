@@ -72,12 +72,14 @@ class RayBatch:
             raise InputError(f"ray directions must have shape {p.shape}, got {d.shape}")
         if not (np.isfinite(p).all() and np.isfinite(d).all()):
             raise InputError("ray positions and directions must be finite numbers (found NaN or inf)")
-        # normalise without overflow or underflow: scale by the largest component first
-        big = np.abs(d).max(axis=1)
+        # normalise without overflow or underflow: scale by the largest component first (column by
+        # column: the same operations, in the same order, as on the (n, 3) array, without its passes)
+        dx, dy, dz = np.abs(d[:, 0]), np.abs(d[:, 1]), np.abs(d[:, 2])
+        big = np.maximum(np.maximum(dx, dy), dz)
         if (big == 0).any():
             raise InputError("a ray direction is the zero vector; give a non-zero direction")
-        d = d / big[:, None]
-        d = d / np.sqrt((d * d).sum(axis=1))[:, None]
+        dx, dy, dz = d[:, 0] / big, d[:, 1] / big, d[:, 2] / big
+        norm = np.sqrt(dx * dx + dy * dy + dz * dz)
         n = p.shape[0]
         wl = np.broadcast_to(np.asarray(wavelength_nm, dtype=np.float64), (n,)).copy()
         require_wavelength(wl, "ray wavelength")
@@ -88,7 +90,7 @@ class RayBatch:
         # which ascontiguousarray would pass through as is) must never reach the kernels
         return cls(
             np.array(p[:, 0], order="C"), np.array(p[:, 1], order="C"), np.array(p[:, 2], order="C"),
-            np.array(d[:, 0], order="C"), np.array(d[:, 1], order="C"), np.array(d[:, 2], order="C"),
+            dx / norm, dy / norm, dz / norm,
             wl, w, np.zeros(n, dtype=np.uint8),
         )
 

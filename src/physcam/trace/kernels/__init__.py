@@ -1,7 +1,8 @@
 """Kernel dispatch: ``backend="auto" | "numba" | "numpy"``.
 
 The only module that imports numba. Both kernels have the signature of :func:`._numpy.trace_rays`
-and give the same rays: identical flags, positions and directions, Fresnel weights within a few
+(its optional ``opl``: each leg's optical path added to a float64 array, the same in both
+kernels, for the wavefront analyses) and give the same rays: identical flags, positions and directions, Fresnel weights within a few
 units in the last place (docs/ray-tracing.md, tests/trace/test_simd_kernel.py). Set
 ``PHYSCAM_BACKEND=numpy`` (or ``numba``) to force one.
 
@@ -33,15 +34,17 @@ BACKENDS = ("auto", "numba", "numpy")
 #: Batches smaller than this run the JIT kernel serially (measured crossover, docs/performance.md).
 SERIAL_BELOW = 1024
 #: "auto" before numba is loaded: the numpy kernel's cost per ray and surface, and per surface and
-#: call (dgauss_50mm on this machine: 1.3-2.2 M rays/s through 11 surfaces; ~25 us of numpy calls
-#: per surface), the numpy work allowed in all (about half of what loading numba costs) and in one call
-NUMPY_RAY_SURFACE_S = 60e-9
+#: call (dgauss_50mm on this machine, 5e5 rays in slices of 2^14: 32-38 ns per ray and surface, one
+#: wavelength or three with the optical path, at load 3.5; ~25 us of numpy calls per surface), the
+#: numpy work allowed in all (about half of what loading numba costs) and in one call
+NUMPY_RAY_SURFACE_S = 40e-9
 NUMPY_SURFACE_S = 30e-6
 NUMPY_BUDGET_S = 0.1
 NUMPY_CALL_MAX_S = 0.04
 #: What loading numba costs a process before its first traced ray: ``import numba`` and the first
-#: call's target initialisation (0.115 s + 0.14 s on this machine, idle; docs/performance.md)
-NUMBA_LOAD_S = 0.25
+#: call's target initialisation (0.115 s + 0.14 s on this machine, idle, 2026-11-23; 0.33-0.38 s of
+#: CPU at load 3.9, 2026-11-26; docs/performance.md)
+NUMBA_LOAD_S = 0.3
 #: Large batches too run serially while the machine is busy (1-minute load average above the
 #: cores numba uses, plus 0.5): numba's parallel loop splits the blocks statically, so with other
 #: processes on the cores it waits for its slowest thread (benchmarks/small_calls.py measured the
@@ -77,13 +80,19 @@ def _load_numba():
             from . import _jitcache
 
             _jitcache.install()
+            import numpy as np
+
             from ._numba import trace_rays
 
-            def trace_rays_auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
+            no_opl = np.empty(0)
+
+            def trace_rays_auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono,
+                                opl=None):
                 below = SERIAL_BELOW
                 if x.shape[0] >= below and LOAD_AWARE and _busy():
                     below = x.shape[0] + 1
-                trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, below)
+                trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, below,
+                           no_opl if opl is None else opl)
 
             trace_rays_auto.jit = trace_rays
             _numba_kernel = trace_rays_auto
@@ -97,13 +106,14 @@ def numba_available() -> bool:
 
 
 def jit_kernel():
-    """The numba dispatcher itself (``trace_rays`` with the trailing ``serial_below`` argument),
-    loading numba; None when numba is unavailable. For benchmarks and tests."""
+    """The numba dispatcher itself (``trace_rays`` with the trailing ``serial_below`` and ``opl``
+    arguments: an empty float64 array for no optical path), loading numba; None when numba is
+    unavailable. For benchmarks and tests."""
     k = _load_numba()
     return None if k is None else k.jit
 
 
-def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono):
+def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
     """The "auto" kernel: numpy until numba pays for its loading, then the JIT kernel (module notes)."""
     global _numpy_spent
     k = _numba_kernel
@@ -118,8 +128,8 @@ def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has
         if k is None:
             from ._numpy import trace_rays
 
-            return trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono)
-    return k(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono)
+            return trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl)
+    return k(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl)
 
 
 def backend_for_job(backend: str, ray_surfaces: float) -> str:
@@ -128,12 +138,19 @@ def backend_for_job(backend: str, ray_surfaces: float) -> str:
 
     "numpy" when ``backend`` is "auto" (and ``PHYSCAM_BACKEND`` does not say otherwise), numba is
     not loaded yet and the numpy kernel would do the whole job (:data:`NUMPY_RAY_SURFACE_S` per
-    intersection) in less time than loading numba takes (:data:`NUMBA_LOAD_S`); ``backend``
-    unchanged otherwise. Either way the rays are the same (module notes).
+    intersection), with the numpy work this process has done so far, in less time than loading
+    numba takes (:data:`NUMBA_LOAD_S`); ``backend`` unchanged otherwise, so a process that keeps
+    tracing pays for numba once its numpy work would have paid for it. Either way the rays are the
+    same (module notes).
     """
+    global _numpy_spent
     if backend != "auto" or os.environ.get("PHYSCAM_BACKEND", "auto") != "auto" or _numba_kernel is not None:
         return backend
-    return "numpy" if ray_surfaces * NUMPY_RAY_SURFACE_S < NUMBA_LOAD_S else backend
+    est = ray_surfaces * NUMPY_RAY_SURFACE_S
+    if _numpy_spent + est < NUMBA_LOAD_S:
+        _numpy_spent += est
+        return "numpy"
+    return backend
 
 
 def resolve_backend(backend: str = "auto") -> str:

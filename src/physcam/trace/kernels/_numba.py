@@ -498,17 +498,50 @@ def _to_plane(buf, m, end_z):
         buf[_CD * B + k] = miss if (live & (not ok)) else cd
 
 
+# ---- optical path ------------------------------------------------------------------------------
+
+@nb.njit(**_OPTS)
+def _add_path_const(buf, m, n1, opl, i0):
+    """Add n (p' - p) . d = n t |d|^2 of this leg (one index ``n1``) to ``opl`` for the lanes still
+    live after the surface's hit and clip (the numpy kernel's order of operations)."""
+    B = BLOCK
+    zero = _like(0.0, buf)
+    for k in range(m):
+        dx = buf[_DX * B + k]
+        dy = buf[_DY * B + k]
+        dz = buf[_DZ * B + k]
+        leg = n1 * (buf[_T * B + k] * (dx * dx + dy * dy + dz * dz))
+        live = buf[_CD * B + k] == zero
+        opl[i0 + k] += np.float64(leg) if live else 0.0
+
+
+@nb.njit(**_OPTS)
+def _add_path(buf, m, opl, i0):
+    """:func:`_add_path_const` with each lane's index before the surface (column N1)."""
+    B = BLOCK
+    zero = _like(0.0, buf)
+    for k in range(m):
+        dx = buf[_DX * B + k]
+        dy = buf[_DY * B + k]
+        dz = buf[_DZ * B + k]
+        leg = buf[_N1 * B + k] * (buf[_T * B + k] * (dx * dx + dy * dy + dz * dz))
+        live = buf[_CD * B + k] == zero
+        opl[i0 + k] += np.float64(leg) if live else 0.0
+
+
 # ---- one block, all surfaces -------------------------------------------------------------------
 
 @nb.njit(**_OPTS)
-def _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, i0, m, buf):
-    """Trace rays i0 .. i0 + m (m <= BLOCK) through every row of ``S`` using the scratch ``buf``."""
+def _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl, i0, m, buf):
+    """Trace rays i0 .. i0 + m (m <= BLOCK) through every row of ``S`` using the scratch ``buf``
+    (and add each leg's optical path to ``opl`` unless it is empty)."""
     B = BLOCK
     zero = _like(0.0, buf)
     one = _like(1.0, buf)
     thousand = _like(1000.0, buf)
     miss = _like(MISSED, buf)
     ez = _like(end_z, buf)
+    with_opl = opl.shape[0] > 0
     for k in range(m):
         buf[_PX * B + k] = x[i0 + k]
         buf[_PY * B + k] = y[i0 + k]
@@ -547,13 +580,20 @@ def _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end
             if kd == _ASPHERE:
                 _newton_asphere(buf, m, S, s, vz)
         _move_and_clip(buf, m, S[s, SEMI] * S[s, SEMI], clip)
+        if with_opl:
+            if mono:
+                _add_path_const(buf, m, S[s, N1], opl, i0)
+            else:
+                _fill_n1(buf, S, s, m)
+                _add_path(buf, m, opl, i0)
         # the stop, and in one-wavelength batches a surface between equal media, bend nothing
         if kd == _STOP or (mono and S[s, N1] == S[s, N2]):
             continue
         if mono:
             _fill_const(buf, m, S[s, N1], S[s, N2], S[s, ETA])
         else:
-            _fill_n1(buf, S, s, m)
+            if not with_opl:
+                _fill_n1(buf, S, s, m)
             _fill_n2(buf, S, s, m)
             _fill_eta(buf, m)
         if kd == _FLAT:
@@ -584,8 +624,10 @@ def _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end
 
 
 @nb.njit(parallel=True, **_OPTS)
-def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, serial_below):
-    """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``.
+def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, serial_below, opl):
+    """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``;
+    with a non-empty float64 ``opl`` (one per ray), add each leg's optical path to it in place
+    (the numpy kernel's ``opl``).
 
     Blocks of :data:`BLOCK` rays run in parallel on numba's thread pool, or, for fewer than
     ``serial_below`` rays, one after the other on the calling thread (one compiled function for
@@ -596,11 +638,11 @@ def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z
         buf = np.empty(_NCOL * BLOCK, dtype=x.dtype)
         for blk in range(nblocks):
             i0 = blk * BLOCK
-            _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, i0,
-                         min(BLOCK, n - i0), buf)
+            _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl,
+                         i0, min(BLOCK, n - i0), buf)
         return
     for blk in nb.prange(nblocks):
         i0 = blk * BLOCK
         buf = np.empty(_NCOL * BLOCK, dtype=x.dtype)
-        _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, i0,
+        _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl, i0,
                      min(BLOCK, n - i0), buf)
