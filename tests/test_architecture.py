@@ -188,7 +188,7 @@ CONCEPT_NAMES = {
     "f-number (EFL over the entrance pupil, the thin-lens formulas' N)": (r"^(f_?number|fnum)$",
                                                                           {"f_number"}),
     "focus mark from the film": (r"^(focus|focus_distance.*|focus_from_.*|focus_mm|mark_mm|focus_mark.*)$",
-                                 {"focus_mm", "focus_from_film_mm", "focus_marks_mm"}),
+                                 {"focus_mm", "focus_marks_mm"}),
     "stop size": (r"^(stop_.*|iris.*)$", {"stop_semi_diameter"}),
     # (Zemax's dispersion formulas are written in micrometres: lens.glassformulas keeps their unit)
     "wavelength": (r"^(wavelength.*|lambda.*|wl.*)$", {"wavelength_nm", "wavelengths_nm", "wavelength_um"}),
