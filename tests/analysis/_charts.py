@@ -44,13 +44,14 @@ def board_points(chart):
     return chart.object_points() + [chart.square_mm, chart.square_mm, 0.0]
 
 
-def point_views(chart=CHARUCO, n=15, noise_px=0.3, seed=1, mark=None, K=K_TRUE):
-    """Views from projected corners (pinhole ``K``) with Gaussian noise; corners outside the frame dropped."""
+def point_views(chart=CHARUCO, n=15, noise_px=0.3, seed=1, mark=None, K=K_TRUE, dist=DIST_TRUE):
+    """Views from projected corners (pinhole ``K``, OpenCV distortion ``dist``) with Gaussian noise;
+    corners outside the frame dropped."""
     rng = np.random.default_rng(seed + 100)
     views = []
     obj = board_points(chart)
     for k, (r, t) in enumerate(poses(n, seed, chart)):
-        img, _ = cv2.projectPoints(obj, r, t, K, DIST_TRUE)
+        img, _ = cv2.projectPoints(obj, r, t, K, dist)
         img = img.reshape(-1, 2) + rng.normal(0, noise_px, (len(obj), 2))
         inside = (img[:, 0] > 2) & (img[:, 1] > 2) & (img[:, 0] < SIZE[0] - 3) & (img[:, 1] < SIZE[1] - 3)
         views.append(ChartView(f"pose{k}", SIZE, img[inside], obj[inside], mark))

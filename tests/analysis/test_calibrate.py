@@ -212,3 +212,71 @@ def test_breathing_between_two_marks_is_the_ratio_of_the_focal_lengths():
     assert near.mark_mm == 500.0
     assert near.change_pct == pytest.approx(2.0, abs=1e-3)
     assert near.focal_length_mm == pytest.approx(1173.0 * PITCH_MM, rel=1e-5)
+
+
+def _ldpk_undistort_px(lens: dict, pts, size):
+    """Undistorted OpenCV pixels of distorted ones as 3DE4 computes them from a lens file: LDPK's
+    ``map_unit_to_dn`` (unit square from the image's lower-left corner, minus the lens centre
+    offset, over the filmback's half diagonal), its "Radial - Standard, Degree 4" formula
+    (radial-decentred, then the cylindric matrix), and ``map_dn_to_unit`` back."""
+    w, h = size
+    fw, fh, lx, ly = lens["w"], lens["h"], lens["cx"], lens["cy"]
+    r_fb = 0.5 * np.hypot(fw, fh)
+    p = lens["params"]
+    c2, u1, v1 = p["Distortion - Degree 2"], p["U - Degree 2"], p["V - Degree 2"]
+    c4, u3, v3 = p["Quartic Distortion - Degree 4"], p["U - Degree 4"], p["V - Degree 4"]
+    x = (((pts[:, 0] + 0.5) / w - 0.5) * fw - lx) / r_fb
+    y = ((1.0 - (pts[:, 1] + 0.5) / h - 0.5) * fh - ly) / r_fb
+    r2 = x * x + y * y
+    xd = x * (1 + c2 * r2 + c4 * r2 * r2) + (r2 + 2 * x * x) * (u1 + u3 * r2) + 2 * x * y * (v1 + v3 * r2)
+    yd = y * (1 + c2 * r2 + c4 * r2 * r2) + (r2 + 2 * y * y) * (v1 + v3 * r2) + 2 * x * y * (u1 + u3 * r2)
+    q, c, s = np.sqrt(1 + p["B - Cylindric Bending"]), np.cos(np.radians(p["Phi - Cylindric Direction"])), \
+        np.sin(np.radians(p["Phi - Cylindric Direction"]))
+    xu = (c * c * q + s * s / q) * xd + (q - 1 / q) * c * s * yd
+    yu = (q - 1 / q) * c * s * xd + (c * c / q + s * s * q) * yd
+    ux = (xu * r_fb + fw / 2 + lx) / fw
+    uy = (yu * r_fb + fh / 2 + ly) / fh
+    return np.column_stack([ux * w - 0.5, (1.0 - uy) * h - 0.5])
+
+
+def _read_lens_file(text):
+    """A 3DE4 lens file read line by line as its *Import Lens...* script reads it."""
+    lines = iter(text.splitlines())
+    next(lines)
+    w, h, fl, _aspect, cx, cy, pa = (float(v) for v in next(lines).split())
+    next(lines), next(lines)
+    params = {}
+    for para in lines:
+        if para.strip() == "<end_of_file>":
+            break
+        params[para.strip()] = float(next(lines))
+        for _ in range(int(next(lines))):
+            next(lines)
+    return dict(w=w, h=h, fl=fl, cx=cx, cy=cy, pa=pa, params=params)
+
+
+def test_the_3de4_lens_file_carries_the_measured_lens_centre(tmp_path):
+    """K_TRUE's principal point (652.4, 471.3) px on a 1280 x 960 px, 12.8 x 9.6 mm sensor lies from the
+    frame centre (639.5, 479.5) by (+12.9, -8.2) px, OpenCV's y down: (+0.129, +0.082) mm x right,
+    y up, so 3DE4's lens centre offset is (+0.0129, +0.0082) cm (worked by hand; 3DE4's convention in
+    physcam.export.tde4's notes). Read back through LDPK's own mapping, the file undistorts the
+    frame as OpenCV undistorts the true camera (within the 3DE4 fit's residual); with the offset
+    left at 0, or its sign flipped, it would not."""
+    from physcam.cli._calibrate_files import _mark_files
+
+    mild = np.array([-0.06, 0.012, 0.0006, -0.0004, 0.0])  # a distortion 3DE4's degree-4 model fits
+    cal = calibrate_mark(_charts.point_views(noise_px=0.0, seed=2, dist=mild), SENSOR_MM, bootstrap=0)
+    files = dict(_mark_files(cal, tmp_path, "synthetic", []))
+    lens = _read_lens_file(files[tmp_path / "3de4_radial_standard_degree_4.txt"].decode())
+    assert (lens["cx"], lens["cy"]) == pytest.approx((0.0129, 0.0082), abs=1e-6)
+    assert lens["fl"] == pytest.approx(1150.0 * PITCH_MM / 10.0, rel=1e-6) and (lens["w"], lens["h"]) == (1.28, 0.96)
+    x, y = np.meshgrid(np.linspace(0, SIZE[0] - 1, 9), np.linspace(0, SIZE[1] - 1, 7))
+    pts = np.column_stack([x.ravel(), y.ravel()])
+    truth = cv2.undistortPointsIter(pts.reshape(-1, 1, 2), K_TRUE, mild, None, K_TRUE,
+                                    (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 100, 1e-12)).reshape(-1, 2)
+    tde = next(f for f in cal.fits if f.model == "3DE4 Radial - Standard, Degree 4")
+    miss = np.hypot(*(_ldpk_undistort_px(lens, pts, SIZE) - truth).T).max()
+    assert miss < tde.max_residual_px + 0.01
+    for wrong in ((0.0, 0.0), (-0.0129, -0.0082)):
+        bad = np.hypot(*(_ldpk_undistort_px(dict(lens, cx=wrong[0], cy=wrong[1]), pts, SIZE) - truth).T).max()
+        assert bad > 1.0 > 3 * miss
