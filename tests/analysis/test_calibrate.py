@@ -371,3 +371,25 @@ def test_a_second_calibration_moves_current_to_the_new_day(checker_marks, tmp_pa
     assert day2["pinholeFocalLengthMm"][0] == pytest.approx(1173.0 * PITCH_MM, rel=1e-3)
     assert day1["focusMarksMm"] == [2000.0, 500.0]
     assert day1["pinholeFocalLengthMm"][0] == pytest.approx(1150.0 * PITCH_MM, rel=1e-3)
+
+
+def test_the_comparison_never_states_less_than_the_fits_covariance():
+    """Over 8 views a bootstrap's standard deviation scatters widely (docs/calibrate.md: 0.02-0.08 % where
+    the focal length scatters by 0.05 %); here (0.3 px noise, seed 4) it says less than OpenCV's
+    covariance at both marks. The comparison takes the larger for each pinhole, and for the breathing
+    the two relative uncertainties added in quadrature: 100 hypot(s_near / f_near, s_far / f_far) f_near / f_far."""
+    from physcam.analysis.calibrate import calibrate_views
+    from physcam.analysis.calibrate_compare import compare_with_lens
+    from physcam.lens.library import load_lens
+
+    views = _charts.point_views(n=8, noise_px=0.3, seed=4, mark=2000.0) + \
+        _charts.point_views(n=8, noise_px=0.3, seed=14, mark=500.0, K=K_NEAR)
+    cal = calibrate_views(views, SENSOR_MM, bootstrap=8)
+    cov = {m.mark_mm: m.opencv_std["fy_px"] * PITCH_MM for m in cal.marks}
+    assert all(m.uncertainty["focal_length_mm"]["y"] < cov[m.mark_mm] for m in cal.marks)  # the case
+    rows = {r["figure"]: r for r in compare_with_lens(cal, load_lens("dgauss_50mm")).rows}
+    for m in cal.marks:
+        assert rows[f"pinhole focal length at {m.mark_mm:g} mm"]["std"] == pytest.approx(cov[m.mark_mm], rel=1e-12)
+    f = {m.mark_mm: m.focal_length_mm[1] for m in cal.marks}
+    want = 100 * np.hypot(cov[500.0] / f[500.0], cov[2000.0] / f[2000.0]) * f[500.0] / f[2000.0]
+    assert rows["breathing 500 mm against 2000 mm"]["std"] == pytest.approx(want, rel=1e-12)
