@@ -47,7 +47,7 @@ $(BLENDER_STAMP): pyproject.toml
 	@( $(PYTHON) -m venv $(BLENDER_VENV) \
 	  && $(BLENDER_PY) -m pip install --quiet --upgrade pip \
 	  && $(BLENDER_PY) -m pip install --quiet "bpy==$(BPY_VERSION)" \
-	  && $(BLENDER_PY) -m pip install --quiet -e . \
+	  && $(BLENDER_PY) -m pip install --quiet -e '.[fast]' \
 	  && touch $(BLENDER_STAMP) ) \
 	|| ( echo "physcam: Blender (bpy==$(BPY_VERSION)) could not be installed here; the Blender tests will be skipped" >&2; \
 	     rm -rf $(BLENDER_VENV) )

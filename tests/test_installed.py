@@ -82,6 +82,10 @@ def test_the_core_installs_light_and_runs_the_report(installed):
     shipped = _run([inst["py"], "-c", "import importlib.resources as r; print(len(list(r.files('physcam.cli.schemas')"
                                       ".iterdir())))"], inst["work"], env=inst["env"]).stdout
     assert int(shipped) == len(list((ROOT / "src/physcam/cli/schemas").glob("*.json")))
+    # the light core (issue 26's goal, under 300 MB): numba is the 'fast' extra, the numpy kernels trace
+    assert inst["core_mb"] < 300.0, f"the core install is {inst['core_mb']:.0f} MB"
+    assert "No module named 'numba'" in _run([inst["py"], "-c", "import numba"], inst["work"], env=inst["env"],
+                                             check=False).stderr
     # the tracer and an analysis figure
     _physcam(inst, "mtf", "dgauss_50mm", "--fstop", "8", "--field", "5", "--pupil-samples", "32", "-o", "mtf.png")
     assert (inst["work"] / "mtf.png").stat().st_size > 10_000
@@ -108,6 +112,14 @@ def test_a_missing_extra_is_one_line_naming_its_install(installed, extra, args):
     assert "Traceback" not in p.stderr
 
 
+def test_the_jit_kernels_missing_is_one_line_naming_the_fast_extra(installed):
+    env = dict(installed["env"], PHYSCAM_BACKEND="numba")
+    p = _run([installed["bin"] / "physcam", "spot", "dgauss_50mm"], installed["work"], env=env, check=False)
+    assert p.returncode == 2
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and "pip install 'physcam[fast]'" in lines[0], p.stderr
+
+
 def test_with_every_extra_the_demo_usd_plugin_and_serve_work(installed):
     inst = installed
     _run([inst["py"], "-m", "pip", "install", "--quiet", "-c", str(ROOT / "constraints.txt"),
@@ -124,4 +136,7 @@ def test_with_every_extra_the_demo_usd_plugin_and_serve_work(installed):
             "print(prim.GetTypeName(), Usd.SchemaRegistry().FindConcretePrimDefinition('PhysicalCamera') is not None)\n")
     out = _run([inst["py"], "-c", code], inst["work"], env=inst["env"]).stdout.split()
     assert out == ["PhysicalCamera", "True"]
+    # with 'all' (which holds 'fast') the JIT kernels load and trace
+    code = "from physcam.trace.kernels import resolve_backend; print(resolve_backend('numba'))"
+    assert _run([inst["py"], "-c", code], inst["work"], env=inst["env"]).stdout.split() == ["numba"]
     assert "answer" in _physcam(inst, "serve", "--port", "0", "--check").stdout

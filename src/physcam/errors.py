@@ -25,6 +25,7 @@ __all__ = [
     "require_type",
     "require_finite",
     "require_positive",
+    "renamed_parameter",
 ]
 
 
@@ -122,6 +123,28 @@ def require_type(name: str, value, cls, hint: str = ""):
 
 class PhysCamWarning(UserWarning):
     """An approximation was made; the message says which."""
+
+
+def renamed_parameter(old: str, new: str, until: str = "0.3"):
+    """Decorator: the keyword ``old`` still works as ``new`` with a DeprecationWarning, until version
+    ``until`` (one name per concept, docs/conventions.md); giving both is an InputError."""
+    import functools
+    import warnings
+
+    def wrap(fn):
+        @functools.wraps(fn)
+        def renamed(*args, **kwargs):
+            if old in kwargs:
+                if new in kwargs:
+                    raise InputError(f"give {new}, not both {new} and {old} (its old name)")
+                warnings.warn(f"{fn.__name__}({old}=...) is now {new}=...; {old} goes in physcam {until}",
+                              DeprecationWarning, stacklevel=2)
+                kwargs[new] = kwargs.pop(old)
+            return fn(*args, **kwargs)
+
+        return renamed
+
+    return wrap
 
 
 def require_finite(name: str, value, *, error=InputError) -> float:

@@ -9,6 +9,7 @@ or where its one function needs it (EXR writers), so a missing extra is one sent
 =========  ====================================  ============================================
 extra      packages                              what it gives
 =========  ====================================  ============================================
+fast       numba                                 the JIT tracing kernels (same rays, faster)
 usd        usd-core                              PhysicalCamera USD files, kits, readers
 exr        OpenEXR                               ST-maps and images as EXR
 live       jsonschema, cbor2                     OpenTrackIO samples (physcam live)
@@ -29,6 +30,7 @@ __all__ = ["EXTRAS", "require_extra", "missing_modules"]
 
 #: extra -> (import name, PyPI name) of each package it brings
 EXTRAS = {
+    "fast": (("numba", "numba"),),
     "usd": (("pxr", "usd-core"),),
     "exr": (("OpenEXR", "OpenEXR"),),
     "live": (("jsonschema", "jsonschema"), ("cbor2", "cbor2")),

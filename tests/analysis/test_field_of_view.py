@@ -84,12 +84,12 @@ def test_rectilinear_lenses_real_close_to_paraxial():
 
 def test_tiny_sensor_at_finite_focus_equals_paraxial(nikkor):
     for lens in (nikkor, load_lens("dgauss_50mm")):
-        r = real_field_of_view(lens, 0.02, 0.01, focus_from_film_mm=3000.0)
+        r = real_field_of_view(lens, 0.02, 0.01, focus_mm=3000.0)
         assert r.focus_from_film_mm == 3000.0
         assert r.horizontal_deg == pytest.approx(r.paraxial_horizontal_deg, rel=1e-5)
         assert r.vertical_deg == pytest.approx(r.paraxial_vertical_deg, rel=1e-5)
     # breathing: the fisheye at 3 m sees a little less than at infinity
-    assert real_field_of_view(nikkor, 36, 24, focus_from_film_mm=3000.0).horizontal_deg < \
+    assert real_field_of_view(nikkor, 36, 24, focus_mm=3000.0).horizontal_deg < \
         real_field_of_view(nikkor, 36, 24).horizontal_deg
 
 
@@ -114,7 +114,7 @@ def test_bad_input():
     with pytest.raises(InputError):
         real_field_of_view(lens, 36.0, float("nan"))
     with pytest.raises(InputError):
-        real_field_of_view(lens, 36.0, 24.0, focus_from_film_mm=3000.0, film_z=100.0)
+        real_field_of_view(lens, 36.0, 24.0, focus_mm=3000.0, film_z=100.0)
     with pytest.raises(InputError):
         real_field_of_view(lens, 36.0, 24.0, film_z=1.0)  # in front of the last vertex
 

@@ -81,7 +81,7 @@ def test_field_of_view_and_breathing(slug, w, h, mark):
     from physcam.analysis.field_of_view import real_field_of_view
 
     lens = load_lens(slug)
-    _check(lambda: real_field_of_view(lens, w, h, focus_from_film_mm=mark))
+    _check(lambda: real_field_of_view(lens, w, h, focus_mm=mark))
     _check(lambda: real_breathing(lens, [mark], sensor_width_mm=w, sensor_height_mm=h))
 
 

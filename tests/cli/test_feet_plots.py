@@ -138,7 +138,7 @@ def test_dof_zone_marks_and_title_in_feet():
 def test_lens_diagram_title_in_feet(dgauss):
     from physcam.analysis.diagram import lens_diagram
 
-    d = lens_diagram(dgauss, focus_from_film_mm=2000.0, fstop=4.0)
+    d = lens_diagram(dgauss, focus_mm=2000.0, fstop=4.0)
     assert "focus 2.000 m," in d.figure(units="m").axes[0].get_title()
     assert f"focus {feet_inches(2000.0)}," in d.figure(units="ft").axes[0].get_title()
 

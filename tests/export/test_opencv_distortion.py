@@ -74,7 +74,7 @@ def test_opencv_lands_on_real_rays_at_a_finite_focus(dgauss):
     from physcam.trace import RayBatch, trace_through
 
     mark = 1500.0
-    cam = fit_opencv_pinhole(dgauss, W_MM, H_MM, W_PX, H_PX, focus_from_film_mm=mark)
+    cam = fit_opencv_pinhole(dgauss, W_MM, H_MM, W_PX, H_PX, focus_mm=mark)
     assert cam.max_residual_px < 0.1
     # fx is physcam's best-match pinhole: 52.048 mm at 1.5 m (GaussianData's documented figure)
     assert cam.fx * W_MM / W_PX == pytest.approx(52.048, abs=1e-3)
@@ -168,7 +168,7 @@ def test_usd_attributes_are_omniverses_names_and_types(dgauss):
 @pytest.mark.parametrize("kwargs", [dict(image_width_px=0), dict(image_width_px=True), dict(image_width_px=4096.0),
                                     dict(image_height_px=10**6), dict(sensor_width_mm=0.0),
                                     dict(sensor_height_mm=float("nan")), dict(terms="k9"),
-                                    dict(focus_from_film_mm=-1.0)])
+                                    dict(focus_mm=-1.0)])
 def test_bad_values_are_input_errors(dgauss, kwargs):
     args = dict(sensor_width_mm=W_MM, sensor_height_mm=H_MM, image_width_px=W_PX, image_height_px=H_PX)
     args.update(kwargs)

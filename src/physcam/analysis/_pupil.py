@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite
-from ..optics.state import CameraState, camera_state
+from ..optics.state import CameraState, as_camera_state
 
 #: Smallest and largest pupil grids (cells across the pupil's bounding square).
 MIN_PUPIL_SAMPLES = 16
@@ -94,11 +94,10 @@ def setup(lens, *, fstop=None, focus_mm=None, aperture=None, backend: str = "aut
 
         require_type("aperture", aperture, Aperture, "physcam.trace.aperture.Aperture(nsides, ...)")
     if isinstance(lens, CameraState):
-        if fstop is not None or focus_mm is not None:
-            raise InputError("a CameraState carries its own focus and f-stop: give them to camera_state(), not here")
-        state = lens if aperture is None else dataclasses.replace(lens, aperture=aperture)
+        state = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
+        state = state if aperture is None else dataclasses.replace(state, aperture=aperture)
     else:
-        state = camera_state(lens, focus_mm=focus_mm, fstop=fstop, aperture=aperture)
+        state = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop, aperture=aperture)
     return Setup(state, backend)
 
 

@@ -22,7 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
+from ..optics.state import takes_camera
 
 __all__ = ["BokehImage", "bokeh_image", "RGB_WAVELENGTHS_NM", "tone_map", "scale_bar_pixels", "write_bokeh_photo"]
 
@@ -76,7 +77,7 @@ class BokehImage:
         return save_figure(fig, path, force=force)
 
 
-@takes_prescription
+@takes_camera
 def bokeh_image(
     lens: Prescription,
     depth_mm: float,
@@ -99,6 +100,9 @@ def bokeh_image(
 ) -> BokehImage:
     """Image of a point light through ``lens`` on the film (see module notes).
 
+    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris, iris
+    shape and primary wavelength) or a Prescription as it is (``film_z`` default the paraxial image of
+    infinity, ``stop_semi_diameter`` default the file's stop, the design wavelength).
     ``aperture`` (a :class:`~physcam.trace.aperture.Aperture`: blades, angle, roundness,
     density) shapes the stop, so the bokeh shows the iris polygon and its brightness ramp.
     ``progress`` (optional) is called as ``progress(rays_done, rays)`` after each chunk.
@@ -107,7 +111,10 @@ def bokeh_image(
     """
     from ..trace import paraxial_image_z
     from ..trace.kernels import backend_for_job
+    from ._camera import camera_of
 
+    cam = camera_of(lens, film_z=film_z, stop_semi_diameter=stop_semi_diameter, aperture=aperture)
+    lens, film_z, stop_semi_diameter, aperture = cam.lens, cam.film_z, cam.stop_semi_diameter, cam.aperture
     depth = require_positive("light distance (depth_mm, --light)", depth_mm)
     x_mm = require_finite("light x", x_mm)
     y_mm = require_finite("light y", y_mm)
@@ -122,7 +129,7 @@ def bokeh_image(
         )
     if precision not in ("double", "single"):
         raise InputError(f"precision must be 'double' or 'single', got {precision!r}")
-    wls = RGB_WAVELENGTHS_NM if spectral else (lens.wavelength_nm,)
+    wls = RGB_WAVELENGTHS_NM if spectral else (lens.wavelength_nm if cam.wavelength_nm is None else cam.wavelength_nm,)
     src = _PointLight(x_mm, y_mm, z_src, lens.surfaces[0].semi_diameter, wls, seed,
                       np.float64 if precision == "double" else np.float32)
     backend = backend_for_job(backend, (rays + (0 if extent_mm is not None else 20_000))

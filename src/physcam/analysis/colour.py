@@ -35,8 +35,9 @@ import numpy as np
 
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
 from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM, PGF_UNCERTAINTY
+from ..optics.state import takes_camera
 
 __all__ = ["LateralColourPoint", "ColourResult", "chromatic_aberration"]
 
@@ -162,7 +163,7 @@ def _pgf_uncertainty(lens, wavelengths):
     return np.sqrt(var)
 
 
-def _zone_focus(lens, height, wls, backend):
+def _zone_focus(lens, height, wls, stop_sd, backend):
     """Axis crossing z of the zone ray at ``height`` for each wavelength: one ray per wavelength, all
     in one tracer call (a mixed-wavelength batch gives each ray the indices of its own wavelength,
     bit for bit those of a one-wavelength trace)."""
@@ -171,7 +172,7 @@ def _zone_focus(lens, height, wls, backend):
     wl = np.asarray(wls, dtype=float)
     rays = RayBatch.collimated(np.zeros(wl.size), np.full(wl.size, height), -1.0)
     rays.wavelength_nm[:] = wl
-    out = trace_through(lens, rays, backend=backend)
+    out = trace_through(lens, rays, stop_semi_diameter=stop_sd, backend=backend)
     zs = []
     for k, w in enumerate(wls):
         if not out.ok[k] or out.M[k] >= 0:
@@ -258,7 +259,7 @@ def _glass_model_uncertainty(result: ColourResult, lens: Prescription, media: di
     result.curve_uncertainty_mm = float(fc[2:].max())
 
 
-@takes_prescription
+@takes_camera
 def chromatic_aberration(
     lens: Prescription,
     fields_deg=None,
@@ -275,14 +276,23 @@ def chromatic_aberration(
 ) -> ColourResult:
     """Longitudinal and lateral colour of ``lens`` (module notes).
 
+    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris and
+    sensor; the object stays at infinity and the wavelengths are this function's) or a Prescription as
+    it is (``film_z`` default the paraxial focus at ``reference_nm``, the file's stop).
     ``wavelengths_nm`` are reported; F and C are always added for the F-C figures. ``zone``
     (0-1] is the real ray's height as a fraction of the entrance-pupil radius. Fields in degrees
     (default: ``n_fields`` up to the sensor corner or ``max_field_deg``).
-    The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
+    The sensor is the state's when it has one, else ``sensor_width_mm`` x ``sensor_height_mm`` (default
+    Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
     from ..optics.paraxial import gaussian
     from ..trace import paraxial_image_z
+    from ._camera import camera_of, sensor_size
     from ._chief import field_angles_deg
+
+    cam = camera_of(lens, film_z=film_z, sensor_mm=sensor_size(sensor_width_mm, sensor_height_mm))
+    lens, film_z, stop = cam.lens, cam.film_z, cam.stop_semi_diameter
+    sensor_width_mm, sensor_height_mm = cam.sensor_mm or (sensor_width_mm, sensor_height_mm)
 
     ref = require_positive("reference wavelength", reference_nm, unit="nm")
     zone = require_finite("zone", zone)
@@ -291,7 +301,7 @@ def chromatic_aberration(
     wls = sorted({float(require_positive("wavelength", w, unit="nm")) for w in wavelengths_nm} | {LINE_F_NM, LINE_C_NM})
     if min(wls) < 300 or max(wls) > 1100:
         raise InputError("wavelengths must lie between 300 and 1100 nm (the glass model is fitted to the visible)")
-    g_ref = gaussian(lens, wavelength_nm=ref)
+    g_ref = gaussian(lens, wavelength_nm=ref, stop_semi_diameter=stop)
     if g_ref.efl <= 0:
         raise OpticsError(f"lens {lens.name!r} has no positive focal length: no real image")
     if film_z is None:
@@ -299,7 +309,7 @@ def chromatic_aberration(
     film_z = require_finite("film_z", film_z)
     par = [gaussian(lens, wavelength_nm=w).z_rear_focal_point for w in wls]
     r_ep = 0.5 * g_ref.entrance_pupil_diameter
-    real = _zone_focus(lens, zone * r_ep, wls, backend)
+    real = _zone_focus(lens, zone * r_ep, wls, stop, backend)
     iF, iC = wls.index(LINE_F_NM), wls.index(LINE_C_NM)
     curve = list(np.arange(400.0, 701.0, 10.0))
     z_ref = g_ref.z_rear_focal_point

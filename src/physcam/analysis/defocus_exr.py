@@ -129,12 +129,14 @@ def write_exr(path, img: ExrImage, planes: dict, *, attributes=None, force: bool
     return atomic_write(path, data, force=force)
 
 
-def defocus_file(image_path, output, lens, *, focus_mm: float, fstop: float, sensor_width_mm: float,
+def defocus_file(image_path, output, lens, *, focus_mm: float | None = None, fstop: float | None = None,
+                 sensor_width_mm: float | None = None,
                  depth: str | None = None, depth_kind: str | None = None, depth_unit: str = "m", aperture=None,
                  dispersion: bool = False, tile: int = 64, step_px: float = 1.0, step_rel: float = 0.05, cache=None,
                  kernel_folder=None,
                  edge_px: int = 1, force: bool = False) -> dict:
-    """Defocus the EXR ``image_path`` through ``lens`` into ``output`` (see
+    """Defocus the EXR ``image_path`` through ``lens`` (a :class:`~physcam.optics.state.CameraState`, or a
+    Prescription with ``focus_mm`` and ``fstop``) into ``output`` (see
     :mod:`physcam.analysis.defocus`). ``depth``: a channel of the image, or a separate EXR file
     (its one depth channel) over the same data window; ``depth_kind`` defaults to ``inverse`` for a
     channel named ``depth.Z`` (Nuke) and ``planar`` otherwise (Blender's Z). ``cache``: a
@@ -169,6 +171,7 @@ def defocus_file(image_path, output, lens, *, focus_mm: float, fstop: float, sen
                              step_rel=step_rel)
         cache = KernelCache(cam, kernel_folder)
     cam = cache.camera
+    lens, focus_mm, fstop, sensor_width_mm = cam.lens, cam.focus_mm, cam.fstop, cam.sensor_width_mm
     if (cam.width, cam.height) != (w, h):
         raise InputError(f"{image_path} is {w} x {h} pixels, the kernel cache's frame {cam.width} x {cam.height}")
     names = [n for n in colour_channels(img) if n != zname]

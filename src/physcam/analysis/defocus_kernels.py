@@ -38,7 +38,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
+from ..optics.state import CameraState, takes_camera
 
 __all__ = ["DefocusCamera", "defocus_camera", "Kernel", "KernelCache"]
 
@@ -202,18 +203,29 @@ def _trim(img: np.ndarray) -> np.ndarray:
     return img[r - e:r + e + 1, r - e:r + e + 1]
 
 
-@takes_prescription
-def defocus_camera(lens: Prescription, *, focus_mm: float, fstop: float, sensor_width_mm: float, width: int,
-                   height: int, aperture=None, dispersion: bool = False, tile: int = 64,
-                   step_px: float = 1.0, step_rel: float = 0.05) -> DefocusCamera:
-    """The :class:`DefocusCamera` for ``lens`` focused at the mark ``focus_mm`` (from the film) at
-    f/``fstop``, a sensor ``sensor_width_mm`` wide imaged on ``width`` x ``height`` pixels (the
-    display window); ``tile`` px per field node; the blur step between depth nodes is
-    ``step_px + step_rel x`` the blur diameter (module notes)."""
-    from ..optics.focusing import focus, iris_semi_diameter, technical_planes
+@takes_camera
+def defocus_camera(lens: CameraState | Prescription, *, focus_mm: float | None = None, fstop: float | None = None,
+                   sensor_width_mm: float | None = None, width: int, height: int, aperture=None,
+                   dispersion: bool = False, tile: int = 64, step_px: float = 1.0,
+                   step_rel: float = 0.05) -> DefocusCamera:
+    """The :class:`DefocusCamera` for ``lens``: a :class:`~physcam.optics.state.CameraState`, or a
+    Prescription focused at the mark ``focus_mm`` (from the film) at f/``fstop`` (both needed); a
+    sensor ``sensor_width_mm`` wide (default: the state's) imaged on ``width`` x ``height`` pixels
+    (the display window); ``aperture``: the iris's shape (default: the state's, else round);
+    ``tile`` px per field node; the blur step between depth nodes is ``step_px + step_rel x`` the
+    blur diameter (module notes)."""
+    from ..optics.state import as_camera_state
+    from ..optics.focusing import technical_planes
     from .bokeh import RGB_WAVELENGTHS_NM
 
-    fstop = require_positive("f-stop", fstop, unit="")
+    if not isinstance(lens, CameraState):
+        if focus_mm is None or fstop is None:
+            raise InputError("give focus_mm and fstop with a lens (or a CameraState: physcam.optics.state.camera_state)")
+        fstop = require_positive("f-stop", fstop, unit="")
+    if sensor_width_mm is None and isinstance(lens, CameraState) and lens.sensor_mm is not None:
+        sensor_width_mm = lens.sensor_mm[0]
+    if sensor_width_mm is None:
+        raise InputError("give the sensor width: sensor_width_mm (or camera_state(sensor_mm=...))")
     sw = require_positive("sensor width", sensor_width_mm)
     for name, v in (("width", width), ("height", height)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 1 <= v <= 65536:
@@ -226,15 +238,16 @@ def defocus_camera(lens: Prescription, *, focus_mm: float, fstop: float, sensor_
     rel = require_finite("relative depth step", step_rel)
     if not 0 <= rel <= 0.5:
         raise InputError(f"the relative depth step must lie between 0 and 0.5 of the blur, got {rel:g}")
-    st = focus(lens, focus_mm)
+    cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
+    lens, focus_mm, fstop = cam.lens, cam.focus_from_film_mm, cam.fstop
     tp = technical_planes(lens, focus_mm, fstop=fstop)
     if tp.pinhole_focal_length_mm is None:
         raise OpticsError(f"{lens.name} has no best-match pinhole at this focus (its chief ray does not reach the film)")
-    ap = _as_aperture(aperture)
+    ap = _as_aperture(cam.aperture if aperture is None else aperture)
     return DefocusCamera(lens=lens, focus_mm=float(focus_mm), fstop=float(fstop), sensor_width_mm=sw,
                          width=int(width), height=int(height), aperture=ap, dispersion=bool(dispersion),
-                         tile=int(tile), step_px=step, step_rel=rel, film_z=st.film_z, stop_semi=iris_semi_diameter(lens, fstop),
-                         focused=st.prescription, pupil_from_film_mm=tp.entrance_pupil_from_film_mm,
+                         tile=int(tile), step_px=step, step_rel=rel, film_z=cam.film_z, stop_semi=cam.stop_semi_diameter,
+                         focused=cam.focused, pupil_from_film_mm=tp.entrance_pupil_from_film_mm,
                          front_from_film_mm=tp.front_vertex_from_film_mm, pinhole_mm=tp.pinhole_focal_length_mm,
                          pupil_diameter_mm=tp.entrance_pupil_diameter_mm,
                          wavelengths_nm=RGB_WAVELENGTHS_NM if dispersion else (lens.wavelength_nm,))

@@ -19,10 +19,11 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import ExportError, InputError
+from ..errors import ExportError, InputError, renamed_parameter
 from ..lens.geometry import sag
 from ..lens.prescription import Prescription, takes_prescription
 from ..optics import focusing, paraxial
+from ..optics.state import CameraState, takes_camera
 
 __all__ = ["DIAGRAM_FORMATS", "trace_meridional_ray", "LensDiagram", "lens_diagram", "save_lens_diagram"]
 
@@ -178,15 +179,23 @@ def _default_field(p: Prescription, g: paraxial.GaussianData, axis: str, wavelen
     return math.atan(min(u, 1.5))
 
 
-@takes_prescription
-def lens_diagram(prescription: Prescription, *, axis: str = "y", focus_from_film_mm: float = math.inf,
+@renamed_parameter("focus_from_film_mm", "focus_mm")
+@takes_camera
+def lens_diagram(prescription: CameraState | Prescription, *, axis: str = "y", focus_mm: float | None = None,
                  fstop=None, field_deg: float | None = None, wavelength_nm=None, rays: int = 3) -> LensDiagram:
-    """Compute a :class:`LensDiagram` with the lens focused at ``focus_from_film_mm`` (from the film plane)."""
+    """Compute a :class:`LensDiagram` of a :class:`~physcam.optics.state.CameraState`, or of a
+    Prescription focused at ``focus_mm`` (the mark from the film plane; None: infinity) with its iris
+    at ``fstop`` (None: the stop as in its file); focused at ``wavelength_nm`` (None: the design one)."""
+    from ..optics.state import as_camera_state
+
     if axis not in paraxial.AXES:
         raise InputError(f"meridian must be 'x' or 'y', got {axis!r}")
-    st = focusing.focus(prescription, focus_from_film_mm, axis="y", wavelength_nm=wavelength_nm)
+    cam = as_camera_state(prescription, focus_mm=focus_mm, fstop=fstop)
+    prescription, focus_mm = cam.lens, cam.focus_from_film_mm
+    fstop = cam.fstop if cam.iris_set else None
+    st = focusing.focus(prescription, focus_mm, axis="y", wavelength_nm=wavelength_nm)
     p = st.prescription
-    iris = None if fstop is None else focusing.iris_semi_diameter(prescription, fstop)
+    iris = cam.stop_semi_diameter if cam.iris_set else None
     g = paraxial.gaussian(p, axis=axis, wavelength_nm=wavelength_nm, stop_semi_diameter=iris, object_z=st.object_z,
                           film_z=st.film_z)
     if fstop is not None:  # draw the stop at the asked opening
@@ -221,12 +230,12 @@ def lens_diagram(prescription: Prescription, *, axis: str = "y", focus_from_film
         y_start = h - tu * (ep - z_start)
         out.append((kind, trace_meridional_ray(p, y_start, z_start, tu, 1.0, axis=axis, wavelength_nm=wavelength_nm,
                                                film_z=g.z_film)))
-    return LensDiagram(p, g, axis, math.degrees(half), out, float(focus_from_film_mm),
+    return LensDiagram(p, g, axis, math.degrees(half), out, float(focus_mm),
                        None if fstop is None else float(fstop))
 
 
-@takes_prescription
-def save_lens_diagram(prescription: Prescription, path, *, force: bool = False, **kwargs) -> Path:
+@takes_camera
+def save_lens_diagram(prescription: CameraState | Prescription, path, *, force: bool = False, **kwargs) -> Path:
     """Draw the diagram to ``path`` (.png, .svg or .pdf) through atomic_write; kwargs as :func:`lens_diagram`,
     and ``units`` (m or ft) for the focus in the title."""
     from ..figures import save_figure

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, require_finite, require_positive
+from ..errors import InputError, renamed_parameter, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["RealFieldOfView", "real_field_of_view", "chief_ray_field_limit", "DIFFERS_PCT"]
@@ -108,12 +108,13 @@ def chief_ray_field_limit(
 
 
 @takes_prescription
+@renamed_parameter("focus_from_film_mm", "focus_mm")
 def real_field_of_view(
     lens: Prescription,
     sensor_width_mm: float,
     sensor_height_mm: float,
     *,
-    focus_from_film_mm: float = math.inf,
+    focus_mm: float = math.inf,
     method: str = "auto",
     film_z: float | None = None,
     wavelength_nm: float | None = None,
@@ -122,7 +123,7 @@ def real_field_of_view(
     """Real (chief-ray) and paraxial full fields of view of a ``sensor_width_mm`` x
     ``sensor_height_mm`` sensor behind ``lens`` (module notes).
 
-    The lens is focused at ``focus_from_film_mm`` (mm in front of the film plane, default
+    The lens is focused at ``focus_mm`` (mm in front of the film plane, default
     infinity; ``method`` as :func:`physcam.optics.focusing.focus`: auto, unit, internal).
     Alternatively ``film_z`` (mm, lens space) puts the film plane behind the lens as given,
     without focusing it. ``wavelength_nm`` defaults to the lens's design wavelength.
@@ -142,16 +143,16 @@ def real_field_of_view(
     wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
     mark: float | None
     if film_z is not None:
-        if not math.isinf(float(focus_from_film_mm)):
-            raise InputError("give either focus_from_film_mm or film_z, not both")
+        if not math.isinf(float(focus_mm)):
+            raise InputError("give either focus_mm or film_z, not both")
         fz = require_finite("film_z", film_z)
         if fz <= lens.vertex_z[-1]:
             raise InputError(f"the film plane (z = {fz:g} mm) must lie behind the last vertex "
                              f"(z = {lens.vertex_z[-1]:g} mm)")
         focused, mark = lens, None
     else:
-        st = focusing.focus(lens, focus_from_film_mm, method=method, axis="y", wavelength_nm=wl)
-        focused, fz, mark = st.prescription, st.film_z, float(focus_from_film_mm)
+        st = focusing.focus(lens, focus_mm, method=method, axis="y", wavelength_nm=wl)
+        focused, fz, mark = st.prescription, st.film_z, float(focus_mm)
 
     # paraxial: tangents of the paraxial chief rays to the edge (X) and the top (Y)
     tx = math.tan(abs(paraxial.field_angle(focused, w / 2.0, fz, "x", wl)))

@@ -36,6 +36,7 @@ import numpy as np
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
+from ..optics.state import takes_camera
 
 __all__ = ["GhostPath", "GhostResult", "ghost_pairs", "ghost_analysis", "trace_ghost"]
 
@@ -188,13 +189,27 @@ def _reflect(rays, t, row, forward: bool):
     rays.weight_sp[live] = w * hdif + d * hsum
 
 
-@takes_prescription
-def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float, *, coating: str = "none",
+def _round_iris(cam) -> None:
+    if cam.aperture is not None:
+        raise InputError("the ghost tracer models a round iris: give a CameraState without an aperture shape")
+
+
+@takes_camera
+def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float | None = None, *, coating: str = "none",
                 stop_semi_diameter=None, backend: str = "auto", _tables=None):
-    """Trace object-space ``rays`` (a RayBatch, copied) along ghost path (i, j) to the film plane ``film_z``."""
+    """Trace object-space ``rays`` (a RayBatch, copied) along ghost path (i, j) to the film plane ``film_z``.
+
+    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane and iris) or a
+    Prescription with the film plane ``film_z`` (lens space, mm; required) and ``stop_semi_diameter``."""
     from ..trace.kernels import get_kernel
     from ..trace.trace import DEFAULT_CHUNK, trace_packed
+    from ._camera import camera_of
 
+    cam = camera_of(lens, film_z=film_z, stop_semi_diameter=stop_semi_diameter)
+    _round_iris(cam)
+    if cam.film_z is None:
+        raise InputError("give the film plane: film_z (mm, lens space), or a CameraState")
+    lens, film_z, stop_semi_diameter = cam.lens, cam.film_z, cam.stop_semi_diameter
     n = len(lens.surfaces)
     if not (0 <= j < i < n):
         raise InputError(f"a ghost path needs 0 <= j < i < {n} surfaces, got i={i}, j={j}")
@@ -246,7 +261,7 @@ def _beam(lens, field_deg, wl, n, rng=None):
 DEFAULT_FIELD_DEG = 10.0
 
 
-@takes_prescription
+@takes_camera
 def ghost_analysis(
     lens: Prescription,
     field_deg: float | None = None,
@@ -267,15 +282,27 @@ def ghost_analysis(
 ) -> GhostResult:
     """Rank every double-bounce path of ``lens`` for a light at ``field_deg`` (module notes).
 
+    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, round iris,
+    primary wavelength and sensor; the light stays at infinity) or a Prescription as it is (``film_z``
+    default the paraxial image at the wavelength, ``stop_semi_diameter`` default the file's stop).
+
     ``rank_rays`` rays (a deterministic grid over the front element) rank the paths; with
     ``image_rays`` > 0, the ``image_paths`` strongest paths are traced again with that many
     random rays each (in chunks of ``chunk``) and binned into a ``pixels``-wide image of the sensor.
     ``coating``: "none", "single", "multi", or None for the lens file's coating (else "none").
     ``field_deg`` None: :data:`DEFAULT_FIELD_DEG`, or the widest field below it that light passes
     (with a note in the result) when none passes there.
-    The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
+    The sensor is the state's when it has one, else ``sensor_width_mm`` x ``sensor_height_mm`` (default
+    Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
     from ..trace import paraxial_image_z, trace_to_film
+    from ._camera import camera_of, sensor_size
+
+    cam = camera_of(lens, film_z=film_z, stop_semi_diameter=stop_semi_diameter, wavelength_nm=wavelength_nm,
+                    sensor_mm=sensor_size(sensor_width_mm, sensor_height_mm))
+    _round_iris(cam)
+    lens, film_z, stop_semi_diameter, wavelength_nm = cam.lens, cam.film_z, cam.stop_semi_diameter, cam.wavelength_nm
+    sensor_width_mm, sensor_height_mm = cam.sensor_mm or (sensor_width_mm, sensor_height_mm)
 
     default_field = field_deg is None
     fd = require_finite("field angle", DEFAULT_FIELD_DEG if default_field else field_deg)
@@ -343,23 +370,30 @@ def ghost_analysis(
     paths.sort(key=lambda p: -p.relative_flux)
     res = GhostResult(lens.name, fd, coating, float(wl), float(film_z), (w, h), dc, paths, notes=notes)
     if image_rays > 0:
-        nx = int(pixels)
-        ny = max(8, int(round(pixels * h / w)))
-        img = np.zeros(nx * ny)
-        rng = np.random.default_rng(seed)
         chosen = [p for p in paths if p.relative_flux > 0][:image_paths]
-        for p in chosen:
-            done = 0
-            while done < image_rays:
-                m = min(chunk, image_rays - done)
-                b = _beam(lens, fd, wl, m, rng)
-                g = trace_ghost(lens, b, p.i, p.j, film_z, backend=backend, _tables=T)
-                ix = np.floor((g.x + w / 2) / w * nx).astype(np.int64)
-                iy = np.floor((g.y + h / 2) / h * ny).astype(np.int64)
-                inside = g.ok & (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)
-                img += np.bincount(iy[inside] * nx + ix[inside], weights=g.weight[inside], minlength=img.size)
-                done += m
-        pix_area = (w / nx) * (h / ny)
-        res.image = img.reshape(ny, nx) / (flux0 * pix_area)
+        img, pix_area = _ghost_image(lens, chosen, fd, wl, film_z, T, (w, h), pixels, image_rays, chunk, seed, backend)
+        res.image = img / (flux0 * pix_area)
         res.image_paths, res.image_rays = len(chosen), int(image_rays)
     return res
+
+
+def _ghost_image(lens, chosen, fd, wl, film_z, T, sensor, pixels, image_rays, chunk, seed, backend):
+    """The ``chosen`` paths' flux binned over the sensor, ``pixels`` wide, and a pixel's area (mm^2): each
+    path traced with ``image_rays`` random rays, in chunks (module notes)."""
+    w, h = sensor
+    nx = int(pixels)
+    ny = max(8, int(round(pixels * h / w)))
+    img = np.zeros(nx * ny)
+    rng = np.random.default_rng(seed)
+    for p in chosen:
+        done = 0
+        while done < image_rays:
+            m = min(chunk, image_rays - done)
+            b = _beam(lens, fd, wl, m, rng)
+            g = trace_ghost(lens, b, p.i, p.j, film_z, backend=backend, _tables=T)
+            ix = np.floor((g.x + w / 2) / w * nx).astype(np.int64)
+            iy = np.floor((g.y + h / 2) / h * ny).astype(np.int64)
+            inside = g.ok & (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)
+            img += np.bincount(iy[inside] * nx + ix[inside], weights=g.weight[inside], minlength=img.size)
+            done += m
+    return img.reshape(ny, nx), (w / nx) * (h / ny)

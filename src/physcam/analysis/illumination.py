@@ -34,7 +34,8 @@ import numpy as np
 
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
+from ..optics.state import takes_camera
 
 __all__ = ["IlluminationPoint", "IlluminationResult", "relative_illumination"]
 
@@ -115,9 +116,9 @@ def _launch_window(lens, direction):
     return z0, (-sd + min(sx) - margin, sd + max(sx) + margin, -sd + min(sy) - margin, sd + max(sy) + margin)
 
 
-def _beam_areas(lens, directions, wl, film_z, grid, fresnel, stop_sd, backend):
+def _beam_areas(lens, directions, wl, film_z, grid, fresnel, stop_sd, aperture, backend):
     """Cross-section (mm^2, perpendicular to the beam) of each collimated beam (one per direction)
-    that reaches the film.
+    that reaches the film (weighted by the ``aperture`` shape's density at the stop, if any).
 
     Rays start on a plane in front of the whole front element, over the projection of its clear
     aperture along the beam (every ray that can pass starts there); pilot grids zoom onto the
@@ -148,7 +149,7 @@ def _beam_areas(lens, directions, wl, film_z, grid, fresnel, stop_sd, backend):
         pos = np.concatenate([np.stack([X, Y, np.full(X.size, z0s[k])], axis=1) for k, X, Y in jobs])
         dirs = np.concatenate([np.broadcast_to(directions[k], (X.size, 3)) for k, X, _ in jobs])
         out = trace_to_film(lens, RayBatch.from_arrays(pos, dirs, wl), film_z, clip=True,
-                            fresnel=fresnel, stop_semi_diameter=stop_sd, backend=backend)
+                            fresnel=fresnel, stop_semi_diameter=stop_sd, aperture=aperture, backend=backend)
         res, a = [], 0
         for _k, X, _ in jobs:
             res.append((out.ok[a:a + X.size], out.weight[a:a + X.size]))
@@ -222,7 +223,7 @@ def _mappings(lens, lm, wl, film_z, backend, eps=1e-5):
     return res
 
 
-@takes_prescription
+@takes_camera
 def relative_illumination(
     lens: Prescription,
     fields_deg=None,
@@ -240,17 +241,27 @@ def relative_illumination(
 ) -> IlluminationResult:
     """Relative illumination of ``lens`` at field angles in degrees (module notes).
 
-    Default fields: ``n_fields`` from 0 to the sensor corner (``max_field_deg`` overrides).
+    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris, iris
+    shape, primary wavelength and sensor; the light still comes from infinity) or a Prescription as it
+    is (``film_z`` default the paraxial image at the wavelength; ``stop_semi_diameter`` (mm) stops it
+    down). Default fields: ``n_fields`` from 0 to the sensor corner (``max_field_deg`` overrides).
     Anamorphic lenses are evaluated in both meridians. ``grid``: rays per side of the sampling
-    grid (``grid``^2 per field). ``stop_semi_diameter`` (mm) stops the lens down. A field where no
-    ray passes, or whose chief ray does not, raises :class:`OpticsError`.
-    The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
+    grid (``grid``^2 per field). A field where no ray passes, or whose chief ray does not, raises
+    :class:`OpticsError`. The sensor is the state's when it has one, else ``sensor_width_mm`` x
+    ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`,
+    the CLI's default too).
     """
     from ..optics.paraxial import gaussian_xy
     from ..trace import paraxial_image_z
+    from ._camera import camera_of, sensor_size
     from ._chief import field_angles_deg, field_direction
 
-    wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
+    cam = camera_of(lens, film_z=film_z, stop_semi_diameter=stop_semi_diameter, wavelength_nm=wavelength_nm,
+                    sensor_mm=sensor_size(sensor_width_mm, sensor_height_mm))
+    lens, film_z, stop_semi_diameter, aperture = cam.lens, cam.film_z, cam.stop_semi_diameter, cam.aperture
+    sensor_width_mm, sensor_height_mm = cam.sensor_mm or (DEFAULT_SENSOR_WIDTH_MM, DEFAULT_SENSOR_HEIGHT_MM)
+    wl = lens.wavelength_nm if cam.wavelength_nm is None else require_positive("wavelength", cam.wavelength_nm,
+                                                                                unit="nm")
     if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 16 <= grid <= MAX_GRID:
         raise InputError(f"grid must be a whole number from 16 to {MAX_GRID} (rays per side), got {grid!r}")
     if isinstance(n_fields, bool) or not isinstance(n_fields, (int, np.integer)) or not 2 <= n_fields <= 200:
@@ -267,7 +278,7 @@ def relative_illumination(
             for fd in field_angles_deg(fields_deg, max_field_deg, n_fields, 0.5 * math.hypot(w, h), g[axis].efl)]
     off = [(axis, fd) for axis, fd in todo if fd != 0]
     dirs = [d0] + [field_direction(math.radians(fd), axis)[0] for axis, fd in off]
-    areas = _beam_areas(lens, dirs, wl, film_z, grid, fresnel, stop_semi_diameter, backend)
+    areas = _beam_areas(lens, dirs, wl, film_z, grid, fresnel, stop_semi_diameter, aperture, backend)
     maps = _mappings(lens, [(d[0], d[1]) if k else (0.0, 0.0) for k, d in enumerate(dirs)], wl, film_z, backend)
     a0, m0 = areas[0], maps[0]
     if a0 <= 0 or m0 is None:
@@ -278,7 +289,7 @@ def relative_illumination(
     def measure(pairs):
         """(beam area, mapping) of more (axis, field) pairs, traced together."""
         ds = [field_direction(math.radians(fd), axis)[0] for axis, fd in pairs]
-        ar = _beam_areas(lens, ds, wl, film_z, grid, fresnel, stop_semi_diameter, backend)
+        ar = _beam_areas(lens, ds, wl, film_z, grid, fresnel, stop_semi_diameter, aperture, backend)
         mps = _mappings(lens, [(d[0], d[1]) for d in ds], wl, film_z, backend)
         return {key: (ar[k], mps[k]) for k, key in enumerate(pairs)}
 

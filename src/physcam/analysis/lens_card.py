@@ -184,7 +184,7 @@ def _diagram(lens, focus_mm):
     from .diagram import lens_diagram
 
     try:
-        return lens_diagram(lens, focus_from_film_mm=focus_mm, rays=5)
+        return lens_diagram(lens, focus_mm=focus_mm, rays=5)
     except OpticsError:
         return lens_diagram(lens, rays=5)
 

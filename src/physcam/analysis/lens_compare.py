@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import math
 
+from ..optics.state import CameraState, takes_camera
+
 __all__ = ["fstop_for_comparison", "lens_measurements"]
 
 #: How far below its widest f-number a lens may be asked to open before it is compared wide open: 1 %
@@ -29,11 +31,28 @@ def fstop_for_comparison(lens, fstop) -> tuple[float, list[str]]:
     return fstop, []
 
 
-def lens_measurements(lens, *, focus_mm, fstop, sensor, coc=None, light_mm=None, rays=200_000) -> dict:
-    """The comparison's figures of ``lens`` focused at ``focus_mm`` (a mark from the film, inf allowed)
-    at ``fstop`` on ``sensor``; curves for the figure under ``_curves``; ``notes``."""
+def _camera(lens, focus_mm, fstop):
+    """(the lens, its mark, its f-stop, a function giving its camera state): the state is made when a
+    measurement asks for it, so a Prescription's stop the lens cannot open to is that measurement's note."""
+    from ..errors import InputError
+    from ..optics.state import as_camera_state
+
+    if isinstance(lens, CameraState):
+        cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
+        return cam.lens, cam.focus_from_film_mm, cam.fstop, lambda: cam
+    if focus_mm is None or fstop is None:
+        raise InputError("give focus_mm and fstop with a lens (or a CameraState: physcam.optics.state.camera_state)")
+    return lens, focus_mm, fstop, lambda: as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
+
+
+@takes_camera
+def lens_measurements(lens, *, focus_mm=None, fstop=None, sensor, coc=None, light_mm=None, rays=200_000) -> dict:
+    """The comparison's figures of ``lens`` (a :class:`~physcam.optics.state.CameraState`, or a
+    Prescription focused at ``focus_mm``, a mark from the film, inf allowed, at ``fstop``) on
+    ``sensor``; curves for the figure under ``_curves``; ``notes``."""
     from ..onset.report import ReportRequest, solve_report
 
+    lens, focus_mm, fstop, state = _camera(lens, focus_mm, fstop)
     r = solve_report(ReportRequest(focal_length_mm=None, lens=lens, sensor=sensor, fstop=fstop, focus_mm=focus_mm,
                                    coc=coc))
     real = r.to_dict()["fov_deg"]["real"] or {}
@@ -51,8 +70,8 @@ def lens_measurements(lens, *, focus_mm, fstop, sensor, coc=None, light_mm=None,
     curves, notes = {}, []
     _breathing(lens, focus_mm, sensor, out, curves)
     _distortion(lens, sensor, out, curves, notes)
-    _illumination(lens, fstop, sensor, out, curves, notes)
-    _bokeh(lens, focus_mm, fstop, light_mm, rays, out, curves, notes)
+    _illumination(lens, state, sensor, out, curves, notes)
+    _bokeh(state, focus_mm, light_mm, rays, out, curves, notes)
     out["notes"] = notes
     out["_curves"] = curves
     return out
@@ -88,14 +107,13 @@ def _distortion(lens, sensor, out, curves, notes) -> None:
         notes.append(f"distortion not measured: {exc}")
 
 
-def _illumination(lens, fstop, sensor, out, curves, notes) -> None:
-    """Relative illumination at ``fstop`` to the sensor corner (clamped likewise)."""
+def _illumination(lens, state, sensor, out, curves, notes) -> None:
+    """Relative illumination at the state's iris to the sensor corner (clamped likewise)."""
     from ..errors import PhysCamError
-    from ..optics import focusing
     from .illumination import relative_illumination
 
     try:
-        sd = focusing.iris_semi_diameter(lens, fstop)
+        sd = state().stop_semi_diameter
         ri = relative_illumination(lens, grid=64, stop_semi_diameter=sd, sensor_width_mm=sensor.width_mm,
                                    sensor_height_mm=sensor.height_mm)
         pts = [p for p in ri.points if p.axis == "y"]
@@ -108,21 +126,19 @@ def _illumination(lens, fstop, sensor, out, curves, notes) -> None:
         notes.append(f"illumination not measured: {exc}")
 
 
-def _bokeh(lens, mark, fstop, light_mm, rays, out, curves, notes) -> None:
+def _bokeh(state, mark, light_mm, rays, out, curves, notes) -> None:
     """The bokeh of a point light on the axis (default: twice the focus, or 1 m focused at infinity)."""
     import numpy as np
 
     from ..errors import PhysCamError
-    from ..optics import focusing
     from .blob import equivalent_diameter
     from .bokeh import bokeh_image
 
     light = light_mm if light_mm is not None else (1000.0 if math.isinf(mark) else 2.0 * mark)
     out["bokeh_light_from_film_mm"] = light
     try:
-        st = focusing.focus(lens, mark)
-        stop = focusing.iris_semi_diameter(lens, fstop)
-        img = bokeh_image(st.prescription, light, film_z=st.film_z, rays=rays, pixels=96, stop_semi_diameter=stop,
+        st = state()
+        img = bokeh_image(st.focused, light, film_z=st.film_z, rays=rays, pixels=96, stop_semi_diameter=st.stop_semi_diameter,
                           chunk=min(max(rays, 1000), 250_000))
         mono = img.image.sum(axis=2) if img.image.ndim == 3 else img.image
         x0, x1, _, _ = img.extent_mm

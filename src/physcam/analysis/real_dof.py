@@ -5,11 +5,11 @@ is the entrance pupil's image, growing as |1/d - 1/s|. A real lens adds its own 
 aberration, coma, field curvature at a field point) and focuses best a little away from the
 paraxial image plane, so its limits differ (docs/lens-report.md, "Depth of field from real rays").
 
-Method: the lens is focused at the mark (:func:`physcam.optics.focusing.focus`) and its iris set to
-the f-stop (:func:`physcam.optics.focusing.iris_semi_diameter`); the film stays where focusing
-put it. An object point at distance d in front of the film lies on the real chief ray that reaches
-the film at ``image_height_mm`` (on the axis by default), so a field point keeps its direction as d
-changes. Its blur is measured by tracing a grid of rays over its beam
+Method: the camera state (:func:`physcam.optics.state.camera_state`) focuses the lens at the mark
+(:func:`physcam.optics.focusing.focus`) and sets its iris to the f-stop (the one iris rule,
+``CameraState.stop_semi_diameter``); the film stays where focusing put it. An object point at
+distance d in front of the film lies on the real chief ray that reaches the film at
+``image_height_mm`` (on the axis by default), so a field point keeps its direction as d changes. Its blur is measured by tracing a grid of rays over its beam
 (:func:`physcam.analysis.centroid.image_moments`) as one of
 
 * ``"moment"``: the second-moment diameter sqrt(8 E[r^2]) about the centroid (a uniform disk of
@@ -32,7 +32,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
+from ..optics.state import CameraState, takes_camera
 
 __all__ = ["RealDepthOfField", "real_depth_of_field", "blur_diameter_mm", "MEASURES"]
 
@@ -78,26 +79,22 @@ class RealDepthOfField:
 class _Blur:
     """The blur diameter on the film of object points along one chief ray, for one focused lens."""
 
-    def __init__(self, lens, mark, fstop, image_height_mm, measure, energy_fraction, backend):
-        from ..optics import focusing
-        from ..optics.paraxial import gaussian
+    def __init__(self, cam: CameraState, image_height_mm, measure, energy_fraction, backend):
         from ..trace import RayBatch, trace_through
         from ._chief import aim_from_film
 
-        st = focusing.focus(lens, mark)
-        self.q, self.film_z, self.backend = st.prescription, st.film_z, backend
-        self.wl = float(lens.wavelength_nm)
-        self.iris = focusing.iris_semi_diameter(lens, fstop)
-        g = gaussian(self.q, object_z=st.object_z, film_z=st.film_z)
-        self.z_ep = g.z_entrance_pupil
-        self.r_ep = g.entrance_pupil_diameter / 2 * self.iris / self.q.surfaces[self.q.stop_index].semi_diameter
-        self.front = st.film_z  # the front vertex (z = 0) lies film_z in front of the film
+        self.q, self.film_z, self.backend = cam.focused, cam.film_z, backend
+        self.wl = float(cam.wavelengths_nm[0])  # the state's primary (default: the design wavelength)
+        self.iris = cam.stop_semi_diameter
+        self.z_ep = cam.entrance_pupil_z
+        self.r_ep = cam.gaussian.entrance_pupil_diameter / 2 * self.iris / self.q.surfaces[self.q.stop_index].semi_diameter
+        self.front = cam.film_z  # the front vertex (z = 0) lies film_z in front of the film
         self.measure, self.fraction = measure, energy_fraction
-        aimed = aim_from_film(self.q, [[0.0, -image_height_mm]], st.film_z, wavelength_nm=self.wl, backend=backend)
+        aimed = aim_from_film(self.q, [[0.0, -image_height_mm]], cam.film_z, wavelength_nm=self.wl, backend=backend)
         out = trace_through(self.q, RayBatch.from_arrays(aimed.start, aimed.direction, self.wl), reverse=True,
                             backend=backend)
         if not (bool(aimed.ok[0]) and bool(out.ok[0]) and out.N[0] < 0):
-            raise OpticsError(f"no chief ray of {lens.name!r} reaches the film {image_height_mm:g} mm from the centre")
+            raise OpticsError(f"no chief ray of {cam.lens_name!r} reaches the film {image_height_mm:g} mm from the centre")
         self.ray = np.array([out.x[0], out.y[0], out.z[0], out.L[0], out.M[0], out.N[0]])
 
     def __call__(self, d_from_film: float) -> float:
@@ -125,32 +122,48 @@ def _measure(measure, energy_fraction):
     return f
 
 
-@takes_prescription
-def blur_diameter_mm(lens: Prescription, light_from_film_mm: float, *, focus_mm: float, fstop: float,
-                     image_height_mm: float = 0.0, measure: str = "moment", energy_fraction: float = 0.8,
-                     backend: str = "auto") -> float:
-    """The real blur diameter (mm, module notes) of a point ``light_from_film_mm`` in front of the film."""
+def _camera(lens, focus_mm, fstop) -> CameraState:
+    """The camera state: ``lens`` as it is, or a Prescription focused at ``focus_mm`` and set to ``fstop``
+    (both needed); its mark must be finite."""
+    from ..optics.state import as_camera_state
+
+    if not isinstance(lens, CameraState):
+        if focus_mm is None or fstop is None:
+            raise InputError("give focus_mm and fstop with a lens (or a CameraState: physcam.optics.state.camera_state)")
+        focus_mm = require_positive("focus mark", focus_mm)
+    cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
+    require_positive("focus mark", cam.focus_from_film_mm)
+    return cam
+
+
+@takes_camera
+def blur_diameter_mm(lens: CameraState | Prescription, light_from_film_mm: float, *, focus_mm: float | None = None,
+                     fstop: float | None = None, image_height_mm: float = 0.0, measure: str = "moment",
+                     energy_fraction: float = 0.8, backend: str = "auto") -> float:
+    """The real blur diameter (mm, module notes) of a point ``light_from_film_mm`` in front of the film;
+    ``lens`` a :class:`~physcam.optics.state.CameraState`, or a Prescription with ``focus_mm`` and ``fstop``."""
     f = _measure(measure, energy_fraction)
-    blur = _Blur(lens, require_positive("focus mark", focus_mm), fstop, require_finite("image height", image_height_mm),
-                 measure, f, backend)
+    blur = _Blur(_camera(lens, focus_mm, fstop), require_finite("image height", image_height_mm), measure, f, backend)
     d = require_positive("light distance", light_from_film_mm)
     if not d > blur.front:
         raise InputError(f"the light at {d:g} mm from the film is not in front of the lens ({blur.front:g} mm)")
     return blur(d)
 
 
-@takes_prescription
-def real_depth_of_field(lens: Prescription, *, focus_mm: float, fstop: float, coc_mm: float,
-                        image_height_mm: float = 0.0, measure: str = "moment", energy_fraction: float = 0.8,
-                        backend: str = "auto") -> RealDepthOfField:
-    """Near and far limits of ``lens`` focused at ``focus_mm`` (mark from the film) at ``fstop`` where the
-    real blur reaches ``coc_mm`` (module notes). Raises :class:`OpticsError` when the lens's own blur at
-    its sharpest already exceeds the CoC."""
-    mark = require_positive("focus mark", focus_mm)
+@takes_camera
+def real_depth_of_field(lens: CameraState | Prescription, *, focus_mm: float | None = None, fstop: float | None = None,
+                        coc_mm: float, image_height_mm: float = 0.0, measure: str = "moment",
+                        energy_fraction: float = 0.8, backend: str = "auto") -> RealDepthOfField:
+    """Near and far limits of ``lens`` (a :class:`~physcam.optics.state.CameraState`, or a Prescription
+    focused at ``focus_mm``, the mark from the film, at ``fstop``) where the real blur reaches
+    ``coc_mm`` (module notes). Raises :class:`OpticsError` when the lens's own blur at its sharpest
+    already exceeds the CoC."""
+    cam = _camera(lens, focus_mm, fstop)
+    lens, mark, fstop = cam.lens, cam.focus_from_film_mm, cam.fstop
     c = require_positive("circle of confusion", coc_mm)
     h = require_finite("image height", image_height_mm)
     frac = _measure(measure, energy_fraction)
-    blur = _Blur(lens, mark, fstop, h, measure, frac, backend)
+    blur = _Blur(cam, h, measure, frac, backend)
     u_front = 1.0 / (blur.front + 1.0)  # 1 mm in front of the front vertex
     b = lambda u: blur(1.0 / u) if u > 0 else blur(FAR_AWAY_MM)  # noqa: E731
     # the sharpest distance: golden-section search on u = 1/d between infinity and the lens front

@@ -4,7 +4,9 @@ For each field angle (degrees, in the Y-Z meridian) a collimated beam fills a di
 paraxial entrance-pupil plane: the paraxial entrance pupil overfilled by ``overfill`` so real
 pupil shifts are covered (the stop and element rims clip what does not pass), or ``pupil_radius``.
 It is traced to the film plane (``film_z``, mm in lens space; default the paraxial image plane
-at the design wavelength). RMS radius is about the centroid, sqrt(mean(dx^2 + dy^2)); geometric
+at the design wavelength). From a :class:`~physcam.optics.state.CameraState` focused closer than
+infinity the rays come instead from the object point at its focus, aimed at the same disk, and land
+on the state's film plane. RMS radius is about the centroid, sqrt(mean(dx^2 + dy^2)); geometric
 radius the largest distance from the centroid. Both in micrometres.
 
 Sampling (area-weighted, deterministic): the disk is cut into equal-area cells on a regular grid
@@ -29,7 +31,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, require_finite
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
+from ..optics.state import takes_camera
 
 __all__ = ["equal_area_disk", "SpotField", "SpotDiagram", "spot_diagram", "MAX_RINGS", "MAX_REFINE"]
 
@@ -242,7 +245,52 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
     return out
 
 
-@takes_prescription
+class _Beams:
+    """The rays of each field aimed at points of the beam's disk on the entrance-pupil plane ``z_ep``
+    (centred on the axis): at infinity a collimated beam along (0, sin theta, cos theta); at a finite
+    ``object_z`` from the object point (0, -tan(theta) (z_ep - object_z), object_z), seen under theta
+    from the entrance pupil (as :mod:`physcam.analysis._pupil`). Rays start on a plane in front of the
+    lens (or at the object point when it is nearer)."""
+
+    def __init__(self, lens, object_z, z_ep, beam, fields, wl):
+        from ..trace import RayBatch
+        from ._chief import start_plane_z
+
+        self.z0 = min(z_ep, start_plane_z(lens)) - 1.0
+        self.object_z, self.z_ep, self.beam, self.wl = object_z, z_ep, beam, float(wl)
+        th = np.radians(np.asarray(fields, dtype=float))
+        self.dirs = np.stack([np.zeros(th.size), np.sin(th), np.cos(th)], axis=1)  # one beam direction per field
+        self.back = (z_ep - self.z0) / self.dirs[:, 2]
+        # the beams' unit directions exactly as RayBatch.from_arrays normalises them, once per field
+        self.unit = RayBatch.from_arrays(np.zeros((th.size, 3)), self.dirs, wl) if th.size else None
+        self.object_y = -np.tan(th) * (z_ep - object_z) if math.isfinite(object_z) else None
+
+    def rays(self, f, u, v):
+        """Rays of fields ``f`` toward points (u, v) of the unit disk, as one RayBatch."""
+        from ..trace import RayBatch
+
+        n = u.size
+        if self.object_y is not None:
+            return self._from_point(f, u, v)
+        # built column by column: the numbers RayBatch.from_arrays(start, dirs[f], wl) would hold
+        y = self.beam * v
+        y -= self.back[f] * self.dirs[f, 1]
+        unit = self.unit
+        return RayBatch(self.beam * u, y, np.full(n, float(self.z0)), unit.L[f], unit.M[f], unit.N[f],
+                        np.full(n, self.wl), np.ones(n), np.zeros(n, dtype=np.uint8))
+
+    def _from_point(self, f, u, v):
+        from ..trace import RayBatch
+
+        n = u.size
+        p = np.stack([np.zeros(n), self.object_y[f], np.full(n, self.object_z)], axis=1)
+        d = np.stack([self.beam * u, self.beam * v, np.full(n, self.z_ep)], axis=1) - p
+        if self.object_z < self.z0:  # start where the ray crosses the plane in front of the lens
+            p = p + d * ((self.z0 - self.object_z) / d[:, 2])[:, None]
+        return RayBatch.from_arrays(p, d, self.wl)
+
+
+@takes_camera
 def spot_diagram(
     lens: Prescription,
     fields_deg=(0.0,),
@@ -259,28 +307,29 @@ def spot_diagram(
 ) -> SpotDiagram:
     """Spot diagram of ``lens`` at the given field angles (see module notes).
 
+    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris,
+    iris shape and primary wavelength; the object at its focus, the field seen from the entrance
+    pupil as for the MTF) or a Prescription (object at infinity; ``film_z`` default the paraxial
+    image at ``wavelength_nm``, ``fstop`` sizes the iris by the one rule).
     ``rings`` (1 to :data:`MAX_RINGS`) sets the base grid, ``refine`` (0 to :data:`MAX_REFINE`)
     the levels of edge refinement. ``pupil_radius`` (mm) replaces the overfilled entrance pupil
     by a disk of that radius on the entrance-pupil plane (e.g. to compare with a published figure
-    at a given beam size). ``fstop`` stops the lens down (the stop's semi-diameter scaled to that
-    f-number). ``clip=False``: no rim or stop clips (the default beam is then the paraxial
-    entrance pupil, not overfilled). A field where no ray reaches the film is undefined (module notes).
+    at a given beam size). ``clip=False``: no rim or stop clips (the default beam is then the
+    paraxial entrance pupil, not overfilled). A field where no ray reaches the film is undefined
+    (module notes).
     """
     from ..optics.paraxial import gaussian
-    from ..trace import CLIPPED, MISSED, OK, TIR, RayBatch, paraxial_image_z, trace_to_film
-    from ._chief import start_plane_z
+    from ..trace import CLIPPED, MISSED, OK, TIR, paraxial_image_z, trace_to_film
+    from ._camera import camera_of
 
-    wl = lens.wavelength_nm if wavelength_nm is None else require_finite("wavelength_nm", wavelength_nm)
+    cam = camera_of(lens, film_z=film_z, fstop=fstop, wavelength_nm=wavelength_nm)
+    lens = cam.lens
+    wl = lens.wavelength_nm if cam.wavelength_nm is None else require_finite("wavelength_nm", cam.wavelength_nm)
     rings = _whole("rings", rings, 1, MAX_RINGS)
     refine = _whole("refine", refine, 0, MAX_REFINE)
-    if film_z is None:
-        film_z = paraxial_image_z(lens, wl)
-    stop = None
-    if fstop is not None:  # the iris sized by the one rule (at infinity focus, design wavelength)
-        from ..optics.focusing import iris_semi_diameter
-
-        stop = iris_semi_diameter(lens, fstop)
-    g = gaussian(lens, wavelength_nm=wl, stop_semi_diameter=stop)
+    film_z = paraxial_image_z(lens, wl) if cam.film_z is None else cam.film_z
+    stop = cam.stop_semi_diameter
+    g = gaussian(lens, wavelength_nm=wl, stop_semi_diameter=stop, object_z=cam.object_z)
     z_ep, r_ep = g.z_entrance_pupil, g.entrance_pupil_diameter / 2
     if pupil_radius is not None:
         beam = require_finite("pupil_radius", pupil_radius)
@@ -292,23 +341,11 @@ def spot_diagram(
     for fd in fields:
         if not -89.0 < fd < 89.0:
             raise InputError(f"field angle must lie between -89 and 89 degrees, got {fd:g}")
-    z0 = min(z_ep, start_plane_z(lens)) - 1.0
-    th = np.radians(np.asarray(fields, dtype=float))
-    dirs = np.stack([np.zeros(th.size), np.sin(th), np.cos(th)], axis=1)  # one beam direction per field
-    back = (z_ep - z0) / dirs[:, 2]
-
-    # the beams' unit directions exactly as RayBatch.from_arrays normalises them, once per field
-    unit = RayBatch.from_arrays(np.zeros((th.size, 3)), dirs, wl) if th.size else None
+    beams = _Beams(lens, cam.object_z, z_ep, beam, fields, wl)
 
     def trace(f, u, v):
-        # every field's rays in one batch (one tracer call per refinement level), built column by
-        # column: the numbers RayBatch.from_arrays(start, dirs[f], wl) would hold
-        n = u.size
-        y = beam * v
-        y -= back[f] * dirs[f, 1]
-        rays = RayBatch(beam * u, y, np.full(n, float(z0)), unit.L[f], unit.M[f], unit.N[f], np.full(n, float(wl)),
-                        np.ones(n), np.zeros(n, dtype=np.uint8))
-        res = trace_to_film(lens, rays, film_z, clip=clip, stop_semi_diameter=stop, backend=backend, in_place=True)
+        res = trace_to_film(lens, beams.rays(f, u, v), film_z, clip=clip, stop_semi_diameter=stop,
+                            aperture=cam.aperture, backend=backend, in_place=True)
         return res.flag, res.x, res.y
 
     samples = _refined_samples(trace, rings, refine, len(fields)) if fields else []

@@ -1,6 +1,6 @@
 """Distortion over the full 2-D field at any focus, and ST-maps for compositing (docs/analyses.md).
 
-**The field.** The lens is focused at the mark ``focus_mm`` (mm from the film plane, as
+**The field.** The lens (a camera state, :mod:`physcam.optics.state`) is focused at its mark (mm from the film plane, as
 :func:`physcam.optics.focusing.focus` does it: unit or internal focusing). For film points on a
 coarse regular grid covering the sensor (about one node per 32 pixels, edges included), the real
 chief ray is traced backward from the film through the centre of the stop
@@ -16,9 +16,10 @@ order accurate, with Keys' boundary rule), separably on the regular grid. Its er
 not assumed: real chief rays are traced at every grid cell's centre and compared with the
 interpolant (``interpolation_error_px``); likewise the inverse map (``inverse_error_px``).
 
-**At a stop.** A chief ray is where a small stop images a point. With ``fstop`` the field is the
-lens's **centroid** distortion at that f-stop (the iris sized by
-:func:`physcam.optics.focusing.iris_semi_diameter`): each node's real position is the energy
+**At a stop.** A chief ray is where a small stop images a point. With the iris set to an f-stop (a
+:class:`~physcam.optics.state.CameraState` made with ``fstop``, or ``fstop`` with a Prescription)
+the field is the lens's **centroid** distortion at that f-stop (the state's iris,
+``CameraState.stop_semi_diameter``): each node's real position is the energy
 centroid of its object point's blur (:func:`physcam.analysis.centroid.image_centroids`), found by
 aiming the chief ray from the node, measuring the centroid's offset from the node and aiming again
 from the node moved back by that offset (the offset changes slowly across the field, so one step
@@ -59,7 +60,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ExportError, InputError, OpticsError, require_positive
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
+from ..optics.state import CameraState, takes_camera
 
 __all__ = ["DistortionField", "distortion_field", "apply_stmap", "write_stmaps", "write_map_exr", "write_map_png", "MAX_SIDE_PX", "MAX_PIXELS"]
 
@@ -395,13 +397,24 @@ def _field_notes(fstop) -> list[str]:
             "focus)"]
 
 
-@takes_prescription
+def _sensor(state, sensor_width_mm, sensor_height_mm) -> tuple[float, float]:
+    """The sensor (width, height) mm: the arguments, or the camera state's own."""
+    if sensor_width_mm is None and sensor_height_mm is None and state.sensor_mm is not None:
+        return state.sensor_mm
+    if state.sensor_mm is not None:
+        raise InputError("a CameraState carries its own sensor: give it to camera_state(sensor_mm=...), not here")
+    if sensor_width_mm is None or sensor_height_mm is None:
+        raise InputError("give the sensor: sensor_width_mm and sensor_height_mm (or camera_state(sensor_mm=...))")
+    return require_positive("sensor width", sensor_width_mm), require_positive("sensor height", sensor_height_mm)
+
+
+@takes_camera
 def distortion_field(
-    lens: Prescription,
+    lens: CameraState | Prescription,
     *,
-    focus_mm: float = math.inf,
-    sensor_width_mm: float,
-    sensor_height_mm: float,
+    focus_mm: float | None = None,
+    sensor_width_mm: float | None = None,
+    sensor_height_mm: float | None = None,
     width_px: int,
     height_px: int,
     wavelength_nm: float | None = None,
@@ -410,29 +423,35 @@ def distortion_field(
     maps: bool = True,
     fstop: float | None = None,
 ) -> DistortionField:
-    """Real distortion of ``lens`` focused at ``focus_mm`` over a ``width_px`` x ``height_px`` frame,
-    with its distortion and undistortion ST-maps (module notes).
+    """Real distortion of ``lens`` (a :class:`~physcam.optics.state.CameraState`, or a Prescription
+    focused at ``focus_mm``, default infinity, and set to ``fstop``) over a ``width_px`` x
+    ``height_px`` frame, with its distortion and undistortion ST-maps (module notes).
 
+    The sensor is the state's (``camera_state(sensor_mm=...)``) or ``sensor_width_mm`` x
+    ``sensor_height_mm``; the wavelength ``wavelength_nm`` or the state's primary one.
     ``maps=False`` traces the same chief rays but makes no ST-maps (the map fields and the overscan
-    are then None and (0, 0)): what fitting models and tables across focus need. ``fstop``: the
-    centroid distortion at that f-stop instead of the chief rays' (module notes, "At a stop").
+    are then None and (0, 0)): what fitting models and tables across focus need. An iris set to an
+    f-stop gives the centroid distortion there instead of the chief rays' (module notes, "At a stop").
     """
-    from ..optics.focusing import focus, iris_semi_diameter
+    from ..optics.state import as_camera_state
+    from ..optics.focusing import focus
     from ..optics.paraxial import gaussian
 
     w_px, h_px = _size("width", width_px), _size("height", height_px)
     if w_px * h_px > MAX_PIXELS:
         raise InputError(f"a {w_px} x {h_px} frame has more than {MAX_PIXELS:,} pixels: give a smaller resolution")
-    W = require_positive("sensor width", sensor_width_mm)
-    H = require_positive("sensor height", sensor_height_mm)
-    wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
-    st = focus(lens, focus_mm, method=method, axis="y", wavelength_nm=wl)
+    cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
+    W, H = _sensor(cam, sensor_width_mm, sensor_height_mm)
+    lens = cam.lens
+    wl = cam.wavelengths_nm[0] if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
+    st = focus(lens, cam.focus_from_film_mm, method=method, axis="y", wavelength_nm=wl)
     q = st.prescription
     g = {a: gaussian(q, axis=a, wavelength_nm=wl, object_z=st.object_z, film_z=st.film_z) for a in ("x", "y")}
     for a in ("x", "y"):
         if g[a].pinhole_focal_length is None or not g[a].efl > 0:
             raise OpticsError(f"lens {lens.name!r} has no best-match pinhole in {a.upper()} at this focus")
-    iris = None if fstop is None else iris_semi_diameter(lens, fstop, method=method)
+    fstop = cam.fstop if cam.iris_set else None
+    iris = cam.stop_semi_diameter if cam.iris_set else None
     rays = _PlateRays(lens.name, q, g["x"], g["y"], st, wl, backend, w_px, h_px, (W, H), iris)
 
     # forward field: real plate position -> ideal plate position, traced at the nodes

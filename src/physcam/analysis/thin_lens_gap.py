@@ -79,15 +79,15 @@ def _thin_lens_blur_mm(report, light_from_film_mm: float) -> float:
     return report.aperture_diameter_mm * report.pinhole[0] * abs(1.0 / d - inv_s)
 
 
-def _real_blur_mm(lens, report, light_from_film_mm: float) -> float:
-    """sqrt(8 E[r^2]) of the real lens's traced image of an on-axis point light."""
-    from ..optics import focusing
+def _real_blur_mm(state, light_from_film_mm: float) -> float:
+    """sqrt(8 E[r^2]) of the real lens's traced image of an on-axis point light; ``state()`` gives the
+    camera state (made when first asked, so a stop the lens cannot open to is a note of each light)."""
     from .blob import equivalent_diameter
     from .bokeh import bokeh_image
 
-    st = focusing.focus(lens, report.focus_from_film_mm)
-    img = bokeh_image(st.prescription, light_from_film_mm, film_z=st.film_z, rays=BOKEH_RAYS, pixels=128,
-                      fresnel=False, stop_semi_diameter=focusing.iris_semi_diameter(lens, report.fstop))
+    st = state()
+    img = bokeh_image(st.focused, light_from_film_mm, film_z=st.film_z, rays=BOKEH_RAYS, pixels=128,
+                      fresnel=False, stop_semi_diameter=st.stop_semi_diameter)
     x0, x1, _, _ = img.extent_mm
     return equivalent_diameter(img.image.sum(axis=2), pixel=(x1 - x0) / img.image.shape[1])
 
@@ -102,23 +102,44 @@ def _lights_mm(report, lens) -> list[float]:
     return [d for d in lights if d > front + 10.0]
 
 
+def _camera(report, lens):
+    """The camera state of ``report`` (its focus mark and f-stop) on ``lens``, made once when first
+    asked; a CameraState given as ``lens`` must be the report's."""
+    import functools
+
+    from ..errors import InputError
+    from ..optics.state import CameraState, camera_state
+
+    if isinstance(lens, CameraState):
+        if (lens.focus_from_film_mm, lens.fstop) != (report.focus_from_film_mm, report.fstop):
+            raise InputError(f"the camera state (focus {lens.focus_from_film_mm:g} mm, f/{lens.fstop:g}) is not the "
+                             f"report's (focus {report.focus_from_film_mm:g} mm, f/{report.fstop:g})")
+        return lambda: lens
+    return functools.cache(lambda: camera_state(lens, focus_mm=report.focus_from_film_mm, fstop=report.fstop))
+
+
 def thin_lens_gap(report, lens) -> ThinLensGap:
     """The thin-lens camera of ``report`` against the real ``lens`` it was solved from (module notes).
 
-    ``report`` must come from :func:`physcam.onset.report.solve_lens_report` with ``lens``. A bokeh
-    that cannot be traced (the light inside the lens's closest focus, everything vignetted) is left
-    out with a note."""
+    ``report`` must come from :func:`physcam.onset.report.solve_lens_report` with ``lens``, a
+    Prescription or the :class:`~physcam.optics.state.CameraState` at the report's focus and f-stop.
+    A bokeh that cannot be traced (the light inside the lens's closest focus, everything vignetted)
+    is left out with a note."""
     from ..lens.prescription import Prescription
     from ..onset.report import LensReport
+    from ..optics.state import CameraState
 
     require_type("report", report, LensReport, "solve one with physcam.onset.report.solve_lens_report")
-    require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name or file)")
+    if not isinstance(lens, CameraState):
+        require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name or file) or a CameraState")
+    state = _camera(report, lens)
+    lens = lens.lens if isinstance(lens, CameraState) else lens
     hfov = None if report.real_fov is None else report.real_fov.get("horizontal_deg")
     hfov_pct = None if not hfov else (report.hfov_focus_deg - hfov) / hfov * 100.0
     rows, notes = [], []
     for light in _lights_mm(report, lens):
         try:
-            thin, real = _thin_lens_blur_mm(report, light), _real_blur_mm(lens, report, light)
+            thin, real = _thin_lens_blur_mm(report, light), _real_blur_mm(state, light)
         except PhysCamError as exc:
             notes.append(f"bokeh at {light:g} mm not measured: {str(exc).splitlines()[0]}")
             continue

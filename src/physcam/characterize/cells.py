@@ -29,7 +29,7 @@ What each kind computes (lengths mm from the film plane, docs/conventions.md):
   Standard Degree 4, USD lensDistortion) with their residuals, in ``fits.json``.
 * ``illumination``: :func:`physcam.analysis.illumination.relative_illumination` of the lens focused
   at the mark (:func:`physcam.optics.focusing.focus`) and stopped down to the f-number
-  (:func:`physcam.optics.focusing.iris_semi_diameter`), fields from the axis to the
+  (the iris of :func:`physcam.optics.state.camera_state`, by the one rule), fields from the axis to the
   sensor corner.
 * ``psf``: :func:`physcam.analysis.bokeh.bokeh_image` of a point light at the focus distance (a
   point 1 km away stands for infinity), placed so that the best-match pinhole at that focus images
@@ -152,11 +152,11 @@ def _distortion_cell(lens, grid: Grid, cell: Cell, dest: Path):
 
 def _illumination_cell(lens, grid: Grid, cell: Cell):
     from ..analysis.illumination import relative_illumination
-    from ..optics.focusing import focus, iris_semi_diameter
+    from ..optics.state import camera_state
 
-    st = focus(lens, cell.focus_mm)
-    sd = iris_semi_diameter(lens, cell.fstop)
-    res = relative_illumination(st.prescription, n_fields=max(grid.fields, 2), sensor_width_mm=grid.sensor_mm[0],
+    st = camera_state(lens, focus_mm=cell.focus_mm, fstop=cell.fstop)
+    sd = st.stop_semi_diameter
+    res = relative_illumination(st.focused, n_fields=max(grid.fields, 2), sensor_width_mm=grid.sensor_mm[0],
                                 sensor_height_mm=grid.sensor_mm[1], grid=grid.illumination_grid,
                                 stop_semi_diameter=sd, film_z=st.film_z, backend=grid.backend)
     doc = res.to_dict() | {"kind": "illumination", "focus_from_film_mm": _none_inf(cell.focus_mm),
@@ -189,10 +189,10 @@ def _psf_cell(lens, grid: Grid, cell: Cell):
     import numpy as np
 
     from ..analysis.bokeh import bokeh_image
-    from ..optics.focusing import iris_semi_diameter
+    from ..optics.state import camera_state
 
     st, depth, x, y, fx, fy = psf_light_position(lens, grid, cell)
-    sd = iris_semi_diameter(lens, cell.fstop)
+    sd = camera_state(lens, fstop=cell.fstop).stop_semi_diameter
     q = dataclasses.replace(st.prescription, wavelength_nm=float(cell.wavelength_nm))
     img = bokeh_image(q, depth, x, y, film_z=st.film_z, rays=grid.psf_rays, pixels=grid.psf_pixels,
                       stop_semi_diameter=sd, chunk=max(1000, min(grid.psf_rays, 1_000_000)), backend=grid.backend)

@@ -114,7 +114,8 @@ def _check_folder(out: Path, dry_run: bool) -> Path:
 
 def _check_lens(lens: Prescription, grid: Grid) -> None:
     """Every mark reachable, every f-stop within the lens's range: the errors a run would hit per cell."""
-    from ..optics.focusing import focus, iris_semi_diameter
+    from ..optics.focusing import focus
+    from ..optics.state import camera_state
 
     for m in grid.focus_mm:
         try:
@@ -123,7 +124,7 @@ def _check_lens(lens: Prescription, grid: Grid) -> None:
             raise InputError(f"lens {lens.name!r}: {exc}") from None
     for n in grid.fstops:
         try:
-            iris_semi_diameter(lens, n)
+            camera_state(lens, fstop=n)  # the iris at that stop, by the one rule
         except OpticsError as exc:
             raise InputError(f"lens {lens.name!r}: {exc}") from None
 

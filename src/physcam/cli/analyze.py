@@ -111,6 +111,15 @@ def _prepare(args):
     return args.loaded_lens
 
 
+def _camera(args, fstop=None):
+    """The one camera state of an analysis command: the lens (``_prepare``), focused at infinity, its iris
+    at ``fstop`` (None: as the file stops it), on the command's sensor."""
+    from ..optics.state import camera_state
+
+    lens = _prepare(args)
+    return camera_state(lens, fstop=fstop, sensor_mm=(args.sensor_width, args.sensor_height))
+
+
 def _finish(args, res, command: str) -> None:
     """The plot (-o), then JSON, CSV or the notes and the written file for people."""
     name, rows = DOCS[command]
@@ -172,14 +181,10 @@ def _resolution(text: str):
 
 def run_illumination(args) -> int:
     from ..analysis.illumination import relative_illumination
-    from ..optics.focusing import iris_semi_diameter
     from ._output import Table, print_table
 
-    lens = _prepare(args)
-    sd = None if args.fstop is None else iris_semi_diameter(lens, args.fstop)
-    res = relative_illumination(lens, args.field, max_field_deg=args.max_field, grid=args.grid, fresnel=args.fresnel,
-                                stop_semi_diameter=sd, sensor_width_mm=args.sensor_width,
-                                sensor_height_mm=args.sensor_height)
+    state = _camera(args, fstop=args.fstop)
+    res = relative_illumination(state, args.field, max_field_deg=args.max_field, grid=args.grid, fresnel=args.fresnel)
     if not (args.json or _csv(args, res, "illumination")):
         t = Table(f"{res.lens_name}: relative illumination at {res.wavelength_nm:g} nm"
                   + (f", f/{args.fstop:g}" if args.fstop else "") + f", {args.sensor_name}",
@@ -197,10 +202,9 @@ def run_colour(args) -> int:
     from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM
     from ._output import Table, print_table
 
-    lens = _prepare(args)
+    state = _camera(args)
     wls = (LINE_F_NM, LINE_D_NM, LINE_C_NM) + tuple(args.wavelength or ())
-    res = chromatic_aberration(lens, args.field, wavelengths_nm=wls, max_field_deg=args.max_field,
-                               sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height)
+    res = chromatic_aberration(state, args.field, wavelengths_nm=wls, max_field_deg=args.max_field)
     if not (args.json or _csv(args, res, "colour")):
         print(f"{res.lens_name}: chromatic aberration (EFL {res.efl_mm:.3f} mm at {res.reference_nm:g} nm), "
               f"{args.sensor_name}")
@@ -256,9 +260,9 @@ def run_ghosts(args) -> int:
     from ..analysis.ghosts import ghost_analysis
     from ._output import Table, print_table
 
-    lens = _prepare(args)
-    res = ghost_analysis(lens, args.field, coating=args.coating, image_rays=args.rays if args.output else 0,
-                         pixels=args.pixels, sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height)
+    state = _camera(args)
+    res = ghost_analysis(state, args.field, coating=args.coating, image_rays=args.rays if args.output else 0,
+                         pixels=args.pixels)
     if not (args.json or _csv(args, res, "ghosts")):
         t = Table(f"{res.lens_name}: {len(res.paths)} double-bounce ghost paths, light at {res.field_deg:g} deg, "
                   f"coating {res.coating}", ("rank", "surfaces", "rel. flux", "RMS r mm", "centroid y mm"),

@@ -111,7 +111,10 @@ def run_blender(args) -> int:
     from ._common import resolve_focus
 
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, args=args)
-    res = compare_bokeh(lens, focus_mm=args.focus, fstop=args.fstop, light_mm=args.light, aperture=aperture,
+    from ..optics.state import camera_state
+
+    state = camera_state(lens, focus_mm=args.focus, fstop=args.fstop, aperture=aperture)
+    res = compare_bokeh(state, light_mm=args.light,
                         crop_mm=args.crop, pixels=args.pixels, samples=args.samples,
                         blender_python=args.blender_python, config_blender=_config_blender())
     table = {k: v for k, v in res.items() if k != "images"}

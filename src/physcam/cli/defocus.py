@@ -117,13 +117,13 @@ def run(args) -> int:
     lens = load_lens(args.lens)
     sensor = resolve_sensor(args)
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
-    opts = dict(focus_mm=args.focus, fstop=args.fstop, sensor_width_mm=sensor.width_mm, depth=args.depth,
-                depth_kind=args.depth_kind, depth_unit=args.depth_unit, aperture=_aperture(args),
+    cam = _camera(args, lens, sensor)
+    opts = dict(depth=args.depth, depth_kind=args.depth_kind, depth_unit=args.depth_unit,
                 dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step, step_rel=args.depth_step_rel,
                 edge_px=args.edge_px)
     if "#" in args.image:
-        return _run_sequence(args, lens, opts)
-    res = defocus_file(args.image, args.output, lens, kernel_folder=args.kernel_cache, force=args.force, **opts)
+        return _run_sequence(args, cam, opts)
+    res = defocus_file(args.image, args.output, cam, kernel_folder=args.kernel_cache, force=args.force, **opts)
     if args.json:
         emit_json(document("defocus", res, units={"length": "mm", "time": "s"}))
         return 0
@@ -134,13 +134,23 @@ def run(args) -> int:
     return 0
 
 
-def _run_sequence(args, lens, opts) -> int:
+def _camera(args, lens, sensor):
+    """The one camera state of a defocus command: the lens at the mark, its iris at the f-stop and of
+    its blades, on the sensor."""
+    from ..optics.state import camera_state
+
+    return camera_state(lens, focus_mm=args.focus, fstop=args.fstop, sensor_mm=(sensor.width_mm, sensor.height_mm),
+                        aperture=_aperture(args))
+
+
+def _run_sequence(args, cam, opts) -> int:
     from ..extras import require_extra
 
     require_extra("dask", "a sequence on Dask (physcam defocus IN.####.exr)")
     from ..characterize.defocus_shot import defocus_sequence
 
-    s = defocus_sequence(args.image, args.output, lens, kernel_folder=args.kernel_cache, scheduler=args.scheduler,
+    lens = cam.lens
+    s = defocus_sequence(args.image, args.output, cam, kernel_folder=args.kernel_cache, scheduler=args.scheduler,
                          workers=args.workers, force=args.force, **opts)
     res = {"images": args.image, "outputs": args.output, "lens": lens.name, "frames_done": s.done,
            "frames_skipped": s.skipped, "kernel_cache": s.kernel_folder, "dashboard": s.dashboard}
@@ -165,8 +175,7 @@ def run_kernels(args) -> int:
     sensor = resolve_sensor(args)
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
     depths = [parse_distance(t, name="depth", allow_inf=True) for t in list_items(args.depths, "the depths", "1m,4m,inf")]
-    cam = defocus_camera(lens, focus_mm=args.focus, fstop=args.fstop, sensor_width_mm=sensor.width_mm,
-                         width=args.resolution[0], height=args.resolution[1], aperture=_aperture(args),
+    cam = defocus_camera(_camera(args, lens, sensor), width=args.resolution[0], height=args.resolution[1],
                          dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step,
                          step_rel=args.depth_step_rel)
     index = write_kernel_stack(args.output, cam, field_grid=args.field_grid, depths_mm=depths, force=args.force)

@@ -155,20 +155,19 @@ def _metadata_step(out, ctx, force):
 def _trace_step(out, ctx, force):
     from ..analysis.bokeh import bokeh_image
     from ..analysis.spot import spot_diagram
-    from ..optics import focusing
+    from ..optics.state import camera_state
     from ..trace.aperture import Aperture
 
     lens = ctx["lens"]
-    spot = spot_diagram(lens, (0.0, 5.0, 10.0))
+    spot = spot_diagram(lens, (0.0, 5.0, 10.0))  # the lens as designed: infinity, wide open
     # a point light 1.2 m from the film, off axis, with the lens focused at 3 m and stopped to
     # f/2.8 by a 7-blade iris: the defocus blur shows the iris and cat's-eye vignetting
-    st = focusing.focus(lens, DEFAULTS["focus"])
-    stop = focusing.iris_semi_diameter(lens, DEFAULTS["fstop"])
-    bokeh = bokeh_image(st.prescription, 1200.0, 250.0, 150.0, film_z=st.film_z, rays=400_000, pixels=160,
-                        stop_semi_diameter=stop, aperture=Aperture(nsides=7, roundness=0.2), spectral=True)
+    s = ctx["report"].sensor
+    state = camera_state(lens, focus_mm=DEFAULTS["focus"], fstop=DEFAULTS["fstop"], sensor_mm=(s.width_mm, s.height_mm),
+                         aperture=Aperture(nsides=7, roundness=0.2))
+    bokeh = bokeh_image(state, 1200.0, 250.0, 150.0, rays=400_000, pixels=160, spectral=True)
     from ..analysis.bokeh import write_bokeh_photo
 
-    s = ctx["report"].sensor
     photo = write_bokeh_photo(bokeh, out / "bokeh_photo", pixel_pitch_um=s.pitch_um or s.width_mm * 1000.0 / 4096,
                               sensor_name=s.name, force=force)
     return [spot.plot(out / "spot.png", force=force), bokeh.plot(out / "bokeh.png", force=force), *photo]

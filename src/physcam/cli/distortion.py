@@ -10,8 +10,6 @@ Examples::
 
 from __future__ import annotations
 
-import math
-
 from ._common import FOCUS_HELP, add_units_option, focus, focus_list, number, units_of
 from ._output import document, emit_json, print_csv
 from .lens import WAVE_UNITS, mark_repaired
@@ -243,16 +241,16 @@ def _run_field(args, lens) -> int:
     from ..analysis.stmap import distortion_field, write_stmaps
     from ..errors import InputError
     from ..io import atomic_write, check_writable
+    from ..optics.state import camera_state
 
     if args.field:
         raise InputError("--field is for the field-angle table; the 2-D field (--resolution) covers the whole frame")
     if args.output:
         raise InputError("-o draws the field-angle table's plot; with --resolution the maps go to --stmap DIR "
                          "(each EXR with a PNG preview)")
-    res = distortion_field(lens, focus_mm=math.inf if args.focus is None else args.focus,
-                           sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
-                           width_px=args.resolution[0], height_px=args.resolution[1], wavelength_nm=args.wavelength,
-                           maps=args.stmap is not None, fstop=args.fstop)
+    cam = camera_state(lens, focus_mm=args.focus, fstop=args.fstop, sensor_mm=(args.sensor_width, args.sensor_height))
+    res = distortion_field(cam, width_px=args.resolution[0], height_px=args.resolution[1], wavelength_nm=args.wavelength,
+                           maps=args.stmap is not None)
     fits = fit_models(samples_from_field(res), args.fit or (), max_residual_px=args.max_residual)
     written = []
     if args.stmap is not None:

@@ -159,8 +159,10 @@ def run_opencv(args) -> int:
     from ..export.opencv_distortion import OMNI_API_SCHEMA, fit_opencv_pinhole
 
     lens = _prepare(args)
-    cam = fit_opencv_pinhole(lens, args.sensor_width, args.sensor_height, args.width_px, args.height_px,
-                             focus_from_film_mm=args.focus, terms=args.terms)
+    from ..optics.state import camera_state
+
+    state = camera_state(lens, focus_mm=args.focus, sensor_mm=(args.sensor_width, args.sensor_height))
+    cam = fit_opencv_pinhole(state, image_width_px=args.width_px, image_height_px=args.height_px, terms=args.terms)
     if args.json:
         emit_json(document("export_opencv", cam.to_dict(), units={"length": "mm", "image": "pixel"}))
         return 0
@@ -186,6 +188,7 @@ def run_blender(args) -> int:
 
     from ..errors import InputError
     from ..export.blender import write_blender_camera
+    from ..optics.state import camera_state
     from ..trace.aperture import Aperture
 
     t0 = time.perf_counter()
@@ -199,9 +202,9 @@ def run_blender(args) -> int:
         aperture = Aperture(int(args.blades or 0), args.blade_angle, args.roundness, args.density)
     w = int(args.width_px)
     h = max(1, int(round(w * args.sensor_height / args.sensor_width)))
-    osl, setup = write_blender_camera(args.output, lens, focus_mm=args.focus, fstop=args.fstop,
-                                      sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
-                                      aperture=aperture, dispersion=args.dispersion, fresnel=args.fresnel,
+    state = camera_state(lens, focus_mm=args.focus, fstop=args.fstop, sensor_mm=(args.sensor_width, args.sensor_height),
+                         aperture=aperture)
+    osl, setup = write_blender_camera(args.output, state, dispersion=args.dispersion, fresnel=args.fresnel,
                                       resolution=(w, h), name=Path(args.lens).stem, force=args.force)
     builtin = gap = None
     if args.builtin:

@@ -222,12 +222,13 @@ def _meridians(p):
 def show_data(args):
     """What ``physcam lens show`` computes: (lens, focus state, {meridian: GaussianData}, focus block)."""
     from ..optics import focusing, paraxial
+    from ..optics.state import camera_state
     from ._common import resolve_focus
 
     p = _load(args)
     args.focus = resolve_focus(args.focus, lens=p, fstop=args.fstop, args=args)
     st = focusing.focus(p, args.focus, method=args.focus_method, wavelength_nm=args.wavelength)
-    iris = None if args.fstop is None else focusing.iris_semi_diameter(p, args.fstop, method=args.focus_method)
+    iris = None if args.fstop is None else camera_state(p, fstop=args.fstop).stop_semi_diameter  # the one iris rule
     data = {
         a: paraxial.gaussian(st.prescription, axis=a, wavelength_nm=args.wavelength, stop_semi_diameter=iris,
                              object_z=st.object_z, film_z=st.film_z, flange_focal_distance_mm=args.flange)
@@ -337,16 +338,19 @@ def diagram_options(args) -> dict:
 
     if args.focus == HYPERFOCAL:
         args.focus = resolve_focus(args.focus, lens=_load(args), fstop=args.fstop, args=args)
-    return dict(axis=args.axis, focus_from_film_mm=args.focus, fstop=args.fstop, field_deg=args.field,
+    return dict(axis=args.axis, focus_mm=args.focus, fstop=args.fstop, field_deg=args.field,
                 wavelength_nm=args.wavelength)
 
 
 def run_diagram(args) -> int:
     from ..analysis.diagram import save_lens_diagram
+    from ..optics.state import camera_state
     from ._common import units_of
 
     p = _load(args)
-    path = save_lens_diagram(p, args.output, force=args.force, units=units_of(args), **diagram_options(args))
+    opts = diagram_options(args)
+    cam = camera_state(p, focus_mm=opts.pop("focus_mm"), fstop=opts.pop("fstop"))  # the one camera state
+    path = save_lens_diagram(cam, args.output, force=args.force, units=units_of(args), **opts)
     print(f"wrote {path}")
     return 0
 

@@ -149,7 +149,7 @@ def run_insert(args) -> int:
     from ..io import atomic_write, check_writable
     from ..lens.formats import iset
     from ..lens.library import load_lens
-    from ..trace.microlens import microlens_array, plenoptic_camera
+    from ..trace.microlens import main_lens_state, microlens_array, plenoptic_camera
 
     if (args.microlens is None) == (args.microlens_focal is None):
         raise InputError("give the lenslet: --microlens NAME_OR_FILE or --microlens-focal MM (one of them)")
@@ -168,7 +168,7 @@ def run_insert(args) -> int:
 
         args.focus = resolve_focus(args.focus, lens=main, sensor=custom_sensor(args.film_width, args.film_height),
                                    args=args)
-        cam = plenoptic_camera(main, array, focus_mm=args.focus)
+        cam = plenoptic_camera(main_lens_state(main, array, focus_mm=args.focus), array)
     else:
         cam = plenoptic_camera(main, array, film_to_lens_mm=50.0 if args.film_to_lens is None else args.film_to_lens)
     if cam.main.surfaces[:-1] != main.surfaces[:-1]:
@@ -201,7 +201,7 @@ def run_render(args) -> int:
     from ..io import check_writable
     from ..lens.formats.iset import microlens_of
     from ..lens.library import load_lens
-    from ..trace.microlens import plenoptic_camera
+    from ..trace.microlens import main_lens_state, plenoptic_camera
 
     if not args.point and args.plane is None:
         raise InputError("nothing to render: give --point D (one or more) or --plane D")
@@ -228,7 +228,8 @@ def run_render(args) -> int:
 
         args.focus = resolve_focus(args.focus, lens=p, fstop=args.fstop, args=args,
                                    sensor=custom_sensor(array.film_width_mm, array.film_height_mm))
-        cam = plenoptic_camera(p, array, focus_mm=args.focus, fstop=args.fstop, pixels_per_lenslet=n)
+        state = main_lens_state(p, array, focus_mm=args.focus, fstop=args.fstop)  # the one camera state
+        cam = plenoptic_camera(state, array, pixels_per_lenslet=n)
     else:
         if info["film_to_lens_mm"] is None:
             raise InputError(f"lens {p.name!r} does not say its film-to-lens distance; give --focus")

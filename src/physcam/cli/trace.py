@@ -75,6 +75,8 @@ def run_spot(args) -> int:
     if args.output:
         check_writable(args.output, force=args.force)
     lens = load_lens(args.lens, lenient=args.lenient)
+    # the lens and its own film plane at --wavelength (the paraxial focus of that wavelength): a
+    # CameraState would keep the film where the lens focuses at its design wavelength
     res = spot_diagram(lens, tuple(args.field or (0.0, 5.0)), wavelength_nm=args.wavelength, rings=args.rings,
                        fstop=args.fstop, clip=args.clip)
     if args.output:
@@ -115,25 +117,24 @@ def run_bokeh(args) -> int:
         check_writable(args.output, force=args.force)
     import math
 
-    from ..optics import focusing
+    from ..optics.state import camera_state
     from ..trace.aperture import Aperture
 
     lens = load_lens(args.lens, lenient=args.lenient)
     from ._common import resolve_focus
 
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, args=args)
-    st = focusing.focus(lens, math.inf if args.focus is None else args.focus)
-    stop = None if args.fstop is None else focusing.iris_semi_diameter(lens, args.fstop)
     aperture = None
     if args.blades >= 3 or args.density != 0.0 or args.roundness != 0.0 or args.blade_angle != 0.0:
         aperture = Aperture(nsides=args.blades, angle_deg=args.blade_angle, roundness=args.roundness,
                             density=args.density)
+    state = camera_state(lens, focus_mm=args.focus, fstop=args.fstop, aperture=aperture)
     from ._common import progress_bar
 
     with progress_bar("tracing bokeh rays", enabled=not args.json) as bar:
-        res = bokeh_image(st.prescription, args.depth, args.x, args.y, film_z=st.film_z, rays=args.rays,
-                          pixels=args.pixels, spectral=args.spectral, stop_semi_diameter=stop, aperture=aperture,
-                          chunk=min(args.rays, 250_000) if args.rays >= 1000 else 1000, progress=bar)
+        res = bokeh_image(state, args.depth, args.x, args.y, rays=args.rays, pixels=args.pixels,
+                          spectral=args.spectral, chunk=min(args.rays, 250_000) if args.rays >= 1000 else 1000,
+                          progress=bar)
     if args.output:
         from ..units import format_distance
         from ._common import units_of

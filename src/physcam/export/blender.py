@@ -37,8 +37,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, require_positive
-from ..lens.prescription import Prescription, takes_prescription
+from ..errors import InputError, require_positive, require_type
+from ..lens.prescription import Prescription, require_prescription
+from ..optics.state import CameraState, camera_state, takes_camera
 from .osl import WAVELENGTH_RANGE_NM, osl_array, osl_number
 
 __all__ = ["BakedCamera", "bake_camera", "osl_camera_shader", "blender_setup_script", "write_blender_camera",
@@ -83,18 +84,31 @@ def _aperture(aperture):
                      "a tuple (blades, angle_deg, roundness, density) or a dict of those")
 
 
-@takes_prescription
-def bake_camera(lens: Prescription, *, focus_mm, fstop=None, sensor_width_mm, sensor_height_mm, aperture=None,
-                fresnel: bool = False) -> BakedCamera:
-    """Focus ``lens`` on a subject ``focus_mm`` in front of the film (:func:`physcam.optics.focusing.focus`:
-    internal focusing when the lens has focus groups, else unit focusing), stop it to ``fstop``,
-    and tabulate what the OSL camera needs. Raises :class:`~physcam.errors.OpticsError` for a
-    focus closer than the lens reaches or an f-number faster than it opens."""
-    from ..optics.focusing import focus, iris_semi_diameter
-    from ..trace.pupil_bounds import exit_pupil_bounds
-    from ..trace.surfaces import surface_table
-    from ..trace.trace import camera_rays
+_LENS_HINT = ("physcam.optics.state.camera_state(lens, focus_mm=..., fstop=..., sensor_mm=...) or "
+              "physcam.lens.library.load_lens(name or file)")
 
+
+def _state(lens, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_height_mm=None,
+           aperture=None) -> CameraState:
+    """The camera state the shader bakes (one place for :func:`bake_camera`, :func:`write_blender_camera`
+    and :func:`physcam.export.blender_compare.compare_bokeh`): ``lens`` as it is when it is a
+    :class:`~physcam.optics.state.CameraState` (with a sensor; the keywords then stay None but
+    ``aperture``, which replaces its iris shape), else the Prescription focused at ``focus_mm`` (mm in
+    front of the film plane; ``math.inf`` for infinity), stopped to ``fstop`` (None: as its file
+    stops it) on the ``sensor_width_mm`` x ``sensor_height_mm`` sensor by
+    :func:`physcam.optics.state.camera_state`. ``aperture`` as in :func:`osl_camera_shader`."""
+    if isinstance(lens, CameraState):
+        given = [k for k, v in (("focus_mm", focus_mm), ("fstop", fstop), ("sensor_width_mm", sensor_width_mm),
+                                ("sensor_height_mm", sensor_height_mm)) if v is not None]
+        if given:
+            raise InputError(f"a CameraState carries its own focus, f-stop and sensor: give {', '.join(given)} to "
+                             "camera_state(), not here")
+        if lens.sensor_mm is None:
+            raise InputError("the Blender camera needs a sensor: camera_state(lens, ..., sensor_mm=(width, height))")
+        ap = _aperture(lens.aperture if aperture is None else aperture)
+        return lens if ap is lens.aperture else dataclasses.replace(lens, aperture=ap)
+    require_prescription(lens)
+    ap = _aperture(aperture)
     sw = require_positive("sensor width", sensor_width_mm)
     sh = require_positive("sensor height", sensor_height_mm)
     if sw > 1000 or sh > 1000:
@@ -104,15 +118,39 @@ def bake_camera(lens: Prescription, *, focus_mm, fstop=None, sensor_width_mm, se
     f = float(focus_mm)
     if not (f > 0):
         raise InputError(f"focus distance must be > 0 mm, got {f:g}")
-    ap = _aperture(aperture)
-    state = focus(lens, f)
-    q = state.prescription
-    if fstop is not None:
-        semi = iris_semi_diameter(lens, fstop)
-        k = q.stop_index
+    return camera_state(lens, focus_mm=f, fstop=fstop, sensor_mm=(sw, sh), aperture=ap)
+
+
+def _fstop_label(state: CameraState) -> float | None:
+    """The f-stop the shader's header names: None ("open") when the iris is the file's own stop."""
+    return state.fstop if state.iris_set else None
+
+
+@takes_camera
+def bake_camera(lens: CameraState | Prescription, *, focus_mm=None, fstop=None, sensor_width_mm=None,
+                sensor_height_mm=None, aperture=None, fresnel: bool = False) -> BakedCamera:
+    """Tabulate what the OSL camera needs for ``lens``: a :class:`~physcam.optics.state.CameraState`
+    with a sensor, or a Prescription with ``focus_mm``, ``fstop`` and the sensor (see
+    :func:`osl_camera_shader`; physcam's focus, :func:`physcam.optics.focusing.focus`: internal
+    focusing when the lens has focus groups, else unit focusing). Raises :class:`~physcam.errors.OpticsError` for a focus closer than
+    the lens reaches or an f-number faster than it opens."""
+    state = _state(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=sensor_width_mm,
+                   sensor_height_mm=sensor_height_mm, aperture=aperture)
+    return _bake(state, fresnel)
+
+
+def _bake(state: CameraState, fresnel: bool) -> BakedCamera:
+    from ..trace.pupil_bounds import exit_pupil_bounds
+    from ..trace.surfaces import surface_table
+    from ..trace.trace import camera_rays
+
+    q = state.focused
+    k = q.stop_index
+    if state.stop_semi_diameter != q.surfaces[k].semi_diameter:
         s = list(q.surfaces)
-        s[k] = dataclasses.replace(s[k], semi_diameter=float(semi))
+        s[k] = dataclasses.replace(s[k], semi_diameter=float(state.stop_semi_diameter))
         q = q.with_surfaces(s)
+    sw, sh = state.sensor_mm
     film_z = float(state.film_z)
     table = surface_table(q, reverse=True, coating="none")
     nx, ny = PUPIL_GRID
@@ -121,14 +159,15 @@ def bake_camera(lens: Prescription, *, focus_mm, fstop=None, sensor_width_mm, se
     m = 128
     u = (np.arange(m) + 0.5) / m
     uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
-    cr = camera_rays(q, np.zeros((uu.size, 2)), np.stack([uu, vv], axis=1), film_z, bounds=bounds, aperture=ap,
-                     fresnel=fresnel)
+    cr = camera_rays(q, np.zeros((uu.size, 2)), np.stack([uu, vv], axis=1), film_z, bounds=bounds,
+                     aperture=state.aperture, fresnel=fresnel)
     norm = float(np.mean(cr.weight))
     if not norm > 0:
         from ..errors import OpticsError
 
-        raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at this focus and stop")
-    return BakedCamera(q, film_z, table, bounds, ap, norm, sw, sh, f, fstop, float(lens.wavelength_nm))
+        raise OpticsError(f"no ray from the film centre passes through {state.lens_name!r} at this focus and stop")
+    return BakedCamera(q, film_z, table, bounds, state.aperture, norm, sw, sh, state.focus_from_film_mm,
+                       _fstop_label(state), float(state.lens.wavelength_nm))
 
 
 _num = osl_number
@@ -140,16 +179,21 @@ def _ident(name: str) -> str:
     return s if not s[0].isdigit() else "lens_" + s
 
 
-def osl_camera_shader(lens: Prescription, *, focus_mm, fstop=None, sensor_width_mm, sensor_height_mm,
+@takes_camera
+def osl_camera_shader(lens: CameraState | Prescription, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_height_mm=None,
                       aperture=None, dispersion: bool = False, fresnel: bool = False) -> str:
-    """OSL source of a Cycles camera shader that traces real rays through ``lens`` focused at
-    ``focus_mm`` (mm in front of the film plane; ``math.inf`` for infinity) and stopped to ``fstop``.
+    """OSL source of a Cycles camera shader that traces real rays through ``lens``: a
+    :class:`~physcam.optics.state.CameraState` with a sensor (then leave ``focus_mm``, ``fstop`` and
+    the sensor out), or a Prescription focused at ``focus_mm`` (mm in front of the film plane;
+    ``math.inf`` for infinity), stopped to ``fstop`` (None: as its file stops it) on the
+    ``sensor_width_mm`` x ``sensor_height_mm`` sensor, through
+    :func:`physcam.optics.state.camera_state`. Both give the same text.
 
     ``aperture``: an :class:`~physcam.trace.aperture.Aperture` (blades, angle, roundness, density),
-    a number of blades, or a tuple/dict of its fields; ``None`` the round stop. ``dispersion``
-    samples one wavelength per ray, uniform over :data:`WAVELENGTH_RANGE_NM`, with the exact index
-    of each medium, and colours it with three tent functions (peaks 450, 550, 650 nm; they sum to
-    1 at every wavelength, so white light stays white); ``fresnel`` multiplies the unpolarised
+    a number of blades, or a tuple/dict of its fields; ``None`` the round stop (or the state's).
+    ``dispersion`` samples one wavelength per ray, uniform over :data:`WAVELENGTH_RANGE_NM`, with the
+    exact index of each medium, and colours it with three tent functions (peaks 450, 550, 650 nm; they
+    sum to 1 at every wavelength, so white light stays white); ``fresnel`` multiplies the unpolarised
     Fresnel transmission (uncoated surfaces). The code is the template ``osl/physcam_lens.osl.in``
     with this lens's data block (:mod:`physcam.export.osl`). See the module docstring for the conventions.
     """
@@ -295,28 +339,30 @@ def blender_setup_script(shader, *, sensor_width_mm, sensor_height_mm, resolutio
                          path=path, source=source)
 
 
-def write_blender_camera(out_dir, lens: Prescription, *, focus_mm, fstop=None, sensor_width_mm, sensor_height_mm,
-                         aperture=None, dispersion: bool = False, fresnel: bool = False, resolution=None,
-                         name: str | None = None, force: bool = False) -> tuple[Path, Path]:
-    """Write ``<name>.osl`` (:func:`osl_camera_shader`) and ``setup_<name>.py``
-    (:func:`blender_setup_script`, with the shader embedded) into ``out_dir`` through
-    :func:`physcam.io.atomic_write` (no overwrite without ``force``). ``name`` defaults to the
-    lens name made an identifier. Returns the two paths."""
+def write_blender_camera(out_dir, lens: CameraState | Prescription, *, focus_mm=None, fstop=None, sensor_width_mm=None,
+                         sensor_height_mm=None, aperture=None, dispersion: bool = False, fresnel: bool = False,
+                         resolution=None, name: str | None = None, force: bool = False) -> tuple[Path, Path]:
+    """Write ``<name>.osl`` (:func:`osl_camera_shader` of ``lens``: a CameraState or a Prescription
+    with its focus, f-stop and sensor) and ``setup_<name>.py`` (:func:`blender_setup_script`, with
+    the shader embedded) into ``out_dir`` through :func:`physcam.io.atomic_write` (no overwrite
+    without ``force``). ``name`` defaults to the lens name made an identifier. Returns the two paths."""
     from ..io import atomic_write, check_writable
-    from ..lens.prescription import require_prescription
 
-    require_prescription(lens)
-    stem = _ident(name if name is not None else lens.name)
+    require_type("lens", lens, (CameraState, Prescription), _LENS_HINT)
+    lens_name = lens.lens_name if isinstance(lens, CameraState) else lens.name
+    stem = _ident(name if name is not None else lens_name)
     out = Path(out_dir)
     osl_path = out / f"{stem}.osl"
     setup_path = out / f"setup_{stem}.py"
     check_writable(osl_path, force=force)
     check_writable(setup_path, force=force)
-    src = osl_camera_shader(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=sensor_width_mm,
-                            sensor_height_mm=sensor_height_mm, aperture=aperture, dispersion=dispersion,
-                            fresnel=fresnel)
-    setup = blender_setup_script(src, sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm,
-                                 resolution=resolution, text_name=f"{stem}.osl")
+    _check_switches(dispersion, fresnel)
+    state = _state(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=sensor_width_mm,
+                   sensor_height_mm=sensor_height_mm, aperture=aperture)
+    src = _emit(_bake(state, fresnel), dispersion=dispersion, fresnel=fresnel)
+    sw, sh = state.sensor_mm
+    setup = blender_setup_script(src, sensor_width_mm=sw, sensor_height_mm=sh, resolution=resolution,
+                                 text_name=f"{stem}.osl")
     atomic_write(osl_path, src, force=force)
     atomic_write(setup_path, setup, force=force)
     return osl_path, setup_path

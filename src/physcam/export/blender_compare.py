@@ -12,6 +12,7 @@ the user config, ``blender`` on PATH, a checkout's ``.venv-blender``), and the r
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 import tempfile
@@ -20,7 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_positive
-from ..lens.prescription import Prescription, takes_prescription
+from ..lens.prescription import Prescription
+from ..optics.state import CameraState, takes_camera
 from .blender_runner import SCRIPT_ARGS, find_blender
 
 __all__ = ["compare_bokeh"]
@@ -65,18 +67,23 @@ print(json.dumps({"ok": True}))
 '''
 
 
-@takes_prescription
-def compare_bokeh(lens: Prescription, *, focus_mm: float, fstop: float, light_mm: float, aperture=None,
-                  crop_mm: float = 3.0, pixels: int = 128, samples: int = 512, rays: int = 2_000_000,
+@takes_camera
+def compare_bokeh(lens: CameraState | Prescription, *, focus_mm: float | None = None, fstop: float | None = None, light_mm: float,
+                  aperture=None, crop_mm: float = 3.0, pixels: int = 128, samples: int = 512, rays: int = 2_000_000,
                   sphere_mm: float = 1.0, blender_python: str | None = None, timeout_s: float = 600.0,
                   config_blender: str | None = None) -> dict:
-    """Render and trace a point light ``light_mm`` in front of the film with ``lens`` focused at
-    ``focus_mm`` and stopped to ``fstop``; return both images and the measured agreement."""
+    """Render and trace a point light ``light_mm`` in front of the film with ``lens``: a
+    :class:`~physcam.optics.state.CameraState` (its focus, iris and iris shape; its sensor is replaced
+    by the ``crop_mm`` square), or a Prescription focused at ``focus_mm`` and stopped to ``fstop``;
+    return both images and the measured agreement."""
     from ..analysis.blob import blob_moments, equivalent_diameter, polygon_corners
     from ..analysis.bokeh import bokeh_image
-    from ..optics.focusing import focus, iris_semi_diameter
-    from .blender import blender_setup_script, osl_camera_shader
+    from .blender import _state, blender_setup_script, osl_camera_shader
 
+    if isinstance(lens, CameraState) and (focus_mm is not None or fstop is not None):
+        raise InputError("a CameraState carries its own focus and f-stop: give them to camera_state(), not here")
+    if not isinstance(lens, CameraState) and fstop is None:
+        raise InputError("the comparison needs an f-stop (fstop=N)")
     crop = require_positive("crop", crop_mm)
     if isinstance(pixels, bool) or not isinstance(pixels, int) or not 32 <= pixels <= 1024:
         raise InputError(f"pixels must be a whole number from 32 to 1024, got {pixels!r}")
@@ -85,10 +92,14 @@ def compare_bokeh(lens: Prescription, *, focus_mm: float, fstop: float, light_mm
     d_light = require_positive("light distance", light_mm)
     sphere = require_positive("sphere diameter", sphere_mm)
     runner = find_blender(blender_python, config_value=config_blender)
-    st = focus(lens, focus_mm)
-    semi = iris_semi_diameter(lens, fstop)  # as the shader bakes it (physcam.export.blender)
-    src = osl_camera_shader(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=crop, sensor_height_mm=crop,
-                            aperture=aperture)
+    if isinstance(lens, CameraState):  # the crop is the frame
+        state = _state(dataclasses.replace(lens, sensor_mm=(crop, crop)), focus_mm=focus_mm, fstop=fstop,
+                       aperture=aperture)
+    else:
+        state = _state(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=crop, sensor_height_mm=crop,
+                       aperture=aperture)
+    aperture = state.aperture
+    src = osl_camera_shader(state)
     with tempfile.TemporaryDirectory(prefix="physcam-compare-") as tmp:
         setup = Path(tmp) / "setup.py"
         setup.write_text(blender_setup_script(src, sensor_width_mm=crop, sensor_height_mm=crop,
@@ -103,9 +114,9 @@ def compare_bokeh(lens: Prescription, *, focus_mm: float, fstop: float, light_mm
             raise OpticsError(f"Blender could not render the comparison: {tail[0][:200]}")
         rendered = np.load(job["npy"])
     h = crop / 2
-    kw = dict(film_z=st.film_z, fresnel=False, stop_semi_diameter=semi, aperture=aperture)
-    traced = bokeh_image(st.prescription, d_light, rays=rays, pixels=pixels, extent_mm=(-h, h, -h, h), **kw)
-    off = bokeh_image(st.prescription, d_light, 10.0, rays=200_000, pixels=64, **kw)  # the magnification there
+    kw = dict(film_z=state.film_z, fresnel=False, stop_semi_diameter=state.stop_semi_diameter, aperture=aperture)
+    traced = bokeh_image(state.focused, d_light, rays=rays, pixels=pixels, extent_mm=(-h, h, -h, h), **kw)
+    off = bokeh_image(state.focused, d_light, 10.0, rays=200_000, pixels=64, **kw)  # the magnification there
     mag = abs(off.to_dict()["centroid_mm"][0]) / 10.0
     pitch = crop / pixels
     image = traced.image[..., 0]
@@ -122,6 +133,6 @@ def compare_bokeh(lens: Prescription, *, focus_mm: float, fstop: float, light_mm
     if aperture is not None and getattr(aperture, "nsides", 0) >= 3:
         # the rim's dominant harmonic is the corner count (robust to render noise, unlike local maxima)
         rows["corners"] = {"cycles": polygon_corners(rendered)[1], "physcam": polygon_corners(image)[1]}
-    return {"lens": lens.name, "focus_from_film_mm": focus_mm, "fstop": fstop, "light_from_film_mm": d_light,
+    return {"lens": state.lens_name, "focus_from_film_mm": state.focus_from_film_mm, "fstop": state.fstop, "light_from_film_mm": d_light,
             "blender": runner.describe(), "crop_mm": crop, "pixels": pixels, "samples": samples, "sphere_image_mm": e, "measured": rows,
             "images": {"cycles": rendered, "physcam": image}}

@@ -5,7 +5,7 @@ unit focusing moves the film, internal focusing the groups; breathing comes with
 uniform in 1/distance from infinity to the closest focus; :func:`focus_table_shader` writes the
 template ``osl/physcam_lens.osl.in`` with that table, and the shader blends the two states that
 bracket its ``focus_distance`` parameter (metres from the film plane), linearly in 1/distance. The
-iris follows physcam's one rule (:func:`~physcam.optics.focusing.iris_semi_diameter`, sized at
+iris follows physcam's one rule (:func:`~physcam.optics.state.camera_state`'s iris, sized at
 infinity focus): paraxial, so its semi-diameter is K / N with K tabulated here. The exit-pupil
 rectangles are those of the open lens and of the lens stopped to :data:`STOP_LEVELS` over a film
 square of :data:`GRID_HALF_MM` (any sensor that fits it; the shader samples the smallest that holds
@@ -73,7 +73,8 @@ def _centre_norm(q, film_z, bounds, fresnel: bool = False) -> float:
 def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: float = GRID_HALF_MM) -> FocusTable:
     """Tabulate ``lens``'s focus states (module notes). Raises OpticsError when the lens passes no
     ray at the film centre."""
-    from ..optics.focusing import closest_focus, focus, gaussian_at_focus, iris_semi_diameter
+    from ..optics.focusing import closest_focus, focus, gaussian_at_focus
+    from ..optics.state import camera_state
     from ..trace.pupil_bounds import exit_pupil_bounds
     from ..trace.surfaces import surface_table
 
@@ -102,7 +103,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     if not all(v > 0 for v in norm):
         raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some focus")
     n_open = gaussian_at_focus(lens, math.inf).f_number * (1 + 1e-9)
-    k = iris_semi_diameter(lens, n_open) * n_open
+    k = camera_state(lens, fstop=n_open).stop_semi_diameter * n_open  # the one iris rule, at infinity focus
     return FocusTable(lens, marks, step, np.array(film_z), np.array(vz), np.array(rects), np.array(stopped),
                       np.array(norm), table0,
                       bounds0, float(k), float(n_open), float(near), float(loss))

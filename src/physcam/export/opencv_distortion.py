@@ -40,8 +40,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_positive
-from ..lens.prescription import Prescription, takes_prescription
+from ..errors import InputError, OpticsError, renamed_parameter, require_positive
+from ..lens.prescription import Prescription
+from ..optics.state import CameraState, takes_camera
 
 __all__ = ["TERMS", "OMNI_API_SCHEMA", "OMNI_PREFIX", "OpenCvPinhole", "fit_opencv_pinhole", "film_to_pixels"]
 
@@ -223,28 +224,49 @@ def _fit(xn, yn, xd, yd, fx, fy, terms):
     return k
 
 
-@takes_prescription
+def _unpack(lens, sensor_width_mm, sensor_height_mm, focus_mm, method, wavelength_nm):
+    """(Prescription, sensor width, height, mark, wavelength) of a CameraState or of the arguments as given."""
+    if not isinstance(lens, CameraState):
+        return lens, sensor_width_mm, sensor_height_mm, math.inf if focus_mm is None else focus_mm, wavelength_nm
+    given = [k for k, v in (("sensor_width_mm", sensor_width_mm), ("sensor_height_mm", sensor_height_mm),
+                            ("focus_mm", focus_mm), ("wavelength_nm", wavelength_nm)) if v is not None]
+    if given or method != "auto":
+        raise InputError(f"a CameraState carries its own focus, sensor and wavelength (focused by the lens's own "
+                         f"method): give {', '.join(given) or 'method'} to camera_state(), not here")
+    if lens.sensor_mm is None:
+        raise InputError("the OpenCV fit needs a sensor: camera_state(lens, ..., sensor_mm=(width, height))")
+    return lens.lens, *lens.sensor_mm, lens.focus_from_film_mm, lens.wavelengths_nm[0]
+
+
+@renamed_parameter("focus_from_film_mm", "focus_mm")
+@takes_camera
 def fit_opencv_pinhole(
-    lens: Prescription,
-    sensor_width_mm: float,
-    sensor_height_mm: float,
-    image_width_px: int,
-    image_height_px: int,
+    lens: CameraState | Prescription,
+    sensor_width_mm: float | None = None,
+    sensor_height_mm: float | None = None,
+    image_width_px: int | None = None,
+    image_height_px: int | None = None,
     *,
-    focus_from_film_mm: float = math.inf,
+    focus_mm: float | None = None,
     terms: str = "k1k2k3",
     method: str = "auto",
     wavelength_nm: float | None = None,
     backend: str = "auto",
 ) -> OpenCvPinhole:
-    """Fit OpenCV pinhole intrinsics and distortion to ``lens`` focused at ``focus_from_film_mm``.
+    """Fit OpenCV pinhole intrinsics and distortion to ``lens`` focused at ``focus_mm``.
 
-    ``terms``: one of :data:`TERMS`. Sensor in mm (0.5 to 1000), image in whole pixels (16 to
-    65536). The focus mark is mm in front of the film plane (inf allowed; closer than the lens's
-    closest focus raises :class:`OpticsError`). See the module notes for the model and conventions.
+    ``lens``: a :class:`~physcam.optics.state.CameraState` with a sensor (its lens, mark, sensor and
+    primary wavelength; leave the sensor, ``focus_mm`` and ``wavelength_nm`` out, ``method`` "auto"),
+    or a Prescription with the sensor and ``focus_mm`` (None: infinity). ``terms``: one of
+    :data:`TERMS`. Sensor in mm (0.5 to 1000), image in whole pixels (16 to 65536). The focus mark is
+    mm in front of the film plane (inf allowed; closer than the lens's closest focus raises
+    :class:`OpticsError`). See the module notes for the model and conventions. ``focus_from_film_mm``:
+    the old name of ``focus_mm`` (deprecated).
     """
     from ..optics.focusing import focus_method, gaussian_at_focus
 
+    lens, sensor_width_mm, sensor_height_mm, focus_mm, wavelength_nm = _unpack(
+        lens, sensor_width_mm, sensor_height_mm, focus_mm, method, wavelength_nm)
     w = _sensor("sensor width", sensor_width_mm)
     h = _sensor("sensor height", sensor_height_mm)
     W = _pixels("image width", image_width_px)
@@ -253,7 +275,7 @@ def fit_opencv_pinhole(
         raise InputError(f"terms must be one of {', '.join(TERMS)}, got {terms!r}")
     wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
     method = focus_method(lens, method)
-    film, xy, notes, st = _traced_points(lens, focus_from_film_mm, w, h, method, wl, backend)
+    film, xy, notes, st = _traced_points(lens, focus_mm, w, h, method, wl, backend)
     g = {a: gaussian_at_focus(lens, st.focus_from_film_mm, axis=a, focus_axis="y", method=method, wavelength_nm=wl)
          for a in ("x", "y")}
     f_pin = {a: g[a].pinhole_focal_length for a in g}

@@ -42,9 +42,10 @@ import warnings
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from ..errors import ExportError, InputError, OpticsError, require_positive
+from ..errors import ExportError, InputError, OpticsError, renamed_parameter, require_positive
 from ..lens.prescription import Prescription, require_prescription
 from ..onset.report import takes_report
+from ..optics.state import CameraState, camera_state, takes_camera
 
 __all__ = [
     "PBRT_CAMERAS",
@@ -170,21 +171,40 @@ def _trace_parallel(lens, x_mm: float, z0: float, direction: float, stop_semi_di
     return float(out.x[0]), float(out.z[0]), float(out.L[0]), float(out.N[0])
 
 
-def pbrt_thick_lens(lens, focus_from_film_mm: float, *, film_diagonal_mm: float = 35.0,
-                    aperture_diameter_mm: float | None = None) -> PbrtThickLens:
-    """The film distance pbrt-v4 chooses for ``lens`` focused ``focus_from_film_mm`` from the film.
+def _pbrt_reads(lens, focus_mm, aperture_diameter_mm, film_diagonal_mm):
+    """(lens as pbrt reads it, mark, aperture diameter, film diagonal) of :func:`pbrt_thick_lens`'s arguments."""
+    if not isinstance(lens, CameraState):
+        return (require_prescription(lens), focus_mm, aperture_diameter_mm,
+                35.0 if film_diagonal_mm is None else film_diagonal_mm)
+    if focus_mm is not None or aperture_diameter_mm is not None:
+        raise InputError("a CameraState carries its own focus and iris: give them to camera_state(), not here")
+    if film_diagonal_mm is None:
+        film_diagonal_mm = 35.0 if lens.sensor_mm is None else math.hypot(*lens.sensor_mm)
+    return lens.focused, lens.focus_from_film_mm, 2.0 * lens.stop_semi_diameter, film_diagonal_mm
 
-    ``lens`` is the lens as pbrt reads it (its last thickness is the ``.dat``'s); its rays are
-    traced with physcam's real-ray tracer at pbrt's height, 0.001 x ``film_diagonal_mm``, starting
-    1 m (pbrt's one scene unit) in front of the first vertex and behind the last one; the stop is
-    ``aperture_diameter_mm`` across (pbrt's ``aperturediameter``; default the file's). See the module
-    notes for the method. Raises :class:`ExportError` where pbrt stops ("Coefficient must be
-    positive": the subject is closer than the lens can focus).
+
+@renamed_parameter("focus_from_film_mm", "focus_mm")
+@takes_camera
+def pbrt_thick_lens(lens: CameraState | Prescription, focus_mm: float | None = None, *, film_diagonal_mm: float | None = None,
+                    aperture_diameter_mm: float | None = None) -> PbrtThickLens:
+    """The film distance pbrt-v4 chooses for ``lens`` focused ``focus_mm`` from the film.
+
+    ``lens``: a :class:`~physcam.optics.state.CameraState` (pbrt gets physcam's focus of the lens at
+    the state's mark, its last thickness the back focus, as :func:`write_pbrt_camera` writes the
+    ``.dat``, and the state's iris; ``focus_mm`` and ``aperture_diameter_mm`` stay None; the film
+    diagonal defaults to its sensor's), or the Prescription as pbrt reads it (its last thickness is the
+    ``.dat``'s). Its rays are traced with physcam's real-ray tracer at pbrt's height, 0.001 x
+    ``film_diagonal_mm`` (default 35 mm), starting 1 m (pbrt's one scene unit) in front of the first
+    vertex and behind the last one; the stop is ``aperture_diameter_mm`` across (pbrt's
+    ``aperturediameter``; default the file's). See the module notes for the method. Raises
+    :class:`ExportError` where pbrt stops ("Coefficient must be positive": the subject is closer than
+    the lens can focus). ``focus_from_film_mm``: the old name of ``focus_mm`` (deprecated).
     """
-    lens = require_prescription(lens)
+    lens, focus_mm, aperture_diameter_mm, film_diagonal_mm = _pbrt_reads(lens, focus_mm, aperture_diameter_mm,
+                                                                          film_diagonal_mm)
     if lens.is_anamorphic:
         raise ExportError(f"pbrt's thick-lens focus needs a rotationally symmetric lens; {lens.name!r} is anamorphic")
-    mark = require_positive("focus distance", focus_from_film_mm)
+    mark = require_positive("focus distance", focus_mm)
     if math.isinf(mark):
         raise InputError("pbrt's focusdistance is a finite distance from the film; give a focus mark, "
                          "e.g. 1000m for a distant subject")
@@ -284,6 +304,11 @@ def _dof_from_film(efl, fstop, coc, s, h1):
     return float(near) + h1, float(far) + h1
 
 
+def _state_at_mark(report, lens) -> CameraState:
+    """physcam's ``lens`` at ``report``'s mark and f-stop (its focus and its iris, in one place)."""
+    return camera_state(lens, focus_mm=report.focus_from_film_mm, fstop=report.fstop)
+
+
 @takes_report
 def pbrt_focus_comparison(report, lens, *, film_diagonal_mm: float | None = None) -> PbrtFocusComparison:
     """pbrt-v4's focus of ``lens`` at ``report``'s mark next to physcam's, with the DOF each gives.
@@ -294,22 +319,27 @@ def pbrt_focus_comparison(report, lens, *, film_diagonal_mm: float | None = None
     the numbers are the file's; a lens a ``.dat`` cannot hold (flats) is compared on its exact
     surfaces, with ``writable`` False and the reason.
     """
+    lens = require_prescription(lens)
+    if not math.isfinite(report.focus_from_film_mm):
+        raise InputError("pbrt's focusdistance is finite; give a focus mark")
+    return _focus_comparison(report, _state_at_mark(report, lens), film_diagonal_mm)
+
+
+def _focus_comparison(report, state: CameraState, film_diagonal_mm) -> PbrtFocusComparison:
     from ..lens.formats import pbrt as dat
     from ..optics import focusing, paraxial
 
-    lens = require_prescription(lens)
-    mark = report.focus_from_film_mm
-    if not math.isfinite(mark):
-        raise InputError("pbrt's focusdistance is finite; give a focus mark")
+    lens, mark = state.lens, state.focus_from_film_mm
     diag = film_diagonal_mm if film_diagonal_mm is not None else report.sensor.diagonal_mm
-    st = focusing.focus(lens, mark)
+    method = focusing.focus_method(lens)
+    back_focus = state.focused.surfaces[-1].thickness  # physcam's exact focus: last vertex to film
     why = _refusal(lens)
-    pbrt_lens = st.prescription
+    pbrt_lens = state.focused
     if why is None:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            pbrt_lens = dat.loads(dat.dumps(st.prescription), name=lens.name)
-    ap = 2.0 * focusing.iris_semi_diameter(lens, report.fstop)
+            pbrt_lens = dat.loads(dat.dumps(state.focused), name=lens.name)
+    ap = 2.0 * state.stop_semi_diameter
     tl = pbrt_thick_lens(pbrt_lens, mark, film_diagonal_mm=diag, aperture_diameter_mm=ap)
     d_pbrt, efl_pbrt, h1_pbrt = _conjugate_from_film(pbrt_lens, tl.film_distance_mm)
     dof = report.dof
@@ -336,8 +366,8 @@ def pbrt_focus_comparison(report, lens, *, film_diagonal_mm: float | None = None
 
     return PbrtFocusComparison(
         lens=lens.name, focus_from_film_mm=mark, fstop=report.fstop, coc_mm=report.coc_mm, film_diagonal_mm=diag,
-        method=st.method, physcam_film_distance_mm=st.back_focus_mm, pbrt_film_distance_mm=tl.film_distance_mm,
-        difference_mm=tl.film_distance_mm - st.back_focus_mm,
+        method=method, physcam_film_distance_mm=back_focus, pbrt_film_distance_mm=tl.film_distance_mm,
+        difference_mm=tl.film_distance_mm - back_focus,
         pbrt_focus_from_film_mm=d_pbrt if math.isfinite(d_pbrt) else None,
         focus_shift_mm=shift(d_pbrt, mark),
         near_from_film_mm=dof.near_from_film_mm, far_from_film_mm=far,
@@ -367,7 +397,22 @@ def pbrt_camera_values(report, lens=None, *, xres: int = 1920, cameras=PBRT_CAME
     from the entrance pupil). ``realistic`` (needs ``lens``): ``lensfile``, ``aperturediameter`` (the
     stop's diameter for the report's f-number, mm) and ``focusdistance`` (the mark, metres from the film).
     """
-    from ..optics import focusing
+    return _camera_values(report, lens, xres=xres, cameras=cameras, lensfile=lensfile)[0]
+
+
+def _realistic_state(report, lens) -> CameraState:
+    """The lens state of pbrt's realistic camera: ``lens`` (a .dat can hold it) at the report's finite mark."""
+    if lens is None:
+        raise ExportError("pbrt-v4's realistic camera traces a lens prescription: give a lens (--lens NAME); "
+                          "a thin lens (--focal) has only the perspective camera (--camera perspective)")
+    lens = check_pbrt_lens(lens)
+    if not math.isfinite(report.focus_from_film_mm):
+        raise InputError("pbrt's focusdistance is a finite distance from the film; give a focus mark")
+    return _state_at_mark(report, lens)
+
+
+def _camera_values(report, lens, *, xres, cameras, lensfile) -> tuple[dict, CameraState | None]:
+    """(:func:`pbrt_camera_values`, the realistic camera's lens state or None)."""
     from .usdgeom import focus_distance_from_pupil_mm
 
     xres = _whole("xres", xres, 16, 65536)
@@ -376,6 +421,7 @@ def pbrt_camera_values(report, lens=None, *, xres: int = 1920, cameras=PBRT_CAME
     bad = [c for c in cameras if c not in PBRT_CAMERAS]
     if bad or not cameras:
         raise InputError(f"pbrt cameras are {' and '.join(PBRT_CAMERAS)}, got {list(cameras)!r}")
+    state = None
     w, h = report.sensor.width_mm, report.sensor.height_mm
     yres = max(1, round(xres * h / w))
     if yres > 65536:
@@ -389,17 +435,10 @@ def pbrt_camera_values(report, lens=None, *, xres: int = 1920, cameras=PBRT_CAME
                  "height_mm": w * yres / xres, "sensor_height_mm": h},
     }
     if "realistic" in cameras:
-        if lens is None:
-            raise ExportError("pbrt-v4's realistic camera traces a lens prescription: give a lens (--lens NAME); "
-                              "a thin lens (--focal) has only the perspective camera (--camera perspective)")
-        lens = check_pbrt_lens(lens)
-        mark = report.focus_from_film_mm
-        if not math.isfinite(mark):
-            raise InputError("pbrt's focusdistance is a finite distance from the film; give a focus mark")
-        st = focusing.focus(lens, mark)
-        stop = 2.0 * focusing.iris_semi_diameter(lens, report.fstop)
-        out["realistic"] = {"lensfile": str(lensfile), "aperturediameter": stop,
-                            "focusdistance": mark / MM_PER_SCENE_UNIT, "film_distance_mm": st.back_focus_mm}
+        state = _realistic_state(report, lens)
+        out["realistic"] = {"lensfile": str(lensfile), "aperturediameter": 2.0 * state.stop_semi_diameter,
+                            "focusdistance": state.focus_from_film_mm / MM_PER_SCENE_UNIT,
+                            "film_distance_mm": state.focused.surfaces[-1].thickness}
     if "perspective" in cameras:
         f_pin, sq = report.pinhole
         if sq != 1.0 or report.squeeze != 1.0:
@@ -421,7 +460,7 @@ def pbrt_camera_values(report, lens=None, *, xres: int = 1920, cameras=PBRT_CAME
             "entrance_pupil_from_film_m": None if report.entrance_pupil_from_film_mm is None
             else report.entrance_pupil_from_film_mm / MM_PER_SCENE_UNIT,
         }
-    return out
+    return out, state
 
 
 def _num(x) -> str:
@@ -474,7 +513,7 @@ def write_pbrt_camera(report, folder, lens=None, *, name: str = "lens", xres: in
     if isinstance(cameras, str):
         cameras = (cameras,)
     folder = Path(folder)
-    values = pbrt_camera_values(report, lens, xres=xres, cameras=cameras, lensfile=f"{name}.dat")
+    values, state = _camera_values(report, lens, xres=xres, cameras=cameras, lensfile=f"{name}.dat")
     files: dict[str, tuple[Path, str]] = {}
     notes: list[str] = []
     comparison = None
@@ -485,12 +524,11 @@ def write_pbrt_camera(report, folder, lens=None, *, name: str = "lens", xres: in
             "units: the scene in metres (pbrt divides the lens file's mm by 1000); diagonal and aperture in mm",
             "Include this before WorldBegin; the camera transform (LookAt ...) comes first"]
     if "realistic" in cameras:
-        st = focusing.focus(lens, report.focus_from_film_mm)
-        text, notes = pbrt_lens_text(st.prescription, comments=[
-            f"{lens.name}: physcam's {st.method} focus at {report.focus_from_film_mm:g} mm from the film; "
-            f"the last thickness is the back focus {st.back_focus_mm:.6g} mm",
+        text, notes = pbrt_lens_text(state.focused, comments=[
+            f"{lens.name}: physcam's {focusing.focus_method(lens)} focus at {report.focus_from_film_mm:g} mm from "
+            f"the film; the last thickness is the back focus {state.focused.surfaces[-1].thickness:.6g} mm",
             "pbrt refocuses it with its thick-lens approximation (physcam export pbrt reports the difference)"])
-        comparison = pbrt_focus_comparison(report, lens, film_diagonal_mm=values["film"]["diagonal"])
+        comparison = _focus_comparison(report, state, values["film"]["diagonal"])
         files["lens"] = (folder / f"{name}.dat", text)
         files["realistic"] = (folder / f"{name}_realistic.pbrt", pbrt_scene_snippet(values, "realistic", comments=head + [
             "realistic camera: its origin is the film plane's centre, looking down +z; focusdistance is the mark "

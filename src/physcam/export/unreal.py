@@ -119,7 +119,7 @@ def unreal_lens_file(
     zoom = technical_planes(lens, math.inf, wavelength_nm=wl, method=method).efl_mm
     rows = []
     for m in marks:
-        cam = fit_opencv_pinhole(lens, w, h, W, H, focus_from_film_mm=m, terms="k1k2k3", method=method,
+        cam = fit_opencv_pinhole(lens, w, h, W, H, focus_mm=m, terms="k1k2k3", method=method,
                                  wavelength_nm=wl, backend=backend)
         tp = technical_planes(lens, m, wavelength_nm=wl, method=method)
         rows.append((m, cam, tp))

@@ -30,7 +30,7 @@ from collections.abc import Mapping
 
 from importlib import resources
 
-from ..errors import InputError
+from ..errors import InputError, require_type
 from .catalog_glass import CatalogGlass
 
 __all__ = ["CatalogGlass", "GlassNotFound", "BUILTIN_CATALOGS", "GLASSES", "find_glass", "glass_names",
@@ -82,7 +82,11 @@ def catalog(name: str) -> dict[str, CatalogGlass] | None:
 
 def register_catalog(name: str, glasses: dict[str, CatalogGlass]) -> None:
     """Add a user catalogue (searched after a file's own catalogues, before the built-in ones)."""
-    _USER[str(name).strip().upper()] = glasses
+    require_type("name", name, str, 'a catalogue name, e.g. "MYGLASS"')
+    require_type("glasses", glasses, Mapping, "a dict of glass name -> CatalogGlass (physcam.lens.agf.read_agf)")
+    for key, glass in glasses.items():
+        require_type(f"glass {key!r}", glass, CatalogGlass, "a physcam.lens.catalog_glass.CatalogGlass")
+    _USER[name.strip().upper()] = {str(k).strip().upper(): g for k, g in glasses.items()}
 
 
 def use_catalog_files(paths) -> list[str]:

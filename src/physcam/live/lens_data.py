@@ -23,19 +23,20 @@ from __future__ import annotations
 import math
 
 from ..analysis.openlensio import DISTORTION_MODEL, RADIAL_TERMS, opencv_to_opentrackio, opentrackio_to_opencv
-from ..errors import InputError, require_finite, require_positive
+from ..errors import InputError, renamed_parameter, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["DISTORTION_MODEL", "RADIAL_TERMS", "opencv_to_opentrackio", "opentrackio_to_opencv",
            "distortion_for_sample", "focus_for_consumer"]
 
 
-def focus_for_consumer(focus_from_film_mm, entrance_pupil_mm, consumer: str = "opentrackio") -> float:
+@renamed_parameter("focus_from_film_mm", "focus_mm")
+def focus_for_consumer(focus_mm, entrance_pupil_mm, consumer: str = "opentrackio") -> float:
     """The focus distance a consumer wants, from the mark physcam sends (mm in front of the film):
     ``"opentrackio"`` the mark itself, metres (module notes); ``"unreal"`` Unreal's CineCamera
     manual focus distance, centimetres from the entrance pupil (``entrancePupilOffset`` in front of
     the film)."""
-    d = require_positive("focus distance", focus_from_film_mm)
+    d = require_positive("focus distance", focus_mm)
     if consumer == "opentrackio":
         return d / 1000.0
     if consumer == "unreal":
@@ -47,10 +48,11 @@ def focus_for_consumer(focus_from_film_mm, entrance_pupil_mm, consumer: str = "o
 
 
 @takes_prescription
-def distortion_for_sample(lens: Prescription, sensor_width_mm, sensor_height_mm, focus_from_film_mm,
+@renamed_parameter("focus_from_film_mm", "focus_mm")
+def distortion_for_sample(lens: Prescription, sensor_width_mm, sensor_height_mm, focus_mm,
                           image_size=(4096, None)) -> tuple[dict, float]:
     """(OpenTrackIO distortion object, the pinhole focal length F in mm it is normalised by) of ``lens``
-    focused at ``focus_from_film_mm`` (mm in front of the film; inf allowed) on a sensor of the given size.
+    focused at ``focus_mm`` (mm in front of the film; inf allowed) on a sensor of the given size.
 
     The one source of the sample's distortion (module notes): Brown-Conrady U-D fitted to real chief
     rays over the frame, in millimetres. ``image_size`` (W, H pixels; H None from the sensor's
@@ -61,8 +63,8 @@ def distortion_for_sample(lens: Prescription, sensor_width_mm, sensor_height_mm,
 
     w = require_positive("sensor width", sensor_width_mm)
     h = require_positive("sensor height", sensor_height_mm)
-    focus = float(focus_from_film_mm) if focus_from_film_mm == math.inf else require_positive(
-        "focus distance", focus_from_film_mm)
+    focus = float(focus_mm) if focus_mm == math.inf else require_positive(
+        "focus distance", focus_mm)
     if not isinstance(image_size, (tuple, list)) or len(image_size) != 2:
         raise InputError("image_size is (width, height) in pixels; height may be None")
     W = image_size[0]

@@ -388,7 +388,7 @@ def _with_real_fov(report: LensReport, lens) -> LensReport:
 
     s = report.sensor
     try:
-        real = real_field_of_view(lens, s.width_mm, s.height_mm, focus_from_film_mm=report.focus_from_film_mm)
+        real = real_field_of_view(lens, s.width_mm, s.height_mm, focus_mm=report.focus_from_film_mm)
     except PhysCamError as exc:
         return dataclasses.replace(report, notes=report.notes + (f"real-ray field of view not available: {exc}",))
     report = dataclasses.replace(report, real_fov=real.to_dict())

@@ -29,7 +29,7 @@ import math
 from dataclasses import asdict, dataclass
 
 from ..data.default_sensor import DEFAULT_SENSOR_WIDTH_MM
-from ..errors import InputError, OpticsError, require_positive
+from ..errors import InputError, OpticsError, renamed_parameter, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 from . import paraxial
 
@@ -297,16 +297,17 @@ def _internal_focus(p: Prescription, mark: float, axis: str, lam) -> FocusState:
 
 
 @takes_prescription
+@renamed_parameter("focus_from_film_mm", "focus_mm")
 def focus(
     prescription: Prescription,
-    focus_from_film_mm: float,
+    focus_mm: float,
     *,
     method: str = "auto",
     axis: str = "y",
     wavelength_nm=None,
     max_extension_mm: float | None = None,
 ) -> FocusState:
-    """Focus ``prescription`` on a subject ``focus_from_film_mm`` in front of the film plane.
+    """Focus ``prescription`` on a subject ``focus_mm`` in front of the film plane.
 
     ``method``: ``"unit"`` (the lens moves), ``"internal"`` (the focus groups move,
     then the back focus is solved), ``"auto"`` (internal when the lens has focus
@@ -316,7 +317,7 @@ def focus(
     the mark is too close.
     """
     method = focus_method(prescription, method)
-    mark = _mark(focus_from_film_mm)
+    mark = _mark(focus_mm)
     paraxial._axis(axis)
     if max_extension_mm is not None:
         max_extension_mm = require_positive("maximum focus extension", max_extension_mm)
@@ -340,7 +341,8 @@ def iris_semi_diameter(prescription: Prescription, fstop: float, *, method: str 
 
 
 @takes_prescription
-def f_number_ratio(prescription: Prescription, focus_from_film_mm: float, *, method: str = "auto") -> float:
+@renamed_parameter("focus_from_film_mm", "focus_mm")
+def f_number_ratio(prescription: Prescription, focus_mm: float, *, method: str = "auto") -> float:
     """The lens's f-number at a focus mark over its f-number at infinity, for one iris.
 
     With the iris fixed (:func:`iris_semi_diameter`), f/N at infinity becomes f/(N x this ratio) at the
@@ -349,13 +351,14 @@ def f_number_ratio(prescription: Prescription, focus_from_film_mm: float, *, met
     entrance pupil change with the gaps. The ratio does not depend on the iris's size (paraxial
     pupils scale with the stop)."""
     at_infinity = gaussian_at_focus(prescription, math.inf, method=method).f_number
-    return gaussian_at_focus(prescription, focus_from_film_mm, method=method).f_number / at_infinity
+    return gaussian_at_focus(prescription, focus_mm, method=method).f_number / at_infinity
 
 
 @takes_prescription
+@renamed_parameter("focus_from_film_mm", "focus_mm")
 def gaussian_at_focus(
     prescription: Prescription,
-    focus_from_film_mm: float = math.inf,
+    focus_mm: float = math.inf,
     *,
     axis: str = "y",
     focus_axis: str = "y",
@@ -366,7 +369,7 @@ def gaussian_at_focus(
 ) -> paraxial.GaussianData:
     """Gaussian data in the ``axis`` meridian with the lens focused (in ``focus_axis``) at the mark;
     ``fstop`` sizes the iris by :func:`iris_semi_diameter` (at infinity focus, kept at every focus)."""
-    st = focus(prescription, focus_from_film_mm, method=method, axis=focus_axis, wavelength_nm=wavelength_nm)
+    st = focus(prescription, focus_mm, method=method, axis=focus_axis, wavelength_nm=wavelength_nm)
     stop = None if fstop is None else iris_semi_diameter(prescription, fstop, method=method)
     return paraxial.gaussian(
         st.prescription,
@@ -380,9 +383,10 @@ def gaussian_at_focus(
 
 
 @takes_prescription
+@renamed_parameter("focus_from_film_mm", "focus_mm")
 def technical_planes(
     prescription: Prescription,
-    focus_from_film_mm: float,
+    focus_mm: float,
     flange_focal_distance_mm: float | None = None,
     wavelength_nm: float | None = None,
     *,
@@ -392,14 +396,14 @@ def technical_planes(
 ) -> TechnicalPlanes:
     """EFL, H1, H2 and the entrance pupil **in front of the film plane** at a focus mark.
 
-    For the on-set report's technical model. ``focus_from_film_mm`` is the mark
+    For the on-set report's technical model. ``focus_mm`` is the mark
     (mm from the film plane, inf allowed); distances returned are positive toward
     the subject; ``back_focus_mm`` is last vertex to film. With
     ``flange_focal_distance_mm`` the same planes are also given from the flange.
     """
     g = gaussian_at_focus(
         prescription,
-        focus_from_film_mm,
+        focus_mm,
         axis=axis,
         focus_axis=axis,
         method=method,
@@ -416,7 +420,7 @@ def technical_planes(
             entrance_pupil_from_flange_mm=g.in_front_of("entrance_pupil", "flange"),
         )
     return TechnicalPlanes(
-        focus_from_film_mm=float(focus_from_film_mm),
+        focus_from_film_mm=float(focus_mm),
         method=st_method,
         axis=axis,
         wavelength_nm=g.wavelength_nm,
@@ -500,11 +504,12 @@ def gaussian_hfov_infinity(prescription: Prescription, sensor_width_mm: float, m
     return math.degrees(2.0 * abs(paraxial.field_angle(st.prescription, sensor_width_mm / 2.0, st.film_z, "x", wavelength_nm)))
 
 
-def pupil_aspect(prescription: Prescription, focus_from_film_mm: float) -> float:
+@renamed_parameter("focus_from_film_mm", "focus_mm")
+def pupil_aspect(prescription: Prescription, focus_mm: float) -> float:
     """An anamorphic lens's blur aspect at a focus mark: its entrance pupil's X over Y diameter (one
     round stop seen through each meridian; the ratio does not depend on the stop's size). 1 for a
     rotationally symmetric lens."""
-    st = focus(prescription, focus_from_film_mm)
+    st = focus(prescription, focus_mm)
     gx, gy = (paraxial.gaussian(st.prescription, axis=a, object_z=st.object_z, film_z=st.film_z) for a in "xy")
     return gx.entrance_pupil_diameter / gy.entrance_pupil_diameter
 

@@ -20,7 +20,7 @@ from ..errors import InputError, OpticsError, require_finite, require_type
 from ..lens.prescription import Prescription
 from .thinlens import MAX_F_NUMBER, MIN_F_NUMBER, require_f_number
 
-__all__ = ["CameraState", "camera_state", "takes_camera", "wavelengths_and_weights", "require_f_number", "MIN_F_NUMBER", "MAX_F_NUMBER"]
+__all__ = ["CameraState", "camera_state", "as_camera_state", "takes_camera", "wavelengths_and_weights", "require_f_number", "MIN_F_NUMBER", "MAX_F_NUMBER"]
 
 @dataclass(frozen=True, eq=False)
 class CameraState:
@@ -37,6 +37,7 @@ class CameraState:
     weights: tuple[float, ...] = ()
     sensor_mm: tuple[float, float] | None = None  # width, height
     aperture: object = None  # an iris shape (physcam.trace.aperture.Aperture); None: round
+    iris_set: bool = False  # True: the iris was set to an f-stop; False: the lens as its file stops it
     notes: tuple[str, ...] = field(default=())
 
     @property
@@ -157,10 +158,22 @@ def camera_state(lens: Prescription, *, focus_mm=None, fstop=None, sensor_mm=Non
             raise InputError(f"the sensor must measure between 0 and 1000 mm a side, got {w:g} x {h:g}")
         sensor_mm = (float(w), float(h))
     wls, ws = (tuple(v) for v in wavelengths_and_weights(lens, wavelengths_nm, weights))
-    state = CameraState(lens, focused, mark, object_z, film_z, stop_n, stop, wls, ws, sensor_mm, aperture)
+    state = CameraState(lens, focused, mark, object_z, film_z, stop_n, stop, wls, ws, sensor_mm, aperture,
+                        fstop is not None)
     if not object_z < state.entrance_pupil_z:
         raise OpticsError(f"the object lies behind the entrance pupil of {lens.name!r}: no real pupil to sample")
     return state
+
+
+def as_camera_state(lens, *, focus_mm=None, fstop=None, **state) -> CameraState:
+    """The door of every function that takes a camera first (issue 28): ``lens`` as it is when it is a
+    :class:`CameraState` (then ``focus_mm`` and ``fstop`` must be None: an InputError), or a
+    Prescription through ``camera_state(lens, focus_mm=, fstop=, **state)``."""
+    if isinstance(lens, CameraState):
+        if focus_mm is not None or fstop is not None:
+            raise InputError("a CameraState carries its own focus and f-stop: give them to camera_state(), not here")
+        return lens
+    return camera_state(lens, focus_mm=focus_mm, fstop=fstop, **state)
 
 
 def takes_camera(fn):

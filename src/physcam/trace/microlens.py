@@ -31,11 +31,12 @@ import numpy as np
 
 from ..errors import InputError, OpticsError, require_positive, require_type
 from ..lens.prescription import Prescription
+from ..optics.state import CameraState, camera_state
 from .rays import CLIPPED, MISSED, OK, RayBatch
 from .trace import trace_through
 
-__all__ = ["MicrolensArray", "PlenopticCamera", "microlens_array", "plenoptic_camera", "refract_through_array",
-           "trace_to_sensor", "trace_from_sensor", "subimage_centres"]
+__all__ = ["MicrolensArray", "PlenopticCamera", "microlens_array", "main_lens_state", "plenoptic_camera",
+           "refract_through_array", "trace_to_sensor", "trace_from_sensor", "subimage_centres"]
 
 #: most lenslets along one side and in all (a Lytro Illum has about 540 x 430; 500000 zero offsets
 #: in ISET JSON stay under the 10 MB lens file limit), and pixels under one lenslet along one side
@@ -182,48 +183,62 @@ class PlenopticCamera:
         return self.array.pitch_x / self.pixels_per_lenslet, self.array.pitch_y / self.pixels_per_lenslet
 
 
-def plenoptic_camera(main: Prescription, array: MicrolensArray, *, focus_mm: float | None = None,
+def main_lens_state(main: Prescription, array: MicrolensArray, *, focus_mm: float,
+                    fstop: float | None = None) -> CameraState:
+    """The main lens's :class:`~physcam.optics.state.CameraState` focused (unit or internal) so that a
+    subject ``focus_mm`` in front of the **sensor** is imaged on the array plane, its film (plenoptic
+    1.0); its iris at ``fstop`` (None: the stop as in its file)."""
+    require_type("main", main, Prescription, "load one with physcam.lens.library.load_lens")
+    require_type("array", array, MicrolensArray, "build one with physcam.trace.microlens.microlens_array")
+    b = array.sensor_offset_mm
+    d = require_positive("focus distance", focus_mm)
+    if not d > b + main.total_track:
+        raise InputError(f"focus distance {d:g} mm is inside the camera (sensor offset {b:g} mm)")
+    return camera_state(main, focus_mm=d - b, fstop=fstop)  # the mark from the array, the main lens's film
+
+
+def plenoptic_camera(main, array: MicrolensArray, *, focus_mm: float | None = None,
                      film_to_lens_mm: float | None = None, fstop: float | None = None,
                      pixels_per_lenslet: int = 9) -> PlenopticCamera:
     """Put ``array`` in front of the sensor behind ``main``.
 
-    Either ``focus_mm``: the main lens is focused (physcam.optics.focusing, unit or internal) so that
-    a subject ``focus_mm`` in front of the **sensor** is imaged on the array plane (plenoptic 1.0);
-    or ``film_to_lens_mm``: the sensor lies this far behind the main lens's rear vertex, as lenstool
-    and ISET3D set it. ``fstop`` stops the main lens down (default: the stop as in its file).
+    ``main``: a :class:`~physcam.optics.state.CameraState` whose film plane is the array's (see
+    :func:`main_lens_state`), or a Prescription placed either by ``focus_mm``: focused so that a
+    subject ``focus_mm`` in front of the **sensor** is imaged on the array plane (plenoptic 1.0);
+    or by ``film_to_lens_mm``: the sensor lies this far behind the main lens's rear vertex, as
+    lenstool and ISET3D set it. ``fstop`` stops a Prescription down (default: the stop as in its file).
     """
-    require_type("main", main, Prescription, "load one with physcam.lens.library.load_lens")
+    if not isinstance(main, CameraState):
+        require_type("main", main, Prescription, "load one with physcam.lens.library.load_lens, or a CameraState "
+                     "(physcam.trace.microlens.main_lens_state)")
     require_type("array", array, MicrolensArray, "build one with physcam.trace.microlens.microlens_array")
     if isinstance(pixels_per_lenslet, bool) or not isinstance(pixels_per_lenslet, (int, np.integer)) \
             or not 1 <= pixels_per_lenslet <= MAX_PIXELS_PER_LENSLET:
         raise InputError(f"pixels per lenslet must be a whole number from 1 to {MAX_PIXELS_PER_LENSLET}, "
                          f"got {pixels_per_lenslet!r}")
-    if main.is_anamorphic:
-        raise InputError(f"main lens {main.name!r} is anamorphic; the light-field camera takes a spherical lens")
-    if (focus_mm is None) == (film_to_lens_mm is None):
-        raise InputError("place the sensor either by a focus distance or by the film-to-lens distance, not both")
-    from ..optics.focusing import iris_semi_diameter
-
-    stop = main.surfaces[main.stop_index].semi_diameter
-    if fstop is not None:
-        stop = iris_semi_diameter(main, require_positive("f-number", fstop, unit=""))
+    lens = main.lens if isinstance(main, CameraState) else main
+    if lens.is_anamorphic:
+        raise InputError(f"main lens {lens.name!r} is anamorphic; the light-field camera takes a spherical lens")
     b = array.sensor_offset_mm
-    if focus_mm is not None:
-        from ..optics.focusing import focus
-
-        d = require_positive("focus distance", focus_mm)
-        if not d > b + main.total_track:
-            raise InputError(f"focus distance {d:g} mm is inside the camera (sensor offset {b:g} mm)")
-        st = focus(main, d - b)
-        lens = st.prescription
-        z_sensor = st.film_z + b
+    if isinstance(main, CameraState):
+        if not (focus_mm is None and film_to_lens_mm is None and fstop is None):
+            raise InputError("a CameraState carries its own focus and f-stop: the array lies on its film plane")
+        cam = main
+    elif (focus_mm is None) == (film_to_lens_mm is None):
+        raise InputError("place the sensor either by a focus distance or by the film-to-lens distance, not both")
+    elif focus_mm is not None:
+        cam = main_lens_state(main, array, focus_mm=focus_mm, fstop=fstop)
     else:
-        lens = main
-        z_sensor = main.vertex_z[-1] + require_positive("film-to-lens distance", film_to_lens_mm)
-        if z_sensor - b - array.thickness_mm <= main.vertex_z[-1]:
-            raise InputError(f"film-to-lens distance {film_to_lens_mm:g} mm leaves no room for the array "
-                             f"({b + array.thickness_mm:g} mm in front of the sensor)")
-    return PlenopticCamera(lens, float(stop), array, float(z_sensor), int(pixels_per_lenslet))
+        cam = None
+    if cam is not None:
+        return PlenopticCamera(cam.focused, float(cam.stop_semi_diameter), array, float(cam.film_z + b),
+                               int(pixels_per_lenslet))
+    stop = camera_state(main, fstop=fstop).stop_semi_diameter
+    z_sensor = main.vertex_z[-1] + require_positive("film-to-lens distance", film_to_lens_mm)
+    if z_sensor - b - array.thickness_mm <= main.vertex_z[-1]:
+        raise InputError(f"film-to-lens distance {film_to_lens_mm:g} mm leaves no room for the array "
+                         f"({b + array.thickness_mm:g} mm in front of the sensor)")
+    return PlenopticCamera(main, float(stop), array, float(z_sensor), int(pixels_per_lenslet))
 
 
 def _propagate(rays: RayBatch, z: float) -> None:

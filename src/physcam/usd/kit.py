@@ -521,7 +521,7 @@ def prescription_opencv(prescription, sensor_width_mm: float, sensor_height_mm: 
     h_px = int(resolution[1]) if resolution and len(resolution) > 1 else max(16, round(w_px * sensor_height_mm /
                                                                                         sensor_width_mm))
     return fit_opencv_pinhole(prescription, sensor_width_mm, sensor_height_mm, w_px, h_px,
-                              focus_from_film_mm=focus_mm)
+                              focus_mm=focus_mm)
 
 
 def _author_prescription(stage, path, rx, focus_mm: float):

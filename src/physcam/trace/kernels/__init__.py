@@ -147,6 +147,9 @@ def resolve_backend(backend: str = "auto") -> str:
     if backend == "auto":
         return "numba" if numba_available() else "numpy"
     if backend == "numba" and not numba_available():
+        if _numba_error.startswith(("ModuleNotFoundError", "ImportError")) and "numba" in _numba_error:
+            raise BackendError("the numba backend needs physcam's 'fast' extra (numba is not installed): "
+                               "pip install 'physcam[fast]', or use backend='numpy' (the same rays, slower)")
         raise BackendError(f"the numba backend is unavailable ({_numba_error}); use backend='numpy'")
     return backend
 
