@@ -12,9 +12,9 @@ the point the distortion model is centred on, lies from the filmback's centre, i
 filmback, x to the right, y *up*. That is 3DE4's own convention as its Lens Distortion Plugin Kit
 writes it (Science-D-Visions, LDPK ``ldpk_ldp_builtin.h`` / ``tde4_ldp_common_sdv.h``,
 ``map_unit_to_dn``): a point's diagonally normalised coordinate is
-``((unit - 1/2) * filmback - lens centre offset) / r_fb``, with unit coordinates (0, 0) at the
-image's lower-left corner and (1, 1) at its upper-right one (the same mapping in Natron's port,
-openfx-misc ``Distortion/Distortion.cpp``). physcam's fits are made about the principal point
+``((unit - 1/2) * filmback - lens centre offset) / r_fb``; Natron's port of that code
+(openfx-misc ``Distortion/Distortion.cpp``) makes the unit coordinates from Nuke's pixel
+coordinates, (0, 0) at the image's lower-left corner, so y is up. physcam's fits are made about the principal point
 (a prescription's lens: the frame centre, offset 0; a chart calibration: the measured principal
 point, ``MarkCalibration.principal_offset_mm``, also x right, y up from the frame centre), so the
 offset written is that point's, divided by 10.
