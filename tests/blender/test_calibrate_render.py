@@ -23,7 +23,7 @@ views' corners put where physcam predicts them and calibrated without noise give
 pinholes to 0.002 % and the breathing to 0.004 % (no model difference); the corners found in the
 renders sit on the predicted ones without bias (<= 0.03 px) but scatter by 0.27-0.31 px RMS, which is
 Cycles' sampling noise (0.09 px at 64 samples); that scatter alone makes the breathing good to only
-~0.34 % (one standard deviation). The 0.2 % needs ~120 samples, ~10 minutes of rendering here:
+~0.34 % (one standard deviation). The 0.2 % needs ~120 samples, 6.5-10 minutes of rendering here:
 ``PHYSCAM_CALIBRATE_RENDER_SAMPLES=128`` runs it and asserts the breathing within 0.2 %.
 """
 
@@ -52,7 +52,7 @@ SENSOR_MM = (36.0, 36.0 * SIZE[1] / SIZE[0])  # square photosites, 56.25 um
 SQUARES, SQUARE_MM, MARKER_MM, DICTIONARY = (10, 7), 35.0, 26.0, "DICT_4X4_50"
 POSES = 8  # per mark
 #: Cycles samples per pixel; PHYSCAM_CALIBRATE_RENDER_SAMPLES=128 runs the issue's 0.2 % breathing proof
-#: (about 10 minutes on 2 cores: module notes)
+#: (6.5-10 minutes on 2 shared cores: module notes)
 SAMPLES = int(os.environ.get("PHYSCAM_CALIBRATE_RENDER_SAMPLES", "8"))
 #: From this many samples the corners are good to <= 0.1 px RMS and the breathing is asserted within 0.2 %
 PROOF_SAMPLES = 96
