@@ -38,19 +38,38 @@ def poses(n=15, seed=1, chart=CHARUCO, partial=True):
     return out
 
 
+def whole_board_poses(n, seed, chart=CHECKER, K=K_TRUE, margin_px=12.0):
+    """The first ``n`` of :func:`poses` (no partial views) whose whole board (its outer corners and
+    every inner one) lands ``margin_px`` inside the frame through ``K`` and DIST_TRUE: a checkerboard
+    is found only whole."""
+    cols, rows = chart.corners[0] + 1, chart.corners[1] + 1
+    outer = np.array([[0, 0, 0], [cols, 0, 0], [cols, rows, 0], [0, rows, 0]], float) * chart.square_mm
+    obj = np.concatenate([board_points(chart), outer])
+    out = []
+    for r, t in poses(4 * n, seed, chart, partial=False):
+        img, _ = cv2.projectPoints(obj, r, t, K, DIST_TRUE)
+        img = img.reshape(-1, 2)
+        if (img.min(axis=0) > margin_px).all() and (img < np.array(SIZE) - margin_px).all():
+            out.append((r, t))
+        if len(out) == n:
+            return out
+    raise ValueError(f"only {len(out)} whole-board poses in {4 * n} draws")
+
+
 def board_points(chart):
     if chart.kind == "charuco":
         return np.asarray(chart.charuco_board().getChessboardCorners(), float).reshape(-1, 3)
     return chart.object_points() + [chart.square_mm, chart.square_mm, 0.0]
 
 
-def point_views(chart=CHARUCO, n=15, noise_px=0.3, seed=1, mark=None, K=K_TRUE):
-    """Views from projected corners (pinhole ``K``) with Gaussian noise; corners outside the frame dropped."""
+def point_views(chart=CHARUCO, n=15, noise_px=0.3, seed=1, mark=None, K=K_TRUE, dist=DIST_TRUE):
+    """Views from projected corners (pinhole ``K``, OpenCV distortion ``dist``) with Gaussian noise;
+    corners outside the frame dropped."""
     rng = np.random.default_rng(seed + 100)
     views = []
     obj = board_points(chart)
     for k, (r, t) in enumerate(poses(n, seed, chart)):
-        img, _ = cv2.projectPoints(obj, r, t, K, DIST_TRUE)
+        img, _ = cv2.projectPoints(obj, r, t, K, dist)
         img = img.reshape(-1, 2) + rng.normal(0, noise_px, (len(obj), 2))
         inside = (img[:, 0] > 2) & (img[:, 1] > 2) & (img[:, 0] < SIZE[0] - 3) & (img[:, 1] < SIZE[1] - 3)
         views.append(ChartView(f"pose{k}", SIZE, img[inside], obj[inside], mark))
@@ -81,8 +100,9 @@ def _upsample(coarse, fine):
     return ((1 - ty) * ((1 - tx) * c00 + tx * c01) + ty * ((1 - tx) * c10 + tx * c11)).astype(np.float32)
 
 
-def render(chart, rvec, tvec, *, board=None, supersample=2, blur_px=0.8, noise=2.0, seed=0):
-    """An 8-bit photograph of the chart at the pose through K_TRUE and DIST_TRUE: every (sub)pixel's
+def render(chart, rvec, tvec, *, board=None, supersample=2, blur_px=0.8, noise=2.0, seed=0, K=K_TRUE, dist=DIST_TRUE):
+    """An 8-bit photograph of the chart at the pose through ``K`` and ``dist`` (K_TRUE and DIST_TRUE by
+    default): every (sub)pixel's
     ray found by OpenCV's inverse of its distortion (undistortPointsIter), met with the chart's
     plane, and the chart's picture sampled there; then a Gaussian blur and noise (grey levels)."""
     img, ppm = board if board is not None else board_image(chart)
@@ -94,7 +114,7 @@ def render(chart, rvec, tvec, *, board=None, supersample=2, blur_px=0.8, noise=2
     X, Y = np.meshgrid(xs, ys)
     pts = np.stack([X.ravel(), Y.ravel()], axis=1).reshape(-1, 1, 2)
     crit = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 40, 1e-10)
-    q = cv2.undistortPointsIter(pts, K_TRUE, DIST_TRUE, None, None, crit).reshape(-1, 2)
+    q = cv2.undistortPointsIter(pts, K, dist, None, None, crit).reshape(-1, 2)
     R = cv2.Rodrigues(np.asarray(rvec, float))[0]
     t = np.asarray(tvec, float)
     d = np.column_stack([q, np.ones(len(q))])

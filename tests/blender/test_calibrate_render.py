@@ -14,23 +14,24 @@ fills the frame as well): a chart's size enters only the poses OpenCV fits, neve
 distortion, so one ``--square`` serves both marks.
 
 Measured (2 shared CPU cores, 16 renders of 640 x 427 px at 8 samples, about 65 s of rendering; the
-test about 75 s): pinhole 36.677 +- 0.071 mm at 600 mm (predicted 36.635) and 35.878 +- 0.235 mm at
+test about 80 s): pinhole 36.677 +- 0.071 mm at 600 mm (predicted 36.635) and 35.878 +- 0.235 mm at
 1500 mm (predicted 35.746); distortion field 0.13 and 0.23 px RMS from the prediction (stated
-uncertainty 0.58 and 0.32 px); breathing 2.23 +- 0.70 % (predicted 2.49 %; another pose draw gave
-2.34 +- 0.50 %). So the pinhole, distortion and breathing agree within the stated uncertainty, but
-the issue's 0.2 % on the breathing is *not* shown: it is below what these images measure. The limit
-is the pinhole's uncertainty, not render noise (corner residuals 0.3-0.4 px RMS): the chart covers a
-quarter of the frame per view and is tilted at most 30 degrees (more tilt puts it out of the f/11
-depth of field at 600 mm), so the focal length trades against the chart's distance; the far
-mark's std (0.2 mm, 0.65 %) dominates. A larger chart filling the frame (tried: 48 mm squares)
-loses corners off the frame and defocuses at the tilted edge (views at 1.4-1.6 px), worse.
-Reaching 0.2 % needs larger images or more views (each view costs ~4 s here).
+uncertainty 0.58 and 0.32 px); breathing 2.23 +- 0.70 % (predicted 2.49 %). So the pinhole,
+distortion and breathing agree within the stated uncertainty, but the issue's 0.2 % on the breathing
+is not shown at 8 samples. Why (docs/calibrate.md, "How well it measures", has the table): these
+views' corners put where physcam predicts them and calibrated without noise give the predicted
+pinholes to 0.002 % and the breathing to 0.004 % (no model difference); the corners found in the
+renders sit on the predicted ones without bias (<= 0.03 px) but scatter by 0.27-0.31 px RMS, which is
+Cycles' sampling noise (0.09 px at 64 samples); that scatter alone makes the breathing good to only
+~0.34 % (one standard deviation). The 0.2 % needs ~120 samples, 6.5-10 minutes of rendering here:
+``PHYSCAM_CALIBRATE_RENDER_SAMPLES=128`` runs it and asserts the breathing within 0.2 %.
 """
 
 from __future__ import annotations
 
 import csv
 import json
+import os
 import time
 
 import numpy as np
@@ -50,7 +51,11 @@ SIZE = (640, 427)
 SENSOR_MM = (36.0, 36.0 * SIZE[1] / SIZE[0])  # square photosites, 56.25 um
 SQUARES, SQUARE_MM, MARKER_MM, DICTIONARY = (10, 7), 35.0, 26.0, "DICT_4X4_50"
 POSES = 8  # per mark
-SAMPLES = 8
+#: Cycles samples per pixel; PHYSCAM_CALIBRATE_RENDER_SAMPLES=128 runs the issue's 0.2 % breathing proof
+#: (6.5-10 minutes on 2 shared cores: module notes)
+SAMPLES = int(os.environ.get("PHYSCAM_CALIBRATE_RENDER_SAMPLES", "8"))
+#: From this many samples the corners are good to <= 0.1 px RMS and the breathing is asserted within 0.2 %
+PROOF_SAMPLES = 96
 
 #: Renders one textured emissive plane per job through each mark's physcam setup script into PNG.
 SCENE = '''
@@ -153,7 +158,7 @@ def photographs(tmp_path_factory):
     with (tmp / "marks.csv").open("w", newline="") as f:
         csv.writer(f).writerows([["image", "mark"], *rows])
     t0 = time.perf_counter()
-    run_blender(SCENE, str(jobs), timeout=600)
+    run_blender(SCENE, str(jobs), timeout=max(600, 6 * SAMPLES * POSES))
     return tmp, time.perf_counter() - t0
 
 
@@ -177,9 +182,11 @@ def test_the_rendered_lens_measures_as_its_prescription(photographs, tmp_path, c
         assert d["agrees"], d
     b = rows[f"breathing {MARKS_MM[0]:g} mm against {MARKS_MM[1]:g} mm"]
     assert b["agrees"], b  # within 2 stated standard uncertainties (percent)
-    # the issue's 0.2 % is not met: at 640 x 427 px, 8 views, the far mark's pinhole is known to only
-    # ~0.5 % (module notes), so the breathing's stated uncertainty is ~0.5-0.7 %; assert it is said so
-    assert 0.1 < b["std"] < 1.5, b
+    if SAMPLES >= PROOF_SAMPLES:  # render noise low enough for the issue's 0.2 % (module notes)
+        assert abs(b["difference"]) <= 0.2, b
+    else:  # at 8 samples the corners carry ~0.27 px RMS of render noise: the breathing is good to ~0.35 %
+        # (one standard deviation), and the bootstrap says about that or more; assert it is said so
+        assert 0.1 < b["std"] < 1.5, b
     # the corners sit on the fitted camera to the render's noise (the verdict may still reject USD's
     # lensDistortion at 600 mm: it misses this Distagon's field by ~0.8 px, a limit of that model)
     assert all(m["residual_px"]["rms"] < 0.5 for m in doc["marks"]), [m["residual_px"]["rms"] for m in doc["marks"]]

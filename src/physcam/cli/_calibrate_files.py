@@ -122,7 +122,7 @@ def _mark_files(m, folder: Path, name: str, notes: list) -> list:
         out.append((folder / FIT_FILES["brown"], _json(brown_conrady_document(name, brown))))
     for f in good:
         if isinstance(f, TDE4RadialStandard):
-            out.append((folder / FIT_FILES["3de4"], tde4_lens_text(f, name).encode()))
+            out.append((folder / FIT_FILES["3de4"], tde4_lens_text(f, name, lens_center_offset_mm=m.principal_offset_mm).encode()))
         elif isinstance(f, USDStandard):
             out.append((folder / FIT_FILES["usd"], _json(usd_distortion_document(name, f))))
     out.append((folder / "opentrackio_lens.json", _json(opentrackio_lens(m))))

@@ -4,8 +4,20 @@ The file is 3DE4's plain-text lens format, the one its *Import Lens...* script r
 in order): the lens name; ``filmback width, filmback height, focal length, film aspect, lens centre
 x, lens centre y, pixel aspect`` (lengths in cm, separated by spaces); the dynamic distortion mode;
 the distortion model's name; then for each model parameter its name, its value and its curve (a
-key count, 0 here: a static lens); and ``<end_of_file>``. Lens centre offsets are 0 (physcam's
-lenses are centred); the focus distance the fit was made at is in the lens name.
+key count, 0 here: a static lens); and ``<end_of_file>``. The focus distance the fit was made at is
+in the lens name.
+
+**Lens centre offset** (3DE4's ``tde4_lens_center_offset_x_cm`` / ``_y_cm``): where the lens centre,
+the point the distortion model is centred on, lies from the filmback's centre, in cm on the
+filmback, x to the right, y *up*. That is 3DE4's own convention as its Lens Distortion Plugin Kit
+writes it (Science-D-Visions, LDPK ``ldpk_ldp_builtin.h`` / ``tde4_ldp_common_sdv.h``,
+``map_unit_to_dn``): a point's diagonally normalised coordinate is
+``((unit - 1/2) * filmback - lens centre offset) / r_fb``; Natron's port of that code
+(openfx-misc ``Distortion/Distortion.cpp``) makes the unit coordinates from Nuke's pixel
+coordinates, (0, 0) at the image's lower-left corner, so y is up. physcam's fits are made about the principal point
+(a prescription's lens: the frame centre, offset 0; a chart calibration: the measured principal
+point, ``MarkCalibration.principal_offset_mm``, also x right, y up from the frame centre), so the
+offset written is that point's, divided by 10.
 """
 
 from __future__ import annotations
@@ -24,12 +36,25 @@ def _num(v: float) -> str:
     return repr(float(v))
 
 
-def tde4_lens_text(fit: TDE4RadialStandard, name: str | None = None) -> str:
-    """The 3DE4 lens file of ``fit`` (module notes); refuses a fit whose residual is not acceptable."""
+def _offset_cm(offset_mm) -> tuple[float, float]:
+    if isinstance(offset_mm, (str, bytes)) or not hasattr(offset_mm, "__len__") or len(offset_mm) != 2:
+        raise InputError(f"the lens centre offset is (x, y) in mm from the filmback centre, got {offset_mm!r}")
+    x, y = (float(v) for v in offset_mm)
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise InputError(f"the lens centre offset must be finite, got {offset_mm!r}")
+    return x / 10.0, y / 10.0
+
+
+def tde4_lens_text(fit: TDE4RadialStandard, name: str | None = None, *,
+                   lens_center_offset_mm=(0.0, 0.0)) -> str:
+    """The 3DE4 lens file of ``fit`` (module notes); refuses a fit whose residual is not acceptable.
+    ``lens_center_offset_mm``: the point ``fit`` is centred on (the principal point) from the filmback
+    centre, mm, x right, y up; written in 3DE4's cm, same signs (module notes)."""
     if not isinstance(fit, TDE4RadialStandard):
         raise InputError(f"tde4_lens_text takes a TDE4RadialStandard fit, got {type(fit).__name__}")
     fit.require_acceptable("3DE4 lens file")
-    lp = fit.lens_parameters()
+    lp = dict(fit.lens_parameters())
+    lp["tde4_lens_center_offset_x_cm"], lp["tde4_lens_center_offset_y_cm"] = _offset_cm(lens_center_offset_mm)
     if name is None:
         name = "physcam lens"
     focus = "infinity" if math.isinf(fit.focus_from_film_mm) else f"{fit.focus_from_film_mm / 1000:g} m"
