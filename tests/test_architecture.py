@@ -218,3 +218,19 @@ def test_one_name_per_concept_in_public_parameters():
                     if re.match(pattern, p) and p not in allowed:
                         wrong.add(f"{module}.{name}({p}): {concept} is spelled {sorted(allowed)}")
     assert not wrong, "\n".join(sorted(wrong))
+
+
+def test_only_the_camera_state_sizes_an_iris():
+    # issue 28: an f-stop becomes a stop size in one place (optics: focusing's rule, called by the
+    # camera state); every analysis, exporter and front end takes the state's stop_semi_diameter
+    wrong = []
+    for path in (SRC / "physcam").rglob("*.py"):
+        rel = path.relative_to(SRC / "physcam")
+        if rel.parts[0] == "optics":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and any(a.name == "iris_semi_diameter" for a in node.names):
+                wrong.append(f"{rel}:{node.lineno}")
+            elif isinstance(node, ast.Attribute) and node.attr == "iris_semi_diameter":
+                wrong.append(f"{rel}:{node.lineno}")
+    assert not wrong, "size the iris through physcam.optics.state.camera_state: " + ", ".join(sorted(wrong))

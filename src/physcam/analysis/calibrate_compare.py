@@ -137,15 +137,15 @@ def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K
 
 def _illumination_rows(calibration, lens, k, fstop, f_pred) -> list[dict]:
     """Each ring of the measured relative illumination against the lens's, interpolated at its image height."""
-    from ..optics.focusing import iris_semi_diameter
+    from ..optics.state import camera_state
     from .illumination import relative_illumination
 
     ill, m = calibration.illumination, calibration.marks[0]
     heights = ill.height_mm[1:]
     top = math.degrees(math.atan(1.02 * heights.max() / f_pred))  # the lens's own pinhole at the mark
-    sd = None if fstop is None else iris_semi_diameter(lens, fstop)
-    res = relative_illumination(lens, list(np.linspace(0.0, top, 12)), sensor_width_mm=m.sensor_mm[0],
-                                sensor_height_mm=m.sensor_mm[1], grid=64, stop_semi_diameter=sd)
+    # the lens at infinity focus, its iris set to the flat fields' f-stop (None: as its file stops it)
+    state = camera_state(lens, fstop=fstop, sensor_mm=tuple(m.sensor_mm))
+    res = relative_illumination(state, list(np.linspace(0.0, top, 12)), grid=64)
     pts = [p for p in res.points if p.axis == "y"]
     pred = np.interp(heights, [abs(p.film_height_mm) for p in pts], [p.relative_illumination for p in pts])
     return [_row(f"relative illumination at {h:.2f} mm", r, p, s, "ratio", k)
