@@ -243,3 +243,18 @@ def test_the_dof_card_carries_the_dof_chart(tmp_path, capsys):
     text = card.read_text(encoding="utf-8")
     assert "focus mark from the film plane" in text and "near and far limits" in text
     assert "H f/2.8" in text and "H f/5.6" in text  # each stop's hyperfocal marked on the chart
+
+
+def test_colour_film_is_the_reference_lines_focus_for_a_lens_designed_elsewhere(capsys, tmp_path):
+    # found in review: through a camera state the film went to the design wavelength's focus (546 nm
+    # here), 7.8 um from the d line's, and every lateral colour figure moved with it
+    from physcam.lens.library import load_lens
+    from physcam.optics.paraxial import gaussian
+
+    src = Path(__file__).resolve().parents[2] / "src/physcam/data/lenses/cooke_triplet_50mm_f4_5.toml"
+    text = src.read_text().replace("coating = \"none\"\n", "coating = \"none\"\nwavelength_nm = 546.074\n", 1)
+    path = tmp_path / "cooke546.toml"
+    path.write_text(text)
+    rc, out, _ = run(capsys, "colour", "--lens", str(path), "--json")
+    d_focus = gaussian(load_lens(str(path)), wavelength_nm=587.5618).z_rear_focal_point
+    assert rc == 0 and json.loads(out)["film_z_mm"] == pytest.approx(d_focus, abs=1e-6)

@@ -127,11 +127,14 @@ def test_fit_opencv_pinhole_of_a_state_is_the_fit_at_its_mark_and_sensor():
 
 
 def test_the_iris_shape_in_the_state_or_beside_it_is_the_same_iris():
-    """A number of blades (the shader's shorthand) in the state, or given with a round state, or with
-    the lens: one six-blade iris in the shader."""
+    """A six-blade iris in the state, or a number of blades (the shader's shorthand) given with a round
+    state or with the lens: one six-blade iris in the shader. (A state holds an iris shape, not a
+    number: camera_state refuses 6, which the ray analyses could not trace.)"""
+    from physcam.trace.aperture import Aperture
+
     lens = load_lens("dgauss_50mm")
     kw = dict(focus_mm=2000.0, sensor_mm=(36.0, 24.0))
-    texts = {osl_camera_shader(camera_state(lens, aperture=6, **kw)),
+    texts = {osl_camera_shader(camera_state(lens, aperture=Aperture(6), **kw)),
              osl_camera_shader(camera_state(lens, **kw), aperture=6),
              osl_camera_shader(lens, focus_mm=2000.0, sensor_width_mm=36.0, sensor_height_mm=24.0, aperture=6)}
     assert len(texts) == 1

@@ -72,6 +72,8 @@ def sensor_size(width_mm, height_mm):
     sensor is used; the pair otherwise."""
     from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 
-    if width_mm == DEFAULT_SENSOR_WIDTH_MM and height_mm == DEFAULT_SENSOR_HEIGHT_MM:
+    # "not given" is the keywords' own default objects (identity, not equality): an explicit 24.89 x 18.66
+    # is a sensor given, refused next to a state's own like any other
+    if width_mm is DEFAULT_SENSOR_WIDTH_MM and height_mm is DEFAULT_SENSOR_HEIGHT_MM:
         return None
     return (width_mm, height_mm)

@@ -222,7 +222,10 @@ def defocus_camera(lens: CameraState | Prescription, *, focus_mm: float | None =
         if focus_mm is None or fstop is None:
             raise InputError("give focus_mm and fstop with a lens (or a CameraState: physcam.optics.state.camera_state)")
         fstop = require_positive("f-stop", fstop, unit="")
-    if sensor_width_mm is None and isinstance(lens, CameraState) and lens.sensor_mm is not None:
+    if isinstance(lens, CameraState) and lens.sensor_mm is not None:
+        if sensor_width_mm is not None:
+            raise InputError("a CameraState carries its own sensor: give sensor_mm to camera_state(), not "
+                             "sensor_width_mm here")
         sensor_width_mm = lens.sensor_mm[0]
     if sensor_width_mm is None:
         raise InputError("give the sensor width: sensor_width_mm (or camera_state(sensor_mm=...))")

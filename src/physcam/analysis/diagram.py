@@ -185,7 +185,8 @@ def lens_diagram(prescription: CameraState | Prescription, *, axis: str = "y", f
                  fstop=None, field_deg: float | None = None, wavelength_nm=None, rays: int = 3) -> LensDiagram:
     """Compute a :class:`LensDiagram` of a :class:`~physcam.optics.state.CameraState`, or of a
     Prescription focused at ``focus_mm`` (the mark from the film plane; None: infinity) with its iris
-    at ``fstop`` (None: the stop as in its file); focused at ``wavelength_nm`` (None: the design one)."""
+    at ``fstop`` (None: the stop as in its file); focused at ``wavelength_nm`` (None: the state's primary
+    wavelength, a lens's design one)."""
     from ..optics.state import as_camera_state
 
     if axis not in paraxial.AXES:
@@ -193,6 +194,8 @@ def lens_diagram(prescription: CameraState | Prescription, *, axis: str = "y", f
     cam = as_camera_state(prescription, focus_mm=focus_mm, fstop=fstop)
     prescription, focus_mm = cam.lens, cam.focus_from_film_mm
     fstop = cam.fstop if cam.iris_set else None
+    if wavelength_nm is None:  # the state's primary wavelength (a lens's: its design wavelength)
+        wavelength_nm = cam.wavelengths_nm[0]
     st = focusing.focus(prescription, focus_mm, axis="y", wavelength_nm=wavelength_nm)
     p = st.prescription
     iris = cam.stop_semi_diameter if cam.iris_set else None

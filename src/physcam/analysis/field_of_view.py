@@ -107,8 +107,8 @@ def chief_ray_field_limit(
                            tol_deg=require_finite("tol_deg", tol_deg), backend=backend)
 
 
-@takes_prescription
 @renamed_parameter("focus_from_film_mm", "focus_mm")
+@takes_prescription
 def real_field_of_view(
     lens: Prescription,
     sensor_width_mm: float,

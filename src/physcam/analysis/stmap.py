@@ -433,13 +433,16 @@ def distortion_field(
     are then None and (0, 0)): what fitting models and tables across focus need. An iris set to an
     f-stop gives the centroid distortion there instead of the chief rays' (module notes, "At a stop").
     """
-    from ..optics.state import as_camera_state
     from ..optics.focusing import focus
+    from ..optics.state import CameraState, as_camera_state
     from ..optics.paraxial import gaussian
 
     w_px, h_px = _size("width", width_px), _size("height", height_px)
     if w_px * h_px > MAX_PIXELS:
         raise InputError(f"a {w_px} x {h_px} frame has more than {MAX_PIXELS:,} pixels: give a smaller resolution")
+    if method != "auto" and isinstance(lens, CameraState):
+        raise InputError("a CameraState is focused already: give the focus method to camera_state's lens "
+                         "(or pass the lens itself with method=...), not here")
     cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
     W, H = _sensor(cam, sensor_width_mm, sensor_height_mm)
     lens = cam.lens

@@ -202,9 +202,12 @@ def run_colour(args) -> int:
     from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM
     from ._output import Table, print_table
 
-    state = _camera(args)
+    # the lens itself, not a camera state: colour's film is the paraxial focus of its reference line (d),
+    # a state's is its design wavelength's (the two differ for a lens not designed at d; found in review)
+    lens = _prepare(args)
     wls = (LINE_F_NM, LINE_D_NM, LINE_C_NM) + tuple(args.wavelength or ())
-    res = chromatic_aberration(state, args.field, wavelengths_nm=wls, max_field_deg=args.max_field)
+    res = chromatic_aberration(lens, args.field, wavelengths_nm=wls, max_field_deg=args.max_field,
+                               sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height)
     if not (args.json or _csv(args, res, "colour")):
         print(f"{res.lens_name}: chromatic aberration (EFL {res.efl_mm:.3f} mm at {res.reference_nm:g} nm), "
               f"{args.sensor_name}")

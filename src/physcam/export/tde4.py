@@ -39,7 +39,10 @@ def _num(v: float) -> str:
 def _offset_cm(offset_mm) -> tuple[float, float]:
     if isinstance(offset_mm, (str, bytes)) or not hasattr(offset_mm, "__len__") or len(offset_mm) != 2:
         raise InputError(f"the lens centre offset is (x, y) in mm from the filmback centre, got {offset_mm!r}")
-    x, y = (float(v) for v in offset_mm)
+    try:
+        x, y = (float(v) for v in offset_mm)
+    except (TypeError, ValueError):
+        raise InputError(f"the lens centre offset is two numbers of mm, got {offset_mm!r:.60}") from None
     if not (math.isfinite(x) and math.isfinite(y)):
         raise InputError(f"the lens centre offset must be finite, got {offset_mm!r}")
     return x / 10.0, y / 10.0

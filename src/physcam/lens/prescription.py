@@ -367,7 +367,10 @@ def takes_prescription(fn):
     AttributeError deep inside the optics."""
     import functools
 
-    first = fn.__code__.co_varnames[0]
+    inner = fn
+    while hasattr(inner, "__wrapped__"):  # under another decorator: the function's own first parameter
+        inner = inner.__wrapped__
+    first = inner.__code__.co_varnames[0]
 
     @functools.wraps(fn)
     def checked(*args, **kwargs):

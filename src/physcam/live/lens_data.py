@@ -47,8 +47,8 @@ def focus_for_consumer(focus_mm, entrance_pupil_mm, consumer: str = "opentrackio
     raise InputError(f"consumer must be opentrackio or unreal, got {consumer!r}")
 
 
-@takes_prescription
 @renamed_parameter("focus_from_film_mm", "focus_mm")
+@takes_prescription
 def distortion_for_sample(lens: Prescription, sensor_width_mm, sensor_height_mm, focus_mm,
                           image_size=(4096, None)) -> tuple[dict, float]:
     """(OpenTrackIO distortion object, the pinhole focal length F in mm it is normalised by) of ``lens``

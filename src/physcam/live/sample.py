@@ -200,11 +200,12 @@ def decode_sample(payload, encoding: str = "json", *, validate: bool = True) -> 
         require_type("payload", payload, (bytes, bytearray, memoryview))
     if encoding not in ("json", "cbor"):
         raise InputError(f"encoding must be json or cbor, got {encoding!r}")
+    if encoding == "cbor":  # a missing extra is said as such, not as a malformed sample
+        _needs_live("CBOR samples")
     try:
         if encoding == "json":
             obj = json.loads(bytes(payload).decode("utf-8"), parse_constant=_reject_constant)
         else:
-            _needs_live("CBOR samples")
             import cbor2
 
             obj = cbor2.loads(bytes(payload))

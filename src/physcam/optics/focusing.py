@@ -296,8 +296,8 @@ def _internal_focus(p: Prescription, mark: float, axis: str, lam) -> FocusState:
     return FocusState(mark, "internal", axis, q.with_thicknesses({len(p.surfaces) - 1: back}), d, back, b_inf, back - b_inf, alpha)
 
 
-@takes_prescription
 @renamed_parameter("focus_from_film_mm", "focus_mm")
+@takes_prescription
 def focus(
     prescription: Prescription,
     focus_mm: float,
@@ -340,8 +340,8 @@ def iris_semi_diameter(prescription: Prescription, fstop: float, *, method: str 
     return paraxial.stop_semi_diameter_for_fstop(inf_state.prescription, fstop)
 
 
-@takes_prescription
 @renamed_parameter("focus_from_film_mm", "focus_mm")
+@takes_prescription
 def f_number_ratio(prescription: Prescription, focus_mm: float, *, method: str = "auto") -> float:
     """The lens's f-number at a focus mark over its f-number at infinity, for one iris.
 
@@ -354,8 +354,8 @@ def f_number_ratio(prescription: Prescription, focus_mm: float, *, method: str =
     return gaussian_at_focus(prescription, focus_mm, method=method).f_number / at_infinity
 
 
-@takes_prescription
 @renamed_parameter("focus_from_film_mm", "focus_mm")
+@takes_prescription
 def gaussian_at_focus(
     prescription: Prescription,
     focus_mm: float = math.inf,
@@ -382,8 +382,8 @@ def gaussian_at_focus(
     )
 
 
-@takes_prescription
 @renamed_parameter("focus_from_film_mm", "focus_mm")
+@takes_prescription
 def technical_planes(
     prescription: Prescription,
     focus_mm: float,

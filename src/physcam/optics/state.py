@@ -16,7 +16,7 @@ import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
-from ..errors import InputError, OpticsError, require_finite, require_type
+from ..errors import InputError, OpticsError, WrongTypeError, require_finite, require_type
 from ..lens.prescription import Prescription
 from .thinlens import MAX_F_NUMBER, MIN_F_NUMBER, require_f_number
 
@@ -150,6 +150,11 @@ def camera_state(lens: Prescription, *, focus_mm=None, fstop=None, sensor_mm=Non
     not needed), at ``wavelengths_nm`` (None: the lens's design wavelength) with ``weights``.
     Every argument is checked here, once (InputError or OpticsError with a sentence)."""
     require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name or file)")
+    if aperture is not None and not all(callable(getattr(aperture, m, None)) for m in ("rim_radius", "density_at",
+                                                                                       "sample")):
+        # (an iris shape is physcam.trace.aperture.Aperture, a layer above: checked by what it must do)
+        raise WrongTypeError(f"aperture must be an iris shape, physcam.trace.aperture.Aperture(blades, ...), or None "
+                             f"(round), got {type(aperture).__name__} {aperture!r:.60}")
     stop_n, stop = _fstop_and_stop(lens, fstop)
     focused, object_z, film_z, mark = _focused(lens, focus_mm)
     if sensor_mm is not None:
@@ -182,7 +187,10 @@ def takes_camera(fn):
     own ``focus_mm`` and ``fstop``); anything else is a WrongTypeError with a sentence."""
     import functools
 
-    first = fn.__code__.co_varnames[0]
+    inner = fn
+    while hasattr(inner, "__wrapped__"):  # under another decorator: the function's own first parameter
+        inner = inner.__wrapped__
+    first = inner.__code__.co_varnames[0]
 
     @functools.wraps(fn)
     def checked(*args, **kwargs):
