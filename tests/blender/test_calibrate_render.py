@@ -49,13 +49,17 @@ MARKS_MM = (600.0, 1500.0)  # focus marks, mm from the film
 FSTOP = 11.0  # depth of field for the tilted chart: blur <= 0.7 px over +-100 mm at 600 mm
 SIZE = (640, 427)
 SENSOR_MM = (36.0, 36.0 * SIZE[1] / SIZE[0])  # square photosites, 56.25 um
-SQUARES, SQUARE_MM, MARKER_MM, DICTIONARY = (10, 7), 35.0, 26.0, "DICT_4X4_50"
+SQUARES, SQUARE_MM = (15, 10), 20.0  # a checkerboard of 14 x 9 inner corners (300 x 200 mm at 600 mm)
+MARGIN = 0.5  # white border around the squares, in squares (the detector needs the outer squares' edges)
 POSES = 8  # per mark
-#: Cycles samples per pixel; PHYSCAM_CALIBRATE_RENDER_SAMPLES=128 runs the issue's 0.2 % breathing proof
-#: (6.5-10 minutes on 2 shared cores: module notes)
-SAMPLES = int(os.environ.get("PHYSCAM_CALIBRATE_RENDER_SAMPLES", "8"))
-#: From this many samples the corners are good to <= 0.1 px RMS and the breathing is asserted within 0.2 %
-PROOF_SAMPLES = 96
+PUSH = (0.12, 0.07)  # the views' push toward the frame's corners, over the distance (the board stays whole)
+#: Cycles' most samples per pixel, adaptive sampling on (module notes)
+SAMPLES = int(os.environ.get("PHYSCAM_CALIBRATE_RENDER_SAMPLES", "64"))
+ADAPTIVE_THRESHOLD, ADAPTIVE_MIN_SAMPLES = 0.01, 8
+#: Cycles' sampling seed (PHYSCAM_CALIBRATE_RENDER_SEED: another draw of the render noise)
+SEED = int(os.environ.get("PHYSCAM_CALIBRATE_RENDER_SEED", "0"))
+#: From this many samples the corners are good to <= 0.06 px RMS and the breathing is asserted within 0.2 %
+PROOF_SAMPLES = 64
 
 #: Renders one textured emissive plane per job through each mark's physcam setup script into PNG.
 SCENE = '''
@@ -88,6 +92,10 @@ for job in jobs["renders"]:
     scene.view_settings.view_transform = "Standard"
     scene.cycles.max_bounces = 0
     scene.cycles.samples = jobs["samples"]
+    scene.cycles.use_adaptive_sampling = True  # flat pixels stop early: the edges get the samples
+    scene.cycles.adaptive_threshold = jobs["adaptive_threshold"]
+    scene.cycles.adaptive_min_samples = jobs["adaptive_min_samples"]
+    scene.cycles.seed = jobs["seed"]
     for o in list(bpy.data.objects):
         if o.type == "MESH":
             bpy.data.objects.remove(o)
@@ -108,7 +116,7 @@ print(json.dumps({"rendered": len(jobs["renders"])}))
 
 def _poses(mark, n, seed):
     """``n`` chart poses (R, t) in OpenCV's camera frame (mm), the chart about ``mark`` from the film,
-    tilted up to 30 degrees, pushed toward every corner of the frame in turn."""
+    tilted up to 30 degrees, pushed toward every corner of the frame in turn (:data:`PUSH`), whole."""
     rng = np.random.default_rng(seed)
     scale = mark / MARKS_MM[0]
     centre = scale * SQUARE_MM * np.array([SQUARES[0] / 2, SQUARES[1] / 2, 0.0])
@@ -119,16 +127,25 @@ def _poses(mark, n, seed):
         R = cv2.Rodrigues(np.array([ax, 0, 0]))[0] @ cv2.Rodrigues(np.array([0, ay, 0]))[0] @ \
             cv2.Rodrigues(np.array([0, 0, az]))[0]
         z = mark * rng.uniform(0.97, 1.03)
-        corner = np.array([(-1) ** i, (-1) ** (i // 2)]) * ([0.16, 0.12] if i < n - 2 else [0.0, 0.0])
+        corner = np.array([(-1) ** i, (-1) ** (i // 2)]) * (PUSH if i < n - 2 else [0.0, 0.0])
         shift = (corner + rng.uniform(-0.03, 0.03, 2)) * z
         out.append((R, np.array([shift[0], shift[1], z]) - R @ centre, scale))
     return out
 
 
+def _board(px_per_square=64):
+    """The checkerboard's picture, with its white margin (uint8)."""
+    j, i = np.mgrid[0:SQUARES[1] * px_per_square, 0:SQUARES[0] * px_per_square] // px_per_square
+    img = np.where((i + j) % 2 == 0, 0, 255).astype(np.uint8)
+    return np.pad(img, int(MARGIN * px_per_square), constant_values=255)
+
+
 def _job(R, t, scale, out):
-    """The chart's four corners in Blender's camera frame (m; OpenCV's y and z negated) and their UVs."""
+    """The chart's four corners (margin included) in Blender's camera frame (m; OpenCV's y and z negated)
+    and their UVs."""
     w, h = SQUARES[0] * SQUARE_MM * scale, SQUARES[1] * SQUARE_MM * scale
-    chart = np.array([[0, 0, 0], [w, 0, 0], [w, h, 0], [0, h, 0]], float)
+    m = MARGIN * SQUARE_MM * scale
+    chart = np.array([[-m, -m, 0], [w + m, -m, 0], [w + m, h + m, 0], [-m, h + m, 0]], float)
     cam = (chart @ R.T + t) * [1.0, -1.0, -1.0] / 1000.0
     return {"corners": cam.tolist(), "uv": [[0, 1], [1, 1], [1, 0], [0, 0]], "out": str(out)}
 
@@ -137,11 +154,7 @@ def _job(R, t, scale, out):
 def photographs(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("calibrate_render")
     lens = load_lens(LENS)
-    d = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, DICTIONARY))
-    board = cv2.aruco.CharucoBoard(SQUARES, SQUARE_MM, MARKER_MM, d)
-    px_per_mm = 8
-    cv2.imwrite(str(tmp / "board.png"), board.generateImage((int(SQUARES[0] * SQUARE_MM * px_per_mm),
-                                                             int(SQUARES[1] * SQUARE_MM * px_per_mm)), marginSize=0))
+    cv2.imwrite(str(tmp / "board.png"), _board())
     renders, rows = [], []
     for k, mark in enumerate(MARKS_MM):
         src = osl_camera_shader(lens, focus_mm=mark, fstop=FSTOP, sensor_width_mm=SENSOR_MM[0],
@@ -154,7 +167,9 @@ def photographs(tmp_path_factory):
             renders.append(dict(_job(R, t, scale, out), setup=str(setup)))
             rows.append([out.name, f"{mark:g}mm"])
     jobs = tmp / "jobs.json"
-    jobs.write_text(json.dumps({"board": str(tmp / "board.png"), "samples": SAMPLES, "renders": renders}))
+    jobs.write_text(json.dumps({"board": str(tmp / "board.png"), "samples": SAMPLES, "seed": SEED, "renders": renders,
+                                "adaptive_threshold": ADAPTIVE_THRESHOLD,
+                                "adaptive_min_samples": ADAPTIVE_MIN_SAMPLES}))
     with (tmp / "marks.csv").open("w", newline="") as f:
         csv.writer(f).writerows([["image", "mark"], *rows])
     t0 = time.perf_counter()
@@ -168,8 +183,8 @@ def test_the_rendered_lens_measures_as_its_prescription(photographs, tmp_path, c
     tmp, seconds = photographs
     images = sorted(str(p) for p in tmp.glob("m*_*.png"))
     rc = main(["calibrate", *images, "--marks", str(tmp / "marks.csv"), "--sensor-width", f"{SENSOR_MM[0]}",
-               "--sensor-height", f"{SENSOR_MM[1]}", "--chart", "charuco", "--corners", f"{SQUARES[0]}x{SQUARES[1]}",
-               "--square", f"{SQUARE_MM}mm", "--marker", f"{MARKER_MM}mm", "--dictionary", DICTIONARY,
+               "--sensor-height", f"{SENSOR_MM[1]}", "--chart", "checkerboard",
+               "--corners", f"{SQUARES[0] - 1}x{SQUARES[1] - 1}", "--square", f"{SQUARE_MM}mm",
                "--lens", LENS, "--bootstrap", "20", "-o", str(tmp_path / "calib"), "--json"])
     assert rc == 0, capsys.readouterr().err
     doc = json.loads(capsys.readouterr().out)
@@ -184,9 +199,9 @@ def test_the_rendered_lens_measures_as_its_prescription(photographs, tmp_path, c
     assert b["agrees"], b  # within 2 stated standard uncertainties (percent)
     if SAMPLES >= PROOF_SAMPLES:  # render noise low enough for the issue's 0.2 % (module notes)
         assert abs(b["difference"]) <= 0.2, b
-    else:  # at 8 samples the corners carry ~0.27 px RMS of render noise: the breathing is good to ~0.35 %
-        # (one standard deviation), and the bootstrap says about that or more; assert it is said so
-        assert 0.1 < b["std"] < 1.5, b
+    else:  # fewer samples: more render noise in the corners (as 1/sqrt(samples)), so the 0.2 % is not
+        # shown; assert the uncertainty is stated
+        assert 0.02 < b["std"] < 1.5, b
     # the corners sit on the fitted camera to the render's noise (the verdict may still reject USD's
     # lensDistortion at 600 mm: it misses this Distagon's field by ~0.8 px, a limit of that model)
     assert all(m["residual_px"]["rms"] < 0.5 for m in doc["marks"]), [m["residual_px"]["rms"] for m in doc["marks"]]
