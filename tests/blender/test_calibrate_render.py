@@ -54,12 +54,13 @@ MARGIN = 0.5  # white border around the squares, in squares (the detector needs 
 POSES = 8  # per mark
 PUSH = (0.12, 0.07)  # the views' push toward the frame's corners, over the distance (the board stays whole)
 #: Cycles' most samples per pixel, adaptive sampling on (module notes)
-SAMPLES = int(os.environ.get("PHYSCAM_CALIBRATE_RENDER_SAMPLES", "64"))
+SAMPLES = int(os.environ.get("PHYSCAM_CALIBRATE_RENDER_SAMPLES", "48"))
 ADAPTIVE_THRESHOLD, ADAPTIVE_MIN_SAMPLES = 0.01, 8
+FILTER_PX = 1.0  # Cycles' Blackman-Harris pixel filter width (default 1.5): sharper edges, less corner noise
 #: Cycles' sampling seed (PHYSCAM_CALIBRATE_RENDER_SEED: another draw of the render noise)
 SEED = int(os.environ.get("PHYSCAM_CALIBRATE_RENDER_SEED", "0"))
 #: From this many samples the corners are good to <= 0.06 px RMS and the breathing is asserted within 0.2 %
-PROOF_SAMPLES = 64
+PROOF_SAMPLES = 48
 
 #: Renders one textured emissive plane per job through each mark's physcam setup script into PNG.
 SCENE = '''
@@ -96,6 +97,7 @@ for job in jobs["renders"]:
     scene.cycles.adaptive_threshold = jobs["adaptive_threshold"]
     scene.cycles.adaptive_min_samples = jobs["adaptive_min_samples"]
     scene.cycles.seed = jobs["seed"]
+    scene.cycles.filter_width = jobs["filter_px"]
     for o in list(bpy.data.objects):
         if o.type == "MESH":
             bpy.data.objects.remove(o)
@@ -168,7 +170,7 @@ def photographs(tmp_path_factory):
             rows.append([out.name, f"{mark:g}mm"])
     jobs = tmp / "jobs.json"
     jobs.write_text(json.dumps({"board": str(tmp / "board.png"), "samples": SAMPLES, "seed": SEED, "renders": renders,
-                                "adaptive_threshold": ADAPTIVE_THRESHOLD,
+                                "adaptive_threshold": ADAPTIVE_THRESHOLD, "filter_px": FILTER_PX,
                                 "adaptive_min_samples": ADAPTIVE_MIN_SAMPLES}))
     with (tmp / "marks.csv").open("w", newline="") as f:
         csv.writer(f).writerows([["image", "mark"], *rows])
