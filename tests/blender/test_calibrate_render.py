@@ -49,10 +49,10 @@ MARKS_MM = (600.0, 1500.0)  # focus marks, mm from the film
 FSTOP = 11.0  # depth of field for the tilted chart: blur <= 0.7 px over +-100 mm at 600 mm
 SIZE = (640, 427)
 SENSOR_MM = (36.0, 36.0 * SIZE[1] / SIZE[0])  # square photosites, 56.25 um
-SQUARES, SQUARE_MM = (15, 10), 20.0  # a checkerboard of 14 x 9 inner corners (300 x 200 mm at 600 mm)
+SQUARES, SQUARE_MM = (15, 10), 16.0  # a checkerboard of 14 x 9 inner corners (240 x 160 mm at 600 mm)
 MARGIN = 0.5  # white border around the squares, in squares (the detector needs the outer squares' edges)
 POSES = 8  # per mark
-PUSH = (0.12, 0.07)  # the views' push toward the frame's corners, over the distance (the board stays whole)
+PUSH = (0.20, 0.12)  # the views' push toward the frame's corners, over the distance (the board stays whole)
 #: Cycles' most samples per pixel, adaptive sampling on (module notes)
 SAMPLES = int(os.environ.get("PHYSCAM_CALIBRATE_RENDER_SAMPLES", "48"))
 ADAPTIVE_THRESHOLD, ADAPTIVE_MIN_SAMPLES = 0.01, 8
