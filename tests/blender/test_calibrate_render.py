@@ -1,4 +1,4 @@
-"""Issue 33, render proof of ``physcam calibrate``: a ChArUco chart photographed through physcam's own
+"""Issue 33, render proof of ``physcam calibrate``: a checkerboard photographed through physcam's own
 OSL real-lens camera of ``zeiss_distagon_35mm_f4`` (Blender Cycles, traced through the prescription)
 at two focus marks, calibrated by ``physcam calibrate --lens``, agrees with physcam's prediction from
 the prescription: the pinhole focal length and the distortion field within the stated uncertainty,
@@ -13,18 +13,27 @@ The far mark's chart is the near one scaled by the ratio of the marks (a bigger 
 fills the frame as well): a chart's size enters only the poses OpenCV fits, never the pinhole or the
 distortion, so one ``--square`` serves both marks.
 
-Measured (2 shared CPU cores, 16 renders of 640 x 427 px at 8 samples, about 65 s of rendering; the
-test about 80 s): pinhole 36.677 +- 0.071 mm at 600 mm (predicted 36.635) and 35.878 +- 0.235 mm at
-1500 mm (predicted 35.746); distortion field 0.13 and 0.23 px RMS from the prediction (stated
-uncertainty 0.58 and 0.32 px); breathing 2.23 +- 0.70 % (predicted 2.49 %). So the pinhole,
-distortion and breathing agree within the stated uncertainty, but the issue's 0.2 % on the breathing
-is not shown at 8 samples. Why (docs/calibrate.md, "How well it measures", has the table): these
-views' corners put where physcam predicts them and calibrated without noise give the predicted
-pinholes to 0.002 % and the breathing to 0.004 % (no model difference); the corners found in the
-renders sit on the predicted ones without bias (<= 0.03 px) but scatter by 0.27-0.31 px RMS, which is
-Cycles' sampling noise (0.09 px at 64 samples); that scatter alone makes the breathing good to only
-~0.34 % (one standard deviation). The 0.2 % needs ~120 samples, 6.5-10 minutes of rendering here:
-``PHYSCAM_CALIBRATE_RENDER_SAMPLES=128`` runs it and asserts the breathing within 0.2 %.
+What makes the 0.2 % affordable (docs/calibrate.md, "How well it measures", has the numbers): the
+breathing's error is Cycles' sampling noise in the corners (no model error: 0.005 %), so the test
+buys corner precision per second of rendering. (1) Adaptive sampling (at most 48 samples, threshold
+0.01, at least 8): a textured emissive plane's flat pixels converge at once, the edges get the
+samples. (2) A 1 px pixel filter instead of Cycles' 1.5 px: sharper edges, 25 % less corner noise per
+sample. (3) A checkerboard of 14 x 9 inner corners instead of a 10 x 7 ChArUco board: 126 corners a
+view instead of ~48, every one refined in a window scaled to its squares (a ChArUco corner's window
+stops at the markers); a checkerboard must be seen whole, so the board is small (16 mm squares at
+600 mm, about 17 px) and pushed toward the frame's corners, so that the distortion field is measured
+out to them (a 20 mm board pushed less missed the corners, and the field there by up to 2.4 px).
+Per render the corners then scatter by ~0.06 px RMS (two seeds' difference over sqrt 2) in about
+2.7 s a view, where 8 plain samples gave 0.29 px in 1.3 s and 128 plain samples ~0.07 px in ~12 s.
+
+Measured (2 shared CPU cores, load 1.7-1.9; 16 renders of 640 x 427 px; ``PHYSCAM_CALIBRATE_RENDER_SEED``
+0-4, five draws of the render noise): the test 52-60 s (rendering 43-47 s); breathing +0.076, +0.118,
+-0.096, +0.138, +0.118 % from the predicted 2.488 % (stated uncertainty 0.13-0.20 %): all within
+0.2 %; pinholes within 0.1 % of the prediction (+-0.03 mm at 600 mm, +-0.03-0.07 mm at 1500 mm);
+distortion field 0.02-0.14 px RMS from the prediction, all within the stated uncertainty. At 96
+samples (73-75 s) the breathing is no better (RESULTS96), so part of what is left is not sampling
+noise but these 16 views' geometry; under heavy load (load 4.5 from other jobs) the test takes about
+twice as long.
 """
 
 from __future__ import annotations
