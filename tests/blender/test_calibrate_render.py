@@ -17,23 +17,25 @@ What makes the 0.2 % affordable (docs/calibrate.md, "How well it measures", has 
 breathing's error is Cycles' sampling noise in the corners (no model error: 0.005 %), so the test
 buys corner precision per second of rendering. (1) Adaptive sampling (at most 48 samples, threshold
 0.01, at least 8): a textured emissive plane's flat pixels converge at once, the edges get the
-samples. (2) A 1 px pixel filter instead of Cycles' 1.5 px: sharper edges, 25 % less corner noise per
+samples. (2) A 1 px pixel filter instead of Cycles' 1.5 px: sharper edges, 28 % less corner noise per
 sample. (3) A checkerboard of 14 x 9 inner corners instead of a 10 x 7 ChArUco board: 126 corners a
 view instead of ~48, every one refined in a window scaled to its squares (a ChArUco corner's window
 stops at the markers); a checkerboard must be seen whole, so the board is small (16 mm squares at
 600 mm, about 17 px) and pushed toward the frame's corners, so that the distortion field is measured
 out to them (a 20 mm board pushed less missed the corners, and the field there by up to 2.4 px).
-Per render the corners then scatter by ~0.06 px RMS (two seeds' difference over sqrt 2) in about
-2.7 s a view, where 8 plain samples gave 0.29 px in 1.3 s and 128 plain samples ~0.07 px in ~12 s.
+Per render the corners then scatter by 0.065 px RMS (two seeds' difference over sqrt 2) in 2.7 s a
+view, where 8 plain samples of the ChArUco board gave 0.29 px in 1.3 s and 128 plain samples 0.065-0.074
+px in 6.5-10 minutes for the 16 views.
 
 Measured (2 shared CPU cores, load 1.7-1.9; 16 renders of 640 x 427 px; ``PHYSCAM_CALIBRATE_RENDER_SEED``
 0-4, five draws of the render noise): the test 52-60 s (rendering 43-47 s); breathing +0.076, +0.118,
 -0.096, +0.138, +0.118 % from the predicted 2.488 % (stated uncertainty 0.13-0.20 %): all within
 0.2 %; pinholes within 0.1 % of the prediction (+-0.03 mm at 600 mm, +-0.03-0.07 mm at 1500 mm);
 distortion field 0.02-0.14 px RMS from the prediction, all within the stated uncertainty. At 96
-samples (73-75 s) the breathing is no better (RESULTS96), so part of what is left is not sampling
-noise but these 16 views' geometry; under heavy load (load 4.5 from other jobs) the test takes about
-twice as long.
+samples (test 71-75 s; corners 0.044 px per render) the breathing is no better (+0.032, +0.123, -0.003,
++0.163, +0.086 %): what is left, about +0.08 % on average, is not sampling noise but something of
+these 16 views' geometry, not identified. Under heavy load (load 4.5 from other jobs) the test takes
+about twice as long.
 """
 
 from __future__ import annotations
