@@ -40,7 +40,7 @@ real chief ray lands, the tilted chart 540-650 mm and 1350-1680 mm from the film
 pixel filter's pixel locking (the corners found are pushed 0.05 px x sin(2 pi x their fraction of a
 pixel) toward the pixel edges, the same in every seed) about +0.02 % (Cycles' 1.5 px filter: 0.033 px
 of locking, breathing +0.034, +0.100, -0.137, +0.145, +0.103 % for seeds 0-4, 0.022 % less on
-average, for 28 % more corner noise). The rest (0.03 px per corner
+average, giving up the 1 px filter's 28 % less corner noise). The rest (0.03 px per corner
 that every seed shares besides) is not identified. Under heavy load (load 4.5 from other jobs) the
 test takes about twice as long.
 """
