@@ -33,10 +33,10 @@ Measured (2 shared CPU cores, load 1.7-1.9; 16 renders of 640 x 427 px; ``PHYSCA
 0.2 %; pinholes within 0.1 % of the prediction (+-0.03 mm at 600 mm, +-0.03-0.07 mm at 1500 mm);
 distortion field 0.02-0.14 px RMS from the prediction, all within the stated uncertainty. At 96
 samples (test 71-75 s; corners 0.044 px per render) the breathing is no better (+0.032, +0.123, -0.003,
-+0.163, +0.086 %): what is left, about +0.08 % on average, is not sampling noise. Checked without
-rendering on these 16 views (docs/calibrate.md, "How well it measures"): the model is not it
++0.163, +0.086 %): what is left, about +0.08 % on average, is not sampling noise. Checked on
+these 16 views (docs/calibrate.md, "How well it measures"): the model is not it
 (corners placed by the prediction: -0.0006 %); the chart's depth is +0.013 % (each corner where its
-real chief ray lands, the tilted chart 540-650 mm and 1350-1680 mm from the film); and the 1 px
+real chief ray lands, the tilted chart 540-670 mm and 1350-1680 mm from the film); and the 1 px
 pixel filter's pixel locking (the corners found are pushed 0.05 px x sin(2 pi x their fraction of a
 pixel) toward the pixel edges, the same in every seed) about +0.02 % (Cycles' 1.5 px filter: 0.033 px
 of locking, breathing +0.034, +0.100, -0.137, +0.145, +0.103 % for seeds 0-4, 0.022 % less on
