@@ -33,6 +33,7 @@ __all__ = [
     "Prescription",
     "require_prescription",
     "takes_prescription",
+    "first_argument_checked",
     "unvalidated",
     "OBJECT_DISTANCE_KEY",
 ]
@@ -361,23 +362,39 @@ def require_prescription(value, name: str = "lens") -> Prescription:
     return require_type(name, value, Prescription, hint)
 
 
+def first_argument_checked(check):
+    """Decorator factory: ``check(value, name)`` is called on the decorated function's first argument
+    (positional or by keyword; ``name`` is that parameter's own name, also under other decorators)
+    before the function runs. The one mechanism of :func:`takes_prescription` and
+    :func:`physcam.optics.state.takes_camera`."""
+    import functools
+
+    from ..errors import WrongTypeError
+
+    if not callable(check):
+        raise WrongTypeError(f"check must be a function check(value, name), got {type(check).__name__}")
+
+    def decorate(fn):
+        inner = fn
+        while hasattr(inner, "__wrapped__"):  # under another decorator: the function's own first parameter
+            inner = inner.__wrapped__
+        first = inner.__code__.co_varnames[0]
+
+        @functools.wraps(fn)
+        def checked(*args, **kwargs):
+            if args:
+                check(args[0], first)
+            elif first in kwargs:
+                check(kwargs[first], first)
+            return fn(*args, **kwargs)
+
+        return checked
+
+    return decorate
+
+
 def takes_prescription(fn):
     """Decorator: the function's first argument (``prescription`` or ``lens``) must be a
     :class:`Prescription`; anything else is a :class:`~physcam.errors.WrongTypeError`, not an
     AttributeError deep inside the optics."""
-    import functools
-
-    inner = fn
-    while hasattr(inner, "__wrapped__"):  # under another decorator: the function's own first parameter
-        inner = inner.__wrapped__
-    first = inner.__code__.co_varnames[0]
-
-    @functools.wraps(fn)
-    def checked(*args, **kwargs):
-        if args:
-            require_prescription(args[0], first)
-        elif first in kwargs:
-            require_prescription(kwargs[first], first)
-        return fn(*args, **kwargs)
-
-    return checked
+    return first_argument_checked(require_prescription)(fn)

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 from ..errors import InputError, OpticsError, WrongTypeError, require_finite, require_type
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, first_argument_checked
 from .thinlens import MAX_F_NUMBER, MIN_F_NUMBER, require_f_number
 
 __all__ = ["CameraState", "camera_state", "as_camera_state", "takes_camera", "wavelengths_and_weights", "require_f_number", "MIN_F_NUMBER", "MAX_F_NUMBER"]
@@ -181,24 +181,15 @@ def as_camera_state(lens, *, focus_mm=None, fstop=None, **state) -> CameraState:
     return camera_state(lens, focus_mm=focus_mm, fstop=fstop, **state)
 
 
+def _require_camera(value, name: str) -> None:
+    if not isinstance(value, CameraState):
+        require_type(name, value, Prescription,
+                     "a CameraState (physcam.optics.state.camera_state(lens, focus_mm=..., fstop=...)) or a lens "
+                     "(physcam.lens.library.load_lens(name or file))")
+
+
 def takes_camera(fn):
     """Decorator: the first argument is a :class:`CameraState` or a
     :class:`~physcam.lens.prescription.Prescription` (then focused and stopped from the function's
     own ``focus_mm`` and ``fstop``); anything else is a WrongTypeError with a sentence."""
-    import functools
-
-    inner = fn
-    while hasattr(inner, "__wrapped__"):  # under another decorator: the function's own first parameter
-        inner = inner.__wrapped__
-    first = inner.__code__.co_varnames[0]
-
-    @functools.wraps(fn)
-    def checked(*args, **kwargs):
-        value = args[0] if args else kwargs.get(first)
-        if not isinstance(value, CameraState):
-            require_type(first, value, Prescription,
-                         "a CameraState (physcam.optics.state.camera_state(lens, focus_mm=..., fstop=...)) or a lens "
-                         "(physcam.lens.library.load_lens(name or file))")
-        return fn(*args, **kwargs)
-
-    return checked
+    return first_argument_checked(_require_camera)(fn)
