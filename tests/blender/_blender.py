@@ -50,6 +50,20 @@ for _p in glob.glob(bpy.utils.resource_path("LOCAL") + "/python/lib/python3*/sit
 """
 
 
+#: A scene of nothing but its camera, placed at the film centre looking down world -Z (+Y up), in a
+#: black world: what the OSL renders of one lit object start from (``scene`` and ``cam_obj`` defined).
+DARK_SCENE_CAMERA_AT_FILM = """
+scene = bpy.context.scene
+for o in list(bpy.data.objects):
+    if o.type != "CAMERA":
+        bpy.data.objects.remove(o)
+cam_obj = scene.camera
+cam_obj.location = (0.0, 0.0, 0.0)       # the film centre
+cam_obj.rotation_euler = (0.0, 0.0, 0.0)  # looks down world -Z, +Y up
+world = bpy.data.worlds.new("black"); scene.world = world; world.use_nodes = True
+world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+"""
+
 #: The start of a script run through the installed physcam extension (argv[1]: its zip): installed with
 #: Blender's own installer, Cycles on the CPU with 2 threads, no denoising, linear EXR out.
 INSTALLED_EXTENSION_SCENE = """

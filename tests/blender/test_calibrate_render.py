@@ -55,7 +55,7 @@ import time
 import numpy as np
 import pytest
 
-from _blender import run_blender
+from _blender import DARK_SCENE_CAMERA_AT_FILM, run_blender
 from physcam.export.blender import blender_setup_script, osl_camera_shader
 from physcam.lens.library import load_lens
 
@@ -84,16 +84,7 @@ PROOF_SAMPLES = 48
 SCENE = '''
 import json, runpy, sys
 jobs = json.loads(open(sys.argv[1]).read())
-scene = bpy.context.scene
-for o in list(bpy.data.objects):
-    if o.type != "CAMERA":
-        bpy.data.objects.remove(o)
-cam_obj = scene.camera
-cam_obj.location = (0.0, 0.0, 0.0)       # the film centre
-cam_obj.rotation_euler = (0.0, 0.0, 0.0)  # looks down world -Z, +Y up
-world = bpy.data.worlds.new("black"); scene.world = world; world.use_nodes = True
-world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-mat = bpy.data.materials.new("chart"); mat.use_nodes = True
+''' + DARK_SCENE_CAMERA_AT_FILM + '''mat = bpy.data.materials.new("chart"); mat.use_nodes = True
 nt = mat.node_tree; nt.nodes.clear()
 tex = nt.nodes.new("ShaderNodeTexImage"); tex.image = bpy.data.images.load(jobs["board"])
 tex.interpolation = "Linear"; tex.extension = "CLIP"

@@ -23,7 +23,7 @@ import time
 import numpy as np
 import pytest
 
-from _blender import run_blender
+from _blender import DARK_SCENE_CAMERA_AT_FILM, run_blender
 from physcam.analysis.blob import blob_moments, polygon_corners
 from physcam.analysis.bokeh import bokeh_image
 from physcam.export.blender import blender_setup_script, osl_camera_shader
@@ -51,16 +51,7 @@ SCENE = '''
 import json, runpy, sys, time
 import numpy as np
 jobs = json.loads(sys.argv[1])
-scene = bpy.context.scene
-for o in list(bpy.data.objects):
-    if o.type != "CAMERA":
-        bpy.data.objects.remove(o)
-cam_obj = scene.camera
-cam_obj.location = (0.0, 0.0, 0.0)       # the film centre
-cam_obj.rotation_euler = (0.0, 0.0, 0.0)  # looks down world -Z, +Y up
-world = bpy.data.worlds.new("black"); scene.world = world; world.use_nodes = True
-world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-mat = bpy.data.materials.new("glow"); mat.use_nodes = True
+''' + DARK_SCENE_CAMERA_AT_FILM + '''mat = bpy.data.materials.new("glow"); mat.use_nodes = True
 nt = mat.node_tree; nt.nodes.clear()
 em = nt.nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = 1.0
 nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
