@@ -110,9 +110,7 @@ def _state(lens, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_heig
     require_prescription(lens)
     ap = _aperture(aperture)
     sw = require_positive("sensor width", sensor_width_mm)
-    sh = require_positive("sensor height", sensor_height_mm)
-    if sw > 1000 or sh > 1000:
-        raise InputError(f"a {sw:g} x {sh:g} mm sensor is not a camera sensor (at most 1000 mm a side)")
+    sh = require_positive("sensor height", sensor_height_mm)  # (its size bounds: camera_state's)
     if isinstance(focus_mm, bool) or not isinstance(focus_mm, (int, float, np.floating, np.integer)):
         raise InputError(f"focus distance must be a number of mm, got {focus_mm!r}")
     f = float(focus_mm)
