@@ -83,6 +83,15 @@ def wait_mm(pg, element_id, mm):
                          arg=[element_id, mm])
 
 
+def wait_chart_for_setup(pg):
+    """Wait until the DOF chart on show, and the numbers it carries, are those of the page's current
+    setup (the report link's query), loaded."""
+    pg.wait_for_function("() => { const i = document.getElementById('dof-chart');"
+                         " const api = document.getElementById('json-link').getAttribute('href')"
+                         ".replace('/api/report?', '');"
+                         " return i.dataset.api === api && i.complete && i.naturalWidth > 0; }")
+
+
 def metric(mm):
     """How the page writes a length in metric (docs/serve.md): cm with one decimal under 1 m, else m."""
     return "∞" if mm is None else (f"{mm / 10:.1f} cm" if abs(mm) < 1000 else f"{mm / 1000:.2f} m")
@@ -282,8 +291,9 @@ def test_dof_chart_fits_the_phone_and_marks_the_cursor(page, server, capsys, tmp
     open_page(page, server)
     type_setup(page)
     wait_mm(page, "out-near", cli_report(capsys, *SETUP)["dof"]["near_from_film_mm"])
-    page.wait_for_function("() => { const i = document.getElementById('dof-chart');"
-                           " return i.complete && i.naturalWidth > 0; }")
+    # the numbers come first and the chart a moment later (SETTLE_MS): wait for the chart of this
+    # setup, not the one still showing from a half-typed one (a CI run read f/2 off that: 3.95 m)
+    wait_chart_for_setup(page)
     page.wait_for_function("() => document.getElementById('dof-readout') && window.getComputedStyle("
                            "document.getElementById('dof-chart')).display !== 'none'")
     page.locator("#dof-wrap").scroll_into_view_if_needed()

@@ -214,6 +214,7 @@ function chart(api) {
     img.hidden = false;
     img.setAttribute("src", src);
     st.chart = null;
+    delete img.dataset.api;
     $("dof-cursor").hidden = true;
     // the chart's axes and curves ride in the SVG's metadata (physcam serve caches the drawing)
     fetch(src).then((r) => (r.ok ? r.text() : "")).then((text) => {
@@ -221,6 +222,7 @@ function chart(api) {
       const doc = new DOMParser().parseFromString(text, "image/svg+xml");
       const desc = doc.getElementsByTagName("dc:description")[0]; // (matplotlib writes the dc: prefix)
       st.chart = desc ? JSON.parse(desc.textContent) : null;
+      img.dataset.api = api; // the chart and its numbers now answer this setup (tests wait on it)
     }).catch(() => { st.chart = null; });
   }
 }
