@@ -208,8 +208,9 @@ def _chart(focus_mm: int) -> str:
     return "/api/dof.svg?" + urlencode({"focal": 50, "fstop": 2.8, "focus": f"{focus_mm}mm", "sensor": "S35"})
 
 
-async def _flood(port, rate, seconds, statuses, stop):
-    """Distinct charts from ABUSER at ``rate`` per second, open loop, one connection each."""
+async def _flood(port, rate, seconds, statuses, stop, drawn):
+    """Distinct charts from ABUSER at ``rate`` per second, open loop, one connection each; ``drawn``
+    gets the time (monotonic) each chart answered 200 came back."""
 
     async def one(path):
         try:
@@ -217,6 +218,8 @@ async def _flood(port, rate, seconds, statuses, stop):
             w.write(f"GET {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n".encode())
             line = await asyncio.wait_for(r.readline(), 30)
             statuses.append(int(line.split()[1]) if line else None)
+            if statuses[-1] == 200:
+                drawn.append(time.monotonic())
             w.close()
         except (TimeoutError, OSError, ValueError, IndexError):
             statuses.append(None)
@@ -233,29 +236,26 @@ async def _flood(port, rate, seconds, statuses, stop):
 @needs_loopback_net
 def test_a_flood_of_slow_work_from_one_address_does_not_starve_another(server):
     """40 distinct charts per second from one address (the worker draws about 20): a chart asked by
-    another address waits at most the chart being drawn and one of the flood's, not the flood's
-    queue. Bound: 0.5 s + 5 x the chart's time with the server to itself (before: 503, or ~32 charts)."""
+    another address waits for the chart being drawn and about one of the flood's, not the flood's
+    queue. Counted in charts, not seconds, so a machine that slows down mid-test cannot fail it: at
+    most 4 of the flood's charts come back while the other address waits (first come, first served
+    lets the 8 the flood may queue go first: 8-9; before the fair worker: 503, or ~32)."""
     port, proc = server
     assert get(port, _chart(1000))[0] == 200  # the first chart imports matplotlib
-    alone = []
-    for k in range(3):
-        t0 = time.monotonic()
-        assert get(port, _chart(1100 + k))[0] == 200
-        alone.append(time.monotonic() - t0)
-    t_alone = max(alone)  # the slowest of three: a loaded machine varies (the queue before took ~32 of them)
-    bound = 0.5 + 5 * t_alone
-    statuses, stop = [], threading.Event()
-    flood = threading.Thread(target=lambda: asyncio.run(_flood(port, 40, 5, statuses, stop)))
+    statuses, drawn, stop = [], [], threading.Event()
+    flood = threading.Thread(target=lambda: asyncio.run(_flood(port, 40, 5, statuses, stop, drawn)))
     flood.start()
     try:
         time.sleep(2.0)  # the flood has filled whatever queue it can
-        waits = []
+        waits, passed = [], []
         for k in range(2):
             t0 = time.monotonic()
             status, _, body = get(port, _chart(1200 + k), timeout=30)
-            waits.append(time.monotonic() - t0)
+            t1 = time.monotonic()
             assert status == 200, (status, body[:200])
-        assert max(waits) < bound, f"waited {waits} s; alone a chart takes {t_alone:.3f} s (bound {bound:.2f} s)"
+            waits.append(round(t1 - t0, 3))
+            passed.append(sum(t0 < t <= t1 for t in list(drawn)))
+        assert max(passed) <= 4, f"{passed} of the flood's charts came back while another address waited {waits} s"
     finally:
         stop.set()
         flood.join(60)
