@@ -1,9 +1,11 @@
-"""Loopback UDP helpers of the live tests: a free port, and waiting until a recorder holds one."""
+"""Loopback UDP helpers of the live tests: a free port, waiting until a recorder holds one, and a
+sender paced to the receiver's socket buffer."""
 
 from __future__ import annotations
 
 import socket
 import time
+from collections import deque
 
 
 def free_port() -> int:
@@ -23,3 +25,36 @@ def wait_for_port(proc, port: int, timeout: float = 60.0) -> None:
             if any(line.split()[1].endswith(f":{port:04X}") for line in f.readlines()[1:]):
                 return
         time.sleep(0.1)
+
+
+class PacedSender:
+    """Send datagrams to an in-process Receiver as fast as it reads them, never more than a quarter of
+    the socket buffer the kernel gave it in flight (sent, not yet counted "received"). UDP drops what
+    overflows that buffer, and a stock kernel's net.core.rmem_max (212992) gives ~416 KiB, not the
+    8 MiB asked for: unpaced, these tests lose datagrams there. Each datagram is charged 1 KiB of
+    kernel overhead (skb truesize) besides its bytes."""
+
+    OVERHEAD = 1024
+
+    def __init__(self, tx, rx):
+        self.tx, self.rx = tx, rx
+        self.budget = rx.receive_buffer_granted_bytes // 4
+        self._costs: deque[int] = deque()
+        self._sent = self._acked = self._in_flight = 0
+
+    def send(self, datagram: bytes, timeout: float = 30.0) -> None:
+        cost = len(datagram) + self.OVERHEAD
+        deadline = time.monotonic() + timeout
+        while self._costs and self._in_flight + cost > self.budget:
+            received = self.rx.counters()["received"]
+            while self._acked < received and self._costs:
+                self._in_flight -= self._costs.popleft()
+                self._acked += 1
+            if self._in_flight + cost > self.budget:
+                if time.monotonic() > deadline:
+                    raise TimeoutError(f"the receiver read {received} of {self._sent} datagrams in {timeout} s")
+                time.sleep(0.0002)
+        self.tx.send_datagram(datagram)
+        self._costs.append(cost)
+        self._in_flight += cost
+        self._sent += 1

@@ -21,6 +21,8 @@ from physcam.live.sample import encode_sample
 from physcam.live.sender import Sender
 from physcam.onset.sensors import find_sensor
 
+from _udp import PacedSender
+
 pytestmark = pytest.mark.slow
 
 N = 10_000
@@ -109,9 +111,10 @@ def test_ten_thousand_samples_with_bad_packets(tmp_path):
     # this test is about every counter and every value under bad packets, test_attacks.py about the window
     with Receiver(0, host="127.0.0.1", queue_size=1024, reorder_timeout_s=1.0) as rx, \
             Sender("127.0.0.1", rx.port) as tx:
+        paced = PacedSender(tx, rx)
         for k, packets in enumerate(plan):
             for d in packets:
-                tx.send_datagram(d)
+                paced.send(d)
             # full speed, limited only by the receiver: keep at most ~500 samples in flight
             while True:
                 while (item := rx.get()) is not None:
@@ -188,19 +191,18 @@ def test_bad_input_alone_does_not_grow_the_receiver():
     count them, the buffers stay at their caps, and memory does not grow with them."""
     rnd = random.Random(5)
     with Receiver(0, host="127.0.0.1") as rx, Sender("127.0.0.1", rx.port) as tx:
+        paced = PacedSender(tx, rx)
         rss0 = _rss_bytes()
         for k in range(20_000):
             kind = k % 3
             if kind == 0:
-                tx.send_datagram(bytes(rnd.getrandbits(8) for _ in range(64)))
+                paced.send(bytes(rnd.getrandbits(8) for _ in range(64)))
             elif kind == 1:
-                tx.send_datagram(b"OTrk" + os.urandom(50_000))
+                paced.send(b"OTrk" + os.urandom(50_000))
             else:
                 first = packetize(b"{" + b" " * 3000 + b"}", encoding=ENCODING_JSON, sequence=k % 65536,
                                   segment_payload=1000)[0]
-                tx.send_datagram(first)
-            if k % 500 == 0:
-                time.sleep(0.01)
+                paced.send(first)
         deadline = time.monotonic() + 20
         while rx.counters()["received"] < 20_000 and time.monotonic() < deadline:
             time.sleep(0.05)

@@ -198,6 +198,12 @@ class Receiver:
         return False
 
     @property
+    def receive_buffer_granted_bytes(self) -> int | None:
+        """The socket receive buffer the kernel gave (it caps ``receive_buffer_bytes`` at its own
+        ``net.core.rmem_max``, and counts each datagram's overhead against it); None before start."""
+        return None if self._sock is None else self._sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+
+    @property
     def running(self) -> bool:
         return self._thread is not None and self._thread.is_alive()
 
