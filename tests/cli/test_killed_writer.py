@@ -1,8 +1,9 @@
 """A writer killed mid-write leaves no litter for good (issue 24 item 12): a real ``physcam usd
-refresh`` of a shot, in place, SIGKILLed while its temporary file is being written (text and
-crate), leaves that hidden temporary behind; the next refresh of the same shot removes it, so
-the folder holds the shot alone again. The shot carries a 12 MB plate array so the write
-lasts long enough to be caught."""
+refresh`` of a shot, in place, SIGKILLed with its temporary file written but not yet renamed
+(text and crate), leaves that hidden temporary behind; the next refresh of the same shot removes
+it, so the folder holds the shot alone again. The refresh runs under a two-line wrapper that stops
+the process (SIGSTOP) just before the rename, so the kill always lands in that window; polling for
+the temporary, as this test first did, could miss a 12-100 ms window on a loaded machine."""
 
 from __future__ import annotations
 
@@ -10,7 +11,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 
 import pytest
 
@@ -20,7 +20,20 @@ pytestmark = pytest.mark.slow
 
 #: the documented naming (docs/cli.md): .<target>.physcam-tmp.<host>.<pid>.<random><suffix>
 TEMP_MARK = ".physcam-tmp."
-PLATE_SAMPLES = 1_000_000  # floats: about 12 MB of .usda text, 4 MB of crate
+PLATE_SAMPLES = 100_000  # floats: a shot with some weight (1.2 MB of .usda text)
+
+#: ``python -c`` this, then physcam's arguments: physcam, stopped by itself before renaming a temporary
+_STOP_BEFORE_RENAME = """
+import os, runpy, signal, sys
+replace = os.replace
+def stop_then_replace(src, dst, *args, **kwargs):
+    if ".physcam-tmp." in os.fspath(src):
+        os.kill(os.getpid(), signal.SIGSTOP)
+    return replace(src, dst, *args, **kwargs)
+os.replace = stop_then_replace
+sys.argv = ["physcam", *sys.argv[1:]]
+runpy.run_module("physcam", run_name="__main__", alter_sys=True)
+"""
 
 
 def _shot(folder, suffix):
@@ -51,24 +64,21 @@ def _refresh(shot):
     return [sys.executable, "-m", "physcam", "usd", "refresh", str(shot)]
 
 
-def _kill_while_writing(shot, timeout_s=120.0):
-    """Start a refresh of ``shot`` and SIGKILL it once its temporary file exists; return the litter."""
-    proc = subprocess.Popen(_refresh(shot), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    t0 = time.monotonic()
-    try:
-        while not _temporaries(shot.parent):
-            if proc.poll() is not None:
-                pytest.fail(f"the refresh ended (exit {proc.returncode}) before it was caught writing: "
-                            f"{proc.stderr.read().decode()[-500:]}")
-            if time.monotonic() - t0 > timeout_s:
-                pytest.fail("the refresh never started writing")
-            time.sleep(0.0005)
-        os.kill(proc.pid, signal.SIGKILL)
-    finally:
-        proc.wait(timeout=60)
-        proc.stderr.close()
-    assert proc.returncode == -signal.SIGKILL
-    return _temporaries(shot.parent)
+def _kill_while_writing(shot):
+    """Run a refresh of ``shot`` until it stops before renaming its temporary, SIGKILL it there, and
+    return the litter."""
+    proc = subprocess.Popen([sys.executable, "-c", _STOP_BEFORE_RENAME, "usd", "refresh", str(shot)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status = os.waitpid(proc.pid, os.WUNTRACED)  # returns once the child has stopped (or ended)
+    if not os.WIFSTOPPED(status):
+        proc.returncode = status  # reaped by waitpid
+        pytest.fail(f"the refresh ended (status {status}) without renaming a temporary: "
+                    f"{proc.stderr.read().decode()[-500:]}")
+    litter = _temporaries(shot.parent)
+    proc.kill()
+    assert proc.wait(timeout=60) == -signal.SIGKILL
+    proc.stderr.close()
+    return litter
 
 
 @pytest.mark.parametrize("suffix", [".usda", ".usdc"])

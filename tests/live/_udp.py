@@ -27,6 +27,20 @@ def wait_for_port(proc, port: int, timeout: float = 60.0) -> None:
         time.sleep(0.1)
 
 
+def wait_until_read(port: int, timeout: float = 60.0) -> None:
+    """Until no datagram waits in the socket on UDP ``port`` (its rx_queue in /proc/net/udp is 0):
+    the receiving process has read everything sent (loopback delivers during the send)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        with open("/proc/net/udp") as f:  # local_address is ADDR:PORT, then rem_address, st, tx_queue:rx_queue
+            rows = [line.split() for line in f.readlines()[1:]]
+        queues = [int(r[4].split(":")[1], 16) for r in rows if r[1].endswith(f":{port:04X}")]
+        if queues and not any(queues):
+            return
+        time.sleep(0.05)
+    raise TimeoutError(f"datagrams still wait on UDP port {port} after {timeout} s")
+
+
 class PacedSender:
     """Send datagrams to an in-process Receiver as fast as it reads them, never more than a quarter of
     the socket buffer the kernel gave it in flight (sent, not yet counted "received"). UDP drops what

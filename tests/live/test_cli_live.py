@@ -15,7 +15,7 @@ from physcam.cli import main
 from physcam.live.camera import camera_frames, frames_to_samples
 from physcam.live.sender import Sender
 from physcam.onset.sensors import find_sensor
-from _udp import free_port, wait_for_port
+from _udp import free_port, wait_for_port, wait_until_read
 
 DATA = Path(__file__).parent / "data"
 
@@ -129,7 +129,9 @@ def test_a_signal_ends_the_recording_and_the_take_is_written(tmp_path, sig):
     wait_for_port(proc, port)
     with Sender("127.0.0.1", port, encoding="cbor") as tx:
         tx.stream(samples, 240)
-    time.sleep(1.5)
+    # the recorder has read all 20 (the first pays for the schema validator): its receiver's stop()
+    # waits for the one being handled and hands on what it holds
+    wait_until_read(port)
     proc.send_signal(getattr(signal, sig))
     stdout, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 0, stderr

@@ -272,8 +272,9 @@ def test_the_worker_takes_one_job_from_each_address_in_turn():
 
     done, gate = [], threading.Event()
     w = FairWorker(per_client=3, total=7)
-    futures = [w.submit("A", gate.wait)]  # A0 holds the worker until the queue is built
-    time.sleep(0.05)
+    started = threading.Event()
+    futures = [w.submit("A", lambda: (started.set(), gate.wait()))]  # A0 holds the worker until the queue is built
+    assert started.wait(10)
     for who, name in [("A", "A1"), ("A", "A2"), ("B", "B1"), ("C", "C1"), ("C", "C2")]:
         futures.append(w.submit(who, lambda n=name: done.append(n)))
     with pytest.raises(Full) as over:  # A has three pending (A0 runs, A1 and A2 wait)
