@@ -16,6 +16,8 @@ import math
 import sys
 from pathlib import Path
 
+from ..figures import styled
+
 __all__ = ["document", "emit_json", "schema_file", "SCHEMA_DIR", "Table", "print_table", "print_csv",
            "csv_text", "add_output_options", "LENGTH_UNITS", "save_plot"]
 
@@ -172,6 +174,7 @@ def print_csv(rows, columns=None) -> None:
 
 
 # ---- plots ------------------------------------------------------------------------------------
+@styled
 def save_plot(result, path, *, force: bool = False, context: str = "", units: str | None = None):
     """Save an analysis result's figure (``result.plot(None)``) with ``context`` (the shot: f-stop,
     focus, sensor) as a line under it, so a plot says what it is of. ``units`` (m or ft) reaches
