@@ -185,9 +185,11 @@ def new_figure(figsize=None, dpi=None, **kwargs):
 
 
 def subplots(nrows: int = 1, ncols: int = 1, *, figsize=None, dpi=None, squeeze: bool = True, **kwargs):
-    """``(fig, axes)`` as ``pyplot.subplots`` gives them, on an Agg canvas."""
+    """``(fig, axes)`` as ``pyplot.subplots`` gives them, on an Agg canvas: figure and axes (spines,
+    grid) in physcam's style; what is drawn on them later, in the style only inside :func:`figure_style`."""
     fig = new_figure(figsize=figsize, dpi=dpi)
-    return fig, fig.subplots(nrows, ncols, squeeze=squeeze, **kwargs)
+    with figure_style():
+        return fig, fig.subplots(nrows, ncols, squeeze=squeeze, **kwargs)
 
 
 class _AggPlot:
@@ -314,8 +316,9 @@ def _has_unit(label: str) -> bool:
     return bool(re.search(r"\([^)]*\S[^)]*\)", label)) or any(w.lower() in label.lower() for w in UNITLESS_WORDS)
 
 
+@styled
 def figure_problems(fig) -> list[str]:
-    """What breaks the figure style in ``fig``, drawn: text (titles, labels, ticks, legends) reaching
+    """What breaks the figure style in ``fig``, drawn (in the style, as physcam saves it): text (titles, labels, ticks, legends) reaching
     outside the figure, and axes with ticks but no label or a label without a unit. Empty when none."""
     import re
 
