@@ -116,9 +116,16 @@ def _compare(lens):
     return compare_figure(rows, curves, sensor=find_sensor("S35"))
 
 
+def _lens_card(lens):
+    from physcam.analysis.lens_card import lens_card
+
+    return lens_card(lens, quality="draft").figure(dpi=30)
+
+
 #: Public functions that return a drawn physcam figure, each made small.
 PRODUCERS = {"dof zone": _dof_zone, "lens diagram": _diagram, "breathing": _breathing,
-             "real breathing": _real_breathing, "mtf chart": _mtf_chart, "spot": _spot, "compare": _compare}
+             "real breathing": _real_breathing, "mtf chart": _mtf_chart, "spot": _spot, "compare": _compare,
+             "lens card": _lens_card}
 
 
 @pytest.mark.parametrize("make", list(PRODUCERS.values()), ids=list(PRODUCERS))
@@ -168,3 +175,30 @@ def test_styled_keeps_the_function_and_restores_on_error():
         with pytest.raises(ValueError):
             wrapped(1)
         assert changed_keys(before, dict(matplotlib.rcParams)) == []
+
+
+def test_threads_drawing_at_once_leave_the_callers_rcparams(dgauss):
+    """rcParams is one dict for every thread: physcam's drawings take turns, so none restores
+    another's settings in the middle of its figure, and the caller's come back at the end."""
+    import threading
+
+    figs, errors = [], []
+
+    def work():
+        try:
+            for _ in range(3):
+                figs.append(_dof_zone(dgauss))
+        except Exception as exc:  # pragma: no cover - reported below
+            errors.append(exc)
+
+    with matplotlib.rc_context(SENTINEL):
+        before = dict(matplotlib.rcParams)
+        threads = [threading.Thread(target=work) for _ in range(3)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        assert errors == [] and changed_keys(before, dict(matplotlib.rcParams)) == []
+    assert len(figs) == 9
+    assert {f.axes[0].xaxis.label.get_fontsize() for f in figs} == {STYLE["axes.labelsize"]}
+    assert {matplotlib.colors.to_hex(f.get_facecolor()) for f in figs} == {"#ffffff"}
