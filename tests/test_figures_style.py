@@ -43,6 +43,9 @@ FIGURE_RUNS = [
     ("psf huygens", ["psf", *L, "--fstop", "8", "--field", "5", "--method", "huygens", "--samples", "33",
                      "-o", "psfh.png"]),
     ("compare lenses", ["compare", "dgauss_50mm", "tessar_50mm_f2_8", "--rays", "2000", "-o", "cmp.png"]),
+    ("distortion across focus", ["distortion", *L, "--resolution", "512x342", "--across-focus", "1m,inf",
+                                 "-o", "daf.png"]),
+    ("distortion fit residual", ["distortion", *L, "--resolution", "256x171", "--stmap", "st", "--fit", "brown"]),
 ]
 
 
@@ -57,9 +60,10 @@ def test_every_figure_keeps_the_style(argv, tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err
     assert rc == 0, err
     assert "figure style" not in err
-    out = argv[argv.index("-o" if "-o" in argv else "--plot") + 1]
-    if out.endswith(".png"):
-        assert imread(tmp_path / out)[0, 0, :3].tolist() == [1.0, 1.0, 1.0]  # physcam's white, not the caller's red
+    named = [argv[i + 1] for i, a in enumerate(argv) if a in ("-o", "--plot")]
+    pngs = [tmp_path / n for n in named if n.endswith(".png")] + list(tmp_path.rglob("residual_*.png"))
+    for png in pngs:  # the figures (not the ST maps beside the residual plots)
+        assert imread(png)[0, 0, :3].tolist() == [1.0, 1.0, 1.0], png.name  # physcam's white, not the caller's red
 
 
 def test_the_checker_sees_a_cut_off_title_and_a_label_without_unit():
