@@ -2,16 +2,22 @@
 title or tick label) and a unit in every axis label with ticks (physcam.figures.figure_problems).
 
 Each command that draws a figure is run once, small, with PHYSCAM_STRICT_FIGURES=1: then
-physcam.figures checks every figure before it is written and raises on a problem. The checker itself
-is tested on figures made to break it.
+physcam.figures checks every figure before it is written and raises on a problem (or on a figure
+made outside physcam's style context). The checker itself is tested on figures made to break it.
+Each run also starts from distinctive matplotlib settings of the caller's (a red background, a 13 pt
+font: tests/test_figures_rcparams.py) and must leave every rcParams key as it found it, while the
+figure it writes keeps physcam's white background.
 """
 
 from __future__ import annotations
 
+import matplotlib
 import pytest
+from matplotlib.image import imread
+from test_figures_rcparams import SENTINEL, changed_keys
 
 from physcam.cli import main
-from physcam.figures import STRICT_ENV, figure_problems, fit_title, new_figure
+from physcam.figures import STRICT_ENV, figure_problems, figure_style, fit_title, new_figure
 
 pytestmark = pytest.mark.slow
 
@@ -37,6 +43,9 @@ FIGURE_RUNS = [
     ("psf huygens", ["psf", *L, "--fstop", "8", "--field", "5", "--method", "huygens", "--samples", "33",
                      "-o", "psfh.png"]),
     ("compare lenses", ["compare", "dgauss_50mm", "tessar_50mm_f2_8", "--rays", "2000", "-o", "cmp.png"]),
+    ("distortion across focus", ["distortion", *L, "--resolution", "512x342", "--across-focus", "1m,inf",
+                                 "-o", "daf.png"]),
+    ("distortion fit residual", ["distortion", *L, "--resolution", "256x171", "--stmap", "st", "--fit", "brown"]),
 ]
 
 
@@ -44,10 +53,17 @@ FIGURE_RUNS = [
 def test_every_figure_keeps_the_style(argv, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv(STRICT_ENV, "1")
-    rc = main(argv)
+    with matplotlib.rc_context(SENTINEL):
+        before = dict(matplotlib.rcParams)
+        rc = main(argv)
+        assert changed_keys(before, dict(matplotlib.rcParams)) == []
     err = capsys.readouterr().err
     assert rc == 0, err
     assert "figure style" not in err
+    named = [argv[i + 1] for i, a in enumerate(argv) if a in ("-o", "--plot")]
+    pngs = [tmp_path / n for n in named if n.endswith(".png")] + list(tmp_path.rglob("residual_*.png"))
+    for png in pngs:  # the figures (not the ST maps beside the residual plots)
+        assert imread(png)[0, 0, :3].tolist() == [1.0, 1.0, 1.0], png.name  # physcam's white, not the caller's red
 
 
 def test_the_checker_sees_a_cut_off_title_and_a_label_without_unit():
@@ -66,11 +82,12 @@ def test_the_checker_sees_a_cut_off_title_and_a_label_without_unit():
 
 def test_fit_title_wraps_to_the_width():
     text = "Double Gauss 50mm f/2  f/2.8  focus 3.000 m  CoC 0.02264 mm (d/1500)  ARRI ALEXA 35 4.6K 3:2 Open Gate"
-    fig = new_figure(figsize=(4.0, 3.0))
-    ax = fig.add_subplot(1, 1, 1)
-    ax.set_title(fit_title(text, 3.2))
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
-    fig.tight_layout()
-    assert figure_problems(fig) == []
+    with figure_style():  # the title's size is the style's (fit_title measures in it)
+        fig = new_figure(figsize=(4.0, 3.0))
+        ax = fig.add_subplot(1, 1, 1)
+        ax.set_title(fit_title(text, 3.2))
+        ax.set_xlabel("x (mm)")
+        ax.set_ylabel("y (mm)")
+        fig.tight_layout()
+        assert figure_problems(fig) == []
     assert fit_title(text, 3.2).replace("\n", " ") == text  # only wrapped, never cut

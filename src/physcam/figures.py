@@ -10,20 +10,29 @@ machine) costs 0.1-0.3 s of a command's cold start and nothing here needs it (do
 :func:`pyplot` returns a small stand-in with pyplot's ``subplots``, ``figure`` and ``close``;
 any other attribute loads the real pyplot (Agg backend).
 
-One style for every figure (:data:`STYLE`, applied by :func:`new_figure`): DejaVu Sans at sizes
-that stay legible on a phone and a printed page, the Okabe-Ito colours (:data:`PALETTE`, told apart
-by readers with any common colour-vision deficiency: Okabe & Ito 2008, "Color Universal Design"),
-units in every axis label, and titles that fit (:func:`fit_title`). :func:`figure_problems` lists
-what breaks those rules in a drawn figure (tests/test_figures_style.py runs it on every figure).
+One style for every figure (:data:`STYLE`): DejaVu Sans at sizes that stay legible on a phone and
+a printed page, the Okabe-Ito colours (:data:`PALETTE`, told apart by readers with any common
+colour-vision deficiency: Okabe & Ito 2008, "Color Universal Design"), units in every axis label,
+and titles that fit (:func:`fit_title`). :func:`figure_problems` lists what breaks those rules in a
+drawn figure (tests/test_figures_style.py runs it on every figure).
+
+The style never touches the caller's matplotlib settings: every physcam function that draws runs
+inside :func:`figure_style` (the :func:`styled` decorator), a ``matplotlib.rc_context`` from the
+figure's creation to its save, so ``matplotlib.rcParams`` is the same after a physcam call as before
+it. For your own plots in physcam's style, draw them inside ``with figure_style():``, or call
+:func:`apply_style` to set it globally (physcam itself never calls it).
 """
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import io
+import threading
 from pathlib import Path
 
 __all__ = ["pyplot", "subplots", "new_figure", "save_figure", "figure_bytes", "PALETTE", "STYLE", "apply_style",
-           "fit_title", "figure_problems", "UNITLESS_WORDS"]
+           "figure_style", "styled", "fit_title", "figure_problems", "UNITLESS_WORDS"]
 
 _FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 
@@ -31,7 +40,7 @@ _FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 #: black): distinguishable with protanopia, deuteranopia and tritanopia (Okabe & Ito 2008).
 PALETTE = ("#0072B2", "#D55E00", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#F0E442", "#000000")
 
-#: matplotlib settings of every physcam figure (:func:`apply_style`).
+#: matplotlib settings of every physcam figure (:func:`figure_style`).
 STYLE = {
     "font.family": "sans-serif",
     "font.sans-serif": ["DejaVu Sans"],
@@ -58,14 +67,80 @@ UNITLESS_WORDS = ("MTF", "relative", "ratio", "fraction", "normalised", "normali
                   "f-number", "weight", "transmission")
 
 
-def apply_style() -> None:
-    """Set :data:`STYLE` and the :data:`PALETTE` colour cycle in matplotlib's rcParams (what every
-    physcam figure is drawn with; :func:`new_figure` calls it)."""
-    import matplotlib
+def _style_params() -> dict:
     from cycler import cycler
 
-    matplotlib.rcParams.update(STYLE)
-    matplotlib.rcParams["axes.prop_cycle"] = cycler(color=list(PALETTE))
+    return {**STYLE, "axes.prop_cycle": cycler(color=list(PALETTE))}
+
+
+def apply_style() -> None:
+    """Set :data:`STYLE` and the :data:`PALETTE` colour cycle in matplotlib's global rcParams, for
+    your own plots in physcam's style from now on. physcam itself never calls it (its figures are
+    drawn inside :func:`figure_style`, which leaves rcParams as it found them)."""
+    import matplotlib
+
+    matplotlib.rcParams.update(_style_params())
+
+
+_LOCK = threading.RLock()  # rcParams is one dict for all threads: one styled drawing at a time
+_STATE = threading.local()
+
+
+def _depth() -> int:
+    return getattr(_STATE, "depth", 0)
+
+
+@contextlib.contextmanager
+def figure_style():
+    """A context in which matplotlib draws in physcam's style (:data:`STYLE`, :data:`PALETTE`):
+    ``matplotlib.rc_context`` over the caller's settings, which are restored on leaving it. Nested
+    uses cost nothing; threads take turns (matplotlib's rcParams is global)."""
+    if _depth():
+        _STATE.depth += 1
+        try:
+            yield
+        finally:
+            _STATE.depth -= 1
+        return
+    import matplotlib
+
+    with _LOCK, matplotlib.rc_context(_style_params()):
+        _STATE.depth = 1
+        try:
+            yield
+        finally:
+            _STATE.depth = 0
+
+
+def _settle(fig) -> None:
+    """Fix now, in the style, what matplotlib would otherwise take from the caller's rcParams at their
+    first draw of a returned figure: the first tick of each axis (later ticks copy its font, size and
+    lines: ``Axis.get_major_ticks``) and the tick label size the tick spacing is worked from
+    (``Axis.get_tick_space`` reads ``xtick.labelsize`` when drawing)."""
+    import matplotlib
+
+    for ax in getattr(fig, "axes", ()):
+        for name, axis in getattr(ax, "_axis_map", {}).items():
+            axis.get_major_ticks(1)
+            axis.get_minor_ticks(1)
+            kw = getattr(axis, "_major_tick_kw", None)
+            if isinstance(kw, dict) and "labelsize" not in kw and f"{name}tick.labelsize" in matplotlib.rcParams:
+                kw["labelsize"] = matplotlib.rcParams[f"{name}tick.labelsize"]
+
+
+def styled(func):
+    """Decorator: ``func`` runs inside :func:`figure_style`, so the figures it makes, draws and saves
+    are physcam's while the caller's rcParams stay theirs. A Figure it returns is complete in style."""
+
+    @functools.wraps(func)
+    def in_style(*args, **kwargs):
+        with figure_style():
+            result = func(*args, **kwargs)
+            if hasattr(result, "canvas") and hasattr(result, "axes"):
+                _settle(result)
+            return result
+
+    return in_style
 
 
 def fit_title(text: str, width_in: float, *, fontsize: float | None = None) -> str:
@@ -74,7 +149,6 @@ def fit_title(text: str, width_in: float, *, fontsize: float | None = None) -> s
     from matplotlib.font_manager import FontProperties
     from matplotlib.textpath import text_to_path
 
-    apply_style()
     prop = FontProperties(family=STYLE["font.sans-serif"], size=fontsize or STYLE["axes.titlesize"])
     limit = width_in * 72.0
 
@@ -96,20 +170,26 @@ def fit_title(text: str, width_in: float, *, fontsize: float | None = None) -> s
 
 
 def new_figure(figsize=None, dpi=None, **kwargs):
-    """A ``Figure`` attached to an Agg canvas (no pyplot), in physcam's style (:func:`apply_style`)."""
+    """A ``Figure`` attached to an Agg canvas (no pyplot), with physcam's figure settings (size,
+    white face). Axes and artists take physcam's style when made inside :func:`figure_style`
+    (every physcam function that draws does so); outside it, the caller's rcParams."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    apply_style()
-    fig = Figure(figsize=figsize, dpi=dpi, **kwargs)
+    inside = _depth() > 0
+    with figure_style():
+        fig = Figure(figsize=figsize, dpi=dpi, **kwargs)
     FigureCanvasAgg(fig)
+    fig._physcam_unstyled = not inside  # STRICT_ENV: a physcam figure made outside the style is a bug
     return fig
 
 
 def subplots(nrows: int = 1, ncols: int = 1, *, figsize=None, dpi=None, squeeze: bool = True, **kwargs):
-    """``(fig, axes)`` as ``pyplot.subplots`` gives them, on an Agg canvas."""
+    """``(fig, axes)`` as ``pyplot.subplots`` gives them, on an Agg canvas: figure and axes (spines,
+    grid) in physcam's style; what is drawn on them later, in the style only inside :func:`figure_style`."""
     fig = new_figure(figsize=figsize, dpi=dpi)
-    return fig, fig.subplots(nrows, ncols, squeeze=squeeze, **kwargs)
+    with figure_style():
+        return fig, fig.subplots(nrows, ncols, squeeze=squeeze, **kwargs)
 
 
 class _AggPlot:
@@ -165,6 +245,7 @@ def _skip_layout_rerun(fig) -> None:
         pass
 
 
+@styled
 def save_figure(fig, path, *, force: bool = False, dpi: int = 130) -> Path:
     """Write ``fig`` to ``path`` (.png, .svg or .pdf, from the extension) and close it.
 
@@ -183,6 +264,7 @@ def save_figure(fig, path, *, force: bool = False, dpi: int = 130) -> Path:
     return atomic_write(p, figure_bytes(fig, fmt, dpi=dpi), force=force)
 
 
+@styled
 def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130, description: str | None = None) -> bytes:
     """``fig`` drawn in memory as ``fmt`` ("png", "svg" or "pdf") and closed: what :func:`save_figure`
     writes, for a caller that sends it elsewhere (``physcam serve``). ``description`` (SVG and PDF)
@@ -207,7 +289,8 @@ def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130, description: str | No
 
 
 #: Set to "1" (tests/test_figures_style.py), every figure physcam saves is checked by
-#: :func:`figure_problems` first, and one that breaks the style raises ExportError.
+#: :func:`figure_problems` first, and one that breaks the style, or was made by :func:`new_figure`
+#: outside :func:`figure_style` (a drawing function without :func:`styled`), raises ExportError.
 STRICT_ENV = "PHYSCAM_STRICT_FIGURES"
 
 
@@ -217,6 +300,8 @@ def _check_style(fig) -> None:
     if os.environ.get(STRICT_ENV) != "1":
         return
     problems = figure_problems(fig)
+    if getattr(fig, "_physcam_unstyled", False):
+        problems.append("it was made outside physcam.figures.figure_style (a drawing function without @styled)")
     if problems:
         from .errors import ExportError
 
@@ -231,8 +316,9 @@ def _has_unit(label: str) -> bool:
     return bool(re.search(r"\([^)]*\S[^)]*\)", label)) or any(w.lower() in label.lower() for w in UNITLESS_WORDS)
 
 
+@styled
 def figure_problems(fig) -> list[str]:
-    """What breaks the figure style in ``fig``, drawn: text (titles, labels, ticks, legends) reaching
+    """What breaks the figure style in ``fig``, drawn (in the style, as physcam saves it): text (titles, labels, ticks, legends) reaching
     outside the figure, and axes with ticks but no label or a label without a unit. Empty when none."""
     import re
 

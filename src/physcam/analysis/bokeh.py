@@ -24,6 +24,7 @@ import numpy as np
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription
 from ..optics.state import takes_camera
+from ..figures import styled
 
 __all__ = ["BokehImage", "bokeh_image", "RGB_WAVELENGTHS_NM", "tone_map", "scale_bar_pixels", "write_bokeh_photo"]
 
@@ -55,6 +56,7 @@ class BokehImage:
                 "pixels": list(self.image.shape[:2]), "rays_traced": self.rays_traced,
                 "rays_passed": self.rays_passed, "film_z_mm": self.film_z_mm, "centroid_mm": [cx, cy]}
 
+    @styled
     def plot(self, path=None, *, force: bool = False):
         """The film-millimetre plot: the image (peak white) on film x and y axes."""
         from ..figures import fit_title, pyplot

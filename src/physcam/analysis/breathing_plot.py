@@ -13,12 +13,14 @@ import math
 from pathlib import Path
 
 from ..errors import InputError, WrongTypeError
+from ..figures import styled
 
 __all__ = ["PLOT_FORMATS", "breathing_figure", "draw_breathing", "save_breathing_plot"]
 
 PLOT_FORMATS = ("png", "svg", "pdf")
 
 
+@styled
 def breathing_figure(rows, *, title: str = "focus breathing", sensor_width_mm: float | None = None,
                      units: str = "m"):
     """A matplotlib Figure (Agg canvas) of HFOV (left axis) and EFL (right axis) against 1/mark;
@@ -86,6 +88,7 @@ def _thin_ticks(ax, gap: float = 0.06) -> None:
             last = x
 
 
+@styled
 def save_breathing_plot(rows, path, *, force: bool = False, **kwargs) -> Path:
     """Write the breathing plot to ``path`` (.png, .svg, .pdf) through atomic_write."""
     from ..figures import save_figure

@@ -20,6 +20,7 @@ import numpy as np
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import OpticsError, require_positive
 from ..lens.prescription import Prescription, takes_prescription
+from ..figures import styled
 
 __all__ = ["RealBreathingRow", "RealBreathing", "real_breathing"]
 
@@ -55,6 +56,7 @@ class RealBreathing:
                 "conventions": "focus marks in mm in front of the film plane (null = infinity); "
                                "changes relative to the first row"}
 
+    @styled
     def plot(self, path=None, *, force: bool = False, units: str = "m"):
         """HFOV change against the focus mark (log axis, a tick at each mark in ``units``: m, or ft for
         feet and inches; infinity at the right); PNG/SVG/PDF if ``path``, else the Figure."""

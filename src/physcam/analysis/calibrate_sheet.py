@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from ..figures import new_figure, save_figure
+from ..figures import new_figure, save_figure, styled
 
 __all__ = ["calibration_sheet"]
 
@@ -57,6 +57,7 @@ def _text(m, cal) -> str:
     return "\n".join(lines)
 
 
+@styled
 def calibration_sheet(calibration, path=None, *, force: bool = False):
     """The sheet of ``calibration`` (a :class:`~physcam.analysis.calibrate.Calibration`); written to
     ``path`` (.png, .svg, .pdf) through :func:`physcam.figures.save_figure`, else returned."""

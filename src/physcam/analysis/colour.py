@@ -35,6 +35,7 @@ import numpy as np
 
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
+from ..figures import styled
 from ..lens.prescription import Prescription
 from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM, PGF_UNCERTAINTY
 from ..optics.state import takes_camera
@@ -95,6 +96,7 @@ class ColourResult:
             "notes": list(self.notes),
         }
 
+    @styled
     def plot(self, path=None, *, force: bool = False):
         from ._plot import figure, save
 

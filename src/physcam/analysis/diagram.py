@@ -24,6 +24,7 @@ from ..lens.geometry import sag
 from ..lens.prescription import Prescription, takes_prescription
 from ..optics import focusing, paraxial
 from ..optics.state import CameraState, takes_camera
+from ..figures import styled
 
 __all__ = ["DIAGRAM_FORMATS", "trace_meridional_ray", "LensDiagram", "lens_diagram", "save_lens_diagram"]
 
@@ -76,6 +77,7 @@ class LensDiagram:
     focus_from_film_mm: float = math.inf
     fstop: float | None = None
 
+    @styled
     def figure(self, *, width_in: float = 10.0, units: str = "m"):
         """A matplotlib Figure (Agg canvas). The view spans the lens and film; an object closer than
         infinity is marked by where its rays enter the view (its distance is in the title, in
@@ -238,6 +240,7 @@ def lens_diagram(prescription: CameraState | Prescription, *, axis: str = "y", f
 
 
 @takes_camera
+@styled
 def save_lens_diagram(prescription: CameraState | Prescription, path, *, force: bool = False, **kwargs) -> Path:
     """Draw the diagram to ``path`` (.png, .svg or .pdf) through atomic_write; kwargs as :func:`lens_diagram`,
     and ``units`` (m or ft) for the focus in the title."""

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
+from ..figures import styled
 from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["DistortionPoint", "StandardDistortion", "DistortionResult", "real_distortion", "fit_standard_distortion"]
@@ -136,6 +137,7 @@ class DistortionResult:
             "usd": None if self.fit is None else self.fit.usd_attributes(), "notes": list(self.notes),
         }
 
+    @styled
     def plot(self, path=None, *, force: bool = False):
         """Percent distortion against field angle per meridian, with the fitted model; PNG if ``path``."""
         from ._plot import figure, save

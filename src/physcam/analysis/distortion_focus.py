@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..figures import PALETTE, styled
 from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["DistortionAcrossFocus", "distortion_across_focus", "MAX_FOCUS_ROWS"]
@@ -36,6 +37,7 @@ class DistortionAcrossFocus:
                 "corner_distortion_definition": "100 (r_real - r_ideal) / r_ideal at the frame corner; negative = barrel",
                 "rows": [dict(r) for r in self.rows], "notes": list(self.notes)}
 
+    @styled
     def plot(self, path=None, *, force: bool = False, units: str = "m"):
         """Corner distortion and pinhole focal length against focus, a tick at each mark in ``units``
         (m, or ft for feet and inches); PNG/SVG if ``path``, else the Figure."""
@@ -53,8 +55,8 @@ class DistortionAcrossFocus:
         ax.set_xlabel(f"focus from the film plane ({unit_words(units)})")
         ax.set_ylabel("corner distortion (%)")
         ax2 = ax.twinx()
-        ax2.plot(x, [r["pinhole_focal_length_mm"] for r in finite], "s--", color="C1", ms=3)
-        ax2.set_ylabel("pinhole focal length (mm)", color="C1")
+        ax2.plot(x, [r["pinhole_focal_length_mm"] for r in finite], "s--", color=PALETTE[1], ms=3)
+        ax2.set_ylabel("pinhole focal length (mm)", color=PALETTE[1])
         ax.legend(fontsize=7, loc="center right")
         ax.set_title(f"{self.lens_name}: distortion across focus on {self.sensor_mm[0]:g} x {self.sensor_mm[1]:g} mm",
                      fontsize=8)

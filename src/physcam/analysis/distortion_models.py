@@ -62,6 +62,7 @@ __all__ = [
 ]
 
 from .distortion_names import DEFAULT_MAX_RESIDUAL_PX, MODEL_CHOICES  # noqa: E402  (re-exported)
+from ..figures import styled
 
 
 @dataclass(frozen=True)
@@ -183,6 +184,7 @@ class FittedDistortion:
             "notes": list(self.notes),
         }
 
+    @styled
     def plot_residual(self, path=None, *, force: bool = False, units: str = "m"):
         """Residual (pixels) over the frame at every traced ray, with its RMS and max; the focus in the
         title in ``units`` (m, or ft for feet and inches); PNG/SVG if ``path``."""

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
+from ..figures import styled
 from ..lens.prescription import Prescription, takes_prescription
 from ..optics.state import takes_camera
 
@@ -82,6 +83,7 @@ class GhostResult:
                           "rays_per_path": self.image_rays, "peak": float(self.image.max())}
         return d
 
+    @styled
     def plot(self, path=None, *, force: bool = False):
         """The ghost image on the sensor (log scale), direct image marked; PNG if ``path``."""
         from ._plot import figure, save

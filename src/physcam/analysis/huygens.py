@@ -52,6 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite
+from ..figures import styled
 from ..lens.prescription import Prescription
 from ..optics.state import takes_camera
 
@@ -112,6 +113,7 @@ class HuygensPSF:
                 "definition": "Huygens PSF: wavelets from the real rays on the exit-pupil reference sphere, energy "
                               "conserved; image in fractions of the field's power per pixel, rows along film y"}
 
+    @styled
     def plot(self, path=None, *, force: bool = False):
         from matplotlib.colors import LogNorm
 

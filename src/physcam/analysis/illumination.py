@@ -36,6 +36,7 @@ from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription
 from ..optics.state import takes_camera
+from ..figures import styled
 
 __all__ = ["IlluminationPoint", "IlluminationResult", "relative_illumination"]
 
@@ -71,6 +72,7 @@ class IlluminationResult:
                 "definition": "irradiance on the film relative to the centre, object of uniform radiance at infinity",
                 "notes": list(self.notes)}
 
+    @styled
     def plot(self, path=None, *, force: bool = False):
         from ._plot import figure, save
 

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 from ..errors import InputError, OpticsError
 from ..lens.prescription import Prescription, takes_prescription
+from ..figures import PALETTE, styled
 
 __all__ = ["PAGES", "PANELS", "LensCard", "lens_card", "save_lens_card"]
 
@@ -65,6 +66,7 @@ class LensCard:
                 "bokeh": [{"label": lab, "image_height_mm": h, **b.to_dict()} for lab, h, b in self.bokeh],
                 "notes": list(self.notes)}
 
+    @styled
     def figure(self, *, units: str = "m", dpi: int | None = None):
         """The page as a matplotlib Figure (Agg canvas), one axes per :data:`PANELS` entry."""
         from ..figures import new_figure
@@ -288,8 +290,8 @@ def _draw_mtf(ax, chart, label, note):
         return
     for k, f in enumerate(chart.frequencies_lpmm):
         lw = 2.0 - 1.2 * k / max(1, len(chart.frequencies_lpmm) - 1)
-        ax.plot(chart.image_heights_mm, chart.sagittal[:, k], color=f"C{k}", lw=lw, label=f"{f:g} lp/mm S")
-        ax.plot(chart.image_heights_mm, chart.tangential[:, k], color=f"C{k}", lw=lw, ls="--", label=f"{f:g} T")
+        ax.plot(chart.image_heights_mm, chart.sagittal[:, k], color=PALETTE[k % len(PALETTE)], lw=lw, label=f"{f:g} lp/mm S")
+        ax.plot(chart.image_heights_mm, chart.tangential[:, k], color=PALETTE[k % len(PALETTE)], lw=lw, ls="--", label=f"{f:g} T")
     ax.set_xlim(0, float(chart.image_heights_mm.max()))
     ax.set_ylim(0, 1.0)
     ax.grid(True)
@@ -307,7 +309,7 @@ def _draw_distortion(ax, res):
     for axis, style in (("y", "-"), ("x", "--")):
         pts = res.meridian(axis)
         if pts:
-            ax.plot([abs(p.real_height_mm) for p in pts], [p.distortion_pct for p in pts], style, color="C0",
+            ax.plot([abs(p.real_height_mm) for p in pts], [p.distortion_pct for p in pts], style, color=PALETTE[0],
                     label=f"{axis.upper()} meridian")
     ax.axhline(0.0, color="0.6", lw=0.6)
     ax.grid(True)
@@ -324,7 +326,7 @@ def _draw_illumination(ax, res):
         return
     pts = [p for p in res.points if p.axis == "y"]
     hs = [abs(p.film_height_mm) for p in pts]
-    ax.plot(hs, [p.relative_illumination for p in pts], "-", color="C0", label="relative illumination")
+    ax.plot(hs, [p.relative_illumination for p in pts], "-", color=PALETTE[0], label="relative illumination")
     ax.plot(hs, [p.cos4 for p in pts], ":", color="0.4", label="cos⁴ of the field angle")
     ax.set_ylim(0, 1.05)
     ax.grid(True)
@@ -361,6 +363,7 @@ def _draw_bokeh(ax, img, label, height_mm):
 
 
 # ---- writing --------------------------------------------------------------------------------------
+@styled
 def save_lens_card(card: LensCard, path, *, force: bool = False, units: str = "m", dpi: int = 150):
     """Write ``card`` as one page to ``path`` (.pdf, .png or .svg) through :func:`physcam.figures.save_figure`."""
     from ..errors import require_type

@@ -51,6 +51,7 @@ import numpy as np
 from ..errors import InputError, OpticsError, require_finite, require_positive, require_type
 from ..trace.microlens import PlenopticCamera, subimage_centres, trace_from_sensor, trace_to_sensor
 from ..trace.rays import OK, RayBatch
+from ..figures import styled
 
 __all__ = ["LightField", "render_point", "render_plane", "render_planes", "subaperture_views", "refocus", "view_disparity",
            "view_mask", "checkerboard", "light_field_figure"]
@@ -383,6 +384,7 @@ def view_disparity(camera, distance_mm: float) -> float:
     return -(D / (cam.pixels_per_lenslet * cam.array.sensor_offset_mm)) * (1.0 - D / Dp)
 
 
+@styled
 def light_field_figure(field_, *, views_shown: int = 3, refocus_slopes=(), path=None, force: bool = False):
     """A figure of the raw light field (and a zoom on its centre), a row of sub-aperture views and
     optional refocused images (``refocus_slopes``: (label, slope) pairs). All images are rotated

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..data.default_sensor import DEFAULT_SENSOR_HALF_DIAGONAL_MM
 from ..errors import InputError, OpticsError, require_finite
+from ..figures import PALETTE, styled
 from ..lens.prescription import Prescription
 from ..optics.state import takes_camera
 from ._sampling import MAX_FREQUENCIES, spatial_frequencies
@@ -123,6 +124,7 @@ class MTFCurve:
                 "definition": "tangential: frequency along y (the field's meridian), sagittal: along x; "
                               "frequencies in lp/mm on the film"}
 
+    @styled
     def plot(self, path=None, *, force: bool = False):
         from ._plot import figure, save
 
@@ -130,8 +132,8 @@ class MTFCurve:
         f = self.frequencies_lpmm
         if self.diffraction_limit_tangential is not None:
             ax.plot(f, self.diffraction_limit_tangential, color="0.6", lw=0.8, label="diffraction limit (T)")
-        ax.plot(f, self.tangential, color="C0", ls="--", label="tangential")
-        ax.plot(f, self.sagittal, color="C0", ls="-", label="sagittal")
+        ax.plot(f, self.tangential, color=PALETTE[0], ls="--", label="tangential")
+        ax.plot(f, self.sagittal, color=PALETTE[0], ls="-", label="sagittal")
         ax.set_ylim(0, 1.02)
         ax.set_xlim(0, float(f.max()) if f.size else 1.0)
         ax.set_xlabel("spatial frequency (lp/mm)")
@@ -292,13 +294,14 @@ class ThroughFocusMTF:
                 "best_focus_mm": {str(k): v for k, v in self.best_focus_mm().items()},
                 "definition": "defocus: the film moved away from the lens (+) from the focus plane, mm"}
 
+    @styled
     def plot(self, path=None, *, force: bool = False):
         from ._plot import figure, save
 
         fig, ax = figure(5.4, 3.8)
         for k, f in enumerate(self.frequencies_lpmm):
-            ax.plot(self.defocus_mm * 1e3, self.tangential[k], color=f"C{k}", ls="--", label=f"{f:g} lp/mm T")
-            ax.plot(self.defocus_mm * 1e3, self.sagittal[k], color=f"C{k}", ls="-", label=f"{f:g} lp/mm S")
+            ax.plot(self.defocus_mm * 1e3, self.tangential[k], color=PALETTE[k % len(PALETTE)], ls="--", label=f"{f:g} lp/mm T")
+            ax.plot(self.defocus_mm * 1e3, self.sagittal[k], color=PALETTE[k % len(PALETTE)], ls="-", label=f"{f:g} lp/mm S")
         ax.set_ylim(0, 1.02)
         ax.set_xlabel("film shift from focus (µm, + away from the lens)")
         ax.set_ylabel("MTF")
@@ -453,6 +456,7 @@ class MTFChart:
         out.append(f"      {keys} (upper case sagittal, lower case tangential)")
         return "\n".join(out)
 
+    @styled
     def plot(self, path=None, *, force: bool = False, units: str = "m"):
         """The vendor chart: solid sagittal, dashed tangential, thicker lines for lower frequencies; the
         focus in the title in ``units`` (m, or ft for feet and inches; image heights stay in mm)."""
@@ -465,8 +469,8 @@ class MTFChart:
         nf = len(self.frequencies_lpmm)
         for k, f in enumerate(self.frequencies_lpmm):
             lw = 2.2 - 1.4 * k / max(1, nf - 1)
-            ax.plot(self.image_heights_mm, self.sagittal[:, k], color=f"C{k}", lw=lw, ls="-", label=f"{f:g} lp/mm S")
-            ax.plot(self.image_heights_mm, self.tangential[:, k], color=f"C{k}", lw=lw, ls="--",
+            ax.plot(self.image_heights_mm, self.sagittal[:, k], color=PALETTE[k % len(PALETTE)], lw=lw, ls="-", label=f"{f:g} lp/mm S")
+            ax.plot(self.image_heights_mm, self.tangential[:, k], color=PALETTE[k % len(PALETTE)], lw=lw, ls="--",
                     label=f"{f:g} lp/mm T")
         ax.set_xlim(0, float(self.image_heights_mm.max()))
         ax.set_ylim(0, 1.0)

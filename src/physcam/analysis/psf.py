@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, require_finite
+from ..figures import styled
 from ..lens.prescription import Prescription
 from ..optics.state import takes_camera
 
@@ -103,6 +104,7 @@ class PointSpreadFunction:
                 "definition": "Strehl = PSF peak / peak of the same pupil without OPD (vignetting and aperture "
                               "shape kept); PSF by FFT of the pupil function"}
 
+    @styled
     def plot(self, path=None, *, force: bool = False, radius_airy: float = 6.0):
         """Draw the PSF (log scale) within ``radius_airy`` Airy radii of the chief ray's point."""
         from matplotlib.colors import LogNorm

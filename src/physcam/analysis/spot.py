@@ -33,6 +33,7 @@ import numpy as np
 from ..errors import InputError, require_finite
 from ..lens.prescription import Prescription
 from ..optics.state import takes_camera
+from ..figures import styled
 
 __all__ = ["equal_area_disk", "SpotField", "SpotDiagram", "spot_diagram", "MAX_RINGS", "MAX_REFINE"]
 
@@ -104,6 +105,7 @@ class SpotDiagram:
                               "(no ray reaches the film)",
                 "fields": [f.to_dict() for f in self.fields]}
 
+    @styled
     def plot(self, path=None, *, force: bool = False):
         """Draw one panel per field (positions relative to the centroid, um); write it to ``path`` (PNG/SVG/PDF) and return the path, else return the figure."""
         from ..figures import fit_title, pyplot

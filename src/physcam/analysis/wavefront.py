@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, require_finite
+from ..figures import styled
 from ..lens.prescription import Prescription
 from ..optics.state import takes_camera
 
@@ -130,6 +131,7 @@ class WavefrontMap:
                           "area-weighted over the lit pupil; PV max - min",
         }
 
+    @styled
     def plot(self, path=None, *, force: bool = False):
         """Draw the OPD map (waves) over the normalised pupil; write it to ``path`` or return the figure."""
         from ._plot import figure, save

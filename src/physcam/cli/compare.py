@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import math
 
+from ..figures import styled
 from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number, whole
 
 EPILOG = """\
@@ -143,6 +144,7 @@ def run_blender(args) -> int:
     return 0
 
 
+@styled
 def _figure(res, path=None, *, force=False, units="m"):
     """physcam's and Cycles' bokeh side by side; the light and focus distances in the title in ``units``
     (m, or ft for feet and inches; film coordinates stay in mm). Saved to ``path``, or the Figure."""
@@ -298,6 +300,7 @@ def run_lenses(args) -> int:
     return 0
 
 
+@styled
 def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False):
     """One figure: breathing, distortion and illumination curves of every lens, and their bokeh; the focus
     and light distances in the title and the breathing axis (1 / mark) in ``units`` (m, or ft for feet

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 
+from ..figures import styled
 from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus_list, list_items, number
 
 EPILOG = """\
@@ -240,6 +241,7 @@ def _card_chart(args):
     return report, data
 
 
+@styled
 def card(d, path, *, units: str = "m", force: bool = False, chart=None):
     """A printable depth-of-field card (A5 landscape): focus marks down, f-stops across, near / far /
     total in each cell, hyperfocal at the foot; with ``chart`` (a report and its

@@ -13,10 +13,13 @@ from __future__ import annotations
 
 import math
 
+from ..figures import styled
+
 #: Millimetres per axis unit, and the axis label, per unit system (``--units``).
 _AXIS = {"m": (1000.0, "m"), "ft": (304.8, "ft")}
 
 
+@styled
 def plot_dof_zone(report, path, *, force: bool = False, units: str = "m"):
     """Draw near, focus, far and hyperfocal on a distance axis (from the film plane); PNG, SVG or PDF.
 
@@ -40,6 +43,7 @@ def plot_title(report, units: str = "m") -> str:
             f"{report.sensor.name}")
 
 
+@styled
 def dof_zone_figure(report, *, size_in=(9.0, 2.6), units: str = "m"):
     """The figure :func:`plot_dof_zone` saves, as a matplotlib Figure on its own Agg canvas (no pyplot
     state, so a server can draw it in memory with :func:`physcam.figures.figure_bytes`); ``size_in``
@@ -173,6 +177,7 @@ def _round_ticks(ax, lo_mm: float, hi_mm: float, units: str, which: str, most: i
     axis.set_minor_locator(NullLocator())
 
 
+@styled
 def dof_chart_figure(report, solve, *, fstops=None, size_in=(7.0, 4.6), units: str = "m", data=None):
     """The chart of the set's apps (module notes) for ``report``: near and far limits against the focus
     mark, a band per stop (``fstops``, default :func:`chart_fstops`), each hyperfocal marked, the
@@ -194,6 +199,7 @@ def dof_chart_figure(report, solve, *, fstops=None, size_in=(7.0, 4.6), units: s
     return fig
 
 
+@styled
 def draw_dof_chart(ax, report, data, *, units: str = "m") -> None:
     """Draw the chart (:func:`dof_chart_figure`) of :func:`dof_chart_data` ``data`` into ``ax``: a band per
     stop, each hyperfocal, the report's focus and limits; log axes with ticks a person reads."""
@@ -258,6 +264,7 @@ def _chart_numbers(ax, data, units: str) -> dict:
                        "rows": [[mm(a), mm(b), mm(c)] for a, b, c in data["curves"][n]]} for n in data["fstops"]]}
 
 
+@styled
 def plot_dof_chart(report, solve, path, *, force: bool = False, units: str = "m", fstops=None):
     """Write :func:`dof_chart_figure` to ``path`` (.png, .svg or .pdf) through :func:`physcam.figures.save_figure`."""
     from ..figures import save_figure
