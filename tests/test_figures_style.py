@@ -66,6 +66,22 @@ def test_every_figure_keeps_the_style(argv, tmp_path, monkeypatch, capsys):
         assert imread(png)[0, 0, :3].tolist() == [1.0, 1.0, 1.0], png.name  # physcam's white, not the caller's red
 
 
+def test_the_light_field_figure_keeps_the_style(tmp_path, monkeypatch, capsys):
+    """``microlens render``'s figure of images (its axes shown off): the checker counted the hidden
+    tick labels of those axes as text outside the figure, so the figure failed the strict run."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["microlens", "insert", *L, "--microlens-focal", "0.224", "--xdim", "77", "--ydim", "77",
+                 "--film-width", "3.08", "--film-height", "3.08", "--focus", "0.8m", "-o", "lf.json"]) == 0
+    monkeypatch.setenv(STRICT_ENV, "1")
+    with matplotlib.rc_context(SENTINEL):
+        before = dict(matplotlib.rcParams)
+        rc = main(["microlens", "render", "--lens", "lf.json", "--fstop", "5.6", "--point", "0.5m", "--point", "5m",
+                   "-o", "lf.png"])
+        assert changed_keys(before, dict(matplotlib.rcParams)) == []
+    assert rc == 0, capsys.readouterr().err
+    assert imread(tmp_path / "lf.png")[0, 0, :3].tolist() == [1.0, 1.0, 1.0]
+
+
 def test_the_checker_sees_a_cut_off_title_and_a_label_without_unit():
     fig = new_figure(figsize=(3.0, 2.0))
     ax = fig.add_subplot(1, 1, 1)

@@ -318,8 +318,9 @@ def _has_unit(label: str) -> bool:
 
 @styled
 def figure_problems(fig) -> list[str]:
-    """What breaks the figure style in ``fig``, drawn (in the style, as physcam saves it): text (titles, labels, ticks, legends) reaching
-    outside the figure, and axes with ticks but no label or a label without a unit. Empty when none."""
+    """What breaks the figure style in ``fig``, drawn (in the style, as physcam saves it): text
+    (titles, labels, ticks, legends) reaching outside the figure, and axes with ticks but no label or
+    a label without a unit. Empty when none."""
     import re
 
     from matplotlib.figure import Figure
@@ -335,6 +336,9 @@ def figure_problems(fig) -> list[str]:
     hidden = set()  # tick labels of ticks outside the view: matplotlib keeps them but does not draw them
     for ax in fig.axes:
         for axis in (ax.xaxis, ax.yaxis):
+            if not ax.get_visible() or not ax.axison:  # an axes shown off (an image) draws no axis text
+                hidden.update(id(t) for t in axis.get_ticklabels(which="both") + [axis.label])
+                continue
             lo, hi = sorted(axis.get_view_interval())
             for tick in axis.get_major_ticks() + axis.get_minor_ticks():
                 if not lo - 1e-9 * abs(hi - lo) <= tick.get_loc() <= hi + 1e-9 * abs(hi - lo):
