@@ -22,10 +22,13 @@ from matplotlib.image import imread
 
 from physcam.figures import PALETTE, STYLE, figure_bytes, figure_style, styled
 
-#: Caller settings that physcam's style overrides, each distinct from STYLE and from matplotlib's default.
+#: Caller settings, each distinct from STYLE and from matplotlib's default: none reaches physcam's figures.
 SENTINEL = {
     "font.size": 13.0,
     "font.family": "serif",
+    "font.sans-serif": ["DejaVu Sans Mono"],  # resolved when a figure is drawn, not when it is made
+    "figure.dpi": 200.0,  # not in STYLE: physcam draws from matplotlib's defaults plus STYLE
+    "axes.unicode_minus": False,
     "axes.titlesize": 15.0,
     "axes.labelsize": 14.0,
     "xtick.labelsize": 12.0,
@@ -40,6 +43,12 @@ SENTINEL = {
     "figure.facecolor": "red",
     "savefig.facecolor": "red",
 }
+
+
+#: SENTINEL's settings that matplotlib reads only when a figure is drawn (the tick formatter's minus
+#: sign): a figure physcam returns and the caller saves themselves takes them from the caller, so the
+#: comparison of such a save sets them back to matplotlib's defaults.
+READ_WHEN_DRAWN = {"axes.unicode_minus": True}
 
 
 def changed_keys(before: dict, after: dict) -> list[str]:
@@ -134,7 +143,8 @@ def test_a_figure_leaves_the_callers_rcparams_and_keeps_its_style(make, dgauss):
         before = dict(matplotlib.rcParams)
         fig = make(dgauss)
         assert changed_keys(before, dict(matplotlib.rcParams)) == []
-        theirs = caller_png(fig)  # drawn for the first time here, under the caller's settings
+        with matplotlib.rc_context(READ_WHEN_DRAWN):  # the caller's own draw reads these: theirs by right
+            theirs = caller_png(fig)  # drawn for the first time here, under the caller's settings
         ours = figure_bytes(fig, "png", dpi=60)
         assert changed_keys(before, dict(matplotlib.rcParams)) == []
     with matplotlib.rc_context():

@@ -19,8 +19,9 @@ drawn figure (tests/test_figures_style.py runs it on every figure).
 The style never touches the caller's matplotlib settings: every physcam function that draws runs
 inside :func:`figure_style` (the :func:`styled` decorator), a ``matplotlib.rc_context`` from the
 figure's creation to its save, so ``matplotlib.rcParams`` is the same after a physcam call as before
-it. For your own plots in physcam's style, draw them inside ``with figure_style():``, or call
-:func:`apply_style` to set it globally (physcam itself never calls it).
+it, and the caller's settings do not reach physcam's figures either (drawn from matplotlib's
+defaults plus the style). For your own plots in physcam's style, draw them inside ``with
+figure_style():``, or call :func:`apply_style` to set it globally (physcam itself never calls it).
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ PALETTE = ("#0072B2", "#D55E00", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#F
 
 #: matplotlib settings of every physcam figure (:func:`figure_style`).
 STYLE = {
-    "font.family": "sans-serif",
+    "font.family": ["DejaVu Sans"],  # the font itself: "sans-serif" would be resolved when drawn
     "font.sans-serif": ["DejaVu Sans"],
     "font.size": 8.5,
     "axes.titlesize": 9.0,
@@ -92,24 +93,26 @@ def _depth() -> int:
 
 @contextlib.contextmanager
 def figure_style():
-    """A context in which matplotlib draws in physcam's style (:data:`STYLE`, :data:`PALETTE`):
-    ``matplotlib.rc_context`` over the caller's settings, which are restored on leaving it. Nested
-    uses cost nothing; threads take turns (matplotlib's rcParams is global)."""
-    if _depth():
-        _STATE.depth += 1
-        try:
+    """A context in which matplotlib draws physcam's figures: matplotlib's own defaults plus
+    :data:`STYLE` and :data:`PALETTE`, whatever the caller's settings (a ``matplotlib.rc_context``;
+    the caller's rcParams come back on leaving it). To change a setting for physcam's figures, set
+    it inside this context. Nested uses cost nothing. rcParams is one dict for the whole process, so
+    threads take turns: while one draws in this context, another thread's plots see physcam's
+    settings, and code inside it must not wait for another thread that draws (it would wait for ever)."""
+    depth = _depth()
+    _STATE.depth = depth + 1
+    try:
+        if depth:
             yield
-        finally:
-            _STATE.depth -= 1
-        return
-    import matplotlib
+            return
+        import matplotlib
 
-    with _LOCK, matplotlib.rc_context(_style_params()):
-        _STATE.depth = 1
-        try:
+        with _LOCK, matplotlib.rc_context():
+            matplotlib.rcdefaults()  # (keeps the backend and the other settings styles never touch)
+            matplotlib.rcParams.update(_style_params())
             yield
-        finally:
-            _STATE.depth = 0
+    finally:
+        _STATE.depth = max(0, _depth() - 1)
 
 
 def _settle(fig) -> None:
@@ -130,7 +133,9 @@ def _settle(fig) -> None:
 
 def styled(func):
     """Decorator: ``func`` runs inside :func:`figure_style`, so the figures it makes, draws and saves
-    are physcam's while the caller's rcParams stay theirs. A Figure it returns is complete in style."""
+    are physcam's while the caller's rcParams stay theirs. A Figure it returns is complete in style,
+    but for what matplotlib reads only when drawing (``axes.unicode_minus``, ``text.hinting``): a
+    caller who draws it under other settings draws those their way."""
 
     @functools.wraps(func)
     def in_style(*args, **kwargs):

@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from physcam.cli import main
+from physcam.figures import figure_style
 from physcam.lens.library import load_lens
 
 MM_PER_INCH = Fraction(254, 10)
@@ -200,7 +201,7 @@ PLOTS = [  # argv (-o FILE.svg added), what the figure must say in feet
 
 def _run_plot(tmp_path, argv, extra=()):
     out = tmp_path / f"{argv[0]}-{len(list(tmp_path.iterdir()))}.svg"
-    with matplotlib.rc_context({"svg.fonttype": "none"}):
+    with figure_style(), matplotlib.rc_context({"svg.fonttype": "none"}):  # text kept as text
         assert main([*argv, "-o", str(out), *extra]) == 0
     return _svg_text(out)
 
@@ -218,7 +219,7 @@ def test_units_ft_reaches_every_plot(tmp_path, capsys, argv, says):
 @pytest.mark.slow
 def test_report_plot_in_feet(tmp_path, capsys):
     out = tmp_path / "dof.svg"
-    with matplotlib.rc_context({"svg.fonttype": "none"}):
+    with figure_style(), matplotlib.rc_context({"svg.fonttype": "none"}):  # text kept as text
         assert main(["report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--units", "ft",
                      "--plot", str(out)]) == 0
     assert f"focus {feet_inches(3000.0)}" in _svg_text(out)

@@ -11,6 +11,8 @@ import os
 import signal
 import subprocess
 import sys
+import tempfile
+import time
 
 import pytest
 
@@ -64,21 +66,31 @@ def _refresh(shot):
     return [sys.executable, "-m", "physcam", "usd", "refresh", str(shot)]
 
 
-def _kill_while_writing(shot):
+def _kill_while_writing(shot, timeout_s=120.0):
     """Run a refresh of ``shot`` until it stops before renaming its temporary, SIGKILL it there, and
     return the litter."""
-    proc = subprocess.Popen([sys.executable, "-c", _STOP_BEFORE_RENAME, "usd", "refresh", str(shot)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status = os.waitpid(proc.pid, os.WUNTRACED)  # returns once the child has stopped (or ended)
-    if not os.WIFSTOPPED(status):
-        proc.returncode = status  # reaped by waitpid
-        pytest.fail(f"the refresh ended (status {status}) without renaming a temporary: "
-                    f"{proc.stderr.read().decode()[-500:]}")
-    litter = _temporaries(shot.parent)
-    proc.kill()
-    assert proc.wait(timeout=60) == -signal.SIGKILL
-    proc.stderr.close()
-    return litter
+    with tempfile.TemporaryFile() as err:  # its stderr: not a pipe, which could fill and block it
+        proc = subprocess.Popen([sys.executable, "-c", _STOP_BEFORE_RENAME, "usd", "refresh", str(shot)],
+                                stdout=subprocess.DEVNULL, stderr=err)
+        try:
+            deadline = time.monotonic() + timeout_s
+            while True:  # until the child stops itself (or ends, or the deadline passes)
+                pid, status = os.waitpid(proc.pid, os.WUNTRACED | os.WNOHANG)
+                if pid:
+                    break
+                if time.monotonic() > deadline:
+                    pytest.fail(f"the refresh neither stopped nor ended in {timeout_s} s")
+                time.sleep(0.01)
+            if not os.WIFSTOPPED(status):
+                proc.returncode = status  # reaped by waitpid
+                err.seek(0)
+                pytest.fail(f"the refresh ended (status {status}) without renaming a temporary: "
+                            f"{err.read().decode()[-500:]}")
+            return _temporaries(shot.parent)
+        finally:
+            if proc.returncode is None:  # stopped, or still running: killed and reaped here, whatever happened
+                proc.kill()
+                assert proc.wait(timeout=60) == -signal.SIGKILL
 
 
 @pytest.mark.parametrize("suffix", [".usda", ".usdc"])

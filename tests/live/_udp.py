@@ -6,6 +6,13 @@ from __future__ import annotations
 import socket
 import time
 from collections import deque
+from pathlib import Path
+
+import pytest
+
+#: The tests that watch a recorder's socket read /proc/net/udp (Linux).
+needs_proc_net_udp = pytest.mark.skipif(not Path("/proc/net/udp").exists(),
+                                        reason="watches the recorder's UDP socket in /proc/net/udp (Linux only)")
 
 
 def free_port() -> int:
@@ -27,18 +34,20 @@ def wait_for_port(proc, port: int, timeout: float = 60.0) -> None:
         time.sleep(0.1)
 
 
-def wait_until_read(port: int, timeout: float = 60.0) -> None:
-    """Until no datagram waits in the socket on UDP ``port`` (its rx_queue in /proc/net/udp is 0):
-    the receiving process has read everything sent (loopback delivers during the send)."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
+def wait_until_read(proc, port: int, timeout: float = 60.0) -> None:
+    """Until no datagram waits in the socket on UDP ``port`` (its rx_queue in /proc/net/udp), three
+    reads 50 ms apart: the receiving process ``proc`` has read everything sent. Raises if it exits."""
+    deadline, empty = time.monotonic() + timeout, 0
+    while empty < 3:
+        if proc.poll() is not None:
+            raise RuntimeError(f"the recorder exited ({proc.returncode}) before reading what was sent")
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"datagrams still wait on UDP port {port} after {timeout} s")
         with open("/proc/net/udp") as f:  # local_address is ADDR:PORT, then rem_address, st, tx_queue:rx_queue
             rows = [line.split() for line in f.readlines()[1:]]
         queues = [int(r[4].split(":")[1], 16) for r in rows if r[1].endswith(f":{port:04X}")]
-        if queues and not any(queues):
-            return
+        empty = empty + 1 if queues and not any(queues) else 0
         time.sleep(0.05)
-    raise TimeoutError(f"datagrams still wait on UDP port {port} after {timeout} s")
 
 
 class PacedSender:

@@ -15,7 +15,7 @@ from physcam.cli import main
 from physcam.live.camera import camera_frames, frames_to_samples
 from physcam.live.sender import Sender
 from physcam.onset.sensors import find_sensor
-from _udp import free_port, wait_for_port, wait_until_read
+from _udp import free_port, needs_proc_net_udp, wait_for_port, wait_until_read
 
 DATA = Path(__file__).parent / "data"
 
@@ -105,6 +105,7 @@ def test_multicast_on_loopback():
 
 
 @pytest.mark.slow
+@needs_proc_net_udp
 @pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP", "SIGINT"])
 def test_a_signal_ends_the_recording_and_the_take_is_written(tmp_path, sig):
     """`physcam live record` stopped by SIGTERM (a process manager), SIGHUP (the terminal closed) or
@@ -126,14 +127,19 @@ def test_a_signal_ends_the_recording_and_the_take_is_written(tmp_path, sig):
     samples = list(frames_to_samples(frames))
     samples[5]["lens"]["fStop"] = 1e308
     samples[9]["lens"]["fStop"] = Decimal("1e5000")
-    wait_for_port(proc, port)
-    with Sender("127.0.0.1", port, encoding="cbor") as tx:
-        tx.stream(samples, 240)
-    # the recorder has read all 20 (the first pays for the schema validator): its receiver's stop()
-    # waits for the one being handled and hands on what it holds
-    wait_until_read(port)
-    proc.send_signal(getattr(signal, sig))
-    stdout, stderr = proc.communicate(timeout=60)
+    try:
+        wait_for_port(proc, port)
+        with Sender("127.0.0.1", port, encoding="cbor") as tx:
+            tx.stream(samples, 240)
+        # the recorder has read all 20 (the first pays for the schema validator): its receiver's stop()
+        # waits for the one being handled and hands on what it holds
+        wait_until_read(proc, port)
+        proc.send_signal(getattr(signal, sig))
+        stdout, stderr = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:  # a failed wait: the recorder would run out its 120 s
+            proc.kill()
+            proc.communicate()
     assert proc.returncode == 0, stderr
     summary = json.loads(stdout)
     assert summary["interrupted"] is True and summary["frames"] == 18

@@ -20,7 +20,7 @@ import pytest
 
 from physcam.cli import main
 from physcam.live.sample import decode_sample
-from _udp import free_port, wait_for_port
+from _udp import free_port, needs_proc_net_udp, wait_for_port
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "camera-metadata"
 ARRI = DATA / "arri" / "B001C001_180327_R1ZA.mov.csv"
@@ -58,6 +58,7 @@ def _record(tmp_path, count, send_args, *record_args):
 
 
 @pytest.mark.slow
+@needs_proc_net_udp
 def test_an_arri_clip_plays_into_the_recorder_frame_by_frame(tmp_path):
     pytest.importorskip("pxr")
     tcs, focus, tstop = _arri_columns()
@@ -70,6 +71,7 @@ def test_an_arri_clip_plays_into_the_recorder_frame_by_frame(tmp_path):
 
 
 @pytest.mark.slow
+@needs_proc_net_udp
 def test_a_red_clip_sent_with_a_named_lens_records_its_focus_iris_and_breathing(tmp_path, capsys):
     pytest.importorskip("pxr")
     tcs, focus, stop = _red_columns()

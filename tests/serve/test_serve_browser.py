@@ -89,7 +89,10 @@ def wait_chart_for_setup(pg):
     pg.wait_for_function("() => { const i = document.getElementById('dof-chart');"
                          " const api = document.getElementById('json-link').getAttribute('href')"
                          ".replace('/api/report?', '');"
-                         " return i.dataset.api === api && i.complete && i.naturalWidth > 0; }")
+                         # the units ride on the chart's src alone (app.js chart())
+                         " const ft = document.getElementById('units-imperial').getAttribute('aria-pressed') === 'true';"
+                         " return i.dataset.api === api && i.getAttribute('src') === '/api/dof.svg?' + api"
+                         " + (ft ? '&units=ft' : '') && i.complete && i.naturalWidth > 0; }")
 
 
 def metric(mm):
@@ -228,7 +231,7 @@ def test_inversions_on_the_page(page, server, capsys):
     n = d["solved"]["fstop"]
     # wait for the f-stop itself: the near limit shown is the measured 8 ft whatever the CoC, so the
     # answer from before the cine CoC and the T-stop already satisfies a wait on it (f/5.03, not f/4.17)
-    want = f"f/{float(f'{n:.2f}'):g} (solved from near/far)"
+    want = f"f/{float(f'{n:.2f}'):g} (solved from near/far) · T2.8"  # the T-stop too: it moves no f-stop
     page.wait_for_function("w => document.getElementById('out-fstop').textContent.startsWith(w)", arg=want)
     assert float(page.get_attribute("#out-near", "data-mm")) == d["dof"]["near_from_film_mm"]
     # focus from a bracket

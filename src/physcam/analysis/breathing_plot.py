@@ -50,6 +50,7 @@ def _checked_rows(rows, units):
     return rows
 
 
+@styled
 def draw_breathing(ax, rows, *, sensor_width_mm: float | None = None, units: str = "m", legend_loc: str = "lower left"):
     """Draw breathing ``rows`` on axes ``ax``: HFOV on ``ax``, EFL on a twin axis at the right (returned)."""
     from ..figures import PALETTE

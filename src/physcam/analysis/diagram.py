@@ -90,6 +90,7 @@ class LensDiagram:
         fig.tight_layout()
         return fig
 
+    @styled
     def draw(self, ax, *, units: str = "m", width_in: float = 10.0, title: bool = True) -> None:
         """Draw the diagram on matplotlib axes ``ax`` (what :meth:`figure` shows; the lens card's
         section); ``width_in`` is the width the title is wrapped to."""

@@ -119,9 +119,9 @@ def _svg(fig, dpi: int = 130, description: str | None = None) -> bytes:
     """A figure as SVG with its text kept as text (a third of the size, quicker to draw and send)."""
     import matplotlib
 
-    from ..figures import figure_bytes
+    from ..figures import figure_bytes, figure_style
 
-    with matplotlib.rc_context({"svg.fonttype": "none"}):
+    with figure_style(), matplotlib.rc_context({"svg.fonttype": "none"}):  # physcam's settings, then this one
         return figure_bytes(fig, "svg", dpi=dpi, description=description)
 
 
