@@ -24,13 +24,19 @@ def free_port() -> int:
     return port
 
 
+def _receive_queues(port: int) -> list[int]:
+    """The bytes waiting (rx_queue) in each UDP socket bound to ``port``; empty if none is."""
+    with open("/proc/net/udp") as f:  # local_address is ADDR:PORT, then rem_address, st, tx_queue:rx_queue
+        rows = [line.split() for line in f.readlines()[1:]]
+    return [int(r[4].split(":")[1], 16) for r in rows if r[1].endswith(f":{port:04X}")]
+
+
 def wait_for_port(proc, port: int, timeout: float = 60.0) -> None:
     """Until the process ``proc`` (a recorder) holds UDP ``port``, or it exits, or ``timeout`` s pass."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline and proc.poll() is None:
-        with open("/proc/net/udp") as f:  # local_address is ADDR:PORT in hex
-            if any(line.split()[1].endswith(f":{port:04X}") for line in f.readlines()[1:]):
-                return
+        if _receive_queues(port):
+            return
         time.sleep(0.1)
 
 
@@ -43,9 +49,7 @@ def wait_until_read(proc, port: int, timeout: float = 60.0) -> None:
             raise RuntimeError(f"the recorder exited ({proc.returncode}) before reading what was sent")
         if time.monotonic() > deadline:
             raise TimeoutError(f"datagrams still wait on UDP port {port} after {timeout} s")
-        with open("/proc/net/udp") as f:  # local_address is ADDR:PORT, then rem_address, st, tx_queue:rx_queue
-            rows = [line.split() for line in f.readlines()[1:]]
-        queues = [int(r[4].split(":")[1], 16) for r in rows if r[1].endswith(f":{port:04X}")]
+        queues = _receive_queues(port)
         empty = empty + 1 if queues and not any(queues) else 0
         time.sleep(0.05)
 
