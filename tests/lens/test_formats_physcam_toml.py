@@ -99,3 +99,43 @@ def test_unknown_kind_and_bad_extras():
         loads_lens(MINIMAL.replace('kind = "spherical"', 'kind = "toric"'), "physcam")
     with pytest.raises(LensFileError, match="JSON"):
         loads_lens(MINIMAL + '[extras]\n"a" = "{nope"\n', "physcam")
+
+
+_MAKER_FIELDS = '''format = "physcam-lens/1"
+[lens]
+name = "maker fields"
+max_fstop = 2.0
+{extra}
+[[surface]]
+kind = "spherical"
+radius = 50.0
+thickness = 5.0
+semi_diameter = 10.0
+medium = {{ nd = 1.5168, vd = 64.17 }}
+[[surface]]
+kind = "stop"
+radius = 0.0
+thickness = 45.0
+semi_diameter = 8.0
+medium = "air"
+'''
+
+
+def test_maker_close_focus_and_t_stop_round_trip():
+    """The maker's minimum object distance (mm from the film) and T-stop are read, kept and written back."""
+    p = loads_lens(_MAKER_FIELDS.format(extra="t_stop = 2.1\nminimum_object_distance = 450.0"), "physcam")
+    assert p.metadata.minimum_object_distance == 450.0 and p.metadata.t_stop == 2.1
+    back = loads_lens(dumps_lens(p, "physcam"), "physcam")
+    assert back.metadata == p.metadata
+    bare = loads_lens(_MAKER_FIELDS.format(extra=""), "physcam")
+    assert bare.metadata.minimum_object_distance is None and bare.metadata.t_stop is None
+
+
+@pytest.mark.parametrize("extra, words", [
+    ("minimum_object_distance = -300.0", "positive distance"),
+    ("minimum_object_distance = 0.0", "positive distance"),
+    ("t_stop = 1.4", "faster than the lens's f-number"),
+])
+def test_maker_fields_that_cannot_be_are_refused(extra, words):
+    with pytest.raises(LensFileError, match=words):
+        loads_lens(_MAKER_FIELDS.format(extra=extra), "physcam")

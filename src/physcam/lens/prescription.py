@@ -177,6 +177,10 @@ class LensMetadata:
     focal_length: float | None = None  # nominal, as engraved, mm
     max_fstop: float | None = None
     coating: str | None = None  # "none", "single", "multi" or free text
+    #: the maker's minimum object distance (close focus), mm from the film plane, as engraved or
+    #: published; None when the source gives none (then only the focusing model's own limit is known)
+    minimum_object_distance: float | None = None
+    t_stop: float | None = None  # the maker's stated T-stop wide open (transmission included)
     source: str | None = None  # provenance: file, book, patent table
     notes: str | None = None
 

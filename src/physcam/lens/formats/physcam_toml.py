@@ -3,8 +3,9 @@
 Layout (docs/lens-formats.md)::
 
     format = "physcam-lens/1"
-    [lens]        name, maker?, patent?, focal_length?, max_fstop?, coating?,
-                  squeeze? (1), wavelength_nm? (587.5618)
+    [lens]        name, maker?, patent?, focal_length?, max_fstop?, t_stop?, coating?,
+                  minimum_object_distance? (mm from the film plane), squeeze? (1),
+                  wavelength_nm? (587.5618)
     [provenance]  source?, notes?, and any further keys (original_file, original_format,
                   corrections, aliases) kept in Prescription.extras as "provenance.<key>"
     [[surface]]   kind, radius, thickness, semi_diameter, medium, conic?, aspheric?
@@ -46,7 +47,8 @@ from ._common import (
 __all__ = ["loads", "dumps", "FORMAT_TAG"]
 
 FORMAT_TAG = "physcam-lens/1"
-LENS_KEYS = ("name", "maker", "patent", "focal_length", "max_fstop", "coating", "squeeze", "wavelength_nm")
+LENS_KEYS = ("name", "maker", "patent", "focal_length", "max_fstop", "t_stop", "coating", "minimum_object_distance",
+             "squeeze", "wavelength_nm")
 SURFACE_KEYS = ("kind", "radius", "thickness", "semi_diameter", "medium", "conic", "aspheric")
 DEFAULT_WAVELENGTH = Prescription.__dataclass_fields__["wavelength_nm"].default
 
@@ -141,6 +143,8 @@ def loads_document(doc: dict, text: str, path=None, name: str | None = None) -> 
         focal_length=opt("focal_length"),
         max_fstop=opt("max_fstop"),
         coating=text_field(lens, "coating", "[lens]", path),
+        minimum_object_distance=opt("minimum_object_distance"),
+        t_stop=opt("t_stop"),
         source=text_field(prov, "source", "[provenance]", path),
         notes=text_field(prov, "notes", "[provenance]", path),
     )
@@ -152,6 +156,12 @@ def loads_document(doc: dict, text: str, path=None, name: str | None = None) -> 
         number(lens.get("wavelength_nm", DEFAULT_WAVELENGTH), "[lens] wavelength_nm", path, None),
         tuple(extras),
     )
+    mod, tstop = meta.minimum_object_distance, meta.t_stop
+    if mod is not None and mod <= 0.0:
+        raise LensFileError(f"[lens] minimum_object_distance {mod:g} must be a positive distance in mm from the film", path)
+    if tstop is not None and not (meta.max_fstop or 0.5) <= tstop <= 1000.0:
+        raise LensFileError(f"[lens] t_stop {tstop:g} cannot be faster than the lens's f-number "
+                            f"(max_fstop {meta.max_fstop or 0.5:g}): a T-stop counts the light the glass loses", path)
     if not 200.0 <= p.wavelength_nm <= 20000.0:
         raise LensFileError(f"[lens] wavelength_nm {p.wavelength_nm:g} is not an optical wavelength in nm", path)
     return validated(p, path, lines)
@@ -174,7 +184,7 @@ def dumps(p: Prescription) -> str:
     m = p.metadata
     out = ["# physcam lens prescription; lengths in mm, +z toward the film (docs/lens-formats.md)",
            f"format = {toml_value(FORMAT_TAG)}", "", "[lens]", f"name = {toml_value(m.name)}"]
-    for key in ("maker", "patent", "focal_length", "max_fstop", "coating"):
+    for key in ("maker", "patent", "focal_length", "max_fstop", "t_stop", "coating", "minimum_object_distance"):
         v = getattr(m, key)
         if v is not None:
             out.append(f"{key} = {toml_value(float(v) if isinstance(v, (int, float)) else v)}")
