@@ -116,3 +116,74 @@ def test_a_temporary_of_a_long_target_name_fits_the_file_system(tmp_path):
     name = "x" * 250 + ".usda"  # 255 bytes: the longest name most file systems take
     p = atomic_write(tmp_path / name, "ok")
     assert p.read_text() == "ok" and [f.name for f in tmp_path.iterdir()] == [name]
+
+
+# ---- folders written as a whole (staged_folder) ----------------------------------------------
+
+def test_a_folder_appears_whole_with_its_manifest(tmp_path):
+    import hashlib
+    from physcam.io import MANIFEST_NAME, folder_manifest, staged_folder
+    out = tmp_path / "maps"
+    with staged_folder(out, about={"command": "test"}) as tmp:
+        assert not out.exists()  # nothing is visible while the folder is being written
+        (tmp / "a.txt").write_text("alpha")
+        (tmp / "sub").mkdir()
+        (tmp / "sub" / "b.bin").write_bytes(b"\0\1\2")
+    doc = folder_manifest(out)
+    assert doc["about"] == {"command": "test"}
+    assert [f["path"] for f in doc["files"]] == ["a.txt", "sub/b.bin"]
+    assert doc["files"][0]["sha256"] == hashlib.sha256(b"alpha").hexdigest()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["maps"]  # no temporary left
+    assert (out / MANIFEST_NAME).is_file()
+    (out / "a.txt").write_text("changed length")
+    assert folder_manifest(out) is None  # a folder changed since is not "complete"
+
+
+def test_a_failed_rerun_keeps_the_previous_folder_whole(tmp_path):
+    from physcam.io import folder_manifest, staged_folder
+    out = tmp_path / "maps"
+    with staged_folder(out) as tmp:
+        (tmp / "first.txt").write_text("1")
+    with pytest.raises(RuntimeError), staged_folder(out, force=True) as tmp:
+        (tmp / "second.txt").write_text("2")
+        raise RuntimeError("killed half way")
+    assert sorted(p.name for p in out.iterdir()) == ["first.txt", "physcam-manifest.json"]
+    assert folder_manifest(out) is not None
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["maps"]
+    with staged_folder(out, force=True) as tmp:
+        (tmp / "second.txt").write_text("2")
+    assert sorted(p.name for p in out.iterdir()) == ["physcam-manifest.json", "second.txt"]  # no mix
+
+
+def test_a_folder_is_never_replaced_without_force_nor_a_users_folder_with_it(tmp_path):
+    from physcam.errors import ExportError
+    from physcam.io import staged_folder
+    out = tmp_path / "shoot"
+    out.mkdir()
+    (out / "IMG_0001.png").write_bytes(b"the user's photo")
+    with pytest.raises(ExportError, match="already exists"), staged_folder(out):
+        pass
+    with pytest.raises(ExportError, match="did not write"), staged_folder(out, force=True):
+        pass
+    assert (out / "IMG_0001.png").read_bytes() == b"the user's photo"
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    with staged_folder(empty, force=True) as tmp:
+        (tmp / "x").write_text("x")
+    assert (empty / "x").read_text() == "x"
+
+
+def test_a_killed_writers_temporary_folder_is_removed_by_the_next_write(tmp_path):
+    import subprocess
+    import sys
+    from physcam.io import staged_folder
+    out = tmp_path / "maps"
+    script = ("import os, signal, sys; from physcam.io import staged_folder\n"
+              "with staged_folder(sys.argv[1]) as tmp:\n"
+              "    (tmp / 'half.txt').write_text('half')\n"
+              "    os.kill(os.getpid(), signal.SIGKILL)\n")
+    subprocess.run([sys.executable, "-c", script, str(out)], check=False)
+    assert not out.exists() and len(list(tmp_path.iterdir())) == 1  # the killed writer's temporary
+    with staged_folder(out) as tmp:
+        (tmp / "whole.txt").write_text("whole")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["maps"]

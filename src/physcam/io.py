@@ -15,17 +15,21 @@ here), are left alone.
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import errno
 import hashlib
+import json
 import os
 import re
 import secrets
+import shutil
 import socket
 from pathlib import Path
 
 from .errors import ExportError
 
-__all__ = ["atomic_write", "check_writable", "remove_stale_temporaries", "staged"]
+__all__ = ["atomic_write", "check_writable", "folder_manifest", "remove_stale_temporaries", "staged",
+           "staged_folder", "MANIFEST_NAME"]
 
 #: What marks a physcam temporary file's name, after the hidden target name.
 TEMP_MARK = ".physcam-tmp."
@@ -189,3 +193,168 @@ def atomic_write(path, data: bytes | str, *, force: bool = False, encoding: str 
     with staged(path, force=force) as tmp, open(tmp, "wb") as fh:
         fh.write(data)
     return Path(path)
+
+
+# ---- a folder of outputs written as a whole ---------------------------------------------------
+
+#: The file :func:`staged_folder` writes last into every folder it publishes: what the folder holds.
+MANIFEST_NAME = "physcam-manifest.json"
+_MANIFEST_FORMAT = "physcam-manifest/1"
+
+
+def _renameat2(src: str, dst: str, flags: int) -> bool:
+    """Linux renameat2(2): ``flags`` 1 = RENAME_NOREPLACE, 2 = RENAME_EXCHANGE. False where the
+    call does not exist (not Linux, old C library, a file system without it); OSError on failure."""
+    try:
+        call = ctypes.CDLL(None, use_errno=True).renameat2
+    except (AttributeError, OSError):
+        return False
+    at_fdcwd = -100
+    if call(at_fdcwd, os.fsencode(src), at_fdcwd, os.fsencode(dst), flags) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP, errno.EOPNOTSUPP):
+        return False
+    raise OSError(err, os.strerror(err), dst)
+
+
+def _file_digest(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _sync_tree(root: Path) -> list[dict]:
+    """fsync every file and folder under ``root``; return the manifest's file entries."""
+    entries = []
+    for folder, _dirs, files in os.walk(root):
+        for name in sorted(files):
+            path = Path(folder, name)
+            with open(path, "rb+") as fh:
+                os.fsync(fh.fileno())
+            entries.append({"path": path.relative_to(root).as_posix(), "bytes": path.stat().st_size,
+                            "sha256": _file_digest(path)})
+        fd = os.open(folder, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+    return sorted(entries, key=lambda e: e["path"])
+
+
+def folder_manifest(path) -> dict | None:
+    """The manifest of a folder :func:`staged_folder` published, checked against what is on disk:
+    the manifest's dict when every listed file is there with its size, else None (a folder that
+    physcam did not write whole, or that was changed since)."""
+    folder = Path(path)
+    try:
+        doc = json.loads((folder / MANIFEST_NAME).read_text(encoding="utf-8"))
+        if doc.get("format") != _MANIFEST_FORMAT:
+            return None
+        for entry in doc["files"]:
+            if (folder / entry["path"]).stat().st_size != entry["bytes"]:
+                return None
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
+    return doc
+
+
+def _replaceable(p: Path) -> bool:
+    """Whether ``--force`` may replace folder ``p`` whole: it is empty, or physcam wrote it."""
+    try:
+        return not any(p.iterdir()) or (p / MANIFEST_NAME).is_file()
+    except OSError:
+        return False
+
+
+def _not_ours_error(p: Path) -> ExportError:
+    return ExportError(f"{p} holds files physcam did not write there; --force replaces only a folder "
+                       f"physcam wrote whole (one with a {MANIFEST_NAME}) or an empty one: choose a new output folder")
+
+
+def _publish_folder(tmp: Path, p: Path, force: bool) -> None:
+    """Put the finished folder ``tmp`` at ``p`` in one rename (or one exchange, when replacing)."""
+    if not (p.exists() or p.is_symlink()):
+        if _renameat2(str(tmp), str(p), 1):
+            return
+        if p.exists():  # no renameat2: a plain rename would replace an empty folder made meanwhile
+            raise _exists_error(p)
+        os.rename(tmp, p)
+        return
+    if not force:
+        raise _exists_error(p)
+    if p.is_symlink() or not p.is_dir():
+        raise ExportError(f"{p} is not a folder; remove it or choose another output folder")
+    if not _replaceable(p):
+        raise _not_ours_error(p)
+    old = Path(_new_temporary_name(p, ".old"))
+    if _renameat2(str(tmp), str(p), 2):  # atomic swap: readers see the old folder or the new one
+        shutil.rmtree(tmp, ignore_errors=True)
+        return
+    os.rename(p, old)
+    os.rename(tmp, p)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def _new_temporary_name(p: Path, suffix: str) -> str:
+    return os.path.join(p.parent, f"{_temp_prefix(p)}{_host()}.{os.getpid()}.{secrets.token_hex(4)}{suffix}")
+
+
+def _remove_stale_folders(p: Path) -> None:
+    """Remove the temporary folders of ``p`` that killed writers of this host left behind."""
+    prefix, host = _temp_prefix(p), _host()
+    try:
+        entries = list(os.scandir(p.parent if str(p.parent) else "."))
+    except OSError:
+        return
+    for entry in entries:
+        parts = entry.name[len(prefix):].split(".") if entry.name.startswith(prefix) else []
+        if (len(parts) >= 3 and parts[0] == host and parts[1].isdigit() and not _running(int(parts[1]))
+                and entry.is_dir(follow_symlinks=False)):
+            shutil.rmtree(entry.path, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def staged_folder(path, *, force: bool = False, about: dict | None = None):
+    """Write a folder of outputs as a whole: yields a private temporary folder next to ``path``;
+    fill it, and on leaving the block every file is synced, ``physcam-manifest.json`` (each file's
+    path, size and SHA-256, plus ``about``) is written last, and the folder is put at ``path`` in one
+    rename. A writer killed at any moment leaves either the previous folder or the new one, never a
+    mix (its temporary folder is removed by the next write of ``path``).
+
+    ``force`` replaces an existing folder only if physcam wrote it (it has a manifest) or it is empty,
+    so a user's own files are never deleted; an error in the block removes the temporary folder.
+    :func:`folder_manifest` tells whether a folder is complete.
+    """
+    p = Path(path)
+    if (p.exists() or p.is_symlink()) and not force:
+        raise _exists_error(p)
+    if p.is_dir() and not _replaceable(p):
+        raise _not_ours_error(p)  # before any work is done
+    try:
+        _make_folder(p)
+        _remove_stale_folders(p)
+        tmp = Path(_new_temporary_name(p, ".d"))
+        tmp.mkdir(mode=0o700)
+    except OSError as exc:
+        raise ExportError(f"cannot write {p}: {exc.strerror or exc}") from None
+    try:
+        yield tmp
+        files = _sync_tree(tmp)
+        if any(f["path"] == MANIFEST_NAME for f in files):
+            raise ExportError(f"{MANIFEST_NAME} is physcam's own record of the folder; name the output otherwise")
+        manifest = {"format": _MANIFEST_FORMAT, "about": about or {}, "files": files}
+        text = json.dumps(manifest, indent=1, sort_keys=True, allow_nan=False) + "\n"
+        with open(tmp / MANIFEST_NAME, "x", encoding="utf-8") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, 0o777 & ~_umask())
+        _publish_folder(tmp, p, force)
+    except OSError as exc:
+        raise ExportError(f"cannot write {p}: {exc.strerror or exc}") from None
+    finally:
+        if tmp.exists():
+            shutil.rmtree(tmp, ignore_errors=True)

@@ -106,6 +106,9 @@ _MAKER_FIELDS = '''format = "physcam-lens/1"
 name = "maker fields"
 max_fstop = 2.0
 {extra}
+[provenance]
+source = "a worked example"
+licence = "CC0-1.0"
 [[surface]]
 kind = "spherical"
 radius = 50.0
@@ -125,6 +128,7 @@ def test_maker_close_focus_and_t_stop_round_trip():
     """The maker's minimum object distance (mm from the film) and T-stop are read, kept and written back."""
     p = loads_lens(_MAKER_FIELDS.format(extra="t_stop = 2.1\nminimum_object_distance = 450.0"), "physcam")
     assert p.metadata.minimum_object_distance == 450.0 and p.metadata.t_stop == 2.1
+    assert p.metadata.licence == "CC0-1.0" and p.extras == ()
     back = loads_lens(dumps_lens(p, "physcam"), "physcam")
     assert back.metadata == p.metadata
     bare = loads_lens(_MAKER_FIELDS.format(extra=""), "physcam")

@@ -183,6 +183,7 @@ class LensMetadata:
     t_stop: float | None = None  # the maker's stated T-stop wide open (transmission included)
     source: str | None = None  # provenance: file, book, patent table
     notes: str | None = None
+    licence: str | None = None  # the prescription file's licence (SPDX identifier where one fits)
 
 
 @dataclass(frozen=True)

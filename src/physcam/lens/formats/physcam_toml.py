@@ -6,7 +6,7 @@ Layout (docs/lens-formats.md)::
     [lens]        name, maker?, patent?, focal_length?, max_fstop?, t_stop?, coating?,
                   minimum_object_distance? (mm from the film plane), squeeze? (1),
                   wavelength_nm? (587.5618)
-    [provenance]  source?, notes?, and any further keys (original_file, original_format,
+    [provenance]  source?, notes?, licence?, and any further keys (original_file, original_format,
                   corrections, aliases) kept in Prescription.extras as "provenance.<key>"
     [[surface]]   kind, radius, thickness, semi_diameter, medium, conic?, aspheric?
                   medium = "air" | { nd = 1.5168, vd = 64.17, glass? = "N-BK7", catalog? = "SCHOTT",
@@ -124,7 +124,7 @@ def loads_document(doc: dict, text: str, path=None, name: str | None = None) -> 
     if "focus" in doc:
         focus = _focus(table(doc["focus"], "[focus]", path), surfaces, text, path)
     prov = table(doc.get("provenance", {}), "[provenance]", path)
-    extras = [(f"provenance.{k}", _json(v, f"[provenance] {k}", path)) for k, v in prov.items() if k not in ("source", "notes")]
+    extras = [(f"provenance.{k}", _json(v, f"[provenance] {k}", path)) for k, v in prov.items() if k not in ("source", "notes", "licence")]
     for k, v in table(doc.get("extras", {}), "[extras]", path).items():
         if not isinstance(v, str):
             raise LensFileError(f"[extras] {k!r} must be a JSON text string", path)
@@ -147,6 +147,7 @@ def loads_document(doc: dict, text: str, path=None, name: str | None = None) -> 
         t_stop=opt("t_stop"),
         source=text_field(prov, "source", "[provenance]", path),
         notes=text_field(prov, "notes", "[provenance]", path),
+        licence=text_field(prov, "licence", "[provenance]", path),
     )
     p = Prescription(
         tuple(surfaces),
@@ -195,16 +196,15 @@ def dumps(p: Prescription) -> str:
     prov, extras = [], []
     for k, v in p.extras:
         value = json.loads(v)
-        if k.startswith("provenance.") and _plain(value) and k[len("provenance."):] not in ("source", "notes"):
+        if k.startswith("provenance.") and _plain(value) and k[len("provenance."):] not in ("source", "notes", "licence"):
             prov.append(f"{toml_key(k[len('provenance.'):])} = {toml_value(value)}")
         else:
             extras.append(f"{toml_key(k)} = {toml_value(v)}")
-    if m.source is not None or m.notes is not None or prov:
+    if m.source is not None or m.notes is not None or m.licence is not None or prov:
         out += ["", "[provenance]"]
-        if m.source is not None:
-            out.append(f"source = {toml_value(m.source)}")
-        if m.notes is not None:
-            out.append(f"notes = {toml_value(m.notes)}")
+        for key in ("source", "licence", "notes"):
+            if getattr(m, key) is not None:
+                out.append(f"{key} = {toml_value(getattr(m, key))}")
         out += prov
     for s in p.surfaces:
         out += ["", "[[surface]]", f"kind = {toml_value(s.kind)}", f"radius = {toml_value(float(s.radius))}",
