@@ -23,6 +23,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..errors import InputError
+from ..optics.thinlens import MAX_F_NUMBER
 
 __all__ = ["build_extension", "lens_payload", "extension_manifest", "REFERENCE_FSTOP", "REPORT_SENSOR_MM"]
 
@@ -87,19 +88,41 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
             shaders[f"{slug}__d{int(disp)}f{int(fres)}.osl"] = focus_table_shader(ft, dispersion=disp, fresnel=fres,
                                                                                pupil_mm=pupil)
     data = {"slug": slug, "name": lens.name, "closest_m": ft.closest_mm / 1000.0, "fstop_min": ft.fstop_min,
+            "fstop_open": ft.fstop_open, "fstop_max": MAX_F_NUMBER,
             "inv_step_per_m": ft.inv_step_per_m, "anamorphic": bool(lens.is_anamorphic),
             "report_fstop": REFERENCE_FSTOP, "report_sensor_mm": list(REPORT_SENSOR_MM),
+            "pupil_fit_m": _line_in_inverse_distance(rows, "pupil_from_film_mm", 1e-3),
+            "pinhole_fit_mm": _line_in_inverse_distance(rows, "pinhole_mm", 1.0),
             "rows": rows}
     return data, shaders
 
 
-def _sensor_presets() -> list[dict]:
-    """physcam's sensor table, those a full-frame pupil table covers (:data:`GRID_HALF_MM`)."""
-    from ..onset.sensors import sensors
-    from .blender_focus import GRID_HALF_MM
+def _line_in_inverse_distance(rows, key, scale) -> list[float]:
+    """(a, b) of the least-squares line a + b u through ``rows[key] * scale`` against u = 1 / mark
+    (1/m): what Focus on Object's driver evaluates (Newton: the film's extension is f^2 u, so the
+    pupil's distance from the film and the best-match pinhole are nearly lines in u)."""
+    import numpy as np
 
-    return [{"name": s.name, "width_mm": s.width_mm, "height_mm": s.height_mm} for s in sensors()
-            if math.hypot(s.width_mm, s.height_mm) / 2 <= GRID_HALF_MM]
+    u = np.array([1000.0 / r["mark_mm"] for r in rows])
+    y = np.array([r[key] * scale for r in rows])
+    b, a = np.polyfit(u, y, 1)
+    return [float(a), float(b)]
+
+
+def _sensor_presets() -> list[dict]:
+    """physcam's whole sensor table (``physcam sensors``): the pupil table reaches the largest's corner."""
+    from ..onset.sensors import sensors
+
+    return [{"name": s.name, "width_mm": s.width_mm, "height_mm": s.height_mm} for s in sensors()]
+
+
+def _limits() -> dict:
+    """The sensor the add-on accepts at most: the pupil table's reach (physcam's largest sensor)."""
+    from ..onset.sensors import sensors
+    from .blender_pupil import RADIAL_MAX_MM
+
+    largest = max(sensors(), key=lambda s: math.hypot(s.width_mm, s.height_mm))
+    return {"sensor_half_diagonal_max_mm": RADIAL_MAX_MM, "sensor_largest": largest.name}
 
 
 def _addon_source() -> str:
@@ -135,4 +158,5 @@ def build_extension(out_dir, *, lenses=None, force: bool = False, progress=None)
                 progress(slug)
         z.writestr("lenses/index.json", json.dumps(index))
         z.writestr("sensors.json", json.dumps(_sensor_presets()))
+        z.writestr("limits.json", json.dumps(_limits()))
     return atomic_write(out, buf.getvalue(), force=force)
