@@ -32,7 +32,7 @@ pytestmark = pytest.mark.slow
 LENS, SW, SH, W, H = "dgauss_50mm", 36.0, 24.0, 256, 144
 FRAME_H = SW * H / W  # Auto fit in a landscape frame: the sensor's width is the frame's width
 KEYS = ((3.0, 2.8), (0.6, 4.0), (3.0, 8.0), (0.6, 16.0))  # (focus m from the film, f-stop) on frames 1-4
-LIGHTS = {"left": (-0.55, 0.0, -2.95, 0.004), "right": (0.55, 0.0, -2.95, 0.004), "near": (0.0, -0.05, -0.40, 0.001)}
+LIGHTS = {"left": (-0.55, 0.0, -2.95, 0.012), "right": (0.55, 0.0, -2.95, 0.012), "near": (0.0, -0.05, -0.40, 0.0017)}
 BACKDROP = {"rows": (128, 140), "cols": (104, 152)}  # rows from the bottom: the backdrop spans the top
 WINDOW = 14  # px around a light
 
@@ -52,7 +52,7 @@ def glow(name, strength):
     em = nt.nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = strength
     nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
     return mat
-light = glow("light", 40.0)
+light = glow("light", 20.0)
 for x, y, z, r in json.loads(sys.argv[5]).values():
     bpy.ops.mesh.primitive_uv_sphere_add(radius=r, location=(x, y, z), segments=24, ring_count=12)
     bpy.context.object.data.materials.append(light)
@@ -115,30 +115,41 @@ def _blob(img, c, r):
     return c0 + cx, r0 + cy, m2
 
 
+def _pinhole(lens, mark_mm):
+    """physcam's best-match pinhole focal length at mark_mm (the lens report), mm."""
+    from physcam.onset.request import ReportRequest
+    from physcam.onset.sensors import custom_sensor
+    from physcam.onset.solvers import field_of_view, lens_at_mark
+
+    req = ReportRequest(sensor=custom_sensor(SW, SH), fstop=8.0, focus_mm=mark_mm, lens=lens)
+    state = lens_at_mark(req)
+    return field_of_view(req, state, state.h2_from_film_mm)["pinhole_focal_length_mm"]
+
+
 @pytest.fixture(scope="module")
 def predictions():
-    """Per frame and light, physcam's tracer: (column, row, blur diameter in px); and the backdrop's
-    brightness (camera_rays' relative illumination at those film points, over the centre's)."""
+    """Per frame and light, physcam's tracer (a point light) at that frame's focus and stop: (column,
+    row, second moment of the blur in px^2, of the sphere's own image, a disk 2 r f_pin / distance
+    across, in px^2); and the backdrop's brightness (camera_rays' relative illumination at those film
+    points, over the centre's)."""
     lens = load_lens(LENS)
     pitch = SW / W
     out = {}
     for frame, (d, n) in enumerate(KEYS, start=1):
         state = camera_state(lens, focus_mm=d * 1000.0, fstop=n, sensor_mm=(SW, FRAME_H))
         pupil = _pupil_from_film(lens, d * 1000.0)
+        f_pin = _pinhole(lens, d * 1000.0)
         lights = {}
         for name, (x, y, z, r) in LIGHTS.items():
             depth = -z * 1000.0 + pupil  # from the film: the camera object is the entrance pupil
             pilot = bokeh_image(state, depth, x * 1000.0, y * 1000.0, rays=20_000, pixels=16, fresnel=False)
             cx, cy = pilot.to_dict()["centroid_mm"]
             h = WINDOW * pitch
-            bk = bokeh_image(state, depth, x * 1000.0, y * 1000.0, rays=400_000, pixels=2 * WINDOW + 1,
-                             extent_mm=(cx - h - pitch / 2, cx + h + pitch / 2, cy - h - pitch / 2, cy + h + pitch / 2),
-                             fresnel=False)
-            m2 = blob_moments(bk.image[..., 0], pitch)[2]
+            bk = bokeh_image(state, depth, x * 1000.0, y * 1000.0, rays=400_000, pixels=8 * (2 * WINDOW + 1),
+                             extent_mm=(cx - h, cx + h, cy - h, cy + h), fresnel=False)
             c, row = _to_px(*bk.to_dict()["centroid_mm"])
-            # the sphere's own image, a disk 2 r f / distance across (50 mm), adds its second moment e^2 / 8
-            own = (2 * r * 50.0 / -z) ** 2 / 8
-            lights[name] = (c, row, m2 / pitch**2, own / pitch**2)
+            own = (2 * r * f_pin / -z) ** 2 / 8
+            lights[name] = (c, row, blob_moments(bk.image[..., 0], pitch / 8)[2] / pitch**2, own / pitch**2)
         b = bake_camera(state)
         rows, cols = BACKDROP["rows"], BACKDROP["cols"]
         bright = predicted_block_brightness(b, {"backdrop": (*rows, *cols)}, W, H, (SW, FRAME_H), samples=48)
@@ -186,7 +197,8 @@ def test_every_frame_renders_its_own_focus_stop_and_exposure(renders, prediction
         img = np.array(frames[str(frame)])
         for name, (c, r, m2_pred, own) in pred["lights"].items():
             gc, gr, m2 = _blob(img, c, r)
-            d_got = math.sqrt(max(8 * (m2 - own), 0.0))
+            # the render's second moment: the blur's, the sphere's own image's and the pixels' (1/12 px^2 an axis)
+            d_got = math.sqrt(max(8 * (m2 - own - 1 / 6), 0.0))
             d_want = math.sqrt(8 * m2_pred)
             print(f"{farm} frame {frame} {name}: centroid ({gc - c:+.3f}, {gr - r:+.3f}) px off, blur {d_got:.2f} px "
                   f"(physcam {d_want:.2f})")

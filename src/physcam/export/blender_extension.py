@@ -91,22 +91,38 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
             "fstop_open": ft.fstop_open, "fstop_max": MAX_F_NUMBER,
             "inv_step_per_m": ft.inv_step_per_m, "anamorphic": bool(lens.is_anamorphic),
             "report_fstop": REFERENCE_FSTOP, "report_sensor_mm": list(REPORT_SENSOR_MM),
-            "pupil_fit_m": _line_in_inverse_distance(rows, "pupil_from_film_mm", 1e-3),
-            "pinhole_fit_mm": _line_in_inverse_distance(rows, "pinhole_mm", 1.0),
+            "focus_object": _focus_object_fits(rows),
             "rows": rows}
     return data, shaders
 
 
-def _line_in_inverse_distance(rows, key, scale) -> list[float]:
-    """(a, b) of the least-squares line a + b u through ``rows[key] * scale`` against u = 1 / mark
-    (1/m): what Focus on Object's driver evaluates (Newton: the film's extension is f^2 u, so the
-    pupil's distance from the film and the best-match pinhole are nearly lines in u)."""
+def _focus_object_fits(rows) -> dict:
+    """What Focus on Object's drivers evaluate (no table lookup fits in a driver's simple expression):
+    with D the object's distance from the entrance pupil (m), the pupil's distance from the film
+    (m) and the best-match pinhole (mm) as a + b / (D + c), fitted to the report's rows (Newton: a
+    lens that focuses as a whole moves its film by f^2 / x, x the object's distance from the front
+    focal point, so the form is exact for it; the internal-focus lenses bundled fit within 0.02 mm).
+    ``d_min_m``: D at the closest focus."""
     import numpy as np
 
-    u = np.array([1000.0 / r["mark_mm"] for r in rows])
-    y = np.array([r[key] * scale for r in rows])
-    b, a = np.polyfit(u, y, 1)
-    return [float(a), float(b)]
+    mark = np.array([r["mark_mm"] for r in rows]) / 1000.0
+    pupil = np.array([r["pupil_from_film_mm"] for r in rows]) / 1000.0
+    d = mark - pupil
+    out = {"d_min_m": float(d.min())}
+    for key, y in (("pupil_m", pupil), ("pinhole_mm", np.array([r["pinhole_mm"] for r in rows]))):
+        def err(c):
+            w = 1.0 / (d + c)
+            return float(np.abs(np.polyval(np.polyfit(w, y, 1), w) - y).max())
+
+        lo, hi = -0.99 * d.min(), 10.0 * max(d.min(), 0.1)
+        for _ in range(5):  # a scan, refined about its best four times
+            cs = np.linspace(lo, hi, 101)
+            best = min(range(cs.size), key=lambda i: err(cs[i]))
+            lo, hi = cs[max(best - 1, 0)], cs[min(best + 1, cs.size - 1)]
+        c = float(cs[best])
+        b, a = np.polyfit(1.0 / (d + c), y, 1)
+        out[key] = [float(a), float(b), c]
+    return out
 
 
 def _sensor_presets() -> list[dict]:

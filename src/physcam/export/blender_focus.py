@@ -13,8 +13,8 @@ rays: for a lens with rotational symmetry, the ellipses of :mod:`physcam.export.
 film radius and iris size (nearly every sample passes, at every stop); for an anamorphic lens, the
 exit-pupil rectangles of the lens at its widest iris and stopped to :data:`STOP_LEVELS` of it over a
 film square of :data:`GRID_HALF_MM` (the shader samples the smallest that holds its iris). The
-weight is normalised at the film centre of each state (the centre renders 1 at every stop; with
-Fresnel on, the centre's transmission at infinity is divided out too). Keyframing the parameters
+weight is normalised at the film centre of each state and iris size (the centre renders 1 at every
+stop; with Fresnel on, the centre's transmission at infinity is divided out too). Keyframing the parameters
 renders a focus pull or an iris change with no rebuild.
 """
 
@@ -56,7 +56,7 @@ class FocusTable:
     radial: np.ndarray | None  # (n, N_LEVEL, N_RADIAL, 3) pupil ellipses (blender_pupil); None: anamorphic
     rects: np.ndarray | None  # (n, ny, nx, 4) exit-pupil rectangles at the widest iris (anamorphic only)
     rects_stopped: np.ndarray | None  # (n, len(STOP_LEVELS), ny, nx, 4): the same stopped to each level
-    norm: np.ndarray  # (n,) mean weight at the film centre, the file's stop
+    norm: np.ndarray  # (n, N_LEVEL) mean weight at the film centre, the round iris at each of iris_levels(semi_max)
     table: object  # SurfaceTable at infinity (the rows that do not move)
     bounds: object  # PupilBounds at infinity (the 2-D grid; anamorphic only, else None)
     iris_k: float  # iris semi-diameter x f-number (mm)
@@ -70,24 +70,43 @@ class FocusTable:
         """The widest iris's semi-diameter (mm): the stop opened to :attr:`fstop_min`."""
         return self.iris_k / self.fstop_min
 
+    @property
+    def levels(self) -> np.ndarray:
+        """The iris radii (mm) of the pupil and normalisation tables (:func:`~physcam.export.blender_pupil.iris_levels`)."""
+        from .blender_pupil import iris_levels
 
-def _centre_norm(q, film_z, bounds, fresnel: bool = False) -> float:
+        return iris_levels(self.semi_max, self.iris_k / self.fstop_open)
+
+
+def _centre_norm(q, film_z, bounds, fresnel: bool = False, stop_semi_diameter=None) -> float:
+    """camera_rays' mean weight at the film centre (64^2 stratified aim points over ``bounds``)."""
     from ..trace.trace import camera_rays
 
-    m = 128
+    m = 64
     u = (np.arange(m) + 0.5) / m
     uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
-    cr = camera_rays(q, np.zeros((uu.size, 2)), np.stack([uu, vv], axis=1), film_z, bounds=bounds, fresnel=fresnel)
+    cr = camera_rays(q, np.zeros((uu.size, 2)), np.stack([uu, vv], axis=1), film_z, bounds=bounds, fresnel=fresnel,
+                     stop_semi_diameter=stop_semi_diameter)
     return float(np.mean(cr.weight))
 
 
-def _centre_bounds(q, radial, film_z):
-    """A PupilBounds that holds the centre's widest ellipse of a radial table (for :func:`_centre_norm`)."""
+def _centre_bounds(q, ellipse):
+    """A PupilBounds whose every node holds the rectangle around an ellipse (cx, ax, ay)."""
     from ..trace.pupil_bounds import PupilBounds
 
-    cx, ax, ay = radial[0, 0]
+    cx, ax, ay = ellipse
     rect = np.broadcast_to([cx - ax, cx + ax, -ay, ay], (2, 2, 4)).copy()
     return PupilBounds(np.array([-1.0, 1.0]), np.array([-1.0, 1.0]), rect, float(q.vertex_z[-1]))
+
+
+def _centre_norms(q, film_z, radial, bounds, levels) -> list[float]:
+    """The centre's mean weight with the round iris at each tabulated iris level: the shader's
+    normalisation (the exit pupil's area is not quite the square of the iris's radius)."""
+    out = []
+    for k, s in enumerate(levels):
+        b = bounds if radial is None else _centre_bounds(q, radial[k, 0])
+        out.append(_centre_norm(q, film_z, b, stop_semi_diameter=float(s)))
+    return out
 
 
 @takes_prescription
@@ -98,7 +117,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
     from ..trace.surfaces import surface_table
-    from .blender_pupil import radial_pupil_table
+    from .blender_pupil import iris_levels, radial_pupil_table
 
     if isinstance(n_focus, bool) or not isinstance(n_focus, int) or n_focus < 2:
         raise InputError(f"a focus table needs at least 2 states, got {n_focus!r}")
@@ -109,7 +128,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     n_open = gaussian_at_focus(lens, math.inf).f_number * (1 + 1e-9)
     k = camera_state(lens, fstop=n_open).stop_semi_diameter * n_open  # the one iris rule, at infinity focus
     n_min = n_open / (1 + STOP_OPENING_TOLERANCE)
-    semi_max = k / n_min
+    levels = iris_levels(k / n_min, k / n_open)
     film_z, vz, radial, rects, stopped, norm = [], [], [], [], [], []
     for mk in marks:
         st = focus(lens, float(mk))
@@ -118,17 +137,18 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
         film_z.append(st.film_z)
         vz.append(t.vertex_z)
         if lens.is_anamorphic:
-            b, rect, levels = _rect_tables(q, st.film_z, semi_max, grid_half_mm)
+            b, rect, rect_levels = _rect_tables(q, st.film_z, levels[0], grid_half_mm)
             rects.append(rect)
-            stopped.append(levels)
+            stopped.append(rect_levels)
+            norm.append(_centre_norms(q, st.film_z, None, b, levels))
         else:
-            radial.append(radial_pupil_table(q, st.film_z, semi_max))
-            b = _centre_bounds(q, radial[-1], st.film_z)
-        norm.append(_centre_norm(q, st.film_z, b))
+            radial.append(radial_pupil_table(q, st.film_z, levels))
+            b = _centre_bounds(q, radial[-1][0, 0])
+            norm.append(_centre_norms(q, st.film_z, radial[-1], None, levels))
         if mk == marks[0]:
             table0, bounds0 = t, (b if lens.is_anamorphic else None)
-            loss = _centre_norm(q, st.film_z, b, fresnel=True) / norm[0]
-    if not all(v > 0 for v in norm):
+            loss = _centre_norm(q, st.film_z, b, fresnel=True) / _centre_norm(q, st.film_z, b)
+    if not all(min(v) > 0 for v in norm):
         raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some focus")
     arr = (lambda v: np.array(v) if v else None)
     return FocusTable(lens, marks, step, np.array(film_z), np.array(vz), arr(radial), arr(rects), arr(stopped),
@@ -183,7 +203,7 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
     the frame's aspect), iris and ghosts are shader parameters (defaults from the keywords; ``fstop``
     0 is wide open). ``pupil_mm``: the entrance pupil's distance in front of the film at each focus
     state; given, the camera's origin is the entrance pupil (the film behind it), else the film plane."""
-    from .blender_pupil import LEVEL_RATIO, N_LEVEL, N_RADIAL, RADIAL_MAX_MM
+    from .blender_pupil import N_LEVEL, N_RADIAL, RADIAL_MAX_MM
 
     require_type("ft", ft, FocusTable, "physcam.export.blender_focus.focus_table(lens)")
     n_focus = len(ft.marks_mm)
@@ -191,7 +211,8 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
     defines, data = lens_data(ft.table, None, ft.lens.wavelength_nm, ft.bounds, dispersion=dispersion,
                               fresnel=fresnel)
     defines += ["#define PHYSCAM_FOCUS_TABLE 1", "#define PHYSCAM_APERTURE 1", "#define PHYSCAM_POLYGON 1",
-                f"#define N_FOCUS {n_focus}", f"#define N_VZ_TAB {n_focus * n}",
+                f"#define N_FOCUS {n_focus}", f"#define N_VZ_TAB {n_focus * n}", f"#define N_IRIS {N_LEVEL}",
+                f"#define N_NORM_TAB {n_focus * N_LEVEL}",
                 f"#define FOCUS_INV_STEP {_num32(ft.inv_step_per_m)}", f"#define IRIS_K {_num32(ft.iris_k)}",
                 f"#define FSTOP_OPEN {_num32(ft.fstop_open)}", f"#define FSTOP_MIN {_num32(ft.fstop_min)}",
                 f"#define SEMI_MAX {_num32(ft.semi_max)}", f"#define FOCUS_DEFAULT_M {osl_number(focus_m)}",
@@ -199,10 +220,9 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
                 f"#define SENSOR_H_DEFAULT {osl_number(sensor_mm[1])}",
                 f"#define ASPECT_DEFAULT {osl_number(sensor_mm[0] / sensor_mm[1])}"]
     if ft.radial is not None:
-        defines += ["#define PHYSCAM_RADIAL_PUPIL 1", f"#define N_RAD {N_RADIAL}", f"#define N_IRIS {N_LEVEL}",
+        defines += ["#define PHYSCAM_RADIAL_PUPIL 1", f"#define N_RAD {N_RADIAL}",
                     f"#define N_RAD_TAB {ft.radial.size}", f"#define RAD_MAX {osl_number(RADIAL_MAX_MM)}",
-                    f"#define RAD_STEP {osl_number(RADIAL_MAX_MM / (N_RADIAL - 1))}",
-                    f"#define LEVEL_RATIO {osl_number(LEVEL_RATIO)}"]
+                    f"#define RAD_STEP {osl_number(RADIAL_MAX_MM / (N_RADIAL - 1))}"]
         data.append(_arr32("RAD_TAB", ft.radial, "N_RAD_TAB"))
     else:
         defines += [f"#define N_LEVEL {1 + len(STOP_LEVELS)}",
@@ -227,8 +247,9 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
             raise InputError(f"pupil_mm needs one distance per focus state ({n_focus}), got {len(pupil_mm)}")
         defines.append("#define PHYSCAM_PUPIL_ORIGIN 1")
         data.append(_arr32("PUPIL_TAB", pupil_mm, "N_FOCUS"))
-    data += [_arr32("FILM_Z_TAB", ft.film_z, "N_FOCUS"), _arr32("NORM_TAB", norm, "N_FOCUS"),
-             _arr32("VZ_TAB", ft.vertex_z, "N_VZ_TAB"), osl_array("SEMI_OPEN", ft.table.semi_diameter, "N_SURF")]
+    data += [_arr32("FILM_Z_TAB", ft.film_z, "N_FOCUS"), _arr32("NORM_TAB", norm, "N_NORM_TAB"),
+             _arr32("VZ_TAB", ft.vertex_z, "N_VZ_TAB"), osl_array("SEMI_OPEN", ft.table.semi_diameter, "N_SURF"),
+             _arr32("IRIS_LEVEL", ft.levels, "N_IRIS")]
     head = [f"// {ft.lens.name}: {n_focus} focus states from infinity to {ft.closest_mm / 1000:.3g} m "
             f"(uniform in 1/distance); dispersion {'on' if dispersion else 'off'}, Fresnel {'on' if fresnel else 'off'}."]
     return render_template(head + defines, data)

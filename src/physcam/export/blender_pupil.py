@@ -13,13 +13,13 @@ For each film radius rho_j (:data:`N_RADIAL` nodes from the axis to :data:`RADIA
 largest sensor's half diagonal), rays from (rho_j, 0) are traced through the lens with the iris
 taken out (its radius recorded where each ray crosses the stop plane): a ray passes an iris of
 radius s exactly when it passes every other surface and crosses the stop within s, so one trace
-gives the passing set at every iris size. The passing set at iris radius s_l (:data:`N_LEVEL`
-levels, each :data:`LEVEL_RATIO` smaller than the last, from the lens's widest iris) is enclosed in
+gives the passing set at every iris size. The passing set at iris radius s_l (:func:`iris_levels`:
+the widest iris, the file's stop and :data:`LEVEL_RATIO` steps below it) is enclosed in
 an ellipse with axes along the radial and tangential directions: centre (cx, 0), semi-axes
 (ax, ay). The set's rim is found between grid samples: where the iris stops a ray, the stop radius
 is interpolated to s along the grid line (it is smooth); where another surface clips, the rim is
 put at the next sample out (conservative). The grids zoom in as the passing set shrinks, so every
-set spans 32-64 samples across.
+set spans 24-48 samples across.
 
 The shader interpolates the ellipse linearly in rho between nodes, in s between levels (below the
 last level it scales the last level's axes by s / s_last: the pupil's linear regime) and between
@@ -40,22 +40,37 @@ import numpy as np
 from ..errors import InputError
 
 __all__ = ["RADIAL_MAX_MM", "N_RADIAL", "LEVEL_RATIO", "N_LEVEL", "radial_pupil_table", "iris_levels",
-           "interpolated_ellipse"]
+           "level_bracket", "interpolated_ellipse"]
 
 #: Film radius the table reaches (mm): the half diagonal of physcam's largest sensor (IMAX 15/70).
 RADIAL_MAX_MM = 44.0
 #: Film radii tabulated, uniform from the axis to :data:`RADIAL_MAX_MM`.
 N_RADIAL = 25
-#: Iris radius ratio between consecutive levels (a third of a stop in f-number).
+#: Iris radius ratio between consecutive levels below the file's stop (a third of a stop in f-number).
 LEVEL_RATIO = 2.0 ** (1.0 / 3.0)
-#: Iris levels tabulated: the largest iris down to 1/16 of it (four stops).
-N_LEVEL = 13
-_GRID = 64  # aim samples across a grid (half as many across its y >= 0 half)
+#: Iris levels tabulated: the widest iris, the file's stop, and on down to 1/16 of it (four stops).
+N_LEVEL = 14
+_GRID = 48  # aim samples across a grid (half as many across its y >= 0 half)
 
 
-def iris_levels(semi_max: float) -> np.ndarray:
-    """The tabulated iris radii (mm), largest first."""
-    return float(semi_max) * LEVEL_RATIO ** -np.arange(N_LEVEL, dtype=float)
+def iris_levels(semi_max: float, semi_file: float) -> np.ndarray:
+    """The tabulated iris radii (mm), largest first: the widest iris (``semi_max``: physcam's camera
+    state opens the stop a little beyond the file's, to the lens's marked f-number), the file's stop
+    (``semi_file``: on axis the other elements pass no more) and :data:`LEVEL_RATIO` steps below it."""
+    if not 0 < semi_file <= semi_max:
+        raise InputError(f"iris levels need 0 < file stop <= widest iris, got {semi_file!r} and {semi_max!r}")
+    return np.concatenate([[float(semi_max)], float(semi_file) * LEVEL_RATIO ** -np.arange(N_LEVEL - 1, dtype=float)])
+
+
+def level_bracket(levels, s: float) -> tuple[int, float, float]:
+    """(l0, lw, shrink): the shader's reading of iris radius ``s``: levels l0 and l0 + 1 mixed with
+    weight lw (linear in s); below the last level, the last one's axes times ``shrink`` = s / s_last."""
+    n = len(levels)
+    if s <= levels[-1]:
+        return n - 2, 1.0, s / levels[-1]
+    l0 = max([k for k in range(n - 1) if s <= levels[k]] or [0])
+    gap = levels[l0] - levels[l0 + 1]
+    return l0, (min(max((levels[l0] - s) / gap, 0.0), 1.0) if gap > 0 else 1.0), 1.0
 
 
 class _StopCrossing:
@@ -105,48 +120,52 @@ def _trace(q, film_z: float, fxs, boxes, big: float) -> list:
     return out
 
 
-def _rim(g, s: float):
-    """The rim of the passing set at iris radius ``s`` on grid ``g``, as points (x, y), or None when
-    nothing passes. Between a passing sample and a neighbour the iris stops, the rim is where the
-    stop radius crosses s (linear between the two: the stop radius is smooth); toward a neighbour
-    another surface clips, or past the grid's edge, the rim is put at the neighbour (conservative)."""
+def _rims(g, radii) -> list:
+    """Per iris radius s in ``radii``, the rim of the passing set on grid ``g`` as points (x, y), or
+    None when nothing passes. Between a passing sample and a neighbour the iris stops, the rim is
+    where the stop radius crosses s (linear between the two: the stop radius is smooth); toward a
+    neighbour another surface clips, or past the grid's edge, it is put at the neighbour
+    (conservative). The set is convex (the iris's image, cut by other round apertures), so its rim
+    bounds it."""
     gx, gy, ok, rad, dx, dy = g
     ny, nx = _GRID // 2, _GRID
     ok, rad = ok.reshape(ny, nx), rad.reshape(ny, nx)
-    gx, gy = gx.reshape(ny, nx), gy.reshape(ny, nx)
-    inside = ok & (rad <= s)
-    if not inside.any():
-        return None
-    xs, ys = [], []
-    for axis, sign in ((1, 1), (1, -1), (0, 1)):  # +x, -x, +y (the y = 0 side mirrors itself)
-        nb_in = np.roll(inside, -sign, axis=axis)
-        nb_ok = np.roll(ok, -sign, axis=axis)
-        nb_rad = np.roll(rad, -sign, axis=axis)
-        edge = np.zeros_like(inside)
-        if axis == 1:
-            edge[:, -1 if sign > 0 else 0] = True
-        else:
-            edge[-1, :] = True
-        rim = inside & (edge | ~nb_in)
-        iris = rim & ~edge & nb_ok & (nb_rad > s)
-        f = np.ones_like(rad)
+    s = np.asarray(radii, dtype=float)[:, None, None]
+    inside = ok & (rad <= s)  # (radii, ny, nx)
+    parts = []  # (radius index, x, y) arrays
+    # toward +x, -x and +y (the y = 0 side mirrors itself): the sample's (a) and its neighbour's (b) cells
+    for (ja, ia_), (jb, ib), ex, ey in (((slice(None), slice(0, -1)), (slice(None), slice(1, None)), dx, 0.0),
+                                        ((slice(None), slice(1, None)), (slice(None), slice(0, -1)), -dx, 0.0),
+                                        ((slice(0, -1), slice(None)), (slice(1, None), slice(None)), 0.0, dy)):
+        ra, rb = rad[ja, ia_], rad[jb, ib]
+        rim = inside[:, ja, ia_] & ~inside[:, jb, ib]
+        k, jj, ii = np.nonzero(rim)
         with np.errstate(divide="ignore", invalid="ignore"):
-            f[iris] = np.clip((s - rad[iris]) / (nb_rad[iris] - rad[iris]), 0.0, 1.0)
-        step = (dx if axis == 1 else dy) * sign
-        xs.append(gx[rim] + (step * f[rim] if axis == 1 else 0.0))
-        ys.append(gy[rim] + (step * f[rim] if axis == 0 else 0.0))
-    xs.append(gx[inside])
-    ys.append(gy[inside])
-    return np.concatenate(xs), np.concatenate(ys)
+            f = np.where(ok[jb, ib][jj, ii], np.clip((s[k, 0, 0] - ra[jj, ii]) / (rb[jj, ii] - ra[jj, ii]), 0.0, 1.0), 1.0)
+        jj, ii = jj + (ja.start or 0), ii + (ia_.start or 0)
+        parts.append((k, gx[0] + ii * dx + ex * f, gy[0] + jj * dy + ey * f))
+    for cells, ox, oy in (((slice(None), slice(0, 1)), -dx, 0.0), ((slice(None), slice(nx - 1, None)), dx, 0.0),
+                          ((slice(ny - 1, None), slice(None)), 0.0, dy)):  # past the grid's edge: a step out
+        k, jj, ii = np.nonzero(inside[:, cells[0], cells[1]])
+        jj, ii = jj + (cells[0].start or 0), ii + (cells[1].start or 0)
+        parts.append((k, gx[0] + ii * dx + ox, gy[0] + jj * dy + oy))
+    k = np.concatenate([p[0] for p in parts])
+    x = np.concatenate([p[1] for p in parts])
+    y = np.concatenate([p[2] for p in parts])
+    order = np.argsort(k, kind="stable")
+    k, x, y = k[order], x[order], y[order]
+    cuts = np.searchsorted(k, np.arange(len(radii) + 1))
+    return [(x[cuts[i]:cuts[i + 1]], y[cuts[i]:cuts[i + 1]]) if cuts[i + 1] > cuts[i] else None
+            for i in range(len(radii))]
 
 
 def _passing_sets(q, film_z: float, fxs, radii, r_rear: float, big: float) -> list:
     """Per film point (fx, 0) and per iris radius in ``radii`` (descending): the rim of the passing
-    set (:func:`_rim`), or None when nothing passes. A point's grid zooms in on its passing set once
+    set (:func:`_rims`), or None when nothing passes. A point's grid zooms in on its passing set once
     that has shrunk to under half of the grid."""
     boxes = [(-r_rear, r_rear, r_rear)] * len(fxs)
     grids = _trace(q, film_z, fxs, boxes, big)
-    out = [[] for _ in fxs]
+    uses = [[(g, [])] for g in grids]  # per film point: (grid, the radii it serves)
     for s in radii:
         zoom = {}
         for p, g in enumerate(grids):
@@ -160,9 +179,10 @@ def _passing_sets(q, film_z: float, fxs, radii, r_rear: float, big: float) -> li
         if zoom:
             for p, g in zip(zoom, _trace(q, film_z, [fxs[p] for p in zoom], list(zoom.values()), big)):
                 grids[p], boxes[p] = g, zoom[p]
-        for p, g in enumerate(grids):
-            out[p].append(_rim(g, s))
-    return out
+                uses[p].append((g, []))
+        for p in range(len(fxs)):
+            uses[p][-1][1].append(s)
+    return [[rim for g, rs in u if rs for rim in _rims(g, rs)] for u in uses]
 
 
 #: Growth of every fitted ellipse beyond its rim points (the rim between two grid lines)
@@ -189,7 +209,7 @@ def _need(rim, cx: float, ax: float, ay: float) -> float:
     return float(np.sqrt(((x - cx) / ax) ** 2 + (y / ay) ** 2).max()) * _SAFETY
 
 
-def interpolated_ellipse(table: np.ndarray, levels: np.ndarray, rho: float, s: float) -> np.ndarray:
+def interpolated_ellipse(table: np.ndarray, levels, rho: float, s: float) -> np.ndarray:
     """(cx, ax, ay) as the shader reads ``table`` (levels x radii x 3) at film radius ``rho`` (mm) and
     iris radius ``s`` (mm): linear in rho, linear in s between levels, the last level's axes scaled
     by s / s_last below it."""
@@ -198,13 +218,8 @@ def interpolated_ellipse(table: np.ndarray, levels: np.ndarray, rho: float, s: f
     j0 = min(int(math.floor(ri)), n_rad - 2)
     rw = ri - j0
     at = (1 - rw) * table[:, j0] + rw * table[:, j0 + 1]
-    if s >= levels[0]:
-        return at[0]
-    if s <= levels[-1]:
-        return at[-1] * np.array([1.0, s / levels[-1], s / levels[-1]])
-    l0 = min(int(math.floor(math.log(levels[0] / s) / math.log(LEVEL_RATIO))), n_level - 2)
-    lw = (levels[l0] - s) / (levels[l0] - levels[l0 + 1])
-    return (1 - lw) * at[l0] + lw * at[l0 + 1]
+    l0, lw, shrink = level_bracket(levels, s)
+    return ((1 - lw) * at[l0] + lw * at[l0 + 1]) * np.array([1.0, shrink, shrink])
 
 
 def _fill(table: np.ndarray, empty: np.ndarray) -> None:
@@ -225,16 +240,17 @@ def _fill(table: np.ndarray, empty: np.ndarray) -> None:
             table[:, j] = table[:, near]
 
 
-def radial_pupil_table(q, film_z: float, semi_max: float) -> np.ndarray:
-    """The table (:data:`N_LEVEL` x :data:`N_RADIAL` x 3: cx, ax, ay in mm on the rear vertex plane) of
-    the focused lens ``q`` (a Prescription) with its film at ``film_z`` and irises up to ``semi_max``
-    (mm, the stop's radius wide open). An ellipse with zero axes: no ray passes at any iris there."""
+def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
+    """The table (len(levels) x :data:`N_RADIAL` x 3: cx, ax, ay in mm on the rear vertex plane) of the
+    focused lens ``q`` (a Prescription) with its film at ``film_z``, at the iris radii ``levels``
+    (:func:`iris_levels`). An ellipse with zero axes: no ray passes at any iris there."""
     if q.is_anamorphic:
         raise InputError(f"{q.name!r} is anamorphic: the radial pupil table needs a lens with rotational symmetry")
-    levels = iris_levels(semi_max)
+    levels = np.asarray(levels, dtype=float)
+    semi_max = levels[0]
     mids = np.sqrt(levels[:-1] * levels[1:])
     below = levels[-1] / 2
-    radii = np.sort(np.concatenate([levels, mids, [below]]))[::-1]
+    radii = np.unique(np.concatenate([levels, mids, [below]]))[::-1]
     index = {float(s): i for i, s in enumerate(radii)}
     r_rear = q.surfaces[-1].semi_diameter
     big = 20.0 * max(semi_max, q.surfaces[q.stop_index].semi_diameter)
@@ -242,8 +258,8 @@ def radial_pupil_table(q, film_z: float, semi_max: float) -> np.ndarray:
     sets = _passing_sets(q, film_z, [j * step for j in range(N_RADIAL)] + [(j + 0.5) * step for j in range(N_RADIAL - 1)],
                          radii, r_rear, big)
     at_node, at_mid = sets[:N_RADIAL], sets[N_RADIAL:]
-    table = np.zeros((N_LEVEL, N_RADIAL, 3))
-    empty = np.ones((N_LEVEL, N_RADIAL), dtype=bool)
+    table = np.zeros((len(levels), N_RADIAL, 3))
+    empty = np.ones((len(levels), N_RADIAL), dtype=bool)
     for j in range(N_RADIAL):
         for k, s in enumerate(levels):
             reg = at_node[j][index[float(s)]]
@@ -274,11 +290,7 @@ def radial_pupil_table(q, film_z: float, semi_max: float) -> np.ndarray:
     return table
 
 
-def _rows_used(levels: np.ndarray, s: float) -> list[int]:
+def _rows_used(levels, s: float) -> list[int]:
     """The level rows the shader reads at iris radius ``s``."""
-    if s >= levels[0]:
-        return [0]
-    if s <= levels[-1]:
-        return [len(levels) - 1]
-    l0 = min(int(math.floor(math.log(levels[0] / s) / math.log(LEVEL_RATIO))), len(levels) - 2)
-    return [l0, l0 + 1]
+    l0, lw, _ = level_bracket(levels, s)
+    return [k for k, w in ((l0, 1 - lw), (l0 + 1, lw)) if w > 0] or [l0]
