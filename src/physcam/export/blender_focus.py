@@ -42,6 +42,8 @@ _GRID = (9, 9)
 #: exit-pupil tables: stopped down, the shader samples the smallest tabulated pupil that holds the
 #: iris's, instead of the open lens's (fewer wasted samples: less noise at equal samples).
 STOP_LEVELS = (0.75, 0.5, 0.35, 0.25)
+#: Aims a camera ray tries, where the passing set's area is known, before it counts as lost.
+N_TRY = 8
 
 
 @dataclasses.dataclass
@@ -94,7 +96,7 @@ def _centre_bounds(q, ellipse):
     """A PupilBounds whose every node holds the rectangle around an ellipse (cx, ax, ay)."""
     from ..trace.pupil_bounds import PupilBounds
 
-    cx, ax, ay = ellipse
+    cx, ax, ay = ellipse[:3]
     rect = np.broadcast_to([cx - ax, cx + ax, -ay, ay], (2, 2, 4)).copy()
     return PupilBounds(np.array([-1.0, 1.0]), np.array([-1.0, 1.0]), rect, float(q.vertex_z[-1]))
 
@@ -222,7 +224,7 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
     if ft.radial is not None:
         defines += ["#define PHYSCAM_RADIAL_PUPIL 1", f"#define N_RAD {N_RADIAL}",
                     f"#define N_RAD_TAB {ft.radial.size}", f"#define RAD_MAX {osl_number(RADIAL_MAX_MM)}",
-                    f"#define RAD_STEP {osl_number(RADIAL_MAX_MM / (N_RADIAL - 1))}"]
+                    f"#define RAD_STEP {osl_number(RADIAL_MAX_MM / (N_RADIAL - 1))}", f"#define N_TRY {N_TRY}"]
         data.append(_arr32("RAD_TAB", ft.radial, "N_RAD_TAB"))
     else:
         defines += [f"#define N_LEVEL {1 + len(STOP_LEVELS)}",

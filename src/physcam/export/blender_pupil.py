@@ -40,7 +40,7 @@ import numpy as np
 from ..errors import InputError
 
 __all__ = ["RADIAL_MAX_MM", "N_RADIAL", "LEVEL_RATIO", "N_LEVEL", "radial_pupil_table", "iris_levels",
-           "level_bracket", "interpolated_ellipse"]
+           "level_bracket", "interpolated_ellipse", "interpolated_area"]
 
 #: Film radius the table reaches (mm): the half diagonal of physcam's largest sensor (IMAX 15/70).
 RADIAL_MAX_MM = 44.0
@@ -142,21 +142,42 @@ def _rims(g, radii) -> list:
         k, jj, ii = np.nonzero(rim)
         with np.errstate(divide="ignore", invalid="ignore"):
             f = np.where(ok[jb, ib][jj, ii], np.clip((s[k, 0, 0] - ra[jj, ii]) / (rb[jj, ii] - ra[jj, ii]), 0.0, 1.0), 1.0)
+        nb_ok = ok[jb, ib][jj, ii]
+        fa = np.where(nb_ok, f, 0.5)  # the area's estimate: half a step where another surface clips
         jj, ii = jj + (ja.start or 0), ii + (ia_.start or 0)
-        parts.append((k, gx[0] + ii * dx + ex * f, gy[0] + jj * dy + ey * f))
+        parts.append((k, gx[0] + ii * dx + ex * f, gy[0] + jj * dy + ey * f,
+                      gx[0] + ii * dx + ex * fa, gy[0] + jj * dy + ey * fa, ~nb_ok))
     for cells, ox, oy in (((slice(None), slice(0, 1)), -dx, 0.0), ((slice(None), slice(nx - 1, None)), dx, 0.0),
                           ((slice(ny - 1, None), slice(None)), 0.0, dy)):  # past the grid's edge: a step out
         k, jj, ii = np.nonzero(inside[:, cells[0], cells[1]])
         jj, ii = jj + (cells[0].start or 0), ii + (cells[1].start or 0)
-        parts.append((k, gx[0] + ii * dx + ox, gy[0] + jj * dy + oy))
+        parts.append((k, gx[0] + ii * dx + ox, gy[0] + jj * dy + oy, gx[0] + ii * dx + ox / 2, gy[0] + jj * dy + oy / 2,
+                      np.ones(k.size, dtype=bool)))
     k = np.concatenate([p[0] for p in parts])
-    x = np.concatenate([p[1] for p in parts])
-    y = np.concatenate([p[2] for p in parts])
+    cols = [np.concatenate([p[c] for p in parts]) for c in range(1, 6)]
     order = np.argsort(k, kind="stable")
-    k, x, y = k[order], x[order], y[order]
+    k, cols = k[order], [c[order] for c in cols]
     cuts = np.searchsorted(k, np.arange(len(radii) + 1))
-    return [(x[cuts[i]:cuts[i + 1]], y[cuts[i]:cuts[i + 1]]) if cuts[i + 1] > cuts[i] else None
-            for i in range(len(radii))]
+    return [Rim(*(c[cuts[i]:cuts[i + 1]] for c in cols[:4]), bool(cols[4][cuts[i]:cuts[i + 1]].any()))
+            if cuts[i + 1] > cuts[i] else None for i in range(len(radii))]
+
+
+class Rim:
+    """A passing set's rim: points (x, y >= 0) that hold it (where another surface clips, a step out),
+    points (xa, ya) at the best estimate of its edge (half a step out there), for its area, and
+    whether a surface other than the iris (or the grid's edge) bounds it anywhere (``clipped``)."""
+
+    def __init__(self, x, y, xa, ya, clipped: bool):
+        self.x, self.y, self.xa, self.ya, self.clipped = x, y, xa, ya, clipped
+
+    def area(self) -> float:
+        """The set's area (mm^2, both halves): the polygon through its edge points, taken in angle order
+        about their middle (the set is convex)."""
+        x = np.concatenate([self.xa, self.xa])
+        y = np.concatenate([self.ya, -self.ya])
+        o = np.argsort(np.arctan2(y, x - 0.5 * (x.min() + x.max())))
+        x, y = x[o], y[o]
+        return float(0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
 
 
 def _passing_sets(q, film_z: float, fxs, radii, r_rear: float, big: float) -> list:
@@ -190,20 +211,22 @@ _SAFETY = 1.003
 
 
 def _fit(rim) -> np.ndarray:
-    """(cx, ax, ay): the ellipse about the rim's middle, axes along x and y, that holds every rim point."""
-    x, y = rim
+    """(cx, ax, ay, area): the ellipse about the rim's middle, axes along x and y, that holds every rim
+    point, and the passing set's area when the iris alone bounds it (else -1: another surface clips
+    it, and its area is not known well enough to weigh rays by)."""
+    x, y = rim.x, rim.y
     cx = 0.5 * (x.min() + x.max())
     ax = 0.5 * (x.max() - x.min())
     ay = y.max()
     g = _need(rim, cx, ax, ay)
-    return np.array([cx, ax * g, ay * g])
+    return np.array([cx, ax * g, ay * g, -1.0 if rim.clipped else rim.area()])
 
 
 def _need(rim, cx: float, ax: float, ay: float) -> float:
     """The factor the ellipse's axes need so that it holds ``rim``'s points (times :data:`_SAFETY`)."""
     if rim is None:
         return 1.0
-    x, y = rim
+    x, y = rim.x, rim.y
     if not (ax > 0 and ay > 0):
         return math.inf
     return float(np.sqrt(((x - cx) / ax) ** 2 + (y / ay) ** 2).max()) * _SAFETY
@@ -219,7 +242,24 @@ def interpolated_ellipse(table: np.ndarray, levels, rho: float, s: float) -> np.
     rw = ri - j0
     at = (1 - rw) * table[:, j0] + rw * table[:, j0 + 1]
     l0, lw, shrink = level_bracket(levels, s)
-    return ((1 - lw) * at[l0] + lw * at[l0 + 1]) * np.array([1.0, shrink, shrink])
+    return ((1 - lw) * at[l0, :3] + lw * at[l0 + 1, :3]) * np.array([1.0, shrink, shrink])
+
+
+def interpolated_area(table: np.ndarray, levels, rho: float, s: float) -> float:
+    """The passing set's area (mm^2) as the shader reads ``table``: linear in rho, linear in s^2
+    between levels (the area of an iris's image goes as its square), scaled by (s / s_last)^2 below;
+    -1 when an entry it reads is clipped by another surface than the iris (the area is not known)."""
+    n_level, n_rad, _ = table.shape
+    ri = min(max(rho / (RADIAL_MAX_MM / (n_rad - 1)), 0.0), n_rad - 1.0)
+    j0 = min(int(math.floor(ri)), n_rad - 2)
+    rw = ri - j0
+    at = (1 - rw) * table[:, j0, 3] + rw * table[:, j0 + 1, 3]
+    l0, _, shrink = level_bracket(levels, s)
+    if min(table[l0:l0 + 2, j0:j0 + 2, 3].ravel()) < 0:
+        return -1.0
+    hi, lo = levels[l0], levels[l0 + 1]
+    w2 = min(max((hi * hi - s * s) / (hi * hi - lo * lo), 0.0), 1.0) if hi > lo else 1.0
+    return float(((1 - w2) * at[l0] + w2 * at[l0 + 1]) * shrink * shrink)
 
 
 def _fill(table: np.ndarray, empty: np.ndarray) -> None:
@@ -241,9 +281,10 @@ def _fill(table: np.ndarray, empty: np.ndarray) -> None:
 
 
 def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
-    """The table (len(levels) x :data:`N_RADIAL` x 3: cx, ax, ay in mm on the rear vertex plane) of the
-    focused lens ``q`` (a Prescription) with its film at ``film_z``, at the iris radii ``levels``
-    (:func:`iris_levels`). An ellipse with zero axes: no ray passes at any iris there."""
+    """The table (len(levels) x :data:`N_RADIAL` x 4: cx, ax, ay in mm on the rear vertex plane and the
+    passing set's area in mm^2) of the focused lens ``q`` (a Prescription) with its film at
+    ``film_z``, at the iris radii ``levels`` (:func:`iris_levels`). An ellipse with zero axes: no
+    ray passes at any iris there."""
     if q.is_anamorphic:
         raise InputError(f"{q.name!r} is anamorphic: the radial pupil table needs a lens with rotational symmetry")
     levels = np.asarray(levels, dtype=float)
@@ -258,7 +299,7 @@ def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
     sets = _passing_sets(q, film_z, [j * step for j in range(N_RADIAL)] + [(j + 0.5) * step for j in range(N_RADIAL - 1)],
                          radii, r_rear, big)
     at_node, at_mid = sets[:N_RADIAL], sets[N_RADIAL:]
-    table = np.zeros((len(levels), N_RADIAL, 3))
+    table = np.zeros((len(levels), N_RADIAL, 4))
     empty = np.ones((len(levels), N_RADIAL), dtype=bool)
     for j in range(N_RADIAL):
         for k, s in enumerate(levels):
@@ -266,7 +307,9 @@ def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
             if reg is not None:
                 table[k, j] = _fit(reg)
                 empty[k, j] = False
+    dark = empty.copy()
     _fill(table, empty)
+    table[..., 3] = np.where(dark, -1.0, table[..., 3])  # nothing passes (the ellipse is a neighbour's)
     # grow the entries until the shader's interpolation holds every traced set between them
     checks = [(j * step, at_node[j]) for j in range(N_RADIAL)] + [((j + 0.5) * step, at_mid[j])
                                                                    for j in range(N_RADIAL - 1)]
@@ -286,7 +329,7 @@ def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
                 rows = _rows_used(levels, float(s))
                 for k in rows:
                     for j in cols:
-                        table[k, j, 1:] *= g * (1 + 1e-6)
+                        table[k, j, 1:3] *= g * (1 + 1e-6)
     return table
 
 
