@@ -144,6 +144,7 @@ def iris_corner_semi(state: CameraState) -> float:
     never beyond the lens's widest iris (the file's stop opened by physcam's stop-opening tolerance)."""
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
 
+    require_type("state", state, CameraState, _LENS_HINT)
     ap = state.aperture
     if ap is None or ap.is_circular:
         return float(state.stop_semi_diameter)

@@ -37,10 +37,10 @@ import math
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, require_finite, require_type
 
 __all__ = ["RADIAL_MAX_MM", "N_RADIAL", "LEVEL_RATIO", "N_LEVEL", "radial_pupil_table", "iris_levels",
-           "level_bracket", "interpolated_ellipse", "interpolated_area"]
+           "level_bracket", "interpolated_ellipse", "interpolated_area", "hermite"]
 
 #: Film radius the table reaches (mm): the half diagonal of physcam's largest sensor (IMAX 15/70).
 RADIAL_MAX_MM = 44.0
@@ -51,6 +51,9 @@ LEVEL_RATIO = 2.0 ** (1.0 / 3.0)
 #: Iris levels tabulated: the widest iris, the file's stop, and on down to 1/16 of it (four stops).
 N_LEVEL = 14
 _GRID = 48  # aim samples across a grid (half as many across its y >= 0 half)
+#: The largest error of the interpolated passing area that may weigh a ray (see radial_pupil_table).
+AREA_TOLERANCE = 0.004
+_DS = 0.02  # the area's slope at a level: from the areas at 2 % smaller and larger irises
 
 
 def iris_levels(semi_max: float, semi_file: float) -> np.ndarray:
@@ -62,13 +65,37 @@ def iris_levels(semi_max: float, semi_file: float) -> np.ndarray:
     return np.concatenate([[float(semi_max)], float(semi_file) * LEVEL_RATIO ** -np.arange(N_LEVEL - 1, dtype=float)])
 
 
+def _levels(levels) -> np.ndarray:
+    """``levels`` as iris radii (mm) that :func:`iris_levels` could have given, or InputError."""
+    try:
+        a = np.asarray(levels, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"iris levels must be radii in mm, largest first (iris_levels), got {levels!r:.60}") from None
+    if a.ndim != 1 or a.size < 2 or not np.isfinite(a).all() or not (a > 0).all() or (np.diff(a) > 0).any():
+        raise InputError(f"iris levels must be at least two radii in mm, largest first (iris_levels), got {levels!r:.60}")
+    return a
+
+
+def _table(table, levels) -> np.ndarray:
+    require_type("table", table, np.ndarray, "a radial pupil table (radial_pupil_table)")
+    if table.ndim != 3 or table.shape[2] != 5 or table.shape[1] != N_RADIAL or table.shape[0] != len(_levels(levels)):
+        raise InputError(f"a radial pupil table has shape (levels, {N_RADIAL}, 5), one row per iris level; "
+                         f"got {table.shape} for {len(_levels(levels))} levels")
+    return table
+
+
 def level_bracket(levels, s: float) -> tuple[int, float, float]:
     """(l0, lw, shrink): the shader's reading of iris radius ``s``: levels l0 and l0 + 1 mixed with
     weight lw (linear in s); below the last level, the last one's axes times ``shrink`` = s / s_last."""
+    return _bracket(_levels(levels), require_finite("iris radius", s))
+
+
+def _bracket(levels, s: float) -> tuple[int, float, float]:
     n = len(levels)
     if s <= levels[-1]:
         return n - 2, 1.0, s / levels[-1]
-    l0 = max([k for k in range(n - 1) if s <= levels[k]] or [0])
+    # the last level at least s (levels descend): the shader's loop, by bisection
+    l0 = min(max(int(np.searchsorted(-levels, -s, side="right")) - 1, 0), n - 2)
     gap = levels[l0] - levels[l0 + 1]
     return l0, (min(max((levels[l0] - s) / gap, 0.0), 1.0) if gap > 0 else 1.0), 1.0
 
@@ -94,30 +121,70 @@ def _grid(box):
     return gx.ravel(), gy.ravel(), dx, dy
 
 
-def _trace(q, film_z: float, fxs, boxes, big: float) -> list:
-    """Rays from film points (fx, 0) to the aim grid over each one's box on the rear vertex plane, in
-    one trace: per film point (x, y, passes every surface but the stop, radius where it crosses the
-    stop plane, grid steps)."""
+def _aims(q, film_z: float, fx, px, py, big: float):
+    """(passes every surface but the stop, radius where it crosses the stop plane) of rays from film
+    points (fx, 0) to aim points (px, py) on the rear vertex plane, in one trace."""
     from ..trace.rays import OK, RayBatch
     from ..trace.trace import trace_through
 
+    fx = np.asarray(fx, dtype=float)
+    start = np.stack([fx, np.zeros_like(fx), np.full(fx.size, film_z)], axis=1)
+    rays = RayBatch.from_arrays(start, np.stack([px - fx, py, np.full(px.size, q.vertex_z[-1] - film_z)], axis=1),
+                                q.wavelength_nm)
+    probe = _StopCrossing()
+    trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=big, aperture=probe, in_place=True)
+    return rays.flag == OK, probe.radius * big
+
+
+#: Neighbours a rim is looked for toward: +x, -x and +y (the y = 0 side mirrors itself), as the
+#: sample's and the neighbour's cells of a (ny, nx) grid, and the step's direction.
+_TOWARD = (((slice(None), slice(0, -1)), (slice(None), slice(1, None)), (1, 0)),
+           ((slice(None), slice(1, None)), (slice(None), slice(0, -1)), (-1, 0)),
+           ((slice(0, -1), slice(None)), (slice(1, None), slice(None)), (0, 1)))
+_HALVINGS = 4  # where another surface clips between two samples, it is found to 1/16 of a step
+
+
+def _trace(q, film_z: float, fxs, boxes, big: float) -> list:
+    """Rays from film points (fx, 0) to the aim grid over each one's box on the rear vertex plane, in
+    one trace: per film point (x, y, passes every surface but the stop, radius where it crosses the
+    stop plane, grid steps, clip edges). Between a passing sample and a clipped neighbour the edge of
+    what the other surfaces pass is found by halving (:data:`_HALVINGS`): per direction of
+    :data:`_TOWARD`, (lo, hi) fractions of the step that pass and that do not."""
     grids = [_grid(b) for b in boxes]
     gx = np.concatenate([g[0] for g in grids])
     gy = np.concatenate([g[1] for g in grids])
     fx = np.repeat(np.asarray(fxs, dtype=float), [g[0].size for g in grids])
-    z_rear = q.vertex_z[-1]
-    start = np.stack([fx, np.zeros_like(fx), np.full(fx.size, film_z)], axis=1)
-    rays = RayBatch.from_arrays(start, np.stack([gx - fx, gy, np.full(gx.size, z_rear - film_z)], axis=1),
-                                q.wavelength_nm)
-    probe = _StopCrossing()
-    trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=big, aperture=probe, in_place=True)
-    ok, rad = rays.flag == OK, probe.radius * big
+    ok, rad = _aims(q, film_z, fx, gx, gy, big)
+    ny, nx = _GRID // 2, _GRID
     out, i = [], 0
-    for g in grids:
+    for f, g in zip(fxs, grids):
         n = g[0].size
-        out.append((g[0], g[1], ok[i:i + n], rad[i:i + n], g[2], g[3]))
+        out.append([g[0], g[1], ok[i:i + n], rad[i:i + n], g[2], g[3], f])
         i += n
-    return out
+    # the clip edges: every (passing sample, clipped neighbour) pair of every grid, halved together
+    pairs = []  # (grid index, direction index, j, i, x, y, step x, step y, film x)
+    for gi, (gx_, gy_, ok_, rad_, dx, dy, f) in enumerate(out):
+        okg = ok_.reshape(ny, nx)
+        for di, (ca, cb, (sx, sy)) in enumerate(_TOWARD):
+            jj, ii = np.nonzero(okg[ca] & ~okg[cb])
+            ja, ia = jj + (ca[0].start or 0), ii + (ca[1].start or 0)
+            pairs.append((gi, di, jj, ii, gx_[0] + ia * dx, gy_[0] + ja * dy, np.full(jj.size, sx * dx),
+                          np.full(jj.size, sy * dy), np.full(jj.size, f)))
+    x, y, sx, sy, ff = [np.concatenate([p[k] for p in pairs]) for k in (4, 5, 6, 7, 8)]
+    lo, hi = np.zeros(x.size), np.ones(x.size)
+    for _ in range(_HALVINGS):
+        mid = 0.5 * (lo + hi)
+        passes = _aims(q, film_z, ff, x + mid * sx, y + mid * sy, big)[0] if x.size else np.zeros(0, bool)
+        lo, hi = np.where(passes, mid, lo), np.where(passes, hi, mid)
+    k = 0
+    for gi, g in enumerate(out):
+        g.append([(np.zeros((ny, nx)), np.ones((ny, nx))) for _ in _TOWARD])
+    for gi, di, jj, ii, *_ in pairs:
+        n = jj.size
+        g_lo, g_hi = out[gi][7][di]
+        g_lo[jj, ii], g_hi[jj, ii] = lo[k:k + n], hi[k:k + n]
+        k += n
+    return [tuple(g[:6]) + (g[7],) for g in out]
 
 
 def _rims(g, radii) -> list:
@@ -127,23 +194,24 @@ def _rims(g, radii) -> list:
     neighbour another surface clips, or past the grid's edge, it is put at the neighbour
     (conservative). The set is convex (the iris's image, cut by other round apertures), so its rim
     bounds it."""
-    gx, gy, ok, rad, dx, dy = g
+    gx, gy, ok, rad, dx, dy, edges = g
     ny, nx = _GRID // 2, _GRID
     ok, rad = ok.reshape(ny, nx), rad.reshape(ny, nx)
     s = np.asarray(radii, dtype=float)[:, None, None]
     inside = ok & (rad <= s)  # (radii, ny, nx)
     parts = []  # (radius index, x, y) arrays
-    # toward +x, -x and +y (the y = 0 side mirrors itself): the sample's (a) and its neighbour's (b) cells
-    for (ja, ia_), (jb, ib), ex, ey in (((slice(None), slice(0, -1)), (slice(None), slice(1, None)), dx, 0.0),
-                                        ((slice(None), slice(1, None)), (slice(None), slice(0, -1)), -dx, 0.0),
-                                        ((slice(0, -1), slice(None)), (slice(1, None), slice(None)), 0.0, dy)):
+    # toward +x, -x and +y: the sample's (a) and its neighbour's (b) cells
+    for ((ja, ia_), (jb, ib), (sx, sy)), (e_lo, e_hi) in zip(_TOWARD, edges):
+        ex, ey = sx * dx, sy * dy
         ra, rb = rad[ja, ia_], rad[jb, ib]
         rim = inside[:, ja, ia_] & ~inside[:, jb, ib]
         k, jj, ii = np.nonzero(rim)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            f = np.where(ok[jb, ib][jj, ii], np.clip((s[k, 0, 0] - ra[jj, ii]) / (rb[jj, ii] - ra[jj, ii]), 0.0, 1.0), 1.0)
         nb_ok = ok[jb, ib][jj, ii]
-        fa = np.where(nb_ok, f, 0.5)  # the area's estimate: half a step where another surface clips
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f_iris = np.clip((s[k, 0, 0] - ra[jj, ii]) / (rb[jj, ii] - ra[jj, ii]), 0.0, 1.0)
+        # where another surface clips, the rim is at the halved edge (held: its far end; area: its middle)
+        f = np.where(nb_ok, f_iris, e_hi[jj, ii])
+        fa = np.where(nb_ok, f_iris, 0.5 * (e_lo[jj, ii] + e_hi[jj, ii]))
         jj, ii = jj + (ja.start or 0), ii + (ia_.start or 0)
         parts.append((k, gx[0] + ii * dx + ex * f, gy[0] + jj * dy + ey * f,
                       gx[0] + ii * dx + ex * fa, gy[0] + jj * dy + ey * fa, ~nb_ok))
@@ -169,41 +237,57 @@ class Rim:
 
     def __init__(self, x, y, xa, ya, clipped: bool):
         self.x, self.y, self.xa, self.ya, self.clipped = x, y, xa, ya, clipped
+        self._area = None
 
     def area(self) -> float:
         """The set's area (mm^2, both halves): the polygon through its edge points, taken in angle order
         about their middle (the set is convex)."""
+        if self._area is None:
+            self._area = self._polygon_area()
+        return self._area
+
+    def _polygon_area(self) -> float:
         x = np.concatenate([self.xa, self.xa])
         y = np.concatenate([self.ya, -self.ya])
         o = np.argsort(np.arctan2(y, x - 0.5 * (x.min() + x.max())))
         x, y = x[o], y[o]
-        return float(0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+        return float(0.5 * abs(x[:-1] @ y[1:] - y[:-1] @ x[1:] + x[-1] * y[0] - y[-1] * x[0]))
 
 
 def _passing_sets(q, film_z: float, fxs, radii, r_rear: float, big: float) -> list:
     """Per film point (fx, 0) and per iris radius in ``radii`` (descending): the rim of the passing
     set (:func:`_rims`), or None when nothing passes. A point's grid zooms in on its passing set once
     that has shrunk to under half of the grid."""
+    radii = np.asarray(radii, dtype=float)
     boxes = [(-r_rear, r_rear, r_rear)] * len(fxs)
     grids = _trace(q, film_z, fxs, boxes, big)
-    uses = [[(g, [])] for g in grids]  # per film point: (grid, the radii it serves)
-    for s in radii:
+    start = [0] * len(fxs)  # the first radius each point's current grid serves
+    uses = [[] for _ in fxs]  # per film point: (grid, the radii it serves)
+    pending = list(range(len(fxs)))
+    while pending:
         zoom = {}
-        for p, g in enumerate(grids):
-            gx, gy, ok, rad, dx, dy = g
-            sel = ok & (rad <= s)
-            if sel.any():
-                x, y = gx[sel], gy[sel]
-                box = boxes[p]
-                if x.max() - x.min() + 4 * dx < 0.5 * (box[1] - box[0]) and y.max() + 2 * dy < 0.5 * box[2]:
-                    zoom[p] = (x.min() - 2 * dx, x.max() + 2 * dx, y.max() + 2 * dy)
-        if zoom:
-            for p, g in zip(zoom, _trace(q, film_z, [fxs[p] for p in zoom], list(zoom.values()), big)):
-                grids[p], boxes[p] = g, zoom[p]
-                uses[p].append((g, []))
-        for p in range(len(fxs)):
-            uses[p][-1][1].append(s)
-    return [[rim for g, rs in u if rs for rim in _rims(g, rs)] for u in uses]
+        for p in pending:
+            gx, gy, ok, rad, dx, dy, _ = grids[p]
+            box = boxes[p]
+            rs = radii[start[p]:]
+            sel = ok & (rad <= rs[:, None])  # (radii, samples)
+            anyp = sel.any(axis=1)
+            xmin = np.where(sel, gx, np.inf).min(axis=1)
+            xmax = np.where(sel, gx, -np.inf).max(axis=1)
+            ymax = np.where(sel, gy, -np.inf).max(axis=1)
+            small = anyp & (xmax - xmin + 4 * dx < 0.5 * (box[1] - box[0])) & (ymax + 2 * dy < 0.5 * box[2])
+            # the grid serves the radii before the first one that has shrunk under half of it
+            first = int(np.argmax(small)) if small.any() else rs.size
+            if first < rs.size:
+                uses[p].append((grids[p], rs[:first]))
+                zoom[p] = (xmin[first] - 2 * dx, xmax[first] + 2 * dx, ymax[first] + 2 * dy)
+                start[p] += first
+            else:
+                uses[p].append((grids[p], rs))
+        for p, g in zip(zoom, _trace(q, film_z, [fxs[p] for p in zoom], list(zoom.values()), big) if zoom else []):
+            grids[p], boxes[p] = g, zoom[p]
+        pending = list(zoom)
+    return [[rim for g, rs in u if len(rs) for rim in _rims(g, rs)] for u in uses]
 
 
 #: Growth of every fitted ellipse beyond its rim points (the rim between two grid lines)
@@ -212,14 +296,13 @@ _SAFETY = 1.003
 
 def _fit(rim) -> np.ndarray:
     """(cx, ax, ay, area): the ellipse about the rim's middle, axes along x and y, that holds every rim
-    point, and the passing set's area when the iris alone bounds it (else -1: another surface clips
-    it, and its area is not known well enough to weigh rays by)."""
+    point, and the passing set's area."""
     x, y = rim.x, rim.y
     cx = 0.5 * (x.min() + x.max())
     ax = 0.5 * (x.max() - x.min())
     ay = y.max()
     g = _need(rim, cx, ax, ay)
-    return np.array([cx, ax * g, ay * g, -1.0 if rim.clipped else rim.area()])
+    return np.array([cx, ax * g, ay * g, rim.area()])
 
 
 def _need(rim, cx: float, ax: float, ay: float) -> float:
@@ -233,33 +316,55 @@ def _need(rim, cx: float, ax: float, ay: float) -> float:
 
 
 def interpolated_ellipse(table: np.ndarray, levels, rho: float, s: float) -> np.ndarray:
-    """(cx, ax, ay) as the shader reads ``table`` (levels x radii x 3) at film radius ``rho`` (mm) and
+    """(cx, ax, ay) as the shader reads ``table`` (levels x radii x 5) at film radius ``rho`` (mm) and
     iris radius ``s`` (mm): linear in rho, linear in s between levels, the last level's axes scaled
     by s / s_last below it."""
-    n_level, n_rad, _ = table.shape
-    ri = min(max(rho / (RADIAL_MAX_MM / (n_rad - 1)), 0.0), n_rad - 1.0)
-    j0 = min(int(math.floor(ri)), n_rad - 2)
-    rw = ri - j0
-    at = (1 - rw) * table[:, j0] + rw * table[:, j0 + 1]
-    l0, lw, shrink = level_bracket(levels, s)
-    return ((1 - lw) * at[l0, :3] + lw * at[l0 + 1, :3]) * np.array([1.0, shrink, shrink])
+    _table(table, levels)
+    return _ellipse_at(table, _levels(levels), require_finite("film radius", rho), require_finite("iris radius", s))
 
 
 def interpolated_area(table: np.ndarray, levels, rho: float, s: float) -> float:
-    """The passing set's area (mm^2) as the shader reads ``table``: linear in rho, linear in s^2
-    between levels (the area of an iris's image goes as its square), scaled by (s / s_last)^2 below;
-    -1 when an entry it reads is clipped by another surface than the iris (the area is not known)."""
-    n_level, n_rad, _ = table.shape
+    """The passing set's area (mm^2) as the shader reads ``table``: linear in rho, between levels a
+    cubic in s through the levels' areas and slopes (Hermite: the area of the iris's image grows as its
+    square, and saturates where other surfaces cut it), scaled by (s / s_last)^2 below the last;
+    -1 where an entry it reads does not hold a trusted area (radial_pupil_table)."""
+    _table(table, levels)
+    return _area_at(table, _levels(levels), require_finite("film radius", rho), require_finite("iris radius", s))
+
+
+def _radial(table, rho):
+    n_rad = table.shape[1]
     ri = min(max(rho / (RADIAL_MAX_MM / (n_rad - 1)), 0.0), n_rad - 1.0)
     j0 = min(int(math.floor(ri)), n_rad - 2)
-    rw = ri - j0
-    at = (1 - rw) * table[:, j0, 3] + rw * table[:, j0 + 1, 3]
-    l0, _, shrink = level_bracket(levels, s)
-    if min(table[l0:l0 + 2, j0:j0 + 2, 3].ravel()) < 0:
+    return j0, ri - j0
+
+
+def _ellipse_at(table, levels, rho, s):
+    j0, rw = _radial(table, rho)
+    l0, lw, shrink = _bracket(levels, s)
+    at = (1 - rw) * table[l0:l0 + 2, j0, :3] + rw * table[l0:l0 + 2, j0 + 1, :3]
+    return ((1 - lw) * at[0] + lw * at[1]) * np.array([1.0, shrink, shrink])
+
+
+def _area_at(table, levels, rho, s):
+    j0, rw = _radial(table, rho)
+    l0, _, shrink = _bracket(levels, s)
+    if table[l0:l0 + 2, j0:j0 + 2, 3].min() < 0:
         return -1.0
-    hi, lo = levels[l0], levels[l0 + 1]
-    w2 = min(max((hi * hi - s * s) / (hi * hi - lo * lo), 0.0), 1.0) if hi > lo else 1.0
-    return float(((1 - w2) * at[l0] + w2 * at[l0 + 1]) * shrink * shrink)
+    at = (1 - rw) * table[l0:l0 + 2, j0, 3:] + rw * table[l0:l0 + 2, j0 + 1, 3:]
+    if shrink < 1.0:
+        return float(at[1, 0] * shrink * shrink)
+    return float(hermite(levels[l0 + 1], at[1, 0], at[1, 1], levels[l0], at[0, 0], at[0, 1], s))
+
+
+def hermite(s0: float, a0: float, d0: float, s1: float, a1: float, d1: float, s: float) -> float:
+    """The cubic through (s0, a0) and (s1, a1) with slopes d0 and d1 there, at s (a0 when s0 == s1)."""
+    span = s1 - s0
+    if not span > 0:
+        return a0
+    t = min(max((s - s0) / span, 0.0), 1.0)
+    return ((2 * t**3 - 3 * t**2 + 1) * a0 + (t**3 - 2 * t**2 + t) * span * d0 + (-2 * t**3 + 3 * t**2) * a1
+            + (t**3 - t**2) * span * d1)
 
 
 def _fill(table: np.ndarray, empty: np.ndarray) -> None:
@@ -281,17 +386,25 @@ def _fill(table: np.ndarray, empty: np.ndarray) -> None:
 
 
 def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
-    """The table (len(levels) x :data:`N_RADIAL` x 4: cx, ax, ay in mm on the rear vertex plane and the
-    passing set's area in mm^2) of the focused lens ``q`` (a Prescription) with its film at
-    ``film_z``, at the iris radii ``levels`` (:func:`iris_levels`). An ellipse with zero axes: no
-    ray passes at any iris there."""
+    """The table (len(levels) x :data:`N_RADIAL` x 5: cx, ax, ay in mm on the rear vertex plane, the
+    passing set's area in mm^2 and its slope in mm^2 per mm of iris radius) of the focused lens ``q``
+    (a Prescription) with its film at ``film_z``, at the iris radii ``levels`` (:func:`iris_levels`).
+    Where nothing passes at any iris, the ellipse is a neighbour's and the area 0."""
+    from ..lens.prescription import require_prescription
+
+    q = require_prescription(q)
+    film_z = require_finite("film z", film_z)
     if q.is_anamorphic:
         raise InputError(f"{q.name!r} is anamorphic: the radial pupil table needs a lens with rotational symmetry")
-    levels = np.asarray(levels, dtype=float)
+    levels = _levels(levels)
+    if not film_z > q.vertex_z[-1]:
+        raise InputError(f"the film (z = {film_z:g} mm) must lie behind the lens's last vertex (z = {q.vertex_z[-1]:g} mm)")
     semi_max = levels[0]
     mids = np.sqrt(levels[:-1] * levels[1:])
     below = levels[-1] / 2
-    radii = np.unique(np.concatenate([levels, mids, [below]]))[::-1]
+    checked = np.unique(np.concatenate([levels, mids, [below]]))[::-1]
+    near = np.concatenate([levels * (1 - _DS), levels * (1 + _DS)])  # the area's slope at each level
+    radii = np.unique(np.concatenate([checked, near]))[::-1]
     index = {float(s): i for i, s in enumerate(radii)}
     r_rear = q.surfaces[-1].semi_diameter
     big = 20.0 * max(semi_max, q.surfaces[q.stop_index].semi_diameter)
@@ -299,17 +412,20 @@ def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
     sets = _passing_sets(q, film_z, [j * step for j in range(N_RADIAL)] + [(j + 0.5) * step for j in range(N_RADIAL - 1)],
                          radii, r_rear, big)
     at_node, at_mid = sets[:N_RADIAL], sets[N_RADIAL:]
-    table = np.zeros((len(levels), N_RADIAL, 4))
+    table = np.zeros((len(levels), N_RADIAL, 5))
     empty = np.ones((len(levels), N_RADIAL), dtype=bool)
     for j in range(N_RADIAL):
         for k, s in enumerate(levels):
             reg = at_node[j][index[float(s)]]
             if reg is not None:
-                table[k, j] = _fit(reg)
+                table[k, j, :4] = _fit(reg)
+                up, down = at_node[j][index[float(s * (1 + _DS))]], at_node[j][index[float(s * (1 - _DS))]]
+                table[k, j, 4] = ((up.area() if up else 0.0) - (down.area() if down else 0.0)) / (2 * _DS * s)
                 empty[k, j] = False
     dark = empty.copy()
     _fill(table, empty)
-    table[..., 3] = np.where(dark, -1.0, table[..., 3])  # nothing passes (the ellipse is a neighbour's)
+    table[..., 3] = np.where(dark, 0.0, table[..., 3])  # nothing passes (the ellipse is a neighbour's)
+    table[..., 4] = np.where(dark, 0.0, table[..., 4])
     # grow the entries until the shader's interpolation holds every traced set between them
     checks = [(j * step, at_node[j]) for j in range(N_RADIAL)] + [((j + 0.5) * step, at_mid[j])
                                                                    for j in range(N_RADIAL - 1)]
@@ -317,12 +433,12 @@ def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
         ri = rho / step
         j0 = min(int(math.floor(ri + 1e-9)), N_RADIAL - 2)
         cols = [j0] if abs(ri - j0) < 1e-9 else [j0, j0 + 1]
-        for s in radii:
+        for s in checked:
             reg = sets[index[float(s)]]
             if reg is None:
                 continue
             for _ in range(8):
-                cx, ax, ay = interpolated_ellipse(table, levels, rho, float(s))
+                cx, ax, ay = _ellipse_at(table, levels, rho, float(s))
                 g = _need(reg, cx, ax, ay)
                 if g <= 1.0:
                     break
@@ -330,10 +446,27 @@ def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
                 for k in rows:
                     for j in cols:
                         table[k, j, 1:3] *= g * (1 + 1e-6)
+    # the area weighs rays only where the shader's interpolation of it is the traced area's within
+    # AREA_TOLERANCE at every radius and iris between the entries (elsewhere their area is -1)
+    trusted = table[..., 3] > 0
+    for rho, sets in checks:
+        ri = rho / step
+        j0 = min(int(math.floor(ri + 1e-9)), N_RADIAL - 2)
+        cols = [j0] if abs(ri - j0) < 1e-9 else [j0, j0 + 1]
+        for s in checked:
+            reg = sets[index[float(s)]]
+            want = reg.area() if reg is not None else 0.0
+            got = _area_at(table, levels, rho, float(s))
+            if abs(got - want) > AREA_TOLERANCE * max(want, 1e-12):
+                l0, lw, shrink = _bracket(levels, float(s))
+                for k in ([l0, l0 + 1] if shrink == 1.0 else [l0 + 1]):
+                    for j in cols:
+                        trusted[k, j] = False
+    table[..., 3] = np.where(trusted, table[..., 3], -1.0)
     return table
 
 
 def _rows_used(levels, s: float) -> list[int]:
     """The level rows the shader reads at iris radius ``s``."""
-    l0, lw, _ = level_bracket(levels, s)
+    l0, lw, _ = _bracket(levels, s)
     return [k for k, w in ((l0, 1 - lw), (l0 + 1, lw)) if w > 0] or [l0]
