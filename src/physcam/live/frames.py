@@ -34,7 +34,7 @@ from .sample import PROTOCOL_VERSION
 #: frame, and a 64 KiB sample could otherwise carry thousands
 MAX_DISTORTION_TERMS = 16
 
-__all__ = ["TrackedFrame", "rate_fraction", "rational", "timecode_fields", "rotation_matrix", "pan_tilt_roll",
+__all__ = ["TrackedFrame", "rate_fraction", "rational", "timecode_fields", "timecode_index", "rotation_matrix", "pan_tilt_roll",
            "compose_transforms", "frame_from_sample", "parse_timecode", "sample_from_frame", "static_block", "new_source_id"]
 
 
@@ -140,6 +140,22 @@ def parse_timecode(text, rate, drop_frame: bool = False) -> int:
         raise InputError(f"timecode {text} names a frame drop-frame counting skips")
     minutes = 60 * h + mi
     return (minutes * 60 + se) * per_s + ff - d * (minutes - minutes // 10)
+
+
+def timecode_index(text, rate, drop_frame: bool = False) -> int:
+    """The sample number since 00:00:00:00 of a timecode text as :class:`TrackedFrame` keeps it
+    ("HH:MM:SS:FF", ";" before FF for drop-frame, ".N" after it for the sub-frame above 60 fps) at the
+    stream's sample ``rate``: :func:`parse_timecode`'s frame count times the samples per timecode
+    frame, plus the sub-frame."""
+    import re
+
+    fr = rate_fraction(rate)
+    k = _timecode_rate(fr)[0]
+    m = re.fullmatch(r"(.+[:;]\d{1,3})\.(\d{1,3})", str(text).strip())
+    label, sub = (m.group(1), int(m.group(2))) if m else (text, 0)
+    if sub >= k:
+        raise InputError(f"timecode {text} has a sub-frame beyond the {k} samples of a timecode frame")
+    return parse_timecode(label, fr, drop_frame) * k + sub
 
 
 def timecode_fields(frame: int, rate, *, start: int = 0, drop_frame: bool = False) -> dict:

@@ -49,7 +49,7 @@ from dataclasses import dataclass
 
 from ..errors import InputError, PhysCamError
 from .protocol import ENCODINGS, PacketError, Reassembler, parse_packet
-from .sample import SampleError, decode_sample, sample_problems
+from .sample import SampleError, SampleProblem, decode_sample, sample_problems
 
 __all__ = ["Receiver", "ReceivedSample", "COUNTERS", "DEFAULT_PORT", "SOURCE_NUMBERS", "MAX_SOURCES", "multicast_group"]
 
@@ -63,6 +63,8 @@ MAX_SOURCES = 16
 _RECV_BUFFER = 65536  # the largest UDP datagram fits
 _DUPLICATE_MEMORY = 4096  # keys of the last datagrams accepted, to know a repeated one
 _EXPIRE_EVERY_S = 0.005
+#: the reasons kept for refused payloads (:meth:`Receiver.refusals`); the counters count them all
+MAX_REFUSALS_NOTED = 10
 
 
 def multicast_group(source_number: int = 1) -> str:
@@ -135,6 +137,7 @@ class Receiver:
         self._queue: queue.Queue = queue.Queue(maxsize=queue_size)
         self._reassembler = Reassembler(max_pending=max_pending)
         self._counts = dict.fromkeys(COUNTERS, 0)
+        self._refusals: list[str] = []
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -287,18 +290,39 @@ class Receiver:
         enc = ENCODINGS[encoding]
         try:
             obj = decode_sample(payload, enc, validate=False)
-        except SampleError:
+        except SampleError as exc:
             self._count("malformed")  # no sample, no source: the streams do not hear of it
+            self._note(header.sequence, addr, exc.problems[0])
             return
         now = time.monotonic()
         key = _source_key(obj)
         lo, hi = SOURCE_NUMBERS
-        if sample_problems(obj) or (key[1] is not None and not lo <= key[1] <= hi):
+        try:
+            problems = sample_problems(obj)
+        except Exception as exc:  # noqa: BLE001 - no sample may end the take: a check that fails refuses it
+            problems = [SampleProblem("$", "check", f"could not be checked ({type(exc).__name__})")]
+        if not problems and key[1] is not None and not lo <= key[1] <= hi:
+            problems = [SampleProblem("$.sourceNumber", "transport", f"source number {key[1]} is outside {lo}..{hi}")]
+        if problems:
             self._count("invalid")
+            self._note(header.sequence, addr, problems[0])
             if key in self._streams:  # its number is used up: the window need not wait for it
                 self._place(key, header.sequence, None, now)
             return
         self._place(key, header.sequence, ReceivedSample(obj, 0, enc, now), now)
+
+    def _note(self, sequence: int, addr, problem) -> None:
+        """Keep the reason a payload was refused, the first MAX_REFUSALS_NOTED of them (one line each)."""
+        with self._lock:
+            if len(self._refusals) < MAX_REFUSALS_NOTED:
+                where = f" from {addr[0]}:{addr[1]}" if isinstance(addr, tuple) and len(addr) >= 2 else ""
+                self._refusals.append(f"packet {sequence}{where}: {problem}")
+
+    def refusals(self) -> list[str]:
+        """Why the first payloads counted ``malformed`` (undecodable) or ``invalid`` were refused: at most
+        MAX_REFUSALS_NOTED lines of at most about 300 characters (a received value is never shown whole)."""
+        with self._lock:
+            return list(self._refusals)
 
     # --- ordering, per source ----------------------------------------------------------------------
     def _place(self, key, seq: int, item, now: float) -> None:

@@ -53,7 +53,7 @@ from ..errors import ExportError, InputError, PhysCamError, PhysCamWarning, requ
 from .frames import TrackedFrame
 from .lens_data import opentrackio_to_opencv
 
-__all__ = ["MAX_RECORDED_FRAMES", "SolvedFrame", "solve_frames", "frame_problem", "time_codes",
+__all__ = ["MAX_RECORDED_FRAMES", "SolvedFrame", "solve_frames", "frame_problem", "time_codes", "absent_frames",
            "write_recording_usd", "lens_report_rows", "write_lens_report", "CARRIED_VALUES"]
 
 #: the most frames one recording keeps (ten minutes at 240 fps)
@@ -168,6 +168,33 @@ def time_codes(frames, rate=None) -> tuple[list[float], Fraction]:
     return codes, fr
 
 
+def absent_frames(frames, rate=None) -> int:
+    """How many frames of one source's time line, between the first and the last of ``frames``, the
+    frames do not hold: a frame lasts 1 / rate s, ``rate`` the stream's sample rate (``sampleRate``;
+    else the ``rate`` given). Each frame's place on the line is, in this order of preference, its
+    ``sampleTimestamp`` (rounded to the nearest frame), its timecode (:func:`~physcam.live.frames.timecode_index`,
+    drop-frame counted), its ``sequenceNumber``; frames with none of them count nothing (0).
+
+    A gap of g frame periods between two neighbours holds g - 1 absent frames, whatever took them
+    (never sent, lost on the network, refused): 18 absent frames are 18, in one gap or several.
+    """
+    from .frames import rate_fraction, timecode_index
+
+    frames = _frames(frames)
+    fr = next((f.rate for f in frames if f.rate is not None), None)
+    fr = rate_fraction(rate) if fr is None and rate is not None else fr
+    if fr is not None and all(f.time_ns is not None for f in frames):
+        t0 = frames[0].time_ns
+        places = {round(Fraction(f.time_ns - t0, 1_000_000_000) * fr) for f in frames}
+    elif fr is not None and all(f.timecode is not None for f in frames):
+        places = {timecode_index(f.timecode, fr, f.drop_frame) for f in frames}
+    elif all(f.sequence_number is not None for f in frames):
+        places = {f.sequence_number for f in frames}
+    else:
+        return 0
+    return max(places) - min(places) + 1 - len(places)
+
+
 def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=None, focus_mm=None,
                  coc=None, refused: list | None = None, lens=None, fiz=None) -> list[SolvedFrame]:
     """Each frame with its time code and lens report (module notes).
@@ -176,8 +203,9 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     ``sourceId`` and ``sourceNumber``), else from these defaults: ``sensor`` (a
     :class:`~physcam.onset.sensors.Sensor`) when the stream's static data gives no sensor size,
     ``focal_length_mm`` (pinhole), ``fstop``, ``focus_mm`` (from the film plane); each
-    :class:`SolvedFrame` names them (``carried``, ``defaulted``). Frames whose time code does not
-    increase are dropped with a warning.
+    :class:`SolvedFrame` names them (``carried``, ``defaulted``). Each source keeps its own time line:
+    a frame whose time code does not pass the latest one **of its source** is dropped with a warning
+    (another source's clock, a day ahead or behind, never drops it).
 
     ``fiz`` (a :class:`~physcam.live.fiz.FizTable`) turns a frame's ``lens.encoders`` into the focus
     mark, f-stop and focal length it does not send itself (``from_encoders`` names them); ``lens`` (a
@@ -213,7 +241,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     held: dict = {}  # per source: the values its frames sent, the latest of each
     sensors: dict = {}
     out: list[SolvedFrame] = []
-    previous = -math.inf
+    previous: dict = {}  # per source: the latest time code solved
     skipped = 0
     for i, (f, t) in enumerate(zip(frames, codes)):
         mine = held.setdefault(f.source, {})
@@ -226,7 +254,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
             refused.append((i, f"frame {i}: {exc}"))
             continue
         sent.update(encoded)
-        if t <= previous:
+        if t <= previous.get(f.source, -math.inf):
             skipped += 1
             mine.update(sent)
             continue
@@ -248,7 +276,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
             refused.append((i, f"{where}: {exc}"))
             continue
         mine.update(sent)
-        previous = t
+        previous[f.source] = t
         names = dict((k, n) for k, n, _ in CARRIED_VALUES)
         out.append(SolvedFrame(f, t, report, tuple(carried), tuple(defaulted),
                                tuple(names[k] for k in encoded), float(report.pinhole[1]),
