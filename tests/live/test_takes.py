@@ -364,7 +364,7 @@ def test_a_name_taken_while_recording_gets_a_free_name(tmp_path):
     check_document(doc)
     assert (doc["file"], doc["report"]) == (str(tmp_path / "take-1.usda"), str(tmp_path / "take-1.csv"))
     assert doc["asked_file"] == str(tmp_path / "take.usda") and doc["frames"] == 10
-    assert f"{tmp_path / 'take.usda'} was taken while recording: written to {tmp_path / 'take-1.usda'}" in rec.stderr
+    assert f"{tmp_path / 'take.usda'} is taken: written to {tmp_path / 'take-1.usda'} instead" in rec.stderr
     assert (tmp_path / "take.usda").read_text() == "someone else's camera\n"
     assert (tmp_path / "take.csv").read_text() == "someone else's report\n"
     assert _sequence_numbers(tmp_path / "take-1.usda") == list(range(10))

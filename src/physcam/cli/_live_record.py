@@ -36,6 +36,15 @@ def source_id(text):
     return t if t.startswith("urn:uuid:") else "urn:uuid:" + t
 
 
+def resolve_sensor_opt(args):
+    """The sensor the options name (--sensor, or --sensor-width and --sensor-height), or None."""
+    if args.sensor is None and args.sensor_width is None and args.sensor_height is None:
+        return None
+    from .report import resolve_sensor
+
+    return resolve_sensor(args)
+
+
 @dataclass
 class Settings:
     """What a take is written with, checked and loaded before anything is received."""
@@ -65,9 +74,7 @@ def settings(args, kept: dict | None = None) -> Settings:
         if getattr(args, name, None) is not None:
             opts[name] = getattr(args, name)
     ns = argparse.Namespace(**{k: opts.get(k) for k in KEPT_OPTIONS})
-    from .live import _resolve_sensor_opt
-
-    sensor = _resolve_sensor_opt(ns)
+    sensor = resolve_sensor_opt(ns)
     if opts.get("focus") is not None and not isinstance(opts["focus"], (int, float)):
         from ._common import resolve_focus
         from .report import resolve_sensor
@@ -351,7 +358,7 @@ def _write_one(write, asked: str, force: bool, journal_path) -> tuple[Path, bool
         first = exc
     else:
         if Path(written) != Path(asked):
-            print(f"physcam: {asked} was taken while recording: written to {written} instead", file=sys.stderr)
+            print(f"physcam: {asked} is taken: written to {written} instead", file=sys.stderr)
         return written, False
     spare = _spare_folder()
     try:

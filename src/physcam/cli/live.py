@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 
 from ._common import distance, focus, number, numbers, whole
+from ._live_record import resolve_sensor_opt as _resolve_sensor_opt
 from ._live_record import source_id
 from ._output import add_output_options, document, emit_json
 
@@ -79,25 +80,11 @@ def _clip_arg(p) -> None:
                         "docs/camera-metadata.md), sent frame by frame at its frame rate with its timecodes")
 
 
-def register(sub) -> None:
-    import argparse
-
-    p = sub.add_parser("live", help="OpenTrackIO camera tracking: validate, record to USD, send, LED-wall frustum",
-                       description="Live camera metadata (OpenTrackIO 1.0.1): validate samples, record a stream "
-                                   "as a time-sampled USD camera with a per-frame lens report, send physcam's camera "
-                                   "or a recording out, and the LED wall's inner frustum (docs/live.md).",
-                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    s = p.add_subparsers(dest="live_command", metavar="ACTION")
-
-    v = s.add_parser("validate", help="validate OpenTrackIO samples (JSON or CBOR files) against the 1.0.1 schema")
-    v.add_argument("files", nargs="+", help="sample files: .json (one sample, or one per line) or .cbor")
-    add_output_options(v, what="the results")
-    v.set_defaults(handler=run_validate)
-
+def _record_parser(s) -> None:
     r = s.add_parser("record", help="record a stream into a time-sampled USD camera (and a lens report)")
     r.add_argument("file", help="output .usda/.usd/.usdc")
     _network_args(r, receive=True)
-    r.add_argument("--count", type=_count, default=None, help="stop after this many samples")
+    r.add_argument("--count", type=_count, default=None, help="stop once the source recorded has this many samples")
     r.add_argument("--report", metavar="FILE", help="also write the per-frame lens report (.csv or .json)")
     _sensor_args(r)
     r.add_argument("--focal", type=distance("focal length"), help="pinhole focal length when the stream has none")
@@ -120,6 +107,8 @@ def register(sub) -> None:
     add_output_options(r, what="the summary")
     r.set_defaults(handler=run_record, output_args=("file", "report"))
 
+
+def _recover_parser(s) -> None:
     rc = s.add_parser("recover", help="write the take an unfinished journal holds (a recorder killed, a full disk)",
                       description="Write the take kept in a journal (FILE.journal, written beside the output while "
                                   "physcam live record runs) as live record would have: the USD camera and the "
@@ -143,6 +132,25 @@ def register(sub) -> None:
     rc.add_argument("--force", action="store_true", help="overwrite existing files")
     add_output_options(rc, what="the summary")
     rc.set_defaults(handler=run_recover, output_args=("file", "report"))
+
+
+def register(sub) -> None:
+    import argparse
+
+    p = sub.add_parser("live", help="OpenTrackIO camera tracking: validate, record to USD, send, LED-wall frustum",
+                       description="Live camera metadata (OpenTrackIO 1.0.1): validate samples, record a stream "
+                                   "as a time-sampled USD camera with a per-frame lens report, send physcam's camera "
+                                   "or a recording out, and the LED wall's inner frustum (docs/live.md).",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    s = p.add_subparsers(dest="live_command", metavar="ACTION")
+
+    v = s.add_parser("validate", help="validate OpenTrackIO samples (JSON or CBOR files) against the 1.0.1 schema")
+    v.add_argument("files", nargs="+", help="sample files: .json (one sample, or one per line) or .cbor")
+    add_output_options(v, what="the results")
+    v.set_defaults(handler=run_validate)
+
+    _record_parser(s)
+    _recover_parser(s)
 
     se = s.add_parser("send", help="stream physcam's camera and lens as OpenTrackIO (a focus pull, a pan), or a "
                                    "recorded clip's camera metadata")
@@ -278,14 +286,6 @@ def run_validate(args) -> int:
 
 
 # --- record --------------------------------------------------------------------------------
-def _resolve_sensor_opt(args):
-    if args.sensor is None and args.sensor_width is None and args.sensor_height is None:
-        return None
-    from .report import resolve_sensor
-
-    return resolve_sensor(args)
-
-
 def _needs_live() -> None:
     """The OpenTrackIO commands need the 'live' extra (schema validation, CBOR): say so up front."""
     from ..extras import require_extra

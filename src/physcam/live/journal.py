@@ -226,6 +226,8 @@ class JournalReader:
     def __init__(self, path):
         self.path = Path(path)
         try:
+            if not self.path.is_file():  # a FIFO or a device would hang or never end
+                raise InputError(f"{self.path}: not a journal file (a take's journal is a regular file)")
             self._fh = open(self.path, "rb")
         except OSError as exc:
             raise InputError(f"cannot read the journal {self.path}: {exc.strerror or exc}") from None

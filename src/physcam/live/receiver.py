@@ -27,7 +27,9 @@ truncated, oversized, contradictory or overlapping segments, undecodable payload
 ``duplicate`` (a datagram received again, byte for byte; a second sample for a number already held);
 ``late``; ``stray``; ``invalid`` (decoded but not a valid sample, or a source number outside
 1..200); ``dropped`` (unfinished segmented samples pushed out, or samples the consumer did not take
-before the queue filled); ``missing`` (sequence numbers given up); ``resync``; ``delivered``.
+before the queue filled); ``missing`` (sequence numbers given up); ``resync``; ``delivered``. No
+payload ends the receiving thread: one the checks themselves fail on is counted ``invalid``; the
+reasons of the first ten refused payloads are kept, one bounded line each (:meth:`Receiver.refusals`).
 
 Memory is bounded whatever arrives: one 64 KiB receive buffer; reassembly of at most
 ``max_pending`` (16) unfinished samples of 64 KiB each with an 8 KiB map (1.125 MiB,

@@ -32,7 +32,9 @@ a focus pull):
 
 Times: a sample's time code is (its timestamp - the first's) x the stage's timeCodesPerSecond (the
 stream's sample rate), computed with exact fractions; samples without timestamps use their
-sequence numbers. The file is written once, atomically, when the recording ends.
+sequence numbers. Each source keeps its own time line (:func:`solve_frames`); a recording writes
+one source (:mod:`physcam.live.take`), and :func:`absent_frames` counts the frames its line lacks.
+The file is written once, atomically, when the recording ends.
 
 The focal length that drives depth of field is the lens's nominal focal length when the stream's
 static data gives one, else the pinhole focal length (a thin lens focused at D frames with s', a

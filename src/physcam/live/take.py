@@ -23,7 +23,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..errors import ExportError, InputError, PhysCamError
+from ..errors import ExportError, InputError, PhysCamError, require_type
 from .record import MAX_RECORDED_FRAMES
 
 __all__ = ["Take", "MAX_SOURCES_NAMED", "MAX_REFUSALS_KEPT", "same_source_id", "free_names", "write_under_free_name"]
@@ -36,6 +36,7 @@ MAX_REFUSALS_KEPT = 100
 
 def same_source_id(given: str, source_id) -> bool:
     """Whether ``source_id`` (a sample's) is the ``given`` one: ``urn:uuid:`` optional, case ignored."""
+    require_type("given", given, str)
     if not isinstance(source_id, str):
         return False
     strip = lambda t: t.strip().lower().removeprefix("urn:uuid:")  # noqa: E731
