@@ -525,3 +525,20 @@ def test_absent_frames_counts_what_a_line_lacks(line, dropped, by):
     if by == "sequence numbers":
         frames = [dataclasses.replace(f, timecode=None) for f in frames]
     assert absent_frames(frames) == len(dropped)
+
+
+@pytest.mark.parametrize("call", ["multicast_group", "build_packet", "Receiver", "timecode_fields", "Sender"])
+def test_the_live_api_refuses_a_5000_digit_argument_in_one_line(call):
+    """The API's own refusals show a 5,000-digit argument by its length (before: str() raised ValueError)."""
+    from physcam.errors import InputError
+    from physcam.live.protocol import build_packet
+    from physcam.live.receiver import multicast_group
+
+    calls = {"multicast_group": lambda: multicast_group(BIG),
+             "build_packet": lambda: build_packet(b"{}", encoding=ENCODING_JSON, sequence=BIG),
+             "Receiver": lambda: Receiver(0, queue_size=BIG),
+             "timecode_fields": lambda: timecode_fields(-BIG, 24),
+             "Sender": lambda: Sender("127.0.0.1", 5555, modulus=BIG)}
+    with pytest.raises(InputError) as err:
+        calls[call]()
+    assert "an integer of 5001 digits" in str(err.value) and len(str(err.value)) < 200

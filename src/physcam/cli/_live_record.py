@@ -63,9 +63,10 @@ KEPT_OPTIONS = ("sensor", "sensor_width", "sensor_height", "focal", "fstop", "fo
                 "meters_per_unit", "path", "source")
 
 
-def settings(args, kept: dict | None = None) -> Settings:
+def settings(args, kept: dict | None = None, *, check_outputs: bool = True) -> Settings:
     """Check every option and load every file it names (``kept``: a journal's options, which the
-    arguments given override). Raises a PhysCamError in one line before anything is received."""
+    arguments given override; ``check_outputs``: refuse output names that exist, without --force).
+    Raises a PhysCamError in one line before anything is received."""
     from ..errors import InputError
     from ..io import check_writable
 
@@ -98,9 +99,10 @@ def settings(args, kept: dict | None = None) -> Settings:
         raise InputError(f"{file}: a USD file name ends in .usda, .usd or .usdc")
     if report is not None and not str(report).lower().endswith((".csv", ".json")):
         raise InputError("--report is written as .csv or .json")
-    check_writable(file, force=args.force)
-    if report is not None:
-        check_writable(report, force=args.force)
+    if check_outputs:  # a recording starts only when its names are free (or --force); recover takes free names
+        check_writable(file, force=args.force)
+        if report is not None:
+            check_writable(report, force=args.force)
     return Settings(str(file), None if report is None else str(report), bool(args.force), opts, sensor, lens, fiz)
 
 
@@ -432,10 +434,12 @@ def run_recover(args) -> int:
     h = reader.header
     folder = Path(args.journal).parent
     if args.file is None:
-        args.file = str(folder / h["output"]) if isinstance(h.get("output"), str) else str(output_of_journal(args.journal))
+        named = h.get("output")  # by name only: a journal never sends its take out of its own folder
+        args.file = str(folder / Path(named).name) if isinstance(named, str) and Path(named).name \
+            else str(output_of_journal(args.journal))
     if args.report is None and isinstance(h.get("report"), str):
         args.report = str(folder / h["report"])  # a whole path stays whole
-    s = settings(args, h.get("options") if isinstance(h.get("options"), dict) else {})
+    s = settings(args, h.get("options") if isinstance(h.get("options"), dict) else {}, check_outputs=False)
     take, counters = Take(s.options.get("source")), {}
     for record in reader:
         if record[0] == "counters":

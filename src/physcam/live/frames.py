@@ -28,7 +28,7 @@ from fractions import Fraction
 import numpy as np
 
 from ..errors import InputError, require_finite, require_type
-from .sample import PROTOCOL_VERSION
+from .sample import PROTOCOL_VERSION, shown
 
 #: the most radial (and tangential) distortion coefficients a frame keeps: a recording holds each
 #: frame, and a 64 KiB sample could otherwise carry thousands
@@ -168,9 +168,9 @@ def timecode_fields(frame: int, rate, *, start: int = 0, drop_frame: bool = Fals
     """
     fr = rate_fraction(rate)
     if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) or frame < 0:
-        raise InputError(f"frame must be a whole number >= 0, got {frame!r}")
+        raise InputError(f"frame must be a whole number >= 0, got {shown(frame)}")
     if isinstance(start, bool) or not isinstance(start, (int, np.integer)) or start < 0:
-        raise InputError(f"the start timecode must be a whole number of frames >= 0, got {start!r}")
+        raise InputError(f"the start timecode must be a whole number of frames >= 0, got {shown(start)}")
     k, tc_rate, per_s = _timecode_rate(fr)
     d = _drop_count(tc_rate) if drop_frame else 0
     if drop_frame and not d:
@@ -366,7 +366,7 @@ def sample_from_frame(frame: TrackedFrame, *, source_id: str, sequence_number: i
     drop-frame when ``frame.drop_frame``), ``static`` is included when given."""
     require_type("frame", frame, TrackedFrame, "build one with TrackedFrame(...)")
     if isinstance(sequence_number, bool) or not isinstance(sequence_number, int) or not 0 <= sequence_number < 2**32:
-        raise InputError(f"sequence number must be a whole number 0..2^32-1, got {sequence_number!r}")
+        raise InputError(f"sequence number must be a whole number 0..2^32-1, got {shown(sequence_number)}")
     timing = {"mode": "internal", "sequenceNumber": sequence_number}
     if frame.time_ns is not None:
         timing["sampleTimestamp"] = {"seconds": frame.time_ns // 1_000_000_000,

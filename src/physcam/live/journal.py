@@ -143,6 +143,10 @@ class Journal:
     def create(cls, output, header: dict) -> "Journal":
         """Create the first free journal name beside ``output`` (exclusively), lock it, write the header."""
         output = Path(output)
+        try:
+            output.parent.mkdir(parents=True, exist_ok=True)  # as the output's own write would
+        except OSError as exc:
+            raise PhysCamError(f"cannot create the folder {output.parent} of the take: {exc.strerror or exc}") from None
         for p in _candidates(output):
             try:
                 fd = os.open(p, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND, 0o644)

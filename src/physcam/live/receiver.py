@@ -51,7 +51,7 @@ from dataclasses import dataclass
 
 from ..errors import InputError, PhysCamError
 from .protocol import ENCODINGS, PacketError, Reassembler, parse_packet
-from .sample import SampleError, SampleProblem, decode_sample, sample_problems
+from .sample import SampleError, SampleProblem, decode_sample, sample_problems, shown
 
 __all__ = ["Receiver", "ReceivedSample", "COUNTERS", "DEFAULT_PORT", "SOURCE_NUMBERS", "MAX_SOURCES", "multicast_group"]
 
@@ -73,13 +73,13 @@ def multicast_group(source_number: int = 1) -> str:
     """OpenTrackIO's multicast group for a source number: 239.135.1.N (current documentation)."""
     lo, hi = SOURCE_NUMBERS
     if isinstance(source_number, bool) or not isinstance(source_number, int) or not lo <= source_number <= hi:
-        raise InputError(f"source number must be {lo}..{hi}, got {source_number!r}")
+        raise InputError(f"source number must be {lo}..{hi}, got {shown(source_number)}")
     return f"239.135.1.{source_number}"
 
 
 def check_port(port) -> int:
     if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
-        raise InputError(f"port must be a whole number 0..65535, got {port!r}")
+        raise InputError(f"port must be a whole number 0..65535, got {shown(port)}")
     return port
 
 
@@ -127,11 +127,11 @@ class Receiver:
         for name, v, lo, hi in (("queue size", queue_size, 1, 1 << 20), ("reorder window", reorder_window, 1, 4096),
                                 ("receive buffer", receive_buffer_bytes, 65536, 1 << 30)):
             if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
-                raise InputError(f"{name} must be a whole number {lo}..{hi}, got {v!r}")
+                raise InputError(f"{name} must be a whole number {lo}..{hi}, got {shown(v)}")
         if modulus not in (255, 256, "auto"):
-            raise InputError(f"the Fletcher-16 modulus is 256, 255 or 'auto', got {modulus!r}")
+            raise InputError(f"the Fletcher-16 modulus is 256, 255 or 'auto', got {shown(modulus)}")
         if not isinstance(reorder_timeout_s, (int, float)) or not 0.0 < reorder_timeout_s <= 10.0:
-            raise InputError(f"reorder timeout must lie in (0, 10] s, got {reorder_timeout_s!r}")
+            raise InputError(f"reorder timeout must lie in (0, 10] s, got {shown(reorder_timeout_s)}")
         self.modulus = modulus
         self.reorder_window = reorder_window
         self.reorder_timeout_s = float(reorder_timeout_s)
