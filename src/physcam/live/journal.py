@@ -18,8 +18,9 @@ and, now and then, ``{"counters": {...}}``: the receiver's counters at that mome
 
 Writing: each line goes to the file in one ``write`` call of the process (no buffer of its own), so
 a recorder killed by SIGKILL loses nothing it took; the file is synced to the disk (``fsync``) at
-least every :data:`SYNC_INTERVAL_S` (0.5 s) and when the take ends, so a power cut loses at most the
-last half-second. A write that fails (disk full) is taken back (the file is cut to its last whole
+least every :data:`SYNC_INTERVAL_S` (0.5 s), on a thread of its own (a slow disk never holds up the
+recorder), and when the take ends, so a power cut loses at most the last half-second (and what a
+slow disk has not yet synced). A write that fails (disk full) is taken back (the file is cut to its last whole
 line) and the journal stops there with one warning; the take goes on in memory. While it records,
 the recorder holds an exclusive lock (``flock``) on its journal: a journal nobody holds belongs to a
 take that did not finish (:func:`unfinished_journals`).
@@ -34,6 +35,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import threading
 import time
 from pathlib import Path
 
@@ -138,6 +140,10 @@ class Journal:
         self.samples = 0
         #: why the journal stopped (the first failed write), or None while it keeps everything
         self.error: str | None = None
+        # the periodic fsync runs on a thread of its own: a slow disk never holds up the recorder
+        self._due = threading.Event()
+        self._closing = False
+        self._syncer: threading.Thread | None = None
 
     @classmethod
     def create(cls, output, header: dict) -> "Journal":
@@ -197,19 +203,46 @@ class Journal:
         self._append({"counters": counters})
 
     def sync(self, *, force: bool = False) -> None:
-        """Sync what was written to the disk, when :data:`SYNC_INTERVAL_S` has passed (or ``force``)."""
+        """Sync what was written to the disk once :data:`SYNC_INTERVAL_S` has passed since the last
+        sync (on the journal's own thread), or now, in this thread, with ``force``."""
         now = time.monotonic()
         if self._fd is None or not self._dirty or (not force and now - self._synced_at < SYNC_INTERVAL_S):
             return
+        self._synced_at, self._dirty = now, False
+        if force:
+            self._fsync()
+            return
+        if self._syncer is None:
+            self._syncer = threading.Thread(target=self._sync_when_due, name="physcam-journal-sync", daemon=True)
+            self._syncer.start()
+        self._due.set()
+
+    def _fsync(self) -> None:
         try:
             os.fsync(self._fd)
         except OSError as exc:
             self.error = self.error or (exc.strerror or str(exc))
-        self._synced_at, self._dirty = now, False
+
+    def _sync_when_due(self) -> None:
+        while True:
+            self._due.wait()
+            self._due.clear()
+            if self._closing:
+                return
+            self._fsync()
+
+    def _stop_syncing(self) -> None:
+        if self._syncer is not None:
+            self._closing = True
+            self._due.set()
+            self._syncer.join()
+            self._syncer = None
 
     def close(self) -> None:
         """Sync and close; the file stays (and its lock goes: it is unfinished until discarded)."""
         if self._fd is not None:
+            self._stop_syncing()
+            self._dirty = True
             self.sync(force=True)
             os.close(self._fd)
             self._fd = None
@@ -217,6 +250,7 @@ class Journal:
     def discard(self) -> None:
         """Close and remove the journal: only once the take is safely written elsewhere."""
         if self._fd is not None:
+            self._stop_syncing()
             os.close(self._fd)
             self._fd = None
         discard_journal(self.path)
