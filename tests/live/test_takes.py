@@ -144,6 +144,33 @@ def test_a_stray_source_a_day_ahead_does_not_cut_the_time_line():
     assert [x.frame.sequence_number for x in solved if x.frame.source_id == SID_A] == list(range(40))
 
 
+def test_one_sample_of_the_same_source_a_day_ahead_is_left_out_not_the_frames_after_it():
+    """A tracker's clock glitches once: its frame 20 is stamped a day late. That one frame is left out
+    of the time line (the longest run of increasing time codes), with a warning, and the 39 others are
+    kept (before: every frame after it "did not advance in time", 19 of them)."""
+    from physcam.errors import PhysCamWarning
+
+    a = _samples(40)
+    a[20]["timing"]["sampleTimestamp"]["seconds"] += 86_400
+    frames = [frame_from_sample(s, static=a[0]["static"]) for s in a]
+    with pytest.warns(PhysCamWarning, match="^1 samples lay off their source's time line"):
+        solved = solve_frames(frames)
+    assert [x.frame.sequence_number for x in solved] == [i for i in range(40) if i != 20]
+
+
+@pytest.mark.parametrize("codes, kept", [
+    ([0, 1, 2, 3], [0, 1, 2, 3]), ([0, 1, 86400, 2, 3], [0, 1, 3, 4]), ([0, 1, 1, 2], [0, 1, 3]),
+    ([5, 6, 0, 1, 2, 3], [2, 3, 4, 5]), ([0, 2, 1, 3], [0, 2, 3]), ([], [])])
+def test_the_time_line_is_the_longest_run_of_increasing_time_codes(codes, kept):
+    """Worked by hand: a frame far ahead is dropped; of equal time codes the first stays; a clock that
+    went back is followed when more frames follow it; of two frames swapped (2 before 1), the one
+    ahead of its neighbours gives way (either run is as long; patience sorting keeps the lower)."""
+    from physcam.live.record import time_line
+
+    frames = [TrackedFrame(source_id=SID_A, source_number=1) for _ in codes]
+    assert sorted(time_line(frames, codes)) == kept
+
+
 @pytest.mark.slow
 @needs_proc_net_udp
 def test_a_stray_sample_and_a_poison_number_leave_the_take_whole(tmp_path):

@@ -55,7 +55,8 @@ from ..errors import ExportError, InputError, PhysCamError, PhysCamWarning, requ
 from .frames import TrackedFrame
 from .lens_data import opentrackio_to_opencv
 
-__all__ = ["MAX_RECORDED_FRAMES", "SolvedFrame", "solve_frames", "frame_problem", "time_codes", "absent_frames",
+__all__ = ["MAX_RECORDED_FRAMES", "SolvedFrame", "solve_frames", "frame_problem", "time_codes", "time_line",
+           "absent_frames",
            "write_recording_usd", "lens_report_rows", "write_lens_report", "CARRIED_VALUES"]
 
 #: the most frames one recording keeps (ten minutes at 240 fps)
@@ -197,6 +198,38 @@ def absent_frames(frames, rate=None) -> int:
     return max(places) - min(places) + 1 - len(places)
 
 
+def time_line(frames, codes) -> set[int]:
+    """The indexes of the frames on their sources' time lines: per source (``sourceId``,
+    ``sourceNumber``), the longest run of its frames, in arrival order, whose time codes increase
+    (the first of equal ones kept; of runs equally long, the one whose time codes stay lowest). One
+    frame a day ahead is left out, not the frames after it; a clock that goes back is followed where
+    more frames follow it. Longest increasing subsequence by
+    patience sorting, O(n log n) (Knuth, TAOCP vol. 3, 5.1.4; Fredman 1975)."""
+    import bisect
+
+    per_source: dict = {}
+    for i, f in enumerate(frames):
+        per_source.setdefault(f.source, []).append(i)
+    keep: set[int] = set()
+    for idx in per_source.values():
+        tails, tail_at, before = [], [], {}
+        for i in idx:
+            k = bisect.bisect_left(tails, codes[i])
+            if k < len(tails) and tails[k] == codes[i]:
+                continue  # an equal time code: the first one stays
+            before[i] = tail_at[k - 1] if k else None
+            if k == len(tails):
+                tails.append(codes[i])
+                tail_at.append(i)
+            else:
+                tails[k], tail_at[k] = codes[i], i
+        i = tail_at[-1] if tail_at else None
+        while i is not None:
+            keep.add(i)
+            i = before[i]
+    return keep
+
+
 def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=None, focus_mm=None,
                  coc=None, refused: list | None = None, lens=None, fiz=None) -> list[SolvedFrame]:
     """Each frame with its time code and lens report (module notes).
@@ -205,9 +238,10 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     ``sourceId`` and ``sourceNumber``), else from these defaults: ``sensor`` (a
     :class:`~physcam.onset.sensors.Sensor`) when the stream's static data gives no sensor size,
     ``focal_length_mm`` (pinhole), ``fstop``, ``focus_mm`` (from the film plane); each
-    :class:`SolvedFrame` names them (``carried``, ``defaulted``). Each source keeps its own time line:
-    a frame whose time code does not pass the latest one **of its source** is dropped with a warning
-    (another source's clock, a day ahead or behind, never drops it).
+    :class:`SolvedFrame` names them (``carried``, ``defaulted``). Each source keeps its own time line
+    (:func:`time_line`): a frame off it (a time code that goes back, or one far ahead that the
+    frames after it do not follow) is dropped with a warning; another source's clock, a day ahead or
+    behind, never drops a frame.
 
     ``fiz`` (a :class:`~physcam.live.fiz.FizTable`) turns a frame's ``lens.encoders`` into the focus
     mark, f-stop and focal length it does not send itself (``from_encoders`` names them); ``lens`` (a
@@ -243,7 +277,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     held: dict = {}  # per source: the values its frames sent, the latest of each
     sensors: dict = {}
     out: list[SolvedFrame] = []
-    previous: dict = {}  # per source: the latest time code solved
+    on_line = time_line(frames, codes)
     skipped = 0
     for i, (f, t) in enumerate(zip(frames, codes)):
         mine = held.setdefault(f.source, {})
@@ -256,7 +290,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
             refused.append((i, f"frame {i}: {exc}"))
             continue
         sent.update(encoded)
-        if t <= previous.get(f.source, -math.inf):
+        if i not in on_line:
             skipped += 1
             mine.update(sent)
             continue
@@ -278,13 +312,13 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
             refused.append((i, f"{where}: {exc}"))
             continue
         mine.update(sent)
-        previous[f.source] = t
         names = dict((k, n) for k, n, _ in CARRIED_VALUES)
         out.append(SolvedFrame(f, t, report, tuple(carried), tuple(defaulted),
                                tuple(names[k] for k in encoded), float(report.pinhole[1]),
                                tuple(last["projection"] or (0.0, 0.0)), tuple(last["distortion_offset"] or (0.0, 0.0))))
     if skipped:
-        warnings.warn(f"{skipped} samples did not advance in time and were left out", PhysCamWarning, stacklevel=2)
+        warnings.warn(f"{skipped} samples lay off their source's time line (a time code going back, or ahead of "
+                      "the frames after it) and were left out", PhysCamWarning, stacklevel=2)
     return out
 
 
