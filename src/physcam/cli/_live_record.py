@@ -189,7 +189,7 @@ def _journal_header(s: Settings) -> dict:
         report = Path(report).name
     elif report is not None:
         report = str(Path(report).resolve())
-    return {"output": out.name, "report": report, "force": s.force,
+    return {"output": out.name, "report": report,
             "started": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"), "options": s.options}
 
 
@@ -295,11 +295,13 @@ def _nothing_written(s, take, counters, journal_path, receiver) -> str:
         names = ", ".join(f"{h['source_id']} ({h['samples']} samples)" for h in heard[:4])
         return (f"no sample of source {take.source} arrived (heard: {names}); the samples are kept in "
                 f"{journal_path}: `physcam live recover {journal_path} --source ID` writes another source's")
-    where = f"on port {receiver.port} " if receiver is not None else ""
     why = f" ({take.refusals[0]})" if take.refusals else ""
-    if receiver is not None and receiver.refusals() and not why:
+    if receiver is None:
+        return f"the journal {journal_path} holds no sample physcam can record{why}; nothing written"
+    if receiver.refusals() and not why:
         why = f" (refused {receiver.refusals()[0]})"
-    return f"no valid samples arrived {where}(received {counters.get('received', 0)} packets){why}; nothing written"
+    return (f"no valid samples arrived on port {receiver.port} (received {counters.get('received', 0)} packets){why}; "
+            "nothing written")
 
 
 def write_take(s: Settings, take, counters: dict, journal_path, elapsed: float, interrupted: bool,
@@ -318,7 +320,7 @@ def write_take(s: Settings, take, counters: dict, journal_path, elapsed: float, 
                           fstop=o.get("fstop"), focus_mm=o.get("focus"), refused=refused, lens=s.lens, fiz=s.fiz)
     refusals = take.refusals + [reason for _, reason in refused]
     if receiver is not None:
-        refusals = [f"{r}" for r in receiver.refusals()] + refusals
+        refusals = receiver.refusals() + refusals
     if not solved:
         raise InputError(f"no frame of the take could be recorded: {refusals[0]}; the samples are kept in "
                          f"{journal_path}")
