@@ -10,11 +10,17 @@ from lens_reference import ISET_FILES, PBRT_FILES, REFERENCE, SEED_FILES, SEED_I
 ALL_REFERENCE = PBRT_FILES + ISET_FILES + SEED_FILES
 
 
+#: The Blender extension's copy of the pbrt double Gauss (the same prescription with Abbe numbers of its
+#: own): dropped from the library in issue 44, its name an alias of dgauss_50mm.
+DUPLICATE = "double_gauss_50mm_f2.toml"
+
+
 def test_every_reference_file_is_bundled_once():
     recs = list_lenses()
     originals = sorted(r.original_file for r in recs)
-    assert originals == sorted(f"{f.parent.name}/{f.name}" for f in ALL_REFERENCE)
-    assert len({r.slug for r in recs}) == len(recs) == 19
+    assert originals == sorted(f"{f.parent.name}/{f.name}" for f in ALL_REFERENCE if f.name != DUPLICATE)
+    assert len({r.slug for r in recs}) == len(recs) == 18
+    assert find_lens(DUPLICATE).slug == find_lens("double_gauss_50mm_f2").slug == "dgauss_50mm"
 
 
 @pytest.mark.parametrize("rec", list_lenses(), ids=lambda r: r.slug)
@@ -25,11 +31,20 @@ def test_bundled_lens_is_valid_and_round_trips(rec):
     assert rec.source and rec.original_format in ("pbrt", "iset", "seed-toml")
 
 
+def _numbers(p):
+    """Each surface's geometry, nd and Vd: what a transcription is (a glass name added later is not)."""
+    return [(s.kind, s.radius, s.thickness, s.semi_diameter, s.conic, s.aspheric, s.medium.nd, s.medium.vd)
+            for s in p.surfaces]
+
+
 @pytest.mark.parametrize("path", [f for f in ALL_REFERENCE if f.name not in SEED_INVALID], ids=lambda p: p.name)
 def test_uncorrected_lenses_equal_their_original(path):
     rec = find_lens(path.name)
     assert not rec.corrected or path.suffix == ".json"  # the ISET copy corrects only its name
-    assert load_lens(rec.slug).surfaces == read_lens(path).surfaces
+    bundled, original = _numbers(load_lens(rec.slug)), _numbers(read_lens(path))
+    if path.name == DUPLICATE:  # the same radii, gaps, nd and apertures; the Abbe numbers are the copy's own
+        bundled, original = [b[:-1] for b in bundled], [o[:-1] for o in original]
+    assert bundled == original
 
 
 @pytest.mark.parametrize("name", sorted(SEED_INVALID))

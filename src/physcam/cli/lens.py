@@ -23,7 +23,10 @@ from ._output import add_output_options
 
 
 def register(sub) -> None:
-    p = sub.add_parser("lenses", help="list the bundled lens library (focal length, f-number, format)")
+    p = sub.add_parser("lenses", help="list the lens library, bundled and yours (focal length, f-number, source, "
+                                      "licence)")
+    p.add_argument("--library", choices=("all", "bundled", "user"), default="all",
+                   help="which lenses: all (default), the bundled ones, or yours (installed with `physcam lens add`)")
     add_output_options(p, csv=True, what="the library")
     p.set_defaults(handler=run_lenses)
 
@@ -166,14 +169,14 @@ def _json_float(v):
     return None if (v is None or (isinstance(v, float) and not math.isfinite(v))) else v
 
 
-def lenses_document() -> list[dict]:
-    """The bundled lenses as ``physcam lenses --json`` prints them (and ``physcam serve`` answers)."""
+def lenses_document(library: str = "all") -> list[dict]:
+    """The library's lenses as ``physcam lenses --json`` prints them (and ``physcam serve`` answers)."""
     from ..errors import PhysCamError
     from ..lens.library import list_lenses, load_lens
     from ..optics.paraxial import gaussian
 
     out = []
-    for rec in list_lenses():
+    for rec in list_lenses(library):
         d = rec.to_dict()
         try:
             g = gaussian(load_lens(rec.slug))
@@ -184,29 +187,39 @@ def lenses_document() -> list[dict]:
     return out
 
 
+def _lens_notes(d: dict) -> list[str]:
+    notes = []
+    if d["anamorphic"]:
+        notes.append(f"anamorphic {d['squeeze']:g}x")
+    if d["has_focus_groups"]:
+        notes.append("internal focus")
+    if d["t_stop"] is not None:
+        notes.append(f"T{d['t_stop']:g}")
+    if d["corrected"]:
+        notes.append("corrected")
+    if d["primary_source_checked"] is False:
+        notes.append("not checked against its source")
+    if d["library"] == "user":
+        notes.append("your library")
+    return notes
+
+
 def run_lenses(args) -> int:
     from ._output import Table, document, emit_json, print_csv, print_table
 
-    out = lenses_document()
+    out = lenses_document(getattr(args, "library", "all"))
     if args.json:
         emit_json(document("lenses", {"lenses": out}))
         return 0
     if args.csv:
         print_csv(out)
         return 0
-    t = Table("bundled lenses (paraxial EFL and f-number at the d line, stop as in the file)",
-              ("name (for physcam lens)", "EFL mm", "f/", "format", "lens and notes"),
-              justify=("left", "right", "right", "left", "left"))
+    t = Table("lens library (paraxial EFL and f-number at the d line, stop as in the file)",
+              ("name (for physcam lens)", "EFL mm", "f/", "lens and notes", "source", "licence"),
+              justify=("left", "right", "right", "left", "left", "left"))
     for d in out:
-        notes = []
-        if d["anamorphic"]:
-            notes.append(f"anamorphic {d['squeeze']:g}x")
-        if d["has_focus_groups"]:
-            notes.append("internal focus")
-        if d["corrected"]:
-            notes.append("corrected")
-        t.add_row(d["slug"], _fmt(d["efl_mm"], 2), _fmt(d["f_number"], 2), d["original_format"] or "-",
-                  "; ".join([d["name"], *notes]))
+        t.add_row(d["slug"], _fmt(d["efl_mm"], 2), _fmt(d["f_number"], 2), "; ".join([d["name"], *_lens_notes(d)]),
+                  d["source"] or "-", d["licence"] or "-")
     print_table(t)
     return 0
 
@@ -256,7 +269,10 @@ def show_document(args) -> dict:
 def _show_document(p, data, focus_info) -> dict:
     from ._output import document
 
+    from ..lens.provenance import provenance_of
+
     return document("lens_show", mark_repaired({"lens": p.name, "squeeze": p.squeeze, "focus": focus_info,
+                                                "provenance": provenance_of(p).to_dict(),
                                                 "meridians": {a: g.to_dict() for a, g in data.items()},
                                                 "points": show_points(data)}, p),
                     units=WAVE_UNITS)
@@ -301,6 +317,7 @@ def run_show(args) -> int:
         print_csv(show_points(data))
         return 0
     g0 = data["y"]
+    _print_provenance(p)
     print(f"{p.name}  (wavelength {g0.wavelength_nm:g} nm, focus {format_distance(st.focus_from_film_mm, units_of(args))} "
           f"from the film, {st.method} focusing, back focus {st.back_focus_mm:.3f} mm)")
     t = Table("first-order data (mm; magnification < 0: an inverted image)", ["quantity"])
@@ -329,6 +346,18 @@ def run_show(args) -> int:
             t.add_row(point.replace("_", " "), *[_fmt(pos[ref][point]) for ref, _ in refs])
         print_table(t)
     return 0
+
+
+def _print_provenance(p) -> None:
+    """The lines ``lens show`` prints above its tables: where the lens's numbers come from, its licence."""
+    from ..lens.provenance import provenance_of
+
+    prov = provenance_of(p)
+    if prov.source is None and prov.licence is None:
+        return
+    checked = {True: "; every number checked against it", False: "; numbers not checked against it"}
+    print(f"source: {prov.source or 'not given'}{checked.get(prov.primary_source_checked, '')}")
+    print(f"licence: {prov.licence or 'not given'}")
 
 
 def diagram_options(args) -> dict:
