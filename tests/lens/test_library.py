@@ -1,9 +1,13 @@
+import json
+from pathlib import Path
+
 import pytest
 
 from physcam.errors import InputError
 from physcam.lens.formats import dumps_lens, loads_lens, read_lens
 from physcam.lens.formats._common import extra
 from physcam.lens.library import find_lens, list_lenses, load_lens
+from physcam.lens.provenance import provenance_of
 
 from lens_reference import ISET_FILES, PBRT_FILES, REFERENCE, SEED_FILES, SEED_INVALID
 
@@ -89,3 +93,78 @@ def test_a_slug_loads_the_lens_the_index_finds():
         for other in recs:
             if other.slug != rec.slug:
                 assert _key(rec.slug) not in {_key(other.name), *map(_key, other.aliases)}
+
+
+# ---- provenance (issue 44) -------------------------------------------------------------------
+ORACLE = json.loads((Path(__file__).resolve().parents[1] / "data" / "optiland_library.json").read_text())["lenses"]
+OTHER_PROJECTS = ("Blender", "pbrt-v4-scenes", "isetlens", "Physical Camera")
+
+
+@pytest.mark.parametrize("rec", list_lenses(), ids=lambda r: r.slug)
+def test_every_bundled_lens_carries_a_provenance_record(rec):
+    prov = provenance_of(load_lens(rec.slug))
+    assert prov.source and not any(name in prov.source for name in OTHER_PROJECTS)  # the primary source
+    assert prov.licence and rec.licence == prov.licence
+    assert prov.transcribed and prov.checked and prov.transcribed_by and prov.checked_by
+    assert isinstance(prov.primary_source_checked, bool) and prov.checks and prov.assumptions
+    if not prov.primary_source_checked:  # where the numbers came from instead, and said to be unchecked
+        assert prov.transcribed_from and "not" in prov.transcribed_from
+        assert any(c.startswith("primary source: not reached") for c in prov.checks)
+        assert prov.licence == "NOASSERTION"
+    kinds = {a.split(":")[0] for a in prov.assumptions}
+    assert {"stop", "semi-diameters"} <= kinds and any(k == "glass" for k in kinds)
+
+
+@pytest.mark.parametrize("rec", list_lenses(), ids=lambda r: r.slug)
+def test_bundled_efl_and_f_number_match_optiland(rec):
+    from physcam.optics.paraxial import gaussian
+
+    p = load_lens(rec.slug)
+    for axis, want in ORACLE[rec.slug].items():  # optiland 0.6.3: scripts/optiland_library_oracle.py
+        g = gaussian(p, axis=axis)
+        assert g.efl == pytest.approx(want["efl_mm"], rel=1e-3)
+        assert g.f_number == pytest.approx(want["f_number"], rel=1e-3)
+
+
+def test_named_glasses_are_the_files_numbers_to_their_printed_digits():
+    # a catalogue glass is named only where the file's nd and Vd, as printed, are that glass's
+    from physcam.lens.catalog import find_glass
+
+    named = 0
+    for rec in list_lenses():
+        for s in load_lens(rec.slug).surfaces:
+            m = s.medium
+            if m.glass:
+                g = find_glass(m.glass, [m.catalog])
+                assert abs(g.nd - m.nd) <= 5e-4 + 1e-9 and abs(g.vd - m.vd) <= 0.05 + 1e-9, (rec.slug, m)
+                named += 1
+    assert named >= 60
+
+
+def test_lenses_and_lens_show_print_source_and_licence(capsys):
+    from physcam.cli import main
+
+    assert main(["lenses"]) == 0
+    out = capsys.readouterr().out
+    header = next(line for line in out.splitlines() if line.startswith("name"))
+    assert "source" in header and "licence" in header
+    row = next(line for line in out.splitlines() if line.startswith("tessar_50mm_f2_8 "))
+    assert "US 4,213,674 (Olympus, 1980), embodiment 1" in row and "NOASSERTION" in row
+    assert main(["lens", "show", "--lens", "tessar_50mm_f2_8"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "source: US 4,213,674 (Olympus, 1980), embodiment 1; numbers not checked against it"
+    assert lines[1] == "licence: NOASSERTION"
+    assert main(["lens", "show", "--lens", "tessar_50mm_f2_8", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["provenance"]["source"] == "US 4,213,674 (Olympus, 1980), embodiment 1"
+    assert doc["provenance"]["primary_source_checked"] is False
+
+
+def test_lens_check_says_what_the_provenance_record_says():
+    from physcam.lens.check import check
+
+    notes = {f.code: f for f in check("tessar_50mm_f2_8") if f.severity == "note"}
+    assert "US 4,213,674" in notes["provenance_unchecked"].message
+    assert "Blender" in notes["provenance_unchecked"].implication
+    assert "NOASSERTION" in notes["licence_unresolved"].message
+    assert not {"provenance_unchecked", "licence_unresolved"} & {f.code for f in check(REFERENCE / "pbrt-dat" / "dgauss.50mm.dat")}

@@ -27,7 +27,7 @@ from ..errors import InputError, LensFileError
 from .prescription import Prescription, takes_prescription
 
 __all__ = ["LensRecord", "list_lenses", "load_lens", "find_lens", "library_dir", "user_library_dir", "load_repaired",
-           "repairs_of", "REPAIRED_KEY", "camera_use", "require_camera_lens", "USER_LIBRARY_ENV", "USER_LENS_FILE"]
+           "repairs_of", "bundled_lens_named", "REPAIRED_KEY", "camera_use", "require_camera_lens", "USER_LIBRARY_ENV", "USER_LENS_FILE"]
 
 #: Environment variable naming the user's lens library folder (overrides the XDG data folder).
 USER_LIBRARY_ENV = "PHYSCAM_LENS_LIBRARY"
@@ -223,6 +223,16 @@ def find_lens(name: str) -> LensRecord:
     hint = f"; did you mean {', '.join(names)}?" if names else ""
     raise InputError(f"no bundled lens called {name!r}, nor one in your library{hint} (`physcam lenses` lists them; "
                      "a file path also works)")
+
+
+def bundled_lens_named(*labels: str) -> LensRecord | None:
+    """The bundled lens one of ``labels`` names (slug, name or alias; case and punctuation ignored), or
+    None: a lens of the user's library may not take a bundled lens's name (it would never be found)."""
+    keys = {_key(x) for x in labels}
+    for rec in list_lenses("bundled"):
+        if keys & {_key(x) for x in (rec.slug, rec.name, *rec.aliases)}:
+            return rec
+    return None
 
 
 def repairs_of(p: Prescription) -> list[str]:
