@@ -126,6 +126,11 @@ def register(sub) -> None:
     add_output_options(f, what="the repairs")
     f.set_defaults(handler=run_fix)
 
+    _register_archives(lsub)
+
+
+def _register_archives(lsub) -> None:
+    """``lens pack`` and ``lens add``: lens archives (docs/lens-library.md)."""
     k = lsub.add_parser("pack", help="publish a lens as one archive: prescription, USD lens file, lens card, provenance",
                         description="Write a lens archive (docs/lens-library.md): the prescription with its provenance "
                                     "(lens.toml), a USD vendor lens file with the detailed model, its best-match pinhole "

@@ -117,6 +117,9 @@ def check_provenance_table(prov: dict, path=None) -> None:
     """Refuse a ``[provenance]`` table whose known keys have the wrong kind of value (file named):
     texts are strings, ``transcribed``/``checked`` ISO dates (YYYY-MM-DD), lists lists of strings,
     ``primary_source_checked`` true or false. Other keys are kept as they are."""
+    from ..errors import require_type
+
+    require_type("prov", prov, dict, "the [provenance] table of a lens TOML, as tomllib reads it")
     for key, v in prov.items():
         where = f"[provenance] {key}"
         if key in TEXT_KEYS and not isinstance(v, str):
