@@ -213,3 +213,18 @@ def test_user_library_is_the_xdg_data_folder(monkeypatch, tmp_path):
     monkeypatch.delenv("XDG_DATA_HOME")
     monkeypatch.setenv("HOME", str(tmp_path / "home"))
     assert user_library_dir() == tmp_path / "home" / ".local" / "share" / "physcam" / "lenses"
+
+
+def test_characterization_rows_by_date_or_variant(tmp_path):
+    from physcam.cli.lens import _read_runs
+    from physcam.errors import LensFileError
+
+    f = tmp_path / "runs.csv"
+    f.write_text("date,efl_mm,note\n2026-03-01,50.04,first\n")
+    assert _read_runs(f) == {"d2026_03_01": {"efl_mm": 50.04, "note": "first"}}
+    f.write_text("variant,efl mm\nrun_1,50.0\n")
+    with pytest.raises(LensFileError, match="letters, digits and underscores"):
+        _read_runs(f)
+    f.write_text("variant,efl_mm\n,50.0\n")
+    with pytest.raises(LensFileError, match="without a variant"):
+        _read_runs(f)

@@ -152,8 +152,9 @@ def test_lenses_and_lens_show_print_source_and_licence(capsys):
     assert "US 4,213,674 (Olympus, 1980), embodiment 1" in row and "NOASSERTION" in row
     assert main(["lens", "show", "--lens", "tessar_50mm_f2_8"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0] == "source: US 4,213,674 (Olympus, 1980), embodiment 1; numbers not checked against it"
-    assert lines[1] == "licence: NOASSERTION"
+    assert lines[0].startswith("Tessar 50mm f/2.8  (wavelength 587.562 nm")
+    assert lines[1] == "source: US 4,213,674 (Olympus, 1980), embodiment 1; numbers not checked against it"
+    assert lines[2] == "licence: NOASSERTION"
     assert main(["lens", "show", "--lens", "tessar_50mm_f2_8", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["provenance"]["source"] == "US 4,213,674 (Olympus, 1980), embodiment 1"

@@ -363,9 +363,9 @@ def run_show(args) -> int:
         print_csv(show_points(data))
         return 0
     g0 = data["y"]
-    _print_provenance(p)
     print(f"{p.name}  (wavelength {g0.wavelength_nm:g} nm, focus {format_distance(st.focus_from_film_mm, units_of(args))} "
           f"from the film, {st.method} focusing, back focus {st.back_focus_mm:.3f} mm)")
+    _print_provenance(p)
     t = Table("first-order data (mm; magnification < 0: an inverted image)", ["quantity"])
     for a in data:
         t.add_column(f"{a.upper()} meridian", justify="right")
