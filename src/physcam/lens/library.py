@@ -156,7 +156,7 @@ def _bundled_index() -> tuple[tuple[LensRecord, Prescription], ...]:
     return tuple(out)
 
 
-@lru_cache(maxsize=8)
+@lru_cache(maxsize=256)
 def _user_lens(path: str, mtime_ns: int, size: int) -> Prescription:
     from .formats import read_lens
 
