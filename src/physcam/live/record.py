@@ -207,6 +207,9 @@ def time_line(frames, codes) -> set[int]:
     patience sorting, O(n log n) (Knuth, TAOCP vol. 3, 5.1.4; Fredman 1975)."""
     import bisect
 
+    frames = [] if isinstance(frames, (list, tuple)) and not frames else _frames(frames)
+    if isinstance(codes, (str, bytes)) or not hasattr(codes, "__len__") or len(codes) != len(frames):
+        raise InputError("codes must be a list of time codes, one per frame (time_codes(frames))")
     per_source: dict = {}
     for i, f in enumerate(frames):
         per_source.setdefault(f.source, []).append(i)
