@@ -100,16 +100,18 @@ class _Recorder:
         return False
 
 
-def _wait_for_lines(path: Path, n: int, proc, timeout: float = 60.0) -> None:
-    """Until ``path`` holds ``n`` whole lines (the recorder has journaled what was sent)."""
+def _wait_for_samples(path: Path, n: int, proc, timeout: float = 60.0) -> None:
+    """Until the journal ``path`` holds ``n`` whole sample lines (the recorder has journaled what was
+    sent; its once-a-second counters lines are not counted)."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         if proc.poll() is not None:
-            raise RuntimeError(f"the recorder exited ({proc.returncode}) before journaling {n} lines")
-        if path.exists() and path.read_bytes().count(b"\n") >= n:
+            raise RuntimeError(f"the recorder exited ({proc.returncode}) before journaling {n} samples")
+        if path.exists() and sum(line.startswith(b'{"sequence":') and line.endswith(b"\n")
+                                 for line in path.read_bytes().splitlines(keepends=True)) >= n:
             return
         time.sleep(0.05)
-    raise TimeoutError(f"{path} holds fewer than {n} lines after {timeout} s")
+    raise TimeoutError(f"{path} holds fewer than {n} samples after {timeout} s")
 
 
 def _sequence_numbers(usd_file) -> list[int]:
@@ -340,7 +342,7 @@ def test_a_killed_recorder_keeps_its_take_and_recover_writes_it(tmp_path, capsys
         rec.wait_for_port()
         with Sender("127.0.0.1", rec.port, encoding="cbor") as tx:
             tx.stream(samples, 240)
-        _wait_for_lines(journal, 1 + 30, rec.proc)  # the header and one line per sample
+        _wait_for_samples(journal, 30, rec.proc)
         rec.proc.kill()
         rec.proc.communicate(timeout=60)
     assert rec.proc.returncode == -signal.SIGKILL
@@ -382,7 +384,7 @@ def test_a_name_taken_while_recording_gets_a_free_name(tmp_path):
         rec.wait_for_port()
         with Sender("127.0.0.1", rec.port, encoding="cbor") as tx:
             tx.stream(samples[:5], 240)
-            _wait_for_lines(tmp_path / "take.usda.journal", 1 + 5, rec.proc)
+            _wait_for_samples(tmp_path / "take.usda.journal", 5, rec.proc)
             (tmp_path / "take.usda").write_text("someone else's camera\n")
             (tmp_path / "take.csv").write_text("someone else's report\n")
             tx.stream(samples[5:], 240)
@@ -442,8 +444,8 @@ def test_a_full_disk_at_the_end_loses_no_take(tmp_path, spare):
         rec.wait_for_port()
         with Sender("127.0.0.1", rec.port, encoding="cbor") as tx:
             tx.stream(samples[:9], 240)
-            _wait_for_lines(inside / "take.usda.journal", 1 + 9, rec.proc)
-            _fill(inside, leave=0 if spare == "writable" else 16384)
+            _wait_for_samples(inside / "take.usda.journal", 9, rec.proc)
+            _fill(inside, leave=0 if spare == "writable" else 8192)  # the USD needs 14 KB
             tx.send(samples[9])
         rc = rec.finish()
     assert "Traceback" not in rec.stderr
