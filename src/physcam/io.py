@@ -24,6 +24,8 @@ import re
 import secrets
 import shutil
 import socket
+import stat
+import tempfile
 from pathlib import Path
 
 from .errors import ExportError
@@ -38,14 +40,102 @@ TEMP_MARK = ".physcam-tmp."
 _TEMP_NAME_BYTES = 120
 
 
+_SPECIAL = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+            (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISSOCK, "a socket"))
+
+
+def _through_fd(p: Path) -> int | None:
+    """The file descriptor to write ``p`` through, when ``p`` is a target physcam writes into rather
+    than replaces: this process's standard output or error (``/dev/stdout``, ``/dev/fd/2``, or the
+    file, pipe or terminal they are), or the null device (same device numbers as ``os.devnull``,
+    wherever its node lives): -1 for the null device (opened when written). None for any other path."""
+    try:
+        st = os.stat(p)
+    except (OSError, ValueError):
+        return None
+    for fd in (1, 2):
+        try:
+            if os.path.samestat(st, os.fstat(fd)):
+                return fd
+        except OSError:
+            pass
+    try:
+        null = os.stat(os.devnull)
+    except OSError:
+        return None
+    if stat.S_ISCHR(st.st_mode) and stat.S_ISCHR(null.st_mode) and st.st_rdev == null.st_rdev:
+        return -1
+    return None
+
+
+def _refuse_special(p: Path) -> None:
+    """:class:`ExportError` when ``p`` exists and is a device, FIFO or socket (symbolic links
+    followed) that physcam would otherwise replace by renaming a file over it."""
+    try:
+        mode = os.stat(p).st_mode
+    except (OSError, ValueError):
+        return
+    for test, what in _SPECIAL:
+        if test(mode):
+            raise ExportError(f"{p} is {what}, not a regular file: physcam writes a file whole and renames it into "
+                              "place, which would replace it; write to a regular file (or /dev/null, or /dev/stdout "
+                              "for standard output)")
+
+
 def check_writable(path, *, force: bool = False) -> Path:
-    """Return ``path`` as a Path; raise :class:`ExportError` if it exists and ``force`` is false."""
+    """Return ``path`` as a Path; raise :class:`ExportError` if it exists and ``force`` is false.
+
+    A device, FIFO or socket is refused even with ``force`` (renaming a file over it would replace
+    it), except the targets written through, never replaced and needing no ``force``: the null
+    device and this process's standard output or error (``/dev/null``, ``/dev/stdout``)."""
     p = Path(path)
+    if _through_fd(p) is not None:
+        return p
+    _refuse_special(p)
     if p.exists() and not force:
         raise ExportError(f"{p} already exists; pass --force (force=True) to overwrite it")
     if p.exists() and p.is_dir():
         raise ExportError(f"{p} is a directory, not a file")
     return p
+
+
+def _write_through(tmp: str, p: Path, fd: int) -> None:
+    """Copy the finished temporary ``tmp`` into ``p`` through ``fd`` (:func:`_through_fd`): standard
+    output or error after Python's own buffer of it, at the stream's place; the null device opened."""
+    import sys
+
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(AttributeError, OSError, ValueError):
+            stream.flush()
+    own = fd < 0
+    if own:
+        fd = os.open(p, os.O_WRONLY)
+    try:
+        with open(tmp, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                view = memoryview(block)
+                while view:
+                    view = view[os.write(fd, view):]
+    finally:
+        if own:
+            os.close(fd)
+
+
+@contextlib.contextmanager
+def _staged_through(p: Path, fd: int, suffix: str):
+    """:func:`staged` for a target written through: the temporary lives in the system's temporary folder."""
+    handle, tmp = tempfile.mkstemp(prefix=".physcam-tmp.", suffix=suffix)
+    os.close(handle)
+    try:
+        yield Path(tmp)
+        _write_through(tmp, p, fd)
+    except OSError as exc:
+        if isinstance(exc, BrokenPipeError):
+            raise  # a reader that has gone: the CLI's quiet exit
+        raise ExportError(f"cannot write {p}: {exc.strerror or exc}") from None
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
 
 
 def _umask() -> int:
@@ -153,8 +243,15 @@ def staged(path, *, force: bool = False, suffix: str = ".tmp"):
     """Write a file in place atomically: yields a temporary path (ending in ``suffix``, for
     libraries that pick a format by extension) next to ``path``; fill it, and on leaving the
     block it is synced and renamed to ``path`` (see :func:`atomic_write` for ``force``). On an
-    error the temporary is removed; stale temporaries of ``path`` are removed first (module notes)."""
+    error the temporary is removed; stale temporaries of ``path`` are removed first (module notes).
+    A device, FIFO or socket is never renamed over (:func:`check_writable`); the null device and
+    standard output or error get the finished temporary's bytes written through."""
     p = check_writable(path, force=force)
+    fd = _through_fd(p)
+    if fd is not None:
+        with _staged_through(p, fd, suffix) as tmp:
+            yield tmp
+        return
     try:
         _make_folder(p)
         remove_stale_temporaries(p)
@@ -170,6 +267,7 @@ def staged(path, *, force: bool = False, suffix: str = ".tmp"):
         replaced = force and p.exists()
         os.chmod(tmp, (os.stat(p).st_mode & 0o7777) if replaced else (0o666 & ~_umask()))
         if force:
+            _refuse_special(p)  # made meanwhile: never renamed over
             os.replace(tmp, p)
         else:
             _publish_new(tmp, p)
