@@ -30,8 +30,8 @@ from pathlib import Path
 
 from .errors import ExportError
 
-__all__ = ["atomic_write", "check_writable", "folder_manifest", "remove_stale_temporaries", "staged",
-           "staged_folder", "MANIFEST_NAME"]
+__all__ = ["atomic_write", "check_writable", "folder_manifest", "refuse_inputs_as_outputs", "remove_stale_temporaries",
+           "staged", "staged_folder", "MANIFEST_NAME"]
 
 #: What marks a physcam temporary file's name, after the hidden target name.
 TEMP_MARK = ".physcam-tmp."
@@ -136,6 +136,42 @@ def _staged_through(p: Path, fd: int, suffix: str):
     finally:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+
+
+def refuse_inputs_as_outputs(inputs, outputs, *, folders=()) -> None:
+    """Raise :class:`ExportError` in one line when an output would overwrite an input.
+
+    ``outputs`` (files) and ``folders`` (outputs written whole, :func:`staged_folder`) may not be an
+    input: the same file or folder by ``os.stat`` identity (device and inode), so a symbolic link to
+    the input, a hard link of it and another spelling of its path all count; nor may an input lie
+    inside one of ``folders``, which the write replaces. Paths are str or Path (None and "" skipped);
+    an input that does not exist is skipped (a bundled lens's name is not a file)."""
+    ins = []
+    for i in inputs:
+        if i is None or (isinstance(i, str) and not i):
+            continue
+        try:
+            ins.append((Path(i), os.stat(i), os.path.realpath(i)))
+        except (OSError, ValueError, TypeError):
+            continue
+    for o, whole in [(o, False) for o in outputs] + [(f, True) for f in folders]:
+        if o is None or (isinstance(o, str) and not o) or _through_fd(Path(o)) is not None:
+            continue  # /dev/null and standard output are written through, never replaced
+        try:
+            so = os.stat(o)
+        except (OSError, ValueError, TypeError):
+            so = None
+        try:
+            inside = os.path.realpath(o).rstrip(os.sep) + os.sep
+        except (OSError, ValueError, TypeError):
+            continue
+        for pi, si, ri in ins:
+            if so is not None and os.path.samestat(si, so):
+                raise ExportError(f"the output {o} is the input {pi} (the same file): writing it would destroy the "
+                                  "input; choose another output")
+            if whole and ri.startswith(inside):
+                raise ExportError(f"the input {pi} lies inside the output folder {o}, which is written whole "
+                                  "(replaced with --force): choose another output folder")
 
 
 def _umask() -> int:
@@ -367,6 +403,14 @@ def _replaceable(p: Path) -> bool:
         return False
 
 
+def _empty_folder(p: Path) -> bool:
+    """Whether ``p`` is an empty folder (not a symbolic link to one): written into without ``force``."""
+    try:
+        return not p.is_symlink() and p.is_dir() and not any(p.iterdir())
+    except OSError:
+        return False
+
+
 def _not_ours_error(p: Path) -> ExportError:
     return ExportError(f"{p} holds files physcam did not write there; --force replaces only a folder "
                        f"physcam wrote whole (one with a {MANIFEST_NAME}) or an empty one: choose a new output folder")
@@ -381,6 +425,14 @@ def _publish_folder(tmp: Path, p: Path, force: bool) -> None:
             raise _exists_error(p)
         os.rename(tmp, p)
         return
+    if not force and not p.is_symlink() and p.is_dir():
+        try:  # an empty folder is filled without force: rename(2) replaces an empty directory only
+            os.rename(tmp, p)
+            return
+        except OSError as exc:
+            if exc.errno not in (errno.ENOTEMPTY, errno.EEXIST):
+                raise
+        raise _exists_error(p)
     if not force:
         raise _exists_error(p)
     if p.is_symlink() or not p.is_dir():
@@ -422,12 +474,14 @@ def staged_folder(path, *, force: bool = False, about: dict | None = None):
     rename. A writer killed at any moment leaves either the previous folder or the new one, never a
     mix (its temporary folder is removed by the next write of ``path``).
 
-    ``force`` replaces an existing folder only if physcam wrote it (it has a manifest) or it is empty,
-    so a user's own files are never deleted; an error in the block removes the temporary folder.
+    An existing empty folder is filled without ``force`` (nothing is overwritten; the rename fails if
+    files appear in it meanwhile). ``force`` replaces an existing folder only if physcam wrote it (it has
+    a manifest) or it is empty, so a user's own files are never deleted; an error in the block removes
+    the temporary folder.
     :func:`folder_manifest` tells whether a folder is complete.
     """
     p = Path(path)
-    if (p.exists() or p.is_symlink()) and not force:
+    if (p.exists() or p.is_symlink()) and not force and not _empty_folder(p):
         raise _exists_error(p)
     if p.is_dir() and not _replaceable(p):
         raise _not_ours_error(p)  # before any work is done
