@@ -396,10 +396,19 @@ def folder_manifest(path) -> dict | None:
 
 
 def _replaceable(p: Path) -> bool:
-    """Whether ``--force`` may replace folder ``p`` whole: it is empty, or physcam wrote it."""
+    """Whether ``--force`` may replace folder ``p`` whole: it is empty, or physcam wrote it and it holds
+    no file its manifest does not list (a file the user put there since is never deleted with it)."""
     try:
-        return not any(p.iterdir()) or (p / MANIFEST_NAME).is_file()
-    except OSError:
+        if not any(p.iterdir()):
+            return True
+        doc = json.loads((p / MANIFEST_NAME).read_text(encoding="utf-8"))
+        listed = {e["path"] for e in doc["files"]} | {MANIFEST_NAME}
+        for folder, _dirs, files in os.walk(p):
+            for name in files:
+                if Path(folder, name).relative_to(p).as_posix() not in listed:
+                    return False
+        return True
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return False
 
 
