@@ -27,6 +27,7 @@ import ast
 import dataclasses
 import io
 import json
+import os
 import re
 import tokenize
 import xml.etree.ElementTree as ET
@@ -504,3 +505,21 @@ def test_cli_export_blender_of_a_hostile_lens_file(tmp_path, capsys):
     assert c_code((outs["evil"] / "evil.osl").read_text()) == c_code((outs["plain"] / "plain.osl").read_text())
     for script in ("setup_evil.py", "builtin_evil.py"):
         _python((outs["evil"] / script).read_text())
+
+
+def test_cli_metadata_usd_of_a_clip_with_an_undecodable_file_name(tmp_path, capsys):
+    """The clip's file name goes into the camera's ``physcam:source`` description: a name with a byte
+    that is not UTF-8 (a surrogate in Python) was a traceback at the write; it is shown as U+FFFD."""
+    pytest.importorskip("pxr")
+    from pxr import Usd
+
+    from physcam.cli import main
+
+    clip = tmp_path / os.fsdecode(b"clip\xff.csv")
+    clip.write_bytes((Path(__file__).resolve().parents[2] / "src/physcam/data/samples/"
+                      "arri_alexa_lf_B001C001_first48.csv").read_bytes())
+    assert main(["metadata", "usd", str(clip), "-o", str(tmp_path / "cam.usda")]) == 0
+    capsys.readouterr()
+    stage = Usd.Stage.Open(str(tmp_path / "cam.usda"))
+    sources = [p.GetCustomDataByKey("physcam:source") for p in stage.Traverse() if p.GetTypeName() == "PhysicalCamera"]
+    assert sources == ["arri camera metadata read by physcam metadata usd (clip\ufffd.csv)"]
