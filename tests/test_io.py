@@ -281,3 +281,17 @@ def test_cli_output_to_a_fifo_or_dev_null(tmp_path, capsys):
     assert stat.S_ISFIFO(os.stat(fifo).st_mode)
     assert main(argv + [os.devnull]) == 0
     assert stat.S_ISCHR(os.stat(os.devnull).st_mode)
+
+
+def test_a_folder_output_never_replaces_a_fifo_or_the_null_device(tmp_path):
+    """Before any work is done (the block is never entered), with or without force."""
+    from physcam.io import staged_folder
+
+    fifo = tmp_path / "maps"
+    os.mkfifo(fifo)
+    for target in (fifo, os.devnull):
+        for force in (False, True):
+            with pytest.raises(ExportError, match="already exists|not a folder"), staged_folder(target, force=force):
+                pytest.fail("the block ran")
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode) and stat.S_ISCHR(os.stat(os.devnull).st_mode)
+    assert [p.name for p in tmp_path.iterdir()] == ["maps"]

@@ -492,6 +492,8 @@ def staged_folder(path, *, force: bool = False, about: dict | None = None):
     p = Path(path)
     if (p.exists() or p.is_symlink()) and not force and not _empty_folder(p):
         raise _exists_error(p)
+    if (p.exists() or p.is_symlink()) and (p.is_symlink() or not p.is_dir()):
+        raise ExportError(f"{p} is not a folder; remove it or choose another output folder")  # before any work
     if p.is_dir() and not _replaceable(p):
         raise _not_ours_error(p)  # before any work is done
     try:
