@@ -10,6 +10,11 @@ power loss) leaves its temporary behind; the next write of the same target remov
 processes on this host that no longer run (:func:`remove_stale_temporaries`). Temporaries of
 running processes, and of other hosts sharing the folder (whose processes cannot be seen from
 here), are left alone.
+
+Renaming over a name replaces whatever it names, so a device, FIFO or socket is never a target
+(:func:`check_writable` refuses it, ``force`` or not); the null device and this process's standard
+output and error are written through instead. :func:`refuse_inputs_as_outputs` keeps a command from
+writing over a file it reads, and :func:`staged_folder` writes a folder of outputs as a whole.
 """
 
 from __future__ import annotations
