@@ -5,6 +5,7 @@ unknown glasses, truncation, .agf catalogues, --glass-catalog and the config key
 
 import json
 import math
+import warnings
 from pathlib import Path
 
 import pytest
@@ -12,7 +13,7 @@ import pytest
 from physcam.cli import main
 from physcam.errors import LensFileError
 from physcam.lens.agf import loads_agf
-from physcam.lens.catalog import GlassNotFound, find_glass, use_catalog_files, user_catalogs
+from physcam.lens.catalog import GlassNotFound, find_glass, strict_glass, use_catalog_files, user_catalogs
 from physcam.lens.formats import dumps_lens, loads_lens, read_lens
 from physcam.optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM, LINE_G_NM, glass_index, medium_dispersion
 from physcam.optics.paraxial import gaussian
@@ -81,11 +82,21 @@ def test_gcat_order_decides_which_f2():
 
 def test_unknown_glass_names_catalogues_line_and_where_it_is():
     text = (DATA / "zemax" / "asphere_780nm.zmx").read_text().replace("GCAT OHARA SCHOTT", "GCAT SCHOTT CORNING")
-    with pytest.raises(LensFileError) as exc:
+    with strict_glass(), pytest.raises(LensFileError) as exc:  # OpticStudio's refusal, kept by --strict-glass
         loads_lens(text, "zemax", "a.zmx")
     msg = str(exc.value)
     assert "a.zmx" in msg and ":22:" in msg and "not in SCHOTT" in msg and "CORNING" in msg
     assert "S-LAH64 is in OHARA, which was not searched" in msg
+    # issue 40 item 15: by default it loads, OHARA's own S-LAH64, with one warning naming OHARA
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        lens = loads_lens(text, "zemax", "a.zmx")
+    assert [str(w.message) for w in seen] == [
+        "a.zmx: S-LAH64 taken from OHARA (not in GCAT SCHOTT CORNING; --strict-glass refuses it, as OpticStudio does)"]
+    glass = next(s.medium for s in lens.surfaces if s.medium.glass)
+    assert (glass.glass, glass.catalog, glass.nd, glass.vd) == ("S-LAH64", "OHARA", 1.788, 47.37)  # OHARA's sheet
+    with pytest.raises(LensFileError, match="unknown glass 'S-QQQ64'"):  # a name in no catalogue is still an error
+        loads_lens(text.replace("S-LAH64", "S-QQQ64"), "zemax", "a.zmx")
     with pytest.raises(GlassNotFound, match="nearest names: N-BK7"):
         find_glass("N-BK8", ["SCHOTT"])
 
