@@ -13,7 +13,7 @@ whole)::
 
 Each file is read by physcam's own .agf reader (physcam.lens.agf, which checks every number), and
 a glass is kept when physcam's current catalogue of that maker (SCHOTT.json, OHARA.json, from the
-makers' spreadsheets) does not hold its name: SCHOTT's lead glasses (SK16, F15, SK1, SSK4A...),
+makers' spreadsheets) does not hold its name (spaces aside: OHARA's sheet writes "S-TIL 2"): SCHOTT's lead glasses (SK16, F15, SK1, SSK4A...),
 BK7, B270; OHARA's names before the S- prefix (LAH64, FPL51...) and its withdrawn S- glasses. Per
 glass: name, Zemax formula and coefficients (lambda in um), nd and Vd as on the NM line, the LD
 range (nm), the 10 mm internal transmission rows, and the catalogue's status (Zemax's code:
@@ -52,11 +52,12 @@ def build(maker: str, agf: Path) -> dict:
     data = _read_bytes(agf)
     text = _decode(data, str(agf))
     glasses = loads_agf(text, f"{maker}_LEGACY", str(agf))
-    current = {g["name"].upper() for g in json.loads((OUT / f"{maker}.json").read_text(encoding="utf-8"))["glasses"]}
+    sheet = json.loads((OUT / f"{maker}.json").read_text(encoding="utf-8"))["glasses"]
+    current = {g["name"].upper().replace(" ", "") for g in sheet}  # OHARA's sheet writes "S-TIL 2", its .agf "S-TIL2"
     status = _statuses(text)
     rows = []
     for key, g in glasses.items():
-        if key in current:
+        if key.replace(" ", "") in current:
             continue
         row = {"name": g.name, "formula": g.formula, "coefficients": list(g.coefficients), "nd": g.nd, "vd": g.vd,
                "status": STATUS.get(status.get(key), "unknown")}

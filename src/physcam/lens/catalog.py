@@ -87,6 +87,8 @@ def _load_builtin(name: str) -> dict[str, CatalogGlass]:
             float(g.get("dpgf", 0.0)), g.get("status")))
     for g in _EXTRA.get(name, ()):
         out.setdefault(g.name.upper(), g)
+    for key, g in list(out.items()):  # OHARA's sheet writes "S-TIL 2", its .agf and Zemax files "S-TIL2"
+        out.setdefault(key.replace(" ", ""), g)
     return out
 
 
