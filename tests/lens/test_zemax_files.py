@@ -309,6 +309,18 @@ def test_legacy_glasses_are_schotts_own_data(name):
     assert g.maker == "SCHOTT_LEGACY" and g.status in ("obsolete", "standard")
 
 
+def test_hikari_and_ohara_legacy_glasses_of_real_files():
+    """Thorlabs' AC254-060-A names HIKARI's withdrawn E-BAF11 (GCAT SCHOTT MISC HIKARI ...); optiland's
+    lens2.zmx OHARA's L-BAL35: each loads from its maker's legacy catalogue, its nd the NM line's."""
+    from physcam.lens.catalog import resolve_glass
+
+    g, how = resolve_glass("E-BAF11", ["SCHOTT", "MISC", "HIKARI"])
+    assert (g.maker, how, g.status) == ("HIKARI_LEGACY", "legacy", "obsolete")
+    assert float(g.index(LINE_D_NM)) == pytest.approx(1.666718, abs=2e-5)
+    g, how = resolve_glass("L-BAL35", ["SCHOTT", "OHARA"])
+    assert (g.maker, how) == ("OHARA_LEGACY", "legacy") and float(g.index(LINE_D_NM)) == pytest.approx(g.nd, abs=2e-5)
+
+
 def test_b270_against_schotts_1993_data_sheet():
     """B 270 from Zemax's catalogue (a Schott-series formula) against the indices SCHOTT's B 270 data
     sheet (August 1993, as tabulated by refractiveindex.info) prints to 4 decimals: an independent
