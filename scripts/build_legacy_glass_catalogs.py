@@ -1,22 +1,25 @@
 """Write physcam's legacy glass catalogues (src/physcam/data/glass/SCHOTT_LEGACY.json, OHARA_LEGACY.json,
-HIKARI_LEGACY.json) from the public Zemax .agf files that carry the makers' obsolete glasses.
+HIKARI_LEGACY.json, HOYA_LEGACY.json) from the public Zemax .agf files that carry the makers' obsolete glasses.
 
 The sources (data/glass/SOURCES.md): Zemax OpticStudio's SCHOTT.AGF whose header reads "SCHOTT
 Preferred optical glasses. 26th February 2008 plus B270 and obsolete glasses", and OHARA's own
 catalogue "Updated 18.10.19" (standard, special-order and obsolete glasses), and HIKARI's catalogue
-as Zemax distributed it ("Hikari Glass Co. Catalog", with its E- glasses), all as published in
+as Zemax distributed it ("Hikari Glass Co. Catalog", with its E- glasses), and HOYA's own
+"20220711 HOYA Optical Glass Catalog" with its obsolete glasses, all as published in
 the KrakenOS repository (GPL-3.0; the files are the makers' data, read here, never copied
 whole)::
 
     BASE=https://raw.githubusercontent.com/Garchupiter/Kraken-Optical-Simulator/d86353370de44a01cb9fe14d871bc3fb46e472f2/KrakenOS/Cat
-    for f in SCHOTT.AGF ohara.agf hikari.agf; do curl -sLo /tmp/$f $BASE/$f; done
-    .venv/bin/python scripts/build_legacy_glass_catalogs.py /tmp/SCHOTT.AGF /tmp/ohara.agf /tmp/hikari.agf
+    for f in SCHOTT.AGF ohara.agf hikari.agf HOYA20220711_include_obsolete.agf; do curl -sLo /tmp/$f $BASE/$f; done
+    .venv/bin/python scripts/build_legacy_glass_catalogs.py /tmp/SCHOTT.AGF /tmp/ohara.agf /tmp/hikari.agf \
+        /tmp/HOYA20220711_include_obsolete.agf
 
 Each file is read by physcam's own .agf reader (physcam.lens.agf, which checks every number), and
 a glass is kept when physcam's current catalogue of that maker (SCHOTT.json, OHARA.json, from the
 makers' spreadsheets) does not hold its name (spaces aside: OHARA's sheet writes "S-TIL 2"): SCHOTT's lead glasses (SK16, F15, SK1, SSK4A...),
 BK7, B270; OHARA's names before the S- prefix (LAH64, FPL51...) and its withdrawn S- glasses;
-HIKARI's E- glasses (E-BAF11, in Thorlabs' achromats) and other withdrawn ones. Per
+HIKARI's E- glasses (E-BAF11, in Thorlabs' achromats) and other withdrawn ones; HOYA's obsolete
+glasses (FD10, in Thorlabs' achromats). Per
 glass: name, Zemax formula and coefficients (lambda in um), nd and Vd as on the NM line, the LD
 range (nm), the 10 mm internal transmission rows, and the catalogue's status (Zemax's code:
 0 standard, 1 preferred, 2 obsolete, 3 special, 4 melt).
@@ -35,8 +38,9 @@ OUT = ROOT / "src" / "physcam" / "data" / "glass"
 STATUS = {0: "standard", 1: "preferred", 2: "obsolete", 3: "special", 4: "melt"}
 SOURCE = {"SCHOTT": "Zemax SCHOTT.AGF, 'SCHOTT Preferred optical glasses. 26th February 2008 plus B270 and obsolete glasses'",
           "OHARA": "OHARA .agf catalogue, 'Updated 18.10.19'",
-          "HIKARI": "Zemax HIKARI.AGF, 'Hikari Glass Co. Catalog (subsidiary of Nikon)'"}
-MAKERS = ("SCHOTT", "OHARA", "HIKARI")
+          "HIKARI": "Zemax HIKARI.AGF, 'Hikari Glass Co. Catalog (subsidiary of Nikon)'",
+          "HOYA": "HOYA .agf catalogue, '20220711 HOYA Optical Glass Catalog' (obsolete glasses included)"}
+MAKERS = ("SCHOTT", "OHARA", "HIKARI", "HOYA")
 
 
 def _statuses(text: str) -> dict[str, int]:
@@ -78,7 +82,8 @@ def build(maker: str, agf: Path) -> dict:
 
 def main(argv: list[str]) -> None:
     if len(argv) != len(MAKERS):
-        raise SystemExit("usage: build_legacy_glass_catalogs.py SCHOTT.AGF ohara.agf hikari.agf (module notes say where)")
+        raise SystemExit("usage: build_legacy_glass_catalogs.py SCHOTT.AGF ohara.agf hikari.agf HOYA.agf "
+                         "(module notes say where)")
     for maker, path in zip(MAKERS, argv):
         doc = build(maker, Path(path))
         text = json.dumps(doc, separators=(",", ":"), ensure_ascii=False)

@@ -310,8 +310,9 @@ def test_legacy_glasses_are_schotts_own_data(name):
 
 
 def test_hikari_and_ohara_legacy_glasses_of_real_files():
-    """Thorlabs' AC254-060-A names HIKARI's withdrawn E-BAF11 (GCAT SCHOTT MISC HIKARI ...); optiland's
-    lens2.zmx OHARA's L-BAL35: each loads from its maker's legacy catalogue, its nd the NM line's."""
+    """Thorlabs' AC254-060-A names HIKARI's withdrawn E-BAF11 and HOYA's FD10 (GCAT SCHOTT MISC HIKARI
+    HOYA ...); optiland's lens2.zmx OHARA's L-BAL35: each loads from its maker's legacy catalogue,
+    its formula giving the NM line's nd (FD10: 1.72825, HOYA's printed nd)."""
     from physcam.lens.catalog import resolve_glass
 
     g, how = resolve_glass("E-BAF11", ["SCHOTT", "MISC", "HIKARI"])
@@ -319,6 +320,9 @@ def test_hikari_and_ohara_legacy_glasses_of_real_files():
     assert float(g.index(LINE_D_NM)) == pytest.approx(1.666718, abs=2e-5)
     g, how = resolve_glass("L-BAL35", ["SCHOTT", "OHARA"])
     assert (g.maker, how) == ("OHARA_LEGACY", "legacy") and float(g.index(LINE_D_NM)) == pytest.approx(g.nd, abs=2e-5)
+    g, how = resolve_glass("FD10", ["SCHOTT", "MISC", "HIKARI", "HOYA"])  # HOYA's FD10, AC254-060-A's flint
+    assert (g.maker, how, g.status) == ("HOYA_LEGACY", "legacy", "obsolete")
+    assert float(g.index(LINE_D_NM)) == pytest.approx(g.nd, abs=2e-5) and g.nd == pytest.approx(1.72825, abs=1e-5)
 
 
 def test_b270_against_schotts_1993_data_sheet():

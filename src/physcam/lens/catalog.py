@@ -1,16 +1,16 @@
 """Optical-glass catalogues: the makers' own (SCHOTT, OHARA, HOYA, CDGM, HIKARI, SUMITA), their
-legacy glasses (SCHOTT_LEGACY, OHARA_LEGACY, HIKARI_LEGACY), a small MISC one, and any Zemax
-``.agf`` catalogue a user names; glasses found by name, searched in order.
+legacy glasses (SCHOTT_LEGACY, OHARA_LEGACY, HIKARI_LEGACY, HOYA_LEGACY), a small MISC one, and
+any Zemax ``.agf`` catalogue a user names; glasses found by name, searched in order.
 
 The makers' catalogues are JSON files in ``physcam/data/glass`` written by
 ``scripts/build_glass_catalogs.py`` from the makers' spreadsheets (editions and licence notes in
 ``data/glass/SOURCES.md``): per glass the Zemax formula number and coefficients
 (:mod:`physcam.lens.glassformulas`), nd and Vd as printed, the printed C/d/F/g indices, the
 wavelength span, the 10 mm internal transmission and a mark for glasses kept from the previous
-edition. SCHOTT_LEGACY, OHARA_LEGACY and HIKARI_LEGACY (``scripts/build_legacy_glass_catalogs.py``)
-hold what those sheets lack and older catalogues carry: SCHOTT's obsolete glasses (SK16, F15,
+edition. The legacy catalogues (``scripts/build_legacy_glass_catalogs.py``) hold what those sheets lack and older catalogues carry: SCHOTT's obsolete glasses (SK16, F15,
 SK1, BK7...) and B 270 from Zemax's 2008 SCHOTT.AGF, OHARA's glasses from its 2019 .agf (LAH64,
-FPL51...), HIKARI's E- glasses from Zemax's HIKARI.AGF, each with the maker's ``status``. No
+FPL51...), HIKARI's E- glasses from Zemax's HIKARI.AGF, HOYA's obsolete ones from its 2022
+.agf, each with the maker's ``status``. No
 file is read at import: a catalogue loads on its first lookup. MISC holds fused silica (as
 F_SILICA and SILICA) and CaF2 (I. H. Malitson, JOSA 55, 1205 (1965); Appl. Opt. 2, 1103 (1963)),
 the names Zemax's MISC catalogue uses.
@@ -49,13 +49,14 @@ __all__ = ["CatalogGlass", "GlassNotFound", "BUILTIN_CATALOGS", "LEGACY", "GLASS
            "strict_glass", "range_note"]
 
 BUILTIN_CATALOGS = ("SCHOTT", "OHARA", "HOYA", "CDGM", "HIKARI", "SUMITA", "MISC", "SCHOTT_LEGACY", "OHARA_LEGACY",
-                    "HIKARI_LEGACY")
+                    "HIKARI_LEGACY", "HOYA_LEGACY")
 #: A maker's catalogue -> the bundled catalogue of its legacy glasses (module notes).
-LEGACY = {"SCHOTT": "SCHOTT_LEGACY", "OHARA": "OHARA_LEGACY", "HIKARI": "HIKARI_LEGACY"}
+LEGACY = {"SCHOTT": "SCHOTT_LEGACY", "OHARA": "OHARA_LEGACY", "HIKARI": "HIKARI_LEGACY", "HOYA": "HOYA_LEGACY"}
 #: What each legacy catalogue is (data/glass/SOURCES.md), for the reader's warning.
 LEGACY_SOURCE = {"SCHOTT_LEGACY": "SCHOTT's glasses from Zemax's SCHOTT.AGF of 2008",
                  "OHARA_LEGACY": "OHARA's glasses from its .agf catalogue of 2019",
-                 "HIKARI_LEGACY": "HIKARI's glasses from Zemax's HIKARI.AGF"}
+                 "HIKARI_LEGACY": "HIKARI's glasses from Zemax's HIKARI.AGF",
+                 "HOYA_LEGACY": "HOYA's glasses from its .agf catalogue of 2022"}
 _CURRENT = tuple(c for c in BUILTIN_CATALOGS if c not in LEGACY.values())
 _STRICT: contextvars.ContextVar[bool] = contextvars.ContextVar("physcam_strict_glass", default=False)
 
