@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from physcam.cli import main
-from physcam.errors import LensFileError
+from physcam.errors import LensFileError, PhysCamWarning
 from physcam.lens.agf import loads_agf
 from physcam.lens.catalog import GlassNotFound, find_glass, strict_glass, use_catalog_files, user_catalogs
 from physcam.lens.formats import dumps_lens, loads_lens, read_lens
@@ -350,8 +350,14 @@ def test_legacy_glasses_load_by_their_own_name_never_a_substitute():
     assert (media["SK1"].nd, media["SK1"].catalog) == (1.61025, "SCHOTT_LEGACY")
     want = ORACLE["double_gauss_legacy"]
     assert abs(gaussian(lens).efl / want["efl_mm_optiland_lookup"] - 1) > 0.3  # not optiland's substitutes
-    with strict_glass():  # OpticStudio's own SCHOTT.AGF holds these: strict keeps them
+    with strict_glass(), pytest.warns(PhysCamWarning, match="taken from SCHOTT_LEGACY"):
+        # OpticStudio's own SCHOTT.AGF holds these: strict keeps them
         assert read_lens(DATA / "zemax" / "double_gauss_legacy.zmx").surfaces == lens.surfaces
+    with warnings.catch_warnings():  # written back (GCAT SCHOTT: OpticStudio's file holds them) and read again
+        warnings.simplefilter("ignore")
+        assert loads_lens(dumps_lens(lens, "zemax"), "zemax").surfaces == lens.surfaces
+        assert loads_lens(dumps_lens(lens, "physcam"), "physcam").surfaces == lens.surfaces
+    assert "GCAT SCHOTT\n" in dumps_lens(lens, "zemax")
 
 
 def test_a_glass_in_no_catalogue_names_the_nearest_never_takes_it():
