@@ -58,7 +58,8 @@ LEGACY_SOURCE = {"SCHOTT_LEGACY": "SCHOTT's glasses from Zemax's SCHOTT.AGF of 2
                  "HIKARI_LEGACY": "HIKARI's glasses from Zemax's HIKARI.AGF",
                  "HOYA_LEGACY": "HOYA's glasses from its .agf catalogue of 2022"}
 _CURRENT = tuple(c for c in BUILTIN_CATALOGS if c not in LEGACY.values())
-_STRICT: contextvars.ContextVar[bool] = contextvars.ContextVar("physcam_strict_glass", default=False)
+_STRICT: contextvars.ContextVar[bool | None] = contextvars.ContextVar("physcam_strict_glass", default=None)
+_STRICT_RUN = [False]  # the run's setting (use_catalog_files), seen by every thread, as the user catalogues are
 
 
 class GlassNotFound(InputError):
@@ -126,14 +127,15 @@ def use_catalog_files(paths, *, strict: bool = False) -> list[str]:
     _USER.clear()
     for name, glasses in read:
         register_catalog(name, glasses)
-    _STRICT.set(bool(strict))
+    _STRICT_RUN[0] = bool(strict)
     return [name for name, _ in read]
 
 
 @contextlib.contextmanager
 def strict_glass(on: bool = True):
-    """Within the block, a lens file's glass comes only from the catalogues it names (and their
-    makers' legacy ones), as OpticStudio refuses others (:func:`resolve_glass`)."""
+    """Within the block (this thread or task), a lens file's glass comes only from the catalogues it
+    names (and their makers' legacy ones), as OpticStudio refuses others (:func:`resolve_glass`);
+    ``on=False`` lifts a run's ``--strict-glass`` there."""
     token = _STRICT.set(bool(on))
     try:
         yield
@@ -180,7 +182,9 @@ def resolve_glass(name: str, catalogs=None, *, strict: bool | None = None) -> tu
         refused = exc
     key = str(name).strip().upper()
     asked = [str(c).strip().upper() for c in (catalogs or ())]
-    strict = _STRICT.get() if strict is None else bool(strict)
+    if strict is None:
+        strict = _STRICT_RUN[0] if _STRICT.get() is None else _STRICT.get()
+    strict = bool(strict)
     legacy = [LEGACY[c] for c in asked if c in LEGACY] if asked else list(LEGACY.values())
     steps = [(c, "legacy") for c in legacy]
     if asked and not strict:
