@@ -15,8 +15,6 @@ written leaves the disk as it was. The folder of deliverables is written as a wh
 
 from __future__ import annotations
 
-import math
-
 from ._common import (
     FOCUS_HELP,
     add_sensor_options,
