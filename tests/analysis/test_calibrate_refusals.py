@@ -319,7 +319,8 @@ def _files(folder: Path) -> dict:
 def test_a_killed_force_rerun_leaves_one_fits_folder(photos, tmp_path, capsys):
     """Fit A (6 views) writes the folder; fit B (the other views, another camera estimate) reruns with
     --force in a child process killed (SIGKILL) as soon as it starts writing: the folder is then exactly A's
-    or exactly B's files (physcam-manifest.json lists them, sizes and SHA-256), never a mix."""
+    or exactly B's files (physcam-manifest.json lists them, sizes and SHA-256), never a mix. The kill comes
+    once B's temporary folder holds two files (its maps being written), or at A's folder changing."""
     from physcam.io import folder_manifest
 
     out = tmp_path / "calib"
@@ -334,7 +335,8 @@ def test_a_killed_force_rerun_leaves_one_fits_folder(photos, tmp_path, capsys):
     try:
         deadline = time.monotonic() + 300
         while child.poll() is None and time.monotonic() < deadline:
-            staged = [p for p in tmp_path.iterdir() if p.name != "calib" and p.is_dir()]
+            staged = [p for p in tmp_path.iterdir() if p.name != "calib" and p.is_dir()
+                      and sum(q.is_file() for q in p.rglob("*")) >= 2]
             changed = any(p.stat().st_mtime_ns > os.stat(out / "physcam-manifest.json").st_mtime_ns
                           for p in out.rglob("*") if p.is_file()) if out.exists() else True
             if staged or changed:
