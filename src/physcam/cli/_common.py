@@ -398,6 +398,34 @@ def merge_lens_argument(args, parser) -> None:
         parser.error("give the lens: --lens NAME_OR_FILE (a bundled name from `physcam lenses`, or a lens file)")
 
 
+# ---- a folder of outputs written as a whole --------------------------------------------------
+#: ``--force`` of a command whose ``-o DIR`` is written whole (:func:`output_folder`).
+FOLDER_FORCE_HELP = "replace the folder if physcam wrote it whole (it has a physcam-manifest.json) or it is empty"
+
+def output_folder(folder, *, force: bool, command: str):
+    """A command's output folder written as a whole (:func:`physcam.io.staged_folder`): a context
+    yielding the private temporary folder to fill; on success it is put at ``folder`` in one rename
+    with its ``physcam-manifest.json`` (``about``: the command and physcam's version). Without
+    ``force`` an existing ``folder`` is refused; with it, only one physcam wrote whole (or an empty one)
+    is replaced, never a folder of the user's own files. Checked at once, before any work."""
+    from .. import __version__
+    from ..io import staged_folder
+
+    return staged_folder(folder, force=force, about={"command": f"physcam {command}", "physcam_version": __version__})
+
+
+def relocated(paths, tmp, folder) -> list:
+    """``paths`` written under the temporary folder ``tmp``, as they are named once it is published
+    at ``folder`` (same types: str stays str)."""
+    from pathlib import Path
+
+    out = []
+    for p in paths:
+        q = Path(folder) / Path(p).relative_to(tmp)
+        out.append(str(q) if isinstance(p, str) else q)
+    return out
+
+
 # ---- notes -----------------------------------------------------------------------------------
 _NOTES: list[str] = []
 
