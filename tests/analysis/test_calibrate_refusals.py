@@ -220,6 +220,24 @@ def test_an_existing_lens_file_variant_and_a_foreign_folder_are_refused_before_t
     assert lens_file.read_bytes() == before
 
 
+def test_photographs_inside_the_output_folder_are_never_replaced(tmp_path, capsys, blank):
+    """-o the photographs' own folder (--force), or a folder physcam wrote to which a file was added: refused
+    before the fit, the files kept."""
+    from physcam.io import MANIFEST_NAME
+
+    _refused(capsys, ["calibrate", str(blank), *CHARUCO_ARGS, "-o", str(tmp_path), "--force"], ["blank.png"])
+    assert blank.is_file()
+    out = tmp_path / "calib"
+    out.mkdir()
+    (out / "calibration.json").write_text("{}")
+    (out / MANIFEST_NAME).write_text(json.dumps({"format": "physcam-manifest/1", "about": {}, "files": [
+        {"path": "calibration.json", "bytes": 2, "sha256": "0"}]}))
+    (out / "notes.txt").write_text("mine")
+    _refused(capsys, ["calibrate", str(blank), *CHARUCO_ARGS, "-o", str(out), "--force"],
+             ["holds files physcam did not write there"])
+    assert (out / "notes.txt").read_text() == "mine"
+
+
 @pytest.mark.parametrize("rows, words", [
     ("image,mark\nblank.png,2m\nblank.png,3m\n", ["line 3: blank.png is given the mark '3m', line 2 gave it another"]),
     ("image,mark\n{path},2m\nblank.png,3m\n", ["one mark by its path and another by its file name blank.png"]),

@@ -159,7 +159,7 @@ def check_outputs(args) -> dict:
     ``force`` and the USD file's target (:func:`physcam.usd.kit.characterization_target`), or None."""
     from ..analysis.calibrate_chart import check_pixels, image_files, image_size
     from ..errors import ExportError, InputError
-    from ..io import MANIFEST_NAME
+    from ..io import MANIFEST_NAME, refuse_inputs_as_outputs
 
     if args.bootstrap in (1, 2) or not 0 <= args.bootstrap <= 1000:
         raise InputError(f"--bootstrap is 0 (OpenCV's covariance) or 3 to 1000 refits, got {args.bootstrap}")
@@ -167,15 +167,17 @@ def check_outputs(args) -> dict:
         raise InputError("--variant names the variant added to the --usd lens file: give --usd too")
     out = Path(args.output)
     force = bool(args.force)
+    refuse_inputs_as_outputs([*args.images, *(args.flat or []), args.marks, args.lens], [args.usd], folders=[out])
     if out.is_symlink() or (out.exists() and not out.is_dir()):
         raise ExportError(f"{out} exists and is not a folder: give a folder for the deliverables (-o DIR)")
     if out.is_dir():
         empty = not any(out.iterdir())
         if not empty and not force:
             raise ExportError(f"{out} exists (give --force to replace a folder physcam wrote, or a new folder)")
-        if not empty and not (out / MANIFEST_NAME).is_file():
+        if not empty and not _physcam_folder(out):
             raise ExportError(f"{out} holds files physcam did not write there; --force replaces only a folder physcam "
-                              f"wrote whole (one with a {MANIFEST_NAME}) or an empty one: choose a new output folder")
+                              f"wrote whole (one with a {MANIFEST_NAME} listing every file) or an empty one: choose "
+                              "a new output folder")
         force = True  # an empty folder, or one physcam wrote with --force: replaced whole
     first = None
     flats = [Path(f) for f in (args.flat or [])]
@@ -200,6 +202,19 @@ def check_outputs(args) -> dict:
         variant = args.variant or "calibration_" + _dt.datetime.now(_dt.UTC).strftime("%Y%m%d")
         usd = dict(characterization_target(args.usd, variant), file=Path(args.usd), variant=variant)
     return {"force": force, "usd": usd}
+
+
+def _physcam_folder(folder: Path) -> bool:
+    """Whether ``folder`` is one physcam wrote whole and nobody added to: its manifest lists every file."""
+    import os
+
+    from ..io import MANIFEST_NAME, folder_manifest
+
+    doc = folder_manifest(folder)
+    if doc is None:
+        return False
+    listed = {e["path"] for e in doc["files"]} | {MANIFEST_NAME}
+    return all(Path(d, f).relative_to(folder).as_posix() in listed for d, _, files in os.walk(folder) for f in files)
 
 
 #: a calibration goes into a lens file when its pinhole is within this factor of the file's focal length
