@@ -30,10 +30,11 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
-from physcam.lens.catalog import BUILTIN_CATALOGS, catalog  # noqa: E402
+from physcam.lens.catalog import catalog  # noqa: E402
 from physcam.optics.glass import FIT_TOLERANCE, dispersion  # noqa: E402
 
-MAKERS = [c for c in BUILTIN_CATALOGS if c != "MISC"]
+#: The makers' current catalogues, in physcam's order (not MISC, nor the legacy ones of discontinued glasses).
+MAKERS = ["SCHOTT", "OHARA", "HOYA", "CDGM", "HIKARI", "SUMITA"]
 
 
 def sections(text: str) -> dict[str, list[list[str]]]:
@@ -64,7 +65,7 @@ def glass_for(nd_text: str, vd_text: str):
     if not hits:
         return None, None, f"glass: nd {nd_text}, Vd {vd_text}: no catalogue glass has it; the normal-line dispersion model of nd and Vd"
     if len(codes) > 1:
-        names = ", ".join(f"{c} {g.name}" for c, g in hits)
+        names = ", ".join(dict.fromkeys(f"{c} {g.name}" for c, g in hits))
         return None, None, (f"glass: nd {nd_text}, Vd {vd_text} fits several glass types ({names}); "
                             "the normal-line dispersion model of nd and Vd")
     code = codes.pop()
