@@ -444,6 +444,14 @@ def _check_zoom(p: "Prescription", fail) -> None:
         raise fail("the lens's focus must be the zoom table's first position (close distance and focus gaps)")
     if not closes and p.focus is not None and seen & {g.surface for g in p.focus.gaps}:
         raise fail("a focus gap that also zooms needs its close thickness at every zoom position (thickness_close)")
+    for k in range(1, n):  # a gap is smallest at a tabulated position (the cams never overshoot): check each
+        at_k = replace(p, zoom=None, focus=None,
+                       surfaces=tuple(replace(s, thickness=next((g.thickness[k] for g in z.gaps if g.surface == i),
+                                                                s.thickness)) for i, s in enumerate(p.surfaces)))
+        try:
+            at_k.validate()
+        except LensFileError as exc:
+            raise fail(f"at zoom position {k + 1}: {exc.args[0]}") from None
 
 
 def require_prescription(value, name: str = "lens") -> Prescription:
