@@ -89,7 +89,11 @@ def encoder_for_focal_length(lens: Prescription, focal_length_mm: float, *, wave
     f = min(max(f, lo), hi)
     k = next(i for i in range(len(us) - 1) if (efls[i] - f) * (efls[i + 1] - f) <= 0)
     a, b, fa = us[k], us[k + 1], efls[k] - f
-    for _ in range(100):  # bisection: EFL is monotone inside the bracket
+    if fa == 0.0:
+        return a
+    if efls[k + 1] == f:
+        return b
+    for _ in range(100):  # bisection: EFL is monotone inside the bracket, fa has the sign of the left end
         m = 0.5 * (a + b)
         fm = efl_at(lens, m, wavelength_nm) - f
         if fm == 0.0 or b - a < 1e-13:
@@ -174,5 +178,18 @@ def zoom_breathing(lens: Prescription, encoders=None, focus_marks_mm=None, *,
     us = list(tabulated_encoders(lens)) if encoders is None else [zoom_encoder(lens, u) for u in encoders]
     if not us:
         raise InputError("give at least one zoom position")
-    return [(u, focusing.breathing_table(prescription_at(lens, u), focus_marks_mm, sensor_width_mm=sensor_width_mm,
-                                         wavelength_nm=wavelength_nm)) for u in us]
+    out = []
+    for u in us:
+        q = prescription_at(lens, u)
+        marks = _default_marks(q, wavelength_nm) if focus_marks_mm is None else focus_marks_mm
+        out.append((u, focusing.breathing_table(q, marks, sensor_width_mm=sensor_width_mm, wavelength_nm=wavelength_nm)))
+    return out
+
+
+def _default_marks(q: Prescription, wavelength_nm) -> list[float]:
+    """The breathing table's default marks down to the closest focus, leaving out marks whose subject would
+    sit inside or at the lens (a long zoom's glass can be longer than a short lens's 1:1 distance)."""
+    near = focusing.closest_focus(q, wavelength_nm=wavelength_nm)
+    length = q.total_track + q.surfaces[-1].thickness
+    marks = [m for m in focusing.DEFAULT_BREATHING_MARKS if m > near and m > 1.5 * length]
+    return marks + ([near] if q.focus is not None and near > 1.5 * length else [])
