@@ -1,4 +1,4 @@
-"""Paraxial EFL, BFL and f-number of every bundled zoom lens at each tabulated position, by optiland.
+"""Paraxial EFL, BFL, f-number and entrance pupil of every bundled zoom lens at each tabulated position, by optiland.
 
 Writes tests/data/optiland_zoom.json, the independent oracle of tests/optics/test_zoom_optics.py. Run
 with optiland 0.6.3 in a throwaway venv (not a physcam dependency)::
@@ -70,7 +70,7 @@ def main():
             o, last_t = build(doc, k)
             p = o.paraxial
             rows.append({"efl_mm": _f(p.f2()), "f_number": _f(p.FNO()), "epd_mm": _f(p.EPD()),
-                         "bfl_mm": _f(p.F2()) + last_t})
+                         "bfl_mm": _f(p.F2()) + last_t, "ep_from_front_vertex_mm": _f(p.EPL())})
         out["lenses"][path.stem] = rows
         print(path.stem, rows)
     OUT.write_text(json.dumps(out, indent=1) + "\n", encoding="utf-8")

@@ -39,6 +39,7 @@ def test_efl_bfl_and_f_number_at_every_position_match_optiland(name):
         assert r.bfl_mm == pytest.approx(o["bfl_mm"], rel=1e-3)
         assert r.f_number == pytest.approx(o["f_number"], rel=1e-3)
         assert r.entrance_pupil_diameter_mm == pytest.approx(o["epd_mm"], rel=1e-3)
+        assert r.entrance_pupil_from_front_vertex_mm == pytest.approx(o["ep_from_front_vertex_mm"], rel=1e-3)
         # the image-plane shift is optiland's BFL less the film distance the file puts at this position
         assert r.image_shift_mm == pytest.approx(o["bfl_mm"] - r.film_distance_mm, abs=1e-3 * o["bfl_mm"])
 
