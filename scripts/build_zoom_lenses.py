@@ -197,10 +197,11 @@ def laikin() -> Prescription:
     return provenance(
         p, source="M. Laikin, Lens Design (4th ed., CRC Press 2007), p. 362: a four-position zoom, EFL 0.591-5.905 in, "
                   "F/2.4, scaled to millimetres (x 25.4)",
-        licence="MIT",
+        licence="NOASSERTION",
         transcribed_from="optiland (HarrisonKramer/optiland, MIT) docs/gallery/specialized_lenses/zoom_lens.ipynb, "
                          "commit 1fcb3876f977: the book's table as optiland enters it; not the book",
-        checks=measured_checks(p, (2.4, 2.4, 2.4, 2.4)),
+        checks=measured_checks(p, (2.4, 2.4, 2.4, 2.4)) + [
+            "primary source: not reached; no number was compared with the book's table"],
         assumptions=["glass: the catalogue glasses optiland names, from physcam's SCHOTT catalogue and SCHOTT's legacy "
                      "glasses (" + "; ".join(dict.fromkeys(glasses)) + ")",
                      "semi-diameters: half optiland's aperture values (optiland takes a number as a clear diameter)",

@@ -240,6 +240,12 @@ def test_a_bad_multi_configuration_file_is_refused_with_its_line(change, message
     assert err.value.path == "bad.zmx"
 
 
+def test_a_position_solve_keeps_the_sum_of_its_gaps():
+    # TOLE 2 55 on surface 5: t2 + t3 + t4 + t5 = 55 with t3 = 2, t4 = 3, so t5 = 40, 35, 30 for t2 = 10, 15, 20
+    p = zemax.loads(HAND_ZMX.replace("TCOM 2 50.0", "TOLE 2 55.0"))
+    assert {g.surface: g.thickness for g in p.zoom.gaps} == {1: (10.0, 15.0, 20.0), 4: (40.0, 35.0, 30.0)}
+
+
 def test_tcom_with_words_is_a_comment():
     p = zemax.loads(HAND_ZMX.replace("TCOM 2 50.0", "TCOM keeps the track"))
     assert {g.surface: g.thickness for g in p.zoom.gaps} == {1: (10.0, 15.0, 20.0)}

@@ -52,7 +52,7 @@ def register_zoom(lsub, add_lens_argument, add_sensor_options, add_output_option
                                     "between them, where interpolated cams stray most), at infinity focus with the "
                                     "stop full open (docs/zoom.md).")
     add_lens_argument(z)
-    z.add_argument("--at", nargs="+", default=None, metavar="POSITION",
+    z.add_argument("--positions", nargs="+", default=None, metavar="POSITION",
                    help="zoom positions to tabulate instead: focal lengths (135mm) or encoder values 0..1")
     z.add_argument("--steps", type=number("steps"), default=None, metavar="N",
                    help="instead: N evenly spaced encoder values from 0 to 1")
@@ -70,14 +70,14 @@ def register_zoom(lsub, add_lens_argument, add_sensor_options, add_output_option
 def _encoders(args, lens):
     from ..errors import InputError
 
-    if args.at is not None and args.steps is not None:
-        raise InputError("give --at or --steps, not both")
+    if args.positions is not None and args.steps is not None:
+        raise InputError("give --positions or --steps, not both")
     if args.steps is not None:
         n = args.steps
-        if n != int(n) or not 2 <= n <= 1001:
+        if not (2 <= n <= 1001 and n == int(n)):  # NaN and inf fail the range first
             raise InputError(f"--steps takes a whole number from 2 to 1001, got {n:g}")
         return [k / (int(n) - 1) for k in range(int(n))]
-    return args.at
+    return args.positions
 
 
 def run_zoom(args) -> int:

@@ -134,6 +134,15 @@ def _same_surface(a, b) -> bool:
 
 def varying_gaps(prescriptions) -> list[int]:
     """The surfaces whose following gap differs between single-position prescriptions of one design."""
+    if isinstance(prescriptions, (str, bytes)) or not hasattr(prescriptions, "__iter__"):
+        from ..errors import WrongTypeError
+
+        raise WrongTypeError(f"prescriptions must be a list of Prescription, got {type(prescriptions).__name__}")
+    prescriptions = list(prescriptions)
+    for k, q in enumerate(prescriptions):
+        require_type(f"prescriptions[{k}]", q, Prescription, "load each position with physcam.lens.library.load_lens")
+    if not prescriptions:
+        raise InputError("give at least one prescription")
     first = prescriptions[0]
     return [i for i in range(len(first.surfaces)) if len({q.surfaces[i].thickness for q in prescriptions}) > 1]
 
@@ -148,6 +157,10 @@ def join_positions(prescriptions, *, encoder=None, stated_focal_length=None, nam
     on the same gaps in every file (their close distances and gaps become the zoom x focus grid).
     ``names`` (the files) name the one that differs. Raises :class:`LensFileError` saying which surface
     differs and how."""
+    if isinstance(prescriptions, (str, bytes)) or not hasattr(prescriptions, "__iter__"):
+        from ..errors import WrongTypeError
+
+        raise WrongTypeError(f"prescriptions must be a list of Prescription, got {type(prescriptions).__name__}")
     ps = list(prescriptions)
     for k, q in enumerate(ps):
         require_type(f"prescriptions[{k}]", q, Prescription, "load each position with physcam.lens.library.load_lens")
