@@ -46,6 +46,8 @@ __all__ = [
     "f_number_ratio",
     "gaussian_at_focus",
     "technical_planes",
+    "EntrancePupils",
+    "entrance_pupils",
     "breathing_table",
     "pupil_aspect",
     "hyperfocal_mark",
@@ -514,6 +516,50 @@ def pupil_aspect(prescription: Prescription, focus_mm: float) -> float:
     st = focus(prescription, focus_mm)
     gx, gy = (paraxial.gaussian(st.prescription, axis=a, object_z=st.object_z, film_z=st.film_z) for a in "xy")
     return gx.entrance_pupil_diameter / gy.entrance_pupil_diameter
+
+
+@dataclass(frozen=True)
+class EntrancePupils:
+    """Both meridians' entrance pupils at one focus mark, in front of the film (mm, + toward the subject).
+
+    An anamorphic lens images its one stop through different powers in X and Y: a front anamorphic
+    (cylinders before the stop) has two entrance pupils at different places ("anamorphic mumps"); a
+    rear one (cylinders behind the stop) has one place and a round pupil. A **pan** (rotation about
+    the vertical axis) moves the picture horizontally: it is parallax-free about the X (horizontal)
+    meridian's pupil; a **tilt** about the Y (vertical) meridian's pupil (Kingslake, *Optics in
+    Photography*, ch. 6: the entrance pupil is the centre of perspective, here in each meridian).
+    """
+
+    focus_from_film_mm: float
+    horizontal_from_film_mm: float  # X meridian: the pan pivot
+    vertical_from_film_mm: float  # Y meridian: the tilt pivot
+    horizontal_diameter_mm: float
+    vertical_diameter_mm: float
+
+    @property
+    def separation_mm(self) -> float:
+        """Horizontal pupil minus vertical pupil (+: the horizontal one lies nearer the subject)."""
+        return self.horizontal_from_film_mm - self.vertical_from_film_mm
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["focus_from_film_mm"] = None if math.isinf(self.focus_from_film_mm) else self.focus_from_film_mm
+        d["separation_mm"] = self.separation_mm
+        d["pan_pivot_from_film_mm"] = self.horizontal_from_film_mm
+        d["tilt_pivot_from_film_mm"] = self.vertical_from_film_mm
+        return d
+
+
+@renamed_parameter("focus_from_film_mm", "focus_mm")
+def entrance_pupils(prescription: Prescription, focus_mm: float, *, method: str = "auto",
+                    wavelength_nm=None) -> EntrancePupils:
+    """The X and Y meridians' paraxial entrance pupils with the lens focused (in Y) at the mark, both
+    from the one film plane (:class:`EntrancePupils`); equal for a rotationally symmetric lens."""
+    st = focus(prescription, focus_mm, method=method, axis="y", wavelength_nm=wavelength_nm)
+    g = {a: paraxial.gaussian(st.prescription, axis=a, wavelength_nm=wavelength_nm, object_z=st.object_z,
+                              film_z=st.film_z) for a in "xy"}
+    return EntrancePupils(float(focus_mm), g["x"].in_front_of("entrance_pupil"), g["y"].in_front_of("entrance_pupil"),
+                          g["x"].entrance_pupil_diameter, g["y"].entrance_pupil_diameter)
 
 
 #: The farthest hyperfocal mark solved (1000 km, the on-set report's largest distance).
