@@ -95,3 +95,33 @@ def test_degree_6_reaches_the_traced_field_on_a_4k_plate(slug, focus, limit_px):
 def test_degree_6_beats_degree_4(neil_inf):
     six, four = fit_tde4_anamorphic(neil_inf, 6), fit_tde4_anamorphic(neil_inf, 4)
     assert six.max_residual_px < four.max_residual_px and six.rms_residual_px < four.rms_residual_px
+
+
+def test_the_cli_writes_3de4_and_unreal_files_of_the_anamorphic_fits(tmp_path, capsys):
+    """``--fit 3de4-anamorphic-4 --fit 3de4-anamorphic-6``: two 3DE4 lens files (the desqueezed filmback,
+    the Y pinhole, f_y / f_x as pixel aspect, 3DE's parameter names), Unreal's degree-4 parameters."""
+    import json
+
+    from physcam.cli import main
+    from _documents import check_document
+
+    out = tmp_path / "out"
+    rc = main(["distortion", "--lens", "neil_front_anamorphic_2x", "--sensor-width", "18", "--sensor-height",
+               "13.5", "--resolution", "512x384", "--stmap", str(out), "--fit", "3de4-anamorphic-4",
+               "--fit", "3de4-anamorphic-6", "--max-residual", "5", "--json"])
+    assert rc == 0
+    d = json.loads(capsys.readouterr().out)
+    assert [f["model"] for f in d["fits"]] == ["3DE4 Anamorphic - Standard, Degree 4",
+                                                "3DE4 Anamorphic - Standard, Degree 6"]
+    fx, fy = d["pinhole_focal_length_mm"]["x"], d["pinhole_focal_length_mm"]["y"]
+    for deg in (4, 6):
+        lines = (out / f"3de4_anamorphic_standard_degree_{deg}.txt").read_text().splitlines()
+        w, h, f, aspect, _, _, pa = (float(v) for v in lines[1].split())
+        assert (w, h, f, pa) == pytest.approx((1.8 * fy / fx, 1.35, fy / 10.0, fy / fx), rel=1e-12)
+        assert lines[3] == f"3DE4 Anamorphic - Standard, Degree {deg}"
+        names = lines[4:-1:3]
+        assert names == tde4_anamorphic_parameter_names(deg) + ["Lens Rotation", "Squeeze-X", "Squeeze-Y"]
+    doc = json.loads((out / "unreal_anamorphic_distortion.json").read_text())
+    assert check_document(doc) == "physcam.distortion_unreal_anamorphic"
+    ue = doc["unreal_anamorphic_parameters"]
+    assert ue["PixelAspect"] == pytest.approx(fy / fx) and ue["CX22"] == doc["coefficients"]["Cx22 - Degree 2"]
