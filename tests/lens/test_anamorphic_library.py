@@ -108,3 +108,40 @@ def test_the_rear_anamorphic_against_its_transcription():
     prov = provenance_of(p)
     assert not prov.primary_source_checked and "crayg" in prov.transcribed_from
     assert efl_y / p.metadata.focal_length == pytest.approx(0.951, abs=1e-3)
+
+
+def _framing_focal_length(surfaces, meridian):
+    """|y_film / u| of the chief ray (through the stop centre) at unit object-space slope, by hand: the
+    focal length a pinhole at the entrance pupil needs to frame like the lens (Smith 3.5)."""
+    _, z_ep, _ = _yu(surfaces, meridian)
+    n0, y, u = 1.0, -z_ep, 1.0  # at the first vertex: height -z_ep, slope 1, crossing the axis at z_ep
+    for i, (kind, r, t, n) in enumerate(surfaces):
+        flat = kind in ("flat", "stop") or r == 0 or kind == f"cylindrical_{'y' if meridian == 'x' else 'x'}"
+        u = (n0 * u - y * (0.0 if flat else 1.0 / r) * (n - n0)) / n
+        y += t * u  # the last gap ends on the film
+        n0 = n
+    return abs(y)
+
+
+@pytest.mark.parametrize("slug", ANAMORPHICS)
+def test_breathing_per_axis_matches_a_hand_trace_of_each_meridian(slug):
+    """``lens breathing``'s horizontal and vertical framing focal lengths are the X and Y meridians' chief
+    rays, traced here by hand through the gaps the focus solver set, at infinity and 1.5 m."""
+    p = load_lens(slug)
+    marks = [math.inf, 1500.0]
+    rows = focusing.breathing_table(p, marks, sensor_width_mm=10.0)
+    for mark, row in zip(marks, rows):
+        st = focusing.focus(p, mark)
+        surfaces = _surfaces(slug, [s.thickness for s in st.prescription.surfaces])
+        assert row.breathing_focal_length_mm == pytest.approx(_framing_focal_length(surfaces, "x"), rel=1e-6)
+        assert row.vertical_breathing_focal_length_mm == pytest.approx(_framing_focal_length(surfaces, "y"), rel=1e-6)
+        assert row.vertical_entrance_pupil_from_film_mm == pytest.approx(sum(s[2] for s in surfaces)
+                                                                          - _yu(surfaces, "y")[1], abs=0.01)
+
+
+def test_a_front_anamorphics_framing_squeeze_grows_as_it_focuses_close():
+    """Neil's front 2x frames 1.980x squeezed at infinity and about 2.02x at 1.5 m: the horizontal
+    framing focal length shortens faster (hand-traced values of the test above)."""
+    rows = focusing.breathing_table(load_lens("neil_front_anamorphic_2x"), [math.inf, 1500.0], sensor_width_mm=10.0)
+    assert rows[0].breathing_squeeze == pytest.approx(42.479 / 21.457, abs=2e-4)
+    assert rows[1].breathing_squeeze > rows[0].breathing_squeeze + 0.03

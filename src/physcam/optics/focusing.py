@@ -142,10 +142,23 @@ class BreathingRow:
     magnification: float
     back_focus_mm: float
     fov_change_pct: float  # HFOV change from infinity focus, percent
-    entrance_pupil_from_film_mm: float | None = None  # where the camera pivots at this mark
+    entrance_pupil_from_film_mm: float | None = None  # where the camera pivots at this mark (X meridian: a pan)
+    #: the Y (vertical) meridian's: EFL and framing focal length (sensor half-width / tan of the Y meridian's
+    #: paraxial half-field there; paraxially the Y pinhole), and its entrance pupil (a tilt's pivot). They
+    #: differ from the X meridian's for an anamorphic lens; equal for a spherical one
+    vertical_efl_mm: float | None = None
+    vertical_breathing_focal_length_mm: float | None = None
+    vertical_entrance_pupil_from_film_mm: float | None = None
+
+    @property
+    def breathing_squeeze(self) -> float | None:
+        """Vertical over horizontal framing focal length: the squeeze the framing shows at this mark."""
+        v = self.vertical_breathing_focal_length_mm
+        return None if v is None else v / self.breathing_focal_length_mm
 
     def to_dict(self) -> dict:
         d = asdict(self)
+        d["breathing_squeeze"] = self.breathing_squeeze
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
 
 
@@ -483,6 +496,9 @@ def breathing_table(
         st = focus(prescription, m, method=method, axis="y", wavelength_nm=wavelength_nm)
         gx = paraxial.gaussian(st.prescription, axis="x", wavelength_nm=wavelength_nm, object_z=st.object_z, film_z=st.film_z)
         half = abs(paraxial.field_angle(st.prescription, w / 2.0, st.film_z, "x", wavelength_nm))
+        gy = paraxial.gaussian(st.prescription, axis="y", wavelength_nm=wavelength_nm, object_z=st.object_z,
+                               film_z=st.film_z)
+        half_y = abs(paraxial.field_angle(st.prescription, w / 2.0, st.film_z, "y", wavelength_nm))
         hfov = math.degrees(2.0 * half)
         if hfov0 is None:
             hfov0 = hfov if math.isinf(m) else gaussian_hfov_infinity(prescription, w, method, wavelength_nm)
@@ -496,6 +512,9 @@ def breathing_table(
                 back_focus_mm=st.back_focus_mm,
                 fov_change_pct=100.0 * (hfov / hfov0 - 1.0),
                 entrance_pupil_from_film_mm=gx.in_front_of("entrance_pupil"),
+                vertical_efl_mm=gy.efl,
+                vertical_breathing_focal_length_mm=(w / 2.0) / math.tan(half_y),
+                vertical_entrance_pupil_from_film_mm=gy.in_front_of("entrance_pupil"),
             )
         )
     return rows
