@@ -145,3 +145,23 @@ def test_a_front_anamorphics_framing_squeeze_grows_as_it_focuses_close():
     rows = focusing.breathing_table(load_lens("neil_front_anamorphic_2x"), [math.inf, 1500.0], sensor_width_mm=10.0)
     assert rows[0].breathing_squeeze == pytest.approx(42.479 / 21.457, abs=2e-4)
     assert rows[1].breathing_squeeze > rows[0].breathing_squeeze + 0.03
+
+
+def test_the_report_carries_both_pupils_and_says_which_pivot_is_which():
+    from physcam.onset.report import solve_lens_report
+    from physcam.onset.sensors import find_sensor
+    from physcam.onset.table import report_rows
+
+    lens = load_lens("neil_front_anamorphic_2x")
+    r = solve_lens_report(focal_length_mm=None, sensor=find_sensor("ALEXA 35"), fstop=2.8, focus_mm=3000.0, lens=lens)
+    eps = focusing.entrance_pupils(lens, 3000.0)
+    d = r.to_dict()["entrance_pupils"]
+    assert d["horizontal_from_film_mm"] == pytest.approx(eps.horizontal_from_film_mm, abs=1e-9)
+    assert d["vertical_from_film_mm"] == pytest.approx(eps.vertical_from_film_mm, abs=1e-9)
+    assert r.entrance_pupil_from_film_mm == pytest.approx(eps.vertical_from_film_mm, abs=1e-9)
+    assert d["pan_pivot_camera_space_mm"][2] == pytest.approx(-eps.horizontal_from_film_mm)
+    labels = [row[0] for row in report_rows(r, "m")]
+    assert "entrance pupil, horizontal (pan pivot)" in labels and "entrance pupil, vertical (tilt pivot)" in labels
+    spherical = solve_lens_report(focal_length_mm=None, sensor=find_sensor("ALEXA 35"), fstop=2.8, focus_mm=3000.0,
+                                  lens=load_lens("dgauss_50mm")).to_dict()["entrance_pupils"]
+    assert spherical["separation_mm"] == 0.0
