@@ -77,6 +77,14 @@ class LensDiagram:
     focus_from_film_mm: float = math.inf
     fstop: float | None = None
 
+    def to_dict(self) -> dict:
+        """The diagram's numbers: the rays drawn, as (z, height) points in lens space (mm), and the film."""
+        return {"lens": self.prescription.name, "axis": self.axis, "field_deg": self.field_deg,
+                "focus_from_film_mm": None if math.isinf(self.focus_from_film_mm) else self.focus_from_film_mm,
+                "fstop": self.fstop, "film_z_mm": self.gaussian.z_film,
+                "reference": "lens space: z from the first vertex, + toward the film",
+                "rays": [{"kind": kind, "points_mm": [list(q) for q in pts]} for kind, pts in self.rays]}
+
     @styled
     def figure(self, *, width_in: float = 10.0, units: str = "m"):
         """A matplotlib Figure (Agg canvas). The view spans the lens and film; an object closer than

@@ -61,9 +61,14 @@ class LensCard:
                 "focus_from_film_mm": None if math.isinf(self.focus_from_film_mm) else self.focus_from_film_mm,
                 "sensor": {"name": self.sensor_name, "width_mm": self.sensor_mm[0], "height_mm": self.sensor_mm[1]},
                 "key": self.key, "panels": list(PANELS),
-                "mtf": [{"label": lab, "fstop": None if c is None else c.fstop, "note": note}
-                        for lab, c, note in self.mtf],
-                "bokeh": [{"label": lab, "image_height_mm": h, **b.to_dict()} for lab, h, b in self.bokeh],
+                "mtf": [{"label": lab, "fstop": None if c is None else c.fstop, "note": note,
+                         "chart": None if c is None else c.to_dict()} for lab, c, note in self.mtf],
+                "diagram": self.diagram.to_dict(),
+                "distortion": None if self.distortion is None else self.distortion.to_dict(),
+                "illumination": None if self.illumination is None else self.illumination.to_dict(),
+                "breathing": [r.to_dict() for r in self.breathing],
+                "bokeh": [{"label": lab, "image_height_mm": h, **({} if b is None else b.to_dict())}
+                          for lab, h, b in self.bokeh],
                 "notes": list(self.notes)}
 
     @styled
@@ -135,7 +140,7 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
     st = focusing.focus(lens, focus_mm)
     diagram = _diagram(lens, focus_mm)
     key = key_numbers(lens, focus_mm, 0.5 * math.hypot(w, h), backend=backend)
-    dist = _distortion(st, w, h, q, backend, notes)
+    dist = _distortion(lens, focus_mm, w, h, q, backend, notes)
     ill = _illumination(st, w, h, q, backend, notes)
     wide = key["f_number"]
     stops = [("full aperture", None)] + ([("stopped down", stopped_fstop)] if stopped_fstop > wide * 1.05
@@ -191,12 +196,13 @@ def _diagram(lens, focus_mm):
         return lens_diagram(lens, rays=5)
 
 
-def _distortion(st, w, h, q, backend, notes):
+def _distortion(lens, focus_mm, w, h, q, backend, notes):
+    """The lens focused at the mark, measured as ``distortion --focus`` and the ST-maps measure it."""
     from .distortion import real_distortion
 
     try:
-        return real_distortion(st.prescription, n_fields=q["curve_fields"], sensor_width_mm=w, sensor_height_mm=h,
-                               film_z=st.film_z, backend=backend)
+        return real_distortion(lens, n_fields=q["curve_fields"], sensor_width_mm=w, sensor_height_mm=h,
+                               focus_mm=focus_mm, backend=backend)
     except OpticsError as exc:
         notes.append(f"distortion: {exc}")
         return None
