@@ -178,6 +178,15 @@ function render(d) {
   showLen($("out-far"), dof.far_from_film_mm);
   showLen($("out-total"), dof.total_mm);
   showLen($("out-hyperfocal"), dof.hyperfocal_from_film_mm);
+  // split focus with the stop given: the limits shown are that stop's; the stop the asked limits need beside them
+  const sf = d.split_focus;
+  $("split-card").hidden = !sf;
+  $("label-near").textContent = sf ? `near at f/${num(d.fstop, 1)}` : "near";
+  $("label-far").textContent = sf ? `far at f/${num(d.fstop, 1)}` : "far";
+  if (sf) {
+    $("out-split").textContent = `f/${num(sf.fstop_needed, 1)} holds ${fmtLen(sf.near_asked_from_film_mm)} – `
+      + `${fmtLen(sf.far_asked_from_film_mm)}` + (sf.holds ? "" : ` (f/${num(sf.fstop_given, 1)} holds less)`);
+  }
   const f = d.fov_deg.focus, i = d.fov_deg.infinity;
   $("out-fov").textContent = `${deg(f.horizontal)} / ${deg(f.vertical)} / ${deg(f.diagonal)}`;
   $("out-fov-inf").textContent = `${deg(i.horizontal)} / ${deg(i.vertical)} / ${deg(i.diagonal)}`;
