@@ -303,7 +303,12 @@ def _draw_mtf(ax, chart, label, note):
     ax.grid(True)
     ax.set_xlabel("image height (mm)")
     ax.set_ylabel("MTF")
-    ax.set_title(f"MTF at f/{chart.fstop:.3g} ({label}), white light", loc="left")
+    light = "white light" if chart.spectrum.startswith("white light") and "no dispersion" not in chart.spectrum \
+        else ("monochromatic: the prescription gives no dispersion" if chart.spectrum.startswith("monochromatic")
+              else "white light, some glasses without dispersion")
+    from ..figures import fit_title
+
+    ax.set_title(fit_title(f"MTF at f/{chart.fstop:.3g} ({label}), {light}", 3.2, fontsize=7), loc="left", fontsize=7)
     ax.legend(ncol=3, loc="lower left", fontsize=5.5, handlelength=1.6, columnspacing=0.8)
 
 
