@@ -78,7 +78,7 @@ class LensCard:
 
         w, h = PAGES[self.page]
         fig = new_figure(figsize=(w, h), dpi=dpi)
-        gs = fig.add_gridspec(5, 6, left=0.08, right=0.9, top=0.93, bottom=0.05, hspace=0.75, wspace=1.6,
+        gs = fig.add_gridspec(5, 6, left=0.08, right=0.9, top=0.93, bottom=0.075, hspace=0.75, wspace=1.6,
                               height_ratios=(1.25, 1.0, 1.0, 1.0, 0.8))
         fig.suptitle(self._title(), fontsize=11, fontweight="bold", y=0.985)
         fig.text(0.5, 0.955, self._subtitle(units), ha="center", va="center", fontsize=7.5, color="0.25")
@@ -91,7 +91,10 @@ class LensCard:
         _draw_breathing(fig.add_subplot(gs[3, :], label="breathing"), self, units)
         for k, (lab, hgt, img) in enumerate(self.bokeh):
             _draw_bokeh(fig.add_subplot(gs[4, 2 * k:2 * k + 2], label=f"bokeh {lab}"), img, lab, hgt)
-        foot = "physcam lens card · " + ("; ".join(self.notes) if self.notes else "all numbers from the prescription")
+        src = self.key.get("source") or "not stated"
+        lic = self.key.get("licence") or "not stated"
+        foot = (f"physcam lens card · prescription: {src} (licence: {lic}) · "
+                + ("; ".join(self.notes) if self.notes else "all numbers from the prescription"))
         fig.text(0.5, 0.012, _wrap(foot, 150), ha="center", va="bottom", fontsize=6, color="0.35")
         return fig
 
@@ -170,7 +173,7 @@ def key_numbers(lens: Prescription, focus_mm: float, half_diagonal_mm: float, *,
     g = paraxial.gaussian(lens)
     ga = focusing.gaussian_at_focus(lens, focus_mm)
     try:
-        close = focusing.closest_focus(lens)
+        close = focusing.close_focus(lens)
     except OpticsError:
         close = None
     limit = field_limit_deg(lens, "y", max_deg=89.0, wavelength_nm=lens.wavelength_nm, backend=backend)
@@ -178,13 +181,17 @@ def key_numbers(lens: Prescription, focus_mm: float, half_diagonal_mm: float, *,
 
     heights, ok = _chief_heights(lens, np.array([0.0, 0.995 * limit]), "y", lens.wavelength_nm, None, backend)
     circle = 2.0 * abs(float(heights[-1])) if ok[-1] else 2.0 * abs(g.efl) * math.tan(math.radians(limit))
-    return {"efl_mm": g.efl, "f_number": g.f_number, "nominal_focal_length_mm": lens.metadata.focal_length,
-            "max_fstop": lens.metadata.max_fstop, "tstop": None,
+    m = lens.metadata
+    return {"efl_mm": g.efl, "f_number": g.f_number, "nominal_focal_length_mm": m.focal_length,
+            "max_fstop": m.max_fstop, "tstop": m.t_stop,
             "entrance_pupil_diameter_mm": g.entrance_pupil_diameter,
             "entrance_pupil_from_film_mm": ga.in_front_of("entrance_pupil"),
-            "close_focus_from_film_mm": close, "image_circle_mm": circle, "field_limit_deg": limit,
+            "close_focus_from_film_mm": None if close is None else close.mark_mm,
+            "close_focus_source": None if close is None else close.source,
+            "close_focus_words": None if close is None else close.words,
+            "image_circle_mm": circle, "field_limit_deg": limit,
             "covers_sensor": circle >= 2.0 * half_diagonal_mm, "total_track_mm": lens.total_track,
-            "squeeze": lens.squeeze, "maker": lens.metadata.maker, "source": lens.metadata.source}
+            "squeeze": lens.squeeze, "maker": m.maker, "source": m.source, "licence": m.licence}
 
 
 def _diagram(lens, focus_mm):
@@ -270,18 +277,23 @@ def _draw_key(ax, key, units):
         return "–" if v is None else format_distance(v, units)
 
     rows = [("EFL", f"{key['efl_mm']:.2f} mm"), ("f-number (wide open)", f"f/{key['f_number']:.2f}"),
-            ("T-stop", "not given" if key["tstop"] is None else f"T{key['tstop']:.2f}"),
+            ("T-stop", "not given in the file" if key["tstop"] is None else f"T{key['tstop']:.2f}"),
             ("entrance pupil", f"Ø {key['entrance_pupil_diameter_mm']:.1f} mm"),
             ("  in front of film", dist(key["entrance_pupil_from_film_mm"])),
-            ("close focus", dist(key["close_focus_from_film_mm"])),
+            ("close focus" + {"maker": " (MOD)", "focus groups": " (focus groups)"}.get(key["close_focus_source"], ""),
+             dist(key["close_focus_from_film_mm"])),
             ("image circle", f"Ø {key['image_circle_mm']:.1f} mm"), ("total track", f"{key['total_track_mm']:.1f} mm")]
+    if key["close_focus_source"] == "unit focusing limit":  # 1:1, which no real lens of the kind reaches
+        rows.insert(6, ("", "unit focusing limit, not the lens's MOD"))
     if key["squeeze"] != 1.0:
         rows.append(("squeeze", f"{key['squeeze']:g}x"))
     ax.set_title("key numbers", loc="left")
     for i, (k, v) in enumerate(rows):
-        y = 0.95 - i * 0.115
+        y = 0.95 - i * 0.1
+        note = k == ""  # a qualifier of the row above, in small type
         ax.text(0.0, y, k, transform=ax.transAxes, fontsize=7.5, va="top")
-        ax.text(1.0, y, v, transform=ax.transAxes, fontsize=7.5, va="top", ha="right", fontweight="bold")
+        ax.text(1.0, y, v, transform=ax.transAxes, fontsize=6 if note else 7.5, va="top", ha="right",
+                fontweight="normal" if note else "bold", color="0.3" if note else "black")
 
 
 def _no_data(ax, text):
