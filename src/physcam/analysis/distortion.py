@@ -235,6 +235,9 @@ def real_distortion(
     w = require_positive("sensor width", sensor_width_mm)
     h = require_positive("sensor height", sensor_height_mm)
     if focus_mm is not None:
+        from ..units import parse_distance
+
+        focus_mm = parse_distance(focus_mm, name="focus distance", allow_inf=True)  # "2m", "infinity" too
         if film_z is not None:
             raise InputError("give either focus_mm (the lens focused there) or film_z (light from infinity on that "
                              "film plane), not both")

@@ -343,7 +343,7 @@ def huygens_psf(
     if pixel_um is not None:
         pixel_um = require_finite("pixel_um", pixel_um)
         if not 1e-3 < pixel_um < 1e3:
-            raise InputError(f"the PSF's pixel must lie between 0.001 and 1000 um, got {pixel_um!r}")
+            raise InputError(f"the PSF's pixel must lie between 0.001 and 1000 µm, got {pixel_um!r}")
     cap = MAX_PUPIL_SAMPLES if max_pupil_samples is None else max_pupil_samples
     kw = dict(wavelengths_nm=wavelengths_nm, weights=weights, fstop=fstop, focus_mm=focus_mm, defocus_mm=[dz],
               aperture=aperture, backend=backend, max_pupil_samples=cap)

@@ -121,14 +121,25 @@ def _wrap(text: str, n: int) -> str:
 @takes_prescription
 def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm: float | None = None,
               sensor_height_mm: float | None = None, sensor_name: str | None = None, stopped_fstop: float = 8.0,
-              page: str = "a4", quality: str = "full", backend: str = "auto") -> LensCard:
-    """Compute the card of ``lens`` focused ``focus_mm`` from the film plane (default infinity) on a
-    ``sensor_width_mm`` x ``sensor_height_mm`` sensor (default Super 35). The MTF chart is drawn
-    wide open and at ``stopped_fstop`` (default f/8; skipped when not slower than wide open).
+              page: str = "a4", quality: str = "full", backend: str = "auto", sensor=None) -> LensCard:
+    """Compute the card of ``lens`` focused ``focus_mm`` from the film plane (default infinity; a string with
+    units such as "2m" or "10ft" too) on a ``sensor_width_mm`` x ``sensor_height_mm`` sensor, or ``sensor``
+    (a name such as "ALEXA 35", or a :class:`~physcam.onset.sensors.Sensor`; default Super 35). The MTF chart
+    is drawn wide open and at ``stopped_fstop`` (default f/8; skipped when not slower than wide open).
     ``page``: "a4" or "letter"; ``quality``: "full" or "draft" (fewer fields and rays: tests)."""
     from ..data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
     from ..errors import require_positive
     from ..optics import focusing
+    from ..units import parse_distance
+
+    if sensor is not None:
+        from ..onset.sensors import Sensor, find_sensor
+
+        if sensor_width_mm is not None or sensor_height_mm is not None:
+            raise InputError("give the sensor either by name (sensor=) or by size (sensor_width_mm=, "
+                             "sensor_height_mm=), not both")
+        s = sensor if isinstance(sensor, Sensor) else find_sensor(sensor)
+        sensor_width_mm, sensor_height_mm, sensor_name = s.width_mm, s.height_mm, sensor_name or s.name
 
     if page not in PAGES:
         raise InputError(f"page must be one of {', '.join(PAGES)}, got {page!r}")
@@ -138,7 +149,7 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
     w = require_positive("sensor width", DEFAULT_SENSOR_WIDTH_MM if sensor_width_mm is None else sensor_width_mm)
     h = require_positive("sensor height", DEFAULT_SENSOR_HEIGHT_MM if sensor_height_mm is None else sensor_height_mm)
     name = sensor_name or (DEFAULT_SENSOR if sensor_width_mm is None else f"{w:g} x {h:g} mm")
-    focus_mm = float(focus_mm)
+    focus_mm = parse_distance(focus_mm, name="focus distance", allow_inf=True)
     notes: list[str] = []
     st = focusing.focus(lens, focus_mm)
     diagram = _diagram(lens, focus_mm)

@@ -416,7 +416,7 @@ class MTFChart:
         """Which focus the chart is at, in words (its title and its JSON's ``film``)."""
         if self.defocus_mm == 0.0:
             return self.focus_rule
-        return f"{self.focus_rule}, {self.defocus_mm * 1e3:+.1f} um from the paraxial image plane"
+        return f"{self.focus_rule}, {self.defocus_mm * 1e3:+.1f} µm from the paraxial image plane"
 
     def to_dict(self) -> dict:
         return {

@@ -163,7 +163,9 @@ def _camera(lens, focus_mm, fstop) -> CameraState:
     if not isinstance(lens, CameraState):
         if focus_mm is None or fstop is None:
             raise InputError("give focus_mm and fstop with a lens (or a CameraState: physcam.optics.state.camera_state)")
-        focus_mm = require_positive("focus mark", focus_mm)
+        from ..units import parse_distance
+
+        focus_mm = require_positive("focus mark", parse_distance(focus_mm, name="focus mark", allow_inf=True))
     cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
     require_positive("focus mark", cam.focus_from_film_mm)
     return cam

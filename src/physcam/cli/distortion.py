@@ -104,7 +104,7 @@ def run_distortion(args) -> int:
     elif not args.json:
         from ._output import Table, print_table
 
-        if res.focus_from_film_mm is None:
+        if res.focus_from_film_mm is None or math.isinf(res.focus_from_film_mm):  # Y's pinhole there is its EFL
             against = f"EFL {res.efl_y_mm:.3f} mm"
         else:
             from ..units import format_distance
@@ -292,9 +292,9 @@ def _run_field(args, lens) -> int:
         print(f"  overscan {res.overscan_px[0]} x {res.overscan_px[1]} px (undistorted frame "
               f"{d['undistorted_size_px'][0]}x{d['undistorted_size_px'][1]}), inverse error {res.inverse_error_px:.4f} px")
     for fit in fits:
-        verdict = "good" if fit.acceptable else f"NOT good (> {fit.max_residual_allowed_px:g} px)"
         coeffs = ", ".join(f"{k} {v:.6g}" for k, v in fit.coefficients.items())
-        print(f"  {fit.model}: residual RMS {fit.rms_residual_px:.3f} px, max {fit.max_residual_px:.3f} px: {verdict}")
+        print(f"  {fit.model}: residual RMS {fit.rms_residual_px:.3f} px, max {fit.max_residual_px:.3f} px: "
+              f"{fit.verdict}")
         print(f"    {coeffs}")
     for p in written:
         print(f"wrote {p}")

@@ -66,7 +66,7 @@ def register(sub) -> None:
                         "Huygens PSF, wavelets summed from the exit-pupil wavefront (slower; docs/image-quality.md)")
     p.add_argument("--best-focus", type=number("best-focus frequency", positive=True), default=None, metavar="LPMM",
                    help="put the chart's film at the best focus for this frequency instead of the paraxial image plane "
-                        "of --focus (the shift is printed in um)")
+                        "of --focus (the shift is printed in µm)")
     p.add_argument("--best-focus-rule", choices=("axis", "field"), default="axis",
                    help="best focus on the axis (default) or averaged over the image by ring area, as makers weigh "
                         "a chart")
@@ -210,7 +210,7 @@ def _one_field(args, lens, wls, weights, freqs, focus) -> int:
     print(f"  wavefront at {wf.wavelength_nm:g} nm: RMS {wf.rms_waves:.4f} waves (to centroid "
           f"{wf.rms_to_centroid_waves:.4f}), PV {wf.pv_waves:.4f} waves")
     print(f"  Strehl ratio {ps.strehl:.4f} (Marechal estimate {wf.strehl_marechal:.4f}); Airy radius "
-          f"{ps.airy_radius_um:.2f} um")
+          f"{ps.airy_radius_um:.2f} µm")
     z = wf.zernike
     print("  Zernike (Noll, waves): " + ", ".join(f"Z{j + 1} {c:+.4f}" for j, c in enumerate(z[:11])))
     from ..analysis.mtf import spectrum_words

@@ -5,7 +5,8 @@ from __future__ import annotations
 from ._common import FOCUS_HELP, coc_value, distance, focus, number
 
 EPILOG = """\
-distances accept units as said on set: 3m, 10ft, 6in, 450mm, 10'6" (a bare number is mm);
+distances accept units as said on set: 3m, 10ft, 6in, 450mm, 10'6" (a bare focus, near or far is mm,
+or feet under --units ft or units = "ft" in the user config; lengths inside the camera are mm);
 --focus also takes hyperfocal and infinity. Focus, near, far and --sensor-front are measured
 from the film plane; --h1/--h2/--pupil are distances in front of the reference plane
 (--reference film|flange). --units ft prints scene distances in feet and inches.
@@ -76,8 +77,10 @@ def add_report_arguments(p) -> None:
     g.add_argument("--squeeze", metavar="S", type=number("squeeze"), default=1.0, help="anamorphic squeeze (default 1)")
     add_coc_option(g)
     g = p.add_argument_group("measured depth of field (inverse solve)")
-    g.add_argument("--near", metavar="DIST", type=distance("near limit"), help="measured near limit, from the film plane")
-    g.add_argument("--far", metavar="DIST", type=distance("far limit", allow_inf=True), help="measured far limit (or inf)")
+    g.add_argument("--near", metavar="DIST", type=distance("near limit", scene=True),
+                   help="measured near limit, from the film plane")
+    g.add_argument("--far", metavar="DIST", type=distance("far limit", allow_inf=True, scene=True),
+                   help="measured far limit (or inf)")
     g = p.add_argument_group("model")
     g.add_argument("--model", choices=("practical", "technical"), default="practical",
                    help="practical = thin lens; technical = datasheet principal planes")

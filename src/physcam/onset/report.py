@@ -244,11 +244,11 @@ class LensReport:
     def diffraction_note(self) -> str:
         d = self.diffraction_dict()
         um = 1000.0
-        text = (f"diffraction ({d['wavelength_nm']:g} nm): Airy disk {d['airy_diameter_mm'] * um:.1f} um across at "
+        text = (f"diffraction ({d['wavelength_nm']:g} nm): Airy disk {d['airy_diameter_mm'] * um:.1f} µm across at "
                 f"f/{self.fstop:.3g} (working f/{d['working_f_number']:.3g}), {d['airy_to_coc']:.2f} of the CoC "
-                f"({self.coc_mm * um:.1f} um)")
+                f"({self.coc_mm * um:.1f} µm)")
         if d["photosite_pitch_mm"] is not None:
-            text += f" and {d['airy_in_photosites']:.1f} photosites ({d['photosite_pitch_mm'] * um:.2f} um)"
+            text += f" and {d['airy_in_photosites']:.1f} photosites ({d['photosite_pitch_mm'] * um:.2f} µm)"
         verb = "exceeds" if d["exceeds_coc"] else "would exceed"
         return text + f"; it {verb} the CoC past f/{d['fstop_airy_exceeds_coc']:.3g}"
 

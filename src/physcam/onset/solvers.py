@@ -247,7 +247,7 @@ def solve_focus(req: ReportRequest, state: LensState, planes: PrincipalPlanes, c
     if req.at_hyperfocal and req.lens is None:  # a prescription's mark is solved with the lens's own planes
         mark = planes.mark_for_s(_dof.hyperfocal_distance(f, state.fstop * state.n_ratio, c))
         solved["focus"] = HYPERFOCAL
-        notes.append(f"focus at the hyperfocal distance: mark {mark:.6g} mm from the film")
+        notes.append("focus at the hyperfocal distance (the focus mark above)")
     elif mark is None:
         if near is not None and far is not None:
             s = _solve_focus_from_bracket(near, far, planes.h1_at, f)

@@ -162,6 +162,10 @@ def focus_method(prescription: Prescription, method: str = "auto") -> str:
 
 
 def _mark(focus_from_film_mm) -> float:
+    if isinstance(focus_from_film_mm, str):  # "2m", "10ft", "infinity": as the command line reads it
+        from ..units import parse_distance
+
+        return _mark(parse_distance(focus_from_film_mm, name="focus distance", allow_inf=True))
     d = float(focus_from_film_mm)
     if math.isnan(d) or d <= 0:
         raise InputError(f"focus distance must be a positive distance from the film plane, got {focus_from_film_mm!r}")
