@@ -25,27 +25,30 @@ def m(v):
     return f"{v / 1000:.3f}"
 
 
-def main() -> None:
+def row(name: str, n: float, mark: float) -> str:
+    """One row of the table: the model's limits and the real rays', collimated and paraxial."""
     sensor = find_sensor("Super 35")
+    lens = load_lens(name)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = solve_lens_report(focal_length_mm=None, lens=lens, sensor=sensor, fstop=n, focus_mm=mark)
+    head = f"| {name} | f/{n:g} | {mark / 1000:g} | {m(r.dof.near_from_film_mm)}-{m(r.dof.far_from_film_mm)} " \
+           f"| {r.dof.total_mm:.0f} |"
+    try:
+        c = real_depth_of_field(lens, focus_mm=mark, fstop=n, coc_mm=r.coc_mm, measure="energy")
+        p = real_depth_of_field(lens, focus_mm=mark, fstop=n, coc_mm=r.coc_mm, measure="energy", focusing="paraxial")
+    except PhysCamError as exc:
+        return head + f" none: {str(exc).split(': ')[-1]} | | | |"
+    return head + (f" {m(c.near_from_film_mm)}-{m(c.far_from_film_mm)} | {c.total_mm:.0f} "
+                   f"| {m(p.near_from_film_mm)}-{m(p.far_from_film_mm)} | {m(p.sharpest_from_film_mm)} |")
+
+
+def main() -> None:
     print("| lens | f-stop | mark (m) | model near-far (m) | model DOF (mm) | collimated near-far (m) | collimated DOF (mm) "
           "| paraxial near-far (m) | paraxial sharpest at (m) |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for name, n, mark in CASES:
-        lens = load_lens(name)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            r = solve_lens_report(focal_length_mm=None, lens=lens, sensor=sensor, fstop=n, focus_mm=mark)
-        row = f"| {name} | f/{n:g} | {mark / 1000:g} | {m(r.dof.near_from_film_mm)}-{m(r.dof.far_from_film_mm)} " \
-              f"| {r.dof.total_mm:.0f} |"
-        try:
-            c = real_depth_of_field(lens, focus_mm=mark, fstop=n, coc_mm=r.coc_mm, measure="energy")
-            p = real_depth_of_field(lens, focus_mm=mark, fstop=n, coc_mm=r.coc_mm, measure="energy",
-                                    focusing="paraxial")
-        except PhysCamError as exc:
-            print(row + f" none: {str(exc).split(': ')[-1]} | | | |")
-            continue
-        print(row + f" {m(c.near_from_film_mm)}-{m(c.far_from_film_mm)} | {c.total_mm:.0f} "
-              f"| {m(p.near_from_film_mm)}-{m(p.far_from_film_mm)} | {m(p.sharpest_from_film_mm)} |")
+        print(row(name, n, mark))
 
 
 if __name__ == "__main__":

@@ -151,8 +151,7 @@ def shown_outputs(path: Path) -> dict:
 
 def argv_of(text: str) -> list[str]:
     """The command's words; a comment starts at a ``#`` after a space (``plates/A.####.exr`` is a word)."""
-    words = shlex.split(text)
-    return words[:next((i for i, w in enumerate(words) if w.startswith("#")), len(words))]
+    return shlex.split(re.sub(r"(^|\s)#.*$", "", text))
 
 
 def test_commands_live_in_fenced_blocks():

@@ -248,6 +248,10 @@ def glasses_without_dispersion(prescription) -> tuple[int, int]:
     """(glasses the prescription gives no dispersion, glasses): the media behind its surfaces that are not
     air, and of them those whose model is constant (Vd 0 and no named glass, module notes): every
     wavelength bends alike in them, so no colour aberration comes from them."""
+    from ..errors import require_type
+    from ..lens.prescription import Prescription
+
+    require_type("prescription", prescription, Prescription, "physcam.lens.library.load_lens(name or file)")
     glass = [s.medium for s in prescription.surfaces if not s.medium.is_air]
     return sum(medium_dispersion(m).kind == "constant" for m in glass), len(glass)
 
