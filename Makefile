@@ -31,7 +31,10 @@ $(STAMP): $(PY) pyproject.toml constraints.txt
 
 venv: $(STAMP)
 
+# demo-output is make demo's own folder: one written by a physcam from before folders carried a
+# manifest (physcam-manifest.json) is removed first, since --force replaces only a folder physcam wrote whole
 demo: $(STAMP)
+	@if [ -d demo-output ] && [ ! -f demo-output/physcam-manifest.json ]; then rm -rf demo-output; fi
 	$(VENV)/bin/physcam demo --out demo-output --force
 	@echo "physcam is installed in $(VENV): run it as $(VENV)/bin/physcam, or type 'make shell' for a shell where 'physcam' works"
 

@@ -130,6 +130,9 @@ JSON_NOT_RUN = {
     ("live", "record"): "needs a UDP stream (tests/live/test_cli_live.py records one and validates the document)",
     ("calibrate",): "needs chart photographs (tests/analysis/test_calibrate.py renders them and validates its document)",
     ("demo",): "writes the whole demo (tests/onset_cli/test_report_cli.py::test_demo_writes_outputs validates it)",
+    ("lens", "pack"): "packs a lens card and a USD file (tests/lens/test_lens_archive.py round-trips an archive through "
+                      "pack, check and add and validates both documents)",
+    ("lens", "add"): "needs an archive from `lens pack` (tests/lens/test_lens_archive.py validates its document)",
 }
 #: Where the rows of each --csv command's document are.
 CSV_ROWS = {

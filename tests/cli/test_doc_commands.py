@@ -191,12 +191,14 @@ def test_technical_examples_are_physically_consistent(capsys):
 
 
 @pytest.mark.parametrize("page", [p for p in PAGES if doc_commands(p)], ids=lambda p: p.name)
-def test_every_command_of_the_page_runs(page, tmp_path, capsys):
+def test_every_command_of_the_page_runs(page, tmp_path, capsys, monkeypatch):
     # pages that show no command (architecture, conventions, ...) have nothing to run: not parametrized
     from _doc_output import compare
 
     cmds = doc_commands(page)
     shown = shown_outputs(page)
+    # a page's `physcam lens add` installs into a lens library of the page's own, not the session's
+    monkeypatch.setenv("PHYSCAM_LENS_LIBRARY", str(tmp_path / ".physcam-lenses"))
     for make in INPUTS:
         make(tmp_path)
     old = os.getcwd()

@@ -404,6 +404,10 @@ def add_lens_argument(p, *, dest: str = "lens", many: bool = False, metavar: str
     p.add_argument("--glass-catalog", dest="glass_catalog", action="append", default=None, metavar="FILE.agf",
                    help="a Zemax .agf glass catalogue searched after the lens file's own (repeat for several; "
                         "adds to the config's glass_catalogs)")
+    p.add_argument("--strict-glass", dest="strict_glass", action="store_true",
+                   help="a Zemax file's glass must be in the catalogues its GCAT line lists (or their makers' legacy "
+                        "glasses), as OpticStudio requires; by default another bundled catalogue holding the same "
+                        "name is used, with a warning")
     p.set_defaults(_lens_dest=dest, _lens_many=many)
 
 
@@ -433,15 +437,17 @@ def lens_use(args):
 
 def use_glass_catalogs(args) -> list[str]:
     """Make the config's ``glass_catalogs`` and the run's ``--glass-catalog`` files the user glass
-    catalogues, in that order (every run starts with none left over); their names."""
+    catalogues, in that order, and ``--strict-glass`` the rule for lens files' glasses (every run
+    starts with none left over); their names."""
     from ._config import load_config
 
     paths = list(load_config().glass_catalogs or ()) + list(getattr(args, "glass_catalog", None) or ())
-    if not paths and "physcam.lens.catalog" not in sys.modules:
+    strict = bool(getattr(args, "strict_glass", False))
+    if not paths and not strict and "physcam.lens.catalog" not in sys.modules:
         return []  # nothing to add and nothing left over: the report starts without the glass code
     from ..lens.catalog import use_catalog_files
 
-    return use_catalog_files(paths)
+    return use_catalog_files(paths, strict=strict)
 
 
 def merge_lens_argument(args, parser) -> None:
@@ -463,6 +469,34 @@ def merge_lens_argument(args, parser) -> None:
              f"(physcam {POSITIONAL_LENS_REMOVED_IN} will refuse the old form)")
     elif not given:
         parser.error("give the lens: --lens NAME_OR_FILE (a bundled name from `physcam lenses`, or a lens file)")
+
+
+# ---- a folder of outputs written as a whole --------------------------------------------------
+#: ``--force`` of a command whose ``-o DIR`` is written whole (:func:`output_folder`).
+FOLDER_FORCE_HELP = "replace the folder if physcam wrote it whole (it has a physcam-manifest.json) or it is empty"
+
+def output_folder(folder, *, force: bool, command: str):
+    """A command's output folder written as a whole (:func:`physcam.io.staged_folder`): a context
+    yielding the private temporary folder to fill; on success it is put at ``folder`` in one rename
+    with its ``physcam-manifest.json`` (``about``: the command and physcam's version). Without
+    ``force`` an existing ``folder`` is refused; with it, only one physcam wrote whole (or an empty one)
+    is replaced, never a folder of the user's own files. Checked at once, before any work."""
+    from .. import __version__
+    from ..io import staged_folder
+
+    return staged_folder(folder, force=force, about={"command": f"physcam {command}", "physcam_version": __version__})
+
+
+def relocated(paths, tmp, folder) -> list:
+    """``paths`` written under the temporary folder ``tmp``, as they are named once it is published
+    at ``folder`` (same types: str stays str)."""
+    from pathlib import Path
+
+    out = []
+    for p in paths:
+        q = Path(folder) / Path(p).relative_to(tmp)
+        out.append(str(q) if isinstance(p, str) else q)
+    return out
 
 
 # ---- notes -----------------------------------------------------------------------------------

@@ -60,7 +60,7 @@ def register(sub) -> None:
                    help="a table of distortion across focus marks, e.g. 0.5m,1m,2m,inf (hyperfocal too); "
                         "needs --resolution")
     add_units_option(p)
-    p.set_defaults(handler=run_distortion)
+    p.set_defaults(handler=run_distortion, output_folders=("stmap",))
 
 
 def run_distortion(args) -> int:
@@ -249,8 +249,12 @@ def _run_field(args, lens) -> int:
     from ..analysis.distortion_models import fit_models, samples_from_field
     from ..analysis.stmap import distortion_field, write_stmaps
     from ..errors import InputError
-    from ..io import atomic_write, check_writable
+    import contextlib
+    from pathlib import Path
+
+    from ..io import atomic_write
     from ..optics.state import camera_state
+    from ._common import output_folder, relocated
 
     if args.field:
         raise InputError("--field is for the field-angle table; the 2-D field (--resolution) covers the whole frame")
@@ -262,16 +266,19 @@ def _run_field(args, lens) -> int:
 
         require_extra("exr", "writing ST-maps as EXR (physcam distortion --stmap)")
     cam = camera_state(lens, focus_mm=args.focus, fstop=args.fstop, sensor_mm=(args.sensor_width, args.sensor_height))
-    res = distortion_field(cam, width_px=args.resolution[0], height_px=args.resolution[1], wavelength_nm=args.wavelength,
-                           maps=args.stmap is not None)
-    fits = fit_models(samples_from_field(res), args.fit or (), max_residual_px=args.max_residual)
     written = []
-    if args.stmap is not None:
-        payload = _fit_payloads(args, res, fits, args.stmap) if args.fit else []
-        for p, _ in payload:  # every name checked before anything is written
-            check_writable(p, force=args.force)
-        written = write_stmaps(res, args.stmap, force=args.force)
-        written += [atomic_write(p, data, force=args.force) for p, data in payload]
+    with contextlib.ExitStack() as stack:  # the --stmap folder is written whole, and checked before the work
+        tmp = None if args.stmap is None else stack.enter_context(
+            output_folder(args.stmap, force=args.force, command="distortion --stmap"))
+        res = distortion_field(cam, width_px=args.resolution[0], height_px=args.resolution[1],
+                               wavelength_nm=args.wavelength, maps=args.stmap is not None)
+        fits = fit_models(samples_from_field(res), args.fit or (), max_residual_px=args.max_residual)
+        if tmp is not None:
+            payload = _fit_payloads(args, res, fits, args.stmap) if args.fit else []  # named in the final folder
+            maps = write_stmaps(res, tmp)
+            for p, data in payload:
+                atomic_write(tmp / Path(p).relative_to(args.stmap), data)
+            written = relocated(maps, tmp, args.stmap) + [p for p, _ in payload]
     d = res.to_dict()
     d["fits"] = [f.to_dict() for f in fits]
     if args.json:

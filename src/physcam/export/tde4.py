@@ -26,6 +26,7 @@ import math
 
 from ..analysis.distortion_models import TDE4_MODEL, TDE4_PARAMETERS, TDE4RadialStandard
 from ..errors import InputError
+from ._codetext import printable_line
 
 __all__ = ["tde4_lens_text"]
 
@@ -61,7 +62,7 @@ def tde4_lens_text(fit: TDE4RadialStandard, name: str | None = None, *,
     if name is None:
         name = "physcam lens"
     focus = "infinity" if math.isinf(fit.focus_from_film_mm) else f"{fit.focus_from_film_mm / 1000:g} m"
-    title = " ".join(f"{name} (physcam fit at focus {focus})".split())
+    title = " ".join(printable_line(f"{name} (physcam fit at focus {focus})").split())
     w, h = lp["tde4_filmback_width_cm"], lp["tde4_filmback_height_cm"]
     lines = [
         title,

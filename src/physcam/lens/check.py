@@ -9,7 +9,8 @@
 - ``warning``: it can be traced but contradicts itself or its stated data (EFL or f-number
   against the name or ``[lens]`` table, a stop wider than the beam its neighbours pass,
   ``[focus]`` gaps that move focus the wrong way, glass off the glass map);
-- ``note``: worth knowing (a duplicate of a bundled lens, a small mismatch).
+- ``note``: worth knowing (a duplicate of a bundled lens, a small mismatch, numbers not compared
+  with their primary source or a licence nobody established, as the ``[provenance]`` record says).
 
 Every finding names the surface (0-based, as in physcam) and the file line. The checks here
 use only the prescription (paraxial optics at nd, exact sags); ray-traced checks (the on-axis
@@ -377,7 +378,23 @@ def _duplicates(c: _Ctx) -> None:
                       f"the same design at {k:.4f}x the size", None, slug=rec.slug, scale=k)
 
 
-CHECKS = (_edges, _crossings, _stop_beam, _stated, _focus, _glass, _duplicates)
+def _provenance(c: _Ctx) -> None:
+    """What a lens file's provenance record says about trusting and sharing it (only for a file that has one)."""
+    from .provenance import provenance_of
+
+    prov = provenance_of(c.p)
+    if prov == type(prov)():
+        return
+    if prov.primary_source_checked is False:
+        c.add("note", "provenance_unchecked",
+              f"its numbers were not compared with the primary source ({prov.source or 'not named'})",
+              f"they are as transcribed from {prov.transcribed_from or 'a source the file does not name'}")
+    if prov.licence and not prov.licence_resolved:
+        c.add("note", "licence_unresolved", f"licence {prov.licence}: nobody has established the file's licence",
+              "others may not be free to use or share the file")
+
+
+CHECKS = (_edges, _crossings, _stop_beam, _stated, _focus, _glass, _duplicates, _provenance)
 
 
 def check(lens, *, format: str | None = None, probes: Iterable[Callable[[Prescription], list]] = ()) -> list[Finding]:

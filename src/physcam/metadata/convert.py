@@ -171,6 +171,7 @@ def write_usd(file, record, solved, *, plate=None, plate_frames=None, meters_per
 
     from pxr import Usd
 
+    from ..export._codetext import printable_line
     from ..io import check_writable
     from ..live.record import write_recording_usd
     from ..usd.author import save_stage
@@ -189,8 +190,8 @@ def write_usd(file, record, solved, *, plate=None, plate_frames=None, meters_per
                                     path=path)
         stage = Usd.Stage.Open(str(first))
         cam = stage.GetPrimAtPath(path)
-        cam.SetCustomDataByKey("physcam:source", f"{record.source} camera metadata read by physcam metadata usd "
-                                                 f"({', '.join(Path(f).name for f in record.files)})")
+        cam.SetCustomDataByKey("physcam:source", printable_line(f"{record.source} camera metadata read by physcam "
+                                                                f"metadata usd ({', '.join(Path(f).name for f in record.files)})"))
         static = {k: v for k, v in record.static_dict().items() if v is not None and k != "notes"}
         cam.SetCustomDataByKey("physcam:clip", json.dumps(static, sort_keys=True))
         if plate_d:

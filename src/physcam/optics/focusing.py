@@ -217,6 +217,8 @@ def _unit_focus(p: Prescription, mark: float, axis: str, lam, max_extension_mm) 
     # 1/s + n'/s' = phi with s = T - s'  ->  phi s'^2 - (phi T + n' - 1) s' + n' T = 0
     bq = phi * T + n2 - 1.0
     disc = bq * bq - 4.0 * phi * n2 * T
+    if -1e-12 * bq * bq <= disc < 0:  # the 1:1 mark itself (closest_focus), a rounding error below zero
+        disc = 0.0
     if T <= 0 or disc < 0:
         t_min = (1.0 + math.sqrt(n2)) ** 2 / phi  # discriminant zero: the 1:1 conjugate in air
         raise OpticsError(

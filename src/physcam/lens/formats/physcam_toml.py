@@ -6,8 +6,9 @@ Layout (docs/lens-formats.md)::
     [lens]        name, maker?, patent?, focal_length?, max_fstop?, t_stop?, coating?,
                   minimum_object_distance? (mm from the film plane), squeeze? (1),
                   wavelength_nm? (587.5618)
-    [provenance]  source?, notes?, licence?, and any further keys (original_file, original_format,
-                  corrections, aliases) kept in Prescription.extras as "provenance.<key>"
+    [provenance]  source?, notes?, licence?, and the rest of the record (physcam.lens.provenance:
+                  source_url, transcribed, checks, assumptions, ...; original_file, corrections,
+                  aliases, ...) kept in Prescription.extras as "provenance.<key>"
     [[surface]]   kind, radius, thickness, semi_diameter, medium, conic?, aspheric?
                   medium = "air" | { nd = 1.5168, vd = 64.17, glass? = "N-BK7", catalog? = "SCHOTT",
                                      dpgf? = 0.0 } | { glass = "N-BK7", catalog? = "SCHOTT" }
@@ -29,6 +30,7 @@ from pathlib import Path
 from ...errors import InputError, LensFileError
 from ..catalog import find_glass
 from ..prescription import AIR, SURFACE_KINDS, Focus, LensMetadata, Medium, Prescription, Surface, takes_prescription
+from ..provenance import ORDER as PROVENANCE_ORDER, check_provenance_table
 from ._common import (
     takes_text,
     MAX_SURFACES,
@@ -124,6 +126,7 @@ def loads_document(doc: dict, text: str, path=None, name: str | None = None) -> 
     if "focus" in doc:
         focus = _focus(table(doc["focus"], "[focus]", path), surfaces, text, path)
     prov = table(doc.get("provenance", {}), "[provenance]", path)
+    check_provenance_table(prov, path)
     extras = [(f"provenance.{k}", _json(v, f"[provenance] {k}", path)) for k, v in prov.items() if k not in ("source", "notes", "licence")]
     for k, v in table(doc.get("extras", {}), "[extras]", path).items():
         if not isinstance(v, str):
@@ -193,19 +196,18 @@ def dumps(p: Prescription) -> str:
         out.append(f"squeeze = {toml_value(float(p.squeeze))}")
     if p.wavelength_nm != DEFAULT_WAVELENGTH:
         out.append(f"wavelength_nm = {toml_value(float(p.wavelength_nm))}")
-    prov, extras = [], []
+    prov, extras = {}, []
     for k, v in p.extras:
         value = json.loads(v)
         if k.startswith("provenance.") and _plain(value) and k[len("provenance."):] not in ("source", "notes", "licence"):
-            prov.append(f"{toml_key(k[len('provenance.'):])} = {toml_value(value)}")
+            prov[k[len("provenance."):]] = value
         else:
             extras.append(f"{toml_key(k)} = {toml_value(v)}")
-    if m.source is not None or m.notes is not None or m.licence is not None or prov:
+    prov.update({key: getattr(m, key) for key in ("source", "licence", "notes") if getattr(m, key) is not None})
+    if prov:
         out += ["", "[provenance]"]
-        for key in ("source", "licence", "notes"):
-            if getattr(m, key) is not None:
-                out.append(f"{key} = {toml_value(getattr(m, key))}")
-        out += prov
+        for key in sorted(prov, key=lambda k: (PROVENANCE_ORDER.index(k) if k in PROVENANCE_ORDER else 99, k)):
+            out.append(_provenance_line(key, prov[key]))
     for s in p.surfaces:
         out += ["", "[[surface]]", f"kind = {toml_value(s.kind)}", f"radius = {toml_value(float(s.radius))}",
                 f"thickness = {toml_value(float(s.thickness))}", f"semi_diameter = {toml_value(float(s.semi_diameter))}"]
@@ -233,6 +235,13 @@ def dumps(p: Prescription) -> str:
     if extras:
         out += ["", "[extras]"] + extras
     return "\n".join(out) + "\n"
+
+
+def _provenance_line(key: str, value) -> str:
+    """``key = value``; a list of more than one string one item a line, so a record reads as a list."""
+    if isinstance(value, list) and len(value) > 1 and all(isinstance(x, str) for x in value):
+        return f"{toml_key(key)} = [\n" + "".join(f"    {toml_value(x)},\n" for x in value) + "]"
+    return f"{toml_key(key)} = {toml_value(value)}"
 
 
 def _plain(v) -> bool:
