@@ -224,7 +224,7 @@ def run_colour(args) -> int:
         for w, zp, zr in zip(res.wavelengths_nm, res.paraxial_focus_z_mm, res.real_focus_z_mm):
             t.add_row(f"{w:.4f}", f"{zp:.4f}", f"{zr:.4f}")
         print_table(t)
-        t = Table("lateral colour F - C on the film", ("field deg", "lateral colour um"), justify=["right"] * 2)
+        t = Table("lateral colour F - C on the film", ("field deg", "lateral colour µm"), justify=["right"] * 2)
         for p in res.lateral:
             t.add_row(f"{p.field_deg:.3f}", f"{p.lateral_colour_um:.3f}")
         print_table(t)
