@@ -50,11 +50,22 @@ def _reachable(lens, focus_mm):
 
 @pytest.mark.parametrize("focus_mm", FOCI, ids=["1m", "2m", "inf"])
 @pytest.mark.parametrize("slug", LENSES)
-def test_card_distortion_matches_forward_chief_rays(slug, focus_mm):
+def test_card_distortion_matches_forward_chief_rays(slug, focus_mm, capsys):
+    from physcam.cli import main
+
     lens = load_lens(slug)
     focus_mm = _reachable(lens, focus_mm)
     res = _card_curve(lens, focus_mm)
     assert res.focus_from_film_mm == focus_mm
+    # `physcam distortion --focus` at the card's own fields prints the card's numbers (within 0.01 %)
+    argv = ["distortion", "--lens", slug, "--focus", "inf" if math.isinf(focus_mm) else f"{focus_mm!r}mm",
+            "--sensor-width", str(SENSOR[0]), "--sensor-height", str(SENSOR[1]), "--json"]
+    for p in res.meridian("y"):
+        argv += ["--field", repr(p.field_deg)]
+    assert main(argv) == 0
+    cli = [p for p in json.loads(capsys.readouterr().out)["points"] if p["axis"] == "y"]
+    assert [p["distortion_pct"] for p in cli] == pytest.approx([p.distortion_pct for p in res.meridian("y")],
+                                                                abs=0.01)
     for axis in {p.axis for p in res.points}:
         pts = [p for p in res.meridian(axis) if p.real_height_mm > 0]
         theta = np.radians([p.field_deg for p in pts])

@@ -338,23 +338,23 @@ class _AtFocus:
             lo, hi = (mid, hi) if self.ideal(axis, [mid])[1][0] else (lo, mid)
         return lo
 
-    def heights_for(self, axis, fields_deg):
-        """Film heights whose object points lie ``fields_deg`` off axis (seen from the entrance pupil): Newton."""
-        want = np.tan(np.radians(fields_deg))
+    def heights_for(self, axis, fields_deg, reach_mm):
+        """Film heights whose object points lie ``fields_deg`` off axis (seen from the entrance pupil), and
+        which were found: bisection on the film height from the axis to ``reach_mm``, where the object angle
+        grows with the height (a height whose chief ray does not leave the lens counts as too far)."""
+        fields = np.asarray(fields_deg, dtype=float)
+        want = np.tan(np.radians(np.abs(fields)))
         f = self.g[axis].pinhole_focal_length
-        h = f * want
-        for _ in range(30):
-            ideal, ok = self.ideal(axis, h)
-            step = 1e-4 * max(1.0, float(np.abs(h).max()))
-            ideal2, ok2 = self.ideal(axis, h + step)
-            if not (ok.all() and ok2.all()):
-                return h, ok & ok2
-            r = -ideal / f - want  # the picture is the film turned: film height +h has its ideal at -f tan theta
-            slope = -(ideal2 - ideal) / f / step
-            h = h - r / slope
-            if np.abs(r).max() < 1e-13:
-                break
-        return h, self.ideal(axis, h)[1]
+        lo, hi = np.zeros(fields.shape), np.full(fields.shape, float(reach_mm))
+        for _ in range(64):  # to the float's own resolution
+            mid = 0.5 * (lo + hi)
+            ideal, ok = self.ideal(axis, mid)
+            below = ok & (np.abs(ideal) / f < want)
+            lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+        h = 0.5 * (lo + hi)
+        ideal, ok = self.ideal(axis, h)
+        found = ok & (np.abs(np.abs(ideal) / f - want) <= 1e-9 * want + 1e-12)
+        return np.sign(fields) * h, found
 
 
 def _focused_distortion(lens, fields_deg, focus_mm, w, h, n_fields, wl, backend) -> DistortionResult:
@@ -375,7 +375,7 @@ def _focused_distortion(lens, fields_deg, focus_mm, w, h, n_fields, wl, backend)
             fields = np.array([require_finite("field angle", f) for f in np.atleast_1d(fields_deg)], dtype=float)
             if fields.size == 0 or (np.abs(fields) >= 89.0).any():
                 raise InputError("give field angles between -89 and 89 degrees")
-            heights, ok = at.heights_for(axis, fields)
+            heights, ok = at.heights_for(axis, fields, 4.0 * half_diag)
         ideal, passed = at.ideal(axis, heights)
         if not (ok & passed).all():
             raise OpticsError(f"a chief ray of {lens.name!r} focused at {focus_mm:g} mm misses the film in the "
@@ -384,8 +384,9 @@ def _focused_distortion(lens, fields_deg, focus_mm, w, h, n_fields, wl, backend)
         for hr, hi in zip(heights, ideal):
             real_pic = -hr  # the upright picture: the film turned by 180 degrees
             d = 0.0 if abs(hi) < 1e-12 else 100.0 * (real_pic - hi) / hi
-            points.append(DistortionPoint(axis, math.degrees(math.atan(abs(hi) / f)), float(abs(hr)), float(abs(hi)),
-                                          float(d)))
+            sign = -1.0 if hr < 0 else 1.0  # a field below the axis: negative angle and heights, as at infinity
+            points.append(DistortionPoint(axis, sign * math.degrees(math.atan(abs(hi) / f)), float(hr),
+                                          sign * float(abs(hi)), float(d)))
     fit = _fit(points, w, notes)
     return DistortionResult(lens.name, float(wl), float(at.st.film_z), float(at.g["x"].pinhole_focal_length),
                             float(at.g["y"].pinhole_focal_length), (w, h), points, fit, notes,
