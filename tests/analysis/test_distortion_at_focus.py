@@ -48,6 +48,7 @@ def _reachable(lens, focus_mm):
     return max(focus_mm, 1.001 * closest_focus(lens))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("focus_mm", FOCI, ids=["1m", "2m", "inf"])
 @pytest.mark.parametrize("slug", LENSES)
 def test_card_distortion_matches_forward_chief_rays(slug, focus_mm, capsys):
@@ -141,6 +142,7 @@ def test_stmap_field_agrees_with_the_card(slug, focus_mm):
         assert d == pytest.approx(p.distortion_pct, abs=0.01)
 
 
+@pytest.mark.slow
 def test_card_json_and_distortion_cli_print_the_same_curve(tmp_path, capsys):
     from physcam.analysis.lens_card import lens_card
     from physcam.cli import main
