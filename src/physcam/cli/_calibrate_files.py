@@ -176,28 +176,53 @@ def _usd_plan(cal, args):
     return p, variant
 
 
-def _measured(cal, out: Path, usd_file: Path) -> dict:
+def _measured(doc: dict, out: Path, usd_file: Path) -> dict:
+    """The ``physcam:characterization:*`` values of a calibration document (``Calibration.to_dict``)."""
     import os
 
-    marks = cal.marks
+    marks = doc["marks"]
     rel = os.path.relpath(out.resolve(), usd_file.resolve().parent)
     return {
         "source": "physcam calibrate: chart photographs",
-        "focusMarksMm": [m.mark_mm if m.mark_mm is not None and math.isfinite(m.mark_mm) else -1.0 for m in marks],
-        "pinholeFocalLengthMm": [m.focal_length_mm[1] for m in marks],
-        "pinholeFocalLengthStdMm": [(m.uncertainty.get("focal_length_mm") or {}).get("y", 0.0) for m in marks],
-        "principalPointOffsetMm": [v for m in marks for v in m.principal_offset_mm],
-        "opencvBrownConrady": [float(v) for m in marks for v in m.distortion],
-        "residualRmsPx": [m.rms_px for m in marks],
-        "verdict": ["good" if m.verdict[0] else "not good: " + "; ".join(m.verdict[1]) for m in marks],
+        "focusMarksMm": [m["focus_mark_mm"] if m["focus_mark_mm"] is not None and math.isfinite(m["focus_mark_mm"])
+                         else -1.0 for m in marks],
+        "pinholeFocalLengthMm": [m["focal_length_mm"]["y"] for m in marks],
+        "pinholeFocalLengthStdMm": [(m["uncertainty"].get("focal_length_mm") or {}).get("y", 0.0) for m in marks],
+        "principalPointOffsetMm": [v for m in marks for v in m["principal_point_offset_mm"]],
+        "opencvBrownConrady": [float(m["opencv"][k]) for m in marks for k in ("k1", "k2", "p1", "p2", "k3")],
+        "residualRmsPx": [m["residual_px"]["rms"] for m in marks],
+        "verdict": ["good" if m["good"] else "not good: " + "; ".join(m["verdict_reasons"]) for m in marks],
         "files": [rel],
     }
 
 
-def write_all(payload, usd, cal, args) -> list:
-    """Write the payload, then the USD variant; returns the paths written."""
+def add_calibration_variant(doc: dict, usd_file, variant: str, *, lens=None, fstop=None, output) -> Path:
+    """Add the characterization variant ``variant`` of the calibration document ``doc`` (the payload of
+    ``calibration.json``, ``Calibration.to_dict``) to the lens file ``usd_file``: the measured pinhole
+    (on ``lens``'s best-match camera at ``fstop`` when a prescription is given) and the measured numbers,
+    the deliverables in the folder ``output``. ``physcam calibrate --usd`` and the farm's ``usd`` step
+    (docs/farm.md) both add it so."""
     from dataclasses import replace
 
+    from ..usd.author import CameraSpec
+    from ..usd.kit import add_characterization, best_match_pinhole
+
+    m = doc["marks"][0]
+    mark = m["focus_mark_mm"]
+    focus = 1.0e7 if mark is None or math.isinf(mark) else float(mark)
+    f = float(m["focal_length_mm"]["y"])
+    w, h = m["sensor_mm"]
+    if lens is not None:
+        spec, _ = best_match_pinhole(lens, focus_mm=focus, fstop=fstop, sensor_width_mm=w, sensor_height_mm=h)
+        spec = replace(spec, pinhole_focal_length_mm=f)
+    else:
+        spec = CameraSpec(focal_length_mm=f, pinhole_focal_length_mm=f, focus_mm=focus, sensor_width_mm=w,
+                          sensor_height_mm=h)
+    return add_characterization(usd_file, variant, spec, _measured(doc, Path(output), Path(usd_file)))
+
+
+def write_all(payload, usd, cal, args) -> list:
+    """Write the payload, then the USD variant; returns the paths written."""
     from ..io import atomic_write
 
     written = []
@@ -207,18 +232,6 @@ def write_all(payload, usd, cal, args) -> list:
         else:
             written.append(atomic_write(p, data() if callable(data) else data, force=args.force))
     if usd is not None:
-        from ..usd.author import CameraSpec
-        from ..usd.kit import add_characterization, best_match_pinhole
-
-        m = cal.marks[0]
-        focus = 1.0e7 if m.mark_mm is None or math.isinf(m.mark_mm) else float(m.mark_mm)
-        f = float(m.focal_length_mm[1])
-        if getattr(args, "loaded_lens", None) is not None:
-            spec, _ = best_match_pinhole(args.loaded_lens, focus_mm=focus, fstop=args.fstop,
-                                         sensor_width_mm=m.sensor_mm[0], sensor_height_mm=m.sensor_mm[1])
-            spec = replace(spec, pinhole_focal_length_mm=f)
-        else:
-            spec = CameraSpec(focal_length_mm=f, pinhole_focal_length_mm=f, focus_mm=focus,
-                              sensor_width_mm=m.sensor_mm[0], sensor_height_mm=m.sensor_mm[1])
-        written.append(add_characterization(usd[0], usd[1], spec, _measured(cal, Path(args.output), usd[0])))
+        written.append(add_calibration_variant(cal.to_dict(), usd[0], usd[1], lens=getattr(args, "loaded_lens", None),
+                                               fstop=args.fstop, output=args.output))
     return written
