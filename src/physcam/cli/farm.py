@@ -101,7 +101,7 @@ def run_farm(args) -> int:
     print(f"{job.name}: physcam {job.kind}, {job.task_count} tasks in {len(job.steps)} steps, from {workdir}")
     for s in job.steps:
         after = f" after {', '.join(s.after)}" if s.after else ""
-        print(f"  {s.name}: {job.frames_are} {s.first}-{s.last}, {len(s.tasks())} tasks of {s.chunk}{after}: {s.what}")
+        print(f"  {s.name}: {job.frames_are} {s.first}-{s.last}, {len(s.tasks())} task(s) of {s.chunk}{after}: {s.what}")
     print(f"wrote {Path(path)}")
     return 0
 
