@@ -246,3 +246,29 @@ def test_a_task_of_another_kind_of_step_is_refused(capsys, tmp_path):
     rc = main(["farm-task", "--step", "cells", "--frames", "1", "--cwd", str(tmp_path), "--", *DEFOCUS])
     err = capsys.readouterr().err
     assert rc == 2 and "a defocus job has the steps kernels, frames" in err
+
+
+def test_farm_task_json_document(capsys, tmp_path):
+    """A frames task whose outputs are there skips them (nothing read or traced) and says so in a document
+    that validates against its schema."""
+    (tmp_path / "dof").mkdir()
+    for n in (7, 8):
+        (tmp_path / "dof" / f"dof.{n:04d}.exr").write_bytes(b"done")
+    capsys.readouterr()
+    rc = main(["farm-task", "--step", "frames", "--frames", "7-8", "--cwd", str(tmp_path), "--json", "--", *DEFOCUS])
+    out, err = capsys.readouterr()
+    assert rc == 0, err
+    doc = json.loads(out)
+    check_document(doc)
+    assert (doc["done"], doc["skipped"], doc["frames"], doc["kernels_traced"]) == ([], [7, 8], [7, 8], [])
+
+
+def test_a_frame_that_is_not_there_fails_the_task_in_one_line(capsys, tmp_path):
+    """A frames task over a frame not rendered yet: exit 2 and one line naming the frame and the file."""
+    capsys.readouterr()
+    rc = main(["farm-task", "--step", "frames", "--frames", "5", "--cwd", str(tmp_path), "--", *DEFOCUS])
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if not ln.startswith("physcam: note:")]
+    assert rc == 2 and len(lines) == 1, err
+    assert lines[0].startswith("physcam: error: frame 5: ") and "render.0005.exr" in lines[0]
+    assert not (tmp_path / "dof").exists()

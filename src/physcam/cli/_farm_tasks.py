@@ -76,6 +76,7 @@ def _defocus(args, ns, inner, first, last) -> dict:
     import contextlib
     import io
     import json
+    import sys
 
     from ..characterize.defocus_shot import frame_path
     from . import main
@@ -88,11 +89,15 @@ def _defocus(args, ns, inner, first, last) -> dict:
             lines.append(f"frame {n}: {target} is there, skipped")
             continue
         argv = _frame_command(inner, ns, image, target)
-        buf = io.StringIO()
-        with contextlib.redirect_stdout(buf):
+        buf, err = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stdout(buf), contextlib.redirect_stderr(err):
             rc = main(argv)
+        said = [ln for ln in err.getvalue().splitlines() if ln.strip()]
         if rc != 0:
-            raise InputError(f"frame {n}: physcam defocus {image} failed (exit {rc}; its error is above)")
+            why = next((ln for ln in reversed(said) if ln.startswith("physcam: error: ")), f"exit {rc}")
+            raise InputError(f"frame {n}: {why.removeprefix('physcam: error: ')}")
+        for ln in said:  # its notes and warnings, for the farm's log
+            print(ln, file=sys.stderr)
         doc = json.loads(buf.getvalue())
         done.append(n)
         traced.append(int(doc["kernels_traced"]))

@@ -26,20 +26,35 @@ __all__ = ["GRID_AXES", "grid_points", "point_of", "run_points", "finish_lenses"
 GRID_AXES = ("lens", "focus_mm", "fstop")
 
 
+def _grid(grid):
+    from ..characterize.grid import Grid
+
+    return require_type("grid", grid, Grid, "physcam.characterize.Grid(focus_mm=..., fstops=...)")
+
+
 def grid_points(lenses, grid) -> list[tuple]:
     """Every point of the grid, numbered from 1 in this order: (lens slug, focus mark mm, f-stop)."""
     require_type("lenses", lenses, (dict, list, tuple), "the lens slugs in order")
+    _grid(grid)
+    for slug in lenses:
+        require_type("lens slug", slug, str, "the lens's folder name")
     return [(slug, m, n) for slug in lenses for m in grid.focus_mm for n in grid.fstops]
 
 
 def point_of(cell, grid) -> tuple:
     """The grid point a cell belongs to: its own lens, focus and f-stop, the grid's first where it has none."""
+    from ..characterize.grid import Cell
+
+    require_type("cell", cell, Cell, "physcam.characterize.build_cells")
+    _grid(grid)
     return (cell.lens, grid.focus_mm[0] if cell.focus_mm is None else cell.focus_mm,
             grid.fstops[0] if cell.fstop is None else cell.fstop)
 
 
 def _plan(lenses, grid):
     from .. import __version__
+
+    _grid(grid)
     from ..characterize.run import plan_cells
 
     return plan_cells(lenses, grid.checked(), __version__), __version__
@@ -53,6 +68,10 @@ def run_points(lenses: dict, grid, output, run_id: str, first: int, last: int) -
     from ..characterize.run import task_groups
 
     require_type("run id", run_id, str, "run_YYYYmmddTHHMMSSZ_xxxxxx")
+    require_type("output", output, (str, Path), "the library folder")
+    for name, v in (("first point", first), ("last point", last)):
+        if isinstance(v, bool) or not isinstance(v, int):
+            raise InputError(f"the {name} is a whole number, got {v!r}")
     plan, version = _plan(lenses, grid)
     points = grid_points(list(plan), grid)
     if not 1 <= first <= last <= len(points):
@@ -78,6 +97,7 @@ def finish_lenses(lenses: dict, grid, output, run_id: str) -> list[dict]:
     from ..characterize.library import lens_usd_update
 
     require_type("run id", run_id, str, "run_YYYYmmddTHHMMSSZ_xxxxxx")
+    require_type("output", output, (str, Path), "the library folder")
     plan, _ = _plan(lenses, grid)
     out = Path(output)
     missing = {slug: [c for c in cells if not (out / c.index_name).is_file()] for slug, (_, _, cells) in plan.items()}

@@ -4,10 +4,11 @@ Deadline 10, Tractor, a studio's own queue or ``xargs -P``: every line that is n
 task, a POSIX shell command line with its chunk's frames written out (``--frames 1002-1005``). The
 tasks come step by step in the order they must run: a step's tasks only after every task of the steps
 it waits for has succeeded; the tasks of one step in any order, at once. Each step is introduced by
-comment lines naming it, its frames, its chunk, what it waits for and its command as a template with
-Deadline 10's frame tokens ``<STARTFRAME>-<ENDFRAME>`` (its CommandLine plugin's Arguments, with
-Frames and ChunkSize as given; docs/farm.md). The first line says the format:
-``# physcam farm tasks 1``.
+comment lines naming it, its frames, its chunk, what it waits for, and its command as Deadline 10's
+CommandLine job takes it: the executable, and the arguments with Deadline's frame tokens
+``<STARTFRAME>-<ENDFRAME>`` (an argument holding a space between ``<QUOTE>`` tokens; ``deadlinecommand
+-SubmitCommandLineJob -executable ... -arguments ... -frames ... -chunksize ...``, docs/farm.md). The
+first line says the format: ``# physcam farm tasks 1``.
 """
 
 from __future__ import annotations
@@ -18,11 +19,22 @@ from ..errors import require_type
 from .frames import frames_text
 from .job import FarmJob
 
-__all__ = ["FORMAT_LINE", "DEADLINE_TOKENS", "task_list", "read_task_list"]
+__all__ = ["FORMAT_LINE", "DEADLINE_TOKENS", "deadline_arguments", "task_list", "read_task_list"]
 
 FORMAT_LINE = "# physcam farm tasks 1"
 #: Deadline 10's tokens for the first and last frame of a task
 DEADLINE_TOKENS = "<STARTFRAME>-<ENDFRAME>"
+
+
+def deadline_arguments(argv) -> str:
+    """``argv`` as one Deadline Arguments string: words joined by spaces, a word with whitespace (or none
+    at all) between ``<QUOTE>`` tokens, which Deadline replaces by double quotes."""
+    require_type("arguments", argv, (list, tuple), "the command's words")
+    out = []
+    for a in argv:
+        require_type("argument", a, str)
+        out.append(f"<QUOTE>{a}<QUOTE>" if not a or any(c.isspace() for c in a) else a)
+    return " ".join(out)
 
 
 def task_list(job: FarmJob) -> str:
@@ -37,7 +49,8 @@ def task_list(job: FarmJob) -> str:
         out += ["#",
                 f"# step {s.name}: {job.frames_are} {frames_text(s.first, s.last)}, chunk {s.chunk}, "
                 f"{len(s.tasks())} task{'s' if len(s.tasks()) > 1 else ''}, after: {', '.join(s.after) or 'nothing'}; {s.what}",
-                "# deadline: " + shlex.join(s.command(DEADLINE_TOKENS, job.workdir))]
+                "# deadline executable: " + s.argv[0],
+                "# deadline arguments: " + deadline_arguments(s.command(DEADLINE_TOKENS, job.workdir)[1:])]
         out += [shlex.join(s.command(frames_text(a, b), job.workdir)) for a, b in s.tasks()]
     return "\n".join(out) + "\n"
 
