@@ -183,7 +183,7 @@ def test_openjd_characterize_grid_gives_the_direct_bytes_after_a_kill(tmp_path):
 def test_openjd_calibrate_gives_the_direct_deliverables_and_variant(tmp_path):
     """Five ChArUco photographs (OpenCV's projection of a known camera, tests/analysis/_charts.py): the
     calibrate and usd steps through openjd run write the deliverables byte for byte as physcam calibrate
-    does (the folder written whole: a manifest besides) and the same USD variant (but the folder's name);
+    does (both folders written whole, manifests included) and the same USD variant (but the folder's name);
     run again, both steps find their outputs and skip."""
     cv2 = pytest.importorskip("cv2")
     sys.path.insert(0, str(Path(__file__).parents[1] / "analysis"))
@@ -202,8 +202,9 @@ def test_openjd_calibrate_gives_the_direct_deliverables_and_variant(tmp_path):
                           "-o", "farm", "--usd", "farm.usda"]) == 0
     _openjd(tmp_path, "job.json", "usd")
     direct, farm = _files(tmp_path / "direct"), _files(tmp_path / "farm")
-    assert farm.pop("physcam-manifest.json") and farm == direct
-    assert {"distortion.exr", "undistortion.exr", "calibration.json", "calibration_sheet.png"} <= set(direct)
+    assert farm == direct  # the manifest too: both folders are written whole
+    assert {"distortion.exr", "undistortion.exr", "calibration.json", "calibration_sheet.png",
+            "physcam-manifest.json"} <= set(direct)
     usd = (tmp_path / "farm.usda").read_text()
     assert usd.replace('["farm"]', '["direct"]') == (tmp_path / "direct.usda").read_text()
     log = _openjd(tmp_path, "job.json", "usd")

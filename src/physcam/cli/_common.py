@@ -337,6 +337,10 @@ def add_lens_argument(p, *, dest: str = "lens", many: bool = False, metavar: str
     p.add_argument("--glass-catalog", dest="glass_catalog", action="append", default=None, metavar="FILE.agf",
                    help="a Zemax .agf glass catalogue searched after the lens file's own (repeat for several; "
                         "adds to the config's glass_catalogs)")
+    p.add_argument("--strict-glass", dest="strict_glass", action="store_true",
+                   help="a Zemax file's glass must be in the catalogues its GCAT line lists (or their makers' legacy "
+                        "glasses), as OpticStudio requires; by default another bundled catalogue holding the same "
+                        "name is used, with a warning")
     p.set_defaults(_lens_dest=dest, _lens_many=many)
 
 
@@ -366,15 +370,17 @@ def lens_use(args):
 
 def use_glass_catalogs(args) -> list[str]:
     """Make the config's ``glass_catalogs`` and the run's ``--glass-catalog`` files the user glass
-    catalogues, in that order (every run starts with none left over); their names."""
+    catalogues, in that order, and ``--strict-glass`` the rule for lens files' glasses (every run
+    starts with none left over); their names."""
     from ._config import load_config
 
     paths = list(load_config().glass_catalogs or ()) + list(getattr(args, "glass_catalog", None) or ())
-    if not paths and "physcam.lens.catalog" not in sys.modules:
+    strict = bool(getattr(args, "strict_glass", False))
+    if not paths and not strict and "physcam.lens.catalog" not in sys.modules:
         return []  # nothing to add and nothing left over: the report starts without the glass code
     from ..lens.catalog import use_catalog_files
 
-    return use_catalog_files(paths)
+    return use_catalog_files(paths, strict=strict)
 
 
 def merge_lens_argument(args, parser) -> None:
@@ -445,8 +451,8 @@ def take_notes() -> list[str]:
 
 
 def print_json(obj) -> None:
-    json.dump(obj, sys.stdout, indent=2, allow_nan=False)
-    sys.stdout.write("\n")
+    """``obj`` as JSON on stdout, whole or not at all (serialised before the first byte is written)."""
+    sys.stdout.write(json.dumps(obj, indent=2, allow_nan=False) + "\n")
 
 
 def console(stderr: bool = False):

@@ -174,37 +174,21 @@ def _characterize(args, ns, inner, physcam, name, workdir):
 def _calibrate(args, ns, inner, physcam, name, workdir):
     import datetime as _dt
 
-    from ..analysis.calibrate_chart import image_files
     from ..farm.job import FarmJob, Step, task_argv
-    from ..io import folder_manifest
+    from ._calibrate_files import check_outputs
 
     _refuse(ns, ("force",))
-    image_files(ns.images)
-    out = Path(ns.output)
-    if out.exists() and (not out.is_dir() or any(out.iterdir())) and folder_manifest(out) is None:
-        raise InputError(f"{out}: a calibrate farm job writes -o DIR whole; give a new or empty folder")
+    if ns.usd is not None and ns.variant is None:
+        inner = [*inner, "--variant", "calibration_" + _dt.datetime.now(_dt.UTC).strftime("%Y%m%d")]
+        ns.variant = inner[-1]
+    check_outputs(ns)  # the options, the images' headers, the output folder and the lens file, as calibrate does
     steps = [Step("calibrate", 1, 1, 1, task_argv(physcam, "calibrate", inner),
                   what="calibrate from the charts; write the ST-maps, fitted models, sheet and calibration.json "
                        "as one folder")]
     if ns.usd is not None:
-        if ns.variant is None:
-            inner = [*inner, "--variant", "calibration_" + _dt.datetime.now(_dt.UTC).strftime("%Y%m%d")]
-            ns.variant = inner[-1]
-        _check_variant_free(ns.usd, ns.variant)
         steps.append(Step("usd", 1, 1, 1, task_argv(physcam, "usd", inner), after=("calibrate",),
                           what=f"add the variant {ns.variant} to {ns.usd}"))
     return FarmJob(name, "calibrate", workdir, tuple(steps)), inner
-
-
-def _check_variant_free(usd, variant) -> None:
-    from ..errors import ExportError
-
-    if not Path(usd).exists():
-        return
-    from ..usd.kit import read_characterizations
-
-    if variant in read_characterizations(usd)["variants"]:
-        raise ExportError(f"{usd}: already has a characterization variant {variant!r}: give another --variant")
 
 
 def write_job(job, args) -> str:

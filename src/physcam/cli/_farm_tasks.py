@@ -9,8 +9,10 @@ Every task is resumable and leaves no mixed result when killed:
   the shared cache (one file per kernel, written atomically).
 * characterize (``cells``, ``usd``): :func:`physcam.farm.grid_tasks.run_points` and
   :func:`~physcam.farm.grid_tasks.finish_lenses` (a cell in the index is skipped).
-* calibrate (``calibrate``, ``usd``): the deliverables through :func:`physcam.io.staged_folder` (a
-  folder whose manifest is complete is skipped), the variant added unless the lens file has it.
+* calibrate (``calibrate``, ``usd``): the deliverables written whole as ``physcam calibrate`` writes
+  them (:func:`physcam.io.staged_folder`; a folder whose manifest is complete is skipped), then the
+  variant from its calibration.json, checked as ``physcam calibrate --usd`` checks it, unless the lens
+  file has it.
 """
 
 from __future__ import annotations
@@ -138,24 +140,22 @@ def _calibrate(args, ns, inner, first, last) -> dict:
     out = Path(ns.output)
     if folder_manifest(out) is not None:
         return {"done": [], "skipped": [1], "lines": [f"{out}: written whole already, skipped"]}
-    from ..io import staged_folder
-    from ._calibrate_files import deliverables, write_all
+    from ._calibrate_files import check_outputs, deliverables, write_all
     from .calibrate import compute
 
-    ns.usd = None  # the variant is the usd step's
+    ns.usd = ns.variant = None  # the variant is the usd step's
+    plan = check_outputs(ns)
     cal, _ = compute(ns)
-    with staged_folder(out, about={"command": "physcam calibrate", "farm": "calibrate"}) as tmp:
-        ns.output = str(tmp)
-        payload, _ = deliverables(cal, ns)
-        written = [out / Path(p).relative_to(tmp) for p in write_all(payload, None, cal, ns)]
+    payload, _ = deliverables(cal, ns, plan)
+    written = write_all(payload, None, cal, ns, plan)  # the folder whole, as physcam calibrate writes it
     return {"done": [1], "skipped": [], "lines": [f"wrote {p}" for p in written]}
 
 
 def _calibrate_usd(ns) -> dict:
     import json
 
-    from ..usd.kit import read_characterizations
-    from ._calibrate_files import add_calibration_variant
+    from ..usd.kit import characterization_target, read_characterizations
+    from ._calibrate_files import _check_usd, add_calibration_variant
 
     usd = Path(ns.usd)
     if usd.exists() and ns.variant in read_characterizations(usd)["variants"]:
@@ -163,11 +163,13 @@ def _calibrate_usd(ns) -> dict:
     calib = Path(ns.output) / "calibration.json"
     if not calib.is_file():
         raise InputError(f"{calib}: not there; the calibrate step has not run")
+    doc = json.loads(calib.read_text(encoding="utf-8"))
+    target = dict(characterization_target(usd, ns.variant), file=usd, variant=ns.variant)
+    _check_usd(doc, target)  # a NOT good calibration, or another lens's, never goes into the lens file
     lens = None
     if ns.lens is not None:
         from ..lens.library import load_lens
 
         lens = load_lens(ns.lens)
-    add_calibration_variant(json.loads(calib.read_text(encoding="utf-8")), usd, ns.variant, lens=lens,
-                            fstop=ns.fstop, output=ns.output)
+    add_calibration_variant(doc, target, lens=lens, fstop=ns.fstop, output=ns.output)
     return {"done": [1], "skipped": [], "lines": [f"{usd}: variant {ns.variant}"]}

@@ -329,11 +329,16 @@ class Prescription:
             if s.kind == "aspheric" and c != 0.0 and (1.0 + s.conic) * (c * s.semi_diameter) ** 2 > 1.0 + 1e-9:
                 raise fail(f"semi-diameter {s.semi_diameter:g} mm lies beyond the conic's edge", i)
         # Surfaces that cross: sag of the next surface at the common aperture must not
-        # come before the sag of this one (measured from this vertex).
+        # come before the sag of this one (measured from this vertex). A stop 0 mm before a face
+        # is a stop on that face (Zemax's and CODE V's STOP on a lens surface): a concave face
+        # curves in front of the stop's plane by design, the paraxial stop stays at the vertex,
+        # and the tracer follows the face back (a virtual leg in the medium before it).
         from .geometry import sag  # local import: geometry depends on nothing but math
 
         for i in range(len(self.surfaces) - 1):
             a, b = self.surfaces[i], self.surfaces[i + 1]
+            if a.is_stop and a.thickness == 0.0:
+                continue
             r = min(a.semi_diameter, b.semi_diameter)
             for axis in ("x", "y"):
                 za = sag(a, r, axis)

@@ -18,9 +18,9 @@ Query parameters are the CLI flags without their dashes (``sensor-width=24.89``)
 endpoint takes comes from the backend (the CLI's own parsers). Safety, all in
 :class:`Limits`: a bounded URL, a bounded number and length of parameters, printable values only,
 no request body, a token bucket per client address (429 with ``Retry-After``), the slow work
-shared between client addresses in turn with bounded queues (worker.py: 429 for one address's
-share, 503 in all), and one JSON line ``{"error": "..."}`` for every refusal (422 for bad
-input), never a traceback. An unexpected exception answers 500 with its class name and is
+shared between client addresses in turn with bounded queues (worker.py: an address's first slow
+request always taken; 429 for one address's share, 503 in all), and one JSON line
+``{"error": "..."}`` for every refusal (422 for bad input), never a traceback. An unexpected exception answers 500 with its class name and is
 logged as one line; the server keeps serving.
 """
 
@@ -83,7 +83,8 @@ class Limits:
     """The server's bounds (docs/serve.md, "What it refuses"). Per client address: ``rate``
     requests per second (a token bucket of ``burst``), ``client_queue`` slow requests (lenses,
     charts) pending for the worker, ``client_connections`` open connections. In all: ``queue`` slow
-    requests, ``connections`` connections. Per request: a head (request line and headers) of at
+    requests (an address's first is taken beyond it: worker.py), ``connections`` connections (and
+    addresses with slow work pending). Per request: a head (request line and headers) of at
     most ``head_bytes``, complete within ``head_timeout`` seconds of the connection opening or of
     the previous answer; a connection idle ``keep_alive`` seconds between requests is closed."""
 
@@ -259,8 +260,9 @@ class _App:
         self.backend, self.limits = backend, limits
         self.cache = _Cache(limits.cache_bytes)
         # One worker thread (numba's tracer and matplotlib are not to be entered from two threads at
-        # once), shared between client addresses in turn (worker.py).
-        self.worker = FairWorker(limits.client_queue, limits.queue)
+        # once), shared between client addresses in turn (worker.py); an address's first slow
+        # request is always taken, up to one address per connection the server accepts.
+        self.worker = FairWorker(limits.client_queue, limits.queue, addresses=limits.connections)
         self.static = {}
         root = resources.files(__package__) / "static"
         for name, media in STATIC_FILES.items():

@@ -10,10 +10,17 @@ Glasses as OpticStudio reads them: ``GCAT A B C`` lists the catalogues searched,
 (:func:`physcam.lens.catalog.find_glass`, plus the user's ``--glass-catalog`` files);
 ``GLAS NAME 0 ...`` is that catalogue glass, its data from the catalogue (the nd and Vd on the
 line are placeholders OpticStudio ignores, and so does physcam; glass substitution flags too);
-``GLAS ___BLANK 1 0 nd vd dPgF`` or any ``GLAS NAME 1 0 nd vd dPgF`` is a model glass. ``WAVM``
-(or ``WAVL``) and ``PWAV`` give the design wavelength (the primary). A stop on a lens face
-becomes a flat stop at that face's vertex, with the face's semi-diameter. Lines read past
-without effect on a refracting lens are listed in :data:`SKIPPED` with the reason.
+``GLAS ___BLANK 1 0 nd vd dPgF`` or any ``GLAS NAME 1 0 nd vd dPgF`` is a model glass. A glass
+the listed catalogues lack is looked for, by its own name only, in the legacy catalogue of a
+listed maker (SCHOTT's obsolete SK16, F15...), then, unless strict (``--strict-glass``, as
+OpticStudio), in every other bundled catalogue (:func:`physcam.lens.catalog.resolve_glass`); one
+:class:`PhysCamWarning` names each such glass and the catalogue it came from. A catalogue glass
+whose stated range does not hold the design wavelength gets one warning too (OpticStudio warns;
+the formula is extrapolated there). ``WAVM`` (or ``WAVL``) and ``PWAV`` give the design
+wavelength (the primary). A stop on a lens face becomes a flat stop at that face's vertex, with
+the face's semi-diameter; on a concave face (every negative lens of Thorlabs' files) the face
+curves in front of that plane, which the lens accepts (:meth:`Prescription.validate`). Lines read
+past without effect on a refracting lens are listed in :data:`SKIPPED` with the reason.
 
 Anything else that changes the optics (other surface types, tilts/decentres, MIRROR, other
 units, an r^2 asphere term, non-zero object-space index) is refused with file and line. Source:
@@ -36,7 +43,7 @@ from pathlib import Path
 
 from ...errors import ExportError, InputError, LensFileError, PhysCamWarning
 from ..aperture import size_stop
-from ..catalog import GlassNotFound, find_glass
+from ..catalog import LEGACY, LEGACY_SOURCE, GlassNotFound, find_glass, range_note, resolve_glass
 from ..prescription import AIR, OBJECT_DISTANCE_KEY, LensMetadata, Medium, Prescription, Surface, takes_prescription
 from ._common import MAX_SURFACES, check_count, extra, fmt, json_text, number, one_line, validated, takes_text
 
@@ -220,9 +227,10 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
     blocks, lens_name, notes, head = _read_blocks(text, path)
     if len(blocks) < 3:
         raise LensFileError("a sequential lens needs an object surface, lens surfaces and an image surface", path)
+    found: list = []  # (catalogue glass, how it was found: None, "legacy", "unlisted")
     for b in blocks:
         if b["glass"] is not None:
-            b["glass"] = _glass(b["glass"], head["gcat"], path, b["glass_line"])
+            b["glass"] = _glass(b["glass"], head["gcat"], path, b["glass_line"], found)
     _check_complete(blocks, path, head["tail"])
     obj, lens_blocks = blocks[0], blocks[1:-1]
     if obj["glass"] is not None and obj["glass"] != AIR:
@@ -234,7 +242,34 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
     meta = LensMetadata(name=name, notes="\n".join(notes) or None)
     extras = () if math.isinf(obj["disz"]) else ((OBJECT_DISTANCE_KEY, json_text(obj["disz"])),)
     p = Prescription(tuple(surfaces), meta, wavelength_nm=_design_wavelength(head, path), extras=extras)
-    return validated(_sized(p, head["aperture"], obj["disz"], path), path, lines)
+    p = validated(_sized(p, head["aperture"], obj["disz"], path), path, lines)
+    _say_glasses(found, head["gcat"], p.wavelength_nm, path)
+    return p
+
+
+def _say_glasses(found: list, gcat: list, wavelength_nm: float, path) -> None:
+    """One warning naming the glasses taken from a catalogue the GCAT line does not list (and
+    which), one for glasses used outside their stated range (module notes)."""
+    where = f"{path}: " if path is not None else ""
+    by_cat: dict = {}
+    for g, how in found:
+        if how is not None:
+            by_cat.setdefault((g.maker, how), {})[g.name] = g
+    if by_cat:
+        listed = " ".join(gcat) or "none"
+        parts = []
+        for (cat, how), glasses in by_cat.items():
+            names = ", ".join(f"{n}{f' ({g.status})' if g.status else ''}" for n, g in glasses.items())
+            if how == "legacy":
+                what = f"{LEGACY_SOURCE[cat]}, not {_MAKER_OF[cat]}'s current catalogue"
+            else:
+                what = f"not in GCAT {listed}; --strict-glass refuses it, as OpticStudio does"
+            parts.append(f"{names} taken from {cat} ({what})")
+        warnings.warn(where + "; ".join(parts), PhysCamWarning, stacklevel=4)
+    outside = list(dict.fromkeys(n for n in (range_note(g, wavelength_nm) for g, _ in found) if n))
+    if outside:
+        warnings.warn(f"{where}the design wavelength {wavelength_nm:g} nm lies outside the stated range of "
+                      f"{'; '.join(outside)}: its formula is extrapolated there", PhysCamWarning, stacklevel=4)
 
 
 def _sized(p: Prescription, aperture, object_distance: float, path) -> Prescription:
@@ -318,9 +353,10 @@ def _num(tok, k, what, path, lineno, *, length=True) -> float:
     return number(tok[k], what, path, lineno, length=length)
 
 
-def _glass(tok, gcat, path, lineno) -> Medium:
+def _glass(tok, gcat, path, lineno, found: list) -> Medium:
     """The medium of a GLAS line: a model glass (___BLANK, or solve code 1) from nd, Vd, dPgF;
-    else the catalogue glass, searched in the GCAT order (the line's numbers are placeholders)."""
+    else the catalogue glass, searched in the GCAT order (the line's numbers are placeholders)
+    and further (:func:`physcam.lens.catalog.resolve_glass`), noted in ``found``."""
     if len(tok) < 2:
         raise LensFileError("GLAS needs a glass name", path, lineno)
     g = tok[1]
@@ -334,9 +370,10 @@ def _glass(tok, gcat, path, lineno) -> Medium:
         dpgf = number(tok[6], "model glass dPgF", path, lineno, length=False) if len(tok) > 6 else 0.0
         return AIR if (nd == 1.0 and vd == 0.0) else Medium(nd, vd, dpgf=dpgf if vd else 0.0)
     try:
-        cat = find_glass(g, gcat)
+        cat, how = resolve_glass(g, gcat)
     except GlassNotFound as exc:
         raise LensFileError(str(exc), path, lineno) from None
+    found.append((cat, how))
     return Medium(cat.nd, cat.vd, cat.name, cat.maker)
 
 
@@ -381,7 +418,7 @@ def dumps(p: Prescription) -> str:
             g = _named(m)
             if g is not None:
                 out.append(f"  GLAS {g.name} 0 0 {fmt(m.nd)} {fmt(m.vd)} 0 0 0 0 0 0")
-                cats.append(g.maker)
+                cats.append(_MAKER_OF.get(g.maker, g.maker))  # OpticStudio's SCHOTT.AGF holds SCHOTT's legacy glasses
             else:
                 out.append(f"  GLAS ___BLANK 1 0 {fmt(m.nd)} {fmt(m.vd)} {fmt(m.dpgf)} 0 0 0 0 0")
         out.append(f"  DIAM {fmt(s.semi_diameter)} 1 0 0 1 \"\"")
@@ -391,6 +428,9 @@ def dumps(p: Prescription) -> str:
     if p.surfaces[-1].medium != AIR:
         out.append("BLNK")  # the file goes on past the image surface: an image space in a medium
     return "\n".join(out) + "\n"
+
+
+_MAKER_OF = {legacy: maker for maker, legacy in LEGACY.items()}
 
 
 def _named(m: Medium):
