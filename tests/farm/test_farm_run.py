@@ -196,6 +196,7 @@ def test_openjd_calibrate_gives_the_direct_deliverables_and_variant(tmp_path):
                     _charts.render(_charts.CHARUCO, r, t, board=board, seed=k))
     args = ["charts", "--sensor-width", "12.8", "--sensor-height", "9.6", "--chart", "charuco", "--corners", "24x18",
             "--square", "15mm", "--marker", "11mm", "--dictionary", "DICT_5X5_250", "--focus", "2m", "--bootstrap", "0",
+            "--max-residual", "2",
             "--variant", "day_1"]
     assert _in(tmp_path, ["calibrate", *args, "-o", "direct", "--usd", "direct.usda"]) == 0
     assert _in(tmp_path, ["farm", "--to", "openjd", "-o", "job.json", "--physcam", PHYSCAM, "--", "calibrate", *args,
