@@ -169,12 +169,15 @@ def test_openjd_refuses_text_it_would_read_as_an_expression(capsys, tmp_path):
 
 
 # ---- OpenCue -------------------------------------------------------------------------------------
-def test_opencue_outline_names_every_frame_exactly_once(capsys, tmp_path):
+def test_opencue_outline_names_every_frame_exactly_once(capsys, tmp_path, monkeypatch):
     """pyoutline's specification of 40 frames in chunks of 6: the kernels layer holds frame 101, the frames
     layer 102-140 with chunk 6 (OpenCue's FileSequence expands the ranges: each frame once), and depends on
-    the kernels layer; the commands carry OpenCue's chunk tokens."""
+    the kernels layer; the commands carry OpenCue's chunk tokens; nothing is left in the user's home
+    (pyoutline's session folder)."""
     pytest.importorskip("outline")
     from FileSequence import FrameSet
+
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
 
     rc, _, err = _farm(capsys, tmp_path, "opencue", "job.xml", "--chunk", "6", "--frames", "101-140",
                        "--show", "demo", "--shot", "sh010", "--user", "td", "--", *DEFOCUS)
@@ -190,6 +193,7 @@ def test_opencue_outline_names_every_frame_exactly_once(capsys, tmp_path):
     assert sorted(frames) == list(range(101, 141)) and len(frames) == len(set(frames))
     assert list(FrameSet(layers["kernels"].findtext("range")).getAll()) == [101]
     assert layers["frames"].findtext("chunk") == "6"
+    assert not (tmp_path / "home").exists()
     dep = root.find("depends/depend")
     assert (dep.get("type"), dep.findtext("deplayer"), dep.findtext("onlayer")) == ("LAYER_ON_LAYER", "frames",
                                                                                     "kernels")

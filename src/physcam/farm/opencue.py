@@ -7,13 +7,15 @@ frame, in its command); a step that waits for others depends on them layer-on-la
 is serialised by ``outline.cuerun.OutlineLauncher.serialize(use_pycuerun=False)`` (the commands run
 as written, not through pycuerun): the XML ``cjsl`` specification a Cuebot takes, e.g. with
 ``pycue``'s ``opencue.api.launchSpec`` (docs/farm.md). The command is one shell line, each
-argument quoted for a POSIX shell. Reference: OpenCue documentation, "Outline" and "Cue job
+argument quoted for a POSIX shell. The session folder pyoutline sets up for a launch through
+pycuerun is made in a temporary folder and removed: nothing is written in the user's home. Reference: OpenCue documentation, "Outline" and "Cue job
 specification" (opencue.io/docs).
 """
 
 from __future__ import annotations
 
 import shlex
+import tempfile
 
 from ..errors import ExportError, InputError, require_type
 from .job import FarmJob
@@ -51,8 +53,15 @@ def opencue_spec(job: FarmJob, *, show: str, shot: str, user: str) -> str:
         for a in s.after:
             layer.depend_all(layers[a])
         layers[s.name] = layer
-    try:
-        return outline.cuerun.OutlineLauncher(ol, user=user).serialize(use_pycuerun=False)
-    except Exception as exc:  # noqa: BLE001 - pyoutline's own errors (OutlineException, config) in one line
-        raise ExportError(f"pyoutline could not serialise the job: {type(exc).__name__}: "
-                          f"{str(exc).splitlines()[0] if str(exc) else ''}") from None
+    # pyoutline sets an outline up (a session folder with a copy of it, under ~/.opencue/sessions) before
+    # it serialises: that folder is for launching through pycuerun, so it goes to a temporary folder here
+    home_sessions = outline.config.get("outline", "session_dir", raw=True)
+    with tempfile.TemporaryDirectory(prefix="physcam-outline-") as sessions:
+        outline.config.set("outline", "session_dir", sessions.replace("%", "%%"))
+        try:
+            return outline.cuerun.OutlineLauncher(ol, user=user).serialize(use_pycuerun=False)
+        except Exception as exc:  # noqa: BLE001 - pyoutline's own errors (OutlineException, config) in one line
+            raise ExportError(f"pyoutline could not serialise the job: {type(exc).__name__}: "
+                              f"{str(exc).splitlines()[0] if str(exc) else ''}") from None
+        finally:
+            outline.config.set("outline", "session_dir", home_sessions)
