@@ -310,3 +310,11 @@ def test_read_lens_takes_a_zoom_file(tmp_path):
     f = tmp_path / "z.zmx"
     f.write_text(HAND_ZMX)
     assert read_lens(f).zoom.positions == 3
+
+
+@pytest.mark.parametrize("fmt", ["pbrt", "iset", "seed-toml"])
+def test_a_format_without_zoom_positions_says_it_writes_one(fmt):
+    from physcam.lens.formats import dumps_lens
+
+    with pytest.warns(PhysCamWarning, match="first zoom position"):
+        dumps_lens(load_lens("laikin_zoom_15_150mm"), fmt)
