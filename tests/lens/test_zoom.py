@@ -259,7 +259,7 @@ def test_a_single_configuration_file_is_no_zoom():
 # ---- single-position files of one design, joined ---------------------------------------------------
 
 def _appleseed(path):
-    from physcam.lens.prescription import AIR, LensMetadata, Medium, Prescription, Surface, unvalidated
+    from physcam.lens.prescription import AIR, LensMetadata, Medium, Prescription, Surface
 
     rows = [ln.split() for ln in path.read_text().splitlines() if ln.strip() and ln.lstrip()[0] not in "/#"]
     surfaces = tuple(Surface(float(r), float(t), AIR if float(n) in (0, 1) else Medium(float(n)), float(a),
