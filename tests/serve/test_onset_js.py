@@ -1,0 +1,231 @@
+"""The page's own solver (serve/static/onset.js) against the CLI on 10,000 random setups.
+
+Each setup is a query as the page sends it to /api/report (the CLI's flags without dashes, values
+as typed: "2.5m", "10'6\"", "inf", "hyperfocal", "d/1730", "25um"). The expected answer is the
+server's, which is `physcam report --json` (physcam.cli.serve.cli_backend: the CLI's own parser and
+document); the page's answer is onset.js's, run by node (or, where node is missing, by the real
+Chromium through Playwright). Every number of the page's document must equal the CLI's to 1e-9
+relative, every refusal must be a refusal on both sides.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import random
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from physcam.errors import PhysCamError
+
+STATIC = Path(__file__).resolve().parents[2] / "src" / "physcam" / "serve" / "static"
+NODE_HARNESS = Path(__file__).with_name("_onset_node.js")
+N_SETUPS = 10_000
+RTOL = 1e-9
+
+
+def run_page_solver(job: dict) -> list:
+    """onset.js's answers for ``job`` (sensors and setups): node, or headless Chromium."""
+    node = shutil.which("node")
+    if node:
+        out = subprocess.run([node, str(NODE_HARNESS), str(STATIC)], input=json.dumps(job), capture_output=True,
+                             text=True, check=True, timeout=600)
+        return json.loads(out.stdout)
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+    sync_api = pytest.importorskip("playwright.sync_api", reason="neither node nor playwright is installed")
+    if chromium is None:
+        pytest.skip("neither node nor chromium is installed: the page's solver cannot run here")
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=chromium, args=["--no-sandbox", "--disable-dev-shm-usage"])
+        try:
+            pg = b.new_page()
+            pg.add_script_tag(content=(STATIC / "onset.js").read_text(encoding="utf-8"))
+            return pg.evaluate("(job) => { if (job.coc_conventions) PhysOnset.setCocConventions(job.coc_conventions);"
+                               " return job.setups.map((q) => PhysOnset.report(q, job.sensors)); }", job)
+        finally:
+            b.close()
+
+
+# --- random setups, written as a person types them --------------------------------------------
+def _len(rng: random.Random, mm: float) -> str:
+    """``mm`` written in one of the ways the page and the CLI read (bare numbers are mm here)."""
+    form = rng.randrange(6)
+    if form == 0:
+        return f"{mm:.6g}"
+    if form == 1:
+        return f"{mm / 1000:.5g}m"
+    if form == 2:
+        return f"{mm / 304.8:.5g}ft"
+    if form == 3:
+        inches = round(mm / 25.4 * 8) / 8
+        ft, inch = divmod(inches, 12)
+        whole, part = int(inch), round((inch - int(inch)) * 8)
+        frac = f" {part}/8" if part else ""
+        return f"{int(ft)}' {whole}{frac}\""
+    if form == 4:
+        return f"{mm / 10:.5g} cm"
+    return f"{mm / 25.4:.5g}in"
+
+
+def _log_uniform(rng, lo, hi):
+    return math.exp(rng.uniform(math.log(lo), math.log(hi)))
+
+
+def random_setup(rng: random.Random, sensor_names: list[str]) -> dict:
+    q: dict[str, str] = {}
+    f = _log_uniform(rng, 8, 400)
+    q["focal"] = rng.choice([f"{f:.4g}", f"{f:.4g}mm"])
+    if rng.random() < 0.85:
+        q["sensor"] = rng.choice(sensor_names)
+    else:
+        q["sensor-width"], q["sensor-height"] = f"{rng.uniform(5, 60):.3f}", f"{rng.uniform(4, 40):.3f}"
+    if rng.random() < 0.35:
+        q["coc"] = rng.choice(["d/1500", "d/1000", "d/1730", "cine", "zeiss", "0.025", "0.03", "25um", "0.019mm",
+                               f"{rng.uniform(0.005, 0.06):.4f}"])
+    if rng.random() < 0.15:
+        q["squeeze"] = rng.choice(["1.3", "1.5", "1.8", "2", "1.25"])
+    fstop = _log_uniform(rng, 0.9, 32)
+    mark = _log_uniform(rng, max(4.2 * f, 250.0), 80_000.0)
+    mode = rng.choices(["dof", "hyper", "inf", "fstop", "focus", "split", "one"], [40, 6, 5, 14, 12, 13, 10])[0]
+    if mode in ("dof", "hyper", "inf", "split", "one") or rng.random() < 0.3:
+        q["fstop"] = f"{fstop:.3g}"
+    if mode == "dof":
+        q["focus"] = _len(rng, mark)
+    elif mode == "hyper":
+        q["focus"] = rng.choice(["hyperfocal", "hyper"])
+    elif mode == "inf":
+        q["focus"] = rng.choice(["inf", "infinity"])
+        if rng.random() < 0.5:
+            q["near"] = _len(rng, mark)
+    else:
+        near, far = mark * rng.uniform(0.55, 0.97), mark * rng.uniform(1.03, 3.0)
+        far_text = "inf" if rng.random() < 0.15 else _len(rng, far)
+        if mode == "fstop":
+            q.update(focus=_len(rng, mark), near=_len(rng, near), far=far_text)
+        elif mode in ("focus", "split"):
+            q.update(near=_len(rng, near), far=far_text)
+        else:
+            q["near" if rng.random() < 0.6 else "far"] = _len(rng, near if rng.random() < 0.6 else far)
+    if rng.random() < 0.2:
+        q["tstop"] = f"{fstop * rng.uniform(1.0, 1.3):.3g}"
+    _datasheet(rng, q, f)
+    return q
+
+
+def _datasheet(rng, q, f):
+    """Sometimes the technical model (datasheet planes, maybe from the flange), a pupil or a tape measure."""
+    r = rng.random()
+    if r < 0.2:
+        q["model"] = "technical"
+        flange = rng.random() < 0.3
+        base = 52.0 if flange else 0.0
+        h2 = f * rng.uniform(0.9, 1.2) - base
+        q["h2"] = f"{h2:.4g}"
+        q["h1"] = f"{h2 + rng.uniform(-30, 60):.4g}"
+        if flange:
+            q.update(reference="flange", flange="52")
+        if rng.random() < 0.5:
+            q["pupil"] = f"{h2 + rng.uniform(-20, 80):.4g}"
+    elif r < 0.3:
+        length = rng.uniform(40, 200)
+        q.update({"sensor-front": f"{length + rng.uniform(30, 120):.4g}", "lens-length": f"{length:.4g}"})
+        if rng.random() < 0.5:
+            q["pupil-fraction"] = f"{rng.uniform(0.2, 0.6):.2f}"
+    elif r < 0.35:
+        q["pupil"] = f"{rng.uniform(20, 200):.4g}"
+
+
+# --- comparison ---------------------------------------------------------------------------------
+#: strings the page's document carries that must read as the CLI's (the rest of the text: notes, names)
+COMPARED_TEXT = {"model", "coc_convention", "entrance_pupil_source", "reference_plane", "key", "schema"}
+
+
+#: differences of two nearly equal lengths: compared to RTOL of the length they are the difference of
+DIFFERENCE_OF = {"far_error_mm": "far_predicted_from_film_mm"}
+
+
+def differences(page, cli, path="", scale=None) -> list[str]:
+    """Where the page's document differs from the CLI's (numbers to RTOL, or to RTOL of ``scale``; every key
+    of the page's document)."""
+    if isinstance(page, dict):
+        if not isinstance(cli, dict):
+            return [f"{path}: page {page!r}, cli {cli!r}"]
+        out = []
+        if path.endswith(("solved", "measured")) and set(page) != set(cli):
+            out.append(f"{path}: keys page {sorted(page)}, cli {sorted(cli)}")
+        for k, v in page.items():
+            if k in ("notes", "name", "cameras"):
+                continue
+            if k not in cli:
+                out.append(f"{path}.{k}: missing from the CLI's document")
+                continue
+            ref = cli.get(DIFFERENCE_OF.get(k, ""))
+            out += differences(v, cli[k], f"{path}.{k}", None if ref is None else abs(ref))
+        return out
+    if isinstance(page, list):
+        if not isinstance(cli, list) or len(page) != len(cli):
+            return [f"{path}: page {page!r}, cli {cli!r}"]
+        return [d for i, (a, b) in enumerate(zip(page, cli)) for d in differences(a, b, f"{path}[{i}]")]
+    if isinstance(page, bool) or page is None or isinstance(cli, bool) or cli is None:
+        return [] if page == cli and type(page) is type(cli) else [f"{path}: page {page!r}, cli {cli!r}"]
+    if isinstance(page, (int, float)):
+        if not isinstance(cli, (int, float)):
+            return [f"{path}: page {page!r}, cli {cli!r}"]
+        size = max(abs(page), abs(cli)) if scale is None else scale
+        ok = abs(page - cli) <= RTOL * size or abs(page - cli) <= 1e-12
+        return [] if ok else [f"{path}: page {page!r}, cli {cli!r}"]
+    key = path.rsplit(".", 1)[-1]
+    return [] if key not in COMPARED_TEXT or page == cli else [f"{path}: page {page!r}, cli {cli!r}"]
+
+
+def cli_answers(setups) -> list:
+    from physcam.cli.serve import cli_backend
+
+    backend = cli_backend()
+    out = []
+    for q in setups:
+        try:
+            out.append({"ok": True, "body": backend.report(q)})
+        except PhysCamError as exc:
+            out.append({"ok": False, "body": {"error": str(exc)}})
+    return out
+
+
+def sensor_table() -> list:
+    from physcam.cli.sensors import sensor_document
+    from physcam.onset.sensors import sensors
+
+    return [sensor_document(s) for s in sensors()]
+
+
+@pytest.mark.slow
+def test_page_solver_equals_the_cli_on_10000_random_setups(monkeypatch, tmp_path):
+    monkeypatch.setenv("HOME", str(tmp_path))  # no user config: the CLI's defaults, as the page's
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path))
+    rng = random.Random(46)
+    table = sensor_table()
+    names = [rng.choice([s["key"], s["name"], *s["aliases"]]) for s in table]
+    setups = [random_setup(rng, names) for _ in range(N_SETUPS)]
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        expected = cli_answers(setups)
+    got = run_page_solver({"sensors": table, "setups": setups})
+    assert len(got) == N_SETUPS
+    bad = []
+    for q, page, cli in zip(setups, got, expected):
+        if page["ok"] != cli["ok"]:
+            bad.append(f"{q}: page {'answers' if page['ok'] else 'refuses: ' + page['body']['error']}, "
+                       f"cli {'answers' if cli['ok'] else 'refuses: ' + cli['body']['error']}")
+        elif page["ok"]:
+            diff = differences(page["body"], cli["body"])
+            if diff:
+                bad.append(f"{q}: {diff[:3]}")
+    answered = sum(a["ok"] for a in expected)
+    assert not bad, f"{len(bad)} of {N_SETUPS} setups differ, e.g.\n" + "\n".join(bad[:8])
+    # the setups exercise the solver, not its refusals: most are answered
+    assert answered > 0.75 * N_SETUPS, answered
