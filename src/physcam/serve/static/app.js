@@ -1,5 +1,7 @@
-// physcam serve: the page. Every number shown comes from the server's /api/report (the CLI's
-// --json); this script only reads the form, keeps the setup in the URL and formats lengths.
+// physcam serve: the page. The numbers come from the server's /api/report (the CLI's --json); with a
+// thin lens or a datasheet the page's own solver (onset.js, the same report in JavaScript) answers
+// first and whenever the server cannot be reached, so the page works with the laptop off (sw.js keeps
+// the page and the camera table). This script reads the form, keeps the setup in the URL, formats lengths.
 "use strict";
 
 const $ = (id) => document.getElementById(id);
@@ -141,24 +143,25 @@ async function update() {
   history.replaceState(null, "", query ? `?${query}` : location.pathname);
   $("share-url").value = location.href;
   $("json-link").href = `/api/report?${api}`;
+  const local = localReport(api);
+  if (local && local.ok) showReport(local.body, "page");
   let res;
   try {
     res = await getJSON("report", `/api/report?${api}`);
   } catch (e) {
     if (e.name === "AbortError") return;
-    if (my === seq) { showMessage("the physcam server cannot be reached; is it still running?"); setStale(true); }
+    if (my !== seq) return;
+    offline(local, api, my);
     return;
   }
   if (my !== seq) return;
+  document.body.dataset.offline = "";
   if (!res.ok) {
     showMessage(res.body && res.body.error ? res.body.error : `the server answered HTTP ${res.status}`);
     setStale(true);
     return;
   }
-  showMessage("");
-  setStale(false);
-  st.report = res.body;
-  render(res.body);
+  showReport(res.body, "server");
   clearTimeout(settle);
   settle = setTimeout(() => {
     if (my !== seq) return;
@@ -166,6 +169,50 @@ async function update() {
     table(res.body, api, my);
     diagram(res.body);
   }, SETTLE_MS);
+}
+
+// --- the page's own solver (onset.js): first, and whenever the server is away ---------------------
+function localReport(api) {
+  if (!window.PhysOnset || api.has("lens") || !SENSORS.length) return null;
+  return PhysOnset.report(Object.fromEntries(api), SENSORS);
+}
+
+function showReport(d, source) {
+  showMessage("");
+  setStale(false);
+  st.report = d;
+  document.body.dataset.source = source; // "page" (onset.js) or "server" (the CLI's numbers)
+  render(d);
+}
+
+function offline(local, api, my) {
+  document.body.dataset.offline = "1";
+  if (!local) {
+    showMessage("the physcam server cannot be reached: a library lens needs it (its prescription is traced there); "
+      + "a focal length is computed in the page");
+    setStale(true);
+    return;
+  }
+  if (!local.ok) {
+    showMessage(local.body.error);
+    setStale(true);
+    return;
+  }
+  showReport(local.body, "page");
+  localTable(local.body, api, my);
+  $("dof-chart").hidden = true;
+}
+
+function localTable(d, api, my) {
+  // the focus marks' rows from onset.js, as /api/focus-table would give them
+  const p = Object.fromEntries(api);
+  for (const k of ["focus", "near", "far", "fstop", "coc"]) delete p[k];
+  const marks = MARKS[st.units];
+  const rows = marks.map((m) => {
+    const r = PhysOnset.report({ ...p, fstop: String(d.fstop), coc: String(d.coc_mm), focus: m }, SENSORS);
+    return r.ok ? { focus: m, report: r.body } : { focus: m, error: r.body.error };
+  });
+  if (my === seq) fillMarks(d, rows, marks);
 }
 
 // --- what comes back -------------------------------------------------------------------------
@@ -283,11 +330,16 @@ async function table(d, api, my) {
   try {
     res = await getJSON("table", `/api/focus-table?${p}`);
   } catch (e) {
+    if (e.name !== "AbortError" && localReport(api)) localTable(d, api, my);
     return;
   }
   if (my !== seq || !res.ok) return;
+  fillMarks(d, res.body, marks);
+}
+
+function fillMarks(d, answers, marks) {
   const body = $("marks").tBodies[0];
-  const rows = res.body.map((row, k) => {
+  const rows = answers.map((row, k) => {
     const tr = document.createElement("tr");
     tr.dataset.focus = marks[k];
     const label = document.createElement("td");
@@ -504,7 +556,17 @@ function wire() {
   }
 }
 
+function registerWorker() {
+  // the installable web app: sw.js keeps the page and the camera table (a secure context only:
+  // localhost, 127.0.0.1 or HTTPS; docs/serve.md)
+  if (!("serviceWorker" in navigator) || !window.isSecureContext) return;
+  navigator.serviceWorker.register("/sw.js").then(() => navigator.serviceWorker.ready)
+    .then(() => { document.body.dataset.worker = "ready"; })
+    .catch(() => { document.body.dataset.worker = "failed"; });
+}
+
 async function start() {
+  registerWorker();
   try {
     const t = localStorage.getItem("physcam-theme");
     if (t === "light" || t === "dark") document.documentElement.dataset.theme = t;
