@@ -276,6 +276,7 @@ class LensReport:
             "flange_focal_distance_mm": self.flange_focal_distance_mm,
             "focus_error_mm": self.focus_error_mm,
             "magnification": self.magnification,
+            "frame_at_focus": _frame_dict(self),
             "dof": self.dof.to_dict(),
             "dof_horizontal": None if self.dof_horizontal is None else self.dof_horizontal.to_dict(),
             "pinhole": {"focal_length_mm": self.pinhole[0], "squeeze": self.pinhole[1],
@@ -306,6 +307,14 @@ class LensReport:
             "notes": list(self.notes),
             "diffraction": self.diffraction_dict(),
         }
+
+
+def _frame_dict(report) -> dict | None:
+    """The picture's width and height in the plane of sharp focus (physcam.onset.framing), or None at infinity."""
+    from .framing import frame_at_focus
+
+    fr = frame_at_focus(report)
+    return None if fr is None else fr.to_dict()
 
 
 # --------------------------------------------------------------------------------------

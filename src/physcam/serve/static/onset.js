@@ -572,6 +572,7 @@
       object_distance_mm: finiteOrNull(s), image_distance_mm: foc.sImg, h1_from_film_mm: h1Film,
       h2_from_film_mm: h2Film, reference_plane: r.reference,
       flange_focal_distance_mm: r.reference === "flange" ? r.flange : null, focus_error_mm: err, magnification: m,
+      frame_at_focus: frameAtFocus(w, h, sq, m, s),
       dof, dof_horizontal: dofH,
       pinhole: { focal_length_mm: pin, squeeze: sq },
       fov_deg: {
@@ -590,6 +591,14 @@
     if (r.sensorDefaulted) notes.push(`no --sensor given: ${sensor.name}, ${w} x ${h} mm`);
     checkFinite(d, "");
     return d;
+  }
+
+  // the picture's width and height in the plane of sharp focus: the (desqueezed) gate over |m|
+  // (physcam.onset.framing.frame_at_focus)
+  function frameAtFocus(w, h, sq, m, s) {
+    if (m === 0.0 || s === Infinity) return null;
+    const fw = w * sq / Math.abs(m), fh = h / Math.abs(m);
+    return { width_mm: fw, height_mm: fh, diagonal_mm: Math.hypot(fw, fh), distance_from_h1_mm: s };
   }
 
   function diffraction(d, sensor) {
