@@ -47,16 +47,16 @@ class CloseUp(NamedTuple):
                 "depth_of_field_mm": None if inf else self.depth_of_field_mm, "magnification": self.magnification}
 
 
-def close_up(focal_length_mm: float, fstop: float, coc_mm: float, focus_mark_mm: float, diopter: float) -> CloseUp:
+def close_up(focal_length_mm: float, fstop: float, coc_mm: float, focus_mm: float, diopter: float) -> CloseUp:
     """A +``diopter`` close-up lens on a thin lens of ``focal_length_mm`` at ``fstop``, its focus ring at
-    ``focus_mark_mm`` (film plane to subject; ``math.inf`` for infinity), CoC ``coc_mm``."""
+    ``focus_mm`` (film plane to subject; ``math.inf`` for infinity), CoC ``coc_mm``."""
     f = require_positive("focal length", focal_length_mm)
     n = require_positive("f-stop", fstop, unit="")
     c = require_positive("circle of confusion", coc_mm)
     p = require_positive("diopter", diopter, unit="dioptres")  # a close-up lens converges
     if p > 20.0:
         raise InputError(f"+{p:g} dioptres is a 50 mm magnifier, not a close-up lens; give the power in dioptres")
-    s = thinlens.object_distance_for_marked(f, focus_mark_mm)
+    s = thinlens.object_distance_for_marked(f, focus_mm)
     s_img = f if math.isinf(s) else thinlens.image_distance(f, s)
     power = p / 1000.0  # per mm
     f_c = 1.0 / (1.0 / f + power)
