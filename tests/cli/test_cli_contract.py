@@ -128,6 +128,7 @@ JSON_NOT_RUN = {
     ("defocus",): "needs an EXR render with depth (tests/analysis/test_defocus.py runs it and validates the document)",
     ("compare", "blender"): "needs Blender's bpy (tests/blender/test_compare.py validates its document)",
     ("live", "record"): "needs a UDP stream (tests/live/test_cli_live.py records one and validates the document)",
+    ("live", "recover"): "needs a recording's journal (tests/live/test_takes.py recovers one and validates the document)",
     ("calibrate",): "needs chart photographs (tests/analysis/test_calibrate.py renders them and validates its document)",
     ("demo",): "writes the whole demo (tests/onset_cli/test_report_cli.py::test_demo_writes_outputs validates it)",
     ("lens", "pack"): "packs a lens card and a USD file (tests/lens/test_lens_archive.py round-trips an archive through "
@@ -151,6 +152,7 @@ NO_UNITS = {
     ("usd", "write"): "prints the file written; the file holds millimetres and scene units",
     ("usd", "kit"): "prints the file written",
     ("live", "record"): "prints frame counts and timecodes",
+    ("live", "recover"): "prints frame counts and timecodes (as live record)",
     ("live", "send"): "prints the samples sent (OpenTrackIO's own units)",
 }
 #: Focus options with a grammar of their own (not _common.focus), and why.
@@ -161,6 +163,7 @@ OWN_FOCUS_GRAMMAR = {
 #: Commands whose --sensor has another default than the one default sensor, and why.
 OTHER_SENSOR_DEFAULT = {
     ("live", "record"): "the stream's sensor, when it carries one",
+    ("live", "recover"): "the recording's own options (its stream's sensor, when it carries one)",
     ("live", "play"): "the recording's sensor",
     ("lens", "check"): "optional: with a sensor the check adds a corner probe",
     ("metadata", "report"): "the clip's recorded sensor area when the file gives it",

@@ -62,11 +62,25 @@ def _take(d: Path) -> None:
                  "--sensor", "ALEXA 35"]) == 0
 
 
-#: Input files the pages name without showing them (a focus pull, a broken sample, a take).
+def _journal(d: Path) -> None:
+    """The journal a killed `live record scene12.usda` leaves: its header and 24 samples."""
+    from physcam.live.camera import camera_samples
+    from physcam.live.journal import Journal
+    from physcam.onset.sensors import find_sensor
+
+    j = Journal.create(d / "scene12.usda", {"output": "scene12.usda", "report": None, "options": {}})
+    for i, s in enumerate(camera_samples(sensor=find_sensor("ALEXA 35"), frames=24, rate=24, focus_mm=2000.0,
+                                         fstop=2.8, focal_length_mm=35.0)):
+        j.add_sample(s, i, "cbor")
+    j.close()
+
+
+#: Input files the pages name without showing them (a focus pull, a broken sample, a take, a journal).
 INPUTS = [
     lambda d: (d / "pull.csv").write_text("frame,focus,fstop\n1,2m,2.8\n12,2.5m,2.8\n24,3m,4\n"),
     _broken_sample,
     _take,
+    _journal,
     lambda d: (d / "tests").mkdir() or os.symlink(REPO / "tests" / "data", d / "tests" / "data"),
 ]
 

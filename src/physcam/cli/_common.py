@@ -451,8 +451,8 @@ def take_notes() -> list[str]:
 
 
 def print_json(obj) -> None:
-    json.dump(obj, sys.stdout, indent=2, allow_nan=False)
-    sys.stdout.write("\n")
+    """``obj`` as JSON on stdout, whole or not at all (serialised before the first byte is written)."""
+    sys.stdout.write(json.dumps(obj, indent=2, allow_nan=False) + "\n")
 
 
 def console(stderr: bool = False):
