@@ -84,6 +84,7 @@ def random_setup(rng: random.Random, sensor_names: list[str]) -> dict:
         q["sensor-width"], q["sensor-height"] = f"{rng.uniform(5, 60):.3f}", f"{rng.uniform(4, 40):.3f}"
     if rng.random() < 0.35:
         q["coc"] = rng.choice(["d/1500", "d/1000", "d/1730", "cine", "zeiss", "0.025", "0.03", "25um", "0.019mm",
+                               "full-frame", "FF", "16mm", "s35", "0.015",
                                f"{rng.uniform(0.005, 0.06):.4f}"])
     if rng.random() < 0.15:
         q["squeeze"] = rng.choice(["1.3", "1.5", "1.8", "2", "1.25"])

@@ -134,7 +134,8 @@ def _camera_formats() -> list[Sensor]:
             key=row["key"], name=f"{row['maker']} {short}", width_mm=w, height_mm=float(row["height_mm"]),
             aliases=(short, *(a.strip() for a in row["aliases"].split(";") if a.strip())), kind="digital",
             source=row["source"], pitch_um=round(w * 1000.0 / int(across), 3) if across else None,
-            pitch_source="width / photosites" if across else "", camera=row["camera"], fmt=row["format"],
+            pitch_source=f"width / photosites: {across} photosites across (the row's source)" if across else "",
+            camera=row["camera"], fmt=row["format"],
             make=row["maker"], anamorphic=tuple(float(x) for x in row["anamorphic"].split(";") if x.strip()),
             read=row["read"], method=row["method"]))
     return out

@@ -9,7 +9,7 @@ const DEBOUNCE_MS = 25; // the numbers: as soon as typing pauses for a moment
 const SETTLE_MS = 250; // the table, the chart and the diagram: once the setup has settled
 const DEFAULT_SENSOR = "s35-4perf";
 const DEFAULT_COC = "d/1500";
-const COCS = ["d/1500", "d/1000", "d/1730", "cine"];
+const COCS = ["d/1500", "d/1000", "d/1730", "cine", "full-frame", "16mm"];
 const MARKS = {
   metric: ["0.5m", "0.75m", "1m", "1.25m", "1.5m", "2m", "2.5m", "3m", "4m", "5m", "7m", "10m", "15m", "20m"],
   imperial: ["2ft", "3ft", "4ft", "5ft", "6ft", "7ft", "8ft", "10ft", "12ft", "15ft", "20ft", "25ft", "35ft", "50ft"],
@@ -181,6 +181,8 @@ function showReport(d, source) {
   showMessage("");
   setStale(false);
   st.report = d;
+  // the CoC in force, in every answer: its value on this sensor and its convention's name
+  $("coc-active").textContent = `circle of confusion ${d.coc_mm.toFixed(4)} mm · ${d.coc_convention}`;
   document.body.dataset.source = source; // "page" (onset.js) or "server" (the CLI's numbers)
   render(d);
 }
@@ -556,6 +558,24 @@ function wire() {
   }
 }
 
+function offerCoc() {
+  // first use: the common conventions offered by name (d/1500 gives 0.0207 mm on Super 35 where a puller's
+  // app says 0.025); the choice is kept on this phone
+  let chosen = null;
+  try { chosen = localStorage.getItem("physcam-coc"); } catch (e) { /* private mode */ }
+  const q = new URLSearchParams(location.search);
+  if (chosen && !q.has("coc")) setCoc(chosen);
+  $("coc-first").hidden = !!chosen || q.has("coc");
+  for (const b of $("coc-first").querySelectorAll("button")) {
+    b.addEventListener("click", () => {
+      setCoc(b.dataset.coc);
+      try { localStorage.setItem("physcam-coc", b.dataset.coc); } catch (e) { /* private mode */ }
+      $("coc-first").hidden = true;
+      update();
+    });
+  }
+}
+
 function registerWorker() {
   // the installable web app: sw.js keeps the page and the camera table (a secure context only:
   // localhost, 127.0.0.1 or HTTPS; docs/serve.md)
@@ -581,6 +601,7 @@ async function start() {
     return;
   }
   applyState(q);
+  offerCoc();
   const lensesLoaded = fetch("/api/lenses").then((r) => r.json()).then((l) => fillLenses(l, q.get("lens")))
     .catch(() => {});
   if (st.lensmode === "library") await lensesLoaded;

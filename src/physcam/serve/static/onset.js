@@ -130,7 +130,9 @@
     { name: "d/1500", kind: "diagonal", value: 1500.0, aliases: ["zeiss", "modern"] },
     { name: "d/1000", kind: "diagonal", value: 1000.0, aliases: ["traditional"] },
     { name: "d/1730", kind: "diagonal", value: 1730.0, aliases: [] },
-    { name: "cine", kind: "fixed", value: 0.025, aliases: ["acm", "0.025"] },
+    { name: "cine", kind: "fixed", value: 0.025, aliases: ["acm", "0.025", "s35", "super35"] },
+    { name: "full-frame", kind: "fixed", value: 0.03, aliases: ["ff", "fullframe", "0.03"] },
+    { name: "16mm", kind: "fixed", value: 0.015, aliases: ["s16", "0.015"] },
   ]);
 
   function cocRule(conv, w, h) {
@@ -140,6 +142,8 @@
   function parseCoc(text) {
     // physcam.optics.coc.parse_coc: a number is mm; a length with a unit is read; a name stays text
     if (text === undefined || text === null) return null;
+    const name = String(text).trim().toLowerCase();
+    if (name in COC_CONVENTIONS || name in COC_ALIASES) return String(text).trim(); // "16mm" is a name
     const f = pyFloat(text);
     if (f !== undefined) return f;
     const t = String(text).trim();
