@@ -66,6 +66,7 @@ JSON_RUNS = {
     ("report",): ["report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--cameras"],
     ("dof-table",): ["dof-table", "--focal", "35", "--fstops", "2,4", "--focus", "1m,hyperfocal,inf"],
     ("sensors",): ["sensors", "ARRI"],
+    ("exposure",): ["exposure", "--fps", "24", "--to-fps", "48"],
     ("lenses",): ["lenses"],
     ("lens", "show"): ["lens", "show", "dgauss_50mm", "--focus", "2m"],
     ("lens", "breathing"): ["lens", "breathing", "dgauss_50mm", "--focus", "1m", "2m", "inf"],

@@ -84,7 +84,7 @@ def stops_between_settings(a: ExposureSetting, b: ExposureSetting) -> dict:
     """How much brighter (+) or darker (-) setting ``b`` makes the picture than ``a``, in stops, and the
     part each control plays (shutter and frame rate, EI, T-stop, ND)."""
     parts = {"time": math.log2(b.exposure_time_s / a.exposure_time_s), "ei": math.log2(b.ei / a.ei),
-             "tstop": -2.0 * math.log2(b.tstop / a.tstop), "nd": -(b.nd - a.nd) / ND_STOP_DENSITY}
+             "tstop": 0.0 - 2.0 * math.log2(b.tstop / a.tstop), "nd": (a.nd - b.nd) / ND_STOP_DENSITY}
     return {"stops": sum(parts.values()), "parts": parts}
 
 
