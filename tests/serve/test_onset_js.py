@@ -43,8 +43,12 @@ def run_page_solver(job: dict) -> list:
         try:
             pg = b.new_page()
             pg.add_script_tag(content=(STATIC / "onset.js").read_text(encoding="utf-8"))
-            return pg.evaluate("(job) => { if (job.coc_conventions) PhysOnset.setCocConventions(job.coc_conventions);"
-                               " return job.setups.map((q) => PhysOnset.report(q, job.sensors)); }", job)
+            return pg.evaluate(
+                "(job) => { const inf = (x) => (x === 'inf' ? Infinity : x);"
+                " const call = (f) => { try { return {ok: true, body: f()}; } catch (e) {"
+                " if (e instanceof PhysOnset.ReportError) return {ok: false, body: {error: e.message}}; throw e; } };"
+                " return job.calls ? job.calls.map(([n, ...a]) => call(() => PhysOnset[n](...a.map(inf), job.sensors)))"
+                " : job.setups.map((q) => PhysOnset.report(q, job.sensors)); }", job)
         finally:
             b.close()
 
@@ -230,3 +234,80 @@ def test_page_solver_equals_the_cli_on_10000_random_setups(monkeypatch, tmp_path
     assert not bad, f"{len(bad)} of {N_SETUPS} setups differ, e.g.\n" + "\n".join(bad[:8])
     # the setups exercise the solver, not its refusals: most are answered
     assert answered > 0.75 * N_SETUPS, answered
+
+
+# --- the page's other answers: exposure, close-up lenses, split focus ------------------------------
+def _agree(page, cli):
+    if page["ok"] != cli["ok"]:
+        return [f"page {page['body']}, cli {cli['body']}"]
+    return differences(page["body"], cli["body"]) if page["ok"] else []
+
+
+def test_page_exposure_and_diopters_equal_the_library():
+    from physcam.onset.diopter import close_up
+    from physcam.onset.exposure import ExposureSetting, compensate, stops_between_settings
+
+    rng = random.Random(4646)
+    calls, expected = [], []
+    for _ in range(1500):
+        a = dict(fps=rng.choice([23.976, 24, 25, 48, 120]), shutter_deg=rng.uniform(5, 360), tstop=rng.uniform(0.9, 22),
+                 ei=rng.choice([200, 400, 800, 1600, 3200]), nd=rng.choice([0, 0.3, 0.6, 0.9, 1.2, 2.1]))
+        b = {k: (v if rng.random() < 0.5 else a[k]) for k, v in
+             dict(fps=rng.choice([24, 48, 96, 240]), shutter_deg=rng.uniform(5, 400), tstop=rng.uniform(0.9, 22),
+                  ei=rng.choice([400, 800, 1280, 6400]), nd=rng.choice([0, 0.3, 0.9, 1.5])).items()}
+        control = rng.choice(["tstop", "nd", "ei", "shutter"])
+        calls += [["exposureStops", a, b], ["compensate", a, b, control]]
+        for fn in (lambda: stops_between_settings(ExposureSetting(**a), ExposureSetting(**b)),
+                   lambda: compensate(ExposureSetting(**a), ExposureSetting(**b), control).to_dict()):
+            try:
+                expected.append({"ok": True, "body": fn()})
+            except PhysCamError as exc:
+                expected.append({"ok": False, "body": {"error": str(exc)}})
+        f, n, c, p = _log_uniform(rng, 10, 300), _log_uniform(rng, 1, 22), rng.uniform(0.01, 0.04), rng.choice(
+            [0.5, 1, 2, 3, 0.25, 4])
+        mark = "inf" if rng.random() < 0.3 else _log_uniform(rng, 3 * f, 20000)
+        calls.append(["closeUp", f, n, c, mark, p])
+        try:
+            expected.append({"ok": True, "body": close_up(f, n, c, math.inf if mark == "inf" else mark, p).to_dict()})
+        except PhysCamError as exc:
+            expected.append({"ok": False, "body": {"error": str(exc)}})
+    got = run_page_solver({"calls": calls})
+    bad = [f"{call}: {d[:2]}" for call, g, e in zip(calls, got, expected) for d in [_agree(g, e)] if d]
+    assert not bad, f"{len(bad)} differ, e.g.\n" + "\n".join(bad[:6])
+    assert sum(e["ok"] for e in expected) > 0.7 * len(expected)
+
+
+def test_page_split_focus_equals_the_library(monkeypatch, tmp_path):
+    from physcam.cli.serve import cli_backend  # noqa: F401  (the CLI's parser reads the queries below)
+    from physcam.onset.report import ReportRequest
+    from physcam.onset.sensors import find_sensor
+    from physcam.onset.split_focus import split_focus
+    from physcam.units import parse_distance
+
+    monkeypatch.setenv("HOME", str(tmp_path))
+    rng = random.Random(39)
+    table = sensor_table()
+    calls, expected = [], []
+    for _ in range(400):
+        f = _log_uniform(rng, 12, 200)
+        mark = _log_uniform(rng, max(5 * f, 400), 30000)
+        q = {"focal": f"{f:.4g}", "sensor": rng.choice(["S35", "ALEXA 35", "FX6 FF 4K 17:9", "VENICE 2"]),
+             "near": _len(rng, mark * rng.uniform(0.5, 0.95)), "far": _len(rng, mark * rng.uniform(1.05, 3))}
+        if rng.random() < 0.6:
+            q["fstop"] = f"{_log_uniform(rng, 1.4, 16):.3g}"
+        if rng.random() < 0.4:
+            q["coc"] = rng.choice(["cine", "d/1730", "0.02", "full-frame"])
+        calls.append(["splitFocus", q])
+        try:
+            from physcam.optics.coc import parse_coc
+
+            req = ReportRequest(sensor=find_sensor(q["sensor"]), focal_length_mm=float(q["focal"]),
+                                near_mm=parse_distance(q["near"]), far_mm=parse_distance(q["far"]),
+                                fstop=float(q["fstop"]) if "fstop" in q else None, coc=parse_coc(q.get("coc")))
+            expected.append({"ok": True, "body": split_focus(req).to_dict()})
+        except PhysCamError as exc:
+            expected.append({"ok": False, "body": {"error": str(exc)}})
+    got = run_page_solver({"sensors": table, "calls": calls})
+    bad = [f"{call}: {d[:2]}" for call, g, e in zip(calls, got, expected) for d in [_agree(g, e)] if d]
+    assert not bad, f"{len(bad)} differ, e.g.\n" + "\n".join(bad[:6])
+    assert sum(e["ok"] for e in expected) > 0.7 * len(expected)

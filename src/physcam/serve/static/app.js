@@ -185,6 +185,7 @@ function showReport(d, source) {
   $("coc-active").textContent = `circle of confusion ${d.coc_mm.toFixed(4)} mm · ${d.coc_convention}`;
   document.body.dataset.source = source; // "page" (onset.js) or "server" (the CLI's numbers)
   render(d);
+  if (window.PhysTools) PhysTools.afterReport(d); // frame, split focus, diopters (tools.js)
 }
 
 function offline(local, api, my) {
@@ -396,7 +397,9 @@ function fillSensors(filter) {
   const sel = $("sensor");
   const cur = sel.value;
   const f = norm(filter || "");
-  const rows = SENSORS.filter((s) => !f || [s.key, s.name, ...s.aliases].some((x) => norm(x).includes(f)));
+  const cam = $("camera").value; // a camera: its recording formats only
+  const rows = SENSORS.filter((s) => (!cam || cameraOf(s) === cam)
+    && (!f || [s.key, s.name, ...s.aliases].some((x) => norm(x).includes(f))));
   const opts = rows.map(sensorOption);
   if (!rows.length) {
     const keep = SENSORS.find((s) => s.key === cur);
@@ -410,6 +413,15 @@ function fillSensors(filter) {
   const values = [...sel.options].map((o) => o.value);
   sel.value = values.includes(cur) ? cur : (rows.length ? rows[0].key : cur);
   if (sel.value !== cur) sensorChanged();
+}
+
+function cameraOf(s) { return s.camera ? `${s.maker} ${s.camera}` : ""; }
+
+function fillCameras() {
+  // the camera table's cameras, by maker; "" the sensors and film gates of sensors.csv
+  const sel = $("camera");
+  const names = [...new Set(SENSORS.map(cameraOf).filter(Boolean))];
+  sel.replaceChildren(new Option("all sensors, gates and formats", ""), ...names.map((n) => new Option(n, n)));
 }
 
 function findSensor(text) {
@@ -494,6 +506,7 @@ function applyState(q) {
   for (const id of ["fstop", "tstop", "focus", "near", "far", "sensor-width", "sensor-height"]) {
     $(id).value = q.get(id) || (empty && DEFAULTS[id] ? DEFAULTS[id] : "");
   }
+  fillCameras();
   fillSensors("");
   if (q.has("sensor-width") || q.has("sensor-height")) {
     $("sensor").value = "custom";
@@ -504,6 +517,13 @@ function applyState(q) {
     $("sensor").value = DEFAULT_SENSOR;
   }
   $("custom-sensor").hidden = $("sensor").value !== "custom";
+  const chosen = SENSORS.find((x) => x.key === $("sensor").value);
+  if (chosen && chosen.camera) { // the camera picker shows the format's camera, the format picker its formats
+    const key = chosen.key;
+    $("camera").value = cameraOf(chosen);
+    fillSensors("");
+    $("sensor").value = key;
+  }
   const sq = q.get("squeeze") || "1";
   if ([...$("squeeze").options].some((o) => Number(o.value) === Number(sq))) {
     $("squeeze").value = [...$("squeeze").options].find((o) => Number(o.value) === Number(sq)).value;
@@ -517,10 +537,12 @@ function wire() {
   const form = $("setup");
   form.addEventListener("input", (e) => {
     if (e.target.id === "sensor-search") fillSensors(e.target.value);
+    else if (e.target.id === "camera") fillSensors(val("sensor-search"));
     else schedule();
   });
   form.addEventListener("change", (e) => {
     if (e.target.id === "sensor") sensorChanged();
+    else if (e.target.id === "camera") fillSensors(val("sensor-search"));
     else if (e.target.id === "coc") {
       $("field-coc-mm").hidden = $("coc").value !== "custom";
       update();

@@ -645,7 +645,91 @@
     }
   }
 
-  const api = { ReportError, solveReport, report, parseDistance, parseCoc, circleOfConfusion, setCocConventions,
+  // --- beyond depth of field (physcam.onset.exposure, .diopter, .split_focus) ----------------------------
+  const ND_STOP_DENSITY = 0.3;
+
+  function exposureTime(angle, fps) {
+    positive("shutter angle", angle, "degrees");
+    if (angle > 360.0) fail(`a shutter angle is at most 360 degrees (open all the frame), got ${angle}`);
+    return (angle / 360.0) / positive("frame rate", fps, "fps");
+  }
+
+  function setting(x) {
+    // {fps, shutter_deg, tstop, ei, nd}, checked as ExposureSetting is
+    const v = { fps: 24.0, shutter_deg: 180.0, tstop: 2.8, ei: 800.0, nd: 0.0, ...x };
+    exposureTime(v.shutter_deg, v.fps);
+    requireFNumber("T-stop", v.tstop);
+    positive("exposure index", v.ei, "");
+    if (!Number.isFinite(v.nd) || v.nd < 0) fail(`an ND's optical density is 0 or more (0.3 per stop), got ${v.nd}`);
+    return { ...v, exposure_time_s: exposureTime(v.shutter_deg, v.fps) };
+  }
+
+  function exposureStops(a, b) {
+    a = setting(a); b = setting(b);
+    const parts = { time: Math.log2(b.exposure_time_s / a.exposure_time_s), ei: Math.log2(b.ei / a.ei),
+      tstop: 0.0 - 2.0 * Math.log2(b.tstop / a.tstop), nd: (a.nd - b.nd) / ND_STOP_DENSITY };
+    return { stops: parts.time + parts.ei + parts.tstop + parts.nd, parts };
+  }
+
+  function compensate(a, b, control = "tstop") {
+    const delta = exposureStops(a, b).stops;
+    b = setting(b);
+    if (control === "tstop") return setting({ ...b, tstop: b.tstop * 2.0 ** (delta / 2.0) });
+    if (control === "nd") {
+      const nd = b.nd + delta * ND_STOP_DENSITY;
+      if (nd < -1e-12) fail(`the new setting is ${(-delta).toFixed(2)} stops darker: no ND can give light back; open the T-stop or raise the EI`);
+      return setting({ ...b, nd: Math.max(nd, 0.0) });
+    }
+    if (control === "ei") return setting({ ...b, ei: b.ei * 2.0 ** -delta });
+    if (control === "shutter") {
+      const t = b.exposure_time_s * 2.0 ** -delta;
+      const angle = 360.0 * t * b.fps;
+      if (angle > 360.0 + 1e-9) fail(`${t} s per frame at ${b.fps} fps needs a ${angle.toFixed(1)} degree shutter: more than the whole frame (360)`);
+      return setting({ ...b, shutter_deg: angle });
+    }
+    return fail(`compensate with tstop, nd, ei or shutter, not '${control}'`);
+  }
+
+  function closeUp(f, n, c, mark, p) {
+    // a +p diopter in contact with a thin lens at its principal plane (physcam.onset.diopter.close_up)
+    positive("focal length", f); positive("f-stop", n, ""); positive("circle of confusion", c);
+    positive("diopter", p, "dioptres");
+    if (p > 20.0) fail(`+${p} dioptres is a 50 mm magnifier, not a close-up lens; give the power in dioptres`);
+    const s = objectDistanceForMarked(f, mark);
+    const sImg = s === Infinity ? f : imageDistance(f, s);
+    const power = p / 1000.0;
+    const fc = 1.0 / (1.0 / f + power);
+    const sd = 1.0 / ((s === Infinity ? 0.0 : 1.0 / s) + power);
+    const nc = n * fc / f;
+    const [near, far] = dofLimits(fc, nc, c, sd);
+    const farFilm = far + sImg;
+    return { diopter: p, focal_length_mm: fc, f_number: nc, subject_from_lens_mm: sd, subject_from_film_mm: sd + sImg,
+      near_from_film_mm: near + sImg, far_from_film_mm: finiteOrNull(farFilm),
+      depth_of_field_mm: finiteOrNull(farFilm - (near + sImg)), magnification: -sImg / sd };
+  }
+
+  function splitFocus(query, sensors) {
+    // "focus here, at this stop": the report's own inverse solve with the near and far subjects and no stop;
+    // with a stop given, that stop's limits at the mark beside it (physcam.onset.split_focus.split_focus)
+    if (!("near" in query) || !("far" in query)) fail("split focus needs the near and the far subject");
+    const q = { ...query };
+    delete q.fstop; delete q.focus; delete q.tstop;
+    const need = solveReport(q, sensors);
+    let given = null;
+    if ("fstop" in query) {
+      const g = { ...query, focus: String(need.focus_from_film_mm), coc: String(need.coc_mm) };
+      delete g.near; delete g.far;
+      given = solveReport(g, sensors);
+    }
+    return { focus_from_film_mm: need.focus_from_film_mm, fstop_needed: need.fstop, coc_mm: need.coc_mm,
+      coc_convention: need.coc_convention, near_from_film_mm: need.measured.near_from_film_mm,
+      far_from_film_mm: need.measured.far_from_film_mm, fstop_given: given && given.fstop,
+      given_holds: given && given.fstop >= need.fstop * (1 - 1e-9),
+      given_near_from_film_mm: given && given.dof.near_from_film_mm,
+      given_far_from_film_mm: given && given.dof.far_from_film_mm };
+  }
+
+  const api = { ReportError, solveReport, report, parseDistance, exposureStops, compensate, closeUp, splitFocus, parseCoc, circleOfConfusion, setCocConventions,
     findSensor, hyperfocalDistance, dofLimits, imageDistance, objectDistanceForMarked, stopsBetween, fovDeg,
     HYPERFOCAL, COC_CONVENTIONS };
   root.PhysOnset = api;

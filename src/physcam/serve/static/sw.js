@@ -6,7 +6,7 @@
 "use strict";
 
 const CACHE = "physcam-v1";
-const SHELL = ["/", "/static/app.js", "/static/onset.js", "/static/app.css",
+const SHELL = ["/", "/static/app.js", "/static/onset.js", "/static/tools.js", "/static/app.css",
   "/static/icon.svg", "/static/icon-192.png", "/manifest.webmanifest", "/api/sensors"];
 // answers kept whenever they come: the catalogues the page needs to compute alone
 const KEPT = ["/api/sensors", "/api/lenses"];
