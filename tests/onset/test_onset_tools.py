@@ -141,3 +141,36 @@ def test_hyperfocal_table_by_hand():
     s_img = 35.0 * h / (h - 35.0)
     assert mark == pytest.approx(h + s_img, rel=1e-9) and near == pytest.approx(h / 2 + s_img, rel=1e-9)
     assert rows[1]["marks"][2.8][0] > rows[1]["marks"][11.0][0] > rows[0]["marks"][11.0][0]
+
+
+# --- lens sets --------------------------------------------------------------------------------------
+def test_a_lens_set_is_read_as_written():
+    from physcam.onset.lens_set import parse_lens_set
+
+    s = parse_lens_set("# S4/i\n18 T2 9in\n25mm T2.0 9in # wide\n100 2 2ft 6in\n75 T2\n", name="S4/i")
+    assert [x.focal_length_mm for x in s.lenses] == [18.0, 25.0, 100.0, 75.0]
+    assert s.lenses[0].close_focus_mm == pytest.approx(9 * 25.4) and s.lenses[2].close_focus_mm == pytest.approx(762.0)
+    assert s.lenses[1].name == "wide" and s.lenses[3].close_focus_mm is None and s.lenses[2].tstop == 2.0
+    with pytest.raises(InputError, match="line 2"):
+        parse_lens_set("50 T2\nfifty T2\n", where="set.txt")
+    with pytest.raises(InputError, match="T-stop"):
+        parse_lens_set("50 T0.1\n")
+
+
+def test_hyperfocal_command_equals_the_report(capsys, tmp_path):
+    import json
+
+    from physcam.cli import main
+
+    f = tmp_path / "primes.txt"
+    f.write_text("# my primes\n25 T2 9in\n50 T1.4 18in # hero\n", encoding="utf-8")
+    assert main(["hyperfocal", "--lens-set", str(f), "--fstops", "1.4,2.8,8", "--sensor", "S35", "--coc", "cine",
+                 "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["lens_set"] == "my primes"
+    l25, l50 = d["lenses"]
+    assert [s["fstop"] for s in l25["stops"]] == [2.8, 8.0]  # f/1.4 is faster than the 25's T2: left out
+    assert [s["fstop"] for s in l50["stops"]] == [1.4, 2.8, 8.0]
+    # the report's own hyperfocal focus: H = f^2 / (N c) + f from H1, marked H + s'(H) from the film
+    h = 25.0 ** 2 / (2.8 * 0.025) + 25.0
+    assert l25["stops"][0]["hyperfocal_mark_mm"] == pytest.approx(h + 25.0 * h / (h - 25.0), rel=1e-12)

@@ -115,3 +115,43 @@ def test_exposure_calculator(page, server, capsys):
     assert "−1.00 stops" in page.text_content("#exposure-answer")
     page.select_option("#ex-compensate", "nd")
     page.wait_for_function("() => document.getElementById('exposure-answer').textContent.includes('no ND')")
+
+
+def test_lens_diagram_text_is_readable_on_a_phone(page, server):
+    # issue 46: the diagram's text was about 4 px on a phone; every text of it reads at least 12 px at 390 px
+    page.goto(f"{server}?lens=dgauss_50mm&fstop=4&focus=2m&sensor=S35")
+    page.wait_for_selector("body[data-ready='1']")
+    page.wait_for_function("() => { const i = document.getElementById('diagram');"
+                           " return i.getAttribute('src') && i.complete && i.naturalWidth > 0; }")
+    sizes = page.evaluate("""async () => {
+        const img = document.getElementById('diagram');
+        const svg = new DOMParser().parseFromString(await (await fetch(img.src)).text(), 'image/svg+xml');
+        const vb = svg.documentElement.getAttribute('viewBox').split(/\\s+/).map(Number);
+        const scale = img.getBoundingClientRect().width / vb[2];
+        return [...svg.querySelectorAll('text')].map((t) => {
+            const m = /font-size:\\s*([\\d.]+)px/.exec(t.getAttribute('style') || '');
+            return m ? Number(m[1]) * scale : null; });
+    }""")
+    assert sizes and None not in sizes
+    assert min(sizes) >= 12.0, sorted(sizes)[:5]
+
+
+@pytest.mark.parametrize("width, height", [(390, 844), (1024, 768)])
+def test_the_limits_read_at_arms_length(server, width, height):
+    # issue 46: every limit at least 16 px, on a phone and a tablet, in the light and the dark theme
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"])
+        try:
+            pg = b.new_page(viewport={"width": width, "height": height})
+            pg.goto(f"{server}?focal=35&fstop=4&focus=2m&sensor=S35")
+            pg.wait_for_selector("body[data-ready='1']")
+            for theme in ("dark", "light"):
+                pg.evaluate("(t) => { document.documentElement.dataset.theme = t; }", theme)
+                px = pg.evaluate("() => ['out-near', 'out-far', 'out-total', 'out-hyperfocal', 'split-answer',"
+                                 " 'exposure-answer', 'out-frame'].map((id) =>"
+                                 " parseFloat(getComputedStyle(document.getElementById(id)).fontSize))")
+                assert min(px) >= 16.0, (theme, px)
+                # no sideways scrolling
+                assert pg.evaluate("() => document.documentElement.scrollWidth <= window.innerWidth + 1")
+        finally:
+            b.close()

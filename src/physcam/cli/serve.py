@@ -21,6 +21,8 @@ API (payloads are the CLI's --json; parameters are its flags without dashes; doc
   /api/sensors   /api/lenses   /api/lens/dgauss_50mm?focus=2m   /api/lens/dgauss_50mm/diagram.svg?fstop=4
 """
 
+#: The lens diagram the page shows: inches wide and the points of its text (at 390 px, text >= 12 px).
+DIAGRAM_WIDTH_IN, DIAGRAM_TEXT_PT = 4.4, 12.0
 #: Flags of the CLI's parsers that choose output, files or file reading: never query parameters.
 OUTPUT_FLAGS = frozenset({"json", "cameras", "plot", "force", "lenient", "output", "help"})
 
@@ -182,7 +184,10 @@ def cli_backend():
         from ..lens.library import load_lens
 
         args = parsers["diagram"].parse_args([*_options(q), "--output=diagram.svg", f"--lens={_bundled(name)}"])
-        fig = lens_diagram(load_lens(args.lens), **diagram_options(args)).figure(units=args.units or "m")
+        # drawn for a phone: 4.4 in wide with 12 pt text reads >= 12 px at 390 px (the page's img is ~366 px wide)
+        fig = lens_diagram(load_lens(args.lens), **diagram_options(args)).figure(units=args.units or "m",
+                                                                                 width_in=DIAGRAM_WIDTH_IN,
+                                                                                 text_pt=DIAGRAM_TEXT_PT)
         return _svg(fig, dpi=150)
 
     return Backend(report=report, dof_svg=dof_svg, sensors=sensors, lenses=lenses_document, lens=lens,
