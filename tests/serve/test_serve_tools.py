@@ -137,21 +137,38 @@ def test_lens_diagram_text_is_readable_on_a_phone(page, server):
 
 
 @pytest.mark.parametrize("width, height", [(390, 844), (1024, 768)])
-def test_the_limits_read_at_arms_length(server, width, height):
+def test_the_limits_read_at_arms_length(page, server, width, height):
     # issue 46: every limit at least 16 px, on a phone and a tablet, in the light and the dark theme
-    with sync_api.sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"])
-        try:
-            pg = b.new_page(viewport={"width": width, "height": height})
-            pg.goto(f"{server}?focal=35&fstop=4&focus=2m&sensor=S35")
-            pg.wait_for_selector("body[data-ready='1']")
-            for theme in ("dark", "light"):
-                pg.evaluate("(t) => { document.documentElement.dataset.theme = t; }", theme)
-                px = pg.evaluate("() => ['out-near', 'out-far', 'out-total', 'out-hyperfocal', 'split-answer',"
-                                 " 'exposure-answer', 'out-frame'].map((id) =>"
-                                 " parseFloat(getComputedStyle(document.getElementById(id)).fontSize))")
-                assert min(px) >= 16.0, (theme, px)
-                # no sideways scrolling
-                assert pg.evaluate("() => document.documentElement.scrollWidth <= window.innerWidth + 1")
-        finally:
-            b.close()
+    pg = page.context.browser.new_page(viewport={"width": width, "height": height})
+    try:
+        pg.goto(f"{server}?focal=35&fstop=4&focus=2m&sensor=S35")
+        pg.wait_for_selector("body[data-ready='1']")
+        for theme in ("dark", "light"):
+            pg.evaluate("(t) => { document.documentElement.dataset.theme = t; }", theme)
+            px = pg.evaluate("() => ['out-near', 'out-far', 'out-total', 'out-hyperfocal', 'split-answer',"
+                             " 'exposure-answer', 'out-frame'].map((id) =>"
+                             " parseFloat(getComputedStyle(document.getElementById(id)).fontSize))")
+            assert min(px) >= 16.0, (theme, px)
+            assert pg.evaluate("() => document.documentElement.scrollWidth <= window.innerWidth + 1")  # no sideways
+    finally:
+        pg.close()
+
+
+def test_my_lens_set(page, server, capsys):
+    # a puller's primes typed once (kept on the phone): picking one sets the focal length; the close focus and
+    # T-stop are checked against the setup; the set's hyperfocal marks equal physcam hyperfocal's
+    page.goto(f"{server}?focal=35&fstop=4&focus=3m&sensor=S35&coc=cine")
+    page.wait_for_selector("body[data-ready='1']")
+    page.click("#lens-set-edit summary")
+    page.fill("#lens-set-text", "25 T2 9in\n50 T1.4 18in # hero\n")
+    page.select_option("#set-lens", "1")
+    doc = cli(capsys, "report", "--focal", "50", "--fstop", "4", "--focus", "3m", "--sensor", "S35", "--coc", "cine")
+    wait_near(page, doc["dof"]["near_from_film_mm"])
+    assert "close focus" in page.text_content("#set-lens-note")
+    page.fill("#focus", "0.4")  # 40 cm: inside the 50's 18 in close focus
+    page.wait_for_selector("#set-lens-note[data-too-close='1']")
+    hyper = cli(capsys, "hyperfocal", "--focal", "25,50", "--fstops", "4", "--sensor", "S35", "--coc", "cine")
+    got = page.eval_on_selector_all("#set-hyperfocal tbody tr td[data-mm]", "ts => ts.map(t => Number(t.dataset.mm))")
+    marks = [lens["stops"][0]["hyperfocal_mark_mm"] for lens in hyper["lenses"]]
+    assert got[0] == pytest.approx(marks[0], rel=1e-9) and got[2] == pytest.approx(marks[1], rel=1e-9)
+    assert page.evaluate("() => localStorage.getItem('physcam-lens-set')").startswith("25 T2")

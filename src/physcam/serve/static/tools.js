@@ -122,14 +122,112 @@
     }
   }
 
+  // --- my lens set: one lens a line, "focal T-stop close-focus # name" (physcam.onset.lens_set) ----------
+  const SET_LINE = /^\s*(\S+?)(?:\s*mm)?\s+[tT]?([\d.]+)(?:\s+([^#]+?))?\s*(?:#\s*(.*))?$/;
+
+  function parseLensSet(text) {
+    const lenses = [];
+    String(text).split(/\r?\n/).forEach((raw, i) => {
+      const line = raw.trim();
+      if (!line || line.startsWith("#")) return;
+      const m = SET_LINE.exec(line);
+      if (!m) throw new Error(`line ${i + 1}: write a lens as 'focal T-stop close-focus', e.g. '50 T2 20in'`);
+      const f = PhysOnset.parseDistance(m[1], "focal length");
+      const t = Number(m[2]);
+      if (!(t >= 0.5 && t <= 4096)) throw new Error(`line ${i + 1}: T-stop ${m[2]} is out of range`);
+      if (!(f >= 1 && f <= 2000)) throw new Error(`line ${i + 1}: focal length ${f} mm is not a camera lens's`);
+      const close = m[3] ? PhysOnset.parseDistance(m[3].trim(), "close focus") : null;
+      lenses.push({ focal_length_mm: f, tstop: t, close_focus_mm: close, name: (m[4] || "").trim() });
+    });
+    return lenses;
+  }
+
+  let SET = [];
+  const setLabel = (x) => `${num(x.focal_length_mm, 1)} mm T${num(x.tstop, 2)}${x.name ? ` ${x.name}` : ""}`;
+
+  function loadSet(text) {
+    const msg = el("lens-set-msg");
+    try {
+      SET = parseLensSet(text);
+      msg.textContent = SET.length ? `${SET.length} lenses` : "One lens a line: focal length, T-stop wide open, close focus (from the film).";
+      try { localStorage.setItem("physcam-lens-set", text); } catch (e) { /* private mode */ }
+    } catch (e) {
+      msg.textContent = e.message;
+      return;
+    }
+    const sel = el("set-lens");
+    const cur = sel.value;
+    sel.replaceChildren(new Option("none: type the focal length", ""),
+      ...SET.map((x, i) => new Option(setLabel(x), String(i))));
+    sel.value = [...sel.options].some((o) => o.value === cur) ? cur : "";
+    el("field-set").hidden = false;
+  }
+
+  function chooseSetLens() {
+    const x = SET[Number(el("set-lens").value)];
+    if (!x) return;
+    el("focal").value = num(x.focal_length_mm, 2);
+    if (!el("tstop").value) el("tstop").placeholder = `T${num(x.tstop, 2)} wide open`;
+    schedule();
+  }
+
+  function setNotes(d) {
+    // the chosen set lens: its T-stop and close focus against the setup
+    const note = el("set-lens-note");
+    const x = SET[Number(el("set-lens").value)];
+    if (!x || Math.abs(x.focal_length_mm - d.focal_length_mm) > 1e-6) { note.textContent = ""; return; }
+    const parts = [`T${num(x.tstop, 2)} wide open`];
+    if (x.close_focus_mm !== null) parts.push(`close focus ${fmtLen(x.close_focus_mm)}`);
+    if (d.tstop !== null && d.tstop < x.tstop - 1e-9) parts.push(`T${num(d.tstop, 2)} is faster than this lens opens`);
+    if (x.close_focus_mm !== null && d.focus_from_film_mm !== null && d.focus_from_film_mm < x.close_focus_mm) {
+      parts.push("the mark is closer than this lens focuses");
+      note.dataset.tooClose = "1";
+    } else {
+      delete note.dataset.tooClose;
+    }
+    note.textContent = parts.join(" · ");
+  }
+
+  function setHyperfocal(d) {
+    // each set lens's hyperfocal mark at the report's stop (or its own T-stop when slower) and CoC
+    const sec = el("hyperfocal-section");
+    sec.hidden = !SET.length;
+    if (!SET.length) return;
+    const q = setupQuery();
+    const rows = SET.map((x) => {
+      const tr = document.createElement("tr");
+      const n = Math.max(d.fstop, x.tstop);
+      const cell = { ...q, focal: String(x.focal_length_mm), fstop: String(n), focus: "hyperfocal", coc: String(d.coc_mm) };
+      for (const k of ["near", "far", "tstop"]) delete cell[k];
+      const r = PhysOnset.report(cell, SENSORS);
+      const cells = [setLabel(x), `f/${num(n, 2)}`];
+      tr.append(...cells.map((t) => { const td = document.createElement("td"); td.textContent = t; return td; }));
+      for (const mm of r.ok ? [r.body.focus_from_film_mm, r.body.dof.near_from_film_mm] : [null, null]) {
+        const td = document.createElement("td");
+        if (r.ok) showLen(td, mm); else td.textContent = "n/a";
+        tr.append(td);
+      }
+      return tr;
+    });
+    el("set-hyperfocal").tBodies[0].replaceChildren(...rows);
+  }
+
   function afterReport(d) {
     last = d;
     frame(d);
     diopters(d);
     splitFocus();
+    setNotes(d);
+    setHyperfocal(d);
   }
 
   function wire() {
+    let saved = "";
+    try { saved = localStorage.getItem("physcam-lens-set") || ""; } catch (e) { /* private mode */ }
+    el("lens-set-text").value = saved;
+    if (saved) loadSet(saved);
+    el("lens-set-text").addEventListener("input", (e) => { loadSet(e.target.value); if (last) setHyperfocal(last); });
+    el("set-lens").addEventListener("change", chooseSetLens);
     for (const id of ["split-near", "split-far"]) el(id).addEventListener("input", splitFocus);
     el("exposure").addEventListener("input", exposure);
     el("exposure").addEventListener("change", exposure);
@@ -137,6 +235,6 @@
     exposure();
   }
 
-  window.PhysTools = { afterReport };
+  window.PhysTools = { afterReport, parseLensSet };
   document.addEventListener("DOMContentLoaded", wire);
 })();
