@@ -41,9 +41,18 @@ def main() -> int:
                 pg.fill("#ex-to-fps", "48")
                 pg.wait_for_selector("#split-answer[data-focus]")
                 pg.wait_for_timeout(800)  # the chart and the table settle
+                pg.evaluate("() => { document.activeElement.blur(); window.scrollTo(0, 0); }")
+                pg.wait_for_timeout(200)
                 path = out / f"serve_{device}_{theme}.png"
                 pg.screenshot(path=str(path))
                 print(f"wrote {path.relative_to(ROOT)}")
+                if device == "phone" and theme == "dark":  # the answers beyond depth of field, further down
+                    pg.evaluate("() => window.scrollTo(0, document.getElementById('split-section').getBoundingClientRect().top"
+                                " + window.scrollY - document.getElementById('top').offsetHeight - 8)")
+                    pg.wait_for_timeout(200)
+                    path = out / "serve_phone_tools_dark.png"
+                    pg.screenshot(path=str(path))
+                    print(f"wrote {path.relative_to(ROOT)}")
                 ctx.close()
         b.close()
     return 0
