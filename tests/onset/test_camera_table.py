@@ -17,6 +17,7 @@ from physcam.onset.sensors import MAKERS, camera_formats, cameras, find_sensor, 
 
 TABLE = Path(__file__).resolve().parents[2] / "src" / "physcam" / "data" / "cameras.csv"
 
+REFERENCE = "shared/reference/formats/sensor_formats.csv (the project's checked table, its sources named)"
 NEWSSHOOTER = ("newsshooter.com, 'ARRI ALEXA LF & Anamorphic Lenses white paper' (2018-07-31), quoting ARRI and "
                "Netflix's white paper")
 #: (format, width mm, height mm, citation with the quoted words); None: the source gives no such number
@@ -35,6 +36,8 @@ CITED = [
     ("ARRI ALEXA Mini LF 4.5K LF 2.39:1", 36.70, 15.31, NEWSSHOOTER),
     ("ARRI ALEXA 65 6.5K Open Gate", 54.12, 25.58, NEWSSHOOTER + ": 'ALEXA 65 has a whopping 54.12mm x 25.58mm "
      "(active image area) sensor'"),
+    ("ARRI ALEXA 265 6.5K 2.12:1 Open Gate", 54.12, 25.58, NEWSSHOOTER + ": the ALEXA 65's 54.12mm x 25.58mm, the "
+     "sensor the ALEXA 265 keeps (EmberLightVFX data/markdown/arri/alexa265.md: 6560 x 3100)"),
     ("RED V-RAPTOR 8K VV 8K 17:9", 40.96, 21.60, NEWSSHOOTER + ": 'The MONSTRO 8K VV sensor ... is 40.96mm x "
      "21.60mm' (RED's VV format, 8192 x 4320 at 5 um)"),
     ("Blackmagic Cinema Camera 2.5K 2.5K 16:9", 15.6, 8.8, "provideocoalition.com, NAB 2012 part 2, citing "
@@ -42,6 +45,17 @@ CITED = [
     ("ARRI ALEXA Mini 2.8K 16:9", 23.76, None, "lightcrafttech.com, ARRI connections: 'the same sensor width when "
      "shooting 1920×1080 16:9 format (23.76 mm wide.)'"),
     ("ARRI ALEXA Mini HD 16:9", 23.76, None, "lightcrafttech.com, ARRI connections (as above)"),
+    # the project's shared reference table (shared/reference/formats/sensor_formats.csv), with its sources
+    ("ARRI ALEXA 35 4.6K 16:9", 27.99, 15.75, REFERENCE + ": 'ARRI ALEXA 35 4.6K 16:9,27.99,15.75' (cineweb; ember "
+     "28.0x15.7)"),
+    ("ARRI ALEXA Mini 3.4K Open Gate", 28.25, 18.17, REFERENCE + ": 'ARRI ALEXA Mini 3.4K Open Gate,28.25,18.17' (ember)"),
+    ("ARRI ALEXA Mini 2.8K 16:9", 23.76, 13.37, REFERENCE + ": 'ARRI ALEXA (S35 ALEV III) 2.8K/HD 16:9,23.76,13.37' "
+     "(nuke; ember; the Mini's ALEV III)"),
+    ("ARRI ALEXA Mini 2.8K 4:3", 23.76, 17.82, REFERENCE + ": 'ARRI ALEXA (S35 ALEV III) 4:3 2.8K,23.76,17.82' "
+     "(nuke; fdtimes; ember)"),
+    ("Sony VENICE 2 8K 8.6K 3:2 FF", 35.94, 23.96, REFERENCE + ": 'Sony VENICE 2 8K 8.6K 3:2 FF,35.94,23.96' (ember)"),
+    ("Sony VENICE FF 6K 3:2", 35.9, 24.0, REFERENCE + ": 'Sony VENICE (6K) 3:2 FF,35.9,24.0' (ember; newsshooter "
+     "says 36.2x24.1)"),
 ]
 #: (format, image circle mm, citation): the source gives the diagonal
 CITED_DIAGONALS = [
@@ -98,6 +112,7 @@ def test_a_camera_alone_asks_which_format():
     assert find_sensor("FX6 FF 4K 17:9").name == "Sony FX6 FF 4K 17:9"
     assert find_sensor("sony fx6 ff 4k 17:9").key == "sony-fx6-ff-4k-17-9"
     assert [s.fmt for s in camera_formats("venice 2 8k")][0] == "8.6K 3:2 FF"
+    assert find_sensor("VENICE S35 anamorphic 4K 6:5").anamorphic == (2.0,)
 
 
 def test_existing_names_still_work():
