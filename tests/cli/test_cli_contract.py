@@ -67,6 +67,7 @@ JSON_RUNS = {
     ("dof-table",): ["dof-table", "--focal", "35", "--fstops", "2,4", "--focus", "1m,hyperfocal,inf"],
     ("sensors",): ["sensors", "ARRI"],
     ("exposure",): ["exposure", "--fps", "24", "--to-fps", "48"],
+    ("diopter",): ["diopter", "--focal", "50", "--fstop", "2.8", "--focus", "inf", "--sensor", "S35"],
     ("hyperfocal",): ["hyperfocal", "--focal", "25,50", "--fstops", "2.8,8", "--sensor", "S35"],
     ("lenses",): ["lenses"],
     ("lens", "show"): ["lens", "show", "dgauss_50mm", "--focus", "2m"],

@@ -174,3 +174,17 @@ def test_hyperfocal_command_equals_the_report(capsys, tmp_path):
     # the report's own hyperfocal focus: H = f^2 / (N c) + f from H1, marked H + s'(H) from the film
     h = 25.0 ** 2 / (2.8 * 0.025) + 25.0
     assert l25["stops"][0]["hyperfocal_mark_mm"] == pytest.approx(h + 25.0 * h / (h - 25.0), rel=1e-12)
+
+
+def test_diopter_command(capsys):
+    import json
+
+    from physcam.cli import main
+
+    assert main(["diopter", "--focal", "50", "--fstop", "2.8", "--focus", "inf", "--sensor", "S35", "--coc", "cine",
+                 "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    one = next(c for c in d["close_ups"] if c["diopter"] == 1.0)
+    # +1 on a 50 mm at infinity: the subject 1 m in front of the lens, the lens 50 mm in front of the film
+    assert one["subject_from_film_mm"] == pytest.approx(1050.0) and one["magnification"] == pytest.approx(-0.05)
+    assert d["coc_mm"] == 0.025 and d["coc_convention"] == "cine"
