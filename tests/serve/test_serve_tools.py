@@ -172,3 +172,22 @@ def test_my_lens_set(page, server, capsys):
     marks = [lens["stops"][0]["hyperfocal_mark_mm"] for lens in hyper["lenses"]]
     assert got[0] == pytest.approx(marks[0], rel=1e-9) and got[2] == pytest.approx(marks[1], rel=1e-9)
     assert page.evaluate("() => localStorage.getItem('physcam-lens-set')").startswith("25 T2")
+
+
+def test_the_coc_conventions_are_offered_on_first_use(page, server):
+    # issue 46: d/1500 gives 0.0207 mm on Super 35 where a puller's app says 0.025 mm: the page asks once
+    ctx = page.context.browser.new_context(viewport={"width": 390, "height": 844})
+    pg = ctx.new_page()
+    try:
+        pg.goto(f"{server}?focal=50&fstop=2.8&focus=3m&sensor=S35")
+        pg.wait_for_selector("body[data-ready='1']")
+        assert pg.is_visible("#coc-first")
+        assert "0.0207 mm · d/1500" in pg.text_content("#coc-active")
+        pg.click("#coc-first button[data-coc='cine']")
+        pg.wait_for_function("() => document.getElementById('coc-active').textContent.includes('0.0250 mm · cine')")
+        pg.goto(f"{server}?focal=50&fstop=2.8&focus=3m&sensor=S35")  # asked once: kept on the phone
+        pg.wait_for_selector("body[data-ready='1']")
+        assert not pg.is_visible("#coc-first")
+        pg.wait_for_function("() => document.getElementById('coc-active').textContent.includes('cine')")
+    finally:
+        ctx.close()

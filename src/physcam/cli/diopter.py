@@ -31,7 +31,7 @@ def register(sub) -> None:
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--focal", required=True, type=distance("focal length"), metavar="MM", help="focal length (mm)")
     p.add_argument("--fstop", required=True, type=number("f-stop", positive=True), metavar="N", help="f-stop")
-    p.add_argument("--focus", required=True, type=focus("focus mark", hyperfocal=False), metavar="DIST",
+    p.add_argument("--focus", required=True, type=focus("focus mark"), metavar="DIST",
                    help=f"the lens's focus mark, from the film plane ({FOCUS_HELP})")
     p.add_argument("--diopters", type=_diopters, default=[0.5, 1.0, 2.0, 3.0], metavar="LIST",
                    help="close-up lenses in dioptres, comma-separated (default 0.5,1,2,3)")
@@ -52,7 +52,8 @@ def run(args) -> int:
     sensor = resolve_sensor(args)
     base = solve_report(ReportRequest(sensor=sensor, focal_length_mm=args.focal, fstop=args.fstop,
                                       focus_mm=args.focus, coc=coc_of(args)))
-    rows = [close_up(args.focal, args.fstop, base.coc_mm, args.focus, p) for p in args.diopters]
+    mark = base.focus_from_film_mm  # a mark as typed, or the hyperfocal distance's
+    rows = [close_up(args.focal, args.fstop, base.coc_mm, mark, p) for p in args.diopters]
     if args.json:
         emit_json(document("diopter", {"focal_length_mm": args.focal, "fstop": args.fstop,
                                        "focus_from_film_mm": None if base.focus_is_infinite else base.focus_from_film_mm,
@@ -64,8 +65,8 @@ def run(args) -> int:
     def d(mm):
         return "∞" if mm is None else format_distance(mm, units)
 
-    mark = d(None if base.focus_is_infinite else base.focus_from_film_mm)
-    t = Table(f"close-up lenses on {args.focal:g} mm f/{args.fstop:g}, focus mark {mark}, "
+    t = Table(f"close-up lenses on {args.focal:g} mm f/{args.fstop:g}, "
+              f"focus mark {d(None if base.focus_is_infinite else mark)}, "
               f"CoC {base.coc_mm:.4f} mm ({base.coc_convention})",
               ("diopter", "subject", "near", "far", "depth of field", "magnification"),
               justify=("left", "right", "right", "right", "right", "right"))

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from ..errors import InputError, require_positive
+from ..errors import InputError, require_positive, require_type
 from ..optics.thinlens import require_f_number
 
 __all__ = ["ExposureSetting", "exposure_time_s", "shutter_angle_for", "stops_between_settings", "compensate",
@@ -83,6 +83,8 @@ class ExposureSetting:
 def stops_between_settings(a: ExposureSetting, b: ExposureSetting) -> dict:
     """How much brighter (+) or darker (-) setting ``b`` makes the picture than ``a``, in stops, and the
     part each control plays (shutter and frame rate, EI, T-stop, ND)."""
+    for name, v in (("a", a), ("b", b)):
+        require_type(name, v, ExposureSetting, "physcam.onset.exposure.ExposureSetting(fps=24, shutter_deg=180, ...)")
     parts = {"time": math.log2(b.exposure_time_s / a.exposure_time_s), "ei": math.log2(b.ei / a.ei),
              "tstop": 0.0 - 2.0 * math.log2(b.tstop / a.tstop), "nd": (a.nd - b.nd) / ND_STOP_DENSITY}
     return {"stops": sum(parts.values()), "parts": parts}
@@ -91,6 +93,8 @@ def stops_between_settings(a: ExposureSetting, b: ExposureSetting) -> dict:
 def compensate(a: ExposureSetting, b: ExposureSetting, control: str = "tstop") -> ExposureSetting:
     """``b`` with ``control`` ("tstop", "nd", "ei" or "shutter") changed so that it exposes as ``a`` does."""
     delta = stops_between_settings(a, b)["stops"]
+    if not isinstance(control, str):
+        raise InputError(f"compensate with tstop, nd, ei or shutter, not {control!r}")
     if control == "tstop":
         return replace(b, tstop=b.tstop * 2.0 ** (delta / 2.0))
     if control == "nd":

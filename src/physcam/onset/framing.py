@@ -14,6 +14,7 @@ import math
 from typing import NamedTuple
 
 from ..errors import InputError, require_positive
+from .report import takes_report
 
 __all__ = ["Frame", "frame_at_focus", "frame_at_distance"]
 
@@ -34,16 +35,15 @@ class Frame(NamedTuple):
                 "distance_from_h1_mm": self.distance_from_h1_mm}
 
 
+@takes_report
 def frame_at_focus(report) -> Frame | None:
     """The frame in the plane of sharp focus of a lens report: the (desqueezed) gate over |m|; None when
-    focused at infinity (no finite plane)."""
-    m = report.magnification
-    if m == 0.0 or math.isinf(report.object_distance_mm):
-        return None
-    s = report.sensor
-    return Frame(s.width_mm * report.squeeze / abs(m), s.height_mm / abs(m), report.object_distance_mm)
+    focused at infinity (no finite plane). The report's ``frame_at_focus`` in its JSON is this frame."""
+    d = report.to_dict()["frame_at_focus"]
+    return None if d is None else Frame(d["width_mm"], d["height_mm"], d["distance_from_h1_mm"])
 
 
+@takes_report
 def frame_at_distance(report, distance_from_h1_mm: float) -> Frame:
     """The frame at a subject ``distance_from_h1_mm`` in front of H1 (not the focus: then the frame is
     of the blurred subject), scaled from the frame at the focus by the pinhole at the principal plane:

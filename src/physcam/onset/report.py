@@ -310,11 +310,14 @@ class LensReport:
 
 
 def _frame_dict(report) -> dict | None:
-    """The picture's width and height in the plane of sharp focus (physcam.onset.framing), or None at infinity."""
-    from .framing import frame_at_focus
-
-    fr = frame_at_focus(report)
-    return None if fr is None else fr.to_dict()
+    """The picture's (desqueezed) width and height in the plane of sharp focus, the gate over |m|
+    (physcam.onset.framing), or None focused at infinity."""
+    m = report.magnification
+    if m == 0.0 or math.isinf(report.object_distance_mm):
+        return None
+    w, h = report.sensor.width_mm * report.squeeze / abs(m), report.sensor.height_mm / abs(m)
+    return {"width_mm": w, "height_mm": h, "diagonal_mm": math.hypot(w, h),
+            "distance_from_h1_mm": report.object_distance_mm}
 
 
 # --------------------------------------------------------------------------------------

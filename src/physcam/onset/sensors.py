@@ -176,6 +176,8 @@ def cameras() -> dict[str, tuple[Sensor, ...]]:
 def camera_formats(name: str) -> tuple[Sensor, ...]:
     """The formats of the camera called ``name`` ("Sony FX6", "FX6", "venice 2 8k"; case and punctuation
     ignored), or () when no camera has that name."""
+    if not isinstance(name, str):
+        raise SensorError(f"a camera name must be text, got {type(name).__name__}")
     key = _norm(name)
     for full, rows in cameras().items():
         if key and key in (_norm(full), _norm(rows[0].camera)):

@@ -46,8 +46,9 @@ def split_focus(request: ReportRequest) -> SplitFocus:
     """The split-focus answer for ``request`` (its ``near_mm`` and ``far_mm`` are the subjects to hold,
     from the film; its ``fstop``, if any, the stop the camera is at): the mark, the stop needed at the
     request's CoC convention, and the given stop's limits at that mark."""
-    from ..errors import InputError
+    from ..errors import InputError, require_type
 
+    require_type("request", request, ReportRequest, "physcam.onset.report.ReportRequest(sensor=..., near_mm=..., ...)")
     if request.near_mm is None or request.far_mm is None:
         raise InputError("split focus needs the near and the far subject (--near, --far)")
     need = solve_report(dataclasses.replace(request, fstop=None, focus_mm=None, tstop=None))
