@@ -202,11 +202,12 @@ FAMILY_NAMES = {"alexa": "ALEXA", "arri": "ALEXA", "arriflex": "ALEXA"}
 def filter_sensors(query: str = "", *, maker: str | None = None, fmt: str | None = None,
                    min_width_mm: float | None = None, max_width_mm: float | None = None) -> list[Sensor]:
     """Sensors matching every word of ``query`` (in the name, key, aliases or maker; case and
-    punctuation ignored), the ``maker`` (ARRI, RED, Sony or film), the ``fmt`` text in the name
-    ("open gate", "16:9", "4-perf") and a width between ``min_width_mm`` and ``max_width_mm``.
+    punctuation ignored), the ``maker`` (ARRI, RED, Sony, Canon, Blackmagic, Panasonic or film), the
+    ``fmt`` text in the name ("open gate", "16:9", "4-perf") and a width between ``min_width_mm`` and
+    ``max_width_mm``.
 
-    >>> [s.key for s in filter_sensors("ARRI", fmt="16:9")]
-    ['alexa35-169', 'alexa-lf-uhd', 'alexa-s35-169']
+    >>> [s.key for s in filter_sensors("FX6", fmt="17:9")]
+    ['sony-fx6-ff-4k-17-9', 'sony-fx6-s35-4k-17-9']
     """
     for name, v in (("query", query), ("maker", maker), ("format", fmt)):
         if v is not None and not isinstance(v, str):
