@@ -222,18 +222,19 @@ def _physcam_folder(folder: Path) -> bool:
 USD_FOCAL_FACTOR = 1.5
 
 
-def _check_usd(cal, usd: dict) -> None:
-    """A NOT good calibration, or one of another lens, never goes into the lens file (module notes)."""
+def _check_usd(doc: dict, usd: dict) -> None:
+    """A NOT good calibration, or one of another lens, never goes into the lens file (module notes); ``doc``:
+    the calibration document (``Calibration.to_dict``, as calibration.json holds it)."""
     from ..errors import ExportError
 
-    bad = [(m, m.verdict[1]) for m in cal.marks if not m.verdict[0]]
+    bad = [m for m in doc["marks"] if not m["good"]]
     if bad:
-        m, why = bad[0]
-        where = "" if m.mark_mm is None else f" at {m.mark_mm:g} mm"
-        raise ExportError(f"{usd['file']}: not changed: the calibration{where} is NOT good ({'; '.join(why)}), and a "
-                          "calibration the run rejects never becomes the lens's current one; rerun without --usd for "
-                          "the deliverables and the sheet")
-    f_file, f = usd["focal_length_mm"], float(cal.marks[0].focal_length_mm[1])
+        m = bad[0]
+        where = "" if m["focus_mark_mm"] is None else f" at {m['focus_mark_mm']:g} mm"
+        raise ExportError(f"{usd['file']}: not changed: the calibration{where} is NOT good "
+                          f"({'; '.join(m['verdict_reasons'])}), and a calibration the run rejects never becomes the "
+                          "lens's current one; rerun without --usd for the deliverables and the sheet")
+    f_file, f = usd["focal_length_mm"], float(doc["marks"][0]["focal_length_mm"]["y"])
     if f_file is not None and not f_file / USD_FOCAL_FACTOR <= f <= f_file * USD_FOCAL_FACTOR:
         raise ExportError(f"{usd['file']}: not changed: the measured pinhole focal length {f:.4g} mm does not fit the "
                           f"file's {f_file:.4g} mm lens (a calibration of this lens is within a factor "
@@ -250,7 +251,7 @@ def deliverables(cal, args, plan):
     out = Path(args.output)
     usd = plan["usd"]
     if usd is not None:
-        _check_usd(cal, usd)
+        _check_usd(cal.to_dict(), usd)
     payload = []
     for m in cal.marks:
         payload += _mark_files(m, _folder(out, m, len(cal.marks) > 1), cal.lens_name, cal.notes)
@@ -260,29 +261,54 @@ def deliverables(cal, args, plan):
     return payload, usd
 
 
-def _measured(cal, out: Path, usd_file: Path) -> dict:
+def _measured(doc: dict, out: Path, usd_file: Path) -> dict:
+    """The ``physcam:characterization:*`` values of a calibration document (``Calibration.to_dict``)."""
     import os
 
-    marks = cal.marks
+    marks = doc["marks"]
     rel = os.path.relpath(out.resolve(), usd_file.resolve().parent)
     return {
         "source": "physcam calibrate: chart photographs",
-        "focusMarksMm": [m.mark_mm if m.mark_mm is not None and math.isfinite(m.mark_mm) else -1.0 for m in marks],
-        "pinholeFocalLengthMm": [m.focal_length_mm[1] for m in marks],
-        "pinholeFocalLengthStdMm": [m.uncertainty["focal_length_mm"]["y"] for m in marks],
-        "principalPointOffsetMm": [v for m in marks for v in m.principal_offset_mm],
-        "opencvBrownConrady": [float(v) for m in marks for v in m.distortion],
-        "residualRmsPx": [m.rms_px for m in marks],
-        "verdict": ["good" if m.verdict[0] else "not good: " + "; ".join(m.verdict[1]) for m in marks],
+        "focusMarksMm": [m["focus_mark_mm"] if m["focus_mark_mm"] is not None and math.isfinite(m["focus_mark_mm"])
+                         else -1.0 for m in marks],
+        "pinholeFocalLengthMm": [m["focal_length_mm"]["y"] for m in marks],
+        "pinholeFocalLengthStdMm": [m["uncertainty"]["focal_length_mm"]["y"] for m in marks],
+        "principalPointOffsetMm": [v for m in marks for v in m["principal_point_offset_mm"]],
+        "opencvBrownConrady": [float(m["opencv"][k]) for m in marks for k in ("k1", "k2", "p1", "p2", "k3")],
+        "residualRmsPx": [m["residual_px"]["rms"] for m in marks],
+        "verdict": ["good" if m["good"] else "not good: " + "; ".join(m["verdict_reasons"]) for m in marks],
         "files": [rel],
     }
+
+
+def add_calibration_variant(doc: dict, usd: dict, *, lens=None, fstop=None, output) -> Path:
+    """Add the characterization variant of the calibration document ``doc`` (the payload of calibration.json,
+    ``Calibration.to_dict``) to the lens file of ``usd`` (``{"file", "variant"}``): the measured pinhole (on
+    ``lens``'s best-match camera at ``fstop`` when a prescription is given) and the measured numbers, the
+    deliverables in the folder ``output``. ``physcam calibrate --usd`` and the farm's ``usd`` step
+    (docs/farm.md) both add it so."""
+    from dataclasses import replace
+
+    from ..usd.author import CameraSpec
+    from ..usd.kit import add_characterization, best_match_pinhole
+
+    m = doc["marks"][0]
+    mark = m["focus_mark_mm"]
+    focus = 1.0e7 if mark is None or math.isinf(mark) else float(mark)
+    f = float(m["focal_length_mm"]["y"])
+    w, h = m["sensor_mm"]
+    if lens is not None:
+        spec, _ = best_match_pinhole(lens, focus_mm=focus, fstop=fstop, sensor_width_mm=w, sensor_height_mm=h)
+        spec = replace(spec, pinhole_focal_length_mm=f)
+    else:
+        spec = CameraSpec(focal_length_mm=f, pinhole_focal_length_mm=f, focus_mm=focus, sensor_width_mm=w,
+                          sensor_height_mm=h)
+    return add_characterization(usd["file"], usd["variant"], spec, _measured(doc, Path(output), Path(usd["file"])))
 
 
 def write_all(payload, usd, cal, args, plan) -> list:
     """Write the folder as a whole (:func:`physcam.io.staged_folder`), then the USD variant; returns the
     paths written (the files at their final places, the manifest, the lens file)."""
-    from dataclasses import replace
-
     from ..io import MANIFEST_NAME, atomic_write, staged_folder
 
     out = Path(args.output)
@@ -298,18 +324,6 @@ def write_all(payload, usd, cal, args, plan) -> list:
             written.append(p)
     written.append(out / MANIFEST_NAME)
     if usd is not None:
-        from ..usd.author import CameraSpec
-        from ..usd.kit import add_characterization, best_match_pinhole
-
-        m = cal.marks[0]
-        focus = 1.0e7 if m.mark_mm is None or math.isinf(m.mark_mm) else float(m.mark_mm)
-        f = float(m.focal_length_mm[1])
-        if getattr(args, "loaded_lens", None) is not None:
-            spec, _ = best_match_pinhole(args.loaded_lens, focus_mm=focus, fstop=args.fstop,
-                                         sensor_width_mm=m.sensor_mm[0], sensor_height_mm=m.sensor_mm[1])
-            spec = replace(spec, pinhole_focal_length_mm=f)
-        else:
-            spec = CameraSpec(focal_length_mm=f, pinhole_focal_length_mm=f, focus_mm=focus,
-                              sensor_width_mm=m.sensor_mm[0], sensor_height_mm=m.sensor_mm[1])
-        written.append(add_characterization(usd["file"], usd["variant"], spec, _measured(cal, out, usd["file"])))
+        written.append(add_calibration_variant(cal.to_dict(), usd, lens=getattr(args, "loaded_lens", None),
+                                               fstop=args.fstop, output=out))
     return written

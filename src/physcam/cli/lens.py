@@ -487,6 +487,9 @@ def run_breathing(args) -> int:
     if args.csv:
         print_csv([r.to_dict() for r in rows])
         return 0
+    if p.is_anamorphic:
+        _print_breathing_per_axis(p, rows, sensor_name, units)
+        return 0
     t = Table(f"{p.name}: focus breathing, {sensor_name} sensor (horizontal field, X meridian)",
               ("focus from film", "EFL (mm)", "HFOV (deg)", "framing focal length (mm)", "magnification",
                "back focus (mm)", "entrance pupil from film (mm)", "FOV change (%)"), justify=["right"] * 8)
@@ -498,6 +501,22 @@ def run_breathing(args) -> int:
     if path is not None:
         print(f"wrote {path}")
     return 0
+
+
+def _print_breathing_per_axis(p, rows, sensor_name, units) -> None:
+    """An anamorphic lens's breathing: horizontal (X) and vertical (Y) framing focal lengths and pupils."""
+    from ..units import format_distance
+    from ._output import Table, print_table
+
+    t = Table(f"{p.name}: focus breathing per axis, {sensor_name} sensor (X horizontal, Y vertical meridian)",
+              ("focus from film", "framing f H (mm)", "framing f V (mm)", "squeeze", "HFOV (deg)",
+               "pupil H (mm)", "pupil V (mm)", "FOV change (%)"), justify=["right"] * 8)
+    for r in rows:
+        t.add_row(format_distance(r.focus_from_film_mm, units), _fmt(r.breathing_focal_length_mm, 3),
+                  _fmt(r.vertical_breathing_focal_length_mm, 3), _fmt(r.breathing_squeeze, 4), _fmt(r.hfov_deg, 3),
+                  _fmt(r.entrance_pupil_from_film_mm, 2), _fmt(r.vertical_entrance_pupil_from_film_mm, 2),
+                  _fmt(r.fov_change_pct, 2))
+    print_table(t)
 
 
 # ---- lens check / lens fix ----------------------------------------------------------------

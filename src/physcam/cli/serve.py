@@ -135,6 +135,8 @@ def cli_backend():
     from ..serve import Backend
     from . import build_parser
     from .lens import diagram_options, lenses_document, show_document
+    from ..errors import InputError, PhysCamError
+    from ._common import bare_hint, resolve_bare_distances
     from .report import camera_blocks, report_document, solve_from_args
     from .sensors import sensor_document
 
@@ -152,7 +154,14 @@ def cli_backend():
         if "lens" in q:
             q["lens"] = _bundled(q["lens"])
         args = parsers["report"].parse_args(_options(q))
-        rep = solve_from_args(args)
+        resolve_bare_distances(args)  # the one rule for a bare focus, near or far (the page sends its units)
+        try:
+            rep = solve_from_args(args)
+        except PhysCamError as exc:  # "did you mean 3m?", as the command line says it
+            hint = bare_hint(args, str(exc))
+            if not hint:
+                raise
+            raise InputError(str(exc).splitlines()[0] + hint) from None
         return rep, args
 
     def report(q):
@@ -187,14 +196,17 @@ def cli_backend():
         from ..lens.library import load_lens
 
         args = parsers["diagram"].parse_args([*_options(q), "--output=diagram.svg", f"--lens={_bundled(name)}"])
+        resolve_bare_distances(args)
         # drawn for a phone: 4.4 in wide with 12 pt text reads >= 12 px at 390 px (the page's img is ~366 px wide)
         fig = lens_diagram(load_lens(args.lens), **diagram_options(args)).figure(units=args.units or "m",
                                                                                  width_in=DIAGRAM_WIDTH_IN,
                                                                                  text_pt=DIAGRAM_TEXT_PT)
         return _svg(fig, dpi=150)
 
+    from ._config import load_config
+
     return Backend(report=report, dof_svg=dof_svg, sensors=sensors, lenses=lenses_document, lens=lens,
-                   diagram_svg=diagram_svg, parameters=params)
+                   diagram_svg=diagram_svg, parameters=params, units=load_config().units or "m")
 
 
 def _tls_files(args):
