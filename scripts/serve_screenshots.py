@@ -36,8 +36,8 @@ def main() -> int:
                                    "localStorage.setItem('physcam-coc', 'cine');")
                 pg.goto(url + SETUP)
                 pg.wait_for_selector("body[data-ready='1']")
-                pg.fill("#split-near", "2.5")
-                pg.fill("#split-far", "4")
+                pg.fill("#split-near", "2.5m")
+                pg.fill("#split-far", "4m")
                 pg.fill("#ex-to-fps", "48")
                 pg.wait_for_selector("#split-answer[data-focus]")
                 pg.wait_for_timeout(800)  # the chart and the table settle

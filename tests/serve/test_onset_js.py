@@ -116,6 +116,8 @@ def random_setup(rng: random.Random, sensor_names: list[str]) -> dict:
             q["near" if rng.random() < 0.6 else "far"] = _len(rng, near if rng.random() < 0.6 else far)
     if rng.random() < 0.2:
         q["tstop"] = f"{fstop * rng.uniform(1.0, 1.3):.3g}"
+    if rng.random() < 0.3:  # the page sends its unit system: a bare focus, near or far is then feet or mm
+        q["units"] = rng.choice(["m", "ft"])
     _datasheet(rng, q, f)
     return q
 

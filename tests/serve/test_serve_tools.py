@@ -81,8 +81,8 @@ def test_camera_then_format_gives_the_cli_numbers(page, server, capsys):
 def test_split_focus_answer(page, server):
     page.goto(f"{server}?focal=50&fstop=4&focus=3m&sensor=S35")
     page.wait_for_selector("body[data-ready='1']")
-    page.fill("#split-near", "2.5")
-    page.fill("#split-far", "4")
+    page.fill("#split-near", "2.5m")
+    page.fill("#split-far", "4m")
     page.wait_for_selector("#split-answer[data-focus]")
     want = split_focus(ReportRequest(sensor=find_sensor("S35"), focal_length_mm=50.0, near_mm=2500.0, far_mm=4000.0,
                                      fstop=4.0))
@@ -165,7 +165,7 @@ def test_my_lens_set(page, server, capsys):
     doc = cli(capsys, "report", "--focal", "50", "--fstop", "4", "--focus", "3m", "--sensor", "S35", "--coc", "cine")
     wait_near(page, doc["dof"]["near_from_film_mm"])
     assert "close focus" in page.text_content("#set-lens-note")
-    page.fill("#focus", "0.4")  # 40 cm: inside the 50's 18 in close focus
+    page.fill("#focus", "40cm")  # 40 cm: inside the 50's 18 in close focus
     page.wait_for_selector("#set-lens-note[data-too-close='1']")
     hyper = cli(capsys, "hyperfocal", "--focal", "25,50", "--fstops", "4", "--sensor", "S35", "--coc", "cine")
     got = page.eval_on_selector_all("#set-hyperfocal tbody tr td[data-mm]", "ts => ts.map(t => Number(t.dataset.mm))")

@@ -636,12 +636,17 @@ async function start() {
   const q = new URLSearchParams(location.search);
   let serverUnits = "m";
   try {
-    const r = await fetch("/api/sensors");
+    const r = await fetch("/api/sensors"); // the camera table: from the server, or the worker's copy offline
     SENSORS = await r.json();
-    serverUnits = (await (await fetch("/api/health")).json()).units || "m";
   } catch (e) {
     showMessage("the physcam server cannot be reached; is it still running?");
     return;
+  }
+  try { // the server's unit system (its user config); offline, the last one it said
+    serverUnits = (await (await fetch("/api/health")).json()).units || "m";
+    try { localStorage.setItem("physcam-server-units", serverUnits); } catch (e) { /* private mode */ }
+  } catch (e) {
+    try { serverUnits = localStorage.getItem("physcam-server-units") || "m"; } catch (e2) { /* private mode */ }
   }
   applyState(q, serverUnits);
   offerCoc();

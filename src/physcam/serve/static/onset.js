@@ -208,26 +208,36 @@
   const FOCUS_WORDS = [HYPERFOCAL, "hyper", "hyperfocal distance"];
   const KNOWN = ["focal", "fstop", "tstop", "focus", "near", "far", "sensor", "sensor-width", "sensor-height",
     "squeeze", "coc", "model", "h1", "h2", "pupil", "reference", "flange", "sensor-front", "lens-length",
-    "pupil-fraction"];
+    "pupil-fraction", "units"];
+  // physcam's one rule for a bare scene distance (cli._common.BARE_RULE): a focus, near or far typed as a bare
+  // number is millimetres, or feet under units=ft; lengths inside the camera are always millimetres
+  const BARE_NUMBER = /^\s*[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?\s*$/;
 
-  function readFocus(text) {
+  function scene(text, name, allowInf, units) {
+    const v = parseDistance(text, name, allowInf);
+    return units === "ft" && BARE_NUMBER.test(String(text)) ? Number(String(text).trim()) * 304.8 : v;
+  }
+
+  function readFocus(text, units) {
     const t = String(text).trim().toLowerCase();
     if (FOCUS_WORDS.includes(t)) return HYPERFOCAL;
     if (INFINITY_WORDS.includes(t)) return Infinity;
-    return parseDistance(text, "focus distance");
+    return scene(text, "focus distance", false, units);
   }
 
   function request(q, sensors, defaultSensor = "Super 35") {
     if ("lens" in q) fail("a real lens prescription needs the physcam server (it traces the lens): reconnect");
     for (const k of Object.keys(q)) if (!KNOWN.includes(k)) fail(`unknown parameter '${k}'`);
     const opt = (k, read) => (k in q ? read(q[k]) : null);
+    const units = q.units === undefined ? "m" : q.units;
+    if (!["m", "ft"].includes(units)) fail(`units: invalid choice '${units}' (choose from 'm', 'ft')`);
     const r = {
       focal: opt("focal", (t) => parseDistance(t, "focal length")),
       fstop: opt("fstop", (t) => number(t, "f-stop")),
       tstop: opt("tstop", (t) => number(t, "T-stop")),
-      focus: opt("focus", readFocus),
-      near: opt("near", (t) => parseDistance(t, "near limit")),
-      far: opt("far", (t) => parseDistance(t, "far limit", true)),
+      focus: opt("focus", (t) => readFocus(t, units)),
+      near: opt("near", (t) => scene(t, "near limit", false, units)),
+      far: opt("far", (t) => scene(t, "far limit", true, units)),
       squeeze: "squeeze" in q ? number(q.squeeze, "squeeze") : 1.0,
       coc: opt("coc", parseCoc),
       model: q.model === undefined ? "practical" : q.model,
@@ -466,7 +476,16 @@
     const { near, far } = r, s = foc.s, solved = {}, notes = [];
     let N = r.fstop;
     const oneLimit = "focus_from_film_mm" in foc.solved && (near === null || far === null);
-    if ((near !== null || far !== null) && !oneLimit) {
+    const split = "focus_from_film_mm" in foc.solved && near !== null && far !== null;
+    if (split && N !== null) {
+      // split focus with the stop given: the stop and CoC are kept; the stop the asked limits need beside them
+      const h = hpFromNear(planes.f, s, planes.toH1(near, s));
+      const need = fNumberForDof(planes.f, c, h);
+      solved.fstop_needed = need;
+      solved.fstop_needed_stops_over_given = stopsBetween(need, N);
+      notes.push(N < need ? `split focus with the stop given: f/${N.toPrecision(3)} holds less than the asked limits; they need f/${need.toPrecision(3)}`
+        : `split focus: f/${N.toPrecision(3)} holds the asked limits; they need f/${need.toPrecision(3)}`);
+    } else if ((near !== null || far !== null) && !oneLimit) {
       const [hpNear, hpFar] = hyperfocalParameters(planes, s, near, far);
       const hp = hpNear !== null ? hpNear : hpFar;
       if (hpNear !== null && hpFar !== null) {
@@ -577,7 +596,7 @@
       h2_from_film_mm: h2Film, reference_plane: r.reference,
       flange_focal_distance_mm: r.reference === "flange" ? r.flange : null, focus_error_mm: err, magnification: m,
       frame_at_focus: frameAtFocus(w, h, sq, m, s),
-      dof, dof_horizontal: dofH,
+      dof, dof_horizontal: dofH, split_focus: null,
       pinhole: { focal_length_mm: pin, squeeze: sq },
       fov_deg: {
         infinity: { horizontal: fovDeg(wd, f), vertical: fovDeg(h, f), diagonal: fovDeg(Math.hypot(wd, h), f) },
@@ -590,6 +609,14 @@
     };
     if (r.near !== null) d.measured.near_from_film_mm = r.near;
     if (r.far !== null) d.measured.far_from_film_mm = finiteOrNull(r.far);
+    if (solved.fstop_needed !== undefined) { // LensReport.split_focus
+      const need = solved.fstop_needed;
+      d.split_focus = { near_asked_from_film_mm: r.near, far_asked_from_film_mm: finiteOrNull(r.far),
+        fstop_given: N, fstop_needed: need, holds: N >= need * (1 - 1e-9) };
+    }
+    const pivot = pupil === null ? null : [0.0, 0.0, -pupil]; // one pupil for both meridians
+    d.entrance_pupils = { horizontal_from_film_mm: pupil, vertical_from_film_mm: pupil,
+      separation_mm: pupil === null ? null : 0.0, pan_pivot_camera_space_mm: pivot, tilt_pivot_camera_space_mm: pivot };
     d.diffraction = diffraction(d, sensor);
     notes.push(diffractionNote(d));
     if (r.sensorDefaulted) notes.push(`no --sensor given: ${sensor.name}, ${w} x ${h} mm`);
