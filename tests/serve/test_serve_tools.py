@@ -121,8 +121,9 @@ def test_lens_diagram_text_is_readable_on_a_phone(page, server):
     # issue 46: the diagram's text was about 4 px on a phone; every text of it reads at least 12 px at 390 px
     page.goto(f"{server}?lens=dgauss_50mm&fstop=4&focus=2m&sensor=S35")
     page.wait_for_selector("body[data-ready='1']")
+    # a traced lens: the server's slow work (a loaded machine may take a while)
     page.wait_for_function("() => { const i = document.getElementById('diagram');"
-                           " return i.getAttribute('src') && i.complete && i.naturalWidth > 0; }")
+                           " return i.getAttribute('src') && i.complete && i.naturalWidth > 0; }", timeout=120_000)
     sizes = page.evaluate("""async () => {
         const img = document.getElementById('diagram');
         const svg = new DOMParser().parseFromString(await (await fetch(img.src)).text(), 'image/svg+xml');
