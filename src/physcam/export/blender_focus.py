@@ -28,6 +28,7 @@ import numpy as np
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_type
 from ..lens.prescription import Prescription, takes_prescription
+from ._codetext import osl_comment
 from .osl import lens_data, osl_array, osl_number, render_template
 
 __all__ = ["FocusTable", "focus_table", "focus_table_shader", "ghost_rows", "N_FOCUS", "GRID_HALF_MM", "STOP_LEVELS"]
@@ -252,6 +253,6 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
     data += [_arr32("FILM_Z_TAB", ft.film_z, "N_FOCUS"), _arr32("NORM_TAB", norm, "N_NORM_TAB"),
              _arr32("VZ_TAB", ft.vertex_z, "N_VZ_TAB"), osl_array("SEMI_OPEN", ft.table.semi_diameter, "N_SURF"),
              _arr32("IRIS_LEVEL", ft.levels, "N_IRIS")]
-    head = [f"// {ft.lens.name}: {n_focus} focus states from infinity to {ft.closest_mm / 1000:.3g} m "
+    head = [f"// {osl_comment(ft.lens.name)}: {n_focus} focus states from infinity to {ft.closest_mm / 1000:.3g} m "
             f"(uniform in 1/distance); dispersion {'on' if dispersion else 'off'}, Fresnel {'on' if fresnel else 'off'}."]
     return render_template(head + defines, data)
