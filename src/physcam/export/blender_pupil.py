@@ -254,13 +254,43 @@ class Rim:
         return float(0.5 * abs(x[:-1] @ y[1:] - y[:-1] @ x[1:] + x[-1] * y[0] - y[-1] * x[0]))
 
 
+def _first_grids(q, film_z: float, fxs, s_max: float, r_rear: float, big: float) -> tuple[list, list]:
+    """Per film point (fx, 0): the box (x0, x1, y1) of its first grid and the grid (:func:`_trace`).
+    The rear element's square, unless fewer than :data:`~physcam.trace.pupil_bounds.MIN_HITS` of its
+    aims pass at iris radius ``s_max`` (a cover glass close to the film: the spot is under one grid
+    step); then a window about the point straight ahead, half as wide as the film's distance from
+    the rear vertex, doubled while the passing aims touch its edge or none pass."""
+    from ..trace.pupil_bounds import MIN_HITS
+
+    full = (-r_rear, r_rear, r_rear)
+    boxes = [full] * len(fxs)
+    grids = _trace(q, film_z, fxs, boxes, big)
+    pending = [p for p, g in enumerate(grids) if (g[2] & (g[3] <= s_max)).sum() < MIN_HITS]
+    h = 0.5 * (film_z - q.vertex_z[-1])
+    while pending and h < 2 * r_rear:
+        wins = {p: (max(fxs[p] - h, -r_rear), min(fxs[p] + h, r_rear), min(h, r_rear)) for p in pending}
+        wins = {p: w for p, w in wins.items() if w[1] > w[0]}
+        done = set()
+        for p, g in zip(wins, _trace(q, film_z, [fxs[p] for p in wins], list(wins.values()), big) if wins else []):
+            w, sel = wins[p], g[2] & (g[3] <= s_max)
+            if sel.any():
+                x, y = g[0][sel], g[1][sel]
+                edge = ((w[0] > -r_rear and x.min() < w[0] + g[4]) or (w[1] < r_rear and x.max() > w[1] - g[4])
+                        or (w[2] < r_rear and y.max() > w[2] - g[5]))
+                if not edge:
+                    boxes[p], grids[p] = w, g
+                    done.add(p)
+        pending = [p for p in pending if p not in done]
+        h *= 2
+    return boxes, grids
+
+
 def _passing_sets(q, film_z: float, fxs, radii, r_rear: float, big: float) -> list:
     """Per film point (fx, 0) and per iris radius in ``radii`` (descending): the rim of the passing
     set (:func:`_rims`), or None when nothing passes. A point's grid zooms in on its passing set once
     that has shrunk to under half of the grid."""
     radii = np.asarray(radii, dtype=float)
-    boxes = [(-r_rear, r_rear, r_rear)] * len(fxs)
-    grids = _trace(q, film_z, fxs, boxes, big)
+    boxes, grids = _first_grids(q, film_z, fxs, radii[0], r_rear, big)
     start = [0] * len(fxs)  # the first radius each point's current grid serves
     uses = [[] for _ in fxs]  # per film point: (grid, the radii it serves)
     pending = list(range(len(fxs)))
