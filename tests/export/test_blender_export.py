@@ -65,7 +65,8 @@ def test_monochrome_indices_are_physcams_at_the_design_wavelength():
     np.testing.assert_allclose(_array(src, "N1"), t.index_before(lens.wavelength_nm), rtol=1e-15)
     np.testing.assert_allclose(_array(src, "N2"), t.index_after(lens.wavelength_nm), rtol=1e-15)
     assert np.array_equal(_array(src, "RSC"), t.r_scale)
-    assert "DB[" not in src and "hashnoise" not in src  # dispersion off: no per-ray index
+    # dispersion off: no per-ray wavelength or index (hashnoise also draws the iris's repeated aims)
+    assert "DB[" not in src and "u_wl" not in src and "lam " not in src
     assert "Ts *=" in src
 
 
