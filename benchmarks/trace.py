@@ -8,7 +8,7 @@ dgauss.50mm (sphere intersections, clipping at every clear semi-diameter, vector
 check) to the paraxial image plane; one wavelength (the d line), no Fresnel. The C reference is
 compiled here with ``gcc -O3 -march=native -fno-math-errno -fopenmp`` when gcc is present (it
 auto-vectorises to AVX-512 on this machine) and run in the same process tree, alternating with
-physcam, on 1 and 2 threads (``OMP_NUM_THREADS``, ``numba.set_num_threads``): other jobs share
+physcam, on 1 and 2 threads (``OMP_NUM_THREADS``, ``physcam.trace.kernels.set_threads``): other jobs share
 this machine, so the ratio physcam / C of one run is the figure that counts. Both print the RMS
 spot radius as a check that they did the same work.
 
@@ -153,7 +153,7 @@ def main() -> None:
     for threads in (1, 2):
         if threads > nmax:
             continue
-        numba.set_num_threads(threads)
+        kernels.set_threads(threads)  # the JIT kernel's threads (one block range each)
         best_p = best_c = 0.0
         rms_p = rms_c = float("nan")
         for _ in range(3):  # alternate, so both see the same machine
@@ -172,7 +172,7 @@ def main() -> None:
         print(line)
     if exe is None and not args.no_c:
         print(f"  (no C reference: gcc or {C_SOURCE} missing)")
-    numba.set_num_threads(nmax)
+    kernels.set_threads(None)
     print(f"physcam alone, {nmax} threads:")
     for name, rays, kw in (("monochrome, copying the batch", mono, dict(in_place=False)),
                            ("dispersion + Fresnel, in place", colour, dict(fresnel=True)),
