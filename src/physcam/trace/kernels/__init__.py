@@ -42,16 +42,21 @@ BACKENDS = ("auto", "numba", "numpy")
 SERIAL_BELOW = 1024
 #: "auto" before numba is loaded: the numpy kernel's cost per ray and surface, and per surface and
 #: call (dgauss_50mm on this machine, 5e5 rays in slices of 2^14: 32-38 ns per ray and surface, one
-#: wavelength or three with the optical path, at load 3.5; ~25 us of numpy calls per surface), the
-#: numpy work allowed in all (about half of what loading numba costs) and in one call
+#: wavelength or three with the optical path, at load 3.5; ~25 us of numpy calls per surface)
 NUMPY_RAY_SURFACE_S = 40e-9
 NUMPY_SURFACE_S = 30e-6
-NUMPY_BUDGET_S = 0.1
-NUMPY_CALL_MAX_S = 0.04
-#: What loading numba costs a process before its first traced ray: ``import numba`` and the first
-#: call's target initialisation (0.115 s + 0.14 s on this machine, idle, 2026-11-23; 0.33-0.38 s of
-#: CPU at load 3.9, 2026-11-26; docs/performance.md)
-NUMBA_LOAD_S = 0.3
+#: What loading numba costs a process before its first traced ray: ``import numba``, the kernel
+#: module and the first variant's target initialisation and cache load (0.18 + 0.05 + 0.16 s of CPU
+#: at load 14, 2026-11-28; 0.33-0.38 s at load 3.9, 2026-11-26; docs/performance.md)
+NUMBA_LOAD_S = 0.35
+#: "auto" runs the numpy kernel while the numpy work of the process, the call at hand included,
+#: stays under this: as much as loading numba costs (rent until the rent paid would have bought:
+#: never more than twice the cheaper choice, whatever work follows); and one call estimated above
+#: ``NUMPY_CALL_MAX_S`` loads numba at once. Both scale with :func:`numba_load_cost` (a cold JIT
+#: cache). Issue 47: at a third of the load cost, the ghost and relative-illumination commands
+#: (0.12-0.18 s of numpy work) loaded numba for nothing.
+NUMPY_BUDGET_S = NUMBA_LOAD_S
+NUMPY_CALL_MAX_S = NUMBA_LOAD_S
 #: Large batches too run serially while the machine is busy (1-minute load average above the
 #: cores numba uses, plus 0.5): numba's parallel loop splits the blocks statically, so with other
 #: processes on the cores it waits for its slowest thread (benchmarks/small_calls.py measured the
@@ -201,10 +206,10 @@ class _JitKernel:
 
         with event.install_listener("numba:compile", Progress()):
             f(*args, 0, 0)
-        if state["started"]:
+        if state["started"] or not _jitcache.is_warm():  # compiled now, or loaded from a cache left unmarked
             _jitcache.mark_compiled()
-            if reporter is not None:
-                reporter(total, total)
+        if state["started"] and reporter is not None:
+            reporter(total, total)
 
 
 def _load_numba():

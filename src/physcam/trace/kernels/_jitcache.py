@@ -58,13 +58,27 @@ def _cache_dirs() -> list[str]:
     return [_user_dir(), pkg] if os.environ.get("NUMBA_CACHE_DIR") else [pkg, _user_dir()]
 
 
-def _writable_dir(path: str) -> bool:
-    """Whether entries can be written in ``path`` (created if missing)."""
-    try:
-        os.makedirs(path, exist_ok=True)
-        return os.access(path, os.W_OK | os.X_OK)
-    except OSError:
-        return False
+def _usable(path: str, create: bool) -> bool:
+    """Whether numba's cache could be written in ``path``: it is a writable folder, or (``create``
+    False) the nearest existing folder above it is writable; ``create`` makes the folder."""
+    if create:
+        try:
+            os.makedirs(path, exist_ok=True)
+        except OSError:
+            return False
+    probe = path
+    while not os.path.exists(probe):
+        parent = os.path.dirname(probe)
+        if parent == probe:
+            return False
+        probe = parent
+    return os.path.isdir(probe) and os.access(probe, os.W_OK | os.X_OK)
+
+
+def cache_dir(create: bool = False) -> str | None:
+    """The folder numba's cache of the kernels uses: the first of :func:`_cache_dirs` that can be
+    written (the locator's own choice below); None if none can."""
+    return next((d for d in _cache_dirs() if _usable(d, create)), None)
 
 
 _warm: bool | None = None
@@ -75,28 +89,29 @@ def _marker() -> str:
 
 
 def is_warm() -> bool:
-    """Whether numba's disk cache holds kernels compiled from these sources (a marker that
-    :func:`mark_compiled` left in one of the cache folders; looked up once per process, without
-    importing numba). A marker whose kernels numba then cannot load (another CPU) costs a compile,
-    never a wrong answer."""
+    """Whether numba's disk cache holds kernels compiled from these sources: the marker
+    :func:`mark_compiled` leaves in :func:`cache_dir` (looked up once per process, without importing
+    numba or creating a folder). A marker whose kernels numba then cannot load (another CPU) costs a
+    compile, never a wrong answer."""
     global _warm
     if _warm is None:
-        _warm = any(os.path.exists(os.path.join(d, _marker())) for d in _cache_dirs())
+        d = cache_dir()
+        _warm = d is not None and os.path.exists(os.path.join(d, _marker()))
     return _warm
 
 
 def mark_compiled() -> None:
-    """Leave the marker of :func:`is_warm` in the first writable cache folder (after a compile)."""
+    """Leave the marker of :func:`is_warm` in :func:`cache_dir` (after a compile or a first load)."""
     global _warm
-    for d in _cache_dirs():
-        if _writable_dir(d):
-            try:
-                with open(os.path.join(d, _marker()), "w") as f:
-                    f.write("numba's cache here holds physcam's kernels compiled from these sources\n")
-            except OSError:
-                continue
-            _warm = True
-            return
+    d = cache_dir(create=True)
+    if d is None:
+        return
+    try:
+        with open(os.path.join(d, _marker()), "w") as f:
+            f.write("numba's cache here holds physcam's kernels compiled from these sources\n")
+    except OSError:
+        return
+    _warm = True
 
 
 def install() -> bool:
@@ -138,14 +153,8 @@ def _register() -> None:
         def from_function(cls, py_func, py_file):
             if os.path.dirname(os.path.abspath(py_file)) != _HERE:
                 return None
-            for path in _cache_dirs():
-                self = cls(py_func, py_file, path)
-                try:
-                    self.ensure_cache_path()
-                except OSError:
-                    continue
-                return self
-            return None
+            path = cache_dir(create=True)
+            return None if path is None else cls(py_func, py_file, path)
 
     caching.CacheImpl._locator_classes.insert(0, PhysCamLocator)
     sys.modules[__name__].PhysCamLocator = PhysCamLocator
