@@ -175,10 +175,10 @@ def _progress(args):
     """Progress for people at a terminal (none with --json or --csv): the JIT compile's bar
     ("compiling the ray tracer (once)") and a spinner for a command still running after 2 s."""
     from . import _common
-    from ..trace.kernels import set_compile_reporter
+    from ..progress import set_reporter
 
     _common.SHOW_PROGRESS = not (getattr(args, "json", False) or getattr(args, "csv", False))
-    set_compile_reporter(_common._CompileProgress() if _common.SHOW_PROGRESS else None)
+    set_reporter("compile", _common._CompileProgress() if _common.SHOW_PROGRESS else None)
     sub = next((v for k, v in vars(args).items() if k.endswith("_command") and isinstance(v, str)), None)
     name = " ".join(v for v in (getattr(args, "command", None), sub) if isinstance(v, str))
     return _common.slow_command_progress(name or "working")
@@ -275,6 +275,9 @@ def _refused_path(exc: OSError) -> str:
 def run() -> None:
     """The ``physcam`` program: :func:`main`, then exit with its status (module notes). It ends the
     process: from Python, call :func:`main` instead."""
+    from .. import figures
+
+    figures.PROGRAM_IMPORT = True  # matplotlib without its docstring tables and 3-D toolkit (figures._lean_import)
     code = main()
     if "numba" in sys.modules:
         _exit_without_teardown(code)

@@ -71,7 +71,6 @@ _numba_error: str | None = None
 _numpy_spent = 0.0
 _load_seen = (-1.0, False)  # (monotonic time of the last look, busy then)
 _threads_set: int | None = None
-_compile_reporter = None
 
 
 def set_threads(n: int | None) -> None:
@@ -97,10 +96,11 @@ def threads() -> int:
 def set_compile_reporter(fn) -> None:
     """``fn(done, total)`` is called while numba compiles a kernel variant (the first use after an
     install or upgrade): ``(0, total)`` when it starts, then after each pass, ``(total, total)`` at
-    the end; None for silence (the default). ``physcam`` shows it as "compiling the ray tracer
-    (once)" with a progress bar on a terminal."""
-    global _compile_reporter
-    _compile_reporter = fn
+    the end; None for silence (the default). The ``"compile"`` reporter of :mod:`physcam.progress`
+    (``physcam`` shows it as "compiling the ray tracer (once)" with a progress bar on a terminal)."""
+    from ...progress import set_reporter
+
+    set_reporter("compile", fn)
 
 
 def _busy() -> bool:
@@ -188,7 +188,9 @@ class _JitKernel:
         passes = set(self._K.variant_passes(*key))
         total = len(passes) + 1
         state = {"done": 0, "started": False}
-        reporter = _compile_reporter
+        from ...progress import reporter as _reporter
+
+        reporter = _reporter("compile")
 
         class Progress(event.Listener):
             def on_start(self, ev):
