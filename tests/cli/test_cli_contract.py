@@ -134,6 +134,10 @@ JSON_NOT_RUN = {
     ("lens", "pack"): "packs a lens card and a USD file (tests/lens/test_lens_archive.py round-trips an archive through "
                       "pack, check and add and validates both documents)",
     ("lens", "add"): "needs an archive from `lens pack` (tests/lens/test_lens_archive.py validates its document)",
+    ("farm",): "its --json goes before the `--` of the command line it wraps, where this test appends it "
+               "(tests/farm/test_farm_jobs.py validates its document)",
+    ("farm-task",): "runs a task of a farm job (tests/farm/test_farm_run.py runs them; test_farm_task_json_document "
+                    "validates its document)",
 }
 #: Where the rows of each --csv command's document are.
 CSV_ROWS = {

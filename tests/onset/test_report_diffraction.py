@@ -42,7 +42,7 @@ def test_thin_lens_airy_disk_against_coc_and_pitch():
     assert d["fstop_airy_exceeds_coc"] == pytest.approx(coc / (2.44 * LAM * (1 + m)))  # f/16.6
     assert d["fstop_airy_exceeds_two_photosites"] == pytest.approx(2 * pitch / (2.44 * LAM * (1 + m)), rel=1e-4)
     assert d["exceeds_coc"] is False
-    assert any(n.startswith("diffraction (550 nm): Airy disk 10.9 um") and "past f/16.6" in n for n in r.notes)
+    assert any(n.startswith("diffraction (550 nm): Airy disk 10.9 µm") and "past f/16.6" in n for n in r.notes)
     # past that f-stop it does
     past = solve_lens_report(focal_length_mm=f, fstop=17.0, focus_mm=mark, sensor=sensor)
     assert past.to_dict()["diffraction"]["exceeds_coc"] is True

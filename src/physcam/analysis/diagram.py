@@ -77,6 +77,14 @@ class LensDiagram:
     focus_from_film_mm: float = math.inf
     fstop: float | None = None
 
+    def to_dict(self) -> dict:
+        """The diagram's numbers: the rays drawn, as (z, height) points in lens space (mm), and the film."""
+        return {"lens": self.prescription.name, "axis": self.axis, "field_deg": self.field_deg,
+                "focus_from_film_mm": None if math.isinf(self.focus_from_film_mm) else self.focus_from_film_mm,
+                "fstop": self.fstop, "film_z_mm": self.gaussian.z_film,
+                "reference": "lens space: z from the first vertex, + toward the film",
+                "rays": [{"kind": kind, "points_mm": [list(q) for q in pts]} for kind, pts in self.rays]}
+
     @styled
     def figure(self, *, width_in: float = 10.0, units: str = "m"):
         """A matplotlib Figure (Agg canvas). The view spans the lens and film; an object closer than
@@ -121,8 +129,12 @@ class LensDiagram:
         colours = {"marginal": PALETTE[1], "chief": PALETTE[2], "rim": PALETTE[5]}
         for kind, pts in self.rays:
             ax.plot([q[0] for q in pts], [q[1] for q in pts], color=colours[kind], linewidth=0.9 if kind != "rim" else 0.6)
-        # film plane
-        ax.plot([g.z_film, g.z_film], [-hmax, hmax], color="0.3", linewidth=1.5)
+        # film plane: tall enough for every ray that lands on it (a wide field's chief ray lands beyond the
+        # largest element's rim)
+        landed = [abs(pts[-1][1]) for _, pts in self.rays if pts and abs(pts[-1][0] - g.z_film) < 1e-6]
+        half_film = max([hmax] + landed)
+        hmax = max(hmax, half_film / 1.25)  # the view's height below follows
+        ax.plot([g.z_film, g.z_film], [-half_film, half_film], color="0.3", linewidth=1.5)
         ax.text(g.z_film, -1.3 * hmax, "film", ha="center", fontsize=8)
         # cardinal points on the axis
         ax.axhline(0.0, color="0.5", linewidth=0.5, linestyle="-.")

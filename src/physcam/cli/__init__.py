@@ -92,6 +92,7 @@ COMMAND_MODULES = {
     "usd": "usd", "demo": "demo", "config": "config", "calibrate": "calibrate", "characterize": "characterize",
     "defocus": "defocus", "defocus-kernels": "defocus", "export": "export", "live": "live",
     "metadata": "metadata", "microlens": "microlens", "mtf": "mtf", "psf": "psf", "serve": "serve",
+    "farm": "farm", "farm-task": "farm",
 }
 
 
@@ -207,6 +208,9 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 0
     try:
+        from ._common import resolve_bare_distances
+
+        resolve_bare_distances(args)  # a bare scene distance in the unit system's unit (BARE_RULE)
         _into_output_dir(args)
         _refuse_outputs_that_are_inputs(args)
         from ._common import lens_use, use_glass_catalogs
@@ -219,8 +223,10 @@ def main(argv: list[str] | None = None) -> int:
             print(f"physcam: note: {n}", file=sys.stderr)
         return rc
     except PhysCamError as exc:
+        from ._common import bare_hint
+
         msg = str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__
-        print(f"physcam: error: {msg}", file=sys.stderr)
+        print(f"physcam: error: {msg}{bare_hint(args, msg)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("physcam: interrupted", file=sys.stderr)

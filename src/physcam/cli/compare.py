@@ -234,8 +234,9 @@ ROWS = [
     ("near_from_film_mm", "near limit", "dist"), ("far_from_film_mm", "far limit", "dist"),
     ("dof_total_mm", "depth of field", "dist"), ("hyperfocal_from_film_mm", "hyperfocal", "dist"),
     ("breathing_at_focus_pct", "HFOV change from ∞ to focus (%)", "{:+.2f}"),
-    ("breathing_closest_pct", "HFOV change from ∞ to closest (%)", "{:+.2f}"),
-    ("closest_focus_mm", "closest focus", "dist"),
+    ("breathing_closest_pct", "HFOV change from ∞ to near mark (%)", "{:+.2f}"),
+    ("breathing_near_mm", "  near mark", "dist"),
+    ("closest_focus_mm", "closest focus", "close"),
     ("distortion_pct", "distortion at widest field (%)", "{:+.2f}"),
     ("distortion_field_deg", "  at field (deg)", "{:.2f}"),
     ("illumination_corner", "relative illumination at corner", "{:.3f}"),
@@ -251,6 +252,10 @@ def _cell(v, kind, units) -> str:
 
     if kind == "dist":
         return format_distance(math.inf if v is None else v, units)
+    if kind == "close":  # (mark, source): a unit-focusing lens's 1:1 limit is not a close focus it has
+        mark, source = v
+        return format_distance(mark, units) + {"maker": " (MOD)", "focus groups": " (focus groups)"}.get(
+            source, " (unit focusing limit, not the lens's MOD)")
     return "-" if v is None else kind.format(v)
 
 
@@ -292,7 +297,8 @@ def run_lenses(args) -> int:
     t = Table(f"lenses compared on {sensor.name} ({sensor.width_mm:g} x {sensor.height_mm:g} mm)",
               ["", *args.lenses], justify=["left"] + ["right"] * len(rows))
     for key, label, kind in ROWS:
-        t.add_row(label, *(_cell(r[key], kind, units) for r in rows))
+        t.add_row(label, *(_cell((r[key], r["closest_focus_source"]) if kind == "close" else r[key], kind, units)
+                           for r in rows))
     print_table(t)
     for name, r in zip(args.lenses, rows):
         for n in r["notes"]:

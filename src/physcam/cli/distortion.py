@@ -10,6 +10,8 @@ Examples::
 
 from __future__ import annotations
 
+import math
+
 from ._common import FOCUS_HELP, add_units_option, focus, focus_list, number, units_of
 from ._output import document, emit_json, print_csv
 from .lens import WAVE_UNITS, mark_repaired
@@ -34,8 +36,8 @@ def register(sub) -> None:
     p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM",
                    help="wavelength in nm (default: the lens's design wavelength, the d line 587.56)")
     p.add_argument("--focus", type=focus("focus distance"), default=None, metavar="D",
-                   help=f"focus mark from the film plane for the 2-D field (default infinity; {FOCUS_HELP}; "
-                        "hyperfocal wide open); needs --resolution")
+                   help=f"focus mark from the film plane (default infinity; {FOCUS_HELP}; hyperfocal wide open): "
+                        "the field-angle table of the lens focused there, or with --resolution the 2-D field")
     p.add_argument("--resolution", type=_resolution, default=None, metavar="WxH",
                    help="frame size in pixels, e.g. 2048x1366: the full 2-D distortion field at --focus")
     p.add_argument("--stmap", metavar="DIR", default=None,
@@ -65,7 +67,7 @@ def run_distortion(args) -> int:
     from ..errors import InputError
     from .analyze import _finish, _prepare
 
-    needs = [n for n, v in (("--focus", args.focus), ("--stmap", args.stmap), ("--fit", args.fit),
+    needs = [n for n, v in (("--stmap", args.stmap), ("--fit", args.fit),
                             ("--across-focus", args.across_focus), ("--fstop", args.fstop)) if v is not None]
     if args.resolution is None and needs:
         raise InputError(f"{', '.join(needs)} {'needs' if len(needs) == 1 else 'need'} --resolution WxH "
@@ -96,14 +98,21 @@ def run_distortion(args) -> int:
     from ..analysis.distortion import real_distortion
 
     res = real_distortion(lens, args.field, sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
-                          wavelength_nm=args.wavelength)
+                          wavelength_nm=args.wavelength, focus_mm=math.inf if args.focus is None else args.focus)
     if args.csv and not args.json:
         print_csv(res.to_dict()["points"])
     elif not args.json:
         from ._output import Table, print_table
 
+        if res.focus_from_film_mm is None or math.isinf(res.focus_from_film_mm):  # Y's pinhole there is its EFL
+            against = f"EFL {res.efl_y_mm:.3f} mm"
+        else:
+            from ..units import format_distance
+
+            against = (f"focused at {format_distance(res.focus_from_film_mm, units_of(args))}, pinhole f "
+                       f"{res.efl_y_mm:.3f} mm (Y) at the entrance pupil")
         t = Table(f"{res.lens_name}: real distortion at {res.wavelength_nm:g} nm (chief ray vs f tan theta), "
-                  f"EFL {res.efl_y_mm:.3f} mm, {args.sensor_name}",
+                  f"{against}, {args.sensor_name}",
                   ("axis", "field deg", "real mm", "f tan mm", "dist %"), justify=["right"] * 5)
         for p in res.points:
             t.add_row(p.axis, f"{p.field_deg:.3f}", f"{p.real_height_mm:.4f}", f"{p.paraxial_height_mm:.4f}",
@@ -290,9 +299,9 @@ def _run_field(args, lens) -> int:
         print(f"  overscan {res.overscan_px[0]} x {res.overscan_px[1]} px (undistorted frame "
               f"{d['undistorted_size_px'][0]}x{d['undistorted_size_px'][1]}), inverse error {res.inverse_error_px:.4f} px")
     for fit in fits:
-        verdict = "good" if fit.acceptable else f"NOT good (> {fit.max_residual_allowed_px:g} px)"
         coeffs = ", ".join(f"{k} {v:.6g}" for k, v in fit.coefficients.items())
-        print(f"  {fit.model}: residual RMS {fit.rms_residual_px:.3f} px, max {fit.max_residual_px:.3f} px: {verdict}")
+        print(f"  {fit.model}: residual RMS {fit.rms_residual_px:.3f} px, max {fit.max_residual_px:.3f} px: "
+              f"{fit.verdict}")
         print(f"    {coeffs}")
     for p in written:
         print(f"wrote {p}")

@@ -130,6 +130,8 @@ def cli_backend():
     from ..serve import Backend
     from . import build_parser
     from .lens import diagram_options, lenses_document, show_document
+    from ..errors import InputError, PhysCamError
+    from ._common import bare_hint, resolve_bare_distances
     from .report import camera_blocks, report_document, solve_from_args
     from .sensors import sensor_document
 
@@ -147,7 +149,14 @@ def cli_backend():
         if "lens" in q:
             q["lens"] = _bundled(q["lens"])
         args = parsers["report"].parse_args(_options(q))
-        rep = solve_from_args(args)
+        resolve_bare_distances(args)  # the one rule for a bare focus, near or far (the page sends its units)
+        try:
+            rep = solve_from_args(args)
+        except PhysCamError as exc:  # "did you mean 3m?", as the command line says it
+            hint = bare_hint(args, str(exc))
+            if not hint:
+                raise
+            raise InputError(str(exc).splitlines()[0] + hint) from None
         return rep, args
 
     def report(q):
@@ -182,11 +191,14 @@ def cli_backend():
         from ..lens.library import load_lens
 
         args = parsers["diagram"].parse_args([*_options(q), "--output=diagram.svg", f"--lens={_bundled(name)}"])
+        resolve_bare_distances(args)
         fig = lens_diagram(load_lens(args.lens), **diagram_options(args)).figure(units=args.units or "m")
         return _svg(fig, dpi=150)
 
+    from ._config import load_config
+
     return Backend(report=report, dof_svg=dof_svg, sensors=sensors, lenses=lenses_document, lens=lens,
-                   diagram_svg=diagram_svg, parameters=params)
+                   diagram_svg=diagram_svg, parameters=params, units=load_config().units or "m")
 
 
 def run(args) -> int:

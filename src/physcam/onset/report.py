@@ -148,6 +148,19 @@ class LensReport:
 
     # --- convenience --------------------------------------------------------
     @property
+    def split_focus(self) -> dict | None:
+        """With the focus solved from a near and a far limit and the stop given: the stop those limits need at
+        this CoC beside the given one (the report's own limits are the given stop's); else None."""
+        need = self.solved.get("fstop_needed")
+        if need is None:
+            return None
+        return {"near_asked_from_film_mm": self.measured.get("near_from_film_mm"),
+                "far_asked_from_film_mm": finite_or_none(self.measured.get("far_from_film_mm", math.inf)),
+                "fstop_given": self.fstop, "fstop_needed": need, "holds": self.fstop >= need * (1 - 1e-9),
+                "definition": "the focus between the asked near and far limits; fstop_needed holds both at this CoC; "
+                              "the report's near and far limits are those of the given stop"}
+
+    @property
     def real_fov_differs(self) -> bool:
         """True when distortion makes the pinhole's field of view wrong by more than
         :data:`REAL_FOV_TOLERANCE_PCT` in some direction, or the sensor is not covered."""
@@ -231,11 +244,11 @@ class LensReport:
     def diffraction_note(self) -> str:
         d = self.diffraction_dict()
         um = 1000.0
-        text = (f"diffraction ({d['wavelength_nm']:g} nm): Airy disk {d['airy_diameter_mm'] * um:.1f} um across at "
+        text = (f"diffraction ({d['wavelength_nm']:g} nm): Airy disk {d['airy_diameter_mm'] * um:.1f} µm across at "
                 f"f/{self.fstop:.3g} (working f/{d['working_f_number']:.3g}), {d['airy_to_coc']:.2f} of the CoC "
-                f"({self.coc_mm * um:.1f} um)")
+                f"({self.coc_mm * um:.1f} µm)")
         if d["photosite_pitch_mm"] is not None:
-            text += f" and {d['airy_in_photosites']:.1f} photosites ({d['photosite_pitch_mm'] * um:.2f} um)"
+            text += f" and {d['airy_in_photosites']:.1f} photosites ({d['photosite_pitch_mm'] * um:.2f} µm)"
         verb = "exceeds" if d["exceeds_coc"] else "would exceed"
         return text + f"; it {verb} the CoC past f/{d['fstop_airy_exceeds_coc']:.3g}"
 
@@ -278,6 +291,7 @@ class LensReport:
             "magnification": self.magnification,
             "dof": self.dof.to_dict(),
             "dof_horizontal": None if self.dof_horizontal is None else self.dof_horizontal.to_dict(),
+            "split_focus": self.split_focus,
             "pinhole": {"focal_length_mm": self.pinhole[0], "squeeze": self.pinhole[1],
                         "definition": "the pinhole at the entrance pupil that frames like the lens at this focus: "
                                       "f = (exit pupil to film) / pupil magnification; s' for a thin lens"},
@@ -286,7 +300,8 @@ class LensReport:
                              "diagonal": self.dfov_inf_deg},
                 "focus": {"horizontal": self.hfov_focus_deg, "vertical": self.vfov_focus_deg,
                           "diagonal": self.dfov_focus_deg},
-                "definition": "infinity and focus: the paraxial (pinhole) field; real: chief rays traced through "
+                "definition": "infinity: the paraxial field of the lens focused at infinity (a prescription's EFL "
+                              "there); focus: the best-match pinhole's at this focus; real: chief rays traced through "
                               "the prescription from the film edge, top and corner (null where not covered)",
                 "real": None if self.real_fov is None else {
                     "horizontal": self.real_fov["horizontal_deg"], "vertical": self.real_fov["vertical_deg"],

@@ -96,7 +96,7 @@ def custom_sensor(width_mm, height_mm, pitch_um=None) -> Sensor:
     if pitch_um is not None:
         p = require_finite("photosite pitch", pitch_um, error=SensorError)
         if not PITCH_RANGE_UM[0] <= p <= PITCH_RANGE_UM[1]:
-            raise SensorError(f"photosite pitch must lie between {PITCH_RANGE_UM[0]:g} and {PITCH_RANGE_UM[1]:g} um, "
+            raise SensorError(f"photosite pitch must lie between {PITCH_RANGE_UM[0]:g} and {PITCH_RANGE_UM[1]:g} µm, "
                               f"got {p:g}")
     return Sensor("custom", f"custom {w:g} x {h:g} mm", w, h, pitch_um=p, pitch_source="given" if p else "")
 

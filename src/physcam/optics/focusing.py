@@ -42,6 +42,8 @@ __all__ = [
     "image_distance",
     "focus",
     "closest_focus",
+    "CloseFocus",
+    "close_focus",
     "iris_semi_diameter",
     "f_number_ratio",
     "gaussian_at_focus",
@@ -160,6 +162,10 @@ def focus_method(prescription: Prescription, method: str = "auto") -> str:
 
 
 def _mark(focus_from_film_mm) -> float:
+    if isinstance(focus_from_film_mm, str):  # "2m", "10ft", "infinity": as the command line reads it
+        from ..units import parse_distance
+
+        return _mark(parse_distance(focus_from_film_mm, name="focus distance", allow_inf=True))
     d = float(focus_from_film_mm)
     if math.isnan(d) or d <= 0:
         raise InputError(f"focus distance must be a positive distance from the film plane, got {focus_from_film_mm!r}")
@@ -262,6 +268,52 @@ def closest_focus(prescription: Prescription, *, method: str = "auto", axis: str
     if g.efl <= 0:
         raise OpticsError(f"lens {prescription.name!r} has negative power: it forms no real image to focus")
     return (1.0 + math.sqrt(g.image_index)) ** 2 * g.efl + (g.z_rear_principal_plane - g.z_front_principal_plane)
+
+
+#: Without the maker's minimum object distance, a unit-focusing lens's breathing is drawn from this many
+#: focal lengths in front of the film (about 1:8): cine primes' published close focus is 8 to 12 focal
+#: lengths (a 50 mm: 0.45-0.6 m), while the 1:1 limit (4 f) is a macro's.
+BREATHING_NEAR_EFL = 10.0
+
+
+@dataclass(frozen=True)
+class CloseFocus:
+    """How close the lens focuses, and where that number comes from (mm from the film plane).
+
+    ``source``: "maker" (the file's ``[lens] minimum_object_distance``), "focus groups" (the close
+    position of an internal-focusing lens's variable gaps) or "unit focusing limit" (no mechanical
+    limit known: the 1:1 conjugate, which no real lens of that kind reaches). ``breathing_near_mm``:
+    where breathing tables and plots start by default (the MOD, the focus groups' close point, or
+    :data:`BREATHING_NEAR_EFL` focal lengths, to two significant figures, for a unit-focusing lens without a
+    MOD)."""
+
+    mark_mm: float
+    source: str
+    words: str
+    breathing_near_mm: float
+
+    def to_dict(self) -> dict:
+        return {"close_focus_from_film_mm": self.mark_mm, "source": self.source, "words": self.words,
+                "breathing_near_from_film_mm": self.breathing_near_mm}
+
+
+@takes_prescription
+def close_focus(prescription: Prescription, *, method: str = "auto", wavelength_nm=None) -> CloseFocus:
+    """The lens's close focus (:class:`CloseFocus`): the maker's minimum object distance when the file gives
+    one (kept at least the focusing model's own limit), else the focusing model's limit, named as such."""
+    limit = closest_focus(prescription, method=method, wavelength_nm=wavelength_nm)
+    mod = prescription.metadata.minimum_object_distance
+    if mod is not None:
+        mark = max(float(mod), limit)
+        return CloseFocus(mark, "maker", "the maker's minimum object distance" + (
+            "" if mark == mod else f" ({mod:g} mm) is closer than this focusing model reaches: its limit"), mark)
+    if focus_method(prescription, method) == "internal":
+        return CloseFocus(limit, "focus groups", "the focus groups' close position (from the file; no MOD given)",
+                          limit)
+    efl = paraxial.gaussian(prescription, wavelength_nm=wavelength_nm).efl
+    near = BREATHING_NEAR_EFL * efl
+    near = round(near, 1 - int(math.floor(math.log10(near))))  # two significant figures, as marks are engraved
+    return CloseFocus(limit, "unit focusing limit", "unit focusing limit, not the lens's MOD", max(limit, near))
 
 
 def _internal_focus(p: Prescription, mark: float, axis: str, lam) -> FocusState:
@@ -457,7 +509,8 @@ def breathing_table(
     """Effective focal length and horizontal field of view against focus mark.
 
     ``focus_marks_mm``: marks from the film plane (default: infinity, 10 m, 5 m, ...
-    down to the closest focus). The horizontal field uses the X meridian (the squeezed one of
+    down to the close focus of :func:`close_focus`: the MOD, the focus groups' close point, or ten focal
+    lengths for a unit-focusing lens without a MOD). The horizontal field uses the X meridian (the squeezed one of
     an anamorphic) with the lens focused in Y; HFOV = 2 atan(...) of the paraxial
     chief ray reaching the sensor edge (``sensor_width_mm``/2 off axis; default the width of Super 35,
     24.89 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, as the CLI).
@@ -467,10 +520,12 @@ def breathing_table(
         raise InputError(f"sensor width must lie between 1e-6 and 1000 mm, got {w:g}")
     method = focus_method(prescription, method)
     if focus_marks_mm is None:
-        near = closest_focus(prescription, method=method, wavelength_nm=wavelength_nm)
-        # internal focusing ends at its close point; unit focusing (no mechanical limit known) stops
-        # at the last default mark beyond 1:1
-        marks = [m for m in DEFAULT_BREATHING_MARKS if m > near] + ([near] if method == "internal" else [])
+        # from infinity to the close focus: the maker's MOD or the focus groups' close point (that mark
+        # last), or for a unit-focusing lens without a MOD the default marks beyond BREATHING_NEAR_EFL focal
+        # lengths (:func:`close_focus`)
+        cf = close_focus(prescription, method=method, wavelength_nm=wavelength_nm)
+        near = cf.breathing_near_mm
+        marks = [m for m in DEFAULT_BREATHING_MARKS if m > near * (1 + 1e-9)] + [near]
     else:
         marks = [_mark(m) for m in focus_marks_mm]
         if not marks:

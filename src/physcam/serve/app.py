@@ -11,7 +11,7 @@ Routes (GET or HEAD only; every answer is JSON, SVG or the page):
 ``/api/lenses``                        ``physcam lenses --json``'s ``lenses`` list
 ``/api/lens/{name}?focus=2m...``       ``physcam lens show NAME ... --json``
 ``/api/lens/{name}/diagram.svg?...``   ``physcam lens diagram NAME ... -o diagram.svg``
-``/api/health``                        ``{"ok": true, "version": ...}``
+``/api/health``                        ``{"ok": true, "version": ..., "units": "m" or "ft"}``
 =====================================  =============================================================
 
 Query parameters are the CLI flags without their dashes (``sensor-width=24.89``); which ones an
@@ -76,6 +76,9 @@ class Backend:
     lens: Callable[[str, Mapping[str, str]], dict]
     diagram_svg: Callable[[str, Mapping[str, str]], bytes]
     parameters: Mapping[str, frozenset[str]]
+    #: the unit system a page starts in when its address does not say: "m", or "ft" (the user config's
+    #: ``units``): a bare focus, near or far is then feet on the page as on the command line
+    units: str = "m"
 
 
 @dataclass(frozen=True)
@@ -471,7 +474,8 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
 
     async def health(request):
         core.query(request.scope, "health")
-        return _no_store(json.dumps({"ok": True, "version": __version__}).encode(), "application/json")
+        return _no_store(json.dumps({"ok": True, "version": __version__, "units": backend.units}).encode(),
+                         "application/json")
 
     async def favicon(request):
         return Response(status_code=204)

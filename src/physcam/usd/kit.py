@@ -739,4 +739,42 @@ def read_characterizations(file) -> dict:
     return {"current_is": prim.GetCustomDataByKey("physcam:currentIs"), "selection": selection, "variants": out}
 
 
-__all__ += ["add_characterization", "read_characterizations", "CHARACTERIZATION_NS"]
+def characterization_target(file, variant: str) -> dict:
+    """Check, before a characterization is measured, that variant ``variant`` can be added to the lens
+    file ``file`` (:func:`add_characterization`'s rules: the name, a physcam lens file or none yet, a new
+    variant); return ``{"exists": bool, "focal_length_mm": float | None}``: the lens's focal length as
+    the file composes it now (its lens model's ``focalLength``, a prescription's effective focal
+    length; None without a file or a lens model), for checking that a measurement is of this lens."""
+    from pathlib import Path
+
+    require_type("lens file", file, (str, Path), "a .usda/.usdc path")
+    variant = _variant_identifier(variant)
+    p = Path(file)
+    if p.suffix not in (".usda", ".usdc", ".usd"):
+        raise InputError(f"{p}: a lens file's name ends in .usda, .usdc or .usd")
+    if not p.exists():
+        if not p.parent.is_dir():
+            raise ExportError(f"{p}: its folder {p.parent} does not exist")
+        return {"exists": False, "focal_length_mm": None}
+    if variant in read_characterizations(p)["variants"]:
+        raise ExportError(f"{p}: already has a characterization variant {variant!r}: give another --variant")
+    ensure_registered()
+    stage = _open_detached(p)  # held: a prim outlives no stage
+    prim = stage.GetPrimAtPath(LENS_PRIM)
+    if not prim or prim.GetTypeName() != "PhysicalCamera":
+        raise ExportError(f"{p}: has no PhysicalCamera {LENS_PRIM} (not a physcam lens file)")
+    rel = prim.GetRelationship(f"lens:{LENS_INSTANCE}:lensModel")
+    targets = rel.GetForwardedTargets() if rel else []
+    model = stage.GetPrimAtPath(targets[0]) if targets else None
+    focal = None
+    if model and model.GetTypeName() == "PhysicalCameraLensModelPrescription":
+        from ..optics.paraxial import gaussian
+        from .read import read_prescription
+
+        focal = float(gaussian(read_prescription(model)).efl)
+    elif model and model.GetAttribute("focalLength") and model.GetAttribute("focalLength").HasAuthoredValue():
+        focal = float(model.GetAttribute("focalLength").Get())
+    return {"exists": True, "focal_length_mm": focal}
+
+
+__all__ += ["add_characterization", "read_characterizations", "characterization_target", "CHARACTERIZATION_NS"]

@@ -50,10 +50,16 @@ function showLen(el, mm) {
 
 const BARE = /^\s*[+-]?(\d+(\.\d*)?|\.\d+)\s*$/;
 
+// physcam's one rule (docs/serve.md): a bare focus, near or far is millimetres in metric and feet in
+// imperial, here as on the command line; the server reads it (the request says its units)
 function withUnit(text) {
   const t = text.trim();
-  if (/^(inf|infinity|∞)$/i.test(t)) return "inf";
-  return BARE.test(t) ? t + (st.units === "imperial" ? "ft" : "m") : t;
+  return /^(inf|infinity|∞)$/i.test(t) ? "inf" : t;
+}
+
+function bareAsWritten(text) {
+  // what a bare number meant before the units switch, written out
+  return BARE.test(text) ? text.trim() + (st.units === "imperial" ? "ft" : "mm") : text;
 }
 
 function stop(text) {
@@ -93,6 +99,7 @@ function apiParams() {
   } else if (coc !== DEFAULT_COC) {
     p.set("coc", coc);
   }
+  p.set("units", st.units === "imperial" ? "ft" : "m"); // how to read a bare focus, near or far
   return p;
 }
 
@@ -178,11 +185,21 @@ function render(d) {
   showLen($("out-far"), dof.far_from_film_mm);
   showLen($("out-total"), dof.total_mm);
   showLen($("out-hyperfocal"), dof.hyperfocal_from_film_mm);
+  // split focus with the stop given: the limits shown are that stop's; the stop the asked limits need beside them
+  const sf = d.split_focus;
+  $("split-card").hidden = !sf;
+  $("label-near").textContent = sf ? `near at f/${num(d.fstop, 1)}` : "near";
+  $("label-far").textContent = sf ? `far at f/${num(d.fstop, 1)}` : "far";
+  if (sf) {
+    $("out-split").textContent = `f/${num(sf.fstop_needed, 1)} holds ${fmtLen(sf.near_asked_from_film_mm)} – `
+      + `${fmtLen(sf.far_asked_from_film_mm)}` + (sf.holds ? "" : ` (f/${num(sf.fstop_given, 1)} holds less)`);
+  }
   const f = d.fov_deg.focus, i = d.fov_deg.infinity;
   $("out-fov").textContent = `${deg(f.horizontal)} / ${deg(f.vertical)} / ${deg(f.diagonal)}`;
   $("out-fov-inf").textContent = `${deg(i.horizontal)} / ${deg(i.vertical)} / ${deg(i.diagonal)}`;
-  const m = d.magnification;
-  $("out-mag").textContent = `1 : ${(1 / m).toFixed(1)}  (${m.toFixed(4)}×)`;
+  const m = d.magnification; // signed: negative is the inverted image on the film
+  $("out-mag").textContent = m === 0 ? "0 (subject at infinity)"
+    : `1 : ${(1 / Math.abs(m)).toFixed(1)}  (${m.toFixed(4)}×, inverted image)`;
   const p = d.entrance_pupil_from_film_mm;
   const inches = st.units === "imperial" && p !== null ? ` (${(p / 25.4).toFixed(2)} in)` : "";
   $("out-pupil").textContent = p === null ? "unknown: the report needs a datasheet pupil"
@@ -209,7 +226,7 @@ function render(d) {
 
 function chart(api) {
   const img = $("dof-chart");
-  const src = `/api/dof.svg?${api}${st.units === "imperial" ? "&units=ft" : ""}`;
+  const src = `/api/dof.svg?${api}`; // (the units ride on the api's parameters)
   if (img.getAttribute("src") !== src) {
     img.hidden = false;
     img.setAttribute("src", src);
@@ -321,7 +338,7 @@ function diagram(d) {
     return;
   }
   sec.hidden = false;
-  const q = new URLSearchParams({ focus: String(d.focus_from_film_mm), fstop: String(d.fstop) });
+  const q = new URLSearchParams({ focus: `${d.focus_from_film_mm}mm`, fstop: String(d.fstop) });
   if (st.units === "imperial") q.set("units", "ft");
   const src = `/api/lens/${encodeURIComponent(val("lens"))}/diagram.svg?${q}`;
   const img = $("diagram");
@@ -393,15 +410,15 @@ function setUnits(units, convert) {
     // a bare number keeps meaning what it meant: 3 (metres) becomes 3m before the switch
     for (const id of ["focus", "near", "far"]) {
       const el = $(id);
-      if (BARE.test(el.value)) el.value = withUnit(el.value);
+      el.value = bareAsWritten(el.value);
     }
   }
   st.units = units;
   press(["units-metric", "units-imperial"], `units-${units}`);
   $("unit-hint").textContent = units === "imperial"
-    ? "A bare number is feet; 10ft, 10'6\", 6in, 3m are read as written."
-    : "A bare number is metres; 3m, 450mm, 10ft, 10'6\" are read as written.";
-  $("focus").placeholder = units === "imperial" ? "10 · 10'6\" · 3m" : "3 · 3m · 10ft · 10'6\"";
+    ? "A bare number is feet (as on the command line with --units ft); 10'6\", 6in, 3m are read as written."
+    : "A bare number is millimetres (as on the command line): write 3m for three metres; 10ft, 10'6\" too.";
+  $("focus").placeholder = units === "imperial" ? "10 · 10'6\" · 3m" : "3m · 10ft · 10'6\"";
 }
 
 function setCoc(value) {
@@ -430,8 +447,10 @@ function fillLenses(lenses, wanted) {
   }
 }
 
-function applyState(q) {
-  setUnits(q.get("units") === "imperial" ? "imperial" : "metric", false);
+function applyState(q, serverUnits) {
+  // the address's units, else the server's (the user config's units = "ft" starts the page in feet)
+  const u = q.get("units") || (serverUnits === "ft" ? "imperial" : "metric");
+  setUnits(u === "imperial" || u === "ft" ? "imperial" : "metric", false);
   setSolve(["fstop", "focus"].includes(q.get("solve")) ? q.get("solve") : "dof");
   const empty = ![...q.keys()].length;
   setLensMode(q.has("lens") ? "library" : "focal");
@@ -511,14 +530,16 @@ async function start() {
   } catch (e) { /* private mode */ }
   wire();
   const q = new URLSearchParams(location.search);
+  let serverUnits = "m";
   try {
     const r = await fetch("/api/sensors");
     SENSORS = await r.json();
+    serverUnits = (await (await fetch("/api/health")).json()).units || "m";
   } catch (e) {
     showMessage("the physcam server cannot be reached; is it still running?");
     return;
   }
-  applyState(q);
+  applyState(q, serverUnits);
   const lensesLoaded = fetch("/api/lenses").then((r) => r.json()).then((l) => fillLenses(l, q.get("lens")))
     .catch(() => {});
   if (st.lensmode === "library") await lensesLoaded;
