@@ -58,21 +58,26 @@ def test_default_bokeh_stays_in_numpy_and_a_large_one_loads_numba():
     assert p.stdout.split() == ["False", "True"]
 
 
-def test_vendor_mtf_chart_stays_in_numpy_and_a_second_one_loads_numba():
-    # a chart's pupils (15 fields x 3 wavelengths, about 5e5 rays) cost the numpy kernel less than
-    # loading numba; a process that draws a second chart has spent that much and loads it
+def test_vendor_mtf_chart_stays_in_numpy_and_a_process_of_charts_loads_numba():
+    # a chart's pupils (15 fields x 3 wavelengths, about 5e5 rays; dgauss_50mm has no dispersion, so a
+    # third of them traced: issue 47) cost the numpy kernel less than loading numba; a process that keeps
+    # drawing charts loads it once its numpy work has reached that cost (by the fourth or fifth chart)
     _warm_jit(["mtf", "--lens", "dgauss_50mm", "--fstop", "8", "--field", "5", "--pupil-samples", "32", "--json"])
     code = ("import sys, io, contextlib\nfrom physcam.cli import main\n"
             "argv = ['mtf', '--lens', 'dgauss_50mm', '--fstop', '4', '--focus', '3m', '--sensor', 'FF', '--json']\n"
             "with contextlib.redirect_stdout(io.StringIO()):\n"
             "    assert main(argv) == 0\n"
             "a = sorted({'numba', 'scipy', 'matplotlib', 'numpy.ma'} & set(sys.modules))\n"
-            "with contextlib.redirect_stdout(io.StringIO()):\n"
-            "    assert main(argv) == 0\n"
-            "print(a, 'numba' in sys.modules)")
+            "charts = 1\n"
+            "while 'numba' not in sys.modules and charts < 6:\n"
+            "    with contextlib.redirect_stdout(io.StringIO()):\n"
+            "        assert main(argv) == 0\n"
+            "    charts += 1\n"
+            "print(a, 'numba' in sys.modules, charts)")
     p = _run(code)
     assert p.returncode == 0, p.stderr
-    assert p.stdout.split() == ["[]", "True"]
+    imported, loaded, charts = p.stdout.split()
+    assert imported == "[]" and loaded == "True" and 2 <= int(charts) <= 5
 
 
 def test_the_program_exits_cleanly_after_numba_was_loaded(tmp_path):

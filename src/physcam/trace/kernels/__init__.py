@@ -71,6 +71,7 @@ _numba_error: str | None = None
 _numpy_spent = 0.0
 _load_seen = (-1.0, False)  # (monotonic time of the last look, busy then)
 _threads_set: int | None = None
+_threads_default: int | None = None
 
 
 def set_threads(n: int | None) -> None:
@@ -85,12 +86,15 @@ def threads() -> int:
     """Threads the JIT kernel uses for a large batch (:func:`set_threads`)."""
     if _threads_set is not None:
         return _threads_set
-    try:
-        import numba
+    global _threads_default
+    if _threads_default is None:
+        try:
+            import numba
 
-        return max(1, int(numba.config.NUMBA_NUM_THREADS))
-    except (ImportError, AttributeError):
-        return os.cpu_count() or 1
+            _threads_default = max(1, int(numba.config.NUMBA_NUM_THREADS))
+        except (ImportError, AttributeError):
+            _threads_default = os.cpu_count() or 1
+    return _threads_default
 
 
 def set_compile_reporter(fn) -> None:
@@ -141,7 +145,8 @@ class _JitKernel:
 
         self._K = _numba
         self._no_opl = np.empty(0)
-        self._ready: set = set()
+        self._variants: dict = {}  # (features, ray and table dtypes) -> the variant, compiled or loaded for them
+        self._asphere: dict = {}  # kinds' bytes -> whether they hold an even asphere
         self._pool = None
 
     def __call__(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
@@ -155,17 +160,27 @@ class _JitKernel:
         """Trace in place; below ``serial_below`` rays on the calling thread alone (the signature of
         the one parallel kernel this replaces: an empty ``opl`` is no optical path)."""
         with_opl = opl is not None and opl.shape[0] > 0
-        key = (bool(mono), with_opl, bool(fresnel), bool(kinds.shape[0] and kinds.max() >= 3))
-        f = self._K.variant(*key)
-        o = opl if with_opl else self._no_opl
-        args = (x, y, z, L, M, N, wl, w, wd, flag, S, kinds, bool(clip), float(end_z), bool(has_end), o)
-        if (key, x.dtype, S.dtype) not in self._ready:
-            self._first_call(f, key, args)
-            self._ready.add((key, x.dtype, S.dtype))
+        kb = kinds.tobytes()  # whether the table holds aspheres, by the kinds' bytes (a few us less than a reduction)
+        asphere = self._asphere.get(kb)
+        if asphere is None:
+            asphere = self._asphere[kb] = bool(kinds.shape[0] and kinds.max() >= 3)
+        key = (bool(mono), with_opl, bool(fresnel), asphere, x.dtype.char, S.dtype.char)
+        f = self._variants.get(key)
+        if f is None:
+            f = self._K.variant(*key[:4])
+        args = (x, y, z, L, M, N, wl, w, wd, flag, S, kinds, bool(clip), float(end_z), bool(has_end),
+                opl if with_opl else self._no_opl)
+        if key not in self._variants:
+            self._first_call(f, key[:4], args)
+            self._variants[key] = f
         n = x.shape[0]
-        nb = (n + self._K.BLOCK - 1) // self._K.BLOCK
+        block = self._K.BLOCK
+        nb = (n + block - 1) // block
+        if n < serial_below or nb < 2:
+            f(*args, 0, nb)
+            return
         k = min(threads(), nb)
-        if n < serial_below or k < 2:
+        if k < 2:
             f(*args, 0, nb)
             return
         if self._pool is None:
