@@ -145,6 +145,10 @@ class LensReport:
     #: the f-number at this focus for the iris set to ``fstop`` at infinity (see f_number_at_focus);
     #: None: ``fstop`` (no focusing changes it)
     fstop_at_focus: float | None = None
+    #: an anamorphic prescription's horizontal (X-meridian) entrance pupil in front of the film, the
+    #: parallax-free pivot of a pan; ``entrance_pupil_from_film_mm`` is then the vertical (Y) one, the
+    #: pivot of a tilt (physcam.optics.focusing.EntrancePupils). None: one pupil for both
+    entrance_pupil_horizontal_from_film_mm: float | None = None
 
     # --- convenience --------------------------------------------------------
     @property
@@ -193,6 +197,18 @@ class LensReport:
         if self.entrance_pupil_from_film_mm is None:
             return None
         return pivot_camera_space(self.entrance_pupil_from_film_mm)
+
+    def entrance_pupils_dict(self) -> dict:
+        """Both meridians' entrance pupils and the pivots they give (equal for a spherical lens)."""
+        v = self.entrance_pupil_from_film_mm
+        h = v if self.entrance_pupil_horizontal_from_film_mm is None else self.entrance_pupil_horizontal_from_film_mm
+        return {"horizontal_from_film_mm": h, "vertical_from_film_mm": v,
+                "separation_mm": None if v is None else h - v,
+                "pan_pivot_camera_space_mm": None if h is None else list(pivot_camera_space(h)),
+                "tilt_pivot_camera_space_mm": None if v is None else list(pivot_camera_space(v)),
+                "definition": "horizontal: the X meridian's paraxial entrance pupil, about which a pan is "
+                              "parallax-free; vertical: the Y meridian's, for a tilt; entrance_pupil_from_film_mm "
+                              "and pivot_camera_space_mm are the vertical one"}
 
     @property
     def desqueezed_width_mm(self) -> float:
@@ -316,6 +332,7 @@ class LensReport:
             "dof_aspect": self.dof_aspect,
             "entrance_pupil_source": self.entrance_pupil_source,
             "pivot_camera_space_mm": None if self.pivot_camera_space_mm is None else list(self.pivot_camera_space_mm),
+            "entrance_pupils": self.entrance_pupils_dict(),
             "solved": dict(self.solved),
             "measured": {k: finite_or_none(v) if isinstance(v, float) else v for k, v in self.measured.items()},
             "notes": list(self.notes),
@@ -367,6 +384,7 @@ def solve_report(request: ReportRequest) -> LensReport:
             h1_film if state.model == "practical" else None),
         dof_aspect=dof.blur_aspect, diffraction_wavelength_nm=req.diffraction_wavelength_nm,
         bellows_factor=state.bellows, fstop_at_focus=None if state.n_ratio == 1.0 else n_focus,
+        entrance_pupil_horizontal_from_film_mm=state.pupil_x_from_film_mm if pupil_src == "prescription" else None,
         **field_of_view(req, state, h2_film))
     report = dataclasses.replace(report, notes=report.notes + (report.diffraction_note(),))
     if req.lens is not None:

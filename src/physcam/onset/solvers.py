@@ -124,6 +124,9 @@ class LensState(NamedTuple):  # a NamedTuple: made at every report, cheap to def
     squeeze_from_lens: bool = False
     pupil_origin: str = "datasheet"
     notes: tuple[str, ...] = ()
+    #: an anamorphic prescription's X-meridian (horizontal, pan) entrance pupil in front of the film;
+    #: ``pupil_from_film_mm`` is then the Y meridian's (vertical, tilt). None: one pupil for both
+    pupil_x_from_film_mm: float | None = None
     #: a prescription's EFL at infinity focus, (Y, X) mm: the field of view at infinity (None: the
     #: focal length, which a thin lens or a datasheet keeps at every focus)
     efl_infinity: tuple[float, float] | None = None
@@ -177,7 +180,13 @@ def _anamorphic_state(lens, state: LensState, planes, notes: list) -> LensState:
     st = focusing.focus(lens, state.focus_mm)
     gx = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z)
     lens_squeeze = planes.efl_mm / gx.efl
-    state = state._replace(lens_squeeze=lens_squeeze, blur_aspect=focusing.pupil_aspect(lens, state.focus_mm))
+    state = state._replace(lens_squeeze=lens_squeeze, blur_aspect=focusing.pupil_aspect(lens, state.focus_mm),
+                           pupil_x_from_film_mm=gx.in_front_of("entrance_pupil"))
+    if abs(state.pupil_x_from_film_mm - state.pupil_from_film_mm) > 0.05:
+        notes.append(f"anamorphic: two entrance pupils, horizontal (X, the pan pivot) "
+                     f"{state.pupil_x_from_film_mm:.1f} mm and vertical (Y, the tilt pivot) "
+                     f"{state.pupil_from_film_mm:.1f} mm in front of the film; the report's entrance pupil is "
+                     "the vertical one")
     if state.squeeze != 1.0:
         return state
     notes.append(f"anamorphic: EFL {planes.efl_mm:.3f} mm (Y) and {gx.efl:.3f} mm (X), effective squeeze "
