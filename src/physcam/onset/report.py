@@ -305,6 +305,7 @@ class LensReport:
             "flange_focal_distance_mm": self.flange_focal_distance_mm,
             "focus_error_mm": self.focus_error_mm,
             "magnification": self.magnification,
+            "frame_at_focus": _frame_dict(self),
             "dof": self.dof.to_dict(),
             "dof_horizontal": None if self.dof_horizontal is None else self.dof_horizontal.to_dict(),
             "split_focus": self.split_focus,
@@ -338,6 +339,17 @@ class LensReport:
             "notes": list(self.notes),
             "diffraction": self.diffraction_dict(),
         }
+
+
+def _frame_dict(report) -> dict | None:
+    """The picture's (desqueezed) width and height in the plane of sharp focus, the gate over |m|
+    (physcam.onset.framing), or None focused at infinity."""
+    m = report.magnification
+    if m == 0.0 or math.isinf(report.object_distance_mm):
+        return None
+    w, h = report.sensor.width_mm * report.squeeze / abs(m), report.sensor.height_mm / abs(m)
+    return {"width_mm": w, "height_mm": h, "diagonal_mm": math.hypot(w, h),
+            "distance_from_h1_mm": report.object_distance_mm}
 
 
 # --------------------------------------------------------------------------------------

@@ -48,6 +48,9 @@ def report_rows(report, units: str = "m", *, notes: bool = True) -> list[tuple[s
         add("focus error", f"{d['focus_error_mm']:+.3f} mm (+ = image in front of film)", "film plane")
     m = d["magnification"]
     add("magnification", f"{m:.5f}  (1:{1 / abs(m):.1f}, inverted image)" if m else "0  (subject at infinity)", "")
+    fr = d["frame_at_focus"]
+    if fr is not None:
+        add("frame at the focus (w x h)", f"{_len(fr['width_mm'])} x {_len(fr['height_mm'])}", "subject plane")
     dof = d["dof"]
     add("hyperfocal", _len(dof["hyperfocal_from_film_mm"]), "film plane")
     add("near limit", _len(dof["near_from_film_mm"]), "film plane")
