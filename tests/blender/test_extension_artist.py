@@ -6,7 +6,6 @@ switched off, and Blender prints no dependency cycle."""
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np

@@ -181,7 +181,9 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
             loss = _centre_norm(q, st.film_z, b, fresnel=True) / _centre_norm(q, st.film_z, b)
     if not all(min(v) > 0 for v in norm):
         raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some focus")
-    arr = (lambda v: np.array(v) if v else None)
+    def arr(v):
+        return np.array(v) if v else None
+
     return FocusTable(lens, marks, step, np.array(film_z), np.array(vz), arr(radial), arr(rects), arr(stopped),
                       np.array(norm), table0, bounds0, float(k), float(n_open), float(n_min), float(near), float(loss))
 
