@@ -157,14 +157,14 @@ def unbroken(text: str) -> str:
     return str(text).replace(" ", NO_BREAK)
 
 
-def fit_title(text: str, width_in: float, *, fontsize: float | None = None) -> str:
+def fit_title(text: str, width_in: float, *, fontsize: float | None = None, weight: str = "normal") -> str:
     """``text`` wrapped at word boundaries so that each line, set in the style's font at ``fontsize``
-    points (default the title size), is at most ``width_in`` inches wide (measured by matplotlib);
-    never at a :data:`NO_BREAK` space (see :func:`unbroken`), which comes out as a plain space."""
+    points (default the title size) and ``weight``, is at most ``width_in`` inches wide (measured by
+    matplotlib); never at a :data:`NO_BREAK` space (see :func:`unbroken`), which comes out as a plain space."""
     from matplotlib.font_manager import FontProperties
     from matplotlib.textpath import text_to_path
 
-    prop = FontProperties(family=STYLE["font.sans-serif"], size=fontsize or STYLE["axes.titlesize"])
+    prop = FontProperties(family=STYLE["font.sans-serif"], size=fontsize or STYLE["axes.titlesize"], weight=weight)
     limit = width_in * 72.0
 
     def width(s: str) -> float:
