@@ -152,7 +152,7 @@ def test_an_aps_c_camera_is_in_the_table():
 
 KINDS = ("maker's figure, quoted: http", "maker document, read through a third party: http", "third-party only: ")
 #: the maker's web domains (a "maker document" row must point at its own maker's site)
-DOMAINS = {"Sony": ("sony",), "ARRI": ("arri.com",), "RED": ("red.com",), "Canon": ("canon",),
+DOMAINS = {"Sony": ("sony",), "ARRI": ("arri.com", "arrirental.com"), "RED": ("red.com",), "Canon": ("canon",),
            "Blackmagic": ("blackmagicdesign.com",), "Panasonic": ("panasonic",), "Fujifilm": ("fujifilm",)}
 
 
@@ -221,3 +221,72 @@ def test_makers_quoted_photosites_times_pitch_give_their_quoted_size():
         s = find_sensor(name)
         assert across * s.pitch_um / 1000 == pytest.approx(w, abs=0.01), name
         assert down * s.pitch_um / 1000 == pytest.approx(h, abs=tol), name
+
+
+EMBER_ISSUES = "github.com/EmberLightVFX/Camera-Sensor-Database/issues/"
+#: (format, width, height, decimals printed, the maker document, what its transcription prints): the sizes below are the
+#: maker documents' figures as the submissions to the EmberLightVFX database transcribe them (read 2026-11-28)
+MAKER_DOCUMENT_FIGURES = [
+    ("RED KOMODO 6K 6K 17:9", 27.03, 14.26, 2, "docs.red.com KOMODO guide, All_Formats", "#36: '6K 17:9 | 6144 x 3240 | 27.03 x 14.26'"),
+    ("RED KOMODO 6K 6K 16:9", 25.34, 14.26, 2, "docs.red.com KOMODO guide, All_Formats", "#36: '6K 16:9 | 5760 x 3240 | 25.34 x 14.26'"),
+    ("RED KOMODO 6K 4K 17:9", 18.02, 9.50, 2, "docs.red.com KOMODO guide, All_Formats", "#36: '4K 17:9 | 4096 x 2160 | 18.02 x 9.50'"),
+    ("RED KOMODO 6K 4K 16:9", 16.90, 9.50, 2, "docs.red.com KOMODO guide, All_Formats", "#36: '4k 16:9 | 3840 x 2160 | 16.90 x 9.50'"),
+    ("RED KOMODO 6K 2K 17:9", 9.01, 4.75, 2, "docs.red.com KOMODO guide, All_Formats", "#36: '2K 17:9 | 2048 x 1080 | 9.01 x 4.75'"),
+    ("RED V-RAPTOR 8K VV 8K 17:9", 40.96, 21.60, 2, "docs.red.com V-RAPTOR guide, VV_8K", "#55: '8K 17:9 | 8192 x 4320 | 40.96 x 21.60'"),
+    ("RED V-RAPTOR 8K VV 6K 17:9", 30.72, 16.20, 2, "docs.red.com V-RAPTOR guide", "#55: '6K 17:9 | 6144 x 3240 | 30.72 x 16.20'"),
+    ("RED V-RAPTOR 8K VV 5K 17:9", 25.60, 13.50, 2, "docs.red.com V-RAPTOR guide, Super35_6K", "#57: '5K 17:9 | 5120 x 2700 | 25.60 x 13.50'"),
+    ("RED V-RAPTOR 8K VV 3K 16:9", 14.40, 8.10, 2, "docs.red.com V-RAPTOR guide, All_Formats", "#59: '3K 16:9 | 2880 x 1620 | 14.40 x 8.10'"),
+    ("RED V-RAPTOR 8K VV 4K 8:1", 20.48, 2.56, 2, "docs.red.com V-RAPTOR guide, All_Formats", "#61: '4K 8:1 | 4096 x 512 | 20.48 x 2.56'"),
+    ("Sony BURANO FF 8.6K 16:9", 35.9, 20.2, 1, "pro.sony BURANO recording poster", "#63: 'FF 8.6K 16:9 | 8632 x 4856 | 35.9 x 20.2'"),
+    ("Sony BURANO FFc 6K 17:9", 33.6, 17.7, 1, "pro.sony BURANO recording poster", "#63: 'FFc 6K 17:9 | 6052 x 3192 | 33.6 x 17.7'"),
+    ("Sony BURANO S35 5.8K 16:9", 24.0, 13.5, 1, "pro.sony BURANO recording poster", "#63: 'S35 5.8K 16:9 | 5760 x 3240 | 24.0 x 13.5'"),
+    ("Sony VENICE 2 6K 6K 17:9 FF", 35.96, 18.96, 2, "sony-cinematography.com frame-line tool", "#75: '6K 17:9 (FF) | 6054 x 3192 | 35.96 x 18.96'"),
+    ("Sony VENICE 2 6K 4K 6:5 S35", 24.33, 20.39, 2, "sony-cinematography.com frame-line tool", "#75: '4K 6:5 (S35) | 4096 x 3432 | 24.33 x 20.39'"),
+    ("Sony VENICE 2 8K 8.2K 17:9 FF", 34.08, 17.97, 2, "sony-cinematography.com frame-line tool", "#79: '8.2K 17:9 (FF) | 8192 x 4320 | 34.08 x 17.97'"),
+    ("Sony VENICE 2 8K 5.8K 6:5 S35", 24.09, 20.19, 2, "sony-cinematography.com frame-line tool", "#79: '5.8K 6:5 (S35) | 5792 x 4854 | 24.09 x 20.19'"),
+    ("Sony FX9 FF 6K 17:9", 35.7, 18.8, 1, "sony-cinematography.com (AbelCine guide)", "#48: 'FF 6K (DCI 4K(17:9)) | 6008 x 3168 | 35.7 x 18.8'"),
+    ("Sony FX9 S35 4K 17:9", 24.3, 12.8, 1, "sony-cinematography.com (AbelCine guide)", "#48: 'S35 4K (DCI 4K(17:9)) | 4096 x 2160 | 24.3 x 12.8'"),
+    ("Blackmagic PYXIS 6K 6K 3:2", 36.0, 24.0, 0, "forum.blackmagicdesign.com t=156200", "#4: '6K 3:2 | 6048 x 4032 | 36 x 24'"),
+    ("Blackmagic PYXIS 6K 4K 6:5", 28.762, 24.0, 2, "forum.blackmagicdesign.com t=156200", "#4: '4K 6:5 | 4832 x 4032 | 28.762 x 24'"),
+    ("Blackmagic Pocket Cinema Camera 6K 6K 16:9", 23.1, 12.99, 2, "forum.blackmagicdesign.com", "#6: '6K 16:9 | 6144 x 3456 | 23.1 x 12.99'"),
+    ("Fujifilm X-H2S 6.2K 3:2", 23.5, 15.6, 1, "fujifilm-x.com X-H2S specifications", "#34: '6.2K 3:2 | 6240 x 4160 | 23.5 x 15.6'"),
+    ("Fujifilm GFX ETERNA 55 8K 16:9", 28.88, 16.24, 2, "dl.fujifilm-x.com GFX ETERNA white paper", "#51: '8K 16:9 | 7680 x 4320 | 28.88 x 16.24'"),
+    ("ARRI ALEXA 265 6.5K 2.12:1 Open Gate", 54.12, 25.58, 2, "arrirental.com ALEXA 265", "#42: '6.5K 2.12:1 Open Gate | 6560 x 3100 | 54.12 x 25.58'"),
+]
+
+
+@pytest.mark.parametrize("name, width, height, decimals, document, quote", MAKER_DOCUMENT_FIGURES,
+                         ids=[m[0] for m in MAKER_DOCUMENT_FIGURES])
+def test_formats_equal_their_maker_documents_figures(name, width, height, decimals, document, quote):
+    """25 formats against the maker documents' figures, to half the last printed digit (the KOMODO's heights were
+    14.25 mm, its 4K 16:9 16.89 mm: photosites x 27.03/6144 um, where RED prints 4.4 um x photosites)."""
+    s = find_sensor(name)
+    tol = 0.5 * 10.0 ** -decimals + 1e-9
+    assert s.width_mm == pytest.approx(width, abs=tol) and s.height_mm == pytest.approx(height, abs=tol), (document, quote)
+    assert s.key.split("-")[0] in s.maker_spec.lower() or document.split()[0] in s.maker_spec, s.maker_spec
+    number = quote[1:].split(":")[0]  # the row names the transcription it was checked against
+    assert EMBER_ISSUES + number in s.maker_spec or (EMBER_ISSUES in s.maker_spec and f"/issues/{number}" in s.maker_spec)
+
+
+def test_alexa_35_open_gate_is_arris_maximum_size_and_diagonal():
+    # ARRI (arri.com ALEXA 35 page, quoted in the EmberLightVFX issue 14): 'Sensor Maximum Size of 27.99 x 19.22 mm',
+    # 'diagonal Ø 33.96 mm'
+    s = find_sensor("ALEXA 35 4.6K 3:2 Open Gate")
+    assert (s.width_mm, s.height_mm) == (27.99, 19.22)
+    assert s.diagonal_mm == pytest.approx(33.96, abs=0.01)
+    assert "arri.com/en/camera-systems/cameras/alexa-35" in s.maker_spec
+
+
+@pytest.mark.parametrize("camera, across, down, width, height, pitch_um", [
+    ("KOMODO 6K", 6144, 3240, 27.03, 14.26, 4.4),     # RED: 6144 x 3240 on 27.03 x 14.26 mm
+    ("V-RAPTOR 8K VV", 8192, 4320, 40.96, 21.60, 5.0),  # RED: 8192 x 4320 on 40.96 x 21.60 mm
+])
+def test_red_formats_are_photosites_at_reds_pitch(camera, across, down, width, height, pitch_um):
+    """Where RED gives both photosites and mm, pitch x photosites = the size within 0.01 mm, and every format of the
+    camera in the table is its photosites at that pitch."""
+    assert across * pitch_um / 1000 == pytest.approx(width, abs=0.01) and down * pitch_um / 1000 == pytest.approx(height, abs=0.01)
+    rows = [r for r in csv.DictReader(TABLE.read_text(encoding="utf-8").splitlines()) if r["camera"] == camera]
+    for r in rows:
+        a, d = int(r["photosites_across"]), int(r["photosites_down"])
+        assert float(r["width_mm"]) == pytest.approx(a * pitch_um / 1000, abs=0.005), r["key"]
+        assert float(r["height_mm"]) == pytest.approx(d * pitch_um / 1000, abs=0.005), r["key"]
