@@ -133,7 +133,7 @@ def test_anamorphic_formats_carry_their_desqueeze():
 
 #: The issue's list of what was missing ("no FX6/FX3/Burano, Komodo, Canon, Blackmagic, Panasonic, ALEXA 265, APS-C;
 #: no recording formats (ALEXA 35 4K 16:9, LF 3.8K UHD, VENICE 6K 17:9 ...)") and its done-when camera/format.
-ISSUE_46_NAMES = ["FX6 FF 4K 17:9", "FX3 FF 4K 17:9", "BURANO FF 8.6K 17:9", "KOMODO 6K 6K 17:9", "EOS C70 S35 DCI 4K 17:9",
+ISSUE_46_NAMES = ["Ronin 4D 6K FF 6K 17:9", "FX6 FF 4K 17:9", "FX3 FF 4K 17:9", "BURANO FF 8.6K 17:9", "KOMODO 6K 6K 17:9", "EOS C70 S35 DCI 4K 17:9",
                   "PYXIS 6K 6K 3:2", "VariCam LT 4K 17:9", "ALEXA 265 6.5K 2.12:1 Open Gate", "X-H2S APS-C",
                   "ALEXA 35 4K 16:9", "ALEXA LF 3.8K LF 16:9 UHD", "VENICE FF 6K 17:9", "Sony FX6 FF 4K 17:9"]
 
@@ -153,7 +153,7 @@ def test_an_aps_c_camera_is_in_the_table():
 KINDS = ("maker's figure, quoted: http", "maker document, read through a third party: http", "third-party only: ")
 #: the maker's web domains (a "maker document" row must point at its own maker's site)
 DOMAINS = {"Sony": ("sony",), "ARRI": ("arri.com", "arrirental.com"), "RED": ("red.com",), "Canon": ("canon",),
-           "Blackmagic": ("blackmagicdesign.com",), "Panasonic": ("panasonic",), "Fujifilm": ("fujifilm",)}
+           "Blackmagic": ("blackmagicdesign.com",), "Panasonic": ("panasonic",), "Fujifilm": ("fujifilm",), "DJI": ("djicdn.com", "dji.com")}
 
 
 def test_every_row_says_whether_its_figure_is_the_makers():
@@ -252,13 +252,17 @@ MAKER_DOCUMENT_FIGURES = [
     ("Fujifilm X-H2S 6.2K 3:2", 23.5, 15.6, 1, "fujifilm-x.com X-H2S specifications", "#34: '6.2K 3:2 | 6240 x 4160 | 23.5 x 15.6'"),
     ("Fujifilm GFX ETERNA 55 8K 16:9", 28.88, 16.24, 2, "dl.fujifilm-x.com GFX ETERNA white paper", "#51: '8K 16:9 | 7680 x 4320 | 28.88 x 16.24'"),
     ("ARRI ALEXA 265 6.5K 2.12:1 Open Gate", 54.12, 25.58, 2, "arrirental.com ALEXA 265", "#42: '6.5K 2.12:1 Open Gate | 6560 x 3100 | 54.12 x 25.58'"),
+    ("DJI Zenmuse X9-8K FF 8K 17:9", 36.0, 19.0, 0, "djicdn.com Ronin 4D spec sheet", "#32: '17:9 Full Frame | 8192 x 4320 | 36 x 19'"),
+    ("DJI Zenmuse X9-8K S35 5.5K 17:9", 24.5, 13.0, 1, "djicdn.com Ronin 4D spec sheet", "#32: '17:9 Super 35 | 5568 x 2952 | 24.5 x 13'"),
+    ("DJI Zenmuse X9-6K FF 6K 17:9", 35.7, 18.8, 1, "djicdn.com Ronin 4D spec sheet", "#26: '17:9 Full Frame | 6008 x 3168 | 35.7 x 18.8'"),
+    ("DJI Zenmuse X9-6K S35 4K 2.39:1", 24.3, 10.2, 1, "djicdn.com Ronin 4D spec sheet", "#26: '2.39:1 Super 35 | 4096 x 1712 | 24.3 x 10.2'"),
 ]
 
 
 @pytest.mark.parametrize("name, width, height, decimals, document, quote", MAKER_DOCUMENT_FIGURES,
                          ids=[m[0] for m in MAKER_DOCUMENT_FIGURES])
 def test_formats_equal_their_maker_documents_figures(name, width, height, decimals, document, quote):
-    """25 formats against the maker documents' figures, to half the last printed digit (the KOMODO's heights were
+    """29 formats against the maker documents' figures, to half the last printed digit (the KOMODO's heights were
     14.25 mm, its 4K 16:9 16.89 mm: photosites x 27.03/6144 um, where RED prints 4.4 um x photosites)."""
     s = find_sensor(name)
     tol = 0.5 * 10.0 ** -decimals + 1e-9

@@ -32,7 +32,7 @@ __all__ = ["Sensor", "sensors", "cameras", "camera_formats", "find_sensor", "fil
            "SENSOR_MAX_ASPECT", "PITCH_RANGE_UM", "MAKERS"]
 
 #: Camera makers in the table (a digital sensor's name starts with its maker); film gates are "film".
-MAKERS = ("ARRI", "RED", "Sony", "Canon", "Blackmagic", "Panasonic", "Fujifilm")
+MAKERS = ("ARRI", "RED", "Sony", "Canon", "Blackmagic", "Panasonic", "Fujifilm", "DJI")
 
 
 @dataclass(frozen=True, slots=True)
