@@ -1,0 +1,464 @@
+"""The depth layers of :func:`physcam.analysis.defocus.defocus`: what each tile sends to each depth
+node, and its blur.
+
+A pixel of inverse depth u lies between depth nodes ``lo`` and ``lo + 1`` and sends the share
+``1 - t`` of its light and coverage to the first, ``t`` to the second (linear in u: the blur grows
+smoothly, no banding). Its **group** is ``lo``. The frame is padded by a margin (the edge pixels
+repeated) so that light comes in from outside the frame as it does in a camera; that light, and the
+**fill** that continues a group behind a nearer one, are kept apart from the picture's own light
+(they are estimates: :func:`physcam.analysis.defocus.defocus` allows them no more light than they
+replace).
+
+The fill of group g: behind a pixel whose group is at least two nodes nearer (a depth edge; a
+surface whose depth varies smoothly needs none), group g is present with the density it has among
+the pixels around that are not nearer than it, in its mean colour there (both per tile, blended
+between tile centres so they vary smoothly): ``rho = S_g / A_g`` and colour ``L_g / S_g``, S_g the
+coverage of group g in a tile, A_g the coverage of groups g and farther, L_g the light of group g.
+A small object (a spot beside a near surface) so continues behind it with little coverage; a
+background around a foreground with coverage 1.
+
+Each (tile, node) pair is blurred with the tile's kernel at that node
+(:meth:`~physcam.analysis.defocus_kernels.KernelCache.tile_kernel`; FFT, or a direct sum for
+kernels up to 7 px): planes ``V`` (the picture's light), ``G`` (margin and fill light), ``A``
+(coverage of group n: its pixels' lower shares and its fill), ``U`` (coverage of group n - 1: its
+pixels' upper shares) and, when the image has an alpha channel, ``A1``, ``U1`` (the same with
+alpha 1, the coverage an opaque picture would have).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Frame", "frame_of", "layer_pairs", "tile_sources", "blur_layer", "fast_len", "convolve"]
+
+
+@dataclass
+class Frame:
+    """The padded picture: colour (h, w, c), coverage ``a`` (h, w), lower node ``lo`` and upper
+    weight ``t`` per pixel, ``inside`` (the picture, not its margin), the margin width, the tile,
+    the display position of pixel (0, 0) and per-tile fill statistics (:func:`fill_stats`)."""
+
+    colour: np.ndarray
+    a: np.ndarray
+    lo: np.ndarray
+    t: np.ndarray
+    inside: np.ndarray
+    margin: int
+    tile: int
+    origin: tuple[float, float]
+    has_alpha: bool
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def tiles(self) -> tuple[int, int]:
+        h, w = self.lo.shape
+        return math.ceil(h / self.tile), math.ceil(w / self.tile)
+
+    def tile_slice(self, ty: int, tx: int):
+        t = self.tile
+        return slice(ty * t, (ty + 1) * t), slice(tx * t, (tx + 1) * t)
+
+
+def frame_of(colour, a, lo, t, margin, tile, origin, has_alpha) -> Frame:
+    """The frame padded by ``margin`` pixels on every side (edge pixels repeated)."""
+    m = int(margin)
+    pad2 = ((m, m), (m, m))
+    h, w = lo.shape
+    inside = np.zeros((h + 2 * m, w + 2 * m), dtype=bool)
+    inside[m:m + h, m:m + w] = True
+    f = Frame(np.pad(colour, pad2 + ((0, 0),), mode="edge"), np.pad(a, pad2, mode="edge"), np.pad(lo, pad2, mode="edge"),
+              np.pad(t, pad2, mode="edge"), inside, m, int(tile), (origin[0] - m, origin[1] - m), has_alpha)
+    f.stats = fill_stats(f)
+    return f
+
+
+def fill_stats(f: Frame) -> dict:
+    """Per tile and group: coverage S, coverage of that group and farther ones A, light L (module notes)."""
+    ny, nx = f.tiles
+    h, w = f.lo.shape
+    ys, xs = np.indices((h, w))
+    tid = (ys // f.tile) * nx + xs // f.tile
+    groups = np.unique(f.lo)
+    gi = np.searchsorted(groups, f.lo)
+    key = (tid * len(groups) + gi).ravel()
+    size = ny * nx * len(groups)
+    S = np.bincount(key, weights=f.a.ravel(), minlength=size).reshape(ny, nx, len(groups))
+    L = np.stack([np.bincount(key, weights=f.colour[..., c].ravel(), minlength=size) for c in range(f.colour.shape[2])],
+                 axis=-1).reshape(ny, nx, len(groups), -1)
+    return {"groups": groups, "S": S, "A": np.cumsum(S, axis=2), "L": L}
+
+
+def layer_pairs(f: Frame) -> dict:
+    """{node: [(ty, tx, fill group present), ...]}: the tiles each depth node receives light or a fill in."""
+    st = f.stats
+    groups, S = st["groups"], st["S"]
+    ny, nx = f.tiles
+    pairs: dict = {}
+    present = S > 0
+    near = np.zeros_like(present)  # the tile or a neighbour holds the group
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            src = present[max(dy, 0):ny + min(dy, 0), max(dx, 0):nx + min(dx, 0)]
+            near[max(-dy, 0):ny + min(-dy, 0), max(-dx, 0):nx + min(-dx, 0)] |= src
+    for ty in range(ny):
+        for tx in range(nx):
+            sl = f.tile_slice(ty, tx)
+            if not f.inside[sl].any():  # the margin sends nothing (light leaving the frame is folded back)
+                continue
+            lo, t = f.lo[sl], f.t[sl]
+            nodes = set(np.unique(lo[t < 1]).tolist()) | set((np.unique(lo[t > 0]) + 1).tolist())
+            top = int(lo.max())
+            fills = {int(g) for i, g in enumerate(groups) if near[ty, tx, i] and g + 2 <= top}
+            for n in nodes | fills:
+                pairs.setdefault(int(n), []).append((ty, tx, int(n) in fills))
+    return pairs
+
+
+def _tile_weights(n_tiles: int, tile: int, index: int, length: int) -> np.ndarray:
+    """(length, 3): each pixel's linear weights on the centres of tiles index - 1, index, index + 1."""
+    pos = (index * tile + np.arange(length) + 0.5) / tile - 0.5  # in tile-centre units
+    w = np.zeros((length, 3))
+    for k, j in enumerate((index - 1, index, index + 1)):
+        if 0 <= j < n_tiles:
+            w[:, k] = np.clip(1.0 - np.abs(pos - j), 0.0, 1.0)
+    ends = (pos < 0) & (index == 0), (pos > n_tiles - 1) & (index == n_tiles - 1)
+    w[ends[0], 1] = 1.0
+    w[ends[1], 1] = 1.0
+    return w
+
+
+def _fill(f: Frame, ty: int, tx: int, g: int, sl):
+    """Group g's density (h, w) and light per unit of coverage (h, w, c) behind the pixels of tile
+    (ty, tx) at least two nodes nearer than it, and those pixels (module notes); None if there are none."""
+    st = f.stats
+    gi = int(np.searchsorted(st["groups"], g))
+    ny, nx = f.tiles
+    lo = f.lo[sl]
+    hole = lo >= g + 2
+    if not hole.any():
+        return None
+    ys, xs = slice(max(ty - 1, 0), ty + 2), slice(max(tx - 1, 0), tx + 2)
+    wy = _tile_weights(ny, f.tile, ty, lo.shape[0])[:, (0 if ty > 0 else 1):(3 if ty < ny - 1 else 2)]
+    wx = _tile_weights(nx, f.tile, tx, lo.shape[1])[:, (0 if tx > 0 else 1):(3 if tx < nx - 1 else 2)]
+    S, A, L = st["S"][ys, xs, gi], st["A"][ys, xs, gi], st["L"][ys, xs, gi]
+    a = wy @ A @ wx.T
+    with np.errstate(invalid="ignore", divide="ignore"):
+        inv = np.where(a > 0, 1.0 / np.where(a > 0, a, 1.0), 0.0)
+    rho = (wy @ S @ wx.T) * inv
+    light = np.stack([(wy @ L[..., c] @ wx.T) * inv for c in range(L.shape[-1])], axis=-1)
+    return rho, light, hole
+
+
+#: a node whose kernels reach more than this many pixels is blurred at a lower resolution (module notes)
+LOW_RES_RADIUS = 4
+#: the fewest low-resolution pixels a side of the tiles a node is blurred in
+MIN_CORNER_STEP = 16
+#: kernels up to this radius (low-resolution px) are applied by a direct sum, larger ones by FFT
+DIRECT_RADIUS = 2
+#: tiles blurred in one batch of FFTs
+_BATCH = 16
+
+
+def _scale(radius: int, tile: int) -> int:
+    """The resolution divisor of a node whose largest kernel has ``radius`` px: a power of two
+    bringing the radius down to about :data:`LOW_RES_RADIUS`, at most the tile."""
+    s = 1
+    while radius / s > LOW_RES_RADIUS and 2 * s <= tile:
+        s *= 2
+    return s
+
+
+def _sources(f: Frame, n: int, tiles, box, s: int) -> dict:
+    """The planes node n receives (module notes) over ``box`` (y0, y1, x0, x1 of the padded frame,
+    multiples of s), summed over s x s blocks: V, G (h, w, c) light (before the transmission), A, U
+    coverage, and A1, U1 with alpha; G is left out when nothing comes from the margin or a fill."""
+    y0, y1, x0, x1 = box
+    c, t = f.colour.shape[2], f.tile
+    names = ["A", "U"] + (["A1", "U1"] if f.has_alpha else [])
+    shape = ((y1 - y0) // s, (x1 - x0) // s)
+    out = {"V": np.zeros(shape + (c,), np.float32)}
+    out.update({k: np.zeros(shape, np.float32) for k in names})
+    for ty, tx, fill in tiles:
+        sl = f.tile_slice(ty, tx)
+        lo, tt, a = f.lo[sl], f.t[sl], f.a[sl]
+        share_lo = np.where(lo == n, 1.0 - tt, 0.0).astype(np.float32)
+        share_up = np.where(lo == n - 1, tt, 0.0).astype(np.float32)
+        ins = f.inside[sl]
+        if not ins.all():  # the margin sends nothing: light leaving the frame is folded back (module notes)
+            share_lo, share_up = share_lo * ins, share_up * ins
+        planes = {"V": (share_lo + share_up)[..., None] * f.colour[sl], "A": share_lo * a, "U": share_up * a}
+        if f.has_alpha:
+            planes["A1"], planes["U1"] = share_lo, share_up
+        got = _fill(f, ty, tx, n, sl) if fill else None
+        if got is not None:
+            rho, fl, hole = got
+            behind = np.where(hole & ins, a, 0.0)  # the fill lies behind the nearer pixels' coverage
+            planes["G"] = planes.get("G", 0.0) + behind[..., None] * fl
+            planes["A"] = planes["A"] + behind * rho
+            if f.has_alpha:
+                planes["A1"] = planes["A1"] + (hole & ins) * rho
+        dst = (slice((sl[0].start - y0) // s, (sl[0].start - y0 + t) // s),
+               slice((sl[1].start - x0) // s, (sl[1].start - x0 + t) // s))
+        for k, v in planes.items():
+            if k == "G" and k not in out:
+                out["G"] = np.zeros_like(out["V"])
+            out[k][dst] += _block_sum(_full_tile(v, t), s)
+    return out
+
+
+def _full_tile(v: np.ndarray, t: int) -> np.ndarray:
+    """A tile's plane padded with zeros to t x t (the frame's last row and column of tiles)."""
+    if v.shape[0] == t and v.shape[1] == t:
+        return v
+    out = np.zeros((t, t) + v.shape[2:], np.float32)
+    out[:v.shape[0], :v.shape[1]] = v
+    return out
+
+
+def _block_sum(a: np.ndarray, s: int) -> np.ndarray:
+    """Sums over s x s blocks (the first two axes; their lengths are multiples of s)."""
+    if s == 1:
+        return a
+    h, w = a.shape[:2]
+    return a.reshape((h // s, s, w // s, s) + a.shape[2:]).sum(axis=(1, 3))
+
+
+def _kernel_at_scale(k: np.ndarray, s: int) -> np.ndarray:
+    """A kernel (unit sum per channel) for a grid s times coarser, centred as the original: each
+    coarse pixel sums the pixels within s/2 of its centre, halving those on the boundary."""
+    if s == 1:
+        return k
+    r = k.shape[0] // 2
+    R = -(-r // s)
+    pad = np.pad(k, ((R * s - r + s // 2, R * s - r + s // 2),) * 2 + ((0, 0),))
+    w = np.ones(s + 1)
+    w[0] = w[-1] = 0.5
+    n = 2 * R + 1
+    rows = np.stack([np.tensordot(w, pad[i * s: i * s + s + 1], axes=(0, 0)) for i in range(n)])
+    return np.stack([np.tensordot(w, rows[:, j * s: j * s + s + 1], axes=(0, 1)) for j in range(n)], axis=1)
+
+
+def blur_layer(f: Frame, cache, n: int, tiles) -> dict | None:
+    """Node n blurred (module notes): its sources summed into s x s blocks (s from its kernels'
+    size: a large blur needs no full resolution), times the transmission, split among the corners
+    of a grid of s * tile pixels (bilinear weights), each corner's part convolved with the kernel
+    at that corner, so every pixel's kernel is the bilinear blend of its four corners' and changes
+    smoothly (no seams at tile borders); then back to full resolution (bilinear, light kept).
+    Returns the planes over a box of the padded frame, the box and the largest kernel radius; None
+    if the node receives nothing."""
+    if not tiles:
+        return None
+    t, (H, W) = f.tile, f.lo.shape
+    s = _scale(_radius(f, cache, n, tiles), t)
+    step = max(t // s, MIN_CORNER_STEP)  # low-res pixels per tile
+    S = s * step
+    y0 = min(ty for ty, _, _ in tiles) * t // S * S
+    x0 = min(tx for _, tx, _ in tiles) * t // S * S
+    y1 = -(-(max(ty for ty, _, _ in tiles) + 1) * t // S) * S
+    x1 = -(-(max(tx for _, tx, _ in tiles) + 1) * t // S) * S
+    low = _sources(f, n, tiles, (y0, y1, x0, x1), s)
+    T = _transmission_blocks(f, cache, n, y0, x0, low["A"].shape, s)
+    low["V"] = low["V"] * T
+    if "G" in low:
+        low["G"] = low["G"] * T
+    out, r = _corners(f, cache, n, low, s, step, (y0, x0))
+    return _to_full(out, s, (y0, x0), r, H, W)
+
+
+def _radius(f: Frame, cache, n: int, tiles) -> int:
+    """The largest kernel radius (px) among the corners of node n's tiles."""
+    t = f.tile
+    corners = {(ty + dy, tx + dx) for ty, tx, _ in tiles for dy in (0, 1) for dx in (0, 1)}
+    return max(cache.tile_kernel(f.origin[0] + cx * t, f.origin[1] + cy * t, n).shape[0] // 2 for cy, cx in corners)
+
+
+def _transmission_blocks(f: Frame, cache, n: int, y0: int, x0: int, shape, s: int) -> np.ndarray:
+    """T at the centres of the s x s blocks of a box at (y0, x0) of the padded frame: (h, w, channels)."""
+    h, w = shape
+    ys = f.origin[1] + y0 + (np.arange(h) + 0.5) * s
+    xs = f.origin[0] + x0 + (np.arange(w) + 0.5) * s
+    yy, xx = np.meshgrid(ys, xs, indexing="ij")
+    return cache.transmission(xx, yy, n)
+
+
+def _corners(f: Frame, cache, n: int, low: dict, s: int, t: int, origin):
+    """The low-resolution planes blurred tile by tile (tiles of ``t`` low-res pixels), each pixel
+    with the bilinear blend of its tile's four corner kernels, to first order: ``K = Kc + xi Kx +
+    eta Ky`` (xi, eta in -1/2..1/2 across the tile; the twist term, second order, left out), so a
+    tile is three convolutions (of the planes, xi times them and eta times them), summed in the
+    Fourier domain; one where its corners' kernels agree within :data:`SAME_KERNEL`. Neighbouring
+    tiles share their corners: the kernel is continuous across tile borders (no seams). Returns
+    the blurred planes over the box grown by the largest kernel radius r, and r."""
+    h, w = low["A"].shape
+    c = f.colour.shape[2]
+    cover = [k for k in ("A", "U", "A1", "U1") if k in low]
+    light = np.moveaxis(low["V"], 2, 0)
+    g = np.moveaxis(low["G"], 2, 0) if "G" in low else None
+    cov = np.stack([low[k] for k in cover])
+    kern, groups = {}, {}
+    for ty in range(h // t):
+        for tx in range(w // t):
+            sl = (slice(None), slice(ty * t, (ty + 1) * t), slice(tx * t, (tx + 1) * t))
+            if not (cov[sl].any() or light[sl].any() or (g is not None and g[sl].any())):
+                continue
+            for cy, cx in ((ty, tx), (ty, tx + 1), (ty + 1, tx), (ty + 1, tx + 1)):
+                if (cy, cx) not in kern:
+                    pos = (f.origin[0] + origin[1] + cx * t * s, f.origin[1] + origin[0] + cy * t * s)
+                    kern[(cy, cx)] = cache.scaled_kernel(pos[0], pos[1], n, s, _kernel_at_scale)
+            key = (g is not None and bool(g[sl].any()), _varies(kern, ty, tx))
+            groups.setdefault(key, []).append((ty, tx))
+    r = max(k.shape[0] for k in kern.values()) // 2
+    kern = {key: _pad_kernel(k, r) for key, k in kern.items()}
+    out = {"V": np.zeros((c, h + 2 * r, w + 2 * r), np.float32),
+           "cov": np.zeros((len(cover), h + 2 * r, w + 2 * r), np.float32)}
+    if g is not None:
+        out["G"] = np.zeros_like(out["V"])
+    for (with_g, varies), tiles in groups.items():
+        names = ["V"] + (["G"] if with_g else []) + cover
+        stack = np.concatenate([light] + ([g] if with_g else []) + [cov], axis=0)
+        for b in range(0, len(tiles), _BATCH):
+            res = _blur_tiles(stack, tiles[b:b + _BATCH], kern, t, r, names, c, varies)
+            for i, (ty, tx) in enumerate(tiles[b:b + _BATCH]):
+                box = (slice(ty * t, ty * t + t + 2 * r), slice(tx * t, tx * t + t + 2 * r))
+                out["V"][(slice(None),) + box] += res[i, :c]
+                if with_g:
+                    out["G"][(slice(None),) + box] += res[i, c:2 * c]
+                out["cov"][(slice(None),) + box] += res[i, -len(cover):]
+    planes = {k: np.moveaxis(np.maximum(out[k], 0.0), 0, 2) for k in ("V", "G") if k in out}
+    for i, k in enumerate(cover):
+        planes[k] = np.maximum(out["cov"][i], 0.0)
+    return planes, r
+
+
+#: a tile whose corner kernels differ by less than this (sum of absolute differences) is blurred
+#: with their mean alone
+SAME_KERNEL = 2e-3
+
+
+def _varies(kern: dict, ty: int, tx: int) -> bool:
+    """Whether tile (ty, tx)'s corner kernels differ (:data:`SAME_KERNEL`)."""
+    ks = [kern[(ty, tx)], kern[(ty, tx + 1)], kern[(ty + 1, tx)], kern[(ty + 1, tx + 1)]]
+    if len({k.shape for k in ks}) > 1:
+        return True
+    return any(float(np.abs(k - ks[0]).sum()) > SAME_KERNEL * k.shape[2] for k in ks[1:])
+
+
+def _blur_tiles(stack, tiles, kern, t, r, names, c, varies) -> np.ndarray:
+    """(tiles, planes, t + 2r, t + 2r): the tiles of ``stack`` blurred (:func:`_corners`)."""
+    ramp = ((np.arange(t) + 0.5) / t - 0.5).astype(np.float32)
+    blocks = np.stack([stack[:, ty * t:(ty + 1) * t, tx * t:(tx + 1) * t] for ty, tx in tiles])  # (k, P, t, t)
+    kb = np.stack([_terms(kern, ty, tx, r) for ty, tx in tiles])  # (k, 3, channels, n, n)
+    if varies:
+        bx = blocks * ramp[None, None, None, :]
+        terms = np.stack([blocks, bx, blocks * ramp[None, None, :, None], bx * ramp[None, None, :, None]], axis=1)
+    else:
+        terms, kb = blocks[:, None], kb[:, :1]
+    plane_of = _kernel_index(names, c, kb.shape[2])
+    if r <= DIRECT_RADIUS:
+        return np.stack([sum(convolve(terms[i, j], kb[i, j][plane_of]) for j in range(terms.shape[1]))
+                         for i in range(len(tiles))])
+    size = fast_len(t + 2 * r)
+    spec = np.fft.rfft2(terms, s=(size, size))
+    spec *= np.fft.rfft2(kb, s=(size, size))[:, :, plane_of]
+    return np.fft.irfft2(spec.sum(axis=1), s=(size, size))[..., :t + 2 * r, :t + 2 * r]
+
+
+def _terms(kern: dict, ty: int, tx: int, r: int) -> np.ndarray:
+    """(4, channels, 2r + 1, 2r + 1): the kernels Kc, Kx, Ky, Kxy of tile (ty, tx) (see :func:`_corners`)."""
+    k00, k01, k10, k11 = kern[(ty, tx)], kern[(ty, tx + 1)], kern[(ty + 1, tx)], kern[(ty + 1, tx + 1)]
+    kc = 0.25 * (k00 + k01 + k10 + k11)
+    kx = 0.5 * (k01 + k11 - k00 - k10)
+    ky = 0.5 * (k10 + k11 - k00 - k01)
+    kxy = k00 + k11 - k01 - k10
+    return np.moveaxis(np.stack([kc, kx, ky, kxy]), 3, 1).astype(np.float32)
+
+
+def _kernel_index(names, c: int, channels: int) -> np.ndarray:
+    """For each plane of ``names``, the kernel channel it is blurred with: its own for light (the
+    middle one beyond the kernel's channels, or for a mono image), the middle one for coverage."""
+    mid = channels // 2
+    own = [i if c >= channels > 1 and i < channels else mid for i in range(c)]
+    out = []
+    for name in names:
+        out += own if name in ("V", "G") else [mid]
+    return np.array(out)
+
+
+def _pad_kernel(k: np.ndarray, r: int) -> np.ndarray:
+    p = r - k.shape[0] // 2
+    return np.pad(k, ((p, p), (p, p), (0, 0))) if p else k
+
+
+def _to_full(planes: dict, s: int, origin, r: int, H: int, W: int) -> dict:
+    """Low-resolution blurred planes back on the padded frame (bilinear; each block's light kept),
+    cut to the frame: the planes, their box and the kernel radius in full-resolution pixels."""
+    y0, x0 = origin
+    if s > 1:
+        planes = {k: _upsample(v, s) for k, v in planes.items()}
+    R = r * s
+    h, w = planes["A"].shape
+    oy, ox = y0 - R, x0 - R
+    ya, xa, yb, xb = max(oy, 0), max(ox, 0), min(oy + h, H), min(ox + w, W)
+    lay = {k: v[ya - oy:yb - oy, xa - ox:xb - ox] for k, v in planes.items()}
+    lay.setdefault("G", None)
+    lay["box"] = (slice(ya, yb), slice(xa, xb))
+    lay["radius"] = R
+    return lay
+
+
+def _upsample(a: np.ndarray, s: int) -> np.ndarray:
+    """(h, w, ...) values per s x s block to (h s, w s, ...) values per pixel: bilinear between block
+    centres (clamped at the ends), divided by s^2, so that each block's sum is kept."""
+    def axis(n):
+        pos = (np.arange(n * s) + 0.5) / s - 0.5
+        i = np.clip(np.floor(pos).astype(np.int64), 0, n - 1)
+        j = np.clip(i + 1, 0, n - 1)
+        wj = np.clip(pos - i, 0.0, 1.0) * (pos >= 0)
+        return i, j, (1.0 - wj).astype(np.float32), wj.astype(np.float32)
+
+    a = a.astype(np.float32, copy=False)
+    i, j, wi, wj = axis(a.shape[0])
+    extra = (None,) * (a.ndim - 2)
+    rows = a[i] * wi[(slice(None), None) + extra] + a[j] * wj[(slice(None), None) + extra]
+    i, j, wi, wj = axis(a.shape[1])
+    return (rows[:, i] * wi[(None, slice(None)) + extra] + rows[:, j] * wj[(None, slice(None)) + extra]) / (s * s)
+
+
+def fast_len(n: int) -> int:
+    """The smallest 2^a 3^b 5^c >= n (a quick FFT length)."""
+    best = 1 << (n - 1).bit_length()
+    p5 = 1
+    while p5 < best:
+        p35 = p5
+        while p35 < best:
+            q = p35
+            while q < n:
+                q *= 2
+            best = min(best, q)
+            p35 *= 3
+        p5 *= 5
+    return best
+
+
+def convolve(src: np.ndarray, ker: np.ndarray) -> np.ndarray:
+    """Full 2-D convolution of each plane of ``src`` (k, h, w) with ``ker`` (n, n) or, per plane,
+    (k, n, n): (k, h + n - 1, w + n - 1). Direct for small kernels, else FFT (float32)."""
+    k, h, w = src.shape
+    n = ker.shape[-1]
+    kers = np.broadcast_to(ker, (k, n, n)) if ker.ndim == 2 else ker
+    if n <= 7:
+        out = np.zeros((k, h + n - 1, w + n - 1), dtype=np.float32)
+        for dy in range(n):
+            for dx in range(n):
+                cf = kers[:, dy, dx]
+                if cf.any():
+                    out[:, dy:dy + h, dx:dx + w] += cf[:, None, None] * src
+        return out
+    sy, sx = fast_len(h + n - 1), fast_len(w + n - 1)
+    fs = np.fft.rfft2(src, s=(sy, sx))
+    fk = np.fft.rfft2(ker, s=(sy, sx))
+    res = np.fft.irfft2(fs * fk, s=(sy, sx))[:, : h + n - 1, : w + n - 1]
+    return np.maximum(res, 0.0).astype(np.float32, copy=False)
