@@ -43,7 +43,7 @@ import numpy as np
 
 from ..errors import InputError
 from .defocus_kernels import DefocusCamera, KernelCache
-from .defocus_layers import blur_layer, frame_of, layer_pairs
+from .defocus_layers import blur_layer, frame_of, layer_corners, layer_pairs
 
 __all__ = ["DEPTH_KINDS", "DEPTH_UNITS_MM", "inverse_depth", "near_edges", "defocus"]
 
@@ -182,14 +182,17 @@ def defocus(image, u, cache: KernelCache, *, origin=(0, 0), edge_px: int = 1, al
 
 
 def _prepare(cache, f, pairs, progress) -> None:
-    """Trace (or read) every node kernel the tiles' corners blend from, in one batch."""
-    t = f.tile
+    """Trace (or read) every node kernel the layers' blur grids blend from, in one batch."""
+    cols, rows = cache.grid
     needed = set()
     for n, tiles in pairs.items():
-        corners = {(ty + dy, tx + dx) for ty, tx, _ in tiles for dy in (0, 1) for dx in (0, 1)}
-        for cy, cx in corners:
-            needed |= {(cc, rr, n) for cc, rr, _ in cache.nodes_of(f.origin[0] + cx * t, f.origin[1] + cy * t)}
-    cache.prepare(needed)
+        xs, ys = layer_corners(f, cache.camera, n, tiles)
+        found = []
+        for nodes, pos in ((cols, xs), (rows, ys)):
+            i = np.clip(np.searchsorted(nodes, pos, side="right") - 1, 0, len(nodes) - 2)
+            found.append(np.unique(np.concatenate([i, i + 1])))
+        needed |= {(int(c), int(r), int(n)) for c in found[0] for r in found[1]}
+    cache.prepare(needed, progress)
 
 
 def _composite(f, cache, pairs, progress):
@@ -267,11 +270,17 @@ def _add_fill(out, box, tr, lay) -> None:
     if not gs.any():
         return
     q = BUDGET_CELL
-    loss = ((1.0 - tr)[..., None] * lay["V"]).sum(axis=2)
     r = max(-(-2 * lay["radius"] // q), 2)
+    ys, xs = np.nonzero(gs.any(axis=1))[0], np.nonzero(gs.any(axis=0))[0]
+    pad = q * (r + 1)
+    y0, x0 = max(ys[0] - pad, 0) // q * q, max(xs[0] - pad, 0) // q * q
+    sub = (slice(y0, ys[-1] + pad + 1), slice(x0, xs[-1] + pad + 1))
+    loss = ((1.0 - tr[sub])[..., None] * lay["V"][sub]).sum(axis=2)
     with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = np.nan_to_num(_box_sum(_cells(loss, q), r) / _box_sum(_cells(gs, q), r), posinf=0.0)
-    out[box] += _upsample_cells(np.clip(ratio, 0.0, 1.0), q, gs.shape)[..., None] * gain
+        ratio = np.nan_to_num(_box_sum(_cells(loss, q), r) / _box_sum(_cells(gs[sub], q), r), posinf=0.0)
+    scale = _upsample_cells(np.clip(ratio, 0.0, 1.0), q, loss.shape)
+    oy, ox = box[0].start + y0, box[1].start + x0
+    out[oy:oy + loss.shape[0], ox:ox + loss.shape[1]] += scale[..., None] * gain[sub]
 
 
 def _upsample_cells(a: np.ndarray, q: int, shape) -> np.ndarray:

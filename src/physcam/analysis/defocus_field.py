@@ -44,7 +44,7 @@ WIDTH_TOL = 0.03
 #: the finest fraction of the half-frame between field nodes, and the most fractions
 _MIN_STEP, _MAX_FRACTIONS = 1.0 / 16, 5
 #: samples of a probe fan
-PROBE_SAMPLES = 1 << 14
+PROBE_SAMPLES = 1 << 13
 #: radii of the transmission table along the diagonal, and grid of an anamorphic's quadrant
 TABLE_RADII, TABLE_GRID = 81, (33, 17)
 #: how far beyond the frame's corner the table reaches (fraction of the half-frame)

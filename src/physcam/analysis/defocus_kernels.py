@@ -57,7 +57,7 @@ __all__ = ["DefocusCamera", "defocus_camera", "Kernel", "KernelCache", "FAR_MM",
 #: rays are traced at every LADDER_STEP-th depth node (module notes)
 LADDER_STEP = 8
 #: samples per lit kernel pixel, and the most and fewest samples of a fan (powers of two)
-SAMPLES_PER_PX, MAX_SAMPLES, MIN_SAMPLES = 12.0, 1 << 16, 1 << 12
+SAMPLES_PER_PX, MAX_SAMPLES, MIN_SAMPLES = 8.0, 1 << 16, 1 << 12
 #: what the disk cache's files are laid out as and the field grid's rules (part of the camera key)
 CACHE_FORMAT = "physcam-defocus-kernels/2"
 
@@ -190,32 +190,32 @@ class DefocusCamera:
     def kernels(self, points) -> list[Kernel]:
         """The PSFs of the object points the pinhole sees at picture positions ``points`` (x_px,
         y_px, planar depth mm), each traced at its own position and depth (not interpolated), with
-        the transmission T and the focus-plane offset (module notes); traced in one batch."""
+        its transmission T (module notes), centred on its light's centroid (``offset_px`` from the
+        pinhole's image); traced in one batch."""
+        from .defocus_field import _trim, box_depths
         from .defocus_trace import bin_fan, fan_centroid, pupil_boxes, trace_fans
 
         pts = [(float(x), float(y)) for x, y, _ in points]
-        ds = [require_positive("depth", d) for _, _, d in points]
-        us = [1.0 / min(d, FAR_MM) for d in ds]
+        ds = [min(require_positive("depth", d), FAR_MM) for _, _, d in points]
+        axis = (self.width / 2, self.height / 2)
+        boxes = pupil_boxes(self, pts + [axis], box_depths(self))
         jobs = []
-        for (p, u) in zip(pts, us):
-            n = self.samples(int(np.floor(self.node_index(u))), int(np.ceil(self.node_index(u))))
-            for q, v in ((p, u), ((self.width / 2, self.height / 2), u), (p, self.focus_u)):
-                jobs.append((q, v, pupil_boxes(self, [q], [u, self.focus_u])[0], n))
+        for p, d, box in zip(pts, ds, boxes):
+            t = float(self.node_index(1.0 / d))
+            n = self.samples(math.floor(t), math.ceil(t))
+            jobs += [(p, 1.0 / d, box, n), (axis, 1.0 / d, boxes[-1], n)]
         fans = trace_fans(self, jobs)
         out, ch = [], len(self.wavelengths_nm)
-        for i, ((x, y), d, u) in enumerate(zip(pts, ds, us)):
-            fan, axis, focus = fans[3 * i: 3 * i + 3]
-            centre = fan_centroid(focus)
+        for i, ((x, y), d) in enumerate(zip(pts, ds)):
+            fan, ax_fan = fans[2 * i], fans[2 * i + 1]
+            centre = fan_centroid(fan)
             img, tot = bin_fan(fan, centre, ch)
-            ax = np.bincount(axis.ch, weights=axis.w, minlength=ch)[:ch]
+            ax = np.bincount(ax_fan.ch, weights=ax_fan.w, minlength=ch)[:ch]
             sx, sy = self.film_point(x, y)
-            dd = 1.0 / u
-            cos_t = dd / math.sqrt(dd * dd + (sx * dd / self.pinhole_x_mm) ** 2 + (sy * dd / self.pinhole_mm) ** 2)
+            cos_t = d / math.sqrt(d * d + (sx * d / self.pinhole_x_mm) ** 2 + (sy * d / self.pinhole_mm) ** 2)
             trans = tuple(float(t / a * cos_t) if a > 0 else 0.0 for t, a in zip(tot, ax))
             with np.errstate(invalid="ignore", divide="ignore"):
                 img = np.where(tot > 0, img / np.where(tot > 0, tot, 1.0) * np.array(trans), 0.0)
-            from .defocus_field import _trim
-
             out.append(Kernel(np.ascontiguousarray(_trim(img), dtype=np.float32), trans, d, (x, y), centre))
         return out
 

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Frame", "frame_of", "layer_pairs", "tile_sources", "blur_layer", "fast_len", "convolve"]
+__all__ = ["Frame", "frame_of", "layer_pairs", "layer_grid", "layer_corners", "blur_layer", "fast_len", "convolve"]
 
 
 @dataclass
@@ -69,8 +69,9 @@ def frame_of(colour, a, lo, t, margin, tile, origin, has_alpha) -> Frame:
     h, w = lo.shape
     inside = np.zeros((h + 2 * m, w + 2 * m), dtype=bool)
     inside[m:m + h, m:m + w] = True
-    f = Frame(np.pad(colour, pad2 + ((0, 0),), mode="edge"), np.pad(a, pad2, mode="edge"), np.pad(lo, pad2, mode="edge"),
-              np.pad(t, pad2, mode="edge"), inside, m, int(tile), (origin[0] - m, origin[1] - m), has_alpha)
+    f = Frame(np.pad(colour, pad2 + ((0, 0),), mode="edge").astype(np.float32), np.pad(a, pad2, mode="edge").astype(np.float32),
+              np.pad(lo, pad2, mode="edge").astype(np.int32), np.pad(t, pad2, mode="edge").astype(np.float32), inside,
+              m, int(tile), (origin[0] - m, origin[1] - m), has_alpha)
     f.stats = fill_stats(f)
     return f
 
@@ -91,18 +92,26 @@ def fill_stats(f: Frame) -> dict:
     return {"groups": groups, "S": S, "A": np.cumsum(S, axis=2), "L": L}
 
 
+#: a group is continued behind nearer pixels (a fill) only where it is at least this dense among
+#: the pixels around that are not nearer (a small object has no fill: module notes)
+FILL_MIN_DENSITY = 0.05
+
+
 def layer_pairs(f: Frame) -> dict:
     """{node: [(ty, tx, fill group present), ...]}: the tiles each depth node receives light or a fill in."""
     st = f.stats
-    groups, S = st["groups"], st["S"]
+    groups = st["groups"]
     ny, nx = f.tiles
     pairs: dict = {}
-    present = S > 0
-    near = np.zeros_like(present)  # the tile or a neighbour holds the group
+    S3, A3 = np.zeros_like(st["S"]), np.zeros_like(st["A"])  # over each tile and its neighbours
     for dy in (-1, 0, 1):
         for dx in (-1, 0, 1):
-            src = present[max(dy, 0):ny + min(dy, 0), max(dx, 0):nx + min(dx, 0)]
-            near[max(-dy, 0):ny + min(-dy, 0), max(-dx, 0):nx + min(-dx, 0)] |= src
+            dst = (slice(max(-dy, 0), ny + min(-dy, 0)), slice(max(-dx, 0), nx + min(-dx, 0)))
+            src = (slice(max(dy, 0), ny + min(dy, 0)), slice(max(dx, 0), nx + min(dx, 0)))
+            S3[dst] += st["S"][src]
+            A3[dst] += st["A"][src]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        near = np.nan_to_num(S3 / A3) >= FILL_MIN_DENSITY  # the group continues behind nearer pixels here
     for ty in range(ny):
         for tx in range(nx):
             sl = f.tile_slice(ty, tx)
@@ -174,56 +183,51 @@ def _scale(radius: int, tile: int) -> int:
 def _sources(f: Frame, n: int, tiles, box, s: int) -> dict:
     """The planes node n receives (module notes) over ``box`` (y0, y1, x0, x1 of the padded frame,
     multiples of s), summed over s x s blocks: V, G (h, w, c) light (before the transmission), A, U
-    coverage, and A1, U1 with alpha; G is left out when nothing comes from the margin or a fill."""
+    coverage, and A1, U1 with alpha; G only when a fill brings light."""
     y0, y1, x0, x1 = box
-    c, t = f.colour.shape[2], f.tile
-    names = ["A", "U"] + (["A1", "U1"] if f.has_alpha else [])
-    shape = ((y1 - y0) // s, (x1 - x0) // s)
-    out = {"V": np.zeros(shape + (c,), np.float32)}
-    out.update({k: np.zeros(shape, np.float32) for k in names})
+    H, W = f.lo.shape
+    ya, xa = max(y0, 0), max(x0, 0)  # the box may reach past the padded frame (its blocks start at the picture's edge)
+    sub = (slice(ya, min(y1, H)), slice(xa, min(x1, W)))
+    lo, tt, a, ins = f.lo[sub], f.t[sub], f.a[sub], f.inside[sub]  # the margin sends nothing (module notes)
+    one = np.float32(1.0)
+    share_lo = np.where((lo == n) & ins, one - tt, np.float32(0.0))
+    share_up = np.where((lo == n - 1) & ins, tt, np.float32(0.0))
+    planes = {"V": (share_lo + share_up)[..., None] * f.colour[sub], "A": share_lo * a, "U": share_up * a}
+    if f.has_alpha:
+        planes["A1"], planes["U1"] = share_lo, share_up
     for ty, tx, fill in tiles:
+        got = _fill(f, ty, tx, n, f.tile_slice(ty, tx)) if fill else None
+        if got is None:
+            continue
+        rho, fl, hole = got
         sl = f.tile_slice(ty, tx)
-        lo, tt, a = f.lo[sl], f.t[sl], f.a[sl]
-        share_lo = np.where(lo == n, 1.0 - tt, 0.0).astype(np.float32)
-        share_up = np.where(lo == n - 1, tt, 0.0).astype(np.float32)
-        ins = f.inside[sl]
-        if not ins.all():  # the margin sends nothing: light leaving the frame is folded back (module notes)
-            share_lo, share_up = share_lo * ins, share_up * ins
-        planes = {"V": (share_lo + share_up)[..., None] * f.colour[sl], "A": share_lo * a, "U": share_up * a}
+        dst = (slice(sl[0].start - ya, sl[0].start - ya + rho.shape[0]), slice(sl[1].start - xa, sl[1].start - xa + rho.shape[1]))
+        hole = hole & f.inside[sl]
+        behind = np.where(hole, f.a[sl], 0.0)  # the fill lies behind the nearer pixels' coverage
+        if "G" not in planes:
+            planes["G"] = np.zeros_like(planes["V"])
+        planes["G"][dst] += behind[..., None] * fl
+        planes["A"][dst] += behind * rho
         if f.has_alpha:
-            planes["A1"], planes["U1"] = share_lo, share_up
-        got = _fill(f, ty, tx, n, sl) if fill else None
-        if got is not None:
-            rho, fl, hole = got
-            behind = np.where(hole & ins, a, 0.0)  # the fill lies behind the nearer pixels' coverage
-            planes["G"] = planes.get("G", 0.0) + behind[..., None] * fl
-            planes["A"] = planes["A"] + behind * rho
-            if f.has_alpha:
-                planes["A1"] = planes["A1"] + (hole & ins) * rho
-        dst = (slice((sl[0].start - y0) // s, (sl[0].start - y0 + t) // s),
-               slice((sl[1].start - x0) // s, (sl[1].start - x0 + t) // s))
-        for k, v in planes.items():
-            if k == "G" and k not in out:
-                out["G"] = np.zeros_like(out["V"])
-            out[k][dst] += _block_sum(_full_tile(v, t), s)
-    return out
-
-
-def _full_tile(v: np.ndarray, t: int) -> np.ndarray:
-    """A tile's plane padded with zeros to t x t (the frame's last row and column of tiles)."""
-    if v.shape[0] == t and v.shape[1] == t:
-        return v
-    out = np.zeros((t, t) + v.shape[2:], np.float32)
-    out[:v.shape[0], :v.shape[1]] = v
+            planes["A1"][dst] += hole * rho
+    shape = (y1 - y0, x1 - x0)
+    out = {}
+    for k, v in planes.items():
+        if v.shape[:2] != shape:
+            full = np.zeros(shape + v.shape[2:], np.float32)
+            full[ya - y0:ya - y0 + v.shape[0], xa - x0:xa - x0 + v.shape[1]] = v
+            v = full
+        out[k] = _block_sum(v, s)
     return out
 
 
 def _block_sum(a: np.ndarray, s: int) -> np.ndarray:
     """Sums over s x s blocks (the first two axes; their lengths are multiples of s)."""
-    if s == 1:
-        return a
-    h, w = a.shape[:2]
-    return a.reshape((h // s, s, w // s, s) + a.shape[2:]).sum(axis=(1, 3))
+    while s > 1:  # halve each axis in turn: strided adds are cheaper than a reduction over a reshape
+        a = a[0::2] + a[1::2]
+        a = a[:, 0::2] + a[:, 1::2]
+        s //= 2
+    return a
 
 
 def _kernel_at_scale(k: np.ndarray, s: int) -> np.ndarray:
@@ -251,14 +255,8 @@ def blur_layer(f: Frame, cache, n: int, tiles) -> dict | None:
     if the node receives nothing."""
     if not tiles:
         return None
-    t, (H, W) = f.tile, f.lo.shape
-    s = _scale(_radius(f, cache, n, tiles), t)
-    step = max(t // s, MIN_CORNER_STEP)  # low-res pixels per tile
-    S = s * step
-    y0 = min(ty for ty, _, _ in tiles) * t // S * S
-    x0 = min(tx for _, tx, _ in tiles) * t // S * S
-    y1 = -(-(max(ty for ty, _, _ in tiles) + 1) * t // S) * S
-    x1 = -(-(max(tx for _, tx, _ in tiles) + 1) * t // S) * S
+    H, W = f.lo.shape
+    s, step, (y0, y1, x0, x1) = layer_grid(f, cache.camera, n, tiles)
     low = _sources(f, n, tiles, (y0, y1, x0, x1), s)
     T = _transmission_blocks(f, cache, n, y0, x0, low["A"].shape, s)
     low["V"] = low["V"] * T
@@ -268,11 +266,30 @@ def blur_layer(f: Frame, cache, n: int, tiles) -> dict | None:
     return _to_full(out, s, (y0, x0), r, H, W)
 
 
-def _radius(f: Frame, cache, n: int, tiles) -> int:
-    """The largest kernel radius (px) among the corners of node n's tiles."""
+def layer_grid(f: Frame, cam, n: int, tiles):
+    """How node n is blurred: its resolution divisor s (from the thin-lens blur there: a power of
+    two bringing the kernel's radius to about :data:`LOW_RES_RADIUS`), the low-res pixels per tile
+    side and the box (y0, y1, x0, x1 of the padded frame) its tiles' sources are summed over."""
     t = f.tile
-    corners = {(ty + dy, tx + dx) for ty, tx, _ in tiles for dy in (0, 1) for dx in (0, 1)}
-    return max(cache.tile_kernel(f.origin[0] + cx * t, f.origin[1] + cy * t, n).shape[0] // 2 for cy, cx in corners)
+    radius = 0.55 * float(cam.blur_px_at(n)) + 1.0
+    s = _scale(radius, t)
+    step = max(t // s, MIN_CORNER_STEP)
+    S, m = s * step, f.margin
+    # the blocks start at the picture's edge, so that none straddles it
+    y0 = m + (min(ty for ty, _, _ in tiles) * t - m) // S * S
+    x0 = m + (min(tx for _, tx, _ in tiles) * t - m) // S * S
+    y1 = m - (-((max(ty for ty, _, _ in tiles) + 1) * t - m) // S) * S
+    x1 = m - (-((max(tx for _, tx, _ in tiles) + 1) * t - m) // S) * S
+    return s, step, (y0, y1, x0, x1)
+
+
+def layer_corners(f: Frame, cam, n: int, tiles) -> tuple[np.ndarray, np.ndarray]:
+    """The display positions (x, y) of every corner of node n's blur grid (:func:`layer_grid`)."""
+    s, step, (y0, y1, x0, x1) = layer_grid(f, cam, n, tiles)
+    S = s * step
+    ys = f.origin[1] + np.arange(y0, y1 + 1, S)
+    xs = f.origin[0] + np.arange(x0, x1 + 1, S)
+    return xs, ys
 
 
 def _transmission_blocks(f: Frame, cache, n: int, y0: int, x0: int, shape, s: int) -> np.ndarray:
@@ -412,19 +429,17 @@ def _to_full(planes: dict, s: int, origin, r: int, H: int, W: int) -> dict:
 def _upsample(a: np.ndarray, s: int) -> np.ndarray:
     """(h, w, ...) values per s x s block to (h s, w s, ...) values per pixel: bilinear between block
     centres (clamped at the ends), divided by s^2, so that each block's sum is kept."""
-    def axis(n):
-        pos = (np.arange(n * s) + 0.5) / s - 0.5
-        i = np.clip(np.floor(pos).astype(np.int64), 0, n - 1)
-        j = np.clip(i + 1, 0, n - 1)
-        wj = np.clip(pos - i, 0.0, 1.0) * (pos >= 0)
-        return i, j, (1.0 - wj).astype(np.float32), wj.astype(np.float32)
-
-    a = a.astype(np.float32, copy=False)
-    i, j, wi, wj = axis(a.shape[0])
-    extra = (None,) * (a.ndim - 2)
-    rows = a[i] * wi[(slice(None), None) + extra] + a[j] * wj[(slice(None), None) + extra]
-    i, j, wi, wj = axis(a.shape[1])
-    return (rows[:, i] * wi[(None, slice(None)) + extra] + rows[:, j] * wj[(None, slice(None)) + extra]) / (s * s)
+    a = np.asarray(a, dtype=np.float32) / np.float32(s * s)
+    for axis in (0, 1):
+        a = np.moveaxis(a, axis, 0)
+        prev = np.concatenate([a[:1], a[:-1]])
+        nxt = np.concatenate([a[1:], a[-1:]])
+        out = np.empty((a.shape[0] * s,) + a.shape[1:], np.float32)
+        for q in range(s):
+            d = np.float32((q + 0.5) / s - 0.5)  # the pixel's offset from its block's centre, in blocks
+            out[q::s] = (1 - abs(d)) * a + abs(d) * (prev if d < 0 else nxt)
+        a = np.moveaxis(out, 0, axis)
+    return a
 
 
 def fast_len(n: int) -> int:

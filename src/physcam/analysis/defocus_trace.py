@@ -193,8 +193,9 @@ def solid_angles(cam, fields_px, us) -> np.ndarray:
     for t, wt in zip(tq, wq):
         r = lo * t
         rays, cos_t = _rays(px, py, pz, cx + r * c, cy + r * s, z_ep, wl)
+        cos3 = cos_t ** 3  # before the trace (in place) moves the directions
         _, _, ok, weight = _trace(cam, rays)
-        total += wt * t * np.where(ok, weight, 0.0) * cos_t ** 3
+        total += wt * t * np.where(ok, weight, 0.0) * cos3
     omega = (total * lo * lo).reshape(m, AZIMUTHS).sum(axis=1) * (2 * math.pi / AZIMUTHS)
     return omega.reshape(len(fields_px), len(us), len(wls))
 
