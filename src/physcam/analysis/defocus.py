@@ -205,6 +205,8 @@ def _composite(f, cache, pairs, progress):
     carry = None  # (U, U1, box): the upper shares of the next farther group
     nodes = sorted(pairs, reverse=True)
     lowest = int(f.lo.min())
+    fills = {n for n, tiles in pairs.items() if any(fill for _, _, fill in tiles)}
+    budget = _Budget(f.lo.shape)
     for done, n in enumerate(range(nodes[0], lowest - 1, -1), 1):
         lay = _fold(f, blur_layer(f, cache, n, pairs.get(n, [])))
         group_cov = [(lay, "A")] + ([(carry, "U")] if carry is not None else [])
@@ -212,7 +214,10 @@ def _composite(f, cache, pairs, progress):
             box = lay["box"]
             tr = f.inside[box] * (1.0 - np.clip(cov[box], 0.0, 1.0))
             out[box] += tr[..., None] * lay["V"]
-            _add_fill(out, box, tr, lay)
+            if n in fills or n - 1 in fills:
+                budget.spend(out, box, tr, lay)
+        else:
+            budget.carry = None
         for src, name in group_cov:
             if src is not None:
                 cov[src["box"]] += src[name]
@@ -223,8 +228,11 @@ def _composite(f, cache, pairs, progress):
             progress(done, len(nodes))
     if cov1 is None:
         return out, None
+    # the coverage, made whole where the picture's pixels, opaque or not, cover the film completely
+    # (the kernels of neighbouring depth layers differ, so their coverages add to 1 only nearly)
+    full = np.clip(cov1, 0.0, 1.0)
     with np.errstate(invalid="ignore", divide="ignore"):
-        alpha = np.where(cov1 > 0, cov / np.where(cov1 > 0, cov1, 1.0), 0.0)
+        alpha = np.where(full > 0, np.clip(cov, 0.0, 1.0) / np.where(full > 0, full, 1.0), 0.0)
     return out, np.clip(alpha, 0.0, 1.0).astype(np.float32)
 
 
@@ -258,29 +266,47 @@ def _fold(f, lay):
     return lay
 
 
-def _add_fill(out, box, tr, lay) -> None:
-    """Fill light (module notes), allowed no more light than the node's own light lost nearby to
-    nearer coverage: both summed over a window twice the kernel's radius, on a grid of
-    :data:`BUDGET_CELL` pixels, the fill scaled down where it would bring more."""
-    g = lay["G"]
-    if g is None:
-        return
-    gain = tr[..., None] * g
-    gs = gain.sum(axis=2)
-    if not gs.any():
-        return
-    q = BUDGET_CELL
-    r = max(-(-2 * lay["radius"] // q), 2)
-    ys, xs = np.nonzero(gs.any(axis=1))[0], np.nonzero(gs.any(axis=0))[0]
-    pad = q * (r + 1)
-    y0, x0 = max(ys[0] - pad, 0) // q * q, max(xs[0] - pad, 0) // q * q
-    sub = (slice(y0, ys[-1] + pad + 1), slice(x0, xs[-1] + pad + 1))
-    loss = ((1.0 - tr[sub])[..., None] * lay["V"][sub]).sum(axis=2)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = np.nan_to_num(_box_sum(_cells(loss, q), r) / _box_sum(_cells(gs[sub], q), r), posinf=0.0)
-    scale = _upsample_cells(np.clip(ratio, 0.0, 1.0), q, loss.shape)
-    oy, ox = box[0].start + y0, box[1].start + x0
-    out[oy:oy + loss.shape[0], ox:ox + loss.shape[1]] += scale[..., None] * gain[sub]
+class _Budget:
+    """The light fills may bring (module notes): each node's light lost to nearer coverage, on a grid
+    of :data:`BUDGET_CELL` pixels, kept for that node's fill and what is left for the next farther
+    node's (a group's light is shared between two nodes), then dropped; a fill is scaled down where,
+    summed over a window twice its kernel's radius, it would bring more than that."""
+
+    def __init__(self, shape):
+        q = BUDGET_CELL
+        self.shape = (-(-shape[0] // q), -(-shape[1] // q))
+        self.carry = None
+
+    def spend(self, out, box, tr, lay) -> None:
+        q = BUDGET_CELL
+        y0, x0 = box[0].start, box[1].start
+        own = np.zeros(self.shape)
+        loss = ((1.0 - tr)[..., None] * lay["V"]).sum(axis=2)
+        _add_cells(own, loss, y0, x0, q)
+        avail = own + (self.carry if self.carry is not None else 0.0)
+        g = lay["G"]
+        if g is not None:
+            gain = tr[..., None] * g
+            gc = np.zeros(self.shape)
+            _add_cells(gc, gain.sum(axis=2), y0, x0, q)
+            r = max(-(-2 * lay["radius"] // q), 2)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                scale = np.clip(np.nan_to_num(_box_sum(avail, r) / _box_sum(gc, r), posinf=0.0), 0.0, 1.0)
+            full = _upsample_cells(scale, q, (self.shape[0] * q, self.shape[1] * q))
+            out[box] += full[box][..., None] * gain
+            avail = np.maximum(avail - scale * gc, 0.0)
+        self.carry = np.minimum(avail, own)  # a node's loss funds its own fill and the next one's, no more
+
+
+def _add_cells(cells: np.ndarray, a: np.ndarray, y0: int, x0: int, q: int) -> None:
+    """Add the sums of ``a`` (placed at (y0, x0) of the frame) over q x q cells into ``cells``."""
+    h, w = a.shape
+    ya, xa = y0 // q * q, x0 // q * q
+    p = np.zeros((-(-(y0 + h - ya) // q) * q, -(-(x0 + w - xa) // q) * q))
+    p[y0 - ya:y0 - ya + h, x0 - xa:x0 - xa + w] = a
+    part = p.reshape(p.shape[0] // q, q, p.shape[1] // q, q).sum(axis=(1, 3))
+    cy, cx = ya // q, xa // q
+    cells[cy:cy + part.shape[0], cx:cx + part.shape[1]] += part[:cells.shape[0] - cy, :cells.shape[1] - cx]
 
 
 def _upsample_cells(a: np.ndarray, q: int, shape) -> np.ndarray:
@@ -299,14 +325,6 @@ def _upsample_cells(a: np.ndarray, q: int, shape) -> np.ndarray:
 
 #: the grid (px) the fill's light budget is summed on
 BUDGET_CELL = 4
-
-
-def _cells(a: np.ndarray, q: int) -> np.ndarray:
-    """Sums of ``a`` over q x q cells (zero padded)."""
-    h, w = a.shape
-    p = np.zeros((-(-h // q) * q, -(-w // q) * q))
-    p[:h, :w] = a
-    return p.reshape(p.shape[0] // q, q, p.shape[1] // q, q).sum(axis=(1, 3))
 
 
 def _box_sum(a: np.ndarray, r: int) -> np.ndarray:

@@ -217,12 +217,12 @@ def _cos_theta(cam, point, d) -> float:
     return d / math.sqrt(d * d + X * X + Y * Y)
 
 
-def node_kernel(cam, fan_a, fan_b, n) -> tuple[np.ndarray, tuple[float, float]]:
+def node_kernel(cam, fan_a, fan_b, n, maps=None) -> tuple[np.ndarray, tuple[float, float]]:
     """The kernel of depth node ``n`` from the ladder fans around it, binned around its light's
     centroid (module notes) and scaled to a unit sum per channel; and that centroid (px from the
     pinhole's image)."""
     u = float(cam.node_u(n))
-    fan = interpolate_fan(fan_a, fan_b, u) if fan_a is not fan_b else fan_a
+    fan = interpolate_fan(fan_a, fan_b, u, maps) if fan_a is not fan_b else fan_a
     centre = fan_centroid(fan)
     img, tot = bin_fan(fan, centre, len(cam.wavelengths_nm))
     with np.errstate(invalid="ignore", divide="ignore"):

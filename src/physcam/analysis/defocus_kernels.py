@@ -43,7 +43,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -107,6 +107,7 @@ class DefocusCamera:
     pupil_diameter_x_mm: float = 0.0
     wavelengths_nm: tuple[float, ...] = ()
     ladder_step: int = LADDER_STEP
+    _memo: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def pitch_mm(self) -> float:
@@ -152,6 +153,12 @@ class DefocusCamera:
 
     def ladder(self, n: int) -> tuple[int, int]:
         """The ladder nodes (traced; module notes) at or around depth node ``n``."""
+        key = ("ladder", int(n))
+        if key not in self._memo:
+            self._memo[key] = self._ladder(int(n))
+        return self._memo[key]
+
+    def _ladder(self, n: int) -> tuple[int, int]:
         n, far, k = int(n), self.node_far(), self.ladder_step
         if n <= far:
             return far, far
@@ -160,15 +167,25 @@ class DefocusCamera:
 
     def ladder_weight(self, n: int) -> tuple[float, float]:
         """The weights of the two ladder nodes around ``n`` (linear in u)."""
+        key = ("weight", int(n))
+        if key in self._memo:
+            return self._memo[key]
         a, b = self.ladder(n)
         if a == b:
             return 1.0, 0.0
         ua, ub, u = (float(self.node_u(m)) for m in (a, b, n))
         s = (u - ua) / (ub - ua)
+        self._memo[key] = (1.0 - s, s)
         return 1.0 - s, s
 
     def samples(self, a: int, b: int) -> int:
         """Samples per fan for the ladder interval a..b (a power of two, from the larger blur)."""
+        key = ("samples", int(a), int(b))
+        if key not in self._memo:
+            self._memo[key] = self._samples(a, b)
+        return self._memo[key]
+
+    def _samples(self, a: int, b: int) -> int:
         blur = float(max(self.blur_px_at(a), self.blur_px_at(b))) + 2.0
         want = SAMPLES_PER_PX * 0.25 * math.pi * blur * blur
         return int(min(MAX_SAMPLES, max(MIN_SAMPLES, 1 << max(0, math.ceil(math.log2(want))))))
@@ -369,19 +386,24 @@ class KernelCache:
         """The field nodes' columns and rows (display px)."""
         from .defocus_field import grid_nodes
 
-        return grid_nodes(self.camera, self.fractions)
+        if getattr(self, "_grid", None) is None or self._grid[0] != self.fractions:
+            self._grid = (self.fractions, grid_nodes(self.camera, self.fractions))
+        return self._grid[1]
 
     @staticmethod
     def _cell(nodes: np.ndarray, x: float) -> list[tuple[int, float]]:
         """The nodes around ``x`` and their linear weights (clamped at the ends)."""
-        i = int(np.clip(np.searchsorted(nodes, x, side="right") - 1, 0, len(nodes) - 2))
-        w = float(np.clip((x - nodes[i]) / (nodes[i + 1] - nodes[i]), 0.0, 1.0))
+        import bisect
+
+        i = min(max(bisect.bisect_right(nodes.tolist(), x) - 1, 0), len(nodes) - 2)
+        w = min(max((x - float(nodes[i])) / float(nodes[i + 1] - nodes[i]), 0.0), 1.0)
         return [(i, 1.0 - w)] + ([(i + 1, w)] if w > 0 else [])
 
     def nodes_of(self, x: float, y: float) -> list[tuple[int, int, float]]:
         """The field nodes (column, row) whose kernels blend into the kernel at picture (x, y), with weights."""
         cols, rows = self.grid
-        return [(i, j, wi * wj) for i, wi in self._cell(cols, x) for j, wj in self._cell(rows, y) if wi * wj > 0]
+        cx, cy = self._cell(cols, float(x)), self._cell(rows, float(y))
+        return [(i, j, wi * wj) for i, wi in cx for j, wj in cy if wi * wj > 0]
 
     # ---- tracing ------------------------------------------------------------------------------
     def prepare(self, needed, progress=None) -> None:
@@ -441,10 +463,13 @@ class KernelCache:
             fans = iter(trace_fans(cam, jobs))
             for (cr, p, need, ns) in batch:
                 got = {m: next(fans) for m in sorted(need)}
+                maps, cut = {}, {}
                 for n in ns:
                     a, b = cam.ladder(n)
                     k = cam.samples(a, b)
-                    img, _ = node_kernel(cam, got[a].prefix(k), got[b].prefix(k), n)
+                    if (a, b) not in cut:  # one prefix pair per interval, so its pupil map is fitted once
+                        cut[(a, b)] = (got[a].prefix(k), got[b].prefix(k))
+                    img, _ = node_kernel(cam, *cut[(a, b)], n, maps)
                     out[cr + (n,)] = img
                 done += len(ns)
                 if progress is not None:

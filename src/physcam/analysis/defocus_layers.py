@@ -89,11 +89,21 @@ def fill_stats(f: Frame) -> dict:
     S = np.bincount(key, weights=f.a.ravel(), minlength=size).reshape(ny, nx, len(groups))
     L = np.stack([np.bincount(key, weights=f.colour[..., c].ravel(), minlength=size) for c in range(f.colour.shape[2])],
                  axis=-1).reshape(ny, nx, len(groups), -1)
-    return {"groups": groups, "S": S, "A": np.cumsum(S, axis=2), "L": L}
+    near = np.zeros((h, w), dtype=np.int32)  # each pixel's nearest 4-neighbour's group
+    near[:] = f.lo
+    for a, b in (((slice(1, None),), (slice(None, -1),)), ((slice(None, -1),), (slice(1, None),)),
+                 ((slice(None), slice(1, None)), (slice(None), slice(None, -1))),
+                 ((slice(None), slice(None, -1)), (slice(None), slice(1, None)))):
+        np.maximum(near[a], f.lo[b], out=near[a])
+    edge = (near >= f.lo + 2).ravel()  # the far side of a depth edge: a neighbour two nodes nearer or more
+    E = np.bincount(key[edge], minlength=size).reshape(ny, nx, len(groups)) > 0
+    S1 = np.bincount(key, minlength=size).reshape(ny, nx, len(groups)).astype(float)  # with alpha 1 (pixel counts)
+    return {"groups": groups, "S": S, "A": np.cumsum(S, axis=2), "L": L, "edge": E, "S1": S1, "A1": np.cumsum(S1, axis=2)}
 
 
-#: a group is continued behind nearer pixels (a fill) only where it is at least this dense among
-#: the pixels around that are not nearer (a small object has no fill: module notes)
+#: a group is continued behind nearer pixels (a fill) only where it meets them at a depth edge (a
+#: neighbour two nodes nearer or more: a surface whose depth changes smoothly needs none) and is at
+#: least this dense among the pixels around that are not nearer (a small object has no fill)
 FILL_MIN_DENSITY = 0.05
 
 
@@ -103,15 +113,25 @@ def layer_pairs(f: Frame) -> dict:
     groups = st["groups"]
     ny, nx = f.tiles
     pairs: dict = {}
-    S3, A3 = np.zeros_like(st["S"]), np.zeros_like(st["A"])  # over each tile and its neighbours
+    sums = {k: np.zeros_like(st[k]) for k in ("S", "A", "S1", "A1")}  # over each tile and its neighbours
     for dy in (-1, 0, 1):
         for dx in (-1, 0, 1):
             dst = (slice(max(-dy, 0), ny + min(-dy, 0)), slice(max(-dx, 0), nx + min(-dx, 0)))
             src = (slice(max(dy, 0), ny + min(dy, 0)), slice(max(dx, 0), nx + min(dx, 0)))
-            S3[dst] += st["S"][src]
-            A3[dst] += st["A"][src]
+            for k in sums:
+                sums[k][dst] += st[k][src]
+    E3 = np.zeros_like(st["edge"])
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            E3[max(-dy, 0):ny + min(-dy, 0), max(-dx, 0):nx + min(-dx, 0)] |= \
+                st["edge"][max(dy, 0):ny + min(dy, 0), max(dx, 0):nx + min(dx, 0)]
     with np.errstate(invalid="ignore", divide="ignore"):
-        near = np.nan_to_num(S3 / A3) >= FILL_MIN_DENSITY  # the group continues behind nearer pixels here
+        # the group continues behind nearer pixels here: it is dense (in light, or in pixels when the
+        # picture has an alpha: its transparent background too), and meets them at a depth edge
+        dense = np.nan_to_num(sums["S"] / sums["A"]) >= FILL_MIN_DENSITY
+        if f.has_alpha:
+            dense |= np.nan_to_num(sums["S1"] / sums["A1"]) >= FILL_MIN_DENSITY
+        near = dense & E3
     for ty in range(ny):
         for tx in range(nx):
             sl = f.tile_slice(ty, tx)
@@ -141,7 +161,8 @@ def _tile_weights(n_tiles: int, tile: int, index: int, length: int) -> np.ndarra
 
 def _fill(f: Frame, ty: int, tx: int, g: int, sl):
     """Group g's density (h, w) and light per unit of coverage (h, w, c) behind the pixels of tile
-    (ty, tx) at least two nodes nearer than it, and those pixels (module notes); None if there are none."""
+    (ty, tx) at least two nodes nearer than it, those pixels, and its density in pixels (alpha 1:
+    the coverage an opaque picture would have); None if there are none (module notes)."""
     st = f.stats
     gi = int(np.searchsorted(st["groups"], g))
     ny, nx = f.tiles
@@ -152,17 +173,19 @@ def _fill(f: Frame, ty: int, tx: int, g: int, sl):
     ys, xs = slice(max(ty - 1, 0), ty + 2), slice(max(tx - 1, 0), tx + 2)
     wy = _tile_weights(ny, f.tile, ty, lo.shape[0])[:, (0 if ty > 0 else 1):(3 if ty < ny - 1 else 2)]
     wx = _tile_weights(nx, f.tile, tx, lo.shape[1])[:, (0 if tx > 0 else 1):(3 if tx < nx - 1 else 2)]
-    S, A, L = st["S"][ys, xs, gi], st["A"][ys, xs, gi], st["L"][ys, xs, gi]
-    a = wy @ A @ wx.T
-    with np.errstate(invalid="ignore", divide="ignore"):
-        inv = np.where(a > 0, 1.0 / np.where(a > 0, a, 1.0), 0.0)
-    rho = (wy @ S @ wx.T) * inv
-    light = np.stack([(wy @ L[..., c] @ wx.T) * inv for c in range(L.shape[-1])], axis=-1)
-    return rho, light, hole
+    def ratio(num, den):
+        d = wy @ den[ys, xs, gi] @ wx.T
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(d > 0, (wy @ num @ wx.T) / np.where(d > 0, d, 1.0), 0.0)
+
+    rho = ratio(st["S"][ys, xs, gi], st["A"])
+    light = np.stack([ratio(st["L"][ys, xs, gi][..., c], st["A"]) for c in range(st["L"].shape[-1])], axis=-1)
+    rho1 = ratio(st["S1"][ys, xs, gi], st["A1"]) if f.has_alpha else rho
+    return rho, light, hole, rho1
 
 
 #: a node whose kernels reach more than this many pixels is blurred at a lower resolution (module notes)
-LOW_RES_RADIUS = 4
+LOW_RES_RADIUS = 6
 #: the fewest low-resolution pixels a side of the tiles a node is blurred in
 MIN_CORNER_STEP = 16
 #: kernels up to this radius (low-resolution px) are applied by a direct sum, larger ones by FFT
@@ -199,7 +222,7 @@ def _sources(f: Frame, n: int, tiles, box, s: int) -> dict:
         got = _fill(f, ty, tx, n, f.tile_slice(ty, tx)) if fill else None
         if got is None:
             continue
-        rho, fl, hole = got
+        rho, fl, hole, rho1 = got
         sl = f.tile_slice(ty, tx)
         dst = (slice(sl[0].start - ya, sl[0].start - ya + rho.shape[0]), slice(sl[1].start - xa, sl[1].start - xa + rho.shape[1]))
         hole = hole & f.inside[sl]
@@ -209,7 +232,7 @@ def _sources(f: Frame, n: int, tiles, box, s: int) -> dict:
         planes["G"][dst] += behind[..., None] * fl
         planes["A"][dst] += behind * rho
         if f.has_alpha:
-            planes["A1"][dst] += hole * rho
+            planes["A1"][dst] += hole * rho1
     shape = (y1 - y0, x1 - x0)
     out = {}
     for k, v in planes.items():
@@ -231,18 +254,37 @@ def _block_sum(a: np.ndarray, s: int) -> np.ndarray:
 
 
 def _kernel_at_scale(k: np.ndarray, s: int) -> np.ndarray:
-    """A kernel (unit sum per channel) for a grid s times coarser, centred as the original: each
-    coarse pixel sums the pixels within s/2 of its centre, halving those on the boundary."""
+    """A kernel (unit sum per channel) for a grid s times coarser. Each fine pixel's share goes to the
+    two nearest coarse pixels linearly (a tent: the sum and the centroid are kept), its offset first
+    shrunk by c per axis so that the blur the coarse grid adds (the sources summed over s x s
+    blocks: s^2 / 12; this tent: s^2 / 6; the bilinear return to full resolution: s^2 / 6) leaves
+    the kernel's second moments as they were: c^2 = 1 - (5 s^2 / 12) / sigma^2 (at least 1/4)."""
     if s == 1:
         return k
     r = k.shape[0] // 2
-    R = -(-r // s)
-    pad = np.pad(k, ((R * s - r + s // 2, R * s - r + s // 2),) * 2 + ((0, 0),))
-    w = np.ones(s + 1)
-    w[0] = w[-1] = 0.5
-    n = 2 * R + 1
-    rows = np.stack([np.tensordot(w, pad[i * s: i * s + s + 1], axes=(0, 0)) for i in range(n)])
-    return np.stack([np.tensordot(w, rows[:, j * s: j * s + s + 1], axes=(0, 1)) for j in range(n)], axis=1)
+    d = np.arange(-r, r + 1, dtype=float)
+    m = k[..., k.shape[2] // 2].astype(float)
+    tot = m.sum()
+    R = r // s + 1
+    out = []
+    for axis in (0, 1):  # rows (y), then columns (x)
+        marg = m.sum(axis=1 - axis)
+        mean = (marg * d).sum() / tot
+        var = (marg * (d - mean) ** 2).sum() / tot
+        c = math.sqrt(max(1.0 - (5.0 * s * s / 12.0) / var, 0.25)) if var > 0 else 1.0
+        out.append(np.clip(1.0 - np.abs(c * d[None, :] - s * (np.arange(2 * R + 1)[:, None] - R)) / s, 0.0, None))
+    wy, wx = out
+    return _trim_kernel(np.einsum("ia,abc,jb->ijc", wy, k, wx).astype(np.float32))
+
+
+def _trim_kernel(k: np.ndarray) -> np.ndarray:
+    """``k`` cut to the smallest centred square holding all its light."""
+    r = k.shape[0] // 2
+    ys, xs = np.nonzero(k.sum(axis=2))
+    if len(ys) == 0:
+        return k[r:r + 1, r:r + 1]
+    e = int(max(np.abs(ys - r).max(), np.abs(xs - r).max()))
+    return k[r - e:r + e + 1, r - e:r + e + 1]
 
 
 def blur_layer(f: Frame, cache, n: int, tiles) -> dict | None:
@@ -274,12 +316,12 @@ def layer_grid(f: Frame, cam, n: int, tiles):
     radius = 0.55 * float(cam.blur_px_at(n)) + 1.0
     s = _scale(radius, t)
     step = max(t // s, MIN_CORNER_STEP)
-    S, m = s * step, f.margin
+    m, H, W = f.margin, f.lo.shape[0], f.lo.shape[1]
     # the blocks start at the picture's edge, so that none straddles it
-    y0 = m + (min(ty for ty, _, _ in tiles) * t - m) // S * S
-    x0 = m + (min(tx for _, tx, _ in tiles) * t - m) // S * S
-    y1 = m - (-((max(ty for ty, _, _ in tiles) + 1) * t - m) // S) * S
-    x1 = m - (-((max(tx for _, tx, _ in tiles) + 1) * t - m) // S) * S
+    y0 = m + (min(ty for ty, _, _ in tiles) * t - m) // s * s
+    x0 = m + (min(tx for _, tx, _ in tiles) * t - m) // s * s
+    y1 = m - (-(min((max(ty for ty, _, _ in tiles) + 1) * t, H) - m) // s) * s
+    x1 = m - (-(min((max(tx for _, tx, _ in tiles) + 1) * t, W) - m) // s) * s
     return s, step, (y0, y1, x0, x1)
 
 
@@ -287,8 +329,8 @@ def layer_corners(f: Frame, cam, n: int, tiles) -> tuple[np.ndarray, np.ndarray]
     """The display positions (x, y) of every corner of node n's blur grid (:func:`layer_grid`)."""
     s, step, (y0, y1, x0, x1) = layer_grid(f, cam, n, tiles)
     S = s * step
-    ys = f.origin[1] + np.arange(y0, y1 + 1, S)
-    xs = f.origin[0] + np.arange(x0, x1 + 1, S)
+    ys = f.origin[1] + np.arange(y0, y1 + S, S)
+    xs = f.origin[0] + np.arange(x0, x1 + S, S)
     return xs, ys
 
 
@@ -316,8 +358,8 @@ def _corners(f: Frame, cache, n: int, low: dict, s: int, t: int, origin):
     g = np.moveaxis(low["G"], 2, 0) if "G" in low else None
     cov = np.stack([low[k] for k in cover])
     kern, groups = {}, {}
-    for ty in range(h // t):
-        for tx in range(w // t):
+    for ty in range(-(-h // t)):
+        for tx in range(-(-w // t)):
             sl = (slice(None), slice(ty * t, (ty + 1) * t), slice(tx * t, (tx + 1) * t))
             if not (cov[sl].any() or light[sl].any() or (g is not None and g[sl].any())):
                 continue
@@ -329,13 +371,16 @@ def _corners(f: Frame, cache, n: int, low: dict, s: int, t: int, origin):
             groups.setdefault(key, []).append((ty, tx))
     r = max(k.shape[0] for k in kern.values()) // 2
     kern = {key: _pad_kernel(k, r) for key, k in kern.items()}
-    out = {"V": np.zeros((c, h + 2 * r, w + 2 * r), np.float32),
-           "cov": np.zeros((len(cover), h + 2 * r, w + 2 * r), np.float32)}
+    H2, W2 = -(-h // t) * t, -(-w // t) * t  # whole tiles: the last row and column padded with zeros
+    out = {"V": np.zeros((c, H2 + 2 * r, W2 + 2 * r), np.float32),
+           "cov": np.zeros((len(cover), H2 + 2 * r, W2 + 2 * r), np.float32)}
     if g is not None:
         out["G"] = np.zeros_like(out["V"])
     for (with_g, varies), tiles in groups.items():
         names = ["V"] + (["G"] if with_g else []) + cover
         stack = np.concatenate([light] + ([g] if with_g else []) + [cov], axis=0)
+        if stack.shape[1:] != (H2, W2):
+            stack = np.pad(stack, ((0, 0), (0, H2 - h), (0, W2 - w)))
         for b in range(0, len(tiles), _BATCH):
             res = _blur_tiles(stack, tiles[b:b + _BATCH], kern, t, r, names, c, varies)
             for i, (ty, tx) in enumerate(tiles[b:b + _BATCH]):
@@ -344,9 +389,10 @@ def _corners(f: Frame, cache, n: int, low: dict, s: int, t: int, origin):
                 if with_g:
                     out["G"][(slice(None),) + box] += res[i, c:2 * c]
                 out["cov"][(slice(None),) + box] += res[i, -len(cover):]
-    planes = {k: np.moveaxis(np.maximum(out[k], 0.0), 0, 2) for k in ("V", "G") if k in out}
+    cut = (slice(None), slice(0, h + 2 * r), slice(0, w + 2 * r))
+    planes = {k: np.moveaxis(np.maximum(out[k][cut], 0.0), 0, 2) for k in ("V", "G") if k in out}
     for i, k in enumerate(cover):
-        planes[k] = np.maximum(out["cov"][i], 0.0)
+        planes[k] = np.maximum(out["cov"][i][cut[1:]], 0.0)
     return planes, r
 
 

@@ -263,9 +263,10 @@ def _trace_batch(cam, jobs, wls, z_ep) -> list[Fan]:
     return fans
 
 
-def interpolate_fan(a: Fan, b: Fan, u: float) -> Fan:
+def interpolate_fan(a: Fan, b: Fan, u: float, _maps: dict | None = None) -> Fan:
     """The fan at inverse depth ``u`` between fans ``a`` and ``b`` of one field node (same samples;
-    module notes). ``u`` at an end returns that end."""
+    module notes). ``u`` at an end returns that end. ``_maps``: a dict memoising the pupil-to-offset
+    maps of fan pairs (several depths between the same two fans)."""
     if u == a.u:
         return a
     if u == b.u:
@@ -276,7 +277,13 @@ def interpolate_fan(a: Fan, b: Fan, u: float) -> Fan:
     oy = np.where(both, a.oy + s * (b.oy - a.oy), np.nan)
     only_a, only_b = (a.w > 0) & ~both, (b.w > 0) & ~both
     if (only_a | only_b).any():
-        gx, gy = _pupil_to_offset(a, b, both)
+        key = (id(a), id(b))
+        if _maps is None or key not in _maps:
+            got = _pupil_to_offset(a, b, both)
+            if _maps is None:
+                _maps = {}
+            _maps[key] = got
+        gx, gy = _maps[key]
         for only, end, t in ((only_a, a, s), (only_b, b, s - 1.0)):
             ox[only] = end.ox[only] + t * (gx[0] * end.ex[only] + gx[1] * end.ey[only] + gx[2])
             oy[only] = end.oy[only] + t * (gy[0] * end.ex[only] + gy[1] * end.ey[only] + gy[2])
