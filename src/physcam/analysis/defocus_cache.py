@@ -28,7 +28,6 @@ import numpy as np
 
 from ..errors import PhysCamWarning
 
-__all__ = ["read_stacks", "write_stack", "STACK_GLOB"]
 
 STACK_GLOB = "stack-*.npz"
 #: a kernel's channel sums may differ from 1 by this much in a file

@@ -131,7 +131,9 @@ def colour_channels(img: ExrImage) -> list[str]:
 
 def alpha_channel(img: ExrImage, colour: list[str]) -> str | None:
     """The alpha (coverage) channel of the picture's layer, if it has one."""
-    prefix = colour[0][:-1] if colour and colour[0].endswith("R") else ""
+    require_type("image", img, ExrImage, "physcam.analysis.defocus_exr.read_exr(path)")
+    require_type("colour channels", colour, list, "colour_channels(image)")
+    prefix = colour[0][:-1] if colour and isinstance(colour[0], str) and colour[0].endswith("R") else ""
     name = prefix + "A"
     return name if name in img.channels and name not in colour else None
 
@@ -269,9 +271,10 @@ def defocus_file(image_path, output, lens, *, focus_mm: float | None = None, fst
     cam = cache.camera
     if (cam.width, cam.height) != (w, h):
         raise InputError(f"{image_path} is {w} x {h} pixels, the kernel cache's frame {cam.width} x {cam.height}")
-    names = [n for n in colour_channels(img) if n != zname]
+    in_image = None if depth_file is not None else zname  # the depth, when it is a channel of the picture
+    names = [n for n in colour_channels(img) if n != in_image]
     alpha = alpha_channel(img, names)
-    alpha = None if alpha == zname else alpha
+    alpha = None if alpha == in_image else alpha
     chans = img.channels
     stack = np.stack([chans[n] for n in names] + ([chans[alpha]] if alpha else []), axis=2).astype(np.float32)
     u = inverse_depth(z, cam, kind=kind, unit=depth_unit, origin=img.origin)

@@ -35,7 +35,6 @@ import numpy as np
 
 from .defocus_trace import FAR_MM, bin_fan, fan_centroid, interpolate_fan, pupil_boxes, solid_angles, trace_fans
 
-__all__ = ["FieldTable", "field_fractions", "field_table", "probe_nodes", "CENTROID_TOL_PX", "WIDTH_TOL"]
 
 #: the blend of two nodes' kernels may sit this far (px) from the kernel traced between them
 CENTROID_TOL_PX = 0.25

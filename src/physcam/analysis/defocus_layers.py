@@ -32,7 +32,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Frame", "frame_of", "layer_pairs", "layer_grid", "layer_corners", "blur_layer", "fast_len", "convolve"]
 
 
 @dataclass

@@ -43,8 +43,6 @@ import numpy as np
 
 from ..errors import OpticsError
 
-__all__ = ["Fan", "trace_fans", "pupil_boxes", "solid_angles", "interpolate_fan", "fan_centroid", "bin_fan",
-           "CHUNK_RAYS", "FAR_MM"]
 
 #: rays per tracer call (about 100 bytes of memory per ray in flight)
 CHUNK_RAYS = 1 << 20
