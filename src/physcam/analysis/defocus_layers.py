@@ -254,26 +254,37 @@ def _block_sum(a: np.ndarray, s: int) -> np.ndarray:
 
 def _kernel_at_scale(k: np.ndarray, s: int) -> np.ndarray:
     """A kernel (unit sum per channel) for a grid s times coarser. Each fine pixel's share goes to the
-    two nearest coarse pixels linearly (a tent: the sum and the centroid are kept), its offset first
-    shrunk by c per axis so that the blur the coarse grid adds (the sources summed over s x s
-    blocks: s^2 / 12; this tent: s^2 / 6; the bilinear return to full resolution: s^2 / 6) leaves
-    the kernel's second moments as they were: c^2 = 1 - (5 s^2 / 12) / sigma^2 (at least 1/4)."""
+    four nearest coarse pixels bilinearly (a tent: the sum and the centroid are kept), its offset d
+    first mapped to M d, M = V diag(c) V^T on the kernel's principal axes V, so that the blur the
+    coarse grid adds (the sources summed over s x s blocks: s^2 / 12 per axis; this tent: s^2 / 6;
+    the bilinear return to full resolution: s^2 / 6) leaves the kernel's covariance as it was:
+    c_i^2 = 1 - (5 s^2 / 12) / lambda_i (at least 1/4), lambda_i its principal variances."""
     if s == 1:
         return k
     r = k.shape[0] // 2
-    d = np.arange(-r, r + 1, dtype=float)
+    ys, xs = np.mgrid[-r:r + 1, -r:r + 1].astype(float)
     m = k[..., k.shape[2] // 2].astype(float)
-    tot = m.sum()
-    R = r // s + 1
-    out = []
-    for axis in (0, 1):  # rows (y), then columns (x)
-        marg = m.sum(axis=1 - axis)
-        mean = (marg * d).sum() / tot
-        var = (marg * (d - mean) ** 2).sum() / tot
-        c = math.sqrt(max(1.0 - (5.0 * s * s / 12.0) / var, 0.25)) if var > 0 else 1.0
-        out.append(np.clip(1.0 - np.abs(c * d[None, :] - s * (np.arange(2 * R + 1)[:, None] - R)) / s, 0.0, None))
-    wy, wx = out
-    return _trim_kernel(np.einsum("ia,abc,jb->ijc", wy, k, wx).astype(np.float32))
+    t = m.sum()
+    mx, my = (m * xs).sum() / t, (m * ys).sum() / t
+    cov = np.array([[(m * (xs - mx) ** 2).sum(), (m * (xs - mx) * (ys - my)).sum()],
+                    [(m * (xs - mx) * (ys - my)).sum(), (m * (ys - my) ** 2).sum()]]) / t
+    lam, vec = np.linalg.eigh(cov)
+    c = np.sqrt(np.clip(1.0 - (5.0 * s * s / 12.0) / np.maximum(lam, 1e-12), 0.25, 1.0))
+    M = vec @ np.diag(c) @ vec.T
+    px = (M[0, 0] * xs + M[0, 1] * ys) / s  # coarse-pixel coordinates of each fine pixel
+    py = (M[1, 0] * xs + M[1, 1] * ys) / s
+    R = int(math.ceil(np.abs(np.concatenate([px.ravel(), py.ravel()])).max())) + 1
+    n = 2 * R + 1
+    out = np.zeros((n, n, k.shape[2]))
+    x0, y0 = np.floor(px).astype(int), np.floor(py).astype(int)
+    fx, fy = px - x0, py - y0
+    for dy, wy in ((0, 1 - fy), (1, fy)):
+        for dx, wx in ((0, 1 - fx), (1, fx)):
+            idx = ((y0 + dy + R) * n + (x0 + dx + R)).ravel()
+            w = (wy * wx).ravel()
+            for ch in range(k.shape[2]):
+                out[..., ch] += np.bincount(idx, weights=w * k[..., ch].ravel(), minlength=n * n).reshape(n, n)
+    return _trim_kernel(out.astype(np.float32))
 
 
 def _trim_kernel(k: np.ndarray) -> np.ndarray:
