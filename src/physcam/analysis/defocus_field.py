@@ -23,7 +23,10 @@ render's geometry: the lens's distortion (up to 16 px in the corners of a 2K fra
 Gauss) and the pixel or two a cat's eye's centroid moves with depth are left out. A kernel that
 moved its light would leave a seam wherever two tiles' kernels move it differently (a tenth of a
 pixel is a 7 % line on a flat field at a small blur); distortion is applied, if wanted, by
-physcam's ST map (``physcam distortion``), as a compositor redistorts a CG element.
+physcam's ST map (``physcam distortion``), as a compositor redistorts a CG element. So that the ST
+map gives the film's blur back (and does not squeeze it a second time), a kernel's offsets are
+taken from the film's pixels to the render's by the inverse of the distortion's local Jacobian at
+its field node (:func:`~physcam.analysis.defocus_trace.distortion_jacobians`).
 """
 
 from __future__ import annotations
@@ -216,14 +219,15 @@ def _cos_theta(cam, point, d) -> float:
     return d / math.sqrt(d * d + X * X + Y * Y)
 
 
-def node_kernel(cam, fan_a, fan_b, n, maps=None) -> tuple[np.ndarray, tuple[float, float]]:
+def node_kernel(cam, fan_a, fan_b, n, maps=None, unwarp=None) -> tuple[np.ndarray, tuple[float, float]]:
     """The kernel of depth node ``n`` from the ladder fans around it, binned around its light's
-    centroid (module notes) and scaled to a unit sum per channel; and that centroid (px from the
+    centroid (module notes) in the render's pixels (``unwarp``: the inverse of the distortion's
+    local Jacobian there) and scaled to a unit sum per channel; and that centroid (px from the
     pinhole's image)."""
     u = float(cam.node_u(n))
     fan = interpolate_fan(fan_a, fan_b, u, maps) if fan_a is not fan_b else fan_a
     centre = fan_centroid(fan)
-    img, tot = bin_fan(fan, centre, len(cam.wavelengths_nm))
+    img, tot = bin_fan(fan, centre, len(cam.wavelengths_nm), unwarp)
     with np.errstate(invalid="ignore", divide="ignore"):
         img = np.where(tot > 0, img / np.where(tot > 0, tot, 1.0), 0.0)
     return _trim(img).astype(np.float32), centre

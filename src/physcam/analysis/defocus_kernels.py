@@ -59,7 +59,7 @@ LADDER_STEP = 8
 #: samples per lit kernel pixel, and the most and fewest samples of a fan (powers of two)
 SAMPLES_PER_PX, MAX_SAMPLES, MIN_SAMPLES = 8.0, 1 << 16, 1 << 12
 #: what the disk cache's files are laid out as and the field grid's rules (part of the camera key)
-CACHE_FORMAT = "physcam-defocus-kernels/2"
+CACHE_FORMAT = "physcam-defocus-kernels/3"
 
 
 @dataclass
@@ -123,6 +123,11 @@ class DefocusCamera:
         """k: blur diameter (px) per unit of inverse depth (1/mm), thin lens at the entrance pupil
         (the larger of the two meridians')."""
         return max(self.pupil_diameter_mm * self.pinhole_mm, self.pupil_diameter_x_mm * self.pinhole_x_mm) / self.pitch_mm
+
+    @property
+    def blur_per_u_minor(self) -> float:
+        """The same for the meridian of the smaller blur (an anamorphic's oval is narrow one way)."""
+        return min(self.pupil_diameter_mm * self.pinhole_mm, self.pupil_diameter_x_mm * self.pinhole_x_mm) / self.pitch_mm
 
     def blur_px(self, depth_mm):
         """Thin-lens estimate of the blur diameter (px) at planar depth ``depth_mm`` from the pupil."""
@@ -210,7 +215,7 @@ class DefocusCamera:
         its transmission T (module notes), centred on its light's centroid (``offset_px`` from the
         pinhole's image); traced in one batch."""
         from .defocus_field import _trim, box_depths
-        from .defocus_trace import bin_fan, fan_centroid, pupil_boxes, trace_fans
+        from .defocus_trace import bin_fan, distortion_jacobians, fan_centroid, pupil_boxes, trace_fans
 
         pts = [(float(x), float(y)) for x, y, _ in points]
         ds = [min(require_positive("depth", d), FAR_MM) for _, _, d in points]
@@ -222,11 +227,12 @@ class DefocusCamera:
             n = self.samples(math.floor(t), math.ceil(t))
             jobs += [(p, 1.0 / d, box, n), (axis, 1.0 / d, boxes[-1], n)]
         fans = trace_fans(self, jobs)
+        unwarps = np.linalg.inv(distortion_jacobians(self, pts))
         out, ch = [], len(self.wavelengths_nm)
         for i, ((x, y), d) in enumerate(zip(pts, ds)):
             fan, ax_fan = fans[2 * i], fans[2 * i + 1]
             centre = fan_centroid(fan)
-            img, tot = bin_fan(fan, centre, ch)
+            img, tot = bin_fan(fan, centre, ch, unwarps[i])
             ax = np.bincount(ax_fan.ch, weights=ax_fan.w, minlength=ch)[:ch]
             sx, sy = self.film_point(x, y)
             cos_t = d / math.sqrt(d * d + (sx * d / self.pinhole_x_mm) ** 2 + (sy * d / self.pinhole_mm) ** 2)
@@ -434,7 +440,7 @@ class KernelCache:
         """Node kernels of ``missing`` from fans traced at their ladder nodes, field node by field
         node in batches of about 4 million rays."""
         from .defocus_field import box_depths, node_kernel
-        from .defocus_trace import pupil_boxes, trace_fans
+        from .defocus_trace import distortion_jacobians, pupil_boxes, trace_fans
 
         cam = self.camera
         cols, rows = self.grid
@@ -461,7 +467,9 @@ class KernelCache:
             jobs = [(p, float(cam.node_u(m)), box, k) for (_, p, need, _), box in zip(batch, boxes)
                     for m, k in sorted(need.items())]
             fans = iter(trace_fans(cam, jobs))
+            unwarps = iter(np.linalg.inv(distortion_jacobians(cam, [p for _, p, _, _ in batch])))
             for (cr, p, need, ns) in batch:
+                unwarp = next(unwarps)
                 got = {m: next(fans) for m in sorted(need)}
                 maps, cut = {}, {}
                 for n in ns:
@@ -469,7 +477,7 @@ class KernelCache:
                     k = cam.samples(a, b)
                     if (a, b) not in cut:  # one prefix pair per interval, so its pupil map is fitted once
                         cut[(a, b)] = (got[a].prefix(k), got[b].prefix(k))
-                    img, _ = node_kernel(cam, *cut[(a, b)], n, maps)
+                    img, _ = node_kernel(cam, *cut[(a, b)], n, maps, unwarp)
                     out[cr + (n,)] = img
                 done += len(ns)
                 if progress is not None:

@@ -319,11 +319,12 @@ def blur_layer(f: Frame, cache, n: int, tiles) -> dict | None:
 
 
 def layer_grid(f: Frame, cam, n: int, tiles):
-    """How node n is blurred: its resolution divisor s (from the thin-lens blur there: a power of
-    two bringing the kernel's radius to about :data:`LOW_RES_RADIUS`), the low-res pixels per tile
-    side and the box (y0, y1, x0, x1 of the padded frame) its tiles' sources are summed over."""
+    """How node n is blurred: its resolution divisor s (from the thin-lens blur there, along the
+    narrower meridian of an anamorphic's oval: a power of two bringing the kernel's radius to about
+    :data:`LOW_RES_RADIUS`), the low-res pixels per tile side and the box (y0, y1, x0, x1 of the
+    padded frame) its tiles' sources are summed over."""
     t = f.tile
-    radius = 0.55 * float(cam.blur_px_at(n)) + 1.0
+    radius = 0.55 * float(cam.blur_px_at(n)) * cam.blur_per_u_minor / cam.blur_per_u + 1.0
     s = _scale(radius, t)
     step = max(t // s, MIN_CORNER_STEP)
     m, H, W = f.margin, f.lo.shape[0], f.lo.shape[1]

@@ -128,26 +128,32 @@ def _trace(cam, rays):
     return out.x, out.y, ok, out.weight
 
 
-def pupil_boxes(cam, fields_px, us) -> list[tuple[float, float, float, float]]:
-    """For each field node, the box (x0, x1, y0, y1, mm on the entrance pupil's plane) that holds
-    every ray from its object points at inverse depths ``us`` that reaches the film (module notes)."""
-    z_ep = cam.film_z - cam.pupil_from_film_mm
+def _pilot_grids(cam, pts, z_ep):
+    """The pilot's aim points on the pupil's plane for object points ``pts`` (n, 3): a grid over the
+    front element's clear disk seen from each point, and a finer one over the paraxial entrance
+    pupil; (x, y, cell size), each (n, points per object point)."""
     r_front = cam.focused.surfaces[0].semi_diameter
     r_ep = 0.5 * max(cam.pupil_diameter_mm, cam.pupil_diameter_x_mm)
-    pts = np.array([_object_point(cam, f, u)[:3] for f in fields_px for u in us])  # (k * len(us), 3)
     s = (z_ep - pts[:, 2]) / (0.0 - pts[:, 2])  # the front vertex plane (z = 0) seen from the point, on the pupil's
     centres = np.stack([pts[:, 0] * (1 - s), pts[:, 1] * (1 - s)], axis=1)
-    grids = []
+    out = []
     for n, c, half in ((_PILOT_FRONT, centres, r_front * s), (_PILOT_PUPIL, np.zeros_like(centres),
                                                                 np.full(len(s), 1.5 * r_ep))):
         g = (np.arange(n) + 0.5) / n * 2 - 1
         gx, gy = (a.ravel() for a in np.meshgrid(g, g))
-        ax = c[:, 0:1] + half[:, None] * gx[None, :]
-        ay = c[:, 1:2] + half[:, None] * gy[None, :]
-        grids.append((ax, ay, np.repeat((2 * half / n)[:, None], n * n, axis=1)))
-    ax = np.concatenate([g[0] for g in grids], axis=1)
-    ay = np.concatenate([g[1] for g in grids], axis=1)
-    cell = np.concatenate([g[2] for g in grids], axis=1)
+        out.append((c[:, 0:1] + half[:, None] * gx[None, :], c[:, 1:2] + half[:, None] * gy[None, :],
+                    np.repeat((2 * half / n)[:, None], n * n, axis=1)))
+    return tuple(np.concatenate([o[i] for o in out], axis=1) for i in range(3))
+
+
+def pupil_boxes(cam, fields_px, us) -> list[tuple[float, float, float, float]]:
+    """For each field node, the box (x0, x1, y0, y1, mm on the entrance pupil's plane) that holds
+    every ray from its object points at inverse depths ``us`` that reaches the film (module notes);
+    the paraxial pupil's box where none does (the frame is wider than the lens covers: no light)."""
+    z_ep = cam.film_z - cam.pupil_from_film_mm
+    r_ep = 0.5 * max(cam.pupil_diameter_mm, cam.pupil_diameter_x_mm)
+    pts = np.array([_object_point(cam, f, u)[:3] for f in fields_px for u in us])  # (k * len(us), 3)
+    ax, ay, cell = _pilot_grids(cam, pts, z_ep)
     m = ax.shape[1]
     rays, _ = _rays(np.repeat(pts[:, 0], m), np.repeat(pts[:, 1], m), np.repeat(pts[:, 2], m), ax.ravel(), ay.ravel(),
                     z_ep, np.full(ax.size, cam.wavelengths_nm[len(cam.wavelengths_nm) // 2]))
@@ -155,11 +161,11 @@ def pupil_boxes(cam, fields_px, us) -> list[tuple[float, float, float, float]]:
     ok = ok.reshape(len(fields_px), -1)
     ax, ay, cell = (a.reshape(len(fields_px), -1) for a in (ax, ay, cell))
     boxes = []
-    for k, f in enumerate(fields_px):
+    for k in range(len(fields_px)):
         sel = ok[k]
         if not sel.any():
-            raise OpticsError(f"no light from the picture position ({f[0]:g}, {f[1]:g}) px reaches the film through "
-                              f"{cam.lens.name}: the frame is wider than the lens covers")
+            boxes.append((-r_ep, r_ep, -r_ep, r_ep))
+            continue
         c = cell[k][sel].max()
         bx, by = ax[k][sel], ay[k][sel]
         boxes.append((bx.min() - c, bx.max() + c, by.min() - c, by.max() + c))
@@ -173,6 +179,8 @@ def solid_angles(cam, fields_px, us) -> np.ndarray:
     wls = np.asarray(cam.wavelengths_nm, dtype=float)
     pts = np.array([_object_point(cam, f, u)[:3] for f in fields_px for u in us])
     centre = _pilot_centres(cam, pts, z_ep)
+    dark = np.isnan(centre[:, 0])  # no light passes from these points
+    centre = np.nan_to_num(centre)
     m = len(pts) * len(wls)
     px, py, pz = (np.repeat(np.repeat(pts[:, i], len(wls)), AZIMUTHS) for i in range(3))
     cx, cy = (np.repeat(np.repeat(centre[:, i], len(wls)), AZIMUTHS) for i in range(2))
@@ -195,25 +203,23 @@ def solid_angles(cam, fields_px, us) -> np.ndarray:
         _, _, ok, weight = _trace(cam, rays)
         total += wt * t * np.where(ok, weight, 0.0) * cos3
     omega = (total * lo * lo).reshape(m, AZIMUTHS).sum(axis=1) * (2 * math.pi / AZIMUTHS)
+    omega[np.repeat(dark, len(wls))] = 0.0
     return omega.reshape(len(fields_px), len(us), len(wls))
 
 
 def _pilot_centres(cam, pts, z_ep) -> np.ndarray:
-    """For each object point (n, 3), the centre of the pilot rays to the pupil's plane that pass."""
-    r = 1.5 * 0.5 * max(cam.pupil_diameter_mm, cam.pupil_diameter_x_mm)
-    n = _PILOT_PUPIL
-    g = (np.arange(n) + 0.5) / n * 2 - 1
-    gx, gy = (a.ravel() * r for a in np.meshgrid(g, g))
-    k = len(gx)
-    rays, _ = _rays(np.repeat(pts[:, 0], k), np.repeat(pts[:, 1], k), np.repeat(pts[:, 2], k), np.tile(gx, len(pts)),
-                    np.tile(gy, len(pts)), z_ep, np.full(k * len(pts), cam.wavelengths_nm[len(cam.wavelengths_nm) // 2]))
+    """For each object point (n, 3), the centre of the pilot rays to the pupil's plane that pass
+    (module notes: the grids of :func:`pupil_boxes`); NaN where none passes."""
+    grids = _pilot_grids(cam, pts, z_ep)
+    ax, ay = grids[0], grids[1]
+    m = ax.shape[1]
+    rays, _ = _rays(np.repeat(pts[:, 0], m), np.repeat(pts[:, 1], m), np.repeat(pts[:, 2], m), ax.ravel(), ay.ravel(),
+                    z_ep, np.full(ax.size, cam.wavelengths_nm[len(cam.wavelengths_nm) // 2]))
     _, _, ok, _ = _trace(cam, rays)
-    ok = ok.reshape(len(pts), k)
+    ok = ok.reshape(len(pts), m)
     cnt = ok.sum(axis=1)
-    if (cnt == 0).any():
-        raise OpticsError(f"no light from a picture position reaches the film through {cam.lens.name}: "
-                          "the frame is wider than the lens covers")
-    return np.stack([(ok * gx).sum(axis=1) / cnt, (ok * gy).sum(axis=1) / cnt], axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.stack([(ok * ax).sum(axis=1) / cnt, (ok * ay).sum(axis=1) / cnt], axis=1)
 
 
 def trace_fans(cam, jobs) -> list[Fan]:
@@ -299,6 +305,23 @@ def _pupil_to_offset(a: Fan, b: Fan, both):
     return g[:, 0], g[:, 1]
 
 
+def distortion_jacobians(cam, fields_px, step_px: float = 4.0) -> np.ndarray:
+    """(k, 2, 2): at each picture position, how the lens's image of the plane of focus moves on the
+    film (px) per pixel the point moves in the render, d(film) / d(render), from the light's
+    centroids of points ``step_px`` either side (the same samples for all four: their noise cancels).
+    The identity for a lens without distortion; its inverse takes a kernel from the film's pixels to
+    the render's, so that an ST map's redistortion gives the film's blur back, not squeezed twice."""
+    pts = [(x + dx, y + dy) for x, y in fields_px for dx, dy in ((step_px, 0), (-step_px, 0), (0, step_px), (0, -step_px))]
+    boxes = pupil_boxes(cam, [tuple(f) for f in fields_px], [cam.focus_u])
+    fans = trace_fans(cam, [(p, cam.focus_u, boxes[i // 4], 1 << 11) for i, p in enumerate(pts)])
+    out = np.empty((len(fields_px), 2, 2))
+    for k, (x, y) in enumerate(fields_px):
+        c = [np.array(fan_centroid(f)) + np.array(p) for f, p in zip(fans[4 * k: 4 * k + 4], pts[4 * k: 4 * k + 4])]
+        out[k, :, 0] = (c[0] - c[1]) / (2 * step_px)
+        out[k, :, 1] = (c[2] - c[3]) / (2 * step_px)
+    return out
+
+
 def fan_centroid(fan: Fan) -> tuple[float, float]:
     """The weighted mean offset of a fan's light (px)."""
     t = fan.w.sum()
@@ -308,15 +331,18 @@ def fan_centroid(fan: Fan) -> tuple[float, float]:
     return float((fan.w[good] * fan.ox[good]).sum() / t), float((fan.w[good] * fan.oy[good]).sum() / t)
 
 
-def bin_fan(fan: Fan, centre: tuple[float, float], channels: int) -> tuple[np.ndarray, np.ndarray]:
+def bin_fan(fan: Fan, centre: tuple[float, float], channels: int, unwarp=None) -> tuple[np.ndarray, np.ndarray]:
     """The fan binned on the picture's pixel grid around ``centre`` (px): (2R+1, 2R+1, channels) of
     summed weights, the centre pixel covering offsets within half a pixel of ``centre``; and each
-    channel's total weight."""
+    channel's total weight. ``unwarp`` (2 x 2) maps each offset first (from the film's pixels to the
+    render's: :func:`distortion_jacobians`)."""
     good = fan.w > 0
     tot = np.bincount(fan.ch[good], weights=fan.w[good], minlength=channels)[:channels]
-    if not good.any():
-        return np.zeros((1, 1, channels)), tot
+    if not good.any():  # no light: a unit kernel (the transmission, 0 there, darkens the pixel)
+        return np.ones((1, 1, channels)), np.ones(channels)
     dx, dy = fan.ox[good] - centre[0], fan.oy[good] - centre[1]
+    if unwarp is not None:
+        dx, dy = unwarp[0, 0] * dx + unwarp[0, 1] * dy, unwarp[1, 0] * dx + unwarp[1, 1] * dy
     r = int(math.ceil(max(np.abs(dx).max(), np.abs(dy).max()) + 0.5))
     if r > 2048:
         raise OpticsError("the blur is over 4096 pixels across: give a nearer depth limit")
