@@ -292,8 +292,11 @@ class _Budget:
             r = max(-(-2 * lay["radius"] // q), 2)
             with np.errstate(invalid="ignore", divide="ignore"):
                 scale = np.clip(np.nan_to_num(_box_sum(avail, r) / _box_sum(gc, r), posinf=0.0), 0.0, 1.0)
-            full = _upsample_cells(scale, q, (self.shape[0] * q, self.shape[1] * q))
-            out[box] += full[box][..., None] * gain
+            cy0, cx0 = max(y0 // q - 1, 0), max(x0 // q - 1, 0)  # the box's cells and one around
+            cy1, cx1 = -(-box[0].stop // q) + 1, -(-box[1].stop // q) + 1
+            part = _upsample_cells(scale[cy0:cy1, cx0:cx1], q, ((cy1 - cy0) * q, (cx1 - cx0) * q))
+            part = part[y0 - cy0 * q: box[0].stop - cy0 * q, x0 - cx0 * q: box[1].stop - cx0 * q]  # (0, 0): (cy0 q, cx0 q)
+            out[box] += part[..., None] * gain
             avail = np.maximum(avail - scale * gc, 0.0)
         self.carry = np.minimum(avail, own)  # a node's loss funds its own fill and the next one's, no more
 

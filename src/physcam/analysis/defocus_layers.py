@@ -356,12 +356,12 @@ def _transmission_blocks(f: Frame, cache, n: int, y0: int, x0: int, shape, s: in
 
 def _corners(f: Frame, cache, n: int, low: dict, s: int, t: int, origin):
     """The low-resolution planes blurred tile by tile (tiles of ``t`` low-res pixels), each pixel
-    with the bilinear blend of its tile's four corner kernels, to first order: ``K = Kc + xi Kx +
-    eta Ky`` (xi, eta in -1/2..1/2 across the tile; the twist term, second order, left out), so a
-    tile is three convolutions (of the planes, xi times them and eta times them), summed in the
-    Fourier domain; one where its corners' kernels agree within :data:`SAME_KERNEL`. Neighbouring
-    tiles share their corners: the kernel is continuous across tile borders (no seams). Returns
-    the blurred planes over the box grown by the largest kernel radius r, and r."""
+    with the bilinear blend of its tile's four corner kernels: ``K = Kc + xi Kx + eta Ky + xi eta
+    Kxy`` (xi, eta in -1/2..1/2 across the tile), so a tile is four convolutions (of the planes and
+    of xi, eta and xi eta times them), summed in the Fourier domain; one where its corners' kernels
+    agree within :data:`SAME_KERNEL`. Neighbouring tiles share their corners: the kernel is
+    continuous across tile borders (no seams). Tiles are batched by the size of their own kernels.
+    Returns the blurred planes over the box grown by the largest kernel radius R, and R."""
     h, w = low["A"].shape
     c = f.colour.shape[2]
     cover = [k for k in ("A", "U", "A1", "U1") if k in low]
@@ -374,37 +374,39 @@ def _corners(f: Frame, cache, n: int, low: dict, s: int, t: int, origin):
             sl = (slice(None), slice(ty * t, (ty + 1) * t), slice(tx * t, (tx + 1) * t))
             if not (cov[sl].any() or light[sl].any() or (g is not None and g[sl].any())):
                 continue
-            for cy, cx in ((ty, tx), (ty, tx + 1), (ty + 1, tx), (ty + 1, tx + 1)):
+            corners = ((ty, tx), (ty, tx + 1), (ty + 1, tx), (ty + 1, tx + 1))
+            for cy, cx in corners:
                 if (cy, cx) not in kern:
                     pos = (f.origin[0] + origin[1] + cx * t * s, f.origin[1] + origin[0] + cy * t * s)
                     kern[(cy, cx)] = cache.scaled_kernel(pos[0], pos[1], n, s, _kernel_at_scale)
-            key = (g is not None and bool(g[sl].any()), _varies(kern, ty, tx))
+            r = max(kern[cn].shape[0] for cn in corners) // 2
+            key = (g is not None and bool(g[sl].any()), _varies(kern, ty, tx), r + r % 2)  # radii batched in pairs
             groups.setdefault(key, []).append((ty, tx))
-    r = max(k.shape[0] for k in kern.values()) // 2
-    kern = {key: _pad_kernel(k, r) for key, k in kern.items()}
+    R = max(k for _, _, k in groups)
     H2, W2 = -(-h // t) * t, -(-w // t) * t  # whole tiles: the last row and column padded with zeros
-    out = {"V": np.zeros((c, H2 + 2 * r, W2 + 2 * r), np.float32),
-           "cov": np.zeros((len(cover), H2 + 2 * r, W2 + 2 * r), np.float32)}
+    out = {"V": np.zeros((c, H2 + 2 * R, W2 + 2 * R), np.float32),
+           "cov": np.zeros((len(cover), H2 + 2 * R, W2 + 2 * R), np.float32)}
     if g is not None:
         out["G"] = np.zeros_like(out["V"])
-    for (with_g, varies), tiles in groups.items():
+    padded: dict = {}
+    for (with_g, varies, r), tiles in groups.items():
         names = ["V"] + (["G"] if with_g else []) + cover
         stack = np.concatenate([light] + ([g] if with_g else []) + [cov], axis=0)
         if stack.shape[1:] != (H2, W2):
             stack = np.pad(stack, ((0, 0), (0, H2 - h), (0, W2 - w)))
         for b in range(0, len(tiles), _BATCH):
-            res = _blur_tiles(stack, tiles[b:b + _BATCH], kern, t, r, names, c, varies)
+            res = _blur_tiles(stack, tiles[b:b + _BATCH], kern, padded, t, r, names, c, varies)
             for i, (ty, tx) in enumerate(tiles[b:b + _BATCH]):
-                box = (slice(ty * t, ty * t + t + 2 * r), slice(tx * t, tx * t + t + 2 * r))
+                box = (slice(ty * t + R - r, ty * t + R + t + r), slice(tx * t + R - r, tx * t + R + t + r))
                 out["V"][(slice(None),) + box] += res[i, :c]
                 if with_g:
                     out["G"][(slice(None),) + box] += res[i, c:2 * c]
                 out["cov"][(slice(None),) + box] += res[i, -len(cover):]
-    cut = (slice(None), slice(0, h + 2 * r), slice(0, w + 2 * r))
+    cut = (slice(None), slice(0, h + 2 * R), slice(0, w + 2 * R))
     planes = {k: np.moveaxis(np.maximum(out[k][cut], 0.0), 0, 2) for k in ("V", "G") if k in out}
     for i, k in enumerate(cover):
         planes[k] = np.maximum(out["cov"][i][cut[1:]], 0.0)
-    return planes, r
+    return planes, R
 
 
 #: a tile whose corner kernels differ by less than this (sum of absolute differences) is blurred
@@ -420,11 +422,16 @@ def _varies(kern: dict, ty: int, tx: int) -> bool:
     return any(float(np.abs(k - ks[0]).sum()) > SAME_KERNEL * k.shape[2] for k in ks[1:])
 
 
-def _blur_tiles(stack, tiles, kern, t, r, names, c, varies) -> np.ndarray:
-    """(tiles, planes, t + 2r, t + 2r): the tiles of ``stack`` blurred (:func:`_corners`)."""
+def _blur_tiles(stack, tiles, kern, padded, t, r, names, c, varies) -> np.ndarray:
+    """(tiles, planes, t + 2r, t + 2r): the tiles of ``stack`` blurred (:func:`_corners`); ``padded``
+    memoises the corner kernels padded to radius r."""
     ramp = ((np.arange(t) + 0.5) / t - 0.5).astype(np.float32)
     blocks = np.stack([stack[:, ty * t:(ty + 1) * t, tx * t:(tx + 1) * t] for ty, tx in tiles])  # (k, P, t, t)
-    kb = np.stack([_terms(kern, ty, tx, r) for ty, tx in tiles])  # (k, 3, channels, n, n)
+    for ty, tx in tiles:
+        for cn in ((ty, tx), (ty, tx + 1), (ty + 1, tx), (ty + 1, tx + 1)):
+            if (cn, r) not in padded:
+                padded[(cn, r)] = _pad_kernel(kern[cn], r)
+    kb = np.stack([_terms(padded, ty, tx, r) for ty, tx in tiles])  # (k, 4, channels, n, n)
     if varies:
         bx = blocks * ramp[None, None, None, :]
         terms = np.stack([blocks, bx, blocks * ramp[None, None, :, None], bx * ramp[None, None, :, None]], axis=1)
@@ -440,9 +447,10 @@ def _blur_tiles(stack, tiles, kern, t, r, names, c, varies) -> np.ndarray:
     return np.fft.irfft2(spec.sum(axis=1), s=(size, size))[..., :t + 2 * r, :t + 2 * r]
 
 
-def _terms(kern: dict, ty: int, tx: int, r: int) -> np.ndarray:
+def _terms(padded: dict, ty: int, tx: int, r: int) -> np.ndarray:
     """(4, channels, 2r + 1, 2r + 1): the kernels Kc, Kx, Ky, Kxy of tile (ty, tx) (see :func:`_corners`)."""
-    k00, k01, k10, k11 = kern[(ty, tx)], kern[(ty, tx + 1)], kern[(ty + 1, tx)], kern[(ty + 1, tx + 1)]
+    k00, k01 = padded[((ty, tx), r)], padded[((ty, tx + 1), r)]
+    k10, k11 = padded[((ty + 1, tx), r)], padded[((ty + 1, tx + 1), r)]
     kc = 0.25 * (k00 + k01 + k10 + k11)
     kx = 0.5 * (k01 + k11 - k00 - k10)
     ky = 0.5 * (k10 + k11 - k00 - k01)
