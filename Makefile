@@ -31,7 +31,10 @@ $(STAMP): $(PY) pyproject.toml constraints.txt
 
 venv: $(STAMP)
 
+# demo-output is make demo's own folder: one written by a physcam from before folders carried a
+# manifest (physcam-manifest.json) is removed first, since --force replaces only a folder physcam wrote whole
 demo: $(STAMP)
+	@if [ -d demo-output ] && [ ! -f demo-output/physcam-manifest.json ]; then rm -rf demo-output; fi
 	$(VENV)/bin/physcam demo --out demo-output --force
 	@echo "physcam is installed in $(VENV): run it as $(VENV)/bin/physcam, or type 'make shell' for a shell where 'physcam' works"
 
@@ -102,10 +105,11 @@ test-latest:
 	$(LATEST_VENV)/bin/python -m pip install --quiet --upgrade pip
 	$(LATEST_VENV)/bin/python -m pip install --quiet --upgrade -e '.[all]' pytest pytest-xdist hypothesis opencv-python-headless
 	@$(LATEST_VENV)/bin/python -m pip list --format=freeze 2>/dev/null \
-	  | grep -i -E '^(numpy|numba|matplotlib|usd-core|openexr|jsonschema|cbor2|dask|pyarrow|starlette|uvicorn)=' \
+	  | grep -i -E '^(numpy|numba|matplotlib|usd-core|openexr|jsonschema|cbor2|dask|pyarrow|starlette|uvicorn|openjd-model|opencue.pyoutline)=' \
 	  | tr '\n' ' ' | sed 's/^/physcam: newest versions tested: /'; echo
 	$(LATEST_VENV)/bin/python -m pytest -n 2 -q -m "not slow" -p no:cacheprovider tests/onset tests/optics \
-	  tests/lens tests/usd tests/live tests/trace/test_tracer.py tests/analysis/test_image_quality_closed_forms.py
+	  tests/lens tests/usd tests/live tests/trace/test_tracer.py tests/analysis/test_image_quality_closed_forms.py \
+	  tests/farm/test_farm_jobs.py
 
 # ruff (pyproject.toml [tool.ruff]): unused imports and variables, undefined names, pycodestyle errors
 lint: $(STAMP)

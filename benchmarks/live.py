@@ -7,13 +7,18 @@ seconds; this process receives them (header, Fletcher-16, decode, schema validat
 records each as a frame (:func:`physcam.live.frames.frame_from_sample`). The rate doubles, then is
 bisected, to the highest one with no sample lost (received = sent, nothing missing or dropped).
 
+``--journal``: record as ``physcam live record`` does: each sample is also appended to a take journal
+(:mod:`physcam.live.journal`, synced every 0.5 s) and taken into a :class:`~physcam.live.take.Take`.
+Before the trials the script prints the CPU time per sample of each step (decode and validate, the
+frame, the journal line, the take), measured side by side on the same samples.
+
 ``--attack``: a second process attacks the receiver during every trial (issue 24): overlapping
 32 KB segments of never-finished samples (``--attack-rate`` datagrams/s), and ten times a second a
 packet with a valid checksum that is no sample and a valid sample of the stream's source far off its
 sequence. The trial also reports the receiver's reassembly high water and the process's peak RSS
 growth (``/proc/self/status`` VmHWM, reset before each trial). Plain script, prints figures:
 
-    .venv/bin/python benchmarks/live.py [--seconds 3] [--cbor] [--attack [--attack-rate 2000]]
+    .venv/bin/python benchmarks/live.py [--seconds 3] [--cbor] [--journal] [--attack [--attack-rate 2000]]
 """
 
 from __future__ import annotations
@@ -102,10 +107,68 @@ def _samples(path: str, count: int = 2400) -> int:
     return len(json.dumps(samples[1]).encode())
 
 
-def trial(rate: float, seconds: float, enc: str, path: str, attack_rate: float = 0.0) -> dict:
+def _recorder(journal: bool, folder: str):
+    """What the benchmark does with each sample: a frame, or (``journal``) as live record: journal and take."""
     from physcam.live.frames import frame_from_sample
+
+    if not journal:
+        return (lambda item: frame_from_sample(item.sample)), (lambda: None)
+    from physcam.live.journal import Journal
+    from physcam.live.take import Take
+
+    j = Journal.create(os.path.join(folder, "bench.usda"), {"output": "bench.usda", "report": None, "options": {}})
+    take = Take()
+
+    def record(item):
+        j.add_sample(item.sample, item.sequence, item.encoding)
+        j.sync()
+        take.add(item.sample, item.sequence)
+    return record, j.discard
+
+
+def cpu_costs(path: str, n: int = 1000) -> dict:
+    """CPU µs per sample of each step of recording, measured side by side (process_time)."""
+    import tempfile
+
+    from physcam.live.frames import frame_from_sample
+    from physcam.live.journal import Journal
+    from physcam.live.sample import decode_sample, encode_sample
+    from physcam.live.take import Take
+
+    samples = [json.loads(line) for line in open(path)][:n]
+    payloads = [encode_sample(s) for s in samples]
+    decode_sample(payloads[0])  # the validator is built once per process
+    out, clock = {}, time.process_time
+    t = clock()
+    decoded = [decode_sample(p) for p in payloads]
+    out["decode and validate"] = clock() - t
+    t = clock()
+    for s in decoded:
+        frame_from_sample(s)
+    out["frame"] = clock() - t
+    with tempfile.TemporaryDirectory() as d:
+        j = Journal.create(os.path.join(d, "c.usda"), {"output": "c.usda", "report": None, "options": {}})
+        t = clock()
+        for i, s in enumerate(decoded):
+            j.add_sample(s, i, "json")
+            j.sync()
+        out["journal line"] = clock() - t
+        j.discard()
+    take = Take()
+    t = clock()
+    for i, s in enumerate(decoded):
+        take.add(s, i)
+    out["take (frame included)"] = clock() - t
+    return {k: v / len(decoded) * 1e6 for k, v in out.items()}
+
+
+def trial(rate: float, seconds: float, enc: str, path: str, attack_rate: float = 0.0, journal: bool = False) -> dict:
+    import tempfile
+
     from physcam.live.receiver import Receiver
 
+    folder = tempfile.mkdtemp()
+    record, done = _recorder(journal, folder)
     recorded = 0
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
     rss0 = _reset_peak_rss()
@@ -120,12 +183,12 @@ def trial(rate: float, seconds: float, enc: str, path: str, attack_rate: float =
         while proc.poll() is None or rx.counters()["received"] < int(rate * seconds):
             item = rx.get(timeout=0.05)
             if item is not None:
-                frame_from_sample(item.sample)
+                record(item)
                 recorded += 1
             elif proc.poll() is not None and time.perf_counter() - t0 > seconds + 2.0:
                 break  # the sender has finished and nothing more arrives
         while (item := rx.get(timeout=0.2)) is not None:
-            frame_from_sample(item.sample)
+            record(item)
             recorded += 1
         elapsed = time.perf_counter() - t0
         sent, send_s = proc.stdout.read().split()
@@ -134,6 +197,8 @@ def trial(rate: float, seconds: float, enc: str, path: str, attack_rate: float =
             attacker.wait()
         c = rx.counters()
         high = dict(rx.high_water)
+    done()
+    os.rmdir(folder)
     peak = _status_kib("VmHWM") * 1024 - rss0
     return {"rate": rate, "sent": int(sent), "recorded": recorded, "send_s": float(send_s), "elapsed_s": elapsed,
             "lost": int(sent) - recorded, "counters": c, "attacks": attacks, "high_water": high,
@@ -155,6 +220,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=3.0, help="length of each trial")
     ap.add_argument("--cbor", action="store_true", help="CBOR payloads (default JSON)")
+    ap.add_argument("--journal", action="store_true", help="journal and take each sample, as live record does")
     ap.add_argument("--attack", action="store_true", help="attack the receiver during every trial (module notes)")
     ap.add_argument("--attack-rate", type=float, default=2000.0, help="overlapping 32 KB segments per second")
     args = ap.parse_args()
@@ -163,12 +229,16 @@ def main() -> None:
     path = os.path.join(os.path.dirname(os.path.abspath(__file__)), ".live_samples.jsonl")
     size = _samples(path)
     print(f"sample: {size} bytes of JSON ({enc} on the wire), one packet each; {args.seconds:g} s per trial"
-          + (f"; under attack, {attack:g} overlapping 32 KB segments/s" if attack else ""))
+          + (f"; under attack, {attack:g} overlapping 32 KB segments/s" if attack else "")
+          + ("; journal and take as live record" if args.journal else ""))
+    costs = cpu_costs(path)
+    print("CPU per sample: " + ", ".join(f"{k} {v:.0f} us" for k, v in costs.items())
+          + f"; journal line / decode and validate = {costs['journal line'] / costs['decode and validate']:.2f}")
     good, bad = 0.0, None
     rate = GOAL / 2
     try:
         while bad is None and rate <= 64 * GOAL:  # double until a trial loses samples
-            r = trial(rate, args.seconds, enc, path, attack)
+            r = trial(rate, args.seconds, enc, path, attack, args.journal)
             _report(rate, r)
             if r["lost"] == 0 and r["send_s"] <= args.seconds * 1.05:
                 good = rate
@@ -177,7 +247,7 @@ def main() -> None:
                 bad = rate
         for _ in range(4 if bad else 0):  # bisect between the last good and the first bad rate
             mid = (good + bad) / 2
-            r = trial(mid, args.seconds, enc, path, attack)
+            r = trial(mid, args.seconds, enc, path, attack, args.journal)
             _report(mid, r)
             if r["lost"] == 0 and r["send_s"] <= args.seconds * 1.05:
                 good = mid

@@ -1,7 +1,11 @@
 #!/usr/bin/env python
-"""Convert every reference lens file into physcam's bundled library (physcam TOML).
+"""Convert every reference lens file into drafts of physcam's bundled library (physcam TOML).
 
-    .venv/bin/python scripts/build_lens_library.py [--reference DIR] [--out DIR] [--force]
+    .venv/bin/python scripts/build_lens_library.py --out DRAFTS/ [--reference DIR] [--force]
+
+The bundled files (``src/physcam/data/lenses``) were made by this script and are since kept by
+hand: each carries a provenance record (issue 44, docs/lens-library.md) and catalogue glasses that
+the drafts do not have, so the script writes drafts to compare with them, never over them.
 
 Reads ../shared/reference/lenses/ (or tests/data/reference_lenses/){pbrt-dat,iset-json,physical-camera-toml} with
 physcam's own readers (without validation), adds curated metadata and provenance, applies the
@@ -93,9 +97,11 @@ def convert(path: Path, fmt: str, folder: str) -> tuple[str, Prescription]:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--reference", default=str(Path(__file__).resolve().parents[1] / "tests" / "data" / "reference_lenses"))
-    ap.add_argument("--out", default=str(ROOT / "src/physcam/data/lenses"))
+    ap.add_argument("--out", required=True, help="folder for the drafts (not the bundled library: it is kept by hand)")
     ap.add_argument("--force", action="store_true", help="overwrite existing library files")
     args = ap.parse_args(argv)
+    if Path(args.out).resolve() == (ROOT / "src/physcam/data/lenses").resolve():
+        ap.error("the bundled library is kept by hand (provenance records): write the drafts elsewhere and compare")
     ref = Path(args.reference)
     jobs = [(f, "pbrt", "pbrt-dat") for f in sorted((ref / "pbrt-dat").glob("*.dat"))]
     jobs += [(f, "iset", "iset-json") for f in sorted((ref / "iset-json").glob("*.json"))]

@@ -16,12 +16,24 @@ at the file's distance (the object surface's DISZ), so optiland sizes the pupil 
 is optiland's entrance-pupil diameter. optiland's F2 is the rear focal point from the image surface, divided
 by the image-space index (a reduced distance); it is multiplied back and the last thickness
 added: the BFL from the last lens vertex that physcam reports.
+
+Issue 40 item 15 adds Thorlabs' negative lenses (a stop on a concave first face, a virtual image
+behind the lens: LC1120-A, LD1170-B, ACN254-050-A) and the B270 condenser ACL3026U, built from
+the numbers of Thorlabs' published .zmx with optiland's own glasses (B270: SCHOTT's 1993 data
+sheet, a source independent of the Zemax catalogue physcam reads), and a double Gauss in SCHOTT's
+legacy glasses (SK16, SK1, F15, SSK4A). optiland's own lookup has no such glasses and takes
+others of similar name (F15 -> SF15, SK1 -> HIKARI SK16: it says so in a warning), so the legacy
+lens is built twice: with the legacy glasses' Sellmeier coefficients as printed in Zemax's
+SCHOTT.AGF (2008; the CD lines, written here as refractiveindex.info "formula 2" files that
+optiland evaluates itself), and with optiland's lookup, whose EFL is kept as
+"efl_mm_optiland_lookup" to show the substitution physcam does not make.
 """
 
 import json
+import tempfile
 from pathlib import Path
 
-from optiland.materials import AbbeMaterial, Material
+from optiland.materials import AbbeMaterial, Material, MaterialFile
 from optiland.optic import Optic
 
 OUT = Path(__file__).resolve().parents[1] / "tests" / "data" / "optiland_zemax.json"
@@ -62,7 +74,66 @@ def lenses():
     return {"cooke_triplet": (cooke, 0.5875618, ("EPD", 10.0), 1.0, inf),
             "asphere_780nm": (asphere, 0.78, ("imageFNO", 2.5), 1.0, inf),
             "water_doublet": (doublet, 0.5875618, ("EPD", 8.0), 1.333, inf),
-            "relay_obna": (relay, 0.6328, ("objectNA", 0.02), 1.0, 150.0)}
+            "relay_obna": (relay, 0.6328, ("objectNA", 0.02), 1.0, 150.0),
+            **thorlabs(), **legacy_double_gauss(LEGACY)}
+
+
+def thorlabs():
+    """Thorlabs' lenses as in tests/data/zemax/thorlabs_*.zmx (the numbers of Thorlabs' .zmx)."""
+    inf = float("inf")
+    bk7 = Material("N-BK7", reference="SCHOTT")
+    lc1120 = [dict(r=1 / -1.943256898561989900e-002, t=4.0, m=bk7, stop=True), dict(r=inf, t=-1.010940419263e2)]
+    ld1170 = [dict(r=1 / -1.284521515735390100e-002, t=3.5, m=bk7, stop=True),
+              dict(r=1 / 1.284521515735390100e-002, t=-7.384151953028e1)]
+    acn = [dict(r=1 / -2.944640753828030000e-002, t=2.0, m=Material("N-BAF10", reference="SCHOTT"), stop=True),
+           dict(r=1 / 3.075976622577670000e-002, t=4.5, m=Material("N-SF6HT", reference="SCHOTT")),
+           dict(r=1 / 5.284574327537899800e-003, t=-5.288445773232e1)]
+    acl = [dict(r=inf, t=5.0), dict(r=1 / 7.379474728988791300e-002, t=11.9, m=Material("B270"), stop=True,
+                                    k=-0.6301, a=[5.513e-6]), dict(r=inf, t=1.809209481007e1)]
+    return {"thorlabs_LC1120-A": (lc1120, 0.5876, ("EPD", 2.208581163847e1), 1.0, inf),
+            "thorlabs_LD1170-B": (ld1170, 0.5876, ("EPD", 2.235211691777e1), 1.0, inf),
+            "thorlabs_ACN254-050-A": (acn, 0.5876, ("EPD", 2.090499755177e1), 1.0, inf),
+            "thorlabs_ACL3026U": (acl, 0.587, ("EPD", 27.0), 1.0, inf)}
+
+
+#: SCHOTT's legacy glasses as Zemax's SCHOTT.AGF (2008) prints them: CD line (B1 C1 B2 C2 B3 C3), LD (um).
+LEGACY = {"SK16": ((1.34317774, 7.04687339e-3, 0.241144399, 2.29005e-2, 0.994317969, 92.7508526), (0.31, 2.5)),
+          "SK1": ((1.23997939, 6.76460788e-3, 0.308829519, 2.33830716e-2, 1.03366266, 114.585882), (0.334, 2.325)),
+          "F15": ((1.31031527, 9.5403489e-3, 0.202636884, 4.55807051e-2, 0.920049222, 109.864711), (0.334, 2.325)),
+          "SSK4A": ((1.38336169, 7.87154985e-3, 0.187125107, 2.89352221e-2, 0.944170902, 105.742424), (0.334, 2.325))}
+
+
+def _rii_file(folder: Path, name: str, coefficients, span) -> MaterialFile:
+    """A refractiveindex.info "formula 2" file (n^2 - 1 = sum B l^2 / (l^2 - C)) of one glass."""
+    f = folder / f"{name}.yml"
+    f.write_text("DATA:\n  - type: formula 2\n    wavelength_range: " + " ".join(map(repr, span)) +
+                 "\n    coefficients: 0 " + " ".join(map(repr, coefficients)) + "\n", encoding="utf-8")
+    return MaterialFile(str(f))
+
+
+def legacy_double_gauss(glasses):
+    """tests/data/zemax/double_gauss_legacy.zmx: US 2,673,491's geometry with SCHOTT legacy glasses."""
+    folder = Path(tempfile.mkdtemp())
+    real = {n: _rii_file(folder, n, c, span) for n, (c, span) in glasses.items()}
+    R = [29.475, 84.83, 19.275, 40.77, 12.75, float("inf"), -14.495, 40.77, -20.385, 437.065, -39.73]
+    T = [3.76, 0.12, 4.025, 3.275, 5.705, 4.5, 1.18, 6.065, 0.19, 3.22, 45.4756]
+    G = ["SK16", None, "SK1", "F15", None, None, "F15", "SSK4A", None, "SK16", None]
+    surfaces = [dict(r=r, t=t, m=real[g] if g else "air", stop=(k == 5)) for k, (r, t, g) in enumerate(zip(R, T, G))]
+    return {"double_gauss_legacy": (surfaces, 0.5875618, ("EPD", 20.0), 1.0, float("inf"))}
+
+
+def optiland_lookup_efl() -> float:
+    """EFL of the legacy double Gauss with optiland's own lookup of the glass names (it substitutes;
+    SSK4A it does not find at all, so that one keeps the real glass)."""
+    surfaces = legacy_double_gauss(LEGACY)["double_gauss_legacy"][0]
+    names = iter(["SK16", "SK1", "F15", "F15", "SSK4A", "SK16"])
+    for s in surfaces:
+        if s["m"] != "air":
+            try:
+                s["m"] = Material(next(names))
+            except ValueError:
+                pass
+    return _f(build(surfaces, 0.5875618, ("EPD", 20.0)).paraxial.f2())
 
 
 def _f(v) -> float:
@@ -82,6 +153,7 @@ def main():
                                "f_number": _f(p.FNO()), "epd_mm": _f(p.EPD()), "image_index": n_image,
                                "aperture": list(aperture), "object_distance_mm": None if distance == float("inf") else distance}
         print(name, out["lenses"][name])
+    out["lenses"]["double_gauss_legacy"]["efl_mm_optiland_lookup"] = optiland_lookup_efl()
     OUT.write_text(json.dumps(out, indent=1) + "\n", encoding="utf-8")
 
 

@@ -12,6 +12,10 @@ from hypothesis import HealthCheck, settings
 _fd, _EMPTY_CONFIG = tempfile.mkstemp(prefix="physcam-test-config-", suffix=".toml")
 os.close(_fd)
 os.environ["PHYSCAM_CONFIG"] = _EMPTY_CONFIG
+# ... nor the real user's lens library (`physcam lens add`): every process of the session sees an
+# empty one of its own, so "every lens" means the bundled ones. Tests of the user library point
+# PHYSCAM_LENS_LIBRARY at a folder of their own with monkeypatch.
+os.environ["PHYSCAM_LENS_LIBRARY"] = tempfile.mkdtemp(prefix="physcam-test-lenses-")
 
 # USD builds its schema registry once per process: register physcam's PhysicalCamera plugin
 # before any test (in any xdist worker, in any order) creates a stage.

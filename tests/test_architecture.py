@@ -21,6 +21,7 @@ LAYER = {
     "usd": 8,
     "live": 8.5, "metadata": 8.5,
     "characterize": 9,
+    "farm": 9.5,
     "serve": 9,
     "cli": 10,
     "": 0,  # the root package only re-exports errors and the version

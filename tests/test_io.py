@@ -187,3 +187,111 @@ def test_a_killed_writers_temporary_folder_is_removed_by_the_next_write(tmp_path
     with staged_folder(out) as tmp:
         (tmp / "whole.txt").write_text("whole")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["maps"]
+
+
+# ---- devices, FIFOs and sockets are never renamed over (issue 40 item 12) -------------------------
+
+def _special_targets(tmp_path):
+    """(label, path) of special files made in ``tmp_path``: a FIFO, a socket, and (where this process
+    may make device nodes) the zero device's numbers (1, 5): none of them may be replaced."""
+    import socket as socket_module
+
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    out = [("FIFO", fifo)]
+    sock_path = tmp_path / "sock"
+    sock = socket_module.socket(socket_module.AF_UNIX, socket_module.SOCK_STREAM)
+    sock.bind(str(sock_path))
+    out.append(("socket", sock_path))
+    try:
+        os.mknod(tmp_path / "zero", stat.S_IFCHR | 0o666, os.makedev(1, 5))
+        out.append(("character device", tmp_path / "zero"))
+    except OSError:  # not root, or a nodev mount: the FIFO and the socket still stand
+        pass
+    return out, sock
+
+
+def test_a_fifo_socket_or_device_is_refused_never_replaced(tmp_path):
+    from physcam.io import check_writable, staged
+
+    targets, sock = _special_targets(tmp_path)
+    try:
+        for label, path in targets:
+            before = os.stat(path)
+            for force in (False, True):
+                for write in (lambda: atomic_write(path, b"data", force=force),
+                              lambda: staged(path, force=force, suffix=".usdc").__enter__(),
+                              lambda: check_writable(path, force=force)):
+                    with pytest.raises(ExportError, match="not a regular file") as exc:
+                        write()
+                    assert len(str(exc.value).splitlines()) == 1, label
+            after = os.stat(path)
+            assert (after.st_ino, stat.S_IFMT(after.st_mode)) == (before.st_ino, stat.S_IFMT(before.st_mode)), label
+        assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for _, p in targets)  # no temporary
+    finally:
+        sock.close()
+
+
+def test_the_null_device_is_written_through_and_stays_a_device(tmp_path):
+    """A node with the null device's numbers (made in tmp where allowed) takes the bytes and stays a
+    character device; only then is the system's /dev/null itself tried (so a regression fails on the
+    copy in tmp first). Neither needs ``force``: nothing is overwritten."""
+    from physcam.io import staged
+
+    null = os.stat(os.devnull)
+    copy = tmp_path / "null"
+    try:
+        os.mknod(copy, stat.S_IFCHR | 0o666, null.st_rdev)
+    except OSError:
+        copy = None
+    for path in ([copy] if copy else []) + [os.devnull]:
+        before = os.stat(path)
+        assert atomic_write(path, b"discarded") == type(tmp_path)(path)
+        with staged(path, force=True, suffix=".png") as tmp:
+            tmp.write_bytes(b"\x89PNG discarded")
+        after = os.stat(path)
+        assert stat.S_ISCHR(after.st_mode) and (after.st_ino, after.st_rdev) == (before.st_ino, before.st_rdev)
+    assert sorted(p.name for p in tmp_path.iterdir()) == (["null"] if copy else [])
+
+
+def test_standard_output_is_written_through(tmp_path):
+    """``/dev/stdout`` is this process's standard output (a pipe here): the file's bytes go down the
+    pipe, in order after what was printed before, and nothing in /dev is touched."""
+    import subprocess
+    import sys
+
+    script = ("import sys; from physcam.io import atomic_write\n"
+              "print('before', flush=False)\n"
+              "atomic_write('/dev/stdout', b'the file\\n')\n"
+              "print('after')\n")
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, check=True)
+    assert p.stdout == b"before\nthe file\nafter\n"
+    assert stat.S_ISCHR(os.stat(os.devnull).st_mode)
+
+
+def test_cli_output_to_a_fifo_or_dev_null(tmp_path, capsys):
+    from physcam.cli import main
+
+    fifo = tmp_path / "cam.rib"
+    os.mkfifo(fifo)
+    argv = ["export", "rib", "--focal", "50", "--fstop", "2", "--focus", "3m", "--force", "-o"]
+    assert main(argv + [str(fifo)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "is a FIFO (named pipe), not a regular file" in err[0]
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)
+    assert main(argv + [os.devnull]) == 0
+    assert stat.S_ISCHR(os.stat(os.devnull).st_mode)
+
+
+def test_a_folder_output_never_replaces_a_fifo_or_the_null_device(tmp_path):
+    """Before any work is done (the block is never entered), with or without force."""
+    from physcam.io import staged_folder
+
+    fifo = tmp_path / "maps"
+    os.mkfifo(fifo)
+    for target in (fifo, os.devnull):
+        for force in (False, True):
+            with pytest.raises(ExportError, match="already exists|not a folder"), staged_folder(target, force=force):
+                pytest.fail("the block ran")
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode) and stat.S_ISCHR(os.stat(os.devnull).st_mode)
+    assert [p.name for p in tmp_path.iterdir()] == ["maps"]

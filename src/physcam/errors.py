@@ -111,13 +111,25 @@ class WrongTypeError(PhysCamError, TypeError):
     """
 
 
+def shown_briefly(value) -> str:
+    """``value`` as an error message shows it, in at most about 60 characters; an integer beyond 20
+    digits by its digit count (``repr`` of a 5000-digit integer raises ValueError in Python 3.11+)."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**20:
+        return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
+    try:
+        text = repr(value)
+    except Exception:  # a value whose repr fails is described by its type
+        return f"a {type(value).__name__}"
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def require_type(name: str, value, cls, hint: str = ""):
     """Return ``value`` if it is an instance of ``cls``, else raise :class:`WrongTypeError` saying what
     was expected (``hint``: how to get one, e.g. "physcam.lens.library.load_lens(name)")."""
     if not isinstance(value, cls):
         want = cls.__name__ if isinstance(cls, type) else " or ".join(c.__name__ for c in cls)
         extra = f" ({hint})" if hint else ""
-        raise WrongTypeError(f"{name} must be a {want}{extra}, got {type(value).__name__} {value!r:.60}")
+        raise WrongTypeError(f"{name} must be a {want}{extra}, got {type(value).__name__} {shown_briefly(value)}")
     return value
 
 
@@ -150,11 +162,13 @@ def renamed_parameter(old: str, new: str, until: str = "0.3"):
 def require_finite(name: str, value, *, error=InputError) -> float:
     """Return ``value`` as float, or raise ``error`` naming ``name`` when it is NaN, inf or not a number."""
     if isinstance(value, bool) or not isinstance(value, (Real,)) and not hasattr(value, "__float__"):
-        raise error(f"{name} must be a number, got {value!r}")
+        raise error(f"{name} must be a number, got {shown_briefly(value)}")
     try:
         v = float(value)
+    except OverflowError:
+        raise error(f"{name} must be a finite number, got {shown_briefly(value)}") from None
     except (TypeError, ValueError):
-        raise error(f"{name} must be a number, got {value!r}") from None
+        raise error(f"{name} must be a number, got {shown_briefly(value)}") from None
     if not math.isfinite(v):
         raise error(f"{name} must be a finite number, got {v}")
     return v

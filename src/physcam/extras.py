@@ -16,6 +16,8 @@ live       jsonschema, cbor2                     OpenTrackIO samples (physcam li
 dask       dask[distributed], bokeh, pyarrow     physcam characterize on a cluster
 serve      starlette, uvicorn, segno             physcam serve, the phone page
 calibrate  opencv-python-headless                physcam calibrate: charts found in photographs
+farm       openjd-model                          physcam farm --to openjd: validated job templates
+opencue    opencue-pyoutline                     physcam farm --to opencue: OpenCue outlines
 all        all of the above
 =========  ====================================  ============================================
 """
@@ -37,6 +39,8 @@ EXTRAS = {
     "dask": (("distributed", "dask[distributed]"), ("bokeh", "bokeh"), ("pyarrow", "pyarrow")),
     "serve": (("starlette", "starlette"), ("uvicorn", "uvicorn"), ("segno", "segno")),
     "calibrate": (("cv2", "opencv-python-headless"),),
+    "farm": (("openjd.model", "openjd-model"),),
+    "opencue": (("outline", "opencue-pyoutline"),),
 }
 
 

@@ -10,6 +10,11 @@ power loss) leaves its temporary behind; the next write of the same target remov
 processes on this host that no longer run (:func:`remove_stale_temporaries`). Temporaries of
 running processes, and of other hosts sharing the folder (whose processes cannot be seen from
 here), are left alone.
+
+Renaming over a name replaces whatever it names, so a device, FIFO or socket is never a target
+(:func:`check_writable` refuses it, ``force`` or not); the null device and this process's standard
+output and error are written through instead. :func:`refuse_inputs_as_outputs` keeps a command from
+writing over a file it reads, and :func:`staged_folder` writes a folder of outputs as a whole.
 """
 
 from __future__ import annotations
@@ -24,12 +29,14 @@ import re
 import secrets
 import shutil
 import socket
+import stat
+import tempfile
 from pathlib import Path
 
 from .errors import ExportError
 
-__all__ = ["atomic_write", "check_writable", "folder_manifest", "remove_stale_temporaries", "staged",
-           "staged_folder", "MANIFEST_NAME"]
+__all__ = ["atomic_write", "check_writable", "folder_manifest", "refuse_inputs_as_outputs", "remove_stale_temporaries",
+           "staged", "staged_folder", "MANIFEST_NAME"]
 
 #: What marks a physcam temporary file's name, after the hidden target name.
 TEMP_MARK = ".physcam-tmp."
@@ -38,14 +45,138 @@ TEMP_MARK = ".physcam-tmp."
 _TEMP_NAME_BYTES = 120
 
 
+_SPECIAL = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+            (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISSOCK, "a socket"))
+
+
+def _through_fd(p: Path) -> int | None:
+    """The file descriptor to write ``p`` through, when ``p`` is a target physcam writes into rather
+    than replaces: this process's standard output or error (``/dev/stdout``, ``/dev/fd/2``, or the
+    file, pipe or terminal they are), or the null device (same device numbers as ``os.devnull``,
+    wherever its node lives): -1 for the null device (opened when written). None for any other path."""
+    try:
+        st = os.stat(p)
+    except (OSError, ValueError):
+        return None
+    for fd in (1, 2):
+        try:
+            if os.path.samestat(st, os.fstat(fd)):
+                return fd
+        except OSError:
+            pass
+    try:
+        null = os.stat(os.devnull)
+    except OSError:
+        return None
+    if stat.S_ISCHR(st.st_mode) and stat.S_ISCHR(null.st_mode) and st.st_rdev == null.st_rdev:
+        return -1
+    return None
+
+
+def _refuse_special(p: Path) -> None:
+    """:class:`ExportError` when ``p`` exists and is a device, FIFO or socket (symbolic links
+    followed) that physcam would otherwise replace by renaming a file over it."""
+    try:
+        mode = os.stat(p).st_mode
+    except (OSError, ValueError):
+        return
+    for test, what in _SPECIAL:
+        if test(mode):
+            raise ExportError(f"{p} is {what}, not a regular file: physcam writes a file whole and renames it into "
+                              "place, which would replace it; write to a regular file (or /dev/null, or /dev/stdout "
+                              "for standard output)")
+
+
 def check_writable(path, *, force: bool = False) -> Path:
-    """Return ``path`` as a Path; raise :class:`ExportError` if it exists and ``force`` is false."""
+    """Return ``path`` as a Path; raise :class:`ExportError` if it exists and ``force`` is false.
+
+    A device, FIFO or socket is refused even with ``force`` (renaming a file over it would replace
+    it), except the targets written through, never replaced and needing no ``force``: the null
+    device and this process's standard output or error (``/dev/null``, ``/dev/stdout``)."""
     p = Path(path)
+    if _through_fd(p) is not None:
+        return p
+    _refuse_special(p)
     if p.exists() and not force:
         raise ExportError(f"{p} already exists; pass --force (force=True) to overwrite it")
     if p.exists() and p.is_dir():
         raise ExportError(f"{p} is a directory, not a file")
     return p
+
+
+def _write_through(tmp: str, p: Path, fd: int) -> None:
+    """Copy the finished temporary ``tmp`` into ``p`` through ``fd`` (:func:`_through_fd`): standard
+    output or error after Python's own buffer of it, at the stream's place; the null device opened."""
+    import sys
+
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(AttributeError, OSError, ValueError):
+            stream.flush()
+    own = fd < 0
+    if own:
+        fd = os.open(p, os.O_WRONLY)
+    try:
+        with open(tmp, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                view = memoryview(block)
+                while view:
+                    view = view[os.write(fd, view):]
+    finally:
+        if own:
+            os.close(fd)
+
+
+@contextlib.contextmanager
+def _staged_through(p: Path, fd: int, suffix: str):
+    """:func:`staged` for a target written through: the temporary lives in the system's temporary folder."""
+    handle, tmp = tempfile.mkstemp(prefix=".physcam-tmp.", suffix=suffix)
+    os.close(handle)
+    try:
+        yield Path(tmp)
+        _write_through(tmp, p, fd)
+    except OSError as exc:
+        if isinstance(exc, BrokenPipeError):
+            raise  # a reader that has gone: the CLI's quiet exit
+        raise ExportError(f"cannot write {p}: {exc.strerror or exc}") from None
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+
+
+def refuse_inputs_as_outputs(inputs, outputs, *, folders=()) -> None:
+    """Raise :class:`ExportError` in one line when an output would overwrite an input.
+
+    ``outputs`` (files) and ``folders`` (outputs written whole, :func:`staged_folder`) may not be an
+    input: the same file or folder by ``os.stat`` identity (device and inode), so a symbolic link to
+    the input, a hard link of it and another spelling of its path all count; nor may an input lie
+    inside one of ``folders``, which the write replaces. Paths are str or Path (None and "" skipped);
+    an input that does not exist is skipped (a bundled lens's name is not a file)."""
+    ins = []
+    for i in inputs:
+        if i is None or (isinstance(i, str) and not i):
+            continue
+        try:
+            ins.append((Path(i), os.stat(i), os.path.realpath(i)))
+        except (OSError, ValueError, TypeError):
+            continue
+    for o, whole in [(o, False) for o in outputs] + [(f, True) for f in folders]:
+        if o is None or (isinstance(o, str) and not o) or _through_fd(Path(o)) is not None:
+            continue  # /dev/null and standard output are written through, never replaced
+        try:
+            so = os.stat(o)
+        except (OSError, ValueError, TypeError):
+            so = None
+        try:
+            inside = os.path.realpath(o).rstrip(os.sep) + os.sep
+        except (OSError, ValueError, TypeError):
+            continue
+        for pi, si, ri in ins:
+            if so is not None and os.path.samestat(si, so):
+                raise ExportError(f"the output {o} is the input {pi} (the same file): writing it would destroy the "
+                                  "input; choose another output")
+            if whole and ri.startswith(inside):
+                raise ExportError(f"the input {pi} lies inside the output folder {o}, which is written whole "
+                                  "(replaced with --force): choose another output folder")
 
 
 def _umask() -> int:
@@ -153,8 +284,15 @@ def staged(path, *, force: bool = False, suffix: str = ".tmp"):
     """Write a file in place atomically: yields a temporary path (ending in ``suffix``, for
     libraries that pick a format by extension) next to ``path``; fill it, and on leaving the
     block it is synced and renamed to ``path`` (see :func:`atomic_write` for ``force``). On an
-    error the temporary is removed; stale temporaries of ``path`` are removed first (module notes)."""
+    error the temporary is removed; stale temporaries of ``path`` are removed first (module notes).
+    A device, FIFO or socket is never renamed over (:func:`check_writable`); the null device and
+    standard output or error get the finished temporary's bytes written through."""
     p = check_writable(path, force=force)
+    fd = _through_fd(p)
+    if fd is not None:
+        with _staged_through(p, fd, suffix) as tmp:
+            yield tmp
+        return
     try:
         _make_folder(p)
         remove_stale_temporaries(p)
@@ -170,6 +308,7 @@ def staged(path, *, force: bool = False, suffix: str = ".tmp"):
         replaced = force and p.exists()
         os.chmod(tmp, (os.stat(p).st_mode & 0o7777) if replaced else (0o666 & ~_umask()))
         if force:
+            _refuse_special(p)  # made meanwhile: never renamed over
             os.replace(tmp, p)
         else:
             _publish_new(tmp, p)
@@ -262,9 +401,26 @@ def folder_manifest(path) -> dict | None:
 
 
 def _replaceable(p: Path) -> bool:
-    """Whether ``--force`` may replace folder ``p`` whole: it is empty, or physcam wrote it."""
+    """Whether ``--force`` may replace folder ``p`` whole: it is empty, or physcam wrote it and it holds
+    no file its manifest does not list (a file the user put there since is never deleted with it)."""
     try:
-        return not any(p.iterdir()) or (p / MANIFEST_NAME).is_file()
+        if not any(p.iterdir()):
+            return True
+        doc = json.loads((p / MANIFEST_NAME).read_text(encoding="utf-8"))
+        listed = {e["path"] for e in doc["files"]} | {MANIFEST_NAME}
+        for folder, _dirs, files in os.walk(p):
+            for name in files:
+                if Path(folder, name).relative_to(p).as_posix() not in listed:
+                    return False
+        return True
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return False
+
+
+def _empty_folder(p: Path) -> bool:
+    """Whether ``p`` is an empty folder (not a symbolic link to one): written into without ``force``."""
+    try:
+        return not p.is_symlink() and p.is_dir() and not any(p.iterdir())
     except OSError:
         return False
 
@@ -283,6 +439,14 @@ def _publish_folder(tmp: Path, p: Path, force: bool) -> None:
             raise _exists_error(p)
         os.rename(tmp, p)
         return
+    if not force and not p.is_symlink() and p.is_dir():
+        try:  # an empty folder is filled without force: rename(2) replaces an empty directory only
+            os.rename(tmp, p)
+            return
+        except OSError as exc:
+            if exc.errno not in (errno.ENOTEMPTY, errno.EEXIST):
+                raise
+        raise _exists_error(p)
     if not force:
         raise _exists_error(p)
     if p.is_symlink() or not p.is_dir():
@@ -324,13 +488,17 @@ def staged_folder(path, *, force: bool = False, about: dict | None = None):
     rename. A writer killed at any moment leaves either the previous folder or the new one, never a
     mix (its temporary folder is removed by the next write of ``path``).
 
-    ``force`` replaces an existing folder only if physcam wrote it (it has a manifest) or it is empty,
-    so a user's own files are never deleted; an error in the block removes the temporary folder.
+    An existing empty folder is filled without ``force`` (nothing is overwritten; the rename fails if
+    files appear in it meanwhile). ``force`` replaces an existing folder only if physcam wrote it (it has
+    a manifest) or it is empty, so a user's own files are never deleted; an error in the block removes
+    the temporary folder.
     :func:`folder_manifest` tells whether a folder is complete.
     """
     p = Path(path)
-    if (p.exists() or p.is_symlink()) and not force:
+    if (p.exists() or p.is_symlink()) and not force and not _empty_folder(p):
         raise _exists_error(p)
+    if (p.exists() or p.is_symlink()) and (p.is_symlink() or not p.is_dir()):
+        raise ExportError(f"{p} is not a folder; remove it or choose another output folder")  # before any work
     if p.is_dir() and not _replaceable(p):
         raise _not_ours_error(p)  # before any work is done
     try:

@@ -49,6 +49,44 @@ def forward_chief_to_film(q, obj_pts, object_z, film_z, wl):
     return np.stack([out.x, out.y], axis=1)
 
 
+def forward_chief_marching(q, obj_pts, object_z, film_z, wl, substeps=8):
+    """As :func:`forward_chief_to_film` for points along one line from the axis (sorted by distance from
+    it), each aimed from the previous one's solution in ``substeps`` steps: a fisheye's wide fields, whose
+    rays aimed at the axis of the entrance pupil miss the front element, are reached by continuation."""
+    k = q.stop_index
+    front = q.with_surfaces(q.surfaces[: k + 1])
+    z_ep = gaussian(q, wavelength_nm=wl, object_z=object_z, film_z=film_z).z_entrance_pupil
+
+    def stop_hit(P, a, b):
+        pos = np.array([[P[0], P[1], object_z]] * a.size)
+        d = np.stack([a - P[0], b - P[1], np.full(a.size, z_ep - object_z)], axis=1)
+        out = trace_through(front, RayBatch.from_arrays(pos, d, wl), clip=False)
+        return np.stack([out.x, out.y], axis=1), out.ok, pos, d
+
+    film = []
+    a = b = 0.0
+    prev = np.zeros(2)
+    e = 1e-7
+    for P in np.asarray(obj_pts, dtype=float):
+        for t in np.linspace(0.0, 1.0, substeps + 1)[1:]:
+            Pt = prev + t * (P - prev)
+            for _ in range(40):
+                s, ok, _, _ = stop_hit(Pt, np.array([a, a + e, a]), np.array([b, b, b + e]))
+                assert ok.all(), "the continuation lost the chief ray"
+                r, ra, rb = s[0], (s[1] - s[0]) / e, (s[2] - s[0]) / e
+                if np.abs(r).max() < 1e-10:
+                    break
+                det = ra[0] * rb[1] - rb[0] * ra[1]
+                a, b = a - (rb[1] * r[0] - rb[0] * r[1]) / det, b - (-ra[1] * r[0] + ra[0] * r[1]) / det
+            assert np.abs(r).max() < 1e-8
+        prev = P
+        _, _, pos, d = stop_hit(P, np.array([a]), np.array([b]))
+        out = trace_through(q, RayBatch.from_arrays(pos, d, wl), end_z=film_z, clip=False)
+        assert out.ok.all()
+        film.append((out.x[0], out.y[0]))
+    return np.array(film)
+
+
 def ideal_grid_and_real(lens, focus_mm, sensor, size, nx=11, ny=8, margin=(40, 30)):
     """An ideal pixel grid inside the frame and the forward-traced real pixel of each point."""
     wl = lens.wavelength_nm

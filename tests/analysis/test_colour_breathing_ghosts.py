@@ -153,7 +153,7 @@ def test_colour_says_when_the_file_has_no_dispersion():
     res = chromatic_aberration(load_lens("dgauss_50mm"))  # pbrt file: no Abbe numbers
     assert res.longitudinal_paraxial_mm == 0.0
     assert any("Abbe" in n for n in res.notes)
-    res = chromatic_aberration(load_lens("double_gauss_50mm_f2"))  # seed TOML with Abbe numbers
+    res = chromatic_aberration(load_lens("tessar_50mm_f2_8"))  # every glass with an Abbe number
     assert res.longitudinal_paraxial_mm != 0.0 and not res.notes
 
 

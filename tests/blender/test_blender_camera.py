@@ -197,7 +197,7 @@ def test_exposure_follows_physcams_relative_illumination(tmp_path):
     """A uniform white world through the double Gauss at f/2: the centre renders 1 (the shader's
     normalisation) and the frame's corners and edges fall off as physcam's camera_rays weight
     predicts (its mean over the pupil at those film points, float64 numpy), within 3 %."""
-    lens = load_lens("double_gauss_50mm_f2")
+    lens = load_lens("dgauss_50mm")
     sw, sh, W, H = 36.0, 24.0, 36, 24
     b = bake_camera(lens, focus_mm=math.inf, sensor_width_mm=sw, sensor_height_mm=sh)
     src = osl_camera_shader(lens, focus_mm=math.inf, sensor_width_mm=sw, sensor_height_mm=sh)

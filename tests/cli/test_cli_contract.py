@@ -66,9 +66,13 @@ JSON_RUNS = {
     ("report",): ["report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--cameras"],
     ("dof-table",): ["dof-table", "--focal", "35", "--fstops", "2,4", "--focus", "1m,hyperfocal,inf"],
     ("sensors",): ["sensors", "ARRI"],
+    ("exposure",): ["exposure", "--fps", "24", "--to-fps", "48"],
+    ("diopter",): ["diopter", "--focal", "50", "--fstop", "2.8", "--focus", "inf", "--sensor", "S35"],
+    ("hyperfocal",): ["hyperfocal", "--focal", "25,50", "--fstops", "2.8,8", "--sensor", "S35"],
     ("lenses",): ["lenses"],
     ("lens", "show"): ["lens", "show", "dgauss_50mm", "--focus", "2m"],
     ("lens", "breathing"): ["lens", "breathing", "dgauss_50mm", "--focus", "1m", "2m", "inf"],
+    ("lens", "zoom"): ["lens", "zoom", "--lens", "laikin_zoom_15_150mm", "--steps", "3"],
     ("lens", "check"): ["lens", "check", "dgauss_50mm"],
     ("lens", "card"): ["lens", "card", "--lens", "dgauss_50mm", "--draft", "--dpi", "30", "-o", "card.png"],
     ("lens", "fix"): ["lens", "fix", "dgauss_50mm.toml", "-o", "fixed.toml"],
@@ -114,6 +118,8 @@ JSON_RUNS = {
 }
 #: Further runs of documents a command prints in other modes.
 EXTRA_JSON_RUNS = {
+    "lens show --zoom": ["lens", "show", "nikon_af_s_70_200mm_f2_8e_zoom", "--zoom", "135mm"],
+    "lens breathing --zoom": ["lens", "breathing", "laikin_zoom_15_150mm", "--zoom", "0.5", "--focus", "2m"],
     "psf_fft": ["psf", "dgauss_50mm", "--fstop", "8"],
     "mtf_chart_best_focus": ["mtf", "dgauss_50mm", "--fstop", "4", "--fields", "3", "--pupil-samples", "32",
                              "--frequency", "20", "--best-focus", "20"],
@@ -128,12 +134,21 @@ JSON_NOT_RUN = {
     ("defocus",): "needs an EXR render with depth (tests/analysis/test_defocus.py runs it and validates the document)",
     ("compare", "blender"): "needs Blender's bpy (tests/blender/test_compare.py validates its document)",
     ("live", "record"): "needs a UDP stream (tests/live/test_cli_live.py records one and validates the document)",
+    ("live", "recover"): "needs a recording's journal (tests/live/test_takes.py recovers one and validates the document)",
     ("calibrate",): "needs chart photographs (tests/analysis/test_calibrate.py renders them and validates its document)",
     ("demo",): "writes the whole demo (tests/onset_cli/test_report_cli.py::test_demo_writes_outputs validates it)",
+    ("lens", "pack"): "packs a lens card and a USD file (tests/lens/test_lens_archive.py round-trips an archive through "
+                      "pack, check and add and validates both documents)",
+    ("lens", "add"): "needs an archive from `lens pack` (tests/lens/test_lens_archive.py validates its document)",
+    ("farm",): "its --json goes before the `--` of the command line it wraps, where this test appends it "
+               "(tests/farm/test_farm_jobs.py validates its document)",
+    ("farm-task",): "runs a task of a farm job (tests/farm/test_farm_run.py runs them; test_farm_task_json_document "
+                    "validates its document)",
 }
 #: Where the rows of each --csv command's document are.
 CSV_ROWS = {
     ("dof-table",): "rows", ("sensors",): "sensors", ("lenses",): "lenses", ("lens", "breathing"): "rows",
+    ("lens", "zoom"): "rows",
     ("spot",): "fields", ("illumination",): "points", ("colour",): "lateral",
     ("breathing-real",): "rows", ("ghosts",): "paths", ("distortion",): "points", ("compare", "lenses"): "lenses",
     ("export", "unreal"): "lens_file.physcam.marks", ("mtf",): "points", ("lens", "show"): "points",
@@ -148,6 +163,7 @@ NO_UNITS = {
     ("usd", "write"): "prints the file written; the file holds millimetres and scene units",
     ("usd", "kit"): "prints the file written",
     ("live", "record"): "prints frame counts and timecodes",
+    ("live", "recover"): "prints frame counts and timecodes (as live record)",
     ("live", "send"): "prints the samples sent (OpenTrackIO's own units)",
 }
 #: Focus options with a grammar of their own (not _common.focus), and why.
@@ -158,6 +174,7 @@ OWN_FOCUS_GRAMMAR = {
 #: Commands whose --sensor has another default than the one default sensor, and why.
 OTHER_SENSOR_DEFAULT = {
     ("live", "record"): "the stream's sensor, when it carries one",
+    ("live", "recover"): "the recording's own options (its stream's sensor, when it carries one)",
     ("live", "play"): "the recording's sensor",
     ("lens", "check"): "optional: with a sensor the check adds a corner probe",
     ("metadata", "report"): "the clip's recorded sensor area when the file gives it",

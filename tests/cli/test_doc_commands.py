@@ -7,7 +7,10 @@ compiles once), in a temporary folder of their own: files a page writes are ther
 commands. A ``$ cat FILE`` in a console block shows a file the page reads: its lines are written
 to FILE first. A few input files the pages name are provided (INPUTS); a short list of commands
 cannot run here, each with its reason (SKIP). A command whose shown output is a refusal
-(``physcam: error: ...``) must refuse: exit 2.
+(``physcam: error: ...``) must refuse: exit 2. **What a page shows a command print is what it prints**
+(issue 39): every number of a console block's shown output is compared with the command's, within
+one unit in its last digit (tests/cli/_doc_output.py says how, and how a block states another
+tolerance or why it cannot be compared).
 """
 
 from __future__ import annotations
@@ -54,6 +57,7 @@ SKIP = {
 def _broken_sample(d: Path) -> None:
     sample = json.loads((REPO / "tests/live/data/recommended_dynamic_example.json").read_text())
     sample["lens"]["fStop"] = 0
+    sample["transforms"][0]["rotation"]["pan"] = "left"  # the two problems docs/live.md shows
     (d / "broken.json").write_text(json.dumps(sample))
 
 
@@ -62,11 +66,25 @@ def _take(d: Path) -> None:
                  "--sensor", "ALEXA 35"]) == 0
 
 
-#: Input files the pages name without showing them (a focus pull, a broken sample, a take).
+def _journal(d: Path) -> None:
+    """The journal a killed `live record scene12.usda` leaves: its header and 24 samples."""
+    from physcam.live.camera import camera_samples
+    from physcam.live.journal import Journal
+    from physcam.onset.sensors import find_sensor
+
+    j = Journal.create(d / "scene12.usda", {"output": "scene12.usda", "report": None, "options": {}})
+    for i, s in enumerate(camera_samples(sensor=find_sensor("ALEXA 35"), frames=24, rate=24, focus_mm=2000.0,
+                                         fstop=2.8, focal_length_mm=35.0)):
+        j.add_sample(s, i, "cbor")
+    j.close()
+
+
+#: Input files the pages name without showing them (a focus pull, a broken sample, a take, a journal).
 INPUTS = [
     lambda d: (d / "pull.csv").write_text("frame,focus,fstop\n1,2m,2.8\n12,2.5m,2.8\n24,3m,4\n"),
     _broken_sample,
     _take,
+    _journal,
     lambda d: (d / "tests").mkdir() or os.symlink(REPO / "tests" / "data", d / "tests" / "data"),
 ]
 
@@ -112,8 +130,42 @@ def doc_commands(path: Path):
     return out
 
 
+def shown_outputs(path: Path) -> dict:
+    """{start line of a ``$ physcam`` command: (its shown output lines, checked, relative tolerance)} of a
+    page's console blocks (tests/cli/_doc_output.py)."""
+    from _doc_output import block_rule
+
+    lines = path.read_text(encoding="utf-8").splitlines()
+    out, lang, rule, current, i = {}, None, (True, None), None, 0
+    while i < len(lines):
+        line = lines[i]
+        m = FENCE.match(line)
+        if m:
+            if lang is None:
+                lang = m.group(1) or "text"
+                prev = next((lines[j] for j in range(i - 1, -1, -1) if lines[j].strip()), "")
+                rule = block_rule(prev)
+            else:
+                lang = None
+            current = None
+        elif lang == "console":
+            st = line.strip()
+            if st.startswith("$ "):
+                current = None
+                if st[2:].startswith("physcam"):
+                    start = i + 1
+                    while lines[i].rstrip().endswith("\\") and i + 1 < len(lines):
+                        i += 1
+                    current = out.setdefault(start, ([], *rule))[0]
+            elif current is not None:
+                current.append(line)
+        i += 1
+    return {k: v for k, v in out.items() if v[0]}
+
+
 def argv_of(text: str) -> list[str]:
-    return shlex.split(text, comments=True)
+    """The command's words; a comment starts at a ``#`` after a space (``plates/A.####.exr`` is a word)."""
+    return shlex.split(re.sub(r"(^|\s)#.*$", "", text))
 
 
 def test_commands_live_in_fenced_blocks():
@@ -153,9 +205,14 @@ def test_technical_examples_are_physically_consistent(capsys):
 
 
 @pytest.mark.parametrize("page", [p for p in PAGES if doc_commands(p)], ids=lambda p: p.name)
-def test_every_command_of_the_page_runs(page, tmp_path, capsys):
+def test_every_command_of_the_page_runs(page, tmp_path, capsys, monkeypatch):
     # pages that show no command (architecture, conventions, ...) have nothing to run: not parametrized
+    from _doc_output import compare
+
     cmds = doc_commands(page)
+    shown = shown_outputs(page)
+    # a page's `physcam lens add` installs into a lens library of the page's own, not the session's
+    monkeypatch.setenv("PHYSCAM_LENS_LIBRARY", str(tmp_path / ".physcam-lenses"))
     for make in INPUTS:
         make(tmp_path)
     old = os.getcwd()
@@ -181,6 +238,12 @@ def test_every_command_of_the_page_runs(page, tmp_path, capsys):
                 failures.append(f"{page.name}:{line}: `{text}` exited {rc} (want {want}): {err.strip()[-400:]}")
             elif "Traceback" in err:
                 failures.append(f"{page.name}:{line}: `{text}` printed a traceback")
+            elif line in shown and shown[line][1]:
+                lines, _, tol = shown[line]
+                problems = compare(lines, out, err, tol)
+                failures += [f"{page.name}:{line}: `{text}`: {p}" for p in problems]
+                if problems:  # what it did print, to put on the page
+                    failures.append(f"    it printed: {(out + err)[:1500]!r}")
             done.add(key)
     finally:
         os.chdir(old)

@@ -246,5 +246,6 @@ def test_the_phone_pages_figures_in_feet():
     assert status == 200 and f"focus {feet_inches(3000.0)}" in html.unescape(body.decode())
     status, _, body = asgi_get(app, f"/api/dof.svg?{q}")
     assert status == 200 and "focus 3.000 m" in html.unescape(body.decode())
-    status, _, body = asgi_get(app, "/api/lens/dgauss_50mm/diagram.svg?fstop=4&focus=2000&units=ft")
+    # (with units=ft a bare 2000 would be feet: physcam's one rule for a bare focus)
+    status, _, body = asgi_get(app, "/api/lens/dgauss_50mm/diagram.svg?fstop=4&focus=2000mm&units=ft")
     assert status == 200 and f"focus {feet_inches(2000.0)}" in html.unescape(body.decode())

@@ -58,7 +58,7 @@ def test_arrays_are_physcams_surface_table_of_the_focused_lens(slug, focus_mm, f
 
 
 def test_monochrome_indices_are_physcams_at_the_design_wavelength():
-    lens = load_lens("double_gauss_50mm_f2")
+    lens = load_lens("dgauss_50mm")
     src = osl_camera_shader(lens, focus_mm=2000.0, sensor_width_mm=36.0, sensor_height_mm=24.0, fresnel=True)
     q = focus(lens, 2000.0).prescription
     t = surface_table(q, reverse=True)

@@ -251,7 +251,8 @@ def test_aspheric_lens_still_has_pbrts_thin_lens(tmp_path, capsys):
     rc = main(["export", "pbrt", "-o", str(tmp_path), "--lens", "canon_rf_85mm_f1_2", "--focus", "2m", "--camera",
                "perspective"])
     assert rc == 0
-    assert [p.name for p in tmp_path.iterdir()] == ["canon_rf_85mm_f1_2_perspective.pbrt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["canon_rf_85mm_f1_2_perspective.pbrt",
+                                                          "physcam-manifest.json"]  # written whole (issue 40)
 
 
 def test_no_clobber_without_force_and_nothing_half_written(tmp_path, capsys):

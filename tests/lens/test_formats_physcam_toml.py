@@ -143,3 +143,57 @@ def test_maker_close_focus_and_t_stop_round_trip():
 def test_maker_fields_that_cannot_be_are_refused(extra, words):
     with pytest.raises(LensFileError, match=words):
         loads_lens(_MAKER_FIELDS.format(extra=extra), "physcam")
+
+
+RECORD = '''format = "physcam-lens/1"
+[lens]
+name = "record"
+[provenance]
+source = "US 2,673,491 (A. W. Tronnier), example 1"
+licence = "CC0-1.0"
+transcribed = "2026-11-28"
+primary_source_checked = true
+checks = ["EFL 100.0 mm stated, 100.02 computed", "f/2 stated, f/2.01 computed"]
+assumptions = ["stop: midway in the central air space, as the patent's figure shows"]
+{extra}
+[[surface]]
+kind = "stop"
+radius = 0.0
+thickness = 10.0
+semi_diameter = 5.0
+medium = "air"
+'''
+
+
+def test_provenance_record_is_read_written_and_read_back():
+    from physcam.lens.provenance import provenance_of
+
+    p = loads_lens(RECORD.format(extra=""), "physcam")
+    prov = provenance_of(p)
+    assert (prov.source, prov.licence, prov.transcribed) == ("US 2,673,491 (A. W. Tronnier), example 1", "CC0-1.0",
+                                                           "2026-11-28")
+    assert prov.primary_source_checked is True and prov.checks == ("EFL 100.0 mm stated, 100.02 computed",
+                                                                   "f/2 stated, f/2.01 computed")
+    text = dumps_lens(p, "physcam")
+    assert loads_lens(text, "physcam") == p
+    # written in the record's order, a list of several one item a line
+    keys = [line.split(" =")[0] for line in text[text.index("[provenance]"):text.index("[[surface]]")].splitlines()
+            if " = " in line]
+    assert keys == ["source", "licence", "transcribed", "primary_source_checked", "checks", "assumptions"]
+    assert 'checks = [\n    "EFL 100.0 mm stated, 100.02 computed",\n' in text
+
+
+@pytest.mark.parametrize("extra, words", [
+    ('checked = "28 Nov 2026"', "checked must be a date as YYYY-MM-DD"),
+    ('checked = "2026-02-30"', "checked must be a date"),
+    ('primary_source_checked = "yes"', "must be true or false"),
+    ('checks = "one check"', "checks must be a list of strings"),
+    ('maker_data = [1, 2]', "maker_data must be a list of strings"),
+    ('source_url = 3', "source_url must be a string"),
+])
+def test_a_provenance_record_of_the_wrong_kind_is_refused(extra, words):
+    key = extra.split(" =")[0]  # the record's own line of that key gives way to the wrong one
+    text = "\n".join(line for line in RECORD.splitlines() if not line.startswith(key + " =")) + "\n"
+    text = text.replace("{extra}", extra)
+    with pytest.raises(LensFileError, match=words):
+        loads_lens(text, "physcam")

@@ -5,14 +5,15 @@ unknown glasses, truncation, .agf catalogues, --glass-catalog and the config key
 
 import json
 import math
+import warnings
 from pathlib import Path
 
 import pytest
 
 from physcam.cli import main
-from physcam.errors import LensFileError
+from physcam.errors import LensFileError, PhysCamWarning
 from physcam.lens.agf import loads_agf
-from physcam.lens.catalog import GlassNotFound, find_glass, use_catalog_files, user_catalogs
+from physcam.lens.catalog import GlassNotFound, find_glass, strict_glass, use_catalog_files, user_catalogs
 from physcam.lens.formats import dumps_lens, loads_lens, read_lens
 from physcam.optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM, LINE_G_NM, glass_index, medium_dispersion
 from physcam.optics.paraxial import gaussian
@@ -29,7 +30,7 @@ def test_efl_bfl_fnumber_against_optiland(name):
     g = gaussian(lens)
     assert g.efl == pytest.approx(want["efl_mm"], rel=1e-3)
     assert g.bfl == pytest.approx(want["bfl_mm"], rel=1e-3)
-    assert g.f_number == pytest.approx(want["f_number"], rel=1e-3)
+    assert g.f_number == pytest.approx(abs(want["f_number"]), rel=1e-3)  # optiland signs a negative lens's
     # the file's aperture (ENPD, FNUM, OBNA) sized the stop as optiland sizes the pupil
     assert g.entrance_pupil_diameter == pytest.approx(want["epd_mm"], rel=1e-4)
 
@@ -81,11 +82,21 @@ def test_gcat_order_decides_which_f2():
 
 def test_unknown_glass_names_catalogues_line_and_where_it_is():
     text = (DATA / "zemax" / "asphere_780nm.zmx").read_text().replace("GCAT OHARA SCHOTT", "GCAT SCHOTT CORNING")
-    with pytest.raises(LensFileError) as exc:
+    with strict_glass(), pytest.raises(LensFileError) as exc:  # OpticStudio's refusal, kept by --strict-glass
         loads_lens(text, "zemax", "a.zmx")
     msg = str(exc.value)
     assert "a.zmx" in msg and ":22:" in msg and "not in SCHOTT" in msg and "CORNING" in msg
     assert "S-LAH64 is in OHARA, which was not searched" in msg
+    # issue 40 item 15: by default it loads, OHARA's own S-LAH64, with one warning naming OHARA
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        lens = loads_lens(text, "zemax", "a.zmx")
+    assert [str(w.message) for w in seen] == [
+        "a.zmx: S-LAH64 taken from OHARA (not in GCAT SCHOTT CORNING; --strict-glass refuses it, as OpticStudio does)"]
+    glass = next(s.medium for s in lens.surfaces if s.medium.glass)
+    assert (glass.glass, glass.catalog, glass.nd, glass.vd) == ("S-LAH64", "OHARA", 1.788, 47.37)  # OHARA's sheet
+    with pytest.raises(LensFileError, match="unknown glass 'S-QQQ64'"):  # a name in no catalogue is still an error
+        loads_lens(text.replace("S-LAH64", "S-QQQ64"), "zemax", "a.zmx")
     with pytest.raises(GlassNotFound, match="nearest names: N-BK7"):
         find_glass("N-BK8", ["SCHOTT"])
 
@@ -249,3 +260,136 @@ def test_a_1550_nm_design_loads_and_its_index_is_the_makers(tmp_path):
     assert max(n) == pytest.approx(float(glass_index(glass.glass, 1550.0, catalog=glass.catalog)), abs=1e-6)
     g780, g1550 = gaussian(load_lens(str(DATA / "zemax" / "asphere_780nm.zmx"))), gaussian(lens)
     assert g1550.efl > g780.efl  # a lower index in the infrared: a longer focal length
+
+
+# --- issue 40 item 15: real Zemax files --------------------------------------------------------------
+THORLABS = {"thorlabs_LC1120-A": -100.0, "thorlabs_LD1170-B": -75.0, "thorlabs_ACN254-050-A": -50.0}
+
+
+@pytest.mark.parametrize("name", sorted(THORLABS))
+def test_thorlabs_negative_lenses_with_the_stop_on_a_concave_face_load(name):
+    """Every negative lens of Thorlabs' files puts STOP on its concave first face; the flat stop
+    physcam makes at that vertex was refused as crossing the face. It loads, the stop 0 mm before
+    the face, and the focal length is Thorlabs' printed one (within its rounding, 0.5 %); EFL and
+    BFL against optiland are in test_efl_bfl_fnumber_against_optiland."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # N-BK7, N-BAF10, N-SF6HT are SCHOTT's current glasses: nothing to say
+        lens = read_lens(DATA / "zemax" / f"{name}.zmx")
+    stop, face = lens.surfaces[0], lens.surfaces[1]
+    assert (stop.kind, stop.thickness) == ("stop", 0.0) and face.radius < 0
+    assert gaussian(lens).efl == pytest.approx(THORLABS[name], rel=5e-3)
+
+
+def test_a_real_ray_passes_the_stop_on_a_concave_face():
+    """The tracer follows the face back in front of the stop's plane (a virtual leg in air): rays
+    0.5 and 10 mm high through LC1120-A (stop semi-diameter 11.04 mm) all pass, and the low one
+    leaves with the paraxial slope y / f' of a -99.57 mm lens (f' = -EFL: it diverges), within 1e-5."""
+    from physcam.trace.rays import OK, RayBatch
+    from physcam.trace.trace import trace_through
+
+    lens = read_lens(DATA / "zemax" / "thorlabs_LC1120-A.zmx")
+    rays = RayBatch.from_arrays([[0.0, 0.5, -20.0], [0.0, 10.0, -20.0]], [[0.0, 0.0, 1.0]] * 2)
+    out = trace_through(lens, rays, backend="numpy")
+    assert (out.flag == OK).all()
+    assert out.M[0] / out.N[0] == pytest.approx(-0.5 / gaussian(lens).efl, abs=1e-5)
+
+
+LEGACY_PRINTED = {  # nd, Vd as SCHOTT printed them (SCHOTT catalogues; the NM lines of Zemax's SCHOTT.AGF)
+    "SK16": (1.62041, 60.32), "SK1": (1.61025, 56.71), "F15": (1.60565, 37.83), "SSK4A": (1.61765, 55.14),
+    "BK7": (1.51680, 64.17), "B270": (1.52308, 58.57)}
+
+
+@pytest.mark.parametrize("name", sorted(LEGACY_PRINTED))
+def test_legacy_glasses_are_schotts_own_data(name):
+    g = find_glass(name, ["SCHOTT_LEGACY"])
+    nd, vd = LEGACY_PRINTED[name]
+    n = {k: float(g.index(nm)) for k, nm in (("C", LINE_C_NM), ("d", LINE_D_NM), ("F", LINE_F_NM))}
+    assert n["d"] == pytest.approx(nd, abs=2e-5)
+    assert (n["d"] - 1) / (n["F"] - n["C"]) == pytest.approx(vd, abs=0.05)
+    assert g.maker == "SCHOTT_LEGACY" and g.status in ("obsolete", "standard")
+
+
+def test_hikari_and_ohara_legacy_glasses_of_real_files():
+    """Thorlabs' AC254-060-A names HIKARI's withdrawn E-BAF11 and HOYA's FD10 (GCAT SCHOTT MISC HIKARI
+    HOYA ...); optiland's lens2.zmx OHARA's L-BAL35: each loads from its maker's legacy catalogue,
+    its formula giving the NM line's nd (FD10: 1.72825, HOYA's printed nd)."""
+    from physcam.lens.catalog import resolve_glass
+
+    g, how = resolve_glass("E-BAF11", ["SCHOTT", "MISC", "HIKARI"])
+    assert (g.maker, how, g.status) == ("HIKARI_LEGACY", "legacy", "obsolete")
+    assert float(g.index(LINE_D_NM)) == pytest.approx(1.666718, abs=2e-5)
+    g, how = resolve_glass("L-BAL35", ["SCHOTT", "OHARA"])
+    assert (g.maker, how) == ("OHARA_LEGACY", "legacy") and float(g.index(LINE_D_NM)) == pytest.approx(g.nd, abs=2e-5)
+    g, how = resolve_glass("FD10", ["SCHOTT", "MISC", "HIKARI", "HOYA"])  # HOYA's FD10, AC254-060-A's flint
+    assert (g.maker, how, g.status) == ("HOYA_LEGACY", "legacy", "obsolete")
+    assert float(g.index(LINE_D_NM)) == pytest.approx(g.nd, abs=2e-5) and g.nd == pytest.approx(1.72825, abs=1e-5)
+
+
+def test_b270_against_schotts_1993_data_sheet():
+    """B 270 from Zemax's catalogue (a Schott-series formula) against the indices SCHOTT's B 270 data
+    sheet (August 1993, as tabulated by refractiveindex.info) prints to 4 decimals: an independent
+    source of the same glass."""
+    sheet = {435.83: 1.5341, 486.13: 1.5292, 546.07: 1.5251, 587.56: 1.5230, 656.27: 1.5203}
+    g = find_glass("B270", ["SCHOTT_LEGACY"])
+    for nm, n in sheet.items():
+        assert float(g.index(nm)) == pytest.approx(n, abs=1.5e-4), nm
+
+
+def test_legacy_glasses_load_by_their_own_name_never_a_substitute():
+    """optiland loads this double Gauss with F15 taken as SF15 and SK1 as HIKARI's SK16 (EFL 105.3 mm,
+    tests/data/optiland_zemax.json); physcam loads SCHOTT's F15 and SK1 (EFL 61.60 mm, optiland's
+    own with the legacy coefficients: test_efl_bfl_fnumber_against_optiland), and says so in one line."""
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        lens = read_lens(DATA / "zemax" / "double_gauss_legacy.zmx")
+    assert len(seen) == 1 and str(seen[0].message).endswith(
+        "SK16 (obsolete), SK1 (obsolete), F15 (obsolete), SSK4A (obsolete) taken from SCHOTT_LEGACY (SCHOTT's "
+        "glasses from Zemax's SCHOTT.AGF of 2008, not SCHOTT's current catalogue)")
+    media = {s.medium.glass: s.medium for s in lens.surfaces if s.medium.glass}
+    assert (media["F15"].nd, media["F15"].catalog) == (1.605651, "SCHOTT_LEGACY")  # SF15 is 1.69895
+    assert (media["SK1"].nd, media["SK1"].catalog) == (1.61025, "SCHOTT_LEGACY")
+    want = ORACLE["double_gauss_legacy"]
+    assert abs(gaussian(lens).efl / want["efl_mm_optiland_lookup"] - 1) > 0.3  # not optiland's substitutes
+    with strict_glass(), pytest.warns(PhysCamWarning, match="taken from SCHOTT_LEGACY"):
+        # OpticStudio's own SCHOTT.AGF holds these: strict keeps them
+        assert read_lens(DATA / "zemax" / "double_gauss_legacy.zmx").surfaces == lens.surfaces
+    with warnings.catch_warnings():  # written back (GCAT SCHOTT: OpticStudio's file holds them) and read again
+        warnings.simplefilter("ignore")
+        assert loads_lens(dumps_lens(lens, "zemax"), "zemax").surfaces == lens.surfaces
+        assert loads_lens(dumps_lens(lens, "physcam"), "physcam").surfaces == lens.surfaces
+    assert "GCAT SCHOTT\n" in dumps_lens(lens, "zemax")
+
+
+def test_a_glass_in_no_catalogue_names_the_nearest_never_takes_it():
+    text = (DATA / "zemax" / "double_gauss_legacy.zmx").read_text(encoding="cp1252").replace("SSK4A", "SSK4")
+    with pytest.raises(LensFileError, match=r"unknown glass 'SSK4'.*nearest names: SSK4A"):
+        loads_lens(text, "zemax", "dg.zmx")
+
+
+def test_legacy_catalogues_never_shadow_a_current_glass():
+    from physcam.lens.catalog import catalog
+
+    from physcam.lens.catalog import resolve_glass
+
+    for maker, legacy in (("SCHOTT", "SCHOTT_LEGACY"), ("OHARA", "OHARA_LEGACY")):
+        assert not set(catalog(maker)) & set(catalog(legacy)), maker
+    # OHARA's sheet writes "S-TIL 2", Zemax files "S-TIL2": the same current glass, not a legacy one
+    assert find_glass("S-TIL2", ["OHARA"]) is find_glass("S-TIL 2", ["OHARA"])
+    assert resolve_glass("F2", ["SCHOTT"]) == (find_glass("F2", ["SCHOTT"]), None)
+    assert resolve_glass("BK7")[0].maker == "SCHOTT_LEGACY" and resolve_glass("BK7")[1] == "legacy"
+    with pytest.raises(GlassNotFound):  # find_glass alone keeps to the current catalogues
+        find_glass("BK7")
+
+
+def test_strict_glass_option_keeps_opticstudios_refusal(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("PHYSCAM_CONFIG", "")
+    f = tmp_path / "a.zmx"
+    f.write_text((DATA / "zemax" / "asphere_780nm.zmx").read_text().replace("GCAT OHARA SCHOTT", "GCAT SCHOTT"))
+    assert main(["lens", "show", "--lens", str(f)]) == 0
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "S-LAH64 taken from OHARA (not in GCAT SCHOTT" in err
+    assert main(["lens", "show", "--lens", str(f), "--strict-glass"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "S-LAH64 is in OHARA, which was not searched" in err
+    assert main(["lens", "show", "--lens", str(f)]) == 0  # the next run is not strict
+    capsys.readouterr()

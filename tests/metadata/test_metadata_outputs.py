@@ -19,6 +19,9 @@ def _samples(attr):
 
 
 def test_arri_usd_has_one_time_sample_per_frame_with_the_files_focus_and_tstop(tmp_path, capsys):
+    """Authored on the plate's frame numbers (issue 40 item 6): plate frame 1001 + t holds the file's
+    row t (its focus in metres x 1000, its Lens Linear Iris as 2^((L - 1000) / 2000), its Master TC);
+    the stage's start and end time codes are the plate range."""
     pytest.importorskip("pxr")
     from pxr import Usd
 
@@ -29,15 +32,18 @@ def test_arri_usd_has_one_time_sample_per_frame_with_the_files_focus_and_tstop(t
     focus = _samples(stage.GetPrimAtPath("/Cameras/Camera/Pinhole").GetAttribute("focusDistance"))
     tstop = _samples(stage.GetPrimAtPath("/Cameras/Camera/Camera").GetAttribute("exposure:fStop"))
     tc = _samples(stage.GetPrimAtPath("/Cameras/Camera").GetAttribute("physcam:live:timecode"))
-    assert sorted(focus) == sorted(tstop) == [float(i) for i in range(500)]  # one sample per row
+    assert sorted(focus) == sorted(tstop) == [float(1001 + i) for i in range(500)]  # one sample per row
+    assert (stage.GetStartTimeCode(), stage.GetEndTimeCode()) == (1001.0, 1500.0)
     rows = ARRI.read_text(encoding="utf-8").splitlines()
     header = rows[0].split("\t")
     i_focus, i_iris, i_tc = header.index("Lens Focus Distance"), header.index("Lens Linear Iris"), header.index("Master TC")
     for t in range(500):
         cells = rows[t + 1].split("\t")
-        assert focus[t] == pytest.approx(float(cells[i_focus]) * 1000, rel=1e-6)  # metres in the file, mm in USD
-        assert tstop[t] == pytest.approx(2 ** ((int(cells[i_iris]) - 1000) / 2000), rel=1e-6)
-        assert tc[t] == cells[i_tc]
+        assert focus[1001 + t] == pytest.approx(float(cells[i_focus]) * 1000, rel=1e-6)  # metres in the file, mm in USD
+        assert tstop[1001 + t] == pytest.approx(2 ** ((int(cells[i_iris]) - 1000) / 2000), rel=1e-6)
+        assert tc[1001 + t] == cells[i_tc]
+    attr = stage.GetPrimAtPath("/Cameras/Camera/Pinhole").GetAttribute("focusDistance")
+    assert attr.Get(1001) == pytest.approx(4812.0) and attr.Get(1500) == pytest.approx(3056.0)  # rows 1 and 500
     plate = stage.GetPrimAtPath("/Cameras/Camera").GetCustomDataByKey("physcam:plate")
     assert dict(plate) == {"path": "plates/B001C001.####.exr", "firstFrame": 1001, "lastFrame": 1500}
     assert stage.GetTimeCodesPerSecond() == 24

@@ -57,6 +57,21 @@ def test_unit_focus_closer_than_one_to_one_names_the_closest_focus():
         focusing.focus(dgauss(), 150.0)
 
 
+@pytest.mark.parametrize("slug", ["fisheye_10mm", "tessar_50mm_f2_8", "dgauss_50mm"])
+def test_unit_focus_reaches_the_closest_focus_it_names(slug):
+    # closest_focus is the 1:1 conjugate, where the focus quadratic's discriminant is zero: a rounding
+    # error below zero refused the very mark closest_focus names (fisheye_10mm, tessar_50mm_f2_8)
+    from physcam.lens.library import load_lens
+
+    lens = load_lens(slug)
+    near = focusing.closest_focus(lens, method="unit")
+    st = focusing.focus(lens, near, method="unit")
+    g = gaussian(lens)
+    assert st.back_focus_mm - st.back_focus_infinity_mm == pytest.approx(g.efl, rel=1e-6)  # 1:1: s' = 2f, extension f
+    with pytest.raises(OpticsError, match="closest real focus"):
+        focusing.focus(lens, near * (1 - 1e-6), method="unit")
+
+
 def test_unit_focus_with_limited_travel():
     # 5 mm of extension: s' = f + 5 -> s = f s'/(s' - f); the mark adds the hiatus
     s2 = F + 5.0

@@ -16,9 +16,10 @@ URL_LINE = re.compile(r"listening on (http://127\.0\.0\.1:(\d+)/)")
 
 
 @contextmanager
-def running_server(*flags: str, timeout: float = 90.0):
-    """`physcam serve --port 0 FLAGS...` in a subprocess; yields (base URL, port, the process)."""
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
+def running_server(*flags: str, timeout: float = 90.0, env: dict | None = None):
+    """`physcam serve --port 0 FLAGS...` in a subprocess (``env``: variables added to its environment);
+    yields (base URL, port, the process)."""
+    env = dict(os.environ, PYTHONUNBUFFERED="1", **(env or {}))
     proc = subprocess.Popen([sys.executable, "-m", "physcam", "serve", "--port", "0", *flags],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     lines: list[str] = []

@@ -158,7 +158,8 @@ def test_methods_and_bodies_are_refused(server):
     with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
         s.sendall(b"GET /api/report?focal=\xff\xfe HTTP/1.1\r\nHost: x\r\n\r\n")
         assert s.recv(100).split(b" ")[1] in (b"400", b"422")
-    assert get_json(port, "/api/health") == (200, {"ok": True, "version": json.loads(request(port, "/api/health")[2])["version"]})
+    assert get_json(port, "/api/health") == (200, {"ok": True, "version": json.loads(request(port, "/api/health")[2])["version"],
+                                                   "units": "m"})  # the page's default: the user config's units (none here)
 
 
 NAMES = ["focal", "fstop", "tstop", "focus", "sensor", "sensor-width", "sensor-height", "squeeze", "coc", "near",

@@ -112,7 +112,7 @@ def type_setup(pg):
     pg.fill("#focal", "35")
     pg.fill("#sensor-search", "alexa 35")  # the search narrows the picker; its first match is chosen
     pg.fill("#fstop", "2")
-    pg.fill("#focus", "2.5")  # a bare number is metres in metric
+    pg.fill("#focus", "2.5m")  # a bare number would be millimetres, as on the command line (docs/serve.md)
 
 
 def test_typed_setup_shows_the_cli_numbers(page, server, capsys):
@@ -156,10 +156,10 @@ def test_imperial_switch(page, server, capsys):
     page.click("#units-imperial")
     page.wait_for_function("() => document.getElementById('out-near').textContent.includes(\"'\")")
     assert page.text_content("#out-near") == imperial(near) == format_feet_inches(near)
-    assert float(page.get_attribute("#out-near", "data-mm")) == near  # the switch keeps 2.5 meaning metres
+    assert float(page.get_attribute("#out-near", "data-mm")) == near  # 2.5m keeps meaning metres
     # the DOF chart is drawn in feet too (physcam serve's /api/dof.svg?...&units=ft)
     page.wait_for_function("() => (document.getElementById('dof-chart').getAttribute('src') || '')"
-                           ".endsWith('&units=ft')")
+                           ".includes('units=ft')")
     assert page.input_value("#focus") == "2.5m"
     page.wait_for_function("() => { const td = document.querySelector('#marks tbody td');"
                            " return td !== null && td.textContent === \"2'\"; }")
@@ -207,7 +207,7 @@ def test_impossible_input_shows_its_message_and_the_page_keeps_working(page, ser
     assert "stale" in page.get_attribute("#summary", "class")
     page.fill("#focus", "3 parsecs")
     page.wait_for_function("() => document.getElementById('message').textContent.startsWith('focus: unknown unit')")
-    page.fill("#focus", "2.5")
+    page.fill("#focus", "2.5m")
     page.fill("#fstop", "4")
     d = cli_report(capsys, *SETUP[:-3], "4", "--focus", "2.5m")
     wait_mm(page, "out-near", d["dof"]["near_from_film_mm"])
@@ -237,13 +237,55 @@ def test_inversions_on_the_page(page, server, capsys):
     # focus from a bracket
     page.click("#solve-focus")
     page.fill("#fstop", "4")
-    page.fill("#near", "2.5")
-    page.fill("#far", "4")
+    page.fill("#near", "2.5m")
+    page.fill("#far", "4m")
     page.select_option("#coc", "d/1500")
     page.fill("#tstop", "")
     d = cli_report(capsys, "--focal", "35", "--near", "2.5m", "--far", "4m", "--fstop", "4")
     wait_mm(page, "out-focus", d["solved"]["focus_from_film_mm"])
     assert page.text_content("#out-focus") == metric(d["focus_from_film_mm"]) + " (solved from near/far)"
+    # split focus with the stop given (issue 39): the top boxes show f/4's own limits and, beside them, the stop
+    # the asked 2.5 m - 4 m needs at this CoC (not a CoC inflated until f/4 seems to hold them)
+    sf = d["split_focus"]
+    wait_mm(page, "out-near", d["dof"]["near_from_film_mm"])
+    assert d["dof"]["near_from_film_mm"] > 2500.0 and not sf["holds"]
+    page.wait_for_selector("#split-card:not([hidden])")
+    assert page.text_content("#label-near") == "near at f/4"
+    need = float(f"{sf['fstop_needed']:.1f}")  # as the page writes it: one decimal, no trailing zero
+    assert page.text_content("#out-split") == f"f/{need:g} holds 2.50 m – 4.00 m (f/4 holds less)"
+
+
+def test_one_rule_for_a_bare_number_and_the_words(page, server, capsys):
+    """Issue 39: a bare focus is millimetres here as on the command line, and one too close says "did you
+    mean 3m?"; the magnification reads 1 : 58.0 for the inverted image, never "1 : -58.0"."""
+    open_page(page, server)
+    type_setup(page)
+    page.fill("#focus", "3")
+    page.wait_for_function("() => document.getElementById('message').textContent.includes('did you mean 3m?')")
+    page.fill("#focus", "3m")
+    d = cli_report(capsys, *SETUP[:-1], "3m")
+    wait_mm(page, "out-near", d["dof"]["near_from_film_mm"])
+    m = d["magnification"]
+    assert m < 0
+    assert page.text_content("#out-mag") == f"1 : {1 / abs(m):.1f}  ({m:.4f}×, inverted image)"
+
+
+def test_a_server_whose_config_says_feet_reads_bare_numbers_in_feet(browser, tmp_path, capsys):
+    cfg = tmp_path / "config.toml"
+    cfg.write_text('units = "ft"\n')
+    with running_server(env={"PHYSCAM_CONFIG": str(cfg)}) as (url, port, proc):
+        ctx = browser.new_context(viewport={"width": 375, "height": 812})
+        pg = ctx.new_page()
+        try:
+            open_page(pg, url)
+            assert pg.get_attribute("#units-imperial", "aria-pressed") == "true"
+            pg.fill("#focal", "35")
+            pg.fill("#fstop", "2")
+            pg.fill("#focus", "10")  # feet, as `physcam report --focus 10` reads it with this config
+            d = cli_report(capsys, "--focal", "35", "--fstop", "2", "--focus", "10ft")
+            wait_mm(pg, "out-near", d["dof"]["near_from_film_mm"])
+        finally:
+            ctx.close()
 
 
 def test_library_lens_and_its_diagram(page, server, capsys):
@@ -252,7 +294,7 @@ def test_library_lens_and_its_diagram(page, server, capsys):
     page.wait_for_function("() => document.getElementById('lens').options.length > 5")
     page.select_option("#lens", "dgauss_50mm")
     page.fill("#fstop", "2.8")
-    page.fill("#focus", "2")
+    page.fill("#focus", "2m")
     d = cli_report(capsys, "--lens", "dgauss_50mm", "--fstop", "2.8", "--focus", "2m")
     wait_mm(page, "out-near", d["dof"]["near_from_film_mm"])
     assert "prescription" in page.text_content("#out-pupil")

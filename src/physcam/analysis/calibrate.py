@@ -20,7 +20,13 @@ Standard, Degree 4, USD lensDistortion, each with its residual over the frame an
 with replacement ``bootstrap`` times and the camera refitted; the standard deviation of each figure
 over the refits is its standard uncertainty (the distortion field's: the RMS over the frame of each
 grid point's standard deviation, in pixels). OpenCV's own standard deviations of the intrinsics
-(from the fit's covariance) are reported beside it.
+(from the fit's covariance) are reported beside it. With ``bootstrap=0`` the focal length's and the
+principal point's uncertainties are OpenCV's covariance's, and the field's is not estimated (absent,
+"not estimated" in print); 1 or 2 refits give no standard deviation and are refused.
+
+**Verdict.** A mark is good when the corners fit (total and per-view residual), the chart covered
+the frame, every model fits the measured field, and the principal point lies inside the frame (a
+principal point outside it is a wrong fit, e.g. of a detected grid out of order).
 
 **Breathing.** With several marks, each mark's pinhole focal length against the farthest mark's:
 ``f(mark) / f(farthest) - 1``, with the two uncertainties added in quadrature.
@@ -158,6 +164,9 @@ class MarkCalibration:
         if bad:
             why.append(f"views off by more than {VIEW_RESIDUAL_FACTOR * self.max_residual_px:g} px RMS: "
                        + ", ".join(bad))
+        (cx, cy), (w, h) = self.principal_point_px, self.size_px
+        if not (-0.5 <= cx <= w - 0.5 and -0.5 <= cy <= h - 0.5):
+            why.append(f"the principal point ({cx:.0f}, {cy:.0f}) px lies outside the {w}x{h} px frame: a wrong fit")
         if self.coverage < 0.5:
             why.append(f"the chart covered only {100 * self.coverage:.0f} % of the frame (shoot it in the "
                        "corners too)")
@@ -255,8 +264,10 @@ def calibrate_mark(views, sensor_mm, *, fix_aspect: bool = True, bootstrap: int 
         raise InputError(f"the images are {size[0]}x{size[1]} px but the sensor is {sw:g} x {sh:g} mm: the photosites "
                          "would not be square; give the sensor's recorded area (--sensor-width/--sensor-height)")
     aspect = pitch[1] / pitch[0]  # fx / fy for square-on-the-sensor pixels
+    bootstrap = _bootstrap_count(bootstrap)
     rms, K, dist, per_view, std_in = _calibrate(views, size, aspect, fix_aspect)
-    unc = _bootstrap(views, size, aspect, fix_aspect, (K, dist), pitch, int(bootstrap), seed) if bootstrap else {}
+    unc = _bootstrap(views, size, aspect, fix_aspect, (K, dist), pitch, bootstrap, seed) if bootstrap \
+        else _covariance_uncertainty(std_in, pitch)
     names = ("fx_px", "fy_px", "cx_px", "cy_px", "k1", "k2", "p1", "p2", "k3")
     cal = MarkCalibration(views[0].mark_mm, size, (sw, sh), K, dist, rms, views, [float(r) for r in per_view],
                           {n: float(s) for n, s in zip(names, std_in)}, unc, _coverage(views, size),
@@ -265,6 +276,20 @@ def calibrate_mark(views, sensor_mm, *, fix_aspect: bool = True, bootstrap: int 
     cal.notes.append("physcam's models are about the measured principal point "
                      f"({cal.principal_offset_mm[0]:+.4f}, {cal.principal_offset_mm[1]:+.4f}) mm from the frame centre")
     return cal
+
+
+def _bootstrap_count(n) -> int:
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0 or n in (1, 2):
+        raise InputError(f"bootstrap is 0 (OpenCV's covariance) or 3 or more refits, got {n!r}")
+    return int(n)
+
+
+def _covariance_uncertainty(std_in, pitch) -> dict:
+    """The uncertainties OpenCV's fit covariance gives (``bootstrap=0``): f in mm, the principal point in
+    px; the distortion field's is not estimated (absent)."""
+    sfx, sfy, scx, scy = (float(v) for v in std_in[:4])
+    return {"method": "OpenCV's covariance of the fit (no bootstrap; the field's uncertainty is not estimated)",
+            "focal_length_mm": {"x": sfx * pitch[0], "y": sfy * pitch[1]}, "principal_point_px": [scx, scy]}
 
 
 def _check_views(views) -> list:

@@ -99,7 +99,7 @@ def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K
         raise InputError(f"give a Calibration (calibrate_views), got {type(calibration).__name__}")
     if not isinstance(lens, Prescription):
         raise InputError(f"give the lens as a Prescription, got {type(lens).__name__}")
-    rows, pred_f = [], {}
+    rows, pred_f, notes = [], {}, []
     for m in calibration.marks:
         mark = math.inf if m.mark_mm is None else float(m.mark_mm)
         fld = distortion_field(lens, focus_mm=mark, sensor_width_mm=m.sensor_mm[0], sensor_height_mm=m.sensor_mm[1],
@@ -111,7 +111,11 @@ def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K
         rows.append(_row(f"pinhole focal length at {where}", m.focal_length_mm[1], f_pred, std_f, "mm", k))
         d = _distortion_difference(m, fld)
         rms = float(np.sqrt(np.mean(np.sum(d * d, axis=1))))
-        std_d = m.uncertainty.get("field_rms_px", math.nan)
+        std_d = m.uncertainty.get("field_rms_px")
+        if std_d is None:  # bootstrap 0: no uncertainty to judge the difference by
+            notes.append(f"distortion field at {where}: RMS difference {rms:.3g} px, not judged (its uncertainty is "
+                         "not estimated without a bootstrap)")
+            continue
         row = _row(f"distortion field at {where} (RMS difference)", rms, 0.0, std_d, "px", k)
         row["max_difference_px"] = float(np.hypot(*d.T).max())
         rows.append(row)
@@ -123,7 +127,6 @@ def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K
         std = 100.0 * math.hypot(_focal_std_mm(m) / r.focal_length_mm, _focal_std_mm(m0) / ref.focal_length_mm) \
             * r.focal_length_mm / ref.focal_length_mm
         rows.append(_row(f"breathing {r.mark_mm:g} mm against {ref.mark_mm:g} mm", r.change_pct, p, std, "%", k))
-    notes = []
     if calibration.illumination is not None:
         from ..errors import OpticsError
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from .calibrate_chart import read_gray
+from .calibrate_chart import MAX_IMAGE_PIXELS, check_pixels, image_size, read_gray
 
 __all__ = ["MeasuredIllumination", "measure_illumination"]
 
@@ -43,9 +43,12 @@ class MeasuredIllumination:
                 "definition": "ring mean over the centre ring's, rings about the measured principal point"}
 
 
-def measure_illumination(paths, size_px, sensor_mm, principal_point_px, *, rings: int = RINGS) -> MeasuredIllumination:
+def measure_illumination(paths, size_px, sensor_mm, principal_point_px, *, rings: int = RINGS,
+                         max_pixels: int = MAX_IMAGE_PIXELS) -> MeasuredIllumination:
     """Relative illumination of the flat-field frames ``paths`` (module notes); ``principal_point_px``
-    in OpenCV pixels (x right, y down, pixel centres at whole numbers)."""
+    in OpenCV pixels (x right, y down, pixel centres at whole numbers). Every frame's size is read
+    from its header before anything is decoded (:func:`.calibrate_chart.read_gray`, ``max_pixels``);
+    the frames are reduced to their ring sums one at a time, a band of rows at a time."""
     from .calibrate import _pair
 
     if isinstance(paths, (str, bytes)) or not hasattr(paths, "__iter__"):
@@ -57,32 +60,50 @@ def measure_illumination(paths, size_px, sensor_mm, principal_point_px, *, rings
             raise InputError(f"{name} is a pair of numbers, got {v!r}")
     if not paths:
         raise InputError("give one or more flat-field frames")
-    imgs = []
-    for p in paths:
-        img = read_gray(p).astype(np.float64)
-        if (img.shape[1], img.shape[0]) != tuple(size_px):
-            raise InputError(f"{p}: {img.shape[1]}x{img.shape[0]} px, but the chart images are "
-                             f"{size_px[0]}x{size_px[1]}: give flat fields of the same camera mode")
-        imgs.append(img)
     w, h = size_px
+    for p in paths:  # every header before the first frame is decoded
+        fw, fh = image_size(p)
+        check_pixels(p, fw, fh, max_pixels)
+        if (fw, fh) != (w, h):
+            raise InputError(f"{p}: {fw}x{fh} px, but the chart images are {w}x{h}: give flat fields of the same "
+                             "camera mode")
     pitch = (sensor_mm[0] / w, sensor_mm[1] / h)
-    y, x = np.mgrid[0:h, 0:w]
-    r = np.hypot((x - principal_point_px[0]) * pitch[0], (y - principal_point_px[1]) * pitch[1])
-    edges = np.linspace(0.0, r.max() * (1 + 1e-9), rings + 1)
-    ring = np.digitize(r, edges) - 1
-    counts = np.bincount(ring.ravel(), minlength=rings)
+    r_max = max(np.hypot((x - principal_point_px[0]) * pitch[0], (y - principal_point_px[1]) * pitch[1])
+                for x in (0, w - 1) for y in (0, h - 1))
+    edges = np.linspace(0.0, r_max * (1 + 1e-9), rings + 1)
+    counts, per, sq = None, [], None
+    for p in paths:
+        c, sums, sums2 = _ring_sums(read_gray(p, max_pixels=max_pixels), edges, pitch, principal_point_px, rings)
+        counts = c
+        per.append(sums / np.maximum(c, 1))
+        sq = sums2 if sq is None else sq
     if (counts == 0).any():
         raise InputError("the frame is too small for the rings of the flat-field measurement")
-    per = np.array([np.bincount(ring.ravel(), img.ravel(), minlength=rings) / counts for img in imgs])
+    per = np.array(per)
     if not (per[:, 0] > 0).all():
         raise InputError(f"{paths[0]}: the flat field's centre is black: not a flat-field frame")
     rel = per / per[:, :1]
-    if len(imgs) > 1:
-        std = rel.std(axis=0, ddof=1) / math.sqrt(len(imgs))
+    if len(paths) > 1:
+        std = rel.std(axis=0, ddof=1) / math.sqrt(len(paths))
     else:
-        sq = np.bincount(ring.ravel(), imgs[0].ravel() ** 2, minlength=rings) / counts
-        spread = np.sqrt(np.maximum(sq - per[0] ** 2, 0.0)) / per[0, 0]
+        spread = np.sqrt(np.maximum(sq / counts - per[0] ** 2, 0.0)) / per[0, 0]
         std = spread / np.sqrt(counts)
     mid = 0.5 * (edges[:-1] + edges[1:])
     mid[0] = 0.0
     return MeasuredIllumination(paths, mid, rel.mean(axis=0), std)
+
+
+def _ring_sums(img, edges, pitch, pp, rings, band: int = 256):
+    """(pixel count, sum, sum of squares) per ring of ``img``, a band of rows at a time (memory of one band)."""
+    h, w = img.shape
+    counts, sums, sums2 = np.zeros(rings), np.zeros(rings), np.zeros(rings)
+    dx2 = ((np.arange(w) - pp[0]) * pitch[0]) ** 2
+    for y0 in range(0, h, band):
+        rows = np.arange(y0, min(h, y0 + band))
+        r = np.sqrt(dx2[None, :] + (((rows - pp[1]) * pitch[1]) ** 2)[:, None])
+        ring = (np.digitize(r, edges) - 1).ravel()
+        v = img[y0:y0 + len(rows)].astype(np.float64).ravel()
+        counts += np.bincount(ring, minlength=rings)[:rings]
+        sums += np.bincount(ring, v, minlength=rings)[:rings]
+        sums2 += np.bincount(ring, v * v, minlength=rings)[:rings]
+    return counts, sums, sums2

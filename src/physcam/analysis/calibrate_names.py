@@ -8,12 +8,16 @@ import re
 
 from ..errors import InputError
 
-__all__ = ["CHARTS", "CHARUCO_DICTIONARY", "parse_corners"]
+__all__ = ["CHARTS", "CHARUCO_DICTIONARY", "MAX_IMAGE_PIXELS", "parse_corners"]
 
 #: The charts physcam detects (OpenCV): a checkerboard or a ChArUco board
 CHARTS = ("checkerboard", "charuco")
 #: The ArUco dictionary of a ChArUco board unless told (OpenCV's tutorial board)
 CHARUCO_DICTIONARY = "DICT_5X5_100"
+#: The most pixels an image may have (width x height, from its header, before it is decoded): a 12K
+#: cinema frame is 80 Mpx, a 100 Mpx stills back 102 Mpx; a decoded 120 Mpx 16-bit image is 240 MB
+#: (``physcam calibrate --max-pixels`` raises it)
+MAX_IMAGE_PIXELS = 120_000_000
 
 
 def parse_corners(text) -> tuple[int, int]:

@@ -44,7 +44,8 @@ def _text(m, cal) -> str:
              (f"principal point ({m.principal_point_px[0]:.2f}, {m.principal_point_px[1]:.2f}) px +- "
               f"({pp[0]:.2f}, {pp[1]:.2f})"),
              f"OpenCV k1 {k1:.5f} k2 {k2:.5f} k3 {k3:.5f} p1 {p1:.6f} p2 {p2:.6f}",
-             (f"residual {m.rms_px:.3f} px RMS; field uncertainty {u.get('field_rms_px', math.nan):.3f} px RMS; "
+             (f"residual {m.rms_px:.3f} px RMS; field uncertainty "
+              f"{'not estimated' if 'field_rms_px' not in u else format(u['field_rms_px'], '.3f') + ' px RMS'}; "
               f"coverage {100 * m.coverage:.0f} %")]
     lines += [f"{f.model}: max {f.max_residual_px:.3f} px {'good' if f.acceptable else 'NOT good'}" for f in m.fits]
     lines.append("verdict: " + ("good" if good else "NOT good: " + "; ".join(why)))

@@ -105,7 +105,7 @@ class ColourResult:
         a1.axvline(0.0, color="0.6", lw=0.6)
         a1.set_xlabel(f"paraxial focus shift from {self.reference_nm:g} nm (mm)")
         a1.set_ylabel("wavelength (nm)")
-        a1.set_title(f"longitudinal colour: C - F = {self.longitudinal_paraxial_mm * 1e3:.1f} um (paraxial)", fontsize=8)
+        a1.set_title(f"longitudinal colour: C - F = {self.longitudinal_paraxial_mm * 1e3:.1f} µm (paraxial)", fontsize=8)
         if self.lateral:
             a2.plot([p.field_deg for p in self.lateral], [p.lateral_colour_um for p in self.lateral], "o-", ms=3)
         a2.axhline(0.0, color="0.6", lw=0.6)

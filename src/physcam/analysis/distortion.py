@@ -11,6 +11,14 @@ Engineering*, 4th ed., 3.5 and 10.5; Kingslake & Johnson, *Lens Design Fundament
 negative is barrel, positive pincushion. Anamorphic lenses are measured in the X-Z and the
 Y-Z meridians with their own EFL each. Heights are in mm on the film, field angles in degrees.
 
+**At a focus** (``focus_mm``, infinity included): the definition of the ST-maps and of
+``physcam distortion --focus`` (:mod:`physcam.analysis.stmap`). The lens is focused at the mark
+(mm from the film plane); the chief ray is traced backward from the film height h through the
+centre of the stop to the object plane; theta is the angle of its object point seen from the
+entrance pupil, and f the best-match pinhole's focal length at that focus
+(``GaussianData.pinhole_focal_length``, per meridian). At infinity f is the EFL (but for the X
+meridian of an anamorphic, whose film lies where Y focuses). The lens card draws this curve.
+
 Radial model ("standard", two coefficients)::
 
     r_real = r_ideal (1 + k1 rho^2 + k2 rho^4),    rho = r_ideal / (sensor width / 2)
@@ -116,12 +124,15 @@ class DistortionResult:
     lens_name: str
     wavelength_nm: float
     film_z_mm: float
-    efl_x_mm: float
+    efl_x_mm: float  # the ideal's focal length per meridian: the EFL, or at a focus the pinhole's there
     efl_y_mm: float
     sensor_mm: tuple[float, float]
     points: list[DistortionPoint]
     fit: StandardDistortion | None  # None with fewer than two field points off axis
     notes: list[str] = field(default_factory=list)
+    #: the focus mark (mm from the film plane) the lens was focused at; None: the legacy infinity
+    #: measurement against the film at ``film_z_mm`` (module notes)
+    focus_from_film_mm: float | None = None
 
     def meridian(self, axis: str) -> list[DistortionPoint]:
         return [p for p in self.points if p.axis == axis]
@@ -132,6 +143,11 @@ class DistortionResult:
             "film_z_reference": "lens space: mm from the first vertex, +z toward the film",
             "efl_x_mm": self.efl_x_mm, "efl_y_mm": self.efl_y_mm, "sensor_mm": list(self.sensor_mm),
             "definition": "100 (h_real - f tan theta) / (f tan theta); negative = barrel",
+            "focus_from_film_mm": None if self.focus_from_film_mm is None or math.isinf(self.focus_from_film_mm)
+            else self.focus_from_film_mm,
+            "focus_is_infinite": self.focus_from_film_mm is None or math.isinf(self.focus_from_film_mm),
+            "ideal": IDEAL_AT_FOCUS if self.focus_from_film_mm is not None else
+            "f = the EFL, theta the field angle of light from infinity",
             "points": [p.to_dict() for p in self.points],
             "fit": None if self.fit is None else self.fit.to_dict(),
             "usd": None if self.fit is None else self.fit.usd_attributes(), "notes": list(self.notes),
@@ -194,9 +210,15 @@ def real_distortion(
     n_fields: int = 15,
     wavelength_nm: float | None = None,
     film_z: float | None = None,
+    focus_mm: float | None = None,
     backend: str = "auto",
 ) -> DistortionResult:
     """Real distortion of ``lens`` (module notes) and the fitted standard model.
+
+    ``focus_mm``: the focus mark (mm from the film plane; ``math.inf`` allowed): the lens is focused
+    there and measured as ``distortion --focus`` and the ST-maps measure it (module notes, "At a
+    focus"); ``film_z`` is then not given. Without it, the legacy measurement: light from infinity on
+    the film at ``film_z`` (default the paraxial image plane).
 
     ``fields_deg``: field angles in degrees (default ``n_fields`` angles from 0 to the field whose
     paraxial image reaches the sensor corner, or the widest field whose chief ray passes the
@@ -212,6 +234,14 @@ def real_distortion(
         raise InputError(f"n_fields must be a whole number from 3 to 200, got {n_fields!r}")
     w = require_positive("sensor width", sensor_width_mm)
     h = require_positive("sensor height", sensor_height_mm)
+    if focus_mm is not None:
+        from ..units import parse_distance
+
+        focus_mm = parse_distance(focus_mm, name="focus distance", allow_inf=True)  # "2m", "infinity" too
+        if film_z is not None:
+            raise InputError("give either focus_mm (the lens focused there) or film_z (light from infinity on that "
+                             "film plane), not both")
+        return _focused_distortion(lens, fields_deg, focus_mm, w, h, n_fields, wl, backend)
     if film_z is None:
         film_z = paraxial_image_z(lens, wl)
     film_z = require_finite("film_z", film_z)
@@ -250,11 +280,114 @@ def real_distortion(
             dist = np.where(np.abs(par) > 1e-12, 100.0 * (heights - par) / np.where(par == 0, 1.0, par), 0.0)
         for f, hr, hp, d in zip(fields, heights, par, dist):
             points.append(DistortionPoint(axis, float(f), float(hr), float(hp), float(d)))
-    r_ideal = np.array([abs(p.paraxial_height_mm) for p in points])
-    fit = None
-    if (r_ideal > 0).sum() >= 2:
-        fit = fit_standard_distortion(r_ideal, [p.distortion_pct for p in points], w / 2.0)
-    else:
-        notes.append("fewer than two field points off axis: no distortion model fitted")
+    fit = _fit(points, w, notes)
     return DistortionResult(lens.name, float(wl), float(film_z), float(g["x"].efl), float(g["y"].efl), (w, h),
                             points, fit, notes)
+
+
+def _fit(points, w, notes):
+    """The standard model fitted to ``points`` (None, with a note, below two points off axis)."""
+    r_ideal = np.array([abs(p.paraxial_height_mm) for p in points])
+    if (r_ideal > 0).sum() >= 2:
+        return fit_standard_distortion(r_ideal, [p.distortion_pct for p in points], w / 2.0)
+    notes.append("fewer than two field points off axis: no distortion model fitted")
+    return None
+
+
+#: What the ideal image is at a focus (the ST-maps' and ``distortion --focus``'s definition).
+IDEAL_AT_FOCUS = ("f = the best-match pinhole's focal length at this focus (GaussianData.pinhole_focal_length), "
+                  "theta the angle of the object point seen from the entrance pupil; h_real the film height of "
+                  "its chief ray, traced backward from the film through the centre of the stop")
+
+
+class _AtFocus:
+    """Chief rays traced backward from film heights of a lens focused at a mark, per meridian: the
+    tangent of the object point's angle from the entrance pupil (the ST-maps' ``_real_to_ideal``)."""
+
+    def __init__(self, lens, focus_mm, wl, backend):
+        from ..optics.focusing import focus
+        from ..optics.paraxial import gaussian
+
+        self.st = focus(lens, focus_mm, axis="y", wavelength_nm=wl)
+        q = self.st.prescription
+        self.g = {a: gaussian(q, axis=a, wavelength_nm=wl, object_z=self.st.object_z, film_z=self.st.film_z)
+                  for a in ("x", "y")}
+        for a in ("x", "y"):
+            if self.g[a].pinhole_focal_length is None or not self.g[a].efl > 0:
+                raise OpticsError(f"lens {lens.name!r} has no best-match pinhole in {a.upper()} at this focus")
+        self.wl, self.backend = wl, backend
+
+    def ideal(self, axis, heights):
+        """(ideal picture heights f_pin tan theta, ok) of the chief rays from film heights along ``axis``; the
+        picture is the film turned by 180 degrees, so a film height +h has its ideal near -h."""
+        from .stmap import _real_to_ideal
+
+        hs = np.asarray(heights, dtype=float)
+        xy = np.zeros((hs.size, 2))
+        xy[:, 0 if axis == "x" else 1] = hs
+        ideal, ok = _real_to_ideal(self.st.prescription, self.g["x"], self.g["y"], self.st, xy, self.wl, self.backend)
+        return ideal[:, 0 if axis == "x" else 1], ok
+
+    def widest(self, axis, top):
+        """The largest film height up to ``top`` whose chief ray leaves the lens (to 1e-3 of ``top``)."""
+        if self.ideal(axis, [top])[1][0]:
+            return top
+        lo, hi = 0.0, top
+        while hi - lo > 1e-3 * top:
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if self.ideal(axis, [mid])[1][0] else (lo, mid)
+        return lo
+
+    def heights_for(self, axis, fields_deg, reach_mm):
+        """Film heights whose object points lie ``fields_deg`` off axis (seen from the entrance pupil), and
+        which were found: bisection on the film height from the axis to ``reach_mm``, where the object angle
+        grows with the height (a height whose chief ray does not leave the lens counts as too far)."""
+        fields = np.asarray(fields_deg, dtype=float)
+        want = np.tan(np.radians(np.abs(fields)))
+        f = self.g[axis].pinhole_focal_length
+        lo, hi = np.zeros(fields.shape), np.full(fields.shape, float(reach_mm))
+        for _ in range(64):  # to the float's own resolution
+            mid = 0.5 * (lo + hi)
+            ideal, ok = self.ideal(axis, mid)
+            below = ok & (np.abs(ideal) / f < want)
+            lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+        h = 0.5 * (lo + hi)
+        ideal, ok = self.ideal(axis, h)
+        found = ok & (np.abs(np.abs(ideal) / f - want) <= 1e-9 * want + 1e-12)
+        return np.sign(fields) * h, found
+
+
+def _focused_distortion(lens, fields_deg, focus_mm, w, h, n_fields, wl, backend) -> DistortionResult:
+    """:func:`real_distortion` of the lens focused at ``focus_mm`` (the ST-maps' definition, IDEAL_AT_FOCUS)."""
+    at = _AtFocus(lens, focus_mm, wl, backend)
+    axes = ("y", "x") if lens.is_anamorphic else ("y",)
+    half_diag = 0.5 * math.hypot(w, h)
+    notes, points = [], []
+    for axis in axes:
+        if fields_deg is None:
+            top = at.widest(axis, half_diag)
+            if top < half_diag - 1e-6:
+                notes.append(f"{axis.upper()} meridian: chief rays leave the lens only from film heights up to "
+                             f"{top:.2f} mm (sensor corner at {half_diag:.2f} mm)")
+            heights = np.linspace(0.0, top, n_fields)
+            ok = np.ones(heights.size, bool)
+        else:
+            fields = np.array([require_finite("field angle", f) for f in np.atleast_1d(fields_deg)], dtype=float)
+            if fields.size == 0 or (np.abs(fields) >= 89.0).any():
+                raise InputError("give field angles between -89 and 89 degrees")
+            heights, ok = at.heights_for(axis, fields, 4.0 * half_diag)
+        ideal, passed = at.ideal(axis, heights)
+        if not (ok & passed).all():
+            raise OpticsError(f"a chief ray of {lens.name!r} focused at {focus_mm:g} mm misses the film in the "
+                              f"{axis.upper()} meridian; choose smaller fields")
+        f = at.g[axis].pinhole_focal_length
+        for hr, hi in zip(heights, ideal):
+            real_pic = -hr  # the upright picture: the film turned by 180 degrees
+            d = 0.0 if abs(hi) < 1e-12 else 100.0 * (real_pic - hi) / hi
+            sign = -1.0 if hr < 0 else 1.0  # a field below the axis: negative angle and heights, as at infinity
+            points.append(DistortionPoint(axis, sign * math.degrees(math.atan(abs(hi) / f)), float(hr),
+                                          sign * float(abs(hi)), float(d)))
+    fit = _fit(points, w, notes)
+    return DistortionResult(lens.name, float(wl), float(at.st.film_z), float(at.g["x"].pinhole_focal_length),
+                            float(at.g["y"].pinhole_focal_length), (w, h), points, fit, notes,
+                            float(at.st.focus_from_film_mm))

@@ -42,8 +42,9 @@ convention of :mod:`physcam.analysis.distortion` (undistorted to distorted,
 r_d = r_u (1 + k1 rho^2 + k2 rho^4), rho = r_u / (gate width / 2)), now fitted over the 2-D frame
 at the shot's focus; ``anaSq`` stays 1 (its meaning in hdPrman is not documented).
 
-A model is **acceptable** when its largest residual is at most ``max_residual_px`` (default
-0.5 px); otherwise physcam says the residual and does not call the fit good (exporters refuse it).
+A model is **good** (``acceptable`` in code and JSON) when its largest residual is at most
+``max_residual_px`` (default 0.5 px); otherwise physcam says the residual and calls it "NOT good"
+(exporters refuse it): one word, :attr:`FittedDistortion.verdict`, in the CLI and on the residual figure.
 """
 
 from __future__ import annotations
@@ -163,6 +164,12 @@ class FittedDistortion:
             return self.formula(u)
         return _newton(self.formula, u, u, self._mm_scale())
 
+    @property
+    def verdict(self) -> str:
+        """The one word for the fit, as the CLI prints it and its residual figure draws it: "good", or "NOT good
+        (> N px)" (``acceptable`` in the JSON)."""
+        return "good" if self.acceptable else f"NOT good (> {self.max_residual_allowed_px:g} px)"
+
     def require_acceptable(self, what: str) -> None:
         """Raise :class:`ExportError` when the residual is above the allowed one."""
         if not self.acceptable:
@@ -204,9 +211,8 @@ class FittedDistortion:
         ax.set_xlabel("x (px from the left)")
         ax.set_ylabel("y (px from the bottom)")
         focus = "infinity" if math.isinf(self.focus_from_film_mm) else format_distance(self.focus_from_film_mm, units)
-        verdict = "acceptable" if self.acceptable else f"NOT acceptable (> {self.max_residual_allowed_px:g} px)"
         ax.set_title(f"{self.model} ({self.direction}) at focus {focus}\nresidual RMS {self.rms_residual_px:.3f} px, "
-                     f"max {self.max_residual_px:.3f} px: {verdict}", fontsize=8)
+                     f"max {self.max_residual_px:.3f} px: {self.verdict}", fontsize=8)
         return save(fig, path, force)
 
 

@@ -61,9 +61,14 @@ class LensCard:
                 "focus_from_film_mm": None if math.isinf(self.focus_from_film_mm) else self.focus_from_film_mm,
                 "sensor": {"name": self.sensor_name, "width_mm": self.sensor_mm[0], "height_mm": self.sensor_mm[1]},
                 "key": self.key, "panels": list(PANELS),
-                "mtf": [{"label": lab, "fstop": None if c is None else c.fstop, "note": note}
-                        for lab, c, note in self.mtf],
-                "bokeh": [{"label": lab, "image_height_mm": h, **b.to_dict()} for lab, h, b in self.bokeh],
+                "mtf": [{"label": lab, "fstop": None if c is None else c.fstop, "note": note,
+                         "chart": None if c is None else c.to_dict()} for lab, c, note in self.mtf],
+                "diagram": self.diagram.to_dict(),
+                "distortion": None if self.distortion is None else self.distortion.to_dict(),
+                "illumination": None if self.illumination is None else self.illumination.to_dict(),
+                "breathing": [r.to_dict() for r in self.breathing],
+                "bokeh": [{"label": lab, "image_height_mm": h, **({} if b is None else b.to_dict())}
+                          for lab, h, b in self.bokeh],
                 "notes": list(self.notes)}
 
     @styled
@@ -73,7 +78,7 @@ class LensCard:
 
         w, h = PAGES[self.page]
         fig = new_figure(figsize=(w, h), dpi=dpi)
-        gs = fig.add_gridspec(5, 6, left=0.08, right=0.9, top=0.93, bottom=0.05, hspace=0.75, wspace=1.6,
+        gs = fig.add_gridspec(5, 6, left=0.08, right=0.9, top=0.93, bottom=0.075, hspace=0.75, wspace=1.6,
                               height_ratios=(1.25, 1.0, 1.0, 1.0, 0.8))
         fig.suptitle(self._title(), fontsize=11, fontweight="bold", y=0.985)
         fig.text(0.5, 0.955, self._subtitle(units), ha="center", va="center", fontsize=7.5, color="0.25")
@@ -86,7 +91,10 @@ class LensCard:
         _draw_breathing(fig.add_subplot(gs[3, :], label="breathing"), self, units)
         for k, (lab, hgt, img) in enumerate(self.bokeh):
             _draw_bokeh(fig.add_subplot(gs[4, 2 * k:2 * k + 2], label=f"bokeh {lab}"), img, lab, hgt)
-        foot = "physcam lens card · " + ("; ".join(self.notes) if self.notes else "all numbers from the prescription")
+        src = self.key.get("source") or "not stated"
+        lic = self.key.get("licence") or "not stated"
+        foot = (f"physcam lens card · prescription: {src} (licence: {lic}) · "
+                + ("; ".join(self.notes) if self.notes else "all numbers from the prescription"))
         fig.text(0.5, 0.012, _wrap(foot, 150), ha="center", va="bottom", fontsize=6, color="0.35")
         return fig
 
@@ -113,14 +121,25 @@ def _wrap(text: str, n: int) -> str:
 @takes_prescription
 def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm: float | None = None,
               sensor_height_mm: float | None = None, sensor_name: str | None = None, stopped_fstop: float = 8.0,
-              page: str = "a4", quality: str = "full", backend: str = "auto") -> LensCard:
-    """Compute the card of ``lens`` focused ``focus_mm`` from the film plane (default infinity) on a
-    ``sensor_width_mm`` x ``sensor_height_mm`` sensor (default Super 35). The MTF chart is drawn
-    wide open and at ``stopped_fstop`` (default f/8; skipped when not slower than wide open).
+              page: str = "a4", quality: str = "full", backend: str = "auto", sensor=None) -> LensCard:
+    """Compute the card of ``lens`` focused ``focus_mm`` from the film plane (default infinity; a string with
+    units such as "2m" or "10ft" too) on a ``sensor_width_mm`` x ``sensor_height_mm`` sensor, or ``sensor``
+    (a name such as "ALEXA 35", or a :class:`~physcam.onset.sensors.Sensor`; default Super 35). The MTF chart
+    is drawn wide open and at ``stopped_fstop`` (default f/8; skipped when not slower than wide open).
     ``page``: "a4" or "letter"; ``quality``: "full" or "draft" (fewer fields and rays: tests)."""
     from ..data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
     from ..errors import require_positive
     from ..optics import focusing
+    from ..units import parse_distance
+
+    if sensor is not None:
+        from ..onset.sensors import Sensor, find_sensor
+
+        if sensor_width_mm is not None or sensor_height_mm is not None:
+            raise InputError("give the sensor either by name (sensor=) or by size (sensor_width_mm=, "
+                             "sensor_height_mm=), not both")
+        s = sensor if isinstance(sensor, Sensor) else find_sensor(sensor)
+        sensor_width_mm, sensor_height_mm, sensor_name = s.width_mm, s.height_mm, sensor_name or s.name
 
     if page not in PAGES:
         raise InputError(f"page must be one of {', '.join(PAGES)}, got {page!r}")
@@ -130,12 +149,12 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
     w = require_positive("sensor width", DEFAULT_SENSOR_WIDTH_MM if sensor_width_mm is None else sensor_width_mm)
     h = require_positive("sensor height", DEFAULT_SENSOR_HEIGHT_MM if sensor_height_mm is None else sensor_height_mm)
     name = sensor_name or (DEFAULT_SENSOR if sensor_width_mm is None else f"{w:g} x {h:g} mm")
-    focus_mm = float(focus_mm)
+    focus_mm = parse_distance(focus_mm, name="focus distance", allow_inf=True)
     notes: list[str] = []
     st = focusing.focus(lens, focus_mm)
     diagram = _diagram(lens, focus_mm)
     key = key_numbers(lens, focus_mm, 0.5 * math.hypot(w, h), backend=backend)
-    dist = _distortion(st, w, h, q, backend, notes)
+    dist = _distortion(lens, focus_mm, w, h, q, backend, notes)
     ill = _illumination(st, w, h, q, backend, notes)
     wide = key["f_number"]
     stops = [("full aperture", None)] + ([("stopped down", stopped_fstop)] if stopped_fstop > wide * 1.05
@@ -165,7 +184,7 @@ def key_numbers(lens: Prescription, focus_mm: float, half_diagonal_mm: float, *,
     g = paraxial.gaussian(lens)
     ga = focusing.gaussian_at_focus(lens, focus_mm)
     try:
-        close = focusing.closest_focus(lens)
+        close = focusing.close_focus(lens)
     except OpticsError:
         close = None
     limit = field_limit_deg(lens, "y", max_deg=89.0, wavelength_nm=lens.wavelength_nm, backend=backend)
@@ -173,13 +192,17 @@ def key_numbers(lens: Prescription, focus_mm: float, half_diagonal_mm: float, *,
 
     heights, ok = _chief_heights(lens, np.array([0.0, 0.995 * limit]), "y", lens.wavelength_nm, None, backend)
     circle = 2.0 * abs(float(heights[-1])) if ok[-1] else 2.0 * abs(g.efl) * math.tan(math.radians(limit))
-    return {"efl_mm": g.efl, "f_number": g.f_number, "nominal_focal_length_mm": lens.metadata.focal_length,
-            "max_fstop": lens.metadata.max_fstop, "tstop": None,
+    m = lens.metadata
+    return {"efl_mm": g.efl, "f_number": g.f_number, "nominal_focal_length_mm": m.focal_length,
+            "max_fstop": m.max_fstop, "tstop": m.t_stop,
             "entrance_pupil_diameter_mm": g.entrance_pupil_diameter,
             "entrance_pupil_from_film_mm": ga.in_front_of("entrance_pupil"),
-            "close_focus_from_film_mm": close, "image_circle_mm": circle, "field_limit_deg": limit,
+            "close_focus_from_film_mm": None if close is None else close.mark_mm,
+            "close_focus_source": None if close is None else close.source,
+            "close_focus_words": None if close is None else close.words,
+            "image_circle_mm": circle, "field_limit_deg": limit,
             "covers_sensor": circle >= 2.0 * half_diagonal_mm, "total_track_mm": lens.total_track,
-            "squeeze": lens.squeeze, "maker": lens.metadata.maker, "source": lens.metadata.source}
+            "squeeze": lens.squeeze, "maker": m.maker, "source": m.source, "licence": m.licence}
 
 
 def _diagram(lens, focus_mm):
@@ -191,12 +214,13 @@ def _diagram(lens, focus_mm):
         return lens_diagram(lens, rays=5)
 
 
-def _distortion(st, w, h, q, backend, notes):
+def _distortion(lens, focus_mm, w, h, q, backend, notes):
+    """The lens focused at the mark, measured as ``distortion --focus`` and the ST-maps measure it."""
     from .distortion import real_distortion
 
     try:
-        return real_distortion(st.prescription, n_fields=q["curve_fields"], sensor_width_mm=w, sensor_height_mm=h,
-                               film_z=st.film_z, backend=backend)
+        return real_distortion(lens, n_fields=q["curve_fields"], sensor_width_mm=w, sensor_height_mm=h,
+                               focus_mm=focus_mm, backend=backend)
     except OpticsError as exc:
         notes.append(f"distortion: {exc}")
         return None
@@ -264,18 +288,23 @@ def _draw_key(ax, key, units):
         return "–" if v is None else format_distance(v, units)
 
     rows = [("EFL", f"{key['efl_mm']:.2f} mm"), ("f-number (wide open)", f"f/{key['f_number']:.2f}"),
-            ("T-stop", "not given" if key["tstop"] is None else f"T{key['tstop']:.2f}"),
+            ("T-stop", "not given in the file" if key["tstop"] is None else f"T{key['tstop']:.2f}"),
             ("entrance pupil", f"Ø {key['entrance_pupil_diameter_mm']:.1f} mm"),
             ("  in front of film", dist(key["entrance_pupil_from_film_mm"])),
-            ("close focus", dist(key["close_focus_from_film_mm"])),
+            ("close focus" + {"maker": " (MOD)", "focus groups": " (focus groups)"}.get(key["close_focus_source"], ""),
+             dist(key["close_focus_from_film_mm"])),
             ("image circle", f"Ø {key['image_circle_mm']:.1f} mm"), ("total track", f"{key['total_track_mm']:.1f} mm")]
+    if key["close_focus_source"] == "unit focusing limit":  # 1:1, which no real lens of the kind reaches
+        rows.insert(6, ("", "unit focusing limit, not the lens's MOD"))
     if key["squeeze"] != 1.0:
         rows.append(("squeeze", f"{key['squeeze']:g}x"))
     ax.set_title("key numbers", loc="left")
     for i, (k, v) in enumerate(rows):
-        y = 0.95 - i * 0.115
+        y = 0.95 - i * 0.1
+        note = k == ""  # a qualifier of the row above, in small type
         ax.text(0.0, y, k, transform=ax.transAxes, fontsize=7.5, va="top")
-        ax.text(1.0, y, v, transform=ax.transAxes, fontsize=7.5, va="top", ha="right", fontweight="bold")
+        ax.text(1.0, y, v, transform=ax.transAxes, fontsize=6 if note else 7.5, va="top", ha="right",
+                fontweight="normal" if note else "bold", color="0.3" if note else "black")
 
 
 def _no_data(ax, text):
@@ -297,7 +326,12 @@ def _draw_mtf(ax, chart, label, note):
     ax.grid(True)
     ax.set_xlabel("image height (mm)")
     ax.set_ylabel("MTF")
-    ax.set_title(f"MTF at f/{chart.fstop:.3g} ({label}), white light", loc="left")
+    light = "white light" if chart.spectrum.startswith("white light") and "no dispersion" not in chart.spectrum \
+        else ("monochromatic: the prescription gives no dispersion" if chart.spectrum.startswith("monochromatic")
+              else "white light, some glasses without dispersion")
+    from ..figures import fit_title
+
+    ax.set_title(fit_title(f"MTF at f/{chart.fstop:.3g} ({label}), {light}", 3.2, fontsize=7), loc="left", fontsize=7)
     ax.legend(ncol=3, loc="lower left", fontsize=5.5, handlelength=1.6, columnspacing=0.8)
 
 

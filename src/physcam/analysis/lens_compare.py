@@ -78,13 +78,16 @@ def lens_measurements(lens, *, focus_mm=None, fstop=None, sensor, coc=None, ligh
 
 
 def _breathing(lens, mark, sensor, out, curves) -> None:
-    """Horizontal field of view from infinity to the closest focus, and at this focus."""
+    """Horizontal field of view from infinity to the close focus (the MOD, the focus groups' close point, or
+    ten focal lengths for a unit-focusing lens without a MOD: physcam.optics.focusing.close_focus), and at
+    this focus."""
     from ..optics import focusing
 
-    closest = focusing.closest_focus(lens)
-    marks = [m for m in focusing.DEFAULT_BREATHING_MARKS if m > closest] + [closest]
-    rows = focusing.breathing_table(lens, marks, sensor_width_mm=sensor.width_mm)
-    out["closest_focus_mm"] = closest
+    cf = focusing.close_focus(lens)
+    rows = focusing.breathing_table(lens, sensor_width_mm=sensor.width_mm)
+    out["closest_focus_mm"] = cf.mark_mm
+    out["closest_focus_source"] = cf.source
+    out["breathing_near_mm"] = cf.breathing_near_mm
     out["breathing_closest_pct"] = rows[-1].fov_change_pct
     at = focusing.breathing_table(lens, [math.inf, mark], sensor_width_mm=sensor.width_mm)
     out["breathing_at_focus_pct"] = at[-1].fov_change_pct

@@ -20,9 +20,10 @@ no longer matters (Smith, *Modern Optical Engineering*, 11.9).
 
 Through focus (:func:`through_focus_mtf`): the MTF at chosen frequencies as the film moves; the
 rays are traced once and only their last leg changes. The vendor chart (:func:`mtf_chart`):
-sagittal and tangential MTF at 10, 20 and 40 lp/mm against image height, in white light (d, F
-and C lines, equal weights, d the primary) unless told otherwise, the fields placed by real chief rays aimed
-back from each image height on the film.
+sagittal and tangential MTF at 10, 20 and 40 lp/mm against image height, in the d, F and C lines
+(equal weights, d the primary) unless told otherwise: white light where the prescription gives its
+glasses dispersion, monochromatic where it gives none (:func:`spectrum_words` says which), the fields
+placed by real chief rays aimed back from each image height on the film.
 
 Frequencies in cycles (line pairs) per mm on the film; lengths in mm; see docs/image-quality.md.
 """
@@ -36,16 +37,37 @@ import numpy as np
 
 from ..data.default_sensor import DEFAULT_SENSOR_HALF_DIAGONAL_MM
 from ..errors import InputError, OpticsError, require_finite
-from ..figures import PALETTE, styled
+from ..figures import PALETTE, fit_title, styled
 from ..lens.prescription import Prescription
 from ..optics.state import takes_camera
 from ._sampling import MAX_FREQUENCIES, spatial_frequencies
 
 __all__ = ["MTFCurve", "ThroughFocusMTF", "MTFChart", "mtf", "geometric_mtf", "through_focus_mtf", "mtf_chart",
-           "diffraction_limited_mtf", "CHART_FREQUENCIES", "WHITE_LIGHT_NM"]
+           "diffraction_limited_mtf", "CHART_FREQUENCIES", "WHITE_LIGHT_NM", "spectrum_words"]
 
 #: The frequencies of a lens maker's MTF chart (lp/mm): contrast (10), resolution (20, 40).
 CHART_FREQUENCIES = (10.0, 20.0, 40.0)
+def spectrum_words(lens, wavelengths_nm) -> str:
+    """What light an MTF is in, in words that follow the lens data: "white light (d, F, C)" only where
+    the prescription gives its glasses dispersion; "monochromatic: the prescription gives no dispersion"
+    where none of them has any (the wavelengths then differ in diffraction alone); a note of how many
+    glasses have none where some do (:func:`physcam.optics.glass.glasses_without_dispersion`)."""
+    from ..optics.glass import glasses_without_dispersion
+    from ..optics.state import CameraState
+
+    wls = tuple(float(w) for w in np.atleast_1d(wavelengths_nm))
+    listed = ", ".join(f"{w:g}" for w in wls) + " nm"
+    if len(wls) == 1:
+        return f"{listed} (one wavelength)"
+    flat, n = glasses_without_dispersion(lens.lens if isinstance(lens, CameraState) else lens)
+    if n and flat == n:
+        return f"monochromatic: the prescription gives no dispersion; {listed} differ in diffraction only"
+    light = "white light (d, F, C)" if wls == WHITE_LIGHT_NM else listed
+    if flat:
+        return f"{light}; {flat} of {n} glasses have no dispersion in the prescription (no colour from them)"
+    return light
+
+
 #: White light for charts: the d, F and C lines, equal weights (d first: the primary, whose chief ray
 #: is the reference of the polychromatic OTF).
 WHITE_LIGHT_NM = (587.5618, 486.1327, 656.2725)
@@ -387,12 +409,14 @@ class MTFChart:
     #: focus mark, by ``focus_rule``
     defocus_mm: float = 0.0
     focus_rule: str = "the paraxial image plane of the focus mark"
+    #: the light in words (:func:`spectrum_words`): "white light (d, F, C)" only where the lens has dispersion
+    spectrum: str = ""
 
     def focus_words(self) -> str:
         """Which focus the chart is at, in words (its title and its JSON's ``film``)."""
         if self.defocus_mm == 0.0:
             return self.focus_rule
-        return f"{self.focus_rule}, {self.defocus_mm * 1e3:+.1f} um from the paraxial image plane"
+        return f"{self.focus_rule}, {self.defocus_mm * 1e3:+.1f} µm from the paraxial image plane"
 
     def to_dict(self) -> dict:
         return {
@@ -400,7 +424,7 @@ class MTFChart:
             "film": {"defocus_mm": self.defocus_mm, "shift_um": self.defocus_mm * 1e3, "rule": self.focus_rule,
                      "words": self.focus_words()},
             "focus_from_film_mm": None if math.isinf(self.focus_from_film_mm) else self.focus_from_film_mm,
-            "wavelengths_nm": list(self.wavelengths_nm), "weights": list(self.weights),
+            "wavelengths_nm": list(self.wavelengths_nm), "weights": list(self.weights), "spectrum": self.spectrum,
             "frequencies_lpmm": list(self.frequencies_lpmm),
             "rows": [{"image_height_mm": float(h), "field_deg": float(a), "pupil_samples": int(n),
                       "sagittal": {f"{f:g}": float(v) for f, v in zip(self.frequencies_lpmm, s)},
@@ -479,10 +503,10 @@ class MTFChart:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, ncol=2, loc="lower left")
         foc = "infinity" if math.isinf(self.focus_from_film_mm) else format_distance(self.focus_from_film_mm, units)
-        wl = ", ".join(f"{w:g}" for w in self.wavelengths_nm)
-        shift = "" if self.defocus_mm == 0.0 else f", film {self.defocus_mm * 1e3:+.1f} um (best focus)"
-        ax.set_title(f"{self.lens_name}\nMTF at f/{self.fstop:.3g}, focus {foc}{shift}, {wl} nm "
-                     "(solid sagittal, dashed tangential)", fontsize=8)
+        wl = self.spectrum or ", ".join(f"{w:g}" for w in self.wavelengths_nm) + " nm"
+        shift = "" if self.defocus_mm == 0.0 else f", film {self.defocus_mm * 1e3:+.1f} µm (best focus)"
+        ax.set_title(fit_title(f"{self.lens_name}: MTF at f/{self.fstop:.3g}, focus {foc}{shift}, {wl} "
+                               "(solid sagittal, dashed tangential)", 5.6, fontsize=8), fontsize=8)
         return save(fig, path, force)
 
 
@@ -510,7 +534,7 @@ def mtf_chart(
     """The vendor MTF chart of ``lens``: sagittal and tangential MTF at ``frequencies`` (default 10,
     20, 40 lp/mm) against image height, ``n_fields`` heights from 0 to ``max_image_height_mm``
     (default 15.55 mm, the corner of the default sensor, Super 35 24.89 x 18.66 mm:
-    :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, as the CLI; 21.63 mm is a 36 x 24 mm corner) or the ``image_heights_mm`` given; white light by
+    :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, as the CLI; 21.63 mm is a 36 x 24 mm corner) or the ``image_heights_mm`` given; the d, F and C lines by
     default. The pupil grids follow the MTF sampling rules up to ``max_pupil_samples`` (default 256,
     so a chart takes seconds). ``progress(done, total)`` is called after each field.
 
@@ -588,7 +612,8 @@ def mtf_chart(
                 progress(i + 1, hs.size)
         return MTFChart(st.lens_name, st.fstop, st.focus_from_film_mm, tuple(wls), tuple(wts),
                         tuple(float(f) for f in freqs), hs, angles, np.clip(sag, 0, 1), np.clip(tan, 0, 1), ns,
-                        ("method: Huygens PSF per field (physcam.analysis.huygens)",), float(dz), rule)
+                        ("method: Huygens PSF per field (physcam.analysis.huygens)",), float(dz), rule,
+                        spectrum_words(lens, wls))
     # fields in runs that fit one tracing batch; each run's pupils are freed before the next
     for run in _sampling._chunks(list(range(hs.size)), lambda i: per_field, _sampling.RAYS_PER_BATCH):
         fps = _sampling.fields_pupils(lens, angles[run], wavelengths_nm=wls, weights=wts, pupil_samples=pupil_samples,
@@ -604,7 +629,7 @@ def mtf_chart(
                 progress(done, hs.size)
     return MTFChart(st.lens_name, st.fstop, st.focus_from_film_mm, tuple(wls), tuple(wts),
                     tuple(float(f) for f in freqs), hs, angles, np.clip(sag, 0, 1), np.clip(tan, 0, 1), ns,
-                    defocus_mm=float(dz), focus_rule=rule)
+                    defocus_mm=float(dz), focus_rule=rule, spectrum=spectrum_words(lens, wls))
 
 
 #: Fields the field-weighted best focus averages over, as fractions of the chart's largest height.

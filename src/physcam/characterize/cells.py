@@ -11,7 +11,8 @@ cell:
    folder waits for the cell instead of computing it twice, then finds it done;
 3. compute (the analyses below; no optics is re-implemented here);
 4. write the result **atomically** (:func:`physcam.io.atomic_write`: a temporary file, then a
-   no-clobber link; a folder of ST-maps is filled under a temporary name and renamed into place);
+   no-clobber link; a folder of ST-maps is written whole by :func:`physcam.io.staged_folder`, with its
+   manifest, and a killed attempt's temporary folder is removed by the next attempt);
    a complete result left by a run killed before step 5 is kept and reused, since its name
    carries the cell's input hash;
 5. write the cell's **row** of the Parquet index, atomically, last. A cell counts as done only
@@ -48,9 +49,7 @@ import io
 import json
 import math
 import os
-import shutil
 import socket
-import tempfile
 import time
 from pathlib import Path
 
@@ -122,7 +121,7 @@ def _lens_cell(lens, grid: Grid):
 def _distortion_cell(lens, grid: Grid, cell: Cell, dest: Path):
     from ..analysis.distortion_models import fit_models, samples_from_field
     from ..analysis.stmap import distortion_field, write_stmaps
-    from ..io import atomic_write
+    from ..io import atomic_write, staged_folder
 
     if dest.is_dir() and (dest / "fits.json").is_file():  # published by an earlier, killed attempt
         return (dest / "fits.json").read_bytes()
@@ -131,22 +130,16 @@ def _distortion_cell(lens, grid: Grid, cell: Cell, dest: Path):
                            width_px=grid.frame_px[0], height_px=grid.frame_px[1],
                            wavelength_nm=cell.wavelength_nm, backend=grid.backend)
     fits = fit_models(samples_from_field(res))
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{dest.name}.", suffix=".tmp", dir=dest.parent))
-    try:
-        files = write_stmaps(res, tmp)
-        doc = {"lens": lens.name, "kind": "distortion", "field": res.to_dict(),
-               "fits": [f.to_dict() for f in fits],
-               "files": {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in files}}
-        atomic_write(tmp / "fits.json", _json_bytes(doc))
-        try:
-            os.rename(tmp, dest)  # publishes the folder whole; fails when another attempt published first
-        except OSError:
-            if not (dest / "fits.json").is_file():
-                raise
-    finally:
-        if tmp.exists():
-            shutil.rmtree(tmp, ignore_errors=True)
+    try:  # the folder is published whole (a killed attempt's temporary is removed by the next one)
+        with staged_folder(dest, about={"kind": "distortion", "cell": dest.name}) as tmp:
+            files = write_stmaps(res, tmp)
+            doc = {"lens": lens.name, "kind": "distortion", "field": res.to_dict(),
+                   "fits": [f.to_dict() for f in fits],
+                   "files": {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in files}}
+            atomic_write(tmp / "fits.json", _json_bytes(doc))
+    except ExportError:
+        if not (dest / "fits.json").is_file():  # not another attempt that published first
+            raise
     return (dest / "fits.json").read_bytes()
 
 

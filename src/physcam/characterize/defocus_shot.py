@@ -18,7 +18,7 @@ from pathlib import Path
 
 from ..errors import InputError
 
-__all__ = ["ShotSummary", "sequence_frames", "defocus_sequence"]
+__all__ = ["ShotSummary", "sequence_frames", "frame_path", "shot_kernel_folder", "defocus_sequence"]
 
 _HASHES = re.compile(r"#+")
 
@@ -53,9 +53,20 @@ def sequence_frames(pattern: str) -> list[tuple[int, Path]]:
     return frames
 
 
-def _frame_path(pattern: str, number: int) -> Path:
+def frame_path(pattern: str, number: int) -> Path:
+    """Frame ``number`` of ``pattern`` (one run of ``#``, each a digit: ``out.####.exr``, 7 -> ``out.0007.exr``)."""
+    from ..errors import require_type
+
+    require_type("pattern", pattern, str, "name.####.exr")
+    if isinstance(number, bool) or not isinstance(number, int) or number < 0:
+        raise InputError(f"a frame number is a whole number >= 0, got {number!r}")
     _, n = _pattern(pattern, "output sequence")
     return Path(_HASHES.sub(f"{number:0{n}d}", pattern))
+
+
+def shot_kernel_folder(output_pattern: str) -> Path:
+    """Where a shot's kernels are shared when no folder is given: ``kernels`` beside its outputs."""
+    return frame_path(output_pattern, 0).parent / "kernels"
 
 
 def _one_frame(image, output, lens, kernel_folder, force, options):
@@ -82,11 +93,11 @@ def defocus_sequence(pattern: str, output_pattern: str, lens, *, kernel_folder=N
         refuse_input_as_output(_frame_path(output_pattern, number), inputs, "output frame")
     if scheduler is not None:
         check_scheduler_address(scheduler)
-    folder = Path(kernel_folder) if kernel_folder is not None else _frame_path(output_pattern, 0).parent / "kernels"
+    folder = Path(kernel_folder) if kernel_folder is not None else shot_kernel_folder(output_pattern)
     out = ShotSummary(kernel_folder=str(folder))
     todo = []
     for number, path in frames:
-        target = _frame_path(output_pattern, number)
+        target = frame_path(output_pattern, number)
         out.outputs.append(str(target))
         (out.skipped if target.exists() and not force else todo).append(number)
         if todo and todo[-1] == number:

@@ -35,7 +35,8 @@ from ..errors import ExportError, InputError, OpticsError, PhysCamError, WrongTy
 from ..lens.prescription import Prescription
 from .grid import HARD_MAX_CELLS, MAX_CELLS, MAX_RAYS, Grid, build_cells, lens_hash, lens_slug
 
-__all__ = ["characterize", "CharacterizeSummary", "check_scheduler_address", "read_index", "DEFAULT_CONNECT_TIMEOUT_S"]
+__all__ = ["characterize", "CharacterizeSummary", "check_scheduler_address", "read_index", "DEFAULT_CONNECT_TIMEOUT_S",
+           "plan_cells", "new_run_id", "load_lenses"]
 
 DEFAULT_CONNECT_TIMEOUT_S = 10.0
 _ADDRESS = re.compile(r"^(tcp|tls|ws|wss)://(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+):(\d{1,5})$")
@@ -89,6 +90,11 @@ def check_scheduler_address(address: str) -> str:
     return address.strip()
 
 
+def new_run_id() -> str:
+    """A run's id: ``run_YYYYmmddTHHMMSSZ_xxxxxx`` (UTC time, 6 random hex digits)."""
+    return time.strftime("run_%Y%m%dT%H%M%SZ", time.gmtime()) + "_" + secrets.token_hex(3)
+
+
 def _check_folder(out: Path, dry_run: bool) -> Path:
     """The output folder, created and proven writable (a file written and removed); dry runs only look."""
     import tempfile
@@ -129,7 +135,7 @@ def _check_lens(lens: Prescription, grid: Grid) -> None:
             raise InputError(f"lens {lens.name!r}: {exc}") from None
 
 
-def _load_lenses(lenses):
+def load_lenses(lenses):
     """{slug: Prescription} from names, files, Prescriptions, or a dict name -> Prescription."""
     from ..lens.library import load_lens
 
@@ -232,6 +238,21 @@ def _dashboard(client):
     return link or None
 
 
+def plan_cells(lenses: dict, grid: Grid, version: str) -> dict:
+    """{slug: (the lens's physcam TOML, its hash, its cells)} for ``lenses`` ({slug: Prescription}) over
+    the checked ``grid``, computed by physcam ``version``: the cells a run makes, whoever runs them (a
+    Dask cluster here, a farm's tasks in :mod:`physcam.farm.grid_tasks`)."""
+    from ..lens.formats.physcam_toml import dumps
+
+    require_type("lenses", lenses, dict, "{slug: Prescription}")
+    plan = {}
+    for slug, rx in lenses.items():
+        require_type("lens", rx, Prescription, "physcam.lens.library.load_lens(name)")
+        digest = lens_hash(rx)
+        plan[slug] = (dumps(rx), digest, build_cells(slug, digest, grid, rx.wavelength_nm, version))
+    return plan
+
+
 def characterize(lenses, grid: Grid, output, *, scheduler: str | None = None, workers: int | None = None,
                  limit: int | None = None, force_large: bool = False, dry_run: bool = False, retries: int = 2,
                  connect_timeout: float = DEFAULT_CONNECT_TIMEOUT_S, usd: bool = True, progress=None,
@@ -261,18 +282,13 @@ def characterize(lenses, grid: Grid, output, *, scheduler: str | None = None, wo
         if workers is not None:
             raise InputError("--workers sizes a local cluster; an existing cluster (--scheduler) has its own workers")
     grid = grid.checked()
-    loaded = _load_lenses(lenses)
+    loaded = load_lenses(lenses)
     for rx in loaded.values():
         _check_lens(rx, grid)
     out = _check_folder(Path(output), dry_run)
-    run_id = run_id or time.strftime("run_%Y%m%dT%H%M%SZ", time.gmtime()) + "_" + secrets.token_hex(3)
+    run_id = run_id or new_run_id()
 
-    plan = {}  # slug -> (toml, digest, cells)
-    from ..lens.formats.physcam_toml import dumps
-
-    for slug, rx in loaded.items():
-        digest = lens_hash(rx)
-        plan[slug] = (dumps(rx), digest, build_cells(slug, digest, grid, rx.wavelength_nm, __version__))
+    plan = plan_cells(loaded, grid, __version__)
     all_cells = [c for _, _, cells in plan.values() for c in cells]
     n = len(all_cells)
     by_kind = {}

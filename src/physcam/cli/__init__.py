@@ -41,8 +41,14 @@ COMMAND_ORDER = ("report", "dof_table", "sensors", "lens", "trace", "analyze", "
 
 #: Option destinations that name files a command writes: a relative path there goes into the user
 #: config's ``output_dir`` when it sets one. A command whose positional argument is an output file
-#: lists it with ``parser.set_defaults(output_args=("file",))``.
+#: lists it with ``parser.set_defaults(output_args=("file",))``; one whose output is a folder written
+#: whole (``physcam.io.staged_folder``) names that destination in ``output_folders`` too.
 OUTPUT_DESTS = ("output", "plot", "stmap", "out")
+#: Commands that check their own outputs against their inputs (their handlers call
+#: ``physcam.io.refuse_inputs_as_outputs`` themselves): the generic check leaves them alone.
+OWN_OUTPUT_CHECK = ("calibrate", "defocus", "defocus-kernels")
+#: Destinations that select what runs (subcommand names, kinds), never a file read.
+_NOT_PATHS = ("command", "handler", "kind", "output_args", "output_folders")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -86,6 +92,8 @@ COMMAND_MODULES = {
     "usd": "usd", "demo": "demo", "config": "config", "calibrate": "calibrate", "characterize": "characterize",
     "defocus": "defocus", "defocus-kernels": "defocus", "export": "export", "live": "live",
     "metadata": "metadata", "microlens": "microlens", "mtf": "mtf", "psf": "psf", "serve": "serve",
+    "exposure": "exposure", "hyperfocal": "hyperfocal", "diopter": "diopter",
+    "farm": "farm", "farm-task": "farm",
 }
 
 
@@ -147,6 +155,24 @@ def _into_output_dir(args) -> None:
             setattr(args, dest, str(folder / v))
 
 
+def _refuse_outputs_that_are_inputs(args) -> None:
+    """No output may overwrite an input (docs/cli.md, "Hostile input"): every other argument that
+    names an existing file or folder is an input to :func:`physcam.io.refuse_inputs_as_outputs`."""
+    from ..io import refuse_inputs_as_outputs
+
+    if getattr(args, "command", None) in OWN_OUTPUT_CHECK:
+        return
+    outs = set(OUTPUT_DESTS) | set(getattr(args, "output_args", ()))
+    whole = set(getattr(args, "output_folders", ()))
+    files, folders, inputs = [], [], []
+    for dest, value in vars(args).items():
+        if dest in _NOT_PATHS or dest.endswith("_command") or dest.startswith("_"):
+            continue
+        paths = [v for v in (value if isinstance(value, (list, tuple)) else [value]) if isinstance(v, (str, os.PathLike))]
+        (folders if dest in whole else files if dest in outs else inputs).extend(paths)
+    refuse_inputs_as_outputs(inputs, files, folders=folders)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 done, 2 refused input or unwritable output)."""
     import warnings
@@ -170,7 +196,11 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 0
     try:
+        from ._common import resolve_bare_distances
+
+        resolve_bare_distances(args)  # a bare scene distance in the unit system's unit (BARE_RULE)
         _into_output_dir(args)
+        _refuse_outputs_that_are_inputs(args)
         from ._common import lens_use, use_glass_catalogs
 
         use_glass_catalogs(args)
@@ -181,8 +211,10 @@ def main(argv: list[str] | None = None) -> int:
             print(f"physcam: note: {n}", file=sys.stderr)
         return rc
     except PhysCamError as exc:
+        from ._common import bare_hint
+
         msg = str(exc).splitlines()[0] if str(exc) else exc.__class__.__name__
-        print(f"physcam: error: {msg}", file=sys.stderr)
+        print(f"physcam: error: {msg}{bare_hint(args, msg)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("physcam: interrupted", file=sys.stderr)

@@ -1,7 +1,11 @@
 """The deliverables of ``physcam calibrate`` (docs/calibrate.md): per focus mark the ST-maps, the fitted
-models' files (as ``physcam distortion --fit`` writes them), an OpenTrackIO lens block, the
-calibration document and sheet; and the day's characterization variant in the lens's USD file.
-Everything is made in memory and every name checked before the first file is written."""
+models' files (as ``physcam distortion --fit`` writes them), an OpenTrackIO lens block (a good mark
+only, with the models the run accepted), the calibration document and sheet; and the day's
+characterization variant in the lens's USD file (a good calibration of that lens only).
+
+:func:`check_outputs` checks every option, output and image header before the fit; the folder is
+written as a whole (:func:`physcam.io.staged_folder`: a temporary folder, every file synced, a
+manifest, one rename), so a killed run, ``--force`` or not, never leaves maps of two fits."""
 
 from __future__ import annotations
 
@@ -66,11 +70,16 @@ def measured_field(m, lens_name: str) -> MeasuredField:
 
 
 def opentrackio_lens(m) -> dict:
-    """OpenTrackIO 1.0.1 ``lens`` fields of a measured mark (OpenLensIO: mm on the sensor, y down)."""
+    """OpenTrackIO 1.0.1 ``lens`` fields of a measured mark (OpenLensIO: mm on the sensor, y down), with
+    only the Brown-Conrady fits the run accepted; a mark the run calls NOT good is an OpticsError."""
     from ..analysis.distortion_models import BrownConrady
+    from ..errors import OpticsError
 
+    good, why = m.verdict
+    if not good:
+        raise OpticsError("the calibration is NOT good (" + "; ".join(why) + "): no OpenTrackIO lens block")
     out = {"pinholeFocalLength": float(m.focal_length_mm[1]),
-           "distortion": [f.opentrackio() for f in m.fits if isinstance(f, BrownConrady)],
+           "distortion": [f.opentrackio() for f in m.fits if isinstance(f, BrownConrady) and f.acceptable],
            "projectionOffset": {"x": float(m.principal_offset_mm[0]), "y": float(-m.principal_offset_mm[1])},
            "distortionOffset": {"x": float(m.principal_offset_mm[0]), "y": float(-m.principal_offset_mm[1])}}
     if m.mark_mm is not None and math.isfinite(m.mark_mm):
@@ -125,7 +134,12 @@ def _mark_files(m, folder: Path, name: str, notes: list) -> list:
             out.append((folder / FIT_FILES["3de4"], tde4_lens_text(f, name, lens_center_offset_mm=m.principal_offset_mm).encode()))
         elif isinstance(f, USDStandard):
             out.append((folder / FIT_FILES["usd"], _json(usd_distortion_document(name, f))))
-    out.append((folder / "opentrackio_lens.json", _json(opentrackio_lens(m))))
+    good, why = m.verdict
+    if good:
+        out.append((folder / "opentrackio_lens.json", _json(opentrackio_lens(m))))
+    else:
+        notes.append(f"{folder.name}/opentrackio_lens.json: not written (this mark's calibration is NOT good: "
+                     + "; ".join(why) + ")")
     return out
 
 
@@ -140,85 +154,176 @@ def _folder(out: Path, m, several: bool) -> Path:
                   else f"focus_{m.mark_mm:.0f}mm")
 
 
-def deliverables(cal, args):
-    """([(path, bytes or a function making them)], USD plan or None), every name checked."""
-    from ..analysis.calibrate_sheet import calibration_sheet
+def check_outputs(args) -> dict:
+    """Every option, output and image header checked before the fit; returns the plan: the folder's
+    ``force`` and the USD file's target (:func:`physcam.usd.kit.characterization_target`), or None."""
+    from ..analysis.calibrate_chart import check_pixels, image_files, image_size
+    from ..errors import ExportError, InputError
+    from ..io import MANIFEST_NAME, refuse_inputs_as_outputs
+
+    if args.bootstrap in (1, 2) or not 0 <= args.bootstrap <= 1000:
+        raise InputError(f"--bootstrap is 0 (OpenCV's covariance) or 3 to 1000 refits, got {args.bootstrap}")
+    if args.variant is not None and args.usd is None:
+        raise InputError("--variant names the variant added to the --usd lens file: give --usd too")
+    out = Path(args.output)
+    force = bool(args.force)
+    refuse_inputs_as_outputs([*args.images, *(args.flat or []), args.marks, args.lens], [args.usd], folders=[out])
+    if out.is_symlink() or (out.exists() and not out.is_dir()):
+        raise ExportError(f"{out} exists and is not a folder: give a folder for the deliverables (-o DIR)")
+    if out.is_dir():
+        empty = not any(out.iterdir())
+        if not empty and not force:
+            raise ExportError(f"{out} exists (give --force to replace a folder physcam wrote, or a new folder)")
+        if not empty and not _physcam_folder(out):
+            raise ExportError(f"{out} holds files physcam did not write there; --force replaces only a folder physcam "
+                              f"wrote whole (one with a {MANIFEST_NAME} listing every file) or an empty one: choose "
+                              "a new output folder")
+        force = True  # an empty folder, or one physcam wrote with --force: replaced whole
+    first = None
+    flats = [Path(f) for f in (args.flat or [])]
+    for p in image_files(args.images) + flats:
+        if not p.is_file():
+            raise InputError(f"{p}: no such flat-field frame")
+        size = image_size(p)
+        check_pixels(p, *size, args.max_pixels)
+        first = first or (size, p)
+        if size != first[0]:
+            what = "flat fields of the same camera mode" if p in flats else "images of one camera mode"
+            raise InputError(f"{p}: {size[0]}x{size[1]} px, but {first[1]} is {first[0][0]}x{first[0][1]}: give {what}")
+    usd = None
+    if args.usd is not None:
+        import datetime as _dt
+
+        from ..extras import require_extra
+
+        require_extra("usd", "the lens file's characterization variant (--usd)")
+        from ..usd.kit import characterization_target
+
+        variant = args.variant or "calibration_" + _dt.datetime.now(_dt.UTC).strftime("%Y%m%d")
+        usd = dict(characterization_target(args.usd, variant), file=Path(args.usd), variant=variant)
+    return {"force": force, "usd": usd}
+
+
+def _physcam_folder(folder: Path) -> bool:
+    """Whether ``folder`` is one physcam wrote whole and nobody added to: its manifest lists every file."""
+    import os
+
+    from ..io import MANIFEST_NAME, folder_manifest
+
+    doc = folder_manifest(folder)
+    if doc is None:
+        return False
+    listed = {e["path"] for e in doc["files"]} | {MANIFEST_NAME}
+    return all(Path(d, f).relative_to(folder).as_posix() in listed for d, _, files in os.walk(folder) for f in files)
+
+
+#: a calibration goes into a lens file when its pinhole is within this factor of the file's focal length
+#: (breathing: a unit-focusing lens at 1:2 is 1.5 f; internal focusing shortens it)
+USD_FOCAL_FACTOR = 1.5
+
+
+def _check_usd(doc: dict, usd: dict) -> None:
+    """A NOT good calibration, or one of another lens, never goes into the lens file (module notes); ``doc``:
+    the calibration document (``Calibration.to_dict``, as calibration.json holds it)."""
     from ..errors import ExportError
+
+    bad = [m for m in doc["marks"] if not m["good"]]
+    if bad:
+        m = bad[0]
+        where = "" if m["focus_mark_mm"] is None else f" at {m['focus_mark_mm']:g} mm"
+        raise ExportError(f"{usd['file']}: not changed: the calibration{where} is NOT good "
+                          f"({'; '.join(m['verdict_reasons'])}), and a calibration the run rejects never becomes the "
+                          "lens's current one; rerun without --usd for the deliverables and the sheet")
+    f_file, f = usd["focal_length_mm"], float(doc["marks"][0]["focal_length_mm"]["y"])
+    if f_file is not None and not f_file / USD_FOCAL_FACTOR <= f <= f_file * USD_FOCAL_FACTOR:
+        raise ExportError(f"{usd['file']}: not changed: the measured pinhole focal length {f:.4g} mm does not fit the "
+                          f"file's {f_file:.4g} mm lens (a calibration of this lens is within a factor "
+                          f"{USD_FOCAL_FACTOR:g} of it): check the sensor size, or give this lens's file")
+
+
+def deliverables(cal, args, plan):
+    """([(path in the folder, bytes or a function making them)], USD target or None), the USD checked
+    against the calibration (:func:`_check_usd`)."""
+    from ..analysis.calibrate_sheet import calibration_sheet
     from ..figures import figure_bytes
-    from ..io import check_writable
     from ._output import document
 
     out = Path(args.output)
-    if out.exists() and not out.is_dir():
-        raise ExportError(f"{out} exists and is not a folder: give a folder for the deliverables (-o DIR)")
+    usd = plan["usd"]
+    if usd is not None:
+        _check_usd(cal.to_dict(), usd)
     payload = []
     for m in cal.marks:
         payload += _mark_files(m, _folder(out, m, len(cal.marks) > 1), cal.lens_name, cal.notes)
     payload.append((out / "calibration_sheet.png", lambda: figure_bytes(calibration_sheet(cal), "png")))
     payload.append((out / "calibration.json", lambda: _json(document("calibrate", dict(cal.to_dict(), written=[]),
                                                                       units=UNITS))))
-    for p, _ in payload:
-        check_writable(p, force=args.force)
-    usd = _usd_plan(cal, args) if args.usd else None
     return payload, usd
 
 
-def _usd_plan(cal, args):
-    import datetime as _dt
-
-    from ..errors import ExportError
-    from ..usd.kit import read_characterizations
-
-    variant = args.variant or "calibration_" + _dt.datetime.now(_dt.UTC).strftime("%Y%m%d")
-    p = Path(args.usd)
-    if p.exists() and variant in read_characterizations(p)["variants"]:
-        raise ExportError(f"{p}: already has a characterization variant {variant!r}: give another --variant")
-    return p, variant
-
-
-def _measured(cal, out: Path, usd_file: Path) -> dict:
+def _measured(doc: dict, out: Path, usd_file: Path) -> dict:
+    """The ``physcam:characterization:*`` values of a calibration document (``Calibration.to_dict``)."""
     import os
 
-    marks = cal.marks
+    marks = doc["marks"]
     rel = os.path.relpath(out.resolve(), usd_file.resolve().parent)
     return {
         "source": "physcam calibrate: chart photographs",
-        "focusMarksMm": [m.mark_mm if m.mark_mm is not None and math.isfinite(m.mark_mm) else -1.0 for m in marks],
-        "pinholeFocalLengthMm": [m.focal_length_mm[1] for m in marks],
-        "pinholeFocalLengthStdMm": [(m.uncertainty.get("focal_length_mm") or {}).get("y", 0.0) for m in marks],
-        "principalPointOffsetMm": [v for m in marks for v in m.principal_offset_mm],
-        "opencvBrownConrady": [float(v) for m in marks for v in m.distortion],
-        "residualRmsPx": [m.rms_px for m in marks],
-        "verdict": ["good" if m.verdict[0] else "not good: " + "; ".join(m.verdict[1]) for m in marks],
+        "focusMarksMm": [m["focus_mark_mm"] if m["focus_mark_mm"] is not None and math.isfinite(m["focus_mark_mm"])
+                         else -1.0 for m in marks],
+        "pinholeFocalLengthMm": [m["focal_length_mm"]["y"] for m in marks],
+        "pinholeFocalLengthStdMm": [m["uncertainty"]["focal_length_mm"]["y"] for m in marks],
+        "principalPointOffsetMm": [v for m in marks for v in m["principal_point_offset_mm"]],
+        "opencvBrownConrady": [float(m["opencv"][k]) for m in marks for k in ("k1", "k2", "p1", "p2", "k3")],
+        "residualRmsPx": [m["residual_px"]["rms"] for m in marks],
+        "verdict": ["good" if m["good"] else "not good: " + "; ".join(m["verdict_reasons"]) for m in marks],
         "files": [rel],
     }
 
 
-def write_all(payload, usd, cal, args) -> list:
-    """Write the payload, then the USD variant; returns the paths written."""
+def add_calibration_variant(doc: dict, usd: dict, *, lens=None, fstop=None, output) -> Path:
+    """Add the characterization variant of the calibration document ``doc`` (the payload of calibration.json,
+    ``Calibration.to_dict``) to the lens file of ``usd`` (``{"file", "variant"}``): the measured pinhole (on
+    ``lens``'s best-match camera at ``fstop`` when a prescription is given) and the measured numbers, the
+    deliverables in the folder ``output``. ``physcam calibrate --usd`` and the farm's ``usd`` step
+    (docs/farm.md) both add it so."""
     from dataclasses import replace
 
-    from ..io import atomic_write
+    from ..usd.author import CameraSpec
+    from ..usd.kit import add_characterization, best_match_pinhole
 
+    m = doc["marks"][0]
+    mark = m["focus_mark_mm"]
+    focus = 1.0e7 if mark is None or math.isinf(mark) else float(mark)
+    f = float(m["focal_length_mm"]["y"])
+    w, h = m["sensor_mm"]
+    if lens is not None:
+        spec, _ = best_match_pinhole(lens, focus_mm=focus, fstop=fstop, sensor_width_mm=w, sensor_height_mm=h)
+        spec = replace(spec, pinhole_focal_length_mm=f)
+    else:
+        spec = CameraSpec(focal_length_mm=f, pinhole_focal_length_mm=f, focus_mm=focus, sensor_width_mm=w,
+                          sensor_height_mm=h)
+    return add_characterization(usd["file"], usd["variant"], spec, _measured(doc, Path(output), Path(usd["file"])))
+
+
+def write_all(payload, usd, cal, args, plan) -> list:
+    """Write the folder as a whole (:func:`physcam.io.staged_folder`), then the USD variant; returns the
+    paths written (the files at their final places, the manifest, the lens file)."""
+    from ..io import MANIFEST_NAME, atomic_write, staged_folder
+
+    out = Path(args.output)
     written = []
-    for p, data in payload:
-        if isinstance(data, WritesItself):
-            written.append(data.write(p, args.force))
-        else:
-            written.append(atomic_write(p, data() if callable(data) else data, force=args.force))
+    with staged_folder(out, force=plan["force"], about={"command": "physcam calibrate", "lens": cal.lens_name,
+                                                        "good": cal.good}) as tmp:
+        for p, data in payload:
+            at = tmp / p.relative_to(out)
+            if isinstance(data, WritesItself):
+                data.write(at, False)
+            else:
+                atomic_write(at, data() if callable(data) else data)
+            written.append(p)
+    written.append(out / MANIFEST_NAME)
     if usd is not None:
-        from ..usd.author import CameraSpec
-        from ..usd.kit import add_characterization, best_match_pinhole
-
-        m = cal.marks[0]
-        focus = 1.0e7 if m.mark_mm is None or math.isinf(m.mark_mm) else float(m.mark_mm)
-        f = float(m.focal_length_mm[1])
-        if getattr(args, "loaded_lens", None) is not None:
-            spec, _ = best_match_pinhole(args.loaded_lens, focus_mm=focus, fstop=args.fstop,
-                                         sensor_width_mm=m.sensor_mm[0], sensor_height_mm=m.sensor_mm[1])
-            spec = replace(spec, pinhole_focal_length_mm=f)
-        else:
-            spec = CameraSpec(focal_length_mm=f, pinhole_focal_length_mm=f, focus_mm=focus,
-                              sensor_width_mm=m.sensor_mm[0], sensor_height_mm=m.sensor_mm[1])
-        written.append(add_characterization(usd[0], usd[1], spec, _measured(cal, Path(args.output), usd[0])))
+        written.append(add_calibration_variant(cal.to_dict(), usd, lens=getattr(args, "loaded_lens", None),
+                                               fstop=args.fstop, output=out))
     return written

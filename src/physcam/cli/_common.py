@@ -2,7 +2,9 @@
 
 A new command complies by using these (docs/cli.md, "Writing a command"):
 
-- distances: :func:`distance` (units as said on set; a bare number is mm);
+- distances: :func:`distance` (units as said on set; a bare number is mm); a scene distance (a
+  focus mark, a measured near or far limit) with ``scene=True``: a bare number then follows
+  the unit system (:data:`BARE_RULE`, resolved by :func:`resolve_bare_distances` after parsing);
 - a focus: :func:`focus` as the option's type (distances, ``hyperfocal``, ``infinity``) and
   :func:`resolve_focus` in the handler, which turns ``hyperfocal`` into a mark;
 - printed distances: :func:`add_units_option` and :func:`units_of` with
@@ -21,6 +23,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 
 from ..data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_LABEL
@@ -37,17 +40,80 @@ INFINITY_WORDS = ("inf", "infinity", "∞")
 FOCUS_HELP = "units ok: 2m, 6ft, 10'6\"; or hyperfocal, infinity"
 
 
-def distance(name: str, allow_inf: bool = False):
-    """An argparse type reading a distance with units (bare number = mm)."""
+#: The one rule for a bare number given as a scene distance (a focus mark, a measured near or far limit),
+#: on the command line and on ``physcam serve``'s page alike: it is read in the unit system's unit,
+#: millimetres under ``m`` (the default) and feet under ``ft`` (``--units ft``, or ``units = "ft"`` in the
+#: user config; a note says so). A bare number closer than the lens focuses is refused with "did you mean
+#: 3m?". Lengths inside the camera (focal length, sensor, offsets) are always millimetres.
+BARE_RULE = "a bare scene distance is millimetres, or feet under --units ft or units = \"ft\" in the user config"
+_BARE = re.compile(r"^\s*[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?\s*$")
+
+
+class BareDistance(float):
+    """A scene distance typed as a bare number: a float of its millimetres under :data:`BARE_RULE` (``unit``
+    "mm" until :func:`resolve_bare_distances` reads it in feet), with the text typed (``text``)."""
+
+    text: str
+    unit: str
+
+    def __new__(cls, mm: float, text: str, unit: str = "mm"):
+        obj = super().__new__(cls, mm)
+        obj.text, obj.unit = str(text).strip(), unit
+        return obj
+
+    def __reduce__(self):  # copies and pickles keep what was typed
+        return (BareDistance, (float(self), self.text, self.unit))
+
+
+def distance(name: str, allow_inf: bool = False, *, scene: bool = False):
+    """An argparse type reading a distance with units (bare number = mm); ``scene``: a bare number follows
+    :data:`BARE_RULE` (returned as a :class:`BareDistance`)."""
 
     def parse(text):
         try:
-            return parse_distance(text, name=name, allow_inf=allow_inf)
+            v = parse_distance(text, name=name, allow_inf=allow_inf)
         except PhysCamError as exc:
             raise argparse.ArgumentTypeError(str(exc)) from None
+        return BareDistance(v, text) if scene and _BARE.match(str(text)) else v
 
     parse.__name__ = name
     return parse
+
+
+def resolve_bare_distances(args) -> None:
+    """After parsing: every scene distance typed as a bare number (:class:`BareDistance`) read by
+    :data:`BARE_RULE`: under feet (``--units ft`` or the config's ``units``) its number becomes feet, and a
+    note says so; under metres it stays millimetres."""
+    if args is None:
+        return
+    bare = [(k, v) for k, v in vars(args).items()
+            if isinstance(v, BareDistance) or (isinstance(v, list) and any(isinstance(x, BareDistance) for x in v))]
+    if not bare or units_of(args) != "ft":
+        return
+
+    def feet(v):
+        return BareDistance(float(v.text) * 304.8, v.text, "ft") if isinstance(v, BareDistance) else v
+
+    for k, v in bare:
+        setattr(args, k, [feet(x) for x in v] if isinstance(v, list) else feet(v))
+    where = "--units ft" if getattr(args, "units", None) == "ft" else 'units = "ft" in the user config'
+    typed = ", ".join(f"--{k.replace('_', '-')} {x.text}" for k, v in bare
+                      for x in (v if isinstance(v, list) else [v]) if isinstance(x, BareDistance))
+    note(f"a bare number is feet here ({where}): {typed} read in feet; write mm or m to say otherwise")
+
+
+def bare_hint(args, message: str) -> str:
+    """" (did you mean 3m?)" when a command failed because a lens cannot focus that close and a scene distance
+    was typed as a bare number read as millimetres (:data:`BARE_RULE`); else ""."""
+    if args is None or not any(w in message for w in ("can focus", "cannot focus", "inside the focal length",
+                                                      "no real image", "in front of the lens")):
+        return ""
+    for k, v in vars(args).items():
+        for x in (v if isinstance(v, list) else [v]):
+            if isinstance(x, BareDistance) and x.unit == "mm" and float(x) < 1000.0:
+                return (f" (--{k.replace('_', '-')} {x.text} is {x.text} mm: a bare number is millimetres; "
+                        f"did you mean {x.text}m?)")
+    return ""
 
 
 #: Whole-number options take at most this many characters (a 400-digit count is refused by length
@@ -158,9 +224,10 @@ def focus(name: str = "focus distance", *, allow_inf: bool = True, hyperfocal: b
                 raise argparse.ArgumentTypeError(f"{name} must be finite here, got {text!r}")
             return math.inf
         try:
-            return parse_distance(text, name=name)
+            v = parse_distance(text, name=name)
         except PhysCamError as exc:
             raise argparse.ArgumentTypeError(f"{exc}; or hyperfocal, infinity" if hyperfocal else str(exc)) from None
+        return BareDistance(v, text) if _BARE.match(str(text)) else v  # BARE_RULE, resolved after parsing
 
     parse.__name__ = name
     parse.physcam_focus = {"infinity": allow_inf, "hyperfocal": hyperfocal}  # the contract test finds focus options
@@ -337,6 +404,10 @@ def add_lens_argument(p, *, dest: str = "lens", many: bool = False, metavar: str
     p.add_argument("--glass-catalog", dest="glass_catalog", action="append", default=None, metavar="FILE.agf",
                    help="a Zemax .agf glass catalogue searched after the lens file's own (repeat for several; "
                         "adds to the config's glass_catalogs)")
+    p.add_argument("--strict-glass", dest="strict_glass", action="store_true",
+                   help="a Zemax file's glass must be in the catalogues its GCAT line lists (or their makers' legacy "
+                        "glasses), as OpticStudio requires; by default another bundled catalogue holding the same "
+                        "name is used, with a warning")
     p.set_defaults(_lens_dest=dest, _lens_many=many)
 
 
@@ -366,15 +437,17 @@ def lens_use(args):
 
 def use_glass_catalogs(args) -> list[str]:
     """Make the config's ``glass_catalogs`` and the run's ``--glass-catalog`` files the user glass
-    catalogues, in that order (every run starts with none left over); their names."""
+    catalogues, in that order, and ``--strict-glass`` the rule for lens files' glasses (every run
+    starts with none left over); their names."""
     from ._config import load_config
 
     paths = list(load_config().glass_catalogs or ()) + list(getattr(args, "glass_catalog", None) or ())
-    if not paths and "physcam.lens.catalog" not in sys.modules:
+    strict = bool(getattr(args, "strict_glass", False))
+    if not paths and not strict and "physcam.lens.catalog" not in sys.modules:
         return []  # nothing to add and nothing left over: the report starts without the glass code
     from ..lens.catalog import use_catalog_files
 
-    return use_catalog_files(paths)
+    return use_catalog_files(paths, strict=strict)
 
 
 def merge_lens_argument(args, parser) -> None:
@@ -398,6 +471,34 @@ def merge_lens_argument(args, parser) -> None:
         parser.error("give the lens: --lens NAME_OR_FILE (a bundled name from `physcam lenses`, or a lens file)")
 
 
+# ---- a folder of outputs written as a whole --------------------------------------------------
+#: ``--force`` of a command whose ``-o DIR`` is written whole (:func:`output_folder`).
+FOLDER_FORCE_HELP = "replace the folder if physcam wrote it whole (it has a physcam-manifest.json) or it is empty"
+
+def output_folder(folder, *, force: bool, command: str):
+    """A command's output folder written as a whole (:func:`physcam.io.staged_folder`): a context
+    yielding the private temporary folder to fill; on success it is put at ``folder`` in one rename
+    with its ``physcam-manifest.json`` (``about``: the command and physcam's version). Without
+    ``force`` an existing ``folder`` is refused; with it, only one physcam wrote whole (or an empty one)
+    is replaced, never a folder of the user's own files. Checked at once, before any work."""
+    from .. import __version__
+    from ..io import staged_folder
+
+    return staged_folder(folder, force=force, about={"command": f"physcam {command}", "physcam_version": __version__})
+
+
+def relocated(paths, tmp, folder) -> list:
+    """``paths`` written under the temporary folder ``tmp``, as they are named once it is published
+    at ``folder`` (same types: str stays str)."""
+    from pathlib import Path
+
+    out = []
+    for p in paths:
+        q = Path(folder) / Path(p).relative_to(tmp)
+        out.append(str(q) if isinstance(p, str) else q)
+    return out
+
+
 # ---- notes -----------------------------------------------------------------------------------
 _NOTES: list[str] = []
 
@@ -417,8 +518,8 @@ def take_notes() -> list[str]:
 
 
 def print_json(obj) -> None:
-    json.dump(obj, sys.stdout, indent=2, allow_nan=False)
-    sys.stdout.write("\n")
+    """``obj`` as JSON on stdout, whole or not at all (serialised before the first byte is written)."""
+    sys.stdout.write(json.dumps(obj, indent=2, allow_nan=False) + "\n")
 
 
 def console(stderr: bool = False):

@@ -89,6 +89,23 @@ def load_config() -> Config:
     return _CACHE[key]
 
 
+def _regular_files_only(path: Path, catalogues) -> None:
+    """Refuse a glass catalogue that exists and is not a regular file (``/dev/zero`` grows without
+    bound, a FIFO blocks): ``stat`` only, nothing is opened. A missing one is said when it is read."""
+    import stat
+
+    for c in catalogues:
+        try:
+            mode = os.stat(c).st_mode
+        except OSError:
+            continue
+        if not stat.S_ISREG(mode):
+            kind = "a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else "a device" \
+                if (stat.S_ISCHR(mode) or stat.S_ISBLK(mode)) else "not a regular file"
+            raise InputError(f"the physcam config {path}: glass_catalogs: {c} is {kind}, not a regular file "
+                             "(a Zemax .agf text file)")
+
+
 def _read(path: Path) -> Config:
     import tomllib
 
@@ -116,6 +133,7 @@ def _read(path: Path) -> Config:
                 raise InputError(f"the physcam config {path}: glass_catalogs must be a list of .agf paths, "
                                  f"e.g. glass_catalogs = [\"~/CORNING.AGF\"], got {v!r}")
             values[k] = tuple(str(Path(x.strip()).expanduser()) for x in v)
+            _regular_files_only(path, values[k])
             continue
         if not isinstance(v, str) or not v.strip():
             raise InputError(f"the physcam config {path}: {k} must be text, e.g. {k} = \"...\", got {v!r}")

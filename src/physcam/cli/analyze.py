@@ -211,11 +211,11 @@ def run_colour(args) -> int:
     if not (args.json or _csv(args, res, "colour")):
         print(f"{res.lens_name}: chromatic aberration (EFL {res.efl_mm:.3f} mm at {res.reference_nm:g} nm), "
               f"{args.sensor_name}")
-        print(f"  longitudinal colour C - F: paraxial {res.longitudinal_paraxial_mm * 1e3:.2f} um, "
-              f"real ({res.zone:.3g} zone) {res.longitudinal_real_mm * 1e3:.2f} um")
+        print(f"  longitudinal colour C - F: paraxial {res.longitudinal_paraxial_mm * 1e3:.2f} µm, "
+              f"real ({res.zone:.3g} zone) {res.longitudinal_real_mm * 1e3:.2f} µm")
         if res.media:
             print(f"  uncertainty (one sigma, P_gF of normal-line glasses): C - F +-{res.longitudinal_uncertainty_mm * 1e3:.2f}"
-                  f" um, focus-shift curve 400-700 nm up to +-{res.curve_uncertainty_mm * 1e3:.1f} um")
+                  f" µm, focus-shift curve 400-700 nm up to +-{res.curve_uncertainty_mm * 1e3:.1f} µm")
             print("  dispersion models:")
             for m in res.media:
                 print(f"    surfaces {','.join(str(i) for i in m['surfaces'])}: {m['description']}")
@@ -224,7 +224,7 @@ def run_colour(args) -> int:
         for w, zp, zr in zip(res.wavelengths_nm, res.paraxial_focus_z_mm, res.real_focus_z_mm):
             t.add_row(f"{w:.4f}", f"{zp:.4f}", f"{zr:.4f}")
         print_table(t)
-        t = Table("lateral colour F - C on the film", ("field deg", "lateral colour um"), justify=["right"] * 2)
+        t = Table("lateral colour F - C on the film", ("field deg", "lateral colour µm"), justify=["right"] * 2)
         for p in res.lateral:
             t.add_row(f"{p.field_deg:.3f}", f"{p.lateral_colour_um:.3f}")
         print_table(t)

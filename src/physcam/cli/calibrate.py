@@ -7,13 +7,13 @@ Examples::
   physcam calibrate near/ far/ --marks marks.csv --lens zeiss_distagon_35mm_f4 --sensor S35 ... -o calib/ \\
       --usd lenses/distagon35.usda --variant day_20260301
 
-Everything is computed and every name checked before anything is written: a bad image, too few
-views or an existing file (without ``--force``) leaves the folder as it was.
+Every option, output and image header is checked before the fit, and everything is computed
+before anything is written: a bad image, too few views, a wrong grid or an output that may not be
+written leaves the disk as it was. The folder of deliverables is written as a whole
+(:func:`physcam.io.staged_folder`: a temporary folder, a manifest, one rename).
 """
 
 from __future__ import annotations
-
-import math
 
 from ._common import (
     FOCUS_HELP,
@@ -33,7 +33,7 @@ FILES = {"calibration": "calibration.json", "sheet": "calibration_sheet.png", "b
 
 
 def register(sub) -> None:
-    from ..analysis.calibrate_names import CHARTS, CHARUCO_DICTIONARY, parse_corners
+    from ..analysis.calibrate_names import CHARTS, CHARUCO_DICTIONARY, MAX_IMAGE_PIXELS, parse_corners
     from ..analysis.distortion_names import DEFAULT_MAX_RESIDUAL_PX
 
     def corners(text):
@@ -70,23 +70,31 @@ def register(sub) -> None:
                    help="the stop the flat fields were shot at (for --lens; default wide open)")
     p.add_argument("--flat", action="append", default=None, metavar="FRAME",
                    help="a flat-field frame (repeat): relative illumination against image height")
-    p.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for the deliverables")
+    p.add_argument("-o", "--output", required=True, metavar="DIR",
+                   help="folder for the deliverables, written as a whole (new, empty, or with --force one physcam "
+                        "wrote)")
     p.add_argument("--usd", default=None, metavar="LENS.usda",
                    help="the lens's USD file: add the day's characterization variant, 'current' moved to it")
     p.add_argument("--variant", default=None, metavar="NAME", help="the variant's name (default calibration_DATE)")
     p.add_argument("--bootstrap", type=whole("bootstrap", lo=0), default=30, metavar="N",
-                   help="refits over resampled views for the uncertainty (default 30; 0: OpenCV's covariance)")
+                   help="refits over resampled views for the uncertainty (default 30; 3 to 1000, or 0: OpenCV's "
+                        "covariance for f and the principal point, the field's not estimated)")
+    p.add_argument("--max-pixels", type=whole("largest image", lo=1), default=MAX_IMAGE_PIXELS, metavar="N",
+                   help=f"refuse an image (chart or flat) of more pixels, read from its header before decoding "
+                        f"(default {MAX_IMAGE_PIXELS:,})")
     p.add_argument("--max-residual", type=number("allowed residual", positive=True),
                    default=DEFAULT_MAX_RESIDUAL_PX, metavar="PX",
                    help=f"largest residual a fit may have to be called good (default {DEFAULT_MAX_RESIDUAL_PX:g} px)")
-    p.add_argument("--force", action="store_true", help="overwrite existing files")
+    p.add_argument("--force", action="store_true",
+                   help="replace the deliverables folder (only one physcam wrote, or an empty one)")
     add_output_options(p, what="the calibration")
     add_units_option(p)
     p.set_defaults(handler=run_calibrate)
 
 
 def _read_marks(path, args) -> dict:
-    """image path (as written) -> mark mm, from a CSV of image,mark."""
+    """image path (as written) -> mark mm, from a CSV of image,mark; an image given two different marks
+    is refused (naming both lines)."""
     import argparse
     import csv
     from pathlib import Path
@@ -97,7 +105,7 @@ def _read_marks(path, args) -> dict:
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{p}: no such marks file")
-    out = {}
+    out, where = {}, {}
     with p.open(newline="", encoding="utf-8") as f:
         for n, row in enumerate(csv.reader(f), 1):
             if not row or (n == 1 and row[0].strip().lower() == "image"):
@@ -108,7 +116,11 @@ def _read_marks(path, args) -> dict:
                 mark = one(row[1])
             except argparse.ArgumentTypeError as e:  # it carries the sentence
                 raise InputError(f"{p}, line {n}: {e}") from None
-            out[str(Path(row[0].strip()))] = mark
+            key = str(Path(row[0].strip()))
+            if key in out and out[key] != mark:
+                raise InputError(f"{p}, line {n}: {key} is given the mark {row[1].strip()!r}, line {where[key]} gave "
+                                 "it another: give each image one mark")
+            out[key], where[key] = mark, n
     if not out:
         raise InputError(f"{p}: no image,mark rows")
     return out
@@ -131,7 +143,11 @@ def _views(args, lens):
         table = _read_marks(args.marks, args)
         marks = []
         for p in paths:
-            m = table.get(str(Path(p)), table.get(Path(p).name))
+            by_path, by_name = table.get(str(Path(p))), table.get(Path(p).name)
+            if by_path is not None and by_name is not None and by_path != by_name:
+                raise InputError(f"{p}: {args.marks} gives it one mark by its path and another by its file name "
+                                 f"{Path(p).name}: give each image one mark")
+            m = by_path if by_path is not None else by_name
             if m is None:
                 raise InputError(f"{p}: not in {args.marks} (give every image a mark)")
             marks.append(m)
@@ -139,7 +155,7 @@ def _views(args, lens):
         marks = [args.focus] * len(paths)
     sensor = _sensor(args)
     marks = [None if m is None else resolve_focus(m, lens=lens, sensor=sensor, args=args) for m in marks]
-    return detect_views(paths, chart, marks)
+    return detect_views(paths, chart, marks, max_pixels=args.max_pixels)
 
 
 def _sensor(args):
@@ -153,7 +169,6 @@ def _sensor(args):
 def compute(args):
     """The calibration of the command line (nothing written)."""
     from ..analysis.calibrate import calibrate_views
-    from ..errors import InputError
 
     lens = None
     if args.lens is not None:
@@ -161,8 +176,6 @@ def compute(args):
 
         lens = load_lens(args.lens)
     args.loaded_lens = lens
-    if not 0 <= args.bootstrap <= 1000:
-        raise InputError(f"--bootstrap must be from 0 to 1000 refits, got {args.bootstrap}")
     views = _views(args, lens)
     s = _sensor(args)
     name = lens.name if lens is not None else "measured"
@@ -172,7 +185,8 @@ def compute(args):
         from ..analysis.calibrate_flat import measure_illumination
 
         m = cal.marks[0]
-        cal.illumination = measure_illumination(args.flat, m.size_px, m.sensor_mm, m.principal_point_px)
+        cal.illumination = measure_illumination(args.flat, m.size_px, m.sensor_mm, m.principal_point_px,
+                                                max_pixels=args.max_pixels)
     if lens is not None:
         from ..analysis.calibrate_compare import compare_with_lens
 
@@ -181,11 +195,12 @@ def compute(args):
 
 
 def run_calibrate(args) -> int:
-    from ._calibrate_files import UNITS, deliverables, write_all
+    from ._calibrate_files import UNITS, check_outputs, deliverables, write_all
 
+    plan = check_outputs(args)  # every option, output and image header before the fit
     cal, _lens = compute(args)
-    payload, usd = deliverables(cal, args)
-    written = write_all(payload, usd, cal, args)
+    payload, usd = deliverables(cal, args, plan)
+    written = write_all(payload, usd, cal, args, plan)
     d = cal.to_dict()
     d["written"] = [str(p) for p in written]
     if args.json:
@@ -205,10 +220,10 @@ def _print(cal, written, args) -> None:
     for m in cal.marks:
         where = "focus not given" if m.mark_mm is None else f"focus {format_distance(m.mark_mm, units_of(args))}"
         u = m.uncertainty or {}
-        fs = (u.get("focal_length_mm") or {}).get("y", math.nan)
+        fs = (u.get("focal_length_mm") or {}).get("y")
         good, why = m.verdict
         print(f"{cal.lens_name}, {where}: {len(m.views)} views, pinhole f {m.focal_length_mm[1]:.4f} mm "
-              f"(+- {fs:.4f}), principal point ({m.principal_point_px[0]:.2f}, {m.principal_point_px[1]:.2f}) px, "
+              f"({'uncertainty not estimated' if fs is None else f'+- {fs:.4f}'}), principal point ({m.principal_point_px[0]:.2f}, {m.principal_point_px[1]:.2f}) px, "
               f"residual {m.rms_px:.3f} px RMS: {'good' if good else 'NOT good: ' + '; '.join(why)}")
         for f in m.fits:
             print(f"  {f.model}: residual RMS {f.rms_residual_px:.3f} px, max {f.max_residual_px:.3f} px: "

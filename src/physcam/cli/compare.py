@@ -8,7 +8,8 @@ import argparse
 import math
 
 from ..figures import styled
-from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number, whole
+from ._common import (FOCUS_HELP, FOLDER_FORCE_HELP, add_lens_argument, add_sensor_options, add_units_option, distance,
+                      focus, number, whole)
 
 EPILOG = """\
 example:
@@ -80,13 +81,14 @@ def register(sub) -> None:
     b.add_argument("--blender-python", metavar="PATH",
                    help="a Python with Blender's bpy (default: $PHYSCAM_BLENDER_PYTHON or ./.venv-blender)")
     b.add_argument("--lenient", action="store_true", help="load a lens file that is not buildable as written, repaired")
-    b.add_argument("-o", "--output", required=True, metavar="DIR", help="folder for compare.png and compare.json")
-    b.add_argument("--force", action="store_true", help="overwrite existing files")
+    b.add_argument("-o", "--output", required=True, metavar="DIR",
+                   help="folder for compare.png and compare.json (written whole, with a physcam-manifest.json)")
+    b.add_argument("--force", action="store_true", help=FOLDER_FORCE_HELP)
     from ._output import add_output_options
 
     add_output_options(b, what="the measured table")
     add_units_option(b)
-    b.set_defaults(handler=run_blender)
+    b.set_defaults(handler=run_blender, output_folders=("output",))
     p.set_defaults(handler=lambda args: (p.print_help(), 0)[1])
     s._name_parser_map.accept_any = True
 
@@ -97,14 +99,13 @@ def run_blender(args) -> int:
 
     from ..errors import InputError
     from ..export.blender_compare import compare_bokeh
-    from ..io import atomic_write, check_writable
+    from ..io import atomic_write
     from ..lens.library import load_lens
     from ..trace.aperture import Aperture
+    from ._common import output_folder
 
     out = Path(args.output)
     png, js = out / "compare.png", out / "compare.json"
-    for f in (png, js):
-        check_writable(f, force=args.force)
     if not (args.blades == 0 or 3 <= args.blades <= 64):
         raise InputError(f"--blades must be 0 (round) or 3 to 64, got {args.blades}")
     aperture = Aperture(args.blades, args.blade_angle) if args.blades else None
@@ -115,14 +116,15 @@ def run_blender(args) -> int:
     from ..optics.state import camera_state
 
     state = camera_state(lens, focus_mm=args.focus, fstop=args.fstop, aperture=aperture)
-    res = compare_bokeh(state, light_mm=args.light,
-                        crop_mm=args.crop, pixels=args.pixels, samples=args.samples,
-                        blender_python=args.blender_python, config_blender=_config_blender())
-    table = {k: v for k, v in res.items() if k != "images"}
-    atomic_write(js, json.dumps(table, indent=2, allow_nan=False) + "\n", force=args.force)
     from ._common import units_of
 
-    _figure(res, png, force=args.force, units=units_of(args))
+    with output_folder(out, force=args.force, command="compare blender") as tmp:  # the folder is written whole
+        res = compare_bokeh(state, light_mm=args.light,
+                            crop_mm=args.crop, pixels=args.pixels, samples=args.samples,
+                            blender_python=args.blender_python, config_blender=_config_blender())
+        table = {k: v for k, v in res.items() if k != "images"}
+        atomic_write(tmp / js.name, json.dumps(table, indent=2, allow_nan=False) + "\n")
+        _figure(res, tmp / png.name, units=units_of(args))
     if args.json:
         from ._output import document, emit_json
 
@@ -232,8 +234,9 @@ ROWS = [
     ("near_from_film_mm", "near limit", "dist"), ("far_from_film_mm", "far limit", "dist"),
     ("dof_total_mm", "depth of field", "dist"), ("hyperfocal_from_film_mm", "hyperfocal", "dist"),
     ("breathing_at_focus_pct", "HFOV change from ∞ to focus (%)", "{:+.2f}"),
-    ("breathing_closest_pct", "HFOV change from ∞ to closest (%)", "{:+.2f}"),
-    ("closest_focus_mm", "closest focus", "dist"),
+    ("breathing_closest_pct", "HFOV change from ∞ to near mark (%)", "{:+.2f}"),
+    ("breathing_near_mm", "  near mark", "dist"),
+    ("closest_focus_mm", "closest focus", "close"),
     ("distortion_pct", "distortion at widest field (%)", "{:+.2f}"),
     ("distortion_field_deg", "  at field (deg)", "{:.2f}"),
     ("illumination_corner", "relative illumination at corner", "{:.3f}"),
@@ -249,6 +252,10 @@ def _cell(v, kind, units) -> str:
 
     if kind == "dist":
         return format_distance(math.inf if v is None else v, units)
+    if kind == "close":  # (mark, source): a unit-focusing lens's 1:1 limit is not a close focus it has
+        mark, source = v
+        return format_distance(mark, units) + {"maker": " (MOD)", "focus groups": " (focus groups)"}.get(
+            source, " (unit focusing limit, not the lens's MOD)")
     return "-" if v is None else kind.format(v)
 
 
@@ -290,7 +297,8 @@ def run_lenses(args) -> int:
     t = Table(f"lenses compared on {sensor.name} ({sensor.width_mm:g} x {sensor.height_mm:g} mm)",
               ["", *args.lenses], justify=["left"] + ["right"] * len(rows))
     for key, label, kind in ROWS:
-        t.add_row(label, *(_cell(r[key], kind, units) for r in rows))
+        t.add_row(label, *(_cell((r[key], r["closest_focus_source"]) if kind == "close" else r[key], kind, units)
+                           for r in rows))
     print_table(t)
     for name, r in zip(args.lenses, rows):
         for n in r["notes"]:

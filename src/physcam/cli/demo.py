@@ -1,8 +1,9 @@
 """``physcam demo``: the main job on the bundled default lens and sensor.
 
 The default setup is the bundled ``dgauss_50mm`` (pbrt's double Gauss, US 2,673,491) on an
-ARRI ALEXA 35 open gate at f/2.8, focused 3 m from the film plane. The demo writes into a
-folder and prints the report:
+ARRI ALEXA 35 open gate at f/2.8, focused 3 m from the film plane. The demo writes a folder,
+whole (``physcam.io.staged_folder``: a killed run leaves no half of one; ``--force`` replaces a demo
+folder physcam wrote), and prints the report:
 
 - ``report.json`` / ``report.txt``: the lens report, technical model filled from the lens
   itself, with its UsdGeomCamera and RenderMan blocks; ``dof.png``: the depth-of-field chart (near
@@ -36,18 +37,18 @@ DEFAULTS = {
 
 def register(sub) -> None:
     p = sub.add_parser("demo", help="run the main job on the default lens and sensor, writing a folder of outputs")
-    from ._common import hidden_alias
+    from ._common import FOLDER_FORCE_HELP, hidden_alias
     from ._output import add_output_options
 
     p.add_argument("-o", "--output", dest="out", default="demo-output", metavar="DIR",
                    help="folder to write (default demo-output)")
     hidden_alias(p, "--out", "out")
-    p.add_argument("--force", action="store_true", help="overwrite files already in the folder")
+    p.add_argument("--force", action="store_true", help=FOLDER_FORCE_HELP)
     from ._common import add_units_option
 
     add_units_option(p)
     add_output_options(p, what="the list of written files")
-    p.set_defaults(handler=run)
+    p.set_defaults(handler=run, output_folders=("out",))
 
 
 def _args():
@@ -207,7 +208,8 @@ def _distortion_step(out, ctx, force):
 
     doc = brown_conrady_document(res.lens_name, brown)
     ox, oy = res.overscan_px
-    nk = nuke_stmap_script(d.resolve() / "undistortion.exr", d.resolve() / "distortion.exr", plate_size=(w, h),
+    final = ctx.get("final", out) / "distortion"  # where the maps will be once the demo folder is published
+    nk = nuke_stmap_script(final.resolve() / "undistortion.exr", final.resolve() / "distortion.exr", plate_size=(w, h),
                            undistorted_size=(w + 2 * ox, h + 2 * oy), version=__version__)
     paths += [atomic_write(d / "brown_conrady.json", json.dumps(doc, indent=2) + "\n", force=force),
               atomic_write(d / "3de4_radial_standard_degree_4.txt", tde4_lens_text(tde4, res.lens_name), force=force),
@@ -242,21 +244,22 @@ def _blender_step(out, ctx, force):
 def run(args) -> int:
     from pathlib import Path
 
-    from ._common import console, units_of
+    from ._common import console, output_folder, relocated, units_of
     from ._output import document, emit_json
 
     from ..extras import require_extra
 
     require_extra("usd", "the demo's USD cameras (physcam demo)")  # before any file is written
     out = Path(args.out)
-    ctx: dict = {"units": units_of(args)}  # scene distances on the plots: --units, else the user config's
+    ctx: dict = {"units": units_of(args), "final": out}  # scene distances on the plots: --units, else the config's
     written = []
     err = console(stderr=True)
-    for name, step in _steps():
-        paths = step(out, ctx, args.force)
-        written.extend(paths)
-        if not args.json:
-            err.print(f"{name}: " + ", ".join(str(p) for p in paths))
+    with output_folder(out, force=args.force, command="demo") as tmp:  # the folder is written whole, at the end
+        for name, step in _steps():
+            paths = relocated(step(tmp, ctx, False), tmp, out)
+            written.extend(paths)
+            if not args.json:
+                err.print(f"{name}: " + ", ".join(str(p) for p in paths))
     if args.json:
         emit_json(document("demo", {"out": str(out), "files": [str(p) for p in written]}))
         return 0

@@ -10,13 +10,18 @@ Examples::
 
 from __future__ import annotations
 
+import math
+
 from ._common import FOCUS_HELP, add_units_option, focus, focus_list, number, units_of
 from ._output import document, emit_json, print_csv
 from .lens import WAVE_UNITS, mark_repaired
 
 #: Names of the files the fits write into --stmap DIR.
 FIT_FILES = {"brown": "brown_conrady.json", "3de4": "3de4_radial_standard_degree_4.txt",
-             "usd": "usd_lens_distortion.json", "nuke": "physcam_stmap.nk"}
+             "usd": "usd_lens_distortion.json", "nuke": "physcam_stmap.nk",
+             "3de4-anamorphic-4": "3de4_anamorphic_standard_degree_4.txt",
+             "3de4-anamorphic-6": "3de4_anamorphic_standard_degree_6.txt",
+             "unreal-anamorphic": "unreal_anamorphic_distortion.json"}
 
 
 _focus_list = focus_list("focus marks")
@@ -34,8 +39,8 @@ def register(sub) -> None:
     p.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM",
                    help="wavelength in nm (default: the lens's design wavelength, the d line 587.56)")
     p.add_argument("--focus", type=focus("focus distance"), default=None, metavar="D",
-                   help=f"focus mark from the film plane for the 2-D field (default infinity; {FOCUS_HELP}; "
-                        "hyperfocal wide open); needs --resolution")
+                   help=f"focus mark from the film plane (default infinity; {FOCUS_HELP}; hyperfocal wide open): "
+                        "the field-angle table of the lens focused there, or with --resolution the 2-D field")
     p.add_argument("--resolution", type=_resolution, default=None, metavar="WxH",
                    help="frame size in pixels, e.g. 2048x1366: the full 2-D distortion field at --focus")
     p.add_argument("--stmap", metavar="DIR", default=None,
@@ -43,7 +48,7 @@ def register(sub) -> None:
                         "files of each --fit into DIR; needs --resolution")
     p.add_argument("--fit", choices=MODEL_CHOICES, action="append", default=None,
                    help="fit a model over the frame (repeat): brown = Brown-Conrady D-U and U-D (OpenTrackIO), "
-                        "3de4 = 3DE4 Radial - Standard, Degree 4, usd = Hydra lensDistortion, nuke = a Nuke "
+                        "3de4 = 3DE4 Radial - Standard, Degree 4, usd = Hydra lensDistortion, 3de4-anamorphic-4 and -6 = 3DE4 Anamorphic - Standard, Degree 4 and 6 (with --stmap: their 3DE4 lens files, and Unreal's anamorphic parameters for degree 4), nuke = a Nuke "
                         "script applying the ST-maps (with --stmap); needs --resolution")
     p.add_argument("--max-residual", type=number("allowed residual", positive=True),
                    default=DEFAULT_MAX_RESIDUAL_PX, metavar="PX",
@@ -58,14 +63,14 @@ def register(sub) -> None:
                    help="a table of distortion across focus marks, e.g. 0.5m,1m,2m,inf (hyperfocal too); "
                         "needs --resolution")
     add_units_option(p)
-    p.set_defaults(handler=run_distortion)
+    p.set_defaults(handler=run_distortion, output_folders=("stmap",))
 
 
 def run_distortion(args) -> int:
     from ..errors import InputError
     from .analyze import _finish, _prepare
 
-    needs = [n for n, v in (("--focus", args.focus), ("--stmap", args.stmap), ("--fit", args.fit),
+    needs = [n for n, v in (("--stmap", args.stmap), ("--fit", args.fit),
                             ("--across-focus", args.across_focus), ("--fstop", args.fstop)) if v is not None]
     if args.resolution is None and needs:
         raise InputError(f"{', '.join(needs)} {'needs' if len(needs) == 1 else 'need'} --resolution WxH "
@@ -96,14 +101,21 @@ def run_distortion(args) -> int:
     from ..analysis.distortion import real_distortion
 
     res = real_distortion(lens, args.field, sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
-                          wavelength_nm=args.wavelength)
+                          wavelength_nm=args.wavelength, focus_mm=math.inf if args.focus is None else args.focus)
     if args.csv and not args.json:
         print_csv(res.to_dict()["points"])
     elif not args.json:
         from ._output import Table, print_table
 
+        if res.focus_from_film_mm is None or math.isinf(res.focus_from_film_mm):  # Y's pinhole there is its EFL
+            against = f"EFL {res.efl_y_mm:.3f} mm"
+        else:
+            from ..units import format_distance
+
+            against = (f"focused at {format_distance(res.focus_from_film_mm, units_of(args))}, pinhole f "
+                       f"{res.efl_y_mm:.3f} mm (Y) at the entrance pupil")
         t = Table(f"{res.lens_name}: real distortion at {res.wavelength_nm:g} nm (chief ray vs f tan theta), "
-                  f"EFL {res.efl_y_mm:.3f} mm, {args.sensor_name}",
+                  f"{against}, {args.sensor_name}",
                   ("axis", "field deg", "real mm", "f tan mm", "dist %"), justify=["right"] * 5)
         for p in res.points:
             t.add_row(p.axis, f"{p.field_deg:.3f}", f"{p.real_height_mm:.4f}", f"{p.paraxial_height_mm:.4f}",
@@ -199,23 +211,33 @@ def _fit_payloads(args, res, fits, folder):
 
     d = Path(folder)
     out = []
+    from ..analysis.anamorphic_distortion import TDE4Anamorphic
+    from ..export.tde4 import tde4_anamorphic_lens_text
+
     brown = [f for f in fits if isinstance(f, BrownConrady)]
     for f in fits:
         f.require_acceptable(FIT_FILES["brown" if f in brown else "3de4" if isinstance(f, TDE4RadialStandard)
-                                        else "usd"])
+                                        else _anamorphic_key(f) if isinstance(f, TDE4Anamorphic) else "usd"])
     if brown:
         out.append((d / FIT_FILES["brown"], (json.dumps(brown_conrady_document(res.lens_name, brown), indent=2)
                                              + "\n").encode()))
     for f in fits:
         if isinstance(f, TDE4RadialStandard):
             out.append((d / FIT_FILES["3de4"], tde4_lens_text(f, res.lens_name).encode()))
+        elif isinstance(f, TDE4Anamorphic):
+            out.append((d / FIT_FILES[_anamorphic_key(f)], tde4_anamorphic_lens_text(f, res.lens_name).encode()))
+            if f.coefficients["degree"] == 4:  # Unreal's anamorphic lens model is the degree-4 one
+                doc = document("distortion_unreal_anamorphic", {"lens": res.lens_name, **f.to_dict()},
+                               units=FIT_UNITS)
+                out.append((d / FIT_FILES["unreal-anamorphic"], (json.dumps(doc, indent=2) + "\n").encode()))
         elif isinstance(f, USDStandard):
             out.append((d / FIT_FILES["usd"], (json.dumps(usd_distortion_document(res.lens_name, f), indent=2)
                                                + "\n").encode()))
     for f in fits:
         slug = {"D-U": "_du", "U-D": "_ud"}.get(f.direction, "") if isinstance(f, BrownConrady) else ""
         stem = ("brown_conrady" + slug if isinstance(f, BrownConrady)
-                else "3de4" if isinstance(f, TDE4RadialStandard) else "usd")
+                else "3de4" if isinstance(f, TDE4RadialStandard)
+                else _anamorphic_key(f).replace("-", "_") if isinstance(f, TDE4Anamorphic) else "usd")
         out.append((d / f"residual_{stem}.png", _png(f, units_of(args))))
     if "nuke" in args.fit:
         w, h = res.size_px
@@ -224,6 +246,22 @@ def _fit_payloads(args, res, fits, folder):
                                  plate_size=(w, h), undistorted_size=(w + 2 * ox, h + 2 * oy), version=__version__)
         out.append((d / FIT_FILES["nuke"], text.encode()))
     return out
+
+
+def _anamorphic_key(fit) -> str:
+    return f"3de4-anamorphic-{int(fit.coefficients['degree'])}"
+
+
+def _fits(samples, names, max_residual_px):
+    """The fitted models named by --fit: physcam.analysis.distortion_models' and the 3DE4 anamorphic ones."""
+    from ..analysis.anamorphic_distortion import fit_tde4_anamorphic
+    from ..analysis.distortion_models import fit_models
+    from ..analysis.distortion_names import ANAMORPHIC_CHOICES
+
+    names = list(names or ())
+    fits = fit_models(samples, [n for n in names if n not in ANAMORPHIC_CHOICES], max_residual_px=max_residual_px)
+    return fits + [fit_tde4_anamorphic(samples, ANAMORPHIC_CHOICES[n], max_residual_px=max_residual_px)
+                   for n in dict.fromkeys(names) if n in ANAMORPHIC_CHOICES]
 
 
 def _png(fit, units: str = "m") -> bytes:
@@ -237,11 +275,15 @@ def _png(fit, units: str = "m") -> bytes:
 
 
 def _run_field(args, lens) -> int:
-    from ..analysis.distortion_models import fit_models, samples_from_field
+    from ..analysis.distortion_models import samples_from_field
     from ..analysis.stmap import distortion_field, write_stmaps
     from ..errors import InputError
-    from ..io import atomic_write, check_writable
+    import contextlib
+    from pathlib import Path
+
+    from ..io import atomic_write
     from ..optics.state import camera_state
+    from ._common import output_folder, relocated
 
     if args.field:
         raise InputError("--field is for the field-angle table; the 2-D field (--resolution) covers the whole frame")
@@ -253,16 +295,19 @@ def _run_field(args, lens) -> int:
 
         require_extra("exr", "writing ST-maps as EXR (physcam distortion --stmap)")
     cam = camera_state(lens, focus_mm=args.focus, fstop=args.fstop, sensor_mm=(args.sensor_width, args.sensor_height))
-    res = distortion_field(cam, width_px=args.resolution[0], height_px=args.resolution[1], wavelength_nm=args.wavelength,
-                           maps=args.stmap is not None)
-    fits = fit_models(samples_from_field(res), args.fit or (), max_residual_px=args.max_residual)
     written = []
-    if args.stmap is not None:
-        payload = _fit_payloads(args, res, fits, args.stmap) if args.fit else []
-        for p, _ in payload:  # every name checked before anything is written
-            check_writable(p, force=args.force)
-        written = write_stmaps(res, args.stmap, force=args.force)
-        written += [atomic_write(p, data, force=args.force) for p, data in payload]
+    with contextlib.ExitStack() as stack:  # the --stmap folder is written whole, and checked before the work
+        tmp = None if args.stmap is None else stack.enter_context(
+            output_folder(args.stmap, force=args.force, command="distortion --stmap"))
+        res = distortion_field(cam, width_px=args.resolution[0], height_px=args.resolution[1],
+                               wavelength_nm=args.wavelength, maps=args.stmap is not None)
+        fits = _fits(samples_from_field(res), args.fit, args.max_residual)
+        if tmp is not None:
+            payload = _fit_payloads(args, res, fits, args.stmap) if args.fit else []  # named in the final folder
+            maps = write_stmaps(res, tmp)
+            for p, data in payload:
+                atomic_write(tmp / Path(p).relative_to(args.stmap), data)
+            written = relocated(maps, tmp, args.stmap) + [p for p, _ in payload]
     d = res.to_dict()
     d["fits"] = [f.to_dict() for f in fits]
     if args.json:
@@ -283,9 +328,9 @@ def _run_field(args, lens) -> int:
         print(f"  overscan {res.overscan_px[0]} x {res.overscan_px[1]} px (undistorted frame "
               f"{d['undistorted_size_px'][0]}x{d['undistorted_size_px'][1]}), inverse error {res.inverse_error_px:.4f} px")
     for fit in fits:
-        verdict = "good" if fit.acceptable else f"NOT good (> {fit.max_residual_allowed_px:g} px)"
         coeffs = ", ".join(f"{k} {v:.6g}" for k, v in fit.coefficients.items())
-        print(f"  {fit.model}: residual RMS {fit.rms_residual_px:.3f} px, max {fit.max_residual_px:.3f} px: {verdict}")
+        print(f"  {fit.model}: residual RMS {fit.rms_residual_px:.3f} px, max {fit.max_residual_px:.3f} px: "
+              f"{fit.verdict}")
         print(f"    {coeffs}")
     for p in written:
         print(f"wrote {p}")

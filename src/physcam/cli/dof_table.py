@@ -63,6 +63,8 @@ def register(sub) -> None:
     add_units_option(p)
     add_output_options(p, csv=True, what="the table")
     p.add_argument("-o", "--output", metavar="CARD", help="draw a printable card (.pdf, .png or .svg)")
+    p.add_argument("--page", choices=("a4", "letter"), default="a4",
+                   help="the card's page, portrait: a4 (210 x 297 mm, default) or letter (8.5 x 11 in)")
     p.add_argument("--force", action="store_true", help="overwrite an existing card")
     p.set_defaults(handler=run)
 
@@ -198,7 +200,7 @@ def run(args) -> int:
 
         d = mark_repaired(d, args.loaded_lens)
     if args.output:
-        card(d, args.output, units=units, force=args.force, chart=_card_chart(args))
+        card(d, args.output, units=units, force=args.force, chart=_card_chart(args), page=args.page)
     if args.json:
         emit_json(document("dof_table", d))
         return 0
@@ -223,12 +225,13 @@ def run(args) -> int:
 
 
 def _card_chart(args):
-    """(report, chart data) of the DOF chart under the card's table: the table's stops (up to six; else
-    the chart's own around the first) against focus, every cell a report as the table's."""
+    """(report, chart data) of the DOF chart under the card's table: the table's stops (up to six of them,
+    spread from its first to its last: never a stop the table does not have) against focus, every cell a
+    report as the table's."""
     import warnings
 
     from ..errors import PhysCamWarning
-    from ..onset.dof_plot import chart_fstops, dof_chart_data
+    from ..onset.dof_plot import dof_chart_data
     from ._common import resolve_sensor
 
     lens, sensor = getattr(args, "loaded_lens", None), resolve_sensor(args)
@@ -236,38 +239,56 @@ def _card_chart(args):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PhysCamWarning)
         report = cell_report(args, lens, sensor, args.fstops[0], marks[len(marks) // 2] if marks else 3000.0)
-        stops = list(args.fstops) if len(args.fstops) <= 6 else chart_fstops(report.fstop)
+        stops = list(args.fstops)
+        if len(stops) > CHART_STOPS:
+            stops = [stops[round(k * (len(stops) - 1) / (CHART_STOPS - 1))] for k in range(CHART_STOPS)]
         data = dof_chart_data(report, lambda n, m: cell_report(args, lens, sensor, n, m), fstops=stops)
     return report, data
 
 
-@styled
-def card(d, path, *, units: str = "m", force: bool = False, chart=None):
-    """A printable depth-of-field card (A5 landscape): focus marks down, f-stops across, near / far /
-    total in each cell, hyperfocal at the foot; with ``chart`` (a report and its
-    :func:`physcam.onset.dof_plot.dof_chart_data`), the DOF chart of the set's apps below the table;
-    PDF, PNG or SVG through :func:`physcam.figures.save_figure`."""
+#: The most f-stops the card's chart draws (its bands stay readable).
+CHART_STOPS = 6
 
-    from ..figures import new_figure, save_figure
+
+@styled
+def card(d, path, *, units: str = "m", force: bool = False, chart=None, page: str = "a4"):
+    """Write :func:`card_figure` to ``path`` (PDF, PNG or SVG) through :func:`physcam.figures.save_figure`."""
+    from ..figures import save_figure
+
+    return save_figure(card_figure(d, units=units, chart=chart, page=page), path, force=force)
+
+
+@styled
+def card_figure(d, *, units: str = "m", chart=None, page: str = "a4"):
+    """A printable depth-of-field card on one A4 or US Letter page (``page``, portrait): focus marks down,
+    f-stops across, near / far / total in each cell, hyperfocal at the foot; with ``chart`` (a report and
+    its :func:`physcam.onset.dof_plot.dof_chart_data`), the DOF chart of the set's apps below the table."""
+
+    from ..analysis.lens_card import PAGES
+    from ..figures import new_figure
     from ..units import format_distance
 
     labels, heads, cells = grid(d, units)
     nrow, ncol = len(labels) + 2, len(heads) + 1
-    table_in = min(11.0, max(3.0, 0.5 * nrow + 0.9))  # A5 landscape width, taller for long tables
+    page_w, h = PAGES[page]
     chart_in = 4.2 if chart is not None else 0.0
-    fig = new_figure(figsize=(8.27, table_in + chart_in))
-    h = table_in + chart_in
-    ax = fig.add_axes((0.03, (chart_in + 0.06 * table_in) / h, 0.94, (0.86 * table_in - 0.25) / h))  # 2 title lines
+    table_in = min(h - chart_in - 0.5, max(3.0, 0.5 * nrow + 0.9))  # taller for long tables, within the page
+    fig = new_figure(figsize=(page_w, h))
+    top = h - 0.15  # the table and its title from the top of the page, the chart below it
+    ax = fig.add_axes((0.03, (top - 0.92 * table_in) / h, 0.94, (0.86 * table_in - 0.25) / h))  # 2 title lines
     if chart is not None:
         from ..onset.dof_plot import draw_dof_chart
 
-        draw_dof_chart(fig.add_axes((0.09, 0.75 / h, 0.88, (chart_in - 1.1) / h)), *chart, units=units)
+        bottom = top - table_in - chart_in + 0.75
+        draw_dof_chart(fig.add_axes((0.09, bottom / h, 0.88, (chart_in - 1.1) / h)), *chart, units=units)
     ax.set_axis_off()
     text = [["focus", *heads]]
     for lab, row in zip(labels, cells):
         text.append([lab, *(f"{near}\n{far}\n({total})" for near, far, total in row)])
-    text.append(["hyperfocal distance", *(format_distance(h["hyperfocal_from_film_mm"], units) for h in d["hyperfocal"])])
-    tab = ax.table(cellText=text, cellLoc="center", bbox=(0.0, 0.0, 1.0, 1.0))
+    text.append(["hyperfocal", *(format_distance(hf["hyperfocal_from_film_mm"], units) for hf in d["hyperfocal"])])
+    first = 1.3 / (ncol + 0.3)  # the label column a little wider than the others
+    tab = ax.table(cellText=text, cellLoc="center", bbox=(0.0, 0.0, 1.0, 1.0),
+                   colWidths=[first] + [(1.0 - first) / (ncol - 1)] * (ncol - 1))
     tab.auto_set_font_size(False)
     tab.set_fontsize(6.5 if ncol > 6 or nrow > 10 else 8)
     for (r, c), cell in tab.get_celld().items():
@@ -277,7 +298,7 @@ def card(d, path, *, units: str = "m", force: bool = False, chart=None):
             cell.set_text_props(weight="bold")
     from ..figures import fit_title
 
-    fig.suptitle(fit_title(_title(d, units), 0.95 * 8.27, fontsize=8), fontsize=8)
+    fig.suptitle(fit_title(_title(d, units), 0.95 * page_w, fontsize=8), fontsize=8, y=(h - 0.05) / h, va="top")
     fig.text(0.5, 0.08 / h, "each cell: near / far / (total depth of field); physcam dof-table", ha="center", fontsize=6,
              color="0.35")
-    return save_figure(fig, path, force=force)
+    return fig

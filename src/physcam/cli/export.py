@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import sys
 
-from ._common import add_lens_argument, FOCUS_HELP, add_units_option, distance, focus, number, numbers, whole
+from ._common import (FOCUS_HELP, FOLDER_FORCE_HELP, add_lens_argument, add_units_option, distance, focus, number, numbers,
+                      whole)
 from ._output import add_output_options, document, emit_json, print_csv
 
 
@@ -74,14 +75,15 @@ def register(sub) -> None:
     b.add_argument("--fresnel", action="store_true", help="include unpolarised Fresnel losses (uncoated surfaces)")
     b.add_argument("--width-px", type=whole("width in pixels", lo=0), default=1920, metavar="PX",
                    help="render width in pixels (height follows the sensor aspect; default 1920)")
-    b.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write the shader and script into")
-    b.add_argument("--force", action="store_true", help="overwrite existing files")
+    b.add_argument("-o", "--output", required=True, metavar="DIR",
+                   help="folder to write the shader and script into (written whole, with a physcam-manifest.json)")
+    b.add_argument("--force", action="store_true", help=FOLDER_FORCE_HELP)
     add_output_options(b, what="what was written")
     add_units_option(b)
     b.add_argument("--builtin", action="store_true",
                    help="also write builtin_<lens>.py: Blender's own camera matched to the lens at this focus "
                         "(best-match pinhole, aperture, focus distance; faster, no real-lens optics)")
-    b.set_defaults(handler=run_blender)
+    b.set_defaults(handler=run_blender, output_folders=("output",))
     e = s.add_parser("blender-extension", help="write the physcam Blender extension (physcam-<version>.zip)",
                      description="Write DIR/physcam-<version>.zip, a Blender 4.2+ extension: a Camera Properties "
                                  "panel with real lenses whose focus and f-stop animate in Cycles. Install it with "
@@ -192,6 +194,7 @@ def run_blender(args) -> int:
     from ..export.blender import write_blender_camera
     from ..optics.state import camera_state
     from ..trace.aperture import Aperture
+    from ._common import output_folder, relocated
 
     t0 = time.perf_counter()
     lens = _prepare(args)
@@ -204,13 +207,18 @@ def run_blender(args) -> int:
         aperture = Aperture(int(args.blades or 0), args.blade_angle, args.roundness, args.density)
     w = int(args.width_px)
     h = max(1, int(round(w * args.sensor_height / args.sensor_width)))
-    state = camera_state(lens, focus_mm=args.focus, fstop=args.fstop, sensor_mm=(args.sensor_width, args.sensor_height),
-                         aperture=aperture)
-    osl, setup = write_blender_camera(args.output, state, dispersion=args.dispersion, fresnel=args.fresnel,
-                                      resolution=(w, h), name=Path(args.lens).stem, force=args.force)
+    out = Path(args.output)
     builtin = gap = None
-    if args.builtin:
-        builtin, gap = _write_builtin(args, lens, w, Path(args.output) / f"builtin_{Path(args.lens).stem}.py")
+    with output_folder(out, force=args.force, command="export blender") as tmp:  # the folder is written whole
+        state = camera_state(lens, focus_mm=args.focus, fstop=args.fstop,
+                             sensor_mm=(args.sensor_width, args.sensor_height), aperture=aperture)
+        osl, setup = write_blender_camera(tmp, state, dispersion=args.dispersion, fresnel=args.fresnel,
+                                          resolution=(w, h), name=Path(args.lens).stem)
+        if args.builtin:
+            builtin, gap = _write_builtin(args, lens, w, tmp / f"builtin_{Path(args.lens).stem}.py")
+    osl, setup = relocated([osl, setup], tmp, out)
+    if builtin is not None:
+        builtin = relocated([builtin], tmp, out)[0]
     data = {"lens": lens.name, "shader": str(osl), "setup": str(setup), "builtin": builtin and str(builtin),
             "focus_from_film_mm": None
             if args.focus == float("inf") else args.focus, "fstop": args.fstop, "sensor_mm": [args.sensor_width,
@@ -424,7 +432,8 @@ def _register_pbrt(s) -> None:
                                  "lens: fov, lensradius, focaldistance). Reports the film distance pbrt's own thick-lens "
                                  "focusing will choose next to physcam's. Scene in metres. See docs/renderman-pbrt.md.",
                      epilog=PBRT_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    b.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write the files into")
+    b.add_argument("-o", "--output", required=True, metavar="DIR",
+                   help="folder to write the files into (written whole, with a physcam-manifest.json)")
     b.add_argument("--lens", metavar="NAME_OR_FILE", help="a real lens (bundled name or prescription file)")
     b.add_argument("--focal", metavar="MM", type=distance("focal length"),
                    help="or a thin lens of this focal length (mm): the perspective camera only")
@@ -442,10 +451,10 @@ def _register_pbrt(s) -> None:
                    help="which pbrt camera to write (default both; a thin lens --focal has only perspective)")
     b.add_argument("--resolution", type=whole("resolution", lo=0), default=1920, metavar="PX",
                    help="film width in pixels (height from the sensor aspect; default 1920)")
-    b.add_argument("--force", action="store_true", help="overwrite existing files")
+    b.add_argument("--force", action="store_true", help=FOLDER_FORCE_HELP)
     add_output_options(b, what="the written paths and pbrt's numbers")
     add_units_option(b)
-    b.set_defaults(handler=run_pbrt)
+    b.set_defaults(handler=run_pbrt, output_folders=("output",))
 
 
 class _warnings_after_success:
@@ -486,7 +495,7 @@ def run_pbrt(args) -> int:
     from ..errors import InputError
     from ..export.pbrt import check_pbrt_lens, write_pbrt_camera
     from ..onset.report import ReportRequest, solve_report
-    from ._common import coc_of
+    from ._common import coc_of, output_folder, relocated
     from .report import resolve_sensor
 
     if not 16 <= args.resolution <= 65536:
@@ -511,8 +520,9 @@ def run_pbrt(args) -> int:
         report = solve_report(ReportRequest(focal_length_mm=args.focal, sensor=resolve_sensor(args), fstop=args.fstop,
                                    focus_mm=args.focus, coc=coc_of(args), lens=lens))
         name = _slug(args.lens) if args.lens else f"thin_{report.focal_length_mm:g}mm".replace(".", "_")
-        out = write_pbrt_camera(report, args.output, lens, name=name, xres=args.resolution, cameras=cameras,
-                                force=args.force)
+        with output_folder(args.output, force=args.force, command="export pbrt") as tmp:  # written whole
+            out = write_pbrt_camera(report, tmp, lens, name=name, xres=args.resolution, cameras=cameras)
+        out["written"] = dict(zip(out["written"], relocated(out["written"].values(), tmp, args.output)))
     if args.json:
         emit_json(document("export_pbrt", out, units={"length": "mm", "angle": "degree",
                                                       "pbrt": "metres (scene), mm (lens .dat)"}))
@@ -570,29 +580,22 @@ def _register_mitsuba(s) -> None:
     m.add_argument("--fps", type=number("frames per second", positive=True), default=24.0,
                    help="frame rate for the shutter interval in seconds (default 24)")
     m.add_argument("--name", default="camera", help="file name stem of the two files (default camera)")
-    m.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write <name>.xml and <name>.json into")
-    m.add_argument("--force", action="store_true", help="overwrite existing files")
+    m.add_argument("-o", "--output", required=True, metavar="DIR",
+                   help="folder to write <name>.xml and <name>.json into (written whole, with a physcam-manifest.json)")
+    m.add_argument("--force", action="store_true", help=FOLDER_FORCE_HELP)
     add_output_options(m, what="what was written")
     add_units_option(m)
-    m.set_defaults(handler=run_mitsuba)
+    m.set_defaults(handler=run_mitsuba, output_folders=("output",))
 
 
-def run_mitsuba(args) -> int:
+def _mitsuba_files(args, xml_path, json_path) -> dict:
+    """Solve the report of ``args``, write the scene XML and dict JSON, return the camera values."""
     import json
-    from pathlib import Path
 
     from ..errors import InputError
     from ..export.mitsuba import mitsuba_camera_values, mitsuba_scene_dict, mitsuba_scene_xml
-    from ..io import atomic_write, check_writable
+    from ..io import atomic_write
 
-    name = str(args.name)
-    if not name or name in (".", "..") or "/" in name or "\\" in name or "\0" in name:
-        raise InputError(f"--name must be a plain file name stem, got {name!r}")
-    if not str(args.output):
-        raise InputError("--output must name a folder")
-    xml_path, json_path = Path(args.output) / f"{name}.xml", Path(args.output) / f"{name}.json"
-    for path in (xml_path, json_path):
-        check_writable(path, force=args.force)
     report = _report(args)
     if report.focus_is_infinite:
         raise InputError("a Mitsuba thinlens sensor's focus_distance is finite: give the focus mark (e.g. --focus "
@@ -604,8 +607,25 @@ def run_mitsuba(args) -> int:
     values["thin_lens_gap"] = gap and gap.to_dict()
     if gap is not None:
         values["physcam"]["notes"].append(gap.summary())
-    atomic_write(xml_path, mitsuba_scene_xml(values), force=args.force)
-    atomic_write(json_path, json.dumps(mitsuba_scene_dict(values), indent=2, allow_nan=False) + "\n", force=args.force)
+    atomic_write(xml_path, mitsuba_scene_xml(values))
+    atomic_write(json_path, json.dumps(mitsuba_scene_dict(values), indent=2, allow_nan=False) + "\n")
+    return values
+
+
+def run_mitsuba(args) -> int:
+    from pathlib import Path
+
+    from ..errors import InputError
+    from ._common import output_folder
+
+    name = str(args.name)
+    if not name or name in (".", "..") or "/" in name or "\\" in name or "\0" in name:
+        raise InputError(f"--name must be a plain file name stem, got {name!r}")
+    if not str(args.output):
+        raise InputError("--output must name a folder")
+    xml_path, json_path = Path(args.output) / f"{name}.xml", Path(args.output) / f"{name}.json"
+    with output_folder(args.output, force=args.force, command="export mitsuba") as tmp:  # written whole
+        values = _mitsuba_files(args, tmp / xml_path.name, tmp / json_path.name)
     if args.json:
         emit_json(document("export_mitsuba", {"xml": str(xml_path), "json": str(json_path), **values},
                            units={"length": "mm", "angle": "degree", "sensor": "scene units of meters_per_unit m"}))

@@ -9,6 +9,9 @@ Examples::
   physcam lens breathing --lens canon_rf_85mm_f1_2 --sensor "Super 35" -o breathing.png --units ft
   physcam lens check --lens my_lens.toml --sensor "Super 35"
   physcam lens fix --lens my_lens.toml -o my_lens_fixed.toml --apply
+  physcam lens pack --lens my_lens.toml --focus 2m -o my_lens.lens.zip
+  physcam lens add my_lens.lens.zip
+  physcam lens zoom --lens nikon_af_s_70_200mm_f2_8e_zoom -o zoom.png
 
 Distances in the output are millimetres. ``show`` gives every cardinal point from
 the front vertex and rear vertex (signed, + toward the film) and from the film
@@ -20,10 +23,14 @@ from __future__ import annotations
 from ..errors import PhysCamError
 from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number, whole
 from ._output import add_output_options
+from ._zoom import add_zoom_option, register_zoom, zoom_info, zoomed
 
 
 def register(sub) -> None:
-    p = sub.add_parser("lenses", help="list the bundled lens library (focal length, f-number, format)")
+    p = sub.add_parser("lenses", help="list the lens library, bundled and yours (focal length, f-number, source, "
+                                      "licence)")
+    p.add_argument("--library", choices=("all", "bundled", "user"), default="all",
+                   help="which lenses: all (default), the bundled ones, or yours (installed with `physcam lens add`)")
     add_output_options(p, csv=True, what="the library")
     p.set_defaults(handler=run_lenses)
 
@@ -44,6 +51,7 @@ def register(sub) -> None:
         q.add_argument("--focus-method", choices=("auto", "unit", "internal"), default="auto",
                        help="unit (whole lens moves) or internal (focus groups); auto: internal when the lens has groups")
         add_lenient(q)
+        add_zoom_option(q)
 
     s = lsub.add_parser("show", help="print the Gaussian (paraxial) data of a lens")
     common(s)
@@ -100,8 +108,10 @@ def register(sub) -> None:
     add_output_options(k, what="the card's numbers")
     k.set_defaults(handler=run_card)
 
-    c = lsub.add_parser("check", help="report what is inconsistent in a lens file (surface, file line, numbers)")
-    add_lens_argument(c, help="bundled lens name or a lens file (read without validation)")
+    c = lsub.add_parser("check", help="report what is inconsistent in a lens file or lens archive (surface, file line, "
+                                      "numbers)")
+    add_lens_argument(c, help="bundled lens name, a lens file (read without validation) or a lens archive "
+                              "(NAME.lens.zip: also its members, checksums, provenance and USD file)")
     c.add_argument("--sensor", default=None,
                    help="also trace the on-axis beam, vignetting and image circle at this sensor's corner "
                         "(see `physcam sensors`)")
@@ -118,6 +128,49 @@ def register(sub) -> None:
     f.add_argument("--force", action="store_true", help="overwrite an existing output file")
     add_output_options(f, what="the repairs")
     f.set_defaults(handler=run_fix)
+
+    _register_archives(lsub)
+    register_zoom(lsub, add_lens_argument, add_sensor_options, add_output_options, number)
+
+
+def _register_archives(lsub) -> None:
+    """``lens pack`` and ``lens add``: lens archives (docs/lens-library.md)."""
+    k = lsub.add_parser("pack", help="publish a lens as one archive: prescription, USD lens file, lens card, provenance",
+                        description="Write a lens archive (docs/lens-library.md): the prescription with its provenance "
+                                    "(lens.toml), a USD vendor lens file with the detailed model, its best-match pinhole "
+                                    "and characterization variants (lens.usda), the lens card (card.pdf) and the "
+                                    "provenance record (provenance.json), listed with checksums in manifest.json.")
+    add_lens_argument(k)
+    k.add_argument("-o", "--output", required=True, metavar="ARCHIVE", help="the archive to write (NAME.lens.zip)")
+    k.add_argument("--slug", default=None, help="the lens's name in a library (default: made from the lens name)")
+    k.add_argument("--focus", type=focus("focus distance"), default=float("inf"),
+                   help=f"focus mark from the film plane of the USD pinhole and the card (default infinity; {FOCUS_HELP})")
+    k.add_argument("--fstop", type=number("f-stop", positive=True), default=None,
+                   help="f-stop of the USD pinhole (default: wide open)")
+    add_sensor_options(k)
+    k.add_argument("--characterizations", metavar="CSV", default=None,
+                   help="measuring runs as USD characterization variants: a CSV with a `variant` (or `date`) column and "
+                        "one column per measured value (numbers or text)")
+    k.add_argument("--source", default=None, help="the primary source, when the lens file's [provenance] gives none")
+    k.add_argument("--licence", default=None, metavar="SPDX",
+                   help="the file's licence (an SPDX identifier such as CC-BY-4.0), when the lens file gives none")
+    k.add_argument("--draft", action="store_true", help="a quick lens card (fewer fields and rays)")
+    k.add_argument("--force", action="store_true", help="overwrite an existing archive")
+    add_units_option(k)
+    add_lenient(k)
+    add_output_options(k, what="what was written")
+    k.set_defaults(handler=run_pack)
+
+    a = lsub.add_parser("add", help="install a lens archive into your lens library (after `physcam lens check` "
+                                    "finds no error)",
+                        description="Check a lens archive as `physcam lens check` does and, when it has no error, "
+                                    "install it into your lens library: $PHYSCAM_LENS_LIBRARY, else "
+                                    "$XDG_DATA_HOME/physcam/lenses, else ~/.local/share/physcam/lenses, one folder per "
+                                    "lens. Its name then works wherever a lens is asked for.")
+    a.add_argument("archive", metavar="ARCHIVE", help="the lens archive (NAME.lens.zip, from `physcam lens pack`)")
+    a.add_argument("--force", action="store_true", help="replace an installed lens of the same name")
+    add_output_options(a, what="what was installed")
+    a.set_defaults(handler=run_add)
 
 
 #: Units of documents that carry wavelengths too.
@@ -166,14 +219,14 @@ def _json_float(v):
     return None if (v is None or (isinstance(v, float) and not math.isfinite(v))) else v
 
 
-def lenses_document() -> list[dict]:
-    """The bundled lenses as ``physcam lenses --json`` prints them (and ``physcam serve`` answers)."""
+def lenses_document(library: str = "all") -> list[dict]:
+    """The library's lenses as ``physcam lenses --json`` prints them (and ``physcam serve`` answers)."""
     from ..errors import PhysCamError
     from ..lens.library import list_lenses, load_lens
     from ..optics.paraxial import gaussian
 
     out = []
-    for rec in list_lenses():
+    for rec in list_lenses(library):
         d = rec.to_dict()
         try:
             g = gaussian(load_lens(rec.slug))
@@ -184,35 +237,45 @@ def lenses_document() -> list[dict]:
     return out
 
 
+def _lens_notes(d: dict) -> list[str]:
+    notes = []
+    if d["anamorphic"]:
+        notes.append(f"anamorphic {d['squeeze']:g}x")
+    if d["has_focus_groups"]:
+        notes.append("internal focus")
+    if d["t_stop"] is not None:
+        notes.append(f"T{d['t_stop']:g}")
+    if d["corrected"]:
+        notes.append("corrected")
+    if d["primary_source_checked"] is False:
+        notes.append("not checked against its source")
+    if d["library"] == "user":
+        notes.append("your library")
+    return notes
+
+
 def run_lenses(args) -> int:
     from ._output import Table, document, emit_json, print_csv, print_table
 
-    out = lenses_document()
+    out = lenses_document(getattr(args, "library", "all"))
     if args.json:
         emit_json(document("lenses", {"lenses": out}))
         return 0
     if args.csv:
         print_csv(out)
         return 0
-    t = Table("bundled lenses (paraxial EFL and f-number at the d line, stop as in the file)",
-              ("name (for physcam lens)", "EFL mm", "f/", "format", "lens and notes"),
-              justify=("left", "right", "right", "left", "left"))
+    t = Table("lens library (paraxial EFL and f-number at the d line, stop as in the file)",
+              ("name (for physcam lens)", "EFL mm", "f/", "lens and notes", "source", "licence"),
+              justify=("left", "right", "right", "left", "left", "left"))
     for d in out:
-        notes = []
-        if d["anamorphic"]:
-            notes.append(f"anamorphic {d['squeeze']:g}x")
-        if d["has_focus_groups"]:
-            notes.append("internal focus")
-        if d["corrected"]:
-            notes.append("corrected")
-        t.add_row(d["slug"], _fmt(d["efl_mm"], 2), _fmt(d["f_number"], 2), d["original_format"] or "-",
-                  "; ".join([d["name"], *notes]))
+        t.add_row(d["slug"], _fmt(d["efl_mm"], 2), _fmt(d["f_number"], 2), "; ".join([d["name"], *_lens_notes(d)]),
+                  d["source"] or "-", d["licence"] or "-")
     print_table(t)
     return 0
 
 
 def _load(args):
-    return load_lens_arg(args.lens, getattr(args, "lenient", False))
+    return zoomed(load_lens_arg(args.lens, getattr(args, "lenient", False)), args)
 
 
 def _meridians(p):
@@ -250,13 +313,19 @@ def show_data(args):
 def show_document(args) -> dict:
     """The document ``physcam lens show --json`` prints (and ``physcam serve`` answers)."""
     p, _, data, focus_info = show_data(args)
-    return _show_document(p, data, focus_info)
+    doc = _show_document(p, data, focus_info)
+    if zoom_info(args, p) is not None:
+        doc["zoom"] = zoom_info(args, p)
+    return doc
 
 
 def _show_document(p, data, focus_info) -> dict:
     from ._output import document
 
+    from ..lens.provenance import provenance_of
+
     return document("lens_show", mark_repaired({"lens": p.name, "squeeze": p.squeeze, "focus": focus_info,
+                                                "provenance": provenance_of(p).to_dict(),
                                                 "meridians": {a: g.to_dict() for a, g in data.items()},
                                                 "points": show_points(data)}, p),
                     units=WAVE_UNITS)
@@ -293,7 +362,10 @@ def run_show(args) -> int:
 
     p, st, data, focus_info = show_data(args)
     if args.json:
-        emit_json(_show_document(p, data, focus_info))
+        doc = _show_document(p, data, focus_info)
+        if zoom_info(args, p) is not None:
+            doc["zoom"] = zoom_info(args, p)
+        emit_json(doc)
         return 0
     if args.csv:
         from ._output import print_csv
@@ -303,6 +375,7 @@ def run_show(args) -> int:
     g0 = data["y"]
     print(f"{p.name}  (wavelength {g0.wavelength_nm:g} nm, focus {format_distance(st.focus_from_film_mm, units_of(args))} "
           f"from the film, {st.method} focusing, back focus {st.back_focus_mm:.3f} mm)")
+    _print_provenance(p)
     t = Table("first-order data (mm; magnification < 0: an inverted image)", ["quantity"])
     for a in data:
         t.add_column(f"{a.upper()} meridian", justify="right")
@@ -329,6 +402,18 @@ def run_show(args) -> int:
             t.add_row(point.replace("_", " "), *[_fmt(pos[ref][point]) for ref, _ in refs])
         print_table(t)
     return 0
+
+
+def _print_provenance(p) -> None:
+    """The lines ``lens show`` prints above its tables: where the lens's numbers come from, its licence."""
+    from ..lens.provenance import provenance_of
+
+    prov = provenance_of(p)
+    if prov.source is None and prov.licence is None:
+        return
+    checked = {True: "; every number checked against it", False: "; numbers not checked against it"}
+    print(f"source: {prov.source or 'not given'}{checked.get(prov.primary_source_checked, '')}")
+    print(f"licence: {prov.licence or 'not given'}")
 
 
 def diagram_options(args) -> dict:
@@ -407,10 +492,13 @@ def run_breathing(args) -> int:
     if args.json:
         emit_json(document("lens_breathing", mark_repaired(
             {"lens": p.name, "sensor": sensor_name, "sensor_width_mm": width, "rows": [r.to_dict() for r in rows],
-             "plot": None if path is None else str(path)}, p)))
+             "plot": None if path is None else str(path), "zoom": zoom_info(args, p)}, p)))
         return 0
     if args.csv:
         print_csv([r.to_dict() for r in rows])
+        return 0
+    if p.is_anamorphic:
+        _print_breathing_per_axis(p, rows, sensor_name, units)
         return 0
     t = Table(f"{p.name}: focus breathing, {sensor_name} sensor (horizontal field, X meridian)",
               ("focus from film", "EFL (mm)", "HFOV (deg)", "framing focal length (mm)", "magnification",
@@ -425,6 +513,22 @@ def run_breathing(args) -> int:
     return 0
 
 
+def _print_breathing_per_axis(p, rows, sensor_name, units) -> None:
+    """An anamorphic lens's breathing: horizontal (X) and vertical (Y) framing focal lengths and pupils."""
+    from ..units import format_distance
+    from ._output import Table, print_table
+
+    t = Table(f"{p.name}: focus breathing per axis, {sensor_name} sensor (X horizontal, Y vertical meridian)",
+              ("focus from film", "framing f H (mm)", "framing f V (mm)", "squeeze", "HFOV (deg)",
+               "pupil H (mm)", "pupil V (mm)", "FOV change (%)"), justify=["right"] * 8)
+    for r in rows:
+        t.add_row(format_distance(r.focus_from_film_mm, units), _fmt(r.breathing_focal_length_mm, 3),
+                  _fmt(r.vertical_breathing_focal_length_mm, 3), _fmt(r.breathing_squeeze, 4), _fmt(r.hfov_deg, 3),
+                  _fmt(r.entrance_pupil_from_film_mm, 2), _fmt(r.vertical_entrance_pupil_from_film_mm, 2),
+                  _fmt(r.fov_change_pct, 2))
+    print_table(t)
+
+
 # ---- lens check / lens fix ----------------------------------------------------------------
 def run_check(args) -> int:
     from ..errors import LensFileError
@@ -437,9 +541,13 @@ def run_check(args) -> int:
 
         find_sensor(args.sensor)  # an unknown name is refused before any work
     from ..analysis.lens_probes import ray_probes
+    from ..usd.lens_archive import check_archive, is_archive
 
-    findings = check(args.lens, probes=ray_probes(args.sensor))
-    unreadable = next((f for f in findings if f.code == "unreadable"), None)
+    if is_archive(args.lens):
+        findings = check_archive(args.lens, probes=ray_probes(args.sensor))
+    else:
+        findings = check(args.lens, probes=ray_probes(args.sensor))
+    unreadable = next((f for f in findings if f.code in ("unreadable", "archive_unreadable")), None)
     if unreadable is not None:  # no such lens, or not a lens file at all: bad input (exit 2), not a finding
         raise LensFileError(unreadable.message, path=None, line=None)
     # a checker: exit 1 when it finds an error in the lens (docs/cli.md, "Exit status"); warnings too with --strict
@@ -520,6 +628,79 @@ def run_fix(args) -> int:
     for line in diff:
         con.print(f"  {line}", soft_wrap=True)
     con.print(f"wrote {written}" if written else f"dry run: add --apply to write {args.output}")
+    return 0
+
+
+# ---- lens pack / lens add -------------------------------------------------------------------
+def _read_runs(csv_path) -> dict:
+    """variant -> {measured name: number or text} from the CSV of ``lens pack --characterizations``."""
+    import csv
+    import re
+    from pathlib import Path
+
+    from ..errors import InputError, LensFileError
+
+    p = Path(csv_path)
+    try:
+        rows = list(csv.DictReader(p.read_text(encoding="utf-8-sig").splitlines()))
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"cannot read {p}: {exc}") from None
+    out = {}
+    for line, row in enumerate(rows, start=2):
+        label = row.get("variant") or row.get("date")
+        if not label:
+            raise LensFileError("a row without a variant (or date)", str(p), line)
+        name = label if "variant" in row else "d" + re.sub(r"[^A-Za-z0-9]", "_", label)
+        values = {}
+        for k, v in row.items():
+            if k in ("variant", "date") or v in (None, ""):
+                continue
+            if not re.fullmatch(r"[A-Za-z0-9_]+", k or ""):
+                raise LensFileError(f"column {k!r}: a measured value's name is letters, digits and underscores", str(p), 1)
+            try:
+                values[k] = float(v)
+            except ValueError:
+                values[k] = v
+        out[name] = values
+    if not out:
+        raise LensFileError("no characterization rows", str(p))
+    return out
+
+
+def run_pack(args) -> int:
+    """``physcam lens pack``: the lens archive (:func:`physcam.usd.lens_archive.pack_lens`)."""
+    from ..io import check_writable
+    from ..usd.lens_archive import read_manifest, pack_lens
+    from ._common import resolve_focus, resolve_sensor
+    from ._output import document, emit_json
+
+    check_writable(args.output, force=args.force)  # before the seconds of work
+    p = _load(args)
+    sensor = resolve_sensor(args)
+    (mark,) = resolve_focus([args.focus], lens=p, sensor=sensor, args=args)
+    runs = _read_runs(args.characterizations) if args.characterizations else None
+    path = pack_lens(p, args.output, slug=args.slug, focus_mm=mark, fstop=args.fstop, sensor=sensor,
+                     characterizations=runs, source=args.source, licence=args.licence, draft=args.draft,
+                     force=args.force)
+    m = read_manifest(path)
+    if args.json:
+        emit_json(document("lens_pack", {"archive": str(path), "slug": m["slug"], "lens": m["name"],
+                                         "files": m["files"], "characterizations": m["characterizations"]}))
+        return 0
+    print(f"wrote {path}: lens {m['slug']!r} ({m['name']}), {', '.join(m['files'])} and manifest.json")
+    return 0
+
+
+def run_add(args) -> int:
+    """``physcam lens add``: check a lens archive and install it (:func:`physcam.usd.lens_archive.add_lens`)."""
+    from ..usd.lens_archive import add_lens
+    from ._output import document, emit_json
+
+    slug, folder = add_lens(args.archive, force=args.force)
+    if args.json:
+        emit_json(document("lens_add", {"archive": args.archive, "slug": slug, "folder": str(folder)}))
+        return 0
+    print(f"installed {slug} into {folder} (`physcam lens show --lens {slug}`)")
     return 0
 
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 import sys
 
 from ._common import distance, focus, number, numbers, whole
+from ._live_record import resolve_sensor_opt as _resolve_sensor_opt
+from ._live_record import source_id
 from ._output import add_output_options, document, emit_json
 
 EPILOG = """\
@@ -14,13 +16,14 @@ examples:
   physcam live send --lens dgauss_50mm --sensor "ALEXA 35" --focus 2m --focus-to 5m --fstop 2.8 --frames 96
   physcam live send --lens navarro_anamorphic_2x --focus 3m --fps 29.97 --timecode "01:00:00;00" --print
   physcam live record take.usda --lens dgauss_50mm --fiz fiz.csv --count 48
+  physcam live recover take.usda.journal
   physcam live play take.usda --port 55555
   physcam live send --clip tests/data/camera-metadata/arri/B001C001_180327_R1ZA.mov.csv --frames 2 --print
   physcam live play --clip tests/data/camera-metadata/arri/B001C001_180327_R1ZA.mov.csv --rate 0
   physcam live wall wall.usda --kind curved --radius 8 --width 14
   physcam live frustum take.usda --wall wall.usda frustum.usda --overscan 10 --latency-ms 40
   physcam live frustum take.usda --wall wall.usda frustum.usda --overscan 10 --overscan-mode ndisplay
-Receivers stop after --duration seconds or --count samples, or on Ctrl-C, SIGTERM or SIGHUP; the file is\nwritten then.
+Receivers stop after --duration seconds or --count samples, or on Ctrl-C, SIGTERM or SIGHUP; the file is\nwritten then. While it records, the take is kept in a journal beside the file (take.usda.journal):\nphyscam live recover writes a take whose recorder was killed or whose disk was full.
 """
 
 
@@ -77,25 +80,11 @@ def _clip_arg(p) -> None:
                         "docs/camera-metadata.md), sent frame by frame at its frame rate with its timecodes")
 
 
-def register(sub) -> None:
-    import argparse
-
-    p = sub.add_parser("live", help="OpenTrackIO camera tracking: validate, record to USD, send, LED-wall frustum",
-                       description="Live camera metadata (OpenTrackIO 1.0.1): validate samples, record a stream "
-                                   "as a time-sampled USD camera with a per-frame lens report, send physcam's camera "
-                                   "or a recording out, and the LED wall's inner frustum (docs/live.md).",
-                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    s = p.add_subparsers(dest="live_command", metavar="ACTION")
-
-    v = s.add_parser("validate", help="validate OpenTrackIO samples (JSON or CBOR files) against the 1.0.1 schema")
-    v.add_argument("files", nargs="+", help="sample files: .json (one sample, or one per line) or .cbor")
-    add_output_options(v, what="the results")
-    v.set_defaults(handler=run_validate)
-
+def _record_parser(s) -> None:
     r = s.add_parser("record", help="record a stream into a time-sampled USD camera (and a lens report)")
     r.add_argument("file", help="output .usda/.usd/.usdc")
     _network_args(r, receive=True)
-    r.add_argument("--count", type=_count, default=None, help="stop after this many samples")
+    r.add_argument("--count", type=_count, default=None, help="stop once the source recorded has this many samples")
     r.add_argument("--report", metavar="FILE", help="also write the per-frame lens report (.csv or .json)")
     _sensor_args(r)
     r.add_argument("--focal", type=distance("focal length"), help="pinhole focal length when the stream has none")
@@ -111,9 +100,57 @@ def register(sub) -> None:
     r.add_argument("--meters-per-unit", type=number("meters per unit", positive=True), default=0.01,
                    help="stage unit (default 0.01: centimetres)")
     r.add_argument("--path", default="/Cameras/Camera", help="camera prim path")
+    r.add_argument("--source", type=source_id, metavar="ID",
+                   help="record the source with this sourceId (urn:uuid:...; default: the source that sent the "
+                        "most samples, the first heard of those tied); the others are named in the summary")
     r.add_argument("--force", action="store_true", help="overwrite existing files")
     add_output_options(r, what="the summary")
     r.set_defaults(handler=run_record, output_args=("file", "report"))
+
+
+def _recover_parser(s) -> None:
+    rc = s.add_parser("recover", help="write the take an unfinished journal holds (a recorder killed, a full disk)",
+                      description="Write the take kept in a journal (FILE.journal, written beside the output while "
+                                  "physcam live record runs) as live record would have: the USD camera and the "
+                                  "report it names, under their names or the first free ones beside them. The "
+                                  "options given override the recording's own (docs/live.md).")
+    rc.add_argument("journal", help="the journal, e.g. take.usda.journal")
+    rc.add_argument("-o", "--output", dest="file", default=None,
+                    help="output .usda/.usd/.usdc (default: the recording's, beside the journal)")
+    rc.add_argument("--report", metavar="FILE", help="the lens report (default: the recording's, if it asked one)")
+    _sensor_args(rc)
+    rc.add_argument("--focal", type=distance("focal length"), help="pinhole focal length when the stream has none")
+    rc.add_argument("--lens", help="bundled lens name or prescription file (as live record)")
+    rc.add_argument("--fiz", metavar="CSV", help="encoder calibration table (as live record)")
+    rc.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop when the stream has none")
+    rc.add_argument("--focus", type=focus("focus distance", allow_inf=False), help="focus mark when the stream has none")
+    rc.add_argument("--fps", type=number("frame rate", positive=True, hi=1000.0), help="time codes per second")
+    rc.add_argument("--meters-per-unit", type=number("meters per unit", positive=True), default=None,
+                    help="stage unit (default: the recording's)")
+    rc.add_argument("--path", default=None, help="camera prim path (default: the recording's)")
+    rc.add_argument("--source", type=source_id, metavar="ID", help="record this sourceId (default: the recording's rule)")
+    rc.add_argument("--force", action="store_true", help="overwrite existing files")
+    add_output_options(rc, what="the summary")
+    rc.set_defaults(handler=run_recover, output_args=("file", "report"))
+
+
+def register(sub) -> None:
+    import argparse
+
+    p = sub.add_parser("live", help="OpenTrackIO camera tracking: validate, record to USD, send, LED-wall frustum",
+                       description="Live camera metadata (OpenTrackIO 1.0.1): validate samples, record a stream "
+                                   "as a time-sampled USD camera with a per-frame lens report, send physcam's camera "
+                                   "or a recording out, and the LED wall's inner frustum (docs/live.md).",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    s = p.add_subparsers(dest="live_command", metavar="ACTION")
+
+    v = s.add_parser("validate", help="validate OpenTrackIO samples (JSON or CBOR files) against the 1.0.1 schema")
+    v.add_argument("files", nargs="+", help="sample files: .json (one sample, or one per line) or .cbor")
+    add_output_options(v, what="the results")
+    v.set_defaults(handler=run_validate)
+
+    _record_parser(s)
+    _recover_parser(s)
 
     se = s.add_parser("send", help="stream physcam's camera and lens as OpenTrackIO (a focus pull, a pan), or a "
                                    "recorded clip's camera metadata")
@@ -249,104 +286,6 @@ def run_validate(args) -> int:
 
 
 # --- record --------------------------------------------------------------------------------
-class _Status:
-    """Rate, counters and last timecode on stderr, redrawn a few times a second at a terminal."""
-
-    def __init__(self, enabled: bool):
-        self.enabled = enabled and sys.stderr.isatty()
-        self._live = None
-
-    def __enter__(self):
-        if self.enabled:
-            from rich.live import Live
-
-            from ._common import console
-
-            self._live = Live(console=console(stderr=True), refresh_per_second=4, transient=True)
-            self._live.__enter__()
-        return self
-
-    def update(self, frames: int, rate: float, counters: dict, timecode, elapsed: float) -> None:
-        if self._live is None:
-            return
-        from rich.table import Table
-
-        t = Table(title="physcam live record", show_header=False, box=None)
-        t.add_row("elapsed", f"{elapsed:.1f} s")
-        t.add_row("recorded", f"{frames} samples ({rate:.1f}/s)")
-        t.add_row("last timecode", str(timecode or "-"))
-        for k, v in counters.items():
-            t.add_row(k.replace("_", " "), str(v))
-        self._live.update(t)
-
-    def __exit__(self, *exc):
-        if self._live is not None:
-            self._live.__exit__(*exc)
-        return False
-
-
-def _resolve_sensor_opt(args):
-    if args.sensor is None and args.sensor_width is None and args.sensor_height is None:
-        return None
-    from .report import resolve_sensor
-
-    return resolve_sensor(args)
-
-
-class _StopSignals:
-    """While recording, SIGINT (Ctrl-C), SIGTERM (a process manager) and SIGHUP (the terminal closed)
-    end the recording, which is then written; :meth:`restore` and leaving give the old handlers back."""
-
-    NAMES = ("SIGINT", "SIGTERM", "SIGHUP")
-
-    def __init__(self):
-        self.received = None
-        self._old: dict = {}
-
-    def _handle(self, signum, frame) -> None:
-        self.received = signum
-
-    def __enter__(self):
-        import signal
-        import threading
-
-        if threading.current_thread() is threading.main_thread():  # only the main thread may set handlers
-            for name in self.NAMES:
-                sig = getattr(signal, name, None)  # Windows has no SIGHUP
-                if sig is not None:
-                    self._old[sig] = signal.signal(sig, self._handle)
-        return self
-
-    def restore(self, name: str) -> None:
-        import signal
-
-        sig = getattr(signal, name, None)
-        if sig in self._old:
-            signal.signal(sig, self._old.pop(sig))
-
-    def __exit__(self, *exc) -> bool:
-        for name in self.NAMES:
-            self.restore(name)
-        return False
-
-
-def _take(item, statics: dict, frames: list, refusals: list) -> None:
-    """Add a received sample to the take as a frame; the static block is remembered per source, and
-    a sample physcam cannot read (a transform chain with no camera orientation, a distance beyond
-    millimetres) is refused with its reason, never ending the recording."""
-    from ..errors import PhysCamError
-    from ..live.frames import frame_from_sample
-
-    sample = item.sample
-    source = (sample.get("sourceId"), sample.get("sourceNumber"))
-    if "static" in sample:
-        statics[source] = sample["static"]
-    try:
-        frames.append(frame_from_sample(sample, static=statics.get(source)))
-    except PhysCamError as exc:
-        refusals.append(f"sample {sample.get('timing', {}).get('sequenceNumber', item.sequence)}: {exc}")
-
-
 def _needs_live() -> None:
     """The OpenTrackIO commands need the 'live' extra (schema validation, CBOR): say so up front."""
     from ..extras import require_extra
@@ -363,115 +302,19 @@ def _needs_usd(what: str) -> None:
 
 
 def run_record(args) -> int:
-    import time
-
-    from ..errors import InputError
-    from ..io import check_writable
-    from ..live.receiver import Receiver, multicast_group
-    from ..live.record import MAX_RECORDED_FRAMES
-
     _needs_live()
     _needs_usd("recording a take to USD (physcam live record)")
-    sensor = _resolve_sensor_opt(args)
-    if args.focus is not None:
-        from ._common import resolve_focus
-        from .report import resolve_sensor
+    from ._live_record import run_record as record
 
-        args.focus = resolve_focus(args.focus, focal_length_mm=args.focal, fstop=args.fstop,
-                                   sensor=sensor or resolve_sensor(args), args=args)
-    check_writable(args.file, force=args.force)
-    if args.report:
-        check_writable(args.report, force=args.force)
-        if not args.report.lower().endswith((".csv", ".json")):
-            raise InputError("--report is written as .csv or .json")
-    if not args.file.lower().endswith((".usda", ".usd", ".usdc")):
-        raise InputError(f"{args.file}: a USD file name ends in .usda, .usd or .usdc")
-    group = multicast_group(args.multicast) if args.multicast is not None else None
-    receiver = Receiver(args.port, host=args.host, group=group, interface=args.interface,
-                        modulus=args.modulus if args.modulus == "auto" else int(args.modulus))
-    frames, statics, refusals = [], {}, []
-    t0 = time.monotonic()
-    last_tc = None
-    interrupted = False
-    with _StopSignals() as stop:
-        with receiver, _Status(not args.json) as status:
-            next_draw = 0.0
-            try:
-                while stop.received is None:
-                    now = time.monotonic()
-                    if args.duration is not None and now - t0 >= args.duration:
-                        break
-                    if args.count is not None and len(frames) >= args.count:
-                        break
-                    item = receiver.get(timeout=0.05)
-                    if item is not None:
-                        _take(item, statics, frames, refusals)
-                        last_tc = (frames[-1].timecode if frames else None) or last_tc
-                        if len(frames) >= MAX_RECORDED_FRAMES:
-                            break
-                    if now >= next_draw:
-                        el = now - t0
-                        status.update(len(frames), len(frames) / el if el > 0 else 0.0, receiver.counters(), last_tc,
-                                      el)
-                        next_draw = now + 0.25
-            except KeyboardInterrupt:
-                interrupted = True  # Ctrl-C where no handler could be set: write what was received
-        stop.restore("SIGINT")  # a second Ctrl-C while writing aborts; SIGTERM and SIGHUP still wait for the file
-        while len(frames) < MAX_RECORDED_FRAMES:  # samples still queued when the receiver stopped
-            item = receiver.get()
-            if item is None or (args.count is not None and len(frames) >= args.count):
-                break
-            _take(item, statics, frames, refusals)
-        interrupted = interrupted or stop.received is not None
-        return _write_take(args, receiver, frames, refusals, sensor, t0, interrupted)
+    return record(args)
 
 
-def _write_take(args, receiver, frames, refusals, sensor, t0, interrupted) -> int:
-    """Solve and write the recorded frames; a frame that cannot be solved is refused, the take kept."""
-    import time
+def run_recover(args) -> int:
+    _needs_live()
+    _needs_usd("recovering a take to USD (physcam live recover)")
+    from ._live_record import run_recover as recover
 
-    from ..errors import InputError
-    from ..live.record import solve_frames, write_lens_report, write_recording_usd
-
-    counters = receiver.counters()
-    elapsed = time.monotonic() - t0
-    if not frames:
-        why = f" ({refusals[0]})" if refusals else ""
-        raise InputError(f"no valid samples arrived on port {receiver.port} in {elapsed:.1f} s "
-                         f"(received {counters['received']} packets){why}; nothing written")
-    refused: list = []
-    lens = fiz = None
-    if args.lens:
-        from ..lens.library import load_lens
-
-        lens = load_lens(args.lens)
-    if args.fiz:
-        from ..live.fiz import read_fiz_table
-
-        fiz = read_fiz_table(args.fiz)
-    solved = solve_frames(frames, sensor=sensor, rate=args.fps, focal_length_mm=args.focal, fstop=args.fstop,
-                          focus_mm=args.focus, refused=refused, lens=lens, fiz=fiz)
-    refusals = refusals + [reason for _, reason in refused]
-    if not solved:
-        raise InputError(f"no frame of the take could be recorded: {refusals[0]}; nothing written")
-    counters["refused"] = len(refusals)
-    for reason in refusals[:10]:
-        print(f"physcam: refused {reason}", file=sys.stderr)
-    if len(refusals) > 10:
-        print(f"physcam: refused {len(refusals) - 10} more samples", file=sys.stderr)
-    out = write_recording_usd(args.file, solved, rate=args.fps, meters_per_unit=args.meters_per_unit,
-                              path=args.path, force=args.force)
-    rep = write_lens_report(args.report, solved, force=args.force) if args.report else None
-    summary = {"file": str(out), "report": None if rep is None else str(rep), "frames": len(solved),
-               "seconds": round(elapsed, 3), "interrupted": interrupted, "counters": counters,
-               "first_timecode": solved[0].frame.timecode, "last_timecode": solved[-1].frame.timecode}
-    if args.json:
-        emit_json(document("live_record", summary, units={"time": "s"}))
-    else:
-        print(f"recorded {len(solved)} frames to {out}" + (f" and {rep}" if rep else "")
-              + f" ({summary['first_timecode'] or '-'} to {summary['last_timecode'] or '-'})")
-        print("  " + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in counters.items()))
-    return 0  # a signal is how a recording is ended: the file is written and that is success
+    return recover(args)
 
 
 # --- send and play ---------------------------------------------------------------------------

@@ -185,9 +185,9 @@ def run_insert(args) -> int:
         emit_json(document("microlens_insert", info))
         return 0
     print(f"wrote {args.output}: {out.name}")
-    print(f"  {args.xdim} x {args.ydim} lenslets, pitch {array.pitch_x * 1000:.4g} x {array.pitch_y * 1000:.4g} um, "
+    print(f"  {args.xdim} x {args.ydim} lenslets, pitch {array.pitch_x * 1000:.4g} x {array.pitch_y * 1000:.4g} µm, "
           f"sensor {array.sensor_offset_mm:.4g} mm behind the array, {cam.film_to_lens_mm:.4f} mm behind the lens")
-    print(f"  sub-image (exit pupil through a lenslet) {info['subimage_diameter_mm'] * 1000:.4g} um = "
+    print(f"  sub-image (exit pupil through a lenslet) {info['subimage_diameter_mm'] * 1000:.4g} µm = "
           f"{info['subimage_over_pitch']:.3f} x the pitch at the file's stop; f/{info['matched_fstop']:.3g} "
           "makes it one pitch (Ng 2005: the sub-images then tile the sensor)")
     return 0

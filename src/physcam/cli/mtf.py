@@ -1,7 +1,7 @@
 """``physcam mtf --lens LENS``: the lens maker's MTF chart, or one field's wavefront, Strehl and MTF (docs/image-quality.md).
 
-The chart: sagittal and tangential MTF at 10, 20 and 40 lp/mm against image height, white
-light (d, F, C), the lens focused at ``--focus`` and stopped to ``--fstop``; printed as a table
+The chart: sagittal and tangential MTF at 10, 20 and 40 lp/mm against image height, in the d, F
+and C lines (white light where the lens's glasses have dispersion; the chart says which), the lens focused at ``--focus`` and stopped to ``--fstop``; printed as a table
 and drawn in characters, ``-o FILE.png`` for the picture, ``--json`` and ``--csv`` (one row per
 image height and frequency) for pipelines.
 ``--field DEG`` reports one field instead: RMS and peak-to-valley wavefront, Strehl ratio and
@@ -66,7 +66,7 @@ def register(sub) -> None:
                         "Huygens PSF, wavelets summed from the exit-pupil wavefront (slower; docs/image-quality.md)")
     p.add_argument("--best-focus", type=number("best-focus frequency", positive=True), default=None, metavar="LPMM",
                    help="put the chart's film at the best focus for this frequency instead of the paraxial image plane "
-                        "of --focus (the shift is printed in um)")
+                        "of --focus (the shift is printed in µm)")
     p.add_argument("--best-focus-rule", choices=("axis", "field"), default="axis",
                    help="best focus on the axis (default) or averaged over the image by ring area, as makers weigh "
                         "a chart")
@@ -144,9 +144,9 @@ def run(args) -> int:
     from ._common import units_of
 
     foc = format_distance(math.inf if focus is None else focus, units_of(args))
-    wl = ", ".join(f"{w:g}" for w in chart.wavelengths_nm)
-    print(f"{chart.lens_name}: MTF at f/{chart.fstop:.3g}, focus {foc} from the film, {wl} nm "
+    print(f"{chart.lens_name}: MTF at f/{chart.fstop:.3g}, focus {foc} from the film "
           f"({sensor.name}, corner at {sensor.diagonal_mm / 2:.2f} mm), {args.method.upper()} method")
+    print(f"  light: {chart.spectrum}")
     print(f"  film: {chart.focus_words()}")
     print("  S = sagittal (lines radial), T = tangential (lines tangential to circles about the centre)")
     for line in chart.table().splitlines():
@@ -210,11 +210,13 @@ def _one_field(args, lens, wls, weights, freqs, focus) -> int:
     print(f"  wavefront at {wf.wavelength_nm:g} nm: RMS {wf.rms_waves:.4f} waves (to centroid "
           f"{wf.rms_to_centroid_waves:.4f}), PV {wf.pv_waves:.4f} waves")
     print(f"  Strehl ratio {ps.strehl:.4f} (Marechal estimate {wf.strehl_marechal:.4f}); Airy radius "
-          f"{ps.airy_radius_um:.2f} um")
+          f"{ps.airy_radius_um:.2f} µm")
     z = wf.zernike
     print("  Zernike (Noll, waves): " + ", ".join(f"Z{j + 1} {c:+.4f}" for j, c in enumerate(z[:11])))
-    wl = ", ".join(f"{w:g}" for w in m.wavelengths_nm)
-    print(f"  MTF ({wl} nm): " + ", ".join(f"{f:g} lp/mm S {s:.3f} T {t:.3f}" for f, s, t in
+    from ..analysis.mtf import spectrum_words
+
+    print(f"  light: {spectrum_words(lens, m.wavelengths_nm)}")
+    print("  MTF: " + ", ".join(f"{f:g} lp/mm S {s:.3f} T {t:.3f}" for f, s, t in
                                          zip(m.frequencies_lpmm, m.sagittal, m.tangential)))
     if args.output:
         print(f"wrote {args.output}")

@@ -5,7 +5,8 @@ from __future__ import annotations
 from ._common import FOCUS_HELP, coc_value, distance, focus, number
 
 EPILOG = """\
-distances accept units as said on set: 3m, 10ft, 6in, 450mm, 10'6" (a bare number is mm);
+distances accept units as said on set: 3m, 10ft, 6in, 450mm, 10'6" (a bare focus, near or far is mm,
+or feet under --units ft or units = "ft" in the user config; lengths inside the camera are mm);
 --focus also takes hyperfocal and infinity. Focus, near, far and --sensor-front are measured
 from the film plane; --h1/--h2/--pupil are distances in front of the reference plane
 (--reference film|flange). --units ft prints scene distances in feet and inches.
@@ -52,6 +53,9 @@ def register(sub) -> None:
                         "(default), moment = the second-moment diameter sqrt(8 E[r^2])")
     g.add_argument("--energy-fraction", metavar="F", type=number("energy fraction"), default=0.8,
                    help="fraction of the light within the blur diameter (default 0.8)")
+    g.add_argument("--focusing", choices=("collimated", "paraxial"), default="collimated",
+                   help="where the real lens's film sits: collimated = its best focus at the mark, as a lens "
+                        "technician sets it (default); paraxial = at the mark's paraxial image (Gaussian optics)")
     p.add_argument("--plot", metavar="FILE", help="draw the depth-of-field chart (near and far against focus, a band per "
                                                   "stop) to FILE (.png, .svg or .pdf; in feet with --units ft)")
     p.add_argument("--force", action="store_true", help="overwrite an existing --plot file")
@@ -62,6 +66,9 @@ def add_report_arguments(p) -> None:
     g = p.add_argument_group("lens and sensor")
     g.add_argument("--lens", metavar="NAME_OR_FILE",
                    help="a real lens (bundled name or prescription file): fills the technical model from it")
+    from ._zoom import add_zoom_option
+
+    add_zoom_option(g)
     g.add_argument("--focal", metavar="MM", type=distance("focal length"), help="focal length (mm)")
     g.add_argument("--fstop", metavar="N", type=number("f-stop"), help="f-stop (geometric f-number); solved from --near/--far if omitted (with --lens: wide open)")
     g.add_argument("--tstop", metavar="T", type=number("T-stop"), help="marked T-stop, compared with the effective f-stop")
@@ -73,8 +80,10 @@ def add_report_arguments(p) -> None:
     g.add_argument("--squeeze", metavar="S", type=number("squeeze"), default=1.0, help="anamorphic squeeze (default 1)")
     add_coc_option(g)
     g = p.add_argument_group("measured depth of field (inverse solve)")
-    g.add_argument("--near", metavar="DIST", type=distance("near limit"), help="measured near limit, from the film plane")
-    g.add_argument("--far", metavar="DIST", type=distance("far limit", allow_inf=True), help="measured far limit (or inf)")
+    g.add_argument("--near", metavar="DIST", type=distance("near limit", scene=True),
+                   help="measured near limit, from the film plane")
+    g.add_argument("--far", metavar="DIST", type=distance("far limit", allow_inf=True, scene=True),
+                   help="measured far limit (or inf)")
     g = p.add_argument_group("model")
     g.add_argument("--model", choices=("practical", "technical"), default="practical",
                    help="practical = thin lens; technical = datasheet principal planes")
@@ -124,7 +133,9 @@ def solve_from_args(args):
     if getattr(args, "lens", None):
         from ..lens.library import load_lens
 
-        lens = load_lens(args.lens, lenient=getattr(args, "lenient", False))
+        from ._zoom import zoomed
+
+        lens = zoomed(load_lens(args.lens, lenient=getattr(args, "lenient", False)), args)
         args.loaded_lens = lens
         if args.focal is not None:
             raise InputError("give either --lens or --focal: the lens sets its own focal length")
@@ -247,22 +258,37 @@ def real_dof_block(report, args) -> dict:
     h = report.sensor.diagonal_mm / 4 if args.dof_field is None else args.dof_field
     model = report.dof
     out = {"measure": args.blur, "energy_fraction": args.energy_fraction if args.blur == "energy" else None,
+           "focusing": args.focusing,
            "model": {"near_from_film_mm": model.near_from_film_mm,
                      "far_from_film_mm": None if model.far_is_infinite else model.far_from_film_mm}}
     for key, height in (("centre", 0.0), ("field", h)):
         try:
             r = real_depth_of_field(lens, focus_mm=report.focus_from_film_mm, fstop=report.fstop,
                                     coc_mm=report.coc_mm, image_height_mm=height, measure=args.blur,
-                                    energy_fraction=args.energy_fraction)
+                                    energy_fraction=args.energy_fraction, focusing=args.focusing)
             d = r.to_dict()
             if not (r.far_is_infinite or model.far_is_infinite):
                 d["model_deeper_pct"] = (model.total_mm / r.total_mm - 1.0) * 100.0
+                d["band_shift_mm"] = 0.5 * (r.near_from_film_mm + r.far_from_film_mm - model.near_from_film_mm
+                                            - model.far_from_film_mm)
+                d["real_deeper_pct"] = (r.total_mm / model.total_mm - 1.0) * 100.0
             out[key] = d
         except OpticsError as exc:
             out[key] = {"image_height_mm": height, "error": str(exc)}
-    out["definition"] = ("near and far where the traced blur (measure) on the film equals the CoC; model_deeper_pct: "
-                         "the model's total depth of field over the real one, minus 1, in percent")
+    out["definition"] = ("near and far where the traced blur (measure) on the film equals the CoC; focusing: "
+                         "collimated = the film at the lens's best focus for the mark, paraxial = at the mark's "
+                         "paraxial image; band_shift_mm: the real band's middle minus the model's (- nearer); "
+                         "real_deeper_pct: the real total depth over the model's, minus 1, in percent; "
+                         "model_deeper_pct: the model's over the real one, minus 1")
     return out
+
+
+def band_words(d: dict) -> str:
+    """The real band against the model's, in words: "31 mm nearer, 10 % deeper" (a real-ray result's dict)."""
+    shift, deeper = d["band_shift_mm"], d["real_deeper_pct"]
+    where = "where the model puts it" if abs(shift) < 0.5 else f"{abs(shift):.0f} mm {'nearer' if shift < 0 else 'farther'}"
+    depth = "as deep" if abs(deeper) < 0.5 else f"{abs(deeper):.0f} % {'deeper' if deeper > 0 else 'shallower'}"
+    return f"real band {where}, {depth} than the model"
 
 
 def _real_rows(real, units) -> list[tuple]:
@@ -280,9 +306,17 @@ def _real_rows(real, units) -> list[tuple]:
             continue
         far = "infinity" if d["far_is_infinite"] else format_distance(d["far_from_film_mm"], units)
         value = f"{format_distance(d['near_from_film_mm'], units)} / {far}"
-        if d.get("model_deeper_pct") is not None:
-            value += f"  (model {d['model_deeper_pct']:+.1f} % deeper)"
+        if d.get("band_shift_mm") is not None:
+            value += f"  ({band_words(d)})"
         rows.append((f"real-ray near / far ({where})", value, "film plane"))
+    if rows:
+        focusing = ("collimated: the lens's best focus at the mark" if real["focusing"] == "collimated" else
+                    "paraxial: the film at the mark's paraxial image")
+        shift = real["centre"].get("film_shift_mm")
+        if shift is not None and real["focusing"] == "collimated":
+            focusing += (f", the film {abs(shift) * 1e3:.0f} µm {'behind' if shift > 0 else 'in front of'} "
+                         "the mark's paraxial image")
+        rows.append(("real-ray focusing", focusing, ""))
     return rows
 
 

@@ -40,6 +40,7 @@ import numpy as np
 from ..errors import InputError, require_positive, require_type
 from ..lens.prescription import Prescription, require_prescription
 from ..optics.state import CameraState, camera_state, takes_camera
+from ._codetext import osl_comment, python_docstring
 from .osl import WAVELENGTH_RANGE_NM, osl_array, osl_number
 
 __all__ = ["BakedCamera", "bake_camera", "osl_camera_shader", "blender_setup_script", "write_blender_camera",
@@ -212,7 +213,7 @@ def _emit(b: BakedCamera, *, dispersion: bool, fresnel: bool) -> str:
 
     fno = "open" if b.fstop is None else f"f/{b.fstop:g}"
     focus_txt = "infinity" if math.isinf(b.focus_mm) else f"{b.focus_mm:g} mm"
-    head = [f"// {b.lens.name}: focus {focus_txt} from the film, {fno}; sensor {b.sensor_width_mm:g} x "
+    head = [f"// {osl_comment(b.lens.name)}: focus {focus_txt} from the film, {fno}; sensor {b.sensor_width_mm:g} x "
             f"{b.sensor_height_mm:g} mm; dispersion {'on' if dispersion else 'off'}, Fresnel "
             f"{'on' if fresnel else 'off'}."]
     defines, data = lens_data(b.table, b.aperture, b.wavelength_nm, b.bounds, dispersion=dispersion, fresnel=fresnel)
@@ -332,7 +333,7 @@ def blender_setup_script(shader, *, sensor_width_mm, sensor_height_mm, resolutio
         raise InputError("shader must be OSL source text (with a `shader` declaration) or a path to an .osl file")
     if not isinstance(text_name, str) or not text_name.strip():
         raise InputError("text_name must be a non-empty string")
-    title = f" ({Path(path).name})" if path else ""
+    title = f" ({python_docstring(Path(path).name)})" if path else ""
     return _SETUP.format(title=title, script="setup.py", sw=float(sw), sh=float(sh), res=res, text_name=text_name,
                          path=path, source=source)
 

@@ -36,6 +36,7 @@ import math
 
 from ..errors import InputError, require_finite
 from ..onset.report import takes_report
+from ._codetext import python_docstring
 from .usdgeom import focus_distance_from_pupil_mm, pinhole_fstop
 
 __all__ = ["blender_camera_values", "blender_camera_script", "blender_blade_rotation_deg"]
@@ -94,7 +95,7 @@ def blender_camera_script(values: dict, *, comments=()) -> str:
     """
     import json
 
-    head = "".join("\n" + str(c).replace("\\", "/").replace('"' * 3, "'" * 3) for c in comments)
+    head = "".join("\n" + python_docstring(line) for c in comments for line in str(c).splitlines() or [""])
     return f'''"""Made by physcam: Blender's built-in camera matched to a lens report (docs/blender.md).{head}
 """
 import json

@@ -23,6 +23,7 @@ import numpy as np
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_type
 from ..lens.prescription import Prescription, takes_prescription
+from ._codetext import osl_comment
 from .osl import lens_data, osl_array, osl_number, render_template
 
 __all__ = ["FocusTable", "focus_table", "focus_table_shader", "ghost_rows", "N_FOCUS", "GRID_HALF_MM", "STOP_LEVELS"]
@@ -179,6 +180,6 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
              _arr32("VZ_TAB", ft.vertex_z, "N_VZ_TAB"), osl_array("SEMI_OPEN", ft.table.semi_diameter, "N_SURF"),
              _arr32("RECT_TAB", np.concatenate([ft.rects[:, None], ft.rects_stopped], axis=1), "N_RECT_TAB"),
              osl_array("STOP_LEVEL", (1.0,) + STOP_LEVELS, "N_LEVEL")]
-    head = [f"// {ft.lens.name}: {n_focus} focus states from infinity to {ft.closest_mm / 1000:.3g} m "
+    head = [f"// {osl_comment(ft.lens.name)}: {n_focus} focus states from infinity to {ft.closest_mm / 1000:.3g} m "
             f"(uniform in 1/distance); dispersion {'on' if dispersion else 'off'}, Fresnel {'on' if fresnel else 'off'}."]
     return render_template(head + defines, data)

@@ -49,6 +49,7 @@ import math
 
 from ..errors import ExportError, InputError, require_finite, require_positive
 from ..onset.report import takes_report
+from ._codetext import xml_attribute, xml_comment
 from .usdgeom import DEFAULT_METERS_PER_UNIT, focus_distance_from_pupil_mm, mm_to_scene_units, shutter_interval
 
 __all__ = ["mitsuba_camera_values", "mitsuba_scene_xml", "mitsuba_scene_dict"]
@@ -163,13 +164,11 @@ def _num(v: float) -> str:
 def mitsuba_scene_xml(values: dict) -> str:
     """A Mitsuba 3 scene file (XML, ``version="3.0.0"``) holding the sensor of
     :func:`mitsuba_camera_values`; load it with ``mi.load_file`` or ``<include>`` it in a scene."""
-    from xml.sax.saxutils import escape
-
     s = _sensor_of(values)
     z = s["to_world"][2][3]
     film, sampler = s["film"], s["sampler"]
     pc = values.get("physcam", {}) if isinstance(values.get("physcam"), dict) else {}
-    comment = escape(f"physcam: {pc.get('lens') or 'thin lens'}; {pc.get('definition', '')}").replace("--", "- -")
+    comment = xml_comment(f"physcam: {pc.get('lens') or 'thin lens'}; {pc.get('definition', '')}")
     floats = "".join(f'        <float name="{k}" value="{_num(s[k])}"/>\n'
                      for k in ("fov", "aperture_radius", "focus_distance", "near_clip", "far_clip", "shutter_open",
                                "shutter_close"))
@@ -179,14 +178,14 @@ def mitsuba_scene_xml(values: dict) -> str:
         '<scene version="3.0.0">\n'
         '    <sensor type="thinlens" id="physcam_camera">\n'
         f"{floats}"
-        f'        <string name="fov_axis" value="{escape(str(s["fov_axis"]))}"/>\n'
+        f'        <string name="fov_axis" value="{xml_attribute(s["fov_axis"])}"/>\n'
         '        <transform name="to_world">\n'
         f'            <lookat origin="0, 0, {_num(z)}" target="0, 0, {_num(z - 1.0)}" up="0, 1, 0"/>\n'
         "        </transform>\n"
-        f'        <sampler type="{escape(str(sampler["type"]))}">\n'
+        f'        <sampler type="{xml_attribute(sampler["type"])}">\n'
         f'            <integer name="sample_count" value="{int(sampler["sample_count"])}"/>\n'
         "        </sampler>\n"
-        f'        <film type="{escape(str(film["type"]))}">\n'
+        f'        <film type="{xml_attribute(film["type"])}">\n'
         f'            <integer name="width" value="{int(film["width"])}"/>\n'
         f'            <integer name="height" value="{int(film["height"])}"/>\n'
         "        </film>\n"

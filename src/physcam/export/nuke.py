@@ -16,15 +16,13 @@ checked end to end by :func:`physcam.analysis.stmap.apply_stmap`.
 from __future__ import annotations
 
 from ..errors import InputError
+from ._codetext import hash_comment, nuke_file_path
 
 __all__ = ["nuke_stmap_script"]
 
 
 def _path(p) -> str:
-    s = str(p).replace("\\", "/")
-    if any(c in s for c in '{}"[]$\n'):
-        raise InputError(f"the path {s!r} has characters a Nuke script cannot quote ({{}}\"[]$ or a newline)")
-    return s
+    return nuke_file_path(p)
 
 
 def nuke_stmap_script(undistortion_map, distortion_map, *, plate="plate.####.exr", render="render.####.exr",
@@ -40,7 +38,7 @@ def nuke_stmap_script(undistortion_map, distortion_map, *, plate="plate.####.exr
         return f"{kind} {{\n{body}}}\n"
 
     parts = [
-        f"# physcam {version}: apply the undistortion and distortion ST-maps (R = u, G = v, origin bottom left)\n"
+        f"# physcam {hash_comment(version)}: apply the undistortion and distortion ST-maps (R = u, G = v, origin bottom left)\n"
         f"# the undistorted picture: the plate's format {w} x {h}, bounding box {W} x {H} "
         f"({(W - w) // 2}, {(H - h) // 2} px of overscan each side; the maps' EXR windows say so)\n",
         node("Root", inputs=0, format=f'"{w} {h} 0 0 {w} {h} 1 physcam_plate"'),

@@ -37,6 +37,7 @@ Cycles OSL camera (``physcam export blender``) traces all of those.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import asdict, dataclass
@@ -46,6 +47,7 @@ from ..errors import ExportError, InputError, OpticsError, renamed_parameter, re
 from ..lens.prescription import Prescription, require_prescription
 from ..onset.report import takes_report
 from ..optics.state import CameraState, camera_state, takes_camera
+from ._codetext import hash_comment, pbrt_string
 
 __all__ = [
     "PBRT_CAMERAS",
@@ -113,6 +115,9 @@ def pbrt_lens_text(lens, *, comments=()) -> tuple[str, list[str]]:
     from ..lens.formats import pbrt as dat
 
     lens = check_pbrt_lens(lens)
+    if lens.metadata.notes:  # the lens file's own notes become # lines of the .dat
+        safe = "\n".join(hash_comment(line) for line in lens.metadata.notes.splitlines())
+        lens = dataclasses.replace(lens, metadata=dataclasses.replace(lens.metadata, notes=safe))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         body = dat.dumps(lens)
@@ -122,7 +127,7 @@ def pbrt_lens_text(lens, *, comments=()) -> tuple[str, list[str]]:
     if lens.focus is not None:
         notes.append("pbrt moves the whole lens to focus: the .dat holds the focus groups at this mark's gaps")
     notes += [str(w.message) for w in caught if "drops" not in str(w.message)]
-    head = "".join(f"# {c}\n" for text in comments for c in str(text).splitlines())
+    head = "".join(f"# {hash_comment(c)}\n" for text in comments for c in str(text).splitlines())
     return head + body, notes
 
 
@@ -480,11 +485,11 @@ def pbrt_scene_snippet(values: dict, camera: str, *, comments=()) -> str:
     if camera not in values or "film" not in values:
         raise InputError(f"values has no {camera} camera; ask pbrt_camera_values for it")
     film, cam = values["film"], values[camera]
-    lines = [f"# {c}".rstrip() for text in comments for c in str(text).splitlines()]
+    lines = [f"# {hash_comment(c)}".rstrip() for text in comments for c in str(text).splitlines()]
     lines.append(f"Film \"rgb\" \"integer xresolution\" [{film['xresolution']}] \"integer yresolution\" "
                  f"[{film['yresolution']}] \"float diagonal\" [{_num(film['diagonal'])}]")
     if camera == "realistic":
-        lensfile = cam["lensfile"].replace("\\", "/").replace('"', "")
+        lensfile = pbrt_string(cam["lensfile"])
         lines.append(f"Camera \"realistic\" \"string lensfile\" [\"{lensfile}\"] "
                      f"\"float aperturediameter\" [{_num(cam['aperturediameter'])}] "
                      f"\"float focusdistance\" [{_num(cam['focusdistance'])}]")

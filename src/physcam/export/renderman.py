@@ -18,6 +18,7 @@ import math
 
 from ..onset.report import takes_report
 from ..errors import ExportError, InputError, require_finite, require_positive
+from ._codetext import hash_comment
 from .usdgeom import DEFAULT_METERS_PER_UNIT, focus_distance_from_pupil_mm, mm_to_scene_units, pinhole_fstop
 
 __all__ = ["renderman_camera_values", "rib_camera_values", "rib_camera_block", "shutter_opening_curve"]
@@ -196,7 +197,7 @@ def rib_camera_block(values: dict, *, legacy: bool = False, comments=()) -> str:
         raise InputError("values must come from rib_camera_values (Format, ScreenWindow, Clipping, Shutter, "
                          "Projection with the aperture and shutter parameters)") from None
     lines = ["##RenderMan RIB"]
-    lines += [f"# {c}".rstrip() for text in comments for c in str(text).splitlines()]
+    lines += [f"# {hash_comment(c)}".rstrip() for text in comments for c in str(text).splitlines()]
     lines.append(f"Format {fmt_['xres']} {fmt_['yres']} {_num(fmt_['pixelaspect'])}")
     lines.append("ScreenWindow " + " ".join(_num(x) for x in win))
     lines.append("Clipping " + " ".join(_num(x) for x in clip))

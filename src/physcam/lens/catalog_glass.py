@@ -14,7 +14,8 @@ __all__ = ["CatalogGlass"]
 @dataclass(frozen=True, slots=True)
 class CatalogGlass:
     """One catalogue glass: ``nd`` at 587.5618 nm, Abbe number ``vd``, its catalogue (``maker``),
-    Zemax ``formula`` number and ``coefficients`` (wavelength in um), span ``range_nm``."""
+    Zemax ``formula`` number and ``coefficients`` (wavelength in um), span ``range_nm``, and in a
+    legacy catalogue the maker's ``status`` ("obsolete", "standard"...)."""
 
     name: str
     nd: float
@@ -27,6 +28,7 @@ class CatalogGlass:
     transmission_10mm: tuple = field(default=(), compare=False)
     previous: bool = False
     dpgf: float = 0.0
+    status: str | None = field(default=None, compare=False)
 
     @property
     def sellmeier(self):

@@ -1,8 +1,10 @@
-"""The bundled lens library: published prescriptions shipped in ``physcam/data/lenses``.
+"""The lens library: published prescriptions shipped in ``physcam/data/lenses``, and the user's.
 
-Each bundled lens is a physcam lens TOML converted from the project's reference files
-by ``scripts/build_lens_library.py``, with its provenance (original file and format,
-source, and any correction made, with the reason) in the ``[provenance]`` table.
+Each bundled lens is a physcam lens TOML with its provenance record in the ``[provenance]``
+table (:mod:`physcam.lens.provenance`: primary source, transcription, checks, assumptions,
+licence, and any correction made, with the reason). The user's library holds the lenses installed
+with ``physcam lens add ARCHIVE`` (:func:`user_library_dir`, one folder per lens holding its
+``lens.toml``); they load by name like bundled ones, and a bundled name always wins.
 
 >>> from physcam.lens.library import list_lenses, load_lens
 >>> lens = load_lens("dgauss.50mm")            # slug, name, alias or a file path
@@ -24,8 +26,13 @@ from pathlib import Path
 from ..errors import InputError, LensFileError
 from .prescription import Prescription, takes_prescription
 
-__all__ = ["LensRecord", "list_lenses", "load_lens", "find_lens", "library_dir", "load_repaired", "repairs_of",
-           "REPAIRED_KEY", "camera_use", "require_camera_lens"]
+__all__ = ["LensRecord", "list_lenses", "load_lens", "find_lens", "library_dir", "user_library_dir", "load_repaired",
+           "repairs_of", "bundled_lens_named", "REPAIRED_KEY", "camera_use", "require_camera_lens", "USER_LIBRARY_ENV", "USER_LENS_FILE"]
+
+#: Environment variable naming the user's lens library folder (overrides the XDG data folder).
+USER_LIBRARY_ENV = "PHYSCAM_LENS_LIBRARY"
+#: The prescription file inside an installed lens's folder.
+USER_LENS_FILE = "lens.toml"
 
 #: ``extras`` key of a lens loaded with ``lenient=True`` that needed repairs (JSON list of messages).
 REPAIRED_KEY = "provenance.repaired_on_load"
@@ -63,9 +70,9 @@ def require_camera_lens(p: Prescription, label: str | None = None, what: str = "
 
 @dataclass(frozen=True, slots=True)
 class LensRecord:
-    """What ``physcam lenses`` lists about one bundled lens (lengths in mm)."""
+    """What ``physcam lenses`` lists about one lens of the library (lengths in mm)."""
 
-    slug: str  # file stem in the library, the canonical short name
+    slug: str  # file stem (bundled) or folder name (user library), the canonical short name
     name: str
     maker: str | None
     focal_length: float | None  # nominal (engraved), mm
@@ -76,10 +83,15 @@ class LensRecord:
     has_focus_groups: bool
     original_format: str | None  # pbrt, iset, seed-toml, ...
     original_file: str | None
-    source: str | None
+    source: str | None  # the primary source (patent and example, book and page, ...)
     corrected: bool  # the bundled copy differs from the original file (see notes)
     aliases: tuple[str, ...]
     path: str
+    licence: str | None = None  # the file's licence (SPDX identifier, NOASSERTION when unresolved)
+    primary_source_checked: bool | None = None  # every number compared with the primary source itself
+    t_stop: float | None = None  # the maker's stated T-stop wide open
+    minimum_object_distance: float | None = None  # the maker's close focus, mm from the film plane
+    library: str = "bundled"  # "bundled" (shipped with physcam) or "user" (installed with `physcam lens add`)
 
     def to_dict(self) -> dict:
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in
@@ -111,45 +123,90 @@ def _slugs() -> frozenset[str]:
     return frozenset(p.stem for p in library_dir().glob("*.toml"))
 
 
-@lru_cache(maxsize=1)
-def _index() -> tuple[tuple[LensRecord, Prescription], ...]:
-    from .formats._common import extra
+def user_library_dir() -> Path:
+    """The user's lens library: ``$PHYSCAM_LENS_LIBRARY`` when set, else ``$XDG_DATA_HOME/physcam/lenses``,
+    else ``~/.local/share/physcam/lenses`` (the XDG Base Directory default). It need not exist."""
+    import os
 
+    if os.environ.get(USER_LIBRARY_ENV):
+        return Path(os.environ[USER_LIBRARY_ENV]).expanduser()
+    base = os.environ.get("XDG_DATA_HOME") or os.path.join(os.path.expanduser("~"), ".local", "share")
+    return Path(base) / "physcam" / "lenses"
+
+
+def _record(slug: str, path: Path, p: Prescription, library: str) -> LensRecord:
+    from .provenance import provenance_of
+
+    m, prov = p.metadata, provenance_of(p)
+    return LensRecord(
+        slug=slug, name=m.name, maker=m.maker, focal_length=m.focal_length, max_fstop=m.max_fstop,
+        squeeze=p.squeeze, anamorphic=p.is_anamorphic, surfaces=len(p.surfaces), has_focus_groups=p.focus is not None,
+        original_format=prov.original_format, original_file=prov.original_file, source=m.source,
+        corrected=bool(prov.corrections), aliases=prov.aliases, path=str(path), licence=m.licence,
+        primary_source_checked=prov.primary_source_checked, t_stop=m.t_stop,
+        minimum_object_distance=m.minimum_object_distance, library=library)
+
+
+@lru_cache(maxsize=1)
+def _bundled_index() -> tuple[tuple[LensRecord, Prescription], ...]:
     out = []
     for path in sorted(library_dir().glob("*.toml")):
         p = _bundled(path.stem)
-        m = p.metadata
-        corrections = extra(p, "provenance.corrections", [])
-        rec = LensRecord(
-            slug=path.stem,
-            name=m.name,
-            maker=m.maker,
-            focal_length=m.focal_length,
-            max_fstop=m.max_fstop,
-            squeeze=p.squeeze,
-            anamorphic=p.is_anamorphic,
-            surfaces=len(p.surfaces),
-            has_focus_groups=p.focus is not None,
-            original_format=extra(p, "provenance.original_format"),
-            original_file=extra(p, "provenance.original_file"),
-            source=m.source,
-            corrected=bool(corrections),
-            aliases=tuple(extra(p, "provenance.aliases", [])),
-            path=str(path),
-        )
-        out.append((rec, p))
+        out.append((_record(path.stem, path, p, "bundled"), p))
     return tuple(out)
 
 
-def list_lenses() -> list[LensRecord]:
-    """Records of every bundled lens, sorted by slug."""
-    return [rec for rec, _ in _index()]
+@lru_cache(maxsize=256)
+def _user_lens(path: str, mtime_ns: int, size: int) -> Prescription:
+    from .formats import read_lens
+
+    return read_lens(path, "physcam")
+
+
+def _user_index() -> tuple[tuple[LensRecord, Prescription], ...]:
+    """The user's installed lenses (read again whenever a lens file changes). A folder whose lens
+    does not load is left out of the listing (``physcam lens check`` on its file says why)."""
+    import warnings
+
+    from ..errors import PhysCamError, PhysCamWarning
+
+    root = user_library_dir()
+    if not root.is_dir():
+        return ()
+    bundled = _slugs()
+    out = []
+    for folder in sorted(root.iterdir()):
+        f = folder / USER_LENS_FILE
+        if folder.name.startswith(".") or folder.name in bundled or not f.is_file():
+            continue
+        try:
+            st = f.stat()
+            p = _user_lens(str(f), st.st_mtime_ns, st.st_size)
+        except (OSError, PhysCamError) as exc:
+            warnings.warn(f"user lens library: {f} is left out ({exc})", PhysCamWarning, stacklevel=3)
+            continue
+        out.append((_record(folder.name, f, p, "user"), p))
+    return tuple(out)
+
+
+def _index() -> tuple[tuple[LensRecord, Prescription], ...]:
+    """Every lens of the library: the bundled ones, then the user's."""
+    return _bundled_index() + _user_index()
+
+
+def list_lenses(library: str = "all") -> list[LensRecord]:
+    """Records of the library's lenses: ``library`` "all" (the bundled ones sorted by slug, then the
+    user's), "bundled" or "user"."""
+    if library not in ("all", "bundled", "user"):
+        raise InputError(f"library must be all, bundled or user, got {library!r}")
+    return [rec for rec, _ in _index() if library in ("all", rec.library)]
 
 
 def find_lens(name: str) -> LensRecord:
-    """The bundled lens whose slug, name or alias matches ``name`` (case and punctuation ignored).
+    """The lens whose slug, name or alias matches ``name`` (case and punctuation ignored): bundled
+    lenses first, then the user's library.
 
-    Raises :class:`InputError` naming the closest bundled lenses when nothing matches.
+    Raises :class:`InputError` naming the closest lenses when nothing matches.
     """
     key = _key(str(name))
     table: dict[str, LensRecord] = {}
@@ -164,7 +221,18 @@ def find_lens(name: str) -> LensRecord:
         if table[c].slug not in names:
             names.append(table[c].slug)
     hint = f"; did you mean {', '.join(names)}?" if names else ""
-    raise InputError(f"no bundled lens called {name!r}{hint} (`physcam lenses` lists them; a file path also works)")
+    raise InputError(f"no bundled lens called {name!r}, nor one in your library{hint} (`physcam lenses` lists them; "
+                     "a file path also works)")
+
+
+def bundled_lens_named(*labels: str) -> LensRecord | None:
+    """The bundled lens one of ``labels`` names (slug, name or alias; case and punctuation ignored), or
+    None: a lens of the user's library may not take a bundled lens's name (it would never be found)."""
+    keys = {_key(x) for x in labels}
+    for rec in list_lenses("bundled"):
+        if keys & {_key(x) for x in (rec.slug, rec.name, *rec.aliases)}:
+            return rec
+    return None
 
 
 def repairs_of(p: Prescription) -> list[str]:

@@ -30,6 +30,7 @@ from fractions import Fraction
 
 from ..errors import InputError, require_finite, require_type
 from .frames import TrackedFrame, new_source_id, rate_fraction, sample_from_frame, static_block, with_time
+from .sample import shown
 
 __all__ = ["CameraMove", "camera_frames", "camera_samples", "frames_to_samples", "with_optics"]
 
@@ -65,7 +66,7 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
 
     require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
     if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= MAX_TAKE_FRAMES:
-        raise InputError(f"frames must be a whole number 1..{MAX_TAKE_FRAMES}, got {frames!r}")
+        raise InputError(f"frames must be a whole number 1..{MAX_TAKE_FRAMES}, got {shown(frames)}")
     fr = rate_fraction(rate)
     move = CameraMove() if move is None else require_type("move", move, CameraMove)
     if (lens is None) == (focal_length_mm is None):

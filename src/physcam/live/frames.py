@@ -28,13 +28,13 @@ from fractions import Fraction
 import numpy as np
 
 from ..errors import InputError, require_finite, require_type
-from .sample import PROTOCOL_VERSION
+from .sample import PROTOCOL_VERSION, shown
 
 #: the most radial (and tangential) distortion coefficients a frame keeps: a recording holds each
 #: frame, and a 64 KiB sample could otherwise carry thousands
 MAX_DISTORTION_TERMS = 16
 
-__all__ = ["TrackedFrame", "rate_fraction", "rational", "timecode_fields", "rotation_matrix", "pan_tilt_roll",
+__all__ = ["TrackedFrame", "rate_fraction", "rational", "timecode_fields", "timecode_index", "rotation_matrix", "pan_tilt_roll",
            "compose_transforms", "frame_from_sample", "parse_timecode", "sample_from_frame", "static_block", "new_source_id"]
 
 
@@ -142,6 +142,22 @@ def parse_timecode(text, rate, drop_frame: bool = False) -> int:
     return (minutes * 60 + se) * per_s + ff - d * (minutes - minutes // 10)
 
 
+def timecode_index(text, rate, drop_frame: bool = False) -> int:
+    """The sample number since 00:00:00:00 of a timecode text as :class:`TrackedFrame` keeps it
+    ("HH:MM:SS:FF", ";" before FF for drop-frame, ".N" after it for the sub-frame above 60 fps) at the
+    stream's sample ``rate``: :func:`parse_timecode`'s frame count times the samples per timecode
+    frame, plus the sub-frame."""
+    import re
+
+    fr = rate_fraction(rate)
+    k = _timecode_rate(fr)[0]
+    m = re.fullmatch(r"(.+[:;]\d{1,3})\.(\d{1,3})", str(text).strip())
+    label, sub = (m.group(1), int(m.group(2))) if m else (text, 0)
+    if sub >= k:
+        raise InputError(f"timecode {text} has a sub-frame beyond the {k} samples of a timecode frame")
+    return parse_timecode(label, fr, drop_frame) * k + sub
+
+
 def timecode_fields(frame: int, rate, *, start: int = 0, drop_frame: bool = False) -> dict:
     """SMPTE timecode of the ``frame``-th sample at ``rate``, ``start`` timecode frames after
     00:00:00:00 (:func:`parse_timecode`), drop-frame counting when ``drop_frame`` (SMPTE ST 12-1:
@@ -152,9 +168,9 @@ def timecode_fields(frame: int, rate, *, start: int = 0, drop_frame: bool = Fals
     """
     fr = rate_fraction(rate)
     if isinstance(frame, bool) or not isinstance(frame, (int, np.integer)) or frame < 0:
-        raise InputError(f"frame must be a whole number >= 0, got {frame!r}")
+        raise InputError(f"frame must be a whole number >= 0, got {shown(frame)}")
     if isinstance(start, bool) or not isinstance(start, (int, np.integer)) or start < 0:
-        raise InputError(f"the start timecode must be a whole number of frames >= 0, got {start!r}")
+        raise InputError(f"the start timecode must be a whole number of frames >= 0, got {shown(start)}")
     k, tc_rate, per_s = _timecode_rate(fr)
     d = _drop_count(tc_rate) if drop_frame else 0
     if drop_frame and not d:
@@ -350,7 +366,7 @@ def sample_from_frame(frame: TrackedFrame, *, source_id: str, sequence_number: i
     drop-frame when ``frame.drop_frame``), ``static`` is included when given."""
     require_type("frame", frame, TrackedFrame, "build one with TrackedFrame(...)")
     if isinstance(sequence_number, bool) or not isinstance(sequence_number, int) or not 0 <= sequence_number < 2**32:
-        raise InputError(f"sequence number must be a whole number 0..2^32-1, got {sequence_number!r}")
+        raise InputError(f"sequence number must be a whole number 0..2^32-1, got {shown(sequence_number)}")
     timing = {"mode": "internal", "sequenceNumber": sequence_number}
     if frame.time_ns is not None:
         timing["sampleTimestamp"] = {"seconds": frame.time_ns // 1_000_000_000,

@@ -40,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, require_finite
+from .sample import shown
 
 __all__ = ["WallMesh", "wall_from_usd", "frustum_directions", "edge_directions", "frame_tangents", "intersect_mesh", "FrustumFrame", "frustum_frames",
            "write_frustum_usd", "write_wall"]
@@ -111,7 +112,7 @@ def edge_directions(tan_u, tan_v, samples_per_edge: int = 8) -> np.ndarray:
     ``tan_u`` = (left, right) and ``tan_v`` = (bottom, top), counter-clockwise from the bottom-left."""
     if isinstance(samples_per_edge, bool) or not isinstance(samples_per_edge, int) \
             or not 1 <= samples_per_edge <= MAX_SAMPLES_PER_EDGE:
-        raise InputError(f"samples per edge must be 1..{MAX_SAMPLES_PER_EDGE}, got {samples_per_edge!r}")
+        raise InputError(f"samples per edge must be 1..{MAX_SAMPLES_PER_EDGE}, got {shown(samples_per_edge)}")
     (u0, u1), (v0, v1) = tan_u, tan_v
     s = (np.linspace(-1.0, 1.0, samples_per_edge + 1)[:-1] + 1.0) / 2.0
     edges = [np.c_[u0 + s * (u1 - u0), np.full_like(s, v0)], np.c_[np.full_like(s, u1), v0 + s * (v1 - v0)],
@@ -164,7 +165,7 @@ def frustum_directions(f_pin_mm, sensor_mm, samples_per_edge: int = 8, widen=(1.
     w, h = _pair("sensor size (mm)", sensor_mm)
     if isinstance(samples_per_edge, bool) or not isinstance(samples_per_edge, int) \
             or not 1 <= samples_per_edge <= MAX_SAMPLES_PER_EDGE:
-        raise InputError(f"samples per edge must be 1..{MAX_SAMPLES_PER_EDGE}, got {samples_per_edge!r}")
+        raise InputError(f"samples per edge must be 1..{MAX_SAMPLES_PER_EDGE}, got {shown(samples_per_edge)}")
     hu, hv = w / 2 * widen[0], h / 2 * widen[1]
     s = np.linspace(-1.0, 1.0, samples_per_edge + 1)[:-1]
     edges = [np.c_[s * hu, np.full_like(s, -hv)], np.c_[np.full_like(s, hu), s * hv],
@@ -354,7 +355,7 @@ def write_wall(file, *, kind: str = "flat", width_m: float = 12.0, height_m: flo
     if not (0 < w <= 1000 and 0 < h <= 1000 and 0 < d <= 1000 and 0 < r <= 1000):
         raise InputError("wall width, height, distance and radius must lie in (0, 1000] m")
     if isinstance(segments, bool) or not isinstance(segments, int) or not 1 <= segments <= 4096:
-        raise InputError(f"segments must be 1..4096, got {segments!r}")
+        raise InputError(f"segments must be 1..4096, got {shown(segments)}")
     if kind == "curved" and w / r >= 2 * math.pi:
         raise InputError("a curved wall's arc must be shorter than the whole circle (width < 2 pi radius)")
     mpu = meters_per_unit

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, PhysCamError, require_type
+from .sample import shown
 
 __all__ = [
     "HEADER_SIZE", "IDENTIFIER", "ENCODING_JSON", "ENCODING_CBOR", "MAX_SEGMENT_PAYLOAD", "DEFAULT_SEGMENT_PAYLOAD",
@@ -76,7 +77,7 @@ class PacketHeader:
 
 def _modulus(modulus) -> int:
     if isinstance(modulus, bool) or modulus not in (255, 256):
-        raise InputError(f"the Fletcher-16 modulus is 256 (current reference code) or 255 (1.0.0 page), got {modulus!r}")
+        raise InputError(f"the Fletcher-16 modulus is 256 (current reference code) or 255 (1.0.0 page), got {shown(modulus)}")
     return int(modulus)
 
 
@@ -133,11 +134,11 @@ def build_packet(piece: bytes, *, encoding: int, sequence: int, offset: int = 0,
     if not isinstance(piece, (bytes, bytearray, memoryview)):
         raise InputError(f"a packet's payload must be bytes, got {type(piece).__name__}")
     if encoding not in ENCODINGS:
-        raise InputError(f"encoding must be 0x01 (JSON) or 0x02 (CBOR), got {encoding!r}")
+        raise InputError(f"encoding must be 0x01 (JSON) or 0x02 (CBOR), got {shown(encoding)}")
     if isinstance(sequence, bool) or not isinstance(sequence, int) or not 0 <= sequence <= 0xFFFF:
-        raise InputError(f"sequence number must be a whole number 0..65535, got {sequence!r}")
+        raise InputError(f"sequence number must be a whole number 0..65535, got {shown(sequence)}")
     if isinstance(offset, bool) or not isinstance(offset, int) or not 0 <= offset <= 0xFFFFFFFF:
-        raise InputError(f"segment offset must be a whole number 0..2^32-1, got {offset!r}")
+        raise InputError(f"segment offset must be a whole number 0..2^32-1, got {shown(offset)}")
     if len(piece) > MAX_SEGMENT_PAYLOAD:
         raise InputError(f"a packet carries at most {MAX_SEGMENT_PAYLOAD} payload bytes, got {len(piece)}")
     head = _HEADER.pack(IDENTIFIER, 0, encoding, sequence, offset, (0x8000 if last else 0) | len(piece))
@@ -152,7 +153,7 @@ def packetize(payload: bytes, *, encoding: int, sequence: int, segment_payload: 
         raise InputError(f"payload must be bytes, got {type(payload).__name__}")
     if isinstance(segment_payload, bool) or not isinstance(segment_payload, int) \
             or not 1 <= segment_payload <= MAX_SEGMENT_PAYLOAD:
-        raise InputError(f"segment payload must be 1..{MAX_SEGMENT_PAYLOAD} bytes, got {segment_payload!r}")
+        raise InputError(f"segment payload must be 1..{MAX_SEGMENT_PAYLOAD} bytes, got {shown(segment_payload)}")
     payload = bytes(payload)
     if not payload:
         raise InputError("an empty payload is not a sample")
@@ -224,10 +225,10 @@ class Reassembler:
 
     def __init__(self, max_pending: int = 16, max_sample_bytes: int = MAX_SAMPLE_BYTES):
         if isinstance(max_pending, bool) or not isinstance(max_pending, int) or not 1 <= max_pending <= 4096:
-            raise InputError(f"max_pending must be 1..4096, got {max_pending!r}")
+            raise InputError(f"max_pending must be 1..4096, got {shown(max_pending)}")
         if isinstance(max_sample_bytes, bool) or not isinstance(max_sample_bytes, int) \
                 or not 1 <= max_sample_bytes <= MAX_SAMPLE_BYTES:
-            raise InputError(f"max_sample_bytes must be 1..{MAX_SAMPLE_BYTES}, got {max_sample_bytes!r}")
+            raise InputError(f"max_sample_bytes must be 1..{MAX_SAMPLE_BYTES}, got {shown(max_sample_bytes)}")
         self.max_pending = max_pending
         self.max_sample_bytes = max_sample_bytes
         self._pending: dict[tuple, _Unfinished] = {}

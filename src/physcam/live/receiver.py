@@ -27,7 +27,9 @@ truncated, oversized, contradictory or overlapping segments, undecodable payload
 ``duplicate`` (a datagram received again, byte for byte; a second sample for a number already held);
 ``late``; ``stray``; ``invalid`` (decoded but not a valid sample, or a source number outside
 1..200); ``dropped`` (unfinished segmented samples pushed out, or samples the consumer did not take
-before the queue filled); ``missing`` (sequence numbers given up); ``resync``; ``delivered``.
+before the queue filled); ``missing`` (sequence numbers given up); ``resync``; ``delivered``. No
+payload ends the receiving thread: one the checks themselves fail on is counted ``invalid``; the
+reasons of the first ten refused payloads are kept, one bounded line each (:meth:`Receiver.refusals`).
 
 Memory is bounded whatever arrives: one 64 KiB receive buffer; reassembly of at most
 ``max_pending`` (16) unfinished samples of 64 KiB each with an 8 KiB map (1.125 MiB,
@@ -49,7 +51,7 @@ from dataclasses import dataclass
 
 from ..errors import InputError, PhysCamError
 from .protocol import ENCODINGS, PacketError, Reassembler, parse_packet
-from .sample import SampleError, decode_sample, sample_problems
+from .sample import SampleError, SampleProblem, decode_sample, sample_problems, shown
 
 __all__ = ["Receiver", "ReceivedSample", "COUNTERS", "DEFAULT_PORT", "SOURCE_NUMBERS", "MAX_SOURCES", "multicast_group"]
 
@@ -63,19 +65,21 @@ MAX_SOURCES = 16
 _RECV_BUFFER = 65536  # the largest UDP datagram fits
 _DUPLICATE_MEMORY = 4096  # keys of the last datagrams accepted, to know a repeated one
 _EXPIRE_EVERY_S = 0.005
+#: the reasons kept for refused payloads (:meth:`Receiver.refusals`); the counters count them all
+MAX_REFUSALS_NOTED = 10
 
 
 def multicast_group(source_number: int = 1) -> str:
     """OpenTrackIO's multicast group for a source number: 239.135.1.N (current documentation)."""
     lo, hi = SOURCE_NUMBERS
     if isinstance(source_number, bool) or not isinstance(source_number, int) or not lo <= source_number <= hi:
-        raise InputError(f"source number must be {lo}..{hi}, got {source_number!r}")
+        raise InputError(f"source number must be {lo}..{hi}, got {shown(source_number)}")
     return f"239.135.1.{source_number}"
 
 
 def check_port(port) -> int:
     if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
-        raise InputError(f"port must be a whole number 0..65535, got {port!r}")
+        raise InputError(f"port must be a whole number 0..65535, got {shown(port)}")
     return port
 
 
@@ -123,11 +127,11 @@ class Receiver:
         for name, v, lo, hi in (("queue size", queue_size, 1, 1 << 20), ("reorder window", reorder_window, 1, 4096),
                                 ("receive buffer", receive_buffer_bytes, 65536, 1 << 30)):
             if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
-                raise InputError(f"{name} must be a whole number {lo}..{hi}, got {v!r}")
+                raise InputError(f"{name} must be a whole number {lo}..{hi}, got {shown(v)}")
         if modulus not in (255, 256, "auto"):
-            raise InputError(f"the Fletcher-16 modulus is 256, 255 or 'auto', got {modulus!r}")
+            raise InputError(f"the Fletcher-16 modulus is 256, 255 or 'auto', got {shown(modulus)}")
         if not isinstance(reorder_timeout_s, (int, float)) or not 0.0 < reorder_timeout_s <= 10.0:
-            raise InputError(f"reorder timeout must lie in (0, 10] s, got {reorder_timeout_s!r}")
+            raise InputError(f"reorder timeout must lie in (0, 10] s, got {shown(reorder_timeout_s)}")
         self.modulus = modulus
         self.reorder_window = reorder_window
         self.reorder_timeout_s = float(reorder_timeout_s)
@@ -135,6 +139,7 @@ class Receiver:
         self._queue: queue.Queue = queue.Queue(maxsize=queue_size)
         self._reassembler = Reassembler(max_pending=max_pending)
         self._counts = dict.fromkeys(COUNTERS, 0)
+        self._refusals: list[str] = []
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -287,18 +292,39 @@ class Receiver:
         enc = ENCODINGS[encoding]
         try:
             obj = decode_sample(payload, enc, validate=False)
-        except SampleError:
+        except SampleError as exc:
             self._count("malformed")  # no sample, no source: the streams do not hear of it
+            self._note(header.sequence, addr, exc.problems[0])
             return
         now = time.monotonic()
         key = _source_key(obj)
         lo, hi = SOURCE_NUMBERS
-        if sample_problems(obj) or (key[1] is not None and not lo <= key[1] <= hi):
+        try:
+            problems = sample_problems(obj)
+        except Exception as exc:  # noqa: BLE001 - no sample may end the take: a check that fails refuses it
+            problems = [SampleProblem("$", "check", f"could not be checked ({type(exc).__name__})")]
+        if not problems and key[1] is not None and not lo <= key[1] <= hi:
+            problems = [SampleProblem("$.sourceNumber", "transport", f"source number {key[1]} is outside {lo}..{hi}")]
+        if problems:
             self._count("invalid")
+            self._note(header.sequence, addr, problems[0])
             if key in self._streams:  # its number is used up: the window need not wait for it
                 self._place(key, header.sequence, None, now)
             return
         self._place(key, header.sequence, ReceivedSample(obj, 0, enc, now), now)
+
+    def _note(self, sequence: int, addr, problem) -> None:
+        """Keep the reason a payload was refused, the first MAX_REFUSALS_NOTED of them (one line each)."""
+        with self._lock:
+            if len(self._refusals) < MAX_REFUSALS_NOTED:
+                where = f" from {addr[0]}:{addr[1]}" if isinstance(addr, tuple) and len(addr) >= 2 else ""
+                self._refusals.append(f"packet {sequence}{where}: {problem}")
+
+    def refusals(self) -> list[str]:
+        """Why the first payloads counted ``malformed`` (undecodable) or ``invalid`` were refused: at most
+        MAX_REFUSALS_NOTED lines of at most about 300 characters (a received value is never shown whole)."""
+        with self._lock:
+            return list(self._refusals)
 
     # --- ordering, per source ----------------------------------------------------------------------
     def _place(self, key, seq: int, item, now: float) -> None:

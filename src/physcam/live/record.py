@@ -32,7 +32,9 @@ a focus pull):
 
 Times: a sample's time code is (its timestamp - the first's) x the stage's timeCodesPerSecond (the
 stream's sample rate), computed with exact fractions; samples without timestamps use their
-sequence numbers. The file is written once, atomically, when the recording ends.
+sequence numbers. Each source keeps its own time line (:func:`solve_frames`); a recording writes
+one source (:mod:`physcam.live.take`), and :func:`absent_frames` counts the frames its line lacks.
+The file is written once, atomically, when the recording ends.
 
 The focal length that drives depth of field is the lens's nominal focal length when the stream's
 static data gives one, else the pinhole focal length (a thin lens focused at D frames with s', a
@@ -53,7 +55,8 @@ from ..errors import ExportError, InputError, PhysCamError, PhysCamWarning, requ
 from .frames import TrackedFrame
 from .lens_data import opentrackio_to_opencv
 
-__all__ = ["MAX_RECORDED_FRAMES", "SolvedFrame", "solve_frames", "frame_problem", "time_codes",
+__all__ = ["MAX_RECORDED_FRAMES", "SolvedFrame", "solve_frames", "frame_problem", "time_codes", "time_line",
+           "absent_frames",
            "write_recording_usd", "lens_report_rows", "write_lens_report", "CARRIED_VALUES"]
 
 #: the most frames one recording keeps (ten minutes at 240 fps)
@@ -168,6 +171,68 @@ def time_codes(frames, rate=None) -> tuple[list[float], Fraction]:
     return codes, fr
 
 
+def absent_frames(frames, rate=None) -> int:
+    """How many frames of one source's time line, between the first and the last of ``frames``, the
+    frames do not hold: a frame lasts 1 / rate s, ``rate`` the stream's sample rate (``sampleRate``;
+    else the ``rate`` given). Each frame's place on the line is, in this order of preference, its
+    ``sampleTimestamp`` (rounded to the nearest frame), its timecode (:func:`~physcam.live.frames.timecode_index`,
+    drop-frame counted), its ``sequenceNumber``; frames with none of them count nothing (0).
+
+    A gap of g frame periods between two neighbours holds g - 1 absent frames, whatever took them
+    (never sent, lost on the network, refused): 18 absent frames are 18, in one gap or several.
+    """
+    from .frames import rate_fraction, timecode_index
+
+    frames = _frames(frames)
+    fr = next((f.rate for f in frames if f.rate is not None), None)
+    fr = rate_fraction(rate) if fr is None and rate is not None else fr
+    if fr is not None and all(f.time_ns is not None for f in frames):
+        t0 = frames[0].time_ns
+        places = {round(Fraction(f.time_ns - t0, 1_000_000_000) * fr) for f in frames}
+    elif fr is not None and all(f.timecode is not None for f in frames):
+        places = {timecode_index(f.timecode, fr, f.drop_frame) for f in frames}
+    elif all(f.sequence_number is not None for f in frames):
+        places = {f.sequence_number for f in frames}
+    else:
+        return 0
+    return max(places) - min(places) + 1 - len(places)
+
+
+def time_line(frames, codes) -> set[int]:
+    """The indexes of the frames on their sources' time lines: per source (``sourceId``,
+    ``sourceNumber``), the longest run of its frames, in arrival order, whose time codes increase
+    (the first of equal ones kept; of runs equally long, the one whose time codes stay lowest). One
+    frame a day ahead is left out, not the frames after it; a clock that goes back is followed where
+    more frames follow it. Longest increasing subsequence by
+    patience sorting, O(n log n) (Knuth, TAOCP vol. 3, 5.1.4; Fredman 1975)."""
+    import bisect
+
+    frames = [] if isinstance(frames, (list, tuple)) and not frames else _frames(frames)
+    if isinstance(codes, (str, bytes)) or not hasattr(codes, "__len__") or len(codes) != len(frames):
+        raise InputError("codes must be a list of time codes, one per frame (time_codes(frames))")
+    per_source: dict = {}
+    for i, f in enumerate(frames):
+        per_source.setdefault(f.source, []).append(i)
+    keep: set[int] = set()
+    for idx in per_source.values():
+        tails, tail_at, before = [], [], {}
+        for i in idx:
+            k = bisect.bisect_left(tails, codes[i])
+            if k < len(tails) and tails[k] == codes[i]:
+                continue  # an equal time code: the first one stays
+            before[i] = tail_at[k - 1] if k else None
+            if k == len(tails):
+                tails.append(codes[i])
+                tail_at.append(i)
+            else:
+                tails[k], tail_at[k] = codes[i], i
+        i = tail_at[-1] if tail_at else None
+        while i is not None:
+            keep.add(i)
+            i = before[i]
+    return keep
+
+
 def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=None, focus_mm=None,
                  coc=None, refused: list | None = None, lens=None, fiz=None) -> list[SolvedFrame]:
     """Each frame with its time code and lens report (module notes).
@@ -176,8 +241,10 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     ``sourceId`` and ``sourceNumber``), else from these defaults: ``sensor`` (a
     :class:`~physcam.onset.sensors.Sensor`) when the stream's static data gives no sensor size,
     ``focal_length_mm`` (pinhole), ``fstop``, ``focus_mm`` (from the film plane); each
-    :class:`SolvedFrame` names them (``carried``, ``defaulted``). Frames whose time code does not
-    increase are dropped with a warning.
+    :class:`SolvedFrame` names them (``carried``, ``defaulted``). Each source keeps its own time line
+    (:func:`time_line`): a frame off it (a time code that goes back, or one far ahead that the
+    frames after it do not follow) is dropped with a warning; another source's clock, a day ahead or
+    behind, never drops a frame.
 
     ``fiz`` (a :class:`~physcam.live.fiz.FizTable`) turns a frame's ``lens.encoders`` into the focus
     mark, f-stop and focal length it does not send itself (``from_encoders`` names them); ``lens`` (a
@@ -213,7 +280,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     held: dict = {}  # per source: the values its frames sent, the latest of each
     sensors: dict = {}
     out: list[SolvedFrame] = []
-    previous = -math.inf
+    on_line = time_line(frames, codes)
     skipped = 0
     for i, (f, t) in enumerate(zip(frames, codes)):
         mine = held.setdefault(f.source, {})
@@ -226,7 +293,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
             refused.append((i, f"frame {i}: {exc}"))
             continue
         sent.update(encoded)
-        if t <= previous:
+        if i not in on_line:
             skipped += 1
             mine.update(sent)
             continue
@@ -248,13 +315,13 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
             refused.append((i, f"{where}: {exc}"))
             continue
         mine.update(sent)
-        previous = t
         names = dict((k, n) for k, n, _ in CARRIED_VALUES)
         out.append(SolvedFrame(f, t, report, tuple(carried), tuple(defaulted),
                                tuple(names[k] for k in encoded), float(report.pinhole[1]),
                                tuple(last["projection"] or (0.0, 0.0)), tuple(last["distortion_offset"] or (0.0, 0.0))))
     if skipped:
-        warnings.warn(f"{skipped} samples did not advance in time and were left out", PhysCamWarning, stacklevel=2)
+        warnings.warn(f"{skipped} samples lay off their source's time line (a time code going back, or ahead of "
+                      "the frames after it) and were left out", PhysCamWarning, stacklevel=2)
     return out
 
 

@@ -9,8 +9,12 @@ broke (``exclusiveMinimum``), the first problem first in document order.
 
 Numbers that JSON cannot carry (NaN, Infinity) and CBOR can are refused too, with their path, and so
 are numbers beyond a 64-bit float (JSON's ``1e5000`` reads as infinity; CBOR's decimal fraction
-``1e5000`` or a 400-digit bignum): no NaN or infinity enters physcam from a stream. CBOR's other
-numbers (decimal fractions, bigfloats, rationals) are read as floats.
+``1e5000`` or a 400-digit bignum, an integer literal of 5,000 digits in either): no NaN or infinity
+enters physcam from a stream. CBOR's other numbers (decimal fractions, bigfloats, rationals) are
+read as floats; what JSON has no form for (CBOR byte strings, tags, dates, sets, keys that are not
+text) is refused with its path. A problem's message is one line of at most 240 characters, and
+shows a received value through :func:`shown`: an integer is described by its number of digits,
+never converted to text whole (Python refuses that past 4,300 digits).
 """
 
 from __future__ import annotations
@@ -25,7 +29,7 @@ from functools import lru_cache
 from ..errors import InputError, require_type
 
 __all__ = ["SCHEMA_FILE", "PROTOCOL_VERSION", "SampleError", "SampleProblem", "schema", "sample_problems",
-           "validate_sample", "decode_sample", "encode_sample", "json_path"]
+           "validate_sample", "decode_sample", "encode_sample", "json_path", "shown"]
 
 SCHEMA_FILE = "opentrackio-schema-1.0.1.json"
 PROTOCOL_VERSION = (1, 0, 1)
@@ -65,6 +69,8 @@ def json_path(parts) -> str:
     for p in parts:
         if isinstance(p, int) and not isinstance(p, bool):
             out += f"[{p}]"
+        elif isinstance(p, str) and len(p) > 40:  # a received key: named by its start and length
+            out += "[" + json.dumps(p[:24])[:-1] + f'..." ({len(p)} characters)]'
         elif isinstance(p, str) and p.isidentifier():
             out += f".{p}"
         else:
@@ -97,37 +103,109 @@ def _validator():
     return cls(s)
 
 
+#: the longest integer literal a JSON sample may hold (digits): more is beyond a 64-bit float anyway
+#: (its largest value has 309 digits), and Python would refuse to read one past 4,300 digits
+_JSON_INT_DIGITS = 309
+#: a problem's message is cut to this many characters (a sample holds up to 64 KiB of text)
+MAX_MESSAGE_CHARS = 240
+
+
+class _LongInteger:
+    """A JSON integer literal of more digits than any 64-bit float holds, kept as its digit count."""
+
+    __slots__ = ("digits",)
+
+    def __init__(self, digits: int):
+        self.digits = digits
+
+
+def _json_int(text: str):
+    digits = len(text) - (text[0] == "-")
+    return _LongInteger(digits) if digits > _JSON_INT_DIGITS else int(text)
+
+
+def _digits(n: int) -> int:
+    """Decimal digits of ``n`` from its bit length, never through str() (which Python refuses past
+    4,300 digits and which takes quadratic time)."""
+    n = abs(n)
+    if n < 10:
+        return 1
+    d = int(n.bit_length() * 0.30102999566398120)  # log10(2)
+    return d + 1 if n >= 10**d else d
+
+
+def shown(value) -> str:
+    """A received value as a message shows it, in at most about 60 characters: an integer beyond 20
+    digits by its digit count, other numbers and text shortened; never str() of an unbounded integer."""
+    from decimal import Decimal
+    from fractions import Fraction
+
+    if isinstance(value, bool) or value is None:
+        return repr(value)
+    if isinstance(value, _LongInteger):
+        return f"an integer of {value.digits} digits"
+    if isinstance(value, int):
+        return str(value) if abs(value) < 10**20 else f"an integer of {_digits(value)} digits"
+    if isinstance(value, Fraction):
+        return f"the fraction {shown(value.numerator)} / {shown(value.denominator)}"
+    if isinstance(value, Decimal):
+        sign, digits, exp = value.as_tuple()
+        if isinstance(exp, int) and len(digits) > 20:
+            return f"a decimal of {len(digits)} digits times 10^{exp}"
+        text = str(value)
+    elif isinstance(value, (float, str)):
+        text = repr(value)
+    elif isinstance(value, (bytes, bytearray)):
+        return f"a byte string of {len(value)} bytes"
+    elif isinstance(getattr(value, "tag", None), int):  # cbor2's CBORTag: a tag it has no reader for
+        return f"CBOR tag {shown(value.tag)}"
+    else:
+        return f"a value of type {type(value).__name__}"
+    return text if len(text) <= 60 else f"{text[:40]}... ({len(text)} characters)"
+
+
 def _number(v, parts):
     """(v as an int or a finite float, None) or (None, the problem): CBOR's decimal fractions,
     bigfloats and rationals become floats; numbers no 64-bit float holds (1e5000, 10**400) are refused."""
     if isinstance(v, int) and not isinstance(v, bool):
         if abs(v) <= _FLOAT_MAX_INT:
             return v, None
-        return None, SampleProblem(json_path(parts), "finite", f"{str(v)[:20]}... is beyond what a 64-bit float holds")
+        return None, SampleProblem(json_path(parts), "finite", f"{shown(v)} is beyond what a 64-bit float holds")
     try:
         f = float(v)
     except (OverflowError, ValueError, TypeError):
         f = math.inf
     if not math.isfinite(f):
-        return None, SampleProblem(json_path(parts), "finite", f"{str(v)[:40]} is not a finite number")
+        return None, SampleProblem(json_path(parts), "finite", f"{shown(v)} is not a finite number")
     return f, None
 
 
 _FLOAT_MAX_INT = int(sys.float_info.max)
+#: what a decoded sample may hold besides objects and arrays: JSON's own types
+_JSON_SCALARS = (str, int, float, bool, type(None))
 
 
 def _non_finite(obj, parts, depth=0):
-    """The path of the first number that is not finite (NaN, inf, or beyond a 64-bit float), or of
-    nesting beyond MAX_DEPTH, else None. Numbers that are not int or float (CBOR's Decimal and
-    Fraction) are replaced by floats in place."""
+    """The first problem that makes ``obj`` no JSON document of finite numbers, or None: a number that
+    is not finite (NaN, inf, or beyond a 64-bit float), nesting beyond MAX_DEPTH, a map key that is not
+    text or a value JSON has no form for (CBOR's byte strings, tags, dates, sets, undefined). Numbers
+    that are not int or float (CBOR's Decimal and Fraction) are replaced by floats in place. Messages
+    show values through :func:`shown`: an integer is never turned into text whole."""
     if depth > MAX_DEPTH:
         return SampleProblem(json_path(parts), "maxDepth", f"nested deeper than {MAX_DEPTH} levels")
+    if isinstance(obj, dict):
+        for k in obj:
+            if not isinstance(k, str):
+                return SampleProblem(json_path(parts), "propertyNames",
+                                     f"a key that is {shown(k)}, not text (JSON keys are text)")
     items = obj.items() if isinstance(obj, dict) else enumerate(obj) if isinstance(obj, list) else ()
     for k, v in items:
         if isinstance(v, (dict, list)):
             bad = _non_finite(v, parts + (k,), depth + 1)
             if bad:
                 return bad
+        elif isinstance(v, _LongInteger):
+            return SampleProblem(json_path(parts + (k,)), "finite", f"{shown(v)} is beyond what a 64-bit float holds")
         elif isinstance(v, numbers.Number) and not isinstance(v, bool) \
                 and not (isinstance(v, float) and math.isfinite(v)) \
                 and not (isinstance(v, int) and abs(v) <= _FLOAT_MAX_INT):
@@ -135,6 +213,8 @@ def _non_finite(obj, parts, depth=0):
             if bad:
                 return bad
             obj[k] = value
+        elif not isinstance(v, _JSON_SCALARS):
+            return SampleProblem(json_path(parts + (k,)), "type", f"{shown(v)}, which JSON has no form for")
     return None
 
 
@@ -145,7 +225,8 @@ def _order_key(error):
 def sample_problems(sample) -> list[SampleProblem]:
     """Every reason ``sample`` (a decoded dict) breaks the schema, sorted by path; empty when valid."""
     if not isinstance(sample, dict):
-        return [SampleProblem("$", "type", f"a sample is a JSON object, got {type(sample).__name__}")]
+        kind = "int" if isinstance(sample, _LongInteger) else type(sample).__name__
+        return [SampleProblem("$", "type", f"a sample is a JSON object, got {kind}")]
     bad = _non_finite(sample, ())
     if bad:
         return [bad]
@@ -160,8 +241,13 @@ def sample_problems(sample) -> list[SampleProblem]:
             import jsonschema.exceptions
 
             best = jsonschema.exceptions.best_match([e]) or e
-        out.append(SampleProblem(json_path(best.absolute_path), str(best.validator), best.message))
+        out.append(SampleProblem(json_path(best.absolute_path), str(best.validator), _cut(best.message)))
     return out
+
+
+def _cut(message: str) -> str:
+    return message if len(message) <= MAX_MESSAGE_CHARS else message[:MAX_MESSAGE_CHARS - 24] + \
+        f"... ({len(message)} characters)"
 
 
 def _timecode_problems(sample) -> list[SampleProblem]:
@@ -204,7 +290,7 @@ def decode_sample(payload, encoding: str = "json", *, validate: bool = True) -> 
         _needs_live("CBOR samples")
     try:
         if encoding == "json":
-            obj = json.loads(bytes(payload).decode("utf-8"), parse_constant=_reject_constant)
+            obj = json.loads(bytes(payload).decode("utf-8"), parse_constant=_reject_constant, parse_int=_json_int)
         else:
             import cbor2
 

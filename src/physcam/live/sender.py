@@ -15,7 +15,7 @@ import time
 from ..errors import InputError, PhysCamError, require_finite
 from .protocol import DEFAULT_SEGMENT_PAYLOAD, ENCODING_CBOR, ENCODING_JSON, packetize
 from .receiver import DEFAULT_PORT, check_address, check_port
-from .sample import encode_sample
+from .sample import encode_sample, shown
 
 __all__ = ["Sender", "MAX_STREAM_RATE"]
 
@@ -35,7 +35,7 @@ class Sender:
         if encoding not in ("json", "cbor"):
             raise InputError(f"encoding must be json or cbor, got {encoding!r}")
         if modulus not in (255, 256):
-            raise InputError(f"the Fletcher-16 modulus is 256 or 255, got {modulus!r}")
+            raise InputError(f"the Fletcher-16 modulus is 256 or 255, got {shown(modulus)}")
         self.encoding = encoding
         self.segment_payload = segment_payload
         self.modulus = modulus

@@ -1,9 +1,11 @@
 """physcam.metadata: camera metadata recorded with real clips, read into one :class:`ClipRecord`.
 
-One module per source (``arri``, ``red`` with ``cooke``, ``venice``, ``canon``, ``bmd``, ``mosys``);
+One module per source (``arri``, ``arri_json``, ``red`` with ``cooke``, ``venice``, ``canon``, ``bmd``,
+``mosys``);
 :func:`detect` tells the format of each file from its content (never its name), :func:`load`
 reads the files of one clip (RED's static and frames CSVs, VENICE's CSV and XML, Canon's two
-CSVs) into a :class:`ClipRecord`. ``convert`` turns a record into tracked frames, lens reports,
+CSVs) into a :class:`ClipRecord`, every value checked against what a camera can record
+(:mod:`.limits`). ``convert`` turns a record into tracked frames, lens reports,
 an animated USD camera (through ``physcam.live.record``) and OpenTrackIO samples.
 Layer 8.5, beside ``live`` (docs/architecture.md); the readers need no optional extra.
 """
@@ -19,6 +21,7 @@ __all__ = ["ClipRecord", "CookeData", "FrameSample", "TrackerPose", "detect", "d
 
 #: the sources physcam reads, and what each is
 FORMATS = {"arri": "ARRI Meta Extract CSV (tab-separated, one row per frame)",
+           "arri-json": "ARRI Reference Tool JSON (metadata_output v2: clip and per-frame metadata sets)",
            "red": "REDline --printMeta 5 frames CSV (+ --printMeta 3 static CSV)",
            "venice": "Sony VENICE per-frame CSV (+ NonRealTimeMeta XML)",
            "canon": "Canon per-frame CSV (+ static CSV)",
@@ -29,7 +32,7 @@ FORMATS = {"arri": "ARRI Meta Extract CSV (tab-separated, one row per frame)",
 def detect_file(path) -> tuple[str, str]:
     """(format, role) of one file from its first bytes: role "frames" (the per-frame file),
     "static" (RED's or Canon's static CSV) or "xml" (VENICE's). Unknown content is a MetadataError."""
-    from . import arri, bmd, canon, mosys, red, venice
+    from . import arri, arri_json, bmd, canon, mosys, red, venice
 
     p = Path(path)
     try:
@@ -51,6 +54,8 @@ def detect_file(path) -> tuple[str, str]:
     if "\0" in text:
         raise MetadataError("a binary file that is not a Mo-Sys F4 recording (no 0xF4 packet with a valid "
                             "checksum at its start)", p, offset=0)
+    if arri_json.sniff(text):
+        return "arri-json", "frames"
     first = text.splitlines()[0] if text.splitlines() else ""
     if arri.sniff(first):
         return "arri", "frames"
@@ -63,8 +68,8 @@ def detect_file(path) -> tuple[str, str]:
         return "venice", "frames" if role == "csv" else "xml"
     if bmd.sniff(text):
         return "bmd", "frames"
-    raise MetadataError("unknown column layout: not an ARRI Meta Extract, REDline, VENICE, Canon, Blackmagic "
-                        "ExtractMetadata or Mo-Sys F4 file", p, 1)
+    raise MetadataError("unknown column layout: not an ARRI Meta Extract or ARRI Reference Tool JSON, REDline, "
+                        "VENICE, Canon, Blackmagic ExtractMetadata or Mo-Sys F4 file", p, 1)
 
 
 def detect(paths) -> str:
@@ -86,7 +91,8 @@ def _paths(paths) -> list[Path]:
 
 def load(paths) -> ClipRecord:
     """Read one clip's metadata files (one path or several) into a :class:`ClipRecord`."""
-    from . import arri, bmd, canon, mosys, red, venice
+    from . import arri, arri_json, bmd, canon, mosys, red, venice
+    from .limits import check_record
 
     files = _paths(paths)
     roles: dict = {}
@@ -101,9 +107,11 @@ def load(paths) -> ClipRecord:
         roles[role] = p
     if "frames" not in roles:
         raise MetadataError(f"only the {fmt} {', '.join(roles)} file: give the per-frame file too", files[0])
-    single = {"arri": arri.read, "bmd": bmd.read, "mosys": mosys.read}
+    single = {"arri": arri.read, "arri-json": arri_json.read, "bmd": bmd.read, "mosys": mosys.read}
     if fmt in single:
-        return single[fmt](roles["frames"])
-    if fmt == "venice":
-        return venice.read(roles["frames"], roles.get("xml"))
-    return {"red": red.read, "canon": canon.read}[fmt](roles["frames"], roles.get("static"))
+        record = single[fmt](roles["frames"])
+    elif fmt == "venice":
+        record = venice.read(roles["frames"], roles.get("xml"))
+    else:
+        record = {"red": red.read, "canon": canon.read}[fmt](roles["frames"], roles.get("static"))
+    return check_record(record)

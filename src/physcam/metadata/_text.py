@@ -15,12 +15,21 @@ MAX_BYTES = 2_000_000_000
 FOOT_MM = 304.8  # international foot (1959), exact
 
 
-def read_text(path) -> str:
-    """A metadata file as text (UTF-8, a BOM dropped); a binary file or a missing one is a MetadataError."""
-    p = Path(path)
+def _check_size(p: Path, limit: int) -> None:
     try:
-        if p.stat().st_size > MAX_BYTES:
-            raise MetadataError(f"the file is larger than {MAX_BYTES // 10**9} GB", p)
+        size = p.stat().st_size
+    except OSError as exc:
+        raise MetadataError(f"cannot read it ({exc.strerror or exc})", p) from None
+    if size > limit:
+        raise MetadataError(f"the file is larger than {limit / 10**9:g} GB", p)
+
+
+def read_text(path, limit: int = MAX_BYTES) -> str:
+    """A small metadata file (a static CSV, an XML) as text (UTF-8, a BOM dropped); a binary file or a
+    missing one is a MetadataError. Per-frame files are read row by row (:func:`rows`, :func:`lines`)."""
+    p = Path(path)
+    _check_size(p, limit)
+    try:
         data = p.read_bytes()
     except OSError as exc:
         raise MetadataError(f"cannot read it ({exc.strerror or exc})", p) from None
@@ -33,33 +42,87 @@ def read_text(path) -> str:
         raise MetadataError("not UTF-8 text", p, line) from None
 
 
-def rows(path, text: str, delimiter: str = ",") -> tuple[list[str], list[tuple[int, dict]]]:
-    """(header, [(line, {column: cell})]) of a delimited file; a row whose field count differs from
-    the header's (a truncated file) is an error naming its line. Duplicate columns keep the first."""
-    reader = csv.reader(text.splitlines(), delimiter=delimiter)
+def _open_text(p: Path):
+    """The file opened as UTF-8 text (BOM dropped, newlines kept for the csv module), after the size
+    and binary checks."""
+    _check_size(p, MAX_BYTES)
+    try:
+        with open(p, "rb") as fh:
+            if b"\0" in fh.read(4096):
+                raise MetadataError("a binary file, not a metadata text export", p, 1)
+        return open(p, encoding="utf-8-sig", newline="")
+    except OSError as exc:
+        raise MetadataError(f"cannot read it ({exc.strerror or exc})", p) from None
+
+
+def lines(path):
+    """Yield (line number, text without its line break) of a text file, read a line at a time (memory
+    of one line, whatever the file's size)."""
+    p = Path(path)
+    n = 0
+    with _open_text(p) as fh:
+        try:
+            for n, raw in enumerate(fh, 1):
+                yield n, raw.rstrip("\r\n")
+        except UnicodeDecodeError:
+            raise MetadataError("not UTF-8 text", p, n + 1) from None
+
+
+def rows(path, delimiter: str = ",") -> tuple[list[str], object]:
+    """(header, rows) of a delimited file, streamed: ``rows`` yields (line, {column: cell}) one row at
+    a time, so a reader keeps only what it takes from each row (memory near the file's size at
+    most). A row whose field count differs from the header's (a truncated file) is an error naming
+    its line; a blank line is skipped. Duplicate columns keep the first."""
+    p = Path(path)
+    fh = _open_text(p)
+    reader = csv.reader(fh, delimiter=delimiter)
     try:
         header = next(reader)
     except StopIteration:
-        raise MetadataError("the file is empty", path, 1) from None
-    except csv.Error as exc:
-        raise MetadataError(f"cannot read the header ({exc})", path, 1) from None
+        fh.close()
+        raise MetadataError("the file is empty", p, 1) from None
+    except (csv.Error, UnicodeDecodeError) as exc:
+        fh.close()
+        why = "not UTF-8 text" if isinstance(exc, UnicodeDecodeError) else f"cannot read the header ({exc})"
+        raise MetadataError(why, p, 1) from None
     header = [h.strip() for h in header]
-    out = []
-    try:
-        for cells in reader:
-            line = reader.line_num
-            if not cells or (len(cells) == 1 and not cells[0].strip()):
-                continue
-            if len(cells) != len(header):
-                raise MetadataError(f"{len(cells)} fields where the header has {len(header)}: the file is truncated "
-                                    "or its rows do not match its header", path, line)
-            row: dict = {}
-            for h, c in zip(header, cells):
-                row.setdefault(h, c.strip())
-            out.append((line, row))
-    except csv.Error as exc:
-        raise MetadataError(f"cannot read the row ({exc})", path, reader.line_num) from None
-    return header, out
+    return header, _data_rows(p, fh, reader, header)
+
+
+def _data_rows(p, fh, reader, header):
+    with fh:
+        try:
+            for cells in reader:
+                line = reader.line_num
+                if not cells or (len(cells) == 1 and not cells[0].strip()):
+                    continue
+                if len(cells) != len(header):
+                    raise MetadataError(f"{len(cells)} fields where the header has {len(header)}: the file is "
+                                        "truncated or its rows do not match its header", p, line)
+                row: dict = {}
+                for h, c in zip(header, cells):
+                    row.setdefault(h, c.strip())
+                yield line, row
+        except csv.Error as exc:
+            raise MetadataError(f"cannot read the row ({exc})", p, reader.line_num) from None
+        except UnicodeDecodeError:
+            raise MetadataError("not UTF-8 text", p, reader.line_num + 1) from None
+
+
+def single_row(path, what: str, columns=()) -> tuple[list[str], int, dict]:
+    """(header, line, row) of a static CSV: exactly one row after its header (reading stops at the second)."""
+    header, data = rows(path)
+    require_columns(path, header, columns, what)
+    got = []
+    for item in data:
+        got.append(item)
+        if len(got) > 1:
+            data.close()
+            break
+    if len(got) != 1:
+        raise MetadataError(f"{'no row' if not got else 'more than one row'} where {what} has one", path,
+                            got[1][0] if got else 2)
+    return header, got[0][0], got[0][1]
 
 
 def require_columns(path, header, columns, what: str) -> None:

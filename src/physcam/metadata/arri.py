@@ -5,7 +5,9 @@ Fields read (AME 4.4 column names; one row per recorded frame):
 * ``Master TC`` (HH:MM:SS:FF; the column appears twice, the first is read), ``Index``;
 * ``Lens Distance Unit`` ("Meter" or "Feet") and ``Lens Focus Distance`` in that unit, the lens
   data system's (LDS) focus mark from the film plane; converted to mm (1 ft = 304.8 mm).
-  A value in feet-and-inches notation (``12'6"``) under "Meter" is refused;
+  A value in feet-and-inches notation (``12'6"``) under "Meter" is refused. A lens that reports
+  no focus (no unit, or no focus column: a zoom's focal length read without focus data) leaves
+  the focus absent and the clip's notes say so; its timecode, iris and focal length are kept;
 * ``Lens Iris``: the T-stop as a whole-stop marking plus tenths ("1.4 + 7/10" = T1.4 and 7/10
   of a stop = T1.80); ``Lens Linear Iris``, the same in 1/1000 stop with 1000 = T1
   (T = 2^((L - 1000) / 2000), camdkit's reading), is preferred when present (finer);
@@ -24,12 +26,12 @@ import re
 from fractions import Fraction
 
 from ..errors import MetadataError, require_type
-from ._text import FOOT_MM, number, read_text, require_columns, rows, stop_from_marking, timecode
+from ._text import FOOT_MM, number, require_columns, rows, stop_from_marking, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
 
-REQUIRED = ("Master TC", "Lens Distance Unit", "Lens Focus Distance", "Lens Iris", "Lens Focal Length")
+REQUIRED = ("Master TC",)
 #: (camera family, recorded width, height) -> active area (mm), ARRI ALEXA LF formats and resolutions
 ACTIVE_AREA_MM = {("ALEXALF", 1920, 1080): (31.68, 17.82), ("ALEXALF", 3840, 2160): (31.68, 17.82),
                   ("ALEXALF", 4448, 3096): (36.70, 25.54)}
@@ -40,7 +42,7 @@ def sniff(head: str) -> bool:
     """True when ``head`` (the file's first line) is an AME header."""
     require_type("head", head, str, "the first bytes of a metadata file")
     cols = head.split("\t")
-    return "Master TC" in cols and "Lens Focus Distance" in cols
+    return "Master TC" in cols and any(c in cols for c in ("Lens Focus Distance", "Lens Focal Length", "Lens Iris"))
 
 
 def _focus_mm(path, line, unit, text):
@@ -63,26 +65,37 @@ def _tstop(path, line, row):
     if lin not in ("", "--"):
         v = number(path, line, "Lens Linear Iris", lin)
         return 2.0 ** ((v - 1000.0) / 2000.0)
-    return stop_from_marking(path, line, "Lens Iris", row["Lens Iris"])
+    return stop_from_marking(path, line, "Lens Iris", row.get("Lens Iris", ""))
+
+
+def _frame(path, line, r, no_unit: list) -> FrameSample:
+    unit = r.get("Lens Distance Unit", "").strip()
+    focus_text = r.get("Lens Focus Distance", "")
+    if unit in ("", "--"):
+        focus = None
+        if focus_text.strip() not in ("", "--"):
+            no_unit.append(line)  # a focus without its unit: not guessed
+    elif unit not in ("Meter", "Feet"):
+        raise MetadataError(f"Lens Distance Unit {unit!r} is neither Meter nor Feet", path, line)
+    else:
+        focus = _focus_mm(path, line, unit, focus_text)
+    return FrameSample(line=line, timecode=timecode(path, line, r["Master TC"]), focus_mm=focus,
+                       tstop=_tstop(path, line, r),
+                       focal_length_mm=number(path, line, "focal length", r.get("Lens Focal Length", "")))
 
 
 def read(path) -> ClipRecord:
-    """The clip of one AME CSV (module notes)."""
-    text = read_text(path)
-    header, data = rows(path, text, "\t")
+    """The clip of one AME CSV (module notes), read row by row."""
+    header, data = rows(path, "\t")
     require_columns(path, header, REQUIRED, "an ARRI Meta Extract CSV")
-    if not data:
-        raise MetadataError("no frame rows after the header", path, 2)
-    frames = []
+    frames, no_unit, first = [], [], None
     for line, r in data:
-        unit = r["Lens Distance Unit"]
-        if unit not in ("Meter", "Feet"):
-            raise MetadataError(f"Lens Distance Unit {unit!r} is neither Meter nor Feet", path, line)
-        frames.append(FrameSample(line=line, timecode=timecode(path, line, r["Master TC"]),
-                                  focus_mm=_focus_mm(path, line, unit, r["Lens Focus Distance"]),
-                                  tstop=_tstop(path, line, r),
-                                  focal_length_mm=number(path, line, "focal length", r["Lens Focal Length"])))
-    line, first = data[0]
+        if first is None:
+            first = (line, r)
+        frames.append(_frame(path, line, r, no_unit))
+    if first is None:
+        raise MetadataError("no frame rows after the header", path, 2)
+    line, first = first
     g = lambda k: (first.get(k) or "").strip() or None  # noqa: E731
     num = lambda k: number(path, line, k, first.get(k, ""))  # noqa: E731
     w, h = num("Image Width"), num("Image Height")
@@ -102,5 +115,19 @@ def read(path) -> ClipRecord:
         lens_serial=g("Lens Serial Number"),
         squeeze=num("Lens Squeeze"), frame_rate=Fraction(str(fps)).limit_denominator(1001) if fps else None,
         shutter_angle_deg=num("Shutter Angle"), exposure_time_s=exposure_s,
-        iso=int(iso) if iso is not None else None,
-        notes=(f"focus distances recorded in {first['Lens Distance Unit']}s, converted to mm",))
+        iso=int(iso) if iso is not None else None, notes=_notes(frames, no_unit, first))
+
+
+def _notes(frames, no_unit, first) -> tuple[str, ...]:
+    unit = (first.get("Lens Distance Unit") or "").strip()
+    if unit in ("Meter", "Feet"):
+        notes = [f"focus distances recorded in {unit}s, converted to mm"]
+    else:
+        notes = []
+    absent = sum(f.focus_mm is None for f in frames)
+    if absent:
+        why = (f"{len(no_unit)} of them give a Lens Focus Distance without a Lens Distance Unit (first at line "
+               f"{no_unit[0]}), not guessed" if no_unit else "the lens reported no focus")
+        notes.append(f"{absent} of {len(frames)} frames have no focus distance ({why}): focus left absent; "
+                     "timecode, iris and focal length kept")
+    return tuple(notes)

@@ -15,7 +15,7 @@ import re
 from fractions import Fraction
 
 from ..errors import MetadataError, require_type
-from ._text import number, read_text, timecode
+from ._text import lines, number, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -32,7 +32,7 @@ def sniff(head: str) -> bool:
 
 def _sections(path):
     clip, frames, cur = {}, [], None
-    for n, raw in enumerate(read_text(path).splitlines(), 1):
+    for n, raw in lines(path):
         line = raw.strip()
         if not line:
             continue

@@ -3,8 +3,8 @@ animated USD camera and OpenTrackIO samples, through ``physcam.live`` (needs the
 USD the ``usd`` extra).
 
 * :func:`tracked_frames`: one :class:`~physcam.live.frames.TrackedFrame` per recorded frame, its
-  sequence number the frame's index (so USD time code = index: one sample per frame), the tracker
-  pose (Mo-Sys) with its translation read as metres (camdkit's reading of F4).
+  sequence number the frame's index (one USD time sample per frame), the tracker pose (Mo-Sys)
+  with its translation read as metres (camdkit's reading of F4).
 * :func:`solve`: the on-set lens report of each frame (:func:`physcam.onset.report.solve_lens_report`)
   with the recorded focus mark and stop, on the named lens (its breathing: FOV at the focus) or a
   thin lens of the recorded focal length. When the file gives a T-stop and no f-stop, depth of
@@ -15,12 +15,23 @@ USD the ``usd`` extra).
   customData ``physcam:source``, ``physcam:clip`` (the static values as JSON text) and
   ``physcam:plate``: a dictionary of ``path`` (as given, a string: a plate that is not there yet or a
   ``####`` sequence pattern is no unresolvable asset for USD's validators) and ``firstFrame`` /
-  ``lastFrame`` (the plate frame at time code 0 is ``firstFrame``; one plate frame per time code).
+  ``lastFrame``. With a plate frame range the camera is authored on the plate's frame numbers
+  (time code ``firstFrame`` + index: frame 1001 of the plate is time code 1001, start and end time
+  codes the range), else on the clip's frame indices from 0.
 * :func:`opentrackio_samples`: OpenTrackIO 1.0.1 samples, validated against the shipped schema.
+  Each sample with a recorded focal length and focus carries ``pinholeFocalLength``: the image
+  distance s' of a thin lens of that focal length focused at the mark (s + s' = mark, 1/s + 1/s' =
+  1/f; Hecht, *Optics* 5th ed., 5.2.3), the pinhole ``physcam live send --clip`` gives a prime
+  through :func:`physcam.live.camera.with_optics`; a zoom's focal length thus reaches every
+  sample. The static ``nominalFocalLength`` is the lens's printed focal length: a prime's (one
+  focal length over the clip), absent for a zoom (OpenTrackIO 1.0.1: "undefined in the case of a
+  zoom lens"). The file's timecodes need a frame rate: a clip with timecodes and no rate (a RED
+  frames CSV without its static CSV) is refused unless ``rate`` is given, never sent without them.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from fractions import Fraction
 
 from ..errors import InputError, MetadataError, OpticsError, require_type
@@ -110,8 +121,6 @@ def _warn_once(caught) -> None:
 def _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze):
     from ..onset.report import ReportRequest, solve_report
 
-    from dataclasses import replace
-
     from ..live.record import SolvedFrame
 
     cache: dict = {}
@@ -141,7 +150,7 @@ def _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze)
         defaulted = tuple(n for n, v in (("fStop", f.fstop is None and f.tstop is None),
                                          ("pinholeFocalLength", lens is None and f.focal_length_mm is None
                                           and record.nominal_focal_length_mm is None)) if v)
-        out.append(SolvedFrame(tf, float(i), report, (), defaulted))
+        out.append(SolvedFrame(tf, float(i), report, (), defaulted, squeeze=squeeze))
     return out
 
 
@@ -171,6 +180,7 @@ def write_usd(file, record, solved, *, plate=None, plate_frames=None, meters_per
 
     from pxr import Usd
 
+    from ..export._codetext import printable_line
     from ..io import check_writable
     from ..live.record import write_recording_usd
     from ..usd.author import save_stage
@@ -184,13 +194,15 @@ def write_usd(file, record, solved, *, plate=None, plate_frames=None, meters_per
     if p.suffix not in (".usda", ".usd", ".usdc"):
         raise InputError(f"{p}: a USD file name ends in .usda, .usd or .usdc")
     rate = solved[0].frame.rate if solved else None
+    if plate_d and "firstFrame" in plate_d:  # the plate's frame numbers are the time codes
+        solved = [replace(s, time_code=float(plate_d["firstFrame"] + i)) for i, s in enumerate(solved)]
     with tempfile.TemporaryDirectory(prefix="physcam-metadata-") as tmp:
         first = write_recording_usd(Path(tmp) / "take.usda", solved, rate=rate, meters_per_unit=meters_per_unit,
                                     path=path)
         stage = Usd.Stage.Open(str(first))
         cam = stage.GetPrimAtPath(path)
-        cam.SetCustomDataByKey("physcam:source", f"{record.source} camera metadata read by physcam metadata usd "
-                                                 f"({', '.join(Path(f).name for f in record.files)})")
+        cam.SetCustomDataByKey("physcam:source", printable_line(f"{record.source} camera metadata read by physcam "
+                                                                f"metadata usd ({', '.join(Path(f).name for f in record.files)})"))
         static = {k: v for k, v in record.static_dict().items() if v is not None and k != "notes"}
         cam.SetCustomDataByKey("physcam:clip", json.dumps(static, sort_keys=True))
         if plate_d:
@@ -209,15 +221,25 @@ def _timecode(tc: str, rate: Fraction) -> dict | None:
 
 def opentrackio_samples(record, *, rate=None) -> list[dict]:
     """The clip as OpenTrackIO 1.0.1 samples (the first with the static block), each validated
-    against the shipped schema; the file's timecodes, its lens encoders (Mo-Sys) and its identity."""
+    against the shipped schema; the file's timecodes, its focal length as each sample's pinhole,
+    its lens encoders (Mo-Sys) and its identity (module notes)."""
     from ..live.frames import sample_from_frame
     from ..live.sample import validate_sample
 
     record = _record(record)
     frames = tracked_frames(record, rate=rate)
-    static = _static(record, frames[0].rate) if frames else None
+    fr = frames[0].rate if frames else None
+    if fr is None and any(f.timecode is not None for f in record.frames):
+        raise MetadataError(f"the {record.source} clip records timecodes but no frame rate, and OpenTrackIO's "
+                            "timecode needs one: give the frame rate (--fps), or the file that carries it (a RED "
+                            "clip's --printMeta 3 static CSV)", record.files[0])
+    if fr is not None and fr > 120 and any(f.timecode is not None for f in record.frames):
+        raise MetadataError(f"the clip's frame rate {float(fr):g} fps is above OpenTrackIO's timecode rates "
+                            "(120 fps at most): its timecodes cannot be sent", record.files[0])
+    static = _static(record, fr) if frames else None
     out = []
     for i, (f, tf) in enumerate(zip(record.frames, frames)):
+        tf = replace(tf, pinhole_focal_length_mm=_pinhole(record, i, f))
         s = sample_from_frame(tf, source_id=_source_urn(record), sequence_number=i,
                               static=static if i == 0 else None, status=f"physcam metadata ({record.source})")
         tc = _timecode(f.timecode, tf.rate)
@@ -233,6 +255,20 @@ def opentrackio_samples(record, *, rate=None) -> list[dict]:
     return out
 
 
+def _pinhole(record, i, f) -> float | None:
+    """The pinhole of a thin lens of the frame's focal length focused at its mark (module notes), or None."""
+    from ..optics.thinlens import image_distance, object_distance_for_marked
+
+    focal = f.focal_length_mm
+    if focal is None or f.focus_mm is None:
+        return None
+    try:
+        return float(image_distance(focal, object_distance_for_marked(focal, f.focus_mm)))
+    except (InputError, OpticsError) as exc:
+        raise MetadataError(f"frame {i}: a {focal:g} mm lens cannot focus at the recorded {f.focus_mm:g} mm ({exc})",
+                            record.files[0], f.line if record.source != "mosys" else None) from None
+
+
 def _source_urn(record) -> str:
     import uuid
 
@@ -242,8 +278,9 @@ def _source_urn(record) -> str:
 def _static(record, rate):
     from ..live.frames import static_block
 
-    focals = {f.focal_length_mm for f in record.frames}
-    nominal = record.nominal_focal_length_mm or (focals.pop() if len(focals) == 1 and None not in focals else None)
+    focals = {f.focal_length_mm for f in record.frames} - {None}
+    # the printed focal length of a prime; a zoom (the focal length changes over the clip) has none
+    nominal = None if len(focals) > 1 else (record.nominal_focal_length_mm or (focals.pop() if focals else None))
     if record.active_area_mm is None or rate is None:
         out = {}
         if nominal is not None or record.lens_model:

@@ -48,7 +48,7 @@ class TrackerPose:
     lens_fields: dict = field(default_factory=dict)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class FrameSample:
     """One frame: ``line`` is where it is in its file (CSV line, or F4 packet index); ``timecode``
     as the file prints it (HH:MM:SS:FF); ``focus_mm`` from the film plane; ``tstop`` / ``fstop``

@@ -20,7 +20,7 @@ from fractions import Fraction
 
 from ..errors import MetadataError, require_type
 from . import cooke
-from ._text import number, read_text, require_columns, rows, timecode
+from ._text import number, require_columns, rows, single_row, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -44,10 +44,8 @@ def sniff(head: str) -> str | None:
 
 
 def _frames(path):
-    header, data = rows(path, read_text(path))
+    header, data = rows(path)
     require_columns(path, header, FRAME_COLUMNS, "a REDline --printMeta 5 CSV")
-    if not data:
-        raise MetadataError("no frame rows after the header", path, 2)
     out = []
     for line, r in data:
         ck = None
@@ -59,15 +57,13 @@ def _frames(path):
                                tstop=None if ck is None else ck.t_stop,
                                focal_length_mm=number(path, line, "focal length", r["Focal Length"]),
                                entrance_pupil_mm=None if ck is None else ck.entrance_pupil_mm, cooke=ck))
+    if not out:
+        raise MetadataError("no frame rows after the header", path, 2)
     return out
 
 
 def _static(path) -> dict:
-    header, data = rows(path, read_text(path))
-    require_columns(path, header, STATIC_COLUMNS, "a REDline --printMeta 3 CSV")
-    if len(data) != 1:
-        raise MetadataError(f"{len(data)} rows where a --printMeta 3 export has one", path, 2)
-    line, r = data[0]
+    _, line, r = single_row(path, "a REDline --printMeta 3 CSV", STATIC_COLUMNS)
     g = lambda k: (r.get(k) or "").strip() or None  # noqa: E731
     num = lambda k: number(path, line, k, r.get(k, ""))  # noqa: E731
     w, h, fps = num("Frame Width"), num("Frame Height"), num("FPS")

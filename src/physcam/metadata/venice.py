@@ -47,22 +47,23 @@ def _focus_column(path, header):
 
 
 def _frames(path):
-    header, data = rows(path, read_text(path))
+    header, data = rows(path)
     missing = [c for c in COLUMNS if c not in header]
     if missing:
         raise MetadataError(f"unknown column layout for a VENICE CSV: no {', '.join(map(repr, missing))} column",
                             path, 1)
     col, scale = _focus_column(path, header)
-    if not data:
-        raise MetadataError("no frame rows after the header", path, 2)
-    out = []
+    out, first = [], None
     for line, r in data:
+        first = first or r
         f = number(path, line, "focus distance", r[col])
         out.append(FrameSample(line=line, timecode=timecode(path, line, r["Timecode"]),
                                focus_mm=None if f is None else f * scale,
                                tstop=stop_from_marking(path, line, "Aperture", r["Aperture"]),
                                focal_length_mm=number(path, line, "focal length", r["Focal Length (mm)"])))
-    return out, data[0][1]
+    if first is None:
+        raise MetadataError("no frame rows after the header", path, 2)
+    return out, first
 
 
 def _xml(path) -> tuple[dict, int | None]:

@@ -145,8 +145,25 @@ class LensReport:
     #: the f-number at this focus for the iris set to ``fstop`` at infinity (see f_number_at_focus);
     #: None: ``fstop`` (no focusing changes it)
     fstop_at_focus: float | None = None
+    #: an anamorphic prescription's horizontal (X-meridian) entrance pupil in front of the film, the
+    #: parallax-free pivot of a pan; ``entrance_pupil_from_film_mm`` is then the vertical (Y) one, the
+    #: pivot of a tilt (physcam.optics.focusing.EntrancePupils). None: one pupil for both
+    entrance_pupil_horizontal_from_film_mm: float | None = None
 
     # --- convenience --------------------------------------------------------
+    @property
+    def split_focus(self) -> dict | None:
+        """With the focus solved from a near and a far limit and the stop given: the stop those limits need at
+        this CoC beside the given one (the report's own limits are the given stop's); else None."""
+        need = self.solved.get("fstop_needed")
+        if need is None:
+            return None
+        return {"near_asked_from_film_mm": self.measured.get("near_from_film_mm"),
+                "far_asked_from_film_mm": finite_or_none(self.measured.get("far_from_film_mm", math.inf)),
+                "fstop_given": self.fstop, "fstop_needed": need, "holds": self.fstop >= need * (1 - 1e-9),
+                "definition": "the focus between the asked near and far limits; fstop_needed holds both at this CoC; "
+                              "the report's near and far limits are those of the given stop"}
+
     @property
     def real_fov_differs(self) -> bool:
         """True when distortion makes the pinhole's field of view wrong by more than
@@ -180,6 +197,18 @@ class LensReport:
         if self.entrance_pupil_from_film_mm is None:
             return None
         return pivot_camera_space(self.entrance_pupil_from_film_mm)
+
+    def entrance_pupils_dict(self) -> dict:
+        """Both meridians' entrance pupils and the pivots they give (equal for a spherical lens)."""
+        v = self.entrance_pupil_from_film_mm
+        h = v if self.entrance_pupil_horizontal_from_film_mm is None else self.entrance_pupil_horizontal_from_film_mm
+        return {"horizontal_from_film_mm": h, "vertical_from_film_mm": v,
+                "separation_mm": None if v is None else h - v,
+                "pan_pivot_camera_space_mm": None if h is None else list(pivot_camera_space(h)),
+                "tilt_pivot_camera_space_mm": None if v is None else list(pivot_camera_space(v)),
+                "definition": "horizontal: the X meridian's paraxial entrance pupil, about which a pan is "
+                              "parallax-free; vertical: the Y meridian's, for a tilt; entrance_pupil_from_film_mm "
+                              "and pivot_camera_space_mm are the vertical one"}
 
     @property
     def desqueezed_width_mm(self) -> float:
@@ -231,11 +260,11 @@ class LensReport:
     def diffraction_note(self) -> str:
         d = self.diffraction_dict()
         um = 1000.0
-        text = (f"diffraction ({d['wavelength_nm']:g} nm): Airy disk {d['airy_diameter_mm'] * um:.1f} um across at "
+        text = (f"diffraction ({d['wavelength_nm']:g} nm): Airy disk {d['airy_diameter_mm'] * um:.1f} µm across at "
                 f"f/{self.fstop:.3g} (working f/{d['working_f_number']:.3g}), {d['airy_to_coc']:.2f} of the CoC "
-                f"({self.coc_mm * um:.1f} um)")
+                f"({self.coc_mm * um:.1f} µm)")
         if d["photosite_pitch_mm"] is not None:
-            text += f" and {d['airy_in_photosites']:.1f} photosites ({d['photosite_pitch_mm'] * um:.2f} um)"
+            text += f" and {d['airy_in_photosites']:.1f} photosites ({d['photosite_pitch_mm'] * um:.2f} µm)"
         verb = "exceeds" if d["exceeds_coc"] else "would exceed"
         return text + f"; it {verb} the CoC past f/{d['fstop_airy_exceeds_coc']:.3g}"
 
@@ -276,8 +305,10 @@ class LensReport:
             "flange_focal_distance_mm": self.flange_focal_distance_mm,
             "focus_error_mm": self.focus_error_mm,
             "magnification": self.magnification,
+            "frame_at_focus": _frame_dict(self),
             "dof": self.dof.to_dict(),
             "dof_horizontal": None if self.dof_horizontal is None else self.dof_horizontal.to_dict(),
+            "split_focus": self.split_focus,
             "pinhole": {"focal_length_mm": self.pinhole[0], "squeeze": self.pinhole[1],
                         "definition": "the pinhole at the entrance pupil that frames like the lens at this focus: "
                                       "f = (exit pupil to film) / pupil magnification; s' for a thin lens"},
@@ -286,7 +317,8 @@ class LensReport:
                              "diagonal": self.dfov_inf_deg},
                 "focus": {"horizontal": self.hfov_focus_deg, "vertical": self.vfov_focus_deg,
                           "diagonal": self.dfov_focus_deg},
-                "definition": "infinity and focus: the paraxial (pinhole) field; real: chief rays traced through "
+                "definition": "infinity: the paraxial field of the lens focused at infinity (a prescription's EFL "
+                              "there); focus: the best-match pinhole's at this focus; real: chief rays traced through "
                               "the prescription from the film edge, top and corner (null where not covered)",
                 "real": None if self.real_fov is None else {
                     "horizontal": self.real_fov["horizontal_deg"], "vertical": self.real_fov["vertical_deg"],
@@ -301,11 +333,23 @@ class LensReport:
             "dof_aspect": self.dof_aspect,
             "entrance_pupil_source": self.entrance_pupil_source,
             "pivot_camera_space_mm": None if self.pivot_camera_space_mm is None else list(self.pivot_camera_space_mm),
+            "entrance_pupils": self.entrance_pupils_dict(),
             "solved": dict(self.solved),
             "measured": {k: finite_or_none(v) if isinstance(v, float) else v for k, v in self.measured.items()},
             "notes": list(self.notes),
             "diffraction": self.diffraction_dict(),
         }
+
+
+def _frame_dict(report) -> dict | None:
+    """The picture's (desqueezed) width and height in the plane of sharp focus, the gate over |m|
+    (physcam.onset.framing), or None focused at infinity."""
+    m = report.magnification
+    if m == 0.0 or math.isinf(report.object_distance_mm):
+        return None
+    w, h = report.sensor.width_mm * report.squeeze / abs(m), report.sensor.height_mm / abs(m)
+    return {"width_mm": w, "height_mm": h, "diagonal_mm": math.hypot(w, h),
+            "distance_from_h1_mm": report.object_distance_mm}
 
 
 # --------------------------------------------------------------------------------------
@@ -352,6 +396,7 @@ def solve_report(request: ReportRequest) -> LensReport:
             h1_film if state.model == "practical" else None),
         dof_aspect=dof.blur_aspect, diffraction_wavelength_nm=req.diffraction_wavelength_nm,
         bellows_factor=state.bellows, fstop_at_focus=None if state.n_ratio == 1.0 else n_focus,
+        entrance_pupil_horizontal_from_film_mm=state.pupil_x_from_film_mm if pupil_src == "prescription" else None,
         **field_of_view(req, state, h2_film))
     report = dataclasses.replace(report, notes=report.notes + (report.diffraction_note(),))
     if req.lens is not None:

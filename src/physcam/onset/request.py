@@ -84,7 +84,7 @@ class ReportRequest:
     fstop_at_focus: float | None = None
 
     def __post_init__(self):
-        for check in (_check_sensor_and_wavelength, _check_lens_or_datasheet, _check_stops, _check_distances,
+        for check in (_read_as_written, _check_sensor_and_wavelength, _check_lens_or_datasheet, _check_stops, _check_distances,
                       _check_planes):
             for name, value in check(self).items():
                 object.__setattr__(self, name, value)
@@ -96,6 +96,33 @@ class ReportRequest:
     @classmethod
     def names(cls) -> tuple[str, ...]:
         return tuple(f.name for f in fields(cls))
+
+
+#: The request's distances, and whether each may be infinite: strings are read as the CLI reads them.
+_DISTANCES = {"focal_length_mm": False, "focus_mm": True, "near_mm": False, "far_mm": True,
+              "sensor_front_mm": False, "lens_length_mm": False}
+
+
+def _read_as_written(r: ReportRequest) -> dict:
+    """What a person writes, read as the CLI reads it: a sensor name ("ALEXA 35"), distances with units
+    ("2m", "10ft", "10'6\"", "infinity", "hyperfocal" for the focus). A number is millimetres; so is a bare
+    number in a string (the Python API reads no user config)."""
+    from ..units import parse_distance
+
+    out = {}
+    if isinstance(r.sensor, str):
+        from .sensors import find_sensor
+
+        out["sensor"] = find_sensor(r.sensor)
+    for key, infinite in _DISTANCES.items():
+        v = getattr(r, key)
+        if not isinstance(v, str):
+            continue
+        if key == "focus_mm" and v.strip().lower() in (HYPERFOCAL, "hyper"):
+            out[key] = HYPERFOCAL
+        else:
+            out[key] = parse_distance(v, name=key.removesuffix("_mm").replace("_", " "), allow_inf=infinite)
+    return out
 
 
 def _check_sensor_and_wavelength(r: ReportRequest) -> dict:

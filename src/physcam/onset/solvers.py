@@ -124,6 +124,12 @@ class LensState(NamedTuple):  # a NamedTuple: made at every report, cheap to def
     squeeze_from_lens: bool = False
     pupil_origin: str = "datasheet"
     notes: tuple[str, ...] = ()
+    #: an anamorphic prescription's X-meridian (horizontal, pan) entrance pupil in front of the film;
+    #: ``pupil_from_film_mm`` is then the Y meridian's (vertical, tilt). None: one pupil for both
+    pupil_x_from_film_mm: float | None = None
+    #: a prescription's EFL at infinity focus, (Y, X) mm: the field of view at infinity (None: the
+    #: focal length, which a thin lens or a datasheet keeps at every focus)
+    efl_infinity: tuple[float, float] | None = None
 
 
 @_typed
@@ -155,10 +161,12 @@ def lens_at_mark(req: ReportRequest) -> LensState:
     notes.append(f"planes from the prescription focused at the mark ({planes.method} focusing): EFL "
                  f"{planes.efl_mm:.3f} mm, back focus {planes.back_focus_mm:.3f} mm")
     n_ratio = focusing.f_number_ratio(lens, mark)
+    inf = paraxial.gaussian_xy(lens)
     state = LensState(planes.efl_mm, fstop, mark, "technical", planes.h1_from_film_mm, planes.h2_from_film_mm,
                       planes.entrance_pupil_from_film_mm, req.squeeze, req.lens_name or lens.name,
                       (planes.pinhole_focal_length_mm,) * 2, planes.stop_from_film_mm, n_ratio,
-                      planes.working_f_number / planes.f_number * n_ratio, pupil_origin="prescription")
+                      planes.working_f_number / planes.f_number * n_ratio, pupil_origin="prescription",
+                      efl_infinity=(inf["y"].efl, inf["x"].efl))
     if lens.is_anamorphic:
         state = _anamorphic_state(req.lens, state, planes, notes)
     return state._replace(notes=tuple(notes))
@@ -172,7 +180,13 @@ def _anamorphic_state(lens, state: LensState, planes, notes: list) -> LensState:
     st = focusing.focus(lens, state.focus_mm)
     gx = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z)
     lens_squeeze = planes.efl_mm / gx.efl
-    state = state._replace(lens_squeeze=lens_squeeze, blur_aspect=focusing.pupil_aspect(lens, state.focus_mm))
+    state = state._replace(lens_squeeze=lens_squeeze, blur_aspect=focusing.pupil_aspect(lens, state.focus_mm),
+                           pupil_x_from_film_mm=gx.in_front_of("entrance_pupil"))
+    if abs(state.pupil_x_from_film_mm - state.pupil_from_film_mm) > 0.05:
+        notes.append(f"anamorphic: two entrance pupils, horizontal (X, the pan pivot) "
+                     f"{state.pupil_x_from_film_mm:.1f} mm and vertical (Y, the tilt pivot) "
+                     f"{state.pupil_from_film_mm:.1f} mm in front of the film; the report's entrance pupil is "
+                     "the vertical one")
     if state.squeeze != 1.0:
         return state
     notes.append(f"anamorphic: EFL {planes.efl_mm:.3f} mm (Y) and {gx.efl:.3f} mm (X), effective squeeze "
@@ -242,7 +256,7 @@ def solve_focus(req: ReportRequest, state: LensState, planes: PrincipalPlanes, c
     if req.at_hyperfocal and req.lens is None:  # a prescription's mark is solved with the lens's own planes
         mark = planes.mark_for_s(_dof.hyperfocal_distance(f, state.fstop * state.n_ratio, c))
         solved["focus"] = HYPERFOCAL
-        notes.append(f"focus at the hyperfocal distance: mark {mark:.6g} mm from the film")
+        notes.append("focus at the hyperfocal distance (the focus mark above)")
     elif mark is None:
         if near is not None and far is not None:
             s = _solve_focus_from_bracket(near, far, planes.h1_at, f)
@@ -313,7 +327,13 @@ def invert_limits(req: ReportRequest, state: LensState, planes: PrincipalPlanes,
     (physcam.optics.dof), checked against the other when both are measured."""
     near, far, s, N, solved, notes = req.near_mm, req.far_mm, focus_solution.object_distance, state.fstop, {}, []
     one_limit_focus = "focus_from_film_mm" in focus_solution.solved and (near is None or far is None)
-    if (near is not None or far is not None) and not one_limit_focus:  # one limit and N made the focus
+    if _is_split_focus(req, focus_solution) and N is not None:  # the stop is kept: what it holds, what is needed
+        solved.update(_split_focus(planes, s, near, far, c, N, state.n_ratio))
+        notes.append(f"split focus with the stop given: f/{N:.3g} holds less than the asked limits at this CoC "
+                     f"({c:.4g} mm); they need f/{solved['fstop_needed']:.3g}" if N < solved["fstop_needed"] else
+                     f"split focus: f/{N:.3g} holds the asked limits at this CoC ({c:.4g} mm); they need "
+                     f"f/{solved['fstop_needed']:.3g}")
+    elif (near is not None or far is not None) and not one_limit_focus:  # one limit and N made the focus
         hp_near, hp_far = _hyperfocal_parameters(planes, s, near, far)
         hp = hp_near if hp_near is not None else hp_far
         if hp_near is not None and hp_far is not None:
@@ -339,6 +359,20 @@ def invert_limits(req: ReportRequest, state: LensState, planes: PrincipalPlanes,
         raise InputError(f"the measured limits need f/{N:.3g}, faster than any lens in air can be "
                          f"(f/{MIN_F_NUMBER:g}); check --near, --far, --focus and the CoC")
     return Aperture(N, c, coc_name, solved, tuple(notes))
+
+
+def _is_split_focus(req: ReportRequest, focus_solution: Focus) -> bool:
+    """Focus solved from a measured (or wanted) near and far limit: split focus."""
+    return "focus_from_film_mm" in focus_solution.solved and req.near_mm is not None and req.far_mm is not None
+
+
+def _split_focus(planes: PrincipalPlanes, s: float, near: float, far: float, c: float, n_given: float,
+                 n_ratio: float) -> dict:
+    """The stop a split focus needs to hold ``near`` to ``far`` (from the film) at the CoC ``c``: N = f^2 / (c h),
+    h the hyperfocal parameter of either limit (they agree: the focus is their harmonic mean about H1)."""
+    h = _dof.hyperfocal_parameter_from_near(planes.f, s, planes.to_h1(near, s))
+    need = _dof.f_number_for_dof(planes.f, c, h) / n_ratio  # the iris's setting
+    return {"fstop_needed": need, "fstop_needed_stops_over_given": _dof.stops_between(need, n_given)}
 
 
 def _hyperfocal_parameters(planes: PrincipalPlanes, s: float, near, far):
@@ -454,18 +488,24 @@ def _fov_deg(size, focal_or_image_distance):
 
 @_typed
 def field_of_view(req: ReportRequest, state: LensState, h2_film: float) -> dict:
-    """The paraxial fields of view at infinity (EFL) and at this focus through the best-match pinhole:
+    """The paraxial fields of view at infinity (the EFL at infinity focus: a prescription's own there, not at
+    the mark) and at this focus through the best-match pinhole:
     the pinhole at the entrance pupil that frames like the lens, f_pin = n (film - exit pupil) /
     (n' m_p) (docs/lens-report.md, "The best-match pinhole"); exact per meridian for a prescription,
     H2 to the film for a thin lens or a datasheet (pupils on the principal planes)."""
     f, sq, w, h = state.focal_length_mm, state.squeeze, req.sensor.width_mm, req.sensor.height_mm
+    f_inf, sq_inf = f, sq
+    if state.efl_infinity is not None:  # a prescription's EFL changes with focus: the lens at infinity
+        f_inf = state.efl_infinity[0]
+        sq_inf = f_inf / state.efl_infinity[1] if state.squeeze_from_lens else sq
     pin_y, pin_x = state.pinhole if state.pinhole is not None else (h2_film, h2_film)
     pin_sq = pin_y / pin_x if pin_x != pin_y else sq  # an anamorphic frames each meridian by its own
     if req.pinhole_focal_length_mm is not None:
         pin_y = req.pinhole_focal_length_mm
         pin_sq = sq if req.pinhole_squeeze is None else req.pinhole_squeeze
-    wd, wp = w * sq, w * pin_sq
-    return dict(hfov_inf_deg=_fov_deg(wd, f), vfov_inf_deg=_fov_deg(h, f), dfov_inf_deg=_fov_deg(math.hypot(wd, h), f),
+    wd, wp = w * sq_inf, w * pin_sq
+    return dict(hfov_inf_deg=_fov_deg(wd, f_inf), vfov_inf_deg=_fov_deg(h, f_inf),
+                dfov_inf_deg=_fov_deg(math.hypot(wd, h), f_inf),
                 hfov_focus_deg=_fov_deg(wp, pin_y), vfov_focus_deg=_fov_deg(h, pin_y),
                 dfov_focus_deg=_fov_deg(math.hypot(wp, h), pin_y),
                 pinhole_focal_length_mm=pin_y, pinhole_squeeze=pin_sq)

@@ -48,11 +48,19 @@ def report_rows(report, units: str = "m", *, notes: bool = True) -> list[tuple[s
         add("focus error", f"{d['focus_error_mm']:+.3f} mm (+ = image in front of film)", "film plane")
     m = d["magnification"]
     add("magnification", f"{m:.5f}  (1:{1 / abs(m):.1f}, inverted image)" if m else "0  (subject at infinity)", "")
+    fr = d["frame_at_focus"]
+    if fr is not None:
+        add("frame at the focus (w x h)", f"{_len(fr['width_mm'])} x {_len(fr['height_mm'])}", "subject plane")
     dof = d["dof"]
     add("hyperfocal", _len(dof["hyperfocal_from_film_mm"]), "film plane")
     add("near limit", _len(dof["near_from_film_mm"]), "film plane")
     add("far limit", _len(dof["far_from_film_mm"]), "film plane")
     add("depth of field", _len(dof["total_mm"]), "")
+    sf = d["split_focus"]
+    if sf is not None:
+        asked = f"{_len(sf['near_asked_from_film_mm'])} – {_len(sf['far_asked_from_film_mm'])}"
+        given = "holds them" if sf["holds"] else f"f/{sf['fstop_given']:.2g} holds only the limits above"
+        add("stop needed (split focus)", f"f/{sf['fstop_needed']:.2g} for {asked} at this CoC  ({given})", "")
     if d["dof_horizontal"]:
         dh = d["dof_horizontal"]
         add("horizontal near / far", f"{_len(dh['near_from_film_mm'])} / {_len(dh['far_from_film_mm'])}", "film plane")
@@ -68,12 +76,22 @@ def report_rows(report, units: str = "m", *, notes: bool = True) -> list[tuple[s
     add("pinhole (render camera)", f"{pin['focal_length_mm']:.3f} mm" + (
         f", squeeze {pin['squeeze']:.4g}" if pin["squeeze"] != 1.0 else "") + "  [frames like the lens at focus]",
         "entrance pupil")
-    if d["entrance_pupil_from_film_mm"] is not None:
+    eps = d.get("entrance_pupils") or {}
+    if eps.get("separation_mm"):  # an anamorphic's two pupils: say which pivot is which
+        add("entrance pupil, horizontal (pan pivot)", f"{eps['horizontal_from_film_mm']:.2f} mm  "
+            f"[{d['entrance_pupil_source']}, X meridian]", "film plane")
+        add("entrance pupil, vertical (tilt pivot)", f"{eps['vertical_from_film_mm']:.2f} mm  "
+            f"[{d['entrance_pupil_source']}, Y meridian]", "film plane")
+    elif d["entrance_pupil_from_film_mm"] is not None:
         add("entrance pupil (pivot)", f"{d['entrance_pupil_from_film_mm']:.2f} mm  [{d['entrance_pupil_source']}]",
             "film plane")
-    for k in ("coc_mm", "consistency", "far_error_mm", "fstop_drift_stops"):
-        if k in d["solved"] and d["solved"][k] is not None:
-            add(f"solved {k}", f"{d['solved'][k]:.6g}", "")
+    sv = d["solved"]
+    if sv.get("coc_mm") is not None:
+        add("circle of confusion (solved)", f"{sv['coc_mm']:.4f} mm", "")
+    if sv.get("fstop_drift_stops") is not None:
+        add("f-stop drift (solved)", f"{sv['fstop_drift_stops']:+.2f} stops from the marked f-stop", "")
+    if sv.get("far_error_mm") is not None:
+        add("far limit: predicted − measured", f"{sv['far_error_mm']:+.1f} mm", "")
     for n in d["notes"] if notes else ():
         add("note", n, "")
     return rows

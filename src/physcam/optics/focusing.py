@@ -42,10 +42,14 @@ __all__ = [
     "image_distance",
     "focus",
     "closest_focus",
+    "CloseFocus",
+    "close_focus",
     "iris_semi_diameter",
     "f_number_ratio",
     "gaussian_at_focus",
     "technical_planes",
+    "EntrancePupils",
+    "entrance_pupils",
     "breathing_table",
     "pupil_aspect",
     "hyperfocal_mark",
@@ -140,10 +144,23 @@ class BreathingRow:
     magnification: float
     back_focus_mm: float
     fov_change_pct: float  # HFOV change from infinity focus, percent
-    entrance_pupil_from_film_mm: float | None = None  # where the camera pivots at this mark
+    entrance_pupil_from_film_mm: float | None = None  # where the camera pivots at this mark (X meridian: a pan)
+    #: the Y (vertical) meridian's: EFL and framing focal length (sensor half-width / tan of the Y meridian's
+    #: paraxial half-field there; paraxially the Y pinhole), and its entrance pupil (a tilt's pivot). They
+    #: differ from the X meridian's for an anamorphic lens; equal for a spherical one
+    vertical_efl_mm: float | None = None
+    vertical_breathing_focal_length_mm: float | None = None
+    vertical_entrance_pupil_from_film_mm: float | None = None
+
+    @property
+    def breathing_squeeze(self) -> float | None:
+        """Vertical over horizontal framing focal length: the squeeze the framing shows at this mark."""
+        v = self.vertical_breathing_focal_length_mm
+        return None if v is None else v / self.breathing_focal_length_mm
 
     def to_dict(self) -> dict:
         d = asdict(self)
+        d["breathing_squeeze"] = self.breathing_squeeze
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
 
 
@@ -160,6 +177,10 @@ def focus_method(prescription: Prescription, method: str = "auto") -> str:
 
 
 def _mark(focus_from_film_mm) -> float:
+    if isinstance(focus_from_film_mm, str):  # "2m", "10ft", "infinity": as the command line reads it
+        from ..units import parse_distance
+
+        return _mark(parse_distance(focus_from_film_mm, name="focus distance", allow_inf=True))
     d = float(focus_from_film_mm)
     if math.isnan(d) or d <= 0:
         raise InputError(f"focus distance must be a positive distance from the film plane, got {focus_from_film_mm!r}")
@@ -211,6 +232,8 @@ def _unit_focus(p: Prescription, mark: float, axis: str, lam, max_extension_mm) 
     # 1/s + n'/s' = phi with s = T - s'  ->  phi s'^2 - (phi T + n' - 1) s' + n' T = 0
     bq = phi * T + n2 - 1.0
     disc = bq * bq - 4.0 * phi * n2 * T
+    if -1e-12 * bq * bq <= disc < 0:  # the 1:1 mark itself (closest_focus), a rounding error below zero
+        disc = 0.0
     if T <= 0 or disc < 0:
         t_min = (1.0 + math.sqrt(n2)) ** 2 / phi  # discriminant zero: the 1:1 conjugate in air
         raise OpticsError(
@@ -260,6 +283,52 @@ def closest_focus(prescription: Prescription, *, method: str = "auto", axis: str
     if g.efl <= 0:
         raise OpticsError(f"lens {prescription.name!r} has negative power: it forms no real image to focus")
     return (1.0 + math.sqrt(g.image_index)) ** 2 * g.efl + (g.z_rear_principal_plane - g.z_front_principal_plane)
+
+
+#: Without the maker's minimum object distance, a unit-focusing lens's breathing is drawn from this many
+#: focal lengths in front of the film (about 1:8): cine primes' published close focus is 8 to 12 focal
+#: lengths (a 50 mm: 0.45-0.6 m), while the 1:1 limit (4 f) is a macro's.
+BREATHING_NEAR_EFL = 10.0
+
+
+@dataclass(frozen=True)
+class CloseFocus:
+    """How close the lens focuses, and where that number comes from (mm from the film plane).
+
+    ``source``: "maker" (the file's ``[lens] minimum_object_distance``), "focus groups" (the close
+    position of an internal-focusing lens's variable gaps) or "unit focusing limit" (no mechanical
+    limit known: the 1:1 conjugate, which no real lens of that kind reaches). ``breathing_near_mm``:
+    where breathing tables and plots start by default (the MOD, the focus groups' close point, or
+    :data:`BREATHING_NEAR_EFL` focal lengths, to two significant figures, for a unit-focusing lens without a
+    MOD)."""
+
+    mark_mm: float
+    source: str
+    words: str
+    breathing_near_mm: float
+
+    def to_dict(self) -> dict:
+        return {"close_focus_from_film_mm": self.mark_mm, "source": self.source, "words": self.words,
+                "breathing_near_from_film_mm": self.breathing_near_mm}
+
+
+@takes_prescription
+def close_focus(prescription: Prescription, *, method: str = "auto", wavelength_nm=None) -> CloseFocus:
+    """The lens's close focus (:class:`CloseFocus`): the maker's minimum object distance when the file gives
+    one (kept at least the focusing model's own limit), else the focusing model's limit, named as such."""
+    limit = closest_focus(prescription, method=method, wavelength_nm=wavelength_nm)
+    mod = prescription.metadata.minimum_object_distance
+    if mod is not None:
+        mark = max(float(mod), limit)
+        return CloseFocus(mark, "maker", "the maker's minimum object distance" + (
+            "" if mark == mod else f" ({mod:g} mm) is closer than this focusing model reaches: its limit"), mark)
+    if focus_method(prescription, method) == "internal":
+        return CloseFocus(limit, "focus groups", "the focus groups' close position (from the file; no MOD given)",
+                          limit)
+    efl = paraxial.gaussian(prescription, wavelength_nm=wavelength_nm).efl
+    near = BREATHING_NEAR_EFL * efl
+    near = round(near, 1 - int(math.floor(math.log10(near))))  # two significant figures, as marks are engraved
+    return CloseFocus(limit, "unit focusing limit", "unit focusing limit, not the lens's MOD", max(limit, near))
 
 
 def _internal_focus(p: Prescription, mark: float, axis: str, lam) -> FocusState:
@@ -455,7 +524,8 @@ def breathing_table(
     """Effective focal length and horizontal field of view against focus mark.
 
     ``focus_marks_mm``: marks from the film plane (default: infinity, 10 m, 5 m, ...
-    down to the closest focus). The horizontal field uses the X meridian (the squeezed one of
+    down to the close focus of :func:`close_focus`: the MOD, the focus groups' close point, or ten focal
+    lengths for a unit-focusing lens without a MOD). The horizontal field uses the X meridian (the squeezed one of
     an anamorphic) with the lens focused in Y; HFOV = 2 atan(...) of the paraxial
     chief ray reaching the sensor edge (``sensor_width_mm``/2 off axis; default the width of Super 35,
     24.89 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, as the CLI).
@@ -465,10 +535,12 @@ def breathing_table(
         raise InputError(f"sensor width must lie between 1e-6 and 1000 mm, got {w:g}")
     method = focus_method(prescription, method)
     if focus_marks_mm is None:
-        near = closest_focus(prescription, method=method, wavelength_nm=wavelength_nm)
-        # internal focusing ends at its close point; unit focusing (no mechanical limit known) stops
-        # at the last default mark beyond 1:1
-        marks = [m for m in DEFAULT_BREATHING_MARKS if m > near] + ([near] if method == "internal" else [])
+        # from infinity to the close focus: the maker's MOD or the focus groups' close point (that mark
+        # last), or for a unit-focusing lens without a MOD the default marks beyond BREATHING_NEAR_EFL focal
+        # lengths (:func:`close_focus`)
+        cf = close_focus(prescription, method=method, wavelength_nm=wavelength_nm)
+        near = cf.breathing_near_mm
+        marks = [m for m in DEFAULT_BREATHING_MARKS if m > near * (1 + 1e-9)] + [near]
     else:
         marks = [_mark(m) for m in focus_marks_mm]
         if not marks:
@@ -479,6 +551,9 @@ def breathing_table(
         st = focus(prescription, m, method=method, axis="y", wavelength_nm=wavelength_nm)
         gx = paraxial.gaussian(st.prescription, axis="x", wavelength_nm=wavelength_nm, object_z=st.object_z, film_z=st.film_z)
         half = abs(paraxial.field_angle(st.prescription, w / 2.0, st.film_z, "x", wavelength_nm))
+        gy = paraxial.gaussian(st.prescription, axis="y", wavelength_nm=wavelength_nm, object_z=st.object_z,
+                               film_z=st.film_z)
+        half_y = abs(paraxial.field_angle(st.prescription, w / 2.0, st.film_z, "y", wavelength_nm))
         hfov = math.degrees(2.0 * half)
         if hfov0 is None:
             hfov0 = hfov if math.isinf(m) else gaussian_hfov_infinity(prescription, w, method, wavelength_nm)
@@ -492,6 +567,9 @@ def breathing_table(
                 back_focus_mm=st.back_focus_mm,
                 fov_change_pct=100.0 * (hfov / hfov0 - 1.0),
                 entrance_pupil_from_film_mm=gx.in_front_of("entrance_pupil"),
+                vertical_efl_mm=gy.efl,
+                vertical_breathing_focal_length_mm=(w / 2.0) / math.tan(half_y),
+                vertical_entrance_pupil_from_film_mm=gy.in_front_of("entrance_pupil"),
             )
         )
     return rows
@@ -512,6 +590,50 @@ def pupil_aspect(prescription: Prescription, focus_mm: float) -> float:
     st = focus(prescription, focus_mm)
     gx, gy = (paraxial.gaussian(st.prescription, axis=a, object_z=st.object_z, film_z=st.film_z) for a in "xy")
     return gx.entrance_pupil_diameter / gy.entrance_pupil_diameter
+
+
+@dataclass(frozen=True)
+class EntrancePupils:
+    """Both meridians' entrance pupils at one focus mark, in front of the film (mm, + toward the subject).
+
+    An anamorphic lens images its one stop through different powers in X and Y: a front anamorphic
+    (cylinders before the stop) has two entrance pupils at different places ("anamorphic mumps"); a
+    rear one (cylinders behind the stop) has one place and a round pupil. A **pan** (rotation about
+    the vertical axis) moves the picture horizontally: it is parallax-free about the X (horizontal)
+    meridian's pupil; a **tilt** about the Y (vertical) meridian's pupil (Kingslake, *Optics in
+    Photography*, ch. 6: the entrance pupil is the centre of perspective, here in each meridian).
+    """
+
+    focus_from_film_mm: float
+    horizontal_from_film_mm: float  # X meridian: the pan pivot
+    vertical_from_film_mm: float  # Y meridian: the tilt pivot
+    horizontal_diameter_mm: float
+    vertical_diameter_mm: float
+
+    @property
+    def separation_mm(self) -> float:
+        """Horizontal pupil minus vertical pupil (+: the horizontal one lies nearer the subject)."""
+        return self.horizontal_from_film_mm - self.vertical_from_film_mm
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["focus_from_film_mm"] = None if math.isinf(self.focus_from_film_mm) else self.focus_from_film_mm
+        d["separation_mm"] = self.separation_mm
+        d["pan_pivot_from_film_mm"] = self.horizontal_from_film_mm
+        d["tilt_pivot_from_film_mm"] = self.vertical_from_film_mm
+        return d
+
+
+@renamed_parameter("focus_from_film_mm", "focus_mm")
+def entrance_pupils(prescription: Prescription, focus_mm: float, *, method: str = "auto",
+                    wavelength_nm=None) -> EntrancePupils:
+    """The X and Y meridians' paraxial entrance pupils with the lens focused (in Y) at the mark, both
+    from the one film plane (:class:`EntrancePupils`); equal for a rotationally symmetric lens."""
+    st = focus(prescription, focus_mm, method=method, axis="y", wavelength_nm=wavelength_nm)
+    g = {a: paraxial.gaussian(st.prescription, axis=a, wavelength_nm=wavelength_nm, object_z=st.object_z,
+                              film_z=st.film_z) for a in "xy"}
+    return EntrancePupils(float(focus_mm), g["x"].in_front_of("entrance_pupil"), g["y"].in_front_of("entrance_pupil"),
+                          g["x"].entrance_pupil_diameter, g["y"].entrance_pupil_diameter)
 
 
 #: The farthest hyperfocal mark solved (1000 km, the on-set report's largest distance).

@@ -48,7 +48,7 @@ import numpy as np
 __all__ = ["LINE_D_NM", "LINE_F_NM", "LINE_C_NM", "LINE_G_NM", "WAVELENGTH_RANGE_NM", "MATCH_TOL_ND",
            "MATCH_TOL_VD", "PGF_NORMAL_LINE", "PGF_UNCERTAINTY", "Dispersion", "dispersion", "normal_line",
            "normal_line_pgf", "cauchy_coefficients", "refractive_index", "medium_index", "require_wavelength",
-           "medium_dispersion", "glass_index", "FIT_TOLERANCE", "FIT_BAND_NM"]
+           "medium_dispersion", "glass_index", "FIT_TOLERANCE", "FIT_BAND_NM", "glasses_without_dispersion"]
 
 LINE_D_NM = 587.5618
 LINE_F_NM = 486.1327
@@ -242,6 +242,18 @@ def medium_dispersion(medium) -> Dispersion:
 
     require_type("medium", medium, Medium, "a Medium(nd, vd, glass=...) of a prescription's surface")
     return dispersion(medium.nd, medium.vd, medium.glass, medium.catalog, medium.dpgf)
+
+
+def glasses_without_dispersion(prescription) -> tuple[int, int]:
+    """(glasses the prescription gives no dispersion, glasses): the media behind its surfaces that are not
+    air, and of them those whose model is constant (Vd 0 and no named glass, module notes): every
+    wavelength bends alike in them, so no colour aberration comes from them."""
+    from ..errors import require_type
+    from ..lens.prescription import Prescription
+
+    require_type("prescription", prescription, Prescription, "physcam.lens.library.load_lens(name or file)")
+    glass = [s.medium for s in prescription.surfaces if not s.medium.is_air]
+    return sum(medium_dispersion(m).kind == "constant" for m in glass), len(glass)
 
 
 def glass_index(name: str, wavelength_nm, catalog: str | None = None):

@@ -96,6 +96,10 @@ def _focused(lens: Prescription, focus_mm) -> tuple[Prescription, float, float, 
     from . import paraxial
     from .focusing import focus
 
+    if isinstance(focus_mm, str):  # "2m", "10ft", "infinity": as the command line reads it (a bare number: mm)
+        from ..units import parse_distance
+
+        focus_mm = parse_distance(focus_mm, name="focus distance", allow_inf=True)
     if focus_mm is None or (isinstance(focus_mm, (int, float)) and not isinstance(focus_mm, bool)
                             and math.isinf(focus_mm) and focus_mm > 0):
         g = paraxial.gaussian(lens)
@@ -145,7 +149,8 @@ def wavelengths_and_weights(lens, wavelengths_nm, weights):
 
 def camera_state(lens: Prescription, *, focus_mm=None, fstop=None, sensor_mm=None, wavelengths_nm=None,
                  weights=None, aperture=None) -> CameraState:
-    """``lens`` focused at ``focus_mm`` (the mark from the film plane; None or inf: infinity), its
+    """``lens`` focused at ``focus_mm`` (the mark from the film plane, mm or a string with units such as
+    "2m", "10ft"; None, inf or "infinity": infinity), its
     iris set to ``fstop`` (None: as the file stops it), on a sensor ``sensor_mm`` (width, height; None:
     not needed), at ``wavelengths_nm`` (None: the lens's design wavelength) with ``weights``.
     Every argument is checked here, once (InputError or OpticsError with a sentence)."""

@@ -3,7 +3,8 @@
 Routes (GET or HEAD only; every answer is JSON, SVG or the page):
 
 =====================================  =============================================================
-``/``                                  the page (``static/index.html``, ``app.js``, ``app.css``)
+``/``                                  the page (``static/index.html``, ``app.js``, ``onset.js``, ``app.css``)
+``/sw.js``, ``/manifest.webmanifest``  the installable web app: service worker (offline) and manifest
 ``/api/report?focal=50&fstop=2.8...``  ``physcam report ... --json``
 ``/api/focus-table?...&marks=1m,2m``   ``physcam report ... --json`` once per focus mark
 ``/api/dof.svg?...``                   ``physcam report ... --plot dof.svg``, drawn in memory
@@ -11,16 +12,16 @@ Routes (GET or HEAD only; every answer is JSON, SVG or the page):
 ``/api/lenses``                        ``physcam lenses --json``'s ``lenses`` list
 ``/api/lens/{name}?focus=2m...``       ``physcam lens show NAME ... --json``
 ``/api/lens/{name}/diagram.svg?...``   ``physcam lens diagram NAME ... -o diagram.svg``
-``/api/health``                        ``{"ok": true, "version": ...}``
+``/api/health``                        ``{"ok": true, "version": ..., "units": "m" or "ft"}``
 =====================================  =============================================================
 
 Query parameters are the CLI flags without their dashes (``sensor-width=24.89``); which ones an
 endpoint takes comes from the backend (the CLI's own parsers). Safety, all in
 :class:`Limits`: a bounded URL, a bounded number and length of parameters, printable values only,
 no request body, a token bucket per client address (429 with ``Retry-After``), the slow work
-shared between client addresses in turn with bounded queues (worker.py: 429 for one address's
-share, 503 in all), and one JSON line ``{"error": "..."}`` for every refusal (422 for bad
-input), never a traceback. An unexpected exception answers 500 with its class name and is
+shared between client addresses in turn with bounded queues (worker.py: an address's first slow
+request always taken; 429 for one address's share, 503 in all), and one JSON line
+``{"error": "..."}`` for every refusal (422 for bad input), never a traceback. An unexpected exception answers 500 with its class name and is
 logged as one line; the server keeps serving.
 """
 
@@ -46,9 +47,18 @@ __all__ = ["Backend", "Limits", "create_app", "STATIC_FILES"]
 STATIC_FILES = {
     "index.html": "text/html; charset=utf-8",
     "app.js": "text/javascript; charset=utf-8",
+    "onset.js": "text/javascript; charset=utf-8",
+    "tools.js": "text/javascript; charset=utf-8",
     "app.css": "text/css; charset=utf-8",
     "icon.svg": "image/svg+xml",
+    "icon-192.png": "image/png",
+    "icon-512.png": "image/png",
+    "sw.js": "text/javascript; charset=utf-8",
+    "manifest.webmanifest": "application/manifest+json",
 }
+#: Files served at the root, not under /static/: the service worker (its scope is the folder it is
+#: served from, so the whole page) and the web-app manifest.
+ROOT_FILES = ("sw.js", "manifest.webmanifest")
 
 #: Headers on every answer: no framing, no sniffing, only this server's own scripts and styles.
 SECURITY_HEADERS = [
@@ -76,6 +86,9 @@ class Backend:
     lens: Callable[[str, Mapping[str, str]], dict]
     diagram_svg: Callable[[str, Mapping[str, str]], bytes]
     parameters: Mapping[str, frozenset[str]]
+    #: the unit system a page starts in when its address does not say: "m", or "ft" (the user config's
+    #: ``units``): a bare focus, near or far is then feet on the page as on the command line
+    units: str = "m"
 
 
 @dataclass(frozen=True)
@@ -83,7 +96,8 @@ class Limits:
     """The server's bounds (docs/serve.md, "What it refuses"). Per client address: ``rate``
     requests per second (a token bucket of ``burst``), ``client_queue`` slow requests (lenses,
     charts) pending for the worker, ``client_connections`` open connections. In all: ``queue`` slow
-    requests, ``connections`` connections. Per request: a head (request line and headers) of at
+    requests (an address's first is taken beyond it: worker.py), ``connections`` connections (and
+    addresses with slow work pending). Per request: a head (request line and headers) of at
     most ``head_bytes``, complete within ``head_timeout`` seconds of the connection opening or of
     the previous answer; a connection idle ``keep_alive`` seconds between requests is closed."""
 
@@ -259,8 +273,9 @@ class _App:
         self.backend, self.limits = backend, limits
         self.cache = _Cache(limits.cache_bytes)
         # One worker thread (numba's tracer and matplotlib are not to be entered from two threads at
-        # once), shared between client addresses in turn (worker.py).
-        self.worker = FairWorker(limits.client_queue, limits.queue)
+        # once), shared between client addresses in turn (worker.py); an address's first slow
+        # request is always taken, up to one address per connection the server accepts.
+        self.worker = FairWorker(limits.client_queue, limits.queue, addresses=limits.connections)
         self.static = {}
         root = resources.files(__package__) / "static"
         for name, media in STATIC_FILES.items():
@@ -456,7 +471,8 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
 
     async def health(request):
         core.query(request.scope, "health")
-        return _no_store(json.dumps({"ok": True, "version": __version__}).encode(), "application/json")
+        return _no_store(json.dumps({"ok": True, "version": __version__, "units": backend.units}).encode(),
+                         "application/json")
 
     async def favicon(request):
         return Response(status_code=204)
@@ -464,9 +480,8 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
     api = {**_report_endpoints(core, backend, limits), **_catalogue_endpoints(core, backend, limits)}
     routes = [
         Route("/", _static_page(core, "index.html")),
-        Route("/static/app.js", _static_page(core, "app.js")),
-        Route("/static/app.css", _static_page(core, "app.css")),
-        Route("/static/icon.svg", _static_page(core, "icon.svg")),
+        *(Route(f"/{name}" if name in ROOT_FILES else f"/static/{name}", _static_page(core, name))
+          for name in STATIC_FILES if name != "index.html"),
         Route("/favicon.ico", favicon),
         *(Route(path, api[path]) for path in ("/api/report", "/api/focus-table", "/api/dof.svg", "/api/sensors",
                                               "/api/lenses", "/api/lens/{name}", "/api/lens/{name}/diagram.svg")),

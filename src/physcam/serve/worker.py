@@ -6,9 +6,17 @@ single first-in first-out queue let one address that asks faster than the thread
 queue and starve everyone else (issue 24 item 11). Here each address has its own queue and the
 thread takes one job from each address in turn (round robin, addresses in order of arrival), so
 a chart asked by a second address waits for at most the job being done and one job of each other
-address with work waiting. Each address may have ``per_client`` jobs pending (waiting or
-running) and all of them together ``total``; beyond either, :meth:`FairWorker.submit` raises
-:class:`Full` and the server answers 429 or 503 (docs/serve.md).
+address with work waiting.
+
+Admission (issue 40 item 14): an address's **first** pending job is always taken, so many
+addresses together cannot fill the queue against one more (40 addresses each under its own rate
+limit answered a 41st with 503 when every job counted against one total). The bounds are on the
+rest: each address may have ``per_client`` jobs pending (waiting or running), a further job is
+taken only while all addresses together have fewer than ``total`` pending, and at most
+``addresses`` addresses have work pending at once. Beyond any of them :meth:`FairWorker.submit`
+raises :class:`Full` and the server answers 429 (this address) or 503 (everyone; docs/serve.md).
+A newly arrived address therefore waits for at most one job of each of the other addresses with
+work pending (fewer than ``addresses``) and the job being done.
 """
 
 from __future__ import annotations
@@ -24,7 +32,8 @@ __all__ = ["FairWorker", "Full"]
 
 class Full(Exception):
     """No room for another job: ``everyone`` is True when all addresses together have ``total``
-    pending (503), False when this address has its ``per_client`` (429)."""
+    pending (or ``addresses`` addresses have work: 503), False when this address has its
+    ``per_client`` (429)."""
 
     def __init__(self, everyone: bool, limit: int):
         super().__init__(f"{limit} slow requests are pending" + (" in all" if everyone else " from this address"))
@@ -34,11 +43,11 @@ class Full(Exception):
 class FairWorker:
     """One daemon thread running submitted functions, one per client address in turn."""
 
-    def __init__(self, per_client: int, total: int, name: str = "physcam-serve"):
-        for label, v in (("per_client", per_client), ("total", total)):
+    def __init__(self, per_client: int, total: int, name: str = "physcam-serve", addresses: int = 256):
+        for label, v in (("per_client", per_client), ("total", total), ("addresses", addresses)):
             if isinstance(v, bool) or not isinstance(v, int) or v < 1:
                 raise WrongTypeError(f"FairWorker {label} must be a positive integer, got {v!r}")
-        self.per_client, self.total, self.name = per_client, total, name
+        self.per_client, self.total, self.name, self.addresses = per_client, total, name, addresses
         self._cv = threading.Condition()
         self._queues: OrderedDict[str, deque] = OrderedDict()  # the turn order: first key goes next
         self._pending: dict[str, int] = {}  # waiting + running, per address
@@ -51,14 +60,19 @@ class FairWorker:
             return sum(self._pending.values()) if client is None else self._pending.get(client, 0)
 
     def submit(self, client: str, fn) -> Future:
-        """Queue ``fn()`` for ``client``; its future holds the result (or the exception)."""
+        """Queue ``fn()`` for ``client`` (module notes: its first job always, further ones within
+        ``per_client`` and ``total``); its future holds the result (or the exception)."""
         with self._cv:
             if self._closed:
                 raise RuntimeError("the worker is closed")
-            if sum(self._pending.values()) >= self.total:
-                raise Full(True, self.total)
-            if self._pending.get(client, 0) >= self.per_client:
+            own = self._pending.get(client, 0)
+            if own == 0:
+                if len(self._pending) >= self.addresses:
+                    raise Full(True, self.addresses)
+            elif own >= self.per_client:
                 raise Full(False, self.per_client)
+            elif sum(self._pending.values()) >= self.total:
+                raise Full(True, self.total)
             future: Future = Future()
             self._queues.setdefault(client, deque()).append((future, fn))
             self._pending[client] = self._pending.get(client, 0) + 1

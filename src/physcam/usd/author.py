@@ -32,6 +32,7 @@ import math
 import struct
 
 from ..errors import ExportError, InputError, require_finite, require_positive, require_type
+from ..export._codetext import usd_text
 from ..export.renderman import shutter_opening_curve  # re-exported: the one copy of seed 002's ramps
 from .plugin import ensure_registered, require_stage
 from .spec import (BLENDER_PROPERTY, DEFAULT_CAMERA_PATH, LENS_INSTANCE, RENDER_CAMERA_NAME, SENSOR_INSTANCE,
@@ -254,7 +255,7 @@ def _author_sensor(cam, spec):
     _set(cam, sp + "circleOfConfusion", Sdf.ValueTypeNames.Float, spec.coc_mm)
     _set(cam, sp + "iso", Sdf.ValueTypeNames.Float, spec.iso)
     if spec.sensor_name:
-        cam.SetCustomDataByKey("physcam:sensorName", spec.sensor_name)
+        cam.SetCustomDataByKey("physcam:sensorName", usd_text(spec.sensor_name, "sensor name"))
 
 
 def _author_lens(stage, cam, spec, eye, su):
@@ -292,7 +293,7 @@ def _author_lens(stage, cam, spec, eye, su):
     _set(model, "squeeze", Sdf.ValueTypeNames.Float, spec.squeeze)
     _set(model, "transmittance", Sdf.ValueTypeNames.Float, spec.transmittance)
     if spec.lens_name:
-        model.SetCustomDataByKey("physcam:lensName", spec.lens_name)
+        model.SetCustomDataByKey("physcam:lensName", usd_text(spec.lens_name, "lens name"))
     cam.GetRelationship(lp + "lensModel") or cam.CreateRelationship(lp + "lensModel", False)
     cam.GetRelationship(lp + "lensModel").SetTargets([model.GetPath()])
 
@@ -553,8 +554,10 @@ def _usd_dict(d: dict) -> dict:
         elif isinstance(v, list) and v and isinstance(v[0], dict):
             v = {str(i): _usd_dict(x) for i, x in enumerate(v)}
         elif isinstance(v, list):
-            v = [str(x) for x in v] if any(isinstance(x, str) for x in v) else [float(x) for x in v]
-        out[k] = v
+            v = [usd_text(x, k) for x in v] if any(isinstance(x, str) for x in v) else [float(x) for x in v]
+        elif isinstance(v, str):
+            v = usd_text(v, k)
+        out[usd_text(k, "key")] = v
     return out
 
 

@@ -21,6 +21,7 @@ from dataclasses import replace
 
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import ExportError, InputError, require_type
+from ..export._codetext import printable_line, usd_text
 from .author import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec, author_camera, author_render_camera, new_stage, save_stage
 from .read import companion_inputs, companion_inputs_hash, composed_prescription
 from .plugin import ensure_registered
@@ -105,6 +106,11 @@ def write_lens_file(file, characterizations: dict, *, force: bool = False, meter
     vset = prim.GetVariantSets().AddVariantSet("characterization")
     dates = sorted(characterizations)
     entries = [(_variant_name(d), characterizations[d]) for d in dates]
+    names = [n for n, _ in entries]
+    clash = sorted({d for d in dates if names.count(_variant_name(d)) > 1})
+    if clash:
+        raise InputError(f"the dates {', '.join(printable_line(d, limit=40) for d in clash)} make one variant name "
+                         f"{_variant_name(clash[0])!r}: give each measuring day a distinct date")
     entries.append(("current", characterizations[dates[-1]]))
     for name, spec in entries:
         vset.AddVariant(name)
@@ -117,8 +123,10 @@ def write_lens_file(file, characterizations: dict, *, force: bool = False, meter
 
 
 def _variant_name(date: str) -> str:
-    name = "d" + "".join(c if c.isalnum() else "_" for c in str(date))
-    return name
+    """``d`` + the date with every character but ASCII letters and digits made ``_``: a USD variant
+    name (Sdf's variant identifiers take letters, digits, ``_``, ``-`` and ``|``; ``str.isalnum`` also
+    passes Unicode digits such as a superscript two that Sdf refuses with an error of its own)."""
+    return "d" + "".join(c if c.isascii() and c.isalnum() else "_" for c in str(date))
 
 
 def write_body_file(file, spec: CameraSpec, *, force: bool = False, meters_per_unit: float = 0.01,
@@ -443,8 +451,9 @@ def write_previs_kit(file, setups: dict | None = None, *, default: str = "OverTh
     from ..export.usdgeom import mm_to_scene_units
 
     for name, spec in setups.items():
-        if not name.replace("_", "").isalnum():
-            raise InputError(f"setup name {name!r} must be letters, digits and underscores")
+        if not isinstance(name, str) or not name.isascii() or not name.replace("_", "").isalnum():
+            raise InputError(f"setup name {printable_line(name, limit=60)!r} must be ASCII letters, digits and "
+                             "underscores")
         vset.AddVariant(name)
         vset.SetVariantSelection(name)
         position, rotation = PREVIS_PLACEMENT.get(name, ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
@@ -540,10 +549,10 @@ def _author_prescription(stage, path, rx, focus_mm: float):
         "conic": (T.DoubleArray, [s.conic for s in S]),
         "asphericCoefficients": (T.DoubleArray,
                                  [a for s in S for a in (list(s.aspheric) + [0.0] * 7)[:7]]),
-        "glass": (T.StringArray, [s.medium.glass or "" for s in S]),
-        "lensName": (T.String, rx.name),
-        "maker": (T.String, rx.metadata.maker or ""),
-        "source": (T.String, rx.metadata.source or ""),
+        "glass": (T.StringArray, [usd_text(s.medium.glass or "", "glass name") for s in S]),
+        "lensName": (T.String, usd_text(rx.name, "lens name")),
+        "maker": (T.String, usd_text(rx.metadata.maker or "", "lens maker")),
+        "source": (T.String, usd_text(rx.metadata.source or "", "lens source")),
         "nominalFocalLength": (T.Float, float(rx.metadata.focal_length or 0.0)),
         "designWavelength": (T.Double, float(rx.wavelength_nm)),
         "squeeze": (T.Float, float(rx.squeeze)),
@@ -730,4 +739,42 @@ def read_characterizations(file) -> dict:
     return {"current_is": prim.GetCustomDataByKey("physcam:currentIs"), "selection": selection, "variants": out}
 
 
-__all__ += ["add_characterization", "read_characterizations", "CHARACTERIZATION_NS"]
+def characterization_target(file, variant: str) -> dict:
+    """Check, before a characterization is measured, that variant ``variant`` can be added to the lens
+    file ``file`` (:func:`add_characterization`'s rules: the name, a physcam lens file or none yet, a new
+    variant); return ``{"exists": bool, "focal_length_mm": float | None}``: the lens's focal length as
+    the file composes it now (its lens model's ``focalLength``, a prescription's effective focal
+    length; None without a file or a lens model), for checking that a measurement is of this lens."""
+    from pathlib import Path
+
+    require_type("lens file", file, (str, Path), "a .usda/.usdc path")
+    variant = _variant_identifier(variant)
+    p = Path(file)
+    if p.suffix not in (".usda", ".usdc", ".usd"):
+        raise InputError(f"{p}: a lens file's name ends in .usda, .usdc or .usd")
+    if not p.exists():
+        if not p.parent.is_dir():
+            raise ExportError(f"{p}: its folder {p.parent} does not exist")
+        return {"exists": False, "focal_length_mm": None}
+    if variant in read_characterizations(p)["variants"]:
+        raise ExportError(f"{p}: already has a characterization variant {variant!r}: give another --variant")
+    ensure_registered()
+    stage = _open_detached(p)  # held: a prim outlives no stage
+    prim = stage.GetPrimAtPath(LENS_PRIM)
+    if not prim or prim.GetTypeName() != "PhysicalCamera":
+        raise ExportError(f"{p}: has no PhysicalCamera {LENS_PRIM} (not a physcam lens file)")
+    rel = prim.GetRelationship(f"lens:{LENS_INSTANCE}:lensModel")
+    targets = rel.GetForwardedTargets() if rel else []
+    model = stage.GetPrimAtPath(targets[0]) if targets else None
+    focal = None
+    if model and model.GetTypeName() == "PhysicalCameraLensModelPrescription":
+        from ..optics.paraxial import gaussian
+        from .read import read_prescription
+
+        focal = float(gaussian(read_prescription(model)).efl)
+    elif model and model.GetAttribute("focalLength") and model.GetAttribute("focalLength").HasAuthoredValue():
+        focal = float(model.GetAttribute("focalLength").Get())
+    return {"exists": True, "focal_length_mm": focal}
+
+
+__all__ += ["add_characterization", "read_characterizations", "characterization_target", "CHARACTERIZATION_NS"]

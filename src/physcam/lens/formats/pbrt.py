@@ -27,7 +27,7 @@ from pathlib import Path
 
 from ...errors import ExportError, LensFileError, PhysCamWarning
 from ..prescription import AIR, LensMetadata, Medium, Prescription, Surface, takes_prescription
-from ._common import check_count, fmt, number, validated, takes_text
+from ._common import check_count, fmt, number, one_line, validated, takes_text
 
 __all__ = ["loads", "dumps", "HEADER"]
 
@@ -105,7 +105,7 @@ def dumps(p: Prescription) -> str:
         warnings.warn(f"pbrt .dat drops {', '.join(dropped)} of lens {p.name!r}", PhysCamWarning, stacklevel=3)
     out = []
     if p.metadata.notes:
-        out += [f"# {line}".rstrip() for line in p.metadata.notes.splitlines()]
+        out += [one_line(f"# {line}").rstrip() for line in p.metadata.notes.splitlines()]
     out.append(f"# {HEADER}")
     for s in p.surfaces:
         if s.medium.is_air or (s.medium.nd == 1.0 and s.medium.vd == 0.0):
