@@ -254,5 +254,5 @@ def test_a_lens_file_inside_the_stack_folder_is_refused(tmp_path):
     shutil.copy(next(r.path for r in list_lenses() if r.slug == "dgauss_50mm"), out / "lens.toml")
     args = [a if a != "dgauss_50mm" else str(out / "lens.toml") for a in KERNELS]
     p = _cli(*args, "--depths", "1m", "-o", out, "--force")
-    assert _one_line(p) and "holds the input" in p.stderr
+    assert _one_line(p) and "lies inside the output folder" in p.stderr
     assert (out / "lens.toml").exists()

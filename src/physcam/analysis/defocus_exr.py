@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,7 +30,7 @@ import numpy as np
 from ..errors import InputError, require_type
 
 __all__ = ["ExrImage", "read_exr", "write_exr", "colour_channels", "alpha_channel", "depth_channel", "defocus_file",
-           "write_kernel_stack", "refuse_input_as_output"]
+           "write_kernel_stack"]
 
 
 @dataclass
@@ -203,24 +202,6 @@ def write_exr(path, img: ExrImage, planes: dict, *, attributes=None, force: bool
     return Path(path)
 
 
-def refuse_input_as_output(output, inputs, what: str = "output") -> None:
-    """Refuse an ``output`` path that is one of ``inputs``: the same path once links are followed,
-    or the same file (a hard link, a symbolic link to it)."""
-    out = Path(output)
-    for src in inputs:
-        if src is None:
-            continue
-        src = Path(src)
-        same = False
-        try:
-            same = out.exists() and src.exists() and os.path.samefile(out, src)
-        except OSError:
-            pass
-        if same or out.resolve(strict=False) == src.resolve(strict=False):
-            raise InputError(f"the {what} {out} is the input {src}: physcam would overwrite what it reads; choose "
-                             "another output name")
-
-
 def _read_depth(img: ExrImage, depth, depth_channel_name):
     """The depth array and its channel's name: a channel of the picture, or of a separate EXR file."""
     if depth is not None and (str(depth).lower().endswith(".exr") or Path(depth).is_file()):
@@ -252,12 +233,12 @@ def defocus_file(image_path, output, lens, *, focus_mm: float | None = None, fst
     written back as read (module notes). Returns a summary."""
     import time
 
-    from ..io import check_writable
+    from ..io import check_writable, refuse_inputs_as_outputs
     from .defocus import defocus, inverse_depth
     from .defocus_kernels import KernelCache, defocus_camera
 
     depth_file = depth if depth is not None and (str(depth).lower().endswith(".exr") or Path(depth).is_file()) else None
-    refuse_input_as_output(output, [image_path, depth_file])
+    refuse_inputs_as_outputs([image_path, depth_file], [output])
     check_writable(output, force=force)
     t0 = time.perf_counter()
     img = read_exr(image_path)
@@ -310,7 +291,7 @@ def write_kernel_stack(folder, camera, *, field_grid=(5, 3), depths_mm=(500.0, 1
     centroid (``centroid_offset_px`` from the pinhole's image of the point: the lens's distortion and
     the cat's eye's shift), each channel summing to the relative transmission (vignetting x cos, 1
     on the axis). ``inputs``: files the stack must not replace (the lens file)."""
-    from ..io import staged_folder
+    from ..io import refuse_inputs_as_outputs, staged_folder
     from .defocus_kernels import FAR_MM, DefocusCamera
 
     require_type("camera", camera, DefocusCamera, "physcam.analysis.defocus_kernels.defocus_camera(lens, ...)")
@@ -320,12 +301,7 @@ def write_kernel_stack(folder, camera, *, field_grid=(5, 3), depths_mm=(500.0, 1
     if not depths_mm or len(depths_mm) > 64:
         raise InputError("give 1 to 64 depths")
     folder = Path(folder)
-    for src in inputs:
-        if src is not None and Path(src).exists():
-            inside = Path(src).resolve() == folder.resolve() or folder.resolve() in Path(src).resolve().parents
-            if inside:
-                raise InputError(f"the output folder {folder} holds the input {src}: physcam would replace it; choose "
-                                 "another output folder")
+    refuse_inputs_as_outputs(inputs, [], folders=[folder])
     points = [(0.5 + (camera.width - 1) * (i / (nx - 1) if nx > 1 else 0.5),
                0.5 + (camera.height - 1) * (j / (ny - 1) if ny > 1 else 0.5), d)
               for j in range(ny) for i in range(nx) for d in depths_mm]

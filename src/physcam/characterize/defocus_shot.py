@@ -83,14 +83,14 @@ def defocus_sequence(pattern: str, output_pattern: str, lens, *, kernel_folder=N
     fstop, sensor_width_mm, depth, ...)."""
     from .run import _connect, check_scheduler_address
 
-    from ..analysis.defocus_exr import refuse_input_as_output
+    from ..io import refuse_inputs_as_outputs
 
     frames = sequence_frames(pattern)
     _pattern(output_pattern, "output sequence")
     depth = options.get("depth")
     inputs = [p for _, p in frames] + ([depth] if depth is not None and Path(str(depth)).is_file() else [])
     for number, _ in frames:  # before any frame is written: an output that is an input is refused
-        refuse_input_as_output(_frame_path(output_pattern, number), inputs, "output frame")
+        refuse_inputs_as_outputs(inputs, [frame_path(output_pattern, number)])
     if scheduler is not None:
         check_scheduler_address(scheduler)
     folder = Path(kernel_folder) if kernel_folder is not None else shot_kernel_folder(output_pattern)
