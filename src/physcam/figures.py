@@ -148,13 +148,14 @@ def styled(func):
     return in_style
 
 
-def fit_title(text: str, width_in: float, *, fontsize: float | None = None) -> str:
+def fit_title(text: str, width_in: float, *, fontsize: float | None = None, weight: str = "normal") -> str:
     """``text`` wrapped at word boundaries so that each line, set in the style's font at ``fontsize``
-    points (default the title size), is at most ``width_in`` inches wide (measured by matplotlib)."""
+    points (default the title size) and ``weight``, is at most ``width_in`` inches wide (measured by
+    matplotlib)."""
     from matplotlib.font_manager import FontProperties
     from matplotlib.textpath import text_to_path
 
-    prop = FontProperties(family=STYLE["font.sans-serif"], size=fontsize or STYLE["axes.titlesize"])
+    prop = FontProperties(family=STYLE["font.sans-serif"], size=fontsize or STYLE["axes.titlesize"], weight=weight)
     limit = width_in * 72.0
 
     def width(s: str) -> float:
