@@ -266,6 +266,8 @@ def _author_lens(stage, cam, spec, eye, su):
     _set(cam, lp + "fStop", Sdf.ValueTypeNames.Float, spec.fstop)
     _set(cam, lp + "iris", Sdf.ValueTypeNames.Float, _iris_mm(spec))
     _set(cam, lp + "entrancePupilDistance", Sdf.ValueTypeNames.Float, eye)
+    if spec.horizontal_entrance_pupil_mm is not None:  # an anamorphic's pan pivot (docs/anamorphic.md)
+        _set(cam, lp + "horizontalEntrancePupilDistance", Sdf.ValueTypeNames.Float, spec.horizontal_entrance_pupil_mm)
     if spec.principal_planes_mm is not None:
         _set(cam, lp + "frontPrincipalPlaneDistance", Sdf.ValueTypeNames.Float, spec.principal_planes_mm[0])
         _set(cam, lp + "rearPrincipalPlaneDistance", Sdf.ValueTypeNames.Float, spec.principal_planes_mm[1])

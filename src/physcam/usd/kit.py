@@ -305,7 +305,8 @@ def _author_lens_derived(stage, cam, spec) -> None:
     F = Sdf.ValueTypeNames.Float
     lp = f"lens:{LENS_INSTANCE}:"
     values = {lp + "entrancePupilDistance": spec.entrance_pupil_mm, lp + "iris": spec.focal_length_mm / spec.fstop,
-              lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze": spec.pinhole_squeeze}
+              lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze": spec.pinhole_squeeze,
+              lp + "horizontalEntrancePupilDistance": spec.horizontal_entrance_pupil_mm}
     if spec.principal_planes_mm is not None:
         values[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]
         values[lp + "rearPrincipalPlaneDistance"] = spec.principal_planes_mm[1]
