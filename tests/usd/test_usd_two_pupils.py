@@ -75,3 +75,45 @@ def test_unreal_nodal_offset_is_the_vertical_pupil_and_the_file_says_where_the_p
         assert m["entrance_pupil_horizontal_from_film_mm"] == pytest.approx(x, abs=0.01)
     note = next(e["value"] for e in doc["metadata"]["userMetadata"] if e["name"] == "physcam.nodalOffset")
     assert "horizontal (X, pan)" in note
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_a_focus_pull_animates_both_pupils(tmp_path):
+    from physcam.usd.animate import FocusKey, write_animated_camera
+
+    slug, keys = "neil_front_anamorphic_2x", [FocusKey(1, 3000.0), FocusKey(25, 1500.0)]
+    out = write_animated_camera(tmp_path / "pull.usda", keys, sensor=find_sensor("ALEXA 35"), lens=load_lens(slug),
+                                fstop=2.8)
+    stage = Usd.Stage.Open(str(out))
+    assert validation_errors(stage) == []
+    cam = stage.GetPrimAtPath("/Cameras/Camera")
+    for k in keys:
+        x, y = hand_pupils_from_film(slug, k.focus_mm)
+        assert cam.GetAttribute(LP + "horizontalEntrancePupilDistance").Get(k.frame) == pytest.approx(x, abs=0.01)
+        assert cam.GetAttribute(LP + "entrancePupilDistance").Get(k.frame) == pytest.approx(y, abs=0.01)
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_a_shot_with_a_vendor_anamorphic_has_both_pupils_and_loses_the_second_with_a_spherical(tmp_path):
+    from physcam.usd.author import CameraSpec
+    from physcam.usd.kit import refresh_shot, write_body_file, write_shot, write_vendor_lens
+
+    slug = "neil_front_anamorphic_2x"
+    lens_f = write_vendor_lens(tmp_path / "lens.usda", load_lens(slug), focus_mm=3000.0, fstop=2.8)
+    body_f = write_body_file(tmp_path / "body.usda", CameraSpec(sensor_width_mm=27.99, sensor_height_mm=19.22))
+    shot = write_shot(tmp_path / "shot.usda", body_f, lens_f)
+    x, y = hand_pupils_from_film(slug, 3000.0)
+    stage = Usd.Stage.Open(str(shot))
+    assert validation_errors(stage) == []
+    cam = stage.GetPrimAtPath("/Cameras/Shot")
+    assert cam.GetAttribute(LP + "horizontalEntrancePupilDistance").Get() == pytest.approx(x, abs=0.01)
+    assert cam.GetAttribute(LP + "entrancePupilDistance").Get() == pytest.approx(y, abs=0.01)
+    del cam, stage
+    # the lens file now holds a spherical lens: the refreshed shot keeps no stale pan pivot
+    write_vendor_lens(lens_f, load_lens("dgauss_50mm"), focus_mm=3000.0, fstop=2.8, force=True)
+    refresh_shot(shot)
+    stage = Usd.Stage.Open(str(shot))
+    stage.Reload()
+    cam = stage.GetPrimAtPath("/Cameras/Shot")
+    assert cam.GetAttribute(LP + "entrancePupilDistance").Get() < 100.0
+    assert cam.GetAttribute(LP + "horizontalEntrancePupilDistance").Get() is None

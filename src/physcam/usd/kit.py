@@ -313,6 +313,8 @@ def _author_lens_derived(stage, cam, spec) -> None:
     for name, v in values.items():
         if v is not None:
             (cam.GetAttribute(name) or cam.CreateAttribute(name, F)).Set(float(v))
+    if spec.horizontal_entrance_pupil_mm is None and cam.GetAttribute(lp + "horizontalEntrancePupilDistance"):
+        cam.GetAttribute(lp + "horizontalEntrancePupilDistance").Clear()  # a lens with one pupil now
 
 
 def check_shot(file, path: str | None = None) -> dict:
