@@ -1,5 +1,6 @@
 """A y-u trace by hand of the bundled anamorphics, per meridian (issue 49): the oracle of their two
-entrance pupils, shared by the lens, USD, OpenTrackIO, frustum and Unreal tests.
+entrance pupils and framing focal lengths (breathing per axis), shared by the lens, USD, OpenTrackIO,
+frustum and Unreal tests.
 
 Written from each lens file's own numbers (``tomllib``, nd at the d line; Smith, *Modern Optical
 Engineering*, 4th ed., eqs. 2.31-2.32: n'u' = nu - y c (n' - n), y' = y + t u'). A cylinder is flat
@@ -44,6 +45,27 @@ def _yu(surfaces, meridian):
     # the chief ray crosses the axis at the stop: a ray y0 A + u0 B (A = (1, 0), B = (0, 1) at the first
     # vertex) passes there when y0 yA + u0 yB = 0; it crosses the axis in object space at z = -y0 / u0
     return -1.0 / u, trace(0.0, 1.0, stop) / trace(1.0, 0.0, stop), -y / u
+
+
+def _framing_focal_length(surfaces, meridian):
+    """|y_film / u| of the chief ray (through the stop centre) at unit object-space slope, by hand: the
+    focal length a pinhole at the entrance pupil needs to frame like the lens (Smith 3.5)."""
+    _, z_ep, _ = _yu(surfaces, meridian)
+    n0, y, u = 1.0, -z_ep, 1.0  # at the first vertex: height -z_ep, slope 1, crossing the axis at z_ep
+    for i, (kind, r, t, n) in enumerate(surfaces):
+        flat = kind in ("flat", "stop") or r == 0 or kind == f"cylindrical_{'y' if meridian == 'x' else 'x'}"
+        u = (n0 * u - y * (0.0 if flat else 1.0 / r) * (n - n0)) / n
+        y += t * u  # the last gap ends on the film
+        n0 = n
+    return abs(y)
+
+
+def hand_framing_focal_lengths(slug, mark):
+    """(X, Y) framing focal lengths (mm) of ``slug`` focused at ``mark``: the per-axis breathing, traced
+    by hand through the gaps the focus solver set."""
+    st = focusing.focus(load_lens(slug), mark)
+    surfaces = _surfaces(slug, [s.thickness for s in st.prescription.surfaces])
+    return _framing_focal_length(surfaces, "x"), _framing_focal_length(surfaces, "y")
 
 
 def hand_pupils_from_film(slug, mark):

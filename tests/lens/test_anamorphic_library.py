@@ -19,7 +19,7 @@ from physcam.lens.library import load_lens
 from physcam.lens.provenance import provenance_of
 from physcam.optics import focusing, paraxial
 
-from _anamorphic_yu import _surfaces, _yu, hand_pupils_from_film
+from _anamorphic_yu import _framing_focal_length, _surfaces, _yu, hand_pupils_from_film
 
 ANAMORPHICS = ("navarro_anamorphic_2x", "neil_front_anamorphic_2x", "panavision_rear_anamorphic_1_3x")
 ORACLE = json.loads((Path(__file__).parents[1] / "data" / "optiland_anamorphic.json").read_text())["lenses"]
@@ -75,19 +75,6 @@ def test_the_rear_anamorphic_against_its_transcription():
     prov = provenance_of(p)
     assert not prov.primary_source_checked and "crayg" in prov.transcribed_from
     assert efl_y / p.metadata.focal_length == pytest.approx(0.951, abs=1e-3)
-
-
-def _framing_focal_length(surfaces, meridian):
-    """|y_film / u| of the chief ray (through the stop centre) at unit object-space slope, by hand: the
-    focal length a pinhole at the entrance pupil needs to frame like the lens (Smith 3.5)."""
-    _, z_ep, _ = _yu(surfaces, meridian)
-    n0, y, u = 1.0, -z_ep, 1.0  # at the first vertex: height -z_ep, slope 1, crossing the axis at z_ep
-    for i, (kind, r, t, n) in enumerate(surfaces):
-        flat = kind in ("flat", "stop") or r == 0 or kind == f"cylindrical_{'y' if meridian == 'x' else 'x'}"
-        u = (n0 * u - y * (0.0 if flat else 1.0 / r) * (n - n0)) / n
-        y += t * u  # the last gap ends on the film
-        n0 = n
-    return abs(y)
 
 
 @pytest.mark.parametrize("slug", ANAMORPHICS)

@@ -20,7 +20,7 @@ from physcam.live.frustum import frustum_frames, wall_from_usd, write_frustum_us
 from physcam.live.sample import validate_sample
 from physcam.onset.sensors import find_sensor
 
-from _anamorphic_yu import hand_pupils_from_film
+from _anamorphic_yu import hand_framing_focal_lengths, hand_pupils_from_film
 
 W, H, F_PIN, SQ = 24.89, 18.66, 50.0, 2.0  # mm, squeeze
 EX, EY = 172.48, 140.39  # mm in front of the film: a front anamorphic's pan and tilt pivots
@@ -156,3 +156,24 @@ def test_a_spherical_take_records_no_second_pupil(tmp_path):
     cam = stage.GetPrimAtPath("/Cameras/Camera")
     assert cam.GetAttribute("lens:main:entrancePupilDistance").HasAuthoredValue()
     assert not cam.GetAttribute("lens:main:horizontalEntrancePupilDistance").HasAuthoredValue()
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_a_focus_pull_sends_the_breathing_of_each_axis():
+    """OpenTrackIO's pinholeFocalLength is the vertical framing focal length; anamorphicSqueeze, re-sent
+    in the static block whenever it changes, makes pinholeFocalLength / squeeze the horizontal one: both
+    breathe as the hand trace of each meridian says (42.03 -> 41.49 mm and 21.02 -> 20.52 mm, 3 m -> 1.5 m)."""
+    from fractions import Fraction
+
+    slug, marks = "neil_front_anamorphic_2x", (3000.0, 2250.0, 1500.0)
+    samples = camera_samples(sensor=find_sensor("ALEXA 35"), frames=3, rate=24, focus_mm=3000.0, focus_to_mm=1500.0,
+                             lens=load_lens(slug), distortion=False, t0_ns=0)
+    squeezes = []
+    for s, mark in zip(samples, marks):
+        validate_sample(s)
+        sq = s["static"]["camera"]["anamorphicSqueeze"]  # a new squeeze each frame: re-sent each frame
+        squeezes.append(float(Fraction(sq["num"], sq["denom"])))
+        fx, fy = hand_framing_focal_lengths(slug, mark)
+        assert s["lens"]["pinholeFocalLength"] == pytest.approx(fy, rel=1e-6)
+        assert s["lens"]["pinholeFocalLength"] / squeezes[-1] == pytest.approx(fx, rel=1e-5)
+    assert squeezes[0] < squeezes[1] < squeezes[2]  # the horizontal shortens faster as the lens focuses close
