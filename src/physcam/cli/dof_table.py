@@ -339,10 +339,12 @@ def card_figure(d, *, units: str = "m", chart=None, page: str = "a4"):
     from ..units import format_distance
 
     labels, heads, cells = grid(d, units)
+    across = grid(d, units, horizontal=True)[2] if "near_horizontal_from_film_mm" in d["rows"][0] else None
     nrow, ncol = len(labels) + 2, len(heads) + 1
     page_w, h = PAGES[page]
-    chart_in = 4.2 if chart is not None else 0.0
-    table_in = min(h - chart_in - 0.5, max(3.0, 0.5 * nrow + 0.9))  # taller for long tables, within the page
+    chart_in = 0.0 if chart is None else (4.2 if across is None else 3.4)  # an anamorphic's table takes more
+    per_row = 0.5 if across is None else 0.8  # an anamorphic's cells take two lines more: the horizontal limits
+    table_in = min(h - chart_in - 0.5, max(3.0, per_row * nrow + 0.9))  # taller for long tables, within the page
     fig = new_figure(figsize=(page_w, h))
     top = h - 0.15  # the table and its title from the top of the page, the chart below it
     ax = fig.add_axes((0.03, (top - 0.92 * table_in) / h, 0.94, (0.86 * table_in - 0.25) / h))  # 2 title lines
@@ -353,8 +355,10 @@ def card_figure(d, *, units: str = "m", chart=None, page: str = "a4"):
         draw_dof_chart(fig.add_axes((0.09, bottom / h, 0.88, (chart_in - 1.1) / h)), *chart, units=units)
     ax.set_axis_off()
     text = [["focus", *heads]]
-    for lab, row in zip(labels, cells):
-        text.append([lab, *(f"{near}\n{far}\n({total})" for near, far, total in row)])
+    for i, (lab, row) in enumerate(zip(labels, cells)):
+        text.append([lab, *(f"{near}\n{far}\n({total})" + ("" if across is None else
+                                                           f"\n↔ {across[i][j][0]}\n↔ {across[i][j][1]}")
+                            for j, (near, far, total) in enumerate(row))])
     text.append(["hyperfocal", *(format_distance(hf["hyperfocal_from_film_mm"], units) for hf in d["hyperfocal"])])
     first = 1.3 / (ncol + 0.3)  # the label column a little wider than the others
     tab = ax.table(cellText=text, cellLoc="center", bbox=(0.0, 0.0, 1.0, 1.0),
@@ -369,6 +373,9 @@ def card_figure(d, *, units: str = "m", chart=None, page: str = "a4"):
     from ..figures import fit_title
 
     fig.suptitle(fit_title(_title(d, units), 0.95 * page_w, fontsize=8), fontsize=8, y=(h - 0.05) / h, va="top")
-    fig.text(0.5, 0.08 / h, "each cell: near / far / (total depth of field); physcam dof-table", ha="center", fontsize=6,
-             color="0.35")
+    foot = "each cell: near / far / (total depth of field); physcam dof-table"
+    if across is not None:
+        foot = (f"each cell: near / far / (total depth of field) up the frame; ↔ near / far across it (anamorphic, "
+                f"squeeze {d['squeeze']:.3g}: CoC {d['coc_mm'] / d['dof_aspect']:.4g} mm); physcam dof-table")
+    fig.text(0.5, 0.08 / h, foot, ha="center", fontsize=6, color="0.35")
     return fig
