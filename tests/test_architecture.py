@@ -10,7 +10,7 @@ from pathlib import Path
 SRC = Path(__file__).resolve().parents[1] / "src"
 
 LAYER = {
-    "errors": 0, "data": 0, "extras": 0,
+    "errors": 0, "data": 0, "extras": 0, "progress": 0,
     "units": 1, "io": 1,
     "figures": 2,
     "lens": 3,

@@ -37,6 +37,18 @@ _QUALITY = {"full": dict(mtf_fields=8, curve_fields=12, pupil_cap=256, rays=120_
             "draft": dict(mtf_fields=4, curve_fields=6, pupil_cap=96, rays=20_000, pixels=48, grid=32)}
 
 
+def _title_that_fits(text: str, width_in: float) -> tuple[str, float]:
+    """The page title and its size: the largest of 11, 10, 9 and 8 pt at which ``text``, bold, fits on one line
+    ``width_in`` inches wide (a long lens name, such as a zoom's with its source), else wrapped at 8 pt."""
+    from ..figures import fit_title
+
+    for size in (11.0, 10.0, 9.0, 8.0):
+        lines = fit_title(text, width_in, fontsize=size, weight="bold")
+        if "\n" not in lines:
+            return lines, size
+    return lines, 8.0
+
+
 @dataclass
 class LensCard:
     """What a lens card shows, computed once; :meth:`figure` draws the page."""
@@ -80,7 +92,8 @@ class LensCard:
         fig = new_figure(figsize=(w, h), dpi=dpi)
         gs = fig.add_gridspec(5, 6, left=0.08, right=0.9, top=0.93, bottom=0.075, hspace=0.75, wspace=1.6,
                               height_ratios=(1.25, 1.0, 1.0, 1.0, 0.8))
-        fig.suptitle(self._title(), fontsize=11, fontweight="bold", y=0.985)
+        title, size = _title_that_fits(self._title(), 0.94 * w)
+        fig.suptitle(title, fontsize=size, fontweight="bold", y=0.985)
         fig.text(0.5, 0.955, self._subtitle(units), ha="center", va="center", fontsize=7.5, color="0.25")
         _draw_diagram(fig.add_subplot(gs[0, :4], label="diagram"), self, units)
         _draw_key(fig.add_subplot(gs[0, 4:], label="key numbers"), self.key, units)
