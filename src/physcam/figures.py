@@ -33,7 +33,7 @@ import threading
 from pathlib import Path
 
 __all__ = ["pyplot", "subplots", "new_figure", "save_figure", "figure_bytes", "PALETTE", "STYLE", "apply_style",
-           "figure_style", "styled", "fit_title", "figure_problems", "UNITLESS_WORDS"]
+           "figure_style", "styled", "fit_title", "unbroken", "NO_BREAK", "figure_problems", "UNITLESS_WORDS"]
 
 _FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 
@@ -180,10 +180,19 @@ def styled(func):
     return in_style
 
 
+#: A space :func:`fit_title` never breaks a line at (it prints as a plain space): a label and its value.
+NO_BREAK = "\u00a0"
+
+
+def unbroken(text: str) -> str:
+    """``text`` (a label and its value, "focus 6' 6 3/4\"") kept on one line by :func:`fit_title`."""
+    return str(text).replace(" ", NO_BREAK)
+
+
 def fit_title(text: str, width_in: float, *, fontsize: float | None = None, weight: str = "normal") -> str:
     """``text`` wrapped at word boundaries so that each line, set in the style's font at ``fontsize``
     points (default the title size) and ``weight``, is at most ``width_in`` inches wide (measured by
-    matplotlib)."""
+    matplotlib); never at a :data:`NO_BREAK` space (see :func:`unbroken`), which comes out as a plain space."""
     from matplotlib.font_manager import FontProperties
     from matplotlib.textpath import text_to_path
 
@@ -204,7 +213,7 @@ def fit_title(text: str, width_in: float, *, fontsize: float | None = None, weig
             else:
                 line = trial
         out.append(line)
-    return "\n".join(out)
+    return "\n".join(out).replace(NO_BREAK, " ")
 
 
 def new_figure(figsize=None, dpi=None, **kwargs):

@@ -107,7 +107,8 @@ def test_openjd_defocus_gives_the_direct_bytes_tracing_the_kernels_once(shot):
     assert _files(folder / "ojd", skip=("kernels",)) == {k.replace("direct", "ojd"): v for k, v in want.items()}
     traced = {int(n): int(k) for n, k in re.findall(r"frame (\d+): wrote \S+ \((\d+) kernels traced", log)}
     assert set(traced) == {1, 2, 3, 4} and traced[1] > 0 and traced[2] == traced[3] == traced[4] == 0
-    assert len(list((folder / "ojd" / "kernels").rglob("*.npz"))) == traced[1]
+    stacks = list((folder / "ojd" / "kernels").rglob("*.npz"))  # frame 1's kernels, one stack file (issue 47)
+    assert len(stacks) == 1 and len(np.load(stacks[0])["nodes"]) == traced[1]
     mtimes = [p.stat().st_mtime_ns for p in sorted((folder / "ojd").glob("d.*.exr"))]
     again = _openjd(folder, "job.json", "frames")
     assert len(re.findall(r"frame \d: \S+ is there, skipped", again)) == 4
@@ -115,9 +116,10 @@ def test_openjd_defocus_gives_the_direct_bytes_tracing_the_kernels_once(shot):
 
 
 def test_a_task_killed_while_tracing_kernels_then_rerun_gives_the_same_bytes(shot):
-    """The kernels task (the plain task list's first line) is SIGKILLed once it has written its first kernel,
-    before its frame: the job then run through openjd run finishes from the kernels there and gives the
-    direct bytes; no temporary file is left in the outputs or the kernel cache."""
+    """The kernels task (the plain task list's first line) is SIGKILLed once its kernel stack file appears
+    (the cache writes one stack per run), before its frame: the job then run through openjd run finishes
+    from the kernels there and gives the direct bytes; no temporary file is left in the outputs or the
+    kernel cache."""
     folder, want = shot
     _defocus_job(folder, "killed", to="tasks", job="job.txt")
     _defocus_job(folder, "killed", job="killed.json")
@@ -128,7 +130,7 @@ def test_a_task_killed_while_tracing_kernels_then_rerun_gives_the_same_bytes(sho
     _openjd(folder, "killed.json", "frames")
     assert _files(folder / "killed", skip=("kernels",)) == {k.replace("direct", "killed"): v for k, v in want.items()}
     names = [p.name for p in (folder / "killed").rglob("*") if p.is_file()]
-    assert all(re.fullmatch(r"d\.000\d\.exr|k_[-0-9.]+_[-0-9.]+_\d+\.npz", n) for n in names), names
+    assert all(re.fullmatch(r"d\.000\d\.exr|stack-\d+-[0-9a-f]+\.npz", n) for n in names), names
 
 
 # ---- characterize ----------------------------------------------------------------------------------

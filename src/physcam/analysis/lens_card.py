@@ -213,6 +213,7 @@ def key_numbers(lens: Prescription, focus_mm: float, half_diagonal_mm: float, *,
             "close_focus_from_film_mm": None if close is None else close.mark_mm,
             "close_focus_source": None if close is None else close.source,
             "close_focus_words": None if close is None else close.words,
+            "minimum_object_distance_mm": m.minimum_object_distance,  # the maker's MOD, from the film
             "image_circle_mm": circle, "field_limit_deg": limit,
             "covers_sensor": circle >= 2.0 * half_diagonal_mm, "total_track_mm": lens.total_track,
             "squeeze": lens.squeeze, "maker": m.maker, "source": m.source, "licence": m.licence}
@@ -305,10 +306,12 @@ def _draw_key(ax, key, units):
             ("entrance pupil", f"Ø {key['entrance_pupil_diameter_mm']:.1f} mm"),
             ("  in front of film", dist(key["entrance_pupil_from_film_mm"])),
             ("close focus" + {"maker": " (MOD)", "focus groups": " (focus groups)"}.get(key["close_focus_source"], ""),
-             dist(key["close_focus_from_film_mm"])),
+             dist(_shown_close_focus(key))),
             ("image circle", f"Ø {key['image_circle_mm']:.1f} mm"), ("total track", f"{key['total_track_mm']:.1f} mm")]
     if key["close_focus_source"] == "unit focusing limit":  # 1:1, which no real lens of the kind reaches
         rows.insert(6, ("", "unit focusing limit, not the lens's MOD"))
+    elif _shown_close_focus(key) != key["close_focus_from_film_mm"]:  # the maker's MOD, closer than the model focuses
+        rows.insert(6, ("", f"beyond the focus model (reaches {dist(key['close_focus_from_film_mm'])})"))
     if key["squeeze"] != 1.0:
         rows.append(("squeeze", f"{key['squeeze']:g}x"))
     ax.set_title("key numbers", loc="left")
@@ -318,6 +321,13 @@ def _draw_key(ax, key, units):
         ax.text(0.0, y, k, transform=ax.transAxes, fontsize=7.5, va="top")
         ax.text(1.0, y, v, transform=ax.transAxes, fontsize=6 if note else 7.5, va="top", ha="right",
                 fontweight="normal" if note else "bold", color="0.3" if note else "black")
+
+
+def _shown_close_focus(key):
+    """The close focus a card shows: the maker's MOD where the file gives one (even closer than the
+    focus model reaches, key["close_focus_from_film_mm"]), else the model's close focus."""
+    mod = key.get("minimum_object_distance_mm")
+    return mod if key["close_focus_source"] == "maker" and mod is not None else key["close_focus_from_film_mm"]
 
 
 def _no_data(ax, text):
