@@ -67,6 +67,8 @@ class FocusTable:
     fstop_min: float  # the fastest f-stop accepted: physcam's camera state opens the iris this far
     closest_mm: float
     fresnel_loss: float  # Fresnel transmission at the film centre at infinity (uncoated)
+    #: the shader's data lines already written, by name and values (the four shaders of a lens share them)
+    osl_lines: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
 
     @property
     def semi_max(self) -> float:
@@ -218,6 +220,15 @@ def _arr32(name, values, size) -> str:
     return f"    float {name}[{size}] = {{{', '.join(_num32(v) for v in np.asarray(values, float).ravel())}}};"
 
 
+def _arr32_once(ft: FocusTable, name, values, size) -> str:
+    """:func:`_arr32`, written once per focus table and values (``ft.osl_lines``)."""
+    a = np.asarray(values, float)
+    key = (name, size, a.shape, a.tobytes())
+    if key not in ft.osl_lines:
+        ft.osl_lines[key] = _arr32(name, a, size)
+    return ft.osl_lines[key]
+
+
 def ghost_rows(ft: FocusTable) -> tuple[list[int], list[int]]:
     """The lens's ghost paths (:func:`physcam.analysis.ghosts.ghost_pairs` order) as the shader's rows
     (film side first): path (i, j) reflects first, from the film, at row N-1-j, then at row N-1-i."""
@@ -256,12 +267,12 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
         defines += ["#define PHYSCAM_RADIAL_PUPIL 1", f"#define N_RAD {N_RADIAL}",
                     f"#define N_RAD_TAB {ft.radial.size}", f"#define RAD_MAX {osl_number(RADIAL_MAX_MM)}",
                     f"#define RAD_STEP {osl_number(RADIAL_MAX_MM / (N_RADIAL - 1))}", f"#define N_TRY {N_TRY}"]
-        data.append(_arr32("RAD_TAB", ft.radial, "N_RAD_TAB"))
+        data.append(_arr32_once(ft, "RAD_TAB", ft.radial, "N_RAD_TAB"))
     else:
         defines += [f"#define N_LEVEL {1 + len(STOP_LEVELS)}",
                     f"#define N_RECT_TAB {ft.rects[0].size * n_focus * (1 + len(STOP_LEVELS))}",
                     f"#define GRID_HW {osl_number(ft.bounds.xs[-1])}", f"#define GRID_HH {osl_number(ft.bounds.ys[-1])}"]
-        data += [_arr32("RECT_TAB", np.concatenate([ft.rects[:, None], ft.rects_stopped], axis=1), "N_RECT_TAB"),
+        data += [_arr32_once(ft, "RECT_TAB", np.concatenate([ft.rects[:, None], ft.rects_stopped], axis=1), "N_RECT_TAB"),
                  osl_array("STOP_LEVEL", (1.0,) + STOP_LEVELS, "N_LEVEL")]
     # with Fresnel on, the centre's transmission at infinity is in the norm (it hardly changes with focus)
     norm = ft.norm * (ft.fresnel_loss if fresnel else 1.0)

@@ -53,6 +53,8 @@ N_LEVEL = 14
 _GRID = 48  # aim samples across a grid (half as many across its y >= 0 half)
 #: The largest error of the interpolated passing area that may weigh a ray (see radial_pupil_table).
 AREA_TOLERANCE = 0.004
+#: About the rays one table traces (2e5 on the double Gauss): what picks its tracing backend.
+TABLE_RAYS = 200_000
 _DS = 0.02  # the area's slope at a level: from the areas at 2 % smaller and larger irises
 
 
@@ -112,16 +114,7 @@ class _StopCrossing:
         return np.ones_like(self.radius)
 
 
-def _grid(box):
-    """A ``_GRID`` x ``_GRID/2`` grid of aim points over ``box`` (x0, x1, y1: the y >= 0 half): x, y, steps."""
-    x0, x1, y1 = box
-    nx, ny = _GRID, _GRID // 2
-    dx, dy = (x1 - x0) / nx, y1 / ny
-    gx, gy = np.meshgrid(x0 + (np.arange(nx) + 0.5) * dx, (np.arange(ny) + 0.5) * dy)
-    return gx.ravel(), gy.ravel(), dx, dy
-
-
-def _aims(q, film_z: float, fx, px, py, big: float):
+def _aims(q, film_z: float, fx, px, py, big: float, backend: str):
     """(passes every surface but the stop, radius where it crosses the stop plane) of rays from film
     points (fx, 0) to aim points (px, py) on the rear vertex plane, in one trace."""
     from ..trace.rays import OK, RayBatch
@@ -132,7 +125,8 @@ def _aims(q, film_z: float, fx, px, py, big: float):
     rays = RayBatch.from_arrays(start, np.stack([px - fx, py, np.full(px.size, q.vertex_z[-1] - film_z)], axis=1),
                                 q.wavelength_nm)
     probe = _StopCrossing()
-    trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=big, aperture=probe, in_place=True)
+    trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=big, aperture=probe, in_place=True,
+                  backend=backend)
     return rays.flag == OK, probe.radius * big
 
 
@@ -144,117 +138,173 @@ _TOWARD = (((slice(None), slice(0, -1)), (slice(None), slice(1, None)), (1, 0)),
 _HALVINGS = 4  # where another surface clips between two samples, it is found to 1/16 of a step
 
 
-def _trace(q, film_z: float, fxs, boxes, big: float) -> list:
+def _trace(q, film_z: float, fxs, boxes, big: float, backend: str) -> list:
     """Rays from film points (fx, 0) to the aim grid over each one's box on the rear vertex plane, in
     one trace: per film point (x, y, passes every surface but the stop, radius where it crosses the
     stop plane, grid steps, clip edges). Between a passing sample and a clipped neighbour the edge of
     what the other surfaces pass is found by halving (:data:`_HALVINGS`): per direction of
     :data:`_TOWARD`, (lo, hi) fractions of the step that pass and that do not."""
-    grids = [_grid(b) for b in boxes]
-    gx = np.concatenate([g[0] for g in grids])
-    gy = np.concatenate([g[1] for g in grids])
-    fx = np.repeat(np.asarray(fxs, dtype=float), [g[0].size for g in grids])
-    ok, rad = _aims(q, film_z, fx, gx, gy, big)
-    ny, nx = _GRID // 2, _GRID
-    out, i = [], 0
-    for f, g in zip(fxs, grids):
-        n = g[0].size
-        out.append([g[0], g[1], ok[i:i + n], rad[i:i + n], g[2], g[3], f])
-        i += n
+    nx, ny = _GRID, _GRID // 2
+    x0, x1, y1 = np.array(boxes, dtype=float).T
+    dx, dy = (x1 - x0) / nx, y1 / ny  # a _GRID x _GRID/2 grid over each box (x0, x1, y1: the y >= 0 half)
+    xs = x0[:, None] + (np.arange(nx) + 0.5)[None, :] * dx[:, None]
+    ys = (np.arange(ny) + 0.5)[None, :] * dy[:, None]
+    gx = np.broadcast_to(xs[:, None, :], (len(boxes), ny, nx)).reshape(len(boxes), -1)
+    gy = np.broadcast_to(ys[:, :, None], (len(boxes), ny, nx)).reshape(len(boxes), -1)
+    fxs = np.asarray(fxs, dtype=float)
+    ok, rad = _aims(q, film_z, np.repeat(fxs, ny * nx), gx.ravel(), gy.ravel(), big, backend)
+    ok, rad = ok.reshape(len(boxes), -1), rad.reshape(len(boxes), -1)
+    okg = ok.reshape(-1, ny, nx)
     # the clip edges: every (passing sample, clipped neighbour) pair of every grid, halved together
-    pairs = []  # (grid index, direction index, j, i, x, y, step x, step y, film x)
-    for gi, (gx_, gy_, ok_, rad_, dx, dy, f) in enumerate(out):
-        okg = ok_.reshape(ny, nx)
-        for di, (ca, cb, (sx, sy)) in enumerate(_TOWARD):
-            jj, ii = np.nonzero(okg[ca] & ~okg[cb])
-            ja, ia = jj + (ca[0].start or 0), ii + (ca[1].start or 0)
-            pairs.append((gi, di, jj, ii, gx_[0] + ia * dx, gy_[0] + ja * dy, np.full(jj.size, sx * dx),
-                          np.full(jj.size, sy * dy), np.full(jj.size, f)))
-    x, y, sx, sy, ff = [np.concatenate([p[k] for p in pairs]) for k in (4, 5, 6, 7, 8)]
+    pairs = []  # per direction: grid index, j, i, x, y, step x, step y, film x
+    for ca, cb, (sx, sy) in _TOWARD:
+        g, jj, ii = np.nonzero(okg[(slice(None),) + ca] & ~okg[(slice(None),) + cb])
+        ja, ia = jj + (ca[0].start or 0), ii + (ca[1].start or 0)
+        pairs.append((g, jj, ii, xs[g, 0] + ia * dx[g], ys[g, 0] + ja * dy[g], sx * dx[g], sy * dy[g], fxs[g]))
+    x, y, sx, sy, ff = [np.concatenate([p[k] for p in pairs]) for k in (3, 4, 5, 6, 7)]
     lo, hi = np.zeros(x.size), np.ones(x.size)
     for _ in range(_HALVINGS):
         mid = 0.5 * (lo + hi)
-        passes = _aims(q, film_z, ff, x + mid * sx, y + mid * sy, big)[0] if x.size else np.zeros(0, bool)
+        passes = _aims(q, film_z, ff, x + mid * sx, y + mid * sy, big, backend)[0] if x.size else np.zeros(0, bool)
         lo, hi = np.where(passes, mid, lo), np.where(passes, hi, mid)
-    k = 0
-    for gi, g in enumerate(out):
-        g.append([(np.zeros((ny, nx)), np.ones((ny, nx))) for _ in _TOWARD])
-    for gi, di, jj, ii, *_ in pairs:
-        n = jj.size
-        g_lo, g_hi = out[gi][7][di]
-        g_lo[jj, ii], g_hi[jj, ii] = lo[k:k + n], hi[k:k + n]
-        k += n
-    return [tuple(g[:6]) + (g[7],) for g in out]
+    edges, k = [], 0
+    for g, jj, ii, *_ in pairs:
+        e_lo, e_hi = np.zeros((len(boxes), ny, nx)), np.ones((len(boxes), ny, nx))
+        e_lo[g, jj, ii], e_hi[g, jj, ii] = lo[k:k + g.size], hi[k:k + g.size]
+        edges.append((e_lo, e_hi))
+        k += g.size
+    dx_, dy_ = dx.tolist(), dy.tolist()
+    return [(gx[i], gy[i], ok[i], rad[i], dx_[i], dy_[i], [(e[0][i], e[1][i]) for e in edges])
+            for i in range(len(boxes))]
 
 
-def _rims(g, radii) -> list:
-    """Per iris radius s in ``radii``, the rim of the passing set on grid ``g`` as points (x, y), or
-    None when nothing passes. Between a passing sample and a neighbour the iris stops, the rim is
-    where the stop radius crosses s (linear between the two: the stop radius is smooth); toward a
-    neighbour another surface clips, or past the grid's edge, it is put at the neighbour
+def _rims(uses, radii) -> list:
+    """Per (grid of :func:`_trace`, first and end index into the descending iris radii ``radii``) in
+    ``uses``, per iris radius s of that range, the rim of the passing set on the grid as points
+    (x, y), or None when nothing passes. Between a passing sample and a neighbour the iris stops,
+    the rim is where the stop radius crosses s (linear between the two: the stop radius is smooth);
+    toward a neighbour another surface clips, or past the grid's edge, it is put at the neighbour
     (conservative). The set is convex (the iris's image, cut by other round apertures), so its rim
-    bounds it."""
-    gx, gy, ok, rad, dx, dy, edges = g
+    bounds it. A sample passes at every iris radius from its stop radius t up (t infinite where
+    another surface clips): a sample and its neighbour make a rim point at the radii in [t_a, t_b),
+    found for every grid and radius at once by bisection in ``radii``."""
     ny, nx = _GRID // 2, _GRID
-    ok, rad = ok.reshape(ny, nx), rad.reshape(ny, nx)
-    s = np.asarray(radii, dtype=float)[:, None, None]
-    inside = ok & (rad <= s)  # (radii, ny, nx)
-    parts = []  # (radius index, x, y) arrays
+    ok = np.stack([g[2].reshape(ny, nx) for g, _, _ in uses])  # (grids, ny, nx)
+    rad = np.stack([g[3].reshape(ny, nx) for g, _, _ in uses])
+    t = np.where(ok, rad, np.inf)
+    x0, y0, dx, dy = (np.array(v) for v in zip(*((g[0][0], g[1][0], g[4], g[5]) for g, _, _ in uses)))
+    edges = [[np.stack([g[6][d][e] for g, _, _ in uses]) for e in (0, 1)] for d in range(len(_TOWARD))]
+    r0, r1 = np.array([u[1] for u in uses]), np.array([u[2] for u in uses])
+    first = np.concatenate([[0], np.cumsum(r1 - r0)])  # each grid's first rim
+    asc = radii[::-1]
+
+    def n_ge(v):  # how many radii are v or more (a sample passes at radii[:n_ge(t)])
+        return radii.size - np.searchsorted(asc, v, side="left")
+
+    def expand(g, lo, hi):  # (rim index, radius index, which entry) of every entry's radii [lo, hi)
+        n = hi - lo
+        e = np.repeat(np.arange(g.size), n)
+        i = lo[e] + np.arange(e.size) - np.repeat(np.cumsum(n) - n, n)
+        return first[g[e]] + i - r0[g[e]], i, e
+
+    r0_, r1_ = r0[:, None, None], r1[:, None, None]
+    n_in = n_ge(t)  # per sample: it passes at radii[:n_in]
+    parts = []  # (rim index, x, y, xa, ya, clipped)
     # toward +x, -x and +y: the sample's (a) and its neighbour's (b) cells
     for ((ja, ia_), (jb, ib), (sx, sy)), (e_lo, e_hi) in zip(_TOWARD, edges):
-        ex, ey = sx * dx, sy * dy
-        ra, rb = rad[ja, ia_], rad[jb, ib]
-        rim = inside[:, ja, ia_] & ~inside[:, jb, ib]
-        k, jj, ii = np.nonzero(rim)
-        nb_ok = ok[jb, ib][jj, ii]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            f_iris = np.clip((s[k, 0, 0] - ra[jj, ii]) / (rb[jj, ii] - ra[jj, ii]), 0.0, 1.0)
+        lo, hi = np.maximum(n_in[:, jb, ib], r0_), np.minimum(n_in[:, ja, ia_], r1_)
+        rim = hi > lo  # the pairs with a rim point at some radius of their grid
+        g, jj, ii = np.nonzero(rim)
+        shape = (slice(None), slice(0, rim.shape[1]), slice(0, rim.shape[2]))  # the clip edges' cells
+        ra, rb, nb_ok = rad[:, ja, ia_][rim], rad[:, jb, ib][rim], ok[:, jb, ib][rim]
         # where another surface clips, the rim is at the halved edge (held: its far end; area: its middle)
-        f = np.where(nb_ok, f_iris, e_hi[jj, ii])
-        fa = np.where(nb_ok, f_iris, 0.5 * (e_lo[jj, ii] + e_hi[jj, ii]))
-        jj, ii = jj + (ja.start or 0), ii + (ia_.start or 0)
-        parts.append((k, gx[0] + ii * dx + ex * f, gy[0] + jj * dy + ey * f,
-                      gx[0] + ii * dx + ex * fa, gy[0] + jj * dy + ey * fa, ~nb_ok))
-    for cells, ox, oy in (((slice(None), slice(0, 1)), -dx, 0.0), ((slice(None), slice(nx - 1, None)), dx, 0.0),
-                          ((slice(ny - 1, None), slice(None)), 0.0, dy)):  # past the grid's edge: a step out
-        k, jj, ii = np.nonzero(inside[:, cells[0], cells[1]])
+        e0, e1 = e_lo[shape][rim], e_hi[shape][rim]
+        ex, ey = sx * dx[g], sy * dy[g]
+        bx, by = x0[g] + (ii + (ia_.start or 0)) * dx[g], y0[g] + (jj + (ja.start or 0)) * dy[g]
+        k, ri, e = expand(g, lo[rim], hi[rim])
+        ra, rb, nb_ok, e0, e1, ex, ey, bx, by = (v[e] for v in (ra, rb, nb_ok, e0, e1, ex, ey, bx, by))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f_iris = np.clip((radii[ri] - ra) / (rb - ra), 0.0, 1.0)
+        f = np.where(nb_ok, f_iris, e1)
+        fa = np.where(nb_ok, f_iris, 0.5 * (e0 + e1))
+        parts.append((k, bx + ex * f, by + ey * f, bx + ex * fa, by + ey * fa, ~nb_ok))
+    for cells, ox, oy in (((slice(None), slice(0, 1)), -1, 0), ((slice(None), slice(nx - 1, None)), 1, 0),
+                          ((slice(ny - 1, None), slice(None)), 0, 1)):  # past the grid's edge: a step out
+        cell = (slice(None),) + cells
+        lo, hi = np.broadcast_to(r0_, t[cell].shape), np.minimum(n_in[cell], r1_)
+        rim = hi > lo
+        g, jj, ii = np.nonzero(rim)
         jj, ii = jj + (cells[0].start or 0), ii + (cells[1].start or 0)
-        parts.append((k, gx[0] + ii * dx + ox, gy[0] + jj * dy + oy, gx[0] + ii * dx + ox / 2, gy[0] + jj * dy + oy / 2,
-                      np.ones(k.size, dtype=bool)))
+        bx, by = x0[g] + ii * dx[g], y0[g] + jj * dy[g]
+        ex, ey = (ox * dx[g] if ox else np.zeros(g.size)), (oy * dy[g] if oy else np.zeros(g.size))
+        k, _, e = expand(g, lo[rim], hi[rim])
+        bx, by, ex, ey = bx[e], by[e], ex[e], ey[e]
+        parts.append((k, bx + ex, by + ey, bx + ex / 2, by + ey / 2, np.ones(k.size, dtype=bool)))
+    n_rims = int(first[-1])
     k = np.concatenate([p[0] for p in parts])
-    cols = [np.concatenate([p[c] for p in parts]) for c in range(1, 6)]
     order = np.argsort(k, kind="stable")
-    k, cols = k[order], [c[order] for c in cols]
-    cuts = np.searchsorted(k, np.arange(len(radii) + 1))
-    return [Rim(*(c[cuts[i]:cuts[i + 1]] for c in cols[:4]), bool(cols[4][cuts[i]:cuts[i + 1]].any()))
-            if cuts[i + 1] > cuts[i] else None for i in range(len(radii))]
+    k = k[order]
+    cols = [np.concatenate([p[c] for p in parts])[order] for c in range(1, 6)]
+    cuts = np.searchsorted(k, np.arange(n_rims + 1))
+    areas = _polygon_areas(k, cols[2], cols[3], cuts)
+    clipped = np.zeros(n_rims, dtype=bool)
+    starts = cuts[:-1][cuts[1:] > cuts[:-1]]
+    if starts.size:
+        clipped[k[starts]] = np.logical_or.reduceat(cols[4], starts)
+    cuts_, clipped_, areas_ = cuts.tolist(), clipped.tolist(), areas.tolist()
+    rims = [Rim(cols, slice(cuts_[i], cuts_[i + 1]), clipped_[i], areas_[i]) if cuts_[i + 1] > cuts_[i] else None
+            for i in range(n_rims)]
+    return [rims[a:b] for a, b in zip(first[:-1].tolist(), first[1:].tolist())]
+
+
+def _polygon_areas(k, xa, ya, cuts) -> np.ndarray:
+    """Per rim (points ``k`` sorted, rim i's from ``cuts[i]`` to ``cuts[i + 1]``): the set's area (mm^2,
+    both halves), the polygon through its edge points (xa, ya >= 0) and their mirror images, taken in
+    angle order about their middle (the set is convex); 0 for a rim without points. With the points
+    U_1..U_m of the half y >= 0 in angle order, the shoelace sum over the whole polygon is twice
+    sum_i (x_i y_i+1 - x_i+1 y_i) + x_1 y_1 - x_m y_m (the mirror half adds as much, and the two
+    closing edges cross the axis)."""
+    n = cuts.size - 1
+    out = np.zeros(n)
+    if k.size == 0:
+        return out
+    starts = cuts[:-1][cuts[1:] > cuts[:-1]]
+    mid = 0.5 * (np.minimum.reduceat(xa, starts) + np.maximum.reduceat(xa, starts))
+    mids = np.zeros(n)
+    mids[k[starts]] = mid
+    # in angle order within each rim (the angle, in [0, pi], plus 4 k: each rim's points stay in its span)
+    o = np.argsort(np.arctan2(ya, xa - mids[k]) + 4.0 * k)
+    x, y = xa[o], ya[o]
+    cross = np.append(x[:-1] * y[1:] - x[1:] * y[:-1], 0.0)
+    ends = np.append(starts[1:], k.size) - 1
+    cross[ends] = 0.0  # no edge from one rim to the next
+    total = np.add.reduceat(cross, starts) + x[starts] * y[starts] - x[ends] * y[ends]
+    out[k[starts]] = np.abs(total)
+    return out
 
 
 class Rim:
     """A passing set's rim: points (x, y >= 0) that hold it (where another surface clips, a step out),
     points (xa, ya) at the best estimate of its edge (half a step out there), for its area, and
-    whether a surface other than the iris (or the grid's edge) bounds it anywhere (``clipped``)."""
+    whether a surface other than the iris (or the grid's edge) bounds it anywhere (``clipped``).
+    The points are rows ``span`` of arrays shared by every rim of a table (``cols``)."""
 
-    def __init__(self, x, y, xa, ya, clipped: bool):
-        self.x, self.y, self.xa, self.ya, self.clipped = x, y, xa, ya, clipped
-        self._area = None
+    __slots__ = ("cols", "span", "clipped", "_area")
+
+    def __init__(self, cols, span: slice, clipped: bool, area: float):
+        self.cols, self.span, self.clipped, self._area = cols, span, clipped, area
+
+    x = property(lambda self: self.cols[0][self.span])
+    y = property(lambda self: self.cols[1][self.span])
+    xa = property(lambda self: self.cols[2][self.span])
+    ya = property(lambda self: self.cols[3][self.span])
 
     def area(self) -> float:
-        """The set's area (mm^2, both halves): the polygon through its edge points, taken in angle order
-        about their middle (the set is convex)."""
-        if self._area is None:
-            self._area = self._polygon_area()
+        """The set's area (mm^2, both halves): :func:`_polygon_areas`."""
         return self._area
 
-    def _polygon_area(self) -> float:
-        x = np.concatenate([self.xa, self.xa])
-        y = np.concatenate([self.ya, -self.ya])
-        o = np.argsort(np.arctan2(y, x - 0.5 * (x.min() + x.max())))
-        x, y = x[o], y[o]
-        return float(0.5 * abs(x[:-1] @ y[1:] - y[:-1] @ x[1:] + x[-1] * y[0] - y[-1] * x[0]))
 
-
-def _first_grids(q, film_z: float, fxs, s_max: float, r_rear: float, big: float) -> tuple[list, list]:
+def _first_grids(q, film_z: float, fxs, s_max: float, r_rear: float, big: float, backend: str) -> tuple[list, list]:
     """Per film point (fx, 0): the box (x0, x1, y1) of its first grid and the grid (:func:`_trace`).
     The rear element's square, unless fewer than :data:`~physcam.trace.pupil_bounds.MIN_HITS` of its
     aims pass at iris radius ``s_max`` (a cover glass close to the film: the spot is under one grid
@@ -264,14 +314,14 @@ def _first_grids(q, film_z: float, fxs, s_max: float, r_rear: float, big: float)
 
     full = (-r_rear, r_rear, r_rear)
     boxes = [full] * len(fxs)
-    grids = _trace(q, film_z, fxs, boxes, big)
+    grids = _trace(q, film_z, fxs, boxes, big, backend)
     pending = [p for p, g in enumerate(grids) if (g[2] & (g[3] <= s_max)).sum() < MIN_HITS]
     h = 0.5 * (film_z - q.vertex_z[-1])
     while pending and h < 2 * r_rear:
         wins = {p: (max(fxs[p] - h, -r_rear), min(fxs[p] + h, r_rear), min(h, r_rear)) for p in pending}
         wins = {p: w for p, w in wins.items() if w[1] > w[0]}
         done = set()
-        for p, g in zip(wins, _trace(q, film_z, [fxs[p] for p in wins], list(wins.values()), big) if wins else []):
+        for p, g in zip(wins, _trace(q, film_z, [fxs[p] for p in wins], list(wins.values()), big, backend) if wins else []):
             w, sel = wins[p], g[2] & (g[3] <= s_max)
             if sel.any():
                 x, y = g[0][sel], g[1][sel]
@@ -285,39 +335,58 @@ def _first_grids(q, film_z: float, fxs, s_max: float, r_rear: float, big: float)
     return boxes, grids
 
 
-def _passing_sets(q, film_z: float, fxs, radii, r_rear: float, big: float) -> list:
+def _passing_sets(q, film_z: float, fxs, radii, r_rear: float, big: float, backend: str) -> list:
     """Per film point (fx, 0) and per iris radius in ``radii`` (descending): the rim of the passing
     set (:func:`_rims`), or None when nothing passes. A point's grid zooms in on its passing set once
     that has shrunk to under half of the grid."""
     radii = np.asarray(radii, dtype=float)
-    boxes, grids = _first_grids(q, film_z, fxs, radii[0], r_rear, big)
+    boxes, grids = _first_grids(q, film_z, fxs, radii[0], r_rear, big, backend)
     start = [0] * len(fxs)  # the first radius each point's current grid serves
-    uses = [[] for _ in fxs]  # per film point: (grid, the radii it serves)
+    uses = [[] for _ in fxs]  # per film point: (grid, the first and end index of the radii it serves)
     pending = list(range(len(fxs)))
     while pending:
+        first, (xmin, xmax, ymax) = _shrunk(radii, [grids[p] for p in pending], [boxes[p] for p in pending],
+                                            [start[p] for p in pending])
         zoom = {}
-        for p in pending:
-            gx, gy, ok, rad, dx, dy, _ = grids[p]
-            box = boxes[p]
-            rs = radii[start[p]:]
-            sel = ok & (rad <= rs[:, None])  # (radii, samples)
-            anyp = sel.any(axis=1)
-            xmin = np.where(sel, gx, np.inf).min(axis=1)
-            xmax = np.where(sel, gx, -np.inf).max(axis=1)
-            ymax = np.where(sel, gy, -np.inf).max(axis=1)
-            small = anyp & (xmax - xmin + 4 * dx < 0.5 * (box[1] - box[0])) & (ymax + 2 * dy < 0.5 * box[2])
-            # the grid serves the radii before the first one that has shrunk under half of it
-            first = int(np.argmax(small)) if small.any() else rs.size
-            if first < rs.size:
-                uses[p].append((grids[p], rs[:first]))
-                zoom[p] = (xmin[first] - 2 * dx, xmax[first] + 2 * dx, ymax[first] + 2 * dy)
-                start[p] += first
-            else:
-                uses[p].append((grids[p], rs))
-        for p, g in zip(zoom, _trace(q, film_z, [fxs[p] for p in zoom], list(zoom.values()), big) if zoom else []):
+        for i, p in enumerate(pending):
+            f, dx, dy = int(first[i]), grids[p][4], grids[p][5]
+            uses[p].append((grids[p], start[p], f))
+            if f < radii.size:
+                zoom[p] = (xmin[i, f] - 2 * dx, xmax[i, f] + 2 * dx, ymax[i, f] + 2 * dy)
+                start[p] = f
+        for p, g in zip(zoom, _trace(q, film_z, [fxs[p] for p in zoom], list(zoom.values()), big, backend)
+                        if zoom else []):
             grids[p], boxes[p] = g, zoom[p]
         pending = list(zoom)
-    return [[rim for g, rs in u if len(rs) for rim in _rims(g, rs)] for u in uses]
+    flat = [use for u in uses for use in u if use[2] > use[1]]
+    rims = iter(_rims(flat, radii) if flat else [])
+    return [[rim for use in u if use[2] > use[1] for rim in next(rims)] for u in uses]
+
+
+def _shrunk(radii, grids, boxes, start):
+    """Per grid (of :func:`_trace`, over its box) the index of the first iris radius, from ``start`` on,
+    whose passing set has shrunk under half of the grid (len(radii) if none), and per grid and
+    radius the passing set's x extent and largest y. The sets nest: over the samples in order of
+    their stop radius, running extremes give every radius's at once."""
+    gx, gy, ok, rad = (np.stack([g[c] for g in grids]) for c in range(4))
+    dx, dy = np.array([g[4] for g in grids])[:, None], np.array([g[5] for g in grids])[:, None]
+    b = np.array(boxes)
+    rad = np.where(ok, rad, np.inf)
+    o = np.argsort(rad, axis=1, kind="stable")
+    rs = np.take_along_axis(rad, o, axis=1)
+    # per grid and radius: how many samples pass (those with stop radius at most it), as an index
+    n = np.stack([np.searchsorted(r, radii[::-1], side="right")[::-1] for r in rs])
+    anyp = n > 0
+    at = np.maximum(n - 1, 0)
+
+    def running(v, fn, empty):
+        run = fn.accumulate(np.take_along_axis(v, o, axis=1), axis=1)
+        return np.where(anyp, np.take_along_axis(run, at, axis=1), empty)
+
+    xmin, xmax, ymax = running(gx, np.minimum, np.inf), running(gx, np.maximum, -np.inf), running(gy, np.maximum, -np.inf)
+    small = (anyp & (xmax - xmin + 4 * dx < 0.5 * (b[:, 1:2] - b[:, 0:1])) & (ymax + 2 * dy < 0.5 * b[:, 2:3])
+             & (np.arange(radii.size)[None, :] >= np.asarray(start)[:, None]))
+    return np.where(small.any(axis=1), np.argmax(small, axis=1), radii.size), (xmin, xmax, ymax)
 
 
 #: Growth of every fitted ellipse beyond its rim points (the rim between two grid lines)
@@ -415,18 +484,22 @@ def _fill(table: np.ndarray, empty: np.ndarray) -> None:
             table[:, j] = table[:, near]
 
 
-def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
+def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto") -> np.ndarray:
     """The table (len(levels) x :data:`N_RADIAL` x 5: cx, ax, ay in mm on the rear vertex plane, the
     passing set's area in mm^2 and its slope in mm^2 per mm of iris radius) of the focused lens ``q``
     (a Prescription) with its film at ``film_z``, at the iris radii ``levels`` (:func:`iris_levels`).
-    Where nothing passes at any iris, the ellipse is a neighbour's and the area 0."""
+    Where nothing passes at any iris, the ellipse is a neighbour's and the area 0. ``backend``: the
+    tracing backend (:func:`~physcam.trace.trace.trace_through`; "auto" picks one for the whole table,
+    :func:`~physcam.trace.kernels.backend_for_job`: both give the same rays)."""
     from ..lens.prescription import require_prescription
+    from ..trace.kernels import backend_for_job
 
     q = require_prescription(q)
     film_z = require_finite("film z", film_z)
     if q.is_anamorphic:
         raise InputError(f"{q.name!r} is anamorphic: the radial pupil table needs a lens with rotational symmetry")
     levels = _levels(levels)
+    backend = backend_for_job(backend, TABLE_RAYS * (len(q.surfaces) + 1))
     if not film_z > q.vertex_z[-1]:
         raise InputError(f"the film (z = {film_z:g} mm) must lie behind the lens's last vertex (z = {q.vertex_z[-1]:g} mm)")
     semi_max = levels[0]
@@ -440,7 +513,7 @@ def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
     big = 20.0 * max(semi_max, q.surfaces[q.stop_index].semi_diameter)
     step = RADIAL_MAX_MM / (N_RADIAL - 1)
     sets = _passing_sets(q, film_z, [j * step for j in range(N_RADIAL)] + [(j + 0.5) * step for j in range(N_RADIAL - 1)],
-                         radii, r_rear, big)
+                         radii, r_rear, big, backend)
     at_node, at_mid = sets[:N_RADIAL], sets[N_RADIAL:]
     table = np.zeros((len(levels), N_RADIAL, 5))
     empty = np.ones((len(levels), N_RADIAL), dtype=bool)
@@ -459,41 +532,102 @@ def radial_pupil_table(q, film_z: float, levels) -> np.ndarray:
     # grow the entries until the shader's interpolation holds every traced set between them
     checks = [(j * step, at_node[j]) for j in range(N_RADIAL)] + [((j + 0.5) * step, at_mid[j])
                                                                    for j in range(N_RADIAL - 1)]
-    for rho, sets in checks:
-        ri = rho / step
-        j0 = min(int(math.floor(ri + 1e-9)), N_RADIAL - 2)
-        cols = [j0] if abs(ri - j0) < 1e-9 else [j0, j0 + 1]
-        for s in checked:
-            reg = sets[index[float(s)]]
-            if reg is None:
-                continue
-            for _ in range(8):
-                cx, ax, ay = _ellipse_at(table, levels, rho, float(s))
-                g = _need(reg, cx, ax, ay)
-                if g <= 1.0:
-                    break
-                rows = _rows_used(levels, float(s))
-                for k in rows:
-                    for j in cols:
-                        table[k, j, 1:3] *= g * (1 + 1e-6)
+    _grow(table, levels, [(rho, float(s), sets[index[float(s)]]) for rho, sets in checks for s in checked], step)
     # the area weighs rays only where the shader's interpolation of it is the traced area's within
     # AREA_TOLERANCE at every radius and iris between the entries (elsewhere their area is -1)
     trusted = table[..., 3] > 0
-    for rho, sets in checks:
-        ri = rho / step
-        j0 = min(int(math.floor(ri + 1e-9)), N_RADIAL - 2)
-        cols = [j0] if abs(ri - j0) < 1e-9 else [j0, j0 + 1]
-        for s in checked:
-            reg = sets[index[float(s)]]
-            want = reg.area() if reg is not None else 0.0
-            got = _area_at(table, levels, rho, float(s))
-            if abs(got - want) > AREA_TOLERANCE * max(want, 1e-12):
-                l0, lw, shrink = _bracket(levels, float(s))
-                for k in ([l0, l0 + 1] if shrink == 1.0 else [l0 + 1]):
-                    for j in cols:
-                        trusted[k, j] = False
+    reads = [(rho, float(s), sets[index[float(s)]]) for rho, sets in checks for s in checked]
+    want = np.array([reg.area() if reg is not None else 0.0 for _, _, reg in reads])
+    got = _areas_at(table, levels, [rho for rho, _, _ in reads], [s for _, s, _ in reads])
+    for i in np.flatnonzero(np.abs(got - want) > AREA_TOLERANCE * np.maximum(want, 1e-12)):
+        rho, s, _ = reads[i]
+        l0, lw, shrink = _bracket(levels, s)
+        for k in ([l0, l0 + 1] if shrink == 1.0 else [l0 + 1]):
+            for j in _cols_used(rho, step):
+                trusted[k, j] = False
     table[..., 3] = np.where(trusted, table[..., 3], -1.0)
     return table
+
+
+def _cols_used(rho: float, step: float) -> list[int]:
+    """The radius columns the shader reads at film radius ``rho`` (a node's own column at a node)."""
+    ri = rho / step
+    j0 = min(int(math.floor(ri + 1e-9)), N_RADIAL - 2)
+    return [j0] if abs(ri - j0) < 1e-9 else [j0, j0 + 1]
+
+
+def _reads(table, levels, rhos, ss):
+    """Per (film radius, iris radius) pair, arrays of what the shader reads: j0, rw (:func:`_radial`)
+    and l0, lw, shrink (:func:`_bracket`)."""
+    rad = {rho: _radial(table, rho) for rho in set(rhos)}
+    br = {s: _bracket(levels, s) for s in set(ss)}
+    j0, rw = (np.array(v) for v in zip(*(rad[rho] for rho in rhos)))
+    l0, lw, shrink = (np.array(v) for v in zip(*(br[s] for s in ss)))
+    return j0, rw, l0, lw, shrink
+
+
+def _ellipses_at(table, levels, rhos, ss) -> np.ndarray:
+    """:func:`_ellipse_at` at every (rho, s) pair, (n, 3), the same arithmetic in whole arrays."""
+    j0, rw, l0, lw, shrink = _reads(table, levels, rhos, ss)
+    rw, lw = rw[:, None], lw[:, None]
+    at0 = (1 - rw) * table[l0, j0, :3] + rw * table[l0, j0 + 1, :3]
+    at1 = (1 - rw) * table[l0 + 1, j0, :3] + rw * table[l0 + 1, j0 + 1, :3]
+    return ((1 - lw) * at0 + lw * at1) * np.stack([np.ones_like(shrink), shrink, shrink], axis=1)
+
+
+def _areas_at(table, levels, rhos, ss) -> np.ndarray:
+    """:func:`_area_at` at every (rho, s) pair, the same arithmetic in whole arrays."""
+    j0, rw, l0, _, shrink = _reads(table, levels, rhos, ss)
+    a = table[..., 3]
+    bad = np.minimum.reduce([a[l0, j0], a[l0, j0 + 1], a[l0 + 1, j0], a[l0 + 1, j0 + 1]]) < 0
+    rw_ = rw[:, None]
+    at0 = (1 - rw_) * table[l0, j0, 3:] + rw_ * table[l0, j0 + 1, 3:]
+    at1 = (1 - rw_) * table[l0 + 1, j0, 3:] + rw_ * table[l0 + 1, j0 + 1, 3:]
+    s0, s1, s = levels[l0 + 1], levels[l0], np.asarray(ss, dtype=float)
+    a0, d0, a1, d1 = at1[:, 0], at1[:, 1], at0[:, 0], at0[:, 1]
+    span = s1 - s0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.minimum(np.maximum((s - s0) / span, 0.0), 1.0)
+    cubic = ((2 * t**3 - 3 * t**2 + 1) * a0 + (t**3 - 2 * t**2 + t) * span * d0 + (-2 * t**3 + 3 * t**2) * a1
+             + (t**3 - t**2) * span * d1)
+    cubic = np.where(span > 0, cubic, a0)  # hermite
+    return np.where(bad, -1.0, np.where(shrink < 1.0, a0 * shrink * shrink, cubic))
+
+
+def _grow(table, levels, reads, step: float) -> None:
+    """Grow the entries (in place) until the shader's ellipse at each (rho, s, rim) of ``reads`` holds
+    the rim, in order. An entry only grows, and a grown entry holds what it held: the reads already held
+    by the table as it is are skipped (found in whole arrays; the rims share one table's points)."""
+    reads = [r for r in reads if r[2] is not None]
+    if not reads:
+        return
+    e = _ellipses_at(table, levels, [r[0] for r in reads], [r[1] for r in reads])
+    spans = [r[2].span for r in reads]
+    n = np.array([sp.stop - sp.start for sp in spans])
+    idx = np.concatenate([np.arange(sp.start, sp.stop) for sp in spans])
+    c = np.repeat(np.arange(len(reads)), n)
+    cols = reads[0][2].cols
+    x, y = cols[0][idx], cols[1][idx]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v = np.sqrt(((x - e[c, 0]) / e[c, 1]) ** 2 + (y / e[c, 2]) ** 2)
+    need = np.maximum.reduceat(v, np.cumsum(n) - n) * _SAFETY
+    need = np.where((e[:, 1] > 0) & (e[:, 2] > 0), need, math.inf)
+    j0, rw, l0, lw, shrink = (v.tolist() for v in _reads(table, levels, [r[0] for r in reads], [r[1] for r in reads]))
+    ends = np.cumsum(n)
+    for i in np.flatnonzero(~(need <= 1.0)).tolist():  # the same arithmetic as _ellipse_at and _need
+        rho, s, reg = reads[i]
+        xi, yi = x[ends[i] - n[i]:ends[i]], y[ends[i] - n[i]:ends[i]]
+        a, b, w, u = j0[i], l0[i], rw[i], lw[i]
+        for _ in range(8):
+            cx, ax, ay = (((1 - u) * ((1 - w) * table[b, a, m] + w * table[b, a + 1, m])
+                           + u * ((1 - w) * table[b + 1, a, m] + w * table[b + 1, a + 1, m])) * (1.0 if m == 0 else shrink[i])
+                          for m in (0, 1, 2))
+            g = float(np.sqrt(((xi - cx) / ax) ** 2 + (yi / ay) ** 2).max()) * _SAFETY if ax > 0 and ay > 0 else math.inf
+            if g <= 1.0:
+                break
+            for k in _rows_used(levels, s):
+                for j in _cols_used(rho, step):
+                    table[k, j, 1:3] *= g * (1 + 1e-6)
 
 
 def _rows_used(levels, s: float) -> list[int]:

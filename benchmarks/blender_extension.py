@@ -1,0 +1,130 @@
+"""Building the Blender extension: CPU seconds per lens (``lens_payload``: its focus table, pupil tables and shaders).
+
+Run:  .venv/bin/python benchmarks/blender_extension.py [--lenses dgauss_50mm,tessar_50mm]
+                                                       [--baseline-src <other checkout>/src]
+
+Goal (issue 41 follow-up): every bundled lens in under ~2.5 min of CPU (the extension build was
+about 8 min). CPU time (``time.process_time``: every thread of the process), so the figure holds on a
+shared machine; the load average is printed with it. One process per lens, the JIT kernel loaded before the
+clock starts (a whole build's "auto" backend switches to it within its first lens).
+
+With ``--baseline-src`` the same lenses are measured with that checkout's physcam too (a subprocess with
+``PYTHONPATH=<src>``, one lens of each side in turn, so both see the same load), and the ratio is printed
+with the largest difference between the two sides' pupil tables (``FocusTable.radial``: per entry the
+change of cx, ax and ay over the entry's size max(ax, ay); the area's relative change where both sides
+trust it, and the entries whose trust differs) and norm tables (relative).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+
+def load() -> str:
+    return ", ".join(f"{v:.2f}" for v in os.getloadavg())
+
+
+def worker(lens_name: str, out: str) -> None:
+    """Build one lens's payload in this process: print its CPU seconds as JSON, save its tables to ``out``."""
+    import physcam.export.blender_focus as bf
+    from physcam.export.blender_extension import lens_payload
+    from physcam.lens.library import load_lens
+    from physcam.trace.kernels import get_kernel
+    from physcam.trace.trace import camera_rays
+
+    lens = load_lens(lens_name)
+    # the JIT kernel loaded and compiled off the clock: a whole build switches to it within its first lens
+    get_kernel("numba")
+    camera_rays(lens, np.zeros((4, 2)), np.full((4, 2), 0.5), 60.0, backend="numba")
+    kept = {}
+    inner = bf.focus_table
+
+    def recording(*a, **k):
+        kept["ft"] = ft = inner(*a, **k)
+        return ft
+
+    bf.focus_table = recording
+    t = time.process_time()
+    lens_payload(lens, lens_name)
+    cpu = time.process_time() - t
+    ft = kept["ft"]
+    np.savez(out, radial=ft.radial if ft.radial is not None else np.zeros(0), norm=ft.norm)
+    print(json.dumps({"lens": lens_name, "cpu_s": cpu, "src": os.path.dirname(os.path.dirname(bf.__file__))}))
+
+
+def run(lens_name: str, src: str | None, out: str) -> float:
+    env = dict(os.environ)
+    if src:
+        env["PYTHONPATH"] = os.path.abspath(src)
+    r = subprocess.run([sys.executable, __file__, "--worker", lens_name, "--out", out], env=env, check=True,
+                       capture_output=True, text=True)
+    row = json.loads(r.stdout.strip().splitlines()[-1])
+    if src and not os.path.samefile(os.path.dirname(row["src"]), os.path.abspath(src)):
+        sys.exit(f"the baseline ran {row['src']}, not {src}: is physcam installed non-editable?")
+    return row["cpu_s"]
+
+
+def table_change(old: dict, new: dict) -> dict:
+    """The largest differences between two sides' tables of one lens (module notes)."""
+    a, b = old["radial"], new["radial"]
+    out = {"norm": float(np.max(np.abs(new["norm"] / old["norm"] - 1)))}
+    if a.size == 0:
+        return out | {"ellipse": 0.0, "area": 0.0, "trust_flips": 0}
+    size = np.maximum(a[..., 1], a[..., 2])
+    out["ellipse"] = float(np.max(np.abs(b[..., :3] - a[..., :3]) / size[..., None]))
+    both = (a[..., 3] > 0) & (b[..., 3] > 0)
+    out["area"] = float(np.max(np.abs(b[..., 3][both] / a[..., 3][both] - 1), initial=0.0))
+    out["trust_flips"] = int(np.sum((a[..., 3] < 0) != (b[..., 3] < 0)))
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--lenses", help="comma-separated bundled slugs (default: every bundled lens)")
+    ap.add_argument("--baseline-src", help="another checkout's src directory to compare against")
+    ap.add_argument("--worker", help=argparse.SUPPRESS)
+    ap.add_argument("--out", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.worker:
+        return worker(args.worker, args.out)
+    from physcam.lens.library import list_lenses
+
+    names = args.lenses.split(",") if args.lenses else [r.slug for r in list_lenses()]
+    here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src")
+    print(f"load average before: {load()}")
+    head = f"{'lens':28s} {'this CPU s':>10s}"
+    if args.baseline_src:
+        head += f" {'base CPU s':>10s} {'ratio':>6s} {'ellipse':>9s} {'area':>9s} {'flips':>5s} {'norm':>9s}"
+    print(head)
+    tot, tot_b, worst = 0.0, 0.0, {"ellipse": 0.0, "area": 0.0, "trust_flips": 0, "norm": 0.0}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in names:
+            new_f, old_f = os.path.join(tmp, "new.npz"), os.path.join(tmp, "old.npz")
+            cpu = run(name, here, new_f)
+            tot += cpu
+            line = f"{name:28s} {cpu:10.2f}"
+            if args.baseline_src:
+                base = run(name, args.baseline_src, old_f)
+                tot_b += base
+                d = table_change(dict(np.load(old_f)), dict(np.load(new_f)))
+                worst = {k: max(worst[k], d[k]) for k in worst}
+                line += (f" {base:10.2f} {base / cpu:6.2f} {d['ellipse']:9.2e} {d['area']:9.2e} {d['trust_flips']:5d}"
+                         f" {d['norm']:9.2e}")
+            print(line, flush=True)
+    print(f"{'total':28s} {tot:10.2f}" + (f" {tot_b:10.2f} {tot_b / tot:6.2f}" if args.baseline_src else ""))
+    if args.baseline_src:
+        print("largest change over every lens: ellipse {ellipse:.2e} of its size, area {area:.2e}, "
+              "{trust_flips} entries whose area trust differs, norm {norm:.2e}".format(**worst))
+    print(f"load average after: {load()}")
+
+
+if __name__ == "__main__":
+    main()
