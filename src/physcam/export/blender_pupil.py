@@ -613,21 +613,26 @@ def _grow(table, levels, reads, step: float) -> None:
     need = np.maximum.reduceat(v, np.cumsum(n) - n) * _SAFETY
     need = np.where((e[:, 1] > 0) & (e[:, 2] > 0), need, math.inf)
     j0, rw, l0, lw, shrink = (v.tolist() for v in _reads(table, levels, [r[0] for r in reads], [r[1] for r in reads]))
-    ends = np.cumsum(n)
+    ends = np.cumsum(n).tolist()
+    t = table[..., :3].tolist()  # grown as Python floats (the same arithmetic), written back at the end
+    rows = {s: _rows_used(levels, s) for s in {r[1] for r in reads}}
+    cols_ = {rho: _cols_used(rho, step) for rho in {r[0] for r in reads}}
     for i in np.flatnonzero(~(need <= 1.0)).tolist():  # the same arithmetic as _ellipse_at and _need
-        rho, s, reg = reads[i]
+        rho, s, _ = reads[i]
         xi, yi = x[ends[i] - n[i]:ends[i]], y[ends[i] - n[i]:ends[i]]
-        a, b, w, u = j0[i], l0[i], rw[i], lw[i]
+        a, w, u, r0, r1 = j0[i], rw[i], lw[i], t[l0[i]], t[l0[i] + 1]
         for _ in range(8):
-            cx, ax, ay = (((1 - u) * ((1 - w) * table[b, a, m] + w * table[b, a + 1, m])
-                           + u * ((1 - w) * table[b + 1, a, m] + w * table[b + 1, a + 1, m])) * (1.0 if m == 0 else shrink[i])
-                          for m in (0, 1, 2))
+            cx, ax, ay = (((1 - u) * ((1 - w) * r0[a][m] + w * r0[a + 1][m]) + u * ((1 - w) * r1[a][m] + w * r1[a + 1][m]))
+                          * (1.0 if m == 0 else shrink[i]) for m in (0, 1, 2))
             g = float(np.sqrt(((xi - cx) / ax) ** 2 + (yi / ay) ** 2).max()) * _SAFETY if ax > 0 and ay > 0 else math.inf
             if g <= 1.0:
                 break
-            for k in _rows_used(levels, s):
-                for j in _cols_used(rho, step):
-                    table[k, j, 1:3] *= g * (1 + 1e-6)
+            f = g * (1 + 1e-6)
+            for k in rows[s]:
+                for j in cols_[rho]:
+                    t[k][j][1] *= f
+                    t[k][j][2] *= f
+    table[..., 1:3] = np.array(t)[..., 1:3]
 
 
 def _rows_used(levels, s: float) -> list[int]:
