@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import subprocess
 import sys
@@ -37,13 +38,15 @@ def worker(lens_name: str, out: str) -> None:
     import physcam.export.blender_focus as bf
     from physcam.export.blender_extension import lens_payload
     from physcam.lens.library import load_lens
+    from physcam.optics.focusing import focus
     from physcam.trace.kernels import get_kernel
     from physcam.trace.trace import camera_rays
 
     lens = load_lens(lens_name)
     # the JIT kernel loaded and compiled off the clock: a whole build switches to it within its first lens
     get_kernel("numba")
-    camera_rays(lens, np.zeros((4, 2)), np.full((4, 2), 0.5), 60.0, backend="numba")
+    st = focus(lens, math.inf)
+    camera_rays(st.prescription, np.zeros((4, 2)), np.full((4, 2), 0.5), st.film_z, backend="numba")
     kept = {}
     inner = bf.focus_table
 
@@ -64,8 +67,10 @@ def run(lens_name: str, src: str | None, out: str) -> float:
     env = dict(os.environ)
     if src:
         env["PYTHONPATH"] = os.path.abspath(src)
-    r = subprocess.run([sys.executable, __file__, "--worker", lens_name, "--out", out], env=env, check=True,
+    r = subprocess.run([sys.executable, __file__, "--worker", lens_name, "--out", out], env=env,
                        capture_output=True, text=True)
+    if r.returncode:
+        sys.exit(f"{lens_name} failed ({src or 'this checkout'}): {r.stderr.strip().splitlines()[-1]}")
     row = json.loads(r.stdout.strip().splitlines()[-1])
     if src and not os.path.samefile(os.path.dirname(row["src"]), os.path.abspath(src)):
         sys.exit(f"the baseline ran {row['src']}, not {src}: is physcam installed non-editable?")
