@@ -37,6 +37,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from ..errors import InputError, require_finite, require_type
+from ..lens.prescription import require_prescription, takes_prescription
 from ..lens.zoom import prescription_at
 from .frames import FOCAL_RANGE_KEY, HORIZONTAL_PUPIL_KEY, TrackedFrame, new_source_id, rate_fraction, sample_from_frame, static_block, with_time
 from .sample import shown
@@ -120,7 +121,9 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
 
 def zoom_path(lens, zoom, zoom_to) -> tuple[float | None, float | None]:
     """(first, last) encoder value of a zoom lens's move (None, None for a prime; :func:`camera_frames`)."""
-    if lens is None or getattr(lens, "zoom", None) is None:
+    if lens is not None:
+        require_prescription(lens)
+    if lens is None or lens.zoom is None:
         if zoom is not None or zoom_to is not None:
             what = "a thin lens" if lens is None else repr(lens.name)
             raise InputError(f"a zoom position needs a zoom lens; {what} has no zoom table (docs/zoom.md)")
@@ -131,6 +134,7 @@ def zoom_path(lens, zoom, zoom_to) -> tuple[float | None, float | None]:
     return u0, u0 if zoom_to is None else zoom_encoder(lens, zoom_to)
 
 
+@takes_prescription
 def _wide_end_first(lens) -> bool:
     """True when the zoom lens's encoder 0 (its first tabulated position) is its wide end."""
     from ..optics.zoom import efl_at
@@ -138,6 +142,7 @@ def _wide_end_first(lens) -> bool:
     return efl_at(lens, 0.0) < efl_at(lens, 1.0)
 
 
+@takes_prescription
 def opentrackio_zoom(lens, encoder: float) -> float:
     """OpenTrackIO's ``lens.encoders.zoom`` (0 wide angle, 1 telephoto; schema 1.0.1) of the zoom lens at
     physcam's encoder value (0 its first tabulated position, docs/zoom.md)."""
@@ -145,11 +150,13 @@ def opentrackio_zoom(lens, encoder: float) -> float:
     return u if _wide_end_first(lens) else 1.0 - u
 
 
+@takes_prescription
 def physcam_zoom(lens, opentrackio_encoder: float) -> float:
     """physcam's encoder value of OpenTrackIO's zoom encoder (the inverse of :func:`opentrackio_zoom`)."""
     return opentrackio_zoom(lens, opentrackio_encoder)
 
 
+@takes_prescription
 def focal_range(lens) -> tuple[float, float]:
     """(shortest, longest) paraxial EFL of a zoom lens at infinity focus (mm; at its two ends, the EFL
     running monotonically along the zoom, :func:`physcam.optics.zoom.encoder_for_focal_length`)."""
