@@ -512,8 +512,8 @@ def run_play(args) -> int:
         samples, rate = _clip_samples(args)
         _stream(args, samples, rate if args.rate is None else args.rate)
         return 0
-    if args.lens is not None or args.focal is not None:
-        raise InputError("--lens and --focal go with --clip: a recording carries its own lens values")
+    if args.lens is not None or args.focal is not None or args.zoom is not None:
+        raise InputError("--lens, --focal and --zoom go with --clip: a recording carries its own lens values")
     name = str(args.file).lower()
     if name.endswith((".usda", ".usd", ".usdc")):
         from ..live.usd_io import frames_from_usd
