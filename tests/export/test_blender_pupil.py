@@ -156,3 +156,46 @@ def test_the_ellipse_holds_the_spot_behind_a_cover_glass():
             cx, ax, ay = interpolated_ellipse(table, levels, rho, s)
             assert ok.sum() > 100 and ax > 0 and ay > 0
             assert (((gx[ok] - cx) / ax) ** 2 + (gy[ok] / ay) ** 2 <= 1).all(), (n, rho)
+
+
+def test_the_rim_area_of_a_regular_polygon():
+    """The batched shoelace area (both halves from the y >= 0 half) against a regular polygon's closed form
+    n/2 R^2 sin(2 pi / n): two rims in one call, their points shuffled, one rim empty."""
+    from physcam.export.blender_pupil import _polygon_areas
+
+    rng = np.random.default_rng(3)
+    k, xs, ys, want = [], [], [], []
+    for rim, (cx, r, m) in enumerate([(1.5, 2.0, 13), (None, None, 0), (-4.0, 0.7, 40)]):
+        if not m:
+            want.append(0.0)
+            continue
+        th = np.pi * rng.permutation(m) / (m - 1)  # m points from 0 to pi: a regular 2(m - 1)-gon
+        k += [rim] * m
+        xs.append(cx + r * np.cos(th))
+        ys.append(r * np.sin(th))
+        n = 2 * (m - 1)
+        want.append(n / 2 * r * r * math.sin(2 * math.pi / n))
+    k = np.array(k)
+    got = _polygon_areas(k, np.concatenate(xs), np.concatenate(ys), np.searchsorted(k, np.arange(4)))
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=0)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_the_batched_reading_is_the_shaders(seed):
+    """The whole-array readings the table is grown and checked with give the shader's reading
+    (interpolated_ellipse, interpolated_area) at every film and iris radius: the ellipse to the last
+    bit, the area to rounding."""
+    from physcam.export.blender_pupil import N_LEVEL, N_RADIAL, _areas_at, _ellipses_at
+
+    rng = np.random.default_rng(seed)
+    levels = iris_levels(12.0, 10.0)
+    table = rng.uniform(0.1, 20.0, (N_LEVEL, N_RADIAL, 5))
+    table[..., 3] = np.where(rng.random((N_LEVEL, N_RADIAL)) < 0.1, -1.0, table[..., 3])
+    rhos = list(rng.uniform(0, RADIAL_MAX_MM, 20)) + [0.0, RADIAL_MAX_MM]
+    ss = list(rng.uniform(levels[-1] / 3, levels[0], 20)) + [float(levels[0]), float(levels[-1])]
+    e = _ellipses_at(table, levels, rhos, ss)
+    a = _areas_at(table, levels, rhos, ss)
+    for i, (rho, s) in enumerate(zip(rhos, ss)):
+        assert e[i].tolist() == interpolated_ellipse(table, levels, rho, s).tolist()
+        assert a[i] == pytest.approx(interpolated_area(table, levels, rho, s), rel=1e-13, abs=0)
