@@ -42,7 +42,7 @@ def report_dict(lens, case: dict) -> dict:
     """The report of ``lens`` for one case, as ``to_dict()``, or its error's type and message."""
     from physcam.errors import PhysCamError
     from physcam.onset.report import ReportRequest, solve_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     try:
         with warnings.catch_warnings():

@@ -76,7 +76,7 @@ def dgauss():
 def _dof_zone(lens):
     from physcam.onset.dof_plot import dof_zone_figure
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     return dof_zone_figure(solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("S35"), fstop=2.8,
                                              focus_mm=3000.0))
@@ -116,7 +116,7 @@ def _spot(lens):
 
 def _compare(lens):
     from physcam.cli.compare import compare_figure
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     rows = [{"name": "A", "fstop": 2.8, "focus_from_film_mm": 2000.0, "bokeh_light_from_film_mm": 4000.0,
              "bokeh_diameter_mm": 0.1}]

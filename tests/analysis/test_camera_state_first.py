@@ -126,7 +126,7 @@ def test_light_field_camera_is_the_same_through_either_door():
 
 def test_lens_measurements_are_the_same_through_either_door():
     from physcam.analysis.lens_compare import lens_measurements
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     ff = find_sensor("FF")
     with warnings.catch_warnings():
@@ -144,7 +144,7 @@ def test_lens_measurements_are_the_same_through_either_door():
 def test_thin_lens_gap_takes_the_reports_camera_state():
     from physcam.analysis.thin_lens_gap import thin_lens_gap
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

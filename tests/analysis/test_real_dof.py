@@ -12,7 +12,7 @@ from physcam.analysis.bokeh import bokeh_image
 from physcam.analysis.real_dof import blur_diameter_mm, real_depth_of_field
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 from physcam.optics import focusing
 
 from _image_quality import perfect_lens

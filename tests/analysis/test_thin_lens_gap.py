@@ -17,7 +17,7 @@ import pytest
 from physcam.analysis.thin_lens_gap import thin_lens_gap
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 
 S35 = find_sensor("Super 35")
 

@@ -13,7 +13,7 @@ import pytest
 
 from physcam.export.blender_camera import blender_camera_script, blender_camera_values
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 
 from _blender import run_blender
 

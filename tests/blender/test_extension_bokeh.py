@@ -62,7 +62,7 @@ print(json.dumps({"message": p.message, "img": a.tolist()}))
 def _pupil_from_film(lens, mark_mm):
     """The entrance pupil's distance in front of the film at mark_mm (physcam's report)."""
     from physcam.onset.request import ReportRequest
-    from physcam.onset.sensors import custom_sensor
+    from physcam.optics.sensors import custom_sensor
     from physcam.onset.solvers import lens_at_mark
 
     return lens_at_mark(ReportRequest(sensor=custom_sensor(36.0, 24.0), fstop=FSTOP, focus_mm=mark_mm,

@@ -70,7 +70,7 @@ def _journal(d: Path) -> None:
     """The journal a killed `live record scene12.usda` leaves: its header and 24 samples."""
     from physcam.live.camera import camera_samples
     from physcam.live.journal import Journal
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     j = Journal.create(d / "scene12.usda", {"output": "scene12.usda", "report": None, "options": {}})
     for i, s in enumerate(camera_samples(sensor=find_sensor("ALEXA 35"), frames=24, rate=24, focus_mm=2000.0,

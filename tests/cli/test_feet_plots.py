@@ -116,7 +116,7 @@ def test_distortion_fit_residual_title_in_feet(dgauss):
 def test_dof_zone_marks_and_title_in_feet():
     from physcam.onset.dof_plot import dof_zone_figure
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     r = solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("S35"), fstop=2.8, focus_mm=3000.0)
     fm, ff = dof_zone_figure(r, units="m"), dof_zone_figure(r, units="ft")
@@ -157,7 +157,7 @@ def test_lens_breathing_plot_in_feet(dgauss):
 
 def test_compare_figures_in_feet():
     from physcam.cli.compare import _figure, compare_figure
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     # physcam compare blender's figure (no Blender needed to draw it: two images and the distances)
     res = {"lens": "dgauss", "crop_mm": 2.0, "fstop": 2.8, "light_from_film_mm": 700.0, "focus_from_film_mm": 2000.0,

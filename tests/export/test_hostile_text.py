@@ -251,7 +251,7 @@ def hash_tokens(text: str) -> list[str]:
 @pytest.fixture(scope="module")
 def report(triplet):
     from physcam.onset.report import ReportRequest, solve_report
-    from physcam.onset.sensors import custom_sensor
+    from physcam.optics.sensors import custom_sensor
 
     return solve_report(ReportRequest(focal_length_mm=None, sensor=custom_sensor(24.0, 18.0), fstop=5.6,
                                       focus_mm=2000.0, lens=triplet))

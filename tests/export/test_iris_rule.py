@@ -15,7 +15,7 @@ import pytest
 
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 from physcam.optics import focusing, paraxial
 
 CASES = [("zuiko_18mm_f3_5", 450.0), ("navarro_anamorphic_2x", 1250.0), ("dgauss_50mm", 600.0)]

@@ -25,7 +25,7 @@ from physcam.live.frustum import frustum_frames, wall_from_usd, write_wall
 from physcam.live.record import lens_report_rows, solve_frames, write_recording_usd
 from physcam.live.sample import decode_sample, encode_sample, sample_problems
 from physcam.live.usd_io import frames_from_usd
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 
 from _opentrackio_readers import camdkit_reader, opencv_rational, unreal_reader
 

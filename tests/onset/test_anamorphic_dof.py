@@ -19,7 +19,7 @@ import pytest
 
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 from physcam.optics import focusing
 
 ALEXA35 = find_sensor("ALEXA 35")

@@ -313,7 +313,7 @@ def ghost_analysis(
     if coating is None:
         coating = lens.metadata.coating if lens.metadata.coating in ("none", "single", "multi") else "none"
     wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
-    from ..onset.sensors import custom_sensor
+    from ..optics.sensors import custom_sensor
 
     sensor = custom_sensor(sensor_width_mm, sensor_height_mm)  # bounded size and aspect: the image stays small
     w, h = sensor.width_mm, sensor.height_mm

@@ -124,7 +124,7 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
               page: str = "a4", quality: str = "full", backend: str = "auto", sensor=None) -> LensCard:
     """Compute the card of ``lens`` focused ``focus_mm`` from the film plane (default infinity; a string with
     units such as "2m" or "10ft" too) on a ``sensor_width_mm`` x ``sensor_height_mm`` sensor, or ``sensor``
-    (a name such as "ALEXA 35", or a :class:`~physcam.onset.sensors.Sensor`; default Super 35). The MTF chart
+    (a name such as "ALEXA 35", or a :class:`~physcam.optics.sensors.Sensor`; default Super 35). The MTF chart
     is drawn wide open and at ``stopped_fstop`` (default f/8; skipped when not slower than wide open).
     ``page``: "a4" or "letter"; ``quality``: "full" or "draft" (fewer fields and rays: tests)."""
     from ..data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
@@ -133,7 +133,7 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
     from ..units import parse_distance
 
     if sensor is not None:
-        from ..onset.sensors import Sensor, find_sensor
+        from ..optics.sensors import Sensor, find_sensor
 
         if sensor_width_mm is not None or sensor_height_mm is not None:
             raise InputError("give the sensor either by name (sensor=) or by size (sensor_width_mm=, "

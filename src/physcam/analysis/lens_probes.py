@@ -43,7 +43,7 @@ def ray_probes(sensor_name: str | None):
         from . import _chief
         from .illumination import relative_illumination
         from ..errors import OpticsError
-        from ..onset.sensors import find_sensor
+        from ..optics.sensors import find_sensor
         from ..optics.paraxial import gaussian
 
         s = find_sensor(sensor_name)

@@ -350,7 +350,7 @@ def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):
     :data:`DEFAULT_SENSOR`), which a note on stderr names (unless ``quiet``: the command says it
     itself). Sets ``args.sensor_defaulted``."""
     from ..errors import InputError
-    from ..onset.sensors import custom_sensor, find_sensor
+    from ..optics.sensors import custom_sensor, find_sensor
 
     name = getattr(args, "sensor", None)
     sw, sh = getattr(args, "sensor_width", None), getattr(args, "sensor_height", None)

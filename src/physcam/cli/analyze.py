@@ -239,7 +239,7 @@ def run_breathing(args) -> int:
     from ._output import Table, print_table
 
     lens = _prepare(args)
-    from ..onset.sensors import custom_sensor
+    from ..optics.sensors import custom_sensor
 
     marks = None if args.focus is None else resolve_focus(
         args.focus, lens=lens, sensor=custom_sensor(args.sensor_width, args.sensor_height), args=args)

@@ -85,7 +85,7 @@ def run_distortion(args) -> int:
                          "--across-focus; the 2-D field writes --stmap files")
     lens = _prepare(args)
     if args.focus is not None or args.across_focus is not None:
-        from ..onset.sensors import custom_sensor
+        from ..optics.sensors import custom_sensor
         from ._common import resolve_focus
 
         sensor = custom_sensor(args.sensor_width, args.sensor_height)

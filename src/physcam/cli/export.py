@@ -104,7 +104,7 @@ def _prepare(args):
     """Resolve the sensor (args.sensor_width/height), load the lens and resolve --focus (hyperfocal:
     the lens at --fstop, or wide open)."""
     from ..lens.library import load_lens
-    from ..onset.sensors import custom_sensor
+    from ..optics.sensors import custom_sensor
     from ._common import resolve_focus
     from .analyze import _resolve_sensor
 
@@ -269,7 +269,7 @@ def _write_builtin(args, lens, width_px: int, path):
     from ..export.blender_camera import blender_camera_script, blender_camera_values
     from ..io import atomic_write
     from ..onset.report import ReportRequest, solve_report
-    from ..onset.sensors import custom_sensor
+    from ..optics.sensors import custom_sensor
 
     if math.isinf(args.focus):
         raise InputError("--builtin needs a finite focus mark (the built-in camera's focus distance); "

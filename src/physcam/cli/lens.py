@@ -508,7 +508,7 @@ def run_check(args) -> int:
     from ._output import document, emit_json
 
     if args.sensor:
-        from ..onset.sensors import find_sensor
+        from ..optics.sensors import find_sensor
 
         find_sensor(args.sensor)  # an unknown name is refused before any work
     from ..analysis.lens_probes import ray_probes

@@ -175,7 +175,7 @@ def cli_backend():
         return _svg(fig, description=json.dumps(fig.physcam_chart, separators=(",", ":")))
 
     def sensors(q):
-        from ..onset.sensors import sensors as all_sensors
+        from ..optics.sensors import sensors as all_sensors
 
         from .sensors import select
 

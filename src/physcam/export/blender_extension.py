@@ -51,7 +51,7 @@ def _report_rows(lens, marks_mm) -> list[dict]:
     """The on-set numbers the panel shows, per focus state: only the report's solvers it needs (the
     lens at the mark and its pinhole; no real-ray field of view, which the panel does not show)."""
     from ..onset.request import ReportRequest
-    from ..onset.sensors import custom_sensor
+    from ..optics.sensors import custom_sensor
     from ..onset.solvers import field_of_view, lens_at_mark
     from ..optics.coc import circle_of_confusion
 
@@ -95,7 +95,7 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
 
 def _sensor_presets() -> list[dict]:
     """physcam's sensor table, those a full-frame pupil table covers (:data:`GRID_HALF_MM`)."""
-    from ..onset.sensors import sensors
+    from ..optics.sensors import sensors
     from .blender_focus import GRID_HALF_MM
 
     return [{"name": s.name, "width_mm": s.width_mm, "height_mm": s.height_mm} for s in sensors()

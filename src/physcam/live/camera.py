@@ -62,9 +62,9 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
     ``focus_mm`` to ``focus_to_mm`` (mm from the film; default: held), ``lens`` (a Prescription) or a
     thin lens of ``focal_length_mm``; ``t0_ns`` the first timestamp (default now); ``shift_mm`` the
     lens shift (+ right, + up); ``drop_frame``: drop-frame timecode (29.97, 59.94)."""
-    from ..onset.sensors import Sensor
+    from ..optics.sensors import Sensor
 
-    require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
+    require_type("sensor", sensor, Sensor, "physcam.optics.sensors.find_sensor(name)")
     if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= MAX_TAKE_FRAMES:
         raise InputError(f"frames must be a whole number 1..{MAX_TAKE_FRAMES}, got {shown(frames)}")
     fr = rate_fraction(rate)
@@ -122,7 +122,7 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
     stream's ``static.camera.activeSensorPhysicalDimensions``; a sample without a focus distance is
     passed on as it is. The pinhole and pupil do not depend on the stop: the lens is solved wide
     open (a thin lens at f/8) and the sample's own stops are sent unchanged."""
-    from ..onset.sensors import custom_sensor
+    from ..optics.sensors import custom_sensor
 
     if (lens is None) == (focal_length_mm is None):
         raise InputError("give either a lens prescription or a focal length")

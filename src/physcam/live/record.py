@@ -239,7 +239,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
 
     Values a frame does not carry come from the latest earlier frame **of the same source** (its
     ``sourceId`` and ``sourceNumber``), else from these defaults: ``sensor`` (a
-    :class:`~physcam.onset.sensors.Sensor`) when the stream's static data gives no sensor size,
+    :class:`~physcam.optics.sensors.Sensor`) when the stream's static data gives no sensor size,
     ``focal_length_mm`` (pinhole), ``fstop``, ``focus_mm`` (from the film plane); each
     :class:`SolvedFrame` names them (``carried``, ``defaulted``). Each source keeps its own time line
     (:func:`time_line`): a frame off it (a time code that goes back, or one far ahead that the
@@ -258,11 +258,11 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     never gave) raises, unless ``refused`` is a list: then it is left out, ``(index, reason)`` is
     appended there, and its values are not carried over to later frames.
     """
-    from ..onset.sensors import Sensor, custom_sensor
+    from ..optics.sensors import Sensor, custom_sensor
 
     frames = _frames(frames)
     if sensor is not None:
-        require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
+        require_type("sensor", sensor, Sensor, "physcam.optics.sensors.find_sensor(name)")
     if refused is not None and not isinstance(refused, list):
         raise InputError(f"refused must be a list to append the refused frames to, got {type(refused).__name__}")
     codes, _ = time_codes(frames, rate)

@@ -78,13 +78,13 @@ def tracked_frames(record, *, rate=None) -> list:
 
 
 def _sensor_of(record, sensor):
-    from ..onset.sensors import Sensor, custom_sensor
+    from ..optics.sensors import Sensor, custom_sensor
 
     if record.active_area_mm is not None:
         return custom_sensor(*record.active_area_mm)
     if sensor is None:
         raise InputError(f"the {record.source} file gives no sensor size; give the sensor (--sensor)")
-    return require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
+    return require_type("sensor", sensor, Sensor, "physcam.optics.sensors.find_sensor(name)")
 
 
 def solve(record, *, sensor=None, lens=None, coc=None, focal_length_mm=None, fstop=None, rate=None) -> list:

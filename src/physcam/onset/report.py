@@ -40,7 +40,7 @@ from ..optics.coc import circle_of_confusion
 from .pupil import pivot_camera_space
 from .request import (DIFFRACTION_WAVELENGTH_NM, HYPERFOCAL, MAX_DISTANCE_MM, MAX_F_NUMBER, MIN_F_NUMBER,
                       ReportRequest)
-from .sensors import Sensor
+from ..optics.sensors import Sensor
 from .solvers import (DepthOfField, depth_of_field, entrance_pupil, field_of_view, finite_or_none, focus_error,
                       invert_limits, lens_at_mark, principal_planes, solve_focus)
 

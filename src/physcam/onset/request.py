@@ -18,7 +18,7 @@ from dataclasses import dataclass, fields
 
 from ..errors import InputError, require_finite, require_positive, require_type
 from ..optics.thinlens import MAX_F_NUMBER, MIN_F_NUMBER, require_f_number
-from .sensors import Sensor
+from ..optics.sensors import Sensor
 
 __all__ = ["ReportRequest", "HYPERFOCAL", "DIFFRACTION_WAVELENGTH_NM", "MIN_F_NUMBER", "MAX_F_NUMBER",
            "MAX_DISTANCE_MM"]
@@ -111,7 +111,7 @@ def _read_as_written(r: ReportRequest) -> dict:
 
     out = {}
     if isinstance(r.sensor, str):
-        from .sensors import find_sensor
+        from ..optics.sensors import find_sensor
 
         out["sensor"] = find_sensor(r.sensor)
     for key, infinite in _DISTANCES.items():
@@ -126,7 +126,7 @@ def _read_as_written(r: ReportRequest) -> dict:
 
 
 def _check_sensor_and_wavelength(r: ReportRequest) -> dict:
-    require_type("sensor", r.sensor, Sensor, "physcam.onset.sensors.find_sensor(name) or custom_sensor(w, h)")
+    require_type("sensor", r.sensor, Sensor, "physcam.optics.sensors.find_sensor(name) or custom_sensor(w, h)")
     lam = require_positive("diffraction wavelength", r.diffraction_wavelength_nm, unit="nm")
     if not 200.0 <= lam <= 20000.0:
         raise InputError(f"diffraction wavelength must lie between 200 and 20000 nm, got {lam:g}")

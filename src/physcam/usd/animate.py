@@ -116,7 +116,7 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     """Write a camera whose focus (and iris) follow ``keys``, one time sample per key; return the Path.
 
     ``lens`` (a Prescription) or ``focal_length_mm`` (a thin lens); ``sensor`` a
-    :class:`~physcam.onset.sensors.Sensor`; ``fstop`` for keys without their own (with a
+    :class:`~physcam.optics.sensors.Sensor`; ``fstop`` for keys without their own (with a
     prescription and no f-stop at all: wide open).
     """
     from pxr import Sdf, UsdGeom

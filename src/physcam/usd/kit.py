@@ -260,7 +260,7 @@ def _author_shot_companion(stage, path) -> str:
     report, distortion, opencv = None, None, None
     if rx is not None and spec.projection == "perspective":
         from ..onset.report import ReportRequest, solve_report
-        from ..onset.sensors import Sensor
+        from ..optics.sensors import Sensor
 
         sensor = Sensor(key="custom", name=spec.sensor_name or f"{spec.sensor_width_mm:g} x {spec.sensor_height_mm:g} mm",
                         width_mm=spec.sensor_width_mm, height_mm=spec.sensor_height_mm)
@@ -476,7 +476,7 @@ def best_match_pinhole(prescription, *, focus_mm: float, fstop: float | None, se
     UsdGeomCamera is that pinhole. f-stop None: the lens wide open, as the lens report decides.
     """
     from ..onset.report import ReportRequest, solve_report
-    from ..onset.sensors import Sensor
+    from ..optics.sensors import Sensor
     from .author import spec_from_report
 
     sensor = Sensor(key="custom", name=f"{sensor_width_mm:g} x {sensor_height_mm:g} mm",

@@ -92,7 +92,7 @@ def pack_lens(prescription, archive, *, slug: str | None = None, focus_mm: float
 
     ``focus_mm`` (from the film plane) and ``fstop`` (None: wide open) are where the USD file's
     best-match pinhole and the lens card are evaluated (a USD focus is finite: infinity is written
-    as 1 km); ``sensor`` an :class:`~physcam.onset.sensors.Sensor` (default Super 35).
+    as 1 km); ``sensor`` an :class:`~physcam.optics.sensors.Sensor` (default Super 35).
     ``characterizations`` maps a variant name (letters, digits, underscores; sorted, the last is
     ``current``) to what was measured that run (name -> number, numbers or text). ``source`` and
     ``licence`` fill the lens's provenance where its file gives none (a published lens must have
@@ -131,7 +131,7 @@ def pack_lens(prescription, archive, *, slug: str | None = None, focus_mm: float
 
 
 def _default_sensor():
-    from ..onset.sensors import find_sensor
+    from ..optics.sensors import find_sensor
 
     return find_sensor("Super 35")
 

@@ -144,7 +144,7 @@ def report_for_spec(spec: CameraSpec):
     import dataclasses
 
     from ..onset.report import ReportRequest, solve_report
-    from ..onset.sensors import Sensor
+    from ..optics.sensors import Sensor
 
     require_type("spec", spec, CameraSpec, "build one with CameraSpec(...) or spec_from_report")
     sensor = Sensor(
