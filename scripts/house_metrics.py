@@ -112,6 +112,9 @@ def _clear_caches():
     for obj in gc.get_objects():
         if isinstance(obj, functools._lru_cache_wrapper) and getattr(obj, "__module__", "").startswith("physcam"):
             obj.cache_clear()
+    models = getattr(sys.modules.get("physcam.optics.lens_model"), "_MODELS", None)
+    if models is not None:  # the lens models keep their focus solutions
+        models.clear()
 
 
 def focus_calls() -> dict:

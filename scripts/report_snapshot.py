@@ -41,13 +41,12 @@ def digest(path: Path) -> str:
 def report_dict(lens, case: dict) -> dict:
     """The report of ``lens`` for one case, as ``to_dict()``, or its error's type and message."""
     from physcam.errors import PhysCamError
-    from physcam.onset.report import ReportRequest, solve_report
-    from physcam.optics.sensors import find_sensor
+    from physcam.onset.report import solve_lens_report
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return solve_report(ReportRequest(lens=lens, sensor=find_sensor(SENSOR), **case)).to_dict()
+            return solve_lens_report(lens=lens, sensor=SENSOR, **case).to_dict()
     except PhysCamError as exc:
         return {"error": type(exc).__name__, "message": str(exc)}
 

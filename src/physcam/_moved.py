@@ -10,11 +10,9 @@ new one. :data:`MOVED` is the one table; docs/CHANGELOG lists it.
 
 from __future__ import annotations
 
-import importlib
-import importlib.abc
-import importlib.util
 import sys
-import warnings
+from importlib import import_module
+from importlib.machinery import ModuleSpec  # (importlib.abc and .util would cost every command 25 ms)
 
 #: old module path -> new module path (removed in physcam :data:`UNTIL`)
 MOVED = {
@@ -23,23 +21,27 @@ MOVED = {
 UNTIL = "0.3"
 
 
-class _MovedLoader(importlib.abc.Loader):
+class _MovedLoader:
+    """A loader (importlib's protocol: create_module, exec_module) that puts the moved module in place."""
+
     def create_module(self, spec):
         return None  # a placeholder: exec_module puts the real module in its place
 
     def exec_module(self, module):
+        import warnings
+
         new = MOVED[module.__name__]
         warnings.warn(f"{module.__name__} moved to {new}; the old path goes in physcam {UNTIL}",
                       DeprecationWarning, stacklevel=2)  # warnings skips importlib's own frames
-        sys.modules[module.__name__] = importlib.import_module(new)
+        sys.modules[module.__name__] = import_module(new)
 
 
-class _MovedFinder(importlib.abc.MetaPathFinder):
+class _MovedFinder:
     """Finds only the old paths of :data:`MOVED`; every other import goes on to Python's own finders."""
 
     def find_spec(self, name, path=None, target=None):
         if name in MOVED:
-            return importlib.util.spec_from_loader(name, _MovedLoader())
+            return ModuleSpec(name, _MovedLoader())
         return None
 
 

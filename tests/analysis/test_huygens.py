@@ -15,6 +15,7 @@ from physcam.analysis import _sampling
 from physcam.analysis.huygens import _field_sum, _wavelets, huygens_mtf, huygens_psf
 from physcam.analysis.mtf import mtf
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 
 from _image_quality import F_MM, bessel_j1, defocus_opd_exact, defocus_otf, perfect_lens, reference_sine, sin_u, \
     textbook_mtf
@@ -86,7 +87,7 @@ def test_the_fast_sum_is_the_exact_wavelet_sum():
     distance, ray by ray, on a grid around an off-axis PSF of dgauss_50mm on a tilted film (intensities
     agree to 1e-6 of the peak: the expansion's remainder is far below a milliradian)."""
     lens = load_lens("dgauss_50mm")
-    fp = _sampling.field_pupils(lens, 14.0, wavelengths_nm=[587.5618], fstop=4.0, pupil_samples=64)
+    fp = _sampling.field_pupils(camera_state(lens, fstop=4.0), 14.0, wavelengths_nm=[587.5618], pupil_samples=64)
     ref = fp.reference_point(0.0)
     A, u, R, C, _, n_img = _wavelets(fp, 0, 0.0, ref)
     lam = 587.5618e-6

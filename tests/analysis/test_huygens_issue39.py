@@ -24,6 +24,7 @@ from physcam.analysis.huygens import _field_sum, _wavelets, huygens_mtf
 from physcam.cli import main
 from physcam.errors import OpticsError
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 PATENT = DATA / "zemax" / "US00583336-2-scaled.zmx"
@@ -65,7 +66,7 @@ def test_a_wide_grid_is_summed_in_quadrants_as_one_long_series(monkeypatch):
     terms of exp(-i kappa Q^2)'s series leave an error of 2^6 / 6! = 9 %. Summed in quadrants (each expanded about
     its own centre) it equals the same sum with the series taken as far as it needs (60 terms allowed, one tile)."""
     lens = load_lens("dgauss_50mm")
-    fp = _sampling.field_pupils(lens, 14.0, wavelengths_nm=[587.5618], fstop=4.0, pupil_samples=48)
+    fp = _sampling.field_pupils(camera_state(lens, fstop=4.0), 14.0, wavelengths_nm=[587.5618], pupil_samples=48)
     ref = fp.reference_point(0.0)
     A, u, R, C, _, n_img = _wavelets(fp, 0, 0.0, ref)
     lam = 587.5618e-6

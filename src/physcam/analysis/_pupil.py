@@ -42,14 +42,13 @@ Lengths in mm, lens space (docs/conventions.md); wavelengths in nm.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite
-from ..optics.state import CameraState, as_camera_state
+from ..optics.state import CameraState
 
 #: Smallest and largest pupil grids (cells across the pupil's bounding square).
 MIN_PUPIL_SAMPLES = 16
@@ -84,22 +83,13 @@ class Setup:
     at_infinity = property(lambda self: self.state.at_infinity)
 
 
-def setup(lens, *, fstop=None, focus_mm=None, aperture=None, backend: str = "auto") -> Setup:
-    """The pupil engine's setup of ``lens``: a :class:`~physcam.optics.state.CameraState` as it is, or a
-    Prescription focused at ``focus_mm`` (mark from the film; None or inf: infinity) and stopped to
-    ``fstop`` by :func:`physcam.optics.state.camera_state` (one place for both)."""
-    from ..trace.aperture import Aperture
+def setup(camera: CameraState, *, backend: str = "auto") -> Setup:
+    """The pupil engine's setup of ``camera`` (a :class:`~physcam.optics.state.CameraState`: the lens
+    focused and stopped once, in the optics layer) and how to trace it."""
+    from ..errors import require_type
 
-    if aperture is not None and not isinstance(aperture, Aperture):
-        from ..errors import require_type
-
-        require_type("aperture", aperture, Aperture, "physcam.trace.aperture.Aperture(nsides, ...)")
-    if isinstance(lens, CameraState):
-        state = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
-        state = state if aperture is None else dataclasses.replace(state, aperture=aperture)
-    else:
-        state = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop, aperture=aperture)
-    return Setup(state, backend)
+    require_type("camera", camera, CameraState, "physcam.optics.state.camera_state(lens, focus_mm=..., fstop=...)")
+    return Setup(camera, backend)
 
 
 # --------------------------------------------------------------------------------------------

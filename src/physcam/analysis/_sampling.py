@@ -75,18 +75,17 @@ class FieldPupils:
         return self._cache[key]
 
 
-def fields_pupils(lens, fields_deg, *, wavelengths_nm=None, weights=None, fstop=None, focus_mm=None,
-                  defocus_mm=(0.0,), pupil_samples=None, min_frequency=None, waves_per_cell=WAVES_PER_CELL_WAVEFRONT,
-                  aperture=None, backend="auto", st: P.Setup | None = None, check: bool = True,
-                  max_pupil_samples=None) -> list[FieldPupils]:
+def fields_pupils(camera, fields_deg, *, wavelengths_nm=None, weights=None, defocus_mm=(0.0,), pupil_samples=None,
+                  min_frequency=None, waves_per_cell=WAVES_PER_CELL_WAVEFRONT, backend="auto",
+                  st: P.Setup | None = None, check: bool = True, max_pupil_samples=None) -> list[FieldPupils]:
     """Trace the pupils of every field of ``fields_deg`` at every wavelength, each field on one grid
     that meets the sampling rules (``check=False``: the grid given or the default, unchecked, for the
     geometric MTF which needs no phase sampling). All fields and wavelengths are traced together.
     ``max_pupil_samples`` caps the grid the rules may choose (default ``MAX_PUPIL_SAMPLES``)."""
     cap = P.MAX_PUPIL_SAMPLES if max_pupil_samples is None else pupil_samples_arg(max_pupil_samples)
-    wls, wts = wavelengths_and_weights(lens, wavelengths_nm, weights)
+    wls, wts = wavelengths_and_weights(camera, wavelengths_nm, weights)
     n_user = pupil_samples_arg(pupil_samples)
-    st = st or P.setup(lens, fstop=fstop, focus_mm=focus_mm, aperture=aperture, backend=backend)
+    st = st or P.setup(camera, backend=backend)
     defocus = [require_finite("defocus_mm", d) for d in defocus_mm]
     if min_frequency is not None:
         min_frequency = require_finite("frequency", min_frequency)

@@ -22,8 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription
-from ..optics.state import takes_camera
+from ..optics.state import CameraState, takes_camera
 from ..figures import styled
 
 __all__ = ["BokehImage", "bokeh_image", "RGB_WAVELENGTHS_NM", "tone_map", "scale_bar_pixels", "write_bokeh_photo"]
@@ -81,42 +80,37 @@ class BokehImage:
 
 @takes_camera
 def bokeh_image(
-    lens: Prescription,
+    camera: CameraState,
     depth_mm: float,
     x_mm: float = 0.0,
     y_mm: float = 0.0,
     *,
-    film_z: float | None = None,
     rays: int = 250_000,
     pixels: int = 256,
     extent_mm: tuple[float, float, float, float] | None = None,
     spectral: bool = False,
     fresnel: bool = True,
-    stop_semi_diameter: float | None = None,
-    aperture=None,
     chunk: int = 1_000_000,
     progress=None,
     seed: int = 0,
     backend: str = "auto",
     precision: str = "double",
 ) -> BokehImage:
-    """Image of a point light through ``lens`` on the film (see module notes).
+    """Image of a point light through ``camera`` on the film (see module notes).
 
-    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris, iris
-    shape and primary wavelength) or a Prescription as it is (``film_z`` default the paraxial image of
-    infinity, ``stop_semi_diameter`` default the file's stop, the design wavelength).
-    ``aperture`` (a :class:`~physcam.trace.aperture.Aperture`: blades, angle, roundness,
-    density) shapes the stop, so the bokeh shows the iris polygon and its brightness ramp.
+    ``camera``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris, iris
+    shape and primary wavelength; a camera built from a bare lens leaves the film at the paraxial image
+    of infinity). Its iris shape (a :class:`~physcam.trace.aperture.Aperture`: blades, angle,
+    roundness, density) shapes the stop, so the bokeh shows the iris polygon and its brightness ramp.
     ``progress`` (optional) is called as ``progress(rays_done, rays)`` after each chunk.
     ``precision="single"`` traces the rays in float32 (faster; its error against double on every
     bundled lens is in docs/ray-tracing.md); the image is accumulated in double either way.
     """
     from ..trace import paraxial_image_z
     from ..trace.kernels import backend_for_job
-    from ._camera import camera_of
+    from ._camera import ray_view
 
-    cam = camera_of(lens, film_z=film_z, stop_semi_diameter=stop_semi_diameter, aperture=aperture)
-    lens, film_z, stop_semi_diameter, aperture = cam.lens, cam.film_z, cam.stop_semi_diameter, cam.aperture
+    lens, _, film_z, stop_semi_diameter, aperture, wl, _ = ray_view(camera)
     depth = require_positive("light distance (depth_mm, --light)", depth_mm)
     x_mm = require_finite("light x", x_mm)
     y_mm = require_finite("light y", y_mm)
@@ -131,7 +125,7 @@ def bokeh_image(
         )
     if precision not in ("double", "single"):
         raise InputError(f"precision must be 'double' or 'single', got {precision!r}")
-    wls = RGB_WAVELENGTHS_NM if spectral else (lens.wavelength_nm if cam.wavelength_nm is None else cam.wavelength_nm,)
+    wls = RGB_WAVELENGTHS_NM if spectral else (wl,)
     src = _PointLight(x_mm, y_mm, z_src, lens.surfaces[0].semi_diameter, wls, seed,
                       np.float64 if precision == "double" else np.float32)
     backend = backend_for_job(backend, (rays + (0 if extent_mm is not None else 20_000))

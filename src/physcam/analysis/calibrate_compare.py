@@ -92,6 +92,7 @@ def _distortion_difference(mark, field_) -> np.ndarray:
 def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K, fstop: float | None = None) -> Comparison:
     """Every measured figure of ``calibration`` against ``lens``'s prediction (module notes); ``fstop``: the
     stop the flat fields were shot at (None: wide open)."""
+    from ..optics.state import camera_state
     from .calibrate import Calibration
     from .stmap import distortion_field
 
@@ -102,7 +103,7 @@ def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K
     rows, pred_f, notes = [], {}, []
     for m in calibration.marks:
         mark = math.inf if m.mark_mm is None else float(m.mark_mm)
-        fld = distortion_field(lens, focus_mm=mark, sensor_width_mm=m.sensor_mm[0], sensor_height_mm=m.sensor_mm[1],
+        fld = distortion_field(camera_state(lens, focus_mm=mark, sensor_mm=tuple(m.sensor_mm)),
                                width_px=m.size_px[0], height_px=m.size_px[1], maps=False)
         where = "infinity" if math.isinf(mark) else f"{mark:g} mm"
         f_pred = fld.pinhole_focal_length_mm[1]

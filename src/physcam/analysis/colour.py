@@ -33,12 +33,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..figures import styled
 from ..lens.prescription import Prescription
 from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM, PGF_UNCERTAINTY
-from ..optics.state import takes_camera
+from ..optics.state import CameraState, takes_camera
 
 __all__ = ["LateralColourPoint", "ColourResult", "chromatic_aberration"]
 
@@ -263,38 +262,34 @@ def _glass_model_uncertainty(result: ColourResult, lens: Prescription, media: di
 
 @takes_camera
 def chromatic_aberration(
-    lens: Prescription,
+    camera: CameraState,
     fields_deg=None,
     *,
     wavelengths_nm=(LINE_F_NM, LINE_D_NM, LINE_C_NM),
     reference_nm: float = LINE_D_NM,
     zone: float = math.sqrt(0.5),
     max_field_deg: float | None = None,
-    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
-    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM,
     n_fields: int = 8,
-    film_z: float | None = None,
     backend: str = "auto",
 ) -> ColourResult:
-    """Longitudinal and lateral colour of ``lens`` (module notes).
+    """Longitudinal and lateral colour of ``camera`` (module notes).
 
-    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris and
-    sensor; the object stays at infinity and the wavelengths are this function's) or a Prescription as
-    it is (``film_z`` default the paraxial focus at ``reference_nm``, the file's stop).
+    ``camera``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris and
+    sensor; the object stays at infinity and the wavelengths are this function's; a camera built from a
+    bare lens leaves the film at the paraxial focus at ``reference_nm``).
     ``wavelengths_nm`` are reported; F and C are always added for the F-C figures. ``zone``
     (0-1] is the real ray's height as a fraction of the entrance-pupil radius. Fields in degrees
     (default: ``n_fields`` up to the sensor corner or ``max_field_deg``).
-    The sensor is the state's when it has one, else ``sensor_width_mm`` x ``sensor_height_mm`` (default
-    Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
+    The sensor is the camera's, else Super 35, 24.89 x 18.66 mm
+    (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
     from ..optics.paraxial import gaussian
     from ..trace import paraxial_image_z
-    from ._camera import camera_of, sensor_size
+    from ._camera import ray_view, sensor_or_default
     from ._chief import field_angles_deg
 
-    cam = camera_of(lens, film_z=film_z, sensor_mm=sensor_size(sensor_width_mm, sensor_height_mm))
-    lens, film_z, stop = cam.lens, cam.film_z, cam.stop_semi_diameter
-    sensor_width_mm, sensor_height_mm = cam.sensor_mm or (sensor_width_mm, sensor_height_mm)
+    lens, _, film_z, stop, _, _, _ = ray_view(camera)
+    sensor_width_mm, sensor_height_mm = sensor_or_default(camera)
 
     ref = require_positive("reference wavelength", reference_nm, unit="nm")
     zone = require_finite("zone", zone)

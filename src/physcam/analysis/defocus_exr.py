@@ -148,7 +148,7 @@ def defocus_file(image_path, output, lens, *, focus_mm: float | None = None, fst
     import time
 
     from .defocus import defocus, inverse_depth
-    from .defocus_kernels import KernelCache, defocus_camera
+    from .defocus_kernels import KernelCache, _as_aperture, defocus_camera
 
     from ..io import check_writable
 
@@ -169,8 +169,12 @@ def defocus_file(image_path, output, lens, *, focus_mm: float | None = None, fst
     kind = depth_kind or ("inverse" if zname.split(".")[-2:] == ["depth", "Z"] else "planar")
     w, h = img.display_size
     if cache is None:
-        cam = defocus_camera(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=sensor_width_mm, width=w, height=h,
-                             aperture=aperture, dispersion=dispersion, tile=tile, step_px=step_px,
+        from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM
+        from ..optics.state import as_camera_state
+
+        sensor = None if sensor_width_mm is None else (sensor_width_mm, DEFAULT_SENSOR_HEIGHT_MM)
+        camera = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop, sensor_mm=sensor, aperture=_as_aperture(aperture))
+        cam = defocus_camera(camera, width=w, height=h, dispersion=dispersion, tile=tile, step_px=step_px,
                              step_rel=step_rel)
         cache = KernelCache(cam, kernel_folder)
     cam = cache.camera

@@ -68,11 +68,10 @@ class Kernel:
 
 @dataclass
 class DefocusCamera:
-    """The lens, focus, stop and frame a render is defocused with (see the module notes)."""
+    """The camera (lens, focus, stop) and the frame a render is defocused with (see the module notes)."""
 
     lens: Prescription
-    focus_mm: float  # the focus mark, from the film
-    fstop: float
+    camera: CameraState  # its focus mark from the film (.focus_mm here) and f-stop (.fstop)
     sensor_width_mm: float
     width: int  # display window, pixels
     height: int
@@ -91,6 +90,23 @@ class DefocusCamera:
     pupil_diameter_mm: float = 0.0
     wavelengths_nm: tuple[float, ...] = ()
     _memory: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def focus_mm(self) -> float:
+        """The camera's focus mark, from the film."""
+        return self.camera.focus_from_film_mm
+
+    @property
+    def _traced(self) -> CameraState:
+        """The camera the kernels trace: its focus, film and iris, this frame's iris shape, the design
+        wavelength (a bokeh's primary; R, G, B when ``dispersion``)."""
+        from dataclasses import replace
+
+        return replace(self.camera, aperture=self.aperture, wavelengths_nm=(self.lens.wavelength_nm,), weights=(1.0,))
+
+    @property
+    def fstop(self) -> float:
+        return self.camera.fstop
 
     @property
     def pitch_mm(self) -> float:
@@ -154,9 +170,8 @@ class DefocusCamera:
         sx, sy = self.film_point(x_px, y_px)
         X, Y = sx * d / self.pinhole_mm, sy * d / self.pinhole_mm
         depth_film = self.pupil_from_film_mm + d
-        kw = dict(film_z=self.film_z, fresnel=False, stop_semi_diameter=self.stop_semi, aperture=self.aperture,
-                  spectral=self.dispersion, backend="auto")
-        pilot = bokeh_image(self.focused, depth_film, X, Y, rays=1000, pixels=8, **kw)
+        kw = dict(fresnel=False, spectral=self.dispersion, backend="auto")
+        pilot = bokeh_image(self._traced, depth_film, X, Y, rays=1000, pixels=8, **kw)
         x0, x1, y0, y1 = pilot.extent_mm
         p = self.pitch_mm
         # the pilot's window is the hits' box centre +- 1.2 x its larger half-span: the farthest hit
@@ -169,7 +184,7 @@ class DefocusCamera:
         h = (r + 0.5) * p
         n = 2 * r + 1
         rays = int(min(max(rays_per_pixel * n * n, 20_000), 4_000_000))
-        b = bokeh_image(self.focused, depth_film, X, Y, rays=rays, pixels=n, extent_mm=(-sx - h, -sx + h, -sy - h, -sy + h),
+        b = bokeh_image(self._traced, depth_film, X, Y, rays=rays, pixels=n, extent_mm=(-sx - h, -sx + h, -sy - h, -sy + h),
                         **kw)
         img = b.image[:, ::-1, :]  # film (y up, x right) turned 180 deg: rows down, columns right
         axis = self._axis_total(d, kw)
@@ -188,7 +203,7 @@ class DefocusCamera:
 
         key = ("axis", float(d))
         if key not in self._memory:
-            b = bokeh_image(self.focused, self.pupil_from_film_mm + d, rays=40_000, pixels=8, **kw)
+            b = bokeh_image(self._traced, self.pupil_from_film_mm + d, rays=40_000, pixels=8, **kw)
             self._memory[key] = b.image.sum(axis=(0, 1))
         return self._memory[key]
 
@@ -204,32 +219,22 @@ def _trim(img: np.ndarray) -> np.ndarray:
 
 
 @takes_camera
-def defocus_camera(lens: CameraState | Prescription, *, focus_mm: float | None = None, fstop: float | None = None,
-                   sensor_width_mm: float | None = None, width: int, height: int, aperture=None,
-                   dispersion: bool = False, tile: int = 64, step_px: float = 1.0,
-                   step_rel: float = 0.05) -> DefocusCamera:
-    """The :class:`DefocusCamera` for ``lens``: a :class:`~physcam.optics.state.CameraState`, or a
-    Prescription focused at the mark ``focus_mm`` (from the film) at f/``fstop`` (both needed); a
-    sensor ``sensor_width_mm`` wide (default: the state's) imaged on ``width`` x ``height`` pixels
-    (the display window); ``aperture``: the iris's shape (default: the state's, else round);
-    ``tile`` px per field node; the blur step between depth nodes is ``step_px + step_rel x`` the
-    blur diameter (module notes)."""
-    from ..optics.state import as_camera_state
-    from ..optics.focusing import technical_planes
+def defocus_camera(camera: CameraState, *, width: int, height: int, aperture=None, dispersion: bool = False,
+                   tile: int = 64, step_px: float = 1.0, step_rel: float = 0.05) -> DefocusCamera:
+    """The :class:`DefocusCamera` of ``camera`` (a :class:`~physcam.optics.state.CameraState`: the lens
+    focused at a mark from the film, its iris at an f-stop and its shape, on a sensor whose width is
+    imaged on ``width`` x ``height`` pixels, the display window); ``aperture`` (an Aperture or a blade
+    count) replaces the camera's iris shape; ``tile`` px per field node; the blur
+    step between depth nodes is ``step_px + step_rel x`` the blur diameter (module notes)."""
+    from ..optics.focusing import planes_of
     from .bokeh import RGB_WAVELENGTHS_NM
 
-    if not isinstance(lens, CameraState):
-        if focus_mm is None or fstop is None:
-            raise InputError("give focus_mm and fstop with a lens (or a CameraState: physcam.optics.state.camera_state)")
-        fstop = require_positive("f-stop", fstop, unit="")
-    if isinstance(lens, CameraState) and lens.sensor_mm is not None:
-        if sensor_width_mm is not None:
-            raise InputError("a CameraState carries its own sensor: give sensor_mm to camera_state(), not "
-                             "sensor_width_mm here")
-        sensor_width_mm = lens.sensor_mm[0]
-    if sensor_width_mm is None:
-        raise InputError("give the sensor width: sensor_width_mm (or camera_state(sensor_mm=...))")
-    sw = require_positive("sensor width", sensor_width_mm)
+    if camera.film_from_analysis or not camera.iris_set:
+        raise InputError("give focus_mm and fstop: a camera focused and stopped by hand, "
+                         "physcam.optics.state.camera_state(lens, focus_mm=..., fstop=...)")
+    if camera.sensor_mm is None:
+        raise InputError("give the sensor: camera_state(lens, ..., sensor=...) (or sensor_mm=(width, height))")
+    sw = require_positive("sensor width", camera.sensor_mm[0])
     for name, v in (("width", width), ("height", height)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 1 <= v <= 65536:
             raise InputError(f"image {name} must be a whole number of pixels from 1 to 65536, got {v!r}")
@@ -241,13 +246,13 @@ def defocus_camera(lens: CameraState | Prescription, *, focus_mm: float | None =
     rel = require_finite("relative depth step", step_rel)
     if not 0 <= rel <= 0.5:
         raise InputError(f"the relative depth step must lie between 0 and 0.5 of the blur, got {rel:g}")
-    cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
-    lens, focus_mm, fstop = cam.lens, cam.focus_from_film_mm, cam.fstop
-    tp = technical_planes(lens, focus_mm, fstop=fstop)
+    cam, lens = camera, camera.lens
+    # the planes at the mark from the camera's own focus solution, its iris (no focus solved again)
+    tp = planes_of(cam.lens_model.focus_state(cam.focus_from_film_mm), stop_semi_diameter=cam.stop_semi_diameter)
     if tp.pinhole_focal_length_mm is None:
         raise OpticsError(f"{lens.name} has no best-match pinhole at this focus (its chief ray does not reach the film)")
     ap = _as_aperture(cam.aperture if aperture is None else aperture)
-    return DefocusCamera(lens=lens, focus_mm=float(focus_mm), fstop=float(fstop), sensor_width_mm=sw,
+    return DefocusCamera(lens=lens, camera=cam, sensor_width_mm=sw,
                          width=int(width), height=int(height), aperture=ap, dispersion=bool(dispersion),
                          tile=int(tile), step_px=step, step_rel=rel, film_z=cam.film_z, stop_semi=cam.stop_semi_diameter,
                          focused=cam.focused, pupil_from_film_mm=tp.entrance_pupil_from_film_mm,

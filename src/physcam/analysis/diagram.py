@@ -74,8 +74,17 @@ class LensDiagram:
     axis: str
     field_deg: float
     rays: list[tuple[str, list[tuple[float, float]]]]
-    focus_from_film_mm: float = math.inf
-    fstop: float | None = None
+    camera: CameraState | None = None  # the camera drawn: its focus and iris
+
+    @property
+    def focus_from_film_mm(self) -> float:
+        """The camera's focus mark in front of the film (inf at infinity)."""
+        return math.inf if self.camera is None else self.camera.focus_from_film_mm
+
+    @property
+    def fstop(self) -> float | None:
+        """The f-stop the iris is drawn at; None: the stop as in the file."""
+        return self.camera.fstop if self.camera is not None and self.camera.iris_set else None
 
     def to_dict(self) -> dict:
         """The diagram's numbers: the rays drawn, as (z, height) points in lens space (mm), and the film."""
@@ -196,17 +205,14 @@ def _default_field(p: Prescription, g: paraxial.GaussianData, axis: str, wavelen
 
 @renamed_parameter("focus_from_film_mm", "focus_mm")
 @takes_camera
-def lens_diagram(prescription: CameraState | Prescription, *, axis: str = "y", focus_mm: float | None = None,
-                 fstop=None, field_deg: float | None = None, wavelength_nm=None, rays: int = 3) -> LensDiagram:
-    """Compute a :class:`LensDiagram` of a :class:`~physcam.optics.state.CameraState`, or of a
-    Prescription focused at ``focus_mm`` (the mark from the film plane; None: infinity) with its iris
-    at ``fstop`` (None: the stop as in its file); focused at ``wavelength_nm`` (None: the state's primary
-    wavelength, a lens's design one)."""
-    from ..optics.state import as_camera_state
-
+def lens_diagram(camera: CameraState, *, axis: str = "y", field_deg: float | None = None, wavelength_nm=None,
+                 rays: int = 3) -> LensDiagram:
+    """Compute a :class:`LensDiagram` of a :class:`~physcam.optics.state.CameraState` (the lens focused at
+    its mark, its iris at its f-stop or as in its file), focused at ``wavelength_nm`` (None: the camera's
+    primary wavelength)."""
     if axis not in paraxial.AXES:
         raise InputError(f"meridian must be 'x' or 'y', got {axis!r}")
-    cam = as_camera_state(prescription, focus_mm=focus_mm, fstop=fstop)
+    cam = camera
     prescription, focus_mm = cam.lens, cam.focus_from_film_mm
     fstop = cam.fstop if cam.iris_set else None
     if wavelength_nm is None:  # the state's primary wavelength (a lens's: its design wavelength)
@@ -248,13 +254,12 @@ def lens_diagram(prescription: CameraState | Prescription, *, axis: str = "y", f
         y_start = h - tu * (ep - z_start)
         out.append((kind, trace_meridional_ray(p, y_start, z_start, tu, 1.0, axis=axis, wavelength_nm=wavelength_nm,
                                                film_z=g.z_film)))
-    return LensDiagram(p, g, axis, math.degrees(half), out, float(focus_mm),
-                       None if fstop is None else float(fstop))
+    return LensDiagram(p, g, axis, math.degrees(half), out, cam)
 
 
 @takes_camera
 @styled
-def save_lens_diagram(prescription: CameraState | Prescription, path, *, force: bool = False, **kwargs) -> Path:
+def save_lens_diagram(camera: CameraState, path, *, force: bool = False, **kwargs) -> Path:
     """Draw the diagram to ``path`` (.png, .svg or .pdf) through atomic_write; kwargs as :func:`lens_diagram`,
     and ``units`` (m or ft) for the focus in the title."""
     from ..figures import save_figure
@@ -265,4 +270,4 @@ def save_lens_diagram(prescription: CameraState | Prescription, path, *, force: 
         raise ExportError(f"cannot draw a diagram to {p.name!r}: use a .png, .svg or .pdf file name")
     check_writable(p, force=force)  # before the work of drawing
     units = kwargs.pop("units", "m")
-    return save_figure(lens_diagram(prescription, **kwargs).figure(units=units), p, force=force, dpi=150)
+    return save_figure(lens_diagram(camera, **kwargs).figure(units=units), p, force=force, dpi=150)

@@ -32,7 +32,8 @@ import numpy as np
 from ..errors import InputError, renamed_parameter, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
-__all__ = ["RealFieldOfView", "real_field_of_view", "chief_ray_field_limit", "DIFFERS_PCT"]
+__all__ = ["RealFieldOfView", "real_field_of_view", "real_field_of_view_focused", "chief_ray_field_limit",
+           "DIFFERS_PCT"]
 
 #: Real and paraxial fields of view "differ" when any full angle differs by more than this (percent).
 DIFFERS_PCT = 1.0
@@ -132,9 +133,7 @@ def real_field_of_view(
     Raises :class:`InputError` for bad sizes, :class:`OpticsError` when the lens forms no image or
     cannot focus at the mark.
     """
-    from ..optics import focusing, paraxial
-    from ..trace import RayBatch, trace_through
-    from ._chief import aim_from_film
+    from ..optics import focusing
 
     if not isinstance(lens, Prescription):
         raise InputError(f"expected a physcam Prescription, got {type(lens).__name__}")
@@ -153,7 +152,21 @@ def real_field_of_view(
     else:
         st = focusing.focus(lens, focus_mm, method=method, axis="y", wavelength_nm=wl)
         focused, fz, mark = st.prescription, st.film_z, float(focus_mm)
+    return real_field_of_view_focused(lens, focused, fz, w, h, mark=mark, wavelength_nm=wl, backend=backend)
 
+
+def real_field_of_view_focused(lens: Prescription, focused: Prescription, film_z: float, sensor_width_mm: float,
+                               sensor_height_mm: float, *, mark: float | None, wavelength_nm=None,
+                               backend: str = "auto") -> RealFieldOfView:
+    """:func:`real_field_of_view` of ``lens`` already focused (``focused``, its film plane at ``film_z``,
+    lens space, for the focus ``mark`` from the film; None: a film plane placed by hand): what the
+    on-set report asks of its camera's own focus solution."""
+    from ..optics import paraxial
+    from ..trace import RayBatch, trace_through
+    from ._chief import aim_from_film
+
+    w, h, fz = float(sensor_width_mm), float(sensor_height_mm), float(film_z)
+    wl = lens.wavelength_nm if wavelength_nm is None else wavelength_nm
     # paraxial: tangents of the paraxial chief rays to the edge (X) and the top (Y)
     tx = math.tan(abs(paraxial.field_angle(focused, w / 2.0, fz, "x", wl)))
     ty = math.tan(abs(paraxial.field_angle(focused, h / 2.0, fz, "y", wl)))

@@ -33,11 +33,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..figures import styled
 from ..lens.prescription import Prescription, takes_prescription
-from ..optics.state import takes_camera
+from ..optics.state import CameraState, takes_camera
 
 __all__ = ["GhostPath", "GhostResult", "ghost_pairs", "ghost_analysis", "trace_ghost"]
 
@@ -191,8 +190,8 @@ def _reflect(rays, t, row, forward: bool):
     rays.weight_sp[live] = w * hdif + d * hsum
 
 
-def _round_iris(cam) -> None:
-    if cam.aperture is not None:
+def _round_iris(aperture) -> None:
+    if aperture is not None:
         raise InputError("the ghost tracer models a round iris: give a CameraState without an aperture shape")
 
 
@@ -201,17 +200,26 @@ def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float | None =
                 stop_semi_diameter=None, backend: str = "auto", _tables=None):
     """Trace object-space ``rays`` (a RayBatch, copied) along ghost path (i, j) to the film plane ``film_z``.
 
-    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane and iris) or a
-    Prescription with the film plane ``film_z`` (lens space, mm; required) and ``stop_semi_diameter``."""
+    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane and iris) or, as a
+    ray-level tracer keeps, a Prescription with the film plane ``film_z`` (lens space, mm; required) and
+    ``stop_semi_diameter``."""
+    if isinstance(lens, CameraState):  # (a ray-level tracer: its film plane and stop may be given by hand)
+        if film_z is not None or stop_semi_diameter is not None:
+            raise InputError("a CameraState carries its own film plane and stop: give them to camera_state(), "
+                             "not here")
+        _round_iris(lens.aperture)
+        lens, film_z, stop_semi_diameter = (lens.focused, lens.film_z,
+                                            lens.stop_semi_diameter if lens.iris_set else None)
+    elif film_z is None:
+        raise InputError("give the film plane: film_z (mm, lens space), or a CameraState")
+    return _ghost_path(lens, rays, i, j, film_z, coating, stop_semi_diameter, backend, _tables)
+
+
+def _ghost_path(lens, rays, i, j, film_z, coating, stop_semi_diameter, backend, _tables):
+    """:func:`trace_ghost` of a prescription, its film plane and stop."""
     from ..trace.kernels import get_kernel
     from ..trace.trace import DEFAULT_CHUNK, trace_packed
-    from ._camera import camera_of
 
-    cam = camera_of(lens, film_z=film_z, stop_semi_diameter=stop_semi_diameter)
-    _round_iris(cam)
-    if cam.film_z is None:
-        raise InputError("give the film plane: film_z (mm, lens space), or a CameraState")
-    lens, film_z, stop_semi_diameter = cam.lens, cam.film_z, cam.stop_semi_diameter
     n = len(lens.surfaces)
     if not (0 <= j < i < n):
         raise InputError(f"a ghost path needs 0 <= j < i < {n} surfaces, got i={i}, j={j}")
@@ -265,28 +273,24 @@ DEFAULT_FIELD_DEG = 10.0
 
 @takes_camera
 def ghost_analysis(
-    lens: Prescription,
+    camera: CameraState,
     field_deg: float | None = None,
     *,
     coating: str | None = None,
     wavelength_nm: float | None = None,
-    film_z: float | None = None,
-    stop_semi_diameter: float | None = None,
     rank_rays: int = 4000,
     image_rays: int = 0,
     image_paths: int = 20,
     pixels: int = 256,
     chunk: int = 250_000,
-    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
-    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM,
     seed: int = 0,
     backend: str = "auto",
 ) -> GhostResult:
-    """Rank every double-bounce path of ``lens`` for a light at ``field_deg`` (module notes).
+    """Rank every double-bounce path of ``camera`` for a light at ``field_deg`` (module notes).
 
-    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, round iris,
-    primary wavelength and sensor; the light stays at infinity) or a Prescription as it is (``film_z``
-    default the paraxial image at the wavelength, ``stop_semi_diameter`` default the file's stop).
+    ``camera``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, round iris,
+    primary wavelength and sensor; the light stays at infinity; a camera built from a bare lens leaves
+    the film at the paraxial image at the wavelength).
 
     ``rank_rays`` rays (a deterministic grid over the front element) rank the paths; with
     ``image_rays`` > 0, the ``image_paths`` strongest paths are traced again with that many
@@ -294,17 +298,15 @@ def ghost_analysis(
     ``coating``: "none", "single", "multi", or None for the lens file's coating (else "none").
     ``field_deg`` None: :data:`DEFAULT_FIELD_DEG`, or the widest field below it that light passes
     (with a note in the result) when none passes there.
-    The sensor is the state's when it has one, else ``sensor_width_mm`` x ``sensor_height_mm`` (default
-    Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
+    The sensor is the camera's, else Super 35, 24.89 x 18.66 mm
+    (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
     from ..trace import paraxial_image_z, trace_to_film
-    from ._camera import camera_of, sensor_size
+    from ._camera import ray_view, sensor_or_default
 
-    cam = camera_of(lens, film_z=film_z, stop_semi_diameter=stop_semi_diameter, wavelength_nm=wavelength_nm,
-                    sensor_mm=sensor_size(sensor_width_mm, sensor_height_mm))
-    _round_iris(cam)
-    lens, film_z, stop_semi_diameter, wavelength_nm = cam.lens, cam.film_z, cam.stop_semi_diameter, cam.wavelength_nm
-    sensor_width_mm, sensor_height_mm = cam.sensor_mm or (sensor_width_mm, sensor_height_mm)
+    lens, _, film_z, stop_semi_diameter, aperture, wavelength_nm, _ = ray_view(camera, wavelength_nm=wavelength_nm)
+    _round_iris(aperture)
+    sensor_width_mm, sensor_height_mm = sensor_or_default(camera)
 
     default_field = field_deg is None
     fd = require_finite("field angle", DEFAULT_FIELD_DEG if default_field else field_deg)
@@ -357,7 +359,7 @@ def ghost_analysis(
     dc = (float((direct.x[direct.ok] * wd).sum() / wd.sum()), float((direct.y[direct.ok] * wd).sum() / wd.sum()))
     paths = []
     for i, j in pairs:
-        g = trace_ghost(lens, beam, i, j, film_z, backend=backend, _tables=T)
+        g = _ghost_path(lens, beam, i, j, film_z, coating, stop_semi_diameter, backend, T)
         ok = g.ok & (g.weight > 0)
         wt = g.weight[ok]
         flux = float(wt.sum())
@@ -392,7 +394,7 @@ def _ghost_image(lens, chosen, fd, wl, film_z, T, sensor, pixels, image_rays, ch
         while done < image_rays:
             m = min(chunk, image_rays - done)
             b = _beam(lens, fd, wl, m, rng)
-            g = trace_ghost(lens, b, p.i, p.j, film_z, backend=backend, _tables=T)
+            g = _ghost_path(lens, b, p.i, p.j, film_z, None, None, backend, T)
             ix = np.floor((g.x + w / 2) / w * nx).astype(np.int64)
             iy = np.floor((g.y + h / 2) / h * ny).astype(np.int64)
             inside = g.ok & (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)

@@ -62,8 +62,7 @@ import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite
 from ..figures import styled
-from ..lens.prescription import Prescription
-from ..optics.state import takes_camera
+from ..optics.state import CameraState, OfACamera, takes_camera
 
 __all__ = ["HuygensPSF", "huygens_psf", "huygens_mtf", "DEFAULT_IMAGE_SAMPLES", "MAX_PUPIL_SAMPLES"]
 
@@ -80,7 +79,7 @@ PIXEL_OVER_LAMBDA_N = 0.25
 
 
 @dataclass
-class HuygensPSF:
+class HuygensPSF(OfACamera):
     """A Huygens PSF (module notes): ``image`` (rows along +t = film y, columns along +s = film x) in
     fractions of the field's power per pixel; ``centre_mm`` the film point of the grid's centre."""
 
@@ -88,8 +87,7 @@ class HuygensPSF:
     field_deg: float
     wavelengths_nm: tuple[float, ...]
     weights: tuple[float, ...]
-    fstop: float
-    focus_from_film_mm: float
+    camera: CameraState  # the camera analysed: its focus and f-stop
     defocus_mm: float
     tilt_deg: tuple[float, float]
     pupil_samples: int
@@ -307,23 +305,20 @@ def _centroid(fp, dz, ref):
 
 @takes_camera
 def huygens_psf(
-    lens: Prescription,
+    camera: CameraState,
     field_deg=0.0,
     *,
     wavelengths_nm=None,
     weights=None,
-    fstop=None,
-    focus_mm=None,
     defocus_mm=0.0,
     tilt_deg=(0.0, 0.0),
     pupil_samples=None,
     image_samples: int = DEFAULT_IMAGE_SAMPLES,
     pixel_um=None,
-    aperture=None,
     backend: str = "auto",
     max_pupil_samples=None,
 ) -> HuygensPSF:
-    """The Huygens PSF of ``lens`` at ``field_deg`` (degrees, Y meridian): module notes.
+    """The Huygens PSF of ``camera`` at ``field_deg`` (degrees, Y meridian): module notes.
 
     Arguments as :func:`physcam.analysis.mtf.mtf`; ``tilt_deg`` (about x, about y) tilts the film,
     ``image_samples`` points per side (8 to 1024) of ``pixel_um`` (default a quarter of lambda N_w at
@@ -345,9 +340,8 @@ def huygens_psf(
         if not 1e-3 < pixel_um < 1e3:
             raise InputError(f"the PSF's pixel must lie between 0.001 and 1000 µm, got {pixel_um!r}")
     cap = MAX_PUPIL_SAMPLES if max_pupil_samples is None else max_pupil_samples
-    kw = dict(wavelengths_nm=wavelengths_nm, weights=weights, fstop=fstop, focus_mm=focus_mm, defocus_mm=[dz],
-              aperture=aperture, backend=backend, max_pupil_samples=cap)
-    fp = _sampling.field_pupils(lens, field_deg, pupil_samples=pupil_samples, **kw)
+    kw = dict(wavelengths_nm=wavelengths_nm, weights=weights, defocus_mm=[dz], backend=backend, max_pupil_samples=cap)
+    fp = _sampling.field_pupils(camera, field_deg, pupil_samples=pupil_samples, **kw)
     for _ in range(3):  # the pupil grid must not alias the image grid (module notes)
         ref = fp.reference_point(dz)
         pix = (PIXEL_OVER_LAMBDA_N * min(fp.wavelengths_nm) * 1e-6 * _working_f_number(fp, dz, ref)
@@ -363,7 +357,7 @@ def huygens_psf(
             raise OpticsError(f"a {m}-sample image grid of {pix * 1e3:.3g} µm pixels needs {need} pupil samples to be "
                               f"free of aliasing, more than {cap}: the spot is too large for a Huygens sum here "
                               "(give max_pupil_samples, or use the FFT or geometric MTF)")
-        fp = _sampling.field_pupils(lens, field_deg, pupil_samples=need, **kw)
+        fp = _sampling.field_pupils(camera, field_deg, pupil_samples=need, **kw)
     st = fp.setup
     centre = _centroid(fp, dz, ref)
     d0 = np.array([centre[0] - ref[0], centre[1] - ref[1], 0.0])
@@ -386,8 +380,8 @@ def huygens_psf(
     if not energy <= 1.0 + ENERGY_SLACK:
         raise OpticsError(f"the Huygens sum put {energy:.3g} of the field's power on the image grid, more than all of "
                           f"it: its sampling ({fp.n} pupil cells, {m} image points) does not hold this field")
-    return HuygensPSF(st.lens_name, fp.field.field_deg, tuple(fp.wavelengths_nm), tuple(fp.weights), st.fstop,
-                      st.focus_from_film_mm, dz, tilt, fp.n, pix * 1e3, centre, (float(ref[0]), float(ref[1])),
+    return HuygensPSF(st.lens_name, fp.field.field_deg, tuple(fp.wavelengths_nm), tuple(fp.weights), st.state,
+                      dz, tilt, fp.n, pix * 1e3, centre, (float(ref[0]), float(ref[1])),
                       strehl, energy, total)
 
 
@@ -423,7 +417,7 @@ MTF_PIXEL_OVER_LAMBDA_N = 0.45
 
 
 @takes_camera
-def huygens_mtf(lens: Prescription, field_deg=0.0, *, frequencies, image_samples: int = MTF_IMAGE_SAMPLES,
+def huygens_mtf(camera: CameraState, field_deg=0.0, *, frequencies, image_samples: int = MTF_IMAGE_SAMPLES,
                 pixel_um=None, **kwargs):
     """(tangential, sagittal, psf): the MTF at ``frequencies`` (lp/mm) from :func:`huygens_psf` (module notes).
 
@@ -434,9 +428,8 @@ def huygens_mtf(lens: Prescription, field_deg=0.0, *, frequencies, image_samples
 
     nu = spatial_frequencies(frequencies)
     if pixel_um is None:  # from a coarse trace of the same field: the beam's f-number and the spot's size
-        probe = _sampling.field_pupils(lens, field_deg, pupil_samples=32, check=False,
-                                       **{k: kwargs[k] for k in ("wavelengths_nm", "weights", "fstop", "focus_mm",
-                                                                 "aperture", "backend") if k in kwargs})
+        probe = _sampling.field_pupils(camera, field_deg, pupil_samples=32, check=False,
+                                       **{k: kwargs[k] for k in ("wavelengths_nm", "weights", "backend") if k in kwargs})
         dz = kwargs.get("defocus_mm", 0.0)
         ref = probe.reference_point(dz)
         pixel_um = MTF_PIXEL_OVER_LAMBDA_N * min(probe.wavelengths_nm) * 1e-3 * _working_f_number(probe, dz, ref)
@@ -445,5 +438,5 @@ def huygens_mtf(lens: Prescription, field_deg=0.0, *, frequencies, image_samples
                      for w in (probe.samples(i, dz, ref) for i in range(len(probe.traces))))
         need = int(math.ceil(3.0 * spread * 1e3 / pixel_um)) | 1
         image_samples = min(max(image_samples, need), MAX_IMAGE_SAMPLES - 1)
-    p = huygens_psf(lens, field_deg, image_samples=image_samples, pixel_um=pixel_um, **kwargs)
+    p = huygens_psf(camera, field_deg, image_samples=image_samples, pixel_um=pixel_um, **kwargs)
     return np.clip(np.abs(p.otf(nu, "y")), 0, 1), np.clip(np.abs(p.otf(nu, "x")), 0, 1), p

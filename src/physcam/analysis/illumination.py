@@ -32,10 +32,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription
-from ..optics.state import takes_camera
+from ..optics.state import CameraState, takes_camera
 from ..figures import styled
 
 __all__ = ["IlluminationPoint", "IlluminationResult", "relative_illumination"]
@@ -227,43 +225,35 @@ def _mappings(lens, lm, wl, film_z, backend, eps=1e-5):
 
 @takes_camera
 def relative_illumination(
-    lens: Prescription,
+    camera: CameraState,
     fields_deg=None,
     *,
     max_field_deg: float | None = None,
     n_fields: int = 10,
-    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
-    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM,
     grid: int = 200,
     fresnel: bool = False,
-    stop_semi_diameter: float | None = None,
     wavelength_nm: float | None = None,
-    film_z: float | None = None,
     backend: str = "auto",
 ) -> IlluminationResult:
-    """Relative illumination of ``lens`` at field angles in degrees (module notes).
+    """Relative illumination of ``camera`` at field angles in degrees (module notes).
 
-    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris, iris
-    shape, primary wavelength and sensor; the light still comes from infinity) or a Prescription as it
-    is (``film_z`` default the paraxial image at the wavelength; ``stop_semi_diameter`` (mm) stops it
-    down). Default fields: ``n_fields`` from 0 to the sensor corner (``max_field_deg`` overrides).
+    ``camera``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris, iris
+    shape, primary wavelength and sensor; the light still comes from infinity; a camera built from a
+    bare lens leaves the film at the paraxial image at the wavelength). Default fields: ``n_fields``
+    from 0 to the sensor corner (``max_field_deg`` overrides).
     Anamorphic lenses are evaluated in both meridians. ``grid``: rays per side of the sampling
     grid (``grid``^2 per field). A field where no ray passes, or whose chief ray does not, raises
-    :class:`OpticsError`. The sensor is the state's when it has one, else ``sensor_width_mm`` x
-    ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`,
-    the CLI's default too).
+    :class:`OpticsError`. The sensor is the camera's, else Super 35, 24.89 x 18.66 mm
+    (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
     from ..optics.paraxial import gaussian_xy
     from ..trace import paraxial_image_z
-    from ._camera import camera_of, sensor_size
+    from ._camera import ray_view, sensor_or_default
     from ._chief import field_angles_deg, field_direction
 
-    cam = camera_of(lens, film_z=film_z, stop_semi_diameter=stop_semi_diameter, wavelength_nm=wavelength_nm,
-                    sensor_mm=sensor_size(sensor_width_mm, sensor_height_mm))
-    lens, film_z, stop_semi_diameter, aperture = cam.lens, cam.film_z, cam.stop_semi_diameter, cam.aperture
-    sensor_width_mm, sensor_height_mm = cam.sensor_mm or (DEFAULT_SENSOR_WIDTH_MM, DEFAULT_SENSOR_HEIGHT_MM)
-    wl = lens.wavelength_nm if cam.wavelength_nm is None else require_positive("wavelength", cam.wavelength_nm,
-                                                                                unit="nm")
+    lens, _, film_z, stop_semi_diameter, aperture, wl, _ = ray_view(camera, wavelength_nm=wavelength_nm)
+    sensor_width_mm, sensor_height_mm = sensor_or_default(camera)
+    wl = require_positive("wavelength", wl, unit="nm")
     if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or not 16 <= grid <= MAX_GRID:
         raise InputError(f"grid must be a whole number from 16 to {MAX_GRID} (rays per side), got {grid!r}")
     if isinstance(n_fields, bool) or not isinstance(n_fields, (int, np.integer)) or not 2 <= n_fields <= 200:

@@ -151,15 +151,17 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
     name = sensor_name or (DEFAULT_SENSOR if sensor_width_mm is None else f"{w:g} x {h:g} mm")
     focus_mm = parse_distance(focus_mm, name="focus distance", allow_inf=True)
     notes: list[str] = []
-    st = focusing.focus(lens, focus_mm)
-    diagram = _diagram(lens, focus_mm)
+    from ..optics.state import camera_state
+
+    camera = camera_state(lens, focus_mm=focus_mm, sensor_mm=(w, h))  # the lens at the mark, as its file stops it
+    diagram = _diagram(camera)
     key = key_numbers(lens, focus_mm, 0.5 * math.hypot(w, h), backend=backend)
     dist = _distortion(lens, focus_mm, w, h, q, backend, notes)
-    ill = _illumination(st, w, h, q, backend, notes)
+    ill = _illumination(camera, q, backend, notes)
     wide = key["f_number"]
     stops = [("full aperture", None)] + ([("stopped down", stopped_fstop)] if stopped_fstop > wide * 1.05
                                          else [])
-    mtf = [_mtf(lens, focus_mm, lab, n, min(0.5 * math.hypot(w, h), key["image_circle_mm"] / 2), q, backend)
+    mtf = [_mtf(camera, lab, n, min(0.5 * math.hypot(w, h), key["image_circle_mm"] / 2), q, backend)
            for lab, n in stops]
     if len(mtf) == 1:
         mtf.append(("stopped down", None, f"the lens is f/{wide:.2g} wide open: no stopped-down chart"))
@@ -168,7 +170,7 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
     except OpticsError as exc:
         rows = []
         notes.append(f"breathing: {exc}")
-    bokeh = _bokeh(st, key, focus_mm, w, h, q, backend, notes)
+    bokeh = _bokeh(camera, key, w, h, q, backend, notes)
     return LensCard(lens.name, focus_mm, name, (w, h), key, diagram, mtf, dist, ill, rows, bokeh, page, notes)
 
 
@@ -205,13 +207,14 @@ def key_numbers(lens: Prescription, focus_mm: float, half_diagonal_mm: float, *,
             "squeeze": lens.squeeze, "maker": m.maker, "source": m.source, "licence": m.licence}
 
 
-def _diagram(lens, focus_mm):
+def _diagram(camera):
+    from ..optics.state import camera_state
     from .diagram import lens_diagram
 
     try:
-        return lens_diagram(lens, focus_mm=focus_mm, rays=5)
+        return lens_diagram(camera, rays=5)
     except OpticsError:
-        return lens_diagram(lens, rays=5)
+        return lens_diagram(camera_state(camera.lens), rays=5)
 
 
 def _distortion(lens, focus_mm, w, h, q, backend, notes):
@@ -226,36 +229,35 @@ def _distortion(lens, focus_mm, w, h, q, backend, notes):
         return None
 
 
-def _illumination(st, w, h, q, backend, notes):
+def _illumination(camera, q, backend, notes):
     from .illumination import relative_illumination
 
     try:
-        return relative_illumination(st.prescription, n_fields=q["curve_fields"], sensor_width_mm=w,
-                                     sensor_height_mm=h, grid=q["grid"], film_z=st.film_z, backend=backend)
+        return relative_illumination(camera, n_fields=q["curve_fields"], grid=q["grid"], backend=backend)
     except OpticsError as exc:
         notes.append(f"relative illumination: {exc}")
         return None
 
 
-def _mtf(lens, focus_mm, label, fstop, top_mm, q, backend):
-    """(label, chart or None, note): the diffraction chart, or why there is none."""
+def _mtf(camera, label, fstop, top_mm, q, backend):
+    """(label, chart or None, note): the diffraction chart of ``camera`` at ``fstop``, or why there is none."""
     from .mtf import mtf_chart
 
     try:
-        chart = mtf_chart(lens, max_image_height_mm=max(top_mm, 0.5), n_fields=q["mtf_fields"], fstop=fstop,
-                          focus_mm=None if math.isinf(focus_mm) else focus_mm, max_pupil_samples=q["pupil_cap"],
-                          backend=backend)
+        at = camera if fstop is None else camera.with_fstop(fstop)
+        chart = mtf_chart(at, max_image_height_mm=max(top_mm, 0.5), n_fields=q["mtf_fields"],
+                          max_pupil_samples=q["pupil_cap"], backend=backend)
     except OpticsError as exc:
         return (label, None, str(exc).split(";")[0])
     return (label, chart, "")
 
 
-def _bokeh(st, key, focus_mm, w, h, q, backend, notes):
+def _bokeh(camera, key, w, h, q, backend, notes):
     """Point lights in front of the focus (half the focus distance; 15 focal lengths when focused at
     infinity) imaged at the centre, half the half-diagonal and 90 % of it (or of the image circle), wide open."""
     from .bokeh import bokeh_image
 
-    efl = key["efl_mm"]
+    efl, focus_mm = key["efl_mm"], camera.focus_from_film_mm
     depth = 15.0 * efl if math.isinf(focus_mm) else 0.5 * focus_mm
     pupil = key["entrance_pupil_from_film_mm"]
     corner = 0.9 * min(0.5 * math.hypot(w, h), 0.5 * key["image_circle_mm"])
@@ -264,8 +266,7 @@ def _bokeh(st, key, focus_mm, w, h, q, backend, notes):
         # the light's lateral place whose chief ray lands near image height hgt (paraxial angle)
         x = -math.tan(math.atan(hgt / efl)) * max(depth - pupil, efl)
         try:
-            img = bokeh_image(st.prescription, depth, x, 0.0, film_z=st.film_z, rays=q["rays"], pixels=q["pixels"],
-                              backend=backend)
+            img = bokeh_image(camera, depth, x, 0.0, rays=q["rays"], pixels=q["pixels"], backend=backend)
         except (OpticsError, InputError) as exc:
             notes.append(f"bokeh {lab}: {exc}")
             img = None

@@ -50,11 +50,11 @@ def lens_measurements(lens, *, focus_mm=None, fstop=None, sensor, coc=None, ligh
     """The comparison's figures of ``lens`` (a :class:`~physcam.optics.state.CameraState`, or a
     Prescription focused at ``focus_mm``, a mark from the film, inf allowed, at ``fstop``) on
     ``sensor``; curves for the figure under ``_curves``; ``notes``."""
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
 
     lens, focus_mm, fstop, state = _camera(lens, focus_mm, fstop)
-    r = solve_report(ReportRequest(focal_length_mm=None, lens=lens, sensor=sensor, fstop=fstop, focus_mm=focus_mm,
-                                   coc=coc))
+    r = solve_report(report_camera(focal_length_mm=None, lens=lens, sensor=sensor, fstop=fstop, focus_mm=focus_mm,
+                      coc=coc))
     real = r.to_dict()["fov_deg"]["real"] or {}
     out = {
         "lens": lens.name, "efl_mm": r.focal_length_mm, "fstop": r.fstop,

@@ -38,8 +38,7 @@ import numpy as np
 from ..data.default_sensor import DEFAULT_SENSOR_HALF_DIAGONAL_MM
 from ..errors import InputError, OpticsError, require_finite
 from ..figures import PALETTE, fit_title, styled
-from ..lens.prescription import Prescription
-from ..optics.state import takes_camera
+from ..optics.state import CameraState, OfACamera, takes_camera
 from ._sampling import MAX_FREQUENCIES, spatial_frequencies
 
 __all__ = ["MTFCurve", "ThroughFocusMTF", "MTFChart", "mtf", "geometric_mtf", "through_focus_mtf", "mtf_chart",
@@ -47,19 +46,19 @@ __all__ = ["MTFCurve", "ThroughFocusMTF", "MTFChart", "mtf", "geometric_mtf", "t
 
 #: The frequencies of a lens maker's MTF chart (lp/mm): contrast (10), resolution (20, 40).
 CHART_FREQUENCIES = (10.0, 20.0, 40.0)
-def spectrum_words(lens, wavelengths_nm) -> str:
+@takes_camera
+def spectrum_words(camera: CameraState, wavelengths_nm) -> str:
     """What light an MTF is in, in words that follow the lens data: "white light (d, F, C)" only where
     the prescription gives its glasses dispersion; "monochromatic: the prescription gives no dispersion"
     where none of them has any (the wavelengths then differ in diffraction alone); a note of how many
     glasses have none where some do (:func:`physcam.optics.glass.glasses_without_dispersion`)."""
     from ..optics.glass import glasses_without_dispersion
-    from ..optics.state import CameraState
 
     wls = tuple(float(w) for w in np.atleast_1d(wavelengths_nm))
     listed = ", ".join(f"{w:g}" for w in wls) + " nm"
     if len(wls) == 1:
         return f"{listed} (one wavelength)"
-    flat, n = glasses_without_dispersion(lens.lens if isinstance(lens, CameraState) else lens)
+    flat, n = glasses_without_dispersion(camera.lens)
     if n and flat == n:
         return f"monochromatic: the prescription gives no dispersion; {listed} differ in diffraction only"
     light = "white light (d, F, C)" if wls == WHITE_LIGHT_NM else listed
@@ -110,16 +109,15 @@ def _cutoffs(fp, dz):
 
 
 @dataclass
-class MTFCurve:
-    """Tangential and sagittal MTF of one field against frequency (module notes)."""
+class MTFCurve(OfACamera):
+    """Tangential and sagittal MTF of one field against frequency (module notes), of ``camera``."""
 
     lens_name: str
     field_deg: float
     chief_image_height_mm: float
     wavelengths_nm: tuple[float, ...]
     weights: tuple[float, ...]
-    fstop: float
-    focus_from_film_mm: float
+    camera: CameraState  # the camera analysed: its focus and f-stop (.focus_from_film_mm, .fstop)
     defocus_mm: float
     method: str  # "diffraction" or "geometric"
     pupil_samples: int
@@ -168,15 +166,15 @@ class MTFCurve:
         return save(fig, path, force)
 
 
-def _common(lens, field_deg, wavelengths_nm, weights, fstop, focus_mm, defocus_mm, pupil_samples, aperture, backend,
-            frequencies, min_frequency, max_pupil_samples):
+def _common(camera, field_deg, wavelengths_nm, weights, defocus_mm, pupil_samples, backend, frequencies,
+            min_frequency, max_pupil_samples):
     from . import _sampling
 
     dz = require_finite("defocus_mm", defocus_mm)
-    fp = _sampling.field_pupils(lens, field_deg, wavelengths_nm=wavelengths_nm, weights=weights, fstop=fstop,
-                                focus_mm=focus_mm, defocus_mm=[dz], pupil_samples=pupil_samples,
-                                min_frequency=min_frequency, waves_per_cell=_sampling.WAVES_PER_CELL_MTF,
-                                aperture=aperture, backend=backend, max_pupil_samples=max_pupil_samples)
+    fp = _sampling.field_pupils(camera, field_deg, wavelengths_nm=wavelengths_nm, weights=weights,
+                                defocus_mm=[dz], pupil_samples=pupil_samples, min_frequency=min_frequency,
+                                waves_per_cell=_sampling.WAVES_PER_CELL_MTF, backend=backend,
+                                max_pupil_samples=max_pupil_samples)
     return fp, dz
 
 
@@ -193,35 +191,32 @@ def _points(points):
 
 @takes_camera
 def mtf(
-    lens: Prescription,
+    camera: CameraState,
     field_deg=0.0,
     *,
     frequencies=None,
     wavelengths_nm=None,
     weights=None,
-    fstop=None,
-    focus_mm=None,
     defocus_mm=0.0,
     pupil_samples=None,
     points: int = 65,
-    aperture=None,
     backend: str = "auto",
     max_pupil_samples=None,
 ) -> MTFCurve:
-    """Diffraction MTF of ``lens`` at ``field_deg`` (degrees, Y meridian), tangential and sagittal.
+    """Diffraction MTF of ``camera`` (:func:`physcam.optics.state.camera_state`: the lens focused and
+    stopped, its iris shape) at ``field_deg`` (degrees, Y meridian), tangential and sagittal.
 
     ``frequencies`` (lp/mm; default ``points`` from 0 to the cut-off), ``wavelengths_nm`` and
-    ``weights`` (default the design wavelength; the first is the primary), ``fstop``,
-    ``focus_mm`` (mark from the film, default infinity), ``defocus_mm`` (film moved away from
-    the lens), ``pupil_samples`` (default chosen by the sampling rules), ``aperture`` (the
-    stop's shape), ``max_pupil_samples`` (cap on the grid the rules may choose, default 1024).
-    Also returns the diffraction limit of the same (vignetted) pupil.
+    ``weights`` (default the camera's; the first is the primary), ``defocus_mm`` (film moved away
+    from the lens), ``pupil_samples`` (default chosen by the sampling rules), ``max_pupil_samples``
+    (cap on the grid the rules may choose, default 1024). Also returns the diffraction limit of the
+    same (vignetted) pupil.
     """
     freqs = None if frequencies is None else spatial_frequencies(frequencies)
     pts = _points(points)
     fmin = None if freqs is None or not (freqs > 0).any() else float(freqs[freqs > 0].min())
-    fp, dz = _common(lens, field_deg, wavelengths_nm, weights, fstop, focus_mm, defocus_mm, pupil_samples, aperture,
-                     backend, freqs, fmin, max_pupil_samples)
+    fp, dz = _common(camera, field_deg, wavelengths_nm, weights, defocus_mm, pupil_samples, backend, freqs, fmin,
+                     max_pupil_samples)
     if freqs is None:
         freqs = _default_freqs(fp, dz, pts)
     t = np.abs(_otf(fp, freqs, 0, dz))
@@ -231,25 +226,22 @@ def mtf(
     ct, cs = _cutoffs(fp, dz)
     st = fp.setup
     h = fp.samples(0, dz).chief_film_xy[1]
-    return MTFCurve(st.lens_name, fp.field.field_deg, h, tuple(fp.wavelengths_nm), tuple(fp.weights), st.fstop,
-                    st.focus_from_film_mm, dz, "diffraction", fp.n, freqs, np.clip(t, 0, 1), np.clip(s, 0, 1),
+    return MTFCurve(st.lens_name, fp.field.field_deg, h, tuple(fp.wavelengths_nm), tuple(fp.weights), st.state,
+                    dz, "diffraction", fp.n, freqs, np.clip(t, 0, 1), np.clip(s, 0, 1),
                     np.clip(dt, 0, 1), np.clip(ds, 0, 1), ct, cs)
 
 
 @takes_camera
 def geometric_mtf(
-    lens: Prescription,
+    camera: CameraState,
     field_deg=0.0,
     *,
     frequencies=None,
     wavelengths_nm=None,
     weights=None,
-    fstop=None,
-    focus_mm=None,
     defocus_mm=0.0,
     pupil_samples=None,
     points: int = 65,
-    aperture=None,
     backend: str = "auto",
 ) -> MTFCurve:
     """Geometric MTF (the Fourier transform of the spot): |sum w exp(-2 pi i nu y)| / sum w over the
@@ -261,9 +253,8 @@ def geometric_mtf(
     pts = _points(points)
     dz = require_finite("defocus_mm", defocus_mm)
     n = _sampling.pupil_samples_arg(pupil_samples) or 64
-    fp = _sampling.field_pupils(lens, field_deg, wavelengths_nm=wavelengths_nm, weights=weights, fstop=fstop,
-                                focus_mm=focus_mm, defocus_mm=[dz], pupil_samples=n, aperture=aperture,
-                                backend=backend, check=False)
+    fp = _sampling.field_pupils(camera, field_deg, wavelengths_nm=wavelengths_nm, weights=weights, defocus_mm=[dz],
+                                pupil_samples=n, backend=backend, check=False)
     if freqs is None:
         freqs = _default_freqs(fp, dz, pts)
     ref = fp.reference_point(dz)
@@ -280,20 +271,20 @@ def geometric_mtf(
         s += w * (np.exp(-2j * np.pi * np.outer(freqs, x)) @ wt)
     st = fp.setup
     return MTFCurve(st.lens_name, fp.field.field_deg, float(ref[1]), tuple(fp.wavelengths_nm), tuple(fp.weights),
-                    st.fstop, st.focus_from_film_mm, dz, "geometric", fp.n, freqs, np.clip(np.abs(t), 0, 1),
+                    st.state, dz, "geometric", fp.n, freqs, np.clip(np.abs(t), 0, 1),
                     np.clip(np.abs(s), 0, 1))
 
 
 @dataclass
-class ThroughFocusMTF:
-    """MTF at fixed frequencies against film position (``defocus_mm``: film moved away from the lens)."""
+class ThroughFocusMTF(OfACamera):
+    """MTF at fixed frequencies against film position (``defocus_mm``: film moved away from the lens), of
+    ``camera``."""
 
     lens_name: str
     field_deg: float
     wavelengths_nm: tuple[float, ...]
     weights: tuple[float, ...]
-    fstop: float
-    focus_from_film_mm: float
+    camera: CameraState  # the camera analysed: its focus and f-stop (.focus_from_film_mm, .fstop)
     pupil_samples: int
     frequencies_lpmm: np.ndarray = field(repr=False)
     defocus_mm: np.ndarray = field(repr=False)
@@ -335,17 +326,14 @@ class ThroughFocusMTF:
 
 @takes_camera
 def through_focus_mtf(
-    lens: Prescription,
+    camera: CameraState,
     field_deg=0.0,
     frequencies=CHART_FREQUENCIES,
     *,
     defocus_mm=None,
     wavelengths_nm=None,
     weights=None,
-    fstop=None,
-    focus_mm=None,
     pupil_samples=None,
-    aperture=None,
     backend: str = "auto",
     max_pupil_samples=None,
 ) -> ThroughFocusMTF:
@@ -360,8 +348,8 @@ def through_focus_mtf(
     if defocus_mm is None:
         from . import _pupil as P
 
-        st = P.setup(lens, fstop=fstop, focus_mm=focus_mm, aperture=aperture, backend=backend)
-        wls, _ = _sampling.wavelengths_and_weights(lens, wavelengths_nm, weights)
+        st = P.setup(camera, backend=backend)
+        wls, _ = _sampling.wavelengths_and_weights(camera, wavelengths_nm, weights)
         span = 20.0 * wls[0] * 1e-6 * st.fstop ** 2
         dzs = np.linspace(-span, span, 41)
     else:
@@ -375,27 +363,25 @@ def through_focus_mtf(
         if not 1 <= dzs.size <= 401 or (np.abs(dzs) > 100.0).any():
             raise InputError("give 1 to 401 film shifts within +-100 mm")
     fmin = float(freqs[freqs > 0].min()) if (freqs > 0).any() else None
-    fp = _sampling.field_pupils(lens, field_deg, wavelengths_nm=wavelengths_nm, weights=weights, fstop=fstop,
-                                focus_mm=focus_mm, defocus_mm=[float(dzs.min()), float(dzs.max())],
-                                pupil_samples=pupil_samples, min_frequency=fmin,
-                                waves_per_cell=_sampling.WAVES_PER_CELL_MTF, aperture=aperture, backend=backend, st=st,
-                                max_pupil_samples=max_pupil_samples)
+    fp = _sampling.field_pupils(camera, field_deg, wavelengths_nm=wavelengths_nm, weights=weights,
+                                defocus_mm=[float(dzs.min()), float(dzs.max())], pupil_samples=pupil_samples,
+                                min_frequency=fmin, waves_per_cell=_sampling.WAVES_PER_CELL_MTF, backend=backend,
+                                st=st, max_pupil_samples=max_pupil_samples)
     t = np.array([np.abs(_otf(fp, freqs, 0, float(dz))) for dz in dzs]).T
     s = np.array([np.abs(_otf(fp, freqs, 1, float(dz))) for dz in dzs]).T
     st = fp.setup
-    return ThroughFocusMTF(st.lens_name, fp.field.field_deg, tuple(fp.wavelengths_nm), tuple(fp.weights), st.fstop,
-                           st.focus_from_film_mm, fp.n, freqs, dzs, np.clip(t, 0, 1), np.clip(s, 0, 1))
+    return ThroughFocusMTF(st.lens_name, fp.field.field_deg, tuple(fp.wavelengths_nm), tuple(fp.weights), st.state,
+                           fp.n, freqs, dzs, np.clip(t, 0, 1), np.clip(s, 0, 1))
 
 
 @dataclass
-class MTFChart:
-    """The lens maker's chart: MTF at ``frequencies_lpmm`` against image height (module notes).
+class MTFChart(OfACamera):
+    """The lens maker's chart of ``camera``: MTF at ``frequencies_lpmm`` against image height (module notes).
 
     ``sagittal`` and ``tangential`` have shape (fields, frequencies)."""
 
     lens_name: str
-    fstop: float
-    focus_from_film_mm: float
+    camera: CameraState  # the camera analysed: its focus and f-stop (.focus_from_film_mm, .fstop)
     wavelengths_nm: tuple[float, ...]
     weights: tuple[float, ...]
     frequencies_lpmm: tuple[float, ...]
@@ -512,7 +498,7 @@ class MTFChart:
 
 @takes_camera
 def mtf_chart(
-    lens: Prescription,
+    camera: CameraState,
     *,
     max_image_height_mm=DEFAULT_SENSOR_HALF_DIAGONAL_MM,
     n_fields: int = 15,
@@ -520,10 +506,7 @@ def mtf_chart(
     frequencies=CHART_FREQUENCIES,
     wavelengths_nm=WHITE_LIGHT_NM,
     weights=None,
-    fstop=None,
-    focus_mm=None,
     pupil_samples=None,
-    aperture=None,
     backend: str = "auto",
     max_pupil_samples=256,
     progress=None,
@@ -531,7 +514,7 @@ def mtf_chart(
     best_focus_rule: str = "axis",
     method: str = "fft",
 ) -> MTFChart:
-    """The vendor MTF chart of ``lens``: sagittal and tangential MTF at ``frequencies`` (default 10,
+    """The vendor MTF chart of ``camera``: sagittal and tangential MTF at ``frequencies`` (default 10,
     20, 40 lp/mm) against image height, ``n_fields`` heights from 0 to ``max_image_height_mm``
     (default 15.55 mm, the corner of the default sensor, Super 35 24.89 x 18.66 mm:
     :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, as the CLI; 21.63 mm is a 36 x 24 mm corner) or the ``image_heights_mm`` given; the d, F and C lines by
@@ -568,14 +551,14 @@ def mtf_chart(
         hs = np.linspace(0.0, top, int(n_fields))
     if (hs < 0).any() or (hs > 500).any():
         raise InputError("image heights must lie between 0 and 500 mm from the centre")
-    wls, wts = _sampling.wavelengths_and_weights(lens, wavelengths_nm, weights)
+    wls, wts = _sampling.wavelengths_and_weights(camera, wavelengths_nm, weights)
     cap = _sampling.pupil_samples_arg(max_pupil_samples)
     n_user = _sampling.pupil_samples_arg(pupil_samples)
     if n_user is not None and cap is not None and n_user > cap:
         raise InputError(f"pupil_samples {n_user} exceeds the chart's max_pupil_samples {cap}")
     if method not in ("fft", "huygens"):
         raise InputError(f"the MTF method is 'fft' or 'huygens', got {method!r}")
-    st = P.setup(lens, fstop=fstop, focus_mm=focus_mm, aperture=aperture, backend=backend)
+    st = P.setup(camera, backend=backend)
     fmin = float(freqs[freqs > 0].min()) if (freqs > 0).any() else None
     try:  # every height at once; past the image circle, one at a time to say where it ends
         angles = P.fields_for_image_heights(st, hs, wls[0])
@@ -590,7 +573,7 @@ def mtf_chart(
                                   f"(max_image_height_mm, --max-height)") from None
     dz, rule = 0.0, "the paraxial image plane of the focus mark"
     if best_focus is not None:
-        dz, rule = best_focus_mm(lens, best_focus, heights_mm=hs, angles_deg=angles, rule=best_focus_rule,
+        dz, rule = best_focus_mm(camera, best_focus, heights_mm=hs, angles_deg=angles, rule=best_focus_rule,
                                  wavelengths_nm=wls, weights=wts, st=st, max_pupil_samples=max_pupil_samples)
     if progress is not None:
         progress(0, hs.size)
@@ -604,19 +587,18 @@ def mtf_chart(
         from .huygens import huygens_mtf
 
         for i, a in enumerate(angles):
-            tan[i], sag[i], p = huygens_mtf(lens, float(a), frequencies=freqs, wavelengths_nm=wls, weights=wts,
-                                            fstop=st.fstop, focus_mm=focus_mm, defocus_mm=dz, aperture=aperture,
-                                            backend=backend)
+            tan[i], sag[i], p = huygens_mtf(camera, float(a), frequencies=freqs, wavelengths_nm=wls, weights=wts,
+                                            defocus_mm=dz, backend=backend)
             ns[i] = p.pupil_samples
             if progress is not None:
                 progress(i + 1, hs.size)
-        return MTFChart(st.lens_name, st.fstop, st.focus_from_film_mm, tuple(wls), tuple(wts),
+        return MTFChart(st.lens_name, st.state, tuple(wls), tuple(wts),
                         tuple(float(f) for f in freqs), hs, angles, np.clip(sag, 0, 1), np.clip(tan, 0, 1), ns,
                         ("method: Huygens PSF per field (physcam.analysis.huygens)",), float(dz), rule,
-                        spectrum_words(lens, wls))
+                        spectrum_words(camera, wls))
     # fields in runs that fit one tracing batch; each run's pupils are freed before the next
     for run in _sampling._chunks(list(range(hs.size)), lambda i: per_field, _sampling.RAYS_PER_BATCH):
-        fps = _sampling.fields_pupils(lens, angles[run], wavelengths_nm=wls, weights=wts, pupil_samples=pupil_samples,
+        fps = _sampling.fields_pupils(camera, angles[run], wavelengths_nm=wls, weights=wts, pupil_samples=pupil_samples,
                                       min_frequency=fmin, waves_per_cell=_sampling.WAVES_PER_CELL_MTF, st=st,
                                       max_pupil_samples=max_pupil_samples, defocus_mm=[dz])
         for k, i in enumerate(run):
@@ -627,9 +609,9 @@ def mtf_chart(
             done += 1
             if progress is not None:
                 progress(done, hs.size)
-    return MTFChart(st.lens_name, st.fstop, st.focus_from_film_mm, tuple(wls), tuple(wts),
+    return MTFChart(st.lens_name, st.state, tuple(wls), tuple(wts),
                     tuple(float(f) for f in freqs), hs, angles, np.clip(sag, 0, 1), np.clip(tan, 0, 1), ns,
-                    defocus_mm=float(dz), focus_rule=rule, spectrum=spectrum_words(lens, wls))
+                    defocus_mm=float(dz), focus_rule=rule, spectrum=spectrum_words(camera, wls))
 
 
 #: Fields the field-weighted best focus averages over, as fractions of the chart's largest height.
@@ -654,7 +636,7 @@ def _least_spread_mm(fps) -> float:
     return -num / den if den > 0 else 0.0
 
 
-def best_focus_mm(lens, frequency, *, heights_mm, angles_deg, rule, wavelengths_nm, weights, st,
+def best_focus_mm(camera, frequency, *, heights_mm, angles_deg, rule, wavelengths_nm, weights, st,
                   max_pupil_samples=256) -> tuple[float, str]:
     """(film shift mm, its rule in words): where the mean of S and T MTF at ``frequency`` is highest,
     on the axis (``rule`` "axis") or averaged over the image with ring-area weights ("field"). The
@@ -688,13 +670,13 @@ def best_focus_mm(lens, frequency, *, heights_mm, angles_deg, rule, wavelengths_
     lam_n2 = wavelengths_nm[0] * 1e-6 * st.fstop ** 2
     # 1. the scan: 41 film positions over +-20 lambda N^2 about the least geometric spread, on a 64-cell
     #    grid whose sampling is not checked so far from focus (it is where the MTF matters: step 2)
-    coarse_fps = _sampling.fields_pupils(lens, angles, pupil_samples=64, check=False, **kw)
+    coarse_fps = _sampling.fields_pupils(camera, angles, pupil_samples=64, check=False, **kw)
     centre = _least_spread_mm(coarse_fps)
     coarse = centre + np.linspace(-20.0, 20.0, 41) * lam_n2
     k = int(np.argmax([merit(coarse_fps, d) for d in coarse]))
     # 2. 21 positions between the best one's neighbours, on grids that meet the sampling rules there
     lo, hi = coarse[max(k - 1, 0)], coarse[min(k + 1, coarse.size - 1)]
-    fps = _sampling.fields_pupils(lens, angles, min_frequency=float(nu[0]), waves_per_cell=_sampling.WAVES_PER_CELL_MTF,
+    fps = _sampling.fields_pupils(camera, angles, min_frequency=float(nu[0]), waves_per_cell=_sampling.WAVES_PER_CELL_MTF,
                                   defocus_mm=[lo, hi], max_pupil_samples=max_pupil_samples, **kw)
     fine = np.linspace(lo, hi, 21)
     best = float(fine[int(np.argmax([merit(fps, d) for d in fine]))])

@@ -26,8 +26,7 @@ import numpy as np
 
 from ..errors import InputError, require_finite
 from ..figures import styled
-from ..lens.prescription import Prescription
-from ..optics.state import takes_camera
+from ..optics.state import CameraState, OfACamera, takes_camera
 
 __all__ = ["PointSpreadFunction", "psf", "strehl_of_pupil"]
 
@@ -74,7 +73,7 @@ def strehl_of_pupil(field_cells, amplitude0, padding: int = 4) -> tuple[float, f
 
 
 @dataclass
-class PointSpreadFunction:
+class PointSpreadFunction(OfACamera):
     """A monochromatic PSF (module notes). ``image`` is normalised so the unaberrated PSF of the
     same pupil peaks at 1 (its maximum is then about the Strehl ratio); rows run along +y on the
     film, columns along +x, centred on the chief ray's film point; pixels ``pixel_um``."""
@@ -82,8 +81,7 @@ class PointSpreadFunction:
     lens_name: str
     field_deg: float
     wavelength_nm: float
-    fstop: float
-    focus_from_film_mm: float
+    camera: CameraState  # the camera analysed: its focus and f-stop
     defocus_mm: float
     pupil_samples: int
     padding: int
@@ -131,20 +129,17 @@ class PointSpreadFunction:
 
 @takes_camera
 def psf(
-    lens: Prescription,
+    camera: CameraState,
     field_deg=0.0,
     *,
     wavelength_nm=None,
-    fstop=None,
-    focus_mm=None,
     defocus_mm=0.0,
     pupil_samples=None,
     padding: int = 4,
-    aperture=None,
     backend: str = "auto",
     max_pupil_samples=None,
 ) -> PointSpreadFunction:
-    """The diffraction PSF and Strehl ratio of ``lens`` at ``field_deg`` (degrees, Y meridian).
+    """The diffraction PSF and Strehl ratio of ``camera`` at ``field_deg`` (degrees, Y meridian).
 
     Arguments as :func:`physcam.analysis.wavefront.wavefront`; ``padding`` (2 to 16) sets the PSF
     sampling: pixels of lambda N / padding or so. The pupil grid follows the quarter-wave rule
@@ -155,9 +150,9 @@ def psf(
     if isinstance(padding, bool) or not isinstance(padding, (int, np.integer)) or not 2 <= padding <= 16:
         raise InputError(f"padding must be a whole number from 2 to 16, got {padding!r}")
     dz = require_finite("defocus_mm", defocus_mm)
-    fp = _sampling.field_pupils(lens, field_deg, wavelengths_nm=None if wavelength_nm is None else [wavelength_nm],
-                                fstop=fstop, focus_mm=focus_mm, defocus_mm=[dz], pupil_samples=pupil_samples,
-                                aperture=aperture, backend=backend, max_pupil_samples=max_pupil_samples)
+    fp = _sampling.field_pupils(camera, field_deg, wavelengths_nm=None if wavelength_nm is None else [wavelength_nm],
+                                defocus_mm=[dz], pupil_samples=pupil_samples, backend=backend,
+                                max_pupil_samples=max_pupil_samples)
     pf = fp.pupil(0, dz)
     ws = fp.samples(0, dz)
     st = fp.setup
@@ -179,7 +174,6 @@ def psf(
     s, fx, fy = strehl_of_pupil(pf.field, pf.amplitude0, padding)
     peak = (-fx * M * dx * 1e3, -fy * M * dy * 1e3)  # film position of the peak's frequency index, um
     na = pf.n_image * abs(pf.slope_y) * st.r_ep
-    return PointSpreadFunction(st.lens_name, fp.field.field_deg, pf.wavelength_nm, st.fstop, st.focus_from_film_mm,
-                               dz, n, int(padding), float(s), (float(peak[0]), float(peak[1])),
+    return PointSpreadFunction(st.lens_name, fp.field.field_deg, pf.wavelength_nm, st.state, dz, n, int(padding), float(s), (float(peak[0]), float(peak[1])),
                                (abs(dx) * 1e3, abs(dy) * 1e3), 0.61 * lam / na * 1e3, ws.chief_film_xy[1],
                                np.ascontiguousarray(img))

@@ -47,8 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription
-from ..optics.state import CameraState, takes_camera
+from ..optics.state import CameraState, OfACamera, takes_camera
 
 __all__ = ["RealDepthOfField", "real_depth_of_field", "blur_diameter_mm", "MEASURES"]
 
@@ -64,12 +63,11 @@ CONVERGED = 1e-3
 
 
 @dataclass(frozen=True)
-class RealDepthOfField:
-    """Near and far limits (mm from the film) where the real blur reaches ``coc_mm`` (module notes)."""
+class RealDepthOfField(OfACamera):
+    """Near and far limits (mm from the film) where the real blur of ``camera`` reaches ``coc_mm`` (module notes)."""
 
     lens_name: str
-    fstop: float
-    focus_from_film_mm: float
+    camera: CameraState  # the camera traced: its focus (.focus_from_film_mm) and f-stop (.fstop)
     coc_mm: float
     image_height_mm: float
     measure: str  # "moment" or "energy 80 %"
@@ -155,33 +153,25 @@ def _measure(measure, energy_fraction):
     return f
 
 
-def _camera(lens, focus_mm, fstop) -> CameraState:
-    """The camera state: ``lens`` as it is, or a Prescription focused at ``focus_mm`` and set to ``fstop``
-    (both needed); its mark must be finite."""
-    from ..optics.state import as_camera_state
-
-    if not isinstance(lens, CameraState):
-        if focus_mm is None or fstop is None:
-            raise InputError("give focus_mm and fstop with a lens (or a CameraState: physcam.optics.state.camera_state)")
-        from ..units import parse_distance
-
-        focus_mm = require_positive("focus mark", parse_distance(focus_mm, name="focus mark", allow_inf=True))
-    cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
-    require_positive("focus mark", cam.focus_from_film_mm)
-    return cam
+def _camera(camera: CameraState) -> CameraState:
+    """The camera (through the door): focused by hand at a finite mark."""
+    if camera.film_from_analysis:
+        raise InputError("give focus_mm and fstop: a camera focused by hand, physcam.optics.state.camera_state(lens, "
+                         "focus_mm=..., fstop=...)")
+    require_positive("focus mark", camera.focus_from_film_mm)
+    return camera
 
 
 @takes_camera
-def blur_diameter_mm(lens: CameraState | Prescription, light_from_film_mm: float, *, focus_mm: float | None = None,
-                     fstop: float | None = None, image_height_mm: float = 0.0, measure: str = "moment",
+def blur_diameter_mm(camera: CameraState, light_from_film_mm: float, *, image_height_mm: float = 0.0, measure: str = "moment",
                      energy_fraction: float = 0.8, film_shift_mm: float = 0.0, grid: int = GRIDS[0],
                      backend: str = "auto") -> float:
     """The real blur diameter (mm, module notes) of a point ``light_from_film_mm`` in front of the film;
-    ``lens`` a :class:`~physcam.optics.state.CameraState`, or a Prescription with ``focus_mm`` and ``fstop``;
+    ``camera`` a :class:`~physcam.optics.state.CameraState` (focused at a mark, stopped);
     ``film_shift_mm``: the film moved from the mark's paraxial image (a collimated lens's
     ``RealDepthOfField.film_shift_mm``); ``grid``: pupil samples per side of the beam."""
     f = _measure(measure, energy_fraction)
-    blur = _Blur(_camera(lens, focus_mm, fstop), require_finite("image height", image_height_mm), measure, f, backend,
+    blur = _Blur(_camera(camera), require_finite("image height", image_height_mm), measure, f, backend,
                  grid=_grid(grid), film_shift_mm=require_finite("film shift", film_shift_mm))
     d = require_positive("light distance", light_from_film_mm)
     if not d > blur.front:
@@ -264,17 +254,16 @@ def _agree(a, b) -> bool:
 
 
 @takes_camera
-def real_depth_of_field(lens: CameraState | Prescription, *, focus_mm: float | None = None, fstop: float | None = None,
-                        coc_mm: float, image_height_mm: float = 0.0, measure: str = "moment",
+def real_depth_of_field(camera: CameraState, *, coc_mm: float, image_height_mm: float = 0.0, measure: str = "moment",
                         energy_fraction: float = 0.8, focusing: str = "collimated", grid: int | None = None,
                         backend: str = "auto") -> RealDepthOfField:
-    """Near and far limits of ``lens`` (a :class:`~physcam.optics.state.CameraState`, or a Prescription
-    focused at ``focus_mm``, the mark from the film, at ``fstop``) where the real blur reaches
+    """Near and far limits of ``camera`` (a :class:`~physcam.optics.state.CameraState`: the lens focused at
+    a mark from the film, its iris at an f-stop) where the real blur reaches
     ``coc_mm`` (module notes). ``focusing``: "collimated" (best focus at the mark, default) or "paraxial";
     ``grid``: one pupil grid (samples per side) instead of sampling until converged. Raises
     :class:`OpticsError` when the lens's own blur at its sharpest already exceeds the CoC."""
-    cam = _camera(lens, focus_mm, fstop)
-    lens, mark, fstop = cam.lens, cam.focus_from_film_mm, cam.fstop
+    cam = _camera(camera)
+    lens, fstop = cam.lens, cam.fstop
     c = require_positive("circle of confusion", coc_mm)
     h = require_finite("image height", image_height_mm)
     frac = _measure(measure, energy_fraction)
@@ -294,7 +283,7 @@ def real_depth_of_field(lens: CameraState | Prescription, *, focus_mm: float | N
         notes.append(f"the limits moved by more than {CONVERGED:.2%} between the {grids[-2]} and {grids[-1]} "
                      "pupil grids: sampling-limited")
     dz, u_best, best, near, far = got
-    return RealDepthOfField(lens.name, float(fstop), mark, c, h, "moment" if measure == "moment" else f"energy {frac:.0%}",
+    return RealDepthOfField(lens.name, cam, c, h, "moment" if measure == "moment" else f"energy {frac:.0%}",
                             1.0 / u_best if u_best > 0 else math.inf, best, near, far, focusing, float(dz), g,
                             converged, tuple(notes))
 

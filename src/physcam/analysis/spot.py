@@ -31,8 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, require_finite
-from ..lens.prescription import Prescription
-from ..optics.state import takes_camera
+from ..optics.state import CameraState, takes_camera
 from ..figures import styled
 
 __all__ = ["equal_area_disk", "SpotField", "SpotDiagram", "spot_diagram", "MAX_RINGS", "MAX_REFINE"]
@@ -294,25 +293,23 @@ class _Beams:
 
 @takes_camera
 def spot_diagram(
-    lens: Prescription,
+    camera: CameraState,
     fields_deg=(0.0,),
     *,
     wavelength_nm: float | None = None,
-    film_z: float | None = None,
     rings: int = 64,
     refine: int = 5,
     overfill: float = 1.3,
     pupil_radius: float | None = None,
-    fstop: float | None = None,
     clip: bool = True,
     backend: str = "auto",
 ) -> SpotDiagram:
-    """Spot diagram of ``lens`` at the given field angles (see module notes).
+    """Spot diagram of ``camera`` at the given field angles (see module notes).
 
-    ``lens``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris,
+    ``camera``: a :class:`~physcam.optics.state.CameraState` (its focused lens, film plane, iris,
     iris shape and primary wavelength; the object at its focus, the field seen from the entrance
-    pupil as for the MTF) or a Prescription (object at infinity; ``film_z`` default the paraxial
-    image at ``wavelength_nm``, ``fstop`` sizes the iris by the one rule).
+    pupil as for the MTF); a camera built from a bare lens leaves the film at the paraxial image at
+    ``wavelength_nm``.
     ``rings`` (1 to :data:`MAX_RINGS`) sets the base grid, ``refine`` (0 to :data:`MAX_REFINE`)
     the levels of edge refinement. ``pupil_radius`` (mm) replaces the overfilled entrance pupil
     by a disk of that radius on the entrance-pupil plane (e.g. to compare with a published figure
@@ -322,16 +319,14 @@ def spot_diagram(
     """
     from ..optics.paraxial import gaussian
     from ..trace import CLIPPED, MISSED, OK, TIR, paraxial_image_z, trace_to_film
-    from ._camera import camera_of
+    from ._camera import ray_view
 
-    cam = camera_of(lens, film_z=film_z, fstop=fstop, wavelength_nm=wavelength_nm)
-    lens = cam.lens
-    wl = lens.wavelength_nm if cam.wavelength_nm is None else require_finite("wavelength_nm", cam.wavelength_nm)
+    lens, object_z, film_z, stop, aperture, wl, _ = ray_view(camera, wavelength_nm=wavelength_nm)
+    wl = require_finite("wavelength_nm", wl)
     rings = _whole("rings", rings, 1, MAX_RINGS)
     refine = _whole("refine", refine, 0, MAX_REFINE)
-    film_z = paraxial_image_z(lens, wl) if cam.film_z is None else cam.film_z
-    stop = cam.stop_semi_diameter
-    g = gaussian(lens, wavelength_nm=wl, stop_semi_diameter=stop, object_z=cam.object_z)
+    film_z = paraxial_image_z(lens, wl) if film_z is None else film_z
+    g = gaussian(lens, wavelength_nm=wl, stop_semi_diameter=stop, object_z=object_z)
     z_ep, r_ep = g.z_entrance_pupil, g.entrance_pupil_diameter / 2
     if pupil_radius is not None:
         beam = require_finite("pupil_radius", pupil_radius)
@@ -343,11 +338,11 @@ def spot_diagram(
     for fd in fields:
         if not -89.0 < fd < 89.0:
             raise InputError(f"field angle must lie between -89 and 89 degrees, got {fd:g}")
-    beams = _Beams(lens, cam.object_z, z_ep, beam, fields, wl)
+    beams = _Beams(lens, object_z, z_ep, beam, fields, wl)
 
     def trace(f, u, v):
         res = trace_to_film(lens, beams.rays(f, u, v), film_z, clip=clip, stop_semi_diameter=stop,
-                            aperture=cam.aperture, backend=backend, in_place=True)
+                            aperture=aperture, backend=backend, in_place=True)
         return res.flag, res.x, res.y
 
     samples = _refined_samples(trace, rings, refine, len(fields)) if fields else []

@@ -150,10 +150,10 @@ def _nodes(extent_px, spacing=NODE_SPACING_PX):
 
 @dataclass
 class DistortionField:
-    """Real against ideal pixel positions over the frame at one focus, and the two ST-maps."""
+    """Real against ideal pixel positions over the frame of ``camera`` at its focus, and the two ST-maps."""
 
     lens_name: str
-    focus_from_film_mm: float
+    camera: CameraState  # the camera mapped: its focus (.focus_from_film_mm) and iris (.fstop below)
     wavelength_nm: float
     sensor_mm: tuple[float, float]
     size_px: tuple[int, int]  # plate width, height
@@ -164,7 +164,6 @@ class DistortionField:
     interpolation_error_px: float  # max |interpolated - traced| ideal position at the grid cells' centres
     inverse_error_px: float  # max |D(U(q)) - q| at the inverse grid cells' centres
     max_distortion_px: float  # largest |ideal - real| over the traced nodes
-    fstop: float | None  # the stop whose centroids the field maps; None: chief rays (a small stop)
     residual_px: tuple[float, float]  # (RMS, max) |field - traced| at the cell centres, at that stop
     distortion_stmap: np.ndarray | None = field(repr=False)  # (h, w, 3) float32; None when made without maps
     undistortion_stmap: np.ndarray | None = field(repr=False)  # (h + 2 oy, w + 2 ox, 3) float32; or None
@@ -173,6 +172,17 @@ class DistortionField:
     #: Every traced chief ray (grid nodes and cell centres): real and ideal plate pixels (n, 2) each
     traced_real_px: np.ndarray | None = field(default=None, repr=False)
     traced_ideal_px: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def focus_from_film_mm(self) -> float:
+        """The camera's focus mark in front of the film (inf at infinity)."""
+        return self.camera.focus_from_film_mm
+
+    @property
+    def fstop(self) -> float | None:
+        """The stop whose centroids the field maps (the camera's iris set to an f-stop); None: chief rays (a
+        small stop)."""
+        return self.camera.fstop if self.camera.iris_set else None
 
     def ideal_from_real(self, xy_px) -> np.ndarray:
         """Ideal (undistorted) plate pixel positions (n, 2) of real ones (interpolated field)."""
@@ -397,55 +407,46 @@ def _field_notes(fstop) -> list[str]:
             "focus)"]
 
 
-def _sensor(state, sensor_width_mm, sensor_height_mm) -> tuple[float, float]:
-    """The sensor (width, height) mm: the arguments, or the camera state's own."""
-    if sensor_width_mm is None and sensor_height_mm is None and state.sensor_mm is not None:
-        return state.sensor_mm
-    if state.sensor_mm is not None:
-        raise InputError("a CameraState carries its own sensor: give it to camera_state(sensor_mm=...), not here")
-    if sensor_width_mm is None or sensor_height_mm is None:
-        raise InputError("give the sensor: sensor_width_mm and sensor_height_mm (or camera_state(sensor_mm=...))")
-    return require_positive("sensor width", sensor_width_mm), require_positive("sensor height", sensor_height_mm)
+def _sensor(camera) -> tuple[float, float]:
+    """The camera's sensor (width, height) mm."""
+    if camera.sensor_mm is None:
+        raise InputError("give the sensor: camera_state(lens, ..., sensor=...) (or sensor_mm=(width, height))")
+    return camera.sensor_mm
 
 
 @takes_camera
 def distortion_field(
-    lens: CameraState | Prescription,
+    camera: CameraState,
     *,
-    focus_mm: float | None = None,
-    sensor_width_mm: float | None = None,
-    sensor_height_mm: float | None = None,
     width_px: int,
     height_px: int,
     wavelength_nm: float | None = None,
     method: str = "auto",
     backend: str = "auto",
     maps: bool = True,
-    fstop: float | None = None,
 ) -> DistortionField:
-    """Real distortion of ``lens`` (a :class:`~physcam.optics.state.CameraState`, or a Prescription
-    focused at ``focus_mm``, default infinity, and set to ``fstop``) over a ``width_px`` x
-    ``height_px`` frame, with its distortion and undistortion ST-maps (module notes).
+    """Real distortion of ``camera`` (a :class:`~physcam.optics.state.CameraState`: the lens focused,
+    its iris, on its sensor) over a ``width_px`` x ``height_px`` frame, with its distortion and
+    undistortion ST-maps (module notes).
 
-    The sensor is the state's (``camera_state(sensor_mm=...)``) or ``sensor_width_mm`` x
-    ``sensor_height_mm``; the wavelength ``wavelength_nm`` or the state's primary one.
+    The wavelength is ``wavelength_nm`` or the camera's primary one; ``method`` the lens's focusing
+    (auto, unit, internal) at that wavelength.
     ``maps=False`` traces the same chief rays but makes no ST-maps (the map fields and the overscan
     are then None and (0, 0)): what fitting models and tables across focus need. An iris set to an
     f-stop gives the centroid distortion there instead of the chief rays' (module notes, "At a stop").
     """
-    from ..optics.focusing import focus
-    from ..optics.state import CameraState, as_camera_state
+    from ..optics.focusing import focus, focus_method
     from ..optics.paraxial import gaussian
 
     w_px, h_px = _size("width", width_px), _size("height", height_px)
     if w_px * h_px > MAX_PIXELS:
         raise InputError(f"a {w_px} x {h_px} frame has more than {MAX_PIXELS:,} pixels: give a smaller resolution")
-    if method != "auto" and isinstance(lens, CameraState):
-        raise InputError("a CameraState is focused already: give the focus method to camera_state's lens "
-                         "(or pass the lens itself with method=...), not here")
-    cam = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop)
-    W, H = _sensor(cam, sensor_width_mm, sensor_height_mm)
+    cam = camera
+    W, H = _sensor(cam)
     lens = cam.lens
+    if method != "auto" and method != focus_method(lens):
+        raise InputError(f"the camera is focused already, by its lens's own {focus_method(lens)} focusing: "
+                         "give a camera focused by that lens, not another method here")
     wl = cam.wavelengths_nm[0] if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
     st = focus(lens, cam.focus_from_film_mm, method=method, axis="y", wavelength_nm=wl)
     q = st.prescription
@@ -468,7 +469,6 @@ def distortion_field(
     _require_pinhole_reach(rays, nodes)
     interp_err = float(np.hypot(*(fwd.at(cx.ravel(), cy.ravel()) - exact).T).max())
     resid = rays.residual(cx.ravel(), cy.ravel(), lambda x, y: fwd.at(x, y))
-    n_stop = None if fstop is None else float(fstop)
     max_dist = float(np.hypot(nodes[..., 0] - X, nodes[..., 1] - Y).max())
     traced_real = np.concatenate([np.stack([X.ravel(), Y.ravel()], axis=1), np.stack([cx.ravel(), cy.ravel()], axis=1)])
     traced_ideal = np.concatenate([nodes.reshape(-1, 2), exact])
@@ -483,10 +483,10 @@ def distortion_field(
             raise OpticsError(f"the ST-maps of {lens.name!r} have non-finite values: no map written")
     zf = st.film_z
     return DistortionField(
-        lens.name, float(st.focus_from_film_mm), float(wl), (W, H), (w_px, h_px),
+        lens.name, cam, float(wl), (W, H), (w_px, h_px),
         (float(g["x"].pinhole_focal_length), float(g["y"].pinhole_focal_length)),
         (float(zf - g["x"].z_entrance_pupil), float(zf - g["y"].z_entrance_pupil)),
-        overscan, (nx, ny), interp_err, inv_err, max_dist, n_stop, resid, dmap, umap, _field_notes(fstop), fwd,
+        overscan, (nx, ny), interp_err, inv_err, max_dist, resid, dmap, umap, _field_notes(fstop), fwd,
         traced_real, traced_ideal)
 
 

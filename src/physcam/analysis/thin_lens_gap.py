@@ -25,6 +25,7 @@ import math
 from dataclasses import dataclass, field
 
 from ..errors import OpticsError, PhysCamError, require_type
+from ..optics.state import CameraState, OfACamera
 
 __all__ = ["ThinLensGap", "thin_lens_gap"]
 
@@ -33,12 +34,11 @@ BOKEH_RAYS = 60_000
 
 
 @dataclass(frozen=True)
-class ThinLensGap:
-    """The thin-lens camera against the real lens at one stop and focus (module notes)."""
+class ThinLensGap(OfACamera):
+    """The thin-lens camera against the real lens of ``camera`` at its stop and focus (module notes)."""
 
     lens_name: str
-    fstop: float
-    focus_from_film_mm: float
+    camera: CameraState  # the report's camera: its focus (.focus_from_film_mm) and f-stop (.fstop)
     hfov_difference_pct: float | None
     #: (light distance from the film mm, thin-lens diameter mm, real diameter mm, difference %)
     bokeh: tuple[tuple[float, float, float, float], ...] = ()
@@ -85,65 +85,68 @@ def _real_blur_mm(state, light_from_film_mm: float) -> float:
     from .blob import equivalent_diameter
     from .bokeh import bokeh_image
 
-    st = state()
-    img = bokeh_image(st.focused, light_from_film_mm, film_z=st.film_z, rays=BOKEH_RAYS, pixels=128,
-                      fresnel=False, stop_semi_diameter=st.stop_semi_diameter)
+    st = state()  # the lens focused at the report's mark, its film there, the iris set
+    img = bokeh_image(st.with_aperture(None), light_from_film_mm, rays=BOKEH_RAYS, pixels=128, fresnel=False)
     x0, x1, _, _ = img.extent_mm
     return equivalent_diameter(img.image.sum(axis=2), pixel=(x1 - x0) / img.image.shape[1])
 
 
-def _lights_mm(report, lens) -> list[float]:
+def _lights_mm(report) -> list[float]:
     """Half and twice the focus distance from the film (1 m when focused at infinity), in front of the lens."""
-    from ..optics import focusing
-
     mark = report.focus_from_film_mm
-    front = focusing.focus(lens, mark).film_z  # the front vertex's distance from the film
+    front = report.camera.lens_model.focus_state(mark).film_z  # the front vertex's distance from the film
     lights = [1000.0] if math.isinf(mark) else [0.5 * mark, 2.0 * mark]
     return [d for d in lights if d > front + 10.0]
 
 
-def _camera(report, lens):
-    """The camera state of ``report`` (its focus mark and f-stop) on ``lens``, made once when first
-    asked; a CameraState given as ``lens`` must be the report's."""
+def _camera(report):
+    """The camera of ``report`` with its iris set to the report's f-stop, made once when first asked (an
+    f-stop solved from measured limits faster than the lens opens is then a note of each light)."""
     import functools
 
-    from ..errors import InputError
-    from ..optics.state import CameraState, camera_state
+    return functools.cache(report.stopped_camera)
 
-    if isinstance(lens, CameraState):
-        if (lens.focus_from_film_mm, lens.fstop) != (report.focus_from_film_mm, report.fstop):
+
+def thin_lens_gap(report, lens=None) -> ThinLensGap:
+    """The thin-lens camera of ``report`` against the real lens of its camera (module notes).
+
+    ``report`` must come from :func:`physcam.onset.report.solve_report` of a prescription's camera.
+    A bokeh that cannot be traced (the light inside the lens's closest focus, everything vignetted)
+    is left out with a note. ``lens`` (the prescription, or the camera again) is the pre-issue-43 form:
+    the report holds its camera; given, it must be that camera's lens (DeprecationWarning)."""
+    from ..errors import InputError
+    from ..onset.report import LensReport
+
+    require_type("report", report, LensReport, "solve one with physcam.onset.report.solve_report(camera)")
+    if not report.camera.traceable:
+        raise InputError("the thin-lens gap compares with a traced lens: give the report of a prescription's camera")
+    if lens is not None:
+        import warnings
+
+        warnings.warn("thin_lens_gap(report, lens): the report holds its camera; call thin_lens_gap(report) (the lens "
+                      "argument goes in physcam 0.3)", DeprecationWarning, stacklevel=2)
+        from ..lens.prescription import Prescription
+
+        require_type("lens", lens, (Prescription, CameraState), "physcam.lens.library.load_lens(name or file)")
+        given = lens.lens if isinstance(lens, CameraState) else lens
+        if isinstance(lens, CameraState) and (lens.focus_from_film_mm, lens.fstop) != (report.focus_from_film_mm,
+                                                                                         report.fstop):
             raise InputError(f"the camera state (focus {lens.focus_from_film_mm:g} mm, f/{lens.fstop:g}) is not the "
                              f"report's (focus {report.focus_from_film_mm:g} mm, f/{report.fstop:g})")
-        return lambda: lens
-    return functools.cache(lambda: camera_state(lens, focus_mm=report.focus_from_film_mm, fstop=report.fstop))
-
-
-def thin_lens_gap(report, lens) -> ThinLensGap:
-    """The thin-lens camera of ``report`` against the real ``lens`` it was solved from (module notes).
-
-    ``report`` must come from :func:`physcam.onset.report.solve_lens_report` with ``lens``, a
-    Prescription or the :class:`~physcam.optics.state.CameraState` at the report's focus and f-stop.
-    A bokeh that cannot be traced (the light inside the lens's closest focus, everything vignetted)
-    is left out with a note."""
-    from ..lens.prescription import Prescription
-    from ..onset.report import LensReport
-    from ..optics.state import CameraState
-
-    require_type("report", report, LensReport, "solve one with physcam.onset.report.solve_lens_report")
-    if not isinstance(lens, CameraState):
-        require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name or file) or a CameraState")
-    state = _camera(report, lens)
-    lens = lens.lens if isinstance(lens, CameraState) else lens
+        if given is not report.camera.lens and given != report.camera.lens:
+            raise InputError("the lens is not the one the report was solved for")
+    state = _camera(report)
+    name = report.camera.lens.name
     hfov = None if report.real_fov is None else report.real_fov.get("horizontal_deg")
     hfov_pct = None if not hfov else (report.hfov_focus_deg - hfov) / hfov * 100.0
     rows, notes = [], []
-    for light in _lights_mm(report, lens):
+    for light in _lights_mm(report):
         try:
             thin, real = _thin_lens_blur_mm(report, light), _real_blur_mm(state, light)
         except PhysCamError as exc:
             notes.append(f"bokeh at {light:g} mm not measured: {str(exc).splitlines()[0]}")
             continue
         if not real > 0:
-            raise OpticsError(f"no light from {light:g} mm reaches the film through {lens.name!r}")
+            raise OpticsError(f"no light from {light:g} mm reaches the film through {name!r}")
         rows.append((light, thin, real, (thin - real) / real * 100.0))
-    return ThinLensGap(lens.name, report.fstop, report.focus_from_film_mm, hfov_pct, tuple(rows), tuple(notes))
+    return ThinLensGap(name, report.camera, hfov_pct, tuple(rows), tuple(notes))

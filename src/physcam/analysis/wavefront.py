@@ -34,8 +34,7 @@ import numpy as np
 
 from ..errors import InputError, require_finite
 from ..figures import styled
-from ..lens.prescription import Prescription
-from ..optics.state import takes_camera
+from ..optics.state import CameraState, OfACamera, takes_camera
 
 __all__ = ["WavefrontMap", "wavefront", "noll_indices", "zernike_noll", "ZERNIKE_ORDERING"]
 
@@ -85,15 +84,14 @@ def zernike_noll(j, rho, theta):
 
 
 @dataclass
-class WavefrontMap:
-    """The wavefront of one field at one wavelength (module notes). OPD in waves; ``x``, ``y``
-    normalised pupil coordinates of every sample (unit radius: the paraxial entrance pupil)."""
+class WavefrontMap(OfACamera):
+    """The wavefront of one field of ``camera`` at one wavelength (module notes). OPD in waves; ``x``,
+    ``y`` normalised pupil coordinates of every sample (unit radius: the paraxial entrance pupil)."""
 
     lens_name: str
     field_deg: float
     wavelength_nm: float
-    fstop: float
-    focus_from_film_mm: float  # inf at infinity
+    camera: CameraState  # the camera analysed: its focus (inf at infinity) and f-stop
     film_z_mm: float
     defocus_mm: float
     pupil_samples: int
@@ -185,33 +183,28 @@ def _terms(zernike_terms) -> int:
 
 @takes_camera
 def wavefront(
-    lens: Prescription,
+    camera: CameraState,
     field_deg=0.0,
     *,
     wavelength_nm=None,
-    fstop=None,
-    focus_mm=None,
     defocus_mm=0.0,
     pupil_samples=None,
     zernike_terms: int = 37,
-    aperture=None,
     backend: str = "auto",
 ) -> WavefrontMap:
-    """Wavefront of ``lens`` at field angle ``field_deg`` (degrees, Y meridian) and ``wavelength_nm``
-    (default the lens's design wavelength), stopped to ``fstop`` (default the stop in the file),
-    focused at ``focus_mm`` (a mark from the film, default infinity), with the film moved
-    ``defocus_mm`` away from the lens. ``pupil_samples``: cells across the pupil (16 to 1024,
-    default 64; each traced at its centre, the pupil's edge at 4 x 4 points per cell). ``aperture`` shapes the stop
-    (:class:`physcam.trace.aperture.Aperture`). See the module notes for the definitions.
+    """Wavefront of ``camera`` (:func:`physcam.optics.state.camera_state`: the lens focused and stopped,
+    its iris shape) at field angle ``field_deg`` (degrees, Y meridian) and ``wavelength_nm`` (default
+    the camera's primary), with the film moved ``defocus_mm`` away from the lens. ``pupil_samples``:
+    cells across the pupil (16 to 1024, default 64; each traced at its centre, the pupil's edge at 4 x 4
+    points per cell). See the module notes for the definitions.
     """
     from . import _sampling
 
     terms = _terms(zernike_terms)
     dz = require_finite("defocus_mm", defocus_mm)
     # the OPD is exact at every ray: no phase sampling rule (RMS and PV converge by 64 cells)
-    fp = _sampling.field_pupils(lens, field_deg, wavelengths_nm=None if wavelength_nm is None else [wavelength_nm],
-                                fstop=fstop, focus_mm=focus_mm, defocus_mm=[dz], pupil_samples=pupil_samples,
-                                aperture=aperture, backend=backend, check=False)
+    fp = _sampling.field_pupils(camera, field_deg, wavelengths_nm=None if wavelength_nm is None else [wavelength_nm],
+                                defocus_mm=[dz], pupil_samples=pupil_samples, backend=backend, check=False)
     pt = fp.traces[0]
     ws = fp.samples(0, dz)
     st = fp.setup
@@ -225,6 +218,5 @@ def wavefront(
     c, *_ = np.linalg.lstsq(A * sw, w * sw[:, 0], rcond=None)
     rms_c, _, _ = rms_pv(w - A @ c, wgt)
     lit = float((pt.weight * pt.rays.amplitude).sum() * pt.cell_mm ** 2 / (math.pi * st.r_ep ** 2))
-    return WavefrontMap(st.lens_name, fp.field.field_deg, pt.wavelength_nm, st.fstop, st.focus_from_film_mm,
-                        st.film_z + dz, dz, pt.n, x, y, w, wgt, rms, pv, rms_c, zernike_fit(x, y, w, wgt, terms),
+    return WavefrontMap(st.lens_name, fp.field.field_deg, pt.wavelength_nm, st.state, st.film_z + dz, dz, pt.n, x, y, w, wgt, rms, pv, rms_c, zernike_fit(x, y, w, wgt, terms),
                         ws.chief_film_xy[1], ws.radius_mm, lit, pt.cell_mm / st.r_ep)

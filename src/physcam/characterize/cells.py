@@ -42,7 +42,6 @@ What each kind computes (lengths mm from the film plane, docs/conventions.md):
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import hashlib
 import io
@@ -122,11 +121,12 @@ def _distortion_cell(lens, grid: Grid, cell: Cell, dest: Path):
     from ..analysis.distortion_models import fit_models, samples_from_field
     from ..analysis.stmap import distortion_field, write_stmaps
     from ..io import atomic_write, staged_folder
+    from ..optics.state import camera_state
 
     if dest.is_dir() and (dest / "fits.json").is_file():  # published by an earlier, killed attempt
         return (dest / "fits.json").read_bytes()
     w, h = grid.sensor_mm
-    res = distortion_field(lens, focus_mm=cell.focus_mm, sensor_width_mm=w, sensor_height_mm=h,
+    res = distortion_field(camera_state(lens, focus_mm=cell.focus_mm, sensor_mm=(w, h)),
                            width_px=grid.frame_px[0], height_px=grid.frame_px[1],
                            wavelength_nm=cell.wavelength_nm, backend=grid.backend)
     fits = fit_models(samples_from_field(res))
@@ -147,11 +147,9 @@ def _illumination_cell(lens, grid: Grid, cell: Cell):
     from ..analysis.illumination import relative_illumination
     from ..optics.state import camera_state
 
-    st = camera_state(lens, focus_mm=cell.focus_mm, fstop=cell.fstop)
+    st = camera_state(lens, focus_mm=cell.focus_mm, fstop=cell.fstop, sensor_mm=tuple(grid.sensor_mm))
     sd = st.stop_semi_diameter
-    res = relative_illumination(st.focused, n_fields=max(grid.fields, 2), sensor_width_mm=grid.sensor_mm[0],
-                                sensor_height_mm=grid.sensor_mm[1], grid=grid.illumination_grid,
-                                stop_semi_diameter=sd, film_z=st.film_z, backend=grid.backend)
+    res = relative_illumination(st, n_fields=max(grid.fields, 2), grid=grid.illumination_grid, backend=grid.backend)
     doc = res.to_dict() | {"kind": "illumination", "focus_from_film_mm": _none_inf(cell.focus_mm),
                            "fstop": cell.fstop, "stop_semi_diameter_mm": sd}
     return _json_bytes(doc), {}
@@ -185,10 +183,10 @@ def _psf_cell(lens, grid: Grid, cell: Cell):
     from ..optics.state import camera_state
 
     st, depth, x, y, fx, fy = psf_light_position(lens, grid, cell)
-    sd = camera_state(lens, fstop=cell.fstop).stop_semi_diameter
-    q = dataclasses.replace(st.prescription, wavelength_nm=float(cell.wavelength_nm))
-    img = bokeh_image(q, depth, x, y, film_z=st.film_z, rays=grid.psf_rays, pixels=grid.psf_pixels,
-                      stop_semi_diameter=sd, chunk=max(1000, min(grid.psf_rays, 1_000_000)), backend=grid.backend)
+    # the lens at the cell's focus (its film there), its iris at the cell's f-stop, in the cell's light
+    cam = camera_state(lens, focus_mm=cell.focus_mm, fstop=cell.fstop, wavelengths_nm=[float(cell.wavelength_nm)])
+    img = bokeh_image(cam, depth, x, y, rays=grid.psf_rays, pixels=grid.psf_pixels,
+                      chunk=max(1000, min(grid.psf_rays, 1_000_000)), backend=grid.backend)
     e = img.image[..., 0]
     total = float(e.sum())
     if not (total > 0 and math.isfinite(total)):

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -21,8 +22,20 @@ from ..analysis.stmap import DistortionField
 MAP_STEP_PX = 4
 
 
+@dataclass
 class MeasuredField(DistortionField):
-    """A :class:`DistortionField` measured from a chart (its maps say so in their EXR headers)."""
+    """A :class:`DistortionField` measured from a chart (its maps say so in their EXR headers): no camera
+    model made it (``camera`` None), the focus mark is the one the photographs were taken at."""
+
+    mark_mm: float = math.inf
+
+    @property
+    def focus_from_film_mm(self) -> float:
+        return self.mark_mm
+
+    @property
+    def fstop(self) -> None:
+        return None  # the chart's corners: no stop's centroids
 
     def to_dict(self) -> dict:
         d = super().to_dict()
@@ -63,10 +76,11 @@ def measured_field(m, lens_name: str) -> MeasuredField:
 
     disp = np.hypot(*displacement_px(m.camera_matrix, m.distortion, m.size_px).T)
     focus = math.inf if m.mark_mm is None else float(m.mark_mm)
-    return MeasuredField(lens_name, focus, math.nan, tuple(m.sensor_mm), (w, h), tuple(m.focal_length_mm),
-                         (math.nan, math.nan), (ox, oy), (0, 0), 0.0, math.nan, float(disp.max()), None,
+    return MeasuredField(lens_name, None, math.nan, tuple(m.sensor_mm), (w, h), tuple(m.focal_length_mm),
+                         (math.nan, math.nan), (ox, oy), (0, 0), 0.0, math.nan, float(disp.max()),
                          (m.rms_px, max(m.view_rms_px)), dmap, umap,
-                         ["measured from chart photographs; residual = the corners' reprojection residual"])
+                         ["measured from chart photographs; residual = the corners' reprojection residual"],
+                         mark_mm=focus)
 
 
 def opentrackio_lens(m) -> dict:

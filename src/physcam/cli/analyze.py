@@ -202,12 +202,14 @@ def run_colour(args) -> int:
     from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM
     from ._output import Table, print_table
 
-    # the lens itself, not a camera state: colour's film is the paraxial focus of its reference line (d),
-    # a state's is its design wavelength's (the two differ for a lens not designed at d; found in review)
+    # the lens as designed: colour's film is the paraxial focus of its reference line (d), camera_state's
+    # is its design wavelength's (the two differ for a lens not designed at d; found in review)
+    from ..optics.state import as_designed
+
     lens = _prepare(args)
     wls = (LINE_F_NM, LINE_D_NM, LINE_C_NM) + tuple(args.wavelength or ())
-    res = chromatic_aberration(lens, args.field, wavelengths_nm=wls, max_field_deg=args.max_field,
-                               sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height)
+    res = chromatic_aberration(as_designed(lens, sensor_mm=(args.sensor_width, args.sensor_height)), args.field,
+                               wavelengths_nm=wls, max_field_deg=args.max_field)
     if not (args.json or _csv(args, res, "colour")):
         print(f"{res.lens_name}: chromatic aberration (EFL {res.efl_mm:.3f} mm at {res.reference_nm:g} nm), "
               f"{args.sensor_name}")

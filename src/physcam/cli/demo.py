@@ -111,6 +111,7 @@ def _lens_step(out, ctx, force):
     from ..io import atomic_write
     from ..lens.library import load_lens
     from ..optics import focusing
+    from ..optics.state import camera_state
 
     lens = load_lens(DEFAULTS["lens"])
     ctx["lens"] = lens
@@ -124,7 +125,7 @@ def _lens_step(out, ctx, force):
     rows = focusing.breathing_table(lens, [600.0, 1000.0, 2000.0, 5000.0, math.inf], sensor_width_mm=sensor.width_mm)
     return [
         atomic_write(out / "lens.json", text + "\n", force=force),
-        save_lens_diagram(lens, out / "lens_diagram.png", force=force, fstop=DEFAULTS["fstop"],
+        save_lens_diagram(camera_state(lens, fstop=DEFAULTS["fstop"]), out / "lens_diagram.png", force=force,
                           units=ctx.get("units", "m")),
         save_breathing_plot(rows, out / "breathing.png", force=force, title=f"focus breathing: {lens.name}",
                             sensor_width_mm=sensor.width_mm, units=ctx.get("units", "m")),
@@ -156,11 +157,11 @@ def _metadata_step(out, ctx, force):
 def _trace_step(out, ctx, force):
     from ..analysis.bokeh import bokeh_image
     from ..analysis.spot import spot_diagram
-    from ..optics.state import camera_state
+    from ..optics.state import as_designed, camera_state
     from ..trace.aperture import Aperture
 
     lens = ctx["lens"]
-    spot = spot_diagram(lens, (0.0, 5.0, 10.0))  # the lens as designed: infinity, wide open
+    spot = spot_diagram(as_designed(lens), (0.0, 5.0, 10.0))  # the lens as designed: infinity, wide open
     # a point light 1.2 m from the film, off axis, with the lens focused at 3 m and stopped to
     # f/2.8 by a 7-blade iris: the defocus blur shows the iris and cat's-eye vignetting
     s = ctx["report"].sensor
@@ -192,13 +193,14 @@ def _distortion_step(out, ctx, force):
     from ..analysis.stmap import distortion_field, write_stmaps
     from ..export.nuke import nuke_stmap_script
     from ..export.tde4 import tde4_lens_text
+    from ..optics.state import camera_state
     from ..io import atomic_write
 
     s = ctx["report"].sensor
     w = 1920
     h = max(16, round(w * s.height_mm / s.width_mm))
-    res = distortion_field(ctx["lens"], focus_mm=DEFAULTS["focus"], sensor_width_mm=s.width_mm,
-                           sensor_height_mm=s.height_mm, width_px=w, height_px=h)
+    camera = camera_state(ctx["lens"], focus_mm=DEFAULTS["focus"], sensor_mm=(s.width_mm, s.height_mm))  # chief rays
+    res = distortion_field(camera, width_px=w, height_px=h)
     d = out / "distortion"
     paths = write_stmaps(res, d, force=force)
     smp = samples_from_field(res)
@@ -222,16 +224,17 @@ def _blender_step(out, ctx, force):
     from ..export.blender import write_blender_camera
     from ..export.blender_camera import blender_camera_script, blender_camera_values
     from ..io import atomic_write
+    from ..optics.state import camera_state
     from ..trace.aperture import Aperture
 
     report = ctx["report"]
     s = report.sensor
     width = 1920
     height = max(1, round(width * s.height_mm / s.width_mm))
-    osl, setup = write_blender_camera(out / "blender", ctx["lens"], focus_mm=DEFAULTS["focus"],
-                                      fstop=DEFAULTS["fstop"], sensor_width_mm=s.width_mm, sensor_height_mm=s.height_mm,
-                                      aperture=Aperture(nsides=7, roundness=0.2), resolution=(width, height),
-                                      name=DEFAULTS["lens"], force=force)
+    camera = camera_state(ctx["lens"], focus_mm=DEFAULTS["focus"], fstop=DEFAULTS["fstop"],
+                          sensor_mm=(s.width_mm, s.height_mm), aperture=Aperture(nsides=7, roundness=0.2))
+    osl, setup = write_blender_camera(camera, out / "blender", resolution=(width, height), name=DEFAULTS["lens"],
+                                      force=force)
     values = blender_camera_values(report, resolution_x=width, blades=7)
     builtin = atomic_write(out / "blender" / f"builtin_{DEFAULTS['lens']}.py", blender_camera_script(values),
                            force=force)

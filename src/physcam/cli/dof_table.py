@@ -71,11 +71,11 @@ def register(sub) -> None:
 
 def cell_report(args, lens, sensor, fstop, focus):
     """The lens report of one cell: what `physcam report` gives for these options."""
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
     from ._common import coc_of
 
-    return solve_report(ReportRequest(focal_length_mm=None if lens is not None else args.focal, lens=lens, sensor=sensor,
-                             fstop=fstop, focus_mm=focus, coc=coc_of(args)))
+    return solve_report(report_camera(focal_length_mm=None if lens is not None else args.focal, lens=lens, sensor=sensor,
+                         fstop=fstop, focus_mm=focus, coc=coc_of(args)))
 
 
 def build(args) -> dict:

@@ -268,7 +268,7 @@ def _write_builtin(args, lens, width_px: int, path):
     from ..errors import InputError
     from ..export.blender_camera import blender_camera_script, blender_camera_values
     from ..io import atomic_write
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
     from ..optics.sensors import custom_sensor
 
     if math.isinf(args.focus):
@@ -276,12 +276,12 @@ def _write_builtin(args, lens, width_px: int, path):
                          "give e.g. --focus 1000m")
     from ..analysis.thin_lens_gap import thin_lens_gap
 
-    report = solve_report(ReportRequest(focal_length_mm=None, sensor=custom_sensor(args.sensor_width, args.sensor_height),
-                               fstop=args.fstop, focus_mm=args.focus, lens=lens))
+    report = solve_report(report_camera(focal_length_mm=None, sensor=custom_sensor(args.sensor_width, args.sensor_height),
+                           fstop=args.fstop, focus_mm=args.focus, lens=lens))
     blades = int(args.blades or 0)
     values = blender_camera_values(report, resolution_x=width_px, blades=blades if blades >= 3 else 0,
                                    blade_rotation_deg=args.blade_angle)
-    gap = thin_lens_gap(report, lens)
+    gap = thin_lens_gap(report)
     values["thin_lens_gap"] = gap.to_dict()
     path = atomic_write(path, blender_camera_script(values, comments=[gap.summary()]), force=args.force)
     return path, gap
@@ -494,7 +494,7 @@ def _slug(text: str) -> str:
 def run_pbrt(args) -> int:
     from ..errors import InputError
     from ..export.pbrt import check_pbrt_lens, write_pbrt_camera
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
     from ._common import coc_of, output_folder, relocated
     from .report import resolve_sensor
 
@@ -517,8 +517,8 @@ def run_pbrt(args) -> int:
     with _warnings_after_success():
         if lens is None and args.fstop is None:
             raise InputError("give the f-stop of the thin lens (--fstop)")
-        report = solve_report(ReportRequest(focal_length_mm=args.focal, sensor=resolve_sensor(args), fstop=args.fstop,
-                                   focus_mm=args.focus, coc=coc_of(args), lens=lens))
+        report = solve_report(report_camera(focal_length_mm=args.focal, sensor=resolve_sensor(args), fstop=args.fstop,
+                               focus_mm=args.focus, coc=coc_of(args), lens=lens))
         name = _slug(args.lens) if args.lens else f"thin_{report.focal_length_mm:g}mm".replace(".", "_")
         with output_folder(args.output, force=args.force, command="export pbrt") as tmp:  # written whole
             out = write_pbrt_camera(report, tmp, lens, name=name, xres=args.resolution, cameras=cameras)

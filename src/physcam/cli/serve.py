@@ -192,7 +192,11 @@ def cli_backend():
 
         args = parsers["diagram"].parse_args([*_options(q), "--output=diagram.svg", f"--lens={_bundled(name)}"])
         resolve_bare_distances(args)
-        fig = lens_diagram(load_lens(args.lens), **diagram_options(args)).figure(units=args.units or "m")
+        from ..optics.state import camera_state
+
+        opts = diagram_options(args)
+        camera = camera_state(load_lens(args.lens), focus_mm=opts.pop("focus_mm"), fstop=opts.pop("fstop"))
+        fig = lens_diagram(camera, **opts).figure(units=args.units or "m")
         return _svg(fig, dpi=150)
 
     from ._config import load_config

@@ -75,10 +75,12 @@ def run_spot(args) -> int:
     if args.output:
         check_writable(args.output, force=args.force)
     lens = load_lens(args.lens, lenient=args.lenient)
-    # the lens and its own film plane at --wavelength (the paraxial focus of that wavelength): a
-    # CameraState would keep the film where the lens focuses at its design wavelength
-    res = spot_diagram(lens, tuple(args.field or (0.0, 5.0)), wavelength_nm=args.wavelength, rings=args.rings,
-                       fstop=args.fstop, clip=args.clip)
+    # the lens as designed, its film at --wavelength's paraxial focus (camera_state would keep the film where
+    # the lens focuses at its design wavelength)
+    from ..optics.state import as_designed
+
+    res = spot_diagram(as_designed(lens, fstop=args.fstop), tuple(args.field or (0.0, 5.0)),
+                       wavelength_nm=args.wavelength, rings=args.rings, clip=args.clip)
     if args.output:
         from ._output import save_plot
 

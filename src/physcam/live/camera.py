@@ -101,10 +101,10 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
 
 def _optics_at(sensor, mark, lens, focal_length_mm, fstop, tstop, distortion):
     """(lens report, OpenTrackIO distortion or None) of the lens (or thin lens) focused at ``mark``."""
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
 
-    rep = solve_report(ReportRequest(focal_length_mm=focal_length_mm, sensor=sensor, fstop=fstop, focus_mm=mark,
-                                     tstop=tstop, lens=lens))
+    rep = solve_report(report_camera(focal_length_mm=focal_length_mm, sensor=sensor, fstop=fstop, focus_mm=mark,
+                        tstop=tstop, lens=lens))
     dist = None
     if lens is not None and distortion:
         from .lens_data import distortion_for_sample

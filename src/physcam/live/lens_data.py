@@ -69,8 +69,9 @@ def distortion_for_sample(lens: Prescription, sensor_width_mm, sensor_height_mm,
         raise InputError("image_size is (width, height) in pixels; height may be None")
     W = image_size[0]
     H = image_size[1] if image_size[1] is not None else max(16, min(MAX_SIDE_PX, round(W * h / w)))
-    field = distortion_field(lens, focus_mm=focus, sensor_width_mm=w, sensor_height_mm=h, width_px=W, height_px=H,
-                             maps=False)
+    from ..optics.state import camera_state
+
+    field = distortion_field(camera_state(lens, focus_mm=focus, sensor_mm=(w, h)), width_px=W, height_px=H, maps=False)
     fit = fit_brown_conrady(samples_from_field(field), "U-D", max_residual_px=math.inf)
     c = fit.coefficients
     f = float(c["fy_mm"])  # the Y pinhole: an anamorphic's F / squeeze is its X focal length

@@ -346,7 +346,7 @@ def _from_encoders(f, fiz, sent) -> dict:
 def _solve_one(f, last, sensor, sensors, coc, custom_sensor, lens=None):
     """The lens report of frame ``f`` with the values ``last`` (its own, carried over or defaults);
     with ``lens`` and no streamed pinhole, the prescription's at the frame's focus."""
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
 
     need_pinhole = lens is None or last["pinhole"] is not None
     missing = [n for n, k in (("a pinhole focal length (pinholeFocalLength, --focal, --lens)", "pinhole"),
@@ -367,15 +367,15 @@ def _solve_one(f, last, sensor, sensors, coc, custom_sensor, lens=None):
     if tstop is not None and tstop < last["fstop"]:
         tstop = None  # a T-stop faster than the f-stop is not physical; the report would refuse it
     if last["pinhole"] is None:  # the named lens at this focus: its breathing, pupil and squeeze
-        return solve_report(ReportRequest(focal_length_mm=None, sensor=sensors[key], fstop=float(last["fstop"]),
-                                 focus_mm=float(last["focus"]), coc=coc, tstop=tstop, lens=lens))
+        return solve_report(report_camera(focal_length_mm=None, sensor=sensors[key], fstop=float(last["fstop"]),
+                             focus_mm=float(last["focus"]), coc=coc, tstop=tstop, lens=lens))
     pin = float(last["pinhole"])
     sq = 1.0 if last["squeeze"] is None else float(last["squeeze"])
     f_dof = float(last["nominal"]) if last["nominal"] is not None else pin
-    return solve_report(ReportRequest(focal_length_mm=f_dof, sensor=sensors[key], fstop=float(last["fstop"]),
-                             focus_mm=float(last["focus"]), coc=coc, tstop=tstop,
-                             pupil_mm=None if last["pupil"] is None else float(last["pupil"]),
-                             pinhole_focal_length_mm=pin, squeeze=sq, pinhole_squeeze=sq))
+    return solve_report(report_camera(focal_length_mm=f_dof, sensor=sensors[key], fstop=float(last["fstop"]),
+                         focus_mm=float(last["focus"]), coc=coc, tstop=tstop,
+                         pupil_mm=None if last["pupil"] is None else float(last["pupil"]),
+                         pinhole_focal_length_mm=pin, squeeze=sq, pinhole_squeeze=sq))
 
 
 def _usd_from_stage(v, mpu):

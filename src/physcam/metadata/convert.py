@@ -119,7 +119,7 @@ def _warn_once(caught) -> None:
 
 
 def _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze):
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
 
     from ..live.record import SolvedFrame
 
@@ -138,7 +138,7 @@ def _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze)
         key = (f.focus_mm, n, tstop, focal, f.entrance_pupil_mm)
         if key not in cache:
             try:
-                cache[key] = solve_report(ReportRequest(
+                cache[key] = solve_report(report_camera(
                     focal_length_mm=focal, sensor=s, fstop=n, focus_mm=f.focus_mm, coc=coc, tstop=tstop,
                     squeeze=squeeze, lens=lens,
                     pupil_mm=None if lens is not None else f.entrance_pupil_mm))

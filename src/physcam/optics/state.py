@@ -32,7 +32,7 @@ from .lens_model import LensModel, PrescriptionLens, lens_model_of
 from .sensors import Sensor
 from .thinlens import MAX_F_NUMBER, MIN_F_NUMBER, require_f_number
 
-__all__ = ["CameraState", "camera_state", "as_camera_state", "takes_camera", "wavelengths_and_weights",
+__all__ = ["CameraState", "camera_state", "as_designed", "as_camera_state", "takes_camera", "OfACamera", "wavelengths_and_weights",
            "require_f_number", "MIN_F_NUMBER", "MAX_F_NUMBER", "HYPERFOCAL", "DOOR_KEYWORDS"]
 
 #: ``focus_mm=HYPERFOCAL``: focus at the hyperfocal mark of this lens, f-stop and circle of confusion.
@@ -152,11 +152,20 @@ class CameraState:
         return float(self.gaussian.efl / (2.0 * self.entrance_pupil_radius))
 
     # --- cameras near this one -------------------------------------------------------------------
-    def with_fstop(self, fstop, *, solved: tuple = ()) -> "CameraState":
-        """This camera with the iris set to ``fstop`` (the focus kept: no focus solved again)."""
+    def with_fstop(self, fstop, *, solved: tuple = (), lenient: bool = False) -> "CameraState":
+        """This camera with the iris set to ``fstop`` (the focus kept: no focus solved again). ``lenient``: an
+        f-stop faster than the lens opens (solved from measured limits: it is what they say) keeps the iris as
+        the file stops it instead of an OpticsError."""
         n = require_f_number("f-stop", fstop)
-        stop = self.lens_model.iris(n) if self.traceable else None
-        cam = replace(self, fstop=float(n), stop_semi_diameter=stop, iris_set=True, solved=self.solved + solved)
+        stop, iris_set = self.stop_semi_diameter, True
+        if self.traceable:
+            try:
+                stop = self.lens_model.iris(n)
+            except OpticsError:
+                if not lenient:
+                    raise
+                iris_set = False
+        cam = replace(self, fstop=float(n), stop_semi_diameter=stop, iris_set=iris_set, solved=self.solved + solved)
         cam.__dict__.pop("at_mark", None)
         cam.__dict__.pop("gaussian", None)
         return cam
@@ -165,6 +174,21 @@ class CameraState:
         """This camera with another iris shape (physcam.trace.aperture.Aperture; None: round)."""
         _require_iris_shape(aperture)
         return replace(self, aperture=aperture)
+
+
+class OfACamera:
+    """A result that holds the camera it was computed for (``camera``) rather than copies of its
+    settings: its focus, f-stop and lens name are the camera's."""
+
+    @property
+    def fstop(self) -> float:
+        """The iris's setting (at infinity focus) of the camera analysed."""
+        return self.camera.fstop
+
+    @property
+    def focus_from_film_mm(self) -> float:
+        """The camera's focus mark in front of the film (inf at infinity)."""
+        return self.camera.focus_from_film_mm
 
 
 def _require_iris_shape(aperture) -> None:
@@ -217,7 +241,7 @@ def wavelengths_and_weights(lens, wavelengths_nm, weights):
 
     if isinstance(lens, CameraState):
         if wavelengths_nm is None:
-            wavelengths_nm, weights = lens.wavelengths_nm, lens.weights
+            wavelengths_nm, weights = lens.wavelengths_nm, lens.weights if weights is None else weights
         lens = lens.lens
     if wavelengths_nm is None:
         wls = [float(lens.wavelength_nm)]
@@ -263,6 +287,25 @@ def camera_state(lens, *, focus_mm=None, fstop=None, sensor=None, sensor_mm=None
     * ``wavelengths_nm``/``weights`` (None: the design wavelength), ``aperture`` the iris shape;
     * ``film_z``: the film plane placed by hand in lens space (a defocused camera), mm.
     """
+    return _camera(lens, False, focus_mm=focus_mm, fstop=fstop, sensor=sensor, sensor_mm=sensor_mm, zoom=zoom, coc=coc,
+                   squeeze=squeeze, wavelengths_nm=wavelengths_nm, weights=weights, aperture=aperture, film_z=film_z,
+                   stop_semi_diameter=stop_semi_diameter)
+
+
+def as_designed(lens, *, fstop=None, sensor=None, sensor_mm=None, wavelengths_nm=None, weights=None, aperture=None,
+                stop_semi_diameter=None) -> CameraState:
+    """The camera of ``lens`` as its file focuses it: the object at infinity, and the film where each ray
+    analysis's own rule puts it (the paraxial image at the analysis's wavelength, not at the design
+    wavelength as :func:`camera_state` places it); the other arguments as :func:`camera_state`. What a
+    bare lens given to an analysis is."""
+    return _camera(lens, True, fstop=fstop, sensor=sensor, sensor_mm=sensor_mm, wavelengths_nm=wavelengths_nm,
+                   weights=weights, aperture=aperture, stop_semi_diameter=stop_semi_diameter)
+
+
+def _camera(lens, film_from_analysis: bool, *, focus_mm=None, fstop=None, sensor=None, sensor_mm=None, zoom=None,
+            coc=None, squeeze=None, wavelengths_nm=None, weights=None, aperture=None, film_z=None,
+            stop_semi_diameter=None) -> CameraState:
+    """:func:`camera_state`; ``film_from_analysis``: the door's camera of a bare lens (no focus, no film)."""
     model = lens_model_of(lens).at_zoom(zoom)
     _require_iris_shape(aperture)
     sensor = _sensor_of(sensor, sensor_mm)
@@ -270,15 +313,14 @@ def camera_state(lens, *, focus_mm=None, fstop=None, sensor=None, sensor_mm=None
     mark, notes, solved = _mark(focus_mm), [], ()
     if isinstance(model, PrescriptionLens):
         return _prescription_camera(model, mark, fstop, stop_semi_diameter, film_z, sensor, zoom, coc, sq,
-                                    wavelengths_nm, weights, aperture, focus_mm is None and film_z is None)
+                                    wavelengths_nm, weights, aperture, film_from_analysis)
     if fstop is None:
         raise InputError(f"a {model.kind} camera needs the f-stop (fstop=...)")
     if stop_semi_diameter is not None or film_z is not None:
         raise InputError(f"a {model.kind} camera has no prescription: its iris and film are not placed by hand")
     n = require_f_number("f-stop", fstop)
     if mark == HYPERFOCAL:
-        mark = model.hyperfocal_mark(n, _coc_mm(sensor, coc))
-        solved, notes = (("focus", HYPERFOCAL),), ["focus at the hyperfocal distance (the focus mark above)"]
+        mark, solved = model.hyperfocal_mark(n, _coc_mm(sensor, coc)), (("focus", HYPERFOCAL),)
     return CameraState(model, mark, float(n), sensor, zoom, sq, iris_set=True, notes=tuple(notes), solved=solved)
 
 
@@ -319,29 +361,45 @@ def _prescription_camera(model: PrescriptionLens, mark, fstop, stop, film_z, sen
         n = float(paraxial.gaussian(inf.prescription, object_z=inf.object_z, film_z=inf.film_z,
                                     stop_semi_diameter=stop).f_number)
     elif fstop is None:  # the lens as its file stops it
-        n, stop = float(paraxial.gaussian(lens).f_number), float(lens.surfaces[lens.stop_index].semi_diameter)
+        stop = float(lens.surfaces[lens.stop_index].semi_diameter)
+        try:
+            n = float(paraxial.gaussian(lens).f_number)
+        except OpticsError:  # an afocal lens (a plate under test) has no f-number: it is still traced
+            n = math.inf
     else:
         n = float(require_f_number("f-stop", fstop))
         stop = float(model.iris(n))
     solved, notes = (), ()
     if mark == HYPERFOCAL:
-        mark = model.hyperfocal_mark(n, _coc_mm(sensor, coc))
-        solved, notes = (("focus", HYPERFOCAL),), ("focus at the hyperfocal distance (the focus mark above)",)
+        mark, solved = model.hyperfocal_mark(n, _coc_mm(sensor, coc)), (("focus", HYPERFOCAL),)
     if math.isinf(mark):  # the file's infinity focus, film at the paraxial image of an axial object at infinity
-        focused, object_z, fz = lens, -math.inf, float(paraxial.gaussian(lens).z_rear_focal_point)
+        focused, object_z = lens, -math.inf
+        fz = require_finite("film plane z", film_z) if film_z is not None else _rear_focal_z(lens, film_from_analysis)
     else:
         st = model.focus_state(mark)
         focused, object_z, fz = st.prescription, float(st.object_z), float(st.film_z)
-    if film_z is not None:
-        fz = require_finite("film plane z", film_z)
+        if film_z is not None:
+            fz = require_finite("film plane z", film_z)
     wls, ws = (tuple(v) for v in wavelengths_and_weights(lens, wavelengths_nm, weights))
     cam = CameraState(model, float(mark), n, sensor=sensor, zoom=zoom, squeeze=sq, stop_semi_diameter=float(stop),
                       object_z=object_z, film_z=fz, wavelengths_nm=wls, weights=ws, aperture=aperture,
                       iris_set=iris_set, film_from_analysis=film_from_analysis, notes=notes, solved=solved,
                       _focused=focused)
-    if not object_z < cam.entrance_pupil_z:
+    if math.isfinite(object_z) and not object_z < cam.entrance_pupil_z:
         raise OpticsError(f"the object lies behind the entrance pupil of {lens.name!r}: no real pupil to sample")
     return cam
+
+
+def _rear_focal_z(lens, film_from_analysis: bool):
+    """The paraxial image of infinity (lens space); for an afocal lens left to the analysis (None)."""
+    from . import paraxial
+
+    try:
+        return float(paraxial.gaussian(lens).z_rear_focal_point)
+    except OpticsError:
+        if film_from_analysis:
+            return None
+        raise
 
 
 def as_camera_state(lens, *, focus_mm=None, fstop=None, **state) -> CameraState:
@@ -360,16 +418,7 @@ def _camera_at_the_door(value, given: dict, where: str) -> CameraState:
 
     given = {k: v for k, v in given.items() if v is not None}
     if isinstance(value, CameraState):
-        extra = [k for k in given if k != "aperture"]
-        if extra:
-            raise InputError(f"a CameraState carries its own focus, stop and sensor: give {', '.join(extra)} to "
-                             "camera_state() (or pass the lens itself), not here")
-        if "aperture" in given:
-            warnings.warn(f"{where}(camera, aperture=...): give the iris shape to the camera "
-                          f"(camera.with_aperture(...) or camera_state(..., aperture=...)); the keyword goes in physcam "
-                          f"{UNTIL}", DeprecationWarning, stacklevel=3)
-            return value.with_aperture(given["aperture"])
-        return value
+        return _camera_and_keywords(value, given, where)
     model = lens_model_of(value)
     if given:
         words = ", ".join(f"{k}=" for k in given)
@@ -384,10 +433,39 @@ def _camera_at_the_door(value, given: dict, where: str) -> CameraState:
         if "sensor_mm" in given or "sensor" in given:
             raise InputError("give the sensor once: sensor, sensor_mm or sensor_width_mm/sensor_height_mm")
         given["sensor_mm"] = (w, h)
-    cam = camera_state(model, **given)
-    if "focus_mm" not in given and "film_z" not in given and cam.traceable:
-        cam = replace(cam, film_from_analysis=True)
-    return cam
+    return _camera(model, "focus_mm" not in given and "film_z" not in given, **given)
+
+
+_SENSOR_WORDS = ("sensor", "sensor_mm", "sensor_width_mm", "sensor_height_mm")
+
+
+def _camera_and_keywords(camera: CameraState, given: dict, where: str) -> CameraState:
+    """A camera given with its pre-issue-43 keywords: its own focus and stop are an InputError; a sensor for a
+    camera without one, or an iris shape, still go in (DeprecationWarning)."""
+    import warnings
+
+    owned = [k for k in given if k in ("focus_mm", "film_z", "fstop", "stop_semi_diameter", "zoom")
+             or (k in _SENSOR_WORDS and camera.sensor is not None)]
+    if owned:
+        what = [w for w, keys in (("focus", ("focus_mm", "film_z", "zoom")), ("stop", ("fstop", "stop_semi_diameter")),
+                                  ("sensor", _SENSOR_WORDS)) if any(k in keys for k in owned)]
+        raise InputError(f"a CameraState carries its own {' and '.join(what)}: give {', '.join(owned)} to "
+                         "camera_state() (or pass the lens itself), not here")
+    if not given:
+        return camera
+    warnings.warn(f"{where}(camera, {', '.join(f'{k}=' for k in given)}...): give them to the camera "
+                  f"(camera_state(..., sensor=..., aperture=...)); the keywords go in physcam {UNTIL}",
+                  DeprecationWarning, stacklevel=4)
+    if "aperture" in given:
+        camera = camera.with_aperture(given.pop("aperture"))
+    if given:
+        w, h = given.pop("sensor_width_mm", None), given.pop("sensor_height_mm", None)
+        if w is not None or h is not None:
+            from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
+
+            given["sensor_mm"] = (DEFAULT_SENSOR_WIDTH_MM if w is None else w, DEFAULT_SENSOR_HEIGHT_MM if h is None else h)
+        camera = replace(camera, sensor=_sensor_of(given.get("sensor"), given.get("sensor_mm")))
+    return camera
 
 
 def takes_camera(fn):
@@ -414,6 +492,8 @@ def takes_camera(fn):
             value, args = args[0], args[1:]
         elif first in kwargs:
             value = kwargs.pop(first)
+        elif first == "camera" and "lens" in kwargs:  # the first parameter's pre-issue-43 name
+            value = kwargs.pop("lens")
         else:
             raise WrongTypeError(f"{fn.__name__}() needs a camera first (physcam.optics.state.camera_state(lens, ...))")
         if not isinstance(value, CameraState):

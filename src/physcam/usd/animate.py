@@ -122,7 +122,7 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     from pxr import Sdf, UsdGeom
 
     from ..export.usdgeom import require_meters_per_unit
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
     from .author import author_camera, new_stage, sample_render_camera, save_stage, spec_from_report
 
     keys = _check_keys(keys)
@@ -138,9 +138,9 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     for k in keys:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PhysCamWarning)
-            report = solve_report(ReportRequest(focal_length_mm=focal_length_mm, sensor=sensor,
-                                       fstop=k.fstop if k.fstop is not None else fstop, focus_mm=k.focus_mm,
-                                       coc=coc, lens=lens))
+            report = solve_report(report_camera(focal_length_mm=focal_length_mm, sensor=sensor,
+                                   fstop=k.fstop if k.fstop is not None else fstop, focus_mm=k.focus_mm,
+                                   coc=coc, lens=lens))
         for w in caught:  # say each approximation once, not once per frame
             if str(w.message) not in seen_notes:
                 seen_notes.add(str(w.message))

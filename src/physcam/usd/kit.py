@@ -259,13 +259,13 @@ def _author_shot_companion(stage, path) -> str:
     cam = stage.GetPrimAtPath(path)
     report, distortion, opencv = None, None, None
     if rx is not None and spec.projection == "perspective":
-        from ..onset.report import ReportRequest, solve_report
+        from ..onset.report import report_camera, solve_report
         from ..optics.sensors import Sensor
 
         sensor = Sensor(key="custom", name=spec.sensor_name or f"{spec.sensor_width_mm:g} x {spec.sensor_height_mm:g} mm",
                         width_mm=spec.sensor_width_mm, height_mm=spec.sensor_height_mm)
-        report = solve_report(ReportRequest(focal_length_mm=None, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
-                                   coc=spec.coc_mm, lens=rx))
+        report = solve_report(report_camera(focal_length_mm=None, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
+                               coc=spec.coc_mm, lens=rx))
         derived = spec_from_report(report)
         _author_lens_derived(stage, cam, derived)
         spec = replace(spec, focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
@@ -475,14 +475,14 @@ def best_match_pinhole(prescription, *, focus_mm: float, fstop: float | None, se
     magnification frames like the lens at this focus, breathing included. The companion
     UsdGeomCamera is that pinhole. f-stop None: the lens wide open, as the lens report decides.
     """
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
     from ..optics.sensors import Sensor
     from .author import spec_from_report
 
     sensor = Sensor(key="custom", name=f"{sensor_width_mm:g} x {sensor_height_mm:g} mm",
                     width_mm=sensor_width_mm, height_mm=sensor_height_mm)
-    report = solve_report(ReportRequest(focal_length_mm=None, sensor=sensor, fstop=fstop, focus_mm=focus_mm, coc=coc_mm,
-                               lens=prescription))
+    report = solve_report(report_camera(focal_length_mm=None, sensor=sensor, fstop=fstop, focus_mm=focus_mm, coc=coc_mm,
+                           lens=prescription))
     return spec_from_report(report), report
 
 
@@ -504,8 +504,11 @@ def prescription_distortion(prescription, sensor_width_mm: float = DEFAULT_SENSO
     w_px = 2048
     h_px = max(16, min(8192, round(w_px * sensor_height_mm / sensor_width_mm)))
     try:
-        field = distortion_field(prescription, focus_mm=focus_mm, sensor_width_mm=sensor_width_mm,
-                                 sensor_height_mm=sensor_height_mm, width_px=w_px, height_px=h_px, maps=False)
+        from ..optics.state import camera_state
+
+        field = distortion_field(camera_state(prescription, focus_mm=focus_mm, sensor_mm=(sensor_width_mm,
+                                                                                          sensor_height_mm)),
+                                 width_px=w_px, height_px=h_px, maps=False)
     except OpticsError as e:
         from ..analysis.distortion import real_distortion
 
