@@ -89,7 +89,7 @@ def test_bad_input_is_a_clear_error(tmp_path):
         osl_camera_shader(lens, focus_mm=50.0, **kw)
     with pytest.raises(OpticsError, match="faster than this lens opens"):
         osl_camera_shader(lens, focus_mm=3000.0, fstop=1.0, **kw)
-    for bad in (0.0, -5.0, float("nan"), "3m", True):
+    for bad in (0.0, -5.0, float("nan"), "three metres", True):  # ("3m" reads as 3000 mm, as camera_state reads it)
         with pytest.raises(InputError):
             osl_camera_shader(lens, focus_mm=bad, **kw)
     with pytest.raises(InputError, match="sensor width"):

@@ -19,7 +19,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import ExportError, InputError, renamed_parameter
+from ..errors import ExportError, InputError
 from ..lens.geometry import sag
 from ..lens.prescription import Prescription, takes_prescription
 from ..optics import focusing, paraxial
@@ -203,7 +203,6 @@ def _default_field(p: Prescription, g: paraxial.GaussianData, axis: str, wavelen
     return math.atan(min(u, 1.5))
 
 
-@renamed_parameter("focus_from_film_mm", "focus_mm")
 @takes_camera
 def lens_diagram(camera: CameraState, *, axis: str = "y", field_deg: float | None = None, wavelength_nm=None,
                  rays: int = 3) -> LensDiagram:

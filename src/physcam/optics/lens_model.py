@@ -235,6 +235,14 @@ class PrescriptionLens:
     def __repr__(self) -> str:
         return f"PrescriptionLens({self.prescription.name!r})"
 
+    def __eq__(self, other) -> bool:  # one lens, one model (its kept focus solutions aside)
+        if not isinstance(other, PrescriptionLens):
+            return NotImplemented
+        return self is other or (self.lens_name == other.lens_name and self.prescription == other.prescription)
+
+    def __hash__(self) -> int:
+        return hash((self.lens_name, self.prescription.name, len(self.prescription.surfaces)))
+
     @property
     def name(self) -> str:
         return self.lens_name or self.prescription.name

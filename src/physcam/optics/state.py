@@ -39,18 +39,19 @@ __all__ = ["CameraState", "camera_state", "as_designed", "as_camera_state", "tak
 HYPERFOCAL = "hyperfocal"
 #: The keywords a function that takes a camera took before issue 43 to build one itself: now the door's
 #: (:func:`takes_camera`), with a DeprecationWarning, until physcam :data:`UNTIL`.
-DOOR_KEYWORDS = ("focus_mm", "fstop", "sensor", "sensor_mm", "sensor_width_mm", "sensor_height_mm", "aperture",
-                 "film_z", "stop_semi_diameter", "zoom")
+DOOR_KEYWORDS = ("focus_mm", "focus_from_film_mm", "fstop", "sensor", "sensor_mm", "sensor_width_mm",
+                 "sensor_height_mm", "aperture", "film_z", "stop_semi_diameter", "zoom")
 UNTIL = "0.3"
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True)
 class CameraState:
     """A lens at one focus, zoom and stop, on a sensor (module notes). Build it with :func:`camera_state`.
 
     ``lens`` is the prescription as designed (its file's infinity focus) for a prescription camera,
     else the lens model; ``focused`` the prescription with the focused gaps and back focus (a thin
-    lens or a datasheet has none: asking for it is an OpticsError naming the model)."""
+    lens or a datasheet has none: asking for it is an OpticsError naming the model). Two cameras are
+    equal when every setting is (the same lens, focus, stop, sensor, light and iris shape)."""
 
     lens_model: LensModel
     focus_from_film_mm: float  # the mark from the film plane; inf at infinity
@@ -211,9 +212,11 @@ def _sensor_of(sensor, sensor_mm) -> Sensor | None:
         return require_type("sensor", sensor, Sensor, "physcam.optics.sensors.find_sensor(name) or custom_sensor(w, h)")
     if sensor_mm is None:
         return None
-    w, h = (require_finite("sensor size", v) for v in sensor_mm)
-    if not (0.0 < w <= 1000.0 and 0.0 < h <= 1000.0):
-        raise InputError(f"the sensor must measure between 0 and 1000 mm a side, got {w:g} x {h:g}")
+    w, h = (require_finite(name, v) for name, v in zip(("sensor width", "sensor height"), sensor_mm))
+    for name, v in (("sensor width", w), ("sensor height", h)):
+        if not 0.0 < v <= 1000.0:
+            raise InputError(f"{name} must lie between 0 and 1000 mm (the sensor must measure between 0 and 1000 mm "
+                             f"a side), got {w:g} x {h:g}")
     return Sensor("custom", f"custom {w:g} x {h:g} mm", float(w), float(h))
 
 
@@ -419,6 +422,10 @@ def _camera_at_the_door(value, given: dict, where: str) -> CameraState:
     given = {k: v for k, v in given.items() if v is not None}
     if isinstance(value, CameraState):
         return _camera_and_keywords(value, given, where)
+    if "focus_from_film_mm" in given:  # the focus mark's name before focus_mm
+        if "focus_mm" in given:
+            raise InputError("give focus_mm, not both focus_mm and focus_from_film_mm (its old name)")
+        given["focus_mm"] = given.pop("focus_from_film_mm")
     model = lens_model_of(value)
     if given:
         words = ", ".join(f"{k}=" for k in given)
@@ -444,10 +451,10 @@ def _camera_and_keywords(camera: CameraState, given: dict, where: str) -> Camera
     camera without one, or an iris shape, still go in (DeprecationWarning)."""
     import warnings
 
-    owned = [k for k in given if k in ("focus_mm", "film_z", "fstop", "stop_semi_diameter", "zoom")
+    owned = [k for k in given if k in ("focus_mm", "focus_from_film_mm", "film_z", "fstop", "stop_semi_diameter", "zoom")
              or (k in _SENSOR_WORDS and camera.sensor is not None)]
     if owned:
-        what = [w for w, keys in (("focus", ("focus_mm", "film_z", "zoom")), ("stop", ("fstop", "stop_semi_diameter")),
+        what = [w for w, keys in (("focus", ("focus_mm", "focus_from_film_mm", "film_z", "zoom")), ("stop", ("fstop", "stop_semi_diameter")),
                                   ("sensor", _SENSOR_WORDS)) if any(k in keys for k in owned)]
         raise InputError(f"a CameraState carries its own {' and '.join(what)}: give {', '.join(owned)} to "
                          "camera_state() (or pass the lens itself), not here")
