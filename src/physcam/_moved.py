@@ -17,6 +17,8 @@ from importlib.machinery import ModuleSpec  # (importlib.abc and .util would cos
 #: old module path -> new module path (removed in physcam :data:`UNTIL`)
 MOVED = {
     "physcam.onset.sensors": "physcam.optics.sensors",
+    "physcam.analysis.lens_compare": "physcam.onset.lens_compare",
+    "physcam.analysis.thin_lens_gap": "physcam.onset.thin_lens_gap",
 }
 UNTIL = "0.3"
 

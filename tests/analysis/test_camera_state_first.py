@@ -125,7 +125,7 @@ def test_light_field_camera_is_the_same_through_either_door():
 
 
 def test_lens_measurements_are_the_same_through_either_door():
-    from physcam.analysis.lens_compare import lens_measurements
+    from physcam.onset.lens_compare import lens_measurements
     from physcam.optics.sensors import find_sensor
 
     ff = find_sensor("FF")
@@ -142,7 +142,7 @@ def test_lens_measurements_are_the_same_through_either_door():
 
 
 def test_thin_lens_gap_takes_the_reports_camera_state():
-    from physcam.analysis.thin_lens_gap import thin_lens_gap
+    from physcam.onset.thin_lens_gap import thin_lens_gap
     from physcam.onset.report import solve_lens_report
     from physcam.optics.sensors import find_sensor
 

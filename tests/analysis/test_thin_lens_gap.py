@@ -14,7 +14,7 @@ import warnings
 
 import pytest
 
-from physcam.analysis.thin_lens_gap import thin_lens_gap
+from physcam.onset.thin_lens_gap import thin_lens_gap
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
 from physcam.optics.sensors import find_sensor

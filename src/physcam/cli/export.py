@@ -274,7 +274,7 @@ def _write_builtin(args, lens, width_px: int, path):
     if math.isinf(args.focus):
         raise InputError("--builtin needs a finite focus mark (the built-in camera's focus distance); "
                          "give e.g. --focus 1000m")
-    from ..analysis.thin_lens_gap import thin_lens_gap
+    from ..onset.thin_lens_gap import thin_lens_gap
 
     report = solve_report(report_camera(focal_length_mm=None, sensor=custom_sensor(args.sensor_width, args.sensor_height),
                            fstop=args.fstop, focus_mm=args.focus, lens=lens))

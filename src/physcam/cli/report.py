@@ -203,10 +203,10 @@ def _request_inputs(args, lens, sensor, coc) -> dict:
 
 def thin_lens_gap_from_args(args, report):
     """How far a renderer's thin-lens camera of ``report`` is from the prescription the command loaded
-    (:func:`physcam.analysis.thin_lens_gap.thin_lens_gap`), or None for a thin lens or a datasheet."""
+    (:func:`physcam.onset.thin_lens_gap.thin_lens_gap`), or None for a thin lens or a datasheet."""
     if getattr(args, "loaded_lens", None) is None:
         return None
-    from ..analysis.thin_lens_gap import thin_lens_gap
+    from ..onset.thin_lens_gap import thin_lens_gap
 
     return thin_lens_gap(report)
 

@@ -82,8 +82,8 @@ def _thin_lens_blur_mm(report, light_from_film_mm: float) -> float:
 def _real_blur_mm(state, light_from_film_mm: float) -> float:
     """sqrt(8 E[r^2]) of the real lens's traced image of an on-axis point light; ``state()`` gives the
     camera state (made when first asked, so a stop the lens cannot open to is a note of each light)."""
-    from .blob import equivalent_diameter
-    from .bokeh import bokeh_image
+    from ..analysis.blob import equivalent_diameter
+    from ..analysis.bokeh import bokeh_image
 
     st = state()  # the lens focused at the report's mark, its film there, the iris set
     img = bokeh_image(st.with_aperture(None), light_from_film_mm, rays=BOKEH_RAYS, pixels=128, fresnel=False)
@@ -115,7 +115,7 @@ def thin_lens_gap(report, lens=None) -> ThinLensGap:
     is left out with a note. ``lens`` (the prescription, or the camera again) is the pre-issue-43 form:
     the report holds its camera; given, it must be that camera's lens (DeprecationWarning)."""
     from ..errors import InputError
-    from ..onset.report import LensReport
+    from .report import LensReport
 
     require_type("report", report, LensReport, "solve one with physcam.onset.report.solve_report(camera)")
     if not report.camera.traceable:

@@ -600,7 +600,7 @@ def write_camera(file, spec: CameraSpec, *, force: bool = False, path: str = DEF
                  thin_lens_gap: dict | None = None):
     """Write a one-camera layer to ``file`` (see :func:`author_camera`), with a ``UsdRenderSettings``
     for its companion camera (:func:`author_render_settings`) unless ``render_settings`` is false;
-    return the Path. ``thin_lens_gap`` (:meth:`physcam.analysis.thin_lens_gap.ThinLensGap.to_dict`) is kept
+    return the Path. ``thin_lens_gap`` (:meth:`physcam.onset.thin_lens_gap.ThinLensGap.to_dict`) is kept
     in the companion camera's customData ``physcam:thinLensGap``: how far it is from the real lens."""
     stage = new_stage(meters_per_unit, fps, up_axis)
     author_camera(stage, path, spec, position=position, rotate_xyz_deg=rotate_xyz_deg, report=report,
