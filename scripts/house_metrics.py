@@ -18,13 +18,18 @@ Metrics (static ones read the source with ``ast``; nothing of physcam is importe
   own code object) while ``solve_report`` reports one prescription, with fresh caches, for a few
   bundled lenses: one at a given mark and one at the hyperfocal mark (imports physcam).
 * ``rooms``: the walk of ``physcam export blender``'s arguments. Start in the handler
-  (``cli/export.py: run_blender``) with ``args`` marked; in each function, a name assigned from a
-  marked expression is marked (to a fixed point); every call with a marked argument whose callee
-  resolves to a physcam function (imported at any depth, ``module.function`` or a name of the same
-  module; a class: its ``__post_init__``) is entered with the matching parameters marked. A *room*
-  is a module the walk enters; a *climb* is a call edge between two rooms (each one a trip down a
-  staircase the reader climbs back up). ``--builtin`` off: the branches under ``if args.builtin``
-  are not followed.
+  (``cli/export.py: run_blender``) with the camera settings marked (:data:`CAMERA_SETTINGS`:
+  ``args.focus``, ``args.fstop``, the sensor, the iris, the render's size and options; not the lens
+  file's name nor the output folder); in each function, a name assigned from a marked expression is
+  marked (to a fixed point); every call with a marked argument whose callee resolves to a physcam
+  function (imported at any depth, ``module.function`` or a name of the same module; a class: its
+  ``__post_init__``; ``getattr(a, "b")`` reads as ``a.b``) is entered with the matching parameters
+  marked. A *room* is a module the walk enters; a *climb* is a call edge between two rooms (each one
+  a trip down a staircase the reader climbs back up). Two walks: "handed on" follows the marked
+  values and the objects made from them as they are handed on (data read off a marked object,
+  ``state.focused``, is asking the object, not a room); "computed from" follows everything computed
+  from them, data read off objects too (the issue's own walk). ``--builtin`` off: the branches under
+  ``if args.builtin`` are not followed. Method calls are asks of an object, not followed.
 * ``loops``: package-level import loops: the graph of physcam's sub-packages with an edge for every
   import between two of them, at any depth of the code (deferred imports included); its strongly
   connected components of more than one package.
@@ -262,11 +267,18 @@ class RoomWalk:
 
     @staticmethod
     def _dotted(node) -> str | None:
-        """``a.b.c`` of a Name or an Attribute chain over a Name, else None."""
+        """``a.b.c`` of a Name or an Attribute chain over a Name (``getattr(a, "b")`` reads as ``a.b``), else None."""
         parts = []
-        while isinstance(node, ast.Attribute):
-            parts.append(node.attr)
-            node = node.value
+        while True:
+            if isinstance(node, ast.Attribute):
+                parts.append(node.attr)
+                node = node.value
+            elif (isinstance(node, ast.Call) and getattr(node.func, "id", None) == "getattr" and len(node.args) >= 2
+                  and isinstance(node.args[1], ast.Constant) and isinstance(node.args[1].value, str)):
+                parts.append(node.args[1].value)
+                node = node.args[0]
+            else:
+                break
         if isinstance(node, ast.Name):
             return ".".join([node.id, *reversed(parts)])
         return None
@@ -319,12 +331,12 @@ class RoomWalk:
         stack = [expr]
         while stack:
             n = stack.pop()
-            if isinstance(n, (ast.Name, ast.Attribute)):
+            if isinstance(n, (ast.Name, ast.Attribute, ast.Call)):
                 d = cls._dotted(n)
                 if d is not None:
                     if d in marked:
                         return True
-                    if isinstance(n, ast.Attribute):
+                    if not isinstance(n, ast.Name):
                         continue  # an attribute chain over a name: marked or not as a whole
             stack.extend(ast.iter_child_nodes(n))
         return False
@@ -337,16 +349,31 @@ CAMERA_SETTINGS = ("args.focus", "args.fstop", "args.sensor", "args.sensor_width
                    "args.dispersion", "args.fresnel")
 
 
+class RoomWalkAll(RoomWalk):
+    """The walk that follows everything computed from the arguments, data read off a marked object too
+    (``state.focused`` handed to the tracer is a room): the issue's own walk (37 rooms on the tree it was
+    measured on)."""
+
+    @classmethod
+    def _uses(cls, expr, marked) -> bool:
+        for n in ast.walk(expr):
+            d = cls._dotted(n) if isinstance(n, (ast.Name, ast.Attribute, ast.Call)) else None
+            if d is not None and any(d == m or d.startswith(m + ".") for m in marked):
+                return True
+        return False
+
+
 def rooms() -> dict:
     out = {}
-    for builtin in (False, True):
-        w = RoomWalk(builtin)
-        start = w.module("physcam.cli.export")
-        w.walk(start, start.defs["run_blender"], set(CAMERA_SETTINGS))
-        out["with_builtin" if builtin else "without_builtin"] = {
-            "rooms": len(w.rooms), "climbs": len(w.climbs),
-            "enters_onset": any(r.startswith("physcam.onset") for r in w.rooms),
-            "room_list": w.rooms}
+    for kind, walker in (("handed_on", RoomWalk), ("computed_from", RoomWalkAll)):
+        for builtin in (False, True):
+            w = walker(builtin)
+            start = w.module("physcam.cli.export")
+            w.walk(start, start.defs["run_blender"], set(CAMERA_SETTINGS))
+            out[f"{kind}_{'with' if builtin else 'without'}_builtin"] = {
+                "rooms": len(w.rooms), "climbs": len(w.climbs),
+                "enters_onset": any(r.startswith("physcam.onset") for r in w.rooms),
+                "room_list": w.rooms}
     return out
 
 
@@ -435,7 +462,7 @@ def main(argv) -> int:
                       f"focus, {x['cpu_ms']} ms CPU")
         elif name == "rooms":
             for k, v in r.items():
-                print(f"export blender {k.replace('_', ' ')}: {v['rooms']} rooms, {v['climbs']} climbs, "
+                print(f"export blender, walk {k.replace('_', ' ')}: {v['rooms']} rooms, {v['climbs']} climbs, "
                       f"enters onset/: {v['enters_onset']}")
         elif name == "loops":
             print(f"package import loops (deferred imports included): {r['count']} "

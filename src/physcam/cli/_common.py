@@ -295,6 +295,21 @@ def resolve_focus(value, *, lens=None, focal_length_mm=None, fstop=None, sensor=
     return mark
 
 
+def camera_from_args(args, lens, *, aperture=None):
+    """The one camera of a command (issue 43): ``lens`` at ``--focus`` (``hyperfocal`` resolved for
+    ``--fstop`` and the sensor), its iris at ``--fstop`` (None: as its file stops it) with the iris shape
+    ``aperture``, on the command's sensor (:func:`resolve_sensor`: ``--sensor`` or the pair, else the
+    default). ``args.sensor_width``/``sensor_height``/``sensor_name`` and ``args.focus`` are set to what
+    the camera holds."""
+    from ..optics.state import camera_state
+
+    sensor = resolve_sensor(args)
+    args.sensor_width, args.sensor_height, args.sensor_name = sensor.width_mm, sensor.height_mm, sensor.name
+    fstop = getattr(args, "fstop", None)
+    args.focus = resolve_focus(getattr(args, "focus", None), lens=lens, fstop=fstop, sensor=sensor, args=args)
+    return camera_state(lens, focus_mm=args.focus, fstop=fstop, sensor=sensor, aperture=aperture)
+
+
 def coc_value(text):
     """A --coc value (:func:`physcam.optics.coc.parse_coc`): a convention name stays text, a length
     becomes a float in mm; a malformed length is argparse's error."""
