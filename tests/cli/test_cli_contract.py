@@ -66,9 +66,13 @@ JSON_RUNS = {
     ("report",): ["report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--cameras"],
     ("dof-table",): ["dof-table", "--focal", "35", "--fstops", "2,4", "--focus", "1m,hyperfocal,inf"],
     ("sensors",): ["sensors", "ARRI"],
+    ("exposure",): ["exposure", "--fps", "24", "--to-fps", "48"],
+    ("diopter",): ["diopter", "--focal", "50", "--fstop", "2.8", "--focus", "inf", "--sensor", "S35"],
+    ("hyperfocal",): ["hyperfocal", "--focal", "25,50", "--fstops", "2.8,8", "--sensor", "S35"],
     ("lenses",): ["lenses"],
     ("lens", "show"): ["lens", "show", "dgauss_50mm", "--focus", "2m"],
     ("lens", "breathing"): ["lens", "breathing", "dgauss_50mm", "--focus", "1m", "2m", "inf"],
+    ("lens", "zoom"): ["lens", "zoom", "--lens", "laikin_zoom_15_150mm", "--steps", "3"],
     ("lens", "check"): ["lens", "check", "dgauss_50mm"],
     ("lens", "card"): ["lens", "card", "--lens", "dgauss_50mm", "--draft", "--dpi", "30", "-o", "card.png"],
     ("lens", "fix"): ["lens", "fix", "dgauss_50mm.toml", "-o", "fixed.toml"],
@@ -114,6 +118,8 @@ JSON_RUNS = {
 }
 #: Further runs of documents a command prints in other modes.
 EXTRA_JSON_RUNS = {
+    "lens show --zoom": ["lens", "show", "nikon_af_s_70_200mm_f2_8e_zoom", "--zoom", "135mm"],
+    "lens breathing --zoom": ["lens", "breathing", "laikin_zoom_15_150mm", "--zoom", "0.5", "--focus", "2m"],
     "psf_fft": ["psf", "dgauss_50mm", "--fstop", "8"],
     "mtf_chart_best_focus": ["mtf", "dgauss_50mm", "--fstop", "4", "--fields", "3", "--pupil-samples", "32",
                              "--frequency", "20", "--best-focus", "20"],
@@ -142,6 +148,7 @@ JSON_NOT_RUN = {
 #: Where the rows of each --csv command's document are.
 CSV_ROWS = {
     ("dof-table",): "rows", ("sensors",): "sensors", ("lenses",): "lenses", ("lens", "breathing"): "rows",
+    ("lens", "zoom"): "rows",
     ("spot",): "fields", ("illumination",): "points", ("colour",): "lateral",
     ("breathing-real",): "rows", ("ghosts",): "paths", ("distortion",): "points", ("compare", "lenses"): "lenses",
     ("export", "unreal"): "lens_file.physcam.marks", ("mtf",): "points", ("lens", "show"): "points",

@@ -32,6 +32,8 @@ def one_line_error(rc, err):
 # ---- sensors -----------------------------------------------------------------------------------
 def test_sensors_filter_by_maker_format_and_width(capsys):
     table = list(csv.DictReader(DATA.read_text().splitlines()))
+    table += [{**r, "name": f"{r['maker']} {r['camera']} {r['format']}", "kind": "digital"}  # the camera table
+              for r in csv.DictReader(DATA.with_name("cameras.csv").read_text().splitlines())]
     arri = {r["key"] for r in table if r["name"].startswith("ARRI ")}
     rc, out, _ = run(capsys, "sensors", "ARRI", "--json")
     assert rc == 0 and {s["key"] for s in json.loads(out)["sensors"]} == arri
@@ -44,7 +46,7 @@ def test_sensors_filter_by_maker_format_and_width(capsys):
                                                               and "16:9" in r["name"]}
     rc, out, _ = run(capsys, "sensors", "Mini LF", "--json")  # an alias: that one sensor
     assert [s["key"] for s in json.loads(out)["sensors"]] == ["alexa-lf-og"]
-    rc, _, err = run(capsys, "sensors", "--maker", "Canon")
+    rc, _, err = run(capsys, "sensors", "--maker", "Nikon")
     assert "no sensor matches" in one_line_error(rc, err)
 
 

@@ -24,7 +24,7 @@ def test_practical_marked_distance_is_s_plus_s_prime():
     h = 50**2 / (4 * 0.03)
     near_h1 = h * s / (h + s - 50)
     assert r.dof.near_from_film_mm == pytest.approx(near_h1 + r.image_distance_mm, rel=1e-12)
-    assert r.coc_convention == "user"
+    assert r.coc_convention == "full-frame"  # 0.03 mm is the full-frame convention's value: named so
 
 
 def test_technical_model_conversion_and_focus_error():

@@ -95,22 +95,28 @@ class LensDiagram:
                 "rays": [{"kind": kind, "points_mm": [list(q) for q in pts]} for kind, pts in self.rays]}
 
     @styled
-    def figure(self, *, width_in: float = 10.0, units: str = "m"):
+    def figure(self, *, width_in: float = 10.0, units: str = "m", text_pt: float | None = None):
         """A matplotlib Figure (Agg canvas). The view spans the lens and film; an object closer than
         infinity is marked by where its rays enter the view (its distance is in the title, in
-        ``units``: m or ft)."""
+        ``units``: m or ft). ``text_pt``: every text that size (a phone's narrow figure: physcam serve),
+        else the style's."""
+        import matplotlib
+
         from ..figures import new_figure
 
-        fig = new_figure(figsize=(width_in, width_in * 0.45))
-        ax = fig.add_subplot(1, 1, 1)
-        self.draw(ax, units=units, width_in=width_in)
-        fig.tight_layout()
+        rc = {} if text_pt is None else {k: text_pt for k in ("font.size", "axes.titlesize", "axes.labelsize",
+                                                              "xtick.labelsize", "ytick.labelsize")}
+        with matplotlib.rc_context(rc):
+            fig = new_figure(figsize=(width_in, width_in * (0.45 if text_pt is None else 1.0)))
+            ax = fig.add_subplot(1, 1, 1)
+            self.draw(ax, units=units, width_in=width_in, label_pt=text_pt or 8.0)
+            fig.tight_layout()
         return fig
 
     @styled
-    def draw(self, ax, *, units: str = "m", width_in: float = 10.0, title: bool = True) -> None:
+    def draw(self, ax, *, units: str = "m", width_in: float = 10.0, title: bool = True, label_pt: float = 8.0) -> None:
         """Draw the diagram on matplotlib axes ``ax`` (what :meth:`figure` shows; the lens card's
-        section); ``width_in`` is the width the title is wrapped to."""
+        section); ``width_in`` is the width the title is wrapped to, ``label_pt`` the size of the labels."""
         from ..figures import PALETTE, fit_title
         from ..units import format_distance
 
@@ -133,7 +139,7 @@ class LensDiagram:
         r = g.stop_semi_diameter
         for sgn in (1, -1):
             ax.plot([zv[k], zv[k]], [sgn * r, sgn * (r + 0.25 * hmax)], color="black", linewidth=2.5)
-        ax.text(zv[k], 1.3 * hmax, "stop", ha="center", fontsize=8)
+        ax.text(zv[k], 1.3 * hmax, "stop", ha="center", fontsize=label_pt)
         # rays
         colours = {"marginal": PALETTE[1], "chief": PALETTE[2], "rim": PALETTE[5]}
         for kind, pts in self.rays:
@@ -144,7 +150,7 @@ class LensDiagram:
         half_film = max([hmax] + landed)
         hmax = max(hmax, half_film / 1.25)  # the view's height below follows
         ax.plot([g.z_film, g.z_film], [-half_film, half_film], color="0.3", linewidth=1.5)
-        ax.text(g.z_film, -1.3 * hmax, "film", ha="center", fontsize=8)
+        ax.text(g.z_film, -1.3 * hmax, "film", ha="center", fontsize=label_pt)
         # cardinal points on the axis
         ax.axhline(0.0, color="0.5", linewidth=0.5, linestyle="-.")
         marks = [("F", g.z_front_focal_point), ("F'", g.z_rear_focal_point), ("H", g.z_front_principal_plane),
@@ -152,10 +158,10 @@ class LensDiagram:
         for label, zp in marks:
             ax.plot([zp], [0.0], marker="o", color=PALETTE[4], markersize=4)
             ax.annotate(label, (zp, 0.0), textcoords="offset points", xytext=(0, 6 if "H" in label else -12),
-                        ha="center", fontsize=8, color=PALETTE[4])
+                        ha="center", fontsize=label_pt, color=PALETTE[4])
         for label, zp, d in (("EP", g.z_entrance_pupil, g.entrance_pupil_diameter), ("XP", g.z_exit_pupil, g.exit_pupil_diameter)):
             ax.plot([zp, zp], [-d / 2, d / 2], color=PALETTE[3], linewidth=1.2, linestyle="--")
-            ax.annotate(label, (zp, d / 2), textcoords="offset points", xytext=(0, 3), ha="center", fontsize=8, color=PALETTE[3])
+            ax.annotate(label, (zp, d / 2), textcoords="offset points", xytext=(0, 3), ha="center", fontsize=label_pt, color=PALETTE[3])
         # the view: the lens and film (rays from a near object enter from the left); points outside are
         # listed below the plot
         z_view = -max(0.3 * p.total_track, 10.0)
@@ -168,15 +174,23 @@ class LensDiagram:
         if math.isfinite(g.z_object) and g.z_object < z_lo:
             outside.insert(0, f"object at z = {g.z_object:.0f} mm")
         if outside:
-            ax.text(0.01, 0.02, "outside the view: " + ", ".join(outside), transform=ax.transAxes, fontsize=7, color="0.3")
+            note = "outside the view: " + ", ".join(outside)
+            if label_pt == 8.0:
+                ax.text(0.01, 0.02, note, transform=ax.transAxes, fontsize=7, color="0.3")
+            else:  # a phone's figure: below the plot, wrapped to the figure's width
+                from ..figures import fit_title
+
+                ax.set_title(fit_title(note, 0.8 * width_in, fontsize=label_pt - 1), fontsize=label_pt - 1,
+                             color="0.3", loc="left", y=-0.62 if title else -0.45)
         ax.set_aspect("equal", adjustable="box")
-        ax.set_xlabel("z from the first vertex (mm, + toward the film)")
+        ax.set_xlabel("z from the first vertex (mm, + toward the film)" if label_pt == 8.0 else "z (mm, toward the film)")
         ax.set_ylabel(f"{axis} (mm)")
         fnum = g.f_number if self.fstop is None else self.fstop
         if title:
             ax.set_title(fit_title(
                 f"{p.name}: EFL {g.efl:.2f} mm, f/{fnum:.3g}, focus {format_distance(self.focus_from_film_mm, units)}, "
-                f"half-field {self.field_deg:.1f}° ({axis.upper()} meridian)", width_in))
+                f"half-field {self.field_deg:.1f}° ({axis.upper()} meridian)",
+                width_in if label_pt == 8.0 else 0.8 * width_in, fontsize=None if label_pt == 8.0 else label_pt))
 
 
 def _default_field(p: Prescription, g: paraxial.GaussianData, axis: str, wavelength_nm) -> float:

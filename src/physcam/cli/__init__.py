@@ -92,6 +92,7 @@ COMMAND_MODULES = {
     "usd": "usd", "demo": "demo", "config": "config", "calibrate": "calibrate", "characterize": "characterize",
     "defocus": "defocus", "defocus-kernels": "defocus", "export": "export", "live": "live",
     "metadata": "metadata", "microlens": "microlens", "mtf": "mtf", "psf": "psf", "serve": "serve",
+    "exposure": "exposure", "hyperfocal": "hyperfocal", "diopter": "diopter",
     "farm": "farm", "farm-task": "farm",
 }
 

@@ -408,7 +408,7 @@ def _summary(s, take, solved, counters, out, rep, elapsed, interrupted, as_json,
                "asked_file": s.file, "asked_report": s.report, "recovered_from": recovered_from,
                "journal": None if journal is None else str(journal)}
     if as_json:
-        emit_json(document("live_record", summary, units={"time": "s"}))
+        emit_json(document("live_record", summary, version=2, units={"time": "s"}))
         return
     name = f"{chosen['source_id'] or 'a source without sourceId'}" + (
         f" (source {chosen['source_number']})" if chosen["source_number"] is not None else "")

@@ -18,7 +18,10 @@ from .lens import WAVE_UNITS, mark_repaired
 
 #: Names of the files the fits write into --stmap DIR.
 FIT_FILES = {"brown": "brown_conrady.json", "3de4": "3de4_radial_standard_degree_4.txt",
-             "usd": "usd_lens_distortion.json", "nuke": "physcam_stmap.nk"}
+             "usd": "usd_lens_distortion.json", "nuke": "physcam_stmap.nk",
+             "3de4-anamorphic-4": "3de4_anamorphic_standard_degree_4.txt",
+             "3de4-anamorphic-6": "3de4_anamorphic_standard_degree_6.txt",
+             "unreal-anamorphic": "unreal_anamorphic_distortion.json"}
 
 
 _focus_list = focus_list("focus marks")
@@ -45,7 +48,7 @@ def register(sub) -> None:
                         "files of each --fit into DIR; needs --resolution")
     p.add_argument("--fit", choices=MODEL_CHOICES, action="append", default=None,
                    help="fit a model over the frame (repeat): brown = Brown-Conrady D-U and U-D (OpenTrackIO), "
-                        "3de4 = 3DE4 Radial - Standard, Degree 4, usd = Hydra lensDistortion, nuke = a Nuke "
+                        "3de4 = 3DE4 Radial - Standard, Degree 4, usd = Hydra lensDistortion, 3de4-anamorphic-4 and -6 = 3DE4 Anamorphic - Standard, Degree 4 and 6 (with --stmap: their 3DE4 lens files, and Unreal's anamorphic parameters for degree 4), nuke = a Nuke "
                         "script applying the ST-maps (with --stmap); needs --resolution")
     p.add_argument("--max-residual", type=number("allowed residual", positive=True),
                    default=DEFAULT_MAX_RESIDUAL_PX, metavar="PX",
@@ -208,23 +211,33 @@ def _fit_payloads(args, res, fits, folder):
 
     d = Path(folder)
     out = []
+    from ..analysis.anamorphic_distortion import TDE4Anamorphic
+    from ..export.tde4 import tde4_anamorphic_lens_text
+
     brown = [f for f in fits if isinstance(f, BrownConrady)]
     for f in fits:
         f.require_acceptable(FIT_FILES["brown" if f in brown else "3de4" if isinstance(f, TDE4RadialStandard)
-                                        else "usd"])
+                                        else _anamorphic_key(f) if isinstance(f, TDE4Anamorphic) else "usd"])
     if brown:
         out.append((d / FIT_FILES["brown"], (json.dumps(brown_conrady_document(res.lens_name, brown), indent=2)
                                              + "\n").encode()))
     for f in fits:
         if isinstance(f, TDE4RadialStandard):
             out.append((d / FIT_FILES["3de4"], tde4_lens_text(f, res.lens_name).encode()))
+        elif isinstance(f, TDE4Anamorphic):
+            out.append((d / FIT_FILES[_anamorphic_key(f)], tde4_anamorphic_lens_text(f, res.lens_name).encode()))
+            if f.coefficients["degree"] == 4:  # Unreal's anamorphic lens model is the degree-4 one
+                doc = document("distortion_unreal_anamorphic", {"lens": res.lens_name, **f.to_dict()},
+                               units=FIT_UNITS)
+                out.append((d / FIT_FILES["unreal-anamorphic"], (json.dumps(doc, indent=2) + "\n").encode()))
         elif isinstance(f, USDStandard):
             out.append((d / FIT_FILES["usd"], (json.dumps(usd_distortion_document(res.lens_name, f), indent=2)
                                                + "\n").encode()))
     for f in fits:
         slug = {"D-U": "_du", "U-D": "_ud"}.get(f.direction, "") if isinstance(f, BrownConrady) else ""
         stem = ("brown_conrady" + slug if isinstance(f, BrownConrady)
-                else "3de4" if isinstance(f, TDE4RadialStandard) else "usd")
+                else "3de4" if isinstance(f, TDE4RadialStandard)
+                else _anamorphic_key(f).replace("-", "_") if isinstance(f, TDE4Anamorphic) else "usd")
         out.append((d / f"residual_{stem}.png", _png(f, units_of(args))))
     if "nuke" in args.fit:
         w, h = res.size_px
@@ -233,6 +246,22 @@ def _fit_payloads(args, res, fits, folder):
                                  plate_size=(w, h), undistorted_size=(w + 2 * ox, h + 2 * oy), version=__version__)
         out.append((d / FIT_FILES["nuke"], text.encode()))
     return out
+
+
+def _anamorphic_key(fit) -> str:
+    return f"3de4-anamorphic-{int(fit.coefficients['degree'])}"
+
+
+def _fits(samples, names, max_residual_px):
+    """The fitted models named by --fit: physcam.analysis.distortion_models' and the 3DE4 anamorphic ones."""
+    from ..analysis.anamorphic_distortion import fit_tde4_anamorphic
+    from ..analysis.distortion_models import fit_models
+    from ..analysis.distortion_names import ANAMORPHIC_CHOICES
+
+    names = list(names or ())
+    fits = fit_models(samples, [n for n in names if n not in ANAMORPHIC_CHOICES], max_residual_px=max_residual_px)
+    return fits + [fit_tde4_anamorphic(samples, ANAMORPHIC_CHOICES[n], max_residual_px=max_residual_px)
+                   for n in dict.fromkeys(names) if n in ANAMORPHIC_CHOICES]
 
 
 def _png(fit, units: str = "m") -> bytes:
@@ -246,7 +275,7 @@ def _png(fit, units: str = "m") -> bytes:
 
 
 def _run_field(args, lens) -> int:
-    from ..analysis.distortion_models import fit_models, samples_from_field
+    from ..analysis.distortion_models import samples_from_field
     from ..analysis.stmap import distortion_field, write_stmaps
     from ..errors import InputError
     import contextlib
@@ -272,7 +301,7 @@ def _run_field(args, lens) -> int:
             output_folder(args.stmap, force=args.force, command="distortion --stmap"))
         res = distortion_field(cam, width_px=args.resolution[0], height_px=args.resolution[1],
                                wavelength_nm=args.wavelength, maps=args.stmap is not None)
-        fits = fit_models(samples_from_field(res), args.fit or (), max_residual_px=args.max_residual)
+        fits = _fits(samples_from_field(res), args.fit, args.max_residual)
         if tmp is not None:
             payload = _fit_payloads(args, res, fits, args.stmap) if args.fit else []  # named in the final folder
             maps = write_stmaps(res, tmp)

@@ -11,6 +11,7 @@ Examples::
   physcam lens fix --lens my_lens.toml -o my_lens_fixed.toml --apply
   physcam lens pack --lens my_lens.toml --focus 2m -o my_lens.lens.zip
   physcam lens add my_lens.lens.zip
+  physcam lens zoom --lens nikon_af_s_70_200mm_f2_8e_zoom -o zoom.png
 
 Distances in the output are millimetres. ``show`` gives every cardinal point from
 the front vertex and rear vertex (signed, + toward the film) and from the film
@@ -22,6 +23,7 @@ from __future__ import annotations
 from ..errors import PhysCamError
 from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number, whole
 from ._output import add_output_options
+from ._zoom import add_zoom_option, register_zoom, zoom_info, zoomed
 
 
 def register(sub) -> None:
@@ -49,6 +51,7 @@ def register(sub) -> None:
         q.add_argument("--focus-method", choices=("auto", "unit", "internal"), default="auto",
                        help="unit (whole lens moves) or internal (focus groups); auto: internal when the lens has groups")
         add_lenient(q)
+        add_zoom_option(q)
 
     s = lsub.add_parser("show", help="print the Gaussian (paraxial) data of a lens")
     common(s)
@@ -127,6 +130,7 @@ def register(sub) -> None:
     f.set_defaults(handler=run_fix)
 
     _register_archives(lsub)
+    register_zoom(lsub, add_lens_argument, add_sensor_options, add_output_options, number)
 
 
 def _register_archives(lsub) -> None:
@@ -271,7 +275,7 @@ def run_lenses(args) -> int:
 
 
 def _load(args):
-    return load_lens_arg(args.lens, getattr(args, "lenient", False))
+    return zoomed(load_lens_arg(args.lens, getattr(args, "lenient", False)), args)
 
 
 def _meridians(p):
@@ -309,7 +313,10 @@ def show_data(args):
 def show_document(args) -> dict:
     """The document ``physcam lens show --json`` prints (and ``physcam serve`` answers)."""
     p, _, data, focus_info = show_data(args)
-    return _show_document(p, data, focus_info)
+    doc = _show_document(p, data, focus_info)
+    if zoom_info(args, p) is not None:
+        doc["zoom"] = zoom_info(args, p)
+    return doc
 
 
 def _show_document(p, data, focus_info) -> dict:
@@ -355,7 +362,10 @@ def run_show(args) -> int:
 
     p, st, data, focus_info = show_data(args)
     if args.json:
-        emit_json(_show_document(p, data, focus_info))
+        doc = _show_document(p, data, focus_info)
+        if zoom_info(args, p) is not None:
+            doc["zoom"] = zoom_info(args, p)
+        emit_json(doc)
         return 0
     if args.csv:
         from ._output import print_csv
@@ -482,10 +492,13 @@ def run_breathing(args) -> int:
     if args.json:
         emit_json(document("lens_breathing", mark_repaired(
             {"lens": p.name, "sensor": sensor_name, "sensor_width_mm": width, "rows": [r.to_dict() for r in rows],
-             "plot": None if path is None else str(path)}, p)))
+             "plot": None if path is None else str(path), "zoom": zoom_info(args, p)}, p)))
         return 0
     if args.csv:
         print_csv([r.to_dict() for r in rows])
+        return 0
+    if p.is_anamorphic:
+        _print_breathing_per_axis(p, rows, sensor_name, units)
         return 0
     t = Table(f"{p.name}: focus breathing, {sensor_name} sensor (horizontal field, X meridian)",
               ("focus from film", "EFL (mm)", "HFOV (deg)", "framing focal length (mm)", "magnification",
@@ -498,6 +511,22 @@ def run_breathing(args) -> int:
     if path is not None:
         print(f"wrote {path}")
     return 0
+
+
+def _print_breathing_per_axis(p, rows, sensor_name, units) -> None:
+    """An anamorphic lens's breathing: horizontal (X) and vertical (Y) framing focal lengths and pupils."""
+    from ..units import format_distance
+    from ._output import Table, print_table
+
+    t = Table(f"{p.name}: focus breathing per axis, {sensor_name} sensor (X horizontal, Y vertical meridian)",
+              ("focus from film", "framing f H (mm)", "framing f V (mm)", "squeeze", "HFOV (deg)",
+               "pupil H (mm)", "pupil V (mm)", "FOV change (%)"), justify=["right"] * 8)
+    for r in rows:
+        t.add_row(format_distance(r.focus_from_film_mm, units), _fmt(r.breathing_focal_length_mm, 3),
+                  _fmt(r.vertical_breathing_focal_length_mm, 3), _fmt(r.breathing_squeeze, 4), _fmt(r.hfov_deg, 3),
+                  _fmt(r.entrance_pupil_from_film_mm, 2), _fmt(r.vertical_entrance_pupil_from_film_mm, 2),
+                  _fmt(r.fov_change_pct, 2))
+    print_table(t)
 
 
 # ---- lens check / lens fix ----------------------------------------------------------------

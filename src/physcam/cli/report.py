@@ -66,6 +66,9 @@ def add_report_arguments(p) -> None:
     g = p.add_argument_group("lens and sensor")
     g.add_argument("--lens", metavar="NAME_OR_FILE",
                    help="a real lens (bundled name or prescription file): fills the technical model from it")
+    from ._zoom import add_zoom_option
+
+    add_zoom_option(g)
     g.add_argument("--focal", metavar="MM", type=distance("focal length"), help="focal length (mm)")
     g.add_argument("--fstop", metavar="N", type=number("f-stop"), help="f-stop (geometric f-number); solved from --near/--far if omitted (with --lens: wide open)")
     g.add_argument("--tstop", metavar="T", type=number("T-stop"), help="marked T-stop, compared with the effective f-stop")
@@ -132,7 +135,9 @@ def solve_from_args(args):
     if getattr(args, "lens", None):
         from ..lens.library import load_lens
 
-        lens = load_lens(args.lens, lenient=getattr(args, "lenient", False))
+        from ._zoom import zoomed
+
+        lens = zoomed(load_lens(args.lens, lenient=getattr(args, "lenient", False)), args)
         args.loaded_lens = lens
         if args.focal is not None:
             raise InputError("give either --lens or --focal: the lens sets its own focal length")

@@ -11,6 +11,8 @@ examples:
   physcam sensors --maker Sony --min-width 30
   physcam sensors --format 16:9 --csv  # for a spreadsheet
   physcam sensors "Mini LF"            # one name or alias: that sensor
+  physcam sensors FX6                  # a camera: every recording format it has (use one with --sensor)
+  physcam sensors --maker Canon 4K     # a maker's 4K formats
 """
 
 
@@ -26,7 +28,7 @@ def register(sub) -> None:
     p.add_argument("name", nargs="*", metavar="WORDS",
                    help="a sensor name or alias (shows that sensor), or words every listed sensor's name, maker or "
                         "aliases contain, e.g. ARRI, \"open gate\"")
-    p.add_argument("--maker", metavar="MAKER", help="only this maker: ARRI, RED, Sony, or film (film gates)")
+    p.add_argument("--maker", metavar="MAKER", help="only this maker: ARRI, RED, Sony, Canon, Blackmagic, Panasonic, or film (film gates)")
     p.add_argument("--format", dest="fmt", metavar="TEXT",
                    help="only names containing this format text, e.g. \"open gate\", 16:9, 4-perf")
     p.add_argument("--min-width", type=distance("minimum width"), default=None, metavar="MM",
@@ -59,7 +61,8 @@ def select(args) -> list:
     if not rows:
         if query and all(f is None for f in filters):
             find_sensor(query)  # raises with the closest names
-        raise SensorError("no sensor matches; `physcam sensors` lists them all (makers: ARRI, RED, Sony, film)")
+        raise SensorError("no sensor matches; `physcam sensors` lists them all (makers: ARRI, RED, Sony, Canon, "
+                          "Blackmagic, Panasonic, film)")
     return rows
 
 
@@ -73,11 +76,11 @@ def run(args) -> int:
     if args.csv:
         print_csv([s.to_dict() for s in rows])
         return 0
-    t = Table("sensors and film gates (active area, mm)", ("name", "maker", "width", "height", "diagonal", "aspect",
-                                                            "aliases"),
-              justify=("left", "left", "right", "right", "right", "right", "left"))
+    t = Table("sensors, film gates and camera formats (active area, mm)",
+              ("name", "maker", "width", "height", "diagonal", "aspect", "anamorphic", "aliases"),
+              justify=("left", "left", "right", "right", "right", "right", "left", "left"))
     for s in rows:
         t.add_row(s.name, s.maker, f"{s.width_mm:.2f}", f"{s.height_mm:.2f}", f"{s.diagonal_mm:.2f}",
-                  f"{s.aspect:.3f}", ", ".join(s.aliases))
+                  f"{s.aspect:.3f}", ", ".join(f"{q:g}x" for q in s.anamorphic), ", ".join(s.aliases))
     print_table(t)
     return 0

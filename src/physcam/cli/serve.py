@@ -21,6 +21,8 @@ API (payloads are the CLI's --json; parameters are its flags without dashes; doc
   /api/sensors   /api/lenses   /api/lens/dgauss_50mm?focus=2m   /api/lens/dgauss_50mm/diagram.svg?fstop=4
 """
 
+#: The lens diagram the page shows: inches wide and the points of its text (at 390 px, text >= 12 px).
+DIAGRAM_WIDTH_IN, DIAGRAM_TEXT_PT = 4.4, 12.0
 #: Flags of the CLI's parsers that choose output, files or file reading: never query parameters.
 OUTPUT_FLAGS = frozenset({"json", "cameras", "plot", "force", "lenient", "output", "help"})
 
@@ -44,6 +46,9 @@ def register(sub) -> None:
                    help="requests per second per client address, in bursts of up to twice that (default 60); "
                         "more are answered 429")
     p.add_argument("--log-requests", action="store_true", help="print one line per request")
+    p.add_argument("--cert", metavar="PEM", help="serve HTTPS with this certificate (with --key): phones on the network "
+                                                 "then install the page's offline copy (a secure context; docs/serve.md)")
+    p.add_argument("--key", metavar="PEM", help="the certificate's private key (with --cert)")
     p.add_argument("--check", action="store_true",
                    help="bind the address, print what would be served, answer one report in-process and exit "
                         "without serving (for scripts and tests)")
@@ -196,13 +201,37 @@ def cli_backend():
 
         opts = diagram_options(args)
         camera = camera_state(load_lens(args.lens), focus_mm=opts.pop("focus_mm"), fstop=opts.pop("fstop"))
-        fig = lens_diagram(camera, **opts).figure(units=args.units or "m")
+        # drawn for a phone: 4.4 in wide with 12 pt text reads >= 12 px at 390 px (the page's img is ~366 px wide)
+        fig = lens_diagram(camera, **opts).figure(units=args.units or "m", width_in=DIAGRAM_WIDTH_IN,
+                                                  text_pt=DIAGRAM_TEXT_PT)
         return _svg(fig, dpi=150)
 
     from ._config import load_config
 
     return Backend(report=report, dof_svg=dof_svg, sensors=sensors, lenses=lenses_document, lens=lens,
                    diagram_svg=diagram_svg, parameters=params, units=load_config().units or "m")
+
+
+def _tls_files(args):
+    """(certificate, key) for --cert/--key, both readable PEM files and a pair that loads, or None."""
+    import ssl
+    from pathlib import Path
+
+    from ..errors import InputError
+
+    if (args.cert is None) != (args.key is None):
+        raise InputError("HTTPS needs both --cert and --key (PEM files, e.g. from mkcert or your own CA)")
+    if args.cert is None:
+        return None
+    for name, path in (("--cert", args.cert), ("--key", args.key)):
+        if not Path(path).is_file():
+            raise InputError(f"{name} {path}: no such file")
+    try:
+        ssl.create_default_context(ssl.Purpose.CLIENT_AUTH).load_cert_chain(args.cert, args.key)
+    except (ssl.SSLError, OSError) as exc:
+        raise InputError(f"--cert {args.cert} with --key {args.key} do not load as a PEM certificate and its key: "
+                         f"{getattr(exc, 'reason', None) or exc}") from None
+    return args.cert, args.key
 
 
 def run(args) -> int:
@@ -213,6 +242,7 @@ def run(args) -> int:
     from ..serve import Limits, asgi_get, bind_socket, create_app, qr_text, run_server, url_for
 
     limits = Limits(rate=args.rate_limit, burst=max(2, int(2 * args.rate_limit)))
+    tls = _tls_files(args)
     app = create_app(cli_backend(), limits)
     sock = bind_socket(args.host, args.port)
     try:
@@ -220,7 +250,7 @@ def run(args) -> int:
             # the lens library (read once, ~0.5 s) before the first phone asks: every page load lists it
             asgi_get(app, "/api/lenses")
         host, port = sock.getsockname()[:2]
-        urls = url_for(sock)
+        urls = url_for(sock, "https" if tls else "http")
         try:
             wildcard = ipaddress.ip_address(host).is_unspecified
         except ValueError:
@@ -251,7 +281,8 @@ def run(args) -> int:
         print("Ctrl-C stops the server", flush=True)
         warnings.simplefilter("ignore", PhysCamWarning)  # the reports carry these in their notes
         try:
-            run_server(app, sock, log_requests=args.log_requests, limits=limits)
+            run_server(app, sock, log_requests=args.log_requests, limits=limits, certfile=tls and tls[0],
+                       keyfile=tls and tls[1])
         except KeyboardInterrupt:  # uvicorn has shut down cleanly and passes Ctrl-C on
             print("physcam serve: stopped", flush=True)
     finally:

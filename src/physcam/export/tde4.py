@@ -28,7 +28,7 @@ from ..analysis.distortion_models import TDE4_MODEL, TDE4_PARAMETERS, TDE4Radial
 from ..errors import InputError
 from ._codetext import printable_line
 
-__all__ = ["tde4_lens_text"]
+__all__ = ["tde4_lens_text", "tde4_anamorphic_lens_text"]
 
 
 def _num(v: float) -> str:
@@ -56,7 +56,27 @@ def tde4_lens_text(fit: TDE4RadialStandard, name: str | None = None, *,
     centre, mm, x right, y up; written in 3DE4's cm, same signs (module notes)."""
     if not isinstance(fit, TDE4RadialStandard):
         raise InputError(f"tde4_lens_text takes a TDE4RadialStandard fit, got {type(fit).__name__}")
+    return _lens_text(fit, name, lens_center_offset_mm, TDE4_MODEL, TDE4_PARAMETERS)
+
+
+def tde4_anamorphic_lens_text(fit, name: str | None = None, *, lens_center_offset_mm=(0.0, 0.0)) -> str:
+    """The 3DE4 lens file of a fitted "3DE4 Anamorphic - Standard, Degree 4/6"
+    (:func:`physcam.analysis.anamorphic_distortion.fit_tde4_anamorphic`): the desqueezed filmback, the Y
+    pinhole as focal length and f_y / f_x as pixel aspect; Lens Rotation 0, Squeeze-X and -Y 1."""
+    from ..analysis.anamorphic_distortion import TDE4Anamorphic, tde4_anamorphic_parameter_names
+
+    if not isinstance(fit, TDE4Anamorphic):
+        raise InputError(f"tde4_anamorphic_lens_text takes a TDE4Anamorphic fit, got {type(fit).__name__}")
+    coeffs = dict(fit.coefficients, **{"Lens Rotation": 0.0, "Squeeze-X": 1.0, "Squeeze-Y": 1.0})
+    names = (*tde4_anamorphic_parameter_names(int(fit.coefficients["degree"])), "Lens Rotation", "Squeeze-X",
+             "Squeeze-Y")
+    return _lens_text(fit, name, lens_center_offset_mm, fit.model, names, coeffs)
+
+
+def _lens_text(fit, name, lens_center_offset_mm, model: str, parameters, coefficients=None) -> str:
+    """The lens file's lines (module notes) for any fitted 3DE4 model with ``lens_parameters``."""
     fit.require_acceptable("3DE4 lens file")
+    coefficients = fit.coefficients if coefficients is None else coefficients
     lp = dict(fit.lens_parameters())
     lp["tde4_lens_center_offset_x_cm"], lp["tde4_lens_center_offset_y_cm"] = _offset_cm(lens_center_offset_mm)
     if name is None:
@@ -69,9 +89,9 @@ def tde4_lens_text(fit: TDE4RadialStandard, name: str | None = None, *,
         " ".join(_num(v) for v in (w, h, lp["tde4_focal_length_cm"], w / h, lp["tde4_lens_center_offset_x_cm"],
                                     lp["tde4_lens_center_offset_y_cm"], lp["tde4_pixel_aspect"])),
         "DISTORTION_STATIC",
-        TDE4_MODEL,
+        model,
     ]
-    for p in TDE4_PARAMETERS:
-        lines += [p, _num(fit.coefficients[p]), "0"]
+    for p in parameters:
+        lines += [p, _num(coefficients[p]), "0"]
     lines.append("<end_of_file>")
     return "\n".join(lines) + "\n"

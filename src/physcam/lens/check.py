@@ -8,9 +8,11 @@
   that cross inside their apertures, a stop plane inside a neighbour's sag, bad numbers);
 - ``warning``: it can be traced but contradicts itself or its stated data (EFL or f-number
   against the name or ``[lens]`` table, a stop wider than the beam its neighbours pass,
-  ``[focus]`` gaps that move focus the wrong way, glass off the glass map);
-- ``note``: worth knowing (a duplicate of a bundled lens, a small mismatch, numbers not compared
-  with their primary source or a licence nobody established, as the ``[provenance]`` record says).
+  ``[focus]`` gaps that push the image away from the film, a T-stop faster than the f-number, glass
+  off the glass map);
+- ``note``: worth knowing (a duplicate of a bundled lens, a small mismatch, a maker's close focus
+  closer than the focus model reaches, numbers not compared with their primary source or a licence
+  nobody established, as the ``[provenance]`` record says).
 
 Every finding names the surface (0-based, as in physcam) and the file line. The checks here
 use only the prescription (paraxial optics at nd, exact sags); ray-traced checks (the on-axis
@@ -296,33 +298,94 @@ def _stated(c: _Ctx) -> None:
               k, **vals)
 
 
+#: A ``[focus]`` table whose gaps push the close object's image away from the film by more than this
+#: fraction of the distance unit focusing would move it is focusing the wrong way (module notes of _focus).
+WRONG_WAY_FRACTION = 0.5
+
+
 def _focus(c: _Ctx) -> None:
+    """Judge a ``[focus]`` table the way physcam focuses the lens (physcam.optics.focusing): the gaps move
+    to their close values and the back focus is then whatever images the close object on the film.
+
+    Unit focusing would move the film ``need`` mm (the close object's image behind the infinity image,
+    gaps held); with the close gaps the lens extends ``extension`` mm instead. The gaps do the fraction
+    ``(need - extension) / need`` of the focusing: about 1 for a focusing group (the back focus stays),
+    about 0 for a floating group that corrects aberrations while the whole lens extends (the patents of
+    Sigma 40/50 mm and Nikkor 28 mm state a close back focus that grows; their groups push the image a
+    few per cent *away*), and about -1 for a table with its travel reversed or its columns swapped. Below
+    -:data:`WRONG_WAY_FRACTION` the gaps work against focusing (the lens would extend over 1.5x what unit
+    focusing needs): a warning. Between 0.1 and 0.9 they do part of it and the extension the rest: a note.
+    """
     p = c.p
     if p.focus is None or not p.focus.gaps:
         return
     d = p.focus.close_distance
-    film = p.surfaces[-1].thickness
-    if film <= 0:
-        film = _image_distance(p, math.inf)
     close = p.with_thicknesses({g.surface: g.thickness_close for g in p.focus.gaps
                                 if 0 <= g.surface < len(p.surfaces)})
-    d_inf = _image_distance(p, d) - film  # defocus with the infinity gaps
-    d_close = _image_distance(close, d) - film
-    if not (math.isfinite(d_inf) and math.isfinite(d_close)):
+    b_inf = _image_distance(p, math.inf)  # the back focus at infinity, as physcam focuses (not the file's gap)
+    need = _image_distance(p, d) - b_inf  # unit focusing: the film moves this far back
+    extension = _image_distance(close, d) - b_inf  # with the close gaps: how far the back focus grows
+    if not (math.isfinite(need) and math.isfinite(extension)) or need <= 0:
         return
+    done = (need - extension) / need
     g0 = p.focus.gaps[0].surface
-    if abs(d_close) > abs(d_inf):
+    vals = dict(unit_extension_mm=need, extension_mm=extension, fraction_by_gaps=done)
+    if done < -WRONG_WAY_FRACTION:
         c.add("warning", "focus_wrong_way",
-              f"[focus]: with the close-focus gaps an object {d:g} mm away images {d_close:+.3f} mm from the film, "
-              f"against {d_inf:+.3f} mm with the infinity gaps: the gaps move focus the wrong way",
-              "swap thickness and thickness_close, or check the sign of the group's travel", g0,
-              defocus_close_mm=d_close, defocus_infinity_gaps_mm=d_inf)
-    elif abs(d_close) > 0.1 * abs(d_inf) and abs(d_close) > 0.05:
+              f"[focus]: an object {d:g} mm away images {need:.3f} mm behind the film with the gaps held (unit "
+              f"focusing), but {extension:.3f} mm behind it with the close-focus gaps: the gaps push the image "
+              f"away by {-done:.0%} of the focusing they should do",
+              "the lens would extend more than 1.5x a unit-focusing lens; swap thickness and thickness_close, "
+              "or check the sign of the group's travel", g0, **vals)
+    elif 0.1 < done < 0.9 and abs(extension) > 0.05:
         c.add("note", "focus_incomplete",
-              f"[focus]: with the close-focus gaps an object {d:g} mm away images {d_close:+.3f} mm from the film "
-              f"({100 * (1 - abs(d_close) / abs(d_inf)):.0f} % of the way from {d_inf:+.3f} mm)",
-              "physcam scales the group travel to focus exactly; the stated close distance is approximate", g0,
-              defocus_close_mm=d_close, defocus_infinity_gaps_mm=d_inf)
+              f"[focus]: the close-focus gaps do {done:.0%} of the focusing for an object {d:g} mm away; the back "
+              f"focus grows {extension:.3f} mm for the rest (unit focusing: {need:.3f} mm)",
+              "physcam solves the back focus at every mark, so the lens focuses; a table meant to focus by its "
+              "gaps alone has an approximate close distance", g0, **vals)
+
+
+def _closest_mark(p: Prescription) -> tuple[float, str]:
+    """The closest focus mark (mm from the film) physcam's focus model reaches, and how: the ``[focus]``
+    gaps at their close values with the back focus that images that object, or, without a ``[focus]``
+    table, unit focusing's 1:1 conjugate (physcam.optics.focusing.closest_focus, here at nd)."""
+    if p.focus is not None and p.focus.gaps:
+        d = p.focus.close_distance
+        close = p.with_thicknesses({g.surface: g.thickness_close for g in p.focus.gaps
+                                    if 0 <= g.surface < len(p.surfaces)})
+        return d + close.total_track + _image_distance(close, d), "the [focus] table's close position"
+    # a ray leaving the first vertex at height 1 with angle t ends with u' = a + b t: magnification t / u' = -1
+    _, _, a = _marginal(p, u0=0.0)
+    _, _, u1 = _marginal(p, u0=1.0)
+    t = -a / (1.0 + (u1 - a))
+    if not t > 0:
+        return math.nan, "unit focusing's 1:1 limit"
+    return 1.0 / t + p.total_track + _image_distance(p, 1.0 / t), "unit focusing's 1:1 limit"
+
+
+def _maker_data(c: _Ctx) -> None:
+    """The maker's statements in ``[lens]`` against the prescription: a T-stop faster than the paraxial
+    f-number (a T-stop counts the light the glass loses, so T >= N), and a minimum object distance closer
+    than physcam's focus model reaches (close focus, breathing and the lens card then stop at the model's
+    limit; the MOD stays the maker's statement, the file is not wrong)."""
+    m = c.p.metadata
+    if m.t_stop is not None:
+        n = _fnum(c.p, "y")
+        if math.isfinite(n) and m.t_stop < n * (1 - 5e-3):
+            c.add("warning", "t_stop_faster", f"[lens] t_stop T{m.t_stop:g} is faster than the paraxial f-number "
+                  f"f/{n:.2f} (the file's stop)", "a T-stop is the f-number with the glass's losses counted, so it is "
+                  "never below it: check the T-stop or the stop's semi-diameter", None, t_stop=m.t_stop, f_number=n)
+    mod = m.minimum_object_distance
+    if mod is None or c.p.zoom is not None:
+        return
+    limit, how = _closest_mark(c.p)
+    if math.isfinite(limit) and mod < limit - 1.0:  # 1 mm: the model at nd against a number printed to cm
+        c.add("note", "mod_beyond_focus_model",
+              f"[lens] minimum_object_distance {mod:g} mm (the maker's close focus) is closer than physcam's focus "
+              f"model reaches: {limit:.1f} mm from the film ({how})",
+              f"close focus, breathing and the lens card stop at {limit:.0f} mm; the file keeps the maker's MOD as "
+              "stated, which the prescription's focusing (a patent example's table, say) does not reach",
+              minimum_object_distance_mm=mod, closest_mark_mm=limit)
 
 
 #: A generous outline of the glass map (nd, Vd) of optical glasses from the SCHOTT, OHARA, HOYA and
@@ -394,7 +457,7 @@ def _provenance(c: _Ctx) -> None:
               "others may not be free to use or share the file")
 
 
-CHECKS = (_edges, _crossings, _stop_beam, _stated, _focus, _glass, _duplicates, _provenance)
+CHECKS = (_edges, _crossings, _stop_beam, _stated, _focus, _maker_data, _glass, _duplicates, _provenance)
 
 
 def check(lens, *, format: str | None = None, probes: Iterable[Callable[[Prescription], list]] = ()) -> list[Finding]:

@@ -29,6 +29,8 @@ __all__ = [
     "Surface",
     "VariableGap",
     "Focus",
+    "ZoomGap",
+    "Zoom",
     "LensMetadata",
     "Prescription",
     "require_prescription",
@@ -168,6 +170,40 @@ class Focus:
 
 
 @dataclass(frozen=True, slots=True)
+class ZoomGap:
+    """An air gap that changes with zoom: its thickness at each zoom position (infinity focus) and,
+    where the source gives them, at each position's close focus (``thickness_close``)."""
+
+    surface: int  # 0-based index of the surface whose following gap varies (the last: the back focus)
+    thickness: tuple[float, ...]
+    thickness_close: tuple[float, ...] | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Zoom:
+    """A zoom lens's tabulated positions (docs/zoom.md). The prescription's own surfaces are the first
+    position; :func:`physcam.lens.zoom.prescription_at` gives any other.
+
+    ``encoder``: the normalised zoom coordinate of each tabulated position, 0 at the first, 1 at the
+    last, increasing (evenly spaced unless the source says otherwise). ``stop_semi_diameter``: the
+    stop's full-open semi-diameter at each position where the source tabulates it (else the stop
+    keeps its size across the zoom). ``close_distance``: each position's close-focus object
+    distance (mm from the first vertex), with the gaps' ``thickness_close``: a zoom x focus grid.
+    ``stated_focal_length``: the source's own focal-length labels, kept to compare, never used.
+    """
+
+    gaps: tuple[ZoomGap, ...]
+    encoder: tuple[float, ...]
+    stop_semi_diameter: tuple[float, ...] | None = None
+    close_distance: tuple[float, ...] | None = None
+    stated_focal_length: tuple[float, ...] | None = None
+
+    @property
+    def positions(self) -> int:
+        return len(self.encoder)
+
+
+@dataclass(frozen=True, slots=True)
 class LensMetadata:
     """What a lens is and where its numbers come from."""
 
@@ -205,6 +241,8 @@ class Prescription:
     #: file's provenance), carried unchanged as ``(key, JSON text)`` pairs so that
     #: write(read(file)) round-trips. Optics code ignores them. See docs/lens-formats.md.
     extras: tuple[tuple[str, str], ...] = ()
+    #: The zoom table of a zoom lens (None for a prime); the surfaces are its first position.
+    zoom: Zoom | None = None
 
     # ---- derived geometry -------------------------------------------------
     @property
@@ -360,7 +398,60 @@ class Prescription:
                     raise fail("a focus gap must be an air gap", g.surface)
                 if not (math.isfinite(g.thickness_close) and g.thickness_close >= 0):
                     raise fail(f"focus gap at close distance must be >= 0 mm, got {g.thickness_close}", g.surface)
+        if self.zoom is not None:
+            _check_zoom(self, fail)
         return self
+
+
+def _check_zoom(p: "Prescription", fail) -> None:
+    """The zoom table fits the lens: positions agree in number, the encoder runs 0..1 upward, every
+    varying gap is an air gap with finite non-negative thicknesses, the surfaces hold the first
+    position, and a zoom x focus grid comes with the lens's focus at its first position."""
+    z, n = p.zoom, p.zoom.positions
+    if n < 2:
+        raise fail(f"a zoom table needs at least two positions, got {n}")
+    enc = z.encoder
+    if not all(math.isfinite(e) for e in enc) or enc[0] != 0.0 or enc[-1] != 1.0 or \
+            any(b <= a for a, b in zip(enc, enc[1:])):
+        raise fail(f"zoom encoder values must rise from 0 to 1, got {list(enc)}")
+    if not z.gaps:
+        raise fail("a zoom table needs at least one varying gap")
+    seen = set()
+    for g in z.gaps:
+        if not 0 <= g.surface < len(p.surfaces) or g.surface in seen:
+            raise fail(f"zoom gap refers to surface {g.surface}, which does not exist or is listed twice")
+        seen.add(g.surface)
+        if p.surfaces[g.surface].medium.nd != 1.0:
+            raise fail("a zoom gap must be an air gap", g.surface)
+        for what, values in (("thickness", g.thickness), ("thickness_close", g.thickness_close)):
+            if values is None:
+                continue
+            if len(values) != n or not all(math.isfinite(t) and 0.0 <= t <= MAX_LENGTH_MM for t in values):
+                raise fail(f"zoom gap {what} needs {n} finite values >= 0 mm, got {list(values)}", g.surface)
+        if p.surfaces[g.surface].thickness != g.thickness[0]:
+            raise fail(f"thickness {p.surfaces[g.surface].thickness:g} mm is not the zoom table's first position "
+                       f"{g.thickness[0]:g} mm", g.surface)
+    for what, values in (("stop_semi_diameter", z.stop_semi_diameter), ("close_distance", z.close_distance),
+                         ("stated_focal_length", z.stated_focal_length)):
+        if values is not None and (len(values) != n or not all(math.isfinite(v) and 0 < v <= MAX_LENGTH_MM
+                                                               for v in values)):
+            raise fail(f"zoom {what} needs {n} positive finite values, got {list(values)}")
+    closes = [g for g in z.gaps if g.thickness_close is not None]
+    if (z.close_distance is None) != (not closes):
+        raise fail("a zoom x focus grid needs both close_distance and the gaps' thickness_close")
+    if closes and (p.focus is None or p.focus.close_distance != z.close_distance[0]
+                   or {g.surface for g in p.focus.gaps} != {g.surface for g in closes}):
+        raise fail("the lens's focus must be the zoom table's first position (close distance and focus gaps)")
+    if not closes and p.focus is not None and seen & {g.surface for g in p.focus.gaps}:
+        raise fail("a focus gap that also zooms needs its close thickness at every zoom position (thickness_close)")
+    for k in range(1, n):  # a gap is smallest at a tabulated position (the cams never overshoot): check each
+        at_k = replace(p, zoom=None, focus=None,
+                       surfaces=tuple(replace(s, thickness=next((g.thickness[k] for g in z.gaps if g.surface == i),
+                                                                s.thickness)) for i, s in enumerate(p.surfaces)))
+        try:
+            at_k.validate()
+        except LensFileError as exc:
+            raise fail(f"at zoom position {k + 1}: {exc.args[0]}") from None
 
 
 def require_prescription(value, name: str = "lens") -> Prescription:

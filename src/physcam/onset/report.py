@@ -143,6 +143,10 @@ class LensReport:
     #: the f-number at this focus for the iris set to ``fstop`` at infinity (see f_number_at_focus);
     #: None: ``fstop`` (no focusing changes it)
     fstop_at_focus: float | None = None
+    #: an anamorphic prescription's horizontal (X-meridian) entrance pupil in front of the film, the
+    #: parallax-free pivot of a pan; ``entrance_pupil_from_film_mm`` is then the vertical (Y) one, the
+    #: pivot of a tilt (physcam.optics.focusing.EntrancePupils). None: one pupil for both
+    entrance_pupil_horizontal_from_film_mm: float | None = None
 
     # --- the camera's own settings, read from it ----------------------------------
     @property
@@ -232,6 +236,18 @@ class LensReport:
         if self.entrance_pupil_from_film_mm is None:
             return None
         return pivot_camera_space(self.entrance_pupil_from_film_mm)
+
+    def entrance_pupils_dict(self) -> dict:
+        """Both meridians' entrance pupils and the pivots they give (equal for a spherical lens)."""
+        v = self.entrance_pupil_from_film_mm
+        h = v if self.entrance_pupil_horizontal_from_film_mm is None else self.entrance_pupil_horizontal_from_film_mm
+        return {"horizontal_from_film_mm": h, "vertical_from_film_mm": v,
+                "separation_mm": None if v is None else h - v,
+                "pan_pivot_camera_space_mm": None if h is None else list(pivot_camera_space(h)),
+                "tilt_pivot_camera_space_mm": None if v is None else list(pivot_camera_space(v)),
+                "definition": "horizontal: the X meridian's paraxial entrance pupil, about which a pan is "
+                              "parallax-free; vertical: the Y meridian's, for a tilt; entrance_pupil_from_film_mm "
+                              "and pivot_camera_space_mm are the vertical one"}
 
     @property
     def desqueezed_width_mm(self) -> float:
@@ -328,6 +344,7 @@ class LensReport:
             "flange_focal_distance_mm": self.flange_focal_distance_mm,
             "focus_error_mm": self.focus_error_mm,
             "magnification": self.magnification,
+            "frame_at_focus": _frame_dict(self),
             "dof": self.dof.to_dict(),
             "dof_horizontal": None if self.dof_horizontal is None else self.dof_horizontal.to_dict(),
             "split_focus": self.split_focus,
@@ -355,11 +372,23 @@ class LensReport:
             "dof_aspect": self.dof_aspect,
             "entrance_pupil_source": self.entrance_pupil_source,
             "pivot_camera_space_mm": None if self.pivot_camera_space_mm is None else list(self.pivot_camera_space_mm),
+            "entrance_pupils": self.entrance_pupils_dict(),
             "solved": dict(self.solved),
             "measured": {k: finite_or_none(v) if isinstance(v, float) else v for k, v in self.measured.items()},
             "notes": list(self.notes),
             "diffraction": self.diffraction_dict(),
         }
+
+
+def _frame_dict(report) -> dict | None:
+    """The picture's (desqueezed) width and height in the plane of sharp focus, the gate over |m|
+    (physcam.onset.framing), or None focused at infinity."""
+    m = report.magnification
+    if m == 0.0 or math.isinf(report.object_distance_mm):
+        return None
+    w, h = report.sensor.width_mm * report.squeeze / abs(m), report.sensor.height_mm / abs(m)
+    return {"width_mm": w, "height_mm": h, "diagonal_mm": math.hypot(w, h),
+            "distance_from_h1_mm": report.object_distance_mm}
 
 
 # --------------------------------------------------------------------------------------
@@ -417,6 +446,7 @@ def solve_report(camera, *, coc=None, measured: MeasuredLimits | None = None,
         else None, references=refs,
         stop_from_film_mm=at.stop_from_film_mm if camera.traceable else (h1_film if at.model == "practical" else None),
         dof_aspect=dof.blur_aspect, bellows_factor=at.bellows, fstop_at_focus=None if at.n_ratio == 1.0 else n_focus,
+        entrance_pupil_horizontal_from_film_mm=at.pupil_x_from_film_mm if pupil_src == "prescription" else None,
         **field_of_view(camera, h2_film, refs, at))
     report = dataclasses.replace(report, notes=report.notes + (report.diffraction_note(),))
     if camera.traceable:

@@ -48,6 +48,9 @@ def report_rows(report, units: str = "m", *, notes: bool = True) -> list[tuple[s
         add("focus error", f"{d['focus_error_mm']:+.3f} mm (+ = image in front of film)", "film plane")
     m = d["magnification"]
     add("magnification", f"{m:.5f}  (1:{1 / abs(m):.1f}, inverted image)" if m else "0  (subject at infinity)", "")
+    fr = d["frame_at_focus"]
+    if fr is not None:
+        add("frame at the focus (w x h)", f"{_len(fr['width_mm'])} x {_len(fr['height_mm'])}", "subject plane")
     dof = d["dof"]
     add("hyperfocal", _len(dof["hyperfocal_from_film_mm"]), "film plane")
     add("near limit", _len(dof["near_from_film_mm"]), "film plane")
@@ -73,7 +76,13 @@ def report_rows(report, units: str = "m", *, notes: bool = True) -> list[tuple[s
     add("pinhole (render camera)", f"{pin['focal_length_mm']:.3f} mm" + (
         f", squeeze {pin['squeeze']:.4g}" if pin["squeeze"] != 1.0 else "") + "  [frames like the lens at focus]",
         "entrance pupil")
-    if d["entrance_pupil_from_film_mm"] is not None:
+    eps = d.get("entrance_pupils") or {}
+    if eps.get("separation_mm"):  # an anamorphic's two pupils: say which pivot is which
+        add("entrance pupil, horizontal (pan pivot)", f"{eps['horizontal_from_film_mm']:.2f} mm  "
+            f"[{d['entrance_pupil_source']}, X meridian]", "film plane")
+        add("entrance pupil, vertical (tilt pivot)", f"{eps['vertical_from_film_mm']:.2f} mm  "
+            f"[{d['entrance_pupil_source']}, Y meridian]", "film plane")
+    elif d["entrance_pupil_from_film_mm"] is not None:
         add("entrance pupil (pivot)", f"{d['entrance_pupil_from_film_mm']:.2f} mm  [{d['entrance_pupil_source']}]",
             "film plane")
     sv = d["solved"]

@@ -7,7 +7,9 @@ conventions below are the ones camera departments actually quote.
   36x24 frame (Wikipedia "Zeiss formula"; "Circle of confusion", table convention).
 - ``d/1000``: diagonal / 1000, the traditional Zeiss rule.
 - ``cine``: 0.025 mm (0.001 in), the American Cinematographer Manual's 35 mm motion
-  picture value (ACM 1986, quoted by DOFMaster).
+  picture value (ACM 1986, quoted by DOFMaster): "Super 35 cine", what pullers' apps default to.
+- ``full-frame``: 0.03 mm, the full-frame (36 x 24) still value of DOFMaster and Canon.
+- ``16mm``: 0.015 mm, the ACM's 16 mm motion picture value (quoted by DOFMaster).
 - a number: the user's own value in mm.
 
 See ``reference/formats/coc_conventions.csv`` in the shared data for sources.
@@ -28,9 +30,13 @@ COC_CONVENTIONS = {
     "d/1500": ("sensor diagonal / 1500 (modern Zeiss)", lambda w, h: math.hypot(w, h) / 1500.0),
     "d/1000": ("sensor diagonal / 1000 (traditional Zeiss)", lambda w, h: math.hypot(w, h) / 1000.0),
     "d/1730": ("sensor diagonal / 1730 ('Zeiss formula')", lambda w, h: math.hypot(w, h) / 1730.0),
-    "cine": ("0.025 mm fixed (ACM 1986, 35 mm motion picture)", lambda w, h: 0.025),
+    "cine": ("0.025 mm fixed, Super 35 cine (ACM 1986, 35 mm motion picture)", lambda w, h: 0.025),
+    "full-frame": ("0.03 mm fixed, full frame 36 x 24 (DOFMaster, Canon)", lambda w, h: 0.03),
+    "16mm": ("0.015 mm fixed, 16 mm cine (ACM 1986)", lambda w, h: 0.015),
 }
-_ALIASES = {"zeiss": "d/1500", "modern": "d/1500", "traditional": "d/1000", "acm": "cine", "0.025": "cine"}
+_ALIASES = {"zeiss": "d/1500", "modern": "d/1500", "traditional": "d/1000", "acm": "cine", "0.025": "cine",
+            "s35": "cine", "super35": "cine", "ff": "full-frame", "fullframe": "full-frame", "0.03": "full-frame",
+            "s16": "16mm", "0.015": "16mm"}
 
 DEFAULT_COC_CONVENTION = "d/1500"
 
@@ -90,6 +96,8 @@ def parse_coc(text):
 
     if text is None:
         return None
+    if str(text).strip().lower() in COC_CONVENTIONS or str(text).strip().lower() in _ALIASES:
+        return str(text).strip()  # a name, though it starts with a digit ("16mm")
     try:
         return float(text)
     except ValueError:

@@ -48,6 +48,8 @@ __all__ = [
     "f_number_ratio",
     "gaussian_at_focus",
     "technical_planes",
+    "EntrancePupils",
+    "entrance_pupils",
     "breathing_table",
     "pupil_aspect",
     "hyperfocal_mark",
@@ -145,10 +147,23 @@ class BreathingRow:
     magnification: float
     back_focus_mm: float
     fov_change_pct: float  # HFOV change from infinity focus, percent
-    entrance_pupil_from_film_mm: float | None = None  # where the camera pivots at this mark
+    entrance_pupil_from_film_mm: float | None = None  # where the camera pivots at this mark (X meridian: a pan)
+    #: the Y (vertical) meridian's: EFL and framing focal length (sensor half-width / tan of the Y meridian's
+    #: paraxial half-field there; paraxially the Y pinhole), and its entrance pupil (a tilt's pivot). They
+    #: differ from the X meridian's for an anamorphic lens; equal for a spherical one
+    vertical_efl_mm: float | None = None
+    vertical_breathing_focal_length_mm: float | None = None
+    vertical_entrance_pupil_from_film_mm: float | None = None
+
+    @property
+    def breathing_squeeze(self) -> float | None:
+        """Vertical over horizontal framing focal length: the squeeze the framing shows at this mark."""
+        v = self.vertical_breathing_focal_length_mm
+        return None if v is None else v / self.breathing_focal_length_mm
 
     def to_dict(self) -> dict:
         d = asdict(self)
+        d["breathing_squeeze"] = self.breathing_squeeze
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
 
 
@@ -541,6 +556,9 @@ def breathing_table(
         st = focus(prescription, m, method=method, axis="y", wavelength_nm=wavelength_nm)
         gx = paraxial.gaussian(st.prescription, axis="x", wavelength_nm=wavelength_nm, object_z=st.object_z, film_z=st.film_z)
         half = abs(paraxial.field_angle(st.prescription, w / 2.0, st.film_z, "x", wavelength_nm))
+        gy = paraxial.gaussian(st.prescription, axis="y", wavelength_nm=wavelength_nm, object_z=st.object_z,
+                               film_z=st.film_z)
+        half_y = abs(paraxial.field_angle(st.prescription, w / 2.0, st.film_z, "y", wavelength_nm))
         hfov = math.degrees(2.0 * half)
         if hfov0 is None:
             hfov0 = hfov if math.isinf(m) else gaussian_hfov_infinity(prescription, w, method, wavelength_nm)
@@ -554,6 +572,9 @@ def breathing_table(
                 back_focus_mm=st.back_focus_mm,
                 fov_change_pct=100.0 * (hfov / hfov0 - 1.0),
                 entrance_pupil_from_film_mm=gx.in_front_of("entrance_pupil"),
+                vertical_efl_mm=gy.efl,
+                vertical_breathing_focal_length_mm=(w / 2.0) / math.tan(half_y),
+                vertical_entrance_pupil_from_film_mm=gy.in_front_of("entrance_pupil"),
             )
         )
     return rows
@@ -574,6 +595,50 @@ def pupil_aspect(prescription: Prescription, focus_mm: float) -> float:
     st = focus(prescription, focus_mm)
     gx, gy = (paraxial.gaussian(st.prescription, axis=a, object_z=st.object_z, film_z=st.film_z) for a in "xy")
     return gx.entrance_pupil_diameter / gy.entrance_pupil_diameter
+
+
+@dataclass(frozen=True)
+class EntrancePupils:
+    """Both meridians' entrance pupils at one focus mark, in front of the film (mm, + toward the subject).
+
+    An anamorphic lens images its one stop through different powers in X and Y: a front anamorphic
+    (cylinders before the stop) has two entrance pupils at different places ("anamorphic mumps"); a
+    rear one (cylinders behind the stop) has one place and a round pupil. A **pan** (rotation about
+    the vertical axis) moves the picture horizontally: it is parallax-free about the X (horizontal)
+    meridian's pupil; a **tilt** about the Y (vertical) meridian's pupil (Kingslake, *Optics in
+    Photography*, ch. 6: the entrance pupil is the centre of perspective, here in each meridian).
+    """
+
+    focus_from_film_mm: float
+    horizontal_from_film_mm: float  # X meridian: the pan pivot
+    vertical_from_film_mm: float  # Y meridian: the tilt pivot
+    horizontal_diameter_mm: float
+    vertical_diameter_mm: float
+
+    @property
+    def separation_mm(self) -> float:
+        """Horizontal pupil minus vertical pupil (+: the horizontal one lies nearer the subject)."""
+        return self.horizontal_from_film_mm - self.vertical_from_film_mm
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["focus_from_film_mm"] = None if math.isinf(self.focus_from_film_mm) else self.focus_from_film_mm
+        d["separation_mm"] = self.separation_mm
+        d["pan_pivot_from_film_mm"] = self.horizontal_from_film_mm
+        d["tilt_pivot_from_film_mm"] = self.vertical_from_film_mm
+        return d
+
+
+@renamed_parameter("focus_from_film_mm", "focus_mm")
+def entrance_pupils(prescription: Prescription, focus_mm: float, *, method: str = "auto",
+                    wavelength_nm=None) -> EntrancePupils:
+    """The X and Y meridians' paraxial entrance pupils with the lens focused (in Y) at the mark, both
+    from the one film plane (:class:`EntrancePupils`); equal for a rotationally symmetric lens."""
+    st = focus(prescription, focus_mm, method=method, axis="y", wavelength_nm=wavelength_nm)
+    g = {a: paraxial.gaussian(st.prescription, axis=a, wavelength_nm=wavelength_nm, object_z=st.object_z,
+                              film_z=st.film_z) for a in "xy"}
+    return EntrancePupils(float(focus_mm), g["x"].in_front_of("entrance_pupil"), g["y"].in_front_of("entrance_pupil"),
+                          g["x"].entrance_pupil_diameter, g["y"].entrance_pupil_diameter)
 
 
 #: The farthest hyperfocal mark solved (1000 km, the on-set report's largest distance).

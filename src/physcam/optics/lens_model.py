@@ -59,6 +59,9 @@ class LensAtMark(NamedTuple):  # a NamedTuple: made for every camera, cheap to d
     #: a prescription's EFL at infinity focus, (Y, X) mm: the field of view at infinity (None: the
     #: focal length, which a thin lens or a datasheet keeps at every focus)
     efl_infinity: tuple[float, float] | None = None
+    #: an anamorphic prescription's X-meridian (horizontal, pan) entrance pupil in front of the film;
+    #: ``pupil_from_film_mm`` is then the Y meridian's (vertical, tilt). None: one pupil for both
+    pupil_x_from_film_mm: float | None = None
 
 
 class PrincipalPlanes(NamedTuple):  # a NamedTuple: made at every report, cheap to define at start-up
@@ -340,7 +343,13 @@ class PrescriptionLens:
         gx = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z)
         gy = paraxial.gaussian(st.prescription, axis="y", object_z=st.object_z, film_z=st.film_z)
         lens_squeeze = planes.efl_mm / gx.efl
-        at = at._replace(lens_squeeze=lens_squeeze, blur_aspect=gx.entrance_pupil_diameter / gy.entrance_pupil_diameter)
+        at = at._replace(lens_squeeze=lens_squeeze, blur_aspect=gx.entrance_pupil_diameter / gy.entrance_pupil_diameter,
+                         pupil_x_from_film_mm=gx.in_front_of("entrance_pupil"))
+        if abs(at.pupil_x_from_film_mm - at.pupil_from_film_mm) > 0.05:
+            notes.append(f"anamorphic: two entrance pupils, horizontal (X, the pan pivot) "
+                         f"{at.pupil_x_from_film_mm:.1f} mm and vertical (Y, the tilt pivot) "
+                         f"{at.pupil_from_film_mm:.1f} mm in front of the film; the report's entrance pupil is "
+                         "the vertical one")
         if at.squeeze != 1.0:
             return at
         notes.append(f"anamorphic: EFL {planes.efl_mm:.3f} mm (Y) and {gx.efl:.3f} mm (X), effective squeeze "

@@ -8,6 +8,12 @@ pitch (``pitch_um``, micrometres): the width over the photosites across it
 (``photosites_across``), each count with its source (``pitch_source``; abbreviations in
 ``physcam/data/SENSORS.md``). Film gates and the generic full-frame format have none. Lookup ignores case, spaces and punctuation;
 an unknown name raises :class:`~physcam.errors.SensorError` listing the closest names.
+
+The camera table ``physcam/data/cameras.csv`` adds every recording format of current cine and hybrid
+cameras (camera -> formats): each row a :class:`Sensor` named "maker camera format" (also found
+without the maker: "FX6 FF 4K 17:9"), with its source, the date it was read and how the size was had
+(stated by the maker, or photosites x the maker's pitch). A camera's name alone ("FX6") is refused
+with its formats listed: DOF and field of view depend on the crop.
 """
 
 from __future__ import annotations
@@ -22,11 +28,11 @@ from pathlib import Path
 
 from ..errors import SensorError
 
-__all__ = ["Sensor", "sensors", "find_sensor", "filter_sensors", "custom_sensor", "SENSOR_SIZE_RANGE_MM",
+__all__ = ["Sensor", "sensors", "cameras", "camera_formats", "find_sensor", "filter_sensors", "custom_sensor", "SENSOR_SIZE_RANGE_MM",
            "SENSOR_MAX_ASPECT", "PITCH_RANGE_UM", "MAKERS"]
 
 #: Camera makers in the table (a digital sensor's name starts with its maker); film gates are "film".
-MAKERS = ("ARRI", "RED", "Sony")
+MAKERS = ("ARRI", "RED", "Sony", "Canon", "Blackmagic", "Panasonic")
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,6 +49,12 @@ class Sensor:
     source: str = ""
     pitch_um: float | None = None
     pitch_source: str = ""
+    camera: str = ""  # the camera table's rows: the camera and its recording format
+    fmt: str = ""
+    make: str = ""
+    anamorphic: tuple[float, ...] = ()  # desqueeze factors the maker offers this format for
+    read: str = ""  # the date the source was read
+    method: str = ""  # how the size was had: "stated mm", "photosites x pitch", "derived: ..."
 
     @property
     def diagonal_mm(self) -> float:
@@ -57,6 +69,8 @@ class Sensor:
         """The camera maker (ARRI, RED, Sony), "film" for a film gate, "" when neither."""
         if self.kind == "film":
             return "film"
+        if self.make:
+            return self.make
         first = self.name.split()[0] if self.name else ""
         return first if first in MAKERS else ""
 
@@ -64,7 +78,8 @@ class Sensor:
         return {"key": self.key, "name": self.name, "maker": self.maker, "kind": self.kind,
                 "width_mm": self.width_mm, "height_mm": self.height_mm, "diagonal_mm": self.diagonal_mm,
                 "aspect": self.aspect, "photosite_pitch_um": self.pitch_um, "aliases": list(self.aliases),
-                "source": self.source}
+                "source": self.source, "camera": self.camera or None, "format": self.fmt or None,
+                "anamorphic": list(self.anamorphic), "read": self.read or None, "method": self.method or None}
 
 
 #: A custom sensor's width and height (mm): from a phone's sensor to beyond 15/70 IMAX film.
@@ -105,10 +120,31 @@ def _norm(text: str) -> str:
     return re.sub(r"[^a-z0-9]+", "", text.lower())
 
 
+def _data(name: str) -> str:
+    return (Path(__file__).resolve().parent.parent / "data" / name).read_text(encoding="utf-8")
+
+
+def _camera_formats() -> list[Sensor]:
+    """The camera table's rows (cameras.csv) as sensors: "maker camera format", also "camera format"."""
+    out = []
+    for row in csv.DictReader(_data("cameras.csv").splitlines()):
+        w, across = float(row["width_mm"]), row["photosites_across"]
+        short = f"{row['camera']} {row['format']}"
+        out.append(Sensor(
+            key=row["key"], name=f"{row['maker']} {short}", width_mm=w, height_mm=float(row["height_mm"]),
+            aliases=(short, *(a.strip() for a in row["aliases"].split(";") if a.strip())), kind="digital",
+            source=row["source"], pitch_um=round(w * 1000.0 / int(across), 3) if across else None,
+            pitch_source=f"width / photosites: {across} photosites across (the row's source)" if across else "",
+            camera=row["camera"], fmt=row["format"],
+            make=row["maker"], anamorphic=tuple(float(x) for x in row["anamorphic"].split(";") if x.strip()),
+            read=row["read"], method=row["method"]))
+    return out
+
+
 @lru_cache(maxsize=1)
 def sensors() -> tuple[Sensor, ...]:
-    """Every known sensor, in table order."""
-    text = (Path(__file__).resolve().parent.parent / "data" / "sensors.csv").read_text(encoding="utf-8")
+    """Every known sensor, in table order: the sensors and film gates, then the camera table's formats."""
+    text = _data("sensors.csv")
     out = []
     for row in csv.DictReader(text.splitlines()):
         out.append(
@@ -124,7 +160,29 @@ def sensors() -> tuple[Sensor, ...]:
                 pitch_source=row.get("pitch_source", ""),
             )
         )
-    return tuple(out)
+    return tuple(out + _camera_formats())
+
+
+@lru_cache(maxsize=1)
+def cameras() -> dict[str, tuple[Sensor, ...]]:
+    """The camera table by camera ("Sony FX6" -> its formats, in table order)."""
+    out: dict[str, list[Sensor]] = {}
+    for s in sensors():
+        if s.camera:
+            out.setdefault(f"{s.make} {s.camera}", []).append(s)
+    return {k: tuple(v) for k, v in out.items()}
+
+
+def camera_formats(name: str) -> tuple[Sensor, ...]:
+    """The formats of the camera called ``name`` ("Sony FX6", "FX6", "venice 2 8k"; case and punctuation
+    ignored), or () when no camera has that name."""
+    if not isinstance(name, str):
+        raise SensorError(f"a camera name must be text, got {type(name).__name__}")
+    key = _norm(name)
+    for full, rows in cameras().items():
+        if key and key in (_norm(full), _norm(rows[0].camera)):
+            return rows
+    return ()
 
 
 @lru_cache(maxsize=1)
@@ -144,11 +202,12 @@ FAMILY_NAMES = {"alexa": "ALEXA", "arri": "ALEXA", "arriflex": "ALEXA"}
 def filter_sensors(query: str = "", *, maker: str | None = None, fmt: str | None = None,
                    min_width_mm: float | None = None, max_width_mm: float | None = None) -> list[Sensor]:
     """Sensors matching every word of ``query`` (in the name, key, aliases or maker; case and
-    punctuation ignored), the ``maker`` (ARRI, RED, Sony or film), the ``fmt`` text in the name
-    ("open gate", "16:9", "4-perf") and a width between ``min_width_mm`` and ``max_width_mm``.
+    punctuation ignored), the ``maker`` (ARRI, RED, Sony, Canon, Blackmagic, Panasonic or film), the
+    ``fmt`` text in the name ("open gate", "16:9", "4-perf") and a width between ``min_width_mm`` and
+    ``max_width_mm``.
 
-    >>> [s.key for s in filter_sensors("ARRI", fmt="16:9")]
-    ['alexa35-169', 'alexa-lf-uhd', 'alexa-s35-169']
+    >>> [s.key for s in filter_sensors("FX6", fmt="17:9")]
+    ['sony-fx6-ff-4k-17-9', 'sony-fx6-s35-4k-17-9']
     """
     for name, v in (("query", query), ("maker", maker), ("format", fmt)):
         if v is not None and not isinstance(v, str):
@@ -192,6 +251,12 @@ def find_sensor(name: str) -> Sensor:
                           + "; ".join(repr(m) for m in members))
     if key in idx:
         return idx[key]
+    formats = camera_formats(name)
+    if formats:
+        cam = f"{formats[0].make} {formats[0].camera}"
+        raise SensorError(f"{cam} records in {len(formats)} formats and the crop sets the depth of field and the "
+                          f"field of view: which one? " + "; ".join(repr(s.aliases[0]) for s in formats)
+                          + f" (`physcam sensors {formats[0].camera}` lists them with their sizes)")
     labels = {}
     for s in sensors():
         for label in (s.name, *s.aliases):

@@ -3,7 +3,8 @@
 Routes (GET or HEAD only; every answer is JSON, SVG or the page):
 
 =====================================  =============================================================
-``/``                                  the page (``static/index.html``, ``app.js``, ``app.css``)
+``/``                                  the page (``static/index.html``, ``app.js``, ``onset.js``, ``app.css``)
+``/sw.js``, ``/manifest.webmanifest``  the installable web app: service worker (offline) and manifest
 ``/api/report?focal=50&fstop=2.8...``  ``physcam report ... --json``
 ``/api/focus-table?...&marks=1m,2m``   ``physcam report ... --json`` once per focus mark
 ``/api/dof.svg?...``                   ``physcam report ... --plot dof.svg``, drawn in memory
@@ -46,9 +47,18 @@ __all__ = ["Backend", "Limits", "create_app", "STATIC_FILES"]
 STATIC_FILES = {
     "index.html": "text/html; charset=utf-8",
     "app.js": "text/javascript; charset=utf-8",
+    "onset.js": "text/javascript; charset=utf-8",
+    "tools.js": "text/javascript; charset=utf-8",
     "app.css": "text/css; charset=utf-8",
     "icon.svg": "image/svg+xml",
+    "icon-192.png": "image/png",
+    "icon-512.png": "image/png",
+    "sw.js": "text/javascript; charset=utf-8",
+    "manifest.webmanifest": "application/manifest+json",
 }
+#: Files served at the root, not under /static/: the service worker (its scope is the folder it is
+#: served from, so the whole page) and the web-app manifest.
+ROOT_FILES = ("sw.js", "manifest.webmanifest")
 
 #: Headers on every answer: no framing, no sniffing, only this server's own scripts and styles.
 SECURITY_HEADERS = [
@@ -470,9 +480,8 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
     api = {**_report_endpoints(core, backend, limits), **_catalogue_endpoints(core, backend, limits)}
     routes = [
         Route("/", _static_page(core, "index.html")),
-        Route("/static/app.js", _static_page(core, "app.js")),
-        Route("/static/app.css", _static_page(core, "app.css")),
-        Route("/static/icon.svg", _static_page(core, "icon.svg")),
+        *(Route(f"/{name}" if name in ROOT_FILES else f"/static/{name}", _static_page(core, name))
+          for name in STATIC_FILES if name != "index.html"),
         Route("/favicon.ico", favicon),
         *(Route(path, api[path]) for path in ("/api/report", "/api/focus-table", "/api/dof.svg", "/api/sensors",
                                               "/api/lenses", "/api/lens/{name}", "/api/lens/{name}/diagram.svg")),

@@ -65,14 +65,16 @@ def _is_wildcard(host: str) -> bool:
         return False
 
 
-def url_for(sock: socket.socket) -> list[str]:
+def url_for(sock: socket.socket, scheme: str = "http") -> list[str]:
     """The URLs a browser opens for the server on ``sock``: the bound address, or for a wildcard
-    address every interface address (LAN first, loopback last)."""
+    address every interface address (LAN first, loopback last); ``scheme`` "https" with a certificate."""
     if not isinstance(sock, socket.socket):
         raise WrongTypeError(f"sock must be a socket, got {type(sock).__name__}")
+    if scheme not in ("http", "https"):
+        raise WrongTypeError(f"scheme must be 'http' or 'https', got {scheme!r}")
     host, port = sock.getsockname()[:2]
     hosts = lan_addresses() + ["127.0.0.1"] if _is_wildcard(host) else [host]
-    return [f"http://[{h}]:{port}/" if ":" in h else f"http://{h}:{port}/" for h in hosts]
+    return [f"{scheme}://[{h}]:{port}/" if ":" in h else f"{scheme}://{h}:{port}/" for h in hosts]
 
 
 def lan_addresses() -> list[str]:
@@ -120,10 +122,13 @@ def qr_text(url: str) -> str:
     return buf.getvalue()
 
 
-def run_server(app, sock: socket.socket, *, log_requests: bool = False, limits: Limits | None = None) -> None:
+def run_server(app, sock: socket.socket, *, log_requests: bool = False, limits: Limits | None = None,
+               certfile=None, keyfile=None) -> None:
     """Serve ``app`` on the listening ``sock`` with uvicorn until interrupted (Ctrl-C, SIGTERM),
     each connection bounded by ``limits`` (default :class:`~physcam.serve.app.Limits`): the head
-    cap, the header timeout and the connection caps of :mod:`physcam.serve.protocol`."""
+    cap, the header timeout and the connection caps of :mod:`physcam.serve.protocol`. With
+    ``certfile`` and ``keyfile`` (PEM) it speaks HTTPS: a secure context, so phones on the network can
+    install the page's offline copy (docs/serve.md)."""
     from .app import Limits
 
     if not callable(app):
@@ -142,6 +147,7 @@ def run_server(app, sock: socket.socket, *, log_requests: bool = False, limits: 
         log_level="warning", access_log=bool(log_requests), server_header=False, proxy_headers=False,
         timeout_keep_alive=limits.keep_alive, limit_concurrency=None, backlog=128,
         h11_max_incomplete_event_size=limits.head_bytes,
+        ssl_certfile=None if certfile is None else str(certfile), ssl_keyfile=None if keyfile is None else str(keyfile),
     )
     uvicorn.Server(config).run(sockets=[sock])
 

@@ -88,8 +88,17 @@ def read_lens(path, format: str | None = None) -> Prescription:
 
 @takes_prescription
 def dumps_lens(p: Prescription, format: str = "physcam") -> str:
-    """The text of ``p`` in ``format`` (:class:`ExportError` when the format cannot hold it)."""
-    return _module(format).dumps(p)
+    """The text of ``p`` in ``format`` (:class:`ExportError` when the format cannot hold it). A format
+    without zoom positions (pbrt, ISET, seed TOML) writes a zoom lens's first position, with a warning."""
+    module = _module(format)
+    if p.zoom is not None and format not in ("physcam", "zemax"):
+        import warnings
+
+        from ...errors import PhysCamWarning
+
+        warnings.warn(f"{format} has no zoom positions: writing the first zoom position of lens {p.name!r} only "
+                      "(physcam TOML or Zemax keep them)", PhysCamWarning, stacklevel=2)
+    return module.dumps(p)
 
 
 def write_lens(p: Prescription, path, format: str | None = None, force: bool = False) -> Path:

@@ -14,7 +14,13 @@ Layout (docs/lens-formats.md)::
                                      dpgf? = 0.0 } | { glass = "N-BK7", catalog? = "SCHOTT" }
     [focus]       close_distance (mm from the front vertex)
     [[focus.gap]] surface (0-based), thickness_infinity?, thickness_close
+    [zoom]        encoder? (0..1 per position; default evenly spaced), stop_semi_diameter?,
+                  close_distance? (mm from the front vertex, per position), stated_focal_length?
+    [[zoom.gap]]  surface (0-based), thickness (one per position), thickness_close? (per position)
     [extras]      "key" = "JSON text"  (blocks of other formats, e.g. ISET's microlens)
+
+A zoom lens's ``[[surface]]`` rows hold its first zoom position; with ``close_distance`` the
+``[focus]`` table is not written (the focus groups are the zoom table's, position by position).
 
 ``semi_diameter`` is the clear semi-diameter (half the clear aperture), all lengths in
 mm. A medium given only by a glass name takes nd and Vd from
@@ -29,7 +35,8 @@ from pathlib import Path
 
 from ...errors import InputError, LensFileError
 from ..catalog import find_glass
-from ..prescription import AIR, SURFACE_KINDS, Focus, LensMetadata, Medium, Prescription, Surface, takes_prescription
+from ..prescription import (AIR, SURFACE_KINDS, Focus, LensMetadata, Medium, Prescription, Surface, VariableGap, Zoom,
+                            ZoomGap, takes_prescription)
 from ..provenance import ORDER as PROVENANCE_ORDER, check_provenance_table
 from ._common import (
     takes_text,
@@ -39,6 +46,7 @@ from ._common import (
     number,
     parse_toml,
     table,
+    table_lines,
     text_field,
     toml_key,
     toml_value,
@@ -89,7 +97,7 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
 
 
 def loads_document(doc: dict, text: str, path=None, name: str | None = None) -> Prescription:
-    unknown_keys(doc, ("format", "lens", "provenance", "surface", "focus", "extras"), "top level", path)
+    unknown_keys(doc, ("format", "lens", "provenance", "surface", "focus", "zoom", "extras"), "top level", path)
     tag = doc.get("format", FORMAT_TAG)
     if tag != FORMAT_TAG:
         raise LensFileError(f"format {tag!r} is not {FORMAT_TAG!r}", path, 1)
@@ -125,6 +133,15 @@ def loads_document(doc: dict, text: str, path=None, name: str | None = None) -> 
     focus = None
     if "focus" in doc:
         focus = _focus(table(doc["focus"], "[focus]", path), surfaces, text, path)
+    zoom = None
+    if "zoom" in doc:
+        zoom = _zoom(table(doc["zoom"], "[zoom]", path), text, path)
+        if zoom.close_distance is not None:
+            if focus is not None:
+                raise LensFileError("a zoom table with close_distance gives the focus groups position by position: "
+                                    "leave out [focus]", path)
+            focus = Focus(zoom.close_distance[0], tuple(VariableGap(g.surface, g.thickness[0], g.thickness_close[0])
+                                                        for g in zoom.gaps if g.thickness_close is not None))
     prov = table(doc.get("provenance", {}), "[provenance]", path)
     check_provenance_table(prov, path)
     extras = [(f"provenance.{k}", _json(v, f"[provenance] {k}", path)) for k, v in prov.items() if k not in ("source", "notes", "licence")]
@@ -159,6 +176,7 @@ def loads_document(doc: dict, text: str, path=None, name: str | None = None) -> 
         number(lens.get("squeeze", 1.0), "[lens] squeeze", path, None, length=False),
         number(lens.get("wavelength_nm", DEFAULT_WAVELENGTH), "[lens] wavelength_nm", path, None),
         tuple(extras),
+        zoom,
     )
     mod, tstop = meta.minimum_object_distance, meta.t_stop
     if mod is not None and mod <= 0.0:
@@ -180,6 +198,62 @@ def _json(v, where, path) -> str:
 
 def _focus(f: dict, surfaces, text, path) -> Focus:
     return focus_table(f, surfaces, text, path, "gap")
+
+
+ZOOM_KEYS = ("encoder", "stop_semi_diameter", "close_distance", "stated_focal_length", "gap")
+
+
+def _numbers(v, what, path, line) -> tuple[float, ...]:
+    if not isinstance(v, list) or not v or len(v) > MAX_SURFACES:
+        raise LensFileError(f"{what} must be a list of numbers, one per zoom position", path, line)
+    return tuple(number(x, what, path, line, length=False) for x in v)
+
+
+def _zoom(z: dict, text, path) -> Zoom:
+    """The ``[zoom]`` table (module notes); positions are counted from the first gap's thicknesses."""
+    unknown_keys(z, ZOOM_KEYS, "[zoom]", path)
+    rows = z.get("gap")
+    if not isinstance(rows, list) or not rows:
+        raise LensFileError("[zoom] needs [[zoom.gap]] rows (surface, thickness = [one per position])", path)
+    lines = table_lines(text, "zoom.gap", len(rows))
+    gaps = []
+    for k, row in enumerate(rows):
+        ln = lines[k]
+        row = table(row, "[[zoom.gap]]", path, ln)
+        unknown_keys(row, ("surface", "thickness", "thickness_close"), "[[zoom.gap]]", path, ln)
+        if "surface" not in row or "thickness" not in row:
+            raise LensFileError("[[zoom.gap]] needs surface and thickness", path, ln)
+        s = row["surface"]
+        if isinstance(s, bool) or not isinstance(s, int):
+            raise LensFileError(f"[[zoom.gap]] surface must be a 0-based surface index, got {s!r}", path, ln)
+        close = row.get("thickness_close")
+        gaps.append(ZoomGap(s, _numbers(row["thickness"], "[[zoom.gap]] thickness", path, ln),
+                            None if close is None else _numbers(close, "[[zoom.gap]] thickness_close", path, ln)))
+    n = len(gaps[0].thickness)
+    if n < 2:
+        raise LensFileError("a zoom table needs at least two positions", path, lines[0])
+    opt = {key: None if key not in z else _numbers(z[key], f"[zoom] {key}", path, None)
+           for key in ("encoder", "stop_semi_diameter", "close_distance", "stated_focal_length")}
+    enc = opt["encoder"] if opt["encoder"] is not None else tuple(k / (n - 1) for k in range(n))
+    return Zoom(tuple(gaps), enc, opt["stop_semi_diameter"], opt["close_distance"], opt["stated_focal_length"])
+
+
+def _zoom_lines(z: Zoom) -> list[str]:
+    def nums(v):
+        return toml_value([float(x) for x in v])
+
+    out = ["", "[zoom]"]
+    n = z.positions
+    if z.encoder != tuple(k / (n - 1) for k in range(n)):
+        out.append(f"encoder = {nums(z.encoder)}")
+    for key in ("stop_semi_diameter", "close_distance", "stated_focal_length"):
+        if getattr(z, key) is not None:
+            out.append(f"{key} = {nums(getattr(z, key))}")
+    for g in z.gaps:
+        out += ["", "[[zoom.gap]]", f"surface = {int(g.surface)}", f"thickness = {nums(g.thickness)}"]
+        if g.thickness_close is not None:
+            out.append(f"thickness_close = {nums(g.thickness_close)}")
+    return out
 
 
 @takes_prescription
@@ -226,12 +300,14 @@ def dumps(p: Prescription) -> str:
             out.append(f"conic = {toml_value(float(s.conic))}")
         if s.aspheric:
             out.append(f"aspheric = {toml_value([float(a) for a in s.aspheric])}")
-    if p.focus is not None:
+    if p.focus is not None and (p.zoom is None or p.zoom.close_distance is None):
         out += ["", "[focus]", f"close_distance = {toml_value(float(p.focus.close_distance))}"]
         for g in p.focus.gaps:
             out += ["", "[[focus.gap]]", f"surface = {int(g.surface)}",
                     f"thickness_infinity = {toml_value(float(g.thickness_infinity))}",
                     f"thickness_close = {toml_value(float(g.thickness_close))}"]
+    if p.zoom is not None:
+        out += _zoom_lines(p.zoom)
     if extras:
         out += ["", "[extras]"] + extras
     return "\n".join(out) + "\n"

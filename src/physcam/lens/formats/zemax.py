@@ -33,21 +33,41 @@ last surface (``TOL``, ``MNUM``, ``MOFF``, ``BLNK``... lines, as OpticStudio wri
 
 The radius is read back as the shortest decimal whose reciprocal is the file's CURV,
 so a radius written by :func:`dumps` (``CURV`` = 1/R to 17 digits) reads back equal.
+
+Multi-configuration files (a zoom lens): ``MNUM n active`` and the configuration editor's rows as
+OpticStudio writes them, operand-major, ``THIC surface config value ...`` (a thickness per
+configuration, 1-based configurations, Zemax surface numbers) and ``APER 0 config value ...``
+(the system aperture per configuration, read under the file's ENPD/FNUM/OBNA kind: a tabulated stop
+size). ``SDIA`` of the stop tabulates its semi-diameter directly. Thickness solves in a ``SURF``
+block are applied in every configuration: ``TCOM s total`` (compensator: this thickness plus surface
+s's stays ``total``) and ``TOLE s total`` (position: the thicknesses from surface s through this one
+add up to ``total``); with words instead of numbers they are read as comments. The configurations
+become the zoom table (:class:`~physcam.lens.prescription.Zoom`, positions in configuration order,
+the lens's surfaces at configuration 1), the gaps that differ its zoom gaps. Rows that do not change
+a lens's first-order optics (:data:`MC_IGNORED`: field points, vignetting, weights, ``MOFF``) are
+read past; any other operand (curvature, glass, conic, a varying object distance...) is refused
+with its line, since physcam's zoom moves gaps only.
 """
 
 from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import replace
 from pathlib import Path
 
 from ...errors import ExportError, InputError, LensFileError, PhysCamWarning
 from ..aperture import size_stop
 from ..catalog import LEGACY, LEGACY_SOURCE, GlassNotFound, find_glass, range_note, resolve_glass
-from ..prescription import AIR, OBJECT_DISTANCE_KEY, LensMetadata, Medium, Prescription, Surface, takes_prescription
+from ..prescription import (AIR, OBJECT_DISTANCE_KEY, LensMetadata, Medium, Prescription, Surface, Zoom, ZoomGap,
+                            takes_prescription)
 from ._common import MAX_SURFACES, check_count, extra, fmt, json_text, number, one_line, validated, takes_text
 
-__all__ = ["loads", "dumps", "SKIPPED"]
+__all__ = ["loads", "dumps", "SKIPPED", "MC_IGNORED"]
+
+#: Multi-configuration operands read past: they set fields, vignetting, weights or nothing, not the lens.
+MC_IGNORED = {"MOFF", "FVCX", "FVCY", "FVDX", "FVDY", "FVAN", "XFIE", "YFIE", "FLWT", "FLTP", "WLWT", "PRWV",
+              "CONF", "MCOM", "NOTE", "HOLD", "TCED", "POPD"}
 
 #: Lines read past, with the reason (docs/lens-formats.md lists them).
 SKIPPED = {
@@ -60,8 +80,7 @@ SKIPPED = {
     "XFLN": "field points: physcam analyses its own fields",
     "YFLN": "field points: physcam analyses its own fields",
     "TOL": "tolerance data",
-    "MNUM": "multi-configuration data",
-    "MOFF": "multi-configuration data",
+    "MOFF": "an unused multi-configuration row",
     "BLNK": "spacer line after the surfaces",
 }
 # Lines after the last surface that show the file goes on (it was not cut short there).
@@ -122,6 +141,8 @@ def _surface_line(cur: dict, key: str, tok: list, raw: str, path, lineno: int) -
     elif key == "GLAS":
         cur["glass"] = tok
         cur["glass_line"] = lineno
+    elif key in ("TCOM", "TOLE"):
+        cur["solve"] = _solve(key, tok, path, lineno)
     elif key in ("DECX", "DECY", "TILTX", "TILTY", "COORD", "CBRK"):
         raise LensFileError(f"{key} (decentre/tilt) is not supported in a rotationally symmetric lens", path, lineno)
     elif key in _IGNORED or key in ("COMM", "NAME", "NOTE", "DISZ"):
@@ -132,11 +153,22 @@ def _surface_line(cur: dict, key: str, tok: list, raw: str, path, lineno: int) -
         raise LensFileError(f"unrecognised line {raw.strip()[:40]!r}", path, lineno)
 
 
+def _solve(key, tok, path, lineno):
+    """(kind, Zemax surface, total, line) of a thickness solve; None for the words of a comment."""
+    try:
+        s, total = int(tok[1]), float(tok[2])
+    except (IndexError, ValueError):
+        return None
+    if s < 0 or not math.isfinite(total):
+        raise LensFileError(f"{key} solve needs a surface number and a finite total", path, lineno)
+    return key, s, total, lineno
+
+
 def _read_blocks(text: str, path):
     """The file's lines as (surface blocks, lens name, notes, header: catalogues, wavelengths, aperture)."""
     blocks: list[dict] = []
     lens_name, notes = None, []
-    head = {"gcat": [], "wavm": {}, "wavl": [], "pwav": 1, "tail": False, "aperture": None}
+    head = {"gcat": [], "wavm": {}, "wavl": [], "pwav": 1, "tail": False, "aperture": None, "mnum": None, "mc": []}
     cur = None
     for lineno, raw in enumerate(text.splitlines(), start=1):
         tok = raw.split()
@@ -148,6 +180,15 @@ def _read_blocks(text: str, path):
             continue
         if key in _TAIL:
             head["tail"] = True
+        if key == "MNUM":
+            n = _num(tok, 1, "MNUM (number of configurations)", path, lineno, length=False)
+            if n != int(n) or not 1 <= n <= 1000:
+                raise LensFileError(f"MNUM {tok[1]} is not a number of configurations (1..1000)", path, lineno)
+            head["mnum"] = (int(n), lineno)
+            continue
+        if head["mnum"] is not None and raw[:1] not in (" ", "\t") and key != "SURF":
+            head["mc"].append((key, tok, lineno))
+            continue
         if key == "SURF":
             head["tail"] = False
             if len(tok) < 2:
@@ -189,7 +230,7 @@ def _asphere_terms(b: dict, path, ln: int) -> tuple:
 def _lens_surfaces(lens_blocks: list, path) -> tuple[list, list]:
     """(surfaces, their file lines) of the blocks between object and image; a stop on a lens face becomes a flat
     stop at the face's vertex."""
-    surfaces, lines = [], []
+    surfaces, lines, owner = [], [], []
     for i, b in enumerate(lens_blocks):
         ln = b["line"]
         if not math.isfinite(b["disz"]):
@@ -206,7 +247,7 @@ def _lens_surfaces(lens_blocks: list, path) -> tuple[list, list]:
             before = surfaces[-1].medium if surfaces else AIR
             surfaces.append(Surface(0.0, 0.0, before, b["diam"], "stop"))
             lines.append(ln)
-            b["stop"] = False
+            b["stop"], b["was_stop"] = False, True
         if b["stop"]:
             kind = "stop"
         elif b["type"] == "EVENASPH" and (aspheric or b["coni"] != 0.0):
@@ -218,7 +259,8 @@ def _lens_surfaces(lens_blocks: list, path) -> tuple[list, list]:
         surfaces.append(Surface(radius, b["disz"], medium, b["diam"], kind, b["coni"] if kind == "aspheric" else 0.0,
                                 aspheric))
         lines.append(ln)
-    return surfaces, lines
+        owner.append(len(surfaces) - 1)
+    return surfaces, lines, owner
 
 
 @takes_text
@@ -236,13 +278,17 @@ def loads(text: str, path=None, name: str | None = None) -> Prescription:
     if obj["glass"] is not None and obj["glass"] != AIR:
         raise LensFileError("the object space must be air", path, obj.get("glass_line", obj["line"]))
     check_count(len(lens_blocks), path)
-    surfaces, lines = _lens_surfaces(lens_blocks, path)
+    surfaces, lines, owner = _lens_surfaces(lens_blocks, path)
     if name is None:
         name = lens_name or (Path(path).stem if path is not None else "unnamed lens")
     meta = LensMetadata(name=name, notes="\n".join(notes) or None)
     extras = () if math.isinf(obj["disz"]) else ((OBJECT_DISTANCE_KEY, json_text(obj["disz"])),)
     p = Prescription(tuple(surfaces), meta, wavelength_nm=_design_wavelength(head, path), extras=extras)
-    p = validated(_sized(p, head["aperture"], obj["disz"], path), path, lines)
+    if head["mnum"] is not None and head["mnum"][0] > 1:
+        p = _configurations(p, blocks, owner, head, path, lines)
+    else:
+        p = _sized(p, head["aperture"], obj["disz"], path)
+    p = validated(p, path, lines)
     _say_glasses(found, head["gcat"], p.wavelength_nm, path)
     return p
 
@@ -270,6 +316,108 @@ def _say_glasses(found: list, gcat: list, wavelength_nm: float, path) -> None:
     if outside:
         warnings.warn(f"{where}the design wavelength {wavelength_nm:g} nm lies outside the stated range of "
                       f"{'; '.join(outside)}: its formula is extrapolated there", PhysCamWarning, stacklevel=4)
+
+
+def _mc_values(head, path) -> dict:
+    """``{(operand, number): [value per configuration]}`` of the configuration rows (module notes)."""
+    n, mline = head["mnum"]
+    rows: dict = {}
+    for key, tok, ln in head["mc"]:
+        if key in MC_IGNORED or (key in _TAIL and key not in ("MNUM",)):
+            continue
+        if key not in ("THIC", "APER", "SDIA"):
+            raise LensFileError(f"multi-configuration operand {key} changes the lens in a way physcam's zoom does not "
+                                "model (only THIC gaps, APER and the stop's SDIA are read)", path, ln)
+        num = _num(tok, 1, f"{key} number", path, ln, length=False)
+        cfg = _num(tok, 2, f"{key} configuration", path, ln, length=False)
+        if cfg != int(cfg) or not 1 <= cfg <= n:
+            raise LensFileError(f"{key} configuration {tok[2]} is not 1..{n} (MNUM {n})", path, ln)
+        row = rows.setdefault((key, int(num)), [None] * n)
+        row[int(cfg) - 1] = (_num(tok, 3, f"{key} value", path, ln, length=False), ln)
+    for (key, num), row in rows.items():
+        if None in row:
+            raise LensFileError(f"{key} {num} has no value for configuration {row.index(None) + 1} of {n}", path,
+                                next(r[1] for r in row if r is not None))
+    return rows
+
+
+def _configurations(p: Prescription, blocks, owner, head, path, lines) -> Prescription:
+    """``p`` at configuration 1 with the other configurations as its zoom table (module notes)."""
+    n = head["mnum"][0]
+    rows = _mc_values(head, path)
+    nz = len(blocks) - 1  # the image surface's Zemax number
+    thick = [[b["disz"] for b in blocks] for _ in range(n)]
+    for (key, num), row in rows.items():
+        if key != "THIC":
+            continue
+        if not 0 <= num <= nz:
+            raise LensFileError(f"THIC {num}: the lens has surfaces 0..{nz}", path, row[0][1])
+        if num == 0 and len({v for v, _ in row}) > 1:
+            raise LensFileError("THIC 0 (the object distance) changes between configurations: a zoom x focus grid in "
+                                "one .zmx is not read; write a physcam zoom TOML (docs/zoom.md)", path, row[0][1])
+        for c, (v, _) in enumerate(row):
+            thick[c][num] = v
+    for c in range(n):
+        _apply_solves(thick[c], blocks, path)
+    gaps = []
+    for z in range(1, nz):
+        values = tuple(thick[c][z] for c in range(n))
+        if len(set(values)) > 1:
+            gaps.append(ZoomGap(owner[z - 1], values))
+    if not gaps:
+        raise LensFileError(f"MNUM {n}: no gap differs between the configurations, so this is no zoom", path,
+                            head["mnum"][1])
+    base = p.with_thicknesses({g.surface: g.thickness[0] for g in gaps})
+    stops = _stop_table(base, rows, gaps, head, n, blocks, path)
+    if stops is not None:
+        k = base.stop_index
+        base = base.with_surfaces(s if i != k else replace(s, semi_diameter=stops[0]) for i, s in enumerate(base.surfaces))
+        stops = None if len(set(stops)) == 1 else stops  # one size at every configuration: a fixed stop
+    return replace(base, zoom=Zoom(tuple(gaps), tuple(c / (n - 1) for c in range(n)), stops))
+
+
+def _apply_solves(t: list, blocks, path) -> None:
+    """Thickness solves (TCOM, TOLE) of one configuration, in surface order, into ``t`` (by Zemax number)."""
+    for j, b in enumerate(blocks):
+        solve = b.get("solve")
+        if solve is None:
+            continue
+        kind, s, total, ln = solve
+        if not 0 < s <= j or (kind == "TCOM" and s == j):
+            raise LensFileError(f"{kind} {s}: the solve of surface {j} refers to a surface at or after it", path, ln)
+        t[j] = total - (t[s] if kind == "TCOM" else sum(t[s:j]))
+        if t[j] < 0:
+            raise LensFileError(f"{kind} {s} {total:g} gives surface {j} a negative thickness {t[j]:g} mm in one "
+                                "configuration", path, ln)
+
+
+def _stop_table(base, rows, gaps, head, n, blocks, path):
+    """The stop's semi-diameter per configuration: SDIA of the stop, else APER under the file's aperture kind."""
+    zemax_stop = next((k for k, b in enumerate(blocks) if b["stop"] or b.get("was_stop")), None)
+    for (key, num), row in rows.items():
+        if key == "SDIA" and num != zemax_stop and len({v for v, _ in row}) > 1:
+            raise LensFileError(f"SDIA {num}: only the stop's semi-diameter may change between configurations",
+                                path, row[0][1])
+    if ("SDIA", zemax_stop) in rows:
+        return tuple(v for v, _ in rows[("SDIA", zemax_stop)])
+    aper = rows.get(("APER", 0))
+    if aper is None:
+        if head["aperture"] is None or head["aperture"][0] == "FLOA":
+            return None
+        values = [head["aperture"][1]] * n
+        ln = head["aperture"][2]
+    else:
+        values, ln = [v for v, _ in aper], aper[0][1]
+        if head["aperture"] is None or head["aperture"][0] == "FLOA":
+            raise LensFileError("APER rows need the file's aperture kind (ENPD, FNUM or OBNA), not float by stop size",
+                                path, ln)
+    kind = head["aperture"][0]
+    out = []
+    for c in range(n):
+        q = base.with_thicknesses({g.surface: g.thickness[c] for g in gaps})
+        q = _sized(q, (kind, values[c], ln), blocks[0]["disz"], path)
+        out.append(q.surfaces[q.stop_index].semi_diameter)
+    return tuple(out)
 
 
 def _sized(p: Prescription, aperture, object_distance: float, path) -> Prescription:
@@ -423,6 +571,7 @@ def dumps(p: Prescription) -> str:
                 out.append(f"  GLAS ___BLANK 1 0 {fmt(m.nd)} {fmt(m.vd)} {fmt(m.dpgf)} 0 0 0 0 0")
         out.append(f"  DIAM {fmt(s.semi_diameter)} 1 0 0 1 \"\"")
     out += [f"SURF {len(p.surfaces) + 1}", "  TYPE STANDARD", "  CURV 0.0", "  DISZ 0.0"]
+    out += _mc_lines(p)
     if cats:
         out.insert(gcat_at, "GCAT " + " ".join(dict.fromkeys(cats)))
     if p.surfaces[-1].medium != AIR:
@@ -431,6 +580,24 @@ def dumps(p: Prescription) -> str:
 
 
 _MAKER_OF = {legacy: maker for maker, legacy in LEGACY.items()}
+
+
+def _mc_lines(p: Prescription) -> list[str]:
+    """The configuration rows of a zoom lens (operand-major THIC, the stop's SDIA); its close-focus grid
+    and uneven encoder places are dropped with a warning (a .zmx configuration has no such field)."""
+    z = p.zoom
+    if z is None:
+        return []
+    if z.close_distance is not None or z.encoder != tuple(c / (z.positions - 1) for c in range(z.positions)):
+        warnings.warn(f"Zemax writer drops the zoom x focus grid and the encoder places of lens {p.name!r}",
+                      PhysCamWarning, stacklevel=4)
+    rows = [f"MNUM {z.positions} 1"]
+    for g in z.gaps:
+        rows += [f"THIC {g.surface + 1} {c + 1} {fmt(t)} 0 0 0 1 1 1 0 0 \"\" 0" for c, t in enumerate(g.thickness)]
+    if z.stop_semi_diameter is not None:
+        rows += [f"SDIA {p.stop_index + 1} {c + 1} {fmt(v)} 0 0 0 1 1 1 0 0 \"\" 0"
+                 for c, v in enumerate(z.stop_semi_diameter)]
+    return rows
 
 
 def _named(m: Medium):

@@ -1,5 +1,7 @@
-// physcam serve: the page. Every number shown comes from the server's /api/report (the CLI's
-// --json); this script only reads the form, keeps the setup in the URL and formats lengths.
+// physcam serve: the page. The numbers come from the server's /api/report (the CLI's --json); with a
+// thin lens or a datasheet the page's own solver (onset.js, the same report in JavaScript) answers
+// first and whenever the server cannot be reached, so the page works with the laptop off (sw.js keeps
+// the page and the camera table). This script reads the form, keeps the setup in the URL, formats lengths.
 "use strict";
 
 const $ = (id) => document.getElementById(id);
@@ -7,7 +9,7 @@ const DEBOUNCE_MS = 25; // the numbers: as soon as typing pauses for a moment
 const SETTLE_MS = 250; // the table, the chart and the diagram: once the setup has settled
 const DEFAULT_SENSOR = "s35-4perf";
 const DEFAULT_COC = "d/1500";
-const COCS = ["d/1500", "d/1000", "d/1730", "cine"];
+const COCS = ["d/1500", "d/1000", "d/1730", "cine", "full-frame", "16mm"];
 const MARKS = {
   metric: ["0.5m", "0.75m", "1m", "1.25m", "1.5m", "2m", "2.5m", "3m", "4m", "5m", "7m", "10m", "15m", "20m"],
   imperial: ["2ft", "3ft", "4ft", "5ft", "6ft", "7ft", "8ft", "10ft", "12ft", "15ft", "20ft", "25ft", "35ft", "50ft"],
@@ -148,24 +150,25 @@ async function update() {
   history.replaceState(null, "", query ? `?${query}` : location.pathname);
   $("share-url").value = location.href;
   $("json-link").href = `/api/report?${api}`;
+  const local = localReport(api);
+  if (local && local.ok) showReport(local.body, "page");
   let res;
   try {
     res = await getJSON("report", `/api/report?${api}`);
   } catch (e) {
     if (e.name === "AbortError") return;
-    if (my === seq) { showMessage("the physcam server cannot be reached; is it still running?"); setStale(true); }
+    if (my !== seq) return;
+    offline(local, api, my);
     return;
   }
   if (my !== seq) return;
+  document.body.dataset.offline = "";
   if (!res.ok) {
     showMessage(res.body && res.body.error ? res.body.error : `the server answered HTTP ${res.status}`);
     setStale(true);
     return;
   }
-  showMessage("");
-  setStale(false);
-  st.report = res.body;
-  render(res.body);
+  showReport(res.body, "server");
   clearTimeout(settle);
   settle = setTimeout(() => {
     if (my !== seq) return;
@@ -173,6 +176,53 @@ async function update() {
     table(res.body, api, my);
     diagram(res.body);
   }, SETTLE_MS);
+}
+
+// --- the page's own solver (onset.js): first, and whenever the server is away ---------------------
+function localReport(api) {
+  if (!window.PhysOnset || api.has("lens") || !SENSORS.length) return null;
+  return PhysOnset.report(Object.fromEntries(api), SENSORS);
+}
+
+function showReport(d, source) {
+  showMessage("");
+  setStale(false);
+  st.report = d;
+  // the CoC in force, in every answer: its value on this sensor and its convention's name
+  $("coc-active").textContent = `circle of confusion ${d.coc_mm.toFixed(4)} mm · ${d.coc_convention}`;
+  document.body.dataset.source = source; // "page" (onset.js) or "server" (the CLI's numbers)
+  render(d);
+  if (window.PhysTools) PhysTools.afterReport(d); // frame, split focus, diopters (tools.js)
+}
+
+function offline(local, api, my) {
+  document.body.dataset.offline = "1";
+  if (!local) {
+    showMessage("the physcam server cannot be reached: a library lens needs it (its prescription is traced there); "
+      + "a focal length is computed in the page");
+    setStale(true);
+    return;
+  }
+  if (!local.ok) {
+    showMessage(local.body.error);
+    setStale(true);
+    return;
+  }
+  showReport(local.body, "page");
+  localTable(local.body, api, my);
+  $("dof-chart").hidden = true;
+}
+
+function localTable(d, api, my) {
+  // the focus marks' rows from onset.js, as /api/focus-table would give them
+  const p = Object.fromEntries(api);
+  for (const k of ["focus", "near", "far", "fstop", "coc"]) delete p[k];
+  const marks = MARKS[st.units];
+  const rows = marks.map((m) => {
+    const r = PhysOnset.report({ ...p, fstop: String(d.fstop), coc: String(d.coc_mm), focus: m }, SENSORS);
+    return r.ok ? { focus: m, report: r.body } : { focus: m, error: r.body.error };
+  });
+  if (my === seq) fillMarks(d, rows, marks);
 }
 
 // --- what comes back -------------------------------------------------------------------------
@@ -300,11 +350,16 @@ async function table(d, api, my) {
   try {
     res = await getJSON("table", `/api/focus-table?${p}`);
   } catch (e) {
+    if (e.name !== "AbortError" && localReport(api)) localTable(d, api, my);
     return;
   }
   if (my !== seq || !res.ok) return;
+  fillMarks(d, res.body, marks);
+}
+
+function fillMarks(d, answers, marks) {
   const body = $("marks").tBodies[0];
-  const rows = res.body.map((row, k) => {
+  const rows = answers.map((row, k) => {
     const tr = document.createElement("tr");
     tr.dataset.focus = marks[k];
     const label = document.createElement("td");
@@ -359,7 +414,9 @@ function fillSensors(filter) {
   const sel = $("sensor");
   const cur = sel.value;
   const f = norm(filter || "");
-  const rows = SENSORS.filter((s) => !f || [s.key, s.name, ...s.aliases].some((x) => norm(x).includes(f)));
+  const cam = $("camera").value; // a camera: its recording formats only
+  const rows = SENSORS.filter((s) => (!cam || cameraOf(s) === cam)
+    && (!f || [s.key, s.name, ...s.aliases].some((x) => norm(x).includes(f))));
   const opts = rows.map(sensorOption);
   if (!rows.length) {
     const keep = SENSORS.find((s) => s.key === cur);
@@ -373,6 +430,15 @@ function fillSensors(filter) {
   const values = [...sel.options].map((o) => o.value);
   sel.value = values.includes(cur) ? cur : (rows.length ? rows[0].key : cur);
   if (sel.value !== cur) sensorChanged();
+}
+
+function cameraOf(s) { return s.camera ? `${s.maker} ${s.camera}` : ""; }
+
+function fillCameras() {
+  // the camera table's cameras, by maker; "" the sensors and film gates of sensors.csv
+  const sel = $("camera");
+  const names = [...new Set(SENSORS.map(cameraOf).filter(Boolean))];
+  sel.replaceChildren(new Option("all sensors, gates and formats", ""), ...names.map((n) => new Option(n, n)));
 }
 
 function findSensor(text) {
@@ -459,6 +525,7 @@ function applyState(q, serverUnits) {
   for (const id of ["fstop", "tstop", "focus", "near", "far", "sensor-width", "sensor-height"]) {
     $(id).value = q.get(id) || (empty && DEFAULTS[id] ? DEFAULTS[id] : "");
   }
+  fillCameras();
   fillSensors("");
   if (q.has("sensor-width") || q.has("sensor-height")) {
     $("sensor").value = "custom";
@@ -469,6 +536,13 @@ function applyState(q, serverUnits) {
     $("sensor").value = DEFAULT_SENSOR;
   }
   $("custom-sensor").hidden = $("sensor").value !== "custom";
+  const chosen = SENSORS.find((x) => x.key === $("sensor").value);
+  if (chosen && chosen.camera) { // the camera picker shows the format's camera, the format picker its formats
+    const key = chosen.key;
+    $("camera").value = cameraOf(chosen);
+    fillSensors("");
+    $("sensor").value = key;
+  }
   const sq = q.get("squeeze") || "1";
   if ([...$("squeeze").options].some((o) => Number(o.value) === Number(sq))) {
     $("squeeze").value = [...$("squeeze").options].find((o) => Number(o.value) === Number(sq)).value;
@@ -482,10 +556,12 @@ function wire() {
   const form = $("setup");
   form.addEventListener("input", (e) => {
     if (e.target.id === "sensor-search") fillSensors(e.target.value);
+    else if (e.target.id === "camera") fillSensors(val("sensor-search"));
     else schedule();
   });
   form.addEventListener("change", (e) => {
     if (e.target.id === "sensor") sensorChanged();
+    else if (e.target.id === "camera") fillSensors(val("sensor-search"));
     else if (e.target.id === "coc") {
       $("field-coc-mm").hidden = $("coc").value !== "custom";
       update();
@@ -523,7 +599,35 @@ function wire() {
   }
 }
 
+function offerCoc() {
+  // first use: the common conventions offered by name (d/1500 gives 0.0207 mm on Super 35 where a puller's
+  // app says 0.025); the choice is kept on this phone
+  let chosen = null;
+  try { chosen = localStorage.getItem("physcam-coc"); } catch (e) { /* private mode */ }
+  const q = new URLSearchParams(location.search);
+  if (chosen && !q.has("coc")) setCoc(chosen);
+  $("coc-first").hidden = !!chosen || q.has("coc");
+  for (const b of $("coc-first").querySelectorAll("button")) {
+    b.addEventListener("click", () => {
+      setCoc(b.dataset.coc);
+      try { localStorage.setItem("physcam-coc", b.dataset.coc); } catch (e) { /* private mode */ }
+      $("coc-first").hidden = true;
+      update();
+    });
+  }
+}
+
+function registerWorker() {
+  // the installable web app: sw.js keeps the page and the camera table (a secure context only:
+  // localhost, 127.0.0.1 or HTTPS; docs/serve.md)
+  if (!("serviceWorker" in navigator) || !window.isSecureContext) return;
+  navigator.serviceWorker.register("/sw.js").then(() => navigator.serviceWorker.ready)
+    .then(() => { document.body.dataset.worker = "ready"; })
+    .catch(() => { document.body.dataset.worker = "failed"; });
+}
+
 async function start() {
+  registerWorker();
   try {
     const t = localStorage.getItem("physcam-theme");
     if (t === "light" || t === "dark") document.documentElement.dataset.theme = t;
@@ -532,14 +636,20 @@ async function start() {
   const q = new URLSearchParams(location.search);
   let serverUnits = "m";
   try {
-    const r = await fetch("/api/sensors");
+    const r = await fetch("/api/sensors"); // the camera table: from the server, or the worker's copy offline
     SENSORS = await r.json();
-    serverUnits = (await (await fetch("/api/health")).json()).units || "m";
   } catch (e) {
     showMessage("the physcam server cannot be reached; is it still running?");
     return;
   }
+  try { // the server's unit system (its user config); offline, the last one it said
+    serverUnits = (await (await fetch("/api/health")).json()).units || "m";
+    try { localStorage.setItem("physcam-server-units", serverUnits); } catch (e) { /* private mode */ }
+  } catch (e) {
+    try { serverUnits = localStorage.getItem("physcam-server-units") || "m"; } catch (e2) { /* private mode */ }
+  }
   applyState(q, serverUnits);
+  offerCoc();
   const lensesLoaded = fetch("/api/lenses").then((r) => r.json()).then((l) => fillLenses(l, q.get("lens")))
     .catch(() => {});
   if (st.lensmode === "library") await lensesLoaded;

@@ -1,0 +1,97 @@
+"""The page with the laptop off: installable (manifest, service worker), and a new setup opened from the
+browser's cache by the page's own URL parameters, once the server is stopped, shows the CLI's numbers.
+
+Real Chromium (Debian's, headless) through Playwright, a real `physcam serve` process that the test stops.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import pytest
+from _serve_helpers import request, running_server
+
+from physcam.cli import main
+
+pytestmark = pytest.mark.slow
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+if CHROMIUM is None:
+    pytest.skip("Debian's chromium is not installed here (`make test` installs it as root); the browser tests need "
+                "it", allow_module_level=True)
+sync_api = pytest.importorskip("playwright.sync_api", reason="playwright (the test extra) is not installed")
+
+SUMMARY = {"out-near": "near_from_film_mm", "out-far": "far_from_film_mm", "out-total": "total_mm",
+           "out-hyperfocal": "hyperfocal_from_film_mm"}
+
+
+def cli_report(capsys, *argv):
+    capsys.readouterr()
+    assert main(["report", *argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def metric(mm):
+    return "∞" if mm is None else (f"{mm / 10:.1f} cm" if abs(mm) < 1000 else f"{mm / 1000:.2f} m")
+
+
+def shown(pg) -> dict:
+    return pg.evaluate("(ids) => Object.fromEntries(ids.map((id) => { const e = document.getElementById(id);"
+                       " return [id, [e.dataset.mm, e.textContent]]; }))", list(SUMMARY))
+
+
+def assert_numbers(pg, doc):
+    for el, key in SUMMARY.items():
+        mm, text = shown(pg)[el]
+        want = doc["dof"][key]
+        if want is None:
+            assert mm == "inf" and text == "∞", el
+        else:
+            assert float(mm) == pytest.approx(want, rel=1e-9), el
+            assert text == metric(want), el
+
+
+def test_manifest_and_worker_are_served():
+    with running_server() as (_, port, _proc):
+        status, headers, body = request(port, "/manifest.webmanifest")
+        m = json.loads(body)
+        assert status == 200 and m["start_url"] == "/" and m["display"] == "standalone"
+        assert {"192x192", "512x512"} <= {i["sizes"] for i in m["icons"]}
+        for icon in m["icons"]:
+            assert request(port, icon["src"])[0] == 200
+        status, headers, body = request(port, "/sw.js")
+        assert status == 200 and b"caches" in body and "javascript" in headers.get("content-type", "")
+        assert request(port, "/static/onset.js")[0] == 200
+
+
+def test_a_new_setup_opens_from_the_cache_with_the_server_stopped(capsys):
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"])
+        try:
+            ctx = b.new_context(viewport={"width": 390, "height": 844}, is_mobile=True, has_touch=True)
+            pg = ctx.new_page()
+            pg.set_default_timeout(30_000)
+            errors: list[str] = []
+            pg.on("pageerror", lambda e: errors.append(str(e)))
+            with running_server() as (url, _port, proc):
+                pg.goto(url)
+                pg.wait_for_selector("body[data-ready='1'][data-worker='ready']")
+                # the worker controls the page and holds the page, its scripts and the camera table
+                pg.wait_for_function("async () => navigator.serviceWorker.controller !== null"
+                                     " && !!(await caches.match('/api/sensors')) && !!(await caches.match('/'))"
+                                     " && !!(await caches.match('/static/onset.js'))")
+            assert proc.poll() is not None  # the laptop is off
+            for query, argv in ((("focal=35&fstop=4&focus=2m&sensor=S35"),
+                                 ("--focal", "35", "--fstop", "4", "--focus", "2m", "--sensor", "S35")),
+                                (("focal=50&fstop=2.8&focus=3m&sensor=FX6%20FF%204K%2017%3A9"),
+                                 ("--focal", "50", "--fstop", "2.8", "--focus", "3m", "--sensor", "FX6 FF 4K 17:9"))):
+                pg.goto(f"{url}?{query}")
+                pg.wait_for_selector("body[data-ready='1'][data-source='page'][data-offline='1']")
+                doc = cli_report(capsys, *argv)
+                assert_numbers(pg, doc)
+                assert pg.locator("#sensor").input_value() == doc["sensor"]["key"]
+            ctx.close()
+        finally:
+            b.close()
+    assert not errors, errors
