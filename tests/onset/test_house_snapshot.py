@@ -1,6 +1,6 @@
 """The report of every bundled lens is what it was before issue 43 rebuilt the house around one camera
 (tests/data/house_snapshot.json, written by scripts/report_snapshot.py from the code of main at
-e8024b3), number by number; and a report of a prescription focuses the lens at most twice.
+e8024b3, rewritten from main at cdf2d0b after its new lenses and report keys), number by number; and a report of a prescription focuses the lens at most twice.
 
 Tolerances: 1e-12 relative. The hyperfocal mark is now solved as a fixed point in the subject's distance
 (physcam.optics.focusing.hyperfocal_state) instead of one focus search per step, each stopping at 1e-9 of

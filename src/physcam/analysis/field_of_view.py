@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, renamed_parameter, require_finite, require_positive
+from ..errors import InputError, renamed_parameter, require_finite, require_positive, require_type
 from ..lens.prescription import Prescription, takes_prescription
 
 __all__ = ["RealFieldOfView", "real_field_of_view", "real_field_of_view_focused", "chief_ray_field_limit",
@@ -165,8 +165,11 @@ def real_field_of_view_focused(lens: Prescription, focused: Prescription, film_z
     from ..trace import RayBatch, trace_through
     from ._chief import aim_from_film
 
-    w, h, fz = float(sensor_width_mm), float(sensor_height_mm), float(film_z)
-    wl = lens.wavelength_nm if wavelength_nm is None else wavelength_nm
+    require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name)")
+    require_type("focused", focused, Prescription, "physcam.optics.focusing.focus(lens, mark).prescription")
+    w, h = require_positive("sensor width", sensor_width_mm), require_positive("sensor height", sensor_height_mm)
+    fz = require_finite("film_z", film_z)
+    wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
     # paraxial: tangents of the paraxial chief rays to the edge (X) and the top (Y)
     tx = math.tan(abs(paraxial.field_angle(focused, w / 2.0, fz, "x", wl)))
     ty = math.tan(abs(paraxial.field_angle(focused, h / 2.0, fz, "y", wl)))

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from ..errors import InputError, OpticsError
+from ..errors import InputError, OpticsError, require_type
 from ..optics import dof as _dof
 from ..optics.lens_model import PrincipalPlanes, lens_model_of
 from ..optics.thinlens import MIN_F_NUMBER
@@ -101,6 +101,8 @@ def require_possible_f_number(n: float, name: str = "f-stop") -> None:
 def hyperfocal_parameters(planes: PrincipalPlanes, s: float, near, far):
     """h from the near limit and from a finite far limit (None where not measured), about H1 for the
     focus s (from H1)."""
+    require_type("planes", planes, PrincipalPlanes, "physcam.onset.solvers.principal_planes(camera)")
+    s = float(s)
     hp_near = hp_far = None
     if near is not None and math.isinf(s):
         hp_near = planes.to_h1(near, s)  # focused at infinity the near limit is h itself (s -> inf)

@@ -158,6 +158,7 @@ def principal_planes(at) -> PrincipalPlanes:
     (a :class:`~physcam.optics.lens_model.LensAtMark`, or the camera whose it is)."""
     if isinstance(at, CameraState):
         at = at.at_mark
+    require_type("at", at, LensAtMark, "a CameraState, or its at_mark")
     return PrincipalPlanes.of(at)
 
 

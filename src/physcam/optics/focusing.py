@@ -29,7 +29,7 @@ import math
 from dataclasses import asdict, dataclass
 
 from ..data.default_sensor import DEFAULT_SENSOR_WIDTH_MM
-from ..errors import InputError, OpticsError, renamed_parameter, require_positive
+from ..errors import InputError, OpticsError, renamed_parameter, require_positive, require_type
 from ..lens.prescription import Prescription, takes_prescription
 from . import paraxial
 
@@ -483,6 +483,7 @@ def planes_of(state: FocusState, *, stop_semi_diameter: float | None = None, wav
               flange_focal_distance_mm: float | None = None) -> TechnicalPlanes:
     """:class:`TechnicalPlanes` of a lens already focused (a :class:`FocusState`: no focus solved here),
     its iris ``stop_semi_diameter`` (None: the file's stop), in the state's own meridian."""
+    require_type("state", state, FocusState, "physcam.optics.focusing.focus(lens, mark)")
     g = paraxial.gaussian(state.prescription, axis=state.axis, wavelength_nm=wavelength_nm,
                           stop_semi_diameter=stop_semi_diameter, object_z=state.object_z, film_z=state.film_z,
                           flange_focal_distance_mm=flange_focal_distance_mm)
