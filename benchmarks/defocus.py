@@ -15,8 +15,8 @@ import time
 
 import numpy as np
 
-from physcam.analysis.defocus import defocus, inverse_depth
-from physcam.analysis.defocus_kernels import KernelCache, defocus_camera
+from physcam.analysis.defocus.render import defocus, inverse_depth
+from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
 from physcam.lens.library import load_lens
 
 

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from physcam.analysis.defocus import defocus, inverse_depth
-from physcam.analysis.defocus_exr import read_exr
-from physcam.analysis.defocus_kernels import KernelCache, defocus_camera
+from physcam.analysis.defocus.render import defocus, inverse_depth
+from physcam.analysis.defocus.exr import read_exr
+from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
 from physcam.lens.library import load_lens
 from physcam.trace.aperture import Aperture
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import warnings
 
-from physcam.analysis.real_dof import real_depth_of_field
+from physcam.analysis.defocus.real_dof import real_depth_of_field
 from physcam.errors import PhysCamError
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report

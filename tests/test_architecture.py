@@ -79,6 +79,58 @@ def test_imports_point_down_the_layers():
     assert not wrong, "upward imports:\n" + "\n".join(sorted(wrong))
 
 
+#: analysis/'s packages, one concept each (issue 43), each with a layer of its own below physcam.onset: the
+#: modules at analysis/'s own level (``_chief``, ``_plot``, ``_camera``, ``centroid``) are what they all share
+ANALYSIS_LAYER = {
+    "analysis": 0,
+    "analysis.image_quality": 1,
+    "analysis.distortion": 2,
+    "analysis.framing": 3,
+    "analysis.defocus": 4,
+    "analysis.calibration": 5,
+    "analysis.lens_cards": 6,
+}
+
+
+def _analysis_package(dotted: str) -> str:
+    """analysis's package of a module path under physcam.analysis ("analysis" for its own level)."""
+    parts = dotted.split(".")
+    if len(parts) > 2 and (SRC / "physcam" / "analysis" / parts[2]).is_dir():
+        return f"analysis.{parts[2]}"
+    return "analysis"
+
+
+def _analysis_edges():
+    """(importing package, imported package, module, target) for every import between two of analysis's
+    packages, deferred imports included."""
+    for path in (SRC / "physcam" / "analysis").rglob("*.py"):
+        parts = path.relative_to(SRC).with_suffix("").parts
+        module = ".".join(p for p in parts if p != "__init__")
+        pkg = _analysis_package(module)
+        for target in _imports(path, module):
+            if target.startswith("physcam.analysis") and _analysis_package(target) != pkg:
+                yield pkg, _analysis_package(target), module, target
+
+
+def test_every_analysis_package_has_a_layer_of_its_own():
+    pkgs = {f"analysis.{p.name}" for p in (SRC / "physcam" / "analysis").iterdir() if (p / "__init__.py").exists()}
+    missing = sorted(pkgs - set(ANALYSIS_LAYER))
+    assert not missing, f"give these packages a layer in tests/test_architecture.py's ANALYSIS_LAYER: {missing}"
+    assert len(set(ANALYSIS_LAYER.values())) == len(ANALYSIS_LAYER), "two of analysis's packages share a layer"
+
+
+def test_analysis_packages_import_down_their_layers():
+    wrong = [f"{module} imports {target}" for pkg, tp, module, target in _analysis_edges()
+             if ANALYSIS_LAYER[tp] > ANALYSIS_LAYER[pkg]]
+    assert not wrong, "upward imports between analysis's packages:\n" + "\n".join(sorted(wrong))
+    graph: dict[str, set[str]] = {}
+    for pkg, tp, _, _ in _analysis_edges():
+        graph.setdefault(pkg, set()).add(tp)
+        graph.setdefault(tp, set())
+    assert graph, "no imports between analysis's packages found: the edge finder is broken"
+    assert not [c for c in _components(graph) if len(c) > 1]
+
+
 def test_no_package_level_import_loop():
     """Issue 43: the graph of packages (an edge for any import between two, deferred ones included) has no
     strongly connected component of more than one package."""

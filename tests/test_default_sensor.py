@@ -81,9 +81,9 @@ def test_every_public_default_sensor_is_the_clis():
     found = _sensor_defaults()
     names = {q for q, _, _ in found}
     # the analyses, the breathing table, the MTF chart, the characterization grid and the USD kit
-    for must in ("physcam.analysis.distortion.real_distortion", "physcam.analysis.illumination.relative_illumination",
-                 "physcam.analysis.colour.chromatic_aberration", "physcam.analysis.ghosts.ghost_analysis",
-                 "physcam.analysis.breathing_real.real_breathing", "physcam.analysis.mtf.mtf_chart",
+    for must in ("physcam.analysis.distortion.field.real_distortion", "physcam.analysis.image_quality.illumination.relative_illumination",
+                 "physcam.analysis.image_quality.colour.chromatic_aberration", "physcam.analysis.image_quality.ghosts.ghost_analysis",
+                 "physcam.analysis.framing.breathing_real.real_breathing", "physcam.analysis.image_quality.mtf.mtf_chart",
                  "physcam.optics.focusing.breathing_table", "physcam.characterize.grid.Grid",
                  "physcam.usd.spec.CameraSpec", "physcam.usd.kit.write_vendor_lens"):
         assert must in names, f"{must} has no sensor default (or is no longer public)"

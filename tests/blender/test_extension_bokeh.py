@@ -1,5 +1,5 @@
 """Bokeh through the physcam extension (its focus-table shader, iris and sensor as the panel's
-parameters) against physcam's :func:`physcam.analysis.bokeh.bokeh_image`, as
+parameters) against physcam's :func:`physcam.analysis.defocus.bokeh.bokeh_image`, as
 tests/blender/test_osl_bokeh.py does for the baked shader: the double Gauss 50 mm focused at a 2 m
 mark, f/2.8 by physcam's one iris rule, 6 straight blades with a corner 15 degrees from +x; a 1 mm
 emissive sphere 0.7 m from the film, rendered on a 3 x 3 mm crop of the film centre (the panel's
@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from _blender import INSTALLED_EXTENSION_SCENE, run_blender
-from physcam.analysis.blob import blob_moments, polygon_corners
-from physcam.analysis.bokeh import bokeh_image
+from physcam.analysis.defocus.blob import blob_moments, polygon_corners
+from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus, iris_semi_diameter
 from physcam.trace.aperture import Aperture

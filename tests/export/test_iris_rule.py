@@ -42,7 +42,7 @@ def test_the_iris_makes_the_lens_f_n_at_infinity_and_keeps_its_size_when_it_focu
 
 @pytest.mark.parametrize("name, mark", CASES)
 def test_every_consumer_writes_the_same_iris(name, mark):
-    from physcam.analysis._pupil import setup
+    from physcam.analysis.image_quality._pupil import setup
     from physcam.export.blender import bake_camera
     from physcam.export.pbrt import pbrt_camera_values
 

@@ -49,8 +49,8 @@ def test_at_infinity_efl_over_the_pupil_is_the_fstop(n):
 
 
 def test_the_analyses_take_the_state_first_and_agree_with_the_old_door():
-    from physcam.analysis.mtf import mtf
-    from physcam.analysis.wavefront import wavefront
+    from physcam.analysis.image_quality.mtf import mtf
+    from physcam.analysis.image_quality.wavefront import wavefront
 
     s = camera_state(DGAUSS, focus_mm=2000.0, fstop=4.0)
     a = mtf(s, 14.0, frequencies=[10, 20, 40], pupil_samples=64)

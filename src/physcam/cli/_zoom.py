@@ -95,7 +95,7 @@ def run_zoom(args) -> int:
     rows = zoom_table(lens, _encoders(args, lens), sensor_width_mm=sensor.width_mm, wavelength_nm=args.wavelength)
     path = None
     if args.output:
-        from ..analysis.zoom_plot import save_zoom_figure
+        from ..analysis.framing.zoom_plot import save_zoom_figure
 
         path = save_zoom_figure(lens, args.output, sensor_width_mm=sensor.width_mm, force=args.force)
     if args.json:

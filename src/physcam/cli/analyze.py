@@ -180,7 +180,7 @@ def _resolution(text: str):
 
 
 def run_illumination(args) -> int:
-    from ..analysis.illumination import relative_illumination
+    from ..analysis.image_quality.illumination import relative_illumination
     from ._output import Table, print_table
 
     state = _camera(args, fstop=args.fstop)
@@ -198,7 +198,7 @@ def run_illumination(args) -> int:
 
 
 def run_colour(args) -> int:
-    from ..analysis.colour import chromatic_aberration
+    from ..analysis.image_quality.colour import chromatic_aberration
     from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM
     from ._output import Table, print_table
 
@@ -235,7 +235,7 @@ def run_colour(args) -> int:
 
 
 def run_breathing(args) -> int:
-    from ..analysis.breathing_real import real_breathing
+    from ..analysis.framing.breathing_real import real_breathing
     from ..units import format_distance
     from ._common import resolve_focus, units_of
     from ._output import Table, print_table
@@ -262,7 +262,7 @@ def run_breathing(args) -> int:
 
 
 def run_ghosts(args) -> int:
-    from ..analysis.ghosts import ghost_analysis
+    from ..analysis.image_quality.ghosts import ghost_analysis
     from ._output import Table, print_table
 
     state = _camera(args)

@@ -106,8 +106,8 @@ def _lens_step(out, ctx, force):
     import json
     import math
 
-    from ..analysis.breathing_plot import save_breathing_plot
-    from ..analysis.diagram import save_lens_diagram
+    from ..analysis.framing.breathing_plot import save_breathing_plot
+    from ..analysis.lens_cards.diagram import save_lens_diagram
     from ..io import atomic_write
     from ..lens.library import load_lens
     from ..optics import focusing
@@ -155,8 +155,8 @@ def _metadata_step(out, ctx, force):
 
 
 def _trace_step(out, ctx, force):
-    from ..analysis.bokeh import bokeh_image
-    from ..analysis.spot import spot_diagram
+    from ..analysis.defocus.bokeh import bokeh_image
+    from ..analysis.image_quality.spot import spot_diagram
     from ..optics.state import as_designed, camera_state
     from ..trace.aperture import Aperture
 
@@ -168,7 +168,7 @@ def _trace_step(out, ctx, force):
     state = camera_state(lens, focus_mm=DEFAULTS["focus"], fstop=DEFAULTS["fstop"], sensor_mm=(s.width_mm, s.height_mm),
                          aperture=Aperture(nsides=7, roundness=0.2))
     bokeh = bokeh_image(state, 1200.0, 250.0, 150.0, rays=400_000, pixels=160, spectral=True)
-    from ..analysis.bokeh import write_bokeh_photo
+    from ..analysis.defocus.bokeh import write_bokeh_photo
 
     photo = write_bokeh_photo(bokeh, out / "bokeh_photo", pixel_pitch_um=s.pitch_um or s.width_mm * 1000.0 / 4096,
                               sensor_name=s.name, force=force)
@@ -177,7 +177,7 @@ def _trace_step(out, ctx, force):
 
 def _card_step(out, ctx, force):
     """The default lens's one-page card (A4) on the demo's sensor, focused at infinity."""
-    from ..analysis.lens_card import lens_card, save_lens_card
+    from ..analysis.lens_cards.card import lens_card, save_lens_card
 
     s = ctx["report"].sensor
     card = lens_card(ctx["lens"], sensor_width_mm=s.width_mm, sensor_height_mm=s.height_mm, sensor_name=s.name)
@@ -189,8 +189,8 @@ def _distortion_step(out, ctx, force):
     import json
 
     from .. import __version__
-    from ..analysis.distortion_models import fit_brown_conrady, fit_tde4_radial, samples_from_field
-    from ..analysis.stmap import distortion_field, write_stmaps
+    from ..analysis.distortion.models import fit_brown_conrady, fit_tde4_radial, samples_from_field
+    from ..analysis.distortion.stmap import distortion_field, write_stmaps
     from ..export.nuke import nuke_stmap_script
     from ..export.tde4 import tde4_lens_text
     from ..optics.state import camera_state

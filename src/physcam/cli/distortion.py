@@ -29,7 +29,7 @@ _focus_list = focus_list("focus marks")
 
 def register(sub) -> None:
     from .analyze import _common, _resolution, _sensor
-    from ..analysis.distortion_names import DEFAULT_MAX_RESIDUAL_PX, MODEL_CHOICES
+    from ..analysis.distortion.names import DEFAULT_MAX_RESIDUAL_PX, MODEL_CHOICES
 
     p = sub.add_parser("distortion", help="real distortion: against field, ST-maps and fitted models at any focus")
     _common(p, "write the distortion plot (field-angle table; with --across-focus the table's plot)")
@@ -98,7 +98,7 @@ def run_distortion(args) -> int:
         return _run_across_focus(args, lens)
     if args.resolution is not None:
         return _run_field(args, lens)
-    from ..analysis.distortion import real_distortion
+    from ..analysis.distortion.field import real_distortion
 
     res = real_distortion(lens, args.field, sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
                           wavelength_nm=args.wavelength, focus_mm=math.inf if args.focus is None else args.focus)
@@ -130,7 +130,7 @@ def run_distortion(args) -> int:
 
 
 def _run_across_focus(args, lens) -> int:
-    from ..analysis.distortion_focus import distortion_across_focus
+    from ..analysis.distortion.across_focus import distortion_across_focus
     from ..errors import InputError
 
     if args.field:
@@ -204,14 +204,14 @@ def _fit_payloads(args, res, fits, folder):
     from pathlib import Path
 
     from .. import __version__
-    from ..analysis.distortion_models import BrownConrady, TDE4RadialStandard, USDStandard
+    from ..analysis.distortion.models import BrownConrady, TDE4RadialStandard, USDStandard
     from ..export.nuke import nuke_stmap_script
     from ..export.tde4 import tde4_lens_text
     from ._common import units_of
 
     d = Path(folder)
     out = []
-    from ..analysis.anamorphic_distortion import TDE4Anamorphic
+    from ..analysis.distortion.anamorphic import TDE4Anamorphic
     from ..export.tde4 import tde4_anamorphic_lens_text
 
     brown = [f for f in fits if isinstance(f, BrownConrady)]
@@ -253,10 +253,10 @@ def _anamorphic_key(fit) -> str:
 
 
 def _fits(samples, names, max_residual_px):
-    """The fitted models named by --fit: physcam.analysis.distortion_models' and the 3DE4 anamorphic ones."""
-    from ..analysis.anamorphic_distortion import fit_tde4_anamorphic
-    from ..analysis.distortion_models import fit_models
-    from ..analysis.distortion_names import ANAMORPHIC_CHOICES
+    """The fitted models named by --fit: physcam.analysis.distortion.models' and the 3DE4 anamorphic ones."""
+    from ..analysis.distortion.anamorphic import fit_tde4_anamorphic
+    from ..analysis.distortion.models import fit_models
+    from ..analysis.distortion.names import ANAMORPHIC_CHOICES
 
     names = list(names or ())
     fits = fit_models(samples, [n for n in names if n not in ANAMORPHIC_CHOICES], max_residual_px=max_residual_px)
@@ -275,8 +275,8 @@ def _png(fit, units: str = "m") -> bytes:
 
 
 def _run_field(args, lens) -> int:
-    from ..analysis.distortion_models import samples_from_field
-    from ..analysis.stmap import distortion_field, write_stmaps
+    from ..analysis.distortion.models import samples_from_field
+    from ..analysis.distortion.stmap import distortion_field, write_stmaps
     from ..errors import InputError
     import contextlib
     from pathlib import Path

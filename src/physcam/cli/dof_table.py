@@ -264,7 +264,7 @@ def card_figure(d, *, units: str = "m", chart=None, page: str = "a4"):
     f-stops across, near / far / total in each cell, hyperfocal at the foot; with ``chart`` (a report and
     its :func:`physcam.onset.dof_plot.dof_chart_data`), the DOF chart of the set's apps below the table."""
 
-    from ..analysis.lens_card import PAGES
+    from ..analysis.lens_cards.card import PAGES
     from ..figures import new_figure
     from ..units import format_distance
 

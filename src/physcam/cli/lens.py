@@ -417,7 +417,7 @@ def _print_provenance(p) -> None:
 
 
 def diagram_options(args) -> dict:
-    """The keyword arguments ``physcam lens diagram`` gives :func:`physcam.analysis.diagram.lens_diagram`
+    """The keyword arguments ``physcam lens diagram`` gives :func:`physcam.analysis.lens_cards.diagram.lens_diagram`
     (``--focus hyperfocal`` resolved to its mark for the lens and f-stop)."""
     from ._common import HYPERFOCAL, resolve_focus
 
@@ -428,7 +428,7 @@ def diagram_options(args) -> dict:
 
 
 def run_diagram(args) -> int:
-    from ..analysis.diagram import save_lens_diagram
+    from ..analysis.lens_cards.diagram import save_lens_diagram
     from ..optics.state import camera_state
     from ._common import units_of
 
@@ -441,8 +441,8 @@ def run_diagram(args) -> int:
 
 
 def run_card(args) -> int:
-    """``physcam lens card``: the one-page lens card (:mod:`physcam.analysis.lens_card`)."""
-    from ..analysis.lens_card import lens_card, save_lens_card
+    """``physcam lens card``: the one-page lens card (:mod:`physcam.analysis.lens_cards.card`)."""
+    from ..analysis.lens_cards.card import lens_card, save_lens_card
     from ..io import check_writable
     from ._common import resolve_focus, resolve_sensor, units_of
     from ._output import document, emit_json
@@ -484,7 +484,7 @@ def run_breathing(args) -> int:
     units = units_of(args)
     path = None
     if args.output:
-        from ..analysis.breathing_plot import save_breathing_plot
+        from ..analysis.framing.breathing_plot import save_breathing_plot
 
         path = save_breathing_plot(rows, args.output, force=args.force,
                                    title=f"{p.name}: focus breathing, {sensor_name} ({width:g} mm wide)",
@@ -540,7 +540,7 @@ def run_check(args) -> int:
         from ..optics.sensors import find_sensor
 
         find_sensor(args.sensor)  # an unknown name is refused before any work
-    from ..analysis.lens_probes import ray_probes
+    from ..analysis.lens_cards.probes import ray_probes
     from ..usd.lens_archive import check_archive, is_archive
 
     if is_archive(args.lens):

@@ -196,7 +196,7 @@ def run_insert(args) -> int:
 def run_render(args) -> int:
     import math
 
-    from ..analysis.lightfield import (checkerboard, light_field_figure, render_plane, render_point, view_disparity)
+    from ..analysis.defocus.lightfield import (checkerboard, light_field_figure, render_plane, render_point, view_disparity)
     from ..errors import InputError
     from ..io import check_writable
     from ..lens.formats.iset import microlens_of

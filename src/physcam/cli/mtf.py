@@ -79,7 +79,7 @@ def register(sub) -> None:
 
 
 def _spectrum(args):
-    from ..analysis.mtf import WHITE_LIGHT_NM
+    from ..analysis.image_quality.mtf import WHITE_LIGHT_NM
     from ..errors import InputError
 
     wls = tuple(args.wavelength) if args.wavelength else WHITE_LIGHT_NM
@@ -122,7 +122,7 @@ def run(args) -> int:
         if args.best_focus is not None:
             raise InputError("--best-focus places the chart's film; with --field the film stays at the focus mark")
         return _one_field(args, camera, wls, weights, freqs)
-    from ..analysis.mtf import mtf_chart
+    from ..analysis.image_quality.mtf import mtf_chart
     from ._common import progress_bar
 
     top = sensor.diagonal_mm / 2 if args.max_height is None else args.max_height
@@ -174,9 +174,9 @@ def _field_points(m) -> list[dict]:
 
 
 def _one_field(args, camera, wls, weights, freqs) -> int:
-    from ..analysis.mtf import mtf
-    from ..analysis.psf import psf
-    from ..analysis.wavefront import wavefront
+    from ..analysis.image_quality.mtf import mtf
+    from ..analysis.image_quality.psf import psf
+    from ..analysis.image_quality.wavefront import wavefront
 
     lens = camera.lens
     wf = wavefront(camera, args.field, wavelength_nm=wls[0], pupil_samples=args.pupil_samples)
@@ -189,7 +189,7 @@ def _one_field(args, camera, wls, weights, freqs) -> int:
 
         import numpy as np
 
-        from ..analysis.huygens import huygens_mtf, huygens_psf
+        from ..analysis.image_quality.huygens import huygens_mtf, huygens_psf
 
         t, s, _ = huygens_mtf(camera, args.field, frequencies=freqs, wavelengths_nm=wls, weights=weights)
         m = dataclasses.replace(m, method="huygens", tangential=np.asarray(t), sagittal=np.asarray(s))
@@ -216,7 +216,7 @@ def _one_field(args, camera, wls, weights, freqs) -> int:
           f"{ps.airy_radius_um:.2f} µm")
     z = wf.zernike
     print("  Zernike (Noll, waves): " + ", ".join(f"Z{j + 1} {c:+.4f}" for j, c in enumerate(z[:11])))
-    from ..analysis.mtf import spectrum_words
+    from ..analysis.image_quality.mtf import spectrum_words
 
     print(f"  light: {spectrum_words(lens, m.wavelengths_nm)}")
     print("  MTF: " + ", ".join(f"{f:g} lp/mm S {s:.3f} T {t:.3f}" for f, s, t in

@@ -86,7 +86,7 @@ def run(args) -> int:
     camera = camera_state(lens, focus_mm=focus_mm, fstop=args.fstop)  # the one camera of the command
     kw = dict(defocus_mm=args.defocus * 1e-3)
     if args.method == "huygens":
-        from ..analysis.huygens import DEFAULT_IMAGE_SAMPLES, huygens_psf
+        from ..analysis.image_quality.huygens import DEFAULT_IMAGE_SAMPLES, huygens_psf
 
         p = huygens_psf(camera, args.field, wavelengths_nm=None if args.wavelength is None else [args.wavelength],
                         tilt_deg=args.tilt, image_samples=args.samples or DEFAULT_IMAGE_SAMPLES, pixel_um=args.pixel,
@@ -95,7 +95,7 @@ def run(args) -> int:
         line = (f"Strehl {p.strehl:.4f}; {p.image.shape[0]} x {p.image.shape[1]} px of {p.pixel_um:.3f} um about the "
                 f"blur's centroid, holding {p.energy_in_grid:.1%} of the power")
     else:
-        from ..analysis.psf import psf
+        from ..analysis.image_quality.psf import psf
 
         p = psf(camera, args.field, wavelength_nm=args.wavelength, **kw)
         d = dict(p.to_dict(), method="fft")

@@ -252,9 +252,9 @@ def camera_blocks(report, args) -> dict:
 
 
 def real_dof_block(report, args) -> dict:
-    """The real-ray depth of field (:func:`physcam.analysis.real_dof.real_depth_of_field`) at the centre and
+    """The real-ray depth of field (:func:`physcam.analysis.defocus.real_dof.real_depth_of_field`) at the centre and
     at a field point, beside the model's, for ``physcam report --dof real``."""
-    from ..analysis.real_dof import real_depth_of_field
+    from ..analysis.defocus.real_dof import real_depth_of_field
     from ..errors import InputError, OpticsError
 
     lens = getattr(args, "loaded_lens", None)

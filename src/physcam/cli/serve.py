@@ -192,7 +192,7 @@ def cli_backend():
         return show_document(parsers["lens"].parse_args([*_options(q), f"--lens={_bundled(name)}"]))
 
     def diagram_svg(name, q):
-        from ..analysis.diagram import lens_diagram
+        from ..analysis.lens_cards.diagram import lens_diagram
         from ..lens.library import load_lens
 
         args = parsers["diagram"].parse_args([*_options(q), "--output=diagram.svg", f"--lens={_bundled(name)}"])

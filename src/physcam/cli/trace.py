@@ -68,7 +68,7 @@ def register(sub) -> None:
 
 
 def run_spot(args) -> int:
-    from ..analysis.spot import spot_diagram
+    from ..analysis.image_quality.spot import spot_diagram
     from ..io import check_writable
     from ..lens.library import load_lens
 
@@ -111,7 +111,7 @@ def run_spot(args) -> int:
 
 
 def run_bokeh(args) -> int:
-    from ..analysis.bokeh import bokeh_image
+    from ..analysis.defocus.bokeh import bokeh_image
     from ..io import check_writable
     from ..lens.library import load_lens
 
@@ -177,7 +177,7 @@ def run_bokeh(args) -> int:
 
 def _bokeh_photo(res, args) -> dict:
     """``physcam bokeh --image``: the EXR and PNG photograph, and what its scale bar means."""
-    from ..analysis.bokeh import scale_bar_pixels, write_bokeh_photo
+    from ..analysis.defocus.bokeh import scale_bar_pixels, write_bokeh_photo
     from ._common import resolve_sensor
 
     sensor = resolve_sensor(args)

@@ -3,8 +3,8 @@
 ``physcam compare blender LENS`` renders one small emissive sphere at a known distance through
 the generated OSL camera in Blender (a crop of the film centre, the shader made for that crop) and
 traces the same light through the same focused, stopped-down prescription with physcam's numba
-tracer (:func:`physcam.analysis.bokeh.bokeh_image`), binned on the render's pixel grid. Both
-images are measured the same way (:mod:`physcam.analysis.blob`): centroid, equivalent diameter
+tracer (:func:`physcam.analysis.defocus.bokeh.bokeh_image`), binned on the render's pixel grid. Both
+images are measured the same way (:mod:`physcam.analysis.defocus.blob`): centroid, equivalent diameter
 (the sphere's own image removed in quadrature) and iris corners. Blender is found by
 :func:`physcam.export.blender_runner.find_blender` (``--blender-python``, ``PHYSCAM_BLENDER_PYTHON``,
 the user config, ``blender`` on PATH, a checkout's ``.venv-blender``), and the result says which.
@@ -74,8 +74,8 @@ def compare_bokeh(camera: CameraState, *, light_mm: float, aperture=None, crop_m
     :class:`~physcam.optics.state.CameraState` (its focus, iris set to an f-stop, and iris shape, which
     ``aperture`` replaces; its sensor is replaced by the ``crop_mm`` square); return both images and the
     measured agreement."""
-    from ..analysis.blob import blob_moments, equivalent_diameter, polygon_corners
-    from ..analysis.bokeh import bokeh_image
+    from ..analysis.defocus.blob import blob_moments, equivalent_diameter, polygon_corners
+    from ..analysis.defocus.bokeh import bokeh_image
     from .blender import _state, blender_setup_script, osl_camera_shader
 
     if not camera.iris_set:

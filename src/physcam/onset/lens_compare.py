@@ -97,7 +97,7 @@ def _breathing(lens, mark, sensor, out, curves) -> None:
 def _distortion(lens, sensor, out, curves, notes) -> None:
     """Real distortion at the widest field the sensor asks for (clamped to what the lens images)."""
     from ..errors import PhysCamError
-    from ..analysis.distortion import real_distortion
+    from ..analysis.distortion.field import real_distortion
 
     try:
         dist = real_distortion(lens, sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm)
@@ -113,7 +113,7 @@ def _distortion(lens, sensor, out, curves, notes) -> None:
 def _illumination(lens, state, sensor, out, curves, notes) -> None:
     """Relative illumination at the state's iris to the sensor corner (clamped likewise)."""
     from ..errors import PhysCamError
-    from ..analysis.illumination import relative_illumination
+    from ..analysis.image_quality.illumination import relative_illumination
 
     try:
         sd = state().stop_semi_diameter
@@ -134,8 +134,8 @@ def _bokeh(state, mark, light_mm, rays, out, curves, notes) -> None:
     import numpy as np
 
     from ..errors import PhysCamError
-    from ..analysis.blob import equivalent_diameter
-    from ..analysis.bokeh import bokeh_image
+    from ..analysis.defocus.blob import equivalent_diameter
+    from ..analysis.defocus.bokeh import bokeh_image
 
     light = light_mm if light_mm is not None else (1000.0 if math.isinf(mark) else 2.0 * mark)
     out["bokeh_light_from_film_mm"] = light

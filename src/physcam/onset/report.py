@@ -127,7 +127,7 @@ class LensReport:
     pinhole_focal_length_mm: float | None = None
     pinhole_squeeze: float | None = None
     #: with a prescription: the field of view of real chief rays from the film edge, top and corner
-    #: (:func:`physcam.analysis.field_of_view.real_field_of_view`, as its ``to_dict``), beside the
+    #: (:func:`physcam.analysis.framing.field_of_view.real_field_of_view`, as its ``to_dict``), beside the
     #: paraxial pinhole's; None for the thin-lens and datasheet models.
     real_fov: dict | None = None
     #: the physical aperture stop (iris) in front of the film: a prescription's stop surface; the
@@ -479,7 +479,7 @@ def _with_real_fov(report: LensReport, camera: CameraState) -> LensReport:
     import dataclasses
     import warnings
 
-    from ..analysis.field_of_view import real_field_of_view_focused
+    from ..analysis.framing.field_of_view import real_field_of_view_focused
     from ..errors import PhysCamError, PhysCamWarning
 
     s = report.sensor

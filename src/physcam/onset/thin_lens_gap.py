@@ -8,7 +8,7 @@ pupils' real positions change the blur. This module measures both gaps so every 
 can print them instead of calling the thin-lens blur "the lens's":
 
 * **field of view**: the pinhole's horizontal field against the real chief rays' from the film
-  edge (:func:`physcam.analysis.field_of_view.real_field_of_view`, kept in the report);
+  edge (:func:`physcam.analysis.framing.field_of_view.real_field_of_view`, kept in the report);
 * **bokeh**: the thin lens's blur diameter on the film, A f_pin |1/d - 1/s| (A the entrance
   pupil's diameter, f_pin the pinhole's focal length, d and s the light's and the focus plane's
   distances from the entrance pupil), against the second-moment diameter sqrt(8 E[r^2]) of the
@@ -82,8 +82,8 @@ def _thin_lens_blur_mm(report, light_from_film_mm: float) -> float:
 def _real_blur_mm(state, light_from_film_mm: float) -> float:
     """sqrt(8 E[r^2]) of the real lens's traced image of an on-axis point light; ``state()`` gives the
     camera state (made when first asked, so a stop the lens cannot open to is a note of each light)."""
-    from ..analysis.blob import equivalent_diameter
-    from ..analysis.bokeh import bokeh_image
+    from ..analysis.defocus.blob import equivalent_diameter
+    from ..analysis.defocus.bokeh import bokeh_image
 
     st = state()  # the lens focused at the report's mark, its film there, the iris set
     img = bokeh_image(st.with_aperture(None), light_from_film_mm, rays=BOKEH_RAYS, pixels=128, fresnel=False)

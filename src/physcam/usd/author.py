@@ -12,7 +12,7 @@ use. The two are written from the same numbers:
   in tenths of a scene unit, focus and clipping distances in scene units
   (``metersPerUnit``; docs/conventions.md);
 * Hydra's ``lensDistortion:*`` when a fitted model is given (a real lens's traced distortion,
-  :mod:`physcam.analysis.distortion`);
+  :mod:`physcam.analysis.distortion.field`);
 * ``exposure:*``, ``shutter:open/close`` (in time codes, from the stage's
   ``timeCodesPerSecond``) and RenderMan's ``ri:aperture*``, ``ri:shutterOpenTime``,
   ``ri:shutterCloseTime``, ``ri:shutteropening`` (hdPrman's camera tokens; seed 002).
@@ -158,7 +158,7 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
     (lens API and lens model prim), "render" (the companion UsdGeomCamera); a body file
     and a lens file each write their own parts and a shot composes them.
     ``lens_distortion``: a fitted radial model
-    (:class:`physcam.analysis.distortion.StandardDistortion`, or its ``usd_attributes()`` dict),
+    (:class:`physcam.analysis.distortion.field.StandardDistortion`, or its ``usd_attributes()`` dict),
     written as Hydra's ``lensDistortion:*`` on the companion UsdGeomCamera.
     """
     bad = set(parts) - set(ALL_PARTS)

@@ -490,15 +490,15 @@ def prescription_distortion(prescription, sensor_width_mm: float = DEFAULT_SENSO
                             sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM, *,
                             focus_mm: float = math.inf):
     """Hydra's "standard" lensDistortion fitted to ``prescription``'s real chief rays over the whole
-    frame at the shot's focus ``focus_mm`` (:func:`physcam.analysis.distortion_models.fit_usd_standard`
+    frame at the shot's focus ``focus_mm`` (:func:`physcam.analysis.distortion.models.fit_usd_standard`
     on a 2048-pixel-wide frame of the sensor, default Super 35, 24.89 x 18.66 mm). Where the lens
     does not cover the frame's corners, the radial fit of
-    :mod:`physcam.analysis.distortion` (object at infinity, fields up to what passes) is used, with a warning.
+    :mod:`physcam.analysis.distortion.field` (object at infinity, fields up to what passes) is used, with a warning.
     """
     import warnings
 
-    from ..analysis.distortion_models import fit_usd_standard, samples_from_field
-    from ..analysis.stmap import distortion_field
+    from ..analysis.distortion.models import fit_usd_standard, samples_from_field
+    from ..analysis.distortion.stmap import distortion_field
     from ..errors import OpticsError, PhysCamWarning
 
     w_px = 2048
@@ -510,7 +510,7 @@ def prescription_distortion(prescription, sensor_width_mm: float = DEFAULT_SENSO
                                                                                           sensor_height_mm)),
                                  width_px=w_px, height_px=h_px, maps=False)
     except OpticsError as e:
-        from ..analysis.distortion import real_distortion
+        from ..analysis.distortion.field import real_distortion
 
         warnings.warn(f"lensDistortion: {e}; fitted radially at infinity instead", PhysCamWarning, stacklevel=2)
         return real_distortion(prescription, sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm).fit

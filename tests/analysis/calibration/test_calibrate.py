@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 cv2 = pytest.importorskip("cv2")
-sys.path.insert(0, str(Path(__file__).parent))
-sys.path.insert(0, str(Path(__file__).parents[1]))
+sys.path.insert(0, str(Path(__file__).parents[1]))  # tests/analysis: _charts
+sys.path.insert(0, str(Path(__file__).parents[2]))  # tests
 
 import _charts
 from _charts import CHARUCO, DIST_TRUE, K_TRUE, SENSOR_MM, SIZE
 
-from physcam.analysis.calibrate import calibrate_mark
+from physcam.analysis.calibration.calibrate import calibrate_mark
 from physcam.cli import main
 
 PITCH_MM = SENSOR_MM[0] / SIZE[0]
@@ -202,7 +202,7 @@ def test_flat_field_and_a_lens_that_is_not_this_camera(photos, tmp_path, capsys)
 def test_breathing_between_two_marks_is_the_ratio_of_the_focal_lengths():
     """Views at 2 m through K_TRUE and at 500 mm through a pinhole 2 % longer (f 1173 px): the breathing
     table says +2 % at 500 mm against the farthest mark (hand value 100 (1173 / 1150 - 1))."""
-    from physcam.analysis.calibrate import calibrate_views
+    from physcam.analysis.calibration.calibrate import calibrate_views
 
     K_near = K_TRUE.copy()
     K_near[0, 0] = K_near[1, 1] = 1173.0
@@ -386,8 +386,8 @@ def test_the_comparison_never_states_less_than_the_fits_covariance():
     the focal length scatters by 0.05 %); here (0.3 px noise, seed 4) it says less than OpenCV's
     covariance at both marks. The comparison takes the larger for each pinhole, and for the breathing
     the two relative uncertainties added in quadrature: 100 hypot(s_near / f_near, s_far / f_far) f_near / f_far."""
-    from physcam.analysis.calibrate import calibrate_views
-    from physcam.analysis.calibrate_compare import compare_with_lens
+    from physcam.analysis.calibration.calibrate import calibrate_views
+    from physcam.analysis.calibration.compare import compare_with_lens
     from physcam.lens.library import load_lens
 
     views = _charts.point_views(n=8, noise_px=0.3, seed=4, mark=2000.0) + \

@@ -20,13 +20,13 @@ import numpy as np
 import pytest
 
 cv2 = pytest.importorskip("cv2")
-sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).parents[1]))  # tests/analysis: _charts
 
 import _charts
 from _charts import CHECKER, K_TRUE, SENSOR_MM
 
-from physcam.analysis.calibrate import calibrate_mark
-from physcam.analysis.calibrate_chart import detect_chart, grid_problem, image_size
+from physcam.analysis.calibration.calibrate import calibrate_mark
+from physcam.analysis.calibration.chart import detect_chart, grid_problem, image_size
 from physcam.cli import main
 from physcam.errors import InputError, OpticsError
 
@@ -98,7 +98,7 @@ def test_a_real_detection_is_a_grid_and_its_reorderings_are_not(checker_photo):
 def test_a_wrong_grid_fits_a_wrong_camera_without_the_check(checker_photo):
     """Why the check matters: 8 views of exact corners, one of them with a row reversed, fit a camera whose
     residual is pixels instead of noise (the views as given to OpenCV's calibration directly)."""
-    from physcam.analysis.calibrate_chart import ChartView
+    from physcam.analysis.calibration.chart import ChartView
 
     obj = CHECKER.object_points()
     views = [ChartView(f"pose{k}", _charts.SIZE, cv2.projectPoints(obj, r, t, K_TRUE, _charts.DIST_TRUE)[0].reshape(-1, 2),
@@ -299,7 +299,7 @@ def test_the_opentrackio_block_carries_only_accepted_models():
 
 @pytest.fixture(scope="module")
 def photos(tmp_path_factory):
-    """8 ChArUco photographs (tests/analysis/test_calibrate.py's renders of K_TRUE and DIST_TRUE)."""
+    """8 ChArUco photographs (tests/analysis/calibration/test_calibrate.py's renders of K_TRUE and DIST_TRUE)."""
     folder = tmp_path_factory.mktemp("charuco")
     board = _charts.board_image(_charts.CHARUCO, 12.0)
     for k, (r, t) in enumerate(_charts.poses(8, 1)):

@@ -15,8 +15,8 @@ import sys
 import numpy as np
 import pytest
 
-from physcam.analysis.defocus import defocus, inverse_depth, near_edges
-from physcam.analysis.defocus_kernels import KernelCache, defocus_camera
+from physcam.analysis.defocus.render import defocus, inverse_depth, near_edges
+from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
 from physcam.errors import InputError
 from physcam.lens.library import load_lens
 
@@ -138,7 +138,7 @@ def test_cli_defocus_json_document(tmp_path):
 
     import jsonschema
 
-    from physcam.analysis.defocus_exr import read_exr
+    from physcam.analysis.defocus.exr import read_exr
     from physcam.cli._output import schema_file
 
     _exr(tmp_path / "in.exr", {**{c: np.ones((H, W)) for c in "RGB"}, "Z": np.full((H, W), 1.0)})

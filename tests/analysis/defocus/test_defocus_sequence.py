@@ -9,7 +9,7 @@ import pytest
 
 pytest.importorskip("distributed")
 
-from physcam.analysis.defocus_exr import defocus_file, read_exr  # noqa: E402
+from physcam.analysis.defocus.exr import defocus_file, read_exr  # noqa: E402
 from physcam.characterize.defocus_shot import defocus_sequence, sequence_frames  # noqa: E402
 from physcam.errors import InputError  # noqa: E402
 from physcam.lens.library import load_lens  # noqa: E402

@@ -3,7 +3,7 @@
 The camera: dgauss.50mm at f/5.6 focused at 0.8 m from the sensor, 77 x 77 thin lenslets of pitch
 40 um and f = 0.224 mm (f/5.6: the sub-image of the exit pupil about fills a lenslet's 9 x 9 pixels).
 
-Closed form of the disparity (worked by hand; the module docstring of physcam.analysis.lightfield
+Closed form of the disparity (worked by hand; the module docstring of physcam.analysis.defocus.lightfield
 derives it): with the exit pupil D in front of the array, the sensor b = f_mu behind it and n
 pixels per lenslet, a subject imaged D' behind the exit pupil shifts by -(D / (n b)) (1 - D/D')
 lenslets from one sub-aperture view to the next. D and D' come from the paraxial (Gaussian) data of
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from physcam.analysis.lightfield import (checkerboard, light_field_figure, refocus, render_plane, render_planes,
+from physcam.analysis.defocus.lightfield import (checkerboard, light_field_figure, refocus, render_plane, render_planes,
                                          render_point, subaperture_views, view_disparity, view_mask)
 from physcam.errors import InputError
 from physcam.lens.library import load_lens

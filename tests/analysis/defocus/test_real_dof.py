@@ -8,8 +8,8 @@ import warnings
 import numpy as np
 import pytest
 
-from physcam.analysis.bokeh import bokeh_image
-from physcam.analysis.real_dof import blur_diameter_mm, real_depth_of_field
+from physcam.analysis.defocus.bokeh import bokeh_image
+from physcam.analysis.defocus.real_dof import blur_diameter_mm, real_depth_of_field
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
 from physcam.optics.sensors import find_sensor

@@ -8,7 +8,7 @@ trace give 1886-1887 mm.
 The independent trace here: rays from the on-axis point to a fine square grid (400 x 400) over
 1.3 times the paraxial entrance pupil, clipped by the lens's apertures and its iris, traced to the
 film by physcam's tracer; the 80 % energy diameter about their centroid; the limit by bisection on
-1 / distance. Nothing of physcam.analysis.real_dof or .centroid is used.
+1 / distance. Nothing of physcam.analysis.defocus.real_dof or .centroid is used.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import warnings
 import numpy as np
 import pytest
 
-from physcam.analysis.real_dof import real_depth_of_field
+from physcam.analysis.defocus.real_dof import real_depth_of_field
 from physcam.cli import main
 from physcam.lens.library import load_lens
 from physcam.optics import focusing as focusing_mod

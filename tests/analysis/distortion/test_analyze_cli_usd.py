@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from _forward_chief import ideal_grid_and_real
-from physcam.analysis.distortion import real_distortion
+from physcam.analysis.distortion.field import real_distortion
 from physcam.cli import main
 from physcam.errors import ExportError
 from physcam.lens.library import load_lens

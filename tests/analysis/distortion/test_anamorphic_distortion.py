@@ -14,10 +14,10 @@ import math
 import numpy as np
 import pytest
 
-from physcam.analysis.anamorphic_distortion import (TDE4Anamorphic, fit_tde4_anamorphic,
+from physcam.analysis.distortion.anamorphic import (TDE4Anamorphic, fit_tde4_anamorphic,
                                                     tde4_anamorphic_parameter_names)
-from physcam.analysis.distortion_models import samples_from_field
-from physcam.analysis.stmap import distortion_field
+from physcam.analysis.distortion.models import samples_from_field
+from physcam.analysis.distortion.stmap import distortion_field
 from physcam.lens.library import load_lens
 
 #: sensors each lens covers (mm); the fit is traced at 1024 px wide, residuals scaled to 4096 px

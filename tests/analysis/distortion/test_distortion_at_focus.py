@@ -22,8 +22,8 @@ import math
 import numpy as np
 import pytest
 
-from physcam.analysis.distortion import real_distortion
-from physcam.analysis.lens_card import _distortion, _QUALITY
+from physcam.analysis.distortion.field import real_distortion
+from physcam.analysis.lens_cards.card import _distortion, _QUALITY
 from physcam.lens.library import list_lenses, load_lens
 
 from _forward_chief import forward_chief_marching
@@ -71,7 +71,7 @@ def test_card_distortion_matches_forward_chief_rays(slug, focus_mm, capsys):
         pts = [p for p in res.meridian(axis) if p.real_height_mm > 0]
         theta = np.radians([p.field_deg for p in pts])
         if math.isinf(focus_mm):  # the legacy measurement: chief rays aimed from infinity, f = the EFL
-            from physcam.analysis.distortion import _chief_heights
+            from physcam.analysis.distortion.field import _chief_heights
             from physcam.optics.paraxial import gaussian_xy
 
             from physcam.optics.paraxial import gaussian
@@ -122,7 +122,7 @@ def test_distagon_is_a_barrel_at_every_focus_as_hand_checked():
 @pytest.mark.parametrize("slug,focus_mm", [("zeiss_distagon_35mm_f4", 2000.0), ("navarro_anamorphic_2x", 1500.0),
                                            ("dgauss_50mm", math.inf)])
 def test_stmap_field_agrees_with_the_card(slug, focus_mm):
-    from physcam.analysis.stmap import distortion_field
+    from physcam.analysis.distortion.stmap import distortion_field
 
     lens = load_lens(slug)
     res = _card_curve(lens, focus_mm)
@@ -144,7 +144,7 @@ def test_stmap_field_agrees_with_the_card(slug, focus_mm):
 
 @pytest.mark.slow
 def test_card_json_and_distortion_cli_print_the_same_curve(tmp_path, capsys):
-    from physcam.analysis.lens_card import lens_card
+    from physcam.analysis.lens_cards.card import lens_card
     from physcam.cli import main
 
     lens = load_lens("zeiss_distagon_35mm_f4")

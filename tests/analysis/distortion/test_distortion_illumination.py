@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from physcam.analysis._chief import aim_from_infinity, field_direction
-from physcam.analysis.distortion import fit_standard_distortion, real_distortion
-from physcam.analysis.illumination import relative_illumination
+from physcam.analysis.distortion.field import fit_standard_distortion, real_distortion
+from physcam.analysis.image_quality.illumination import relative_illumination
 from physcam.errors import InputError, OpticsError
 from physcam.lens.library import load_lens
 from physcam.optics.paraxial import stop_semi_diameter_for_fstop

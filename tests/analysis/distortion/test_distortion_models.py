@@ -1,4 +1,4 @@
-"""Fitted distortion models (physcam.analysis.distortion_models) against hand-worked numbers,
+"""Fitted distortion models (physcam.analysis.distortion.models) against hand-worked numbers,
 OpenCV (a test-only oracle for the Brown-Conrady U-D formula) and forward-traced chief rays."""
 
 from __future__ import annotations
@@ -10,11 +10,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from physcam.analysis.distortion_models import (
+from physcam.analysis.distortion.models import (
     TDE4_PARAMETERS, BrownConrady, DistortionSamples, TDE4RadialStandard, fit_brown_conrady, fit_models,
     fit_tde4_radial, fit_usd_standard, samples_from_field,
 )
-from physcam.analysis.stmap import distortion_field
+from physcam.analysis.distortion.stmap import distortion_field
 from physcam.errors import ExportError, PhysCamError
 from physcam.lens.library import load_lens
 
@@ -143,7 +143,7 @@ def test_fits_land_forward_traced_points_within_their_stated_residual(distagon):
 def test_usd_fit_agrees_with_the_radial_fit_of_the_field_angle_table():
     """At infinity the 2-D USD fit and the 1-D radial fit of real_distortion (another code path, from
     infinity to the paraxial focus) describe the same lens: their predictions agree to 0.1 px."""
-    from physcam.analysis.distortion import real_distortion
+    from physcam.analysis.distortion.field import real_distortion
 
     lens = load_lens("dgauss_50mm")
     res = distortion_field(lens, sensor_width_mm=36, sensor_height_mm=24, width_px=W_PX, height_px=H_PX, maps=False)
@@ -244,7 +244,7 @@ def test_nuke_script_feeds_the_image_to_src_and_the_map_to_stmap(tmp_path):
 def test_anamorphic_lens_gets_maps_and_a_3de4_cylindric_fit():
     """Navarro 2x: maps checked against forward-traced rays in both meridians; the 3DE4 fit with its
     cylindric terms, its residual stated (and judged)."""
-    from physcam.analysis.stmap import apply_stmap
+    from physcam.analysis.distortion.stmap import apply_stmap
 
     lens = load_lens("navarro_anamorphic_2x")
     sensor, size, focus_mm = (24.9, 18.7), (1536, 1152), 3000.0
@@ -313,7 +313,7 @@ def test_distortions_opentrackio_block_reads_right_in_camdkit_and_unreal(reader)
     (tests/_opentrackio_readers.py) both read back to the fitted map at the 4K corners within 0.1 px."""
     from _opentrackio_readers import READERS, opencv_rational
 
-    from physcam.analysis.distortion_models import samples_from_field
+    from physcam.analysis.distortion.models import samples_from_field
     from physcam.cli.distortion import brown_conrady_document
     from physcam.live.lens_data import distortion_for_sample
 

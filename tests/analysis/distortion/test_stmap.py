@@ -1,4 +1,4 @@
-"""ST-maps at a focus (physcam.analysis.stmap), checked against forward-traced object points.
+"""ST-maps at a focus (physcam.analysis.distortion.stmap), checked against forward-traced object points.
 
 The oracle (tests/analysis/_forward_chief.py): object points on the plane of sharp focus, each
 placed where physcam's best-match pinhole sees a chosen ideal pixel, their chief rays aimed
@@ -24,7 +24,7 @@ FOCUS = 2000.0
 
 def _sample(stmap, xy_px, size):
     """Bilinear sample of a map at plate-style pixel positions (n, 2) of an image ``size`` (w, h)."""
-    from physcam.analysis.stmap import apply_stmap
+    from physcam.analysis.distortion.stmap import apply_stmap
 
     w, h = size
     probe = np.zeros((1, xy_px.shape[0], 3))
@@ -35,7 +35,7 @@ def _sample(stmap, xy_px, size):
 
 @pytest.fixture(scope="module", params=["zeiss_distagon_35mm_f4", "zuiko_18mm_f3_5"])
 def case(request):
-    from physcam.analysis.stmap import distortion_field
+    from physcam.analysis.distortion.stmap import distortion_field
 
     lens = load_lens(request.param)
     res = distortion_field(lens, focus_mm=FOCUS, sensor_width_mm=SENSOR[0], sensor_height_mm=SENSOR[1],
@@ -91,7 +91,7 @@ def test_overscan_keeps_every_plate_pixel(case):
 
 def test_image_round_trip_through_both_maps(case):
     """A smooth image undistorted then distorted comes back (bilinear twice: small blur only)."""
-    from physcam.analysis.stmap import apply_stmap
+    from physcam.analysis.distortion.stmap import apply_stmap
 
     _, res = case
     yy, xx = np.mgrid[0:H_PX, 0:W_PX] + 0.5
@@ -103,7 +103,7 @@ def test_image_round_trip_through_both_maps(case):
 
 
 def test_identity_map_and_bilinear_by_hand():
-    from physcam.analysis.stmap import apply_stmap
+    from physcam.analysis.distortion.stmap import apply_stmap
 
     img = np.arange(12.0).reshape(3, 4)  # rows top first
     h, w = img.shape
@@ -119,7 +119,7 @@ def test_identity_map_and_bilinear_by_hand():
 def test_exr_files_open_as_float_rgb(tmp_path, case):
     import OpenEXR
 
-    from physcam.analysis.stmap import write_stmaps
+    from physcam.analysis.distortion.stmap import write_stmaps
 
     _, res = case
     paths = write_stmaps(res, tmp_path / "maps")
@@ -154,7 +154,7 @@ def test_exr_files_open_as_float_rgb(tmp_path, case):
                                 dict(width_px=2048, height_px=1366, focus_mm=-3.0),
                                 dict(width_px=2048, height_px=1366, focus_mm=math.nan)])
 def test_bad_inputs_are_one_clear_error(kw):
-    from physcam.analysis.stmap import distortion_field
+    from physcam.analysis.distortion.stmap import distortion_field
 
     with pytest.raises(PhysCamError) as e:
         distortion_field(load_lens("zeiss_distagon_35mm_f4"), sensor_width_mm=36, sensor_height_mm=24,

@@ -15,8 +15,8 @@ import warnings
 import numpy as np
 import pytest
 
-from physcam.analysis.bokeh import bokeh_image
-from physcam.analysis.stmap import distortion_field
+from physcam.analysis.defocus.bokeh import bokeh_image
+from physcam.analysis.distortion.stmap import distortion_field
 from physcam.lens.library import load_lens
 from physcam.optics import focusing, paraxial
 

@@ -18,7 +18,7 @@ GOAL_BYTES = 2 * 1024**3
 CHILD = r"""
 import json, resource, sys, tempfile
 import numpy as np
-from physcam.analysis.stmap import MAX_SIDE_PX, distortion_field, write_stmaps
+from physcam.analysis.distortion.stmap import MAX_SIDE_PX, distortion_field, write_stmaps
 from physcam.lens.library import load_lens
 
 w, h = MAX_SIDE_PX, 4320

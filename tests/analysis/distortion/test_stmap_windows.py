@@ -54,7 +54,7 @@ def _buf(a):
 
 @pytest.fixture(scope="module")
 def maps(tmp_path_factory):
-    from physcam.analysis.stmap import distortion_field, write_stmaps
+    from physcam.analysis.distortion.stmap import distortion_field, write_stmaps
 
     lens = load_lens("zeiss_distagon_35mm_f4")
     res = distortion_field(lens, focus_mm=FOCUS, sensor_width_mm=SENSOR[0], sensor_height_mm=SENSOR[1],

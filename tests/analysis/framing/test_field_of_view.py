@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from physcam.analysis._chief import aim_from_film, aim_from_infinity, field_direction
-from physcam.analysis.field_of_view import chief_ray_field_limit, real_field_of_view
+from physcam.analysis.framing.field_of_view import chief_ray_field_limit, real_field_of_view
 from physcam.errors import InputError
 from physcam.lens.library import load_lens
 from physcam.optics import focusing
@@ -122,7 +122,7 @@ def test_bad_input():
 def test_real_breathing_corner_beyond_ninety_degrees(nikkor):
     # breathing-real measured the corner's angle with |N|, folding 90.13 deg back to 89.87; the
     # independent Snell trace of the corner ray (test above) leaves at half of 180.26 deg
-    from physcam.analysis.breathing_real import real_breathing
+    from physcam.analysis.framing.breathing_real import real_breathing
 
     row = real_breathing(nikkor, [math.inf], sensor_width_mm=36.0, sensor_height_mm=24.0).rows[0]
     fov = real_field_of_view(nikkor, 36.0, 24.0)

@@ -5,10 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from physcam.analysis.breathing_real import real_breathing
-from physcam.analysis.colour import chromatic_aberration
-from physcam.analysis.distortion import real_distortion
-from physcam.analysis.ghosts import _Tables, ghost_analysis, ghost_pairs, trace_ghost
+from physcam.analysis.framing.breathing_real import real_breathing
+from physcam.analysis.image_quality.colour import chromatic_aberration
+from physcam.analysis.distortion.field import real_distortion
+from physcam.analysis.image_quality.ghosts import _Tables, ghost_analysis, ghost_pairs, trace_ghost
 from physcam.errors import InputError, OpticsError
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import breathing_table
@@ -147,7 +147,7 @@ def test_lens_ghosts_ranked_coated_and_imaged(dgauss):
 
 
 def test_colour_says_when_the_file_has_no_dispersion():
-    from physcam.analysis.colour import chromatic_aberration
+    from physcam.analysis.image_quality.colour import chromatic_aberration
     from physcam.lens.library import load_lens
 
     res = chromatic_aberration(load_lens("dgauss_50mm"))  # pbrt file: no Abbe numbers

@@ -11,9 +11,9 @@ import math
 import numpy as np
 import pytest
 
-from physcam.analysis import _sampling
-from physcam.analysis.huygens import _field_sum, _wavelets, huygens_mtf, huygens_psf
-from physcam.analysis.mtf import mtf
+from physcam.analysis.image_quality import _sampling
+from physcam.analysis.image_quality.huygens import _field_sum, _wavelets, huygens_mtf, huygens_psf
+from physcam.analysis.image_quality.mtf import mtf
 from physcam.lens.library import load_lens
 from physcam.optics.state import camera_state
 

@@ -18,15 +18,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from physcam.analysis import _sampling
-import physcam.analysis.huygens as H
-from physcam.analysis.huygens import _field_sum, _wavelets, huygens_mtf
+from physcam.analysis.image_quality import _sampling
+import physcam.analysis.image_quality.huygens as H
+from physcam.analysis.image_quality.huygens import _field_sum, _wavelets, huygens_mtf
 from physcam.cli import main
 from physcam.errors import OpticsError
 from physcam.lens.library import load_lens
 from physcam.optics.state import camera_state
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[2] / "data"
 PATENT = DATA / "zemax" / "US00583336-2-scaled.zmx"
 
 

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from physcam.analysis.illumination import MAX_GRID, relative_illumination
+from physcam.analysis.image_quality.illumination import MAX_GRID, relative_illumination
 from physcam.cli import main
 from physcam.errors import InputError
 from physcam.lens.library import load_lens
@@ -59,7 +59,7 @@ def test_sizes_are_bounded_before_allocation(capsys):
 
 
 def test_field_counts_are_bounded_before_allocation():
-    from physcam.analysis.distortion import real_distortion
+    from physcam.analysis.distortion.field import real_distortion
 
     lens = load_lens("dgauss_50mm")
     for bad in (10**9, 201, 2):

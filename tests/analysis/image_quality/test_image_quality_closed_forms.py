@@ -10,9 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from physcam.analysis.mtf import diffraction_limited_mtf, geometric_mtf, mtf, through_focus_mtf
-from physcam.analysis.psf import psf
-from physcam.analysis.wavefront import noll_indices, wavefront, zernike_noll
+from physcam.analysis.image_quality.mtf import diffraction_limited_mtf, geometric_mtf, mtf, through_focus_mtf
+from physcam.analysis.image_quality.psf import psf
+from physcam.analysis.image_quality.wavefront import noll_indices, wavefront, zernike_noll
 from physcam.trace.aperture import Aperture
 
 from _image_quality import (F_MM, defocus_opd_exact, defocus_otf, disk_mtf, perfect_lens, reference_sine, sin_u,

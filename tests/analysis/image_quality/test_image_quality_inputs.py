@@ -10,9 +10,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from physcam.analysis.mtf import geometric_mtf, mtf, mtf_chart, through_focus_mtf
-from physcam.analysis.psf import psf
-from physcam.analysis.wavefront import noll_indices, wavefront
+from physcam.analysis.image_quality.mtf import geometric_mtf, mtf, mtf_chart, through_focus_mtf
+from physcam.analysis.image_quality.psf import psf
+from physcam.analysis.image_quality.wavefront import noll_indices, wavefront
 from physcam.errors import InputError, OpticsError, PhysCamError
 from physcam.lens.library import load_lens
 from physcam.lens.prescription import LensMetadata, Medium, Prescription, Surface

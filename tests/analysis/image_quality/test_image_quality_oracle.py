@@ -13,15 +13,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from physcam.analysis.mtf import mtf
-from physcam.analysis.psf import psf
-from physcam.analysis.wavefront import wavefront
+from physcam.analysis.image_quality.mtf import mtf
+from physcam.analysis.image_quality.psf import psf
+from physcam.analysis.image_quality.wavefront import wavefront
 from physcam.lens.library import load_lens
 from physcam.trace import paraxial_image_z
 
 pytestmark = pytest.mark.slow
 
-DATA = json.loads((Path(__file__).resolve().parents[1] / "data" / "optiland_mtf_dgauss.json").read_text())
+DATA = json.loads((Path(__file__).resolve().parents[2] / "data" / "optiland_mtf_dgauss.json").read_text())
 CASES = [pytest.param(c, id=f"f{c['fstop']:g}-{c['field_deg']:g}deg") for c in DATA["cases"]]
 LENS = load_lens("dgauss_50mm")
 

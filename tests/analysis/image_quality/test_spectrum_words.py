@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from physcam.analysis.mtf import WHITE_LIGHT_NM, spectrum_words
+from physcam.analysis.image_quality.mtf import WHITE_LIGHT_NM, spectrum_words
 from physcam.cli import main
 from physcam.lens.library import find_lens, list_lenses, load_lens
 from physcam.lens.prescription import Medium
@@ -68,7 +68,7 @@ def test_mtf_cli_and_lens_card_say_monochromatic(capsys):
     assert main(["mtf", "--lens", "dgauss_50mm", "--fstop", "8", "--fields", "2", "--sensor", "S35"]) == 0
     out = capsys.readouterr().out
     assert f"light: {MONO}" in out and "white light" not in out
-    from physcam.analysis.lens_card import lens_card
+    from physcam.analysis.lens_cards.card import lens_card
 
     card = lens_card(load_lens("dgauss_50mm"), quality="draft")
     fig = card.figure(dpi=30)

@@ -12,8 +12,8 @@ import math
 import numpy as np
 import pytest
 
-from physcam.analysis.illumination import relative_illumination
-from physcam.analysis.spot import MAX_RINGS, equal_area_disk, spot_diagram
+from physcam.analysis.image_quality.illumination import relative_illumination
+from physcam.analysis.image_quality.spot import MAX_RINGS, equal_area_disk, spot_diagram
 from physcam.cli import main
 from physcam.errors import InputError
 from physcam.lens.library import load_lens

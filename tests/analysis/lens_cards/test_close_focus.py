@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from physcam.analysis.lens_card import lens_card
+from physcam.analysis.lens_cards.card import lens_card
 from physcam.cli import main
 from physcam.lens.library import find_lens, load_lens
 from physcam.optics.focusing import breathing_table, close_focus

@@ -13,7 +13,7 @@ import re
 
 import pytest
 
-from physcam.analysis.lens_card import PAGES, PANELS, lens_card, save_lens_card
+from physcam.analysis.lens_cards.card import PAGES, PANELS, lens_card, save_lens_card
 from physcam.lens.library import list_lenses, load_lens
 
 pytestmark = pytest.mark.slow

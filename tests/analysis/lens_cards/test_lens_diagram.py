@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "optics"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "optics"))
 from _gauss_lenses import dgauss, stop  # noqa: E402
 
-from physcam.analysis.diagram import lens_diagram, trace_meridional_ray  # noqa: E402
+from physcam.analysis.lens_cards.diagram import lens_diagram, trace_meridional_ray  # noqa: E402
 from physcam.lens.prescription import AIR, Medium, Prescription, Surface  # noqa: E402
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from physcam.analysis.diagram import lens_diagram
+from physcam.analysis.lens_cards.diagram import lens_diagram
 from physcam.lens.library import list_lenses, load_lens
 
 

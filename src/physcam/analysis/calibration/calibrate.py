@@ -12,7 +12,7 @@ between the corners found and the fitted camera's projection of the chart.
 
 **physcam's models.** The measured field is sampled on a grid over the whole frame (plate pixels
 and their undistorted positions for the measured pinhole, about the measured principal point,
-y up, picture mm) and handed to :mod:`physcam.analysis.distortion_models`' fitters, exactly as
+y up, picture mm) and handed to :mod:`physcam.analysis.distortion.models`' fitters, exactly as
 ``physcam distortion --fit`` hands them traced rays: Brown-Conrady D-U and U-D, 3DE4 Radial -
 Standard, Degree 4, USD lensDistortion, each with its residual over the frame and its verdict.
 
@@ -39,9 +39,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_positive
-from .calibrate_chart import ChartView, _cv2
-from .distortion_models import (
+from ...errors import InputError, OpticsError, require_positive
+from .chart import ChartView, _cv2
+from ..distortion.models import (
     DEFAULT_MAX_RESIDUAL_PX,
     DistortionSamples,
     FittedDistortion,
@@ -297,7 +297,7 @@ def _check_views(views) -> list:
         raise InputError(f"give the chart views (detect_views), got {type(views).__name__}")
     views = list(views)
     if not all(isinstance(v, ChartView) for v in views):
-        raise InputError("give the chart views (physcam.analysis.calibrate_chart.detect_views)")
+        raise InputError("give the chart views (physcam.analysis.calibration.chart.detect_views)")
     return views
 
 
@@ -371,7 +371,7 @@ def calibrate_views(views, sensor_mm, *, lens_name: str = "measured", **kwargs) 
     views = _check_views(views)
     sensor_mm = _pair("sensor_mm", sensor_mm)
     if not views:
-        raise InputError("give the chart views (physcam.analysis.calibrate_chart.detect_views)")
+        raise InputError("give the chart views (physcam.analysis.calibration.chart.detect_views)")
     sizes = {v.size_px for v in views}
     if len(sizes) > 1:
         raise InputError(f"the views are of {len(sizes)} image sizes ({', '.join(f'{w}x{h}' for w, h in sizes)}): "

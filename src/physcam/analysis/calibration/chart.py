@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, require_positive
-from .calibrate_names import CHARTS, CHARUCO_DICTIONARY, MAX_IMAGE_PIXELS, parse_corners  # noqa: F401 (re-exported)
+from ...errors import InputError, require_positive
+from .names import CHARTS, CHARUCO_DICTIONARY, MAX_IMAGE_PIXELS, parse_corners  # noqa: F401 (re-exported)
 
 __all__ = [
     "CHARTS",
@@ -51,7 +51,7 @@ GRID_TOLERANCE = 0.2
 
 
 def _cv2():
-    from ..extras import require_extra
+    from ...extras import require_extra
 
     require_extra("calibrate", "calibrating a camera from chart photographs")
     import cv2
@@ -304,7 +304,7 @@ def _refine_checkerboard(cv2, img, corners, inner) -> np.ndarray:
     every edge gradient around it is orthogonal to), in a window of 0.4 of the smallest corner spacing
     (2 to 15 px each way): on blurred, noisy chart photographs the detector alone is good to ~0.3 px
     RMS and now and then misplaces a corner by several pixels; refined, 0.03-0.08 px
-    (tests/analysis/test_calibrate.py's rendered checkerboards)."""
+    (tests/analysis/calibration/test_calibrate.py's rendered checkerboards)."""
     g = corners.reshape(inner[1], inner[0], 2)
     spacing = min(np.linalg.norm(np.diff(g, axis=0), axis=2).min(), np.linalg.norm(np.diff(g, axis=1), axis=2).min())
     w = int(np.clip(0.4 * spacing, 2, 15))

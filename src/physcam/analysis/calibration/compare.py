@@ -1,7 +1,7 @@
 """A lens measured from chart photographs against physcam's prediction from its prescription (docs/calibrate.md).
 
 For each focus mark the prediction is the one ``physcam distortion`` makes for that lens, mark and
-sensor at the images' resolution (:func:`physcam.analysis.stmap.distortion_field`): the pinhole
+sensor at the images' resolution (:func:`physcam.analysis.distortion.stmap.distortion_field`): the pinhole
 focal length at that focus (breathing included; the best-match pinhole of the lens report) and the
 real chief rays' distortion over the frame. The distortions are compared as functions of the
 direction of the ray: at the predicted field's traced rays, the undistorted position normalised by
@@ -29,8 +29,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
-from ..lens.prescription import Prescription
+from ...errors import InputError
+from ...lens.prescription import Prescription
 
 __all__ = ["AGREEMENT_K", "Comparison", "compare_with_lens"]
 
@@ -73,8 +73,8 @@ def _focal_std_mm(m) -> float:
 
 def _distortion_difference(mark, field_) -> np.ndarray:
     """Measured minus predicted distortion (px) at the predicted field's traced rays inside the frame."""
-    from .calibrate_chart import _cv2
-    from .distortion_models import samples_from_field
+    from .chart import _cv2
+    from ..distortion.models import samples_from_field
 
     cv2 = _cv2()
     s = samples_from_field(field_)
@@ -92,9 +92,9 @@ def _distortion_difference(mark, field_) -> np.ndarray:
 def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K, fstop: float | None = None) -> Comparison:
     """Every measured figure of ``calibration`` against ``lens``'s prediction (module notes); ``fstop``: the
     stop the flat fields were shot at (None: wide open)."""
-    from ..optics.state import camera_state
+    from ...optics.state import camera_state
     from .calibrate import Calibration
-    from .stmap import distortion_field
+    from ..distortion.stmap import distortion_field
 
     if not isinstance(calibration, Calibration):
         raise InputError(f"give a Calibration (calibrate_views), got {type(calibration).__name__}")
@@ -129,7 +129,7 @@ def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K
             * r.focal_length_mm / ref.focal_length_mm
         rows.append(_row(f"breathing {r.mark_mm:g} mm against {ref.mark_mm:g} mm", r.change_pct, p, std, "%", k))
     if calibration.illumination is not None:
-        from ..errors import OpticsError
+        from ...errors import OpticsError
 
         try:
             rows += _illumination_rows(calibration, lens, k, fstop, pred_f[calibration.marks[0].mark_mm])
@@ -141,8 +141,8 @@ def compare_with_lens(calibration, lens: Prescription, *, k: float = AGREEMENT_K
 
 def _illumination_rows(calibration, lens, k, fstop, f_pred) -> list[dict]:
     """Each ring of the measured relative illumination against the lens's, interpolated at its image height."""
-    from ..optics.state import camera_state
-    from .illumination import relative_illumination
+    from ...optics.state import camera_state
+    from ..image_quality.illumination import relative_illumination
 
     ill, m = calibration.illumination, calibration.marks[0]
     heights = ill.height_mm[1:]

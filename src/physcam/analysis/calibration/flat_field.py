@@ -4,7 +4,7 @@ A flat field is a picture of a uniform, diffuse light source filling the lens (a
 evenly lit white card out of focus) at the stop being characterized. The frames are averaged;
 the picture is divided into rings about the measured principal point; each ring's mean over the
 centre ring's is the **relative illumination** at that image height (mm on the sensor from the
-optical axis), the quantity :func:`physcam.analysis.illumination.relative_illumination` predicts
+optical axis), the quantity :func:`physcam.analysis.image_quality.illumination.relative_illumination` predicts
 from a prescription. The uncertainty of a ring is the standard deviation of its value over the
 frames divided by the square root of their number (with one frame: the spread of the ring's
 pixels over the square root of their count). The sensor's own response (microlens acceptance
@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
-from .calibrate_chart import MAX_IMAGE_PIXELS, check_pixels, image_size, read_gray
+from ...errors import InputError
+from .chart import MAX_IMAGE_PIXELS, check_pixels, image_size, read_gray
 
 __all__ = ["MeasuredIllumination", "measure_illumination"]
 

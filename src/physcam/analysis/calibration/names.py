@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import re
 
-from ..errors import InputError
+from ...errors import InputError
 
 __all__ = ["CHARTS", "CHARUCO_DICTIONARY", "MAX_IMAGE_PIXELS", "parse_corners"]
 

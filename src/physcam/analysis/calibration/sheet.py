@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from ..figures import new_figure, save_figure, styled
+from ...figures import new_figure, save_figure, styled
 
 __all__ = ["calibration_sheet"]
 
@@ -60,9 +60,9 @@ def _text(m, cal) -> str:
 
 @styled
 def calibration_sheet(calibration, path=None, *, force: bool = False):
-    """The sheet of ``calibration`` (a :class:`~physcam.analysis.calibrate.Calibration`); written to
+    """The sheet of ``calibration`` (a :class:`~physcam.analysis.calibration.calibrate.Calibration`); written to
     ``path`` (.png, .svg, .pdf) through :func:`physcam.figures.save_figure`, else returned."""
-    from ..errors import InputError
+    from ...errors import InputError
     from .calibrate import Calibration
 
     if not isinstance(calibration, Calibration):

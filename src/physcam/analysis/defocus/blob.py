@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..errors import InputError
+from ...errors import InputError
 
 __all__ = ["blob_moments", "equivalent_diameter", "rim_profile", "polygon_corners"]
 

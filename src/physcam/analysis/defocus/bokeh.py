@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..optics.state import CameraState, takes_camera
-from ..figures import styled
+from ...errors import InputError, OpticsError, require_finite, require_positive
+from ...optics.state import CameraState, takes_camera
+from ...figures import styled
 
 __all__ = ["BokehImage", "bokeh_image", "RGB_WAVELENGTHS_NM", "tone_map", "scale_bar_pixels", "write_bokeh_photo"]
 
@@ -58,7 +58,7 @@ class BokehImage:
     @styled
     def plot(self, path=None, *, force: bool = False):
         """The film-millimetre plot: the image (peak white) on film x and y axes."""
-        from ..figures import fit_title, pyplot
+        from ...figures import fit_title, pyplot
 
         plt = pyplot()
 
@@ -73,7 +73,7 @@ class BokehImage:
         fig.tight_layout()
         if path is None:
             return fig
-        from ..figures import save_figure
+        from ...figures import save_figure
 
         return save_figure(fig, path, force=force)
 
@@ -106,9 +106,9 @@ def bokeh_image(
     ``precision="single"`` traces the rays in float32 (faster; its error against double on every
     bundled lens is in docs/ray-tracing.md); the image is accumulated in double either way.
     """
-    from ..trace import paraxial_image_z
-    from ..trace.kernels import backend_for_job
-    from ._camera import ray_view
+    from ...trace import paraxial_image_z
+    from ...trace.kernels import backend_for_job
+    from .._camera import ray_view
 
     lens, _, film_z, stop_semi_diameter, aperture, wl, _ = ray_view(camera)
     depth = require_positive("light distance (depth_mm, --light)", depth_mm)
@@ -154,7 +154,7 @@ class _PointLight:
     i goes to wavelength i mod k, as point i // k of that wavelength's sequence): module notes."""
 
     def __init__(self, x_mm, y_mm, z_src, r_front, wls, seed, dtype):
-        from ..trace.lowdiscrepancy import random_seed
+        from ...trace.lowdiscrepancy import random_seed
 
         self.x, self.y, self.z_src, self.r_front, self.dtype = x_mm, y_mm, z_src, r_front, dtype
         rng = np.random.default_rng(seed)
@@ -164,7 +164,7 @@ class _PointLight:
 
     def points(self, n, start):
         """(u, v, channel) of rays ``start`` .. ``start + n``."""
-        from ..trace.lowdiscrepancy import owen_sobol_2d
+        from ...trace.lowdiscrepancy import owen_sobol_2d
 
         k = self.k
         if k == 1:
@@ -184,7 +184,7 @@ class _PointLight:
         """Rays ``start`` .. ``start + n`` as a RayBatch in ``dt`` (default the light's precision), and
         their channels. Built column by column (the arithmetic of RayBatch.from_arrays, without its
         checks: every number here is finite and every direction has dz = -z_src > 0), in one pass per column."""
-        from ..trace import RayBatch
+        from ...trace import RayBatch
 
         dt = self.dtype if dt is None else dt
         x_mm, y_mm, z_src = self.x, self.y, self.z_src
@@ -236,7 +236,7 @@ def _unit_directions(dx, dy, dz):
 
 def _pilot_extent(lens, src, trace, depth):
     """A square window on the film around where 20000 pilot rays (in double) land, 20 % margin."""
-    from ..trace import trace_to_film
+    from ...trace import trace_to_film
 
     pilot, _ = src.batch(20_000, 0, np.float64)
     pr = trace_to_film(lens, pilot, **trace)
@@ -251,7 +251,7 @@ def _pilot_extent(lens, src, trace, depth):
 def _accumulate(lens, src, trace, extent, rays, pixels, chunk, fresnel, progress):
     """Trace ``rays`` in chunks and bin their weights into a flat (pixels, pixels, channels) histogram
     over ``extent``; returns it and the count of rays that reached the film."""
-    from ..trace import trace_to_film
+    from ...trace import trace_to_film
 
     x0, x1, y0, y1 = extent
     nch = src.k
@@ -304,11 +304,11 @@ def write_bokeh_photo(img: BokehImage, path, *, pixel_pitch_um: float, sensor_na
     ``pixel_pitch_um``). Returns both paths. Rows top first: film +y up, as the camera sees it."""
     from pathlib import Path
 
-    from ..errors import require_positive, require_type
-    from ..io import check_writable
-    from .stmap import write_map_exr
+    from ...errors import require_positive, require_type
+    from ...io import check_writable
+    from ..distortion.stmap import write_map_exr
 
-    require_type("img", img, BokehImage, "physcam.analysis.bokeh.bokeh_image(lens, ...)")
+    require_type("img", img, BokehImage, "physcam.analysis.defocus.bokeh.bokeh_image(lens, ...)")
     pitch = require_positive("pixel pitch", pixel_pitch_um, unit="um")
     base = Path(path)
     base = base.with_suffix("") if base.suffix.lower() in (".exr", ".png") else base
@@ -330,7 +330,7 @@ def _write_photo_png(srgb, path, width_mm, pitch_um, sensor_name, force):
     """``srgb`` (0..1) as an 8-bit PNG, enlarged to at least 512 pixels, with the scale bar and its label."""
     from PIL import Image, ImageDraw
 
-    from ..io import staged
+    from ...io import staged
 
     im = Image.fromarray((np.clip(srgb, 0, 1) * 255 + 0.5).astype(np.uint8), "RGB")
     k = max(1, math.ceil(512 / im.width))

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, require_type
+from ...errors import InputError, require_type
 
 __all__ = ["ExrImage", "read_exr", "write_exr", "colour_channels", "depth_channel", "defocus_file", "write_kernel_stack"]
 
@@ -44,7 +44,7 @@ class ExrImage:
 
 def read_exr(path) -> ExrImage:
     """Read every channel of a scanline or tiled EXR (one part)."""
-    from ..extras import require_extra
+    from ...extras import require_extra
 
     require_extra("exr", "reading EXR images")
     import OpenEXR
@@ -66,7 +66,7 @@ def read_exr(path) -> ExrImage:
 def colour_channels(img: ExrImage) -> list[str]:
     """The colour channels (R, G, B, A in that order, with or without a layer prefix; Blender's
     ``Combined`` layer preferred); else every channel that is not a depth."""
-    require_type("image", img, ExrImage, "physcam.analysis.defocus_exr.read_exr(path)")
+    require_type("image", img, ExrImage, "physcam.analysis.defocus.exr.read_exr(path)")
     names = list(img.channels)
     for prefix in ("", "ViewLayer.Combined.", "RenderLayer.Combined."):
         got = [prefix + c for c in "RGBA" if prefix + c in names]
@@ -84,7 +84,7 @@ def colour_channels(img: ExrImage) -> list[str]:
 def depth_channel(img: ExrImage, name: str | None = None) -> str:
     """The named depth channel, or the one depth channel the file has (``Z``, ``*.Depth.Z``,
     ``depth.Z``, or a file's only channel)."""
-    require_type("image", img, ExrImage, "physcam.analysis.defocus_exr.read_exr(path)")
+    require_type("image", img, ExrImage, "physcam.analysis.defocus.exr.read_exr(path)")
     if name is not None:
         require_type("depth channel", name, str, "a channel name such as 'Z'")
     names = list(img.channels)
@@ -109,14 +109,14 @@ def write_exr(path, img: ExrImage, planes: dict, *, attributes=None, force: bool
     import os
     import tempfile
 
-    require_type("image", img, ExrImage, "physcam.analysis.defocus_exr.read_exr(path)")
+    require_type("image", img, ExrImage, "physcam.analysis.defocus.exr.read_exr(path)")
     require_type("planes", planes, dict, "{channel name: (h, w) array}")
-    from ..extras import require_extra
+    from ...extras import require_extra
 
     require_extra("exr", "writing EXR images")
     import OpenEXR
 
-    from ..io import atomic_write, check_writable
+    from ...io import atomic_write, check_writable
 
     check_writable(path, force=force)
     keep = {k: v for k, v in img.header.items() if k not in ("channels", "type", "chunkCount", "tiles")}
@@ -140,17 +140,17 @@ def defocus_file(image_path, output, lens, *, focus_mm: float | None = None, fst
                  edge_px: int = 1, force: bool = False) -> dict:
     """Defocus the EXR ``image_path`` through ``lens`` (a :class:`~physcam.optics.state.CameraState`, or a
     Prescription with ``focus_mm`` and ``fstop``) into ``output`` (see
-    :mod:`physcam.analysis.defocus`). ``depth``: a channel of the image, or a separate EXR file
+    :mod:`physcam.analysis.defocus.render`). ``depth``: a channel of the image, or a separate EXR file
     (its one depth channel) over the same data window; ``depth_kind`` defaults to ``inverse`` for a
     channel named ``depth.Z`` (Nuke) and ``planar`` otherwise (Blender's Z). ``cache``: a
-    :class:`~physcam.analysis.defocus_kernels.KernelCache` to share between frames; ``edge_px``: see
-    :func:`~physcam.analysis.defocus.defocus`. Returns a summary."""
+    :class:`~physcam.analysis.defocus.kernels.KernelCache` to share between frames; ``edge_px``: see
+    :func:`~physcam.analysis.defocus.render.defocus`. Returns a summary."""
     import time
 
-    from .defocus import defocus, inverse_depth
-    from .defocus_kernels import KernelCache, _as_aperture, defocus_camera
+    from .render import defocus, inverse_depth
+    from .kernels import KernelCache, _as_aperture, defocus_camera
 
-    from ..io import check_writable
+    from ...io import check_writable
 
     check_writable(output, force=force)
     t0 = time.perf_counter()
@@ -169,8 +169,8 @@ def defocus_file(image_path, output, lens, *, focus_mm: float | None = None, fst
     kind = depth_kind or ("inverse" if zname.split(".")[-2:] == ["depth", "Z"] else "planar")
     w, h = img.display_size
     if cache is None:
-        from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM
-        from ..optics.state import as_camera_state
+        from ...data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM
+        from ...optics.state import as_camera_state
 
         sensor = None if sensor_width_mm is None else (sensor_width_mm, DEFAULT_SENSOR_HEIGHT_MM)
         camera = as_camera_state(lens, focus_mm=focus_mm, fstop=fstop, sensor_mm=sensor, aperture=_as_aperture(aperture))
@@ -198,16 +198,16 @@ def defocus_file(image_path, output, lens, *, focus_mm: float | None = None, fst
 
 def write_kernel_stack(folder, camera, *, field_grid=(5, 3), depths_mm=(500.0, 1000.0, 2000.0, 4000.0, math.inf),
                        force: bool = False) -> dict:
-    """The PSF stack of ``camera`` (a :class:`~physcam.analysis.defocus_kernels.DefocusCamera`):
+    """The PSF stack of ``camera`` (a :class:`~physcam.analysis.defocus.kernels.DefocusCamera`):
     for each of ``field_grid`` (nx, ny) picture positions (spread corner to corner, at pixel
     centres) and each planar depth from the entrance pupil, one EXR (R, G, B: the kernel per
     channel; mono kernels repeat) and ``index.json`` describing them. Kernels are on the picture's
     pixel grid, rows down, the pinhole's image of the point at the centre pixel, each channel
     summing to the relative transmission (vignetting x cos, 1 on the axis)."""
-    from ..io import atomic_write, check_writable
-    from .defocus_kernels import DefocusCamera
+    from ...io import atomic_write, check_writable
+    from .kernels import DefocusCamera
 
-    require_type("camera", camera, DefocusCamera, "physcam.analysis.defocus_kernels.defocus_camera(lens, ...)")
+    require_type("camera", camera, DefocusCamera, "physcam.analysis.defocus.kernels.defocus_camera(lens, ...)")
     nx, ny = (int(v) for v in field_grid)
     if not (1 <= nx <= 33 and 1 <= ny <= 33):
         raise InputError(f"the field grid must be 1 to 33 positions a side, got {nx} x {ny}")
@@ -222,7 +222,7 @@ def write_kernel_stack(folder, camera, *, field_grid=(5, 3), depths_mm=(500.0, 1
             x = 0.5 + (camera.width - 1) * (i / (nx - 1) if nx > 1 else 0.5)
             y = 0.5 + (camera.height - 1) * (j / (ny - 1) if ny > 1 else 0.5)
             for k, d in enumerate(depths_mm):
-                from .defocus_kernels import FAR_MM
+                from .kernels import FAR_MM
 
                 kern = camera.kernel(x, y, FAR_MM if math.isinf(d) else float(d))
                 img = kern.image if kern.image.shape[2] == 3 else np.repeat(kern.image, 3, axis=2)

@@ -1,4 +1,4 @@
-"""The lens's own point spread functions for :mod:`physcam.analysis.defocus`: a (field x depth) stack.
+"""The lens's own point spread functions for :mod:`physcam.analysis.defocus.render`: a (field x depth) stack.
 
 Geometry (docs/defocus.md): the render is a pinhole picture taken from the lens's **entrance
 pupil** with the lens's best-match pinhole focal length ``f_pin`` at this focus
@@ -7,7 +7,7 @@ pupil** with the lens's best-match pinhole focal length ``f_pin`` at this focus
 picture point (sx, sy) mm from the frame centre (x right, y up) at planar depth ``d`` mm (along
 the optical axis, from the plane of the entrance pupil) is the object point (sx d / f_pin,
 sy d / f_pin) in lens space, ``entrance_pupil_from_film + d`` in front of the film. The kernel is
-that point's image traced by physcam's tracer (:func:`physcam.analysis.bokeh.bokeh_image`: the
+that point's image traced by physcam's tracer (:func:`physcam.analysis.defocus.bokeh.bokeh_image`: the
 focused prescription, the iris at the f-stop and its shape, cat's-eye vignetting, optionally three
 wavelengths), binned on the picture's pixel grid around the pinhole's image of the point (so
 distortion shows as the kernel's offset) and turned 180 deg (the lens inverts; the picture is
@@ -37,9 +37,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..lens.prescription import Prescription
-from ..optics.state import CameraState, takes_camera
+from ...errors import InputError, OpticsError, require_finite, require_positive
+from ...lens.prescription import Prescription
+from ...optics.state import CameraState, takes_camera
 
 __all__ = ["DefocusCamera", "defocus_camera", "Kernel", "KernelCache"]
 
@@ -226,7 +226,7 @@ def defocus_camera(camera: CameraState, *, width: int, height: int, aperture=Non
     imaged on ``width`` x ``height`` pixels, the display window); ``aperture`` (an Aperture or a blade
     count) replaces the camera's iris shape; ``tile`` px per field node; the blur
     step between depth nodes is ``step_px + step_rel x`` the blur diameter (module notes)."""
-    from ..optics.focusing import planes_of
+    from ...optics.focusing import planes_of
     from .bokeh import RGB_WAVELENGTHS_NM
 
     if camera.film_from_analysis or not camera.iris_set:
@@ -262,7 +262,7 @@ def defocus_camera(camera: CameraState, *, width: int, height: int, aperture=Non
 
 
 def _as_aperture(aperture):
-    from ..trace.aperture import Aperture
+    from ...trace.aperture import Aperture
 
     if aperture is None or isinstance(aperture, Aperture):
         return aperture
@@ -317,8 +317,8 @@ class KernelCache:
 def _save_npz(path: Path, k: Kernel) -> None:
     import io
 
-    from ..errors import ExportError
-    from ..io import atomic_write
+    from ...errors import ExportError
+    from ...io import atomic_write
 
     buf = io.BytesIO()
     np.savez(buf, image=k.image, transmission=np.array(k.transmission), depth=k.depth_mm)

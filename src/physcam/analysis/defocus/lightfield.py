@@ -48,10 +48,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_finite, require_positive, require_type
-from ..trace.microlens import PlenopticCamera, subimage_centres, trace_from_sensor, trace_to_sensor
-from ..trace.rays import OK, RayBatch
-from ..figures import styled
+from ...errors import InputError, OpticsError, require_finite, require_positive, require_type
+from ...trace.microlens import PlenopticCamera, subimage_centres, trace_from_sensor, trace_to_sensor
+from ...trace.rays import OK, RayBatch
+from ...figures import styled
 
 __all__ = ["LightField", "render_point", "render_plane", "render_planes", "subaperture_views", "refocus", "view_disparity",
            "view_mask", "checkerboard", "light_field_figure"]
@@ -130,7 +130,7 @@ def render_point(camera, distance_mm: float, x_mm: float = 0.0, y_mm: float = 0.
     entrance-pupil plane (module notes); each weighs the solid angle it stands for, so the image is
     the irradiance from a unit-intensity point (relative units, integrated over each pixel).
     """
-    from ..optics.paraxial import gaussian
+    from ...optics.paraxial import gaussian
 
     cam = _camera(camera)
     n = _count("rays", rays, MAX_RAYS)
@@ -324,7 +324,7 @@ def view_mask(camera) -> np.ndarray:
     """(n, n) booleans: the sub-aperture views whose pixel (with its bilinear neighbours) lies wholly
     inside every sub-image, the exit pupil's image of diameter XP b / D (paraxial, at the camera's
     stop). Views outside it mix in the neighbouring lenslet's sub-image or see no pupil at all."""
-    from ..optics.paraxial import gaussian
+    from ...optics.paraxial import gaussian
 
     cam = _camera(camera)
     g = gaussian(cam.main, film_z=cam.z_array)
@@ -372,7 +372,7 @@ def view_disparity(camera, distance_mm: float) -> float:
     and D' the paraxial distances from the main lens's exit pupil to the array and to the subject's
     image, b the sensor offset and n the pixels per lenslet. Exact for thin lenslets focused at
     infinity (b = f_mu) and a paraxial main lens."""
-    from ..optics.paraxial import gaussian
+    from ...optics.paraxial import gaussian
 
     cam = _camera(camera)
     z0 = _z_of(cam, distance_mm)
@@ -391,7 +391,7 @@ def light_field_figure(field_, *, views_shown: int = 3, refocus_slopes=(), path=
     180 degrees to show the scene upright. Saved to ``path`` (.png/.svg/.pdf) or returned."""
     lf = require_type("field_", field_, LightField, "render one with render_point or render_plane")
     k = _count("views shown", views_shown, 9)
-    from ..figures import pyplot
+    from ...figures import pyplot
 
     plt = pyplot()
     cam = lf.camera
@@ -430,6 +430,6 @@ def light_field_figure(field_, *, views_shown: int = 3, refocus_slopes=(), path=
     fig.tight_layout()
     if path is None:
         return fig
-    from ..figures import save_figure
+    from ...figures import save_figure
 
     return save_figure(fig, path, force=force)

@@ -46,8 +46,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..optics.state import CameraState, OfACamera, takes_camera
+from ...errors import InputError, OpticsError, require_finite, require_positive
+from ...optics.state import CameraState, OfACamera, takes_camera
 
 __all__ = ["RealDepthOfField", "real_depth_of_field", "blur_diameter_mm", "MEASURES"]
 
@@ -111,8 +111,8 @@ class _Blur:
 
     def __init__(self, cam: CameraState, image_height_mm, measure, energy_fraction, backend, *, grid: int = GRIDS[0],
                  film_shift_mm: float = 0.0):
-        from ..trace import RayBatch, trace_through
-        from ._chief import aim_from_film
+        from ...trace import RayBatch, trace_through
+        from .._chief import aim_from_film
 
         self.q, self.film_z, self.backend, self.grid = cam.focused, cam.film_z + film_shift_mm, backend, grid
         self.wl = float(cam.wavelengths_nm[0])  # the state's primary (default: the design wavelength)
@@ -129,7 +129,7 @@ class _Blur:
         self.ray = np.array([out.x[0], out.y[0], out.z[0], out.L[0], out.M[0], out.N[0]])
 
     def __call__(self, d_from_film: float) -> float:
-        from .centroid import image_moments
+        from ..centroid import image_moments
 
         x, y, z, L, M, N = self.ray
         z_obj = self.film_z - d_from_film
@@ -200,7 +200,7 @@ def _golden(fn, lo, hi, tol):
 def _collimate(cam: CameraState, measure, fraction, backend, grid) -> float:
     """The film shift (mm, + away from the lens) that puts the best focus of an on-axis point at the mark on
     the film: the smallest blur of that point over film positions (golden-section search)."""
-    from .centroid import image_moments
+    from ..centroid import image_moments
 
     mark = cam.focus_from_film_mm
     reach = max(2.0, 0.05 * cam.gaussian.efl)  # best focus lies well within 5 % of the EFL of the paraxial one

@@ -2,7 +2,7 @@
 
 Method (docs/defocus.md): each pixel is a point of the scene, at the inverse depth ``u`` its
 depth pass gives; it is split linearly in ``u`` between the two bracketing depth nodes of
-:mod:`physcam.analysis.defocus_kernels` (so the blur grows smoothly, with no banding). The
+:mod:`physcam.analysis.defocus.kernels` (so the blur grows smoothly, with no banding). The
 picture is cut into depth **layers**, one per node, and each layer is *scattered*: every
 ``tile`` x ``tile`` block of it is convolved (FFT; a direct sum for kernels up to 7 px) with the
 lens's own PSF traced for that tile's centre and that node's depth (field- and depth-dependent:
@@ -41,8 +41,8 @@ import math
 
 import numpy as np
 
-from ..errors import InputError
-from .defocus_kernels import DefocusCamera, KernelCache
+from ...errors import InputError
+from .kernels import DefocusCamera, KernelCache
 
 __all__ = ["DEPTH_KINDS", "DEPTH_UNITS_MM", "inverse_depth", "near_edges", "defocus"]
 
@@ -104,7 +104,7 @@ def near_edges(u: np.ndarray, px: int = 1) -> np.ndarray:
     blurs it with the foreground instead (the background's part of that pixel then moves with the
     foreground: an error of at most ``px`` pixels along the edge)."""
     if not isinstance(u, np.ndarray) or u.ndim != 2:
-        from ..errors import WrongTypeError
+        from ...errors import WrongTypeError
 
         raise WrongTypeError(f"near_edges takes an (h, w) numpy array of inverse depths, got {u!r:.60}")
     if px <= 0:

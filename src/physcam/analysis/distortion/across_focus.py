@@ -1,7 +1,7 @@
 """Distortion across focus: the breathing of distortion, as a table for a lens report (docs/distortion.md).
 
 For each focus mark (mm from the film plane; infinity allowed) the real chief rays are traced over
-the frame (:func:`physcam.analysis.stmap.distortion_field`, no maps) and measured against the
+the frame (:func:`physcam.analysis.distortion.stmap.distortion_field`, no maps) and measured against the
 best-match pinhole *at that focus*; the row gives that pinhole's focal length, the largest
 distortion in pixels, the corner distortion in percent, 100 (r_real - r_ideal) / r_ideal of the
 frame's corner, and the fitted Brown-Conrady D-U and 3DE4 coefficients with their residuals.
@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
-from ..figures import PALETTE, styled
-from ..lens.prescription import Prescription, takes_prescription
+from ...errors import InputError
+from ...figures import PALETTE, styled
+from ...lens.prescription import Prescription, takes_prescription
 
 __all__ = ["DistortionAcrossFocus", "distortion_across_focus", "MAX_FOCUS_ROWS"]
 
@@ -41,7 +41,7 @@ class DistortionAcrossFocus:
     def plot(self, path=None, *, force: bool = False, units: str = "m"):
         """Corner distortion and pinhole focal length against focus, a tick at each mark in ``units``
         (m, or ft for feet and inches); PNG/SVG if ``path``, else the Figure."""
-        from ._plot import distance_ticks, figure, save, unit_words
+        from .._plot import distance_ticks, figure, save, unit_words
 
         fig, ax = figure(5.6, 3.6)
         finite = [r for r in self.rows if r["focus_from_film_mm"] is not None]
@@ -68,7 +68,7 @@ def distortion_across_focus(lens: Prescription, focus_mm, *, sensor_width_mm: fl
                             width_px: int, height_px: int, wavelength_nm: float | None = None,
                             method: str = "auto") -> DistortionAcrossFocus:
     """One row per focus mark in ``focus_mm`` (module notes)."""
-    from .distortion_models import fit_brown_conrady, fit_tde4_radial, samples_from_field
+    from .models import fit_brown_conrady, fit_tde4_radial, samples_from_field
     from .stmap import distortion_field
 
     marks = list(np.atleast_1d(np.asarray(focus_mm, dtype=float)))

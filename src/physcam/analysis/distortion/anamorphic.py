@@ -1,6 +1,6 @@
 """3DEqualizer's "Anamorphic - Standard, Degree 4" and "Degree 6" fitted to an anamorphic lens's traced field.
 
-The data are the traced pairs of :func:`physcam.analysis.distortion_models.samples_from_field`
+The data are the traced pairs of :func:`physcam.analysis.distortion.models.samples_from_field`
 (picture mm on the physical, squeezed, film; x right, y up): where the real lens images a point
 (*distorted*) and where the best-match pinhole at that focus does (*undistorted*, f_x in X, f_y in Y).
 
@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
-from .distortion_models import (DEFAULT_MAX_RESIDUAL_PX, DistortionSamples, FittedDistortion, _allowed, _check,
+from ...errors import InputError
+from .models import (DEFAULT_MAX_RESIDUAL_PX, DistortionSamples, FittedDistortion, _allowed, _check,
                                 _finish, _lstsq)
 
 __all__ = ["TDE4_ANAMORPHIC_MODELS", "TDE4Anamorphic", "anamorphic_terms", "fit_tde4_anamorphic",

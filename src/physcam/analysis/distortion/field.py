@@ -12,7 +12,7 @@ negative is barrel, positive pincushion. Anamorphic lenses are measured in the X
 Y-Z meridians with their own EFL each. Heights are in mm on the film, field angles in degrees.
 
 **At a focus** (``focus_mm``, infinity included): the definition of the ST-maps and of
-``physcam distortion --focus`` (:mod:`physcam.analysis.stmap`). The lens is focused at the mark
+``physcam distortion --focus`` (:mod:`physcam.analysis.distortion.stmap`). The lens is focused at the mark
 (mm from the film plane); the chief ray is traced backward from the film height h through the
 centre of the stop to the object plane; theta is the angle of its object point seen from the
 entrance pupil, and f the best-match pinhole's focal length at that focus
@@ -41,10 +41,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
-from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..figures import styled
-from ..lens.prescription import Prescription, takes_prescription
+from ...data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
+from ...errors import InputError, OpticsError, require_finite, require_positive
+from ...figures import styled
+from ...lens.prescription import Prescription, takes_prescription
 
 __all__ = ["DistortionPoint", "StandardDistortion", "DistortionResult", "real_distortion", "fit_standard_distortion"]
 
@@ -156,7 +156,7 @@ class DistortionResult:
     @styled
     def plot(self, path=None, *, force: bool = False):
         """Percent distortion against field angle per meridian, with the fitted model; PNG if ``path``."""
-        from ._plot import figure, save
+        from .._plot import figure, save
 
         fig, ax = figure(5.2, 3.6)
         for axis, style in (("y", "o-"), ("x", "s--")):
@@ -179,7 +179,7 @@ class DistortionResult:
 
 def _max_field_deg(lens, axis, wl, half_diag, efl, backend) -> float:
     """Largest field (deg) up to the sensor corner whose chief ray reaches the film unclipped (to 0.01 deg)."""
-    from ._chief import field_limit_deg
+    from .._chief import field_limit_deg
 
     return field_limit_deg(lens, axis, max_deg=min(math.degrees(math.atan(half_diag / abs(efl))), 89.0),
                            wavelength_nm=wl, backend=backend)
@@ -187,8 +187,8 @@ def _max_field_deg(lens, axis, wl, half_diag, efl, backend) -> float:
 
 def _chief_heights(lens, fields_deg, axis, wl, film_z, backend, clip=True):
     """Film heights (mm, along ``axis``) of the aimed chief rays, and which reached the film."""
-    from ..trace import RayBatch, paraxial_image_z, trace_through
-    from ._chief import aim_from_infinity, field_direction
+    from ...trace import RayBatch, paraxial_image_z, trace_through
+    from .._chief import aim_from_infinity, field_direction
 
     if film_z is None:
         film_z = paraxial_image_z(lens, wl)
@@ -226,8 +226,8 @@ def real_distortion(
     chief ray misses or is clipped raises :class:`OpticsError` naming the widest field that passes.
     The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
-    from ..optics.paraxial import gaussian_xy
-    from ..trace import paraxial_image_z
+    from ...optics.paraxial import gaussian_xy
+    from ...trace import paraxial_image_z
 
     wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
     if isinstance(n_fields, bool) or not isinstance(n_fields, (int, np.integer)) or not 3 <= n_fields <= 200:
@@ -235,7 +235,7 @@ def real_distortion(
     w = require_positive("sensor width", sensor_width_mm)
     h = require_positive("sensor height", sensor_height_mm)
     if focus_mm is not None:
-        from ..units import parse_distance
+        from ...units import parse_distance
 
         focus_mm = parse_distance(focus_mm, name="focus distance", allow_inf=True)  # "2m", "infinity" too
         if film_z is not None:
@@ -305,8 +305,8 @@ class _AtFocus:
     tangent of the object point's angle from the entrance pupil (the ST-maps' ``_real_to_ideal``)."""
 
     def __init__(self, lens, focus_mm, wl, backend):
-        from ..optics.focusing import focus
-        from ..optics.paraxial import gaussian
+        from ...optics.focusing import focus
+        from ...optics.paraxial import gaussian
 
         self.st = focus(lens, focus_mm, axis="y", wavelength_nm=wl)
         q = self.st.prescription

@@ -1,6 +1,6 @@
 """Lens distortion models fitted to real chief rays over the whole frame (docs/distortion.md).
 
-The data are the traced pairs of :func:`physcam.analysis.stmap.distortion_field` at one focus:
+The data are the traced pairs of :func:`physcam.analysis.distortion.stmap.distortion_field` at one focus:
 for every traced film point, where the real lens puts it (*distorted*, the plate) and where the
 best-match pinhole at that focus puts it (*undistorted*: the paraxial focal length at that focus,
 camera at the entrance pupil). Positions here are **picture millimetres**: on the film, measured
@@ -38,7 +38,7 @@ c4 "Quartic Distortion - Degree 4", u3 "U - Degree 4", v3 "V - Degree 4". For an
 (variable projection: phi and b outside, the six linear coefficients inside).
 
 **USD / Hydra ``lensDistortion:*``** ("standard": k1, k2, center, anaSq, asym, scale): physcam's
-convention of :mod:`physcam.analysis.distortion` (undistorted to distorted,
+convention of :mod:`physcam.analysis.distortion.field` (undistorted to distorted,
 r_d = r_u (1 + k1 rho^2 + k2 rho^4), rho = r_u / (gate width / 2)), now fitted over the 2-D frame
 at the shot's focus; ``anaSq`` stays 1 (its meaning in hdPrman is not documented).
 
@@ -54,7 +54,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ExportError, InputError, OpticsError, require_positive
+from ...errors import ExportError, InputError, OpticsError, require_positive
 
 __all__ = [
     "DistortionSamples", "FittedDistortion", "BrownConrady", "TDE4RadialStandard", "USDStandard",
@@ -62,8 +62,8 @@ __all__ = [
     "MODEL_CHOICES", "DEFAULT_MAX_RESIDUAL_PX",
 ]
 
-from .distortion_names import DEFAULT_MAX_RESIDUAL_PX, MODEL_CHOICES  # noqa: E402  (re-exported)
-from ..figures import styled
+from .names import DEFAULT_MAX_RESIDUAL_PX, MODEL_CHOICES  # noqa: E402  (re-exported)
+from ...figures import styled
 
 
 @dataclass(frozen=True)
@@ -88,7 +88,7 @@ class DistortionSamples:
 
 
 def samples_from_field(result) -> DistortionSamples:
-    """The traced pairs of a :class:`~physcam.analysis.stmap.DistortionField` in picture mm."""
+    """The traced pairs of a :class:`~physcam.analysis.distortion.stmap.DistortionField` in picture mm."""
     from .stmap import DistortionField
 
     if not isinstance(result, DistortionField):
@@ -195,8 +195,8 @@ class FittedDistortion:
     def plot_residual(self, path=None, *, force: bool = False, units: str = "m"):
         """Residual (pixels) over the frame at every traced ray, with its RMS and max; the focus in the
         title in ``units`` (m, or ft for feet and inches); PNG/SVG if ``path``."""
-        from ..units import format_distance
-        from ._plot import figure, per_unit, save
+        from ...units import format_distance
+        from .._plot import figure, per_unit, save
 
         per_unit(units)
 
@@ -280,7 +280,7 @@ class BrownConrady(FittedDistortion):
 
     def opentrackio(self) -> dict:
         """The OpenTrackIO 1.0.1 ``lens.distortion`` entry in OpenLensIO's units and order, as
-        ``physcam live`` sends it (:func:`physcam.analysis.openlensio.opencv_to_opentrackio`):
+        ``physcam live`` sends it (:func:`physcam.analysis.distortion.openlensio.opencv_to_opentrackio`):
         millimetres on the sensor from the centre, y down, for the pinhole of focal length F
         (``pinholeFocalLength``, the Y pinhole here); ``radial`` six terms [k1/F^2, 0, k2/F^4, 0,
         k3/F^6, 0] (OpenLensIO's l1-l6, the denominator's l2, l4, l6 zero), ``tangential``

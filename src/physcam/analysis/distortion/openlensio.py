@@ -38,7 +38,7 @@ direction OpenLensIO calls U^-1; OpenTrackIO names coefficients of that directio
 
 from __future__ import annotations
 
-from ..errors import InputError, require_finite, require_positive
+from ...errors import InputError, require_finite, require_positive
 
 __all__ = ["DISTORTION_MODEL", "RADIAL_TERMS", "opencv_to_opentrackio", "opentrackio_to_opencv"]
 

@@ -46,7 +46,7 @@ pixel centres at (i + 0.5) / width; B = 0.
 * The **distortion map** (width x height) turns such an undistorted image back into the plate;
   its R, G are normalised to the undistorted image's frame, which is the plate's (its display
   window): values below 0 and above 1 reach into the overscan (its data window). OpenImageIO's
-  ``st_warp`` and Nuke's STMap read a source's coordinates so (tests/analysis/test_stmap_windows.py).
+  ``st_warp`` and Nuke's STMap read a source's coordinates so (tests/analysis/distortion/test_stmap_windows.py).
 
 Map arrays are image arrays: row 0 is the top row (as in EXR and PNG files).
 """
@@ -59,9 +59,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ExportError, InputError, OpticsError, require_positive
-from ..lens.prescription import Prescription
-from ..optics.state import CameraState, takes_camera
+from ...errors import ExportError, InputError, OpticsError, require_positive
+from ...lens.prescription import Prescription
+from ...optics.state import CameraState, takes_camera
 
 __all__ = ["DistortionField", "distortion_field", "apply_stmap", "write_stmaps", "write_map_exr", "write_map_png", "MAX_SIDE_PX", "MAX_PIXELS"]
 
@@ -221,8 +221,8 @@ def _real_to_ideal(q, gx, gy, st, film_xy, wl, backend, objects=False):
     """Trace chief rays backward from film points (n, 2) mm; ideal upright picture mm (n, 2) and ok.
     With ``objects``, also the object points (or light directions at infinity) and where the chief
     rays cross the Y meridian's entrance-pupil plane (for :func:`physcam.analysis.centroid.image_centroids`)."""
-    from ..trace import RayBatch, trace_through
-    from ._chief import aim_from_film
+    from ...trace import RayBatch, trace_through
+    from .._chief import aim_from_film
 
     aimed = aim_from_film(q, film_xy, st.film_z, wavelength_nm=wl, backend=backend)
     out = trace_through(q, RayBatch.from_arrays(aimed.start, aimed.direction, wl), reverse=True, backend=backend)
@@ -293,7 +293,7 @@ class _PlateRays:
 
     def centroid_px(self, obj, crossing):
         """Where the stopped-down lens images the object points, plate px."""
-        from .centroid import image_centroids
+        from ..centroid import image_centroids
 
         q, g, st, iris = self.q, self.gy, self.st, self.iris
         r_ep = g.entrance_pupil_diameter / 2 * iris / q.surfaces[q.stop_index].semi_diameter
@@ -435,8 +435,8 @@ def distortion_field(
     are then None and (0, 0)): what fitting models and tables across focus need. An iris set to an
     f-stop gives the centroid distortion there instead of the chief rays' (module notes, "At a stop").
     """
-    from ..optics.focusing import focus, focus_method
-    from ..optics.paraxial import gaussian
+    from ...optics.focusing import focus, focus_method
+    from ...optics.paraxial import gaussian
 
     w_px, h_px = _size("width", width_px), _size("height", height_px)
     if w_px * h_px > MAX_PIXELS:
@@ -534,8 +534,8 @@ def write_map_exr(rgb: np.ndarray, path, attributes=None, *, overscan=(0, 0), fo
     (strings and floats). ``overscan`` (ox, oy): ``rgb`` is a frame with that margin around it; the
     display window is the frame, the data window the whole array (OpenEXR's "Technical Introduction",
     data and display windows; y grows downward)."""
-    from ..extras import require_extra
-    from ..io import staged
+    from ...extras import require_extra
+    from ...io import staged
 
     rgb = _map_array(rgb)
     require_extra("exr", "writing ST-maps as EXR")
@@ -556,7 +556,7 @@ def _map_array(rgb) -> np.ndarray:
     """``rgb`` checked as an (h, w, 3) map of finite numbers (a sentence, not an AttributeError)."""
     a = rgb if isinstance(rgb, np.ndarray) else None
     if a is None or a.ndim != 3 or a.shape[2] != 3 or min(a.shape[:2]) < 1:
-        from ..errors import WrongTypeError
+        from ...errors import WrongTypeError
 
         raise WrongTypeError(f"an ST-map is an (h, w, 3) numpy array, got {rgb!r:.60}")
     return a
@@ -576,7 +576,7 @@ def write_map_png(rgb: np.ndarray, path, *, force: bool = False) -> Path:
     2048-pixel map, which a characterization run writes by the hundred)."""
     from PIL import Image
 
-    from ..io import staged
+    from ...io import staged
 
     rgb = _map_array(rgb)
     with staged(path, force=force, suffix=".png") as tmp:
@@ -599,7 +599,7 @@ def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> lis
     and put in place before the next is encoded (an 8K pair peaks under 2 GiB: docs/performance.md).
     Returns the paths written.
     """
-    from ..io import check_writable
+    from ...io import check_writable
 
     if not isinstance(result, DistortionField):
         raise InputError(f"write_stmaps takes a DistortionField, got {type(result).__name__}")

@@ -12,8 +12,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ..errors import InputError, WrongTypeError
-from ..figures import styled
+from ...errors import InputError, WrongTypeError
+from ...figures import styled
 
 __all__ = ["PLOT_FORMATS", "breathing_figure", "draw_breathing", "save_breathing_plot"]
 
@@ -25,7 +25,7 @@ def breathing_figure(rows, *, title: str = "focus breathing", sensor_width_mm: f
                      units: str = "m"):
     """A matplotlib Figure (Agg canvas) of HFOV (left axis) and EFL (right axis) against 1/mark;
     ``units`` ("m" or "ft") for the focus axis."""
-    from ..figures import fit_title, new_figure
+    from ...figures import fit_title, new_figure
 
     rows = _checked_rows(rows, units)
     fig = new_figure(figsize=(7.5, 4.2))
@@ -37,8 +37,8 @@ def breathing_figure(rows, *, title: str = "focus breathing", sensor_width_mm: f
 
 
 def _checked_rows(rows, units):
-    from ..optics.focusing import BreathingRow
-    from ..units import UNIT_SYSTEMS
+    from ...optics.focusing import BreathingRow
+    from ...units import UNIT_SYSTEMS
 
     if units not in UNIT_SYSTEMS:
         raise InputError(f"units must be one of {', '.join(UNIT_SYSTEMS)}, got {units!r}")
@@ -53,8 +53,8 @@ def _checked_rows(rows, units):
 @styled
 def draw_breathing(ax, rows, *, sensor_width_mm: float | None = None, units: str = "m", legend_loc: str = "lower left"):
     """Draw breathing ``rows`` on axes ``ax``: HFOV on ``ax``, EFL on a twin axis at the right (returned)."""
-    from ..figures import PALETTE
-    from ._plot import tick_label
+    from ...figures import PALETTE
+    from .._plot import tick_label
 
     rows = _checked_rows(rows, units)
     per = 1000.0 if units == "m" else 304.8
@@ -92,6 +92,6 @@ def _thin_ticks(ax, gap: float = 0.06) -> None:
 @styled
 def save_breathing_plot(rows, path, *, force: bool = False, **kwargs) -> Path:
     """Write the breathing plot to ``path`` (.png, .svg, .pdf) through atomic_write."""
-    from ..figures import save_figure
+    from ...figures import save_figure
 
     return save_figure(breathing_figure(rows, **kwargs), path, force=force, dpi=150)

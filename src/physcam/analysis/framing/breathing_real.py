@@ -17,10 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
-from ..errors import OpticsError, require_positive
-from ..lens.prescription import Prescription, takes_prescription
-from ..figures import styled
+from ...data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
+from ...errors import OpticsError, require_positive
+from ...lens.prescription import Prescription, takes_prescription
+from ...figures import styled
 
 __all__ = ["RealBreathingRow", "RealBreathing", "real_breathing"]
 
@@ -60,7 +60,7 @@ class RealBreathing:
     def plot(self, path=None, *, force: bool = False, units: str = "m"):
         """HFOV change against the focus mark (log axis, a tick at each mark in ``units``: m, or ft for
         feet and inches; infinity at the right); PNG/SVG/PDF if ``path``, else the Figure."""
-        from ._plot import distance_ticks, figure, per_unit, save, unit_words
+        from .._plot import distance_ticks, figure, per_unit, save, unit_words
 
         per = per_unit(units)
         fig, ax = figure(5.2, 3.6)
@@ -81,8 +81,8 @@ class RealBreathing:
 
 
 def _real_half_angles(st, w, h, wl, backend):
-    from ..trace import RayBatch, trace_through
-    from ._chief import aim_from_film
+    from ...trace import RayBatch, trace_through
+    from .._chief import aim_from_film
 
     lens, film_z = st.prescription, st.film_z
     aimed = aim_from_film(lens, [[w / 2.0, 0.0], [w / 2.0, h / 2.0]], film_z, wavelength_nm=wl, backend=backend)
@@ -113,7 +113,7 @@ def real_breathing(
 
     The sensor is ``sensor_width_mm`` x ``sensor_height_mm`` (default Super 35, 24.89 x 18.66 mm: :data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
-    from ..optics.focusing import breathing_table, focus, focus_method
+    from ...optics.focusing import breathing_table, focus, focus_method
 
     w = require_positive("sensor width", sensor_width_mm)
     h = require_positive("sensor height", sensor_height_mm)

@@ -29,8 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, renamed_parameter, require_finite, require_positive, require_type
-from ..lens.prescription import Prescription, takes_prescription
+from ...errors import InputError, renamed_parameter, require_finite, require_positive, require_type
+from ...lens.prescription import Prescription, takes_prescription
 
 __all__ = ["RealFieldOfView", "real_field_of_view", "real_field_of_view_focused", "chief_ray_field_limit",
            "DIFFERS_PCT"]
@@ -99,7 +99,7 @@ def chief_ray_field_limit(
 
     Scans out from the axis in 1-degree steps to the first field that fails, then bisects.
     """
-    from ._chief import field_limit_deg
+    from .._chief import field_limit_deg
 
     if axis not in ("x", "y"):
         raise InputError(f"axis must be 'x' or 'y', got {axis!r}")
@@ -133,7 +133,7 @@ def real_field_of_view(
     Raises :class:`InputError` for bad sizes, :class:`OpticsError` when the lens forms no image or
     cannot focus at the mark.
     """
-    from ..optics import focusing
+    from ...optics import focusing
 
     if not isinstance(lens, Prescription):
         raise InputError(f"expected a physcam Prescription, got {type(lens).__name__}")
@@ -161,9 +161,9 @@ def real_field_of_view_focused(lens: Prescription, focused: Prescription, film_z
     """:func:`real_field_of_view` of ``lens`` already focused (``focused``, its film plane at ``film_z``,
     lens space, for the focus ``mark`` from the film; None: a film plane placed by hand): what the
     on-set report asks of its camera's own focus solution."""
-    from ..optics import paraxial
-    from ..trace import RayBatch, trace_through
-    from ._chief import aim_from_film
+    from ...optics import paraxial
+    from ...trace import RayBatch, trace_through
+    from .._chief import aim_from_film
 
     require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name)")
     require_type("focused", focused, Prescription, "physcam.optics.focusing.focus(lens, mark).prescription")

@@ -12,9 +12,9 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ..data.default_sensor import DEFAULT_SENSOR_WIDTH_MM
-from ..figures import styled
-from ..lens.prescription import Prescription, takes_prescription
+from ...data.default_sensor import DEFAULT_SENSOR_WIDTH_MM
+from ...figures import styled
+from ...lens.prescription import Prescription, takes_prescription
 
 __all__ = ["zoom_figure", "save_zoom_figure"]
 
@@ -26,8 +26,8 @@ CURVE_SAMPLES = 41
 @takes_prescription
 def zoom_figure(lens: Prescription, *, sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM):
     """A matplotlib Figure (Agg canvas) of breathing and parfocality (module notes)."""
-    from ..figures import PALETTE, fit_title, new_figure
-    from ..optics.zoom import zoom_breathing, zoom_table
+    from ...figures import PALETTE, fit_title, new_figure
+    from ...optics.zoom import zoom_breathing, zoom_table
 
     fig = new_figure(figsize=(10.0, 4.2))
     ax, bx = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
@@ -67,6 +67,6 @@ def zoom_figure(lens: Prescription, *, sensor_width_mm: float = DEFAULT_SENSOR_W
 def save_zoom_figure(lens: Prescription, path, *, force: bool = False,
                      sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM) -> Path:
     """Write :func:`zoom_figure` to ``path`` (.png, .svg, .pdf) through atomic_write."""
-    from ..figures import save_figure
+    from ...figures import save_figure
 
     return save_figure(zoom_figure(lens, sensor_width_mm=sensor_width_mm), path, force=force, dpi=150)

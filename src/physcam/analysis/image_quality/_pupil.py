@@ -47,8 +47,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_finite
-from ..optics.state import CameraState
+from ...errors import InputError, OpticsError, require_finite
+from ...optics.state import CameraState
 
 #: Smallest and largest pupil grids (cells across the pupil's bounding square).
 MIN_PUPIL_SAMPLES = 16
@@ -86,7 +86,7 @@ class Setup:
 def setup(camera: CameraState, *, backend: str = "auto") -> Setup:
     """The pupil engine's setup of ``camera`` (a :class:`~physcam.optics.state.CameraState`: the lens
     focused and stopped once, in the optics layer) and how to trace it."""
-    from ..errors import require_type
+    from ...errors import require_type
 
     require_type("camera", camera, CameraState, "physcam.optics.state.camera_state(lens, focus_mm=..., fstop=...)")
     return Setup(camera, backend)
@@ -126,9 +126,9 @@ class _Tracer:
     all fields of a chart) to call them few times."""
 
     def __init__(self, st: Setup):
-        from ..trace.kernels import get_kernel
-        from ..trace.kernels._layout import pack
-        from ..trace.surfaces import surface_table
+        from ...trace.kernels import get_kernel
+        from ...trace.kernels._layout import pack
+        from ...trace.surfaces import surface_table
 
         self.st = st
         self.table = surface_table(st.lens, stop_semi_diameter=st.stop_semi_diameter)
@@ -141,7 +141,7 @@ class _Tracer:
         """Pick the kernel for a job of about ``rays`` rays through every surface, known ahead:
         the numpy kernel where it does the whole job in less time than loading numba takes
         (:func:`physcam.trace.kernels.backend_for_job`; both kernels give the same rays)."""
-        from ..trace.kernels import backend_for_job, get_kernel
+        from ...trace.kernels import backend_for_job, get_kernel
 
         self.kernel = get_kernel(backend_for_job(self.st.backend, rays * (self.S.shape[0] + 1)))
 
@@ -164,8 +164,8 @@ class _Tracer:
 
     def trace(self, start, direction, opl0, wavelengths, *, clip=True) -> Traced:
         """Trace rays (n, 3) with per-ray ``wavelengths`` (nm) front to back, adding n (p' - p) . d per leg."""
-        from ..trace import OK, RayBatch
-        from ..trace.trace import trace_packed
+        from ...trace import OK, RayBatch
+        from ...trace.trace import trace_packed
 
         wl = np.broadcast_to(np.asarray(wavelengths, dtype=float), (np.shape(start)[0],))
         rest = wl  # every medium usable at every wavelength (a batch has a few; np.unique imports numpy.ma)
@@ -205,7 +205,7 @@ class Field:
 
 
 def _outside(st: Setup, field_deg: float, wl: float, why: str) -> OpticsError:
-    from ._chief import field_limit_deg
+    from .._chief import field_limit_deg
 
     try:
         lim = field_limit_deg(st.lens, "y", max_deg=89.0, wavelength_nm=wl, tol_deg=0.05, backend=st.backend)
@@ -231,7 +231,7 @@ def field_angles(fields_deg) -> list[float]:
 
 def make_fields(st: Setup, fields_deg, wavelength_nm: float) -> list[Field]:
     """The beams or object points of ``fields_deg`` and their chief rays (through the centre of the stop)."""
-    from ._chief import _newton, aim_from_infinity, field_direction
+    from .._chief import _newton, aim_from_infinity, field_direction
 
     fds = field_angles(fields_deg)
     th = np.radians(fds)
@@ -247,7 +247,7 @@ def make_fields(st: Setup, fields_deg, wavelength_nm: float) -> list[Field]:
             t = (st.z_ep - s[2]) / d[i, 2]
             out.append(Field(fd, wl, d[i], None, s, d[i], (float(s[0] + t * d[i, 0]), float(s[1] + t * d[i, 1]))))
         return out
-    from ..trace import RayBatch, trace_through
+    from ...trace import RayBatch, trace_through
 
     objs = np.stack([np.zeros(th.size), -np.tan(th) * (st.z_ep - st.object_z), np.full(th.size, st.object_z)], axis=1)
     k = st.lens.stop_index
@@ -282,8 +282,8 @@ def fields_for_image_heights(st: Setup, heights_mm, wavelength_nm: float) -> np.
     """:func:`field_for_image_height` of several heights at once (one aiming, one trace: each ray's
     Newton iteration is its own, so the angles are those of one height at a time); the error names
     the first height outside the image circle."""
-    from ..trace import RayBatch, trace_through
-    from ._chief import aim_from_film
+    from ...trace import RayBatch, trace_through
+    from .._chief import aim_from_film
 
     hs = np.array([require_finite("image height", h) for h in heights_mm], dtype=float)
     out = np.zeros(hs.size)
@@ -326,7 +326,7 @@ def image_circle_radius(st: Setup, wavelength_nm: float, outside_mm: float, tol_
 
 def _starts(st: Setup, fl: Field, n_object: float, gx: np.ndarray, gy: np.ndarray):
     """Start points, directions and starting optical paths of rays aimed at (gx, gy) on the entrance-pupil plane."""
-    from ._chief import start_plane_z
+    from .._chief import start_plane_z
 
     n = gx.size
     if fl.direction is not None:

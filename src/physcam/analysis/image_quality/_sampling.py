@@ -1,6 +1,6 @@
 """Fields' pupils at one or more wavelengths, sampled finely enough (shared by wavefront, PSF, MTF).
 
-Sampling rules (limits in :mod:`physcam.analysis._pupil`):
+Sampling rules (limits in :mod:`physcam.analysis.image_quality._pupil`):
 
 - **phase**: the OPD may change by at most a given number of waves between neighbouring cells,
   at every wavelength and film plane asked for: a quarter wave for the wavefront and the PSF
@@ -23,9 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_finite
+from ...errors import InputError, OpticsError, require_finite
 from . import _pupil as P
-from ..optics.state import wavelengths_and_weights  # noqa: F401 (the analyses call it from here)
+from ...optics.state import wavelengths_and_weights  # noqa: F401 (the analyses call it from here)
 
 
 def pupil_samples_arg(value):

@@ -33,11 +33,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..figures import styled
-from ..lens.prescription import Prescription
-from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM, PGF_UNCERTAINTY
-from ..optics.state import CameraState, takes_camera
+from ...errors import InputError, OpticsError, require_finite, require_positive
+from ...figures import styled
+from ...lens.prescription import Prescription
+from ...optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM, PGF_UNCERTAINTY
+from ...optics.state import CameraState, takes_camera
 
 __all__ = ["LateralColourPoint", "ColourResult", "chromatic_aberration"]
 
@@ -97,7 +97,7 @@ class ColourResult:
 
     @styled
     def plot(self, path=None, *, force: bool = False):
-        from ._plot import figure, save
+        from .._plot import figure, save
 
         fig, (a1, a2) = figure(9.0, 3.6, ncols=2)
         a1.plot(self.curve_shift_mm, self.curve_nm, "-")
@@ -117,7 +117,7 @@ class ColourResult:
 
 def _media(lens):
     """Distinct dispersive media of ``lens``, in order: (key, Dispersion)."""
-    from ..optics.glass import medium_dispersion
+    from ...optics.glass import medium_dispersion
 
     out = {}
     for s in lens.surfaces:
@@ -131,7 +131,7 @@ def _media(lens):
 def _rear_focus_z(lens, wavelength_nm, models):
     """Paraxial rear focal point z (lens space) by a y-nu trace (Y meridian), indices from
     ``models[(nd, vd, glass)]`` where given, else each medium's own model."""
-    from ..optics.glass import medium_index
+    from ...optics.glass import medium_index
 
     y, nu, n = 1.0, 0.0, 1.0
     for s in lens.surfaces:
@@ -149,7 +149,7 @@ def _rear_focus_z(lens, wavelength_nm, models):
 
 def _pgf_uncertainty(lens, wavelengths):
     """One-sigma focus uncertainty (mm) per wavelength from the normal-line glasses' P_gF."""
-    from ..optics.glass import normal_line
+    from ...optics.glass import normal_line
 
     wl = list(wavelengths)
     var = np.zeros(len(wl))
@@ -168,7 +168,7 @@ def _zone_focus(lens, height, wls, stop_sd, backend):
     """Axis crossing z of the zone ray at ``height`` for each wavelength: one ray per wavelength, all
     in one tracer call (a mixed-wavelength batch gives each ray the indices of its own wavelength,
     bit for bit those of a one-wavelength trace)."""
-    from ..trace import RayBatch, trace_through
+    from ...trace import RayBatch, trace_through
 
     wl = np.asarray(wls, dtype=float)
     rays = RayBatch.collimated(np.zeros(wl.size), np.full(wl.size, height), -1.0)
@@ -187,8 +187,8 @@ def _zone_focus(lens, height, wls, stop_sd, backend):
 
 def _chief_heights(lens: Prescription, fields, wls, film_z: float, backend: str):
     """Film heights of the chief rays per wavelength, or (field, wavelength) of the first that does not pass."""
-    from ..trace import RayBatch, trace_through
-    from ._chief import aim_from_infinity, field_direction
+    from ...trace import RayBatch, trace_through
+    from .._chief import aim_from_infinity, field_direction
 
     dirs = field_direction(np.radians(fields), "y")
     aims = [aim_from_infinity(lens, dirs, wavelength_nm=w, backend=backend) for w in wls]
@@ -214,12 +214,12 @@ def _lateral_colour(lens: Prescription, fields, wls, film_z: float, backend: str
     ``clamp``: the fields are the default range to the sensor corner, so clamp it to the field every
     wavelength's chief ray passes instead of refusing.
     """
-    from ._chief import field_angles_deg
+    from .._chief import field_angles_deg
 
     clamped = None
     heights = _chief_heights(lens, fields, wls, film_z, backend)
     if isinstance(heights, tuple) and clamp and heights[0] > 0:
-        from ._chief import clamp_note, widest_passing_deg
+        from .._chief import clamp_note, widest_passing_deg
 
         good = max([0.0] + [f for f in fields if f < heights[0]])
         top = widest_passing_deg(lambda f: not isinstance(_chief_heights(lens, [f], wls, film_z, backend), tuple),
@@ -241,7 +241,7 @@ def _lateral_colour(lens: Prescription, fields, wls, film_z: float, backend: str
 
 def _glass_model_uncertainty(result: ColourResult, lens: Prescription, media: dict, curve) -> None:
     """Set the longitudinal and curve uncertainties from the normal-line glasses' P_gF +- PGF_UNCERTAINTY."""
-    from ..optics.glass import normal_line
+    from ...optics.glass import normal_line
 
     fc = _pgf_uncertainty(lens, [LINE_F_NM, LINE_C_NM] + list(curve))
     # C - F: the perturbation moves F and C foci together; the uncertainty of their difference
@@ -283,10 +283,10 @@ def chromatic_aberration(
     The sensor is the camera's, else Super 35, 24.89 x 18.66 mm
     (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
-    from ..optics.paraxial import gaussian
-    from ..trace import paraxial_image_z
-    from ._camera import ray_view, sensor_or_default
-    from ._chief import field_angles_deg
+    from ...optics.paraxial import gaussian
+    from ...trace import paraxial_image_z
+    from .._camera import ray_view, sensor_or_default
+    from .._chief import field_angles_deg
 
     lens, _, film_z, stop, _, _, _ = ray_view(camera)
     sensor_width_mm, sensor_height_mm = sensor_or_default(camera)

@@ -33,10 +33,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..figures import styled
-from ..lens.prescription import Prescription, takes_prescription
-from ..optics.state import CameraState, takes_camera
+from ...errors import InputError, OpticsError, require_finite, require_positive
+from ...figures import styled
+from ...lens.prescription import Prescription, takes_prescription
+from ...optics.state import CameraState, takes_camera
 
 __all__ = ["GhostPath", "GhostResult", "ghost_pairs", "ghost_analysis", "trace_ghost"]
 
@@ -85,7 +85,7 @@ class GhostResult:
     @styled
     def plot(self, path=None, *, force: bool = False):
         """The ghost image on the sensor (log scale), direct image marked; PNG if ``path``."""
-        from ._plot import figure, save
+        from .._plot import figure, save
 
         if self.image is None:
             raise InputError("this ghost result has no image; run ghost_analysis with image_rays > 0")
@@ -120,7 +120,7 @@ class _Tables:
     their index columns per wavelength."""
 
     def __init__(self, lens, coating, stop_sd):
-        from ..trace.tables import packed_table
+        from ...trace.tables import packed_table
 
         self.n = len(lens.surfaces)
         self.pf = packed_table(lens, coating=coating, stop_semi_diameter=stop_sd)
@@ -133,7 +133,7 @@ class _Tables:
     def _ending(S, kinds, a, b):
         """Rows a..b-1 of a packed table; the last row keeps the ray on its surface (no refraction).
         Where ``S`` holds one wavelength's indices, the last row's index after is its index before."""
-        from ..trace.kernels._layout import ETA, N1, N2, NA, NB, SA, SB
+        from ...trace.kernels._layout import ETA, N1, N2, NA, NB, SA, SB
 
         s = np.array(S[a:b], copy=True)
         s[-1, NA:NA + 9] = s[-1, NB:NB + 9]
@@ -145,7 +145,7 @@ class _Tables:
 
 def _normal(t, row, x, y, z):
     """Unit surface normal (not oriented) of row ``row`` of SurfaceTable ``t`` at points on it."""
-    from ..trace.surfaces import KIND_ASPHERE, KIND_QUADRIC
+    from ...trace.surfaces import KIND_ASPHERE, KIND_QUADRIC
 
     kind = int(t.kind[row])
     if kind == KIND_QUADRIC:
@@ -167,7 +167,7 @@ def _normal(t, row, x, y, z):
 
 def _reflect(rays, t, row, forward: bool):
     """Reflect live rays at row ``row`` of table ``t``, weighing their s and p halves by R_s and R_p."""
-    from ..trace.fresnel import fresnel_transmittances
+    from ...trace.fresnel import fresnel_transmittances
 
     live = rays.ok
     if not live.any():
@@ -176,7 +176,7 @@ def _reflect(rays, t, row, forward: bool):
     L, M, N = rays.L[live], rays.M[live], rays.N[live]
     nx, ny, nz = _normal(t, row, x, y, z)
     dn = L * nx + M * ny + N * nz
-    from ..optics.glass import evaluate
+    from ...optics.glass import evaluate
 
     wl = rays.wavelength_nm[live]
     n1 = evaluate(t.disp_before[row], wl)  # the medium the ray travels in (table order)
@@ -217,8 +217,8 @@ def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float | None =
 
 def _ghost_path(lens, rays, i, j, film_z, coating, stop_semi_diameter, backend, _tables):
     """:func:`trace_ghost` of a prescription, its film plane and stop."""
-    from ..trace.kernels import get_kernel
-    from ..trace.trace import DEFAULT_CHUNK, trace_packed
+    from ...trace.kernels import get_kernel
+    from ...trace.trace import DEFAULT_CHUNK, trace_packed
 
     n = len(lens.surfaces)
     if not (0 <= j < i < n):
@@ -246,8 +246,8 @@ def _ghost_path(lens, rays, i, j, film_z, coating, stop_semi_diameter, backend, 
 
 def _beam(lens, field_deg, wl, n, rng=None):
     """Collimated rays at ``field_deg`` (Y meridian) over the front element; each stands for an equal area."""
-    from ..trace import RayBatch
-    from ._chief import field_direction
+    from ...trace import RayBatch
+    from .._chief import field_direction
 
     r = lens.surfaces[0].semi_diameter
     if rng is None:  # a deterministic grid inside the disk
@@ -301,8 +301,8 @@ def ghost_analysis(
     The sensor is the camera's, else Super 35, 24.89 x 18.66 mm
     (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
-    from ..trace import paraxial_image_z, trace_to_film
-    from ._camera import ray_view, sensor_or_default
+    from ...trace import paraxial_image_z, trace_to_film
+    from .._camera import ray_view, sensor_or_default
 
     lens, _, film_z, stop_semi_diameter, aperture, wavelength_nm, _ = ray_view(camera, wavelength_nm=wavelength_nm)
     _round_iris(aperture)
@@ -315,7 +315,7 @@ def ghost_analysis(
     if coating is None:
         coating = lens.metadata.coating if lens.metadata.coating in ("none", "single", "multi") else "none"
     wl = lens.wavelength_nm if wavelength_nm is None else require_positive("wavelength", wavelength_nm, unit="nm")
-    from ..optics.sensors import custom_sensor
+    from ...optics.sensors import custom_sensor
 
     sensor = custom_sensor(sensor_width_mm, sensor_height_mm)  # bounded size and aspect: the image stays small
     w, h = sensor.width_mm, sensor.height_mm
@@ -341,7 +341,7 @@ def ghost_analysis(
     beam, direct = direct_image(fd)
     flux0 = float(direct.weight[direct.ok].sum())
     if flux0 <= 0 and default_field:
-        from ._chief import widest_passing_deg
+        from .._chief import widest_passing_deg
 
         def passes(f):
             d = direct_image(f)[1]

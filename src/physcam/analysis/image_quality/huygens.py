@@ -1,6 +1,6 @@
 """Huygens point spread function and MTF: the exit-pupil wavefront summed as secondary wavelets.
 
-The FFT method (:mod:`physcam.analysis.psf`, :mod:`physcam.analysis.mtf`) takes the pupil function
+The FFT method (:mod:`physcam.analysis.image_quality.psf`, :mod:`physcam.analysis.image_quality.mtf`) takes the pupil function
 on the entrance-pupil grid and maps grid cells to image-space directions by one affine fit. The
 Huygens method needs no such map (Zemax OpticStudio's "Huygens PSF"; Born & Wolf, *Principles of
 Optics*, 8.3, the Huygens-Fresnel principle): every traced ray j is a wavelet source at its point
@@ -33,7 +33,7 @@ pixels log pixels) instead of rays x pixels; |D|^2 is the same for every ray (a 
 which intensities do not see); the last term, a few hundredths of a radian over a PSF's extent, is
 expanded in its power series (one more transform per monomial) until the next term is below 1e-6
 radian. The next term of the distance's own expansion, (u.D)(|D|^2 - (u.D)^2) / 2R^2, is under 1e-3
-radian over a PSF's grid; tests/analysis/test_huygens.py checks the whole sum against the exact
+radian over a PSF's grid; tests/analysis/image_quality/test_huygens.py checks the whole sum against the exact
 distance |P - S_j| summed ray by ray.
 
 **MTF**: the Fourier transform of the PSF on its grid, evaluated at each frequency directly
@@ -60,9 +60,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_finite
-from ..figures import styled
-from ..optics.state import CameraState, OfACamera, takes_camera
+from ...errors import InputError, OpticsError, require_finite
+from ...figures import styled
+from ...optics.state import CameraState, OfACamera, takes_camera
 
 __all__ = ["HuygensPSF", "huygens_psf", "huygens_mtf", "DEFAULT_IMAGE_SAMPLES", "MAX_PUPIL_SAMPLES"]
 
@@ -130,7 +130,7 @@ class HuygensPSF(OfACamera):
     def plot(self, path=None, *, force: bool = False):
         from matplotlib.colors import LogNorm
 
-        from ._plot import figure, save
+        from .._plot import figure, save
 
         img = self.image
         n = img.shape[0]
@@ -320,7 +320,7 @@ def huygens_psf(
 ) -> HuygensPSF:
     """The Huygens PSF of ``camera`` at ``field_deg`` (degrees, Y meridian): module notes.
 
-    Arguments as :func:`physcam.analysis.mtf.mtf`; ``tilt_deg`` (about x, about y) tilts the film,
+    Arguments as :func:`physcam.analysis.image_quality.mtf.mtf`; ``tilt_deg`` (about x, about y) tilts the film,
     ``image_samples`` points per side (8 to 1024) of ``pixel_um`` (default a quarter of lambda N_w at
     the shortest wavelength). The pupil grid follows the quarter-wave rule (:mod:`._sampling`) and is
     made fine enough that its wavelets do not alias the image grid (a grid spanning more than

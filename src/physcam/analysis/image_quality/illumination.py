@@ -32,9 +32,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, OpticsError, require_finite, require_positive
-from ..optics.state import CameraState, takes_camera
-from ..figures import styled
+from ...errors import InputError, OpticsError, require_finite, require_positive
+from ...optics.state import CameraState, takes_camera
+from ...figures import styled
 
 __all__ = ["IlluminationPoint", "IlluminationResult", "relative_illumination"]
 
@@ -72,7 +72,7 @@ class IlluminationResult:
 
     @styled
     def plot(self, path=None, *, force: bool = False):
-        from ._plot import figure, save
+        from .._plot import figure, save
 
         fig, ax = figure(5.2, 3.6)
         for axis, style in (("y", "o-"), ("x", "s--")):
@@ -100,8 +100,8 @@ _CHUNK_RAYS = 1 << 18
 def _launch_window(lens, direction):
     """Start plane z0 and the rectangle on it that holds every ray of ``direction`` that can meet
     the front surface inside its clear aperture: the aperture's projection along the beam."""
-    from ..lens.geometry import sag
-    from ._chief import start_plane_z
+    from ...lens.geometry import sag
+    from .._chief import start_plane_z
 
     s = lens.surfaces[0]
     sd = s.semi_diameter
@@ -126,7 +126,7 @@ def _beam_areas(lens, directions, wl, film_z, grid, fresnel, stop_sd, aperture, 
     Every beam still zooming is traced in the same tracer call, and the fine grids of several
     beams share a call too; each beam's rays and sums are those it would get alone.
     """
-    from ..trace import RayBatch, trace_to_film
+    from ...trace import RayBatch, trace_to_film
 
     nb = len(directions)
     z0s, boxes = [], []
@@ -199,8 +199,8 @@ def _mappings(lens, lm, wl, film_z, backend, eps=1e-5):
     """Per chief ray of direction cosines (l, m): its film position and dA/d(omega) there (mm^2/sr),
     or None where it (or a neighbour of the finite-difference stencil) does not pass. All the
     stencils are aimed and traced in one batch (each ray is aimed independently)."""
-    from ..trace import RayBatch, trace_through
-    from ._chief import aim_from_infinity
+    from ...trace import RayBatch, trace_through
+    from .._chief import aim_from_infinity
 
     n = len(lm)
     L = np.concatenate([np.array([l, l + eps, l - eps, l, l]) for l, _m in lm])
@@ -246,10 +246,10 @@ def relative_illumination(
     :class:`OpticsError`. The sensor is the camera's, else Super 35, 24.89 x 18.66 mm
     (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`, the CLI's default too).
     """
-    from ..optics.paraxial import gaussian_xy
-    from ..trace import paraxial_image_z
-    from ._camera import ray_view, sensor_or_default
-    from ._chief import field_angles_deg, field_direction
+    from ...optics.paraxial import gaussian_xy
+    from ...trace import paraxial_image_z
+    from .._camera import ray_view, sensor_or_default
+    from .._chief import field_angles_deg, field_direction
 
     lens, _, film_z, stop_semi_diameter, aperture, wl, _ = ray_view(camera, wavelength_nm=wavelength_nm)
     sensor_width_mm, sensor_height_mm = sensor_or_default(camera)
@@ -293,7 +293,7 @@ def relative_illumination(
         return IlluminationPoint(axis, float(fd), float((a / mp[2]) / e0), c**4, a, a / (a0 * c), mp[2],
                                  mp[0] if axis == "x" else mp[1])
 
-    from ._chief import clamp_note, widest_passing_deg
+    from .._chief import clamp_note, widest_passing_deg
 
     default_range = fields_deg is None and max_field_deg is None
     points, notes = [], []

@@ -4,7 +4,7 @@ Diffraction MTF (:func:`mtf`): the optical transfer function is the autocorrelat
 pupil function (Goodman, *Introduction to Fourier Optics*, 6.3): OTF(nu) = sum P(u) P*(u - s) /
 sum |P|^2, with the pupil sheared by s = nu lambda / (n' |dL/dx|) along x for the sagittal MTF
 and by nu lambda / (n' |dM/dy|) along y for the tangential one (the slopes of the reference
-directions over the pupil grid, :mod:`physcam.analysis._pupil`). The sum runs over sub-cells of
+directions over the pupil grid, :mod:`physcam.analysis.image_quality._pupil`). The sum runs over sub-cells of
 the pupil (a binary mask resolved to a quarter cell at the pupil's edge, so the sheared overlap
 measures area), with the sheared copy between sub-cells interpolated linearly in amplitude and
 OPD: the MTF at any frequency comes straight from the shear, with no FFT grid to interpolate.
@@ -35,10 +35,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..data.default_sensor import DEFAULT_SENSOR_HALF_DIAGONAL_MM
-from ..errors import InputError, OpticsError, require_finite
-from ..figures import PALETTE, fit_title, styled
-from ..optics.state import CameraState, OfACamera, takes_camera
+from ...data.default_sensor import DEFAULT_SENSOR_HALF_DIAGONAL_MM
+from ...errors import InputError, OpticsError, require_finite
+from ...figures import PALETTE, fit_title, styled
+from ...optics.state import CameraState, OfACamera, takes_camera
 from ._sampling import MAX_FREQUENCIES, spatial_frequencies
 
 __all__ = ["MTFCurve", "ThroughFocusMTF", "MTFChart", "mtf", "geometric_mtf", "through_focus_mtf", "mtf_chart",
@@ -52,7 +52,7 @@ def spectrum_words(camera: CameraState, wavelengths_nm) -> str:
     the prescription gives its glasses dispersion; "monochromatic: the prescription gives no dispersion"
     where none of them has any (the wavelengths then differ in diffraction alone); a note of how many
     glasses have none where some do (:func:`physcam.optics.glass.glasses_without_dispersion`)."""
-    from ..optics.glass import glasses_without_dispersion
+    from ...optics.glass import glasses_without_dispersion
 
     wls = tuple(float(w) for w in np.atleast_1d(wavelengths_nm))
     listed = ", ".join(f"{w:g}" for w in wls) + " nm"
@@ -146,7 +146,7 @@ class MTFCurve(OfACamera):
 
     @styled
     def plot(self, path=None, *, force: bool = False):
-        from ._plot import figure, save
+        from .._plot import figure, save
 
         fig, ax = figure(5.4, 3.8)
         f = self.frequencies_lpmm
@@ -309,7 +309,7 @@ class ThroughFocusMTF(OfACamera):
 
     @styled
     def plot(self, path=None, *, force: bool = False):
-        from ._plot import figure, save
+        from .._plot import figure, save
 
         fig, ax = figure(5.4, 3.8)
         for k, f in enumerate(self.frequencies_lpmm):
@@ -470,8 +470,8 @@ class MTFChart(OfACamera):
     def plot(self, path=None, *, force: bool = False, units: str = "m"):
         """The vendor chart: solid sagittal, dashed tangential, thicker lines for lower frequencies; the
         focus in the title in ``units`` (m, or ft for feet and inches; image heights stay in mm)."""
-        from ..units import format_distance
-        from ._plot import figure, per_unit, save
+        from ...units import format_distance
+        from .._plot import figure, per_unit, save
 
         per_unit(units)
 
@@ -526,7 +526,7 @@ def mtf_chart(
     "axis" (the mean of S and T on the axis) or "field" (that mean averaged over the image, each
     height weighted by the area of its ring, as lens makers weigh a chart). The chart says which
     (``focus_rule``, ``defocus_mm``). ``method`` "huygens" computes each field's MTF from its Huygens PSF
-    (:func:`physcam.analysis.huygens.huygens_mtf`; slower, no pupil-to-direction map) instead of the
+    (:func:`physcam.analysis.image_quality.huygens.huygens_mtf`; slower, no pupil-to-direction map) instead of the
     pupil's autocorrelation ("fft")."""
     from . import _pupil as P
     from . import _sampling
@@ -594,7 +594,7 @@ def mtf_chart(
                 progress(i + 1, hs.size)
         return MTFChart(st.lens_name, st.state, tuple(wls), tuple(wts),
                         tuple(float(f) for f in freqs), hs, angles, np.clip(sag, 0, 1), np.clip(tan, 0, 1), ns,
-                        ("method: Huygens PSF per field (physcam.analysis.huygens)",), float(dz), rule,
+                        ("method: Huygens PSF per field (physcam.analysis.image_quality.huygens)",), float(dz), rule,
                         spectrum_words(camera, wls))
     # fields in runs that fit one tracing batch; each run's pupils are freed before the next
     for run in _sampling._chunks(list(range(hs.size)), lambda i: per_field, _sampling.RAYS_PER_BATCH):

@@ -1,6 +1,6 @@
 """Diffraction point spread function by FFT of the pupil function, and the Strehl ratio.
 
-The pupil function of a field (:mod:`physcam.analysis._pupil`: amplitude from the real pupil
+The pupil function of a field (:mod:`physcam.analysis.image_quality._pupil`: amplitude from the real pupil
 -- the stop, its aperture shape and every rim that vignettes -- and phase exp(-2 pi i W) from
 the OPD against the reference sphere) is sampled on a grid of cells; its discrete Fourier
 transform, zero-padded ``padding`` times, gives the PSF on the film (Goodman, *Introduction to
@@ -24,9 +24,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, require_finite
-from ..figures import styled
-from ..optics.state import CameraState, OfACamera, takes_camera
+from ...errors import InputError, require_finite
+from ...figures import styled
+from ...optics.state import CameraState, OfACamera, takes_camera
 
 __all__ = ["PointSpreadFunction", "psf", "strehl_of_pupil"]
 
@@ -107,7 +107,7 @@ class PointSpreadFunction(OfACamera):
         """Draw the PSF (log scale) within ``radius_airy`` Airy radii of the chief ray's point."""
         from matplotlib.colors import LogNorm
 
-        from ._plot import figure, save
+        from .._plot import figure, save
 
         img = self.image
         ny, nx = img.shape
@@ -141,9 +141,9 @@ def psf(
 ) -> PointSpreadFunction:
     """The diffraction PSF and Strehl ratio of ``camera`` at ``field_deg`` (degrees, Y meridian).
 
-    Arguments as :func:`physcam.analysis.wavefront.wavefront`; ``padding`` (2 to 16) sets the PSF
+    Arguments as :func:`physcam.analysis.image_quality.wavefront.wavefront`; ``padding`` (2 to 16) sets the PSF
     sampling: pixels of lambda N / padding or so. The pupil grid follows the quarter-wave rule
-    (:mod:`physcam.analysis._sampling`), up to ``max_pupil_samples`` (default 1024).
+    (:mod:`physcam.analysis.image_quality._sampling`), up to ``max_pupil_samples`` (default 1024).
     """
     from . import _sampling
 

@@ -30,9 +30,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, require_finite
-from ..optics.state import CameraState, takes_camera
-from ..figures import styled
+from ...errors import InputError, require_finite
+from ...optics.state import CameraState, takes_camera
+from ...figures import styled
 
 __all__ = ["equal_area_disk", "SpotField", "SpotDiagram", "spot_diagram", "MAX_RINGS", "MAX_REFINE"]
 
@@ -107,7 +107,7 @@ class SpotDiagram:
     @styled
     def plot(self, path=None, *, force: bool = False):
         """Draw one panel per field (positions relative to the centroid, um); write it to ``path`` (PNG/SVG/PDF) and return the path, else return the figure."""
-        from ..figures import fit_title, pyplot
+        from ...figures import fit_title, pyplot
 
         plt = pyplot()
 
@@ -130,7 +130,7 @@ class SpotDiagram:
         fig.tight_layout()
         if path is None:
             return fig
-        from ..figures import save_figure
+        from ...figures import save_figure
 
         return save_figure(fig, path, force=force)
 
@@ -154,7 +154,7 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
     ancestor. Cells are kept sparse (sorted integer keys per level), so the bookkeeping grows with
     the rays traced, not with the 4^level fine grid.
     """
-    from ..trace import OK
+    from ...trace import OK
 
     ns, nphi = rings, 2 * math.ceil(1.5 * rings)
 
@@ -250,12 +250,12 @@ class _Beams:
     """The rays of each field aimed at points of the beam's disk on the entrance-pupil plane ``z_ep``
     (centred on the axis): at infinity a collimated beam along (0, sin theta, cos theta); at a finite
     ``object_z`` from the object point (0, -tan(theta) (z_ep - object_z), object_z), seen under theta
-    from the entrance pupil (as :mod:`physcam.analysis._pupil`). Rays start on a plane in front of the
+    from the entrance pupil (as :mod:`physcam.analysis.image_quality._pupil`). Rays start on a plane in front of the
     lens (or at the object point when it is nearer)."""
 
     def __init__(self, lens, object_z, z_ep, beam, fields, wl):
-        from ..trace import RayBatch
-        from ._chief import start_plane_z
+        from ...trace import RayBatch
+        from .._chief import start_plane_z
 
         self.z0 = min(z_ep, start_plane_z(lens)) - 1.0
         self.object_z, self.z_ep, self.beam, self.wl = object_z, z_ep, beam, float(wl)
@@ -268,7 +268,7 @@ class _Beams:
 
     def rays(self, f, u, v):
         """Rays of fields ``f`` toward points (u, v) of the unit disk, as one RayBatch."""
-        from ..trace import RayBatch
+        from ...trace import RayBatch
 
         n = u.size
         if self.object_y is not None:
@@ -281,7 +281,7 @@ class _Beams:
                         np.full(n, self.wl), np.ones(n), np.zeros(n, dtype=np.uint8))
 
     def _from_point(self, f, u, v):
-        from ..trace import RayBatch
+        from ...trace import RayBatch
 
         n = u.size
         p = np.stack([np.zeros(n), self.object_y[f], np.full(n, self.object_z)], axis=1)
@@ -317,9 +317,9 @@ def spot_diagram(
     paraxial entrance pupil, not overfilled). A field where no ray reaches the film is undefined
     (module notes).
     """
-    from ..optics.paraxial import gaussian
-    from ..trace import CLIPPED, MISSED, OK, TIR, paraxial_image_z, trace_to_film
-    from ._camera import ray_view
+    from ...optics.paraxial import gaussian
+    from ...trace import CLIPPED, MISSED, OK, TIR, paraxial_image_z, trace_to_film
+    from .._camera import ray_view
 
     lens, object_z, film_z, stop, aperture, wl, _ = ray_view(camera, wavelength_nm=wavelength_nm)
     wl = require_finite("wavelength_nm", wl)

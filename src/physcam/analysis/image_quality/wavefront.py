@@ -1,6 +1,6 @@
 """Wavefront error: optical path difference over the exit pupil, its Zernike fit, RMS and peak-to-valley.
 
-The OPD of a field is computed by :mod:`physcam.analysis._pupil` (real rays over the real
+The OPD of a field is computed by :mod:`physcam.analysis.image_quality._pupil` (real rays over the real
 pupil, each followed to the reference sphere centred on the chief ray's point on the film and
 passing through the paraxial exit pupil; W = OPL(chief) - OPL(ray), the sign optiland 0.6.3
 uses). Reported in waves of the wavelength analysed:
@@ -32,9 +32,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, require_finite
-from ..figures import styled
-from ..optics.state import CameraState, OfACamera, takes_camera
+from ...errors import InputError, require_finite
+from ...figures import styled
+from ...optics.state import CameraState, OfACamera, takes_camera
 
 __all__ = ["WavefrontMap", "wavefront", "noll_indices", "zernike_noll", "ZERNIKE_ORDERING"]
 
@@ -132,7 +132,7 @@ class WavefrontMap(OfACamera):
     @styled
     def plot(self, path=None, *, force: bool = False):
         """Draw the OPD map (waves) over the normalised pupil; write it to ``path`` or return the figure."""
-        from ._plot import figure, save
+        from .._plot import figure, save
 
         fig, ax = figure(5.2, 4.4)
         lim = 1.05 * max(1.0, float(np.abs(self.x).max()), float(np.abs(self.y).max()))

@@ -1,12 +1,12 @@
 """The lens card: one printed page per lens, like a lens maker's data sheet.
 
 One A4 or US Letter page (portrait) with the lens section and its rays
-(:mod:`physcam.analysis.diagram`), the vendor MTF chart at 10, 20 and 40 lp/mm, sagittal and
-tangential, at full aperture and stopped down (:func:`physcam.analysis.mtf.mtf_chart`), real
-distortion and relative illumination against image height (:mod:`~physcam.analysis.distortion`,
-:mod:`~physcam.analysis.illumination`), focus breathing against the focus mark
+(:mod:`physcam.analysis.lens_cards.diagram`), the vendor MTF chart at 10, 20 and 40 lp/mm, sagittal and
+tangential, at full aperture and stopped down (:func:`physcam.analysis.image_quality.mtf.mtf_chart`), real
+distortion and relative illumination against image height (:mod:`~physcam.analysis.distortion.field`,
+:mod:`~physcam.analysis.image_quality.illumination`), focus breathing against the focus mark
 (:func:`physcam.optics.focusing.breathing_table`), bokeh of point lights at the centre, middle and
-corner of the sensor at full aperture (:func:`physcam.analysis.bokeh.bokeh_image`: the corner's
+corner of the sensor at full aperture (:func:`physcam.analysis.defocus.bokeh.bokeh_image`: the corner's
 cat's eye is the mechanical vignetting), and the key numbers (EFL, f-number, entrance pupil, close
 focus, image circle). Every number is computed by those functions as they are; this module only
 chooses their inputs and draws. Image heights and film sizes in mm; scene distances from the film
@@ -18,9 +18,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ..errors import InputError, OpticsError
-from ..lens.prescription import Prescription, takes_prescription
-from ..figures import PALETTE, styled
+from ...errors import InputError, OpticsError
+from ...lens.prescription import Prescription, takes_prescription
+from ...figures import PALETTE, styled
 
 __all__ = ["PAGES", "PANELS", "LensCard", "lens_card", "save_lens_card"]
 
@@ -74,7 +74,7 @@ class LensCard:
     @styled
     def figure(self, *, units: str = "m", dpi: int | None = None):
         """The page as a matplotlib Figure (Agg canvas), one axes per :data:`PANELS` entry."""
-        from ..figures import new_figure
+        from ...figures import new_figure
 
         w, h = PAGES[self.page]
         fig = new_figure(figsize=(w, h), dpi=dpi)
@@ -102,7 +102,7 @@ class LensCard:
         return f"{self.lens_name}"
 
     def _subtitle(self, units: str) -> str:
-        from ..units import format_distance
+        from ...units import format_distance
 
         foc = "infinity" if math.isinf(self.focus_from_film_mm) else format_distance(self.focus_from_film_mm, units)
         w, h = self.sensor_mm
@@ -127,13 +127,13 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
     (a name such as "ALEXA 35", or a :class:`~physcam.optics.sensors.Sensor`; default Super 35). The MTF chart
     is drawn wide open and at ``stopped_fstop`` (default f/8; skipped when not slower than wide open).
     ``page``: "a4" or "letter"; ``quality``: "full" or "draft" (fewer fields and rays: tests)."""
-    from ..data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
-    from ..errors import require_positive
-    from ..optics import focusing
-    from ..units import parse_distance
+    from ...data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
+    from ...errors import require_positive
+    from ...optics import focusing
+    from ...units import parse_distance
 
     if sensor is not None:
-        from ..optics.sensors import Sensor, find_sensor
+        from ...optics.sensors import Sensor, find_sensor
 
         if sensor_width_mm is not None or sensor_height_mm is not None:
             raise InputError("give the sensor either by name (sensor=) or by size (sensor_width_mm=, "
@@ -151,7 +151,7 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
     name = sensor_name or (DEFAULT_SENSOR if sensor_width_mm is None else f"{w:g} x {h:g} mm")
     focus_mm = parse_distance(focus_mm, name="focus distance", allow_inf=True)
     notes: list[str] = []
-    from ..optics.state import camera_state
+    from ...optics.state import camera_state
 
     camera = camera_state(lens, focus_mm=focus_mm, sensor_mm=(w, h))  # the lens at the mark, as its file stops it
     diagram = _diagram(camera)
@@ -179,9 +179,9 @@ def key_numbers(lens: Prescription, focus_mm: float, half_diagonal_mm: float, *,
     (diameter, and place in front of the film at ``focus_mm``), close focus (from the film plane),
     the image circle (twice the film height of the widest chief ray that passes the lens; mm) and
     whether it covers a sensor of ``half_diagonal_mm``."""
-    from ..optics import focusing, paraxial
-    from ._chief import field_limit_deg
-    from .distortion import _chief_heights
+    from ...optics import focusing, paraxial
+    from .._chief import field_limit_deg
+    from ..distortion.field import _chief_heights
 
     g = paraxial.gaussian(lens)
     ga = focusing.gaussian_at_focus(lens, focus_mm)
@@ -208,7 +208,7 @@ def key_numbers(lens: Prescription, focus_mm: float, half_diagonal_mm: float, *,
 
 
 def _diagram(camera):
-    from ..optics.state import camera_state
+    from ...optics.state import camera_state
     from .diagram import lens_diagram
 
     try:
@@ -219,7 +219,7 @@ def _diagram(camera):
 
 def _distortion(lens, focus_mm, w, h, q, backend, notes):
     """The lens focused at the mark, measured as ``distortion --focus`` and the ST-maps measure it."""
-    from .distortion import real_distortion
+    from ..distortion.field import real_distortion
 
     try:
         return real_distortion(lens, n_fields=q["curve_fields"], sensor_width_mm=w, sensor_height_mm=h,
@@ -230,7 +230,7 @@ def _distortion(lens, focus_mm, w, h, q, backend, notes):
 
 
 def _illumination(camera, q, backend, notes):
-    from .illumination import relative_illumination
+    from ..image_quality.illumination import relative_illumination
 
     try:
         return relative_illumination(camera, n_fields=q["curve_fields"], grid=q["grid"], backend=backend)
@@ -241,7 +241,7 @@ def _illumination(camera, q, backend, notes):
 
 def _mtf(camera, label, fstop, top_mm, q, backend):
     """(label, chart or None, note): the diffraction chart of ``camera`` at ``fstop``, or why there is none."""
-    from .mtf import mtf_chart
+    from ..image_quality.mtf import mtf_chart
 
     try:
         at = camera if fstop is None else camera.with_fstop(fstop)
@@ -255,7 +255,7 @@ def _mtf(camera, label, fstop, top_mm, q, backend):
 def _bokeh(camera, key, w, h, q, backend, notes):
     """Point lights in front of the focus (half the focus distance; 15 focal lengths when focused at
     infinity) imaged at the centre, half the half-diagonal and 90 % of it (or of the image circle), wide open."""
-    from .bokeh import bokeh_image
+    from ..defocus.bokeh import bokeh_image
 
     efl, focus_mm = key["efl_mm"], camera.focus_from_film_mm
     depth = 15.0 * efl if math.isinf(focus_mm) else 0.5 * focus_mm
@@ -281,7 +281,7 @@ def _draw_diagram(ax, card, units):
 
 
 def _draw_key(ax, key, units):
-    from ..units import format_distance
+    from ...units import format_distance
 
     ax.set_axis_off()
 
@@ -330,7 +330,7 @@ def _draw_mtf(ax, chart, label, note):
     light = "white light" if chart.spectrum.startswith("white light") and "no dispersion" not in chart.spectrum \
         else ("monochromatic: the prescription gives no dispersion" if chart.spectrum.startswith("monochromatic")
               else "white light, some glasses without dispersion")
-    from ..figures import fit_title
+    from ...figures import fit_title
 
     ax.set_title(fit_title(f"MTF at f/{chart.fstop:.3g} ({label}), {light}", 3.2, fontsize=7), loc="left", fontsize=7)
     ax.legend(ncol=3, loc="lower left", fontsize=5.5, handlelength=1.6, columnspacing=0.8)
@@ -371,7 +371,7 @@ def _draw_illumination(ax, res):
 
 
 def _draw_breathing(ax, card, units):
-    from .breathing_plot import draw_breathing
+    from ..framing.breathing_plot import draw_breathing
 
     ax.set_title(f"focus breathing: horizontal field of view ({card.sensor_mm[0]:g} mm wide sensor) and focal length "
                  "against the focus mark", loc="left")
@@ -401,10 +401,10 @@ def _draw_bokeh(ax, img, label, height_mm):
 @styled
 def save_lens_card(card: LensCard, path, *, force: bool = False, units: str = "m", dpi: int = 150):
     """Write ``card`` as one page to ``path`` (.pdf, .png or .svg) through :func:`physcam.figures.save_figure`."""
-    from ..errors import require_type
-    from ..figures import save_figure
-    from ..io import check_writable
+    from ...errors import require_type
+    from ...figures import save_figure
+    from ...io import check_writable
 
-    require_type("card", card, LensCard, "physcam.analysis.lens_card.lens_card(lens)")
+    require_type("card", card, LensCard, "physcam.analysis.lens_cards.card.lens_card(lens)")
     check_writable(path, force=force)
     return save_figure(card.figure(units=units), path, force=force, dpi=dpi)

@@ -19,12 +19,12 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import ExportError, InputError
-from ..lens.geometry import sag
-from ..lens.prescription import Prescription, takes_prescription
-from ..optics import focusing, paraxial
-from ..optics.state import CameraState, takes_camera
-from ..figures import styled
+from ...errors import ExportError, InputError
+from ...lens.geometry import sag
+from ...lens.prescription import Prescription, takes_prescription
+from ...optics import focusing, paraxial
+from ...optics.state import CameraState, takes_camera
+from ...figures import styled
 
 __all__ = ["DIAGRAM_FORMATS", "trace_meridional_ray", "LensDiagram", "lens_diagram", "save_lens_diagram"]
 
@@ -43,7 +43,7 @@ def trace_meridional_ray(prescription: Prescription, y0: float, z0: float, dy: f
     """
     import numpy as np
 
-    from ..trace import OK, RayBatch, trace_path
+    from ...trace import OK, RayBatch, trace_path
 
     wl = prescription.wavelength_nm if wavelength_nm is None else wavelength_nm
     pos = [[0.0, y0, z0]] if axis == "y" else [[y0, 0.0, z0]]
@@ -102,7 +102,7 @@ class LensDiagram:
         else the style's."""
         import matplotlib
 
-        from ..figures import new_figure
+        from ...figures import new_figure
 
         rc = {} if text_pt is None else {k: text_pt for k in ("font.size", "axes.titlesize", "axes.labelsize",
                                                               "xtick.labelsize", "ytick.labelsize")}
@@ -117,8 +117,8 @@ class LensDiagram:
     def draw(self, ax, *, units: str = "m", width_in: float = 10.0, title: bool = True, label_pt: float = 8.0) -> None:
         """Draw the diagram on matplotlib axes ``ax`` (what :meth:`figure` shows; the lens card's
         section); ``width_in`` is the width the title is wrapped to, ``label_pt`` the size of the labels."""
-        from ..figures import PALETTE, fit_title
-        from ..units import format_distance
+        from ...figures import PALETTE, fit_title
+        from ...units import format_distance
 
         p, g, axis = self.prescription, self.gaussian, self.axis
         zv = p.vertex_z
@@ -178,7 +178,7 @@ class LensDiagram:
             if label_pt == 8.0:
                 ax.text(0.01, 0.02, note, transform=ax.transAxes, fontsize=7, color="0.3")
             else:  # a phone's figure: below the plot, wrapped to the figure's width
-                from ..figures import fit_title
+                from ...figures import fit_title
 
                 ax.set_title(fit_title(note, 0.8 * width_in, fontsize=label_pt - 1), fontsize=label_pt - 1,
                              color="0.3", loc="left", y=-0.62 if title else -0.45)
@@ -275,8 +275,8 @@ def lens_diagram(camera: CameraState, *, axis: str = "y", field_deg: float | Non
 def save_lens_diagram(camera: CameraState, path, *, force: bool = False, **kwargs) -> Path:
     """Draw the diagram to ``path`` (.png, .svg or .pdf) through atomic_write; kwargs as :func:`lens_diagram`,
     and ``units`` (m or ft) for the focus in the title."""
-    from ..figures import save_figure
-    from ..io import check_writable
+    from ...figures import save_figure
+    from ...io import check_writable
 
     p = Path(path)
     if p.suffix.lower().lstrip(".") not in DIAGRAM_FORMATS:

@@ -14,13 +14,13 @@ def ray_probes(sensor_name: str | None):
     image circle at its corner."""
     import math
 
-    from ..lens.check import Finding
+    from ...lens.check import Finding
 
     def beam(p):
         import numpy as np
 
-        from ..optics.paraxial import gaussian
-        from ..trace import OK, RayBatch, trace_to_film
+        from ...optics.paraxial import gaussian
+        from ...trace import OK, RayBatch, trace_to_film
 
         g = gaussian(p)
         r = 0.5 * g.entrance_pupil_diameter
@@ -40,11 +40,11 @@ def ray_probes(sensor_name: str | None):
         return []
 
     def corner(p):
-        from . import _chief
-        from .illumination import relative_illumination
-        from ..errors import OpticsError
-        from ..optics.sensors import find_sensor
-        from ..optics.paraxial import gaussian
+        from .. import _chief
+        from ..image_quality.illumination import relative_illumination
+        from ...errors import OpticsError
+        from ...optics.sensors import find_sensor
+        from ...optics.paraxial import gaussian
 
         s = find_sensor(sensor_name)
         half = 0.5 * s.diagonal_mm
