@@ -8,7 +8,7 @@ dgauss.50mm (sphere intersections, clipping at every clear semi-diameter, vector
 check) to the paraxial image plane; one wavelength (the d line), no Fresnel. The C reference is
 compiled here with ``gcc -O3 -march=native -fno-math-errno -fopenmp`` when gcc is present (it
 auto-vectorises to AVX-512 on this machine) and run in the same process tree, alternating with
-physcam, on 1 and 2 threads (``OMP_NUM_THREADS``, ``numba.set_num_threads``): other jobs share
+physcam, on 1 and 2 threads (``OMP_NUM_THREADS``, ``physcam.trace.kernels.set_threads``): other jobs share
 this machine, so the ratio physcam / C of one run is the figure that counts. Both print the RMS
 spot radius as a check that they did the same work.
 
@@ -45,7 +45,22 @@ ROWS = [  # radius thickness index aperture-diameter (pbrt-v4 scenes/lenses/dgau
 ]
 ABBE = {1.67: 47.2, 1.699: 30.1, 1.603: 38.0, 1.658: 57.3, 1.717: 47.9}  # assumed, typical glasses
 BEAM_MM = 12.40255  # the C reference's beam radius (every ray passes)
-C_SOURCE = Path(__file__).resolve().parents[2] / "shared" / "bench" / "limit_soa.c"
+
+
+def _c_source() -> Path:
+    """shared/bench/limit_soa.c in the nearest folder above this checkout that has it (the repository's
+    parent, or its parent's parent for a worktree under wt/); ``PHYSCAM_C_REFERENCE`` overrides."""
+    if os.environ.get("PHYSCAM_C_REFERENCE"):
+        return Path(os.environ["PHYSCAM_C_REFERENCE"])
+    here = Path(__file__).resolve().parent
+    for up in here.parents:
+        cand = up / "shared" / "bench" / "limit_soa.c"
+        if cand.exists():
+            return cand
+    return here.parents[1] / "shared" / "bench" / "limit_soa.c"
+
+
+C_SOURCE = _c_source()
 CEILING_PER_CORE = 100e6  # rays/s: ~790 flops + 20 sqrt + 12 div per ray at this core's peak (issue 14)
 
 
@@ -133,6 +148,7 @@ def main() -> None:
     ap.add_argument("--rays", type=int, default=1_000_000)
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--no-c", action="store_true", help="skip the C reference")
+    ap.add_argument("--c-source", type=Path, default=C_SOURCE, help=f"the C reference (default {C_SOURCE})")
     args = ap.parse_args()
     lens = dgauss()
     film = paraxial_image_z(lens)
@@ -146,14 +162,16 @@ def main() -> None:
         trace_to_film(lens, b.take(slice(0, 5000)), film, fresnel=True)
         trace_to_film(lens, b.take(slice(0, 5000)), film)
     mono32 = mono.astype(np.float32)
-    exe = None if args.no_c else build_c(C_SOURCE)
+    exe = None if args.no_c else build_c(args.c_source)
     print(f"dgauss.50mm, {args.rays:,} rays, beam radius {BEAM_MM} mm, film at z = {film:.4f} mm")
+    if exe is not None:
+        print(f"C reference: {args.c_source}")
     print(f"machine: {os.cpu_count()} cores, load average {load()} at start")
     nmax = numba.config.NUMBA_NUM_THREADS
     for threads in (1, 2):
         if threads > nmax:
             continue
-        numba.set_num_threads(threads)
+        kernels.set_threads(threads)  # the JIT kernel's threads (one block range each)
         best_p = best_c = 0.0
         rms_p = rms_c = float("nan")
         for _ in range(3):  # alternate, so both see the same machine
@@ -171,8 +189,8 @@ def main() -> None:
         line += f" | float32 {r32 / 1e6:.2f} M rays/s"
         print(line)
     if exe is None and not args.no_c:
-        print(f"  (no C reference: gcc or {C_SOURCE} missing)")
-    numba.set_num_threads(nmax)
+        print(f"  (no C reference: gcc or {args.c_source} missing)")
+    kernels.set_threads(None)
     print(f"physcam alone, {nmax} threads:")
     for name, rays, kw in (("monochrome, copying the batch", mono, dict(in_place=False)),
                            ("dispersion + Fresnel, in place", colour, dict(fresnel=True)),

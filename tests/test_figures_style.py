@@ -107,3 +107,16 @@ def test_fit_title_wraps_to_the_width():
         fig.tight_layout()
         assert figure_problems(fig) == []
     assert fit_title(text, 3.2).replace("\n", " ") == text  # only wrapped, never cut
+
+
+def test_fit_title_never_breaks_a_label_from_its_value():
+    """A value in feet and inches has spaces (6' 6 3/4"): wrapped at any width, "focus" and the value
+    stay on one line (the phone's lens diagram split them once its lens name grew)."""
+    from physcam.figures import unbroken
+
+    value = "focus 6' 6 3/4\""
+    text = f"Double Gauss 50mm f/2 (pbrt dgauss.50mm): EFL 50.36 mm, f/4, {unbroken(value)}, half-field 16.0°"
+    for width in (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 6.0):
+        lines = fit_title(text, width).split("\n")
+        assert value in lines[[i for i, ln in enumerate(lines) if "focus" in ln][0]], (width, lines)
+        assert "\u00a0" not in "".join(lines)

@@ -147,6 +147,40 @@ def test_the_jit_kernels_missing_is_one_line_naming_the_fast_extra(installed):
     assert len(lines) == 1 and "pip install 'physcam[fast]'" in lines[0], p.stderr
 
 
+FIRST_TRACE = """
+import json
+from physcam.lens.library import load_lens
+from physcam.trace import RayBatch, kernels, trace_to_film
+from physcam.trace.kernels import _jitcache
+calls = []
+kernels.set_compile_reporter(lambda done, total: calls.append(done))
+lens = load_lens("dgauss_50mm")
+rays = RayBatch.collimated([0.0, 1.0, 2.0], [0.0, 0.5, 1.0], -1.0)
+trace_to_film(lens, rays, 68.0, backend="numba")
+print(json.dumps({"compiled": bool(calls), "dir": _jitcache.cache_dir()}))
+"""
+
+
+def test_the_fast_extra_compiles_once_where_the_install_can_write(installed):
+    """Issue 47: the first traced command after `pip install 'physcam[fast]'` compiles the JIT variant it
+    needs and caches it; where the package folder cannot take numba's cache (a system install; here the
+    cache folder is blocked by a file, since this suite may run as root, whom permissions do not stop)
+    it goes to the user cache (XDG_CACHE_HOME), and the next process loads it instead of compiling."""
+    inst = installed
+    _run([inst["py"], "-m", "pip", "install", "--quiet", "-c", str(ROOT / "constraints.txt"),
+          f"{inst['wheel']}[fast]"], inst["work"], env=inst["env"])
+    pycache = inst["site"] / "physcam" / "trace" / "kernels" / "__pycache__"
+    pycache.mkdir(exist_ok=True)
+    (pycache / "physcam-jit").write_text("not a folder: the package's own cache place is unusable\n")
+    env = dict(inst["env"], XDG_CACHE_HOME=str(inst["tmp"] / "user-cache"))
+    env.pop("NUMBA_CACHE_DIR", None)
+    first = json.loads(_run([inst["py"], "-c", FIRST_TRACE], inst["work"], env=env).stdout)
+    assert first["compiled"] and first["dir"].startswith(str(inst["tmp"] / "user-cache" / "physcam" / "jit"))
+    assert any(name.endswith(".nbi") for name in os.listdir(first["dir"]))
+    second = json.loads(_run([inst["py"], "-c", FIRST_TRACE], inst["work"], env=env).stdout)
+    assert second == {"compiled": False, "dir": first["dir"]}
+
+
 def test_with_every_extra_the_demo_usd_plugin_and_serve_work(installed):
     inst = installed
     _run([inst["py"], "-m", "pip", "install", "--quiet", "-c", str(ROOT / "constraints.txt"),

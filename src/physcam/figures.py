@@ -33,7 +33,7 @@ import threading
 from pathlib import Path
 
 __all__ = ["pyplot", "subplots", "new_figure", "save_figure", "figure_bytes", "PALETTE", "STYLE", "apply_style",
-           "figure_style", "styled", "fit_title", "figure_problems", "UNITLESS_WORDS"]
+           "figure_style", "styled", "fit_title", "unbroken", "NO_BREAK", "figure_problems", "UNITLESS_WORDS"]
 
 _FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 
@@ -83,6 +83,37 @@ def apply_style() -> None:
     matplotlib.rcParams.update(_style_params())
 
 
+#: Set by the ``physcam`` program (``physcam.cli.run``), never by the library: matplotlib is then
+#: imported without what that program never uses (:func:`_lean_import`).
+PROGRAM_IMPORT = False
+
+
+def _lean_import() -> None:
+    """Import matplotlib for the ``physcam`` program, skipping two things it never uses (issue 47,
+    measured in docs/performance.md): the property tables matplotlib writes into the docstring of
+    every artist class's ``set()`` as the class is made (``matplotlib.artist.kwdoc``: a third of
+    matplotlib's import, 0.15 s of CPU), and its 3-D toolkit, which registering the ``3d``
+    projection imports with every figure. Only when matplotlib is not imported yet and
+    :data:`PROGRAM_IMPORT` is set; a library caller's matplotlib is left whole."""
+    import sys
+
+    if not PROGRAM_IMPORT or "matplotlib.artist" in sys.modules:
+        return
+    import warnings
+
+    import matplotlib.artist
+
+    matplotlib.artist.kwdoc = lambda artist: "(see the matplotlib documentation)"
+    if "mpl_toolkits.mplot3d" not in sys.modules:
+        sys.modules["mpl_toolkits.mplot3d"] = None  # the projections' import of it fails: no "3d" projection
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                import matplotlib.projections  # noqa: F401
+        finally:
+            del sys.modules["mpl_toolkits.mplot3d"]
+
+
 _LOCK = threading.RLock()  # rcParams is one dict for all threads: one styled drawing at a time
 _STATE = threading.local()
 
@@ -105,6 +136,7 @@ def figure_style():
         if depth:
             yield
             return
+        _lean_import()
         import matplotlib
 
         with _LOCK, matplotlib.rc_context():
@@ -148,13 +180,23 @@ def styled(func):
     return in_style
 
 
-def fit_title(text: str, width_in: float, *, fontsize: float | None = None) -> str:
+#: A space :func:`fit_title` never breaks a line at (it prints as a plain space): a label and its value.
+NO_BREAK = "\u00a0"
+
+
+def unbroken(text: str) -> str:
+    """``text`` (a label and its value, "focus 6' 6 3/4\"") kept on one line by :func:`fit_title`."""
+    return str(text).replace(" ", NO_BREAK)
+
+
+def fit_title(text: str, width_in: float, *, fontsize: float | None = None, weight: str = "normal") -> str:
     """``text`` wrapped at word boundaries so that each line, set in the style's font at ``fontsize``
-    points (default the title size), is at most ``width_in`` inches wide (measured by matplotlib)."""
+    points (default the title size) and ``weight``, is at most ``width_in`` inches wide (measured by
+    matplotlib); never at a :data:`NO_BREAK` space (see :func:`unbroken`), which comes out as a plain space."""
     from matplotlib.font_manager import FontProperties
     from matplotlib.textpath import text_to_path
 
-    prop = FontProperties(family=STYLE["font.sans-serif"], size=fontsize or STYLE["axes.titlesize"])
+    prop = FontProperties(family=STYLE["font.sans-serif"], size=fontsize or STYLE["axes.titlesize"], weight=weight)
     limit = width_in * 72.0
 
     def width(s: str) -> float:
@@ -171,13 +213,14 @@ def fit_title(text: str, width_in: float, *, fontsize: float | None = None) -> s
             else:
                 line = trial
         out.append(line)
-    return "\n".join(out)
+    return "\n".join(out).replace(NO_BREAK, " ")
 
 
 def new_figure(figsize=None, dpi=None, **kwargs):
     """A ``Figure`` attached to an Agg canvas (no pyplot), with physcam's figure settings (size,
     white face). Axes and artists take physcam's style when made inside :func:`figure_style`
     (every physcam function that draws does so); outside it, the caller's rcParams."""
+    _lean_import()
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 

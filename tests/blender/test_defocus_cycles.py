@@ -11,9 +11,13 @@ bounces, 1 px box filter):
 - a pinhole at the lens's entrance pupil with the lens's best-match pinhole focal length, with a
   Z pass (planar depth from the camera, metres), in a multilayer EXR;
 
-and Blender's own compositor Defocus node (hexagonal bokeh, the same f-stop and focus distance,
-the Z pass) defocuses the pinhole render: the baseline. Bokeh sizes are measured on renders of the
-spheres alone (the plane hidden); the image error on the full scene.
+and two baselines: Blender's own compositor Defocus node (hexagonal bokeh, the same f-stop and
+focus distance, the Z pass) on the pinhole render, and Cycles' own thin-lens depth of field (the
+pinhole with its f-stop, 6 blades, focused on the same plane). physcam defocus keeps the render's
+geometry; its output is redistorted with physcam's own distortion ST map (centroid distortion at
+the f-stop), as a compositor redistorts a CG element, before it is compared with the real-lens
+render. Bokeh sizes are measured on renders of the spheres alone (the plane hidden); the image
+error on the full scene.
 """
 
 from __future__ import annotations
@@ -28,8 +32,10 @@ from _blender import run_blender
 from physcam.analysis.defocus.render import defocus, inverse_depth
 from physcam.analysis.defocus.exr import read_exr
 from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
+from physcam.analysis.distortion.stmap import apply_stmap, distortion_field
 from physcam.export.blender import blender_setup_script, osl_camera_shader
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 from physcam.trace.aperture import Aperture
 
 pytestmark = pytest.mark.slow
@@ -127,6 +133,18 @@ for name, socket in (("pinhole", rl.outputs["Image"]), ("depth", rl.outputs["Dep
     for tag, hide in (("_spheres", True), ("", False)):
         plane.hide_render = hide
         render(job["out"] + "/" + name + tag + ".exr")
+# 3. Cycles' own thin-lens depth of field: the same pinhole, its f-stop, 6 blades, focused on the plane
+for link in list(out.inputs[0].links):
+    tree.links.remove(link)
+tree.links.new(rl.outputs["Image"], out.inputs[0])
+cam.data.dof.use_dof = True
+cam.data.dof.aperture_fstop = job["fstop_thin"]
+cam.data.dof.aperture_blades = 6
+cam.data.dof.aperture_rotation = job["blade_rotation"]
+settings(job["samples_osl_full"])
+for tag, hide in (("_spheres", True), ("", False)):
+    plane.hide_render = hide
+    render(job["out"] + "/cycles_dof" + tag + ".exr")
 print(json.dumps({"ok": True}))
 '''
 
@@ -147,21 +165,27 @@ def scene(tmp_path_factory):
         return [sx * d / cam.pinhole_mm / 1000, sy * d / cam.pinhole_mm / 1000, -(ep + d) / 1000, r_mm / 1000]
 
     spheres = [world(W / 2, H / 2, NEAR_MM, 2.0), world(*CORNER_PX, NEAR_MM, 2.0), world(80.0, 130.0, MID_MM, 4.0)]
+    # Cycles' thin lens: the entrance pupil's diameter is f / N for its focal length f (the pinhole's)
+    fstop_thin = cam.pinhole_mm / cam.pupil_diameter_mm
     job = {"setup": str(tmp / "setup.py"), "out": str(tmp), "spheres": spheres, "strength": 20.0,
            "plane": [-(ep + PLANE_MM) / 1000, 2.4 * PLANE_MM * SW / 2 / cam.pinhole_mm / 1000],
            "pinhole_mm": cam.pinhole_mm, "sensor_mm": [SW, sh], "pupil_m": ep / 1000,
-           "focus_m": (MARK_MM - ep) / 1000, "fstop": FSTOP, "samples_osl": 256, "samples_osl_full": 64, "samples_pinhole": 16}
-    run_blender(SCRIPT, json.dumps(job), timeout=600)
+           "focus_m": (MARK_MM - ep) / 1000, "fstop": FSTOP, "fstop_thin": fstop_thin,
+           "blade_rotation": math.radians(IRIS.angle_deg), "samples_osl": 256, "samples_osl_full": 64,
+           "samples_pinhole": 16}
+    run_blender(SCRIPT, json.dumps(job), timeout=900)
     cache = KernelCache(cam)
-    out = {}
+    dist = distortion_field(camera_state(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_mm=(SW, sh)), width_px=W, height_px=H)
+    out = {"dir": tmp}
     for name in ("spheres", ""):
         tag = f"_{name}" if name else ""
         pin = read_exr(tmp / f"pinhole{tag}.exr")
         rgb = np.stack([pin.channels[c] for c in "RGB"], axis=2)
         u = inverse_depth(read_exr(tmp / f"depth{tag}.exr").channels["R"], cam, kind="planar", unit="m")
-        out["physcam" + tag] = defocus(rgb, u, cache)
+        out["physcam_undistorted" + tag] = defocus(rgb, u, cache)
+        out["physcam" + tag] = apply_stmap(out["physcam_undistorted" + tag], dist.distortion_stmap)
         out["pinhole" + tag] = rgb
-        for kind in ("truth", "blender"):
+        for kind in ("truth", "blender", "cycles_dof"):
             e = read_exr(tmp / f"{kind}{tag}.exr")
             out[kind + tag] = np.stack([e.channels[c] for c in "RGB"], axis=2)
     out["cam"] = cam
@@ -194,7 +218,9 @@ def test_bokeh_diameter_matches_the_real_lens_render(scene, where):
     d_t, _ = _diameter_and_aspect(_window(scene["truth_spheres"], cx, cy))
     d_p, _ = _diameter_and_aspect(_window(scene["physcam_spheres"], cx, cy))
     d_b, _ = _diameter_and_aspect(_window(scene["blender_spheres"], cx, cy))
-    print(f"\n{where}: diameter truth {d_t:.3f} px, physcam defocus {d_p:.3f} px, Blender Defocus {d_b:.3f} px")
+    d_c, _ = _diameter_and_aspect(_window(scene["cycles_dof_spheres"], cx, cy))
+    print(f"\n{where}: diameter truth {d_t:.3f} px, physcam defocus {d_p:.3f} px, Blender Defocus {d_b:.3f} px, "
+          f"Cycles thin lens {d_c:.3f} px")
     assert d_t > 10  # a real blur
     assert d_p == pytest.approx(d_t, rel=0.03)
 
@@ -205,7 +231,8 @@ def test_corner_cats_eye_matches(scene):
     _, a_t = _diameter_and_aspect(_window(scene["truth_spheres"], *CORNER_PX))
     _, a_p = _diameter_and_aspect(_window(scene["physcam_spheres"], *CORNER_PX))
     _, a_c = _diameter_and_aspect(_window(scene["truth_spheres"], W / 2, H / 2))
-    print(f"\naspect: corner truth {a_t:.3f}, physcam {a_p:.3f}; centre truth {a_c:.3f}")
+    _, a_d = _diameter_and_aspect(_window(scene["cycles_dof_spheres"], *CORNER_PX))
+    print(f"\naspect: corner truth {a_t:.3f}, physcam {a_p:.3f}, Cycles thin lens {a_d:.3f}; centre truth {a_c:.3f}")
     assert a_t < 0.9 * a_c  # the corner really is a cat's eye
     assert a_p == pytest.approx(a_t, rel=0.05)
 
@@ -220,6 +247,18 @@ def test_image_error_beats_blenders_defocus_node(scene):
         return 10 * math.log10(peak**2 / float(np.mean((img - truth) ** 2)))
 
     p, b, n = psnr(scene["physcam"]), psnr(scene["blender"]), psnr(scene["pinhole"])
-    print(f"\nPSNR vs the OSL render: physcam defocus {p:.2f} dB, Blender Defocus node {b:.2f} dB, "
-          f"pinhole (no defocus) {n:.2f} dB")
-    assert p > b
+    c, u = psnr(scene["cycles_dof"]), psnr(scene["physcam_undistorted"])
+    print(f"\nPSNR vs the OSL render: physcam defocus {p:.2f} dB (not redistorted {u:.2f} dB), Cycles thin lens "
+          f"{c:.2f} dB, Blender Defocus node {b:.2f} dB, pinhole (no defocus) {n:.2f} dB")
+    assert p > c > b
+
+
+def test_light_of_the_cycles_scene(scene):
+    """Issue 42 item 1 on a real render: the defocused pinhole render holds the light the real lens
+    passes (the OSL render's total: the pinhole's times the relative illumination, less what the
+    frame's edge loses), within 3 %, and no pixel is negative."""
+    pin, truth, phys = (float(scene[k].sum()) for k in ("pinhole", "truth", "physcam_undistorted"))
+    print(f"\nlight: pinhole {pin:.1f}, truth {truth:.1f}, physcam defocus {phys:.1f}")
+    assert truth < 0.95 * pin  # the real lens really loses light toward the corners
+    assert phys == pytest.approx(truth, rel=0.03)
+    assert scene["physcam_undistorted"].min() >= 0.0

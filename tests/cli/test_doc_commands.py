@@ -79,12 +79,25 @@ def _journal(d: Path) -> None:
     j.close()
 
 
-#: Input files the pages name without showing them (a focus pull, a broken sample, a take, a journal).
+def _render(d: Path) -> None:
+    """A small render with depth (R, G, B, Z): docs/defocus.md shows one refused as its own output."""
+    import numpy as np
+    import OpenEXR
+
+    rgb = np.full((8, 12), 0.5, np.float32)
+    with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION},
+                      {"R": rgb, "G": rgb, "B": rgb, "Z": np.full((8, 12), 2000.0, np.float32)}) as f:
+        f.write(str(d / "render.exr"))
+
+
+#: Input files the pages name without showing them (a focus pull, a broken sample, a take, a journal,
+#: a render with depth).
 INPUTS = [
     lambda d: (d / "pull.csv").write_text("frame,focus,fstop\n1,2m,2.8\n12,2.5m,2.8\n24,3m,4\n"),
     _broken_sample,
     _take,
     _journal,
+    _render,
     lambda d: (d / "tests").mkdir() or os.symlink(REPO / "tests" / "data", d / "tests" / "data"),
 ]
 

@@ -108,6 +108,7 @@ def test_close_focus_is_the_mod_where_the_focus_model_reaches_it(slug, tmp_path,
     assert not [f for f in findings if f.severity == "error"]
     notes = [f for f in findings if f.code == "mod_beyond_focus_model"]
     assert key["close_focus_source"] == row["closest_focus_source"] == "maker"
+    assert key["minimum_object_distance_mm"] == row["minimum_object_distance_mm"] == mod  # the maker's, as given
     if mod >= limit - 1.0:
         assert key["close_focus_from_film_mm"] == pytest.approx(mod, abs=0.5)
         assert row["closest_focus_mm"] == pytest.approx(mod, abs=0.5)

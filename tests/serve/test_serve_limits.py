@@ -396,3 +396,25 @@ def test_the_worker_bounds_the_addresses_with_work():
         f.result(timeout=10)
     assert w.submit("C", lambda: 7).result(timeout=10) == 7  # room again once A and B are done
     w.close()
+
+
+def test_one_question_asked_at_once_by_many_connections_is_computed_once(server):
+    """Issue 47: 24 connections of one address ask the same new chart at the same moment (a page
+    reloaded on many phones, a benchmark's repeated query). They wait for the one computation
+    instead of each queueing its own copy: every answer is 200 and the same chart. Before, each
+    request put its own job on the worker, the address's 8 places filled (Limits.client_queue)
+    and the rest were answered 429 while the worker drew the same chart over and over."""
+    port, proc = server
+    path = _chart(4321)
+    socks = [connect(port, NORMAL, timeout=60) for _ in range(24)]
+    try:
+        for s in socks:  # every request sent before any answer is read
+            s.sendall(f"GET {path} HTTP/1.1\r\nHost: x\r\n\r\n".encode())
+        answers = [read_answer(s) for s in socks]
+    finally:
+        for s in socks:
+            s.close()
+    statuses = [a[0] for a in answers]
+    assert statuses == [200] * 24, {s: statuses.count(s) for s in set(statuses)}
+    assert len({a[2] for a in answers}) == 1 and answers[0][2].startswith(b"<?xml")
+    assert proc.poll() is None

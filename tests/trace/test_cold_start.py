@@ -27,9 +27,25 @@ def _run(code: str) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
 
 
+def _warm_jit(*argv: list[str]) -> None:
+    """Run each command once with the JIT kernel forced, so numba's disk cache holds the variants they
+    use: "auto" counts a cold cache as a compile (kernels.numba_load_cost), and these tests are about
+    a warm one."""
+    import os
+
+    code = ("import io, contextlib\nfrom physcam.cli import main\n"
+            f"for argv in {list(argv)!r}:\n"
+            "    with contextlib.redirect_stdout(io.StringIO()):\n"
+            "        assert main(argv) == 0\n")
+    env = dict(os.environ, PHYSCAM_BACKEND="numba")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+    assert p.returncode == 0, p.stderr
+
+
 def test_default_bokeh_stays_in_numpy_and_a_large_one_loads_numba():
     # the whole job is known ahead: 250,000 rays cost the numpy kernel less than loading numba
     # (kernels.backend_for_job), 1e6 rays do not
+    _warm_jit(["bokeh", "dgauss_50mm", "--rays", "2000", "--pixels", "16", "--json"])
     code = ("import sys, io, contextlib\nfrom physcam.cli import main\n"
             "with contextlib.redirect_stdout(io.StringIO()):\n"
             "    assert main(['bokeh', 'dgauss_50mm', '--json']) == 0\n"
@@ -42,20 +58,26 @@ def test_default_bokeh_stays_in_numpy_and_a_large_one_loads_numba():
     assert p.stdout.split() == ["False", "True"]
 
 
-def test_vendor_mtf_chart_stays_in_numpy_and_a_second_one_loads_numba():
-    # a chart's pupils (15 fields x 3 wavelengths, about 5e5 rays) cost the numpy kernel less than
-    # loading numba; a process that draws a second chart has spent that much and loads it
+def test_vendor_mtf_chart_stays_in_numpy_and_a_process_of_charts_loads_numba():
+    # a chart's pupils (15 fields x 3 wavelengths, about 5e5 rays; dgauss_50mm has no dispersion, so a
+    # third of them traced: issue 47) cost the numpy kernel less than loading numba; a process that keeps
+    # drawing charts loads it once its numpy work has reached that cost (by the fourth or fifth chart)
+    _warm_jit(["mtf", "--lens", "dgauss_50mm", "--fstop", "8", "--field", "5", "--pupil-samples", "32", "--json"])
     code = ("import sys, io, contextlib\nfrom physcam.cli import main\n"
             "argv = ['mtf', '--lens', 'dgauss_50mm', '--fstop', '4', '--focus', '3m', '--sensor', 'FF', '--json']\n"
             "with contextlib.redirect_stdout(io.StringIO()):\n"
             "    assert main(argv) == 0\n"
             "a = sorted({'numba', 'scipy', 'matplotlib', 'numpy.ma'} & set(sys.modules))\n"
-            "with contextlib.redirect_stdout(io.StringIO()):\n"
-            "    assert main(argv) == 0\n"
-            "print(a, 'numba' in sys.modules)")
+            "charts = 1\n"
+            "while 'numba' not in sys.modules and charts < 6:\n"
+            "    with contextlib.redirect_stdout(io.StringIO()):\n"
+            "        assert main(argv) == 0\n"
+            "    charts += 1\n"
+            "print(a, 'numba' in sys.modules, charts)")
     p = _run(code)
     assert p.returncode == 0, p.stderr
-    assert p.stdout.split() == ["[]", "True"]
+    imported, loaded, charts = p.stdout.split()
+    assert imported == "[]" and loaded == "True" and 2 <= int(charts) <= 5
 
 
 def test_the_program_exits_cleanly_after_numba_was_loaded(tmp_path):
@@ -79,3 +101,18 @@ def test_the_program_exits_cleanly_after_numba_was_loaded(tmp_path):
                        text=True)
     assert p.returncode == 2 and p.stderr.startswith("physcam: error:") and "Traceback" not in p.stderr
     assert flag.read_text() == "ran"
+
+
+def test_ghosts_and_relative_illumination_stay_in_numpy():
+    # issue 47: each one's tracing (0.19 and 0.23 s estimated in the numpy kernel, in many small calls)
+    # costs less than loading numba (kernels.NUMBA_LOAD_S); "auto" used to load it after a third of that
+    _warm_jit(["ghosts", "--lens", "dgauss_50mm", "--field", "10", "--top", "1"])
+    for argv in (["ghosts", "--lens", "dgauss_50mm", "--field", "10", "--top", "5"], ["illumination", "--lens",
+                                                                                      "dgauss_50mm"]):
+        code = ("import sys, io, contextlib\nfrom physcam.cli import main\n"
+                "with contextlib.redirect_stdout(io.StringIO()):\n"
+                f"    assert main({argv!r}) == 0\n"
+                "print('numba' in sys.modules)")
+        p = _run(code)
+        assert p.returncode == 0, p.stderr
+        assert p.stdout.split() == ["False"], argv

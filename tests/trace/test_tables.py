@@ -101,7 +101,7 @@ def test_jit_cache_is_keyed_by_version_and_every_kernel_source():
     assert _jitcache.source_stamp() == h.hexdigest()
     # the kernels' cache uses physcam's locator, so its index carries that stamp (numba ignores an
     # index whose stamp differs: code from another version or source is recompiled, never loaded)
-    cache = _numba.trace_rays._cache
+    cache = _numba.variant(True, False, False, False)._cache
     assert type(cache._impl.locator).__name__ == "PhysCamLocator"
     assert cache._cache_file._source_stamp == _jitcache.source_stamp()
     assert "_layout.py" in os.listdir(here)  # the column layout is part of the stamp

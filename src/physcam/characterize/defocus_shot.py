@@ -5,7 +5,8 @@ single-threaded worker processes by default, or a farm's scheduler (``tcp://HOST
 task per frame (:func:`physcam.analysis.defocus.exr.defocus_file`); the kernels live in one
 folder on disk (:class:`~physcam.analysis.defocus.kernels.KernelCache`, one ``.npz`` per kernel,
 written atomically) that every worker reads: the first frame runs alone to trace them, the others
-then load them. Resumable per frame: a frame whose output exists is skipped unless ``force``.
+then load them. Resumable per frame: a frame whose output exists is skipped unless ``force``. An
+output frame that is an input frame (or the depth file) is refused before any frame is done.
 """
 
 from __future__ import annotations
@@ -82,8 +83,14 @@ def defocus_sequence(pattern: str, output_pattern: str, lens, *, kernel_folder=N
     fstop, sensor_width_mm, depth, ...)."""
     from .run import _connect, check_scheduler_address
 
+    from ..io import refuse_inputs_as_outputs
+
     frames = sequence_frames(pattern)
     _pattern(output_pattern, "output sequence")
+    depth = options.get("depth")
+    inputs = [p for _, p in frames] + ([depth] if depth is not None and Path(str(depth)).is_file() else [])
+    for number, _ in frames:  # before any frame is written: an output that is an input is refused
+        refuse_inputs_as_outputs(inputs, [frame_path(output_pattern, number)])
     if scheduler is not None:
         check_scheduler_address(scheduler)
     folder = Path(kernel_folder) if kernel_folder is not None else shot_kernel_folder(output_pattern)

@@ -173,6 +173,19 @@ def _refuse_outputs_that_are_inputs(args) -> None:
     refuse_inputs_as_outputs(inputs, files, folders=folders)
 
 
+def _progress(args):
+    """Progress for people at a terminal (none with --json or --csv): the JIT compile's bar
+    ("compiling the ray tracer (once)") and a spinner for a command still running after 2 s."""
+    from . import _common
+    from ..progress import set_reporter
+
+    _common.SHOW_PROGRESS = not (getattr(args, "json", False) or getattr(args, "csv", False))
+    set_reporter("compile", _common._CompileProgress() if _common.SHOW_PROGRESS else None)
+    sub = next((v for k, v in vars(args).items() if k.endswith("_command") and isinstance(v, str)), None)
+    name = " ".join(v for v in (getattr(args, "command", None), sub) if isinstance(v, str))
+    return _common.slow_command_progress(name or "working")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 done, 2 refused input or unwritable output)."""
     import warnings
@@ -204,7 +217,7 @@ def main(argv: list[str] | None = None) -> int:
         from ._common import lens_use, use_glass_catalogs
 
         use_glass_catalogs(args)
-        with lens_use(args):  # a camera command refuses a finite-conjugate lens
+        with lens_use(args), _progress(args):  # a camera command refuses a finite-conjugate lens
             rc = int(args.handler(args) or 0)
         sys.stdout.flush()  # a full disk or closed pipe shows here, inside the error handling
         for n in take_notes():  # defaults taken, ranges clamped: said once the command has worked
@@ -269,6 +282,9 @@ def _refused_path(exc: OSError) -> str:
 def run() -> None:
     """The ``physcam`` program: :func:`main`, then exit with its status (module notes). It ends the
     process: from Python, call :func:`main` instead."""
+    from .. import figures
+
+    figures.PROGRAM_IMPORT = True  # matplotlib without its docstring tables and 3-D toolkit (figures._lean_import)
     code = main()
     if "numba" in sys.modules:
         _exit_without_teardown(code)

@@ -23,8 +23,10 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import re
 import sys
+import threading
 
 from ..data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_LABEL
 from ..errors import PhysCamError
@@ -547,27 +549,60 @@ def console(stderr: bool = False):
     return Console(stderr=stderr, markup=False, highlight=False, emoji=False)
 
 
+#: The rich Progress on screen (one at a time: rich allows one live display), shared by the bars
+#: that nest (a compile inside a chart's bar, a command's bar over the slow-command spinner), and
+#: whether this run shows progress at all (main(): not with --json or --csv).
+_LIVE: list = []
+_LIVE_LOCK = threading.RLock()
+SHOW_PROGRESS = True
+#: A command still running after this many seconds gets a spinner with its elapsed time, unless a
+#: bar of its own is up (``PHYSCAM_PROGRESS_AFTER`` overrides it; tests use 0).
+PROGRESS_AFTER_S = 2.0
+
+
+def _stdout_is_terminal() -> bool:
+    """Whether standard output shares the terminal the bars are drawn on: its lines then go through
+    rich (above the bar); to a pipe or file they go as they are."""
+    try:
+        return sys.stdout.isatty()
+    except (AttributeError, ValueError):
+        return False
+
+
 class progress_bar:
     """A rich progress bar on stderr for long jobs, shown only to a person at a terminal.
 
-    Use as a context manager; the object is a ``progress(done, total)`` callback.
+    Use as a context manager; the object is a ``progress(done, total)`` callback. Bars opened while
+    another is up join its display as a line of their own.
     """
 
     def __init__(self, description: str, enabled: bool = True):
-        self.enabled = enabled and sys.stderr.isatty()
+        self.enabled = enabled and SHOW_PROGRESS and sys.stderr.isatty()
         self.description = description
         self._progress = None
         self._task = None
+        self._own = False
 
     def __enter__(self):
         if self.enabled:
-            from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+            with _LIVE_LOCK:
+                return self._enter()
+        return self
+
+    def _enter(self):
+        if _LIVE:
+            self._progress = _LIVE[-1]
+        else:
+            from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
             self._progress = Progress(TextColumn("{task.description}"), BarColumn(),
                                       TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn(),
-                                      console=console(stderr=True), transient=True)
+                                      TimeElapsedColumn(), console=console(stderr=True), transient=True,
+                                      redirect_stdout=_stdout_is_terminal())
             self._progress.__enter__()
-            self._task = self._progress.add_task(self.description, total=None)
+            self._own = True
+            _LIVE.append(self._progress)
+        self._task = self._progress.add_task(self.description, total=None)
         return self
 
     def __call__(self, done, total):
@@ -575,6 +610,72 @@ class progress_bar:
             self._progress.update(self._task, completed=done, total=total)
 
     def __exit__(self, *exc):
+        with _LIVE_LOCK:
+            self._exit(*exc)
+        return False
+
+    def _exit(self, *exc):
         if self._progress is not None:
-            self._progress.__exit__(*exc)
+            self._progress.remove_task(self._task)
+            if self._own:
+                _LIVE.remove(self._progress)
+                self._progress.__exit__(*exc)
+            self._progress = None
+
+
+class _CompileProgress:
+    """The JIT compile reporter (``physcam.trace.kernels.set_compile_reporter``): "compiling the ray
+    tracer (once)" as a bar while numba compiles a kernel variant."""
+
+    def __init__(self):
+        self._bar = None
+
+    def __call__(self, done, total):
+        if self._bar is None and done < total:
+            self._bar = progress_bar("compiling the ray tracer (once)").__enter__()
+        if self._bar is not None:
+            self._bar(done, total)
+            if done >= total:
+                self._bar.__exit__(None, None, None)
+                self._bar = None
+
+
+class slow_command_progress:
+    """A spinner with the elapsed time for a command still running after :data:`PROGRESS_AFTER_S`
+    (started by a timer thread, stopped at the end; nothing when a bar of the command's own is up,
+    when stderr is not a terminal, or with --json/--csv)."""
+
+    def __init__(self, name: str):
+        self.name = name
+        self._timer = None
+        self._bar = None
+        self._lock = threading.Lock()
+        self._done = False
+
+    def _start(self):
+        with self._lock:
+            if self._done or _LIVE:
+                return
+            self._bar = progress_bar(f"physcam {self.name}").__enter__()
+
+    def __enter__(self):
+        if SHOW_PROGRESS and sys.stderr.isatty():
+            after = os.environ.get("PHYSCAM_PROGRESS_AFTER")
+            try:
+                delay = PROGRESS_AFTER_S if after is None else max(0.0, float(after))
+            except ValueError:
+                delay = PROGRESS_AFTER_S
+            self._timer = threading.Timer(delay, self._start)
+            self._timer.daemon = True
+            self._timer.start()
+        return self
+
+    def __exit__(self, *exc):
+        if self._timer is not None:
+            self._timer.cancel()
+        with self._lock:
+            self._done = True
+            if self._bar is not None:
+                self._bar.__exit__(*exc)
+                self._bar = None
         return False

@@ -252,8 +252,11 @@ def _cell(v, kind, units) -> str:
 
     if kind == "dist":
         return format_distance(math.inf if v is None else v, units)
-    if kind == "close":  # (mark, source): a unit-focusing lens's 1:1 limit is not a close focus it has
-        mark, source = v
+    if kind == "close":  # (mark, source, MOD): a unit-focusing lens's 1:1 limit is not a close focus it has
+        mark, source, mod = v
+        if source == "maker" and mod is not None:  # the maker's figure, even where the focus model stops short
+            return format_distance(mod, units) + (" (MOD)" if mod >= mark else
+                                                  f" (MOD; beyond the focus model, which reaches {format_distance(mark, units)})")
         return format_distance(mark, units) + {"maker": " (MOD)", "focus groups": " (focus groups)"}.get(
             source, " (unit focusing limit, not the lens's MOD)")
     return "-" if v is None else kind.format(v)
@@ -297,7 +300,7 @@ def run_lenses(args) -> int:
     t = Table(f"lenses compared on {sensor.name} ({sensor.width_mm:g} x {sensor.height_mm:g} mm)",
               ["", *args.lenses], justify=["left"] + ["right"] * len(rows))
     for key, label, kind in ROWS:
-        t.add_row(label, *(_cell((r[key], r["closest_focus_source"]) if kind == "close" else r[key], kind, units)
+        t.add_row(label, *(_cell((r[key], r["closest_focus_source"], r["minimum_object_distance_mm"]) if kind == "close" else r[key], kind, units)
                            for r in rows))
     print_table(t)
     for name, r in zip(args.lenses, rows):

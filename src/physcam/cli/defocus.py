@@ -32,6 +32,9 @@ def register(sub) -> None:
     p.add_argument("image", metavar="IMAGE.exr", help="the pinhole render (linear light), or a sequence IN.####.exr")
     p.add_argument("--depth", metavar="CHANNEL|DEPTH.exr", default=None,
                    help="the depth channel of IMAGE (default: its one Z / *.Depth.Z / depth.Z channel) or an EXR file")
+    p.add_argument("--depth-channel", metavar="NAME", default=None,
+                   help="the channel of the --depth file holding the depth (default: its one depth channel; a pass "
+                        "Blender 5 wrote through the compositor, R = G = B, is read from R)")
     p.add_argument("--depth-kind", choices=("planar", "ray", "inverse"), default=None,
                    help="planar: along the axis from the entrance pupil's plane (Blender's Z); ray: along the pixel's "
                         "ray; inverse: 1/planar (Nuke's depth.Z). Default: inverse for a depth.Z channel, else planar")
@@ -66,7 +69,8 @@ def register(sub) -> None:
     k.add_argument("--depths", default="0.5m,1m,2m,4m,inf", metavar="D1,D2,...",
                    help="planar depths from the entrance pupil (default 0.5m,1m,2m,4m,inf)")
     k.add_argument("-o", "--output", metavar="DIR", required=True, help="folder for the EXR kernels and index.json")
-    k.add_argument("--force", action="store_true", help="overwrite existing files")
+    k.add_argument("--force", action="store_true",
+                   help="replace an existing stack (a folder physcam wrote, whole; never a folder of other files)")
     add_output_options(k, what="the index")
     k.set_defaults(handler=run_kernels)
 
@@ -118,20 +122,41 @@ def run(args) -> int:
     sensor = resolve_sensor(args)
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, sensor=sensor, args=args)
     cam = _camera(args, lens, sensor)
-    opts = dict(depth=args.depth, depth_kind=args.depth_kind, depth_unit=args.depth_unit,
+    opts = dict(depth=args.depth, depth_channel=args.depth_channel, depth_kind=args.depth_kind, depth_unit=args.depth_unit,
                 dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step, step_rel=args.depth_step_rel,
                 edge_px=args.edge_px)
     if "#" in args.image:
         return _run_sequence(args, cam, opts)
-    res = defocus_file(args.image, args.output, cam, kernel_folder=args.kernel_cache, force=args.force, **opts)
+    res = defocus_file(args.image, args.output, cam, kernel_folder=args.kernel_cache, force=args.force,
+                       progress=_progress(args), **opts)
     if args.json:
         emit_json(document("defocus", res, units={"length": "mm", "time": "s"}))
         return 0
+    pin = f"{res['pinhole_focal_length_mm']:.3f} mm"
+    if abs(res["pinhole_focal_length_x_mm"] - res["pinhole_focal_length_mm"]) > 1e-9:
+        pin += f" (X {res['pinhole_focal_length_x_mm']:.3f} mm: pixel aspect " \
+               f"{res['pinhole_focal_length_mm'] / res['pinhole_focal_length_x_mm']:.4f})"
     print(f"{res['lens']}: {res['pixels'][0]} x {res['pixels'][1]} px defocused at f/{res['fstop']:g} "
-          f"({res['kernels_traced']} kernels traced, {res['seconds']:.1f} s); pinhole {res['pinhole_focal_length_mm']:.3f} mm "
+          f"({res['kernels_traced']} kernels traced, {res['kernels_loaded']} read, {res['seconds']:.1f} s); pinhole {pin} "
           f"at the entrance pupil, {res['entrance_pupil_from_film_mm']:.3f} mm in front of the film")
+    if res["kept_channels"]:
+        print(f"kept as read: {', '.join(res['kept_channels'][:8])}{' ...' if len(res['kept_channels']) > 8 else ''}")
     print(f"wrote {res['output']}")
     return 0
+
+
+def _progress(args):
+    """A progress bar on stderr for people (none with --json or when stderr is not a terminal)."""
+    import sys
+
+    if getattr(args, "json", False) or not sys.stderr.isatty():
+        return None
+
+    def show(done, total):
+        sys.stderr.write(f"\rdefocus: depth layer {done}/{total}" + ("\n" if done == total else ""))
+        sys.stderr.flush()
+
+    return show
 
 
 def _camera(args, lens, sensor):
@@ -180,7 +205,11 @@ def run_kernels(args) -> int:
     cam = defocus_camera(_camera(args, lens, sensor), width=args.resolution[0], height=args.resolution[1],
                          dispersion=args.dispersion, tile=args.tile, step_px=args.depth_step,
                          step_rel=args.depth_step_rel)
-    index = write_kernel_stack(args.output, cam, field_grid=args.field_grid, depths_mm=depths, force=args.force)
+    from pathlib import Path
+
+    lens_file = args.lens if Path(str(args.lens)).is_file() else None
+    index = write_kernel_stack(args.output, cam, field_grid=args.field_grid, depths_mm=depths, force=args.force,
+                               inputs=[lens_file])
     if args.json:
         emit_json(document("defocus_kernels", index, units={"length": "mm"}))
         return 0

@@ -28,7 +28,7 @@ def register(sub) -> None:
     p.add_argument("name", nargs="*", metavar="WORDS",
                    help="a sensor name or alias (shows that sensor), or words every listed sensor's name, maker or "
                         "aliases contain, e.g. ARRI, \"open gate\"")
-    p.add_argument("--maker", metavar="MAKER", help="only this maker: ARRI, RED, Sony, Canon, Blackmagic, Panasonic, or film (film gates)")
+    p.add_argument("--maker", metavar="MAKER", help="only this maker: ARRI, RED, Sony, Canon, Blackmagic, Panasonic, Fujifilm, DJI, or film (film gates)")
     p.add_argument("--format", dest="fmt", metavar="TEXT",
                    help="only names containing this format text, e.g. \"open gate\", 16:9, 4-perf")
     p.add_argument("--min-width", type=distance("minimum width"), default=None, metavar="MM",

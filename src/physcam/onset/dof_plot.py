@@ -35,11 +35,13 @@ def plot_dof_zone(report, path, *, force: bool = False, units: str = "m"):
 
 def plot_title(report, units: str = "m") -> str:
     """Lens, f-stop, focus, CoC and sensor: what a depth-of-field picture is of."""
+    from ..figures import unbroken
     from ..units import format_distance
 
     lens = report.lens_name or f"{report.focal_length_mm:g} mm"
-    focus = format_distance(report.focus_from_film_mm, units)
-    return (f"{lens}  f/{report.fstop:.3g}  focus {focus}  CoC {report.coc_mm:.4g} mm ({report.coc_convention})  "
+    focus = unbroken(f"focus {format_distance(report.focus_from_film_mm, units)}")
+    coc = unbroken(f"CoC {report.coc_mm:.4g} mm")
+    return (f"{lens}  f/{report.fstop:.3g}  {focus}  {coc} ({report.coc_convention})  "
             f"{report.sensor.name}")
 
 

@@ -87,6 +87,7 @@ def _breathing(lens, mark, sensor, out, curves) -> None:
     rows = focusing.breathing_table(lens, sensor_width_mm=sensor.width_mm)
     out["closest_focus_mm"] = cf.mark_mm
     out["closest_focus_source"] = cf.source
+    out["minimum_object_distance_mm"] = lens.metadata.minimum_object_distance  # the maker's, maybe beyond the model
     out["breathing_near_mm"] = cf.breathing_near_mm
     out["breathing_closest_pct"] = rows[-1].fov_change_pct
     at = focusing.breathing_table(lens, [math.inf, mark], sensor_width_mm=sensor.width_mm)

@@ -12,7 +12,7 @@ an unknown name raises :class:`~physcam.errors.SensorError` listing the closest 
 The camera table ``physcam/data/cameras.csv`` adds every recording format of current cine and hybrid
 cameras (camera -> formats): each row a :class:`Sensor` named "maker camera format" (also found
 without the maker: "FX6 FF 4K 17:9"), with its source, the date it was read and how the size was had
-(stated by the maker, or photosites x the maker's pitch). A camera's name alone ("FX6") is refused
+(stated by the maker, or photosites x the maker's pitch), and whose figure it is (``maker_spec``). A camera's name alone ("FX6") is refused
 with its formats listed: DOF and field of view depend on the crop.
 """
 
@@ -32,7 +32,7 @@ __all__ = ["Sensor", "sensors", "cameras", "camera_formats", "find_sensor", "fil
            "SENSOR_MAX_ASPECT", "PITCH_RANGE_UM", "MAKERS"]
 
 #: Camera makers in the table (a digital sensor's name starts with its maker); film gates are "film".
-MAKERS = ("ARRI", "RED", "Sony", "Canon", "Blackmagic", "Panasonic")
+MAKERS = ("ARRI", "RED", "Sony", "Canon", "Blackmagic", "Panasonic", "Fujifilm", "DJI")
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,6 +55,7 @@ class Sensor:
     anamorphic: tuple[float, ...] = ()  # desqueeze factors the maker offers this format for
     read: str = ""  # the date the source was read
     method: str = ""  # how the size was had: "stated mm", "photosites x pitch", "derived: ..."
+    maker_spec: str = ""  # whose figure the size is: the maker's (quoted, or its document via a transcription) or a third party's
 
     @property
     def diagonal_mm(self) -> float:
@@ -79,7 +80,8 @@ class Sensor:
                 "width_mm": self.width_mm, "height_mm": self.height_mm, "diagonal_mm": self.diagonal_mm,
                 "aspect": self.aspect, "photosite_pitch_um": self.pitch_um, "aliases": list(self.aliases),
                 "source": self.source, "camera": self.camera or None, "format": self.fmt or None,
-                "anamorphic": list(self.anamorphic), "read": self.read or None, "method": self.method or None}
+                "anamorphic": list(self.anamorphic), "read": self.read or None, "method": self.method or None,
+                "maker_spec": self.maker_spec or None}
 
 
 #: A custom sensor's width and height (mm): from a phone's sensor to beyond 15/70 IMAX film.
@@ -137,7 +139,7 @@ def _camera_formats() -> list[Sensor]:
             pitch_source=f"width / photosites: {across} photosites across (the row's source)" if across else "",
             camera=row["camera"], fmt=row["format"],
             make=row["maker"], anamorphic=tuple(float(x) for x in row["anamorphic"].split(";") if x.strip()),
-            read=row["read"], method=row["method"]))
+            read=row["read"], method=row["method"], maker_spec=row["maker_spec"]))
     return out
 
 

@@ -272,6 +272,7 @@ class _App:
     def __init__(self, backend: Backend, limits: Limits):
         self.backend, self.limits = backend, limits
         self.cache = _Cache(limits.cache_bytes)
+        self.running: dict = {}  # cache key -> the asyncio future of its slow answer being computed
         # One worker thread (numba's tracer and matplotlib are not to be entered from two threads at
         # once), shared between client addresses in turn (worker.py); an address's first slow
         # request is always taken, up to one address per connection the server accepts.
@@ -314,8 +315,12 @@ class _App:
         """Compute ``fn()`` (inline when light, on the worker in ``client``'s turn when heavy),
         cached by ``key``; a :class:`PhysCamError` becomes 422 with its first line."""
         hit = self.cache.get(key)
-        if hit is None:
-            if heavy:
+        if hit is None and heavy:
+            # the same question asked again while it is being computed waits for that computation
+            # (issue 47: every connection asking one setup at once queued its own copy of the work and
+            # filled its address's queue: 429s and a stall)
+            running = self.running.get(key)
+            if running is None:
                 try:
                     future = self.worker.submit(client_address(scope), lambda: _computed(fn, media))
                 except Full as full:
@@ -323,14 +328,22 @@ class _App:
                                   f"{'the server is busy with' if full.everyone else 'this address has'} "
                                   f"{full.limit} slow requests (lenses, charts) waiting; try again",
                                   [(b"retry-after", b"1")]) from None
-                hit = await asyncio.wrap_future(future)
-            else:
-                hit = _computed(fn, media)
+                running = self.running[key] = asyncio.wrap_future(future)
+                running.add_done_callback(lambda f, key=key: self._done(key, f))
+            hit = await asyncio.shield(running)  # a waiter that goes away cancels nothing shared
+        elif hit is None:
+            hit = _computed(fn, media)
             self.cache.put(key, hit)
         status, body = hit
         if status != 200:
             raise Refused(status, body.decode())
         return body
+
+    def _done(self, key, future) -> None:
+        """A slow answer is in: cached, and no longer running."""
+        self.running.pop(key, None)
+        if not future.cancelled() and future.exception() is None:
+            self.cache.put(key, future.result())
 
 
 def _computed(fn, media):

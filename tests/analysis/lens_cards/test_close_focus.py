@@ -78,3 +78,23 @@ def test_compare_table_labels_the_unit_limit(capsys):
     out = capsys.readouterr().out
     row = next(line for line in out.splitlines() if line.startswith("closest focus"))
     assert re.search(r"196\.0 mm \(unit focusing limit, not the lens's MOD\)", row)
+
+
+def test_a_mod_beyond_the_focus_model_is_shown_as_the_makers_figure(tmp_path, capsys):
+    """Issue 44: a MOD closer than the focus model reaches (dgauss here: 150 mm against its 196.0 mm unit
+    focusing limit; the Sigma 28 Art's 0.28 m against its patent's 1.275 m) is what the card and compare
+    label "close focus (MOD)", with a note giving the model's limit; it printed the model's limit."""
+    path = _dgauss_with(tmp_path, "minimum_object_distance = 150.0\n")
+    lens = load_lens(str(path))
+    assert close_focus(lens).mark_mm == pytest.approx(196.0, abs=0.05)  # the focus model stops there
+    card = lens_card(lens, quality="draft")
+    key = next(ax for ax in card.figure(dpi=30).axes if ax.get_label() == "key numbers")
+    texts = [t.get_text() for t in key.texts]
+    assert texts[texts.index("close focus (MOD)") + 1] == "150.0 mm"
+    assert "beyond the focus model (reaches 196.0 mm)" in texts
+    assert card.key["minimum_object_distance_mm"] == 150.0
+    assert main(["compare", "lenses", "--lens", str(path), "--lens", "sigma_28mm_f1_4_art", "--focus", "2m",
+                 "--fstop", "4", "--sensor", "S35", "--rays", "1000"]) == 0
+    row = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("closest focus"))
+    assert "150.0 mm (MOD; beyond the focus model, which reaches 196.0 mm)" in row
+    assert "280.0 mm (MOD; beyond the focus model, which reaches 1.275 m)" in row  # Sigma's 28 cm; its patent's S

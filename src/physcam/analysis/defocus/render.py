@@ -43,6 +43,7 @@ import numpy as np
 
 from ...errors import InputError
 from .kernels import DefocusCamera, KernelCache
+from .layers import blur_layer, frame_of, layer_corners, layer_pairs
 
 __all__ = ["DEPTH_KINDS", "DEPTH_UNITS_MM", "inverse_depth", "near_edges", "defocus"]
 
@@ -124,96 +125,10 @@ def _node_weights(u: np.ndarray, cam: DefocusCamera):
     lo = np.maximum(np.floor(cam.node_index(u) + 1e-9), n_far).astype(np.int64)
     u_lo, u_hi = cam.node_u(lo), cam.node_u(lo + 1)
     w_hi = np.clip((u - u_lo) / (u_hi - u_lo), 0.0, 1.0)
-    return lo, w_hi.astype(np.float32)
+    return lo, w_hi
 
 
-def _fast_len(n: int) -> int:
-    """The smallest 2^a 3^b 5^c >= n (a quick FFT length)."""
-    best = 1 << (n - 1).bit_length()
-    p5 = 1
-    while p5 < best:
-        p35 = p5
-        while p35 < best:
-            q = p35
-            while q < n:
-                q *= 2
-            best = min(best, q)
-            p35 *= 3
-        p5 *= 5
-    return best
-
-
-def _convolve(src: np.ndarray, ker: np.ndarray) -> np.ndarray:
-    """Full 2-D convolution of each plane of ``src`` (k, h, w) with ``ker`` (n, n) or, per plane,
-    (k, n, n): (k, h + n - 1, w + n - 1). Direct for small kernels, else FFT (float32)."""
-    k, h, w = src.shape
-    n = ker.shape[-1]
-    kers = np.broadcast_to(ker, (k, n, n)) if ker.ndim == 2 else ker
-    if n <= 7:
-        out = np.zeros((k, h + n - 1, w + n - 1), dtype=np.float32)
-        for dy in range(n):
-            for dx in range(n):
-                c = kers[:, dy, dx]
-                if c.any():
-                    out[:, dy:dy + h, dx:dx + w] += c[:, None, None] * src
-        return out
-    sy, sx = _fast_len(h + n - 1), _fast_len(w + n - 1)
-    fs = np.fft.rfft2(src, s=(sy, sx))
-    fk = np.fft.rfft2(kers if ker.ndim == 3 else ker, s=(sy, sx))
-    return np.fft.irfft2(fs * fk, s=(sy, sx))[:, : h + n - 1, : w + n - 1].astype(np.float32, copy=False)
-
-
-def _layer_source(img, wgt, rel):
-    """Planes (colour..., alpha, alpha of the farther group) of one tile of one layer (node n).
-    A pixel belongs to the **group** of its lower node (``rel`` = that node - n): its light and
-    its coverage are shared between that node's layer and the next, so its group's coverage is
-    (1 - w) K_lo + w K_hi, like its light. Colour: the layer's share ``wgt`` of each pixel's light.
-    Alpha: the share of the pixels of group n, and 1 where a nearer group hides this layer
-    (``rel`` > 0), whose colour there continues the layer's mean colour over the tile (so the hole a
-    foreground leaves is not renormalised away, C / A, later). Last plane: the upper share of group
-    n - 1's coverage (``rel`` = -1), added to that group's alpha before it is composited."""
-    col = img * wgt[..., None]
-    hidden = rel > 0
-    if hidden.any():
-        col = col + hidden[..., None] * (col.sum(axis=(0, 1)) / max(float(wgt.sum()), 1e-12))
-    alpha = np.where(rel == 0, wgt, 0.0) + hidden
-    upper = np.where(rel == -1, wgt, 0.0)
-    return np.concatenate([np.moveaxis(col, 2, 0), alpha[None], upper[None]], axis=0).astype(np.float32)
-
-
-def _tile_layer(img, wgt, kernel, colour_channels, rel):
-    """One tile of one layer blurred: planes (colour..., alpha, farther alpha) convolved with the
-    kernel; colour scaled by the transmission (vignetting), the alphas by a kernel of unit sum."""
-    k = kernel.image
-    tr = np.asarray(kernel.transmission, dtype=np.float32)
-    g = 1 if k.shape[2] == 3 else 0
-    unit = k[..., g] / tr[g] if tr[g] > 0 else np.zeros_like(k[..., g])
-    c = img.shape[2]
-    src = _layer_source(img, wgt, rel)
-    if k.shape[2] == 1 or colour_channels < 3:
-        out = _convolve(src, unit)
-        out[:c] *= tr[g]
-        return out
-    kers = np.empty((c + 2,) + unit.shape, dtype=np.float32)
-    for i in range(c):
-        kers[i] = k[..., i] if i < 3 else unit * tr[g]
-    kers[c] = kers[c + 1] = unit
-    return _convolve(src, kers)
-
-
-def _over(acc_c, acc_a, lay_c, lay_a, bb) -> None:
-    """``acc`` = the layer over ``acc`` (premultiplied), in the box ``bb``."""
-    a = np.clip(lay_a[bb], 0.0, 1.0)
-    acc_c[bb] = lay_c[bb] + (1.0 - a)[..., None] * acc_c[bb]
-    acc_a[bb] = a + (1.0 - a) * acc_a[bb]
-
-
-def defocus(image, u, cache: KernelCache, *, origin=(0, 0), edge_px: int = 1, progress=None) -> np.ndarray:
-    """``image`` (h, w, channels; linear light) defocused through the cache's camera, given each
-    pixel's inverse planar depth ``u`` (1/mm, :func:`inverse_depth`). ``origin``: the data
-    window's corner in the display window; ``edge_px``: depth edges widened toward the far side by
-    this many pixels (:func:`near_edges`; 0: the depth as given). Returns a float32 array of the
-    image's shape (method and limits in the module notes)."""
+def _check(image, u, edge_px, alpha_channel):
     img = np.asarray(image, dtype=np.float32)
     if img.ndim == 2:
         img = img[..., None]
@@ -222,59 +137,203 @@ def defocus(image, u, cache: KernelCache, *, origin=(0, 0), edge_px: int = 1, pr
                          "they must be the same size")
     if not np.isfinite(img).all():
         raise InputError("the image has NaN or infinite pixels: defocus needs finite linear light")
-    cam = cache.camera
-    h, w, c = img.shape
     if isinstance(edge_px, bool) or not isinstance(edge_px, (int, np.integer)) or not 0 <= edge_px <= 8:
         raise InputError(f"edge_px must be a whole number of pixels from 0 to 8, got {edge_px!r}")
-    lo, w_hi = _node_weights(near_edges(np.asarray(u, dtype=np.float64), int(edge_px)), cam)
-    t = cam.tile
-    layers: dict[int, list] = {}
-    for ty in range(math.ceil(h / t)):
-        for tx in range(math.ceil(w / t)):
-            sl = (slice(ty * t, (ty + 1) * t), slice(tx * t, (tx + 1) * t))
-            for n in np.unique(np.concatenate([lo[sl].ravel(), lo[sl].ravel() + 1])):
-                wt = np.where(lo[sl] == n, 1.0 - w_hi[sl], 0.0) + np.where(lo[sl] + 1 == n, w_hi[sl], 0.0)
-                if wt.max() > 1e-6:
-                    layers.setdefault(int(n), []).append((tx, ty, sl, wt.astype(np.float32), lo[sl] - n))
-    acc_c = np.zeros((h, w, c), dtype=np.float32)
-    acc_a = np.zeros((h, w), dtype=np.float32)
-    pending = None  # (node, colour, alpha, box): composited once the next node adds its coverage
-    for done, n in enumerate(sorted(layers), 1):  # far (small u) first: back to front
-        lay_c, lay_a, lay_u, bb = _blur_layer(img, layers[n], n, cache, origin)
-        if pending is not None:
-            m, pc, pa, pbb = pending
-            if m == n - 1:
-                pa += lay_u
-                pbb = (slice(min(pbb[0].start, bb[0].start), max(pbb[0].stop, bb[0].stop)),
-                       slice(min(pbb[1].start, bb[1].start), max(pbb[1].stop, bb[1].stop)))
-            _over(acc_c, acc_a, pc, pa, pbb)
-        pending = (n, lay_c, lay_a, bb)
-        if progress is not None:
-            progress(done, len(layers))
-    if pending is not None:
-        _over(acc_c, acc_a, pending[1], pending[2], pending[3])
-    out = acc_c / np.maximum(acc_a, 1e-6)[..., None]
+    if alpha_channel is not None:
+        if isinstance(alpha_channel, bool) or not isinstance(alpha_channel, (int, np.integer)) or \
+                not 0 <= alpha_channel < img.shape[2] or img.shape[2] < 2:
+            raise InputError(f"alpha_channel must index one of the image's {img.shape[2]} channels beside a colour one, "
+                             f"got {alpha_channel!r}")
+        a = img[..., alpha_channel]
+        if (a < -1e-6).any() or (a > 1 + 1e-6).any():
+            raise InputError("the alpha channel must lie in 0..1 (premultiplied colour over coverage)")
+    if (img < 0).any():
+        raise InputError("the image has negative pixels: defocus needs linear light, 0 or more")
+    return img
+
+
+def defocus(image, u, cache: KernelCache, *, origin=(0, 0), edge_px: int = 1, alpha_channel: int | None = None,
+            progress=None) -> np.ndarray:
+    """``image`` (h, w, channels; linear light, colour premultiplied by alpha) defocused through the
+    cache's camera, given each pixel's inverse planar depth ``u`` (1/mm, :func:`inverse_depth`).
+    ``origin``: the data window's corner in the display window; ``edge_px``: depth edges widened
+    toward the far side by this many pixels (:func:`near_edges`; 0: the depth as given);
+    ``alpha_channel``: the index of the image's coverage channel (None: an opaque picture), which
+    comes back as the defocused coverage. Returns a float32 array of the image's shape (method and
+    limits in the module notes)."""
+    img = _check(image, u, edge_px, alpha_channel)
+    cam = cache.camera
+    h, w, c = img.shape
+    lo, t = _node_weights(near_edges(np.asarray(u, dtype=np.float64), int(edge_px)), cam)
+    keep = [i for i in range(c) if i != alpha_channel]
+    a = np.clip(img[..., alpha_channel], 0.0, 1.0) if alpha_channel is not None else np.ones((h, w), np.float32)
+    nodes = np.unique(np.concatenate([np.unique(lo), np.unique(lo) + 1]))
+    margin = int(math.ceil(0.75 * float(np.max(cam.blur_px_at(nodes))))) + 4
+    f = frame_of(img[..., keep], a, lo, t, margin, cam.tile, origin, alpha_channel is not None)
+    pairs = layer_pairs(f)
+    _prepare(cache, f, pairs, progress)
+    colour, cover = _composite(f, cache, pairs, progress)
+    m = f.margin
+    out = np.empty_like(img)
+    out[..., keep] = colour[m:m + h, m:m + w]
+    if alpha_channel is not None:
+        out[..., alpha_channel] = cover[m:m + h, m:m + w]
     return out if np.ndim(image) == 3 else out[..., 0]
 
 
-def _blur_layer(img, tiles, n, cache, origin):
-    """Layer ``n`` scattered tile by tile: its colour, its group's alpha, the upper share of group
-    n - 1's alpha (full-frame arrays) and the box they cover."""
-    h, w, c = img.shape
-    lay_c = np.zeros((h, w, c), dtype=np.float32)
-    lay_a = np.zeros((h, w), dtype=np.float32)
-    lay_u = np.zeros((h, w), dtype=np.float32)
-    y_lo, y_hi, x_lo, x_hi = h, 0, w, 0
-    for tx, ty, sl, wt, rel in tiles:
-        kern = cache.get(cache.node_centre(tx, ty, (h, w), origin), n)
-        out = _tile_layer(img[sl], wt, kern, c, rel)
-        r = kern.radius
-        ya, xa = sl[0].start - r, sl[1].start - r
-        yb, xb = ya + out.shape[1], xa + out.shape[2]
-        cy0, cx0, cy1, cx1 = max(ya, 0), max(xa, 0), min(yb, h), min(xb, w)
-        part = out[:, cy0 - ya: cy1 - ya, cx0 - xa: cx1 - xa]
-        lay_c[cy0:cy1, cx0:cx1] += np.moveaxis(part[:c], 0, 2)
-        lay_a[cy0:cy1, cx0:cx1] += part[c]
-        lay_u[cy0:cy1, cx0:cx1] += part[c + 1]
-        y_lo, y_hi, x_lo, x_hi = min(y_lo, cy0), max(y_hi, cy1), min(x_lo, cx0), max(x_hi, cx1)
-    return lay_c, lay_a, lay_u, (slice(y_lo, y_hi), slice(x_lo, x_hi))
+def _prepare(cache, f, pairs, progress) -> None:
+    """Trace (or read) every node kernel the layers' blur grids blend from, in one batch."""
+    cols, rows = cache.grid
+    needed = set()
+    for n, tiles in pairs.items():
+        xs, ys = layer_corners(f, cache.camera, n, tiles)
+        found = []
+        for nodes, pos in ((cols, xs), (rows, ys)):
+            i = np.clip(np.searchsorted(nodes, pos, side="right") - 1, 0, len(nodes) - 2)
+            found.append(np.unique(np.concatenate([i, i + 1])))
+        needed |= {(int(c), int(r), int(n)) for c in found[0] for r in found[1]}
+    cache.prepare(needed, progress)
+
+
+def _composite(f, cache, pairs, progress):
+    """The nodes blurred and composited near to far (module notes): the colour and the coverage."""
+    H, W = f.lo.shape
+    c = f.colour.shape[2]
+    out = np.zeros((H, W, c), dtype=np.float32)
+    cov = np.zeros((H, W), dtype=np.float32)  # coverage of the groups composited so far
+    cov1 = np.zeros((H, W), dtype=np.float32) if f.has_alpha else None
+    carry = None  # (U, U1, box): the upper shares of the next farther group
+    nodes = sorted(pairs, reverse=True)
+    lowest = int(f.lo.min())
+    fills = {n for n, tiles in pairs.items() if any(fill for _, _, fill in tiles)}
+    budget = _Budget(f.lo.shape)
+    for done, n in enumerate(range(nodes[0], lowest - 1, -1), 1):
+        lay = _fold(f, blur_layer(f, cache, n, pairs.get(n, [])))
+        group_cov = [(lay, "A")] + ([(carry, "U")] if carry is not None else [])
+        if lay is not None:
+            box = lay["box"]
+            tr = f.inside[box] * (1.0 - np.clip(cov[box], 0.0, 1.0))
+            out[box] += tr[..., None] * lay["V"]
+            if n in fills or n - 1 in fills:
+                budget.spend(out, box, tr, lay)
+        else:
+            budget.carry = None
+        for src, name in group_cov:
+            if src is not None:
+                cov[src["box"]] += src[name]
+                if cov1 is not None:
+                    cov1[src["box"]] += src[name + "1"]
+        carry = lay
+        if progress is not None and n in pairs:
+            progress(done, len(nodes))
+    if cov1 is None:
+        return out, None
+    # the coverage, made whole where the picture's pixels, opaque or not, cover the film completely
+    # (the kernels of neighbouring depth layers differ, so their coverages add to 1 only nearly)
+    full = np.clip(cov1, 0.0, 1.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        alpha = np.where(full > 0, np.clip(cov, 0.0, 1.0) / np.where(full > 0, full, 1.0), 0.0)
+    return out, np.clip(alpha, 0.0, 1.0).astype(np.float32)
+
+
+def _fold(f, lay):
+    """The light and coverage a node sends past the picture's edge, folded back across it (a
+    mirror): none is lost or made there, and a flat field stays flat to the edge (exactly where the
+    kernels are symmetric across it)."""
+    if lay is None:
+        return None
+    m = f.margin
+    H, W = f.lo.shape
+    ys, xs = lay["box"]
+    for axis, (sl, size) in enumerate(((ys, H), (xs, W))):
+        lo_out, hi_out = max(m - sl.start, 0), max(sl.stop - (size - m), 0)
+        if not (lo_out or hi_out):
+            continue
+        for k in ("V", "G", "A", "U", "A1", "U1"):
+            a = lay.get(k)
+            if a is None:
+                continue
+            a = np.moveaxis(a, axis, 0)  # a view: folding it folds the plane
+            n = a.shape[0]
+            if lo_out:  # rows 0 .. lo_out-1 of the box lie before the picture: mirror them in
+                k = min(lo_out, n - lo_out)
+                a[lo_out:lo_out + k] += a[lo_out - 1:lo_out - 1 - k:-1] if lo_out - 1 - k >= 0 else a[lo_out - 1::-1][:k]
+                a[:lo_out] = 0
+            if hi_out:
+                k = min(hi_out, n - hi_out)
+                a[n - hi_out - k:n - hi_out] += a[n - hi_out:n - hi_out + k][::-1]
+                a[n - hi_out:] = 0
+    return lay
+
+
+class _Budget:
+    """The light fills may bring (module notes): each node's light lost to nearer coverage, on a grid
+    of :data:`BUDGET_CELL` pixels, kept for that node's fill and what is left for the next farther
+    node's (a group's light is shared between two nodes), then dropped; a fill is scaled down where,
+    summed over a window twice its kernel's radius, it would bring more than that."""
+
+    def __init__(self, shape):
+        q = BUDGET_CELL
+        self.shape = (-(-shape[0] // q), -(-shape[1] // q))
+        self.carry = None
+
+    def spend(self, out, box, tr, lay) -> None:
+        q = BUDGET_CELL
+        y0, x0 = box[0].start, box[1].start
+        own = np.zeros(self.shape)
+        loss = ((1.0 - tr)[..., None] * lay["V"]).sum(axis=2)
+        _add_cells(own, loss, y0, x0, q)
+        avail = own + (self.carry if self.carry is not None else 0.0)
+        g = lay["G"]
+        if g is not None:
+            gain = tr[..., None] * g
+            gc = np.zeros(self.shape)
+            _add_cells(gc, gain.sum(axis=2), y0, x0, q)
+            r = max(-(-2 * lay["radius"] // q), 2)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                scale = np.clip(np.nan_to_num(_box_sum(avail, r) / _box_sum(gc, r), posinf=0.0), 0.0, 1.0)
+            cy0, cx0 = max(y0 // q - 1, 0), max(x0 // q - 1, 0)  # the box's cells and one around
+            cy1, cx1 = -(-box[0].stop // q) + 1, -(-box[1].stop // q) + 1
+            part = _upsample_cells(scale[cy0:cy1, cx0:cx1], q, ((cy1 - cy0) * q, (cx1 - cx0) * q))
+            part = part[y0 - cy0 * q: box[0].stop - cy0 * q, x0 - cx0 * q: box[1].stop - cx0 * q]  # (0, 0): (cy0 q, cx0 q)
+            out[box] += part[..., None] * gain
+            avail = np.maximum(avail - scale * gc, 0.0)
+        self.carry = np.minimum(avail, own)  # a node's loss funds its own fill and the next one's, no more
+
+
+def _add_cells(cells: np.ndarray, a: np.ndarray, y0: int, x0: int, q: int) -> None:
+    """Add the sums of ``a`` (placed at (y0, x0) of the frame) over q x q cells into ``cells``."""
+    h, w = a.shape
+    ya, xa = y0 // q * q, x0 // q * q
+    p = np.zeros((-(-(y0 + h - ya) // q) * q, -(-(x0 + w - xa) // q) * q))
+    p[y0 - ya:y0 - ya + h, x0 - xa:x0 - xa + w] = a
+    part = p.reshape(p.shape[0] // q, q, p.shape[1] // q, q).sum(axis=(1, 3))
+    cy, cx = ya // q, xa // q
+    cells[cy:cy + part.shape[0], cx:cx + part.shape[1]] += part[:cells.shape[0] - cy, :cells.shape[1] - cx]
+
+
+def _upsample_cells(a: np.ndarray, q: int, shape) -> np.ndarray:
+    """Values per q x q cell to values per pixel, bilinear between cell centres (clamped at the ends)."""
+    def axis(n, m):
+        pos = np.clip((np.arange(m) + 0.5) / q - 0.5, 0, n - 1)
+        i = np.minimum(np.floor(pos).astype(np.int64), n - 1)
+        j = np.minimum(i + 1, n - 1)
+        return i, j, pos - i
+
+    i, j, w = axis(a.shape[0], shape[0])
+    rows = a[i] * (1 - w)[:, None] + a[j] * w[:, None]
+    i, j, w = axis(a.shape[1], shape[1])
+    return (rows[:, i] * (1 - w)[None, :] + rows[:, j] * w[None, :]).astype(np.float32)
+
+
+#: the grid (px) the fill's light budget is summed on
+BUDGET_CELL = 4
+
+
+def _box_sum(a: np.ndarray, r: int) -> np.ndarray:
+    """Sum of ``a`` over the (2r + 1)^2 window around each pixel (zero outside)."""
+    c = np.pad(a.astype(np.float64), ((r + 1, r), (r + 1, r))).cumsum(axis=0).cumsum(axis=1)
+    n = 2 * r + 1
+    return c[n:, n:] - c[:-n, n:] - c[n:, :-n] + c[:-n, :-n]
+
+

@@ -37,6 +37,18 @@ _QUALITY = {"full": dict(mtf_fields=8, curve_fields=12, pupil_cap=256, rays=120_
             "draft": dict(mtf_fields=4, curve_fields=6, pupil_cap=96, rays=20_000, pixels=48, grid=32)}
 
 
+def _title_that_fits(text: str, width_in: float) -> tuple[str, float]:
+    """The page title and its size: the largest of 11, 10, 9 and 8 pt at which ``text``, bold, fits on one line
+    ``width_in`` inches wide (a long lens name, such as a zoom's with its source), else wrapped at 8 pt."""
+    from ..figures import fit_title
+
+    for size in (11.0, 10.0, 9.0, 8.0):
+        lines = fit_title(text, width_in, fontsize=size, weight="bold")
+        if "\n" not in lines:
+            return lines, size
+    return lines, 8.0
+
+
 @dataclass
 class LensCard:
     """What a lens card shows, computed once; :meth:`figure` draws the page."""
@@ -80,7 +92,8 @@ class LensCard:
         fig = new_figure(figsize=(w, h), dpi=dpi)
         gs = fig.add_gridspec(5, 6, left=0.08, right=0.9, top=0.93, bottom=0.075, hspace=0.75, wspace=1.6,
                               height_ratios=(1.25, 1.0, 1.0, 1.0, 0.8))
-        fig.suptitle(self._title(), fontsize=11, fontweight="bold", y=0.985)
+        title, size = _title_that_fits(self._title(), 0.94 * w)
+        fig.suptitle(title, fontsize=size, fontweight="bold", y=0.985)
         fig.text(0.5, 0.955, self._subtitle(units), ha="center", va="center", fontsize=7.5, color="0.25")
         _draw_diagram(fig.add_subplot(gs[0, :4], label="diagram"), self, units)
         _draw_key(fig.add_subplot(gs[0, 4:], label="key numbers"), self.key, units)
@@ -202,6 +215,7 @@ def key_numbers(lens: Prescription, focus_mm: float, half_diagonal_mm: float, *,
             "close_focus_from_film_mm": None if close is None else close.mark_mm,
             "close_focus_source": None if close is None else close.source,
             "close_focus_words": None if close is None else close.words,
+            "minimum_object_distance_mm": m.minimum_object_distance,  # the maker's MOD, from the film
             "image_circle_mm": circle, "field_limit_deg": limit,
             "covers_sensor": circle >= 2.0 * half_diagonal_mm, "total_track_mm": lens.total_track,
             "squeeze": lens.squeeze, "maker": m.maker, "source": m.source, "licence": m.licence}
@@ -293,10 +307,12 @@ def _draw_key(ax, key, units):
             ("entrance pupil", f"Ø {key['entrance_pupil_diameter_mm']:.1f} mm"),
             ("  in front of film", dist(key["entrance_pupil_from_film_mm"])),
             ("close focus" + {"maker": " (MOD)", "focus groups": " (focus groups)"}.get(key["close_focus_source"], ""),
-             dist(key["close_focus_from_film_mm"])),
+             dist(_shown_close_focus(key))),
             ("image circle", f"Ø {key['image_circle_mm']:.1f} mm"), ("total track", f"{key['total_track_mm']:.1f} mm")]
     if key["close_focus_source"] == "unit focusing limit":  # 1:1, which no real lens of the kind reaches
         rows.insert(6, ("", "unit focusing limit, not the lens's MOD"))
+    elif _shown_close_focus(key) != key["close_focus_from_film_mm"]:  # the maker's MOD, closer than the model focuses
+        rows.insert(6, ("", f"beyond the focus model (reaches {dist(key['close_focus_from_film_mm'])})"))
     if key["squeeze"] != 1.0:
         rows.append(("squeeze", f"{key['squeeze']:g}x"))
     ax.set_title("key numbers", loc="left")
@@ -306,6 +322,13 @@ def _draw_key(ax, key, units):
         ax.text(0.0, y, k, transform=ax.transAxes, fontsize=7.5, va="top")
         ax.text(1.0, y, v, transform=ax.transAxes, fontsize=6 if note else 7.5, va="top", ha="right",
                 fontweight="normal" if note else "bold", color="0.3" if note else "black")
+
+
+def _shown_close_focus(key):
+    """The close focus a card shows: the maker's MOD where the file gives one (even closer than the
+    focus model reaches, key["close_focus_from_film_mm"]), else the model's close focus."""
+    mod = key.get("minimum_object_distance_mm")
+    return mod if key["close_focus_source"] == "maker" and mod is not None else key["close_focus_from_film_mm"]
 
 
 def _no_data(ax, text):

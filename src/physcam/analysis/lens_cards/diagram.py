@@ -117,7 +117,7 @@ class LensDiagram:
     def draw(self, ax, *, units: str = "m", width_in: float = 10.0, title: bool = True, label_pt: float = 8.0) -> None:
         """Draw the diagram on matplotlib axes ``ax`` (what :meth:`figure` shows; the lens card's
         section); ``width_in`` is the width the title is wrapped to, ``label_pt`` the size of the labels."""
-        from ...figures import PALETTE, fit_title
+        from ...figures import PALETTE, fit_title, unbroken
         from ...units import format_distance
 
         p, g, axis = self.prescription, self.gaussian, self.axis
@@ -188,8 +188,9 @@ class LensDiagram:
         fnum = g.f_number if self.fstop is None else self.fstop
         if title:
             ax.set_title(fit_title(
-                f"{p.name}: EFL {g.efl:.2f} mm, f/{fnum:.3g}, focus {format_distance(self.focus_from_film_mm, units)}, "
-                f"half-field {self.field_deg:.1f}° ({axis.upper()} meridian)",
+                f"{p.name}: {unbroken(f'EFL {g.efl:.2f} mm')}, f/{fnum:.3g}, "
+                f"{unbroken('focus ' + format_distance(self.focus_from_film_mm, units))}, "
+                f"{unbroken(f'half-field {self.field_deg:.1f}°')} ({axis.upper()} meridian)",
                 width_in if label_pt == 8.0 else 0.8 * width_in, fontsize=None if label_pt == 8.0 else label_pt))
 
 

@@ -12,14 +12,20 @@ about 0.2 s once per process, more than a short command's whole tracing work in 
 has done (estimated from rays x surfaces, :data:`NUMPY_RAY_SURFACE_S`, :data:`NUMPY_SURFACE_S`)
 stays under :data:`NUMPY_BUDGET_S` and the call at hand under :data:`NUMPY_CALL_MAX_S`; the first
 call past either loads numba, and from then on (or whenever numba is already loaded) every call
-uses the JIT kernel. Since the kernels agree, the answer does not depend on which one ran.
+uses the JIT kernel. Since the kernels agree, the answer does not depend on which one ran. Before
+numba's disk cache holds compiled kernels (the first commands after an install or upgrade), making
+the JIT kernel ready means compiling it (:data:`NUMBA_COMPILE_S`, :func:`numba_load_cost`), and the
+budgets grow in proportion: a job the numpy kernel does faster than the compile stays in numpy.
 
-The JIT kernel runs on the calling thread below :data:`SERIAL_BELOW` rays (and, with
-:data:`LOAD_AWARE`, at any size while the machine is busy) and on numba's thread pool otherwise:
-waking the pool costs a few microseconds on an idle machine and, on a busy one, up to a scheduler
-time slice (milliseconds) while a worker waits for a core (benchmarks/small_calls.py). Serial and
-parallel give identical rays. Compiled kernels are cached on disk under a key that includes
-physcam's version and a hash of the kernel sources (:mod:`._jitcache`).
+The JIT kernel is one compiled variant per feature set (``_numba.variant``: one wavelength or each
+ray's own, optical path, Fresnel weights, aspheres), each compiled on first use with the passes it
+calls only; :func:`set_compile_reporter` hears about a compile as it happens. It runs on the calling
+thread below :data:`SERIAL_BELOW` rays (and, with :data:`LOAD_AWARE`, at any size while the machine
+is busy) and otherwise splits the batch's blocks into one range per thread (:func:`threads`), each
+traced without the GIL: a thread costs tens of microseconds to wake, and on a busy machine waits for
+a core (benchmarks/small_calls.py). Serial and threaded runs give identical rays. Compiled kernels
+are cached on disk under a key that includes physcam's version and a hash of the kernel sources
+(:mod:`._jitcache`).
 """
 
 from __future__ import annotations
@@ -28,32 +34,77 @@ import os
 
 from ...errors import BackendError
 
-__all__ = ["BACKENDS", "SERIAL_BELOW", "backend_for_job", "get_kernel", "resolve_backend", "numba_available", "jit_kernel"]
+__all__ = ["BACKENDS", "SERIAL_BELOW", "backend_for_job", "get_kernel", "resolve_backend", "numba_available", "jit_kernel",
+           "numba_load_cost", "set_compile_reporter", "set_threads", "threads"]
 
 BACKENDS = ("auto", "numba", "numpy")
 #: Batches smaller than this run the JIT kernel serially (measured crossover, docs/performance.md).
 SERIAL_BELOW = 1024
 #: "auto" before numba is loaded: the numpy kernel's cost per ray and surface, and per surface and
 #: call (dgauss_50mm on this machine, 5e5 rays in slices of 2^14: 32-38 ns per ray and surface, one
-#: wavelength or three with the optical path, at load 3.5; ~25 us of numpy calls per surface), the
-#: numpy work allowed in all (about half of what loading numba costs) and in one call
+#: wavelength or three with the optical path, at load 3.5; ~25 us of numpy calls per surface)
 NUMPY_RAY_SURFACE_S = 40e-9
 NUMPY_SURFACE_S = 30e-6
-NUMPY_BUDGET_S = 0.1
-NUMPY_CALL_MAX_S = 0.04
-#: What loading numba costs a process before its first traced ray: ``import numba`` and the first
-#: call's target initialisation (0.115 s + 0.14 s on this machine, idle, 2026-11-23; 0.33-0.38 s of
-#: CPU at load 3.9, 2026-11-26; docs/performance.md)
-NUMBA_LOAD_S = 0.3
+#: What loading numba costs a process before its first traced ray: ``import numba``, the kernel
+#: module and the first variant's target initialisation and cache load (0.18 + 0.05 + 0.16 s of CPU
+#: at load 14, 2026-11-28; 0.33-0.38 s at load 3.9, 2026-11-26; docs/performance.md)
+NUMBA_LOAD_S = 0.35
+#: "auto" runs the numpy kernel while the numpy work of the process, the call at hand included,
+#: stays under this: as much as loading numba costs (rent until the rent paid would have bought:
+#: never more than twice the cheaper choice, whatever work follows); and one call estimated above
+#: ``NUMPY_CALL_MAX_S`` loads numba at once. Both scale with :func:`numba_load_cost` (a cold JIT
+#: cache). Issue 47: at a third of the load cost, the ghost and relative-illumination commands
+#: (0.12-0.18 s of numpy work) loaded numba for nothing.
+NUMPY_BUDGET_S = NUMBA_LOAD_S
+NUMPY_CALL_MAX_S = NUMBA_LOAD_S
 #: Large batches too run serially while the machine is busy (1-minute load average above the
 #: cores numba uses, plus 0.5): numba's parallel loop splits the blocks statically, so with other
 #: processes on the cores it waits for its slowest thread (benchmarks/small_calls.py measured the
 #: parallel kernel 2-5x slower than the serial one under load, up to 1e6 rays).
 LOAD_AWARE = True
+#: What compiling a variant of the JIT kernel costs when numba's disk cache does not hold it yet
+#: (the first traced command after installing or upgrading physcam): the variant a bokeh or an MTF
+#: chart uses, CPU seconds on this machine (docs/performance.md, "The first traced command")
+NUMBA_COMPILE_S = 4.0
 _numba_kernel = None
 _numba_error: str | None = None
 _numpy_spent = 0.0
 _load_seen = (-1.0, False)  # (monotonic time of the last look, busy then)
+_threads_set: int | None = None
+_threads_default: int | None = None
+
+
+def set_threads(n: int | None) -> None:
+    """Threads the JIT kernel runs large batches on (None: numba's ``NUMBA_NUM_THREADS``, the cores)."""
+    global _threads_set
+    if n is not None and (isinstance(n, bool) or not isinstance(n, int) or n < 1):
+        raise BackendError(f"threads must be a whole number from 1, got {n!r}")
+    _threads_set = n
+
+
+def threads() -> int:
+    """Threads the JIT kernel uses for a large batch (:func:`set_threads`)."""
+    if _threads_set is not None:
+        return _threads_set
+    global _threads_default
+    if _threads_default is None:
+        try:
+            import numba
+
+            _threads_default = max(1, int(numba.config.NUMBA_NUM_THREADS))
+        except (ImportError, AttributeError):
+            _threads_default = os.cpu_count() or 1
+    return _threads_default
+
+
+def set_compile_reporter(fn) -> None:
+    """``fn(done, total)`` is called while numba compiles a kernel variant (the first use after an
+    install or upgrade): ``(0, total)`` when it starts, then after each pass, ``(total, total)`` at
+    the end; None for silence (the default). The ``"compile"`` reporter of :mod:`physcam.progress`
+    (``physcam`` shows it as "compiling the ray tracer (once)" with a progress bar on a terminal)."""
+    from ...progress import set_reporter
+
+    set_reporter("compile", fn)
 
 
 def _busy() -> bool:
@@ -64,13 +115,118 @@ def _busy() -> bool:
     now = time.monotonic()
     if now - _load_seen[0] > 1.0:
         try:
-            import numba
-
-            busy = os.getloadavg()[0] > numba.get_num_threads() + 0.5
+            busy = os.getloadavg()[0] > threads() + 0.5
         except (OSError, AttributeError):  # no load average on this platform
             busy = False
         _load_seen = (now, busy)
     return _load_seen[1]
+
+
+def numba_load_cost() -> float:
+    """What making the JIT kernel ready costs this process (CPU seconds): :data:`NUMBA_LOAD_S` when
+    numba's disk cache holds compiled kernels of this physcam (:func:`._jitcache.is_warm`), else
+    :data:`NUMBA_COMPILE_S`; 0 once loaded."""
+    if _numba_kernel is not None:
+        return 0.0
+    from . import _jitcache
+
+    return NUMBA_LOAD_S if _jitcache.is_warm() else NUMBA_COMPILE_S
+
+
+class _JitKernel:
+    """The JIT kernel with the numpy kernel's signature: picks the variant (``_numba.variant``) of the
+    call's features, compiles or loads it on first use (telling the compile reporter), and runs a
+    batch of :data:`SERIAL_BELOW` rays or more as one range of blocks per thread (module notes)."""
+
+    def __init__(self):
+        import numpy as np
+
+        from . import _numba
+
+        self._K = _numba
+        self._no_opl = np.empty(0)
+        self._variants: dict = {}  # (features, ray and table dtypes) -> the variant, compiled or loaded for them
+        self._asphere: dict = {}  # kinds' bytes -> whether they hold an even asphere
+        self._pool = None
+
+    def __call__(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
+        below = SERIAL_BELOW
+        if x.shape[0] >= below and LOAD_AWARE and _busy():
+            below = x.shape[0] + 1
+        self.run(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, below, opl)
+
+    def run(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, serial_below,
+            opl=None):
+        """Trace in place; below ``serial_below`` rays on the calling thread alone (the signature of
+        the one parallel kernel this replaces: an empty ``opl`` is no optical path)."""
+        with_opl = opl is not None and opl.shape[0] > 0
+        kb = kinds.tobytes()  # whether the table holds aspheres, by the kinds' bytes (a few us less than a reduction)
+        asphere = self._asphere.get(kb)
+        if asphere is None:
+            asphere = self._asphere[kb] = bool(kinds.shape[0] and kinds.max() >= 3)
+        key = (bool(mono), with_opl, bool(fresnel), asphere, x.dtype.char, S.dtype.char)
+        f = self._variants.get(key)
+        if f is None:
+            f = self._K.variant(*key[:4])
+        args = (x, y, z, L, M, N, wl, w, wd, flag, S, kinds, bool(clip), float(end_z), bool(has_end),
+                opl if with_opl else self._no_opl)
+        if key not in self._variants:
+            self._first_call(f, key[:4], args)
+            self._variants[key] = f
+        n = x.shape[0]
+        block = self._K.BLOCK
+        nb = (n + block - 1) // block
+        if n < serial_below or nb < 2:
+            f(*args, 0, nb)
+            return
+        k = min(threads(), nb)
+        if k < 2:
+            f(*args, 0, nb)
+            return
+        if self._pool is None:
+            from concurrent.futures import ThreadPoolExecutor
+
+            self._pool = ThreadPoolExecutor(max_workers=max(1, threads() - 1), thread_name_prefix="physcam-trace")
+        cuts = [nb * i // k for i in range(k + 1)]
+        futures = [self._pool.submit(f, *args, cuts[i], cuts[i + 1]) for i in range(1, k)]
+        f(*args, cuts[0], cuts[1])
+        for fut in futures:
+            fut.result()
+
+    def _first_call(self, f, key, args) -> None:
+        """Compile (or load from numba's disk cache) variant ``f`` for these argument types by a call on
+        no block, telling the compile reporter about each pass numba compiles."""
+        from numba.core import event
+
+        from . import _jitcache
+
+        passes = set(self._K.variant_passes(*key))
+        total = len(passes) + 1
+        state = {"done": 0, "started": False}
+        from ...progress import reporter as _reporter
+
+        reporter = _reporter("compile")
+
+        class Progress(event.Listener):
+            def on_start(self, ev):
+                if not state["started"]:
+                    state["started"] = True
+                    if reporter is not None:
+                        reporter(0, total)
+
+            def on_end(self, ev):
+                name = getattr(ev.data.get("dispatcher"), "py_func", None)
+                if name is not None and name.__name__ in passes:
+                    state["done"] = min(total - 1, state["done"] + 1)
+                    if reporter is not None:
+                        reporter(state["done"], total)
+
+        with event.install_listener("numba:compile", Progress()):
+            f(*args, 0, 0)
+        if state["started"] or not _jitcache.is_warm():  # compiled now, or loaded from a cache left unmarked
+            _jitcache.mark_compiled()
+        if state["started"] and reporter is not None:
+            reporter(total, total)
 
 
 def _load_numba():
@@ -80,22 +236,7 @@ def _load_numba():
             from . import _jitcache
 
             _jitcache.install()
-            import numpy as np
-
-            from ._numba import trace_rays
-
-            no_opl = np.empty(0)
-
-            def trace_rays_auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono,
-                                opl=None):
-                below = SERIAL_BELOW
-                if x.shape[0] >= below and LOAD_AWARE and _busy():
-                    below = x.shape[0] + 1
-                trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, below,
-                           no_opl if opl is None else opl)
-
-            trace_rays_auto.jit = trace_rays
-            _numba_kernel = trace_rays_auto
+            _numba_kernel = _JitKernel()
         except Exception as exc:  # ImportError, or numba failing to initialise
             _numba_error = f"{type(exc).__name__}: {exc}"
     return _numba_kernel
@@ -106,11 +247,11 @@ def numba_available() -> bool:
 
 
 def jit_kernel():
-    """The numba dispatcher itself (``trace_rays`` with the trailing ``serial_below`` and ``opl``
-    arguments: an empty float64 array for no optical path), loading numba; None when numba is
-    unavailable. For benchmarks and tests."""
+    """The JIT kernel with the one parallel kernel's signature (the numpy kernel's, then
+    ``serial_below`` and ``opl``: an empty float64 array for no optical path), loading numba; None
+    when numba is unavailable. For benchmarks and tests."""
     k = _load_numba()
-    return None if k is None else k.jit
+    return None if k is None else k.run
 
 
 def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
@@ -120,7 +261,8 @@ def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has
     if k is None:
         if _numba_error is None:
             est = (kinds.shape[0] + 1) * (NUMPY_SURFACE_S + x.shape[0] * NUMPY_RAY_SURFACE_S)
-            if est < NUMPY_CALL_MAX_S and _numpy_spent + est < NUMPY_BUDGET_S:
+            scale = numba_load_cost() / NUMBA_LOAD_S  # a cold JIT cache: compiling costs more than loading
+            if est < NUMPY_CALL_MAX_S * scale and _numpy_spent + est < NUMPY_BUDGET_S * scale:
                 _numpy_spent += est
                 k = None
             else:
@@ -147,7 +289,7 @@ def backend_for_job(backend: str, ray_surfaces: float) -> str:
     if backend != "auto" or os.environ.get("PHYSCAM_BACKEND", "auto") != "auto" or _numba_kernel is not None:
         return backend
     est = ray_surfaces * NUMPY_RAY_SURFACE_S
-    if _numpy_spent + est < NUMBA_LOAD_S:
+    if _numpy_spent + est < numba_load_cost():
         _numpy_spent += est
         return "numpy"
     return backend

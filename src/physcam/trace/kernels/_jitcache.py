@@ -9,9 +9,9 @@ by any other version or source is never used: it is recompiled and overwritten. 
 release not accept the locator, the kernels are compiled without a disk cache (slow to start,
 never stale) rather than cached under numba's weaker key.
 
-Entries go to ``__pycache__/physcam-jit`` beside the kernels, or, where the package directory is
-not writable (a system install), to the user cache (``$NUMBA_CACHE_DIR`` if set, else
-``$XDG_CACHE_HOME`` or ``~/.cache``, under ``physcam/jit``). The locator subclasses numba's cache
+Entries go to ``$NUMBA_CACHE_DIR`` when it is set (as numba's own caches), else to
+``__pycache__/physcam-jit`` beside the kernels, or, where the package directory is not writable (a
+system install), to the user cache (``$XDG_CACHE_HOME`` or ``~/.cache``, under ``physcam/jit``). The locator subclasses numba's cache
 locator class (``numba.core.caching._CacheLocator``, the class ``NUMBA_CACHE_LOCATOR_CLASSES``
 names; an internal of numba) and is registered ahead of numba's own, for functions defined in
 this directory only: other numba users are unaffected.
@@ -49,6 +49,69 @@ def _user_dir() -> str:
         os.path.expanduser("~"), ".cache")
     tag = hashlib.sha1(_HERE.encode()).hexdigest()[:16]
     return os.path.join(base, "physcam", "jit", tag)
+
+
+def _cache_dirs() -> list[str]:
+    """Where entries go, in order of preference: ``$NUMBA_CACHE_DIR`` when set (numba's own rule: the
+    user's choice comes first), else beside the kernels, else the user cache."""
+    pkg = os.path.join(_HERE, "__pycache__", "physcam-jit")
+    return [_user_dir(), pkg] if os.environ.get("NUMBA_CACHE_DIR") else [pkg, _user_dir()]
+
+
+def _usable(path: str, create: bool) -> bool:
+    """Whether numba's cache could be written in ``path``: it is a writable folder, or (``create``
+    False) the nearest existing folder above it is writable; ``create`` makes the folder."""
+    if create:
+        try:
+            os.makedirs(path, exist_ok=True)
+        except OSError:
+            return False
+    probe = path
+    while not os.path.exists(probe):
+        parent = os.path.dirname(probe)
+        if parent == probe:
+            return False
+        probe = parent
+    return os.path.isdir(probe) and os.access(probe, os.W_OK | os.X_OK)
+
+
+def cache_dir(create: bool = False) -> str | None:
+    """The folder numba's cache of the kernels uses: the first of :func:`_cache_dirs` that can be
+    written (the locator's own choice below); None if none can."""
+    return next((d for d in _cache_dirs() if _usable(d, create)), None)
+
+
+_warm: bool | None = None
+
+
+def _marker() -> str:
+    return f"physcam-compiled-{source_stamp()[:20]}"
+
+
+def is_warm() -> bool:
+    """Whether numba's disk cache holds kernels compiled from these sources: the marker
+    :func:`mark_compiled` leaves in :func:`cache_dir` (looked up once per process, without importing
+    numba or creating a folder). A marker whose kernels numba then cannot load (another CPU) costs a
+    compile, never a wrong answer."""
+    global _warm
+    if _warm is None:
+        d = cache_dir()
+        _warm = d is not None and os.path.exists(os.path.join(d, _marker()))
+    return _warm
+
+
+def mark_compiled() -> None:
+    """Leave the marker of :func:`is_warm` in :func:`cache_dir` (after a compile or a first load)."""
+    global _warm
+    d = cache_dir(create=True)
+    if d is None:
+        return
+    try:
+        with open(os.path.join(d, _marker()), "w") as f:
+            f.write("numba's cache here holds physcam's kernels compiled from these sources\n")
+    except OSError:
+        return
+    _warm = True
 
 
 def install() -> bool:
@@ -90,14 +153,8 @@ def _register() -> None:
         def from_function(cls, py_func, py_file):
             if os.path.dirname(os.path.abspath(py_file)) != _HERE:
                 return None
-            for path in (os.path.join(_HERE, "__pycache__", "physcam-jit"), _user_dir()):
-                self = cls(py_func, py_file, path)
-                try:
-                    self.ensure_cache_path()
-                except OSError:
-                    continue
-                return self
-            return None
+            path = cache_dir(create=True)
+            return None if path is None else cls(py_func, py_file, path)
 
     caching.CacheImpl._locator_classes.insert(0, PhysCamLocator)
     sys.modules[__name__].PhysCamLocator = PhysCamLocator

@@ -18,10 +18,13 @@ Two rare cases are handled per block, not per ray: the far root of a quadric (th
 sphere met first; a fix-up pass runs only when some lane needs it) and the Newton iteration of an
 even asphere (all lanes step together; it stops when no lane of the block still moves).
 
-``trace_rays`` runs the blocks in parallel (``prange``), or, below ``serial_below`` rays, on the
-calling thread: for small batches waking the thread pool costs more than the rays
-(:data:`physcam.trace.kernels.SERIAL_BELOW`). It takes float64 or float32 rays and table: the
-working precision follows the arrays.
+A kernel is one **variant** per feature set (one wavelength or each ray's own, optical path,
+Fresnel weights, even aspheres: :func:`variant`), so a command compiles only the passes it uses
+(numba compiles whatever a function calls, reached or not: the one kernel that took these as
+arguments compiled every pass, 9-12 s of CPU on first use). A variant traces a range of blocks on
+the calling thread without the GIL; :mod:`physcam.trace.kernels` runs large batches as one range
+per thread (numba's ``prange`` would add its parallel compiler, 2-3 s more at first use). It takes
+float64 or float32 rays and table: the working precision follows the arrays.
 """
 
 from __future__ import annotations
@@ -58,17 +61,8 @@ _OPTS = dict(fastmath=False, error_model="numpy", nogil=True, cache=_CACHE)
 _FMA_OPTS = dict(fastmath={"contract"}, error_model="numpy", nogil=True, cache=_CACHE)
 
 
-def _like(value, arr):  # pragma: no cover - replaced by the overload inside jitted code
-    """``value`` in the element type of ``arr`` (float64 or float32), so float32 kernels stay float32."""
-    raise NotImplementedError
-
-
-@overload(_like, inline="always")
-def _like_impl(value, arr):
-    dt = arr.dtype if isinstance(arr, types.Array) else arr
-    if dt == types.float32:
-        return lambda value, arr: np.float32(value)
-    return lambda value, arr: np.float64(value)
+# Constants take the scratch array's element type, ``F = buf.dtype.type`` (float64 or float32), so
+# float32 kernels stay float32 (a typed constructor: cheaper to compile than an inlined overload).
 
 
 def _newton_rel_tol(arr):  # pragma: no cover - replaced by the overload inside jitted code
@@ -95,8 +89,9 @@ NEWTON_TOL_F32 = 1e-6
 def _intersect_plane(buf, m, vz):
     """t to the plane z = vz into column T; a live ray parallel to it misses."""
     B = BLOCK
-    zero = _like(0.0, buf)
-    miss = _like(MISSED, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    zero = F(0.0)
+    miss = F(MISSED)
     for k in range(m):
         dz = buf[_DZ * B + k]
         cd = buf[_CD * B + k]
@@ -112,10 +107,11 @@ def _intersect_quadric(buf, m, vz, ax, ay, az):
     of the ray's dz, computed without cancellation as c / (-b + s sq) when b s < 0. A crossing on the
     far cap (az z >= 1, the back of a sphere) is no crossing of the surface: MISSED."""
     B = BLOCK
-    zero = _like(0.0, buf)
-    one = _like(1.0, buf)
-    two = _like(2.0, buf)
-    miss = _like(MISSED, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    zero = F(0.0)
+    one = F(1.0)
+    two = F(2.0)
+    miss = F(MISSED)
     for k in range(m):
         px = buf[_PX * B + k]
         py = buf[_PY * B + k]
@@ -146,11 +142,12 @@ def _newton_asphere(buf, m, S, s, vz):
     lanes in step (a lane stops moving once converged or broken); then dz/dr at the hit point into
     column DS, and lanes that did not converge flagged MISSED (as the numpy kernel)."""
     B = BLOCK
-    zero = _like(0.0, buf)
-    one = _like(1.0, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    zero = F(0.0)
+    one = F(1.0)
     rel = _newton_rel_tol(buf)
-    tol = _like(NEWTON_TOL, buf) if rel == zero else _like(NEWTON_TOL_F32, buf)
-    miss = _like(MISSED, buf)
+    tol = F(NEWTON_TOL) if rel == zero else F(NEWTON_TOL_F32)
+    miss = F(MISSED)
     cv = S[s, CV]
     ck1 = (one + S[s, CK]) * cv * cv
     a4 = S[s, A4]
@@ -161,13 +158,13 @@ def _newton_asphere(buf, m, S, s, vz):
     a14 = S[s, A4 + 5]
     a16 = S[s, A4 + 6]
     # (2 j + 4) A_(2j+4): the products of the numpy kernel's ((2.0 * j + 4.0) * coef[j])
-    c4 = _like(4.0, buf) * a4
-    c6 = _like(6.0, buf) * a6
-    c8 = _like(8.0, buf) * a8
-    c10 = _like(10.0, buf) * a10
-    c12 = _like(12.0, buf) * a12
-    c14 = _like(14.0, buf) * a14
-    c16 = _like(16.0, buf) * a16
+    c4 = F(4.0) * a4
+    c6 = F(6.0) * a6
+    c8 = F(8.0) * a8
+    c10 = F(10.0) * a10
+    c12 = F(12.0) * a12
+    c14 = F(14.0) * a14
+    c16 = F(16.0) * a16
     nact = np.int32(0)
     for k in range(m):
         live = buf[_CD * B + k] == zero
@@ -267,9 +264,10 @@ def _move_and_clip(buf, m, sd2, clip):
     """Live lanes to their hit point p + t d; clip outside the semi-diameter. The same comparison
     catches a hit point that is not finite (overflow, 0/0): NaN fails it (MISSED, not CLIPPED)."""
     B = BLOCK
-    zero = _like(0.0, buf)
-    miss = _like(MISSED, buf)
-    clipped = _like(CLIPPED, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    zero = F(0.0)
+    miss = F(MISSED)
+    clipped = F(CLIPPED)
     for k in range(m):
         cd = buf[_CD * B + k]
         live = cd == zero
@@ -294,8 +292,9 @@ def _move_and_clip(buf, m, sd2, clip):
 @nb.njit(**_OPTS)
 def _normal_flat(buf, m):
     B = BLOCK
-    zero = _like(0.0, buf)
-    one = _like(1.0, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    zero = F(0.0)
+    one = F(1.0)
     for k in range(m):
         buf[_GX * B + k] = zero
         buf[_GY * B + k] = zero
@@ -306,7 +305,8 @@ def _normal_flat(buf, m):
 def _normal_quadric(buf, m, vz, ax, ay, az):
     """Gradient (ax x, ay y, az z - 1) of the quadric: already a unit vector on spheres and cylinders."""
     B = BLOCK
-    one = _like(1.0, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    one = F(1.0)
     for k in range(m):
         buf[_GX * B + k] = ax * buf[_PX * B + k]
         buf[_GY * B + k] = ay * buf[_PY * B + k]
@@ -317,7 +317,8 @@ def _normal_quadric(buf, m, vz, ax, ay, az):
 def _normal_asphere(buf, m):
     """(dz/dr x, dz/dr y, -1) with dz/dr (per unit r) from the Newton pass."""
     B = BLOCK
-    one = _like(1.0, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    one = F(1.0)
     for k in range(m):
         ds = buf[_DS * B + k]
         buf[_GX * B + k] = ds * buf[_PX * B + k]
@@ -328,7 +329,8 @@ def _normal_asphere(buf, m):
 @nb.njit(**_OPTS)
 def _normalise(buf, m):
     B = BLOCK
-    one = _like(1.0, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    one = F(1.0)
     for k in range(m):
         gx = buf[_GX * B + k]
         gy = buf[_GY * B + k]
@@ -357,10 +359,11 @@ def _fill_index(buf, col, S, s, c, flag, m):
     :func:`physcam.optics.glass.evaluate` and ``_layout.index_rows``, so a mixed-wavelength batch
     gets bit for bit the indices of the one-wavelength path."""
     B = BLOCK
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
     a0 = S[s, c]
     a1 = S[s, c + 1]
     a2 = S[s, c + 2]
-    one = _like(1.0, buf)
+    one = F(1.0)
     if S[s, flag] != 0.0:
         b1 = S[s, c + 3]
         b2 = S[s, c + 4]
@@ -407,10 +410,11 @@ def _refract(buf, m):
     side the ray travels to; TIR where 1 - eta^2 (1 - cos^2 i) < 0 (a NaN there, from a degenerate
     normal, is MISSED). Leaves cos i, cos t and whether the lane refracted for :func:`_fresnel_pass`."""
     B = BLOCK
-    zero = _like(0.0, buf)
-    one = _like(1.0, buf)
-    miss = _like(MISSED, buf)
-    tir_code = _like(TIR, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    zero = F(0.0)
+    one = F(1.0)
+    miss = F(MISSED)
+    tir_code = F(TIR)
     for k in range(m):
         cd = buf[_CD * B + k]
         live = cd == zero
@@ -449,9 +453,10 @@ def _fresnel_pass(buf, m, rsc):
     (numpy kernel): with A, B the s and p throughputs, w = (A + B) / 2 and wd = (A - B) / 2; R
     clipped to 1. Contracted to FMA: no decision depends on these numbers (docs/ray-tracing.md)."""
     B = BLOCK
-    zero = _like(0.0, buf)
-    one = _like(1.0, buf)
-    half = _like(0.5, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    zero = F(0.0)
+    one = F(1.0)
+    half = F(0.5)
     for k in range(m):
         eta = buf[_ETA * B + k]
         ci = buf[_CI * B + k]
@@ -479,8 +484,9 @@ def _fresnel_pass(buf, m, rsc):
 def _to_plane(buf, m, end_z):
     """Live lanes on to the plane z = end_z; a ray parallel to it, or landing at inf/NaN, misses."""
     B = BLOCK
-    zero = _like(0.0, buf)
-    miss = _like(MISSED, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    zero = F(0.0)
+    miss = F(MISSED)
     for k in range(m):
         cd = buf[_CD * B + k]
         live = cd == zero
@@ -505,7 +511,8 @@ def _add_path_const(buf, m, n1, opl, i0):
     """Add n (p' - p) . d = n t |d|^2 of this leg (one index ``n1``) to ``opl`` for the lanes still
     live after the surface's hit and clip (the numpy kernel's order of operations)."""
     B = BLOCK
-    zero = _like(0.0, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    zero = F(0.0)
     for k in range(m):
         dx = buf[_DX * B + k]
         dy = buf[_DY * B + k]
@@ -519,7 +526,8 @@ def _add_path_const(buf, m, n1, opl, i0):
 def _add_path(buf, m, opl, i0):
     """:func:`_add_path_const` with each lane's index before the surface (column N1)."""
     B = BLOCK
-    zero = _like(0.0, buf)
+    F = buf.dtype.type  # constants in the working precision (float64 or float32)
+    zero = F(0.0)
     for k in range(m):
         dx = buf[_DX * B + k]
         dy = buf[_DY * B + k]
@@ -529,120 +537,146 @@ def _add_path(buf, m, opl, i0):
         opl[i0 + k] += np.float64(leg) if live else 0.0
 
 
-# ---- one block, all surfaces -------------------------------------------------------------------
+# ---- the kernel: blocks of rays through every surface, one variant per feature set -------------
 
-@nb.njit(**_OPTS)
-def _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl, i0, m, buf):
-    """Trace rays i0 .. i0 + m (m <= BLOCK) through every row of ``S`` using the scratch ``buf``
-    (and add each leg's optical path to ``opl`` unless it is empty)."""
-    B = BLOCK
-    zero = _like(0.0, buf)
-    one = _like(1.0, buf)
-    thousand = _like(1000.0, buf)
-    miss = _like(MISSED, buf)
-    ez = _like(end_z, buf)
-    with_opl = opl.shape[0] > 0
-    for k in range(m):
-        buf[_PX * B + k] = x[i0 + k]
-        buf[_PY * B + k] = y[i0 + k]
-        buf[_PZ * B + k] = z[i0 + k]
-        buf[_DX * B + k] = L[i0 + k]
-        buf[_DY * B + k] = M[i0 + k]
-        buf[_DZ * B + k] = N[i0 + k]
-        buf[_W * B + k] = w[i0 + k]
-        buf[_WD * B + k] = wd[i0 + k]
-        buf[_CD * B + k] = flag[i0 + k]
-    # a live ray must start with finite weights (and, mixed wavelengths, a usable wavelength: > 0
-    # with a finite 1/l^2); a NaN/inf position or direction makes the first hit point or
-    # incidence cosine NaN/inf, which the passes flag
-    for k in range(m):
-        v = buf[_W * B + k] + buf[_WD * B + k]
-        cd = buf[_CD * B + k]
-        good = v - v == zero
-        if not mono:
-            lam = wl[i0 + k] / thousand
-            l2 = lam * lam
-            u = one / l2
-            buf[_L2 * B + k] = l2
-            buf[_U * B + k] = u
-            good = good & (wl[i0 + k] > zero) & (u - u == zero)
-        buf[_CD * B + k] = miss if ((cd == zero) & (not good)) else cd
-    for s in range(S.shape[0]):
-        kd = kinds[s]
-        vz = S[s, VZ]
-        ax = S[s, AX]
-        ay = S[s, AY]
-        az = S[s, AZ]
-        if kd <= _STOP:
-            _intersect_plane(buf, m, vz)
-        else:
-            _intersect_quadric(buf, m, vz, ax, ay, az)
-            if kd == _ASPHERE:
-                _newton_asphere(buf, m, S, s, vz)
-        _move_and_clip(buf, m, S[s, SEMI] * S[s, SEMI], clip)
-        if with_opl:
-            if mono:
-                _add_path_const(buf, m, S[s, N1], opl, i0)
-            else:
-                _fill_n1(buf, S, s, m)
-                _add_path(buf, m, opl, i0)
-        # the stop, and in one-wavelength batches a surface between equal media, bend nothing
-        if kd == _STOP or (mono and S[s, N1] == S[s, N2]):
-            continue
-        if mono:
-            _fill_const(buf, m, S[s, N1], S[s, N2], S[s, ETA])
-        else:
-            if not with_opl:
-                _fill_n1(buf, S, s, m)
-            _fill_n2(buf, S, s, m)
-            _fill_eta(buf, m)
-        if kd == _FLAT:
-            _normal_flat(buf, m)
-        elif kd == _QUADRIC:
-            _normal_quadric(buf, m, vz, ax, ay, az)
-        else:
-            _normal_asphere(buf, m)
-        if S[s, UNIT] == zero:
-            _normalise(buf, m)
-        _refract(buf, m)
-        if fresnel:
-            _fresnel_pass(buf, m, S[s, RSC])
-    if has_end:
-        _to_plane(buf, m, ez)
-    for k in range(m):
-        cd = buf[_CD * B + k]
-        lost = (cd != zero) & (flag[i0 + k] == 0)
-        x[i0 + k] = buf[_PX * B + k]
-        y[i0 + k] = buf[_PY * B + k]
-        z[i0 + k] = buf[_PZ * B + k]
-        L[i0 + k] = buf[_DX * B + k]
-        M[i0 + k] = buf[_DY * B + k]
-        N[i0 + k] = buf[_DZ * B + k]
-        w[i0 + k] = zero if lost else buf[_W * B + k]
-        wd[i0 + k] = zero if lost else buf[_WD * B + k]
-        flag[i0 + k] = np.uint8(cd)
+#: The passes a variant calls beyond the common ones, by feature (what :func:`variant_passes` lists).
+_COMMON = ("_intersect_plane", "_intersect_quadric", "_move_and_clip", "_normal_flat", "_normal_quadric",
+           "_normalise", "_refract", "_to_plane")
 
 
-@nb.njit(parallel=True, **_OPTS)
-def trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, serial_below, opl):
-    """Trace rays in place through the rows of ``S`` (tracing order), then to the plane ``end_z``;
-    with a non-empty float64 ``opl`` (one per ray), add each leg's optical path to it in place
-    (the numpy kernel's ``opl``).
+def variant_passes(mono: bool, opl: bool, fresnel: bool, asphere: bool) -> tuple[str, ...]:
+    """The pass functions the variant ``(mono, opl, fresnel, asphere)`` compiles (module notes)."""
+    out = list(_COMMON)
+    out += ["_fill_const"] if mono else ["_fill_n1", "_fill_n2", "_fill_eta"]
+    if opl:
+        out += ["_add_path_const"] if mono else ["_add_path"]
+    if fresnel:
+        out.append("_fresnel_pass")
+    if asphere:
+        out += ["_newton_asphere", "_normal_asphere"]
+    return tuple(out)
 
-    Blocks of :data:`BLOCK` rays run in parallel on numba's thread pool, or, for fewer than
-    ``serial_below`` rays, one after the other on the calling thread (one compiled function for
-    both, so a cold start loads one kernel from the cache)."""
-    n = x.shape[0]
-    nblocks = (n + BLOCK - 1) // BLOCK
-    if n < serial_below:
+
+def _build(MONO, OPL, FRESNEL, ASPHERE):
+    """The kernel for one feature set: one wavelength (``MONO``: indices from the table's columns) or
+    each ray's own, each leg's optical path added (``OPL``), Fresnel weights (``FRESNEL``), even
+    aspheres in the table (``ASPHERE``). The flags are the closure's constants, so numba prunes the
+    branches they close before typing: a variant compiles only the passes it calls
+    (:func:`variant_passes`), and numba's cache keys each variant by them. The same passes in the
+    same order as the one kernel that took them as arguments: the same rays, bit for bit."""
+
+    @nb.njit(**_OPTS)
+    def trace_blocks(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, end_z, has_end, opl, b0, b1):
+        """Trace blocks ``b0`` .. ``b1`` of :data:`BLOCK` rays in place through every row of ``S`` (and
+        add each leg's optical path to ``opl`` with ``OPL``), one block at a time in a scratch array."""
+        B = BLOCK
+        n = x.shape[0]
         buf = np.empty(_NCOL * BLOCK, dtype=x.dtype)
-        for blk in range(nblocks):
-            i0 = blk * BLOCK
-            _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl,
-                         i0, min(BLOCK, n - i0), buf)
-        return
-    for blk in nb.prange(nblocks):
-        i0 = blk * BLOCK
-        buf = np.empty(_NCOL * BLOCK, dtype=x.dtype)
-        _trace_block(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl, i0,
-                     min(BLOCK, n - i0), buf)
+        F = buf.dtype.type  # constants in the working precision (float64 or float32)
+        zero = F(0.0)
+        one = F(1.0)
+        thousand = F(1000.0)
+        miss = F(MISSED)
+        ez = F(end_z)
+        for blk in range(b0, b1):
+            i0 = blk * B
+            m = min(B, n - i0)
+            for k in range(m):
+                buf[_PX * B + k] = x[i0 + k]
+                buf[_PY * B + k] = y[i0 + k]
+                buf[_PZ * B + k] = z[i0 + k]
+                buf[_DX * B + k] = L[i0 + k]
+                buf[_DY * B + k] = M[i0 + k]
+                buf[_DZ * B + k] = N[i0 + k]
+                buf[_W * B + k] = w[i0 + k]
+                buf[_WD * B + k] = wd[i0 + k]
+                buf[_CD * B + k] = flag[i0 + k]
+            # a live ray must start with finite weights (and, mixed wavelengths, a usable wavelength:
+            # > 0 with a finite 1/l^2); a NaN/inf position or direction makes the first hit point or
+            # incidence cosine NaN/inf, which the passes flag
+            for k in range(m):
+                v = buf[_W * B + k] + buf[_WD * B + k]
+                cd = buf[_CD * B + k]
+                good = v - v == zero
+                if not MONO:
+                    lam = wl[i0 + k] / thousand
+                    l2 = lam * lam
+                    u = one / l2
+                    buf[_L2 * B + k] = l2
+                    buf[_U * B + k] = u
+                    good = good & (wl[i0 + k] > zero) & (u - u == zero)
+                buf[_CD * B + k] = miss if ((cd == zero) & (not good)) else cd
+            for s in range(S.shape[0]):
+                kd = kinds[s]
+                vz = S[s, VZ]
+                ax = S[s, AX]
+                ay = S[s, AY]
+                az = S[s, AZ]
+                if kd <= _STOP:
+                    _intersect_plane(buf, m, vz)
+                else:
+                    _intersect_quadric(buf, m, vz, ax, ay, az)
+                    if ASPHERE:
+                        if kd == _ASPHERE:
+                            _newton_asphere(buf, m, S, s, vz)
+                _move_and_clip(buf, m, S[s, SEMI] * S[s, SEMI], clip)
+                if OPL:
+                    if MONO:
+                        _add_path_const(buf, m, S[s, N1], opl, i0)
+                    else:
+                        _fill_n1(buf, S, s, m)
+                        _add_path(buf, m, opl, i0)
+                # the stop, and in one-wavelength batches a surface between equal media, bend nothing
+                if kd == _STOP:
+                    continue
+                if MONO:
+                    if S[s, N1] == S[s, N2]:
+                        continue
+                    _fill_const(buf, m, S[s, N1], S[s, N2], S[s, ETA])
+                else:
+                    if not OPL:
+                        _fill_n1(buf, S, s, m)
+                    _fill_n2(buf, S, s, m)
+                    _fill_eta(buf, m)
+                if kd == _FLAT:
+                    _normal_flat(buf, m)
+                elif kd == _QUADRIC:
+                    _normal_quadric(buf, m, vz, ax, ay, az)
+                else:
+                    if ASPHERE:
+                        _normal_asphere(buf, m)
+                if S[s, UNIT] == zero:
+                    _normalise(buf, m)
+                _refract(buf, m)
+                if FRESNEL:
+                    _fresnel_pass(buf, m, S[s, RSC])
+            if has_end:
+                _to_plane(buf, m, ez)
+            for k in range(m):
+                cd = buf[_CD * B + k]
+                lost = (cd != zero) & (flag[i0 + k] == 0)
+                x[i0 + k] = buf[_PX * B + k]
+                y[i0 + k] = buf[_PY * B + k]
+                z[i0 + k] = buf[_PZ * B + k]
+                L[i0 + k] = buf[_DX * B + k]
+                M[i0 + k] = buf[_DY * B + k]
+                N[i0 + k] = buf[_DZ * B + k]
+                w[i0 + k] = zero if lost else buf[_W * B + k]
+                wd[i0 + k] = zero if lost else buf[_WD * B + k]
+                flag[i0 + k] = np.uint8(cd)
+
+    return trace_blocks
+
+
+_VARIANTS: dict = {}
+
+
+def variant(mono: bool, opl: bool, fresnel: bool, asphere: bool):
+    """The numba dispatcher of one feature set (built once per process; compiled, or loaded from the
+    disk cache, at its first call): ``(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, end_z,
+    has_end, opl, b0, b1)``, blocks ``b0`` to ``b1`` (an empty float64 ``opl`` without ``opl``)."""
+    key = (bool(mono), bool(opl), bool(fresnel), bool(asphere))
+    f = _VARIANTS.get(key)
+    if f is None:
+        f = _VARIANTS[key] = _build(*key)
+    return f

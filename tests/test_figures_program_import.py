@@ -1,0 +1,31 @@
+"""The ``physcam`` program imports matplotlib without what it never uses (figures.PROGRAM_IMPORT,
+issue 47: the property tables of artist docstrings and the 3-D toolkit, 0.15 s of CPU): the
+pictures are the same, byte for byte, and a library caller's matplotlib stays whole."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+
+def _draw(tmp_path, program: bool):
+    out = tmp_path / ("program.png" if program else "library.png")
+    code = ("import sys, io, contextlib\n"
+            "from physcam import figures\n"
+            f"figures.PROGRAM_IMPORT = {program}\n"
+            "from physcam.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            f"    assert main(['spot', '--lens', 'dgauss_50mm', '--rings', '4', '-o', {str(out)!r}]) == 0\n"
+            "import matplotlib.lines\n"
+            "print('mpl_toolkits.mplot3d' in sys.modules, 'Properties:' in (matplotlib.lines.Line2D.set.__doc__ or ''))\n")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    return out.read_bytes(), p.stdout.split()
+
+
+def test_the_program_draws_the_same_pictures_and_the_library_keeps_matplotlib_whole(tmp_path):
+    lean, seen_lean = _draw(tmp_path, True)
+    whole, seen_whole = _draw(tmp_path, False)
+    assert lean[:8] == b"\x89PNG\r\n\x1a\n" and lean == whole
+    assert seen_lean == ["False", "False"]  # no 3-D toolkit, no property table in set()'s docstring
+    assert seen_whole == ["True", "True"]
