@@ -15,7 +15,7 @@ import warnings
 import numpy as np
 import pytest
 
-from physcam.analysis import defocus_trace as dt
+from physcam.analysis.defocus import trace as dt
 from physcam.analysis.defocus.render import defocus, inverse_depth
 from physcam.analysis.defocus.cache import STACK_GLOB
 from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
