@@ -47,3 +47,27 @@ def test_every_word_fits_its_cell_and_the_chart_has_only_the_tables_stops():
     drawn = [t.get_text() for t in chart.get_legend().get_texts() if t.get_text().startswith("f/")]
     assert drawn and set(drawn) <= set(heads)
     assert drawn[0] == heads[0] and drawn[-1] == heads[-1]
+
+
+@pytest.mark.parametrize("page", ["a4", "letter"])
+def test_an_anamorphic_card_says_the_horizontal_limits_and_they_fit(page):
+    """Issue 49 item 4: with a desqueeze every cell adds the limits across the frame (CoC c / 0.5 for a 2x
+    thin lens: 2.588 m and 3.572 m at f/2.8 and 3 m, worked by hand in tests/cli/test_dof_table_anamorphic.py),
+    and every word still fits its cell on the page."""
+    from test_dof_table_anamorphic import _limits
+
+    args = _args("--focal", "50", "--sensor", "ALEXA 35 3.3K 6:5", "--squeeze", "format", "--coc", "0.025")
+    d = build(args)
+    fig = card_figure(d, chart=_card_chart(args), page=page)
+    fig.canvas.draw()
+    r = fig.canvas.get_renderer()
+    table = next(a for a in fig.axes if a.tables).tables[0]
+    for (row, col), cell in table.get_celld().items():
+        box, text = cell.get_window_extent(r), cell.get_text().get_window_extent(r)
+        assert text.width <= box.width and text.height <= box.height, cell.get_text().get_text()
+    cells = {(row, col): c.get_text().get_text() for (row, col), c in table.get_celld().items()}
+    col = next(c for (row, c), t in cells.items() if row == 0 and t == "f/2.8")
+    row = next(rw for (rw, c), t in cells.items() if c == 0 and t == "3.000 m")
+    near_h, far_h = _limits(0.025 / 0.5)
+    assert cells[(row, col)].splitlines()[3:] == [f"↔ {near_h / 1000:.3f} m", f"↔ {far_h / 1000:.3f} m"]
+    assert any("across it (anamorphic, squeeze 2" in t.get_text() for t in fig.texts)

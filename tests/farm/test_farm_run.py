@@ -116,9 +116,10 @@ def test_openjd_defocus_gives_the_direct_bytes_tracing_the_kernels_once(shot):
 
 
 def test_a_task_killed_while_tracing_kernels_then_rerun_gives_the_same_bytes(shot):
-    """The kernels task (the plain task list's first line) is SIGKILLed once it has written its first kernel,
-    before its frame: the job then run through openjd run finishes from the kernels there and gives the
-    direct bytes; no temporary file is left in the outputs or the kernel cache."""
+    """The kernels task (the plain task list's first line) is SIGKILLed once its kernel stack file appears
+    (the cache writes one stack per run), before its frame: the job then run through openjd run finishes
+    from the kernels there and gives the direct bytes; no temporary file is left in the outputs or the
+    kernel cache."""
     folder, want = shot
     _defocus_job(folder, "killed", to="tasks", job="job.txt")
     _defocus_job(folder, "killed", job="killed.json")
@@ -129,7 +130,7 @@ def test_a_task_killed_while_tracing_kernels_then_rerun_gives_the_same_bytes(sho
     _openjd(folder, "killed.json", "frames")
     assert _files(folder / "killed", skip=("kernels",)) == {k.replace("direct", "killed"): v for k, v in want.items()}
     names = [p.name for p in (folder / "killed").rglob("*") if p.is_file()]
-    assert all(re.fullmatch(r"d\.000\d\.exr|k_[-0-9.]+_[-0-9.]+_\d+\.npz", n) for n in names), names
+    assert all(re.fullmatch(r"d\.000\d\.exr|stack-\d+-[0-9a-f]+\.npz", n) for n in names), names
 
 
 # ---- characterize ----------------------------------------------------------------------------------

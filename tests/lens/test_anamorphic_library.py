@@ -11,49 +11,18 @@ from __future__ import annotations
 
 import json
 import math
-import tomllib
 from pathlib import Path
 
 import pytest
 
-from physcam.lens.library import library_dir, load_lens
+from physcam.lens.library import load_lens
 from physcam.lens.provenance import provenance_of
 from physcam.optics import focusing, paraxial
 
+from _anamorphic_yu import _framing_focal_length, _surfaces, _yu, hand_pupils_from_film
+
 ANAMORPHICS = ("navarro_anamorphic_2x", "neil_front_anamorphic_2x", "panavision_rear_anamorphic_1_3x")
 ORACLE = json.loads((Path(__file__).parents[1] / "data" / "optiland_anamorphic.json").read_text())["lenses"]
-
-
-def _surfaces(slug, thicknesses=None):
-    doc = tomllib.loads((library_dir() / f"{slug}.toml").read_text(encoding="utf-8"))
-    out = []
-    for i, s in enumerate(doc["surface"]):
-        n = 1.0 if s["medium"] == "air" else float(s["medium"]["nd"])
-        t = float(s["thickness"]) if thicknesses is None else thicknesses[i]
-        out.append((s["kind"], float(s["radius"]), t, n))
-    return out
-
-
-def _yu(surfaces, meridian):
-    """(EFL, entrance pupil z from the first vertex, back focal distance) by a y-u trace, by hand."""
-    def trace(y, u, upto=None):
-        n0 = 1.0
-        for i, (kind, r, t, n) in enumerate(surfaces):
-            flat = kind in ("flat", "stop") or r == 0 or kind == f"cylindrical_{'y' if meridian == 'x' else 'x'}"
-            c = 0.0 if flat else 1.0 / r
-            if i == upto:
-                return y
-            u = (n0 * u - y * c * (n - n0)) / n
-            if i < len(surfaces) - 1:
-                y += t * u
-            n0 = n
-        return y, u
-
-    y, u = trace(1.0, 0.0)
-    stop = next(i for i, s in enumerate(surfaces) if s[0] == "stop")
-    # the chief ray crosses the axis at the stop: a ray y0 A + u0 B (A = (1, 0), B = (0, 1) at the first
-    # vertex) passes there when y0 yA + u0 yB = 0; it crosses the axis in object space at z = -y0 / u0
-    return -1.0 / u, trace(0.0, 1.0, stop) / trace(1.0, 0.0, stop), -y / u
 
 
 @pytest.mark.parametrize("slug", ANAMORPHICS)
@@ -72,12 +41,10 @@ def test_efl_f_number_and_pupil_per_meridian_match_a_hand_trace_and_optiland(slu
 @pytest.mark.parametrize("mark", [math.inf, 3000.0, 1500.0])
 def test_both_pupils_from_the_film_at_a_focus_match_a_hand_trace_of_the_focused_lens(slug, mark):
     """The focus solver moves the gaps; the hand trace takes those gaps and finds both pupils itself."""
-    st = focusing.focus(load_lens(slug), mark)
-    surfaces = _surfaces(slug, [s.thickness for s in st.prescription.surfaces])
-    z_film = sum(s[2] for s in surfaces)  # the last gap is the back focus to the film
     eps = focusing.entrance_pupils(load_lens(slug), mark)
-    assert eps.horizontal_from_film_mm == pytest.approx(z_film - _yu(surfaces, "x")[1], abs=0.01)
-    assert eps.vertical_from_film_mm == pytest.approx(z_film - _yu(surfaces, "y")[1], abs=0.01)
+    x, y = hand_pupils_from_film(slug, mark)
+    assert eps.horizontal_from_film_mm == pytest.approx(x, abs=0.01)
+    assert eps.vertical_from_film_mm == pytest.approx(y, abs=0.01)
 
 
 def test_front_and_rear_anamorphics_by_where_their_cylinders_sit():
@@ -108,19 +75,6 @@ def test_the_rear_anamorphic_against_its_transcription():
     prov = provenance_of(p)
     assert not prov.primary_source_checked and "crayg" in prov.transcribed_from
     assert efl_y / p.metadata.focal_length == pytest.approx(0.951, abs=1e-3)
-
-
-def _framing_focal_length(surfaces, meridian):
-    """|y_film / u| of the chief ray (through the stop centre) at unit object-space slope, by hand: the
-    focal length a pinhole at the entrance pupil needs to frame like the lens (Smith 3.5)."""
-    _, z_ep, _ = _yu(surfaces, meridian)
-    n0, y, u = 1.0, -z_ep, 1.0  # at the first vertex: height -z_ep, slope 1, crossing the axis at z_ep
-    for i, (kind, r, t, n) in enumerate(surfaces):
-        flat = kind in ("flat", "stop") or r == 0 or kind == f"cylindrical_{'y' if meridian == 'x' else 'x'}"
-        u = (n0 * u - y * (0.0 if flat else 1.0 / r) * (n - n0)) / n
-        y += t * u  # the last gap ends on the film
-        n0 = n
-    return abs(y)
 
 
 @pytest.mark.parametrize("slug", ANAMORPHICS)

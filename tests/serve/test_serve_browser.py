@@ -379,3 +379,34 @@ def test_dof_chart_fits_the_phone_and_marks_the_cursor(page, server, capsys, tmp
 
         page.screenshot(path=str(shot))
         atomic_write(DOCS_CHART_SCREENSHOT, shot.read_bytes(), force=True)
+
+
+def test_an_anamorphic_format_brings_its_desqueeze_and_both_limits(page, server):
+    """Issue 49 item 4: picking a format the camera table gives a 2x desqueeze sets the squeeze, and the
+    page says the horizontal limits (the oval blur takes c / 0.5 across the frame) and the desqueezed
+    field, worked by hand from the thin lens; a spherical format puts the squeeze back, a squeeze the
+    user chose stays."""
+    open_page(page, server)
+    page.fill("#focal", "50")
+    page.fill("#fstop", "2.8")
+    page.fill("#focus", "3m")
+    page.select_option("#coc", "cine")
+    page.select_option("#sensor", "arri-alexa-35-3-3k-6-5")  # 20.22 x 16.95 mm, desqueeze 2 in cameras.csv
+    assert page.input_value("#squeeze") == "2" and "camera table" in page.text_content("#squeeze-hint")
+    f, n, mark = 50.0, 2.8, 3000.0
+    s_img = image_distance_at_mark(f, mark)
+    s = mark - s_img
+    hyper = f * f / (n * 0.05) + f  # c = 0.025 mm / blur aspect 0.5
+    near_h, far_h = s * (hyper - f) / (hyper + s - 2 * f) + s_img, s * (hyper - f) / (hyper - s) + s_img
+    page.wait_for_selector("#out-horizontal:not([hidden])")
+    assert page.text_content("#out-horizontal") == f"{metric(near_h)} / {metric(far_h)}"  # 2.59 m / 3.57 m
+    h_deg = math.degrees(2 * math.atan(2 * 20.22 / (2 * s_img)))
+    v_deg = math.degrees(2 * math.atan(16.95 / (2 * s_img)))
+    assert page.text_content("#out-fov").startswith(f"{h_deg:.1f}° / {v_deg:.1f}° / ")  # 43.4° / 18.9°
+    page.select_option("#sensor", "alexa35-og")  # spherical: the squeeze the format set goes
+    assert page.input_value("#squeeze") == "1" and page.is_hidden("#squeeze-hint")
+    page.wait_for_selector("#out-horizontal", state="hidden")
+    page.select_option("#sensor", "arri-alexa-35-3-3k-6-5")
+    page.select_option("#squeeze", "1.5")  # the user's own
+    page.select_option("#sensor", "alexa35-og")
+    assert page.input_value("#squeeze") == "1.5"

@@ -2,7 +2,10 @@
 
 Every cell is the lens report of that f-stop and focus mark (the same solver, sensor, CoC and
 model as ``physcam report``), so the table and the report agree cell by cell. Distances are
-from the film plane; ``--units ft`` prints feet and inches (1/8 inch below 10 ft). ``-o
+from the film plane. An anamorphic (``--squeeze S``, ``--squeeze format`` for the desqueeze the camera
+table gives the format, or an anamorphic ``--lens``) gets the report's horizontal limits beside the
+vertical ones (a defocused point's blur is oval, so across the frame the CoC is c / blur aspect:
+docs/anamorphic.md) and every row says the horizontal and vertical field at its mark; ``--units ft`` prints feet and inches (1/8 inch below 10 ft). ``-o
 card.pdf`` draws a printable card (PDF, PNG or SVG), the chart an assistant tapes to the camera.
 """
 
@@ -19,6 +22,7 @@ examples:
   physcam dof-table --focal 50 --sensor "ALEXA 35" --units ft --focus 4ft,6ft,8ft,10ft,15ft,hyperfocal
   physcam dof-table --lens dgauss_50mm --fstops 2.8,4 --focus 1m,2m,inf --csv
   physcam dof-table --focal 35 --fstops 2,2.8,4,5.6 --focus 1m,2m,3m,5m,10m -o card.pdf
+  physcam dof-table --focal 50 --sensor "ALEXA 35 3.3K 6:5" --squeeze format --fstops 2.8,4 --focus 2m,3m
 """
 
 #: The f-stops and marks of a table when none are given (the full stops of a cine lens; common marks).
@@ -35,6 +39,28 @@ def _fstops(text):
     if len(parts) > 24:
         raise argparse.ArgumentTypeError(f"a table takes up to 24 f-stops, got {len(parts)}")
     return [one(t.removeprefix("f/").removeprefix("T")) for t in parts]
+
+
+def _squeeze(text):
+    """--squeeze: a number (0.1-10) or ``format`` (the sensor format's desqueeze, camera table)."""
+    if text.strip().lower() == "format":
+        return "format"
+    return number("squeeze", positive=True)(text)
+
+
+def squeeze_of(args, sensor) -> float:
+    """The desqueeze the table takes: --squeeze's number, or with ``format`` the one the camera table
+    gives the format (refused, with what it offers, when it gives none or several)."""
+    from ..errors import InputError
+
+    sq = getattr(args, "squeeze", 1.0)
+    if sq != "format":
+        return float(sq)
+    offered = tuple(getattr(sensor, "anamorphic", ()) or ())
+    if len(offered) != 1:
+        what = "no anamorphic desqueeze" if not offered else "desqueezes " + ", ".join(f"{v:g}" for v in offered)
+        raise InputError(f"--squeeze format: the camera table gives {sensor.name} {what}; give --squeeze S")
+    return float(offered[0])
 
 
 def register(sub) -> None:
@@ -59,6 +85,9 @@ def register(sub) -> None:
     g.add_argument("--focus", type=focus_list("focus marks"), default=None, metavar="LIST",
                    help=f"focus marks from the film plane, comma-separated (default {DEFAULT_FOCUS}; {FOCUS_HELP})")
     add_sensor_options(g, what="group")
+    g.add_argument("--squeeze", metavar="S", type=_squeeze, default=1.0,
+                   help="anamorphic desqueeze: a number, or `format` for the one the camera table gives the sensor "
+                        "format (default 1: spherical, or an anamorphic --lens's own); adds the horizontal limits")
     add_coc_option(g)
     add_units_option(p)
     add_output_options(p, csv=True, what="the table")
@@ -75,7 +104,7 @@ def cell_report(args, lens, sensor, fstop, focus):
     from ._common import coc_of
 
     return solve_report(report_camera(focal_length_mm=None if lens is not None else args.focal, lens=lens, sensor=sensor,
-                         fstop=fstop, focus_mm=focus, coc=coc_of(args)))
+                                      fstop=fstop, focus_mm=focus, coc=coc_of(args), squeeze=squeeze_of(args, sensor)))
 
 
 def build(args) -> dict:
@@ -107,7 +136,7 @@ def build(args) -> dict:
                 r = cell_report(args, lens, sensor, n, m)
                 first = first or r
                 d = r.dof
-                rows.append({
+                row = {
                     "fstop": r.fstop,
                     "focus": m if isinstance(m, str) else ("infinity" if math.isinf(m) else None),
                     "focus_from_film_mm": None if math.isinf(r.focus_from_film_mm) else r.focus_from_film_mm,
@@ -117,16 +146,28 @@ def build(args) -> dict:
                     "far_is_infinite": d.far_is_infinite,
                     "hyperfocal_from_film_mm": d.hyperfocal_from_film_mm,
                     "focal_length_mm": r.focal_length_mm,
-                })
+                    "hfov_deg": r.hfov_focus_deg, "vfov_deg": r.vfov_focus_deg,
+                }
+                if r.dof_horizontal is not None:  # an anamorphic: the limits across the frame (oval blur)
+                    dh = r.dof_horizontal
+                    row.update({
+                        "near_horizontal_from_film_mm": dh.near_from_film_mm,
+                        "far_horizontal_from_film_mm": None if dh.far_is_infinite else dh.far_from_film_mm,
+                        "total_horizontal_mm": None if dh.far_is_infinite else dh.total_mm,
+                        "far_horizontal_is_infinite": dh.far_is_infinite,
+                        "hyperfocal_horizontal_from_film_mm": dh.hyperfocal_from_film_mm})
+                rows.append(row)
             hyper.append({"fstop": n, "hyperfocal_from_film_mm": rows[-1]["hyperfocal_from_film_mm"]})
     return {
         "lens": None if lens is None else lens.name, "model": first.model, "focal_length_mm": first.focal_length_mm,
         "sensor": {"name": sensor.name, "width_mm": sensor.width_mm, "height_mm": sensor.height_mm},
-        "coc_mm": first.coc_mm, "coc_convention": first.coc_convention, "fstops": list(args.fstops),
+        "coc_mm": first.coc_mm, "coc_convention": first.coc_convention, "squeeze": first.squeeze,
+        "dof_aspect": first.dof_aspect, "fstops": list(args.fstops),
         "focus": [m if isinstance(m, str) else ("infinity" if math.isinf(m) else m) for m in marks],
         "rows": rows, "hyperfocal": hyper,
         "definition": "distances from the film plane; each row is `physcam report` at that f-stop and focus mark "
-                      "(null far and total: infinite)",
+                      "(null far and total: infinite); hfov_deg and vfov_deg: the desqueezed picture's field at the "
+                      "mark; *_horizontal_*: an anamorphic's limits across the frame, where the CoC is c / dof_aspect",
     }
 
 
@@ -139,14 +180,18 @@ def _label(m, units) -> str:
 def _title(d, units) -> str:
     lens = d["lens"] or f"{d['focal_length_mm']:g} mm"
     s = d["sensor"]
+    anamorphic = "; vertical limits (up the frame)" if "near_horizontal_from_film_mm" in d["rows"][0] else ""
     return (f"depth of field: {lens}, {s['name']} ({s['width_mm']:g} x {s['height_mm']:g} mm), CoC "
-            f"{d['coc_mm']:.4g} mm ({d['coc_convention']}); from the film plane, in {'feet' if units == 'ft' else 'metres'}")
+            f"{d['coc_mm']:.4g} mm ({d['coc_convention']}); from the film plane, in {'feet' if units == 'ft' else 'metres'}"
+            f"{anamorphic}")
 
 
-def grid(d, units):
-    """(row labels, f-stop headers, cells[row][col] = (near, far, total) text) of the table."""
+def grid(d, units, horizontal: bool = False):
+    """(row labels, f-stop headers, cells[row][col] = (near, far, total) text) of the table; ``horizontal``:
+    an anamorphic's limits across the frame."""
     from ..units import format_distance
 
+    x = "_horizontal" if horizontal else ""
     fs = d["fstops"]
     nm = len(d["focus"])
     cells = []
@@ -154,9 +199,9 @@ def grid(d, units):
         row = []
         for j in range(len(fs)):
             r = d["rows"][j * nm + i]
-            far = math.inf if r["far_from_film_mm"] is None else r["far_from_film_mm"]
-            total = math.inf if r["total_mm"] is None else r["total_mm"]
-            row.append((format_distance(r["near_from_film_mm"], units), format_distance(far, units),
+            far = math.inf if r[f"far{x}_from_film_mm"] is None else r[f"far{x}_from_film_mm"]
+            total = math.inf if r[f"total{x}_mm"] is None else r[f"total{x}_mm"]
+            row.append((format_distance(r[f"near{x}_from_film_mm"], units), format_distance(far, units),
                         format_distance(total, units)))
         cells.append(row)
     labels = []
@@ -215,6 +260,8 @@ def run(args) -> int:
 
     t.add_row("hyperfocal distance", *(format_distance(h["hyperfocal_from_film_mm"], units) for h in d["hyperfocal"]))
     print_table(t)
+    if "near_horizontal_from_film_mm" in d["rows"][0]:
+        _print_horizontal(d, units, heads, labels)
     t = Table("total depth of field", ["focus", *heads], justify=["left"] + ["right"] * len(heads))
     for lab, row in zip(labels, cells):
         t.add_row(lab, *(total for _, _, total in row))
@@ -222,6 +269,29 @@ def run(args) -> int:
     if args.output:
         print(f"wrote {args.output}")
     return 0
+
+
+def _print_horizontal(d, units, heads, labels) -> None:
+    """An anamorphic's horizontal limits (CoC c / blur aspect across the frame) and the field at each mark."""
+    from ..units import format_distance
+    from ._output import Table, print_table
+
+    _, _, cells = grid(d, units, horizontal=True)
+    aspect = d["dof_aspect"]
+    t = Table(f"horizontal (across the frame): squeeze {d['squeeze']:.4g}, a blur {aspect:.3g} as wide as tall, CoC "
+              f"{d['coc_mm'] / aspect:.4g} mm", ["focus", *(f"{h} near - far" for h in heads)],
+              justify=["left"] + ["right"] * len(heads))
+    for lab, row in zip(labels, cells):
+        t.add_row(lab, *(f"{near} - {far}" for near, far, _ in row))
+    nm = len(labels)
+    hyper = [d["rows"][j * nm + nm - 1]["hyperfocal_horizontal_from_film_mm"] for j in range(len(heads))]
+    t.add_row("hyperfocal distance", *(format_distance(h, units) for h in hyper))
+    print_table(t)
+    t = Table("field of view at the mark (desqueezed picture, degrees)", ["focus", "horizontal", "vertical"],
+              justify=["left", "right", "right"])
+    for lab, r in zip(labels, d["rows"][:nm]):
+        t.add_row(lab, f"{r['hfov_deg']:.2f}", f"{r['vfov_deg']:.2f}")
+    print_table(t)
 
 
 def _card_chart(args):
@@ -269,10 +339,12 @@ def card_figure(d, *, units: str = "m", chart=None, page: str = "a4"):
     from ..units import format_distance
 
     labels, heads, cells = grid(d, units)
+    across = grid(d, units, horizontal=True)[2] if "near_horizontal_from_film_mm" in d["rows"][0] else None
     nrow, ncol = len(labels) + 2, len(heads) + 1
     page_w, h = PAGES[page]
-    chart_in = 4.2 if chart is not None else 0.0
-    table_in = min(h - chart_in - 0.5, max(3.0, 0.5 * nrow + 0.9))  # taller for long tables, within the page
+    chart_in = 0.0 if chart is None else (4.2 if across is None else 3.4)  # an anamorphic's table takes more
+    per_row = 0.5 if across is None else 0.8  # an anamorphic's cells take two lines more: the horizontal limits
+    table_in = min(h - chart_in - 0.5, max(3.0, per_row * nrow + 0.9))  # taller for long tables, within the page
     fig = new_figure(figsize=(page_w, h))
     top = h - 0.15  # the table and its title from the top of the page, the chart below it
     ax = fig.add_axes((0.03, (top - 0.92 * table_in) / h, 0.94, (0.86 * table_in - 0.25) / h))  # 2 title lines
@@ -283,8 +355,10 @@ def card_figure(d, *, units: str = "m", chart=None, page: str = "a4"):
         draw_dof_chart(fig.add_axes((0.09, bottom / h, 0.88, (chart_in - 1.1) / h)), *chart, units=units)
     ax.set_axis_off()
     text = [["focus", *heads]]
-    for lab, row in zip(labels, cells):
-        text.append([lab, *(f"{near}\n{far}\n({total})" for near, far, total in row)])
+    for i, (lab, row) in enumerate(zip(labels, cells)):
+        text.append([lab, *(f"{near}\n{far}\n({total})" + ("" if across is None else
+                                                           f"\n↔ {across[i][j][0]}\n↔ {across[i][j][1]}")
+                            for j, (near, far, total) in enumerate(row))])
     text.append(["hyperfocal", *(format_distance(hf["hyperfocal_from_film_mm"], units) for hf in d["hyperfocal"])])
     first = 1.3 / (ncol + 0.3)  # the label column a little wider than the others
     tab = ax.table(cellText=text, cellLoc="center", bbox=(0.0, 0.0, 1.0, 1.0),
@@ -299,6 +373,9 @@ def card_figure(d, *, units: str = "m", chart=None, page: str = "a4"):
     from ..figures import fit_title
 
     fig.suptitle(fit_title(_title(d, units), 0.95 * page_w, fontsize=8), fontsize=8, y=(h - 0.05) / h, va="top")
-    fig.text(0.5, 0.08 / h, "each cell: near / far / (total depth of field); physcam dof-table", ha="center", fontsize=6,
-             color="0.35")
+    foot = "each cell: near / far / (total depth of field); physcam dof-table"
+    if across is not None:
+        foot = (f"each cell: near / far / (total depth of field) up the frame; ↔ near / far across it (anamorphic, "
+                f"squeeze {d['squeeze']:.3g}: CoC {d['coc_mm'] / d['dof_aspect']:.4g} mm); physcam dof-table")
+    fig.text(0.5, 0.08 / h, foot, ha="center", fontsize=6, color="0.35")
     return fig

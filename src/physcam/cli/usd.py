@@ -178,22 +178,25 @@ def run_write(args) -> int:
                             shift_mm=(args.shift_x, args.shift_y), enlarge=args.enlarge,
                             handedness=float(args.handedness))
     distortion = opencv = None
+    anamorphic = []
     if getattr(args, "lens", None) and not args.orthographic:  # a prescription-backed report: its real distortion
         from ..lens.library import load_lens
-        from ..usd.kit import prescription_distortion, prescription_opencv
+        from ..usd.kit import prescription_anamorphic_distortion, prescription_distortion, prescription_opencv
 
         lens = load_lens(args.lens, lenient=args.lenient)
         distortion = prescription_distortion(lens, report.sensor.width_mm, report.sensor.height_mm,
                                              focus_mm=report.focus_from_film_mm)
         opencv = prescription_opencv(lens, report.sensor.width_mm, report.sensor.height_mm,
                                      focus_mm=report.focus_from_film_mm, resolution=args.resolution)
+        anamorphic = prescription_anamorphic_distortion(lens, report.sensor.width_mm, report.sensor.height_mm,
+                                                        focus_mm=report.focus_from_film_mm)
     from .report import thin_lens_gap_from_args
 
     gap = None if args.orthographic else thin_lens_gap_from_args(args, report)
     path = write_camera(args.file, spec, force=args.force, path=args.path, meters_per_unit=args.meters_per_unit,
                         fps=args.fps, report=report if not args.orthographic else None, lens_distortion=distortion,
                         opencv_distortion=opencv, resolution=args.resolution, overscan=args.overscan / 100.0,
-                        thin_lens_gap=gap and gap.to_dict())
+                        thin_lens_gap=gap and gap.to_dict(), anamorphic_distortion=anamorphic)
     if gap is not None and not getattr(args, "json", False):
         print(f"note: {gap.summary()}")
     return _done(args, path, extra={"thin_lens_gap": gap and gap.to_dict()})

@@ -15,7 +15,10 @@ Per focus mark physcam writes:
   fit of :func:`physcam.export.opencv_distortion.fit_opencv_pinhole` (``terms="k1k2k3"``) at that mark;
 * **NodalOffsetTable**: identity rotation and the translation from the film plane (physcam's
   choice for the tracked camera point) to the entrance pupil, in OpenCV axes (z forward) and
-  Unreal units (cm): ``Tz = entrance_pupil_from_film_mm / 10``, ``Tx = Ty = 0``.
+  Unreal units (cm): ``Tz = entrance_pupil_from_film_mm / 10``, ``Tx = Ty = 0``. An anamorphic has
+  two pupils (docs/anamorphic.md): Unreal's camera has one eye, so the table carries the **vertical**
+  (Y) one, the tilt pivot, physcam's eye everywhere; the horizontal (X) one, the pan pivot, is in the
+  ``physcam`` block (``entrance_pupil_horizontal_from_film_mm``) and the user metadata.
 
 Focus keys (``FocusEncoder``) are the focus mark from the film plane in **cm**, with an identity
 ``Focus`` encoder table (encoder value = cm); infinity is written as :data:`INFINITY_FOCUS_CM`.
@@ -92,7 +95,7 @@ def unreal_lens_file(
     marks of :func:`physcam.optics.focusing.breathing_table`, infinity to the closest focus.
     """
     from .. import __version__
-    from ..optics.focusing import breathing_table, focus_method, technical_planes
+    from ..optics.focusing import breathing_table, entrance_pupils, focus_method, technical_planes
     from .opencv_distortion import _pixels, _sensor, fit_opencv_pinhole
 
     w = _sensor("sensor width", sensor_width_mm)
@@ -122,22 +125,25 @@ def unreal_lens_file(
         cam = fit_opencv_pinhole(lens, w, h, W, H, focus_mm=m, terms="k1k2k3", method=method,
                                  wavelength_nm=wl, backend=backend)
         tp = technical_planes(lens, m, wavelength_nm=wl, method=method)
-        rows.append((m, cam, tp))
-    key = [INFINITY_FOCUS_CM if math.isinf(m) else m / 10.0 for m, _, _ in rows]
+        pupil_x = entrance_pupils(lens, m, method=method, wavelength_nm=wl).horizontal_from_film_mm
+        rows.append((m, cam, tp, pupil_x))
+    key = [INFINITY_FOCUS_CM if math.isinf(m) else m / 10.0 for m, _, _, _ in rows]
     tables = [
         _table("FocalLengthTable", HEADERS["FocalLengthTable"],
-               [(k, zoom, c.pinhole_focal_length_x_mm / w, c.pinhole_focal_length_y_mm / h) for k, (_, c, _) in
+               [(k, zoom, c.pinhole_focal_length_x_mm / w, c.pinhole_focal_length_y_mm / h) for k, (_, c, _, _) in
                 zip(key, rows)]),
         _table("ImageCenterTable", HEADERS["ImageCenterTable"], [(k, zoom, 0.5, 0.5) for k in key]),
         _table("DistortionTable", HEADERS["DistortionTable"],
-               [(k, zoom, c.k1, c.k2, c.k3, c.p1, c.p2) for k, (_, c, _) in zip(key, rows)]),
+               [(k, zoom, c.k1, c.k2, c.k3, c.p1, c.p2) for k, (_, c, _, _) in zip(key, rows)]),
         _table("NodalOffsetTable", HEADERS["NodalOffsetTable"],
                [(k, zoom, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, tp.entrance_pupil_from_film_mm / 10.0)
-                for k, (_, _, tp) in zip(key, rows)]),
+                for k, (_, _, tp, _) in zip(key, rows)]),
     ]
     user = [("physcam.version", __version__), ("physcam.lens", lens.name), ("physcam.squeeze", _num(lens.squeeze)),
             ("physcam.focusUnits", "FocusEncoder = focus mark from the film plane in cm"),
-            ("physcam.nodalOffset", "film plane to entrance pupil, cm, OpenCV axes (z forward)")]
+            ("physcam.nodalOffset", "film plane to entrance pupil, cm, OpenCV axes (z forward)"
+             + ("; the vertical (Y, tilt) pupil of an anamorphic: the horizontal (X, pan) one is "
+                "physcam.marks[].entrance_pupil_horizontal_from_film_mm" if lens.is_anamorphic else ""))]
     return {
         "metadata": {
             "type": LENS_FILE_TYPE,
@@ -161,10 +167,11 @@ def unreal_lens_file(
                 "pinhole_focal_length_x_mm": c.pinhole_focal_length_x_mm,
                 "pinhole_focal_length_y_mm": c.pinhole_focal_length_y_mm,
                 "entrance_pupil_from_film_mm": tp.entrance_pupil_from_film_mm,
+                "entrance_pupil_horizontal_from_film_mm": pupil_x,
                 "efl_mm": tp.efl_mm,
                 "k1": c.k1, "k2": c.k2, "k3": c.k3, "p1": c.p1, "p2": c.p2,
                 "max_residual_px": c.max_residual_px, "notes": list(c.notes),
-            } for m, c, tp in rows],
+            } for m, c, tp, pupil_x in rows],
         },
     }
 

@@ -4,7 +4,8 @@ For each frame the lens is solved at that frame's focus mark and f-stop
 (:func:`physcam.onset.report.solve_lens_report`; with a prescription its Gaussian optics focused
 there, so the pinhole focal length breathes and the entrance pupil moves) and the sample carries:
 ``pinholeFocalLength`` (the best-match pinhole, mm), ``focusDistance`` (the mark from the film plane,
-m), ``fStop`` and ``tStop``, ``entrancePupilOffset`` (m in front of the film), the distortion of a
+m), ``fStop`` and ``tStop``, ``entrancePupilOffset`` (m in front of the film; an anamorphic's vertical
+pupil, its horizontal one in ``custom``, :mod:`physcam.live.frames`), the distortion of a
 prescription at that focus (:func:`physcam.live.lens_data.distortion_for_sample`), timing (exact
 timestamps at the frame rate, timecode from a start label, drop-frame when asked, sequence number) and
 the camera transform. The ``static`` block (sensor size, capture rate, anamorphic squeeze, lens,
@@ -29,7 +30,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from ..errors import InputError, require_finite, require_type
-from .frames import TrackedFrame, new_source_id, rate_fraction, sample_from_frame, static_block, with_time
+from .frames import HORIZONTAL_PUPIL_KEY, TrackedFrame, new_source_id, rate_fraction, sample_from_frame, static_block, with_time
 from .sample import shown
 
 __all__ = ["CameraMove", "camera_frames", "camera_samples", "frames_to_samples", "with_optics"]
@@ -94,6 +95,7 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
             squeeze=float(rep.pinhole[1]), drop_frame=bool(drop_frame), **offsets, rate=fr, translation_m=pos, rotation_deg=rot, pinhole_focal_length_mm=rep.pinhole[0],
             focus_from_film_mm=rep.focus_from_film_mm, fstop=rep.fstop, tstop=rep.tstop,
             entrance_pupil_mm=pupil if pupil is not None else rep.h1_from_film_mm, distortion=dist,
+            entrance_pupil_horizontal_mm=rep.entrance_pupil_horizontal_from_film_mm,
             sensor_mm=(sensor.width_mm, sensor.height_mm),
             nominal_focal_length_mm=rep.focal_length_mm), t0, i))
     return out
@@ -143,6 +145,13 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
         out = dict(s, lens=dict(lens_d, pinholeFocalLength=float(rep.pinhole[0])))
         pupil = rep.entrance_pupil_from_film_mm if rep.entrance_pupil_from_film_mm is not None else rep.h1_from_film_mm
         out["lens"]["entrancePupilOffset"] = float(pupil) / 1000.0
+        prior = s.get("custom")
+        if prior is None or isinstance(prior, dict):  # this lens's pupils replace the ones the clip carried
+            custom = {k: v for k, v in (prior or {}).items() if k != HORIZONTAL_PUPIL_KEY}
+            if rep.entrance_pupil_horizontal_from_film_mm is not None:  # an anamorphic's pan pivot (frames.py)
+                custom[HORIZONTAL_PUPIL_KEY] = float(rep.entrance_pupil_horizontal_from_film_mm) / 1000.0
+            if custom or prior is not None:
+                out["custom"] = custom
         if dist is not None:
             out["lens"]["distortion"] = [dist]
         sq = Fraction(float(rep.pinhole[1])).limit_denominator(1_000_000)  # as static_block keeps it

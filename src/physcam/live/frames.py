@@ -11,6 +11,15 @@ plane (the film), positive toward the object, i.e. physcam's ``entrance_pupil_fr
 ``focusDistance`` is read as the focus mark, from the film plane (the schema says only "focus
 distance/position of the lens"; the image plane is the reference it gives the pupil offset).
 
+Two entrance pupils (an anamorphic lens, docs/anamorphic.md): the standard ``entrancePupilOffset``
+carries the **vertical** (Y meridian) pupil, the tilt pivot and the eye physcam renders from; the
+horizontal (X meridian) pupil, the pan pivot, rides in the sample's top-level ``custom`` object as
+``"physcam:horizontalEntrancePupilOffset"`` (metres, the same plane and sign). OpenTrackIO 1.0.1 has no
+field for a second pupil; its schema leaves the sample's top level open (the official
+complete_dynamic_example carries a ``custom`` object there), while ``lens`` allows no extra keys and its
+``custom`` array is coefficients whose meaning each producer and consumer must negotiate. A reader
+that knows nothing of the key ignores it and sees one pupil.
+
 Transforms: OpenTrackIO's stage is right-handed and Z-up, Y forward (toward the LED wall), X to
 camera right; rotations are intrinsic Z-X-Y, ``[pan, tilt, roll]`` in degrees, each by the right-hand
 rule (pan turns +X toward +Y, tilt +Y toward +Z, roll +Z toward +X; camdkit's axis figure). A list
@@ -29,6 +38,9 @@ import numpy as np
 
 from ..errors import InputError, require_finite, require_type
 from .sample import PROTOCOL_VERSION, shown
+
+#: the key of the horizontal (X) entrance pupil in a sample's top-level ``custom`` object (module notes)
+HORIZONTAL_PUPIL_KEY = "physcam:horizontalEntrancePupilOffset"
 
 #: the most radial (and tangential) distortion coefficients a frame keeps: a recording holds each
 #: frame, and a 64 KiB sample could otherwise carry thousands
@@ -72,6 +84,9 @@ class TrackedFrame:
     encoders: dict | None = None
     #: the sample's ``timing.timecode.dropFrame``
     drop_frame: bool = False
+    #: an anamorphic's horizontal (X) entrance pupil in front of the film (mm), the pan pivot;
+    #: ``entrance_pupil_mm`` is then the vertical (Y) one. None: one pupil (module notes)
+    entrance_pupil_horizontal_mm: float | None = None
 
     @property
     def source(self) -> tuple:
@@ -310,7 +325,14 @@ def frame_from_sample(sample, *, static=None) -> TrackedFrame:
         v = lens.get(name)
         return None if v is None else (require_finite(name, v["x"]), require_finite(name, v["y"]))
     encoders = {k: float(v) for k, v in lens["encoders"].items()} if lens.get("encoders") else None
+    custom = sample.get("custom")
+    pupil_x = custom.get(HORIZONTAL_PUPIL_KEY) if isinstance(custom, dict) else None
+    if pupil_x is not None:
+        if isinstance(pupil_x, bool) or not isinstance(pupil_x, (int, float)):
+            raise InputError(f"custom.{HORIZONTAL_PUPIL_KEY} must be a number of metres, got {shown(pupil_x)}")
+        pupil_x = require_finite(HORIZONTAL_PUPIL_KEY, float(pupil_x) * 1000.0)
     return TrackedFrame(
+        entrance_pupil_horizontal_mm=pupil_x,
         squeeze=squeeze, projection_offset_mm=offset("projectionOffset"),
         distortion_offset_mm=offset("distortionOffset"), encoders=encoders,
         drop_frame=bool(timing.get("timecode", {}).get("dropFrame", False)),
@@ -407,6 +429,8 @@ def sample_from_frame(frame: TrackedFrame, *, source_id: str, sequence_number: i
         "transforms": [{"id": "Camera", "translation": {"x": x, "y": y, "z": z},
                         "rotation": {"pan": pan, "tilt": tilt, "roll": roll}}],
     }
+    if frame.entrance_pupil_horizontal_mm is not None:
+        out["custom"] = {HORIZONTAL_PUPIL_KEY: m(float(frame.entrance_pupil_horizontal_mm))}
     if static:
         out["static"] = static
     return out

@@ -8,6 +8,15 @@ point (u, v) of the upright image (mm on the sensor, u right, v up) has the came
 edges (``samples_per_edge`` each, corners included) first hit the wall mesh (Möller-Trumbore ray /
 triangle intersection over every triangle, Möller & Trumbore, J. Graphics Tools 2(1), 1997).
 
+Two entrance pupils (an anamorphic, ``entrance_pupil_horizontal_mm``; docs/anamorphic.md): the lens
+images a subject point's horizontal angle about the X meridian's pupil (at ``e_x`` in front of the
+film) and its vertical angle about the Y meridian's (``e_y``). The points that land on the frame at
+tangents (t_u, t_v) are then X = t_u (s - e_x), Y = t_v (s - e_y), Z = -s for every depth s in front
+of the film: a straight ray of direction (t_u, t_v, -1) through (t_u (e_y - e_x), 0, -e_y). The left and
+right edges' rays all pass through the vertical line through the X pupil, the top and bottom edges'
+through the horizontal line through the Y pupil; with one pupil every ray leaves from it. The
+projection camera (one eye, as a wall renderer has) sits at the Y pupil.
+
 The frame's edges: OpenLensIO's screen point ε (mm on the sensor, x right, y down) looks along
 x/z = squeeze (ε_x - ΔP_x) / F and y/z = (ε_y - ΔP_y) / F (OpenLensIO 1.0.1 eq. 3 with the projection
 offset ΔP = ``projectionOffset``; an anamorphic's horizontal focal length is F / squeeze,
@@ -176,21 +185,26 @@ def frustum_directions(f_pin_mm, sensor_mm, samples_per_edge: int = 8, widen=(1.
 
 def intersect_mesh(origin, directions, triangles) -> np.ndarray:
     """Distance t (k,) along each ray ``origin + t d`` to its first hit on ``triangles`` (n, 3, 3);
-    inf where a ray misses (Möller-Trumbore, module notes)."""
+    inf where a ray misses (Möller-Trumbore, module notes). ``origin``: one point (3,) for every ray,
+    or one per ray (k, 3)."""
     try:
         o = np.asarray(origin, dtype=float)
         d = np.atleast_2d(np.asarray(directions, dtype=float))
         tri = np.asarray(triangles, dtype=float)
     except (TypeError, ValueError):
         raise InputError("origin (3,), directions (k, 3) and triangles (n, 3, 3) must be arrays of numbers") from None
-    if o.shape != (3,) or d.ndim != 2 or d.shape[1] != 3 or tri.ndim != 3 or tri.shape[1:] != (3, 3):
-        raise InputError(f"origin (3,), directions (k, 3) and triangles (n, 3, 3), got {o.shape}, {d.shape}, "
-                         f"{tri.shape}")
+    if o.shape not in ((3,), (len(d), 3)) or d.ndim != 2 or d.shape[1] != 3 or tri.ndim != 3 \
+            or tri.shape[1:] != (3, 3):
+        raise InputError(f"origin (3,) or (k, 3), directions (k, 3) and triangles (n, 3, 3), got {o.shape}, "
+                         f"{d.shape}, {tri.shape}")
     v0, e1, e2 = tri[:, 0], tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
     out = np.full(len(d), np.inf)
-    tvec = o - v0  # (n, 3)
-    qvec = np.cross(tvec, e1)  # (n, 3)
+    tvec = o - v0 if o.ndim == 1 else None  # (n, 3)
+    qvec = np.cross(tvec, e1) if o.ndim == 1 else None  # (n, 3)
     for i, di in enumerate(d):
+        if o.ndim == 2:
+            tvec = o[i] - v0
+            qvec = np.cross(tvec, e1)
         pvec = np.cross(di, e2)
         det = np.einsum("ij,ij->i", e1, pvec)
         ok = np.abs(det) > 1e-14
@@ -220,6 +234,8 @@ class FrustumFrame:
     missed: int
     #: ((left, right), (bottom, top)) tangents of the widened frustum's edges (camera space)
     tangents: tuple = ((0.0, 0.0), (0.0, 0.0))
+    #: an anamorphic's horizontal (X) pupil, world; ``pupil`` is then the vertical (Y) one. None: one pupil
+    pupil_horizontal: np.ndarray | None = None
 
 
 def _angle_between(r0, r1) -> float:
@@ -275,14 +291,22 @@ def frustum_frames(frames, wall: WallMesh, *, overscan: float = 0.1, latency_s: 
         film = c @ np.asarray(f.translation_m) / mpu
         eye_mm = f.entrance_pupil_mm or 0.0
         pupil = film + rots[i] @ np.array([0.0, 0.0, -eye_mm / 1000.0 / mpu])
-        dirs = edge_directions(tu_w, tv_w, samples_per_edge) @ rots[i].T
-        dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
-        t = intersect_mesh(pupil, dirs, wall.triangles)
+        cam_dirs = edge_directions(tu_w, tv_w, samples_per_edge)
+        origins, pupil_x = pupil, None
+        if f.entrance_pupil_horizontal_mm is not None:  # two pupils: each edge ray's own origin (module notes)
+            ex = f.entrance_pupil_horizontal_mm / 1000.0 / mpu
+            pupil_x = film + rots[i] @ np.array([0.0, 0.0, -ex])
+            shift = cam_dirs[:, 0] * (eye_mm / 1000.0 / mpu - ex)  # t_u (e_y - e_x), along camera X
+            origins = pupil + np.outer(shift, rots[i][:, 0])
+        dirs = cam_dirs @ rots[i].T
+        norm = np.linalg.norm(dirs, axis=1, keepdims=True)
+        dirs /= norm
+        t = intersect_mesh(origins, dirs, wall.triangles)
         missed = int(np.isinf(t).sum())
         t = np.where(np.isinf(t), wall.size, t)
         fc = round(float(times[i] * rate), 6)
         out.append(FrustumFrame(fc, pupil, rots[i], f_pin, (w, h), widen, math.degrees(pad),
-                                pupil + t[:, None] * dirs, missed, (tu_w, tv_w)))
+                                origins + t[:, None] * dirs, missed, (tu_w, tv_w), pupil_x))
     return out
 
 
@@ -319,6 +343,9 @@ def write_frustum_usd(file, frustum, *, meters_per_unit: float, fps: float, forc
     a_miss = prim.CreateAttribute("physcam:frustum:missedRays", Sdf.ValueTypeNames.Int, True)
     a_widen = prim.CreateAttribute("physcam:frustum:widen", Sdf.ValueTypeNames.Double2, True)
     a_pad = prim.CreateAttribute("physcam:frustum:latencyMarginDeg", Sdf.ValueTypeNames.Double, True)
+    a_px = None
+    if any(fr.pupil_horizontal is not None for fr in frustum):  # an anamorphic's pan pivot, beside the eye
+        a_px = prim.CreateAttribute("physcam:frustum:horizontalPupil", Sdf.ValueTypeNames.Point3d, True)
     tenths = lambda mm: mm_to_tenths_of_scene_unit(mm, meters_per_unit)  # noqa: E731
     for fr in frustum:
         t = fr.time_code
@@ -335,6 +362,8 @@ def write_frustum_usd(file, frustum, *, meters_per_unit: float, fps: float, forc
         a_miss.Set(int(fr.missed), t)
         a_widen.Set(Gf.Vec2d(*fr.widen), t)
         a_pad.Set(float(fr.pad_deg), t)
+        if a_px is not None:
+            a_px.Set(Gf.Vec3d(*map(float, fr.pupil if fr.pupil_horizontal is None else fr.pupil_horizontal)), t)
     return save_stage(stage, file, force=force)
 
 

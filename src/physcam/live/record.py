@@ -14,7 +14,9 @@ a focus pull):
   camera at zero rotation looks along the stage's +Y (OpenTrackIO) = USD's -Z, a USD camera's own
   view direction;
 * the lens: ``fStop``, ``iris``, ``entrancePupilDistance``, ``pinholeFocalLength``, the lens model's
-  ``focalLength`` and ``focusDistance`` (mm, from the film plane);
+  ``focalLength`` and ``focusDistance`` (mm, from the film plane); an anamorphic's horizontal pupil
+  (``physcam:horizontalEntrancePupilOffset`` in the stream, or the named lens's) as
+  ``horizontalEntrancePupilDistance``, at the eye for a frame with one pupil;
 * the companion UsdGeomCamera: ``focalLength`` (the best-match pinhole), apertures, ``fStop``,
   ``focusDistance`` (from the pupil), ``exposure:fStop`` (the T-stop) and its eye on the pupil;
 * the anamorphic squeeze and lens shift: ``physcam:live:anamorphicSqueeze`` (the lens model's
@@ -52,7 +54,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from ..errors import ExportError, InputError, PhysCamError, PhysCamWarning, require_finite, require_type
-from .frames import TrackedFrame
+from .frames import HORIZONTAL_PUPIL_KEY, TrackedFrame
 from .lens_data import opentrackio_to_opencv
 
 __all__ = ["MAX_RECORDED_FRAMES", "SolvedFrame", "solve_frames", "frame_problem", "time_codes", "time_line",
@@ -66,7 +68,7 @@ REPORT_COLUMNS = ("frame", "time_code", "timecode", "sequence_number", "focus_fr
                   "near_from_film_mm", "far_from_film_mm", "hyperfocal_from_film_mm", "hfov_deg", "vfov_deg",
                   "dfov_deg", "coc_mm", "x_m", "y_m", "z_m", "pan_deg", "tilt_deg", "roll_deg", "source_id",
                   "carried_over", "defaulted", "squeeze", "projection_offset_x_mm", "projection_offset_y_mm",
-                  "focus_from_pupil_mm", "from_encoders")
+                  "focus_from_pupil_mm", "from_encoders", "entrance_pupil_horizontal_from_film_mm")
 
 
 @dataclass(frozen=True)
@@ -86,6 +88,9 @@ class SolvedFrame:
     squeeze: float = 1.0
     projection_offset_mm: tuple[float, float] = (0.0, 0.0)
     distortion_offset_mm: tuple[float, float] = (0.0, 0.0)
+    #: an anamorphic's horizontal (X) entrance pupil in front of the film (mm), the pan pivot, streamed
+    #: (:data:`physcam.live.frames.HORIZONTAL_PUPIL_KEY`) or from the named lens; None: one pupil
+    entrance_pupil_horizontal_mm: float | None = None
 
 
 #: the values a frame may leave out: (key, OpenTrackIO name, TrackedFrame attribute)
@@ -95,7 +100,8 @@ CARRIED_VALUES = (("pinhole", "pinholeFocalLength", "pinhole_focal_length_mm"), 
                   ("sensor", "activeSensorPhysicalDimensions", "sensor_mm"),
                   ("nominal", "nominalFocalLength", "nominal_focal_length_mm"),
                   ("squeeze", "anamorphicSqueeze", "squeeze"), ("projection", "projectionOffset", "projection_offset_mm"),
-                  ("distortion_offset", "distortionOffset", "distortion_offset_mm"))
+                  ("distortion_offset", "distortionOffset", "distortion_offset_mm"),
+                  ("pupil_x", HORIZONTAL_PUPIL_KEY, "entrance_pupil_horizontal_mm"))
 CARRY_OVER_NOTE = ("a value a sample leaves out is carried over from the latest earlier sample of the same source "
                    "(sourceId, sourceNumber), never from another source; physcam:live:carriedOver names them per "
                    "time sample, physcam:live:defaulted those given on the command line")
@@ -114,7 +120,8 @@ def frame_problem(frame: TrackedFrame, pinhole_mm=None) -> str | None:
     if pinhole_mm is not None:
         pinhole_mm = require_finite("pinhole focal length", pinhole_mm)
     lengths = (("pinholeFocalLength", frame.pinhole_focal_length_mm), ("focusDistance", frame.focus_from_film_mm),
-               ("entrancePupilOffset", frame.entrance_pupil_mm), ("nominalFocalLength", frame.nominal_focal_length_mm))
+               ("entrancePupilOffset", frame.entrance_pupil_mm), ("nominalFocalLength", frame.nominal_focal_length_mm),
+               (HORIZONTAL_PUPIL_KEY, frame.entrance_pupil_horizontal_mm))
     lengths += tuple(("activeSensorPhysicalDimensions", v) for v in (frame.sensor_mm or ()))
     for name, v in lengths:
         if v is not None and not abs(v) <= MAX_LENGTH_MM:
@@ -268,7 +275,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     codes, _ = time_codes(frames, rate)
     defaults = {"pinhole": focal_length_mm, "fstop": fstop, "focus": focus_mm, "tstop": None, "pupil": None,
                 "sensor": None if sensor is None else (sensor.width_mm, sensor.height_mm), "nominal": None,
-                "squeeze": None, "projection": None, "distortion_offset": None}
+                "squeeze": None, "projection": None, "distortion_offset": None, "pupil_x": None}
     if lens is not None:
         from ..lens.prescription import Prescription
 
@@ -318,11 +325,20 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
         names = dict((k, n) for k, n, _ in CARRIED_VALUES)
         out.append(SolvedFrame(f, t, report, tuple(carried), tuple(defaulted),
                                tuple(names[k] for k in encoded), float(report.pinhole[1]),
-                               tuple(last["projection"] or (0.0, 0.0)), tuple(last["distortion_offset"] or (0.0, 0.0))))
+                               tuple(last["projection"] or (0.0, 0.0)), tuple(last["distortion_offset"] or (0.0, 0.0)),
+                               _pupil_x(report, last)))
     if skipped:
         warnings.warn(f"{skipped} samples lay off their source's time line (a time code going back, or ahead of "
                       "the frames after it) and were left out", PhysCamWarning, stacklevel=2)
     return out
+
+
+def _pupil_x(report, last) -> float | None:
+    """The frame's horizontal pupil: the named lens's when the report was solved through it (its
+    vertical pupil is then the lens's too), else the streamed one (carried over like the others)."""
+    if report.entrance_pupil_horizontal_from_film_mm is not None:
+        return float(report.entrance_pupil_horizontal_from_film_mm)
+    return None if last["pupil_x"] is None else float(last["pupil_x"])
 
 
 def _from_encoders(f, fiz, sent) -> dict:
@@ -442,6 +458,10 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
     a_proj = cam.CreateAttribute("physcam:live:projectionOffset", Sdf.ValueTypeNames.Double2, True)
     a_doff = cam.CreateAttribute("physcam:live:distortionOffset", Sdf.ValueTypeNames.Double2, True)
     a_shift = cam.GetAttribute("sensor:main:shift")
+    a_pupil_x = None  # an anamorphic's pan pivot; a frame with one pupil has it at the eye
+    if any(s.entrance_pupil_horizontal_mm is not None for s in solved):
+        a_pupil_x = cam.GetAttribute(lp + "horizontalEntrancePupilDistance") \
+            or cam.CreateAttribute(lp + "horizontalEntrancePupilDistance", Sdf.ValueTypeNames.Float)
     omni = None
     c = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])  # OpenTrackIO stage -> USD Y-up
     for s in solved:
@@ -467,6 +487,8 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
         names["iris"].Set(spec.focal_length_mm / spec.fstop, t)
         body_iris.Set(spec.focal_length_mm / spec.fstop, t)
         names["entrancePupilDistance"].Set(eye, t)
+        if a_pupil_x is not None:
+            a_pupil_x.Set(float(eye if s.entrance_pupil_horizontal_mm is None else s.entrance_pupil_horizontal_mm), t)
         if names["pinholeFocalLength"]:
             names["pinholeFocalLength"].Set(report.pinhole[0], t)
         sample_render_camera(geom, spec, report, mpu, tcps, t, where=path)
@@ -550,6 +572,7 @@ def lens_report_rows(solved) -> list[dict]:
             "focus_from_pupil_mm": None if r.entrance_pupil_from_film_mm is None
             else r.focus_from_film_mm - r.entrance_pupil_from_film_mm,
             "from_encoders": list(s.from_encoders),
+            "entrance_pupil_horizontal_from_film_mm": s.entrance_pupil_horizontal_mm,
         })
     return rows
 

@@ -6,7 +6,8 @@ the film plane's centre and orientation come from the body (its origin is the fi
 docs/usd.md), turned into OpenTrackIO's Z-up stage ((x, y, z) = USD's (x, -z, y) on a Y-up stage;
 a Z-up stage is read as it is) and into pan/tilt/roll. Lens values are the PhysicalCamera's own
 (mm): ``lens:main:pinholeFocalLength`` (else the lens model's focal length), the lens model's
-``focusDistance``, ``lens:main:fStop``, ``lens:main:entrancePupilDistance``, the sensor aperture,
+``focusDistance``, ``lens:main:fStop``, ``lens:main:entrancePupilDistance`` (and an anamorphic's
+``horizontalEntrancePupilDistance``, the pan pivot), the sensor aperture,
 and the recorded ``physcam:live:*`` attributes when present: ``anamorphicSqueeze`` (else the lens
 model's ``squeeze``), ``projectionOffset`` and ``distortionOffset`` (else the projection offset of the
 PhysicalCamera's ``sensor:main:shift``: (-shift x, shift y), docs/live.md).
@@ -97,6 +98,7 @@ def frames_from_usd(file, path: str | None = None, *, max_frames: int = 144_000)
     a_sq, a_proj, a_doff = (get("physcam:live:anamorphicSqueeze"), get("physcam:live:projectionOffset"),
                             get("physcam:live:distortionOffset"))
     a_model_sq = model.GetAttribute("squeeze") if model else None
+    a_pupil_x = get(lp + "horizontalEntrancePupilDistance")  # an anamorphic's pan pivot, when authored
     a_shift = get("sensor:main:shift")
     times = _times(cam, [a_pin, a_fstop, a_pupil, a_focal, a_focus, a_seq])
     if len(times) > max_frames:
@@ -148,6 +150,7 @@ def frames_from_usd(file, path: str | None = None, *, max_frames: int = 144_000)
             focus_from_film_mm=None if val(a_focus, t) is None else float(val(a_focus, t)),
             fstop=None if val(a_fstop, t) is None else float(val(a_fstop, t)),
             entrance_pupil_mm=None if val(a_pupil, t) is None else float(val(a_pupil, t)),
+            entrance_pupil_horizontal_mm=None if val(a_pupil_x, t) is None else float(val(a_pupil_x, t)),
             distortion=dist, sensor_mm=None if ap is None else (float(ap[0]), float(ap[1])),
             nominal_focal_length_mm=None if val(a_focal, t) is None else float(val(a_focal, t)),
             squeeze=None if sq is None else float(sq), projection_offset_mm=proj, distortion_offset_mm=doff))

@@ -173,7 +173,7 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
                                   (cam, lp + "entrancePupilDistance", eye)):
             sample(prim, name, value, t)
         optional = {lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "apertureDistance":
-                    spec.aperture_distance_mm}
+                    spec.aperture_distance_mm, lp + "horizontalEntrancePupilDistance": spec.horizontal_entrance_pupil_mm}
         if spec.principal_planes_mm is not None:
             optional[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]
             optional[lp + "rearPrincipalPlaneDistance"] = spec.principal_planes_mm[1]

@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 import struct
 
-from ..errors import ExportError, InputError, require_finite, require_positive, require_type
+from ..errors import ExportError, InputError, WrongTypeError, require_finite, require_positive, require_type
 from ..export._codetext import usd_text
 from ..export.renderman import shutter_opening_curve  # re-exported: the one copy of seed 002's ramps
 from .plugin import ensure_registered, require_stage
@@ -54,6 +54,7 @@ __all__ = [
     "author_render_settings",
     "render_camera_values",
     "sample_render_camera",
+    "author_anamorphic_distortion",
 ]
 
 def new_stage(meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y"):
@@ -266,6 +267,8 @@ def _author_lens(stage, cam, spec, eye, su):
     _set(cam, lp + "fStop", Sdf.ValueTypeNames.Float, spec.fstop)
     _set(cam, lp + "iris", Sdf.ValueTypeNames.Float, _iris_mm(spec))
     _set(cam, lp + "entrancePupilDistance", Sdf.ValueTypeNames.Float, eye)
+    if spec.horizontal_entrance_pupil_mm is not None:  # an anamorphic's pan pivot (docs/anamorphic.md)
+        _set(cam, lp + "horizontalEntrancePupilDistance", Sdf.ValueTypeNames.Float, spec.horizontal_entrance_pupil_mm)
     if spec.principal_planes_mm is not None:
         _set(cam, lp + "frontPrincipalPlaneDistance", Sdf.ValueTypeNames.Float, spec.principal_planes_mm[0])
         _set(cam, lp + "rearPrincipalPlaneDistance", Sdf.ValueTypeNames.Float, spec.principal_planes_mm[1])
@@ -500,6 +503,53 @@ def _author_lens_distortion(prim, lens_distortion):
         _set(prim, name, getattr(Sdf.ValueTypeNames, kind), v, custom=True)
 
 
+#: the companion camera's attributes of a 3DE4 anamorphic fit: ``physcam:tde4AnamorphicDegree4:*`` (and 6)
+TDE4_ANAMORPHIC_PREFIX = "physcam:tde4AnamorphicDegree"
+
+
+def author_anamorphic_distortion(prim, fits) -> None:
+    """3DE4 Anamorphic - Standard fits (:class:`physcam.analysis.distortion.anamorphic.TDE4Anamorphic`) as
+    custom attributes on the companion camera ``prim``, one group per degree,
+    ``physcam:tde4AnamorphicDegree<d>:``: ``model``, ``focalLength`` (mm, the Y pinhole), ``filmback`` (mm,
+    the desqueezed one), ``pixelAspect`` (f_y / f_x), ``parameterNames`` and ``parameters`` (3DE's names and
+    values, distorted to undistorted), ``rmsResidualPx``, ``maxResidualPx`` and ``plateSizePx`` (the frame
+    the residuals are in). USD has no anamorphic lensDistortion; these carry 3DE's own model
+    (docs/anamorphic.md). Groups of degrees not in ``fits`` are removed."""
+    from pxr import Gf, Sdf, Vt
+
+    from ..analysis.distortion.anamorphic import TDE4Anamorphic, tde4_anamorphic_parameter_names
+
+    if isinstance(fits, (str, bytes)) or not hasattr(fits, "__iter__"):
+        raise WrongTypeError("fits must be a list of 3DE4 anamorphic fits "
+                             "(physcam.usd.kit.prescription_anamorphic_distortion(lens, ...))")
+    fits = [require_type("fit", f, TDE4Anamorphic, "physcam.analysis.distortion.anamorphic.fit_tde4_anamorphic(...)")
+            for f in fits]
+    kept = set()
+    for fit in fits:
+        c = fit.coefficients
+        degree = int(c["degree"])
+        p = f"{TDE4_ANAMORPHIC_PREFIX}{degree}:"
+        kept.add(p)
+        names = tde4_anamorphic_parameter_names(degree)
+        values = [require_finite(n, c[n], error=ExportError) for n in names]
+        T = Sdf.ValueTypeNames
+        _set(prim, p + "model", T.String, fit.model, custom=True)
+        _set(prim, p + "focalLength", T.Double, require_finite("focal length", c["focal_length_mm"], error=ExportError),
+             custom=True)
+        _set(prim, p + "filmback", T.Double2, Gf.Vec2d(fit.sensor_mm[0] * c["pixel_aspect"], fit.sensor_mm[1]),
+             custom=True)
+        _set(prim, p + "pixelAspect", T.Double, require_finite("pixel aspect", c["pixel_aspect"], error=ExportError),
+             custom=True)
+        _set(prim, p + "parameterNames", T.StringArray, Vt.StringArray(names), custom=True)
+        _set(prim, p + "parameters", T.DoubleArray, Vt.DoubleArray(values), custom=True)
+        _set(prim, p + "rmsResidualPx", T.Double, float(fit.rms_residual_px), custom=True)
+        _set(prim, p + "maxResidualPx", T.Double, float(fit.max_residual_px), custom=True)
+        _set(prim, p + "plateSizePx", T.Int2, Gf.Vec2i(*map(int, fit.size_px)), custom=True)
+    for prop in prim.GetAuthoredPropertyNames():
+        if prop.startswith(TDE4_ANAMORPHIC_PREFIX) and prop[:prop.index(":", len(TDE4_ANAMORPHIC_PREFIX)) + 1] not in kept:
+            prim.RemoveProperty(prop)
+
+
 def author_from_report(stage, path: str, report, *, position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0),
                        lens_distortion=None, **body):
     """Author the camera of a :class:`~physcam.onset.report.LensReport` (see :func:`author_camera`)."""
@@ -597,17 +647,20 @@ def write_camera(file, spec: CameraSpec, *, force: bool = False, path: str = DEF
                  meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y",
                  position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, lens_distortion=None,
                  opencv_distortion=None, render_settings: bool = True, resolution=None, overscan: float = 0.0,
-                 thin_lens_gap: dict | None = None):
+                 thin_lens_gap: dict | None = None, anamorphic_distortion=()):
     """Write a one-camera layer to ``file`` (see :func:`author_camera`), with a ``UsdRenderSettings``
     for its companion camera (:func:`author_render_settings`) unless ``render_settings`` is false;
     return the Path. ``thin_lens_gap`` (:meth:`physcam.onset.thin_lens_gap.ThinLensGap.to_dict`) is kept
-    in the companion camera's customData ``physcam:thinLensGap``: how far it is from the real lens."""
+    in the companion camera's customData ``physcam:thinLensGap``: how far it is from the real lens.
+    ``anamorphic_distortion``: 3DE4 anamorphic fits for the companion (:func:`author_anamorphic_distortion`)."""
     stage = new_stage(meters_per_unit, fps, up_axis)
     author_camera(stage, path, spec, position=position, rotate_xyz_deg=rotate_xyz_deg, report=report,
                   lens_distortion=lens_distortion, opencv_distortion=opencv_distortion)
     if thin_lens_gap is not None:
         companion = stage.GetPrimAtPath(f"{path}/{RENDER_CAMERA_NAME}")
         companion.SetCustomDataByKey("physcam:thinLensGap", _usd_dict(thin_lens_gap))
+    if anamorphic_distortion:
+        author_anamorphic_distortion(stage.GetPrimAtPath(f"{path}/{RENDER_CAMERA_NAME}"), anamorphic_distortion)
     if render_settings:
         author_render_settings(stage, f"{path}/{RENDER_CAMERA_NAME}", spec, resolution=resolution, overscan=overscan)
     return save_stage(stage, file, force=force)

@@ -22,6 +22,7 @@ from dataclasses import replace
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import ExportError, InputError, require_type
 from ..export._codetext import printable_line, usd_text
+from ..lens.prescription import takes_prescription
 from .author import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec, author_camera, author_render_camera, new_stage, save_stage
 from .read import companion_inputs, companion_inputs_hash, composed_prescription
 from .plugin import ensure_registered
@@ -39,6 +40,7 @@ __all__ = [
     "refresh_shot",
     "companion_inputs_hash",
     "prescription_opencv",
+    "prescription_anamorphic_distortion",
 ]
 
 LENS_PRIM = "/Lens"
@@ -251,13 +253,13 @@ def _author_shot_companion(stage, path) -> str:
     """
     from pxr import Sdf
 
-    from .author import _eye_from_film, spec_from_report
+    from .author import _eye_from_film, author_anamorphic_distortion, spec_from_report
     from .read import read_camera
 
     spec = read_camera(stage, path).spec
     rx = composed_prescription(stage, path)
     cam = stage.GetPrimAtPath(path)
-    report, distortion, opencv = None, None, None
+    report, distortion, opencv, anamorphic = None, None, None, []
     if rx is not None and spec.projection == "perspective":
         from ..onset.report import report_camera, solve_report
         from ..optics.sensors import Sensor
@@ -273,6 +275,8 @@ def _author_shot_companion(stage, path) -> str:
                        pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
                        pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze)
         distortion = prescription_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
+        anamorphic = prescription_anamorphic_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm,
+                                                        focus_mm=spec.focus_mm)
         opencv = prescription_opencv(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
     # values derived from the composed lens, rewritten every time: the iris (f / N) and the film's
     # place behind the pupil, so the pupil stays where the shot put it when the lens file changes
@@ -281,6 +285,7 @@ def _author_shot_companion(stage, path) -> str:
     _move_film_behind_pupil(cam, _eye_from_film(spec, report))
     geom = author_render_camera(stage, Sdf.Path(path), spec, report=report, lens_distortion=distortion,
                                 opencv_distortion=opencv)
+    author_anamorphic_distortion(geom.GetPrim(), anamorphic)  # none: a stale one from another lens goes
     digest = companion_inputs(stage, path)
     geom.GetPrim().SetCustomDataByKey("physcam:companionInputs", digest)
     return digest
@@ -305,13 +310,16 @@ def _author_lens_derived(stage, cam, spec) -> None:
     F = Sdf.ValueTypeNames.Float
     lp = f"lens:{LENS_INSTANCE}:"
     values = {lp + "entrancePupilDistance": spec.entrance_pupil_mm, lp + "iris": spec.focal_length_mm / spec.fstop,
-              lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze": spec.pinhole_squeeze}
+              lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze": spec.pinhole_squeeze,
+              lp + "horizontalEntrancePupilDistance": spec.horizontal_entrance_pupil_mm}
     if spec.principal_planes_mm is not None:
         values[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]
         values[lp + "rearPrincipalPlaneDistance"] = spec.principal_planes_mm[1]
     for name, v in values.items():
         if v is not None:
             (cam.GetAttribute(name) or cam.CreateAttribute(name, F)).Set(float(v))
+    if spec.horizontal_entrance_pupil_mm is None and cam.GetAttribute(lp + "horizontalEntrancePupilDistance"):
+        cam.GetAttribute(lp + "horizontalEntrancePupilDistance").Clear()  # a lens with one pupil now
 
 
 def check_shot(file, path: str | None = None) -> dict:
@@ -517,9 +525,38 @@ def prescription_distortion(prescription, sensor_width_mm: float = DEFAULT_SENSO
     fit = fit_usd_standard(samples_from_field(field))
     if not fit.acceptable:
         warnings.warn(f"lensDistortion: the standard model misses the traced rays by up to {fit.max_residual_px:.2g} px "
-                      f"on a {w_px}-pixel-wide frame (written anyway; ST-maps are exact: physcam distortion --stmap)",
+                      f"on a {w_px}-pixel-wide frame (written anyway; ST-maps are exact: physcam distortion --stmap"
+                      + ("; an anamorphic's 3DE4 model is written beside it" if prescription.is_anamorphic else "") + ")",
                       PhysCamWarning, stacklevel=2)
     return fit
+
+
+@takes_prescription
+def prescription_anamorphic_distortion(prescription, sensor_width_mm: float, sensor_height_mm: float, *,
+                                       focus_mm: float = math.inf) -> list:
+    """3DE4 Anamorphic - Standard, Degree 4 and 6 (:func:`physcam.analysis.distortion.anamorphic.fit_tde4_anamorphic`)
+    fitted to an anamorphic ``prescription``'s traced chief rays over the whole frame at ``focus_mm``, on the
+    2048-pixel-wide frame :func:`prescription_distortion` traces; ``[]`` for a spherical lens, and, with a
+    warning, for one whose field does not cover the frame (its corners are not imaged)."""
+    import warnings
+
+    if not prescription.is_anamorphic:
+        return []
+    from ..analysis.distortion.anamorphic import fit_tde4_anamorphic
+    from ..analysis.distortion.models import samples_from_field
+    from ..analysis.distortion.stmap import distortion_field
+    from ..errors import OpticsError, PhysCamWarning
+
+    w_px = 2048
+    h_px = max(16, min(8192, round(w_px * sensor_height_mm / sensor_width_mm)))
+    try:
+        field = distortion_field(prescription, focus_mm=focus_mm, sensor_width_mm=sensor_width_mm,
+                                 sensor_height_mm=sensor_height_mm, width_px=w_px, height_px=h_px, maps=False)
+    except OpticsError as e:
+        warnings.warn(f"3DE4 anamorphic distortion not written: {e}", PhysCamWarning, stacklevel=2)
+        return []
+    samples = samples_from_field(field)
+    return [fit_tde4_anamorphic(samples, degree) for degree in (4, 6)]
 
 
 def prescription_opencv(prescription, sensor_width_mm: float, sensor_height_mm: float, *, focus_mm: float,

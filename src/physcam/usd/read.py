@@ -261,6 +261,7 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
         coc_mm=float(_get(prim, sp + "circleOfConfusion", "")),
         squeeze=float(_get(model, "squeeze", "")),
         entrance_pupil_mm=float(_get(prim, lp + "entrancePupilDistance", "")),
+        horizontal_entrance_pupil_mm=_optional(prim, lp + "horizontalEntrancePupilDistance"),
         principal_planes_mm=_principal_planes(prim, lp),
         pinhole_focal_length_mm=_optional(prim, lp + "pinholeFocalLength"),
         pinhole_squeeze=_optional(prim, lp + "pinholeSqueeze"),
@@ -316,7 +317,10 @@ def companion_inputs_hash(spec, prescription=None) -> str:
     import json
     from dataclasses import asdict
 
-    doc = {"camera": asdict(spec)}
+    camera = asdict(spec)
+    if camera.get("horizontal_entrance_pupil_mm") is None:  # files written before the field hash as they did
+        camera.pop("horizontal_entrance_pupil_mm", None)
+    doc = {"camera": camera}
     if prescription is not None:
         doc["prescription"] = [asdict(s) for s in prescription.surfaces]
         doc["focus"] = None if prescription.focus is None else asdict(prescription.focus)

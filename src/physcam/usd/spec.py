@@ -33,6 +33,9 @@ class CameraSpec:
     (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`).
     ``entrance_pupil_mm``: the pupil in front of the film plane; ``None`` uses the thin
     lens (the pupil on the principal plane, s' in front of the film).
+    ``horizontal_entrance_pupil_mm``: an anamorphic's horizontal (X meridian) pupil in front of the
+    film, the pan pivot (``entrance_pupil_mm`` is then the vertical one, the tilt pivot and the eye);
+    ``None``: one pupil for both meridians.
     ``principal_planes_mm``: (H1, H2) in front of the film plane, from a datasheet or a
     prescription (the technical model); ``None`` for a thin lens.
     ``pinhole_focal_length_mm``, ``pinhole_squeeze``: the best-match pinhole (the companion
@@ -60,6 +63,7 @@ class CameraSpec:
     coc_mm: float = 0.03
     squeeze: float = 1.0
     entrance_pupil_mm: float | None = None
+    horizontal_entrance_pupil_mm: float | None = None
     principal_planes_mm: tuple[float, float] | None = None
     pinhole_focal_length_mm: float | None = None
     pinhole_squeeze: float | None = None
@@ -120,6 +124,8 @@ class CameraSpec:
             raise InputError(f"handedness is 1 (right-handed) or -1 (left-handed, mirrored), got {self.handedness!r}")
         if self.entrance_pupil_mm is not None:
             require_finite("entrance pupil distance", self.entrance_pupil_mm)
+        if self.horizontal_entrance_pupil_mm is not None:
+            require_finite("horizontal entrance pupil distance", self.horizontal_entrance_pupil_mm)
         if self.principal_planes_mm is not None:
             for v in self.principal_planes_mm:
                 require_finite("principal plane distance", v)
@@ -184,6 +190,7 @@ def spec_from_report(report, **body) -> CameraSpec:
         squeeze=report.squeeze,
         entrance_pupil_mm=(report.entrance_pupil_from_film_mm if report.entrance_pupil_from_film_mm is not None
                            else report.h1_from_film_mm),
+        horizontal_entrance_pupil_mm=report.entrance_pupil_horizontal_from_film_mm,
         principal_planes_mm=((report.h1_from_film_mm, report.h2_from_film_mm) if report.model == "technical"
                              else None),
         aperture_distance_mm=report.stop_from_film_mm,

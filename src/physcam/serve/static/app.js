@@ -16,7 +16,7 @@ const MARKS = {
 };
 const DEFAULTS = { focal: "50", fstop: "2.8", focus: "3m" };
 
-const st = { units: "metric", lensmode: "focal", solve: "dof", report: null };
+const st = { units: "metric", lensmode: "focal", solve: "dof", report: null, squeezeFromFormat: false };
 let SENSORS = [];
 let timer = null;
 let settle = null;
@@ -449,7 +449,26 @@ function findSensor(text) {
 
 function sensorChanged() {
   $("custom-sensor").hidden = $("sensor").value !== "custom";
+  squeezeFromFormat();
   schedule();
+}
+
+// an anamorphic recording format's desqueeze (the camera table's, when it gives one): the squeeze follows
+// the format unless the user chose another; a format without one puts back the squeeze it set
+function squeezeFromFormat() {
+  const s = SENSORS.find((x) => x.key === $("sensor").value);
+  const offered = s && s.anamorphic && s.anamorphic.length === 1 ? Number(s.anamorphic[0]) : null;
+  const sel = $("squeeze");
+  if (offered !== null && (sel.value === "1" || st.squeezeFromFormat)) {
+    const o = [...sel.options].find((x) => Number(x.value) === offered);
+    if (o) sel.value = o.value; else addOption(sel, String(offered), `${offered}×`);
+    st.squeezeFromFormat = true;
+  } else if (offered === null && st.squeezeFromFormat) {
+    sel.value = "1";
+    st.squeezeFromFormat = false;
+  }
+  $("squeeze-hint").hidden = !st.squeezeFromFormat;
+  if (st.squeezeFromFormat) $("squeeze-hint").textContent = `${num(offered, 3)}× desqueeze: the camera table's for ${s.name}`;
 }
 
 function press(ids, on) {
@@ -562,6 +581,11 @@ function wire() {
   form.addEventListener("change", (e) => {
     if (e.target.id === "sensor") sensorChanged();
     else if (e.target.id === "camera") fillSensors(val("sensor-search"));
+    else if (e.target.id === "squeeze") {
+      st.squeezeFromFormat = false; // the user's own choice, kept across formats
+      $("squeeze-hint").hidden = true;
+      update();
+    }
     else if (e.target.id === "coc") {
       $("field-coc-mm").hidden = $("coc").value !== "custom";
       update();
