@@ -8,7 +8,7 @@ camera through the one door, as a Mermaid diagram in docs/architecture.md.
 Read with ``ast`` (nothing is imported): a module is a front end when its code calls ``camera_state(``,
 ``as_designed(`` or ``report_camera(`` (outside ``optics/state.py`` and ``onset/``); the solvers are the
 calls of ``solve_report``'s body to names that ``physcam.onset.solvers`` defines; the door's users are
-the functions decorated ``@takes_camera``, counted per package. tests/test_architecture.py runs ``--check``.
+the functions decorated ``@takes_camera``, counted per package (analysis's per package of its own). tests/test_architecture.py runs ``--check``.
 """
 
 from __future__ import annotations
@@ -46,13 +46,14 @@ def front_ends() -> list[str]:
 
 
 def door_users() -> dict[str, int]:
-    """Functions decorated ``@takes_camera``, counted per package."""
+    """Functions decorated ``@takes_camera``, counted per package (analysis's per package of its own)."""
     out: dict[str, int] = {}
     for path in sorted(SRC.rglob("*.py")):
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             if isinstance(node, ast.FunctionDef) and any(getattr(d, "id", None) == "takes_camera"
                                                           for d in node.decorator_list):
-                pkg = path.relative_to(SRC).parts[0]
+                parts = path.relative_to(SRC).parts
+                pkg = ".".join(parts[:2]) if parts[0] == "analysis" and len(parts) > 2 else parts[0]
                 out[pkg] = out.get(pkg, 0) + 1
     return dict(sorted(out.items()))
 
@@ -85,7 +86,8 @@ def diagram() -> str:
         prev = f"s{i}"
     lines.append(f'    {prev} --> report["LensReport (holds the camera)"]')
     for pkg, n in door_users().items():
-        lines.append(f'    camera --> door_{pkg}["{pkg}: {n} function{"s" if n != 1 else ""} through @takes_camera"]')
+        lines.append(f'    camera --> door_{pkg.replace(".", "_")}["{pkg}: {n} function{"s" if n != 1 else ""} '
+                     'through @takes_camera"]')
     lines.append("```")
     return "\n".join(lines)
 
