@@ -40,7 +40,7 @@ _QUALITY = {"full": dict(mtf_fields=8, curve_fields=12, pupil_cap=256, rays=120_
 def _title_that_fits(text: str, width_in: float) -> tuple[str, float]:
     """The page title and its size: the largest of 11, 10, 9 and 8 pt at which ``text``, bold, fits on one line
     ``width_in`` inches wide (a long lens name, such as a zoom's with its source), else wrapped at 8 pt."""
-    from ..figures import fit_title
+    from ...figures import fit_title
 
     for size in (11.0, 10.0, 9.0, 8.0):
         lines = fit_title(text, width_in, fontsize=size, weight="bold")
