@@ -15,7 +15,7 @@ import math
 from ..errors import InputError, OpticsError, require_type
 from ..optics import dof as _dof
 from ..optics.lens_model import PrincipalPlanes, lens_model_of
-from ..optics.thinlens import MIN_F_NUMBER
+from ..optics.thinlens import MAX_F_NUMBER, MIN_F_NUMBER
 
 __all__ = ["focus_from_limits", "fstop_from_limits", "hyperfocal_parameters"]
 
@@ -84,9 +84,9 @@ def fstop_from_limits(lens, *, focus_mm, sensor, near_mm=None, far_mm=None, coc=
         solved += (("fstop_drift_stops", _dof.stops_between(n, marked_fstop)),)
     if model.kind == "prescription":
         return cam.with_fstop(n, solved=solved, lenient=True)
-    from dataclasses import replace
-
-    return replace(camera_state(model, focus_mm=mark, fstop=n, sensor=sensor, squeeze=squeeze), solved=solved)
+    # (built at a stop the door accepts, then set to the solved one: beyond f/4096 it is still the answer)
+    cam = camera_state(model, focus_mm=mark, fstop=min(n, MAX_F_NUMBER), sensor=sensor, squeeze=squeeze)
+    return cam.with_fstop(n, solved=solved, lenient=True)
 
 
 def require_possible_f_number(n: float, name: str = "f-stop") -> None:

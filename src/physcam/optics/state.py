@@ -156,8 +156,9 @@ class CameraState:
     def with_fstop(self, fstop, *, solved: tuple = (), lenient: bool = False) -> "CameraState":
         """This camera with the iris set to ``fstop`` (the focus kept: no focus solved again). ``lenient``: an
         f-stop faster than the lens opens (solved from measured limits: it is what they say) keeps the iris as
-        the file stops it instead of an OpticsError."""
-        n = require_f_number("f-stop", fstop)
+        the file stops it instead of an OpticsError, and one slower than :data:`MAX_F_NUMBER` is kept as solved
+        (a typed f-stop that slow is refused as a typo; a solved one is the answer the limits give)."""
+        n = float(fstop) if lenient and math.isfinite(fstop) and fstop > MAX_F_NUMBER else require_f_number("f-stop", fstop)
         stop, iris_set = self.stop_semi_diameter, True
         if self.traceable:
             try:
