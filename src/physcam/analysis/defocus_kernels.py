@@ -58,6 +58,10 @@ __all__ = ["DefocusCamera", "defocus_camera", "Kernel", "KernelCache", "FAR_MM",
 LADDER_STEP = 8
 #: samples per lit kernel pixel, and the most and fewest samples of a fan (powers of two)
 SAMPLES_PER_PX, MAX_SAMPLES, MIN_SAMPLES = 8.0, 1 << 16, 1 << 12
+#: depth nodes whose thin-lens blur is at most this (px) get kernels traced at each tile corner they
+#: are used at, not blended between field nodes: a small aberrated kernel changes its shape and its
+#: orientation (coma turns with the azimuth) faster than a few field nodes follow (issue 47)
+DIRECT_BLUR_PX = 16.0
 #: what the disk cache's files are laid out as and the field grid's rules (part of the camera key)
 CACHE_FORMAT = "physcam-defocus-kernels/3"
 
@@ -353,6 +357,7 @@ class KernelCache:
         self._kernels: dict = {}
         self._table = None
         self._tiles: dict = {}
+        self._direct: dict = {}
         self._read = False
 
     # ---- the field grid -----------------------------------------------------------------------
@@ -484,6 +489,26 @@ class KernelCache:
                     progress(done, len(missing))
         return out
 
+    def prepare_direct(self, points) -> None:
+        """Trace, in one batch, the kernels at picture positions and depth nodes ``points`` ((x, y, n)
+        triples) of a small blur (:data:`DIRECT_BLUR_PX`), each at its own place and its node's own
+        depth, so that :meth:`tile_kernel` reads them instead of blending field nodes (kept in memory)."""
+        from .defocus_field import box_depths, node_kernel
+        from .defocus_trace import distortion_jacobians, pupil_boxes, trace_fans
+
+        cam = self.camera
+        todo = sorted({(round(float(x), 3), round(float(y), 3), int(n)) for x, y, n in points} - set(self._direct))
+        for b in range(0, len(todo), 512):
+            part = todo[b:b + 512]
+            pts = [(x, y) for x, y, _ in part]
+            boxes = pupil_boxes(cam, pts, box_depths(cam))
+            fans = trace_fans(cam, [(p, float(cam.node_u(n)), box, cam.samples(n, n))
+                                    for p, (_, _, n), box in zip(pts, part, boxes)])
+            unwarps = np.linalg.inv(distortion_jacobians(cam, pts))
+            for key, fan, unwarp in zip(part, fans, unwarps):
+                self._direct[key] = node_kernel(cam, fan, fan, key[2], None, unwarp)[0]
+        self.traced += len(todo)
+
     # ---- what defocus reads -------------------------------------------------------------------
     def node_kernel(self, col: int, row: int, n: int) -> np.ndarray:
         """The kernel of field node (col, row) at depth node ``n`` (unit sum per channel)."""
@@ -496,6 +521,8 @@ class KernelCache:
         """The kernel at picture (x, y), depth node ``n``: its field nodes' kernels blended
         bilinearly (unit sum per channel)."""
         key = (round(float(x), 3), round(float(y), 3), int(n))
+        if key in self._direct:
+            return self._direct[key]
         if key not in self._tiles:
             parts = [(w, self.node_kernel(c, r, n)) for c, r, w in self.nodes_of(x, y)]
             size = max(k.shape[0] for _, k in parts)
