@@ -358,6 +358,7 @@ class KernelCache:
         self._table = None
         self._tiles: dict = {}
         self._direct: dict = {}
+        self._places: dict = {}
         self._read = False
 
     # ---- the field grid -----------------------------------------------------------------------
@@ -498,15 +499,16 @@ class KernelCache:
 
         cam = self.camera
         todo = sorted({(round(float(x), 3), round(float(y), 3), int(n)) for x, y, n in points} - set(self._direct))
+        places = sorted({(x, y) for x, y, _ in todo} - set(self._places))
+        if places:  # a place's sampling box and unwarp serve all its depths (box_depths: one set per camera)
+            boxes = pupil_boxes(cam, places, box_depths(cam))
+            self._places.update(zip(places, zip(boxes, np.linalg.inv(distortion_jacobians(cam, places)))))
         for b in range(0, len(todo), 512):
             part = todo[b:b + 512]
-            pts = [(x, y) for x, y, _ in part]
-            boxes = pupil_boxes(cam, pts, box_depths(cam))
-            fans = trace_fans(cam, [(p, float(cam.node_u(n)), box, cam.samples(n, n))
-                                    for p, (_, _, n), box in zip(pts, part, boxes)])
-            unwarps = np.linalg.inv(distortion_jacobians(cam, pts))
-            for key, fan, unwarp in zip(part, fans, unwarps):
-                self._direct[key] = node_kernel(cam, fan, fan, key[2], None, unwarp)[0]
+            fans = trace_fans(cam, [((x, y), float(cam.node_u(n)), self._places[(x, y)][0], cam.samples(n, n))
+                                    for x, y, n in part])
+            for key, fan in zip(part, fans):
+                self._direct[key] = node_kernel(cam, fan, fan, key[2], None, self._places[key[:2]][1])[0]
         self.traced += len(todo)
 
     # ---- what defocus reads -------------------------------------------------------------------
