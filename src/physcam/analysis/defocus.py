@@ -195,8 +195,7 @@ def _prepare(cache, f, pairs, progress) -> None:
             i = np.clip(np.searchsorted(nodes, pos, side="right") - 1, 0, len(nodes) - 2)
             found.append(np.unique(np.concatenate([i, i + 1])))
         needed |= {(int(c), int(r), int(n)) for c in found[0] for r in found[1]}
-    cache.prepare(needed, progress)
-    cache.prepare_direct(direct)
+    cache.prepare(needed, progress, direct)
 
 
 def _used_corners(f, cam, n, tiles, xs, ys) -> list[tuple[float, float, int]]:

@@ -63,7 +63,7 @@ SAMPLES_PER_PX, MAX_SAMPLES, MIN_SAMPLES = 8.0, 1 << 16, 1 << 12
 #: orientation (coma turns with the azimuth) faster than a few field nodes follow (issue 47)
 DIRECT_BLUR_PX = 16.0
 #: what the disk cache's files are laid out as and the field grid's rules (part of the camera key)
-CACHE_FORMAT = "physcam-defocus-kernels/3"
+CACHE_FORMAT = "physcam-defocus-kernels/4"
 
 
 @dataclass
@@ -372,13 +372,14 @@ class KernelCache:
         from .defocus_cache import read_stacks
         from .defocus_field import FieldTable, _table_positions
 
-        fractions, kernels, table = read_stacks(self.folder, self.camera.key(), CACHE_FORMAT,
+        fractions, kernels, table, direct = read_stacks(self.folder, self.camera.key(), CACHE_FORMAT,
                                                 len(self.camera.wavelengths_nm))
         if fractions is None:
             return
         self._fractions = tuple(float(f) for f in fractions)
         self._kernels.update(kernels)
-        self.loaded += len(kernels)
+        self._direct.update(direct)
+        self.loaded += len(kernels) + len(direct)
         radial, qx, qy = _table_positions(self.camera)
         if table is not None and table[:2] == (radial, len(qx)):
             self._table = FieldTable(radial, qx, qy, dict(table[2]))
@@ -418,29 +419,32 @@ class KernelCache:
         return [(i, j, wi * wj) for i, wi in cx for j, wj in cy if wi * wj > 0]
 
     # ---- tracing ------------------------------------------------------------------------------
-    def prepare(self, needed, progress=None) -> None:
-        """Make every node kernel of ``needed`` ((column, row, depth node) triples) and the
-        transmission table at their depths: read from disk, else traced in batches; the new ones
-        are written to the folder as one stack file."""
+    def prepare(self, needed, progress=None, direct=()) -> None:
+        """Make every node kernel of ``needed`` ((column, row, depth node) triples), every kernel of
+        ``direct`` ((x, y, depth node) of a small blur: :meth:`trace_direct`) and the transmission
+        table at their depths: read from disk, else traced in batches; the new ones are written to
+        the folder as one stack file."""
         from .defocus_field import field_table
 
         self._load()
         cam = self.camera
-        needed = set(needed)
-        ladder = {m for _, _, n in needed for m in cam.ladder(n)} | {0}
+        needed, direct = set(needed), list(direct)
+        ladder = {m for _, _, n in [*needed, *direct] for m in cam.ladder(n)} | {0}
         old_table = set() if self._table is None else set(self._table.transmission)
         self._table = field_table(cam, self._table, ladder)
         missing = sorted(k for k in needed if k not in self._kernels)
         new = self._trace(missing, progress) if missing else {}
         self._kernels.update(new)
         self.traced += len(new)
+        new_direct = self.trace_direct(direct)
         if self.folder is not None:
             from .defocus_cache import write_stack
 
             t = self._table
             rows = {n: t.transmission[n] for n in set(t.transmission) - old_table}
             self.folder.mkdir(parents=True, exist_ok=True)
-            write_stack(self.folder, cam.key(), CACHE_FORMAT, self.fractions, new, (t.radial, len(t.qx), rows))
+            write_stack(self.folder, cam.key(), CACHE_FORMAT, self.fractions, new, (t.radial, len(t.qx), rows),
+                        new_direct)
 
     def _trace(self, missing, progress) -> dict:
         """Node kernels of ``missing`` from fans traced at their ladder nodes, field node by field
@@ -490,10 +494,10 @@ class KernelCache:
                     progress(done, len(missing))
         return out
 
-    def prepare_direct(self, points) -> None:
+    def trace_direct(self, points) -> dict:
         """Trace, in one batch, the kernels at picture positions and depth nodes ``points`` ((x, y, n)
         triples) of a small blur (:data:`DIRECT_BLUR_PX`), each at its own place and its node's own
-        depth, so that :meth:`tile_kernel` reads them instead of blending field nodes (kept in memory)."""
+        depth, so that :meth:`tile_kernel` reads them instead of blending field nodes; returns the new ones."""
         from .defocus_field import box_depths, node_kernel
         from .defocus_trace import distortion_jacobians, pupil_boxes, trace_fans
 
@@ -510,6 +514,7 @@ class KernelCache:
             for key, fan in zip(part, fans):
                 self._direct[key] = node_kernel(cam, fan, fan, key[2], None, self._places[key[:2]][1])[0]
         self.traced += len(todo)
+        return {k: self._direct[k] for k in todo}
 
     # ---- what defocus reads -------------------------------------------------------------------
     def node_kernel(self, col: int, row: int, n: int) -> np.ndarray:
