@@ -32,11 +32,21 @@ settings.load_profile("physcam")
 def extension_zip(tmp_path_factory):
     """``physcam export blender-extension`` of every bundled lens, built once per test session and shared
     by the Blender extension's tests (building it solves every bundled lens's focus table, the slowest
-    step). Here, not in tests/blender/conftest.py: with --doctest-modules two conftest modules of one
-    name collide."""
+    step). Under pytest-xdist the workers share one build: the first worker to ask builds it under a
+    lock in the session's common temporary folder, the others wait and read it (each worker building
+    its own doubled the suite's slowest step). Here, not in tests/blender/conftest.py: with
+    --doctest-modules two conftest modules of one name collide."""
+    import fcntl
+
     from physcam.cli import main
 
-    out = tmp_path_factory.mktemp("ext")
-    assert main(["export", "blender-extension", "-o", str(out)]) == 0
+    base = tmp_path_factory.getbasetemp()
+    root = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+    out = root / "blender-extension"
+    with open(root / "blender-extension.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+        if not list(out.glob("physcam-*.zip")):
+            out.mkdir(exist_ok=True)
+            assert main(["export", "blender-extension", "-o", str(out)]) == 0
     (zp,) = out.glob("physcam-*.zip")
     return zp

@@ -81,6 +81,11 @@ scene.render.image_settings.file_format = "OPEN_EXR"
 def run_blender(script: str, *args, timeout: float = 300.0, env: dict | None = None) -> dict:
     """Run ``script`` (Python source) in Blender; it must print one JSON object on its last stdout line,
     which is returned. The source tree under test comes first on sys.path; ``env`` adds variables."""
+    return run_blender_log(script, *args, timeout=timeout, env=env)[0]
+
+
+def run_blender_log(script: str, *args, timeout: float = 300.0, env: dict | None = None) -> tuple[dict, str]:
+    """:func:`run_blender`, and everything Blender printed (stdout, then stderr)."""
     runner = require_blender()
     env = dict(os.environ, PYTHONPATH=str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""), **(env or {}))
     with tempfile.TemporaryDirectory(prefix="physcam-blender-") as tmp:
@@ -93,7 +98,7 @@ def run_blender(script: str, *args, timeout: float = 300.0, env: dict | None = N
     lines = [ln for ln in p.stdout.strip().splitlines() if ln.startswith("{")]
     if not lines:
         raise AssertionError(f"Blender script printed no JSON:\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}")
-    return json.loads(lines[-1])
+    return json.loads(lines[-1]), p.stdout + p.stderr
 
 
 def predicted_block_brightness(b, blocks: dict, w_px: int, h_px: int, sensor_mm, samples: int = 96) -> dict:

@@ -1,7 +1,8 @@
 """Bokeh through the physcam extension (its focus-table shader, iris and sensor as the panel's
 parameters) against physcam's :func:`physcam.analysis.bokeh.bokeh_image`, as
 tests/blender/test_osl_bokeh.py does for the baked shader: the double Gauss 50 mm focused at a 2 m
-mark, f/2.8 by physcam's one iris rule, 6 straight blades with a corner 15 degrees from +x; a 1 mm
+mark, f/2.8 by physcam's one iris rule, 6 straight blades with a corner 15 degrees from +x (the
+hexagon has the area of f/2.8's round iris: docs/conventions.md); a 1 mm
 emissive sphere 0.7 m from the film, rendered on a 3 x 3 mm crop of the film centre (the panel's
 custom sensor) and traced by physcam's tracer onto the same pixel grid."""
 
@@ -76,7 +77,10 @@ def test_bokeh_diameter_and_iris_corners_match_bokeh_image(extension_zip, tmp_pa
     st = focus(lens, MARK_MM)
     iris = Aperture(BLADES, CORNER_DEG)
     h = CROP_MM / 2
-    kw = dict(film_z=st.film_z, fresnel=False, stop_semi_diameter=iris_semi_diameter(lens, FSTOP), aperture=iris)
+    # the bladed iris has the area of the round iris of f/2.8 (docs/conventions.md): physcam's tracer
+    # draws the polygon inside the stop's circle, so that circle is sqrt(pi / polygon area) larger
+    corner = iris_semi_diameter(lens, FSTOP) * math.sqrt(math.pi / iris.area())
+    kw = dict(film_z=st.film_z, fresnel=False, stop_semi_diameter=corner, aperture=iris)
     near = bokeh_image(st.prescription, NEAR_MM, rays=2_000_000, pixels=CROP_PX, extent_mm=(-h, h, -h, h), **kw)
     off = bokeh_image(st.prescription, NEAR_MM, 10.0, rays=200_000, pixels=64, **kw)
     mag = abs(off.to_dict()["centroid_mm"][0]) / 10.0  # the sphere's own image: lateral magnification

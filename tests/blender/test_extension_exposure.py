@@ -1,9 +1,10 @@
-"""Stopped down, the extension's shader samples a smaller exit-pupil table (the smallest tabulated
-iris that holds the set one: :data:`physcam.export.blender_focus.STOP_LEVELS`) instead of the open
+"""Stopped down, the extension's shader aims its rays over the exit pupil of the set iris
+(:mod:`physcam.export.blender_pupil`: an ellipse per film radius and iris size) instead of the open
 lens's. Sampling a smaller region must change the noise only, not the picture: a uniform white
-world through the double Gauss at f/2.8 (open table), f/4.5 (the 0.5 table) and f/8 (the 0.35
-table) falls off from the centre to the edge and the corner as physcam's ``camera_rays`` weight
-predicts for the lens stopped to that f-number (its mean over the pupil, float64)."""
+world through the double Gauss at f/2.8, f/4.5 and f/8 falls off from the centre to the edge and
+the corner as physcam's ``camera_rays`` weight predicts for the lens stopped to that f-number (its
+mean over the pupil, float64); and a 5- or 6-blade iris at f/4.5 renders the centre as bright as
+the round one (the polygon has its area)."""
 
 from __future__ import annotations
 
@@ -49,6 +50,16 @@ for n in json.loads(sys.argv[9]):
     a = np.array(img.pixels[:], dtype=np.float64).reshape(H, W, 4)
     bpy.data.images.remove(img)
     out[str(n)] = {k: float(a[r0:r1, c0:c1, :3].mean()) for k, (r0, r1, c0, c1) in blocks.items()}
+p.fstop = 4.5
+for blades in (5, 6):  # a bladed iris has the round one's area (docs/conventions.md): the same exposure
+    p.blades = blades
+    scene.render.filepath = sys.argv[2] + f"/blades{blades}.exr"
+    bpy.ops.render.render(write_still=True)
+    img = bpy.data.images.load(scene.render.filepath)
+    a = np.array(img.pixels[:], dtype=np.float64).reshape(H, W, 4)
+    bpy.data.images.remove(img)
+    out[f"blades{blades}"] = {k: float(a[r0:r1, c0:c1, :3].mean()) for k, (r0, r1, c0, c1) in blocks.items()}
+p.blades = 0
 out["message"] = p.message
 print(json.dumps(out))
 '''
@@ -89,3 +100,9 @@ def test_stopped_down_pupil_tables_keep_the_picture(extension_zip, tmp_path):
         assert got["centre"] == pytest.approx(1.0, abs=0.03)
         for k in ("right", "corner"):
             assert abs(got[k] / got["centre"] - want[k]) < 0.02, (n, k)
+    # 5 and 6 blades at f/4.5: the centre as bright as the round iris's (the inscribed polygons of
+    # before rendered it at their area's share, 0.757 and 0.827 of the circle's)
+    for blades in (5, 6):
+        got = out[f"blades{blades}"]["centre"] / out["4.5"]["centre"]
+        print(f"{blades} blades at f/4.5: centre {got:.4f} of the round iris's")
+        assert got == pytest.approx(1.0, abs=0.015)

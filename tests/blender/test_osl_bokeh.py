@@ -125,7 +125,9 @@ def predicted():
     the shader."""
     lens = load_lens(LENS)
     st = focus(lens, MARK_MM)
-    semi = stop_semi_diameter_for_fstop(lens, FSTOP)
+    # the hexagon has the area of f/2.8's round iris (docs/conventions.md): physcam's tracer draws the
+    # polygon inside the stop's circle, so that circle is sqrt(pi / hexagon's area) larger
+    semi = stop_semi_diameter_for_fstop(lens, FSTOP) * math.sqrt(math.pi / IRIS.area())
     h = CROP_MM / 2
     kw = dict(film_z=st.film_z, fresnel=False, stop_semi_diameter=semi, aperture=IRIS)
     t0 = time.perf_counter()

@@ -65,7 +65,8 @@ def test_monochrome_indices_are_physcams_at_the_design_wavelength():
     np.testing.assert_allclose(_array(src, "N1"), t.index_before(lens.wavelength_nm), rtol=1e-15)
     np.testing.assert_allclose(_array(src, "N2"), t.index_after(lens.wavelength_nm), rtol=1e-15)
     assert np.array_equal(_array(src, "RSC"), t.r_scale)
-    assert "DB[" not in src and "hashnoise" not in src  # dispersion off: no per-ray index
+    # dispersion off: no per-ray wavelength or index (hashnoise also draws the iris's repeated aims)
+    assert "DB[" not in src and "u_wl" not in src and "lam " not in src
     assert "Ts *=" in src
 
 
@@ -169,3 +170,19 @@ def test_cli_errors_are_one_line(capsys, tmp_path, argv, message):
     assert rc == 2 and message in err and len(err.strip().splitlines()) == 1
     assert not any(tmp_path.iterdir())
 
+
+
+def test_focus_table_of_a_lens_longer_than_its_one_to_one_conjugate():
+    """The Laikin zoom at 15 mm is 288 mm long while its 1:1 conjugate (closest_focus, 4 f + hiatus)
+    is 250 mm from the film: a subject there would be inside the lens. The extension's focus table
+    (and its panel's closest focus) stops where the subject reaches the front vertex: the mark equals
+    the back focus plus the lens's track (subject distance 0), not the 1:1 mark."""
+    from physcam.export.blender_focus import focus_table
+    from physcam.optics.focusing import closest_focus
+
+    lens = load_lens("laikin_zoom_15_150mm")
+    ft = focus_table(lens, n_focus=2)
+    st = focus(lens, float(ft.closest_mm))
+    assert closest_focus(lens) < 260.0 < lens.total_track
+    assert st.object_distance_mm == pytest.approx(0.0, abs=0.01)
+    assert ft.closest_mm == pytest.approx(st.back_focus_mm + lens.total_track, abs=0.01)

@@ -44,7 +44,7 @@ from ._codetext import osl_comment, python_docstring
 from .osl import WAVELENGTH_RANGE_NM, osl_array, osl_number
 
 __all__ = ["BakedCamera", "bake_camera", "osl_camera_shader", "blender_setup_script", "write_blender_camera",
-           "PUPIL_GRID", "WAVELENGTH_RANGE_NM"]
+           "iris_corner_semi", "PUPIL_GRID", "WAVELENGTH_RANGE_NM"]
 
 #: Film grid of the baked exit-pupil table (nodes per axis).
 PUPIL_GRID = (9, 9)
@@ -138,6 +138,22 @@ def bake_camera(lens: CameraState | Prescription, *, focus_mm=None, fstop=None, 
     return _bake(state, fresnel)
 
 
+def iris_corner_semi(state: CameraState) -> float:
+    """The stop radius (mm) the iris's corners reach in the shader and in its bokeh comparison: a
+    bladed iris has the area of the round iris of the f-number (docs/conventions.md), so its corners
+    lie :meth:`~physcam.trace.aperture.Aperture.equal_area_scale` farther out than that circle, but
+    never beyond the lens's widest iris (the file's stop opened by physcam's stop-opening tolerance)."""
+    from ..optics.paraxial import STOP_OPENING_TOLERANCE
+
+    require_type("state", state, CameraState, _LENS_HINT)
+    ap = state.aperture
+    if ap is None or ap.is_circular:
+        return float(state.stop_semi_diameter)
+    q = state.focused
+    widest = q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE)
+    return float(min(state.stop_semi_diameter * ap.equal_area_scale(), max(widest, state.stop_semi_diameter)))
+
+
 def _bake(state: CameraState, fresnel: bool) -> BakedCamera:
     from ..trace.pupil_bounds import exit_pupil_bounds
     from ..trace.surfaces import surface_table
@@ -145,9 +161,10 @@ def _bake(state: CameraState, fresnel: bool) -> BakedCamera:
 
     q = state.focused
     k = q.stop_index
-    if state.stop_semi_diameter != q.surfaces[k].semi_diameter:
+    semi = iris_corner_semi(state)
+    if semi != q.surfaces[k].semi_diameter:
         s = list(q.surfaces)
-        s[k] = dataclasses.replace(s[k], semi_diameter=float(state.stop_semi_diameter))
+        s[k] = dataclasses.replace(s[k], semi_diameter=semi)
         q = q.with_surfaces(s)
     sw, sh = state.sensor_mm
     film_z = float(state.film_z)

@@ -78,7 +78,7 @@ def compare_bokeh(lens: CameraState | Prescription, *, focus_mm: float | None = 
     return both images and the measured agreement."""
     from ..analysis.blob import blob_moments, equivalent_diameter, polygon_corners
     from ..analysis.bokeh import bokeh_image
-    from .blender import _state, blender_setup_script, osl_camera_shader
+    from .blender import _state, blender_setup_script, iris_corner_semi, osl_camera_shader
 
     if isinstance(lens, CameraState) and (focus_mm is not None or fstop is not None):
         raise InputError("a CameraState carries its own focus and f-stop: give them to camera_state(), not here")
@@ -114,7 +114,7 @@ def compare_bokeh(lens: CameraState | Prescription, *, focus_mm: float | None = 
             raise OpticsError(f"Blender could not render the comparison: {tail[0][:200]}")
         rendered = np.load(job["npy"])
     h = crop / 2
-    kw = dict(film_z=state.film_z, fresnel=False, stop_semi_diameter=state.stop_semi_diameter, aperture=aperture)
+    kw = dict(film_z=state.film_z, fresnel=False, stop_semi_diameter=iris_corner_semi(state), aperture=aperture)
     traced = bokeh_image(state.focused, d_light, rays=rays, pixels=pixels, extent_mm=(-h, h, -h, h), **kw)
     off = bokeh_image(state.focused, d_light, 10.0, rays=200_000, pixels=64, **kw)  # the magnification there
     mag = abs(off.to_dict()["centroid_mm"][0]) / 10.0

@@ -23,6 +23,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..errors import InputError
+from ..optics.thinlens import MAX_F_NUMBER
 
 __all__ = ["build_extension", "lens_payload", "extension_manifest", "REFERENCE_FSTOP", "REPORT_SENSOR_MM"]
 
@@ -87,19 +88,57 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
             shaders[f"{slug}__d{int(disp)}f{int(fres)}.osl"] = focus_table_shader(ft, dispersion=disp, fresnel=fres,
                                                                                pupil_mm=pupil)
     data = {"slug": slug, "name": lens.name, "closest_m": ft.closest_mm / 1000.0, "fstop_min": ft.fstop_min,
+            "fstop_open": ft.fstop_open, "fstop_max": MAX_F_NUMBER,
             "inv_step_per_m": ft.inv_step_per_m, "anamorphic": bool(lens.is_anamorphic),
             "report_fstop": REFERENCE_FSTOP, "report_sensor_mm": list(REPORT_SENSOR_MM),
+            "focus_object": _focus_object_fits(rows),
             "rows": rows}
     return data, shaders
 
 
-def _sensor_presets() -> list[dict]:
-    """physcam's sensor table, those a full-frame pupil table covers (:data:`GRID_HALF_MM`)."""
-    from ..onset.sensors import sensors
-    from .blender_focus import GRID_HALF_MM
+def _focus_object_fits(rows) -> dict:
+    """What Focus on Object's drivers evaluate (no table lookup fits in a driver's simple expression):
+    with D the object's distance from the entrance pupil (m), the pupil's distance from the film
+    (m) and the best-match pinhole (mm) as a + b / (D + c), fitted to the report's rows (Newton: a
+    lens that focuses as a whole moves its film by f^2 / x, x the object's distance from the front
+    focal point, so the form is exact for it; the internal-focus lenses bundled fit within 0.02 mm).
+    ``d_min_m``: D at the closest focus."""
+    import numpy as np
 
-    return [{"name": s.name, "width_mm": s.width_mm, "height_mm": s.height_mm} for s in sensors()
-            if math.hypot(s.width_mm, s.height_mm) / 2 <= GRID_HALF_MM]
+    mark = np.array([r["mark_mm"] for r in rows]) / 1000.0
+    pupil = np.array([r["pupil_from_film_mm"] for r in rows]) / 1000.0
+    d = mark - pupil
+    out = {"d_min_m": float(d.min())}
+    for key, y in (("pupil_m", pupil), ("pinhole_mm", np.array([r["pinhole_mm"] for r in rows]))):
+        def err(c):
+            w = 1.0 / (d + c)
+            return float(np.abs(np.polyval(np.polyfit(w, y, 1), w) - y).max())
+
+        lo, hi = -0.99 * d.min(), 10.0 * max(d.min(), 0.1)
+        for _ in range(5):  # a scan, refined about its best four times
+            cs = np.linspace(lo, hi, 101)
+            best = min(range(cs.size), key=lambda i: err(cs[i]))
+            lo, hi = cs[max(best - 1, 0)], cs[min(best + 1, cs.size - 1)]
+        c = float(cs[best])
+        b, a = np.polyfit(1.0 / (d + c), y, 1)
+        out[key] = [float(a), float(b), c]
+    return out
+
+
+def _sensor_presets() -> list[dict]:
+    """physcam's whole sensor table (``physcam sensors``): the pupil table reaches the largest's corner."""
+    from ..onset.sensors import sensors
+
+    return [{"name": s.name, "width_mm": s.width_mm, "height_mm": s.height_mm} for s in sensors()]
+
+
+def _limits() -> dict:
+    """The sensor the add-on accepts at most: the pupil table's reach (physcam's largest sensor)."""
+    from ..onset.sensors import sensors
+    from .blender_pupil import RADIAL_MAX_MM
+
+    largest = max(sensors(), key=lambda s: math.hypot(s.width_mm, s.height_mm))
+    return {"sensor_half_diagonal_max_mm": RADIAL_MAX_MM, "sensor_largest": largest.name}
 
 
 def _addon_source() -> str:
@@ -135,4 +174,5 @@ def build_extension(out_dir, *, lenses=None, force: bool = False, progress=None)
                 progress(slug)
         z.writestr("lenses/index.json", json.dumps(index))
         z.writestr("sensors.json", json.dumps(_sensor_presets()))
+        z.writestr("limits.json", json.dumps(_limits()))
     return atomic_write(out, buf.getvalue(), force=force)

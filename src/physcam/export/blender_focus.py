@@ -6,11 +6,16 @@ uniform in 1/distance from infinity to the closest focus; :func:`focus_table_sha
 template ``osl/physcam_lens.osl.in`` with that table, and the shader blends the two states that
 bracket its ``focus_distance`` parameter (metres from the film plane), linearly in 1/distance. The
 iris follows physcam's one rule (:func:`~physcam.optics.state.camera_state`'s iris, sized at
-infinity focus): paraxial, so its semi-diameter is K / N with K tabulated here. The exit-pupil
-rectangles are those of the open lens and of the lens stopped to :data:`STOP_LEVELS` over a film
-square of :data:`GRID_HALF_MM` (any sensor that fits it; the shader samples the smallest that holds
-its iris), the weight normalised at the film centre of each state (the centre renders 1 at every
-stop; with Fresnel on, the centre's transmission at infinity is divided out too). Keyframing the parameters renders a focus pull or an iris change with no rebuild.
+infinity focus): paraxial, so its semi-diameter is K / N with K tabulated here; it opens as far as
+physcam's camera state opens it, :data:`~physcam.optics.paraxial.STOP_OPENING_TOLERANCE` beyond the
+file's stop (a lens's own marked f-number, rounded, is always accepted). Where the shader aims its
+rays: for a lens with rotational symmetry, the ellipses of :mod:`physcam.export.blender_pupil` per
+film radius and iris size (nearly every sample passes, at every stop); for an anamorphic lens, the
+exit-pupil rectangles of the lens at its widest iris and stopped to :data:`STOP_LEVELS` of it over a
+film square of :data:`GRID_HALF_MM` (the shader samples the smallest that holds its iris). The
+weight is normalised at the film centre of each state and iris size (the centre renders 1 at every
+stop; with Fresnel on, the centre's transmission at infinity is divided out too). Keyframing the parameters
+renders a focus pull or an iris change with no rebuild.
 """
 
 from __future__ import annotations
@@ -38,6 +43,8 @@ _GRID = (9, 9)
 #: exit-pupil tables: stopped down, the shader samples the smallest tabulated pupil that holds the
 #: iris's, instead of the open lens's (fewer wasted samples: less noise at equal samples).
 STOP_LEVELS = (0.75, 0.5, 0.35, 0.25)
+#: Aims a camera ray tries, where the passing set's area is known, before it counts as lost.
+N_TRY = 8
 
 
 @dataclasses.dataclass
@@ -49,25 +56,88 @@ class FocusTable:
     inv_step_per_m: float  # spacing of the marks in 1/metres
     film_z: np.ndarray  # (n,) film plane z, lens space
     vertex_z: np.ndarray  # (n, surfaces)
-    rects: np.ndarray  # (n, ny, nx, 4) exit-pupil rectangles of the open lens
-    rects_stopped: np.ndarray  # (n, len(STOP_LEVELS), ny, nx, 4): the same with the iris at each level
-    norm: np.ndarray  # (n,) mean weight at the film centre, open
+    radial: np.ndarray | None  # (n, N_LEVEL, N_RADIAL, 3) pupil ellipses (blender_pupil); None: anamorphic
+    rects: np.ndarray | None  # (n, ny, nx, 4) exit-pupil rectangles at the widest iris (anamorphic only)
+    rects_stopped: np.ndarray | None  # (n, len(STOP_LEVELS), ny, nx, 4): the same stopped to each level
+    norm: np.ndarray  # (n, N_LEVEL) mean weight at the film centre, the round iris at each of iris_levels(semi_max)
     table: object  # SurfaceTable at infinity (the rows that do not move)
-    bounds: object  # PupilBounds at infinity (the grid)
+    bounds: object  # PupilBounds at infinity (the 2-D grid; anamorphic only, else None)
     iris_k: float  # iris semi-diameter x f-number (mm)
-    fstop_min: float  # the lens wide open
+    fstop_open: float  # the lens wide open (the file's stop)
+    fstop_min: float  # the fastest f-stop accepted: physcam's camera state opens the iris this far
     closest_mm: float
     fresnel_loss: float  # Fresnel transmission at the film centre at infinity (uncoated)
 
+    @property
+    def semi_max(self) -> float:
+        """The widest iris's semi-diameter (mm): the stop opened to :attr:`fstop_min`."""
+        return self.iris_k / self.fstop_min
 
-def _centre_norm(q, film_z, bounds, fresnel: bool = False) -> float:
+    @property
+    def levels(self) -> np.ndarray:
+        """The iris radii (mm) of the pupil and normalisation tables (:func:`~physcam.export.blender_pupil.iris_levels`)."""
+        from .blender_pupil import iris_levels
+
+        return iris_levels(self.semi_max, self.iris_k / self.fstop_open)
+
+
+def _centre_norm(q, film_z, bounds, fresnel: bool = False, stop_semi_diameter=None) -> float:
+    """camera_rays' mean weight at the film centre (64^2 stratified aim points over ``bounds``)."""
     from ..trace.trace import camera_rays
 
     m = 64
     u = (np.arange(m) + 0.5) / m
     uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
-    cr = camera_rays(q, np.zeros((uu.size, 2)), np.stack([uu, vv], axis=1), film_z, bounds=bounds, fresnel=fresnel)
+    cr = camera_rays(q, np.zeros((uu.size, 2)), np.stack([uu, vv], axis=1), film_z, bounds=bounds, fresnel=fresnel,
+                     stop_semi_diameter=stop_semi_diameter)
     return float(np.mean(cr.weight))
+
+
+def _centre_bounds(q, ellipse):
+    """A PupilBounds whose every node holds the rectangle around an ellipse (cx, ax, ay)."""
+    from ..trace.pupil_bounds import PupilBounds
+
+    cx, ax, ay = ellipse[:3]
+    rect = np.broadcast_to([cx - ax, cx + ax, -ay, ay], (2, 2, 4)).copy()
+    return PupilBounds(np.array([-1.0, 1.0]), np.array([-1.0, 1.0]), rect, float(q.vertex_z[-1]))
+
+
+def _centre_norms(q, film_z, radial, bounds, levels) -> list[float]:
+    """The centre's mean weight with the round iris at each tabulated iris level: the shader's
+    normalisation (the exit pupil's area is not quite the square of the iris's radius)."""
+    out = []
+    for k, s in enumerate(levels):
+        b = bounds if radial is None else _centre_bounds(q, radial[k, 0])
+        out.append(_centre_norm(q, film_z, b, stop_semi_diameter=float(s)))
+    return out
+
+
+def _nearest_mark(lens: Prescription, near: float) -> float:
+    """The closest mark (mm from the film), at or beyond ``near``, that physcam's focusing reaches: a
+    lens longer than its 1:1 conjugate (the Laikin zoom at 15 mm: 288 mm long, 1:1 at 250 mm from the
+    film) would hold the subject inside it there, so the mark is moved out (bisection to 1e-6)."""
+    from ..optics.focusing import focus
+
+    def reaches(m):
+        try:
+            focus(lens, m)
+        except OpticsError:
+            return False
+        return True
+
+    if reaches(near):
+        return near
+    lo, hi = near, 2 * near
+    for _ in range(30):
+        if reaches(hi):
+            break
+        lo, hi = hi, 2 * hi
+    else:
+        raise OpticsError(f"{lens.name!r} focuses at no distance from {near:.1f} mm to {hi:.0f} mm from the film")
+    while hi - lo > 1e-6 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if reaches(mid) else (mid, hi)
+    return hi
 
 
 @takes_prescription
@@ -75,39 +145,60 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     """Tabulate ``lens``'s focus states (module notes). Raises OpticsError when the lens passes no
     ray at the film centre."""
     from ..optics.focusing import closest_focus, focus, gaussian_at_focus
+    from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
-    from ..trace.pupil_bounds import exit_pupil_bounds
     from ..trace.surfaces import surface_table
+    from .blender_pupil import iris_levels, radial_pupil_table
 
     if isinstance(n_focus, bool) or not isinstance(n_focus, int) or n_focus < 2:
         raise InputError(f"a focus table needs at least 2 states, got {n_focus!r}")
-    near = closest_focus(lens) * (1 + 1e-6)  # a hair beyond: rounding must not ask for closer than it reaches
+    near = _nearest_mark(lens, closest_focus(lens) * (1 + 1e-6))  # a hair beyond: rounding must not ask closer
     step = 1000.0 / near / (n_focus - 1)  # 1/m
     marks = np.array([math.inf] + [1000.0 / (step * i) for i in range(1, n_focus)])
     marks[-1] = max(marks[-1], near)
-    film_z, vz, rects, stopped, norm = [], [], [], [], []
-    nx, ny = _GRID
+    n_open = gaussian_at_focus(lens, math.inf).f_number * (1 + 1e-9)
+    k = camera_state(lens, fstop=n_open).stop_semi_diameter * n_open  # the one iris rule, at infinity focus
+    n_min = n_open / (1 + STOP_OPENING_TOLERANCE)
+    levels = iris_levels(k / n_min, k / n_open)
+    film_z, vz, radial, rects, stopped, norm = [], [], [], [], [], []
     for mk in marks:
         st = focus(lens, float(mk))
         q = st.prescription
         t = surface_table(q, reverse=True, coating="none")
-        b = exit_pupil_bounds(q, grid_half_mm, grid_half_mm, st.film_z, nx=nx, ny=ny, samples=48)
         film_z.append(st.film_z)
         vz.append(t.vertex_z)
-        rects.append(b.rects)
-        stopped.append([exit_pupil_bounds(_stopped(q, f), grid_half_mm, grid_half_mm, st.film_z, nx=nx, ny=ny,
-                                          samples=32).rects for f in STOP_LEVELS])
-        norm.append(_centre_norm(q, st.film_z, b))
+        if lens.is_anamorphic:
+            b, rect, rect_levels = _rect_tables(q, st.film_z, levels[0], grid_half_mm)
+            rects.append(rect)
+            stopped.append(rect_levels)
+            norm.append(_centre_norms(q, st.film_z, None, b, levels))
+        else:
+            radial.append(radial_pupil_table(q, st.film_z, levels))
+            b = _centre_bounds(q, radial[-1][0, 0])
+            norm.append(_centre_norms(q, st.film_z, radial[-1], None, levels))
         if mk == marks[0]:
-            table0, bounds0 = t, b
-            loss = _centre_norm(q, st.film_z, b, fresnel=True) / norm[0]
-    if not all(v > 0 for v in norm):
+            table0, bounds0 = t, (b if lens.is_anamorphic else None)
+            loss = _centre_norm(q, st.film_z, b, fresnel=True) / _centre_norm(q, st.film_z, b)
+    if not all(min(v) > 0 for v in norm):
         raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some focus")
-    n_open = gaussian_at_focus(lens, math.inf).f_number * (1 + 1e-9)
-    k = camera_state(lens, fstop=n_open).stop_semi_diameter * n_open  # the one iris rule, at infinity focus
-    return FocusTable(lens, marks, step, np.array(film_z), np.array(vz), np.array(rects), np.array(stopped),
-                      np.array(norm), table0,
-                      bounds0, float(k), float(n_open), float(near), float(loss))
+    def arr(v):
+        return np.array(v) if v else None
+
+    return FocusTable(lens, marks, step, np.array(film_z), np.array(vz), arr(radial), arr(rects), arr(stopped),
+                      np.array(norm), table0, bounds0, float(k), float(n_open), float(n_min), float(near), float(loss))
+
+
+def _rect_tables(q, film_z, semi_max, grid_half_mm):
+    """(PupilBounds at the widest iris, its rectangles, the rectangles at each of :data:`STOP_LEVELS`)."""
+    from ..trace.pupil_bounds import exit_pupil_bounds
+
+    nx, ny = _GRID
+    semi_file = q.surfaces[q.stop_index].semi_diameter
+    b = exit_pupil_bounds(_stopped(q, semi_max / semi_file), grid_half_mm, grid_half_mm, film_z, nx=nx, ny=ny,
+                          samples=48)
+    levels = [exit_pupil_bounds(_stopped(q, f * semi_max / semi_file), grid_half_mm, grid_half_mm, film_z, nx=nx,
+                                ny=ny, samples=32).rects for f in STOP_LEVELS]
+    return b, b.rects, levels
 
 
 def _stopped(q: Prescription, fraction: float) -> Prescription:
@@ -141,24 +232,37 @@ def ghost_rows(ft: FocusTable) -> tuple[list[int], list[int]]:
 def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: bool = False, focus_m: float = 3.0,
                        fstop: float = 0.0, sensor_mm=(DEFAULT_SENSOR_WIDTH_MM, DEFAULT_SENSOR_HEIGHT_MM),
                        pupil_mm=None) -> str:
-    """The template with ``ft``'s focus table: focus, f-stop, sensor, iris and ghosts are shader
-    parameters (defaults from the keywords; ``fstop`` 0 is wide open). ``pupil_mm``: the entrance
-    pupil's distance in front of the film at each focus state; given, the camera's origin is the
-    entrance pupil (the film behind it), else the film plane."""
+    """The template with ``ft``'s focus table: focus, f-stop, sensor (with Blender's sensor fit and
+    the frame's aspect), iris and ghosts are shader parameters (defaults from the keywords; ``fstop``
+    0 is wide open). ``pupil_mm``: the entrance pupil's distance in front of the film at each focus
+    state; given, the camera's origin is the entrance pupil (the film behind it), else the film plane."""
+    from .blender_pupil import N_LEVEL, N_RADIAL, RADIAL_MAX_MM
+
     require_type("ft", ft, FocusTable, "physcam.export.blender_focus.focus_table(lens)")
     n_focus = len(ft.marks_mm)
     n = len(ft.table)
     defines, data = lens_data(ft.table, None, ft.lens.wavelength_nm, ft.bounds, dispersion=dispersion,
                               fresnel=fresnel)
     defines += ["#define PHYSCAM_FOCUS_TABLE 1", "#define PHYSCAM_APERTURE 1", "#define PHYSCAM_POLYGON 1",
-                f"#define N_FOCUS {n_focus}", f"#define N_VZ_TAB {n_focus * n}",
-                f"#define N_LEVEL {1 + len(STOP_LEVELS)}",
-                f"#define N_RECT_TAB {ft.rects[0].size * n_focus * (1 + len(STOP_LEVELS))}",
+                f"#define N_FOCUS {n_focus}", f"#define N_VZ_TAB {n_focus * n}", f"#define N_IRIS {N_LEVEL}",
+                f"#define N_NORM_TAB {n_focus * N_LEVEL}",
                 f"#define FOCUS_INV_STEP {_num32(ft.inv_step_per_m)}", f"#define IRIS_K {_num32(ft.iris_k)}",
-                f"#define FSTOP_MIN {_num32(ft.fstop_min)}", f"#define FOCUS_DEFAULT_M {osl_number(focus_m)}",
+                f"#define FSTOP_OPEN {_num32(ft.fstop_open)}", f"#define FSTOP_MIN {_num32(ft.fstop_min)}",
+                f"#define SEMI_MAX {_num32(ft.semi_max)}", f"#define FOCUS_DEFAULT_M {osl_number(focus_m)}",
                 f"#define FSTOP_DEFAULT {osl_number(fstop)}", f"#define SENSOR_W_DEFAULT {osl_number(sensor_mm[0])}",
                 f"#define SENSOR_H_DEFAULT {osl_number(sensor_mm[1])}",
-                f"#define GRID_HW {osl_number(ft.bounds.xs[-1])}", f"#define GRID_HH {osl_number(ft.bounds.ys[-1])}"]
+                f"#define ASPECT_DEFAULT {osl_number(sensor_mm[0] / sensor_mm[1])}"]
+    if ft.radial is not None:
+        defines += ["#define PHYSCAM_RADIAL_PUPIL 1", f"#define N_RAD {N_RADIAL}",
+                    f"#define N_RAD_TAB {ft.radial.size}", f"#define RAD_MAX {osl_number(RADIAL_MAX_MM)}",
+                    f"#define RAD_STEP {osl_number(RADIAL_MAX_MM / (N_RADIAL - 1))}", f"#define N_TRY {N_TRY}"]
+        data.append(_arr32("RAD_TAB", ft.radial, "N_RAD_TAB"))
+    else:
+        defines += [f"#define N_LEVEL {1 + len(STOP_LEVELS)}",
+                    f"#define N_RECT_TAB {ft.rects[0].size * n_focus * (1 + len(STOP_LEVELS))}",
+                    f"#define GRID_HW {osl_number(ft.bounds.xs[-1])}", f"#define GRID_HH {osl_number(ft.bounds.ys[-1])}"]
+        data += [_arr32("RECT_TAB", np.concatenate([ft.rects[:, None], ft.rects_stopped], axis=1), "N_RECT_TAB"),
+                 osl_array("STOP_LEVEL", (1.0,) + STOP_LEVELS, "N_LEVEL")]
     # with Fresnel on, the centre's transmission at infinity is in the norm (it hardly changes with focus)
     norm = ft.norm * (ft.fresnel_loss if fresnel else 1.0)
     ga, gb = ghost_rows(ft)
@@ -176,10 +280,9 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
             raise InputError(f"pupil_mm needs one distance per focus state ({n_focus}), got {len(pupil_mm)}")
         defines.append("#define PHYSCAM_PUPIL_ORIGIN 1")
         data.append(_arr32("PUPIL_TAB", pupil_mm, "N_FOCUS"))
-    data += [_arr32("FILM_Z_TAB", ft.film_z, "N_FOCUS"), _arr32("NORM_TAB", norm, "N_FOCUS"),
+    data += [_arr32("FILM_Z_TAB", ft.film_z, "N_FOCUS"), _arr32("NORM_TAB", norm, "N_NORM_TAB"),
              _arr32("VZ_TAB", ft.vertex_z, "N_VZ_TAB"), osl_array("SEMI_OPEN", ft.table.semi_diameter, "N_SURF"),
-             _arr32("RECT_TAB", np.concatenate([ft.rects[:, None], ft.rects_stopped], axis=1), "N_RECT_TAB"),
-             osl_array("STOP_LEVEL", (1.0,) + STOP_LEVELS, "N_LEVEL")]
+             _arr32("IRIS_LEVEL", ft.levels, "N_IRIS")]
     head = [f"// {osl_comment(ft.lens.name)}: {n_focus} focus states from infinity to {ft.closest_mm / 1000:.3g} m "
             f"(uniform in 1/distance); dispersion {'on' if dispersion else 'off'}, Fresnel {'on' if fresnel else 'off'}."]
     return render_template(head + defines, data)

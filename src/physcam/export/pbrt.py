@@ -400,7 +400,8 @@ def pbrt_camera_values(report, lens=None, *, xres: int = 1920, cameras=PBRT_CAME
     ``perspective`` (thin lens): ``fov`` (degrees, across the shorter image axis) of the best-match
     pinhole, ``lensradius`` (half the entrance pupil, f / 2N, in metres) and ``focaldistance`` (metres
     from the entrance pupil). ``realistic`` (needs ``lens``): ``lensfile``, ``aperturediameter`` (the
-    stop's diameter for the report's f-number, mm) and ``focusdistance`` (the mark, metres from the film).
+    stop's diameter for the report's f-number, mm: the round iris, which has the area of any bladed
+    iris of that f-number, docs/conventions.md) and ``focusdistance`` (the mark, metres from the film).
     """
     return _camera_values(report, lens, xres=xres, cameras=cameras, lensfile=lensfile)[0]
 

@@ -126,7 +126,8 @@ def rib_camera_values(
 ) -> dict:
     """Everything a RIB camera block says for ``report``: :func:`renderman_camera_values` plus
     ``Shutter`` (from the rotary shutter angle, in frames), the aperture shape
-    (nsides, angle in degrees, roundness, density; seed 002), the shutter opening ramps and
+    (nsides, angle in degrees, roundness, density; seed 002; ``fStop`` is N, the bladed iris having
+    the area of the round iris of f/N, docs/conventions.md), the shutter opening ramps and
     ``dofaspect`` (width / height of the defocus blur in the desqueezed picture: the lens
     report's ``dof_aspect``, 1 / squeeze for a thin anamorphic, the entrance pupil's X / Y
     diameter for a prescription). Lengths in scene units of ``meters_per_unit`` metres.

@@ -78,6 +78,12 @@ class Aperture:
         phi = (np.arange(_TABLE) + 0.5) * 2 * math.pi / _TABLE
         return float(0.5 * (self.rim_radius(phi) ** 2).sum() * 2 * math.pi / _TABLE)
 
+    def equal_area_scale(self) -> float:
+        """sqrt(pi / :meth:`area`): how far out the corners go (in the round iris's radii) when the shape
+        has the round iris's area, physcam's meaning of an f-number with blades (docs/conventions.md);
+        1 for a circle."""
+        return 1.0 if self.is_circular else math.sqrt(math.pi / self.area())
+
     def sample(self, u) -> np.ndarray:
         """Map (n, 2) uniform numbers in [0, 1) to (n, 2) points on the shape, pdf prop. to density."""
         u = np.atleast_2d(np.asarray(u, dtype=float))

@@ -228,7 +228,9 @@ def _author_body(cam, spec, position, rotate_xyz_deg, eye_su):
 
 
 def _iris_mm(spec) -> float:
-    """The schema's ``iris``: the entrance pupil's diameter at this focus, focal length / f-number there."""
+    """The schema's ``iris``: the entrance pupil's diameter at this focus, focal length / f-number there
+    (with ``shutterBlades`` the equal-area diameter: the blades' polygon has this circle's area,
+    docs/conventions.md)."""
     return spec.focal_length_mm / (spec.fstop if spec.fstop_at_focus is None else spec.fstop_at_focus)
 
 

@@ -21,7 +21,7 @@ __all__ = ["FEATURES", "template_text", "render_template", "lens_data", "osl_num
 
 #: The template's feature switches: a data block that defines one keeps that code, else it goes.
 FEATURES = ("PHYSCAM_FOCUS_TABLE", "HAS_ASPHERE", "PHYSCAM_DISPERSION", "PHYSCAM_FRESNEL", "PHYSCAM_APERTURE",
-            "PHYSCAM_POLYGON", "PHYSCAM_GHOSTS", "PHYSCAM_PUPIL_ORIGIN", "PHYSCAM_SP")
+            "PHYSCAM_POLYGON", "PHYSCAM_GHOSTS", "PHYSCAM_PUPIL_ORIGIN", "PHYSCAM_RADIAL_PUPIL", "PHYSCAM_SP")
 #: Wavelengths sampled per ray when dispersion is on (uniform).
 WAVELENGTH_RANGE_NM = (400.0, 700.0)
 
@@ -100,7 +100,8 @@ def render_template(defines: list[str], data: list[str]) -> str:
 def lens_data(table, aperture, wavelength_nm: float, bounds, *, dispersion: bool, fresnel: bool) -> tuple[list[str], list[str]]:
     """The defines and the data lines that do not change with focus: surface kinds, quadric and
     asphere coefficients, indices (or dispersion coefficients), Fresnel scales and the iris shape
-    (``aperture``; in a focus-table shader the iris is the shader's parameters, pass None). ``table``: a :func:`physcam.trace.surfaces.surface_table` (film side first)."""
+    (``aperture``; in a focus-table shader the iris is the shader's parameters, pass None). ``table``: a :func:`physcam.trace.surfaces.surface_table` (film side first);
+    ``bounds``: the exit-pupil rectangles' PupilBounds, or None for a radial pupil table."""
     from ...errors import require_type
     from ...trace.kernels._layout import NA, NB, SA, SB, index_rows, pack
     from ...trace.surfaces import SurfaceTable
@@ -109,11 +110,11 @@ def lens_data(table, aperture, wavelength_nm: float, bounds, *, dispersion: bool
 
     n = len(table)
     S, kinds = pack(table)
-    nx, ny = len(bounds.xs), len(bounds.ys)
-    defines = [f"#define N_SURF {n}", f"#define STOP_ROW {int(np.flatnonzero(table.kind == 1)[0])}",
-               f"#define N_BX {nx}", f"#define N_BY {ny}", f"#define N_RECT {nx * ny * 4}",
-               f"#define N_ASPH {n * 7}  // OSL array sizes must be plain integer literals",
-               f"#define N_DISP {n * 9}"]
+    defines = [f"#define N_SURF {n}", f"#define STOP_ROW {int(np.flatnonzero(table.kind == 1)[0])}"]
+    if bounds is not None:  # the exit-pupil rectangles' grid (a radial pupil table has none)
+        nx, ny = len(bounds.xs), len(bounds.ys)
+        defines += [f"#define N_BX {nx}", f"#define N_BY {ny}", f"#define N_RECT {nx * ny * 4}"]
+    defines += [f"#define N_ASPH {n * 7}  // OSL array sizes must be plain integer literals", f"#define N_DISP {n * 9}"]
     data = [osl_array("KIND", kinds, "N_SURF", "int")]
     for name, col in (("AX", table.ax), ("AY", table.ay), ("AZ", table.az), ("CV", table.curvature),
                       ("CK", table.conic)):
