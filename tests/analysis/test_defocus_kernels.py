@@ -203,3 +203,25 @@ def test_bright_spot_near_focus_matches_kernels_traced_at_its_corners(blur_px):
     ref = defocus(img, u, _TracedAtCorners(cam))
     assert ref.max() > 2.0  # a concentrated spot: the case the blend got wrong
     assert np.abs(out - ref).max() <= 0.005 * ref.max()
+
+
+def test_a_bladed_iris_blurs_as_the_round_iris_of_its_f_number():
+    """One f-number convention with blades (docs/conventions.md, issue 41 item 5): a 6-blade iris at f/2.8
+    has the round f/2.8 iris's area, so its corners lie sqrt(pi / (3 sin 60 deg)) = 1.0996 round radii out
+    (closed form of a regular hexagon's area), as in physcam's Blender camera. A uniform hexagon of the
+    disk's area has a polar second moment 20 sqrt(3) pi^2 / 216 / (pi / 2) = 1.0077 times the disk's, so
+    an on-axis point's blur has an RMS radius within 2 % of the round iris's (the hexagon inscribed in the
+    round pupil, the old convention, gave 0.913 of it)."""
+    from physcam.trace.aperture import Aperture
+
+    lens = load_lens("dgauss_50mm")
+    kw = dict(focus_mm=2000.0, fstop=2.8, sensor_width_mm=36.0, width=320, height=180, tile=32)
+    rnd = defocus_camera(lens, **kw)
+    hexa = defocus_camera(lens, aperture=Aperture(6), **kw)
+    assert hexa.stop_semi / rnd.stop_semi == pytest.approx(math.sqrt(math.pi / (3 * math.sin(math.pi / 3))), rel=1e-6)
+    point = [(160.0, 90.0, 500.0)]  # on the axis, 0.5 m from the pupil: a blur about 12 px across
+    radii = []
+    for c in (rnd, hexa):
+        sx, sy = _moments(c.kernels(point)[0].image)
+        radii.append(math.hypot(sx, sy))
+    assert radii[1] / radii[0] == pytest.approx(1.0077 ** 0.5, abs=0.02)

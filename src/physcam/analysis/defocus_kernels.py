@@ -63,7 +63,7 @@ SAMPLES_PER_PX, MAX_SAMPLES, MIN_SAMPLES = 8.0, 1 << 16, 1 << 12
 #: orientation (coma turns with the azimuth) faster than a few field nodes follow (issue 47)
 DIRECT_BLUR_PX = 16.0
 #: what the disk cache's files are laid out as and the field grid's rules (part of the camera key)
-CACHE_FORMAT = "physcam-defocus-kernels/4"
+CACHE_FORMAT = "physcam-defocus-kernels/5"
 
 
 @dataclass
@@ -296,10 +296,11 @@ def defocus_camera(lens: CameraState | Prescription, *, focus_mm: float | None =
     if tp.pinhole_focal_length_mm is None:
         raise OpticsError(f"{lens.name} has no best-match pinhole at this focus (its chief ray does not reach the film)")
     ap = _as_aperture(cam.aperture if aperture is None else aperture)
+    stop_semi = cam.stop_semi_diameter if ap is None else ap.corner_semi(cam.stop_semi_diameter, _widest_iris(cam))
     fx, dx = _x_meridian(lens, focus_mm, fstop, tp)
     return DefocusCamera(lens=lens, focus_mm=float(focus_mm), fstop=float(fstop), sensor_width_mm=sw,
                          width=int(width), height=int(height), aperture=ap, dispersion=bool(dispersion),
-                         tile=int(tile), step_px=step, step_rel=rel, film_z=cam.film_z, stop_semi=cam.stop_semi_diameter,
+                         tile=int(tile), step_px=step, step_rel=rel, film_z=cam.film_z, stop_semi=stop_semi,
                          focused=cam.focused, pupil_from_film_mm=tp.entrance_pupil_from_film_mm,
                          front_from_film_mm=tp.front_vertex_from_film_mm, pinhole_mm=tp.pinhole_focal_length_mm,
                          pupil_diameter_mm=tp.entrance_pupil_diameter_mm, pinhole_x_mm=fx, pupil_diameter_x_mm=dx,
@@ -321,6 +322,15 @@ def _x_meridian(lens, focus_mm, fstop, tp) -> tuple[float, float]:
     s = focus_mm - tp.entrance_pupil_from_film_mm
     scale = s / (s - delta) if math.isfinite(s) else 1.0
     return tx.pinhole_focal_length_mm * scale, tx.entrance_pupil_diameter_mm
+
+
+def _widest_iris(cam) -> float:
+    """The lens's widest iris (mm): its file's stop opened by physcam's stop-opening tolerance, the
+    farthest a bladed iris's corners go (docs/conventions.md, f-numbers)."""
+    from ..optics.paraxial import STOP_OPENING_TOLERANCE
+
+    q = cam.focused
+    return q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE)
 
 
 def _as_aperture(aperture):
