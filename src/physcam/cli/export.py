@@ -38,6 +38,9 @@ def register(sub) -> None:
     u.add_argument("--focus", type=focus("focus distance"), action="append", metavar="D",
                    help=f"focus mark from the film plane (repeat; default: infinity to the closest focus; {FOCUS_HELP}; "
                         "hyperfocal wide open)")
+    u.add_argument("--zoom", action="append", default=None, metavar="POSITION",
+                   help="a zoom lens's position (repeat; a focal length with its unit, 135mm, or the encoder value "
+                        "0..1; default: its tabulated positions): the lens file is a focus x zoom grid (docs/zoom.md)")
     u.add_argument("--force", action="store_true", help="overwrite an existing file")
     add_units_option(u)
     add_output_options(u, csv=True, what="the lens file's marks")
@@ -129,7 +132,7 @@ def run_unreal(args) -> int:
     check_writable(args.output, force=args.force)
     lens = _prepare(args)
     data = unreal_lens_file(lens, args.sensor_width, args.sensor_height, image_width_px=args.width_px,
-                            image_height_px=args.height_px, focus_marks_mm=args.focus)
+                            image_height_px=args.height_px, focus_marks_mm=args.focus, zoom_positions=args.zoom)
     import json
 
     atomic_write(args.output, json.dumps(data, indent=2, allow_nan=False) + "\n", force=args.force)
@@ -146,10 +149,12 @@ def run_unreal(args) -> int:
     units = units_of(args)
     print(f"wrote {args.output}: Unreal lens file of {pc['lens']} on {args.sensor_width:g} x {args.sensor_height:g} mm, "
           f"{args.width_px} x {args.height_px} px")
-    t = Table(None, ("focus", "Fx", "Fy", "K1", "K2", "K3", "pupil cm", "resid px"), justify=["right"] * 8)
+    zoomed = any(m["zoom_encoder"] is not None for m in pc["marks"])
+    head = ("zoom mm",) * zoomed + ("focus", "Fx", "Fy", "K1", "K2", "K3", "pupil cm", "resid px")
+    t = Table(None, head, justify=["right"] * len(head))
     for m in pc["marks"]:
         f = m["focus_from_film_mm"]
-        t.add_row(_mark(float("inf") if f is None else f, units), f"{m['pinhole_focal_length_x_mm'] / args.sensor_width:.5f}",
+        t.add_row(*(f"{m['zoom_focal_length_mm']:.2f}",) * zoomed, _mark(float("inf") if f is None else f, units), f"{m['pinhole_focal_length_x_mm'] / args.sensor_width:.5f}",
                   f"{m['pinhole_focal_length_y_mm'] / args.sensor_height:.5f}", f"{m['k1']:.6f}", f"{m['k2']:.6f}",
                   f"{m['k3']:.6f}", f"{m['entrance_pupil_from_film_mm'] / 10.0:.3f}", f"{m['max_residual_px']:.4f}")
     print_table(t)

@@ -164,6 +164,12 @@ def register(sub) -> None:
                     help="focus mark (default 3m; units ok; or hyperfocal at --fstop)")
     se.add_argument("--focus-to", type=focus("focus distance to pull to", allow_inf=False),
                     help="pull focus to this mark (units ok; or hyperfocal)")
+    se.add_argument("--zoom", default=None, metavar="POSITION",
+                    help="a zoom lens's position: a focal length with its unit (135mm, the paraxial EFL) or the "
+                         "encoder value 0..1 (default: its first tabulated position; a clip: each frame's "
+                         "recorded focal length, this where it records none)")
+    se.add_argument("--zoom-to", default=None, metavar="POSITION",
+                    help="zoom to this position over the take, linearly in the encoder (docs/zoom.md)")
     se.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop (a lens: default wide open)")
     se.add_argument("--tstop", type=number("T-stop", positive=True), help="marked T-stop")
     se.add_argument("--fps", type=number("frame rate", positive=True, hi=1000.0), default=None,
@@ -192,6 +198,8 @@ def register(sub) -> None:
     _clip_arg(pl)
     pl.add_argument("--lens", help="with --clip: bundled lens name or prescription file (breathing, pupil, distortion)")
     pl.add_argument("--focal", type=distance("focal length"), help="with --clip: or a thin lens of this focal length")
+    pl.add_argument("--zoom", default=None, metavar="POSITION",
+                    help="with --clip and a zoom --lens: the position of frames that record no focal length")
     pl.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")
     pl.add_argument("--rate", type=number("rate", lo=0.0, hi=100000.0), default=None,
                     help="samples per second (default the file's rate; 0 as fast as possible)")
@@ -376,14 +384,27 @@ def _clip_samples(args) -> tuple[list, float]:
     else:
         focal = args.focal or samples[0].get("static", {}).get("lens", {}).get("nominalFocalLength")
     if lens is not None or focal is not None:
-        samples = with_optics(samples, lens=lens, focal_length_mm=focal)
+        samples = with_optics(samples, lens=lens, focal_length_mm=focal,
+                              zooms=clip_zooms(record, lens, getattr(args, "zoom", None), len(samples)))
     return samples, rate["num"] / rate["denom"]
+
+
+def clip_zooms(record, lens, fallback, count: int):
+    """The zoom position of each of a clip's first ``count`` frames on the zoom ``lens``: its recorded
+    focal length (the paraxial EFL, docs/zoom.md), else ``fallback`` (``--zoom``); None for a prime."""
+    from ..errors import InputError
+
+    if getattr(lens, "zoom", None) is None:
+        if fallback is not None:
+            raise InputError("--zoom takes a zoom lens (--lens NAME of a zoom; docs/zoom.md)")
+        return None
+    return [fallback if f.focal_length_mm is None else f"{f.focal_length_mm!r}mm" for f in record.frames[:count]]
 
 
 #: send's options that describe a generated take: a clip brings its own
 _TAKE_OPTIONS = (("focus", "--focus"), ("focus_to", "--focus-to"), ("fstop", "--fstop"), ("tstop", "--tstop"),
                  ("timecode", "--timecode"), ("drop_frame", "--drop-frame"), ("pan_rate", "--pan-rate"),
-                 ("shift_x", "--shift-x"), ("shift_y", "--shift-y"))
+                 ("shift_x", "--shift-x"), ("shift_y", "--shift-y"), ("zoom_to", "--zoom-to"))
 
 
 def _send_clip(args) -> int:
@@ -435,7 +456,7 @@ def run_send(args) -> int:
     frames = camera_frames(sensor=sensor, frames=args.frames, rate=args.fps, focus_mm=args.focus,
                            focus_to_mm=args.focus_to, fstop=args.fstop, tstop=args.tstop, lens=lens,
                            focal_length_mm=args.focal, move=move, shift_mm=(args.shift_x, args.shift_y),
-                           drop_frame=drop)
+                           drop_frame=drop, zoom=args.zoom, zoom_to=args.zoom_to)
     samples = frames_to_samples(frames, lens_name=getattr(lens, "name", None), start_timecode=start)
     _stream(args, samples, float(frames[0].rate))
     return 0
@@ -491,8 +512,8 @@ def run_play(args) -> int:
         samples, rate = _clip_samples(args)
         _stream(args, samples, rate if args.rate is None else args.rate)
         return 0
-    if args.lens is not None or args.focal is not None:
-        raise InputError("--lens and --focal go with --clip: a recording carries its own lens values")
+    if args.lens is not None or args.focal is not None or args.zoom is not None:
+        raise InputError("--lens, --focal and --zoom go with --clip: a recording carries its own lens values")
     name = str(args.file).lower()
     if name.endswith((".usda", ".usd", ".usdc")):
         from ..live.usd_io import frames_from_usd

@@ -13,6 +13,7 @@ examples:
   physcam metadata report B001C001_180327_R1ZA.mov.csv --csv
   physcam metadata usd B001C001_180327_R1ZA.mov.csv -o shot.usda --plate plates/B001C001.####.exr --plate-frames 1001-1500
   physcam metadata opentrackio B001C001_180327_R1ZA.mov.csv -o take.jsonl
+  physcam metadata opentrackio zoom_clip.csv --lens canon_ef_70_200mm_f2_8_zoom -o take.jsonl
 Formats are told from the files' content: ARRI Meta Extract, REDline, Sony VENICE, Canon,
 Blackmagic RAW ExtractMetadata, Mo-Sys F4. Give the files of one clip together.
 """
@@ -90,6 +91,12 @@ def register(sub) -> None:
                    help="write the samples here, one JSON sample per line (default: standard output)")
     o.add_argument("--fps", type=number("frame rate", positive=True, hi=1000.0), default=None,
                    help="frame rate when the file records none")
+    o.add_argument("--lens", default=None, metavar="NAME_OR_FILE",
+                   help=LENS_HELP + "; optional: its optics at each frame's focus (a zoom: at each frame's recorded "
+                                    "focal length), as physcam live send --clip sends them")
+    o.add_argument("--zoom", default=None, metavar="POSITION",
+                   help="with a zoom --lens: the position of frames that record no focal length (135mm or 0..1)")
+    add_sensor_options(o)
     o.add_argument("--force", action="store_true", help="overwrite an existing file")
     o.set_defaults(handler=run_opentrackio, output_args=("file",))
     p.set_defaults(handler=lambda args: p.print_help() or 0)
@@ -225,7 +232,33 @@ def run_opentrackio(args) -> int:
 
     if args.file is not None:
         check_writable(args.file, force=args.force)
-    samples = opentrackio_samples(_load(args), rate=args.fps)
+    import dataclasses
+
+    from ._live_record import resolve_sensor_opt
+
+    record = _load(args)
+    sensor = resolve_sensor_opt(args)
+    if record.active_area_mm is None and sensor is not None:
+        record = dataclasses.replace(record, active_area_mm=(sensor.width_mm, sensor.height_mm))
+    samples = opentrackio_samples(record, rate=args.fps)
+    if args.lens is not None:  # the named lens's optics at each frame (docs/zoom.md, docs/live.md)
+        from ..errors import InputError
+        from ..lens.library import load_lens
+
+        if record.active_area_mm is None:
+            raise InputError(f"the {record.source} clip gives no sensor size: give the sensor (--sensor) for the "
+                             "lens's optics")
+        from ..live.camera import with_optics
+        from ..live.sample import validate_sample
+        from .live import clip_zooms
+
+        lens = load_lens(args.lens)
+        samples = [validate_sample(s) for s in with_optics(
+            samples, lens=lens, zooms=clip_zooms(record, lens, args.zoom, len(samples)))]
+    elif args.zoom is not None:
+        from ..errors import InputError
+
+        raise InputError("--zoom takes a zoom lens (--lens NAME of a zoom; docs/zoom.md)")
     text = "".join(json.dumps(s, allow_nan=False, separators=(",", ":")) + "\n" for s in samples)
     if args.file is None:
         sys.stdout.write(text)

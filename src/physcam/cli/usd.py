@@ -90,13 +90,17 @@ def register(sub) -> None:
                      description="Write a camera whose focus and f-stop follow marks per frame (docs/usd.md).",
                      epilog="example:\n  physcam usd animate pull.usda --lens dgauss_50mm --marks pull.csv "
                             "--sensor \"ALEXA 35\" --fstop 2.8\n"
-                            "pull.csv has columns frame,focus[,fstop]; focus with units (5m, 16ft; bare = mm).",
+                            "pull.csv has columns frame,focus[,fstop][,zoom]; focus with units (5m, 16ft; bare = mm); zoom "
+                            "a focal length (135mm) or encoder 0..1 (a zoom lens).",
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     a.add_argument("file", help="output .usda/.usd/.usdc")
     a.add_argument("--marks", required=True, metavar="CSV", help="focus marks per frame: frame,focus[,fstop]")
     a.add_argument("--lens", help="bundled lens name or prescription file (breathing from the real lens)")
     a.add_argument("--focal", type=distance("focal length"), help="or a thin lens of this focal length")
     a.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop for frames without one")
+    a.add_argument("--zoom", default=None, metavar="POSITION",
+                   help="a zoom lens's position for frames without a zoom column: a focal length with its unit "
+                        "(135mm) or the encoder value 0..1 (docs/zoom.md)")
     add_coc_option(a)
     add_sensor_options(a)
     a.add_argument("--shutter-angle", type=number("shutter angle", positive=True), default=180.0,
@@ -432,7 +436,7 @@ def run_animate(args) -> int:
                                  focal_length_mm=args.focal, fstop=args.fstop, coc=coc, path=args.path,
                                  meters_per_unit=args.meters_per_unit, fps=args.fps,
                                  shutter_angle_deg=args.shutter_angle, position=args.position,
-                                 rotate_xyz_deg=args.rotate, force=args.force)
+                                 rotate_xyz_deg=args.rotate, force=args.force, zoom=args.zoom)
     if args.json:
         emit_json(document("usd_animate", {"written": str(path), "frames": len(keys), "first": keys[0].frame,
                                            "last": keys[-1].frame}))

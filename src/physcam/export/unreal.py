@@ -22,7 +22,11 @@ Per focus mark physcam writes:
 
 Focus keys (``FocusEncoder``) are the focus mark from the film plane in **cm**, with an identity
 ``Focus`` encoder table (encoder value = cm); infinity is written as :data:`INFINITY_FOCUS_CM`.
-``ZoomEncoder`` is the lens's focal length at infinity in mm (a prime has one zoom). Numbers are
+``ZoomEncoder`` is the lens's focal length at infinity in mm (a prime has one zoom). A zoom lens
+(docs/zoom.md) gives a **focus x zoom grid**: at each zoom position (its tabulated positions unless
+asked, each the prescription at that position, :func:`physcam.lens.zoom.prescription_at`) the rows
+of its focus marks, keyed by that position's paraxial EFL at infinity focus (mm); each position
+focuses with its own focus groups and close distance. Numbers are
 written in plain decimal notation. A top-level ``physcam`` block (ignored by Unreal's importer,
 which reads named fields only) carries the same numbers in mm with infinity as ``null``.
 """
@@ -75,6 +79,62 @@ def parse_parameter_table(table: dict) -> tuple[list[str], list[list[float]]]:
     return header, rows
 
 
+def _marks(q: Prescription, focus_marks_mm, w: float, method: str, wl: float) -> list[float]:
+    """The focus marks of one lens (or zoom position): as given, else its breathing marks."""
+    from ..optics.focusing import breathing_table
+
+    if focus_marks_mm is None:
+        return [r.focus_from_film_mm for r in breathing_table(q, None, sensor_width_mm=w, method=method,
+                                                              wavelength_nm=wl)]
+    try:
+        marks = [float(m) for m in focus_marks_mm]
+    except (TypeError, ValueError):
+        raise InputError(f"focus marks must be numbers (mm from the film plane), got {focus_marks_mm!r}") from None
+    if not marks or len(marks) > 64:
+        raise InputError("give 1 to 64 focus marks")
+    if any(math.isnan(m) or m <= 0 for m in marks):
+        raise InputError("focus marks must be positive distances from the film plane")
+    return sorted(set(marks), reverse=True)
+
+
+def _zoom_positions(lens: Prescription, zoom_positions) -> list[float | None]:
+    """The zoom encoder values of the grid (the tabulated positions by default); [None] for a prime."""
+    if lens.zoom is None:
+        if zoom_positions is not None:
+            raise InputError(f"{lens.name!r} has no zoom table: zoom positions need a zoom lens (docs/zoom.md)")
+        return [None]
+    from ..lens.zoom import tabulated_encoders
+    from ..optics.zoom import zoom_encoder
+
+    if zoom_positions is None:
+        return list(tabulated_encoders(lens))
+    us = sorted({zoom_encoder(lens, z) for z in zoom_positions})
+    if not us or len(us) > 32:
+        raise InputError("give 1 to 32 zoom positions")
+    return us
+
+
+def _grid(lens, zoom_positions, focus_marks_mm, w, h, W, H, method, wavelength_nm, backend) -> list[dict]:
+    """One entry per (zoom position, focus mark): the fitted camera, planes and pupils (module notes)."""
+    from ..lens.zoom import prescription_at
+    from ..optics.focusing import entrance_pupils, focus_method, technical_planes
+    from .opencv_distortion import fit_opencv_pinhole
+
+    out = []
+    for u in _zoom_positions(lens, zoom_positions):
+        q = lens if u is None else prescription_at(lens, u)
+        m_q = focus_method(q, method)
+        wl = q.wavelength_nm if wavelength_nm is None else wavelength_nm
+        zoom = technical_planes(q, math.inf, wavelength_nm=wl, method=m_q).efl_mm
+        for m in _marks(q, focus_marks_mm, w, m_q, wl):
+            cam = fit_opencv_pinhole(q, w, h, W, H, focus_mm=m, terms="k1k2k3", method=m_q, wavelength_nm=wl,
+                                     backend=backend)
+            out.append({"u": u, "zoom": zoom, "mark": m, "cam": cam, "method": m_q, "wl": wl,
+                        "tp": technical_planes(q, m, wavelength_nm=wl, method=m_q),
+                        "pupil_x": entrance_pupils(q, m, method=m_q, wavelength_nm=wl).horizontal_from_film_mm})
+    return out
+
+
 @takes_prescription
 def unreal_lens_file(
     lens: Prescription,
@@ -88,15 +148,17 @@ def unreal_lens_file(
     wavelength_nm: float | None = None,
     serial_number: str = "",
     backend: str = "auto",
+    zoom_positions=None,
 ) -> dict:
     """The ``.ulens`` exchange JSON (a dict) of ``lens`` on the sensor (module notes).
 
     ``focus_marks_mm``: marks in front of the film plane (inf allowed); by default the breathing
-    marks of :func:`physcam.optics.focusing.breathing_table`, infinity to the closest focus.
+    marks of :func:`physcam.optics.focusing.breathing_table`, infinity to the closest focus (a zoom:
+    at each position). ``zoom_positions``: a zoom lens's positions (focal lengths ``"135mm"`` or
+    encoder values, :func:`physcam.optics.zoom.zoom_encoder`; default its tabulated positions).
     """
     from .. import __version__
-    from ..optics.focusing import breathing_table, entrance_pupils, focus_method, technical_planes
-    from .opencv_distortion import _pixels, _sensor, fit_opencv_pinhole
+    from .opencv_distortion import _pixels, _sensor
 
     w = _sensor("sensor width", sensor_width_mm)
     h = _sensor("sensor height", sensor_height_mm)
@@ -104,46 +166,27 @@ def unreal_lens_file(
     H = _pixels("image height", image_height_px)
     if not isinstance(serial_number, str):
         raise InputError("the serial number must be text")
-    method = focus_method(lens, method)
-    wl = lens.wavelength_nm if wavelength_nm is None else wavelength_nm
-    if focus_marks_mm is None:
-        marks = [r.focus_from_film_mm for r in breathing_table(lens, None, sensor_width_mm=w, method=method,
-                                                                wavelength_nm=wl)]
-    else:
-        try:
-            marks = [float(m) for m in focus_marks_mm]
-        except (TypeError, ValueError):
-            raise InputError(f"focus marks must be numbers (mm from the film plane), got {focus_marks_mm!r}") from None
-        if not marks or len(marks) > 64:
-            raise InputError("give 1 to 64 focus marks")
-        if any(math.isnan(m) or m <= 0 for m in marks):
-            raise InputError("focus marks must be positive distances from the film plane")
-        marks = sorted(set(marks), reverse=True)
-    zoom = technical_planes(lens, math.inf, wavelength_nm=wl, method=method).efl_mm
-    rows = []
-    for m in marks:
-        cam = fit_opencv_pinhole(lens, w, h, W, H, focus_mm=m, terms="k1k2k3", method=method,
-                                 wavelength_nm=wl, backend=backend)
-        tp = technical_planes(lens, m, wavelength_nm=wl, method=method)
-        pupil_x = entrance_pupils(lens, m, method=method, wavelength_nm=wl).horizontal_from_film_mm
-        rows.append((m, cam, tp, pupil_x))
-    key = [INFINITY_FOCUS_CM if math.isinf(m) else m / 10.0 for m, _, _, _ in rows]
+    grid = _grid(lens, zoom_positions, focus_marks_mm, w, h, W, H, method, wavelength_nm, backend)
+    key = [(INFINITY_FOCUS_CM if math.isinf(g["mark"]) else g["mark"] / 10.0, g["zoom"]) for g in grid]
     tables = [
         _table("FocalLengthTable", HEADERS["FocalLengthTable"],
-               [(k, zoom, c.pinhole_focal_length_x_mm / w, c.pinhole_focal_length_y_mm / h) for k, (_, c, _, _) in
-                zip(key, rows)]),
-        _table("ImageCenterTable", HEADERS["ImageCenterTable"], [(k, zoom, 0.5, 0.5) for k in key]),
+               [(*k, g["cam"].pinhole_focal_length_x_mm / w, g["cam"].pinhole_focal_length_y_mm / h)
+                for k, g in zip(key, grid)]),
+        _table("ImageCenterTable", HEADERS["ImageCenterTable"], [(*k, 0.5, 0.5) for k in key]),
         _table("DistortionTable", HEADERS["DistortionTable"],
-               [(k, zoom, c.k1, c.k2, c.k3, c.p1, c.p2) for k, (_, c, _, _) in zip(key, rows)]),
+               [(*k, g["cam"].k1, g["cam"].k2, g["cam"].k3, g["cam"].p1, g["cam"].p2) for k, g in zip(key, grid)]),
         _table("NodalOffsetTable", HEADERS["NodalOffsetTable"],
-               [(k, zoom, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, tp.entrance_pupil_from_film_mm / 10.0)
-                for k, (_, _, tp, _) in zip(key, rows)]),
+               [(*k, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, g["tp"].entrance_pupil_from_film_mm / 10.0)
+                for k, g in zip(key, grid)]),
     ]
     user = [("physcam.version", __version__), ("physcam.lens", lens.name), ("physcam.squeeze", _num(lens.squeeze)),
             ("physcam.focusUnits", "FocusEncoder = focus mark from the film plane in cm"),
             ("physcam.nodalOffset", "film plane to entrance pupil, cm, OpenCV axes (z forward)"
              + ("; the vertical (Y, tilt) pupil of an anamorphic: the horizontal (X, pan) one is "
                 "physcam.marks[].entrance_pupil_horizontal_from_film_mm" if lens.is_anamorphic else ""))]
+    if lens.zoom is not None:
+        user.append(("physcam.zoomUnits", "ZoomEncoder = the zoom position's paraxial EFL at infinity focus, mm"))
+    focus_keys = sorted({k[0] for k in key}, reverse=True)
     return {
         "metadata": {
             "type": LENS_FILE_TYPE,
@@ -158,21 +201,30 @@ def unreal_lens_file(
         "sensorDimensions": {"width": w, "height": h, "units": "Millimeters"},
         "imageDimensions": {"width": W, "height": H},
         "cameraParameterTables": tables,
-        "encoderTables": [_table("Focus", FOCUS_ENCODER_HEADER, [(k, k) for k in key])],
-        "physcam": {
-            "lens": lens.name, "method": method, "wavelength_nm": float(wl), "zoom_focal_length_mm": zoom,
-            "infinity_focus_cm": INFINITY_FOCUS_CM,
-            "marks": [{
-                "focus_from_film_mm": None if math.isinf(m) else m,
-                "pinhole_focal_length_x_mm": c.pinhole_focal_length_x_mm,
-                "pinhole_focal_length_y_mm": c.pinhole_focal_length_y_mm,
-                "entrance_pupil_from_film_mm": tp.entrance_pupil_from_film_mm,
-                "entrance_pupil_horizontal_from_film_mm": pupil_x,
-                "efl_mm": tp.efl_mm,
-                "k1": c.k1, "k2": c.k2, "k3": c.k3, "p1": c.p1, "p2": c.p2,
-                "max_residual_px": c.max_residual_px, "notes": list(c.notes),
-            } for m, c, tp, pupil_x in rows],
-        },
+        "encoderTables": [_table("Focus", FOCUS_ENCODER_HEADER, [(k, k) for k in focus_keys])],
+        "physcam": _physcam_block(lens, grid),
+    }
+
+
+def _physcam_block(lens: Prescription, grid: list[dict]) -> dict:
+    """The file's ``physcam`` block: the same numbers in mm, infinity as null (module notes)."""
+    g0 = grid[0]
+    zooms = sorted({g["zoom"] for g in grid})
+    return {
+        "lens": lens.name, "method": g0["method"], "wavelength_nm": float(g0["wl"]),
+        "zoom_focal_length_mm": zooms[0] if len(zooms) == 1 else None,
+        "zoom_focal_lengths_mm": zooms, "infinity_focus_cm": INFINITY_FOCUS_CM,
+        "marks": [{
+            "zoom_encoder": g["u"], "zoom_focal_length_mm": g["zoom"],
+            "focus_from_film_mm": None if math.isinf(g["mark"]) else g["mark"],
+            "pinhole_focal_length_x_mm": g["cam"].pinhole_focal_length_x_mm,
+            "pinhole_focal_length_y_mm": g["cam"].pinhole_focal_length_y_mm,
+            "entrance_pupil_from_film_mm": g["tp"].entrance_pupil_from_film_mm,
+            "entrance_pupil_horizontal_from_film_mm": g["pupil_x"],
+            "efl_mm": g["tp"].efl_mm,
+            "k1": g["cam"].k1, "k2": g["cam"].k2, "k3": g["cam"].k3, "p1": g["cam"].p1, "p2": g["cam"].p2,
+            "max_residual_px": g["cam"].max_residual_px, "notes": list(g["cam"].notes),
+        } for g in grid],
     }
 
 

@@ -20,6 +20,13 @@ and + up: the view moves that way, as ``report --shift-x/--shift-y``) is sent as
 ``lens.projectionOffset`` = (-shift_x, +shift_y), OpenLensIO's perspective offset ΔP: where the
 optical axis lands on the sensor, mm from the centre, x right, y down (OpenLensIO 1.0.1 section
 1.5); ``distortionOffset`` (ΔC) is 0 because physcam's distortion is centred on that axis.
+
+A zoom lens (docs/zoom.md) is taken at each frame's zoom position (:func:`physcam.lens.zoom.prescription_at`),
+moved linearly in physcam's encoder u from ``zoom`` to ``zoom_to`` as a zoom motor runs, and focused
+there: ``pinholeFocalLength`` is that position's best-match pinhole at the frame's focus, the
+zoom encoder rides in ``lens.encoders.zoom`` (OpenTrackIO's 0 wide, 1 tele: u or 1 - u, whichever
+end is wide), and ``static`` carries no ``nominalFocalLength`` (undefined for a zoom in the schema)
+but the focal length range in the sample's ``custom`` (:data:`physcam.live.frames.FOCAL_RANGE_KEY`).
 """
 
 from __future__ import annotations
@@ -30,10 +37,13 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 from ..errors import InputError, require_finite, require_type
-from .frames import HORIZONTAL_PUPIL_KEY, TrackedFrame, new_source_id, rate_fraction, sample_from_frame, static_block, with_time
+from ..lens.prescription import require_prescription, takes_prescription
+from ..lens.zoom import prescription_at
+from .frames import FOCAL_RANGE_KEY, HORIZONTAL_PUPIL_KEY, TrackedFrame, new_source_id, rate_fraction, sample_from_frame, static_block, with_time
 from .sample import shown
 
-__all__ = ["CameraMove", "camera_frames", "camera_samples", "frames_to_samples", "with_optics"]
+__all__ = ["CameraMove", "camera_frames", "camera_samples", "frames_to_samples", "with_optics", "zoom_path",
+           "opentrackio_zoom", "physcam_zoom", "focal_range"]
 
 #: the most frames one generated take holds (an hour at 240 fps is 864,000; a demo needs far fewer)
 MAX_TAKE_FRAMES = 1_000_000
@@ -58,11 +68,14 @@ class CameraMove:
 
 def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None, focal_length_mm=None,
                   focus_to_mm=None, tstop=None, move: CameraMove | None = None, distortion: bool = True,
-                  t0_ns: int | None = None, shift_mm=(0.0, 0.0), drop_frame: bool = False) -> list[TrackedFrame]:
+                  t0_ns: int | None = None, shift_mm=(0.0, 0.0), drop_frame: bool = False, zoom=None,
+                  zoom_to=None) -> list[TrackedFrame]:
     """The take's frames (module notes): ``frames`` frames at ``rate``, focus pulled linearly from
     ``focus_mm`` to ``focus_to_mm`` (mm from the film; default: held), ``lens`` (a Prescription) or a
     thin lens of ``focal_length_mm``; ``t0_ns`` the first timestamp (default now); ``shift_mm`` the
-    lens shift (+ right, + up); ``drop_frame``: drop-frame timecode (29.97, 59.94)."""
+    lens shift (+ right, + up); ``drop_frame``: drop-frame timecode (29.97, 59.94); a zoom lens's
+    ``zoom`` (a focal length ``"135mm"`` or encoder value, :func:`physcam.optics.zoom.zoom_encoder`;
+    default its first tabulated position) zoomed linearly in the encoder to ``zoom_to`` (module notes)."""
     from ..optics.sensors import Sensor
 
     require_type("sensor", sensor, Sensor, "physcam.optics.sensors.find_sensor(name)")
@@ -72,6 +85,7 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
     move = CameraMove() if move is None else require_type("move", move, CameraMove)
     if (lens is None) == (focal_length_mm is None):
         raise InputError("give either a lens prescription or a focal length")
+    u0, u1 = zoom_path(lens, zoom, zoom_to)
     f0 = require_finite("focus distance", focus_mm)
     f1 = f0 if focus_to_mm is None else require_finite("focus distance to pull to", focus_to_mm)
     from .frames import _pair, timecode_fields
@@ -86,9 +100,13 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
     for i in range(frames):
         u = i / (frames - 1) if frames > 1 else 0.0
         mark = f0 + (f1 - f0) * u
-        if mark not in cache:
-            cache[mark] = _optics_at(sensor, mark, lens, focal_length_mm, fstop, tstop, distortion)
-        rep, dist = cache[mark]
+        zu = None if u0 is None else u0 + (u1 - u0) * u
+        if (mark, zu) not in cache:
+            cache[mark, zu] = _optics_at(sensor, mark, lens if zu is None else prescription_at(lens, zu),
+                                         focal_length_mm, fstop, tstop, distortion)
+        rep, dist = cache[mark, zu]
+        zoomed = {} if zu is None else {"encoders": {"zoom": opentrackio_zoom(lens, zu)},
+                                         "focal_range_mm": focal_range(lens)}
         pos, rot = move.at(i / float(fr))
         pupil = rep.entrance_pupil_from_film_mm
         out.append(with_time(TrackedFrame(
@@ -96,9 +114,56 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
             focus_from_film_mm=rep.focus_from_film_mm, fstop=rep.fstop, tstop=rep.tstop,
             entrance_pupil_mm=pupil if pupil is not None else rep.h1_from_film_mm, distortion=dist,
             entrance_pupil_horizontal_mm=rep.entrance_pupil_horizontal_from_film_mm,
-            sensor_mm=(sensor.width_mm, sensor.height_mm),
-            nominal_focal_length_mm=rep.focal_length_mm), t0, i))
+            sensor_mm=(sensor.width_mm, sensor.height_mm), **zoomed,
+            nominal_focal_length_mm=None if zu is not None else rep.focal_length_mm), t0, i))
     return out
+
+
+def zoom_path(lens, zoom, zoom_to) -> tuple[float | None, float | None]:
+    """(first, last) encoder value of a zoom lens's move (None, None for a prime; :func:`camera_frames`)."""
+    if lens is not None:
+        require_prescription(lens)
+    if lens is None or lens.zoom is None:
+        if zoom is not None or zoom_to is not None:
+            what = "a thin lens" if lens is None else repr(lens.name)
+            raise InputError(f"a zoom position needs a zoom lens; {what} has no zoom table (docs/zoom.md)")
+        return None, None
+    from ..optics.zoom import zoom_encoder
+
+    u0 = zoom_encoder(lens, 0.0 if zoom is None else zoom)
+    return u0, u0 if zoom_to is None else zoom_encoder(lens, zoom_to)
+
+
+@takes_prescription
+def _wide_end_first(lens) -> bool:
+    """True when the zoom lens's encoder 0 (its first tabulated position) is its wide end."""
+    from ..optics.zoom import efl_at
+
+    return efl_at(lens, 0.0) < efl_at(lens, 1.0)
+
+
+@takes_prescription
+def opentrackio_zoom(lens, encoder: float) -> float:
+    """OpenTrackIO's ``lens.encoders.zoom`` (0 wide angle, 1 telephoto; schema 1.0.1) of the zoom lens at
+    physcam's encoder value (0 its first tabulated position, docs/zoom.md)."""
+    u = float(encoder)
+    return u if _wide_end_first(lens) else 1.0 - u
+
+
+@takes_prescription
+def physcam_zoom(lens, opentrackio_encoder: float) -> float:
+    """physcam's encoder value of OpenTrackIO's zoom encoder (the inverse of :func:`opentrackio_zoom`)."""
+    return opentrackio_zoom(lens, opentrackio_encoder)
+
+
+@takes_prescription
+def focal_range(lens) -> tuple[float, float]:
+    """(shortest, longest) paraxial EFL of a zoom lens at infinity focus (mm; at its two ends, the EFL
+    running monotonically along the zoom, :func:`physcam.optics.zoom.encoder_for_focal_length`)."""
+    from ..optics.zoom import efl_at
+
+    a, b = efl_at(lens, 0.0), efl_at(lens, 1.0)
+    return (min(a, b), max(a, b))
 
 
 def _optics_at(sensor, mark, lens, focal_length_mm, fstop, tstop, distortion):
@@ -115,7 +180,7 @@ def _optics_at(sensor, mark, lens, focal_length_mm, fstop, tstop, distortion):
     return rep, dist
 
 
-def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = True):
+def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = True, zooms=None):
     """Yield ``samples`` (OpenTrackIO dicts, e.g. a recorded clip's,
     :func:`physcam.metadata.convert.opentrackio_samples`) with the optics of ``lens`` (a
     Prescription) or a thin lens of ``focal_length_mm`` at each sample's ``focusDistance``, as
@@ -123,13 +188,25 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
     distortion and (a lens) its squeeze (``static`` re-sent when it changes). The sensor is the
     stream's ``static.camera.activeSensorPhysicalDimensions``; a sample without a focus distance is
     passed on as it is. The pinhole and pupil do not depend on the stop: the lens is solved wide
-    open (a thin lens at f/8) and the sample's own stops are sent unchanged."""
+    open (a thin lens at f/8) and the sample's own stops are sent unchanged.
+
+    A zoom ``lens`` is taken at each sample's zoom position: ``zooms``, one per sample (a focal length
+    ``"135mm"`` or an encoder value, :func:`physcam.optics.zoom.zoom_encoder`; None: its first
+    tabulated position), sent as ``lens.encoders.zoom`` with the focal length range in ``custom``
+    beside ``static`` (module notes)."""
     from ..optics.sensors import custom_sensor
 
     if (lens is None) == (focal_length_mm is None):
         raise InputError("give either a lens prescription or a focal length")
+    zoom_lens = lens is not None and getattr(lens, "zoom", None) is not None
+    if zooms is not None and not zoom_lens:
+        zoom_path(lens, "zoom", None)  # refuses zoom positions for a prime, in its words
+    zooms = iter(zooms) if zooms is not None else None
     static, sent_squeeze, cache = None, None, {}
     for s in samples:
+        zu = None
+        if zoom_lens:
+            zu = zoom_path(lens, next(zooms, None) if zooms is not None else None, None)[0]
         static = s.get("static") or static
         dims = ((static or {}).get("camera") or {}).get("activeSensorPhysicalDimensions")
         lens_d = s.get("lens") or {}
@@ -137,12 +214,15 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
             yield s
             continue
         mark = lens_d["focusDistance"] * 1000.0
-        key = (dims["width"], dims["height"], mark)
+        key = (dims["width"], dims["height"], mark, zu)
         if key not in cache:  # a lens wide open, a thin lens at f/8: the stop changes neither pinhole nor pupil
-            cache[key] = _optics_at(custom_sensor(dims["width"], dims["height"]), mark, lens, focal_length_mm,
+            cache[key] = _optics_at(custom_sensor(dims["width"], dims["height"]), mark,
+                                    lens if zu is None else prescription_at(lens, zu), focal_length_mm,
                                     None if lens is not None else 8.0, None, distortion)
         rep, dist = cache[key]
         out = dict(s, lens=dict(lens_d, pinholeFocalLength=float(rep.pinhole[0])))
+        if zu is not None:
+            out["lens"]["encoders"] = dict(lens_d.get("encoders") or {}, zoom=opentrackio_zoom(lens, zu))
         pupil = rep.entrance_pupil_from_film_mm if rep.entrance_pupil_from_film_mm is not None else rep.h1_from_film_mm
         out["lens"]["entrancePupilOffset"] = float(pupil) / 1000.0
         prior = s.get("custom")
@@ -150,8 +230,12 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
             custom = {k: v for k, v in (prior or {}).items() if k != HORIZONTAL_PUPIL_KEY}
             if rep.entrance_pupil_horizontal_from_film_mm is not None:  # an anamorphic's pan pivot (frames.py)
                 custom[HORIZONTAL_PUPIL_KEY] = float(rep.entrance_pupil_horizontal_from_film_mm) / 1000.0
+            if zu is not None and s.get("static"):
+                custom[FOCAL_RANGE_KEY] = list(focal_range(lens))
             if custom or prior is not None:
                 out["custom"] = custom
+        if zu is not None and "nominalFocalLength" in ((out.get("static") or {}).get("lens") or {}):
+            out["static"] = _without_nominal(out["static"])  # a zoom has none (schema 1.0.1)
         if dist is not None:
             out["lens"]["distortion"] = [dist]
         sq = Fraction(float(rep.pinhole[1])).limit_denominator(1_000_000)  # as static_block keeps it
@@ -161,6 +245,15 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
             out["static"] = dict(out.get("static") or static, camera=cam)
             static, sent_squeeze = out["static"], squeeze
         yield out
+
+
+def _without_nominal(static: dict) -> dict:
+    """``static`` without ``lens.nominalFocalLength`` (and without an emptied ``lens``)."""
+    lens = {k: v for k, v in static["lens"].items() if k != "nominalFocalLength"}
+    out = {k: v for k, v in static.items() if k != "lens"}
+    if lens:
+        out["lens"] = lens
+    return out
 
 
 def frames_to_samples(frames, *, source_id: str | None = None, static_every: int | None = None,

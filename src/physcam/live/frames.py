@@ -20,6 +20,12 @@ complete_dynamic_example carries a ``custom`` object there), while ``lens`` allo
 ``custom`` array is coefficients whose meaning each producer and consumer must negotiate. A reader
 that knows nothing of the key ignores it and sees one pupil.
 
+A zoom lens: each sample carries the zoom position as ``lens.encoders.zoom`` (0 wide angle, 1
+telephoto, as the schema orders it) and its focal length as ``pinholeFocalLength``; the static
+``nominalFocalLength`` is left out (the schema: "undefined in the case of a zoom lens") and the
+lens's focal length range, ``[shortest, longest]`` mm, rides with ``static`` in the same top-level
+``custom`` object as ``"physcam:focalLengthRange"`` (``static.lens`` allows no extra keys).
+
 Transforms: OpenTrackIO's stage is right-handed and Z-up, Y forward (toward the LED wall), X to
 camera right; rotations are intrinsic Z-X-Y, ``[pan, tilt, roll]`` in degrees, each by the right-hand
 rule (pan turns +X toward +Y, tilt +Y toward +Z, roll +Z toward +X; camdkit's axis figure). A list
@@ -41,6 +47,10 @@ from .sample import PROTOCOL_VERSION, shown
 
 #: the key of the horizontal (X) entrance pupil in a sample's top-level ``custom`` object (module notes)
 HORIZONTAL_PUPIL_KEY = "physcam:horizontalEntrancePupilOffset"
+
+#: the key of a zoom lens's focal length range, ``[shortest, longest]`` mm, in the top-level ``custom``
+#: object of a sample that carries ``static`` (module notes)
+FOCAL_RANGE_KEY = "physcam:focalLengthRange"
 
 #: the most radial (and tangential) distortion coefficients a frame keeps: a recording holds each
 #: frame, and a 64 KiB sample could otherwise carry thousands
@@ -87,6 +97,8 @@ class TrackedFrame:
     #: an anamorphic's horizontal (X) entrance pupil in front of the film (mm), the pan pivot;
     #: ``entrance_pupil_mm`` is then the vertical (Y) one. None: one pupil (module notes)
     entrance_pupil_horizontal_mm: float | None = None
+    #: a zoom lens's (shortest, longest) focal length, mm (custom ``physcam:focalLengthRange``, module notes)
+    focal_range_mm: tuple[float, float] | None = None
 
     @property
     def source(self) -> tuple:
@@ -332,6 +344,7 @@ def frame_from_sample(sample, *, static=None) -> TrackedFrame:
             raise InputError(f"custom.{HORIZONTAL_PUPIL_KEY} must be a number of metres, got {shown(pupil_x)}")
         pupil_x = require_finite(HORIZONTAL_PUPIL_KEY, float(pupil_x) * 1000.0)
     return TrackedFrame(
+        focal_range_mm=_focal_range(custom),
         entrance_pupil_horizontal_mm=pupil_x,
         squeeze=squeeze, projection_offset_mm=offset("projectionOffset"),
         distortion_offset_mm=offset("distortionOffset"), encoders=encoders,
@@ -345,6 +358,20 @@ def frame_from_sample(sample, *, static=None) -> TrackedFrame:
         nominal_focal_length_mm=st.get("lens", {}).get("nominalFocalLength"),
         notes=notes, source_id=sample.get("sourceId"), source_number=sample.get("sourceNumber"),
     )
+
+
+def _focal_range(custom) -> tuple[float, float] | None:
+    """A sample's ``custom`` zoom focal length range (module notes), checked; None when absent."""
+    v = custom.get(FOCAL_RANGE_KEY) if isinstance(custom, dict) else None
+    if v is None:
+        return None
+    if (not isinstance(v, list) or len(v) != 2
+            or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in v)):
+        raise InputError(f"custom.{FOCAL_RANGE_KEY} must be [shortest, longest] focal lengths in mm, got {shown(v)}")
+    lo, hi = (require_finite(FOCAL_RANGE_KEY, float(x)) for x in v)
+    if not 0.0 < lo <= hi:
+        raise InputError(f"custom.{FOCAL_RANGE_KEY} must hold 0 < shortest <= longest, got {shown(v)}")
+    return (lo, hi)
 
 
 def new_source_id() -> str:
@@ -429,8 +456,13 @@ def sample_from_frame(frame: TrackedFrame, *, source_id: str, sequence_number: i
         "transforms": [{"id": "Camera", "translation": {"x": x, "y": y, "z": z},
                         "rotation": {"pan": pan, "tilt": tilt, "roll": roll}}],
     }
+    custom = {}
     if frame.entrance_pupil_horizontal_mm is not None:
-        out["custom"] = {HORIZONTAL_PUPIL_KEY: m(float(frame.entrance_pupil_horizontal_mm))}
+        custom[HORIZONTAL_PUPIL_KEY] = m(float(frame.entrance_pupil_horizontal_mm))
+    if static and frame.focal_range_mm is not None:
+        custom[FOCAL_RANGE_KEY] = [float(v) for v in frame.focal_range_mm]
+    if custom:
+        out["custom"] = custom
     if static:
         out["static"] = static
     return out

@@ -257,7 +257,8 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     mark, f-stop and focal length it does not send itself (``from_encoders`` names them); ``lens`` (a
     :class:`~physcam.lens.prescription.Prescription`) solves a frame that sends no pinhole focal
     length through the named lens at its focus: breathing pinhole, entrance pupil and squeeze from
-    the prescription, as ``physcam lens breathing`` computes them. The anamorphic squeeze
+    the prescription, as ``physcam lens breathing`` computes them (a zoom lens at the frame's
+    ``lens.encoders.zoom``, else its first tabulated position). The anamorphic squeeze
     (``static.camera.anamorphicSqueeze``) widens the horizontal field: F / squeeze is the horizontal
     focal length.
 
@@ -383,8 +384,9 @@ def _solve_one(f, last, sensor, sensors, coc, custom_sensor, lens=None):
     if tstop is not None and tstop < last["fstop"]:
         tstop = None  # a T-stop faster than the f-stop is not physical; the report would refuse it
     if last["pinhole"] is None:  # the named lens at this focus: its breathing, pupil and squeeze
+        lens = _at_zoom_encoder(lens, f.encoders)
         return solve_report(report_camera(focal_length_mm=None, sensor=sensors[key], fstop=float(last["fstop"]),
-                             focus_mm=float(last["focus"]), coc=coc, tstop=tstop, lens=lens))
+                                          focus_mm=float(last["focus"]), coc=coc, tstop=tstop, lens=lens))
     pin = float(last["pinhole"])
     sq = 1.0 if last["squeeze"] is None else float(last["squeeze"])
     f_dof = float(last["nominal"]) if last["nominal"] is not None else pin
@@ -392,6 +394,18 @@ def _solve_one(f, last, sensor, sensors, coc, custom_sensor, lens=None):
                          focus_mm=float(last["focus"]), coc=coc, tstop=tstop,
                          pupil_mm=None if last["pupil"] is None else float(last["pupil"]),
                          pinhole_focal_length_mm=pin, squeeze=sq, pinhole_squeeze=sq))
+
+
+def _at_zoom_encoder(lens, encoders):
+    """A zoom lens at the frame's OpenTrackIO zoom encoder (0 wide, 1 tele), else at its first
+    tabulated position; any other lens as it is (docs/zoom.md)."""
+    if getattr(lens, "zoom", None) is None:
+        return lens
+    from ..lens.zoom import prescription_at
+    from .camera import physcam_zoom
+
+    z = (encoders or {}).get("zoom")
+    return prescription_at(lens, 0.0 if z is None else physcam_zoom(lens, z))
 
 
 def _usd_from_stage(v, mpu):

@@ -13,6 +13,14 @@ for a thin lens the practical model. What changes with focus is time-sampled:
   translate: the eye follows the entrance pupil while the body, and so the film plane, stays
   where it was placed (the body's ``translate:pupilToFilm`` is the first frame's pupil).
 
+A zoom lens (docs/zoom.md) is taken at each key's zoom position (a ``zoom`` column: a focal length
+with its unit, ``135mm``, or the encoder value 0..1; else the ``zoom`` argument, else its first
+tabulated position) and focused there, so a zoom over the take ramps the same attributes: the EFL and
+the companion camera's ``focalLength``, the entrance pupil, and, with the iris wide open (no f-stop
+given), the f-number as the stop's size and the pupil change along the zoom. The zoom encoder is
+time-sampled too, as the custom attribute ``physcam:zoomEncoder`` on the camera (0..1, 0 the first
+tabulated position).
+
 Frames are USD time codes; the stage's timeCodesPerSecond is the frame rate. Each key is one
 frame: USD interpolates linearly between samples, which breathing is not, so give a mark per
 frame (the CSV of a focus-pull recording is). Lengths in mm (docs/conventions.md).
@@ -25,8 +33,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ExportError, InputError, LensFileError, PhysCamWarning, require_finite
+from ..lens.zoom import prescription_at
 
 __all__ = ["FocusKey", "read_focus_marks", "write_animated_camera", "ntsc_rate"]
+
+#: The camera prim's time-sampled zoom encoder of a zoom lens (module notes).
+ZOOM_ENCODER_ATTR = "physcam:zoomEncoder"
 
 #: The most frames one animated camera holds (a 10-minute take at 48 fps), bounded before any work.
 MAX_FRAMES = 28_800
@@ -34,16 +46,19 @@ MAX_FRAMES = 28_800
 
 @dataclass(frozen=True)
 class FocusKey:
-    """One frame: its number, the focus mark from the film plane (mm), and an f-stop (None: unchanged)."""
+    """One frame: its number, the focus mark from the film plane (mm), an f-stop (None: unchanged) and a
+    zoom lens's position (a focal length ``"135mm"`` or an encoder value 0..1; None: unchanged)."""
 
     frame: float
     focus_mm: float
     fstop: float | None = None
+    zoom: str | float | None = None
 
 
 def read_focus_marks(path) -> list[FocusKey]:
     """Keys from a CSV with columns ``frame``, ``focus`` (a distance with units, ``5m``, ``16ft``; bare
-    numbers are mm) and optionally ``fstop`` (an iris pull). Errors name the file and line."""
+    numbers are mm) and optionally ``fstop`` (an iris pull) and ``zoom`` (a zoom lens's position:
+    ``135mm`` or an encoder value 0..1). Errors name the file and line."""
     import csv
 
     from ..units import parse_distance
@@ -56,10 +71,11 @@ def read_focus_marks(path) -> list[FocusKey]:
     rows = csv.DictReader(text.splitlines())
     cols = set(rows.fieldnames or ())
     if not {"frame", "focus"} <= cols:
-        raise LensFileError("the focus-mark CSV needs 'frame' and 'focus' columns (and optionally 'fstop')", str(p), 1)
-    unknown = cols - {"frame", "focus", "fstop"}
+        raise LensFileError("the focus-mark CSV needs 'frame' and 'focus' columns (and optionally 'fstop', 'zoom')",
+                            str(p), 1)
+    unknown = cols - {"frame", "focus", "fstop", "zoom"}
     if unknown:
-        raise LensFileError(f"unknown columns {sorted(unknown)}; use frame, focus, fstop", str(p), 1)
+        raise LensFileError(f"unknown columns {sorted(unknown)}; use frame, focus, fstop, zoom", str(p), 1)
     keys = []
     for line, row in enumerate(rows, start=2):
         try:
@@ -69,7 +85,8 @@ def read_focus_marks(path) -> list[FocusKey]:
         except (ValueError, TypeError, InputError) as exc:
             raise LensFileError(str(exc) if isinstance(exc, InputError) else f"not a number: {exc}", str(p), line) \
                 from None
-        keys.append(FocusKey(frame, focus, fstop))
+        zoom = (row.get("zoom") or "").strip() or None
+        keys.append(FocusKey(frame, focus, fstop, zoom))
         if len(keys) > MAX_FRAMES:
             raise LensFileError(f"more than {MAX_FRAMES} frames in one camera", str(p), line)
     if not keys:
@@ -112,12 +129,15 @@ def ntsc_rate(fps) -> float:
 def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: float | None = None,
                           fstop: float | None = None, coc=None, path: str = "/Cameras/Camera",
                           meters_per_unit: float = 0.01, fps: float = 24.0, shutter_angle_deg: float = 180.0,
-                          position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), force: bool = False):
-    """Write a camera whose focus (and iris) follow ``keys``, one time sample per key; return the Path.
+                          position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), force: bool = False,
+                          zoom=None):
+    """Write a camera whose focus (and iris, and a zoom lens's zoom) follow ``keys``, one time sample per
+    key; return the Path.
 
     ``lens`` (a Prescription) or ``focal_length_mm`` (a thin lens); ``sensor`` a
     :class:`~physcam.optics.sensors.Sensor`; ``fstop`` for keys without their own (with a
-    prescription and no f-stop at all: wide open).
+    prescription and no f-stop at all: wide open); ``zoom`` a zoom lens's position for keys without
+    their own (module notes).
     """
     from pxr import Sdf, UsdGeom
 
@@ -133,14 +153,15 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     mpu = require_meters_per_unit(meters_per_unit)
     rate = ntsc_rate(fps)
 
+    zooms = _zoom_encoders(keys, lens, zoom)
     frames = []
     seen_notes: set[str] = set()
-    for k in keys:
+    for k, u in zip(keys, zooms):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PhysCamWarning)
             report = solve_report(report_camera(focal_length_mm=focal_length_mm, sensor=sensor,
-                                   fstop=k.fstop if k.fstop is not None else fstop, focus_mm=k.focus_mm,
-                                   coc=coc, lens=lens))
+                                                 fstop=k.fstop if k.fstop is not None else fstop, focus_mm=k.focus_mm,
+                                                 coc=coc, lens=lens if u is None else prescription_at(lens, u)))
         for w in caught:  # say each approximation once, not once per frame
             if str(w.message) not in seen_notes:
                 seen_notes.add(str(w.message))
@@ -181,4 +202,27 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
             if value is not None and cam.GetAttribute(name):
                 sample(cam, name, value, t)
         sample_render_camera(geom, spec, report, mpu, rate, t, where=path)
+    if zooms[0] is not None:
+        attr = cam.CreateAttribute(ZOOM_ENCODER_ATTR, Sdf.ValueTypeNames.Double, custom=True)
+        attr.SetDocumentation("the zoom lens's position: physcam's normalised zoom encoder, 0 the first tabulated "
+                              "position, 1 the last (docs/zoom.md)")
+        for (frame, _, _), u in zip(frames, zooms):
+            attr.Set(float(u), float(frame))
     return save_stage(stage, file, force=force)
+
+
+def _zoom_encoders(keys, lens, zoom) -> list:
+    """Each key's zoom encoder value on a zoom ``lens`` (its own, else the last key's, else ``zoom``,
+    else the first tabulated position); Nones for any other lens, which refuses a zoom position."""
+    if lens is None or lens.zoom is None:
+        if zoom is not None or any(k.zoom is not None for k in keys):
+            raise InputError("a zoom position needs a zoom lens (a prescription with a zoom table, docs/zoom.md)")
+        return [None] * len(keys)
+    from ..optics.zoom import zoom_encoder
+
+    out, held = [], zoom_encoder(lens, 0.0 if zoom is None else zoom)
+    for k in keys:
+        if k.zoom is not None:
+            held = zoom_encoder(lens, k.zoom)
+        out.append(held)
+    return out
