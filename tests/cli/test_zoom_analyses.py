@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from _documents import check_document
 from physcam.cli import main
 
 CANON = "canon_ef_70_200mm_f2_8_zoom"
@@ -53,11 +54,12 @@ def _exr(path):
 def test_stmaps_at_a_zoom_position_are_those_of_the_single_position_prescription(tmp_path, capsys):
     single = _single_position_file(tmp_path, 1)
     a, b = tmp_path / "zoomed", tmp_path / "single"
-    rc, out, err = _run(capsys, "distortion", CANON, "--zoom", "0.5", "--focus", "3m", "--resolution", "40x30",
+    rc, out, err = _run(capsys, "distortion", "--lens", CANON, "--zoom", "0.5", "--focus", "3m", "--resolution", "40x30",
                         "--stmap", a, "--json")
     assert rc == 0, err
     doc = json.loads(out)
-    rc, out_single, err = _run(capsys, "distortion", single, "--focus", "3m", "--resolution", "40x30",
+    assert check_document(doc) == "physcam.distortion_field"
+    rc, out_single, err = _run(capsys, "distortion", "--lens", single, "--focus", "3m", "--resolution", "40x30",
                                "--stmap", b, "--json")
     assert rc == 0, err
     for name in ("distortion.exr", "undistortion.exr"):
@@ -73,9 +75,9 @@ def test_stmaps_at_a_zoom_position_are_those_of_the_single_position_prescription
 
 def test_the_field_angle_table_at_a_focal_length(capsys):
     # at infinity the table's pinhole is the EFL (f tan theta): the position asked for, 100 mm
-    rc, out, _ = _run(capsys, "distortion", CANON, "--zoom", "100mm", "--field", "3", "--json")
+    rc, out, _ = _run(capsys, "distortion", "--lens", CANON, "--zoom", "100mm", "--field", "3", "--json")
     doc = json.loads(out)
-    assert rc == 0 and doc["zoom"]["asked"] == "100mm"
+    assert rc == 0 and check_document(doc) == "physcam.distortion" and doc["zoom"]["asked"] == "100mm"
     assert doc["efl_y_mm"] == pytest.approx(100.0, rel=1e-6)
     assert doc["points"][0]["paraxial_height_mm"] == pytest.approx(100.0 * math.tan(math.radians(3.0)), rel=1e-6)
 
@@ -90,6 +92,7 @@ def test_dof_table_at_100mm_is_the_datasheet_computation_of_that_position(capsys
                         "--coc", "0.025", "--json")
     assert rc == 0, err
     d = json.loads(out)
+    assert check_document(d) == "physcam.dof_table"
     (row,) = d["rows"]
     # the position's Gaussian data: the lens at 100 mm focused at 3 m (its planes from the film plane)
     canon = load_lens(CANON)
@@ -109,6 +112,7 @@ def test_lens_card_at_a_zoom_position_has_optilands_numbers(tmp_path, capsys):
                         "--dpi", "30", "-o", tmp_path / "card.png", "--json")
     assert rc == 0, err
     d = json.loads(out)
+    assert check_document(d) == "physcam.lens_card"
     ref = OPTILAND["laikin_zoom_15_150mm"][3]
     assert d["key"]["efl_mm"] == pytest.approx(ref["efl_mm"], rel=1e-3)
     assert d["key"]["f_number"] == pytest.approx(ref["f_number"], rel=1e-3)
@@ -118,7 +122,7 @@ def test_lens_card_at_a_zoom_position_has_optilands_numbers(tmp_path, capsys):
 
 
 def test_characterize_plan_has_a_lens_per_zoom_position(tmp_path, capsys):
-    rc, out, err = _run(capsys, "characterize", CANON, "--zoom", "100mm,0.5,1", "--focus", "3m,inf", "--fstop", "2.8,4",
+    rc, out, err = _run(capsys, "characterize", "--lens", CANON, "--zoom", "100mm,0.5,1", "--focus", "3m,inf", "--fstop", "2.8,4",
                         "--kinds", "lens,illumination", "-o", tmp_path / "lib", "--dry-run", "--json")
     assert rc == 0, err
     d = json.loads(out)
@@ -135,7 +139,7 @@ def test_characterize_over_zoom_on_dask_gives_each_positions_efl(tmp_path, capsy
     from physcam.characterize import read_index
 
     out = tmp_path / "lib"
-    rc, _, err = _run(capsys, "characterize", CANON, "--zoom", "0,1", "--focus", "inf", "--kinds", "lens",
+    rc, _, err = _run(capsys, "characterize", "--lens", CANON, "--zoom", "0,1", "--focus", "inf", "--kinds", "lens",
                       "-o", out, "--workers", "1", "--no-usd", "--json")
     assert rc == 0, err
     rows = read_index(out).to_pylist()
@@ -150,14 +154,14 @@ def test_characterize_over_zoom_on_dask_gives_each_positions_efl(tmp_path, capsy
 
 
 @pytest.mark.parametrize("argv, words", [
-    (("distortion", "dgauss_50mm", "--zoom", "0.5"), "not a zoom lens"),
+    (("distortion", "--lens", "dgauss_50mm", "--zoom", "0.5"), "not a zoom lens"),
     (("dof-table", "--lens", "dgauss_50mm", "--zoom", "50mm"), "not a zoom lens"),
     (("dof-table", "--focal", "50", "--zoom", "0.5"), "--zoom takes a zoom lens"),
     (("lens", "card", "--lens", "dgauss_50mm", "--zoom", "0.5", "-o", "never.png"), "not a zoom lens"),
-    (("characterize", "dgauss_50mm", "--zoom", "0.5", "--focus", "inf", "-o", "never", "--dry-run"),
+    (("characterize", "--lens", "dgauss_50mm", "--zoom", "0.5", "--focus", "inf", "-o", "never", "--dry-run"),
      "not a zoom lens"),
-    (("distortion", CANON, "--zoom", "300mm"), "outside the zoom range"),
-    (("characterize", CANON, "--zoom", "0,0", "--focus", "inf", "-o", "never", "--dry-run"), "already given"),
+    (("distortion", "--lens", CANON, "--zoom", "300mm"), "outside the zoom range"),
+    (("characterize", "--lens", CANON, "--zoom", "0,0", "--focus", "inf", "-o", "never", "--dry-run"), "already given"),
 ])
 def test_a_prime_or_a_bad_position_is_one_line_and_exit_2(capsys, tmp_path, monkeypatch, argv, words):
     monkeypatch.chdir(tmp_path)
