@@ -168,3 +168,20 @@ def test_a_prime_or_a_bad_position_is_one_line_and_exit_2(capsys, tmp_path, monk
     rc, _, err = _run(capsys, *argv)
     assert rc == 2 and err.count("\n") == 1 and words in err and "Traceback" not in err
     assert not any(tmp_path.iterdir())
+
+
+def test_a_farm_characterize_job_has_a_grid_point_per_zoom_position(capsys, tmp_path, monkeypatch):
+    from physcam.farm.frames import parse_frames
+    from physcam.farm.tasklist import read_task_list
+
+    monkeypatch.chdir(tmp_path)
+    rc, out, err = _run(capsys, "farm", "--to", "tasks", "-o", "grid.txt", "--chunk", "1", "--json", "--",
+                        "characterize", "--lens", CANON, "--zoom", "0,1", "--focus", "3m,inf", "--fstop", "2.8",
+                        "--kinds", "lens,illumination", "--grid", "16", "-o", "lib")
+    assert rc == 0, err
+    tasks = read_task_list((tmp_path / "grid.txt").read_text())
+    cells = [parse_frames(argv[argv.index("--frames") + 1]) for step, argv in tasks if step == "cells"]
+    # 2 zoom positions x 2 focus marks x 1 stop = 4 grid points, one task each; every task keeps --zoom
+    assert cells == [(k, k) for k in range(1, 5)]
+    assert all(argv[argv.index("--zoom") + 1] == "0,1" for _, argv in tasks)
+    assert not (tmp_path / "lib").exists()
