@@ -82,6 +82,17 @@ def test_the_field_angle_table_at_a_focal_length(capsys):
     assert doc["points"][0]["paraxial_height_mm"] == pytest.approx(100.0 * math.tan(math.radians(3.0)), rel=1e-6)
 
 
+def test_distortion_across_focus_at_a_zoom_position(capsys):
+    rc, out, err = _run(capsys, "distortion", "--lens", CANON, "--zoom", "100mm", "--resolution", "32x24",
+                        "--across-focus", "2m,inf", "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    assert check_document(d) == "physcam.distortion_across_focus" and d["zoom"]["asked"] == "100mm"
+    # at infinity the pinhole is the EFL, the 100 mm asked for; focused at 2 m it is longer (breathing)
+    assert d["rows"][1]["pinhole_focal_length_mm"] == pytest.approx(100.0, rel=1e-6)
+    assert d["rows"][0]["pinhole_focal_length_mm"] > 100.0
+
+
 def test_dof_table_at_100mm_is_the_datasheet_computation_of_that_position(capsys):
     from physcam.lens.library import load_lens
     from physcam.lens.zoom import prescription_at
