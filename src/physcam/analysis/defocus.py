@@ -42,8 +42,8 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from .defocus_kernels import DefocusCamera, KernelCache
-from .defocus_layers import blur_layer, frame_of, layer_corners, layer_pairs
+from .defocus_kernels import DIRECT_BLUR_PX, DefocusCamera, KernelCache
+from .defocus_layers import blur_layer, frame_of, layer_corners, layer_grid, layer_pairs
 
 __all__ = ["DEPTH_KINDS", "DEPTH_UNITS_MM", "inverse_depth", "near_edges", "defocus"]
 
@@ -184,15 +184,31 @@ def defocus(image, u, cache: KernelCache, *, origin=(0, 0), edge_px: int = 1, al
 def _prepare(cache, f, pairs, progress) -> None:
     """Trace (or read) every node kernel the layers' blur grids blend from, in one batch."""
     cols, rows = cache.grid
-    needed = set()
+    needed, direct = set(), []
     for n, tiles in pairs.items():
         xs, ys = layer_corners(f, cache.camera, n, tiles)
+        if float(cache.camera.blur_px_at(n)) <= DIRECT_BLUR_PX:
+            direct += _used_corners(f, cache.camera, n, tiles, xs, ys)
+            continue
         found = []
         for nodes, pos in ((cols, xs), (rows, ys)):
             i = np.clip(np.searchsorted(nodes, pos, side="right") - 1, 0, len(nodes) - 2)
             found.append(np.unique(np.concatenate([i, i + 1])))
         needed |= {(int(c), int(r), int(n)) for c in found[0] for r in found[1]}
-    cache.prepare(needed, progress)
+    cache.prepare(needed, progress, direct)
+
+
+def _used_corners(f, cam, n, tiles, xs, ys) -> list[tuple[float, float, int]]:
+    """The corners (x, y, n) of node n's blur grid (columns ``xs``, rows ``ys``) within one grid step
+    of one of its tiles: the only ones whose kernels the layer reads."""
+    s, step, _ = layer_grid(f, cam, n, tiles)
+    S, t = s * step, f.tile
+    ty = np.array([a for a, _, _ in tiles])[:, None]
+    tx = np.array([b for _, b, _ in tiles])[:, None]
+    near_x = (f.origin[0] + tx * t < xs[None, :] + S) & (f.origin[0] + (tx + 1) * t > xs[None, :] - S)
+    near_y = (f.origin[1] + ty * t < ys[None, :] + S) & (f.origin[1] + (ty + 1) * t > ys[None, :] - S)
+    used = near_y.T.astype(np.int64) @ near_x.astype(np.int64)  # (rows, columns): tiles near both
+    return [(float(xs[i]), float(ys[j]), int(n)) for j, i in zip(*np.nonzero(used))]
 
 
 def _composite(f, cache, pairs, progress):

@@ -58,8 +58,12 @@ __all__ = ["DefocusCamera", "defocus_camera", "Kernel", "KernelCache", "FAR_MM",
 LADDER_STEP = 8
 #: samples per lit kernel pixel, and the most and fewest samples of a fan (powers of two)
 SAMPLES_PER_PX, MAX_SAMPLES, MIN_SAMPLES = 8.0, 1 << 16, 1 << 12
+#: depth nodes whose thin-lens blur is at most this (px) get kernels traced at each tile corner they
+#: are used at, not blended between field nodes: a small aberrated kernel changes its shape and its
+#: orientation (coma turns with the azimuth) faster than a few field nodes follow (issue 47)
+DIRECT_BLUR_PX = 16.0
 #: what the disk cache's files are laid out as and the field grid's rules (part of the camera key)
-CACHE_FORMAT = "physcam-defocus-kernels/3"
+CACHE_FORMAT = "physcam-defocus-kernels/5"
 
 
 @dataclass
@@ -292,10 +296,11 @@ def defocus_camera(lens: CameraState | Prescription, *, focus_mm: float | None =
     if tp.pinhole_focal_length_mm is None:
         raise OpticsError(f"{lens.name} has no best-match pinhole at this focus (its chief ray does not reach the film)")
     ap = _as_aperture(cam.aperture if aperture is None else aperture)
+    stop_semi = cam.stop_semi_diameter if ap is None else ap.corner_semi(cam.stop_semi_diameter, _widest_iris(cam))
     fx, dx = _x_meridian(lens, focus_mm, fstop, tp)
     return DefocusCamera(lens=lens, focus_mm=float(focus_mm), fstop=float(fstop), sensor_width_mm=sw,
                          width=int(width), height=int(height), aperture=ap, dispersion=bool(dispersion),
-                         tile=int(tile), step_px=step, step_rel=rel, film_z=cam.film_z, stop_semi=cam.stop_semi_diameter,
+                         tile=int(tile), step_px=step, step_rel=rel, film_z=cam.film_z, stop_semi=stop_semi,
                          focused=cam.focused, pupil_from_film_mm=tp.entrance_pupil_from_film_mm,
                          front_from_film_mm=tp.front_vertex_from_film_mm, pinhole_mm=tp.pinhole_focal_length_mm,
                          pupil_diameter_mm=tp.entrance_pupil_diameter_mm, pinhole_x_mm=fx, pupil_diameter_x_mm=dx,
@@ -317,6 +322,15 @@ def _x_meridian(lens, focus_mm, fstop, tp) -> tuple[float, float]:
     s = focus_mm - tp.entrance_pupil_from_film_mm
     scale = s / (s - delta) if math.isfinite(s) else 1.0
     return tx.pinhole_focal_length_mm * scale, tx.entrance_pupil_diameter_mm
+
+
+def _widest_iris(cam) -> float:
+    """The lens's widest iris (mm): its file's stop opened by physcam's stop-opening tolerance, the
+    farthest a bladed iris's corners go (docs/conventions.md, f-numbers)."""
+    from ..optics.paraxial import STOP_OPENING_TOLERANCE
+
+    q = cam.focused
+    return q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE)
 
 
 def _as_aperture(aperture):
@@ -353,6 +367,8 @@ class KernelCache:
         self._kernels: dict = {}
         self._table = None
         self._tiles: dict = {}
+        self._direct: dict = {}
+        self._places: dict = {}
         self._read = False
 
     # ---- the field grid -----------------------------------------------------------------------
@@ -366,13 +382,14 @@ class KernelCache:
         from .defocus_cache import read_stacks
         from .defocus_field import FieldTable, _table_positions
 
-        fractions, kernels, table = read_stacks(self.folder, self.camera.key(), CACHE_FORMAT,
+        fractions, kernels, table, direct = read_stacks(self.folder, self.camera.key(), CACHE_FORMAT,
                                                 len(self.camera.wavelengths_nm))
         if fractions is None:
             return
         self._fractions = tuple(float(f) for f in fractions)
         self._kernels.update(kernels)
-        self.loaded += len(kernels)
+        self._direct.update(direct)
+        self.loaded += len(kernels) + len(direct)
         radial, qx, qy = _table_positions(self.camera)
         if table is not None and table[:2] == (radial, len(qx)):
             self._table = FieldTable(radial, qx, qy, dict(table[2]))
@@ -412,29 +429,32 @@ class KernelCache:
         return [(i, j, wi * wj) for i, wi in cx for j, wj in cy if wi * wj > 0]
 
     # ---- tracing ------------------------------------------------------------------------------
-    def prepare(self, needed, progress=None) -> None:
-        """Make every node kernel of ``needed`` ((column, row, depth node) triples) and the
-        transmission table at their depths: read from disk, else traced in batches; the new ones
-        are written to the folder as one stack file."""
+    def prepare(self, needed, progress=None, direct=()) -> None:
+        """Make every node kernel of ``needed`` ((column, row, depth node) triples), every kernel of
+        ``direct`` ((x, y, depth node) of a small blur: :meth:`trace_direct`) and the transmission
+        table at their depths: read from disk, else traced in batches; the new ones are written to
+        the folder as one stack file."""
         from .defocus_field import field_table
 
         self._load()
         cam = self.camera
-        needed = set(needed)
-        ladder = {m for _, _, n in needed for m in cam.ladder(n)} | {0}
+        needed, direct = set(needed), list(direct)
+        ladder = {m for _, _, n in [*needed, *direct] for m in cam.ladder(n)} | {0}
         old_table = set() if self._table is None else set(self._table.transmission)
         self._table = field_table(cam, self._table, ladder)
         missing = sorted(k for k in needed if k not in self._kernels)
         new = self._trace(missing, progress) if missing else {}
         self._kernels.update(new)
         self.traced += len(new)
+        new_direct = self.trace_direct(direct)
         if self.folder is not None:
             from .defocus_cache import write_stack
 
             t = self._table
             rows = {n: t.transmission[n] for n in set(t.transmission) - old_table}
             self.folder.mkdir(parents=True, exist_ok=True)
-            write_stack(self.folder, cam.key(), CACHE_FORMAT, self.fractions, new, (t.radial, len(t.qx), rows))
+            write_stack(self.folder, cam.key(), CACHE_FORMAT, self.fractions, new, (t.radial, len(t.qx), rows),
+                        new_direct)
 
     def _trace(self, missing, progress) -> dict:
         """Node kernels of ``missing`` from fans traced at their ladder nodes, field node by field
@@ -484,6 +504,28 @@ class KernelCache:
                     progress(done, len(missing))
         return out
 
+    def trace_direct(self, points) -> dict:
+        """Trace, in one batch, the kernels at picture positions and depth nodes ``points`` ((x, y, n)
+        triples) of a small blur (:data:`DIRECT_BLUR_PX`), each at its own place and its node's own
+        depth, so that :meth:`tile_kernel` reads them instead of blending field nodes; returns the new ones."""
+        from .defocus_field import box_depths, node_kernel
+        from .defocus_trace import distortion_jacobians, pupil_boxes, trace_fans
+
+        cam = self.camera
+        todo = sorted({(round(float(x), 3), round(float(y), 3), int(n)) for x, y, n in points} - set(self._direct))
+        places = sorted({(x, y) for x, y, _ in todo} - set(self._places))
+        if places:  # a place's sampling box and unwarp serve all its depths (box_depths: one set per camera)
+            boxes = pupil_boxes(cam, places, box_depths(cam))
+            self._places.update(zip(places, zip(boxes, np.linalg.inv(distortion_jacobians(cam, places)))))
+        for b in range(0, len(todo), 512):
+            part = todo[b:b + 512]
+            fans = trace_fans(cam, [((x, y), float(cam.node_u(n)), self._places[(x, y)][0], cam.samples(n, n))
+                                    for x, y, n in part])
+            for key, fan in zip(part, fans):
+                self._direct[key] = node_kernel(cam, fan, fan, key[2], None, self._places[key[:2]][1])[0]
+        self.traced += len(todo)
+        return {k: self._direct[k] for k in todo}
+
     # ---- what defocus reads -------------------------------------------------------------------
     def node_kernel(self, col: int, row: int, n: int) -> np.ndarray:
         """The kernel of field node (col, row) at depth node ``n`` (unit sum per channel)."""
@@ -496,6 +538,8 @@ class KernelCache:
         """The kernel at picture (x, y), depth node ``n``: its field nodes' kernels blended
         bilinearly (unit sum per channel)."""
         key = (round(float(x), 3), round(float(y), 3), int(n))
+        if key in self._direct:
+            return self._direct[key]
         if key not in self._tiles:
             parts = [(w, self.node_kernel(c, r, n)) for c, r, w in self.nodes_of(x, y)]
             size = max(k.shape[0] for _, k in parts)

@@ -150,8 +150,7 @@ def iris_corner_semi(state: CameraState) -> float:
     if ap is None or ap.is_circular:
         return float(state.stop_semi_diameter)
     q = state.focused
-    widest = q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE)
-    return float(min(state.stop_semi_diameter * ap.equal_area_scale(), max(widest, state.stop_semi_diameter)))
+    return ap.corner_semi(state.stop_semi_diameter, q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE))
 
 
 def _bake(state: CameraState, fresnel: bool) -> BakedCamera:
