@@ -132,6 +132,8 @@ def _finish(args, res, command: str) -> None:
     d = mark_repaired(res.to_dict(), args.loaded_lens)
     if getattr(args, "sensor_name", None):
         d["sensor"] = args.sensor_name
+    if getattr(args, "zoom_block", None) is not None:  # a zoom lens at --zoom (docs/zoom.md)
+        d["zoom"] = args.zoom_block
     if args.json:
         emit_json(document(name, d, units=WAVE_UNITS))
         return

@@ -14,6 +14,7 @@ import math
 
 from ._common import FOCUS_HELP, add_units_option, focus, focus_list, number, units_of
 from ._output import document, emit_json, print_csv
+from ._zoom import add_zoom_option, at_zoom_named
 from .lens import WAVE_UNITS, mark_repaired
 
 #: Names of the files the fits write into --stmap DIR.
@@ -62,6 +63,7 @@ def register(sub) -> None:
     p.add_argument("--across-focus", type=_focus_list, default=None, metavar="LIST",
                    help="a table of distortion across focus marks, e.g. 0.5m,1m,2m,inf (hyperfocal too); "
                         "needs --resolution")
+    add_zoom_option(p)
     add_units_option(p)
     p.set_defaults(handler=run_distortion, output_folders=("stmap",))
 
@@ -86,7 +88,7 @@ def run_distortion(args) -> int:
     if args.csv and args.resolution is not None and args.across_focus is None:
         raise InputError("--csv prints a table's rows: the field-angle table (without --resolution) or "
                          "--across-focus; the 2-D field writes --stmap files")
-    lens = _prepare(args)
+    lens = at_zoom_named(_prepare(args), args)
     if args.focus is not None or args.across_focus is not None:
         from ..optics.sensors import custom_sensor
         from ._common import resolve_focus
@@ -143,7 +145,8 @@ def _run_across_focus(args, lens) -> int:
 
         tab.plot(args.output, force=args.force, units=units_of(args))
     if args.json:
-        emit_json(document("distortion_across_focus", mark_repaired(tab.to_dict(), args.loaded_lens),
+        emit_json(document("distortion_across_focus", mark_repaired({**tab.to_dict(), "zoom": args.zoom_block},
+                                                                     args.loaded_lens),
                            units=dict(WAVE_UNITS, image="pixel")))
         return 0
     rows = [dict(r, brown_du_k1=r["brown_du"]["k1"], brown_du_k2=r["brown_du"]["k2"],
@@ -310,6 +313,7 @@ def _run_field(args, lens) -> int:
             written = relocated(maps, tmp, args.stmap) + [p for p, _ in payload]
     d = res.to_dict()
     d["fits"] = [f.to_dict() for f in fits]
+    d["zoom"] = args.zoom_block
     if args.json:
         d["written"] = [str(p) for p in written]
         emit_json(document("distortion_field", mark_repaired(d, args.loaded_lens),

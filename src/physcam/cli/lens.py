@@ -23,7 +23,7 @@ from __future__ import annotations
 from ..errors import PhysCamError
 from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number, whole
 from ._output import add_output_options
-from ._zoom import add_zoom_option, register_zoom, zoom_info, zoomed
+from ._zoom import add_zoom_option, at_zoom_named, register_zoom, zoom_info, zoomed
 
 
 def register(sub) -> None:
@@ -105,6 +105,7 @@ def register(sub) -> None:
     k.add_argument("--force", action="store_true", help="overwrite an existing file")
     add_units_option(k)
     add_lenient(k)
+    add_zoom_option(k)
     add_output_options(k, what="the card's numbers")
     k.set_defaults(handler=run_card)
 
@@ -448,7 +449,7 @@ def run_card(args) -> int:
     from ._output import document, emit_json
 
     check_writable(args.output, force=args.force)  # before the seconds of work
-    p = _load(args)
+    p = at_zoom_named(load_lens_arg(args.lens, args.lenient), args)  # a zoom's card at --zoom, named so in its title
     sensor = resolve_sensor(args)
     (mark,) = resolve_focus([args.focus], lens=p, sensor=sensor, args=args)
     card = lens_card(p, focus_mm=mark, sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm,
@@ -456,7 +457,7 @@ def run_card(args) -> int:
                      quality="draft" if args.draft else "full")
     path = save_lens_card(card, args.output, force=args.force, units=units_of(args), dpi=args.dpi)
     if args.json:
-        emit_json(document("lens_card", {**card.to_dict(), "output": str(path)}))
+        emit_json(document("lens_card", {**card.to_dict(), "output": str(path), "zoom": args.zoom_block}))
         return 0
     print(f"wrote {path}")
     return 0
@@ -675,7 +676,7 @@ def run_pack(args) -> int:
     from ._output import document, emit_json
 
     check_writable(args.output, force=args.force)  # before the seconds of work
-    p = _load(args)
+    p = at_zoom_named(load_lens_arg(args.lens, args.lenient), args)  # a zoom's card at --zoom, named so in its title
     sensor = resolve_sensor(args)
     (mark,) = resolve_focus([args.focus], lens=p, sensor=sensor, args=args)
     runs = _read_runs(args.characterizations) if args.characterizations else None
