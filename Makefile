@@ -108,7 +108,7 @@ test-latest:
 	  | grep -i -E '^(numpy|numba|matplotlib|usd-core|openexr|jsonschema|cbor2|dask|pyarrow|starlette|uvicorn|openjd-model|opencue.pyoutline)=' \
 	  | tr '\n' ' ' | sed 's/^/physcam: newest versions tested: /'; echo
 	$(LATEST_VENV)/bin/python -m pytest -n 2 -q -m "not slow" -p no:cacheprovider tests/onset tests/optics \
-	  tests/lens tests/usd tests/live tests/trace/test_tracer.py tests/analysis/test_image_quality_closed_forms.py \
+	  tests/lens tests/usd tests/live tests/trace/test_tracer.py tests/analysis/image_quality/test_image_quality_closed_forms.py \
 	  tests/farm/test_farm_jobs.py
 
 # ruff (pyproject.toml [tool.ruff]): unused imports and variables, undefined names, pycodestyle errors

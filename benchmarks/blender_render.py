@@ -150,7 +150,7 @@ def _cameras(lens, slug, fstop, tmp, ext_src):
     from physcam.export.blender import blender_setup_script, osl_camera_shader
     from physcam.export.blender_camera import blender_camera_script, blender_camera_values
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     src = osl_camera_shader(lens, focus_mm=FOCUS_MM, fstop=fstop, sensor_width_mm=36.0, sensor_height_mm=24.0)
     setup = tmp / "setup.py"

@@ -8,7 +8,7 @@ import argparse
 import resource
 import time
 
-from physcam.analysis.bokeh import bokeh_image
+from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.lens.library import load_lens
 from physcam.optics import focusing
 

@@ -45,9 +45,9 @@ def warm_worker(lens: str) -> None:
     import numpy as np
     import pyarrow.parquet  # noqa: F401
 
-    import physcam.analysis.distortion_models  # noqa: F401
-    import physcam.analysis.illumination  # noqa: F401
-    import physcam.analysis.stmap  # noqa: F401
+    import physcam.analysis.distortion.models  # noqa: F401
+    import physcam.analysis.image_quality.illumination  # noqa: F401
+    import physcam.analysis.distortion.stmap  # noqa: F401
     import physcam.characterize.cells  # noqa: F401
     from physcam.lens.library import load_lens
     from physcam.trace import RayBatch, paraxial_image_z, trace_to_film

@@ -44,8 +44,8 @@ def frame(w, h, seed=0):
 
 def run(width, height, tile, kernel_cache=None):
     """Cold and warm CPU seconds of one frame (a fresh process's first and second defocus)."""
-    from physcam.analysis.defocus import defocus, inverse_depth
-    from physcam.analysis.defocus_kernels import KernelCache, defocus_camera
+    from physcam.analysis.defocus.render import defocus, inverse_depth
+    from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
     from physcam.lens.library import load_lens
 
     cam = defocus_camera(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_width_mm=36.0, width=width,
@@ -66,8 +66,8 @@ def run(width, height, tile, kernel_cache=None):
 def interpolation_check(cam, img, u, out):
     """The largest difference (per cent of the peak) between ``out`` and the frame defocused with every
     kernel traced where it is used (module notes)."""
-    from physcam.analysis.defocus import defocus
-    from physcam.analysis.defocus_kernels import KernelCache
+    from physcam.analysis.defocus.render import defocus
+    from physcam.analysis.defocus.kernels import KernelCache
 
     class Traced(KernelCache):
         """Every tile corner's kernel traced at its own position and its node's own depth."""
@@ -124,8 +124,8 @@ def main():
         import cProfile
         import pstats
 
-        from physcam.analysis.defocus import defocus
-        from physcam.analysis.defocus_kernels import KernelCache
+        from physcam.analysis.defocus.render import defocus
+        from physcam.analysis.defocus.kernels import KernelCache
 
         cache = KernelCache(cam)
         defocus(img, u, cache)

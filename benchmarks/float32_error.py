@@ -23,8 +23,8 @@ import os
 
 import numpy as np
 
-from physcam.analysis.bokeh import bokeh_image
-from physcam.analysis.spot import equal_area_disk
+from physcam.analysis.defocus.bokeh import bokeh_image
+from physcam.analysis.image_quality.spot import equal_area_disk
 from physcam.lens.library import list_lenses, load_lens
 from physcam.optics.paraxial import gaussian
 from physcam.trace import RayBatch, camera_rays, paraxial_image_z, trace_to_film

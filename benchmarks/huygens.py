@@ -13,8 +13,8 @@ from __future__ import annotations
 import statistics
 import time
 
-from physcam.analysis.huygens import huygens_psf
-from physcam.analysis.mtf import mtf
+from physcam.analysis.image_quality.huygens import huygens_psf
+from physcam.analysis.image_quality.mtf import mtf
 from physcam.lens.library import load_lens
 
 REPEATS = 5

@@ -93,7 +93,7 @@ def _samples(path: str, count: int = 2400) -> int:
     import dataclasses
 
     from physcam.live.camera import CameraMove, camera_frames, frames_to_samples
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     frames = camera_frames(sensor=find_sensor("ALEXA 35"), frames=count, rate=240, focus_mm=1500.0,
                            focus_to_mm=6000.0, fstop=2.8, tstop=3.0, focal_length_mm=35.0,

@@ -50,7 +50,7 @@ print(json.dumps(res))
 
 
 def time_physcam(repeat: int):
-    from physcam.analysis.mtf import WHITE_LIGHT_NM, mtf_chart
+    from physcam.analysis.image_quality.mtf import WHITE_LIGHT_NM, mtf_chart
     from physcam.lens.library import load_lens
 
     lens = load_lens("dgauss_50mm")

@@ -27,8 +27,8 @@ import time
 
 import numpy as np
 
-from physcam.analysis.distortion import real_distortion
-from physcam.analysis.spot import spot_diagram
+from physcam.analysis.distortion.field import real_distortion
+from physcam.analysis.image_quality.spot import spot_diagram
 from physcam.lens.library import load_lens
 from physcam.trace import RayBatch, paraxial_image_z, trace_through, trace_to_film
 

@@ -17,7 +17,7 @@ GOAL_MIB = 2048
 #: the child: build the maps, write them, report the peak resident memory before and after
 CHILD = r"""
 import json, resource, sys, tempfile, time
-from physcam.analysis.stmap import distortion_field, write_stmaps
+from physcam.analysis.distortion.stmap import distortion_field, write_stmaps
 from physcam.lens.library import load_lens
 
 w, h = int(sys.argv[1]), int(sys.argv[2])

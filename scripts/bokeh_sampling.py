@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from physcam.analysis.bokeh import bokeh_image
+from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.lens.library import load_lens
 from physcam.optics import focusing
 from physcam.trace import RayBatch, trace_to_film

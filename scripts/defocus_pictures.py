@@ -28,10 +28,10 @@ from pathlib import Path
 
 import numpy as np
 
-from physcam.analysis.defocus import defocus, inverse_depth
-from physcam.analysis.defocus_exr import read_exr
-from physcam.analysis.defocus_kernels import KernelCache, defocus_camera
-from physcam.analysis.stmap import apply_stmap, distortion_field
+from physcam.analysis.defocus.render import defocus, inverse_depth
+from physcam.analysis.defocus.exr import read_exr
+from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
+from physcam.analysis.distortion.stmap import apply_stmap, distortion_field
 from physcam.lens.library import load_lens
 from physcam.optics.state import camera_state
 from physcam.trace.aperture import Aperture
@@ -43,8 +43,8 @@ W, H, SW = 320, 180, 36.0
 _BEFORE = """
 import json, sys
 import numpy as np
-from physcam.analysis.defocus import defocus, inverse_depth
-from physcam.analysis.defocus_kernels import KernelCache, defocus_camera
+from physcam.analysis.defocus.render import defocus, inverse_depth
+from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
 from physcam.lens.library import load_lens
 from physcam.trace.aperture import Aperture
 for img, z, w, h, tile, blades, out in json.loads(sys.argv[1]):

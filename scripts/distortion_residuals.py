@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import math
 
-from physcam.analysis.distortion_models import fit_models, samples_from_field
-from physcam.analysis.stmap import distortion_field
+from physcam.analysis.distortion.models import fit_models, samples_from_field
+from physcam.analysis.distortion.stmap import distortion_field
 from physcam.errors import PhysCamError
 from physcam.lens.library import list_lenses, load_lens
 

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import warnings
 
-from physcam.analysis.real_dof import real_depth_of_field
+from physcam.analysis.defocus.real_dof import real_depth_of_field
 from physcam.errors import PhysCamError
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 
 CASES = [("dgauss_50mm", 2.8, 1000.0), ("dgauss_50mm", 2.8, 3000.0), ("dgauss_50mm", 5.6, 3000.0),
          ("tessar_50mm_f2_8", 2.8, 2000.0), ("sonnar_50mm_f1_5", 2.0, 2000.0), ("zeiss_distagon_35mm_f4", 4.0, 2000.0),

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from physcam.analysis.lightfield import checkerboard, light_field_figure, render_planes, view_disparity
+from physcam.analysis.defocus.lightfield import checkerboard, light_field_figure, render_planes, view_disparity
 from physcam.lens.library import load_lens
 from physcam.trace.microlens import microlens_array, plenoptic_camera
 

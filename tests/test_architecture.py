@@ -1,7 +1,11 @@
-"""Data flows one way: measurements and prescriptions -> optics -> analyses -> exporters -> CLI.
+"""Data flows one way: measurements and prescriptions -> optics -> analyses -> the on-set report ->
+exporters -> USD -> live and camera metadata -> farm and server -> CLI.
 
-Each sub-package may import only packages of a lower (or its own) layer; docs/architecture.md
-draws the same picture. A new import that points upward fails here.
+Every sub-package (and every module at the package's root) has a layer of its own (issue 43) and may
+import only packages of a lower layer, at any depth of its code: a deferred, function-level import is
+an edge too. So no two packages import each other, and the package graph has no loop, which
+:func:`test_no_package_level_import_loop` checks on its own. docs/architecture.md draws the same
+picture. A new import that points upward fails here; a new package needs its layer here.
 """
 
 import ast
@@ -10,22 +14,23 @@ from pathlib import Path
 SRC = Path(__file__).resolve().parents[1] / "src"
 
 LAYER = {
-    "errors": 0, "data": 0, "extras": 0, "progress": 0,
-    "units": 1, "io": 1,
-    "figures": 2,
-    "lens": 3,
-    "optics": 4,
-    "trace": 5,
-    "analysis": 6, "onset": 6,
-    "export": 7,
-    "usd": 8,
-    "live": 8.5, "metadata": 8.5,
-    "characterize": 9,
-    "farm": 9.5,
-    "serve": 9,
-    "cli": 10,
-    "": 0,  # the root package only re-exports errors and the version
-    "__main__": 11,
+    "errors": 0, "_moved": 1,
+    "": 2,  # the root package only re-exports errors and the version, and installs the old module paths
+    "data": 3, "extras": 4, "progress": 5, "units": 6, "io": 7, "figures": 8,
+    "lens": 9,
+    "optics": 10,
+    "trace": 11,
+    "analysis": 12,
+    "onset": 13,
+    "export": 14,
+    "usd": 15,
+    "live": 16,
+    "metadata": 17,
+    "characterize": 18,
+    "serve": 19,
+    "farm": 20,
+    "cli": 21,
+    "__main__": 22,
 }
 
 
@@ -45,8 +50,8 @@ def _imports(path: Path, module: str):
             yield from (a.name for a in node.names)
 
 
-def test_imports_point_down_the_layers():
-    wrong = []
+def _package_edges():
+    """(importing package, imported package, module, target) for every import between two packages."""
     for path in (SRC / "physcam").rglob("*.py"):
         parts = path.relative_to(SRC).with_suffix("").parts
         module = ".".join(p for p in parts if p != "__init__")
@@ -55,11 +60,90 @@ def test_imports_point_down_the_layers():
             if not target.startswith("physcam"):
                 continue
             tp = target.split(".")[1] if target.count(".") else ""
-            if tp == pkg:
-                continue
-            if LAYER.get(tp, 99) > LAYER.get(pkg, -1):
-                wrong.append(f"{module} imports {target}")
+            if tp != pkg:
+                yield pkg, tp, module, target
+
+
+def test_every_package_has_a_layer_of_its_own():
+    pkgs = {p.name if p.is_dir() else p.stem for p in (SRC / "physcam").iterdir()
+            if (p.is_dir() and (p / "__init__.py").exists()) or (p.suffix == ".py" and p.stem != "__init__")}
+    missing = sorted(pkgs - set(LAYER))
+    assert not missing, f"give these packages a layer in tests/test_architecture.py: {missing}"
+    values = [v for k, v in LAYER.items()]
+    assert len(values) == len(set(values)), "two packages share a layer"
+
+
+def test_imports_point_down_the_layers():
+    wrong = [f"{module} imports {target}" for pkg, tp, module, target in _package_edges()
+             if LAYER.get(tp, 99) > LAYER.get(pkg, -1)]
     assert not wrong, "upward imports:\n" + "\n".join(sorted(wrong))
+
+
+#: analysis/'s packages, one concept each (issue 43), each with a layer of its own below physcam.onset: the
+#: modules at analysis/'s own level (``_chief``, ``_plot``, ``_camera``, ``centroid``) are what they all share
+ANALYSIS_LAYER = {
+    "analysis": 0,
+    "analysis.image_quality": 1,
+    "analysis.distortion": 2,
+    "analysis.framing": 3,
+    "analysis.defocus": 4,
+    "analysis.calibration": 5,
+    "analysis.lens_cards": 6,
+}
+
+
+def _analysis_package(dotted: str) -> str:
+    """analysis's package of a module path under physcam.analysis ("analysis" for its own level)."""
+    parts = dotted.split(".")
+    if len(parts) > 2 and (SRC / "physcam" / "analysis" / parts[2]).is_dir():
+        return f"analysis.{parts[2]}"
+    return "analysis"
+
+
+def _analysis_edges():
+    """(importing package, imported package, module, target) for every import between two of analysis's
+    packages, deferred imports included."""
+    for path in (SRC / "physcam" / "analysis").rglob("*.py"):
+        parts = path.relative_to(SRC).with_suffix("").parts
+        module = ".".join(p for p in parts if p != "__init__")
+        pkg = _analysis_package(module)
+        for target in _imports(path, module):
+            if target.startswith("physcam.analysis") and _analysis_package(target) != pkg:
+                yield pkg, _analysis_package(target), module, target
+
+
+def test_every_analysis_package_has_a_layer_of_its_own():
+    pkgs = {f"analysis.{p.name}" for p in (SRC / "physcam" / "analysis").iterdir() if (p / "__init__.py").exists()}
+    missing = sorted(pkgs - set(ANALYSIS_LAYER))
+    assert not missing, f"give these packages a layer in tests/test_architecture.py's ANALYSIS_LAYER: {missing}"
+    assert len(set(ANALYSIS_LAYER.values())) == len(ANALYSIS_LAYER), "two of analysis's packages share a layer"
+
+
+def test_analysis_packages_import_down_their_layers():
+    wrong = [f"{module} imports {target}" for pkg, tp, module, target in _analysis_edges()
+             if ANALYSIS_LAYER[tp] > ANALYSIS_LAYER[pkg]]
+    assert not wrong, "upward imports between analysis's packages:\n" + "\n".join(sorted(wrong))
+    graph: dict[str, set[str]] = {}
+    for pkg, tp, _, _ in _analysis_edges():
+        graph.setdefault(pkg, set()).add(tp)
+        graph.setdefault(tp, set())
+    assert graph, "no imports between analysis's packages found: the edge finder is broken"
+    assert not [c for c in _components(graph) if len(c) > 1]
+
+
+def test_no_package_level_import_loop():
+    """Issue 43: the graph of packages (an edge for any import between two, deferred ones included) has no
+    strongly connected component of more than one package."""
+    graph: dict[str, set[str]] = {}
+    for pkg, tp, _, _ in _package_edges():
+        graph.setdefault(pkg, set()).add(tp)
+        graph.setdefault(tp, set())
+    loops = [" <-> ".join(c) for c in _components(graph) if len(c) > 1]
+    assert not loops, "package import loops (move what both sides need below both):\n" + "\n".join(loops)
+
+
+def test_the_loop_finder_finds_a_loop():
+    assert [sorted(c) for c in _components({"a": {"b"}, "b": {"a"}, "c": {"a"}}) if len(c) > 1] == [["a", "b"]]
 
 
 def test_pxr_and_numba_stay_in_their_modules():
@@ -108,11 +192,9 @@ def _imports_of(node, path, module):
         yield node.module or ""
 
 
-def test_no_import_cycles_deferred_imports_included():
-    """Issue 28: no two modules import each other, directly or round a longer circle, counting the
-    imports inside functions (Tarjan's strongly connected components, iteratively)."""
-    graph = _module_graph()
-    index, low, on, stack, cycles, counter = {}, {}, set(), [], [], [0]
+def _components(graph: dict) -> list[list[str]]:
+    """The strongly connected components of ``graph`` (node -> set of nodes), Tarjan's, iteratively."""
+    index, low, on, stack, comps, counter = {}, {}, set(), [], [], [0]
     for root in graph:
         if root in index:
             continue
@@ -130,7 +212,7 @@ def test_no_import_cycles_deferred_imports_included():
                     counter[0] += 1
                     stack.append(w)
                     on.add(w)
-                    work.append((w, iter(sorted(graph[w]))))
+                    work.append((w, iter(sorted(graph.get(w, ())))))
                 elif w in on:
                     low[v] = min(low[v], index[w])
                 continue
@@ -145,8 +227,34 @@ def test_no_import_cycles_deferred_imports_included():
                     comp.append(w)
                     if w == v:
                         break
-                if len(comp) > 1:
-                    cycles.append(" <-> ".join(sorted(comp)))
+                comps.append(sorted(comp))
+    return comps
+
+
+def test_every_relative_import_names_a_module_of_physcam():
+    """Issue 43 moved modules a level down: a relative import left one level short (``from ..figures`` in
+    a module of analysis's packages) fails only when its function runs. Every ``from .x import`` (deferred
+    ones included) must name an existing module or package of physcam."""
+    mods = set()
+    for path in (SRC / "physcam").rglob("*.py"):
+        parts = path.relative_to(SRC).with_suffix("").parts
+        mods.add(".".join(p for p in parts if p != "__init__"))
+    wrong = []
+    for path in (SRC / "physcam").rglob("*.py"):
+        parts = path.relative_to(SRC).with_suffix("").parts
+        module = ".".join(p for p in parts if p != "__init__")
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.level:
+                base = next(_imports_of(node, path, module))
+                if base not in mods:
+                    wrong.append(f"{module}:{node.lineno} imports {base}")
+    assert not wrong, "relative imports of no module:\n" + "\n".join(sorted(wrong))
+
+
+def test_no_import_cycles_deferred_imports_included():
+    """Issue 28: no two modules import each other, directly or round a longer circle, counting the
+    imports inside functions (Tarjan's strongly connected components, iteratively)."""
+    cycles = [" <-> ".join(c) for c in _components(_module_graph()) if len(c) > 1]
     assert not cycles, "import cycles (move what both sides need to the module that owns the concept):\n" + \
         "\n".join(cycles)
 

@@ -81,9 +81,9 @@ def test_every_public_default_sensor_is_the_clis():
     found = _sensor_defaults()
     names = {q for q, _, _ in found}
     # the analyses, the breathing table, the MTF chart, the characterization grid and the USD kit
-    for must in ("physcam.analysis.distortion.real_distortion", "physcam.analysis.illumination.relative_illumination",
-                 "physcam.analysis.colour.chromatic_aberration", "physcam.analysis.ghosts.ghost_analysis",
-                 "physcam.analysis.breathing_real.real_breathing", "physcam.analysis.mtf.mtf_chart",
+    # (the ray analyses that take a camera read its sensor, else the default: test_a_camera_without_a_sensor...)
+    for must in ("physcam.analysis.distortion.field.real_distortion",
+                 "physcam.analysis.framing.breathing_real.real_breathing", "physcam.analysis.image_quality.mtf.mtf_chart",
                  "physcam.optics.focusing.breathing_table", "physcam.characterize.grid.Grid",
                  "physcam.usd.spec.CameraSpec", "physcam.usd.kit.write_vendor_lens"):
         assert must in names, f"{must} has no sensor default (or is no longer public)"
@@ -94,6 +94,37 @@ def test_every_public_default_sensor_is_the_clis():
         if got != pytest.approx(expected, abs=1e-12):
             wrong.append(f"{qual}({name}={value!r}): the CLI's default is {s.name} ({expected})")
     assert not wrong, "defaults that differ from the CLI's sensor:\n" + "\n".join(wrong)
+
+
+@pytest.mark.parametrize("analysis", ["illumination.relative_illumination", "colour.chromatic_aberration",
+                                      "ghosts.ghost_analysis"])
+def test_a_camera_without_a_sensor_is_analysed_on_the_clis_sensor(analysis):
+    """Issue 43: relative illumination, colour and ghosts take the camera and nothing else about it; a
+    camera built without a sensor is analysed on the CLI's default sensor (its fields reach that sensor's
+    corner), exactly as with that sensor given."""
+    import importlib
+
+    from physcam.lens.library import load_lens
+    from physcam.optics.state import camera_state
+
+    module, _, name = analysis.rpartition(".")
+    fn = getattr(importlib.import_module(f"physcam.analysis.image_quality.{module}"), name)
+    kw = {"relative_illumination": dict(n_fields=3, grid=16), "ghost_analysis": dict(rank_rays=200)}.get(name, {})
+    lens = load_lens("dgauss_50mm")
+    bare = _flat(fn(camera_state(lens), **kw).to_dict())
+    given = _flat(fn(camera_state(lens, sensor=_cli_default_sensor()), **kw).to_dict())
+    assert bare.keys() == given.keys()
+    for key, value in bare.items():  # the tracer's backends (numpy, then numba once compiled) differ by 1e-15
+        assert given[key] == (pytest.approx(value, rel=1e-9, abs=1e-12) if isinstance(value, float) else value), key
+
+
+def _flat(doc, path=""):
+    """A JSON-like document as {path: leaf}."""
+    if isinstance(doc, dict):
+        return {k: v for key, item in doc.items() for k, v in _flat(item, f"{path}.{key}").items()}
+    if isinstance(doc, (list, tuple)):
+        return {k: v for i, item in enumerate(doc) for k, v in _flat(item, f"{path}[{i}]").items()}
+    return {path: doc}
 
 
 def test_dataclass_defaults_are_the_clis_too():

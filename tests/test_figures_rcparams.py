@@ -76,47 +76,47 @@ def dgauss():
 def _dof_zone(lens):
     from physcam.onset.dof_plot import dof_zone_figure
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     return dof_zone_figure(solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("S35"), fstop=2.8,
                                              focus_mm=3000.0))
 
 
 def _diagram(lens):
-    from physcam.analysis.diagram import lens_diagram
+    from physcam.analysis.lens_cards.diagram import lens_diagram
 
     return lens_diagram(lens, focus_mm=2000.0, fstop=4.0).figure()
 
 
 def _breathing(lens):
-    from physcam.analysis.breathing_plot import breathing_figure
+    from physcam.analysis.framing.breathing_plot import breathing_figure
     from physcam.optics.focusing import breathing_table
 
     return breathing_figure(breathing_table(lens, [math.inf, 2000.0, 1000.0], sensor_width_mm=36.0))
 
 
 def _real_breathing(lens):
-    from physcam.analysis.breathing_real import real_breathing
+    from physcam.analysis.framing.breathing_real import real_breathing
 
     return real_breathing(lens, [math.inf, 2000.0, 1000.0], sensor_width_mm=36.0, sensor_height_mm=24.0).plot()
 
 
 def _mtf_chart(lens):
-    from physcam.analysis.mtf import mtf_chart
+    from physcam.analysis.image_quality.mtf import mtf_chart
 
     return mtf_chart(lens, focus_mm=3000.0, fstop=8.0, n_fields=2, max_image_height_mm=5.0, frequencies=(10.0,),
                      wavelengths_nm=(587.5618,), pupil_samples=16).plot()
 
 
 def _spot(lens):
-    from physcam.analysis.spot import spot_diagram
+    from physcam.analysis.image_quality.spot import spot_diagram
 
     return spot_diagram(lens, (0.0, 5.0), rings=8, refine=2).plot()
 
 
 def _compare(lens):
     from physcam.cli.compare import compare_figure
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     rows = [{"name": "A", "fstop": 2.8, "focus_from_film_mm": 2000.0, "bokeh_light_from_film_mm": 4000.0,
              "bokeh_diameter_mm": 0.1}]
@@ -126,7 +126,7 @@ def _compare(lens):
 
 
 def _lens_card(lens):
-    from physcam.analysis.lens_card import lens_card
+    from physcam.analysis.lens_cards.card import lens_card
 
     return lens_card(lens, quality="draft").figure(dpi=30)
 

@@ -71,7 +71,7 @@ def test_the_core_installs_light_and_runs_the_report(installed):
     jsonschema.validate(doc, schema)
     # the installed wheel computes what this tree computes
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     here = solve_lens_report(focal_length_mm=50.0, fstop=2.8, focus_mm=3000.0, sensor=find_sensor("Super 35"))
     assert doc["dof"]["near_from_film_mm"] == pytest.approx(here.dof.near_from_film_mm, rel=1e-12)

@@ -6,6 +6,7 @@ real lens prescriptions, and cameras for OpenUSD, RenderMan, Blender and pbrt.
 Millimetres throughout; see docs/conventions.md.
 """
 
+from . import _moved
 from .errors import (
     BackendError,
     ExportError,
@@ -19,6 +20,8 @@ from .errors import (
 )
 
 __version__ = "0.2.0"
+
+_moved.install()  # old module paths (issue 43) answer for one version, with a DeprecationWarning
 
 __all__ = [
     "__version__",

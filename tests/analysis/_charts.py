@@ -1,5 +1,5 @@
 """Chart photographs made with OpenCV's own projection (cv2.projectPoints and its inverse), an
-independent ground truth for physcam.analysis.calibrate: a known pinhole, principal point and
+independent ground truth for physcam.analysis.calibration.calibrate: a known pinhole, principal point and
 Brown-Conrady distortion, poses at many angles (some cut by the frame), blur and noise."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from physcam.analysis.calibrate_chart import ChartSpec, ChartView
+from physcam.analysis.calibration.chart import ChartSpec, ChartView
 
 SIZE = (1280, 960)  # width, height px
 SENSOR_MM = (12.8, 9.6)  # 10 um photosites

@@ -3,7 +3,7 @@
 Object points on the plane of sharp focus, each placed where physcam's best-match pinhole
 (GaussianData at that focus, camera at the entrance pupil) sees a chosen ideal pixel; their chief
 rays are aimed from the object point through the centre of the stop (a Newton iteration written
-here) and traced to the film. Independent of physcam.analysis.stmap's backward chief rays from film
+here) and traced to the film. Independent of physcam.analysis.distortion.stmap's backward chief rays from film
 points, its interpolation and its inversion.
 """
 

@@ -28,7 +28,7 @@ STATE = camera_state(DGAUSS, focus_mm=MARK, fstop=N)
 
 
 def test_distortion_field_at_a_stop_is_the_same_through_either_door():
-    from physcam.analysis.stmap import distortion_field
+    from physcam.analysis.distortion.stmap import distortion_field
 
     kw = dict(width_px=48, height_px=32, maps=False)
     a = distortion_field(camera_state(DGAUSS, focus_mm=MARK, fstop=N, sensor_mm=(36.0, 24.0)), **kw)
@@ -48,7 +48,7 @@ def test_distortion_field_at_a_stop_is_the_same_through_either_door():
 
 
 def test_real_blur_is_the_same_through_either_door():
-    from physcam.analysis.real_dof import blur_diameter_mm, real_depth_of_field
+    from physcam.analysis.defocus.real_dof import blur_diameter_mm, real_depth_of_field
 
     a = blur_diameter_mm(STATE, 1000.0, image_height_mm=5.0)
     b = blur_diameter_mm(DGAUSS, 1000.0, focus_mm=MARK, fstop=N, image_height_mm=5.0)
@@ -64,7 +64,7 @@ def test_real_blur_is_the_same_through_either_door():
 
 
 def test_defocus_camera_is_the_same_through_either_door():
-    from physcam.analysis.defocus_kernels import defocus_camera
+    from physcam.analysis.defocus.kernels import defocus_camera
 
     s = camera_state(DGAUSS, focus_mm=MARK, fstop=2.8, sensor_mm=(36.0, 24.0))
     a = defocus_camera(s, width=128, height=72)
@@ -88,7 +88,7 @@ def test_defocus_camera_is_the_same_through_either_door():
 
 
 def test_lens_diagram_is_the_same_through_either_door():
-    from physcam.analysis.diagram import lens_diagram
+    from physcam.analysis.lens_cards.diagram import lens_diagram
 
     a = lens_diagram(STATE, rays=3)
     b = lens_diagram(DGAUSS, focus_mm=MARK, fstop=N, rays=3)
@@ -125,8 +125,8 @@ def test_light_field_camera_is_the_same_through_either_door():
 
 
 def test_lens_measurements_are_the_same_through_either_door():
-    from physcam.analysis.lens_compare import lens_measurements
-    from physcam.onset.sensors import find_sensor
+    from physcam.onset.lens_compare import lens_measurements
+    from physcam.optics.sensors import find_sensor
 
     ff = find_sensor("FF")
     with warnings.catch_warnings():
@@ -142,9 +142,9 @@ def test_lens_measurements_are_the_same_through_either_door():
 
 
 def test_thin_lens_gap_takes_the_reports_camera_state():
-    from physcam.analysis.thin_lens_gap import thin_lens_gap
+    from physcam.onset.thin_lens_gap import thin_lens_gap
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

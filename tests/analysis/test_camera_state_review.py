@@ -16,7 +16,7 @@ def canon():
 
 
 def test_a_focused_state_with_another_focus_method_is_refused_not_refocused(canon):
-    from physcam.analysis.stmap import distortion_field
+    from physcam.analysis.distortion.stmap import distortion_field
 
     st = camera_state(canon, focus_mm=900.0, fstop=4.0, sensor_mm=(36.0, 24.0))
     with pytest.raises(InputError, match="focused already"):
@@ -24,7 +24,7 @@ def test_a_focused_state_with_another_focus_method_is_refused_not_refocused(cano
 
 
 def test_the_lens_diagram_of_a_state_is_at_the_states_wavelength(canon):
-    from physcam.analysis.diagram import lens_diagram
+    from physcam.analysis.lens_cards.diagram import lens_diagram
 
     blue = 486.1327
     got = lens_diagram(camera_state(canon, focus_mm=900.0, fstop=4.0, wavelengths_nm=[blue]))
@@ -38,7 +38,7 @@ def test_an_iris_shape_that_is_not_one_is_refused_when_the_state_is_made(canon):
 
 
 def test_an_explicit_default_sensor_next_to_a_states_own_is_refused(canon):
-    from physcam.analysis.illumination import relative_illumination
+    from physcam.analysis.image_quality.illumination import relative_illumination
     from physcam.data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 
     st = camera_state(canon, sensor_mm=(36.0, 24.0))
@@ -48,7 +48,7 @@ def test_an_explicit_default_sensor_next_to_a_states_own_is_refused(canon):
 
 
 def test_a_defocus_camera_refuses_a_second_sensor_next_to_the_states(canon):
-    from physcam.analysis.defocus_kernels import defocus_camera
+    from physcam.analysis.defocus.kernels import defocus_camera
 
     st = camera_state(canon, focus_mm=2000.0, fstop=4.0, sensor_mm=(36.0, 24.0))
     with pytest.raises(InputError, match="own sensor"):

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from physcam.analysis._chief import aim_from_infinity, field_direction
-from physcam.analysis.distortion import real_distortion
+from physcam.analysis.distortion.field import real_distortion
 from physcam.lens.library import load_lens
 from physcam.trace import RayBatch, paraxial_image_z, trace_through
 
@@ -47,7 +47,7 @@ def test_fisheye_chief_ray_passes_at_wide_fields(fisheye, theta):
 
 
 def test_fisheye_field_limit_is_at_least_the_corner(fisheye):
-    from physcam.analysis.field_of_view import chief_ray_field_limit
+    from physcam.analysis.framing.field_of_view import chief_ray_field_limit
 
     assert chief_ray_field_limit(fisheye) >= 65.2
     r = real_distortion(fisheye, sensor_width_mm=36.0, sensor_height_mm=24.0)  # 15 fields to the full-frame corner, 65.21 deg
@@ -56,7 +56,7 @@ def test_fisheye_field_limit_is_at_least_the_corner(fisheye):
 
 
 def test_fisheye_field_limit_is_where_the_chief_ray_meets_the_front_rim(fisheye):
-    from physcam.analysis.field_of_view import chief_ray_field_limit
+    from physcam.analysis.framing.field_of_view import chief_ray_field_limit
 
     limit = chief_ray_field_limit(fisheye)  # beyond the full-frame corner: searched up to 89 deg
     assert 65.2 < limit < 89.0

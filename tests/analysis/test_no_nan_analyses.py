@@ -61,7 +61,7 @@ WAVES = st.one_of(st.none(), st.floats(380.0, 780.0), st.sampled_from([300.0, 11
 @given(slug=st.sampled_from(SLUGS), field=FIELDS, wl=WAVES, clip=st.booleans(),
        film_dz=st.one_of(st.none(), st.floats(-20.0, 20.0)))
 def test_spot_and_field_limit(slug, field, wl, clip, film_dz):
-    from physcam.analysis.spot import spot_diagram
+    from physcam.analysis.image_quality.spot import spot_diagram
     from physcam.trace import paraxial_image_z
 
     lens = load_lens(slug)
@@ -77,8 +77,8 @@ def test_spot_and_field_limit(slug, field, wl, clip, film_dz):
 @settings(max_examples=30, database=None)
 @given(slug=st.sampled_from(SLUGS), w=SIZES, h=SIZES, mark=MARKS)
 def test_field_of_view_and_breathing(slug, w, h, mark):
-    from physcam.analysis.breathing_real import real_breathing
-    from physcam.analysis.field_of_view import real_field_of_view
+    from physcam.analysis.framing.breathing_real import real_breathing
+    from physcam.analysis.framing.field_of_view import real_field_of_view
 
     lens = load_lens(slug)
     _check(lambda: real_field_of_view(lens, w, h, focus_mm=mark))
@@ -88,9 +88,9 @@ def test_field_of_view_and_breathing(slug, w, h, mark):
 @settings(max_examples=25, database=None)
 @given(slug=st.sampled_from(SLUGS), w=SIZES, h=SIZES, top=st.one_of(st.none(), st.floats(0.1, 88.9)))
 def test_distortion_illumination_colour(slug, w, h, top):
-    from physcam.analysis.colour import chromatic_aberration
-    from physcam.analysis.distortion import real_distortion
-    from physcam.analysis.illumination import relative_illumination
+    from physcam.analysis.image_quality.colour import chromatic_aberration
+    from physcam.analysis.distortion.field import real_distortion
+    from physcam.analysis.image_quality.illumination import relative_illumination
 
     lens = load_lens(slug)
     _check(lambda: real_distortion(lens, sensor_width_mm=w, sensor_height_mm=h, n_fields=5))
@@ -103,8 +103,8 @@ def test_distortion_illumination_colour(slug, w, h, top):
 @given(slug=st.sampled_from(SLUGS), depth=st.one_of(st.floats(10.0, 1e6), st.sampled_from([1e9, 1.0])),
        x=st.floats(-50.0, 50.0), spectral=st.booleans(), field=FIELDS)
 def test_bokeh_and_ghosts(slug, depth, x, spectral, field):
-    from physcam.analysis.bokeh import bokeh_image
-    from physcam.analysis.ghosts import ghost_analysis
+    from physcam.analysis.defocus.bokeh import bokeh_image
+    from physcam.analysis.image_quality.ghosts import ghost_analysis
 
     lens = load_lens(slug)
     _check(lambda: bokeh_image(lens, depth, x, 0.0, rays=2000, pixels=16, chunk=1000, spectral=spectral))

@@ -16,11 +16,11 @@ import math
 import numpy as np
 import pytest
 
-from physcam.analysis.bokeh import bokeh_image
-from physcam.analysis.colour import chromatic_aberration
-from physcam.analysis.ghosts import ghost_analysis, trace_ghost
-from physcam.analysis.illumination import relative_illumination
-from physcam.analysis.spot import spot_diagram
+from physcam.analysis.defocus.bokeh import bokeh_image
+from physcam.analysis.image_quality.colour import chromatic_aberration
+from physcam.analysis.image_quality.ghosts import ghost_analysis, trace_ghost
+from physcam.analysis.image_quality.illumination import relative_illumination
+from physcam.analysis.image_quality.spot import spot_diagram
 from physcam.errors import InputError, WrongTypeError
 from physcam.lens.library import load_lens
 from physcam.optics import focusing
@@ -135,7 +135,7 @@ def test_anything_but_a_state_or_a_lens_first_is_a_wrong_type_error(fn, args, ba
 
 
 def test_one_ghost_path_traced_from_a_state_is_the_path_of_its_lens_stop_and_film():
-    from physcam.analysis.ghosts import _beam
+    from physcam.analysis.image_quality.ghosts import _beam
 
     s = camera_state(DGAUSS, focus_mm=2000.0, fstop=2.8)
     lens, film, iris = _by_hand(DGAUSS, 2000.0, 2.8)

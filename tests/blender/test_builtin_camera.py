@@ -13,7 +13,7 @@ import pytest
 
 from physcam.export.blender_camera import blender_camera_script, blender_camera_values
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 
 from _blender import run_blender
 
@@ -170,7 +170,7 @@ def test_builtin_iris_corners_where_physcam_puts_them(tmp_path):
     the 180/N the corners came out at 45 degrees (issue 24 item 3)."""
     import numpy as np
 
-    from physcam.analysis.blob import polygon_corners
+    from physcam.analysis.defocus.blob import polygon_corners
 
     r = solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("FF"), fstop=2.0, focus_mm=2000.0)
     v = blender_camera_values(r, resolution_x=512, blades=6, blade_rotation_deg=15.0)

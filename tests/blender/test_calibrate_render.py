@@ -7,7 +7,7 @@ and the breathing between the marks within 0.2 %.
 The two sides are independent: Cycles renders through the OSL shader's float32 ray trace (film to
 scene, the chart a textured emissive plane), the chart is found by OpenCV and fitted by OpenCV's
 calibration; the prediction is physcam's numpy tracer's paraxial pinhole at the mark and its real
-chief rays (:func:`physcam.analysis.stmap.distortion_field`).
+chief rays (:func:`physcam.analysis.distortion.stmap.distortion_field`).
 
 The far mark's chart is the near one scaled by the ratio of the marks (a bigger board, so that it
 fills the frame as well): a chart's size enters only the poses OpenCV fits, never the pinhole or the

@@ -29,10 +29,10 @@ import numpy as np
 import pytest
 
 from _blender import run_blender
-from physcam.analysis.defocus import defocus, inverse_depth
-from physcam.analysis.defocus_exr import read_exr
-from physcam.analysis.defocus_kernels import KernelCache, defocus_camera
-from physcam.analysis.stmap import apply_stmap, distortion_field
+from physcam.analysis.defocus.render import defocus, inverse_depth
+from physcam.analysis.defocus.exr import read_exr
+from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
+from physcam.analysis.distortion.stmap import apply_stmap, distortion_field
 from physcam.export.blender import blender_setup_script, osl_camera_shader
 from physcam.lens.library import load_lens
 from physcam.optics.state import camera_state

@@ -7,7 +7,7 @@ The Neil front anamorphic 2x (42.5 mm), focused at a 2 m mark, f/2.8, a 20 x 15 
 spheres 0.25 m in front of the pinhole, one on the axis and one toward the top right, and an
 emissive checker plane 3 m away. Cycles renders it through physcam's OSL camera (the truth), and
 through a pinhole at the lens's Y entrance pupil with the Y meridian's best-match focal length and
-the pixel aspect f_pin,y / f_pin,x (physcam.analysis.defocus_kernels: the X pinhole seen from the Y
+the pixel aspect f_pin,y / f_pin,x (physcam.analysis.defocus.kernels: the X pinhole seen from the Y
 pupil frames the plane of focus as the lens's X meridian does), with a Z pass. physcam defocus keeps
 the render's geometry; its output (and, for the baseline, the pinhole render) is redistorted with
 physcam's own ST map (this lens's barrel distortion is strong) before it is compared.
@@ -22,10 +22,10 @@ import numpy as np
 import pytest
 
 from _blender import run_blender
-from physcam.analysis.defocus import defocus, inverse_depth
-from physcam.analysis.defocus_exr import read_exr
-from physcam.analysis.defocus_kernels import KernelCache, defocus_camera
-from physcam.analysis.stmap import apply_stmap, distortion_field
+from physcam.analysis.defocus.render import defocus, inverse_depth
+from physcam.analysis.defocus.exr import read_exr
+from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
+from physcam.analysis.distortion.stmap import apply_stmap, distortion_field
 from physcam.export.blender import blender_setup_script, osl_camera_shader
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import pupil_aspect

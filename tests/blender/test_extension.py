@@ -128,7 +128,7 @@ def _centroids(img, guesses, r=8):
 def _report_at(lens, mark_mm, sh):
     """physcam's lens report at mark_mm: (entrance pupil from the film, best-match pinhole), mm."""
     from physcam.onset.request import ReportRequest
-    from physcam.onset.sensors import custom_sensor
+    from physcam.optics.sensors import custom_sensor
     from physcam.onset.solvers import field_of_view, lens_at_mark
 
     req = ReportRequest(sensor=custom_sensor(SW, sh), fstop=8.0, focus_mm=mark_mm, lens=lens)

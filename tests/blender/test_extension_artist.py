@@ -13,7 +13,7 @@ import pytest
 
 from _blender import INSTALLED_EXTENSION_SCENE, run_blender_log
 from physcam.lens.library import load_lens
-from physcam.onset.sensors import sensors
+from physcam.optics.sensors import sensors
 
 pytestmark = pytest.mark.slow
 
@@ -207,13 +207,13 @@ def test_sensor_presets_are_physcams_table(artist):
 def _mark_for_axial(lens, axial_mm):
     """The focus mark (mm from the film) of an object ``axial_mm`` in front of the entrance pupil:
     mark = axial + pupil_from_film(mark), solved by bisection on physcam's report."""
-    from physcam.onset.request import ReportRequest
-    from physcam.onset.sensors import custom_sensor
+    from physcam.onset.request import report_camera
     from physcam.onset.solvers import lens_at_mark
+    from physcam.optics.sensors import custom_sensor
 
     def pupil(m):
-        return lens_at_mark(ReportRequest(sensor=custom_sensor(36.0, 24.0), fstop=8.0, focus_mm=m,
-                                          lens=lens)).pupil_from_film_mm
+        return lens_at_mark(report_camera(sensor=custom_sensor(36.0, 24.0), fstop=8.0, focus_mm=m,
+                                          lens=lens).camera).pupil_from_film_mm
 
     lo, hi = axial_mm, axial_mm + 200.0
     for _ in range(40):

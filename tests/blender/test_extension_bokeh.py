@@ -1,5 +1,5 @@
 """Bokeh through the physcam extension (its focus-table shader, iris and sensor as the panel's
-parameters) against physcam's :func:`physcam.analysis.bokeh.bokeh_image`, as
+parameters) against physcam's :func:`physcam.analysis.defocus.bokeh.bokeh_image`, as
 tests/blender/test_osl_bokeh.py does for the baked shader: the double Gauss 50 mm focused at a 2 m
 mark, f/2.8 by physcam's one iris rule, 6 straight blades with a corner 15 degrees from +x (the
 hexagon has the area of f/2.8's round iris: docs/conventions.md); a 1 mm
@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from _blender import INSTALLED_EXTENSION_SCENE, run_blender
-from physcam.analysis.blob import blob_moments, polygon_corners
-from physcam.analysis.bokeh import bokeh_image
+from physcam.analysis.defocus.blob import blob_moments, polygon_corners
+from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus, iris_semi_diameter
 from physcam.trace.aperture import Aperture
@@ -62,12 +62,12 @@ print(json.dumps({"message": p.message, "img": a.tolist()}))
 
 def _pupil_from_film(lens, mark_mm):
     """The entrance pupil's distance in front of the film at mark_mm (physcam's report)."""
-    from physcam.onset.request import ReportRequest
-    from physcam.onset.sensors import custom_sensor
+    from physcam.onset.request import report_camera
+    from physcam.optics.sensors import custom_sensor
     from physcam.onset.solvers import lens_at_mark
 
-    return lens_at_mark(ReportRequest(sensor=custom_sensor(36.0, 24.0), fstop=FSTOP, focus_mm=mark_mm,
-                                      lens=lens)).pupil_from_film_mm
+    return lens_at_mark(report_camera(sensor=custom_sensor(36.0, 24.0), fstop=FSTOP, focus_mm=mark_mm,
+                                      lens=lens).camera).pupil_from_film_mm
 
 
 def test_bokeh_diameter_and_iris_corners_match_bokeh_image(extension_zip, tmp_path):

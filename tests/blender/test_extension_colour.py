@@ -1,5 +1,5 @@
 """Lateral colour through the physcam extension's OSL camera with dispersion on, against
-:func:`physcam.analysis.colour.chromatic_aberration`: the Zuiko 18 mm f/3.5 (the bundled lens with
+:func:`physcam.analysis.image_quality.colour.chromatic_aberration`: the Zuiko 18 mm f/3.5 (the bundled lens with
 the most lateral colour at the corner, 76 um F-C at 48 degrees) at f/8, focused at infinity, a
 light 1 km away at 48 degrees along the full-frame diagonal (19.7 mm off axis of 21.6). The shader draws one wavelength per ray, uniform on
 400-700 nm, and colours it with three tents (blue 1 below 450 nm falling to 0 at 550, red rising
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from _blender import INSTALLED_EXTENSION_SCENE, run_blender
-from physcam.analysis.colour import chromatic_aberration
+from physcam.analysis.image_quality.colour import chromatic_aberration
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus
 

@@ -21,8 +21,8 @@ import numpy as np
 import pytest
 
 from _blender import INSTALLED_EXTENSION_SCENE, predicted_block_brightness, run_blender_log
-from physcam.analysis.blob import blob_moments
-from physcam.analysis.bokeh import bokeh_image
+from physcam.analysis.defocus.blob import blob_moments
+from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.export.blender import bake_camera
 from physcam.lens.library import load_lens
 from physcam.optics.state import camera_state
@@ -93,12 +93,12 @@ print(json.dumps({"frames": frames, "extension": hasattr(bpy.types.Camera, "phys
 
 def _pupil_from_film(lens, mark_mm):
     """The entrance pupil's distance in front of the film at mark_mm (physcam's report), mm."""
-    from physcam.onset.request import ReportRequest
-    from physcam.onset.sensors import custom_sensor
+    from physcam.onset.request import report_camera
     from physcam.onset.solvers import lens_at_mark
+    from physcam.optics.sensors import custom_sensor
 
-    return lens_at_mark(ReportRequest(sensor=custom_sensor(SW, SH), fstop=8.0, focus_mm=mark_mm,
-                                      lens=lens)).pupil_from_film_mm
+    return lens_at_mark(report_camera(sensor=custom_sensor(SW, SH), fstop=8.0, focus_mm=mark_mm,
+                                      lens=lens).camera).pupil_from_film_mm
 
 
 def _to_px(fx, fy):
@@ -117,13 +117,13 @@ def _blob(img, c, r):
 
 def _pinhole(lens, mark_mm):
     """physcam's best-match pinhole focal length at mark_mm (the lens report), mm."""
-    from physcam.onset.request import ReportRequest
-    from physcam.onset.sensors import custom_sensor
+    from physcam.onset.request import report_camera
     from physcam.onset.solvers import field_of_view, lens_at_mark
+    from physcam.optics.sensors import custom_sensor
 
-    req = ReportRequest(sensor=custom_sensor(SW, SH), fstop=8.0, focus_mm=mark_mm, lens=lens)
-    state = lens_at_mark(req)
-    return field_of_view(req, state, state.h2_from_film_mm)["pinhole_focal_length_mm"]
+    inputs = report_camera(sensor=custom_sensor(SW, SH), fstop=8.0, focus_mm=mark_mm, lens=lens)
+    at = lens_at_mark(inputs.camera)
+    return field_of_view(inputs.camera, at.h2_from_film_mm, inputs.references, at)["pinhole_focal_length_mm"]
 
 
 @pytest.fixture(scope="module")

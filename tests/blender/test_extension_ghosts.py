@@ -1,7 +1,7 @@
 """Ghosts in the physcam extension's OSL camera against physcam's ghost analysis: a bright light
 8 degrees off axis through the double Gauss 50 mm at f/2.8, focused at infinity, rendered by Cycles
 with one ghost path only (the debug view "Ghosts only") and with the picture; the ghost's centroid
-and its flux relative to the direct image are those of :func:`physcam.analysis.ghosts.ghost_analysis`
+and its flux relative to the direct image are those of :func:`physcam.analysis.image_quality.ghosts.ghost_analysis`
 (uncoated surfaces, the same iris by :func:`physcam.optics.focusing.iris_semi_diameter`)."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from _blender import INSTALLED_EXTENSION_SCENE, run_blender
-from physcam.analysis.ghosts import ghost_analysis, ghost_pairs
+from physcam.analysis.image_quality.ghosts import ghost_analysis, ghost_pairs
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus, iris_semi_diameter
 

@@ -5,7 +5,7 @@ The double Gauss 50 mm is focused at a 2 m mark (physcam's focus solution) at f/
 6-blade iris. Cycles renders small emissive spheres through the generated OSL camera (Blender
 side, float32, rays traced from the film out); physcam's numba tracer traces the same focused,
 stopped-down prescription forward from a point light to the same film plane
-(:func:`physcam.analysis.bokeh.bokeh_image`). The two are independent implementations, compared
+(:func:`physcam.analysis.defocus.bokeh.bokeh_image`). The two are independent implementations, compared
 through numbers measured the same way on both images:
 
 1. a sphere on the plane of sharp focus (2 m from the film: the camera object's origin is the
@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 
 from _blender import DARK_SCENE_CAMERA_AT_FILM, run_blender
-from physcam.analysis.blob import blob_moments, polygon_corners
-from physcam.analysis.bokeh import bokeh_image
+from physcam.analysis.defocus.blob import blob_moments, polygon_corners
+from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.export.blender import blender_setup_script, osl_camera_shader
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus

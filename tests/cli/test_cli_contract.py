@@ -131,11 +131,11 @@ EXTRA_JSON_RUNS = {
 }
 #: Commands with --json this test does not run, and why (each is covered where named).
 JSON_NOT_RUN = {
-    ("defocus",): "needs an EXR render with depth (tests/analysis/test_defocus.py runs it and validates the document)",
+    ("defocus",): "needs an EXR render with depth (tests/analysis/defocus/test_defocus.py runs it and validates the document)",
     ("compare", "blender"): "needs Blender's bpy (tests/blender/test_compare.py validates its document)",
     ("live", "record"): "needs a UDP stream (tests/live/test_cli_live.py records one and validates the document)",
     ("live", "recover"): "needs a recording's journal (tests/live/test_takes.py recovers one and validates the document)",
-    ("calibrate",): "needs chart photographs (tests/analysis/test_calibrate.py renders them and validates its document)",
+    ("calibrate",): "needs chart photographs (tests/analysis/calibration/test_calibrate.py renders them and validates its document)",
     ("demo",): "writes the whole demo (tests/onset_cli/test_report_cli.py::test_demo_writes_outputs validates it)",
     ("lens", "pack"): "packs a lens card and a USD file (tests/lens/test_lens_archive.py round-trips an archive through "
                       "pack, check and add and validates both documents)",

@@ -81,7 +81,7 @@ def test_fits_in_json_and_their_files(tmp_path, capsys):
 
 
 def test_distortion_across_focus_table(capsys):
-    from physcam.analysis.distortion import real_distortion
+    from physcam.analysis.distortion.field import real_distortion
     from physcam.lens.library import load_lens
 
     rc = main(["distortion", "zuiko_18mm_f3_5", "--resolution", "1024x683", "--across-focus", "0.4m,1m,inf",

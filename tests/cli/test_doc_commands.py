@@ -44,9 +44,9 @@ BOUNDED = {
 #: Commands that cannot run in a test, and why.
 SKIP = {
     "physcam defocus render.exr --depth ViewLayer.Depth.Z --lens dgauss_50mm --focus 2m --fstop 2.8 --blades 6 -o dof.exr":
-        "needs a render with depth (tests/analysis/test_defocus.py runs physcam defocus on one)",
+        "needs a render with depth (tests/analysis/defocus/test_defocus.py runs physcam defocus on one)",
     "physcam defocus plate.exr --depth plate_depth.exr --depth-kind inverse --lens dgauss_50mm --focus 3m --fstop 4 -o dof.exr":
-        "needs a plate with depth (tests/analysis/test_defocus.py runs physcam defocus on one)",
+        "needs a plate with depth (tests/analysis/defocus/test_defocus.py runs physcam defocus on one)",
     "physcam compare blender --lens dgauss_50mm --focus 2m --fstop 2.8 --light 0.7m --blades 6 -o cmp/":
         "needs Blender's bpy (tests/blender/test_compare.py runs it where Blender is installed)",
     "physcam live record --port 55555 --duration 30 take.usda --report take.csv":
@@ -70,7 +70,7 @@ def _journal(d: Path) -> None:
     """The journal a killed `live record scene12.usda` leaves: its header and 24 samples."""
     from physcam.live.camera import camera_samples
     from physcam.live.journal import Journal
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     j = Journal.create(d / "scene12.usda", {"output": "scene12.usda", "report": None, "options": {}})
     for i, s in enumerate(camera_samples(sensor=find_sensor("ALEXA 35"), frames=24, rate=24, focus_mm=2000.0,

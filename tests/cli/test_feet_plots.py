@@ -64,7 +64,7 @@ def _metric_to_feet(labels):
 
 
 def test_breathing_real_focus_axis_in_feet(dgauss):
-    from physcam.analysis.breathing_real import real_breathing
+    from physcam.analysis.framing.breathing_real import real_breathing
 
     res = real_breathing(dgauss, [math.inf, 2000.0, 1000.0], sensor_width_mm=36.0, sensor_height_mm=24.0)
     xm, lm = _xticks(res.plot(units="m"))
@@ -77,7 +77,7 @@ def test_breathing_real_focus_axis_in_feet(dgauss):
 
 
 def test_distortion_across_focus_axis_in_feet(dgauss):
-    from physcam.analysis.distortion_focus import distortion_across_focus
+    from physcam.analysis.distortion.across_focus import distortion_across_focus
 
     tab = distortion_across_focus(dgauss, [1000.0, 2000.0, 5000.0, math.inf], sensor_width_mm=36.0,
                                   sensor_height_mm=24.0, width_px=64, height_px=43)
@@ -90,7 +90,7 @@ def test_distortion_across_focus_axis_in_feet(dgauss):
 
 
 def test_mtf_chart_title_focus_in_feet(dgauss):
-    from physcam.analysis.mtf import mtf_chart
+    from physcam.analysis.image_quality.mtf import mtf_chart
 
     chart = mtf_chart(dgauss, focus_mm=3000.0, fstop=8.0, n_fields=2, max_image_height_mm=5.0, frequencies=(10.0,),
                       wavelengths_nm=(587.5618,), pupil_samples=16)
@@ -103,8 +103,8 @@ def test_mtf_chart_title_focus_in_feet(dgauss):
 
 
 def test_distortion_fit_residual_title_in_feet(dgauss):
-    from physcam.analysis.distortion_models import fit_brown_conrady, samples_from_field
-    from physcam.analysis.stmap import distortion_field
+    from physcam.analysis.distortion.models import fit_brown_conrady, samples_from_field
+    from physcam.analysis.distortion.stmap import distortion_field
 
     field = distortion_field(dgauss, focus_mm=2000.0, sensor_width_mm=36.0, sensor_height_mm=24.0, width_px=64,
                              height_px=43, maps=False)
@@ -116,7 +116,7 @@ def test_distortion_fit_residual_title_in_feet(dgauss):
 def test_dof_zone_marks_and_title_in_feet():
     from physcam.onset.dof_plot import dof_zone_figure
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     r = solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("S35"), fstop=2.8, focus_mm=3000.0)
     fm, ff = dof_zone_figure(r, units="m"), dof_zone_figure(r, units="ft")
@@ -137,7 +137,7 @@ def test_dof_zone_marks_and_title_in_feet():
 
 
 def test_lens_diagram_title_in_feet(dgauss):
-    from physcam.analysis.diagram import lens_diagram
+    from physcam.analysis.lens_cards.diagram import lens_diagram
 
     d = lens_diagram(dgauss, focus_mm=2000.0, fstop=4.0)
     assert "focus 2.000 m," in d.figure(units="m").axes[0].get_title()
@@ -145,7 +145,7 @@ def test_lens_diagram_title_in_feet(dgauss):
 
 
 def test_lens_breathing_plot_in_feet(dgauss):
-    from physcam.analysis.breathing_plot import breathing_figure
+    from physcam.analysis.framing.breathing_plot import breathing_figure
     from physcam.optics.focusing import breathing_table
 
     rows = breathing_table(dgauss, [math.inf, 2000.0, 1000.0], sensor_width_mm=36.0)
@@ -157,7 +157,7 @@ def test_lens_breathing_plot_in_feet(dgauss):
 
 def test_compare_figures_in_feet():
     from physcam.cli.compare import _figure, compare_figure
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     # physcam compare blender's figure (no Blender needed to draw it: two images and the distances)
     res = {"lens": "dgauss", "crop_mm": 2.0, "fstop": 2.8, "light_from_film_mm": 700.0, "focus_from_film_mm": 2000.0,

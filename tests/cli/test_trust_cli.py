@@ -112,7 +112,7 @@ def test_illumination_huge_grid_is_refused():
 
 def test_ghost_image_sizes_are_bounded_in_the_api():
     """Issue 8: the Python API bounds the ghost image before allocating, like the CLI."""
-    from physcam.analysis.ghosts import ghost_analysis
+    from physcam.analysis.image_quality.ghosts import ghost_analysis
     from physcam.errors import InputError, SensorError
     from physcam.lens.library import load_lens
 

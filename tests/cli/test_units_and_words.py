@@ -68,8 +68,8 @@ def test_feet_reports_print_no_scene_distance_in_millimetres(capsys):
 
 
 def test_a_fit_is_good_in_the_cli_and_on_its_figure(tmp_path, capsys):
-    from physcam.analysis.distortion_models import fit_models, samples_from_field
-    from physcam.analysis.stmap import distortion_field
+    from physcam.analysis.distortion.models import fit_models, samples_from_field
+    from physcam.analysis.distortion.stmap import distortion_field
     from physcam.lens.library import load_lens
 
     res = distortion_field(load_lens("dgauss_50mm"), focus_mm=2000.0, sensor_width_mm=24.89, sensor_height_mm=18.66,

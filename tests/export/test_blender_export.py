@@ -13,6 +13,7 @@ from physcam.cli import main
 from physcam.errors import ExportError, InputError, OpticsError
 from physcam.export.blender import blender_setup_script, osl_camera_shader, write_blender_camera
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 from physcam.optics.focusing import focus
 from physcam.optics.paraxial import stop_semi_diameter_for_fstop
 from physcam.trace.surfaces import surface_table
@@ -90,7 +91,7 @@ def test_bad_input_is_a_clear_error(tmp_path):
         osl_camera_shader(lens, focus_mm=50.0, **kw)
     with pytest.raises(OpticsError, match="faster than this lens opens"):
         osl_camera_shader(lens, focus_mm=3000.0, fstop=1.0, **kw)
-    for bad in (0.0, -5.0, float("nan"), "3m", True):
+    for bad in (0.0, -5.0, float("nan"), "three metres", True):  # ("3m" reads as 3000 mm, as camera_state reads it)
         with pytest.raises(InputError):
             osl_camera_shader(lens, focus_mm=bad, **kw)
     with pytest.raises(InputError, match="sensor width"):
@@ -153,8 +154,8 @@ def test_cli_export_blender(capsys, tmp_path):
     src = (tmp_path / "navarro_anamorphic_2x.osl").read_text()
     assert d["shader"] == str(tmp_path / "navarro_anamorphic_2x.osl") and d["resolution"] == [1920, 1439]
     lens = load_lens("navarro_anamorphic_2x")
-    assert src == osl_camera_shader(lens, focus_mm=3000.0, fstop=4.0, sensor_width_mm=24.89, sensor_height_mm=18.66,
-                                    aperture=(7, 0.0, 0.0, 0.0), dispersion=True, fresnel=True)
+    camera = camera_state(lens, focus_mm=3000.0, fstop=4.0, sensor_mm=(24.89, 18.66))
+    assert src == osl_camera_shader(camera, aperture=(7, 0.0, 0.0, 0.0), dispersion=True, fresnel=True)
     assert (tmp_path / "setup_navarro_anamorphic_2x.py").is_file()
     rc, _, err = run(capsys, "export", "blender", "navarro_anamorphic_2x", "--focus", "3m", "-o", str(tmp_path))
     assert rc == 2 and "exists" in err and "--force" in err and len(err.strip().splitlines()) == 1

@@ -19,7 +19,7 @@ from physcam.export.blender_focus import focus_table
 from physcam.export.blender_pupil import (RADIAL_MAX_MM, interpolated_area, interpolated_ellipse, iris_levels,
                                          level_bracket)
 from physcam.lens.library import load_lens
-from physcam.onset.sensors import sensors
+from physcam.optics.sensors import sensors
 from physcam.optics.focusing import focus
 from physcam.trace.rays import OK, RayBatch
 from physcam.trace.trace import trace_through

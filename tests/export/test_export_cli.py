@@ -9,7 +9,7 @@ import pytest
 from physcam.cli import main
 from physcam.export.opencv_distortion import fit_opencv_pinhole
 from physcam.lens.library import load_lens
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 
 
 def run(capsys, *argv):

@@ -251,7 +251,7 @@ def hash_tokens(text: str) -> list[str]:
 @pytest.fixture(scope="module")
 def report(triplet):
     from physcam.onset.report import ReportRequest, solve_report
-    from physcam.onset.sensors import custom_sensor
+    from physcam.optics.sensors import custom_sensor
 
     return solve_report(ReportRequest(focal_length_mm=None, sensor=custom_sensor(24.0, 18.0), fstop=5.6,
                                       focus_mm=2000.0, lens=triplet))
@@ -359,8 +359,8 @@ def test_nuke_script_quotes_paths_or_refuses_them(name):
 # ------------------------------------------------------------------ 3DEqualizer
 @pytest.fixture(scope="module")
 def tde4_fit(triplet):
-    from physcam.analysis.distortion_models import fit_tde4_radial, samples_from_field
-    from physcam.analysis.stmap import distortion_field
+    from physcam.analysis.distortion.models import fit_tde4_radial, samples_from_field
+    from physcam.analysis.distortion.stmap import distortion_field
 
     res = distortion_field(triplet, focus_mm=2000.0, sensor_width_mm=24.0, sensor_height_mm=18.0, width_px=96,
                            height_px=72, maps=False)

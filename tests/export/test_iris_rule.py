@@ -15,7 +15,8 @@ import pytest
 
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
+from physcam.optics.state import camera_state
 from physcam.optics import focusing, paraxial
 
 CASES = [("zuiko_18mm_f3_5", 450.0), ("navarro_anamorphic_2x", 1250.0), ("dgauss_50mm", 600.0)]
@@ -41,7 +42,7 @@ def test_the_iris_makes_the_lens_f_n_at_infinity_and_keeps_its_size_when_it_focu
 
 @pytest.mark.parametrize("name, mark", CASES)
 def test_every_consumer_writes_the_same_iris(name, mark):
-    from physcam.analysis._pupil import setup
+    from physcam.analysis.image_quality._pupil import setup
     from physcam.export.blender import bake_camera
     from physcam.export.pbrt import pbrt_camera_values
 
@@ -53,7 +54,7 @@ def test_every_consumer_writes_the_same_iris(name, mark):
                         sensor_height_mm=sensor.height_mm)
     written = {
         "Blender OSL": 2.0 * baked.lens.surfaces[baked.lens.stop_index].semi_diameter,
-        "analyses (MTF, PSF)": 2.0 * setup(lens, fstop=N, focus_mm=mark).stop_semi_diameter,
+        "analyses (MTF, PSF)": 2.0 * setup(camera_state(lens, fstop=N, focus_mm=mark)).stop_semi_diameter,
     }
     if not lens.is_anamorphic:  # pbrt's realistic camera takes spherical lenses only
         written["pbrt realistic"] = pbrt_camera_values(report, lens, cameras=("realistic",))["realistic"]["aperturediameter"]

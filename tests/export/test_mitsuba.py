@@ -19,7 +19,7 @@ from physcam.errors import ExportError, InputError, WrongTypeError
 from physcam.export.mitsuba import mitsuba_camera_values, mitsuba_scene_dict, mitsuba_scene_xml
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import custom_sensor, find_sensor
+from physcam.optics.sensors import custom_sensor, find_sensor
 
 from _thin_lens import fov_deg, image_distance_at_mark
 

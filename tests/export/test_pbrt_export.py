@@ -103,7 +103,7 @@ def test_every_spherical_lens_pbrt_film_distance_next_to_physcams(key, tmp_path,
     from physcam.export.pbrt import pbrt_focus_comparison
     from physcam.lens.library import load_lens
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
     from physcam.optics.focusing import focus
 
     lens = load_lens(key)

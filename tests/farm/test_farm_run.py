@@ -108,7 +108,7 @@ def test_openjd_defocus_gives_the_direct_bytes_tracing_the_kernels_once(shot):
     traced = {int(n): int(k) for n, k in re.findall(r"frame (\d+): wrote \S+ \((\d+) kernels traced", log)}
     assert set(traced) == {1, 2, 3, 4} and traced[1] > 0 and traced[2] == traced[3] == traced[4] == 0
     stacks = list((folder / "ojd" / "kernels").rglob("*.npz"))  # frame 1's kernels, one stack file (issue 47)
-    assert len(stacks) == 1 and len(np.load(stacks[0])["nodes"]) == traced[1]
+    assert len(stacks) == 1 and sum(len(np.load(stacks[0])[k]) for k in ("nodes", "direct_nodes")) == traced[1]
     mtimes = [p.stat().st_mtime_ns for p in sorted((folder / "ojd").glob("d.*.exr"))]
     again = _openjd(folder, "job.json", "frames")
     assert len(re.findall(r"frame \d: \S+ is there, skipped", again)) == 4

@@ -103,7 +103,7 @@ def test_a_front_anamorphics_framing_squeeze_grows_as_it_focuses_close():
 
 def test_the_report_carries_both_pupils_and_says_which_pivot_is_which():
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
     from physcam.onset.table import report_rows
 
     lens = load_lens("neil_front_anamorphic_2x")

@@ -24,7 +24,7 @@ from physcam.live.protocol import (
 )
 from physcam.live.receiver import Receiver
 from physcam.live.sample import SampleError, decode_sample, encode_sample
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 
 SID_A = "urn:uuid:0a0a0a0a-0000-4000-8000-00000000000a"
 SID_B = "urn:uuid:0b0b0b0b-0000-4000-8000-00000000000b"

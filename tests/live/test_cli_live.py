@@ -14,7 +14,7 @@ import pytest
 from physcam.cli import main
 from physcam.live.camera import camera_frames, frames_to_samples
 from physcam.live.sender import Sender
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 from _udp import free_port, needs_proc_net_udp, wait_for_port, wait_until_read
 
 DATA = Path(__file__).parent / "data"

@@ -18,7 +18,7 @@ from physcam.live.camera import camera_samples
 from physcam.live.frames import HORIZONTAL_PUPIL_KEY, TrackedFrame, frame_from_sample, sample_from_frame
 from physcam.live.frustum import frustum_frames, wall_from_usd, write_frustum_usd, write_wall
 from physcam.live.sample import validate_sample
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 
 from _anamorphic_yu import hand_framing_focal_lengths, hand_pupils_from_film
 

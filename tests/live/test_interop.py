@@ -25,7 +25,7 @@ from physcam.live.frustum import frustum_frames, wall_from_usd, write_wall
 from physcam.live.record import lens_report_rows, solve_frames, write_recording_usd
 from physcam.live.sample import decode_sample, encode_sample, sample_problems
 from physcam.live.usd_io import frames_from_usd
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 
 from _opentrackio_readers import camdkit_reader, opencv_rational, unreal_reader
 
@@ -40,8 +40,8 @@ def _corners(w, h, f):
 
 def _physcam_fit(lens, focus_mm):
     """physcam's own distortion model of the lens at this focus (OpenCV form, normalised by F_y)."""
-    from physcam.analysis.distortion_models import fit_brown_conrady, samples_from_field
-    from physcam.analysis.stmap import distortion_field
+    from physcam.analysis.distortion.models import fit_brown_conrady, samples_from_field
+    from physcam.analysis.distortion.stmap import distortion_field
 
     h_px = round(WIDTH_PX * S35.height_mm / S35.width_mm)
     field = distortion_field(lens, focus_mm=focus_mm, sensor_width_mm=S35.width_mm, sensor_height_mm=S35.height_mm,

@@ -19,7 +19,7 @@ from physcam.live.receiver import Receiver
 from physcam.live.record import solve_frames, write_lens_report, write_recording_usd
 from physcam.live.sample import encode_sample
 from physcam.live.sender import Sender
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 
 from _udp import PacedSender
 

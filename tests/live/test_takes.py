@@ -35,7 +35,7 @@ from physcam.live.receiver import Receiver
 from physcam.live.record import solve_frames
 from physcam.live.sample import SampleError, decode_sample
 from physcam.live.sender import Sender
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 from _udp import free_port, needs_proc_net_udp, wait_for_port, wait_until_read
 
 SID_A = "urn:uuid:0a0a0a0a-0000-4000-8000-00000000000a"

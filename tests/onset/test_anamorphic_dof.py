@@ -19,7 +19,7 @@ import pytest
 
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 from physcam.optics import focusing
 
 ALEXA35 = find_sensor("ALEXA 35")
@@ -55,7 +55,7 @@ def test_the_cli_and_its_json_say_the_same():
 def _blur_widths(lens, mark, fstop, light_mm):
     """(width, height) of a point light's blur on the film, 4 sqrt(second moment) per axis (the full
     width of a uniform ellipse), traced through the real lens with the iris at ``fstop``."""
-    from physcam.analysis.bokeh import bokeh_image
+    from physcam.analysis.defocus.bokeh import bokeh_image
 
     st = focusing.focus(lens, mark)
     img = bokeh_image(st.prescription, light_mm, film_z=st.film_z, rays=100_000, pixels=192, fresnel=False,

@@ -11,8 +11,8 @@ import math
 
 import pytest
 
-from physcam.analysis.distortion import real_distortion
-from physcam.analysis.real_dof import real_depth_of_field
+from physcam.analysis.distortion.field import real_distortion
+from physcam.analysis.defocus.real_dof import real_depth_of_field
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
 from physcam.optics.focusing import focus

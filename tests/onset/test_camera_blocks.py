@@ -7,7 +7,7 @@ import pytest
 from physcam.export.renderman import renderman_camera_values
 from physcam.export.usdgeom import shutter_interval, usdgeom_camera_values
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import Sensor, find_sensor
+from physcam.optics.sensors import Sensor, find_sensor
 
 from _thin_lens import fov_deg, image_distance_at_mark
 

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from physcam.cli import main
 from physcam.onset.report import HYPERFOCAL, solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 from physcam.optics.dof import dof_limits
 from physcam.units import format_distance, inch_fraction_for, parse_distance
 
@@ -144,7 +144,7 @@ def test_reports_that_worked_before_the_fixed_point_still_work(kw):
     import warnings
 
     from physcam.lens.library import load_lens
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     kw = dict(kw)
     lens = load_lens(kw.pop("lens"))

@@ -14,8 +14,9 @@ from physcam.onset.diopter import COMMON_DIOPTERS, close_up
 from physcam.onset.exposure import ExposureSetting, compensate, exposure_time_s, stops_between_settings
 from physcam.onset.framing import frame_at_distance, frame_at_focus
 from physcam.onset.hyperfocal import hyperfocal_table
-from physcam.onset.report import ReportRequest, solve_report
-from physcam.onset.sensors import custom_sensor, find_sensor
+from physcam.onset.report import solve_report
+from physcam.onset.request import report_camera
+from physcam.optics.sensors import custom_sensor, find_sensor
 from physcam.onset.split_focus import split_focus
 
 FF = custom_sensor(36.0, 24.0)
@@ -25,13 +26,13 @@ FF = custom_sensor(36.0, 24.0)
 def test_frame_at_focus_by_hand():
     # 50 mm thin lens, subject 5050 mm from H1: s' = 50 x 5050 / 5000 = 50.5 mm, |m| = 0.01, the 36 x 24 gate
     # spans 3600 x 2400 mm there; the mark is s + s' = 5100.5 mm from the film
-    r = solve_report(ReportRequest(sensor=FF, focal_length_mm=50.0, fstop=2.8, focus_mm=5100.5))
+    r = solve_report(report_camera(sensor=FF, focal_length_mm=50.0, fstop=2.8, focus_mm=5100.5))
     fr = frame_at_focus(r)
     assert fr.width_mm == pytest.approx(3600.0, rel=1e-9) and fr.height_mm == pytest.approx(2400.0, rel=1e-9)
     assert frame_at_distance(r, 10100.0).width_mm == pytest.approx(7200.0, rel=1e-9)  # twice as far, twice as wide
-    sq = solve_report(ReportRequest(sensor=FF, focal_length_mm=50.0, fstop=2.8, focus_mm=5100.5, squeeze=2.0))
+    sq = solve_report(report_camera(sensor=FF, focal_length_mm=50.0, fstop=2.8, focus_mm=5100.5, squeeze=2.0))
     assert frame_at_focus(sq).width_mm == pytest.approx(7200.0, rel=1e-9)  # desqueezed
-    inf = solve_report(ReportRequest(sensor=FF, focal_length_mm=50.0, fstop=2.8, focus_mm=math.inf))
+    inf = solve_report(report_camera(sensor=FF, focal_length_mm=50.0, fstop=2.8, focus_mm=math.inf))
     assert frame_at_focus(inf) is None
     assert r.to_dict()["frame_at_focus"]["width_mm"] == pytest.approx(3600.0, rel=1e-9)
 
@@ -82,12 +83,11 @@ def test_compensation_restores_the_exposure(fps, angle, t, ei, nd, control):
 def test_split_focus_needs_the_stop_issue_39_names():
     # issue 39: `report --focal 50 --near 2.5m --far 4m --fstop 4` on Super 35: "the stop the chosen CoC needs
     # (f/9.5 here)"
-    sf = split_focus(ReportRequest(sensor=find_sensor("S35"), focal_length_mm=50.0, near_mm=2500.0, far_mm=4000.0,
-                                   fstop=4.0))
+    sf = split_focus(sensor=find_sensor("S35"), focal_length_mm=50.0, near_mm=2500.0, far_mm=4000.0, fstop=4.0)
     assert round(sf.fstop_needed, 1) == 9.5 and sf.given_holds is False
     # focus at the harmonic mean of the limits about H1 (thin lens: H1 moves with focus, so check the limits)
-    at_need = solve_report(ReportRequest(sensor=find_sensor("S35"), focal_length_mm=50.0, fstop=sf.fstop_needed,
-                                         focus_mm=sf.focus_from_film_mm))
+    at_need = solve_report(report_camera(sensor=find_sensor("S35"), focal_length_mm=50.0, fstop=sf.fstop_needed,
+                                        focus_mm=sf.focus_from_film_mm))
     assert at_need.dof.near_from_film_mm == pytest.approx(2500.0, rel=1e-9)
     assert at_need.dof.far_from_film_mm == pytest.approx(4000.0, rel=1e-9)
     assert sf.given.dof.near_from_film_mm > 2500.0 and sf.given.dof.far_from_film_mm < 4000.0  # f/4 holds less

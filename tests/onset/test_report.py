@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from physcam import InputError, OpticsError, SensorError
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import Sensor, find_sensor
+from physcam.optics.sensors import Sensor, find_sensor
 
 FF = Sensor("ff", "36x24", 36.0, 24.0)
 
@@ -239,7 +239,7 @@ def test_a_flange_distance_only_moves_offsets_given_from_the_flange():
     flange focal distance given beside them changes nothing; from the flange, H1 = FFD + offset (by hand:
     52 + 10 = 62 mm). The request and solvers of issue 28 keep this."""
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     s = find_sensor("ALEXA 35")
     film = solve_lens_report(focal_length_mm=50, fstop=2.8, focus_mm=3000, sensor=s, model="technical", h1_mm=60,

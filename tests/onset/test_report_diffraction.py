@@ -14,7 +14,7 @@ from physcam.cli import main
 from physcam.errors import InputError, SensorError
 from physcam.lens.library import load_lens
 from physcam.onset.report import REPORT_VERSION, solve_lens_report
-from physcam.onset.sensors import custom_sensor, find_sensor, sensors
+from physcam.optics.sensors import custom_sensor, find_sensor, sensors
 
 from _thin_lens import image_distance_at_mark
 

@@ -22,7 +22,7 @@ from _thin_lens import image_distance_at_mark  # noqa: F401  (the same oracle mo
 from physcam.cli import main
 from physcam.lens.library import list_lenses, load_lens
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 from physcam.optics.focusing import closest_focus
 
 S35 = find_sensor("S35")

@@ -9,7 +9,7 @@ import pytest
 
 from physcam import InputError
 from physcam.onset.pupil import entrance_pupil_practical, pivot_camera_space, pivot_world
-from physcam.onset.sensors import find_sensor, sensors
+from physcam.optics.sensors import find_sensor, sensors
 
 REF = Path(__file__).resolve().parents[1] / "data" / "sensor_formats.csv"  # copy of shared/reference/formats
 

@@ -49,8 +49,8 @@ def test_at_infinity_efl_over_the_pupil_is_the_fstop(n):
 
 
 def test_the_analyses_take_the_state_first_and_agree_with_the_old_door():
-    from physcam.analysis.mtf import mtf
-    from physcam.analysis.wavefront import wavefront
+    from physcam.analysis.image_quality.mtf import mtf
+    from physcam.analysis.image_quality.wavefront import wavefront
 
     s = camera_state(DGAUSS, focus_mm=2000.0, fstop=4.0)
     a = mtf(s, 14.0, frequencies=[10, 20, 40], pupil_samples=64)
@@ -74,3 +74,20 @@ def test_bad_input_is_one_sentence():
     with pytest.raises(WrongTypeError):
         camera_state("dgauss_50mm")
     assert isinstance(camera_state(DGAUSS, sensor_mm=(36, 24)), CameraState)
+
+
+#: (zoom position, EFL at infinity, tolerance mm): focal lengths asked for, and the wide end (encoder 0), which the patent's
+#: own label gives as 72.1 mm (US 5,537,259 via the lens file's source note: "72.1-194.01 mm")
+@pytest.mark.parametrize("zoom, efl, tol", [("100mm", 100.0, 1e-4), ("135mm", 135.0, 1e-4), (0.0, 72.1, 0.05)])
+def test_the_zoom_slot_beside_the_focus(zoom, efl, tol):
+    """Issue 43 leaves a zoom position beside the focus (issue 45's phase 2 fills it): a zoom lens's camera
+    at a focal length asked for has that EFL at infinity (the zoom position solved on the paraxial EFL,
+    physcam.optics.zoom), keeps the position it was given, and a prime refuses any."""
+    lens = load_lens("canon_ef_70_200mm_f2_8_zoom")
+    cam = camera_state(lens, focus_mm=math.inf, fstop=4.0, zoom=zoom, sensor="S35")
+    assert cam.zoom == zoom
+    assert cam.at_mark.focal_length_mm == pytest.approx(efl, abs=tol)  # mm
+    near = camera_state(lens, focus_mm=3000.0, fstop=4.0, zoom=zoom, sensor="S35")
+    assert near.zoom == zoom and near.focus_from_film_mm == 3000.0
+    with pytest.raises(InputError, match="not a zoom lens"):
+        camera_state(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=4.0, zoom=0.5)

@@ -31,8 +31,8 @@ def test_the_warning_points_at_the_callers_line_for_every_renamed_function():
     # default filters hide a DeprecationWarning
     import warnings
 
-    from physcam.analysis.diagram import lens_diagram
-    from physcam.analysis.field_of_view import real_field_of_view
+    from physcam.analysis.lens_cards.diagram import lens_diagram
+    from physcam.analysis.framing.field_of_view import real_field_of_view
     from physcam.errors import WrongTypeError
     from physcam.export.opencv_distortion import fit_opencv_pinhole
     from physcam.export.pbrt import pbrt_thick_lens

@@ -203,7 +203,7 @@ def cli_answers(setups) -> list:
 
 def sensor_table() -> list:
     from physcam.cli.sensors import sensor_document
-    from physcam.onset.sensors import sensors
+    from physcam.optics.sensors import sensors
 
     return [sensor_document(s) for s in sensors()]
 
@@ -281,8 +281,7 @@ def test_page_exposure_and_diopters_equal_the_library():
 
 def test_page_split_focus_equals_the_library(monkeypatch, tmp_path):
     from physcam.cli.serve import cli_backend  # noqa: F401  (the CLI's parser reads the queries below)
-    from physcam.onset.report import ReportRequest
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
     from physcam.onset.split_focus import split_focus
     from physcam.units import parse_distance
 
@@ -303,10 +302,10 @@ def test_page_split_focus_equals_the_library(monkeypatch, tmp_path):
         try:
             from physcam.optics.coc import parse_coc
 
-            req = ReportRequest(sensor=find_sensor(q["sensor"]), focal_length_mm=float(q["focal"]),
-                                near_mm=parse_distance(q["near"]), far_mm=parse_distance(q["far"]),
-                                fstop=float(q["fstop"]) if "fstop" in q else None, coc=parse_coc(q.get("coc")))
-            expected.append({"ok": True, "body": split_focus(req).to_dict()})
+            sf = split_focus(sensor=find_sensor(q["sensor"]), focal_length_mm=float(q["focal"]),
+                             near_mm=parse_distance(q["near"]), far_mm=parse_distance(q["far"]),
+                             fstop=float(q["fstop"]) if "fstop" in q else None, coc=parse_coc(q.get("coc")))
+            expected.append({"ok": True, "body": sf.to_dict()})
         except PhysCamError as exc:
             expected.append({"ok": False, "body": {"error": str(exc)}})
     got = run_page_solver({"sensors": table, "calls": calls})

@@ -16,8 +16,7 @@ from _serve_helpers import running_server
 
 from physcam.cli import main
 from physcam.onset.diopter import close_up
-from physcam.onset.report import ReportRequest
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 from physcam.onset.split_focus import split_focus
 
 pytestmark = pytest.mark.slow
@@ -84,8 +83,7 @@ def test_split_focus_answer(page, server):
     page.fill("#split-near", "2.5m")
     page.fill("#split-far", "4m")
     page.wait_for_selector("#split-answer[data-focus]")
-    want = split_focus(ReportRequest(sensor=find_sensor("S35"), focal_length_mm=50.0, near_mm=2500.0, far_mm=4000.0,
-                                     fstop=4.0))
+    want = split_focus(sensor=find_sensor("S35"), focal_length_mm=50.0, near_mm=2500.0, far_mm=4000.0, fstop=4.0)
     assert float(page.get_attribute("#split-answer", "data-focus")) == pytest.approx(want.focus_from_film_mm, rel=1e-9)
     assert float(page.get_attribute("#split-answer", "data-fstop")) == pytest.approx(want.fstop_needed, rel=1e-9)
     text = page.text_content("#split-answer")

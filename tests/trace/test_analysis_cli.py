@@ -5,8 +5,8 @@ import json
 import numpy as np
 import pytest
 
-from physcam.analysis.bokeh import bokeh_image
-from physcam.analysis.spot import spot_diagram
+from physcam.analysis.defocus.bokeh import bokeh_image
+from physcam.analysis.image_quality.spot import spot_diagram
 from physcam.cli import main
 from physcam.errors import InputError
 
@@ -43,7 +43,7 @@ def test_cli_spot_and_bokeh(tmp_path, capsys):
 def test_stopping_down_shrinks_the_axial_spot():
     # on axis, at the paraxial focus, spherical aberration grows with the aperture: every stop
     # down shrinks the RMS spot, and every ray that passes lies within the stopped pupil
-    from physcam.analysis.spot import spot_diagram
+    from physcam.analysis.image_quality.spot import spot_diagram
     from physcam.lens.library import load_lens
 
     lens = load_lens("dgauss_50mm")

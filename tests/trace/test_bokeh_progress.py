@@ -1,6 +1,6 @@
 """bokeh_image reports progress per chunk, ending at the total."""
 
-from physcam.analysis.bokeh import bokeh_image
+from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.lens.library import load_lens
 
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from physcam.analysis.bokeh import bokeh_image
+from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.lens.library import load_lens
 from physcam.optics import focusing
 

@@ -67,7 +67,7 @@ def test_thin_lens_iris_and_focus_pull(tmp_path):
 
 def test_bad_marks_name_file_and_line(tmp_path):
     from physcam.usd.animate import FocusKey, read_focus_marks, write_animated_camera
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
 
     bad = _csv(tmp_path, ["1,3m", "2,three metres"])
     with pytest.raises(LensFileError, match=r"pull.csv:3"):

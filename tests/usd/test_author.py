@@ -265,7 +265,7 @@ def test_aperture_distance_is_the_physical_stop():
     vertex z of the focused lens, computed here from the focused prescription's own geometry."""
     from physcam.lens.library import load_lens
     from physcam.onset.report import solve_lens_report
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
     from physcam.optics.focusing import focus
     from physcam.usd.author import spec_from_report
 

@@ -151,7 +151,7 @@ def test_body_and_vendor_lens_combine_in_a_shot(tmp_path):
     """Issue 9.3, done when: a shot built from a body file and a vendor lens file has the body's
     sensor, ISO, flange and placement and the lens's optics, at the body's sensor size; the lens
     distortion is fitted for that sensor."""
-    from physcam.analysis.distortion import real_distortion
+    from physcam.analysis.distortion.field import real_distortion
     from physcam.lens.library import load_lens
 
     rx = load_lens("dgauss_50mm")

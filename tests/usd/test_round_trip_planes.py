@@ -5,7 +5,7 @@ import pytest
 from physcam.export.usdgeom import usdgeom_camera_values
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import Sensor, find_sensor
+from physcam.optics.sensors import Sensor, find_sensor
 from physcam.usd.author import author_from_report, new_stage
 from physcam.usd.read import read_camera
 

@@ -64,8 +64,8 @@ def _attrs(prim, degree):
 
 @pytest.mark.parametrize("degree, max_px", [(4, 0.5), (6, 0.1)])
 def test_the_stored_model_reproduces_the_traced_field(stage, degree, max_px):
-    from physcam.analysis.distortion_models import samples_from_field
-    from physcam.analysis.stmap import distortion_field
+    from physcam.analysis.distortion.models import samples_from_field
+    from physcam.analysis.distortion.stmap import distortion_field
     from physcam.lens.library import load_lens
 
     assert validation_errors(stage) == []

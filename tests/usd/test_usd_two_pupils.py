@@ -11,7 +11,7 @@ import pytest
 
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
-from physcam.onset.sensors import find_sensor
+from physcam.optics.sensors import find_sensor
 
 from _anamorphic_yu import hand_pupils_from_film
 

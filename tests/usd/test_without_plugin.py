@@ -66,7 +66,7 @@ def written(tmp_path_factory):
         write_previs_kit(d / "kit.usda"),
         write_vendor_lens(d / "vendor.usda", load_lens("dgauss_50mm"), focus_mm=1500.0, fstop=4.0),
     ]
-    from physcam.onset.sensors import find_sensor
+    from physcam.optics.sensors import find_sensor
     from physcam.usd.animate import FocusKey, write_animated_camera
 
     files.append(write_animated_camera(d / "pull.usda", [FocusKey(1, 5000.0), FocusKey(2, 3000.0), FocusKey(3, 1000.0)],

@@ -20,19 +20,19 @@ cell:
 
 What each kind computes (lengths mm from the film plane, docs/conventions.md):
 
-* ``lens``: :func:`physcam.analysis.breathing_real.real_breathing` over the focus marks and, at
+* ``lens``: :func:`physcam.analysis.framing.breathing_real.real_breathing` over the focus marks and, at
   every mark and f-stop, :func:`physcam.optics.focusing.technical_planes` (EFL, principal planes,
   entrance and exit pupils in front of the film, the best-match pinhole, pupil diameter,
   working f-number).
-* ``distortion``: :func:`physcam.analysis.stmap.distortion_field` at the mark and wavelength, its
-  ST-maps by :func:`physcam.analysis.stmap.write_stmaps` (EXR and PNG previews), and
-  :func:`physcam.analysis.distortion_models.fit_models` (Brown-Conrady D-U and U-D, 3DE4 Radial -
+* ``distortion``: :func:`physcam.analysis.distortion.stmap.distortion_field` at the mark and wavelength, its
+  ST-maps by :func:`physcam.analysis.distortion.stmap.write_stmaps` (EXR and PNG previews), and
+  :func:`physcam.analysis.distortion.models.fit_models` (Brown-Conrady D-U and U-D, 3DE4 Radial -
   Standard Degree 4, USD lensDistortion) with their residuals, in ``fits.json``.
-* ``illumination``: :func:`physcam.analysis.illumination.relative_illumination` of the lens focused
+* ``illumination``: :func:`physcam.analysis.image_quality.illumination.relative_illumination` of the lens focused
   at the mark (:func:`physcam.optics.focusing.focus`) and stopped down to the f-number
   (the iris of :func:`physcam.optics.state.camera_state`, by the one rule), fields from the axis to the
   sensor corner.
-* ``psf``: :func:`physcam.analysis.bokeh.bokeh_image` of a point light at the focus distance (a
+* ``psf``: :func:`physcam.analysis.defocus.bokeh.bokeh_image` of a point light at the focus distance (a
   point 1 km away stands for infinity), placed so that the best-match pinhole at that focus images
   it at the film point (k w/2, k h/2), k the field fraction (lens-space film coordinates: the upright
   picture is the film turned by 180 degrees, so this is toward the picture's bottom-left corner);
@@ -42,7 +42,6 @@ What each kind computes (lengths mm from the film plane, docs/conventions.md):
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import hashlib
 import io
@@ -88,7 +87,7 @@ def _none_inf(v):
 
 # ------------------------------------------------------------------------------------------- kinds
 def _lens_cell(lens, grid: Grid):
-    from ..analysis.breathing_real import real_breathing
+    from ..analysis.framing.breathing_real import real_breathing
     from ..optics.focusing import technical_planes
 
     w, h = grid.sensor_mm
@@ -119,14 +118,15 @@ def _lens_cell(lens, grid: Grid):
 
 
 def _distortion_cell(lens, grid: Grid, cell: Cell, dest: Path):
-    from ..analysis.distortion_models import fit_models, samples_from_field
-    from ..analysis.stmap import distortion_field, write_stmaps
+    from ..analysis.distortion.models import fit_models, samples_from_field
+    from ..analysis.distortion.stmap import distortion_field, write_stmaps
     from ..io import atomic_write, staged_folder
+    from ..optics.state import camera_state
 
     if dest.is_dir() and (dest / "fits.json").is_file():  # published by an earlier, killed attempt
         return (dest / "fits.json").read_bytes()
     w, h = grid.sensor_mm
-    res = distortion_field(lens, focus_mm=cell.focus_mm, sensor_width_mm=w, sensor_height_mm=h,
+    res = distortion_field(camera_state(lens, focus_mm=cell.focus_mm, sensor_mm=(w, h)),
                            width_px=grid.frame_px[0], height_px=grid.frame_px[1],
                            wavelength_nm=cell.wavelength_nm, backend=grid.backend)
     fits = fit_models(samples_from_field(res))
@@ -144,14 +144,12 @@ def _distortion_cell(lens, grid: Grid, cell: Cell, dest: Path):
 
 
 def _illumination_cell(lens, grid: Grid, cell: Cell):
-    from ..analysis.illumination import relative_illumination
+    from ..analysis.image_quality.illumination import relative_illumination
     from ..optics.state import camera_state
 
-    st = camera_state(lens, focus_mm=cell.focus_mm, fstop=cell.fstop)
+    st = camera_state(lens, focus_mm=cell.focus_mm, fstop=cell.fstop, sensor_mm=tuple(grid.sensor_mm))
     sd = st.stop_semi_diameter
-    res = relative_illumination(st.focused, n_fields=max(grid.fields, 2), sensor_width_mm=grid.sensor_mm[0],
-                                sensor_height_mm=grid.sensor_mm[1], grid=grid.illumination_grid,
-                                stop_semi_diameter=sd, film_z=st.film_z, backend=grid.backend)
+    res = relative_illumination(st, n_fields=max(grid.fields, 2), grid=grid.illumination_grid, backend=grid.backend)
     doc = res.to_dict() | {"kind": "illumination", "focus_from_film_mm": _none_inf(cell.focus_mm),
                            "fstop": cell.fstop, "stop_semi_diameter_mm": sd}
     return _json_bytes(doc), {}
@@ -181,14 +179,14 @@ def psf_light_position(lens, grid: Grid, cell: Cell):
 def _psf_cell(lens, grid: Grid, cell: Cell):
     import numpy as np
 
-    from ..analysis.bokeh import bokeh_image
+    from ..analysis.defocus.bokeh import bokeh_image
     from ..optics.state import camera_state
 
     st, depth, x, y, fx, fy = psf_light_position(lens, grid, cell)
-    sd = camera_state(lens, fstop=cell.fstop).stop_semi_diameter
-    q = dataclasses.replace(st.prescription, wavelength_nm=float(cell.wavelength_nm))
-    img = bokeh_image(q, depth, x, y, film_z=st.film_z, rays=grid.psf_rays, pixels=grid.psf_pixels,
-                      stop_semi_diameter=sd, chunk=max(1000, min(grid.psf_rays, 1_000_000)), backend=grid.backend)
+    # the lens at the cell's focus (its film there), its iris at the cell's f-stop, in the cell's light
+    cam = camera_state(lens, focus_mm=cell.focus_mm, fstop=cell.fstop, wavelengths_nm=[float(cell.wavelength_nm)])
+    img = bokeh_image(cam, depth, x, y, rays=grid.psf_rays, pixels=grid.psf_pixels,
+                      chunk=max(1000, min(grid.psf_rays, 1_000_000)), backend=grid.backend)
     e = img.image[..., 0]
     total = float(e.sum())
     if not (total > 0 and math.isfinite(total)):

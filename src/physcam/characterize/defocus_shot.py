@@ -2,8 +2,8 @@
 
 The same cluster as :func:`physcam.characterize.characterize`: a ``LocalCluster`` of
 single-threaded worker processes by default, or a farm's scheduler (``tcp://HOST:PORT``). One
-task per frame (:func:`physcam.analysis.defocus_exr.defocus_file`); the kernels live in one
-folder on disk (:class:`~physcam.analysis.defocus_kernels.KernelCache`, one ``.npz`` per kernel,
+task per frame (:func:`physcam.analysis.defocus.exr.defocus_file`); the kernels live in one
+folder on disk (:class:`~physcam.analysis.defocus.kernels.KernelCache`, one ``.npz`` per kernel,
 written atomically) that every worker reads: the first frame runs alone to trace them, the others
 then load them. Resumable per frame: a frame whose output exists is skipped unless ``force``. An
 output frame that is an input frame (or the depth file) is refused before any frame is done.
@@ -70,7 +70,7 @@ def shot_kernel_folder(output_pattern: str) -> Path:
 
 
 def _one_frame(image, output, lens, kernel_folder, force, options):
-    from ..analysis.defocus_exr import defocus_file
+    from ..analysis.defocus.exr import defocus_file
 
     return defocus_file(image, output, lens, kernel_folder=kernel_folder, force=force, **options)
 

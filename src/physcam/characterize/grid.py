@@ -301,7 +301,7 @@ class Cell:
         return f"index/{self.lens}/{self.kind}/{self.stem}.parquet"
 
 
-#: How a PSF cell's rays are sampled (physcam.analysis.bokeh): in every PSF cell's input hash
+#: How a PSF cell's rays are sampled (physcam.analysis.defocus.bokeh): in every PSF cell's input hash
 PSF_SAMPLING = "owen-scrambled-sobol-1"
 
 

@@ -11,18 +11,31 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..analysis.stmap import DistortionField
+from ..analysis.distortion.stmap import DistortionField
 
 #: Spacing (px) of the exactly computed ST-map nodes; bilinear between (the maps are smooth)
 MAP_STEP_PX = 4
 
 
+@dataclass
 class MeasuredField(DistortionField):
-    """A :class:`DistortionField` measured from a chart (its maps say so in their EXR headers)."""
+    """A :class:`DistortionField` measured from a chart (its maps say so in their EXR headers): no camera
+    model made it (``camera`` None), the focus mark is the one the photographs were taken at."""
+
+    mark_mm: float = math.inf
+
+    @property
+    def focus_from_film_mm(self) -> float:
+        return self.mark_mm
+
+    @property
+    def fstop(self) -> None:
+        return None  # the chart's corners: no stop's centroids
 
     def to_dict(self) -> dict:
         d = super().to_dict()
@@ -46,8 +59,8 @@ def _coarse_then_bilinear(fn, width, height, step=MAP_STEP_PX):
 
 
 def measured_field(m, lens_name: str) -> MeasuredField:
-    """The ST-maps of a :class:`~physcam.analysis.calibrate.MarkCalibration` (conventions of
-    :mod:`physcam.analysis.stmap`: R = u, G = v from the bottom-left, rows top first)."""
+    """The ST-maps of a :class:`~physcam.analysis.calibration.calibrate.MarkCalibration` (conventions of
+    :mod:`physcam.analysis.distortion.stmap`: R = u, G = v from the bottom-left, rows top first)."""
     w, h = m.size_px
     edge = np.array([[x, y] for x in np.linspace(-0.5, w - 0.5, 65) for y in (-0.5, h - 0.5)]
                     + [[x, y] for y in np.linspace(-0.5, h - 0.5, 49) for x in (-0.5, w - 0.5)])
@@ -59,20 +72,21 @@ def measured_field(m, lens_name: str) -> MeasuredField:
     dmap = np.dstack([(dm[..., 0] + 0.5) / w, (h - dm[..., 1] - 0.5) / h, np.zeros((h, w))]).astype(np.float32)
     umap = np.dstack([(um[..., 0] + 0.5) / w, (h - um[..., 1] - 0.5) / h,
                       np.zeros(um.shape[:2])]).astype(np.float32)
-    from ..analysis.calibrate import displacement_px
+    from ..analysis.calibration.calibrate import displacement_px
 
     disp = np.hypot(*displacement_px(m.camera_matrix, m.distortion, m.size_px).T)
     focus = math.inf if m.mark_mm is None else float(m.mark_mm)
-    return MeasuredField(lens_name, focus, math.nan, tuple(m.sensor_mm), (w, h), tuple(m.focal_length_mm),
-                         (math.nan, math.nan), (ox, oy), (0, 0), 0.0, math.nan, float(disp.max()), None,
+    return MeasuredField(lens_name, None, math.nan, tuple(m.sensor_mm), (w, h), tuple(m.focal_length_mm),
+                         (math.nan, math.nan), (ox, oy), (0, 0), 0.0, math.nan, float(disp.max()),
                          (m.rms_px, max(m.view_rms_px)), dmap, umap,
-                         ["measured from chart photographs; residual = the corners' reprojection residual"])
+                         ["measured from chart photographs; residual = the corners' reprojection residual"],
+                         mark_mm=focus)
 
 
 def opentrackio_lens(m) -> dict:
     """OpenTrackIO 1.0.1 ``lens`` fields of a measured mark (OpenLensIO: mm on the sensor, y down), with
     only the Brown-Conrady fits the run accepted; a mark the run calls NOT good is an OpticsError."""
-    from ..analysis.distortion_models import BrownConrady
+    from ..analysis.distortion.models import BrownConrady
     from ..errors import OpticsError
 
     good, why = m.verdict
@@ -102,12 +116,12 @@ UNITS = {"length": "mm", "image": "pixel (OpenCV: x right, y down, pixel centres
 
 
 def _mark_files(m, folder: Path, name: str, notes: list) -> list:
-    from ..analysis.distortion_models import (
+    from ..analysis.distortion.models import (
         BrownConrady,
         TDE4RadialStandard,
         USDStandard,
     )
-    from ..analysis.stmap import write_map_exr, write_map_png
+    from ..analysis.distortion.stmap import write_map_exr, write_map_png
     from ..export.tde4 import tde4_lens_text
     from .distortion import FIT_FILES, brown_conrady_document, usd_distortion_document
 
@@ -157,7 +171,7 @@ def _folder(out: Path, m, several: bool) -> Path:
 def check_outputs(args) -> dict:
     """Every option, output and image header checked before the fit; returns the plan: the folder's
     ``force`` and the USD file's target (:func:`physcam.usd.kit.characterization_target`), or None."""
-    from ..analysis.calibrate_chart import check_pixels, image_files, image_size
+    from ..analysis.calibration.chart import check_pixels, image_files, image_size
     from ..errors import ExportError, InputError
     from ..io import MANIFEST_NAME, refuse_inputs_as_outputs
 
@@ -244,7 +258,7 @@ def _check_usd(doc: dict, usd: dict) -> None:
 def deliverables(cal, args, plan):
     """([(path in the folder, bytes or a function making them)], USD target or None), the USD checked
     against the calibration (:func:`_check_usd`)."""
-    from ..analysis.calibrate_sheet import calibration_sheet
+    from ..analysis.calibration.sheet import calibration_sheet
     from ..figures import figure_bytes
     from ._output import document
 

@@ -273,25 +273,43 @@ def resolve_focus(value, *, lens=None, focal_length_mm=None, fstop=None, sensor=
     if value != HYPERFOCAL:
         return value
     from ..errors import InputError
-    from ..onset.report import ReportRequest, solve_report
+    from ..optics.coc import named_circle_of_confusion
+    from ..optics.lens_model import ThinLens, lens_model_of
 
     if lens is None and focal_length_mm is None:
         raise InputError("--focus hyperfocal needs a lens or a focal length")
+    model = lens_model_of(lens) if lens is not None else ThinLens(focal_length_mm)
+    fstop = fstop if fstop is not None else model.wide_open()  # a lens: wide open
+    if fstop is None:
+        raise InputError("focus at the hyperfocal distance needs the f-stop (--fstop), and no measured near/far "
+                         "limits (they solve the focus themselves)")
     if sensor is None:
         sensor = resolve_sensor(args)
-    import warnings
+    from ..optics.thinlens import require_f_number
 
-    from ..errors import PhysCamWarning
-
-    with warnings.catch_warnings():  # the command's own work warns where it matters, once
-        warnings.simplefilter("ignore", PhysCamWarning)
-        r = solve_report(ReportRequest(focal_length_mm=None if lens is not None else focal_length_mm, lens=lens, sensor=sensor,
-                              fstop=fstop, focus_mm=HYPERFOCAL, coc=coc if coc is not None else coc_of(args)))
+    fstop = require_f_number("f-stop", fstop)
+    c, name = named_circle_of_confusion(sensor.width_mm, sensor.height_mm, coc if coc is not None else coc_of(args))
+    mark = model.hyperfocal_mark(fstop, c)  # the lens model keeps its focus there: the camera asks it again
     from ..units import format_distance
 
-    note(f"hyperfocal focus: {format_distance(r.focus_from_film_mm, units_of(args))} from the film at f/{r.fstop:.3g}, "
-         f"CoC {r.coc_mm:.4g} mm ({r.coc_convention}, {sensor.name})")
-    return r.focus_from_film_mm
+    note(f"hyperfocal focus: {format_distance(mark, units_of(args))} from the film at f/{fstop:.3g}, "
+         f"CoC {c:.4g} mm ({name}, {sensor.name})")
+    return mark
+
+
+def camera_from_args(args, lens, *, aperture=None):
+    """The one camera of a command (issue 43): ``lens`` at ``--focus`` (``hyperfocal`` resolved for
+    ``--fstop`` and the sensor), its iris at ``--fstop`` (None: as its file stops it) with the iris shape
+    ``aperture``, on the command's sensor (:func:`resolve_sensor`: ``--sensor`` or the pair, else the
+    default). ``args.sensor_width``/``sensor_height``/``sensor_name`` and ``args.focus`` are set to what
+    the camera holds."""
+    from ..optics.state import camera_state
+
+    sensor = resolve_sensor(args)
+    args.sensor_width, args.sensor_height, args.sensor_name = sensor.width_mm, sensor.height_mm, sensor.name
+    fstop = getattr(args, "fstop", None)
+    args.focus = resolve_focus(getattr(args, "focus", None), lens=lens, fstop=fstop, sensor=sensor, args=args)
+    return camera_state(lens, focus_mm=args.focus, fstop=fstop, sensor=sensor, aperture=aperture)
 
 
 def coc_value(text):
@@ -352,7 +370,7 @@ def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):
     :data:`DEFAULT_SENSOR`), which a note on stderr names (unless ``quiet``: the command says it
     itself). Sets ``args.sensor_defaulted``."""
     from ..errors import InputError
-    from ..onset.sensors import custom_sensor, find_sensor
+    from ..optics.sensors import custom_sensor, find_sensor
 
     name = getattr(args, "sensor", None)
     sw, sh = getattr(args, "sensor_width", None), getattr(args, "sensor_height", None)

@@ -139,7 +139,7 @@ def _read(path: Path) -> Config:
             raise InputError(f"the physcam config {path}: {k} must be text, e.g. {k} = \"...\", got {v!r}")
         values[k] = v.strip()
     if "sensor" in values:
-        from ..onset.sensors import find_sensor
+        from ..optics.sensors import find_sensor
 
         try:
             find_sensor(values["sensor"])

@@ -137,17 +137,11 @@ def _defocus(args, ns, inner, physcam, name, workdir):
 
 
 def command_lenses(ns) -> dict:
-    """{slug: Prescription} of a characterize command's lenses (as ``physcam characterize`` loads them)."""
-    from ..characterize.grid import lens_slug
-    from .lens import load_lens_arg
+    """{slug: Prescription} of a characterize command's lenses (as ``physcam characterize`` loads them,
+    a zoom lens once per ``--zoom`` position)."""
+    from .characterize import characterize_lenses
 
-    lenses = {}
-    for name in ns.lens:
-        slug = lens_slug(Path(name).stem if ("/" in name or "\\" in name) else name)
-        if slug in lenses:
-            raise InputError(f"lens {name!r} is given twice")
-        lenses[slug] = load_lens_arg(name, ns.lenient)
-    return lenses
+    return characterize_lenses(ns)
 
 
 def _characterize(args, ns, inner, physcam, name, workdir):

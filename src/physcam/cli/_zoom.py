@@ -44,6 +44,20 @@ def zoom_info(args, lens) -> dict | None:
     return {"asked": str(args.zoom), "encoder": args.zoom_encoder, "efl_mm": paraxial.gaussian(lens).efl}
 
 
+def at_zoom_named(lens, args):
+    """``lens`` at ``--zoom`` for a command whose outputs carry the lens's name (ST-map headers, cards, tables):
+    the prescription there named with its position (paraxial EFL and encoder value), and ``args.zoom_block``
+    the JSON ``zoom`` block (None without --zoom). A prime given --zoom is refused (InputError)."""
+    from dataclasses import replace
+
+    q = zoomed(lens, args)
+    args.zoom_block = zoom_info(args, q) if q is not lens else None
+    if args.zoom_block is None:
+        return lens
+    b = args.zoom_block
+    return replace(q, metadata=replace(q.metadata, name=f"{lens.name} at {b['efl_mm']:.1f} mm (zoom {b['encoder']:.4g})"))
+
+
 def register_zoom(lsub, add_lens_argument, add_sensor_options, add_output_options, number) -> None:
     """``physcam lens zoom``'s parser."""
     z = lsub.add_parser("zoom", help="a zoom lens across its range: EFL, f-number, entrance pupil, back focus and the "
@@ -95,7 +109,7 @@ def run_zoom(args) -> int:
     rows = zoom_table(lens, _encoders(args, lens), sensor_width_mm=sensor.width_mm, wavelength_nm=args.wavelength)
     path = None
     if args.output:
-        from ..analysis.zoom_plot import save_zoom_figure
+        from ..analysis.framing.zoom_plot import save_zoom_figure
 
         path = save_zoom_figure(lens, args.output, sensor_width_mm=sensor.width_mm, force=args.force)
     if args.json:

@@ -132,6 +132,8 @@ def _finish(args, res, command: str) -> None:
     d = mark_repaired(res.to_dict(), args.loaded_lens)
     if getattr(args, "sensor_name", None):
         d["sensor"] = args.sensor_name
+    if getattr(args, "zoom_block", None) is not None:  # a zoom lens at --zoom (docs/zoom.md)
+        d["zoom"] = args.zoom_block
     if args.json:
         emit_json(document(name, d, units=WAVE_UNITS))
         return
@@ -180,7 +182,7 @@ def _resolution(text: str):
 
 
 def run_illumination(args) -> int:
-    from ..analysis.illumination import relative_illumination
+    from ..analysis.image_quality.illumination import relative_illumination
     from ._output import Table, print_table
 
     state = _camera(args, fstop=args.fstop)
@@ -198,16 +200,18 @@ def run_illumination(args) -> int:
 
 
 def run_colour(args) -> int:
-    from ..analysis.colour import chromatic_aberration
+    from ..analysis.image_quality.colour import chromatic_aberration
     from ..optics.glass import LINE_C_NM, LINE_D_NM, LINE_F_NM
     from ._output import Table, print_table
 
-    # the lens itself, not a camera state: colour's film is the paraxial focus of its reference line (d),
-    # a state's is its design wavelength's (the two differ for a lens not designed at d; found in review)
+    # the lens as designed: colour's film is the paraxial focus of its reference line (d), camera_state's
+    # is its design wavelength's (the two differ for a lens not designed at d; found in review)
+    from ..optics.state import as_designed
+
     lens = _prepare(args)
     wls = (LINE_F_NM, LINE_D_NM, LINE_C_NM) + tuple(args.wavelength or ())
-    res = chromatic_aberration(lens, args.field, wavelengths_nm=wls, max_field_deg=args.max_field,
-                               sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height)
+    res = chromatic_aberration(as_designed(lens, sensor_mm=(args.sensor_width, args.sensor_height)), args.field,
+                               wavelengths_nm=wls, max_field_deg=args.max_field)
     if not (args.json or _csv(args, res, "colour")):
         print(f"{res.lens_name}: chromatic aberration (EFL {res.efl_mm:.3f} mm at {res.reference_nm:g} nm), "
               f"{args.sensor_name}")
@@ -233,13 +237,13 @@ def run_colour(args) -> int:
 
 
 def run_breathing(args) -> int:
-    from ..analysis.breathing_real import real_breathing
+    from ..analysis.framing.breathing_real import real_breathing
     from ..units import format_distance
     from ._common import resolve_focus, units_of
     from ._output import Table, print_table
 
     lens = _prepare(args)
-    from ..onset.sensors import custom_sensor
+    from ..optics.sensors import custom_sensor
 
     marks = None if args.focus is None else resolve_focus(
         args.focus, lens=lens, sensor=custom_sensor(args.sensor_width, args.sensor_height), args=args)
@@ -260,7 +264,7 @@ def run_breathing(args) -> int:
 
 
 def run_ghosts(args) -> int:
-    from ..analysis.ghosts import ghost_analysis
+    from ..analysis.image_quality.ghosts import ghost_analysis
     from ._output import Table, print_table
 
     state = _camera(args)

@@ -33,8 +33,8 @@ FILES = {"calibration": "calibration.json", "sheet": "calibration_sheet.png", "b
 
 
 def register(sub) -> None:
-    from ..analysis.calibrate_names import CHARTS, CHARUCO_DICTIONARY, MAX_IMAGE_PIXELS, parse_corners
-    from ..analysis.distortion_names import DEFAULT_MAX_RESIDUAL_PX
+    from ..analysis.calibration.names import CHARTS, CHARUCO_DICTIONARY, MAX_IMAGE_PIXELS, parse_corners
+    from ..analysis.distortion.names import DEFAULT_MAX_RESIDUAL_PX
 
     def corners(text):
         import argparse
@@ -129,7 +129,7 @@ def _read_marks(path, args) -> dict:
 def _views(args, lens):
     from pathlib import Path
 
-    from ..analysis.calibrate_chart import ChartSpec, detect_views, image_files
+    from ..analysis.calibration.chart import ChartSpec, detect_views, image_files
     from ..errors import InputError
     from ._common import resolve_focus
 
@@ -168,7 +168,7 @@ def _sensor(args):
 
 def compute(args):
     """The calibration of the command line (nothing written)."""
-    from ..analysis.calibrate import calibrate_views
+    from ..analysis.calibration.calibrate import calibrate_views
 
     lens = None
     if args.lens is not None:
@@ -182,13 +182,13 @@ def compute(args):
     cal = calibrate_views(views, (s.width_mm, s.height_mm), lens_name=name, bootstrap=args.bootstrap,
                           max_residual_px=args.max_residual)
     if args.flat:
-        from ..analysis.calibrate_flat import measure_illumination
+        from ..analysis.calibration.flat_field import measure_illumination
 
         m = cal.marks[0]
         cal.illumination = measure_illumination(args.flat, m.size_px, m.sensor_mm, m.principal_point_px,
                                                 max_pixels=args.max_pixels)
     if lens is not None:
-        from ..analysis.calibrate_compare import compare_with_lens
+        from ..analysis.calibration.compare import compare_with_lens
 
         cal.comparison = compare_with_lens(cal, lens, fstop=args.fstop)
     return cal, lens

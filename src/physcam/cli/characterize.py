@@ -31,6 +31,10 @@ def register(sub) -> None:
     p.add_argument("--focus", required=True, metavar="MARKS",
                    help="focus marks from the film plane: NEAR:FAR:N = N marks evenly in 1/distance "
                         "(0.5m:inf:8 = 0.5, 0.583, 0.7, 0.875, 1.17, 1.75, 3.5 m, inf), or a list 1m,2m,inf")
+    p.add_argument("--zoom", default=None, metavar="Z,Z",
+                   help="zoom positions of zoom lenses, comma-separated: focal lengths (70mm,135mm) or encoder "
+                        "values 0..1; each lens is characterized at each position, as lens SLUG_zoom_<EFL>mm "
+                        "(zoom x focus x iris; docs/zoom.md)")
     p.add_argument("--fstop", default="2.8", metavar="N,N",
                    help="f-numbers, comma-separated (default 2.8)")
     p.add_argument("--fields", type=_whole("fields", 1, 64), default=5, metavar="K",
@@ -86,24 +90,42 @@ def _grid(args):
                 kinds=tuple(k.strip() for k in str(args.kinds).split(",") if k.strip())).checked()
 
 
+def characterize_lenses(ns) -> dict:
+    """{slug: Prescription} of a characterize command's lenses; with ``--zoom`` each (zoom) lens once per
+    zoom position, the prescription there, slug ``<lens>_zoom_<EFL>mm`` and named with its position."""
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    from ..characterize.grid import lens_slug
+    from ..errors import InputError
+    from ._zoom import at_zoom_named
+    from .lens import load_lens_arg
+
+    zooms = None if getattr(ns, "zoom", None) is None else [z.strip() for z in str(ns.zoom).split(",") if z.strip()]
+    if zooms is not None and not zooms:
+        raise InputError("--zoom: give zoom positions, e.g. 70mm,135mm,200mm or 0,0.5,1")
+    lenses = {}
+    for name in ns.lens:
+        base = lens_slug(Path(name).stem if ("/" in name or "\\" in name) else name)
+        lens = load_lens_arg(name, ns.lenient)
+        for z in [None] if zooms is None else zooms:
+            at = SimpleNamespace(zoom=z, wavelength=None)
+            rx = at_zoom_named(lens, at)
+            slug = base if z is None else lens_slug(f"{base}_zoom_{at.zoom_block['efl_mm']:.1f}mm")
+            if slug in lenses:
+                raise InputError(f"lens {name!r} is given twice" if z is None else
+                                 f"zoom {z!r} of {name!r} is a position already given ({slug})")
+            lenses[slug] = rx
+    return lenses
+
+
 def run_characterize(args) -> int:
     import sys
 
     from ..characterize import characterize
-    from ..characterize.grid import lens_slug
-    from .lens import load_lens_arg
 
     grid = _grid(args)  # every check that needs no lens first: a bad grid costs nothing
-    lenses = {}
-    for name in args.lens:
-        from pathlib import Path
-
-        slug = lens_slug(Path(name).stem if ("/" in name or "\\" in name) else name)
-        if slug in lenses:
-            from ..errors import InputError
-
-            raise InputError(f"lens {name!r} is given twice")
-        lenses[slug] = load_lens_arg(name, args.lenient)
+    lenses = characterize_lenses(args)
     show = not args.json
 
     def started(summary):

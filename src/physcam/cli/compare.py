@@ -214,9 +214,9 @@ def measure_lens(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays, units="m
 
 
 def _measure(lens, *, focus_mm, fstop, sensor, coc, light_mm, rays):
-    """physcam.analysis.lens_compare's measurements at the command's focus (``hyperfocal`` resolved here,
+    """physcam.onset.lens_compare's measurements at the command's focus (``hyperfocal`` resolved here,
     with its note)."""
-    from ..analysis.lens_compare import fstop_for_comparison, lens_measurements
+    from ..onset.lens_compare import fstop_for_comparison, lens_measurements
     from ._common import resolve_focus
 
     n, notes = fstop_for_comparison(lens, fstop)

@@ -114,7 +114,7 @@ def _aperture(args):
 
 
 def run(args) -> int:
-    from ..analysis.defocus_exr import defocus_file
+    from ..analysis.defocus.exr import defocus_file
     from ..lens.library import load_lens
     from ._common import resolve_focus, resolve_sensor
 
@@ -190,8 +190,8 @@ def _run_sequence(args, cam, opts) -> int:
 def run_kernels(args) -> int:
     import math
 
-    from ..analysis.defocus_exr import write_kernel_stack
-    from ..analysis.defocus_kernels import defocus_camera
+    from ..analysis.defocus.exr import write_kernel_stack
+    from ..analysis.defocus.kernels import defocus_camera
     from ..lens.library import load_lens
     from ..units import parse_distance
     from ..extras import require_extra

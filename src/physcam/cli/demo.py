@@ -106,11 +106,12 @@ def _lens_step(out, ctx, force):
     import json
     import math
 
-    from ..analysis.breathing_plot import save_breathing_plot
-    from ..analysis.diagram import save_lens_diagram
+    from ..analysis.framing.breathing_plot import save_breathing_plot
+    from ..analysis.lens_cards.diagram import save_lens_diagram
     from ..io import atomic_write
     from ..lens.library import load_lens
     from ..optics import focusing
+    from ..optics.state import camera_state
 
     lens = load_lens(DEFAULTS["lens"])
     ctx["lens"] = lens
@@ -124,7 +125,7 @@ def _lens_step(out, ctx, force):
     rows = focusing.breathing_table(lens, [600.0, 1000.0, 2000.0, 5000.0, math.inf], sensor_width_mm=sensor.width_mm)
     return [
         atomic_write(out / "lens.json", text + "\n", force=force),
-        save_lens_diagram(lens, out / "lens_diagram.png", force=force, fstop=DEFAULTS["fstop"],
+        save_lens_diagram(camera_state(lens, fstop=DEFAULTS["fstop"]), out / "lens_diagram.png", force=force,
                           units=ctx.get("units", "m")),
         save_breathing_plot(rows, out / "breathing.png", force=force, title=f"focus breathing: {lens.name}",
                             sensor_width_mm=sensor.width_mm, units=ctx.get("units", "m")),
@@ -154,20 +155,20 @@ def _metadata_step(out, ctx, force):
 
 
 def _trace_step(out, ctx, force):
-    from ..analysis.bokeh import bokeh_image
-    from ..analysis.spot import spot_diagram
-    from ..optics.state import camera_state
+    from ..analysis.defocus.bokeh import bokeh_image
+    from ..analysis.image_quality.spot import spot_diagram
+    from ..optics.state import as_designed, camera_state
     from ..trace.aperture import Aperture
 
     lens = ctx["lens"]
-    spot = spot_diagram(lens, (0.0, 5.0, 10.0))  # the lens as designed: infinity, wide open
+    spot = spot_diagram(as_designed(lens), (0.0, 5.0, 10.0))  # the lens as designed: infinity, wide open
     # a point light 1.2 m from the film, off axis, with the lens focused at 3 m and stopped to
     # f/2.8 by a 7-blade iris: the defocus blur shows the iris and cat's-eye vignetting
     s = ctx["report"].sensor
     state = camera_state(lens, focus_mm=DEFAULTS["focus"], fstop=DEFAULTS["fstop"], sensor_mm=(s.width_mm, s.height_mm),
                          aperture=Aperture(nsides=7, roundness=0.2))
     bokeh = bokeh_image(state, 1200.0, 250.0, 150.0, rays=400_000, pixels=160, spectral=True)
-    from ..analysis.bokeh import write_bokeh_photo
+    from ..analysis.defocus.bokeh import write_bokeh_photo
 
     photo = write_bokeh_photo(bokeh, out / "bokeh_photo", pixel_pitch_um=s.pitch_um or s.width_mm * 1000.0 / 4096,
                               sensor_name=s.name, force=force)
@@ -176,7 +177,7 @@ def _trace_step(out, ctx, force):
 
 def _card_step(out, ctx, force):
     """The default lens's one-page card (A4) on the demo's sensor, focused at infinity."""
-    from ..analysis.lens_card import lens_card, save_lens_card
+    from ..analysis.lens_cards.card import lens_card, save_lens_card
 
     s = ctx["report"].sensor
     card = lens_card(ctx["lens"], sensor_width_mm=s.width_mm, sensor_height_mm=s.height_mm, sensor_name=s.name)
@@ -188,17 +189,18 @@ def _distortion_step(out, ctx, force):
     import json
 
     from .. import __version__
-    from ..analysis.distortion_models import fit_brown_conrady, fit_tde4_radial, samples_from_field
-    from ..analysis.stmap import distortion_field, write_stmaps
+    from ..analysis.distortion.models import fit_brown_conrady, fit_tde4_radial, samples_from_field
+    from ..analysis.distortion.stmap import distortion_field, write_stmaps
     from ..export.nuke import nuke_stmap_script
     from ..export.tde4 import tde4_lens_text
+    from ..optics.state import camera_state
     from ..io import atomic_write
 
     s = ctx["report"].sensor
     w = 1920
     h = max(16, round(w * s.height_mm / s.width_mm))
-    res = distortion_field(ctx["lens"], focus_mm=DEFAULTS["focus"], sensor_width_mm=s.width_mm,
-                           sensor_height_mm=s.height_mm, width_px=w, height_px=h)
+    camera = camera_state(ctx["lens"], focus_mm=DEFAULTS["focus"], sensor_mm=(s.width_mm, s.height_mm))  # chief rays
+    res = distortion_field(camera, width_px=w, height_px=h)
     d = out / "distortion"
     paths = write_stmaps(res, d, force=force)
     smp = samples_from_field(res)
@@ -222,16 +224,17 @@ def _blender_step(out, ctx, force):
     from ..export.blender import write_blender_camera
     from ..export.blender_camera import blender_camera_script, blender_camera_values
     from ..io import atomic_write
+    from ..optics.state import camera_state
     from ..trace.aperture import Aperture
 
     report = ctx["report"]
     s = report.sensor
     width = 1920
     height = max(1, round(width * s.height_mm / s.width_mm))
-    osl, setup = write_blender_camera(out / "blender", ctx["lens"], focus_mm=DEFAULTS["focus"],
-                                      fstop=DEFAULTS["fstop"], sensor_width_mm=s.width_mm, sensor_height_mm=s.height_mm,
-                                      aperture=Aperture(nsides=7, roundness=0.2), resolution=(width, height),
-                                      name=DEFAULTS["lens"], force=force)
+    camera = camera_state(ctx["lens"], focus_mm=DEFAULTS["focus"], fstop=DEFAULTS["fstop"],
+                          sensor_mm=(s.width_mm, s.height_mm), aperture=Aperture(nsides=7, roundness=0.2))
+    osl, setup = write_blender_camera(camera, out / "blender", resolution=(width, height), name=DEFAULTS["lens"],
+                                      force=force)
     values = blender_camera_values(report, resolution_x=width, blades=7)
     builtin = atomic_write(out / "blender" / f"builtin_{DEFAULTS['lens']}.py", blender_camera_script(values),
                            force=force)

@@ -44,13 +44,14 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..onset.diopter import close_up
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import solve_report
+    from ..onset.request import report_camera
     from ..units import format_distance
     from ._common import coc_of, resolve_sensor, units_of
     from ._output import Table, document, emit_json, print_table
 
     sensor = resolve_sensor(args)
-    base = solve_report(ReportRequest(sensor=sensor, focal_length_mm=args.focal, fstop=args.fstop,
+    base = solve_report(report_camera(sensor=sensor, focal_length_mm=args.focal, fstop=args.fstop,
                                       focus_mm=args.focus, coc=coc_of(args)))
     mark = base.focus_from_film_mm  # a mark as typed, or the hyperfocal distance's
     rows = [close_up(args.focal, args.fstop, base.coc_mm, mark, p) for p in args.diopters]

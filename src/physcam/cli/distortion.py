@@ -14,6 +14,7 @@ import math
 
 from ._common import FOCUS_HELP, add_units_option, focus, focus_list, number, units_of
 from ._output import document, emit_json, print_csv
+from ._zoom import add_zoom_option, at_zoom_named
 from .lens import WAVE_UNITS, mark_repaired
 
 #: Names of the files the fits write into --stmap DIR.
@@ -29,7 +30,7 @@ _focus_list = focus_list("focus marks")
 
 def register(sub) -> None:
     from .analyze import _common, _resolution, _sensor
-    from ..analysis.distortion_names import DEFAULT_MAX_RESIDUAL_PX, MODEL_CHOICES
+    from ..analysis.distortion.names import DEFAULT_MAX_RESIDUAL_PX, MODEL_CHOICES
 
     p = sub.add_parser("distortion", help="real distortion: against field, ST-maps and fitted models at any focus")
     _common(p, "write the distortion plot (field-angle table; with --across-focus the table's plot)")
@@ -62,6 +63,7 @@ def register(sub) -> None:
     p.add_argument("--across-focus", type=_focus_list, default=None, metavar="LIST",
                    help="a table of distortion across focus marks, e.g. 0.5m,1m,2m,inf (hyperfocal too); "
                         "needs --resolution")
+    add_zoom_option(p)
     add_units_option(p)
     p.set_defaults(handler=run_distortion, output_folders=("stmap",))
 
@@ -86,9 +88,9 @@ def run_distortion(args) -> int:
     if args.csv and args.resolution is not None and args.across_focus is None:
         raise InputError("--csv prints a table's rows: the field-angle table (without --resolution) or "
                          "--across-focus; the 2-D field writes --stmap files")
-    lens = _prepare(args)
+    lens = at_zoom_named(_prepare(args), args)
     if args.focus is not None or args.across_focus is not None:
-        from ..onset.sensors import custom_sensor
+        from ..optics.sensors import custom_sensor
         from ._common import resolve_focus
 
         sensor = custom_sensor(args.sensor_width, args.sensor_height)
@@ -98,7 +100,7 @@ def run_distortion(args) -> int:
         return _run_across_focus(args, lens)
     if args.resolution is not None:
         return _run_field(args, lens)
-    from ..analysis.distortion import real_distortion
+    from ..analysis.distortion.field import real_distortion
 
     res = real_distortion(lens, args.field, sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
                           wavelength_nm=args.wavelength, focus_mm=math.inf if args.focus is None else args.focus)
@@ -130,7 +132,7 @@ def run_distortion(args) -> int:
 
 
 def _run_across_focus(args, lens) -> int:
-    from ..analysis.distortion_focus import distortion_across_focus
+    from ..analysis.distortion.across_focus import distortion_across_focus
     from ..errors import InputError
 
     if args.field:
@@ -143,7 +145,8 @@ def _run_across_focus(args, lens) -> int:
 
         tab.plot(args.output, force=args.force, units=units_of(args))
     if args.json:
-        emit_json(document("distortion_across_focus", mark_repaired(tab.to_dict(), args.loaded_lens),
+        emit_json(document("distortion_across_focus", mark_repaired({**tab.to_dict(), "zoom": args.zoom_block},
+                                                                     args.loaded_lens),
                            units=dict(WAVE_UNITS, image="pixel")))
         return 0
     rows = [dict(r, brown_du_k1=r["brown_du"]["k1"], brown_du_k2=r["brown_du"]["k2"],
@@ -204,14 +207,14 @@ def _fit_payloads(args, res, fits, folder):
     from pathlib import Path
 
     from .. import __version__
-    from ..analysis.distortion_models import BrownConrady, TDE4RadialStandard, USDStandard
+    from ..analysis.distortion.models import BrownConrady, TDE4RadialStandard, USDStandard
     from ..export.nuke import nuke_stmap_script
     from ..export.tde4 import tde4_lens_text
     from ._common import units_of
 
     d = Path(folder)
     out = []
-    from ..analysis.anamorphic_distortion import TDE4Anamorphic
+    from ..analysis.distortion.anamorphic import TDE4Anamorphic
     from ..export.tde4 import tde4_anamorphic_lens_text
 
     brown = [f for f in fits if isinstance(f, BrownConrady)]
@@ -253,10 +256,10 @@ def _anamorphic_key(fit) -> str:
 
 
 def _fits(samples, names, max_residual_px):
-    """The fitted models named by --fit: physcam.analysis.distortion_models' and the 3DE4 anamorphic ones."""
-    from ..analysis.anamorphic_distortion import fit_tde4_anamorphic
-    from ..analysis.distortion_models import fit_models
-    from ..analysis.distortion_names import ANAMORPHIC_CHOICES
+    """The fitted models named by --fit: physcam.analysis.distortion.models' and the 3DE4 anamorphic ones."""
+    from ..analysis.distortion.anamorphic import fit_tde4_anamorphic
+    from ..analysis.distortion.models import fit_models
+    from ..analysis.distortion.names import ANAMORPHIC_CHOICES
 
     names = list(names or ())
     fits = fit_models(samples, [n for n in names if n not in ANAMORPHIC_CHOICES], max_residual_px=max_residual_px)
@@ -275,8 +278,8 @@ def _png(fit, units: str = "m") -> bytes:
 
 
 def _run_field(args, lens) -> int:
-    from ..analysis.distortion_models import samples_from_field
-    from ..analysis.stmap import distortion_field, write_stmaps
+    from ..analysis.distortion.models import samples_from_field
+    from ..analysis.distortion.stmap import distortion_field, write_stmaps
     from ..errors import InputError
     import contextlib
     from pathlib import Path
@@ -310,6 +313,7 @@ def _run_field(args, lens) -> int:
             written = relocated(maps, tmp, args.stmap) + [p for p, _ in payload]
     d = res.to_dict()
     d["fits"] = [f.to_dict() for f in fits]
+    d["zoom"] = args.zoom_block
     if args.json:
         d["written"] = [str(p) for p in written]
         emit_json(document("distortion_field", mark_repaired(d, args.loaded_lens),

@@ -67,6 +67,7 @@ def register(sub) -> None:
     import argparse
 
     from ._output import add_output_options
+    from ._zoom import add_zoom_option
     from .lens import add_lenient
     from .report import add_coc_option
 
@@ -80,6 +81,7 @@ def register(sub) -> None:
     g.add_argument("--lens", metavar="NAME_OR_FILE",
                    help="a real lens (bundled name or prescription file) instead of --focal: the technical model")
     add_lenient(p)
+    add_zoom_option(g)
     g.add_argument("--fstops", type=_fstops, default=list(DEFAULT_FSTOPS), metavar="LIST",
                    help="f-stops (geometric f-numbers), comma-separated (default 1.4,2,2.8,4,5.6,8,11,16)")
     g.add_argument("--focus", type=focus_list("focus marks"), default=None, metavar="LIST",
@@ -100,11 +102,11 @@ def register(sub) -> None:
 
 def cell_report(args, lens, sensor, fstop, focus):
     """The lens report of one cell: what `physcam report` gives for these options."""
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
     from ._common import coc_of
 
-    return solve_report(ReportRequest(focal_length_mm=None if lens is not None else args.focal, lens=lens, sensor=sensor,
-                             fstop=fstop, focus_mm=focus, coc=coc_of(args), squeeze=squeeze_of(args, sensor)))
+    return solve_report(report_camera(focal_length_mm=None if lens is not None else args.focal, lens=lens, sensor=sensor,
+                                      fstop=fstop, focus_mm=focus, coc=coc_of(args), squeeze=squeeze_of(args, sensor)))
 
 
 def build(args) -> dict:
@@ -119,9 +121,12 @@ def build(args) -> dict:
         if args.focal is not None:
             raise InputError("give either --lens or --focal: the lens sets its own focal length")
         from ..lens.library import load_lens
+        from ._zoom import at_zoom_named
 
-        lens = load_lens(args.lens, lenient=args.lenient)
-        args.loaded_lens = lens
+        args.loaded_lens = load_lens(args.lens, lenient=args.lenient)
+        lens = args.table_lens = at_zoom_named(args.loaded_lens, args)
+    elif getattr(args, "zoom", None) is not None:
+        raise InputError("--zoom takes a zoom lens: give it with --lens NAME (a thin --focal lens has no zoom)")
     elif args.focal is None:
         raise InputError("give the focal length, e.g. --focal 35, or a lens with --lens NAME")
     marks = args.focus if args.focus is not None else focus_list("focus marks")(DEFAULT_FOCUS)
@@ -164,7 +169,7 @@ def build(args) -> dict:
         "coc_mm": first.coc_mm, "coc_convention": first.coc_convention, "squeeze": first.squeeze,
         "dof_aspect": first.dof_aspect, "fstops": list(args.fstops),
         "focus": [m if isinstance(m, str) else ("infinity" if math.isinf(m) else m) for m in marks],
-        "rows": rows, "hyperfocal": hyper,
+        "rows": rows, "hyperfocal": hyper, "zoom": getattr(args, "zoom_block", None),
         "definition": "distances from the film plane; each row is `physcam report` at that f-stop and focus mark "
                       "(null far and total: infinite); hfov_deg and vfov_deg: the desqueezed picture's field at the "
                       "mark; *_horizontal_*: an anamorphic's limits across the frame, where the CoC is c / dof_aspect",
@@ -304,7 +309,7 @@ def _card_chart(args):
     from ..onset.dof_plot import dof_chart_data
     from ._common import resolve_sensor
 
-    lens, sensor = getattr(args, "loaded_lens", None), resolve_sensor(args)
+    lens, sensor = getattr(args, "table_lens", None), resolve_sensor(args)
     marks = [m for m in (args.focus or []) if isinstance(m, float) and math.isfinite(m)]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PhysCamWarning)
@@ -334,7 +339,7 @@ def card_figure(d, *, units: str = "m", chart=None, page: str = "a4"):
     f-stops across, near / far / total in each cell, hyperfocal at the foot; with ``chart`` (a report and
     its :func:`physcam.onset.dof_plot.dof_chart_data`), the DOF chart of the set's apps below the table."""
 
-    from ..analysis.lens_card import PAGES
+    from ..analysis.lens_cards.card import PAGES
     from ..figures import new_figure
     from ..units import format_distance
 

@@ -107,7 +107,7 @@ def _prepare(args):
     """Resolve the sensor (args.sensor_width/height), load the lens and resolve --focus (hyperfocal:
     the lens at --fstop, or wide open)."""
     from ..lens.library import load_lens
-    from ..onset.sensors import custom_sensor
+    from ..optics.sensors import custom_sensor
     from ._common import resolve_focus
     from .analyze import _resolve_sensor
 
@@ -197,12 +197,11 @@ def run_blender(args) -> int:
 
     from ..errors import InputError
     from ..export.blender import write_blender_camera
-    from ..optics.state import camera_state
+    from ..lens.library import load_lens
     from ..trace.aperture import Aperture
-    from ._common import output_folder, relocated
+    from ._common import camera_from_args, output_folder, relocated
 
     t0 = time.perf_counter()
-    lens = _prepare(args)
     if not 16 <= args.width_px <= 65536:
         raise InputError(f"--width-px must lie in 16..65536, got {args.width_px}")
     if args.blades is not None and args.blades != int(args.blades):
@@ -210,33 +209,33 @@ def run_blender(args) -> int:
     aperture = None
     if args.blades is not None or args.roundness or args.density:
         aperture = Aperture(int(args.blades or 0), args.blade_angle, args.roundness, args.density)
+    lens = load_lens(args.lens, lenient=args.lenient)
+    camera = camera_from_args(args, lens, aperture=aperture)  # the one camera: focus, iris, sensor
+    sw, sh = camera.sensor_mm
     w = int(args.width_px)
-    h = max(1, int(round(w * args.sensor_height / args.sensor_width)))
+    h = max(1, int(round(w * sh / sw)))
     out = Path(args.output)
     builtin = gap = None
     with output_folder(out, force=args.force, command="export blender") as tmp:  # the folder is written whole
-        state = camera_state(lens, focus_mm=args.focus, fstop=args.fstop,
-                             sensor_mm=(args.sensor_width, args.sensor_height), aperture=aperture)
-        osl, setup = write_blender_camera(tmp, state, dispersion=args.dispersion, fresnel=args.fresnel,
+        osl, setup = write_blender_camera(camera, tmp, dispersion=args.dispersion, fresnel=args.fresnel,
                                           resolution=(w, h), name=Path(args.lens).stem)
         if args.builtin:
-            builtin, gap = _write_builtin(args, lens, w, tmp / f"builtin_{Path(args.lens).stem}.py")
+            builtin, gap = _write_builtin(args, camera, w, tmp / f"builtin_{Path(args.lens).stem}.py")
     osl, setup = relocated([osl, setup], tmp, out)
     if builtin is not None:
         builtin = relocated([builtin], tmp, out)[0]
+    focus = camera.focus_from_film_mm
     data = {"lens": lens.name, "shader": str(osl), "setup": str(setup), "builtin": builtin and str(builtin),
-            "focus_from_film_mm": None
-            if args.focus == float("inf") else args.focus, "fstop": args.fstop, "sensor_mm": [args.sensor_width,
-            args.sensor_height], "resolution": [w, h], "dispersion": args.dispersion, "fresnel": args.fresnel,
+            "focus_from_film_mm": None if focus == float("inf") else focus, "fstop": args.fstop,
+            "sensor_mm": [sw, sh], "resolution": [w, h], "dispersion": args.dispersion, "fresnel": args.fresnel,
             "thin_lens_gap": gap and gap.to_dict(), "seconds": round(time.perf_counter() - t0, 3)}
     if args.json:
         emit_json(document("export_blender", data, units={"length": "mm", "time": "s", "image": "pixel"}))
         return 0
     from ._common import units_of
 
-    print(f"wrote {osl} and {setup}: {lens.name} focused at {_mark(args.focus, units_of(args))}"
-          f"{'' if args.fstop is None else f', f/{args.fstop:g}'} on {args.sensor_width:g} x {args.sensor_height:g} mm, "
-          f"{w} x {h} px")
+    print(f"wrote {osl} and {setup}: {lens.name} focused at {_mark(focus, units_of(args))}"
+          f"{'' if args.fstop is None else f', f/{args.fstop:g}'} on {sw:g} x {sh:g} mm, {w} x {h} px")
     print(f"  in Blender: blender your.blend --python {setup}  (Cycles, CPU, OSL)")
     if builtin is not None:
         print(f"  or Blender's own camera, matched: blender your.blend --python {builtin}")
@@ -266,27 +265,29 @@ def run_blender_extension(args) -> int:
     return 0
 
 
-def _write_builtin(args, lens, width_px: int, path):
-    """Blender's built-in camera matched to the lens report at this focus (physcam.export.blender_camera)."""
+def _write_builtin(args, camera, width_px: int, path):
+    """Blender's built-in camera matched to the lens report of ``camera`` (physcam.export.blender_camera)."""
     import math
 
     from ..errors import InputError
     from ..export.blender_camera import blender_camera_script, blender_camera_values
     from ..io import atomic_write
-    from ..onset.report import ReportRequest, solve_report
-    from ..onset.sensors import custom_sensor
+    from ..onset.report import report_camera, solve_report
+    from ..optics.sensors import custom_sensor
 
-    if math.isinf(args.focus):
+    if math.isinf(camera.focus_from_film_mm):
         raise InputError("--builtin needs a finite focus mark (the built-in camera's focus distance); "
                          "give e.g. --focus 1000m")
-    from ..analysis.thin_lens_gap import thin_lens_gap
+    from ..onset.thin_lens_gap import thin_lens_gap
 
-    report = solve_report(ReportRequest(focal_length_mm=None, sensor=custom_sensor(args.sensor_width, args.sensor_height),
-                               fstop=args.fstop, focus_mm=args.focus, lens=lens))
+    # the report's camera: this lens at this focus on this sensor (its focus solution shared), wide open
+    # without --fstop as the report says it
+    report = solve_report(report_camera(focal_length_mm=None, sensor=custom_sensor(*camera.sensor_mm), fstop=args.fstop,
+                                        focus_mm=camera.focus_from_film_mm, lens=camera.lens))
     blades = int(args.blades or 0)
     values = blender_camera_values(report, resolution_x=width_px, blades=blades if blades >= 3 else 0,
                                    blade_rotation_deg=args.blade_angle)
-    gap = thin_lens_gap(report, lens)
+    gap = thin_lens_gap(report)
     values["thin_lens_gap"] = gap.to_dict()
     path = atomic_write(path, blender_camera_script(values, comments=[gap.summary()]), force=args.force)
     return path, gap
@@ -499,7 +500,7 @@ def _slug(text: str) -> str:
 def run_pbrt(args) -> int:
     from ..errors import InputError
     from ..export.pbrt import check_pbrt_lens, write_pbrt_camera
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
     from ._common import coc_of, output_folder, relocated
     from .report import resolve_sensor
 
@@ -522,8 +523,8 @@ def run_pbrt(args) -> int:
     with _warnings_after_success():
         if lens is None and args.fstop is None:
             raise InputError("give the f-stop of the thin lens (--fstop)")
-        report = solve_report(ReportRequest(focal_length_mm=args.focal, sensor=resolve_sensor(args), fstop=args.fstop,
-                                   focus_mm=args.focus, coc=coc_of(args), lens=lens))
+        report = solve_report(report_camera(focal_length_mm=args.focal, sensor=resolve_sensor(args), fstop=args.fstop,
+                               focus_mm=args.focus, coc=coc_of(args), lens=lens))
         name = _slug(args.lens) if args.lens else f"thin_{report.focal_length_mm:g}mm".replace(".", "_")
         with output_folder(args.output, force=args.force, command="export pbrt") as tmp:  # written whole
             out = write_pbrt_camera(report, tmp, lens, name=name, xres=args.resolution, cameras=cameras)

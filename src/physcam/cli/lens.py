@@ -23,7 +23,7 @@ from __future__ import annotations
 from ..errors import PhysCamError
 from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number, whole
 from ._output import add_output_options
-from ._zoom import add_zoom_option, register_zoom, zoom_info, zoomed
+from ._zoom import add_zoom_option, at_zoom_named, register_zoom, zoom_info, zoomed
 
 
 def register(sub) -> None:
@@ -105,6 +105,7 @@ def register(sub) -> None:
     k.add_argument("--force", action="store_true", help="overwrite an existing file")
     add_units_option(k)
     add_lenient(k)
+    add_zoom_option(k)
     add_output_options(k, what="the card's numbers")
     k.set_defaults(handler=run_card)
 
@@ -417,7 +418,7 @@ def _print_provenance(p) -> None:
 
 
 def diagram_options(args) -> dict:
-    """The keyword arguments ``physcam lens diagram`` gives :func:`physcam.analysis.diagram.lens_diagram`
+    """The keyword arguments ``physcam lens diagram`` gives :func:`physcam.analysis.lens_cards.diagram.lens_diagram`
     (``--focus hyperfocal`` resolved to its mark for the lens and f-stop)."""
     from ._common import HYPERFOCAL, resolve_focus
 
@@ -428,7 +429,7 @@ def diagram_options(args) -> dict:
 
 
 def run_diagram(args) -> int:
-    from ..analysis.diagram import save_lens_diagram
+    from ..analysis.lens_cards.diagram import save_lens_diagram
     from ..optics.state import camera_state
     from ._common import units_of
 
@@ -441,14 +442,14 @@ def run_diagram(args) -> int:
 
 
 def run_card(args) -> int:
-    """``physcam lens card``: the one-page lens card (:mod:`physcam.analysis.lens_card`)."""
-    from ..analysis.lens_card import lens_card, save_lens_card
+    """``physcam lens card``: the one-page lens card (:mod:`physcam.analysis.lens_cards.card`)."""
+    from ..analysis.lens_cards.card import lens_card, save_lens_card
     from ..io import check_writable
     from ._common import resolve_focus, resolve_sensor, units_of
     from ._output import document, emit_json
 
     check_writable(args.output, force=args.force)  # before the seconds of work
-    p = _load(args)
+    p = at_zoom_named(load_lens_arg(args.lens, args.lenient), args)  # a zoom's card at --zoom, named so in its title
     sensor = resolve_sensor(args)
     (mark,) = resolve_focus([args.focus], lens=p, sensor=sensor, args=args)
     card = lens_card(p, focus_mm=mark, sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm,
@@ -456,7 +457,7 @@ def run_card(args) -> int:
                      quality="draft" if args.draft else "full")
     path = save_lens_card(card, args.output, force=args.force, units=units_of(args), dpi=args.dpi)
     if args.json:
-        emit_json(document("lens_card", {**card.to_dict(), "output": str(path)}))
+        emit_json(document("lens_card", {**card.to_dict(), "output": str(path), "zoom": args.zoom_block}))
         return 0
     print(f"wrote {path}")
     return 0
@@ -484,7 +485,7 @@ def run_breathing(args) -> int:
     units = units_of(args)
     path = None
     if args.output:
-        from ..analysis.breathing_plot import save_breathing_plot
+        from ..analysis.framing.breathing_plot import save_breathing_plot
 
         path = save_breathing_plot(rows, args.output, force=args.force,
                                    title=f"{p.name}: focus breathing, {sensor_name} ({width:g} mm wide)",
@@ -537,10 +538,10 @@ def run_check(args) -> int:
     from ._output import document, emit_json
 
     if args.sensor:
-        from ..onset.sensors import find_sensor
+        from ..optics.sensors import find_sensor
 
         find_sensor(args.sensor)  # an unknown name is refused before any work
-    from ..analysis.lens_probes import ray_probes
+    from ..analysis.lens_cards.probes import ray_probes
     from ..usd.lens_archive import check_archive, is_archive
 
     if is_archive(args.lens):
@@ -675,7 +676,7 @@ def run_pack(args) -> int:
     from ._output import document, emit_json
 
     check_writable(args.output, force=args.force)  # before the seconds of work
-    p = _load(args)
+    p = at_zoom_named(load_lens_arg(args.lens, args.lenient), args)  # a zoom's card at --zoom, named so in its title
     sensor = resolve_sensor(args)
     (mark,) = resolve_focus([args.focus], lens=p, sensor=sensor, args=args)
     runs = _read_runs(args.characterizations) if args.characterizations else None

@@ -163,7 +163,7 @@ def run_insert(args) -> int:
     array = microlens_array(args.xdim, args.ydim, args.film_width, args.film_height, focal_length_mm=args.microlens_focal,
                             lenslet=lenslet, sensor_offset_mm=args.sensor_offset)
     if args.focus is not None:
-        from ..onset.sensors import custom_sensor
+        from ..optics.sensors import custom_sensor
         from ._common import resolve_focus
 
         args.focus = resolve_focus(args.focus, lens=main, sensor=custom_sensor(args.film_width, args.film_height),
@@ -196,7 +196,7 @@ def run_insert(args) -> int:
 def run_render(args) -> int:
     import math
 
-    from ..analysis.lightfield import (checkerboard, light_field_figure, render_plane, render_point, view_disparity)
+    from ..analysis.defocus.lightfield import (checkerboard, light_field_figure, render_plane, render_point, view_disparity)
     from ..errors import InputError
     from ..io import check_writable
     from ..lens.formats.iset import microlens_of
@@ -223,7 +223,7 @@ def run_render(args) -> int:
         raise InputError(f"{array.count_x * n} x {array.count_y * n} sensor pixels is more than {MAX_CLI_PIXELS}; "
                          "lower --pixels-per-lenslet")
     if args.focus is not None:
-        from ..onset.sensors import custom_sensor
+        from ..optics.sensors import custom_sensor
         from ._common import resolve_focus
 
         args.focus = resolve_focus(args.focus, lens=p, fstop=args.fstop, args=args,

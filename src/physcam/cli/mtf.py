@@ -79,7 +79,7 @@ def register(sub) -> None:
 
 
 def _spectrum(args):
-    from ..analysis.mtf import WHITE_LIGHT_NM
+    from ..analysis.image_quality.mtf import WHITE_LIGHT_NM
     from ..errors import InputError
 
     wls = tuple(args.wavelength) if args.wavelength else WHITE_LIGHT_NM
@@ -113,19 +113,22 @@ def run(args) -> int:
     wls, weights = _spectrum(args)
     freqs = tuple(args.frequency) if args.frequency else (10.0, 20.0, 40.0)
     focus = None if args.focus is None or math.isinf(args.focus) else args.focus
+    from ..optics.state import camera_state
+
+    camera = camera_state(lens, focus_mm=focus, fstop=args.fstop)  # the one camera of the command
     if args.field is not None:
         if args.max_height is not None or args.fields != 15:
             raise InputError("--fields and --max-height set the chart; with --field one field is reported")
         if args.best_focus is not None:
             raise InputError("--best-focus places the chart's film; with --field the film stays at the focus mark")
-        return _one_field(args, lens, wls, weights, freqs, focus)
-    from ..analysis.mtf import mtf_chart
+        return _one_field(args, camera, wls, weights, freqs)
+    from ..analysis.image_quality.mtf import mtf_chart
     from ._common import progress_bar
 
     top = sensor.diagonal_mm / 2 if args.max_height is None else args.max_height
     with progress_bar("MTF chart", enabled=not (args.json or args.csv)) as bar:
-        chart = mtf_chart(lens, max_image_height_mm=top, n_fields=args.fields, frequencies=freqs, wavelengths_nm=wls,
-                          weights=weights, fstop=args.fstop, focus_mm=focus, pupil_samples=args.pupil_samples,
+        chart = mtf_chart(camera, max_image_height_mm=top, n_fields=args.fields, frequencies=freqs, wavelengths_nm=wls,
+                          weights=weights, pupil_samples=args.pupil_samples,
                           max_pupil_samples=CHART_MAX_PUPIL_SAMPLES, progress=bar, best_focus=args.best_focus,
                           best_focus_rule=args.best_focus_rule, method=args.method)
     if args.output:
@@ -170,31 +173,31 @@ def _field_points(m) -> list[dict]:
             for i, f in enumerate(m.frequencies_lpmm)]
 
 
-def _one_field(args, lens, wls, weights, freqs, focus) -> int:
-    from ..analysis.mtf import mtf
-    from ..analysis.psf import psf
-    from ..analysis.wavefront import wavefront
+def _one_field(args, camera, wls, weights, freqs) -> int:
+    from ..analysis.image_quality.mtf import mtf
+    from ..analysis.image_quality.psf import psf
+    from ..analysis.image_quality.wavefront import wavefront
 
-    kw = dict(fstop=args.fstop, focus_mm=focus)
-    wf = wavefront(lens, args.field, wavelength_nm=wls[0], pupil_samples=args.pupil_samples, **kw)
-    ps = psf(lens, args.field, wavelength_nm=wls[0], pupil_samples=args.pupil_samples,
-             max_pupil_samples=CLI_MAX_PUPIL_SAMPLES, **kw)
-    m = mtf(lens, args.field, frequencies=freqs, wavelengths_nm=wls, weights=weights, pupil_samples=args.pupil_samples,
-            max_pupil_samples=CLI_MAX_PUPIL_SAMPLES, **kw)
+    lens = camera.lens
+    wf = wavefront(camera, args.field, wavelength_nm=wls[0], pupil_samples=args.pupil_samples)
+    ps = psf(camera, args.field, wavelength_nm=wls[0], pupil_samples=args.pupil_samples,
+             max_pupil_samples=CLI_MAX_PUPIL_SAMPLES)
+    m = mtf(camera, args.field, frequencies=freqs, wavelengths_nm=wls, weights=weights, pupil_samples=args.pupil_samples,
+            max_pupil_samples=CLI_MAX_PUPIL_SAMPLES)
     if args.method == "huygens":  # the MTF from the Huygens PSF; the Strehl ratio from the monochromatic one
         import dataclasses
 
         import numpy as np
 
-        from ..analysis.huygens import huygens_mtf, huygens_psf
+        from ..analysis.image_quality.huygens import huygens_mtf, huygens_psf
 
-        t, s, _ = huygens_mtf(lens, args.field, frequencies=freqs, wavelengths_nm=wls, weights=weights, **kw)
+        t, s, _ = huygens_mtf(camera, args.field, frequencies=freqs, wavelengths_nm=wls, weights=weights)
         m = dataclasses.replace(m, method="huygens", tangential=np.asarray(t), sagittal=np.asarray(s))
-        hp = huygens_psf(lens, args.field, wavelengths_nm=[wls[0]], **kw)
+        hp = huygens_psf(camera, args.field, wavelengths_nm=[wls[0]])
         ps = dataclasses.replace(ps, strehl=float(hp.strehl))
     if args.output:
-        curve = mtf(lens, args.field, wavelengths_nm=wls, weights=weights, pupil_samples=args.pupil_samples,
-                    max_pupil_samples=CLI_MAX_PUPIL_SAMPLES, **kw)
+        curve = mtf(camera, args.field, wavelengths_nm=wls, weights=weights, pupil_samples=args.pupil_samples,
+                    max_pupil_samples=CLI_MAX_PUPIL_SAMPLES)
         curve.plot(args.output, force=args.force)
     points = _field_points(m)
     if args.json:
@@ -213,7 +216,7 @@ def _one_field(args, lens, wls, weights, freqs, focus) -> int:
           f"{ps.airy_radius_um:.2f} µm")
     z = wf.zernike
     print("  Zernike (Noll, waves): " + ", ".join(f"Z{j + 1} {c:+.4f}" for j, c in enumerate(z[:11])))
-    from ..analysis.mtf import spectrum_words
+    from ..analysis.image_quality.mtf import spectrum_words
 
     print(f"  light: {spectrum_words(lens, m.wavelengths_nm)}")
     print("  MTF: " + ", ".join(f"{f:g} lp/mm S {s:.3f} T {t:.3f}" for f, s, t in

@@ -81,20 +81,23 @@ def run(args) -> int:
     lens = load_lens(args.lens, lenient=args.lenient)
     args.focus = resolve_focus(args.focus, lens=lens, fstop=args.fstop, args=args)
     focus_mm = None if args.focus is None or math.isinf(args.focus) else args.focus
-    kw = dict(fstop=args.fstop, focus_mm=focus_mm, defocus_mm=args.defocus * 1e-3)
-    if args.method == "huygens":
-        from ..analysis.huygens import DEFAULT_IMAGE_SAMPLES, huygens_psf
+    from ..optics.state import camera_state
 
-        p = huygens_psf(lens, args.field, wavelengths_nm=None if args.wavelength is None else [args.wavelength],
+    camera = camera_state(lens, focus_mm=focus_mm, fstop=args.fstop)  # the one camera of the command
+    kw = dict(defocus_mm=args.defocus * 1e-3)
+    if args.method == "huygens":
+        from ..analysis.image_quality.huygens import DEFAULT_IMAGE_SAMPLES, huygens_psf
+
+        p = huygens_psf(camera, args.field, wavelengths_nm=None if args.wavelength is None else [args.wavelength],
                         tilt_deg=args.tilt, image_samples=args.samples or DEFAULT_IMAGE_SAMPLES, pixel_um=args.pixel,
                         **kw)
         d = dict(p.to_dict(), method="huygens")
         line = (f"Strehl {p.strehl:.4f}; {p.image.shape[0]} x {p.image.shape[1]} px of {p.pixel_um:.3f} um about the "
                 f"blur's centroid, holding {p.energy_in_grid:.1%} of the power")
     else:
-        from ..analysis.psf import psf
+        from ..analysis.image_quality.psf import psf
 
-        p = psf(lens, args.field, wavelength_nm=args.wavelength, **kw)
+        p = psf(camera, args.field, wavelength_nm=args.wavelength, **kw)
         d = dict(p.to_dict(), method="fft")
         line = (f"Strehl {p.strehl:.4f}; pixels {p.pixel_um[0]:.3f} x {p.pixel_um[1]:.3f} um; Airy radius "
                 f"{p.airy_radius_um:.2f} um")

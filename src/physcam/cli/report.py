@@ -126,8 +126,10 @@ def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):
 
 
 def solve_from_args(args):
+    """The lens report of the command's options: the camera built once at the door
+    (:func:`physcam.onset.request.report_camera`), then its report; ``args.report_inputs`` keeps them."""
     from ..errors import InputError
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
 
     lens = None
     if getattr(args, "lens", None):
@@ -148,7 +150,8 @@ def solve_from_args(args):
 
     coc = coc_of(args)
     sensor = resolve_sensor(args, quiet=True)  # the report says it in its notes
-    report = solve_report(ReportRequest(**_request_inputs(args, lens, sensor, coc)))
+    args.report_inputs = report_camera(**_request_inputs(args, lens, sensor, coc))
+    report = solve_report(args.report_inputs)
     if getattr(args, "sensor_defaulted", False):
         import dataclasses
 
@@ -159,23 +162,27 @@ def solve_from_args(args):
 
 
 def dof_chart_solver(args, report):
-    """``solve(fstop, focus_mm)`` for :func:`physcam.onset.dof_plot.dof_chart_figure`: the report of
-    ``args`` (after :func:`solve_from_args`) at another stop and focus mark, with the report's CoC and
-    sensor and no measured limits, so that the chart and the report agree at the report's own cell."""
-    from ..onset.report import ReportRequest, solve_report
+    """``solve(fstop, focus_mm)`` for :func:`physcam.onset.dof_plot.dof_chart_figure`: the report of the
+    camera of ``report`` (after :func:`solve_from_args`) at another stop and focus mark, with the report's
+    CoC and sensor and no measured limits, so that the chart and the report agree at the report's own
+    cell. The cameras share the lens model, so a prescription focuses at each mark once."""
+    import dataclasses
 
-    lens = getattr(args, "loaded_lens", None)
+    from ..onset.report import solve_report
+    from ..optics.state import camera_state
+
+    cam, refs = report.camera, dataclasses.replace(report.references, tstop=None)
 
     def solve(fstop, focus_mm):
-        inputs = _request_inputs(args, lens, report.sensor, report.coc_mm)
-        inputs.update(fstop=fstop, focus_mm=focus_mm, near_mm=None, far_mm=None, tstop=None)
-        return solve_report(ReportRequest(**inputs))
+        at = camera_state(cam.lens_model, focus_mm=focus_mm, fstop=fstop, sensor=cam.sensor, squeeze=cam.squeeze,
+                          zoom=cam.zoom)
+        return solve_report(at, coc=report.coc_mm, references=refs)
 
     return solve
 
 
 def _request_inputs(args, lens, sensor, coc) -> dict:
-    """The report's inputs from the parsed options (the fields of ReportRequest)."""
+    """The report's inputs from the parsed options (the inputs of physcam.onset.request.report_camera)."""
     return dict(
         focal_length_mm=args.focal,
         sensor=sensor,
@@ -201,13 +208,12 @@ def _request_inputs(args, lens, sensor, coc) -> dict:
 
 def thin_lens_gap_from_args(args, report):
     """How far a renderer's thin-lens camera of ``report`` is from the prescription the command loaded
-    (:func:`physcam.analysis.thin_lens_gap.thin_lens_gap`), or None for a thin lens or a datasheet."""
-    lens = getattr(args, "loaded_lens", None)
-    if lens is None:
+    (:func:`physcam.onset.thin_lens_gap.thin_lens_gap`), or None for a thin lens or a datasheet."""
+    if getattr(args, "loaded_lens", None) is None:
         return None
-    from ..analysis.thin_lens_gap import thin_lens_gap
+    from ..onset.thin_lens_gap import thin_lens_gap
 
-    return thin_lens_gap(report, lens)
+    return thin_lens_gap(report)
 
 
 def camera_blocks(report, args) -> dict:
@@ -223,7 +229,9 @@ def camera_blocks(report, args) -> dict:
 
         from ..onset.report import MAX_DISTANCE_MM
 
-        calc = dataclasses.replace(report, focus_from_film_mm=MAX_DISTANCE_MM, object_distance_mm=MAX_DISTANCE_MM)
+        # (the camera moved to that mark for these values only: no focus is solved, nothing else asks it)
+        far = dataclasses.replace(report.camera, focus_from_film_mm=MAX_DISTANCE_MM)
+        calc = dataclasses.replace(report, camera=far, object_distance_mm=MAX_DISTANCE_MM)
     blocks = {
         "meters_per_unit": mpu,
         "camera": "the best-match pinhole at the entrance pupil (docs/lens-report.md)",
@@ -244,9 +252,9 @@ def camera_blocks(report, args) -> dict:
 
 
 def real_dof_block(report, args) -> dict:
-    """The real-ray depth of field (:func:`physcam.analysis.real_dof.real_depth_of_field`) at the centre and
+    """The real-ray depth of field (:func:`physcam.analysis.defocus.real_dof.real_depth_of_field`) at the centre and
     at a field point, beside the model's, for ``physcam report --dof real``."""
-    from ..analysis.real_dof import real_depth_of_field
+    from ..analysis.defocus.real_dof import real_depth_of_field
     from ..errors import InputError, OpticsError
 
     lens = getattr(args, "loaded_lens", None)
@@ -263,8 +271,8 @@ def real_dof_block(report, args) -> dict:
                      "far_from_film_mm": None if model.far_is_infinite else model.far_from_film_mm}}
     for key, height in (("centre", 0.0), ("field", h)):
         try:
-            r = real_depth_of_field(lens, focus_mm=report.focus_from_film_mm, fstop=report.fstop,
-                                    coc_mm=report.coc_mm, image_height_mm=height, measure=args.blur,
+            r = real_depth_of_field(report.stopped_camera(), coc_mm=report.coc_mm, image_height_mm=height,
+                                    measure=args.blur,
                                     energy_fraction=args.energy_fraction, focusing=args.focusing)
             d = r.to_dict()
             if not (r.far_is_infinite or model.far_is_infinite):

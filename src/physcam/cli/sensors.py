@@ -47,7 +47,7 @@ def sensor_document(s) -> dict:
 def select(args) -> list:
     """The sensors ``args`` ask for: one exact name or alias, else every match of the filters."""
     from ..errors import SensorError
-    from ..onset.sensors import filter_sensors, find_sensor
+    from ..optics.sensors import filter_sensors, find_sensor
 
     query = " ".join(args.name or ()) if isinstance(args.name, (list, tuple)) else (args.name or "")
     filters = (getattr(args, "maker", None), getattr(args, "fmt", None), getattr(args, "min_width", None),

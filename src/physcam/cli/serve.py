@@ -180,7 +180,7 @@ def cli_backend():
         return _svg(fig, description=json.dumps(fig.physcam_chart, separators=(",", ":")))
 
     def sensors(q):
-        from ..onset.sensors import sensors as all_sensors
+        from ..optics.sensors import sensors as all_sensors
 
         from .sensors import select
 
@@ -192,15 +192,18 @@ def cli_backend():
         return show_document(parsers["lens"].parse_args([*_options(q), f"--lens={_bundled(name)}"]))
 
     def diagram_svg(name, q):
-        from ..analysis.diagram import lens_diagram
+        from ..analysis.lens_cards.diagram import lens_diagram
         from ..lens.library import load_lens
 
         args = parsers["diagram"].parse_args([*_options(q), "--output=diagram.svg", f"--lens={_bundled(name)}"])
         resolve_bare_distances(args)
+        from ..optics.state import camera_state
+
+        opts = diagram_options(args)
+        camera = camera_state(load_lens(args.lens), focus_mm=opts.pop("focus_mm"), fstop=opts.pop("fstop"))
         # drawn for a phone: 4.4 in wide with 12 pt text reads >= 12 px at 390 px (the page's img is ~366 px wide)
-        fig = lens_diagram(load_lens(args.lens), **diagram_options(args)).figure(units=args.units or "m",
-                                                                                 width_in=DIAGRAM_WIDTH_IN,
-                                                                                 text_pt=DIAGRAM_TEXT_PT)
+        fig = lens_diagram(camera, **opts).figure(units=args.units or "m", width_in=DIAGRAM_WIDTH_IN,
+                                                  text_pt=DIAGRAM_TEXT_PT)
         return _svg(fig, dpi=150)
 
     from ._config import load_config

@@ -68,17 +68,19 @@ def register(sub) -> None:
 
 
 def run_spot(args) -> int:
-    from ..analysis.spot import spot_diagram
+    from ..analysis.image_quality.spot import spot_diagram
     from ..io import check_writable
     from ..lens.library import load_lens
 
     if args.output:
         check_writable(args.output, force=args.force)
     lens = load_lens(args.lens, lenient=args.lenient)
-    # the lens and its own film plane at --wavelength (the paraxial focus of that wavelength): a
-    # CameraState would keep the film where the lens focuses at its design wavelength
-    res = spot_diagram(lens, tuple(args.field or (0.0, 5.0)), wavelength_nm=args.wavelength, rings=args.rings,
-                       fstop=args.fstop, clip=args.clip)
+    # the lens as designed, its film at --wavelength's paraxial focus (camera_state would keep the film where
+    # the lens focuses at its design wavelength)
+    from ..optics.state import as_designed
+
+    res = spot_diagram(as_designed(lens, fstop=args.fstop), tuple(args.field or (0.0, 5.0)),
+                       wavelength_nm=args.wavelength, rings=args.rings, clip=args.clip)
     if args.output:
         from ._output import save_plot
 
@@ -109,7 +111,7 @@ def run_spot(args) -> int:
 
 
 def run_bokeh(args) -> int:
-    from ..analysis.bokeh import bokeh_image
+    from ..analysis.defocus.bokeh import bokeh_image
     from ..io import check_writable
     from ..lens.library import load_lens
 
@@ -175,7 +177,7 @@ def run_bokeh(args) -> int:
 
 def _bokeh_photo(res, args) -> dict:
     """``physcam bokeh --image``: the EXR and PNG photograph, and what its scale bar means."""
-    from ..analysis.bokeh import scale_bar_pixels, write_bokeh_photo
+    from ..analysis.defocus.bokeh import scale_bar_pixels, write_bokeh_photo
     from ._common import resolve_sensor
 
     sensor = resolve_sensor(args)

@@ -2,7 +2,7 @@
 
 :data:`DEFAULT_SENSOR` names the sensor every command and every public function uses when none is
 given; its gate, width x height in mm, is looked up in the bundled table ``physcam/data/sensors.csv``
-(the row whose key, name or alias is that name, matched as :func:`physcam.onset.sensors.find_sensor`
+(the row whose key, name or alias is that name, matched as :func:`physcam.optics.sensors.find_sensor`
 matches: case, spaces and punctuation ignored). This module sits at the bottom of the layers, so
 ``optics/``, ``analysis/``, ``characterize/``, ``usd/`` and ``cli/`` all import it.
 

@@ -38,8 +38,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, require_positive, require_type
-from ..lens.prescription import Prescription, require_prescription
-from ..optics.state import CameraState, camera_state, takes_camera
+from ..lens.prescription import Prescription
+from ..optics.state import CameraState, takes_camera
 from ._codetext import osl_comment, python_docstring
 from .osl import WAVELENGTH_RANGE_NM, osl_array, osl_number
 
@@ -52,7 +52,7 @@ PUPIL_GRID = (9, 9)
 
 @dataclasses.dataclass
 class BakedCamera:
-    """What the shader bakes in: the focused, stopped-down prescription and everything derived."""
+    """What the shader bakes in of ``camera``: the focused, stopped-down prescription and everything derived."""
 
     lens: Prescription  # focused, with the stop at its working semi-diameter
     film_z: float  # mm, lens space
@@ -62,9 +62,18 @@ class BakedCamera:
     norm: float  # mean camera_rays weight at the film centre
     sensor_width_mm: float
     sensor_height_mm: float
-    focus_mm: float
-    fstop: float | None
+    camera: CameraState  # the camera baked: its focus mark (.focus_mm) and f-stop (.fstop)
     wavelength_nm: float
+
+    @property
+    def focus_mm(self) -> float:
+        """The camera's focus mark in front of the film (inf at infinity)."""
+        return self.camera.focus_from_film_mm
+
+    @property
+    def fstop(self) -> float | None:
+        """The f-stop the shader's header names: None ("open") when the iris is the file's own stop."""
+        return _fstop_label(self.camera)
 
 
 def _aperture(aperture):
@@ -85,39 +94,14 @@ def _aperture(aperture):
                      "a tuple (blades, angle_deg, roundness, density) or a dict of those")
 
 
-_LENS_HINT = ("physcam.optics.state.camera_state(lens, focus_mm=..., fstop=..., sensor_mm=...) or "
-              "physcam.lens.library.load_lens(name or file)")
-
-
-def _state(lens, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_height_mm=None,
-           aperture=None) -> CameraState:
-    """The camera state the shader bakes (one place for :func:`bake_camera`, :func:`write_blender_camera`
-    and :func:`physcam.export.blender_compare.compare_bokeh`): ``lens`` as it is when it is a
-    :class:`~physcam.optics.state.CameraState` (with a sensor; the keywords then stay None but
-    ``aperture``, which replaces its iris shape), else the Prescription focused at ``focus_mm`` (mm in
-    front of the film plane; ``math.inf`` for infinity), stopped to ``fstop`` (None: as its file
-    stops it) on the ``sensor_width_mm`` x ``sensor_height_mm`` sensor by
-    :func:`physcam.optics.state.camera_state`. ``aperture`` as in :func:`osl_camera_shader`."""
-    if isinstance(lens, CameraState):
-        given = [k for k, v in (("focus_mm", focus_mm), ("fstop", fstop), ("sensor_width_mm", sensor_width_mm),
-                                ("sensor_height_mm", sensor_height_mm)) if v is not None]
-        if given:
-            raise InputError(f"a CameraState carries its own focus, f-stop and sensor: give {', '.join(given)} to "
-                             "camera_state(), not here")
-        if lens.sensor_mm is None:
-            raise InputError("the Blender camera needs a sensor: camera_state(lens, ..., sensor_mm=(width, height))")
-        ap = _aperture(lens.aperture if aperture is None else aperture)
-        return lens if ap is lens.aperture else dataclasses.replace(lens, aperture=ap)
-    require_prescription(lens)
-    ap = _aperture(aperture)
-    sw = require_positive("sensor width", sensor_width_mm)
-    sh = require_positive("sensor height", sensor_height_mm)  # (its size bounds: camera_state's)
-    if isinstance(focus_mm, bool) or not isinstance(focus_mm, (int, float, np.floating, np.integer)):
-        raise InputError(f"focus distance must be a number of mm, got {focus_mm!r}")
-    f = float(focus_mm)
-    if not (f > 0):
-        raise InputError(f"focus distance must be > 0 mm, got {f:g}")
-    return camera_state(lens, focus_mm=f, fstop=fstop, sensor_mm=(sw, sh), aperture=ap)
+def _state(camera: CameraState, aperture=None) -> CameraState:
+    """The camera the shader bakes (one place for :func:`bake_camera`, :func:`write_blender_camera` and
+    :func:`physcam.export.blender_compare.compare_bokeh`): it needs a sensor; ``aperture`` (as in
+    :func:`osl_camera_shader`) replaces its iris shape."""
+    if camera.sensor_mm is None:
+        raise InputError("the Blender camera needs a sensor: camera_state(lens, ..., sensor_mm=(width, height))")
+    ap = _aperture(camera.aperture if aperture is None else aperture)
+    return camera if ap is camera.aperture else camera.with_aperture(ap)
 
 
 def _fstop_label(state: CameraState) -> float | None:
@@ -126,16 +110,13 @@ def _fstop_label(state: CameraState) -> float | None:
 
 
 @takes_camera
-def bake_camera(lens: CameraState | Prescription, *, focus_mm=None, fstop=None, sensor_width_mm=None,
-                sensor_height_mm=None, aperture=None, fresnel: bool = False) -> BakedCamera:
-    """Tabulate what the OSL camera needs for ``lens``: a :class:`~physcam.optics.state.CameraState`
-    with a sensor, or a Prescription with ``focus_mm``, ``fstop`` and the sensor (see
-    :func:`osl_camera_shader`; physcam's focus, :func:`physcam.optics.focusing.focus`: internal
-    focusing when the lens has focus groups, else unit focusing). Raises :class:`~physcam.errors.OpticsError` for a focus closer than
-    the lens reaches or an f-number faster than it opens."""
-    state = _state(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=sensor_width_mm,
-                   sensor_height_mm=sensor_height_mm, aperture=aperture)
-    return _bake(state, fresnel)
+def bake_camera(camera: CameraState, *, aperture=None, fresnel: bool = False) -> BakedCamera:
+    """Tabulate what the OSL camera needs for ``camera``: a :class:`~physcam.optics.state.CameraState`
+    with a sensor (see :func:`osl_camera_shader`; physcam's focus, :func:`physcam.optics.focusing.focus`:
+    internal focusing when the lens has focus groups, else unit focusing). Raises
+    :class:`~physcam.errors.OpticsError` for a focus closer than the lens reaches or an f-number faster
+    than it opens."""
+    return _bake(_state(camera, aperture), fresnel)
 
 
 def iris_corner_semi(state: CameraState) -> float:
@@ -145,13 +126,12 @@ def iris_corner_semi(state: CameraState) -> float:
     never beyond the lens's widest iris (the file's stop opened by physcam's stop-opening tolerance)."""
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
 
-    require_type("state", state, CameraState, _LENS_HINT)
+    require_type("state", state, CameraState, "physcam.optics.state.camera_state(lens, focus_mm=..., fstop=..., sensor=...)")
     ap = state.aperture
     if ap is None or ap.is_circular:
         return float(state.stop_semi_diameter)
     q = state.focused
-    widest = q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE)
-    return float(min(state.stop_semi_diameter * ap.equal_area_scale(), max(widest, state.stop_semi_diameter)))
+    return ap.corner_semi(state.stop_semi_diameter, q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE))
 
 
 def _bake(state: CameraState, fresnel: bool) -> BakedCamera:
@@ -182,8 +162,7 @@ def _bake(state: CameraState, fresnel: bool) -> BakedCamera:
         from ..errors import OpticsError
 
         raise OpticsError(f"no ray from the film centre passes through {state.lens_name!r} at this focus and stop")
-    return BakedCamera(q, film_z, table, bounds, state.aperture, norm, sw, sh, state.focus_from_film_mm,
-                       _fstop_label(state), float(state.lens.wavelength_nm))
+    return BakedCamera(q, film_z, table, bounds, state.aperture, norm, sw, sh, state, float(state.lens.wavelength_nm))
 
 
 _num = osl_number
@@ -196,14 +175,10 @@ def _ident(name: str) -> str:
 
 
 @takes_camera
-def osl_camera_shader(lens: CameraState | Prescription, *, focus_mm=None, fstop=None, sensor_width_mm=None, sensor_height_mm=None,
-                      aperture=None, dispersion: bool = False, fresnel: bool = False) -> str:
-    """OSL source of a Cycles camera shader that traces real rays through ``lens``: a
-    :class:`~physcam.optics.state.CameraState` with a sensor (then leave ``focus_mm``, ``fstop`` and
-    the sensor out), or a Prescription focused at ``focus_mm`` (mm in front of the film plane;
-    ``math.inf`` for infinity), stopped to ``fstop`` (None: as its file stops it) on the
-    ``sensor_width_mm`` x ``sensor_height_mm`` sensor, through
-    :func:`physcam.optics.state.camera_state`. Both give the same text.
+def osl_camera_shader(camera: CameraState, *, aperture=None, dispersion: bool = False, fresnel: bool = False) -> str:
+    """OSL source of a Cycles camera shader that traces real rays through ``camera``: a
+    :class:`~physcam.optics.state.CameraState` with a sensor (the lens focused at its mark, mm in front
+    of the film plane, stopped to its f-stop or as its file stops it).
 
     ``aperture``: an :class:`~physcam.trace.aperture.Aperture` (blades, angle, roundness, density),
     a number of blades, or a tuple/dict of its fields; ``None`` the round stop (or the state's).
@@ -214,8 +189,7 @@ def osl_camera_shader(lens: CameraState | Prescription, *, focus_mm=None, fstop=
     with this lens's data block (:mod:`physcam.export.osl`). See the module docstring for the conventions.
     """
     _check_switches(dispersion, fresnel)
-    b = bake_camera(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=sensor_width_mm,
-                    sensor_height_mm=sensor_height_mm, aperture=aperture, fresnel=fresnel)
+    b = bake_camera(camera, aperture=aperture, fresnel=fresnel)
     return _emit(b, dispersion=dispersion, fresnel=fresnel)
 
 
@@ -355,26 +329,42 @@ def blender_setup_script(shader, *, sensor_width_mm, sensor_height_mm, resolutio
                          path=path, source=source)
 
 
-def write_blender_camera(out_dir, lens: CameraState | Prescription, *, focus_mm=None, fstop=None, sensor_width_mm=None,
-                         sensor_height_mm=None, aperture=None, dispersion: bool = False, fresnel: bool = False,
-                         resolution=None, name: str | None = None, force: bool = False) -> tuple[Path, Path]:
-    """Write ``<name>.osl`` (:func:`osl_camera_shader` of ``lens``: a CameraState or a Prescription
-    with its focus, f-stop and sensor) and ``setup_<name>.py`` (:func:`blender_setup_script`, with
-    the shader embedded) into ``out_dir`` through :func:`physcam.io.atomic_write` (no overwrite
-    without ``force``). ``name`` defaults to the lens name made an identifier. Returns the two paths."""
+def _camera_first(fn):
+    """``write_blender_camera(out_dir, camera, ...)``, the pre-issue-43 order, still works (DeprecationWarning)."""
+    import functools
+
+    @functools.wraps(fn)
+    def reordered(*args, **kwargs):
+        if len(args) >= 2 and isinstance(args[0], (str, Path)) and not isinstance(args[1], (str, Path)):
+            import warnings
+
+            warnings.warn("write_blender_camera(out_dir, camera, ...) is now write_blender_camera(camera, out_dir, "
+                          "...); the old order goes in physcam 0.3", DeprecationWarning, stacklevel=2)
+            args = (args[1], args[0], *args[2:])
+        return fn(*args, **kwargs)
+
+    return reordered
+
+
+@_camera_first
+@takes_camera
+def write_blender_camera(camera: CameraState, out_dir, *, aperture=None, dispersion: bool = False,
+                         fresnel: bool = False, resolution=None, name: str | None = None,
+                         force: bool = False) -> tuple[Path, Path]:
+    """Write ``<name>.osl`` (:func:`osl_camera_shader` of ``camera``, a CameraState with a sensor) and
+    ``setup_<name>.py`` (:func:`blender_setup_script`, with the shader embedded) into ``out_dir`` through
+    :func:`physcam.io.atomic_write` (no overwrite without ``force``). ``name`` defaults to the lens name
+    made an identifier. Returns the two paths."""
     from ..io import atomic_write, check_writable
 
-    require_type("lens", lens, (CameraState, Prescription), _LENS_HINT)
-    lens_name = lens.lens_name if isinstance(lens, CameraState) else lens.name
-    stem = _ident(name if name is not None else lens_name)
+    stem = _ident(name if name is not None else camera.lens_name)
     out = Path(out_dir)
     osl_path = out / f"{stem}.osl"
     setup_path = out / f"setup_{stem}.py"
     check_writable(osl_path, force=force)
     check_writable(setup_path, force=force)
     _check_switches(dispersion, fresnel)
-    state = _state(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=sensor_width_mm,
-                   sensor_height_mm=sensor_height_mm, aperture=aperture)
+    state = _state(camera, aperture)
     src = _emit(_bake(state, fresnel), dispersion=dispersion, fresnel=fresnel)
     sw, sh = state.sensor_mm
     setup = blender_setup_script(src, sensor_width_mm=sw, sensor_height_mm=sh, resolution=resolution,

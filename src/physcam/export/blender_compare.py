@@ -3,8 +3,8 @@
 ``physcam compare blender LENS`` renders one small emissive sphere at a known distance through
 the generated OSL camera in Blender (a crop of the film centre, the shader made for that crop) and
 traces the same light through the same focused, stopped-down prescription with physcam's numba
-tracer (:func:`physcam.analysis.bokeh.bokeh_image`), binned on the render's pixel grid. Both
-images are measured the same way (:mod:`physcam.analysis.blob`): centroid, equivalent diameter
+tracer (:func:`physcam.analysis.defocus.bokeh.bokeh_image`), binned on the render's pixel grid. Both
+images are measured the same way (:mod:`physcam.analysis.defocus.blob`): centroid, equivalent diameter
 (the sphere's own image removed in quadrature) and iris corners. Blender is found by
 :func:`physcam.export.blender_runner.find_blender` (``--blender-python``, ``PHYSCAM_BLENDER_PYTHON``,
 the user config, ``blender`` on PATH, a checkout's ``.venv-blender``), and the result says which.
@@ -21,7 +21,6 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_positive
-from ..lens.prescription import Prescription
 from ..optics.state import CameraState, takes_camera
 from .blender_runner import SCRIPT_ARGS, find_blender
 
@@ -68,22 +67,19 @@ print(json.dumps({"ok": True}))
 
 
 @takes_camera
-def compare_bokeh(lens: CameraState | Prescription, *, focus_mm: float | None = None, fstop: float | None = None, light_mm: float,
-                  aperture=None, crop_mm: float = 3.0, pixels: int = 128, samples: int = 512, rays: int = 2_000_000,
+def compare_bokeh(camera: CameraState, *, light_mm: float, aperture=None, crop_mm: float = 3.0, pixels: int = 128, samples: int = 512, rays: int = 2_000_000,
                   sphere_mm: float = 1.0, blender_python: str | None = None, timeout_s: float = 600.0,
                   config_blender: str | None = None) -> dict:
-    """Render and trace a point light ``light_mm`` in front of the film with ``lens``: a
-    :class:`~physcam.optics.state.CameraState` (its focus, iris and iris shape; its sensor is replaced
-    by the ``crop_mm`` square), or a Prescription focused at ``focus_mm`` and stopped to ``fstop``;
-    return both images and the measured agreement."""
-    from ..analysis.blob import blob_moments, equivalent_diameter, polygon_corners
-    from ..analysis.bokeh import bokeh_image
+    """Render and trace a point light ``light_mm`` in front of the film with ``camera``: a
+    :class:`~physcam.optics.state.CameraState` (its focus, iris set to an f-stop, and iris shape, which
+    ``aperture`` replaces; its sensor is replaced by the ``crop_mm`` square); return both images and the
+    measured agreement."""
+    from ..analysis.defocus.blob import blob_moments, equivalent_diameter, polygon_corners
+    from ..analysis.defocus.bokeh import bokeh_image
     from .blender import _state, blender_setup_script, iris_corner_semi, osl_camera_shader
 
-    if isinstance(lens, CameraState) and (focus_mm is not None or fstop is not None):
-        raise InputError("a CameraState carries its own focus and f-stop: give them to camera_state(), not here")
-    if not isinstance(lens, CameraState) and fstop is None:
-        raise InputError("the comparison needs an f-stop (fstop=N)")
+    if not camera.iris_set:
+        raise InputError("the comparison needs an f-stop: camera_state(lens, focus_mm=..., fstop=N)")
     crop = require_positive("crop", crop_mm)
     if isinstance(pixels, bool) or not isinstance(pixels, int) or not 32 <= pixels <= 1024:
         raise InputError(f"pixels must be a whole number from 32 to 1024, got {pixels!r}")
@@ -92,12 +88,10 @@ def compare_bokeh(lens: CameraState | Prescription, *, focus_mm: float | None = 
     d_light = require_positive("light distance", light_mm)
     sphere = require_positive("sphere diameter", sphere_mm)
     runner = find_blender(blender_python, config_value=config_blender)
-    if isinstance(lens, CameraState):  # the crop is the frame
-        state = _state(dataclasses.replace(lens, sensor_mm=(crop, crop)), focus_mm=focus_mm, fstop=fstop,
-                       aperture=aperture)
-    else:
-        state = _state(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=crop, sensor_height_mm=crop,
-                       aperture=aperture)
+    from ..optics.sensors import Sensor
+
+    square = Sensor("custom", f"custom {crop:g} x {crop:g} mm", crop, crop)  # the crop is the frame
+    state = _state(dataclasses.replace(camera, sensor=square), aperture)
     aperture = state.aperture
     src = osl_camera_shader(state)
     with tempfile.TemporaryDirectory(prefix="physcam-compare-") as tmp:
@@ -114,9 +108,10 @@ def compare_bokeh(lens: CameraState | Prescription, *, focus_mm: float | None = 
             raise OpticsError(f"Blender could not render the comparison: {tail[0][:200]}")
         rendered = np.load(job["npy"])
     h = crop / 2
-    kw = dict(film_z=state.film_z, fresnel=False, stop_semi_diameter=iris_corner_semi(state), aperture=aperture)
-    traced = bokeh_image(state.focused, d_light, rays=rays, pixels=pixels, extent_mm=(-h, h, -h, h), **kw)
-    off = bokeh_image(state.focused, d_light, 10.0, rays=200_000, pixels=64, **kw)  # the magnification there
+    # the iris's corners reach iris_corner_semi in the shader: the tracer's iris the same (main's issue 41)
+    traced_cam = dataclasses.replace(state, stop_semi_diameter=iris_corner_semi(state))
+    traced = bokeh_image(traced_cam, d_light, rays=rays, pixels=pixels, extent_mm=(-h, h, -h, h), fresnel=False)
+    off = bokeh_image(traced_cam, d_light, 10.0, rays=200_000, pixels=64, fresnel=False)  # the magnification there
     mag = abs(off.to_dict()["centroid_mm"][0]) / 10.0
     pitch = crop / pixels
     image = traced.image[..., 0]

@@ -51,24 +51,25 @@ license = ["SPDX:Apache-2.0"]
 def _report_rows(lens, marks_mm) -> list[dict]:
     """The on-set numbers the panel shows, per focus state: only the report's solvers it needs (the
     lens at the mark and its pinhole; no real-ray field of view, which the panel does not show)."""
-    from ..onset.request import ReportRequest
-    from ..onset.sensors import custom_sensor
-    from ..onset.solvers import field_of_view, lens_at_mark
+    from ..onset.solvers import field_of_view
     from ..optics.coc import circle_of_confusion
+    from ..optics.lens_model import lens_model_of
+    from ..optics.sensors import custom_sensor
+    from ..optics.state import camera_state
 
-    sensor = custom_sensor(*REPORT_SENSOR_MM)
+    sensor, model = custom_sensor(*REPORT_SENSOR_MM), lens_model_of(lens)
     coc_mm, _ = circle_of_confusion(sensor.width_mm, sensor.height_mm, None)
     rows = []
     for m in marks_mm:
         mark = 1.0e7 if math.isinf(m) else float(m)  # the report's infinity: 10 km
-        req = ReportRequest(sensor=sensor, fstop=REFERENCE_FSTOP, focus_mm=mark, lens=lens)
-        state = lens_at_mark(req)
-        fov = field_of_view(req, state, state.h2_from_film_mm)
-        rows.append({"mark_mm": mark, "efl_mm": state.focal_length_mm, "pinhole_mm": fov["pinhole_focal_length_mm"],
-                     "pinhole_squeeze": fov["pinhole_squeeze"], "pupil_from_film_mm": state.pupil_from_film_mm or 0.0,
-                     "h1_from_film_mm": state.h1_from_film_mm, "coc_mm": coc_mm,
+        camera = camera_state(model, focus_mm=mark, fstop=REFERENCE_FSTOP, sensor=sensor)
+        at = camera.at_mark
+        fov = field_of_view(camera, at.h2_from_film_mm)
+        rows.append({"mark_mm": mark, "efl_mm": at.focal_length_mm, "pinhole_mm": fov["pinhole_focal_length_mm"],
+                     "pinhole_squeeze": fov["pinhole_squeeze"], "pupil_from_film_mm": at.pupil_from_film_mm or 0.0,
+                     "h1_from_film_mm": at.h1_from_film_mm, "coc_mm": coc_mm,
                      # the entrance pupil at this focus times N: EFL / (N x f-number ratio) x N
-                     "pupil_diameter_x_n": state.focal_length_mm / state.n_ratio})
+                     "pupil_diameter_x_n": at.focal_length_mm / at.n_ratio})
     return rows
 
 
@@ -127,14 +128,14 @@ def _focus_object_fits(rows) -> dict:
 
 def _sensor_presets() -> list[dict]:
     """physcam's whole sensor table (``physcam sensors``): the pupil table reaches the largest's corner."""
-    from ..onset.sensors import sensors
+    from ..optics.sensors import sensors
 
     return [{"name": s.name, "width_mm": s.width_mm, "height_mm": s.height_mm} for s in sensors()]
 
 
 def _limits() -> dict:
     """The sensor the add-on accepts at most: the pupil table's reach (physcam's largest sensor)."""
-    from ..onset.sensors import sensors
+    from ..optics.sensors import sensors
     from .blender_pupil import RADIAL_MAX_MM
 
     largest = max(sensors(), key=lambda s: math.hypot(s.width_mm, s.height_mm))

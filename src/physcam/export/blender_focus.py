@@ -230,9 +230,9 @@ def _arr32_once(ft: FocusTable, name, values, size) -> str:
 
 
 def ghost_rows(ft: FocusTable) -> tuple[list[int], list[int]]:
-    """The lens's ghost paths (:func:`physcam.analysis.ghosts.ghost_pairs` order) as the shader's rows
+    """The lens's ghost paths (:func:`physcam.analysis.image_quality.ghosts.ghost_pairs` order) as the shader's rows
     (film side first): path (i, j) reflects first, from the film, at row N-1-j, then at row N-1-i."""
-    from ..analysis.ghosts import ghost_pairs
+    from ..analysis.image_quality.ghosts import ghost_pairs
 
     require_type("ft", ft, FocusTable, "physcam.export.blender_focus.focus_table(lens)")
     n = len(ft.table)

@@ -3,14 +3,14 @@
 Two branches, each a ``Read`` of the map (raw, so no colour transform touches the numbers), a
 ``Read`` of the image and an ``STMap`` (``uv rgb``): *undistort* turns the plate into the
 undistorted, overscanned picture; *redistort* turns a render of that picture back into the plate.
-The maps carry their own frames (:func:`physcam.analysis.stmap.write_stmaps`): the undistorted
+The maps carry their own frames (:func:`physcam.analysis.distortion.stmap.write_stmaps`): the undistorted
 picture's format is the plate's and its bounding box the overscan (EXR display and data windows),
 so the render to redistort is an EXR of that frame too (display window = the plate, data window =
 the overscan, as renderers write overscan).
 In a ``.nk`` file a node with ``inputs 2`` takes its inputs from the node stack, the top of the
 stack as input 0: the image is written last, so it is the STMap's ``src`` (input 0) and the map
 its ``stmap`` input (input 1). No Nuke was run to check the script; the maps themselves are
-checked end to end by :func:`physcam.analysis.stmap.apply_stmap`.
+checked end to end by :func:`physcam.analysis.distortion.stmap.apply_stmap`.
 """
 
 from __future__ import annotations

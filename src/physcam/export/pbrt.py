@@ -40,7 +40,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
 from ..errors import ExportError, InputError, OpticsError, renamed_parameter, require_positive
@@ -255,8 +255,7 @@ class PbrtFocusComparison:
     """
 
     lens: str
-    focus_from_film_mm: float
-    fstop: float
+    camera: CameraState  # physcam's camera at the report's mark and f-stop (.focus_from_film_mm, .fstop)
     coc_mm: float
     film_diagonal_mm: float
     method: str
@@ -279,8 +278,18 @@ class PbrtFocusComparison:
     unit_focus_film_distance_mm: float | None = None
     unit_focus_efl_mm: float | None = None
 
+    @property
+    def focus_from_film_mm(self) -> float:
+        """The focus mark, from the film: the camera's."""
+        return self.camera.focus_from_film_mm
+
+    @property
+    def fstop(self) -> float:
+        return self.camera.fstop
+
     def to_dict(self) -> dict:
-        d = asdict(self)
+        d = {"lens": self.lens, "focus_from_film_mm": self.focus_from_film_mm, "fstop": self.fstop}
+        d.update((f.name, getattr(self, f.name)) for f in fields(self) if f.name not in ("lens", "camera"))
         d["thick_lens"] = self.thick_lens.to_dict()
         d["units"] = "mm; *_from_film_mm in front of the film plane; film distances from the last vertex"
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
@@ -310,21 +319,25 @@ def _dof_from_film(efl, fstop, coc, s, h1):
 
 
 def _state_at_mark(report, lens) -> CameraState:
-    """physcam's ``lens`` at ``report``'s mark and f-stop (its focus and its iris, in one place)."""
+    """physcam's ``lens`` at ``report``'s mark and f-stop (its focus and its iris, in one place): the report's
+    own camera when it is of this lens with its iris set (no focus solved again)."""
+    cam = report.camera
+    if cam.traceable and (lens is cam.lens or lens == cam.lens):
+        return report.stopped_camera()
     return camera_state(lens, focus_mm=report.focus_from_film_mm, fstop=report.fstop)
 
 
 @takes_report
-def pbrt_focus_comparison(report, lens, *, film_diagonal_mm: float | None = None) -> PbrtFocusComparison:
+def pbrt_focus_comparison(report, lens=None, *, film_diagonal_mm: float | None = None) -> PbrtFocusComparison:
     """pbrt-v4's focus of ``lens`` at ``report``'s mark next to physcam's, with the DOF each gives.
 
-    ``report`` is the lens report of ``lens`` (its mark, f-number and CoC); ``film_diagonal_mm``
+    ``report`` is the lens report of ``lens`` (its mark, f-number and CoC; default: its camera's lens); ``film_diagonal_mm``
     (default the sensor's diagonal) sets the height of pbrt's thick-lens rays. The lens pbrt gets is
     physcam's focus of ``lens`` at the mark (gaps and back focus), read back from its ``.dat`` text so
     the numbers are the file's; a lens a ``.dat`` cannot hold (flats) is compared on its exact
     surfaces, with ``writable`` False and the reason.
     """
-    lens = require_prescription(lens)
+    lens = report.camera.lens if lens is None else require_prescription(lens)
     if not math.isfinite(report.focus_from_film_mm):
         raise InputError("pbrt's focusdistance is finite; give a focus mark")
     return _focus_comparison(report, _state_at_mark(report, lens), film_diagonal_mm)
@@ -370,7 +383,7 @@ def _focus_comparison(report, state: CameraState, film_diagonal_mm) -> PbrtFocus
         return None if a is None or b is None or not (math.isfinite(a) and math.isfinite(b)) else a - b
 
     return PbrtFocusComparison(
-        lens=lens.name, focus_from_film_mm=mark, fstop=report.fstop, coc_mm=report.coc_mm, film_diagonal_mm=diag,
+        lens=lens.name, camera=state, coc_mm=report.coc_mm, film_diagonal_mm=diag,
         method=method, physcam_film_distance_mm=back_focus, pbrt_film_distance_mm=tl.film_distance_mm,
         difference_mm=tl.film_distance_mm - back_focus,
         pbrt_focus_from_film_mm=d_pbrt if math.isfinite(d_pbrt) else None,

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 
-from ..analysis.distortion_models import TDE4_MODEL, TDE4_PARAMETERS, TDE4RadialStandard
+from ..analysis.distortion.models import TDE4_MODEL, TDE4_PARAMETERS, TDE4RadialStandard
 from ..errors import InputError
 from ._codetext import printable_line
 
@@ -61,9 +61,9 @@ def tde4_lens_text(fit: TDE4RadialStandard, name: str | None = None, *,
 
 def tde4_anamorphic_lens_text(fit, name: str | None = None, *, lens_center_offset_mm=(0.0, 0.0)) -> str:
     """The 3DE4 lens file of a fitted "3DE4 Anamorphic - Standard, Degree 4/6"
-    (:func:`physcam.analysis.anamorphic_distortion.fit_tde4_anamorphic`): the desqueezed filmback, the Y
+    (:func:`physcam.analysis.distortion.anamorphic.fit_tde4_anamorphic`): the desqueezed filmback, the Y
     pinhole as focal length and f_y / f_x as pixel aspect; Lens Rotation 0, Squeeze-X and -Y 1."""
-    from ..analysis.anamorphic_distortion import TDE4Anamorphic, tde4_anamorphic_parameter_names
+    from ..analysis.distortion.anamorphic import TDE4Anamorphic, tde4_anamorphic_parameter_names
 
     if not isinstance(fit, TDE4Anamorphic):
         raise InputError(f"tde4_anamorphic_lens_text takes a TDE4Anamorphic fit, got {type(fit).__name__}")

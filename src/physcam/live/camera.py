@@ -76,9 +76,9 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
     lens shift (+ right, + up); ``drop_frame``: drop-frame timecode (29.97, 59.94); a zoom lens's
     ``zoom`` (a focal length ``"135mm"`` or encoder value, :func:`physcam.optics.zoom.zoom_encoder`;
     default its first tabulated position) zoomed linearly in the encoder to ``zoom_to`` (module notes)."""
-    from ..onset.sensors import Sensor
+    from ..optics.sensors import Sensor
 
-    require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
+    require_type("sensor", sensor, Sensor, "physcam.optics.sensors.find_sensor(name)")
     if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= MAX_TAKE_FRAMES:
         raise InputError(f"frames must be a whole number 1..{MAX_TAKE_FRAMES}, got {shown(frames)}")
     fr = rate_fraction(rate)
@@ -168,10 +168,10 @@ def focal_range(lens) -> tuple[float, float]:
 
 def _optics_at(sensor, mark, lens, focal_length_mm, fstop, tstop, distortion):
     """(lens report, OpenTrackIO distortion or None) of the lens (or thin lens) focused at ``mark``."""
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
 
-    rep = solve_report(ReportRequest(focal_length_mm=focal_length_mm, sensor=sensor, fstop=fstop, focus_mm=mark,
-                                     tstop=tstop, lens=lens))
+    rep = solve_report(report_camera(focal_length_mm=focal_length_mm, sensor=sensor, fstop=fstop, focus_mm=mark,
+                        tstop=tstop, lens=lens))
     dist = None
     if lens is not None and distortion:
         from .lens_data import distortion_for_sample
@@ -194,7 +194,7 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
     ``"135mm"`` or an encoder value, :func:`physcam.optics.zoom.zoom_encoder`; None: its first
     tabulated position), sent as ``lens.encoders.zoom`` with the focal length range in ``custom``
     beside ``static`` (module notes)."""
-    from ..onset.sensors import custom_sensor
+    from ..optics.sensors import custom_sensor
 
     if (lens is None) == (focal_length_mm is None):
         raise InputError("give either a lens prescription or a focal length")

@@ -2,12 +2,12 @@
 
 OpenTrackIO's ``lens.distortion[]`` follows the OpenLensIO lens model: millimetres on the sensor,
 y down, six radial terms in OpenLensIO's order, which camdkit's conversion note and Unreal's Live
-Link OpenTrackIO receiver both read the same way; :mod:`physcam.analysis.openlensio` converts
+Link OpenTrackIO receiver both read the same way; :mod:`physcam.analysis.distortion.openlensio` converts
 (its module notes give the units, the order and the direction).
 
 The coefficients come from ONE function, :func:`distortion_for_sample`: the Brown-Conrady U-D model
 fitted over the whole frame to the lens's real chief rays at the frame's focus
-(:func:`physcam.analysis.distortion_models.fit_brown_conrady`, docs/distortion.md), converted by
+(:func:`physcam.analysis.distortion.models.fit_brown_conrady`, docs/distortion.md), converted by
 its ``opentrackio()``, the entry ``physcam distortion`` writes (y down turns the sign of p1).
 
 Focus distance: OpenTrackIO 1.0.1 defines ``lens.focusDistance`` only as "focus distance/position of
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 
-from ..analysis.openlensio import DISTORTION_MODEL, RADIAL_TERMS, opencv_to_opentrackio, opentrackio_to_opencv
+from ..analysis.distortion.openlensio import DISTORTION_MODEL, RADIAL_TERMS, opencv_to_opentrackio, opentrackio_to_opencv
 from ..errors import InputError, renamed_parameter, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
@@ -58,8 +58,8 @@ def distortion_for_sample(lens: Prescription, sensor_width_mm, sensor_height_mm,
     rays over the frame, in millimetres. ``image_size`` (W, H pixels; H None from the sensor's
     aspect) sets the fit's pixel weighting and the density of traced rays.
     """
-    from ..analysis.distortion_models import fit_brown_conrady, samples_from_field
-    from ..analysis.stmap import MAX_SIDE_PX, distortion_field
+    from ..analysis.distortion.models import fit_brown_conrady, samples_from_field
+    from ..analysis.distortion.stmap import MAX_SIDE_PX, distortion_field
 
     w = require_positive("sensor width", sensor_width_mm)
     h = require_positive("sensor height", sensor_height_mm)
@@ -69,8 +69,9 @@ def distortion_for_sample(lens: Prescription, sensor_width_mm, sensor_height_mm,
         raise InputError("image_size is (width, height) in pixels; height may be None")
     W = image_size[0]
     H = image_size[1] if image_size[1] is not None else max(16, min(MAX_SIDE_PX, round(W * h / w)))
-    field = distortion_field(lens, focus_mm=focus, sensor_width_mm=w, sensor_height_mm=h, width_px=W, height_px=H,
-                             maps=False)
+    from ..optics.state import camera_state
+
+    field = distortion_field(camera_state(lens, focus_mm=focus, sensor_mm=(w, h)), width_px=W, height_px=H, maps=False)
     fit = fit_brown_conrady(samples_from_field(field), "U-D", max_residual_px=math.inf)
     c = fit.coefficients
     f = float(c["fy_mm"])  # the Y pinhole: an anamorphic's F / squeeze is its X focal length

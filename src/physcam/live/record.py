@@ -246,7 +246,7 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
 
     Values a frame does not carry come from the latest earlier frame **of the same source** (its
     ``sourceId`` and ``sourceNumber``), else from these defaults: ``sensor`` (a
-    :class:`~physcam.onset.sensors.Sensor`) when the stream's static data gives no sensor size,
+    :class:`~physcam.optics.sensors.Sensor`) when the stream's static data gives no sensor size,
     ``focal_length_mm`` (pinhole), ``fstop``, ``focus_mm`` (from the film plane); each
     :class:`SolvedFrame` names them (``carried``, ``defaulted``). Each source keeps its own time line
     (:func:`time_line`): a frame off it (a time code that goes back, or one far ahead that the
@@ -266,11 +266,11 @@ def solve_frames(frames, *, sensor=None, rate=None, focal_length_mm=None, fstop=
     never gave) raises, unless ``refused`` is a list: then it is left out, ``(index, reason)`` is
     appended there, and its values are not carried over to later frames.
     """
-    from ..onset.sensors import Sensor, custom_sensor
+    from ..optics.sensors import Sensor, custom_sensor
 
     frames = _frames(frames)
     if sensor is not None:
-        require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
+        require_type("sensor", sensor, Sensor, "physcam.optics.sensors.find_sensor(name)")
     if refused is not None and not isinstance(refused, list):
         raise InputError(f"refused must be a list to append the refused frames to, got {type(refused).__name__}")
     codes, _ = time_codes(frames, rate)
@@ -363,7 +363,7 @@ def _from_encoders(f, fiz, sent) -> dict:
 def _solve_one(f, last, sensor, sensors, coc, custom_sensor, lens=None):
     """The lens report of frame ``f`` with the values ``last`` (its own, carried over or defaults);
     with ``lens`` and no streamed pinhole, the prescription's at the frame's focus."""
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
 
     need_pinhole = lens is None or last["pinhole"] is not None
     missing = [n for n, k in (("a pinhole focal length (pinholeFocalLength, --focal, --lens)", "pinhole"),
@@ -385,15 +385,15 @@ def _solve_one(f, last, sensor, sensors, coc, custom_sensor, lens=None):
         tstop = None  # a T-stop faster than the f-stop is not physical; the report would refuse it
     if last["pinhole"] is None:  # the named lens at this focus: its breathing, pupil and squeeze
         lens = _at_zoom_encoder(lens, f.encoders)
-        return solve_report(ReportRequest(focal_length_mm=None, sensor=sensors[key], fstop=float(last["fstop"]),
-                                 focus_mm=float(last["focus"]), coc=coc, tstop=tstop, lens=lens))
+        return solve_report(report_camera(focal_length_mm=None, sensor=sensors[key], fstop=float(last["fstop"]),
+                                          focus_mm=float(last["focus"]), coc=coc, tstop=tstop, lens=lens))
     pin = float(last["pinhole"])
     sq = 1.0 if last["squeeze"] is None else float(last["squeeze"])
     f_dof = float(last["nominal"]) if last["nominal"] is not None else pin
-    return solve_report(ReportRequest(focal_length_mm=f_dof, sensor=sensors[key], fstop=float(last["fstop"]),
-                             focus_mm=float(last["focus"]), coc=coc, tstop=tstop,
-                             pupil_mm=None if last["pupil"] is None else float(last["pupil"]),
-                             pinhole_focal_length_mm=pin, squeeze=sq, pinhole_squeeze=sq))
+    return solve_report(report_camera(focal_length_mm=f_dof, sensor=sensors[key], fstop=float(last["fstop"]),
+                         focus_mm=float(last["focus"]), coc=coc, tstop=tstop,
+                         pupil_mm=None if last["pupil"] is None else float(last["pupil"]),
+                         pinhole_focal_length_mm=pin, squeeze=sq, pinhole_squeeze=sq))
 
 
 def _at_zoom_encoder(lens, encoders):

@@ -78,13 +78,13 @@ def tracked_frames(record, *, rate=None) -> list:
 
 
 def _sensor_of(record, sensor):
-    from ..onset.sensors import Sensor, custom_sensor
+    from ..optics.sensors import Sensor, custom_sensor
 
     if record.active_area_mm is not None:
         return custom_sensor(*record.active_area_mm)
     if sensor is None:
         raise InputError(f"the {record.source} file gives no sensor size; give the sensor (--sensor)")
-    return require_type("sensor", sensor, Sensor, "physcam.onset.sensors.find_sensor(name)")
+    return require_type("sensor", sensor, Sensor, "physcam.optics.sensors.find_sensor(name)")
 
 
 def solve(record, *, sensor=None, lens=None, coc=None, focal_length_mm=None, fstop=None, rate=None) -> list:
@@ -119,7 +119,7 @@ def _warn_once(caught) -> None:
 
 
 def _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze):
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
 
     from ..live.record import SolvedFrame
 
@@ -138,7 +138,7 @@ def _solve_frames(record, frames, s, lens, coc, focal_length_mm, fstop, squeeze)
         key = (f.focus_mm, n, tstop, focal, f.entrance_pupil_mm)
         if key not in cache:
             try:
-                cache[key] = solve_report(ReportRequest(
+                cache[key] = solve_report(report_camera(
                     focal_length_mm=focal, sensor=s, fstop=n, focus_mm=f.focus_mm, coc=coc, tstop=tstop,
                     squeeze=squeeze, lens=lens,
                     pupil_mm=None if lens is not None else f.entrance_pupil_mm))

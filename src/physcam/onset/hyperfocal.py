@@ -7,7 +7,8 @@ near limit H / 2 from H1; the CoC by the sensor and convention, as in every repo
 
 from __future__ import annotations
 
-from .report import HYPERFOCAL, ReportRequest, solve_report
+from .report import HYPERFOCAL, solve_report
+from .request import report_camera
 
 __all__ = ["hyperfocal_table"]
 
@@ -19,7 +20,7 @@ def hyperfocal_table(focal_lengths_mm, fstops, *, sensor, coc=None) -> list[dict
     for f in focal_lengths_mm:
         marks, rep = {}, None
         for n in fstops:
-            rep = solve_report(ReportRequest(sensor=sensor, focal_length_mm=f, fstop=n, focus_mm=HYPERFOCAL, coc=coc))
+            rep = solve_report(report_camera(sensor=sensor, focal_length_mm=f, fstop=n, focus_mm=HYPERFOCAL, coc=coc))
             marks[n] = (rep.focus_from_film_mm, rep.dof.near_from_film_mm)
         rows.append({"focal_length_mm": f, "coc_mm": rep.coc_mm, "coc_convention": rep.coc_convention, "marks": marks})
     return rows

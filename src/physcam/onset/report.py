@@ -33,18 +33,20 @@ import math
 import dataclasses
 from dataclasses import dataclass, field
 
-from ..errors import OpticsError, require_positive
+from ..errors import InputError, OpticsError, require_positive, require_type
 from ..optics import _num
 from ..optics import dof as _dof
-from ..optics.coc import circle_of_confusion
+from ..optics.coc import named_circle_of_confusion
+from ..optics.sensors import Sensor
+from ..optics.state import CameraState
 from .pupil import pivot_camera_space
 from .request import (DIFFRACTION_WAVELENGTH_NM, HYPERFOCAL, MAX_DISTANCE_MM, MAX_F_NUMBER, MIN_F_NUMBER,
-                      ReportRequest)
-from .sensors import Sensor
+                      MeasuredLimits, References, ReportInputs, ReportRequest, report_camera)
 from .solvers import (DepthOfField, depth_of_field, entrance_pupil, field_of_view, finite_or_none, focus_error,
                       invert_limits, lens_at_mark, principal_planes, solve_focus)
 
 __all__ = ["LensReport", "DepthOfField", "ReportRequest", "solve_report", "solve_lens_report", "takes_report",
+           "report_camera", "MeasuredLimits", "References",
            "REPORT_SCHEMA", "REPORT_VERSION", "HYPERFOCAL", "DIFFRACTION_WAVELENGTH_NM", "MIN_F_NUMBER",
            "MAX_F_NUMBER", "MAX_DISTANCE_MM", "airy_diameter_mm", "fstop_airy_equals"]
 
@@ -90,14 +92,12 @@ class LensReport:
     name says otherwise; ``object_distance_mm`` is from H1, ``image_distance_mm`` from H2.
     """
 
+    camera: CameraState  # the camera this report is a view of: lens, focus, f-stop, sensor
     model: str
     focal_length_mm: float
-    fstop: float
-    sensor: Sensor
     squeeze: float
     coc_mm: float
     coc_convention: str
-    focus_from_film_mm: float
     object_distance_mm: float
     image_distance_mm: float
     h1_from_film_mm: float
@@ -117,17 +117,17 @@ class LensReport:
     solved: dict = field(default_factory=dict)
     measured: dict = field(default_factory=dict)
     notes: tuple[str, ...] = ()
-    lens_name: str | None = None
     reference_plane: str = "film"
     flange_focal_distance_mm: float | None = None
-    tstop: float | None = None
+    #: figures from elsewhere the report compared or took (the marked T-stop, the diffraction wavelength ...)
+    references: References = field(default_factory=References)
     #: the best-match pinhole: a pinhole at the entrance pupil with this focal length (and the
     #: horizontal aperture widened by ``pinhole_squeeze``) frames like the lens at this focus.
     #: None means the thin-lens value, the distance from H2 to the film.
     pinhole_focal_length_mm: float | None = None
     pinhole_squeeze: float | None = None
     #: with a prescription: the field of view of real chief rays from the film edge, top and corner
-    #: (:func:`physcam.analysis.field_of_view.real_field_of_view`, as its ``to_dict``), beside the
+    #: (:func:`physcam.analysis.framing.field_of_view.real_field_of_view`, as its ``to_dict``), beside the
     #: paraxial pinhole's; None for the thin-lens and datasheet models.
     real_fov: dict | None = None
     #: the physical aperture stop (iris) in front of the film: a prescription's stop surface; the
@@ -137,8 +137,6 @@ class LensReport:
     #: pupil's X over Y diameter (object-space blur angles scale with it); 1 for a spherical lens,
     #: 1 / squeeze for a thin lens given a squeeze (a front anamorphic's cylinders narrow the pupil in X)
     dof_aspect: float = 1.0
-    #: wavelength (nm) of the diffraction figures
-    diffraction_wavelength_nm: float = DIFFRACTION_WAVELENGTH_NM
     #: working over geometric f-number at this focus: a prescription's paraxial ratio; None: 1 + m
     #: (pupils taken as equal)
     bellows_factor: float | None = None
@@ -149,6 +147,47 @@ class LensReport:
     #: parallax-free pivot of a pan; ``entrance_pupil_from_film_mm`` is then the vertical (Y) one, the
     #: pivot of a tilt (physcam.optics.focusing.EntrancePupils). None: one pupil for both
     entrance_pupil_horizontal_from_film_mm: float | None = None
+
+    # --- the camera's own settings, read from it ----------------------------------
+    @property
+    def fstop(self) -> float:
+        """The iris's setting (at infinity focus): the camera's."""
+        return self.camera.fstop
+
+    @property
+    def focus_from_film_mm(self) -> float:
+        """The focus mark in front of the film plane: the camera's (inf at infinity)."""
+        return self.camera.focus_from_film_mm
+
+    @property
+    def sensor(self) -> Sensor:
+        return self.camera.sensor
+
+    @property
+    def lens_name(self) -> str | None:
+        return self.camera.lens_name
+
+    @property
+    def tstop(self) -> float | None:
+        """The marked T-stop the report compared (its references')."""
+        return self.references.tstop
+
+    @property
+    def diffraction_wavelength_nm(self) -> float:
+        """Wavelength (nm) of the diffraction figures."""
+        return self.references.diffraction_wavelength_nm
+
+    def stopped_camera(self) -> CameraState:
+        """The report's camera with its iris set to the report's f-stop (what a tracer traces): the camera
+        itself, or, for an f-stop solved from measured limits, the lens at that stop (an OpticsError
+        when the lens cannot open to it)."""
+        cam = self.camera
+        if cam.iris_set or not cam.traceable:
+            return cam
+        from ..optics.state import camera_state
+
+        return camera_state(cam.lens_model, focus_mm=cam.focus_from_film_mm, fstop=cam.fstop, sensor=cam.sensor,
+                            squeeze=cam.squeeze, zoom=cam.zoom)
 
     # --- convenience --------------------------------------------------------
     @property
@@ -353,87 +392,101 @@ def _frame_dict(report) -> dict | None:
 
 
 # --------------------------------------------------------------------------------------
-def solve_report(request: ReportRequest) -> LensReport:
-    """Solve the lens report for a :class:`ReportRequest` (checked when it was made): a composition of
-    the solvers of :mod:`physcam.onset.solvers`, in the order the optics needs them.
+def solve_report(camera, *, coc=None, measured: MeasuredLimits | None = None,
+                 references: References | None = None) -> LensReport:
+    """The lens report of ``camera`` (:class:`~physcam.optics.state.CameraState`: a lens model focused
+    and stopped on a sensor): a view of the camera, composed of the solvers of
+    :mod:`physcam.onset.solvers` in the order the optics needs them.
 
-    Solving rules: with a near and/or far limit measured, the report solves the focus (when none is
-    given), then the effective f-stop (when none is given, or when both an f-stop and a CoC are) or
-    else the CoC. Without measured limits it is a forward report and needs an f-stop (a prescription
-    defaults to wide open). The f-stop is the iris's setting, defined at infinity focus
-    (:func:`physcam.optics.focusing.iris_semi_diameter`); depth of field uses the f-number at the
-    focus (:attr:`LensReport.f_number_at_focus`).
+    ``coc``: the circle of confusion, a convention ("d/1500", "cine" ...) or mm (None: d/1500).
+    ``measured``: near/far limits measured on a plate (:class:`~physcam.onset.request.MeasuredLimits`):
+    the report solves the CoC from them (the camera's f-stop kept), or, when the camera's f-stop or
+    focus was solved from them (:mod:`physcam.onset.inverse`), checks them against it.
+    ``references``: figures from elsewhere (:class:`~physcam.onset.request.References`: the marked
+    T-stop, a tape-measured pupil, a USD file's pinhole). The f-stop is the iris's setting, defined at
+    infinity focus (:func:`physcam.optics.focusing.iris_semi_diameter`); depth of field uses the
+    f-number at the focus (:attr:`LensReport.f_number_at_focus`). A :class:`ReportRequest` first (the
+    pre-issue-43 form) or the :class:`~physcam.onset.request.ReportInputs` of
+    :func:`~physcam.onset.request.report_camera` is read as its camera and options.
     """
-    req = request
-    state = lens_at_mark(req)  # a prescription focused at the mark, or the thin lens / datasheet
-    planes = principal_planes(state)
-    w, h = req.sensor.width_mm, req.sensor.height_mm
-    c, coc_name = _named_coc(w, h, req.coc, *circle_of_confusion(w, h, req.coc))
-    focus = solve_focus(req, state, planes, c)
-    ap = invert_limits(req, state, planes, focus, c, coc_name)
-    solved, notes = {**focus.solved, **ap.solved}, [*state.notes, *focus.notes, *ap.notes]
-    if req.tstop is not None:
-        solved["tstop_drift_stops"] = _dof.stops_between(ap.fstop, req.tstop)
-        if req.tstop < ap.fstop - 1e-9:
+    if isinstance(camera, (ReportRequest, ReportInputs)):  # the inputs of a front end, whole
+        camera, coc, measured, references = camera.inputs if isinstance(camera, ReportRequest) else camera
+    require_type("camera", camera, CameraState, "physcam.optics.state.camera_state(lens, focus_mm=..., fstop=..., "
+                 "sensor=...), or physcam.onset.request.report_camera(...) from a front end's inputs")
+    if camera.sensor is None:
+        raise InputError("the lens report needs the camera's sensor: camera_state(..., sensor=...)")
+    refs = References() if references is None else require_type("references", references, References)
+    if measured is not None:
+        require_type("measured", measured, MeasuredLimits, "physcam.onset.request.MeasuredLimits(near_mm, far_mm)")
+    at = lens_at_mark(camera, refs)  # the lens at the mark, solved when the camera was made
+    planes = principal_planes(at)
+    w, h = camera.sensor.width_mm, camera.sensor.height_mm
+    c, coc_name = named_circle_of_confusion(w, h, coc)
+    focus = solve_focus(camera, planes, measured)
+    ap = invert_limits(camera, planes, focus, c, coc_name, measured, at)
+    solved, notes = {**focus.solved, **ap.solved}, [*camera.notes, *at.notes, *focus.notes, *ap.notes]
+    if refs.tstop is not None:
+        solved["tstop_drift_stops"] = _dof.stops_between(ap.fstop, refs.tstop)
+        if refs.tstop < ap.fstop - 1e-9:
             notes.append("the T-stop is faster than the f-stop: a T-stop is never below the f-number")
-    dof = depth_of_field(req, state, planes, focus, ap)
+    dof = depth_of_field(camera, planes, focus, ap, at)
     h1_film, h2_film, error, error_notes = focus_error(planes, focus)
-    pupil, pupil_src, pupil_notes = entrance_pupil(req, state, h1_film)
-    s, n_focus = focus.object_distance, ap.fstop * state.n_ratio
+    pupil, pupil_src, pupil_notes = entrance_pupil(camera, h1_film, refs, at)
+    s, n_focus, model = focus.object_distance, ap.fstop * at.n_ratio, camera.lens_model
     report = LensReport(
-        model=state.model, focal_length_mm=state.focal_length_mm, fstop=ap.fstop, sensor=req.sensor,
-        squeeze=state.squeeze, coc_mm=ap.coc_mm, coc_convention=ap.coc_convention, focus_from_film_mm=focus.mark,
-        object_distance_mm=s, image_distance_mm=focus.image_distance, h1_from_film_mm=h1_film,
-        h2_from_film_mm=h2_film, focus_error_mm=error,
-        magnification=0.0 if math.isinf(s) else -state.focal_length_mm / (s - state.focal_length_mm),
+        camera=camera, model=at.model, focal_length_mm=at.focal_length_mm, squeeze=at.squeeze, coc_mm=ap.coc_mm,
+        coc_convention=ap.coc_convention, object_distance_mm=s, image_distance_mm=focus.image_distance,
+        h1_from_film_mm=h1_film, h2_from_film_mm=h2_film, focus_error_mm=error,
+        magnification=0.0 if math.isinf(s) else -at.focal_length_mm / (s - at.focal_length_mm),
         dof=dof.dof, dof_horizontal=dof.horizontal, entrance_pupil_from_film_mm=pupil,
-        entrance_pupil_source=pupil_src, solved=solved, measured=_measured(req),
-        notes=(*notes, *dof.notes, *error_notes, *pupil_notes), lens_name=state.lens_name,
-        reference_plane="film" if req.lens is not None else req.reference_plane,
-        flange_focal_distance_mm=req.flange_focal_distance_mm if req.reference_plane == "flange" else None,
-        tstop=req.tstop,
-        stop_from_film_mm=state.stop_from_film_mm if req.lens is not None else (
-            h1_film if state.model == "practical" else None),
-        dof_aspect=dof.blur_aspect, diffraction_wavelength_nm=req.diffraction_wavelength_nm,
-        bellows_factor=state.bellows, fstop_at_focus=None if state.n_ratio == 1.0 else n_focus,
-        entrance_pupil_horizontal_from_film_mm=state.pupil_x_from_film_mm if pupil_src == "prescription" else None,
-        **field_of_view(req, state, h2_film))
+        entrance_pupil_source=pupil_src, solved=solved, measured=_measured(measured),
+        notes=(*notes, *dof.notes, *error_notes, *pupil_notes),
+        reference_plane=getattr(model, "reference_plane", "film"),
+        flange_focal_distance_mm=model.flange_focal_distance_mm if getattr(model, "reference_plane", "film") == "flange"
+        else None, references=refs,
+        stop_from_film_mm=at.stop_from_film_mm if camera.traceable else (h1_film if at.model == "practical" else None),
+        dof_aspect=dof.blur_aspect, bellows_factor=at.bellows, fstop_at_focus=None if at.n_ratio == 1.0 else n_focus,
+        entrance_pupil_horizontal_from_film_mm=at.pupil_x_from_film_mm if pupil_src == "prescription" else None,
+        **field_of_view(camera, h2_film, refs, at))
     report = dataclasses.replace(report, notes=report.notes + (report.diffraction_note(),))
-    if req.lens is not None:
-        report = _with_real_fov(report, req.lens)
+    if camera.traceable:
+        report = _with_real_fov(report, camera)
     _check_finite(report)
     return report
 
 
 def solve_lens_report(**inputs) -> LensReport:
-    """``solve_report(ReportRequest(**inputs))``: the report from keyword inputs (the fields of
-    :class:`ReportRequest`; distances on set from the film plane, datasheet offsets from the
-    reference plane). Front ends build the request themselves."""
-    return solve_report(ReportRequest(**inputs))
+    """The report from keyword inputs (the inputs of :func:`~physcam.onset.request.report_camera`:
+    distances on set from the film plane, datasheet offsets from the reference plane):
+    ``solve_report(report_camera(**inputs))``."""
+    return solve_report(report_camera(**inputs))
 
 
-def _measured(req: ReportRequest) -> dict:
+def _measured(measured: MeasuredLimits | None) -> dict:
     """The limits measured on set, from the film plane."""
     out = {}
-    if req.near_mm is not None:
-        out["near_from_film_mm"] = req.near_mm
-    if req.far_mm is not None:
-        out["far_from_film_mm"] = req.far_mm
+    if measured is not None and measured.near_mm is not None:
+        out["near_from_film_mm"] = measured.near_mm
+    if measured is not None and measured.far_mm is not None:
+        out["far_from_film_mm"] = measured.far_mm
     return out
 
 
-def _with_real_fov(report: LensReport, lens) -> LensReport:
-    """Add the real-ray field of view of ``lens`` (issue 8: a fisheye's paraxial field is 98 deg where
-    its chief rays reach 140 deg) and, when it differs from the pinhole's, a note and a warning."""
+def _with_real_fov(report: LensReport, camera: CameraState) -> LensReport:
+    """Add the real-ray field of view of the camera's lens at its mark (issue 8: a fisheye's paraxial
+    field is 98 deg where its chief rays reach 140 deg) and, when it differs from the pinhole's, a note
+    and a warning. The lens focused at the mark is the camera's own solution (no focus solved again)."""
     import dataclasses
     import warnings
 
-    from ..analysis.field_of_view import real_field_of_view
+    from ..analysis.framing.field_of_view import real_field_of_view_focused
     from ..errors import PhysCamError, PhysCamWarning
 
     s = report.sensor
+    st = camera.lens_model.focus_state(report.focus_from_film_mm)
     try:
-        real = real_field_of_view(lens, s.width_mm, s.height_mm, focus_mm=report.focus_from_film_mm)
+        real = real_field_of_view_focused(camera.lens, st.prescription, st.film_z, s.width_mm, s.height_mm,
+                                          mark=report.focus_from_film_mm)
     except PhysCamError as exc:
         return dataclasses.replace(report, notes=report.notes + (f"real-ray field of view not available: {exc}",))
     report = dataclasses.replace(report, real_fov=real.to_dict())
@@ -461,20 +514,6 @@ def _caller_level() -> int:
     while frame.f_back is not None and frame.f_globals.get("__name__", "").startswith("physcam.onset"):
         frame, level = frame.f_back, level + 1
     return level
-
-
-def _named_coc(w, h, given, c, name):
-    """A CoC value that is one of the named conventions for this sensor (to float32 precision, as a
-    USD file stores it) keeps that convention's name instead of "user"."""
-    from ..optics.coc import COC_CONVENTIONS
-
-    if name != "user" or not isinstance(given, (int, float)):
-        return c, name
-    for key, (_, rule) in COC_CONVENTIONS.items():
-        v = rule(w, h)
-        if abs(c - v) <= 1e-6 * v:
-            return c, key
-    return c, name
 
 
 def _check_finite(report: LensReport) -> None:

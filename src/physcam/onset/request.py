@@ -1,35 +1,50 @@
-"""What the user asked the on-set lens report for: a :class:`ReportRequest`, checked once at the door.
+"""What the user asked the on-set lens report for, read and checked once at the door, as the camera
+the report is a view of (issue 43).
 
 Each front end (the CLI's ``report``, ``dof-table``, the exporters, ``serve``, the USD kits, the
-OpenTrackIO recorder) builds one request from its own input and hands it to
-:func:`physcam.onset.report.solve_report`; every check that needs no optics happens here, when the
-request is made, so a bad value is refused before any work and with the same sentence everywhere.
+OpenTrackIO recorder, the camera-metadata converter) hands what it was given to :func:`report_camera`,
+which checks it (every check that needs no optics first, so a bad value is refused before any work
+and with the same sentence everywhere) and returns the :class:`ReportInputs`: the camera (a lens
+model focused and stopped; a focus or an f-stop solved from measured limits is solved here,
+:mod:`physcam.onset.inverse`), the circle of confusion, the :class:`MeasuredLimits` and the
+:class:`References` (figures from elsewhere the report compares or takes: a T-stop, a tape-measured
+pupil, a best-match pinhole or an f-number at the focus recorded in a USD file). Then
+``solve_report(*inputs)``, or ``inputs.solve()``.
 
 Distances measured on set (``focus_mm``, ``near_mm``, ``far_mm``, ``sensor_front_mm``) are from the
 film plane; datasheet offsets (``h1_mm``, ``h2_mm``, ``pupil_mm``) are in front of
 ``reference_plane`` ("film", or "flange": ``flange_focal_distance_mm`` in front of the film)
-(docs/conventions.md).
+(docs/conventions.md). :class:`ReportRequest`, the record of the same inputs before issue 43, answers
+for one version (DeprecationWarning).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
+from types import SimpleNamespace
+from typing import NamedTuple
 
 from ..errors import InputError, require_finite, require_positive, require_type
+from ..optics.sensors import Sensor
+from ..optics.state import HYPERFOCAL
 from ..optics.thinlens import MAX_F_NUMBER, MIN_F_NUMBER, require_f_number
-from .sensors import Sensor
 
-__all__ = ["ReportRequest", "HYPERFOCAL", "DIFFRACTION_WAVELENGTH_NM", "MIN_F_NUMBER", "MAX_F_NUMBER",
-           "MAX_DISTANCE_MM"]
+__all__ = ["report_camera", "ReportInputs", "MeasuredLimits", "References", "ReportRequest", "INPUTS", "HYPERFOCAL",
+           "DIFFRACTION_WAVELENGTH_NM", "MIN_F_NUMBER", "MAX_F_NUMBER", "MAX_DISTANCE_MM"]
 
-#: ``focus_mm=HYPERFOCAL``: focus at the hyperfocal distance of this lens, f-stop and CoC.
-HYPERFOCAL = "hyperfocal"
 #: Wavelength of the report's diffraction figures: 550 nm, near the peak of the eye's photopic
 #: sensitivity (CIE V(lambda) peaks at 555 nm), the usual choice of diffraction-limit tables.
 DIFFRACTION_WAVELENGTH_NM = 550.0
 #: Largest finite distance the report accepts (1000 km); beyond it use infinity.
 MAX_DISTANCE_MM = 1.0e9
+
+#: What a front end may give :func:`report_camera`, and each default (the sensor is required).
+INPUTS = dict(sensor=None, focal_length_mm=None, fstop=None, focus_mm=None, coc=None, near_mm=None, far_mm=None,
+              tstop=None, squeeze=1.0, model="practical", h1_mm=None, h2_mm=None, pupil_mm=None,
+              reference_plane="film", flange_focal_distance_mm=None, sensor_front_mm=None, lens_length_mm=None,
+              pupil_fraction=0.4, lens_name=None, lens=None, pinhole_focal_length_mm=None, pinhole_squeeze=None,
+              diffraction_wavelength_nm=DIFFRACTION_WAVELENGTH_NM, fstop_at_focus=None)
 
 
 def require_distance(name: str, value) -> float:
@@ -47,55 +62,137 @@ def require_focus(value) -> float:
     return require_distance("focus distance", value)
 
 
-@dataclass(frozen=True, kw_only=True)
-class ReportRequest:
-    """The lens report's inputs, as the user gave them (see the module notes for planes and units).
+@dataclass(frozen=True)
+class MeasuredLimits:
+    """Near and far limits of acceptable sharpness measured on a plate (or wanted), from the film plane
+    (mm; ``far_mm`` may be inf); either may be None."""
 
-    ``lens`` (a :class:`~physcam.lens.prescription.Prescription`) replaces the datasheet: focal
-    length, principal planes and pupil come from the lens focused at ``focus_mm``. ``fstop`` is the
-    iris's setting (defined at infinity focus); ``fstop_at_focus`` the f-number at this focus when it
-    is known from elsewhere (a USD file). ``pinhole_focal_length_mm``/``pinhole_squeeze``: a
-    best-match pinhole known from elsewhere. Made once; checked on construction (InputError).
-    """
-
-    sensor: Sensor
-    focal_length_mm: float | None = None
-    fstop: float | None = None
-    focus_mm: float | str | None = None
-    coc: str | float | None = None
     near_mm: float | None = None
     far_mm: float | None = None
+
+    def __post_init__(self):
+        near, far = self.near_mm, self.far_mm
+        if near is not None:
+            near = require_distance("near limit", near)
+        if far is not None:
+            far = float(far)
+            if math.isnan(far) or far <= 0:
+                raise InputError(f"far limit must be a positive distance (or inf), got {self.far_mm!r}")
+            far = require_distance("far limit", far) if math.isfinite(far) else far
+        if near is not None and far is not None and not near < far:
+            raise InputError(f"near limit {near:g} mm must be closer than far limit {far:g} mm")
+        object.__setattr__(self, "near_mm", near)
+        object.__setattr__(self, "far_mm", far)
+
+    def __bool__(self) -> bool:
+        return self.near_mm is not None or self.far_mm is not None
+
+
+@dataclass(frozen=True)
+class References:
+    """Figures from outside the optics the report compares with or takes as given: the marked
+    ``tstop``; a tape-measured entrance pupil (``sensor_front_mm`` from the film to the lens front,
+    ``lens_length_mm``, the pupil ``pupil_fraction`` of the length behind the front); a best-match
+    pinhole (``pinhole_focal_length_mm``, ``pinhole_squeeze``) and the f-number at the focus
+    (``fstop_at_focus``) recorded elsewhere (a USD file); the wavelength of the diffraction figures."""
+
     tstop: float | None = None
-    squeeze: float = 1.0
-    model: str = "practical"
-    h1_mm: float | None = None
-    h2_mm: float | None = None
-    pupil_mm: float | None = None
-    reference_plane: str = "film"
-    flange_focal_distance_mm: float | None = None
     sensor_front_mm: float | None = None
     lens_length_mm: float | None = None
     pupil_fraction: float = 0.4
-    lens_name: str | None = None
-    lens: object = None
     pinhole_focal_length_mm: float | None = None
     pinhole_squeeze: float | None = None
-    diffraction_wavelength_nm: float = DIFFRACTION_WAVELENGTH_NM
     fstop_at_focus: float | None = None
+    diffraction_wavelength_nm: float = DIFFRACTION_WAVELENGTH_NM
 
-    def __post_init__(self):
-        for check in (_read_as_written, _check_sensor_and_wavelength, _check_lens_or_datasheet, _check_stops, _check_distances,
-                      _check_planes):
-            for name, value in check(self).items():
-                object.__setattr__(self, name, value)
 
-    @property
-    def at_hyperfocal(self) -> bool:
-        return isinstance(self.focus_mm, str) and self.focus_mm == HYPERFOCAL
+class ReportInputs(NamedTuple):
+    """The report's inputs after the door: ``solve_report(inputs)`` takes them whole."""
 
-    @classmethod
-    def names(cls) -> tuple[str, ...]:
-        return tuple(f.name for f in fields(cls))
+    camera: object  # physcam.optics.state.CameraState
+    coc: str | float | None = None
+    measured: MeasuredLimits | None = None
+    references: References | None = None
+
+
+def report_camera(**inputs) -> ReportInputs:
+    """Read and check the report's inputs (the keys of :data:`INPUTS`: a lens prescription or a focal
+    length, the f-stop, the focus mark, the sensor, the CoC, measured near/far limits, the model and a
+    datasheet's planes ...) and build the camera the report is a view of: focused at the mark (or the
+    hyperfocal mark, or where measured limits put it), stopped to the f-stop (or the one measured limits
+    need), on the sensor. InputError with a sentence for any bad value, before any optics."""
+    return _camera_of(checked_inputs(inputs))
+
+
+def checked_inputs(inputs: dict) -> SimpleNamespace:
+    """The inputs with their defaults, read as written and checked (no optics): InputError."""
+    unknown = sorted(set(inputs) - set(INPUTS))
+    if unknown:
+        raise TypeError(f"unexpected report input(s) {', '.join(unknown)}; the inputs are {', '.join(INPUTS)}")
+    r = SimpleNamespace(**{**INPUTS, **inputs})
+    if r.sensor is None:
+        raise TypeError("the report needs a sensor (sensor=physcam.optics.sensors.find_sensor(name) or its name)")
+    for check in (_read_as_written, _check_sensor_and_wavelength, _check_lens_or_datasheet, _check_stops, _check_distances,
+                  _check_planes):
+        for name, value in check(r).items():
+            setattr(r, name, value)
+    return r
+
+
+def _at_hyperfocal(r) -> bool:
+    return isinstance(r.focus_mm, str) and r.focus_mm == HYPERFOCAL
+
+
+def _lens_model(r):
+    """The lens model of the inputs: the prescription, a datasheet (technical) or a thin lens."""
+    from ..optics.lens_model import Datasheet, PrescriptionLens, ThinLens, lens_model_of
+
+    if r.lens is not None:
+        return lens_model_of(r.lens) if r.lens_name is None else PrescriptionLens(r.lens, lens_name=r.lens_name)
+    common = dict(squeeze=r.squeeze, lens_name=r.lens_name, pupil_mm=r.pupil_mm, reference_plane=r.reference_plane,
+                  flange_focal_distance_mm=r.flange_focal_distance_mm)
+    if r.model == "technical":
+        return Datasheet(r.focal_length_mm, h1_mm=r.h1_mm, h2_mm=r.h2_mm, **common)
+    return ThinLens(r.focal_length_mm, **common)
+
+
+def _camera_of(r: SimpleNamespace) -> ReportInputs:
+    """The camera of checked inputs (:func:`checked_inputs`), its focus or f-stop solved from measured limits."""
+    from ..optics.state import camera_state
+    from . import inverse
+
+    model, notes = _lens_model(r), ()
+    measured = MeasuredLimits(r.near_mm, r.far_mm) if r.near_mm is not None or r.far_mm is not None else None
+    refs = References(r.tstop, r.sensor_front_mm, r.lens_length_mm, r.pupil_fraction, r.pinhole_focal_length_mm,
+                      r.pinhole_squeeze, r.fstop_at_focus, r.diffraction_wavelength_nm)
+    squeeze = None if r.lens is not None and r.squeeze == 1.0 else r.squeeze
+    fstop = r.fstop
+    if fstop is None and measured is None and r.lens is not None:  # the engraving, or slower
+        fstop = model.wide_open()
+        notes = (f"f-stop not given: wide open at f/{fstop:.3g}",)
+    common = dict(sensor=r.sensor, coc=r.coc, squeeze=squeeze, n_ratio=_n_ratio(r))
+    if measured is None and r.focus_mm is None:
+        raise InputError("give a focus distance (--focus), or measured near and far limits (--near, --far), "
+                         "or one limit with the f-stop")
+    if fstop is None and measured is None:
+        raise InputError("give the f-stop (--fstop) or a measured near/far limit to solve it")
+    if r.focus_mm is None:
+        cam = inverse.focus_from_limits(model, near_mm=r.near_mm, far_mm=r.far_mm, fstop=fstop, **common)
+    elif measured is not None and (fstop is None or r.coc is not None):
+        cam = inverse.fstop_from_limits(model, focus_mm=r.focus_mm, near_mm=r.near_mm, far_mm=r.far_mm,
+                                        marked_fstop=fstop, **common)
+    else:
+        cam = camera_state(model, focus_mm=r.focus_mm, fstop=fstop, sensor=r.sensor, coc=r.coc, squeeze=squeeze)
+    if notes:
+        from dataclasses import replace
+
+        cam = replace(cam, notes=notes + cam.notes)
+    return ReportInputs(cam, r.coc, measured, refs)
+
+
+def _n_ratio(r) -> float:
+    """The f-number at the focus over the f-stop, when the inputs say it (a USD file's), else 1."""
+    return 1.0 if r.fstop_at_focus is None or r.fstop is None else r.fstop_at_focus / r.fstop
 
 
 #: The request's distances, and whether each may be infinite: strings are read as the CLI reads them.
@@ -103,7 +200,7 @@ _DISTANCES = {"focal_length_mm": False, "focus_mm": True, "near_mm": False, "far
               "sensor_front_mm": False, "lens_length_mm": False}
 
 
-def _read_as_written(r: ReportRequest) -> dict:
+def _read_as_written(r) -> dict:
     """What a person writes, read as the CLI reads it: a sensor name ("ALEXA 35"), distances with units
     ("2m", "10ft", "10'6\"", "infinity", "hyperfocal" for the focus). A number is millimetres; so is a bare
     number in a string (the Python API reads no user config)."""
@@ -111,7 +208,7 @@ def _read_as_written(r: ReportRequest) -> dict:
 
     out = {}
     if isinstance(r.sensor, str):
-        from .sensors import find_sensor
+        from ..optics.sensors import find_sensor
 
         out["sensor"] = find_sensor(r.sensor)
     for key, infinite in _DISTANCES.items():
@@ -125,8 +222,8 @@ def _read_as_written(r: ReportRequest) -> dict:
     return out
 
 
-def _check_sensor_and_wavelength(r: ReportRequest) -> dict:
-    require_type("sensor", r.sensor, Sensor, "physcam.onset.sensors.find_sensor(name) or custom_sensor(w, h)")
+def _check_sensor_and_wavelength(r) -> dict:
+    require_type("sensor", r.sensor, Sensor, "physcam.optics.sensors.find_sensor(name) or custom_sensor(w, h)")
     lam = require_positive("diffraction wavelength", r.diffraction_wavelength_nm, unit="nm")
     if not 200.0 <= lam <= 20000.0:
         raise InputError(f"diffraction wavelength must lie between 200 and 20000 nm, got {lam:g}")
@@ -144,7 +241,7 @@ def _check_sensor_and_wavelength(r: ReportRequest) -> dict:
     return {"diffraction_wavelength_nm": lam, "squeeze": sq}
 
 
-def _check_lens_or_datasheet(r: ReportRequest) -> dict:
+def _check_lens_or_datasheet(r) -> dict:
     """A prescription replaces the datasheet: refuse what would contradict it; else a focal length."""
     if r.lens is None:
         if r.focal_length_mm is None:
@@ -173,7 +270,7 @@ def _check_lens_or_datasheet(r: ReportRequest) -> dict:
     return {}
 
 
-def _check_stops(r: ReportRequest) -> dict:
+def _check_stops(r) -> dict:
     out = {}
     if r.model not in ("practical", "technical"):
         raise InputError(f"model must be 'practical' or 'technical', got {r.model!r}")
@@ -192,28 +289,20 @@ def _check_stops(r: ReportRequest) -> dict:
     return out
 
 
-def _check_distances(r: ReportRequest) -> dict:
+def _check_distances(r) -> dict:
     out = {}
     limits = r.near_mm is not None or r.far_mm is not None
-    if r.at_hyperfocal and (limits or (r.fstop is None and r.lens is None)):
+    if _at_hyperfocal(r) and (limits or (r.fstop is None and r.lens is None)):
         raise InputError("focus at the hyperfocal distance needs the f-stop (--fstop), and no measured near/far "
                          "limits (they solve the focus themselves)")
-    if r.focus_mm is not None and not r.at_hyperfocal:
+    if r.focus_mm is not None and not _at_hyperfocal(r):
         out["focus_mm"] = require_focus(r.focus_mm)
-    if r.near_mm is not None:
-        out["near_mm"] = require_distance("near limit", r.near_mm)
-    if r.far_mm is not None:
-        far = float(r.far_mm)
-        if math.isnan(far) or far <= 0:
-            raise InputError(f"far limit must be a positive distance (or inf), got {r.far_mm!r}")
-        out["far_mm"] = require_distance("far limit", far) if math.isfinite(far) else far
-    near, far = out.get("near_mm"), out.get("far_mm")
-    if near is not None and far is not None and not near < far:
-        raise InputError(f"near limit {near:g} mm must be closer than far limit {far:g} mm")
+    limits = MeasuredLimits(r.near_mm, r.far_mm)
+    out.update(near_mm=limits.near_mm, far_mm=limits.far_mm)
     return out
 
 
-def _check_planes(r: ReportRequest) -> dict:
+def _check_planes(r) -> dict:
     out = {}
     if r.reference_plane not in ("film", "flange"):
         raise InputError(f"reference plane must be 'film' or 'flange', got {r.reference_plane!r}")
@@ -234,3 +323,44 @@ def _check_planes(r: ReportRequest) -> dict:
         if getattr(r, key) is not None:
             out[key] = require_finite(name, getattr(r, key))
     return out
+
+
+class ReportRequest:
+    """Deprecated (issue 43; goes in physcam 0.3): the report's inputs as one record. Use
+    :func:`report_camera` (the same keywords), then ``solve_report(*inputs)``, or build the camera
+    yourself (:func:`physcam.optics.state.camera_state`) and call ``solve_report(camera, coc=...)``.
+
+    Checked when it is made, as before; its inputs read as attributes (``request.focus_mm``)."""
+
+    def __init__(self, **inputs):
+        import warnings
+
+        warnings.warn("ReportRequest(...) is now physcam.onset.request.report_camera(...) (the same keywords), or "
+                      "solve_report(camera_state(lens, focus_mm=..., fstop=..., sensor=...), coc=...); ReportRequest "
+                      "goes in physcam 0.3", DeprecationWarning, stacklevel=2)
+        self.__dict__["_inputs"] = checked_inputs(inputs)
+        self.__dict__["_made"] = None
+
+    def __getattr__(self, name):
+        try:
+            return getattr(self.__dict__["_inputs"], name)
+        except AttributeError:
+            raise AttributeError(f"ReportRequest has no input {name!r}") from None
+
+    def __setattr__(self, name, value):
+        raise AttributeError("a ReportRequest is read-only")
+
+    @property
+    def at_hyperfocal(self) -> bool:
+        return _at_hyperfocal(self._inputs)
+
+    @classmethod
+    def names(cls) -> tuple[str, ...]:
+        return tuple(INPUTS)
+
+    @property
+    def inputs(self) -> ReportInputs:
+        """The camera and the report's options these inputs make (built once)."""
+        if self.__dict__["_made"] is None:
+            self.__dict__["_made"] = _camera_of(self._inputs)
+        return self.__dict__["_made"]

@@ -9,11 +9,11 @@ near and far limits); with a stop given as well, the answer adds that stop's rea
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from typing import NamedTuple
 
-from .report import LensReport, ReportRequest, solve_report
+from .report import LensReport, solve_report
+from .request import INPUTS, ReportRequest, checked_inputs, report_camera
 
 __all__ = ["SplitFocus", "split_focus"]
 
@@ -42,19 +42,24 @@ class SplitFocus(NamedTuple):
                 "given_far_from_film_mm": None if g is None or g.dof.far_is_infinite else g.dof.far_from_film_mm}
 
 
-def split_focus(request: ReportRequest) -> SplitFocus:
-    """The split-focus answer for ``request`` (its ``near_mm`` and ``far_mm`` are the subjects to hold,
-    from the film; its ``fstop``, if any, the stop the camera is at): the mark, the stop needed at the
-    request's CoC convention, and the given stop's limits at that mark."""
+def split_focus(request: ReportRequest | None = None, /, **inputs) -> SplitFocus:
+    """The split-focus answer for the report's inputs (the keywords of
+    :func:`~physcam.onset.request.report_camera`: ``near_mm`` and ``far_mm`` are the subjects to hold, from
+    the film; ``fstop``, if any, the stop the camera is at): the mark, the stop needed at the inputs' CoC
+    convention, and the given stop's limits at that mark. A :class:`ReportRequest` (deprecated, issue 43)
+    is read as its inputs."""
     from ..errors import InputError, require_type
 
-    require_type("request", request, ReportRequest, "physcam.onset.report.ReportRequest(sensor=..., near_mm=..., ...)")
-    if request.near_mm is None or request.far_mm is None:
+    if request is not None:
+        require_type("request", request, ReportRequest, "split_focus(sensor=..., near_mm=..., far_mm=..., ...)")
+        inputs = {k: getattr(request, k) for k in INPUTS}
+    r = checked_inputs(inputs)
+    if r.near_mm is None or r.far_mm is None:
         raise InputError("split focus needs the near and the far subject (--near, --far)")
-    need = solve_report(dataclasses.replace(request, fstop=None, focus_mm=None, tstop=None))
+    need = solve_report(report_camera(**{**inputs, "fstop": None, "focus_mm": None, "tstop": None}))
     given = None
-    if request.fstop is not None:
-        given = solve_report(dataclasses.replace(request, focus_mm=need.focus_from_film_mm, near_mm=None, far_mm=None,
-                                                 coc=need.coc_mm))
-    return SplitFocus(need.focus_from_film_mm, need.fstop, need.coc_mm, need.coc_convention, request.near_mm,
-                      request.far_mm, given)
+    if r.fstop is not None:
+        given = solve_report(report_camera(**{**inputs, "focus_mm": need.focus_from_film_mm, "near_mm": None,
+                                              "far_mm": None, "coc": need.coc_mm}))
+    return SplitFocus(need.focus_from_film_mm, need.fstop, need.coc_mm, need.coc_convention, r.near_mm, r.far_mm,
+                      given)

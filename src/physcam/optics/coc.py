@@ -22,7 +22,8 @@ import math
 
 from ..errors import InputError, require_positive
 
-__all__ = ["COC_CONVENTIONS", "DEFAULT_COC_CONVENTION", "circle_of_confusion", "parse_coc"]
+__all__ = ["COC_CONVENTIONS", "DEFAULT_COC_CONVENTION", "circle_of_confusion", "named_circle_of_confusion",
+           "parse_coc"]
 
 #: name -> (description, function of (width_mm, height_mm) -> coc_mm)
 COC_CONVENTIONS = {
@@ -71,6 +72,19 @@ def circle_of_confusion(width_mm: float, height_mm: float, convention: str | flo
             f"use one of {', '.join(COC_CONVENTIONS)} or a value in mm"
         ) from None
     return require_positive("circle of confusion", value), "user"
+
+
+def named_circle_of_confusion(width_mm: float, height_mm: float, convention: str | float | None = None):
+    """:func:`circle_of_confusion`, where a value that is one of the named conventions for this sensor
+    (to float32 precision, as a USD file stores it) keeps that convention's name instead of "user"."""
+    c, name = circle_of_confusion(width_mm, height_mm, convention)
+    if name != "user" or not isinstance(convention, (int, float)):
+        return c, name
+    for key, (_, rule) in COC_CONVENTIONS.items():
+        v = rule(width_mm, height_mm)
+        if abs(c - v) <= 1e-6 * v:
+            return c, key
+    return c, name
 
 
 def parse_coc(text):

@@ -29,7 +29,7 @@ import math
 from dataclasses import asdict, dataclass
 
 from ..data.default_sensor import DEFAULT_SENSOR_WIDTH_MM
-from ..errors import InputError, OpticsError, renamed_parameter, require_positive
+from ..errors import InputError, OpticsError, renamed_parameter, require_positive, require_type
 from ..lens.prescription import Prescription, takes_prescription
 from . import paraxial
 
@@ -53,6 +53,9 @@ __all__ = [
     "breathing_table",
     "pupil_aspect",
     "hyperfocal_mark",
+    "hyperfocal_state",
+    "planes_of",
+    "state_for_object",
 ]
 
 FOCUS_METHODS = ("auto", "unit", "internal")
@@ -470,17 +473,20 @@ def technical_planes(
     the subject; ``back_focus_mm`` is last vertex to film. With
     ``flange_focal_distance_mm`` the same planes are also given from the flange.
     """
-    g = gaussian_at_focus(
-        prescription,
-        focus_mm,
-        axis=axis,
-        focus_axis=axis,
-        method=method,
-        wavelength_nm=wavelength_nm,
-        fstop=fstop,
-        flange_focal_distance_mm=flange_focal_distance_mm,
-    )
-    st_method = focus_method(prescription, method)
+    st = focus(prescription, focus_mm, method=method, axis=axis, wavelength_nm=wavelength_nm)
+    stop = None if fstop is None else iris_semi_diameter(prescription, fstop, method=method)
+    return planes_of(st, stop_semi_diameter=stop, wavelength_nm=wavelength_nm,
+                     flange_focal_distance_mm=flange_focal_distance_mm)
+
+
+def planes_of(state: FocusState, *, stop_semi_diameter: float | None = None, wavelength_nm=None,
+              flange_focal_distance_mm: float | None = None) -> TechnicalPlanes:
+    """:class:`TechnicalPlanes` of a lens already focused (a :class:`FocusState`: no focus solved here),
+    its iris ``stop_semi_diameter`` (None: the file's stop), in the state's own meridian."""
+    require_type("state", state, FocusState, "physcam.optics.focusing.focus(lens, mark)")
+    g = paraxial.gaussian(state.prescription, axis=state.axis, wavelength_nm=wavelength_nm,
+                          stop_semi_diameter=stop_semi_diameter, object_z=state.object_z, film_z=state.film_z,
+                          flange_focal_distance_mm=flange_focal_distance_mm)
     fl = {}
     if flange_focal_distance_mm is not None:
         fl = dict(
@@ -489,9 +495,9 @@ def technical_planes(
             entrance_pupil_from_flange_mm=g.in_front_of("entrance_pupil", "flange"),
         )
     return TechnicalPlanes(
-        focus_from_film_mm=float(focus_mm),
-        method=st_method,
-        axis=axis,
+        focus_from_film_mm=float(state.focus_from_film_mm),
+        method=state.method,
+        axis=state.axis,
         wavelength_nm=g.wavelength_nm,
         efl_mm=g.efl,
         h1_from_film_mm=g.in_front_of("front_principal_plane"),
@@ -640,30 +646,91 @@ def entrance_pupils(prescription: Prescription, focus_mm: float, *, method: str 
 _MAX_MARK_MM = 1.0e9
 
 
-@functools.lru_cache(maxsize=64)  # a hyperfocal focus solves it, and its report's DOF block asks again
-def hyperfocal_mark(prescription: Prescription, fstop: float, coc_mm: float, *, blur_aspect: float | None = 1.0):
-    """(mark, planes at the mark): the focus mark whose subject plane lies at the hyperfocal distance
-    H = f^2/(N c) + f from H1 (Wikipedia, "Hyperfocal distance"), with f and H1 of the lens focused at
-    that mark: a fixed point (the planes move little with focus; a few steps reach 1e-9 of the mark).
+@takes_prescription
+def state_for_object(prescription: Prescription, object_distance_mm: float, *, method: str = "auto",
+                     axis: str = "y", wavelength_nm=None) -> FocusState:
+    """The lens focused on a subject ``object_distance_mm`` in front of its first vertex (inf allowed):
+    the inverse of :func:`focus` without its search. Internal focusing sets the gaps for that object
+    (:func:`interpolated_gaps`) and the back focus at its paraxial image; unit focusing keeps the gaps
+    and puts the film at the paraxial image (:func:`image_distance`). The mark is object distance +
+    glass length + back focus. No limit is checked here (a subject closer than the focus groups' close
+    point is a clamped state): :func:`focus` refuses marks the lens cannot reach."""
+    method = focus_method(prescription, method)
+    last = len(prescription.surfaces) - 1
+    if method == "internal":
+        q_inf, b_inf, _ = _internal_state(prescription, math.inf, axis, wavelength_nm)
+        if math.isinf(object_distance_mm):
+            return FocusState(math.inf, "internal", axis, q_inf.with_thicknesses({last: b_inf}), math.inf, b_inf,
+                              b_inf, 0.0, 0.0)
+        q, back, alpha = _internal_state(prescription, object_distance_mm, axis, wavelength_nm)
+        return FocusState(object_distance_mm + q.total_track + back, "internal", axis, q.with_thicknesses({last: back}),
+                          object_distance_mm, back, b_inf, back - b_inf, alpha)
+    b_inf = paraxial.gaussian(prescription, axis=axis, wavelength_nm=wavelength_nm).bfl
+    if math.isinf(object_distance_mm):
+        return FocusState(math.inf, "unit", axis, prescription.with_thicknesses({last: b_inf}), math.inf, b_inf, b_inf,
+                          0.0, 0.0)
+    back = image_distance(prescription, object_distance_mm, axis, wavelength_nm)
+    return FocusState(object_distance_mm + prescription.total_track + back, "unit", axis,
+                      prescription.with_thicknesses({last: back}), object_distance_mm, back, b_inf, back - b_inf, 0.0)
 
-    ``fstop`` is the iris's setting at infinity; the f-number at each candidate mark is ``fstop``
-    times :func:`f_number_ratio` there (internal focusing). ``blur_aspect``: the CoC is ``coc_mm /
-    blur_aspect`` (an anamorphic's horizontal limits); None takes the lens's own :func:`pupil_aspect`
-    at each mark, so the horizontal mark too is a fixed point."""
+
+def _reachable(prescription: Prescription, st: FocusState) -> bool:
+    """Whether :func:`focus` would reach ``st`` (a state made by :func:`state_for_object`)."""
+    if not (st.back_focus_mm > 0 and math.isfinite(st.focus_from_film_mm)):
+        return False
+    if st.method == "internal":
+        return st.object_distance_mm >= prescription.focus.close_distance
+    return st.object_distance_mm > 0
+
+
+@functools.lru_cache(maxsize=64)  # a hyperfocal camera solves it, and every report's DOF block asks again
+def hyperfocal_state(prescription: Prescription, fstop: float, coc_mm: float, *,
+                     blur_aspect: float | None = 1.0) -> FocusState:
+    """The lens focused at its hyperfocal mark (:func:`hyperfocal_mark`), as a :class:`FocusState`.
+
+    Solved as a fixed point in the subject's distance d from the first vertex, where the lens's state
+    needs no search (:func:`state_for_object`): d <- H(d) - z_H1(d), H = f^2/(N c) + f from H1 with f,
+    H1 and the f-number of the lens focused on d (the planes move little with focus: a few steps reach
+    1e-12 of d). A candidate the lens cannot reach, or beyond 1000 km, is refused as :func:`focus`
+    and the report refuse it, named by the mark the planes of the previous step give."""
     from . import dof
 
     n = require_positive("f-stop", fstop, unit="")
     c = require_positive("circle of confusion", coc_mm)
-    mark = math.inf
-    for _ in range(50):
-        planes = technical_planes(prescription, mark)
-        aspect = pupil_aspect(prescription, mark) if blur_aspect is None else blur_aspect
-        new = dof.hyperfocal_distance(planes.efl_mm, n * f_number_ratio(prescription, mark), c / aspect)
-        new += planes.h1_from_film_mm
-        if not 0.0 < new <= _MAX_MARK_MM:
-            raise InputError(f"hyperfocal focus mark {new:g} mm is beyond 1000 km; for a subject at infinity use a "
+    p, method = prescription, focus_method(prescription)
+    st = state_for_object(p, math.inf, method=method)
+    g_inf = paraxial.gaussian(st.prescription, object_z=st.object_z, film_z=st.film_z)
+    d = math.inf
+    for _ in range(100):
+        g = g_inf if math.isinf(d) else paraxial.gaussian(st.prescription, object_z=st.object_z, film_z=st.film_z)
+        if blur_aspect is None:
+            gx = paraxial.gaussian(st.prescription, axis="x", object_z=st.object_z, film_z=st.film_z)
+            aspect = gx.entrance_pupil_diameter / g.entrance_pupil_diameter
+        else:
+            aspect = blur_aspect
+        h = dof.hyperfocal_distance(g.efl, n * (g.f_number / g_inf.f_number), c / aspect)
+        mark = h + g.in_front_of("front_principal_plane")  # the candidate mark, with the planes of this step
+        if not 0.0 < mark <= _MAX_MARK_MM:
+            raise InputError(f"hyperfocal focus mark {mark:g} mm is beyond 1000 km; for a subject at infinity use a "
                              "far limit of inf")
-        if math.isfinite(mark) and abs(new - mark) <= 1e-9 * new:
-            return new, technical_planes(prescription, new)
-        mark = new
+        d_new = h - g.z_front_principal_plane  # the subject H in front of H1, from the first vertex
+        if math.isfinite(d) and abs(d_new - d) <= 1e-12 * d_new:
+            return st
+        nxt = state_for_object(p, d_new, method=method)
+        if not _reachable(p, nxt):
+            return focus(p, mark, method=method)  # raises the lens's own "cannot focus" sentence
+        st, d = nxt, d_new
     raise OpticsError(f"the hyperfocal focus of {prescription.name!r} did not settle; give the focus mark")
+
+
+def hyperfocal_mark(prescription: Prescription, fstop: float, coc_mm: float, *, blur_aspect: float | None = 1.0):
+    """(mark, planes at the mark): the focus mark whose subject plane lies at the hyperfocal distance
+    H = f^2/(N c) + f from H1 (Wikipedia, "Hyperfocal distance"), with f and H1 of the lens focused at
+    that mark (:func:`hyperfocal_state`).
+
+    ``fstop`` is the iris's setting at infinity; the f-number at each candidate focus is ``fstop``
+    times :func:`f_number_ratio` there (internal focusing). ``blur_aspect``: the CoC is ``coc_mm /
+    blur_aspect`` (an anamorphic's horizontal limits); None takes the lens's own :func:`pupil_aspect`
+    at each focus, so the horizontal mark too is a fixed point."""
+    st = hyperfocal_state(prescription, fstop, coc_mm, blur_aspect=blur_aspect)
+    return st.focus_from_film_mm, planes_of(st)

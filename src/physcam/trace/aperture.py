@@ -84,6 +84,15 @@ class Aperture:
         1 for a circle."""
         return 1.0 if self.is_circular else math.sqrt(math.pi / self.area())
 
+    def corner_semi(self, round_semi: float, widest_semi: float) -> float:
+        """The stop radius (mm) the shape's corners reach when it has the area of the round iris of radius
+        ``round_semi`` (an f-number with blades, docs/conventions.md): ``round_semi`` x
+        :meth:`equal_area_scale`, but never beyond ``widest_semi`` (the lens's widest iris) unless the
+        round iris itself is wider. ``round_semi`` for a circle."""
+        if self.is_circular:
+            return float(round_semi)
+        return float(min(round_semi * self.equal_area_scale(), max(widest_semi, round_semi)))
+
     def sample(self, u) -> np.ndarray:
         """Map (n, 2) uniform numbers in [0, 1) to (n, 2) points on the shape, pdf prop. to density."""
         u = np.atleast_2d(np.asarray(u, dtype=float))

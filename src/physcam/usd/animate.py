@@ -135,14 +135,14 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     key; return the Path.
 
     ``lens`` (a Prescription) or ``focal_length_mm`` (a thin lens); ``sensor`` a
-    :class:`~physcam.onset.sensors.Sensor`; ``fstop`` for keys without their own (with a
+    :class:`~physcam.optics.sensors.Sensor`; ``fstop`` for keys without their own (with a
     prescription and no f-stop at all: wide open); ``zoom`` a zoom lens's position for keys without
     their own (module notes).
     """
     from pxr import Sdf, UsdGeom
 
     from ..export.usdgeom import require_meters_per_unit
-    from ..onset.report import ReportRequest, solve_report
+    from ..onset.report import report_camera, solve_report
     from .author import author_camera, new_stage, sample_render_camera, save_stage, spec_from_report
 
     keys = _check_keys(keys)
@@ -159,9 +159,9 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     for k, u in zip(keys, zooms):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", PhysCamWarning)
-            report = solve_report(ReportRequest(focal_length_mm=focal_length_mm, sensor=sensor,
-                                       fstop=k.fstop if k.fstop is not None else fstop, focus_mm=k.focus_mm,
-                                       coc=coc, lens=lens if u is None else prescription_at(lens, u)))
+            report = solve_report(report_camera(focal_length_mm=focal_length_mm, sensor=sensor,
+                                                 fstop=k.fstop if k.fstop is not None else fstop, focus_mm=k.focus_mm,
+                                                 coc=coc, lens=lens if u is None else prescription_at(lens, u)))
         for w in caught:  # say each approximation once, not once per frame
             if str(w.message) not in seen_notes:
                 seen_notes.add(str(w.message))

@@ -12,7 +12,7 @@ use. The two are written from the same numbers:
   in tenths of a scene unit, focus and clipping distances in scene units
   (``metersPerUnit``; docs/conventions.md);
 * Hydra's ``lensDistortion:*`` when a fitted model is given (a real lens's traced distortion,
-  :mod:`physcam.analysis.distortion`);
+  :mod:`physcam.analysis.distortion.field`);
 * ``exposure:*``, ``shutter:open/close`` (in time codes, from the stage's
   ``timeCodesPerSecond``) and RenderMan's ``ri:aperture*``, ``ri:shutterOpenTime``,
   ``ri:shutterCloseTime``, ``ri:shutteropening`` (hdPrman's camera tokens; seed 002).
@@ -159,7 +159,7 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
     (lens API and lens model prim), "render" (the companion UsdGeomCamera); a body file
     and a lens file each write their own parts and a shot composes them.
     ``lens_distortion``: a fitted radial model
-    (:class:`physcam.analysis.distortion.StandardDistortion`, or its ``usd_attributes()`` dict),
+    (:class:`physcam.analysis.distortion.field.StandardDistortion`, or its ``usd_attributes()`` dict),
     written as Hydra's ``lensDistortion:*`` on the companion UsdGeomCamera.
     """
     bad = set(parts) - set(ALL_PARTS)
@@ -510,7 +510,7 @@ TDE4_ANAMORPHIC_PREFIX = "physcam:tde4AnamorphicDegree"
 
 
 def author_anamorphic_distortion(prim, fits) -> None:
-    """3DE4 Anamorphic - Standard fits (:class:`physcam.analysis.anamorphic_distortion.TDE4Anamorphic`) as
+    """3DE4 Anamorphic - Standard fits (:class:`physcam.analysis.distortion.anamorphic.TDE4Anamorphic`) as
     custom attributes on the companion camera ``prim``, one group per degree,
     ``physcam:tde4AnamorphicDegree<d>:``: ``model``, ``focalLength`` (mm, the Y pinhole), ``filmback`` (mm,
     the desqueezed one), ``pixelAspect`` (f_y / f_x), ``parameterNames`` and ``parameters`` (3DE's names and
@@ -519,12 +519,12 @@ def author_anamorphic_distortion(prim, fits) -> None:
     (docs/anamorphic.md). Groups of degrees not in ``fits`` are removed."""
     from pxr import Gf, Sdf, Vt
 
-    from ..analysis.anamorphic_distortion import TDE4Anamorphic, tde4_anamorphic_parameter_names
+    from ..analysis.distortion.anamorphic import TDE4Anamorphic, tde4_anamorphic_parameter_names
 
     if isinstance(fits, (str, bytes)) or not hasattr(fits, "__iter__"):
         raise WrongTypeError("fits must be a list of 3DE4 anamorphic fits "
                              "(physcam.usd.kit.prescription_anamorphic_distortion(lens, ...))")
-    fits = [require_type("fit", f, TDE4Anamorphic, "physcam.analysis.anamorphic_distortion.fit_tde4_anamorphic(...)")
+    fits = [require_type("fit", f, TDE4Anamorphic, "physcam.analysis.distortion.anamorphic.fit_tde4_anamorphic(...)")
             for f in fits]
     kept = set()
     for fit in fits:
@@ -652,7 +652,7 @@ def write_camera(file, spec: CameraSpec, *, force: bool = False, path: str = DEF
                  thin_lens_gap: dict | None = None, anamorphic_distortion=()):
     """Write a one-camera layer to ``file`` (see :func:`author_camera`), with a ``UsdRenderSettings``
     for its companion camera (:func:`author_render_settings`) unless ``render_settings`` is false;
-    return the Path. ``thin_lens_gap`` (:meth:`physcam.analysis.thin_lens_gap.ThinLensGap.to_dict`) is kept
+    return the Path. ``thin_lens_gap`` (:meth:`physcam.onset.thin_lens_gap.ThinLensGap.to_dict`) is kept
     in the companion camera's customData ``physcam:thinLensGap``: how far it is from the real lens.
     ``anamorphic_distortion``: 3DE4 anamorphic fits for the companion (:func:`author_anamorphic_distortion`)."""
     stage = new_stage(meters_per_unit, fps, up_axis)

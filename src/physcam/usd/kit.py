@@ -261,13 +261,13 @@ def _author_shot_companion(stage, path) -> str:
     cam = stage.GetPrimAtPath(path)
     report, distortion, opencv, anamorphic = None, None, None, []
     if rx is not None and spec.projection == "perspective":
-        from ..onset.report import ReportRequest, solve_report
-        from ..onset.sensors import Sensor
+        from ..onset.report import report_camera, solve_report
+        from ..optics.sensors import Sensor
 
         sensor = Sensor(key="custom", name=spec.sensor_name or f"{spec.sensor_width_mm:g} x {spec.sensor_height_mm:g} mm",
                         width_mm=spec.sensor_width_mm, height_mm=spec.sensor_height_mm)
-        report = solve_report(ReportRequest(focal_length_mm=None, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
-                                   coc=spec.coc_mm, lens=rx))
+        report = solve_report(report_camera(focal_length_mm=None, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
+                               coc=spec.coc_mm, lens=rx))
         derived = spec_from_report(report)
         _author_lens_derived(stage, cam, derived)
         spec = replace(spec, focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
@@ -483,14 +483,14 @@ def best_match_pinhole(prescription, *, focus_mm: float, fstop: float | None, se
     magnification frames like the lens at this focus, breathing included. The companion
     UsdGeomCamera is that pinhole. f-stop None: the lens wide open, as the lens report decides.
     """
-    from ..onset.report import ReportRequest, solve_report
-    from ..onset.sensors import Sensor
+    from ..onset.report import report_camera, solve_report
+    from ..optics.sensors import Sensor
     from .author import spec_from_report
 
     sensor = Sensor(key="custom", name=f"{sensor_width_mm:g} x {sensor_height_mm:g} mm",
                     width_mm=sensor_width_mm, height_mm=sensor_height_mm)
-    report = solve_report(ReportRequest(focal_length_mm=None, sensor=sensor, fstop=fstop, focus_mm=focus_mm, coc=coc_mm,
-                               lens=prescription))
+    report = solve_report(report_camera(focal_length_mm=None, sensor=sensor, fstop=fstop, focus_mm=focus_mm, coc=coc_mm,
+                           lens=prescription))
     return spec_from_report(report), report
 
 
@@ -498,24 +498,27 @@ def prescription_distortion(prescription, sensor_width_mm: float = DEFAULT_SENSO
                             sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM, *,
                             focus_mm: float = math.inf):
     """Hydra's "standard" lensDistortion fitted to ``prescription``'s real chief rays over the whole
-    frame at the shot's focus ``focus_mm`` (:func:`physcam.analysis.distortion_models.fit_usd_standard`
+    frame at the shot's focus ``focus_mm`` (:func:`physcam.analysis.distortion.models.fit_usd_standard`
     on a 2048-pixel-wide frame of the sensor, default Super 35, 24.89 x 18.66 mm). Where the lens
     does not cover the frame's corners, the radial fit of
-    :mod:`physcam.analysis.distortion` (object at infinity, fields up to what passes) is used, with a warning.
+    :mod:`physcam.analysis.distortion.field` (object at infinity, fields up to what passes) is used, with a warning.
     """
     import warnings
 
-    from ..analysis.distortion_models import fit_usd_standard, samples_from_field
-    from ..analysis.stmap import distortion_field
+    from ..analysis.distortion.models import fit_usd_standard, samples_from_field
+    from ..analysis.distortion.stmap import distortion_field
     from ..errors import OpticsError, PhysCamWarning
 
     w_px = 2048
     h_px = max(16, min(8192, round(w_px * sensor_height_mm / sensor_width_mm)))
     try:
-        field = distortion_field(prescription, focus_mm=focus_mm, sensor_width_mm=sensor_width_mm,
-                                 sensor_height_mm=sensor_height_mm, width_px=w_px, height_px=h_px, maps=False)
+        from ..optics.state import camera_state
+
+        field = distortion_field(camera_state(prescription, focus_mm=focus_mm, sensor_mm=(sensor_width_mm,
+                                                                                          sensor_height_mm)),
+                                 width_px=w_px, height_px=h_px, maps=False)
     except OpticsError as e:
-        from ..analysis.distortion import real_distortion
+        from ..analysis.distortion.field import real_distortion
 
         warnings.warn(f"lensDistortion: {e}; fitted radially at infinity instead", PhysCamWarning, stacklevel=2)
         return real_distortion(prescription, sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm).fit
@@ -531,7 +534,7 @@ def prescription_distortion(prescription, sensor_width_mm: float = DEFAULT_SENSO
 @takes_prescription
 def prescription_anamorphic_distortion(prescription, sensor_width_mm: float, sensor_height_mm: float, *,
                                        focus_mm: float = math.inf) -> list:
-    """3DE4 Anamorphic - Standard, Degree 4 and 6 (:func:`physcam.analysis.anamorphic_distortion.fit_tde4_anamorphic`)
+    """3DE4 Anamorphic - Standard, Degree 4 and 6 (:func:`physcam.analysis.distortion.anamorphic.fit_tde4_anamorphic`)
     fitted to an anamorphic ``prescription``'s traced chief rays over the whole frame at ``focus_mm``, on the
     2048-pixel-wide frame :func:`prescription_distortion` traces; ``[]`` for a spherical lens, and, with a
     warning, for one whose field does not cover the frame (its corners are not imaged)."""
@@ -539,9 +542,9 @@ def prescription_anamorphic_distortion(prescription, sensor_width_mm: float, sen
 
     if not prescription.is_anamorphic:
         return []
-    from ..analysis.anamorphic_distortion import fit_tde4_anamorphic
-    from ..analysis.distortion_models import samples_from_field
-    from ..analysis.stmap import distortion_field
+    from ..analysis.distortion.anamorphic import fit_tde4_anamorphic
+    from ..analysis.distortion.models import samples_from_field
+    from ..analysis.distortion.stmap import distortion_field
     from ..errors import OpticsError, PhysCamWarning
 
     w_px = 2048

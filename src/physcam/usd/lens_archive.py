@@ -9,7 +9,7 @@ A lens archive (``NAME.lens.zip``, a ZIP file; docs/lens-library.md) holds, flat
   ``characterization`` variant set: one variant per measuring run holding what was measured
   (``physcam:characterization:NAME`` attributes, as :func:`physcam.usd.kit.read_characterizations`
   reads them) and ``current``, a copy of the latest, selected;
-* ``card.pdf`` — the lens card (:mod:`physcam.analysis.lens_card`);
+* ``card.pdf`` — the lens card (:mod:`physcam.analysis.lens_cards.card`);
 * ``provenance.json`` — the provenance record (:class:`physcam.lens.provenance.Provenance`), the
   one ``lens.toml`` carries, for tools that do not read TOML;
 * ``manifest.json`` — ``{"format": "physcam-lens-archive/1", "slug", "name", "files": {name:
@@ -92,7 +92,7 @@ def pack_lens(prescription, archive, *, slug: str | None = None, focus_mm: float
 
     ``focus_mm`` (from the film plane) and ``fstop`` (None: wide open) are where the USD file's
     best-match pinhole and the lens card are evaluated (a USD focus is finite: infinity is written
-    as 1 km); ``sensor`` an :class:`~physcam.onset.sensors.Sensor` (default Super 35).
+    as 1 km); ``sensor`` an :class:`~physcam.optics.sensors.Sensor` (default Super 35).
     ``characterizations`` maps a variant name (letters, digits, underscores; sorted, the last is
     ``current``) to what was measured that run (name -> number, numbers or text). ``source`` and
     ``licence`` fill the lens's provenance where its file gives none (a published lens must have
@@ -131,7 +131,7 @@ def pack_lens(prescription, archive, *, slug: str | None = None, focus_mm: float
 
 
 def _default_sensor():
-    from ..onset.sensors import find_sensor
+    from ..optics.sensors import find_sensor
 
     return find_sensor("Super 35")
 
@@ -176,7 +176,7 @@ def _author_characterizations(file: Path, runs: dict) -> None:
 
 
 def _card_bytes(p, tmp: Path, focus_mm, sensor, draft) -> bytes:
-    from ..analysis.lens_card import lens_card, save_lens_card
+    from ..analysis.lens_cards.card import lens_card, save_lens_card
 
     card = lens_card(p, focus_mm=focus_mm, sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm,
                      sensor_name=sensor.name, quality="draft" if draft else "full")

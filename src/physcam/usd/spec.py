@@ -149,8 +149,8 @@ def report_for_spec(spec: CameraSpec):
     """
     import dataclasses
 
-    from ..onset.report import ReportRequest, solve_report
-    from ..onset.sensors import Sensor
+    from ..onset.report import report_camera, solve_report
+    from ..optics.sensors import Sensor
 
     require_type("spec", spec, CameraSpec, "build one with CameraSpec(...) or spec_from_report")
     sensor = Sensor(
@@ -165,9 +165,9 @@ def report_for_spec(spec: CameraSpec):
                   fstop_at_focus=spec.fstop_at_focus)
     if spec.principal_planes_mm is not None:
         h1, h2 = spec.principal_planes_mm
-        return solve_report(ReportRequest(model="technical", h1_mm=h1, h2_mm=h2, pupil_mm=spec.entrance_pupil_mm,
-                                          **common))
-    report = solve_report(ReportRequest(**common))
+        return solve_report(report_camera(model="technical", h1_mm=h1, h2_mm=h2, pupil_mm=spec.entrance_pupil_mm,
+                             **common))
+    report = solve_report(report_camera(**common))
     if spec.entrance_pupil_mm is not None:
         report = dataclasses.replace(report, entrance_pupil_from_film_mm=spec.entrance_pupil_mm,
                                      entrance_pupil_source="USD file")
@@ -178,7 +178,7 @@ def spec_from_report(report, **body) -> CameraSpec:
     """A :class:`CameraSpec` from a lens report plus body/shutter/aperture keywords of CameraSpec."""
     from ..onset.report import LensReport
 
-    require_type("report", report, LensReport, "solve one with physcam.onset.report.solve_report(ReportRequest(...))")
+    require_type("report", report, LensReport, "solve one with physcam.onset.request.solve_report(report_camera(...))")
     s = report.sensor
     return CameraSpec(
         focal_length_mm=report.focal_length_mm,

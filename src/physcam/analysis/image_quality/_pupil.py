@@ -1,0 +1,824 @@
+"""The engine under the wavefront, PSF and MTF analyses: real rays over the pupil of one field,
+with their optical path lengths, and the optical path difference they make against the
+reference sphere.
+
+Configuration (:func:`setup`): the lens is focused at a mark from the film
+(:func:`physcam.optics.focusing.focus`; infinity keeps the prescription and puts the film at
+the paraxial image of infinity) and stopped down to an f-number (the stop's semi-diameter
+sized by :func:`physcam.optics.focusing.iris_semi_diameter`). Pupil positions come
+from the Gaussian engine of the focused lens: the paraxial entrance pupil (plane ``z_ep``,
+radius ``r_ep`` at that stop) and exit pupil (``z_xp``).
+
+Field: an object-space angle theta in the Y-Z meridian (positive light travels toward +y and
+images on the +y side of the film). At infinity a collimated beam along (0, sin theta, cos
+theta); at a finite distance the object point (0, -tan(theta) (z_ep - z_object), z_object),
+seen under theta from the paraxial entrance pupil. The chief ray is the ray of the field
+through the centre of the real stop (:mod:`physcam.analysis._chief`, Newton aiming); a field
+whose chief ray cannot be aimed through the stop (it misses a surface or is totally reflected
+even without rims) lies outside the lens's field.
+
+Pupil sampling: a square grid of ``n`` x ``n`` cells on the plane of the paraxial entrance
+pupil, each traced at its centre. The grid is laid over the real pupil: a coarse trace of an
+overfilled square around the chief ray finds the rays that pass the stop (and its aperture
+shape) and every element rim, and the grid covers their bounding square. A cell on the edge
+of what passes (a neighbour differs) is traced again at 4 x 4 sub-cell centres, so the pupil's
+edge (the real aperture shape, vignetting by rims) is resolved to 1/16 of a cell's area. Each
+traced ray carries its cell-area share (1 or 1/16) as a quadrature weight.
+
+Optical path: the kernels add each leg's n (p' - p) . d, signed, so virtual legs of sequential
+tracing count negative (:func:`physcam.trace.trace.trace_packed` with ``opl``; one call through
+every surface, two around a shaped stop).
+At infinity a ray starts with n (d . (p - p_chief)), the path from the plane wavefront through
+the chief ray's start. Optical path difference (Welford, *Aberrations of Optical Systems*, 9.2;
+the convention of optiland 0.6.3, see docs/image-quality.md): the reference sphere is centred
+on the chief ray's point on the film (or a given reference point) and passes through the
+paraxial exit pupil point (0, 0, z_xp); each ray is followed along its image-space line back
+to that sphere, and W = OPL(chief) - OPL(ray), in waves of the ray's wavelength. With this sign
+a film moved away from the lens past the focus gives positive defocus,
+W = +dz (1 - cos u') ~ dz rho^2 / (8 N^2).
+
+Lengths in mm, lens space (docs/conventions.md); wavelengths in nm.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import InputError, OpticsError, require_finite
+from ...optics.state import CameraState
+
+#: Smallest and largest pupil grids (cells across the pupil's bounding square).
+MIN_PUPIL_SAMPLES = 16
+MAX_PUPIL_SAMPLES = 1024
+#: Grid chosen when the caller gives none, before the sampling rules raise it.
+DEFAULT_PUPIL_SAMPLES = 64
+#: Sub-cells per side traced in a cell on the pupil's edge.
+EDGE_SUBSAMPLES = 4
+
+
+@dataclass(frozen=True)
+class Setup:
+    """The pupil engine's view of a :class:`~physcam.optics.state.CameraState` (the lens focused and
+    stopped once, in the optics layer), plus how to trace it (``backend``)."""
+
+    state: CameraState
+    backend: str
+
+    # the names the pupil engine reads, each from the one state
+    lens = property(lambda self: self.state.focused)  # focused
+    lens_name = property(lambda self: self.state.lens_name)
+    fstop = property(lambda self: self.state.fstop)
+    focus_from_film_mm = property(lambda self: self.state.focus_from_film_mm)  # inf at infinity
+    object_z = property(lambda self: self.state.object_z)  # -inf at infinity
+    film_z = property(lambda self: self.state.film_z)  # the film plane (focus plane) in lens space
+    stop_semi_diameter = property(lambda self: self.state.stop_semi_diameter)
+    z_ep = property(lambda self: self.state.entrance_pupil_z)
+    r_ep = property(lambda self: self.state.entrance_pupil_radius)
+    z_xp = property(lambda self: self.state.exit_pupil_z)
+    aperture = property(lambda self: self.state.aperture)
+    design_wavelength_nm = property(lambda self: float(self.state.lens.wavelength_nm))
+    at_infinity = property(lambda self: self.state.at_infinity)
+
+
+def setup(camera: CameraState, *, backend: str = "auto") -> Setup:
+    """The pupil engine's setup of ``camera`` (a :class:`~physcam.optics.state.CameraState`: the lens
+    focused and stopped once, in the optics layer) and how to trace it."""
+    from ...errors import require_type
+
+    require_type("camera", camera, CameraState, "physcam.optics.state.camera_state(lens, focus_mm=..., fstop=...)")
+    return Setup(camera, backend)
+
+
+# --------------------------------------------------------------------------------------------
+# tracing with optical path
+@dataclass
+class Traced:
+    """Rays after the last surface (lens space) with their optical path so far and their fate."""
+
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    L: np.ndarray
+    M: np.ndarray
+    N: np.ndarray
+    opl: np.ndarray
+    ok: np.ndarray
+    amplitude: np.ndarray  # sqrt of the aperture density at the stop (1 for a plain stop)
+
+    _KEYS = ("x", "y", "z", "L", "M", "N", "opl", "ok", "amplitude")
+
+    def take(self, idx) -> "Traced":
+        return Traced(*(getattr(self, k)[idx] for k in self._KEYS))
+
+
+def _concat(parts) -> Traced:
+    return Traced(*(np.concatenate([getattr(p, k) for p in parts]) for k in Traced._KEYS))
+
+
+class _Tracer:
+    """One focused, stopped-down lens: the packed table, reused for every batch.
+
+    A batch may mix wavelengths (the kernels take each ray's own, and add each leg's optical path
+    in the same call); every batch of the analyses is made as large as it can be (all wavelengths,
+    all fields of a chart) to call them few times."""
+
+    def __init__(self, st: Setup):
+        from ...trace.kernels import get_kernel
+        from ...trace.kernels._layout import pack
+        from ...trace.surfaces import surface_table
+
+        self.st = st
+        self.table = surface_table(st.lens, stop_semi_diameter=st.stop_semi_diameter)
+        self.S, self.kinds = pack(self.table)
+        self.stop_row = int(np.flatnonzero(self.table.index == st.lens.stop_index)[0])
+        self.kernel = get_kernel(st.backend)
+        self._n = {}
+
+    def plan(self, rays: float) -> None:
+        """Pick the kernel for a job of about ``rays`` rays through every surface, known ahead:
+        the numpy kernel where it does the whole job in less time than loading numba takes
+        (:func:`physcam.trace.kernels.backend_for_job`; both kernels give the same rays)."""
+        from ...trace.kernels import backend_for_job, get_kernel
+
+        self.kernel = get_kernel(backend_for_job(self.st.backend, rays * (self.S.shape[0] + 1)))
+
+    def indices(self, wavelength_nm: float) -> tuple[np.ndarray, float]:
+        """(index before each row, index of image space) at one wavelength."""
+        w = float(wavelength_nm)
+        if w not in self._n:
+            nb = self.table.index_before(w)
+            ni = float(self.table.index_after(w)[-1])
+            if not (np.isfinite(nb).all() and math.isfinite(ni) and ni > 0):
+                raise OpticsError(f"a medium of {self.st.lens_name!r} has no usable index at {w:g} nm")
+            self._n[w] = (nb, ni)
+        return self._n[w]
+
+    def n_object(self, wavelength_nm: float) -> float:
+        return float(self.indices(wavelength_nm)[0][0])
+
+    def n_image(self, wavelength_nm: float) -> float:
+        return self.indices(wavelength_nm)[1]
+
+    def trace(self, start, direction, opl0, wavelengths, *, clip=True) -> Traced:
+        """Trace rays (n, 3) with per-ray ``wavelengths`` (nm) front to back, adding n (p' - p) . d per leg."""
+        from ...trace import OK, RayBatch
+        from ...trace.trace import trace_packed
+
+        wl = np.broadcast_to(np.asarray(wavelengths, dtype=float), (np.shape(start)[0],))
+        rest = wl  # every medium usable at every wavelength (a batch has a few; np.unique imports numpy.ma)
+        while rest.size:
+            self.indices(rest[0])
+            rest = rest[rest != rest[0]]
+        rays = RayBatch.from_arrays(start, direction, wl)
+        opl = np.array(opl0, dtype=np.float64, copy=True)
+        amp = np.ones(len(rays))
+        # the kernel adds each leg's optical path: one call through every row, or two around a shaped stop
+        shaped = clip and self.st.aperture is not None
+        cut = self.stop_row + 1 if shaped else self.S.shape[0]
+        trace_packed(self.kernel, rays, self.S[:cut], self.kinds[:cut], clip=clip, fresnel=False, end_z=None, opl=opl)
+        if shaped:
+            r = self.S[self.stop_row, 6]  # SEMI: the stop's semi-diameter at this f-stop
+            dens = self.st.aperture.density_at(rays.x / r, rays.y / r)
+            blocked = (rays.flag == OK) & ~(dens > 0.0)
+            rays.flag[blocked] = 2  # CLIPPED
+            amp = np.sqrt(np.maximum(dens, 0.0))
+            trace_packed(self.kernel, rays, self.S[cut:], self.kinds[cut:], clip=clip, fresnel=False, end_z=None,
+                         opl=opl)
+        ok = (rays.flag == OK) & np.isfinite(opl)
+        return Traced(rays.x, rays.y, rays.z, rays.L, rays.M, rays.N, opl, ok, np.where(ok, amp, 0.0))
+
+
+# --------------------------------------------------------------------------------------------
+# the field: object point or beam direction, and the chief ray
+@dataclass(frozen=True)
+class Field:
+    field_deg: float
+    wavelength_nm: float
+    direction: np.ndarray | None  # collimated beam (at infinity)
+    object_point: np.ndarray | None  # finite object
+    chief_start: np.ndarray
+    chief_direction: np.ndarray
+    chief_ep_xy: tuple[float, float]  # where the chief ray crosses the entrance-pupil plane
+
+
+def _outside(st: Setup, field_deg: float, wl: float, why: str) -> OpticsError:
+    from .._chief import field_limit_deg
+
+    try:
+        lim = field_limit_deg(st.lens, "y", max_deg=89.0, wavelength_nm=wl, tol_deg=0.05, backend=st.backend)
+        extra = f"; its chief rays pass up to {lim:.2f} degrees"
+    except Exception:  # noqa: BLE001 - only for the message
+        extra = ""
+    return OpticsError(f"field {field_deg:g} degrees lies outside the field of {st.lens_name!r}: {why}{extra}")
+
+
+def field_angles(fields_deg) -> list[float]:
+    try:
+        seq = np.atleast_1d(np.asarray(fields_deg, dtype=object)).ravel().tolist()
+    except Exception:  # noqa: BLE001
+        raise InputError(f"field angles must be numbers in degrees, got {fields_deg!r:.60}") from None
+    if isinstance(fields_deg, (str, bytes)) or not seq:
+        raise InputError(f"field angles must be numbers in degrees, got {fields_deg!r:.60}")
+    out = [require_finite("field angle", f) for f in seq]
+    for f in out:
+        if not -89.0 < f < 89.0:
+            raise InputError(f"field angle must lie between -89 and 89 degrees, got {f:g}")
+    return out
+
+
+def make_fields(st: Setup, fields_deg, wavelength_nm: float) -> list[Field]:
+    """The beams or object points of ``fields_deg`` and their chief rays (through the centre of the stop)."""
+    from .._chief import _newton, aim_from_infinity, field_direction
+
+    fds = field_angles(fields_deg)
+    th = np.radians(fds)
+    wl = float(wavelength_nm)
+    if st.at_infinity:
+        d = field_direction(th, "y")
+        aimed = aim_from_infinity(st.lens, d, wavelength_nm=wl, backend=st.backend)
+        out = []
+        for i, fd in enumerate(fds):
+            if not bool(aimed.ok[i]):
+                raise _outside(st, fd, wl, "no ray of this beam passes through the centre of the stop")
+            s = aimed.start[i]
+            t = (st.z_ep - s[2]) / d[i, 2]
+            out.append(Field(fd, wl, d[i], None, s, d[i], (float(s[0] + t * d[i, 0]), float(s[1] + t * d[i, 1]))))
+        return out
+    from ...trace import RayBatch, trace_through
+
+    objs = np.stack([np.zeros(th.size), -np.tan(th) * (st.z_ep - st.object_z), np.full(th.size, st.object_z)], axis=1)
+    k = st.lens.stop_index
+    front = st.lens.with_surfaces(st.lens.surfaces[: k + 1])
+
+    def residual(uu, vv):  # aim points (uu, vv) on the entrance-pupil plane -> stop-plane x, y
+        o = np.tile(objs, (uu.size // objs.shape[0], 1))
+        dirn = np.stack([uu - o[:, 0], vv - o[:, 1], st.z_ep - o[:, 2]], axis=1)
+        res = trace_through(front, RayBatch.from_arrays(o, dirn, wl), clip=False, backend=st.backend)
+        return res.x, res.y, res.ok
+
+    u, v, ok, _ = _newton(residual, np.zeros(th.size), np.zeros(th.size), max(1.0, st.r_ep))
+    out = []
+    for i, fd in enumerate(fds):
+        if not bool(ok[i]):
+            raise _outside(st, fd, wl, "no ray from this object point passes through the centre of the stop")
+        o = objs[i]
+        dirn = np.array([u[i] - o[0], v[i] - o[1], st.z_ep - o[2]])
+        out.append(Field(fd, wl, None, o, o, dirn / np.linalg.norm(dirn), (float(u[i]), float(v[i]))))
+    return out
+
+
+def field_for_image_height(st: Setup, height_mm: float, wavelength_nm: float) -> float:
+    """The field angle (degrees, Y meridian) whose chief ray meets the film at ``height_mm`` on the y axis:
+    the chief ray is aimed back from the film through the centre of the stop (:func:`._chief.aim_from_film`)
+    and traced out of the lens; at infinity its direction is the field, at a finite object the point
+    where it meets the object plane, seen from the paraxial entrance pupil."""
+    return float(fields_for_image_heights(st, [height_mm], wavelength_nm)[0])
+
+
+def fields_for_image_heights(st: Setup, heights_mm, wavelength_nm: float) -> np.ndarray:
+    """:func:`field_for_image_height` of several heights at once (one aiming, one trace: each ray's
+    Newton iteration is its own, so the angles are those of one height at a time); the error names
+    the first height outside the image circle."""
+    from ...trace import RayBatch, trace_through
+    from .._chief import aim_from_film
+
+    hs = np.array([require_finite("image height", h) for h in heights_mm], dtype=float)
+    out = np.zeros(hs.size)
+    idx = np.flatnonzero(hs != 0.0)
+    if idx.size == 0:
+        return out
+    aimed = aim_from_film(st.lens, np.stack([np.zeros(idx.size), hs[idx]], axis=1), st.film_z,
+                          wavelength_nm=wavelength_nm, backend=st.backend)
+    ok = aimed.ok.copy()
+    if ok.any():
+        rays = trace_through(st.lens, RayBatch.from_arrays(aimed.start[ok], aimed.direction[ok], wavelength_nm),
+                             reverse=True, clip=False, backend=st.backend)
+        ok[ok] = rays.ok & (rays.N < 0)
+    if not ok.all():
+        h = hs[idx[np.flatnonzero(~ok)[0]]]
+        raise OpticsError(f"image height {h:g} mm lies outside the image circle of {st.lens_name!r}: no chief ray "
+                          f"from there passes through the centre of the stop and out of the lens")
+    for i, y, z, M, N in zip(idx, rays.y, rays.z, rays.M, rays.N):  # math.atan2: libm's rounding, as before
+        if st.at_infinity:
+            out[i] = math.degrees(math.atan2(-float(M), -float(N)))
+        else:
+            t = (st.object_z - z) / N
+            out[i] = math.degrees(math.atan2(-float(y + t * M), st.z_ep - st.object_z))
+    return out
+
+
+def image_circle_radius(st: Setup, wavelength_nm: float, outside_mm: float, tol_mm: float = 0.05) -> float:
+    """Largest image height (mm, below ``outside_mm``, which has no chief ray) whose chief ray
+    passes out of the lens (:func:`field_for_image_height`), by bisection to ``tol_mm``."""
+    lo, hi = 0.0, float(outside_mm)
+    while hi - lo > tol_mm:
+        mid = 0.5 * (lo + hi)
+        try:
+            field_for_image_height(st, mid, wavelength_nm)
+            lo = mid
+        except OpticsError:
+            hi = mid
+    return lo
+
+
+def _starts(st: Setup, fl: Field, n_object: float, gx: np.ndarray, gy: np.ndarray):
+    """Start points, directions and starting optical paths of rays aimed at (gx, gy) on the entrance-pupil plane."""
+    from .._chief import start_plane_z
+
+    n = gx.size
+    if fl.direction is not None:
+        d = fl.direction
+        z0 = min(st.z_ep, start_plane_z(st.lens)) - 1.0
+        t = (st.z_ep - z0) / d[2]
+        start = np.stack([gx - t * d[0], gy - t * d[1], np.full(n, z0)], axis=1)
+        opl0 = n_object * ((start - fl.chief_start) @ d)
+        return start, np.broadcast_to(d, (n, 3)), opl0
+    o = fl.object_point
+    start = np.broadcast_to(o, (n, 3))
+    dirn = np.stack([gx - o[0], gy - o[1], np.full(n, st.z_ep - o[2])], axis=1)
+    return start, dirn, np.zeros(n)
+
+
+def _trace_groups(tracer: _Tracer, groups, *, clip=True) -> list[Traced]:
+    """Trace several (field, gx, gy) groups in one batch; returns one :class:`Traced` per group."""
+    if not groups:
+        return []
+    # by wavelength, so that the kernels see a few runs of one wavelength (trace.trace_packed)
+    order = sorted(range(len(groups)), key=lambda i: groups[i][0].wavelength_nm)
+    starts, dirs, opls, wls, sizes = [], [], [], [], []
+    for fl, gx, gy in (groups[i] for i in order):
+        s, d, o = _starts(tracer.st, fl, tracer.n_object(fl.wavelength_nm), gx, gy)
+        starts.append(s)
+        dirs.append(d)
+        opls.append(o)
+        wls.append(np.full(gx.size, fl.wavelength_nm))
+        sizes.append(gx.size)
+    res = tracer.trace(np.concatenate(starts), np.concatenate(dirs), np.concatenate(opls), np.concatenate(wls),
+                       clip=clip)
+    cut = np.cumsum([0] + sizes)
+    out: list = [None] * len(groups)
+    for j, i in enumerate(order):
+        out[i] = res.take(slice(cut[j], cut[j + 1]))
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# the pupil grid
+@dataclass
+class PupilTrace:
+    """Rays over the real pupil of one field at one wavelength (see module notes).
+
+    Grid: ``n`` x ``n`` cells of side ``cell_mm`` on the entrance-pupil plane, centred at
+    (``cx``, ``cy``); row index along y, column along x. ``samples``: every traced ray that
+    passed, with its cell (``row``, ``col``), quadrature weight (cell-area share), its grid
+    coordinates (``gx``, ``gy``, mm) and the traced state after the last surface.
+    """
+
+    field: Field
+    wavelength_nm: float
+    n: int
+    cell_mm: float
+    cx: float
+    cy: float
+    row: np.ndarray
+    col: np.ndarray
+    sub: np.ndarray  # -1 for a cell's centre ray, else the sub-cell (row * EDGE_SUBSAMPLES + column) of an edge ray
+    weight: np.ndarray
+    gx: np.ndarray
+    gy: np.ndarray
+    rays: Traced
+    chief: Traced
+    n_image: float
+    launched: int
+    r_ep: float
+    z_xp: float
+    meta: dict = field(default_factory=dict)
+
+
+def _grid_centres(n, cell, cx, cy):
+    c = (np.arange(n) + 0.5) * cell - 0.5 * n * cell
+    return cx + c, cy + c
+
+
+def _vignetted(st: Setup, fd: float) -> OpticsError:
+    return OpticsError(f"field {fd:g} degrees of {st.lens_name!r} is fully vignetted at f/{st.fstop:.3g}: no ray of it "
+                       "passes the stop and every element rim to the film")
+
+
+def pupil_boxes(st: Setup, fields: list[Field], tracer: _Tracer) -> list[tuple]:
+    """Per field, (x0, x1, y0, y1) on the entrance-pupil plane around every ray that passes (one coarse
+    grid, overfilling the paraxial pupil and doubled while light touches its border); raise if none passes."""
+    boxes: list = [None] * len(fields)
+    for m, tries in ((33, 5), (129, 1)):
+        half = [1.6 * st.r_ep] * len(fields)
+        for _ in range(tries):
+            todo = [i for i in range(len(fields)) if boxes[i] is None]
+            if not todo:
+                return boxes
+            grids = []
+            for i in todo:
+                cx, cy = fields[i].chief_ep_xy
+                xs = cx + np.linspace(-half[i], half[i], m)
+                ys = cy + np.linspace(-half[i], half[i], m)
+                gx, gy = (a.ravel() for a in np.meshgrid(xs, ys))
+                grids.append((xs, ys, gx, gy))
+            res = _trace_groups(tracer, [(fields[i], g[2], g[3]) for i, g in zip(todo, grids)])
+            for i, (xs, ys, _, _), r in zip(todo, grids, res):
+                ok = r.ok.reshape(m, m)
+                if not ok.any() or ok[0].any() or ok[-1].any() or ok[:, 0].any() or ok[:, -1].any():
+                    half[i] *= 2.0
+                    continue
+                step = xs[1] - xs[0]
+                rows, cols = np.nonzero(ok)
+                boxes[i] = (xs[cols.min()] - step, xs[cols.max()] + step, ys[rows.min()] - step, ys[rows.max()] + step)
+    for i, b in enumerate(boxes):
+        if b is None:
+            raise _vignetted(st, fields[i].field_deg)
+    return boxes
+
+
+def pupil_box(st: Setup, fl: Field, tracer: _Tracer):
+    return pupil_boxes(st, [fl], tracer)[0]
+
+
+def _same_rays_key(tracer: _Tracer, fl: Field, n: int, box) -> bytes:
+    """What a job's rays depend on: the grid, the field's beam or object point and chief ray, and
+    every medium's index at the job's wavelength. Two jobs with the same key trace the same rays, bit
+    for bit (a lens whose prescription gives no dispersion: its wavelengths differ in diffraction only)."""
+    nb, ni = tracer.indices(fl.wavelength_nm)
+    parts = [np.asarray([n, *box, ni], dtype=float), nb, fl.chief_start, fl.chief_direction]
+    parts += [a for a in (fl.direction, fl.object_point) if a is not None]
+    return b"".join(np.ascontiguousarray(a, dtype=float).tobytes() for a in parts)
+
+
+def trace_pupils(st: Setup, jobs, tracer: _Tracer) -> list[PupilTrace]:
+    """Trace each job (field, n, box) -- an ``n`` x ``n`` grid over ``box`` with the edge refined -- all
+    jobs together: one batch for the cell centres, one for the edge sub-cells, one for the chief rays.
+    Jobs whose rays would be the same (:func:`_same_rays_key`: the wavelengths of a lens without
+    dispersion) are traced once and share the rays, each with its own wavelength."""
+    first: dict = {}
+    rep = [first.setdefault(_same_rays_key(tracer, fl, n, box), j) for j, (fl, n, box) in enumerate(jobs)]
+    traced = dict(zip(sorted(set(rep)), _trace_pupils([jobs[j] for j in sorted(set(rep))], st, tracer)))
+    out = []
+    for (fl, _, _), r in zip(jobs, rep):
+        pt = traced[r]
+        out.append(pt if jobs[r][0] is fl else dataclasses.replace(pt, field=fl, wavelength_nm=fl.wavelength_nm,
+                                                                   n_image=tracer.n_image(fl.wavelength_nm),
+                                                                   meta=dict(pt.meta)))
+    return out
+
+
+def _trace_pupils(jobs, st: Setup, tracer: _Tracer) -> list[PupilTrace]:
+    q = EDGE_SUBSAMPLES
+    grids = []
+    for fl, n, box in jobs:
+        x0, x1, y0, y1 = box
+        side = max(x1 - x0, y1 - y0)
+        cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+        cell = side / n
+        xs, ys = _grid_centres(n, cell, cx, cy)
+        GX, GY = np.meshgrid(xs, ys)
+        grids.append((n, cell, cx, cy, xs, ys, GX.ravel(), GY.ravel()))
+    # the job ahead: every cell centre, and the edge of a round pupil (about 7 n cells) at q x q sub-cells
+    tracer.plan(sum(n * n + 7 * n * q * q for _, n, _ in jobs))
+    centres = _trace_groups(tracer, [(fl, g[6], g[7]) for (fl, _, _), g in zip(jobs, grids)])
+    edges, subs = [], []
+    off = ((np.arange(q) + 0.5) / q - 0.5)
+    for (fl, n, _), g, c in zip(jobs, grids, centres):
+        status = c.ok.reshape(n, n)
+        pad = np.pad(status, 1, constant_values=False)  # the grid's border counts as blocked
+        edge = np.zeros_like(status)
+        for di in (-1, 0, 1):
+            for dj in (-1, 0, 1):
+                if di or dj:
+                    edge |= pad[1 + di:1 + di + n, 1 + dj:1 + dj + n] != status
+        er, ec = np.nonzero(edge)
+        ox, oy = (a.ravel() * g[1] for a in np.meshgrid(off, off))
+        sgx = (g[4][ec][:, None] + ox[None, :]).ravel()
+        sgy = (g[5][er][:, None] + oy[None, :]).ravel()
+        edges.append((status, edge, er, ec, sgx, sgy))
+        subs.append((fl, sgx, sgy))
+    subtraced = _trace_groups(tracer, subs)
+    chiefs = tracer.trace(np.stack([fl.chief_start for fl, _, _ in jobs]),
+                          np.stack([fl.chief_direction for fl, _, _ in jobs]), np.zeros(len(jobs)),
+                          np.array([fl.wavelength_nm for fl, _, _ in jobs]), clip=False)
+    out = []
+    for j, ((fl, n, box), g, c, (status, edge, er, ec, sgx, sgy), sub) in enumerate(
+            zip(jobs, grids, centres, edges, subtraced)):
+        keep = np.flatnonzero((status & ~edge).ravel())
+        sub_ok = np.flatnonzero(sub.ok)
+        if keep.size + sub_ok.size == 0:
+            raise _vignetted(st, fl.field_deg)
+        chief = chiefs.take(slice(j, j + 1))
+        if not bool(chief.ok[0]):
+            raise OpticsError(f"the chief ray of field {fl.field_deg:g} degrees does not reach the film of "
+                              f"{st.lens_name!r}")
+        rows_all, cols_all = np.divmod(np.arange(n * n), n)
+        out.append(PupilTrace(
+            fl, fl.wavelength_nm, int(n), float(g[1]), float(g[2]), float(g[3]),
+            np.concatenate([rows_all[keep], np.repeat(er, q * q)[sub_ok]]),
+            np.concatenate([cols_all[keep], np.repeat(ec, q * q)[sub_ok]]),
+            np.concatenate([np.full(keep.size, -1), np.tile(np.arange(q * q), er.size)[sub_ok]]),
+            np.concatenate([np.ones(keep.size), np.full(sub_ok.size, 1.0 / (q * q))]),
+            np.concatenate([g[6][keep], sgx[sub_ok]]), np.concatenate([g[7][keep], sgy[sub_ok]]),
+            _concat([c.take(keep), sub.take(sub_ok)]), chief, tracer.n_image(fl.wavelength_nm),
+            int(n * n + sgx.size), st.r_ep, st.z_xp,
+            {"edge_cells": int(er.size), "box": tuple(float(b) for b in box)}))
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# the wavefront on a film plane
+@dataclass
+class WavefrontSamples:
+    """OPD (waves) of every passing ray against the reference sphere for one film plane.
+
+    ``ref_L``, ``ref_M``: direction cosines from each ray's point on the reference sphere to the
+    sphere's centre (the plane-wave component the ray stands for; they set the frequency scale)."""
+
+    opd_waves: np.ndarray
+    film_x: np.ndarray
+    film_y: np.ndarray
+    ref_L: np.ndarray
+    ref_M: np.ndarray
+    reference: tuple[float, float, float]  # centre of the reference sphere (the chief ray's film point)
+    radius_mm: float
+    chief_film_xy: tuple[float, float]
+
+
+def chief_point(pt: PupilTrace, film_z: float) -> tuple[float, float, float]:
+    c = pt.chief
+    t = (film_z - c.z[0]) / c.N[0]
+    return float(c.x[0] + t * c.L[0]), float(c.y[0] + t * c.M[0]), float(film_z)
+
+
+def wavefront_on(pt: PupilTrace, film_z: float, reference=None) -> WavefrontSamples:
+    """OPD of the pupil rays for the film at ``film_z`` (reference sphere centred on ``reference``,
+    default the chief ray's film point, through the paraxial exit pupil point)."""
+    cp = chief_point(pt, film_z)
+    C = np.array(cp if reference is None else reference, dtype=float)
+    E = np.array([0.0, 0.0, pt.z_xp])
+    R = float(np.linalg.norm(C - E))
+    if not R > 1e-9:
+        raise OpticsError("the film lies on the exit pupil: no reference sphere")
+
+    def to_sphere(r: Traced):
+        wx, wy, wz = r.x - C[0], r.y - C[1], r.z - C[2]
+        b = wx * r.L + wy * r.M + wz * r.N
+        disc = b * b - (wx * wx + wy * wy + wz * wz - R * R)
+        t = -b - np.sqrt(np.maximum(disc, 0.0))
+        return t, disc >= 0.0
+
+    tc, _ = to_sphere(pt.chief)
+    t, hit = to_sphere(pt.rays)
+    if not hit.all():
+        raise OpticsError(f"rays of field {pt.field.field_deg:g} degrees miss the reference sphere: the wavefront "
+                          "is too aberrated for a diffraction calculation (use the geometric MTF)")
+    r = pt.rays
+    lam_mm = pt.wavelength_nm * 1e-6
+    w = ((pt.chief.opl[0] + pt.n_image * tc[0]) - (r.opl + pt.n_image * t)) / lam_mm
+    # the ray's point on the sphere and the direction from it to the centre
+    sx, sy = r.x + t * r.L, r.y + t * r.M
+    tf = (film_z - r.z) / r.N
+    return WavefrontSamples(w, r.x + tf * r.L, r.y + tf * r.M, (C[0] - sx) / R, (C[1] - sy) / R,
+                            (float(C[0]), float(C[1]), float(C[2])), R, (cp[0], cp[1]))
+
+
+# --------------------------------------------------------------------------------------------
+# the pupil function on the grid
+@dataclass
+class PupilFunction:
+    """The pupil function on the grid (see module notes) at two resolutions.
+
+    Cells (``n`` x ``n``): ``field`` = sum over a cell's rays of weight x amplitude x exp(-2 pi i W)
+    (the cell's integral of the pupil function, for the PSF and the Strehl ratio), ``amplitude0``
+    the same with W = 0 (the unaberrated pupil of the same shape), ``opd`` the cell's mean OPD
+    (waves), ``mask`` where light passes. Sub-cells (``n q`` x ``n q``, q = EDGE_SUBSAMPLES, built
+    on first use): a binary ``fine_mask`` (an edge ray's own sub-cell, a whole interior cell),
+    ``fine_opd`` (an edge ray's own OPD, else interpolated bilinearly between cell means) and
+    ``fine_amp`` (aperture amplitude), for the MTF: an overlap of binary masks measures the sheared
+    pupil's area, where products of fractional edge cells would underestimate the loss by about
+    half a cell of rim.
+    """
+
+    field: np.ndarray
+    amplitude0: np.ndarray
+    opd: np.ndarray
+    mask: np.ndarray
+    cell_mm: float
+    wavelength_nm: float
+    n_image: float
+    slope_x: float  # d(reference direction L)/d(pupil x), 1/mm
+    slope_y: float  # d(reference direction M)/d(pupil y), 1/mm
+    _pt: object = None
+    _ws: object = None
+    _fine: tuple | None = None
+    _lags: dict = field(default_factory=dict)  # (axis, aberrated) -> OTF at whole sub-cell shears
+
+    @property
+    def q(self) -> int:
+        return EDGE_SUBSAMPLES
+
+    def _build_fine(self):
+        if self._fine is None:
+            self._fine = _fine_arrays(self._pt, self._ws, self.mask, self.opd)
+        return self._fine
+
+    @property
+    def fine_mask(self) -> np.ndarray:
+        return self._build_fine()[0]
+
+    @property
+    def fine_opd(self) -> np.ndarray:
+        return self._build_fine()[1]
+
+    @property
+    def fine_amp(self) -> np.ndarray:
+        return self._build_fine()[2]
+
+    @property
+    def freq_per_cell_x(self) -> float:
+        """Spatial frequency (cycles/mm on the film) of a pupil shear of one cell along x (sagittal)."""
+        return self.n_image * abs(self.slope_x) * self.cell_mm / (self.wavelength_nm * 1e-6)
+
+    @property
+    def freq_per_cell_y(self) -> float:
+        """... along y (tangential)."""
+        return self.n_image * abs(self.slope_y) * self.cell_mm / (self.wavelength_nm * 1e-6)
+
+
+def direction_slopes(pt: PupilTrace, ws: WavefrontSamples) -> tuple[float, float]:
+    """Least-squares slopes dL/dx and dM/dy of the reference-sphere directions over the pupil grid
+    (the affine map from pupil to image-space angle that sets the frequency scale)."""
+    w = pt.weight * pt.rays.amplitude
+    A = np.stack([np.ones_like(pt.gx), pt.gx - pt.cx, pt.gy - pt.cy], axis=1)
+    sw = np.sqrt(w)[:, None]
+    sx = sy = 0.0
+    if pt.gx.size >= 3:
+        cl, *_ = np.linalg.lstsq(A * sw, ws.ref_L * sw[:, 0], rcond=None)
+        cm, *_ = np.linalg.lstsq(A * sw, ws.ref_M * sw[:, 0], rcond=None)
+        sx, sy = float(cl[1]), float(cm[2])
+    if not (abs(sx) > 0 and abs(sy) > 0 and math.isfinite(sx) and math.isfinite(sy)):
+        raise OpticsError(f"the pupil of field {pt.field.field_deg:g} degrees is too small to set a frequency scale "
+                          f"({pt.gx.size} rays pass)")
+    return sx, sy
+
+
+def pupil_function(pt: PupilTrace, ws: WavefrontSamples) -> PupilFunction:
+    n = pt.n
+    idx = pt.row * n + pt.col
+    amp = pt.rays.amplitude
+    wa = pt.weight * amp
+    ph = np.exp(-2j * np.pi * ws.opd_waves)  # a ray whose path is longer (W < 0) lags: exp(i k OPL)
+    fld = (np.bincount(idx, weights=wa * ph.real, minlength=n * n)
+           + 1j * np.bincount(idx, weights=wa * ph.imag, minlength=n * n)).reshape(n, n)
+    a0 = np.bincount(idx, weights=wa, minlength=n * n)
+    wsum = np.bincount(idx, weights=wa * ws.opd_waves, minlength=n * n)
+    mask = a0 > 0
+    wmean = np.where(mask, wsum / np.where(mask, a0, 1.0), 0.0).reshape(n, n)
+    sx, sy = direction_slopes(pt, ws)
+    return PupilFunction(fld, a0.reshape(n, n), wmean, mask.reshape(n, n), pt.cell_mm, pt.wavelength_nm, pt.n_image,
+                         sx, sy, pt, ws)
+
+
+def _fine_arrays(pt: PupilTrace, ws: WavefrontSamples, mask: np.ndarray, wmean: np.ndarray):
+    """Sub-cell mask, OPD and amplitude (see :class:`PupilFunction`)."""
+    n, q = pt.n, EDGE_SUBSAMPLES
+    amp = pt.rays.amplitude
+    centre = pt.sub < 0
+    cr, cc = pt.row[centre], pt.col[centre]
+    interior = np.zeros((n, n), dtype=bool)
+    interior[cr, cc] = True
+    cell_amp = np.zeros((n, n))
+    cell_amp[cr, cc] = amp[centre]
+    fine_mask = np.repeat(np.repeat(interior, q, axis=0), q, axis=1)
+    fine_amp = np.repeat(np.repeat(cell_amp, q, axis=0), q, axis=1)
+    # bilinear OPD between the cells' means, over lit cells only
+    c = (np.arange(n * q) + 0.5) / q - 0.5
+    i0 = np.clip(np.floor(c).astype(int), 0, n - 1)
+    i1 = np.clip(i0 + 1, 0, n - 1)
+    f = np.clip(c - np.floor(c), 0.0, 1.0)
+    g = 1.0 - f
+
+    def lerp2(a):  # separable: along rows, then along columns; the columns as rows of the transpose, taken
+        # whole and scaled in place (half the time of a fancy index per column: the same operations, and the
+        # same column-major result, whose layout sets the order of every sum after it)
+        rows = g[:, None] * np.take(a, i0, axis=0) + f[:, None] * np.take(a, i1, axis=0)
+        cols = np.ascontiguousarray(rows.T)
+        out = np.take(cols, i0, axis=0)
+        out *= g[:, None]
+        right = np.take(cols, i1, axis=0)
+        right *= f[:, None]
+        out += right
+        return out.T
+
+    lit = mask.astype(float)
+    num = lerp2(lit * wmean)
+    den = lerp2(lit)
+    fine_opd = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
+    e = ~centre
+    er, ec = pt.row[e] * q + pt.sub[e] // q, pt.col[e] * q + pt.sub[e] % q
+    fine_mask[er, ec] = True
+    fine_amp[er, ec] = amp[e]
+    fine_opd[er, ec] = ws.opd_waves[e]
+    return fine_mask, fine_opd, fine_amp
+
+
+def max_waves_per_cell(pf: PupilFunction) -> float:
+    """Largest OPD change (waves) between neighbouring lit cells."""
+    m, w = pf.mask, pf.opd
+    worst = 0.0
+    for a, b, ma, mb in ((w[:, 1:], w[:, :-1], m[:, 1:], m[:, :-1]), (w[1:], w[:-1], m[1:], m[:-1])):
+        both = ma & mb
+        if both.any():
+            worst = max(worst, float(np.abs(a - b)[both].max()))
+    return worst
+
+
+#: Whole sub-cell lags a pupil sums one by one (a product summed over the overlap each, about
+#: 0.1 ms at 256 sub-cells across) before :func:`otf_lags` computes them all by FFT (1.5-4 ms per
+#: axis): a chart reads 2 per frequency.
+DIRECT_LAGS_MAX = 16
+
+
+def _complex_pupil(pf: PupilFunction, aberrated: bool) -> np.ndarray:
+    """P = A exp(-2 pi i W) over the sub-cells (cached per pupil); ``aberrated=False``: A alone. Only
+    the bounding box of the lit sub-cells: the rows and columns outside it add nothing to any lag."""
+    key = ("P", aberrated)
+    if key not in pf._lags:
+        A = pf.fine_amp * pf.fine_mask
+        rows, cols = np.flatnonzero(A.any(axis=1)), np.flatnonzero(A.any(axis=0))
+        box = np.s_[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1] if rows.size else np.s_[:0, :0]
+        A = A[box]
+        pf._lags[key] = A * np.exp(-2j * np.pi * pf.fine_opd[box]) if aberrated else A.astype(complex)
+    return pf._lags[key]
+
+
+def otf_lags(pf: PupilFunction, axis: int, *, aberrated: bool = True) -> np.ndarray:
+    """Normalised OTF at every whole sub-cell shear 0, 1, ... along ``axis`` (0: y, the tangential
+    direction of a Y-meridian field; 1: x, sagittal): R[k] = sum P(u) conj(P(u - k)) / sum |P|^2 over
+    the sub-cells (Goodman, *Introduction to Fourier Optics*, 6.3.1), every lag at once by FFT
+    autocorrelation along the axis (Wiener-Khinchin: the inverse transform of |FFT|^2, zero-padded to
+    twice the length so the correlation does not wrap), summed over the other axis. Cached per pupil.
+    ``aberrated=False``: the same pupil without its OPD (the diffraction limit of that pupil)."""
+    key = (axis, aberrated)
+    cache = pf._lags
+    if key not in cache:
+        P = _complex_pupil(pf, aberrated)
+        if axis == 1:
+            P = P.T
+        n, size = P.shape[0], pf.fine_mask.shape[axis]
+        norm = float((np.abs(P) ** 2).sum())
+        F = np.fft.fft(P, n=2 * n, axis=0)
+        r = np.zeros(size, dtype=complex)  # no overlap past the lit box: 0
+        r[:n] = np.fft.ifft((F * F.conj()).sum(axis=1))[:n]
+        # r[k] = sum P(u + k) conj(P(u)); the shear convention here is P(u) conj(P(u - k)): the same sum
+        cache[key] = r / norm if norm > 0 else np.zeros(size, dtype=complex)
+    return cache[key]
+
+
+def _lag(pf: PupilFunction, k: int, axis: int, aberrated: bool) -> complex:
+    """R[k] of :func:`otf_lags` (k < the sub-cells across), summed directly over the overlap of P and
+    P shifted by k while a pupil has been asked for few lags, from the FFT of all lags after."""
+    full = pf._lags.get((axis, aberrated))
+    if full is not None:
+        return complex(full[k])
+    direct = pf._lags.setdefault(("direct", axis, aberrated), {})
+    if k not in direct:
+        if len(direct) >= DIRECT_LAGS_MAX:
+            return complex(otf_lags(pf, axis, aberrated=aberrated)[k])
+        P = _complex_pupil(pf, aberrated)
+        if ("conj", aberrated) not in pf._lags:
+            pf._lags["conj", aberrated] = P.conj()
+            pf._lags["norm", aberrated] = float((P.real * P.real + P.imag * P.imag).sum())
+        Pc, norm = pf._lags["conj", aberrated], pf._lags["norm", aberrated]
+        if axis == 1:
+            P, Pc = P.T, Pc.T
+        n = P.shape[0]
+        lit = norm > 0 and k < n  # past the lit box the shifted pupil does not overlap
+        direct[k] = complex(np.einsum("ij,ij->", P[k:], Pc[:n - k])) / norm if lit else 0j
+    return direct[k]
+
+
+def shear_otf(pf: PupilFunction, shift_cells: float, axis: int, *, aberrated: bool = True) -> complex:
+    """Normalised OTF at a pupil shear of ``shift_cells`` (>= 0, in cells) along ``axis``: :func:`otf_lags`
+    interpolated linearly between whole sub-cell shears (a quarter cell apart, where the OTF is
+    smooth: its curvature times (1/4 cell)^2 / 8 is the interpolation error)."""
+    size = pf.fine_mask.shape[axis]  # sub-cells across along the shear
+    s = float(shift_cells) * pf.q
+    k = int(math.floor(s))
+    if k >= size - 1:
+        return 0j if k >= size else _lag(pf, size - 1, axis, aberrated) * (k + 1 - s)
+    f = s - k
+    return (1.0 - f) * _lag(pf, k, axis, aberrated) + f * _lag(pf, k + 1, axis, aberrated)
+
+
+def cutoff_cells(pf: PupilFunction, axis: int) -> float:
+    """Shear (cells) beyond which the pupil no longer overlaps itself along ``axis``."""
+    lit = pf.fine_mask.any(axis=1 - axis)
+    idx = np.flatnonzero(lit)
+    return float(idx.max() - idx.min() + 1) / pf.q if idx.size else 0.0
