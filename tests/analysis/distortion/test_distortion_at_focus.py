@@ -170,3 +170,26 @@ def test_card_json_and_distortion_cli_print_the_same_curve(tmp_path, capsys):
     ax = next(a for a in fig.axes if a.get_label() == "distortion")
     line = ax.get_lines()[0]
     assert list(line.get_ydata()) == pytest.approx(got, abs=1e-12)
+
+
+def test_fields_one_meridian_does_not_reach_are_left_out_with_a_note(capsys):
+    """An anamorphic's two meridians cover different fields: `distortion --field` at a field the Y meridian
+    reaches but the X meridian does not (Panavision's rear 1.3x at the lens card's widest Y field) keeps
+    the Y points and names the X field it leaves out, instead of refusing the whole command (the card's
+    Y fields, asked again on the command line, exited 2)."""
+    import json
+
+    from physcam.cli import main
+
+    lens = load_lens("panavision_rear_anamorphic_1_3x")
+    top = max(p.field_deg for p in _card_curve(lens, math.inf).meridian("y"))
+    argv = ["distortion", "--lens", "panavision_rear_anamorphic_1_3x", "--focus", "inf",
+            "--sensor-width", str(SENSOR[0]), "--sensor-height", str(SENSOR[1]), "--json",
+            "--field", "1", "--field", repr(top)]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    ys = [p["field_deg"] for p in out["points"] if p["axis"] == "y"]
+    xs = [p["field_deg"] for p in out["points"] if p["axis"] == "x"]
+    assert ys == pytest.approx([1.0, top], abs=1e-9)
+    assert xs == pytest.approx([1.0], abs=1e-9)
+    assert any("X meridian" in n and "left out" in n for n in out["notes"])

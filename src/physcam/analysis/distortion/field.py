@@ -377,9 +377,14 @@ def _focused_distortion(lens, fields_deg, focus_mm, w, h, n_fields, wl, backend)
                 raise InputError("give field angles between -89 and 89 degrees")
             heights, ok = at.heights_for(axis, fields, 4.0 * half_diag)
         ideal, passed = at.ideal(axis, heights)
-        if not (ok & passed).all():
+        keep = ok & passed
+        if not keep.any() or (fields_deg is None and not keep.all()):
             raise OpticsError(f"a chief ray of {lens.name!r} focused at {focus_mm:g} mm misses the film in the "
                               f"{axis.upper()} meridian; choose smaller fields")
+        if not keep.all():  # e.g. an anamorphic's X meridian covers less than its Y meridian's fields
+            gone = ", ".join(f"{f:g}" for f in np.atleast_1d(fields_deg)[~keep])
+            notes.append(f"{axis.upper()} meridian: no chief ray reaches the film at {gone} deg; left out")
+            heights, ideal = heights[keep], ideal[keep]
         f = at.g[axis].pinhole_focal_length
         for hr, hi in zip(heights, ideal):
             real_pic = -hr  # the upright picture: the film turned by 180 degrees
