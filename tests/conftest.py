@@ -32,10 +32,10 @@ settings.load_profile("physcam")
 def extension_zip(tmp_path_factory):
     """``physcam export blender-extension`` of every bundled lens, built once per test session and shared
     by the Blender extension's tests (building it solves every bundled lens's focus table, the slowest
-    step). Under pytest-xdist the tests that use it are one xdist group (``make test`` runs ``--dist
-    loadgroup``), so one worker builds it while the other runs the rest; should two workers ask, they
-    share one build: the first builds it under a lock in the session's common temporary folder, the
-    other waits and reads it (each worker building its own doubled the suite's slowest step). Here, not in tests/blender/conftest.py: with
+    step). Under pytest-xdist the workers share one build: the first worker to ask builds it under a
+    lock in the session's common temporary folder, the other waits and reads it (each worker building
+    its own doubled the suite's slowest step; putting every test that uses it on one worker, xdist's
+    loadgroup, made that worker the suite's last by a minute). Here, not in tests/blender/conftest.py: with
     --doctest-modules two conftest modules of one name collide."""
     import fcntl
 

@@ -18,7 +18,7 @@ from physcam.optics.focusing import breathing_table
 from physcam.trace.rays import RayBatch
 from physcam.trace.trace import trace_to_film
 
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("blender-extension")]  # one worker builds and uses the zip
+pytestmark = pytest.mark.slow
 
 SLUG = "zeiss_distagon_35mm_f4"
 SW, SH, W, H = 36.0, 24.0, 512, 342

@@ -15,7 +15,7 @@ from _blender import INSTALLED_EXTENSION_SCENE, run_blender_log
 from physcam.lens.library import load_lens
 from physcam.optics.sensors import sensors
 
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("blender-extension")]  # one worker builds and uses the zip
+pytestmark = pytest.mark.slow
 
 ARTIST = INSTALLED_EXTENSION_SCENE + '''
 scene.cycles.samples = 16; scene.cycles.use_adaptive_sampling = False; scene.cycles.max_bounces = 0

@@ -20,7 +20,7 @@ from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus, iris_semi_diameter
 from physcam.trace.aperture import Aperture
 
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("blender-extension")]  # one worker builds and uses the zip
+pytestmark = pytest.mark.slow
 
 LENS, MARK_MM, FSTOP, BLADES, CORNER_DEG = "dgauss_50mm", 2000.0, 2.8, 6, 15.0
 NEAR_MM, SPHERE_M = 700.0, 0.001  # the sphere: mm from the film, radius (m)

@@ -20,7 +20,7 @@ from physcam.analysis.image_quality.colour import chromatic_aberration
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus
 
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("blender-extension")]  # one worker builds and uses the zip
+pytestmark = pytest.mark.slow
 
 SLUG, FSTOP, FIELD_DEG = "zuiko_18mm_f3_5", 8.0, 48.0
 SW, W, H = 36.0, 512, 342

@@ -19,7 +19,7 @@ from physcam.export.blender import bake_camera
 from physcam.lens.library import load_lens
 from physcam.trace.trace import camera_rays
 
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("blender-extension")]  # one worker builds and uses the zip
+pytestmark = pytest.mark.slow
 
 LENS, SW, SH, W, H = "dgauss_50mm", 36.0, 24.0, 36, 24
 FSTOPS = (2.8, 4.5, 8.0)

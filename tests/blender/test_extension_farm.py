@@ -27,7 +27,7 @@ from physcam.export.blender import bake_camera
 from physcam.lens.library import load_lens
 from physcam.optics.state import camera_state
 
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("blender-extension")]  # one worker builds and uses the zip
+pytestmark = pytest.mark.slow
 
 LENS, SW, SH, W, H = "dgauss_50mm", 36.0, 24.0, 256, 144
 FRAME_H = SW * H / W  # Auto fit in a landscape frame: the sensor's width is the frame's width

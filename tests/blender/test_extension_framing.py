@@ -15,7 +15,7 @@ import pytest
 
 from _blender import INSTALLED_EXTENSION_SCENE, run_blender_log
 
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("blender-extension")]  # one worker builds and uses the zip
+pytestmark = pytest.mark.slow
 
 LENS = "dgauss_50mm"
 CASES = [("16:9, auto", 96, 54, "AUTO"), ("9:16, auto", 54, 96, "AUTO"), ("9:16, horizontal", 54, 96, "HORIZONTAL"),

@@ -16,7 +16,7 @@ from physcam.analysis.image_quality.ghosts import ghost_analysis, ghost_pairs
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus, iris_semi_diameter
 
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("blender-extension")]  # one worker builds and uses the zip
+pytestmark = pytest.mark.slow
 
 SLUG, FSTOP, FIELD_DEG = "dgauss_50mm", 2.8, 8.0
 SW, W, H = 36.0, 256, 171
