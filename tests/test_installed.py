@@ -9,6 +9,7 @@ docs/install.md.
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import subprocess
@@ -39,7 +40,12 @@ def installed(tmp_path_factory):
     env = {k: v for k, v in os.environ.items() if not k.startswith(("PHYSCAM_", "PYTHON", "VIRTUAL_ENV"))}
     env["PIP_DISABLE_PIP_VERSION_CHECK"] = "1"
     dist = tmp / "dist"
-    _run([sys.executable, "-m", "build", "--outdir", str(dist), str(ROOT)], tmp, env=env)
+    # `python -m build` stages the sdist in the checkout itself (physcam-<version>/, src/*.egg-info): two
+    # xdist workers building at once removed each other's staging folder, so they take turns
+    base = tmp_path_factory.getbasetemp()
+    with open((base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "build.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+        _run([sys.executable, "-m", "build", "--outdir", str(dist), str(ROOT)], tmp, env=env)
     wheels, sdists = sorted(dist.glob("physcam-*.whl")), sorted(dist.glob("physcam-*.tar.gz"))
     assert len(wheels) == 1 and len(sdists) == 1
     venv = tmp / "venv"
