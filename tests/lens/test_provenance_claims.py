@@ -7,6 +7,7 @@ from physcam's output; each test removes one piece and expects the sentence that
 """
 
 import dataclasses
+import re
 from pathlib import Path
 
 import pytest
@@ -14,6 +15,8 @@ import pytest
 from physcam.lens.check import check
 from physcam.lens.library import find_lens, list_lenses, load_lens
 from physcam.lens.provenance import Provenance, primary_source_claim_gaps, provenance_of
+
+from patent_stated import PATENT_STATED
 
 BACKED = Provenance(
     source="US 9,999,999 (Example Co.), example 2 (Table 2)",
@@ -96,3 +99,16 @@ def test_lens_check_accepts_a_backed_claim(tmp_path):
     path.write_text(text)
     codes = {f.code for f in check(path)}
     assert "provenance_check_unstated" not in codes and "provenance_unchecked" not in codes
+
+
+@pytest.mark.parametrize("slug", sorted(PATENT_STATED))
+def test_the_stated_numbers_in_the_file_are_the_sources(slug):
+    """[lens] focal_length and max_fstop, and the stated EFL its checks line compares, are the numbers
+    tests/lens/patent_stated.py typed from the transcriptions of the patents' tables, not physcam's
+    paraxial values (which differ in the last digits: 49.993 against the stated 49.99)."""
+    want = PATENT_STATED[slug]
+    p = load_lens(slug)
+    assert p.metadata.focal_length == want["efl"] and p.metadata.max_fstop == want["fno"]
+    (line,) = [c for c in provenance_of(p).checks if c.startswith("EFL:")]
+    stated = re.search(r"stated focal length \(as transcribed\) (\d+(?:\.\d+)?) mm against paraxial (\d+\.\d+)", line)
+    assert float(stated.group(1)) == want["efl"]
