@@ -1,6 +1,6 @@
 """A lens file that says its numbers were compared with the primary source must say with what and how
-(issue 44): the source names the example, table or page, says where it can be read, and one
-``checks`` line starting ``primary source:`` names that place and the numbers compared.
+(issue 44): the source names the example, table or page, ``checked``/``checked_by`` say when and by
+whom, and one ``checks`` line starting ``primary source:`` names that place and the numbers compared.
 
 The records below are written here by hand (a made-up transcription of a patent example), not taken
 from physcam's output; each test removes one piece and expects the sentence that names it.
@@ -41,7 +41,6 @@ def test_a_backed_claim_has_no_gaps():
 
 @pytest.mark.parametrize("change, words", [
     ({"source": "US 9,999,999 (Example Co.)"}, "does not name the example, table or page"),
-    ({"source_url": None}, "no source_url"),
     ({"checked_by": None}, "checked and checked_by"),
     ({"checks": ("EFL: the patent's stated 51.10 mm against paraxial 51.100 mm",)}, "no checks line"),
     ({"checks": ("primary source: Table 2 compared",)}, "no checks line"),  # no numbers, no comparison
@@ -52,11 +51,14 @@ def test_each_missing_piece_is_named(change, words):
     assert len(gaps) == 1 and words in gaps[0]
 
 
-def test_a_book_page_stands_for_a_url():
+def test_a_book_page_and_a_design_revision_are_places():
     book = dataclasses.replace(BACKED, source="W. J. Smith, Modern Lens Design (1st ed., 1992), p. 312",
                                source_url=None, checks=("primary source: the table on p. 312 against the file: "
                                                         "r1 58.950 against 58.950, nd 1.670 against 1.670",))
-    assert primary_source_claim_gaps(book) == []
+    design = dataclasses.replace(BACKED, source="Beloved Lens Co. design BL-50, revision C", source_url=None,
+                                 checks=("primary source: revision C's table against the file: r1 24.84 against "
+                                         "24.84 ... (every row equal)",))
+    assert primary_source_claim_gaps(book) == [] == primary_source_claim_gaps(design)
 
 
 def test_no_claim_no_gaps():
@@ -71,7 +73,7 @@ def test_every_bundled_record_backs_what_it_claims(rec):
     bundled file may carry a bare claim."""
     prov = provenance_of(load_lens(rec.slug))
     assert primary_source_claim_gaps(prov) == []
-    if prov.primary_source_checked:
+    if prov.primary_source_checked:  # a bundled lens also says where its source can be read
         assert prov.source_url and any(c.startswith("primary source:") for c in prov.checks)
 
 

@@ -39,9 +39,10 @@ __all__ = ["Provenance", "provenance_of", "check_provenance_table", "primary_sou
 
 #: How a ``checks`` line about the primary source itself begins (``"primary source: ..."``).
 PRIMARY_SOURCE_CHECK = "primary source:"
-#: Words that name a place inside a source: a patent's example or table, a book's page or figure.
-_PLACE = re.compile(r"\b(example|embodiment|table|fig\.?|figure|p\.|pp\.|page|beispiel|tabelle)\s*[\dIVX]",
-                    re.IGNORECASE)
+#: Words that name a place inside a source: a patent's example or table, a book's page or figure, a
+#: design file's revision.
+_PLACE = re.compile(r"\b(example|embodiment|table|fig\.?|figure|p\.|pp\.|page|revision|rev\.|beispiel|tabelle)"
+                    r"\s*(\d+|[IVX]+\b|[A-Z]\b)", re.IGNORECASE)
 _DECIMAL = re.compile(r"[-+]?\d+\.\d+")
 _COMPARED = re.compile(r"\b(against|equal|equals|match|matches|agree|agrees|differ|differs)\b", re.IGNORECASE)
 
@@ -143,18 +144,16 @@ def check_provenance_table(prov: dict, path=None) -> None:
 
 def primary_source_claim_gaps(prov: Provenance) -> list[str]:
     """What a record that says ``primary_source_checked = true`` leaves unsaid, one sentence each
-    (empty when the claim is backed, or not made): the source must name the place in it (example,
-    table, page), say where it can be read (``source_url``, or a page of a book), who checked and
-    when, and one ``checks`` line starting ``primary source:`` must name that place and the numbers
-    compared (a decimal number and ``against``/``equal``/``match``/``differ``). A ``primary source:
-    not reached`` line contradicts the claim."""
+    (empty when the claim is backed, or not made): the source must name the place in it (a patent's
+    example or table, a book's page, a design's revision), ``checked`` and ``checked_by`` who checked
+    and when, and one ``checks`` line starting ``primary source:`` must name that place and the
+    numbers compared (a decimal number and ``against``/``equal``/``match``/``differ``). A ``primary
+    source: not reached`` line contradicts the claim."""
     if prov.primary_source_checked is not True:
         return []
     gaps = []
     if not (prov.source and _PLACE.search(prov.source)):
         gaps.append("the source does not name the example, table or page the numbers were compared with")
-    if not (prov.source_url or (prov.source and re.search(r"\bpp?\.\s*\d", prov.source))):
-        gaps.append("no source_url (nor a book page) says where the primary source can be read")
     if not (prov.checked and prov.checked_by):
         gaps.append("checked and checked_by do not say when and by whom")
     lines = [c for c in prov.checks if c.lower().startswith(PRIMARY_SOURCE_CHECK)]
