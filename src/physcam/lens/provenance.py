@@ -149,6 +149,9 @@ def primary_source_claim_gaps(prov: Provenance) -> list[str]:
     and when, and one ``checks`` line starting ``primary source:`` must name that place and the
     numbers compared (a decimal number and ``against``/``equal``/``match``/``differ``). A ``primary
     source: not reached`` line contradicts the claim."""
+    from ..errors import require_type
+
+    require_type("prov", prov, Provenance, "physcam.lens.provenance.provenance_of(lens)")
     if prov.primary_source_checked is not True:
         return []
     gaps = []
