@@ -81,13 +81,15 @@ class AnamorphicPage:
     pupils: list  # EntrancePupils at the same marks
     distortion: list  # (mark mm, DistortionResult or None): infinity and the close focus
     bokeh: list  # (label, (x mm, y mm) on the film aimed at, BokehImage or None)
+    light_from_film_mm: float  # where the bokeh lights stand, in front of the film
     notes: list[str] = field(default_factory=list)
 
     def bokeh_rows(self) -> list[dict]:
         out = []
         for lab, (hx, hy), img in self.bokeh:
             a = None if img is None or img.rays_passed < MIN_RAYS_FOR_ASPECT else blur_aspect(img)
-            out.append({"label": lab, "aimed_at_film_mm": [hx, hy], "aspect_on_film": a,
+            out.append({"label": lab, "aimed_at_film_mm": [hx, hy], "light_from_film_mm": self.light_from_film_mm,
+                        "aspect_on_film": a,
                         "aspect_desqueezed": None if a is None else a * self.stated_squeeze,
                         **({} if img is None else img.to_dict())})
         return out
@@ -137,9 +139,9 @@ def anamorphic_page(lens, camera, breathing: list, sensor_mm: tuple[float, float
             d = None
             notes.append(f"distortion per meridian at {m:g} mm: {exc}")
         distortion.append((m, d))
-    bokeh = _bokeh(lens, camera, (w, h), image_circle_mm, rays, pixels, backend, notes)
+    depth, bokeh = _bokeh(lens, camera, (w, h), image_circle_mm, rays, pixels, backend, notes)
     return AnamorphicPage(lens.name, float(lens.squeeze), _meridians(lens), list(breathing), pupils, distortion,
-                          bokeh, notes)
+                          bokeh, depth, notes)
 
 
 def _bokeh(lens, camera, sensor_mm, circle_mm, rays, pixels, backend, notes):
@@ -171,7 +173,7 @@ def _bokeh(lens, camera, sensor_mm, circle_mm, rays, pixels, backend, notes):
             notes.append(f"bokeh {lab}: {exc}")
             img = None
         out.append((lab, (hx, hy), img))
-    return out
+    return depth, out
 
 
 # ---- drawing --------------------------------------------------------------------------------------
@@ -314,8 +316,7 @@ def _draw_bokeh(fig, sub, page):
         asp = row["aspect_desqueezed"]
         ax.set_xlabel("x desqueezed (mm)\n" + (f"aspect {asp:.2f} (w / h)" if asp is not None else
                                                 f"{img.rays_passed} rays: too few for an aspect"), fontsize=6)
-        if k == 0:
-            ax.set_ylabel("y (mm)", fontsize=6)
+        ax.set_ylabel("y (mm)", fontsize=6, labelpad=1)
 
 
 def _window(img, squeeze):
