@@ -27,7 +27,7 @@ from ...errors import InputError, OpticsError
 from ...lens.prescription import Prescription, takes_prescription
 from ...figures import PALETTE, styled
 
-__all__ = ["PAGES", "PANELS", "LensCard", "lens_card", "save_lens_card", "card_files"]
+__all__ = ["PAGES", "PANELS", "LensCard", "lens_card", "save_lens_card", "card_pages", "card_files"]
 
 #: Page sizes (width, height) in inches, portrait: ISO A4 (210 x 297 mm) and US Letter (8.5 x 11 in).
 PAGES = {"a4": (210.0 / 25.4, 297.0 / 25.4), "letter": (8.5, 11.0)}
@@ -536,19 +536,29 @@ def _draw_bokeh(ax, img, label, height_mm):
 
 
 # ---- writing --------------------------------------------------------------------------------------
-def card_files(card: LensCard, path) -> list:
-    """The files :func:`save_lens_card` writes for ``card`` at ``path``: the one PDF; for a PNG or SVG, ``path``
-    (the first page) and one file per further page beside it, ``<stem>-zoom<suffix>``,
-    ``<stem>-anamorphic<suffix>``."""
+@takes_prescription
+def card_pages(lens: Prescription) -> list[str]:
+    """The pages of ``lens``'s card, before it is computed: "main", then "zoom" for a zoom lens and
+    "anamorphic" for an anamorphic one (what :attr:`LensCard.pages` will say)."""
+    return ["main"] + (["zoom"] if lens.zoom is not None else []) + (["anamorphic"] if lens.squeeze != 1.0 else [])
+
+
+def card_files(card, path) -> list:
+    """The files :func:`save_lens_card` writes for ``card`` (a :class:`LensCard`, or its pages' names:
+    :func:`card_pages`) at ``path``: the one PDF; for a PNG or SVG, ``path`` (the first page) and one file per
+    further page beside it, ``<stem>-zoom<suffix>``, ``<stem>-anamorphic<suffix>``."""
     from pathlib import Path
 
-    from ...errors import require_type
+    from ...errors import WrongTypeError
 
-    require_type("card", card, LensCard, "physcam.analysis.lens_cards.card.lens_card(lens)")
+    pages = card.pages if isinstance(card, LensCard) else card
+    if not (isinstance(pages, list) and pages[:1] == ["main"]):
+        raise WrongTypeError("card must be a LensCard (physcam.analysis.lens_cards.card.lens_card(lens)) or its "
+                             "pages' names (card_pages(lens))")
     p = Path(path)
     if p.suffix.lower() == ".pdf":
         return [p]
-    return [p] + [p.with_name(f"{p.stem}-{name}{p.suffix}") for name in card.pages[1:]]
+    return [p] + [p.with_name(f"{p.stem}-{name}{p.suffix}") for name in pages[1:]]
 
 
 @styled
@@ -556,9 +566,11 @@ def save_lens_card(card: LensCard, path, *, force: bool = False, units: str = "m
     """Write ``card`` to ``path`` (.pdf, .png or .svg): a PDF with one page per page of the card, or a PNG/SVG
     of its first page and one file per further page (:func:`card_files`); each through atomic_write, none
     written when any exists (without ``force``). Returns ``path``."""
+    from ...errors import require_type
     from ...figures import save_figure
     from ...io import check_writable
 
+    require_type("card", card, LensCard, "physcam.analysis.lens_cards.card.lens_card(lens)")
     files = card_files(card, path)
     for f in files:
         check_writable(f, force=force)
