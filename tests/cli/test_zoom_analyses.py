@@ -181,6 +181,11 @@ def test_characterize_over_zoom_on_dask_gives_each_positions_efl(tmp_path, capsy
     assert got.keys() == want.keys()
     for k in want:
         assert got[k] == pytest.approx(want[k], rel=1e-3)
+    # the index's zoom columns: each position's encoder value and optiland's EFL there
+    zoom = {r["lens"]: (r["zoom_encoder"], r["zoom_focal_length_mm"]) for r in rows}
+    for u, ref in ((0.0, OPTILAND[CANON][0]), (1.0, OPTILAND[CANON][2])):
+        enc, efl = zoom[f"{CANON}_zoom_{ref['efl_mm']:.1f}mm"]
+        assert enc == u and efl == pytest.approx(ref["efl_mm"], rel=1e-3)
 
 
 @pytest.mark.parametrize("argv, words", [

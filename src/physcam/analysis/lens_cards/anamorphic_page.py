@@ -187,13 +187,13 @@ def draw_anamorphic_page(fig, page: AnamorphicPage, units: str) -> None:
                [r.breathing_focal_length_mm for r in page.breathing],
                [r.vertical_breathing_focal_length_mm for r in page.breathing])
     _draw_pair(fig.add_subplot(gs[1, 1], label="entrance pupils"), page, units,
-               "entrance pupils in front of the film (X: pan pivot, Y: tilt)", "in front of the film (mm)",
+               "entrance pupils: X the pan pivot, Y the tilt pivot", "in front of the film (mm)",
                [p.horizontal_from_film_mm for p in page.pupils], [p.vertical_from_film_mm for p in page.pupils])
     _draw_distortion(fig.add_subplot(gs[2, 0], label="distortion per meridian"), page, units)
     _draw_pair(fig.add_subplot(gs[2, 1], label="pupil diameters"), page, units,
                "entrance-pupil diameter per meridian", "entrance pupil Ø (mm)",
                [p.horizontal_diameter_mm for p in page.pupils], [p.vertical_diameter_mm for p in page.pupils])
-    _draw_bokeh(fig, fig.add_gridspec(1, len(page.bokeh), left=0.09, right=0.9, top=0.2, bottom=0.06, wspace=0.4),
+    _draw_bokeh(fig, fig.add_gridspec(1, len(page.bokeh), left=0.09, right=0.9, top=0.215, bottom=0.06, wspace=0.4),
                 page)
 
 
