@@ -6,9 +6,6 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["focus_x", "focus_axis"]
-
-
 def focus_x(mark_mm: float, units: str) -> float:
     """Where a focus mark (mm from the film plane) sits on the axis: 1 / mark in 1/m (1/ft); infinity 0."""
     per = 1000.0 if units == "m" else 304.8

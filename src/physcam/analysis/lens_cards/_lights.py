@@ -4,9 +4,6 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["light_distance_mm"]
-
-
 def light_distance_mm(camera, efl_mm: float) -> float:
     """The lights' distance in front of the film plane (mm): half the camera's focus distance, or 15 focal
     lengths (``efl_mm``) when it is focused at infinity; at least 1.5 times the front vertex's distance from

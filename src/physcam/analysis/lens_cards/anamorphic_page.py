@@ -31,8 +31,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...errors import InputError, OpticsError
+from ...errors import InputError, OpticsError, require_type
 from ...figures import PALETTE
+from ...lens.prescription import Prescription, takes_prescription
+from ._page import checked_drawing, sensor_size
 
 __all__ = ["ANAMORPHIC_PANELS", "AnamorphicPage", "anamorphic_page", "draw_anamorphic_page", "blur_aspect"]
 
@@ -56,6 +58,9 @@ RAYS_CAP = 40
 
 def blur_aspect(img) -> float | None:
     """Width over height of a blur on the film: sqrt(var x / var y) of its irradiance (None: no light)."""
+    from ..defocus.bokeh import BokehImage
+
+    require_type("img", img, BokehImage, "physcam.analysis.defocus.bokeh.bokeh_image(camera, ...)")
     e = img.image.sum(axis=2)
     tot = float(e.sum())
     if tot <= 0.0:
@@ -119,14 +124,19 @@ def _meridians(lens) -> dict:
     return out
 
 
-def anamorphic_page(lens, camera, breathing: list, sensor_mm: tuple[float, float], image_circle_mm: float, *,
+@takes_prescription
+def anamorphic_page(lens: Prescription, camera, breathing: list, sensor_mm: tuple[float, float], image_circle_mm: float, *,
                     curve_fields: int = 6, rays: int = 20_000, pixels: int = 48, backend: str = "auto") -> AnamorphicPage:
     """The anamorphic page of ``lens`` (module notes): ``camera`` its state at the card's focus,
     ``breathing`` the card's breathing rows (infinity to the close focus)."""
-    from ...optics.focusing import entrance_pupils
+    from ...optics.focusing import BreathingRow, entrance_pupils
+    from ...optics.state import CameraState
     from ..distortion.field import real_distortion
 
-    w, h = sensor_mm
+    require_type("camera", camera, CameraState, "physcam.optics.state.camera_state(lens, focus_mm=...)")
+    if not (isinstance(breathing, list) and all(isinstance(r, BreathingRow) for r in breathing)):
+        raise InputError("breathing must be a list of BreathingRow (physcam.optics.focusing.breathing_table)")
+    w, h = sensor_size(sensor_mm)
     notes: list[str] = []
     pupils = [entrance_pupils(lens, r.focus_from_film_mm) for r in breathing]
     marks = [math.inf] + ([breathing[-1].focus_from_film_mm] if breathing else [])
@@ -179,6 +189,7 @@ def _bokeh(lens, camera, sensor_mm, circle_mm, rays, pixels, backend, notes):
 # ---- drawing --------------------------------------------------------------------------------------
 def draw_anamorphic_page(fig, page: AnamorphicPage, units: str) -> None:
     """Draw ``page`` on ``fig`` (a card-sized Figure) below its title, one axes per :data:`ANAMORPHIC_PANELS`."""
+    checked_drawing(fig, page, AnamorphicPage, units)
     gs = fig.add_gridspec(3, 2, left=0.09, right=0.9, top=0.925, bottom=0.32, hspace=0.5, wspace=0.42)
     _draw_numbers(fig.add_subplot(gs[0, 0], label="anamorphic numbers"), page, units)
     _draw_squeeze(fig.add_subplot(gs[0, 1], label="squeeze breathing"), page, units)

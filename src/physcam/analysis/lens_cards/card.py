@@ -199,7 +199,6 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
     a prime given ``zoom`` is refused."""
     from ...data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
     from ...errors import require_positive
-    from ...optics import focusing
     from ...units import parse_distance
 
     if sensor is not None:
@@ -386,7 +385,7 @@ def _bokeh(camera, key, w, h, q, backend, notes):
     from ..defocus.bokeh import bokeh_image
     from ._lights import light_distance_mm
 
-    efl, focus_mm = key["efl_mm"], camera.focus_from_film_mm
+    efl = key["efl_mm"]
     depth = light_distance_mm(camera, efl)
     pupil = key["entrance_pupil_from_film_mm"]
     corner = 0.9 * min(0.5 * math.hypot(w, h), 0.5 * key["image_circle_mm"])

@@ -18,8 +18,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ...errors import OpticsError
+from ...errors import InputError, OpticsError
 from ...figures import PALETTE
+from ...lens.prescription import Prescription, takes_prescription
+from ._page import checked_drawing, sensor_size
 
 __all__ = ["ZOOM_PANELS", "ZoomPage", "zoom_page", "draw_zoom_page"]
 
@@ -59,16 +61,21 @@ class ZoomPage:
                 "notes": list(self.notes)}
 
 
-def zoom_page(lens, encoder: float, sensor_mm: tuple[float, float], *, curve_fields: int = 6,
+@takes_prescription
+def zoom_page(lens: Prescription, encoder: float, sensor_mm: tuple[float, float], *, curve_fields: int = 6,
               backend: str = "auto") -> ZoomPage:
-    """The zoom page of zoom lens ``lens`` whose first page shows zoom ``encoder`` (module notes)."""
+    """The zoom page of zoom lens ``lens`` whose first page shows zoom ``encoder`` (0..1 or a focal length
+    such as "135mm") on a ``sensor_mm`` (width, height) sensor (module notes)."""
     from ...lens.zoom import prescription_at
     from ...optics.state import camera_state
-    from ...optics.zoom import default_encoders, zoom_breathing, zoom_table
+    from ...optics.zoom import default_encoders, zoom_breathing, zoom_encoder, zoom_table
     from ..distortion.field import real_distortion
     from .diagram import lens_diagram
 
-    w, h = sensor_mm
+    if lens.zoom is None:
+        raise InputError(f"lens {lens.name!r} is not a zoom lens (its file has no zoom table): it has no zoom page")
+    encoder = zoom_encoder(lens, encoder)
+    w, h = sensor_size(sensor_mm)
     notes: list[str] = []
     enc = list(lens.zoom.encoder)
     positions = zoom_table(lens, default_encoders(lens), sensor_width_mm=w)
@@ -101,6 +108,7 @@ def _wrap(text: str, n: int) -> str:
 
 def draw_zoom_page(fig, page: ZoomPage, units: str) -> None:
     """Draw ``page`` on ``fig`` (a card-sized Figure) below its title, one axes per :data:`ZOOM_PANELS`."""
+    checked_drawing(fig, page, ZoomPage, units)
     gs = fig.add_gridspec(5, 2, left=0.09, right=0.9, top=0.925, bottom=0.06, hspace=0.62, wspace=0.42,
                           height_ratios=(0.85, 0.7, 1.0, 1.0, 1.0))
     for k, (u, d) in enumerate(page.sections):
