@@ -267,3 +267,28 @@ def test_a_pdf_holds_every_page_and_a_png_writes_the_others_beside_it(neil_card,
     for f in files:
         with Image.open(f) as im:
             assert im.size == pytest.approx((PAGES["a4"][0] * 30, PAGES["a4"][1] * 30), abs=1.0)
+
+
+def test_a_lens_longer_than_its_close_marks_still_has_breathing_pupils_and_bokeh():
+    """The Panavision rear 1.3x is 19 mm long in focal length and 300 mm long in glass: the default breathing
+    marks below 0.5 m, and bokeh lights 15 focal lengths (285 mm) from the film, would sit inside it. Its card
+    breathes from infinity to the last mark 1.5 lens lengths away (said in the notes), with both meridians'
+    framing focal lengths and one pupil (a rear anamorphic) as the hand y-u trace gives them, and its lights
+    stand in front of the lens. (Before: no breathing table and no bokeh on its card.)"""
+    slug = "panavision_rear_anamorphic_1_3x"
+    lens = load_lens(slug)
+    card = lens_card(lens, quality="draft")
+    length = lens.total_track + lens.surfaces[-1].thickness
+    marks = [r.focus_from_film_mm for r in card.breathing]
+    assert math.isinf(marks[0]) and marks[-1] == 500.0 and marks[-1] > 1.5 * length
+    assert any(n.startswith("breathing down to 0.5 m only") for n in card.notes)
+    for r, p in zip(card.anamorphic_page.breathing, card.anamorphic_page.pupils):
+        fx, fy = hand_framing_focal_lengths(slug, r.focus_from_film_mm)
+        assert (r.breathing_focal_length_mm, r.vertical_breathing_focal_length_mm) == pytest.approx((fx, fy), rel=1e-6)
+        hx, hy = hand_pupils_from_film(slug, r.focus_from_film_mm)
+        assert (p.horizontal_from_film_mm, p.vertical_from_film_mm) == pytest.approx((hx, hy), rel=1e-6)
+        assert abs(p.separation_mm) < 0.1
+    assert card.breathing[0].breathing_squeeze == pytest.approx(1.3, rel=0.01)  # the published 1.3x
+    assert all(img is not None and img.rays_passed > 0 for _, _, img in card.bokeh)
+    assert all(img is not None for _, _, img in card.anamorphic_page.bokeh)
+    assert card.anamorphic_page.light_from_film_mm >= 1.5 * length
