@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..errors import ExportError
+from ..errors import ExportError, require_type
 from .spec import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec
 from .plugin import ensure_registered, require_prim, require_stage
 
@@ -315,6 +315,7 @@ def companion_inputs_hash(spec, prescription=None) -> str:
     import json
     from dataclasses import asdict
 
+    require_type("spec", spec, CameraSpec, "the composed camera: physcam.usd.read.read_camera(stage).spec")
     camera = spec.values()
     if camera.get("horizontal_entrance_pupil_mm") is None:  # files written before the field hash as they did
         camera.pop("horizontal_entrance_pupil_mm", None)
