@@ -112,7 +112,7 @@ class CameraSpec:
         old = {k: values.pop(k) for k in CAMERA_VALUES if k in values}
         if old:
             warnings.warn("CameraSpec(focal_length_mm=..., fstop=..., focus_mm=...) builds its camera from numbers: "
-                          "use CameraSpec.of(...) or CameraSpec(camera, ...); the keyword form goes in physcam "
+                          "use CameraSpec.of(...), CameraSpec(camera, ...) or spec.replaced(...); the keyword form goes in physcam "
                           f"{UNTIL}", DeprecationWarning, stacklevel=2)
             camera = _camera_of_numbers(**{**(_numbers_of(camera) if camera is not None else _DEFAULT_CAMERA), **old})
         elif camera is None:
