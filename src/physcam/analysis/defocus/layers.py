@@ -275,15 +275,14 @@ def _kernel_at_scale(k: np.ndarray, s: int) -> np.ndarray:
     py = (M[1, 0] * xs + M[1, 1] * ys) / s
     R = int(math.ceil(np.abs(np.concatenate([px.ravel(), py.ravel()])).max())) + 1
     n = 2 * R + 1
-    out = np.zeros((n, n, k.shape[2]))
     x0, y0 = np.floor(px).astype(int), np.floor(py).astype(int)
     fx, fy = px - x0, py - y0
-    for dy, wy in ((0, 1 - fy), (1, fy)):
-        for dx, wx in ((0, 1 - fx), (1, fx)):
-            idx = ((y0 + dy + R) * n + (x0 + dx + R)).ravel()
-            w = (wy * wx).ravel()
-            for ch in range(k.shape[2]):
-                out[..., ch] += np.bincount(idx, weights=w * k[..., ch].ravel(), minlength=n * n).reshape(n, n)
+    at = ((y0 + R) * n + (x0 + R)).ravel()
+    idx = np.concatenate([at, at + 1, at + n, at + n + 1])  # the four coarse pixels around each fine one
+    w = np.concatenate([((1 - fy) * (1 - fx)).ravel(), ((1 - fy) * fx).ravel(), (fy * (1 - fx)).ravel(),
+                        (fy * fx).ravel()])
+    out = np.stack([np.bincount(idx, weights=w * np.tile(k[..., ch].ravel(), 4), minlength=n * n).reshape(n, n)
+                    for ch in range(k.shape[2])], axis=-1)
     return _trim_kernel(out.astype(np.float32))
 
 
