@@ -390,7 +390,6 @@ class KernelCache:
         self._tiles: dict = {}
         self._direct: dict = {}
         self._places: dict = {}
-        self._jacobians = None
         self._read = False
 
     # ---- the field grid -----------------------------------------------------------------------
@@ -485,7 +484,7 @@ class KernelCache:
         """Node kernels of ``missing`` from fans traced at their ladder nodes, field node by field
         node in batches of about 4 million rays."""
         from .field import box_depths, node_kernel
-        from .trace import pupil_boxes, trace_fans
+        from .trace import distortion_jacobians, pupil_boxes, trace_fans
 
         cam = self.camera
         cols, rows = self.grid
@@ -512,7 +511,7 @@ class KernelCache:
             jobs = [(p, float(cam.node_u(m)), box, k) for (_, p, need, _), box in zip(batch, boxes)
                     for m, k in sorted(need.items())]
             fans = iter(trace_fans(cam, jobs))
-            unwarps = iter(np.linalg.inv(self.distortion_jacobians([p for _, p, _, _ in batch])))
+            unwarps = iter(np.linalg.inv(distortion_jacobians(cam, [p for _, p, _, _ in batch])))
             for (cr, p, need, ns) in batch:
                 unwarp = next(unwarps)
                 got = {m: next(fans) for m in sorted(need)}
@@ -534,14 +533,14 @@ class KernelCache:
         triples) of a small blur (:data:`DIRECT_BLUR_PX`), each at its own place and its node's own
         depth, so that :meth:`tile_kernel` reads them instead of blending field nodes; returns the new ones."""
         from .field import box_depths, node_kernel
-        from .trace import pupil_boxes, trace_fans
+        from .trace import distortion_jacobians, pupil_boxes, trace_fans
 
         cam = self.camera
         todo = sorted({_place(x, y, n) for x, y, n in points} - set(self._direct))
         places = sorted({(x, y) for x, y, _ in todo} - set(self._places))
         if places:  # a place's sampling box and unwarp serve all its depths (box_depths: one set per camera)
             boxes = pupil_boxes(cam, places, box_depths(cam))
-            self._places.update(zip(places, zip(boxes, np.linalg.inv(self.distortion_jacobians(places)))))
+            self._places.update(zip(places, zip(boxes, np.linalg.inv(distortion_jacobians(cam, places)))))
         for b in range(0, len(todo), 512):
             part = todo[b:b + 512]
             fans = trace_fans(cam, [((x, y), float(cam.node_u(n)), self._places[(x, y)][0], cam.samples(n, n))
@@ -550,22 +549,6 @@ class KernelCache:
                 self._direct[key] = node_kernel(cam, fan, fan, key[2], None, self._places[key[:2]][1])[0]
         self.traced += len(todo)
         return {k: self._direct[k] for k in todo}
-
-    def distortion_jacobians(self, points) -> np.ndarray:
-        """(k, 2, 2): the distortion's local Jacobian at picture positions ``points``
-        (:func:`~physcam.analysis.defocus.trace.distortion_jacobians`), traced once per camera at the
-        field nodes and bilinear between them (a smooth function of the field: the distortion is a
-        low-order polynomial of it; clamped beyond the frame's edges). Exact at a node."""
-        if self._jacobians is None or self._jacobians[0] != self.fractions:
-            from .trace import distortion_jacobians
-
-            cols, rows = self.grid
-            J = distortion_jacobians(self.camera, [(float(c), float(r)) for r in rows for c in cols])
-            self._jacobians = (self.fractions, J.reshape(len(rows), len(cols), 2, 2))
-        J = self._jacobians[1]
-        cols, rows = self.grid
-        return np.array([sum(wi * wj * J[j, i] for i, wi in self._cell(cols, float(x)) for j, wj in self._cell(rows, float(y)))
-                         for x, y in points]).reshape(-1, 2, 2)
 
     # ---- what defocus reads -------------------------------------------------------------------
     def node_kernel(self, col: int, row: int, n: int) -> np.ndarray:

@@ -469,8 +469,13 @@ def _kernel_index(names, c: int, channels: int) -> np.ndarray:
 
 
 def _pad_kernel(k: np.ndarray, r: int) -> np.ndarray:
+    """``k`` (2q + 1, 2q + 1, channels) centred in zeros of radius r >= q."""
     p = r - k.shape[0] // 2
-    return np.pad(k, ((p, p), (p, p), (0, 0))) if p else k
+    if not p:
+        return k
+    out = np.zeros((2 * r + 1, 2 * r + 1) + k.shape[2:], k.dtype)
+    out[p:p + k.shape[0], p:p + k.shape[1]] = k
+    return out
 
 
 def _to_full(planes: dict, s: int, origin, r: int, H: int, W: int) -> dict:

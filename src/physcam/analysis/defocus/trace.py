@@ -361,7 +361,8 @@ def fan_centroid(fan: Fan) -> tuple[float, float]:
     t = fan.w.sum()
     if not t > 0:
         return 0.0, 0.0
-    return float(np.dot(fan.w, fan.ox) / t), float(np.dot(fan.w, fan.oy) / t)  # blocked rays: 0 x 0
+    # blocked rays: 0 x 0 (a product and a sum, not np.dot: BLAS wakes its threads for long vectors)
+    return float((fan.w * fan.ox).sum() / t), float((fan.w * fan.oy).sum() / t)
 
 
 def bin_fan(fan: Fan, centre: tuple[float, float], channels: int, unwarp=None) -> tuple[np.ndarray, np.ndarray]:
