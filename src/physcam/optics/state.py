@@ -133,6 +133,23 @@ class CameraState:
         return self.stop_semi_diameter / self.focused.surfaces[self.focused.stop_index].semi_diameter
 
     @property
+    def iris_corner_semi(self) -> float:
+        """The stop radius (mm) the iris's corners reach: a bladed iris has the area of the round iris
+        of the f-number (docs/conventions.md), so its corners lie ``aperture.equal_area_scale()``
+        (:meth:`physcam.trace.aperture.Aperture.equal_area_scale`) farther out than that circle, but
+        never beyond the lens's widest iris (the file's stop opened by
+        :data:`~physcam.optics.paraxial.STOP_OPENING_TOLERANCE`) unless the round iris itself is wider;
+        the round iris's radius (:attr:`stop_semi_diameter`) for a round one. Every tracer of a bladed
+        iris draws its polygon inside this radius: the analyses, the defocus kernels, the Blender shader."""
+        ap = self.aperture
+        if ap is None or ap.is_circular:
+            return float(self.stop_semi_diameter)
+        from .paraxial import STOP_OPENING_TOLERANCE
+
+        q = self.focused
+        return ap.corner_semi(self.stop_semi_diameter, q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE))
+
+    @property
     def entrance_pupil_z(self) -> float:
         return float(self.gaussian.z_entrance_pupil)
 

@@ -302,7 +302,7 @@ def defocus_camera(camera: CameraState, *, width: int, height: int, aperture=Non
     if tp.pinhole_focal_length_mm is None:
         raise OpticsError(f"{lens.name} has no best-match pinhole at this focus (its chief ray does not reach the film)")
     ap = _as_aperture(cam.aperture if aperture is None else aperture)
-    stop_semi = cam.stop_semi_diameter if ap is None else ap.corner_semi(cam.stop_semi_diameter, _widest_iris(cam))
+    stop_semi = cam.with_aperture(ap).iris_corner_semi  # a bladed iris of the round one's area (docs/conventions.md)
     fx, dx = _x_meridian(lens, cam.focus_from_film_mm, cam.fstop, tp)
     return DefocusCamera(lens=lens, camera=cam, sensor_width_mm=sw,
                          width=int(width), height=int(height), aperture=ap, dispersion=bool(dispersion),
@@ -328,15 +328,6 @@ def _x_meridian(lens, focus_mm, fstop, tp) -> tuple[float, float]:
     s = focus_mm - tp.entrance_pupil_from_film_mm
     scale = s / (s - delta) if math.isfinite(s) else 1.0
     return tx.pinhole_focal_length_mm * scale, tx.entrance_pupil_diameter_mm
-
-
-def _widest_iris(cam) -> float:
-    """The lens's widest iris (mm): its file's stop opened by physcam's stop-opening tolerance, the
-    farthest a bladed iris's corners go (docs/conventions.md, f-numbers)."""
-    from ...optics.paraxial import STOP_OPENING_TOLERANCE
-
-    q = cam.focused
-    return q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE)
 
 
 def _place(x, y, n) -> tuple[float, float, int]:
