@@ -458,7 +458,20 @@ def _camera_at_the_door(value, given: dict, where: str) -> CameraState:
         if "sensor_mm" in given or "sensor" in given:
             raise InputError("give the sensor once: sensor, sensor_mm or sensor_width_mm/sensor_height_mm")
         given["sensor_mm"] = (w, h)
+    _corner_radius_given(given)
     return _camera(model, "focus_mm" not in given and "film_z" not in given, **given)
+
+
+def _corner_radius_given(given: dict) -> None:
+    """The old ray-level form (a prescription with ``stop_semi_diameter=`` and a bladed ``aperture=``) drew
+    the polygon inside the radius it was given, its corners: the camera's iris is the round one of the
+    polygon's area, that radius over ``aperture.equal_area_scale()`` (docs/conventions.md), so that
+    :attr:`CameraState.iris_corner_semi` gives the corners back where they were."""
+    ap, stop = given.get("aperture"), given.get("stop_semi_diameter")
+    scale = getattr(ap, "equal_area_scale", None)
+    if callable(scale) and not getattr(ap, "is_circular", True) and isinstance(stop, (int, float)) \
+            and not isinstance(stop, bool) and math.isfinite(stop) and stop > 0:
+        given["stop_semi_diameter"] = float(stop) / scale()
 
 
 _SENSOR_WORDS = ("sensor", "sensor_mm", "sensor_width_mm", "sensor_height_mm")

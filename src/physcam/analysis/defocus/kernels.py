@@ -167,11 +167,20 @@ class DefocusCamera:
 
     def node_far(self) -> int:
         """Index of the farthest node (it stands for infinity)."""
-        return -math.floor(-float(self.node_index(0.0)) + 1e-12) if self.focus_u > 0 else 0
+        if "far" not in self._memo:
+            self._memo["far"] = -math.floor(-float(self.node_index(0.0)) + 1e-12) if self.focus_u > 0 else 0
+        return self._memo["far"]
 
     def node_u(self, n):
         """Inverse depth (1/mm) of node(s) ``n``; the farthest node is infinity (0)."""
-        n = np.asarray(n)
+        if isinstance(n, (int, np.integer)) and not isinstance(n, bool):  # one node: memoised (thousands of calls a frame)
+            key = ("u", int(n))
+            if key not in self._memo:
+                self._memo[key] = np.float64(self._node_u(np.asarray(n)))
+            return self._memo[key]
+        return self._node_u(np.asarray(n))
+
+    def _node_u(self, n):
         t = np.abs(n).astype(float)
         b = self.step_px * (np.expm1(self.step_rel * t) / self.step_rel if self.step_rel > 0 else t)
         return np.where(n <= self.node_far(), 0.0, self.focus_u + np.sign(n) * b / self.blur_per_u)
