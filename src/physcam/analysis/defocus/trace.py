@@ -240,64 +240,70 @@ def trace_fans(cam, jobs) -> list[Fan]:
 
 
 def _trace_batch(cam, jobs, wls, z_ep) -> list[Fan]:
-    """One tracer call for the rays of ``jobs`` (module notes). The rays are written job by job into
-    preallocated columns (a job's object point, box and wavelength are constants of its slice)."""
+    """One tracer call for the rays of ``jobs`` (module notes). The rays are laid out by sample count:
+    the jobs of one count are a (jobs, samples) block of the columns, written with one broadcast
+    operation per column (a job's object point, box and wavelength are constants of its row)."""
     from ...trace import RayBatch
 
-    counts = [int(n) for _, _, _, n in jobs]
-    total = sum(counts)
-    sx, sy = _unit_samples(max(counts))
+    counts = np.array([n for _, _, _, n in jobs], dtype=np.int64)
+    order = np.argsort(counts, kind="stable")
+    starts = np.empty(len(jobs), dtype=np.int64)
+    starts[order] = np.cumsum(counts[order]) - counts[order]
+    total = int(counts.sum())
+    sx, sy = _unit_samples(int(counts.max()))
     k = len(wls)
-    chs = (np.arange(max(counts)) % k).astype(np.int8)
-    x, y, z, L, M, N, w = (np.empty(total) for _ in range(7))
-    ex, ey = np.empty(total), np.empty(total)
-    wl = np.full(total, wls[0]) if k == 1 else np.empty(total)
-    start = 0
-    for (f, u, box, n) in jobs:
-        sl = slice(start, start + n)
-        start += n
-        px, py, pz, _ = _object_point(cam, f, u)
-        x0, x1, y0, y1 = (float(b) for b in box)
-        x[sl], y[sl], z[sl] = px, py, pz
-        e, g = ex[sl], ey[sl]
-        np.multiply(sx[:n], x1 - x0, out=e)
-        e += x0
-        np.multiply(sy[:n], y1 - y0, out=g)
-        g += y0
-        dx, dy, dn = L[sl], M[sl], N[sl]
+    chs = (np.arange(int(counts.max())) % k).astype(np.int8)
+    pts = np.array([_object_point(cam, f, u)[:3] for f, u, _, _ in jobs])
+    box = np.array([b for _, _, b, _ in jobs], dtype=float)
+    cols = [np.empty(total) for _ in range(9)]  # x y z L M N w ex ey
+    x, y, z, L, M, N, w, ex, ey = cols
+    for n in np.unique(counts):
+        js = order[counts[order] == n]  # consecutive in the layout
+        a, n = int(starts[js[0]]), int(n)
+        x2, y2, z2, L2, M2, N2, w2, e2, g2 = (c[a:a + len(js) * n].reshape(len(js), n) for c in cols)
+        px, py, pz = (pts[js, i][:, None] for i in range(3))
+        x0, y0 = box[js, 0][:, None], box[js, 2][:, None]
+        bw, bh = (box[js, 1] - box[js, 0])[:, None], (box[js, 3] - box[js, 2])[:, None]
+        x2[:], y2[:], z2[:] = px, py, pz
+        np.multiply(sx[:n], bw, out=e2)
+        e2 += x0
+        np.multiply(sy[:n], bh, out=g2)
+        g2 += y0
         dz = z_ep - pz
-        np.subtract(e, px, out=dx)
-        np.subtract(g, py, out=dy)
-        np.multiply(dx, dx, out=dn)
-        dn += dy * dy
-        dn += dz * dz
-        np.sqrt(dn, out=dn)
-        np.divide(1.0, dn, out=dn)
-        dx *= dn
-        dy *= dn
-        dn *= dz
-        np.power(dn, 3, out=w[sl])  # before the trace moves the directions
-        w[sl] *= (x1 - x0) * (y1 - y0) / n
-        if k > 1:
-            wl[sl] = wls[chs[:n]]
+        np.subtract(e2, px, out=L2)
+        np.subtract(g2, py, out=M2)
+        np.multiply(L2, L2, out=N2)
+        N2 += M2 * M2
+        N2 += dz * dz
+        np.sqrt(N2, out=N2)
+        np.divide(1.0, N2, out=N2)
+        L2 *= N2
+        M2 *= N2
+        N2 *= dz
+        np.power(N2, 3, out=w2)  # before the trace moves the directions
+        w2 *= bw * bh / n
+    wl = np.full(total, wls[0]) if k == 1 else np.concatenate([wls[chs[:n]] for n in counts[order]])
     rays = RayBatch(x, y, z, L, M, N, wl, np.ones(total), np.zeros(total, dtype=np.uint8))
     x, y, ok, _ = _trace(cam, rays)
-    fans, start = [], 0
-    for (f, u, _, n) in jobs:
-        sl = slice(start, start + n)
-        start += n
-        sx0, sy0 = cam.film_point(*f)
-        ox, oy = x[sl], y[sl]
-        ox += sx0
+    sx0 = np.array([cam.film_point(*f)[0] for f, _, _, _ in jobs])
+    sy0 = np.array([cam.film_point(*f)[1] for f, _, _, _ in jobs])
+    for n in np.unique(counts):
+        js = order[counts[order] == n]
+        a, n = int(starts[js[0]]), int(n)
+        ox, oy = x[a:a + len(js) * n].reshape(len(js), n), y[a:a + len(js) * n].reshape(len(js), n)
+        ox += sx0[js][:, None]
         np.divide(ox, -cam.pitch_mm, out=ox)
-        oy += sy0
+        oy += sy0[js][:, None]
         np.divide(oy, cam.pitch_mm, out=oy)
-        fans.append(Fan(tuple(f), float(u), ox, oy, w[sl], chs[:n], ex[sl], ey[sl]))
-    for a in (x, y, w):  # blocked rays: offset 0, weight 0 (a product, not a masked store: several times faster)
-        a *= ok
+    for c in (x, y, w):  # blocked rays: offset 0, weight 0 (a product, not a masked store: several times faster)
+        c *= ok
     if not (np.isfinite(x.sum()) and np.isfinite(y.sum())):  # a blocked ray the tracer left at inf or NaN
         x[~ok] = 0.0
         y[~ok] = 0.0
+    fans = []
+    for (f, u, _, n), a in zip(jobs, starts):
+        sl = slice(int(a), int(a) + n)
+        fans.append(Fan(tuple(f), float(u), x[sl], y[sl], w[sl], chs[:n], ex[sl], ey[sl]))
     return fans
 
 
