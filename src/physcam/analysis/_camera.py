@@ -16,9 +16,13 @@ from ..optics.state import CameraState
 
 def ray_view(camera: CameraState, *, wavelength_nm=None):
     """(lens traced, object z, film z or None, iris semi-diameter or None, iris shape, wavelength, sensor
-    (width, height) or None) of ``camera`` (module notes); ``wavelength_nm`` replaces its primary."""
+    (width, height) or None) of ``camera`` (module notes); ``wavelength_nm`` replaces its primary. The
+    iris semi-diameter is the one its shape is drawn inside: a bladed iris's corner radius, so that the
+    polygon has the round iris's area (:attr:`~physcam.optics.state.CameraState.iris_corner_semi`,
+    docs/conventions.md)."""
     film = None if camera.film_from_analysis else camera.film_z
-    stop = camera.stop_semi_diameter if camera.iris_set else None
+    bladed = camera.aperture is not None and not camera.aperture.is_circular
+    stop = camera.iris_corner_semi if camera.iris_set or bladed else None
     wl = camera.wavelengths_nm[0] if wavelength_nm is None else wavelength_nm
     return camera.focused, camera.object_z, film, stop, camera.aperture, wl, camera.sensor_mm
 

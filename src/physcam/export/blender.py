@@ -120,18 +120,11 @@ def bake_camera(camera: CameraState, *, aperture=None, fresnel: bool = False) ->
 
 
 def iris_corner_semi(state: CameraState) -> float:
-    """The stop radius (mm) the iris's corners reach in the shader and in its bokeh comparison: a
-    bladed iris has the area of the round iris of the f-number (docs/conventions.md), so its corners
-    lie :meth:`~physcam.trace.aperture.Aperture.equal_area_scale` farther out than that circle, but
-    never beyond the lens's widest iris (the file's stop opened by physcam's stop-opening tolerance)."""
-    from ..optics.paraxial import STOP_OPENING_TOLERANCE
-
+    """The stop radius (mm) the iris's corners reach in the shader and in its bokeh comparison:
+    :attr:`physcam.optics.state.CameraState.iris_corner_semi` (a bladed iris has the area of the round
+    iris of the f-number, docs/conventions.md)."""
     require_type("state", state, CameraState, "physcam.optics.state.camera_state(lens, focus_mm=..., fstop=..., sensor=...)")
-    ap = state.aperture
-    if ap is None or ap.is_circular:
-        return float(state.stop_semi_diameter)
-    q = state.focused
-    return ap.corner_semi(state.stop_semi_diameter, q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE))
+    return state.iris_corner_semi
 
 
 def _bake(state: CameraState, fresnel: bool) -> BakedCamera:

@@ -76,7 +76,7 @@ def compare_bokeh(camera: CameraState, *, light_mm: float, aperture=None, crop_m
     measured agreement."""
     from ..analysis.defocus.blob import blob_moments, equivalent_diameter, polygon_corners
     from ..analysis.defocus.bokeh import bokeh_image
-    from .blender import _state, blender_setup_script, iris_corner_semi, osl_camera_shader
+    from .blender import _state, blender_setup_script, osl_camera_shader
 
     if not camera.iris_set:
         raise InputError("the comparison needs an f-stop: camera_state(lens, focus_mm=..., fstop=N)")
@@ -108,10 +108,9 @@ def compare_bokeh(camera: CameraState, *, light_mm: float, aperture=None, crop_m
             raise OpticsError(f"Blender could not render the comparison: {tail[0][:200]}")
         rendered = np.load(job["npy"])
     h = crop / 2
-    # the iris's corners reach iris_corner_semi in the shader: the tracer's iris the same (main's issue 41)
-    traced_cam = dataclasses.replace(state, stop_semi_diameter=iris_corner_semi(state))
-    traced = bokeh_image(traced_cam, d_light, rays=rays, pixels=pixels, extent_mm=(-h, h, -h, h), fresnel=False)
-    off = bokeh_image(traced_cam, d_light, 10.0, rays=200_000, pixels=64, fresnel=False)  # the magnification there
+    # the iris's corners reach CameraState.iris_corner_semi in the shader, and in bokeh_image's tracer
+    traced = bokeh_image(state, d_light, rays=rays, pixels=pixels, extent_mm=(-h, h, -h, h), fresnel=False)
+    off = bokeh_image(state, d_light, 10.0, rays=200_000, pixels=64, fresnel=False)  # the magnification there
     mag = abs(off.to_dict()["centroid_mm"][0]) / 10.0
     pitch = crop / pixels
     image = traced.image[..., 0]

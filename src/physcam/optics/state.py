@@ -133,6 +133,23 @@ class CameraState:
         return self.stop_semi_diameter / self.focused.surfaces[self.focused.stop_index].semi_diameter
 
     @property
+    def iris_corner_semi(self) -> float:
+        """The stop radius (mm) the iris's corners reach: a bladed iris has the area of the round iris
+        of the f-number (docs/conventions.md), so its corners lie ``aperture.equal_area_scale()``
+        (:meth:`physcam.trace.aperture.Aperture.equal_area_scale`) farther out than that circle, but
+        never beyond the lens's widest iris (the file's stop opened by
+        :data:`~physcam.optics.paraxial.STOP_OPENING_TOLERANCE`) unless the round iris itself is wider;
+        the round iris's radius (:attr:`stop_semi_diameter`) for a round one. Every tracer of a bladed
+        iris draws its polygon inside this radius: the analyses, the defocus kernels, the Blender shader."""
+        ap = self.aperture
+        if ap is None or ap.is_circular:
+            return float(self.stop_semi_diameter)
+        from .paraxial import STOP_OPENING_TOLERANCE
+
+        q = self.focused
+        return ap.corner_semi(self.stop_semi_diameter, q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE))
+
+    @property
     def entrance_pupil_z(self) -> float:
         return float(self.gaussian.z_entrance_pupil)
 
@@ -441,7 +458,20 @@ def _camera_at_the_door(value, given: dict, where: str) -> CameraState:
         if "sensor_mm" in given or "sensor" in given:
             raise InputError("give the sensor once: sensor, sensor_mm or sensor_width_mm/sensor_height_mm")
         given["sensor_mm"] = (w, h)
+    _corner_radius_given(given)
     return _camera(model, "focus_mm" not in given and "film_z" not in given, **given)
+
+
+def _corner_radius_given(given: dict) -> None:
+    """The old ray-level form (a prescription with ``stop_semi_diameter=`` and a bladed ``aperture=``) drew
+    the polygon inside the radius it was given, its corners: the camera's iris is the round one of the
+    polygon's area, that radius over ``aperture.equal_area_scale()`` (docs/conventions.md), so that
+    :attr:`CameraState.iris_corner_semi` gives the corners back where they were."""
+    ap, stop = given.get("aperture"), given.get("stop_semi_diameter")
+    scale = getattr(ap, "equal_area_scale", None)
+    if callable(scale) and not getattr(ap, "is_circular", True) and isinstance(stop, (int, float)) \
+            and not isinstance(stop, bool) and math.isfinite(stop) and stop > 0:
+        given["stop_semi_diameter"] = float(stop) / scale()
 
 
 _SENSOR_WORDS = ("sensor", "sensor_mm", "sensor_width_mm", "sensor_height_mm")

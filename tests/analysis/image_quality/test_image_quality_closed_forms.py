@@ -159,11 +159,14 @@ def test_geometric_mtf_of_a_large_defocus_is_a_uniform_disk():
 
 
 def test_hexagonal_iris_sets_the_pupil_shape():
-    # a regular hexagon inscribed in the stop's circle has area (3 sqrt 3 / 2) r^2: 0.827 of the disk
+    # f/16 with blades is the round f/16 iris's area (docs/conventions.md): a regular hexagon of corner
+    # radius R has area (3 sqrt 3 / 2) R^2, so its corners lie sqrt(2 pi / (3 sqrt 3)) = 1.0996 round
+    # radii out and it lights the whole of the round pupil's area (inscribed in the round iris, the old
+    # convention, it lit 0.827 of it)
     wf = wavefront(LENS, 0.0, wavelength_nm=WL, fstop=16.0, aperture=Aperture(nsides=6))
-    assert wf.lit_fraction == pytest.approx(3 * math.sqrt(3) / (2 * math.pi), abs=0.004)
-    # along x a vertex reaches the rim (the pupil spans the full diameter), along y the flats sit at
-    # cos 30 of it: the sagittal cut-off is the circle's, the tangential one 0.866 of it
+    assert wf.lit_fraction == pytest.approx(1.0, abs=0.004)
+    # along x a vertex reaches the corner radius, along y the flats sit at cos 30 of it: the tangential
+    # cut-off is 0.866 of the sagittal one
     m = mtf(LENS, 0.0, wavelengths_nm=[WL], fstop=16.0, aperture=Aperture(nsides=6))
     assert m.cutoff_tangential_lpmm / m.cutoff_sagittal_lpmm == pytest.approx(math.cos(math.pi / 6), abs=0.01)
 

@@ -167,11 +167,20 @@ class DefocusCamera:
 
     def node_far(self) -> int:
         """Index of the farthest node (it stands for infinity)."""
-        return -math.floor(-float(self.node_index(0.0)) + 1e-12) if self.focus_u > 0 else 0
+        if "far" not in self._memo:
+            self._memo["far"] = -math.floor(-float(self.node_index(0.0)) + 1e-12) if self.focus_u > 0 else 0
+        return self._memo["far"]
 
     def node_u(self, n):
         """Inverse depth (1/mm) of node(s) ``n``; the farthest node is infinity (0)."""
-        n = np.asarray(n)
+        if isinstance(n, (int, np.integer)) and not isinstance(n, bool):  # one node: memoised (thousands of calls a frame)
+            key = ("u", int(n))
+            if key not in self._memo:
+                self._memo[key] = np.float64(self._node_u(np.asarray(n)))
+            return self._memo[key]
+        return self._node_u(np.asarray(n))
+
+    def _node_u(self, n):
         t = np.abs(n).astype(float)
         b = self.step_px * (np.expm1(self.step_rel * t) / self.step_rel if self.step_rel > 0 else t)
         return np.where(n <= self.node_far(), 0.0, self.focus_u + np.sign(n) * b / self.blur_per_u)
@@ -302,7 +311,7 @@ def defocus_camera(camera: CameraState, *, width: int, height: int, aperture=Non
     if tp.pinhole_focal_length_mm is None:
         raise OpticsError(f"{lens.name} has no best-match pinhole at this focus (its chief ray does not reach the film)")
     ap = _as_aperture(cam.aperture if aperture is None else aperture)
-    stop_semi = cam.stop_semi_diameter if ap is None else ap.corner_semi(cam.stop_semi_diameter, _widest_iris(cam))
+    stop_semi = cam.with_aperture(ap).iris_corner_semi  # a bladed iris of the round one's area (docs/conventions.md)
     fx, dx = _x_meridian(lens, cam.focus_from_film_mm, cam.fstop, tp)
     return DefocusCamera(lens=lens, camera=cam, sensor_width_mm=sw,
                          width=int(width), height=int(height), aperture=ap, dispersion=bool(dispersion),
@@ -330,13 +339,19 @@ def _x_meridian(lens, focus_mm, fstop, tp) -> tuple[float, float]:
     return tx.pinhole_focal_length_mm * scale, tx.entrance_pupil_diameter_mm
 
 
-def _widest_iris(cam) -> float:
-    """The lens's widest iris (mm): its file's stop opened by physcam's stop-opening tolerance, the
-    farthest a bladed iris's corners go (docs/conventions.md, f-numbers)."""
-    from ...optics.paraxial import STOP_OPENING_TOLERANCE
+def _place(x, y, n) -> tuple[float, float, int]:
+    """The key of a tile corner's kernel: picture position (px, to a thousandth) and depth node."""
+    return round(float(x), 3), round(float(y), 3), int(n)
 
-    q = cam.focused
-    return q.surfaces[q.stop_index].semi_diameter * (1 + STOP_OPENING_TOLERANCE)
+
+def _ready_tracer() -> None:
+    """Load the JIT tracer now (when numba is installed and ``PHYSCAM_BACKEND`` allows it): a frame's
+    kernels are millions of rays, so the numpy kernel's budget for short jobs
+    (:mod:`physcam.trace.kernels`, "auto") would only be spent before numba loads anyway. Both
+    kernels give the same rays."""
+    from ...trace.kernels import resolve_backend
+
+    resolve_backend("auto")
 
 
 def _as_aperture(aperture):
@@ -407,6 +422,7 @@ class KernelCache:
         if self._fractions is None:
             from .field import field_fractions
 
+            _ready_tracer()
             self._fractions = field_fractions(self.camera)
         return self._fractions
 
@@ -447,6 +463,8 @@ class KernelCache:
         needed, direct = set(needed), list(direct)
         ladder = {m for _, _, n in [*needed, *direct] for m in cam.ladder(n)} | {0}
         old_table = set() if self._table is None else set(self._table.transmission)
+        if needed - set(self._kernels) or ladder - old_table or {_place(*p) for p in direct} - set(self._direct):
+            _ready_tracer()
         self._table = field_table(cam, self._table, ladder)
         missing = sorted(k for k in needed if k not in self._kernels)
         new = self._trace(missing, progress) if missing else {}
@@ -518,7 +536,7 @@ class KernelCache:
         from .trace import distortion_jacobians, pupil_boxes, trace_fans
 
         cam = self.camera
-        todo = sorted({(round(float(x), 3), round(float(y), 3), int(n)) for x, y, n in points} - set(self._direct))
+        todo = sorted({_place(x, y, n) for x, y, n in points} - set(self._direct))
         places = sorted({(x, y) for x, y, _ in todo} - set(self._places))
         if places:  # a place's sampling box and unwarp serve all its depths (box_depths: one set per camera)
             boxes = pupil_boxes(cam, places, box_depths(cam))

@@ -262,7 +262,7 @@ def _kernel_at_scale(k: np.ndarray, s: int) -> np.ndarray:
     if s == 1:
         return k
     r = k.shape[0] // 2
-    ys, xs = np.mgrid[-r:r + 1, -r:r + 1].astype(float)
+    ys, xs = _offsets(r)
     m = k[..., k.shape[2] // 2].astype(float)
     t = m.sum()
     mx, my = (m * xs).sum() / t, (m * ys).sum() / t
@@ -270,21 +270,30 @@ def _kernel_at_scale(k: np.ndarray, s: int) -> np.ndarray:
                     [(m * (xs - mx) * (ys - my)).sum(), (m * (ys - my) ** 2).sum()]]) / t
     lam, vec = np.linalg.eigh(cov)
     c = np.sqrt(np.clip(1.0 - (5.0 * s * s / 12.0) / np.maximum(lam, 1e-12), 0.25, 1.0))
-    M = vec @ np.diag(c) @ vec.T
+    M = (vec * c) @ vec.T
     px = (M[0, 0] * xs + M[0, 1] * ys) / s  # coarse-pixel coordinates of each fine pixel
     py = (M[1, 0] * xs + M[1, 1] * ys) / s
-    R = int(math.ceil(np.abs(np.concatenate([px.ravel(), py.ravel()])).max())) + 1
+    R = int(math.ceil(max(np.abs(px).max(), np.abs(py).max()))) + 1
     n = 2 * R + 1
-    out = np.zeros((n, n, k.shape[2]))
     x0, y0 = np.floor(px).astype(int), np.floor(py).astype(int)
     fx, fy = px - x0, py - y0
-    for dy, wy in ((0, 1 - fy), (1, fy)):
-        for dx, wx in ((0, 1 - fx), (1, fx)):
-            idx = ((y0 + dy + R) * n + (x0 + dx + R)).ravel()
-            w = (wy * wx).ravel()
-            for ch in range(k.shape[2]):
-                out[..., ch] += np.bincount(idx, weights=w * k[..., ch].ravel(), minlength=n * n).reshape(n, n)
+    at = ((y0 + R) * n + (x0 + R)).ravel()
+    idx = np.concatenate([at, at + 1, at + n, at + n + 1])  # the four coarse pixels around each fine one
+    w = np.concatenate([((1 - fy) * (1 - fx)).ravel(), ((1 - fy) * fx).ravel(), (fy * (1 - fx)).ravel(),
+                        (fy * fx).ravel()])
+    out = np.stack([np.bincount(idx, weights=w * np.tile(k[..., ch].ravel(), 4), minlength=n * n).reshape(n, n)
+                    for ch in range(k.shape[2])], axis=-1)
     return _trim_kernel(out.astype(np.float32))
+
+
+_OFFSETS: dict = {}
+
+
+def _offsets(r: int) -> tuple[np.ndarray, np.ndarray]:
+    """The pixel offsets (rows y, columns x; float) of a kernel of radius r from its centre (memoised)."""
+    if r not in _OFFSETS:
+        _OFFSETS[r] = tuple(a.astype(float) for a in np.mgrid[-r:r + 1, -r:r + 1])
+    return _OFFSETS[r]
 
 
 def _trim_kernel(k: np.ndarray) -> np.ndarray:
@@ -470,8 +479,13 @@ def _kernel_index(names, c: int, channels: int) -> np.ndarray:
 
 
 def _pad_kernel(k: np.ndarray, r: int) -> np.ndarray:
+    """``k`` (2q + 1, 2q + 1, channels) centred in zeros of radius r >= q."""
     p = r - k.shape[0] // 2
-    return np.pad(k, ((p, p), (p, p), (0, 0))) if p else k
+    if not p:
+        return k
+    out = np.zeros((2 * r + 1, 2 * r + 1) + k.shape[2:], k.dtype)
+    out[p:p + k.shape[0], p:p + k.shape[1]] = k
+    return out
 
 
 def _to_full(planes: dict, s: int, origin, r: int, H: int, W: int) -> dict:

@@ -43,7 +43,7 @@ import numpy as np
 
 from ...errors import InputError
 from .kernels import DIRECT_BLUR_PX, DefocusCamera, KernelCache
-from .layers import blur_layer, frame_of, layer_corners, layer_grid, layer_pairs
+from .layers import _upsample, blur_layer, frame_of, layer_corners, layer_grid, layer_pairs
 
 __all__ = ["DEPTH_KINDS", "DEPTH_UNITS_MM", "inverse_depth", "near_edges", "defocus"]
 
@@ -297,24 +297,32 @@ class _Budget:
         q = BUDGET_CELL
         y0, x0 = box[0].start, box[1].start
         own = np.zeros(self.shape)
-        loss = ((1.0 - tr)[..., None] * lay["V"]).sum(axis=2)
+        loss = (1.0 - tr) * _channel_sum(lay["V"])
         _add_cells(own, loss, y0, x0, q)
         avail = own + (self.carry if self.carry is not None else 0.0)
         g = lay["G"]
         if g is not None:
-            gain = tr[..., None] * g
             gc = np.zeros(self.shape)
-            _add_cells(gc, gain.sum(axis=2), y0, x0, q)
+            _add_cells(gc, tr * _channel_sum(g), y0, x0, q)
             r = max(-(-2 * lay["radius"] // q), 2)
             with np.errstate(invalid="ignore", divide="ignore"):
                 scale = np.clip(np.nan_to_num(_box_sum(avail, r) / _box_sum(gc, r), posinf=0.0), 0.0, 1.0)
             cy0, cx0 = max(y0 // q - 1, 0), max(x0 // q - 1, 0)  # the box's cells and one around
             cy1, cx1 = -(-box[0].stop // q) + 1, -(-box[1].stop // q) + 1
-            part = _upsample_cells(scale[cy0:cy1, cx0:cx1], q, ((cy1 - cy0) * q, (cx1 - cx0) * q))
+            part = _upsample_cells(scale[cy0:cy1, cx0:cx1], q)  # the cells that exist (the last ones hold the box)
             part = part[y0 - cy0 * q: box[0].stop - cy0 * q, x0 - cx0 * q: box[1].stop - cx0 * q]  # (0, 0): (cy0 q, cx0 q)
-            out[box] += part[..., None] * gain
+            out[box] += (part * tr)[..., None] * g
             avail = np.maximum(avail - scale * gc, 0.0)
         self.carry = np.minimum(avail, own)  # a node's loss funds its own fill and the next one's, no more
+
+
+def _channel_sum(a: np.ndarray) -> np.ndarray:
+    """The sum of an (h, w, c) array's channels, channel by channel (a reduction over a short last
+    axis is several times slower)."""
+    out = a[..., 0].copy()
+    for c in range(1, a.shape[2]):
+        out += a[..., c]
+    return out
 
 
 def _add_cells(cells: np.ndarray, a: np.ndarray, y0: int, x0: int, q: int) -> None:
@@ -328,18 +336,11 @@ def _add_cells(cells: np.ndarray, a: np.ndarray, y0: int, x0: int, q: int) -> No
     cells[cy:cy + part.shape[0], cx:cx + part.shape[1]] += part[:cells.shape[0] - cy, :cells.shape[1] - cx]
 
 
-def _upsample_cells(a: np.ndarray, q: int, shape) -> np.ndarray:
-    """Values per q x q cell to values per pixel, bilinear between cell centres (clamped at the ends)."""
-    def axis(n, m):
-        pos = np.clip((np.arange(m) + 0.5) / q - 0.5, 0, n - 1)
-        i = np.minimum(np.floor(pos).astype(np.int64), n - 1)
-        j = np.minimum(i + 1, n - 1)
-        return i, j, pos - i
-
-    i, j, w = axis(a.shape[0], shape[0])
-    rows = a[i] * (1 - w)[:, None] + a[j] * w[:, None]
-    i, j, w = axis(a.shape[1], shape[1])
-    return (rows[:, i] * (1 - w)[None, :] + rows[:, j] * w[None, :]).astype(np.float32)
+def _upsample_cells(a: np.ndarray, q: int) -> np.ndarray:
+    """Values per q x q cell to values per pixel (q times the cells each way), bilinear between cell
+    centres (clamped at the ends): :func:`~physcam.analysis.defocus.layers._upsample` without its
+    division by q^2."""
+    return _upsample(a, q) * np.float32(q * q)
 
 
 #: the grid (px) the fill's light budget is summed on

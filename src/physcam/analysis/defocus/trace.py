@@ -59,8 +59,8 @@ _SEED = 0x5EED_DEF0
 
 @dataclass
 class Fan:
-    """One object point's rays: ``ox``, ``oy`` picture offsets (px) from its pinhole image (NaN where
-    blocked), ``w`` the solid angle per ray (0 where blocked), ``ch`` each ray's wavelength index,
+    """One object point's rays: ``ox``, ``oy`` picture offsets (px) from its pinhole image (0 where
+    blocked, so that sums over a fan need no mask), ``w`` the solid angle per ray (0 where blocked), ``ch`` each ray's wavelength index,
     ``ex``, ``ey`` its aim point on the entrance pupil's plane (mm)."""
 
     field_px: tuple[float, float]
@@ -240,30 +240,70 @@ def trace_fans(cam, jobs) -> list[Fan]:
 
 
 def _trace_batch(cam, jobs, wls, z_ep) -> list[Fan]:
-    """One tracer call for the rays of ``jobs`` (module notes)."""
-    counts = np.array([n for _, _, _, n in jobs])
+    """One tracer call for the rays of ``jobs`` (module notes). The rays are laid out by sample count:
+    the jobs of one count are a (jobs, samples) block of the columns, written with one broadcast
+    operation per column (a job's object point, box and wavelength are constants of its row)."""
+    from ...trace import RayBatch
+
+    counts = np.array([n for _, _, _, n in jobs], dtype=np.int64)
+    order = np.argsort(counts, kind="stable")
+    starts = np.empty(len(jobs), dtype=np.int64)
+    starts[order] = np.cumsum(counts[order]) - counts[order]
+    total = int(counts.sum())
     sx, sy = _unit_samples(int(counts.max()))
-    ux = np.concatenate([sx[:n] for n in counts])
-    uy = np.concatenate([sy[:n] for n in counts])
+    k = len(wls)
+    chs = (np.arange(int(counts.max())) % k).astype(np.int8)
     pts = np.array([_object_point(cam, f, u)[:3] for f, u, _, _ in jobs])
     box = np.array([b for _, _, b, _ in jobs], dtype=float)
-    rep = np.repeat(np.arange(len(jobs)), counts)
-    ex = box[rep, 0] + (box[rep, 1] - box[rep, 0]) * ux
-    ey = box[rep, 2] + (box[rep, 3] - box[rep, 2]) * uy
-    ch = (np.arange(len(rep)) - np.repeat(np.cumsum(counts) - counts, counts)) % len(wls)
-    rays, cos_t = _rays(pts[rep, 0], pts[rep, 1], pts[rep, 2], ex, ey, z_ep, wls[ch])
-    area = (box[:, 1] - box[:, 0]) * (box[:, 3] - box[:, 2]) / counts
-    w_all = area[rep] * cos_t ** 3  # before the trace moves the directions
+    cols = [np.empty(total) for _ in range(9)]  # x y z L M N w ex ey
+    x, y, z, L, M, N, w, ex, ey = cols
+    for n in np.unique(counts):
+        js = order[counts[order] == n]  # consecutive in the layout
+        a, n = int(starts[js[0]]), int(n)
+        x2, y2, z2, L2, M2, N2, w2, e2, g2 = (c[a:a + len(js) * n].reshape(len(js), n) for c in cols)
+        px, py, pz = (pts[js, i][:, None] for i in range(3))
+        x0, y0 = box[js, 0][:, None], box[js, 2][:, None]
+        bw, bh = (box[js, 1] - box[js, 0])[:, None], (box[js, 3] - box[js, 2])[:, None]
+        x2[:], y2[:], z2[:] = px, py, pz
+        np.multiply(sx[:n], bw, out=e2)
+        e2 += x0
+        np.multiply(sy[:n], bh, out=g2)
+        g2 += y0
+        dz = z_ep - pz
+        np.subtract(e2, px, out=L2)
+        np.subtract(g2, py, out=M2)
+        np.multiply(L2, L2, out=N2)
+        N2 += M2 * M2
+        N2 += dz * dz
+        np.sqrt(N2, out=N2)
+        np.divide(1.0, N2, out=N2)
+        L2 *= N2
+        M2 *= N2
+        N2 *= dz
+        np.power(N2, 3, out=w2)  # before the trace moves the directions
+        w2 *= bw * bh / n
+    wl = np.full(total, wls[0]) if k == 1 else np.concatenate([wls[chs[:n]] for n in counts[order]])
+    rays = RayBatch(x, y, z, L, M, N, wl, np.ones(total), np.zeros(total, dtype=np.uint8))
     x, y, ok, _ = _trace(cam, rays)
-    fans, start = [], 0
-    for (f, u, _, n) in jobs:
-        sl = slice(start, start + n)
-        start += n
-        sx0, sy0 = cam.film_point(*f)
-        good = ok[sl]
-        fans.append(Fan(tuple(f), float(u), np.where(good, -(x[sl] + sx0) / cam.pitch_mm, np.nan),
-                        np.where(good, (y[sl] + sy0) / cam.pitch_mm, np.nan), np.where(good, w_all[sl], 0.0),
-                        ch[sl].astype(np.int8), ex[sl], ey[sl]))
+    sx0 = np.array([cam.film_point(*f)[0] for f, _, _, _ in jobs])
+    sy0 = np.array([cam.film_point(*f)[1] for f, _, _, _ in jobs])
+    for n in np.unique(counts):
+        js = order[counts[order] == n]
+        a, n = int(starts[js[0]]), int(n)
+        ox, oy = x[a:a + len(js) * n].reshape(len(js), n), y[a:a + len(js) * n].reshape(len(js), n)
+        ox += sx0[js][:, None]
+        np.divide(ox, -cam.pitch_mm, out=ox)
+        oy += sy0[js][:, None]
+        np.divide(oy, cam.pitch_mm, out=oy)
+    for c in (x, y, w):  # blocked rays: offset 0, weight 0 (a product, not a masked store: several times faster)
+        c *= ok
+    if not (np.isfinite(x.sum()) and np.isfinite(y.sum())):  # a blocked ray the tracer left at inf or NaN
+        x[~ok] = 0.0
+        y[~ok] = 0.0
+    fans = []
+    for (f, u, _, n), a in zip(jobs, starts):
+        sl = slice(int(a), int(a) + n)
+        fans.append(Fan(tuple(f), float(u), x[sl], y[sl], w[sl], chs[:n], ex[sl], ey[sl]))
     return fans
 
 
@@ -277,8 +317,8 @@ def interpolate_fan(a: Fan, b: Fan, u: float, _maps: dict | None = None) -> Fan:
         return b
     s = (u - a.u) / (b.u - a.u)
     both = (a.w > 0) & (b.w > 0)
-    ox = np.where(both, a.ox + s * (b.ox - a.ox), np.nan)
-    oy = np.where(both, a.oy + s * (b.oy - a.oy), np.nan)
+    ox = a.ox + s * (b.ox - a.ox)  # 0 where both are blocked (their offsets are 0)
+    oy = a.oy + s * (b.oy - a.oy)
     only_a, only_b = (a.w > 0) & ~both, (b.w > 0) & ~both
     if (only_a | only_b).any():
         key = (id(a), id(b))
@@ -327,8 +367,8 @@ def fan_centroid(fan: Fan) -> tuple[float, float]:
     t = fan.w.sum()
     if not t > 0:
         return 0.0, 0.0
-    good = fan.w > 0
-    return float((fan.w[good] * fan.ox[good]).sum() / t), float((fan.w[good] * fan.oy[good]).sum() / t)
+    # blocked rays: 0 x 0 (a product and a sum, not np.dot: BLAS wakes its threads for long vectors)
+    return float((fan.w * fan.ox).sum() / t), float((fan.w * fan.oy).sum() / t)
 
 
 def bin_fan(fan: Fan, centre: tuple[float, float], channels: int, unwarp=None) -> tuple[np.ndarray, np.ndarray]:
@@ -336,19 +376,23 @@ def bin_fan(fan: Fan, centre: tuple[float, float], channels: int, unwarp=None) -
     summed weights, the centre pixel covering offsets within half a pixel of ``centre``; and each
     channel's total weight. ``unwarp`` (2 x 2) maps each offset first (from the film's pixels to the
     render's: :func:`distortion_jacobians`)."""
-    good = fan.w > 0
-    tot = np.bincount(fan.ch[good], weights=fan.w[good], minlength=channels)[:channels]
-    if not good.any():  # no light: a unit kernel (the transmission, 0 there, darkens the pixel)
+    w = fan.w
+    tot = np.bincount(fan.ch, weights=w, minlength=channels)[:channels]  # blocked rays weigh 0
+    if not tot.sum() > 0:  # no light: a unit kernel (the transmission, 0 there, darkens the pixel)
         return np.ones((1, 1, channels)), np.ones(channels)
-    dx, dy = fan.ox[good] - centre[0], fan.oy[good] - centre[1]
+    dx, dy = fan.ox - centre[0], fan.oy - centre[1]  # a blocked ray's (weight 0) lands at the pinhole image
     if unwarp is not None:
         dx, dy = unwarp[0, 0] * dx + unwarp[0, 1] * dy, unwarp[1, 0] * dx + unwarp[1, 1] * dy
     r = int(math.ceil(max(np.abs(dx).max(), np.abs(dy).max()) + 0.5))
     if r > 2048:
         raise OpticsError("the blur is over 4096 pixels across: give a nearer depth limit")
     n = 2 * r + 1
-    ix = np.floor(dx + r + 0.5).astype(np.int64).clip(0, n - 1)
-    iy = np.floor(dy + r + 0.5).astype(np.int64).clip(0, n - 1)
-    flat = (iy * n + ix) * channels + fan.ch[good]
-    img = np.bincount(flat, weights=fan.w[good], minlength=n * n * channels).reshape(n, n, channels)
+    dx += r  # then + 0.5: floor(dx + r + 0.5) as written, rounded the same
+    dx += 0.5
+    dy += r
+    dy += 0.5
+    flat = np.floor(dy).astype(np.int64).clip(0, n - 1) * n + np.floor(dx).astype(np.int64).clip(0, n - 1)
+    if channels > 1:
+        flat = flat * channels + fan.ch
+    img = np.bincount(flat, weights=w, minlength=n * n * channels).reshape(n, n, channels)
     return img, tot

@@ -75,7 +75,8 @@ class Setup:
     focus_from_film_mm = property(lambda self: self.state.focus_from_film_mm)  # inf at infinity
     object_z = property(lambda self: self.state.object_z)  # -inf at infinity
     film_z = property(lambda self: self.state.film_z)  # the film plane (focus plane) in lens space
-    stop_semi_diameter = property(lambda self: self.state.stop_semi_diameter)
+    # the radius the iris shape is drawn inside: a bladed iris's corners (the round iris's area, docs/conventions.md)
+    stop_semi_diameter = property(lambda self: self.state.iris_corner_semi)
     z_ep = property(lambda self: self.state.entrance_pupil_z)
     r_ep = property(lambda self: self.state.entrance_pupil_radius)
     z_xp = property(lambda self: self.state.exit_pupil_z)

@@ -288,7 +288,7 @@ def chromatic_aberration(
     from .._camera import ray_view, sensor_or_default
     from .._chief import field_angles_deg
 
-    lens, _, film_z, stop, _, _, _ = ray_view(camera)
+    lens, _, film_z, stop, _, _, _ = ray_view(camera.with_aperture(None))  # Gaussian colour: the round iris of the f-number
     sensor_width_mm, sensor_height_mm = sensor_or_default(camera)
 
     ref = require_positive("reference wavelength", reference_nm, unit="nm")
