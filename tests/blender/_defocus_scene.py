@@ -6,8 +6,10 @@ only in the windows their bokeh is measured in; and the pinhole renders defocuse
 The spheres' real-lens render is the proofs' costliest (256 samples a pixel through the OSL camera):
 it is rendered in Cycles' render border, one border per measured window, into full frames black
 outside it (``use_crop_to_border`` off). Cycles seeds a pixel's samples by its place in the frame, so
-every pixel of a window is the one a full-frame render gives (checked bit for bit on the anamorphic
-proof's 256-sample render, 13:40 UTC 2026-11-28), at an eighth to a twelfth of the pixels.
+every pixel of a window is the one a full-frame render gives (checked on both proofs, 2026-11-28:
+the windows' pixels and every other render bit for bit the same as before), at an eighth (the
+anamorphic proof: 2 windows of 84 x 84 px of 384 x 288) and a thirteenth (52 x 52 and 42 x 42 px of
+320 x 180) of the pixels.
 """
 
 from __future__ import annotations

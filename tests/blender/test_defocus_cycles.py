@@ -126,7 +126,7 @@ def scene(tmp_path_factory):
            "plane": [-(ep + PLANE_MM) / 1000, side, side], "checker_scale": 12.0, "windows": windows,
            "pinhole_mm": cam.pinhole_mm, "sensor_mm": [SW, sh], "pupil_m": ep / 1000,
            "focus_m": (MARK_MM - ep) / 1000, "fstop": FSTOP, "fstop_thin": fstop_thin,
-           "blade_rotation": math.radians(IRIS.angle_deg), "samples_osl": 256, "samples_osl_full": 64,
+           "blade_rotation": math.radians(IRIS.angle_deg), "samples_osl": 256, "samples_osl_full": 32,
            "samples_pinhole": 16}
     run_blender(SCRIPT, json.dumps(job), timeout=900)
     cache = KernelCache(cam)

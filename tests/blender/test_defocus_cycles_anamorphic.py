@@ -97,7 +97,7 @@ def scene(tmp_path_factory):
     job = {"setup": str(tmp / "setup.py"), "out": str(tmp), "spheres": spheres, "strength": 30.0,
            "plane": [-(ep + PLANE_MM) / 1000, 2 * half_w, 2 * half_h], "checker_scale": 10.0,
            "pinhole_y_mm": cam.pinhole_mm, "sensor_width_eff_mm": SW * ratio, "pixel_aspect": ratio,
-           "pupil_m": ep / 1000, "samples_osl": 256, "samples_osl_full": 64, "samples_pinhole": 16, "windows": windows}
+           "pupil_m": ep / 1000, "samples_osl": 256, "samples_osl_full": 32, "samples_pinhole": 16, "windows": windows}
     run_blender(SCRIPT, json.dumps(job), timeout=1200)
     cache = KernelCache(cam)
     dist = distortion_field(camera_state(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_mm=(SW, SH)), width_px=W, height_px=H)
