@@ -16,25 +16,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from _blender import DARK_SCENE_CAMERA_AT_FILM
 from physcam.analysis.defocus.exr import read_exr
 from physcam.analysis.defocus.render import defocus, inverse_depth
 from physcam.analysis.distortion.stmap import apply_stmap
 
 #: The scene, built in Blender from ``job`` (sys.argv[1], JSON): ``spheres`` [[x, y, z, r] m], glowing
 #: ``strength``; ``plane`` [z, width, height] m, a checker of ``checker_scale`` squares glowing 0.5.
-#: Defines ``scene``, ``cam``, ``plane``, ``settings(samples)``, ``render(path)`` and
+#: Defines ``scene``, ``cam``, ``plane``, ``settings(samples)``, ``render(path)``,
 #: ``render_windows(path, windows)`` (the frame rendered only in ``windows``, each [x0, x1, y0, y1] px,
-#: y down from the top row, into one file per window: path + f"_w{i}.exr").
+#: y down from the top row, into one file per window: path + f"_w{i}.exr") and ``render_truth()``: the
+#: real-lens renders, the spheres alone at ``samples_osl`` in ``windows`` (truth_spheres_w*.exr) and the
+#: full scene at ``samples_osl_full`` (truth.exr).
 SCENE = '''
 import json, runpy, sys
 job = json.loads(sys.argv[1])
-scene = bpy.context.scene
-for o in list(bpy.data.objects):
-    if o.type != "CAMERA":
-        bpy.data.objects.remove(o)
-cam = scene.camera
-world = bpy.data.worlds.new("black"); scene.world = world; world.use_nodes = True
-world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+''' + DARK_SCENE_CAMERA_AT_FILM + '''cam = cam_obj
 
 def emissive(name, strength, checker=False):
     m = bpy.data.materials.new(name); m.use_nodes = True
@@ -80,6 +77,16 @@ def render_windows(path, windows):
         scene.render.border_min_y, scene.render.border_max_y = (h - y1) / h, (h - y0) / h
         render(path + f"_w{i}.exr")
     scene.render.use_border = False
+
+def render_truth():  # through physcam's OSL camera (job["setup"]), its origin the film centre
+    cam.location, cam.rotation_euler = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    runpy.run_path(job["setup"], run_name="physcam_setup")["apply"](scene)
+    settings(job["samples_osl"])
+    plane.hide_render = True
+    render_windows(job["out"] + "/truth_spheres", job["windows"])
+    plane.hide_render = False
+    scene.cycles.samples = job["samples_osl_full"]
+    render(job["out"] + "/truth.exr")
 '''
 
 

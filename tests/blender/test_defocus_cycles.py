@@ -56,15 +56,8 @@ CORNER_PX = (304.0, 16.0)  # the top-right tile's centre (x right, y down)
 BOX = 24  # half-size of the window a bokeh is measured in, px
 
 SCRIPT = SCENE + '''
-# 1. the truth: physcam's OSL camera, its origin the film centre
-cam.location, cam.rotation_euler = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
-runpy.run_path(job["setup"], run_name="physcam_setup")["apply"](scene)
-settings(job["samples_osl"])
-plane.hide_render = True
-render_windows(job["out"] + "/truth_spheres", job["windows"])
-plane.hide_render = False
-scene.cycles.samples = job["samples_osl_full"]
-render(job["out"] + "/truth.exr")
+# 1. the truth: physcam's OSL camera
+render_truth()
 # 2. a pinhole at the entrance pupil, the best-match focal length, with a Z pass
 cam.data.type = "PERSP"
 cam.data.lens = job["pinhole_mm"]

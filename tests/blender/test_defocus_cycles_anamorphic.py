@@ -46,15 +46,8 @@ SPOTS = {"centre": (W / 2, H / 2), "off axis": (300.0, 80.0)}
 BOX = 40
 
 SCRIPT = SCENE + '''
-# 1. the truth: physcam's OSL camera, its origin the film centre
-cam.location, cam.rotation_euler = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
-runpy.run_path(job["setup"], run_name="physcam_setup")["apply"](scene)
-settings(job["samples_osl"])
-plane.hide_render = True
-render_windows(job["out"] + "/truth_spheres", job["windows"])
-plane.hide_render = False
-scene.cycles.samples = job["samples_osl_full"]
-render(job["out"] + "/truth.exr")
+# 1. the truth: physcam's OSL camera
+render_truth()
 # 2. a pinhole at the Y entrance pupil: the Y focal length, pixel aspect f_y / f_x, with a Z pass
 cam.data.type = "PERSP"
 cam.data.lens = job["pinhole_y_mm"]
