@@ -13,13 +13,15 @@ through numbers measured the same way on both images:
 2. a sphere 0.7 m from the film renders as a bokeh disk of the size physcam predicts;
 3. that disk is a hexagon, corners where physcam puts them.
 
-The sharp spot's render is made only in a 41 x 41 px render border about the centre pixel (black
-outside it): Cycles seeds a pixel's samples by its place in the frame, and the full frame's render
-had light in the centre pixel alone, so the picture is the full render's bit for bit (checked
-2026-11-28: identical EXRs, diameter 0.000 px against 1.5 px, centroid 0.000 px against 0.25 px,
-either way) at 1/58 of its pixels: the whole pytest run of this file took 8.0 s CPU instead of
-15.4 s (``/usr/bin/time``, load 8-10; the focus render 48.5 s wall -> 3.8 s). A spot blurred or moved by a focus error still shows: 20 px is 13 times the asserted
-1.5 px diameter.
+Both renders are made only in a render border about the centre (black outside it): the sharp
+spot's 41 x 41 px of 383 x 255, the bokeh's 72 x 72 px of 128 x 128. Cycles seeds a pixel's samples
+by its place in the frame, and the full frames had light only within 5 px (the spot: one pixel) and
+25 px (the bokeh, 49 px across) of the centre, so both pictures are the full renders' bit for bit
+(checked 2026-11-28: identical EXRs; every figure as before: spot diameter 0.000 px of 1.5, centroid
+0.000 px of 0.25, bokeh ratio 1.0036 within 3 %, corners 0.3 deg of 3 deg). The pytest run of this
+file took 6.7 s user CPU instead of 15.4 s (``/usr/bin/time``, load 8-10; the focus render 48.5 s
+wall -> 3.8 s). A focus error still shows: 20 px is 13 times the asserted 1.5 px diameter; a bokeh
+too large is clipped at 72 px, still 1.5 times physcam's 40 px, far outside 3 %.
 """
 
 from __future__ import annotations
@@ -52,6 +54,7 @@ FOCUS_PX = (383, 255)
 FOCUS_BORDER_PX = 20  # the sharp spot's render: only this many px either side of the centre pixel (module notes)
 NEAR_SPHERE_M = 0.001  # 1 mm: its image (0.16 mm) is removed from the bokeh's second moment
 CROP_MM, CROP_PX = 3.0, 128  # the bokeh render: a 3 x 3 mm crop of the film centre, 42.7 px/mm
+BOKEH_BORDER_PX = 36  # the bokeh's render: only this many px either side of the crop's centre (module notes)
 
 #: Renders emissive spheres (black world, no bounces, CPU, OSL) through each physcam setup script
 #: and returns the red channel (rows from the bottom of the picture). One Blender process, one
@@ -122,7 +125,9 @@ def renders(tmp_path_factory):
                             aperture=IRIS)
     (tmp / "bokeh.py").write_text(blender_setup_script(src, sensor_width_mm=CROP_MM, sensor_height_mm=CROP_MM,
                                                        resolution=(CROP_PX, CROP_PX), text_name="bokeh.osl"))
-    jobs.append({"name": "bokeh", "setup": str(tmp / "bokeh.py"), "samples": 512,
+    #    rendered in a border of BOKEH_BORDER_PX about the centre (module notes)
+    b = [(CROP_PX / 2 - BOKEH_BORDER_PX) / CROP_PX, (CROP_PX / 2 + BOKEH_BORDER_PX) / CROP_PX]
+    jobs.append({"name": "bokeh", "setup": str(tmp / "bokeh.py"), "samples": 512, "border": b + b,
                  "sphere": [0.0, 0.0, -NEAR_MM / 1000.0, NEAR_SPHERE_M], "out": str(tmp / "bokeh.exr")})
     t0 = time.perf_counter()
     out = run_blender(SCENE, json.dumps(jobs))
