@@ -15,8 +15,8 @@ through numbers measured the same way on both images:
 
 Both renders are made only in a render border about the centre (black outside it): the sharp
 spot's 41 x 41 px of 383 x 255, the bokeh's 72 x 72 px of 128 x 128. Cycles seeds a pixel's samples
-by its place in the frame, and the full frames had light only within 5 px (the spot: one pixel) and
-25 px (the bokeh, 49 px across) of the centre, so both pictures are the full renders' bit for bit
+by its place in the frame, and the full frames had light only in the centre pixel (the spot) and within
+25 px of the centre (the bokeh, 49 px across), so both pictures are the full renders' bit for bit
 (checked 2026-11-28: identical EXRs; every figure as before: spot diameter 0.000 px of 1.5, centroid
 0.000 px of 0.25, bokeh ratio 1.0036 within 3 %, corners 0.3 deg of 3 deg). The pytest run of this
 file took 6.7 s user CPU instead of 15.4 s (``/usr/bin/time``, load 8-10; the focus render 48.5 s
