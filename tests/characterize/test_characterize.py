@@ -278,7 +278,7 @@ def test_a_lens_file_of_dated_variants_gains_a_run_and_keeps_them(tmp_path):
             "d2026_03_01")
         return {str(a.GetPath()): a.Get() for p in stage.Traverse() for a in p.GetAttributes() if a.HasAuthoredValue()}
 
-    f = write_lens_file(tmp_path / "lens.usda", {"2026-03-01": CameraSpec(focal_length_mm=24.0, fstop=2.0)})
+    f = write_lens_file(tmp_path / "lens.usda", {"2026-03-01": CameraSpec.of(focal_length_mm=24.0, fstop=2.0)})
     before = dated(f)
     assert before["/Lens.lens:main:fStop"] == pytest.approx(2.0)
     spec, _ = best_match_pinhole(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_width_mm=36.0,
