@@ -91,13 +91,13 @@ def board_image(chart, px_per_mm=8.0):
 
 def _upsample(coarse, fine):
     """Bilinear interpolation of a smooth coarse map (node spacing 1) at fractional node positions
-    (the chart's map bends by far less than a thousandth of a pixel over one node spacing)."""
+    (the chart's map bends by far less than a thousandth of a pixel over one node spacing): along x on
+    the coarse rows, then along y (the same bilinear weights, one pass a direction)."""
     fx, fy = fine
     i, j = np.minimum(fx.astype(int), coarse.shape[1] - 2), np.minimum(fy.astype(int), coarse.shape[0] - 2)
-    tx, ty = (fx - i)[None, :], (fy - j)[:, None]
-    c00, c01 = coarse[j][:, i], coarse[j][:, i + 1]
-    c10, c11 = coarse[j + 1][:, i], coarse[j + 1][:, i + 1]
-    return ((1 - ty) * ((1 - tx) * c00 + tx * c01) + ty * ((1 - tx) * c10 + tx * c11)).astype(np.float32)
+    tx, ty = fx - i, (fy - j)[:, None]
+    rows = (1 - tx) * coarse[:, i] + tx * coarse[:, i + 1]  # (coarse rows, fine columns)
+    return ((1 - ty) * rows[j] + ty * rows[j + 1]).astype(np.float32)
 
 
 def render(chart, rvec, tvec, *, board=None, supersample=2, blur_px=0.8, noise=2.0, seed=0, K=K_TRUE, dist=DIST_TRUE):

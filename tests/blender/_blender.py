@@ -113,16 +113,16 @@ def predicted_block_brightness(b, blocks: dict, w_px: int, h_px: int, sensor_mm,
 
     sw, sh = sensor_mm
     u = (np.arange(samples) + 0.5) / samples
-    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
+    uv = np.stack([a.ravel() for a in np.meshgrid(u, u)], 1)
     predicted = {}
     for k, (r0, r1, c0, c1) in blocks.items():
+        cols = np.arange(c0, c1)
+        fx = -(2 * (cols + 0.5) / w_px - 1) * sw / 2
         vals = []
-        for r in range(r0, r1):
-            for c in range(c0, c1):
-                fx = -(2 * (c + 0.5) / w_px - 1) * sw / 2
-                fy = -(2 * (r + 0.5) / h_px - 1) * sh / 2
-                cr = camera_rays(b.lens, np.tile([fx, fy], (uu.size, 1)), np.stack([uu, vv], 1), b.film_z,
-                                 bounds=b.bounds)
-                vals.append(cr.weight.mean() / b.norm)
+        for r in range(r0, r1):  # one row of the block a trace: every pixel's film point times the pupil grid
+            fy = -(2 * (r + 0.5) / h_px - 1) * sh / 2
+            film = np.repeat(np.stack([fx, np.full_like(fx, fy)], 1), len(uv), axis=0)
+            cr = camera_rays(b.lens, film, np.tile(uv, (len(cols), 1)), b.film_z, bounds=b.bounds)
+            vals.append(cr.weight.reshape(len(cols), len(uv)).mean(axis=1) / b.norm)
         predicted[k] = float(np.mean(vals))
     return predicted

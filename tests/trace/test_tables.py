@@ -14,6 +14,7 @@ from physcam.trace import RayBatch, trace_through
 from physcam.trace.kernels import get_kernel
 from physcam.trace.kernels._layout import ETA, N1, N2, pack, set_wavelength
 from physcam.trace.surfaces import surface_table
+from physcam.trace import tables
 from physcam.trace.tables import clear_table_cache, packed_table
 from physcam.trace.trace import trace_packed
 
@@ -46,17 +47,35 @@ def test_keys_separate_what_changes_the_table_and_share_what_does_not():
     assert packed_table(lens, coating=None) is packed_table(lens, coating="none")
 
 
-def test_a_new_lens_never_gets_a_dead_lens_table():
-    # ids of freed objects are reused by CPython: the weak reference must tell them apart
+def test_a_new_lens_never_gets_a_dead_lens_table(monkeypatch):
+    """ids of freed objects are reused by CPython: the weak reference must tell them apart. The cache
+    keeps one lens here (with its 64 none of the 40 lenses this test made was ever freed, so no id
+    came back and the test passed with the weak-reference check taken out), so each lens frees the
+    one before it and some get its id (2-18 of 40 in five runs): each must still get its own table.
+    The heap the session made before is frozen (``gc.freeze``): each collection looks at this test's
+    objects only (40 full collections of a whole session's heap were this test's 11 s)."""
+    monkeypatch.setattr(tables, "MAX_LENSES", 1)
+    clear_table_cache()
     base = load_lens("dgauss_50mm")
-    for k in range(40):
-        s = list(base.surfaces)
-        s[0] = replace(s[0], thickness=3.0 + 0.01 * k)
-        lens = replace(base, surfaces=tuple(s))
-        p = packed_table(lens)
-        np.testing.assert_array_equal(p.table.vertex_z, np.asarray(lens.vertex_z))
-        del lens, p
-        gc.collect()
+    seen, reused = set(), 0
+    gc.freeze()
+    try:
+        for k in range(200):
+            s = list(base.surfaces)
+            s[0] = replace(s[0], thickness=3.0 + 0.01 * k)
+            surfaces = tuple(s)
+            packed_table(base)  # takes the cache's one place: the lens before is freed here
+            lens = replace(base, surfaces=surfaces)
+            reused += id(lens) in seen
+            seen.add(id(lens))
+            p = packed_table(lens)
+            np.testing.assert_array_equal(p.table.vertex_z, np.asarray(lens.vertex_z))
+            del lens, p, surfaces
+            gc.collect()
+    finally:
+        gc.unfreeze()
+        clear_table_cache()
+    assert reused > 0  # the case under test happened
 
 
 def test_tracing_does_not_modify_a_table():
