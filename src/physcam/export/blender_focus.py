@@ -95,23 +95,47 @@ def _centre_norm(q, film_z, bounds, fresnel: bool = False, stop_semi_diameter=No
     return float(np.mean(cr.weight))
 
 
+def _ellipse_rect(ellipse) -> np.ndarray:
+    """(x0, x1, y0, y1): the rectangle around an ellipse (cx, ax, ay) on the rear vertex plane."""
+    cx, ax, ay = ellipse[:3]
+    return np.array([cx - ax, cx + ax, -ay, ay])
+
+
 def _centre_bounds(q, ellipse):
     """A PupilBounds whose every node holds the rectangle around an ellipse (cx, ax, ay)."""
     from ..trace.pupil_bounds import PupilBounds
 
-    cx, ax, ay = ellipse[:3]
-    rect = np.broadcast_to([cx - ax, cx + ax, -ay, ay], (2, 2, 4)).copy()
+    rect = np.broadcast_to(_ellipse_rect(ellipse), (2, 2, 4)).copy()
     return PupilBounds(np.array([-1.0, 1.0]), np.array([-1.0, 1.0]), rect, float(q.vertex_z[-1]))
 
 
-def _centre_norms(q, film_z, radial, bounds, levels) -> list[float]:
-    """The centre's mean weight with the round iris at each tabulated iris level: the shader's
+class _RayRects:
+    """Bounds for camera_rays that hold one aim rectangle (x0, x1, y0, y1) per ray, in order."""
+
+    def __init__(self, rects):
+        self.rects = rects
+
+    def rect_at(self, fx, fy):
+        return tuple(self.rects[:, c] for c in range(4))
+
+
+def _centre_norms(q, film_z, rects, levels) -> list[float]:
+    """The centre's mean weight with the round iris at each tabulated iris level, aiming at
+    ``rects[k]`` for level k (:func:`_centre_norm`'s 64^2 aims; levels that share a rectangle share
+    their rays), all in one trace (:func:`~physcam.trace.pupil_bounds.iris_camera_rays`): the shader's
     normalisation (the exit pupil's area is not quite the square of the iris's radius)."""
-    out = []
-    for k, s in enumerate(levels):
-        b = bounds if radial is None else _centre_bounds(q, radial[k, 0])
-        out.append(_centre_norm(q, film_z, b, stop_semi_diameter=float(s)))
-    return out
+    from ..trace.pupil_bounds import iris_camera_rays
+
+    m = 64
+    u = (np.arange(m) + 0.5) / m
+    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
+    uniq, which = np.unique(np.asarray(rects, dtype=float), axis=0, return_inverse=True)
+    n = uu.size
+    cr, passing = iris_camera_rays(q, np.zeros((n * len(uniq), 2)), np.tile(np.stack([uu, vv], axis=1), (len(uniq), 1)),
+                                   film_z, [float(s) for s in levels], bounds=_RayRects(np.repeat(uniq, n, axis=0)))
+    w = cr.weight.reshape(len(uniq), n)
+    return [float(np.mean(np.where(ok.reshape(len(uniq), n)[g], w[g], 0.0)))
+            for g, ok in zip(np.ravel(which).tolist(), passing)]
 
 
 def _nearest_mark(lens: Prescription, near: float) -> float:
@@ -173,11 +197,11 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
             b, rect, rect_levels = _rect_tables(q, st.film_z, levels[0], grid_half_mm)
             rects.append(rect)
             stopped.append(rect_levels)
-            norm.append(_centre_norms(q, st.film_z, None, b, levels))
+            norm.append(_centre_norms(q, st.film_z, [np.array(b.rect_at(0.0, 0.0))] * len(levels), levels))
         else:
             radial.append(radial_pupil_table(q, st.film_z, levels))
             b = _centre_bounds(q, radial[-1][0, 0])
-            norm.append(_centre_norms(q, st.film_z, radial[-1], None, levels))
+            norm.append(_centre_norms(q, st.film_z, [_ellipse_rect(e) for e in radial[-1][:, 0]], levels))
         if mk == marks[0]:
             table0, bounds0 = t, (b if lens.is_anamorphic else None)
             loss = _centre_norm(q, st.film_z, b, fresnel=True) / _centre_norm(q, st.film_z, b)
@@ -192,23 +216,16 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
 
 def _rect_tables(q, film_z, semi_max, grid_half_mm):
     """(PupilBounds at the widest iris, its rectangles, the rectangles at each of :data:`STOP_LEVELS`)."""
-    from ..trace.pupil_bounds import exit_pupil_bounds
+    from ..trace.pupil_bounds import stopped_pupil_bounds
 
     nx, ny = _GRID
     semi_file = q.surfaces[q.stop_index].semi_diameter
-    b = exit_pupil_bounds(_stopped(q, semi_max / semi_file), grid_half_mm, grid_half_mm, film_z, nx=nx, ny=ny,
-                          samples=48)
-    levels = [exit_pupil_bounds(_stopped(q, f * semi_max / semi_file), grid_half_mm, grid_half_mm, film_z, nx=nx,
-                                ny=ny, samples=32).rects for f in STOP_LEVELS]
-    return b, b.rects, levels
-
-
-def _stopped(q: Prescription, fraction: float) -> Prescription:
-    """``q`` with its stop's semi-diameter times ``fraction``."""
-    s = list(q.surfaces)
-    k = q.stop_index
-    s[k] = dataclasses.replace(s[k], semi_diameter=float(s[k].semi_diameter * fraction))
-    return q.with_surfaces(s)
+    # the stop's semi-diameter as a prescription stopped to each fraction of the file's holds it
+    b = stopped_pupil_bounds(q, [float(semi_file * (semi_max / semi_file))], grid_half_mm, grid_half_mm, film_z,
+                             nx=nx, ny=ny, samples=48)[0]
+    levels = stopped_pupil_bounds(q, [float(semi_file * (f * semi_max / semi_file)) for f in STOP_LEVELS],
+                                  grid_half_mm, grid_half_mm, film_z, nx=nx, ny=ny, samples=32)
+    return b, b.rects, [lv.rects for lv in levels]
 
 
 def _num32(x) -> str:
