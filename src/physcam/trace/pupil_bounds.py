@@ -18,7 +18,6 @@ touch its edge or none pass, until it is the whole square.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
