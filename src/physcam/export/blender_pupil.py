@@ -196,11 +196,6 @@ def _rims(uses, radii) -> list:
     edges = [[np.stack([g[6][d][e] for g, _, _ in uses]) for e in (0, 1)] for d in range(len(_TOWARD))]
     r0, r1 = np.array([u[1] for u in uses]), np.array([u[2] for u in uses])
     first = np.concatenate([[0], np.cumsum(r1 - r0)])  # each grid's first rim
-    asc = radii[::-1]
-
-    def n_ge(v):  # how many radii are v or more (a sample passes at radii[:n_ge(t)])
-        return radii.size - np.searchsorted(asc, v, side="left")
-
     def expand(g, lo, hi):  # (rim index, radius index, which entry) of every entry's radii [lo, hi)
         n = hi - lo
         e = np.repeat(np.arange(g.size), n)
@@ -208,7 +203,7 @@ def _rims(uses, radii) -> list:
         return first[g[e]] + i - r0[g[e]], i, e
 
     r0_, r1_ = r0[:, None, None], r1[:, None, None]
-    n_in = n_ge(t)  # per sample: it passes at radii[:n_in]
+    n_in = _n_passing(radii, t)  # per sample: it passes at radii[:n_in]
     parts = []  # (rim index, x, y, xa, ya, clipped)
     # toward +x, -x and +y: the sample's (a) and its neighbour's (b) cells
     for ((ja, ia_), (jb, ib), (sx, sy)), (e_lo, e_hi) in zip(_TOWARD, edges):
@@ -363,26 +358,30 @@ def _passing_sets(q, film_z: float, fxs, radii, r_rear: float, big: float, backe
     return [[rim for use in u if use[2] > use[1] for rim in next(rims)] for u in uses]
 
 
+def _n_passing(radii, t) -> np.ndarray:
+    """Per sample of stop radius ``t`` (inf where another surface clips): how many of the descending
+    iris radii ``radii`` it passes at (those at least t: ``radii[:n]``)."""
+    return radii.size - np.searchsorted(radii[::-1], t, side="left")
+
+
 def _shrunk(radii, grids, boxes, start):
     """Per grid (of :func:`_trace`, over its box) the index of the first iris radius, from ``start`` on,
     whose passing set has shrunk under half of the grid (len(radii) if none), and per grid and
-    radius the passing set's x extent and largest y. The sets nest: over the samples in order of
-    their stop radius, running extremes give every radius's at once."""
+    radius the passing set's x extent and largest y. The sets nest: a sample with n passing radii
+    (:func:`_n_passing`) is in the sets of radii[:n], so each grid's extremes per n, taken from the
+    largest n down, give every radius's at once."""
     gx, gy, ok, rad = (np.stack([g[c] for g in grids]) for c in range(4))
     dx, dy = np.array([g[4] for g in grids])[:, None], np.array([g[5] for g in grids])[:, None]
     b = np.array(boxes)
-    rad = np.where(ok, rad, np.inf)
-    o = np.argsort(rad, axis=1, kind="stable")
-    rs = np.take_along_axis(rad, o, axis=1)
-    # per grid and radius: how many samples pass (those with stop radius at most it), as an index
-    n = np.stack([np.searchsorted(r, radii[::-1], side="right")[::-1] for r in rs])
-    anyp = n > 0
-    at = np.maximum(n - 1, 0)
+    n_grid, n_rad = len(grids), radii.size
+    key = (np.arange(n_grid)[:, None] * (n_rad + 1) + _n_passing(radii, np.where(ok, rad, np.inf))).ravel()
 
-    def running(v, fn, empty):
-        run = fn.accumulate(np.take_along_axis(v, o, axis=1), axis=1)
-        return np.where(anyp, np.take_along_axis(run, at, axis=1), empty)
+    def running(v, fn, empty):  # per grid and radius i: fn over the samples with n > i
+        e = np.full(n_grid * (n_rad + 1), empty)
+        fn.at(e, key, v.ravel())
+        return fn.accumulate(e.reshape(n_grid, n_rad + 1)[:, ::-1], axis=1)[:, ::-1][:, 1:]
 
+    anyp = running(np.ones(key.size), np.add, 0.0) > 0
     xmin, xmax, ymax = running(gx, np.minimum, np.inf), running(gx, np.maximum, -np.inf), running(gy, np.maximum, -np.inf)
     small = (anyp & (xmax - xmin + 4 * dx < 0.5 * (b[:, 1:2] - b[:, 0:1])) & (ymax + 2 * dy < 0.5 * b[:, 2:3])
              & (np.arange(radii.size)[None, :] >= np.asarray(start)[:, None]))
