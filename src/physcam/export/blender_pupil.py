@@ -142,8 +142,10 @@ def _trace(q, film_z: float, fxs, boxes, big: float, backend: str) -> list:
     """Rays from film points (fx, 0) to the aim grid over each one's box on the rear vertex plane, in
     one trace: per film point (x, y, passes every surface but the stop, radius where it crosses the
     stop plane, grid steps, clip edges). Between a passing sample and a clipped neighbour the edge of
-    what the other surfaces pass is found by halving (:data:`_HALVINGS`): per direction of
-    :data:`_TOWARD`, (lo, hi) fractions of the step that pass and that do not."""
+    what the other surfaces pass is found by halving (:data:`_HALVINGS`): the clip edges are (key,
+    lo, hi), the pair's key (d ny + j) nx + i for direction d of :data:`_TOWARD` and the pair's cell
+    (j, i) in that direction's view of the grid, ascending, and the fractions of the step that pass
+    and that do not."""
     nx, ny = _GRID, _GRID // 2
     x0, x1, y1 = np.array(boxes, dtype=float).T
     dx, dy = (x1 - x0) / nx, y1 / ny  # a _GRID x _GRID/2 grid over each box (x0, x1, y1: the y >= 0 half)
@@ -167,15 +169,15 @@ def _trace(q, film_z: float, fxs, boxes, big: float, backend: str) -> list:
         mid = 0.5 * (lo + hi)
         passes = _aims(q, film_z, ff, x + mid * sx, y + mid * sy, big, backend)[0] if x.size else np.zeros(0, bool)
         lo, hi = np.where(passes, mid, lo), np.where(passes, hi, mid)
-    edges, k = [], 0
-    for g, jj, ii, *_ in pairs:
-        e_lo, e_hi = np.zeros((len(boxes), ny, nx)), np.ones((len(boxes), ny, nx))
-        e_lo[g, jj, ii], e_hi[g, jj, ii] = lo[k:k + g.size], hi[k:k + g.size]
-        edges.append((e_lo, e_hi))
-        k += g.size
+    # per grid, its halved edges sorted by key: direction d, the pair's cell (j, i) -> (d ny + j) nx + i
+    g = np.concatenate([p[0] for p in pairs])
+    key = np.concatenate([(d * ny + p[1]) * nx + p[2] for d, p in enumerate(pairs)])
+    o = np.lexsort((key, g))
+    g, key, lo, hi = g[o], key[o], lo[o], hi[o]
+    cuts = np.searchsorted(g, np.arange(len(boxes) + 1)).tolist()
     dx_, dy_ = dx.tolist(), dy.tolist()
-    return [(gx[i], gy[i], ok[i], rad[i], dx_[i], dy_[i], [(e[0][i], e[1][i]) for e in edges])
-            for i in range(len(boxes))]
+    return [(gx[i], gy[i], ok[i], rad[i], dx_[i], dy_[i], (key[a:b], lo[a:b], hi[a:b]))
+            for i, a, b in zip(range(len(boxes)), cuts[:-1], cuts[1:])]
 
 
 def _rims(uses, radii) -> list:
@@ -189,34 +191,44 @@ def _rims(uses, radii) -> list:
     another surface clips): a sample and its neighbour make a rim point at the radii in [t_a, t_b),
     found for every grid and radius at once by bisection in ``radii``."""
     ny, nx = _GRID // 2, _GRID
-    ok = np.stack([g[2].reshape(ny, nx) for g, _, _ in uses])  # (grids, ny, nx)
-    rad = np.stack([g[3].reshape(ny, nx) for g, _, _ in uses])
-    t = np.where(ok, rad, np.inf)
+    ok = np.stack([g[2] for g, _, _ in uses])  # (grids, ny nx)
+    rad = np.stack([g[3] for g, _, _ in uses])
+    t = np.where(ok, rad, np.inf).reshape(-1, ny, nx)
     x0, y0, dx, dy = (np.array(v) for v in zip(*((g[0][0], g[1][0], g[4], g[5]) for g, _, _ in uses)))
-    edges = [[np.stack([g[6][d][e] for g, _, _ in uses]) for e in (0, 1)] for d in range(len(_TOWARD))]
+    # every grid's clip edges, by key (its place in uses, then its own key): ascending
+    n_edge = np.array([g[6][0].size for g, _, _ in uses])
+    e_key = np.concatenate([g[6][0] for g, _, _ in uses]) + np.repeat(np.arange(len(uses)) * (3 * ny * nx), n_edge)
+    e_lo, e_hi = (np.concatenate([g[6][c] for g, _, _ in uses]) for c in (1, 2))
     r0, r1 = np.array([u[1] for u in uses]), np.array([u[2] for u in uses])
     first = np.concatenate([[0], np.cumsum(r1 - r0)])  # each grid's first rim
+
     def expand(g, lo, hi):  # (rim index, radius index, which entry) of every entry's radii [lo, hi)
         n = hi - lo
         e = np.repeat(np.arange(g.size), n)
         i = lo[e] + np.arange(e.size) - np.repeat(np.cumsum(n) - n, n)
         return first[g[e]] + i - r0[g[e]], i, e
 
-    r0_, r1_ = r0[:, None, None], r1[:, None, None]
-    n_in = _n_passing(radii, t)  # per sample: it passes at radii[:n_in]
+    small = np.int16 if radii.size < 2**15 else np.int64
+    r0_, r1_ = r0.astype(small)[:, None, None], r1.astype(small)[:, None, None]
+    n_in = _n_passing(radii, t).astype(small)  # per sample: it passes at radii[:n_in]
+    rad, ok = rad.ravel(), ok.ravel()
     parts = []  # (rim index, x, y, xa, ya, clipped)
     # toward +x, -x and +y: the sample's (a) and its neighbour's (b) cells
-    for ((ja, ia_), (jb, ib), (sx, sy)), (e_lo, e_hi) in zip(_TOWARD, edges):
+    for d, ((ja, ia_), (jb, ib), (sx, sy)) in enumerate(_TOWARD):
         lo, hi = np.maximum(n_in[:, jb, ib], r0_), np.minimum(n_in[:, ja, ia_], r1_)
-        rim = hi > lo  # the pairs with a rim point at some radius of their grid
-        g, jj, ii = np.nonzero(rim)
-        shape = (slice(None), slice(0, rim.shape[1]), slice(0, rim.shape[2]))  # the clip edges' cells
-        ra, rb, nb_ok = rad[:, ja, ia_][rim], rad[:, jb, ib][rim], ok[:, jb, ib][rim]
+        g, jj, ii = np.nonzero(hi > lo)  # the pairs with a rim point at some radius of their grid
+        a = (g * ny + jj + (ja.start or 0)) * nx + ii + (ia_.start or 0)  # the cells in the flat grids
+        b = (g * ny + jj + (jb.start or 0)) * nx + ii + (ib.start or 0)
+        ra, rb, nb_ok = rad[a], rad[b], ok[b]
         # where another surface clips, the rim is at the halved edge (held: its far end; area: its middle)
-        e0, e1 = e_lo[shape][rim], e_hi[shape][rim]
+        e0, e1 = np.zeros(g.size), np.ones(g.size)
+        cut = np.flatnonzero(~nb_ok)
+        at = np.searchsorted(e_key, (g[cut] * 3 + d) * (ny * nx) + jj[cut] * nx + ii[cut])
+        e0[cut], e1[cut] = e_lo[at], e_hi[at]
         ex, ey = sx * dx[g], sy * dy[g]
         bx, by = x0[g] + (ii + (ia_.start or 0)) * dx[g], y0[g] + (jj + (ja.start or 0)) * dy[g]
-        k, ri, e = expand(g, lo[rim], hi[rim])
+        k, ri, e = expand(g, np.maximum(n_in.ravel()[b], r0_.ravel()[g]).astype(np.int64),
+                          np.minimum(n_in.ravel()[a], r1_.ravel()[g]).astype(np.int64))
         ra, rb, nb_ok, e0, e1, ex, ey, bx, by = (v[e] for v in (ra, rb, nb_ok, e0, e1, ex, ey, bx, by))
         with np.errstate(divide="ignore", invalid="ignore"):
             f_iris = np.clip((radii[ri] - ra) / (rb - ra), 0.0, 1.0)
@@ -232,12 +244,12 @@ def _rims(uses, radii) -> list:
         jj, ii = jj + (cells[0].start or 0), ii + (cells[1].start or 0)
         bx, by = x0[g] + ii * dx[g], y0[g] + jj * dy[g]
         ex, ey = (ox * dx[g] if ox else np.zeros(g.size)), (oy * dy[g] if oy else np.zeros(g.size))
-        k, _, e = expand(g, lo[rim], hi[rim])
+        k, _, e = expand(g, lo[rim].astype(np.int64), hi[rim].astype(np.int64))
         bx, by, ex, ey = bx[e], by[e], ex[e], ey[e]
         parts.append((k, bx + ex, by + ey, bx + ex / 2, by + ey / 2, np.ones(k.size, dtype=bool)))
     n_rims = int(first[-1])
     k = np.concatenate([p[0] for p in parts])
-    order = np.argsort(k, kind="stable")
+    order = np.argsort(k.astype(small), kind="stable")  # a radix sort on 16-bit integers
     k = k[order]
     cols = [np.concatenate([p[c] for p in parts])[order] for c in range(1, 6)]
     cuts = np.searchsorted(k, np.arange(n_rims + 1))
