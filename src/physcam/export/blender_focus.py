@@ -234,7 +234,12 @@ def _num32(x) -> str:
 
 
 def _arr32(name, values, size) -> str:
-    return f"    float {name}[{size}] = {{{', '.join(_num32(v) for v in np.asarray(values, float).ravel())}}};"
+    a = np.asarray(values, float).ravel()
+    if not np.isfinite(a).all():
+        _num32(a[~np.isfinite(a)][0])  # raises osl_number's error
+    # _num32 of each, inlined (osl_number of a finite float: its repr, with ".0" when that is an integer)
+    nums = [repr(float(format(v, ".9g"))) for v in a.tolist()]
+    return f"    float {name}[{size}] = {{{', '.join(r if ('.' in r or 'e' in r) else r + '.0' for r in nums)}}};"
 
 
 def _arr32_once(ft: FocusTable, name, values, size) -> str:

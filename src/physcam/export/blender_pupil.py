@@ -404,25 +404,21 @@ def _shrunk(radii, grids, boxes, start):
 _SAFETY = 1.003
 
 
-def _fit(rim) -> np.ndarray:
-    """(cx, ax, ay, area): the ellipse about the rim's middle, axes along x and y, that holds every rim
-    point, and the passing set's area."""
-    x, y = rim.x, rim.y
-    cx = 0.5 * (x.min() + x.max())
-    ax = 0.5 * (x.max() - x.min())
-    ay = y.max()
-    g = _need(rim, cx, ax, ay)
-    return np.array([cx, ax * g, ay * g, rim.area()])
-
-
-def _need(rim, cx: float, ax: float, ay: float) -> float:
-    """The factor the ellipse's axes need so that it holds ``rim``'s points (times :data:`_SAFETY`)."""
-    if rim is None:
-        return 1.0
-    x, y = rim.x, rim.y
-    if not (ax > 0 and ay > 0):
-        return math.inf
-    return float(np.sqrt(((x - cx) / ax) ** 2 + (y / ay) ** 2).max()) * _SAFETY
+def _fits(rims) -> np.ndarray:
+    """Per rim of ``rims`` (rims of one table: rows of the same arrays), (cx, ax, ay, area): the
+    ellipse about the rim's middle, axes along x and y, that holds every rim point (grown by
+    :data:`_SAFETY`), and the passing set's area."""
+    n = np.array([r.span.stop - r.span.start for r in rims])
+    idx = np.concatenate([np.arange(r.span.start, r.span.stop) for r in rims])
+    starts = np.cumsum(n) - n
+    x, y = rims[0].cols[0][idx], rims[0].cols[1][idx]
+    lo, hi = np.minimum.reduceat(x, starts), np.maximum.reduceat(x, starts)
+    cx, ax, ay = 0.5 * (lo + hi), 0.5 * (hi - lo), np.maximum.reduceat(y, starts)
+    c = np.repeat(np.arange(n.size), n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v = np.sqrt(((x - cx[c]) / ax[c]) ** 2 + (y / ay[c]) ** 2)
+    g = np.where((ax > 0) & (ay > 0), np.maximum.reduceat(v, starts) * _SAFETY, math.inf)
+    return np.stack([cx, ax * g, ay * g, [r.area() for r in rims]], axis=1)
 
 
 def interpolated_ellipse(table: np.ndarray, levels, rho: float, s: float) -> np.ndarray:
@@ -528,14 +524,15 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto") -> np
     at_node, at_mid = sets[:N_RADIAL], sets[N_RADIAL:]
     table = np.zeros((len(levels), N_RADIAL, 5))
     empty = np.ones((len(levels), N_RADIAL), dtype=bool)
-    for j in range(N_RADIAL):
-        for k, s in enumerate(levels):
-            reg = at_node[j][index[float(s)]]
-            if reg is not None:
-                table[k, j, :4] = _fit(reg)
-                up, down = at_node[j][index[float(s * (1 + _DS))]], at_node[j][index[float(s * (1 - _DS))]]
-                table[k, j, 4] = ((up.area() if up else 0.0) - (down.area() if down else 0.0)) / (2 * _DS * s)
-                empty[k, j] = False
+    lit = [(k, j) for j in range(N_RADIAL) for k, s in enumerate(levels) if at_node[j][index[float(s)]] is not None]
+    if lit:
+        kk, jj = np.array(lit).T
+        table[kk, jj, :4] = _fits([at_node[j][index[float(levels[k])]] for k, j in lit])
+        empty[kk, jj] = False
+    for k, j in lit:
+        s = levels[k]
+        up, down = at_node[j][index[float(s * (1 + _DS))]], at_node[j][index[float(s * (1 - _DS))]]
+        table[k, j, 4] = ((up.area() if up else 0.0) - (down.area() if down else 0.0)) / (2 * _DS * s)
     dark = empty.copy()
     _fill(table, empty)
     table[..., 3] = np.where(dark, 0.0, table[..., 3])  # nothing passes (the ellipse is a neighbour's)
