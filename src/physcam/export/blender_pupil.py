@@ -121,9 +121,8 @@ def _aims(q, film_z: float, fx, px, py, big: float, backend: str):
     from ..trace.trace import trace_through
 
     fx = np.asarray(fx, dtype=float)
-    start = np.stack([fx, np.zeros_like(fx), np.full(fx.size, film_z)], axis=1)
-    rays = RayBatch.from_arrays(start, np.stack([px - fx, py, np.full(px.size, q.vertex_z[-1] - film_z)], axis=1),
-                                q.wavelength_nm)
+    rays = RayBatch.from_columns(fx, np.zeros_like(fx), np.full(fx.size, film_z), px - fx, py,
+                                 np.full(px.size, q.vertex_z[-1] - film_z), q.wavelength_nm)
     probe = _StopCrossing()
     trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=big, aperture=probe, in_place=True,
                   backend=backend)

@@ -69,11 +69,11 @@ def exit_pupil_bounds(lens, film_half_width: float, film_half_height: float, fil
 _OPEN_STOP = 2.0 ** 20
 
 
-def stopped_pupil_bounds(lens, stop_semi_diameters, film_half_width: float, film_half_height: float,
+def stopped_pupil_bounds(lens, stop_semi_diameter, film_half_width: float, film_half_height: float,
                          film_z: float | None = None, *, nx: int = 17, ny: int = 17, samples: int = 64,
                          backend: str = "auto") -> list[PupilBounds]:
-    """:func:`exit_pupil_bounds` with the stop's semi-diameter set to each of ``stop_semi_diameters``
-    (mm; None: the lens's own), one :class:`PupilBounds` each. The aims of every node are traced in
+    """:func:`exit_pupil_bounds` with the stop's semi-diameter set to each size of the sequence
+    ``stop_semi_diameter`` (mm; None: the lens's own), one :class:`PupilBounds` each. The aims of every node are traced in
     one call for all irises (:func:`iris_camera_rays`), and so are the windows of every node still
     searching (module notes), round by round."""
     from .trace import paraxial_image_z
@@ -82,7 +82,7 @@ def stopped_pupil_bounds(lens, stop_semi_diameters, film_half_width: float, film
     hh = require_positive("film half height", film_half_height)
     if nx < 2 or ny < 2 or samples < 4:
         raise InputError("pupil bounds need nx, ny >= 2 and samples >= 4")
-    sd = [s if s is None else require_positive("stop semi-diameter", s) for s in stop_semi_diameters]
+    sd = [s if s is None else require_positive("stop semi-diameter", s) for s in stop_semi_diameter]
     if any(s is None for s in sd) and not all(s is None for s in sd):  # the lens's own among others
         sd = [float(lens.surfaces[lens.stop_index].semi_diameter) if s is None else s for s in sd]
     if film_z is None:
@@ -133,10 +133,10 @@ class _StopCrossing:
         return np.ones_like(x)
 
 
-def iris_camera_rays(lens, film_xy, pupil_samples, film_z: float, stop_semi_diameters, *, bounds=None,
+def iris_camera_rays(lens, film_xy, pupil_samples, film_z: float, stop_semi_diameter, *, bounds=None,
                      backend: str = "auto"):
     """:func:`~physcam.trace.trace.camera_rays` for several irises in one trace: (the rays, traced with
-    the stop opened to :data:`_OPEN_STOP`; per stop semi-diameter in ``stop_semi_diameters`` (mm), which
+    the stop opened to :data:`_OPEN_STOP`; per stop semi-diameter of the sequence ``stop_semi_diameter`` (mm), which
     rays pass it). A ray passes an iris of radius s when it passes every other surface and crosses the
     stop plane at x^2 + y^2 <= s^2: the tracer's own test, so each mask is camera_rays' ``ok`` with
     ``stop_semi_diameter=s``, and where it holds the weight is the same too."""
@@ -147,7 +147,7 @@ def iris_camera_rays(lens, film_xy, pupil_samples, film_z: float, stop_semi_diam
                       aperture=probe, backend=backend)
     x, y = probe.x * _OPEN_STOP, probe.y * _OPEN_STOP
     r2 = x * x + y * y
-    return res, [res.ok & (r2 <= float(s) * float(s)) for s in stop_semi_diameters]
+    return res, [res.ok & (r2 <= float(s) * float(s)) for s in stop_semi_diameter]
 
 
 def _box_hits(lens, fx, fy, film_z, boxes, uu, vv, stops, backend) -> np.ndarray:
