@@ -138,34 +138,6 @@ def _centre_norms(q, film_z, rects, levels) -> list[float]:
             for g, ok in zip(np.ravel(which).tolist(), passing)]
 
 
-def _nearest_mark(lens: Prescription, near: float) -> float:
-    """The closest mark (mm from the film), at or beyond ``near``, that physcam's focusing reaches: a
-    lens longer than its 1:1 conjugate (the Laikin zoom at 15 mm: 288 mm long, 1:1 at 250 mm from the
-    film) would hold the subject inside it there, so the mark is moved out (bisection to 1e-6)."""
-    from ..optics.focusing import focus
-
-    def reaches(m):
-        try:
-            focus(lens, m)
-        except OpticsError:
-            return False
-        return True
-
-    if reaches(near):
-        return near
-    lo, hi = near, 2 * near
-    for _ in range(30):
-        if reaches(hi):
-            break
-        lo, hi = hi, 2 * hi
-    else:
-        raise OpticsError(f"{lens.name!r} focuses at no distance from {near:.1f} mm to {hi:.0f} mm from the film")
-    while hi - lo > 1e-6 * hi:
-        mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if reaches(mid) else (mid, hi)
-    return hi
-
-
 @takes_prescription
 def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: float = GRID_HALF_MM) -> FocusTable:
     """Tabulate ``lens``'s focus states (module notes). Raises OpticsError when the lens passes no
@@ -178,7 +150,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
 
     if isinstance(n_focus, bool) or not isinstance(n_focus, int) or n_focus < 2:
         raise InputError(f"a focus table needs at least 2 states, got {n_focus!r}")
-    near = _nearest_mark(lens, closest_focus(lens) * (1 + 1e-6))  # a hair beyond: rounding must not ask closer
+    near = closest_focus(lens) * (1 + 1e-6)  # a hair beyond: rounding must not ask closer
     step = 1000.0 / near / (n_focus - 1)  # 1/m
     marks = np.array([math.inf] + [1000.0 / (step * i) for i in range(1, n_focus)])
     marks[-1] = max(marks[-1], near)
