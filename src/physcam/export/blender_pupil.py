@@ -566,10 +566,10 @@ def _cols_used(rho: float, step: float) -> list[int]:
 def _reads(table, levels, rhos, ss):
     """Per (film radius, iris radius) pair, arrays of what the shader reads: j0, rw (:func:`_radial`)
     and l0, lw, shrink (:func:`_bracket`)."""
-    rad = {rho: _radial(table, rho) for rho in set(rhos)}
-    br = {s: _bracket(levels, s) for s in set(ss)}
-    j0, rw = (np.array(v) for v in zip(*(rad[rho] for rho in rhos)))
-    l0, lw, shrink = (np.array(v) for v in zip(*(br[s] for s in ss)))
+    rho_u, rho_i = np.unique(np.asarray(rhos, dtype=float), return_inverse=True)
+    s_u, s_i = np.unique(np.asarray(ss, dtype=float), return_inverse=True)
+    j0, rw = (np.array(v)[rho_i.ravel()] for v in zip(*(_radial(table, rho) for rho in rho_u.tolist())))
+    l0, lw, shrink = (np.array(v)[s_i.ravel()] for v in zip(*(_bracket(levels, s) for s in s_u.tolist())))
     return j0, rw, l0, lw, shrink
 
 

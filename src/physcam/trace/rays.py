@@ -89,10 +89,12 @@ class RayBatch:
             raise InputError("a ray direction is the zero vector; give a non-zero direction")
         dx, dy, dz = dx / big, dy / big, dz / big
         norm = np.sqrt(dx * dx + dy * dy + dz * dz)
-        wl = np.broadcast_to(np.asarray(wavelength_nm, dtype=np.float64), (n,)).copy()
-        require_wavelength(wl, "ray wavelength")
-        w = np.broadcast_to(np.asarray(weight, dtype=np.float64), (n,)).copy()
-        if not (np.isfinite(w).all() and (w >= 0).all()):
+        wl_in, w_in = np.asarray(wavelength_nm, dtype=np.float64), np.asarray(weight, dtype=np.float64)
+        wl = np.broadcast_to(wl_in, (n,)).copy()
+        if n:  # the values, checked before broadcasting
+            require_wavelength(float(wl_in) if wl_in.ndim == 0 else wl_in, "ray wavelength")
+        w = np.broadcast_to(w_in, (n,)).copy()
+        if n and not (np.isfinite(w_in).all() and (w_in >= 0).all()):
             raise InputError("ray weights must be finite and >= 0")
         # own, writable, contiguous columns: a broadcast input (read-only, possibly one element,
         # which ascontiguousarray would pass through as is) must never reach the kernels
