@@ -33,21 +33,18 @@ def extension_zip(tmp_path_factory):
     """``physcam export blender-extension`` of every bundled lens, built once per test session and shared
     by the Blender extension's tests (building it solves every bundled lens's focus table, the slowest
     step). Under pytest-xdist the workers share one build: the first worker to ask builds it under a
-    lock in the session's common temporary folder, the other waits and reads it (each worker building
-    its own doubled the suite's slowest step; putting every test that uses it on one worker, xdist's
-    loadgroup, made that worker the suite's last by a minute). Here, not in tests/blender/conftest.py: with
-    --doctest-modules two conftest modules of one name collide."""
-    import fcntl
+    session lock, with two processes (the other worker mostly waits for it; `--workers`), the other
+    reads it (each worker building its own doubled the suite's slowest step; putting every test that
+    uses it on one worker, xdist's loadgroup, made that worker the suite's last by a minute). Here, not
+    in tests/blender/conftest.py: with --doctest-modules two conftest modules of one name collide."""
+    from _session import session_lock
 
     from physcam.cli import main
 
-    base = tmp_path_factory.getbasetemp()
-    root = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
-    out = root / "blender-extension"
-    with open(root / "blender-extension.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+    with session_lock(tmp_path_factory, "blender-extension") as root:
+        out = root / "blender-extension"
         if not list(out.glob("physcam-*.zip")):
             out.mkdir(exist_ok=True)
-            assert main(["export", "blender-extension", "-o", str(out)]) == 0
+            assert main(["export", "blender-extension", "-o", str(out), "--workers", "2"]) == 0
     (zp,) = out.glob("physcam-*.zip")
     return zp

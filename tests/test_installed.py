@@ -9,7 +9,6 @@ docs/install.md.
 
 from __future__ import annotations
 
-import fcntl
 import json
 import os
 import subprocess
@@ -18,6 +17,7 @@ import time
 from pathlib import Path
 
 import pytest
+from _session import session_lock
 
 ROOT = Path(__file__).resolve().parents[1]
 pytestmark = pytest.mark.slow
@@ -42,9 +42,7 @@ def installed(tmp_path_factory):
     dist = tmp / "dist"
     # `python -m build` stages the sdist in the checkout itself (physcam-<version>/, src/*.egg-info): two
     # xdist workers building at once removed each other's staging folder, so they take turns
-    base = tmp_path_factory.getbasetemp()
-    with open((base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "build.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+    with session_lock(tmp_path_factory, "build"):
         _run([sys.executable, "-m", "build", "--outdir", str(dist), str(ROOT)], tmp, env=env)
     wheels, sdists = sorted(dist.glob("physcam-*.whl")), sorted(dist.glob("physcam-*.tar.gz"))
     assert len(wheels) == 1 and len(sdists) == 1

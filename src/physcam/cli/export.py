@@ -94,6 +94,8 @@ def register(sub) -> None:
     e.add_argument("-o", "--output", required=True, metavar="DIR", help="folder to write the zip into")
     e.add_argument("--lens", action="append", default=None, metavar="LENS",
                    help="a lens to ship (bundled name or a lens file; repeat; default every bundled lens)")
+    e.add_argument("--workers", type=whole("workers", lo=1, hi=256), default=None, metavar="N",
+                   help="processes computing the lenses' tables at once (default: one per core)")
     e.add_argument("--force", action="store_true", help="overwrite an existing zip")
     add_output_options(e, what="what was written")
     e.set_defaults(handler=run_blender_extension)
@@ -255,7 +257,7 @@ def run_blender_extension(args) -> int:
         names.append(name)
         print(f"  {name}: {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
 
-    path = build_extension(args.output, lenses=args.lens, force=args.force, progress=progress)
+    path = build_extension(args.output, lenses=args.lens, force=args.force, progress=progress, workers=args.workers)
     data = {"zip": str(path), "lenses": names, "seconds": round(time.perf_counter() - t0, 3)}
     if args.json:
         emit_json(document("export_blender_extension", data, units={"time": "s"}))

@@ -443,11 +443,17 @@ def _duplicates(c: _Ctx) -> None:
 
 def _provenance(c: _Ctx) -> None:
     """What a lens file's provenance record says about trusting and sharing it (only for a file that has one)."""
-    from .provenance import provenance_of
+    from .provenance import primary_source_claim_gaps, provenance_of
 
     prov = provenance_of(c.p)
     if prov == type(prov)():
         return
+    gaps = primary_source_claim_gaps(prov)
+    if gaps:
+        c.add("warning", "provenance_check_unstated",
+              "primary_source_checked is true, but " + "; ".join(gaps),
+              "nobody can tell what was compared with the primary source: state it in [provenance] checks, or set "
+              "primary_source_checked = false", None, gaps=gaps)
     if prov.primary_source_checked is False:
         c.add("note", "provenance_unchecked",
               f"its numbers were not compared with the primary source ({prov.source or 'not named'})",

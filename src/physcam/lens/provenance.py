@@ -28,13 +28,23 @@ from __future__ import annotations
 
 import datetime
 import json
+import re
 from dataclasses import dataclass, fields
 
 from ..errors import LensFileError
 from .prescription import Prescription, takes_prescription
 
-__all__ = ["Provenance", "provenance_of", "check_provenance_table", "TEXT_KEYS", "DATE_KEYS", "LIST_KEYS",
-           "UNRESOLVED_LICENCE", "ORDER"]
+__all__ = ["Provenance", "provenance_of", "check_provenance_table", "primary_source_claim_gaps", "TEXT_KEYS",
+           "DATE_KEYS", "LIST_KEYS", "UNRESOLVED_LICENCE", "ORDER", "PRIMARY_SOURCE_CHECK"]
+
+#: How a ``checks`` line about the primary source itself begins (``"primary source: ..."``).
+PRIMARY_SOURCE_CHECK = "primary source:"
+#: Words that name a place inside a source: a patent's example or table, a book's page or figure, a
+#: design file's revision.
+_PLACE = re.compile(r"\b(example|embodiment|table|fig\.?|figure|p\.|pp\.|page|revision|rev\.|beispiel|tabelle)"
+                    r"\s*(\d+|[IVX]+\b|[A-Z]\b)", re.IGNORECASE)
+_DECIMAL = re.compile(r"[-+]?\d+\.\d+")
+_COMPARED = re.compile(r"\b(against|equal|equals|match|matches|agree|agrees|differ|differs)\b", re.IGNORECASE)
 
 #: The SPDX value of a file whose licence nobody has established (its numbers came from a file
 #: under another licence and were not re-entered from the primary source).
@@ -130,3 +140,29 @@ def check_provenance_table(prov: dict, path=None) -> None:
             raise LensFileError(f"{where} must be a list of strings, got {v!r}", path)
         if key in BOOL_KEYS and not isinstance(v, bool):
             raise LensFileError(f"{where} must be true or false, got {v!r}", path)
+
+
+def primary_source_claim_gaps(prov: Provenance) -> list[str]:
+    """What a record that says ``primary_source_checked = true`` leaves unsaid, one sentence each
+    (empty when the claim is backed, or not made): the source must name the place in it (a patent's
+    example or table, a book's page, a design's revision), ``checked`` and ``checked_by`` who checked
+    and when, and one ``checks`` line starting ``primary source:`` must name that place and the
+    numbers compared (a decimal number and ``against``/``equal``/``match``/``differ``). A ``primary
+    source: not reached`` line contradicts the claim."""
+    from ..errors import require_type
+
+    require_type("prov", prov, Provenance, "physcam.lens.provenance.provenance_of(lens)")
+    if prov.primary_source_checked is not True:
+        return []
+    gaps = []
+    if not (prov.source and _PLACE.search(prov.source)):
+        gaps.append("the source does not name the example, table or page the numbers were compared with")
+    if not (prov.checked and prov.checked_by):
+        gaps.append("checked and checked_by do not say when and by whom")
+    lines = [c for c in prov.checks if c.lower().startswith(PRIMARY_SOURCE_CHECK)]
+    if any("not reached" in c for c in lines):
+        gaps.append("a checks line says the primary source was not reached")
+    elif not any(_PLACE.search(c) and _DECIMAL.search(c) and _COMPARED.search(c) for c in lines):
+        gaps.append(f"no checks line '{PRIMARY_SOURCE_CHECK} ...' names the table or example and the numbers compared "
+                    "(radii, gaps, nd, Vd, stated EFL and f-number)")
+    return gaps

@@ -33,7 +33,7 @@ import numpy as np
 
 from ...errors import InputError
 from .models import (DEFAULT_MAX_RESIDUAL_PX, DistortionSamples, FittedDistortion, _allowed, _check,
-                                _finish, _lstsq)
+                                _finish, _lstsq, tde4_lens_parameters)
 
 __all__ = ["TDE4_ANAMORPHIC_MODELS", "TDE4Anamorphic", "anamorphic_terms", "fit_tde4_anamorphic",
            "tde4_anamorphic_parameter_names"]
@@ -77,17 +77,7 @@ class TDE4Anamorphic(FittedDistortion):
 
     def lens_parameters(self) -> dict:
         """3DE4's built-in lens parameters (cm): the filmback is the desqueezed one (module notes)."""
-        c = self.coefficients
-        return {
-            "tde4_focal_length_cm": c["focal_length_mm"] / 10.0,
-            "tde4_filmback_width_cm": self.sensor_mm[0] * c["pixel_aspect"] / 10.0,
-            "tde4_filmback_height_cm": self.sensor_mm[1] / 10.0,
-            "tde4_lens_center_offset_x_cm": 0.0,
-            "tde4_lens_center_offset_y_cm": 0.0,
-            "tde4_pixel_aspect": c["pixel_aspect"],
-            "tde4_custom_focus_distance_cm": None if math.isinf(self.focus_from_film_mm)
-            else self.focus_from_film_mm / 10.0,
-        }
+        return tde4_lens_parameters(self, self.sensor_mm[0] * self.coefficients["pixel_aspect"])
 
     def unreal_parameters(self) -> dict:
         """Unreal's ``FAnamorphicDistortionParameters`` (CameraCalibrationCore, "3DE4 Anamorphic -

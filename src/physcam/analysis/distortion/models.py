@@ -358,22 +358,28 @@ class TDE4RadialStandard(FittedDistortion):
 
     def lens_parameters(self) -> dict:
         """3DE4's built-in lens parameters (its identifiers; lengths in cm as 3DE4 takes them)."""
-        c = self.coefficients
-        return {
-            "tde4_focal_length_cm": c["focal_length_mm"] / 10.0,
-            "tde4_filmback_width_cm": self.sensor_mm[0] / 10.0,
-            "tde4_filmback_height_cm": self.sensor_mm[1] / 10.0,
-            "tde4_lens_center_offset_x_cm": 0.0,
-            "tde4_lens_center_offset_y_cm": 0.0,
-            "tde4_pixel_aspect": c["pixel_aspect"],
-            "tde4_custom_focus_distance_cm": None if math.isinf(self.focus_from_film_mm)
-            else self.focus_from_film_mm / 10.0,
-        }
+        return tde4_lens_parameters(self, self.sensor_mm[0])
 
     def to_dict(self) -> dict:
         d = super().to_dict()
         d["lens_parameters"] = self.lens_parameters()
         return d
+
+
+def tde4_lens_parameters(fit: FittedDistortion, filmback_width_mm: float) -> dict:
+    """3DE4's built-in lens parameters of a 3DE4 fit (its identifiers; lengths in cm as 3DE4 takes
+    them): the focal length, the filmback (``filmback_width_mm`` wide: the anamorphic model's is the
+    desqueezed one), the lens centre on the axis, the pixel aspect and the focus distance (from the film)."""
+    c = fit.coefficients
+    return {
+        "tde4_focal_length_cm": c["focal_length_mm"] / 10.0,
+        "tde4_filmback_width_cm": filmback_width_mm / 10.0,
+        "tde4_filmback_height_cm": fit.sensor_mm[1] / 10.0,
+        "tde4_lens_center_offset_x_cm": 0.0,
+        "tde4_lens_center_offset_y_cm": 0.0,
+        "tde4_pixel_aspect": c["pixel_aspect"],
+        "tde4_custom_focus_distance_cm": None if math.isinf(fit.focus_from_film_mm) else fit.focus_from_film_mm / 10.0,
+    }
 
 
 def _tde4_linear(q, t, M, wpx):

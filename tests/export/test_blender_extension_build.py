@@ -1,0 +1,40 @@
+"""``physcam export blender-extension --workers``: the lenses' tables computed by several processes give
+the zip one process gives (the session's shared zip is built with two workers, tests/conftest.py)."""
+
+import json
+import zipfile
+
+import pytest
+
+from physcam.cli import main
+from physcam.errors import PhysCamError
+from physcam.export.blender_extension import build_extension, lens_payload
+from physcam.lens.library import list_lenses, load_lens
+
+LENS = "dgauss_77deg_3_5201mm"  # the cheapest lens to tabulate (~2 s)
+
+
+def test_tables_of_the_pooled_build_are_the_one_process_ones(extension_zip):
+    """Every bundled lens is in the pooled zip, in the library's order, and one lens's table and four
+    shaders computed here, in this process, are the zip's byte for byte."""
+    data, shaders = lens_payload(load_lens(LENS), LENS)
+    with zipfile.ZipFile(extension_zip) as z:
+        index = json.loads(z.read("lenses/index.json"))
+        assert [e["slug"] for e in index] == [r.slug for r in list_lenses()]
+        assert json.loads(z.read(f"lenses/{LENS}.json")) == json.loads(json.dumps(data))
+        for name, text in shaders.items():
+            assert z.read(f"shaders/{name}").decode("utf-8") == text, name
+
+
+@pytest.mark.parametrize("workers", [0, 257, 1.5, True])
+def test_a_bad_number_of_workers_is_refused(workers, tmp_path):
+    with pytest.raises(PhysCamError, match="workers"):
+        build_extension(tmp_path, lenses=[LENS], workers=workers)
+    assert not list(tmp_path.iterdir())
+
+
+def test_the_cli_refuses_zero_workers_in_one_line(tmp_path, capsys):
+    assert main(["export", "blender-extension", "-o", str(tmp_path), "--lens", LENS, "--workers", "0"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "workers" in err and len(err.splitlines()) == 1
+    assert not list(tmp_path.iterdir())
