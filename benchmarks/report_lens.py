@@ -6,9 +6,11 @@ Each command runs in a fresh Python process, alternately from this tree and from
 system) of the child, less disturbed by other jobs than the wall clock, and its ratio. A second
 table times the report alone inside each process (the lens loaded and the glass catalogue read
 first), where the focus solves are. Bytecode caches are kept (PYTHONDONTWRITEBYTECODE dropped, as in
-benchmarks/startup.py).
+benchmarks/startup.py). A third line times the floor in the same alternation: a Python that only imports
+numpy (every prescription report imports it, for the glass and the real-ray field of view), and the
+ratio no report that imports numpy can beat (baseline / floor).
 
-    .venv/bin/python benchmarks/report_lens.py --baseline /tmp/base/src [--runs 15] [--lens zuiko_18mm_f3_5]
+    .venv/bin/python benchmarks/report_lens.py --baseline /tmp/base/src [--runs 15] [--lens zuiko_18mm_f3_5] [--text]
 """
 
 import argparse
@@ -61,10 +63,11 @@ def main() -> None:
     ap.add_argument("--lens", default="zuiko_18mm_f3_5")
     ap.add_argument("--fstop", default="4")
     ap.add_argument("--focus-mm", default="2000")
+    ap.add_argument("--text", action="store_true", help="time the table people read (no --json)")
     args = ap.parse_args()
     trees = {"baseline": Path(args.baseline).resolve(), "this tree": HERE}
     cmd = [sys.executable, "-m", "physcam", "report", "--lens", args.lens, "--fstop", args.fstop, "--focus",
-           f"{float(args.focus_mm) / 1000:g}m", "--json"]
+           f"{float(args.focus_mm) / 1000:g}m", *(() if args.text else ("--json",))]
     inner = [sys.executable, "-c", INNER, args.lens, args.fstop, args.focus_mm]
     print(f"load average {', '.join(f'{v:.2f}' for v in os.getloadavg())} at start; {' '.join(cmd[2:])}")
     for name, src in trees.items():  # warm the OS file cache and the bytecode caches
@@ -72,7 +75,9 @@ def main() -> None:
     cpu = {k: [] for k in trees}
     wall = {k: [] for k in trees}
     report = {k: [] for k in trees}
+    floor = []
     for _ in range(args.runs):
+        floor.append(cpu_of([sys.executable, "-c", "import numpy"], env_for(HERE))[0])
         for name, src in trees.items():
             c, w = cpu_of(cmd, env_for(src))
             cpu[name].append(c)
@@ -84,6 +89,9 @@ def main() -> None:
     for name in trees:
         print(f"{name:10s} physcam report --lens: CPU median {med[name] * 1000:.0f} ms (wall median "
               f"{statistics.median(wall[name]) * 1000:.0f} ms); the report alone {rep[name] * 1000:.1f} ms CPU")
+    fl = statistics.median(floor)
+    print(f"floor      python -c 'import numpy': CPU median {fl * 1000:.0f} ms; a report importing numpy is at most "
+          f"{med['baseline'] / fl:.2f}x faster than the baseline")
     print(f"ratio baseline / this tree: command {med['baseline'] / med['this tree']:.2f}x, "
           f"report alone {rep['baseline'] / rep['this tree']:.2f}x over {args.runs} runs "
           f"(load {', '.join(f'{v:.2f}' for v in os.getloadavg())} at the end)")

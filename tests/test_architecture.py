@@ -343,3 +343,57 @@ def test_only_the_camera_state_sizes_an_iris():
             elif isinstance(node, ast.Attribute) and node.attr == "iris_semi_diameter":
                 wrong.append(f"{rel}:{node.lineno}")
     assert not wrong, "size the iris through physcam.optics.state.camera_state: " + ", ".join(sorted(wrong))
+
+
+# issue 43 ("Done when"): a focus and a stop are the camera's (physcam.optics.state.CameraState); a record
+# elsewhere holds the camera, never its own copies. The names are scripts/house_metrics.py's (the issue's
+# count); the allowed places are the optics models and the raw records of what a camera or a take recorded.
+FOCUS_FIELD = r"^(focus|focus_mm|focus_from_film_mm|focus_distance.*|object_z|focused)$"
+STOP_FIELD = r"^(fstop|f_stop|tstop|f_number|stop_semi_diameter|aperture_fstop|fstop_at_focus|iris_set)$"
+FOCUS_AND_STOP_ALLOWED = ("optics/", "metadata/", "live/", "characterize/", "usd/animate.py:FocusKey")
+
+
+def _class_fields(cls: ast.ClassDef) -> list[str]:
+    """The fields a class body declares: annotated names (dataclasses, NamedTuples, attrs with annotations)
+    and names assigned an ``attr.ib()``, ``attrs.field()`` or ``dataclasses.field()`` (attrs without them)."""
+    names = []
+    for s in cls.body:
+        if isinstance(s, ast.AnnAssign) and isinstance(s.target, ast.Name):
+            names.append(s.target.id)
+        elif isinstance(s, ast.Assign) and isinstance(s.value, ast.Call):
+            f = s.value.func
+            callee = f.attr if isinstance(f, ast.Attribute) else getattr(f, "id", "")
+            if callee in ("ib", "attrib", "field"):
+                names += [t.id for t in s.targets if isinstance(t, ast.Name)]
+    return names
+
+
+def _classes_with_focus_and_stop(source: str, rel: str) -> list[str]:
+    import re
+
+    out = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ClassDef):
+            names = _class_fields(node)
+            if any(re.match(FOCUS_FIELD, n) for n in names) and any(re.match(STOP_FIELD, n) for n in names):
+                out.append(f"{rel}:{node.name}")
+    return out
+
+
+def test_no_class_outside_the_raw_records_carries_a_focus_and_a_stop():
+    found = []
+    for path in sorted((SRC / "physcam").rglob("*.py")):
+        rel = path.relative_to(SRC / "physcam").as_posix()
+        found += _classes_with_focus_and_stop(path.read_text(encoding="utf-8"), rel)
+    wrong = [c for c in found if not any(c.startswith(a) for a in FOCUS_AND_STOP_ALLOWED)]
+    assert not wrong, ("hold the camera (physcam.optics.state.CameraState) instead of its focus and stop: "
+                       + ", ".join(wrong))
+
+
+def test_the_focus_and_stop_finder_finds_each_kind_of_record():
+    src = ("@dataclass\nclass A:\n    focus_mm: float\n    fstop: float\n"
+           "class B(NamedTuple):\n    focus_from_film_mm: float\n    f_number: float\n"
+           "@attr.s\nclass C:\n    focus = attr.ib()\n    tstop = attr.ib(default=None)\n"
+           "@dataclass\nclass D:\n    camera: object\n    coc_mm: float\n"
+           "class E:\n    fstop = 4.0\n    focus_mm = 3000.0\n")  # class constants, not fields
+    assert _classes_with_focus_and_stop(src, "x.py") == ["x.py:A", "x.py:B", "x.py:C"]

@@ -79,6 +79,10 @@ def test_every_public_default_sensor_is_the_clis():
     want = {"width": s.width_mm, "height": s.height_mm, "both": (s.width_mm, s.height_mm),
             "half_diagonal": math.hypot(s.width_mm, s.height_mm) / 2}
     found = _sensor_defaults()
+    from physcam.usd.spec import CameraSpec  # (its numbers' defaults are CameraSpec.of's, issue 43)
+
+    found += [("physcam.usd.spec.CameraSpec", p.name, p.default) for p in
+              inspect.signature(CameraSpec.of).parameters.values() if p.name in SENSOR_PARAMS]
     names = {q for q, _, _ in found}
     # the analyses, the breathing table, the MTF chart, the characterization grid and the USD kit
     # (the ray analyses that take a camera read its sensor, else the default: test_a_camera_without_a_sensor...)

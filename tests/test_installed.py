@@ -197,7 +197,7 @@ def test_with_every_extra_the_demo_usd_plugin_and_serve_work(installed):
             "from pxr import Usd, Sdf\n"
             "from physcam.usd.author import CameraSpec, author_camera, new_stage\n"
             "stage = new_stage()\n"
-            "prim = author_camera(stage, '/Cam', CameraSpec(focal_length_mm=35.0, fstop=2.8, focus_mm=2000.0))\n"
+            "prim = author_camera(stage, '/Cam', CameraSpec.of(focal_length_mm=35.0, fstop=2.8, focus_mm=2000.0))\n"
             "print(prim.GetTypeName(), Usd.SchemaRegistry().FindConcretePrimDefinition('PhysicalCamera') is not None)\n")
     out = _run([inst["py"], "-c", code], inst["work"], env=inst["env"]).stdout.split()
     assert out == ["PhysicalCamera", "True"]

@@ -21,6 +21,8 @@ def forward_chief_to_film(q, obj_pts, object_z, film_z, wl):
     k = q.stop_index
     front = q.with_surfaces(q.surfaces[: k + 1])
     z_ep = gaussian(q, wavelength_nm=wl, object_z=object_z, film_z=film_z).z_entrance_pupil
+    # an anamorphic's X meridian has its own entrance pupil: the first aim is the ray towards it
+    z_ep_x = gaussian(q, axis="x", wavelength_nm=wl, object_z=object_z, film_z=film_z).z_entrance_pupil
     n = obj_pts.shape[0]
 
     def at_stop(a, b):
@@ -31,7 +33,7 @@ def forward_chief_to_film(q, obj_pts, object_z, film_z, wl):
         assert out.ok.all()
         return np.stack([out.x, out.y], axis=1), pos, d
 
-    a = np.zeros(n)
+    a = obj_pts[:, 0] * (z_ep_x - z_ep) / (z_ep_x - object_z)
     b = np.zeros(n)
     e = 1e-6
     for _ in range(30):

@@ -14,7 +14,7 @@ pytestmark = pytest.mark.slow
 
 
 def test_blender_imports_the_camera_in_place(tmp_path):
-    f = write_camera(tmp_path / "cam.usda", CameraSpec(focal_length_mm=35.0, fstop=2.8, focus_mm=3000.0,
+    f = write_camera(tmp_path / "cam.usda", CameraSpec.of(focal_length_mm=35.0, fstop=2.8, focus_mm=3000.0,
                                                        sensor_width_mm=36.0, sensor_height_mm=24.0),
                      position=(120.0, 150.0, -40.0), rotate_xyz_deg=(0.0, 30.0, 0.0))
     out = run_blender('''
@@ -57,7 +57,7 @@ def test_blender_keeps_the_iris_and_resolution_that_its_importer_does_not_apply(
     """Blender's USD importer reads no iris or resolution (UsdGeomCamera has none; it ignores
     UsdRenderSettings): physcam writes them as userProperties, which Blender keeps on the camera, and
     the documented snippet applies them (issue 24 item 3)."""
-    spec = CameraSpec(focal_length_mm=35.0, fstop=2.8, focus_mm=3000.0, sensor_width_mm=36.0, sensor_height_mm=24.0,
+    spec = CameraSpec.of(focal_length_mm=35.0, fstop=2.8, focus_mm=3000.0, sensor_width_mm=36.0, sensor_height_mm=24.0,
                       aperture_blades=6, aperture_angle_deg=15.0)
     f = write_camera(tmp_path / "cam.usda", spec, resolution=(1234, 823))
     out = run_blender('''

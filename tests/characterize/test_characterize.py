@@ -278,7 +278,7 @@ def test_a_lens_file_of_dated_variants_gains_a_run_and_keeps_them(tmp_path):
             "d2026_03_01")
         return {str(a.GetPath()): a.Get() for p in stage.Traverse() for a in p.GetAttributes() if a.HasAuthoredValue()}
 
-    f = write_lens_file(tmp_path / "lens.usda", {"2026-03-01": CameraSpec(focal_length_mm=24.0, fstop=2.0)})
+    f = write_lens_file(tmp_path / "lens.usda", {"2026-03-01": CameraSpec.of(focal_length_mm=24.0, fstop=2.0)})
     before = dated(f)
     assert before["/Lens.lens:main:fStop"] == pytest.approx(2.0)
     spec, _ = best_match_pinhole(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_width_mm=36.0,
@@ -357,3 +357,51 @@ def test_light_cells_share_a_task_per_lens():
     light = [g for g in groups if g[0].kind in ("lens", "illumination")]
     assert len(light) == 2 and all(len({c.lens for c in g}) == 1 for g in light)
     assert all(len(g) == 1 for g in groups if g not in light)
+
+
+def test_the_index_has_a_zoom_lens_position_in_zoom_columns(tmp_path):
+    """A zoom lens characterized at a position (``characterize --zoom``) says where in the index: its encoder
+    value and paraxial EFL there, against a ray-transfer (ABCD) product of the lens file's gap table
+    written here (tests/export/test_unreal_zoom.py's); a prime's are null. An index row written before the
+    columns existed reads back with nulls there, losing nothing."""
+    import tomllib
+    from importlib import resources
+
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from physcam.characterize.cells import run_cell
+    from physcam.lens.formats.physcam_toml import dumps
+    from physcam.lens.zoom import prescription_at
+
+    canon = "canon_ef_70_200mm_f2_8_zoom"
+    doc = tomllib.loads(resources.files("physcam.data").joinpath("lenses", f"{canon}.toml").read_text(encoding="utf-8"))
+    a, b, c, d, n = 1.0, 0.0, 0.0, 1.0, 1.0  # position 2 of 3 (encoder 0.5): refraction and reduced transfer
+    gaps = {g["surface"]: g["thickness"][1] for g in doc["zoom"]["gap"]}
+    for i, s in enumerate(doc["surface"]):
+        n2 = 1.0 if s["medium"] == "air" else float(s["medium"]["nd"])
+        r = s.get("radius", 0.0)
+        power = 0.0 if s["kind"] in ("flat", "stop") or r == 0 else (n2 - n) / r
+        c, d = c - power * a, d - power * b
+        n = n2
+        if i < len(doc["surface"]) - 1:
+            t = float(gaps.get(i, s["thickness"])) / n
+            a, b = a + t * c, b + t * d
+    grid = tiny(kinds=("lens",), focus_mm=(INF,)).checked()
+    rows = {}
+    for name, rx in (("zoomed", prescription_at(load_lens(canon), 0.5)), ("prime", load_lens("dgauss_50mm"))):
+        (cell,) = build_cells(name, lens_hash(rx), grid, rx.wavelength_nm, "0")
+        res = run_cell(dumps(rx), lens_hash(rx), cell, grid, str(tmp_path), "run_test", "0")
+        assert res["status"] == "computed", res["error"]
+        rows[name] = res["row"]
+    assert rows["zoomed"]["zoom_encoder"] == 0.5
+    assert rows["zoomed"]["zoom_focal_length_mm"] == pytest.approx(-1.0 / c, rel=1e-9)  # 134.95 mm (patent: 135)
+    assert rows["prime"]["zoom_encoder"] is None and rows["prime"]["zoom_focal_length_mm"] is None
+    old = tmp_path / "index" / "old" / "lens" / "old.parquet"  # a row from before the zoom columns
+    old.parent.mkdir(parents=True)
+    legacy = {k: v for k, v in rows["prime"].items() if not k.startswith("zoom_")} | {"lens": "old"}
+    pq.write_table(pa.Table.from_pylist([legacy]), old)
+    got = {r["lens"]: r for r in read_index(tmp_path).to_pylist()}
+    assert got.keys() == {"zoomed", "prime", "old"}
+    assert got["old"]["zoom_encoder"] is None and got["old"]["content_hash"] == rows["prime"]["content_hash"]
+    assert got["zoomed"]["zoom_focal_length_mm"] == rows["zoomed"]["zoom_focal_length_mm"]

@@ -130,6 +130,25 @@ def test_lens_card_at_a_zoom_position_has_optilands_numbers(tmp_path, capsys):
     assert d["key"]["entrance_pupil_diameter_mm"] == pytest.approx(ref["epd_mm"], rel=1e-3)
     assert d["zoom"]["encoder"] == 1.0 and "at 149.9 mm (zoom 1)" in d["lens"]
     assert (tmp_path / "card.png").read_bytes()[:4] == b"\x89PNG"
+    # the zoom page: beside the PNG, every tabulated position at optiland's EFL, f-number and pupil; page 1 at 1
+    assert d["pages"] == ["main", "zoom"] and d["files"] == [str(tmp_path / "card.png"), str(tmp_path / "card-zoom.png")]
+    assert (tmp_path / "card-zoom.png").read_bytes()[:4] == b"\x89PNG"
+    z = d["zoom_page"]
+    assert z["card_encoder"] == 1.0 and d["anamorphic_page"] is None
+    tab = [r for r in z["positions"] if r["tabulated"]]
+    assert len(tab) == 4
+    for r, ref in zip(tab, OPTILAND["laikin_zoom_15_150mm"]):
+        assert r["efl_mm"] == pytest.approx(ref["efl_mm"], rel=1e-3)
+        assert r["f_number"] == pytest.approx(ref["f_number"], rel=1e-3)
+        assert r["entrance_pupil_diameter_mm"] == pytest.approx(ref["epd_mm"], rel=1e-3)
+    assert [b["encoder"] for b in z["breathing"]] == [r["encoder"] for r in tab]
+
+
+def test_lens_card_keeps_an_existing_further_page(tmp_path, capsys):
+    (tmp_path / "card-zoom.png").write_bytes(b"mine")
+    rc, out, err = _run(capsys, "lens", "card", "--lens", CANON, "--draft", "--dpi", "30", "-o", tmp_path / "card.png")
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and "card-zoom.png" in err
+    assert not (tmp_path / "card.png").exists() and (tmp_path / "card-zoom.png").read_bytes() == b"mine"
 
 
 def test_characterize_plan_has_a_lens_per_zoom_position(tmp_path, capsys):
@@ -162,6 +181,11 @@ def test_characterize_over_zoom_on_dask_gives_each_positions_efl(tmp_path, capsy
     assert got.keys() == want.keys()
     for k in want:
         assert got[k] == pytest.approx(want[k], rel=1e-3)
+    # the index's zoom columns: each position's encoder value and optiland's EFL there
+    zoom = {r["lens"]: (r["zoom_encoder"], r["zoom_focal_length_mm"]) for r in rows}
+    for u, ref in ((0.0, OPTILAND[CANON][0]), (1.0, OPTILAND[CANON][2])):
+        enc, efl = zoom[f"{CANON}_zoom_{ref['efl_mm']:.1f}mm"]
+        assert enc == u and efl == pytest.approx(ref["efl_mm"], rel=1e-3)
 
 
 @pytest.mark.parametrize("argv, words", [

@@ -46,7 +46,7 @@ def test_gf_camera_reproduces_fov(mpu, focal, w, h, squeeze):
     Gf.Camera.GetFieldOfView returns a 32-bit float, so it is held to its own rounding.
     """
     stage = new_stage(mpu)
-    spec = CameraSpec(focal_length_mm=focal, sensor_width_mm=w, sensor_height_mm=h, squeeze=squeeze)
+    spec = CameraSpec.of(focal_length_mm=focal, sensor_width_mm=w, sensor_height_mm=h, squeeze=squeeze)
     author_camera(stage, "/Cameras/Camera", spec)
     focal = image_distance_at_mark(focal, spec.focus_mm)
     cam = gf_camera(stage)
@@ -65,8 +65,8 @@ def test_gf_camera_reproduces_fov(mpu, focal, w, h, squeeze):
 def test_units_tenths_of_scene_unit(mpu, focal_expected):
     """50 mm is 50 tenths of a cm, 0.5 tenths of a metre, 19.685 tenths of an inch (2.54 mm each)."""
     stage = new_stage(mpu)
-    author_camera(stage, "/Cameras/Camera", CameraSpec(focal_length_mm=50.0, focus_mm=3000.0, sensor_width_mm=36.0,
-                                                       sensor_height_mm=24.0, clipping_mm=(100.0, 1.0e6)))
+    author_camera(stage, "/Cameras/Camera", CameraSpec.of(focal_length_mm=50.0, focus_mm=3000.0, sensor_width_mm=36.0,
+                                                          sensor_height_mm=24.0, clipping_mm=(100.0, 1.0e6)))
     g = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
     # float32 values chosen to keep aperture/focal exact stay within a few ulps (2e-6) of the exact ones;
     # the focal length is the best-match pinhole, s' of the 50 mm thin lens at the 3 m mark
@@ -86,7 +86,7 @@ def test_dof_survives_unit_change():
     out = {}
     for mpu in (0.01, 1.0):
         stage = new_stage(mpu)
-        author_camera(stage, "/Cameras/Camera", CameraSpec(focus_mm=2500.0, fstop=2.8))
+        author_camera(stage, "/Cameras/Camera", CameraSpec.of(focus_mm=2500.0, fstop=2.8))
         g = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
         eye = g.ComputeLocalToWorldTransform(Usd.TimeCode.Default()).ExtractTranslation()
         film = UsdGeom.Xformable(stage.GetPrimAtPath("/Cameras/Camera")).ComputeLocalToWorldTransform(
@@ -104,7 +104,7 @@ def test_dof_survives_unit_change():
 def test_pivot_is_the_entrance_pupil():
     """Rotating the body leaves the eye (entrance pupil) where it was: a nodal pan."""
     stage = new_stage(0.01)
-    author_camera(stage, "/Cameras/Camera", CameraSpec(entrance_pupil_mm=120.0), position=(10.0, 20.0, 30.0),
+    author_camera(stage, "/Cameras/Camera", CameraSpec.of(entrance_pupil_mm=120.0), position=(10.0, 20.0, 30.0),
                   rotate_xyz_deg=(15.0, 40.0, 5.0))
     eye = UsdGeom.Xformable(stage.GetPrimAtPath("/Cameras/Camera/Camera")).ComputeLocalToWorldTransform(
         Usd.TimeCode.Default()).ExtractTranslation()
@@ -116,8 +116,8 @@ def test_pivot_is_the_entrance_pupil():
 
 def test_exposure_shutter_and_renderman():
     stage = new_stage(0.01, fps=25.0)
-    spec = CameraSpec(fstop=4.0, transmittance=0.81, shutter_open_s=-0.01, shutter_duration_s=0.02,
-                      shutter_opening=(0.25, 0.75), aperture_blades=9, aperture_roundness=0.5, iso=800.0)
+    spec = CameraSpec.of(fstop=4.0, transmittance=0.81, shutter_open_s=-0.01, shutter_duration_s=0.02,
+                         shutter_opening=(0.25, 0.75), aperture_blades=9, aperture_roundness=0.5, iso=800.0)
     author_camera(stage, "/Cameras/Camera", spec)
     prim = stage.GetPrimAtPath("/Cameras/Camera/Camera")
     g = UsdGeom.Camera(prim)
@@ -146,8 +146,8 @@ def test_shutter_curve_points_lie_on_the_ramps(o, c):
 
 def test_orthographic_camera():
     stage = new_stage(1.0)
-    author_camera(stage, "/Cameras/Camera", CameraSpec(projection="orthographic", magnification=0.01,
-                                                       sensor_width_mm=36.0, sensor_height_mm=24.0))
+    author_camera(stage, "/Cameras/Camera", CameraSpec.of(projection="orthographic", magnification=0.01,
+                                                          sensor_width_mm=36.0, sensor_height_mm=24.0))
     g = UsdGeom.Camera(stage.GetPrimAtPath("/Cameras/Camera/Camera"))
     assert g.GetProjectionAttr().Get() == "orthographic"
     # 36 mm / 0.01 = 3.6 m wide = 36 tenths of a metre
@@ -162,9 +162,9 @@ def test_write_validates_and_refuses_to_overwrite(tmp_path):
     assert not validation_errors(Usd.Stage.Open(str(f)))
     before = f.read_bytes()
     with pytest.raises(ExportError, match="already exists"):
-        write_camera(f, CameraSpec(focal_length_mm=85.0))
+        write_camera(f, CameraSpec.of(focal_length_mm=85.0))
     assert f.read_bytes() == before
-    write_camera(f, CameraSpec(focal_length_mm=85.0), force=True)
+    write_camera(f, CameraSpec.of(focal_length_mm=85.0), force=True)
     assert b"focalLength = 85" in f.read_bytes()
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temp file left behind
 
@@ -183,12 +183,12 @@ def test_foreign_prim_is_named(tmp_path):
                                  dict(clipping_mm=(10.0, 5.0)), dict(focus_mm=float("inf"))])
 def test_bad_input_is_a_physcam_error(bad):
     with pytest.raises(InputError):
-        author_camera(new_stage(), "/Cameras/Camera", CameraSpec(**bad))
+        author_camera(new_stage(), "/Cameras/Camera", CameraSpec.of(**bad))
 
 
 def test_second_process_sees_schema_with_only_the_plugin_path(tmp_path):
     f = tmp_path / "cam.usda"
-    write_camera(f, CameraSpec(focal_length_mm=35.0))
+    write_camera(f, CameraSpec.of(focal_length_mm=35.0))
     code = f"""
 import sys
 from pxr import Usd, Sdf
@@ -236,8 +236,8 @@ def test_enlarge_and_shift_render_a_tile():
     quadrant: its Gf.Camera window is the upper-left quarter of the full frame's window."""
     full_stage, tile_stage = new_stage(0.01), new_stage(0.01)
     base = dict(focal_length_mm=50.0, sensor_width_mm=36.0, sensor_height_mm=24.0)
-    author_camera(full_stage, "/Cameras/Camera", CameraSpec(**base))
-    author_camera(tile_stage, "/Cameras/Camera", CameraSpec(**base, enlarge=(2.0, 2.0), shift_mm=(-9.0, 6.0)))
+    author_camera(full_stage, "/Cameras/Camera", CameraSpec.of(**base))
+    author_camera(tile_stage, "/Cameras/Camera", CameraSpec.of(**base, enlarge=(2.0, 2.0), shift_mm=(-9.0, 6.0)))
     full, tile = gf_camera(full_stage).frustum.GetWindow(), gf_camera(tile_stage).frustum.GetWindow()
     xm, ym = (full.GetMin()[0] + full.GetMax()[0]) / 2, (full.GetMin()[1] + full.GetMax()[1]) / 2
     quadrant = (full.GetMin()[0], xm, ym, full.GetMax()[1])
@@ -249,14 +249,14 @@ def test_left_handed_camera_mirrors_the_image():
     """handedness -1 (seed 001: a left-handed camera) mirrors the companion: its camera-to-world
     matrix has a negative determinant and camera +X maps to world -X (body unrotated)."""
     stage = new_stage(0.01)
-    author_camera(stage, "/Cameras/Camera", CameraSpec(handedness=-1.0))
+    author_camera(stage, "/Cameras/Camera", CameraSpec.of(handedness=-1.0))
     m = UsdGeom.Xformable(stage.GetPrimAtPath("/Cameras/Camera/Camera")).ComputeLocalToWorldTransform(
         Usd.TimeCode.Default())
     assert m.GetDeterminant() == pytest.approx(-1.0)
     assert m.TransformDir(Gf.Vec3d(1, 0, 0)) == pytest.approx(Gf.Vec3d(-1, 0, 0))
     assert not validation_errors(stage)
     with pytest.raises(InputError):
-        CameraSpec(handedness=0.5).checked()
+        CameraSpec.of(handedness=0.5).checked()
 
 
 def test_aperture_distance_is_the_physical_stop():
@@ -279,3 +279,36 @@ def test_aperture_distance_is_the_physical_stop():
     stage = new_stage(0.01)
     cam = author_camera(stage, "/Cameras/Camera", spec, report=r)
     assert cam.GetAttribute("lens:main:apertureDistance").Get() == pytest.approx(st.film_z - stop_z, rel=1e-6)
+
+
+def test_a_spec_holds_its_camera_and_the_keyword_form_answers_for_one_version(tmp_path):
+    """Issue 43: the spec holds a CameraState (focus and stop are the camera's); the old keyword form
+    still builds the same spec with a DeprecationWarning; the spec of a report holds the report's camera."""
+    from physcam.lens.library import load_lens
+    from physcam.onset.report import solve_report
+    from physcam.optics.sensors import find_sensor
+    from physcam.optics.state import CameraState, camera_state
+    from physcam.usd.author import spec_from_report
+
+    typed = dict(focal_length_mm=35.0, fstop=2.8, focus_mm=2000.0, sensor_width_mm=36.0, sensor_height_mm=24.0,
+                 squeeze=2.0, lens_name="Darling 35", shift_mm=(1.0, -2.0))
+    with pytest.warns(DeprecationWarning, match=r"CameraSpec\.of"):
+        old = CameraSpec(**typed)
+    new = CameraSpec.of(**typed)
+    assert old == new and isinstance(new.camera, CameraState)
+    # the numbers read back are the ones typed (the camera's and the spec's own)
+    assert (new.focal_length_mm, new.fstop, new.focus_mm, new.squeeze) == (35.0, 2.8, 2000.0, 2.0)
+    assert (new.sensor_width_mm, new.sensor_height_mm, new.lens_name, new.sensor_name) == (36.0, 24.0, "Darling 35",
+                                                                                          None)
+    assert new.camera.fstop == 2.8 and new.camera.focus_from_film_mm == 2000.0 and new.shift_mm == (1.0, -2.0)
+    assert new.replaced(fstop=4.0).camera.fstop == 4.0 and new.replaced(fstop=4.0).focus_mm == 2000.0
+    # the spec of a prescription's report holds that very camera (no copies of its focus and stop)
+    cam = camera_state(load_lens("dgauss_50mm"), focus_mm=1500.0, fstop=4.0, sensor=find_sensor("S35"))
+    report = solve_report(cam)
+    spec = spec_from_report(report)
+    assert spec.camera is cam and spec.fstop == 4.0 and spec.focus_mm == 1500.0
+    assert spec.focal_length_mm == report.focal_length_mm and spec.squeeze == report.squeeze
+    from physcam.usd.read import open_stage, read_camera
+
+    back = read_camera(open_stage(write_camera(tmp_path / "cam.usda", spec))).spec
+    assert back.fstop == pytest.approx(4.0, rel=F32_EPS) and back.focus_mm == pytest.approx(1500.0, rel=F32_EPS)

@@ -101,7 +101,7 @@ def test_a_shots_companion_gets_the_model_and_loses_it_with_a_spherical_lens(tmp
     from physcam.usd.kit import refresh_shot, write_body_file, write_shot, write_vendor_lens
 
     lens_f = write_vendor_lens(tmp_path / "lens.usda", load_lens(SLUG), focus_mm=3000.0, fstop=2.8)
-    body_f = write_body_file(tmp_path / "body.usda", CameraSpec(sensor_width_mm=W, sensor_height_mm=H))
+    body_f = write_body_file(tmp_path / "body.usda", CameraSpec.of(sensor_width_mm=W, sensor_height_mm=H))
     shot = write_shot(tmp_path / "shot.usda", body_f, lens_f)
     stage = Usd.Stage.Open(str(shot))
     assert validation_errors(stage) == []

@@ -100,7 +100,7 @@ def test_a_shot_with_a_vendor_anamorphic_has_both_pupils_and_loses_the_second_wi
 
     slug = "neil_front_anamorphic_2x"
     lens_f = write_vendor_lens(tmp_path / "lens.usda", load_lens(slug), focus_mm=3000.0, fstop=2.8)
-    body_f = write_body_file(tmp_path / "body.usda", CameraSpec(sensor_width_mm=27.99, sensor_height_mm=19.22))
+    body_f = write_body_file(tmp_path / "body.usda", CameraSpec.of(sensor_width_mm=27.99, sensor_height_mm=19.22))
     shot = write_shot(tmp_path / "shot.usda", body_f, lens_f)
     x, y = hand_pupils_from_film(slug, 3000.0)
     stage = Usd.Stage.Open(str(shot))

@@ -58,11 +58,11 @@ def probe(files, plugin: bool):
 def written(tmp_path_factory):
     d = tmp_path_factory.mktemp("noplugin")
     files = [
-        write_camera(d / "cam.usda", CameraSpec(focal_length_mm=35.0, fstop=2.8, focus_mm=2500.0, shift_mm=(1.0, -2.0)),
+        write_camera(d / "cam.usda", CameraSpec.of(focal_length_mm=35.0, fstop=2.8, focus_mm=2500.0, shift_mm=(1.0, -2.0)),
                      position=(120.0, 150.0, -40.0), rotate_xyz_deg=(-5.0, 30.0, 2.0)),
-        write_camera(d / "ortho.usda", CameraSpec(projection="orthographic", magnification=0.5),
+        write_camera(d / "ortho.usda", CameraSpec.of(projection="orthographic", magnification=0.5),
                      position=(0.0, 10.0, 0.0), rotate_xyz_deg=(-90.0, 0.0, 0.0)),
-        write_camera(d / "crate.usdc", CameraSpec(focal_length_mm=85.0), position=(1.0, 2.0, 3.0)),
+        write_camera(d / "crate.usdc", CameraSpec.of(focal_length_mm=85.0), position=(1.0, 2.0, 3.0)),
         write_previs_kit(d / "kit.usda"),
         write_vendor_lens(d / "vendor.usda", load_lens("dgauss_50mm"), focus_mm=1500.0, fstop=4.0),
     ]
@@ -72,8 +72,8 @@ def written(tmp_path_factory):
     files.append(write_animated_camera(d / "pull.usda", [FocusKey(1, 5000.0), FocusKey(2, 3000.0), FocusKey(3, 1000.0)],
                                        sensor=find_sensor("FF"), lens=load_lens("dgauss_50mm"), fstop=2.8,
                                        position=(10.0, 160.0, 300.0), rotate_xyz_deg=(0.0, -20.0, 0.0)))
-    body = write_body_file(d / "body.usda", CameraSpec(sensor_width_mm=27.99, sensor_height_mm=19.22))
-    lens = write_lens_file(d / "lens.usda", {"2026-03-01": CameraSpec(focal_length_mm=24.0, entrance_pupil_mm=80.0)})
+    body = write_body_file(d / "body.usda", CameraSpec.of(sensor_width_mm=27.99, sensor_height_mm=19.22))
+    lens = write_lens_file(d / "lens.usda", {"2026-03-01": CameraSpec.of(focal_length_mm=24.0, entrance_pupil_mm=80.0)})
     files += [body, lens, write_shot(d / "shot.usda", body, lens, position=(300.0, 170.0, 500.0),
                                      rotate_xyz_deg=(0.0, -45.0, 0.0)),
               write_shot(d / "vendor_shot.usda", body, files[4], position=(-20.0, 90.0, 40.0),

@@ -57,15 +57,32 @@ from .grid import PSF_INFINITY_STANDIN_MM, Cell, Grid, focus_label
 
 __all__ = ["run_cell", "run_cells", "compute_cell", "INDEX_SCHEMA_FIELDS", "read_row", "cell_lock"]
 
-#: Columns of the Parquet index (one row per cell; None where a kind has no such axis).
+#: Columns of the Parquet index (one row per cell; None where a kind has no such axis). ``zoom_encoder`` and
+#: ``zoom_focal_length_mm``: a zoom lens's position (``characterize --zoom``; None for a prime), its encoder
+#: value 0..1 and the paraxial EFL there at infinity focus (mm).
 INDEX_SCHEMA_FIELDS = (
-    ("lens", "string"), ("lens_hash", "string"), ("kind", "string"),
+    ("lens", "string"), ("lens_hash", "string"), ("zoom_encoder", "float64"), ("zoom_focal_length_mm", "float64"),
+    ("kind", "string"),
     ("focus_mm", "float64"), ("focus_label", "string"), ("fstop", "float64"), ("field", "float64"),
     ("field_x_mm", "float64"), ("field_y_mm", "float64"), ("wavelength_nm", "float64"),
     ("settings", "string"), ("file", "string"), ("content_hash", "string"), ("input_hash", "string"),
     ("physcam_version", "string"), ("run_id", "string"), ("created_utc", "string"), ("compute_s", "float64"),
     ("worker", "string"),
 )
+
+
+def zoom_columns(lens) -> dict:
+    """The index's zoom columns of ``lens``: the encoder value a zoom lens's position was taken at
+    (:data:`physcam.lens.zoom.ZOOM_ENCODER_KEY` in its extras, kept by its TOML) and the paraxial EFL there;
+    both None for a lens that is not a zoom position."""
+    from ..lens.zoom import ZOOM_ENCODER_KEY
+
+    raw = dict(lens.extras).get(ZOOM_ENCODER_KEY)
+    if raw is None:
+        return {"zoom_encoder": None, "zoom_focal_length_mm": None}
+    from ..optics.paraxial import gaussian
+
+    return {"zoom_encoder": float(json.loads(raw)), "zoom_focal_length_mm": gaussian(lens).efl}
 
 
 def _schema():
@@ -343,7 +360,7 @@ def run_cell(lens_toml: str, lens_digest: str, cell: Cell, grid: Grid, root: str
                     type(exc).__name__, "cell": cell}
         seconds = time.perf_counter() - t0
         file = cell.result_name + ("/fits.json" if cell.kind == "distortion" else "")
-        row = {"lens": cell.lens, "lens_hash": lens_digest, "kind": cell.kind,
+        row = {"lens": cell.lens, "lens_hash": lens_digest, **zoom_columns(lens), "kind": cell.kind,
                "focus_mm": _none_inf(cell.focus_mm),
                "focus_label": None if cell.focus_mm is None else focus_label(cell.focus_mm),
                "fstop": cell.fstop, "field": cell.field, "field_x_mm": extra.get("field_x_mm"),

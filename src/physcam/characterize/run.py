@@ -181,9 +181,21 @@ def read_index(folder):
 
     require_type("folder", folder, (str, Path), "the library folder")
     files = sorted(Path(folder, "index").rglob("*.parquet"))
+    schema = _schema()
     if not files:
-        return _schema().empty_table()
-    return pa.concat_tables([pq.read_table(f) for f in files])
+        return schema.empty_table()
+    return pa.concat_tables([_conformed(pq.read_table(f), schema) for f in files])
+
+
+def _conformed(table, schema):
+    """``table`` with ``schema``'s columns in its order: a row written before a column existed (the zoom
+    columns) gets nulls there."""
+    import pyarrow as pa
+
+    for f in schema:
+        if f.name not in table.column_names:
+            table = table.append_column(f, pa.nulls(len(table), f.type))
+    return table.select(schema.names).cast(schema)
 
 
 def _connect(scheduler, workers, connect_timeout):

@@ -315,8 +315,8 @@ def add_calibration_variant(doc: dict, usd: dict, *, lens=None, fstop=None, outp
         spec, _ = best_match_pinhole(lens, focus_mm=focus, fstop=fstop, sensor_width_mm=w, sensor_height_mm=h)
         spec = replace(spec, pinhole_focal_length_mm=f)
     else:
-        spec = CameraSpec(focal_length_mm=f, pinhole_focal_length_mm=f, focus_mm=focus, sensor_width_mm=w,
-                          sensor_height_mm=h)
+        spec = CameraSpec.of(focal_length_mm=f, pinhole_focal_length_mm=f, focus_mm=focus, sensor_width_mm=w,
+                             sensor_height_mm=h)
     return add_characterization(usd["file"], usd["variant"], spec, _measured(doc, Path(output), Path(usd["file"])))
 
 

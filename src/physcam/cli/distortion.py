@@ -47,6 +47,9 @@ def register(sub) -> None:
     p.add_argument("--stmap", metavar="DIR", default=None,
                    help="write distortion.exr and undistortion.exr (32-bit float ST-maps), PNG previews and the "
                         "files of each --fit into DIR; needs --resolution")
+    p.add_argument("--desqueeze", action="store_true",
+                   help="an anamorphic lens: the undistortion map makes the desqueezed picture (the round pinhole's, "
+                        "square pixels, round(width x f_y / f_x) wide) in one STMap; needs --stmap")
     p.add_argument("--fit", choices=MODEL_CHOICES, action="append", default=None,
                    help="fit a model over the frame (repeat): brown = Brown-Conrady D-U and U-D (OpenTrackIO), "
                         "3de4 = 3DE4 Radial - Standard, Degree 4, usd = Hydra lensDistortion, 3de4-anamorphic-4 and -6 = 3DE4 Anamorphic - Standard, Degree 4 and 6 (with --stmap: their 3DE4 lens files, and Unreal's anamorphic parameters for degree 4), nuke = a Nuke "
@@ -77,6 +80,8 @@ def run_distortion(args) -> int:
     if args.resolution is None and needs:
         raise InputError(f"{', '.join(needs)} {'needs' if len(needs) == 1 else 'need'} --resolution WxH "
                          "(the frame size in pixels)")
+    if args.desqueeze and args.stmap is None:
+        raise InputError("--desqueeze shapes the undistortion ST-map: give --stmap DIR (and --resolution WxH)")
     if args.across_focus is not None and (args.focus is not None or args.stmap or args.fit):
         raise InputError("--across-focus makes a table of its own focus marks: give it without --focus, --stmap "
                          "and --fit")
@@ -243,10 +248,10 @@ def _fit_payloads(args, res, fits, folder):
                 else _anamorphic_key(f).replace("-", "_") if isinstance(f, TDE4Anamorphic) else "usd")
         out.append((d / f"residual_{stem}.png", _png(f, units_of(args))))
     if "nuke" in args.fit:
-        w, h = res.size_px
-        ox, oy = res.overscan_px
+        (fw, fh), (ox, oy) = res.frame_px, res.overscan_px
         text = nuke_stmap_script(d.resolve() / "undistortion.exr", d.resolve() / "distortion.exr", plate=args.plate,
-                                 plate_size=(w, h), undistorted_size=(w + 2 * ox, h + 2 * oy), version=__version__)
+                                 plate_size=res.size_px, undistorted_size=(fw + 2 * ox, fh + 2 * oy),
+                                 undistorted_frame=res.frame_px, version=__version__)
         out.append((d / FIT_FILES["nuke"], text.encode()))
     return out
 
@@ -303,7 +308,7 @@ def _run_field(args, lens) -> int:
         tmp = None if args.stmap is None else stack.enter_context(
             output_folder(args.stmap, force=args.force, command="distortion --stmap"))
         res = distortion_field(cam, width_px=args.resolution[0], height_px=args.resolution[1],
-                               wavelength_nm=args.wavelength, maps=args.stmap is not None)
+                               wavelength_nm=args.wavelength, maps=args.stmap is not None, desqueeze=args.desqueeze)
         fits = _fits(samples_from_field(res), args.fit, args.max_residual)
         if tmp is not None:
             payload = _fit_payloads(args, res, fits, args.stmap) if args.fit else []  # named in the final folder
@@ -329,8 +334,9 @@ def _run_field(args, lens) -> int:
     print(f"  the map is for {d['map_for']}; its residual there: RMS {res.residual_px[0]:.3f} px, "
           f"max {res.residual_px[1]:.3f} px")
     if res.distortion_stmap is not None:
+        desq = f", desqueezed x{d['desqueeze']:.4f}" if res.frame_px != res.size_px else ""
         print(f"  overscan {res.overscan_px[0]} x {res.overscan_px[1]} px (undistorted frame "
-              f"{d['undistorted_size_px'][0]}x{d['undistorted_size_px'][1]}), inverse error {res.inverse_error_px:.4f} px")
+              f"{d['undistorted_size_px'][0]}x{d['undistorted_size_px'][1]}{desq}), inverse error {res.inverse_error_px:.4f} px")
     for fit in fits:
         coeffs = ", ".join(f"{k} {v:.6g}" for k, v in fit.coefficients.items())
         print(f"  {fit.model}: residual RMS {fit.rms_residual_px:.3f} px, max {fit.max_residual_px:.3f} px: "

@@ -443,23 +443,31 @@ def run_diagram(args) -> int:
 
 def run_card(args) -> int:
     """``physcam lens card``: the one-page lens card (:mod:`physcam.analysis.lens_cards.card`)."""
-    from ..analysis.lens_cards.card import lens_card, save_lens_card
+    from ..analysis.lens_cards.card import card_files, card_pages, lens_card, save_lens_card
     from ..io import check_writable
     from ._common import resolve_focus, resolve_sensor, units_of
     from ._output import document, emit_json
 
     check_writable(args.output, force=args.force)  # before the seconds of work
-    p = at_zoom_named(load_lens_arg(args.lens, args.lenient), args)  # a zoom's card at --zoom, named so in its title
+    lens = load_lens_arg(args.lens, args.lenient)
+    for f in card_files(card_pages(lens), args.output):  # a PNG's or SVG's further pages beside it: none written over
+        check_writable(f, force=args.force)
+    p = at_zoom_named(lens, args)  # the zoom lens at --zoom (a prime given --zoom is refused here)
     sensor = resolve_sensor(args)
     (mark,) = resolve_focus([args.focus], lens=p, sensor=sensor, args=args)
-    card = lens_card(p, focus_mm=mark, sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm,
+    # a zoom lens's card: page 1 at --zoom (named so in its title), its zoom page the whole range
+    card = lens_card(lens, focus_mm=mark, sensor_width_mm=sensor.width_mm, sensor_height_mm=sensor.height_mm,
                      sensor_name=sensor.name, stopped_fstop=args.stopped, page=args.page,
-                     quality="draft" if args.draft else "full")
+                     quality="draft" if args.draft else "full",
+                     zoom=None if args.zoom_block is None else args.zoom_block["encoder"])
     path = save_lens_card(card, args.output, force=args.force, units=units_of(args), dpi=args.dpi)
+    files = [str(f) for f in card_files(card, path)]
     if args.json:
-        emit_json(document("lens_card", {**card.to_dict(), "output": str(path), "zoom": args.zoom_block}))
+        emit_json(document("lens_card", {**card.to_dict(), "output": str(path), "files": files,
+                                         "zoom": args.zoom_block}))
         return 0
-    print(f"wrote {path}")
+    for f in files:
+        print(f"wrote {f}")
     return 0
 
 

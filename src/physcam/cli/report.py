@@ -350,7 +350,7 @@ def run(args) -> int:
     from ._common import units_of
 
     report = solve_from_args(args)
-    cams = camera_blocks(report, args)
+    cams = camera_blocks(report, args) if args.json or args.cameras else None  # (the table prints none)
     units = units_of(args)
     real = real_dof_block(report, args) if args.dof == "real" else None
     if args.plot:

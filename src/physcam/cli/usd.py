@@ -246,9 +246,8 @@ def reading_as_written(reading):
     import dataclasses
 
     spec = reading.spec
-    clean = {f.name: as_written(getattr(spec, f.name)) for f in dataclasses.fields(spec)
-             if isinstance(getattr(spec, f.name), (float, tuple))}
-    return dataclasses.replace(reading, spec=dataclasses.replace(spec, **clean))
+    clean = {k: as_written(v) for k, v in spec.values().items() if isinstance(v, (float, tuple))}
+    return dataclasses.replace(reading, spec=spec.replaced(**clean))
 
 
 def run_read(args) -> int:
@@ -342,7 +341,7 @@ def run_kit(args) -> int:
 
             shutter_interval(args.shutter_angle)  # validates 0 < angle <= 360
             body["shutter_duration_s"] = args.shutter_angle / 360.0 / args.fps
-        path = kit.write_body_file(args.file, CameraSpec(**body), **common)
+        path = kit.write_body_file(args.file, CameraSpec.of(**body), **common)
     else:
         if not args.body or not args.lens:
             raise InputError("physcam usd kit shot needs --body FILE and --lens FILE")
@@ -386,10 +385,12 @@ def _read_characterizations(csv_path) -> dict:
         text = p.read_text(encoding="utf-8-sig")
     except OSError as exc:
         raise InputError(f"cannot read {p}: {exc.strerror or exc}") from None
-    numeric = {f.name for f in dataclasses.fields(CameraSpec)
-               if f.name not in ("projection", "lens_name", "sensor_name") and not f.name.endswith("_mm")
-               or f.name in ("focal_length_mm", "entrance_pupil_mm", "focus_mm", "aperture_distance_mm",
-                             "pinhole_focal_length_mm")}
+    from ..usd.spec import CAMERA_VALUES
+
+    numeric = {n for n in (*CAMERA_VALUES, *(f.name for f in dataclasses.fields(CameraSpec)[1:]))
+               if n not in ("projection", "lens_name", "sensor_name") and not n.endswith("_mm")
+               or n in ("focal_length_mm", "entrance_pupil_mm", "focus_mm", "aperture_distance_mm",
+                        "pinhole_focal_length_mm")}
     numeric -= {"principal_planes_mm", "shift_mm", "clipping_mm", "shutter_opening"}
     out = {}
     rows = csv.DictReader(text.splitlines())
@@ -411,7 +412,7 @@ def _read_characterizations(csv_path) -> dict:
         if not row.get("date"):
             raise LensFileError("a row without a date", str(p), line)
         try:
-            out[row["date"]] = CameraSpec(lens_name=row.get("lens_name") or None, **values).checked()
+            out[row["date"]] = CameraSpec.of(lens_name=row.get("lens_name") or None, **values).checked()
         except InputError as exc:
             raise LensFileError(str(exc), str(p), line) from None
     if not out:

@@ -68,6 +68,8 @@ def _report_rows(lens, marks_mm) -> list[dict]:
         fov = field_of_view(camera, at.h2_from_film_mm)
         rows.append({"mark_mm": mark, "efl_mm": at.focal_length_mm, "pinhole_mm": fov["pinhole_focal_length_mm"],
                      "pinhole_squeeze": fov["pinhole_squeeze"], "pupil_from_film_mm": at.pupil_from_film_mm or 0.0,
+                     # an anamorphic's horizontal (X, pan) entrance pupil; a spherical lens's is the one pupil
+                     "pupil_x_from_film_mm": at.pupil_x_from_film_mm or at.pupil_from_film_mm or 0.0,
                      "h1_from_film_mm": at.h1_from_film_mm, "coc_mm": coc_mm,
                      # the entrance pupil at this focus times N: EFL / (N x f-number ratio) x N
                      "pupil_diameter_x_n": at.focal_length_mm / at.n_ratio})

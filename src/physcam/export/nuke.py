@@ -26,12 +26,17 @@ def _path(p) -> str:
 
 
 def nuke_stmap_script(undistortion_map, distortion_map, *, plate="plate.####.exr", render="render.####.exr",
-                      plate_size=(2048, 1080), undistorted_size=(2048, 1080), version: str = "") -> str:
-    """The ``.nk`` text (module notes); sizes in pixels (width, height)."""
-    for n, s in (("plate", plate_size), ("undistorted", undistorted_size)):
+                      plate_size=(2048, 1080), undistorted_size=(2048, 1080), undistorted_frame=None,
+                      version: str = "") -> str:
+    """The ``.nk`` text (module notes); sizes in pixels (width, height). ``undistorted_frame``: the
+    undistorted picture's frame without its overscan when it is not the plate's (desqueezed)."""
+    frame = plate_size if undistorted_frame is None else undistorted_frame
+    for n, s in (("plate", plate_size), ("undistorted", undistorted_size), ("undistorted frame", frame)):
         if len(s) != 2 or not all(isinstance(v, int) and v > 0 for v in s):
             raise InputError(f"the {n} size must be two whole numbers of pixels, got {s!r}")
-    (w, h), (W, H) = plate_size, undistorted_size
+    (w, h), (W, H), (fw, fh) = plate_size, undistorted_size, frame
+    said = (f"the plate's format {w} x {h}" if (fw, fh) == (w, h) else
+            f"desqueezed from the plate's {w} x {h} to {fw} x {fh} square pixels")
 
     def node(kind, **knobs):
         body = "".join(f" {k} {v}\n" for k, v in knobs.items())
@@ -39,8 +44,8 @@ def nuke_stmap_script(undistortion_map, distortion_map, *, plate="plate.####.exr
 
     parts = [
         f"# physcam {hash_comment(version)}: apply the undistortion and distortion ST-maps (R = u, G = v, origin bottom left)\n"
-        f"# the undistorted picture: the plate's format {w} x {h}, bounding box {W} x {H} "
-        f"({(W - w) // 2}, {(H - h) // 2} px of overscan each side; the maps' EXR windows say so)\n",
+        f"# the undistorted picture: {said}, bounding box {W} x {H} "
+        f"({(W - fw) // 2}, {(H - fh) // 2} px of overscan each side; the maps' EXR windows say so)\n",
         node("Root", inputs=0, format=f'"{w} {h} 0 0 {w} {h} 1 physcam_plate"'),
         node("Read", inputs=0, file=f'"{_path(undistortion_map)}"', raw="true", name="physcam_undistortion_map"),
         node("Read", inputs=0, file=f'"{_path(plate)}"', name="physcam_plate"),

@@ -17,7 +17,6 @@ Every file is validated with usd-core's validators and written atomically
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import ExportError, InputError, require_type
@@ -48,23 +47,23 @@ BODY_PRIM = "/Body"
 
 #: The previs kit's eight setups: variant name -> camera (mm, f-numbers; focus from the film plane).
 PREVIS_SETUPS: dict[str, CameraSpec] = {
-    "DollHouse": CameraSpec(focal_length_mm=24.0, fstop=16.0, focus_mm=300.0, sensor_width_mm=23.6,
-                            sensor_height_mm=15.6, coc_mm=0.02, clipping_mm=(10.0, 1.0e5)),
-    "OverTheShoulder": CameraSpec(focal_length_mm=50.0, fstop=2.8, focus_mm=1500.0, sensor_width_mm=24.89,
-                                  sensor_height_mm=18.66, coc_mm=0.025),
-    "OutInTheDesert": CameraSpec(focal_length_mm=24.0, fstop=11.0, focus_mm=20000.0, sensor_width_mm=24.89,
-                                 sensor_height_mm=18.66, coc_mm=0.025, clipping_mm=(500.0, 1.0e8)),
-    "CloseUp": CameraSpec(focal_length_mm=85.0, fstop=2.0, focus_mm=1000.0, sensor_width_mm=24.89,
-                          sensor_height_mm=18.66, coc_mm=0.025),
-    "WideMaster": CameraSpec(focal_length_mm=18.0, fstop=5.6, focus_mm=4000.0, sensor_width_mm=24.89,
+    "DollHouse": CameraSpec.of(focal_length_mm=24.0, fstop=16.0, focus_mm=300.0, sensor_width_mm=23.6,
+                               sensor_height_mm=15.6, coc_mm=0.02, clipping_mm=(10.0, 1.0e5)),
+    "OverTheShoulder": CameraSpec.of(focal_length_mm=50.0, fstop=2.8, focus_mm=1500.0, sensor_width_mm=24.89,
+                                     sensor_height_mm=18.66, coc_mm=0.025),
+    "OutInTheDesert": CameraSpec.of(focal_length_mm=24.0, fstop=11.0, focus_mm=20000.0, sensor_width_mm=24.89,
+                                    sensor_height_mm=18.66, coc_mm=0.025, clipping_mm=(500.0, 1.0e8)),
+    "CloseUp": CameraSpec.of(focal_length_mm=85.0, fstop=2.0, focus_mm=1000.0, sensor_width_mm=24.89,
                              sensor_height_mm=18.66, coc_mm=0.025),
-    "LongLens": CameraSpec(focal_length_mm=200.0, fstop=4.0, focus_mm=30000.0, sensor_width_mm=24.89,
-                           sensor_height_mm=18.66, coc_mm=0.025, clipping_mm=(1000.0, 1.0e8)),
-    "Anamorphic": CameraSpec(focal_length_mm=50.0, fstop=2.8, focus_mm=3000.0, sensor_width_mm=22.0,
-                             sensor_height_mm=18.6, squeeze=2.0, coc_mm=0.025, aperture_blades=11),
-    "TopDownPlan": CameraSpec(projection="orthographic", magnification=0.002, focal_length_mm=50.0,
-                              focus_mm=10000.0, sensor_width_mm=36.0, sensor_height_mm=24.0,
-                              clipping_mm=(100.0, 1.0e6)),
+    "WideMaster": CameraSpec.of(focal_length_mm=18.0, fstop=5.6, focus_mm=4000.0, sensor_width_mm=24.89,
+                                sensor_height_mm=18.66, coc_mm=0.025),
+    "LongLens": CameraSpec.of(focal_length_mm=200.0, fstop=4.0, focus_mm=30000.0, sensor_width_mm=24.89,
+                              sensor_height_mm=18.66, coc_mm=0.025, clipping_mm=(1000.0, 1.0e8)),
+    "Anamorphic": CameraSpec.of(focal_length_mm=50.0, fstop=2.8, focus_mm=3000.0, sensor_width_mm=22.0,
+                                sensor_height_mm=18.6, squeeze=2.0, coc_mm=0.025, aperture_blades=11),
+    "TopDownPlan": CameraSpec.of(projection="orthographic", magnification=0.002, focal_length_mm=50.0,
+                                 focus_mm=10000.0, sensor_width_mm=36.0, sensor_height_mm=24.0,
+                                 clipping_mm=(100.0, 1.0e6)),
 }
 
 #: Where a previs setup's camera stands (mm, Y up) and how it turns (degrees, XYZ): the plan view
@@ -203,7 +202,7 @@ def write_shot(file, body_file, lens_file, *, overrides: dict | None = None, len
         lens_mpu, lens_clip_mm = sources[LENS_PRIM]
         if lens_clip_mm is not None and lens_mpu != meters_per_unit and "clipping_mm" not in overrides:
             overrides["clipping_mm"] = lens_clip_mm
-        spec = replace(_read_spec(stage, path), **overrides).checked()
+        spec = _read_spec(stage, path).replaced(**overrides).checked()
         # only what the shot overrides becomes a shot-layer opinion: everything else stays with the
         # referenced body and lens files (and their variants), so switching a characterization in the
         # shot still switches the lens
@@ -270,10 +269,10 @@ def _author_shot_companion(stage, path) -> str:
                                coc=spec.coc_mm, lens=rx))
         derived = spec_from_report(report)
         _author_lens_derived(stage, cam, derived)
-        spec = replace(spec, focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
-                       principal_planes_mm=derived.principal_planes_mm,
-                       pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
-                       pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze)
+        spec = spec.replaced(focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
+                             principal_planes_mm=derived.principal_planes_mm,
+                             pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
+                             pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze)
         distortion = prescription_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
         anamorphic = prescription_anamorphic_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm,
                                                         focus_mm=spec.focus_mm)

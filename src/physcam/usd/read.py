@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..errors import ExportError
+from ..errors import ExportError, require_type
 from .spec import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec
 from .plugin import ensure_registered, require_prim, require_stage
 
@@ -39,13 +39,11 @@ class CameraReading:
         return report_for_spec(self.spec)
 
     def to_dict(self) -> dict:
-        from dataclasses import asdict
-
         return {
             "path": self.path,
             "lens_model": {"path": self.lens_model_path, "type": self.lens_model_type},
             "variants": dict(self.variants),
-            "camera": asdict(self.spec),
+            "camera": self.spec.values(),
             "has_prescription": self.prescription is not None,
         }
 
@@ -252,7 +250,7 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
     aperture = _get(prim, sp + "aperture", "author the sensor size in mm")
     shift = _get(prim, sp + "shift", "")
     opening = _get(prim, "shutterOpening", "")
-    spec = CameraSpec(
+    spec = CameraSpec.of(
         focal_length_mm=focal,
         sensor_width_mm=float(aperture[0]),
         sensor_height_mm=float(aperture[1]),
@@ -317,7 +315,8 @@ def companion_inputs_hash(spec, prescription=None) -> str:
     import json
     from dataclasses import asdict
 
-    camera = asdict(spec)
+    require_type("spec", spec, CameraSpec, "the composed camera: physcam.usd.read.read_camera(stage).spec")
+    camera = spec.values()
     if camera.get("horizontal_entrance_pupil_mm") is None:  # files written before the field hash as they did
         camera.pop("horizontal_entrance_pupil_mm", None)
     doc = {"camera": camera}

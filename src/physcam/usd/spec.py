@@ -7,12 +7,18 @@ imports the other for it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import dataclasses
+import warnings
+from dataclasses import dataclass, fields
 
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, require_finite, require_positive, require_type
+from ..optics.state import CameraState
 
-__all__ = ["CameraSpec", "DEFAULT_CAMERA_PATH", "LENS_INSTANCE", "SENSOR_INSTANCE", "RENDER_CAMERA_NAME",
+#: the keyword form of CameraSpec goes in this version
+UNTIL = "0.3"
+
+__all__ = ["CameraSpec", "CAMERA_VALUES", "DEFAULT_CAMERA_PATH", "LENS_INSTANCE", "SENSOR_INSTANCE", "RENDER_CAMERA_NAME",
            "BLENDER_PROPERTY", "report_for_spec", "spec_from_report"]
 
 DEFAULT_CAMERA_PATH = "/Cameras/Camera"
@@ -24,13 +30,33 @@ RENDER_CAMERA_NAME = "Camera"
 BLENDER_PROPERTY = "userProperties:physcam:"
 
 
-@dataclass(frozen=True)
-class CameraSpec:
-    """A physical camera as plain numbers (mm, seconds, degrees), what the schema stores.
+#: The numbers of the camera a :class:`CameraSpec` holds (its lens, sensor, focus and stop), each read
+#: back as a property of the spec; :meth:`CameraSpec.of` and :meth:`CameraSpec.replaced` take them.
+CAMERA_VALUES = ("focal_length_mm", "sensor_width_mm", "sensor_height_mm", "fstop", "focus_mm", "squeeze",
+                 "lens_name", "sensor_name")
+_DEFAULT_CAMERA = dict(focal_length_mm=50.0, sensor_width_mm=DEFAULT_SENSOR_WIDTH_MM,
+                       sensor_height_mm=DEFAULT_SENSOR_HEIGHT_MM, fstop=8.0, focus_mm=3000.0, squeeze=1.0,
+                       lens_name=None, sensor_name=None)
+#: the key of a spec's sensor known only by its size (its name then reads as None)
+_NAMELESS_SENSOR = "usd: no name"
 
-    ``focus_mm`` is measured in front of the film plane (the on-set mark).
+
+@dataclass(frozen=True, init=False)
+class CameraSpec:
+    """A physical camera as the PhysicalCamera schema stores it: the camera (``camera``, a
+    :class:`~physcam.optics.state.CameraState`: the lens, its focus mark, its f-stop, the sensor and
+    the squeeze) and the body, shutter, iris-shape and render values beside it (mm, seconds, degrees).
+
+    ``CameraSpec(camera, **values)`` holds a camera built elsewhere (:func:`spec_from_report` holds the
+    report's); ``CameraSpec.of(focal_length_mm=, fstop=, focus_mm=, sensor_width_mm=, ...)`` builds a thin
+    lens camera from the schema's numbers. The camera's numbers (:data:`CAMERA_VALUES`) read back as
+    properties: ``focus_mm`` is the mark in front of the film plane (the on-set mark);
     ``sensor_width_mm`` x ``sensor_height_mm``: default sensor Super 35 (24.89 x 18.66 mm), the CLI's
-    (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`).
+    (:data:`physcam.data.default_sensor.DEFAULT_SENSOR`). The keyword form of before issue 43,
+    ``CameraSpec(focal_length_mm=..., fstop=..., focus_mm=...)``, still builds one, with a
+    DeprecationWarning (it goes in physcam 0.3); ``CameraSpec()`` is the default camera (50 mm f/8
+    at 3 m on Super 35).
+
     ``entrance_pupil_mm``: the pupil in front of the film plane; ``None`` uses the thin
     lens (the pupil on the principal plane, s' in front of the film).
     ``horizontal_entrance_pupil_mm``: an anamorphic's horizontal (X meridian) pupil in front of the
@@ -49,19 +75,14 @@ class CameraSpec:
     ``dof_aspect``: width / height of the defocus blur in the desqueezed picture (RenderMan's
     ``dofaspect``); None: 1 / squeeze (a front anamorphic), 1 for a spherical lens.
     ``fstop_at_focus``: the f-number at this focus of an internal-focus lens whose iris is set to
-    ``fstop`` at infinity (:attr:`physcam.onset.report.LensReport.f_number_at_focus`); the lens's
-    ``iris`` (entrance pupil diameter) is focal length / it. None: ``fstop``.
+    the camera's f-stop at infinity (:attr:`physcam.onset.report.LensReport.f_number_at_focus`); the
+    lens's ``iris`` (entrance pupil diameter) is focal length / it. None: the f-stop.
     ``projection``: "perspective" (a pinhole/thin-lens model) or "orthographic"
     (a telecentric model imaging ``sensor / magnification`` of the scene).
     """
 
-    focal_length_mm: float = 50.0
-    sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM  # Super 35 (24.89 x 18.66 mm), as the CLI
-    sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM
-    fstop: float = 8.0
-    focus_mm: float = 3000.0
+    camera: CameraState
     coc_mm: float = 0.03
-    squeeze: float = 1.0
     entrance_pupil_mm: float | None = None
     horizontal_entrance_pupil_mm: float | None = None
     principal_planes_mm: tuple[float, float] | None = None
@@ -86,8 +107,99 @@ class CameraSpec:
     clipping_mm: tuple[float, float] = (100.0, 1.0e7)
     projection: str = "perspective"
     magnification: float = 1.0
-    lens_name: str | None = None
-    sensor_name: str | None = None
+
+    def __init__(self, camera: CameraState | None = None, **values):
+        old = {k: values.pop(k) for k in CAMERA_VALUES if k in values}
+        if old:
+            warnings.warn("CameraSpec(focal_length_mm=..., fstop=..., focus_mm=...) builds its camera from numbers: "
+                          "use CameraSpec.of(...), CameraSpec(camera, ...) or spec.replaced(...); the keyword form goes in physcam "
+                          f"{UNTIL}", DeprecationWarning, stacklevel=2)
+            camera = _camera_of_numbers(**{**(_numbers_of(camera) if camera is not None else _DEFAULT_CAMERA), **old})
+        elif camera is None:
+            camera = _camera_of_numbers(**_DEFAULT_CAMERA)
+        require_type("camera", camera, CameraState, "build one with physcam.optics.state.camera_state(...) or use "
+                     "CameraSpec.of(focal_length_mm=..., fstop=..., focus_mm=...)")
+        if camera.sensor is None:
+            raise InputError("a CameraSpec's camera needs its sensor (camera_state(..., sensor=...))")
+        object.__setattr__(self, "camera", camera)
+        for f in fields(self)[1:]:
+            object.__setattr__(self, f.name, values.pop(f.name) if f.name in values else f.default)
+        if values:
+            raise TypeError(f"CameraSpec got unexpected keyword arguments {sorted(values)}")
+
+    @classmethod
+    def of(cls, focal_length_mm: float = 50.0, sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM,
+           sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM, fstop: float = 8.0, focus_mm: float = 3000.0,
+           squeeze: float = 1.0, lens_name: str | None = None, sensor_name: str | None = None,
+           **values) -> "CameraSpec":
+        """A spec from the schema's numbers: a thin lens camera of ``focal_length_mm`` focused at ``focus_mm``
+        (from the film plane) at ``fstop`` on a ``sensor_width_mm`` x ``sensor_height_mm`` sensor (default
+        Super 35, the CLI's), and the other fields' values."""
+        camera = _camera_of_numbers(focal_length_mm=focal_length_mm, sensor_width_mm=sensor_width_mm,
+                                    sensor_height_mm=sensor_height_mm, fstop=fstop, focus_mm=focus_mm, squeeze=squeeze,
+                                    lens_name=lens_name, sensor_name=sensor_name)
+        return cls(camera, **values)
+
+    def replaced(self, **changes) -> "CameraSpec":
+        """This spec with ``changes`` (the camera's numbers, :data:`CAMERA_VALUES`, or fields): a change of a
+        camera number rebuilds the camera from numbers (a thin lens); the f-stop alone keeps the lens."""
+        numbers = {k: changes.pop(k) for k in CAMERA_VALUES if k in changes}
+        camera = self.camera
+        if set(numbers) == {"fstop"} and camera.traceable:
+            camera = camera.with_fstop(numbers["fstop"])
+        elif numbers:
+            camera = _camera_of_numbers(**{**_numbers_of(camera), **numbers})
+        return dataclasses.replace(self, camera=camera, **changes)
+
+    def values(self) -> dict:
+        """Every number of the spec by name (the fields of the spec before issue 43, in their order): the
+        camera's (:data:`CAMERA_VALUES`) and the fields'. What ``physcam usd read --json`` prints and the
+        companion camera's inputs hash reads."""
+        cam = _numbers_of(self.camera)
+        out = {k: cam.pop(k) for k in ("focal_length_mm", "sensor_width_mm", "sensor_height_mm", "fstop", "focus_mm")}
+        out["coc_mm"] = self.coc_mm
+        out["squeeze"] = cam.pop("squeeze")
+        out.update((f.name, getattr(self, f.name)) for f in fields(self)[2:])
+        return {**out, **cam}  # lens_name, sensor_name last, as they were
+
+    # --- the camera's numbers, read from it ------------------------------------------------------
+    @property
+    def focal_length_mm(self) -> float:
+        """The lens's focal length at the mark (a prescription's EFL there), mm."""
+        return self.camera.at_mark.focal_length_mm
+
+    @property
+    def fstop(self) -> float:
+        """The iris's setting (at infinity focus): the camera's."""
+        return self.camera.fstop
+
+    @property
+    def focus_mm(self) -> float:
+        """The focus mark in front of the film plane, mm: the camera's."""
+        return self.camera.focus_from_film_mm
+
+    @property
+    def squeeze(self) -> float:
+        """The picture's desqueeze factor at the mark: the camera's."""
+        return self.camera.at_mark.squeeze
+
+    @property
+    def sensor_width_mm(self) -> float:
+        return self.camera.sensor.width_mm
+
+    @property
+    def sensor_height_mm(self) -> float:
+        return self.camera.sensor.height_mm
+
+    @property
+    def sensor_name(self) -> str | None:
+        """The sensor's name; None for a sensor known only by its size."""
+        s = self.camera.sensor
+        return None if s.key == _NAMELESS_SENSOR else s.name
+
+    @property
+    def lens_name(self) -> str | None:
+        return self.camera.lens_name
 
     def checked(self) -> "CameraSpec":
         """Return self after range checks; raise :class:`InputError` saying what to change."""
@@ -140,6 +252,32 @@ class CameraSpec:
         return self
 
 
+def _camera_of_numbers(*, focal_length_mm, sensor_width_mm, sensor_height_mm, fstop, focus_mm, squeeze, lens_name,
+                       sensor_name) -> CameraState:
+    """The thin lens camera of the schema's numbers (checked as :meth:`CameraSpec.checked` checks them)."""
+    from ..optics.lens_model import ThinLens
+    from ..optics.sensors import Sensor
+    from ..optics.state import camera_state
+
+    for name, v in (("focal_length_mm", focal_length_mm), ("sensor_width_mm", sensor_width_mm),
+                    ("sensor_height_mm", sensor_height_mm), ("fstop", fstop), ("focus_mm", focus_mm),
+                    ("squeeze", squeeze)):
+        require_positive(name, v, unit="")
+    w, h = float(sensor_width_mm), float(sensor_height_mm)
+    sensor = Sensor(key=sensor_name or _NAMELESS_SENSOR, name=sensor_name or f"{w:g} x {h:g} mm", width_mm=w,
+                    height_mm=h)
+    return camera_state(ThinLens(float(focal_length_mm), lens_name=lens_name), focus_mm=float(focus_mm),
+                        fstop=float(fstop), sensor=sensor, squeeze=float(squeeze))
+
+
+def _numbers_of(camera: CameraState) -> dict:
+    """The schema's numbers of ``camera`` (:data:`CAMERA_VALUES`)."""
+    at, s = camera.at_mark, camera.sensor
+    return dict(focal_length_mm=at.focal_length_mm, sensor_width_mm=s.width_mm, sensor_height_mm=s.height_mm,
+                fstop=camera.fstop, focus_mm=camera.focus_from_film_mm, squeeze=at.squeeze,
+                lens_name=camera.lens_name, sensor_name=None if s.key == _NAMELESS_SENSOR else s.name)
+
+
 def report_for_spec(spec: CameraSpec):
     """The on-set :class:`~physcam.onset.report.LensReport` of ``spec``.
 
@@ -147,19 +285,10 @@ def report_for_spec(spec: CameraSpec):
     model with those planes and the pupil; otherwise the practical thin lens, keeping the
     spec's entrance pupil when it has one.
     """
-    import dataclasses
-
     from ..onset.report import report_camera, solve_report
-    from ..optics.sensors import Sensor
 
-    require_type("spec", spec, CameraSpec, "build one with CameraSpec(...) or spec_from_report")
-    sensor = Sensor(
-        key=spec.sensor_name or "custom",
-        name=spec.sensor_name or f"{spec.sensor_width_mm:g} x {spec.sensor_height_mm:g} mm",
-        width_mm=spec.sensor_width_mm,
-        height_mm=spec.sensor_height_mm,
-    )
-    common = dict(focal_length_mm=spec.focal_length_mm, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
+    require_type("spec", spec, CameraSpec, "build one with CameraSpec.of(...) or spec_from_report")
+    common = dict(focal_length_mm=spec.focal_length_mm, sensor=spec.camera.sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
                   coc=spec.coc_mm, squeeze=spec.squeeze, lens_name=spec.lens_name,
                   pinhole_focal_length_mm=spec.pinhole_focal_length_mm, pinhole_squeeze=spec.pinhole_squeeze,
                   fstop_at_focus=spec.fstop_at_focus)
@@ -175,19 +304,14 @@ def report_for_spec(spec: CameraSpec):
 
 
 def spec_from_report(report, **body) -> CameraSpec:
-    """A :class:`CameraSpec` from a lens report plus body/shutter/aperture keywords of CameraSpec."""
+    """A :class:`CameraSpec` holding the report's camera, with the report's planes and pupils, plus
+    body/shutter/aperture keywords of CameraSpec."""
     from ..onset.report import LensReport
 
     require_type("report", report, LensReport, "solve one with physcam.onset.request.solve_report(report_camera(...))")
-    s = report.sensor
     return CameraSpec(
-        focal_length_mm=report.focal_length_mm,
-        sensor_width_mm=s.width_mm,
-        sensor_height_mm=s.height_mm,
-        fstop=report.fstop,
-        focus_mm=report.focus_from_film_mm,
+        report.camera,
         coc_mm=report.coc_mm,
-        squeeze=report.squeeze,
         entrance_pupil_mm=(report.entrance_pupil_from_film_mm if report.entrance_pupil_from_film_mm is not None
                            else report.h1_from_film_mm),
         horizontal_entrance_pupil_mm=report.entrance_pupil_horizontal_from_film_mm,
@@ -203,8 +327,6 @@ def spec_from_report(report, **body) -> CameraSpec:
         flange_distance_mm=body.pop("flange_distance_mm", report.flange_focal_distance_mm or 52.0),
         # a marked T-stop is the photometric f-number: T = N / sqrt(transmittance)
         transmittance=body.pop("transmittance", _transmittance(report.fstop, report.tstop)),
-        lens_name=report.lens_name,
-        sensor_name=s.name,
         **body,
     ).checked()
 

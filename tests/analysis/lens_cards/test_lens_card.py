@@ -1,7 +1,7 @@
 """The lens card (issue 32): one page for every bundled lens, with every panel.
 
-Each lens's card is rendered small (draft quality, 30 dpi). Checked: one page (the PDF's page
-count), the page size stated (A4 210 x 297 mm, Letter 8.5 x 11 in: ISO 216 and ANSI), every panel's
+Each lens's card is rendered small (draft quality, 30 dpi). Checked: one page, two for a zoom or an
+anamorphic lens (the PDF's page count), the page size stated (A4 210 x 297 mm, Letter 8.5 x 11 in: ISO 216 and ANSI), every panel's
 axes present, and key numbers against independent values: the EFL from the paraxial y-u trace of
 physcam.optics.paraxial, and the image circle at least the sensor it covers when the real chief
 ray at the corner passes.
@@ -28,7 +28,7 @@ def test_page_sizes_are_a4_and_letter():
 
 
 @pytest.mark.parametrize("slug", LENSES)
-def test_every_bundled_lens_has_a_one_page_card_with_every_panel(slug, tmp_path):
+def test_every_bundled_lens_has_a_card_with_every_panel(slug, tmp_path):
     from physcam.figures import figure_problems
     from physcam.optics.paraxial import gaussian
 
@@ -44,7 +44,10 @@ def test_every_bundled_lens_has_a_one_page_card_with_every_panel(slug, tmp_path)
     pdf = save_lens_card(card, tmp_path / "card.pdf", dpi=30)
     data = pdf.read_bytes()
     assert data.startswith(b"%PDF")
-    assert len(re.findall(rb"/Type\s*/Page[^s]", data)) == 1
+    # one page, and a second for a zoom (across its range) or an anamorphic (its two meridians)
+    want = ["main"] + (["zoom"] if lens.zoom is not None else []) + (["anamorphic"] if lens.squeeze != 1.0 else [])
+    assert card.pages == want
+    assert len(re.findall(rb"/Type\s*/Page[^s]", data)) == len(want)
 
 
 def test_letter_page_and_png(tmp_path):

@@ -43,6 +43,12 @@ pixel centres at (i + 0.5) / width; B = 0.
   Its EXR file carries its own frame (the OpenEXR and Nuke convention): display window = the
   plate's frame (0, 0)-(width - 1, height - 1), data window = the overscanned region
   (-ox, -oy)-(width + ox - 1, height + oy - 1).
+* **Desqueezed** (``desqueeze=True``, an anamorphic lens): the undistorted image is the round pinhole's,
+  in square pixels: width' = round(width x a) columns, a = f_pin,y / f_pin,x at this focus (the pixel
+  aspect of physcam's 3DE4 anamorphic fits), its overscan in those pixels. A column x' of it is the
+  squeezed ideal position x' width / width' (so its pixels are square to 0.5 / width'). The
+  undistortion map turns the squeezed plate into that picture in one STMap; the distortion map is
+  unchanged (its values are normalised, and the desqueezed frame is the squeezed one stretched).
 * The **distortion map** (width x height) turns such an undistorted image back into the plate;
   its R, G are normalised to the undistorted image's frame, which is the plate's (its display
   window): values below 0 and above 1 reach into the overscan (its data window). OpenImageIO's
@@ -172,6 +178,8 @@ class DistortionField:
     #: Every traced chief ray (grid nodes and cell centres): real and ideal plate pixels (n, 2) each
     traced_real_px: np.ndarray | None = field(default=None, repr=False)
     traced_ideal_px: np.ndarray | None = field(default=None, repr=False)
+    #: The undistorted picture's frame (its EXR display window), px: the plate's, or desqueezed (module notes)
+    undistorted_frame_px: tuple[int, int] | None = None
 
     @property
     def focus_from_film_mm(self) -> float:
@@ -183,6 +191,12 @@ class DistortionField:
         """The stop whose centroids the field maps (the camera's iris set to an f-stop); None: chief rays (a
         small stop)."""
         return self.camera.fstop if self.camera.iris_set else None
+
+    @property
+    def frame_px(self) -> tuple[int, int]:
+        """The undistorted picture's frame (width, height) px, without the overscan: the plate's, or
+        the desqueezed one (module notes)."""
+        return self.undistorted_frame_px or self.size_px
 
     def ideal_from_real(self, xy_px) -> np.ndarray:
         """Ideal (undistorted) plate pixel positions (n, 2) of real ones (interpolated field)."""
@@ -198,7 +212,9 @@ class DistortionField:
             "entrance_pupil_from_film_mm": {"x": self.entrance_pupil_from_film_mm[0],
                                             "y": self.entrance_pupil_from_film_mm[1]},
             "overscan_px": list(self.overscan_px),
-            "undistorted_size_px": [self.size_px[0] + 2 * self.overscan_px[0], self.size_px[1] + 2 * self.overscan_px[1]],
+            "undistorted_frame_px": list(self.frame_px),
+            "undistorted_size_px": [self.frame_px[0] + 2 * self.overscan_px[0], self.frame_px[1] + 2 * self.overscan_px[1]],
+            "desqueeze": self.frame_px[0] / self.size_px[0],
             "grid_nodes": list(self.grid_nodes), "interpolation_error_px": self.interpolation_error_px,
             "inverse_error_px": None if math.isnan(self.inverse_error_px) else self.inverse_error_px,
             "maps": self.distortion_stmap is not None, "max_distortion_px": self.max_distortion_px,
@@ -340,8 +356,9 @@ def _require_pinhole_reach(rays: _PlateRays, nodes) -> None:
             "it (a fisheye); give a smaller sensor")
 
 
-def _overscan_px(fwd: _Grid, nodes, w_px: int, h_px: int) -> tuple[int, int]:
-    """The symmetric margin (ox, oy) whose box keeps the ideal position of every plate pixel.
+def _overscan_px(fwd: _Grid, nodes, w_px: int, h_px: int, xscale: float = 1.0) -> tuple[int, int]:
+    """The symmetric margin (ox, oy) whose box keeps the ideal position of every plate pixel; ``xscale``:
+    the undistorted picture's columns per plate column (desqueezed: width' / width).
 
     The pixels' ideal positions in blocks of rows, then again into the map: never a float64 frame whole.
     """
@@ -350,9 +367,9 @@ def _overscan_px(fwd: _Grid, nodes, w_px: int, h_px: int) -> tuple[int, int]:
     for _, block in fwd.row_blocks(w_px, h_px):
         lo = np.minimum(lo, block.reshape(-1, 2).min(axis=0))
         hi = np.maximum(hi, block.reshape(-1, 2).max(axis=0))
-    ox = int(math.ceil(max(0.0, -lo[0], hi[0] - w_px) - 1e-9))
+    ox = int(math.ceil(xscale * max(0.0, -lo[0], hi[0] - w_px) - 1e-9))
     oy = int(math.ceil(max(0.0, -lo[1], hi[1] - h_px) - 1e-9))
-    W2, H2 = w_px + 2 * ox, h_px + 2 * oy
+    W2, H2 = round(w_px * xscale) + 2 * ox, h_px + 2 * oy
     if W2 * H2 > 4 * MAX_PIXELS or W2 > 4 * MAX_SIDE_PX or H2 > 4 * MAX_SIDE_PX:
         raise OpticsError(f"the undistorted frame would be {W2} x {H2} px: the distortion is too strong for an ST-map")
     return ox, oy
@@ -378,21 +395,24 @@ def _invert_field(fwd: _Grid, qx, qy, w_px: int, h_px: int, name: str):
     return r
 
 
-def _undistortion_map(fwd: _Grid, overscan, w_px: int, h_px: int, name: str):
-    """(undistortion ST-map, its worst round-trip error in px): the inverse field at nodes over the
-    overscanned frame (coordinates in plate pixels: -ox .. w + ox)."""
+def _undistortion_map(fwd: _Grid, overscan, w_px: int, h_px: int, name: str, frame_w: int | None = None):
+    """(undistortion ST-map, its worst round-trip error in px of the map): the inverse field at nodes over
+    the overscanned frame (coordinates in the undistorted picture's pixels: -ox .. frame_w + ox; a
+    desqueezed frame_w is the squeezed ideal position times frame_w / w_px)."""
     ox, oy = overscan
-    W2, H2 = w_px + 2 * ox, h_px + 2 * oy
+    frame_w = w_px if frame_w is None else frame_w
+    s = frame_w / w_px  # undistorted columns per plate column
+    W2, H2 = frame_w + 2 * ox, h_px + 2 * oy
     mx, ex = _nodes(W2)
     my, ey = _nodes(H2)
     QX, QY = np.meshgrid(np.arange(mx) * ex - ox, np.arange(my) * ey - oy)
-    inv_nodes = _invert_field(fwd, QX.ravel(), QY.ravel(), w_px, h_px, name).reshape(my, mx, 2)
+    inv_nodes = _invert_field(fwd, QX.ravel() / s, QY.ravel(), w_px, h_px, name).reshape(my, mx, 2)
     if not np.isfinite(inv_nodes).all():
         raise OpticsError(f"the undistortion of {name!r} did not converge: no map written")
     inv = _Grid(inv_nodes, -ox, ex, -oy, ey)
     kx, ky = np.meshgrid((np.arange(mx - 1) + 0.5) * ex - ox, (np.arange(my - 1) + 0.5) * ey - oy)
     back = fwd.at(*inv.at(kx.ravel(), ky.ravel()).T)
-    inv_err = float(np.hypot(back[:, 0] - kx.ravel(), back[:, 1] - ky.ravel()).max())
+    inv_err = float(np.hypot((back[:, 0] - kx.ravel() / s) * s, back[:, 1] - ky.ravel()).max())
     umap = np.zeros((H2, W2, 3), dtype=np.float32)
     inv.fill(umap, (w_px, h_px), origin=(-ox, -oy))
     return umap, inv_err
@@ -405,6 +425,20 @@ def _field_notes(fstop) -> list[str]:
             "real positions: chief rays (a small stop); at a working aperture give the f-stop (centroids)"
             if fstop is None else f"real positions: the blur centroids at f/{fstop:g} (the iris sized at infinity "
             "focus)"]
+
+
+def _desqueezed_width(w_px: int, g, notes: list) -> int:
+    """The desqueezed picture's width, px: round(w_px a), a = f_pin,y / f_pin,x (module notes)."""
+    a = float(g["y"].pinhole_focal_length / g["x"].pinhole_focal_length)
+    frame_w = round(w_px * a)
+    if frame_w == w_px:
+        notes.append(f"desqueeze: the lens is not anamorphic (pinhole f_y / f_x = {a:.5f}): the picture is its own")
+    else:
+        notes.append(f"desqueezed: the undistorted picture is {frame_w} px wide, the round pinhole's in square "
+                     f"pixels (pinhole f_y / f_x = {a:.5f} at this focus)")
+    if frame_w > 4 * MAX_SIDE_PX:
+        raise OpticsError(f"the desqueezed picture would be {frame_w} px wide: give a smaller resolution")
+    return frame_w
 
 
 def _sensor(camera) -> tuple[float, float]:
@@ -424,6 +458,7 @@ def distortion_field(
     method: str = "auto",
     backend: str = "auto",
     maps: bool = True,
+    desqueeze: bool = False,
 ) -> DistortionField:
     """Real distortion of ``camera`` (a :class:`~physcam.optics.state.CameraState`: the lens focused,
     its iris, on its sensor) over a ``width_px`` x ``height_px`` frame, with its distortion and
@@ -434,6 +469,8 @@ def distortion_field(
     ``maps=False`` traces the same chief rays but makes no ST-maps (the map fields and the overscan
     are then None and (0, 0)): what fitting models and tables across focus need. An iris set to an
     f-stop gives the centroid distortion there instead of the chief rays' (module notes, "At a stop").
+    ``desqueeze=True`` makes the undistortion map for the desqueezed picture of an anamorphic lens
+    (module notes; a spherical lens's picture is its own, said in the notes).
     """
     from ...optics.focusing import focus, focus_method
     from ...optics.paraxial import gaussian
@@ -473,12 +510,14 @@ def distortion_field(
     traced_real = np.concatenate([np.stack([X.ravel(), Y.ravel()], axis=1), np.stack([cx.ravel(), cy.ravel()], axis=1)])
     traced_ideal = np.concatenate([nodes.reshape(-1, 2), exact])
 
+    notes = _field_notes(fstop)
+    frame_w = _desqueezed_width(w_px, g, notes) if desqueeze else w_px
     overscan, inv_err, dmap, umap = (0, 0), math.nan, None, None
     if maps:
-        overscan = _overscan_px(fwd, nodes, w_px, h_px)
+        overscan = _overscan_px(fwd, nodes, w_px, h_px, frame_w / w_px)
         dmap = np.zeros((h_px, w_px, 3), dtype=np.float32)
         fwd.fill(dmap, (w_px, h_px))  # normalised to the plate's frame (module notes)
-        umap, inv_err = _undistortion_map(fwd, overscan, w_px, h_px, lens.name)
+        umap, inv_err = _undistortion_map(fwd, overscan, w_px, h_px, lens.name, frame_w)
         if not (np.isfinite(dmap).all() and np.isfinite(umap).all()):
             raise OpticsError(f"the ST-maps of {lens.name!r} have non-finite values: no map written")
     zf = st.film_z
@@ -486,8 +525,8 @@ def distortion_field(
         lens.name, cam, float(wl), (W, H), (w_px, h_px),
         (float(g["x"].pinhole_focal_length), float(g["y"].pinhole_focal_length)),
         (float(zf - g["x"].z_entrance_pupil), float(zf - g["y"].z_entrance_pupil)),
-        overscan, (nx, ny), interp_err, inv_err, max_dist, resid, dmap, umap, _field_notes(fstop), fwd,
-        traced_real, traced_ideal)
+        overscan, (nx, ny), interp_err, inv_err, max_dist, resid, dmap, umap, notes, fwd,
+        traced_real, traced_ideal, (frame_w, h_px))
 
 
 def apply_stmap(image, stmap, *, overscan=(0, 0)) -> np.ndarray:

@@ -11,6 +11,11 @@ cat's eye is the mechanical vignetting), and the key numbers (EFL, f-number, ent
 focus, image circle). Every number is computed by those functions as they are; this module only
 chooses their inputs and draws. Image heights and film sizes in mm; scene distances from the film
 plane (docs/conventions.md).
+
+A zoom lens's card has a second page, across its zoom range (:mod:`.zoom_page`), and its first page
+shows one zoom position; an anamorphic lens's card has a page of its two meridians
+(:mod:`.anamorphic_page`). A PDF holds every page; a PNG or SVG holds one, so the further pages go to
+files beside it named ``<name>-zoom`` and ``<name>-anamorphic`` (:func:`card_files`).
 """
 
 from __future__ import annotations
@@ -22,7 +27,7 @@ from ...errors import InputError, OpticsError
 from ...lens.prescription import Prescription, takes_prescription
 from ...figures import PALETTE, styled
 
-__all__ = ["PAGES", "PANELS", "LensCard", "lens_card", "save_lens_card"]
+__all__ = ["PAGES", "PANELS", "LensCard", "lens_card", "save_lens_card", "card_pages", "card_files"]
 
 #: Page sizes (width, height) in inches, portrait: ISO A4 (210 x 297 mm) and US Letter (8.5 x 11 in).
 PAGES = {"a4": (210.0 / 25.4, 297.0 / 25.4), "letter": (8.5, 11.0)}
@@ -66,6 +71,14 @@ class LensCard:
     bokeh: list  # (label, image height mm, BokehImage)
     page: str = "a4"
     notes: list[str] = field(default_factory=list)
+    zoom_page: object = None  # ZoomPage of a zoom lens (.zoom_page), else None
+    anamorphic_page: object = None  # AnamorphicPage of an anamorphic lens (.anamorphic_page), else None
+
+    @property
+    def pages(self) -> list[str]:
+        """The card's pages in order: "main", then "zoom" and "anamorphic" where the lens has them."""
+        return ["main"] + [n for n, pg in (("zoom", self.zoom_page), ("anamorphic", self.anamorphic_page))
+                           if pg is not None]
 
     def to_dict(self) -> dict:
         """The card's numbers (what ``physcam lens card --json`` prints besides the file)."""
@@ -81,7 +94,36 @@ class LensCard:
                 "breathing": [r.to_dict() for r in self.breathing],
                 "bokeh": [{"label": lab, "image_height_mm": h, **({} if b is None else b.to_dict())}
                           for lab, h, b in self.bokeh],
-                "notes": list(self.notes)}
+                "notes": list(self.notes), "pages": self.pages,
+                "zoom_page": None if self.zoom_page is None else self.zoom_page.to_dict(),
+                "anamorphic_page": None if self.anamorphic_page is None else self.anamorphic_page.to_dict()}
+
+    @styled
+    def figures(self, *, units: str = "m", dpi: int | None = None) -> list:
+        """Every page as a matplotlib Figure, in the order of :attr:`pages`."""
+        return [self.figure(units=units, dpi=dpi) if name == "main" else self.extra_page(name, units=units, dpi=dpi)
+                for name in self.pages]
+
+    @styled
+    def extra_page(self, name: str, *, units: str = "m", dpi: int | None = None):
+        """The "zoom" or "anamorphic" page as a Figure the size of the card's first page."""
+        from ...figures import new_figure
+        from .anamorphic_page import draw_anamorphic_page
+        from .zoom_page import draw_zoom_page
+
+        if name not in self.pages[1:]:
+            raise InputError(f"the card of {self.lens_name!r} has no {name!r} page; its pages: {', '.join(self.pages)}")
+        w, h = PAGES[self.page]
+        fig = new_figure(figsize=(w, h), dpi=dpi)
+        pg = self.zoom_page if name == "zoom" else self.anamorphic_page
+        what = "across the zoom" if name == "zoom" else "anamorphic, in its two meridians"
+        title, size = _title_that_fits(f"{pg.lens_name}: {what}", 0.94 * w)
+        fig.suptitle(title, fontsize=size, fontweight="bold", y=0.985)
+        fig.text(0.5, 0.955, self._page_subtitle(name, units), ha="center", va="center", fontsize=7.5, color="0.25")
+        (draw_zoom_page if name == "zoom" else draw_anamorphic_page)(fig, pg, units)
+        if pg.notes:
+            fig.text(0.5, 0.012, _wrap("; ".join(pg.notes), 150), ha="center", va="bottom", fontsize=6, color="0.35")
+        return fig
 
     @styled
     def figure(self, *, units: str = "m", dpi: int | None = None):
@@ -111,6 +153,18 @@ class LensCard:
         fig.text(0.5, 0.012, _wrap(foot, 150), ha="center", va="bottom", fontsize=6, color="0.35")
         return fig
 
+    def _page_subtitle(self, name: str, units: str) -> str:
+        from ...units import format_distance
+
+        w, h = self.sensor_mm
+        sensor = f"sensor {self.sensor_name} ({w:.2f} x {h:.2f} mm)"
+        if name == "zoom":
+            return _wrap(f"infinity focus and the stop full open unless stated · {sensor} · dotted line: the zoom "
+                         f"position of page 1 (EFL {self.key['efl_mm']:.1f} mm, zoom {self.zoom_page.encoder:.4g})", 140)
+        foc = "infinity" if math.isinf(self.focus_from_film_mm) else format_distance(self.focus_from_film_mm, units)
+        return _wrap(f"X = the picture's horizontal (squeezed) meridian, Y its vertical · {sensor} · bokeh focused "
+                     f"at {foc} from the film plane", 140)
+
     def _title(self) -> str:
         return f"{self.lens_name}"
 
@@ -134,15 +188,17 @@ def _wrap(text: str, n: int) -> str:
 @takes_prescription
 def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm: float | None = None,
               sensor_height_mm: float | None = None, sensor_name: str | None = None, stopped_fstop: float = 8.0,
-              page: str = "a4", quality: str = "full", backend: str = "auto", sensor=None) -> LensCard:
+              page: str = "a4", quality: str = "full", backend: str = "auto", sensor=None, zoom=None) -> LensCard:
     """Compute the card of ``lens`` focused ``focus_mm`` from the film plane (default infinity; a string with
     units such as "2m" or "10ft" too) on a ``sensor_width_mm`` x ``sensor_height_mm`` sensor, or ``sensor``
     (a name such as "ALEXA 35", or a :class:`~physcam.optics.sensors.Sensor`; default Super 35). The MTF chart
     is drawn wide open and at ``stopped_fstop`` (default f/8; skipped when not slower than wide open).
-    ``page``: "a4" or "letter"; ``quality``: "full" or "draft" (fewer fields and rays: tests)."""
+    ``page``: "a4" or "letter"; ``quality``: "full" or "draft" (fewer fields and rays: tests).
+    A zoom lens's first page shows it at ``zoom`` (an encoder value 0..1 or a focal length such as "135mm";
+    default its first tabulated position), named with that position, and its zoom page the whole range;
+    a prime given ``zoom`` is refused."""
     from ...data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
     from ...errors import require_positive
-    from ...optics import focusing
     from ...units import parse_distance
 
     if sensor is not None:
@@ -164,6 +220,9 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
     name = sensor_name or (DEFAULT_SENSOR if sensor_width_mm is None else f"{w:g} x {h:g} mm")
     focus_mm = parse_distance(focus_mm, name="focus distance", allow_inf=True)
     notes: list[str] = []
+    zoom_lens, encoder = _zoom_position(lens, zoom)
+    if zoom_lens is not None:
+        lens = _named_at(zoom_lens, encoder)
     from ...optics.state import camera_state
 
     camera = camera_state(lens, focus_mm=focus_mm, sensor_mm=(w, h))  # the lens at the mark, as its file stops it
@@ -178,13 +237,67 @@ def lens_card(lens: Prescription, *, focus_mm: float = math.inf, sensor_width_mm
            for lab, n in stops]
     if len(mtf) == 1:
         mtf.append(("stopped down", None, f"the lens is f/{wide:.2g} wide open: no stopped-down chart"))
-    try:
-        rows = focusing.breathing_table(lens, sensor_width_mm=w)
-    except OpticsError as exc:
-        rows = []
-        notes.append(f"breathing: {exc}")
+    rows = _breathing(lens, w, notes)
     bokeh = _bokeh(camera, key, w, h, q, backend, notes)
-    return LensCard(lens.name, focus_mm, name, (w, h), key, diagram, mtf, dist, ill, rows, bokeh, page, notes)
+    zpage = None
+    if zoom_lens is not None:
+        from .zoom_page import zoom_page
+
+        zpage = zoom_page(zoom_lens, encoder, (w, h), curve_fields=q["curve_fields"], backend=backend)
+    apage = None
+    if lens.squeeze != 1.0:
+        from .anamorphic_page import anamorphic_page
+
+        apage = anamorphic_page(lens, camera, rows, (w, h), key["image_circle_mm"], curve_fields=q["curve_fields"],
+                                rays=q["rays"] // 2, pixels=q["pixels"], backend=backend)
+    return LensCard(lens.name, focus_mm, name, (w, h), key, diagram, mtf, dist, ill, rows, bokeh, page, notes,
+                    zpage, apage)
+
+
+def _zoom_position(lens: Prescription, zoom):
+    """(the zoom lens, the encoder value of ``zoom``) for a zoom lens (default its first position);
+    (None, None) for a prime, which refuses a ``zoom``."""
+    if lens.zoom is None:
+        if zoom is not None:
+            raise InputError(f"lens {lens.name!r} is not a zoom lens (its file has no zoom table): give no zoom "
+                             "position")
+        return None, None
+    from ...optics.zoom import zoom_encoder
+
+    return lens, zoom_encoder(lens, 0.0 if zoom is None else zoom)
+
+
+def _named_at(zoom_lens: Prescription, encoder: float) -> Prescription:
+    """The zoom lens at ``encoder`` (a plain prescription), named with its position as the CLI's --zoom
+    names it: "<lens> at <EFL> mm (zoom <encoder>)"."""
+    from dataclasses import replace
+
+    from ...lens.zoom import prescription_at
+    from ...optics.paraxial import gaussian
+
+    q = prescription_at(zoom_lens, encoder)
+    name = f"{zoom_lens.name} at {gaussian(q).efl:.1f} mm (zoom {encoder:.4g})"
+    return replace(q, metadata=replace(q.metadata, name=name))
+
+
+def _breathing(lens, w, notes):
+    """The breathing table from infinity to the close focus; for a lens longer than its close marks (a subject
+    there would sit inside the glass), from infinity to the last default mark 1.5 lens lengths away, said
+    so in ``notes``."""
+    from ...optics import focusing
+
+    try:
+        return focusing.breathing_table(lens, sensor_width_mm=w)
+    except OpticsError as exc:
+        length = lens.total_track + lens.surfaces[-1].thickness
+        marks = [m for m in focusing.DEFAULT_BREATHING_MARKS if m > 1.5 * length]
+        try:
+            rows = focusing.breathing_table(lens, marks, sensor_width_mm=w)
+        except OpticsError:
+            notes.append(f"breathing: {exc}")
+            return []
+        notes.append(f"breathing down to {marks[-1] / 1000:g} m only ({str(exc).split(';')[0]})")
+        return rows
 
 
 def key_numbers(lens: Prescription, focus_mm: float, half_diagonal_mm: float, *, backend: str = "auto") -> dict:
@@ -270,9 +383,10 @@ def _bokeh(camera, key, w, h, q, backend, notes):
     """Point lights in front of the focus (half the focus distance; 15 focal lengths when focused at
     infinity) imaged at the centre, half the half-diagonal and 90 % of it (or of the image circle), wide open."""
     from ..defocus.bokeh import bokeh_image
+    from ._lights import light_distance_mm
 
-    efl, focus_mm = key["efl_mm"], camera.focus_from_film_mm
-    depth = 15.0 * efl if math.isinf(focus_mm) else 0.5 * focus_mm
+    efl = key["efl_mm"]
+    depth = light_distance_mm(camera, efl)
     pupil = key["entrance_pupil_from_film_mm"]
     corner = 0.9 * min(0.5 * math.hypot(w, h), 0.5 * key["image_circle_mm"])
     out = []
@@ -421,13 +535,64 @@ def _draw_bokeh(ax, img, label, height_mm):
 
 
 # ---- writing --------------------------------------------------------------------------------------
+@takes_prescription
+def card_pages(lens: Prescription) -> list[str]:
+    """The pages of ``lens``'s card, before it is computed: "main", then "zoom" for a zoom lens and
+    "anamorphic" for an anamorphic one (what :attr:`LensCard.pages` will say)."""
+    return ["main"] + (["zoom"] if lens.zoom is not None else []) + (["anamorphic"] if lens.squeeze != 1.0 else [])
+
+
+def card_files(card, path) -> list:
+    """The files :func:`save_lens_card` writes for ``card`` (a :class:`LensCard`, or its pages' names:
+    :func:`card_pages`) at ``path``: the one PDF; for a PNG or SVG, ``path`` (the first page) and one file per
+    further page beside it, ``<stem>-zoom<suffix>``, ``<stem>-anamorphic<suffix>``."""
+    from pathlib import Path
+
+    from ...errors import WrongTypeError
+
+    pages = card.pages if isinstance(card, LensCard) else card
+    if not (isinstance(pages, list) and pages[:1] == ["main"]):
+        raise WrongTypeError("card must be a LensCard (physcam.analysis.lens_cards.card.lens_card(lens)) or its "
+                             "pages' names (card_pages(lens))")
+    p = Path(path)
+    if p.suffix.lower() == ".pdf":
+        return [p]
+    return [p] + [p.with_name(f"{p.stem}-{name}{p.suffix}") for name in pages[1:]]
+
+
 @styled
 def save_lens_card(card: LensCard, path, *, force: bool = False, units: str = "m", dpi: int = 150):
-    """Write ``card`` as one page to ``path`` (.pdf, .png or .svg) through :func:`physcam.figures.save_figure`."""
+    """Write ``card`` to ``path`` (.pdf, .png or .svg): a PDF with one page per page of the card, or a PNG/SVG
+    of its first page and one file per further page (:func:`card_files`); each through atomic_write, none
+    written when any exists (without ``force``). Returns ``path``."""
     from ...errors import require_type
     from ...figures import save_figure
     from ...io import check_writable
 
     require_type("card", card, LensCard, "physcam.analysis.lens_cards.card.lens_card(lens)")
-    check_writable(path, force=force)
-    return save_figure(card.figure(units=units), path, force=force, dpi=dpi)
+    files = card_files(card, path)
+    for f in files:
+        check_writable(f, force=force)
+    if files[0].suffix.lower() == ".pdf" and len(card.pages) > 1:
+        return _save_pdf(card.figures(units=units), files[0], force, dpi)
+    return [save_figure(fig, f, force=force, dpi=dpi) for f, fig in zip(files, card.figures(units=units))][0]
+
+
+def _save_pdf(figs, path, force, dpi):
+    """The pages ``figs`` as one PDF at ``path``, written atomically."""
+    import io
+
+    from matplotlib.backends.backend_pdf import PdfPages
+
+    from ...figures import pyplot
+    from ...io import atomic_write
+
+    buf = io.BytesIO()
+    try:
+        with PdfPages(buf) as pdf:
+            for fig in figs:
+                fig.savefig(pdf, format="pdf", dpi=dpi)
+    finally:
+        for fig in figs:
+            pyplot().close(fig)
+    return atomic_write(path, buf.getvalue(), force=force)

@@ -19,7 +19,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...errors import ExportError, LensFileError
-from ...io import atomic_write
 from ..prescription import Prescription, takes_prescription
 from . import iset, pbrt, physcam_toml, seedtoml, zemax
 from ._common import extra, read_text
@@ -112,4 +111,6 @@ def write_lens(p: Prescription, path, format: str | None = None, force: bool = F
     if fmt is None:
         raise ExportError(f"cannot tell the lens format of {path}; use .toml, .dat, .json or .zmx, or pass format=")
     text = dumps_lens(p, fmt)
+    from ...io import atomic_write  # (here: reading a lens, every command's start, needs none of io's imports)
+
     return atomic_write(path, text, force=force)

@@ -261,7 +261,10 @@ def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has
     if k is None:
         if _numba_error is None:
             est = (kinds.shape[0] + 1) * (NUMPY_SURFACE_S + x.shape[0] * NUMPY_RAY_SURFACE_S)
-            scale = numba_load_cost() / NUMBA_LOAD_S  # a cold JIT cache: compiling costs more than loading
+            # a cold JIT cache: compiling costs more than loading (scale >= 1); a call numpy takes even at
+            # scale 1 (a report's few chief rays) does not look at the cache (_jitcache: hashlib, the sources)
+            small = est < NUMPY_CALL_MAX_S and _numpy_spent + est < NUMPY_BUDGET_S
+            scale = 1.0 if small else numba_load_cost() / NUMBA_LOAD_S
             if est < NUMPY_CALL_MAX_S * scale and _numpy_spent + est < NUMPY_BUDGET_S * scale:
                 _numpy_spent += est
                 k = None
