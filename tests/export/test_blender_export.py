@@ -174,16 +174,19 @@ def test_cli_errors_are_one_line(capsys, tmp_path, argv, message):
 
 
 def test_focus_table_of_a_lens_longer_than_its_one_to_one_conjugate():
-    """The Laikin zoom at 15 mm is 288 mm long while its 1:1 conjugate (closest_focus, 4 f + hiatus)
-    is 250 mm from the film: a subject there would be inside the lens. The extension's focus table
-    (and its panel's closest focus) stops where the subject reaches the front vertex: the mark equals
-    the back focus plus the lens's track (subject distance 0), not the 1:1 mark."""
+    """The Laikin zoom at 15 mm is 288 mm long while its 1:1 conjugate (4 f + hiatus) is 250 mm from
+    the film: a subject there would be inside the lens. closest_focus, and so the extension's focus
+    table (and its panel's closest focus), stops where the subject reaches the front vertex: the mark
+    equals the back focus plus the lens's track (subject distance 0), not the 1:1 mark."""
     from physcam.export.blender_focus import focus_table
     from physcam.optics.focusing import closest_focus
+    from physcam.optics.paraxial import gaussian
 
     lens = load_lens("laikin_zoom_15_150mm")
+    g = gaussian(lens)
+    assert 4 * g.efl + g.z_rear_principal_plane - g.z_front_principal_plane < 260.0 < lens.total_track
     ft = focus_table(lens, n_focus=2)
     st = focus(lens, float(ft.closest_mm))
-    assert closest_focus(lens) < 260.0 < lens.total_track
+    assert ft.closest_mm == pytest.approx(closest_focus(lens), rel=2e-6)
     assert st.object_distance_mm == pytest.approx(0.0, abs=0.01)
     assert ft.closest_mm == pytest.approx(st.back_focus_mm + lens.total_track, abs=0.01)

@@ -72,6 +72,23 @@ def test_unit_focus_reaches_the_closest_focus_it_names(slug):
         focusing.focus(lens, near * (1 - 1e-6), method="unit")
 
 
+def test_a_lens_longer_than_its_one_to_one_conjugate_focuses_closest_with_the_subject_at_its_first_vertex():
+    # a stop 150 mm in front of a thin f = 50 mm lens: the 1:1 subject (2 f = 100 mm in front of the
+    # lens) would be 50 mm behind the stop, inside the lens (the Laikin zoom at 15 mm is such a lens).
+    # Worked by hand: the closest subject is at the stop, s = 150 mm from the lens, s' = 1 / (1/50 -
+    # 1/150) = 75 mm, mark s + s' = 225 mm (the old answer, 4 f = 200 mm, is not reachable)
+    from _gauss_lenses import stop, thin_lens_surfaces
+    from physcam.lens.prescription import Prescription
+
+    lens = Prescription((stop(150.0),) + tuple(thin_lens_surfaces(50.0)))
+    assert focusing.closest_focus(lens) == pytest.approx(225.0, rel=1e-9)
+    st_ = focusing.focus(lens, 225.0 * (1 + 1e-9))
+    assert st_.object_distance_mm == pytest.approx(0.0, abs=1e-6)
+    assert st_.back_focus_mm == pytest.approx(75.0, rel=1e-6)
+    with pytest.raises(OpticsError, match="inside the lens"):
+        focusing.focus(lens, 225.0 * (1 - 1e-6))
+
+
 def test_unit_focus_with_limited_travel():
     # 5 mm of extension: s' = f + 5 -> s = f s'/(s' - f); the mark adds the hiatus
     s2 = F + 5.0

@@ -111,3 +111,47 @@ def test_bounds_find_the_spot_behind_a_cover_glass(name):
     half = d / (2 * gaussian_at_focus(q, math.inf).f_number)
     assert 0.5 * (x1 - x0) == pytest.approx(half, rel=0.1)
     assert (pb.rects[..., 1] > pb.rects[..., 0]).all()  # every node of the 24 x 16 mm film passes light
+
+
+def test_one_trace_for_several_irises_is_the_tracer_stopped_to_each(dgauss):
+    # iris_camera_rays traces once with the stop opened; each iris's mask and weights must be what the
+    # tracer itself gives with the stop set to that size (camera_rays with stop_semi_diameter=s)
+    from physcam.trace.pupil_bounds import iris_camera_rays
+    from physcam.trace.trace import paraxial_image_z
+
+    film_z = paraxial_image_z(dgauss)
+    rng = np.random.default_rng(7)
+    film, u = rng.uniform(-15, 15, (3000, 2)), rng.random((3000, 2))
+    semi = dgauss.surfaces[dgauss.stop_index].semi_diameter
+    stops = [semi * f for f in (1.0, 0.71, 0.5, 0.25)]
+    res, passing = iris_camera_rays(dgauss, film, u, film_z, stops)
+    for s, ok in zip(stops, passing):
+        ref = camera_rays(dgauss, film, u, film_z, stop_semi_diameter=s)
+        assert 100 < ref.ok.sum() < 3000
+        assert np.array_equal(ok, ref.ok)
+        assert np.array_equal(res.weight[ok], ref.weight[ref.ok])
+
+
+@pytest.mark.parametrize("name", ["navarro_anamorphic_2x", "arri_signature_prime_58mm_ex1"])
+def test_stopped_bounds_are_the_bounds_of_the_stopped_lens(name):
+    # stopped_pupil_bounds (one trace per round for every iris and node) against exit_pupil_bounds of
+    # the prescription with its stop set to each size; the Signature's cover glass sends its nodes
+    # through the window search (a spot under one sample of the rear square)
+    import dataclasses
+    import math
+
+    from physcam.lens.library import load_lens
+    from physcam.optics.focusing import focus
+    from physcam.trace.pupil_bounds import stopped_pupil_bounds
+
+    st = focus(load_lens(name), math.inf)
+    q = st.prescription
+    semi = q.surfaces[q.stop_index].semi_diameter
+    stops = [semi, 0.5 * semi, 0.25 * semi]
+    got = stopped_pupil_bounds(q, stops, 12.0, 8.0, st.film_z, nx=3, ny=3, samples=24)
+    for s, pb in zip(stops, got):
+        surfs = list(q.surfaces)
+        surfs[q.stop_index] = dataclasses.replace(surfs[q.stop_index], semi_diameter=s)
+        ref = exit_pupil_bounds(q.with_surfaces(surfs), 12.0, 8.0, st.film_z, nx=3, ny=3, samples=24)
+        assert (ref.rects[..., 1] > ref.rects[..., 0]).all()
+        assert np.array_equal(pb.rects, ref.rects)

@@ -95,51 +95,47 @@ def _centre_norm(q, film_z, bounds, fresnel: bool = False, stop_semi_diameter=No
     return float(np.mean(cr.weight))
 
 
+def _ellipse_rect(ellipse) -> np.ndarray:
+    """(x0, x1, y0, y1): the rectangle around an ellipse (cx, ax, ay) on the rear vertex plane."""
+    cx, ax, ay = ellipse[:3]
+    return np.array([cx - ax, cx + ax, -ay, ay])
+
+
 def _centre_bounds(q, ellipse):
     """A PupilBounds whose every node holds the rectangle around an ellipse (cx, ax, ay)."""
     from ..trace.pupil_bounds import PupilBounds
 
-    cx, ax, ay = ellipse[:3]
-    rect = np.broadcast_to([cx - ax, cx + ax, -ay, ay], (2, 2, 4)).copy()
+    rect = np.broadcast_to(_ellipse_rect(ellipse), (2, 2, 4)).copy()
     return PupilBounds(np.array([-1.0, 1.0]), np.array([-1.0, 1.0]), rect, float(q.vertex_z[-1]))
 
 
-def _centre_norms(q, film_z, radial, bounds, levels) -> list[float]:
-    """The centre's mean weight with the round iris at each tabulated iris level: the shader's
+class _RayRects:
+    """Bounds for camera_rays that hold one aim rectangle (x0, x1, y0, y1) per ray, in order."""
+
+    def __init__(self, rects):
+        self.rects = rects
+
+    def rect_at(self, fx, fy):
+        return tuple(self.rects[:, c] for c in range(4))
+
+
+def _centre_norms(q, film_z, rects, levels) -> list[float]:
+    """The centre's mean weight with the round iris at each tabulated iris level, aiming at
+    ``rects[k]`` for level k (:func:`_centre_norm`'s 64^2 aims; levels that share a rectangle share
+    their rays), all in one trace (:func:`~physcam.trace.pupil_bounds.iris_camera_rays`): the shader's
     normalisation (the exit pupil's area is not quite the square of the iris's radius)."""
-    out = []
-    for k, s in enumerate(levels):
-        b = bounds if radial is None else _centre_bounds(q, radial[k, 0])
-        out.append(_centre_norm(q, film_z, b, stop_semi_diameter=float(s)))
-    return out
+    from ..trace.pupil_bounds import iris_camera_rays
 
-
-def _nearest_mark(lens: Prescription, near: float) -> float:
-    """The closest mark (mm from the film), at or beyond ``near``, that physcam's focusing reaches: a
-    lens longer than its 1:1 conjugate (the Laikin zoom at 15 mm: 288 mm long, 1:1 at 250 mm from the
-    film) would hold the subject inside it there, so the mark is moved out (bisection to 1e-6)."""
-    from ..optics.focusing import focus
-
-    def reaches(m):
-        try:
-            focus(lens, m)
-        except OpticsError:
-            return False
-        return True
-
-    if reaches(near):
-        return near
-    lo, hi = near, 2 * near
-    for _ in range(30):
-        if reaches(hi):
-            break
-        lo, hi = hi, 2 * hi
-    else:
-        raise OpticsError(f"{lens.name!r} focuses at no distance from {near:.1f} mm to {hi:.0f} mm from the film")
-    while hi - lo > 1e-6 * hi:
-        mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if reaches(mid) else (mid, hi)
-    return hi
+    m = 64
+    u = (np.arange(m) + 0.5) / m
+    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
+    uniq, which = np.unique(np.asarray(rects, dtype=float), axis=0, return_inverse=True)
+    n = uu.size
+    cr, passing = iris_camera_rays(q, np.zeros((n * len(uniq), 2)), np.tile(np.stack([uu, vv], axis=1), (len(uniq), 1)),
+                                   film_z, [float(s) for s in levels], bounds=_RayRects(np.repeat(uniq, n, axis=0)))
+    w = cr.weight.reshape(len(uniq), n)
+    return [float(np.mean(np.where(ok.reshape(len(uniq), n)[g], w[g], 0.0)))
+            for g, ok in zip(np.ravel(which).tolist(), passing)]
 
 
 @takes_prescription
@@ -154,7 +150,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
 
     if isinstance(n_focus, bool) or not isinstance(n_focus, int) or n_focus < 2:
         raise InputError(f"a focus table needs at least 2 states, got {n_focus!r}")
-    near = _nearest_mark(lens, closest_focus(lens) * (1 + 1e-6))  # a hair beyond: rounding must not ask closer
+    near = closest_focus(lens) * (1 + 1e-6)  # a hair beyond: rounding must not ask closer
     step = 1000.0 / near / (n_focus - 1)  # 1/m
     marks = np.array([math.inf] + [1000.0 / (step * i) for i in range(1, n_focus)])
     marks[-1] = max(marks[-1], near)
@@ -173,11 +169,11 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
             b, rect, rect_levels = _rect_tables(q, st.film_z, levels[0], grid_half_mm)
             rects.append(rect)
             stopped.append(rect_levels)
-            norm.append(_centre_norms(q, st.film_z, None, b, levels))
+            norm.append(_centre_norms(q, st.film_z, [np.array(b.rect_at(0.0, 0.0))] * len(levels), levels))
         else:
             radial.append(radial_pupil_table(q, st.film_z, levels))
             b = _centre_bounds(q, radial[-1][0, 0])
-            norm.append(_centre_norms(q, st.film_z, radial[-1], None, levels))
+            norm.append(_centre_norms(q, st.film_z, [_ellipse_rect(e) for e in radial[-1][:, 0]], levels))
         if mk == marks[0]:
             table0, bounds0 = t, (b if lens.is_anamorphic else None)
             loss = _centre_norm(q, st.film_z, b, fresnel=True) / _centre_norm(q, st.film_z, b)
@@ -192,23 +188,16 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
 
 def _rect_tables(q, film_z, semi_max, grid_half_mm):
     """(PupilBounds at the widest iris, its rectangles, the rectangles at each of :data:`STOP_LEVELS`)."""
-    from ..trace.pupil_bounds import exit_pupil_bounds
+    from ..trace.pupil_bounds import stopped_pupil_bounds
 
     nx, ny = _GRID
     semi_file = q.surfaces[q.stop_index].semi_diameter
-    b = exit_pupil_bounds(_stopped(q, semi_max / semi_file), grid_half_mm, grid_half_mm, film_z, nx=nx, ny=ny,
-                          samples=48)
-    levels = [exit_pupil_bounds(_stopped(q, f * semi_max / semi_file), grid_half_mm, grid_half_mm, film_z, nx=nx,
-                                ny=ny, samples=32).rects for f in STOP_LEVELS]
-    return b, b.rects, levels
-
-
-def _stopped(q: Prescription, fraction: float) -> Prescription:
-    """``q`` with its stop's semi-diameter times ``fraction``."""
-    s = list(q.surfaces)
-    k = q.stop_index
-    s[k] = dataclasses.replace(s[k], semi_diameter=float(s[k].semi_diameter * fraction))
-    return q.with_surfaces(s)
+    # the stop's semi-diameter as a prescription stopped to each fraction of the file's holds it
+    b = stopped_pupil_bounds(q, [float(semi_file * (semi_max / semi_file))], grid_half_mm, grid_half_mm, film_z,
+                             nx=nx, ny=ny, samples=48)[0]
+    levels = stopped_pupil_bounds(q, [float(semi_file * (f * semi_max / semi_file)) for f in STOP_LEVELS],
+                                  grid_half_mm, grid_half_mm, film_z, nx=nx, ny=ny, samples=32)
+    return b, b.rects, [lv.rects for lv in levels]
 
 
 def _num32(x) -> str:
@@ -217,7 +206,12 @@ def _num32(x) -> str:
 
 
 def _arr32(name, values, size) -> str:
-    return f"    float {name}[{size}] = {{{', '.join(_num32(v) for v in np.asarray(values, float).ravel())}}};"
+    a = np.asarray(values, float).ravel()
+    if not np.isfinite(a).all():
+        _num32(a[~np.isfinite(a)][0])  # raises osl_number's error
+    # _num32 of each, inlined (osl_number of a finite float: its repr, with ".0" when that is an integer)
+    nums = [repr(float(format(v, ".9g"))) for v in a.tolist()]
+    return f"    float {name}[{size}] = {{{', '.join(r if ('.' in r or 'e' in r) else r + '.0' for r in nums)}}};"
 
 
 def _arr32_once(ft: FocusTable, name, values, size) -> str:

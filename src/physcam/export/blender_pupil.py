@@ -121,9 +121,8 @@ def _aims(q, film_z: float, fx, px, py, big: float, backend: str):
     from ..trace.trace import trace_through
 
     fx = np.asarray(fx, dtype=float)
-    start = np.stack([fx, np.zeros_like(fx), np.full(fx.size, film_z)], axis=1)
-    rays = RayBatch.from_arrays(start, np.stack([px - fx, py, np.full(px.size, q.vertex_z[-1] - film_z)], axis=1),
-                                q.wavelength_nm)
+    rays = RayBatch.from_columns(fx, np.zeros_like(fx), np.full(fx.size, film_z), px - fx, py,
+                                 np.full(px.size, q.vertex_z[-1] - film_z), q.wavelength_nm)
     probe = _StopCrossing()
     trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=big, aperture=probe, in_place=True,
                   backend=backend)
@@ -142,8 +141,10 @@ def _trace(q, film_z: float, fxs, boxes, big: float, backend: str) -> list:
     """Rays from film points (fx, 0) to the aim grid over each one's box on the rear vertex plane, in
     one trace: per film point (x, y, passes every surface but the stop, radius where it crosses the
     stop plane, grid steps, clip edges). Between a passing sample and a clipped neighbour the edge of
-    what the other surfaces pass is found by halving (:data:`_HALVINGS`): per direction of
-    :data:`_TOWARD`, (lo, hi) fractions of the step that pass and that do not."""
+    what the other surfaces pass is found by halving (:data:`_HALVINGS`): the clip edges are (key,
+    lo, hi), the pair's key (d ny + j) nx + i for direction d of :data:`_TOWARD` and the pair's cell
+    (j, i) in that direction's view of the grid, ascending, and the fractions of the step that pass
+    and that do not."""
     nx, ny = _GRID, _GRID // 2
     x0, x1, y1 = np.array(boxes, dtype=float).T
     dx, dy = (x1 - x0) / nx, y1 / ny  # a _GRID x _GRID/2 grid over each box (x0, x1, y1: the y >= 0 half)
@@ -167,15 +168,15 @@ def _trace(q, film_z: float, fxs, boxes, big: float, backend: str) -> list:
         mid = 0.5 * (lo + hi)
         passes = _aims(q, film_z, ff, x + mid * sx, y + mid * sy, big, backend)[0] if x.size else np.zeros(0, bool)
         lo, hi = np.where(passes, mid, lo), np.where(passes, hi, mid)
-    edges, k = [], 0
-    for g, jj, ii, *_ in pairs:
-        e_lo, e_hi = np.zeros((len(boxes), ny, nx)), np.ones((len(boxes), ny, nx))
-        e_lo[g, jj, ii], e_hi[g, jj, ii] = lo[k:k + g.size], hi[k:k + g.size]
-        edges.append((e_lo, e_hi))
-        k += g.size
+    # per grid, its halved edges sorted by key: direction d, the pair's cell (j, i) -> (d ny + j) nx + i
+    g = np.concatenate([p[0] for p in pairs])
+    key = np.concatenate([(d * ny + p[1]) * nx + p[2] for d, p in enumerate(pairs)])
+    o = np.lexsort((key, g))
+    g, key, lo, hi = g[o], key[o], lo[o], hi[o]
+    cuts = np.searchsorted(g, np.arange(len(boxes) + 1)).tolist()
     dx_, dy_ = dx.tolist(), dy.tolist()
-    return [(gx[i], gy[i], ok[i], rad[i], dx_[i], dy_[i], [(e[0][i], e[1][i]) for e in edges])
-            for i in range(len(boxes))]
+    return [(gx[i], gy[i], ok[i], rad[i], dx_[i], dy_[i], (key[a:b], lo[a:b], hi[a:b]))
+            for i, a, b in zip(range(len(boxes)), cuts[:-1], cuts[1:])]
 
 
 def _rims(uses, radii) -> list:
@@ -189,17 +190,16 @@ def _rims(uses, radii) -> list:
     another surface clips): a sample and its neighbour make a rim point at the radii in [t_a, t_b),
     found for every grid and radius at once by bisection in ``radii``."""
     ny, nx = _GRID // 2, _GRID
-    ok = np.stack([g[2].reshape(ny, nx) for g, _, _ in uses])  # (grids, ny, nx)
-    rad = np.stack([g[3].reshape(ny, nx) for g, _, _ in uses])
-    t = np.where(ok, rad, np.inf)
+    ok = np.stack([g[2] for g, _, _ in uses])  # (grids, ny nx)
+    rad = np.stack([g[3] for g, _, _ in uses])
+    t = np.where(ok, rad, np.inf).reshape(-1, ny, nx)
     x0, y0, dx, dy = (np.array(v) for v in zip(*((g[0][0], g[1][0], g[4], g[5]) for g, _, _ in uses)))
-    edges = [[np.stack([g[6][d][e] for g, _, _ in uses]) for e in (0, 1)] for d in range(len(_TOWARD))]
+    # every grid's clip edges, by key (its place in uses, then its own key): ascending
+    n_edge = np.array([g[6][0].size for g, _, _ in uses])
+    e_key = np.concatenate([g[6][0] for g, _, _ in uses]) + np.repeat(np.arange(len(uses)) * (3 * ny * nx), n_edge)
+    e_lo, e_hi = (np.concatenate([g[6][c] for g, _, _ in uses]) for c in (1, 2))
     r0, r1 = np.array([u[1] for u in uses]), np.array([u[2] for u in uses])
     first = np.concatenate([[0], np.cumsum(r1 - r0)])  # each grid's first rim
-    asc = radii[::-1]
-
-    def n_ge(v):  # how many radii are v or more (a sample passes at radii[:n_ge(t)])
-        return radii.size - np.searchsorted(asc, v, side="left")
 
     def expand(g, lo, hi):  # (rim index, radius index, which entry) of every entry's radii [lo, hi)
         n = hi - lo
@@ -207,21 +207,27 @@ def _rims(uses, radii) -> list:
         i = lo[e] + np.arange(e.size) - np.repeat(np.cumsum(n) - n, n)
         return first[g[e]] + i - r0[g[e]], i, e
 
-    r0_, r1_ = r0[:, None, None], r1[:, None, None]
-    n_in = n_ge(t)  # per sample: it passes at radii[:n_in]
+    small = np.int16 if radii.size < 2**15 else np.int64
+    r0_, r1_ = r0.astype(small)[:, None, None], r1.astype(small)[:, None, None]
+    n_in = _n_passing(radii, t).astype(small)  # per sample: it passes at radii[:n_in]
+    rad, ok = rad.ravel(), ok.ravel()
     parts = []  # (rim index, x, y, xa, ya, clipped)
     # toward +x, -x and +y: the sample's (a) and its neighbour's (b) cells
-    for ((ja, ia_), (jb, ib), (sx, sy)), (e_lo, e_hi) in zip(_TOWARD, edges):
+    for d, ((ja, ia_), (jb, ib), (sx, sy)) in enumerate(_TOWARD):
         lo, hi = np.maximum(n_in[:, jb, ib], r0_), np.minimum(n_in[:, ja, ia_], r1_)
-        rim = hi > lo  # the pairs with a rim point at some radius of their grid
-        g, jj, ii = np.nonzero(rim)
-        shape = (slice(None), slice(0, rim.shape[1]), slice(0, rim.shape[2]))  # the clip edges' cells
-        ra, rb, nb_ok = rad[:, ja, ia_][rim], rad[:, jb, ib][rim], ok[:, jb, ib][rim]
+        g, jj, ii = np.nonzero(hi > lo)  # the pairs with a rim point at some radius of their grid
+        a = (g * ny + jj + (ja.start or 0)) * nx + ii + (ia_.start or 0)  # the cells in the flat grids
+        b = (g * ny + jj + (jb.start or 0)) * nx + ii + (ib.start or 0)
+        ra, rb, nb_ok = rad[a], rad[b], ok[b]
         # where another surface clips, the rim is at the halved edge (held: its far end; area: its middle)
-        e0, e1 = e_lo[shape][rim], e_hi[shape][rim]
+        e0, e1 = np.zeros(g.size), np.ones(g.size)
+        cut = np.flatnonzero(~nb_ok)
+        at = np.searchsorted(e_key, (g[cut] * 3 + d) * (ny * nx) + jj[cut] * nx + ii[cut])
+        e0[cut], e1[cut] = e_lo[at], e_hi[at]
         ex, ey = sx * dx[g], sy * dy[g]
         bx, by = x0[g] + (ii + (ia_.start or 0)) * dx[g], y0[g] + (jj + (ja.start or 0)) * dy[g]
-        k, ri, e = expand(g, lo[rim], hi[rim])
+        k, ri, e = expand(g, np.maximum(n_in.ravel()[b], r0_.ravel()[g]).astype(np.int64),
+                          np.minimum(n_in.ravel()[a], r1_.ravel()[g]).astype(np.int64))
         ra, rb, nb_ok, e0, e1, ex, ey, bx, by = (v[e] for v in (ra, rb, nb_ok, e0, e1, ex, ey, bx, by))
         with np.errstate(divide="ignore", invalid="ignore"):
             f_iris = np.clip((radii[ri] - ra) / (rb - ra), 0.0, 1.0)
@@ -237,12 +243,12 @@ def _rims(uses, radii) -> list:
         jj, ii = jj + (cells[0].start or 0), ii + (cells[1].start or 0)
         bx, by = x0[g] + ii * dx[g], y0[g] + jj * dy[g]
         ex, ey = (ox * dx[g] if ox else np.zeros(g.size)), (oy * dy[g] if oy else np.zeros(g.size))
-        k, _, e = expand(g, lo[rim], hi[rim])
+        k, _, e = expand(g, lo[rim].astype(np.int64), hi[rim].astype(np.int64))
         bx, by, ex, ey = bx[e], by[e], ex[e], ey[e]
         parts.append((k, bx + ex, by + ey, bx + ex / 2, by + ey / 2, np.ones(k.size, dtype=bool)))
     n_rims = int(first[-1])
     k = np.concatenate([p[0] for p in parts])
-    order = np.argsort(k, kind="stable")
+    order = np.argsort(k.astype(small), kind="stable")  # a radix sort on 16-bit integers
     k = k[order]
     cols = [np.concatenate([p[c] for p in parts])[order] for c in range(1, 6)]
     cuts = np.searchsorted(k, np.arange(n_rims + 1))
@@ -363,26 +369,30 @@ def _passing_sets(q, film_z: float, fxs, radii, r_rear: float, big: float, backe
     return [[rim for use in u if use[2] > use[1] for rim in next(rims)] for u in uses]
 
 
+def _n_passing(radii, t) -> np.ndarray:
+    """Per sample of stop radius ``t`` (inf where another surface clips): how many of the descending
+    iris radii ``radii`` it passes at (those at least t: ``radii[:n]``)."""
+    return radii.size - np.searchsorted(radii[::-1], t, side="left")
+
+
 def _shrunk(radii, grids, boxes, start):
     """Per grid (of :func:`_trace`, over its box) the index of the first iris radius, from ``start`` on,
     whose passing set has shrunk under half of the grid (len(radii) if none), and per grid and
-    radius the passing set's x extent and largest y. The sets nest: over the samples in order of
-    their stop radius, running extremes give every radius's at once."""
+    radius the passing set's x extent and largest y. The sets nest: a sample with n passing radii
+    (:func:`_n_passing`) is in the sets of radii[:n], so each grid's extremes per n, taken from the
+    largest n down, give every radius's at once."""
     gx, gy, ok, rad = (np.stack([g[c] for g in grids]) for c in range(4))
     dx, dy = np.array([g[4] for g in grids])[:, None], np.array([g[5] for g in grids])[:, None]
     b = np.array(boxes)
-    rad = np.where(ok, rad, np.inf)
-    o = np.argsort(rad, axis=1, kind="stable")
-    rs = np.take_along_axis(rad, o, axis=1)
-    # per grid and radius: how many samples pass (those with stop radius at most it), as an index
-    n = np.stack([np.searchsorted(r, radii[::-1], side="right")[::-1] for r in rs])
-    anyp = n > 0
-    at = np.maximum(n - 1, 0)
+    n_grid, n_rad = len(grids), radii.size
+    key = (np.arange(n_grid)[:, None] * (n_rad + 1) + _n_passing(radii, np.where(ok, rad, np.inf))).ravel()
 
-    def running(v, fn, empty):
-        run = fn.accumulate(np.take_along_axis(v, o, axis=1), axis=1)
-        return np.where(anyp, np.take_along_axis(run, at, axis=1), empty)
+    def running(v, fn, empty):  # per grid and radius i: fn over the samples with n > i
+        e = np.full(n_grid * (n_rad + 1), empty)
+        fn.at(e, key, v.ravel())
+        return fn.accumulate(e.reshape(n_grid, n_rad + 1)[:, ::-1], axis=1)[:, ::-1][:, 1:]
 
+    anyp = running(np.ones(key.size), np.add, 0.0) > 0
     xmin, xmax, ymax = running(gx, np.minimum, np.inf), running(gx, np.maximum, -np.inf), running(gy, np.maximum, -np.inf)
     small = (anyp & (xmax - xmin + 4 * dx < 0.5 * (b[:, 1:2] - b[:, 0:1])) & (ymax + 2 * dy < 0.5 * b[:, 2:3])
              & (np.arange(radii.size)[None, :] >= np.asarray(start)[:, None]))
@@ -393,25 +403,21 @@ def _shrunk(radii, grids, boxes, start):
 _SAFETY = 1.003
 
 
-def _fit(rim) -> np.ndarray:
-    """(cx, ax, ay, area): the ellipse about the rim's middle, axes along x and y, that holds every rim
-    point, and the passing set's area."""
-    x, y = rim.x, rim.y
-    cx = 0.5 * (x.min() + x.max())
-    ax = 0.5 * (x.max() - x.min())
-    ay = y.max()
-    g = _need(rim, cx, ax, ay)
-    return np.array([cx, ax * g, ay * g, rim.area()])
-
-
-def _need(rim, cx: float, ax: float, ay: float) -> float:
-    """The factor the ellipse's axes need so that it holds ``rim``'s points (times :data:`_SAFETY`)."""
-    if rim is None:
-        return 1.0
-    x, y = rim.x, rim.y
-    if not (ax > 0 and ay > 0):
-        return math.inf
-    return float(np.sqrt(((x - cx) / ax) ** 2 + (y / ay) ** 2).max()) * _SAFETY
+def _fits(rims) -> np.ndarray:
+    """Per rim of ``rims`` (rims of one table: rows of the same arrays), (cx, ax, ay, area): the
+    ellipse about the rim's middle, axes along x and y, that holds every rim point (grown by
+    :data:`_SAFETY`), and the passing set's area."""
+    n = np.array([r.span.stop - r.span.start for r in rims])
+    idx = np.concatenate([np.arange(r.span.start, r.span.stop) for r in rims])
+    starts = np.cumsum(n) - n
+    x, y = rims[0].cols[0][idx], rims[0].cols[1][idx]
+    lo, hi = np.minimum.reduceat(x, starts), np.maximum.reduceat(x, starts)
+    cx, ax, ay = 0.5 * (lo + hi), 0.5 * (hi - lo), np.maximum.reduceat(y, starts)
+    c = np.repeat(np.arange(n.size), n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v = np.sqrt(((x - cx[c]) / ax[c]) ** 2 + (y / ay[c]) ** 2)
+    g = np.where((ax > 0) & (ay > 0), np.maximum.reduceat(v, starts) * _SAFETY, math.inf)
+    return np.stack([cx, ax * g, ay * g, [r.area() for r in rims]], axis=1)
 
 
 def interpolated_ellipse(table: np.ndarray, levels, rho: float, s: float) -> np.ndarray:
@@ -517,14 +523,15 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto") -> np
     at_node, at_mid = sets[:N_RADIAL], sets[N_RADIAL:]
     table = np.zeros((len(levels), N_RADIAL, 5))
     empty = np.ones((len(levels), N_RADIAL), dtype=bool)
-    for j in range(N_RADIAL):
-        for k, s in enumerate(levels):
-            reg = at_node[j][index[float(s)]]
-            if reg is not None:
-                table[k, j, :4] = _fit(reg)
-                up, down = at_node[j][index[float(s * (1 + _DS))]], at_node[j][index[float(s * (1 - _DS))]]
-                table[k, j, 4] = ((up.area() if up else 0.0) - (down.area() if down else 0.0)) / (2 * _DS * s)
-                empty[k, j] = False
+    lit = [(k, j) for j in range(N_RADIAL) for k, s in enumerate(levels) if at_node[j][index[float(s)]] is not None]
+    if lit:
+        kk, jj = np.array(lit).T
+        table[kk, jj, :4] = _fits([at_node[j][index[float(levels[k])]] for k, j in lit])
+        empty[kk, jj] = False
+    for k, j in lit:
+        s = levels[k]
+        up, down = at_node[j][index[float(s * (1 + _DS))]], at_node[j][index[float(s * (1 - _DS))]]
+        table[k, j, 4] = ((up.area() if up else 0.0) - (down.area() if down else 0.0)) / (2 * _DS * s)
     dark = empty.copy()
     _fill(table, empty)
     table[..., 3] = np.where(dark, 0.0, table[..., 3])  # nothing passes (the ellipse is a neighbour's)
@@ -559,10 +566,10 @@ def _cols_used(rho: float, step: float) -> list[int]:
 def _reads(table, levels, rhos, ss):
     """Per (film radius, iris radius) pair, arrays of what the shader reads: j0, rw (:func:`_radial`)
     and l0, lw, shrink (:func:`_bracket`)."""
-    rad = {rho: _radial(table, rho) for rho in set(rhos)}
-    br = {s: _bracket(levels, s) for s in set(ss)}
-    j0, rw = (np.array(v) for v in zip(*(rad[rho] for rho in rhos)))
-    l0, lw, shrink = (np.array(v) for v in zip(*(br[s] for s in ss)))
+    rho_u, rho_i = np.unique(np.asarray(rhos, dtype=float), return_inverse=True)
+    s_u, s_i = np.unique(np.asarray(ss, dtype=float), return_inverse=True)
+    j0, rw = (np.array(v)[rho_i.ravel()] for v in zip(*(_radial(table, rho) for rho in rho_u.tolist())))
+    l0, lw, shrink = (np.array(v)[s_i.ravel()] for v in zip(*(_bracket(levels, s) for s in s_u.tolist())))
     return j0, rw, l0, lw, shrink
 
 

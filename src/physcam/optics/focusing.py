@@ -274,8 +274,12 @@ def _internal_state(p: Prescription, d_obj: float, axis: str, lam):
 def closest_focus(prescription: Prescription, *, method: str = "auto", axis: str = "y", wavelength_nm=None) -> float:
     """Closest focus mark (mm from the film plane).
 
-    Internal focusing: the close calibration point of the focus groups. Unit
-    focusing (no mechanical limit known): the 1:1 conjugate, 4 f + hiatus in air.
+    Internal focusing: the close calibration point of the focus groups. Unit focusing (no mechanical
+    limit known): the 1:1 conjugate, (1 + sqrt(n'))^2 f + hiatus (4 f + hiatus in air), the closest
+    real image; unless there the subject would be inside the lens (a lens longer than that: the
+    subject (1 + sqrt(n')) f in front of H1, which lies further behind the first vertex), then the
+    mark with the subject at the first vertex: s = z(H1) in front of H1, s' = n' / (1/f - 1/s) behind
+    H2 (Gaussian conjugates), mark s + s' + hiatus. Marks beyond it focus; marks closer do not.
     """
     method = focus_method(prescription, method)
     if method == "internal":
@@ -285,7 +289,11 @@ def closest_focus(prescription: Prescription, *, method: str = "auto", axis: str
     g = paraxial.gaussian(prescription, axis=axis, wavelength_nm=wavelength_nm)
     if g.efl <= 0:
         raise OpticsError(f"lens {prescription.name!r} has negative power: it forms no real image to focus")
-    return (1.0 + math.sqrt(g.image_index)) ** 2 * g.efl + (g.z_rear_principal_plane - g.z_front_principal_plane)
+    hiatus = g.z_rear_principal_plane - g.z_front_principal_plane
+    s = g.z_front_principal_plane  # the first vertex (lens space z = 0) in front of H1
+    if s > (1.0 + math.sqrt(g.image_index)) * g.efl:  # the 1:1 subject would be behind the first vertex
+        return s + g.image_index / (1.0 / g.efl - 1.0 / s) + hiatus
+    return (1.0 + math.sqrt(g.image_index)) ** 2 * g.efl + hiatus
 
 
 #: Without the maker's minimum object distance, a unit-focusing lens's breathing is drawn from this many

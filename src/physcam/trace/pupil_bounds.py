@@ -18,14 +18,13 @@ touch its edge or none pass, until it is the whole square.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError, OpticsError, require_positive
 
-__all__ = ["PupilBounds", "exit_pupil_bounds", "MIN_HITS"]
+__all__ = ["PupilBounds", "exit_pupil_bounds", "stopped_pupil_bounds", "iris_camera_rays", "MIN_HITS"]
 
 #: Passing samples below which a film node's spot is searched for again in a finer window (module notes).
 MIN_HITS = 16
@@ -61,12 +60,31 @@ class PupilBounds:
 def exit_pupil_bounds(lens, film_half_width: float, film_half_height: float, film_z: float | None = None, *,
                       nx: int = 17, ny: int = 17, samples: int = 64, backend: str = "auto") -> PupilBounds:
     """Tabulate :class:`PupilBounds` over the film rectangle (half sizes in mm) at ``film_z``."""
+    return stopped_pupil_bounds(lens, [None], film_half_width, film_half_height, film_z, nx=nx, ny=ny,
+                                samples=samples, backend=backend)[0]
+
+
+#: The stop's semi-diameter (mm) while one trace serves several irises: a power of two, so the stop
+#: crossing (x, y), handed over on the stop's unit disk, comes back exact (x / 2^k * 2^k == x).
+_OPEN_STOP = 2.0 ** 20
+
+
+def stopped_pupil_bounds(lens, stop_semi_diameter, film_half_width: float, film_half_height: float,
+                         film_z: float | None = None, *, nx: int = 17, ny: int = 17, samples: int = 64,
+                         backend: str = "auto") -> list[PupilBounds]:
+    """:func:`exit_pupil_bounds` with the stop's semi-diameter set to each size of the sequence
+    ``stop_semi_diameter`` (mm; None: the lens's own), one :class:`PupilBounds` each. The aims of every node are traced in
+    one call for all irises (:func:`iris_camera_rays`), and so are the windows of every node still
+    searching (module notes), round by round."""
     from .trace import paraxial_image_z
 
     hw = require_positive("film half width", film_half_width)
     hh = require_positive("film half height", film_half_height)
     if nx < 2 or ny < 2 or samples < 4:
         raise InputError("pupil bounds need nx, ny >= 2 and samples >= 4")
+    sd = [s if s is None else require_positive("stop semi-diameter", s) for s in stop_semi_diameter]
+    if any(s is None for s in sd) and not all(s is None for s in sd):  # the lens's own among others
+        sd = [float(lens.surfaces[lens.stop_index].semi_diameter) if s is None else s for s in sd]
     if film_z is None:
         film_z = paraxial_image_z(lens)
     r = lens.surfaces[-1].semi_diameter
@@ -74,56 +92,105 @@ def exit_pupil_bounds(lens, film_half_width: float, film_half_height: float, fil
     uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
     xs = np.linspace(-hw, hw, nx)
     ys = np.linspace(-hh, hh, ny)
-    rects = np.zeros((ny, nx, 4))
-    for j, fy in enumerate(ys):
-        for i, fx in enumerate(xs):
-            rects[j, i] = _node_rect(lens, fx, fy, film_z, r, uu, vv, backend)
-    if not (rects[..., 1] > rects[..., 0]).any():
-        raise OpticsError(f"no ray from the film reaches the scene through {lens.name!r}")
-    return PupilBounds(xs, ys, rects, float(lens.vertex_z[-1]))
+    fy, fx = (a.ravel() for a in np.meshgrid(ys, xs, indexing="ij"))  # the nodes, row by row
+    full = np.array([-r, r, -r, r])
+    box = np.broadcast_to(full, (len(sd), fx.size, 4)).copy()  # per stop and node: the box its hits are on
+    ext = _box_hits(lens, fx, fy, film_z, box[0], uu, vv, sd, backend)  # (stops, nodes, 5): extremes, count
+    pending = ext[..., 4] < MIN_HITS
+    h = 0.5 * (film_z - lens.vertex_z[-1])
+    while pending.any():
+        live = pending.any(axis=0) & (h < r + np.maximum(np.abs(fx), np.abs(fy)))
+        if not live.any():
+            break
+        win = np.stack([np.maximum(fx - h, -r), np.minimum(fx + h, r), np.maximum(fy - h, -r), np.minimum(fy + h, r)],
+                       axis=1)
+        nodes = np.flatnonzero(live & (win[:, 1] > win[:, 0]) & (win[:, 3] > win[:, 2]))
+        if nodes.size:
+            got = _box_hits(lens, fx[nodes], fy[nodes], film_z, win[nodes], uu, vv, sd, backend)
+            take = pending[:, nodes] & (got[..., 4] > 0) & ~_touches(got, win[nodes], full, samples)
+            k, i = np.nonzero(take)
+            ext[k, nodes[i]], box[k, nodes[i]] = got[k, i], win[nodes[i]]
+            pending[k, nodes[i]] = False
+        h *= 2
+    out = []
+    for e, b in zip(ext, box):
+        rects = _rects(e, b, r, samples).reshape(ny, nx, 4)
+        if not (rects[..., 1] > rects[..., 0]).any():
+            raise OpticsError(f"no ray from the film reaches the scene through {lens.name!r}")
+        out.append(PupilBounds(xs, ys, rects, float(lens.vertex_z[-1])))
+    return out
 
 
-def _window_hits(lens, fx, fy, film_z, r, box, uu, vv, backend):
-    """(x, y) of the aims that pass among the grid (``uu``, ``vv`` in [0, 1]) over ``box`` (x0, x1, y0,
-    y1 on the rear-vertex plane, inside the rear element's square of half side ``r``)."""
+class _StopCrossing:
+    """An iris shape for the tracer (``density_at`` gets every ray's crossing on the stop's unit disk)
+    that keeps the crossings and passes every ray."""
+
+    def __init__(self):
+        self.x = self.y = None
+
+    def density_at(self, x, y):
+        self.x, self.y = x, y
+        return np.ones_like(x)
+
+
+def iris_camera_rays(lens, film_xy, pupil_samples, film_z: float, stop_semi_diameter, *, bounds=None,
+                     backend: str = "auto"):
+    """:func:`~physcam.trace.trace.camera_rays` for several irises in one trace: (the rays, traced with
+    the stop opened to :data:`_OPEN_STOP`; per stop semi-diameter of the sequence ``stop_semi_diameter`` (mm), which
+    rays pass it). A ray passes an iris of radius s when it passes every other surface and crosses the
+    stop plane at x^2 + y^2 <= s^2: the tracer's own test, so each mask is camera_rays' ``ok`` with
+    ``stop_semi_diameter=s``, and where it holds the weight is the same too."""
     from .trace import camera_rays
 
-    x0, x1, y0, y1 = box
-    px, py = x0 + uu * (x1 - x0), y0 + vv * (y1 - y0)
-    film = np.broadcast_to([fx, fy], (uu.size, 2))
-    res = camera_rays(lens, film, np.stack([(px + r) / (2 * r), (py + r) / (2 * r)], axis=1), film_z, backend=backend)
-    return px[res.ok], py[res.ok]
+    probe = _StopCrossing()
+    res = camera_rays(lens, film_xy, pupil_samples, film_z, bounds=bounds, stop_semi_diameter=_OPEN_STOP,
+                      aperture=probe, backend=backend)
+    x, y = probe.x * _OPEN_STOP, probe.y * _OPEN_STOP
+    r2 = x * x + y * y
+    return res, [res.ok & (r2 <= float(s) * float(s)) for s in stop_semi_diameter]
 
 
-def _node_rect(lens, fx, fy, film_z, r, uu, vv, backend) -> tuple:
-    """(x0, x1, y0, y1) around the aims from film point (fx, fy) that pass, grown by a sample spacing
-    and kept inside the rear element's square; (0, 0, 0, 0) when none passes (module notes)."""
-    full = (-r, r, -r, r)
-    hits = _window_hits(lens, fx, fy, film_z, r, full, uu, vv, backend)
-    box = full
-    if hits[0].size < MIN_HITS:
-        h = 0.5 * (film_z - lens.vertex_z[-1])
-        while h < r + max(abs(fx), abs(fy)):
-            win = (max(fx - h, -r), min(fx + h, r), max(fy - h, -r), min(fy + h, r))
-            if win[1] > win[0] and win[3] > win[2]:
-                got = _window_hits(lens, fx, fy, film_z, r, win, uu, vv, backend)
-                if got[0].size and not _touches(got, win, full, uu):
-                    hits, box = got, win
-                    break
-            h *= 2
-    if not hits[0].size:
-        return (0.0, 0.0, 0.0, 0.0)
-    n = round(math.sqrt(uu.size))
-    sx, sy = (box[1] - box[0]) / n, (box[3] - box[2]) / n
-    px, py = hits
-    return (max(px.min() - sx, -r), min(px.max() + sx, r), max(py.min() - sy, -r), min(py.max() + sy, r))
+def _box_hits(lens, fx, fy, film_z, boxes, uu, vv, stops, backend) -> np.ndarray:
+    """Per stop and film point (``fx``, ``fy``): (x min, x max, y min, y max, count) of the aims that
+    pass among the grid (``uu``, ``vv`` in [0, 1]) over its box (x0, x1, y0, y1 on the rear-vertex
+    plane, inside the rear element's square of half side ``r``), all in one trace; the extremes are
+    inf where none passes."""
+    r = lens.surfaces[-1].semi_diameter
+    x0, x1, y0, y1 = (boxes[:, c:c + 1] for c in range(4))
+    px, py = x0 + uu * (x1 - x0), y0 + vv * (y1 - y0)  # (nodes, aims)
+    m = uu.size
+    film = np.stack([np.repeat(fx, m), np.repeat(fy, m)], axis=1)
+    uv = np.stack([((px + r) / (2 * r)).ravel(), ((py + r) / (2 * r)).ravel()], axis=1)
+    if all(s is None for s in stops):  # no stop to size: the lens as it is
+        from .trace import camera_rays
+
+        passing = [camera_rays(lens, film, uv, film_z, backend=backend).ok] * len(stops)
+    else:
+        passing = iris_camera_rays(lens, film, uv, film_z, stops, backend=backend)[1]
+    out = np.empty((len(stops), fx.size, 5))
+    for k, ok in enumerate(passing):
+        ok = ok.reshape(px.shape)
+        out[k, :, 0], out[k, :, 1] = np.where(ok, px, np.inf).min(axis=1), np.where(ok, px, -np.inf).max(axis=1)
+        out[k, :, 2], out[k, :, 3] = np.where(ok, py, np.inf).min(axis=1), np.where(ok, py, -np.inf).max(axis=1)
+        out[k, :, 4] = ok.sum(axis=1)
+    return out
 
 
-def _touches(hits, win, full, uu) -> bool:
-    """Whether a passing aim lies in the outermost samples of window ``win`` on a side where the
-    window stops short of the rear element's square ``full`` (the spot may reach beyond it)."""
-    n = round(math.sqrt(uu.size))
-    px, py = hits
-    sx, sy = (win[1] - win[0]) / n, (win[3] - win[2]) / n
-    return bool((win[0] > full[0] and px.min() < win[0] + sx) or (win[1] < full[1] and px.max() > win[1] - sx)
-                or (win[2] > full[2] and py.min() < win[2] + sy) or (win[3] < full[3] and py.max() > win[3] - sy))
+def _touches(ext, win, full, samples) -> np.ndarray:
+    """Per stop and node, whether a passing aim (extremes ``ext`` of :func:`_box_hits`) lies in the
+    outermost samples of its window ``win`` on a side where the window stops short of the rear
+    element's square ``full`` (the spot may reach beyond it)."""
+    sx, sy = (win[:, 1] - win[:, 0]) / samples, (win[:, 3] - win[:, 2]) / samples
+    return (((win[:, 0] > full[0]) & (ext[..., 0] < win[:, 0] + sx)) | ((win[:, 1] < full[1]) & (ext[..., 1] > win[:, 1] - sx))
+            | ((win[:, 2] > full[2]) & (ext[..., 2] < win[:, 2] + sy)) | ((win[:, 3] < full[3]) & (ext[..., 3] > win[:, 3] - sy)))
+
+
+def _rects(ext, box, r, samples) -> np.ndarray:
+    """Per node, the rectangle around its passing aims (extremes ``ext`` of :func:`_box_hits` on the
+    grid over ``box``), grown by a sample spacing and kept inside the rear element's square; (0, 0, 0,
+    0) where none passes."""
+    sx, sy = (box[:, 1] - box[:, 0]) / samples, (box[:, 3] - box[:, 2]) / samples
+    rect = np.stack([np.maximum(ext[:, 0] - sx, -r), np.minimum(ext[:, 1] + sx, r), np.maximum(ext[:, 2] - sy, -r),
+                     np.minimum(ext[:, 3] + sy, r)], axis=1)
+    rect[ext[:, 4] == 0] = 0.0
+    return rect

@@ -70,26 +70,36 @@ class RayBatch:
             raise InputError(f"ray directions must have shape {p.shape}, got {d.shape}") from None
         if d.shape != p.shape:
             raise InputError(f"ray directions must have shape {p.shape}, got {d.shape}")
-        if not (np.isfinite(p).all() and np.isfinite(d).all()):
+        return cls.from_columns(p[:, 0], p[:, 1], p[:, 2], d[:, 0], d[:, 1], d[:, 2], wavelength_nm, weight)
+
+    @classmethod
+    def from_columns(cls, x, y, z, dx, dy, dz, wavelength_nm=587.5618, weight=1.0) -> "RayBatch":
+        """:meth:`from_arrays` with the positions (mm) and directions (normalised here) as six 1-D
+        arrays of one length, with no (n, 3) array built on the way."""
+        cols = [np.asarray(c, dtype=np.float64) for c in (x, y, z, dx, dy, dz)]
+        n = cols[0].shape[0] if cols[0].ndim == 1 else -1
+        if any(c.shape != (n,) for c in cols):
+            raise InputError(f"ray columns must be six 1-D arrays of one length, got shapes {[c.shape for c in cols]}")
+        if not all(np.isfinite(c).all() for c in cols):
             raise InputError("ray positions and directions must be finite numbers (found NaN or inf)")
-        # normalise without overflow or underflow: scale by the largest component first (column by
-        # column: the same operations, in the same order, as on the (n, 3) array, without its passes)
-        dx, dy, dz = np.abs(d[:, 0]), np.abs(d[:, 1]), np.abs(d[:, 2])
-        big = np.maximum(np.maximum(dx, dy), dz)
+        # normalise without overflow or underflow: scale by the largest component first
+        dx, dy, dz = cols[3:]
+        big = np.maximum(np.maximum(np.abs(dx), np.abs(dy)), np.abs(dz))
         if (big == 0).any():
             raise InputError("a ray direction is the zero vector; give a non-zero direction")
-        dx, dy, dz = d[:, 0] / big, d[:, 1] / big, d[:, 2] / big
+        dx, dy, dz = dx / big, dy / big, dz / big
         norm = np.sqrt(dx * dx + dy * dy + dz * dz)
-        n = p.shape[0]
-        wl = np.broadcast_to(np.asarray(wavelength_nm, dtype=np.float64), (n,)).copy()
-        require_wavelength(wl, "ray wavelength")
-        w = np.broadcast_to(np.asarray(weight, dtype=np.float64), (n,)).copy()
-        if not (np.isfinite(w).all() and (w >= 0).all()):
+        wl_in, w_in = np.asarray(wavelength_nm, dtype=np.float64), np.asarray(weight, dtype=np.float64)
+        wl = np.broadcast_to(wl_in, (n,)).copy()
+        if n:  # the values, checked before broadcasting
+            require_wavelength(float(wl_in) if wl_in.ndim == 0 else wl_in, "ray wavelength")
+        w = np.broadcast_to(w_in, (n,)).copy()
+        if n and not (np.isfinite(w_in).all() and (w_in >= 0).all()):
             raise InputError("ray weights must be finite and >= 0")
         # own, writable, contiguous columns: a broadcast input (read-only, possibly one element,
         # which ascontiguousarray would pass through as is) must never reach the kernels
         return cls(
-            np.array(p[:, 0], order="C"), np.array(p[:, 1], order="C"), np.array(p[:, 2], order="C"),
+            np.array(cols[0], order="C"), np.array(cols[1], order="C"), np.array(cols[2], order="C"),
             dx / norm, dy / norm, dz / norm,
             wl, w, np.zeros(n, dtype=np.uint8),
         )

@@ -346,10 +346,9 @@ def camera_rays(
     px = x0 + uv[:, 0] * (x1 - x0)
     py = y0 + uv[:, 1] * (y1 - y0)
     area = (x1 - x0) * (y1 - y0)
-    start = np.stack([fxy[:, 0], fxy[:, 1], np.full(n, film_z)], axis=1)
-    dirn = np.stack([px - fxy[:, 0], py - fxy[:, 1], np.full(n, -d)], axis=1)
     wl = lens.wavelength_nm if wavelength_nm is None else wavelength_nm
-    rays = RayBatch.from_arrays(start, dirn, wl)
+    rays = RayBatch.from_columns(fxy[:, 0], fxy[:, 1], np.full(n, film_z), px - fxy[:, 0], py - fxy[:, 1],
+                                 np.full(n, -d), wl)
     cos_t = -rays.N
     with np.errstate(over="ignore", invalid="ignore"):
         rays.weight[:] = cos_t**4 * area / (d * d)  # unpolarised at the film: weight_sp stays 0
