@@ -69,7 +69,10 @@ def test_bokeh_from_a_state_is_the_bokeh_of_the_lens_focused_and_stopped_by_hand
     s = camera_state(DGAUSS, focus_mm=2000.0, fstop=4.0, aperture=hexagon)
     a = bokeh_image(s, 1000.0, 2.0, 1.0, rays=20_000, pixels=32)
     lens, film, iris = _by_hand(DGAUSS, 2000.0, 4.0)
-    b = bokeh_image(lens, 1000.0, 2.0, 1.0, film_z=film, stop_semi_diameter=iris, aperture=hexagon, rays=20_000,
+    # the hexagon has the round iris's area (docs/conventions.md): its corners at iris x equal_area_scale
+    # (f/4 is far inside the widest iris, so no clamp); the ray-level form draws inside the radius given
+    corner = iris * hexagon.equal_area_scale()
+    b = bokeh_image(lens, 1000.0, 2.0, 1.0, film_z=film, stop_semi_diameter=corner, aperture=hexagon, rays=20_000,
                     pixels=32)
     assert np.array_equal(a.image, b.image) and a.extent_mm == b.extent_mm and a.rays_passed == b.rays_passed
 
