@@ -176,11 +176,12 @@ def _payloads(names, workers: int):
         yield from pool.map(_payload_job, names)  # in order; a lens's error is raised here, as its own class
 
 
-def build_extension(out_dir, *, lenses=None, force: bool = False, progress=None, workers: int | None = None) -> Path:
+def build_extension(out_dir, *, lenses=None, force: bool = False, progress=None, workers: int | None = 1) -> Path:
     """Write ``out_dir/physcam-<version>.zip`` (module notes) through :func:`physcam.io.atomic_write`.
     ``lenses``: bundled slugs or lens files physcam reads (default: every bundled lens). ``workers``:
-    processes computing the lenses' tables at once (``None``: one per core); the zip is the same
-    whatever the number."""
+    processes computing the lenses' tables at once (``None``: one per core, the CLI's default); the zip
+    is the same whatever the number. More than one starts fresh Python processes that import the
+    calling script: call it from a script under ``if __name__ == "__main__":``."""
     from .. import __version__
     from ..errors import require_type
     from ..io import atomic_write, check_writable
