@@ -4,7 +4,8 @@ Two branches, each a ``Read`` of the map (raw, so no colour transform touches th
 ``Read`` of the image and an ``STMap`` (``uv rgb``): *undistort* turns the plate into the
 undistorted, overscanned picture; *redistort* turns a render of that picture back into the plate.
 The maps carry their own frames (:func:`physcam.analysis.distortion.stmap.write_stmaps`): the undistorted
-picture's format is the plate's and its bounding box the overscan (EXR display and data windows),
+picture's format is the plate's (or, desqueezed, the wider frame the map's display window says) and
+its bounding box the overscan (EXR display and data windows),
 so the render to redistort is an EXR of that frame too (display window = the plate, data window =
 the overscan, as renderers write overscan).
 In a ``.nk`` file a node with ``inputs 2`` takes its inputs from the node stack, the top of the

@@ -626,8 +626,8 @@ def write_map_png(rgb: np.ndarray, path, *, force: bool = False) -> Path:
 def write_stmaps(result: DistortionField, folder, *, force: bool = False) -> list[Path]:
     """Write ``distortion.exr``, ``undistortion.exr`` and a PNG preview beside each into ``folder``.
 
-    ``undistortion.exr``'s display window is the plate's frame and its data window the overscanned
-    region (module notes); ``distortion.exr`` is the plate's size, both windows alike.
+    ``undistortion.exr``'s display window is the undistorted picture's frame (the plate's, or the
+    desqueezed one) and its data window the overscanned region (module notes); ``distortion.exr`` is the plate's size, both windows alike.
 
     Each EXR's header says which stop the map is for and its residual there: ``physcamMapFor`` (text),
     ``physcamFStop`` (0 for a chief-ray map), ``physcamResidualRmsPx``, ``physcamResidualMaxPx``,
