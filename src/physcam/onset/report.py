@@ -38,7 +38,7 @@ from ..optics import _num
 from ..optics import dof as _dof
 from ..optics.coc import named_circle_of_confusion
 from ..optics.sensors import Sensor
-from ..optics.state import CameraState
+from ..optics.state import CameraState, OfACamera
 from .pupil import pivot_camera_space
 from .request import (DIFFRACTION_WAVELENGTH_NM, HYPERFOCAL, MAX_DISTANCE_MM, MAX_F_NUMBER, MIN_F_NUMBER,
                       MeasuredLimits, References, ReportInputs, ReportRequest, report_camera)
@@ -85,7 +85,7 @@ def fstop_airy_equals(size_mm, wavelength_nm=DIFFRACTION_WAVELENGTH_NM, bellows_
 
 
 @dataclass(frozen=True)
-class LensReport:
+class LensReport(OfACamera):
     """Everything the lens report knows. Lengths in mm, angles in degrees.
 
     Positions are distances in front of the film plane (``*_from_film_mm``) unless the
@@ -148,17 +148,7 @@ class LensReport:
     #: pivot of a tilt (physcam.optics.focusing.EntrancePupils). None: one pupil for both
     entrance_pupil_horizontal_from_film_mm: float | None = None
 
-    # --- the camera's own settings, read from it ----------------------------------
-    @property
-    def fstop(self) -> float:
-        """The iris's setting (at infinity focus): the camera's."""
-        return self.camera.fstop
-
-    @property
-    def focus_from_film_mm(self) -> float:
-        """The focus mark in front of the film plane: the camera's (inf at infinity)."""
-        return self.camera.focus_from_film_mm
-
+    # --- the camera's own settings, read from it (fstop, focus_from_film_mm: OfACamera) -----------
     @property
     def sensor(self) -> Sensor:
         return self.camera.sensor
