@@ -101,6 +101,17 @@ def run_blender_log(script: str, *args, timeout: float = 300.0, env: dict | None
     return json.loads(lines[-1]), p.stdout + p.stderr
 
 
+def light_centroid(img, c, r, win: int):
+    """The centroid (column, row) of a small light in ``img`` (rows as stored), in the (2 win + 1)-pixel
+    square about (c, r), negative pixels counted as 0."""
+    import numpy as np
+
+    c0, r0 = int(round(c)), int(round(r))
+    a = np.clip(img[r0 - win:r0 + win + 1, c0 - win:c0 + win + 1], 0.0, None)
+    yy, xx = np.mgrid[r0 - win:r0 + win + 1, c0 - win:c0 + win + 1]
+    return float((a * xx).sum() / a.sum()), float((a * yy).sum() / a.sum())
+
+
 def predicted_block_brightness(b, blocks: dict, w_px: int, h_px: int, sensor_mm, samples: int = 96) -> dict:
     """physcam's own prediction of a white world's brightness in pixel ``blocks`` ({name: (row0, row1,
     col0, col1)}, rows from the bottom) of a ``w_px`` x ``h_px`` render through the baked camera ``b``

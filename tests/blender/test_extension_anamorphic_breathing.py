@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from _anamorphic_yu import hand_framing_focal_lengths, hand_pupils_from_film
-from _blender import INSTALLED_EXTENSION_SCENE, run_blender_log
+from _blender import INSTALLED_EXTENSION_SCENE, light_centroid, run_blender_log
 
 pytestmark = pytest.mark.slow
 
@@ -85,13 +85,6 @@ def _marks():
     return marks
 
 
-def _centroid(img, c, r, win=5):
-    c0, r0 = int(round(c)), int(round(r))
-    a = np.clip(img[r0 - win:r0 + win + 1, c0 - win:c0 + win + 1], 0.0, None)
-    yy, xx = np.mgrid[r0 - win:r0 + win + 1, c0 - win:c0 + win + 1]
-    return float((a * xx).sum() / a.sum()), float((a * yy).sum() / a.sum())
-
-
 @pytest.fixture(scope="module")
 def renders(extension_zip, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("anamorphic_breathing")
@@ -108,7 +101,7 @@ def _spans(img, want_mm):
     for sx in (-1, 1):
         for sy in (-1, 1):
             c, r = W / 2 - 0.5 + sx * want_mm[0] / px, H / 2 - 0.5 + sy * want_mm[1] / px
-            gc, gr = _centroid(img, c, r)
+            gc, gr = light_centroid(img, c, r, win=5)
             xs.append(abs(gc - (W / 2 - 0.5)) * px)
             ys.append(abs(gr - (H / 2 - 0.5)) * px)
     return float(np.mean(xs)), float(np.mean(ys))

@@ -13,7 +13,7 @@ import json
 import numpy as np
 import pytest
 
-from _blender import INSTALLED_EXTENSION_SCENE, run_blender_log
+from _blender import INSTALLED_EXTENSION_SCENE, light_centroid, run_blender_log
 
 pytestmark = pytest.mark.slow
 
@@ -83,13 +83,6 @@ print(json.dumps(out))
 '''
 
 
-def _centroid(img, c, r, win=4):
-    c0, r0 = int(round(c)), int(round(r))
-    a = np.clip(img[r0 - win:r0 + win + 1, c0 - win:c0 + win + 1], 0.0, None)
-    yy, xx = np.mgrid[r0 - win:r0 + win + 1, c0 - win:c0 + win + 1]
-    return float((a * xx).sum() / a.sum()), float((a * yy).sum() / a.sum())
-
-
 @pytest.fixture(scope="module")
 def framing(extension_zip, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("framing")
@@ -116,7 +109,7 @@ def test_render_viewport_and_builtin_frame_alike(framing, case):
     for name in ("osl", "builtin"):
         img = np.array(res[name])
         for c, r in res["expect"]:
-            gc, gr = _centroid(img, c, r)
+            gc, gr = light_centroid(img, c, r, win=4)
             print(f"{case} {name}: light at ({gc:.2f}, {gr:.2f}) px, Blender's frame ({c:.2f}, {r:.2f})")
             err[name] = max(err.get(name, 0.0), float(np.hypot(gc - c, gr - r)))
     assert err["osl"] < 0.3 and err["builtin"] < 0.3, (case, err)
