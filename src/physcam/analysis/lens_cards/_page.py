@@ -23,3 +23,24 @@ def checked_drawing(fig, page, cls, units) -> None:
     require_type("fig", fig, Figure, "a card-sized matplotlib Figure")
     require_type("page", page, cls, "the card's page (LensCard.zoom_page or .anamorphic_page)")
     per_unit(units)
+
+
+def draw_distortion_curves(ax, curves, xlabel: str, *, ncol: int = 1) -> None:
+    """A page's distortion panel: ``curves`` are (label, meridian points, line style, colour), each point
+    with ``real_height_mm`` and ``distortion_pct``; a curve without points is left out, and a panel
+    with none says so instead of drawing empty axes."""
+    shown = False
+    for label, pts, style, colour in curves:
+        if pts:
+            shown = True
+            ax.plot([abs(p.real_height_mm) for p in pts], [p.distortion_pct for p in pts], style, color=colour,
+                    label=label)
+    if not shown:
+        ax.set_axis_off()
+        ax.text(0.5, 0.5, "no distortion: see the notes", transform=ax.transAxes, ha="center", fontsize=7)
+        return
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.grid(True)
+    ax.set_xlabel(xlabel, fontsize=7)
+    ax.set_ylabel("distortion (%)")
+    ax.legend(loc="best", fontsize=6, ncol=ncol)

@@ -34,7 +34,7 @@ import numpy as np
 from ...errors import InputError, OpticsError, require_type
 from ...figures import PALETTE
 from ...lens.prescription import Prescription, takes_prescription
-from ._page import checked_drawing, sensor_size
+from ._page import checked_drawing, draw_distortion_curves, sensor_size
 
 __all__ = ["ANAMORPHIC_PANELS", "AnamorphicPage", "anamorphic_page", "draw_anamorphic_page", "blur_aspect"]
 
@@ -276,24 +276,12 @@ def _draw_distortion(ax, page, units):
     from ...units import format_distance
 
     ax.set_title("distortion per meridian (− barrel)", loc="left", fontsize=8)
-    shown = False
+    curves = []
     for k, (m, d) in enumerate(page.distortion):
         at = "∞" if math.isinf(m) else format_distance(m, units)
         for axis, style in (("x", "-"), ("y", "--")):
-            pts = [] if d is None else d.meridian(axis)
-            if pts:
-                shown = True
-                ax.plot([abs(p.real_height_mm) for p in pts], [p.distortion_pct for p in pts], style,
-                        color=PALETTE[k], label=f"{axis.upper()}, {at}")
-    if not shown:
-        ax.set_axis_off()
-        ax.text(0.5, 0.5, "no distortion: see the notes", transform=ax.transAxes, ha="center", fontsize=7)
-        return
-    ax.axhline(0.0, color="0.6", lw=0.6)
-    ax.grid(True)
-    ax.set_xlabel("image height on the film (mm)", fontsize=7)
-    ax.set_ylabel("distortion (%)")
-    ax.legend(loc="best", fontsize=6, ncol=2)
+            curves.append((f"{axis.upper()}, {at}", [] if d is None else d.meridian(axis), style, PALETTE[k]))
+    draw_distortion_curves(ax, curves, "image height on the film (mm)", ncol=2)
 
 
 def _draw_bokeh(fig, sub, page):

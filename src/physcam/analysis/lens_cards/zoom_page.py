@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from ...errors import InputError, OpticsError
 from ...figures import PALETTE
 from ...lens.prescription import Prescription, takes_prescription
-from ._page import checked_drawing, sensor_size
+from ._page import checked_drawing, draw_distortion_curves, sensor_size
 
 __all__ = ["ZOOM_PANELS", "ZoomPage", "zoom_page", "draw_zoom_page"]
 
@@ -249,19 +249,7 @@ def _draw_breathing(ax, page, units):
 
 def _draw_distortion(ax, page):
     ax.set_title("distortion at each tabulated position, infinity", loc="left", fontsize=8)
-    shown, efl = False, {r.encoder: r.efl_mm for r in page.positions}
-    for k, (u, d) in enumerate(page.distortion):
-        pts = [] if d is None else d.meridian("y")
-        if pts:
-            shown = True
-            ax.plot([abs(p.real_height_mm) for p in pts], [p.distortion_pct for p in pts], color=PALETTE[k % len(PALETTE)],
-                    label=f"EFL {efl[u]:.1f} mm")
-    if not shown:
-        ax.set_axis_off()
-        ax.text(0.5, 0.5, "no distortion: see the notes", transform=ax.transAxes, ha="center", fontsize=7)
-        return
-    ax.axhline(0.0, color="0.6", lw=0.6)
-    ax.grid(True)
-    ax.set_xlabel("image height (mm)", fontsize=7)
-    ax.set_ylabel("distortion (%)")
-    ax.legend(loc="best", fontsize=6)
+    efl = {r.encoder: r.efl_mm for r in page.positions}
+    curves = [(f"EFL {efl[u]:.1f} mm", [] if d is None else d.meridian("y"), "-", PALETTE[k % len(PALETTE)])
+              for k, (u, d) in enumerate(page.distortion)]
+    draw_distortion_curves(ax, curves, "image height (mm)")
