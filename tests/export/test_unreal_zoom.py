@@ -13,6 +13,7 @@ import tomllib
 from importlib import resources
 
 import pytest
+from _zoom_abcd import abcd_position
 
 from physcam.errors import InputError
 from physcam.export.unreal import INFINITY_FOCUS_CM, unreal_lens_file
@@ -23,25 +24,6 @@ from physcam.optics.zoom import encoder_for_focal_length
 
 CANON = "canon_ef_70_200mm_f2_8_zoom"
 W_MM, H_MM, W_PX, H_PX = 24.89, 18.66, 1920, 1440
-
-
-def _abcd_efl(doc, k):
-    """EFL of tabulated position k by the ray-transfer matrices of refraction (n - n') / (n' R) and
-    transfer by t / n (reduced thickness), front vertex to last vertex: EFL = -1 / C."""
-    gaps = {g["surface"]: g["thickness"][k] for g in doc["zoom"]["gap"]}
-    a, b, c, d = 1.0, 0.0, 0.0, 1.0
-    n = 1.0
-    surfaces = doc["surface"]
-    for i, s in enumerate(surfaces):
-        n2 = 1.0 if s["medium"] == "air" else float(s["medium"]["nd"])
-        r = s.get("radius", 0.0)
-        power = 0.0 if s["kind"] in ("flat", "stop") or r == 0 else (n2 - n) / r
-        a, b, c, d = a, b, c - power * a, d - power * b  # refraction [[1, 0], [-P, 1]] @ M
-        n = n2
-        if i < len(surfaces) - 1:
-            t = float(gaps.get(i, s["thickness"])) / n
-            a, b, c, d = a + t * c, b + t * d, c, d  # transfer [[1, t/n], [0, 1]] @ M
-    return -1.0 / c
 
 
 def _doc():
@@ -57,7 +39,7 @@ def _rows(data, name):
 def test_a_zoom_lens_file_is_a_focus_by_zoom_grid_against_a_hand_abcd_trace():
     lens = load_lens(CANON)
     doc = _doc()
-    efls = [_abcd_efl(doc, k) for k in range(3)]
+    efls = [abcd_position(doc, k)[0] for k in range(3)]
     assert efls == pytest.approx([72.118, 134.948, 193.910], abs=5e-4)  # docs/zoom.md's table, optiland's
     data = unreal_lens_file(lens, W_MM, H_MM, image_width_px=W_PX, image_height_px=H_PX,
                             focus_marks_mm=[math.inf, 3000.0])

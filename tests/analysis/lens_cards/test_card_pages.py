@@ -27,6 +27,7 @@ from pathlib import Path
 import pytest
 
 from _anamorphic_yu import _surfaces, _yu, hand_framing_focal_lengths, hand_pupils_from_film
+from _zoom_abcd import abcd_position
 from physcam.analysis.lens_cards.anamorphic_page import ANAMORPHIC_PANELS
 from physcam.analysis.lens_cards.card import PAGES, card_files, lens_card, save_lens_card
 from physcam.analysis.lens_cards.zoom_page import ZOOM_PANELS
@@ -52,26 +53,6 @@ def neil_card():
 # ---- oracles ------------------------------------------------------------------------------------
 def _toml(slug):
     return tomllib.loads(resources.files("physcam.data").joinpath("lenses", f"{slug}.toml").read_text(encoding="utf-8"))
-
-
-def _abcd(doc, k):
-    """(EFL, BFL, film distance) of tabulated position k: the product of refraction [[1, 0], [-(n' - n)/R, 1]]
-    and reduced transfer [[1, t/n], [0, 1]] matrices from the first vertex to the last; EFL = -1/C,
-    BFL = -A/C (Hecht, Optics, 6.2)."""
-    gaps = {g["surface"]: g["thickness"][k] for g in doc["zoom"]["gap"]}
-    a, b, c, d = 1.0, 0.0, 0.0, 1.0
-    n = 1.0
-    surfaces = doc["surface"]
-    for i, s in enumerate(surfaces):
-        n2 = 1.0 if s["medium"] == "air" else float(s["medium"]["nd"])
-        r = s.get("radius", 0.0)
-        power = 0.0 if s["kind"] in ("flat", "stop") or r == 0 else (n2 - n) / r
-        a, b, c, d = a, b, c - power * a, d - power * b
-        n = n2
-        if i < len(surfaces) - 1:
-            t = float(gaps.get(i, s["thickness"])) / n
-            a, b, c, d = a + t * c, b + t * d, c, d
-    return -1.0 / c, -a / c, float(gaps.get(len(surfaces) - 1, surfaces[-1]["thickness"]))
 
 
 def _hand_blur_half_widths(slug, depth_mm):
@@ -106,7 +87,7 @@ def test_zoom_page_focal_lengths_and_back_focus_against_a_hand_abcd_trace(canon_
     tab = [r for r in page.positions if r.tabulated]
     assert [r.encoder for r in tab] == [0.0, 0.5, 1.0]
     for k, r in enumerate(tab):
-        efl, bfl, film = _abcd(doc, k)
+        efl, bfl, film = abcd_position(doc, k)
         assert r.efl_mm == pytest.approx(efl, rel=1e-9)
         assert r.image_shift_mm == pytest.approx(bfl - film, abs=1e-6)  # + behind the film
         # field of view at infinity: the paraxial chief ray at the sensor's edge, 2 atan(w / 2f)
@@ -119,7 +100,7 @@ def test_zoom_page_focal_lengths_and_back_focus_against_a_hand_abcd_trace(canon_
     assert all(b > a for a, b in zip(curve, curve[1:]))
     assert (curve[0], curve[-1]) == pytest.approx((72.1, 194.01), rel=1e-3)
     # page 1 is the first position, named so, at its EFL
-    assert page.encoder == 0.0 and canon_card.key["efl_mm"] == pytest.approx(_abcd(doc, 0)[0], rel=1e-9)
+    assert page.encoder == 0.0 and canon_card.key["efl_mm"] == pytest.approx(abcd_position(doc, 0)[0], rel=1e-9)
     assert canon_card.lens_name.endswith("at 72.1 mm (zoom 0)")
 
 
@@ -140,7 +121,7 @@ def test_zoom_page_breathing_and_distortion_at_each_tabulated_position(canon_car
     assert [u for u, _ in page.breathing] == [0.0, 0.5, 1.0]
     for k, (u, rows) in enumerate(page.breathing):
         assert math.isinf(rows[0].focus_from_film_mm) and rows[0].fov_change_pct == 0.0
-        assert rows[0].efl_mm == pytest.approx(_abcd(doc, k)[0], rel=1e-9)
+        assert rows[0].efl_mm == pytest.approx(abcd_position(doc, k)[0], rel=1e-9)
         # unit focusing: the field narrows as the lens racks out (breathing in), mark by mark
         assert all(b.hfov_deg < a.hfov_deg for a, b in zip(rows, rows[1:]))
     for u, d in page.distortion:
