@@ -75,7 +75,7 @@ chromium:
 	fi
 
 test: $(STAMP) $(BLENDER_STAMP) chromium lint
-	PHYSCAM_BLENDER_PYTHON=$(abspath $(BLENDER_PY)) $(PY) -m pytest -n 2 -q
+	PHYSCAM_BLENDER_PYTHON=$(abspath $(BLENDER_PY)) $(PY) -m pytest -n 2 --dist worksteal -q
 	$(MAKE) --no-print-directory usd-min
 	$(MAKE) --no-print-directory test-latest
 
