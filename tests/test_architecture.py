@@ -14,7 +14,7 @@ from pathlib import Path
 SRC = Path(__file__).resolve().parents[1] / "src"
 
 LAYER = {
-    "errors": 0, "_moved": 1,
+    "errors": 0, "_moved": 1, "_program": 1,
     "": 2,  # the root package only re-exports errors and the version, and installs the old module paths
     "data": 3, "extras": 4, "progress": 5, "units": 6, "io": 7, "figures": 8,
     "lens": 9,
