@@ -75,9 +75,15 @@ def film_chief_directions(lens: Prescription, film_xy, film_z: float, wavelength
     """The aimed chief ray of each film point (x, y) on the plane ``film_z`` (mm, lens space) as
     (flag, L, M, N) after tracing it back out through ``lens`` with clipping (``aim_from_film`` then
     ``trace_through(..., reverse=True, clip=True)``), or None when a ray needs the numpy path."""
+    from ..errors import InputError, require_finite, require_positive, require_type
     from ..optics.paraxial import gaussian
 
-    wl = float(wavelength_nm)
+    require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name)")
+    film_z, wl = require_finite("film_z", film_z), require_positive("wavelength", wavelength_nm, unit="nm")
+    try:
+        film_xy = [(require_finite("film x", x), require_finite("film y", y)) for x, y in film_xy]
+    except (TypeError, ValueError):
+        raise InputError(f"film points must be (x, y) pairs in mm, got {film_xy!r:.60}") from None
     k = lens.stop_index
     back = rows(lens.with_surfaces(lens.surfaces[k:]), wl, reverse=True)
     whole = rows(lens, wl, reverse=True)

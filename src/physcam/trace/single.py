@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from ..errors import WrongTypeError, require_finite, require_positive, require_type
 from ..lens.prescription import Prescription
 from ..optics.glass import dispersion, medium_dispersion
 from .kernels._layout import CLIPPED, MISSED, NEWTON_MAX_ITER, NEWTON_TOL, OK, TIR
@@ -58,6 +59,8 @@ def _index(coefficients, lam: float) -> float:
 def rows(lens: Prescription, wavelength_nm: float, *, reverse: bool = False) -> tuple[Row, ...]:
     """The surfaces of ``lens`` in tracing order (film side first when ``reverse``) with their indices
     at ``wavelength_nm``: :func:`~physcam.trace.surfaces.surface_table` (no stop override, no coating)."""
+    require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name)")
+    wavelength_nm = require_positive("wavelength", wavelength_nm, unit="nm")
     media = (dispersion(1.0, 0.0),) + tuple(medium_dispersion(s.medium) for s in lens.surfaces)
     index = [_index(m.coefficients, float(wavelength_nm)) for m in media]
     out = []
@@ -187,6 +190,12 @@ def trace_ray(surface_rows, x: float, y: float, z: float, dx: float, dy: float, 
     """Trace one ray (start point in lens space, mm; a unit direction) through ``surface_rows``
     (:func:`rows`): (flag, x, y, z, L, M, N) after the last one, flag ``OK`` or why it was lost
     (``MISSED``, ``CLIPPED``, ``TIR``; then the other six are None)."""
+    if type(surface_rows) is not tuple or not all(type(r) is Row for r in surface_rows):
+        raise WrongTypeError(f"surface_rows must be physcam.trace.single.rows(lens, wavelength_nm), got "
+                             f"{type(surface_rows).__name__}")
+    if not all(type(v) is float for v in (x, y, z, dx, dy, dz)):
+        x, y, z, dx, dy, dz = (require_finite(n, v, error=WrongTypeError) for n, v in
+                               zip(("x", "y", "z", "dx", "dy", "dz"), (x, y, z, dx, dy, dz)))
     for r in surface_rows:
         try:
             out = _step(r, x, y, z, dx, dy, dz, clip)
