@@ -308,6 +308,10 @@ def run() -> None:
     from .. import _program
 
     _program.RUNNING = True  # matplotlib without its docstring tables and 3-D toolkit (figures._lean_import)
+    # numpy's BLAS on one thread unless the user says otherwise (before numpy loads): the program's linear
+    # algebra is small (a Zernike fit of a few thousand pupil samples), where OpenBLAS's second thread
+    # spins and doubles the CPU time (`mtf --field 0`: 0.85 -> 0.5 s, the same output; docs/performance.md)
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     code = main()
     if "numba" in sys.modules:
         _exit_without_teardown(code)

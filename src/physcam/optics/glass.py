@@ -217,9 +217,10 @@ def _catalogue(nd, vd, g, matched_by) -> Dispersion:
         b1, b2, b3, c1, c2, c3 = g.sellmeier
         base, kind, err = (0.0, 0.0, 0.0, b1, b2, b3, c1, c2, c3), "sellmeier", 0.0
     else:
-        from .glassfit import tracer_form
+        from .glassfit import stored_form, tracer_form
 
-        base, err = tracer_form(g.formula, tuple(g.coefficients), _traced_band(g))
+        band = _traced_band(g)
+        base, err = stored_form(g, band) or tracer_form(g.formula, tuple(g.coefficients), band)
         kind = "catalogue-fit"
         if err > FIT_TOLERANCE:
             import warnings
