@@ -6,8 +6,8 @@ semi-diameter (the radius a bladed iris's corners reach,
 :attr:`~physcam.optics.state.CameraState.iris_corner_semi`; the round iris's radius for a round one), its
 film plane and its iris shape. A :class:`CameraTracer` of a bare prescription (no camera: a focus state of
 :func:`physcam.export.blender_focus.focus_table`) holds the same three. After that its users ask it, and
-do not follow the tracer's own modules: the surface table film side first (made on the first ask and
-kept), the exit-pupil rectangles over a film window (:func:`physcam.trace.pupil_bounds.exit_pupil_bounds`),
+do not follow the tracer's own modules: the surface tables, scene side or film side first (each made on the
+first ask and kept), the exit-pupil rectangles over a film window (:func:`physcam.trace.pupil_bounds.exit_pupil_bounds`),
 camera rays (:func:`physcam.trace.trace.camera_rays`, pbrt-v4's ``RealisticCamera`` weight) and their mean
 weight at the film centre, the normalisation a renderer divides by.
 
@@ -37,6 +37,14 @@ class CameraTracer:
     aperture: object = None  # the iris shape (physcam.trace.aperture.Aperture) drawn inside the stop; None: round
 
     @functools.cached_property
+    def scene_side_table(self):
+        """The :class:`~physcam.trace.surfaces.SurfaceTable` front to back (rays from the scene), uncoated;
+        made on the first ask and kept."""
+        from .surfaces import surface_table
+
+        return surface_table(self.lens, coating="none")
+
+    @functools.cached_property
     def film_side_table(self):
         """The :class:`~physcam.trace.surfaces.SurfaceTable` film side first (the camera rays' order),
         uncoated; made on the first ask and kept."""
@@ -52,6 +60,22 @@ class CameraTracer:
 
         return exit_pupil_bounds(self.lens, film_half_width, film_half_height, self.film_z, nx=nx, ny=ny,
                                  samples=samples)
+
+    def stopped_pupil_bounds(self, stop_semi_diameters, film_half_width: float, film_half_height: float, *, nx: int,
+                             ny: int, samples: int) -> list:
+        """:func:`physcam.trace.pupil_bounds.stopped_pupil_bounds`: :meth:`exit_pupil_bounds` with the stop
+        set to each semi-diameter of the sequence (mm; None: this tracer's own), one trace for them all."""
+        from .pupil_bounds import stopped_pupil_bounds
+
+        return stopped_pupil_bounds(self.lens, stop_semi_diameters, film_half_width, film_half_height, self.film_z,
+                                    nx=nx, ny=ny, samples=samples)
+
+    def iris_camera_rays(self, film_xy, pupil_samples, stop_semi_diameters, *, bounds=None):
+        """:func:`physcam.trace.pupil_bounds.iris_camera_rays`: camera rays for several round irises (mm) in one
+        trace, and which pass each (this tracer's iris shape is not drawn: the irises are round)."""
+        from .pupil_bounds import iris_camera_rays
+
+        return iris_camera_rays(self.lens, film_xy, pupil_samples, self.film_z, stop_semi_diameters, bounds=bounds)
 
     def camera_rays(self, film_xy, pupil_samples, *, bounds=None, fresnel: bool = False):
         """:func:`physcam.trace.trace.camera_rays` from this film plane through this lens and iris shape."""
