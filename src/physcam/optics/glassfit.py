@@ -151,6 +151,14 @@ def stored_form(glass, band_nm: tuple) -> tuple[tuple, float] | None:
     """:func:`tracer_form` of a bundled catalogue's ``glass`` (a :class:`~physcam.lens.catalog_glass.CatalogGlass`)
     over ``band_nm`` as stored in :data:`STORED_DIR`, or None when not stored for exactly this formula,
     these coefficients and this band (a user's catalogue, or data changed since the table was written)."""
+    from ..errors import InputError, require_type
+    from ..lens.catalog_glass import CatalogGlass
+
+    require_type("glass", glass, CatalogGlass, "physcam.lens.catalog.find_glass(name)")
+    try:
+        band_nm = tuple(float(b) for b in band_nm)
+    except (TypeError, ValueError):
+        raise InputError(f"band_nm must be (low, high) in nm, got {band_nm!r:.40}") from None
     e = _stored(glass.maker).get(glass.name.upper())
     if (e is None or e["formula"] != glass.formula or tuple(e["coefficients"]) != tuple(glass.coefficients)
             or tuple(e["band_nm"]) != tuple(band_nm)):
