@@ -1,0 +1,144 @@
+"""A zoom lens's tables for the Blender extension's shader: zoom x focus (docs/blender.md, "Zoom").
+
+The shader of a zoom lens takes the zoom as a focal length (``zoom_focal_length``, mm: the paraxial
+EFL at infinity focus, as ``physcam --zoom 135mm`` names a position, :mod:`physcam.optics.zoom`) and
+finds the encoder u from :data:`N_ZOOM_EFL` EFLs uniform in u (linear between them: within 0.07 % of
+the library's bisection on the bundled zooms). The lens's state is tabulated on two grids sharing
+one focus axis (:data:`N_FOCUS_ZOOM` marks uniform in 1/distance, infinity to the closest focus
+every zoom position reaches):
+
+- the geometry (film plane, vertices, entrance pupil, the iris rule's K and f-numbers) at
+  :data:`N_ZOOM_GEOMETRY` positions uniform in u: each is :func:`physcam.lens.zoom.prescription_at`
+  (the gaps on their pchip cams) focused by :func:`physcam.optics.focusing.focus`; the shader blends
+  them bilinearly in (u, 1/distance). Linear in u between 33 nodes follows the pchip cams within
+  0.02 mm on the bundled zooms (0.85 mm between the tabulated positions and their midpoints alone);
+- the pupil sampling tables (:mod:`physcam.export.blender_pupil`, the costly part) and the centre's
+  normalisation only at the source's tabulated positions, blended linearly in u (the ellipses grown
+  by their centres' and axes' spread between the two positions: a sampling region, not the image).
+
+The iris levels are common to every position (the widest iris and the file's stop of the position
+that opens most), so one level index means one iris radius at every position.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..errors import InputError
+from ..lens.prescription import Prescription
+
+__all__ = ["ZoomGrid", "zoom_focus_table", "zoom_defines", "N_FOCUS_ZOOM", "N_ZOOM_GEOMETRY", "N_ZOOM_EFL"]
+
+#: Focus marks of a zoom lens's tables (fewer than a prime's 32: the pupil tables are per position).
+N_FOCUS_ZOOM = 12
+#: Zoom positions of the geometry, uniform in the encoder u.
+N_ZOOM_GEOMETRY = 33
+#: EFL samples, uniform in u, from which the shader finds u for a focal length.
+N_ZOOM_EFL = 65
+
+
+@dataclasses.dataclass
+class ZoomGrid:
+    """The zoom axis of a zoom lens's focus table (module notes)."""
+
+    geometry_u: np.ndarray  # (N_ZOOM_GEOMETRY,) encoder of each geometry row block
+    pupil_u: np.ndarray  # (n,) the tabulated positions: encoder of each pupil-table block
+    efl_u_mm: np.ndarray  # (N_ZOOM_EFL,) paraxial EFL at infinity focus, u uniform 0..1
+    iris_k: np.ndarray  # (N_ZOOM_GEOMETRY,) iris semi-diameter x f-number at each geometry position
+    fstop_open: np.ndarray  # (N_ZOOM_GEOMETRY,) the lens wide open there
+    fstop_min: np.ndarray  # (N_ZOOM_GEOMETRY,) the fastest f-stop physcam's camera state opens to there
+    levels: np.ndarray  # the common iris radii (mm) of the pupil and normalisation tables
+
+    @property
+    def range_mm(self) -> tuple[float, float]:
+        return float(self.efl_u_mm.min()), float(self.efl_u_mm.max())
+
+
+def _iris_rule(q: Prescription) -> tuple[float, float, float]:
+    """(K, widest f-number, fastest accepted f-number) of a plain prescription: blender_focus's rule."""
+    from ..optics.focusing import gaussian_at_focus
+    from ..optics.paraxial import STOP_OPENING_TOLERANCE
+    from ..optics.state import camera_state
+
+    n_open = gaussian_at_focus(q, math.inf).f_number * (1 + 1e-9)
+    k = camera_state(q, fstop=n_open).stop_semi_diameter * n_open
+    return float(k), float(n_open), float(n_open / (1 + STOP_OPENING_TOLERANCE))
+
+
+def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geometry: int = N_ZOOM_GEOMETRY):
+    """The :class:`~physcam.export.blender_focus.FocusTable` of a zoom lens over zoom x focus (module
+    notes): ``film_z`` and ``vertex_z`` hold ``n_geometry`` blocks of ``n_focus`` states (u major),
+    ``radial`` and ``norm`` one block per tabulated position; ``zoom`` the :class:`ZoomGrid`. Its
+    ``fstop_open``/``fstop_min`` are the slowest over the zoom (an f-stop every position reaches) and
+    ``closest_mm`` the farthest closest focus (a mark every position focuses to)."""
+    from ..lens.zoom import prescription_at, tabulated_encoders
+    from ..optics.focusing import closest_focus, focus
+    from ..optics.zoom import efl_at
+    from ..trace.surfaces import surface_table
+    from .blender_focus import FocusTable, _centre_bounds, _centre_norm, _centre_norms, _ellipse_rect
+    from .blender_pupil import iris_levels, radial_pupil_table
+
+    if lens.zoom is None:
+        raise InputError(f"{lens.name!r} is not a zoom lens: use blender_focus.focus_table")
+    if lens.is_anamorphic:
+        raise InputError(f"{lens.name!r} is an anamorphic zoom: the extension's zoom control takes lenses with "
+                         "rotational symmetry")
+    geo_u = np.linspace(0.0, 1.0, n_geometry)
+    pupil_u = np.array(tabulated_encoders(lens), dtype=float)
+    geo_q = [prescription_at(lens, float(u)) for u in geo_u]
+    near = max(closest_focus(q) for q in geo_q) * (1 + 1e-6)
+    step = 1000.0 / near / (n_focus - 1)
+    marks = np.array([math.inf] + [1000.0 / (step * i) for i in range(1, n_focus)])
+    marks[-1] = max(marks[-1], near)
+    rule = np.array([_iris_rule(q) for q in geo_q])  # (n_geometry, 3): K, n_open, n_min
+    pupil_q = [prescription_at(lens, float(u)) for u in pupil_u]
+    pupil_rule = np.array([_iris_rule(q) for q in pupil_q])
+    both = np.concatenate([rule, pupil_rule])
+    levels = iris_levels(float(np.max(both[:, 0] / both[:, 2])), float(np.max(both[:, 0] / both[:, 1])))
+    film_z, vz = [], []
+    for q in geo_q:
+        for mk in marks:
+            st = focus(q, float(mk))
+            film_z.append(st.film_z)
+            vz.append(surface_table(st.prescription, reverse=True, coating="none").vertex_z)
+    radial, norm = [], []
+    for q in pupil_q:
+        for mk in marks:
+            st = focus(q, float(mk))
+            radial.append(radial_pupil_table(st.prescription, st.film_z, levels))
+            norm.append(_centre_norms(st.prescription, st.film_z, [_ellipse_rect(e) for e in radial[-1][:, 0]], levels))
+    if not all(min(v) > 0 for v in norm):
+        from ..errors import OpticsError
+
+        raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some zoom and focus")
+    st0 = focus(geo_q[0], math.inf)
+    b = _centre_bounds(st0.prescription, radial[0][0, 0])
+    loss = _centre_norm(st0.prescription, st0.film_z, b, fresnel=True) / _centre_norm(st0.prescription, st0.film_z, b)
+    grid = ZoomGrid(geo_u, pupil_u, np.array([efl_at(lens, float(u)) for u in np.linspace(0.0, 1.0, N_ZOOM_EFL)]),
+                    rule[:, 0], rule[:, 1], rule[:, 2], levels)
+    table0 = surface_table(st0.prescription, reverse=True, coating="none")
+    n_open, n_min = float(rule[:, 1].max()), float(rule[:, 2].max())
+    return FocusTable(lens, marks, step, np.array(film_z), np.array(vz), np.array(radial), None, None, np.array(norm),
+                      table0, None, float(rule[0, 0]), n_open, n_min, float(near), float(loss), zoom=grid)
+
+
+def zoom_defines(ft, arr32) -> tuple[list[str], list[str]]:
+    """The zoom shader's defines and data lines (``arr32``: blender_focus's float32 array writer)."""
+    from .osl import osl_number
+
+    z = ft.zoom
+    nz, nf, npu = len(z.geometry_u), len(ft.marks_mm), len(z.pupil_u)
+    n_iris = len(z.levels)
+    defines = ["#define PHYSCAM_ZOOM 1", f"#define N_ZG {nz}", f"#define N_ZP {npu}", f"#define N_ZEFL {len(z.efl_u_mm)}",
+               f"#define N_GEO_TAB {nz * nf}", f"#define ZOOM_DEFAULT_MM {osl_number(round(float(z.efl_u_mm[0]), 3))}",
+               f"#define RAD_ZSTRIDE {ft.radial[0].size * nf}", f"#define NORM_ZSTRIDE {nf * n_iris}",
+               # the iris rule's numbers at the zoom position (the shader's locals)
+               "#define IRIS_K zoom_iris_k", "#define FSTOP_OPEN zoom_fstop_open", "#define FSTOP_MIN zoom_fstop_min",
+               "#define SEMI_MAX zoom_semi_max"]
+    data = [arr32("ZOOM_EFL", z.efl_u_mm, "N_ZEFL"), arr32("ZOOM_PU", z.pupil_u, "N_ZP"),
+            arr32("ZOOM_IRIS_K", z.iris_k, "N_ZG"), arr32("ZOOM_FSTOP_OPEN", z.fstop_open, "N_ZG"),
+            arr32("ZOOM_FSTOP_MIN", z.fstop_min, "N_ZG")]
+    return defines, data
