@@ -98,6 +98,8 @@ for sx in (-1, 1):
 p = cam.physcam
 p.lens = sys.argv[5]; p.sensor = "CUSTOM"; p.sensor_width = 36.0; p.sensor_height = 24.0; p.fstop = 8.0
 p.enabled = True
+p.zoom_focal_length = 250.0  # beyond the lens's 72.1-193.9 mm
+bad = p.message
 keys = json.loads(sys.argv[9])
 for frame, (z, d) in enumerate(keys, start=1):
     p.zoom_focal_length = z; p.focus_distance = d
@@ -109,7 +111,7 @@ panel = [mod.on_set_numbers(cam, focus_m=d, zoom_mm=z) for z, d in keys]
 bpy.ops.wm.save_as_mainfile(filepath=sys.argv[2] + "/shot.blend", copy=True)  # the add-on syncs before a save
 from bpy_extras import anim_utils
 lens_fc = anim_utils.action_get_channelbag_for_slot(cam.animation_data.action, cam.animation_data.action_slot).fcurves.find("lens")
-print(json.dumps({"message": p.message, "panel": panel, "builtin_lens": [lens_fc.evaluate(f) for f in range(1, len(keys) + 1)]}))
+print(json.dumps({"bad": bad, "message": p.message, "panel": panel, "builtin_lens": [lens_fc.evaluate(f) for f in range(1, len(keys) + 1)]}))
 '''
 
 FARM = '''
@@ -178,15 +180,15 @@ def test_the_pinhole_agrees_with_a_hand_abcd_trace_at_the_tabulated_positions(pr
 
 def test_the_panel_and_the_builtin_camera_follow_the_zoom(renders, predictions):
     """The panel's pinhole (the table in zoom x 1/distance) and the built-in camera's keyed focal length
-    at each frame: physcam's pinhole at that zoom and focus within 0.3 %."""
+    at each frame: physcam's pinhole at that zoom and focus within 0.3 %. A zoom beyond the lens's
+    range (its paraxial EFL from the hand trace's first to last tabulated position) is refused in one
+    sentence naming the range."""
     built, _ = renders
+    doc = _doc()
+    lo, hi = abcd_position(doc, 0)[0], abcd_position(doc, 2)[0]
+    assert built["bad"] == (f"Canon EF 70-200mm f/2.8 L (US 5,537,259) zooms from {lo:.2f} to {hi:.2f} mm (paraxial EFL "
+                            "at infinity; asked 250 mm). The render keeps the last valid camera.")
     for pred, v, lens in zip(predictions, built["panel"], built["builtin_lens"]):
         assert v["pinhole_mm"] == pytest.approx(pred["pinhole_mm"], rel=3e-3)
         assert lens == pytest.approx(pred["pinhole_mm"], rel=3e-3)
         assert v["pupil_from_film_mm"] == pytest.approx(pred["pupil_mm"], abs=0.5)
-
-
-@pytest.fixture(scope="module")  # TEMP-ITERATION
-def extension_zip():  # TEMP-ITERATION
-    from pathlib import Path  # TEMP-ITERATION
-    return Path("/tmp/r6zoom/small/physcam-0.2.0.zip")  # TEMP-ITERATION

@@ -85,15 +85,19 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
 
     zoom = lens.zoom is not None and not lens.is_anamorphic
     if zoom:
+        import numpy as np
+
         from ..lens.zoom import prescription_at
-        from .blender_zoom import zoom_focus_table
+        from .blender_zoom import N_ZOOM_ROWS, rows_to_geometry, zoom_focus_table
 
         ft = zoom_focus_table(lens)
-        rows = [r for u in ft.zoom.geometry_u for r in _report_rows(prescription_at(lens, float(u)), ft.marks_mm)]
+        rows_u = np.linspace(0.0, 1.0, N_ZOOM_ROWS)
+        rows = [r for u in rows_u for r in _report_rows(prescription_at(lens, float(u)), ft.marks_mm)]
+        pupil = rows_to_geometry([r["pupil_from_film_mm"] for r in rows], len(ft.marks_mm))
     else:
         ft = focus_table(lens)
         rows = _report_rows(lens, ft.marks_mm)
-    pupil = [r["pupil_from_film_mm"] for r in rows]  # the camera object is the entrance pupil
+        pupil = [r["pupil_from_film_mm"] for r in rows]  # the camera object is the entrance pupil
     shaders = {}
     for disp in (False, True):
         for fres in (False, True):
@@ -108,7 +112,7 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
     if zoom:  # rows: one block of focus states per geometry zoom position (u major), as the shader's
         z = ft.zoom
         lo, hi = z.range_mm
-        data["zoom"] = {"geometry_u": z.geometry_u.tolist(), "n_focus": len(ft.marks_mm),
+        data["zoom"] = {"rows_u": rows_u.tolist(), "n_focus": len(ft.marks_mm),
                         "efl_mm": z.efl_u_mm.tolist(), "range_mm": [lo, hi], "default_mm": round(float(z.efl_u_mm[0]), 3),
                         "stated_mm": list(lens.zoom.stated_focal_length or ())}
     return data, shaders

@@ -7,11 +7,13 @@ the library's bisection on the bundled zooms). The lens's state is tabulated on 
 one focus axis (:data:`N_FOCUS_ZOOM` marks uniform in 1/distance, infinity to the closest focus
 every zoom position reaches):
 
-- the geometry (film plane, vertices, entrance pupil, the iris rule's K and f-numbers) at
-  :data:`N_ZOOM_GEOMETRY` positions uniform in u: each is :func:`physcam.lens.zoom.prescription_at`
-  (the gaps on their pchip cams) focused by :func:`physcam.optics.focusing.focus`; the shader blends
-  them bilinearly in (u, 1/distance). Linear in u between 33 nodes follows the pchip cams within
-  0.02 mm on the bundled zooms (0.85 mm between the tabulated positions and their midpoints alone);
+- the geometry (film plane, vertices) at :data:`N_ZOOM_GEOMETRY` positions uniform in u: each is
+  :func:`physcam.lens.zoom.prescription_at` (the gaps on their pchip cams) focused by
+  :func:`physcam.optics.focusing.focus`; the shader blends them bilinearly in (u, 1/distance).
+  Linear in u between 33 nodes follows the pchip cams within 0.02 mm on the bundled zooms (0.85 mm
+  between the tabulated positions and their midpoints alone). The entrance pupil (the camera's
+  origin) and the iris rule's K and f-numbers come from :data:`N_ZOOM_ROWS` of those positions
+  (the report's rows, which the panel reads too), linear in u between them;
 - the pupil sampling tables (:mod:`physcam.export.blender_pupil`, the costly part) and the centre's
   normalisation only at the source's tabulated positions, blended linearly in u (the ellipses grown
   by their centres' and axes' spread between the two positions: a sampling region, not the image).
@@ -30,12 +32,17 @@ import numpy as np
 from ..errors import InputError
 from ..lens.prescription import Prescription
 
-__all__ = ["ZoomGrid", "zoom_focus_table", "zoom_defines", "N_FOCUS_ZOOM", "N_ZOOM_GEOMETRY", "N_ZOOM_EFL"]
+__all__ = ["ZoomGrid", "zoom_focus_table", "zoom_defines", "rows_to_geometry", "N_FOCUS_ZOOM", "N_ZOOM_GEOMETRY",
+           "N_ZOOM_ROWS", "N_ZOOM_EFL"]
 
 #: Focus marks of a zoom lens's tables (fewer than a prime's 32: the pupil tables are per position).
 N_FOCUS_ZOOM = 12
 #: Zoom positions of the geometry, uniform in the encoder u.
 N_ZOOM_GEOMETRY = 33
+#: Zoom positions (uniform in u, every other geometry position) of the report rows (the panel's numbers
+#: and the entrance pupil, the camera's origin) and of the iris rule: slowly varying, and the costly
+#: part of the geometry (paraxial solves in Python); linear in u to the geometry's positions.
+N_ZOOM_ROWS = 17
 #: EFL samples, uniform in u, from which the shader finds u for a focal length.
 N_ZOOM_EFL = 65
 
@@ -93,10 +100,12 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     step = 1000.0 / near / (n_focus - 1)
     marks = np.array([math.inf] + [1000.0 / (step * i) for i in range(1, n_focus)])
     marks[-1] = max(marks[-1], near)
-    rule = np.array([_iris_rule(q) for q in geo_q])  # (n_geometry, 3): K, n_open, n_min
+    rows_u = np.linspace(0.0, 1.0, N_ZOOM_ROWS)
+    rule_rows = np.array([_iris_rule(prescription_at(lens, float(u))) for u in rows_u])  # K, n_open, n_min
+    rule = np.stack([np.interp(geo_u, rows_u, rule_rows[:, c]) for c in range(3)], axis=1)
     pupil_q = [prescription_at(lens, float(u)) for u in pupil_u]
     pupil_rule = np.array([_iris_rule(q) for q in pupil_q])
-    both = np.concatenate([rule, pupil_rule])
+    both = np.concatenate([rule_rows, pupil_rule])
     levels = iris_levels(float(np.max(both[:, 0] / both[:, 2])), float(np.max(both[:, 0] / both[:, 1])))
     film_z, vz = [], []
     for q in geo_q:
@@ -120,9 +129,17 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     grid = ZoomGrid(geo_u, pupil_u, np.array([efl_at(lens, float(u)) for u in np.linspace(0.0, 1.0, N_ZOOM_EFL)]),
                     rule[:, 0], rule[:, 1], rule[:, 2], levels)
     table0 = surface_table(st0.prescription, reverse=True, coating="none")
-    n_open, n_min = float(rule[:, 1].max()), float(rule[:, 2].max())
+    n_open, n_min = float(rule_rows[:, 1].max()), float(rule_rows[:, 2].max())
     return FocusTable(lens, marks, step, np.array(film_z), np.array(vz), np.array(radial), None, None, np.array(norm),
                       table0, None, float(rule[0, 0]), n_open, n_min, float(near), float(loss), zoom=grid)
+
+
+def rows_to_geometry(values, n_focus: int) -> np.ndarray:
+    """Per-row values (:data:`N_ZOOM_ROWS` zoom positions x ``n_focus``, u major) at the geometry's
+    :data:`N_ZOOM_GEOMETRY` positions: linear in u, per focus mark."""
+    a = np.asarray(values, dtype=float).reshape(N_ZOOM_ROWS, n_focus)
+    rows_u, geo_u = np.linspace(0.0, 1.0, N_ZOOM_ROWS), np.linspace(0.0, 1.0, N_ZOOM_GEOMETRY)
+    return np.stack([np.interp(geo_u, rows_u, a[:, k]) for k in range(n_focus)], axis=1).ravel()
 
 
 def zoom_defines(ft, arr32) -> tuple[list[str], list[str]]:
