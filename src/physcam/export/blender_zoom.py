@@ -84,8 +84,8 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     from ..lens.zoom import prescription_at, tabulated_encoders
     from ..optics.focusing import closest_focus, focus
     from ..optics.zoom import efl_at
-    from ..trace.surfaces import surface_table
-    from .blender_focus import FocusTable, _centre_bounds, _centre_norm, _centre_norms, _ellipse_rect
+    from ..trace.camera_tracer import CameraTracer
+    from .blender_focus import FocusTable, _centre_bounds, _centre_norms, _ellipse_rect
     from .blender_pupil import iris_levels, radial_pupil_table
 
     if lens.zoom is None:
@@ -112,23 +112,25 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
         for mk in marks:
             st = focus(q, float(mk))
             film_z.append(st.film_z)
-            vz.append(surface_table(st.prescription, reverse=True, coating="none").vertex_z)
+            vz.append(CameraTracer(st.prescription, st.film_z).film_side_table.vertex_z)
     radial, norm = [], []
     for q in pupil_q:
         for mk in marks:
             st = focus(q, float(mk))
-            radial.append(radial_pupil_table(st.prescription, st.film_z, levels))
-            norm.append(_centre_norms(st.prescription, st.film_z, [_ellipse_rect(e) for e in radial[-1][:, 0]], levels))
+            tracer = CameraTracer(st.prescription, st.film_z)  # the lens at this zoom and focus as the file stops it
+            radial.append(radial_pupil_table(tracer.lens, st.film_z, levels))
+            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in radial[-1][:, 0]], levels))
     if not all(min(v) > 0 for v in norm):
         from ..errors import OpticsError
 
         raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some zoom and focus")
     st0 = focus(geo_q[0], math.inf)
-    b = _centre_bounds(st0.prescription, radial[0][0, 0])
-    loss = _centre_norm(st0.prescription, st0.film_z, b, fresnel=True) / _centre_norm(st0.prescription, st0.film_z, b)
+    tracer0 = CameraTracer(st0.prescription, st0.film_z)
+    b = _centre_bounds(tracer0.lens, radial[0][0, 0])
+    loss = tracer0.centre_weight(b, samples=64, fresnel=True) / tracer0.centre_weight(b, samples=64)
     grid = ZoomGrid(geo_u, pupil_u, np.array([efl_at(lens, float(u)) for u in np.linspace(0.0, 1.0, N_ZOOM_EFL)]),
                     rule[:, 0], rule[:, 1], rule[:, 2], levels)
-    table0 = surface_table(st0.prescription, reverse=True, coating="none")
+    table0 = tracer0.film_side_table
     n_open, n_min = float(rule_rows[:, 1].max()), float(rule_rows[:, 2].max())
     return FocusTable(lens, marks, step, np.array(film_z), np.array(vz), np.array(radial), None, None, np.array(norm),
                       table0, None, float(rule[0, 0]), n_open, n_min, float(near), float(loss), zoom=grid)
