@@ -226,6 +226,23 @@ def ghost_rows(ft: FocusTable) -> tuple[list[int], list[int]]:
     return [n - 1 - j for _, j in pairs], [n - 1 - i for i, _ in pairs]
 
 
+def _zoom_defines(ft: FocusTable) -> tuple[list[str], list[str]]:
+    """A zoom lens's shader defines and data lines (``ft.zoom``: :class:`physcam.export.blender_zoom.ZoomGrid`)."""
+    z = ft.zoom
+    nz, nf, npu = len(z.geometry_u), len(ft.marks_mm), len(z.pupil_u)
+    n_iris = len(z.levels)
+    defines = ["#define PHYSCAM_ZOOM 1", f"#define N_ZG {nz}", f"#define N_ZP {npu}", f"#define N_ZEFL {len(z.efl_u_mm)}",
+               f"#define N_GEO_TAB {nz * nf}", f"#define ZOOM_DEFAULT_MM {osl_number(round(float(z.efl_u_mm[0]), 3))}",
+               f"#define RAD_ZSTRIDE {ft.radial[0].size * nf}", f"#define NORM_ZSTRIDE {nf * n_iris}",
+               # the iris rule's numbers at the zoom position (the shader's locals)
+               "#define IRIS_K zoom_iris_k", "#define FSTOP_OPEN zoom_fstop_open", "#define FSTOP_MIN zoom_fstop_min",
+               "#define SEMI_MAX zoom_semi_max"]
+    data = [_arr32("ZOOM_EFL", z.efl_u_mm, "N_ZEFL"), _arr32("ZOOM_PU", z.pupil_u, "N_ZP"),
+            _arr32("ZOOM_IRIS_K", z.iris_k, "N_ZG"), _arr32("ZOOM_FSTOP_OPEN", z.fstop_open, "N_ZG"),
+            _arr32("ZOOM_FSTOP_MIN", z.fstop_min, "N_ZG")]
+    return defines, data
+
+
 def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: bool = False, focus_m: float = 3.0,
                        fstop: float = 0.0, sensor_mm=(DEFAULT_SENSOR_WIDTH_MM, DEFAULT_SENSOR_HEIGHT_MM),
                        pupil_mm=None) -> str:
@@ -253,9 +270,7 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
                 f"#define SENSOR_H_DEFAULT {osl_number(sensor_mm[1])}",
                 f"#define ASPECT_DEFAULT {osl_number(sensor_mm[0] / sensor_mm[1])}"]
     if zoom:
-        from .blender_zoom import zoom_defines
-
-        zd, zdata = zoom_defines(ft, _arr32)
+        zd, zdata = _zoom_defines(ft)
         defines += zd
         data += zdata
     if ft.radial is not None:

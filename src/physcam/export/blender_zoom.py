@@ -30,9 +30,9 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from ..lens.prescription import Prescription
+from ..lens.prescription import Prescription, takes_prescription
 
-__all__ = ["ZoomGrid", "zoom_focus_table", "zoom_defines", "rows_to_geometry", "N_FOCUS_ZOOM", "N_ZOOM_GEOMETRY",
+__all__ = ["ZoomGrid", "zoom_focus_table", "rows_to_geometry", "N_FOCUS_ZOOM", "N_ZOOM_GEOMETRY",
            "N_ZOOM_ROWS", "N_ZOOM_EFL"]
 
 #: Focus marks of a zoom lens's tables (fewer than a prime's 32: the pupil tables are per position).
@@ -75,6 +75,7 @@ def _iris_rule(q: Prescription) -> tuple[float, float, float]:
     return float(k), float(n_open), float(n_open / (1 + STOP_OPENING_TOLERANCE))
 
 
+@takes_prescription
 def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geometry: int = N_ZOOM_GEOMETRY):
     """The :class:`~physcam.export.blender_focus.FocusTable` of a zoom lens over zoom x focus (module
     notes): ``film_z`` and ``vertex_z`` hold ``n_geometry`` blocks of ``n_focus`` states (u major),
@@ -142,22 +143,3 @@ def rows_to_geometry(values, n_focus: int) -> np.ndarray:
     a = np.asarray(values, dtype=float).reshape(N_ZOOM_ROWS, n_focus)
     rows_u, geo_u = np.linspace(0.0, 1.0, N_ZOOM_ROWS), np.linspace(0.0, 1.0, N_ZOOM_GEOMETRY)
     return np.stack([np.interp(geo_u, rows_u, a[:, k]) for k in range(n_focus)], axis=1).ravel()
-
-
-def zoom_defines(ft, arr32) -> tuple[list[str], list[str]]:
-    """The zoom shader's defines and data lines (``arr32``: blender_focus's float32 array writer)."""
-    from .osl import osl_number
-
-    z = ft.zoom
-    nz, nf, npu = len(z.geometry_u), len(ft.marks_mm), len(z.pupil_u)
-    n_iris = len(z.levels)
-    defines = ["#define PHYSCAM_ZOOM 1", f"#define N_ZG {nz}", f"#define N_ZP {npu}", f"#define N_ZEFL {len(z.efl_u_mm)}",
-               f"#define N_GEO_TAB {nz * nf}", f"#define ZOOM_DEFAULT_MM {osl_number(round(float(z.efl_u_mm[0]), 3))}",
-               f"#define RAD_ZSTRIDE {ft.radial[0].size * nf}", f"#define NORM_ZSTRIDE {nf * n_iris}",
-               # the iris rule's numbers at the zoom position (the shader's locals)
-               "#define IRIS_K zoom_iris_k", "#define FSTOP_OPEN zoom_fstop_open", "#define FSTOP_MIN zoom_fstop_min",
-               "#define SEMI_MAX zoom_semi_max"]
-    data = [arr32("ZOOM_EFL", z.efl_u_mm, "N_ZEFL"), arr32("ZOOM_PU", z.pupil_u, "N_ZP"),
-            arr32("ZOOM_IRIS_K", z.iris_k, "N_ZG"), arr32("ZOOM_FSTOP_OPEN", z.fstop_open, "N_ZG"),
-            arr32("ZOOM_FSTOP_MIN", z.fstop_min, "N_ZG")]
-    return defines, data
