@@ -113,8 +113,8 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
         z = ft.zoom
         lo, hi = z.range_mm
         data["zoom"] = {"rows_u": rows_u.tolist(), "n_focus": len(ft.marks_mm),
-                        "efl_mm": z.efl_u_mm.tolist(), "range_mm": [lo, hi], "default_mm": round(float(z.efl_u_mm[0]), 3),
-                        "stated_mm": list(lens.zoom.stated_focal_length or ())}
+                        "efl_mm": z.efl_u_mm.tolist(), "range_mm": [lo, hi],
+                        "default_mm": float(z.efl_u_mm[0])}  # the first position: inside the range, exactly
     return data, shaders
 
 

@@ -232,7 +232,7 @@ def _zoom_defines(ft: FocusTable) -> tuple[list[str], list[str]]:
     nz, nf, npu = len(z.geometry_u), len(ft.marks_mm), len(z.pupil_u)
     n_iris = len(z.levels)
     defines = ["#define PHYSCAM_ZOOM 1", f"#define N_ZG {nz}", f"#define N_ZP {npu}", f"#define N_ZEFL {len(z.efl_u_mm)}",
-               f"#define N_GEO_TAB {nz * nf}", f"#define ZOOM_DEFAULT_MM {osl_number(round(float(z.efl_u_mm[0]), 3))}",
+               f"#define N_GEO_TAB {nz * nf}", f"#define ZOOM_DEFAULT_MM {_num32(z.efl_u_mm[0])}",
                f"#define RAD_ZSTRIDE {ft.radial[0].size * nf}", f"#define NORM_ZSTRIDE {nf * n_iris}",
                # the iris rule's numbers at the zoom position (the shader's locals)
                "#define IRIS_K zoom_iris_k", "#define FSTOP_OPEN zoom_fstop_open", "#define FSTOP_MIN zoom_fstop_min",
@@ -262,7 +262,7 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
     defines += ["#define PHYSCAM_FOCUS_TABLE 1", "#define PHYSCAM_APERTURE 1", "#define PHYSCAM_POLYGON 1",
                 f"#define N_FOCUS {n_focus}", f"#define N_VZ_TAB {n_states * n}", f"#define N_IRIS {N_LEVEL}",
                 f"#define N_NORM_TAB {ft.norm.size}", f"#define FOCUS_INV_STEP {_num32(ft.inv_step_per_m)}"]
-    if not zoom:  # a zoom lens's iris rule changes along the zoom: blender_zoom.zoom_defines
+    if not zoom:  # a zoom lens's iris rule changes along the zoom: _zoom_defines
         defines += [f"#define IRIS_K {_num32(ft.iris_k)}", f"#define FSTOP_OPEN {_num32(ft.fstop_open)}",
                     f"#define FSTOP_MIN {_num32(ft.fstop_min)}", f"#define SEMI_MAX {_num32(ft.semi_max)}"]
     defines += [f"#define FOCUS_DEFAULT_M {osl_number(focus_m)}",
