@@ -83,9 +83,21 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
     require_type("slug", slug, str, "the lens's name in the zip, e.g. 'dgauss_50mm'")
     from .blender_focus import focus_table, focus_table_shader
 
-    ft = focus_table(lens)
-    rows = _report_rows(lens, ft.marks_mm)
-    pupil = [r["pupil_from_film_mm"] for r in rows]  # the camera object is the entrance pupil
+    zoom = lens.zoom is not None and not lens.is_anamorphic
+    if zoom:
+        import numpy as np
+
+        from ..lens.zoom import prescription_at
+        from .blender_zoom import N_ZOOM_ROWS, rows_to_geometry, zoom_focus_table
+
+        ft = zoom_focus_table(lens)
+        rows_u = np.linspace(0.0, 1.0, N_ZOOM_ROWS)
+        rows = [r for u in rows_u for r in _report_rows(prescription_at(lens, float(u)), ft.marks_mm)]
+        pupil = rows_to_geometry([r["pupil_from_film_mm"] for r in rows], len(ft.marks_mm))
+    else:
+        ft = focus_table(lens)
+        rows = _report_rows(lens, ft.marks_mm)
+        pupil = [r["pupil_from_film_mm"] for r in rows]  # the camera object is the entrance pupil
     shaders = {}
     for disp in (False, True):
         for fres in (False, True):
@@ -95,8 +107,14 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
             "fstop_open": ft.fstop_open, "fstop_max": MAX_F_NUMBER,
             "inv_step_per_m": ft.inv_step_per_m, "anamorphic": bool(lens.is_anamorphic),
             "report_fstop": REFERENCE_FSTOP, "report_sensor_mm": list(REPORT_SENSOR_MM),
-            "focus_object": _focus_object_fits(rows),
+            "focus_object": _focus_object_fits(rows[:len(ft.marks_mm)]),
             "rows": rows}
+    if zoom:  # rows: one block of focus states per geometry zoom position (u major), as the shader's
+        z = ft.zoom
+        lo, hi = z.range_mm
+        data["zoom"] = {"rows_u": rows_u.tolist(), "n_focus": len(ft.marks_mm),
+                        "efl_mm": z.efl_u_mm.tolist(), "range_mm": [lo, hi],
+                        "default_mm": float(z.efl_u_mm[0])}  # the first position: inside the range, exactly
     return data, shaders
 
 

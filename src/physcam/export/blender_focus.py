@@ -69,6 +69,9 @@ class FocusTable:
     fresnel_loss: float  # Fresnel transmission at the film centre at infinity (uncoated)
     #: the shader's data lines already written, by name and values (the four shaders of a lens share them)
     osl_lines: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
+    #: a zoom lens's zoom axis (:class:`physcam.export.blender_zoom.ZoomGrid`): the arrays above then
+    #: hold zoom x focus blocks (:func:`physcam.export.blender_zoom.zoom_focus_table`); None: a lens without zoom
+    zoom: object = None
 
     @property
     def semi_max(self) -> float:
@@ -80,6 +83,8 @@ class FocusTable:
         """The iris radii (mm) of the pupil and normalisation tables (:func:`~physcam.export.blender_pupil.iris_levels`)."""
         from .blender_pupil import iris_levels
 
+        if self.zoom is not None:
+            return self.zoom.levels
         return iris_levels(self.semi_max, self.iris_k / self.fstop_open)
 
 
@@ -221,6 +226,23 @@ def ghost_rows(ft: FocusTable) -> tuple[list[int], list[int]]:
     return [n - 1 - j for _, j in pairs], [n - 1 - i for i, _ in pairs]
 
 
+def _zoom_defines(ft: FocusTable) -> tuple[list[str], list[str]]:
+    """A zoom lens's shader defines and data lines (``ft.zoom``: :class:`physcam.export.blender_zoom.ZoomGrid`)."""
+    z = ft.zoom
+    nz, nf, npu = len(z.geometry_u), len(ft.marks_mm), len(z.pupil_u)
+    n_iris = len(z.levels)
+    defines = ["#define PHYSCAM_ZOOM 1", f"#define N_ZG {nz}", f"#define N_ZP {npu}", f"#define N_ZEFL {len(z.efl_u_mm)}",
+               f"#define N_GEO_TAB {nz * nf}", f"#define ZOOM_DEFAULT_MM {_num32(z.efl_u_mm[0])}",
+               f"#define RAD_ZSTRIDE {ft.radial[0].size * nf}", f"#define NORM_ZSTRIDE {nf * n_iris}",
+               # the iris rule's numbers at the zoom position (the shader's locals)
+               "#define IRIS_K zoom_iris_k", "#define FSTOP_OPEN zoom_fstop_open", "#define FSTOP_MIN zoom_fstop_min",
+               "#define SEMI_MAX zoom_semi_max"]
+    data = [_arr32("ZOOM_EFL", z.efl_u_mm, "N_ZEFL"), _arr32("ZOOM_PU", z.pupil_u, "N_ZP"),
+            _arr32("ZOOM_IRIS_K", z.iris_k, "N_ZG"), _arr32("ZOOM_FSTOP_OPEN", z.fstop_open, "N_ZG"),
+            _arr32("ZOOM_FSTOP_MIN", z.fstop_min, "N_ZG")]
+    return defines, data
+
+
 def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: bool = False, focus_m: float = 3.0,
                        fstop: float = 0.0, sensor_mm=(DEFAULT_SENSOR_WIDTH_MM, DEFAULT_SENSOR_HEIGHT_MM),
                        pupil_mm=None) -> str:
@@ -235,15 +257,22 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
     n = len(ft.table)
     defines, data = lens_data(ft.table, None, ft.lens.wavelength_nm, ft.bounds, dispersion=dispersion,
                               fresnel=fresnel)
+    zoom = ft.zoom is not None
+    n_states = len(ft.film_z)  # n_focus, or (zoom positions x n_focus) for a zoom lens
     defines += ["#define PHYSCAM_FOCUS_TABLE 1", "#define PHYSCAM_APERTURE 1", "#define PHYSCAM_POLYGON 1",
-                f"#define N_FOCUS {n_focus}", f"#define N_VZ_TAB {n_focus * n}", f"#define N_IRIS {N_LEVEL}",
-                f"#define N_NORM_TAB {n_focus * N_LEVEL}",
-                f"#define FOCUS_INV_STEP {_num32(ft.inv_step_per_m)}", f"#define IRIS_K {_num32(ft.iris_k)}",
-                f"#define FSTOP_OPEN {_num32(ft.fstop_open)}", f"#define FSTOP_MIN {_num32(ft.fstop_min)}",
-                f"#define SEMI_MAX {_num32(ft.semi_max)}", f"#define FOCUS_DEFAULT_M {osl_number(focus_m)}",
+                f"#define N_FOCUS {n_focus}", f"#define N_VZ_TAB {n_states * n}", f"#define N_IRIS {N_LEVEL}",
+                f"#define N_NORM_TAB {ft.norm.size}", f"#define FOCUS_INV_STEP {_num32(ft.inv_step_per_m)}"]
+    if not zoom:  # a zoom lens's iris rule changes along the zoom: _zoom_defines
+        defines += [f"#define IRIS_K {_num32(ft.iris_k)}", f"#define FSTOP_OPEN {_num32(ft.fstop_open)}",
+                    f"#define FSTOP_MIN {_num32(ft.fstop_min)}", f"#define SEMI_MAX {_num32(ft.semi_max)}"]
+    defines += [f"#define FOCUS_DEFAULT_M {osl_number(focus_m)}",
                 f"#define FSTOP_DEFAULT {osl_number(fstop)}", f"#define SENSOR_W_DEFAULT {osl_number(sensor_mm[0])}",
                 f"#define SENSOR_H_DEFAULT {osl_number(sensor_mm[1])}",
                 f"#define ASPECT_DEFAULT {osl_number(sensor_mm[0] / sensor_mm[1])}"]
+    if zoom:
+        zd, zdata = _zoom_defines(ft)
+        defines += zd
+        data += zdata
     if ft.radial is not None:
         defines += ["#define PHYSCAM_RADIAL_PUPIL 1", f"#define N_RAD {N_RADIAL}",
                     f"#define N_RAD_TAB {ft.radial.size}", f"#define RAD_MAX {osl_number(RADIAL_MAX_MM)}",
@@ -268,13 +297,15 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
                     f"#define FRESNEL_LOSS {_num32(ft.fresnel_loss)}"] + ([] if fresnel else ["#define PHYSCAM_SP 1"])
         data += [osl_array("GHOST_A", ga, "N_GHOST", "int"), osl_array("GHOST_B", gb, "N_GHOST", "int")]
     if pupil_mm is not None:
-        if len(pupil_mm) != n_focus:
-            raise InputError(f"pupil_mm needs one distance per focus state ({n_focus}), got {len(pupil_mm)}")
+        if len(pupil_mm) != n_states:
+            raise InputError(f"pupil_mm needs one distance per focus state ({n_states}), got {len(pupil_mm)}")
         defines.append("#define PHYSCAM_PUPIL_ORIGIN 1")
-        data.append(_arr32("PUPIL_TAB", pupil_mm, "N_FOCUS"))
-    data += [_arr32("FILM_Z_TAB", ft.film_z, "N_FOCUS"), _arr32("NORM_TAB", norm, "N_NORM_TAB"),
+        data.append(_arr32("PUPIL_TAB", pupil_mm, "N_GEO_TAB" if zoom else "N_FOCUS"))
+    data += [_arr32("FILM_Z_TAB", ft.film_z, "N_GEO_TAB" if zoom else "N_FOCUS"), _arr32("NORM_TAB", norm, "N_NORM_TAB"),
              _arr32("VZ_TAB", ft.vertex_z, "N_VZ_TAB"), osl_array("SEMI_OPEN", ft.table.semi_diameter, "N_SURF"),
              _arr32("IRIS_LEVEL", ft.levels, "N_IRIS")]
+    zoom_note = (f" at each of {len(ft.zoom.geometry_u)} zoom positions (pupil tables at {len(ft.zoom.pupil_u)})"
+                 if zoom else "")
     head = [f"// {osl_comment(ft.lens.name)}: {n_focus} focus states from infinity to {ft.closest_mm / 1000:.3g} m "
-            f"(uniform in 1/distance); dispersion {'on' if dispersion else 'off'}, Fresnel {'on' if fresnel else 'off'}."]
+            f"(uniform in 1/distance){zoom_note}; dispersion {'on' if dispersion else 'off'}, Fresnel {'on' if fresnel else 'off'}."]
     return render_template(head + defines, data)

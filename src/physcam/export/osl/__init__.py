@@ -21,7 +21,7 @@ __all__ = ["FEATURES", "template_text", "render_template", "lens_data", "osl_num
 
 #: The template's feature switches: a data block that defines one keeps that code, else it goes.
 FEATURES = ("PHYSCAM_FOCUS_TABLE", "HAS_ASPHERE", "PHYSCAM_DISPERSION", "PHYSCAM_FRESNEL", "PHYSCAM_APERTURE",
-            "PHYSCAM_POLYGON", "PHYSCAM_GHOSTS", "PHYSCAM_PUPIL_ORIGIN", "PHYSCAM_RADIAL_PUPIL", "PHYSCAM_SP")
+            "PHYSCAM_POLYGON", "PHYSCAM_GHOSTS", "PHYSCAM_PUPIL_ORIGIN", "PHYSCAM_RADIAL_PUPIL", "PHYSCAM_SP", "PHYSCAM_ZOOM")
 #: Wavelengths sampled per ray when dispersion is on (uniform).
 WAVELENGTH_RANGE_NM = (400.0, 700.0)
 
