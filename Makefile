@@ -17,16 +17,20 @@ BLENDER_PY    := $(BLENDER_VENV)/bin/python
 BLENDER_STAMP := $(BLENDER_VENV)/.physcam-installed
 BPY_VERSION   ?= 5.0.1
 
-.PHONY: demo test venv blender blender-extension bench clean schema chromium shell test-latest wheel usd-min lint
+.PHONY: demo test venv blender blender-extension bench clean schema chromium shell test-latest latest-venv latest-run wheel usd-min lint
 
+# Installs go through uv (https://docs.astral.sh/uv/, installed into .venv by pip first): it resolves
+# the same versions as pip (constraints.txt) and installs them 2-3x faster, which the 15-minute CI
+# budget needs (docs/performance.md, "make test"). A user's own `pip install physcam` is unaffected.
+UV := $(VENV)/bin/uv
 $(PY):
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet --disable-pip-version-check -c constraints.txt uv
 
 # The test environment gets the exact versions of constraints.txt (reproducible CI); the library's own
 # dependencies are ranges (pyproject.toml), so a studio can install physcam into its environment.
 $(STAMP): $(PY) pyproject.toml constraints.txt
-	$(PY) -m pip install --quiet -c constraints.txt -e '.[test]'
+	$(UV) pip install --quiet --python $(PY) -c constraints.txt -e '.[test]'
 	touch $(STAMP)
 
 venv: $(STAMP)
@@ -45,15 +49,22 @@ shell: $(STAMP)
 	@VIRTUAL_ENV="$(abspath $(VENV))" PATH="$(abspath $(VENV))/bin:$$PATH" $${SHELL:-/bin/sh}
 
 # Where bpy cannot be installed (another Python, another platform) the Blender tests skip and
-# pytest's summary says why; the rest of the suite runs.
-$(BLENDER_STAMP): pyproject.toml
+# pytest's summary says why; the rest of the suite runs. bpy (a 300 MB download) is fetched on its
+# own (BLENDER_BPY), so `make test` can fetch it while .venv installs; physcam's editable install
+# follows .venv's (two editable builds of one source tree must not run at once).
+BLENDER_BPY := $(BLENDER_VENV)/.bpy-installed
+$(BLENDER_BPY): | $(PY)
 	@( $(PYTHON) -m venv $(BLENDER_VENV) \
-	  && $(BLENDER_PY) -m pip install --quiet --upgrade pip \
-	  && $(BLENDER_PY) -m pip install --quiet "bpy==$(BPY_VERSION)" \
-	  && $(BLENDER_PY) -m pip install --quiet -e '.[fast]' \
-	  && touch $(BLENDER_STAMP) ) \
+	  && $(UV) pip install --quiet --python $(BLENDER_PY) "bpy==$(BPY_VERSION)" \
+	  && touch $(BLENDER_BPY) ) \
 	|| ( echo "physcam: Blender (bpy==$(BPY_VERSION)) could not be installed here; the Blender tests will be skipped" >&2; \
 	     rm -rf $(BLENDER_VENV) )
+
+$(BLENDER_STAMP): pyproject.toml $(STAMP) | $(BLENDER_BPY)
+	@if [ -f $(BLENDER_BPY) ]; then \
+	  $(UV) pip install --quiet --python $(BLENDER_PY) -e '.[fast]' && touch $(BLENDER_STAMP) \
+	  || { echo "physcam: physcam could not be installed beside Blender; the Blender tests will be skipped" >&2; \
+	       rm -rf $(BLENDER_VENV); }; fi
 
 # the physcam Blender extension zip (docs/blender.md)
 blender-extension: $(STAMP)
@@ -74,10 +85,14 @@ chromium:
 	  || echo "physcam: chromium could not be installed; the browser tests will be skipped" >&2; \
 	fi
 
-test: $(STAMP) $(BLENDER_STAMP) chromium lint
+# The installs are mostly downloads and unpacking: they run side by side (.venv, bpy, chromium, the
+# newest-versions environment), then the suite.
+test:
+	$(MAKE) --no-print-directory -j4 $(STAMP) $(BLENDER_BPY) chromium latest-venv
+	$(MAKE) --no-print-directory $(BLENDER_STAMP) lint
 	PHYSCAM_BLENDER_PYTHON=$(abspath $(BLENDER_PY)) $(PY) -m pytest -n 2 --dist worksteal -q
 	$(MAKE) --no-print-directory usd-min
-	$(MAKE) --no-print-directory test-latest
+	$(MAKE) --no-print-directory latest-run
 
 # The oldest usd-core physcam supports, the `usd` extra's lower bound in pyproject.toml (the two must
 # agree: tests/usd/test_usd_minimum.py). Older ones fail: 24.8 to 25.2 lack UsdGeomCamera's exposure
@@ -90,24 +105,32 @@ USD_MIN     ?= 25.8
 USD_MIN_DIR ?= $(VENV)/usd-min-$(USD_MIN)
 usd-min: $(STAMP)
 	@test -f $(USD_MIN_DIR)/.installed || ( rm -rf $(USD_MIN_DIR) \
-	  && $(PY) -m pip install --quiet --no-deps --target $(USD_MIN_DIR) "usd-core==$(USD_MIN)" \
+	  && $(UV) pip install --quiet --python $(PY) --no-deps --target $(USD_MIN_DIR) "usd-core==$(USD_MIN)" \
 	  && touch $(USD_MIN_DIR)/.installed )
 	PYTHONPATH="$(abspath $(USD_MIN_DIR)):$(abspath src)" PHYSCAM_USD_MIN=$(USD_MIN) \
 	  PHYSCAM_USD_MIN_DIR="$(abspath $(USD_MIN_DIR))" $(PY) -m pytest -q -p no:cacheprovider tests/usd \
 	  --deselect tests/usd/test_schema.py::test_generated_plugin_is_current
 
-# The newest versions the ranges allow, not constraints.txt: a fresh environment each run (pip's
+# The newest versions the ranges allow, not constraints.txt: a fresh environment each run (uv's
 # cache makes it quick), the core and extras' tests that need no Blender, browser or renderer.
+# `make test` builds it (latest-venv) beside its other installs and runs it (latest-run) at the end.
 LATEST_VENV ?= .venv-latest
+LATEST_PY   := $(LATEST_VENV)/bin/python
 test-latest:
+	$(MAKE) --no-print-directory latest-venv
+	$(MAKE) --no-print-directory latest-run
+
+# after .venv's install: two editable builds of one source tree must not run at once
+latest-venv: | $(STAMP)
 	rm -rf $(LATEST_VENV)
 	$(PYTHON) -m venv $(LATEST_VENV)
-	$(LATEST_VENV)/bin/python -m pip install --quiet --upgrade pip
-	$(LATEST_VENV)/bin/python -m pip install --quiet --upgrade -e '.[all]' pytest pytest-xdist hypothesis opencv-python-headless
-	@$(LATEST_VENV)/bin/python -m pip list --format=freeze 2>/dev/null \
+	$(UV) pip install --quiet --python $(LATEST_PY) --upgrade -e '.[all]' pytest pytest-xdist hypothesis opencv-python-headless
+
+latest-run:
+	@$(UV) pip list --python $(LATEST_PY) --format=freeze 2>/dev/null \
 	  | grep -i -E '^(numpy|numba|matplotlib|usd-core|openexr|jsonschema|cbor2|dask|pyarrow|starlette|uvicorn|openjd-model|opencue.pyoutline)=' \
 	  | tr '\n' ' ' | sed 's/^/physcam: newest versions tested: /'; echo
-	$(LATEST_VENV)/bin/python -m pytest -n 2 -q -m "not slow" -p no:cacheprovider tests/onset tests/optics \
+	$(LATEST_PY) -m pytest -n 2 -q -m "not slow" -p no:cacheprovider tests/onset tests/optics \
 	  tests/lens tests/usd tests/live tests/trace/test_tracer.py tests/analysis/image_quality/test_image_quality_closed_forms.py \
 	  tests/farm/test_farm_jobs.py
 

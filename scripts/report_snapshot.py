@@ -5,8 +5,9 @@ rebuilt house can be compared with it number by number (tests/onset/test_house_s
     python scripts/report_snapshot.py           # rewrite the snapshot (the tree's own code)
     python scripts/report_snapshot.py --check   # compare the tree's reports with the snapshot
 
-Each lens is keyed by the SHA-256 of its file, so a lens whose data changed later (another issue's
-correction) is skipped, not reported as a regression. Cases: wide open at 2 m, f/4 at infinity, f/5.6
+Each lens is keyed by the SHA-256 of its file's data less its [provenance] table, so a lens whose data
+changed later (another issue's correction) is skipped, not reported as a regression, while a lens whose
+provenance record alone grew (a check, a maker's figure quoted) is still compared. Cases: wide open at 2 m, f/4 at infinity, f/5.6
 at the hyperfocal mark, and f/4 at 3 m with a measured near limit of 2.5 m (the f-stop solved).
 """
 
@@ -35,7 +36,13 @@ def lens_files():
 
 
 def digest(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
+    """SHA-256 of the lens file's TOML data without its ``[provenance]`` table (canonical JSON): what a
+    report can depend on. Provenance lines (sources, checks, quoted maker figures) change no report."""
+    import tomllib
+
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    data.pop("provenance", None)
+    return hashlib.sha256(json.dumps(data, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
 
 
 def report_dict(lens, case: dict) -> dict:

@@ -37,7 +37,11 @@ MAKER_CLOSE_FOCUS = {
         ("https://webnews.it/rilasciato-il-sigma-28mm-f-1-4-dg-hsm-art",
          "La distanza minima di messa a fuoco è invece di 28cm", "cm"),
     ],
+    "sony_zeiss_55mm_f1_8_za": [("https://xov.jp/e/1463/", "SEL55F18Zの最短撮影距離は50cm。", "cm")],
 }
+#: Where a Japanese specification's 最短撮影距離 is counted from: "the former [最短撮影距離] is the distance from
+#: the image plane to the subject" (a blog explaining the term, read 2026-11-28).
+SAITAN_FROM_IMAGE_PLANE = ("https://siam-breeze.hatenadiary.org/entry/20091129/1259465139", "前者は結像面から被写体までの距離")
 #: Sigma says where its minimum focusing distance is measured from (sigmaphoto.com's FAQ, read 2026-11-28).
 SIGMA_FAQ = ("https://www.sigmaphoto.com/faq/you-use-the-term-minimum-focusing-distance-on-all-your-lens-specifications-"
              "what-does-this-mean", "This is the distance from the film plane/image sensor to the subject.")
@@ -69,6 +73,12 @@ def test_sigma_counts_its_minimum_focusing_distance_from_the_film_plane():
     line = next(x for x in provenance_of(load_lens("sigma_28mm_f1_4_art")).maker_data if x.startswith("close focus"))
     assert url in line and "from the film plane/image sensor to the subject" in text
     assert "film plane/image sensor to the subject" in line
+
+
+def test_the_sony_mod_is_counted_from_the_image_plane_as_the_japanese_term_is():
+    url, text = SAITAN_FROM_IMAGE_PLANE
+    line = next(x for x in provenance_of(load_lens("sony_zeiss_55mm_f1_8_za")).maker_data if x.startswith("close focus 0"))
+    assert url in line and text in line and "from the film plane" in line
 
 
 def _with_mod():
@@ -243,3 +253,108 @@ def test_the_same_tables_unspoiled_focus_by_their_gaps(slug):
     state = focusing.focus(p, focusing.closest_focus(p))
     assert abs(state.back_focus_mm - state.back_focus_infinity_mm) < 0.25  # internal focusing: the back focus stays
     assert not [f for f in check(slug) if f.code.startswith("focus_")]
+
+
+# ---- the maker's construction against the file's (issue 44: is the example the product?) -------------
+#: slug -> (url, the text quoted exactly) of pages printing the product's construction (read 2026-11-28;
+#: reviews repeating the maker's figures, the makers' own pages not reached). Each number the test expects
+#: is parsed from the quoted text.
+MAKER_CONSTRUCTION = {
+    "canon_rf_50mm_f1_2": [
+        ("https://www.photoreview.com.au/reviews/mirrorless-lenses/mirrorless-lenses-full-frame/canon-rf-50mm-f-1-2-l-usm-lens/",
+         "comprising 15 elements in nine groups"),
+        ("https://www.photoreview.com.au/reviews/mirrorless-lenses/mirrorless-lenses-full-frame/canon-rf-50mm-f-1-2-l-usm-lens/",
+         "three aspherical lenses"),
+        ("https://focus-review.com/en/canon-rf-50mm-f-1-2l-usm-review/",
+         "The lens contains 15 lens elements, divided into 9 groups. Three lens elements are aspherical"),
+    ],
+    "sigma_28mm_f1_4_art": [
+        ("https://webnews.it/rilasciato-il-sigma-28mm-f-1-4-dg-hsm-art", "Il design ottico enumera 17 elementi in 12 gruppi"),
+        ("https://www.slrlounge.com/sigma-28mm-1-4-art-lens-hands-on-review/", "17 elements in 12 groups"),
+    ],
+    "sigma_40mm_f1_4_art": [
+        ("https://www.thephoblographer.com/2018/12/18/could-the-40mm-f1-4-art-be-one-of-the-sharpest-sigma-lenses-ever-made/",
+         "16 elements in 12 groups and nine rounded aperture blades"),
+    ],
+    "sigma_50mm_f1_4_art": [
+        ("https://www.popphoto.com/gear/2014/04/lens-test-sigma-50mm-f14-dg-hsm-art-lens/",
+         "It is made up of 13 elements, arranged into 8 groups"),
+        ("http://www.dpreview.com/reviews/sigma-50mm-f1-4-dg-hsm", "Its complex optical formula of 13 elements in 8 groups"),
+    ],
+    "nikkor_28mm_f1_4e": [
+        ("https://photography-news-wp.bright-staging.uk/reviews/nikon-af-s-28mm-f-1-4e-ed",
+         "the lens has 14 elements of which two are extra-low dispersion and three aspherical elements"),
+    ],
+}
+WORDS = {"two": 2, "three": 3, "eight": 8, "nine": 9, "twelve": 12}
+
+
+def _stated(text: str) -> dict[str, int]:
+    """The counts a quoted text states: elements, groups, aspherical elements (numerals or words)."""
+    found = {}
+    for key, pattern in (("elements", r"(\w+)\s+(?:lens\s+)?(?:elements|elementi)\b"), ("groups", r"(\w+)\s+(?:groups|gruppi)\b"),
+                         ("aspherical", r"(\w+)\s+(?:lens elements are\s+)?aspherical")):
+        m = re.search(pattern, text, re.IGNORECASE)
+        if m:
+            word = m.group(1).lower()
+            found[key] = int(word) if word.isdigit() else WORDS[word]
+    assert found, f"no count in {text!r}"
+    return found
+
+
+def _construction(p) -> dict[str, int]:
+    """Elements, groups and aspherical elements of a prescription, counted the way makers count: a glass
+    layer between two surfaces is an element, cemented layers one group; a lone plane-parallel plate (a
+    filter or cover glass in a patent's table) is not an element, and a layer under 0.1 mm cemented to an
+    element is a hybrid aspheric element's resin, part of that element."""
+    s = p.surfaces
+    layers = [i for i in range(len(s) - 1) if s[i].medium.nd > 1.0]
+    groups, run = [], []
+    for i in layers:
+        if run and i != run[-1] + 1:
+            groups.append(run)
+            run = []
+        run.append(i)
+    groups.append(run)
+    groups = [g for g in groups if not (len(g) == 1 and s[g[0]].curvature == 0 and s[g[0] + 1].curvature == 0)]
+    elements = []
+    for g in groups:
+        members = [[i] for i in g if s[i].thickness >= 0.1]
+        for i in g:
+            if s[i].thickness < 0.1:  # the resin joins the element it is cemented to
+                min(members, key=lambda m: min(abs(i - j) for j in m)).append(i)
+        elements += members
+    aspherical = sum(any(s[j].kind == "aspheric" or s[j + 1].kind == "aspheric" for j in m) for m in elements)
+    return {"elements": len(elements), "groups": len(groups), "aspherical": aspherical}
+
+
+def test_the_stated_counts_are_parsed_from_the_quotes():
+    # the parser on the quotes themselves, worked by hand
+    assert _stated("comprising 15 elements in nine groups") == {"elements": 15, "groups": 9}
+    assert _stated("The lens contains 15 lens elements, divided into 9 groups. Three lens elements are aspherical") == {
+        "elements": 15, "groups": 9, "aspherical": 3}
+    assert _stated("the lens has 14 elements of which two are extra-low dispersion and three aspherical elements") == {
+        "elements": 14, "aspherical": 3}
+
+
+@pytest.mark.parametrize("slug", sorted(MAKER_CONSTRUCTION))
+def test_the_files_construction_is_the_products_as_the_cited_pages_print_it(slug):
+    """The transcribers identify these patent examples with products; the maker's element and group counts
+    (as reviews print them) agree with each file's, which a different example or a mistyped table would
+    rarely do. The file's maker_data quotes each page."""
+    p = load_lens(slug)
+    counted = _construction(p)
+    (line,) = [x for x in provenance_of(p).maker_data if x.startswith("construction:")]
+    for url, text in MAKER_CONSTRUCTION[slug]:
+        for key, n in _stated(text).items():
+            assert counted[key] == n, (slug, key, text)
+        assert url in line and text in line
+    assert "read 2026-11-28" in line and "not reached" in line
+
+
+def test_the_counting_rules_on_a_plate_and_a_resin_layer():
+    """Sigma 28 Art: 18 glass layers in the file, the last a plane-parallel plate (nd 1.52301) before the
+    image; Nikkor 28/1.4E: 15, one a 0.05 mm resin (nd 1.5138) on the third element."""
+    sigma, nikkor = load_lens("sigma_28mm_f1_4_art"), load_lens("nikkor_28mm_f1_4e")
+    assert sum(x.medium.nd > 1 for x in sigma.surfaces[:-1]) == 18 and _construction(sigma)["elements"] == 17
+    assert sum(x.medium.nd > 1 for x in nikkor.surfaces[:-1]) == 15 and _construction(nikkor)["elements"] == 14

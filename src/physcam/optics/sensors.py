@@ -55,7 +55,7 @@ class Sensor:
     anamorphic: tuple[float, ...] = ()  # desqueeze factors the maker offers this format for
     read: str = ""  # the date the source was read
     method: str = ""  # how the size was had: "stated mm", "photosites x pitch", "derived: ..."
-    maker_spec: str = ""  # whose figure the size is: the maker's (quoted, or its document via a transcription) or a third party's
+    maker_spec: str = ""  # whose figure the size is: the maker's (its page read, quoted, or its document via a transcription) or a third party's
 
     @property
     def diagonal_mm(self) -> float:

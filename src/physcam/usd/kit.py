@@ -507,6 +507,7 @@ def prescription_distortion(prescription, sensor_width_mm: float = DEFAULT_SENSO
     from ..analysis.distortion.models import fit_usd_standard, samples_from_field
     from ..analysis.distortion.stmap import distortion_field
     from ..errors import OpticsError, PhysCamWarning
+    from ..optics.state import camera_state
 
     w_px = 2048
     h_px = max(16, min(8192, round(w_px * sensor_height_mm / sensor_width_mm)))
@@ -545,12 +546,13 @@ def prescription_anamorphic_distortion(prescription, sensor_width_mm: float, sen
     from ..analysis.distortion.models import samples_from_field
     from ..analysis.distortion.stmap import distortion_field
     from ..errors import OpticsError, PhysCamWarning
+    from ..optics.state import camera_state
 
     w_px = 2048
     h_px = max(16, min(8192, round(w_px * sensor_height_mm / sensor_width_mm)))
     try:
-        field = distortion_field(prescription, focus_mm=focus_mm, sensor_width_mm=sensor_width_mm,
-                                 sensor_height_mm=sensor_height_mm, width_px=w_px, height_px=h_px, maps=False)
+        camera = camera_state(prescription, focus_mm=focus_mm, sensor_mm=(sensor_width_mm, sensor_height_mm))
+        field = distortion_field(camera, width_px=w_px, height_px=h_px, maps=False)
     except OpticsError as e:
         warnings.warn(f"3DE4 anamorphic distortion not written: {e}", PhysCamWarning, stacklevel=2)
         return []
