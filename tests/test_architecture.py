@@ -20,23 +20,23 @@ sys.path.insert(0, str(SRC.parent / "scripts"))
 from house_metrics import RoomWalkAll, strongly_connected, walk_rooms  # noqa: E402
 
 LAYER = {
-    "errors": 0, "_moved": 1,
-    "": 2,  # the root package only re-exports errors and the version, and installs the old module paths
-    "data": 3, "extras": 4, "progress": 5, "units": 6, "io": 7, "figures": 8,
-    "lens": 9,
-    "optics": 10,
-    "trace": 11,
-    "analysis": 12,
-    "onset": 13,
-    "export": 14,
-    "usd": 15,
-    "live": 16,
-    "metadata": 17,
-    "characterize": 18,
-    "serve": 19,
-    "farm": 20,
-    "cli": 21,
-    "__main__": 22,
+    "errors": 0, "_moved": 1, "_program": 2,
+    "": 3,  # the root package only re-exports errors and the version, and installs the old module paths
+    "data": 4, "extras": 5, "progress": 6, "units": 7, "io": 8, "figures": 9,
+    "lens": 10,
+    "optics": 11,
+    "trace": 12,
+    "analysis": 13,
+    "onset": 14,
+    "export": 15,
+    "usd": 16,
+    "live": 17,
+    "metadata": 18,
+    "characterize": 19,
+    "serve": 20,
+    "farm": 21,
+    "cli": 22,
+    "__main__": 23,
 }
 
 
