@@ -174,6 +174,10 @@ def _cameras(lens, slug, fstop, tmp, ext_src):
         cam.cycles_custom["focus_distance"] = FOCUS_MM / 1000.0
         cam.cycles_custom["fstop"] = fstop
         cam.cycles_custom["aspect"] = W / H
+        # the built-in camera's full-frame gate (the shader's defaults are physcam's default sensor,
+        # Super 35: a smaller, less vignetted frame than the built-in camera renders)
+        cam.cycles_custom["sensor_width"] = 36.0
+        cam.cycles_custom["sensor_height"] = 24.0
 
     def builtin_cam(scene):
         scene.camera.data.type = "PERSP"

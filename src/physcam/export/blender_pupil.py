@@ -40,7 +40,7 @@ import numpy as np
 from ..errors import InputError, require_finite, require_type
 
 __all__ = ["RADIAL_MAX_MM", "N_RADIAL", "LEVEL_RATIO", "N_LEVEL", "radial_pupil_table", "iris_levels",
-           "level_bracket", "interpolated_ellipse", "interpolated_area", "hermite"]
+           "level_bracket", "interpolated_ellipse", "interpolated_area", "cell_area", "hermite"]
 
 #: Film radius the table reaches (mm): the half diagonal of physcam's largest sensor (IMAX 15/70).
 RADIAL_MAX_MM = 44.0
@@ -432,7 +432,7 @@ def interpolated_area(table: np.ndarray, levels, rho: float, s: float) -> float:
     """The passing set's area (mm^2) as the shader reads ``table``: linear in rho, between levels a
     cubic in s through the levels' areas and slopes (Hermite: the area of the iris's image grows as its
     square, and saturates where other surfaces cut it), scaled by (s / s_last)^2 below the last;
-    -1 where an entry it reads does not hold a trusted area (radial_pupil_table)."""
+    -1 where the cell it reads in is not trusted (radial_pupil_table)."""
     _table(table, levels)
     return _area_at(table, _levels(levels), require_finite("film radius", rho), require_finite("iris radius", s))
 
@@ -454,9 +454,10 @@ def _ellipse_at(table, levels, rho, s):
 def _area_at(table, levels, rho, s):
     j0, rw = _radial(table, rho)
     l0, _, shrink = _bracket(levels, s)
-    if table[l0:l0 + 2, j0:j0 + 2, 3].min() < 0:
+    if table[l0 + (shrink < 1.0), j0, 3] < 0:  # the cell's trust (below the last level: the last row's)
         return -1.0
-    at = (1 - rw) * table[l0:l0 + 2, j0, 3:] + rw * table[l0:l0 + 2, j0 + 1, 3:]
+    t = np.concatenate([cell_area(table[l0:l0 + 2, :, 3:4]), table[l0:l0 + 2, :, 4:]], axis=2)
+    at = (1 - rw) * t[:, j0] + rw * t[:, j0 + 1]
     if shrink < 1.0:
         return float(at[1, 0] * shrink * shrink)
     return float(hermite(levels[l0 + 1], at[1, 0], at[1, 1], levels[l0], at[0, 0], at[0, 1], s))
@@ -494,7 +495,9 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto") -> np
     """The table (len(levels) x :data:`N_RADIAL` x 5: cx, ax, ay in mm on the rear vertex plane, the
     passing set's area in mm^2 and its slope in mm^2 per mm of iris radius) of the focused lens ``q``
     (a Prescription) with its film at ``film_z``, at the iris radii ``levels`` (:func:`iris_levels`).
-    Where nothing passes at any iris, the ellipse is a neighbour's and the area 0. ``backend``: the
+    Where nothing passes at any iris, the ellipse is a neighbour's and the area 0. An entry's area
+    is -1 - area where the shader may not weigh rays by the area in its cell (:func:`_trusted_cells`,
+    :func:`cell_area`). ``backend``: the
     tracing backend (:func:`~physcam.trace.trace.trace_through`; "auto" picks one for the whole table,
     :func:`~physcam.trace.kernels.backend_for_job`: both give the same rays)."""
     from ..lens.prescription import require_prescription
@@ -540,20 +543,44 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto") -> np
     checks = [(j * step, at_node[j]) for j in range(N_RADIAL)] + [((j + 0.5) * step, at_mid[j])
                                                                    for j in range(N_RADIAL - 1)]
     _grow(table, levels, [(rho, float(s), sets[index[float(s)]]) for rho, sets in checks for s in checked], step)
-    # the area weighs rays only where the shader's interpolation of it is the traced area's within
-    # AREA_TOLERANCE at every radius and iris between the entries (elsewhere their area is -1)
-    trusted = table[..., 3] > 0
+    # the area weighs rays only in the cells (between two levels and two radii) where the iris alone
+    # bounds every set checked on or in the cell and the shader's interpolation of the area is the
+    # traced one's within AREA_TOLERANCE there; an entry's sign says whether its cell is trusted
+    # (untrusted: -1 - area, cell_area). A failed check withdraws only the cells it lies on or in.
     reads = [(rho, float(s), sets[index[float(s)]]) for rho, sets in checks for s in checked]
     want = np.array([reg.area() if reg is not None else 0.0 for _, _, reg in reads])
     got = _areas_at(table, levels, [rho for rho, _, _ in reads], [s for _, s, _ in reads])
-    for i in np.flatnonzero(np.abs(got - want) > AREA_TOLERANCE * np.maximum(want, 1e-12)):
-        rho, s, _ = reads[i]
-        l0, lw, shrink = _bracket(levels, s)
-        for k in ([l0, l0 + 1] if shrink == 1.0 else [l0 + 1]):
-            for j in _cols_used(rho, step):
-                trusted[k, j] = False
-    table[..., 3] = np.where(trusted, table[..., 3], -1.0)
+    # a set another surface cuts has corners its rim polygon cuts short (its area up to ~1 % low, checked
+    # against a dense trace): its area never weighs rays
+    clipped = np.array([reg is not None and reg.clipped for _, _, reg in reads])
+    bad = clipped | (np.abs(got - want) > AREA_TOLERANCE * np.maximum(want, 1e-12))
+    trusted = _trusted_cells(levels, [(rho, s) for (rho, s, _), b in zip(reads, bad.tolist()) if b],
+                             table[..., 3] > 0, step)
+    table[..., 3] = np.where(trusted, table[..., 3], -1.0 - table[..., 3])
     return table
+
+
+def _trusted_cells(levels, failed, lit, step: float) -> np.ndarray:
+    """Per table entry (k, j), whether the shader may weigh rays by the area in its cell: iris radii
+    from levels[k + 1] to levels[k] (k the last level: below it) and film radii from node j to j + 1.
+    A cell is trusted when something passes at each of its corner entries (``lit``) and no
+    (film radius, iris radius) of ``failed`` lies on or in it. The last radius column has no cell."""
+    n_level, n_rad = lit.shape
+    ok = lit.copy()
+    for k in range(n_level):
+        rows = lit[k:k + 2] if k < n_level - 1 else lit[k:k + 1]
+        ok[k, :-1] = rows[:, :-1].all(axis=0) & rows[:, 1:].all(axis=0)
+    for rho, s in failed:
+        ks = [k for k in range(n_level - 1) if levels[k + 1] <= s <= levels[k]] + ([n_level - 1] if s <= levels[-1] else [])
+        js = [j for j in range(n_rad - 1) if j * step - 1e-9 <= rho <= (j + 1) * step + 1e-9]
+        ok[np.ix_(ks, js)] = False
+    return ok
+
+
+def cell_area(v):
+    """The passing set's area (mm^2) from a table entry's area column ``v`` (an untrusted cell's entry
+    holds -1 - area, :func:`radial_pupil_table`)."""
+    return np.where(np.asarray(v) < 0, -1.0 - np.asarray(v), v)
 
 
 def _cols_used(rho: float, step: float) -> list[int]:
@@ -585,11 +612,11 @@ def _ellipses_at(table, levels, rhos, ss) -> np.ndarray:
 def _areas_at(table, levels, rhos, ss) -> np.ndarray:
     """:func:`_area_at` at every (rho, s) pair, the same arithmetic in whole arrays."""
     j0, rw, l0, _, shrink = _reads(table, levels, rhos, ss)
-    a = table[..., 3]
-    bad = np.minimum.reduce([a[l0, j0], a[l0, j0 + 1], a[l0 + 1, j0], a[l0 + 1, j0 + 1]]) < 0
+    bad = table[l0 + (shrink < 1.0), j0, 3] < 0
+    table = np.concatenate([cell_area(table[..., 3:4]), table[..., 4:]], axis=2)
     rw_ = rw[:, None]
-    at0 = (1 - rw_) * table[l0, j0, 3:] + rw_ * table[l0, j0 + 1, 3:]
-    at1 = (1 - rw_) * table[l0 + 1, j0, 3:] + rw_ * table[l0 + 1, j0 + 1, 3:]
+    at0 = (1 - rw_) * table[l0, j0] + rw_ * table[l0, j0 + 1]
+    at1 = (1 - rw_) * table[l0 + 1, j0] + rw_ * table[l0 + 1, j0 + 1]
     s0, s1, s = levels[l0 + 1], levels[l0], np.asarray(ss, dtype=float)
     a0, d0, a1, d1 = at1[:, 0], at1[:, 1], at0[:, 0], at0[:, 1]
     span = s1 - s0
