@@ -7,8 +7,9 @@ system) of the child, less disturbed by other jobs than the wall clock, and its 
 table times the report alone inside each process (the lens loaded and the glass catalogue read
 first), where the focus solves are. Bytecode caches are kept (PYTHONDONTWRITEBYTECODE dropped, as in
 benchmarks/startup.py). A third line times the floor in the same alternation: a Python that only imports
-numpy (every prescription report imports it, for the glass and the real-ray field of view), and the
-ratio no report that imports numpy can beat (baseline / floor).
+numpy (every prescription report imported it, for the glass and the real-ray field of view, until issue
+43's round 6 made the report numpy-free), and the ratio no report that imports numpy can beat
+(baseline / floor).
 
     .venv/bin/python benchmarks/report_lens.py --baseline /tmp/base/src [--runs 15] [--lens zuiko_18mm_f3_5] [--text]
 """

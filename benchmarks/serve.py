@@ -202,7 +202,20 @@ def pct(values, p):
     return v[min(len(v) - 1, int(round(p / 100 * (len(v) - 1))))]
 
 
-def report(name, lat, statuses, wall, rate, goal=True):
+def server_cpu(proc):
+    """CPU seconds (user + system, all threads) the server process has used; None off Linux."""
+    try:
+        with open(f"/proc/{proc.pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def report(name, lat, statuses, wall, rate, goal=True, cpu=None):
+    """One run's line: latencies, statuses, and (``cpu``: the server's CPU seconds over the run) its
+    CPU per request and the load it ran in: under load the wall clock follows the machine, the CPU
+    time follows the code."""
     n = len(lat)
     p50, p99 = pct(lat, 50), pct(lat, 99)
     five = sum(c for s, c in statuses.items() if s >= 500)
@@ -211,7 +224,8 @@ def report(name, lat, statuses, wall, rate, goal=True):
           f"{p50 * 1000:.1f} ms, p99 {p99 * 1000:.1f} ms, max {max(lat) * 1000:.1f} ms; status {codes}")
     verdict = (f"goal p99 < {GOAL_P99_S * 1000:.0f} ms: ratio p99/goal = {p99 / GOAL_P99_S:.2f} "
                f"({'met' if p99 < GOAL_P99_S else 'NOT met'}); " if goal else "")
-    print(f"  {verdict}server errors (5xx): {five}")
+    spent = "" if cpu is None else f"server CPU {cpu / n * 1000:.2f} ms per request; "
+    print(f"  {verdict}{spent}load {os.getloadavg()[0]:.2f} (1 min); server errors (5xx): {five}")
     return five
 
 
@@ -342,8 +356,10 @@ def main():
         for name, make, seed, key in runs:
             if not wanted(key):
                 continue
+            cpu0 = server_cpu(proc)
             lat, statuses, wall = asyncio.run(run(port, make, args.rate, args.seconds, args.clients, seed))
-            five += report(name, lat, statuses, wall, args.rate)
+            cpu1 = server_cpu(proc)
+            five += report(name, lat, statuses, wall, args.rate, cpu=None if cpu0 is None else cpu1 - cpu0)
         rate = 3 * args.page_rate
         if wanted("page"):
             lat, statuses, wall = asyncio.run(run(port, page_update, rate, args.seconds, args.clients, 2))

@@ -363,13 +363,21 @@ class RoomWalkAll(RoomWalk):
         return False
 
 
+def walk_rooms(walker=RoomWalkAll, *, builtin: bool = False) -> RoomWalk:
+    """One walk of ``physcam export blender``'s camera settings (:data:`CAMERA_SETTINGS`) from
+    ``cli/export.py: run_blender``: ``walker.rooms`` and ``walker.climbs`` after it (``--builtin`` off:
+    its branches not followed)."""
+    w = walker(builtin)
+    start = w.module("physcam.cli.export")
+    w.walk(start, start.defs["run_blender"], set(CAMERA_SETTINGS))
+    return w
+
+
 def rooms() -> dict:
     out = {}
     for kind, walker in (("handed_on", RoomWalk), ("computed_from", RoomWalkAll)):
         for builtin in (False, True):
-            w = walker(builtin)
-            start = w.module("physcam.cli.export")
-            w.walk(start, start.defs["run_blender"], set(CAMERA_SETTINGS))
+            w = walk_rooms(walker, builtin=builtin)
             out[f"{kind}_{'with' if builtin else 'without'}_builtin"] = {
                 "rooms": len(w.rooms), "climbs": len(w.climbs),
                 "enters_onset": any(r.startswith("physcam.onset") for r in w.rooms),
@@ -399,39 +407,52 @@ def package_graph() -> dict[str, set[str]]:
 
 
 def strongly_connected(graph: dict[str, set[str]]) -> list[list[str]]:
-    """Tarjan's strongly connected components with more than one node."""
-    index, low, on, stack, out, counter = {}, {}, set(), [], [], [0]
+    """The strongly connected components of ``graph`` (node -> set of nodes), each sorted, singletons
+    included: Tarjan's algorithm (R. Tarjan, "Depth-first search and linear graph algorithms", SIAM J.
+    Comput. 1, 1972), iteratively, so a long import chain needs no deep recursion. tests/test_architecture.py
+    runs it on physcam's module and package graphs."""
+    index, low, on, stack, comps = {}, {}, set(), [], []
 
-    def visit(v):
-        index[v] = low[v] = counter[0]
-        counter[0] += 1
+    def enter(v):
+        index[v] = low[v] = len(index)
         stack.append(v)
         on.add(v)
-        for w in sorted(graph.get(v, ())):
-            if w not in index:
-                visit(w)
-                low[v] = min(low[v], low[w])
-            elif w in on:
-                low[v] = min(low[v], index[w])
-        if low[v] == index[v]:
-            comp = []
-            while True:
-                w = stack.pop()
-                on.discard(w)
-                comp.append(w)
-                if w == v:
-                    break
-            if len(comp) > 1:
-                out.append(sorted(comp))
+        return v, iter(sorted(graph.get(v, ())))
 
-    for v in sorted(graph):
-        if v not in index:
-            visit(v)
-    return out
+    for root in sorted(graph):
+        if root in index:
+            continue
+        work = [enter(root)]
+        while work:
+            v, it = work[-1]
+            w = next(it, None)
+            if w is not None:
+                if w not in index:
+                    work.append(enter(w))
+                elif w in on:
+                    low[v] = min(low[v], index[w])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                comps.append(sorted(_pop_component(stack, on, v)))
+    return comps
+
+
+def _pop_component(stack: list, on: set, v) -> list:
+    """Tarjan's step at a root ``v``: pop the stack down to ``v``, one component."""
+    comp = []
+    while True:
+        w = stack.pop()
+        on.discard(w)
+        comp.append(w)
+        if w == v:
+            return comp
 
 
 def loops() -> dict:
-    comps = strongly_connected(package_graph())
+    comps = [c for c in strongly_connected(package_graph()) if len(c) > 1]
     return {"loops": comps, "count": len(comps)}
 
 

@@ -83,8 +83,8 @@ def apply_style() -> None:
     matplotlib.rcParams.update(_style_params())
 
 
-#: Set by the ``physcam`` program (``physcam.cli.run``), never by the library: matplotlib is then
-#: imported without what that program never uses (:func:`_lean_import`).
+#: Set for the ``physcam`` program (``physcam.cli.run`` sets :data:`physcam._program.RUNNING`), never by
+#: the library: matplotlib is then imported without what that program never uses (:func:`_lean_import`).
 PROGRAM_IMPORT = False
 
 
@@ -94,10 +94,13 @@ def _lean_import() -> None:
     every artist class's ``set()`` as the class is made (``matplotlib.artist.kwdoc``: a third of
     matplotlib's import, 0.15 s of CPU), and its 3-D toolkit, which registering the ``3d``
     projection imports with every figure. Only when matplotlib is not imported yet and
-    :data:`PROGRAM_IMPORT` is set; a library caller's matplotlib is left whole."""
+    :data:`PROGRAM_IMPORT` (or :data:`physcam._program.RUNNING`) is set; a library caller's matplotlib is
+    left whole."""
     import sys
 
-    if not PROGRAM_IMPORT or "matplotlib.artist" in sys.modules:
+    from . import _program
+
+    if not (PROGRAM_IMPORT or _program.RUNNING) or "matplotlib.artist" in sys.modules:
         return
     import warnings
 

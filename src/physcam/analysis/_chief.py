@@ -31,14 +31,10 @@ import numpy as np
 from ..errors import InputError
 from ..lens.geometry import sag
 from ..lens.prescription import Prescription, takes_prescription
+from ._chief_float import AIM_MAX_ITER, AIM_TOL_MM
 
 __all__ = ["AimedRays", "aim_from_infinity", "aim_from_film", "field_direction", "start_plane_z", "chief_ray_passes",
            "field_limit_deg", "widest_passing_deg", "clamp_note"]
-
-#: Aiming stops when the ray meets the stop plane within this distance of its centre (mm).
-AIM_TOL_MM = 1e-9
-AIM_MAX_ITER = 20
-
 
 @dataclass
 class AimedRays:

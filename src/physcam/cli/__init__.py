@@ -26,7 +26,6 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
-import pkgutil
 import sys
 
 from .. import __version__
@@ -54,6 +53,25 @@ _NOT_PATHS = ("command", "handler", "kind", "output_args", "output_folders")
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # usage errors: one line, exit 2 (argparse's own code)
         self.exit(2, f"physcam: error: {message}\n")
+
+    def _get_formatter(self):
+        """argparse's formatter at the width argparse gives it, measured without importing shutil (its
+        formatter imports it for ``get_terminal_size``: 4 ms of every command's start, issue 43)."""
+        return self.formatter_class(prog=self.prog, width=_terminal_columns() - 2)
+
+
+def _terminal_columns() -> int:
+    """``shutil.get_terminal_size().columns``: $COLUMNS when a positive number, else the terminal's, else 80."""
+    try:
+        columns = int(os.environ["COLUMNS"])
+    except (KeyError, ValueError):
+        columns = 0
+    if columns <= 0:
+        try:
+            columns = os.get_terminal_size(sys.__stdout__.fileno()).columns or 80
+        except (AttributeError, ValueError, OSError):
+            columns = 80
+    return columns
 
 
 class _StoreOnce(argparse._StoreAction):
@@ -111,6 +129,8 @@ def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
     if first in COMMAND_MODULES:
         names = [COMMAND_MODULES[first]]
     else:
+        import pkgutil  # only for the whole list (a command named first loads its own module alone)
+
         names = [m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")]
     # --help lists commands in the order people use them: on set, lenses, rays, USD, the demo
     order = {name: i for i, name in enumerate(COMMAND_ORDER)}
@@ -285,9 +305,13 @@ def _refused_path(exc: OSError) -> str:
 def run() -> None:
     """The ``physcam`` program: :func:`main`, then exit with its status (module notes). It ends the
     process: from Python, call :func:`main` instead."""
-    from .. import figures
+    from .. import _program
 
-    figures.PROGRAM_IMPORT = True  # matplotlib without its docstring tables and 3-D toolkit (figures._lean_import)
+    _program.RUNNING = True  # matplotlib without its docstring tables and 3-D toolkit (figures._lean_import)
+    # numpy's BLAS on one thread unless the user says otherwise (before numpy loads): the program's linear
+    # algebra is small (a Zernike fit of a few thousand pupil samples), where OpenBLAS's second thread
+    # spins and doubles the CPU time (`mtf --field 0`: 0.85 -> 0.5 s, the same output; docs/performance.md)
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     code = main()
     if "numba" in sys.modules:
         _exit_without_teardown(code)

@@ -128,34 +128,22 @@ def iris_corner_semi(state: CameraState) -> float:
 
 
 def _bake(state: CameraState, fresnel: bool) -> BakedCamera:
-    from ..trace.pupil_bounds import exit_pupil_bounds
-    from ..trace.surfaces import surface_table
-    from ..trace.trace import camera_rays
+    """What the shader bakes of ``state``, asked of its tracer (:func:`physcam.trace.camera_tracer.camera_tracer`:
+    the focused lens stopped to the iris's corners, the film plane, the iris shape): the surface table, the
+    exit-pupil rectangles over the sensor and the mean weight at the film centre the shader divides by."""
+    from ..trace.camera_tracer import camera_tracer
 
-    q = state.focused
-    k = q.stop_index
-    semi = iris_corner_semi(state)
-    if semi != q.surfaces[k].semi_diameter:
-        s = list(q.surfaces)
-        s[k] = dataclasses.replace(s[k], semi_diameter=semi)
-        q = q.with_surfaces(s)
+    tracer = camera_tracer(state)
     sw, sh = state.sensor_mm
-    film_z = float(state.film_z)
-    table = surface_table(q, reverse=True, coating="none")
     nx, ny = PUPIL_GRID
-    bounds = exit_pupil_bounds(q, sw / 2, sh / 2, film_z, nx=nx, ny=ny, samples=64)
-    # mean weight at the film centre over a stratified pupil grid (the shader divides by it)
-    m = 128
-    u = (np.arange(m) + 0.5) / m
-    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
-    cr = camera_rays(q, np.zeros((uu.size, 2)), np.stack([uu, vv], axis=1), film_z, bounds=bounds,
-                     aperture=state.aperture, fresnel=fresnel)
-    norm = float(np.mean(cr.weight))
+    bounds = tracer.exit_pupil_bounds(sw / 2, sh / 2, nx=nx, ny=ny, samples=64)
+    norm = tracer.centre_weight(bounds, samples=128, fresnel=fresnel)  # a stratified 128^2 grid of aims
     if not norm > 0:
         from ..errors import OpticsError
 
         raise OpticsError(f"no ray from the film centre passes through {state.lens_name!r} at this focus and stop")
-    return BakedCamera(q, film_z, table, bounds, state.aperture, norm, sw, sh, state, float(state.lens.wavelength_nm))
+    return BakedCamera(tracer.lens, tracer.film_z, tracer.film_side_table, bounds, tracer.aperture, norm, sw, sh, state,
+                       float(state.lens.wavelength_nm))
 
 
 _num = osl_number

@@ -83,18 +83,6 @@ class FocusTable:
         return iris_levels(self.semi_max, self.iris_k / self.fstop_open)
 
 
-def _centre_norm(q, film_z, bounds, fresnel: bool = False, stop_semi_diameter=None) -> float:
-    """camera_rays' mean weight at the film centre (64^2 stratified aim points over ``bounds``)."""
-    from ..trace.trace import camera_rays
-
-    m = 64
-    u = (np.arange(m) + 0.5) / m
-    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
-    cr = camera_rays(q, np.zeros((uu.size, 2)), np.stack([uu, vv], axis=1), film_z, bounds=bounds, fresnel=fresnel,
-                     stop_semi_diameter=stop_semi_diameter)
-    return float(np.mean(cr.weight))
-
-
 def _ellipse_rect(ellipse) -> np.ndarray:
     """(x0, x1, y0, y1): the rectangle around an ellipse (cx, ax, ay) on the rear vertex plane."""
     cx, ax, ay = ellipse[:3]
@@ -119,20 +107,19 @@ class _RayRects:
         return tuple(self.rects[:, c] for c in range(4))
 
 
-def _centre_norms(q, film_z, rects, levels) -> list[float]:
+def _centre_norms(tracer, rects, levels) -> list[float]:
     """The centre's mean weight with the round iris at each tabulated iris level, aiming at
-    ``rects[k]`` for level k (:func:`_centre_norm`'s 64^2 aims; levels that share a rectangle share
-    their rays), all in one trace (:func:`~physcam.trace.pupil_bounds.iris_camera_rays`): the shader's
+    ``rects[k]`` for level k (the 64^2 aims of :meth:`~physcam.trace.camera_tracer.CameraTracer.centre_weight`;
+    levels that share a rectangle share their rays), all in one trace
+    (:meth:`~physcam.trace.camera_tracer.CameraTracer.iris_camera_rays`): the shader's
     normalisation (the exit pupil's area is not quite the square of the iris's radius)."""
-    from ..trace.pupil_bounds import iris_camera_rays
-
     m = 64
     u = (np.arange(m) + 0.5) / m
     uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
     uniq, which = np.unique(np.asarray(rects, dtype=float), axis=0, return_inverse=True)
     n = uu.size
-    cr, passing = iris_camera_rays(q, np.zeros((n * len(uniq), 2)), np.tile(np.stack([uu, vv], axis=1), (len(uniq), 1)),
-                                   film_z, [float(s) for s in levels], bounds=_RayRects(np.repeat(uniq, n, axis=0)))
+    cr, passing = tracer.iris_camera_rays(np.zeros((n * len(uniq), 2)), np.tile(np.stack([uu, vv], axis=1), (len(uniq), 1)),
+                                          [float(s) for s in levels], bounds=_RayRects(np.repeat(uniq, n, axis=0)))
     w = cr.weight.reshape(len(uniq), n)
     return [float(np.mean(np.where(ok.reshape(len(uniq), n)[g], w[g], 0.0)))
             for g, ok in zip(np.ravel(which).tolist(), passing)]
@@ -145,7 +132,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..optics.focusing import closest_focus, focus, gaussian_at_focus
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
-    from ..trace.surfaces import surface_table
+    from ..trace.camera_tracer import CameraTracer
     from .blender_pupil import iris_levels, radial_pupil_table
 
     if isinstance(n_focus, bool) or not isinstance(n_focus, int) or n_focus < 2:
@@ -161,22 +148,22 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     film_z, vz, radial, rects, stopped, norm = [], [], [], [], [], []
     for mk in marks:
         st = focus(lens, float(mk))
-        q = st.prescription
-        t = surface_table(q, reverse=True, coating="none")
+        tracer = CameraTracer(st.prescription, st.film_z)  # the lens at this focus state as the file stops it
+        t = tracer.film_side_table
         film_z.append(st.film_z)
         vz.append(t.vertex_z)
         if lens.is_anamorphic:
-            b, rect, rect_levels = _rect_tables(q, st.film_z, levels[0], grid_half_mm)
+            b, rect, rect_levels = _rect_tables(tracer, levels[0], grid_half_mm)
             rects.append(rect)
             stopped.append(rect_levels)
-            norm.append(_centre_norms(q, st.film_z, [np.array(b.rect_at(0.0, 0.0))] * len(levels), levels))
+            norm.append(_centre_norms(tracer, [np.array(b.rect_at(0.0, 0.0))] * len(levels), levels))
         else:
-            radial.append(radial_pupil_table(q, st.film_z, levels))
-            b = _centre_bounds(q, radial[-1][0, 0])
-            norm.append(_centre_norms(q, st.film_z, [_ellipse_rect(e) for e in radial[-1][:, 0]], levels))
+            radial.append(radial_pupil_table(tracer.lens, st.film_z, levels))
+            b = _centre_bounds(tracer.lens, radial[-1][0, 0])
+            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in radial[-1][:, 0]], levels))
         if mk == marks[0]:
             table0, bounds0 = t, (b if lens.is_anamorphic else None)
-            loss = _centre_norm(q, st.film_z, b, fresnel=True) / _centre_norm(q, st.film_z, b)
+            loss = tracer.centre_weight(b, samples=64, fresnel=True) / tracer.centre_weight(b, samples=64)
     if not all(min(v) > 0 for v in norm):
         raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some focus")
     def arr(v):
@@ -186,17 +173,17 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
                       np.array(norm), table0, bounds0, float(k), float(n_open), float(n_min), float(near), float(loss))
 
 
-def _rect_tables(q, film_z, semi_max, grid_half_mm):
-    """(PupilBounds at the widest iris, its rectangles, the rectangles at each of :data:`STOP_LEVELS`)."""
-    from ..trace.pupil_bounds import stopped_pupil_bounds
-
+def _rect_tables(tracer, semi_max, grid_half_mm):
+    """(PupilBounds at the widest iris, its rectangles, the rectangles at each of :data:`STOP_LEVELS`) of one
+    focus state's :class:`~physcam.trace.camera_tracer.CameraTracer`."""
     nx, ny = _GRID
+    q = tracer.lens
     semi_file = q.surfaces[q.stop_index].semi_diameter
     # the stop's semi-diameter as a prescription stopped to each fraction of the file's holds it
-    b = stopped_pupil_bounds(q, [float(semi_file * (semi_max / semi_file))], grid_half_mm, grid_half_mm, film_z,
-                             nx=nx, ny=ny, samples=48)[0]
-    levels = stopped_pupil_bounds(q, [float(semi_file * (f * semi_max / semi_file)) for f in STOP_LEVELS],
-                                  grid_half_mm, grid_half_mm, film_z, nx=nx, ny=ny, samples=32)
+    b = tracer.stopped_pupil_bounds([float(semi_file * (semi_max / semi_file))], grid_half_mm, grid_half_mm,
+                                    nx=nx, ny=ny, samples=48)[0]
+    levels = tracer.stopped_pupil_bounds([float(semi_file * (f * semi_max / semi_file)) for f in STOP_LEVELS],
+                                         grid_half_mm, grid_half_mm, nx=nx, ny=ny, samples=32)
     return b, b.rects, [lv.rects for lv in levels]
 
 

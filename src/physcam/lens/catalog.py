@@ -35,11 +35,10 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
-import difflib
 import json
 from collections.abc import Mapping
 
-from importlib import resources
+from pathlib import Path
 
 from ..errors import InputError, require_type
 from .catalog_glass import CatalogGlass
@@ -82,7 +81,7 @@ _USER: dict[str, dict[str, CatalogGlass]] = {}  # name -> glasses, in the order 
 
 
 def _load_builtin(name: str) -> dict[str, CatalogGlass]:
-    text = resources.files("physcam.data").joinpath("glass", f"{name}.json").read_text(encoding="utf-8")
+    text = (Path(__file__).parent.parent / "data" / "glass" / f"{name}.json").read_text(encoding="utf-8")
     out = {}
     for g in json.loads(text)["glasses"]:
         out.setdefault(g["name"].upper(), CatalogGlass(
@@ -218,6 +217,8 @@ def _not_found(name, key, order, missing) -> str:
     for cat in searched:
         for k, g in catalog(cat).items():
             known.setdefault(k, g.name)
+    import difflib
+
     close = difflib.get_close_matches(key, list(known), n=3, cutoff=0.6)
     msg = f"unknown glass {name!r}: not in {', '.join(searched) or 'any catalogue'}"
     if missing:

@@ -15,12 +15,10 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
-import difflib
 import math
 import re
 from dataclasses import dataclass
 from functools import lru_cache
-from importlib import resources
 from pathlib import Path
 
 from ..errors import InputError, LensFileError
@@ -100,7 +98,7 @@ class LensRecord:
 
 def library_dir() -> Path:
     """Folder of the bundled lens TOML files."""
-    return Path(str(resources.files("physcam") / "data" / "lenses"))
+    return Path(__file__).parent.parent / "data" / "lenses"  # what importlib.resources.files gives, without it
 
 
 def _key(s: str) -> str:
@@ -215,6 +213,8 @@ def find_lens(name: str) -> LensRecord:
             table.setdefault(_key(label), rec)
     if key in table:
         return table[key]
+    import difflib
+
     close = difflib.get_close_matches(key, list(table), n=3, cutoff=0.5)
     names = []
     for c in close:

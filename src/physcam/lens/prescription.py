@@ -18,7 +18,7 @@ import contextlib
 import contextvars
 import math
 from dataclasses import dataclass, field, replace
-from typing import Iterable
+from collections.abc import Iterable
 
 from ..errors import LensFileError
 

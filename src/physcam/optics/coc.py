@@ -17,7 +17,6 @@ See ``reference/formats/coc_conventions.csv`` in the shared data for sources.
 
 from __future__ import annotations
 
-import difflib
 import math
 
 from ..errors import InputError, require_positive
@@ -65,6 +64,8 @@ def circle_of_confusion(width_mm: float, height_mm: float, convention: str | flo
     try:
         value = float(key.removesuffix("mm"))
     except ValueError:
+        import difflib
+
         close = difflib.get_close_matches(key, list(COC_CONVENTIONS), n=3, cutoff=0.3)
         hint = f" (did you mean {', '.join(close)}?)" if close else ""
         raise InputError(

@@ -43,8 +43,6 @@ import math
 from dataclasses import dataclass
 from functools import lru_cache
 
-import numpy as np
-
 __all__ = ["LINE_D_NM", "LINE_F_NM", "LINE_C_NM", "LINE_G_NM", "WAVELENGTH_RANGE_NM", "MATCH_TOL_ND",
            "MATCH_TOL_VD", "PGF_NORMAL_LINE", "PGF_UNCERTAINTY", "Dispersion", "dispersion", "normal_line",
            "normal_line_pgf", "cauchy_coefficients", "refractive_index", "medium_index", "require_wavelength",
@@ -79,6 +77,8 @@ def require_wavelength(wavelength_nm, name: str = "wavelength"):
     lo, hi = WAVELENGTH_RANGE_NM
     if type(wavelength_nm) is float and lo <= wavelength_nm <= hi:  # the common scalar case, without numpy
         return wavelength_nm
+    import numpy as np
+
     lam = np.asarray(wavelength_nm, dtype=float)
     if not (np.all(np.isfinite(lam)) and np.all(lam >= lo) and np.all(lam <= hi)):
         bad = lam[~(np.isfinite(lam) & (lam >= lo) & (lam <= hi))].ravel()
@@ -89,11 +89,15 @@ def require_wavelength(wavelength_nm, name: str = "wavelength"):
 
 def normal_line_pgf(vd):
     """P_gF on SCHOTT's normal line at Abbe number ``vd``."""
+    if type(vd) is float:  # a lens's medium: no numpy (the on-set report does not import it)
+        return PGF_NORMAL_LINE[0] + PGF_NORMAL_LINE[1] * vd
+    import numpy as np
+
     return PGF_NORMAL_LINE[0] + PGF_NORMAL_LINE[1] * np.asarray(vd, dtype=float)
 
 
-def _u(lam_nm):
-    return 1.0 / ((np.asarray(lam_nm, dtype=float) / 1000.0) ** 2)
+def _u(lam_nm: float) -> float:
+    return 1.0 / ((lam_nm / 1000.0) ** 2)
 
 
 def evaluate(coefficients, wavelength_nm):
@@ -103,12 +107,19 @@ def evaluate(coefficients, wavelength_nm):
     n = a0 + (a1 + a2 u) u [+ sqrt(1 + B1 l2/(l2-C1) + B2 l2/(l2-C2) + B3 l2/(l2-C3))].
     """
     a0, a1, a2, b1, b2, b3, c1, c2, c3 = coefficients
-    lam = np.asarray(wavelength_nm, dtype=float)
+    if type(wavelength_nm) is float:  # one wavelength in Python floats, the same operations (no numpy)
+        lam = wavelength_nm
+        sqrt = math.sqrt
+    else:
+        import numpy as np
+
+        lam = np.asarray(wavelength_nm, dtype=float)
+        sqrt = np.sqrt
     l2 = (lam / 1000.0) * (lam / 1000.0)
     u = 1.0 / l2
     n = a0 + (a1 + a2 * u) * u
     if b1 != 0.0 or b2 != 0.0 or b3 != 0.0:
-        n = n + np.sqrt(1.0 + b1 * l2 / (l2 - c1) + b2 * l2 / (l2 - c2) + b3 * l2 / (l2 - c3))
+        n = n + sqrt(1.0 + b1 * l2 / (l2 - c1) + b2 * l2 / (l2 - c2) + b3 * l2 / (l2 - c3))
     return n
 
 
@@ -156,9 +167,28 @@ def _cauchy3(nd, vd, pgf):
     """(A, B, C) of n = A + B u + C u^2 (u = 1/l^2, l in um) through nd, nF - nC, ng - nF."""
     uf, uc, ud, ug = (float(_u(w)) for w in (LINE_F_NM, LINE_C_NM, LINE_D_NM, LINE_G_NM))
     dn = (nd - 1.0) / vd
-    m = np.array([[uf - uc, uf * uf - uc * uc], [ug - uf, ug * ug - uf * uf]])
-    b, c = np.linalg.solve(m, np.array([dn, pgf * dn]))
-    return nd - b * ud - c * ud * ud, float(b), float(c)
+    b, c = _solve2((uf - uc, uf * uf - uc * uc), (ug - uf, ug * ug - uf * uf), dn, pgf * dn)
+    return nd - b * ud - c * ud * ud, b, c
+
+
+def _fma(a: float, b: float, c: float) -> float:
+    """a b + c rounded once (exact rationals, then Python's correctly rounded integer division)."""
+    (an, ad), (bn, bd), (cn, cd) = a.as_integer_ratio(), b.as_integer_ratio(), c.as_integer_ratio()
+    return (an * bn * cd + cn * ad * bd) / (ad * bd * cd)
+
+
+def _solve2(row0, row1, r0: float, r1: float) -> tuple[float, float]:
+    """x of [row0; row1] x = (r0, r1) in Python floats: Gaussian elimination with partial pivoting, the
+    operations of LAPACK's dgesv as numpy's OpenBLAS runs them here (the updates of the right-hand
+    side fused multiply-adds), so the normal-line coefficients are the ones numpy gave (checked
+    against numpy.linalg.solve in tests/optics/test_glass_scalar.py) without importing numpy."""
+    (a00, a01), (a10, a11) = row0, row1
+    if abs(a10) > abs(a00):
+        (a00, a01, r0), (a10, a11, r1) = (a10, a11, r1), (a00, a01, r0)
+    lower = a10 / a00
+    u11 = a11 - lower * a01
+    x1 = _fma(-lower, r0, r1) / u11
+    return _fma(-x1, a01, r0) / a00, x1
 
 
 def normal_line(nd: float, vd: float, pgf: float | None = None) -> Dispersion:
@@ -187,9 +217,10 @@ def _catalogue(nd, vd, g, matched_by) -> Dispersion:
         b1, b2, b3, c1, c2, c3 = g.sellmeier
         base, kind, err = (0.0, 0.0, 0.0, b1, b2, b3, c1, c2, c3), "sellmeier", 0.0
     else:
-        from .glassfit import tracer_form
+        from .glassfit import stored_form, tracer_form
 
-        base, err = tracer_form(g.formula, tuple(g.coefficients), _traced_band(g))
+        band = _traced_band(g)
+        base, err = stored_form(g, band) or tracer_form(g.formula, tuple(g.coefficients), band)
         kind = "catalogue-fit"
         if err > FIT_TOLERANCE:
             import warnings
@@ -263,6 +294,8 @@ def glass_index(name: str, wavelength_nm, catalog: str | None = None):
     >>> round(float(glass_index("N-BK7", 486.1327)), 5)
     1.52238
     """
+    import numpy as np
+
     from ..lens.catalog import find_glass
 
     return find_glass(name, [catalog] if catalog else None).index(np.asarray(wavelength_nm, dtype=float))
@@ -284,6 +317,8 @@ def refractive_index(nd, vd, wavelength_nm, glass: str | None = None):
     >>> round(float(refractive_index(1.5168, 64.17, 587.5618)), 6)
     1.5168
     """
+    import numpy as np
+
     nd_a, vd_a = np.broadcast_arrays(np.asarray(nd, dtype=float), np.asarray(vd, dtype=float))
     if nd_a.ndim == 0:
         return dispersion(float(nd_a), float(vd_a), glass).index(wavelength_nm)
@@ -300,6 +335,8 @@ def cauchy_coefficients(nd, vd):
     physcam's model before the normal-line one (kept for comparisons: it forces
     P_gF = (1/g^2 - 1/F^2) / (1/F^2 - 1/C^2) = 0.5410 on every glass); B = 0 when Vd = 0.
     """
+    import numpy as np
+
     nd = np.asarray(nd, dtype=float)
     vd = np.asarray(vd, dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -19,13 +19,16 @@ the fitted band (the fit error a lens's report shows; :data:`FIT_TOLERANCE` in
 
 from __future__ import annotations
 
+import json
 from functools import lru_cache
+from pathlib import Path
 
-import numpy as np
+__all__ = ["tracer_form", "stored_form", "fit_table"]
 
-from ..lens.glassformulas import formula_index
-
-__all__ = ["tracer_form"]
+#: The fits of the bundled catalogues, one file per catalogue (``scripts/glass_fits.py`` writes them with
+#: :func:`fit_table`): the same numbers :func:`tracer_form` computes, read instead of fitted (issue 43: a
+#: lens of HOYA or CDGM glass reported without numpy, and 50 ms less per glass).
+STORED_DIR = Path(__file__).parent.parent / "data" / "glass" / "fits"
 
 _KEY_UM = (0.6562725, 0.5875618, 0.4861327)  # C, d, F
 
@@ -33,6 +36,8 @@ _KEY_UM = (0.6562725, 0.5875618, 0.4861327)  # C, d, F
 def _solve(l2, n, w, poles):
     """B (least squares on n^2 - 1) then a0 a1 a2 (weighted least squares on what is left in n)
     for the given poles; returns (a, b, residual in n)."""
+    import numpy as np
+
     sb = np.stack([l2 / (l2 - c) for c in poles], axis=1)
     b, *_ = np.linalg.lstsq(sb / (2 * n[:, None]), (n * n - 1.0) / (2 * n), rcond=None)
     s = 1.0 + sb @ b
@@ -47,6 +52,8 @@ def _solve(l2, n, w, poles):
 
 def _fit_poles(l2, n, w, lo2, hi2):
     """Poles by a coarse grid, then Levenberg-Marquardt on log C (variable projection)."""
+    import numpy as np
+
     best = None
     for c1 in np.geomspace(1e-4, 0.3 * lo2, 8):
         for c2 in np.geomspace(2.0 * c1, 0.9 * lo2, 7):
@@ -83,6 +90,8 @@ def _fit_poles(l2, n, w, lo2, hi2):
 
 
 def _model(p, l2):
+    import numpy as np
+
     c = np.exp(p[6:])
     s = 1.0 + sum(p[3 + i] * l2 / (l2 - c[i]) for i in range(3))
     return p[0] + (p[1] + p[2] / l2) / l2 + np.sqrt(np.maximum(s, 1e-12))
@@ -90,6 +99,8 @@ def _model(p, l2):
 
 def _polish(l2, n, w, p, lo2, hi2, r0):
     """Levenberg-Marquardt on all nine parameters (weighted residual) from the projected start."""
+    import numpy as np
+
     r = (_model(p, l2) - n) * w
     cost, lam = float(r @ r), 1e-3
     for _ in range(200):
@@ -119,6 +130,10 @@ def _polish(l2, n, w, p, lo2, hi2, r0):
 @lru_cache(maxsize=2048)
 def tracer_form(formula: int, coefficients: tuple, band_nm: tuple) -> tuple[tuple, float]:
     """(9 coefficients a0 a1 a2 B1 B2 B3 C1 C2 C3, max |error|) of ``formula`` fitted over ``band_nm``."""
+    import numpy as np
+
+    from ..lens.glassformulas import formula_index
+
     lam = np.concatenate([np.linspace(band_nm[0], band_nm[1], 161) / 1000.0, _KEY_UM])
     n = np.asarray(formula_index(formula, coefficients, lam), dtype=float)
     l2 = lam * lam
@@ -130,3 +145,40 @@ def tracer_form(formula: int, coefficients: tuple, band_nm: tuple) -> tuple[tupl
     a, b, poles, r = _polish(l2, n, w, np.concatenate([a, b, np.log(poles)]), lo2, hi2, r)
     coefs = (float(a[0]), float(a[1]), float(a[2]), *map(float, b), *map(float, poles))
     return coefs, float(np.max(np.abs(r)))
+
+
+def stored_form(glass, band_nm: tuple) -> tuple[tuple, float] | None:
+    """:func:`tracer_form` of a bundled catalogue's ``glass`` (a :class:`~physcam.lens.catalog_glass.CatalogGlass`)
+    over ``band_nm`` as stored in :data:`STORED_DIR`, or None when not stored for exactly this formula,
+    these coefficients and this band (a user's catalogue, or data changed since the table was written)."""
+    from ..errors import InputError, require_type
+    from ..lens.catalog_glass import CatalogGlass
+
+    require_type("glass", glass, CatalogGlass, "physcam.lens.catalog.find_glass(name)")
+    try:
+        band_nm = tuple(float(b) for b in band_nm)
+    except (TypeError, ValueError):
+        raise InputError(f"band_nm must be (low, high) in nm, got {band_nm!r:.40}") from None
+    e = _stored(glass.maker).get(glass.name.upper())
+    if (e is None or e["formula"] != glass.formula or tuple(e["coefficients"]) != tuple(glass.coefficients)
+            or tuple(e["band_nm"]) != tuple(band_nm)):
+        return None
+    return tuple(e["form"]), e["error"]
+
+
+@lru_cache(maxsize=None)
+def _stored(maker: str) -> dict:
+    path = STORED_DIR / f"{maker}.json"
+    return json.loads(path.read_text(encoding="utf-8"))["glasses"] if path.is_file() else {}
+
+
+def fit_table(glasses, band_of) -> dict:
+    """The stored form of ``glasses`` (catalogue glasses whose formula is refitted): {NAME: entry},
+    each entry the formula, coefficients and band fitted (the key :func:`stored_form` checks) and the fit."""
+    out = {}
+    for g in glasses:
+        band = band_of(g)
+        form, err = tracer_form(g.formula, tuple(g.coefficients), band)
+        out[g.name.upper()] = {"formula": g.formula, "coefficients": list(g.coefficients), "band_nm": list(band),
+                               "form": list(form), "error": err}
+    return out

@@ -19,7 +19,6 @@ with its formats listed: DOF and field of view depend on the crop.
 from __future__ import annotations
 
 import csv
-import difflib
 import math
 import re
 from dataclasses import dataclass
@@ -263,6 +262,8 @@ def find_sensor(name: str) -> Sensor:
     for s in sensors():
         for label in (s.name, *s.aliases):
             labels.setdefault(_norm(label), label)
+    import difflib
+
     close = difflib.get_close_matches(key, list(labels), n=4, cutoff=0.4)
     hint = "; closest: " + ", ".join(repr(labels[c]) for c in close) if close else ""
     raise SensorError(f"unknown sensor {name!r}{hint}. `physcam sensors` lists them all")

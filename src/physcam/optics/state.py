@@ -255,9 +255,8 @@ def _mark(focus_mm) -> float | str:
 
 def wavelengths_and_weights(lens, wavelengths_nm, weights):
     """Validated wavelengths (nm) and weights normalised to sum 1; the first wavelength is the primary.
-    ``lens``: a Prescription (default: its design wavelength) or a CameraState (default: its own)."""
-    import numpy as np
-
+    ``lens``: a Prescription (default: its design wavelength) or a CameraState (default: its own).
+    numpy only for given sequences (the on-set report of a prescription does not import it)."""
     from .glass import require_wavelength
 
     if isinstance(lens, CameraState):
@@ -267,6 +266,8 @@ def wavelengths_and_weights(lens, wavelengths_nm, weights):
     if wavelengths_nm is None:
         wls = [float(lens.wavelength_nm)]
     else:
+        import numpy as np
+
         if isinstance(wavelengths_nm, (str, bytes)) or np.ndim(wavelengths_nm) > 1:
             raise InputError(f"wavelengths must be numbers in nm, got {wavelengths_nm!r:.60}")
         seq = np.atleast_1d(np.asarray(wavelengths_nm, dtype=object)).tolist()
@@ -280,6 +281,8 @@ def wavelengths_and_weights(lens, wavelengths_nm, weights):
     if weights is None:
         ws = [1.0] * len(wls)
     else:
+        import numpy as np
+
         if isinstance(weights, (str, bytes)) or np.ndim(weights) > 1:
             raise InputError(f"weights must be numbers, got {weights!r:.60}")
         ws = [require_finite("wavelength weight", w) for w in np.atleast_1d(np.asarray(weights, dtype=object)).tolist()]

@@ -129,7 +129,7 @@ def run_server(app, sock: socket.socket, *, log_requests: bool = False, limits: 
     cap, the header timeout and the connection caps of :mod:`physcam.serve.protocol`. With
     ``certfile`` and ``keyfile`` (PEM) it speaks HTTPS: a secure context, so phones on the network can
     install the page's offline copy (docs/serve.md)."""
-    from .app import Limits
+    from .app import Limits, settle_heap
 
     if not callable(app):
         raise WrongTypeError(f"app must be an ASGI application, got {type(app).__name__}")
@@ -149,6 +149,7 @@ def run_server(app, sock: socket.socket, *, log_requests: bool = False, limits: 
         h11_max_incomplete_event_size=limits.head_bytes,
         ssl_certfile=None if certfile is None else str(certfile), ssl_keyfile=None if keyfile is None else str(keyfile),
     )
+    settle_heap()  # what start-up made (modules, the app, the lens library) is never collected again
     uvicorn.Server(config).run(sockets=[sock])
 
 

@@ -27,8 +27,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from ...errors import InputError, renamed_parameter, require_finite, require_positive, require_type
 from ...lens.prescription import Prescription, takes_prescription
 
@@ -162,8 +160,6 @@ def real_field_of_view_focused(lens: Prescription, focused: Prescription, film_z
     lens space, for the focus ``mark`` from the film; None: a film plane placed by hand): what the
     on-set report asks of its camera's own focus solution."""
     from ...optics import paraxial
-    from ...trace import RayBatch, trace_through
-    from .._chief import aim_from_film
 
     require_type("lens", lens, Prescription, "physcam.lens.library.load_lens(name)")
     require_type("focused", focused, Prescription, "physcam.optics.focusing.focus(lens, mark).prescription")
@@ -177,13 +173,9 @@ def real_field_of_view_focused(lens: Prescription, focused: Prescription, film_z
            2.0 * math.degrees(math.atan(math.hypot(tx, ty))))
 
     names = ("horizontal", "vertical", "diagonal")
-    pts = np.array([[w / 2.0, 0.0], [0.0, h / 2.0], [w / 2.0, h / 2.0]])
-    aimed = aim_from_film(focused, pts, fz, wavelength_nm=wl, backend=backend)
-    out = trace_through(focused, RayBatch.from_arrays(aimed.start, aimed.direction, wl), reverse=True, clip=True,
-                        backend=backend)
-    ok = aimed.ok & out.ok
-    half = np.degrees(np.arctan2(np.hypot(out.L, out.M), -out.N))
-    real = [float(2.0 * a) if good else None for a, good in zip(half, ok)]
+    pts = ((w / 2.0, 0.0), (0.0, h / 2.0), (w / 2.0, h / 2.0))
+    real = _real_full_angles(focused, pts, fz, float(wl), backend)
+    ok = [r is not None for r in real]
     diff = [None if r is None else 100.0 * (r / p - 1.0) for r, p in zip(real, par)]
     missing = tuple(n for n, good in zip(names, ok) if not good)
     reason = None
@@ -194,3 +186,24 @@ def real_field_of_view_focused(lens: Prescription, focused: Prescription, film_z
     return RealFieldOfView(
         lens.name, w, h, mark, float(fz), float(wl), real[0], real[1], real[2], par[0], par[1], par[2],
         diff[0], diff[1], diff[2], any(d is not None and abs(d) > DIFFERS_PCT for d in diff), missing, reason)
+
+
+def _real_full_angles(focused: Prescription, pts, film_z: float, wl: float, backend: str) -> list:
+    """2 theta (degrees) of the chief ray from each film point, None where it does not pass: in Python
+    floats when Newton alone aims every ray (:mod:`physcam.analysis._chief_float`, no numpy import; the
+    default backend only), else with the tracer (continuation from the axis, any backend)."""
+    from .._chief_float import film_chief_directions
+
+    rays = film_chief_directions(focused, pts, film_z, wl) if backend == "auto" else None
+    if rays is not None:
+        return [2.0 * math.degrees(math.atan2(math.hypot(L, M), -N)) if flag == 0 else None for flag, L, M, N in rays]
+    import numpy as np
+
+    from ...trace import RayBatch, trace_through
+    from .._chief import aim_from_film
+
+    aimed = aim_from_film(focused, np.array(pts), film_z, wavelength_nm=wl, backend=backend)
+    out = trace_through(focused, RayBatch.from_arrays(aimed.start, aimed.direction, wl), reverse=True, clip=True,
+                        backend=backend)
+    half = np.degrees(np.arctan2(np.hypot(out.L, out.M), -out.N))
+    return [float(2.0 * a) if good else None for a, good in zip(half, aimed.ok & out.ok)]

@@ -128,12 +128,13 @@ class _Tracer:
     all fields of a chart) to call them few times."""
 
     def __init__(self, st: Setup):
+        from ...trace.camera_tracer import camera_tracer
         from ...trace.kernels import get_kernel
         from ...trace.kernels._layout import pack
-        from ...trace.surfaces import surface_table
 
         self.st = st
-        self.table = surface_table(st.lens, stop_semi_diameter=st.stop_semi_diameter)
+        # the camera's tracer: its lens focused and stopped to the iris's corners (st.stop_semi_diameter)
+        self.table = camera_tracer(st.state).scene_side_table
         self.S, self.kinds = pack(self.table)
         self.stop_row = int(np.flatnonzero(self.table.index == st.lens.stop_index)[0])
         self.kernel = get_kernel(st.backend)

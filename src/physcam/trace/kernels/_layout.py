@@ -1,8 +1,7 @@
-"""Column layout of the packed surface array shared by the kernels (no numba import here)."""
+"""Column layout of the packed surface array shared by the kernels (no numba import here; numpy only
+when a table is packed, so the constants load without it)."""
 
 from __future__ import annotations
-
-import numpy as np
 
 VZ, AX, AY, AZ, CV, CK, SEMI, RSC, UNIT, N1, N2, ETA, SB, SA = range(14)
 #: 9 dispersion coefficients (a0 a1 a2 B1 B2 B3 C1 C2 C3, :func:`physcam.optics.glass.evaluate`)
@@ -22,6 +21,8 @@ NEWTON_MAX_ITER = 40
 
 def pack(table):
     """(float64 (n, N_COLS) array, int64 kinds) from a :class:`~physcam.trace.surfaces.SurfaceTable`."""
+    import numpy as np
+
     n = len(table)
     s = np.zeros((n, N_COLS), dtype=np.float64)
     s[:, VZ] = table.vertex_z
@@ -46,6 +47,8 @@ def pack(table):
 def index_rows(S, first, flag, wavelength_nm):
     """Index of one medium per row at one wavelength: the arithmetic of
     :func:`physcam.optics.glass.evaluate` (and of the kernels' per-ray path), so all agree bitwise."""
+    import numpy as np
+
     lam = np.float64(wavelength_nm)
     l2 = (lam / 1000.0) * (lam / 1000.0)
     u = 1.0 / l2
@@ -61,6 +64,8 @@ def set_wavelength(S, wavelength_nm: float) -> None:
     Same arithmetic as the per-ray path (:func:`index_rows`, eta = n1 / n2), so both paths give
     bit-identical rays.
     """
+    import numpy as np
+
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         S[:, N1] = index_rows(S, NB, SB, wavelength_nm)
         S[:, N2] = index_rows(S, NA, SA, wavelength_nm)
