@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from ..optics.state import CameraState, takes_camera
+from ..optics.state import CameraState, as_designed, camera_state, takes_camera
 
 __all__ = ["fstop_for_comparison", "lens_measurements"]
 
@@ -117,9 +117,9 @@ def _illumination(lens, state, sensor, out, curves, notes) -> None:
     from ..analysis.image_quality.illumination import relative_illumination
 
     try:
-        sd = state().stop_semi_diameter
-        ri = relative_illumination(lens, grid=64, stop_semi_diameter=sd, sensor_width_mm=sensor.width_mm,
-                                   sensor_height_mm=sensor.height_mm)
+        camera = as_designed(lens, stop_semi_diameter=state().stop_semi_diameter,
+                             sensor_mm=(sensor.width_mm, sensor.height_mm))
+        ri = relative_illumination(camera, grid=64)
         pts = [p for p in ri.points if p.axis == "y"]
         out["illumination_field_deg"], out["illumination_corner"] = pts[-1].field_deg, pts[-1].relative_illumination
         out["illumination_corner_stops"] = -math.log2(max(pts[-1].relative_illumination, 1e-12))
@@ -142,8 +142,8 @@ def _bokeh(state, mark, light_mm, rays, out, curves, notes) -> None:
     out["bokeh_light_from_film_mm"] = light
     try:
         st = state()
-        img = bokeh_image(st.focused, light, film_z=st.film_z, rays=rays, pixels=96, stop_semi_diameter=st.stop_semi_diameter,
-                          chunk=min(max(rays, 1000), 250_000))
+        camera = camera_state(st.focused, film_z=st.film_z, stop_semi_diameter=st.stop_semi_diameter)
+        img = bokeh_image(camera, light, rays=rays, pixels=96, chunk=min(max(rays, 1000), 250_000))
         mono = img.image.sum(axis=2) if img.image.ndim == 3 else img.image
         x0, x1, _, _ = img.extent_mm
         out["bokeh_diameter_mm"] = equivalent_diameter(mono, pixel=(x1 - x0) / mono.shape[1])

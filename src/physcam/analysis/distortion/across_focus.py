@@ -68,6 +68,7 @@ def distortion_across_focus(lens: Prescription, focus_mm, *, sensor_width_mm: fl
                             width_px: int, height_px: int, wavelength_nm: float | None = None,
                             method: str = "auto") -> DistortionAcrossFocus:
     """One row per focus mark in ``focus_mm`` (module notes)."""
+    from ...optics.state import camera_state
     from .models import fit_brown_conrady, fit_tde4_radial, samples_from_field
     from .stmap import distortion_field
 
@@ -76,9 +77,9 @@ def distortion_across_focus(lens: Prescription, focus_mm, *, sensor_width_mm: fl
         raise InputError(f"give 1 to {MAX_FOCUS_ROWS} focus distances, got {len(marks)}")
     rows = []
     for s in marks:
-        res = distortion_field(lens, focus_mm=s, sensor_width_mm=sensor_width_mm, sensor_height_mm=sensor_height_mm,
-                               width_px=width_px, height_px=height_px, wavelength_nm=wavelength_nm, method=method,
-                               maps=False)
+        camera = camera_state(lens, focus_mm=s, sensor_mm=(sensor_width_mm, sensor_height_mm))
+        res = distortion_field(camera, width_px=width_px, height_px=height_px, wavelength_nm=wavelength_nm,
+                               method=method, maps=False)
         smp = samples_from_field(res)
         r_real = np.hypot(*smp.distorted_mm.T)
         k = int(np.argmax(r_real))  # a frame corner
