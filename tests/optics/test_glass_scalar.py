@@ -41,7 +41,6 @@ def _stored():
 
 
 def test_every_refitted_catalogue_glass_is_stored_with_its_current_data():
-    stored = _stored()
     for name in BUILTIN_CATALOGS:
         for g in catalog(name).values():
             if g.formula is not None and g.sellmeier is None:
