@@ -22,6 +22,8 @@ BPY_VERSION   ?= 5.0.1
 # Installs go through uv (https://docs.astral.sh/uv/, installed into .venv by pip first): it resolves
 # the same versions as pip (constraints.txt) and installs them 2-3x faster, which the 15-minute CI
 # budget needs (docs/performance.md, "make test"). A user's own `pip install physcam` is unaffected.
+# --compile-bytecode, as pip does: under PYTHONDONTWRITEBYTECODE (CI sets it) every test's subprocess
+# would otherwise compile numpy, matplotlib and physcam's dependencies from source again (+185 s).
 UV := $(VENV)/bin/uv
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -30,7 +32,7 @@ $(PY):
 # The test environment gets the exact versions of constraints.txt (reproducible CI); the library's own
 # dependencies are ranges (pyproject.toml), so a studio can install physcam into its environment.
 $(STAMP): $(PY) pyproject.toml constraints.txt
-	$(UV) pip install --quiet --python $(PY) -c constraints.txt -e '.[test]'
+	$(UV) pip install --quiet --compile-bytecode --python $(PY) -c constraints.txt -e '.[test]'
 	touch $(STAMP)
 
 venv: $(STAMP)
@@ -55,14 +57,14 @@ shell: $(STAMP)
 BLENDER_BPY := $(BLENDER_VENV)/.bpy-installed
 $(BLENDER_BPY): | $(PY)
 	@( $(PYTHON) -m venv $(BLENDER_VENV) \
-	  && $(UV) pip install --quiet --python $(BLENDER_PY) "bpy==$(BPY_VERSION)" \
+	  && $(UV) pip install --quiet --compile-bytecode --python $(BLENDER_PY) "bpy==$(BPY_VERSION)" \
 	  && touch $(BLENDER_BPY) ) \
 	|| ( echo "physcam: Blender (bpy==$(BPY_VERSION)) could not be installed here; the Blender tests will be skipped" >&2; \
 	     rm -rf $(BLENDER_VENV) )
 
 $(BLENDER_STAMP): pyproject.toml $(STAMP) | $(BLENDER_BPY)
 	@if [ -f $(BLENDER_BPY) ]; then \
-	  $(UV) pip install --quiet --python $(BLENDER_PY) -e '.[fast]' && touch $(BLENDER_STAMP) \
+	  $(UV) pip install --quiet --compile-bytecode --python $(BLENDER_PY) -e '.[fast]' && touch $(BLENDER_STAMP) \
 	  || { echo "physcam: physcam could not be installed beside Blender; the Blender tests will be skipped" >&2; \
 	       rm -rf $(BLENDER_VENV); }; fi
 
@@ -105,7 +107,7 @@ USD_MIN     ?= 25.8
 USD_MIN_DIR ?= $(VENV)/usd-min-$(USD_MIN)
 usd-min: $(STAMP)
 	@test -f $(USD_MIN_DIR)/.installed || ( rm -rf $(USD_MIN_DIR) \
-	  && $(UV) pip install --quiet --python $(PY) --no-deps --target $(USD_MIN_DIR) "usd-core==$(USD_MIN)" \
+	  && $(UV) pip install --quiet --compile-bytecode --python $(PY) --no-deps --target $(USD_MIN_DIR) "usd-core==$(USD_MIN)" \
 	  && touch $(USD_MIN_DIR)/.installed )
 	PYTHONPATH="$(abspath $(USD_MIN_DIR)):$(abspath src)" PHYSCAM_USD_MIN=$(USD_MIN) \
 	  PHYSCAM_USD_MIN_DIR="$(abspath $(USD_MIN_DIR))" $(PY) -m pytest -q -p no:cacheprovider tests/usd \
@@ -124,7 +126,7 @@ test-latest:
 latest-venv: | $(STAMP)
 	rm -rf $(LATEST_VENV)
 	$(PYTHON) -m venv $(LATEST_VENV)
-	$(UV) pip install --quiet --python $(LATEST_PY) --upgrade -e '.[all]' pytest pytest-xdist hypothesis opencv-python-headless
+	$(UV) pip install --quiet --compile-bytecode --python $(LATEST_PY) --upgrade -e '.[all]' pytest pytest-xdist hypothesis opencv-python-headless
 
 latest-run:
 	@$(UV) pip list --python $(LATEST_PY) --format=freeze 2>/dev/null \

@@ -128,14 +128,14 @@ def test_setup_script_embeds_the_shader_and_sets_the_camera():
 
 def test_write_blender_camera_does_not_clobber(tmp_path):
     lens = load_lens("cooke_triplet_50mm_f4_5")
-    kw = dict(focus_mm=5000.0, sensor_width_mm=36.0, sensor_height_mm=24.0)
-    osl, setup = write_blender_camera(tmp_path, lens, name="cooke", **kw)
+    camera = camera_state(lens, focus_mm=5000.0, sensor_mm=(36.0, 24.0))
+    osl, setup = write_blender_camera(camera, tmp_path, name="cooke")
     assert osl.name == "cooke.osl" and setup.name == "setup_cooke.py"
-    assert osl.read_text() == osl_camera_shader(lens, **kw)
+    assert osl.read_text() == osl_camera_shader(camera)
     assert repr(osl.read_text()) in setup.read_text()
     with pytest.raises(ExportError, match="exists"):
-        write_blender_camera(tmp_path, lens, name="cooke", **kw)
-    write_blender_camera(tmp_path, lens, name="cooke", force=True, **dict(kw, focus_mm=2000.0))
+        write_blender_camera(camera, tmp_path, name="cooke")
+    write_blender_camera(camera_state(lens, focus_mm=2000.0, sensor_mm=(36.0, 24.0)), tmp_path, name="cooke", force=True)
     assert "focus 2000 mm" in osl.read_text()
 
 

@@ -41,8 +41,9 @@ def test_write_blender_camera_from_a_state_writes_the_same_files(tmp_path):
     lens = load_lens("dgauss_50mm")
     kw = dict(resolution=(360, 270), name="cam")
     a = write_blender_camera(tmp_path / "a", camera_state(lens, focus_mm=2000.0, fstop=4.0, sensor_mm=SENSOR), **kw)
-    b = write_blender_camera(tmp_path / "b", lens, focus_mm=2000.0, fstop=4.0, sensor_width_mm=SENSOR[0],
-                             sensor_height_mm=SENSOR[1], **kw)
+    with pytest.warns(DeprecationWarning, match="camera_state"):  # the pre-issue-43 form, until physcam 0.3
+        b = write_blender_camera(tmp_path / "b", lens, focus_mm=2000.0, fstop=4.0, sensor_width_mm=SENSOR[0],
+                                 sensor_height_mm=SENSOR[1], **kw)
     assert [p.name for p in a] == [p.name for p in b] == ["cam.osl", "setup_cam.py"]
     for pa, pb in zip(a, b):
         assert pa.read_text() == pb.read_text()
