@@ -498,6 +498,10 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
 
     if not isinstance(backend, Backend):
         raise WrongTypeError(f"backend must be a physcam.serve.Backend, got {type(backend).__name__}")
+    # numpy now, on this one thread: the report path no longer imports it (issue 43), and requests run
+    # on several threads; two of them importing it first at once can see it half initialised (Python
+    # 3.11's import-deadlock avoidance: "partially initialized module 'numpy' has no attribute 'errstate'")
+    import numpy  # noqa: F401
     limits = Limits() if limits is None else limits
     if not isinstance(limits, Limits):
         raise WrongTypeError(f"limits must be a physcam.serve.Limits, got {type(limits).__name__}")
