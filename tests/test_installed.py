@@ -2,8 +2,8 @@
 into a fresh virtual environment in a temporary folder (no source tree on the path, no physcam
 environment variables), first alone (the light core), then with every extra (issue 26).
 
-It needs pip to reach the package index (CI does; the versions come from constraints.txt, so pip's
-cache serves them). The sizes and times it measures are printed (pytest -s) and recorded in
+It needs pip to reach the package index (CI does; the versions come from constraints.txt). The core
+wheel goes in with pip; the extras with uv where the test environment has it (:func:`_add`). The sizes and times it measures are printed (pytest -s) and recorded in
 docs/install.md.
 """
 
@@ -28,6 +28,21 @@ def _run(cmd, cwd, *, env, check=True, timeout=900):
     if check and p.returncode != 0:
         raise AssertionError(f"{' '.join(map(str, cmd))} exited {p.returncode}:\n{p.stdout[-2000:]}\n{p.stderr[-3000:]}")
     return p
+
+
+def _add(inst, *requirements, target=None):
+    """Install ``requirements`` (constraints.txt's versions) into the installed environment, or into the
+    folder ``target``: with the test environment's uv where it has one (the Makefile's installer, the
+    same resolution as pip; its cache is warm from `make test`, and it does not byte-compile what no
+    test imports: the extras cost 66 s of the suite with pip), else pip. The core wheel itself goes in
+    with pip, as a studio installs it."""
+    uv = Path(sys.executable).with_name("uv")
+    where = ["--target", str(target)] if target is not None else []
+    if uv.exists():
+        cmd = [uv, "pip", "install", "--quiet", "--python", inst["py"], *where]
+    else:
+        cmd = [inst["py"], "-m", "pip", "install", "--quiet", *where]
+    _run([*cmd, "-c", str(ROOT / "constraints.txt"), *map(str, requirements)], inst["work"], env=inst["env"])
 
 
 def _size_mb(folder: Path) -> float:
@@ -132,8 +147,7 @@ def test_the_core_reads_camera_metadata_and_a_take_needs_usd_before_it_is_receiv
     assert len(json.loads(p.stdout)["frames"]) == 48
     # with the 'live' extra but not 'usd' (its two packages on a side path), a recording stops at once
     side = inst["tmp"] / "live-only"
-    _run([inst["py"], "-m", "pip", "install", "--quiet", "-c", str(ROOT / "constraints.txt"), "--target", str(side),
-          "jsonschema", "cbor2"], inst["work"], env=inst["env"])
+    _add(inst, "jsonschema", "cbor2", target=side)
     env = dict(inst["env"], PYTHONPATH=str(side))
     t0 = time.perf_counter()
     p = _run([inst["bin"] / "physcam", "live", "record", "take.usda", "--port", "55631", "--duration", "30"],
@@ -171,8 +185,7 @@ def test_the_fast_extra_compiles_once_where_the_install_can_write(installed):
     cache folder is blocked by a file, since this suite may run as root, whom permissions do not stop)
     it goes to the user cache (XDG_CACHE_HOME), and the next process loads it instead of compiling."""
     inst = installed
-    _run([inst["py"], "-m", "pip", "install", "--quiet", "-c", str(ROOT / "constraints.txt"),
-          f"{inst['wheel']}[fast]"], inst["work"], env=inst["env"])
+    _add(inst, f"{inst['wheel']}[fast]")
     pycache = inst["site"] / "physcam" / "trace" / "kernels" / "__pycache__"
     pycache.mkdir(exist_ok=True)
     (pycache / "physcam-jit").write_text("not a folder: the package's own cache place is unusable\n")
@@ -187,8 +200,7 @@ def test_the_fast_extra_compiles_once_where_the_install_can_write(installed):
 
 def test_with_every_extra_the_demo_usd_plugin_and_serve_work(installed):
     inst = installed
-    _run([inst["py"], "-m", "pip", "install", "--quiet", "-c", str(ROOT / "constraints.txt"),
-          f"{inst['wheel']}[all]"], inst["work"], env=inst["env"])
+    _add(inst, f"{inst['wheel']}[all]")
     print(f"\nwith every extra: {_size_mb(inst['site']):.0f} MB in site-packages")
     _physcam(inst, "demo", "--out", "demo")
     assert (inst["work"] / "demo").is_dir()

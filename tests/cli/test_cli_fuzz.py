@@ -220,7 +220,7 @@ class ForkServer:
 
 #: Commands whose every accepted run does minutes of work (the demo; the extension zip of every bundled
 #: lens) get fewer drawn runs: their refusals are what the fuzzer is for, and the suite keeps its budget.
-EXAMPLES = {("demo",): 4, ("export", "blender-extension"): 4}
+EXAMPLES = {("demo",): 2, ("export", "blender-extension"): 4}
 
 #: checkers exit 1 when they find a problem (docs/cli.md, "Exit status")
 CHECKERS = {("lens", "check"), ("usd", "check")}
