@@ -4,8 +4,6 @@ array form, and the stored catalogue fits (src/physcam/data/glass/fits) against 
 
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 from hypothesis import given, settings
@@ -57,13 +55,3 @@ def test_stored_fits_are_what_fitting_gives():
             form, err = tracer_form(e["formula"], tuple(e["coefficients"]), tuple(e["band_nm"]))
             assert all(math.isclose(a, b, rel_tol=1e-12, abs_tol=1e-18) for a, b in zip(form, e["form"])), key
             assert math.isclose(err, e["error"], rel_tol=1e-6, abs_tol=1e-12)
-
-
-def test_a_report_of_a_lens_of_refitted_glass_does_not_import_numpy():
-    code = ("import sys, warnings; warnings.simplefilter('ignore')\n"
-            "from physcam.lens.library import load_lens\n"
-            "from physcam.onset.report import solve_lens_report\n"
-            "r = solve_lens_report(lens=load_lens('zuiko_18mm_f3_5'), sensor='S35', fstop=4.0, focus_mm=2000.0)\n"
-            "print(sorted(m for m in ('numpy', 'scipy', 'matplotlib') if m in sys.modules))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "[]"
