@@ -33,7 +33,7 @@ def register(sub) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_report_arguments(p)
-    from .lens import add_lenient
+    from ._common import add_lenient
 
     add_lenient(p)
     from ._common import add_units_option
@@ -334,7 +334,7 @@ def report_document(report, cams, args) -> dict:
     d = report.to_dict()
     d["cameras"] = cams
     if getattr(args, "loaded_lens", None) is not None:
-        from .lens import mark_repaired
+        from ._common import mark_repaired
 
         d = mark_repaired(d, args.loaded_lens)
     return d
