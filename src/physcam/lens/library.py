@@ -17,10 +17,10 @@ import contextlib
 import contextvars
 import math
 import re
-from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+from .._record import record
 from ..errors import InputError, LensFileError
 from .prescription import Prescription, takes_prescription
 
@@ -66,7 +66,7 @@ def require_camera_lens(p: Prescription, label: str | None = None, what: str = "
                      "an infinite-conjugate lens (`physcam lens show` and `physcam trace` read it)")
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class LensRecord:
     """What ``physcam lenses`` lists about one lens of the library (lengths in mm)."""
 

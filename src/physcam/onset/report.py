@@ -31,8 +31,9 @@ from __future__ import annotations
 
 import math
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import field
 
+from .._record import record
 from ..errors import InputError, OpticsError, require_positive, require_type
 from ..optics import _num
 from ..optics import dof as _dof
@@ -84,7 +85,7 @@ def fstop_airy_equals(size_mm, wavelength_nm=DIFFRACTION_WAVELENGTH_NM, bellows_
     return _num.out(c / airy_per_stop, what="the f-stop whose Airy disk equals the size")
 
 
-@dataclass(frozen=True)
+@record
 class LensReport(OfACamera):
     """Everything the lens report knows. Lengths in mm, angles in degrees.
 

@@ -20,9 +20,10 @@ front of the reference, toward the subject), the on-set convention.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, field
 from functools import lru_cache
 
+from .._record import record
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
@@ -175,7 +176,7 @@ def _inverse(m):
     return (m[3] / det, -m[1] / det, -m[2] / det, m[0] / det)
 
 
-@dataclass(frozen=True)
+@record
 class GaussianData:
     """First-order data of one lens configuration in one meridian.
 
@@ -360,7 +361,7 @@ def _stop_semi(prescription: Prescription, axis: str, lam: float, fstop, stop_se
     return stop_semi
 
 
-@dataclass(frozen=True)
+@record
 class _Pupils:
     """The entrance and exit pupils (images of the stop) and the chief ray that defines them."""
 
