@@ -2,6 +2,7 @@
 repr, equality, hash and frozen-ness, class by class (issue 43: records cost less to define)."""
 
 import dataclasses
+import pickle
 
 import pytest
 from hypothesis import given, settings, strategies as st
@@ -53,6 +54,50 @@ def test_a_record_behaves_as_the_frozen_dataclass(options, x, y):
         rx.a = 1.0
     with pytest.raises(dataclasses.FrozenInstanceError):
         del rx.b
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        rx.other = 1  # not a field either (CPython 3.11's frozen slots dataclass raises TypeError here instead)
+    p, q = rec.__dataclass_params__, std.__dataclass_params__
+    assert (p.init, p.repr, p.eq, p.order, p.unsafe_hash, p.frozen) == (q.init, q.repr, q.eq, q.order, q.unsafe_hash,
+                                                                        q.frozen)
+
+
+@record
+class Plain:
+    a: float
+    b: tuple = ()
+
+
+@record(slots=True)
+class Slotted:
+    a: float
+    b: tuple = ()
+
+
+@pytest.mark.parametrize("cls", [Plain, Slotted])
+def test_a_record_pickles_and_copies(cls):
+    import copy
+
+    r = cls(1.5, (2, 3))
+    assert pickle.loads(pickle.dumps(r)) == r and copy.deepcopy(r) == r and copy.copy(r) == r
+    assert pickle.loads(pickle.dumps(r)) is not r
+
+
+def test_a_record_over_a_record_is_frozen_and_compares_its_own_fields():
+    @record
+    class Base:
+        a: float
+
+    @record
+    class Child(Base):
+        b: float = 2.0
+
+    c = Child(1.0)
+    assert repr(c).endswith("Child(a=1.0, b=2.0)") and c == Child(1.0, 2.0) and c != Child(1.0, 3.0)
+    assert c != Base(1.0) and hash(c) == hash((1.0, 2.0))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        c.b = 3.0
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        Base(1.0).a = 2.0
 
 
 def test_a_method_the_class_defines_is_kept():

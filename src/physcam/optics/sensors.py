@@ -266,7 +266,8 @@ def find_sensor(name: str) -> Sensor:
         members = [s.name for s in sensors() if fam in _norm(s.name)]
         raise SensorError(f"{name!r} names a camera family, not one sensor: give one of "
                           + "; ".join(repr(m) for m in members))
-    for idx in (_gate_index(), _index()):
+    for index in (_gate_index, _index):  # the camera table is read only for a name not among the gates
+        idx = index()
         if key in idx:
             return idx[key]
     formats = camera_formats(name)
