@@ -2,6 +2,7 @@
 repr, equality, hash and frozen-ness, class by class (issue 43: records cost less to define)."""
 
 import dataclasses
+import inspect
 import pickle
 
 import pytest
@@ -24,6 +25,12 @@ def _pair(**options):
             c: tuple = ()
             d: float | None = dataclasses.field(default=None, compare=False)
             e: int = dataclasses.field(default=0, repr=False)
+            f: list = dataclasses.field(default_factory=list, compare=False)
+            g: int = dataclasses.field(default=7, kw_only=True)
+            h: int = dataclasses.field(default=3, init=False)
+
+            def __post_init__(self):
+                object.__setattr__(self, "f", [*self.f, self.e])
 
         return Row
 
@@ -50,6 +57,12 @@ def test_a_record_behaves_as_the_frozen_dataclass(options, x, y):
     assert dataclasses.asdict(rx) == dataclasses.asdict(sx)
     assert dataclasses.replace(rx, b="y") == rec(**{**x, "b": "y"})
     assert rec.__match_args__ == std.__match_args__
+    assert str(inspect.signature(rec)) == str(inspect.signature(std))  # (each has its own "<factory>" marker)
+    for bad_args, bad_kwargs in (((), {}), ((1.0, "b", (), None, 0, 9), {}), ((1.0,), {"a": 2.0}), ((1.0,), {"z": 1})):
+        with pytest.raises(TypeError):
+            std(*bad_args, **bad_kwargs)
+        with pytest.raises(TypeError):
+            rec(*bad_args, **bad_kwargs)
     with pytest.raises(dataclasses.FrozenInstanceError):
         rx.a = 1.0
     with pytest.raises(dataclasses.FrozenInstanceError):
