@@ -8,10 +8,10 @@ what reads it (:mod:`physcam.figures`, which a report never needs: issue 43's st
 RUNNING = False
 
 #: The program's first threshold of the cyclic garbage collector (CPython's default: 700 container
-#: objects allocated and not freed). Start-up builds some 20,000 long-lived objects (modules, classes,
-#: functions, the sensor and glass tables), each collection scanning what the last ones kept: at 700 a
-#: `physcam report --lens` ran 28 collections for 6 ms of its 90 (issue 43, docs/performance.md). Cycles
-#: are still collected, every 50,000 allocations; the library, imported, leaves the caller's setting alone.
+#: objects allocated and not freed). Start-up builds some 18,000 long-lived objects (modules, classes,
+#: functions, the sensor and glass tables): at 700 a `physcam report --lens` ran 24 young, 3 middle and
+#: one full collection, each scanning what the last ones kept. Cycles are still collected, every 50,000
+#: allocations; the library, imported, leaves the caller's setting alone (issue 43, docs/performance.md).
 GC_THRESHOLD = 50_000
 
 
@@ -27,7 +27,7 @@ def start() -> None:
 
 def finish() -> None:
     """The program has answered and is about to exit (``sys.exit``): skip CPython's collection before
-    the module teardown, which scans every object start-up built (5 ms of a ``physcam report``). The
+    the module teardown, which scans every object start-up built (about 5 ms of a ``physcam report``). The
     interpreter still finalises what is left after the teardown; physcam has no finalisers, and exit
     handlers (``atexit``: temporary folders, numba, matplotlib) have run before either collection."""
     import gc
