@@ -8,7 +8,7 @@ import pickle
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from physcam._record import record
+from physcam._record import asdict, field, field_names, record, replace
 from physcam.lens.prescription import Medium, Surface
 from physcam.optics.sensors import Sensor
 
@@ -16,25 +16,25 @@ from physcam.optics.sensors import Sensor
 def _pair(**options):
     """The same class body made by dataclass(frozen=True) (the oracle) and by record."""
 
-    def body():
+    def body(field):
         class Row:
             """A row."""
 
             a: float
             b: str = "x"
             c: tuple = ()
-            d: float | None = dataclasses.field(default=None, compare=False)
-            e: int = dataclasses.field(default=0, repr=False)
-            f: list = dataclasses.field(default_factory=list, compare=False)
-            g: int = dataclasses.field(default=7, kw_only=True)
-            h: int = dataclasses.field(default=3, init=False)
+            d: float | None = field(default=None, compare=False)
+            e: int = field(default=0, repr=False)
+            f: list = field(default_factory=list, compare=False)
+            g: int = field(default=7, kw_only=True)
+            h: int = field(default=3, init=False)
 
             def __post_init__(self):
                 object.__setattr__(self, "f", [*self.f, self.e])
 
         return Row
 
-    return dataclasses.dataclass(frozen=True, **options)(body()), record(**options)(body())
+    return dataclasses.dataclass(frozen=True, **options)(body(dataclasses.field)), record(**options)(body(field))
 
 
 values = st.builds(lambda a, b, c, d, e: dict(a=a, b=b, c=c, d=d, e=e),
@@ -54,8 +54,16 @@ def test_a_record_behaves_as_the_frozen_dataclass(options, x, y):
     assert hash(rx) == hash(sx)
     assert rx.__eq__(sx) is NotImplemented and (rx == sx) is False  # another class, as the dataclass's
     assert [f.name for f in dataclasses.fields(rec)] == [f.name for f in dataclasses.fields(std)]
-    assert dataclasses.asdict(rx) == dataclasses.asdict(sx)
-    assert dataclasses.replace(rx, b="y") == rec(**{**x, "b": "y"})
+    assert dataclasses.asdict(rx) == dataclasses.asdict(sx) == asdict(rx)
+    assert [f.type for f in dataclasses.fields(rec)] == [f.type for f in dataclasses.fields(std)]
+    assert field_names(rx) == tuple(f.name for f in dataclasses.fields(std))
+    assert dataclasses.replace(rx, b="y") == replace(rx, b="y") == rec(**{**x, "b": "y"})
+    assert repr(replace(rx, g=1)) == repr(dataclasses.replace(sx, g=1))
+    with pytest.raises(ValueError):
+        replace(rx, h=1)  # an init=False field, as dataclasses.replace refuses it
+    with pytest.raises(ValueError):
+        dataclasses.replace(sx, h=1)
+    assert dataclasses.is_dataclass(rec) and dataclasses.is_dataclass(rx)
     assert rec.__match_args__ == std.__match_args__
     assert str(inspect.signature(rec)) == str(inspect.signature(std))  # (each has its own "<factory>" marker)
     for bad_args, bad_kwargs in (((), {}), ((1.0, "b", (), None, 0, 9), {}), ((1.0,), {"a": 2.0}), ((1.0,), {"z": 1})):

@@ -19,10 +19,9 @@ read is refused with the file's name, so a typo never silently falls back to a d
 from __future__ import annotations
 
 import os
-from dataclasses import field
 from pathlib import Path
 
-from .._record import record
+from .._record import field, record
 from ..errors import InputError
 
 __all__ = ["Config", "config_path", "load_config", "KEYS"]

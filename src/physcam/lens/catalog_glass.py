@@ -3,9 +3,8 @@ the catalogue's own dispersion formula (:mod:`physcam.lens.glassformulas`)."""
 
 from __future__ import annotations
 
-from dataclasses import field
 
-from .._record import record
+from .._record import field, record
 from ..errors import InputError
 from .glassformulas import formula_index, is_sellmeier3
 

@@ -17,10 +17,9 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import math
-from dataclasses import field, replace
 from collections.abc import Iterable
 
-from .._record import record
+from .._record import field, record, replace
 from ..errors import LensFileError
 
 __all__ = [

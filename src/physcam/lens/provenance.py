@@ -29,9 +29,8 @@ from __future__ import annotations
 import datetime
 import json
 import re
-from dataclasses import fields
 
-from .._record import record
+from .._record import field_names, record
 from ..errors import LensFileError
 from .prescription import Prescription, takes_prescription
 
@@ -98,9 +97,9 @@ class Provenance:
 
     def to_dict(self) -> dict:
         out = {}
-        for f in fields(self):
-            v = getattr(self, f.name)
-            out[f.name] = list(v) if isinstance(v, tuple) else v
+        for name in field_names(self):
+            v = getattr(self, name)
+            out[name] = list(v) if isinstance(v, tuple) else v
         return out
 
 
@@ -109,7 +108,7 @@ def provenance_of(prescription: Prescription) -> Provenance:
     """The provenance record of ``prescription`` (its metadata and ``provenance.*`` extras)."""
     m = prescription.metadata
     found = {"source": m.source, "licence": m.licence, "notes": m.notes}
-    names = {f.name for f in fields(Provenance)}
+    names = set(field_names(Provenance))
     for k, v in prescription.extras:
         key = k[len("provenance."):] if k.startswith("provenance.") else None
         if key in names and key not in found:

@@ -184,7 +184,7 @@ def _camera_of(r: SimpleNamespace) -> ReportInputs:
     else:
         cam = camera_state(model, focus_mm=r.focus_mm, fstop=fstop, sensor=r.sensor, coc=r.coc, squeeze=squeeze)
     if notes:
-        from dataclasses import replace
+        from .._record import replace
 
         cam = replace(cam, notes=notes + cam.notes)
     return ReportInputs(cam, r.coc, measured, refs)

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import replace
 from typing import NamedTuple
 
 from ..errors import InputError, OpticsError, require_type
@@ -39,7 +38,7 @@ from .inverse import hyperfocal_parameters, require_possible_f_number
 from .pupil import entrance_pupil_practical
 from .request import MeasuredLimits, References
 
-from .._record import record
+from .._record import record, replace
 
 __all__ = ["DepthOfField", "LensState", "PrincipalPlanes", "lens_at_mark", "principal_planes", "solve_focus",
            "invert_limits", "depth_of_field", "focus_error", "field_of_view", "entrance_pupil"]

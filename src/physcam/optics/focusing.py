@@ -26,9 +26,8 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import asdict
 
-from .._record import record
+from .._record import asdict, record
 from ..data.default_sensor import DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, renamed_parameter, require_positive, require_type
 from ..lens.prescription import Prescription, takes_prescription

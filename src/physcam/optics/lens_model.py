@@ -22,13 +22,12 @@ thin lens or a datasheet imports nothing heavier (docs/performance.md).
 from __future__ import annotations
 
 import math
-from dataclasses import field
 from typing import NamedTuple, Protocol, runtime_checkable
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from . import thinlens
 
-from .._record import record
+from .._record import field, record
 
 __all__ = ["LensModel", "LensAtMark", "PrincipalPlanes", "ThinLens", "Datasheet", "PrescriptionLens",
            "lens_model_of", "REFERENCE_PLANES"]

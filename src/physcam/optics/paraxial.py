@@ -20,10 +20,9 @@ front of the reference, toward the subject), the on-set convention.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, field
 from functools import lru_cache
 
-from .._record import record
+from .._record import asdict, field, record
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 

@@ -25,9 +25,8 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import field, replace
 
-from .._record import record
+from .._record import field, record, replace
 from ..errors import InputError, OpticsError, WrongTypeError, require_finite, require_type
 from .lens_model import LensModel, PrescriptionLens, lens_model_of
 from .sensors import Sensor

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 
-from ..._record import record
+from ..._record import field_names, record
 from ...errors import InputError, renamed_parameter, require_finite, require_positive, require_type
 from ...lens.prescription import Prescription, takes_prescription
 
@@ -72,7 +72,7 @@ class RealFieldOfView:
         return not self.not_covered
 
     def to_dict(self) -> dict:
-        d = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        d = {k: getattr(self, k) for k in field_names(self)}
         d["not_covered"] = list(self.not_covered)
         if d["focus_from_film_mm"] is not None and math.isinf(d["focus_from_film_mm"]):
             d["focus_from_film_mm"] = None
