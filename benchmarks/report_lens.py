@@ -25,7 +25,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parents[1] / "src"
 #: the standard library's modules `physcam report --lens` imports (round 7, issue 43), besides Python's start-up
-STDLIB = "argparse, contextvars, csv, dataclasses, datetime, json, pathlib, threading, tomllib, typing, unicodedata"
+STDLIB = "argparse, contextvars, csv, datetime, json, pathlib, threading, tomllib, typing, unicodedata"
 #: the report alone, inside one process: the lens and its glasses loaded first (what both trees share)
 INNER = r"""
 import sys, time, warnings
