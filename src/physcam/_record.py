@@ -197,6 +197,8 @@ class _StandardView:
         shadow = dataclasses.make_dataclass(owner.__name__, spec, init=False, repr=False, eq=False)
         params = shadow.__dataclass_params__  # what the record is: dataclass(frozen=True)'s
         params.init = params.repr = params.eq = params.frozen = True
+        if hasattr(params, "slots"):  # (Python 3.12 and later record it)
+            params.slots = "__slots__" in owner.__dict__
         fields = shadow.__dataclass_fields__
         if isinstance(owner.__dict__.get("__dataclass_fields__"), _StandardView):
             type.__setattr__(owner, "__dataclass_fields__", fields)
