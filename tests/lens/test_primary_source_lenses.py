@@ -1,8 +1,8 @@
 """Bundled lenses re-entered from their patents' own printed pages (issue 44): every number of the
-file against the patent's table as typed below, and the first-order data the patent states against
+file against the patent's table as typed in primary_stated.py, and the first-order data the patent states against
 physcam's paraxial values and optiland's.
 
-The tables below were typed from the patents' scanned pages (a reading independent of the lens
+The tables there were typed from the patents' scanned pages (a reading independent of the lens
 file's, done a second time for this test), not from physcam's files or output.
 """
 
@@ -15,22 +15,8 @@ from physcam.lens.library import find_lens, load_lens
 from physcam.lens.provenance import primary_source_claim_gaps, provenance_of
 from physcam.optics.paraxial import gaussian
 
-#: US 2,701,982 (P. Angenieux, 1955), claim 4's table (column 3; column 2 prints the same): radius,
-#: the thickness or air space after it (e1 ... e13), nD and v of the glass after it (None: air).
-US_2701982 = [
-    (164.13, 10.99, 1.6751, 32.3), (559.20, 0.23, None, None), (100.12, 11.45, 1.6689, 46.7),
-    (213.54, 0.23, None, None), (58.04, 22.95, 1.6913, 53.8), (2551.10, 2.58, 1.6751, 32.3),
-    (32.39, 30.66, None, None), (-40.42, 2.74, 1.6992, 30.2), (192.98, 27.92, 1.6204, 60.2),
-    (-55.53, 0.23, None, None), (192.98, 7.98, 1.6913, 53.8), (-225.30, 0.23, None, None),
-    (175.09, 8.48, 1.6913, 53.8), (-203.55, None, None, None),
-]
+from primary_stated import PRIMARY
 
-#: slug -> (the patent's table, what the patent states: focal length, f-number ("relative aperture
-#: 1:1"), back focus from the last vertex ("a value of 56", column 2), and how many digits it prints
-#: the back focus to).
-PRIMARY = {
-    "angenieux_us2701982_100mm_f1": (US_2701982, dict(efl=100.0, fno=1.0, bf=56.0, bf_tol=0.5)),
-}
 ORACLE = json.loads((Path(__file__).resolve().parents[1] / "data" / "optiland_library.json").read_text())["lenses"]
 
 

@@ -1,0 +1,30 @@
+"""Bundled lenses re-entered from their patents' own printed pages (issue 44), as the patents state them.
+
+The tables were typed from the patents' scanned pages (a reading independent of the lens files',
+done a second time for the tests), not from physcam's files or output.
+"""
+
+#: US 2,701,982 (P. Angenieux, 1955), claim 4's table (column 3; column 2 prints the same): radius,
+#: the thickness or air space after it (e1 ... e13), nD and v of the glass after it (None: air).
+US_2701982 = [
+    (164.13, 10.99, 1.6751, 32.3), (559.20, 0.23, None, None), (100.12, 11.45, 1.6689, 46.7),
+    (213.54, 0.23, None, None), (58.04, 22.95, 1.6913, 53.8), (2551.10, 2.58, 1.6751, 32.3),
+    (32.39, 30.66, None, None), (-40.42, 2.74, 1.6992, 30.2), (192.98, 27.92, 1.6204, 60.2),
+    (-55.53, 0.23, None, None), (192.98, 7.98, 1.6913, 53.8), (-225.30, 0.23, None, None),
+    (175.09, 8.48, 1.6913, 53.8), (-203.55, None, None, None),
+]
+#: US 2,500,046 (W. Schade / Eastman Kodak, 1950), the table of column 3 (Fig. 2 prints the same); R3 is
+#: flat (0 here, as physcam writes a flat), s1 49.3 holds the stop.
+US_2500046 = [
+    (70.97, 15.0, 1.523, 58.6), (-56.79, 4.5, 1.617, 38.5), (0.0, 49.3, None, None), (119.91, 3.8, 1.649, 33.8),
+    (40.87, 0.9, None, None), (46.87, 7.5, 1.697, 56.1), (-282.05, None, None, None),
+]
+
+#: slug -> (the patent's table, what the patent states: focal length, f-number ("relative aperture
+#: 1:1"), back focus from the last vertex ("a value of 56", column 2), and how many digits it prints
+#: the back focus to).
+PRIMARY = {
+    "angenieux_us2701982_100mm_f1": (US_2701982, dict(efl=100.0, fno=1.0, bf=56.0, bf_tol=0.5)),
+    # Schade: "a focal length of 100 mm." (column 3), Fig. 3's aberrations plotted to "f:2.0", BF = 56.5
+    "kodak_petzval_us2500046_100mm_f2": (US_2500046, dict(efl=100.0, fno=2.0, bf=56.5, bf_tol=0.05)),
+}
