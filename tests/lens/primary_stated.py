@@ -28,10 +28,18 @@ US_3583791 = [
     (-140.91, 19.58, None, None), (-65.04, 16.22, 1.7552, 27.5), (188.11, 2.52, None, None), (-323.43, 7.00, 1.713, 53.9),
     (-65.39, 0.18, None, None), (-8741.25, 6.64, 1.6583, 57.3), (-117.55, None, None, None),
 ]
+#: US 3,451,745 (T. Kazamaki, Y. Takahashi / Asahi Kogaku, 1969), the table of column 4 (claim 1 prints it
+#: in units of F); the stop sits in d6.
+US_3451745 = [
+    (110.000, 10.00, 1.80416, 46.6), (588.748, 0.20, None, None), (51.600, 14.50, 1.79446, 45.4),
+    (100.426, 3.50, None, None), (119.000, 3.00, 1.71736, 29.5), (32.792, 32.50, None, None),
+    (-36.500, 2.00, 1.68893, 31.1), (131.500, 20.00, 1.77252, 49.6), (-56.806, 0.20, None, None),
+    (-160.000, 8.50, 1.77252, 49.6), (-74.352, 0.20, None, None), (122.000, 9.50, 1.77252, 49.6),
+    (2092.573, None, None, None),
+]
 
-#: slug -> (the patent's table, what the patent states: focal length, f-number ("relative aperture
-#: 1:1"), back focus from the last vertex ("a value of 56", column 2), and how many digits it prints
-#: the back focus to).
+#: slug -> (the patent's table, what the patent states: focal length, f-number, back focus from the last
+#: vertex (None: the patent states none) and the tolerance its printed digits allow).
 PRIMARY = {
     "angenieux_us2701982_100mm_f1": (US_2701982, dict(efl=100.0, fno=1.0, bf=56.0, bf_tol=0.5)),
     # Schade: "a focal length of 100 mm." (column 3), Fig. 3's aberrations plotted to "f:2.0", BF = 56.5
@@ -39,5 +47,7 @@ PRIMARY = {
     # Mori: "relative aperture is F/2.8, the angle of field is 75 deg, and the focal length f=100", Bf=131.19.
     # The printed example is 0.17 % short of f = 100 throughout (EFL 99.83), so its back focus is 0.27 mm
     # short too (0.21 %): the tolerance is the 0.5 % of the issue, not the printed digits
+    # Kazamaki and Takahashi: "a focal length of 100 mm. and a relative aperture of 1:1.2"; no back focus
+    "asahi_us3451745_100mm_f1_2": (US_3451745, dict(efl=100.0, fno=1.2, bf=None)),
     "nikon_retrofocus_us3583791_100mm_f2_8": (US_3583791, dict(efl=100.0, fno=2.8, bf=131.19, bf_tol=0.005 * 131.19)),
 }

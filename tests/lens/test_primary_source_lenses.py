@@ -51,7 +51,8 @@ def test_first_order_data_match_the_patent_and_optiland(slug):
     g = gaussian(load_lens(slug))
     assert g.efl == pytest.approx(want["efl"], rel=5e-3)
     assert g.f_number == pytest.approx(want["fno"], rel=5e-3)
-    assert g.bfl == pytest.approx(want["bf"], abs=want["bf_tol"])
+    if want["bf"] is not None:
+        assert g.bfl == pytest.approx(want["bf"], abs=want["bf_tol"])
     oracle = ORACLE[slug]["y"]  # optiland 0.6.3, scripts/optiland_library_oracle.py
     assert g.efl == pytest.approx(oracle["efl_mm"], rel=1e-3)
     assert g.f_number == pytest.approx(oracle["f_number"], rel=1e-3)
