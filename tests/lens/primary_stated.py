@@ -37,6 +37,19 @@ US_3451745 = [
     (-160.000, 8.50, 1.77252, 49.6), (-74.352, 0.20, None, None), (122.000, 9.50, 1.77252, 49.6),
     (2092.573, None, None, None),
 ]
+#: US 3,841,736 (Y. Takahashi, S. Okudaira / Asahi Kogaku, 1974), Table I (claim 1 prints the same), but r14:
+#: both print -52.41, and the patent's own F = 100, F_B = 198.7, F7 = 102.06 and F8 = -69.76 all need -62.41
+#: (tests below); the stop sits in d12.
+US_3841736_R14_PRINTED = -52.41
+US_3841736 = [
+    (196.25, 9.57, 1.80610, 40.8), (95.73, 47.09, None, None), (3033.14, 43.17, 1.53172, 48.9),
+    (-342.39, 0.65, None, None), (130.31, 7.23, 1.69350, 53.3), (57.80, 18.81, None, None),
+    (246.94, 7.45, 1.71300, 54.0), (72.22, 14.74, None, None), (235.07, 18.11, 1.74077, 27.8),
+    (-357.57, 18.97, None, None), (272.12, 36.59, 1.60562, 43.7), (-86.37, 13.70, None, None),
+    (312.47, 18.11, 1.51823, 59.0), (-62.41, 5.76, 1.83400, 37.2), (894.12, 8.43, None, None),
+    (-1416.27, 16.64, 1.69350, 53.3), (-110.97, 0.49, None, None), (-887.30, 5.27, 1.80518, 25.4),
+    (118.00, 10.71, None, None), (-1386.54, 16.31, 1.64850, 53.0), (-98.62, None, None, None),
+]
 
 #: slug -> (the patent's table, what the patent states: focal length, f-number, back focus from the last
 #: vertex (None: the patent states none) and the tolerance its printed digits allow).
@@ -49,5 +62,7 @@ PRIMARY = {
     # short too (0.21 %): the tolerance is the 0.5 % of the issue, not the printed digits
     # Kazamaki and Takahashi: "a focal length of 100 mm. and a relative aperture of 1:1.2"; no back focus
     "asahi_us3451745_100mm_f1_2": (US_3451745, dict(efl=100.0, fno=1.2, bf=None)),
+    # Takahashi and Okudaira: F 100, "aperture ratio of 1:3.5" (column 6), F_B = 1.987F = 198.7
+    "asahi_wide_angle_us3841736_100mm_f3_5": (US_3841736, dict(efl=100.0, fno=3.5, bf=198.7, bf_tol=0.05)),
     "nikon_retrofocus_us3583791_100mm_f2_8": (US_3583791, dict(efl=100.0, fno=2.8, bf=131.19, bf_tol=0.005 * 131.19)),
 }

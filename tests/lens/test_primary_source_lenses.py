@@ -6,6 +6,7 @@ The tables there were typed from the patents' scanned pages (a reading independe
 file's, done a second time for this test), not from physcam's files or output.
 """
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -15,7 +16,7 @@ from physcam.lens.library import find_lens, load_lens
 from physcam.lens.provenance import primary_source_claim_gaps, provenance_of
 from physcam.optics.paraxial import gaussian
 
-from primary_stated import PRIMARY
+from primary_stated import PRIMARY, US_3841736_R14_PRINTED
 
 ORACLE = json.loads((Path(__file__).resolve().parents[1] / "data" / "optiland_library.json").read_text())["lenses"]
 
@@ -82,3 +83,23 @@ def test_provenance_is_the_patent_itself_and_checked(slug, capsys):
 
     key = key_numbers(load_lens(slug), 3000.0, 21.63)
     assert key["licence"] == "Apache-2.0" and key["source"] == prov.source
+
+
+def test_a_misprinted_radius_is_corrected_by_the_patents_own_stated_values():
+    """US 3,841,736 prints r14 = -52.41 twice; its stated F, F_B and the focal lengths F7 = 102.06 and
+    F8 = -69.76 of the cemented lenses 7 and 8 (Table I) are those of r14 = -62.41, which the file uses."""
+    p = load_lens("asahi_wide_angle_us3841736_100mm_f3_5")
+    s = [x for x in p.surfaces if x.kind != "stop"]
+    assert s[13].radius == pytest.approx(-62.41) and "-52.41" in provenance_of(p).corrections[0]
+
+    def thick_lens_f(n, r1, r2, t):  # Smith, Modern Optical Engineering, eq. 2.48
+        return 1.0 / ((n - 1.0) * (1.0 / r1 - 1.0 / r2 + (n - 1.0) * t / (n * r1 * r2)))
+
+    r13, r15 = s[12].radius, s[14].radius
+    assert thick_lens_f(1.51823, r13, -62.41, 18.11) == pytest.approx(102.06, abs=0.01)
+    assert thick_lens_f(1.83400, -62.41, r15, 5.76) == pytest.approx(-69.76, abs=0.01)
+    assert thick_lens_f(1.51823, r13, US_3841736_R14_PRINTED, 18.11) == pytest.approx(88.10, abs=0.01)
+    i = p.surfaces.index(s[13])  # the printed r14 in the lens: F 117.5, not the stated 100
+    printed = p.with_surfaces(dataclasses.replace(x, radius=US_3841736_R14_PRINTED) if k == i else x
+                              for k, x in enumerate(p.surfaces))
+    assert gaussian(printed).efl == pytest.approx(117.51, abs=0.01)
