@@ -50,6 +50,14 @@ US_3841736 = [
     (-1416.27, 16.64, 1.69350, 53.3), (-110.97, 0.49, None, None), (-887.30, 5.27, 1.80518, 25.4),
     (118.00, 10.71, None, None), (-1386.54, 16.31, 1.64850, 53.0), (-98.62, None, None, None),
 ]
+#: US 3,506,336 (Y. Takahashi / Asahi Kogaku, 1970), Table 1 (claim 1 prints the same); the stop sits in t4.
+US_3506336 = [
+    (450.000, 7.00, 1.58913, 61.2), (80.137, 47.00, None, None), (-2300.000, 10.00, 1.76200, 40.3),
+    (-292.234, 2.00, None, None), (95.700, 18.00, 1.77252, 49.6), (-707.468, 1.00, None, None),
+    (80.000, 8.00, 1.53172, 48.9), (84.488, 18.00, None, None), (-91.500, 6.50, 1.74077, 27.7),
+    (98.025, 8.00, None, None), (1000.000, 4.00, 1.83400, 37.2), (71.000, 19.00, 1.77252, 49.6),
+    (-89.354, 0.50, None, None), (-600.000, 10.00, 1.77252, 49.6), (-110.648, None, None, None),
+]
 
 #: slug -> (the patent's table, what the patent states: focal length, f-number, back focus from the last
 #: vertex (None: the patent states none) and the tolerance its printed digits allow).
@@ -64,5 +72,7 @@ PRIMARY = {
     "asahi_us3451745_100mm_f1_2": (US_3451745, dict(efl=100.0, fno=1.2, bf=None)),
     # Takahashi and Okudaira: F 100, "aperture ratio of 1:3.5" (column 6), F_B = 1.987F = 198.7
     "asahi_wide_angle_us3841736_100mm_f3_5": (US_3841736, dict(efl=100.0, fno=3.5, bf=198.7, bf_tol=0.05)),
+    # Takahashi: "resultant focal length F=100" (column 2), Fig. 2's aberrations to "1:2.0"; no back focus
+    "asahi_wide_angle_us3506336_100mm_f2": (US_3506336, dict(efl=100.0, fno=2.0, bf=None)),
     "nikon_retrofocus_us3583791_100mm_f2_8": (US_3583791, dict(efl=100.0, fno=2.8, bf=131.19, bf_tol=0.005 * 131.19)),
 }
