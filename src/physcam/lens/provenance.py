@@ -39,10 +39,11 @@ __all__ = ["Provenance", "provenance_of", "check_provenance_table", "primary_sou
 
 #: How a ``checks`` line about the primary source itself begins (``"primary source: ..."``).
 PRIMARY_SOURCE_CHECK = "primary source:"
-#: Words that name a place inside a source: a patent's example or table, a book's page or figure, a
-#: design file's revision.
+#: Words that name a place inside a source: a patent's example, table, claim or column, a book's page or
+#: figure, a design file's revision.
 #: (patterns compiled by ``re`` on first use: reading a lens never needs them)
-_PLACE = (r"\b(example|embodiment|table|fig\.?|figure|p\.|pp\.|page|revision|rev\.|beispiel|tabelle)"
+_PLACE = (r"\b(example|embodiment|table|claim|column|col\.|fig\.?|figure|p\.|pp\.|page|revision|rev\.|"
+          r"beispiel|tabelle)"
           r"\s*(\d+|[IVX]+\b|[A-Z]\b)")
 _DECIMAL = r"[-+]?\d+\.\d+"
 _COMPARED = r"\b(against|equal|equals|match|matches|agree|agrees|differ|differs)\b"
