@@ -399,6 +399,9 @@ class PupilTrace:
     r_ep: float
     z_xp: float
     meta: dict = field(default_factory=dict)
+    # what depends on the rays alone (the sub-cell layout, the direction slopes per reference): one dict for
+    # every wavelength that shares the rays (:func:`trace_pupils` copies a trace with the same dict)
+    shared: dict = field(default_factory=dict, repr=False, compare=False)
 
 
 def _grid_centres(n, cell, cx, cy):
@@ -597,17 +600,16 @@ class PupilFunction:
     """The pupil function on the grid (see module notes) at two resolutions.
 
     Cells (``n`` x ``n``): ``field`` = sum over a cell's rays of weight x amplitude x exp(-2 pi i W)
-    (the cell's integral of the pupil function, for the PSF and the Strehl ratio), ``amplitude0``
-    the same with W = 0 (the unaberrated pupil of the same shape), ``opd`` the cell's mean OPD
-    (waves), ``mask`` where light passes. Sub-cells (``n q`` x ``n q``, q = EDGE_SUBSAMPLES, built
-    on first use): a binary ``fine_mask`` (an edge ray's own sub-cell, a whole interior cell),
-    ``fine_opd`` (an edge ray's own OPD, else interpolated bilinearly between cell means) and
-    ``fine_amp`` (aperture amplitude), for the MTF: an overlap of binary masks measures the sheared
-    pupil's area, where products of fractional edge cells would underestimate the loss by about
-    half a cell of rim.
+    (the cell's integral of the pupil function, for the PSF and the Strehl ratio; made on first use:
+    the MTF never reads it), ``amplitude0`` the same with W = 0 (the unaberrated pupil of the same
+    shape), ``opd`` the cell's mean OPD (waves), ``mask`` where light passes. Sub-cells (``n q`` x
+    ``n q``, q = EDGE_SUBSAMPLES, for the MTF, :func:`sub_cell_pupil`): a binary mask (an edge ray's
+    own sub-cell, a whole interior cell), the OPD (an edge ray's own, else interpolated bilinearly
+    between cell means) and the aperture amplitude: an overlap of binary masks measures the sheared
+    pupil's area, where products of fractional edge cells would underestimate the loss by about half
+    a cell of rim.
     """
 
-    field: np.ndarray
     amplitude0: np.ndarray
     opd: np.ndarray
     mask: np.ndarray
@@ -618,29 +620,17 @@ class PupilFunction:
     slope_y: float  # d(reference direction M)/d(pupil y), 1/mm
     _pt: object = None
     _ws: object = None
-    _fine: tuple | None = None
+    _field: np.ndarray | None = None
     _lags: dict = field(default_factory=dict)  # (axis, aberrated) -> OTF at whole sub-cell shears
 
     @property
     def q(self) -> int:
         return EDGE_SUBSAMPLES
 
-    def _build_fine(self):
-        if self._fine is None:
-            self._fine = _fine_arrays(self._pt, self._ws, self.mask, self.opd)
-        return self._fine
-
     @property
-    def fine_mask(self) -> np.ndarray:
-        return self._build_fine()[0]
-
-    @property
-    def fine_opd(self) -> np.ndarray:
-        return self._build_fine()[1]
-
-    @property
-    def fine_amp(self) -> np.ndarray:
-        return self._build_fine()[2]
+    def sub_cells_across(self) -> int:
+        """Sub-cells across the grid (n q)."""
+        return self.mask.shape[0] * EDGE_SUBSAMPLES
 
     @property
     def freq_per_cell_x(self) -> float:
@@ -651,6 +641,12 @@ class PupilFunction:
     def freq_per_cell_y(self) -> float:
         """... along y (tangential)."""
         return self.n_image * abs(self.slope_y) * self.cell_mm / (self.wavelength_nm * 1e-6)
+
+    @property
+    def field(self) -> np.ndarray:  # the cells' complex field, made on first use
+        if self._field is None:
+            self._field = _cell_field(self._pt, self._ws)
+        return self._field
 
 
 def direction_slopes(pt: PupilTrace, ws: WavefrontSamples) -> tuple[float, float]:
@@ -673,61 +669,155 @@ def direction_slopes(pt: PupilTrace, ws: WavefrontSamples) -> tuple[float, float
 def pupil_function(pt: PupilTrace, ws: WavefrontSamples) -> PupilFunction:
     n = pt.n
     idx = pt.row * n + pt.col
-    amp = pt.rays.amplitude
-    wa = pt.weight * amp
-    ph = np.exp(-2j * np.pi * ws.opd_waves)  # a ray whose path is longer (W < 0) lags: exp(i k OPL)
-    fld = (np.bincount(idx, weights=wa * ph.real, minlength=n * n)
-           + 1j * np.bincount(idx, weights=wa * ph.imag, minlength=n * n)).reshape(n, n)
+    wa = pt.weight * pt.rays.amplitude
     a0 = np.bincount(idx, weights=wa, minlength=n * n)
     wsum = np.bincount(idx, weights=wa * ws.opd_waves, minlength=n * n)
     mask = a0 > 0
     wmean = np.where(mask, wsum / np.where(mask, a0, 1.0), 0.0).reshape(n, n)
-    sx, sy = direction_slopes(pt, ws)
-    return PupilFunction(fld, a0.reshape(n, n), wmean, mask.reshape(n, n), pt.cell_mm, pt.wavelength_nm, pt.n_image,
+    # the slopes depend on the rays and the reference sphere alone: the same for every wavelength sharing them
+    key = ("slopes", ws.reference)
+    if key not in pt.shared:
+        pt.shared[key] = direction_slopes(pt, ws)
+    sx, sy = pt.shared[key]
+    return PupilFunction(a0.reshape(n, n), wmean, mask.reshape(n, n), pt.cell_mm, pt.wavelength_nm, pt.n_image,
                          sx, sy, pt, ws)
 
 
-def _fine_arrays(pt: PupilTrace, ws: WavefrontSamples, mask: np.ndarray, wmean: np.ndarray):
-    """Sub-cell mask, OPD and amplitude (see :class:`PupilFunction`)."""
+def _cell_field(pt: PupilTrace, ws: WavefrontSamples) -> np.ndarray:
+    """The cells' complex field of :class:`PupilFunction` (its ``field``)."""
+    n = pt.n
+    idx = pt.row * n + pt.col
+    wa = pt.weight * pt.rays.amplitude
+    ph = np.exp(-2j * np.pi * ws.opd_waves)  # a ray whose path is longer (W < 0) lags: exp(i k OPL)
+    return (np.bincount(idx, weights=wa * ph.real, minlength=n * n)
+            + 1j * np.bincount(idx, weights=wa * ph.imag, minlength=n * n)).reshape(n, n)
+
+
+def _lerp_axis(lo: int, hi: int, q: int):
+    """Along one axis, for each sub-cell of cells ``lo`` .. ``hi - 1``: the two cells whose centres it
+    lies between (counted from ``lo``, clipped to those cells) and the bilinear weights (1 - f, f)."""
+    c = (np.arange(lo * q, hi * q) + 0.5) / q - 0.5
+    fl = np.floor(c)
+    i0 = np.clip(fl.astype(int), lo, hi - 1)
+    f = np.clip(c - fl, 0.0, 1.0)
+    return i0 - lo, np.minimum(i0 + 1, hi - 1) - lo, 1.0 - f, f
+
+
+def _lerp2(a: np.ndarray, rows, cols) -> np.ndarray:
+    """Cell values ``a`` at the sub-cells, bilinearly (:func:`_lerp_axis` weights ``rows``, ``cols``).
+    Separable: along rows, then along columns; the columns as rows of the transpose, taken whole and
+    scaled in place (half the time of a fancy index per column), so the result is column-major."""
+    i0, i1, g, f = rows
+    along = g[:, None] * np.take(a, i0, axis=0) + f[:, None] * np.take(a, i1, axis=0)
+    cols_first = np.ascontiguousarray(along.T)
+    i0, i1, g, f = cols
+    out = np.take(cols_first, i0, axis=0)
+    out *= g[:, None]
+    right = np.take(cols_first, i1, axis=0)
+    right *= f[:, None]
+    out += right
+    return out.T
+
+
+def _sub_cells(pt: PupilTrace) -> dict:
+    """What the sub-cell pupil (:func:`sub_cell_pupil`) takes from the rays alone, made once for every
+    wavelength that shares them (``pt.shared``): the box of the lit cells with one cell of margin (no
+    sub-cell outside it is lit, and a lit sub-cell's bilinear OPD reads only cells within one of its
+    own), the bilinear weights there, the interpolation's denominator (the weights of lit cells only),
+    the edge rays' own sub-cells, and over the box of the lit sub-cells (``crop``) the aperture
+    amplitude ``A`` (0 where no light passes; column-major, as the OPD)."""
+    lay = pt.shared.get("sub_cells")
+    if lay is not None:
+        return lay
     n, q = pt.n, EDGE_SUBSAMPLES
-    amp = pt.rays.amplitude
+    r0, r1 = max(int(pt.row.min()) - 1, 0), min(int(pt.row.max()) + 2, n)
+    c0, c1 = max(int(pt.col.min()) - 1, 0), min(int(pt.col.max()) + 2, n)
+    rows, cols = _lerp_axis(r0, r1, q), _lerp_axis(c0, c1, q)
+    lit = np.zeros((r1 - r0, c1 - c0))
+    lit[pt.row - r0, pt.col - c0] = 1.0
     centre = pt.sub < 0
-    cr, cc = pt.row[centre], pt.col[centre]
-    interior = np.zeros((n, n), dtype=bool)
-    interior[cr, cc] = True
-    cell_amp = np.zeros((n, n))
-    cell_amp[cr, cc] = amp[centre]
-    fine_mask = np.repeat(np.repeat(interior, q, axis=0), q, axis=1)
-    fine_amp = np.repeat(np.repeat(cell_amp, q, axis=0), q, axis=1)
-    # bilinear OPD between the cells' means, over lit cells only
-    c = (np.arange(n * q) + 0.5) / q - 0.5
-    i0 = np.clip(np.floor(c).astype(int), 0, n - 1)
-    i1 = np.clip(i0 + 1, 0, n - 1)
-    f = np.clip(c - np.floor(c), 0.0, 1.0)
-    g = 1.0 - f
+    edge = ~centre
+    amp = pt.rays.amplitude
+    cell_amp = np.zeros(lit.shape)
+    cell_amp[pt.row[centre] - r0, pt.col[centre] - c0] = amp[centre]
+    A = np.repeat(np.repeat(cell_amp, q, axis=0), q, axis=1)
+    er = (pt.row[edge] - r0) * q + pt.sub[edge] // q
+    ec = (pt.col[edge] - c0) * q + pt.sub[edge] % q
+    A[er, ec] = amp[edge]
+    lit_rows, lit_cols = np.flatnonzero(A.any(axis=1)), np.flatnonzero(A.any(axis=0))
+    crop = np.s_[lit_rows[0]:lit_rows[-1] + 1, lit_cols[0]:lit_cols[-1] + 1]
+    den = _lerp2(lit, rows, cols)
+    lay = {"box": np.s_[r0:r1, c0:c1], "rows": rows, "cols": cols, "lit": lit, "den": den, "divide": den > 0,
+           "er": er, "ec": ec, "edge": edge, "crop": crop, "A": np.asfortranarray(A[crop])}
+    pt.shared["sub_cells"] = lay
+    return lay
 
-    def lerp2(a):  # separable: along rows, then along columns; the columns as rows of the transpose, taken
-        # whole and scaled in place (half the time of a fancy index per column: the same operations, and the
-        # same column-major result, whose layout sets the order of every sum after it)
-        rows = g[:, None] * np.take(a, i0, axis=0) + f[:, None] * np.take(a, i1, axis=0)
-        cols = np.ascontiguousarray(rows.T)
-        out = np.take(cols, i0, axis=0)
-        out *= g[:, None]
-        right = np.take(cols, i1, axis=0)
-        right *= f[:, None]
-        out += right
-        return out.T
 
-    lit = mask.astype(float)
-    num = lerp2(lit * wmean)
-    den = lerp2(lit)
-    fine_opd = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
-    e = ~centre
-    er, ec = pt.row[e] * q + pt.sub[e] // q, pt.col[e] * q + pt.sub[e] % q
-    fine_mask[er, ec] = True
-    fine_amp[er, ec] = amp[e]
-    fine_opd[er, ec] = ws.opd_waves[e]
-    return fine_mask, fine_opd, fine_amp
+#: The OPD phasors exp(-2 pi i m / 256) that :func:`unit_phasors` starts from, and the values it takes at a time.
+_PHASOR_STEPS = 256
+_PHASOR_TABLE = np.exp(-2j * np.pi * np.arange(_PHASOR_STEPS) / _PHASOR_STEPS)
+_PHASOR_BLOCK = 16384
+
+
+def unit_phasors(w: np.ndarray) -> np.ndarray:
+    """exp(-2 pi i w) of a 2-D array of OPDs ``w`` (waves), in the layout of ``w``: numpy's complex
+    exponential to 1e-15 at a third of its time here (libm's, about 45 ns a value, was most of an MTF
+    chart's OTF). With w = (m + r) / 256, m whole: exp(-2 pi i m / 256) from a table of 256, times
+    exp(-2 pi i r / 256) from its Taylor series to the 7th power (|2 pi r / 256| <= pi / 256: the first
+    term left out is below 1e-20), a block of rows at a time so the temporaries stay in the cache."""
+    if w.ndim == 2 and w.strides[0] < w.strides[1]:  # column-major: the rows of the transpose
+        return unit_phasors(w.T).T
+    out = np.empty(w.shape, dtype=complex)
+    step = max(1, _PHASOR_BLOCK // max(w.shape[-1], 1))
+    for a in range(0, w.shape[0], step):
+        _phasor_block(w[a:a + step], out[a:a + step])
+    return out
+
+
+def _phasor_block(w: np.ndarray, out: np.ndarray) -> None:
+    s = w * float(_PHASOR_STEPS)  # exact: a power of two
+    m = np.rint(s)
+    t = s - m  # exact (the two are within 0.5 of each other)
+    t *= -2.0 * np.pi / _PHASOR_STEPS
+    t2 = t * t
+    c = t2 * (1.0 / 720.0)  # 1 - cos t = t^2/2 - t^4/24 + t^6/720
+    c -= 1.0 / 24.0
+    c *= t2
+    c += 0.5
+    c *= t2
+    sn = t2 * (-1.0 / 5040.0)  # sin t = t - t^3/6 + t^5/120 - t^7/5040
+    sn += 1.0 / 120.0
+    sn *= t2
+    sn -= 1.0 / 6.0
+    sn *= t2
+    sn *= t
+    sn += t
+    np.subtract(1.0, c, out=out.real)
+    np.copyto(out.imag, sn)
+    idx = m.astype(np.int64)
+    idx &= _PHASOR_STEPS - 1  # m modulo 256 (two's complement for m < 0)
+    out *= np.take(_PHASOR_TABLE, idx)
+
+
+def sub_cell_pupil(pf: PupilFunction, aberrated: bool = True) -> np.ndarray:
+    """P = A exp(-2 pi i W) over the sub-cells (:class:`PupilFunction`; cached per pupil), only over the
+    box of the lit sub-cells: the rows and columns outside it add nothing to any lag. ``aberrated=False``:
+    A alone. W: an edge ray's own OPD in its sub-cell, else the cells' mean OPD bilinearly between the
+    lit cells' centres."""
+    key = ("P", aberrated)
+    if key not in pf._lags:
+        lay = _sub_cells(pf._pt)
+        if aberrated:
+            num = _lerp2(lay["lit"] * pf.opd[lay["box"]], lay["rows"], lay["cols"])
+            opd = np.zeros_like(num)
+            np.divide(num, lay["den"], out=opd, where=lay["divide"])
+            opd[lay["er"], lay["ec"]] = pf._ws.opd_waves[lay["edge"]]
+            P = unit_phasors(opd[lay["crop"]])
+            P *= lay["A"]
+        else:
+            P = lay["A"].astype(complex)
+        pf._lags[key] = P
+    return pf._lags[key]
 
 
 def max_waves_per_cell(pf: PupilFunction) -> float:
@@ -747,19 +837,6 @@ def max_waves_per_cell(pf: PupilFunction) -> float:
 DIRECT_LAGS_MAX = 16
 
 
-def _complex_pupil(pf: PupilFunction, aberrated: bool) -> np.ndarray:
-    """P = A exp(-2 pi i W) over the sub-cells (cached per pupil); ``aberrated=False``: A alone. Only
-    the bounding box of the lit sub-cells: the rows and columns outside it add nothing to any lag."""
-    key = ("P", aberrated)
-    if key not in pf._lags:
-        A = pf.fine_amp * pf.fine_mask
-        rows, cols = np.flatnonzero(A.any(axis=1)), np.flatnonzero(A.any(axis=0))
-        box = np.s_[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1] if rows.size else np.s_[:0, :0]
-        A = A[box]
-        pf._lags[key] = A * np.exp(-2j * np.pi * pf.fine_opd[box]) if aberrated else A.astype(complex)
-    return pf._lags[key]
-
-
 def otf_lags(pf: PupilFunction, axis: int, *, aberrated: bool = True) -> np.ndarray:
     """Normalised OTF at every whole sub-cell shear 0, 1, ... along ``axis`` (0: y, the tangential
     direction of a Y-meridian field; 1: x, sagittal): R[k] = sum P(u) conj(P(u - k)) / sum |P|^2 over
@@ -770,10 +847,10 @@ def otf_lags(pf: PupilFunction, axis: int, *, aberrated: bool = True) -> np.ndar
     key = (axis, aberrated)
     cache = pf._lags
     if key not in cache:
-        P = _complex_pupil(pf, aberrated)
+        P = sub_cell_pupil(pf, aberrated)
         if axis == 1:
             P = P.T
-        n, size = P.shape[0], pf.fine_mask.shape[axis]
+        n, size = P.shape[0], pf.sub_cells_across
         norm = float((np.abs(P) ** 2).sum())
         F = np.fft.fft(P, n=2 * n, axis=0)
         r = np.zeros(size, dtype=complex)  # no overlap past the lit box: 0
@@ -793,7 +870,7 @@ def _lag(pf: PupilFunction, k: int, axis: int, aberrated: bool) -> complex:
     if k not in direct:
         if len(direct) >= DIRECT_LAGS_MAX:
             return complex(otf_lags(pf, axis, aberrated=aberrated)[k])
-        P = _complex_pupil(pf, aberrated)
+        P = sub_cell_pupil(pf, aberrated)
         if ("conj", aberrated) not in pf._lags:
             pf._lags["conj", aberrated] = P.conj()
             pf._lags["norm", aberrated] = float((P.real * P.real + P.imag * P.imag).sum())
@@ -810,7 +887,7 @@ def shear_otf(pf: PupilFunction, shift_cells: float, axis: int, *, aberrated: bo
     """Normalised OTF at a pupil shear of ``shift_cells`` (>= 0, in cells) along ``axis``: :func:`otf_lags`
     interpolated linearly between whole sub-cell shears (a quarter cell apart, where the OTF is
     smooth: its curvature times (1/4 cell)^2 / 8 is the interpolation error)."""
-    size = pf.fine_mask.shape[axis]  # sub-cells across along the shear
+    size = pf.sub_cells_across  # sub-cells across along the shear
     s = float(shift_cells) * pf.q
     k = int(math.floor(s))
     if k >= size - 1:
@@ -820,7 +897,6 @@ def shear_otf(pf: PupilFunction, shift_cells: float, axis: int, *, aberrated: bo
 
 
 def cutoff_cells(pf: PupilFunction, axis: int) -> float:
-    """Shear (cells) beyond which the pupil no longer overlaps itself along ``axis``."""
-    lit = pf.fine_mask.any(axis=1 - axis)
-    idx = np.flatnonzero(lit)
-    return float(idx.max() - idx.min() + 1) / pf.q if idx.size else 0.0
+    """Shear (cells) beyond which the pupil no longer overlaps itself along ``axis``: the extent of
+    the lit sub-cells along it."""
+    return float(_sub_cells(pf._pt)["A"].shape[axis]) / pf.q
