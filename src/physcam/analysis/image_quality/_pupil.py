@@ -273,6 +273,26 @@ def make_fields(st: Setup, fields_deg, wavelength_nm: float) -> list[Field]:
     return out
 
 
+def fields_at_wavelengths(st: Setup, fields_deg, wavelengths_nm, tracer: _Tracer) -> list[list[Field]]:
+    """:func:`make_fields` at each wavelength, [wavelength][field]. The chief rays depend on the media's
+    indices alone: a wavelength at which every medium has the index of an earlier one (a lens whose
+    prescription gives no dispersion) gets that wavelength's chief rays, aimed once."""
+    out, aimed = [], {}
+    for w in wavelengths_nm:
+        try:
+            nb, ni = tracer.indices(w)
+            key = nb.tobytes() + np.float64(ni).tobytes()
+        except OpticsError:  # make_fields says what is wrong at this wavelength
+            key = None
+        if key is not None and key in aimed:
+            out.append([dataclasses.replace(f, wavelength_nm=float(w)) for f in aimed[key]])
+            continue
+        out.append(make_fields(st, fields_deg, w))
+        if key is not None:
+            aimed[key] = out[-1]
+    return out
+
+
 def field_for_image_height(st: Setup, height_mm: float, wavelength_nm: float) -> float:
     """The field angle (degrees, Y meridian) whose chief ray meets the film at ``height_mm`` on the y axis:
     the chief ray is aimed back from the film through the centre of the stop (:func:`._chief.aim_from_film`)
@@ -753,18 +773,18 @@ def _sub_cells(pt: PupilTrace) -> dict:
     return lay
 
 
-#: The OPD phasors exp(-2 pi i m / 256) that :func:`unit_phasors` starts from, and the values it takes at a time.
-_PHASOR_STEPS = 256
+#: The OPD phasors exp(-2 pi i m / 4096) that :func:`unit_phasors` starts from, and the values it takes at a time.
+_PHASOR_STEPS = 4096
 _PHASOR_TABLE = np.exp(-2j * np.pi * np.arange(_PHASOR_STEPS) / _PHASOR_STEPS)
 _PHASOR_BLOCK = 16384
 
 
 def unit_phasors(w: np.ndarray) -> np.ndarray:
     """exp(-2 pi i w) of a 2-D array of OPDs ``w`` (waves), in the layout of ``w``: numpy's complex
-    exponential to 1e-15 at a third of its time here (libm's, about 45 ns a value, was most of an MTF
-    chart's OTF). With w = (m + r) / 256, m whole: exp(-2 pi i m / 256) from a table of 256, times
-    exp(-2 pi i r / 256) from its Taylor series to the 7th power (|2 pi r / 256| <= pi / 256: the first
-    term left out is below 1e-20), a block of rows at a time so the temporaries stay in the cache."""
+    exponential to 1e-15 in a third of its time here (libm's, about 45 ns a value, was most of an MTF
+    chart's OTF). With w = (m + r) / 4096, m whole and |r| <= 1/2: exp(-2 pi i m / 4096) from a table,
+    times exp(i t), t = -2 pi r / 4096, from its Taylor series to t^4 and t^3 (|t| <= pi / 4096: the
+    first terms left out are below 3e-18), a block of rows at a time so the temporaries stay in the cache."""
     if w.ndim == 2 and w.strides[0] < w.strides[1]:  # column-major: the rows of the transpose
         return unit_phasors(w.T).T
     out = np.empty(w.shape, dtype=complex)
@@ -780,22 +800,16 @@ def _phasor_block(w: np.ndarray, out: np.ndarray) -> None:
     t = s - m  # exact (the two are within 0.5 of each other)
     t *= -2.0 * np.pi / _PHASOR_STEPS
     t2 = t * t
-    c = t2 * (1.0 / 720.0)  # 1 - cos t = t^2/2 - t^4/24 + t^6/720
-    c -= 1.0 / 24.0
+    c = t2 * (1.0 / 24.0)  # 1 - cos t = t^2/2 - t^4/24
+    np.subtract(0.5, c, out=c)
     c *= t2
-    c += 0.5
-    c *= t2
-    sn = t2 * (-1.0 / 5040.0)  # sin t = t - t^3/6 + t^5/120 - t^7/5040
-    sn += 1.0 / 120.0
-    sn *= t2
-    sn -= 1.0 / 6.0
-    sn *= t2
-    sn *= t
-    sn += t
     np.subtract(1.0, c, out=out.real)
-    np.copyto(out.imag, sn)
+    t2 *= -1.0 / 6.0  # sin t = t - t^3/6
+    t2 *= t
+    t2 += t
+    np.copyto(out.imag, t2)
     idx = m.astype(np.int64)
-    idx &= _PHASOR_STEPS - 1  # m modulo 256 (two's complement for m < 0)
+    idx &= _PHASOR_STEPS - 1  # m modulo 4096 (two's complement for m < 0)
     out *= np.take(_PHASOR_TABLE, idx)
 
 
@@ -831,9 +845,9 @@ def max_waves_per_cell(pf: PupilFunction) -> float:
     return worst
 
 
-#: Whole sub-cell lags a pupil sums one by one (a product summed over the overlap each, about
-#: 0.1 ms at 256 sub-cells across) before :func:`otf_lags` computes them all by FFT (1.5-4 ms per
-#: axis): a chart reads 2 per frequency.
+#: Whole sub-cell lags a pupil sums one by one (a dot product over the overlap each, about 0.1 ms
+#: at 700 x 400 sub-cells) before :func:`otf_lags` computes them all by FFT (1.5-4 ms per axis): a
+#: chart reads 2 per frequency.
 DIRECT_LAGS_MAX = 16
 
 
@@ -870,17 +884,40 @@ def _lag(pf: PupilFunction, k: int, axis: int, aberrated: bool) -> complex:
     if k not in direct:
         if len(direct) >= DIRECT_LAGS_MAX:
             return complex(otf_lags(pf, axis, aberrated=aberrated)[k])
-        P = sub_cell_pupil(pf, aberrated)
-        if ("conj", aberrated) not in pf._lags:
-            pf._lags["conj", aberrated] = P.conj()
-            pf._lags["norm", aberrated] = float((P.real * P.real + P.imag * P.imag).sum())
-        Pc, norm = pf._lags["conj", aberrated], pf._lags["norm", aberrated]
-        if axis == 1:
-            P, Pc = P.T, Pc.T
-        n = P.shape[0]
+        rows = _shear_rows(pf, axis, aberrated)
+        norm = pf._lags["norm", aberrated]
+        n = rows.shape[0]
         lit = norm > 0 and k < n  # past the lit box the shifted pupil does not overlap
-        direct[k] = complex(np.einsum("ij,ij->", P[k:], Pc[:n - k])) / norm if lit else 0j
+        # sum P(u + k) conj(P(u)) over the overlap: the rows k apart, each block contiguous
+        direct[k] = _dot(rows[:n - k], rows[k:]) / norm if lit else 0j
     return direct[k]
+
+
+def _shear_rows(pf: PupilFunction, axis: int, aberrated: bool) -> np.ndarray:
+    """The sub-cell pupil with the shear's axis first, contiguous (cached per pupil, with sum |P|^2):
+    the column-major P's transpose as it lies for x, a row-major copy for y."""
+    key = ("rows", axis, aberrated)
+    if key not in pf._lags:
+        P = sub_cell_pupil(pf, aberrated)
+        pf._lags[key] = rows = np.ascontiguousarray(P.T if axis == 1 else P)
+        if ("norm", aberrated) not in pf._lags:
+            pf._lags["norm", aberrated] = _dot(rows, rows).real
+    return pf._lags[key]
+
+
+#: Values per BLAS dot product in :func:`_dot`: OpenBLAS shares a longer one (over 10 000) among threads,
+#: whose waiting cost ten times the CPU of the sum itself when the caller's BLAS is not limited to one
+#: thread (the `physcam` program limits it; a Python caller may not).
+_DOT_BLOCK = 8192
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> complex:
+    """sum conj(a) b over two C-contiguous complex arrays of one shape (BLAS's dot, in blocks)."""
+    a, b = a.reshape(-1), b.reshape(-1)
+    total = 0j
+    for j in range(0, a.size, _DOT_BLOCK):
+        total += complex(np.vdot(a[j:j + _DOT_BLOCK], b[j:j + _DOT_BLOCK]))
+    return total
 
 
 def shear_otf(pf: PupilFunction, shift_cells: float, axis: int, *, aberrated: bool = True) -> complex:
