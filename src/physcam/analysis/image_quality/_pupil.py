@@ -165,17 +165,18 @@ class _Tracer:
     def n_image(self, wavelength_nm: float) -> float:
         return self.indices(wavelength_nm)[1]
 
-    def trace(self, start, direction, opl0, wavelengths, *, clip=True) -> Traced:
-        """Trace rays (n, 3) with per-ray ``wavelengths`` (nm) front to back, adding n (p' - p) . d per leg."""
+    def trace(self, columns, opl0, wavelengths, *, clip=True) -> Traced:
+        """Trace rays given as six columns (x, y, z of the start, the direction's x, y, z; 1-D, one
+        length) with per-ray ``wavelengths`` (nm) front to back, adding n (p' - p) . d per leg."""
         from ...trace import OK, RayBatch
         from ...trace.trace import trace_packed
 
-        wl = np.broadcast_to(np.asarray(wavelengths, dtype=float), (np.shape(start)[0],))
+        wl = np.broadcast_to(np.asarray(wavelengths, dtype=float), (np.shape(columns[0])[0],))
         rest = wl  # every medium usable at every wavelength (a batch has a few; np.unique imports numpy.ma)
         while rest.size:
             self.indices(rest[0])
             rest = rest[rest != rest[0]]
-        rays = RayBatch.from_arrays(start, direction, wl)
+        rays = RayBatch.from_columns(*columns, wl)
         opl = np.array(opl0, dtype=np.float64, copy=True)
         amp = np.ones(len(rays))
         # the kernel adds each leg's optical path: one call through every row, or two around a shaped stop
@@ -348,7 +349,8 @@ def image_circle_radius(st: Setup, wavelength_nm: float, outside_mm: float, tol_
 
 
 def _starts(st: Setup, fl: Field, n_object: float, gx: np.ndarray, gy: np.ndarray):
-    """Start points, directions and starting optical paths of rays aimed at (gx, gy) on the entrance-pupil plane."""
+    """Start points and directions (six columns) and starting optical paths of rays aimed at (gx, gy)
+    on the entrance-pupil plane."""
     from .._chief import start_plane_z
 
     n = gx.size
@@ -356,13 +358,13 @@ def _starts(st: Setup, fl: Field, n_object: float, gx: np.ndarray, gy: np.ndarra
         d = fl.direction
         z0 = min(st.z_ep, start_plane_z(st.lens)) - 1.0
         t = (st.z_ep - z0) / d[2]
-        start = np.stack([gx - t * d[0], gy - t * d[1], np.full(n, z0)], axis=1)
-        opl0 = n_object * ((start - fl.chief_start) @ d)
-        return start, np.broadcast_to(d, (n, 3)), opl0
+        x, y = gx - t * d[0], gy - t * d[1]
+        c = fl.chief_start  # the plane wavefront through the chief ray's start: n d . (p - p_chief)
+        opl0 = n_object * ((x - c[0]) * d[0] + (y - c[1]) * d[1] + (z0 - c[2]) * d[2])
+        return (x, y, np.full(n, z0), *(np.broadcast_to(v, (n,)) for v in d)), opl0
     o = fl.object_point
-    start = np.broadcast_to(o, (n, 3))
-    dirn = np.stack([gx - o[0], gy - o[1], np.full(n, st.z_ep - o[2])], axis=1)
-    return start, dirn, np.zeros(n)
+    start = tuple(np.broadcast_to(v, (n,)) for v in o)
+    return (*start, gx - o[0], gy - o[1], np.full(n, st.z_ep - o[2])), np.zeros(n)
 
 
 def _trace_groups(tracer: _Tracer, groups, *, clip=True) -> list[Traced]:
@@ -371,15 +373,14 @@ def _trace_groups(tracer: _Tracer, groups, *, clip=True) -> list[Traced]:
         return []
     # by wavelength, so that the kernels see a few runs of one wavelength (trace.trace_packed)
     order = sorted(range(len(groups)), key=lambda i: groups[i][0].wavelength_nm)
-    starts, dirs, opls, wls, sizes = [], [], [], [], []
+    columns, opls, wls, sizes = [], [], [], []
     for fl, gx, gy in (groups[i] for i in order):
-        s, d, o = _starts(tracer.st, fl, tracer.n_object(fl.wavelength_nm), gx, gy)
-        starts.append(s)
-        dirs.append(d)
+        c, o = _starts(tracer.st, fl, tracer.n_object(fl.wavelength_nm), gx, gy)
+        columns.append(c)
         opls.append(o)
         wls.append(np.full(gx.size, fl.wavelength_nm))
         sizes.append(gx.size)
-    res = tracer.trace(np.concatenate(starts), np.concatenate(dirs), np.concatenate(opls), np.concatenate(wls),
+    res = tracer.trace([np.concatenate(c) for c in zip(*columns)], np.concatenate(opls), np.concatenate(wls),
                        clip=clip)
     cut = np.cumsum([0] + sizes)
     out: list = [None] * len(groups)
@@ -528,9 +529,10 @@ def _trace_pupils(jobs, st: Setup, tracer: _Tracer) -> list[PupilTrace]:
         edges.append((status, edge, er, ec, sgx, sgy))
         subs.append((fl, sgx, sgy))
     subtraced = _trace_groups(tracer, subs)
-    chiefs = tracer.trace(np.stack([fl.chief_start for fl, _, _ in jobs]),
-                          np.stack([fl.chief_direction for fl, _, _ in jobs]), np.zeros(len(jobs)),
-                          np.array([fl.wavelength_nm for fl, _, _ in jobs]), clip=False)
+    ends = np.concatenate([np.stack([fl.chief_start for fl, _, _ in jobs]),
+                           np.stack([fl.chief_direction for fl, _, _ in jobs])], axis=1)
+    chiefs = tracer.trace(list(ends.T), np.zeros(len(jobs)), np.array([fl.wavelength_nm for fl, _, _ in jobs]),
+                          clip=False)
     out = []
     for j, ((fl, n, box), g, c, (status, edge, er, ec, sgx, sgy), sub) in enumerate(
             zip(jobs, grids, centres, edges, subtraced)):
@@ -884,24 +886,31 @@ def _lag(pf: PupilFunction, k: int, axis: int, aberrated: bool) -> complex:
     if k not in direct:
         if len(direct) >= DIRECT_LAGS_MAX:
             return complex(otf_lags(pf, axis, aberrated=aberrated)[k])
-        rows = _shear_rows(pf, axis, aberrated)
+        cols = _pupil_by_columns(pf, aberrated)
         norm = pf._lags["norm", aberrated]
-        n = rows.shape[0]
-        lit = norm > 0 and k < n  # past the lit box the shifted pupil does not overlap
-        # sum P(u + k) conj(P(u)) over the overlap: the rows k apart, each block contiguous
-        direct[k] = _dot(rows[:n - k], rows[k:]) / norm if lit else 0j
+        m, n = cols.shape
+        if not (norm > 0 and k < (m if axis == 1 else n)):  # past the lit box the shifted pupil does not overlap
+            direct[k] = 0j
+        elif axis == 1:  # sum P(u + k) conj(P(u)): whole columns k apart, one contiguous block each
+            direct[k] = _dot(cols[:m - k], cols[k:]) / norm
+        elif 2 * k <= n:  # along each column: the pairs k apart over the whole array, less those across columns
+            direct[k] = (_dot(cols.reshape(-1)[:m * n - k], cols.reshape(-1)[k:])
+                         - _dot(np.ascontiguousarray(cols[:-1, n - k:]), np.ascontiguousarray(cols[1:, :k]))) / norm
+        else:
+            rows = pf._lags.get(("rows", aberrated))
+            if rows is None:
+                rows = pf._lags["rows", aberrated] = np.ascontiguousarray(cols.T)
+            direct[k] = _dot(rows[:n - k], rows[k:]) / norm
     return direct[k]
 
 
-def _shear_rows(pf: PupilFunction, axis: int, aberrated: bool) -> np.ndarray:
-    """The sub-cell pupil with the shear's axis first, contiguous (cached per pupil, with sum |P|^2):
-    the column-major P's transpose as it lies for x, a row-major copy for y."""
-    key = ("rows", axis, aberrated)
+def _pupil_by_columns(pf: PupilFunction, aberrated: bool) -> np.ndarray:
+    """The sub-cell pupil's transpose, contiguous: a column of P (one x) per row (cached per pupil,
+    with sum |P|^2). P is column-major as made, so this is P's own memory."""
+    key = ("columns", aberrated)
     if key not in pf._lags:
-        P = sub_cell_pupil(pf, aberrated)
-        pf._lags[key] = rows = np.ascontiguousarray(P.T if axis == 1 else P)
-        if ("norm", aberrated) not in pf._lags:
-            pf._lags["norm", aberrated] = _dot(rows, rows).real
+        pf._lags[key] = cols = np.ascontiguousarray(sub_cell_pupil(pf, aberrated).T)
+        pf._lags["norm", aberrated] = _dot(cols, cols).real
     return pf._lags[key]
 
 
