@@ -88,3 +88,29 @@ def test_the_direct_lag_sums_are_the_fft_autocorrelation(axis):
         direct = P._lag(dataclasses.replace(pf, _lags={}), k, axis, True)
         assert abs(direct - by_fft[k]) < 1e-12
     assert abs(by_fft[0] - 1.0) < 1e-12
+
+
+def test_a_fields_pupil_is_traced_once_for_its_wavefront_and_its_mtf(monkeypatch):
+    # `physcam mtf --field` asks the wavefront, the PSF and the MTF of one field: main traced the same
+    # 64-cell pupil for each; now the last camera's pupils are kept (P.RECENT_RAYS)
+    from physcam.analysis.image_quality.mtf import mtf
+    from physcam.analysis.image_quality.wavefront import wavefront
+
+    jobs = []
+    trace = P._trace_pupils
+
+    def counted(js, st, tracer):
+        jobs.extend((f.field_deg, f.wavelength_nm, n) for f, n, _ in js)
+        return trace(js, st, tracer)
+
+    monkeypatch.setattr(P, "_trace_pupils", counted)
+    cam = camera_state(load_lens("dgauss_50mm"), fstop=4.0)
+    wavefront(cam, 5.0, wavelength_nm=WHITE_LIGHT_NM[0])
+    kept = mtf(cam, 5.0, frequencies=[10.0, 30.0])
+    assert jobs == [(5.0, WHITE_LIGHT_NM[0], 64)]
+    P._recent.clear()  # the same MTF traced afresh: the kept rays change nothing
+    fresh = mtf(cam, 5.0, frequencies=[10.0, 30.0])
+    assert len(jobs) == 2
+    assert np.array_equal(kept.sagittal, fresh.sagittal) and np.array_equal(kept.tangential, fresh.tangential)
+    mtf(camera_state(load_lens("dgauss_50mm"), fstop=4.0), 5.0, frequencies=[10.0])  # another camera: traced
+    assert len(jobs) == 3

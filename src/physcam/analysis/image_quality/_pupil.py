@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -481,20 +482,44 @@ def _same_rays_key(tracer: _Tracer, fl: Field, n: int, box) -> bytes:
     return b"".join(np.ascontiguousarray(a, dtype=float).tobytes() for a in parts)
 
 
+#: Rays of the pupils traced last that are kept for the next call (about 100 bytes each): `physcam mtf
+#: --field` asks one field's wavefront, PSF and MTF, the same rays three times. Only the last camera's
+#: pupils are kept; the oldest go first.
+RECENT_RAYS = 100_000
+_recent: dict = {}
+_recent_lock = threading.Lock()
+
+
 def trace_pupils(st: Setup, jobs, tracer: _Tracer) -> list[PupilTrace]:
     """Trace each job (field, n, box) -- an ``n`` x ``n`` grid over ``box`` with the edge refined -- all
     jobs together: one batch for the cell centres, one for the edge sub-cells, one for the chief rays.
     Jobs whose rays would be the same (:func:`_same_rays_key`: the wavelengths of a lens without
-    dispersion) are traced once and share the rays, each with its own wavelength."""
+    dispersion; a job of the last call on the same camera, :data:`RECENT_RAYS`) are traced once and
+    share the rays, each with its own wavelength."""
+    keys = [_same_rays_key(tracer, fl, n, box) for fl, n, box in jobs]
     first: dict = {}
-    rep = [first.setdefault(_same_rays_key(tracer, fl, n, box), j) for j, (fl, n, box) in enumerate(jobs)]
-    traced = dict(zip(sorted(set(rep)), _trace_pupils([jobs[j] for j in sorted(set(rep))], st, tracer)))
+    rep = [first.setdefault(k, j) for j, k in enumerate(keys)]
+    with _recent_lock:
+        if _recent.get("camera") is not st.state:
+            _recent.clear()
+            _recent["camera"] = st.state
+        known = {j: _recent[keys[j]] for j in first.values() if keys[j] in _recent}
+    todo = [j for j in sorted(first.values()) if j not in known]
+    traced = dict(zip(todo, _trace_pupils([jobs[j] for j in todo], st, tracer) if todo else []))
+    # kept and handed out without what later calls derive from the rays (``shared``: sub-cell arrays)
+    traced.update({j: dataclasses.replace(pt, shared={}) for j, pt in known.items()})
+    with _recent_lock:
+        if _recent.get("camera") is st.state:
+            for j in todo:
+                _recent[keys[j]] = dataclasses.replace(traced[j], shared={})
+            while sum(pt.rays.x.size for k, pt in _recent.items() if k != "camera") > RECENT_RAYS:
+                del _recent[next(k for k in _recent if k != "camera")]
     out = []
     for (fl, _, _), r in zip(jobs, rep):
         pt = traced[r]
-        out.append(pt if jobs[r][0] is fl else dataclasses.replace(pt, field=fl, wavelength_nm=fl.wavelength_nm,
-                                                                   n_image=tracer.n_image(fl.wavelength_nm),
-                                                                   meta=dict(pt.meta)))
+        out.append(pt if pt.field is fl else dataclasses.replace(pt, field=fl, wavelength_nm=fl.wavelength_nm,
+                                                                 n_image=tracer.n_image(fl.wavelength_nm),
+                                                                 meta=dict(pt.meta)))
     return out
 
 
