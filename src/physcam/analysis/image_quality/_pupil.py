@@ -940,7 +940,7 @@ def _pupil_by_columns(pf: PupilFunction, aberrated: bool) -> np.ndarray:
 
 
 #: Values per BLAS dot product in :func:`_dot`: OpenBLAS shares a longer one (over 10 000) among threads,
-#: whose waiting cost ten times the CPU of the sum itself when the caller's BLAS is not limited to one
+#: whose waiting cost 14 times the CPU of the sum itself when the caller's BLAS is not limited to one
 #: thread (the `physcam` program limits it; a Python caller may not).
 _DOT_BLOCK = 8192
 
