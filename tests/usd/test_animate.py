@@ -63,6 +63,8 @@ def test_thin_lens_iris_and_focus_pull(tmp_path):
     for frame, mark, n in ((1, 3000.0, 2.8), (2, 2500.0, 4.0), (3, 2000.0, 5.6)):
         assert geom.GetFocalLengthAttr().Get(frame) == pytest.approx(image_distance_at_mark(35.0, mark), rel=3e-6)  # float32, chosen within 24 ulps to keep the FOV exact
         assert cam.GetAttribute("lens:main:fStop").Get(frame) == pytest.approx(n, rel=1e-6)
+        # the exposure follows the iris pull: exposure:fStop is the T-stop, N for a lens of transmittance 1
+        assert geom.GetExposureFStopAttr().Get(frame) == pytest.approx(n, rel=1e-6)
 
 
 def test_bad_marks_name_file_and_line(tmp_path):

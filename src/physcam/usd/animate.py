@@ -143,7 +143,7 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
 
     from ..export.usdgeom import require_meters_per_unit
     from ..onset.report import report_camera, solve_report
-    from .author import author_camera, new_stage, sample_render_camera, save_stage, spec_from_report
+    from .author import author_camera, iris_mm, new_stage, sample_render_camera, save_stage, spec_from_report
 
     keys = _check_keys(keys)
     if (lens is None) == (focal_length_mm is None):
@@ -189,8 +189,8 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
         eye = spec.entrance_pupil_mm
         sample(model, "focalLength", spec.focal_length_mm, t)
         sample(model, "focusDistance", spec.focus_mm, t)
-        for prim, name, value in ((cam, lp + "fStop", spec.fstop), (cam, lp + "iris", spec.focal_length_mm / spec.fstop),
-                                  (cam, "iris", spec.focal_length_mm / spec.fstop),
+        for prim, name, value in ((cam, lp + "fStop", spec.fstop), (cam, lp + "iris", iris_mm(spec)),
+                                  (cam, "iris", iris_mm(spec)),
                                   (cam, lp + "entrancePupilDistance", eye)):
             sample(prim, name, value, t)
         optional = {lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "apertureDistance":
