@@ -74,6 +74,14 @@ def test_bad_marks_name_file_and_line(tmp_path):
     bad = _csv(tmp_path, ["1,3m", "2,three metres"])
     with pytest.raises(LensFileError, match=r"pull.csv:3"):
         read_focus_marks(bad)
+    # an f-stop that is not one, frames going back, a row cut short: each names its line
+    for rows, header, said in ((["1,3m,2.8", "2,2m,nan"], "frame,focus,fstop", "f-stop must be a finite number"),
+                               (["1,3m,2.8", "2,2m,-4"], "frame,focus,fstop", "f-stop must be greater than 0"),
+                               (["1,3m", "2,2m", "2,1m"], "frame,focus", "frame 2 does not follow frame 2"),
+                               (["1,3m,2.8", "2"], "frame,focus,fstop", "this row has fewer values than the header.s 3")):
+        line = len(rows) + 1
+        with pytest.raises(LensFileError, match=rf"pull.csv:{line}: {said}"):
+            read_focus_marks(_csv(tmp_path, rows, header=header))
     with pytest.raises(InputError, match="increase"):
         write_animated_camera(tmp_path / "x.usda", [FocusKey(2, 3000.0), FocusKey(1, 2000.0)],
                               sensor=find_sensor("FF"), focal_length_mm=50.0, fstop=2.8)

@@ -32,7 +32,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import ExportError, InputError, LensFileError, PhysCamWarning, require_finite
+from ..errors import ExportError, InputError, LensFileError, PhysCamWarning, require_finite, require_positive
 from ..lens.zoom import prescription_at
 
 __all__ = ["FocusKey", "read_focus_marks", "write_animated_camera", "ntsc_rate"]
@@ -78,10 +78,16 @@ def read_focus_marks(path) -> list[FocusKey]:
         raise LensFileError(f"unknown columns {sorted(unknown)}; use frame, focus, fstop, zoom", str(p), 1)
     keys = []
     for line, row in enumerate(rows, start=2):
+        if row.get("frame") is None or row.get("focus") is None:
+            raise LensFileError(f"this row has fewer values than the header's {len(rows.fieldnames)} columns", str(p),
+                                line)
         try:
             frame = require_finite("frame", float(row["frame"]))
             focus = parse_distance(row["focus"], name="focus mark")
-            fstop = None if not (row.get("fstop") or "").strip() else float(row["fstop"])
+            fstop = None if not (row.get("fstop") or "").strip() else require_positive("f-stop", float(row["fstop"]),
+                                                                                        unit="")
+            if keys and frame <= keys[-1].frame:
+                raise InputError(f"frame {frame:g} does not follow frame {keys[-1].frame:g}: frames must increase")
         except (ValueError, TypeError, InputError) as exc:
             raise LensFileError(str(exc) if isinstance(exc, InputError) else f"not a number: {exc}", str(p), line) \
                 from None
