@@ -26,7 +26,7 @@ import re
 from fractions import Fraction
 
 from ..errors import MetadataError, require_type
-from ._text import FOOT_MM, number, require_columns, rows, stop_from_marking, timecode
+from ._text import FOOT_MM, header_columns, number, require_columns, rows, stop_from_marking, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -41,7 +41,7 @@ _FT_IN = re.compile(r"""^\s*(\d+(?:\.\d+)?)\s*'\s*(?:(\d+(?:\.\d+)?)\s*"?)?\s*$"
 def sniff(head: str) -> bool:
     """True when ``head`` (the file's first line) is an AME header."""
     require_type("head", head, str, "the first bytes of a metadata file")
-    cols = head.split("\t")
+    cols = header_columns(head, "\t")
     return "Master TC" in cols and any(c in cols for c in ("Lens Focus Distance", "Lens Focal Length", "Lens Iris"))
 
 
