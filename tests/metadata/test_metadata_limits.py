@@ -216,3 +216,24 @@ def test_drop_frame_timecode_at_29_97_counts_on_through_the_dropped_numbers(tmp_
     skip = _ame_rows(tmp_path, "df1.csv", ["00:00:59;29", "00:01:00;03"], fps="29.970")
     with pytest.raises(MetadataError, match=r"df1.csv:3: the timecode skips 1 frame"):
         load(skip)
+
+
+def test_a_take_in_feet_is_converted_and_said_in_feet(tmp_path):
+    """Lens Distance Unit "Feet": the first row's 4.812 is 4.812 x 304.8 mm = 1466.7 mm (1 ft = 304.8 mm)."""
+    lines = ARRI.read_text(encoding="utf-8").splitlines()
+    header = lines[0].split("\t")
+    u, d = header.index("Lens Distance Unit"), header.index("Lens Focus Distance")
+    rows = [r.split("\t") for r in lines[1:3]]
+    for r in rows:
+        r[u] = "Feet"
+    p = tmp_path / "feet.csv"
+    p.write_text("\n".join([lines[0], *("\t".join(r) for r in rows)]) + "\n", encoding="utf-8")
+    rec = load(p)
+    assert rec.frames[0].focus_mm == pytest.approx(float(rows[0][d]) * 304.8, rel=1e-12)
+    assert "focus distances recorded in feet, converted to mm" in rec.notes
+
+
+def test_a_corrupt_lens_iris_cell_is_refused_even_beside_the_linear_iris(tmp_path, capsys):
+    """The linear iris is the one read (finer), but a Lens Iris cell that is no stop is a corrupt row."""
+    p = _arri_with(tmp_path, name="iris.csv", Lens_Iris="banana")
+    _refused(capsys, ["metadata", "show", str(p)], ["iris.csv:2: ", "Lens Iris 'banana' is not a stop"])

@@ -62,10 +62,11 @@ def _focus_mm(path, line, unit, text):
 
 def _tstop(path, line, row):
     lin = row.get("Lens Linear Iris", "")
+    marked = stop_from_marking(path, line, "Lens Iris", row.get("Lens Iris", ""))  # read, so a corrupt cell is said
     if lin not in ("", "--"):
         v = number(path, line, "Lens Linear Iris", lin)
         return 2.0 ** ((v - 1000.0) / 2000.0)
-    return stop_from_marking(path, line, "Lens Iris", row.get("Lens Iris", ""))
+    return marked
 
 
 def _frame(path, line, r, no_unit: list) -> FrameSample:
@@ -121,7 +122,7 @@ def read(path) -> ClipRecord:
 def _notes(frames, no_unit, first) -> tuple[str, ...]:
     unit = (first.get("Lens Distance Unit") or "").strip()
     if unit in ("Meter", "Feet"):
-        notes = [f"focus distances recorded in {unit}s, converted to mm"]
+        notes = [f"focus distances recorded in {'metres' if unit == 'Meter' else 'feet'}, converted to mm"]
     else:
         notes = []
     absent = sum(f.focus_mm is None for f in frames)
