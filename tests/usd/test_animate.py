@@ -85,3 +85,26 @@ def test_bad_marks_name_file_and_line(tmp_path):
     with pytest.raises(InputError, match="increase"):
         write_animated_camera(tmp_path / "x.usda", [FocusKey(2, 3000.0), FocusKey(1, 2000.0)],
                               sensor=find_sensor("FF"), focal_length_mm=50.0, fstop=2.8)
+
+
+def test_an_anamorphic_pulls_pinhole_squeeze_is_sampled_per_frame(tmp_path, capsys):
+    """An anamorphic's best-match squeeze breathes with focus: each frame's ``lens:main:pinholeSqueeze`` is
+    `physcam report`'s pinhole squeeze at that mark, as the focal length beside it is (a reader rebuilding the
+    companion from the PhysicalCamera at frame 2 got frame 1's squeeze)."""
+    marks = _csv(tmp_path, ["1,3m", "2,1.5m"])
+    out = tmp_path / "ana.usda"
+    assert main(["usd", "animate", str(out), "--lens", "navarro_anamorphic_2x", "--marks", str(marks),
+                 "--sensor", "ALEXA 35", "--fstop", "4"]) == 0
+    stage = open_stage(out)
+    cam = stage.GetPrimAtPath("/Cameras/Camera")
+    squeezes = []
+    for frame, mark in ((1, "3m"), (2, "1.5m")):
+        capsys.readouterr()
+        assert main(["report", "--lens", "navarro_anamorphic_2x", "--focus", mark, "--fstop", "4",
+                     "--sensor", "ALEXA 35", "--json"]) == 0
+        pinhole = json.loads(capsys.readouterr().out)["pinhole"]
+        squeezes.append(pinhole["squeeze"])
+        assert cam.GetAttribute("lens:main:pinholeSqueeze").Get(frame) == pytest.approx(pinhole["squeeze"], rel=1e-6)
+        assert cam.GetAttribute("lens:main:pinholeFocalLength").Get(frame) == pytest.approx(
+            pinhole["focal_length_mm"], rel=1e-6)
+    assert abs(squeezes[1] - squeezes[0]) > 1e-4  # the case (100 x the tolerance): the squeeze does breathe between the marks

@@ -7,7 +7,8 @@ for a thin lens the practical model. What changes with focus is time-sampled:
 
 * the lens model's ``focusDistance`` and ``focalLength`` (the EFL: it changes with internal
   focusing), the lens's ``fStop``, ``iris``, ``entrancePupilDistance``, ``pinholeFocalLength``,
-  principal planes and ``apertureDistance`` (the stop moves with unit focusing);
+  ``pinholeSqueeze`` (an anamorphic's squeeze breathes too), principal planes and ``apertureDistance``
+  (the stop moves with unit focusing);
 * the companion UsdGeomCamera's ``focalLength`` (the best-match pinhole: breathing), apertures
   (float32 values that keep the field of view exact), ``fStop``, ``focusDistance`` and its
   translate: the eye follows the entrance pupil while the body, and so the film plane, stays
@@ -199,7 +200,8 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
                                   (cam, "iris", iris_mm(spec)),
                                   (cam, lp + "entrancePupilDistance", eye)):
             sample(prim, name, value, t)
-        optional = {lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "apertureDistance":
+        optional = {lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze":
+                    spec.pinhole_squeeze, lp + "apertureDistance":
                     spec.aperture_distance_mm, lp + "horizontalEntrancePupilDistance": spec.horizontal_entrance_pupil_mm}
         if spec.principal_planes_mm is not None:
             optional[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]
