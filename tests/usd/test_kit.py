@@ -82,8 +82,12 @@ def test_shot_can_pin_a_characterization_for_archive(tmp_path, library):
     shot = tmp_path / "shot.usda"
     write_shot(shot, body, library, lens_variant="d2026_03_01")
     assert read_camera(open_stage(shot)).spec.focal_length_mm == pytest.approx(24.1)
-    with pytest.raises(ExportError, match="no characterization variant"):
+    with pytest.raises(ExportError, match=r"no characterization variant 'd1999' \(it has .*d2026_03_01"):
         write_shot(tmp_path / "x.usda", body, library, lens_variant="d1999")
+    # the measuring day as the characterization CSV writes it pins the same variant (24.1 mm that day)
+    by_day = tmp_path / "by_day.usda"
+    write_shot(by_day, body, library, lens_variant="2026-03-01")
+    assert read_camera(open_stage(by_day)).spec.focal_length_mm == pytest.approx(24.1)
     with pytest.raises(InputError, match="cannot override"):
         write_shot(tmp_path / "y.usda", body, library, overrides={"focal_length_mm": 10})
 

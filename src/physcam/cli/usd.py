@@ -81,7 +81,8 @@ def register(sub) -> None:
                    help="shot: where the entrance pupil goes, in scene units")
     k.add_argument("--rotate", type=numbers("rotation", 3), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ",
                    help="shot: pan/tilt/roll about the entrance pupil, degrees (XYZ order)")
-    k.add_argument("--variant", help="shot: pin a lens characterization variant (default the lens file's current)")
+    k.add_argument("--variant", help="shot: pin a lens characterization variant, by its name (d2026_03_01) or its "
+                   "measuring day (2026-03-01); default the lens file's current")
     _stage_args(k)
     add_lenient(k)
     k.set_defaults(handler=run_kit, output_args=("file",))

@@ -232,6 +232,7 @@ def iris_mm(spec) -> float:
     """The schema's ``iris``: the entrance pupil's diameter at this focus, focal length / f-number there
     (with ``shutterBlades`` the equal-area diameter: the blades' polygon has this circle's area,
     docs/conventions.md)."""
+    spec = require_type("spec", spec, CameraSpec, "build one with CameraSpec(...)")
     return spec.focal_length_mm / (spec.fstop if spec.fstop_at_focus is None else spec.fstop_at_focus)
 
 

@@ -192,9 +192,13 @@ def write_shot(file, body_file, lens_file, *, overrides: dict | None = None, len
         refs.AddReference(Path(_relpath(Path(f).resolve(), out.parent)).as_posix(), Sdf.Path(prim_path))
     if lens_variant is not None:
         vsets = cam.GetVariantSets()
-        if "characterization" not in vsets.GetNames() or lens_variant not in \
-                vsets.GetVariantSet("characterization").GetVariantNames():
-            raise ExportError(f"{path}: lens file {lens_file} has no characterization variant {lens_variant!r}")
+        names = vsets.GetVariantSet("characterization").GetVariantNames() \
+            if "characterization" in vsets.GetNames() else []
+        if lens_variant not in names and _variant_name(lens_variant) in names:
+            lens_variant = _variant_name(lens_variant)  # the measuring day as the CSV wrote it: 2026-03-01
+        if lens_variant not in names:
+            raise ExportError(f"{path}: lens file {lens_file} has no characterization variant {lens_variant!r}"
+                              f" (it has {', '.join(names) or 'none'})")
         vsets.GetVariantSet("characterization").SetVariantSelection(lens_variant)
     try:
         # the clipping range in mm, read from the lens file in its own unit (issue 9: a metre shot
