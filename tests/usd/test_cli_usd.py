@@ -67,6 +67,15 @@ def test_write_refuses_zero_fps_without_traceback(tmp_path, capsys):
     assert not f.exists()
 
 
+def test_export_usd_points_to_usd_write(tmp_path, capsys):
+    """`physcam export` writes every other renderer's camera; a TD typing `export usd` is told where USD lives."""
+    f = tmp_path / "cam.usda"
+    assert main(["export", "usd", str(f), "--focal", "50"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("physcam: error: ") and "`physcam usd write`" in err, err
+    assert not f.exists()
+
+
 def _write_read(tmp_path, *flags, path=None):
     from physcam.usd.read import open_stage, read_camera
 
