@@ -237,3 +237,13 @@ def test_a_corrupt_lens_iris_cell_is_refused_even_beside_the_linear_iris(tmp_pat
     """The linear iris is the one read (finer), but a Lens Iris cell that is no stop is a corrupt row."""
     p = _arri_with(tmp_path, name="iris.csv", Lens_Iris="banana")
     _refused(capsys, ["metadata", "show", str(p)], ["iris.csv:2: ", "Lens Iris 'banana' is not a stop"])
+
+
+def test_fps_that_contradicts_the_files_rate_is_refused_not_ignored(tmp_path, capsys):
+    """--fps stands in for a rate the file lacks; the ARRI take records Project FPS 24, so --fps 25 (which was
+    silently ignored: the USD came out at 24) is refused, and nothing is written; --fps 24 agrees."""
+    out = tmp_path / "take.usda"
+    _refused(capsys, ["metadata", "usd", str(ARRI), "-o", str(out), "--fps", "25"],
+             ["records 24 fps, not --fps 25"])
+    assert not out.exists()
+    assert main(["metadata", "opentrackio", str(ARRI), "--fps", "24", "-o", str(tmp_path / "t.jsonl")]) == 0
