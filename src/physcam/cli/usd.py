@@ -163,9 +163,18 @@ def _stage_args(p, units: bool = True) -> None:
     if units:
         p.add_argument("--meters-per-unit", type=number("metersPerUnit"), default=0.01,
                        help="stage metersPerUnit (default 0.01: centimetres)")
-    p.add_argument("--fps", type=number("frames per second", positive=True), default=24.0, help="timeCodesPerSecond (default 24)")
+    p.add_argument("--fps", type=_time_code_rate, default=24.0,
+                   help="timeCodesPerSecond (default 24; 23.976, 29.97, 59.94 are the exact N x 1000/1001)")
     p.add_argument("--force", action="store_true", help="overwrite an existing file")
     add_output_options(p, what="what was written")
+
+
+def _time_code_rate(text) -> float:
+    """--fps as the stage's timeCodesPerSecond: an NTSC rate to three decimals is N x 1000/1001, as usd animate,
+    live record and metadata usd write it, so every physcam file of a 23.976 shot lines up (ntsc_rate)."""
+    from ..usd.animate import ntsc_rate
+
+    return ntsc_rate(number("frames per second", positive=True)(text))
 
 
 def run_write(args) -> int:
