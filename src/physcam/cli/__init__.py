@@ -314,7 +314,7 @@ def run() -> None:
     process: from Python, call :func:`main` instead."""
     from .. import _program
 
-    _program.RUNNING = True  # matplotlib without its docstring tables and 3-D toolkit (figures._lean_import)
+    _program.start()  # RUNNING (matplotlib without its docstring tables and 3-D toolkit: figures._lean_import), gc
     # numpy's BLAS on one thread unless the user says otherwise (before numpy loads): the program's linear
     # algebra is small (a Zernike fit of a few thousand pupil samples), where OpenBLAS's second thread
     # spins and doubles the CPU time (`mtf --field 0`: 0.85 -> 0.5 s, the same output; docs/performance.md)
@@ -322,6 +322,7 @@ def run() -> None:
     code = main()
     if "numba" in sys.modules:
         _exit_without_teardown(code)
+    _program.finish()
     sys.exit(code)
 
 

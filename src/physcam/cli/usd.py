@@ -31,7 +31,7 @@ def register(sub) -> None:
     from .report import add_report_arguments
 
     add_report_arguments(w)  # brings --meters-per-unit and --shutter-angle with it
-    from .lens import add_lenient
+    from ._common import add_lenient
 
     add_lenient(w)
     _stage_args(w, units=False)
