@@ -50,8 +50,15 @@ OWN_OUTPUT_CHECK = ("calibrate", "defocus", "defocus-kernels")
 _NOT_PATHS = ("command", "handler", "kind", "output_args", "output_folders")
 
 
+#: (command, a word people type after it) -> where that lives: said after argparse's "invalid choice"
+_ELSEWHERE = {("export", "usd"): "USD cameras are written by `physcam usd write` (docs/usd.md)"}
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # usage errors: one line, exit 2 (argparse's own code)
+        for (command, word), where in _ELSEWHERE.items():
+            if self.prog.endswith(f" {command}") and f"invalid choice: '{word}'" in message:
+                message += f"; {where}"
         self.exit(2, f"physcam: error: {message}\n")
 
     def _get_formatter(self):
