@@ -23,6 +23,7 @@ from physcam.export.blender_focus import N_FOCUS, blend_weights, focus_axis, foc
 from physcam.export.blender_zoom import N_FOCUS_ZOOM, N_ZOOM_GEOMETRY, zoom_focus_axis
 from physcam.lens.library import list_lenses, load_lens
 from physcam.lens.zoom import prescription_at
+from physcam.optics import paraxial
 from physcam.optics.focusing import closest_focus, focus, image_distance
 
 
@@ -43,16 +44,14 @@ def sharpness(q, film, vz_film_first, mark_mm):
     qb = q.with_thicknesses(thick)
     d_obj = mark_mm - (film - vz[0])
     defocus = vz[-1] + image_distance(qb, d_obj) - film
-    # the object whose image lands on the film: image_distance is monotone in d, bisect in 1/d
+    # the object x in front of the first vertex whose image lands on the film: with the lens's ABCD
+    # matrix on (y, n u), a ray from the axial object (y = x, n u = 1 at the first vertex: A x + B, C x + D)
+    # meets the axis back / n' behind the last vertex: -(A x + B) n' / (C x + D) = back, linear in x
+    a, b, c, d = paraxial.system_matrix(qb, "y")
+    n_img = paraxial.media_indices(qb)[-1]
     back = film - vz[-1]
-    lo, hi = 0.0, 1.0 / max(d_obj * 0.2, 1e-3)
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if (image_distance(qb, 1.0 / mid if mid > 0 else math.inf) - back) < 0:
-            lo = mid
-        else:
-            hi = mid
-    return defocus, 1.0 / (0.5 * (lo + hi)) + film - vz[0]
+    x = -(b * n_img + back * d) / (a * n_img + back * c)
+    return defocus, x + film - vz[0]
 
 
 def errors(q, axis, geometry, sub: int, blend=blended) -> dict:

@@ -29,13 +29,13 @@ import math
 import numpy as np
 
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
-from ..errors import InputError, OpticsError, require_type
+from ..errors import InputError, OpticsError, require_positive, require_type
 from ..lens.prescription import Prescription, takes_prescription
 from ._codetext import osl_comment
 from .osl import lens_data, osl_array, osl_number, render_template
 
-__all__ = ["FocusAxis", "FocusTable", "blend_weights", "focus_geometry", "focus_table", "focus_table_shader",
-           "ghost_rows", "N_FOCUS", "GRID_HALF_MM", "STOP_LEVELS"]
+__all__ = ["FocusAxis", "FocusTable", "blend_weights", "focus_axis", "focus_geometry", "focus_table",
+           "focus_table_shader", "ghost_rows", "hermite_basis", "N_FOCUS", "GRID_HALF_MM", "STOP_LEVELS"]
 
 #: Focus states tabulated (infinity first, uniform in :class:`FocusAxis`'s s).
 N_FOCUS = 32
@@ -93,7 +93,8 @@ def focus_axis(closest_mm: float, n_focus: int) -> FocusAxis:
     """The :class:`FocusAxis` of ``n_focus`` marks down to ``closest_mm`` (mm from the film)."""
     if isinstance(n_focus, bool) or not isinstance(n_focus, int) or n_focus < 3:
         raise InputError(f"a focus table needs at least 3 states, got {n_focus!r}")
-    return FocusAxis(float(closest_mm), float(closest_mm) * (1 + 1e-6), n_focus)
+    closest = require_positive("closest focus (mm from the film)", closest_mm)
+    return FocusAxis(closest, closest * (1 + 1e-6), n_focus)
 
 
 def blend_weights(index: float, n: int) -> tuple[int, float, list[int], list[float]]:
@@ -125,22 +126,24 @@ def hermite_basis(t: float) -> tuple[float, float, float, float]:
     return 2 * t3 - 3 * t2 + 1, t3 - 2 * t2 + t, 3 * t2 - 2 * t3, t3 - t2
 
 
-def focus_geometry(q: Prescription, axis: FocusAxis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(film_z, its slope per index step, vertex_z film side first) of the plain prescription ``q``
+@takes_prescription
+def focus_geometry(lens: Prescription, axis: FocusAxis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(film_z, its slope per index step, vertex_z film side first) of the plain prescription ``lens``
     focused (:func:`physcam.optics.focusing.focus`) at each of ``axis``'s marks: the focus table's
     geometry. The slope is physcam's own: a difference of exact focus solves 1e-3 index steps apart
     (second order, one-sided at the ends)."""
     from ..optics.focusing import focus
     from ..trace.surfaces import surface_table
 
+    require_type("axis", axis, FocusAxis, "physcam.export.blender_focus.focus_axis(closest_mm, n_focus)")
     eps = 1e-3
 
     def film(x):
-        return focus(q, axis.mark(x)).film_z
+        return focus(lens, axis.mark(x)).film_z
 
     film_z, slope, vz = [], [], []
     for k in range(axis.n):
-        st = focus(q, axis.mark(k))
+        st = focus(lens, axis.mark(k))
         film_z.append(st.film_z)
         vz.append(surface_table(st.prescription, reverse=True, coating="none").vertex_z)
         if k == 0:

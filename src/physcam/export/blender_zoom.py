@@ -32,6 +32,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..lens.prescription import Prescription, takes_prescription
+from .blender_focus import FocusAxis
 
 __all__ = ["ZoomGrid", "zoom_focus_table", "zoom_focus_axis", "rows_to_geometry", "N_FOCUS_ZOOM", "N_ZOOM_GEOMETRY",
            "N_ZOOM_ROWS", "N_ZOOM_EFL"]
@@ -132,7 +133,7 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
                       table0, None, float(rule[0, 0]), n_open, n_min, axis.near_mm, float(loss), zoom=grid)
 
 
-def zoom_focus_axis(geometry_prescriptions, n_focus: int = N_FOCUS_ZOOM):
+def zoom_focus_axis(geometry_prescriptions: list[Prescription], n_focus: int = N_FOCUS_ZOOM) -> FocusAxis:
     """The focus axis (:class:`~physcam.export.blender_focus.FocusAxis`) a zoom lens's tables share: down to
     the farthest closest focus of the plain prescriptions at the geometry's zoom positions."""
     from ..optics.focusing import closest_focus
