@@ -4,7 +4,7 @@ Run:  .venv/bin/python benchmarks/blender_focus_tables.py [--lenses dgauss_50mm,
 
 For each bundled lens (a zoom at u = 0, 0.5 and 1, on the zoom's shared focus axis) the table's
 geometry (:func:`physcam.export.blender_focus.focus_geometry`) is blended as the shader blends it
-(:func:`~physcam.export.blender_focus.blend_weights`) at ``--sub`` - 1 points inside every interval
+(:func:`~physcam.export.blender_focus.blended_geometry`) at ``--sub`` - 1 points inside every interval
 between marks, and compared with :func:`physcam.optics.focusing.focus` at that mark: the film plane's
 and the largest gap's error (mm), the defocus (the paraxial image of the mark through the blended
 lens less the blended film plane, mm) and the mark that the blended state focuses at (% of the mark).
@@ -19,21 +19,12 @@ import math
 
 import numpy as np
 
-from physcam.export.blender_focus import N_FOCUS, blend_weights, focus_axis, focus_geometry, hermite_basis
+from physcam.export.blender_focus import N_FOCUS, blended_geometry, focus_axis, focus_geometry
 from physcam.export.blender_zoom import N_FOCUS_ZOOM, N_ZOOM_GEOMETRY, zoom_focus_axis
 from physcam.lens.library import list_lenses, load_lens
 from physcam.lens.zoom import prescription_at
 from physcam.optics import paraxial
 from physcam.optics.focusing import closest_focus, focus, image_distance
-
-
-def blended(axis, geometry, focus_mm):
-    """(film_z, vertex_z film side first) of the table at focus_mm, as the shader blends them."""
-    film_z, slope, vz = geometry
-    k0, t, taps, w = blend_weights(axis.index(focus_mm), axis.n)
-    h00, h10, h01, h11 = hermite_basis(t)
-    film = h00 * film_z[k0] + h10 * slope[k0] + h01 * film_z[k0 + 1] + h11 * slope[k0 + 1]
-    return film, sum(wi * vz[i] for i, wi in zip(taps, w))
 
 
 def sharpness(q, film, vz_film_first, mark_mm):
@@ -54,7 +45,7 @@ def sharpness(q, film, vz_film_first, mark_mm):
     return defocus, x + film - vz[0]
 
 
-def errors(q, axis, geometry, sub: int, blend=blended) -> dict:
+def errors(q, axis, geometry, sub: int, blend=blended_geometry) -> dict:
     out = {"film": 0.0, "gap": 0.0, "defocus": 0.0, "mark_pct": 0.0}
     for k in range(axis.n - 1):
         for j in range(1, sub):

@@ -3,7 +3,7 @@ state the shader blends focuses where physcam's exact focus solve (physcam.optic
 says, down to the closest focus. Before round 7 the marks were uniform in 1/distance and the states
 linear in it: near a unit-focusing lens's 1:1 closest focus the film plane was out by 4.3 mm on the
 double Gauss 50 (1.3 mm of defocus) and 27 mm at the Canon 70-200's tele end (12 marks; 11.7 mm of
-defocus). The blend is evaluated as the shader's lines do (blend_weights, hermite_basis); the oracle
+defocus). The blend is evaluated as the shader's lines do (blended_geometry); the oracle
 is the exact focus solve at the same mark, and the defocus is the paraxial image of that mark through
 the blended lens less the blended film plane."""
 
@@ -17,8 +17,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from physcam.errors import InputError
-from physcam.export.blender_focus import (N_FOCUS, FocusAxis, blend_weights, focus_axis, focus_geometry,
-                                         hermite_basis)
+from physcam.export.blender_focus import (N_FOCUS, FocusAxis, blend_weights, blended_geometry, focus_axis,
+                                         focus_geometry, hermite_basis)
 from physcam.export.blender_zoom import N_FOCUS_ZOOM, N_ZOOM_GEOMETRY, zoom_focus_axis
 from physcam.lens.library import load_lens
 from physcam.lens.zoom import prescription_at
@@ -27,15 +27,6 @@ from physcam.optics.focusing import closest_focus, focus, gaussian_at_focus, ima
 #: Half the depth of focus a 0.030 mm circle of confusion (full frame) allows at f/N is N x 0.030 mm
 #: (object side far away; more at close focus): the tables must stay within a tenth of it wide open.
 COC_MM = 0.030
-
-
-def _blend(axis, geometry, mark_mm):
-    """(film_z, vertex_z film side first) as the shader blends the table at mark_mm."""
-    film_z, slope, vz = geometry
-    k0, t, taps, w = blend_weights(axis.index(mark_mm), axis.n)
-    h00, h10, h01, h11 = hermite_basis(t)
-    film = h00 * film_z[k0] + h10 * slope[k0] + h01 * film_z[k0 + 1] + h11 * slope[k0 + 1]
-    return film, sum(wi * vz[i] for i, wi in zip(taps, w))
 
 
 def _defocus(q, film, vz_film_first, mark_mm):
@@ -78,7 +69,7 @@ def test_between_marks_the_table_focuses_where_physcam_does(slug):
     worst = {"film": 0.0, "gap": 0.0, "defocus": 0.0}
     for x in points:
         mark = axis.mark(x)
-        film, vz = _blend(axis, geometry, mark)
+        film, vz = blended_geometry(axis, geometry, mark)
         exact = focus(q, mark)
         worst["film"] = max(worst["film"], abs(film - exact.film_z))
         worst["gap"] = max(worst["gap"], float(np.abs(np.diff(vz) - np.diff(exact.prescription.vertex_z[::-1])).max()))

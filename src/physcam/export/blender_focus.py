@@ -34,7 +34,7 @@ from ..lens.prescription import Prescription, takes_prescription
 from ._codetext import osl_comment
 from .osl import lens_data, osl_array, osl_number, render_template
 
-__all__ = ["FocusAxis", "FocusTable", "blend_weights", "focus_axis", "focus_geometry", "focus_table",
+__all__ = ["FocusAxis", "FocusTable", "blend_weights", "blended_geometry", "focus_axis", "focus_geometry", "focus_table",
            "focus_table_shader", "ghost_rows", "hermite_basis", "N_FOCUS", "GRID_HALF_MM", "STOP_LEVELS"]
 
 #: Focus states tabulated (infinity first, uniform in :class:`FocusAxis`'s s).
@@ -124,6 +124,17 @@ def hermite_basis(t: float) -> tuple[float, float, float, float]:
     """The cubic Hermite basis (h00, h10, h01, h11) at t in [0, 1] (unit interval)."""
     t2, t3 = t * t, t * t * t
     return 2 * t3 - 3 * t2 + 1, t3 - 2 * t2 + t, 3 * t2 - 2 * t3, t3 - t2
+
+
+def blended_geometry(axis: FocusAxis, geometry, focus_mm: float) -> tuple[float, np.ndarray]:
+    """(film_z, vertex_z film side first) of a table's ``geometry`` (:func:`focus_geometry`'s) at the mark
+    ``focus_mm`` as the shader blends them (:func:`blend_weights`): its lines in Python."""
+    require_type("axis", axis, FocusAxis, "physcam.export.blender_focus.focus_axis(closest_mm, n_focus)")
+    film_z, slope, vz = geometry
+    k0, t, taps, w = blend_weights(axis.index(float(focus_mm)), axis.n)
+    h00, h10, h01, h11 = hermite_basis(t)
+    film = h00 * film_z[k0] + h10 * slope[k0] + h01 * film_z[k0 + 1] + h11 * slope[k0 + 1]
+    return float(film), sum(wi * np.asarray(vz[i]) for i, wi in zip(taps, w))
 
 
 @takes_prescription
