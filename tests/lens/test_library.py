@@ -11,6 +11,7 @@ from physcam.lens.provenance import provenance_of
 
 from lens_reference import ISET_FILES, PBRT_FILES, REFERENCE, SEED_FILES, SEED_INVALID
 from patent_stated import PATENT_STATED
+from primary_stated import PRIMARY
 
 ALL_REFERENCE = PBRT_FILES + ISET_FILES + SEED_FILES
 
@@ -31,7 +32,7 @@ def test_every_reference_file_is_bundled_once():
     recs = list_lenses()
     originals = sorted(r.original_file for r in recs if r.original_file)
     assert originals == sorted(f"{f.parent.name}/{f.name}" for f in ALL_REFERENCE if f.name != DUPLICATE)
-    assert len({r.slug for r in recs}) == len(recs) == 18 + len(PATENT_STATED) + len(SECOND_HAND) + len(ZOOMS)
+    assert len({r.slug for r in recs}) == len(recs) == 18 + len(PATENT_STATED) + len(SECOND_HAND) + len(ZOOMS) + len(PRIMARY)
     assert find_lens(DUPLICATE).slug == find_lens("double_gauss_50mm_f2").slug == "dgauss_50mm"
 
 
@@ -41,7 +42,7 @@ def test_bundled_lens_is_valid_and_round_trips(rec):
     p.validate()
     assert loads_lens(dumps_lens(p, "physcam"), "physcam") == p
     assert rec.source and (rec.original_format in ("pbrt", "iset", "seed-toml") or rec.slug in PATENT_STATED
-                           or rec.slug in SECOND_HAND or (rec.slug in ZOOMS and p.zoom is not None))
+                           or rec.slug in SECOND_HAND or rec.slug in PRIMARY or (rec.slug in ZOOMS and p.zoom is not None))
 
 
 def _numbers(p):

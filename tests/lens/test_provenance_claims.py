@@ -61,6 +61,16 @@ def test_a_book_page_and_a_design_revision_are_places():
     assert primary_source_claim_gaps(book) == [] == primary_source_claim_gaps(design)
 
 
+def test_a_patent_claim_and_column_are_places():
+    # an old patent prints its one example as a claim's table or in a column, unnumbered otherwise
+    claim = dataclasses.replace(BACKED, source="US 2,701,982 (P. Angenieux), the table of claim 4 (column 3)",
+                                checks=("primary source: claim 4's table against the file: R1 +164.13 against "
+                                        "164.13 (every row equal)",))
+    assert primary_source_claim_gaps(claim) == []
+    unplaced = dataclasses.replace(claim, source="US 2,701,982 (P. Angenieux), in a claim")
+    assert len(primary_source_claim_gaps(unplaced)) == 1
+
+
 def test_no_claim_no_gaps():
     assert primary_source_claim_gaps(dataclasses.replace(BACKED, primary_source_checked=False, checks=())) == []
     assert primary_source_claim_gaps(Provenance()) == []

@@ -99,7 +99,7 @@ def test_sensor_pitches_are_width_over_photosites():
             with_pitch += not s.camera  # the sensors table's; the camera table's formats are counted apart
             assert s.pitch_um == pytest.approx(s.width_mm * 1000 / int(r["photosites_across"]), abs=6e-4)
             assert r["photosites_across"] in s.pitch_source  # the count and where it comes from
-            assert 3.0 < s.pitch_um < 10.0
+            assert 2.5 < s.pitch_um < 10.0  # cine and hybrid sensors: the LUMIX GH6's 2.995 um (17.3 mm / 5776) the finest
     assert with_pitch == 11
     assert find_sensor("ALEXA 35").pitch_um == pytest.approx(6.074)
     assert find_sensor("FF").pitch_um is None  # a format, not a camera

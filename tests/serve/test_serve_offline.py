@@ -66,6 +66,8 @@ def test_manifest_and_worker_are_served():
 
 
 def test_a_new_setup_opens_from_the_cache_with_the_server_stopped(capsys):
+    """Setups opened by the page's own URL parameters, then issue 46's done-when as a puller does it on the phone
+    (the_done_when_path): both with the laptop's server stopped, each number `physcam report`'s."""
     with sync_api.sync_playwright() as p:
         b = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"])
         try:
@@ -91,7 +93,46 @@ def test_a_new_setup_opens_from_the_cache_with_the_server_stopped(capsys):
                 doc = cli_report(capsys, *argv)
                 assert_numbers(pg, doc)
                 assert pg.locator("#sensor").input_value() == doc["sensor"]["key"]
+            the_done_when_path(pg, url, capsys)
             ctx.close()
         finally:
             b.close()
     assert not errors, errors
+
+
+
+def the_done_when_path(pg, url, capsys):
+    """Issue 46's done-when, as a puller does it with the laptop off: a 390 x 844 phone opens the page from its
+    cache, picks the camera "Sony FX6" then its format "FF 4K 17:9", a lens of their set (typed on the phone) and a
+    stop, and reads near, far, depth of field, the frame at the subject and the split-focus answer. Every number
+    is `physcam report`'s for the same setup (the split focus: `physcam report --near --far --fstop`, the focus
+    solved, and its split_focus.fstop_needed)."""
+    setup = ("--focal", "50", "--fstop", "2.8", "--sensor", "FX6 FF 4K 17:9", "--coc", "cine")
+    pg.goto(url)
+    pg.wait_for_selector("body[data-ready='1']")
+    pg.click("#coc-first button[data-coc='cine']")  # the first-use question: the puller's 0.025 mm
+    pg.select_option("#camera", "Sony FX6")
+    pg.select_option("#sensor", "sony-fx6-ff-4k-17-9")
+    assert pg.locator("#sensor option:checked").text_content().startswith("Sony FX6 FF 4K 17:9 — 35.6 × 18.77 mm")
+    pg.click("#lens-set-edit summary")
+    pg.fill("#lens-set-text", "25 T2 9in\n50 T1.4 18in # hero\n85 T1.4 3ft\n")
+    pg.select_option("#set-lens", "1")  # the 50 of the set
+    pg.fill("#fstop", "2.8")
+    pg.fill("#focus", "3m")
+    doc = cli_report(capsys, *setup, "--focus", "3m")
+    pg.wait_for_function("(v) => Math.abs(Number(document.getElementById('out-near').dataset.mm) - v) <= 1e-9 * v",
+                         arg=doc["dof"]["near_from_film_mm"])
+    assert pg.get_attribute("body", "data-source") == "page" and pg.get_attribute("body", "data-offline") == "1"
+    assert pg.locator("#sensor").input_value() == doc["sensor"]["key"] == "sony-fx6-ff-4k-17-9"
+    assert_numbers(pg, doc)  # near, far, depth of field, hyperfocal
+    for side in ("width", "height"):
+        got = float(pg.get_attribute("#out-frame", f"data-{side}"))
+        assert got == pytest.approx(doc["frame_at_focus"][f"{side}_mm"], rel=1e-9), side
+    pg.fill("#split-near", "2.5m")
+    pg.fill("#split-far", "4m")
+    pg.wait_for_selector("#split-answer[data-focus]")
+    split = cli_report(capsys, *setup, "--near", "2.5m", "--far", "4m")
+    assert float(pg.get_attribute("#split-answer", "data-focus")) == pytest.approx(split["focus_from_film_mm"], rel=1e-9)
+    need = split["split_focus"]["fstop_needed"]
+    assert float(pg.get_attribute("#split-answer", "data-fstop")) == pytest.approx(need, rel=1e-9)
+    assert f"f/{need:.1f}" in pg.text_content("#split-answer")

@@ -39,9 +39,10 @@ __all__ = ["Provenance", "provenance_of", "check_provenance_table", "primary_sou
 
 #: How a ``checks`` line about the primary source itself begins (``"primary source: ..."``).
 PRIMARY_SOURCE_CHECK = "primary source:"
-#: Words that name a place inside a source: a patent's example or table, a book's page or figure, a
-#: design file's revision.
-_PLACE = re.compile(r"\b(example|embodiment|table|fig\.?|figure|p\.|pp\.|page|revision|rev\.|beispiel|tabelle)"
+#: Words that name a place inside a source: a patent's example, table, claim or column, a book's page or
+#: figure, a design file's revision.
+_PLACE = re.compile(r"\b(example|embodiment|table|claim|column|col\.|fig\.?|figure|p\.|pp\.|page|revision|rev\.|"
+                    r"beispiel|tabelle)"
                     r"\s*(\d+|[IVX]+\b|[A-Z]\b)", re.IGNORECASE)
 _DECIMAL = re.compile(r"[-+]?\d+\.\d+")
 _COMPARED = re.compile(r"\b(against|equal|equals|match|matches|agree|agrees|differ|differs)\b", re.IGNORECASE)

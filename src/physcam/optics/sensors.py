@@ -208,7 +208,7 @@ def filter_sensors(query: str = "", *, maker: str | None = None, fmt: str | None
     ``max_width_mm``.
 
     >>> [s.key for s in filter_sensors("FX6", fmt="17:9")]
-    ['sony-fx6-ff-4k-17-9', 'sony-fx6-s35-4k-17-9']
+    ['sony-fx6-ff-4k-17-9']
     """
     for name, v in (("query", query), ("maker", maker), ("format", fmt)):
         if v is not None and not isinstance(v, str):
