@@ -20,23 +20,23 @@ sys.path.insert(0, str(SRC.parent / "scripts"))
 from house_metrics import RoomWalkAll, strongly_connected, walk_rooms  # noqa: E402
 
 LAYER = {
-    "errors": 0, "_moved": 1, "_program": 2,
-    "": 3,  # the root package only re-exports errors and the version, and installs the old module paths
-    "data": 4, "extras": 5, "progress": 6, "units": 7, "io": 8, "figures": 9,
-    "lens": 10,
-    "optics": 11,
-    "trace": 12,
-    "analysis": 13,
-    "onset": 14,
-    "export": 15,
-    "usd": 16,
-    "live": 17,
-    "metadata": 18,
-    "characterize": 19,
-    "serve": 20,
-    "farm": 21,
-    "cli": 22,
-    "__main__": 23,
+    "errors": 0, "_record": 1, "_moved": 2, "_program": 3,
+    "": 4,  # the root package only re-exports errors and the version, and installs the old module paths
+    "data": 5, "extras": 6, "progress": 7, "units": 8, "io": 9, "figures": 10,
+    "lens": 11,
+    "optics": 12,
+    "trace": 13,
+    "analysis": 14,
+    "onset": 15,
+    "export": 16,
+    "usd": 17,
+    "live": 18,
+    "metadata": 19,
+    "characterize": 20,
+    "serve": 21,
+    "farm": 22,
+    "cli": 23,
+    "__main__": 24,
 }
 
 

@@ -42,9 +42,9 @@ _NUMBER = r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?"
 _SIMPLE = re.compile(rf"^\s*({_NUMBER})\s*([a-zA-Zµ'\"]*)\s*$")
 #: inches as a number, a whole number and a fraction ("6 1/2") or a fraction alone ("3/8")
 _INCHES = r"(?:(\d+(?:\.\d*)?)(?:\s+(\d+)/(\d+))?|(\d+)/(\d+))"
-_FEET_INCHES = re.compile(
-    rf"^\s*(?:({_NUMBER})\s*(?:ft|feet|foot|'))?\s*(?:{_INCHES}\s*(?:in|inch|inches|\"))?\s*$")
-_FEET_BARE_INCHES = re.compile(rf"^\s*({_NUMBER})\s*(?:ft|feet|foot|')\s*{_INCHES}\s*$")
+#: (patterns compiled by ``re`` when a distance in feet is first read: a metric one never needs them)
+_FEET_INCHES = rf"^\s*(?:({_NUMBER})\s*(?:ft|feet|foot|'))?\s*(?:{_INCHES}\s*(?:in|inch|inches|\"))?\s*$"
+_FEET_BARE_INCHES = rf"^\s*({_NUMBER})\s*(?:ft|feet|foot|')\s*{_INCHES}\s*$"
 
 #: The unit systems distances are printed in (``--units``): metric or feet and inches.
 UNIT_SYSTEMS = ("m", "ft")
@@ -84,9 +84,9 @@ def parse_distance(text, *, name: str = "distance", allow_inf: bool = False) -> 
             if allow_inf:
                 return math.inf
             raise UnitError(f"{name} must be finite, got {s!r}")
-        m = _FEET_INCHES.match(s) if any(c in s for c in "'\"/") or re.search(r"\d\s*(ft|feet|foot)\s*\d", s) \
+        m = re.match(_FEET_INCHES, s) if any(c in s for c in "'\"/") or re.search(r"\d\s*(ft|feet|foot)\s*\d", s) \
             else None
-        m = m or (_FEET_BARE_INCHES.match(s) if "/" in s else None)
+        m = m or (re.match(_FEET_BARE_INCHES, s) if "/" in s else None)
         if m and (m.group(1) is not None or any(g is not None for g in m.groups()[1:])):
             # a sign belongs to the whole distance: -1' 2" is -(1 foot 2 inches)
             v = abs(float(m.group(1) or 0.0)) * 304.8 + _inches(*m.groups()[1:]) * 25.4

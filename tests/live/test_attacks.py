@@ -478,3 +478,22 @@ def test_after_a_restart_a_stray_sample_within_the_old_numbers_is_still_off_the_
         c = rx.counters()
     assert _ids(got) == [s["sampleId"] for s in good], c
     assert c["resync"] == 1 and c["stray"] == 1
+
+
+@pytest.mark.parametrize("forged_first", [True, False])
+def test_an_invalid_copy_of_a_sample_does_not_cost_the_real_one(forged_first):
+    """A schema-invalid sample (fStop -1) with the same source and sequence number as a real one, mid-take:
+    before the real one (a forged or corrupted copy) or after it, every real sample is delivered, in order,
+    and the copy is counted invalid, not the real one late."""
+    good = _samples(5)
+    bad = copy.deepcopy(good[2])
+    bad["lens"]["fStop"] = -1
+    copy_and_real = [("tx", _datagrams(bad, 2)), ("tx", _datagrams(good[2], 2))]
+    order = [("tx", _datagrams(good[i], i)) for i in (0, 1)] + (copy_and_real if forged_first else copy_and_real[::-1]) \
+        + [("tx", _datagrams(good[i], i)) for i in (3, 4)]
+    with Receiver(0, host="127.0.0.1", reorder_timeout_s=5.0) as rx:  # the order, not the clock, is tested
+        got = _stream(rx, order)
+        _drain(rx, got, 5, timeout=1.0)
+        c = rx.counters()
+    assert _ids(got) == [s["sampleId"] for s in good], c
+    assert c["invalid"] == 1 and c["late"] == 0 and c["missing"] == 0

@@ -157,3 +157,93 @@ def test_a_20_mb_csv_is_read_in_less_memory_than_its_size(tmp_path):
         tracemalloc.stop()
     assert len(rec.frames) == 17_000 and rec.frames[-1].focus_mm == pytest.approx(load(ARRI).frames[499].focus_mm)
     assert peak < 0.5 * size, f"peak {peak / 1e6:.1f} MB for a {size / 1e6:.1f} MB file"
+
+
+def _ame_rows(tmp_path, name, timecodes, fps=None):
+    """The real AME sample's first rows with these Master TCs (and Project FPS), nothing after them."""
+    lines = ARRI.read_text(encoding="utf-8").splitlines()
+    header = lines[0].split("\t")
+    out = [lines[0]]
+    for k, tc in enumerate(timecodes):
+        cells = lines[1 + k].split("\t")
+        for i, h in enumerate(header):
+            if h == "Master TC":
+                cells[i] = tc
+            elif h == "Project FPS" and fps is not None:
+                cells[i] = fps
+        out.append("\t".join(cells))
+    p = tmp_path / name
+    p.write_text("\n".join(out) + "\n", encoding="utf-8")
+    return p
+
+
+def test_a_deleted_row_is_refused_where_the_timecode_skips(tmp_path, capsys):
+    """The real ARRI take with its 200th frame row (file line 201) deleted: every later frame would land one
+    plate frame early, so the reader refuses at the row after the gap, naming the timecodes either side."""
+    lines = ARRI.read_text(encoding="utf-8").splitlines()
+    tc = lambda line: lines[line - 1].split("\t")[1]  # noqa: E731  (Master TC is the 2nd column)
+    before, gone = tc(200), tc(201)
+    p = tmp_path / "gap.csv"
+    p.write_text("\n".join(lines[:200] + lines[201:]) + "\n", encoding="utf-8")
+    _refused(capsys, ["metadata", "show", str(p)],
+             ["gap.csv:201: ", f"skips 1 frame from {before} to {tc(202)} at the clip's 24 fps"])
+    assert gone not in capsys.readouterr().err
+
+
+def test_a_frame_rate_the_timecode_was_not_counted_at_is_refused(tmp_path, capsys):
+    """The real take (timecode counted at 24 fps) with Project FPS changed to 25: at 25 fps, :23 to :00 of the
+    next second skips frame :24, at the first second boundary of the file."""
+    p = _arri_with(tmp_path, name="fps25.csv", Project_FPS="25.000")
+    lines = p.read_text(encoding="utf-8").splitlines()
+    line = next(n for n in range(2, len(lines) + 1) if lines[n - 1].split("\t")[1].endswith(":00"))
+    _refused(capsys, ["metadata", "show", str(p)], [f"fps25.csv:{line}: ", "skips 1 frame", "at the clip's 25 fps"])
+
+
+def test_a_timecode_frame_past_the_frame_rate_is_refused_at_its_line(tmp_path, capsys):
+    """Frame 24 does not exist at 24 fps (frames run 00 to 23): refused at its line, not taken for a new take."""
+    p = _ame_rows(tmp_path, "tc.csv", ["13:36:49:22", "13:36:49:23", "13:36:49:24", "13:36:50:00"])
+    _refused(capsys, ["metadata", "show", str(p)], ["tc.csv:4: ", "timecode 13:36:49:24 is not a time", "00 to 23"])
+
+
+def test_drop_frame_timecode_at_29_97_counts_on_through_the_dropped_numbers(tmp_path):
+    """SMPTE ST 12-1 drop frame: numbers ;00 and ;01 are skipped at each minute but every tenth, so
+    00:00:59;29 -> 00:01:00;02 and 00:09:59;29 -> 00:10:00;00 are one frame each, and
+    00:00:59;29 -> 00:01:00;03 loses the frame numbered ;02: refused."""
+    ok = _ame_rows(tmp_path, "df.csv", ["00:00:59;28", "00:00:59;29", "00:01:00;02", "00:01:00;03"], fps="29.970")
+    assert [f.timecode for f in load(ok).frames][2] == "00:01:00;02"
+    ok10 = _ame_rows(tmp_path, "df10.csv", ["00:09:59;29", "00:10:00;00", "00:10:00;01"], fps="29.970")
+    assert len(load(ok10).frames) == 3
+    skip = _ame_rows(tmp_path, "df1.csv", ["00:00:59;29", "00:01:00;03"], fps="29.970")
+    with pytest.raises(MetadataError, match=r"df1.csv:3: the timecode skips 1 frame"):
+        load(skip)
+
+
+def test_a_take_in_feet_is_converted_and_said_in_feet(tmp_path):
+    """Lens Distance Unit "Feet": the first row's 4.812 is 4.812 x 304.8 mm = 1466.7 mm (1 ft = 304.8 mm)."""
+    lines = ARRI.read_text(encoding="utf-8").splitlines()
+    header = lines[0].split("\t")
+    u, d = header.index("Lens Distance Unit"), header.index("Lens Focus Distance")
+    rows = [r.split("\t") for r in lines[1:3]]
+    for r in rows:
+        r[u] = "Feet"
+    p = tmp_path / "feet.csv"
+    p.write_text("\n".join([lines[0], *("\t".join(r) for r in rows)]) + "\n", encoding="utf-8")
+    rec = load(p)
+    assert rec.frames[0].focus_mm == pytest.approx(float(rows[0][d]) * 304.8, rel=1e-12)
+    assert "focus distances recorded in feet, converted to mm" in rec.notes
+
+
+def test_a_corrupt_lens_iris_cell_is_refused_even_beside_the_linear_iris(tmp_path, capsys):
+    """The linear iris is the one read (finer), but a Lens Iris cell that is no stop is a corrupt row."""
+    p = _arri_with(tmp_path, name="iris.csv", Lens_Iris="banana")
+    _refused(capsys, ["metadata", "show", str(p)], ["iris.csv:2: ", "Lens Iris 'banana' is not a stop"])
+
+
+def test_fps_that_contradicts_the_files_rate_is_refused_not_ignored(tmp_path, capsys):
+    """--fps stands in for a rate the file lacks; the ARRI take records Project FPS 24, so --fps 25 (which was
+    silently ignored: the USD came out at 24) is refused, and nothing is written; --fps 24 agrees."""
+    out = tmp_path / "take.usda"
+    _refused(capsys, ["metadata", "usd", str(ARRI), "-o", str(out), "--fps", "25"],
+             ["records 24 fps, not --fps 25"])
+    assert not out.exists()
+    assert main(["metadata", "opentrackio", str(ARRI), "--fps", "24", "-o", str(tmp_path / "t.jsonl")]) == 0

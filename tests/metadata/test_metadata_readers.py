@@ -235,3 +235,36 @@ def test_errors_are_physcam_errors():
     assert issubclass(MetadataError, PhysCamError)
     with pytest.raises(MetadataError):
         detect_file(D / "does-not-exist.csv")
+
+
+def _resaved(src: Path, dst: Path, quoting, drop: str | None = None) -> Path:
+    """``src`` read as CSV and written again as a spreadsheet would, with other quoting (and without ``drop``)."""
+    import csv
+
+    rows = list(csv.reader(src.read_text(encoding="utf-8-sig").splitlines()))
+    keep = [i for i, h in enumerate(rows[0]) if h != drop]
+    with dst.open("w", encoding="utf-8", newline="") as fh:
+        csv.writer(fh, quoting=quoting, lineterminator="\n").writerows([[r[i] for i in keep] for r in rows])
+    return dst
+
+
+def test_a_csv_saved_again_with_other_quoting_reads_the_same_frames(tmp_path):
+    """VENICE quotes every cell, REDline none: a spreadsheet's save swaps that, and the clip is the same."""
+    import csv
+
+    for src, others, quoting, name in ((VENICE[0], VENICE[1:], csv.QUOTE_MINIMAL, "v.csv"),
+                                       (RED[0], RED[1:], csv.QUOTE_ALL, "r.frames.csv"),
+                                       (CANON[0], CANON[1:], csv.QUOTE_ALL, "c_Frames.csv")):
+        again, original = load([_resaved(src, tmp_path / name, quoting), *others]), load([src, *others])
+        assert again.frames == original.frames and len(again.frames) > 0
+
+
+@pytest.mark.parametrize("src, column", [(VENICE[0], "Focus Distance (ft)"), (VENICE[0], "Aperture"),
+                                         (RED[0], "Focus Distance"), (CANON[0], "FocusPosition")])
+def test_a_missing_column_is_named(tmp_path, src, column):
+    import csv
+
+    p = _resaved(src, tmp_path / ("cut_Frames.csv" if src in CANON else "cut.frames.csv"), csv.QUOTE_MINIMAL, column)
+    with pytest.raises(MetadataError, match=r"cut.*:1: the header looks like .* but has no '" +
+                       column.split(" (")[0]):
+        load(p)

@@ -63,6 +63,8 @@ def test_thin_lens_iris_and_focus_pull(tmp_path):
     for frame, mark, n in ((1, 3000.0, 2.8), (2, 2500.0, 4.0), (3, 2000.0, 5.6)):
         assert geom.GetFocalLengthAttr().Get(frame) == pytest.approx(image_distance_at_mark(35.0, mark), rel=3e-6)  # float32, chosen within 24 ulps to keep the FOV exact
         assert cam.GetAttribute("lens:main:fStop").Get(frame) == pytest.approx(n, rel=1e-6)
+        # the exposure follows the iris pull: exposure:fStop is the T-stop, N for a lens of transmittance 1
+        assert geom.GetExposureFStopAttr().Get(frame) == pytest.approx(n, rel=1e-6)
 
 
 def test_bad_marks_name_file_and_line(tmp_path):
@@ -72,6 +74,37 @@ def test_bad_marks_name_file_and_line(tmp_path):
     bad = _csv(tmp_path, ["1,3m", "2,three metres"])
     with pytest.raises(LensFileError, match=r"pull.csv:3"):
         read_focus_marks(bad)
+    # an f-stop that is not one, frames going back, a row cut short: each names its line
+    for rows, header, said in ((["1,3m,2.8", "2,2m,nan"], "frame,focus,fstop", "f-stop must be a finite number"),
+                               (["1,3m,2.8", "2,2m,-4"], "frame,focus,fstop", "f-stop must be greater than 0"),
+                               (["1,3m", "2,2m", "2,1m"], "frame,focus", "frame 2 does not follow frame 2"),
+                               (["1,3m,2.8", "2"], "frame,focus,fstop", "this row has fewer values than the header.s 3")):
+        line = len(rows) + 1
+        with pytest.raises(LensFileError, match=rf"pull.csv:{line}: {said}"):
+            read_focus_marks(_csv(tmp_path, rows, header=header))
     with pytest.raises(InputError, match="increase"):
         write_animated_camera(tmp_path / "x.usda", [FocusKey(2, 3000.0), FocusKey(1, 2000.0)],
                               sensor=find_sensor("FF"), focal_length_mm=50.0, fstop=2.8)
+
+
+def test_an_anamorphic_pulls_pinhole_squeeze_is_sampled_per_frame(tmp_path, capsys):
+    """An anamorphic's best-match squeeze breathes with focus: each frame's ``lens:main:pinholeSqueeze`` is
+    `physcam report`'s pinhole squeeze at that mark, as the focal length beside it is (a reader rebuilding the
+    companion from the PhysicalCamera at frame 2 got frame 1's squeeze)."""
+    marks = _csv(tmp_path, ["1,3m", "2,1.5m"])
+    out = tmp_path / "ana.usda"
+    assert main(["usd", "animate", str(out), "--lens", "navarro_anamorphic_2x", "--marks", str(marks),
+                 "--sensor", "ALEXA 35", "--fstop", "4"]) == 0
+    stage = open_stage(out)
+    cam = stage.GetPrimAtPath("/Cameras/Camera")
+    squeezes = []
+    for frame, mark in ((1, "3m"), (2, "1.5m")):
+        capsys.readouterr()
+        assert main(["report", "--lens", "navarro_anamorphic_2x", "--focus", mark, "--fstop", "4",
+                     "--sensor", "ALEXA 35", "--json"]) == 0
+        pinhole = json.loads(capsys.readouterr().out)["pinhole"]
+        squeezes.append(pinhole["squeeze"])
+        assert cam.GetAttribute("lens:main:pinholeSqueeze").Get(frame) == pytest.approx(pinhole["squeeze"], rel=1e-6)
+        assert cam.GetAttribute("lens:main:pinholeFocalLength").Get(frame) == pytest.approx(
+            pinhole["focal_length_mm"], rel=1e-6)
+    assert abs(squeezes[1] - squeezes[0]) > 1e-4  # the case (100 x the tolerance): the squeeze does breathe between the marks

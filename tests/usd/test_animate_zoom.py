@@ -77,6 +77,28 @@ def test_physcams_reader_gets_back_the_zoomed_pinhole_and_pupil(tmp_path):
         assert f.fstop == pytest.approx(4.0)
 
 
+def test_each_frames_iris_is_the_reports_entrance_pupil_at_that_focus(tmp_path, capsys):
+    """An internal-focus zoom's iris set to f/2.8 is f/2.74 at 100 mm and 2.5 m (docs/lens-report.md, "The iris
+    and the f-stop at a focus"): each frame's lens ``iris`` is the entrance pupil there, `physcam report`'s
+    ``aperture_diameter_mm`` for that zoom, focus and f-stop, as `usd write` stores it, not EFL / 2.8."""
+    marks = tmp_path / "pull.csv"
+    frames = ((1, "2.5m", "2.8", "100mm"), (2, "5m", "5.6", "190mm"))
+    marks.write_text("frame,focus,fstop,zoom\n" + "".join(",".join(map(str, f)) + "\n" for f in frames))
+    out = tmp_path / "zoom.usda"
+    assert main(["usd", "animate", str(out), "--lens", NIKON, "--marks", str(marks), "--sensor", "ALEXA 35"]) == 0
+    stage = open_stage(out)
+    cam = stage.GetPrimAtPath("/Cameras/Camera")
+    for frame, focus, n, zoom in frames:
+        capsys.readouterr()
+        assert main(["report", "--lens", NIKON, "--zoom", zoom, "--focus", focus, "--fstop", n,
+                     "--sensor", "ALEXA 35", "--json"]) == 0
+        report = json.loads(capsys.readouterr().out)
+        assert report["fstop_at_focus"] != pytest.approx(float(n), rel=5e-3)  # the case: the f-number moved
+        for name in ("lens:main:iris", "iris"):
+            assert cam.GetAttribute(name).Get(Usd.TimeCode(frame)) == pytest.approx(
+                report["aperture_diameter_mm"], rel=1e-6), (frame, name)
+
+
 def test_a_zoom_column_on_a_prime_is_refused(tmp_path, capsys):
     marks = tmp_path / "pull.csv"
     marks.write_text("frame,focus,zoom\n1,2m,50mm\n")

@@ -67,6 +67,34 @@ def test_write_refuses_zero_fps_without_traceback(tmp_path, capsys):
     assert not f.exists()
 
 
+def test_export_usd_points_to_usd_write(tmp_path, capsys):
+    """`physcam export` writes every other renderer's camera; a TD typing `export usd` is told where USD lives."""
+    f = tmp_path / "cam.usda"
+    assert main(["export", "usd", str(f), "--focal", "50"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("physcam: error: ") and "`physcam usd write`" in err, err
+    assert not f.exists()
+
+
+def test_write_and_animate_agree_on_an_ntsc_rate(tmp_path):
+    """`--fps 23.976` is 24000/1001 time codes per second from usd write as from usd animate (and a live
+    recording): a camera from one referenced beside a take from the other is not rescaled in time; the
+    shutter at 180 degrees is half of 1001/24000 s."""
+    from physcam.usd.read import open_stage
+
+    marks = tmp_path / "pull.csv"
+    marks.write_text("frame,focus\n1,3m\n")
+    written, animated = tmp_path / "w.usda", tmp_path / "a.usda"
+    assert main(["usd", "write", str(written), *BASE, "--fps", "23.976"]) == 0
+    assert main(["usd", "animate", str(animated), "--focal", "50", "--fstop", "4", "--marks", str(marks),
+                 "--fps", "23.976"]) == 0
+    for f in (written, animated):
+        stage = open_stage(f)
+        assert stage.GetTimeCodesPerSecond() == 24000 / 1001, f
+        assert stage.GetPrimAtPath("/Cameras/Camera").GetAttribute("shutterDuration").Get() == pytest.approx(
+            0.5 * 1001 / 24000, rel=1e-7)
+
+
 def _write_read(tmp_path, *flags, path=None):
     from physcam.usd.read import open_stage, read_camera
 

@@ -82,8 +82,12 @@ def test_shot_can_pin_a_characterization_for_archive(tmp_path, library):
     shot = tmp_path / "shot.usda"
     write_shot(shot, body, library, lens_variant="d2026_03_01")
     assert read_camera(open_stage(shot)).spec.focal_length_mm == pytest.approx(24.1)
-    with pytest.raises(ExportError, match="no characterization variant"):
+    with pytest.raises(ExportError, match=r"no characterization variant 'd1999' \(it has .*d2026_03_01"):
         write_shot(tmp_path / "x.usda", body, library, lens_variant="d1999")
+    # the measuring day as the characterization CSV writes it pins the same variant (24.1 mm that day)
+    by_day = tmp_path / "by_day.usda"
+    write_shot(by_day, body, library, lens_variant="2026-03-01")
+    assert read_camera(open_stage(by_day)).spec.focal_length_mm == pytest.approx(24.1)
     with pytest.raises(InputError, match="cannot override"):
         write_shot(tmp_path / "y.usda", body, library, overrides={"focal_length_mm": 10})
 
@@ -358,3 +362,42 @@ def test_check_says_current_for_every_file_physcam_writes(tmp_path):
     assert check_shot(cam)["stale"] is False
     kit = write_previs_kit(tmp_path / "kit.usda")
     assert check_shot(kit)["stale"] is False
+
+
+NAVARRO = "navarro_anamorphic_2x"  # internal focus: its iris set to f/4 is f/3.62 at 1.25 m (docs/lens-report.md)
+
+
+def _report_iris_mm(capsys, *flags):
+    import json
+
+    from physcam.cli import main
+
+    capsys.readouterr()
+    assert main(["report", "--lens", NAVARRO, "--sensor", "ALEXA 35", "--json", *flags]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert abs(report["fstop_at_focus"] / report["fstop"] - 1) > 0.05  # the case: the f-number moved
+    return report["aperture_diameter_mm"]
+
+
+def test_a_vendor_lens_shot_and_a_refresh_keep_the_iris_at_the_focus(tmp_path, capsys):
+    """The iris of an internal-focus lens is its entrance pupil at the focus, `physcam report`'s
+    aperture_diameter_mm (32.18 mm for the Navarro at 1.25 m, f/4), not EFL / 4 (29.15 mm): in a shot
+    composed from a vendor lens file, and after `usd refresh` of a camera `usd write` wrote (which
+    `usd check` calls current, and which refresh used to rewrite to EFL / N)."""
+    from physcam.cli import main
+
+    want = _report_iris_mm(capsys, "--focus", "1.25m", "--fstop", "4")
+    vendor, body, shot = tmp_path / "nav.usda", tmp_path / "body.usda", tmp_path / "shot.usda"
+    assert main(["usd", "kit", "vendor", str(vendor), "--lens", NAVARRO, "--focus", "3m", "--fstop", "4"]) == 0
+    assert main(["usd", "kit", "body", str(body), "--sensor", "ALEXA 35"]) == 0
+    assert main(["usd", "kit", "shot", str(shot), "--body", str(body), "--lens", str(vendor),
+                 "--focus", "1.25m", "--fstop", "4"]) == 0
+    stage = open_stage(shot)
+    assert stage.GetPrimAtPath("/Cameras/Shot").GetAttribute("lens:main:iris").Get() == pytest.approx(want, rel=1e-6)
+
+    cam = tmp_path / "cam.usda"
+    assert main(["usd", "write", str(cam), "--lens", NAVARRO, "--focus", "1.25m", "--fstop", "4",
+                 "--sensor", "ALEXA 35"]) == 0
+    assert main(["usd", "refresh", str(cam)]) == 0
+    stage = open_stage(cam)
+    assert stage.GetPrimAtPath("/Cameras/Camera").GetAttribute("lens:main:iris").Get() == pytest.approx(want, rel=1e-6)

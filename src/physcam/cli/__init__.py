@@ -50,8 +50,15 @@ OWN_OUTPUT_CHECK = ("calibrate", "defocus", "defocus-kernels")
 _NOT_PATHS = ("command", "handler", "kind", "output_args", "output_folders")
 
 
+#: (command, a word people type after it) -> where that lives: said after argparse's "invalid choice"
+_ELSEWHERE = {("export", "usd"): "USD cameras are written by `physcam usd write` (docs/usd.md)"}
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # usage errors: one line, exit 2 (argparse's own code)
+        for (command, word), where in _ELSEWHERE.items():
+            if self.prog.endswith(f" {command}") and f"invalid choice: '{word}'" in message:
+                message += f"; {where}"
         self.exit(2, f"physcam: error: {message}\n")
 
     def _get_formatter(self):
@@ -307,7 +314,7 @@ def run() -> None:
     process: from Python, call :func:`main` instead."""
     from .. import _program
 
-    _program.RUNNING = True  # matplotlib without its docstring tables and 3-D toolkit (figures._lean_import)
+    _program.start()  # RUNNING (matplotlib without its docstring tables and 3-D toolkit: figures._lean_import), gc
     # numpy's BLAS on one thread unless the user says otherwise (before numpy loads): the program's linear
     # algebra is small (a Zernike fit of a few thousand pupil samples), where OpenBLAS's second thread
     # spins and doubles the CPU time (`mtf --field 0`: 0.85 -> 0.5 s, the same output; docs/performance.md)
@@ -315,6 +322,7 @@ def run() -> None:
     code = main()
     if "numba" in sys.modules:
         _exit_without_teardown(code)
+    _program.finish()
     sys.exit(code)
 
 

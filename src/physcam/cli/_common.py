@@ -442,6 +442,25 @@ CAMERA_COMMANDS = {
 }
 
 
+def add_lenient(parser) -> None:
+    """The --lenient flag of every command that takes a lens."""
+    parser.add_argument("--lenient", action="store_true",
+                        help="load a lens file that is not buildable as written with its impossible parts repaired as "
+                             "`physcam lens fix` would (one warning line per repair; results marked as repaired)")
+
+
+def mark_repaired(d, lens):
+    """JSON output ``d`` with ``lens_repaired`` and ``lens_repairs`` when ``lens`` was repaired on load."""
+    from ..lens.library import repairs_of
+
+    reps = repairs_of(lens)
+    if reps and isinstance(d, dict):
+        d = dict(d)
+        d["lens_repaired"] = True
+        d["lens_repairs"] = reps
+    return d
+
+
 def lens_use(args):
     """The context the command's handler runs in: :func:`physcam.lens.library.camera_use` for a
     :data:`CAMERA_COMMANDS` command, so every lens it loads must be a camera lens; else none."""

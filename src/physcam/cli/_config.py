@@ -19,9 +19,9 @@ read is refused with the file's name, so a typo never silently falls back to a d
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
 from pathlib import Path
 
+from .._record import field, record
 from ..errors import InputError
 
 __all__ = ["Config", "config_path", "load_config", "KEYS"]
@@ -39,7 +39,7 @@ KEYS = {
 }
 
 
-@dataclass(frozen=True)
+@record
 class Config:
     """The user's defaults; None where the file does not set them."""
 

@@ -48,7 +48,7 @@ def at_zoom_named(lens, args):
     """``lens`` at ``--zoom`` for a command whose outputs carry the lens's name (ST-map headers, cards, tables):
     the prescription there named with its position (paraxial EFL and encoder value), and ``args.zoom_block``
     the JSON ``zoom`` block (None without --zoom). A prime given --zoom is refused (InputError)."""
-    from dataclasses import replace
+    from .._record import replace
 
     q = zoomed(lens, args)
     args.zoom_block = zoom_info(args, q) if q is not lens else None

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, focus, hidden_alias, number, whole
 from ._output import add_output_options, document, emit_json, print_csv
-from .lens import WAVE_UNITS, add_lenient, mark_repaired
+from ._common import add_lenient, mark_repaired
+from .lens import WAVE_UNITS
 
 #: How each analysis names its document (``physcam.NAME``), its rows (for --csv) and its units.
 DOCS = {"illumination": ("illumination", "points"), "colour": ("colour", "lateral"),

@@ -21,7 +21,7 @@ def _whole(name: str, lo: int, hi: int):
 
 def register(sub) -> None:
     from .analyze import _resolution, _sensor
-    from .lens import add_lenient
+    from ._common import add_lenient
 
     p = sub.add_parser("characterize", help="characterize lenses over a grid of focus, f-stop, field and wavelength "
                                             "on Dask: PSF kernels, ST-maps and fitted distortion, breathing, "

@@ -174,7 +174,7 @@ def _figure(res, path=None, *, force=False, units="m"):
 # ---- physcam compare --lens LENS_A --lens LENS_B --lens ... ------------------------------------------------------------
 def _register_lenses(s) -> None:
     from ._output import add_output_options
-    from .lens import add_lenient
+    from ._common import add_lenient
     from .report import add_coc_option
 
     c = s.add_parser("lenses", help="lenses side by side: FOV, DOF, breathing, distortion, illumination, bokeh "

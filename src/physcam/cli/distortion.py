@@ -15,7 +15,8 @@ import math
 from ._common import FOCUS_HELP, add_units_option, focus, focus_list, number, units_of
 from ._output import document, emit_json, print_csv
 from ._zoom import add_zoom_option, at_zoom_named
-from .lens import WAVE_UNITS, mark_repaired
+from ._common import mark_repaired
+from .lens import WAVE_UNITS
 
 #: Names of the files the fits write into --stmap DIR.
 FIT_FILES = {"brown": "brown_conrady.json", "3de4": "3de4_radial_standard_degree_4.txt",

@@ -68,7 +68,7 @@ def register(sub) -> None:
 
     from ._output import add_output_options
     from ._zoom import add_zoom_option
-    from .lens import add_lenient
+    from ._common import add_lenient
     from .report import add_coc_option
 
     p = sub.add_parser("dof-table", help="depth-of-field table: near, far, total, hyperfocal for f-stops x focus marks",
@@ -246,7 +246,7 @@ def run(args) -> int:
     units = units_of(args)
     d = build(args)
     if getattr(args, "loaded_lens", None) is not None:
-        from .lens import mark_repaired
+        from ._common import mark_repaired
 
         d = mark_repaired(d, args.loaded_lens)
     if args.output:

@@ -12,7 +12,7 @@ from ._output import add_output_options, document, emit_json, print_csv
 
 def _sensor(p) -> None:
     from .analyze import _sensor as add
-    from .lens import add_lenient
+    from ._common import add_lenient
 
     add(p)
     add_lenient(p)  # every export takes a lens
@@ -313,7 +313,7 @@ examples:
 def _register_rib(s) -> None:
     import argparse
 
-    from .lens import add_lenient
+    from ._common import add_lenient
     from .report import add_report_arguments
 
     r = s.add_parser("rib", help="write a RenderMan RIB camera block (PxrCamera, or the legacy Hider form)",
@@ -432,7 +432,7 @@ def run_rib(args) -> int:
 def _register_pbrt(s) -> None:
     import argparse
 
-    from .lens import add_lenient
+    from ._common import add_lenient
 
     b = s.add_parser("pbrt", help="write pbrt-v4 cameras: the lens .dat with a realistic camera, and the thin lens",
                      description="Write pbrt-v4 files for a lens report: <lens>.dat (the lens focused at the mark) and "
@@ -572,7 +572,7 @@ def _shift(v) -> str:
 
 # --- physcam export mitsuba (Mitsuba 3 thinlens sensor; docs/mitsuba.md) ----------------------------
 def _register_mitsuba(s) -> None:
-    from .lens import add_lenient
+    from ._common import add_lenient
     from .report import add_report_arguments
 
     m = s.add_parser("mitsuba", help="write a Mitsuba 3 thinlens sensor (scene XML and dict JSON) matching the lens report",

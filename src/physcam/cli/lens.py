@@ -21,7 +21,8 @@ plane and flange (distance in front, + toward the subject); see docs/conventions
 from __future__ import annotations
 
 from ..errors import PhysCamError
-from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number, whole
+from ._common import (add_lenient, add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus,
+                      hidden_alias, mark_repaired, number, whole)
 from ._output import add_output_options
 from ._zoom import add_zoom_option, at_zoom_named, register_zoom, zoom_info, zoomed
 
@@ -178,30 +179,11 @@ def _register_archives(lsub) -> None:
 WAVE_UNITS = {"length": "mm", "angle": "degree", "wavelength": "nm"}
 
 
-def add_lenient(parser) -> None:
-    """The --lenient flag of every command that takes a lens."""
-    parser.add_argument("--lenient", action="store_true",
-                        help="load a lens file that is not buildable as written with its impossible parts repaired as "
-                             "`physcam lens fix` would (one warning line per repair; results marked as repaired)")
-
-
 def load_lens_arg(name, lenient: bool = False):
     """The lens a command was given, loaded strictly or (``lenient``) repaired on load."""
     from ..lens.library import load_lens
 
     return load_lens(name, lenient=lenient)
-
-
-def mark_repaired(d, lens):
-    """JSON output ``d`` with ``lens_repaired`` and ``lens_repairs`` when ``lens`` was repaired on load."""
-    from ..lens.library import repairs_of
-
-    reps = repairs_of(lens)
-    if reps and isinstance(d, dict):
-        d = dict(d)
-        d["lens_repaired"] = True
-        d["lens_repairs"] = reps
-    return d
 
 
 def _fmt(v, nd=3):

@@ -103,9 +103,15 @@ def register(sub) -> None:
 
 
 def _load(args):
+    from ..errors import InputError
     from ..metadata import load
 
-    return load(args.clip)
+    rec = load(args.clip)
+    fps = getattr(args, "fps", None)
+    if fps is not None and rec.frame_rate is not None and abs(float(rec.frame_rate) - fps) > 1e-3:
+        # --fps stands in for a rate the file lacks; over a recorded one it would be silently ignored
+        raise InputError(f"the {rec.source} file records {float(rec.frame_rate):g} fps, not --fps {fps:g}; drop --fps")
+    return rec
 
 
 def _m(v, units):

@@ -40,7 +40,7 @@ def _count(name, lo, hi):
 def register(sub) -> None:
     import argparse
 
-    from .lens import add_lenient
+    from ._common import add_lenient
 
     p = sub.add_parser("microlens", help="light-field cameras: insert a microlens array (ISET JSON), render raw "
                                          "light fields, sub-aperture views and refocused pictures",

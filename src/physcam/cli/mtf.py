@@ -14,7 +14,8 @@ import math
 
 from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number, whole
 from ._output import add_output_options, document, emit_json, print_csv
-from .lens import WAVE_UNITS, add_lenient, mark_repaired
+from ._common import add_lenient, mark_repaired
+from .lens import WAVE_UNITS
 
 #: The CLI's largest pupil grids (the Python API goes to 1024): bound a chart's time and memory
 #: (15 fields x 3 wavelengths), and one field's.

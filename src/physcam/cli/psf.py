@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from ._common import add_lens_argument, FOCUS_HELP, focus, number, whole
 from ._output import add_output_options, document, emit_json
-from .lens import WAVE_UNITS, add_lenient, mark_repaired
+from ._common import add_lenient, mark_repaired
+from .lens import WAVE_UNITS
 
 EPILOG = """\
 examples:

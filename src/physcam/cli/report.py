@@ -33,7 +33,7 @@ def register(sub) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_report_arguments(p)
-    from .lens import add_lenient
+    from ._common import add_lenient
 
     add_lenient(p)
     from ._common import add_units_option
@@ -153,9 +153,9 @@ def solve_from_args(args):
     args.report_inputs = report_camera(**_request_inputs(args, lens, sensor, coc))
     report = solve_report(args.report_inputs)
     if getattr(args, "sensor_defaulted", False):
-        import dataclasses
+        from .._record import replace
 
-        report = dataclasses.replace(report, notes=report.notes + (
+        report = replace(report, notes=report.notes + (
             f"no --sensor given: {sensor.name}, {sensor.width_mm:g} x {sensor.height_mm:g} mm "
             f"({args.sensor_default_source}; give --sensor to change it)",))
     return report
@@ -166,12 +166,12 @@ def dof_chart_solver(args, report):
     camera of ``report`` (after :func:`solve_from_args`) at another stop and focus mark, with the report's
     CoC and sensor and no measured limits, so that the chart and the report agree at the report's own
     cell. The cameras share the lens model, so a prescription focuses at each mark once."""
-    import dataclasses
+    from .._record import replace
 
     from ..onset.report import solve_report
     from ..optics.state import camera_state
 
-    cam, refs = report.camera, dataclasses.replace(report.references, tstop=None)
+    cam, refs = report.camera, replace(report.references, tstop=None)
 
     def solve(fstop, focus_mm):
         at = camera_state(cam.lens_model, focus_mm=focus_mm, fstop=fstop, sensor=cam.sensor, squeeze=cam.squeeze,
@@ -225,13 +225,13 @@ def camera_blocks(report, args) -> dict:
     d = report.to_dict()
     calc = report
     if report.focus_is_infinite:  # every value but the focus distance is that of a far, finite focus
-        import dataclasses
+        from .._record import replace
 
         from ..onset.report import MAX_DISTANCE_MM
 
         # (the camera moved to that mark for these values only: no focus is solved, nothing else asks it)
-        far = dataclasses.replace(report.camera, focus_from_film_mm=MAX_DISTANCE_MM)
-        calc = dataclasses.replace(report, camera=far, object_distance_mm=MAX_DISTANCE_MM)
+        far = replace(report.camera, focus_from_film_mm=MAX_DISTANCE_MM)
+        calc = replace(report, camera=far, object_distance_mm=MAX_DISTANCE_MM)
     blocks = {
         "meters_per_unit": mpu,
         "camera": "the best-match pinhole at the entrance pupil (docs/lens-report.md)",
@@ -334,7 +334,7 @@ def report_document(report, cams, args) -> dict:
     d = report.to_dict()
     d["cameras"] = cams
     if getattr(args, "loaded_lens", None) is not None:
-        from .lens import mark_repaired
+        from ._common import mark_repaired
 
         d = mark_repaired(d, args.loaded_lens)
     return d

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number, whole
 from ._output import add_output_options, document, emit_json, print_csv
-from .lens import WAVE_UNITS, add_lenient, mark_repaired
+from ._common import add_lenient, mark_repaired
+from .lens import WAVE_UNITS
 
 
 def register(sub) -> None:

@@ -31,7 +31,7 @@ def register(sub) -> None:
     from .report import add_report_arguments
 
     add_report_arguments(w)  # brings --meters-per-unit and --shutter-angle with it
-    from .lens import add_lenient
+    from ._common import add_lenient
 
     add_lenient(w)
     _stage_args(w, units=False)
@@ -81,7 +81,8 @@ def register(sub) -> None:
                    help="shot: where the entrance pupil goes, in scene units")
     k.add_argument("--rotate", type=numbers("rotation", 3), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ",
                    help="shot: pan/tilt/roll about the entrance pupil, degrees (XYZ order)")
-    k.add_argument("--variant", help="shot: pin a lens characterization variant (default the lens file's current)")
+    k.add_argument("--variant", help="shot: pin a lens characterization variant, by its name (d2026_03_01) or its "
+                   "measuring day (2026-03-01); default the lens file's current")
     _stage_args(k)
     add_lenient(k)
     k.set_defaults(handler=run_kit, output_args=("file",))
@@ -162,9 +163,18 @@ def _stage_args(p, units: bool = True) -> None:
     if units:
         p.add_argument("--meters-per-unit", type=number("metersPerUnit"), default=0.01,
                        help="stage metersPerUnit (default 0.01: centimetres)")
-    p.add_argument("--fps", type=number("frames per second", positive=True), default=24.0, help="timeCodesPerSecond (default 24)")
+    p.add_argument("--fps", type=_time_code_rate, default=24.0,
+                   help="timeCodesPerSecond (default 24; 23.976, 29.97, 59.94 are the exact N x 1000/1001)")
     p.add_argument("--force", action="store_true", help="overwrite an existing file")
     add_output_options(p, what="what was written")
+
+
+def _time_code_rate(text) -> float:
+    """--fps as the stage's timeCodesPerSecond: an NTSC rate to three decimals is N x 1000/1001, as usd animate,
+    live record and metadata usd write it, so every physcam file of a 23.976 shot lines up (ntsc_rate)."""
+    from ..usd.animate import ntsc_rate
+
+    return ntsc_rate(number("frames per second", positive=True)(text))
 
 
 def run_write(args) -> int:

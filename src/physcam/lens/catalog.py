@@ -266,9 +266,27 @@ def glass_names() -> list[str]:
     return [g.name for g in GLASSES.values()]
 
 
+#: (name, nd, Vd) of the common glasses with a formula, as the built-in catalogues give them
+#: (tests/lens/test_catalog_common.py checks them against the catalogues): a medium of nd and Vd far
+#: from all of them needs no catalogue read to say so (issue 43: a report's start-up).
+_COMMON_ND_VD = (("N-BK7", 1.5168, 64.17), ("N-BK10", 1.49782, 66.95), ("N-K5", 1.52249, 59.48),
+                 ("N-FK5", 1.48749, 70.41), ("N-PK51", 1.52855, 76.98), ("N-BAK4", 1.56883, 55.98),
+                 ("N-BAF10", 1.67003, 47.11), ("N-SK4", 1.61272, 58.63), ("N-SK16", 1.62041, 60.32),
+                 ("N-SSK8", 1.61773, 49.83), ("N-LAK8", 1.713, 53.83), ("N-LAK9", 1.691, 54.71),
+                 ("N-LAK22", 1.65113, 55.89), ("N-LAF2", 1.74397, 44.85), ("N-LASF9", 1.85025, 32.17),
+                 ("F2", 1.62004, 36.37), ("N-F2", 1.62005, 36.43), ("N-SF2", 1.64769, 33.82),
+                 ("N-SF5", 1.67271, 32.25), ("N-SF6", 1.80518, 25.36), ("N-SF8", 1.68894, 31.31),
+                 ("N-SF10", 1.72828, 28.53), ("N-SF11", 1.78472, 25.68), ("N-SF57", 1.84666, 23.78),
+                 ("S-FPL51", 1.497, 81.54), ("S-TIH53", 1.84666, 23.78), ("F_SILICA", 1.45846, 67.82),
+                 ("CAF2", 1.43385, 94.99))
+
+
 def match_glass(nd: float, vd: float, tol_nd: float, tol_vd: float) -> CatalogGlass | None:
     """The one common glass (:data:`GLASSES`) with a formula within (``tol_nd``, ``tol_vd``) of
     (nd, Vd), or None when none or several match."""
+    built_in = _Common._table is None and not any(cat in _USER for cat, _ in _COMMON)
+    if built_in and not any(abs(n - nd) <= tol_nd and abs(v - vd) <= tol_vd for _, n, v in _COMMON_ND_VD):
+        return None  # none near: the common glasses' catalogues (SCHOTT, OHARA) stay unread
     hits = [g for g in GLASSES.values()
             if g.formula is not None and abs(g.nd - nd) <= tol_nd and abs(g.vd - vd) <= tol_vd]
     return hits[0] if len(hits) == 1 else None

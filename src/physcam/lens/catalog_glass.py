@@ -3,15 +3,15 @@ the catalogue's own dispersion formula (:mod:`physcam.lens.glassformulas`)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 
+from .._record import field, record
 from ..errors import InputError
 from .glassformulas import formula_index, is_sellmeier3
 
 __all__ = ["CatalogGlass"]
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class CatalogGlass:
     """One catalogue glass: ``nd`` at 587.5618 nm, Abbe number ``vd``, its catalogue (``maker``),
     Zemax ``formula`` number and ``coefficients`` (wavelength in um), span ``range_nm``, and in a

@@ -17,10 +17,10 @@ import contextlib
 import contextvars
 import math
 import re
-from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+from .._record import field_names, record
 from ..errors import InputError, LensFileError
 from .prescription import Prescription, takes_prescription
 
@@ -66,7 +66,7 @@ def require_camera_lens(p: Prescription, label: str | None = None, what: str = "
                      "an infinite-conjugate lens (`physcam lens show` and `physcam trace` read it)")
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class LensRecord:
     """What ``physcam lenses`` lists about one lens of the library (lengths in mm)."""
 
@@ -93,7 +93,7 @@ class LensRecord:
 
     def to_dict(self) -> dict:
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in
-                ((f, getattr(self, f)) for f in self.__dataclass_fields__)}
+                ((f, getattr(self, f)) for f in field_names(self))}
 
 
 def library_dir() -> Path:
@@ -249,7 +249,7 @@ def load_repaired(path, format: str | None = None):
     made, named "<name> (repaired)" and carries them in ``extras`` (:data:`REPAIRED_KEY`) and in
     ``[provenance] corrections``. Raises :class:`LensFileError` when no repair is defined.
     """
-    import dataclasses
+    from .._record import replace
 
     from .raw import read_raw
     from .formats._common import json_text
@@ -264,7 +264,7 @@ def load_repaired(path, format: str | None = None):
         q = with_corrections(q, repairs)
         extras = dict(q.extras)
         extras[REPAIRED_KEY] = json_text([r.message for r in repairs])
-        q = dataclasses.replace(q, metadata=dataclasses.replace(q.metadata, name=f"{q.metadata.name} (repaired)"),
+        q = replace(q, metadata=replace(q.metadata, name=f"{q.metadata.name} (repaired)"),
                                 extras=tuple(sorted(extras.items())))
     try:
         q.validate(str(path), list(raw.lines))

@@ -17,9 +17,9 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import math
-from dataclasses import dataclass, field, replace
 from collections.abc import Iterable
 
+from .._record import field, record, replace
 from ..errors import LensFileError
 
 __all__ = [
@@ -79,7 +79,7 @@ MAX_LENGTH_MM = 1.0e5
 MAX_CONIC = 1.0e4
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Medium:
     """The optical medium after a surface.
 
@@ -105,7 +105,7 @@ class Medium:
 AIR = Medium()
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Surface:
     """One refracting surface (or the aperture stop) of a sequential lens.
 
@@ -147,7 +147,7 @@ class Surface:
         return self.kind == "stop"
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class VariableGap:
     """An air gap that changes with focus: its thickness at infinity and at the close distance."""
 
@@ -156,7 +156,7 @@ class VariableGap:
     thickness_close: float
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Focus:
     """Internal focusing: gaps given at infinity and at ``close_distance``.
 
@@ -169,7 +169,7 @@ class Focus:
     gaps: tuple[VariableGap, ...]
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class ZoomGap:
     """An air gap that changes with zoom: its thickness at each zoom position (infinity focus) and,
     where the source gives them, at each position's close focus (``thickness_close``)."""
@@ -179,7 +179,7 @@ class ZoomGap:
     thickness_close: tuple[float, ...] | None = None
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Zoom:
     """A zoom lens's tabulated positions (docs/zoom.md). The prescription's own surfaces are the first
     position; :func:`physcam.lens.zoom.prescription_at` gives any other.
@@ -203,7 +203,7 @@ class Zoom:
         return len(self.encoder)
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class LensMetadata:
     """What a lens is and where its numbers come from."""
 
@@ -222,7 +222,7 @@ class LensMetadata:
     licence: str | None = None  # the prescription file's licence (SPDX identifier where one fits)
 
 
-@dataclass(frozen=True)
+@record
 class Prescription:
     """A sequential lens: surfaces front (scene side) to back (film side).
 

@@ -29,8 +29,8 @@ from __future__ import annotations
 import datetime
 import json
 import re
-from dataclasses import dataclass, fields
 
+from .._record import field_names, record
 from ..errors import LensFileError
 from .prescription import Prescription, takes_prescription
 
@@ -41,11 +41,12 @@ __all__ = ["Provenance", "provenance_of", "check_provenance_table", "primary_sou
 PRIMARY_SOURCE_CHECK = "primary source:"
 #: Words that name a place inside a source: a patent's example, table, claim or column, a book's page or
 #: figure, a design file's revision.
-_PLACE = re.compile(r"\b(example|embodiment|table|claim|column|col\.|fig\.?|figure|p\.|pp\.|page|revision|rev\.|"
-                    r"beispiel|tabelle)"
-                    r"\s*(\d+|[IVX]+\b|[A-Z]\b)", re.IGNORECASE)
-_DECIMAL = re.compile(r"[-+]?\d+\.\d+")
-_COMPARED = re.compile(r"\b(against|equal|equals|match|matches|agree|agrees|differ|differs)\b", re.IGNORECASE)
+#: (patterns compiled by ``re`` on first use: reading a lens never needs them)
+_PLACE = (r"\b(example|embodiment|table|claim|column|col\.|fig\.?|figure|p\.|pp\.|page|revision|rev\.|"
+          r"beispiel|tabelle)"
+          r"\s*(\d+|[IVX]+\b|[A-Z]\b)")
+_DECIMAL = r"[-+]?\d+\.\d+"
+_COMPARED = r"\b(against|equal|equals|match|matches|agree|agrees|differ|differs)\b"
 
 #: The SPDX value of a file whose licence nobody has established (its numbers came from a file
 #: under another licence and were not re-entered from the primary source).
@@ -62,7 +63,7 @@ ORDER = ("source", "source_url", "licence", "transcribed", "transcribed_by", "tr
          "corrections", "aliases", "original_file", "original_format")
 
 
-@dataclass(frozen=True)
+@record
 class Provenance:
     """A lens file's provenance (module notes); None or () where the file does not say."""
 
@@ -97,9 +98,9 @@ class Provenance:
 
     def to_dict(self) -> dict:
         out = {}
-        for f in fields(self):
-            v = getattr(self, f.name)
-            out[f.name] = list(v) if isinstance(v, tuple) else v
+        for name in field_names(self):
+            v = getattr(self, name)
+            out[name] = list(v) if isinstance(v, tuple) else v
         return out
 
 
@@ -108,7 +109,7 @@ def provenance_of(prescription: Prescription) -> Provenance:
     """The provenance record of ``prescription`` (its metadata and ``provenance.*`` extras)."""
     m = prescription.metadata
     found = {"source": m.source, "licence": m.licence, "notes": m.notes}
-    names = {f.name for f in fields(Provenance)}
+    names = set(field_names(Provenance))
     for k, v in prescription.extras:
         key = k[len("provenance."):] if k.startswith("provenance.") else None
         if key in names and key not in found:
@@ -156,14 +157,15 @@ def primary_source_claim_gaps(prov: Provenance) -> list[str]:
     if prov.primary_source_checked is not True:
         return []
     gaps = []
-    if not (prov.source and _PLACE.search(prov.source)):
+    if not (prov.source and re.search(_PLACE, prov.source, re.IGNORECASE)):
         gaps.append("the source does not name the example, table or page the numbers were compared with")
     if not (prov.checked and prov.checked_by):
         gaps.append("checked and checked_by do not say when and by whom")
     lines = [c for c in prov.checks if c.lower().startswith(PRIMARY_SOURCE_CHECK)]
     if any("not reached" in c for c in lines):
         gaps.append("a checks line says the primary source was not reached")
-    elif not any(_PLACE.search(c) and _DECIMAL.search(c) and _COMPARED.search(c) for c in lines):
+    elif not any(re.search(_PLACE, c, re.IGNORECASE) and re.search(_DECIMAL, c) and re.search(_COMPARED, c, re.IGNORECASE)
+                 for c in lines):
         gaps.append(f"no checks line '{PRIMARY_SOURCE_CHECK} ...' names the table or example and the numbers compared "
                     "(radii, gaps, nd, Vd, stated EFL and f-number)")
     return gaps

@@ -13,7 +13,9 @@ discarded, as the transport asks of consumers, although the schema allows 0..2^3
 Order: a source's 16-bit packet sequence numbers are unwrapped into a running count. A sample waits
 in a reorder window for the ones before it: a missing number is given up (counted **missing**)
 once ``reorder_window`` (8) later samples wait, or the oldest of them has waited
-``reorder_timeout_s`` (50 ms). A sample is on its stream when its number lies between the next one
+``reorder_timeout_s`` (50 ms). An invalid sample of a known source holds its number the same way: a
+valid sample with that number arriving meanwhile (the real one, after a forged or corrupted copy)
+takes its place; else the number is passed over when the gap would be given up. A sample is on its stream when its number lies between the next one
 due and ``reorder_window`` past the highest seen; anything else starts or extends an off-stream
 **run**. A run **resynchronises** the source (the window is handed on, the run becomes the stream;
 counted in ``resync``) when two samples in a row follow each other and are newer (by
@@ -308,8 +310,8 @@ class Receiver:
         if problems:
             self._count("invalid")
             self._note(header.sequence, addr, problems[0])
-            if key in self._streams:  # its number is used up: the window need not wait for it
-                self._place(key, header.sequence, None, now)
+            if key in self._streams:  # its number is held as a gap a valid sample may still fill (a forged or
+                self._place(key, header.sequence, None, now)  # corrupt copy must not cost the real frame)
             return
         self._place(key, header.sequence, ReceivedSample(obj, 0, enc, now), now)
 
@@ -417,15 +419,19 @@ class Receiver:
         ``reorder_window`` samples wait and the oldest has waited less than the timeout, else (or with
         ``skip_all``: stopping, resynchronising) give the gap up as missing."""
         while st.window:
-            if st.next in st.window:
+            held = st.window.get(st.next)
+            if held is not None and held[1] is not None:
                 self._deliver(st, st.next)
             elif skip_all or len(st.window) >= self.reorder_window \
                     or now - min(a for a, _ in st.window.values()) > self.reorder_timeout_s:
+                if held is not None:  # an invalid sample's number, no valid one came for it: passed over
+                    self._deliver(st, st.next)
+                    continue
                 ext = min(st.window)
                 self._count("missing", ext - st.next)
                 st.next = ext
             else:
-                break
+                break  # a gap, or an invalid sample's number that its valid sample may still fill
 
     def _expire(self, now: float) -> None:
         """Windows whose oldest sample has waited the timeout give their gaps up."""

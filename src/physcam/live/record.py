@@ -421,7 +421,7 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
     from pxr import Gf, Sdf, UsdGeom, Vt
 
     from ..export.usdgeom import mm_to_scene_units, require_meters_per_unit
-    from ..usd.author import author_camera, new_stage, sample_render_camera, save_stage, spec_from_report
+    from ..usd.author import author_camera, iris_mm, new_stage, sample_render_camera, save_stage, spec_from_report
     from .frames import rotation_matrix
 
     if isinstance(solved, (str, bytes)) or not hasattr(solved, "__iter__"):
@@ -498,15 +498,14 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
         model.GetAttribute("focalLength").Set(spec.focal_length_mm, t)
         model.GetAttribute("focusDistance").Set(spec.focus_mm, t)
         names["fStop"].Set(spec.fstop, t)
-        names["iris"].Set(spec.focal_length_mm / spec.fstop, t)
-        body_iris.Set(spec.focal_length_mm / spec.fstop, t)
+        names["iris"].Set(iris_mm(spec), t)
+        body_iris.Set(iris_mm(spec), t)
         names["entrancePupilDistance"].Set(eye, t)
         if a_pupil_x is not None:
             a_pupil_x.Set(float(eye if s.entrance_pupil_horizontal_mm is None else s.entrance_pupil_horizontal_mm), t)
         if names["pinholeFocalLength"]:
             names["pinholeFocalLength"].Set(report.pinhole[0], t)
         sample_render_camera(geom, spec, report, mpu, tcps, t, where=path)
-        geom.GetExposureFStopAttr().Set(spec.fstop / math.sqrt(spec.transmittance), t)
         if f.sequence_number is not None:
             a_seq.Set(int(f.sequence_number), t)
         if f.timecode is not None:

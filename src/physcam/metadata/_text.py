@@ -125,6 +125,15 @@ def single_row(path, what: str, columns=()) -> tuple[list[str], int, dict]:
     return header, got[0][0], got[0][1]
 
 
+def header_columns(first_line: str, delimiter: str = ",") -> list[str]:
+    """The column names of a header line, quoted or not (a CSV a spreadsheet saved again drops or adds
+    the quotes), stripped."""
+    try:
+        return [c.strip() for c in next(csv.reader([first_line], delimiter=delimiter), [])]
+    except csv.Error:
+        return []
+
+
 def require_columns(path, header, columns, what: str) -> None:
     missing = [c for c in columns if c not in header]
     if missing:

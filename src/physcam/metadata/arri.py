@@ -26,7 +26,7 @@ import re
 from fractions import Fraction
 
 from ..errors import MetadataError, require_type
-from ._text import FOOT_MM, number, require_columns, rows, stop_from_marking, timecode
+from ._text import FOOT_MM, header_columns, number, require_columns, rows, stop_from_marking, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -41,7 +41,7 @@ _FT_IN = re.compile(r"""^\s*(\d+(?:\.\d+)?)\s*'\s*(?:(\d+(?:\.\d+)?)\s*"?)?\s*$"
 def sniff(head: str) -> bool:
     """True when ``head`` (the file's first line) is an AME header."""
     require_type("head", head, str, "the first bytes of a metadata file")
-    cols = head.split("\t")
+    cols = header_columns(head, "\t")
     return "Master TC" in cols and any(c in cols for c in ("Lens Focus Distance", "Lens Focal Length", "Lens Iris"))
 
 
@@ -62,10 +62,11 @@ def _focus_mm(path, line, unit, text):
 
 def _tstop(path, line, row):
     lin = row.get("Lens Linear Iris", "")
+    marked = stop_from_marking(path, line, "Lens Iris", row.get("Lens Iris", ""))  # read, so a corrupt cell is said
     if lin not in ("", "--"):
         v = number(path, line, "Lens Linear Iris", lin)
         return 2.0 ** ((v - 1000.0) / 2000.0)
-    return stop_from_marking(path, line, "Lens Iris", row.get("Lens Iris", ""))
+    return marked
 
 
 def _frame(path, line, r, no_unit: list) -> FrameSample:
@@ -121,7 +122,7 @@ def read(path) -> ClipRecord:
 def _notes(frames, no_unit, first) -> tuple[str, ...]:
     unit = (first.get("Lens Distance Unit") or "").strip()
     if unit in ("Meter", "Feet"):
-        notes = [f"focus distances recorded in {unit}s, converted to mm"]
+        notes = [f"focus distances recorded in {'metres' if unit == 'Meter' else 'feet'}, converted to mm"]
     else:
         notes = []
     absent = sum(f.focus_mm is None for f in frames)

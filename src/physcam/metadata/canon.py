@@ -21,7 +21,7 @@ from __future__ import annotations
 import struct
 
 from ..errors import MetadataError, require_type
-from ._text import number, require_columns, rows, single_row, timecode
+from ._text import header_columns, number, require_columns, rows, single_row, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -33,7 +33,7 @@ SQUEEZE = {0: 1.0, 1: 1.33, 2: 2.0, 3: 1.8}
 
 def sniff(head: str) -> str | None:
     require_type("head", head, str, "the first bytes of a metadata file")
-    cols = head.split(",")
+    cols = header_columns(head)
     if "FocusPosition" in cols and "ApertureNumber" in cols:
         return "frames"
     if "LensSqueezeFactor" in cols and "Timescale" in cols:

@@ -15,12 +15,18 @@ refused with the file, the line (a Mo-Sys packet's index) and the range, so noth
 
 A timecode that goes back (other than through midnight) means the file holds several takes one
 after another (a concatenated recording): refused, naming each place a take starts, so the file
-can be split there.
+can be split there. With the clip's frame rate known, a timecode must be a time at that rate
+(frames 00 to the nominal rate - 1, seconds and minutes below 60, hours below 24) and each frame's
+must follow the last by one frame (a drop-frame ``;`` timecode counted as SMPTE 12M drops it): a
+skip is a dropped or deleted row, which would shift every later frame onto the wrong plate frame,
+or a frame rate the timecode was not counted at (a 25 fps clip with a 24 fps timecode skips a frame
+every second). Both are refused at the line where they happen.
 """
 
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 
 from ..errors import MetadataError, require_type
 from .record import ClipRecord
@@ -78,8 +84,64 @@ def check_record(record) -> ClipRecord:
                 raise MetadataError(f"{where}{what} {float(v):g}{' ' + unit if unit else ''} is outside "
                                     f"{_range_text(lo, hi, closed, unit)}: not a value a lens records (a corrupt "
                                     "file or a misread field)", record.files[0], None if mosys else f.line)
+    _check_timecode_fields(record)
     _check_timecode(record)
+    _check_timecode_steps(record)
     return record
+
+
+def _nominal(rate) -> int:
+    return math.ceil(Fraction(rate) - Fraction(1, 10**6))
+
+
+def _where_in_file(record, f) -> tuple[str, int | None]:
+    return (f"packet {f.line}: ", None) if record.source == "mosys" else ("", f.line)
+
+
+def _check_timecode_fields(record) -> None:
+    if record.frame_rate is None:
+        return
+    n = _nominal(record.frame_rate)
+    for f in record.frames:
+        if f.timecode is None:
+            continue
+        h, m, s, ff = _tc_key(f.timecode)
+        if h > 23 or m > 59 or s > 59 or ff >= n:
+            where, line = _where_in_file(record, f)
+            raise MetadataError(f"{where}timecode {f.timecode} is not a time at the clip's {float(record.frame_rate):g} "
+                                f"fps: frames run 00 to {n - 1:02d}, seconds and minutes 00 to 59, hours 00 to 23",
+                                record.files[0], line)
+
+
+def _tc_count(tc: str, nominal: int) -> int:
+    """Frames since midnight of ``tc``; a drop-frame (``;``) timecode skips frames 0..d-1 of each minute but
+    every tenth, d = 2 per 30 nominal fps (SMPTE ST 12-1)."""
+    h, m, s, f = _tc_key(tc)
+    count = ((h * 60 + m) * 60 + s) * nominal + f
+    if ";" in tc:
+        minutes = h * 60 + m
+        count -= 2 * round(nominal / 30) * (minutes - minutes // 10)
+    return count
+
+
+def _check_timecode_steps(record) -> None:
+    if record.frame_rate is None:
+        return
+    n = _nominal(record.frame_rate)
+    day = _tc_count("24:00:00:00", n)
+    prev = None
+    for f in record.frames:
+        if f.timecode is None:
+            continue
+        if prev is not None:
+            step = (_tc_count(f.timecode, n) - _tc_count(prev.timecode, n)) % day
+            if step > 1:
+                where, line = _where_in_file(record, f)
+                raise MetadataError(f"{where}the timecode skips {step - 1} frame{'s' if step > 2 else ''} from "
+                                    f"{prev.timecode} to {f.timecode} at the clip's {float(record.frame_rate):g} fps: "
+                                    "a dropped or deleted row, or a frame rate the timecode was not counted at",
+                                    record.files[0], line)
+        prev = f
 
 
 def _tc_key(tc: str) -> tuple[int, ...]:

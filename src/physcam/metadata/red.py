@@ -20,7 +20,7 @@ from fractions import Fraction
 
 from ..errors import MetadataError, require_type
 from . import cooke
-from ._text import number, require_columns, rows, single_row, timecode
+from ._text import header_columns, number, require_columns, rows, single_row, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -35,7 +35,7 @@ PITCH_UM = {"MONSTRO 8K VV": 5.0, "HELIUM 8K S35": 3.65, "GEMINI 5K S35": 6.0, "
 def sniff(head: str) -> str | None:
     """"frames" or "static" when ``head`` is a REDline header, else None."""
     require_type("head", head, str, "the first bytes of a metadata file")
-    cols = head.split(",")
+    cols = header_columns(head)
     if "FrameNo" in cols and "Focus Distance" in cols:
         return "frames"
     if "Camera PIN" in cols and "Sensor Name" in cols:

@@ -19,7 +19,7 @@ import xml.etree.ElementTree as ET
 from fractions import Fraction
 
 from ..errors import MetadataError, require_type
-from ._text import FOOT_MM, number, read_text, rows, stop_from_marking, timecode
+from ._text import FOOT_MM, header_columns, number, read_text, rows, stop_from_marking, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -33,8 +33,8 @@ def sniff(head: str) -> str | None:
     require_type("head", head, str, "the first bytes of a metadata file")
     if "NonRealTimeMeta" in head:
         return "xml"
-    first = head.splitlines()[0] if head else ""
-    if '"Timecode"' in first and "Focus Distance (" in first and '"Aperture"' in first:
+    cols = header_columns(head.splitlines()[0] if head else "")
+    if "Timecode" in cols and "Aperture" in cols and any(c.startswith("Focus Distance (") for c in cols):
         return "csv"
     return None
 

@@ -51,7 +51,7 @@ def focus_from_limits(lens, *, sensor, near_mm=None, far_mm=None, fstop=None, co
     if fstop is None:
         return fstop_from_limits(model, focus_mm=mark, sensor=sensor, near_mm=near_mm, far_mm=far_mm, coc=coc,
                                  squeeze=squeeze, n_ratio=n_ratio, solved=solved)
-    from dataclasses import replace
+    from .._record import replace
 
     return replace(camera_state(model, focus_mm=mark, fstop=fstop, sensor=sensor, squeeze=squeeze), solved=solved)
 

@@ -30,9 +30,8 @@ than the CoC: N = c / (2.44 lambda (N_w / N)). Scalars only (no numpy), like the
 from __future__ import annotations
 
 import math
-import dataclasses
-from dataclasses import dataclass, field
 
+from .._record import field, record, replace
 from ..errors import InputError, OpticsError, require_positive, require_type
 from ..optics import _num
 from ..optics import dof as _dof
@@ -84,7 +83,7 @@ def fstop_airy_equals(size_mm, wavelength_nm=DIFFRACTION_WAVELENGTH_NM, bellows_
     return _num.out(c / airy_per_stop, what="the f-stop whose Airy disk equals the size")
 
 
-@dataclass(frozen=True)
+@record
 class LensReport(OfACamera):
     """Everything the lens report knows. Lengths in mm, angles in degrees.
 
@@ -438,7 +437,7 @@ def solve_report(camera, *, coc=None, measured: MeasuredLimits | None = None,
         dof_aspect=dof.blur_aspect, bellows_factor=at.bellows, fstop_at_focus=None if at.n_ratio == 1.0 else n_focus,
         entrance_pupil_horizontal_from_film_mm=at.pupil_x_from_film_mm if pupil_src == "prescription" else None,
         **field_of_view(camera, h2_film, refs, at))
-    report = dataclasses.replace(report, notes=report.notes + (report.diffraction_note(),))
+    report = replace(report, notes=report.notes + (report.diffraction_note(),))
     if camera.traceable:
         report = _with_real_fov(report, camera)
     _check_finite(report)
@@ -466,7 +465,6 @@ def _with_real_fov(report: LensReport, camera: CameraState) -> LensReport:
     """Add the real-ray field of view of the camera's lens at its mark (issue 8: a fisheye's paraxial
     field is 98 deg where its chief rays reach 140 deg) and, when it differs from the pinhole's, a note
     and a warning. The lens focused at the mark is the camera's own solution (no focus solved again)."""
-    import dataclasses
     import warnings
 
     from ..analysis.framing.field_of_view import real_field_of_view_focused
@@ -478,8 +476,8 @@ def _with_real_fov(report: LensReport, camera: CameraState) -> LensReport:
         real = real_field_of_view_focused(camera.lens, st.prescription, st.film_z, s.width_mm, s.height_mm,
                                           mark=report.focus_from_film_mm)
     except PhysCamError as exc:
-        return dataclasses.replace(report, notes=report.notes + (f"real-ray field of view not available: {exc}",))
-    report = dataclasses.replace(report, real_fov=real.to_dict())
+        return replace(report, notes=report.notes + (f"real-ray field of view not available: {exc}",))
+    report = replace(report, real_fov=real.to_dict())
     if not report.real_fov_differs:
         return report
 
@@ -493,7 +491,7 @@ def _with_real_fov(report: LensReport, camera: CameraState) -> LensReport:
     if real.not_covered:
         msg += f"; the sensor's {', '.join(real.not_covered)} lie outside the lens's image circle"
     warnings.warn(msg, PhysCamWarning, stacklevel=_caller_level())
-    return dataclasses.replace(report, notes=report.notes + (msg,))
+    return replace(report, notes=report.notes + (msg,))
 
 
 def _caller_level() -> int:

@@ -21,10 +21,10 @@ for one version (DeprecationWarning).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import NamedTuple
 
+from .._record import record
 from ..errors import InputError, require_finite, require_positive, require_type
 from ..optics.sensors import Sensor
 from ..optics.state import HYPERFOCAL
@@ -62,7 +62,7 @@ def require_focus(value) -> float:
     return require_distance("focus distance", value)
 
 
-@dataclass(frozen=True)
+@record
 class MeasuredLimits:
     """Near and far limits of acceptable sharpness measured on a plate (or wanted), from the film plane
     (mm; ``far_mm`` may be inf); either may be None."""
@@ -88,7 +88,7 @@ class MeasuredLimits:
         return self.near_mm is not None or self.far_mm is not None
 
 
-@dataclass(frozen=True)
+@record
 class References:
     """Figures from outside the optics the report compares with or takes as given: the marked
     ``tstop``; a tape-measured entrance pupil (``sensor_front_mm`` from the film to the lens front,
@@ -184,7 +184,7 @@ def _camera_of(r: SimpleNamespace) -> ReportInputs:
     else:
         cam = camera_state(model, focus_mm=r.focus_mm, fstop=fstop, sensor=r.sensor, coc=r.coc, squeeze=squeeze)
     if notes:
-        from dataclasses import replace
+        from .._record import replace
 
         cam = replace(cam, notes=notes + cam.notes)
     return ReportInputs(cam, r.coc, measured, refs)

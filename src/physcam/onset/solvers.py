@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 from ..errors import InputError, OpticsError, require_type
@@ -38,6 +37,8 @@ from ..optics.state import HYPERFOCAL, CameraState
 from .inverse import hyperfocal_parameters, require_possible_f_number
 from .pupil import entrance_pupil_practical
 from .request import MeasuredLimits, References
+
+from .._record import record, replace
 
 __all__ = ["DepthOfField", "LensState", "PrincipalPlanes", "lens_at_mark", "principal_planes", "solve_focus",
            "invert_limits", "depth_of_field", "focus_error", "field_of_view", "entrance_pupil"]
@@ -103,7 +104,7 @@ def finite_or_none(v: float | None):
     return None if v is None or math.isinf(v) else v
 
 
-@dataclass(frozen=True)
+@record
 class DepthOfField:
     """Limits of acceptable sharpness for one circle of confusion.
 

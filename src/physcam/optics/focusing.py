@@ -26,8 +26,8 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import asdict, dataclass
 
+from .._record import asdict, record
 from ..data.default_sensor import DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, renamed_parameter, require_positive, require_type
 from ..lens.prescription import Prescription, takes_prescription
@@ -64,7 +64,7 @@ FOCUS_METHODS = ("auto", "unit", "internal")
 DEFAULT_BREATHING_MARKS = (math.inf, 10000.0, 5000.0, 3000.0, 2000.0, 1500.0, 1000.0, 700.0, 500.0, 400.0, 300.0, 250.0, 200.0)
 
 
-@dataclass(frozen=True)
+@record
 class FocusState:
     """A lens focused at a mark.
 
@@ -97,7 +97,7 @@ class FocusState:
         return self.prescription.vertex_z[-1] + self.back_focus_mm
 
 
-@dataclass(frozen=True)
+@record
 class TechnicalPlanes:
     """What the on-set report's technical model needs, at one focus.
 
@@ -136,7 +136,7 @@ class TechnicalPlanes:
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in d.items()}
 
 
-@dataclass(frozen=True)
+@record
 class BreathingRow:
     """One focus mark of a breathing table (lengths mm, angles degrees)."""
 
@@ -302,7 +302,7 @@ def closest_focus(prescription: Prescription, *, method: str = "auto", axis: str
 BREATHING_NEAR_EFL = 10.0
 
 
-@dataclass(frozen=True)
+@record
 class CloseFocus:
     """How close the lens focuses, and where that number comes from (mm from the film plane).
 
@@ -606,7 +606,7 @@ def pupil_aspect(prescription: Prescription, focus_mm: float) -> float:
     return gx.entrance_pupil_diameter / gy.entrance_pupil_diameter
 
 
-@dataclass(frozen=True)
+@record
 class EntrancePupils:
     """Both meridians' entrance pupils at one focus mark, in front of the film (mm, + toward the subject).
 

@@ -40,8 +40,9 @@ C 656.2725 nm (H), g 435.8343 nm (Hg).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from functools import lru_cache
+
+from .._record import record
 
 __all__ = ["LINE_D_NM", "LINE_F_NM", "LINE_C_NM", "LINE_G_NM", "WAVELENGTH_RANGE_NM", "MATCH_TOL_ND",
            "MATCH_TOL_VD", "PGF_NORMAL_LINE", "PGF_UNCERTAINTY", "Dispersion", "dispersion", "normal_line",
@@ -123,7 +124,7 @@ def evaluate(coefficients, wavelength_nm):
     return n
 
 
-@dataclass(frozen=True)
+@record
 class Dispersion:
     """The dispersion model of one medium (module notes)."""
 

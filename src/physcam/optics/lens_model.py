@@ -22,11 +22,12 @@ thin lens or a datasheet imports nothing heavier (docs/performance.md).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from typing import NamedTuple, Protocol, runtime_checkable
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from . import thinlens
+
+from .._record import field, record
 
 __all__ = ["LensModel", "LensAtMark", "PrincipalPlanes", "ThinLens", "Datasheet", "PrescriptionLens",
            "lens_model_of", "REFERENCE_PLANES"]
@@ -128,7 +129,7 @@ def _require_no_zoom(name, zoom):
         raise InputError(f"{name} is not a zoom lens: drop the zoom position")
 
 
-@dataclass(frozen=True)
+@record
 class _OnTheFilm:
     """A lens whose planes are known as numbers (thin lens, datasheet): offsets from a reference plane."""
 
@@ -184,7 +185,7 @@ class _OnTheFilm:
         return PrincipalPlanes.of(at).mark_for_s(dof.hyperfocal_distance(at.focal_length_mm, fstop, coc_mm))
 
 
-@dataclass(frozen=True)
+@record
 class ThinLens(_OnTheFilm):
     """The practical model: a thin lens of ``focal_length_mm`` whose principal planes H1 = H2 sit s' in
     front of the film (so a focus mark D is s + s', docs/conventions.md); ``squeeze`` the anamorphic
@@ -198,7 +199,7 @@ class ThinLens(_OnTheFilm):
                           self.lens_name)
 
 
-@dataclass(frozen=True)
+@record
 class Datasheet(_OnTheFilm):
     """The technical model: a maker's principal planes ``h1_mm``, ``h2_mm`` and entrance pupil
     ``pupil_mm`` (None: not published), each a distance in front of ``reference_plane`` ("film", or

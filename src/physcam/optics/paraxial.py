@@ -20,9 +20,9 @@ front of the reference, toward the subject), the on-set convention.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
 from functools import lru_cache
 
+from .._record import asdict, field, record
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 
@@ -175,7 +175,7 @@ def _inverse(m):
     return (m[3] / det, -m[1] / det, -m[2] / det, m[0] / det)
 
 
-@dataclass(frozen=True)
+@record
 class GaussianData:
     """First-order data of one lens configuration in one meridian.
 
@@ -360,7 +360,7 @@ def _stop_semi(prescription: Prescription, axis: str, lam: float, fstop, stop_se
     return stop_semi
 
 
-@dataclass(frozen=True)
+@record
 class _Pupils:
     """The entrance and exit pupils (images of the stop) and the chief ray that defines them."""
 

@@ -21,10 +21,10 @@ from __future__ import annotations
 import csv
 import math
 import re
-from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+from .._record import record
 from ..errors import SensorError
 
 __all__ = ["Sensor", "sensors", "cameras", "camera_formats", "find_sensor", "filter_sensors", "custom_sensor", "SENSOR_SIZE_RANGE_MM",
@@ -34,7 +34,7 @@ __all__ = ["Sensor", "sensors", "cameras", "camera_formats", "find_sensor", "fil
 MAKERS = ("ARRI", "RED", "Sony", "Canon", "Blackmagic", "Panasonic", "Fujifilm", "DJI")
 
 
-@dataclass(frozen=True, slots=True)
+@record(slots=True)
 class Sensor:
     """A sensor or film gate: active area ``width_mm`` x ``height_mm``; ``pitch_um`` the photosite
     pitch (micrometres) where one camera's sensor is meant, else None."""
@@ -143,11 +143,10 @@ def _camera_formats() -> list[Sensor]:
 
 
 @lru_cache(maxsize=1)
-def sensors() -> tuple[Sensor, ...]:
-    """Every known sensor, in table order: the sensors and film gates, then the camera table's formats."""
-    text = _data("sensors.csv")
+def _gates() -> tuple[Sensor, ...]:
+    """The sensors and film gates of sensors.csv, in table order (the first rows of :func:`sensors`)."""
     out = []
-    for row in csv.DictReader(text.splitlines()):
+    for row in csv.DictReader(_data("sensors.csv").splitlines()):
         out.append(
             Sensor(
                 key=row["key"],
@@ -161,7 +160,13 @@ def sensors() -> tuple[Sensor, ...]:
                 pitch_source=row.get("pitch_source", ""),
             )
         )
-    return tuple(out + _camera_formats())
+    return tuple(out)
+
+
+@lru_cache(maxsize=1)
+def sensors() -> tuple[Sensor, ...]:
+    """Every known sensor, in table order: the sensors and film gates, then the camera table's formats."""
+    return _gates() + tuple(_camera_formats())
 
 
 @lru_cache(maxsize=1)
@@ -186,13 +191,25 @@ def camera_formats(name: str) -> tuple[Sensor, ...]:
     return ()
 
 
-@lru_cache(maxsize=1)
-def _index() -> dict[str, Sensor]:
+def _labelled(rows) -> dict[str, Sensor]:
     idx: dict[str, Sensor] = {}
-    for s in sensors():
+    for s in rows:
         for label in (s.key, s.name, *s.aliases):
             idx.setdefault(_norm(label), s)
     return idx
+
+
+@lru_cache(maxsize=1)
+def _index() -> dict[str, Sensor]:
+    """Every sensor by its key, name and aliases, normalised; the first row in table order wins."""
+    return _labelled(sensors())
+
+
+@lru_cache(maxsize=1)
+def _gate_index() -> dict[str, Sensor]:
+    """:func:`_index` of sensors.csv's rows alone: they come first in table order, so a name found here
+    is the one :func:`_index` gives, without reading the camera table (issue 43: a report's start-up)."""
+    return _labelled(_gates())
 
 
 #: Names of camera families rather than of one sensor: refused with the family's members, so a
@@ -241,7 +258,6 @@ def find_sensor(name: str) -> Sensor:
     """
     if not isinstance(name, str):
         raise SensorError(f"a sensor name must be text, got {type(name).__name__}")
-    idx = _index()
     key = _norm(name)
     if not key:
         raise SensorError("the sensor name is empty. `physcam sensors` lists them all")
@@ -250,8 +266,10 @@ def find_sensor(name: str) -> Sensor:
         members = [s.name for s in sensors() if fam in _norm(s.name)]
         raise SensorError(f"{name!r} names a camera family, not one sensor: give one of "
                           + "; ".join(repr(m) for m in members))
-    if key in idx:
-        return idx[key]
+    for index in (_gate_index, _index):  # the camera table is read only for a name not among the gates
+        idx = index()
+        if key in idx:
+            return idx[key]
     formats = camera_formats(name)
     if formats:
         cam = f"{formats[0].make} {formats[0].camera}"

@@ -25,8 +25,8 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field, replace
 
+from .._record import field, record, replace
 from ..errors import InputError, OpticsError, WrongTypeError, require_finite, require_type
 from .lens_model import LensModel, PrescriptionLens, lens_model_of
 from .sensors import Sensor
@@ -44,7 +44,7 @@ DOOR_KEYWORDS = ("focus_mm", "focus_from_film_mm", "fstop", "sensor", "sensor_mm
 UNTIL = "0.3"
 
 
-@dataclass(frozen=True)
+@record
 class CameraState:
     """A lens at one focus, zoom and stop, on a sensor (module notes). Build it with :func:`camera_state`.
 

@@ -7,7 +7,8 @@ for a thin lens the practical model. What changes with focus is time-sampled:
 
 * the lens model's ``focusDistance`` and ``focalLength`` (the EFL: it changes with internal
   focusing), the lens's ``fStop``, ``iris``, ``entrancePupilDistance``, ``pinholeFocalLength``,
-  principal planes and ``apertureDistance`` (the stop moves with unit focusing);
+  ``pinholeSqueeze`` (an anamorphic's squeeze breathes too), principal planes and ``apertureDistance``
+  (the stop moves with unit focusing);
 * the companion UsdGeomCamera's ``focalLength`` (the best-match pinhole: breathing), apertures
   (float32 values that keep the field of view exact), ``fStop``, ``focusDistance`` and its
   translate: the eye follows the entrance pupil while the body, and so the film plane, stays
@@ -32,7 +33,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import ExportError, InputError, LensFileError, PhysCamWarning, require_finite
+from ..errors import ExportError, InputError, LensFileError, PhysCamWarning, require_finite, require_positive
 from ..lens.zoom import prescription_at
 
 __all__ = ["FocusKey", "read_focus_marks", "write_animated_camera", "ntsc_rate"]
@@ -78,10 +79,16 @@ def read_focus_marks(path) -> list[FocusKey]:
         raise LensFileError(f"unknown columns {sorted(unknown)}; use frame, focus, fstop, zoom", str(p), 1)
     keys = []
     for line, row in enumerate(rows, start=2):
+        if row.get("frame") is None or row.get("focus") is None:
+            raise LensFileError(f"this row has fewer values than the header's {len(rows.fieldnames)} columns", str(p),
+                                line)
         try:
             frame = require_finite("frame", float(row["frame"]))
             focus = parse_distance(row["focus"], name="focus mark")
-            fstop = None if not (row.get("fstop") or "").strip() else float(row["fstop"])
+            fstop = None if not (row.get("fstop") or "").strip() else require_positive("f-stop", float(row["fstop"]),
+                                                                                        unit="")
+            if keys and frame <= keys[-1].frame:
+                raise InputError(f"frame {frame:g} does not follow frame {keys[-1].frame:g}: frames must increase")
         except (ValueError, TypeError, InputError) as exc:
             raise LensFileError(str(exc) if isinstance(exc, InputError) else f"not a number: {exc}", str(p), line) \
                 from None
@@ -143,7 +150,7 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
 
     from ..export.usdgeom import require_meters_per_unit
     from ..onset.report import report_camera, solve_report
-    from .author import author_camera, new_stage, sample_render_camera, save_stage, spec_from_report
+    from .author import author_camera, iris_mm, new_stage, sample_render_camera, save_stage, spec_from_report
 
     keys = _check_keys(keys)
     if (lens is None) == (focal_length_mm is None):
@@ -189,11 +196,12 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
         eye = spec.entrance_pupil_mm
         sample(model, "focalLength", spec.focal_length_mm, t)
         sample(model, "focusDistance", spec.focus_mm, t)
-        for prim, name, value in ((cam, lp + "fStop", spec.fstop), (cam, lp + "iris", spec.focal_length_mm / spec.fstop),
-                                  (cam, "iris", spec.focal_length_mm / spec.fstop),
+        for prim, name, value in ((cam, lp + "fStop", spec.fstop), (cam, lp + "iris", iris_mm(spec)),
+                                  (cam, "iris", iris_mm(spec)),
                                   (cam, lp + "entrancePupilDistance", eye)):
             sample(prim, name, value, t)
-        optional = {lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "apertureDistance":
+        optional = {lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze":
+                    spec.pinhole_squeeze, lp + "apertureDistance":
                     spec.aperture_distance_mm, lp + "horizontalEntrancePupilDistance": spec.horizontal_entrance_pupil_mm}
         if spec.principal_planes_mm is not None:
             optional[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]

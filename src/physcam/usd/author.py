@@ -54,6 +54,7 @@ __all__ = [
     "author_render_settings",
     "render_camera_values",
     "sample_render_camera",
+    "iris_mm",
     "author_anamorphic_distortion",
 ]
 
@@ -223,14 +224,15 @@ def _author_body(cam, spec, position, rotate_xyz_deg, eye_su):
     _set(cam, "shutterOpen", Sdf.ValueTypeNames.Float, spec.shutter_open_s)
     _set(cam, "shutterDuration", Sdf.ValueTypeNames.Float, spec.shutter_duration_s)
     _set(cam, "shutterOpening", Sdf.ValueTypeNames.Float2, Gf.Vec2f(*spec.shutter_opening))
-    _set(cam, "iris", Sdf.ValueTypeNames.Float, _iris_mm(spec))
+    _set(cam, "iris", Sdf.ValueTypeNames.Float, iris_mm(spec))
     author_transform(cam, position, rotate_xyz_deg, eye_su)
 
 
-def _iris_mm(spec) -> float:
+def iris_mm(spec) -> float:
     """The schema's ``iris``: the entrance pupil's diameter at this focus, focal length / f-number there
     (with ``shutterBlades`` the equal-area diameter: the blades' polygon has this circle's area,
     docs/conventions.md)."""
+    spec = require_type("spec", spec, CameraSpec, "build one with CameraSpec(...)")
     return spec.focal_length_mm / (spec.fstop if spec.fstop_at_focus is None else spec.fstop_at_focus)
 
 
@@ -267,7 +269,7 @@ def _author_lens(stage, cam, spec, eye, su):
     sdf_path = cam.GetPath()
     lp = f"lens:{LENS_INSTANCE}:"
     _set(cam, lp + "fStop", Sdf.ValueTypeNames.Float, spec.fstop)
-    _set(cam, lp + "iris", Sdf.ValueTypeNames.Float, _iris_mm(spec))
+    _set(cam, lp + "iris", Sdf.ValueTypeNames.Float, iris_mm(spec))
     _set(cam, lp + "entrancePupilDistance", Sdf.ValueTypeNames.Float, eye)
     if spec.horizontal_entrance_pupil_mm is not None:  # an anamorphic's pan pivot (docs/anamorphic.md)
         _set(cam, lp + "horizontalEntrancePupilDistance", Sdf.ValueTypeNames.Float, spec.horizontal_entrance_pupil_mm)
@@ -317,6 +319,7 @@ def sample_render_camera(geom, spec: CameraSpec, report, meters_per_unit: float,
     geom.GetHorizontalApertureAttr().Set(values["horizontalAperture"], time)
     geom.GetVerticalApertureAttr().Set(values["verticalAperture"], time)
     geom.GetFStopAttr().Set(values["fStop"], time)
+    geom.GetExposureFStopAttr().Set(spec.fstop / math.sqrt(spec.transmittance), time)  # the T-stop, as authored
     geom.GetFocusDistanceAttr().Set(values["focusDistance"], time)
     translate = UsdGeom.Xformable(geom.GetPrim()).GetOrderedXformOps()[0]
     translate.Set(Gf.Vec3d(0.0, 0.0, -mm_to_scene_units(eye, meters_per_unit)), time)

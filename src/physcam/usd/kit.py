@@ -192,9 +192,13 @@ def write_shot(file, body_file, lens_file, *, overrides: dict | None = None, len
         refs.AddReference(Path(_relpath(Path(f).resolve(), out.parent)).as_posix(), Sdf.Path(prim_path))
     if lens_variant is not None:
         vsets = cam.GetVariantSets()
-        if "characterization" not in vsets.GetNames() or lens_variant not in \
-                vsets.GetVariantSet("characterization").GetVariantNames():
-            raise ExportError(f"{path}: lens file {lens_file} has no characterization variant {lens_variant!r}")
+        names = vsets.GetVariantSet("characterization").GetVariantNames() \
+            if "characterization" in vsets.GetNames() else []
+        if lens_variant not in names and _variant_name(lens_variant) in names:
+            lens_variant = _variant_name(lens_variant)  # the measuring day as the CSV wrote it: 2026-03-01
+        if lens_variant not in names:
+            raise ExportError(f"{path}: lens file {lens_file} has no characterization variant {lens_variant!r}"
+                              f" (it has {', '.join(names) or 'none'})")
         vsets.GetVariantSet("characterization").SetVariantSelection(lens_variant)
     try:
         # the clipping range in mm, read from the lens file in its own unit (issue 9: a metre shot
@@ -252,7 +256,7 @@ def _author_shot_companion(stage, path) -> str:
     """
     from pxr import Sdf
 
-    from .author import _eye_from_film, author_anamorphic_distortion, spec_from_report
+    from .author import _eye_from_film, author_anamorphic_distortion, iris_mm, spec_from_report
     from .read import read_camera
 
     spec = read_camera(stage, path).spec
@@ -272,15 +276,19 @@ def _author_shot_companion(stage, path) -> str:
         spec = spec.replaced(focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
                              principal_planes_mm=derived.principal_planes_mm,
                              pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
-                             pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze)
+                             pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze,
+                             fstop_at_focus=derived.fstop_at_focus)
         distortion = prescription_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
         anamorphic = prescription_anamorphic_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm,
                                                         focus_mm=spec.focus_mm)
         opencv = prescription_opencv(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
-    # values derived from the composed lens, rewritten every time: the iris (f / N) and the film's
-    # place behind the pupil, so the pupil stays where the shot put it when the lens file changes
+    elif spec.pinhole_focal_length_mm is None:  # no lens solved at a focus (a thin lens): the iris is f / N
+        spec = spec.replaced(fstop_at_focus=None)
+    # values derived from the composed lens, rewritten every time: the iris (the entrance pupil at the focus,
+    # f / N but for an internal-focus lens, whose f-number moves: iris_mm) and the film's place behind the
+    # pupil, so the pupil stays where the shot put it when the lens file changes
     (cam.GetAttribute(f"lens:{LENS_INSTANCE}:iris") or cam.CreateAttribute(
-        f"lens:{LENS_INSTANCE}:iris", Sdf.ValueTypeNames.Float)).Set(spec.focal_length_mm / spec.fstop)
+        f"lens:{LENS_INSTANCE}:iris", Sdf.ValueTypeNames.Float)).Set(iris_mm(spec))
     _move_film_behind_pupil(cam, _eye_from_film(spec, report))
     geom = author_render_camera(stage, Sdf.Path(path), spec, report=report, lens_distortion=distortion,
                                 opencv_distortion=opencv)

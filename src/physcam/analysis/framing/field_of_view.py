@@ -25,8 +25,8 @@ totally reflected) gets ``None`` and a ``reason``. Angles in degrees, lengths in
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
+from ..._record import field_names, record
 from ...errors import InputError, renamed_parameter, require_finite, require_positive, require_type
 from ...lens.prescription import Prescription, takes_prescription
 
@@ -37,7 +37,7 @@ __all__ = ["RealFieldOfView", "real_field_of_view", "real_field_of_view_focused"
 DIFFERS_PCT = 1.0
 
 
-@dataclass(frozen=True)
+@record
 class RealFieldOfView:
     """Full fields of view (degrees) of a sensor behind a lens, from real chief rays and paraxially.
 
@@ -72,7 +72,7 @@ class RealFieldOfView:
         return not self.not_covered
 
     def to_dict(self) -> dict:
-        d = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        d = {k: getattr(self, k) for k in field_names(self)}
         d["not_covered"] = list(self.not_covered)
         if d["focus_from_film_mm"] is not None and math.isinf(d["focus_from_film_mm"]):
             d["focus_from_film_mm"] = None

@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -165,17 +166,18 @@ class _Tracer:
     def n_image(self, wavelength_nm: float) -> float:
         return self.indices(wavelength_nm)[1]
 
-    def trace(self, start, direction, opl0, wavelengths, *, clip=True) -> Traced:
-        """Trace rays (n, 3) with per-ray ``wavelengths`` (nm) front to back, adding n (p' - p) . d per leg."""
+    def trace(self, columns, opl0, wavelengths, *, clip=True) -> Traced:
+        """Trace rays given as six columns (x, y, z of the start, the direction's x, y, z; 1-D, one
+        length) with per-ray ``wavelengths`` (nm) front to back, adding n (p' - p) . d per leg."""
         from ...trace import OK, RayBatch
         from ...trace.trace import trace_packed
 
-        wl = np.broadcast_to(np.asarray(wavelengths, dtype=float), (np.shape(start)[0],))
+        wl = np.broadcast_to(np.asarray(wavelengths, dtype=float), (np.shape(columns[0])[0],))
         rest = wl  # every medium usable at every wavelength (a batch has a few; np.unique imports numpy.ma)
         while rest.size:
             self.indices(rest[0])
             rest = rest[rest != rest[0]]
-        rays = RayBatch.from_arrays(start, direction, wl)
+        rays = RayBatch.from_columns(*columns, wl)
         opl = np.array(opl0, dtype=np.float64, copy=True)
         amp = np.ones(len(rays))
         # the kernel adds each leg's optical path: one call through every row, or two around a shaped stop
@@ -273,6 +275,26 @@ def make_fields(st: Setup, fields_deg, wavelength_nm: float) -> list[Field]:
     return out
 
 
+def fields_at_wavelengths(st: Setup, fields_deg, wavelengths_nm, tracer: _Tracer) -> list[list[Field]]:
+    """:func:`make_fields` at each wavelength, [wavelength][field]. The chief rays depend on the media's
+    indices alone: a wavelength at which every medium has the index of an earlier one (a lens whose
+    prescription gives no dispersion) gets that wavelength's chief rays, aimed once."""
+    out, aimed = [], {}
+    for w in wavelengths_nm:
+        try:
+            nb, ni = tracer.indices(w)
+            key = nb.tobytes() + np.float64(ni).tobytes()
+        except OpticsError:  # make_fields says what is wrong at this wavelength
+            key = None
+        if key is not None and key in aimed:
+            out.append([dataclasses.replace(f, wavelength_nm=float(w)) for f in aimed[key]])
+            continue
+        out.append(make_fields(st, fields_deg, w))
+        if key is not None:
+            aimed[key] = out[-1]
+    return out
+
+
 def field_for_image_height(st: Setup, height_mm: float, wavelength_nm: float) -> float:
     """The field angle (degrees, Y meridian) whose chief ray meets the film at ``height_mm`` on the y axis:
     the chief ray is aimed back from the film through the centre of the stop (:func:`._chief.aim_from_film`)
@@ -328,7 +350,8 @@ def image_circle_radius(st: Setup, wavelength_nm: float, outside_mm: float, tol_
 
 
 def _starts(st: Setup, fl: Field, n_object: float, gx: np.ndarray, gy: np.ndarray):
-    """Start points, directions and starting optical paths of rays aimed at (gx, gy) on the entrance-pupil plane."""
+    """Start points and directions (six columns) and starting optical paths of rays aimed at (gx, gy)
+    on the entrance-pupil plane."""
     from .._chief import start_plane_z
 
     n = gx.size
@@ -336,13 +359,13 @@ def _starts(st: Setup, fl: Field, n_object: float, gx: np.ndarray, gy: np.ndarra
         d = fl.direction
         z0 = min(st.z_ep, start_plane_z(st.lens)) - 1.0
         t = (st.z_ep - z0) / d[2]
-        start = np.stack([gx - t * d[0], gy - t * d[1], np.full(n, z0)], axis=1)
-        opl0 = n_object * ((start - fl.chief_start) @ d)
-        return start, np.broadcast_to(d, (n, 3)), opl0
+        x, y = gx - t * d[0], gy - t * d[1]
+        c = fl.chief_start  # the plane wavefront through the chief ray's start: n d . (p - p_chief)
+        opl0 = n_object * ((x - c[0]) * d[0] + (y - c[1]) * d[1] + (z0 - c[2]) * d[2])
+        return (x, y, np.full(n, z0), *(np.broadcast_to(v, (n,)) for v in d)), opl0
     o = fl.object_point
-    start = np.broadcast_to(o, (n, 3))
-    dirn = np.stack([gx - o[0], gy - o[1], np.full(n, st.z_ep - o[2])], axis=1)
-    return start, dirn, np.zeros(n)
+    start = tuple(np.broadcast_to(v, (n,)) for v in o)
+    return (*start, gx - o[0], gy - o[1], np.full(n, st.z_ep - o[2])), np.zeros(n)
 
 
 def _trace_groups(tracer: _Tracer, groups, *, clip=True) -> list[Traced]:
@@ -351,15 +374,14 @@ def _trace_groups(tracer: _Tracer, groups, *, clip=True) -> list[Traced]:
         return []
     # by wavelength, so that the kernels see a few runs of one wavelength (trace.trace_packed)
     order = sorted(range(len(groups)), key=lambda i: groups[i][0].wavelength_nm)
-    starts, dirs, opls, wls, sizes = [], [], [], [], []
+    columns, opls, wls, sizes = [], [], [], []
     for fl, gx, gy in (groups[i] for i in order):
-        s, d, o = _starts(tracer.st, fl, tracer.n_object(fl.wavelength_nm), gx, gy)
-        starts.append(s)
-        dirs.append(d)
+        c, o = _starts(tracer.st, fl, tracer.n_object(fl.wavelength_nm), gx, gy)
+        columns.append(c)
         opls.append(o)
         wls.append(np.full(gx.size, fl.wavelength_nm))
         sizes.append(gx.size)
-    res = tracer.trace(np.concatenate(starts), np.concatenate(dirs), np.concatenate(opls), np.concatenate(wls),
+    res = tracer.trace([np.concatenate(c) for c in zip(*columns)], np.concatenate(opls), np.concatenate(wls),
                        clip=clip)
     cut = np.cumsum([0] + sizes)
     out: list = [None] * len(groups)
@@ -399,6 +421,9 @@ class PupilTrace:
     r_ep: float
     z_xp: float
     meta: dict = field(default_factory=dict)
+    # what depends on the rays alone (the sub-cell layout, the direction slopes per reference): one dict for
+    # every wavelength that shares the rays (:func:`trace_pupils` copies a trace with the same dict)
+    shared: dict = field(default_factory=dict, repr=False, compare=False)
 
 
 def _grid_centres(n, cell, cx, cy):
@@ -457,20 +482,44 @@ def _same_rays_key(tracer: _Tracer, fl: Field, n: int, box) -> bytes:
     return b"".join(np.ascontiguousarray(a, dtype=float).tobytes() for a in parts)
 
 
+#: Rays of the pupils traced last that are kept for the next call (about 100 bytes each): `physcam mtf
+#: --field` asks one field's wavefront, PSF and MTF, the same rays three times. Only the last camera's
+#: pupils are kept; the oldest go first.
+RECENT_RAYS = 100_000
+_recent: dict = {}
+_recent_lock = threading.Lock()
+
+
 def trace_pupils(st: Setup, jobs, tracer: _Tracer) -> list[PupilTrace]:
     """Trace each job (field, n, box) -- an ``n`` x ``n`` grid over ``box`` with the edge refined -- all
     jobs together: one batch for the cell centres, one for the edge sub-cells, one for the chief rays.
     Jobs whose rays would be the same (:func:`_same_rays_key`: the wavelengths of a lens without
-    dispersion) are traced once and share the rays, each with its own wavelength."""
+    dispersion; a job of the last call on the same camera, :data:`RECENT_RAYS`) are traced once and
+    share the rays, each with its own wavelength."""
+    keys = [_same_rays_key(tracer, fl, n, box) for fl, n, box in jobs]
     first: dict = {}
-    rep = [first.setdefault(_same_rays_key(tracer, fl, n, box), j) for j, (fl, n, box) in enumerate(jobs)]
-    traced = dict(zip(sorted(set(rep)), _trace_pupils([jobs[j] for j in sorted(set(rep))], st, tracer)))
+    rep = [first.setdefault(k, j) for j, k in enumerate(keys)]
+    with _recent_lock:
+        if _recent.get("camera") is not st.state:
+            _recent.clear()
+            _recent["camera"] = st.state
+        known = {j: _recent[keys[j]] for j in first.values() if keys[j] in _recent}
+    todo = [j for j in sorted(first.values()) if j not in known]
+    traced = dict(zip(todo, _trace_pupils([jobs[j] for j in todo], st, tracer) if todo else []))
+    # kept and handed out without what later calls derive from the rays (``shared``: sub-cell arrays)
+    traced.update({j: dataclasses.replace(pt, shared={}) for j, pt in known.items()})
+    with _recent_lock:
+        if _recent.get("camera") is st.state:
+            for j in todo:
+                _recent[keys[j]] = dataclasses.replace(traced[j], shared={})
+            while sum(pt.rays.x.size for k, pt in _recent.items() if k != "camera") > RECENT_RAYS:
+                del _recent[next(k for k in _recent if k != "camera")]
     out = []
     for (fl, _, _), r in zip(jobs, rep):
         pt = traced[r]
-        out.append(pt if jobs[r][0] is fl else dataclasses.replace(pt, field=fl, wavelength_nm=fl.wavelength_nm,
-                                                                   n_image=tracer.n_image(fl.wavelength_nm),
-                                                                   meta=dict(pt.meta)))
+        out.append(pt if pt.field is fl else dataclasses.replace(pt, field=fl, wavelength_nm=fl.wavelength_nm,
+                                                                 n_image=tracer.n_image(fl.wavelength_nm),
+                                                                 meta=dict(pt.meta)))
     return out
 
 
@@ -505,9 +554,10 @@ def _trace_pupils(jobs, st: Setup, tracer: _Tracer) -> list[PupilTrace]:
         edges.append((status, edge, er, ec, sgx, sgy))
         subs.append((fl, sgx, sgy))
     subtraced = _trace_groups(tracer, subs)
-    chiefs = tracer.trace(np.stack([fl.chief_start for fl, _, _ in jobs]),
-                          np.stack([fl.chief_direction for fl, _, _ in jobs]), np.zeros(len(jobs)),
-                          np.array([fl.wavelength_nm for fl, _, _ in jobs]), clip=False)
+    ends = np.concatenate([np.stack([fl.chief_start for fl, _, _ in jobs]),
+                           np.stack([fl.chief_direction for fl, _, _ in jobs])], axis=1)
+    chiefs = tracer.trace(list(ends.T), np.zeros(len(jobs)), np.array([fl.wavelength_nm for fl, _, _ in jobs]),
+                          clip=False)
     out = []
     for j, ((fl, n, box), g, c, (status, edge, er, ec, sgx, sgy), sub) in enumerate(
             zip(jobs, grids, centres, edges, subtraced)):
@@ -597,17 +647,16 @@ class PupilFunction:
     """The pupil function on the grid (see module notes) at two resolutions.
 
     Cells (``n`` x ``n``): ``field`` = sum over a cell's rays of weight x amplitude x exp(-2 pi i W)
-    (the cell's integral of the pupil function, for the PSF and the Strehl ratio), ``amplitude0``
-    the same with W = 0 (the unaberrated pupil of the same shape), ``opd`` the cell's mean OPD
-    (waves), ``mask`` where light passes. Sub-cells (``n q`` x ``n q``, q = EDGE_SUBSAMPLES, built
-    on first use): a binary ``fine_mask`` (an edge ray's own sub-cell, a whole interior cell),
-    ``fine_opd`` (an edge ray's own OPD, else interpolated bilinearly between cell means) and
-    ``fine_amp`` (aperture amplitude), for the MTF: an overlap of binary masks measures the sheared
-    pupil's area, where products of fractional edge cells would underestimate the loss by about
-    half a cell of rim.
+    (the cell's integral of the pupil function, for the PSF and the Strehl ratio; made on first use:
+    the MTF never reads it), ``amplitude0`` the same with W = 0 (the unaberrated pupil of the same
+    shape), ``opd`` the cell's mean OPD (waves), ``mask`` where light passes. Sub-cells (``n q`` x
+    ``n q``, q = EDGE_SUBSAMPLES, for the MTF, :func:`sub_cell_pupil`): a binary mask (an edge ray's
+    own sub-cell, a whole interior cell), the OPD (an edge ray's own, else interpolated bilinearly
+    between cell means) and the aperture amplitude: an overlap of binary masks measures the sheared
+    pupil's area, where products of fractional edge cells would underestimate the loss by about half
+    a cell of rim.
     """
 
-    field: np.ndarray
     amplitude0: np.ndarray
     opd: np.ndarray
     mask: np.ndarray
@@ -618,29 +667,17 @@ class PupilFunction:
     slope_y: float  # d(reference direction M)/d(pupil y), 1/mm
     _pt: object = None
     _ws: object = None
-    _fine: tuple | None = None
+    _field: np.ndarray | None = None
     _lags: dict = field(default_factory=dict)  # (axis, aberrated) -> OTF at whole sub-cell shears
 
     @property
     def q(self) -> int:
         return EDGE_SUBSAMPLES
 
-    def _build_fine(self):
-        if self._fine is None:
-            self._fine = _fine_arrays(self._pt, self._ws, self.mask, self.opd)
-        return self._fine
-
     @property
-    def fine_mask(self) -> np.ndarray:
-        return self._build_fine()[0]
-
-    @property
-    def fine_opd(self) -> np.ndarray:
-        return self._build_fine()[1]
-
-    @property
-    def fine_amp(self) -> np.ndarray:
-        return self._build_fine()[2]
+    def sub_cells_across(self) -> int:
+        """Sub-cells across the grid (n q)."""
+        return self.mask.shape[0] * EDGE_SUBSAMPLES
 
     @property
     def freq_per_cell_x(self) -> float:
@@ -651,6 +688,12 @@ class PupilFunction:
     def freq_per_cell_y(self) -> float:
         """... along y (tangential)."""
         return self.n_image * abs(self.slope_y) * self.cell_mm / (self.wavelength_nm * 1e-6)
+
+    @property
+    def field(self) -> np.ndarray:  # the cells' complex field, made on first use
+        if self._field is None:
+            self._field = _cell_field(self._pt, self._ws)
+        return self._field
 
 
 def direction_slopes(pt: PupilTrace, ws: WavefrontSamples) -> tuple[float, float]:
@@ -673,61 +716,149 @@ def direction_slopes(pt: PupilTrace, ws: WavefrontSamples) -> tuple[float, float
 def pupil_function(pt: PupilTrace, ws: WavefrontSamples) -> PupilFunction:
     n = pt.n
     idx = pt.row * n + pt.col
-    amp = pt.rays.amplitude
-    wa = pt.weight * amp
-    ph = np.exp(-2j * np.pi * ws.opd_waves)  # a ray whose path is longer (W < 0) lags: exp(i k OPL)
-    fld = (np.bincount(idx, weights=wa * ph.real, minlength=n * n)
-           + 1j * np.bincount(idx, weights=wa * ph.imag, minlength=n * n)).reshape(n, n)
+    wa = pt.weight * pt.rays.amplitude
     a0 = np.bincount(idx, weights=wa, minlength=n * n)
     wsum = np.bincount(idx, weights=wa * ws.opd_waves, minlength=n * n)
     mask = a0 > 0
     wmean = np.where(mask, wsum / np.where(mask, a0, 1.0), 0.0).reshape(n, n)
-    sx, sy = direction_slopes(pt, ws)
-    return PupilFunction(fld, a0.reshape(n, n), wmean, mask.reshape(n, n), pt.cell_mm, pt.wavelength_nm, pt.n_image,
+    # the slopes depend on the rays and the reference sphere alone: the same for every wavelength sharing them
+    key = ("slopes", ws.reference)
+    if key not in pt.shared:
+        pt.shared[key] = direction_slopes(pt, ws)
+    sx, sy = pt.shared[key]
+    return PupilFunction(a0.reshape(n, n), wmean, mask.reshape(n, n), pt.cell_mm, pt.wavelength_nm, pt.n_image,
                          sx, sy, pt, ws)
 
 
-def _fine_arrays(pt: PupilTrace, ws: WavefrontSamples, mask: np.ndarray, wmean: np.ndarray):
-    """Sub-cell mask, OPD and amplitude (see :class:`PupilFunction`)."""
+def _cell_field(pt: PupilTrace, ws: WavefrontSamples) -> np.ndarray:
+    """The cells' complex field of :class:`PupilFunction` (its ``field``)."""
+    n = pt.n
+    idx = pt.row * n + pt.col
+    wa = pt.weight * pt.rays.amplitude
+    ph = np.exp(-2j * np.pi * ws.opd_waves)  # a ray whose path is longer (W < 0) lags: exp(i k OPL)
+    return (np.bincount(idx, weights=wa * ph.real, minlength=n * n)
+            + 1j * np.bincount(idx, weights=wa * ph.imag, minlength=n * n)).reshape(n, n)
+
+
+def _lerp_axis(lo: int, hi: int, q: int):
+    """Along one axis, for each sub-cell of cells ``lo`` .. ``hi - 1``: the two cells whose centres it
+    lies between (counted from ``lo``, clipped to those cells) and the bilinear weights (1 - f, f)."""
+    c = (np.arange(lo * q, hi * q) + 0.5) / q - 0.5
+    fl = np.floor(c)
+    i0 = np.clip(fl.astype(int), lo, hi - 1)
+    f = np.clip(c - fl, 0.0, 1.0)
+    return i0 - lo, np.minimum(i0 + 1, hi - 1) - lo, 1.0 - f, f
+
+
+def _lerp2(a: np.ndarray, rows, cols) -> np.ndarray:
+    """Cell values ``a`` at the sub-cells, bilinearly (:func:`_lerp_axis` weights ``rows``, ``cols``).
+    Separable: along rows, then along columns; the columns as rows of the transpose, taken whole and
+    scaled in place (half the time of a fancy index per column), so the result is column-major."""
+    i0, i1, g, f = rows
+    along = g[:, None] * np.take(a, i0, axis=0) + f[:, None] * np.take(a, i1, axis=0)
+    cols_first = np.ascontiguousarray(along.T)
+    i0, i1, g, f = cols
+    out = np.take(cols_first, i0, axis=0)
+    out *= g[:, None]
+    right = np.take(cols_first, i1, axis=0)
+    right *= f[:, None]
+    out += right
+    return out.T
+
+
+def _sub_cells(pt: PupilTrace) -> dict:
+    """What the sub-cell pupil (:func:`sub_cell_pupil`) takes from the rays alone, made once for every
+    wavelength that shares them (``pt.shared``): the box of the lit cells with one cell of margin (no
+    sub-cell outside it is lit, and a lit sub-cell's bilinear OPD reads only cells within one of its
+    own), the bilinear weights there, the interpolation's denominator (the weights of lit cells only),
+    the edge rays' own sub-cells, and over the box of the lit sub-cells (``crop``) the aperture
+    amplitude ``A`` (0 where no light passes; column-major, as the OPD)."""
+    lay = pt.shared.get("sub_cells")
+    if lay is not None:
+        return lay
     n, q = pt.n, EDGE_SUBSAMPLES
-    amp = pt.rays.amplitude
+    r0, r1 = max(int(pt.row.min()) - 1, 0), min(int(pt.row.max()) + 2, n)
+    c0, c1 = max(int(pt.col.min()) - 1, 0), min(int(pt.col.max()) + 2, n)
+    rows, cols = _lerp_axis(r0, r1, q), _lerp_axis(c0, c1, q)
+    lit = np.zeros((r1 - r0, c1 - c0))
+    lit[pt.row - r0, pt.col - c0] = 1.0
     centre = pt.sub < 0
-    cr, cc = pt.row[centre], pt.col[centre]
-    interior = np.zeros((n, n), dtype=bool)
-    interior[cr, cc] = True
-    cell_amp = np.zeros((n, n))
-    cell_amp[cr, cc] = amp[centre]
-    fine_mask = np.repeat(np.repeat(interior, q, axis=0), q, axis=1)
-    fine_amp = np.repeat(np.repeat(cell_amp, q, axis=0), q, axis=1)
-    # bilinear OPD between the cells' means, over lit cells only
-    c = (np.arange(n * q) + 0.5) / q - 0.5
-    i0 = np.clip(np.floor(c).astype(int), 0, n - 1)
-    i1 = np.clip(i0 + 1, 0, n - 1)
-    f = np.clip(c - np.floor(c), 0.0, 1.0)
-    g = 1.0 - f
+    edge = ~centre
+    amp = pt.rays.amplitude
+    cell_amp = np.zeros(lit.shape)
+    cell_amp[pt.row[centre] - r0, pt.col[centre] - c0] = amp[centre]
+    A = np.repeat(np.repeat(cell_amp, q, axis=0), q, axis=1)
+    er = (pt.row[edge] - r0) * q + pt.sub[edge] // q
+    ec = (pt.col[edge] - c0) * q + pt.sub[edge] % q
+    A[er, ec] = amp[edge]
+    lit_rows, lit_cols = np.flatnonzero(A.any(axis=1)), np.flatnonzero(A.any(axis=0))
+    crop = np.s_[lit_rows[0]:lit_rows[-1] + 1, lit_cols[0]:lit_cols[-1] + 1]
+    den = _lerp2(lit, rows, cols)
+    lay = {"box": np.s_[r0:r1, c0:c1], "rows": rows, "cols": cols, "lit": lit, "den": den, "divide": den > 0,
+           "er": er, "ec": ec, "edge": edge, "crop": crop, "A": np.asfortranarray(A[crop])}
+    pt.shared["sub_cells"] = lay
+    return lay
 
-    def lerp2(a):  # separable: along rows, then along columns; the columns as rows of the transpose, taken
-        # whole and scaled in place (half the time of a fancy index per column: the same operations, and the
-        # same column-major result, whose layout sets the order of every sum after it)
-        rows = g[:, None] * np.take(a, i0, axis=0) + f[:, None] * np.take(a, i1, axis=0)
-        cols = np.ascontiguousarray(rows.T)
-        out = np.take(cols, i0, axis=0)
-        out *= g[:, None]
-        right = np.take(cols, i1, axis=0)
-        right *= f[:, None]
-        out += right
-        return out.T
 
-    lit = mask.astype(float)
-    num = lerp2(lit * wmean)
-    den = lerp2(lit)
-    fine_opd = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
-    e = ~centre
-    er, ec = pt.row[e] * q + pt.sub[e] // q, pt.col[e] * q + pt.sub[e] % q
-    fine_mask[er, ec] = True
-    fine_amp[er, ec] = amp[e]
-    fine_opd[er, ec] = ws.opd_waves[e]
-    return fine_mask, fine_opd, fine_amp
+#: The OPD phasors exp(-2 pi i m / 4096) that :func:`unit_phasors` starts from, and the values it takes at a time.
+_PHASOR_STEPS = 4096
+_PHASOR_TABLE = np.exp(-2j * np.pi * np.arange(_PHASOR_STEPS) / _PHASOR_STEPS)
+_PHASOR_BLOCK = 16384
+
+
+def unit_phasors(w: np.ndarray) -> np.ndarray:
+    """exp(-2 pi i w) of a 2-D array of OPDs ``w`` (waves), in the layout of ``w``: numpy's complex
+    exponential to 1e-15 in a third of its time here (libm's, about 45 ns a value, was most of an MTF
+    chart's OTF). With w = (m + r) / 4096, m whole and |r| <= 1/2: exp(-2 pi i m / 4096) from a table,
+    times exp(i t), t = -2 pi r / 4096, from its Taylor series to t^4 and t^3 (|t| <= pi / 4096: the
+    first terms left out are below 3e-18), a block of rows at a time so the temporaries stay in the cache."""
+    if w.ndim == 2 and w.strides[0] < w.strides[1]:  # column-major: the rows of the transpose
+        return unit_phasors(w.T).T
+    out = np.empty(w.shape, dtype=complex)
+    step = max(1, _PHASOR_BLOCK // max(w.shape[-1], 1))
+    for a in range(0, w.shape[0], step):
+        _phasor_block(w[a:a + step], out[a:a + step])
+    return out
+
+
+def _phasor_block(w: np.ndarray, out: np.ndarray) -> None:
+    s = w * float(_PHASOR_STEPS)  # exact: a power of two
+    m = np.rint(s)
+    t = s - m  # exact (the two are within 0.5 of each other)
+    t *= -2.0 * np.pi / _PHASOR_STEPS
+    t2 = t * t
+    c = t2 * (1.0 / 24.0)  # 1 - cos t = t^2/2 - t^4/24
+    np.subtract(0.5, c, out=c)
+    c *= t2
+    np.subtract(1.0, c, out=out.real)
+    t2 *= -1.0 / 6.0  # sin t = t - t^3/6
+    t2 *= t
+    t2 += t
+    np.copyto(out.imag, t2)
+    idx = m.astype(np.int64)
+    idx &= _PHASOR_STEPS - 1  # m modulo 4096 (two's complement for m < 0)
+    out *= np.take(_PHASOR_TABLE, idx)
+
+
+def sub_cell_pupil(pf: PupilFunction, aberrated: bool = True) -> np.ndarray:
+    """P = A exp(-2 pi i W) over the sub-cells (:class:`PupilFunction`; cached per pupil), only over the
+    box of the lit sub-cells: the rows and columns outside it add nothing to any lag. ``aberrated=False``:
+    A alone. W: an edge ray's own OPD in its sub-cell, else the cells' mean OPD bilinearly between the
+    lit cells' centres."""
+    key = ("P", aberrated)
+    if key not in pf._lags:
+        lay = _sub_cells(pf._pt)
+        if aberrated:
+            num = _lerp2(lay["lit"] * pf.opd[lay["box"]], lay["rows"], lay["cols"])
+            opd = np.zeros_like(num)
+            np.divide(num, lay["den"], out=opd, where=lay["divide"])
+            opd[lay["er"], lay["ec"]] = pf._ws.opd_waves[lay["edge"]]
+            P = unit_phasors(opd[lay["crop"]])
+            P *= lay["A"]
+        else:
+            P = lay["A"].astype(complex)
+        pf._lags[key] = P
+    return pf._lags[key]
 
 
 def max_waves_per_cell(pf: PupilFunction) -> float:
@@ -741,23 +872,10 @@ def max_waves_per_cell(pf: PupilFunction) -> float:
     return worst
 
 
-#: Whole sub-cell lags a pupil sums one by one (a product summed over the overlap each, about
-#: 0.1 ms at 256 sub-cells across) before :func:`otf_lags` computes them all by FFT (1.5-4 ms per
-#: axis): a chart reads 2 per frequency.
+#: Whole sub-cell lags a pupil sums one by one (a dot product over the overlap each, about 0.1 ms
+#: at 700 x 400 sub-cells) before :func:`otf_lags` computes them all by FFT (1.5-4 ms per axis): a
+#: chart reads 2 per frequency.
 DIRECT_LAGS_MAX = 16
-
-
-def _complex_pupil(pf: PupilFunction, aberrated: bool) -> np.ndarray:
-    """P = A exp(-2 pi i W) over the sub-cells (cached per pupil); ``aberrated=False``: A alone. Only
-    the bounding box of the lit sub-cells: the rows and columns outside it add nothing to any lag."""
-    key = ("P", aberrated)
-    if key not in pf._lags:
-        A = pf.fine_amp * pf.fine_mask
-        rows, cols = np.flatnonzero(A.any(axis=1)), np.flatnonzero(A.any(axis=0))
-        box = np.s_[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1] if rows.size else np.s_[:0, :0]
-        A = A[box]
-        pf._lags[key] = A * np.exp(-2j * np.pi * pf.fine_opd[box]) if aberrated else A.astype(complex)
-    return pf._lags[key]
 
 
 def otf_lags(pf: PupilFunction, axis: int, *, aberrated: bool = True) -> np.ndarray:
@@ -770,10 +888,10 @@ def otf_lags(pf: PupilFunction, axis: int, *, aberrated: bool = True) -> np.ndar
     key = (axis, aberrated)
     cache = pf._lags
     if key not in cache:
-        P = _complex_pupil(pf, aberrated)
+        P = sub_cell_pupil(pf, aberrated)
         if axis == 1:
             P = P.T
-        n, size = P.shape[0], pf.fine_mask.shape[axis]
+        n, size = P.shape[0], pf.sub_cells_across
         norm = float((np.abs(P) ** 2).sum())
         F = np.fft.fft(P, n=2 * n, axis=0)
         r = np.zeros(size, dtype=complex)  # no overlap past the lit box: 0
@@ -793,24 +911,54 @@ def _lag(pf: PupilFunction, k: int, axis: int, aberrated: bool) -> complex:
     if k not in direct:
         if len(direct) >= DIRECT_LAGS_MAX:
             return complex(otf_lags(pf, axis, aberrated=aberrated)[k])
-        P = _complex_pupil(pf, aberrated)
-        if ("conj", aberrated) not in pf._lags:
-            pf._lags["conj", aberrated] = P.conj()
-            pf._lags["norm", aberrated] = float((P.real * P.real + P.imag * P.imag).sum())
-        Pc, norm = pf._lags["conj", aberrated], pf._lags["norm", aberrated]
-        if axis == 1:
-            P, Pc = P.T, Pc.T
-        n = P.shape[0]
-        lit = norm > 0 and k < n  # past the lit box the shifted pupil does not overlap
-        direct[k] = complex(np.einsum("ij,ij->", P[k:], Pc[:n - k])) / norm if lit else 0j
+        cols = _pupil_by_columns(pf, aberrated)
+        norm = pf._lags["norm", aberrated]
+        m, n = cols.shape
+        if not (norm > 0 and k < (m if axis == 1 else n)):  # past the lit box the shifted pupil does not overlap
+            direct[k] = 0j
+        elif axis == 1:  # sum P(u + k) conj(P(u)): whole columns k apart, one contiguous block each
+            direct[k] = _dot(cols[:m - k], cols[k:]) / norm
+        elif 2 * k <= n:  # along each column: the pairs k apart over the whole array, less those across columns
+            direct[k] = (_dot(cols.reshape(-1)[:m * n - k], cols.reshape(-1)[k:])
+                         - _dot(np.ascontiguousarray(cols[:-1, n - k:]), np.ascontiguousarray(cols[1:, :k]))) / norm
+        else:
+            rows = pf._lags.get(("rows", aberrated))
+            if rows is None:
+                rows = pf._lags["rows", aberrated] = np.ascontiguousarray(cols.T)
+            direct[k] = _dot(rows[:n - k], rows[k:]) / norm
     return direct[k]
+
+
+def _pupil_by_columns(pf: PupilFunction, aberrated: bool) -> np.ndarray:
+    """The sub-cell pupil's transpose, contiguous: a column of P (one x) per row (cached per pupil,
+    with sum |P|^2). P is column-major as made, so this is P's own memory."""
+    key = ("columns", aberrated)
+    if key not in pf._lags:
+        pf._lags[key] = cols = np.ascontiguousarray(sub_cell_pupil(pf, aberrated).T)
+        pf._lags["norm", aberrated] = _dot(cols, cols).real
+    return pf._lags[key]
+
+
+#: Values per BLAS dot product in :func:`_dot`: OpenBLAS shares a longer one (over 10 000) among threads,
+#: whose waiting cost 14 times the CPU of the sum itself when the caller's BLAS is not limited to one
+#: thread (the `physcam` program limits it; a Python caller may not).
+_DOT_BLOCK = 8192
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> complex:
+    """sum conj(a) b over two C-contiguous complex arrays of one shape (BLAS's dot, in blocks)."""
+    a, b = a.reshape(-1), b.reshape(-1)
+    total = 0j
+    for j in range(0, a.size, _DOT_BLOCK):
+        total += complex(np.vdot(a[j:j + _DOT_BLOCK], b[j:j + _DOT_BLOCK]))
+    return total
 
 
 def shear_otf(pf: PupilFunction, shift_cells: float, axis: int, *, aberrated: bool = True) -> complex:
     """Normalised OTF at a pupil shear of ``shift_cells`` (>= 0, in cells) along ``axis``: :func:`otf_lags`
     interpolated linearly between whole sub-cell shears (a quarter cell apart, where the OTF is
     smooth: its curvature times (1/4 cell)^2 / 8 is the interpolation error)."""
-    size = pf.fine_mask.shape[axis]  # sub-cells across along the shear
+    size = pf.sub_cells_across  # sub-cells across along the shear
     s = float(shift_cells) * pf.q
     k = int(math.floor(s))
     if k >= size - 1:
@@ -820,7 +968,6 @@ def shear_otf(pf: PupilFunction, shift_cells: float, axis: int, *, aberrated: bo
 
 
 def cutoff_cells(pf: PupilFunction, axis: int) -> float:
-    """Shear (cells) beyond which the pupil no longer overlaps itself along ``axis``."""
-    lit = pf.fine_mask.any(axis=1 - axis)
-    idx = np.flatnonzero(lit)
-    return float(idx.max() - idx.min() + 1) / pf.q if idx.size else 0.0
+    """Shear (cells) beyond which the pupil no longer overlaps itself along ``axis``: the extent of
+    the lit sub-cells along it."""
+    return float(_sub_cells(pf._pt)["A"].shape[axis]) / pf.q

@@ -91,7 +91,7 @@ def fields_pupils(camera, fields_deg, *, wavelengths_nm=None, weights=None, defo
         min_frequency = require_finite("frequency", min_frequency)
     angles = P.field_angles(fields_deg)
     tracer = P._Tracer(st)
-    per_wl = [P.make_fields(st, angles, w) for w in wls]  # [wavelength][field]
+    per_wl = P.fields_at_wavelengths(st, angles, wls, tracer)  # [wavelength][field]
     boxes = P.pupil_boxes(st, per_wl[0], tracer)
     ns = [n_user or P.DEFAULT_PUPIL_SAMPLES] * len(angles)
     result: list = [None] * len(angles)

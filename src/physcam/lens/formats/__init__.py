@@ -20,13 +20,13 @@ from pathlib import Path
 
 from ...errors import ExportError, LensFileError
 from ..prescription import Prescription, takes_prescription
-from . import iset, pbrt, physcam_toml, seedtoml, zemax
 from ._common import extra, read_text
 
 __all__ = ["FORMATS", "extra", "read_lens", "loads_lens", "write_lens", "dumps_lens", "detect_format"]
 
-#: Format name -> module with ``loads(text, path=None, name=None)`` and ``dumps(p)``.
-FORMATS = {"physcam": physcam_toml, "seed-toml": seedtoml, "pbrt": pbrt, "iset": iset, "zemax": zemax}
+#: Format name -> the name of its module in this package (imported when that format is read or
+#: written: a bundled TOML lens's report loads no Zemax, pbrt, ISET or seed reader, issue 43).
+_MODULE_NAMES = {"physcam": "physcam_toml", "seed-toml": "seedtoml", "pbrt": "pbrt", "iset": "iset", "zemax": "zemax"}
 _EXT = {".dat": "pbrt", ".json": "iset", ".zmx": "zemax", ".toml": "physcam"}
 #: Other programs' lens files physcam recognises but does not read.
 _NOT_READ = {".seq": "CODE V sequence files (.seq)", ".len": "OSLO lens files (.len)",
@@ -61,10 +61,25 @@ def detect_format(path, text: str | None = None) -> str:
 
 
 def _module(fmt: str):
+    from importlib import import_module
+
     try:
-        return FORMATS[fmt]
+        name = _MODULE_NAMES[fmt]
     except KeyError:
-        raise LensFileError(f"unknown lens format {fmt!r}; use one of {', '.join(FORMATS)}") from None
+        raise LensFileError(f"unknown lens format {fmt!r}; use one of {', '.join(_MODULE_NAMES)}") from None
+    return import_module(f"{__name__}.{name}")
+
+
+def __getattr__(name: str):
+    """``FORMATS`` (format name -> module with ``loads(text, path=None, name=None)`` and ``dumps(p)``)
+    and the format modules themselves, imported on first use."""
+    if name == "FORMATS":
+        return {fmt: _module(fmt) for fmt in _MODULE_NAMES}
+    if name in _MODULE_NAMES.values():
+        from importlib import import_module
+
+        return import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def loads_lens(text: str, format: str, path=None, name: str | None = None) -> Prescription:

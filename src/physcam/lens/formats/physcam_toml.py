@@ -60,7 +60,7 @@ FORMAT_TAG = "physcam-lens/1"
 LENS_KEYS = ("name", "maker", "patent", "focal_length", "max_fstop", "t_stop", "coating", "minimum_object_distance",
              "squeeze", "wavelength_nm")
 SURFACE_KEYS = ("kind", "radius", "thickness", "semi_diameter", "medium", "conic", "aspheric")
-DEFAULT_WAVELENGTH = Prescription.__dataclass_fields__["wavelength_nm"].default
+DEFAULT_WAVELENGTH = Prescription.wavelength_nm  # the field's default (a class attribute)
 
 
 def _medium(v, where, path, ln) -> Medium:
