@@ -55,6 +55,15 @@ def worker(lens_name: str, out: str) -> None:
         return ft
 
     bf.focus_table = recording
+    import physcam.export.blender_zoom as bz  # a zoom lens's tables (lens_payload imports it when called)
+
+    inner_zoom = bz.zoom_focus_table
+
+    def recording_zoom(*a, **k):
+        kept["ft"] = ft = inner_zoom(*a, **k)
+        return ft
+
+    bz.zoom_focus_table = recording_zoom
     t = time.process_time()
     lens_payload(lens, lens_name)
     cpu = time.process_time() - t

@@ -77,6 +77,37 @@ scene.view_settings.view_transform = "Standard"
 scene.render.image_settings.file_format = "OPEN_EXR"
 """
 
+#: Blender code defining ``glow(name, strength)``: a new material that only emits (white light of that
+#: strength), what the lit objects of the rendered tests are made of.
+GLOW_MATERIAL = """
+def glow(name, strength):
+    mat = bpy.data.materials.new(name); mat.use_nodes = True
+    nt = mat.node_tree; nt.nodes.clear()
+    em = nt.nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = strength
+    nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
+    return mat
+"""
+
+
+def installed_dark_scene(samples: int | None = None) -> str:
+    """:data:`INSTALLED_EXTENSION_SCENE`, then nothing but the camera, in no world (black): the camera
+    object at the origin looking down world -Z, +Y up (with an extension's lens, the origin is its
+    entrance pupil), ``cam_obj`` and ``cam`` (its data) defined, and :data:`GLOW_MATERIAL`'s ``glow``.
+    With ``samples``: Cycles at that many samples a pixel, not adaptive, a 1 px box filter and no
+    bounces (each pixel the light reaching it straight from the lit objects)."""
+    render = "" if samples is None else f"""
+scene.cycles.samples = {int(samples)}; scene.cycles.use_adaptive_sampling = False
+scene.cycles.pixel_filter_type = "BOX"; scene.cycles.filter_width = 1.0; scene.cycles.max_bounces = 0"""
+    return INSTALLED_EXTENSION_SCENE + render + """
+for o in list(bpy.data.objects):
+    if o.type != "CAMERA":
+        bpy.data.objects.remove(o)
+scene.world = None
+cam_obj = scene.camera
+cam_obj.location = (0.0, 0.0, 0.0); cam_obj.rotation_euler = (0.0, 0.0, 0.0)
+cam = cam_obj.data
+""" + GLOW_MATERIAL
+
 
 def run_blender(script: str, *args, timeout: float = 300.0, env: dict | None = None) -> dict:
     """Run ``script`` (Python source) in Blender; it must print one JSON object on its last stdout line,

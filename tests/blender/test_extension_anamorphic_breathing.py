@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from _anamorphic_yu import hand_framing_focal_lengths, hand_pupils_from_film
-from _blender import INSTALLED_EXTENSION_SCENE, light_centroid, run_blender_log
+from _blender import installed_dark_scene, light_centroid, run_blender_log
 
 pytestmark = pytest.mark.slow
 
@@ -28,23 +28,11 @@ W, H = 160, 120  # square pixels on the film: 160 / 18 = 120 / 13.5
 MARKS_MM = (1000.0, 5000.0)  # its closest focus is 985 mm; the squeeze breathes 2.048 -> 1.991
 SPOT_MM = (2.7, 2.0)  # where the lights land on the film, mm from the centre (~30 % of the half frame)
 
-SCENE = INSTALLED_EXTENSION_SCENE + '''
-scene.cycles.samples = 48; scene.cycles.use_adaptive_sampling = False
-scene.cycles.pixel_filter_type = "BOX"; scene.cycles.filter_width = 1.0; scene.cycles.max_bounces = 0
+SCENE = installed_dark_scene(samples=48) + '''
 scene.render.resolution_x, scene.render.resolution_y = int(sys.argv[3]), int(sys.argv[4])
 scene.render.resolution_percentage = 100
-for o in list(bpy.data.objects):
-    if o.type != "CAMERA":
-        bpy.data.objects.remove(o)
-scene.world = None
-cam_obj = scene.camera
-cam_obj.location = (0.0, 0.0, 0.0); cam_obj.rotation_euler = (0.0, 0.0, 0.0)
-cam = cam_obj.data
 cam.type = "CUSTOM"
-mat = bpy.data.materials.new("E"); mat.use_nodes = True
-nt = mat.node_tree; nt.nodes.clear()
-em = nt.nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = 50.0
-nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
+mat = glow("E", 50.0)
 p = cam.physcam
 p.lens = sys.argv[2]; p.sensor = "CUSTOM"; p.sensor_width = 18.0; p.sensor_height = 13.5; p.fstop = 8.0
 p.enabled = True

@@ -11,28 +11,16 @@ import math
 import numpy as np
 import pytest
 
-from _blender import INSTALLED_EXTENSION_SCENE, run_blender_log
+from _blender import installed_dark_scene, run_blender_log
 from physcam.lens.library import load_lens
 from physcam.optics.sensors import sensors
 
 pytestmark = pytest.mark.slow
 
-ARTIST = INSTALLED_EXTENSION_SCENE + '''
-scene.cycles.samples = 16; scene.cycles.use_adaptive_sampling = False; scene.cycles.max_bounces = 0
-scene.cycles.pixel_filter_type = "BOX"; scene.cycles.filter_width = 1.0
+ARTIST = installed_dark_scene(samples=16) + '''
 scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 96, 64, 100
-for o in list(bpy.data.objects):
-    if o.type != "CAMERA":
-        bpy.data.objects.remove(o)
-scene.world = None
-cam_obj = scene.camera
-cam_obj.location = (0.0, 0.0, 0.0); cam_obj.rotation_euler = (0.0, 0.0, 0.0)
-cam = cam_obj.data
 p = cam.physcam
-mat = bpy.data.materials.new("E"); mat.use_nodes = True
-nt = mat.node_tree; nt.nodes.clear()
-em = nt.nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = 20.0
-nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
+mat = glow("E", 20.0)
 bpy.ops.mesh.primitive_uv_sphere_add(radius=0.001, location=(0.0, 0.0, -0.25), segments=24, ring_count=12)
 bpy.context.object.data.materials.append(mat)
 out = {}

@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pytest
 
-from _blender import INSTALLED_EXTENSION_SCENE, run_blender
+from _blender import installed_dark_scene, run_blender
 from physcam.analysis.image_quality.colour import chromatic_aberration
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus
@@ -26,22 +26,12 @@ SLUG, FSTOP, FIELD_DEG = "zuiko_18mm_f3_5", 8.0, 48.0
 SW, W, H = 36.0, 512, 342
 SH = SW * H / W
 
-COLOUR = INSTALLED_EXTENSION_SCENE + '''
-for o in list(bpy.data.objects):
-    if o.type != "CAMERA":
-        bpy.data.objects.remove(o)
-scene.world = None
-cam_obj = scene.camera
-cam_obj.location = (0.0, 0.0, 0.0); cam_obj.rotation_euler = (0.0, 0.0, 0.0)
-cam = cam_obj.data
+COLOUR = installed_dark_scene() + '''
 cam.clip_end = 1.0e5
 p = cam.physcam
 p.lens = sys.argv[3]; p.sensor = "CUSTOM"; p.sensor_width = float(sys.argv[4]); p.sensor_height = float(sys.argv[5])
 p.focus_distance = 1.0e4; p.fstop = float(sys.argv[6]); p.dispersion = True; p.enabled = True
-mat = bpy.data.materials.new("E"); mat.use_nodes = True
-nt = mat.node_tree; nt.nodes.clear()
-em = nt.nodes.new("ShaderNodeEmission"); em.inputs[1].default_value = 10.0
-nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
+mat = glow("E", 10.0)
 x, y, z = json.loads(sys.argv[7])
 bpy.ops.mesh.primitive_uv_sphere_add(radius=20.0, location=(x, y, z), segments=32, ring_count=16)
 bpy.context.object.data.materials.append(mat)

@@ -20,7 +20,7 @@ import math
 import numpy as np
 import pytest
 
-from _blender import INSTALLED_EXTENSION_SCENE, predicted_block_brightness, run_blender_log
+from _blender import installed_dark_scene, predicted_block_brightness, run_blender_log
 from physcam.analysis.defocus.blob import blob_moments
 from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.export.blender import bake_camera
@@ -36,22 +36,8 @@ LIGHTS = {"left": (-0.55, 0.0, -2.95, 0.012), "right": (0.55, 0.0, -2.95, 0.012)
 BACKDROP = {"rows": (128, 140), "cols": (104, 152)}  # rows from the bottom: the backdrop spans the top
 WINDOW = 14  # px around a light
 
-BUILD = INSTALLED_EXTENSION_SCENE + '''
+BUILD = installed_dark_scene(samples=64) + '''
 scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = int(sys.argv[3]), int(sys.argv[4]), 100
-scene.cycles.samples = 64; scene.cycles.use_adaptive_sampling = False
-scene.cycles.pixel_filter_type = "BOX"; scene.cycles.filter_width = 1.0; scene.cycles.max_bounces = 0
-for o in list(bpy.data.objects):
-    if o.type != "CAMERA":
-        bpy.data.objects.remove(o)
-scene.world = None
-cam_obj = scene.camera
-cam_obj.location = (0.0, 0.0, 0.0); cam_obj.rotation_euler = (0.0, 0.0, 0.0)  # the entrance pupil
-def glow(name, strength):
-    mat = bpy.data.materials.new(name); mat.use_nodes = True
-    nt = mat.node_tree; nt.nodes.clear()
-    em = nt.nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = strength
-    nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
-    return mat
 light = glow("light", 20.0)
 for x, y, z, r in json.loads(sys.argv[5]).values():
     bpy.ops.mesh.primitive_uv_sphere_add(radius=r, location=(x, y, z), segments=24, ring_count=12)

@@ -13,7 +13,7 @@ import json
 import numpy as np
 import pytest
 
-from _blender import INSTALLED_EXTENSION_SCENE, light_centroid, run_blender_log
+from _blender import installed_dark_scene, light_centroid, run_blender_log
 
 pytestmark = pytest.mark.slow
 
@@ -23,21 +23,9 @@ CASES = [("16:9, auto", 96, 54, "AUTO"), ("9:16, auto", 54, 96, "AUTO"), ("9:16,
 SPOT = 0.4  # the lights at this fraction of the half frame (the real lens distorts little there)
 DIST = 30.0  # m from the camera object
 
-FRAMING = INSTALLED_EXTENSION_SCENE + '''
-scene.cycles.samples = 32; scene.cycles.use_adaptive_sampling = False
-scene.cycles.pixel_filter_type = "BOX"; scene.cycles.filter_width = 1.0; scene.cycles.max_bounces = 0
+FRAMING = installed_dark_scene(samples=32) + '''
 scene.render.resolution_percentage = 100
-for o in list(bpy.data.objects):
-    if o.type != "CAMERA":
-        bpy.data.objects.remove(o)
-scene.world = None
-cam_obj = scene.camera
-cam_obj.location = (0.0, 0.0, 0.0); cam_obj.rotation_euler = (0.0, 0.0, 0.0)
-cam = cam_obj.data
-mat = bpy.data.materials.new("E"); mat.use_nodes = True
-nt = mat.node_tree; nt.nodes.clear()
-em = nt.nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = 20.0
-nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
+mat = glow("E", 20.0)
 p = cam.physcam
 p.lens = sys.argv[2]; p.sensor = "CUSTOM"; p.sensor_width = 36.0; p.sensor_height = 24.0
 p.focus_distance = float(sys.argv[4]); p.fstop = 8.0; p.enabled = True

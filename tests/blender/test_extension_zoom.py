@@ -22,7 +22,7 @@ from importlib import resources
 import numpy as np
 import pytest
 
-from _blender import INSTALLED_EXTENSION_SCENE, light_centroid, run_blender_log
+from _blender import installed_dark_scene, light_centroid, run_blender_log
 from _zoom_abcd import abcd_position, abcd_unit_focus_magnification
 
 pytestmark = pytest.mark.slow
@@ -74,23 +74,11 @@ def predictions():
     return out
 
 
-ARTIST = INSTALLED_EXTENSION_SCENE + '''
+ARTIST = installed_dark_scene(samples=48) + '''
 scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = int(sys.argv[3]), int(sys.argv[4]), 100
-scene.cycles.samples = 48; scene.cycles.use_adaptive_sampling = False
-scene.cycles.pixel_filter_type = "BOX"; scene.cycles.filter_width = 1.0; scene.cycles.max_bounces = 0
 scene.render.use_border = True; scene.render.use_crop_to_border = False  # the lights' rows only
 scene.render.border_min_x, scene.render.border_max_x, scene.render.border_min_y, scene.render.border_max_y = 0.0, 1.0, 0.4, 0.6
-for o in list(bpy.data.objects):
-    if o.type != "CAMERA":
-        bpy.data.objects.remove(o)
-scene.world = None
-cam_obj = scene.camera
-cam_obj.location = (0.0, 0.0, 0.0); cam_obj.rotation_euler = (0.0, 0.0, 0.0)
-cam = cam_obj.data
-mat = bpy.data.materials.new("E"); mat.use_nodes = True
-nt = mat.node_tree; nt.nodes.clear()
-em = nt.nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = 50.0
-nt.links.new(em.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs[0])
+mat = glow("E", 50.0)
 x, dist, r = (float(v) / 1000.0 for v in sys.argv[6:9])
 for sx in (-1, 1):
     bpy.ops.mesh.primitive_uv_sphere_add(radius=r, location=(sx * x, 0.0, -dist), segments=24, ring_count=12)

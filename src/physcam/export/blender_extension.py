@@ -105,7 +105,9 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
                                                                                pupil_mm=pupil)
     data = {"slug": slug, "name": lens.name, "closest_m": ft.closest_mm / 1000.0, "fstop_min": ft.fstop_min,
             "fstop_open": ft.fstop_open, "fstop_max": MAX_F_NUMBER,
-            "inv_step_per_m": ft.inv_step_per_m, "anamorphic": bool(lens.is_anamorphic),
+            # the focus axis (blender_focus.FocusAxis): the add-on finds a mark's rows as the shader does
+            "focus_axis": {"closest_m": ft.axis.closest_mm / 1000.0, "s_near": ft.axis.s_near},
+            "anamorphic": bool(lens.is_anamorphic),
             "report_fstop": REFERENCE_FSTOP, "report_sensor_mm": list(REPORT_SENSOR_MM),
             "focus_object": _focus_object_fits(rows[:len(ft.marks_mm)]),
             "rows": rows}

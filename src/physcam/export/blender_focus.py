@@ -1,10 +1,13 @@
 """A Blender OSL camera whose focus, f-stop, sensor and iris are shader parameters.
 
 :func:`focus_table` tabulates physcam's focus states of a lens (:func:`physcam.optics.focusing.focus`:
-unit focusing moves the film, internal focusing the groups; breathing comes with them) at marks
-uniform in 1/distance from infinity to the closest focus; :func:`focus_table_shader` writes the
-template ``osl/physcam_lens.osl.in`` with that table, and the shader blends the two states that
-bracket its ``focus_distance`` parameter (metres from the film plane), linearly in 1/distance. The
+unit focusing moves the film, internal focusing the groups; breathing comes with them) at the
+marks of a :class:`FocusAxis` (from infinity to the closest focus, denser toward it);
+:func:`focus_table_shader` writes the template ``osl/physcam_lens.osl.in`` with that table, and the
+shader finds its ``focus_distance`` parameter (metres from the film plane) among the marks and
+blends the states about it (:func:`blend_weights`: the film plane a cubic Hermite with its
+tabulated slopes, the vertices and the entrance pupil a Catmull-Rom cubic; docs/blender.md, "Focus
+tables", has the error bound). The
 iris follows physcam's one rule (:func:`~physcam.optics.state.camera_state`'s iris, sized at
 infinity focus): paraxial, so its semi-diameter is K / N with K tabulated here; it opens as far as
 physcam's camera state opens it, :data:`~physcam.optics.paraxial.STOP_OPENING_TOLERANCE` beyond the
@@ -26,14 +29,15 @@ import math
 import numpy as np
 
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
-from ..errors import InputError, OpticsError, require_type
+from ..errors import InputError, OpticsError, require_positive, require_type
 from ..lens.prescription import Prescription, takes_prescription
 from ._codetext import osl_comment
 from .osl import lens_data, osl_array, osl_number, render_template
 
-__all__ = ["FocusTable", "focus_table", "focus_table_shader", "ghost_rows", "N_FOCUS", "GRID_HALF_MM", "STOP_LEVELS"]
+__all__ = ["FocusAxis", "FocusTable", "blend_weights", "blended_geometry", "focus_axis", "focus_geometry", "focus_table",
+           "focus_table_shader", "ghost_rows", "hermite_basis", "N_FOCUS", "GRID_HALF_MM", "STOP_LEVELS"]
 
-#: Focus states tabulated (uniform in 1/distance, infinity first).
+#: Focus states tabulated (infinity first, uniform in :class:`FocusAxis`'s s).
 N_FOCUS = 32
 #: Half size (mm) of the film square the exit-pupil table covers: a full-frame 36 x 24 mm gate's
 #: half diagonal, so every sensor up to full frame (any aspect) fits.
@@ -47,14 +51,129 @@ STOP_LEVELS = (0.75, 0.5, 0.35, 0.25)
 N_TRY = 8
 
 
+@dataclasses.dataclass(frozen=True)
+class FocusAxis:
+    """Where a focus table's marks lie. A mark D (mm from the film plane) has s = sqrt(1 - C / D), C the
+    lens's closest focus (:func:`~physcam.optics.focusing.closest_focus`); the marks are uniform in s
+    from 1 (infinity) to s_near, the last mark ``near_mm`` (a hair beyond C, so rounding never asks
+    closer), and D's place among them, the index, is (n - 1)(1 - s) / (1 - s_near). Why s: a
+    unit-focusing lens's closest focus is its 1:1 conjugate, where D = 2f + hiatus + x' + f^2/x'
+    (Newton, x x' = f^2; x' the film's extension) is least, so the extension grows as sqrt(D - C) and
+    no polynomial in 1/D follows it there (uniform in 1/D and linear, the last interval was out by
+    millimetres); in s it is smooth from infinity to 1:1."""
+
+    closest_mm: float
+    near_mm: float
+    n: int
+
+    @property
+    def s_near(self) -> float:
+        return math.sqrt(max(1.0 - self.closest_mm / self.near_mm, 0.0))
+
+    def index(self, focus_mm: float) -> float:
+        """The fractional index (0 at infinity, n - 1 at the last mark) of a mark ``focus_mm`` from the film."""
+        s = math.sqrt(max(1.0 - self.closest_mm / focus_mm, 0.0)) if focus_mm > 0 else 1.0  # 0: infinity, as the shader
+        return min(max((self.n - 1) * (1.0 - s) / (1.0 - self.s_near), 0.0), self.n - 1.0)
+
+    def mark(self, index: float) -> float:
+        """The mark (mm from the film plane; inf at index 0) at a fractional index."""
+        if index <= 0:
+            return math.inf
+        if index >= self.n - 1:
+            return self.near_mm
+        a = index / (self.n - 1) * (1.0 - self.s_near)  # 1 - s
+        return self.closest_mm / (a * (2.0 - a))  # C / (1 - s^2)
+
+    @property
+    def marks_mm(self) -> np.ndarray:
+        return np.array([self.mark(k) for k in range(self.n)])
+
+
+def focus_axis(closest_mm: float, n_focus: int) -> FocusAxis:
+    """The :class:`FocusAxis` of ``n_focus`` marks down to ``closest_mm`` (mm from the film)."""
+    if isinstance(n_focus, bool) or not isinstance(n_focus, int) or n_focus < 3:
+        raise InputError(f"a focus table needs at least 3 states, got {n_focus!r}")
+    closest = require_positive("closest focus (mm from the film)", closest_mm)
+    return FocusAxis(closest, closest * (1 + 1e-6), n_focus)
+
+
+def blend_weights(index: float, n: int) -> tuple[int, float, list[int], list[float]]:
+    """How the shader blends the states about a fractional focus ``index`` of ``n`` states: (k0, t, taps,
+    weights) with k0 the state before it and t in [0, 1] its place to the next (the pupil tables, linear).
+    A table T is read at the index as sum(weights[i] * T[taps[i]]): the Catmull-Rom cubic through
+    k0 - 1 .. k0 + 2 (slopes (T[k+1] - T[k-1]) / 2; at the ends the quadratic's one-sided slope). The
+    film plane is the cubic Hermite with its own slopes: h00 F[k0] + h10 F'[k0] + h01 F[k0+1] + h11 F'[k0+1],
+    (h00, h10, h01, h11) = (2t^3 - 3t^2 + 1, t^3 - 2t^2 + t, 3t^2 - 2t^3, t^3 - t^2)."""
+    k0 = min(int(math.floor(index)), n - 2)
+    t = index - k0
+    h00, h10, h01, h11 = hermite_basis(t)
+    taps = [k0 - 1, k0, k0 + 1, k0 + 2]
+    w = [-0.5 * h10, h00 - 0.5 * h11, h01 + 0.5 * h10, 0.5 * h11]
+    if k0 == 0:  # the tap before the first: the quadratic through the first three, extrapolated
+        taps[0] = 2
+        w[1] += 3 * w[0]
+        w[2] -= 3 * w[0]
+    if k0 + 2 == n:  # the tap after the last, likewise
+        taps[3] = n - 3
+        w[2] += 3 * w[3]
+        w[1] -= 3 * w[3]
+    return k0, t, taps, w
+
+
+def hermite_basis(t: float) -> tuple[float, float, float, float]:
+    """The cubic Hermite basis (h00, h10, h01, h11) at t in [0, 1] (unit interval)."""
+    t2, t3 = t * t, t * t * t
+    return 2 * t3 - 3 * t2 + 1, t3 - 2 * t2 + t, 3 * t2 - 2 * t3, t3 - t2
+
+
+def blended_geometry(axis: FocusAxis, geometry, focus_mm: float) -> tuple[float, np.ndarray]:
+    """(film_z, vertex_z film side first) of a table's ``geometry`` (:func:`focus_geometry`'s) at the mark
+    ``focus_mm`` as the shader blends them (:func:`blend_weights`): its lines in Python."""
+    require_type("axis", axis, FocusAxis, "physcam.export.blender_focus.focus_axis(closest_mm, n_focus)")
+    film_z, slope, vz = geometry
+    k0, t, taps, w = blend_weights(axis.index(float(focus_mm)), axis.n)
+    h00, h10, h01, h11 = hermite_basis(t)
+    film = h00 * film_z[k0] + h10 * slope[k0] + h01 * film_z[k0 + 1] + h11 * slope[k0 + 1]
+    return float(film), sum(wi * np.asarray(vz[i]) for i, wi in zip(taps, w))
+
+
+@takes_prescription
+def focus_geometry(lens: Prescription, axis: FocusAxis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(film_z, its slope per index step, vertex_z film side first) of the plain prescription ``lens``
+    focused (:func:`physcam.optics.focusing.focus`) at each of ``axis``'s marks: the focus table's
+    geometry. The slope is physcam's own: a difference of exact focus solves 1e-3 index steps apart
+    (second order, one-sided at the ends)."""
+    from ..optics.focusing import focus
+    from ..trace.surfaces import surface_table
+
+    require_type("axis", axis, FocusAxis, "physcam.export.blender_focus.focus_axis(closest_mm, n_focus)")
+    eps = 1e-3
+
+    def film(x):
+        return focus(lens, axis.mark(x)).film_z
+
+    film_z, slope, vz = [], [], []
+    for k in range(axis.n):
+        st = focus(lens, axis.mark(k))
+        film_z.append(st.film_z)
+        vz.append(surface_table(st.prescription, reverse=True, coating="none").vertex_z)
+        if k == 0:
+            slope.append((-3 * st.film_z + 4 * film(eps) - film(2 * eps)) / (2 * eps))
+        elif k == axis.n - 1:
+            slope.append((3 * st.film_z - 4 * film(k - eps) + film(k - 2 * eps)) / (2 * eps))
+        else:
+            slope.append((film(k + eps) - film(k - eps)) / (2 * eps))
+    return np.array(film_z), np.array(slope), np.array(vz)
+
+
 @dataclasses.dataclass
 class FocusTable:
     """physcam's focus states of one lens, film side first (the tracing order)."""
 
     lens: Prescription
-    marks_mm: np.ndarray  # focus marks from the film plane, inf first
-    inv_step_per_m: float  # spacing of the marks in 1/metres
+    axis: FocusAxis  # where the marks lie
     film_z: np.ndarray  # (n,) film plane z, lens space
+    film_slope: np.ndarray  # (n,) d film_z / d index at each state (the shader's cubic Hermite)
     vertex_z: np.ndarray  # (n, surfaces)
     radial: np.ndarray | None  # (n, N_LEVEL, N_RADIAL, 3) pupil ellipses (blender_pupil); None: anamorphic
     rects: np.ndarray | None  # (n, ny, nx, 4) exit-pupil rectangles at the widest iris (anamorphic only)
@@ -72,6 +191,11 @@ class FocusTable:
     #: a zoom lens's zoom axis (:class:`physcam.export.blender_zoom.ZoomGrid`): the arrays above then
     #: hold zoom x focus blocks (:func:`physcam.export.blender_zoom.zoom_focus_table`); None: a lens without zoom
     zoom: object = None
+
+    @property
+    def marks_mm(self) -> np.ndarray:
+        """The focus marks (mm from the film plane, inf first): ``axis.marks_mm``."""
+        return self.axis.marks_mm
 
     @property
     def semi_max(self) -> float:
@@ -140,23 +264,18 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..trace.camera_tracer import CameraTracer
     from .blender_pupil import iris_levels, radial_pupil_table
 
-    if isinstance(n_focus, bool) or not isinstance(n_focus, int) or n_focus < 2:
-        raise InputError(f"a focus table needs at least 2 states, got {n_focus!r}")
-    near = closest_focus(lens) * (1 + 1e-6)  # a hair beyond: rounding must not ask closer
-    step = 1000.0 / near / (n_focus - 1)  # 1/m
-    marks = np.array([math.inf] + [1000.0 / (step * i) for i in range(1, n_focus)])
-    marks[-1] = max(marks[-1], near)
+    axis = focus_axis(closest_focus(lens), n_focus)
+    marks = axis.marks_mm
+    film_z, slope, vz = focus_geometry(lens, axis)
     n_open = gaussian_at_focus(lens, math.inf).f_number * (1 + 1e-9)
     k = camera_state(lens, fstop=n_open).stop_semi_diameter * n_open  # the one iris rule, at infinity focus
     n_min = n_open / (1 + STOP_OPENING_TOLERANCE)
     levels = iris_levels(k / n_min, k / n_open)
-    film_z, vz, radial, rects, stopped, norm = [], [], [], [], [], []
+    radial, rects, stopped, norm = [], [], [], []
     for mk in marks:
         st = focus(lens, float(mk))
         tracer = CameraTracer(st.prescription, st.film_z)  # the lens at this focus state as the file stops it
         t = tracer.film_side_table
-        film_z.append(st.film_z)
-        vz.append(t.vertex_z)
         if lens.is_anamorphic:
             b, rect, rect_levels = _rect_tables(tracer, levels[0], grid_half_mm)
             rects.append(rect)
@@ -174,8 +293,8 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     def arr(v):
         return np.array(v) if v else None
 
-    return FocusTable(lens, marks, step, np.array(film_z), np.array(vz), arr(radial), arr(rects), arr(stopped),
-                      np.array(norm), table0, bounds0, float(k), float(n_open), float(n_min), float(near), float(loss))
+    return FocusTable(lens, axis, film_z, slope, vz, arr(radial), arr(rects), arr(stopped),
+                      np.array(norm), table0, bounds0, float(k), float(n_open), float(n_min), axis.near_mm, float(loss))
 
 
 def _rect_tables(tracer, semi_max, grid_half_mm):
@@ -261,7 +380,8 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
     n_states = len(ft.film_z)  # n_focus, or (zoom positions x n_focus) for a zoom lens
     defines += ["#define PHYSCAM_FOCUS_TABLE 1", "#define PHYSCAM_APERTURE 1", "#define PHYSCAM_POLYGON 1",
                 f"#define N_FOCUS {n_focus}", f"#define N_VZ_TAB {n_states * n}", f"#define N_IRIS {N_LEVEL}",
-                f"#define N_NORM_TAB {ft.norm.size}", f"#define FOCUS_INV_STEP {_num32(ft.inv_step_per_m)}"]
+                f"#define N_NORM_TAB {ft.norm.size}", f"#define FOCUS_CLOSEST_M {_num32(ft.axis.closest_mm / 1000.0)}",
+                f"#define FOCUS_S_NEAR {_num32(ft.axis.s_near)}"]
     if not zoom:  # a zoom lens's iris rule changes along the zoom: _zoom_defines
         defines += [f"#define IRIS_K {_num32(ft.iris_k)}", f"#define FSTOP_OPEN {_num32(ft.fstop_open)}",
                     f"#define FSTOP_MIN {_num32(ft.fstop_min)}", f"#define SEMI_MAX {_num32(ft.semi_max)}"]
@@ -301,11 +421,12 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
             raise InputError(f"pupil_mm needs one distance per focus state ({n_states}), got {len(pupil_mm)}")
         defines.append("#define PHYSCAM_PUPIL_ORIGIN 1")
         data.append(_arr32("PUPIL_TAB", pupil_mm, "N_GEO_TAB" if zoom else "N_FOCUS"))
-    data += [_arr32("FILM_Z_TAB", ft.film_z, "N_GEO_TAB" if zoom else "N_FOCUS"), _arr32("NORM_TAB", norm, "N_NORM_TAB"),
+    data += [_arr32("FILM_Z_TAB", ft.film_z, "N_GEO_TAB" if zoom else "N_FOCUS"),
+             _arr32("FILM_DZ_TAB", ft.film_slope, "N_GEO_TAB" if zoom else "N_FOCUS"), _arr32("NORM_TAB", norm, "N_NORM_TAB"),
              _arr32("VZ_TAB", ft.vertex_z, "N_VZ_TAB"), osl_array("SEMI_OPEN", ft.table.semi_diameter, "N_SURF"),
              _arr32("IRIS_LEVEL", ft.levels, "N_IRIS")]
     zoom_note = (f" at each of {len(ft.zoom.geometry_u)} zoom positions (pupil tables at {len(ft.zoom.pupil_u)})"
                  if zoom else "")
     head = [f"// {osl_comment(ft.lens.name)}: {n_focus} focus states from infinity to {ft.closest_mm / 1000:.3g} m "
-            f"(uniform in 1/distance){zoom_note}; dispersion {'on' if dispersion else 'off'}, Fresnel {'on' if fresnel else 'off'}."]
+            f"(uniform in sqrt(1 - closest / distance)){zoom_note}; dispersion {'on' if dispersion else 'off'}, Fresnel {'on' if fresnel else 'off'}."]
     return render_template(head + defines, data)

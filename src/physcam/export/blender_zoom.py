@@ -4,12 +4,13 @@ The shader of a zoom lens takes the zoom as a focal length (``zoom_focal_length`
 EFL at infinity focus, as ``physcam --zoom 135mm`` names a position, :mod:`physcam.optics.zoom`) and
 finds the encoder u from :data:`N_ZOOM_EFL` EFLs uniform in u (linear between them: within 0.07 % of
 the library's bisection on the bundled zooms). The lens's state is tabulated on two grids sharing
-one focus axis (:data:`N_FOCUS_ZOOM` marks uniform in 1/distance, infinity to the closest focus
-every zoom position reaches):
+one focus axis (:data:`N_FOCUS_ZOOM` marks of a :class:`~physcam.export.blender_focus.FocusAxis`,
+infinity to the closest focus every zoom position reaches):
 
 - the geometry (film plane, vertices) at :data:`N_ZOOM_GEOMETRY` positions uniform in u: each is
   :func:`physcam.lens.zoom.prescription_at` (the gaps on their pchip cams) focused by
-  :func:`physcam.optics.focusing.focus`; the shader blends them bilinearly in (u, 1/distance).
+  :func:`physcam.optics.focusing.focus`; the shader blends them linearly in u and, along focus, as
+  :func:`~physcam.export.blender_focus.blend_weights` says (cubic in the axis's index).
   Linear in u between 33 nodes follows the pchip cams within 0.02 mm on the bundled zooms (0.85 mm
   between the tabulated positions and their midpoints alone). The entrance pupil (the camera's
   origin) and the iris rule's K and f-numbers come from :data:`N_ZOOM_ROWS` of those positions
@@ -31,8 +32,9 @@ import numpy as np
 
 from ..errors import InputError
 from ..lens.prescription import Prescription, takes_prescription
+from .blender_focus import FocusAxis
 
-__all__ = ["ZoomGrid", "zoom_focus_table", "rows_to_geometry", "N_FOCUS_ZOOM", "N_ZOOM_GEOMETRY",
+__all__ = ["ZoomGrid", "zoom_focus_table", "zoom_focus_axis", "rows_to_geometry", "N_FOCUS_ZOOM", "N_ZOOM_GEOMETRY",
            "N_ZOOM_ROWS", "N_ZOOM_EFL"]
 
 #: Focus marks of a zoom lens's tables (fewer than a prime's 32: the pupil tables are per position).
@@ -83,10 +85,10 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     ``fstop_open``/``fstop_min`` are the slowest over the zoom (an f-stop every position reaches) and
     ``closest_mm`` the farthest closest focus (a mark every position focuses to)."""
     from ..lens.zoom import prescription_at, tabulated_encoders
-    from ..optics.focusing import closest_focus, focus
+    from ..optics.focusing import focus
     from ..optics.zoom import efl_at
     from ..trace.camera_tracer import CameraTracer
-    from .blender_focus import FocusTable, _centre_bounds, _centre_norms, _ellipse_rect
+    from .blender_focus import FocusTable, _centre_bounds, _centre_norms, _ellipse_rect, focus_geometry
     from .blender_pupil import iris_levels, radial_pupil_table
 
     if lens.zoom is None:
@@ -97,10 +99,8 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     geo_u = np.linspace(0.0, 1.0, n_geometry)
     pupil_u = np.array(tabulated_encoders(lens), dtype=float)
     geo_q = [prescription_at(lens, float(u)) for u in geo_u]
-    near = max(closest_focus(q) for q in geo_q) * (1 + 1e-6)
-    step = 1000.0 / near / (n_focus - 1)
-    marks = np.array([math.inf] + [1000.0 / (step * i) for i in range(1, n_focus)])
-    marks[-1] = max(marks[-1], near)
+    axis = zoom_focus_axis(geo_q, n_focus)
+    marks = axis.marks_mm
     rows_u = np.linspace(0.0, 1.0, N_ZOOM_ROWS)
     rule_rows = np.array([_iris_rule(prescription_at(lens, float(u))) for u in rows_u])  # K, n_open, n_min
     rule = np.stack([np.interp(geo_u, rows_u, rule_rows[:, c]) for c in range(3)], axis=1)
@@ -108,12 +108,8 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     pupil_rule = np.array([_iris_rule(q) for q in pupil_q])
     both = np.concatenate([rule_rows, pupil_rule])
     levels = iris_levels(float(np.max(both[:, 0] / both[:, 2])), float(np.max(both[:, 0] / both[:, 1])))
-    film_z, vz = [], []
-    for q in geo_q:
-        for mk in marks:
-            st = focus(q, float(mk))
-            film_z.append(st.film_z)
-            vz.append(CameraTracer(st.prescription, st.film_z).film_side_table.vertex_z)
+    geometry = [focus_geometry(q, axis) for q in geo_q]
+    film_z, slope, vz = (np.concatenate([g[i] for g in geometry]) for i in range(3))
     radial, norm = [], []
     for q in pupil_q:
         for mk in marks:
@@ -133,8 +129,17 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
                     rule[:, 0], rule[:, 1], rule[:, 2], levels)
     table0 = tracer0.film_side_table
     n_open, n_min = float(rule_rows[:, 1].max()), float(rule_rows[:, 2].max())
-    return FocusTable(lens, marks, step, np.array(film_z), np.array(vz), np.array(radial), None, None, np.array(norm),
-                      table0, None, float(rule[0, 0]), n_open, n_min, float(near), float(loss), zoom=grid)
+    return FocusTable(lens, axis, film_z, slope, vz, np.array(radial), None, None, np.array(norm),
+                      table0, None, float(rule[0, 0]), n_open, n_min, axis.near_mm, float(loss), zoom=grid)
+
+
+def zoom_focus_axis(geometry_prescriptions: list[Prescription], n_focus: int = N_FOCUS_ZOOM) -> FocusAxis:
+    """The focus axis (:class:`~physcam.export.blender_focus.FocusAxis`) a zoom lens's tables share: down to
+    the farthest closest focus of the plain prescriptions at the geometry's zoom positions."""
+    from ..optics.focusing import closest_focus
+    from .blender_focus import focus_axis
+
+    return focus_axis(max(closest_focus(q) for q in geometry_prescriptions), n_focus)
 
 
 def rows_to_geometry(values, n_focus: int) -> np.ndarray:
