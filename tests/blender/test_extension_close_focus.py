@@ -7,7 +7,6 @@ and the spot came out 3.4 px."""
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
