@@ -319,7 +319,7 @@ def sample_render_camera(geom, spec: CameraSpec, report, meters_per_unit: float,
     geom.GetHorizontalApertureAttr().Set(values["horizontalAperture"], time)
     geom.GetVerticalApertureAttr().Set(values["verticalAperture"], time)
     geom.GetFStopAttr().Set(values["fStop"], time)
-    geom.GetExposureFStopAttr().Set(spec.fstop / math.sqrt(spec.transmittance), time)  # the T-stop, as authored
+    geom.GetExposureFStopAttr().Set(spec.t_stop, time)  # the T-stop, as authored
     geom.GetFocusDistanceAttr().Set(values["focusDistance"], time)
     translate = UsdGeom.Xformable(geom.GetPrim()).GetOrderedXformOps()[0]
     translate.Set(Gf.Vec3d(0.0, 0.0, -mm_to_scene_units(eye, meters_per_unit)), time)
@@ -433,7 +433,7 @@ def author_render_camera(stage, cam_path, spec: CameraSpec, *, report=None, lens
     geom.CreateShutterOpenAttr(values["shutter:open"])
     geom.CreateShutterCloseAttr(values["shutter:close"])
     geom.CreateExposureTimeAttr(spec.shutter_duration_s)
-    geom.CreateExposureFStopAttr(spec.fstop / math.sqrt(spec.transmittance))  # photometric: the T-stop
+    geom.CreateExposureFStopAttr(spec.t_stop)  # photometric: the T-stop
     geom.CreateExposureIsoAttr(spec.iso)
     prim = geom.GetPrim()
     # the defocus blur's aspect in the desqueezed picture (hdPrman reads ri:dofaspect off the camera)

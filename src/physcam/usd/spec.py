@@ -8,6 +8,7 @@ imports the other for it.
 from __future__ import annotations
 
 import dataclasses
+import math
 import warnings
 from dataclasses import dataclass, fields
 
@@ -172,6 +173,12 @@ class CameraSpec:
     def fstop(self) -> float:
         """The iris's setting (at infinity focus): the camera's."""
         return self.camera.fstop
+
+    @property
+    def t_stop(self) -> float:
+        """The photometric stop the companion camera's ``exposure:fStop`` carries: the f-stop over the square
+        root of the lens's ``transmittance`` (T = N / sqrt(tau), as the T-stop is defined)."""
+        return self.fstop / math.sqrt(self.transmittance)
 
     @property
     def focus_mm(self) -> float:
