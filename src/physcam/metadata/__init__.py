@@ -75,27 +75,20 @@ def detect_file(path) -> tuple[str, str]:
                         "VENICE, Canon, Blackmagic ExtractMetadata or Mo-Sys F4 file", p, 1)
 
 
-#: per-frame CSV layouts: (what, columns only that layout has, the column groups it needs: one of each group;
-#: a name ending in "(" is a prefix, as VENICE's "Focus Distance (ft)")
-_LAYOUTS = (("an ARRI Meta Extract CSV", ("Master TC", "Lens Linear Iris", "Camera Clip Name"),
-             (("Master TC",), ("Lens Focus Distance", "Lens Focal Length", "Lens Iris"))),
-            ("a REDline frames CSV", ("FrameNo",), (("FrameNo",), ("Focus Distance",))),
-            ("a Canon per-frame CSV", ("FocusPosition", "ApertureNumber"), (("FocusPosition",), ("ApertureNumber",))),
-            ("a Sony VENICE per-frame CSV", ("Focal Length (mm)", "Camera Tilt", "Camera Roll"),
-             (("Timecode",), ("Focus Distance (",), ("Aperture",))))
-
-
 def _missing_columns(first_line: str) -> str | None:
-    """What a header that has a layout's own columns but not all it needs lacks, in words; else None."""
-    from ._text import header_columns
+    """What a header that has a per-frame CSV layout's own columns (its reader's ``LAYOUT_MARKERS``) but not
+    all it needs (``LAYOUT_GROUPS``, one of each group) lacks, in words; else None."""
+    from . import arri, canon, red, venice
+    from ._text import header_columns, lacking_columns
 
+    layouts = (("an ARRI Meta Extract CSV", arri), ("a REDline frames CSV", red), ("a Canon per-frame CSV", canon),
+               ("a Sony VENICE per-frame CSV", venice))
     for delimiter in ("\t", ","):
         cols = set(header_columns(first_line, delimiter))
-        has = lambda name: name in cols or (name.endswith("(") and any(c.startswith(name) for c in cols))  # noqa: E731
-        for what, markers, groups in _LAYOUTS:
-            if any(has(m) for m in markers):
+        for what, reader in layouts:
+            if any(m in cols for m in reader.LAYOUT_MARKERS):
                 lacking = [" or ".join(repr(n + ("...)" if n.endswith("(") else "")) for n in g)
-                           for g in groups if not any(has(n) for n in g)]
+                           for g in lacking_columns(cols, reader.LAYOUT_GROUPS)]
                 if lacking:
                     return f"the header looks like {what} but has no {', no '.join(lacking)} column"
     return None

@@ -134,6 +134,15 @@ def header_columns(first_line: str, delimiter: str = ",") -> list[str]:
         return []
 
 
+def lacking_columns(cols, groups) -> list[tuple[str, ...]]:
+    """The groups of ``groups`` (each a tuple of column names, one of which a layout needs) that none of
+    ``cols`` satisfies; a name ending in "(" is a prefix (VENICE's "Focus Distance (ft)")."""
+    def has(name):
+        return name in cols or (name.endswith("(") and any(c.startswith(name) for c in cols))
+
+    return [g for g in groups if not any(has(n) for n in g)]
+
+
 def require_columns(path, header, columns, what: str) -> None:
     missing = [c for c in columns if c not in header]
     if missing:

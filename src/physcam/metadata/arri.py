@@ -26,7 +26,7 @@ import re
 from fractions import Fraction
 
 from ..errors import MetadataError, require_type
-from ._text import FOOT_MM, header_columns, number, require_columns, rows, stop_from_marking, timecode
+from ._text import FOOT_MM, header_columns, lacking_columns, number, require_columns, rows, stop_from_marking, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -38,11 +38,16 @@ ACTIVE_AREA_MM = {("ALEXALF", 1920, 1080): (31.68, 17.82), ("ALEXALF", 3840, 216
 _FT_IN = re.compile(r"""^\s*(\d+(?:\.\d+)?)\s*'\s*(?:(\d+(?:\.\d+)?)\s*"?)?\s*$""")
 
 
+#: The columns an AME header needs (one of each group; :func:`physcam.metadata.detect_file` names what lacks),
+#: and columns only this layout has
+LAYOUT_GROUPS = (("Master TC",), ("Lens Focus Distance", "Lens Focal Length", "Lens Iris"))
+LAYOUT_MARKERS = ("Master TC", "Lens Linear Iris", "Camera Clip Name")
+
+
 def sniff(head: str) -> bool:
     """True when ``head`` (the file's first line) is an AME header."""
     require_type("head", head, str, "the first bytes of a metadata file")
-    cols = header_columns(head, "\t")
-    return "Master TC" in cols and any(c in cols for c in ("Lens Focus Distance", "Lens Focal Length", "Lens Iris"))
+    return not lacking_columns(header_columns(head, "\t"), LAYOUT_GROUPS)
 
 
 def _focus_mm(path, line, unit, text):

@@ -21,7 +21,7 @@ from __future__ import annotations
 import struct
 
 from ..errors import MetadataError, require_type
-from ._text import header_columns, number, require_columns, rows, single_row, timecode
+from ._text import header_columns, lacking_columns, number, require_columns, rows, single_row, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -31,10 +31,15 @@ STATIC_COLUMNS = ("LensSqueezeFactor", "Timescale", "Duration")
 SQUEEZE = {0: 1.0, 1: 1.33, 2: 2.0, 3: 1.8}
 
 
+#: The columns a Canon per-frame header needs (one of each group), and columns only this layout has
+LAYOUT_GROUPS = (("FocusPosition",), ("ApertureNumber",))
+LAYOUT_MARKERS = ("FocusPosition", "ApertureNumber")
+
+
 def sniff(head: str) -> str | None:
     require_type("head", head, str, "the first bytes of a metadata file")
     cols = header_columns(head)
-    if "FocusPosition" in cols and "ApertureNumber" in cols:
+    if not lacking_columns(cols, LAYOUT_GROUPS):
         return "frames"
     if "LensSqueezeFactor" in cols and "Timescale" in cols:
         return "static"

@@ -20,7 +20,7 @@ from fractions import Fraction
 
 from ..errors import MetadataError, require_type
 from . import cooke
-from ._text import header_columns, number, require_columns, rows, single_row, timecode
+from ._text import header_columns, lacking_columns, number, require_columns, rows, single_row, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -32,11 +32,16 @@ PITCH_UM = {"MONSTRO 8K VV": 5.0, "HELIUM 8K S35": 3.65, "GEMINI 5K S35": 6.0, "
             "RAPTOR 8K VV": 5.0, "DRAGON": 5.0}
 
 
+#: The columns a REDline frames header needs (one of each group), and columns only this layout has
+LAYOUT_GROUPS = (("FrameNo",), ("Focus Distance",))
+LAYOUT_MARKERS = ("FrameNo",)
+
+
 def sniff(head: str) -> str | None:
     """"frames" or "static" when ``head`` is a REDline header, else None."""
     require_type("head", head, str, "the first bytes of a metadata file")
     cols = header_columns(head)
-    if "FrameNo" in cols and "Focus Distance" in cols:
+    if not lacking_columns(cols, LAYOUT_GROUPS):
         return "frames"
     if "Camera PIN" in cols and "Sensor Name" in cols:
         return "static"

@@ -19,7 +19,7 @@ import xml.etree.ElementTree as ET
 from fractions import Fraction
 
 from ..errors import MetadataError, require_type
-from ._text import FOOT_MM, header_columns, number, read_text, rows, stop_from_marking, timecode
+from ._text import FOOT_MM, header_columns, lacking_columns, number, read_text, rows, stop_from_marking, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -28,13 +28,18 @@ NS = {"nrt": "urn:schemas-professionalDisc:nonRealTimeMeta:ver.2.10"}
 COLUMNS = ("Timecode", "Focal Length (mm)", "Aperture")
 
 
+#: The columns a VENICE per-frame CSV header needs (one of each group; "Focus Distance (" a prefix: its unit
+#: follows), and columns only this layout has
+LAYOUT_GROUPS = (("Timecode",), ("Focus Distance (",), ("Aperture",))
+LAYOUT_MARKERS = ("Focal Length (mm)", "Camera Tilt", "Camera Roll")
+
+
 def sniff(head: str) -> str | None:
     """"csv" or "xml" when ``head`` (the first 2 kB) is a VENICE export, else None."""
     require_type("head", head, str, "the first bytes of a metadata file")
     if "NonRealTimeMeta" in head:
         return "xml"
-    cols = header_columns(head.splitlines()[0] if head else "")
-    if "Timecode" in cols and "Aperture" in cols and any(c.startswith("Focus Distance (") for c in cols):
+    if not lacking_columns(header_columns(head.splitlines()[0] if head else ""), LAYOUT_GROUPS):
         return "csv"
     return None
 
