@@ -118,3 +118,29 @@ def test_the_blend_is_exact_for_quadratics_and_the_hermite_for_cubics(x, c, n):
     h = hermite_basis(t)
     got = h[0] * cubic[k0] + h[1] * slope[k0] + h[2] * cubic[k0 + 1] + h[3] * slope[k0 + 1]
     assert got == pytest.approx(c[0] + c[1] * x + c[2] * x * x + c[3] * x ** 3, abs=1e-8)
+
+
+def _addon_function(name):
+    """A function of the add-on's template (it runs inside Blender, without physcam), compiled alone."""
+    import ast
+    from importlib import resources
+
+    src = resources.files("physcam.export").joinpath("blender_addon.py.in").read_text(encoding="utf-8")
+    (node,) = [n for n in ast.parse(src).body if isinstance(n, ast.FunctionDef) and n.name == name]
+    scope = {"math": math}
+    exec(compile(ast.Module([node], type_ignores=[]), "blender_addon.py.in", "exec"), scope)
+    return scope[name]
+
+
+@settings(max_examples=60)
+@given(closest=st.floats(100.0, 5000.0), n=st.integers(3, 40), s=st.floats(0.0, 1.0))
+def test_the_addons_focus_taps_are_blend_weights(closest, n, s):
+    """The panel's report rows (the add-on's _focus_taps, a copy of the shader's blend for Blender's Python)
+    take the states and weights physcam's blend_weights gives at the same mark (s = sqrt(1 - C / D))."""
+    ax = focus_axis(closest, n)
+    focus_mm = closest / max(1.0 - s * s, 1e-12)
+    data = {"focus_axis": {"closest_m": ax.closest_mm / 1000.0, "s_near": ax.s_near}}
+    _, _, taps, w = blend_weights(ax.index(focus_mm), n)
+    got = _addon_function("_focus_taps")(data, focus_mm / 1000.0, n)
+    assert [k for k, _ in got] == taps
+    assert [x for _, x in got] == pytest.approx(w, abs=1e-9)
