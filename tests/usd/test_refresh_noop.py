@@ -54,6 +54,10 @@ def test_a_stale_refresh_rewrites_only_what_changed_and_says_what(tmp_path, caps
     capsys.readouterr()
     assert main(["usd", "refresh", str(cam), "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
+    after = cam.read_text().splitlines()
+    differ = [b for a, b in zip(edited, after) if a != b]
+    assert len(after) == len(edited) and len(differ) == 4, differ  # (before: 10, shutter:close among them)
+    assert sum("companionInputs" in line for line in differ) == 1
     assert doc["written"] is True and doc["stale"] is False
     got = {c["attribute"]: c["after"] for c in doc["changed"]}
     assert set(got) == {"/Cameras/Camera.lens:main:iris", "/Cameras/Camera/Camera.exposure:fStop",
@@ -62,10 +66,6 @@ def test_a_stale_refresh_rewrites_only_what_changed_and_says_what(tmp_path, caps
     assert got["/Cameras/Camera/Camera.exposure:fStop"] == pytest.approx(4.0, rel=1e-7)
     assert got["/Cameras/Camera/Camera.fStop"] == pytest.approx(4.0 * image_distance_at_mark(50.0, 3000.0) / 50.0,
                                                                  rel=1e-6)
-    after = cam.read_text().splitlines()
-    differ = [b for a, b in zip(edited, after) if a != b]
-    assert len(after) == len(edited) and len(differ) == 4, differ
-    assert sum("companionInputs" in line for line in differ) == 1
     assert not validation_errors(open_stage(cam))
     assert main(["usd", "refresh", str(cam)]) == 0  # now current: a second refresh is a no-op
     assert "not rewritten" in capsys.readouterr().out and cam.read_text().splitlines() == after
