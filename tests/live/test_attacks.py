@@ -550,3 +550,22 @@ def test_two_claimants_in_the_window_are_both_handed_on():
         (good[0]["sampleId"], 0, False), (good[1]["sampleId"], 1, False), (forged["sampleId"], 2, False),
         (good[2]["sampleId"], 2, True), (good[3]["sampleId"], 3, False), (good[4]["sampleId"], 4, False)], c
     assert c["conflict"] == 1 and c["duplicate"] == 1 and c["late"] == 0
+
+
+def test_a_flood_of_forged_copies_of_one_number_is_counted_and_bounded():
+    """Ten different valid copies of sample 2 after the real one: all ten counted `conflict`, the first four
+    handed on flagged (a bound per number, like the window's), the real stream whole and nothing `late`."""
+    good = _samples(5)
+    copies = []
+    for k in range(10):
+        f = _forged(good[2], frames_ahead=k + 1)
+        f["sampleId"] = f"urn:uuid:f0f0f0f0-0000-4000-8000-0000000000{k:02d}"
+        copies.append(("tx", _datagrams(f, 2)))
+    order = [("tx", _datagrams(good[i], i)) for i in (0, 1, 2)] + copies + [("tx", _datagrams(good[i], i)) for i in (3, 4)]
+    with Receiver(0, host="127.0.0.1", reorder_timeout_s=5.0) as rx:
+        got = _stream(rx, order)
+        _drain(rx, got, 9, timeout=1.0)
+        c = rx.counters()
+    assert [i.sample["sampleId"] for i in got if not i.conflict] == [s["sampleId"] for s in good], c
+    assert [i.sample["sampleId"][-2:] for i in got if i.conflict] == ["00", "01", "02", "03"]
+    assert c["conflict"] == 10 and c["late"] == 0 and c["delivered"] == 5

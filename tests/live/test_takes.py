@@ -653,3 +653,27 @@ def test_live_recover_judges_a_journals_claimants_as_the_recorder_does(tmp_path,
     doc = json.loads(capsys.readouterr().out)
     assert doc["frames"] == 5 and [c["kept"] for c in doc["conflicts"]] == [good[2]["sampleId"]]
     assert _timecodes(tmp_path / "take.usda") == [f"00:00:00:0{i}" for i in range(5)]
+
+
+@pytest.mark.parametrize("rival_frame, rival_timecode, kept, why", [
+    (11, "00:00:00:19", 0, "the only one"),  # the review's forgery: the timestamp copied, the timecode 8 ahead
+    (12, "00:00:00:11", 0, "the only one"),  # a timestamp a frame late gives it away alone
+    (11, "00:00:00:11", None, "more than one"),  # the same clocks (other lens values): no telling them apart
+    (None, "00:00:00:11", None, "more than one"),  # no timestamp, the same timecode
+    (10, "00:00:00:10", None, "none agrees"),  # and the "real" one stamped frame 9 (below): neither fits
+])
+def test_judge_claimants_keeps_the_one_its_neighbours_clocks_agree_with(rival_frame, rival_timecode, kept, why):
+    """At 24 fps, packets 10 and 12 are frames 10 and 12 (00:00:00:10, :12) by both clocks; packet 11 is
+    claimed by the real frame 11 and a rival. A clock counts where both frames carry it: frames apart must
+    be packets apart. (Worked by hand.)"""
+    from physcam.live.take import judge_claimants
+
+    at = lambda frame, tc: TrackedFrame(time_ns=None if frame is None else T0_NS + frame * 10**9 // 24,  # noqa: E731
+                                        timecode=tc, rate=Fraction(24))
+    real, rival = at(11, "00:00:00:11"), at(rival_frame, rival_timecode)
+    if kept is None and why == "none agrees":
+        real = at(9, "00:00:00:09")  # a real frame that the neighbours do not vouch for either
+    neighbours = [(at(10, "00:00:00:10"), 10), (at(12, "00:00:00:12"), 12)]
+    assert judge_claimants([(real, 11), (rival, 11)], neighbours)[0] == kept
+    assert why in judge_claimants([(real, 11), (rival, 11)], neighbours)[1]
+    assert judge_claimants([(real, 11), (rival, 11)], []) == (None, "no undisputed neighbour to judge by")

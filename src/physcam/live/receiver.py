@@ -404,8 +404,9 @@ class Receiver:
             if item is not None and not counted:
                 if self._rival(st, ext, item):
                     self._count("conflict")
-                    st.handed[ext] += (_digest(item),)
-                    self._hand_on(item, ext, conflict=True)
+                    if len(st.handed[ext]) <= MAX_RIVALS:  # more are counted, not handed on (bounded)
+                        st.handed[ext] += (_digest(item),)
+                        self._hand_on(item, ext, conflict=True)
                 elif ext < st.next and _digest(item) in st.handed.get(ext, ()):
                     self._count("duplicate")  # a sample handed on already, in another encoding
                 else:

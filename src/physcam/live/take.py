@@ -201,13 +201,12 @@ class Take:
         if key is None:
             return []
         src = self._sources[key]
-        left_out = {i for i, c in self._judged(src) if c["kept"] is None}
-        kept = {i: c["kept_index"] for i, c in self._judged(src) if c["kept"] is not None}
+        kept = {i: c["kept_index"] for i, c in self._judged(src)}  # None: neither claimant
         out = []
         for i, f in enumerate(src.frames):
-            if i in left_out:
-                continue
-            out.append(f if kept.get(i, 0) == 0 else src.rivals[i][kept[i] - 1][0])
+            k = kept.get(i, 0)
+            if k is not None:
+                out.append(f if k == 0 else src.rivals[i][k - 1][0])
         return out
 
     def conflicts(self) -> list[dict]:
