@@ -398,9 +398,10 @@ def refresh_shot(file, path: str | None = None) -> dict:
         if len(cams) != 1:
             raise ExportError(f"{file}: found {len(cams)} PhysicalCamera prims; name the one to refresh")
         path = cams[0]
-    now = check_shot(file, path)
-    if not now["stale"]:
-        return dict(now, written=False, changed=[])
+    if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):  # else there is no companion yet: write it
+        now = check_shot(file, path)
+        if not now["stale"]:
+            return dict(now, written=False, changed=[])
     layer = stage.GetRootLayer()
     before = _authored_values(layer, path)
     _author_shot_companion(stage, path)
