@@ -69,3 +69,20 @@ def test_a_stale_refresh_rewrites_only_what_changed_and_says_what(tmp_path, caps
     assert not validation_errors(open_stage(cam))
     assert main(["usd", "refresh", str(cam)]) == 0  # now current: a second refresh is a no-op
     assert "not rewritten" in capsys.readouterr().out and cam.read_text().splitlines() == after
+
+
+def test_a_camera_without_a_companion_gets_one(tmp_path, capsys):
+    """Refresh still writes a companion a file lacks (the no-op rule reads an existing one's inputs hash)."""
+    cam = tmp_path / "cam.usda"
+    assert main(["usd", "write", str(cam), *WRITES["thin 50 mm, ALEXA 35"]]) == 0
+    stage = Usd.Stage.Open(str(cam))
+    stage.RemovePrim("/Cameras/Camera/Camera")
+    stage.GetRootLayer().Save()
+    capsys.readouterr()
+    assert main(["usd", "refresh", str(cam), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    added = {c["attribute"]: c["after"] for c in doc["changed"] if c["before"] is None}
+    assert doc["written"] is True and doc["stale"] is False
+    assert added["/Cameras/Camera/Camera.focalLength"] == pytest.approx(image_distance_at_mark(50.0, 3000.0), rel=3e-6)
+    assert main(["usd", "check", str(cam)]) == 0
+    assert not validation_errors(open_stage(cam))
