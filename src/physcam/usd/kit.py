@@ -455,7 +455,8 @@ def _same_value(a, b) -> bool:
 def _same_view(old: dict, new: dict, geom: str) -> bool:
     """Whether the companion's (focalLength, horizontalAperture, verticalAperture) before and after give
     one field of view: the aperture / focal length ratios equal at float32 precision and the focal
-    lengths within 48 float32 steps (each pick of fov_preserving_float32 lies within 24 of the exact one)."""
+    lengths within 49 float32 steps (each pick of fov_preserving_float32 lies within 24 of its exact
+    focal length, and the two exact ones, a double and its float32 read back, within one)."""
     import numpy as np
 
     names = [f"{geom}.{n}" for n in ("focalLength", "horizontalAperture", "verticalAperture")]
@@ -465,7 +466,7 @@ def _same_view(old: dict, new: dict, geom: str) -> bool:
     if min(f0, f1) <= 0.0:
         return False
     steps = abs(f0 - f1) / float(np.spacing(np.float32(max(f0, f1))))
-    return steps <= 48 and _same_value([w0 / f0, h0 / f0], [w1 / f1, h1 / f1])
+    return steps <= 49 and _same_value([w0 / f0, h0 / f0], [w1 / f1, h1 / f1])
 
 
 def _keep_equal_values(layer, before: dict, after: dict, path) -> list[dict]:
