@@ -22,10 +22,12 @@ nearest frames before and after it, on each clock both carry (``sampleTimestamp`
 the timecode), lie exactly as many frames away as their packet numbers say. A claimant that any clock
 contradicts is left out; when not exactly one claimant agrees (both do: a copy with the same clocks;
 none does; no neighbour or clock to judge by), the take keeps **neither** and the frame is absent
-(counted in ``missing``). Each conflict is named (:meth:`Take.conflicts`), never counted as late. A sample physcam cannot read as a frame (a transform chain with
-no orientation, a distance beyond millimetres) is refused with its reason and counted; the first
-:data:`MAX_REFUSALS_KEPT` reasons are kept. Bounded: at most ``max_frames`` frames in all, and
-:data:`MAX_SOURCES_NAMED` sources by name (the samples of further ones are counted together).
+(counted in ``missing``). Each conflict is named (:meth:`Take.conflicts`), never counted as late.
+
+A sample physcam cannot read as a frame (a transform chain with no orientation, a distance beyond
+millimetres) is refused with its reason and counted; the first :data:`MAX_REFUSALS_KEPT` reasons
+are kept. Bounded: at most ``max_frames`` frames in all (and :data:`MAX_CLAIMANTS` rivals of each),
+and :data:`MAX_SOURCES_NAMED` sources by name (the samples of further ones are counted together).
 """
 
 from __future__ import annotations
@@ -130,7 +132,6 @@ class Take:
         self.held = 0
         self.refused = 0
         self.refusals: list[str] = []
-        self.claimants = 0  # samples that claimed a number another sample of their source held
 
     @property
     def full(self) -> bool:
@@ -165,7 +166,6 @@ class Take:
                 self.refusals.append(f"sample {number}: {exc}")
             return None
         if held_at is not None:  # a rival claimant: judged against its neighbours when the take is read
-            self.claimants += 1
             rivals = src.rivals.setdefault(held_at, [])
             if len(rivals) < MAX_CLAIMANTS:
                 rivals.append((frame, sample.get("sampleId")))
