@@ -125,3 +125,28 @@ def test_an_edited_sensor_refits_the_distortion(written, tmp_path, capsys):
     assert _value(cam, GEOM, "verticalAperture") / focal == pytest.approx(24.0 / pinhole, rel=1e-6)
     before, after = changed[f"{GEOM}.lensDistortion:k1"]
     assert after < before < 0.0  # barrel distortion, more of it towards the corners of a larger frame
+
+
+def test_a_zoom_camera_carries_and_fits_the_lens_at_its_zoom(tmp_path, capsys):
+    """`usd write --zoom 135mm` keeps the lens at 135 mm (its EFL, from the paraxial solve of the zoom at that
+    position) and fits the distortion there; before, it fitted the zoom's first position (70 mm: k1 0.00086 for
+    0.0115 at 135 mm). A refresh of the current camera changes nothing."""
+    from physcam.lens.zoom import prescription_at
+    from physcam.optics.zoom import zoom_encoder
+    from physcam.usd.read import composed_prescription
+
+    cam = tmp_path / "zoom.usda"
+    args = ["--lens", "nikon_af_s_70_200mm_f2_8e_zoom", "--zoom", "135mm", "--fstop", "4", "--focus", "5m",
+            "--sensor", "ALEXA 35"]
+    assert main(["usd", "write", str(cam), *args]) == 0
+    zoom = load_lens("nikon_af_s_70_200mm_f2_8e_zoom")
+    at = prescription_at(zoom, zoom_encoder(zoom, "135mm"))
+    stage = open_stage(cam)
+    assert gaussian(composed_prescription(stage, CAM)).efl == pytest.approx(135.0, rel=1e-6)
+    from physcam.usd.kit import prescription_distortion
+
+    fit = prescription_distortion(at, 27.99, 19.22, focus_mm=5000.0).coefficients["k1"]
+    assert _value(cam, GEOM, "lensDistortion:k1") == pytest.approx(fit, rel=1e-5)
+    written = cam.read_bytes()
+    capsys.readouterr()
+    assert main(["usd", "refresh", str(cam)]) == 0 and cam.read_bytes() == written
