@@ -70,6 +70,14 @@ US_4310222 = [
     (55.637, 0.846, None, None), (-55.153, 1.0, 1.84666, 23.9), (27.603, 4.24, 1.48749, 70.1),
     (-15.512, 0.15, None, None), (111.951, 3.41, 1.60311, 60.7), (-32.396, None, None, None),
 ]
+#: The fourth embodiment: the table of column 13 (R3 non-spherical); the stop sits in D10.
+US_4310222_EX4 = [
+    (36.562, 2.5, 1.6968, 55.5), (18.877, 6.76, None, None), (36.009, 5.31, 1.60311, 60.7), (36.0, 0.16, None, None),
+    (26.936, 1.5, 1.6968, 55.7), (10.237, 7.52, None, None), (40.279, 12.62, 1.60342, 38.0), (-15.661, 1.116, None, None),
+    (-13.1, 1.0, 1.7725, 49.6), (-27.485, 1.7, None, None), (87.301, 5.967, 1.69895, 30.1),
+    (-16.511, 1.0, 1.59551, 39.2), (123.783, 1.788, None, None), (-56.858, 1.0, 1.92286, 21.3),
+    (27.983, 4.0, 1.48749, 70.1), (-15.574, 0.15, None, None), (1652.078, 2.65, 1.7725, 49.6), (-29.01, None, None, None),
+]
 #: The fifth embodiment: the table of column 15 (R3 non-spherical); the stop sits in D13. R6 is printed
 #: 3.3649; the patent's own h column, Petzval term and f need 8.3649 (the file's; tests below).
 US_4310222_R6_PRINTED = 3.3649
@@ -96,6 +104,15 @@ US_4310222_COLUMNS = {
         pt=(0.1322, -0.2300, 0.0943, -0.0910, 0.1806, -0.3735, 0.1818, -0.3804, 0.0289, -0.0387, 0.1280, 0.0867,
             0.3531, -0.4914, 0.2350, 0.0418, 0.0257, -0.0988, -0.1187, -0.6776, 0.3016, 0.0479, 0.1658),
         pt_total=0.1138, groups=((1, 8, -1.06), (9, 15, 2.67), (16, 23, 2.37)), f=14.2, bf=36.6),
+    "canon_wide_angle_us4310222_17mm_f2_8": dict(
+        asphere=(2.530e-5, 1.505e-8, -2.012e-11, 2.102e-13),
+        h=(1.000, 0.972, 1.086, 1.081, 1.084, 1.074, 1.539, 1.844, 1.808, 1.849, 1.887, 1.913, 1.910, 1.918,
+           1.936, 2.113, 2.113, 2.110),
+        hbar=(-1.133, -1.016, -0.734, -0.555, -0.548, -0.496, -0.306, -0.072, -0.036, -0.019, 0.034, 0.142,
+              0.160, 0.215, 0.233, 0.334, 0.338, 0.379),
+        pt=(0.1948, -0.3773, 0.1812, -0.1812, 0.2644, -0.6958, 0.1620, 0.4168, -0.5770, 0.2750, 0.0817, 0.0400,
+            -0.0523, -0.1464, -0.0943, 0.3650, 0.0045, 0.2605),
+        pt_total=0.1218, groups=((1, 6, -0.93), (7, 10, 2.46), (11, 18, 1.54)), f=17.34, bf=36.61),
     "canon_wide_angle_us4310222_5_5mm_f1_6": dict(
         asphere=(1.111e-4, -1.823e-7, -6.583e-11, 6.906e-12),
         h=(1.000, 0.981, 1.120, 1.162, 1.193, 1.189, 1.710, 1.789, 2.444, 2.574, 2.820, 2.738, 2.819, 2.857,
@@ -127,6 +144,8 @@ PRIMARY = {
     # The stated 14.2 is nominal: the patent's own h column gives f = bf / 2.563 = 14.280 (test below), which the
     # lens has (+0.56 %), so the EFL's tolerance is 0.6 % here and the design's f is checked at 0.1 % below
     "canon_wide_angle_us4310222_14mm_f2_8": (US_4310222, dict(efl=14.2, efl_rel=6e-3, fno=2.8, bf=36.6, bf_tol=0.05)),
+    # the same, fourth embodiment: "f = 17.34, bf = 36.61, F No. = 1:2.8, Angle of field = 104 deg"
+    "canon_wide_angle_us4310222_17mm_f2_8": (US_4310222_EX4, dict(efl=17.34, fno=2.8, bf=36.61, bf_tol=0.005)),
     # the same, fifth embodiment: "f = 5.52 ... bf = 17.2, F No. = 1:1.6, Angle of field = 99.8 deg". The printed
     # bf 17.2 is not this table's: its own h column ends at bf/f = 3.152, i.e. 17.40 (test below), as the
     # sixth embodiment's bf = 17.4 reads; the back focus is checked against 17.4
