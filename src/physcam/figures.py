@@ -92,10 +92,10 @@ def _lean_import() -> None:
     """Import matplotlib for the ``physcam`` program, skipping three things it never uses (issue 47,
     measured in docs/performance.md): the property tables matplotlib writes into the docstring of
     every artist class's ``set()`` as the class is made (``matplotlib.artist.kwdoc``: a third of
-    matplotlib's import, 0.15 s of CPU), the signature listing those properties (0.06 s), and its
-    3-D toolkit, which registering the ``3d`` projection imports with every figure. Only when matplotlib is not imported yet and
-    :data:`PROGRAM_IMPORT` (or :data:`physcam._program.RUNNING`) is set; a library caller's matplotlib is
-    left whole."""
+    matplotlib's import, 0.15 s of CPU), the signature listing those properties (0.04-0.06 s), and
+    its 3-D toolkit, which registering the ``3d`` projection imports with every figure. Only when
+    matplotlib is not imported yet and :data:`PROGRAM_IMPORT` (or :data:`physcam._program.RUNNING`) is
+    set; a library caller's matplotlib is left whole."""
     import sys
 
     from . import _program
