@@ -260,12 +260,21 @@ def _accumulate(lens, src, trace, extent, rays, pixels, chunk, fresnel, progress
     """Trace ``rays`` in chunks and bin their weights into a flat (pixels, pixels, channels) histogram
     over ``extent``; returns it and the count of rays that reached the film. ``head`` (the pilot's
     traced rays and channels, fewer than a chunk): the first rays, already traced (issue 47: the
-    pilot's 20 000 rays were traced twice); each ray's trace is its own, so the image is the same."""
+    pilot's 20 000 rays were traced twice); each ray's trace is its own, and its bin and weight go
+    into the first chunk's sum in the same order, so the image is the same."""
     from ...trace import trace_to_film
 
     x0, x1, y0, y1 = extent
     nch = src.k
     img = np.zeros(pixels * pixels * nch)
+
+    def bins(out, ch):
+        """The flat bins and weights of the rays of ``out`` that land in the image."""
+        ix = np.floor((out.x - x0) / (x1 - x0) * pixels).astype(np.int64)
+        iy = np.floor((out.y - y0) / (y1 - y0) * pixels).astype(np.int64)
+        inside = out.ok & (ix >= 0) & (ix < pixels) & (iy >= 0) & (iy < pixels)
+        return (iy[inside] * pixels + ix[inside]) * nch + ch[inside], out.weight[inside]
+
     passed = 0
     done = 0
     while done < rays:
@@ -273,16 +282,12 @@ def _accumulate(lens, src, trace, extent, rays, pixels, chunk, fresnel, progress
         k = 0 if head is None or done else head[1].size
         b, ch = src.batch(n - k, done + k)
         out = trace_to_film(lens, b, fresnel=fresnel, in_place=True, **trace)
-        ok, x, y, weight = out.ok, out.x, out.y, out.weight
+        flat, weight = bins(out, ch)
+        passed += int(out.ok.sum())
         if k:
-            ok, x, y, weight, ch = (np.concatenate(pair) for pair in zip(
-                (head[0].ok, head[0].x, head[0].y, head[0].weight, head[1]), (ok, x, y, weight, ch)))
-        ix = np.floor((x - x0) / (x1 - x0) * pixels).astype(np.int64)
-        iy = np.floor((y - y0) / (y1 - y0) * pixels).astype(np.int64)
-        inside = ok & (ix >= 0) & (ix < pixels) & (iy >= 0) & (iy < pixels)
-        flat = (iy[inside] * pixels + ix[inside]) * nch + ch[inside]
-        img += np.bincount(flat, weights=weight[inside], minlength=img.size)
-        passed += int(ok.sum())
+            (hf, hw), passed = bins(*head), passed + int(head[0].ok.sum())
+            flat, weight = np.concatenate((hf, flat)), np.concatenate((hw, weight))
+        img += np.bincount(flat, weights=weight, minlength=img.size)
         done += n
         if progress is not None:
             progress(done, rays)
