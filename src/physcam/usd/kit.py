@@ -324,7 +324,9 @@ def _author_model_focal_length(stage, cam, efl_mm: float) -> None:
     targets = cam.GetRelationship(f"lens:{LENS_INSTANCE}:lensModel").GetForwardedTargets()
     model = stage.GetPrimAtPath(targets[0]) if targets else None
     if model and model.GetTypeName() == "PhysicalCameraLensModelPinhole":
-        model.GetAttribute("focalLength").Set(float(efl_mm))
+        attr = model.GetAttribute("focalLength")
+        if not _same_value(attr.Get(), float(efl_mm)):  # no shot opinion where the lens file says it already
+            attr.Set(float(efl_mm))
 
 
 def _author_lens_derived(stage, cam, spec) -> None:
@@ -335,8 +337,10 @@ def _author_lens_derived(stage, cam, spec) -> None:
     lp = f"lens:{LENS_INSTANCE}:"
     values = {lp + "entrancePupilDistance": spec.entrance_pupil_mm, lp + "iris": spec.focal_length_mm / spec.fstop,
               lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze": spec.pinhole_squeeze,
-              lp + "horizontalEntrancePupilDistance": spec.horizontal_entrance_pupil_mm,
-              lp + "apertureDistance": spec.aperture_distance_mm}  # the stop moves with a unit-focusing lens
+              lp + "horizontalEntrancePupilDistance": spec.horizontal_entrance_pupil_mm}
+    stop = cam.GetAttribute(lp + "apertureDistance")  # the stop moves with a unit-focusing lens
+    if spec.aperture_distance_mm is not None and not (stop and _same_value(stop.Get(), spec.aperture_distance_mm)):
+        values[lp + "apertureDistance"] = spec.aperture_distance_mm
     if spec.principal_planes_mm is not None:
         values[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]
         values[lp + "rearPrincipalPlaneDistance"] = spec.principal_planes_mm[1]
