@@ -107,7 +107,7 @@ class _Init:
     first, keyword-only after, as dataclass orders them), their defaults and default factories, the
     fields set without a parameter, and whether ``__post_init__`` follows."""
 
-    __slots__ = ("fields", "every", "positional", "names", "defaults", "factories", "fixed", "post")
+    __slots__ = ("fields", "every", "positional", "names", "name_set", "defaults", "factories", "fixed", "post")
 
     def __init__(self, cls, fs):
         self.fields = fs
@@ -115,6 +115,7 @@ class _Init:
         params = [f for f in fs if f.init]
         self.positional = tuple(f.name for f in params if not f.kw_only)
         self.names = self.positional + tuple(f.name for f in params if f.kw_only)
+        self.name_set = frozenset(self.names)
         self.defaults = {f.name: f.default for f in params if f.default is not MISSING}
         self.factories = {f.name: f.default_factory for f in params if f.default_factory is not MISSING}
         self.fixed = tuple((f.name, f.default, f.default_factory) for f in fs if not f.init
@@ -123,7 +124,34 @@ class _Init:
 
 
 def _init(self, *args, **kwargs):
-    """dataclass's ``__init__`` for any record: the same parameters, defaults, errors and ``__post_init__``."""
+    """dataclass's ``__init__`` for any record: the same parameters, defaults, errors and ``__post_init__``.
+    Arguments that fit go straight in (a lens report builds eight records: issue 47); any that do not
+    go through :func:`_init_checked`, which says what is wrong as dataclass does."""
+    plan = type(self).__record_init__
+    if len(args) > len(plan.positional) or not plan.name_set.issuperset(kwargs):
+        return _init_checked(self, *args, **kwargs)
+    values = dict(zip(plan.positional, args)) if args else {}
+    if values and not values.keys().isdisjoint(kwargs):
+        return _init_checked(self, *args, **kwargs)
+    values.update(kwargs)
+    setter = object.__setattr__
+    for name in plan.names:
+        if name in values:
+            setter(self, name, values[name])
+        elif name in plan.defaults:
+            setter(self, name, plan.defaults[name])
+        elif name in plan.factories:
+            setter(self, name, plan.factories[name]())
+        else:
+            return _init_checked(self, *args, **kwargs)  # (a required argument missing: its TypeError)
+    for name, default, factory in plan.fixed:
+        setter(self, name, factory() if default is MISSING else default)
+    if plan.post:
+        self.__post_init__()
+
+
+def _init_checked(self, *args, **kwargs):
+    """:func:`_init` for arguments that may not fit, each checked in dataclass's order with its TypeError."""
     plan = type(self).__record_init__
     where = f"{type(self).__qualname__}.__init__()"
     if len(args) > len(plan.positional):

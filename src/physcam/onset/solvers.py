@@ -36,7 +36,7 @@ from ..optics.lens_model import LensAtMark, PrincipalPlanes
 from ..optics.state import HYPERFOCAL, CameraState
 from .inverse import hyperfocal_parameters, require_possible_f_number
 from .pupil import entrance_pupil_practical
-from .request import MeasuredLimits, References
+from .request import MeasuredLimits, References, ReportRequest
 
 from .._record import record, replace
 
@@ -63,8 +63,6 @@ def _typed(fn):
 
     @functools.wraps(fn)
     def checked(*args, **kwargs):
-        from .request import ReportRequest
-
         if args and isinstance(args[0], ReportRequest):
             args, kwargs = _old_form(fn, args, kwargs)
         for name, value in (*zip(names, args), *kwargs.items()):
