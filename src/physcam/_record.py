@@ -107,7 +107,8 @@ class _Init:
     first, keyword-only after, as dataclass orders them), their defaults and default factories, the
     fields set without a parameter, and whether ``__post_init__`` follows."""
 
-    __slots__ = ("fields", "every", "positional", "names", "name_set", "defaults", "factories", "fixed", "post")
+    __slots__ = ("fields", "every", "positional", "names", "name_set", "defaults", "factories", "fixed", "post",
+                 "cls", "direct")
 
     def __init__(self, cls, fs):
         self.fields = fs
@@ -121,6 +122,19 @@ class _Init:
         self.fixed = tuple((f.name, f.default, f.default_factory) for f in fs if not f.init
                            and (f.default is not MISSING or f.default_factory is not MISSING))
         self.post = hasattr(cls, "__post_init__")
+        self.cls, self.direct = cls, _fields_in_dict(cls, self.every)
+
+
+def _fields_in_dict(cls, names) -> bool:
+    """Whether an instance of ``cls`` keeps each field in its ``__dict__``: no class of it has
+    ``__slots__`` and no field's name is a descriptor that sets (``object.__setattr__`` would call it)."""
+    if any("__slots__" in k.__dict__ for k in cls.__mro__[:-1]):
+        return False
+    for name in names:
+        owner = next((k for k in cls.__mro__ if name in k.__dict__), None)
+        if owner is not None and hasattr(type(owner.__dict__[name]), "__set__"):
+            return False
+    return True
 
 
 def _init(self, *args, **kwargs):
@@ -134,18 +148,23 @@ def _init(self, *args, **kwargs):
     if values and not values.keys().isdisjoint(kwargs):
         return _init_checked(self, *args, **kwargs)
     values.update(kwargs)
-    setter = object.__setattr__
+    filled = []
     for name in plan.names:
         if name in values:
-            setter(self, name, values[name])
+            filled.append((name, values[name]))
         elif name in plan.defaults:
-            setter(self, name, plan.defaults[name])
+            filled.append((name, plan.defaults[name]))
         elif name in plan.factories:
-            setter(self, name, plan.factories[name]())
+            filled.append((name, plan.factories[name]()))
         else:
             return _init_checked(self, *args, **kwargs)  # (a required argument missing: its TypeError)
     for name, default, factory in plan.fixed:
-        setter(self, name, factory() if default is MISSING else default)
+        filled.append((name, factory() if default is MISSING else default))
+    if plan.direct and type(self) is plan.cls:
+        self.__dict__.update(filled)  # what object.__setattr__ does for these fields, in one call
+    else:
+        for name, value in filled:
+            object.__setattr__(self, name, value)
     if plan.post:
         self.__post_init__()
 
