@@ -367,6 +367,13 @@ def replace(obj, /, **changes):
         import dataclasses
 
         return dataclasses.replace(obj, **changes)
+    cls = type(obj)
+    if (plan.direct and cls is plan.cls and not plan.post and cls.__new__ is object.__new__
+            and len(plan.names) == len(plan.every) == len(obj.__dict__) and plan.name_set.issuperset(changes)):
+        new = object.__new__(cls)  # what cls(**every field) makes, without reading each back (issue 47)
+        new.__dict__.update(obj.__dict__)
+        new.__dict__.update(changes)
+        return new
     for f in plan.fields:
         if not f.init:
             if f.name in changes:
