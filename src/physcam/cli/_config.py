@@ -86,18 +86,16 @@ _CACHE: dict = {}
 
 
 def load_config() -> Config:
-    """The user config (cached per file and modification time)."""
+    """The user config (cached per file and modification time, and while there is none)."""
     path = config_path()
     try:
         st = None if path is None else os.stat(path)
     except (OSError, ValueError):
         st = None
-    if st is None or not stat.S_ISREG(st.st_mode):
-        return Config(path=path, exists=False)
-    key = (str(path), st.st_mtime_ns)
+    key = (path, None if st is None or not stat.S_ISREG(st.st_mode) else st.st_mtime_ns)
     if key not in _CACHE:
         _CACHE.clear()
-        _CACHE[key] = _read(path)
+        _CACHE[key] = Config(path=path, exists=False) if key[1] is None else _read(path)
     return _CACHE[key]
 
 
