@@ -140,3 +140,12 @@ def test_show_csv_rows_equal_json_rows(capsys):
     assert main(["metadata", "show", str(CANON[0]), "--csv"]) == 0
     out = capsys.readouterr().out.splitlines()
     assert out[0].startswith("frame,line,timecode,focus_mm,tstop") and len(out) == 2
+
+
+def test_a_clip_without_a_name_is_titled_without_a_gap(capsys):
+    """Canon's per-frame file alone names no clip: the report's title read "canon clip : a thin lens ..."
+    (round 8). Its static file names it A001C001 (its ShotNumber column)."""
+    assert main(["metadata", "report", str(CANON[0]), "--sensor", "S35"]) == 0
+    assert capsys.readouterr().out.startswith("canon clip: a thin lens of the recorded focal length")
+    assert main(["metadata", "report", *map(str, CANON), "--sensor", "S35"]) == 0
+    assert capsys.readouterr().out.startswith("canon clip A001C001: a thin lens")

@@ -114,6 +114,12 @@ def _load(args):
     return rec
 
 
+def _clip(rec) -> str:
+    """The clip as a title names it: arri clip B001C001, or canon clip when the files name none (not
+    "canon clip : ...")."""
+    return f"{rec.source} clip" + (f" {rec.clip_name}" if rec.clip_name else "")
+
+
 def _m(v, units):
     from ..units import format_distance
 
@@ -132,7 +138,7 @@ def run_show(args) -> int:
     if args.csv:
         print_csv(rows)
         return 0
-    t = Table(f"{rec.source} clip {rec.clip_name or ''}".rstrip(), ["value", "recorded"])
+    t = Table(_clip(rec), ["value", "recorded"])
     for k, v in static.items():
         if k not in ("frame_rate_exact",):
             t.add_row(k, "-" if v is None else (", ".join(map(str, v)) if isinstance(v, list) else v))
@@ -188,7 +194,7 @@ def run_report(args) -> int:
     u = units_of(args)
     what = f"lens {args.lens}" if lens is not None else "a thin lens of the recorded focal length"
     cols = ["frame", "timecode", "focus", "stop", "near", "far", "hyperfocal", "hfov_deg"]
-    t = Table(f"{rec.source} clip {rec.clip_name or ''}: {what}, sensor {s.width_mm:g} x {s.height_mm:g} mm", cols,
+    t = Table(f"{_clip(rec)}: {what}, sensor {s.width_mm:g} x {s.height_mm:g} mm", cols,
               justify=["right", "left"] + ["right"] * 6)
     for r in rows:
         t.add_row(r["frame"], r["timecode"] or "-", _m(r["focus_from_film_mm"], u), f"{r['fstop']:.3g}",
@@ -221,8 +227,7 @@ def run_usd(args) -> int:
     if args.json:
         emit_json(document("metadata_usd", summary))
     else:
-        print(f"wrote {out}: {len(solved)} frames of {rec.source} clip {rec.clip_name or ''}".rstrip()
-              + (f", plate {args.plate}" if args.plate else ""))
+        print(f"wrote {out}: {len(solved)} frames of {_clip(rec)}" + (f", plate {args.plate}" if args.plate else ""))
     return 0
 
 
