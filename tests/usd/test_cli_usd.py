@@ -338,3 +338,15 @@ def test_hyperfocal_focus_reads_back_with_an_infinite_far_limit(tmp_path, capsys
     assert main(["usd", "read", str(f), "--json"]) == 0
     dof = json.loads(capsys.readouterr().out)["report"]["dof"]
     assert dof["far_is_infinite"] is True and dof["far_from_film_mm"] is None
+
+
+def test_a_plain_camera_file_is_told_apart_from_a_physical_one(tmp_path, capsys):
+    """A matchmove artist's plain UsdGeomCamera file got "found 0 PhysicalCamera prims (none); name the
+    one to read": there was none to name (round 8). The answer names the plain cameras it holds."""
+    f = tmp_path / "plain.usda"
+    f.write_text('#usda 1.0\ndef Xform "cams" {\n    def Camera "shotcam" {\n    }\n}\n')
+    for verb in ("read", "check", "refresh"):
+        assert main(["usd", verb, str(f)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "name the one" not in err
+        assert f"no physical camera to {verb}" in err and "UsdGeomCamera prims (/cams/shotcam)" in err
