@@ -120,6 +120,30 @@ def _clip(rec) -> str:
     return f"{rec.source} clip" + (f" {rec.clip_name}" if rec.clip_name else "")
 
 
+def clip_notes(per_frame) -> list[str]:
+    """The notes of a clip's frames (one tuple a frame), one per kind: notes that differ only in their
+    numbers (the diffraction note's working f-number along a focus pull) are one note, the first such
+    frame's, saying on how many frames it came in how many versions (a 500-frame clip printed 21
+    diffraction notes)."""
+    import re
+
+    def kind(note: str) -> str:
+        return re.sub(r"\d+(?:\.\d+)?", "#", note)
+
+    first: dict[str, str] = {}
+    versions: dict[str, set] = {}
+    frames: dict[str, int] = {}
+    for notes in per_frame:
+        for k in {kind(n) for n in notes}:
+            frames[k] = frames.get(k, 0) + 1
+        for n in notes:
+            first.setdefault(kind(n), n)
+            versions.setdefault(kind(n), set()).add(n)
+    return sorted(n if len(versions[k]) == 1 else
+                  f"{n} (the first frame's: {len(versions[k])} versions of this note on {frames[k]} frames, "
+                  "their numbers vary)" for k, n in first.items())
+
+
 def _m(v, units):
     from ..units import format_distance
 
@@ -182,7 +206,7 @@ def run_report(args) -> int:
     solved, lens = _solve(args, rec)
     rows = lens_report_rows(solved)
     s = solved[0].report.sensor
-    notes = sorted({n for x in solved for n in x.report.notes})
+    notes = clip_notes([x.report.notes for x in solved])
     if args.json:
         emit_json(document("metadata_report", {
             "clip": rec.static_dict(), "lens": args.lens, "model": "prescription" if lens is not None else "thin lens",
