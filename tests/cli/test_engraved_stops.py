@@ -28,3 +28,13 @@ def test_a_word_that_is_no_stop_gets_no_hint(capsys):
     assert main([*BASE, "--fstop", "fast"]) == 2
     err = capsys.readouterr().err
     assert "must be a number, got 'fast'" in err and "write the number" not in err
+
+
+def test_a_t_stop_alone_says_how_to_give_the_f_stop(capsys, tmp_path):
+    """A matchmove artist's notes say T2.8 and no f-stop: `usd write --tstop 2.8` was told only to
+    "give the f-stop (--fstop) or a measured near/far limit" (round 8)."""
+    for argv in (["report", *BASE[1:]], ["usd", "write", str(tmp_path / "never.usda"), "--focal", "50", "--focus", "3m"]):
+        assert main([*argv, "--tstop", "2.8"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "a T-stop alone (--tstop 2.8)" in err and "--fstop 2.8 takes the T-stop" in err
+    assert not (tmp_path / "never.usda").exists()
