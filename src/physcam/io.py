@@ -95,7 +95,7 @@ def check_writable(path, *, force: bool = False) -> Path:
         return p
     _refuse_special(p)
     if p.exists() and not force:
-        raise ExportError(f"{p} already exists; pass --force (force=True) to overwrite it")
+        raise ExportError(f"{p} already exists; pass --force (in Python, force=True) to overwrite it")
     if p.exists() and p.is_dir():
         raise ExportError(f"{p} is a directory, not a file")
     return p
@@ -185,7 +185,7 @@ def _umask() -> int:
 
 
 def _exists_error(p: Path) -> ExportError:
-    return ExportError(f"{p} already exists; pass --force (force=True) to overwrite it")
+    return ExportError(f"{p} already exists; pass --force (in Python, force=True) to overwrite it")
 
 
 def _publish_new(tmp: str, p: Path) -> None:

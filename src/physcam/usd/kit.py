@@ -361,15 +361,15 @@ def check_shot(file, path: str | None = None) -> dict:
     """
     from pxr import Sdf, UsdGeom
 
-    from .read import find_cameras, open_stage
+    from .read import only_camera, open_stage
 
     stage = open_stage(file)
     stage.Reload()  # the referenced files as they are on disk now, not as this process cached them
     if path is None:
-        cams = find_cameras(stage)
-        if len(cams) != 1:
-            raise ExportError(f"{file}: found {len(cams)} PhysicalCamera prims; name the one to check")
-        path = cams[0]
+        try:
+            path = only_camera(stage, "check")
+        except ExportError as exc:
+            raise ExportError(f"{file}: {exc}") from None
     geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
     if not geom:
         raise ExportError(f"{path}: has no companion camera to check")
@@ -406,7 +406,7 @@ def refresh_shot(file, path: str | None = None) -> dict:
     """
     from pxr import Sdf, Usd
 
-    from .read import find_cameras
+    from .read import only_camera
 
     ensure_registered()
     from .read import open_stage
@@ -416,10 +416,10 @@ def refresh_shot(file, path: str | None = None) -> dict:
     stage = Usd.Stage.Open(layer)
     stage.Reload()  # the shot and its referenced files as they are on disk now
     if path is None:
-        cams = find_cameras(stage)
-        if len(cams) != 1:
-            raise ExportError(f"{file}: found {len(cams)} PhysicalCamera prims; name the one to refresh")
-        path = cams[0]
+        try:
+            path = only_camera(stage, "refresh")
+        except ExportError as exc:
+            raise ExportError(f"{file}: {exc}") from None
     if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):  # else there is no companion yet: write it
         now = check_shot(file, path)
         if not now["stale"]:
