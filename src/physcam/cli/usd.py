@@ -194,10 +194,9 @@ def run_write(args) -> int:
     distortion = opencv = None
     anamorphic = []
     if getattr(args, "lens", None) and not args.orthographic:  # a prescription-backed report: its real distortion
-        from ..lens.library import load_lens
         from ..usd.kit import prescription_anamorphic_distortion, prescription_distortion, prescription_opencv
 
-        lens = load_lens(args.lens, lenient=args.lenient)
+        lens = args.loaded_lens  # the lens the report solved (a zoom at --zoom)
         distortion = prescription_distortion(lens, report.sensor.width_mm, report.sensor.height_mm,
                                              focus_mm=report.focus_from_film_mm)
         opencv = prescription_opencv(lens, report.sensor.width_mm, report.sensor.height_mm,
@@ -210,7 +209,8 @@ def run_write(args) -> int:
     path = write_camera(args.file, spec, force=args.force, path=args.path, meters_per_unit=args.meters_per_unit,
                         fps=args.fps, report=report if not args.orthographic else None, lens_distortion=distortion,
                         opencv_distortion=opencv, resolution=args.resolution, overscan=args.overscan / 100.0,
-                        thin_lens_gap=gap and gap.to_dict(), anamorphic_distortion=anamorphic)
+                        thin_lens_gap=gap and gap.to_dict(), anamorphic_distortion=anamorphic,
+                        prescription=None if args.orthographic else getattr(args, "loaded_lens", None))
     if gap is not None and not getattr(args, "json", False):
         print(f"note: {gap.summary()}")
     return _done(args, path, extra={"thin_lens_gap": gap and gap.to_dict()})
