@@ -385,3 +385,38 @@ def test_the_fx6_and_fx3_have_only_their_makers_formats():
     for gone in ("FX6 S35 4K 17:9", "FX3 S35 4K 16:9 UHD", "VariCam LT 4K 17:9"):
         with pytest.raises(SensorError):
             find_sensor(gone)
+
+
+# --- a bare camera name the sensor table gives the full sensor says so (first-day review, round 8) -------------
+
+#: (the name an AC types, the camera and its full-sensor format as cameras.csv spells them)
+FULL_SENSOR_NAMES = [("ALEXA 35", "ALEXA 35", "4.6K 3:2 Open Gate"), ("ALEXA Mini", "ALEXA Mini", "3.4K Open Gate"),
+                     ("Mini LF", "ALEXA Mini LF", "4.5K LF 3:2 Open Gate"), ("VENICE 2", "VENICE 2 8K", "8.6K 3:2 FF")]
+
+
+@pytest.mark.parametrize("name, camera, fmt", FULL_SENSOR_NAMES)
+def test_a_bare_camera_name_says_which_format_it_is_and_how_to_name_another(name, camera, fmt):
+    import json
+
+    from physcam.cli import main
+
+    rows = [r for r in csv.DictReader(TABLE.read_text(encoding="utf-8").splitlines()) if r["camera"] == camera]
+    full = next(r for r in rows if r["format"] == fmt)
+    s = find_sensor(name)  # the old meaning is kept: the full sensor
+    assert (s.width_mm, s.height_mm) == (float(full["width_mm"]), float(full["height_mm"]))
+    import contextlib
+    import io
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert main(["report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--sensor", name, "--json"]) == 0
+    said = [n for n in json.loads(out.getvalue())["notes"] if name in n]
+    assert len(said) == 1 and fmt in said[0] and f"{len(rows)} formats" in said[0], said
+    assert f"{camera} {rows[1]['format']}" in said[0]  # how to name another: a name find_sensor takes
+    assert find_sensor(f"{camera} {rows[1]['format']}").fmt == rows[1]["format"]
+
+
+def test_a_format_or_gate_name_carries_no_camera_note():
+    from physcam.optics.sensors import camera_name_note
+
+    assert [camera_name_note(n) for n in ("S35", "ALEXA 35 4.6K 16:9", "LF Open Gate", "alexa35-og")] == [""] * 4

@@ -384,7 +384,7 @@ def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):
     :data:`DEFAULT_SENSOR`), which a note on stderr names (unless ``quiet``: the command says it
     itself). Sets ``args.sensor_defaulted``."""
     from ..errors import InputError
-    from ..optics.sensors import custom_sensor, find_sensor
+    from ..optics.sensors import camera_name_note, custom_sensor, find_sensor
 
     name = getattr(args, "sensor", None)
     sw, sh = getattr(args, "sensor_width", None), getattr(args, "sensor_height", None)
@@ -394,7 +394,13 @@ def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):
     if args is not None:
         args.sensor_defaulted = False
     if name is not None:
-        return find_sensor(name)
+        s = find_sensor(name)
+        said = camera_name_note(name)  # a bare camera name ("ALEXA 35") is its full sensor: say so
+        if args is not None:
+            args.sensor_note = said
+        if said and not quiet:
+            note(said)
+        return s
     if custom:
         if sw is None or sh is None:
             raise InputError("give both --sensor-width and --sensor-height")

@@ -13,7 +13,9 @@ The camera table ``physcam/data/cameras.csv`` adds every recording format of cur
 cameras (camera -> formats): each row a :class:`Sensor` named "maker camera format" (also found
 without the maker: "FX6 FF 4K 17:9"), with its source, the date it was read and how the size was had
 (stated by the maker, or photosites x the maker's pitch), and whose figure it is (``maker_spec``). A camera's name alone ("FX6") is refused
-with its formats listed: DOF and field of view depend on the crop.
+with its formats listed: DOF and field of view depend on the crop. The few camera names the sensor table
+has long given to a camera's full sensor ("ALEXA 35", "ALEXA Mini", "Mini LF", "VENICE 2", "V-RAPTOR")
+keep that meaning, and :func:`camera_name_note` says which format that is and how to choose another.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from pathlib import Path
 from .._record import record
 from ..errors import SensorError
 
-__all__ = ["Sensor", "sensors", "cameras", "camera_formats", "find_sensor", "filter_sensors", "custom_sensor", "SENSOR_SIZE_RANGE_MM",
+__all__ = ["Sensor", "sensors", "cameras", "camera_formats", "find_sensor", "camera_name_note", "filter_sensors", "custom_sensor", "SENSOR_SIZE_RANGE_MM",
            "SENSOR_MAX_ASPECT", "PITCH_RANGE_UM", "MAKERS"]
 
 #: Camera makers in the table (a digital sensor's name starts with its maker); film gates are "film".
@@ -189,6 +191,37 @@ def camera_formats(name: str) -> tuple[Sensor, ...]:
         if key and key in (_norm(full), _norm(rows[0].camera)):
             return rows
     return ()
+
+
+def _full_sensor_camera(name: str):
+    """(camera, its format) when ``name`` is a bare camera name the sensor table gives the camera's full
+    sensor ("ALEXA 35": the 4.6K 3:2 Open Gate), else None. The camera is the table's one whose name holds
+    ``name`` and which records a format of the gate's size; the exact name, then the one the gate's name
+    names ("VENICE 2": the 8K, not the 6K), then the shortest wins ("ALEXA Mini", not "ALEXA Mini LF")."""
+    key = _norm(name)
+    gate = _gate_index().get(key)
+    if gate is None or name.strip() == gate.key:  # a key is a row's name, not a camera's
+        return None
+    found = []
+    for full, rows in cameras().items():
+        short = _norm(rows[0].camera)
+        same = [r for r in rows if abs(r.width_mm - gate.width_mm) <= 0.011 and abs(r.height_mm - gate.height_mm) <= 0.011]
+        if len(rows) > 1 and same and key in _norm(full):
+            found.append(((key not in (short, _norm(full)), _norm(full) not in _norm(gate.name), len(full)), full, same[0]))
+    return min(found)[1:] if found else None
+
+
+def camera_name_note(name: str) -> str:
+    """What a bare camera name given as a sensor ("ALEXA 35", "Mini LF") was taken as: the camera's full
+    sensor, which format of the camera table that is and how to name another; "" for any other name."""
+    hit = _full_sensor_camera(name) if isinstance(name, str) else None
+    if hit is None:
+        return ""
+    full, fmt = hit
+    n = len(cameras()[full])
+    return (f"{name!r} is the {full}'s full sensor, its {fmt.fmt} ({fmt.width_mm:g} x {fmt.height_mm:g} mm); the "
+            f"camera records in {n} formats and the crop sets the depth of field and the field of view: name "
+            f"another as the sensor, e.g. {cameras()[full][1].aliases[0]!r} (`physcam sensors \"{full}\"` lists them)")
 
 
 def _labelled(rows) -> dict[str, Sensor]:
