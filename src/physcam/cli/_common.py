@@ -350,8 +350,11 @@ def coc_of(args):
 # ---- units -----------------------------------------------------------------------------------
 def add_units_option(p) -> None:
     """``--units m|ft``: the unit system distances are printed in (tables, CSV, plots)."""
-    p.add_argument("--units", choices=UNIT_SYSTEMS, default=None,
-                   help="print distances in metres (m) or feet and inches (ft: to 1/8 inch below 10 ft); "
+    from ..units import unit_system
+
+    p.add_argument("--units", type=unit_system, choices=UNIT_SYSTEMS, default=None,
+                   help="print distances in metres (m, metres, meters) or feet and inches (ft, feet, foot: to 1/8 "
+                        "inch below 10 ft); "
                         "default m, or `units` in the user config (physcam config show); JSON stays in mm")
 
 
