@@ -94,3 +94,11 @@ def test_units_take_the_common_spellings(capsys, spelling, system):
     assert said == capsys.readouterr().out
     assert main([*argv, "yards"]) == 2
     assert "invalid choice: 'yards'" in capsys.readouterr().err
+
+
+def test_feet_spelled_out_in_the_config_is_feet(capsys, tmp_path, monkeypatch):
+    cfg = tmp_path / "config.toml"
+    cfg.write_text('units = "feet"\n')
+    monkeypatch.setenv("PHYSCAM_CONFIG", str(cfg))
+    rc, d, _ = _report(capsys, "--focal", "50", "--fstop", "4", "--focus", "10", "--sensor", "S35")
+    assert rc == 0 and d["focus_from_film_mm"] == pytest.approx(3048.0)  # 10 ft = 3048 mm
