@@ -139,3 +139,35 @@ def test_the_film_slope_is_the_difference_of_exact_solves(slug):
         else:
             ref = (film(k + eps) - film(k - eps)) / (2 * eps)
         assert slope[k] == pytest.approx(ref, abs=2e-5), (slug, k)
+
+
+@pytest.mark.slow
+def test_a_filled_mark_holds_the_rays_at_the_frame_edge_stopped_far_down():
+    """The double Gauss at filled mark 1 (between traced 0 and 4), a film point 26.6 mm off axis (past full
+    frame: 65 mm and IMAX sensors) at iris radius 0.267 mm (half the last level, about f/46): the tracer's
+    passing rays (dense aim grid, the real stop) all lie in the ellipse the shader samples. The pupil
+    table grows this entry at some marks and not others (blender_pupil._grow); filled by the cubic alone
+    it held 71 % of them (before _roughness)."""
+    from physcam.export.blender_focus import focus_table
+    from physcam.export.blender_pupil import interpolated_ellipse
+    from physcam.trace.camera_tracer import CameraTracer
+    from physcam.trace.rays import OK, RayBatch
+    from physcam.trace.trace import trace_through
+
+    lens = load_lens("dgauss_50mm")
+    ft = focus_table(lens)
+    st = focus(lens, float(ft.marks_mm[1]))
+    q = CameraTracer(st.prescription, st.film_z).lens
+    rho, s = 26.583333333333332, ft.levels[-1] / 2
+    cx, ax, ay = interpolated_ellipse(ft.radial[1], ft.levels, rho, s)
+    n = 200
+    gx, gy = np.meshgrid(cx + ((np.arange(n) + 0.5) / n * 2 - 1) * 3 * ax, ((np.arange(n) + 0.5) / n * 2 - 1) * 3 * ay)
+    gx, gy = gx.ravel(), gy.ravel()
+    rays = RayBatch.from_arrays(np.broadcast_to([rho, 0.0, st.film_z], (gx.size, 3)),
+                                np.stack([gx - rho, gy, np.full(gx.size, q.vertex_z[-1] - st.film_z)], axis=1),
+                                q.wavelength_nm)
+    trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=s, in_place=True)
+    ok = rays.flag == OK
+    inside = ((gx - cx) / ax) ** 2 + (gy / ay) ** 2 <= 1
+    assert ok.sum() > 500
+    assert (ok & ~inside).sum() == 0

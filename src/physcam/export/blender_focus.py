@@ -421,6 +421,7 @@ def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=(
         untrusted = blend(reads.astype(float), tab[..., 3] < 0) > 0
         untrusted |= np.abs(area_c - area_l) > AREA_TOLERANCE * np.maximum(np.abs(area_c), 1e-12)
         area = np.maximum(area_c, 0.0)
+        scale = scale * _roughness(traced, tab)[None]
         out_radial = np.stack([c[..., 0], (c[..., 1] + d[..., 1]) * scale, (c[..., 2] + d[..., 2]) * scale,
                                np.where(untrusted, -1.0 - area, area), c[..., 4]], axis=-1)
         out_radial[traced] = tab
@@ -431,6 +432,39 @@ def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=(
         out_norm = blend(cubic, norm)
         out_norm[traced] = np.asarray(norm, dtype=float)
     return out_radial, out_rects, out_stopped, out_norm
+
+
+def _ellipse_reach(e, f) -> np.ndarray:
+    """How far ellipses ``e`` (..., cx, ax, ay) reach out of ellipses ``f``: the largest of sqrt(((x - cx_f) /
+    ax_f)^2 + (y / ay_f)^2) over 48 points of each rim of e (at most 1: e lies in f; nan-free, 1 where f is empty)."""
+    th = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
+    x = e[..., 0:1] + e[..., 1:2] * np.cos(th)
+    y = e[..., 2:3] * np.sin(th)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.sqrt(((x - f[..., 0:1]) / f[..., 1:2]) ** 2 + (y / f[..., 2:3]) ** 2).max(axis=-1)
+    return np.where((f[..., 1] > 0) & (f[..., 2] > 0) & np.isfinite(r), r, 1.0)
+
+
+def _roughness(traced, tab) -> np.ndarray:
+    """Per (level, radius) entry of the traced radial tables ``tab`` (marks, levels, radii, 5), how much the
+    interpolation misses where it can be checked (at least 1): each traced mark between the first and the
+    last left out, the cubic and the line through the others there, grown as :func:`fill_pupil_tables`
+    grows them, must hold the traced ellipse; the largest factor it falls short by over those marks (and
+    the entry's neighbours, as the shader blends them). The pupil tables' ellipses are grown where the
+    shader's blends in film radius and iris miss a traced set, and that growth comes and goes from mark to
+    mark (small sets at the frame's edge, stopped far down): a filled mark takes its entry's worst."""
+    m = len(traced)
+    worst = np.ones(tab.shape[1:3])
+    for j in range(1, m - 1):
+        others = np.delete(traced, j)
+        cubic, linear = _interpolation_weights(others - others[0], int(others[-1] - others[0]) + 1)
+        row = int(traced[j] - others[0])
+        c = np.tensordot(cubic[row], np.delete(tab, j, axis=0)[..., :3], axes=1)
+        d = _neighbourhood_max(np.abs(c - np.tensordot(linear[row], np.delete(tab, j, axis=0)[..., :3], axes=1))[None])[0]
+        scale = 1.0 + d[..., 0] / np.maximum(c[..., 1], 1e-12)
+        grown = np.stack([c[..., 0], (c[..., 1] + d[..., 1]) * scale, (c[..., 2] + d[..., 2]) * scale], axis=-1)
+        worst = np.maximum(worst, _ellipse_reach(tab[j, ..., :3], grown))
+    return _neighbourhood_max(worst[None, ..., None])[0, ..., 0]
 
 
 def _neighbourhood_max(v: np.ndarray) -> np.ndarray:
