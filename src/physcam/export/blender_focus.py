@@ -394,8 +394,9 @@ def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=(
     cubic in the index through the four traced marks about it (the tables are smooth in the axis's s,
     as the film plane is), and what the shader must hold is grown by that cubic's difference from the
     line through the two about it (for a smooth table, an upper bound of the cubic's error by far):
-    an ellipse (cx, ax, ay) has its axes grown by d_ax, d_ay and then scaled by 1 + d_cx / ax (then it
-    holds every ellipse within those differences: the triangle inequality in the ellipse's own norm), a
+    an ellipse (cx, ax, ay) has its axes (never below the line's) grown by d_ax, d_ay and then scaled by
+    1 + d_cx / ax (then it holds every ellipse within those differences: the triangle inequality in the
+    ellipse's own norm) and by its entry's :func:`_roughness`, a
     rectangle its sides moved out. A passing area is trusted (its sign, :func:`~physcam.export.blender_pupil.cell_area`)
     only where every traced table the cubic reads trusts it and the two interpolations agree within
     :data:`~physcam.export.blender_pupil.AREA_TOLERANCE`. A rectangle is empty only where the two traced
@@ -415,8 +416,8 @@ def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=(
         tab = np.asarray(radial, dtype=float)
         c, lin = blend(cubic, tab), blend(linear, tab)
         d = _neighbourhood_max(np.abs(c - lin)[..., :3])  # the shader's reads blend an entry with its neighbours
-        ax = np.maximum(c[..., 1], 1e-12)
-        scale = 1.0 + d[..., 0] / ax
+        c[..., 1:3] = np.maximum(c[..., 1:3], lin[..., 1:3])  # the axes never below the line (a cubic may dip)
+        scale = 1.0 + d[..., 0] / c[..., 1]
         area_c, area_l = blend(cubic, cell_area(tab[..., 3])), blend(linear, cell_area(tab[..., 3]))
         untrusted = blend(reads.astype(float), tab[..., 3] < 0) > 0
         untrusted |= np.abs(area_c - area_l) > AREA_TOLERANCE * np.maximum(np.abs(area_c), 1e-12)
@@ -424,6 +425,10 @@ def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=(
         scale = scale * _roughness(traced, tab)[None]
         out_radial = np.stack([c[..., 0], (c[..., 1] + d[..., 1]) * scale, (c[..., 2] + d[..., 2]) * scale,
                                np.where(untrusted, -1.0 - area, area), c[..., 4]], axis=-1)
+        # where nothing passes at both traced marks about it, an entry holds a neighbour's ellipse (blender_pupil's
+        # _fill), which jumps from mark to mark: the line between the two, ungrown (no ray to hold)
+        dark = blend(linear, cell_area(tab[..., 3]) <= 0) > 1.0 - 1e-9
+        out_radial[..., :3] = np.where(dark[..., None], lin[..., :3], out_radial[..., :3])
         out_radial[traced] = tab
     out_rects = _fill_rects(traced, n, cubic, linear, rects) if len(rects) else None
     out_stopped = _fill_rects(traced, n, cubic, linear, stopped) if len(stopped) else None
@@ -460,8 +465,10 @@ def _roughness(traced, tab) -> np.ndarray:
         cubic, linear = _interpolation_weights(others - others[0], int(others[-1] - others[0]) + 1)
         row = int(traced[j] - others[0])
         c = np.tensordot(cubic[row], np.delete(tab, j, axis=0)[..., :3], axes=1)
-        d = _neighbourhood_max(np.abs(c - np.tensordot(linear[row], np.delete(tab, j, axis=0)[..., :3], axes=1))[None])[0]
-        scale = 1.0 + d[..., 0] / np.maximum(c[..., 1], 1e-12)
+        lin = np.tensordot(linear[row], np.delete(tab, j, axis=0)[..., :3], axes=1)
+        d = _neighbourhood_max(np.abs(c - lin)[None])[0]
+        c[..., 1:3] = np.maximum(c[..., 1:3], lin[..., 1:3])
+        scale = 1.0 + d[..., 0] / c[..., 1]
         grown = np.stack([c[..., 0], (c[..., 1] + d[..., 1]) * scale, (c[..., 2] + d[..., 2]) * scale], axis=-1)
         worst = np.maximum(worst, _ellipse_reach(tab[j, ..., :3], grown))
     return _neighbourhood_max(worst[None, ..., None])[0, ..., 0]
