@@ -171,3 +171,17 @@ def test_a_filled_mark_holds_the_rays_at_the_frame_edge_stopped_far_down():
     inside = ((gx - cx) / ax) ** 2 + (gy / ay) ** 2 <= 1
     assert ok.sum() > 500
     assert (ok & ~inside).sum() == 0
+
+
+def test_an_entry_that_jumps_between_traced_marks_keeps_a_sane_ellipse():
+    """An entry whose axes jump from mark to mark (the pupil table's growth comes and goes) makes the
+    cubic dip below zero between traced marks: the filled axes stay at least the line's and within the
+    growth the rule allows (a dip once scaled an ellipse to 1e11 mm: every sample wasted)."""
+    n = 32
+    traced = pupil_marks(n, 4)
+    ax = np.array([3.0, 0.02, 0.02, 3.0, 3.0, 0.02, 0.02, 3.0, 3.0])  # the centre jumps with it
+    tab = _radial(np.stack([5.0 + ax, ax, ax, 0.5 + 0 * ax, 0 * ax], axis=1))
+    radial, _, _, _ = fill_pupil_tables(traced, n, radial=tab)
+    assert np.isfinite(radial).all()
+    assert (radial[..., 1:3] >= 0.02 - 1e-12).all()
+    assert radial[..., 1:3].max() < 100.0  # 17 mm here; 1.8e10 mm before the axes were kept above the line
