@@ -108,13 +108,12 @@ def test_rectangles_between_traced_marks_hold_both_neighbours():
     rects[:, 0, 0] = [[-1.0 - 0.1 * (i % 2), 1.0, -2.0, 2.0] for i in range(len(traced))]  # steps in x0
     rects[:3, 0, 1] = [-1.0, 1.0, -1.0, 1.0]  # empty from traced mark 6 on
     _, out, _, _ = fill_pupil_tables(traced, n, rects=rects)
-    for i in range(n):
-        j = min(np.searchsorted(traced, i, side="right") - 1, len(traced) - 2)
-        if traced[j] == i:
-            continue
+    for i in sorted(set(range(n)) - set(traced.tolist())):
+        j = np.searchsorted(traced, i) - 1
         a, b = rects[j, 0, 0], rects[j + 1, 0, 0]
         assert out[i, 0, 0, 0] <= min(a[0], b[0]) and out[i, 0, 0, 1] >= max(a[1], b[1])
     assert out[5, 0, 1].tolist() == [-1.0, 1.0, -1.0, 1.0]  # between mark 4 (full) and 6 (empty)
+    assert np.array_equal(out[traced], rects)  # the traced marks keep their own, the last one too
     assert (out[7:, 0, 1] == 0).all() and (out[:, 0, 2] == 0).all()
 
 

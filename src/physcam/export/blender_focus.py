@@ -505,6 +505,7 @@ def _fill_rects(traced, n: int, cubic, linear, rects) -> np.ndarray:
         held = np.stack([np.minimum(grown[i, ..., 0], union[..., 0]), np.maximum(grown[i, ..., 1], union[..., 1]),
                          np.minimum(grown[i, ..., 2], union[..., 2]), np.maximum(grown[i, ..., 3], union[..., 3])], axis=-1)
         out[i] = np.where(every[..., None], held, np.where((fa | fb)[..., None], union, 0.0))
+    out[traced] = tab  # the last mark too (it ends the last interval)
     return out
 
 
