@@ -194,10 +194,9 @@ def run_write(args) -> int:
     distortion = opencv = None
     anamorphic = []
     if getattr(args, "lens", None) and not args.orthographic:  # a prescription-backed report: its real distortion
-        from ..lens.library import load_lens
         from ..usd.kit import prescription_anamorphic_distortion, prescription_distortion, prescription_opencv
 
-        lens = load_lens(args.lens, lenient=args.lenient)
+        lens = args.loaded_lens  # the lens the report solved (a zoom at --zoom)
         distortion = prescription_distortion(lens, report.sensor.width_mm, report.sensor.height_mm,
                                              focus_mm=report.focus_from_film_mm)
         opencv = prescription_opencv(lens, report.sensor.width_mm, report.sensor.height_mm,
@@ -210,7 +209,8 @@ def run_write(args) -> int:
     path = write_camera(args.file, spec, force=args.force, path=args.path, meters_per_unit=args.meters_per_unit,
                         fps=args.fps, report=report if not args.orthographic else None, lens_distortion=distortion,
                         opencv_distortion=opencv, resolution=args.resolution, overscan=args.overscan / 100.0,
-                        thin_lens_gap=gap and gap.to_dict(), anamorphic_distortion=anamorphic)
+                        thin_lens_gap=gap and gap.to_dict(), anamorphic_distortion=anamorphic,
+                        prescription=None if args.orthographic else getattr(args, "loaded_lens", None))
     if gap is not None and not getattr(args, "json", False):
         print(f"note: {gap.summary()}")
     return _done(args, path, extra={"thin_lens_gap": gap and gap.to_dict()})
@@ -482,9 +482,24 @@ def run_refresh(args) -> int:
         d = dict(res)
         d["file_units"] = d.pop("units")  # as usd check
         emit_json(document("usd_refresh", d))
+    elif not res["written"]:
+        print(f"{res['path']}: companion camera current; nothing to recompute, {args.file} not rewritten")
     else:
-        print(f"{res['path']}: companion camera recomputed")
+        n = len(res["changed"])
+        print(f"{res['path']}: companion camera recomputed; {n} value{'s' * (n != 1)} changed"
+              + (":" if n else " (the inputs hash only)"))
+        for c in res["changed"]:
+            print(f"  {c['attribute']}: {_shown(c['before'])} -> {_shown(c['after'])}")
     return 0
+
+
+def _shown(v) -> str:
+    """A refreshed attribute's value for people: numbers as %g, lists in parentheses, none as '(none)'."""
+    if v is None:
+        return "(none)"
+    if isinstance(v, list):
+        return "(" + ", ".join(f"{x:.9g}" for x in v) + ")"
+    return f"{v:.9g}" if isinstance(v, float) else str(v)
 
 
 def run_plugin_path(args) -> int:
