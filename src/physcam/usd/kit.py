@@ -367,7 +367,7 @@ def check_shot(file, path: str | None = None) -> dict:
     stage.Reload()  # the referenced files as they are on disk now, not as this process cached them
     if path is None:
         path = only_camera(stage, "check")  # its error names the file
-    refuse_time_samples(stage, path, file, "check")
+    _refuse_time_samples(stage, path, file, "check")
     geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
     if not geom:
         raise ExportError(f"{path}: has no companion camera to check")
@@ -415,12 +415,12 @@ def refresh_shot(file, path: str | None = None) -> dict:
     stage.Reload()  # the shot and its referenced files as they are on disk now
     if path is None:
         path = only_camera(stage, "refresh")  # its error names the file
-    refuse_time_samples(stage, path, file, "refresh")
+    _refuse_time_samples(stage, path, file, "refresh")
     if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):  # else there is no companion yet: write it
         now = check_shot(file, path)
         if not now["stale"]:
             return dict(now, written=False, changed=[])
-    refuse_lens_not_stored(stage, path, file)
+    _refuse_lens_not_stored(stage, path, file)
     layer = stage.GetRootLayer()
     before = _authored_values(layer, path)
     notes = _companion_notes(stage, path)
@@ -435,7 +435,7 @@ def refresh_shot(file, path: str | None = None) -> dict:
 _ANIMATED_FIRST = ("focusDistance", f"lens:{LENS_INSTANCE}:fStop", "focalLength")
 
 
-def refuse_time_samples(stage, path, file, action: str) -> None:
+def _refuse_time_samples(stage, path, file, action: str) -> None:
     """ExportError naming the file and an animated attribute when the camera at ``path`` (or its lens model or
     companion) has time samples: check and refresh compare and recompute one still camera (its default
     values), and an animation's per-frame lens (``usd animate``) is not stored in the file to solve again."""
@@ -450,7 +450,7 @@ def refuse_time_samples(stage, path, file, action: str) -> None:
                       f"`physcam usd animate {file} --marks CSV ... --force`")
 
 
-def refuse_lens_not_stored(stage, path, file) -> None:
+def _refuse_lens_not_stored(stage, path, file) -> None:
     """ExportError when the camera was written from a real lens (its companion shows the lens's traced field,
     ``physcam:fieldOfView``) by a ``usd write --lens`` older than the stored lens (``<path>/Prescription``):
     a refresh would solve a thin lens in its place."""
