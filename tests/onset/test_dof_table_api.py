@@ -67,7 +67,20 @@ def test_the_defaults_are_the_commands():
     assert command.DEFAULT_FOCUS == ",".join(api.DEFAULT_FOCUS)
 
 
+def test_the_formats_squeeze_is_the_commands(capsys):
+    """squeeze="format" is --squeeze format: ALEXA 35 3.3K 6:5 is a 2x anamorphic format in the camera table."""
+    from physcam.onset.dof_table import dof_table
+
+    assert main(["dof-table", "--focal", "50", "--sensor", "ALEXA 35 3.3K 6:5", "--squeeze", "format", "--fstops", "2.8",
+                 "--focus", "3m", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    api = dof_table(50, sensor="ALEXA 35 3.3K 6:5", squeeze="format", fstops=[2.8], focus_marks_mm=["3m"])
+    assert api["squeeze"] == doc["squeeze"] == 2.0
+    assert api["rows"] == doc["rows"]
+
+
 @pytest.mark.parametrize("kwargs, words", [
+    (dict(focal_length_mm=50, squeeze="format"), r"gives Super 35 .* no anamorphic desqueeze"),
     (dict(), "give either a focal length"),
     (dict(focal_length_mm=35, focus_marks_mm=[-1.0]), "focus mark"),
     (dict(focal_length_mm=35, fstops=[]), "1 to 24 f-stops"),

@@ -51,17 +51,12 @@ def _squeeze(text):
 
 def squeeze_of(args, sensor) -> float:
     """The desqueeze the table takes: --squeeze's number, or with ``format`` the one the camera table
-    gives the format (refused, with what it offers, when it gives none or several)."""
-    from ..errors import InputError
+    gives the format (:func:`physcam.onset.dof_table.format_squeeze`; refused, with what it offers, when it
+    gives none or several)."""
+    from ..onset.dof_table import format_squeeze
 
     sq = getattr(args, "squeeze", 1.0)
-    if sq != "format":
-        return float(sq)
-    offered = tuple(getattr(sensor, "anamorphic", ()) or ())
-    if len(offered) != 1:
-        what = "no anamorphic desqueeze" if not offered else "desqueezes " + ", ".join(f"{v:g}" for v in offered)
-        raise InputError(f"--squeeze format: the camera table gives {sensor.name} {what}; give --squeeze S")
-    return float(offered[0])
+    return format_squeeze(sensor) if sq == "format" else float(sq)
 
 
 def register(sub) -> None:

@@ -19,7 +19,7 @@ from ..units import parse_distance
 from .report import HYPERFOCAL, solve_report
 from .request import report_camera
 
-__all__ = ["DEFAULT_FOCUS", "DEFAULT_FSTOPS", "dof_table"]
+__all__ = ["DEFAULT_FOCUS", "DEFAULT_FSTOPS", "dof_table", "format_squeeze"]
 
 #: The f-stops and marks of a table when none are given (the full stops of a cine lens; common marks).
 DEFAULT_FSTOPS = (1.4, 2.0, 2.8, 4.0, 5.6, 8.0, 11.0, 16.0)
@@ -71,20 +71,37 @@ def _row(report, mark) -> dict:
     return row
 
 
+def format_squeeze(sensor) -> float:
+    """The anamorphic desqueeze the camera table gives ``sensor``'s recording format (``squeeze="format"``,
+    ``--squeeze format``); InputError, saying what it offers, when it gives none or several."""
+    from ..optics.sensors import find_sensor
+
+    sensor = find_sensor(sensor) if isinstance(sensor, str) else sensor
+    offered = tuple(getattr(sensor, "anamorphic", ()) or ())
+    if len(offered) != 1:
+        what = "no anamorphic desqueeze" if not offered else "desqueezes " + ", ".join(f"{v:g}" for v in offered)
+        raise InputError(f"squeeze format: the camera table gives {sensor.name} {what}; give the squeeze as a number "
+                         "(--squeeze S)")
+    return float(offered[0])
+
+
 def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops=DEFAULT_FSTOPS,
-              focus_marks_mm=DEFAULT_FOCUS, coc=None, squeeze: float = 1.0) -> dict:
+              focus_marks_mm=DEFAULT_FOCUS, coc=None, squeeze: float | str = 1.0) -> dict:
     """The depth-of-field table of a thin lens of ``focal_length_mm`` or of ``lens`` (a prescription,
     the technical model) on ``sensor`` (a name or a Sensor; required, as the report's): one row per
     f-stop and focus mark, each the lens report there, and the hyperfocal distance per f-stop.
 
     ``focus_marks_mm``: marks from the film plane, each mm (a number), ``math.inf``, ``"hyperfocal"`` or text
     with a unit ("2m", "6ft"); ``coc``: mm or a convention's name (None: the sensor's default);
-    ``squeeze``: an anamorphic desqueeze. Returns the dict ``physcam dof-table --json`` prints (without
+    ``squeeze``: an anamorphic desqueeze, or ``"format"`` for the one the camera table gives the sensor's
+    format (:func:`format_squeeze`). Returns the dict ``physcam dof-table --json`` prints (without
     its ``schema``/``version``/``units`` keys and the zoom block): keys ``rows`` (fstop, focus,
     ``*_from_film_mm``, ``total_mm``, fields of view), ``hyperfocal``, ``sensor``, ``coc_mm``, ...
     """
     if (lens is None) == (focal_length_mm is None):
         raise InputError("give either a focal length (focal_length_mm=35) or a lens (lens=load_lens(name))")
+    if isinstance(squeeze, str) and squeeze.strip().lower() == "format":
+        squeeze = format_squeeze(sensor)
     fstops = [float(n) for n in fstops]
     marks = [_mark(m) for m in focus_marks_mm]
     if not fstops or len(fstops) > MAX_FSTOPS:
