@@ -109,7 +109,7 @@ class GhostResult:
 
 @takes_prescription
 def ghost_pairs(lens: Prescription) -> list[tuple[int, int]]:
-    """All (i, j), j < i, of surfaces that reflect (index changes across them)."""
+    """All (i, j), j < i, of surfaces that reflect (index changes across them), grouped by i in order."""
     media = [(1.0, 0.0)] + [(s.medium.nd, s.medium.vd) for s in lens.surfaces]
     refl = [k for k, s in enumerate(lens.surfaces) if not s.is_stop and media[k] != media[k + 1]]
     return [(i, j) for a, i in enumerate(refl) for j in refl[:a]]
@@ -381,11 +381,11 @@ def ghost_analysis(
     wd = direct.weight[direct.ok]
     dc = (float((direct.x[direct.ok] * wd).sum() / wd.sum()), float((direct.y[direct.ok] * wd).sum() / wd.sum()))
     paths = []
-    first = {}  # the beam after leg 1 of the paths that reflect first at i (_first_bounce)
-    for i, j in pairs:
-        if i not in first:
-            first[i] = _first_bounce(lens, beam, i, T, backend)
-        g = _ghost_path(lens, beam, i, j, film_z, coating, stop_semi_diameter, backend, T, first[i])
+    first_i, first = None, None  # the beam after leg 1 of the paths that reflect first at first_i
+    for i, j in pairs:  # (grouped by i: one first leg in memory at a time, each traced once)
+        if i != first_i:
+            first_i, first = i, _first_bounce(lens, beam, i, T, backend)
+        g = _ghost_path(lens, beam, i, j, film_z, coating, stop_semi_diameter, backend, T, first)
         ok = g.ok & (g.weight > 0)
         wt = g.weight[ok]
         flux = float(wt.sum())
