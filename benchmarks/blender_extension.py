@@ -89,6 +89,8 @@ def run(lens_name: str, src: str | None, out: str) -> float:
 def table_change(old: dict, new: dict) -> dict:
     """The largest differences between two sides' tables of one lens (module notes)."""
     a, b = old["radial"], new["radial"]
+    if a.shape != b.shape or old["norm"].shape != new["norm"].shape:  # another grid of radii or levels
+        return {"ellipse": math.nan, "area": math.nan, "trust_flips": -1, "norm": math.nan}
     out = {"norm": float(np.max(np.abs(new["norm"] / old["norm"] - 1)))}
     if a.size == 0:
         return out | {"ellipse": 0.0, "area": 0.0, "trust_flips": 0}
