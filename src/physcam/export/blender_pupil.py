@@ -414,8 +414,9 @@ def _shrunk(radii, grids, boxes, start):
     return np.where(small.any(axis=1), np.argmax(small, axis=1), radii.size), (xmin, xmax, ymax)
 
 
-#: Growth of every fitted ellipse beyond its rim points (the rim between two grid lines)
-_SAFETY = 1.003
+#: Growth of every fitted ellipse beyond its rim points (the rim between two grid lines; 1.003 left the
+#: Canon RF 85 wide open at 16.5 mm off axis 0.07 % short with the coarser grids of round 7)
+_SAFETY = 1.006
 
 
 def _fits(rims) -> np.ndarray:
