@@ -320,9 +320,11 @@ def _arr32(name, values, size) -> str:
     a = np.asarray(values, float).ravel()
     if not np.isfinite(a).all():
         _num32(a[~np.isfinite(a)][0])  # raises osl_number's error
-    # _num32 of each, inlined (osl_number of a finite float: its repr, with ".0" when that is an integer)
-    nums = [repr(float(format(v, ".9g"))) for v in a.tolist()]
-    return f"    float {name}[{size}] = {{{', '.join(r if ('.' in r or 'e' in r) else r + '.0' for r in nums)}}};"
+    # _num32 of each (osl_number of the nine-digit rounding: its repr, with ".0" when that is an
+    # integer). Where "%.9g" writes a fraction without exponent (1e-4 <= |v| < 1e9) that is the repr
+    # already: it strips its zeros, and no shorter decimal names the same double
+    nums = [r if ("." in r and "e" not in r) else osl_number(float(r)) for r in map("%.9g".__mod__, a.tolist())]
+    return f"    float {name}[{size}] = {{{', '.join(nums)}}};"
 
 
 def _arr32_once(ft: FocusTable, name, values, size) -> str:
