@@ -77,6 +77,20 @@ def iris_levels(semi_max: float, semi_file: float) -> np.ndarray:
     return np.concatenate([[float(semi_max)], float(semi_file) * LEVEL_RATIO ** -np.arange(N_LEVEL - 1, dtype=float)])
 
 
+#: Iris levels that share the aims of the centre's normalisation (:func:`_centre_ellipses`)
+_NORM_GROUP = 2
+
+
+def _centre_ellipses(table) -> np.ndarray:
+    """Per iris level of a radial pupil table (:func:`radial_pupil_table`), the film centre's ellipse
+    (cx, ax, ay) whose aims weigh the centre's mean weight at that level (the shader's normalisation):
+    the widest level's of each :data:`_NORM_GROUP` consecutive levels. The passing sets nest, so it
+    holds the smaller ones' too; the mean weight does not depend on the region sampled, only its
+    noise does, and levels that share a region share their rays."""
+    table = np.asarray(table)
+    return table[(np.arange(table.shape[0]) // _NORM_GROUP) * _NORM_GROUP, 0, :3]
+
+
 def _levels(levels) -> np.ndarray:
     """``levels`` as iris radii (mm) that :func:`iris_levels` could have given, or InputError."""
     try:
@@ -151,11 +165,7 @@ _HALVINGS = 4  # where another surface clips between two samples, it is found to
 def _trace(q, film_z: float, fxs, boxes, big: float, backend: str) -> list:
     """Rays from film points (fx, 0) to the aim grid over each one's box on the rear vertex plane, in
     one trace: per film point (x, y, passes every surface but the stop, radius where it crosses the
-    stop plane, grid steps, clip edges). Between a passing sample and a clipped neighbour the edge of
-    what the other surfaces pass is found by halving (:data:`_HALVINGS`): the clip edges are (key,
-    lo, hi), the pair's key (d ny + j) nx + i for direction d of :data:`_TOWARD` and the pair's cell
-    (j, i) in that direction's view of the grid, ascending, and the fractions of the step that pass
-    and that do not."""
+    stop plane, grid steps, fx)."""
     nx, ny = _GRID, _GRID // 2
     x0, x1, y1 = np.array(boxes, dtype=float).T
     dx, dy = (x1 - x0) / nx, y1 / ny  # a _GRID x _GRID/2 grid over each box (x0, x1, y1: the y >= 0 half)
@@ -166,64 +176,74 @@ def _trace(q, film_z: float, fxs, boxes, big: float, backend: str) -> list:
     fxs = np.asarray(fxs, dtype=float)
     ok, rad = _aims(q, film_z, np.repeat(fxs, ny * nx), gx.ravel(), gy.ravel(), big, backend)
     ok, rad = ok.reshape(len(boxes), -1), rad.reshape(len(boxes), -1)
-    okg = ok.reshape(-1, ny, nx)
-    # the clip edges: every (passing sample, clipped neighbour) pair of every grid, halved together
-    pairs = []  # per direction: grid index, j, i, x, y, step x, step y, film x, the sample's stop radius
-    for ca, cb, (sx, sy) in _TOWARD:
-        g, jj, ii = np.nonzero(okg[(slice(None),) + ca] & ~okg[(slice(None),) + cb])
+    return [(gx[i], gy[i], ok[i], rad[i], d_x, d_y, f) for i, (d_x, d_y, f) in enumerate(zip(dx.tolist(), dy.tolist(), fxs.tolist()))]
+
+
+def _clip_edges(q, film_z: float, uses, radii, big: float, backend: str):
+    """The clip edges of the grids in ``uses`` (grid of :func:`_trace`, first and end index into the
+    descending iris radii ``radii`` it serves), all halved in one batch of traces: between a sample
+    that passes at the grid's first radius and a neighbour another surface clips, the edge of what
+    the other surfaces pass is found by halving (:data:`_HALVINGS`). Returns (key, lo, hi, r_lo)
+    sorted by key: the pair's key (3 u + d) ny nx + j nx + i for grid u, direction d of
+    :data:`_TOWARD` and the pair's cell (j, i) in that direction's view of the grid, the fractions of
+    the step that pass and that do not, and the stop radius at the last passing point."""
+    nx, ny = _GRID, _GRID // 2
+    okg = np.stack([g[2] for g, _, _ in uses]).reshape(-1, ny, nx)
+    rad = np.stack([g[3] for g, _, _ in uses])
+    x0, y0, dx, dy, fx = (np.array(v) for v in zip(*((g[0][0], g[1][0], g[4], g[5], g[6]) for g, _, _ in uses)))
+    # a pair matters only where its passing sample passes at the grid's first radius (it then makes rim points)
+    serves = (rad <= radii[np.array([u[1] for u in uses])][:, None]).reshape(-1, ny, nx)
+    parts = []  # per direction: key, x, y, step x, step y, film x, the sample's stop radius
+    for d, (ca, cb, (sx, sy)) in enumerate(_TOWARD):
+        g, jj, ii = np.nonzero((okg & serves)[(slice(None),) + ca] & ~okg[(slice(None),) + cb])
         ja, ia = jj + (ca[0].start or 0), ii + (ca[1].start or 0)
-        pairs.append((g, jj, ii, xs[g, 0] + ia * dx[g], ys[g, 0] + ja * dy[g], sx * dx[g], sy * dy[g], fxs[g],
-                      rad[g, ja * nx + ia]))
-    x, y, sx, sy, ff, r_lo = [np.concatenate([p[k] for p in pairs]) for k in (3, 4, 5, 6, 7, 8)]
+        parts.append(((g * 3 + d) * (ny * nx) + jj * nx + ii, x0[g] + ia * dx[g], y0[g] + ja * dy[g], sx * dx[g],
+                      sy * dy[g], fx[g], rad[g, ja * nx + ia]))
+    key, x, y, sx, sy, ff, r_lo = (np.concatenate([p[k] for p in parts]) for k in range(7))
     lo, hi = np.zeros(x.size), np.ones(x.size)
-    g = np.concatenate([p[0] for p in pairs])
-    key = np.concatenate([(d * ny + p[1]) * nx + p[2] for d, p in enumerate(pairs)])
-    for _ in range(_HALVINGS):
+    for _ in range(_HALVINGS if x.size else 0):
         mid = 0.5 * (lo + hi)
-        passes, r_mid = _aims(q, film_z, ff, x + mid * sx, y + mid * sy, big, backend) if x.size else (np.zeros(0, bool),) * 2
+        passes, r_mid = _aims(q, film_z, ff, x + mid * sx, y + mid * sy, big, backend)
         lo, hi, r_lo = np.where(passes, mid, lo), np.where(passes, hi, mid), np.where(passes, r_mid, r_lo)
-    # per grid, its halved edges sorted by key: direction d, the pair's cell (j, i) -> (d ny + j) nx + i
-    o = np.lexsort((key, g))
-    g, key, lo, hi, r_lo = g[o], key[o], lo[o], hi[o], r_lo[o]
-    cuts = np.searchsorted(g, np.arange(len(boxes) + 1)).tolist()
-    dx_, dy_ = dx.tolist(), dy.tolist()
-    return [(gx[i], gy[i], ok[i], rad[i], dx_[i], dy_[i], (key[a:b], lo[a:b], hi[a:b], r_lo[a:b]))
-            for i, a, b in zip(range(len(boxes)), cuts[:-1], cuts[1:])]
+    o = np.argsort(key, kind="stable")
+    return key[o], lo[o], hi[o], r_lo[o]
 
 
-def _rims(uses, radii) -> list:
-    """Per (grid of :func:`_trace`, first and end index into the descending iris radii ``radii``) in
-    ``uses``, per iris radius s of that range, the rim of the passing set on the grid as points
-    (x, y), or None when nothing passes. Between a passing sample and a neighbour the iris stops,
+def _rims(uses, edges, radii, wanted) -> "_RimSet":
+    """The rims of the passing sets of the grids in ``uses`` (grid of :func:`_trace`, first and end
+    index into the descending iris radii ``radii`` it serves), one per grid and iris radius of its
+    range, numbered in that order (grid after grid), as points (x, y) (:class:`_RimSet`; a rim
+    without points: nothing passes). Between a passing sample and a neighbour the iris stops,
     the rim is where the stop radius crosses s (linear between the two: the stop radius is smooth);
-    toward a neighbour another surface clips, or past the grid's edge, it is put at the neighbour
-    (conservative). The set is convex (the iris's image, cut by other round apertures), so its rim
-    bounds it. A sample passes at every iris radius from its stop radius t up (t infinite where
-    another surface clips): a sample and its neighbour make a rim point at the radii in [t_a, t_b),
-    found for every grid and radius at once by bisection in ``radii``."""
+    toward a neighbour another surface clips it is at the halved edge (``edges``:
+    :func:`_clip_edges`), past the grid's edge at the neighbour (conservative). The set is convex
+    (the iris's image, cut by other round apertures), so its rim bounds it. A sample passes at
+    every iris radius from its stop radius t up (t infinite where another surface clips): a sample
+    and its neighbour make a rim point at the radii in [t_a, t_b), found for every grid and radius
+    at once by bisection in ``radii``. ``wanted`` (grids x radii): the rims to find (the others are
+    left without points)."""
     ny, nx = _GRID // 2, _GRID
     ok = np.stack([g[2] for g, _, _ in uses])  # (grids, ny nx)
     rad = np.stack([g[3] for g, _, _ in uses])
     t = np.where(ok, rad, np.inf).reshape(-1, ny, nx)
     x0, y0, dx, dy = (np.array(v) for v in zip(*((g[0][0], g[1][0], g[4], g[5]) for g, _, _ in uses)))
-    # every grid's clip edges, by key (its place in uses, then its own key): ascending
-    n_edge = np.array([g[6][0].size for g, _, _ in uses])
-    e_key = np.concatenate([g[6][0] for g, _, _ in uses]) + np.repeat(np.arange(len(uses)) * (3 * ny * nx), n_edge)
-    e_lo, e_hi, e_rad = (np.concatenate([g[6][c] for g, _, _ in uses]) for c in (1, 2, 3))
+    e_key, e_lo, e_hi, e_rad = edges
     r0, r1 = np.array([u[1] for u in uses]), np.array([u[2] for u in uses])
     first = np.concatenate([[0], np.cumsum(r1 - r0)])  # each grid's first rim
 
-    def expand(g, lo, hi):  # (rim index, radius index, which entry) of every entry's radii [lo, hi)
+    def expand(g, lo, hi):  # (rim index, radius index, which entry) of every entry's wanted radii in [lo, hi)
         n = hi - lo
         e = np.repeat(np.arange(g.size), n)
         i = lo[e] + np.arange(e.size) - np.repeat(np.cumsum(n) - n, n)
+        keep = wanted[g[e], i]
+        e, i = e[keep], i[keep]
         return first[g[e]] + i - r0[g[e]], i, e
 
-    small = np.int16 if radii.size < 2**15 else np.int64
+    small = np.int16 if max(int(first[-1]), radii.size) < 2**15 else np.int64
     r0_, r1_ = r0.astype(small)[:, None, None], r1.astype(small)[:, None, None]
     n_in = _n_passing(radii, t).astype(small)  # per sample: it passes at radii[:n_in]
     rad, ok = rad.ravel(), ok.ravel()
-    parts = []  # (rim index, x, y, xa, ya, clipped)
+    parts = []  # (rim index, x, y, xa, ya)
     # toward +x, -x and +y: the sample's (a) and its neighbour's (b) cells
     for d, ((ja, ia_), (jb, ib), (sx, sy)) in enumerate(_TOWARD):
         lo, hi = np.maximum(n_in[:, jb, ib], r0_), np.minimum(n_in[:, ja, ia_], r1_)
@@ -248,7 +268,7 @@ def _rims(uses, radii) -> list:
             f_iris = np.clip(np.where(nb_ok, (radii[ri] - ra) / (rb - ra), e0 * (radii[ri] - ra) / (r_e - ra)), 0.0, 1.0)
         f = np.where(iris, f_iris, e1)
         fa = np.where(iris, f_iris, 0.5 * (e0 + e1))
-        parts.append((k, bx + ex * f, by + ey * f, bx + ex * fa, by + ey * fa, ~iris))
+        parts.append((k, bx + ex * f, by + ey * f, bx + ex * fa, by + ey * fa))
     for cells, ox, oy in (((slice(None), slice(0, 1)), -1, 0), ((slice(None), slice(nx - 1, None)), 1, 0),
                           ((slice(ny - 1, None), slice(None)), 0, 1)):  # past the grid's edge: a step out
         cell = (slice(None),) + cells
@@ -260,22 +280,14 @@ def _rims(uses, radii) -> list:
         ex, ey = (ox * dx[g] if ox else np.zeros(g.size)), (oy * dy[g] if oy else np.zeros(g.size))
         k, _, e = expand(g, lo[rim].astype(np.int64), hi[rim].astype(np.int64))
         bx, by, ex, ey = bx[e], by[e], ex[e], ey[e]
-        parts.append((k, bx + ex, by + ey, bx + ex / 2, by + ey / 2, np.ones(k.size, dtype=bool)))
+        parts.append((k, bx + ex, by + ey, bx + ex / 2, by + ey / 2))
     n_rims = int(first[-1])
     k = np.concatenate([p[0] for p in parts])
     order = np.argsort(k.astype(small), kind="stable")  # a radix sort on 16-bit integers
     k = k[order]
-    cols = [np.concatenate([p[c] for p in parts])[order] for c in range(1, 6)]
+    x, y, xa, ya = (np.concatenate([p[c] for p in parts])[order] for c in range(1, 5))
     cuts = np.searchsorted(k, np.arange(n_rims + 1))
-    areas = _polygon_areas(k, cols[2], cols[3], cuts)
-    clipped = np.zeros(n_rims, dtype=bool)
-    starts = cuts[:-1][cuts[1:] > cuts[:-1]]
-    if starts.size:
-        clipped[k[starts]] = np.logical_or.reduceat(cols[4], starts)
-    cuts_, clipped_, areas_ = cuts.tolist(), clipped.tolist(), areas.tolist()
-    rims = [Rim(cols, slice(cuts_[i], cuts_[i + 1]), clipped_[i], areas_[i]) if cuts_[i + 1] > cuts_[i] else None
-            for i in range(n_rims)]
-    return [rims[a:b] for a, b in zip(first[:-1].tolist(), first[1:].tolist())]
+    return _RimSet(x, y, cuts, _polygon_areas(k, xa, ya, cuts))
 
 
 def _polygon_areas(k, xa, ya, cuts) -> np.ndarray:
@@ -304,25 +316,21 @@ def _polygon_areas(k, xa, ya, cuts) -> np.ndarray:
     return out
 
 
-class Rim:
-    """A passing set's rim: points (x, y >= 0) that hold it (where another surface clips, a step out),
-    points (xa, ya) at the best estimate of its edge (half a step out there), for its area, and
-    whether a surface other than the iris (or the grid's edge) bounds it anywhere (``clipped``).
-    The points are rows ``span`` of arrays shared by every rim of a table (``cols``)."""
+class _RimSet:
+    """Rims of passing sets (:func:`_rims`): rim i holds points (x, y >= 0) rows ``cuts[i]`` to
+    ``cuts[i + 1]`` (where another surface clips, a step out: they hold the set), and ``area[i]``, the
+    set's area (mm^2, both halves, :func:`_polygon_areas`: from points at the best estimate of its edge)."""
 
-    __slots__ = ("cols", "span", "clipped", "_area")
+    __slots__ = ("x", "y", "cuts", "area")
 
-    def __init__(self, cols, span: slice, clipped: bool, area: float):
-        self.cols, self.span, self.clipped, self._area = cols, span, clipped, area
+    def __init__(self, x, y, cuts, area):
+        self.x, self.y, self.cuts, self.area = x, y, cuts, area
 
-    x = property(lambda self: self.cols[0][self.span])
-    y = property(lambda self: self.cols[1][self.span])
-    xa = property(lambda self: self.cols[2][self.span])
-    ya = property(lambda self: self.cols[3][self.span])
-
-    def area(self) -> float:
-        """The set's area (mm^2, both halves): :func:`_polygon_areas`."""
-        return self._area
+    def points(self, which) -> tuple:
+        """(x, y, count): the points of the rims ``which`` (indices), rim after rim, and each one's count."""
+        a, n = self.cuts[which], self.cuts[np.asarray(which) + 1] - self.cuts[which]
+        idx = np.repeat(a - (np.cumsum(n) - n), n) + np.arange(int(n.sum()))
+        return self.x[idx], self.y[idx], n
 
 
 def _first_grids(q, film_z: float, fxs, s_max: float, r_rear: float, big: float, backend: str) -> tuple[list, list]:
@@ -356,10 +364,11 @@ def _first_grids(q, film_z: float, fxs, s_max: float, r_rear: float, big: float,
     return boxes, grids
 
 
-def _passing_sets(q, film_z: float, fxs, radii, r_rear: float, big: float, backend: str) -> list:
-    """Per film point (fx, 0) and per iris radius in ``radii`` (descending): the rim of the passing
-    set (:func:`_rims`), or None when nothing passes. A point's grid zooms in on its passing set once
-    that has shrunk to under half of the grid."""
+def _passing_sets(q, film_z: float, fxs, radii, wanted, r_rear: float, big: float, backend: str) -> tuple:
+    """(index, rims): the rims of the passing sets (:class:`_RimSet`, :func:`_rims`) and per film
+    point (fx, 0) and iris radius in ``radii`` (descending) the index of its rim there, -1 where
+    nothing passes (or the rim is not ``wanted``: film points x radii). A point's grid zooms in on its
+    passing set once that has shrunk under :data:`_ZOOM` of the grid."""
     radii = np.asarray(radii, dtype=float)
     boxes, grids = _first_grids(q, film_z, fxs, radii[0], r_rear, big, backend)
     start = [0] * len(fxs)  # the first radius each point's current grid serves
@@ -379,9 +388,17 @@ def _passing_sets(q, film_z: float, fxs, radii, r_rear: float, big: float, backe
                         if zoom else []):
             grids[p], boxes[p] = g, zoom[p]
         pending = list(zoom)
-    flat = [use for u in uses for use in u if use[2] > use[1]]
-    rims = iter(_rims(flat, radii) if flat else [])
-    return [[rim for use in u if use[2] > use[1] for rim in next(rims)] for u in uses]
+    flat = [(p, use) for p, u in enumerate(uses) for use in u if use[2] > use[1]]
+    index = np.full((len(fxs), radii.size), -1)
+    if not flat:
+        return index, _RimSet(np.zeros(0), np.zeros(0), np.zeros(1, dtype=int), np.zeros(0))
+    used = [use for _, use in flat]
+    p, r0, r1 = (np.array(v) for v in zip(*((p, use[1], use[2]) for p, use in flat)))
+    rims = _rims(used, _clip_edges(q, film_z, used, radii, big, backend), radii, np.asarray(wanted)[p])
+    n = r1 - r0
+    k = np.arange(int(n.sum()))  # the rims in their order: grid after grid, radius after radius
+    index[np.repeat(p, n), np.repeat(r0 - (np.cumsum(n) - n), n) + k] = np.where(rims.cuts[k + 1] > rims.cuts[k], k, -1)
+    return index, rims
 
 
 def _n_passing(radii, t) -> np.ndarray:
@@ -419,21 +436,19 @@ def _shrunk(radii, grids, boxes, start):
 _SAFETY = 1.006
 
 
-def _fits(rims) -> np.ndarray:
-    """Per rim of ``rims`` (rims of one table: rows of the same arrays), (cx, ax, ay, area): the
-    ellipse about the rim's middle, axes along x and y, that holds every rim point (grown by
+def _fits(rims, which) -> np.ndarray:
+    """Per rim ``which`` (indices into ``rims``, each with points), (cx, ax, ay, area): the ellipse
+    about the rim's middle, axes along x and y, that holds every rim point (grown by
     :data:`_SAFETY`), and the passing set's area."""
-    n = np.array([r.span.stop - r.span.start for r in rims])
-    idx = np.concatenate([np.arange(r.span.start, r.span.stop) for r in rims])
+    x, y, n = rims.points(which)
     starts = np.cumsum(n) - n
-    x, y = rims[0].cols[0][idx], rims[0].cols[1][idx]
     lo, hi = np.minimum.reduceat(x, starts), np.maximum.reduceat(x, starts)
     cx, ax, ay = 0.5 * (lo + hi), 0.5 * (hi - lo), np.maximum.reduceat(y, starts)
     c = np.repeat(np.arange(n.size), n)
     with np.errstate(divide="ignore", invalid="ignore"):
         v = np.sqrt(((x - cx[c]) / ax[c]) ** 2 + (y / ay[c]) ** 2)
     g = np.where((ax > 0) & (ay > 0), np.maximum.reduceat(v, starts) * _SAFETY, math.inf)
-    return np.stack([cx, ax * g, ay * g, [r.area() for r in rims]], axis=1)
+    return np.stack([cx, ax * g, ay * g, rims.area[which]], axis=1)
 
 
 def interpolated_ellipse(table: np.ndarray, levels, rho: float, s: float) -> np.ndarray:
@@ -552,43 +567,41 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto") -> np
     checked = np.unique(np.concatenate([levels, mids, [below]]))[::-1]
     near = levels * (1 - _DS)  # the area's slope at each level (one-sided: one radius more per level, not two)
     radii = np.unique(np.concatenate([checked, near]))[::-1]
-    index = {float(s): i for i, s in enumerate(radii)}
     r_rear = q.surfaces[-1].semi_diameter
     big = 20.0 * max(semi_max, q.surfaces[q.stop_index].semi_diameter)
     step = RADIAL_MAX_MM / (N_RADIAL - 1)
-    sets = _passing_sets(q, film_z, [j * step for j in range(N_RADIAL)] + [(j + 0.5) * step for j in range(N_RADIAL - 1)],
-                         radii, r_rear, big, backend)
-    at_node, at_mid = sets[:N_RADIAL], sets[N_RADIAL:]
+    rhos = np.concatenate([np.arange(N_RADIAL) * step, (np.arange(N_RADIAL - 1) + 0.5) * step])  # nodes, then mids
+    wanted = np.ones((rhos.size, radii.size), dtype=bool)
+    wanted[N_RADIAL:] = np.isin(radii, checked)  # between the nodes only the checks
+    index, rims = _passing_sets(q, film_z, rhos.tolist(), radii, wanted, r_rear, big, backend)
+    at = {float(s): i for i, s in enumerate(radii)}
+    area = np.append(rims.area, 0.0)  # index -1: nothing passes
+    node = index[:N_RADIAL, [at[float(s)] for s in levels]].T  # (levels, radii): the rims the entries fit
+    lit = node >= 0
     table = np.zeros((len(levels), N_RADIAL, 5))
-    empty = np.ones((len(levels), N_RADIAL), dtype=bool)
-    lit = [(k, j) for j in range(N_RADIAL) for k, s in enumerate(levels) if at_node[j][index[float(s)]] is not None]
-    if lit:
-        kk, jj = np.array(lit).T
-        table[kk, jj, :4] = _fits([at_node[j][index[float(levels[k])]] for k, j in lit])
-        empty[kk, jj] = False
-    for k, j in lit:
-        s = levels[k]
-        up, down = at_node[j][index[float(s)]], at_node[j][index[float(s * (1 - _DS))]]
-        table[k, j, 4] = ((up.area() if up else 0.0) - (down.area() if down else 0.0)) / (_DS * s)
-    dark = empty.copy()
+    if lit.any():
+        table[lit, :4] = _fits(rims, node[lit])
+        down = index[:N_RADIAL, [at[float(s)] for s in near]].T
+        table[..., 4] = np.where(lit, (area[node] - area[down]) / (_DS * levels[:, None]), 0.0)
+    empty = ~lit
     _fill(table, empty)
-    table[..., 3] = np.where(dark, 0.0, table[..., 3])  # nothing passes (the ellipse is a neighbour's)
-    table[..., 4] = np.where(dark, 0.0, table[..., 4])
-    # grow the entries until the shader's interpolation holds every traced set between them
-    checks = [(j * step, at_node[j]) for j in range(N_RADIAL)] + [((j + 0.5) * step, at_mid[j])
-                                                                   for j in range(N_RADIAL - 1)]
-    _grow(table, levels, [(rho, float(s), sets[index[float(s)]]) for rho, sets in checks for s in checked], step)
+    table[..., 3:5] = np.where(lit[..., None], table[..., 3:5], 0.0)  # nothing passes (the ellipse is a neighbour's)
+    # every film point (nodes and mids) at every iris radius checked: the shader's reading there must hold
+    # the traced set (grown until it does) and, for its cell to be trusted, give its area
+    cols = [at[float(s)] for s in checked]
+    read_rho, read_s = np.repeat(rhos, len(cols)), np.tile(checked, len(rhos))
+    read_rim = index[:, cols].ravel()
+    has = read_rim >= 0
+    _grow(table, levels, read_rho[has], read_s[has], read_rim[has], rims)
     # the area weighs rays only in the cells (between two levels and two radii) where the shader's
     # interpolation of the area is the traced one's within AREA_TOLERANCE at every set checked on or in
     # the cell, whatever bounds the set (the iris alone, or other surfaces too: the rim's area is a dense
     # trace's within 0.4 % either way, module notes); an entry's sign says whether its cell is trusted (untrusted:
     # -1 - area, cell_area). A failed check withdraws only the cells it lies on or in.
-    reads = [(rho, float(s), sets[index[float(s)]]) for rho, sets in checks for s in checked]
-    want = np.array([reg.area() if reg is not None else 0.0 for _, _, reg in reads])
-    got = _areas_at(table, levels, [rho for rho, _, _ in reads], [s for _, s, _ in reads])
+    want = area[read_rim]
+    got = _areas_at(table, levels, read_rho, read_s)
     bad = np.abs(got - want) > AREA_TOLERANCE * np.maximum(want, 1e-12)
-    trusted = _trusted_cells(levels, [(rho, s) for (rho, s, _), b in zip(reads, bad.tolist()) if b],
-                             table[..., 3] > 0, step)
+    trusted = _trusted_cells(levels, np.stack([read_rho[bad], read_s[bad]], axis=1), table[..., 3] > 0, step)
     table[..., 3] = np.where(trusted, table[..., 3], -1.0 - table[..., 3])
     return table
 
@@ -600,13 +613,15 @@ def _trusted_cells(levels, failed, lit, step: float) -> np.ndarray:
     (film radius, iris radius) of ``failed`` lies on or in it. The last radius column has no cell."""
     n_level, n_rad = lit.shape
     ok = lit.copy()
-    for k in range(n_level):
-        rows = lit[k:k + 2] if k < n_level - 1 else lit[k:k + 1]
-        ok[k, :-1] = rows[:, :-1].all(axis=0) & rows[:, 1:].all(axis=0)
-    for rho, s in failed:
-        ks = [k for k in range(n_level - 1) if levels[k + 1] <= s <= levels[k]] + ([n_level - 1] if s <= levels[-1] else [])
-        js = [j for j in range(n_rad - 1) if j * step - 1e-9 <= rho <= (j + 1) * step + 1e-9]
-        ok[np.ix_(ks, js)] = False
+    both = np.concatenate([lit[:-1] & lit[1:], lit[-1:]])  # each cell's two levels (the last: itself)
+    ok[:, :-1] = both[:, :-1] & both[:, 1:]
+    failed = np.asarray(failed, dtype=float).reshape(-1, 2)
+    rho, s = failed[:, :1], failed[:, 1:]
+    lv = np.asarray(levels, dtype=float)
+    on_k = np.concatenate([(lv[1:] <= s) & (s <= lv[:-1]), s <= lv[-1]], axis=1)  # (failed, levels)
+    j = np.arange(n_rad)
+    on_j = (j[:-1] * step - 1e-9 <= rho) & (rho <= j[1:] * step + 1e-9)  # (failed, cells across)
+    ok[:, :-1] &= ~((on_k.T.astype(np.int32) @ on_j.astype(np.int32)) > 0)
     return ok
 
 
@@ -614,13 +629,6 @@ def cell_area(v):
     """The passing set's area (mm^2) from a table entry's area column ``v`` (an untrusted cell's entry
     holds -1 - area, :func:`radial_pupil_table`)."""
     return np.where(np.asarray(v) < 0, -1.0 - np.asarray(v), v)
-
-
-def _cols_used(rho: float, step: float) -> list[int]:
-    """The radius columns the shader reads at film radius ``rho`` (a node's own column at a node)."""
-    ri = rho / step
-    j0 = min(int(math.floor(ri + 1e-9)), N_RADIAL - 2)
-    return [j0] if abs(ri - j0) < 1e-9 else [j0, j0 + 1]
 
 
 def _reads(table, levels, rhos, ss):
@@ -635,7 +643,10 @@ def _reads(table, levels, rhos, ss):
 
 def _ellipses_at(table, levels, rhos, ss) -> np.ndarray:
     """:func:`_ellipse_at` at every (rho, s) pair, (n, 3), the same arithmetic in whole arrays."""
-    j0, rw, l0, lw, shrink = _reads(table, levels, rhos, ss)
+    return _ellipses_read(table, *_reads(table, levels, rhos, ss))
+
+
+def _ellipses_read(table, j0, rw, l0, lw, shrink) -> np.ndarray:
     rw, lw = rw[:, None], lw[:, None]
     at0 = (1 - rw) * table[l0, j0, :3] + rw * table[l0, j0 + 1, :3]
     at1 = (1 - rw) * table[l0 + 1, j0, :3] + rw * table[l0 + 1, j0 + 1, :3]
@@ -661,48 +672,30 @@ def _areas_at(table, levels, rhos, ss) -> np.ndarray:
     return np.where(bad, -1.0, np.where(shrink < 1.0, a0 * shrink * shrink, cubic))
 
 
-def _grow(table, levels, reads, step: float) -> None:
-    """Grow the entries (in place) until the shader's ellipse at each (rho, s, rim) of ``reads`` holds
-    the rim, in order. An entry only grows, and a grown entry holds what it held: the reads already held
-    by the table as it is are skipped (found in whole arrays; the rims share one table's points)."""
-    reads = [r for r in reads if r[2] is not None]
-    if not reads:
+def _grow(table, levels, rhos, ss, which, rims) -> None:
+    """Grow the entries (in place) until the shader's ellipse at each film radius ``rhos[i]`` and iris
+    radius ``ss[i]`` holds the rim ``which[i]`` of ``rims``: each entry's axes by the largest factor
+    that any reading it weighs in (with weight over 1e-9) needs, until every one holds. An entry only
+    grows, and a grown entry holds what it held (the centres do not move)."""
+    if len(which) == 0:
         return
-    e = _ellipses_at(table, levels, [r[0] for r in reads], [r[1] for r in reads])
-    spans = [r[2].span for r in reads]
-    n = np.array([sp.stop - sp.start for sp in spans])
-    idx = np.concatenate([np.arange(sp.start, sp.stop) for sp in spans])
-    c = np.repeat(np.arange(len(reads)), n)
-    cols = reads[0][2].cols
-    x, y = cols[0][idx], cols[1][idx]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        v = np.sqrt(((x - e[c, 0]) / e[c, 1]) ** 2 + (y / e[c, 2]) ** 2)
-    need = np.maximum.reduceat(v, np.cumsum(n) - n) * _SAFETY
-    need = np.where((e[:, 1] > 0) & (e[:, 2] > 0), need, math.inf)
-    j0, rw, l0, lw, shrink = (v.tolist() for v in _reads(table, levels, [r[0] for r in reads], [r[1] for r in reads]))
-    ends = np.cumsum(n).tolist()
-    t = table[..., :3].tolist()  # grown as Python floats (the same arithmetic), written back at the end
-    rows = {s: _rows_used(levels, s) for s in {r[1] for r in reads}}
-    cols_ = {rho: _cols_used(rho, step) for rho in {r[0] for r in reads}}
-    for i in np.flatnonzero(~(need <= 1.0)).tolist():  # the same arithmetic as _ellipse_at and _need
-        rho, s, _ = reads[i]
-        xi, yi = x[ends[i] - n[i]:ends[i]], y[ends[i] - n[i]:ends[i]]
-        a, w, u, r0, r1 = j0[i], rw[i], lw[i], t[l0[i]], t[l0[i] + 1]
-        for _ in range(8):
-            cx, ax, ay = (((1 - u) * ((1 - w) * r0[a][m] + w * r0[a + 1][m]) + u * ((1 - w) * r1[a][m] + w * r1[a + 1][m]))
-                          * (1.0 if m == 0 else shrink[i]) for m in (0, 1, 2))
-            g = float(np.sqrt(((xi - cx) / ax) ** 2 + (yi / ay) ** 2).max()) * _SAFETY if ax > 0 and ay > 0 else math.inf
-            if g <= 1.0:
-                break
-            f = g * (1 + 1e-6)
-            for k in rows[s]:
-                for j in cols_[rho]:
-                    t[k][j][1] *= f
-                    t[k][j][2] *= f
-    table[..., 1:3] = np.array(t)[..., 1:3]
-
-
-def _rows_used(levels, s: float) -> list[int]:
-    """The level rows the shader reads at iris radius ``s``."""
-    l0, lw, _ = _bracket(levels, s)
-    return [k for k, w in ((l0, 1 - lw), (l0 + 1, lw)) if w > 0] or [l0]
+    reads = _reads(table, levels, rhos, ss)
+    j0, rw, l0, lw, _ = reads
+    x, y, n = rims.points(which)
+    starts, c = np.cumsum(n) - n, np.repeat(np.arange(n.size), n)
+    # the four entries each reading mixes, and which of them weigh in it
+    rows, cols = np.stack([l0, l0, l0 + 1, l0 + 1]), np.stack([j0, j0 + 1, j0, j0 + 1])
+    weighs = np.stack([(lw < 1) & (rw < 1 - 1e-9), (lw < 1) & (rw > 1e-9), (lw > 0) & (rw < 1 - 1e-9), (lw > 0) & (rw > 1e-9)])
+    for _ in range(8):
+        e = _ellipses_read(table, *reads)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            v = np.sqrt(((x - e[c, 0]) / e[c, 1]) ** 2 + (y / e[c, 2]) ** 2)
+        need = np.maximum.reduceat(v, starts) * _SAFETY
+        need = np.where((e[:, 1] > 0) & (e[:, 2] > 0), need, math.inf)
+        short = ~(need <= 1.0)
+        if not short.any():
+            return
+        f = np.ones(table.shape[:2])
+        w = weighs & short[None, :]
+        np.maximum.at(f, (rows[w], cols[w]), np.broadcast_to(need * (1 + 1e-6), w.shape)[w])
+        table[..., 1:3] *= f[..., None]
