@@ -262,7 +262,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
     from ..trace.camera_tracer import CameraTracer
-    from .blender_pupil import iris_levels, radial_pupil_table
+    from .blender_pupil import _centre_ellipses, iris_levels, radial_pupil_table
 
     axis = focus_axis(closest_focus(lens), n_focus)
     marks = axis.marks_mm
@@ -284,7 +284,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
         else:
             radial.append(radial_pupil_table(tracer.lens, st.film_z, levels))
             b = _centre_bounds(tracer.lens, radial[-1][0, 0])
-            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in radial[-1][:, 0]], levels))
+            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(radial[-1])], levels))
         if mk == marks[0]:
             table0, bounds0 = t, (b if lens.is_anamorphic else None)
             loss = tracer.centre_weight(b, samples=64, fresnel=True) / tracer.centre_weight(b, samples=64)

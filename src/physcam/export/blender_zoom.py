@@ -89,7 +89,7 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     from ..optics.zoom import efl_at
     from ..trace.camera_tracer import CameraTracer
     from .blender_focus import FocusTable, _centre_bounds, _centre_norms, _ellipse_rect, focus_geometry
-    from .blender_pupil import iris_levels, radial_pupil_table
+    from .blender_pupil import _centre_ellipses, iris_levels, radial_pupil_table
 
     if lens.zoom is None:
         raise InputError(f"{lens.name!r} is not a zoom lens: use blender_focus.focus_table")
@@ -116,7 +116,7 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
             st = focus(q, float(mk))
             tracer = CameraTracer(st.prescription, st.film_z)  # the lens at this zoom and focus as the file stops it
             radial.append(radial_pupil_table(tracer.lens, st.film_z, levels))
-            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in radial[-1][:, 0]], levels))
+            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(radial[-1])], levels))
     if not all(min(v) > 0 for v in norm):
         from ..errors import OpticsError
 
