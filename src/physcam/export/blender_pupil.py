@@ -145,8 +145,13 @@ def _aims(q, film_z: float, fx, px, py, big: float, backend: str):
     from ..trace.trace import trace_through
 
     fx = np.asarray(fx, dtype=float)
-    rays = RayBatch.from_columns(fx, np.zeros_like(fx), np.full(fx.size, film_z), px - fx, py,
-                                 np.full(px.size, q.vertex_z[-1] - film_z), q.wavelength_nm)
+    # the batch built here, not by RayBatch.from_columns: every input is finite by construction, and
+    # its checks and copies cost as much as the trace kernel on these short rays
+    n, dz = fx.size, float(q.vertex_z[-1] - film_z)
+    ux, uy = px - fx, np.asarray(py, dtype=float)
+    inv = 1.0 / np.sqrt(ux * ux + uy * uy + dz * dz)
+    rays = RayBatch(fx.copy(), np.zeros(n), np.full(n, film_z), ux * inv, uy * inv, dz * inv,
+                    np.full(n, q.wavelength_nm), np.ones(n), np.zeros(n, dtype=np.uint8))
     probe = _StopCrossing()
     trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=big, aperture=probe, in_place=True,
                   backend=backend)
@@ -162,10 +167,11 @@ _ZOOM = 0.6  # a grid zooms in once its set spans under this share of it, across
 _HALVINGS = 4  # where another surface clips between two samples, it is found to 1/16 of a step
 
 
-def _trace(q, film_z: float, fxs, boxes, big: float, backend: str) -> list:
+def _trace(q, film_z: float, fxs, boxes, radii, big: float, backend: str) -> list:
     """Rays from film points (fx, 0) to the aim grid over each one's box on the rear vertex plane, in
     one trace: per film point (x, y, passes every surface but the stop, radius where it crosses the
-    stop plane, grid steps, fx)."""
+    stop plane, grid steps, fx, at how many of the descending iris radii ``radii`` it passes:
+    :func:`_n_passing`)."""
     nx, ny = _GRID, _GRID // 2
     x0, x1, y1 = np.array(boxes, dtype=float).T
     dx, dy = (x1 - x0) / nx, y1 / ny  # a _GRID x _GRID/2 grid over each box (x0, x1, y1: the y >= 0 half)
@@ -176,7 +182,9 @@ def _trace(q, film_z: float, fxs, boxes, big: float, backend: str) -> list:
     fxs = np.asarray(fxs, dtype=float)
     ok, rad = _aims(q, film_z, np.repeat(fxs, ny * nx), gx.ravel(), gy.ravel(), big, backend)
     ok, rad = ok.reshape(len(boxes), -1), rad.reshape(len(boxes), -1)
-    return [(gx[i], gy[i], ok[i], rad[i], d_x, d_y, f) for i, (d_x, d_y, f) in enumerate(zip(dx.tolist(), dy.tolist(), fxs.tolist()))]
+    n_in = _n_passing(radii, np.where(ok, rad, np.inf)).astype(np.int16 if radii.size < 2**15 else np.int64)
+    return [(gx[i], gy[i], ok[i], rad[i], d_x, d_y, f, n_in[i])
+            for i, (d_x, d_y, f) in enumerate(zip(dx.tolist(), dy.tolist(), fxs.tolist()))]
 
 
 def _clip_edges(q, film_z: float, uses, radii, big: float, backend: str):
@@ -241,7 +249,7 @@ def _rims(uses, edges, radii, wanted) -> "_RimSet":
 
     small = np.int16 if max(int(first[-1]), radii.size) < 2**15 else np.int64
     r0_, r1_ = r0.astype(small)[:, None, None], r1.astype(small)[:, None, None]
-    n_in = _n_passing(radii, t).astype(small)  # per sample: it passes at radii[:n_in]
+    n_in = np.stack([g[7] for g, _, _ in uses]).reshape(-1, ny, nx).astype(small)  # per sample: it passes at radii[:n_in]
     rad, ok = rad.ravel(), ok.ravel()
     parts = []  # (rim index, x, y, xa, ya)
     # toward +x, -x and +y: the sample's (a) and its neighbour's (b) cells
@@ -250,25 +258,33 @@ def _rims(uses, edges, radii, wanted) -> "_RimSet":
         g, jj, ii = np.nonzero(hi > lo)  # the pairs with a rim point at some radius of their grid
         a = (g * ny + jj + (ja.start or 0)) * nx + ii + (ia_.start or 0)  # the cells in the flat grids
         b = (g * ny + jj + (jb.start or 0)) * nx + ii + (ib.start or 0)
-        ra, rb, nb_ok = rad[a], rad[b], ok[b]
-        # where another surface clips, the rim is at the halved edge (held: its far end; area: its middle)
-        e0, e1, r_e = np.zeros(g.size), np.ones(g.size), np.full(g.size, np.inf)
+        ra, nb_ok = rad[a], ok[b]
+        # toward a neighbour the iris stops, the rim is where the stop radius crosses s, linear from
+        # the sample's (ra) to the neighbour's; toward one another surface clips, at the halved edge
+        # (held: its far end e1; area: its middle), unless the iris stops the ray first: where the
+        # stop radius at the halved edge's last passing point (r_e, at e0 of the step) exceeds s, the
+        # rim is between the two
+        r_e, rate = np.full(g.size, np.inf), np.zeros(g.size)
+        e1, e_mid = np.ones(g.size), np.ones(g.size)
         cut = np.flatnonzero(~nb_ok)
         at = np.searchsorted(e_key, (g[cut] * 3 + d) * (ny * nx) + jj[cut] * nx + ii[cut])
-        e0[cut], e1[cut], r_e[cut] = e_lo[at], e_hi[at], e_rad[at]
-        ex, ey = sx * dx[g], sy * dy[g]
-        bx, by = x0[g] + (ii + (ia_.start or 0)) * dx[g], y0[g] + (jj + (ja.start or 0)) * dy[g]
-        k, ri, e = expand(g, np.maximum(n_in.ravel()[b], r0_.ravel()[g]).astype(np.int64),
-                          np.minimum(n_in.ravel()[a], r1_.ravel()[g]).astype(np.int64))
-        ra, rb, nb_ok, e0, e1, r_e, ex, ey, bx, by = (v[e] for v in (ra, rb, nb_ok, e0, e1, r_e, ex, ey, bx, by))
-        # toward a clipped neighbour the iris still stops the ray first where the stop radius at the
-        # halved edge's last passing point (r_e, at e0 of the step) exceeds s: the rim is between the two
-        iris = nb_ok | (radii[ri] < r_e)
         with np.errstate(divide="ignore", invalid="ignore"):
-            f_iris = np.clip(np.where(nb_ok, (radii[ri] - ra) / (rb - ra), e0 * (radii[ri] - ra) / (r_e - ra)), 0.0, 1.0)
-        f = np.where(iris, f_iris, e1)
-        fa = np.where(iris, f_iris, 0.5 * (e0 + e1))
-        parts.append((k, bx + ex * f, by + ey * f, bx + ex * fa, by + ey * fa))
+            rate[nb_ok] = 1.0 / (rad[b[nb_ok]] - ra[nb_ok])
+            r_e[cut], rate[cut] = e_rad[at], e_lo[at] / (e_rad[at] - ra[cut])
+        e1[cut], e_mid[cut] = e_hi[at], 0.5 * (e_lo[at] + e_hi[at])
+        step = sx * dx[g] + sy * dy[g]  # the step's length (along x or y)
+        base = (x0[g] + (ii + (ia_.start or 0)) * dx[g]) if sx else (y0[g] + (jj + (ja.start or 0)) * dy[g])
+        other = (y0[g] + (jj + (ja.start or 0)) * dy[g]) if sx else (x0[g] + (ii + (ia_.start or 0)) * dx[g])
+        k, ri, e = expand(g, lo[g, jj, ii].astype(np.int64), hi[g, jj, ii].astype(np.int64))
+        s_ = radii[ri]
+        iris = s_ < r_e[e]
+        with np.errstate(invalid="ignore"):
+            f_iris = np.clip((s_ - ra[e]) * rate[e], 0.0, 1.0)
+        f, fa = np.where(iris, f_iris, e1[e]), np.where(iris, f_iris, e_mid[e])
+        along, across = base[e], other[e]
+        step = step[e]
+        moved, moved_a = along + step * f, along + step * fa
+        parts.append((k, moved, across, moved_a, across) if sx else (k, across, moved, across, moved_a))
     for cells, ox, oy in (((slice(None), slice(0, 1)), -1, 0), ((slice(None), slice(nx - 1, None)), 1, 0),
                           ((slice(ny - 1, None), slice(None)), 0, 1)):  # past the grid's edge: a step out
         cell = (slice(None),) + cells
@@ -333,24 +349,24 @@ class _RimSet:
         return self.x[idx], self.y[idx], n
 
 
-def _first_grids(q, film_z: float, fxs, s_max: float, r_rear: float, big: float, backend: str) -> tuple[list, list]:
+def _first_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, backend: str) -> tuple[list, list]:
     """Per film point (fx, 0): the box (x0, x1, y1) of its first grid and the grid (:func:`_trace`).
     The rear element's square, unless fewer than :data:`~physcam.trace.pupil_bounds.MIN_HITS` of its
-    aims pass at iris radius ``s_max`` (a cover glass close to the film: the spot is under one grid
+    aims pass at the widest iris radius (``radii[0]``; a cover glass close to the film: the spot is under one grid
     step); then a window about the point straight ahead, half as wide as the film's distance from
     the rear vertex, doubled while the passing aims touch its edge or none pass."""
     from ..trace.pupil_bounds import MIN_HITS
 
-    full = (-r_rear, r_rear, r_rear)
+    full, s_max = (-r_rear, r_rear, r_rear), radii[0]
     boxes = [full] * len(fxs)
-    grids = _trace(q, film_z, fxs, boxes, big, backend)
+    grids = _trace(q, film_z, fxs, boxes, radii, big, backend)
     pending = [p for p, g in enumerate(grids) if (g[2] & (g[3] <= s_max)).sum() < MIN_HITS]
     h = 0.5 * (film_z - q.vertex_z[-1])
     while pending and h < 2 * r_rear:
         wins = {p: (max(fxs[p] - h, -r_rear), min(fxs[p] + h, r_rear), min(h, r_rear)) for p in pending}
         wins = {p: w for p, w in wins.items() if w[1] > w[0]}
         done = set()
-        for p, g in zip(wins, _trace(q, film_z, [fxs[p] for p in wins], list(wins.values()), big, backend) if wins else []):
+        for p, g in zip(wins, _trace(q, film_z, [fxs[p] for p in wins], list(wins.values()), radii, big, backend) if wins else []):
             w, sel = wins[p], g[2] & (g[3] <= s_max)
             if sel.any():
                 x, y = g[0][sel], g[1][sel]
@@ -370,7 +386,7 @@ def _passing_sets(q, film_z: float, fxs, radii, wanted, r_rear: float, big: floa
     nothing passes (or the rim is not ``wanted``: film points x radii). A point's grid zooms in on its
     passing set once that has shrunk under :data:`_ZOOM` of the grid."""
     radii = np.asarray(radii, dtype=float)
-    boxes, grids = _first_grids(q, film_z, fxs, radii[0], r_rear, big, backend)
+    boxes, grids = _first_grids(q, film_z, fxs, radii, r_rear, big, backend)
     start = [0] * len(fxs)  # the first radius each point's current grid serves
     uses = [[] for _ in fxs]  # per film point: (grid, the first and end index of the radii it serves)
     pending = list(range(len(fxs)))
@@ -384,7 +400,7 @@ def _passing_sets(q, film_z: float, fxs, radii, wanted, r_rear: float, big: floa
             if f < radii.size:
                 zoom[p] = (xmin[i, f] - 2 * dx, xmax[i, f] + 2 * dx, ymax[i, f] + 2 * dy)
                 start[p] = f
-        for p, g in zip(zoom, _trace(q, film_z, [fxs[p] for p in zoom], list(zoom.values()), big, backend)
+        for p, g in zip(zoom, _trace(q, film_z, [fxs[p] for p in zoom], list(zoom.values()), radii, big, backend)
                         if zoom else []):
             grids[p], boxes[p] = g, zoom[p]
         pending = list(zoom)
@@ -417,15 +433,15 @@ def _shrunk(radii, grids, boxes, start):
     dx, dy = np.array([g[4] for g in grids])[:, None], np.array([g[5] for g in grids])[:, None]
     b = np.array(boxes)
     n_grid, n_rad = len(grids), radii.size
-    key = (np.arange(n_grid)[:, None] * (n_rad + 1) + _n_passing(radii, np.where(ok, rad, np.inf))).ravel()
+    key = (np.arange(n_grid)[:, None] * (n_rad + 1) + np.stack([g[7] for g in grids])).ravel()
 
     def running(v, fn, empty):  # per grid and radius i: fn over the samples with n > i
         e = np.full(n_grid * (n_rad + 1), empty)
         fn.at(e, key, v.ravel())
         return fn.accumulate(e.reshape(n_grid, n_rad + 1)[:, ::-1], axis=1)[:, ::-1][:, 1:]
 
-    anyp = running(np.ones(key.size), np.add, 0.0) > 0
     xmin, xmax, ymax = running(gx, np.minimum, np.inf), running(gx, np.maximum, -np.inf), running(gy, np.maximum, -np.inf)
+    anyp = xmin < np.inf
     small = (anyp & ((xmax - xmin + 4 * dx < _ZOOM * (b[:, 1:2] - b[:, 0:1])) | (ymax + 2 * dy < _ZOOM * b[:, 2:3]))
              & (np.arange(radii.size)[None, :] >= np.asarray(start)[:, None]))
     return np.where(small.any(axis=1), np.argmax(small, axis=1), radii.size), (xmin, xmax, ymax)
@@ -681,21 +697,24 @@ def _grow(table, levels, rhos, ss, which, rims) -> None:
         return
     reads = _reads(table, levels, rhos, ss)
     j0, rw, l0, lw, _ = reads
-    x, y, n = rims.points(which)
-    starts, c = np.cumsum(n) - n, np.repeat(np.arange(n.size), n)
     # the four entries each reading mixes, and which of them weigh in it
     rows, cols = np.stack([l0, l0, l0 + 1, l0 + 1]), np.stack([j0, j0 + 1, j0, j0 + 1])
     weighs = np.stack([(lw < 1) & (rw < 1 - 1e-9), (lw < 1) & (rw > 1e-9), (lw > 0) & (rw < 1 - 1e-9), (lw > 0) & (rw > 1e-9)])
+    which = np.asarray(which)
     for _ in range(8):
+        x, y, n = rims.points(which)
+        starts, c = np.cumsum(n) - n, np.repeat(np.arange(n.size), n)
         e = _ellipses_read(table, *reads)
         with np.errstate(divide="ignore", invalid="ignore"):
             v = np.sqrt(((x - e[c, 0]) / e[c, 1]) ** 2 + (y / e[c, 2]) ** 2)
         need = np.maximum.reduceat(v, starts) * _SAFETY
         need = np.where((e[:, 1] > 0) & (e[:, 2] > 0), need, math.inf)
-        short = ~(need <= 1.0)
-        if not short.any():
+        short = np.flatnonzero(~(need <= 1.0))
+        if not short.size:
             return
         f = np.ones(table.shape[:2])
-        w = weighs & short[None, :]
-        np.maximum.at(f, (rows[w], cols[w]), np.broadcast_to(need * (1 + 1e-6), w.shape)[w])
+        w = weighs[:, short]
+        np.maximum.at(f, (rows[:, short][w], cols[:, short][w]), np.broadcast_to(need[short] * (1 + 1e-6), w.shape)[w])
         table[..., 1:3] *= f[..., None]
+        # the readings that held hold still (their entries only grew): only the short ones are read again
+        which, reads, rows, cols, weighs = which[short], tuple(r[short] for r in reads), rows[:, short], cols[:, short], w
