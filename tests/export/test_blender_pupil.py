@@ -254,3 +254,41 @@ def test_the_batched_reading_is_the_shaders(seed):
     for i, (rho, s) in enumerate(zip(rhos, ss)):
         assert e[i].tolist() == interpolated_ellipse(table, levels, rho, s).tolist()
         assert a[i] == pytest.approx(interpolated_area(table, levels, rho, s), rel=1e-13, abs=0)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64) | st.floats(-1e4, 1e4).map(round)
+                | st.sampled_from([0.0, -0.0, 1e-4, 9.99999999e-5, 1e9, 999999999.5, 1.5e9, 1e16, 5e-324]),
+                min_size=1, max_size=40))
+def test_the_shaders_data_lines_write_each_number_as_its_nine_digit_repr(values):
+    """Every number of a data line (the pupil table's 154,000 among them) is osl_number of its nine-digit
+    rounding (a float32 exactly; the repr of that double, ".0" on an integer), whatever the shortcut
+    the line writer takes for the common case."""
+    from physcam.export.blender_focus import _arr32
+    from physcam.export.osl import osl_number
+
+    want = ", ".join(osl_number(float(format(v, ".9g"))) for v in values)
+    assert _arr32("T", values, "N") == f"    float T[N] = {{{want}}};"
+
+
+def test_levels_that_share_the_centres_aims_sample_a_region_holding_their_sets(table):
+    """The centre's normalisation traces one region per pair of levels (the wider one's ellipse at the
+    film centre): it holds every aim a dense trace finds passing at the narrower level's iris."""
+    from physcam.export.blender_pupil import _centre_ellipses
+
+    lens, ft, states = table
+    q = states[0]
+    st_ = focus(lens, float(ft.marks_mm[0]))
+    shared = _centre_ellipses(ft.radial[0])
+    assert (shared[1::2] == ft.radial[0][0::2, 0, :3][: len(shared[1::2])]).all()
+    for k in (1, 7, len(ft.levels) - 1):
+        cx, ax, ay = shared[k]
+        u = np.linspace(-1.0, 1.0, 121)
+        gx, gy = [a.ravel() for a in np.meshgrid(u * ft.radial[0][k, 0, 1] * 1.2, u * ft.radial[0][k, 0, 2] * 1.2)]
+        rays = RayBatch.from_arrays(np.broadcast_to([0.0, 0.0, st_.film_z], (gx.size, 3)),
+                                    np.stack([gx, gy, np.full(gx.size, q.vertex_z[-1] - st_.film_z)], axis=1),
+                                    q.wavelength_nm)
+        trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=float(ft.levels[k]), in_place=True)
+        ok = rays.flag == OK
+        assert ok.sum() > 100
+        assert (np.abs(gx[ok] - cx) <= ax).all() and (np.abs(gy[ok]) <= ay).all(), k
