@@ -390,3 +390,29 @@ def test_the_walk_of_export_blender_crosses_at_most_half_the_rooms():
 def test_the_walk_enters_onset_when_builtin_is_asked():
     """--builtin matches Blender's own camera to the lens report (onset/): the walk must see it there."""
     assert any(r.startswith("physcam.onset.") for r in walk_rooms(RoomWalkAll, builtin=True).rooms)
+
+
+def _import_module_calls(tree) -> int:
+    """Calls of importlib's import_module (by name or as importlib.import_module) in a module's tree."""
+    return sum(isinstance(n, ast.Call) and (getattr(n.func, "id", None) == "import_module"
+                                            or getattr(n.func, "attr", None) == "import_module")
+               for n in ast.walk(tree))
+
+
+def test_a_package_imports_its_lazy_names_through_one_path():
+    """A package whose module ``__getattr__`` imports names on first use imports them in one place (one
+    import_module call): physcam.lens.formats had two, its ``__getattr__`` and ``_module`` each importing
+    the same format modules (a fix to one, a missing name's message, would miss the other)."""
+    counts = {}
+    for init in sorted((SRC / "physcam").rglob("__init__.py")):
+        tree = ast.parse(init.read_text(encoding="utf-8"))
+        if any(isinstance(n, ast.FunctionDef) and n.name == "__getattr__" for n in tree.body):
+            counts[str(init.relative_to(SRC))] = _import_module_calls(tree)
+    assert "physcam/lens/formats/__init__.py" in counts  # the finder sees the lazy packages
+    assert {k: n for k, n in counts.items() if n > 1} == {}
+
+
+def test_the_lazy_import_counter_counts_both_spellings():
+    tree = ast.parse("import importlib\nfrom importlib import import_module\n"
+                     "def f():\n    return import_module('a')\ndef g():\n    return importlib.import_module('b')\n")
+    assert _import_module_calls(tree) == 2

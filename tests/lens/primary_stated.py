@@ -59,6 +59,71 @@ US_3506336 = [
     (-89.354, 0.50, None, None), (-600.000, 10.00, 1.77252, 49.6), (-110.648, None, None, None),
 ]
 
+#: US 4,310,222 (K. Ikemori / Canon, 1982), the first embodiment: the table of columns 8 and 9 (R3 is
+#: non-spherical, coefficients below); the stop sits in D15.
+US_4310222 = [
+    (44.344, 3.0, 1.6968, 55.5), (25.494, 10.63, None, None), (56.952, 6.14, 1.6031, 60.7), (58.976, 1.0, None, None),
+    (32.455, 1.5, 1.6968, 55.5), (15.699, 5.45, None, None), (34.226, 1.5, 1.7725, 49.7), (16.356, 4.18, None, None),
+    (202.88, 2.0, 1.6968, 55.5), (12.66, 12.71, 1.60342, 38.0), (-41.964, 2.187, None, None),
+    (56.099, 8.88, 1.51742, 52.3), (-13.786, 0.738, None, None), (-12.664, 1.2, 1.7725, 49.7),
+    (-26.477, 1.7, None, None), (140.256, 7.98, 1.69895, 30.1), (-14.608, 1.0, 1.62606, 39.1),
+    (55.637, 0.846, None, None), (-55.153, 1.0, 1.84666, 23.9), (27.603, 4.24, 1.48749, 70.1),
+    (-15.512, 0.15, None, None), (111.951, 3.41, 1.60311, 60.7), (-32.396, None, None, None),
+]
+#: The fourth embodiment: the table of column 13 (R3 non-spherical); the stop sits in D10.
+US_4310222_EX4 = [
+    (36.562, 2.5, 1.6968, 55.5), (18.877, 6.76, None, None), (36.009, 5.31, 1.60311, 60.7), (36.0, 0.16, None, None),
+    (26.936, 1.5, 1.6968, 55.7), (10.237, 7.52, None, None), (40.279, 12.62, 1.60342, 38.0), (-15.661, 1.116, None, None),
+    (-13.1, 1.0, 1.7725, 49.6), (-27.485, 1.7, None, None), (87.301, 5.967, 1.69895, 30.1),
+    (-16.511, 1.0, 1.59551, 39.2), (123.783, 1.788, None, None), (-56.858, 1.0, 1.92286, 21.3),
+    (27.983, 4.0, 1.48749, 70.1), (-15.574, 0.15, None, None), (1652.078, 2.65, 1.7725, 49.6), (-29.01, None, None, None),
+]
+#: The fifth embodiment: the table of column 15 (R3 non-spherical); the stop sits in D13. R6 is printed
+#: 3.3649; the patent's own h column, Petzval term and f need 8.3649 (the file's; tests below).
+US_4310222_R6_PRINTED = 3.3649
+US_4310222_EX5 = [
+    (49.0189, 2.3, 1.6968, 55.5), (15.0921, 4.48, None, None), (47.2056, 4.0, 1.60311, 60.7), (47.2056, 1.0, None, None),
+    (21.34, 1.0, 1.6968, 55.5), (8.3649, 5.685, None, None), (514.905, 1.5, 1.6968, 55.5), (7.745, 9.46, 1.60342, 38.0),
+    (-139.463, 1.3, None, None), (33.6069, 7.295, 1.60342, 38.0), (-16.1228, 1.6, None, None),
+    (-10.9129, 1.0, 1.7725, 49.6), (-18.1377, 1.7, None, None), (131.723, 6.376, 1.59551, 39.2),
+    (35.387, 0.927, None, None), (-489.874, 0.7, 1.92286, 21.3), (16.7027, 3.684, 1.48749, 70.1),
+    (-11.9649, 0.15, None, None), (23.5946, 2.925, 1.7725, 49.6), (-31.1173, None, None, None),
+]
+#: What the patent prints beside each of the two tables: R3's non-spherical coefficients B, C, D, E (A = 0:
+#: X = R(1 - (1 - H^2/R^2)^(1/2)) + A H^2 + B H^4 + ... + E H^10); the h (axial paraxial ray, incident height
+#: 1) and h-bar (principal ray, f = 1) columns; the third-order table's PT (Petzval) column and its total
+#: (row 20 of the first is printed -0.6776); its lens groups' focal lengths (first and last surface, in units
+#: of the stated f); and the stated f those are in.
+US_4310222_COLUMNS = {
+    "canon_wide_angle_us4310222_14mm_f2_8": dict(
+        asphere=(9.660e-6, 2.605e-9, 1.106e-11, 2.260e-14),
+        h=(1.000, 0.972, 1.088, 1.085, 1.096, 1.084, 1.275, 1.280, 1.559, 1.631, 2.213, 2.304, 2.423, 2.371,
+           2.421, 2.427, 2.386, 2.373, 2.378, 2.401, 2.612, 2.610, 2.563),
+        hbar=(-1.942, -1.764, -1.208, -0.958, -0.903, -0.837, -0.632, -0.588, -0.487, -0.457, -0.280, -0.223,
+              -0.056, -0.034, -0.014, 0.035, 0.170, 0.187, 0.212, 0.230, 0.333, 0.337, 0.388),
+        pt=(0.1322, -0.2300, 0.0943, -0.0910, 0.1806, -0.3735, 0.1818, -0.3804, 0.0289, -0.0387, 0.1280, 0.0867,
+            0.3531, -0.4914, 0.2350, 0.0418, 0.0257, -0.0988, -0.1187, -0.6776, 0.3016, 0.0479, 0.1658),
+        pt_total=0.1138, groups=((1, 8, -1.06), (9, 15, 2.67), (16, 23, 2.37)), f=14.2, bf=36.6),
+    "canon_wide_angle_us4310222_17mm_f2_8": dict(
+        asphere=(2.530e-5, 1.505e-8, -2.012e-11, 2.102e-13),
+        h=(1.000, 0.972, 1.086, 1.081, 1.084, 1.074, 1.539, 1.844, 1.808, 1.849, 1.887, 1.913, 1.910, 1.918,
+           1.936, 2.113, 2.113, 2.110),
+        hbar=(-1.133, -1.016, -0.734, -0.555, -0.548, -0.496, -0.306, -0.072, -0.036, -0.019, 0.034, 0.142,
+              0.160, 0.215, 0.233, 0.334, 0.338, 0.379),
+        pt=(0.1948, -0.3773, 0.1812, -0.1812, 0.2644, -0.6958, 0.1620, 0.4168, -0.5770, 0.2750, 0.0817, 0.0400,
+            -0.0523, -0.1464, -0.0943, 0.3650, 0.0045, 0.2605),
+        pt_total=0.1218, groups=((1, 6, -0.93), (7, 10, 2.46), (11, 18, 1.54)), f=17.34, bf=36.61),
+    "canon_wide_angle_us4310222_5_5mm_f1_6": dict(
+        asphere=(1.111e-4, -1.823e-7, -6.583e-11, 6.906e-12),
+        h=(1.000, 0.981, 1.120, 1.162, 1.193, 1.189, 1.710, 1.789, 2.444, 2.574, 2.820, 2.738, 2.819, 2.857,
+           2.894, 2.948, 2.971, 3.321, 3.322, 3.152),
+        hbar=(-2.561, -2.266, -1.761, -1.423, -1.305, -1.211, -0.876, -0.823, -0.526, -0.458, -0.182, -0.073,
+              -0.038, 0.070, 0.325, 0.389, 0.414, 0.614, 0.622, 0.680),
+        pt=(0.0462, -0.1502, 0.0439, -0.0439, 0.1062, -0.2709, 0.0044, -0.0244, 0.0148, 0.0618, 0.1288, -0.2204,
+            0.1326, 0.0156, -0.0582, -0.0054, -0.0503, 0.1511, 0.1019, 0.0773),
+        pt_total=0.0611, groups=((1, 6, -1.976), (7, 13, 7.22), (14, 20, 2.735)), f=5.52, bf=17.4),
+}
+
 #: slug -> (the patent's table, what the patent states: focal length, f-number, back focus from the last
 #: vertex (None: the patent states none) and the tolerance its printed digits allow).
 PRIMARY = {
@@ -75,4 +140,14 @@ PRIMARY = {
     # Takahashi: "resultant focal length F=100" (column 2), Fig. 2's aberrations to "1:2.0"; no back focus
     "asahi_wide_angle_us3506336_100mm_f2": (US_3506336, dict(efl=100.0, fno=2.0, bf=None)),
     "nikon_retrofocus_us3583791_100mm_f2_8": (US_3583791, dict(efl=100.0, fno=2.8, bf=131.19, bf_tol=0.005 * 131.19)),
+    # Ikemori: "f (focal distance) = 14.2; F No. = 1:2.8, bf (back focal distance) = 36.6, Angle of field = 114 deg".
+    # The stated 14.2 is nominal: the patent's own h column gives f = bf / 2.563 = 14.280 (test below), which the
+    # lens has (+0.56 %), so the EFL's tolerance is 0.6 % here and the design's f is checked at 0.1 % below
+    "canon_wide_angle_us4310222_14mm_f2_8": (US_4310222, dict(efl=14.2, efl_rel=6e-3, fno=2.8, bf=36.6, bf_tol=0.05)),
+    # the same, fourth embodiment: "f = 17.34, bf = 36.61, F No. = 1:2.8, Angle of field = 104 deg"
+    "canon_wide_angle_us4310222_17mm_f2_8": (US_4310222_EX4, dict(efl=17.34, fno=2.8, bf=36.61, bf_tol=0.005)),
+    # the same, fifth embodiment: "f = 5.52 ... bf = 17.2, F No. = 1:1.6, Angle of field = 99.8 deg". The printed
+    # bf 17.2 is not this table's: its own h column ends at bf/f = 3.152, i.e. 17.40 (test below), as the
+    # sixth embodiment's bf = 17.4 reads; the back focus is checked against 17.4
+    "canon_wide_angle_us4310222_5_5mm_f1_6": (US_4310222_EX5, dict(efl=5.52, fno=1.6, bf=17.4, bf_tol=0.005)),
 }

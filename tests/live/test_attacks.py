@@ -497,3 +497,75 @@ def test_an_invalid_copy_of_a_sample_does_not_cost_the_real_one(forged_first):
         c = rx.counters()
     assert _ids(got) == [s["sampleId"] for s in good], c
     assert c["invalid"] == 1 and c["late"] == 0 and c["missing"] == 0
+
+
+def _forged(sample, frames_ahead=7):
+    """A schema-valid deep copy of ``sample`` with a new sampleId and its timecode ``frames_ahead`` later
+    (the review's forgery: same source, same packet number, nothing a schema check can refuse)."""
+    f = copy.deepcopy(sample)
+    f["sampleId"] = "urn:uuid:f0f0f0f0-0000-4000-8000-0000000000f0"
+    f["timing"]["timecode"]["frames"] += frames_ahead
+    decode_sample(encode_sample(f))  # valid
+    return f
+
+
+@pytest.mark.parametrize("forged_first", [True, False])
+def test_a_valid_forged_copy_is_handed_on_as_a_conflict_not_the_real_one_late(forged_first):
+    """Samples 0 and 1, a valid forged copy of 2 (new sampleId, timecode changed, packet number 2) and the
+    real 2, in either order, then 3 and 4, over UDP: the receiver hands on 0-4 in order as they came and
+    the second claimant of 2, flagged as a conflict right after its number; counted `conflict`, never
+    `late` (before: the real 2, after the forgery, was counted late and lost)."""
+    good = _samples(5)
+    forged = _forged(good[2])
+    claim = [("tx", _datagrams(forged, 2)), ("tx", _datagrams(good[2], 2))]
+    claim = claim if forged_first else claim[::-1]
+    order = [("tx", _datagrams(good[i], i)) for i in (0, 1)] + claim + [("tx", _datagrams(good[i], i)) for i in (3, 4)]
+    with Receiver(0, host="127.0.0.1", reorder_timeout_s=5.0) as rx:
+        got = _stream(rx, order)
+        _drain(rx, got, 6, timeout=1.0)
+        c = rx.counters()
+    first, second = (forged, good[2]) if forged_first else (good[2], forged)
+    assert c["late"] == 0 and [i.sample["sampleId"] for i in got].count(good[2]["sampleId"]) == 1, c
+    assert [(i.sample["sampleId"], i.sequence, i.conflict) for i in got] == [
+        (good[0]["sampleId"], 0, False), (good[1]["sampleId"], 1, False), (first["sampleId"], 2, False),
+        (second["sampleId"], 2, True), (good[3]["sampleId"], 3, False), (good[4]["sampleId"], 4, False)], c
+    assert c["conflict"] == 1 and c["late"] == 0 and c["stray"] == 0 and c["delivered"] == 5 and c["missing"] == 0
+
+
+def test_two_claimants_in_the_window_are_both_handed_on():
+    """While number 2 waits in the window for a lost 1 (sent last), a forged 2 and the real 2 both arrive:
+    the first is handed on in order, the second flagged as a conflict after it (before: counted `duplicate`
+    and dropped, whichever came first kept); the same sample sent again as CBOR is a duplicate."""
+    good = _samples(5)
+    forged = _forged(good[2])
+    order = [("tx", _datagrams(good[0], 0)), ("tx", _datagrams(forged, 2)), ("tx", _datagrams(good[2], 2)),
+             ("tx", _datagrams(good[2], 2, "cbor")), ("tx", _datagrams(good[1], 1)),
+             ("tx", _datagrams(good[3], 3)), ("tx", _datagrams(good[4], 4))]
+    with Receiver(0, host="127.0.0.1", reorder_timeout_s=5.0) as rx:
+        got = _stream(rx, order)
+        _drain(rx, got, 6, timeout=1.0)
+        c = rx.counters()
+    assert [i.sample["sampleId"] for i in got].count(good[2]["sampleId"]) == 1, c
+    assert [(i.sample["sampleId"], i.sequence, i.conflict) for i in got] == [
+        (good[0]["sampleId"], 0, False), (good[1]["sampleId"], 1, False), (forged["sampleId"], 2, False),
+        (good[2]["sampleId"], 2, True), (good[3]["sampleId"], 3, False), (good[4]["sampleId"], 4, False)], c
+    assert c["conflict"] == 1 and c["duplicate"] == 1 and c["late"] == 0
+
+
+def test_a_flood_of_forged_copies_of_one_number_is_counted_and_bounded():
+    """Ten different valid copies of sample 2 after the real one: all ten counted `conflict`, the first four
+    handed on flagged (a bound per number, like the window's), the real stream whole and nothing `late`."""
+    good = _samples(5)
+    copies = []
+    for k in range(10):
+        f = _forged(good[2], frames_ahead=k + 1)
+        f["sampleId"] = f"urn:uuid:f0f0f0f0-0000-4000-8000-0000000000{k:02d}"
+        copies.append(("tx", _datagrams(f, 2)))
+    order = [("tx", _datagrams(good[i], i)) for i in (0, 1, 2)] + copies + [("tx", _datagrams(good[i], i)) for i in (3, 4)]
+    with Receiver(0, host="127.0.0.1", reorder_timeout_s=5.0) as rx:
+        got = _stream(rx, order)
+        _drain(rx, got, 9, timeout=1.0)
+        c = rx.counters()
+    assert [i.sample["sampleId"] for i in got if not i.conflict] == [s["sampleId"] for s in good], c
+    assert [i.sample["sampleId"][-2:] for i in got if i.conflict] == ["00", "01", "02", "03"]
+    assert c["conflict"] == 10 and c["late"] == 0 and c["delivered"] == 5

@@ -571,3 +571,109 @@ def test_the_live_api_refuses_a_5000_digit_argument_in_one_line(call):
     with pytest.raises(InputError) as err:
         calls[call]()
     assert "an integer of 5001 digits" in str(err.value) and len(str(err.value)) < 200
+
+
+# --- a valid forged copy of a sample (a user review, round 8) ------------------------------------------------
+def _timecodes(usd_file) -> list[str]:
+    from pxr import Usd
+
+    stage = Usd.Stage.Open(str(usd_file))
+    attr = stage.GetPrimAtPath("/Cameras/Camera").GetAttribute("physcam:live:timecode")
+    return [attr.Get(t) for t in attr.GetTimeSamples()]
+
+
+@pytest.mark.slow
+@needs_proc_net_udp
+@pytest.mark.parametrize("forgery", ["timecode 7 frames later", "same clocks, focus moved"])
+def test_a_valid_forged_copy_never_silently_takes_the_real_frame(tmp_path, forgery):
+    """The review's stream over UDP into `physcam live record`: samples 0 and 1, then a schema-valid deep
+    copy of 2 (new sampleId, packet number 2), then the real 2, 3, 4. When the copy's timecode contradicts
+    its neighbours (00:00:00:09 between :01 and :03) the take holds the real 2; when it carries the same
+    clocks as the real one (only the focus differs) nothing tells them apart and the take holds neither
+    (frame 2 missing). Either way the conflict is named on stderr and in the summary, and counted
+    `conflict`, not `late` (before: the copy was recorded as frame 2 and the real 2 counted late)."""
+    pytest.importorskip("pxr")
+    from _documents import check_document
+
+    good = _samples(5)
+    forged = copy.deepcopy(good[2])
+    forged["sampleId"] = "urn:uuid:f0f0f0f0-0000-4000-8000-0000000000f0"
+    if forgery.startswith("timecode"):
+        forged["timing"]["timecode"]["frames"] += 7
+    else:
+        forged["lens"]["focusDistance"] += 1.0
+    decode_sample(json.dumps(forged).encode())  # valid against the schema
+    with _Recorder(tmp_path, "--json") as rec:
+        rec.wait_for_port()
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+            for seq, s in [(0, good[0]), (1, good[1]), (2, forged), (2, good[2]), (3, good[3]), (4, good[4])]:
+                _send_raw(sock, rec.port, json.dumps(s).encode(), seq, "json")
+        assert rec.finish(signal.SIGTERM) == 0, rec.stderr
+    doc = json.loads(rec.stdout)
+    check_document(doc)
+    c = doc["counters"]
+    if forgery.startswith("timecode"):  # (before: ..., "00:00:00:09", "00:00:00:03", ... and late 1)
+        assert _timecodes(tmp_path / "take.usda") == [f"00:00:00:0{i}" for i in range(5)], c
+    assert c["late"] == 0 and c["conflict"] == 1 and c["stray"] == 0, c
+    real, fake = good[2]["sampleId"], forged["sampleId"]
+    [conflict] = doc["conflicts"]
+    assert conflict["sequence"] == 2 and [x["sample_id"] for x in conflict["claimants"]] == [fake, real]
+    lines = [line for line in rec.stderr.splitlines() if line.startswith("physcam: conflict: packet 2 ")]
+    assert len(lines) == 1 and fake in lines[0] and real in lines[0], rec.stderr
+    if forgery.startswith("timecode"):
+        assert conflict["kept"] == real and [x["timecode"] for x in conflict["claimants"]] == ["00:00:00:09",
+                                                                                             "00:00:00:02"]
+        assert doc["frames"] == 5 and c["missing"] == 0
+        assert _timecodes(tmp_path / "take.usda") == [f"00:00:00:0{i}" for i in range(5)]
+        assert f"kept {real}" in lines[0]
+    else:
+        assert conflict["kept"] is None and "more than one agrees" in conflict["reason"]
+        assert doc["frames"] == 4 and c["missing"] == 1
+        assert _timecodes(tmp_path / "take.usda") == ["00:00:00:00", "00:00:00:01", "00:00:00:03", "00:00:00:04"]
+        assert "kept neither" in lines[0]
+
+
+def test_live_recover_judges_a_journals_claimants_as_the_recorder_does(tmp_path, capsys):
+    """The journal keeps both claimants of packet 2, the second marked `"conflict": true`; `live recover`
+    reads the mark and keeps the real 2 (its timecode agrees with frames 1 and 3), naming the conflict."""
+    pytest.importorskip("pxr")
+    from physcam.live.journal import Journal
+
+    good = _samples(5)
+    forged = copy.deepcopy(good[2])
+    forged["sampleId"] = "urn:uuid:f0f0f0f0-0000-4000-8000-0000000000f0"
+    forged["timing"]["timecode"]["frames"] += 7
+    j = Journal.create(tmp_path / "take.usda", {"output": "take.usda", "report": None, "options": {}})
+    for seq, s, conflict in [(0, good[0], False), (1, good[1], False), (2, forged, False), (2, good[2], True),
+                             (3, good[3], False), (4, good[4], False)]:
+        j.add_sample(s, seq, "cbor", conflict)
+    j.close()
+    assert b'"conflict":true' in j.path.read_bytes()
+    assert main(["live", "recover", str(j.path), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["frames"] == 5 and [c["kept"] for c in doc["conflicts"]] == [good[2]["sampleId"]]
+    assert _timecodes(tmp_path / "take.usda") == [f"00:00:00:0{i}" for i in range(5)]
+
+
+@pytest.mark.parametrize("rival_frame, rival_timecode, kept, why", [
+    (11, "00:00:00:19", 0, "the only one"),  # the review's forgery: the timestamp copied, the timecode 8 ahead
+    (12, "00:00:00:11", 0, "the only one"),  # a timestamp a frame late gives it away alone
+    (11, "00:00:00:11", None, "more than one"),  # the same clocks (other lens values): no telling them apart
+    (None, "00:00:00:11", None, "more than one"),  # no timestamp, the same timecode
+    (10, "00:00:00:10", None, "none agrees"),  # and the "real" one stamped frame 9 (below): neither fits
+])
+def test_judge_claimants_keeps_the_one_its_neighbours_clocks_agree_with(rival_frame, rival_timecode, kept, why):
+    """At 24 fps, packets 10 and 12 are frames 10 and 12 (00:00:00:10, :12) by both clocks; packet 11 is
+    claimed by the real frame 11 and a rival. A clock counts where both frames carry it: frames apart must
+    be packets apart. (Worked by hand.)"""
+    from physcam.live.take import judge_claimants
+
+    at = lambda frame, tc: TrackedFrame(time_ns=None if frame is None else T0_NS + frame * 10**9 // 24,  # noqa: E731
+                                        timecode=tc, rate=Fraction(24))
+    real, rival = at(11, "00:00:00:11"), at(rival_frame, rival_timecode)
+    if kept is None and why == "none agrees":
+        real = at(9, "00:00:00:09")  # a real frame that the neighbours do not vouch for either
+    neighbours = [(at(10, "00:00:00:10"), 10), (at(12, "00:00:00:12"), 12)]
+    assert judge_claimants([(real, 11), (rival, 11)], neighbours)[0] == kept
+    assert why in judge_claimants([(real, 11), (rival, 11)], neighbours)[1]
+    assert judge_claimants([(real, 11), (rival, 11)], []) == (None, "no undisputed neighbour to judge by")

@@ -202,12 +202,13 @@ class _Recording:
         self.warned = False
 
     def add(self, item) -> None:
-        if self.journal is not None and not self.journal.add_sample(item.sample, item.sequence, item.encoding) \
+        if self.journal is not None and not self.journal.add_sample(item.sample, item.sequence, item.encoding,
+                                                                    item.conflict) \
                 and self.journal.error is not None and not self.warned:
             self.warned = True
             print(f"physcam: warning: the journal {self.journal.path} stopped ({self.journal.error}); the take "
                   f"goes on in memory from sample {self.journal.samples + 1}", file=sys.stderr)
-        self.take.add(item.sample, item.sequence)
+        self.take.add(item.sample, item.sequence, item.conflict)
 
     def keep(self, receiver, now: float) -> None:
         if self.journal is None:
@@ -330,13 +331,18 @@ def write_take(s: Settings, take, counters: dict, journal_path, elapsed: float, 
     counters["refused"] = take.refused + len(refused)
     for reason in refusals[:10]:
         print(f"physcam: refused {reason}", file=sys.stderr)
+    conflicts = take.conflicts()
+    for c in conflicts[:10]:
+        print(f"physcam: {conflict_line(c)}", file=sys.stderr)
+    if len(conflicts) > 10:
+        print(f"physcam: {len(conflicts) - 10} more packet numbers claimed by different samples", file=sys.stderr)
     if len(refusals) > 10:
         print(f"physcam: refused {len(refusals) - 10} more samples", file=sys.stderr)
     out, rep, moved = _write_files(s, solved, journal_path)
     if not moved:  # every file where it was asked (or beside it): the journal has done its work
         discard()
     _summary(s, take, solved, counters, out, rep, elapsed, interrupted, as_json, recovered_from,
-             journal_path if moved else None)
+             journal_path if moved else None, conflicts)
     return 0  # a signal is how a recording is ended: the file is written and that is success
 
 
@@ -397,7 +403,16 @@ def _write_files(s: Settings, solved, journal_path) -> tuple[Path, Path | None, 
     return out, rep, moved
 
 
-def _summary(s, take, solved, counters, out, rep, elapsed, interrupted, as_json, recovered_from, journal) -> None:
+def conflict_line(c: dict) -> str:
+    """One line naming a packet number that different samples claimed, and what the take kept."""
+    who = ", ".join(f"{x['sample_id']} (timecode {x['timecode'] or '-'})" for x in c["claimants"])
+    kept = f"kept {c['kept']}" if c["kept"] is not None else "kept neither (the frame is missing)"
+    return f"conflict: packet {c['sequence']} was claimed by {len(c['claimants'])} different samples: {who}; " \
+           f"{kept}: {c['reason']}"
+
+
+def _summary(s, take, solved, counters, out, rep, elapsed, interrupted, as_json, recovered_from, journal,
+             conflicts) -> None:
     heard = take.sources()
     chosen = next(h for h in heard if h["recorded"])
     others = [h for h in heard if not h["recorded"]]
@@ -406,7 +421,7 @@ def _summary(s, take, solved, counters, out, rep, elapsed, interrupted, as_json,
                "first_timecode": solved[0].frame.timecode, "last_timecode": solved[-1].frame.timecode,
                "source": chosen, "other_sources": others, "unlisted_source_samples": take.unlisted_samples,
                "asked_file": s.file, "asked_report": s.report, "recovered_from": recovered_from,
-               "journal": None if journal is None else str(journal)}
+               "journal": None if journal is None else str(journal), "conflicts": conflicts[:100]}
     if as_json:
         emit_json(document("live_record", summary, version=2, units={"time": "s"}))
         return
@@ -420,6 +435,8 @@ def _summary(s, take, solved, counters, out, rep, elapsed, interrupted, as_json,
             f" (source {h['source_number']})" if h["source_number"] is not None else "") + f": {h['samples']} sample{'s' * (h['samples'] != 1)}")
     if take.unlisted_samples:
         print(f"  and {take.unlisted_samples} samples of further sources")
+    for c in conflicts[:10]:
+        print(f"  {conflict_line(c)}")
 
 
 def run_recover(args) -> int:
@@ -447,7 +464,7 @@ def run_recover(args) -> int:
         if record[0] == "counters":
             counters = {k: v for k, v in record[1].items() if isinstance(k, str) and isinstance(v, int)}
         elif not take.full:
-            take.add(record[3], record[1])
+            take.add(record[3], record[1], record[4])
     for what, n in (("torn at its end (a write cut short)", reader.torn), ("damaged, skipped", reader.skipped)):
         if n:
             print(f"physcam: note: {args.journal}: {n} line{'s' * (n > 1)} {what}", file=sys.stderr)

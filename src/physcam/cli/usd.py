@@ -482,9 +482,24 @@ def run_refresh(args) -> int:
         d = dict(res)
         d["file_units"] = d.pop("units")  # as usd check
         emit_json(document("usd_refresh", d))
+    elif not res["written"]:
+        print(f"{res['path']}: companion camera current; nothing to recompute, {args.file} not rewritten")
     else:
-        print(f"{res['path']}: companion camera recomputed")
+        n = len(res["changed"])
+        print(f"{res['path']}: companion camera recomputed; {n} value{'s' * (n != 1)} changed"
+              + (":" if n else " (the inputs hash only)"))
+        for c in res["changed"]:
+            print(f"  {c['attribute']}: {_shown(c['before'])} -> {_shown(c['after'])}")
     return 0
+
+
+def _shown(v) -> str:
+    """A refreshed attribute's value for people: numbers as %g, lists in parentheses, none as '(none)'."""
+    if v is None:
+        return "(none)"
+    if isinstance(v, list):
+        return "(" + ", ".join(f"{x:.9g}" for x in v) + ")"
+    return f"{v:.9g}" if isinstance(v, float) else str(v)
 
 
 def run_plugin_path(args) -> int:

@@ -14,7 +14,9 @@ recorder took, the decoded and validated sample as sent::
 
     {"sequence": 17, "encoding": "cbor", "sample": {...}}
 
-and, now and then, ``{"counters": {...}}``: the receiver's counters at that moment.
+(with ``"conflict": true`` when the sample claimed a number another sample of its source held:
+:mod:`physcam.live.take`, "Conflicts") and, now and then, ``{"counters": {...}}``: the receiver's
+counters at that moment.
 
 Writing: each line goes to the file in one ``write`` call of the process (no buffer of its own), so
 a recorder killed by SIGKILL loses nothing it took; the file is synced to the disk (``fsync``) at
@@ -193,9 +195,13 @@ class Journal:
         self._dirty = True
         return True
 
-    def add_sample(self, sample: dict, sequence: int, encoding: str) -> bool:
-        """Append one taken sample; False when the journal has stopped (:attr:`error`)."""
-        ok = self._append({"sequence": sequence, "encoding": encoding, "sample": sample})
+    def add_sample(self, sample: dict, sequence: int, encoding: str, conflict: bool = False) -> bool:
+        """Append one taken sample (``conflict``: a rival claimant of its number); False when the journal
+        has stopped (:attr:`error`)."""
+        line = {"sequence": sequence, "encoding": encoding, "sample": sample}
+        if conflict:
+            line["conflict"] = True
+        ok = self._append(line)
         self.samples += ok
         return ok
 
@@ -258,7 +264,7 @@ class Journal:
 
 class JournalReader:
     """Read a journal (module notes): :attr:`header`, then iterate for ``("sample", sequence,
-    encoding, sample)`` and ``("counters", counters)``; :attr:`torn` and :attr:`skipped` count the
+    encoding, sample, conflict)`` and ``("counters", counters)``; :attr:`torn` and :attr:`skipped` count the
     lines left out once iteration ends."""
 
     def __init__(self, path):
@@ -312,7 +318,7 @@ def _parse(line: bytes):
         return None
     if isinstance(obj.get("sample"), dict) and isinstance(obj.get("sequence"), int) \
             and obj.get("encoding") in ("json", "cbor"):
-        return ("sample", obj["sequence"], obj["encoding"], obj["sample"])
+        return ("sample", obj["sequence"], obj["encoding"], obj["sample"], obj.get("conflict") is True)
     if isinstance(obj.get("counters"), dict):
         return ("counters", obj["counters"])
     return None

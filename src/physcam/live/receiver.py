@@ -24,10 +24,17 @@ do: a restarted sender (numbers back to 0) or a jump is followed, and one packet
 sequence never moves it. A run that the stream's own samples interrupt is dropped: **late** if it
 lay behind, **stray** if ahead.
 
+Conflicts: UDP cannot be authenticated, so a different valid sample may claim a number its source has
+used (a forged or replayed copy). A digest of each source's last ``HANDED_MEMORY`` (64) samples handed
+on is kept (their content, whatever the encoding); a different valid sample for one of those numbers,
+or for one waiting in the window, is counted **conflict** (never late) and handed on flagged
+(:attr:`ReceivedSample.conflict`) after the sample it disputes, for the take to judge
+(:mod:`physcam.live.take`, "Conflicts").
+
 Counters (:meth:`Receiver.counters`): ``received`` datagrams; ``malformed`` (not OpenTrackIO,
 truncated, oversized, contradictory or overlapping segments, undecodable payload); ``wrong_checksum``;
-``duplicate`` (a datagram received again, byte for byte; a second sample for a number already held);
-``late``; ``stray``; ``invalid`` (decoded but not a valid sample, or a source number outside
+``duplicate`` (a datagram received again, byte for byte; the same sample again in another encoding);
+``late``; ``conflict``; ``stray``; ``invalid`` (decoded but not a valid sample, or a source number outside
 1..200); ``dropped`` (unfinished segmented samples pushed out, or samples the consumer did not take
 before the queue filled); ``missing`` (sequence numbers given up); ``resync``; ``delivered``. No
 payload ends the receiving thread: one the checks themselves fail on is counted ``invalid``; the
@@ -43,6 +50,7 @@ thread and closes the socket.
 
 from __future__ import annotations
 
+import json
 import queue
 import socket
 import struct
@@ -58,8 +66,8 @@ from .sample import SampleError, SampleProblem, decode_sample, sample_problems, 
 __all__ = ["Receiver", "ReceivedSample", "COUNTERS", "DEFAULT_PORT", "SOURCE_NUMBERS", "MAX_SOURCES", "multicast_group"]
 
 DEFAULT_PORT = 55555
-COUNTERS = ("received", "malformed", "wrong_checksum", "duplicate", "late", "stray", "invalid", "dropped",
-            "missing", "resync", "delivered")
+COUNTERS = ("received", "malformed", "wrong_checksum", "duplicate", "late", "conflict", "stray", "invalid",
+            "dropped", "missing", "resync", "delivered")
 #: OpenTrackIO's source numbers (the transport's multicast groups 239.135.1.1 to 239.135.1.200)
 SOURCE_NUMBERS = (1, 200)
 #: sources followed at once; a new one beyond this pushes out the one heard from longest ago
@@ -67,6 +75,10 @@ MAX_SOURCES = 16
 _RECV_BUFFER = 65536  # the largest UDP datagram fits
 _DUPLICATE_MEMORY = 4096  # keys of the last datagrams accepted, to know a repeated one
 _EXPIRE_EVERY_S = 0.005
+#: sequence numbers per source whose handed-on sample is remembered (a digest), to know a rival claimant
+HANDED_MEMORY = 64
+#: rival claimants held per number while it waits in the window (more are counted, not handed on)
+MAX_RIVALS = 4
 #: the reasons kept for refused payloads (:meth:`Receiver.refusals`); the counters count them all
 MAX_REFUSALS_NOTED = 10
 
@@ -100,12 +112,15 @@ def check_address(name: str, text) -> str:
 @dataclass(frozen=True)
 class ReceivedSample:
     """A validated sample, its packet sequence number (unwrapped per source: it goes back when the
-    source restarts), encoding and arrival time (monotonic s)."""
+    source restarts), encoding and arrival time (monotonic s). ``conflict``: a second, different valid
+    sample claiming a number that another sample of its source holds (module notes); handed on out of
+    order, after that one, for the consumer to judge (:mod:`physcam.live.take`)."""
 
     sample: dict
     sequence: int
     encoding: str
     arrival_s: float
+    conflict: bool = False
 
 
 class Receiver:
@@ -348,6 +363,11 @@ class Receiver:
                 held = st.window[ext]
                 if held[1] is None and item is not None:  # a valid sample beats an invalid one's placeholder
                     st.window[ext] = (held[0], item)
+                elif item is not None and _digest(item) not in map(_digest, (held[1], *st.rivals.get(ext, ()))):
+                    self._count("conflict")  # two different valid samples, one number
+                    rivals = st.rivals.setdefault(ext, [])
+                    if len(rivals) < MAX_RIVALS:
+                        rivals.append(item)  # handed on, flagged, right after the one held
                 else:
                     self._count("duplicate")
             else:
@@ -363,7 +383,8 @@ class Receiver:
         A straggler older than what was handed on is late at once (and taken back should its run
         resynchronise after all: a sender replaying old timestamps)."""
         stamp = _stamp(item)
-        stale = ext < st.next and stamp is not None and st.stamp is not None and stamp <= st.stamp
+        stale = ext < st.next and stamp is not None and st.stamp is not None and stamp <= st.stamp \
+            and not self._rival(st, ext, item)  # a rival of a handed-on sample is counted when its run ends
         if stale:
             self._count("late")
         entry = (seq, ext, now, item, stale)
@@ -377,10 +398,25 @@ class Receiver:
             self._resync(st, now)
 
     def _drop_run(self, st: "_Stream") -> None:
+        """The run was no new stream: count its samples late or stray, except a different sample for a
+        number already handed on, which is handed on flagged as a conflict (module notes)."""
         for _, ext, _, item, counted in st.run:
             if item is not None and not counted:
-                self._count("late" if ext < st.next else "stray")
+                if self._rival(st, ext, item):
+                    self._count("conflict")
+                    if len(st.handed[ext]) <= MAX_RIVALS:  # more are counted, not handed on (bounded)
+                        st.handed[ext] += (_digest(item),)
+                        self._hand_on(item, ext, conflict=True)
+                elif ext < st.next and _digest(item) in st.handed.get(ext, ()):
+                    self._count("duplicate")  # a sample handed on already, in another encoding
+                else:
+                    self._count("late" if ext < st.next else "stray")
         st.run = []
+
+    @staticmethod
+    def _rival(st: "_Stream", ext: int, item) -> bool:
+        """Whether ``item`` is a different sample for the number ``ext`` that this source handed on lately."""
+        return ext < st.next and ext in st.handed and _digest(item) not in st.handed[ext]
 
     def _resync(self, st: "_Stream", now: float) -> None:
         """The run becomes the stream: hand on what the window holds, then number from the run's first."""
@@ -395,24 +431,36 @@ class Receiver:
             ext = st.next + (seq - first) % 65536
             st.window[ext] = (arrived, item)
             st.top = max(st.top, ext)
+        st.handed.clear()  # the numbers now name the new stream's samples
         self._count("resync")
         self._flush(st, now)
 
     def _deliver(self, st: "_Stream", ext: int) -> None:
         _, item = st.window.pop(ext)
+        rivals = st.rivals.pop(ext, ())
         st.next = ext + 1
         if item is None:
             return
         stamp = _stamp(item)
         if stamp is not None:
             st.stamp = stamp if st.stamp is None else max(st.stamp, stamp)
+        st.handed[ext] = (_digest(item), *map(_digest, rivals))
+        if len(st.handed) > HANDED_MEMORY:
+            del st.handed[next(iter(st.handed))]
+        if self._hand_on(item, ext):
+            self._count("delivered")
+        for rival in rivals:
+            self._hand_on(rival, ext, conflict=True)
+
+    def _hand_on(self, item, ext: int, conflict: bool = False) -> bool:
+        """Put one sample in the queue (numbered ``ext``); False (counted dropped) when the queue is full."""
         try:
-            self._queue.put_nowait(ReceivedSample(item.sample, ext, item.encoding, item.arrival_s))
+            self._queue.put_nowait(ReceivedSample(item.sample, ext, item.encoding, item.arrival_s, conflict))
         except queue.Full:
             self._count("dropped")
-            return
-        self._count("delivered")
+            return False
         self.high_water["queue"] = max(self.high_water["queue"], self._queue.qsize())
+        return True
 
     def _flush(self, st: "_Stream", now: float, skip_all: bool = False) -> None:
         """Hand on the window's samples that are next in order. Past a gap: wait while fewer than
@@ -444,7 +492,7 @@ class Receiver:
 class _Stream:
     """One source's ordering state (module notes)."""
 
-    __slots__ = ("next", "top", "window", "run", "stamp")
+    __slots__ = ("next", "top", "window", "run", "stamp", "handed", "rivals")
 
     def __init__(self, first: int):
         self.next = first  # the next (unwrapped) sequence number to hand on
@@ -453,6 +501,8 @@ class _Stream:
         self.run: list[tuple] = []  # off-stream samples that follow each other:
         # (seq, number, arrival, item, counted late already)
         self.stamp: int | None = None  # the newest sampleTimestamp handed on (ns)
+        self.handed: dict[int, tuple] = {}  # number -> digests of the samples handed on, the last HANDED_MEMORY
+        self.rivals: dict[int, list] = {}  # number in the window -> other valid samples claiming it
 
 
 def _source_key(obj) -> tuple:
@@ -462,6 +512,11 @@ def _source_key(obj) -> tuple:
     sid, num = obj.get("sourceId"), obj.get("sourceNumber")
     return (sid if isinstance(sid, str) else None,
             num if isinstance(num, int) and not isinstance(num, bool) else None)
+
+
+def _digest(item) -> int:
+    """A digest of a sample's content, whatever its encoding (JSON or CBOR of one sample digest alike)."""
+    return hash(json.dumps(item.sample, sort_keys=True, separators=(",", ":"), default=repr))
 
 
 def _stamp(item) -> int | None:

@@ -12,26 +12,42 @@ source**. A take records one source, chosen by this rule:
   never becomes the take, and never touches its time line.
 
 The other sources are named with their sample counts (:meth:`Take.sources`), so a recording says
-when two cameras were on one port. A sample physcam cannot read as a frame (a transform chain with
-no orientation, a distance beyond millimetres) is refused with its reason and counted; the first
-:data:`MAX_REFUSALS_KEPT` reasons are kept. Bounded: at most ``max_frames`` frames in all, and
-:data:`MAX_SOURCES_NAMED` sources by name (the samples of further ones are counted together).
+when two cameras were on one port.
+
+**Conflicts.** UDP cannot be authenticated: a second, different valid sample may claim a packet number
+its source has already used (a forged or replayed copy, a second sender with the same sourceId). The
+receiver hands it on flagged (:attr:`~physcam.live.receiver.ReceivedSample.conflict`); the take holds
+every claimant of the number and keeps the one its neighbours vouch for (:func:`judge_claimants`): the
+nearest frames before and after it, on each clock both carry (``sampleTimestamp`` at the sample rate,
+the timecode), lie exactly as many frames away as their packet numbers say. A claimant that any clock
+contradicts is left out; when not exactly one claimant agrees (both do: a copy with the same clocks;
+none does; no neighbour or clock to judge by), the take keeps **neither** and the frame is absent
+(counted in ``missing``). Each conflict is named (:meth:`Take.conflicts`), never counted as late.
+
+A sample physcam cannot read as a frame (a transform chain with no orientation, a distance beyond
+millimetres) is refused with its reason and counted; the first :data:`MAX_REFUSALS_KEPT` reasons
+are kept. Bounded: at most ``max_frames`` frames in all (and :data:`MAX_CLAIMANTS` rivals of each),
+and :data:`MAX_SOURCES_NAMED` sources by name (the samples of further ones are counted together).
 """
 
 from __future__ import annotations
 
 import os
+from fractions import Fraction
 from pathlib import Path
 
 from ..errors import ExportError, InputError, PhysCamError, require_type
 from .record import MAX_RECORDED_FRAMES
 
-__all__ = ["Take", "MAX_SOURCES_NAMED", "MAX_REFUSALS_KEPT", "same_source_id", "free_names", "write_under_free_name"]
+__all__ = ["Take", "MAX_SOURCES_NAMED", "MAX_REFUSALS_KEPT", "same_source_id", "free_names", "write_under_free_name",
+           "judge_claimants"]
 
 #: sources a take names one by one; the samples of any further source are counted together
 MAX_SOURCES_NAMED = 64
 #: reasons kept for refused samples (all are counted)
 MAX_REFUSALS_KEPT = 100
+#: claimants a take holds for one packet number besides the first (the receiver hands on at most 4)
+MAX_CLAIMANTS = 8
 
 
 def same_source_id(given: str, source_id) -> bool:
@@ -44,13 +60,61 @@ def same_source_id(given: str, source_id) -> bool:
 
 
 class _Source:
-    __slots__ = ("key", "order", "frames", "samples", "refused", "static")
+    __slots__ = ("key", "order", "frames", "samples", "refused", "static", "numbers", "ids", "at", "rivals")
 
     def __init__(self, key: tuple, order: int):
         self.key, self.order = key, order
         self.frames: list = []
+        self.numbers: list = []  # each frame's packet number (the receiver's, unwrapped)
+        self.ids: list = []  # each frame's sampleId
+        self.at: dict = {}  # packet number -> index of the latest frame with it
+        self.rivals: dict = {}  # frame index -> [(frame, sampleId)] other claimants of its number
         self.samples = self.refused = 0
         self.static = None
+
+
+def _places(frame):
+    """(clock name, place in frames) of each clock a frame carries: its sampleTimestamp at the sample
+    rate, its timecode (drop-frame counted); packet numbers count one a frame."""
+    from .frames import timecode_index
+
+    out = []
+    if frame.rate is not None and frame.time_ns is not None:
+        out.append(("sampleTimestamp", Fraction(frame.time_ns, 1_000_000_000) * frame.rate))
+    if frame.rate is not None and frame.timecode is not None:
+        try:
+            out.append(("timecode", timecode_index(frame.timecode, frame.rate, frame.drop_frame)))
+        except PhysCamError:
+            pass
+    return out
+
+
+def judge_claimants(claimants, neighbours):
+    """Which of several frames claiming one packet number to keep: ``claimants`` and ``neighbours``
+    are (frame, packet number) pairs, the neighbours the nearest undisputed frames before and after.
+    A claimant agrees with a neighbour on a clock both carry when their places differ by exactly the
+    packet numbers' difference (:func:`_places`; a timestamp to the nearest frame). Returns (index of
+    the one claimant no clock contradicts and at least one confirms, or None; a reason in words)."""
+    verdicts = []
+    for frame, number in claimants:
+        agree = disagree = 0
+        mine = dict(_places(frame))
+        for other, n in neighbours:
+            for clock, place in _places(other):
+                if clock in mine:
+                    if round(mine[clock] - place) == number - n:
+                        agree += 1
+                    else:
+                        disagree += 1
+        verdicts.append((agree, disagree))
+    good = [i for i, (a, d) in enumerate(verdicts) if a and not d]
+    if len(good) == 1:
+        return good[0], "the only one whose clocks agree with its neighbours'"
+    if not neighbours:
+        return None, "no undisputed neighbour to judge by"
+    if good:
+        return None, "more than one agrees with its neighbours' clocks"
+    return None, "none agrees with its neighbours' clocks"
 
 
 class Take:
@@ -74,8 +138,9 @@ class Take:
         """Whether the take holds ``max_frames`` frames (the recording ends there)."""
         return self.held >= self.max_frames
 
-    def add(self, sample: dict, sequence: int | None = None):
-        """Take one validated sample; return its frame, or None (refused, another source's, or full)."""
+    def add(self, sample: dict, sequence: int | None = None, conflict: bool = False):
+        """Take one validated sample; return its frame, or None (refused, another source's, or full).
+        ``conflict``: it claims ``sequence``, a number another sample of its source holds (module notes)."""
         from .frames import frame_from_sample
 
         key = (sample.get("sourceId"), sample.get("sourceNumber"))
@@ -86,7 +151,8 @@ class Take:
                 return None
             src = self._sources[key] = _Source(key, len(self._sources))
         src.samples += 1
-        if "static" in sample:
+        held_at = src.at.get(sequence) if conflict else None
+        if "static" in sample and held_at is None:  # a rival claimant's static block changes nothing
             src.static = sample["static"]
         if self.full or (self.source is not None and src is not self._named()):
             return None
@@ -99,7 +165,15 @@ class Take:
                 number = sample.get("timing", {}).get("sequenceNumber", sequence)
                 self.refusals.append(f"sample {number}: {exc}")
             return None
+        if held_at is not None:  # a rival claimant: judged against its neighbours when the take is read
+            rivals = src.rivals.setdefault(held_at, [])
+            if len(rivals) < MAX_CLAIMANTS:
+                rivals.append((frame, sample.get("sampleId")))
+            return frame
+        src.at[sequence] = len(src.frames)
         src.frames.append(frame)
+        src.numbers.append(sequence)
+        src.ids.append(sample.get("sampleId"))
         self.held += 1
         return frame
 
@@ -121,9 +195,43 @@ class Take:
         return 0 if key is None else len(self._sources[key].frames)
 
     def frames(self) -> list:
-        """The frames of the source the take records, in the order they arrived."""
+        """The frames of the source the take records, in the order they arrived; of claimants of one
+        packet number, the one :func:`judge_claimants` keeps, or none."""
         key = self.chosen()
-        return [] if key is None else list(self._sources[key].frames)
+        if key is None:
+            return []
+        src = self._sources[key]
+        kept = {i: c["kept_index"] for i, c in self._judged(src)}  # None: neither claimant
+        out = []
+        for i, f in enumerate(src.frames):
+            k = kept.get(i, 0)
+            if k is not None:
+                out.append(f if k == 0 else src.rivals[i][k - 1][0])
+        return out
+
+    def conflicts(self) -> list[dict]:
+        """The packet numbers of the recorded source that several different samples claimed: ``sequence``,
+        ``claimants`` (sampleId and timecode of each, first arrived first), ``kept`` (a sampleId or None)
+        and ``reason`` (module notes)."""
+        key = self.chosen()
+        if key is None:
+            return []
+        return [{k: v for k, v in c.items() if k != "kept_index"} for _, c in self._judged(self._sources[key])]
+
+    @staticmethod
+    def _judged(src) -> list[tuple[int, dict]]:
+        out = []
+        disputed = set(src.rivals)
+        for i in sorted(src.rivals):
+            claimants = [(src.frames[i], src.ids[i])] + src.rivals[i]
+            before = next((j for j in range(i - 1, -1, -1) if j not in disputed), None)
+            after = next((j for j in range(i + 1, len(src.frames)) if j not in disputed), None)
+            neighbours = [(src.frames[j], src.numbers[j]) for j in (before, after) if j is not None]
+            k, reason = judge_claimants([(f, src.numbers[i]) for f, _ in claimants], neighbours)
+            out.append((i, {"sequence": src.numbers[i], "source_id": src.key[0],
+                            "claimants": [{"sample_id": sid, "timecode": f.timecode} for f, sid in claimants],
+                            "kept": None if k is None else claimants[k][1], "kept_index": k, "reason": reason}))
+        return out
 
     def sources(self) -> list[dict]:
         """Every source heard, first heard first: ``source_id``, ``source_number``, ``samples``

@@ -370,7 +370,18 @@ def check_shot(file, path: str | None = None) -> dict:
 
 
 def refresh_shot(file, path: str | None = None) -> dict:
-    """Recompute a shot's companion camera from the composed camera, in place; return check_shot's answer after."""
+    """Recompute a shot's companion camera from the composed camera, in place, when it is stale; return
+    check_shot's answer after, with ``written`` (whether the file was rewritten) and ``changed`` (each
+    attribute of the camera whose value changed: ``attribute``, ``before``, ``after``; None for an
+    attribute added or removed).
+
+    A current camera (:func:`check_shot`) is left untouched: nothing is written, so a refresh that has
+    nothing to do does not change the file (a pipeline diffs its USD files). A stale one is recomputed,
+    and a recomputed value equal to the file's at the precision of the float32 values it is computed
+    from (:func:`_same_value`; the companion's field of view, :func:`_same_view`) keeps the file's
+    digits: reading the camera back through 32-bit attributes moves doubles by a few 1e-8, and
+    :func:`~physcam.usd.author.fov_preserving_float32` may pick another float32 triple of one view.
+    """
     from pxr import Sdf, Usd
 
     from .read import find_cameras
@@ -387,9 +398,104 @@ def refresh_shot(file, path: str | None = None) -> dict:
         if len(cams) != 1:
             raise ExportError(f"{file}: found {len(cams)} PhysicalCamera prims; name the one to refresh")
         path = cams[0]
+    if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):  # else there is no companion yet: write it
+        now = check_shot(file, path)
+        if not now["stale"]:
+            return dict(now, written=False, changed=[])
+    layer = stage.GetRootLayer()
+    before = _authored_values(layer, path)
     _author_shot_companion(stage, path)
+    changed = _keep_equal_values(layer, before, _authored_values(layer, path), path)
     save_stage(stage, file, force=True)
-    return check_shot(file, path)
+    return dict(check_shot(file, path), written=True, changed=changed)
+
+
+def _authored_values(layer, path) -> dict:
+    """Attribute path -> its default value, of every attribute the layer authors at or below ``path``."""
+    from pxr import Sdf
+
+    out = {}
+
+    def visit(p):
+        if p.IsPropertyPath():
+            spec = layer.GetAttributeAtPath(p)
+            if spec and spec.HasDefaultValue():
+                out[str(p)] = spec.default
+
+    layer.Traverse(Sdf.Path(path), visit)
+    return out
+
+
+def _numbers(v):
+    """The numbers of a scalar, vector or array value, or None for any other value."""
+    if isinstance(v, bool):
+        return None
+    if isinstance(v, (int, float)):
+        return [float(v)]
+    try:
+        out = [float(x) for x in v]
+    except (TypeError, ValueError):
+        return None
+    return None if isinstance(v, str) else out
+
+
+#: two values computed from one camera's 32-bit attributes are the same when they differ by at most
+#: this much relative: two float32 rounding steps (2 x 2^-23), the round trip's, not a change
+_F32_SAME = 2.0 ** -22
+
+
+def _same_value(a, b) -> bool:
+    """Whether ``a`` and ``b`` (attribute values) are equal at float32 precision (:data:`_F32_SAME`)."""
+    x, y = _numbers(a), _numbers(b)
+    if x is None or y is None:
+        return a == b
+    return len(x) == len(y) and all(abs(p - q) <= _F32_SAME * max(abs(p), abs(q)) for p, q in zip(x, y))
+
+
+def _same_view(old: dict, new: dict, geom: str) -> bool:
+    """Whether the companion's (focalLength, horizontalAperture, verticalAperture) before and after give
+    one field of view: the aperture / focal length ratios equal at float32 precision and the focal
+    lengths within 49 float32 steps (each pick of fov_preserving_float32 lies within 24 of its exact
+    focal length, and the two exact ones, a double and its float32 read back, within one)."""
+    import numpy as np
+
+    names = [f"{geom}.{n}" for n in ("focalLength", "horizontalAperture", "verticalAperture")]
+    if not all(n in old and n in new for n in names):
+        return False
+    (f0, w0, h0), (f1, w1, h1) = ([float(d[n]) for n in names] for d in (old, new))
+    if min(f0, f1) <= 0.0:
+        return False
+    steps = abs(f0 - f1) / float(np.spacing(np.float32(max(f0, f1))))
+    return steps <= 49 and _same_value([w0 / f0, h0 / f0], [w1 / f1, h1 / f1])
+
+
+def _keep_equal_values(layer, before: dict, after: dict, path) -> list[dict]:
+    """Give back the file's value to every recomputed attribute equal to it (:func:`_same_value`,
+    :func:`_same_view`); return the changes left, as the refresh reports them."""
+    from pxr import Sdf
+
+    geom = str(Sdf.Path(path).AppendChild("Camera"))
+    keep = {n for n in after if n in before and _same_value(before[n], after[n])}
+    if _same_view(before, after, geom):
+        keep |= {f"{geom}.{n}" for n in ("focalLength", "horizontalAperture", "verticalAperture")}
+    changed = []
+    for name in sorted(set(before) | set(after)):
+        if name in keep:
+            if after[name] != before[name]:
+                layer.GetAttributeAtPath(name).default = before[name]
+            continue
+        old, new = before.get(name), after.get(name)
+        if old is None or new is None or old != new:
+            changed.append({"attribute": name, "before": _shown_value(old), "after": _shown_value(new)})
+    return changed
+
+
+def _shown_value(v):
+    """An attribute value as JSON: numbers, lists of numbers, text; None for none."""
+    if v is None or isinstance(v, (bool, int, float, str)):
+        return v
+    nums = _numbers(v)
+    return nums if nums is not None else str(v)
 
 
 def _shot_attributes(spec, su):

@@ -61,6 +61,7 @@ def detect_format(path, text: str | None = None) -> str:
 
 
 def _module(fmt: str):
+    """The module of format ``fmt``, imported on first use (the one place this package imports one)."""
     from importlib import import_module
 
     try:
@@ -70,15 +71,17 @@ def _module(fmt: str):
     return import_module(f"{__name__}.{name}")
 
 
+#: module name -> its format name, for ``formats.zemax`` and the like
+_FORMAT_OF = {module: fmt for fmt, module in _MODULE_NAMES.items()}
+
+
 def __getattr__(name: str):
     """``FORMATS`` (format name -> module with ``loads(text, path=None, name=None)`` and ``dumps(p)``)
-    and the format modules themselves, imported on first use."""
+    and the format modules themselves, imported on first use through :func:`_module`."""
     if name == "FORMATS":
         return {fmt: _module(fmt) for fmt in _MODULE_NAMES}
-    if name in _MODULE_NAMES.values():
-        from importlib import import_module
-
-        return import_module(f"{__name__}.{name}")
+    if name in _FORMAT_OF:
+        return _module(_FORMAT_OF[name])
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
