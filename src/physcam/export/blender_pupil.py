@@ -425,22 +425,26 @@ def _n_passing(radii, t) -> np.ndarray:
 
 def _shrunk(radii, grids, boxes, start):
     """Per grid (of :func:`_trace`, over its box) the index of the first iris radius, from ``start`` on,
-    whose passing set has shrunk under half of the grid (len(radii) if none), and per grid and
-    radius the passing set's x extent and largest y. The sets nest: a sample with n passing radii
-    (:func:`_n_passing`) is in the sets of radii[:n], so each grid's extremes per n, taken from the
-    largest n down, give every radius's at once."""
-    gx, gy, ok, rad = (np.stack([g[c] for g in grids]) for c in range(4))
+    whose passing set has shrunk under :data:`_ZOOM` of the grid (len(radii) if none), and per grid
+    and radius the passing set's x extent and largest y (of the sample centres). The sets nest: a
+    sample with n passing radii (:func:`_n_passing`) is in the sets of radii[:n], so the extremes of
+    the columns (rows) per their largest n, taken from the largest n down, give every radius's at once."""
     dx, dy = np.array([g[4] for g in grids])[:, None], np.array([g[5] for g in grids])[:, None]
     b = np.array(boxes)
     n_grid, n_rad = len(grids), radii.size
-    key = (np.arange(n_grid)[:, None] * (n_rad + 1) + np.stack([g[7] for g in grids])).ravel()
+    n_in = np.stack([g[7] for g in grids]).reshape(n_grid, _GRID // 2, _GRID)
+    # a column (row) holds a sample of the set at radius i when its largest count exceeds i
+    xs, ys = np.stack([g[0][:_GRID] for g in grids]), np.stack([g[1][::_GRID] for g in grids])
 
-    def running(v, fn, empty):  # per grid and radius i: fn over the samples with n > i
+    def running(n, v, fn, empty):  # per grid and radius i: fn over the columns (rows) whose count n > i
+        key = (np.arange(n_grid)[:, None] * (n_rad + 1) + n).ravel()
         e = np.full(n_grid * (n_rad + 1), empty)
         fn.at(e, key, v.ravel())
         return fn.accumulate(e.reshape(n_grid, n_rad + 1)[:, ::-1], axis=1)[:, ::-1][:, 1:]
 
-    xmin, xmax, ymax = running(gx, np.minimum, np.inf), running(gx, np.maximum, -np.inf), running(gy, np.maximum, -np.inf)
+    col, row = n_in.max(axis=1), n_in.max(axis=2)
+    xmin, xmax = running(col, xs, np.minimum, np.inf), running(col, xs, np.maximum, -np.inf)
+    ymax = running(row, ys, np.maximum, -np.inf)
     anyp = xmin < np.inf
     small = (anyp & ((xmax - xmin + 4 * dx < _ZOOM * (b[:, 1:2] - b[:, 0:1])) | (ymax + 2 * dy < _ZOOM * b[:, 2:3]))
              & (np.arange(radii.size)[None, :] >= np.asarray(start)[:, None]))
