@@ -295,3 +295,13 @@ def test_a_folder_output_never_replaces_a_fifo_or_the_null_device(tmp_path):
                 pytest.fail("the block ran")
     assert stat.S_ISFIFO(os.stat(fifo).st_mode) and stat.S_ISCHR(os.stat(os.devnull).st_mode)
     assert [p.name for p in tmp_path.iterdir()] == ["maps"]
+
+
+def test_the_refusal_to_overwrite_speaks_to_both_kinds_of_user(tmp_path):
+    """`pass --force (force=True)` read to a 1st AC at the command line like a second flag (round 8):
+    the Python keyword is said to be Python's."""
+    f = tmp_path / "card.pdf"
+    atomic_write(f, b"x")
+    with pytest.raises(ExportError, match=r"already exists; pass --force \(in Python, force=True\) to overwrite it"):
+        atomic_write(f, b"y")
+    assert f.read_bytes() == b"x"

@@ -107,7 +107,8 @@ class _Init:
     first, keyword-only after, as dataclass orders them), their defaults and default factories, the
     fields set without a parameter, and whether ``__post_init__`` follows."""
 
-    __slots__ = ("fields", "every", "positional", "names", "defaults", "factories", "fixed", "post")
+    __slots__ = ("fields", "every", "positional", "names", "name_set", "defaults", "factories", "fixed", "post",
+                 "cls", "direct")
 
     def __init__(self, cls, fs):
         self.fields = fs
@@ -115,15 +116,61 @@ class _Init:
         params = [f for f in fs if f.init]
         self.positional = tuple(f.name for f in params if not f.kw_only)
         self.names = self.positional + tuple(f.name for f in params if f.kw_only)
+        self.name_set = frozenset(self.names)
         self.defaults = {f.name: f.default for f in params if f.default is not MISSING}
         self.factories = {f.name: f.default_factory for f in params if f.default_factory is not MISSING}
         self.fixed = tuple((f.name, f.default, f.default_factory) for f in fs if not f.init
                            and (f.default is not MISSING or f.default_factory is not MISSING))
         self.post = hasattr(cls, "__post_init__")
+        self.cls, self.direct = cls, _fields_in_dict(cls, self.every)
+
+
+def _fields_in_dict(cls, names) -> bool:
+    """Whether an instance of ``cls`` keeps each field in its ``__dict__``: no class of it has
+    ``__slots__`` and no field's name is a descriptor that sets (``object.__setattr__`` would call it)."""
+    if any("__slots__" in k.__dict__ for k in cls.__mro__[:-1]):
+        return False
+    for name in names:
+        owner = next((k for k in cls.__mro__ if name in k.__dict__), None)
+        if owner is not None and hasattr(type(owner.__dict__[name]), "__set__"):
+            return False
+    return True
 
 
 def _init(self, *args, **kwargs):
-    """dataclass's ``__init__`` for any record: the same parameters, defaults, errors and ``__post_init__``."""
+    """dataclass's ``__init__`` for any record: the same parameters, defaults, errors and ``__post_init__``.
+    Arguments that fit go straight in (a lens report builds eight records: issue 47); any that do not
+    go through :func:`_init_checked`, which says what is wrong as dataclass does."""
+    plan = type(self).__record_init__
+    if len(args) > len(plan.positional) or not plan.name_set.issuperset(kwargs):
+        return _init_checked(self, *args, **kwargs)
+    values = dict(zip(plan.positional, args)) if args else {}
+    if values and not values.keys().isdisjoint(kwargs):
+        return _init_checked(self, *args, **kwargs)
+    values.update(kwargs)
+    filled = []
+    for name in plan.names:
+        if name in values:
+            filled.append((name, values[name]))
+        elif name in plan.defaults:
+            filled.append((name, plan.defaults[name]))
+        elif name in plan.factories:
+            filled.append((name, plan.factories[name]()))
+        else:
+            return _init_checked(self, *args, **kwargs)  # (a required argument missing: its TypeError)
+    for name, default, factory in plan.fixed:
+        filled.append((name, factory() if default is MISSING else default))
+    if plan.direct and type(self) is plan.cls:
+        self.__dict__.update(filled)  # what object.__setattr__ does for these fields, in one call
+    else:
+        for name, value in filled:
+            object.__setattr__(self, name, value)
+    if plan.post:
+        self.__post_init__()
+
+
+def _init_checked(self, *args, **kwargs):
+    """:func:`_init` for arguments that may not fit, each checked in dataclass's order with its TypeError."""
     plan = type(self).__record_init__
     where = f"{type(self).__qualname__}.__init__()"
     if len(args) > len(plan.positional):
@@ -320,6 +367,13 @@ def replace(obj, /, **changes):
         import dataclasses
 
         return dataclasses.replace(obj, **changes)
+    cls = type(obj)
+    if (plan.direct and cls is plan.cls and not plan.post and cls.__new__ is object.__new__
+            and len(plan.names) == len(plan.every) == len(obj.__dict__) and plan.name_set.issuperset(changes)):
+        new = object.__new__(cls)  # what cls(**every field) makes, without reading each back (issue 47)
+        new.__dict__.update(obj.__dict__)
+        new.__dict__.update(changes)
+        return new
     for f in plan.fields:
         if not f.init:
             if f.name in changes:

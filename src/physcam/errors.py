@@ -161,6 +161,8 @@ def renamed_parameter(old: str, new: str, until: str = "0.3"):
 
 def require_finite(name: str, value, *, error=InputError) -> float:
     """Return ``value`` as float, or raise ``error`` naming ``name`` when it is NaN, inf or not a number."""
+    if type(value) is float and math.isfinite(value):  # the common case, at once (issue 47)
+        return value
     if isinstance(value, bool) or not isinstance(value, (Real,)) and not hasattr(value, "__float__"):
         raise error(f"{name} must be a number, got {shown_briefly(value)}")
     try:

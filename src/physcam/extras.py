@@ -14,7 +14,7 @@ usd        usd-core                              PhysicalCamera USD files, kits,
 exr        OpenEXR                               ST-maps and images as EXR
 live       jsonschema, cbor2                     OpenTrackIO samples (physcam live)
 dask       dask[distributed], bokeh, pyarrow     physcam characterize on a cluster
-serve      starlette, uvicorn, segno             physcam serve, the phone page
+serve      starlette, uvicorn, httptools, segno  physcam serve, the phone page
 calibrate  opencv-python-headless                physcam calibrate: charts found in photographs
 farm       openjd-model                          physcam farm --to openjd: validated job templates
 opencue    opencue-pyoutline                     physcam farm --to opencue: OpenCue outlines
@@ -37,7 +37,7 @@ EXTRAS = {
     "exr": (("OpenEXR", "OpenEXR"),),
     "live": (("jsonschema", "jsonschema"), ("cbor2", "cbor2")),
     "dask": (("distributed", "dask[distributed]"), ("bokeh", "bokeh"), ("pyarrow", "pyarrow")),
-    "serve": (("starlette", "starlette"), ("uvicorn", "uvicorn"), ("segno", "segno")),
+    "serve": (("starlette", "starlette"), ("uvicorn", "uvicorn"), ("httptools", "httptools"), ("segno", "segno")),
     "calibrate": (("cv2", "opencv-python-headless"),),
     "farm": (("openjd.model", "openjd-model"),),
     "opencue": (("outline", "opencue-pyoutline"),),

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import shutil
 import sys
 import tempfile
 
@@ -280,3 +281,4 @@ def test_cli_fuzz(path, parser):
         one()
     finally:
         server.close()
+        shutil.rmtree(workdir, ignore_errors=True)  # each leaf's folder holds tens of MB of outputs

@@ -163,6 +163,8 @@ def test_refusal_names_the_way_forward_and_lenient_loads(capsys):
     f = str(_TOML / "nikkor_fisheye_16mm_f2_8.toml")
     rc, _, err = run(capsys, "lens", "show", f)
     assert rc == 2 and "--lenient" in err and "physcam lens fix" in err and err.count("\n") == 1
+    # the commands it suggests are written in the one grammar, --lens (round 8: they used the hidden positional)
+    assert f"`physcam lens check --lens {f}`" in err and f"`physcam lens fix --lens {f} -o FIXED.toml --apply`" in err
     rc, out, err = run(capsys, "lens", "show", f, "--lenient", "--json")
     assert rc == 0
     assert err.count("physcam: warning:") == 2  # halved apertures, clipped surfaces 1-2 (docs/lens-formats.md)

@@ -245,6 +245,17 @@ def test_bad_jobs_are_one_line_and_write_nothing(capsys, tmp_path, args, words):
     assert not (tmp_path / "job.txt").exists()
 
 
+def test_a_defocus_job_without_dask_names_the_defocus_sequence(capsys, tmp_path, monkeypatch):
+    """A new user's `farm --to tasks -- defocus ...` without the dask extra was told that
+    "characterizing on Dask (physcam characterize)" needs it (round 8)."""
+    for module in ("dask", "distributed", "bokeh", "pyarrow"):
+        monkeypatch.setitem(sys.modules, module, None)  # find_spec: not installed
+    rc, out, err = _farm(capsys, tmp_path, "tasks", "job.txt", "--frames", "1-3", "--", *DEFOCUS)
+    assert rc == 2 and err.count("physcam: error:") == 1, err
+    assert "physcam farm -- defocus" in err and "characterize" not in err
+    assert "pip install 'physcam[dask]'" in err and not (tmp_path / "job.txt").exists()
+
+
 def test_a_task_of_another_kind_of_step_is_refused(capsys, tmp_path):
     capsys.readouterr()
     rc = main(["farm-task", "--step", "cells", "--frames", "1", "--cwd", str(tmp_path), "--", *DEFOCUS])

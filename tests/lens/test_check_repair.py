@@ -206,3 +206,44 @@ def test_check_never_crashes_on_mutated_files(tmp_path, fmt, data):
 @given(text=st.text(alphabet=st.sampled_from(list("0123456789.-+eE \t\n#[]{}\"=,:abcdnrsu_")), max_size=200))
 def test_check_never_crashes_on_random_text(tmp_path, fmt, text):
     _check_never_crashes(tmp_path, fmt, text)
+
+
+_SINGLET = """format = "physcam-lens/1"
+[lens]
+name = "Acme Singlet 50"
+focal_length = 50.8
+max_fstop = 8.0
+[[surface]]
+kind = "stop"
+radius = 0.0
+thickness = 5.0
+semi_diameter = 3.2
+medium = "air"
+[[surface]]
+kind = "spherical"
+radius = 51.68
+thickness = 5.0
+semi_diameter = 8.0
+medium = { nd = 1.5168, vd = 64.17 }
+[[surface]]
+kind = "spherical"
+radius = -51.68
+thickness = 49.0
+semi_diameter = 8.0
+medium = "air"
+"""
+
+
+def test_a_duplicate_names_its_library_and_the_lens_option(tmp_path, monkeypatch):
+    """A lens vendor's own file, already installed, was called "the bundled lens", and the hint's
+    `physcam lens show SLUG` used the hidden positional instead of --lens (round 8)."""
+    bundled = next(x for x in check(REF / "pbrt-dat" / "dgauss.50mm.dat") if x.code == "duplicate")
+    assert "bundled lens 'dgauss_50mm'" in bundled.message
+    assert "physcam lens show --lens dgauss_50mm" in bundled.implication
+    monkeypatch.setenv("PHYSCAM_LENS_LIBRARY", str(tmp_path / "lib"))
+    (tmp_path / "lib" / "acme_singlet_v1").mkdir(parents=True)
+    (tmp_path / "lib" / "acme_singlet_v1" / "lens.toml").write_text(_SINGLET)
+    (tmp_path / "mine.toml").write_text(_SINGLET)
+    mine = next(x for x in check(tmp_path / "mine.toml") if x.code == "duplicate")
+    assert mine.values["slug"] == "acme_singlet_v1" and "installed lens 'acme_singlet_v1'" in mine.message
+    assert "physcam lens show --lens acme_singlet_v1" in mine.implication

@@ -197,3 +197,25 @@ def test_a_provenance_record_of_the_wrong_kind_is_refused(extra, words):
     text = text.replace("{extra}", extra)
     with pytest.raises(LensFileError, match=words):
         loads_lens(text, "physcam")
+
+
+@pytest.mark.parametrize("line", ['format="physcam-lens/1"', "format = 'physcam-lens/1'", '  format  =  "physcam-lens/1"'])
+def test_the_format_line_is_read_however_toml_spaces_or_quotes_it(tmp_path, line):
+    """A lens vendor's `format="physcam-lens/1"` (valid TOML) was read as the seed TOML and refused as
+    "unknown key 'format'" (round 8). Oracle: the file written with the documented spacing."""
+    from physcam.lens.formats import read_lens
+
+    f = tmp_path / "mine.toml"
+    f.write_text(MINIMAL.replace('format = "physcam-lens/1"', line))
+    assert read_lens(f) == loads_lens(MINIMAL, "physcam")
+
+
+def test_a_physcam_toml_without_its_format_line_is_told_to_add_it(tmp_path):
+    """Without the line the file was read as the seed TOML: "top level: unknown key 'provenance' ..."."""
+    from physcam.lens.formats import read_lens
+
+    f = tmp_path / "mine.toml"
+    f.write_text(MINIMAL.replace('format = "physcam-lens/1"\n', ""))
+    with pytest.raises(LensFileError, match=r'starts with the line format = "physcam-lens/1"') as err:
+        read_lens(f)
+    assert err.value.line == 1

@@ -157,3 +157,15 @@ def test_a_truncated_file_is_an_error_never_another_lens(slug):
         except LensFileError:
             continue
         assert got == whole, f"cut after line {cut} ({lines[cut - 1].strip()!r}) loads as another lens"
+
+
+def test_a_hand_written_block_without_curv_is_not_called_truncated():
+    """A lens vendor's hand-written .zmx with the stop's CURV left out was told "the file seems cut short
+    (truncated)" although three surfaces followed it (round 8); it is told what the block lacks."""
+    text = ("SURF 0\n  CURV 0\n  DISZ INFINITY\nSURF 1\n  STOP\n  DIAM 5\n  DISZ 10\n"
+            "SURF 2\n  CURV 0.02\n  DISZ 5\n  GLAS N-BK7\n  DIAM 10\nSURF 3\n  CURV -0.02\n  DISZ 45\n  DIAM 10\n"
+            "SURF 4\n  CURV 0\n  DISZ 0\n")
+    with pytest.raises(LensFileError, match=r"SURF 1 has no CURV line: every SURF block needs both") as err:
+        loads_lens(text, "zemax", path="hand.zmx")
+    assert "truncated" not in str(err.value) and err.value.line == 4
+    assert loads_lens(text.replace("  STOP\n", "  STOP\n  CURV 0\n"), "zemax").stop_index == 0  # SURF 1, the first surface after the object

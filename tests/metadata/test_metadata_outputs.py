@@ -140,3 +140,31 @@ def test_show_csv_rows_equal_json_rows(capsys):
     assert main(["metadata", "show", str(CANON[0]), "--csv"]) == 0
     out = capsys.readouterr().out.splitlines()
     assert out[0].startswith("frame,line,timecode,focus_mm,tstop") and len(out) == 2
+
+
+def test_a_clip_without_a_name_is_titled_without_a_gap(capsys):
+    """Canon's per-frame file alone names no clip: the report's title read "canon clip : a thin lens ..."
+    (round 8). Its static file names it A001C001 (its ShotNumber column)."""
+    assert main(["metadata", "report", str(CANON[0]), "--sensor", "S35"]) == 0
+    assert capsys.readouterr().out.startswith("canon clip: a thin lens of the recorded focal length")
+    assert main(["metadata", "report", *map(str, CANON), "--sensor", "S35"]) == 0
+    assert capsys.readouterr().out.startswith("canon clip A001C001: a thin lens")
+
+
+def test_a_clips_notes_are_one_per_kind(capsys):
+    """The ARRI clip's 500 frames gave 21 diffraction notes that differed only in the working f-number
+    (round 8: a TD's JSON, and the table's "and 19 more notes"). Oracle: the per-frame reports'
+    own notes, read again here: one note per kind, the first frame's, counting the versions."""
+    from physcam.cli.metadata import clip_notes
+    from physcam.metadata.convert import solve
+    from physcam.optics.sensors import find_sensor
+
+    solved = solve(load([ARRI]), sensor=find_sensor("S35"))
+    per_frame = [x.report.notes for x in solved]
+    notes = clip_notes(per_frame)
+    diffraction = [n for n in notes if n.startswith("diffraction")]
+    versions = {n for f in per_frame for n in f if n.startswith("diffraction")}
+    assert len(diffraction) == 1 and len(versions) > 1
+    assert diffraction[0].startswith(per_frame[0][[n.startswith("diffraction") for n in per_frame[0]].index(True)])
+    assert f"{len(versions)} versions of this note on {len(solved)} frames" in diffraction[0]
+    assert clip_notes([("a note", "b 1.5"), ("a note", "b 1.5")]) == ["a note", "b 1.5"]

@@ -268,3 +268,20 @@ def test_a_missing_column_is_named(tmp_path, src, column):
     with pytest.raises(MetadataError, match=r"cut.*:1: the header looks like .* but has no '" +
                        column.split(" (")[0]):
         load(p)
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be"])
+def test_a_clip_saved_as_utf16_reads_as_its_utf8_export(tmp_path, encoding):
+    """A TD's VENICE CSV and XML re-saved as "Unicode text" (UTF-16 with a byte-order mark) were "a
+    binary file that is not a Mo-Sys F4 recording" (round 8). Oracle: the camera's own UTF-8 files."""
+    copies = []
+    for f in VENICE:
+        text = f.read_text(encoding="utf-8-sig")
+        c = tmp_path / f.name
+        c.write_bytes((b"\xfe\xff" if encoding.endswith("be") else b"") + text.encode(encoding))
+        copies.append(c)
+    assert detect_file(copies[0]) == detect_file(VENICE[0]) and detect_file(copies[1]) == detect_file(VENICE[1])
+    got, want = load(copies), load(VENICE)
+    assert got.frame_rows() == want.frame_rows()
+    assert {k: v for k, v in got.static_dict().items() if k != "files"} == \
+        {k: v for k, v in want.static_dict().items() if k != "files"}

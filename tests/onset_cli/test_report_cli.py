@@ -83,6 +83,7 @@ def test_demo_writes_outputs(tmp_path, capsys):
     assert lens["gaussian"]["efl"] == pytest.approx(50.3582, abs=1e-3)  # published dgauss.50mm EFL
     assert all(os.path.exists(f) for f in files)
     assert json.loads((out / "report.json").read_text())["schema"] == "physcam.lens_report"
+    assert "┃" not in (out / "report.txt").read_text()  # the report's plain table, no box (round 8)
     # issue 10: the demo writes the Blender cameras for the default lens
     osl = (out / "blender" / "dgauss_50mm.osl").read_text()
     assert "camera_shader_raster_position" in osl and (out / "blender" / "setup_dgauss_50mm.py").exists()
@@ -132,3 +133,20 @@ def test_fisheye_camera_blocks_say_which_field_they_show(capsys, tmp_path):
     stage = Usd.Stage.Open(str(f))
     fov = stage.GetPrimAtPath("/Cameras/Camera/Camera").GetCustomDataByKey("physcam:fieldOfView")
     assert fov["realChiefRaysDeg"][0] == pytest.approx(140.0, abs=0.5) and fov["realDiffers"]
+
+
+def test_the_demos_report_txt_is_the_reports_plain_table(tmp_path, capsys):
+    """The demo's report.txt was a rich table captured at 80 columns: a box drawn into the file and the
+    lens name, notes and pinhole row folded over lines (round 8, a new user's `physcam demo`). Oracle:
+    the text `physcam report` prints, piped, for the demo's lens, stop, focus and sensor.
+    (test_demo_writes_outputs writes the file itself.)"""
+    from physcam.cli.demo import DEFAULTS, _args, report_text
+    from physcam.cli.report import solve_from_args
+
+    table, notes = report_text(solve_from_args(_args()))
+    assert main(["report", "--lens", DEFAULTS["lens"], "--fstop", str(DEFAULTS["fstop"]),
+                 "--focus", f"{DEFAULTS['focus']}mm", "--sensor", DEFAULTS["sensor"]]) == 0
+    printed = capsys.readouterr().out
+    written = table.plain() + notes
+    assert written == printed
+    assert "┃" not in written and "Double Gauss 50mm f/2 (pbrt dgauss.50mm)" in written

@@ -54,6 +54,70 @@ def test_report_is_the_cli_json(server, capsys, params):
     assert got == cli_json(capsys, ["report", *flags(params)])
 
 
+#: Values of the page's practical report (and a few it refuses), for the property tests below.
+PRACTICAL = {
+    "focal": st.sampled_from(["18", "25", "35", "50", "85.5", "135", "0", "-5", "abc", "2in"]),
+    "fstop": st.sampled_from(["1.4", "2", "2.8", "4", "5.6", "11", "0.3", "x"]),
+    "focus": st.one_of(st.integers(300, 60000).map(lambda mm: f"{mm}mm"),
+                       st.sampled_from(["2.5m", "10ft", "10'6\"", "hyperfocal", "infinity", "3000", "-2m", "1e9"])),
+    "sensor": st.sampled_from(["S35", "ALEXA 35", "FF", "VENICE 2", "Super 16", "anamorphic-35", "nope"]),
+    "coc": st.sampled_from(["0.025", "d/1500", "d/1000", "cine", "25um", "bogus"]),
+    "squeeze": st.sampled_from(["1", "1.33", "2", "0"]),
+    "tstop": st.sampled_from(["2.1", "4.2"]),
+    "near": st.sampled_from(["2m", "8ft", "2500"]),
+    "far": st.sampled_from(["4m", "inf", "14ft"]),
+    "units": st.sampled_from(["m", "ft", "yards"]),
+    "model": st.sampled_from(["practical", "technical"]),
+    "shutter-angle": st.sampled_from(["180", "172.8", "-1"]),
+}
+practical_queries = st.fixed_dictionaries(
+    {"focal": PRACTICAL["focal"], "fstop": PRACTICAL["fstop"]},
+    optional={k: v for k, v in PRACTICAL.items() if k not in ("focal", "fstop")})
+
+
+def test_distinct_reports_are_the_cli_json(server, capsys):
+    """Random setups as the page sends them per keystroke: the server answers the CLI's --json, and
+    refuses (422, one line) what the CLI refuses (exit 2)."""
+    port, _ = server
+
+    @settings(max_examples=40, deadline=None, database=None)
+    @given(practical_queries)
+    def same(params):
+        status, got = get_json(port, "/api/report?" + urlencode(params))
+        capsys.readouterr()
+        code = main(["report", *flags(params), "--json"])
+        out = capsys.readouterr()
+        if code == 0:
+            assert status == 200 and got == json.loads(out.out), (params, got)
+        else:
+            assert code == 2 and status == 422 and "\n" not in got["error"], (params, got, out.err)
+
+    same()
+
+
+def test_the_servers_query_parser_is_argparses():
+    """cli.serve's parser of a report query (argparse's conversions without its scan, issue 47) gives
+    parse_args's namespace, and its refusal word for word."""
+    from physcam.cli import build_parser
+    from physcam.cli.serve import _leaf, _options, _QueryParser
+
+    parser = _leaf(build_parser(["report"]), "report")
+    quick = _QueryParser(parser)
+
+    def outcome(parse):
+        try:
+            return vars(parse())
+        except InputError as exc:
+            return str(exc)
+
+    @settings(max_examples=80, deadline=None, database=None)
+    @given(practical_queries)
+    def same(params):
+        assert outcome(lambda: quick.parse(params)) == outcome(lambda: parser.parse_args(_options(params)))
+
+    same()
+
+
 def test_far_at_infinity_is_null(server):
     status, d = get_json(port := server[0], "/api/report?focal=24&fstop=8&focus=100m&sensor=FF")
     assert status == 200 and d["dof"]["far_from_film_mm"] is None and d["dof"]["far_is_infinite"] is True

@@ -174,8 +174,19 @@ def _head(extra_bytes: int) -> bytes:
     return head
 
 
-def test_request_head_is_capped_at_16_kib_whole_or_in_pieces(server):
-    port, _ = server
+@pytest.fixture(scope="module", params=["default", "h11"])
+def any_parser_server(request, server):
+    """The server with its HTTP parser (httptools, installed by the serve extra), and with h11 (what
+    serves when httptools is not installed): the same bounds."""
+    if request.param == "default":
+        yield server
+        return
+    with running_server(env={"PHYSCAM_HTTP_PARSER": "h11"}) as (_, port, proc):
+        yield port, proc
+
+
+def test_request_head_is_capped_at_16_kib_whole_or_in_pieces(any_parser_server):
+    port, _ = any_parser_server
     big = _head(20_000)  # 20 KB of header, in one piece: h11 alone only bounds an incomplete head
     with connect(port, NORMAL) as s:
         s.sendall(big)
@@ -196,11 +207,34 @@ def test_request_head_is_capped_at_16_kib_whole_or_in_pieces(server):
         assert status == 200 and json.loads(body)["ok"] is True
 
 
-def test_malformed_http_is_one_json_line(server):
-    port, _ = server
+def test_malformed_http_is_one_json_line(any_parser_server):
+    port, _ = any_parser_server
     with connect(port, NORMAL) as s:
         s.sendall(b"GET /api/health HTTP/1.1\r\nHost x no colon\r\n\r\n")
         assert_refusal(*read_answer(s), 400)
+
+
+def test_pipelined_requests_are_answered_in_order_and_the_next_head_is_capped(any_parser_server):
+    """Requests sent back to back in one write are answered in turn; a head over the cap that follows
+    a small request in the same write is refused (its bytes are counted from its own start)."""
+    port, _ = any_parser_server
+    one = b"GET /api/health HTTP/1.1\r\nHost: x\r\n\r\n"
+
+    def answers(s, n):  # (status, body) of n answers read from one stream (http.client would read ahead)
+        f, out = s.makefile("rb"), []
+        for _ in range(n):
+            status = int(f.readline().split()[1])
+            headers = dict(line.decode().lower().rstrip().split(": ", 1) for line in iter(f.readline, b"\r\n"))
+            out.append((status, f.read(int(headers["content-length"]))))
+        return out
+
+    with connect(port, NORMAL) as s:
+        s.sendall(one + b"GET /nope HTTP/1.1\r\nHost: x\r\n\r\n" + one)
+        assert [status for status, _ in answers(s, 3)] == [200, 404, 200]
+    with connect(port, NORMAL) as s:
+        s.sendall(one + _head(20_000))
+        (first, _), (second, body) = answers(s, 2)
+        assert first == 200 and second == 431 and "over 16384 bytes" in json.loads(body)["error"]
 
 
 # --- sharing the slow work ---------------------------------------------------------------------

@@ -116,3 +116,16 @@ def test_ghosts_and_relative_illumination_stay_in_numpy():
         p = _run(code)
         assert p.returncode == 0, p.stderr
         assert p.stdout.split() == ["False"], argv
+
+
+def test_a_command_that_writes_no_file_loads_neither_the_writers_modules_nor_plotting():
+    # issue 47: physcam.io imports what writing a file needs (shutil and the compressors it imports, socket,
+    # tempfile) where it writes; a bokeh that only prints its numbers loads none of them, nor matplotlib
+    code = ("import sys, io, contextlib\nfrom physcam.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()):\n"
+            "    assert main(['bokeh', 'dgauss_50mm', '--rays', '2000', '--pixels', '16']) == 0\n"
+            "print(sorted({'shutil', 'lzma', 'bz2', 'socket', 'tempfile', 'matplotlib', 'scipy', 'numba', 'rich'}"
+            " & set(sys.modules)))")
+    p = _run(code)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.split() == ["[]"]

@@ -338,3 +338,34 @@ def test_hyperfocal_focus_reads_back_with_an_infinite_far_limit(tmp_path, capsys
     assert main(["usd", "read", str(f), "--json"]) == 0
     dof = json.loads(capsys.readouterr().out)["report"]["dof"]
     assert dof["far_is_infinite"] is True and dof["far_from_film_mm"] is None
+
+
+def test_a_plain_camera_file_is_told_apart_from_a_physical_one(tmp_path, capsys):
+    """A matchmove artist's plain UsdGeomCamera file got "found 0 PhysicalCamera prims (none); name the
+    one to read": there was none to name (round 8). The answer names the plain cameras it holds."""
+    f = tmp_path / "plain.usda"
+    f.write_text('#usda 1.0\ndef Xform "cams" {\n    def Camera "shotcam" {\n    }\n}\n')
+    for verb in ("read", "check", "refresh"):
+        assert main(["usd", verb, str(f)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "name the one" not in err
+        assert f"no physical camera to {verb}" in err and "UsdGeomCamera prims (/cams/shotcam)" in err
+
+
+def test_usd_write_places_the_camera_from_the_notes(tmp_path, capsys):
+    """A matchmove artist's notes: the lens 150 cm up, tilted 5 degrees down, panned 30 left. `usd write`
+    had no --position/--rotate (only `usd kit shot`, which needs body and lens files). Oracle: the closed
+    form of rotateXYZ on the camera's -Z, (-cos 5 sin 30, -sin 5, -cos 5 cos 30), and the eye on the
+    entrance pupil (here the thin lens's H1, docs/usd.md "Transform"), read by usd-core's Gf.Camera."""
+    import math
+
+    import pytest
+    from pxr import Gf, Usd, UsdGeom
+
+    s, _ = _write_read(tmp_path, *BASE, "--position", "-20,150,400", "--rotate", "-5,30,0")
+    cam = UsdGeom.Camera(s.GetPrimAtPath("/Cameras/Camera/Camera")).GetCamera(Usd.TimeCode.Default())
+    t, p = math.radians(5), math.radians(30)
+    assert tuple(cam.transform.ExtractTranslation()) == pytest.approx((-20, 150, 400), abs=1e-9)
+    look = cam.transform.TransformDir(Gf.Vec3d(0, 0, -1))
+    assert tuple(look) == pytest.approx((-math.cos(t) * math.sin(p), -math.sin(t), -math.cos(t) * math.cos(p)),
+                                        abs=1e-6)

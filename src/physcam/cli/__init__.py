@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 
 from .. import __version__
@@ -54,7 +55,17 @@ _NOT_PATHS = ("command", "handler", "kind", "output_args", "output_folders")
 _ELSEWHERE = {("export", "usd"): "USD cameras are written by `physcam usd write` (docs/usd.md)"}
 
 
+#: A word that starts with a minus and a digit is a value, never an option (physcam has no option
+#: named -<digit>): argparse's own rule takes only plain negative numbers, so `--rotate -5,30,0` (a
+#: camera tilted down), `--shift-x -1.5e-1` or `--focus -3m` were "expected one argument".
+_NEGATIVE_VALUE = re.compile(r"-\.?\d.*", re.DOTALL)
+
+
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_VALUE
+
     def error(self, message):  # usage errors: one line, exit 2 (argparse's own code)
         for (command, word), where in _ELSEWHERE.items():
             if self.prog.endswith(f" {command}") and f"invalid choice: '{word}'" in message:

@@ -161,13 +161,27 @@ def whole(name: str, *, lo: int | None = None, hi: int | None = None):
     return parse
 
 
+_ENGRAVED_STOP = re.compile(r"\s*(?:([tT])|[fF]\s*/?)\s*(\d+(?:\.\d+)?)\s*")
+
+
+def _stop_hint(name: str, text) -> str:
+    """What to type instead of a stop written as engraved ("T2.8", "f/2.8"), for an f-stop option."""
+    m = _ENGRAVED_STOP.fullmatch(str(text)) if name in ("f-stop", "f-number", "T-stop") else None
+    if m is None:
+        return ""
+    return (f": write the number alone, {m.group(2)}"
+            + (" (a T-stop is --tstop where the command takes one; the f-stop is the geometric f-number)"
+               if m.group(1) and name != "T-stop" else ""))
+
+
 def _finite(name: str, text) -> float:
     """``text`` as a finite, normal float (or 0): NaN, infinities and subnormals (``1e-320``, below
     2.2e-308, where 1/x overflows and precision is lost) are refused."""
     try:
         v = float(text)
     except (ValueError, TypeError):
-        raise argparse.ArgumentTypeError(f"{name} must be a number, got {_shown(text)}") from None
+        raise argparse.ArgumentTypeError(f"{name} must be a number, got {_shown(text)}{_stop_hint(name, text)}") \
+            from None
     if not math.isfinite(v):
         raise argparse.ArgumentTypeError(f"{name} must be a finite number, got {_shown(text)}")
     if v != 0.0 and abs(v) < sys.float_info.min:

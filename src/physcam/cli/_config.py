@@ -19,6 +19,7 @@ read is refused with the file's name, so a typo never silently falls back to a d
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
 
 from .._record import field, record
@@ -63,6 +64,17 @@ class Config:
 
 def config_path() -> Path | None:
     """Where the config is read from (see the module notes); None when ``PHYSCAM_CONFIG`` is empty."""
+    key = (os.environ.get("PHYSCAM_CONFIG"), os.environ.get("XDG_CONFIG_HOME"), os.environ.get("HOME"))
+    if key not in _PATHS:  # (the server asks per request: issue 47)
+        _PATHS.clear()
+        _PATHS[key] = _config_path()
+    return _PATHS[key]
+
+
+_PATHS: dict = {}
+
+
+def _config_path() -> Path | None:
     env = os.environ.get("PHYSCAM_CONFIG")
     if env is not None:
         return Path(env).expanduser() if env.strip() else None
@@ -74,18 +86,16 @@ _CACHE: dict = {}
 
 
 def load_config() -> Config:
-    """The user config (cached per file and modification time)."""
+    """The user config (cached per file and modification time, and while there is none)."""
     path = config_path()
-    if path is None or not path.is_file():
-        return Config(path=path, exists=False)
     try:
-        stamp = path.stat().st_mtime_ns
-    except OSError:
-        stamp = None
-    key = (str(path), stamp)
+        st = None if path is None else os.stat(path)
+    except (OSError, ValueError):
+        st = None
+    key = (path, None if st is None or not stat.S_ISREG(st.st_mode) else st.st_mtime_ns)
     if key not in _CACHE:
         _CACHE.clear()
-        _CACHE[key] = _read(path)
+        _CACHE[key] = Config(path=path, exists=False) if key[1] is None else _read(path)
     return _CACHE[key]
 
 

@@ -111,6 +111,11 @@ def plan_job(args, workdir: str):
 
 
 def _defocus(args, ns, inner, physcam, name, workdir):
+    from ..extras import require_extra
+
+    # its tasks run `physcam defocus IN.####.exr`, which needs dask (as the command says); named here
+    # before physcam.characterize's own check, which would name `physcam characterize`
+    require_extra("dask", "a defocus sequence as a farm job (physcam farm -- defocus IN.####.exr)")
     from ..characterize.defocus_shot import frame_path, sequence_frames, shot_kernel_folder
     from ..farm.frames import parse_frames
     from ..farm.job import FarmJob, Step, task_argv

@@ -76,13 +76,23 @@ def _steps():
     ]
 
 
+def report_text(report, units: str = "m"):
+    """(the Table, the note lines) that `physcam report` prints: report.txt holds the table's plain
+    text, every cell whole (a rich table captured at 80 columns drew a box and folded the cells)."""
+    from ..onset.table import report_rows, report_title
+    from ._output import Table
+
+    table = Table(report_title(report), ("quantity", "value", "measured from"))
+    for r in report_rows(report, units, notes=False):
+        table.add_row(*r)
+    return table, "".join(f"note: {n}\n" for n in report.notes)
+
+
 def _report_step(out, ctx, force):
     import json
 
     from ..io import atomic_write
     from ..onset.dof_plot import plot_dof_chart
-    from ..onset.table import report_table
-    from ._common import console
     from .report import camera_blocks, dof_chart_solver, solve_from_args
 
     ns = _args()
@@ -90,13 +100,11 @@ def _report_step(out, ctx, force):
     ctx["report"] = report
     d = report.to_dict()
     d["cameras"] = camera_blocks(report, ns)
-    con = console()
-    with con.capture() as cap:
-        con.print(report_table(report, ctx.get("units", "m")))
-    ctx["table"] = cap.get()
+    ctx["table"], ctx["notes"] = report_text(report, ctx.get("units", "m"))
+    table = ctx["table"]
     return [
         atomic_write(out / "report.json", json.dumps(d, indent=2, allow_nan=False) + "\n", force=force),
-        atomic_write(out / "report.txt", ctx["table"], force=force),
+        atomic_write(out / "report.txt", table.plain() + ctx["notes"], force=force),
         plot_dof_chart(report, dof_chart_solver(ns, report), out / "dof.png", force=force,
                        units=ctx.get("units", "m")),
     ]
@@ -248,7 +256,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from ._common import console, output_folder, relocated, units_of
-    from ._output import document, emit_json
+    from ._output import document, emit_json, print_table
 
     from ..extras import require_extra
 
@@ -266,5 +274,6 @@ def run(args) -> int:
     if args.json:
         emit_json(document("demo", {"out": str(out), "files": [str(p) for p in written]}))
         return 0
-    print(ctx["table"], end="")
+    print_table(ctx["table"])
+    print(ctx["notes"], end="")
     return 0

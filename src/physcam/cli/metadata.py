@@ -114,6 +114,36 @@ def _load(args):
     return rec
 
 
+def _clip(rec) -> str:
+    """The clip as a title names it: arri clip B001C001, or canon clip when the files name none (not
+    "canon clip : ...")."""
+    return f"{rec.source} clip" + (f" {rec.clip_name}" if rec.clip_name else "")
+
+
+def clip_notes(per_frame) -> list[str]:
+    """The notes of a clip's frames (one tuple a frame), one per kind: notes that differ only in their
+    numbers (the diffraction note's working f-number along a focus pull) are one note, the first such
+    frame's, saying on how many frames it came in how many versions (a 500-frame clip printed 21
+    diffraction notes)."""
+    import re
+
+    def kind(note: str) -> str:
+        return re.sub(r"\d+(?:\.\d+)?", "#", note)
+
+    first: dict[str, str] = {}
+    versions: dict[str, set] = {}
+    frames: dict[str, int] = {}
+    for notes in per_frame:
+        for k in {kind(n) for n in notes}:
+            frames[k] = frames.get(k, 0) + 1
+        for n in notes:
+            first.setdefault(kind(n), n)
+            versions.setdefault(kind(n), set()).add(n)
+    return sorted(n if len(versions[k]) == 1 else
+                  f"{n} (the first frame's: {len(versions[k])} versions of this note on {frames[k]} frames, "
+                  "their numbers vary)" for k, n in first.items())
+
+
 def _m(v, units):
     from ..units import format_distance
 
@@ -132,7 +162,7 @@ def run_show(args) -> int:
     if args.csv:
         print_csv(rows)
         return 0
-    t = Table(f"{rec.source} clip {rec.clip_name or ''}".rstrip(), ["value", "recorded"])
+    t = Table(_clip(rec), ["value", "recorded"])
     for k, v in static.items():
         if k not in ("frame_rate_exact",):
             t.add_row(k, "-" if v is None else (", ".join(map(str, v)) if isinstance(v, list) else v))
@@ -176,7 +206,7 @@ def run_report(args) -> int:
     solved, lens = _solve(args, rec)
     rows = lens_report_rows(solved)
     s = solved[0].report.sensor
-    notes = sorted({n for x in solved for n in x.report.notes})
+    notes = clip_notes([x.report.notes for x in solved])
     if args.json:
         emit_json(document("metadata_report", {
             "clip": rec.static_dict(), "lens": args.lens, "model": "prescription" if lens is not None else "thin lens",
@@ -188,7 +218,7 @@ def run_report(args) -> int:
     u = units_of(args)
     what = f"lens {args.lens}" if lens is not None else "a thin lens of the recorded focal length"
     cols = ["frame", "timecode", "focus", "stop", "near", "far", "hyperfocal", "hfov_deg"]
-    t = Table(f"{rec.source} clip {rec.clip_name or ''}: {what}, sensor {s.width_mm:g} x {s.height_mm:g} mm", cols,
+    t = Table(f"{_clip(rec)}: {what}, sensor {s.width_mm:g} x {s.height_mm:g} mm", cols,
               justify=["right", "left"] + ["right"] * 6)
     for r in rows:
         t.add_row(r["frame"], r["timecode"] or "-", _m(r["focus_from_film_mm"], u), f"{r['fstop']:.3g}",
@@ -221,8 +251,7 @@ def run_usd(args) -> int:
     if args.json:
         emit_json(document("metadata_usd", summary))
     else:
-        print(f"wrote {out}: {len(solved)} frames of {rec.source} clip {rec.clip_name or ''}".rstrip()
-              + (f", plate {args.plate}" if args.plate else ""))
+        print(f"wrote {out}: {len(solved)} frames of {_clip(rec)}" + (f", plate {args.plate}" if args.plate else ""))
     return 0
 
 

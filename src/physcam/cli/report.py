@@ -222,7 +222,7 @@ def camera_blocks(report, args) -> dict:
 
     mpu = args.meters_per_unit
     shift = (getattr(args, "shift_x", 0.0), getattr(args, "shift_y", 0.0))
-    d = report.to_dict()
+    fov = report.fov_dict()  # (not the whole to_dict: the serve page asks it per keystroke, issue 47)
     calc = report
     if report.focus_is_infinite:  # every value but the focus distance is that of a far, finite focus
         from .._record import replace
@@ -235,7 +235,7 @@ def camera_blocks(report, args) -> dict:
     blocks = {
         "meters_per_unit": mpu,
         "camera": "the best-match pinhole at the entrance pupil (docs/lens-report.md)",
-        "fov_deg": {"pinhole": d["fov_deg"]["focus"], "real": d["fov_deg"]["real"]},
+        "fov_deg": {"pinhole": fov["focus"], "real": fov["real"]},
         "usd_geom_camera": usdgeom_camera_values(calc, mpu, shutter_angle_deg=args.shutter_angle, shift_mm=shift),
         "renderman": renderman_camera_values(calc, mpu, shift_mm=shift),
         "notes": [],

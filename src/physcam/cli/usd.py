@@ -18,6 +18,11 @@ that `physcam usd plugin-path` prints.
 """
 
 
+#: The body's rotateXYZ, as a camera operator says it (docs/usd.md, "Transform").
+ROTATE_HELP = ("tilt (X), pan (Y) and roll (Z) about the entrance pupil, degrees, applied X then Y then Z "
+               "(rotateXYZ): -5,30,0 tilts 5 down and pans 30 to the left")
+
+
 def register(sub) -> None:
     import argparse
 
@@ -49,6 +54,10 @@ def register(sub) -> None:
                         "distortion (default 2048 and 4096 wide, height from the sensor's aspect)")
     w.add_argument("--overscan", type=number("overscan", lo=0.0, hi=100.0), default=0.0, metavar="PCT",
                    help="render beyond the frame by this percentage (UsdRenderSettings dataWindowNDC)")
+    w.add_argument("--position", type=numbers("position", 3), default=(0.0, 0.0, 0.0), metavar="X,Y,Z",
+                   help="where the entrance pupil goes, in scene units (--meters-per-unit)")
+    w.add_argument("--rotate", type=numbers("rotation", 3), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ",
+                   help=ROTATE_HELP)
     w.set_defaults(handler=run_write, output_args=("file",))
 
     r = s.add_parser("read", help="read a PhysicalCamera back into a lens report")
@@ -80,7 +89,7 @@ def register(sub) -> None:
     k.add_argument("--position", type=numbers("position", 3), default=(0.0, 0.0, 0.0), metavar="X,Y,Z",
                    help="shot: where the entrance pupil goes, in scene units")
     k.add_argument("--rotate", type=numbers("rotation", 3), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ",
-                   help="shot: pan/tilt/roll about the entrance pupil, degrees (XYZ order)")
+                   help="shot: " + ROTATE_HELP)
     k.add_argument("--variant", help="shot: pin a lens characterization variant, by its name (d2026_03_01) or its "
                    "measuring day (2026-03-01); default the lens file's current")
     _stage_args(k)
@@ -110,7 +119,7 @@ def register(sub) -> None:
     a.add_argument("--position", type=numbers("position", 3), default=(0.0, 0.0, 0.0), metavar="X,Y,Z",
                    help="where the first frame's entrance pupil goes, in scene units (the film stays there)")
     a.add_argument("--rotate", type=numbers("rotation", 3), default=(0.0, 0.0, 0.0), metavar="RX,RY,RZ",
-                   help="pan/tilt/roll about the entrance pupil, degrees (XYZ order)")
+                   help=ROTATE_HELP)
     _stage_args(a)
     add_lenient(a)
     a.set_defaults(handler=run_animate, output_args=("file",))
@@ -194,10 +203,9 @@ def run_write(args) -> int:
     distortion = opencv = None
     anamorphic = []
     if getattr(args, "lens", None) and not args.orthographic:  # a prescription-backed report: its real distortion
-        from ..lens.library import load_lens
         from ..usd.kit import prescription_anamorphic_distortion, prescription_distortion, prescription_opencv
 
-        lens = load_lens(args.lens, lenient=args.lenient)
+        lens = args.loaded_lens  # the lens the report solved (a zoom at --zoom)
         distortion = prescription_distortion(lens, report.sensor.width_mm, report.sensor.height_mm,
                                              focus_mm=report.focus_from_film_mm)
         opencv = prescription_opencv(lens, report.sensor.width_mm, report.sensor.height_mm,
@@ -210,7 +218,9 @@ def run_write(args) -> int:
     path = write_camera(args.file, spec, force=args.force, path=args.path, meters_per_unit=args.meters_per_unit,
                         fps=args.fps, report=report if not args.orthographic else None, lens_distortion=distortion,
                         opencv_distortion=opencv, resolution=args.resolution, overscan=args.overscan / 100.0,
-                        thin_lens_gap=gap and gap.to_dict(), anamorphic_distortion=anamorphic)
+                        thin_lens_gap=gap and gap.to_dict(), anamorphic_distortion=anamorphic,
+                        prescription=None if args.orthographic else getattr(args, "loaded_lens", None),
+                        position=args.position, rotate_xyz_deg=args.rotate)
     if gap is not None and not getattr(args, "json", False):
         print(f"note: {gap.summary()}")
     return _done(args, path, extra={"thin_lens_gap": gap and gap.to_dict()})

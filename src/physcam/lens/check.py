@@ -432,13 +432,18 @@ def _duplicates(c: _Ctx) -> None:
             if abs(k - 1) < 1e-6:
                 same_ap = all(abs(a.semi_diameter - b.semi_diameter) < 1e-6 for a, b in zip(p.surfaces, q.surfaces))
                 what = "the same prescription" if same_ap else "the same radii, gaps and glass (other apertures)"
-                c.add("note", "duplicate", f"{what} as the bundled lens {rec.slug!r}",
-                      f"load it by name (`physcam lens show {rec.slug}`)" + (
-                          "; the bundled copy is corrected (`physcam lens check " + rec.slug + "`)" if rec.corrected
-                          else ""), None, slug=rec.slug, scale=1.0)
+                c.add("note", "duplicate", f"{what} as the {_whose(rec)} lens {rec.slug!r}",
+                      f"load it by name (`physcam lens show --lens {rec.slug}`)" + (
+                          f"; the {_whose(rec)} copy is corrected (`physcam lens check --lens {rec.slug}`)"
+                          if rec.corrected else ""), None, slug=rec.slug, scale=1.0)
             else:
-                c.add("note", "duplicate_scaled", f"the bundled lens {rec.slug!r} scaled by {k:.4f}",
+                c.add("note", "duplicate_scaled", f"the {_whose(rec)} lens {rec.slug!r} scaled by {k:.4f}",
                       f"the same design at {k:.4f}x the size", None, slug=rec.slug, scale=k)
+
+
+def _whose(rec) -> str:
+    """How a finding names a library lens: "bundled", or "installed" for one of the user's library."""
+    return "installed" if rec.library == "user" else "bundled"
 
 
 def _provenance(c: _Ctx) -> None:

@@ -294,8 +294,8 @@ def _way_forward(path: Path, s: str) -> str:
             warnings.simplefilter("ignore")
             load_repaired(path)
     except PhysCamError:
-        return f"; no repair is defined for it (`physcam lens check {s}` lists every problem)"
-    return (f"; `physcam lens check {s}` explains, `physcam lens fix {s} -o FIXED.toml --apply` writes a repaired "
+        return f"; no repair is defined for it (`physcam lens check --lens {s}` lists every problem)"
+    return (f"; `physcam lens check --lens {s}` explains, `physcam lens fix --lens {s} -o FIXED.toml --apply` writes a repaired "
             "copy, --lenient (Python: load_lens(path, lenient=True)) loads it repaired")
 
 

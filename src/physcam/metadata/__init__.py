@@ -33,6 +33,7 @@ def detect_file(path) -> tuple[str, str]:
     """(format, role) of one file from its first bytes: role "frames" (the per-frame file),
     "static" (RED's or Canon's static CSV) or "xml" (VENICE's). Unknown content is a MetadataError."""
     from . import arri, arri_json, bmd, canon, mosys, red, venice
+    from ._text import encoding_of
 
     p = Path(path)
     try:
@@ -45,7 +46,10 @@ def detect_file(path) -> tuple[str, str]:
     if mosys.sniff(head):
         return "mosys", "frames"
     try:
-        text = head.decode("utf-8-sig")
+        if encoding_of(head) == "utf-16":  # a whole number of code units; a pair cut at 4 kB is dropped
+            text = head[: len(head) // 2 * 2].decode("utf-16", errors="ignore")
+        else:
+            text = head.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         if exc.start < len(head) - 4:  # not a character cut at the 4 kB boundary: binary
             raise MetadataError("a binary file that is not a Mo-Sys F4 recording (no 0xF4 packet with a valid "

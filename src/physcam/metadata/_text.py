@@ -24,33 +24,43 @@ def _check_size(p: Path, limit: int) -> None:
         raise MetadataError(f"the file is larger than {limit / 10**9:g} GB", p)
 
 
+def encoding_of(head: bytes) -> str:
+    """The text encoding a file's first bytes announce: "utf-16" after a UTF-16 byte-order mark (a
+    spreadsheet's "Unicode text" export of a clip's CSV), else "utf-8-sig" (UTF-8, a BOM dropped)."""
+    return "utf-16" if head[:2] in (b"\xff\xfe", b"\xfe\xff") else "utf-8-sig"
+
+
 def read_text(path, limit: int = MAX_BYTES) -> str:
-    """A small metadata file (a static CSV, an XML) as text (UTF-8, a BOM dropped); a binary file or a
-    missing one is a MetadataError. Per-frame files are read row by row (:func:`rows`, :func:`lines`)."""
+    """A small metadata file (a static CSV, an XML) as text (UTF-8, or UTF-16 with its BOM; a BOM
+    dropped); a binary file or a missing one is a MetadataError. Per-frame files are read row by row
+    (:func:`rows`, :func:`lines`)."""
     p = Path(path)
     _check_size(p, limit)
     try:
         data = p.read_bytes()
     except OSError as exc:
         raise MetadataError(f"cannot read it ({exc.strerror or exc})", p) from None
-    if b"\0" in data[:4096]:
+    encoding = encoding_of(data)
+    if encoding != "utf-16" and b"\0" in data[:4096]:
         raise MetadataError("a binary file, not a metadata text export", p, 1)
     try:
-        return data.decode("utf-8-sig")
+        return data.decode(encoding)
     except UnicodeDecodeError as exc:
-        line = data[: exc.start].count(b"\n") + 1
-        raise MetadataError("not UTF-8 text", p, line) from None
+        line = data[: exc.start].decode(encoding, errors="ignore").count("\n") + 1
+        raise MetadataError(f"not {'UTF-16' if encoding == 'utf-16' else 'UTF-8'} text", p, line) from None
 
 
 def _open_text(p: Path):
-    """The file opened as UTF-8 text (BOM dropped, newlines kept for the csv module), after the size
-    and binary checks."""
+    """The file opened as text (UTF-8 or UTF-16 by its BOM, the BOM dropped, newlines kept for the csv
+    module), after the size and binary checks."""
     _check_size(p, MAX_BYTES)
     try:
         with open(p, "rb") as fh:
-            if b"\0" in fh.read(4096):
-                raise MetadataError("a binary file, not a metadata text export", p, 1)
-        return open(p, encoding="utf-8-sig", newline="")
+            head = fh.read(4096)
+        encoding = encoding_of(head)
+        if encoding != "utf-16" and b"\0" in head:
+            raise MetadataError("a binary file, not a metadata text export", p, 1)
+        return open(p, encoding=encoding, newline="")
     except OSError as exc:
         raise MetadataError(f"cannot read it ({exc.strerror or exc})", p) from None
 
@@ -65,7 +75,7 @@ def lines(path):
             for n, raw in enumerate(fh, 1):
                 yield n, raw.rstrip("\r\n")
         except UnicodeDecodeError:
-            raise MetadataError("not UTF-8 text", p, n + 1) from None
+            raise MetadataError("not UTF-8 or UTF-16 text", p, n + 1) from None
 
 
 def rows(path, delimiter: str = ",") -> tuple[list[str], object]:
@@ -83,7 +93,7 @@ def rows(path, delimiter: str = ",") -> tuple[list[str], object]:
         raise MetadataError("the file is empty", p, 1) from None
     except (csv.Error, UnicodeDecodeError) as exc:
         fh.close()
-        why = "not UTF-8 text" if isinstance(exc, UnicodeDecodeError) else f"cannot read the header ({exc})"
+        why = "not UTF-8 or UTF-16 text" if isinstance(exc, UnicodeDecodeError) else f"cannot read the header ({exc})"
         raise MetadataError(why, p, 1) from None
     header = [h.strip() for h in header]
     return header, _data_rows(p, fh, reader, header)

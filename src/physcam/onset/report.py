@@ -296,6 +296,26 @@ class LensReport(OfACamera):
         verb = "exceeds" if d["exceeds_coc"] else "would exceed"
         return text + f"; it {verb} the CoC past f/{d['fstop_airy_exceeds_coc']:.3g}"
 
+    def fov_dict(self) -> dict:
+        """The fields of view of :meth:`to_dict` (``fov_deg``): at infinity, the best-match pinhole's at this
+        focus, and the real chief rays' (None without a prescription)."""
+        return {
+            "infinity": {"horizontal": self.hfov_inf_deg, "vertical": self.vfov_inf_deg,
+                         "diagonal": self.dfov_inf_deg},
+            "focus": {"horizontal": self.hfov_focus_deg, "vertical": self.vfov_focus_deg,
+                      "diagonal": self.dfov_focus_deg},
+            "definition": "infinity: the paraxial field of the lens focused at infinity (a prescription's EFL "
+                          "there); focus: the best-match pinhole's at this focus; real: chief rays traced through "
+                          "the prescription from the film edge, top and corner (null where not covered)",
+            "real": None if self.real_fov is None else {
+                "horizontal": self.real_fov["horizontal_deg"], "vertical": self.real_fov["vertical_deg"],
+                "diagonal": self.real_fov["diagonal_deg"],
+                "difference_pct": {k: self.real_fov[f"{k}_difference_pct"]
+                                   for k in ("horizontal", "vertical", "diagonal")},
+                "not_covered": list(self.real_fov["not_covered"]), "reason": self.real_fov["reason"]},
+            "real_differs": self.real_fov_differs,
+        }
+
     def to_dict(self) -> dict:
         """Versioned, JSON-ready dict with stable keys; infinities become null plus a flag."""
         s = self.sensor
@@ -340,22 +360,7 @@ class LensReport(OfACamera):
             "pinhole": {"focal_length_mm": self.pinhole[0], "squeeze": self.pinhole[1],
                         "definition": "the pinhole at the entrance pupil that frames like the lens at this focus: "
                                       "f = (exit pupil to film) / pupil magnification; s' for a thin lens"},
-            "fov_deg": {
-                "infinity": {"horizontal": self.hfov_inf_deg, "vertical": self.vfov_inf_deg,
-                             "diagonal": self.dfov_inf_deg},
-                "focus": {"horizontal": self.hfov_focus_deg, "vertical": self.vfov_focus_deg,
-                          "diagonal": self.dfov_focus_deg},
-                "definition": "infinity: the paraxial field of the lens focused at infinity (a prescription's EFL "
-                              "there); focus: the best-match pinhole's at this focus; real: chief rays traced through "
-                              "the prescription from the film edge, top and corner (null where not covered)",
-                "real": None if self.real_fov is None else {
-                    "horizontal": self.real_fov["horizontal_deg"], "vertical": self.real_fov["vertical_deg"],
-                    "diagonal": self.real_fov["diagonal_deg"],
-                    "difference_pct": {k: self.real_fov[f"{k}_difference_pct"]
-                                       for k in ("horizontal", "vertical", "diagonal")},
-                    "not_covered": list(self.real_fov["not_covered"]), "reason": self.real_fov["reason"]},
-                "real_differs": self.real_fov_differs,
-            },
+            "fov_deg": self.fov_dict(),
             "entrance_pupil_from_film_mm": self.entrance_pupil_from_film_mm,
             "stop_from_film_mm": self.stop_from_film_mm,
             "dof_aspect": self.dof_aspect,
@@ -505,8 +510,12 @@ def _caller_level() -> int:
 
 
 def _check_finite(report: LensReport) -> None:
-    """No NaN leaves the library; infinities only where documented (far limits)."""
+    """No NaN leaves the library; infinities only where documented (far limits). The numbers are checked
+    in one pass; the first bad one is named by a second, only then (``physcam serve`` checks a report per
+    keystroke: building each value's path cost a third of the check, issue 47)."""
     d = report.to_dict()
+    if _all_finite(d):
+        return
 
     def walk(x, path):
         if isinstance(x, float) and not math.isfinite(x):
@@ -519,6 +528,21 @@ def _check_finite(report: LensReport) -> None:
                 walk(v, f"{path}[{i}]")
 
     walk(d, "")
+
+
+def _all_finite(doc) -> bool:
+    """Whether every float in ``doc`` (dicts and lists, nested) is finite."""
+    isfinite, stack = math.isfinite, [doc]
+    while stack:
+        x = stack.pop()
+        if isinstance(x, float):
+            if not isfinite(x):
+                return False
+        elif isinstance(x, dict):
+            stack.extend(x.values())
+        elif isinstance(x, list):
+            stack.extend(x)
+    return True
 
 
 def takes_report(fn):

@@ -174,6 +174,10 @@ def _camera_of(r: SimpleNamespace) -> ReportInputs:
     if measured is None and r.focus_mm is None:
         raise InputError("give a focus distance (--focus), or measured near and far limits (--near, --far), "
                          "or one limit with the f-stop")
+    if fstop is None and measured is None and r.tstop is not None:  # notes that say "T2.8" and nothing else
+        raise InputError(f"a T-stop alone (--tstop {r.tstop:g}) is not the f-stop depth of field needs: give "
+                         f"--fstop too (the geometric f-number; with nothing better, --fstop {r.tstop:g} takes "
+                         "the T-stop for it, as on-set calculators do, a little deeper than the true f-number)")
     if fstop is None and measured is None:
         raise InputError("give the f-stop (--fstop) or a measured near/far limit to solve it")
     if r.focus_mm is None:

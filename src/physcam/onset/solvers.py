@@ -36,7 +36,7 @@ from ..optics.lens_model import LensAtMark, PrincipalPlanes
 from ..optics.state import HYPERFOCAL, CameraState
 from .inverse import hyperfocal_parameters, require_possible_f_number
 from .pupil import entrance_pupil_practical
-from .request import MeasuredLimits, References
+from .request import MeasuredLimits, References, ReportRequest
 
 from .._record import record, replace
 
@@ -60,20 +60,29 @@ def _typed(fn):
     ReportRequest first (the pre-issue-43 form, with the LensState after it) is read as its camera, with a
     DeprecationWarning."""
     names = fn.__code__.co_varnames[:fn.__code__.co_argcount]  # positional parameters, in order
+    typed = [(i, name) for i, name in enumerate(names) if name in _MADE_BY]  # (the rest are never checked)
 
     @functools.wraps(fn)
     def checked(*args, **kwargs):
-        from .request import ReportRequest
-
         if args and isinstance(args[0], ReportRequest):
             args, kwargs = _old_form(fn, args, kwargs)
-        for name, value in (*zip(names, args), *kwargs.items()):
-            if name in _MADE_BY:
+        for i, name in typed:  # (issue 47: the common case, an instance of the very class, at once)
+            value = args[i] if i < len(args) else kwargs.get(name, _ABSENT)
+            cls, hint = _MADE_BY[name]
+            if value is not _ABSENT and type(value) is not _CLASSES.get(cls):
+                require_type(name, value, globals()[cls], hint)
+        for name, value in kwargs.items():
+            if name in _MADE_BY and name not in names:
                 cls, hint = _MADE_BY[name]
                 require_type(name, value, globals()[cls], hint)
         return fn(*args, **kwargs)
 
     return checked
+
+
+_ABSENT = object()
+#: The classes of :data:`_MADE_BY` by name, filled when the module is loaded (``type(value) is`` them passes)
+_CLASSES: dict = {}
 
 
 def _old_form(fn, args, kwargs):
@@ -395,3 +404,6 @@ def entrance_pupil(camera: CameraState, h1_film: float, references: References |
     if at.model == "practical":
         return h1_film, "thin lens: at the principal plane", ()
     return None, "unknown", ("no entrance pupil: give --pupil (technical) or --sensor-front and --lens-length",)
+
+
+_CLASSES.update({name: globals()[name] for name, _ in _MADE_BY.values()})

@@ -95,15 +95,3 @@ def report_rows(report, units: str = "m", *, notes: bool = True) -> list[tuple[s
     for n in d["notes"] if notes else ():
         add("note", n, "")
     return rows
-
-
-def report_table(report, units: str = "m"):
-    """A rich Table of the report's main figures (:func:`report_rows`)."""
-    from rich.table import Table
-
-    t = Table(title=report_title(report), show_header=True, header_style="bold")
-    for col in ("quantity", "value", "measured from"):
-        t.add_column(col)
-    for r in report_rows(report, units):
-        t.add_row(*r)
-    return t

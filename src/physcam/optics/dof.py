@@ -58,6 +58,8 @@ HYPERFOCAL_RTOL = 1e-6
 def _h(f, a, b):
     """f^2 / (a b) for positive inputs, as (f / a)(f / b) so no product underflows to 0; a quotient too
     large for a float is an OpticsError (raised by :func:`_num.out` on the infinity)."""
+    if type(f) is float and type(a) is float and type(b) is float:
+        return (f / a) * (f / b)  # (Python floats: numpy's error state is not theirs, issue 47)
     with nx.float_errors_ignored():
         return (f / a) * (f / b)
 

@@ -517,14 +517,14 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
         return Response(status_code=204)
 
     api = {**_report_endpoints(core, backend, limits), **_catalogue_endpoints(core, backend, limits)}
-    routes = [
+    routes = [  # (no two paths overlap: the order is the router's trials, the report first, issue 47)
+        *(Route(path, api[path]) for path in ("/api/report", "/api/focus-table", "/api/dof.svg", "/api/sensors",
+                                              "/api/lenses", "/api/lens/{name}", "/api/lens/{name}/diagram.svg")),
+        Route("/api/health", health),
         Route("/", _static_page(core, "index.html")),
         *(Route(f"/{name}" if name in ROOT_FILES else f"/static/{name}", _static_page(core, name))
           for name in STATIC_FILES if name != "index.html"),
         Route("/favicon.ico", favicon),
-        *(Route(path, api[path]) for path in ("/api/report", "/api/focus-table", "/api/dof.svg", "/api/sensors",
-                                              "/api/lenses", "/api/lens/{name}", "/api/lens/{name}/diagram.svg")),
-        Route("/api/health", health),
     ]
     app = Starlette(routes=routes, exception_handlers={HTTPException: _http_error},
                     middleware=[Middleware(_Guard, limits=limits, log=log)])

@@ -138,12 +138,16 @@ def run_server(app, sock: socket.socket, *, log_requests: bool = False, limits: 
     limits = Limits() if limits is None else limits
     if not isinstance(limits, Limits):
         raise WrongTypeError(f"limits must be a physcam.serve.Limits, got {type(limits).__name__}")
+    import os
+
     import uvicorn
 
     from .protocol import protocol_class
 
+    # the HTTP parser: httptools when installed, else h11; PHYSCAM_HTTP_PARSER=h11 chooses h11 (tests run both)
+    http = protocol_class(limits, os.environ.get("PHYSCAM_HTTP_PARSER") or None)
     config = uvicorn.Config(
-        app, http=protocol_class(limits), loop="asyncio", lifespan="off", ws="none", interface="asgi3",
+        app, http=http, loop="asyncio", lifespan="off", ws="none", interface="asgi3",
         log_level="warning", access_log=bool(log_requests), server_header=False, proxy_headers=False,
         timeout_keep_alive=limits.keep_alive, limit_concurrency=None, backlog=128,
         h11_max_incomplete_event_size=limits.head_bytes,

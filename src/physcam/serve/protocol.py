@@ -1,4 +1,4 @@
-"""The HTTP/1.1 connection of ``physcam serve``: uvicorn's h11 protocol with bounds per connection.
+"""The HTTP/1.1 connection of ``physcam serve``: uvicorn's protocol with bounds per connection.
 
 uvicorn alone let one client lock everyone out (issue 24 item 11): a connection that never
 finishes its request head was held for ever, so 256 half-sent requests filled uvicorn's
@@ -19,13 +19,20 @@ malformed HTTP too). After refusing a client that has sent something, the server
 and reads and discards its input for up to :data:`LINGER_S` seconds before closing: closing a
 socket with unread input sends a reset, which can make the client lose the answer.
 
-This relies on uvicorn internals (``uvicorn>=0.29``, checked against 0.54): the
-``H11Protocol`` attributes ``conn`` (the ``h11.Connection``, replaced here), ``transport``,
-``client``, ``loop`` and ``flow``; its methods ``connection_made``, ``connection_lost``,
-``data_received``, ``on_response_complete``, ``shutdown`` and ``_unset_keepalive_if_required``;
-and that ``handle_events`` answers an ``h11.RemoteProtocolError`` by calling
-``send_400_response``. h11 is used through its public API (``trailing_data``, states,
-``RemoteProtocolError.error_status_hint``).
+Two parsers, the same bounds (:class:`_Bounded`): httptools (llhttp, in C; the serve extra installs
+it: h11 in Python cost a third of a cached answer's CPU, issue 47), or h11 when httptools is not
+installed or ``PHYSCAM_HTTP_PARSER=h11`` asks for it. The head cap counts the bytes up to the head's first empty line itself for both, before
+the parser sees them. One difference is h11's: an HTTP/1.1 request without a Host header is
+malformed there (400), llhttp takes it.
+
+This relies on uvicorn internals (``uvicorn>=0.29``, checked against 0.54): the protocols'
+attributes ``transport``, ``client``, ``loop`` and ``flow``, the methods ``connection_made``,
+``connection_lost``, ``data_received``, ``on_response_complete``, ``shutdown`` and
+``_unset_keepalive_if_required``; for h11, ``conn`` (the ``h11.Connection``, replaced here) and
+that ``handle_events`` answers an ``h11.RemoteProtocolError`` by calling ``send_400_response``;
+for httptools, ``parser`` and its callbacks ``on_headers_complete`` and ``on_message_complete``.
+h11 is used through its public API (``trailing_data``, states,
+``RemoteProtocolError.error_status_hint``), httptools through ``feed_data`` and its errors.
 """
 
 from __future__ import annotations
@@ -37,6 +44,12 @@ from http import HTTPStatus
 import h11
 from uvicorn.protocols.http.h11_impl import H11Protocol
 
+try:
+    import httptools
+    from uvicorn.protocols.http.httptools_impl import HttpToolsProtocol
+except ImportError:  # the serve extra installs it; h11 serves alone without it
+    httptools = HttpToolsProtocol = None
+
 from .app import SECURITY_HEADERS, Limits, one_line
 
 __all__ = ["LINGER_S", "protocol_class"]
@@ -46,6 +59,10 @@ LINGER_S = 2.0
 
 #: Where h11 ends a head: the first empty line (h11._receivebuffer's blank_line_regex).
 _BLANK_LINE = re.compile(b"\n\r?\n")
+
+
+def _head_too_long(head_bytes: int) -> str:
+    return f"the request line and headers are over {head_bytes} bytes ({head_bytes // 1024} KiB)"
 
 
 class _HeadCappedConnection(h11.Connection):
@@ -74,7 +91,7 @@ class _HeadCappedConnection(h11.Connection):
             raise
 
     def _too_long(self) -> str:
-        return f"the request line and headers are over {self.head_bytes} bytes ({self.head_bytes // 1024} KiB)"
+        return _head_too_long(self.head_bytes)
 
 
 class _Tally:
@@ -95,19 +112,23 @@ class _Tally:
         self.total -= 1
 
 
-class LimitedH11Protocol(H11Protocol):
-    """uvicorn's h11 protocol with the head cap, the header timeout and the connection caps."""
+class _Bounded:
+    """The bounds of a connection, over uvicorn's protocol (h11's or httptools'): the connection caps,
+    the header timeout and the refusals. A subclass says where the request stands (:meth:`_stage`)."""
 
     limits: Limits = Limits()
     tally: _Tally = _Tally()
 
-    def __init__(self, *args, **kwargs):
-        super().__init__(*args, **kwargs)
-        self.conn = _HeadCappedConnection(self.limits.head_bytes)
+    def _bounds_init(self) -> None:
         self._who: str | None = None  # the address this connection is counted under
         self._refused = False
         self._phase_start = 0.0
         self._timer = None
+
+    def _stage(self) -> str:
+        """"idle" (no byte of the next head yet), "head" (part of it), "body" (its body coming) or
+        "answering" (the request is in: the server's answer starts the next phase)."""
+        raise NotImplementedError
 
     # --- the connection caps ----------------------------------------------------------------
     def connection_made(self, transport) -> None:
@@ -149,16 +170,15 @@ class LimitedH11Protocol(H11Protocol):
         self._timer = None
         if self._refused or self.transport.is_closing():
             return
-        conn, lim = self.conn, self.limits
-        if conn.their_state not in (h11.IDLE, h11.SEND_BODY):
-            return  # the request is in (DONE, or MUST_CLOSE after "Connection: close"): the server is
-            # answering, and its answer starts the next phase
+        lim, stage = self.limits, self._stage()
+        if stage == "answering":
+            return  # the request is in: the server is answering, and its answer starts the next phase
         elapsed = self.loop.time() - self._phase_start
-        idle = conn.their_state is h11.IDLE and not conn.trailing_data[0]
+        idle = stage == "idle"
         if idle and elapsed >= lim.keep_alive:
             self._close_quietly()
         elif elapsed >= lim.head_timeout:
-            if conn.their_state is h11.IDLE:
+            if stage != "body":
                 self._refuse(408, f"the request line and headers did not arrive within {lim.head_timeout:g} s",
                              linger=True)
             else:
@@ -169,22 +189,13 @@ class LimitedH11Protocol(H11Protocol):
 
     def _close_quietly(self) -> None:
         self._refused = True
-        self.transport.close()  # uvicorn's connection_lost tells h11
+        self.transport.close()  # uvicorn's connection_lost tells the parser
 
     # --- uvicorn's hooks --------------------------------------------------------------------
-    def data_received(self, data: bytes) -> None:
-        if self._refused:
-            return  # discarded, so that closing sends no reset before the client has read its answer
-        super().data_received(data)
-
     def on_response_complete(self) -> None:
         if not self.transport.is_closing():
             self._start_phase()
         super().on_response_complete()
-
-    def send_400_response(self, msg: str) -> None:
-        status, reason = self.conn.refusal or (400, "malformed HTTP request")
-        self._refuse(status, reason, linger=True)
 
     def shutdown(self) -> None:
         if self._refused:
@@ -214,11 +225,127 @@ class LimitedH11Protocol(H11Protocol):
         self._timer = self.loop.call_later(LINGER_S, self.transport.close)
 
 
-def protocol_class(limits: Limits) -> type[LimitedH11Protocol]:
+class LimitedH11Protocol(_Bounded, H11Protocol):
+    """uvicorn's h11 protocol with the head cap, the header timeout and the connection caps."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.conn = _HeadCappedConnection(self.limits.head_bytes)
+        self._bounds_init()
+
+    def _stage(self) -> str:
+        state = self.conn.their_state
+        if state is h11.IDLE:
+            return "head" if self.conn.trailing_data[0] else "idle"
+        return "body" if state is h11.SEND_BODY else "answering"
+
+    def data_received(self, data: bytes) -> None:
+        if self._refused:
+            return  # discarded, so that closing sends no reset before the client has read its answer
+        super().data_received(data)
+
+    def send_400_response(self, msg: str) -> None:
+        status, reason = self.conn.refusal or (400, "malformed HTTP request")
+        self._refuse(status, reason, linger=True)
+
+
+class LimitedHttpToolsProtocol(_Bounded, HttpToolsProtocol or object):
+    """uvicorn's httptools protocol with the head cap, the header timeout and the connection caps.
+    The head's bytes are counted here up to its first empty line before llhttp parses them (llhttp
+    sets no bound: httptools gathers a header's value however long it grows)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._bounds_init()
+        self._in_head = True  # the bytes coming are a request head's
+        self._head_len = 0  # bytes of it so far
+        self._tail = b""  # its last two bytes, for an empty line split between two reads
+        self._pending = 0  # requests in and not yet answered
+        self._deferred: tuple[int, str] | None = None  # a refusal waiting for those answers
+
+    def _stage(self) -> str:
+        if self._pending:
+            return "answering"
+        if self._in_head:
+            return "head" if self._head_len else "idle"
+        return "body"
+
+    def data_received(self, data: bytes) -> None:
+        if self._refused or self._deferred:
+            return  # discarded, so that closing sends no reset before the client has read its answer
+        while data:
+            if not self._in_head:  # a body (this server answers one with 413)
+                self._feed(data)
+                return
+            found = _BLANK_LINE.search(self._tail + data)
+            end = len(data) if found is None else found.end() - len(self._tail)
+            if self._head_len + end > self.limits.head_bytes:
+                self._refuse_in_turn(431, _head_too_long(self.limits.head_bytes))
+                return
+            self._head_len += end
+            self._tail = b"" if found is not None else (self._tail + data)[-2:]
+            piece, data = data[:end], data[end:]
+            if not self._feed(piece):
+                return
+
+    def _feed(self, data: bytes) -> bool:
+        """``data`` to the parser (uvicorn's ``data_received``, a malformed request refused here); whether
+        the connection goes on."""
+        self._unset_keepalive_if_required()
+        try:
+            self.parser.feed_data(data)
+        except httptools.HttpParserUpgrade:
+            self._unsupported_upgrade_warning()  # (no websockets here)
+        except httptools.HttpParserError as exc:
+            self._refuse_in_turn(400, f"malformed HTTP request ({str(exc)[:120]})")
+        return not (self._refused or self._deferred or self.transport.is_closing())
+
+    def _refuse_in_turn(self, status: int, reason: str) -> None:
+        """Refuse the request being read, after the answers of those before it (pipelined in the
+        same connection: h11 reads a request only once the one before is answered)."""
+        if self._pending:
+            self._deferred = (status, reason)
+        else:
+            self._refuse(status, reason, linger=True)
+
+    def on_headers_complete(self) -> None:
+        self._in_head = False
+        super().on_headers_complete()
+
+    def on_message_complete(self) -> None:
+        if not self.cycle.response_complete:
+            self._pending += 1
+        self._in_head, self._head_len, self._tail = True, 0, b""
+        super().on_message_complete()
+
+    def on_response_complete(self) -> None:
+        self._pending = max(0, self._pending - 1)
+        super().on_response_complete()
+        if self._deferred and not self._pending and not self.transport.is_closing():
+            self._refuse(*self._deferred, linger=True)
+
+    def send_400_response(self, msg: str) -> None:
+        self._refuse(400, "malformed HTTP request", linger=True)
+
+
+def protocol_class(limits: Limits, parser: str | None = None) -> type[_Bounded]:
     """A protocol class for ``uvicorn.Config(http=...)`` bounded by ``limits``, with its own
-    count of open connections (one class per server)."""
+    count of open connections (one class per server). ``parser``: "httptools" or "h11"; None
+    (default) httptools when it is installed, else h11."""
     if not isinstance(limits, Limits):
         from ..errors import WrongTypeError
 
         raise WrongTypeError(f"limits must be a physcam.serve.Limits, got {type(limits).__name__}")
-    return type("PhysCamH11Protocol", (LimitedH11Protocol,), {"limits": limits, "tally": _Tally()})
+    if parser is None:
+        parser = "h11" if httptools is None else "httptools"
+    if parser not in ("httptools", "h11"):
+        from ..errors import InputError
+
+        raise InputError(f"the HTTP parser is 'httptools' or 'h11', got {parser!r}")
+    if parser == "httptools" and httptools is None:
+        from ..errors import InputError
+
+        raise InputError("the httptools parser is not installed: pip install 'physcam[serve]'")
+    base, name = (LimitedHttpToolsProtocol, "PhysCamHttpToolsProtocol") if parser == "httptools" else (
+        LimitedH11Protocol, "PhysCamH11Protocol")
+    return type(name, (base,), {"limits": limits, "tally": _Tally()})

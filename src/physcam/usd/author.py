@@ -56,6 +56,7 @@ __all__ = [
     "sample_render_camera",
     "iris_mm",
     "author_anamorphic_distortion",
+    "author_prescription",
 ]
 
 def new_stage(meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y"):
@@ -648,19 +649,77 @@ def save_stage(stage, file, *, force: bool = False):
     return p
 
 
+def author_prescription(stage, path, rx, focus_mm: float):
+    """Author ``rx`` as a ``PhysicalCameraLensModelPrescription`` at ``path`` (surfaces scene side to film side,
+    one array element per surface; docs/usd.md, "Lens models"), focused ``focus_mm`` in front of the film;
+    return the prim."""
+    from pxr import Sdf
+
+    from ..lens.prescription import require_prescription
+
+    require_stage(stage)
+    require_prescription(rx, "rx")
+    require_positive("focus distance", focus_mm)
+    if not isinstance(path, (str, Sdf.Path)) or not Sdf.Path.IsValidPathString(str(path))[0] \
+            or not Sdf.Path(str(path)).IsAbsolutePath():
+        raise ExportError(f"lens model path {path!r} is not an absolute prim path such as /Lens/Prescription")
+
+    prim = stage.DefinePrim(path, "PhysicalCameraLensModelPrescription")
+    S = rx.surfaces
+    T = Sdf.ValueTypeNames
+    vals = {
+        "radius": (T.DoubleArray, [s.radius for s in S]),
+        "thickness": (T.DoubleArray, [s.thickness for s in S]),
+        "nd": (T.DoubleArray, [s.medium.nd for s in S]),
+        "vd": (T.DoubleArray, [s.medium.vd for s in S]),
+        "semiDiameter": (T.DoubleArray, [s.semi_diameter for s in S]),
+        "surfaceKind": (T.TokenArray, [s.kind for s in S]),
+        "conic": (T.DoubleArray, [s.conic for s in S]),
+        "asphericCoefficients": (T.DoubleArray,
+                                 [a for s in S for a in (list(s.aspheric) + [0.0] * 7)[:7]]),
+        "glass": (T.StringArray, [usd_text(s.medium.glass or "", "glass name") for s in S]),
+        "lensName": (T.String, usd_text(rx.name, "lens name")),
+        "maker": (T.String, usd_text(rx.metadata.maker or "", "lens maker")),
+        "source": (T.String, usd_text(rx.metadata.source or "", "lens source")),
+        "nominalFocalLength": (T.Float, float(rx.metadata.focal_length or 0.0)),
+        "designWavelength": (T.Double, float(rx.wavelength_nm)),
+        "squeeze": (T.Float, float(rx.squeeze)),
+        "focusDistance": (T.Float, float(focus_mm)),
+    }
+    if rx.focus is not None:
+        vals["focusCloseDistance"] = (T.Double, float(rx.focus.close_distance))
+        vals["focusGapSurface"] = (T.IntArray, [g.surface for g in rx.focus.gaps])
+        vals["focusGapThicknessInfinity"] = (T.DoubleArray, [g.thickness_infinity for g in rx.focus.gaps])
+        vals["focusGapThicknessClose"] = (T.DoubleArray, [g.thickness_close for g in rx.focus.gaps])
+    for name, (t, v) in vals.items():
+        prim.CreateAttribute(name, t, False).Set(v)
+    return prim
+
+
 def write_camera(file, spec: CameraSpec, *, force: bool = False, path: str = DEFAULT_CAMERA_PATH,
                  meters_per_unit: float = 0.01, fps: float = 24.0, up_axis: str = "Y",
                  position=(0.0, 0.0, 0.0), rotate_xyz_deg=(0.0, 0.0, 0.0), report=None, lens_distortion=None,
                  opencv_distortion=None, render_settings: bool = True, resolution=None, overscan: float = 0.0,
-                 thin_lens_gap: dict | None = None, anamorphic_distortion=()):
+                 thin_lens_gap: dict | None = None, anamorphic_distortion=(), prescription=None):
     """Write a one-camera layer to ``file`` (see :func:`author_camera`), with a ``UsdRenderSettings``
     for its companion camera (:func:`author_render_settings`) unless ``render_settings`` is false;
     return the Path. ``thin_lens_gap`` (:meth:`physcam.onset.thin_lens_gap.ThinLensGap.to_dict`) is kept
     in the companion camera's customData ``physcam:thinLensGap``: how far it is from the real lens.
-    ``anamorphic_distortion``: 3DE4 anamorphic fits for the companion (:func:`author_anamorphic_distortion`)."""
+    ``anamorphic_distortion``: 3DE4 anamorphic fits for the companion (:func:`author_anamorphic_distortion`).
+    ``prescription``: the real lens ``spec`` was solved from, kept as ``<path>/Prescription`` beside the
+    pinhole that renders, so ``physcam usd refresh`` solves the lens again at an edited f-stop, focus or
+    sensor (:func:`physcam.usd.kit.refresh_shot`)."""
     stage = new_stage(meters_per_unit, fps, up_axis)
     author_camera(stage, path, spec, position=position, rotate_xyz_deg=rotate_xyz_deg, report=report,
                   lens_distortion=lens_distortion, opencv_distortion=opencv_distortion)
+    if prescription is not None:
+        from pxr import Sdf
+
+        from .read import companion_inputs
+
+        author_prescription(stage, Sdf.Path(path).AppendChild("Prescription"), prescription, spec.focus_mm)
+        companion = stage.GetPrimAtPath(f"{path}/{RENDER_CAMERA_NAME}")  # its inputs now hold the lens too
+        companion.SetCustomDataByKey("physcam:companionInputs", companion_inputs(stage, path))
     if thin_lens_gap is not None:
         companion = stage.GetPrimAtPath(f"{path}/{RENDER_CAMERA_NAME}")
         companion.SetCustomDataByKey("physcam:thinLensGap", _usd_dict(thin_lens_gap))

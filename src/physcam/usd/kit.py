@@ -20,9 +20,10 @@ import math
 
 from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
 from ..errors import ExportError, InputError, require_type
-from ..export._codetext import printable_line, usd_text
+from ..export._codetext import printable_line
 from ..lens.prescription import takes_prescription
-from .author import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec, author_camera, author_render_camera, new_stage, save_stage
+from .author import (LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec, author_camera, author_prescription, author_render_camera,
+                     new_stage, save_stage)
 from .read import companion_inputs, companion_inputs_hash, composed_prescription
 from .plugin import ensure_registered
 
@@ -273,6 +274,7 @@ def _author_shot_companion(stage, path) -> str:
                                coc=spec.coc_mm, lens=rx))
         derived = spec_from_report(report)
         _author_lens_derived(stage, cam, derived)
+        _author_model_focal_length(stage, cam, derived.focal_length_mm)
         spec = spec.replaced(focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
                              principal_planes_mm=derived.principal_planes_mm,
                              pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
@@ -293,6 +295,12 @@ def _author_shot_companion(stage, path) -> str:
     geom = author_render_camera(stage, Sdf.Path(path), spec, report=report, lens_distortion=distortion,
                                 opencv_distortion=opencv)
     author_anamorphic_distortion(geom.GetPrim(), anamorphic)  # none: a stale one from another lens goes
+    if report is not None and geom.GetPrim().GetCustomDataByKey("physcam:thinLensGap") is not None:
+        from ..onset.thin_lens_gap import thin_lens_gap
+        from .author import _usd_dict
+
+        # usd write's account of the thin lens against the real one, at the stop and focus now authored
+        geom.GetPrim().SetCustomDataByKey("physcam:thinLensGap", _usd_dict(thin_lens_gap(report).to_dict()))
     digest = companion_inputs(stage, path)
     geom.GetPrim().SetCustomDataByKey("physcam:companionInputs", digest)
     return digest
@@ -310,6 +318,17 @@ def _move_film_behind_pupil(cam, pupil_mm: float) -> None:
         op.Set(Gf.Vec3d(0.0, 0.0, mm_to_scene_units(pupil_mm, UsdGeom.GetStageMetersPerUnit(cam.GetStage()))))
 
 
+def _author_model_focal_length(stage, cam, efl_mm: float) -> None:
+    """The pinhole model's ``focalLength`` is the lens's EFL at the focus (an internal-focus lens's moves
+    with it, as ``usd animate`` samples it); a shot's opinion over a referenced model."""
+    targets = cam.GetRelationship(f"lens:{LENS_INSTANCE}:lensModel").GetForwardedTargets()
+    model = stage.GetPrimAtPath(targets[0]) if targets else None
+    if model and model.GetTypeName() == "PhysicalCameraLensModelPinhole":
+        attr = model.GetAttribute("focalLength")
+        if not _same_value(attr.Get(), float(efl_mm)):  # no shot opinion where the lens file says it already
+            attr.Set(float(efl_mm))
+
+
 def _author_lens_derived(stage, cam, spec) -> None:
     """Lens values a prescription gives at the shot's focus, as shot opinions."""
     from pxr import Sdf
@@ -319,6 +338,9 @@ def _author_lens_derived(stage, cam, spec) -> None:
     values = {lp + "entrancePupilDistance": spec.entrance_pupil_mm, lp + "iris": spec.focal_length_mm / spec.fstop,
               lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze": spec.pinhole_squeeze,
               lp + "horizontalEntrancePupilDistance": spec.horizontal_entrance_pupil_mm}
+    stop = cam.GetAttribute(lp + "apertureDistance")  # the stop moves with a unit-focusing lens
+    if spec.aperture_distance_mm is not None and not (stop and _same_value(stop.Get(), spec.aperture_distance_mm)):
+        values[lp + "apertureDistance"] = spec.aperture_distance_mm
     if spec.principal_planes_mm is not None:
         values[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]
         values[lp + "rearPrincipalPlaneDistance"] = spec.principal_planes_mm[1]
@@ -339,15 +361,15 @@ def check_shot(file, path: str | None = None) -> dict:
     """
     from pxr import Sdf, UsdGeom
 
-    from .read import find_cameras, open_stage
+    from .read import only_camera, open_stage
 
     stage = open_stage(file)
     stage.Reload()  # the referenced files as they are on disk now, not as this process cached them
     if path is None:
-        cams = find_cameras(stage)
-        if len(cams) != 1:
-            raise ExportError(f"{file}: found {len(cams)} PhysicalCamera prims; name the one to check")
-        path = cams[0]
+        try:
+            path = only_camera(stage, "check")
+        except ExportError as exc:
+            raise ExportError(f"{file}: {exc}") from None
     geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
     if not geom:
         raise ExportError(f"{path}: has no companion camera to check")
@@ -384,7 +406,7 @@ def refresh_shot(file, path: str | None = None) -> dict:
     """
     from pxr import Sdf, Usd
 
-    from .read import find_cameras
+    from .read import only_camera
 
     ensure_registered()
     from .read import open_stage
@@ -394,20 +416,51 @@ def refresh_shot(file, path: str | None = None) -> dict:
     stage = Usd.Stage.Open(layer)
     stage.Reload()  # the shot and its referenced files as they are on disk now
     if path is None:
-        cams = find_cameras(stage)
-        if len(cams) != 1:
-            raise ExportError(f"{file}: found {len(cams)} PhysicalCamera prims; name the one to refresh")
-        path = cams[0]
+        try:
+            path = only_camera(stage, "refresh")
+        except ExportError as exc:
+            raise ExportError(f"{file}: {exc}") from None
     if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):  # else there is no companion yet: write it
         now = check_shot(file, path)
         if not now["stale"]:
             return dict(now, written=False, changed=[])
     layer = stage.GetRootLayer()
     before = _authored_values(layer, path)
+    notes = _companion_notes(stage, path)
     _author_shot_companion(stage, path)
     changed = _keep_equal_values(layer, before, _authored_values(layer, path), path)
+    _keep_equal_notes(stage, path, notes)
     save_stage(stage, file, force=True)
     return dict(check_shot(file, path), written=True, changed=changed)
+
+
+#: the companion's customData entries of numbers that a refresh recomputes (author_render_camera, usd write)
+_COMPANION_NOTES = ("physcam:fieldOfView", "physcam:thinLensGap")
+
+
+def _companion_notes(stage, path) -> dict:
+    from pxr import Sdf
+
+    geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
+    return {key: geom.GetCustomDataByKey(key) for key in _COMPANION_NOTES} if geom else {}
+
+
+def _same_note(a, b) -> bool:
+    """Whether two customData values (numbers, vectors, text, nested dicts) are equal at float32 precision."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_same_note(a[n], b[n]) for n in a)
+    return _same_value(a, b)
+
+
+def _keep_equal_notes(stage, path, before: dict) -> None:
+    """Give back the file's digits to each recomputed companion note equal to it (:func:`_same_note`): the
+    fields of view a refresh recomputes from 32-bit attributes move in the 8th digit."""
+    from pxr import Sdf
+
+    geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
+    for key, old in before.items():
+        if old is not None and _same_note(old, geom.GetCustomDataByKey(key)):
+            geom.SetCustomDataByKey(key, old)
 
 
 def _authored_values(layer, path) -> dict:
@@ -688,41 +741,6 @@ def prescription_opencv(prescription, sensor_width_mm: float, sensor_height_mm: 
                               focus_mm=focus_mm)
 
 
-def _author_prescription(stage, path, rx, focus_mm: float):
-    from pxr import Sdf
-
-    prim = stage.DefinePrim(path, "PhysicalCameraLensModelPrescription")
-    S = rx.surfaces
-    T = Sdf.ValueTypeNames
-    vals = {
-        "radius": (T.DoubleArray, [s.radius for s in S]),
-        "thickness": (T.DoubleArray, [s.thickness for s in S]),
-        "nd": (T.DoubleArray, [s.medium.nd for s in S]),
-        "vd": (T.DoubleArray, [s.medium.vd for s in S]),
-        "semiDiameter": (T.DoubleArray, [s.semi_diameter for s in S]),
-        "surfaceKind": (T.TokenArray, [s.kind for s in S]),
-        "conic": (T.DoubleArray, [s.conic for s in S]),
-        "asphericCoefficients": (T.DoubleArray,
-                                 [a for s in S for a in (list(s.aspheric) + [0.0] * 7)[:7]]),
-        "glass": (T.StringArray, [usd_text(s.medium.glass or "", "glass name") for s in S]),
-        "lensName": (T.String, usd_text(rx.name, "lens name")),
-        "maker": (T.String, usd_text(rx.metadata.maker or "", "lens maker")),
-        "source": (T.String, usd_text(rx.metadata.source or "", "lens source")),
-        "nominalFocalLength": (T.Float, float(rx.metadata.focal_length or 0.0)),
-        "designWavelength": (T.Double, float(rx.wavelength_nm)),
-        "squeeze": (T.Float, float(rx.squeeze)),
-        "focusDistance": (T.Float, float(focus_mm)),
-    }
-    if rx.focus is not None:
-        vals["focusCloseDistance"] = (T.Double, float(rx.focus.close_distance))
-        vals["focusGapSurface"] = (T.IntArray, [g.surface for g in rx.focus.gaps])
-        vals["focusGapThicknessInfinity"] = (T.DoubleArray, [g.thickness_infinity for g in rx.focus.gaps])
-        vals["focusGapThicknessClose"] = (T.DoubleArray, [g.thickness_close for g in rx.focus.gaps])
-    for name, (t, v) in vals.items():
-        prim.CreateAttribute(name, t, False).Set(v)
-    return prim
-
-
 def write_vendor_lens(file, prescription, *, focus_mm: float, fstop: float | None = None,
                       sensor_width_mm: float = DEFAULT_SENSOR_WIDTH_MM, sensor_height_mm: float = DEFAULT_SENSOR_HEIGHT_MM,
                       coc_mm: float = 0.03,
@@ -749,7 +767,7 @@ def write_vendor_lens(file, prescription, *, focus_mm: float, fstop: float | Non
                                        coc_mm=coc_mm)
     stage = _stage(meters_per_unit, fps)
     cam = author_camera(stage, LENS_PRIM, spec, parts=("lens",))
-    rx_prim = _author_prescription(stage, Sdf.Path(LENS_PRIM).AppendChild("Prescription"), prescription, focus_mm)
+    rx_prim = author_prescription(stage, Sdf.Path(LENS_PRIM).AppendChild("Prescription"), prescription, focus_mm)
     pin = stage.GetPrimAtPath(Sdf.Path(LENS_PRIM).AppendChild("Pinhole"))
     rel_name = f"lens:{LENS_INSTANCE}:lensModel"
     cam.GetRelationship(rel_name).ClearTargets(True)  # the variant decides

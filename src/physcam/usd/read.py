@@ -17,7 +17,7 @@ from ..errors import ExportError, require_type
 from .spec import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec
 from .plugin import ensure_registered, require_prim, require_stage
 
-__all__ = ["CameraReading", "find_cameras", "open_stage", "read_camera", "read_prescription", "composed_prescription",
+__all__ = ["CameraReading", "find_cameras", "only_camera", "open_stage", "read_camera", "read_prescription", "composed_prescription",
            "companion_inputs", "companion_inputs_hash"]
 
 
@@ -78,6 +78,28 @@ def find_cameras(stage) -> list[str]:
 
     t = Usd.SchemaRegistry.GetTypeFromSchemaTypeName("PhysicalCamera")
     return [str(p.GetPath()) for p in stage.Traverse() if p.IsA(t)]
+
+
+def only_camera(stage, verb: str) -> str:
+    """The path of the stage's one PhysicalCamera, for ``verb`` (read, check, refresh); otherwise an
+    :class:`ExportError` saying what the stage holds: several (name one with --path), or none (and
+    its plain UsdGeomCamera prims, which physcam does not read as PhysicalCameras)."""
+    from pxr import UsdGeom
+
+    cams = find_cameras(stage)
+    if len(cams) == 1:
+        return cams[0]
+    if cams:
+        raise ExportError(f"found {len(cams)} PhysicalCamera prims ({_listed(cams)}); name the one to {verb} "
+                          "(--path)")
+    plain = [str(p.GetPath()) for p in stage.Traverse() if p.IsA(UsdGeom.Camera)]
+    also = (f"; its UsdGeomCamera prims ({_listed(plain)}) are plain cameras, not PhysicalCameras (physcam usd "
+            "write makes one from the lens report's values)") if plain else ""
+    raise ExportError(f"found 0 PhysicalCamera prims: no physical camera to {verb}{also}")
+
+
+def _listed(paths: list[str], most: int = 5) -> str:
+    return ", ".join(paths[:most]) + (f" and {len(paths) - most} more" if len(paths) > most else "")
 
 
 def _get(prim, name, what):
@@ -198,11 +220,7 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
     from ..export.usdgeom import mm_to_scene_units
 
     if path is None:
-        cams = find_cameras(stage)
-        if len(cams) != 1:
-            listed = ", ".join(cams) if cams else "none"
-            raise ExportError(f"found {len(cams)} PhysicalCamera prims ({listed}); name the one to read")
-        path = cams[0]
+        path = only_camera(stage, "read")
     prim = stage.GetPrimAtPath(Sdf.Path(path)) if Sdf.Path.IsValidPathString(path) else None
     if not prim:
         raise ExportError(f"{path}: no prim at that path")

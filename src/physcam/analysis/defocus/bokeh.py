@@ -131,12 +131,15 @@ def bokeh_image(
     backend = backend_for_job(backend, (rays + (0 if extent_mm is not None else 20_000))
                               * (len(lens.surfaces) + 1))
     trace = dict(film_z=film_z, stop_semi_diameter=stop_semi_diameter, aperture=aperture, backend=backend)
+    head = None
     if extent_mm is None:  # a pilot trace sizes the window (in double: it sets the image's frame)
-        extent_mm = _pilot_extent(lens, src, trace, depth)
+        extent_mm, head = _pilot_extent(lens, src, trace, depth, fresnel)
+        if src.dtype is not np.float64 or min(rays, chunk) <= PILOT_RAYS:
+            head = None  # the pilot's rays are not the image's first rays
     x0, x1, y0, y1 = (float(v) for v in extent_mm)
     if not (x1 > x0 and y1 > y0):
         raise InputError(f"bokeh extent must have x1 > x0 and y1 > y0, got {extent_mm}")
-    img, passed = _accumulate(lens, src, trace, (x0, x1, y0, y1), rays, pixels, chunk, fresnel, progress)
+    img, passed = _accumulate(lens, src, trace, (x0, x1, y0, y1), rays, pixels, chunk, fresnel, progress, head)
     img = img.reshape(pixels, pixels, len(wls)) * (np.pi * src.r_front**2 / (z_src * z_src) / rays)
     return BokehImage(lens.name, img, (x0, x1, y0, y1), tuple(wls), rays, passed, float(film_z))
 
@@ -234,41 +237,57 @@ def _unit_directions(dx, dy, dz):
     return dx, dy, dzn, dzn**3
 
 
-def _pilot_extent(lens, src, trace, depth):
-    """A square window on the film around where 20000 pilot rays (in double) land, 20 % margin."""
+#: Rays of the pilot trace that frames the image (:func:`_pilot_extent`).
+PILOT_RAYS = 20_000
+
+
+def _pilot_extent(lens, src, trace, depth, fresnel):
+    """A square window on the film around where the first :data:`PILOT_RAYS` rays (in double) land, 20 %
+    margin; and those rays traced (as the image traces them: with ``fresnel``) and their channels."""
     from ...trace import trace_to_film
 
-    pilot, _ = src.batch(20_000, 0, np.float64)
-    pr = trace_to_film(lens, pilot, **trace)
+    pilot, ch = src.batch(PILOT_RAYS, 0, np.float64)
+    pr = trace_to_film(lens, pilot, fresnel=fresnel, in_place=True, **trace)
     if not pr.ok.any():
         raise OpticsError(f"no light from ({src.x:g}, {src.y:g}) mm at depth {depth:g} mm reaches the film")
     xs, ys = pr.x[pr.ok], pr.y[pr.ok]
     cx, cy = 0.5 * (xs.min() + xs.max()), 0.5 * (ys.min() + ys.max())
     half = 0.6 * max(xs.max() - xs.min(), ys.max() - ys.min(), 0.01)
-    return (cx - half, cx + half, cy - half, cy + half)
+    return (cx - half, cx + half, cy - half, cy + half), (pr, ch)
 
 
-def _accumulate(lens, src, trace, extent, rays, pixels, chunk, fresnel, progress):
+def _accumulate(lens, src, trace, extent, rays, pixels, chunk, fresnel, progress, head=None):
     """Trace ``rays`` in chunks and bin their weights into a flat (pixels, pixels, channels) histogram
-    over ``extent``; returns it and the count of rays that reached the film."""
+    over ``extent``; returns it and the count of rays that reached the film. ``head`` (the pilot's
+    traced rays and channels, fewer than a chunk): the first rays, already traced (issue 47: the
+    pilot's 20 000 rays were traced twice); each ray's trace is its own, and its bin and weight go
+    into the first chunk's sum in the same order, so the image is the same."""
     from ...trace import trace_to_film
 
     x0, x1, y0, y1 = extent
     nch = src.k
     img = np.zeros(pixels * pixels * nch)
+
+    def bins(out, ch):
+        """The flat bins and weights of the rays of ``out`` that land in the image."""
+        ix = np.floor((out.x - x0) / (x1 - x0) * pixels).astype(np.int64)
+        iy = np.floor((out.y - y0) / (y1 - y0) * pixels).astype(np.int64)
+        inside = out.ok & (ix >= 0) & (ix < pixels) & (iy >= 0) & (iy < pixels)
+        return (iy[inside] * pixels + ix[inside]) * nch + ch[inside], out.weight[inside]
+
     passed = 0
     done = 0
     while done < rays:
         n = min(chunk, rays - done)
-        b, ch = src.batch(n, done)
+        k = 0 if head is None or done else head[1].size
+        b, ch = src.batch(n - k, done + k)
         out = trace_to_film(lens, b, fresnel=fresnel, in_place=True, **trace)
-        ok = out.ok
-        ix = np.floor((out.x - x0) / (x1 - x0) * pixels).astype(np.int64)
-        iy = np.floor((out.y - y0) / (y1 - y0) * pixels).astype(np.int64)
-        inside = ok & (ix >= 0) & (ix < pixels) & (iy >= 0) & (iy < pixels)
-        flat = (iy[inside] * pixels + ix[inside]) * nch + ch[inside]
-        img += np.bincount(flat, weights=out.weight[inside], minlength=img.size)
-        passed += int(ok.sum())
+        flat, weight = bins(out, ch)
+        passed += int(out.ok.sum())
+        if k:
+            (hf, hw), passed = bins(*head), passed + int(head[0].ok.sum())
+            flat, weight = np.concatenate((hf, flat)), np.concatenate((hw, weight))
+        img += np.bincount(flat, weights=weight, minlength=img.size)
         done += n
         if progress is not None:
             progress(done, rays)

@@ -16,6 +16,7 @@ Every reader returns a validated prescription or raises
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from ...errors import ExportError, LensFileError
@@ -31,6 +32,12 @@ _EXT = {".dat": "pbrt", ".json": "iset", ".zmx": "zemax", ".toml": "physcam"}
 #: Other programs' lens files physcam recognises but does not read.
 _NOT_READ = {".seq": "CODE V sequence files (.seq)", ".len": "OSLO lens files (.len)",
              ".zos": "Zemax OpticStudio session files (.zos)", ".zar": "Zemax archives (.zar)"}
+
+
+#: physcam TOML's first line, however the TOML is spaced or quoted (`format="physcam-lens/1"` too)
+_PHYSCAM_FORMAT = re.compile(r"""^[ \t]*format[ \t]*=[ \t]*["']physcam-lens/""", re.MULTILINE)
+#: keys only physcam TOML has (the seed TOML's surfaces have type, aperture and ior)
+_PHYSCAM_ONLY = re.compile(r"^[ \t]*(\[provenance\]|semi_diameter[ \t]*=|medium[ \t]*=|kind[ \t]*=)", re.MULTILINE)
 
 
 def detect_format(path, text: str | None = None) -> str:
@@ -55,7 +62,11 @@ def detect_format(path, text: str | None = None) -> str:
             f"unknown lens file extension {ext or '(none)'!r}; use .toml, .dat, .json or .zmx, or pass format=",
             str(path),
         )
-    if fmt == "physcam" and text is not None and 'format = "physcam-lens/' not in text:
+    if fmt == "physcam" and text is not None and not _PHYSCAM_FORMAT.search(text):
+        if _PHYSCAM_ONLY.search(text):
+            raise LensFileError('a physcam lens TOML (kind, semi_diameter, medium) starts with the line '
+                                'format = "physcam-lens/1"; without it a .toml is read as the seed TOML '
+                                "(type, aperture, ior): add it (docs/lens-formats.md)", str(path), 1)
         fmt = "seed-toml"
     return fmt
 

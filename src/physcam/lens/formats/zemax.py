@@ -483,6 +483,10 @@ def _check_complete(blocks, path, goes_on: bool = False) -> None:
     hint = "the file seems cut short (truncated); save the whole lens again"
     for b in blocks:
         missing = [k for k in ("CURV", "DISZ") if k not in b["seen"]]
+        if missing and b is not blocks[-1]:  # surfaces follow: a block written short (by hand), not a cut
+            raise LensFileError(f"SURF {b['number']} has no {' or '.join(missing)} line: every SURF block "
+                                "needs both, as OpticStudio writes them (CURV 0 for a flat surface or the "
+                                "stop, DISZ its distance to the next surface)", path, b["line"])
         if missing:
             raise LensFileError(f"SURF {b['number']} has no {' or '.join(missing)} line: {hint}", path, b["line"])
     image, last = blocks[-1], blocks[-2]
