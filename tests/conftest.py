@@ -28,6 +28,33 @@ settings.register_profile("physcam", deadline=None, suppress_health_check=[Healt
 settings.load_profile("physcam")
 
 
+#: Test modules run before every other: the one whose first test builds the session's extension zip
+#: (two processes, the suite's longest step, which every Blender extension test waits for).
+#: `make test`'s pytest-xdist (--dist worksteal) hands each worker one half of the collection in
+#: order, and a worker that runs out takes the tail of the other's queue. In the folders' order the zip
+#: was built wherever tests/blender came up on its worker (a fresh clone under load, 2026-11-28: 45
+#: minutes into the run, at 83 % of its tests, the other worker waiting on it and on the extension tests queued
+#: behind it); now it is built first while the other worker runs short tests, and the slow modules
+#: follow, so what a worker takes from the other at the end is short. Whole modules move, each in its
+#: own order, so a module-scoped fixture is built once.
+LONG_FIRST = (
+    "tests/blender/test_extension.py",
+)
+
+
+def pytest_collection_modifyitems(config, items):
+    """Put :data:`LONG_FIRST`'s modules first, then every other module with a test marked slow, then the
+    rest, each module's tests together and in their order (a stable sort on the module's rank)."""
+    rank = {path: i for i, path in enumerate(LONG_FIRST)}
+    slow_modules = {item.nodeid.split("::", 1)[0] for item in items if item.get_closest_marker("slow")}
+
+    def key(item):
+        module = item.nodeid.split("::", 1)[0]
+        return rank.get(module, len(rank) + (module not in slow_modules))
+
+    items.sort(key=key)
+
+
 @pytest.fixture(scope="session")
 def extension_zip(tmp_path_factory):
     """``physcam export blender-extension`` of every bundled lens, built once per test session and shared

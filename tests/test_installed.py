@@ -57,8 +57,13 @@ def installed(tmp_path_factory):
     dist = tmp / "dist"
     # `python -m build` stages the sdist in the checkout itself (physcam-<version>/, src/*.egg-info): two
     # xdist workers building at once removed each other's staging folder, so they take turns
+    # build's isolated build environments (the sdist's, then the wheel's from it) made with the test
+    # environment's uv where it has one: the same isolation and wheel, 8.5 -> 5.0 s CPU (pip's venvs)
+    uv = Path(sys.executable).with_name("uv")
+    installer = ["--installer", "uv"] if uv.exists() else []
     with session_lock(tmp_path_factory, "build"):
-        _run([sys.executable, "-m", "build", "--outdir", str(dist), str(ROOT)], tmp, env=env)
+        _run([sys.executable, "-m", "build", *installer, "--outdir", str(dist), str(ROOT)], tmp,
+             env=dict(env, UV=str(uv)))
     wheels, sdists = sorted(dist.glob("physcam-*.whl")), sorted(dist.glob("physcam-*.tar.gz"))
     assert len(wheels) == 1 and len(sdists) == 1
     venv = tmp / "venv"

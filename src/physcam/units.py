@@ -17,7 +17,7 @@ import re
 
 from .errors import UnitError
 
-__all__ = ["MM_PER_UNIT", "UNIT_SYSTEMS", "parse_distance", "format_feet_inches", "format_distance", "mm_to", "to_mm",
+__all__ = ["MM_PER_UNIT", "UNIT_SYSTEMS", "unit_system", "parse_distance", "format_feet_inches", "format_distance", "mm_to", "to_mm",
            "inch_fraction_for"]
 
 #: Millimetres in one of each accepted unit.
@@ -42,12 +42,23 @@ _NUMBER = r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?"
 _SIMPLE = re.compile(rf"^\s*({_NUMBER})\s*([a-zA-Zµ'\"]*)\s*$")
 #: inches as a number, a whole number and a fraction ("6 1/2") or a fraction alone ("3/8")
 _INCHES = r"(?:(\d+(?:\.\d*)?)(?:\s+(\d+)/(\d+))?|(\d+)/(\d+))"
-#: (patterns compiled by ``re`` when a distance in feet is first read: a metric one never needs them)
-_FEET_INCHES = rf"^\s*(?:({_NUMBER})\s*(?:ft|feet|foot|'))?\s*(?:{_INCHES}\s*(?:in|inch|inches|\"))?\s*$"
+#: (patterns compiled by ``re`` when a distance in feet is first read: a metric one never needs them; a sign
+#: before inches alone, -1 1/4", as before feet)
+_FEET_INCHES = rf"^\s*(?:[+-](?=[\d.]))?(?:({_NUMBER})\s*(?:ft|feet|foot|'))?\s*(?:{_INCHES}\s*(?:in|inch|inches|\"))?\s*$"
 _FEET_BARE_INCHES = rf"^\s*({_NUMBER})\s*(?:ft|feet|foot|')\s*{_INCHES}\s*$"
 
 #: The unit systems distances are printed in (``--units``): metric or feet and inches.
 UNIT_SYSTEMS = ("m", "ft")
+#: The spellings people type for a unit system ("--units feet"), each read as its system's name.
+UNIT_SYSTEM_WORDS = {"m": "m", "metre": "m", "metres": "m", "meter": "m", "meters": "m",
+                     "ft": "ft", "foot": "ft", "feet": "ft"}
+
+
+def unit_system(text: str) -> str:
+    """The unit system (:data:`UNIT_SYSTEMS`) a spelling names: "feet", "foot", "ft" give "ft"; "metres",
+    "meters", "m" give "m" (case and spaces ignored); any other text comes back as typed, for the caller
+    to refuse with the choices."""
+    return UNIT_SYSTEM_WORDS.get(text.strip().lower(), text) if isinstance(text, str) else text
 
 
 def to_mm(value: float, unit: str) -> float:
@@ -123,7 +134,8 @@ def inch_fraction_for(value_mm: float) -> int:
 
 def format_feet_inches(value_mm: float, fraction: int = 1) -> str:
     """Millimetres as feet and inches to the nearest ``1/fraction`` inch, e.g. ``8' 9\"`` or
-    ``4' 6 3/8\"`` (fraction 8); ``inf`` as ``∞``. Fractions are reduced (4/8 is 1/2).
+    ``4' 6 3/8\"`` (fraction 8), inches alone under a foot (``1 1/4\"``, not ``0' 1 1/4\"``); ``inf`` as
+    ``∞``. Fractions are reduced (4/8 is 1/2).
 
     >>> print(format_feet_inches(3048.0), format_feet_inches(1381.125, fraction=8))
     10' 0" 4' 6 3/8"
@@ -139,6 +151,8 @@ def format_feet_inches(value_mm: float, fraction: int = 1) -> str:
     whole_in, part = divmod(abs(steps), fraction)
     ft, inch = divmod(whole_in, 12)
     frac = "" if part == 0 else f" {fractions.Fraction(part, fraction)}"
+    if ft == 0:  # under a foot, inches alone, as a puller writes it: 1 1/4", 3/8"
+        return f"{sign}{frac.strip() if inch == 0 and frac else f'{inch}{frac}'}\""
     return f"{sign}{ft}' {inch}{frac}\""
 
 

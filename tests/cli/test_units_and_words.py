@@ -81,3 +81,24 @@ def test_a_fit_is_good_in_the_cli_and_on_its_figure(tmp_path, capsys):
     assert main(["distortion", "--lens", "dgauss_50mm", "--focus", "2m", "--resolution", "512x384",
                  "--fit", "brown"]) == 0
     assert ": good" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("spelling, system", [("feet", "ft"), ("foot", "ft"), ("FT", "ft"), ("metres", "m"),
+                                              ("meters", "m"), ("metre", "m")])
+def test_units_take_the_common_spellings(capsys, spelling, system):
+    """--units feet prints what --units ft prints (a first-day review: feet was refused)."""
+    argv = ["hyperfocal", "--focal", "35,50", "--sensor", "S35", "--units"]
+    assert main([*argv, spelling]) == 0
+    said = capsys.readouterr().out
+    assert main([*argv, system]) == 0
+    assert said == capsys.readouterr().out
+    assert main([*argv, "yards"]) == 2
+    assert "invalid choice: 'yards'" in capsys.readouterr().err
+
+
+def test_feet_spelled_out_in_the_config_is_feet(capsys, tmp_path, monkeypatch):
+    cfg = tmp_path / "config.toml"
+    cfg.write_text('units = "feet"\n')
+    monkeypatch.setenv("PHYSCAM_CONFIG", str(cfg))
+    rc, d, _ = _report(capsys, "--focal", "50", "--fstop", "4", "--focus", "10", "--sensor", "S35")
+    assert rc == 0 and d["focus_from_film_mm"] == pytest.approx(3048.0)  # 10 ft = 3048 mm

@@ -272,3 +272,11 @@ def test_feet_output_is_the_metric_output_converted(capsys):
             mm = row[f"{key}_mm"]
             assert (ft_row[f"{key}_ft"] == "") if mm is None else float(ft_row[f"{key}_ft"]) == pytest.approx(
                 mm / 304.8, rel=1e-15)
+
+
+@pytest.mark.parametrize("mm, text", [(31.75, '1 1/4"'), (9.525, '3/8"'), (298.45, '11 3/4"'), (-31.75, '-1 1/4"'),
+                                      (304.8, "1' 0\""), (-355.6, "-1' 2\"")])
+def test_under_a_foot_is_inches_alone_as_a_puller_writes_it(mm, text):
+    """1.25 in x 25.4 = 31.75 mm is written 1 1/4", not 0' 1 1/4" (a first-day review); a foot and more keep feet."""
+    assert format_distance(mm, "ft") == text
+    assert parse_distance(text) == pytest.approx(mm, abs=1e-9)

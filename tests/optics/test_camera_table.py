@@ -385,3 +385,66 @@ def test_the_fx6_and_fx3_have_only_their_makers_formats():
     for gone in ("FX6 S35 4K 17:9", "FX3 S35 4K 16:9 UHD", "VariCam LT 4K 17:9"):
         with pytest.raises(SensorError):
             find_sensor(gone)
+
+
+# --- a bare camera name the sensor table gives the full sensor says so (first-day review, round 8) -------------
+
+#: (the name an AC types, the camera and its full-sensor format as cameras.csv spells them)
+FULL_SENSOR_NAMES = [("ALEXA 35", "ALEXA 35", "4.6K 3:2 Open Gate"), ("ALEXA Mini", "ALEXA Mini", "3.4K Open Gate"),
+                     ("Mini LF", "ALEXA Mini LF", "4.5K LF 3:2 Open Gate"), ("VENICE 2", "VENICE 2 8K", "8.6K 3:2 FF")]
+
+
+@pytest.mark.parametrize("name, camera, fmt", FULL_SENSOR_NAMES)
+def test_a_bare_camera_name_says_which_format_it_is_and_how_to_name_another(name, camera, fmt):
+    import json
+
+    from physcam.cli import main
+
+    rows = [r for r in csv.DictReader(TABLE.read_text(encoding="utf-8").splitlines()) if r["camera"] == camera]
+    full = next(r for r in rows if r["format"] == fmt)
+    s = find_sensor(name)  # the old meaning is kept: the full sensor
+    assert (s.width_mm, s.height_mm) == (float(full["width_mm"]), float(full["height_mm"]))
+    import contextlib
+    import io
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert main(["report", "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--sensor", name, "--json"]) == 0
+    said = [n for n in json.loads(out.getvalue())["notes"] if name in n]
+    assert len(said) == 1 and fmt in said[0] and f"{len(rows)} formats" in said[0], said
+    assert f"{camera} {rows[1]['format']}" in said[0]  # how to name another: a name find_sensor takes
+    assert find_sensor(f"{camera} {rows[1]['format']}").fmt == rows[1]["format"]
+
+
+def test_a_format_or_gate_name_carries_no_camera_note():
+    from physcam.optics.sensors import camera_name_note
+
+    assert [camera_name_note(n) for n in ("S35", "ALEXA 35 4.6K 16:9", "LF Open Gate", "alexa35-og")] == [""] * 4
+
+
+# --- the names ACs use for the KOMODO and the Pocket 6K (first-day review, round 8) ---------------------------
+
+def test_komodo_and_bmpcc_6k_are_known_and_ask_which_format():
+    for name, first in (("Komodo", "'KOMODO 6K 17:9'"), ("RED Komodo", "'RED KOMODO 6K 17:9'"),
+                        ("BMPCC 6K", "'BMPCC 6K 16:9'")):
+        with pytest.raises(SensorError) as e:
+            find_sensor(name)
+        msg = str(e.value)
+        assert "which one?" in msg and first in msg and "6K 6K" not in msg and "closest" not in msg, msg
+    # docs.red.com KOMODO guide, All_Formats: '6K 17:9 | 6144 x 3240 | 27.03 x 14.26', '4K 17:9 | 4096 x 2160 | 18.02 x 9.50'
+    assert (find_sensor("KOMODO 6K 17:9").width_mm, find_sensor("KOMODO 6K 17:9").height_mm) == (27.03, 14.26)
+    assert (find_sensor("Komodo 4K 17:9").width_mm, find_sensor("Komodo 4K 17:9").height_mm) == (18.02, 9.50)
+    # forum.blackmagicdesign.com: '6K 16:9 | 6144 x 3456 | 23.1 x 12.99'
+    assert (find_sensor("BMPCC 6K 16:9").width_mm, find_sensor("BMPCC 6K 16:9").height_mm) == (23.1, 12.99)
+    assert find_sensor("RED KOMODO 6K 6K 17:9").name == "RED KOMODO 6K 17:9"  # the old spelling still works
+
+
+def test_no_format_name_repeats_a_word_and_every_name_finds_its_own_format():
+    import re
+
+    for formats in cameras().values():
+        for s in formats:
+            assert not re.search(r"\b(\S+) \1\b", s.name), s.name
+            for label in (s.name, *s.aliases):  # or the sensors.csv gate of that name, the same area
+                found = find_sensor(label)
+                assert found is s or (found.width_mm, found.height_mm) == (s.width_mm, s.height_mm), (label, s.name)

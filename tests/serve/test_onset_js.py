@@ -312,3 +312,24 @@ def test_page_split_focus_equals_the_library(monkeypatch, tmp_path):
     bad = [f"{call}: {d[:2]}" for call, g, e in zip(calls, got, expected) for d in [_agree(g, e)] if d]
     assert not bad, f"{len(bad)} differ, e.g.\n" + "\n".join(bad[:6])
     assert sum(e["ok"] for e in expected) > 0.7 * len(expected)
+
+
+#: names an AC types for a camera: full-sensor names, formats by another name of the camera, a camera alone
+CAMERA_NAMES = ("ALEXA 35", "ALEXA Mini", "Mini LF", "VENICE 2", "KOMODO 4K 17:9", "BMPCC 6K 16:9", "Komodo",
+                "BMPCC 6K", "FX6")
+
+
+def test_page_and_server_take_a_camera_name_alike():
+    """The page's findSensor (onset.js, on the sensor table the server sends) and the library's find_sensor give the
+    same format for every camera name, or both refuse (a camera alone: the library lists its formats)."""
+    from physcam.optics.sensors import find_sensor
+
+    table = sensor_table()
+    got = run_page_solver({"sensors": table, "calls": [["findSensor", table, n] for n in CAMERA_NAMES]})
+    for name, g in zip(CAMERA_NAMES, got):
+        try:
+            s = find_sensor(name)
+        except PhysCamError:
+            assert not g["ok"], (name, g)
+            continue
+        assert g["ok"] and g["body"]["key"] == s.key, (name, g)

@@ -33,7 +33,9 @@ def test_kit_and_foreign_file(tmp_path, capsys):
     foreign = tmp_path / "x.usda"
     foreign.write_text('#usda 1.0\ndef Xform "A" {}\n')
     assert main(["usd", "read", str(foreign)]) == 2
-    assert "found 0 PhysicalCamera prims" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "found 0 PhysicalCamera prims" in err
+    assert f"{foreign.resolve()}: found 0" in err  # which file (a first-day review: the error did not say)
     assert main(["usd", "read", str(foreign), "--path", "/A"]) == 2
     assert "/A: is a Xform, not a PhysicalCamera" in capsys.readouterr().err
 

@@ -350,8 +350,11 @@ def coc_of(args):
 # ---- units -----------------------------------------------------------------------------------
 def add_units_option(p) -> None:
     """``--units m|ft``: the unit system distances are printed in (tables, CSV, plots)."""
-    p.add_argument("--units", choices=UNIT_SYSTEMS, default=None,
-                   help="print distances in metres (m) or feet and inches (ft: to 1/8 inch below 10 ft); "
+    from ..units import unit_system
+
+    p.add_argument("--units", type=unit_system, choices=UNIT_SYSTEMS, default=None,
+                   help="print distances in metres (m, metres, meters) or feet and inches (ft, feet, foot: to 1/8 "
+                        "inch below 10 ft); "
                         "default m, or `units` in the user config (physcam config show); JSON stays in mm")
 
 
@@ -384,7 +387,7 @@ def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):
     :data:`DEFAULT_SENSOR`), which a note on stderr names (unless ``quiet``: the command says it
     itself). Sets ``args.sensor_defaulted``."""
     from ..errors import InputError
-    from ..optics.sensors import custom_sensor, find_sensor
+    from ..optics.sensors import camera_name_note, custom_sensor, find_sensor
 
     name = getattr(args, "sensor", None)
     sw, sh = getattr(args, "sensor_width", None), getattr(args, "sensor_height", None)
@@ -394,7 +397,13 @@ def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):
     if args is not None:
         args.sensor_defaulted = False
     if name is not None:
-        return find_sensor(name)
+        s = find_sensor(name)
+        said = camera_name_note(name)  # a bare camera name ("ALEXA 35") is its full sensor: say so
+        if args is not None:
+            args.sensor_note = said
+        if said and not quiet:
+            note(said)
+        return s
     if custom:
         if sw is None or sh is None:
             raise InputError("give both --sensor-width and --sensor-height")

@@ -170,8 +170,9 @@ def _read(path: Path) -> Config:
             except InputError as exc:
                 raise InputError(f"the physcam config {path}: coc: {exc}") from None
     if "units" in values:
-        from ..units import UNIT_SYSTEMS
+        from ..units import UNIT_SYSTEMS, unit_system
 
+        values["units"] = unit_system(values["units"])  # "feet" is ft, "metres" m, as on the command line
         if values["units"] not in UNIT_SYSTEMS:
             raise InputError(f"the physcam config {path}: units must be one of {', '.join(UNIT_SYSTEMS)}, "
                              f"got {values['units']!r}")

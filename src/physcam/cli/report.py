@@ -152,6 +152,10 @@ def solve_from_args(args):
     sensor = resolve_sensor(args, quiet=True)  # the report says it in its notes
     args.report_inputs = report_camera(**_request_inputs(args, lens, sensor, coc))
     report = solve_report(args.report_inputs)
+    if getattr(args, "sensor_note", ""):  # a bare camera name: which format it is and how to name another
+        from .._record import replace
+
+        report = replace(report, notes=report.notes + (args.sensor_note,))
     if getattr(args, "sensor_defaulted", False):
         from .._record import replace
 

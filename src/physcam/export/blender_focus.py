@@ -35,7 +35,8 @@ from ._codetext import osl_comment
 from .osl import lens_data, osl_array, osl_number, render_template
 
 __all__ = ["FocusAxis", "FocusTable", "blend_weights", "blended_geometry", "focus_axis", "focus_geometry", "focus_table",
-           "focus_table_shader", "ghost_rows", "hermite_basis", "N_FOCUS", "GRID_HALF_MM", "STOP_LEVELS"]
+           "focus_table_shader", "fill_pupil_tables", "ghost_rows", "hermite_basis", "pupil_marks", "N_FOCUS", "GRID_HALF_MM",
+           "PUPIL_STRIDE", "ANAMORPHIC_PUPIL_STRIDE", "STOP_LEVELS"]
 
 #: Focus states tabulated (infinity first, uniform in :class:`FocusAxis`'s s).
 N_FOCUS = 32
@@ -49,6 +50,12 @@ _GRID = (9, 9)
 STOP_LEVELS = (0.75, 0.5, 0.35, 0.25)
 #: Aims a camera ray tries, where the passing set's area is known, before it counts as lost.
 N_TRY = 8
+#: Every PUPIL_STRIDE-th focus mark (and the last) has its pupil and normalisation tables traced; the
+#: marks between are interpolated (:func:`fill_pupil_tables`; docs/blender.md, "Focus tables").
+PUPIL_STRIDE = 4
+#: The same for an anamorphic lens: its exit-pupil rectangles step by a window sample as the lens
+#: focuses (not smooth), so every other mark is traced and a mark between holds both neighbours'.
+ANAMORPHIC_PUPIL_STRIDE = 2
 
 
 @dataclasses.dataclass(frozen=True)
@@ -138,12 +145,16 @@ def blended_geometry(axis: FocusAxis, geometry, focus_mm: float) -> tuple[float,
 
 
 @takes_prescription
-def focus_geometry(lens: Prescription, axis: FocusAxis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def focus_geometry(lens: Prescription, axis: FocusAxis, *, states: list | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(film_z, its slope per index step, vertex_z film side first) of the plain prescription ``lens``
     focused (:func:`physcam.optics.focusing.focus`) at each of ``axis``'s marks: the focus table's
-    geometry. The slope is physcam's own: a difference of exact focus solves 1e-3 index steps apart
-    (second order, one-sided at the ends)."""
-    from ..optics.focusing import focus
+    geometry. The slope is physcam's own at infinity (a difference of exact focus solves 1e-3 index steps
+    apart, one-sided), in closed form at the other marks (:func:`_unit_film_slope`, :func:`_internal_film_slope`:
+    no more focus solves). ``states``: a list that receives each mark's
+    :class:`~physcam.optics.focusing.FocusState` (solved once, for the caller's tables too)."""
+    from ..optics.focusing import focus, focus_method
+    from ..optics.paraxial import gaussian
     from ..trace.surfaces import surface_table
 
     require_type("axis", axis, FocusAxis, "physcam.export.blender_focus.focus_axis(closest_mm, n_focus)")
@@ -152,18 +163,65 @@ def focus_geometry(lens: Prescription, axis: FocusAxis) -> tuple[np.ndarray, np.
     def film(x):
         return focus(lens, axis.mark(x)).film_z
 
+    internal = focus_method(lens) == "internal"
+    gauss = None if internal else gaussian(lens)
     film_z, slope, vz = [], [], []
     for k in range(axis.n):
         st = focus(lens, axis.mark(k))
+        if states is not None:
+            states.append(st)
         film_z.append(st.film_z)
         vz.append(surface_table(st.prescription, reverse=True, coating="none").vertex_z)
-        if k == 0:
+        if internal and k > 0:
+            slope.append(_internal_film_slope(lens, axis, k, st.object_distance_mm))
+        elif k > 0:
+            slope.append(_unit_film_slope(gauss, axis, k))
+        elif k == 0:
             slope.append((-3 * st.film_z + 4 * film(eps) - film(2 * eps)) / (2 * eps))
         elif k == axis.n - 1:
             slope.append((3 * st.film_z - 4 * film(k - eps) + film(k - 2 * eps)) / (2 * eps))
         else:
             slope.append((film(k + eps) - film(k - eps)) / (2 * eps))
     return np.array(film_z), np.array(slope), np.array(vz)
+
+
+def _mark_step(axis: FocusAxis, k: int) -> float:
+    """d mark / d index (mm per index step) at the finite mark ``k``: the derivative of C / (a (2 - a))."""
+    a = k / (axis.n - 1) * (1.0 - axis.s_near)
+    return -axis.closest_mm * (2.0 - 2.0 * a) / (a * (2.0 - a)) ** 2 * (1.0 - axis.s_near) / (axis.n - 1)
+
+
+def _unit_film_slope(g, axis: FocusAxis, k: int) -> float:
+    """d film_z / d index at the finite mark ``k`` of a unit-focusing lens whose Gaussian constants at infinity
+    are ``g`` (:func:`physcam.optics.paraxial.gaussian`), in closed form: the film lies s' behind H2 with
+    phi s'^2 - b s' + n' T = 0, b = phi T + n' - 1, T the mark less the hiatus (the root
+    :func:`physcam.optics.focusing.focus` takes, s' = (b - sqrt(b^2 - 4 phi n' T)) / (2 phi)), so
+    d s' / d T = (1 - (b - 2 n') / sqrt(b^2 - 4 phi n' T)) / 2; times d mark / d index."""
+    phi, n2 = 1.0 / g.efl, g.image_index
+    t = axis.mark(k) - (g.z_rear_principal_plane - g.z_front_principal_plane)
+    b = phi * t + n2 - 1.0
+    return 0.5 * (1.0 - (b - 2.0 * n2) / math.sqrt(max(b * b - 4.0 * phi * n2 * t, 1e-300))) * _mark_step(axis, k)
+
+
+def _internal_film_slope(lens: Prescription, axis: FocusAxis, k: int, d: float) -> float:
+    """d film_z / d index at mark ``k`` (finite) of an internal-focusing ``lens`` whose subject lies ``d`` mm in
+    front of its first vertex there, without another focus solve (a bisection): the mark is d + film_z(d)
+    (film_z from the first vertex: the focus groups' gaps at d, then the paraxial image of the subject,
+    as :func:`physcam.optics.focusing.focus` solves it), so d film_z / d mark = f' / (1 + f') with f' =
+    d film_z / d d by differences 1e-4 d apart (central; at the last mark, the groups' close end, one-sided
+    toward farther subjects), times d mark / d index (:meth:`FocusAxis.mark`: C / (a (2 - a)))."""
+    from ..optics.focusing import image_distance, interpolated_gaps
+
+    def film(x):
+        q = lens.with_thicknesses(interpolated_gaps(lens, x)[0])
+        return q.vertex_z[-1] + image_distance(q, x)
+
+    h = 1e-4 * d
+    if k == axis.n - 1:
+        fp = (-3.0 * film(d) + 4.0 * film(d + h) - film(d + 2 * h)) / (2 * h)
+    else:
+        fp = (film(d + h) - film(d - h)) / (2 * h)
+    return fp / (1.0 + fp) * _mark_step(axis, k)
 
 
 @dataclasses.dataclass
@@ -255,27 +313,32 @@ def _centre_norms(tracer, rects, levels) -> list[float]:
 
 
 @takes_prescription
-def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: float = GRID_HALF_MM) -> FocusTable:
-    """Tabulate ``lens``'s focus states (module notes). Raises OpticsError when the lens passes no
-    ray at the film centre."""
-    from ..optics.focusing import closest_focus, focus, gaussian_at_focus
+def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: float = GRID_HALF_MM,
+                pupil_stride: int | None = None) -> FocusTable:
+    """Tabulate ``lens``'s focus states (module notes). The pupil and normalisation tables are traced at
+    :func:`pupil_marks` (``pupil_stride`` 1: at every mark; None: :data:`PUPIL_STRIDE`, or
+    :data:`ANAMORPHIC_PUPIL_STRIDE` for an anamorphic lens) and interpolated between them
+    (:func:`fill_pupil_tables`). Raises OpticsError when the lens passes no ray at the film centre."""
+    from ..optics.focusing import closest_focus, gaussian_at_focus
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
     from ..trace.camera_tracer import CameraTracer
     from .blender_pupil import _centre_ellipses, iris_levels, radial_pupil_table
 
     axis = focus_axis(closest_focus(lens), n_focus)
-    marks = axis.marks_mm
-    film_z, slope, vz = focus_geometry(lens, axis)
+    states = []
+    film_z, slope, vz = focus_geometry(lens, axis, states=states)
     n_open = gaussian_at_focus(lens, math.inf).f_number * (1 + 1e-9)
     k = camera_state(lens, fstop=n_open).stop_semi_diameter * n_open  # the one iris rule, at infinity focus
     n_min = n_open / (1 + STOP_OPENING_TOLERANCE)
     levels = iris_levels(k / n_min, k / n_open)
+    if pupil_stride is None:
+        pupil_stride = ANAMORPHIC_PUPIL_STRIDE if lens.is_anamorphic else PUPIL_STRIDE
+    traced = pupil_marks(n_focus, pupil_stride)
     radial, rects, stopped, norm = [], [], [], []
-    for mk in marks:
-        st = focus(lens, float(mk))
+    for i in traced.tolist():
+        st = states[i]
         tracer = CameraTracer(st.prescription, st.film_z)  # the lens at this focus state as the file stops it
-        t = tracer.film_side_table
         if lens.is_anamorphic:
             b, rect, rect_levels = _rect_tables(tracer, levels[0], grid_half_mm)
             rects.append(rect)
@@ -285,16 +348,165 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
             radial.append(radial_pupil_table(tracer.lens, st.film_z, levels))
             b = _centre_bounds(tracer.lens, radial[-1][0, 0])
             norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(radial[-1])], levels))
-        if mk == marks[0]:
-            table0, bounds0 = t, (b if lens.is_anamorphic else None)
+        if i == 0:
+            table0, bounds0 = tracer.film_side_table, (b if lens.is_anamorphic else None)
             loss = tracer.centre_weight(b, samples=64, fresnel=True) / tracer.centre_weight(b, samples=64)
     if not all(min(v) > 0 for v in norm):
         raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some focus")
-    def arr(v):
-        return np.array(v) if v else None
+    radial, rects, stopped, norm = fill_pupil_tables(traced, n_focus, radial=radial, rects=rects, stopped=stopped,
+                                                     norm=norm)
+    return FocusTable(lens, axis, film_z, slope, vz, radial, rects, stopped,
+                      norm, table0, bounds0, float(k), float(n_open), float(n_min), axis.near_mm, float(loss))
 
-    return FocusTable(lens, axis, film_z, slope, vz, arr(radial), arr(rects), arr(stopped),
-                      np.array(norm), table0, bounds0, float(k), float(n_open), float(n_min), axis.near_mm, float(loss))
+
+def pupil_marks(n: int, stride: int) -> np.ndarray:
+    """The indices of the marks (of ``n``) whose pupil tables are traced: every ``stride``-th from infinity,
+    and the last."""
+    if isinstance(stride, bool) or not isinstance(stride, int) or stride < 1:
+        raise InputError(f"the pupil tables' stride must be a whole number of marks, at least 1, got {stride!r}")
+    return np.unique(np.append(np.arange(0, n, stride), n - 1))
+
+
+def _interpolation_weights(traced: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(cubic, linear): (n, len(traced)) weights giving each of the ``n`` indices from the values at the
+    ``traced`` ones (ascending, first 0, last n - 1): the cubic through the four traced indices about it
+    (Lagrange; the first or last four at the ends), and the line through the two about it. A traced
+    index takes its own value."""
+    m = traced.size
+    cubic, linear = np.zeros((n, m)), np.zeros((n, m))
+    for i in range(n):
+        j = min(int(np.searchsorted(traced, i, side="right")) - 1, m - 2)  # traced[j] <= i < traced[j + 1]
+        if traced[j] == i:
+            cubic[i, j] = linear[i, j] = 1.0
+            continue
+        t = (i - traced[j]) / (traced[j + 1] - traced[j])
+        linear[i, j], linear[i, j + 1] = 1.0 - t, t
+        start = min(max(j - 1, 0), max(m - 4, 0))
+        nodes = range(start, start + min(4, m))
+        for a in nodes:
+            cubic[i, a] = math.prod((i - traced[b]) / (traced[a] - traced[b]) for b in nodes if b != a)
+    return cubic, linear
+
+
+def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=()):
+    """(radial, rects, stopped, norm) at every one of ``n`` focus marks from the tables traced at the marks
+    ``traced`` (:func:`pupil_marks`; empty sequences give None). Between traced marks each number is the
+    cubic in the index through the four traced marks about it (the tables are smooth in the axis's s,
+    as the film plane is), and what the shader must hold is grown by that cubic's difference from the
+    line through the two about it (for a smooth table, an upper bound of the cubic's error by far):
+    an ellipse (cx, ax, ay) has its axes (never below the line's) grown by d_ax, d_ay and then scaled by
+    1 + d_cx / ax (then it holds every ellipse within those differences: the triangle inequality in the
+    ellipse's own norm) and by its entry's :func:`_roughness`, a
+    rectangle its sides moved out. A passing area is trusted (its sign, :func:`~physcam.export.blender_pupil.cell_area`)
+    only where every traced table the cubic reads trusts it and the two interpolations agree within
+    :data:`~physcam.export.blender_pupil.AREA_TOLERANCE`. A rectangle is empty only where the two traced
+    about it are; next to an empty one it is the other's."""
+    from .blender_pupil import AREA_TOLERANCE, cell_area
+
+    traced = np.asarray(traced)
+    cubic, linear = _interpolation_weights(traced, n)
+    reads = (cubic != 0) | (linear != 0)
+
+    def blend(w, v):
+        v = np.asarray(v, dtype=float)
+        return (w @ v.reshape(len(v), -1)).reshape((n,) + v.shape[1:])
+
+    out_radial = None
+    if len(radial):
+        tab = np.asarray(radial, dtype=float)
+        c, lin = blend(cubic, tab), blend(linear, tab)
+        d = _neighbourhood_max(np.abs(c - lin)[..., :3])  # the shader's reads blend an entry with its neighbours
+        c[..., 1:3] = np.maximum(c[..., 1:3], lin[..., 1:3])  # the axes never below the line (a cubic may dip)
+        scale = 1.0 + d[..., 0] / c[..., 1]
+        area_c, area_l = blend(cubic, cell_area(tab[..., 3])), blend(linear, cell_area(tab[..., 3]))
+        untrusted = blend(reads.astype(float), tab[..., 3] < 0) > 0
+        untrusted |= np.abs(area_c - area_l) > AREA_TOLERANCE * np.maximum(np.abs(area_c), 1e-12)
+        area = np.maximum(area_c, 0.0)
+        scale = scale * _roughness(traced, tab)[None]
+        out_radial = np.stack([c[..., 0], (c[..., 1] + d[..., 1]) * scale, (c[..., 2] + d[..., 2]) * scale,
+                               np.where(untrusted, -1.0 - area, area), c[..., 4]], axis=-1)
+        # where nothing passes at both traced marks about it, an entry holds a neighbour's ellipse (blender_pupil's
+        # _fill), which jumps from mark to mark: the line between the two, ungrown (no ray to hold)
+        dark = blend(linear, cell_area(tab[..., 3]) <= 0) > 1.0 - 1e-9
+        out_radial[..., :3] = np.where(dark[..., None], lin[..., :3], out_radial[..., :3])
+        out_radial[traced] = tab
+    out_rects = _fill_rects(traced, n, cubic, linear, rects) if len(rects) else None
+    out_stopped = _fill_rects(traced, n, cubic, linear, stopped) if len(stopped) else None
+    out_norm = None
+    if len(norm):
+        out_norm = blend(cubic, norm)
+        out_norm[traced] = np.asarray(norm, dtype=float)
+    return out_radial, out_rects, out_stopped, out_norm
+
+
+def _ellipse_reach(e, f) -> np.ndarray:
+    """How far ellipses ``e`` (..., cx, ax, ay) reach out of ellipses ``f``: the largest of sqrt(((x - cx_f) /
+    ax_f)^2 + (y / ay_f)^2) over 48 points of each rim of e (at most 1: e lies in f; nan-free, 1 where f is empty)."""
+    th = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
+    x = e[..., 0:1] + e[..., 1:2] * np.cos(th)
+    y = e[..., 2:3] * np.sin(th)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.sqrt(((x - f[..., 0:1]) / f[..., 1:2]) ** 2 + (y / f[..., 2:3]) ** 2).max(axis=-1)
+    return np.where((f[..., 1] > 0) & (f[..., 2] > 0) & np.isfinite(r), r, 1.0)
+
+
+def _roughness(traced, tab) -> np.ndarray:
+    """Per (level, radius) entry of the traced radial tables ``tab`` (marks, levels, radii, 5), how much the
+    interpolation misses where it can be checked (at least 1): each traced mark between the first and the
+    last left out, the cubic and the line through the others there, grown as :func:`fill_pupil_tables`
+    grows them, must hold the traced ellipse; the largest factor it falls short by over those marks (and
+    the entry's neighbours, as the shader blends them). The pupil tables' ellipses are grown where the
+    shader's blends in film radius and iris miss a traced set, and that growth comes and goes from mark to
+    mark (small sets at the frame's edge, stopped far down): a filled mark takes its entry's worst."""
+    m = len(traced)
+    worst = np.ones(tab.shape[1:3])
+    for j in range(1, m - 1):
+        others = np.delete(traced, j)
+        cubic, linear = _interpolation_weights(others - others[0], int(others[-1] - others[0]) + 1)
+        row = int(traced[j] - others[0])
+        c = np.tensordot(cubic[row], np.delete(tab, j, axis=0)[..., :3], axes=1)
+        lin = np.tensordot(linear[row], np.delete(tab, j, axis=0)[..., :3], axes=1)
+        d = _neighbourhood_max(np.abs(c - lin)[None])[0]
+        c[..., 1:3] = np.maximum(c[..., 1:3], lin[..., 1:3])
+        scale = 1.0 + d[..., 0] / c[..., 1]
+        grown = np.stack([c[..., 0], (c[..., 1] + d[..., 1]) * scale, (c[..., 2] + d[..., 2]) * scale], axis=-1)
+        worst = np.maximum(worst, _ellipse_reach(tab[j, ..., :3], grown))
+    return _neighbourhood_max(worst[None, ..., None])[0, ..., 0]
+
+
+def _neighbourhood_max(v: np.ndarray) -> np.ndarray:
+    """Per entry of (marks, levels, radii, c) ``v``, the largest over its level and radius and their neighbours."""
+    p = np.pad(v, ((0, 0), (1, 1), (1, 1), (0, 0)), mode="edge")
+    n_l, n_r = v.shape[1], v.shape[2]
+    return np.max([p[:, a:a + n_l, b:b + n_r] for a in range(3) for b in range(3)], axis=0)
+
+
+def _fill_rects(traced, n: int, cubic, linear, rects) -> np.ndarray:
+    """:func:`fill_pupil_tables`'s rectangles (x0, x1, y0, y1; (0, 0, 0, 0) empty) at every mark."""
+    tab = np.asarray(rects, dtype=float)
+    full = tab[..., 1] > tab[..., 0]
+    c = (cubic @ tab.reshape(len(tab), -1)).reshape((n,) + tab.shape[1:])
+    d = np.abs(c - (linear @ tab.reshape(len(tab), -1)).reshape(c.shape))
+    grown = np.stack([c[..., 0] - d[..., 0], c[..., 1] + d[..., 1], c[..., 2] - d[..., 2], c[..., 3] + d[..., 3]], axis=-1)
+    out = np.zeros_like(grown)
+    reads = (cubic != 0) | (linear != 0)
+    for i in range(n):
+        j = min(int(np.searchsorted(traced, i, side="right")) - 1, len(traced) - 2)
+        if traced[j] == i:
+            out[i] = tab[j]
+            continue
+        every = full[reads[i]].all(axis=0)
+        a, b = tab[j], tab[j + 1]
+        fa, fb = full[j], full[j + 1]
+        union = np.stack([np.minimum(np.where(fa, a[..., 0], np.inf), np.where(fb, b[..., 0], np.inf)),
+                          np.maximum(np.where(fa, a[..., 1], -np.inf), np.where(fb, b[..., 1], -np.inf)),
+                          np.minimum(np.where(fa, a[..., 2], np.inf), np.where(fb, b[..., 2], np.inf)),
+                          np.maximum(np.where(fa, a[..., 3], -np.inf), np.where(fb, b[..., 3], -np.inf))], axis=-1)
+        held = np.stack([np.minimum(grown[i, ..., 0], union[..., 0]), np.maximum(grown[i, ..., 1], union[..., 1]),
+                         np.minimum(grown[i, ..., 2], union[..., 2]), np.maximum(grown[i, ..., 3], union[..., 3])], axis=-1)
+        out[i] = np.where(every[..., None], held, np.where((fa | fb)[..., None], union, 0.0))
+    out[traced] = tab  # the last mark too (it ends the last interval)
+    return out
 
 
 def _rect_tables(tracer, semi_max, grid_half_mm):

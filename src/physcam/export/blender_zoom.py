@@ -35,7 +35,7 @@ from ..lens.prescription import Prescription, takes_prescription
 from .blender_focus import FocusAxis
 
 __all__ = ["ZoomGrid", "zoom_focus_table", "zoom_focus_axis", "rows_to_geometry", "N_FOCUS_ZOOM", "N_ZOOM_GEOMETRY",
-           "N_ZOOM_ROWS", "N_ZOOM_EFL"]
+           "N_ZOOM_ROWS", "N_ZOOM_EFL", "ZOOM_PUPIL_STRIDE"]
 
 #: Focus marks of a zoom lens's tables (fewer than a prime's 32: the pupil tables are per position).
 N_FOCUS_ZOOM = 12
@@ -47,6 +47,10 @@ N_ZOOM_GEOMETRY = 33
 N_ZOOM_ROWS = 17
 #: EFL samples, uniform in u, from which the shader finds u for a focal length.
 N_ZOOM_EFL = 65
+#: Every ZOOM_PUPIL_STRIDE-th focus mark (and the last) of a tabulated position has its pupil tables traced,
+#: the marks between interpolated (:func:`physcam.export.blender_focus.fill_pupil_tables`): the 12 marks are
+#: twice as far apart in s as a prime's 32, so every other one.
+ZOOM_PUPIL_STRIDE = 2
 
 
 @dataclasses.dataclass
@@ -78,17 +82,20 @@ def _iris_rule(q: Prescription) -> tuple[float, float, float]:
 
 
 @takes_prescription
-def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geometry: int = N_ZOOM_GEOMETRY):
+def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geometry: int = N_ZOOM_GEOMETRY,
+                     pupil_stride: int = ZOOM_PUPIL_STRIDE):
     """The :class:`~physcam.export.blender_focus.FocusTable` of a zoom lens over zoom x focus (module
     notes): ``film_z`` and ``vertex_z`` hold ``n_geometry`` blocks of ``n_focus`` states (u major),
-    ``radial`` and ``norm`` one block per tabulated position; ``zoom`` the :class:`ZoomGrid`. Its
+    ``radial`` and ``norm`` one block per tabulated position (traced at every ``pupil_stride``-th mark and the
+    last, :func:`~physcam.export.blender_focus.fill_pupil_tables` between); ``zoom`` the :class:`ZoomGrid`. Its
     ``fstop_open``/``fstop_min`` are the slowest over the zoom (an f-stop every position reaches) and
     ``closest_mm`` the farthest closest focus (a mark every position focuses to)."""
     from ..lens.zoom import prescription_at, tabulated_encoders
     from ..optics.focusing import focus
     from ..optics.zoom import efl_at
     from ..trace.camera_tracer import CameraTracer
-    from .blender_focus import FocusTable, _centre_bounds, _centre_norms, _ellipse_rect, focus_geometry
+    from .blender_focus import (FocusTable, _centre_bounds, _centre_norms, _ellipse_rect, fill_pupil_tables, focus_geometry,
+                                pupil_marks)
     from .blender_pupil import _centre_ellipses, iris_levels, radial_pupil_table
 
     if lens.zoom is None:
@@ -110,17 +117,22 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     levels = iris_levels(float(np.max(both[:, 0] / both[:, 2])), float(np.max(both[:, 0] / both[:, 1])))
     geometry = [focus_geometry(q, axis) for q in geo_q]
     film_z, slope, vz = (np.concatenate([g[i] for g in geometry]) for i in range(3))
+    traced = pupil_marks(n_focus, pupil_stride)
     radial, norm = [], []
     for q in pupil_q:
-        for mk in marks:
+        block, block_norm = [], []
+        for mk in marks[traced]:
             st = focus(q, float(mk))
             tracer = CameraTracer(st.prescription, st.film_z)  # the lens at this zoom and focus as the file stops it
-            radial.append(radial_pupil_table(tracer.lens, st.film_z, levels))
-            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(radial[-1])], levels))
-    if not all(min(v) > 0 for v in norm):
-        from ..errors import OpticsError
+            block.append(radial_pupil_table(tracer.lens, st.film_z, levels))
+            block_norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(block[-1])], levels))
+        if not all(min(v) > 0 for v in block_norm):
+            from ..errors import OpticsError
 
-        raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some zoom and focus")
+            raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some zoom and focus")
+        block, _, _, block_norm = fill_pupil_tables(traced, n_focus, radial=block, norm=block_norm)
+        radial.extend(block)
+        norm.extend(block_norm)
     st0 = focus(geo_q[0], math.inf)
     tracer0 = CameraTracer(st0.prescription, st0.film_z)
     b = _centre_bounds(tracer0.lens, radial[0][0, 0])

@@ -11,9 +11,12 @@ an unknown name raises :class:`~physcam.errors.SensorError` listing the closest 
 
 The camera table ``physcam/data/cameras.csv`` adds every recording format of current cine and hybrid
 cameras (camera -> formats): each row a :class:`Sensor` named "maker camera format" (also found
-without the maker: "FX6 FF 4K 17:9"), with its source, the date it was read and how the size was had
+without the maker: "FX6 FF 4K 17:9", or by another name of the camera, ``camera_aliases.csv``: "KOMODO 4K 17:9",
+"BMPCC 6K 4K DCI"), with its source, the date it was read and how the size was had
 (stated by the maker, or photosites x the maker's pitch), and whose figure it is (``maker_spec``). A camera's name alone ("FX6") is refused
-with its formats listed: DOF and field of view depend on the crop.
+with its formats listed: DOF and field of view depend on the crop. The few camera names the sensor table
+has long given to a camera's full sensor ("ALEXA 35", "ALEXA Mini", "Mini LF", "VENICE 2", "V-RAPTOR")
+keep that meaning, and :func:`camera_name_note` says which format that is and how to choose another.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from pathlib import Path
 from .._record import record
 from ..errors import SensorError
 
-__all__ = ["Sensor", "sensors", "cameras", "camera_formats", "find_sensor", "filter_sensors", "custom_sensor", "SENSOR_SIZE_RANGE_MM",
+__all__ = ["Sensor", "sensors", "cameras", "camera_formats", "find_sensor", "camera_name_note", "camera_aliases", "filter_sensors", "custom_sensor", "SENSOR_SIZE_RANGE_MM",
            "SENSOR_MAX_ASPECT", "PITCH_RANGE_UM", "MAKERS"]
 
 #: Camera makers in the table (a digital sensor's name starts with its maker); film gates are "film".
@@ -125,15 +128,34 @@ def _data(name: str) -> str:
     return (Path(__file__).resolve().parent.parent / "data" / name).read_text(encoding="utf-8")
 
 
+def _joined(camera: str, fmt: str) -> str:
+    """"camera format", the format's first word dropped when the camera's name ends with it: the KOMODO 6K's
+    "6K 17:9" is "KOMODO 6K 17:9", not "KOMODO 6K 6K 17:9"."""
+    head, _, rest = fmt.partition(" ")
+    return f"{camera} {rest}" if rest and camera.split()[-1].lower() == head.lower() else f"{camera} {fmt}"
+
+
+@lru_cache(maxsize=1)
+def camera_aliases() -> dict[str, tuple[str, ...]]:
+    """Other names of a camera ("maker camera" -> its names: "KOMODO", "BMPCC 6K"), from camera_aliases.csv:
+    names people use, not specifications, so they cite nothing."""
+    return {f"{r['maker']} {r['camera']}": tuple(a.strip() for a in r["aliases"].split(";") if a.strip())
+            for r in csv.DictReader(_data("camera_aliases.csv").splitlines())}
+
+
 def _camera_formats() -> list[Sensor]:
-    """The camera table's rows (cameras.csv) as sensors: "maker camera format", also "camera format"."""
+    """The camera table's rows (cameras.csv) as sensors: "maker camera format", also "camera format" and
+    "other-name format" (:func:`camera_aliases`), the doubled word of "KOMODO 6K 6K 17:9" once."""
     out = []
     for row in csv.DictReader(_data("cameras.csv").splitlines()):
         w, across = float(row["width_mm"]), row["photosites_across"]
-        short = f"{row['camera']} {row['format']}"
+        short, doubled = _joined(row["camera"], row["format"]), f"{row['camera']} {row['format']}"
+        others = [_joined(a, row["format"]) for a in camera_aliases().get(f"{row['maker']} {row['camera']}", ())]
+        names = dict.fromkeys((short, doubled, f"{row['maker']} {doubled}", *others,
+                               *(a.strip() for a in row["aliases"].split(";") if a.strip())))
         out.append(Sensor(
             key=row["key"], name=f"{row['maker']} {short}", width_mm=w, height_mm=float(row["height_mm"]),
-            aliases=(short, *(a.strip() for a in row["aliases"].split(";") if a.strip())), kind="digital",
+            aliases=tuple(n for n in names if n != f"{row['maker']} {short}"), kind="digital",
             source=row["source"], pitch_um=round(w * 1000.0 / int(across), 3) if across else None,
             pitch_source=f"width / photosites: {across} photosites across (the row's source)" if across else "",
             camera=row["camera"], fmt=row["format"],
@@ -186,9 +208,40 @@ def camera_formats(name: str) -> tuple[Sensor, ...]:
         raise SensorError(f"a camera name must be text, got {type(name).__name__}")
     key = _norm(name)
     for full, rows in cameras().items():
-        if key and key in (_norm(full), _norm(rows[0].camera)):
+        if key and key in (_norm(full), _norm(rows[0].camera), *(_norm(a) for a in camera_aliases().get(full, ()))):
             return rows
     return ()
+
+
+def _full_sensor_camera(name: str):
+    """(camera, its format) when ``name`` is a bare camera name the sensor table gives the camera's full
+    sensor ("ALEXA 35": the 4.6K 3:2 Open Gate), else None. The camera is the table's one whose name holds
+    ``name`` and which records a format of the gate's size; the exact name, then the one the gate's name
+    names ("VENICE 2": the 8K, not the 6K), then the shortest wins ("ALEXA Mini", not "ALEXA Mini LF")."""
+    key = _norm(name)
+    gate = _gate_index().get(key)
+    if gate is None or name.strip() == gate.key:  # a key is a row's name, not a camera's
+        return None
+    found = []
+    for full, rows in cameras().items():
+        short = _norm(rows[0].camera)
+        same = [r for r in rows if abs(r.width_mm - gate.width_mm) <= 0.011 and abs(r.height_mm - gate.height_mm) <= 0.011]
+        if len(rows) > 1 and same and key in _norm(full):
+            found.append(((key not in (short, _norm(full)), _norm(full) not in _norm(gate.name), len(full)), full, same[0]))
+    return min(found)[1:] if found else None
+
+
+def camera_name_note(name: str) -> str:
+    """What a bare camera name given as a sensor ("ALEXA 35", "Mini LF") was taken as: the camera's full
+    sensor, which format of the camera table that is and how to name another; "" for any other name."""
+    hit = _full_sensor_camera(name) if isinstance(name, str) else None
+    if hit is None:
+        return ""
+    full, fmt = hit
+    n = len(cameras()[full])
+    return (f"{name!r} is the {full}'s full sensor, its {fmt.fmt} ({fmt.width_mm:g} x {fmt.height_mm:g} mm); the "
+            f"camera records in {n} formats and the crop sets the depth of field and the field of view: name "
+            f"another as the sensor, e.g. {cameras()[full][1].aliases[0]!r} (`physcam sensors \"{full}\"` lists them)")
 
 
 def _labelled(rows) -> dict[str, Sensor]:
@@ -273,9 +326,11 @@ def find_sensor(name: str) -> Sensor:
     formats = camera_formats(name)
     if formats:
         cam = f"{formats[0].make} {formats[0].camera}"
+        other = [a for a in camera_aliases().get(cam, ()) if _norm(a) == key]  # as the user called it: "KOMODO 4K 17:9"
+        shown = [_joined(other[0], s.fmt) if other else s.aliases[0] for s in formats]
         raise SensorError(f"{cam} records in {len(formats)} formats and the crop sets the depth of field and the "
-                          f"field of view: which one? " + "; ".join(repr(s.aliases[0]) for s in formats)
-                          + f" (`physcam sensors {formats[0].camera}` lists them with their sizes)")
+                          f"field of view: which one? " + "; ".join(repr(n) for n in shown)
+                          + f' (`physcam sensors "{formats[0].camera}"` lists them with their sizes)')
     labels = {}
     for s in sensors():
         for label in (s.name, *s.aliases):

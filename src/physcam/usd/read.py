@@ -89,13 +89,15 @@ def only_camera(stage, verb: str) -> str:
     cams = find_cameras(stage)
     if len(cams) == 1:
         return cams[0]
+    layer = stage.GetRootLayer()  # the file, when the stage is one: the error names it
+    where = "" if layer.anonymous else f"{layer.realPath or layer.identifier}: "
     if cams:
-        raise ExportError(f"found {len(cams)} PhysicalCamera prims ({_listed(cams)}); name the one to {verb} "
+        raise ExportError(f"{where}found {len(cams)} PhysicalCamera prims ({_listed(cams)}); name the one to {verb} "
                           "(--path)")
     plain = [str(p.GetPath()) for p in stage.Traverse() if p.IsA(UsdGeom.Camera)]
     also = (f"; its UsdGeomCamera prims ({_listed(plain)}) are plain cameras, not PhysicalCameras (physcam usd "
             "write makes one from the lens report's values)") if plain else ""
-    raise ExportError(f"found 0 PhysicalCamera prims: no physical camera to {verb}{also}")
+    raise ExportError(f"{where}found 0 PhysicalCamera prims: no physical camera to {verb}{also}")
 
 
 def _listed(paths: list[str], most: int = 5) -> str:
