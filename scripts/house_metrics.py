@@ -115,7 +115,9 @@ def _clear_caches():
     import gc
 
     for obj in gc.get_objects():
-        if isinstance(obj, functools._lru_cache_wrapper) and getattr(obj, "__module__", "").startswith("physcam"):
+        # type(), not isinstance(): the heap may hold a weak proxy whose object is gone, and isinstance asks
+        # the proxy for its __class__ (ReferenceError)
+        if type(obj) is functools._lru_cache_wrapper and getattr(obj, "__module__", "").startswith("physcam"):
             obj.cache_clear()
     models = getattr(sys.modules.get("physcam.optics.lens_model"), "_MODELS", None)
     if models is not None:  # the lens models keep their focus solutions

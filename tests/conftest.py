@@ -60,7 +60,8 @@ def extension_zip(tmp_path_factory):
     """``physcam export blender-extension`` of every bundled lens, built once per test session and shared
     by the Blender extension's tests (building it solves every bundled lens's focus table, the slowest
     step). Under pytest-xdist the workers share one build: the first worker to ask builds it under a
-    session lock, with two processes (the other worker mostly waits for it; `--workers`), the other
+    session lock, with two processes (`--workers`; its module runs first, :data:`LONG_FIRST`, so the build
+    starts at once and the other worker runs other tests meanwhile), the other
     reads it (each worker building its own doubled the suite's slowest step; putting every test that
     uses it on one worker, xdist's loadgroup, made that worker the suite's last by a minute). Here, not
     in tests/blender/conftest.py: with --doctest-modules two conftest modules of one name collide."""

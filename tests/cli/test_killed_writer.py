@@ -39,7 +39,8 @@ runpy.run_module("physcam", run_name="__main__", alter_sys=True)
 
 
 def _shot(folder, suffix):
-    """A shot (lens and body referenced) with a large plate array, written as ``shot<suffix>``."""
+    """A shot (lens and body referenced) with a large plate array and an edited f-stop, written as
+    ``shot<suffix>``."""
     import numpy as np
     from pxr import Sdf, Usd, Vt
 
@@ -52,6 +53,12 @@ def _shot(folder, suffix):
     stage = Usd.Stage.Open(layer)
     plate = stage.DefinePrim("/Plate", "Scope").CreateAttribute("samples", Sdf.ValueTypeNames.FloatArray)
     plate.Set(Vt.FloatArray.FromNumpy(np.random.default_rng(1).random(PLATE_SAMPLES, dtype=np.float32)))
+    # the f-stop edited after writing, so the shot is out of date and a refresh writes it (a refresh of a
+    # current shot writes nothing: tests/usd/test_refresh_noop.py)
+    stops = [a for a in (p.GetAttribute("lens:main:fStop") for p in stage.Traverse()) if a and a.HasAuthoredValue()]
+    assert stops, "the shot's authored f-stop"
+    for stop in stops:
+        stop.Set(4.0)
     assert layer.Export(str(folder / f"shot{suffix}"))
     os.unlink(folder / "draft.usda")
     return folder / f"shot{suffix}"

@@ -239,7 +239,8 @@ def invert_limits(camera: CameraState, planes: PrincipalPlanes, focus_solution: 
         if hp_near is not None and hp_far is not None:
             solved.update(hyperfocal_parameter_from_near_mm=hp_near, hyperfocal_parameter_from_far_mm=hp_far,
                           consistency=abs(hp_far - hp_near) / hp_near)
-            notes.append("near and far limits agree to {:.1%} in the hyperfocal parameter".format(solved["consistency"]))
+            if "focus_from_film_mm" not in was:  # over-determined; the focus and stop solved from both: 0 by construction
+                notes.append("near and far limits agree to {:.1%} in the hyperfocal parameter".format(solved["consistency"]))
         if "fstop" in was:  # solved when the camera was made
             solved.update((k, v) for k, v in camera.solved if k in ("fstop", "fstop_drift_stops"))
         else:

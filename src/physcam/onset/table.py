@@ -11,6 +11,18 @@ from __future__ import annotations
 from ..units import format_distance
 
 
+def signed(value: float, digits: int) -> str:
+    """``value`` with its sign, to ``digits`` decimals; one that rounds to zero reads +0 (never -0.000)."""
+    text = f"{value:+.{digits}f}"
+    return text if float(text) != 0.0 else f"{0.0:+.{digits}f}"
+
+
+def exactly_determined(d: dict) -> bool:
+    """Whether the report's focus and f-stop were both solved from its measured near and far limits: two
+    limits, two unknowns, so the check of one limit against the other is zero by construction."""
+    return "focus_from_film_mm" in d["solved"] and "fstop" in d["solved"]
+
+
 def report_title(report) -> str:
     return f"physcam lens report — {report.model} model"
 
@@ -32,7 +44,7 @@ def report_rows(report, units: str = "m", *, notes: bool = True) -> list[tuple[s
     fs = f"f/{d['fstop']:.2f}" + (" (solved)" if "fstop" in d["solved"] else "")
     add("f-stop", fs, "")
     if d["tstop"] is not None:
-        add("T-stop", f"T{d['tstop']:.2f}  (drift {d['solved'].get('tstop_drift_stops', 0):+.2f} stops)", "")
+        add("T-stop", f"T{d['tstop']:.2f}  (drift {signed(d['solved'].get('tstop_drift_stops', 0), 2)} stops)", "")
     s = d["sensor"]
     add("sensor", f"{s['name']}  {s['width_mm']:.2f} x {s['height_mm']:.2f} mm", "")
     if d["squeeze"] != 1.0:
@@ -45,7 +57,7 @@ def report_rows(report, units: str = "m", *, notes: bool = True) -> list[tuple[s
     add("image distance s'", f"{d['image_distance_mm']:.2f} mm", "H2")
     add("H1 / H2", f"{d['h1_from_film_mm']:.2f} / {d['h2_from_film_mm']:.2f} mm", "film plane")
     if d["model"] == "technical":
-        add("focus error", f"{d['focus_error_mm']:+.3f} mm (+ = image in front of film)", "film plane")
+        add("focus error", f"{signed(d['focus_error_mm'], 3)} mm (+ = image in front of film)", "film plane")
     m = d["magnification"]
     add("magnification", f"{m:.5f}  (1:{1 / abs(m):.1f}, inverted image)" if m else "0  (subject at infinity)", "")
     fr = d["frame_at_focus"]
@@ -89,9 +101,9 @@ def report_rows(report, units: str = "m", *, notes: bool = True) -> list[tuple[s
     if sv.get("coc_mm") is not None:
         add("circle of confusion (solved)", f"{sv['coc_mm']:.4f} mm", "")
     if sv.get("fstop_drift_stops") is not None:
-        add("f-stop drift (solved)", f"{sv['fstop_drift_stops']:+.2f} stops from the marked f-stop", "")
-    if sv.get("far_error_mm") is not None:
-        add("far limit: predicted − measured", f"{sv['far_error_mm']:+.1f} mm", "")
+        add("f-stop drift (solved)", f"{signed(sv['fstop_drift_stops'], 2)} stops from the marked f-stop", "")
+    if sv.get("far_error_mm") is not None and not exactly_determined(d):  # else zero by construction
+        add("far limit: predicted − measured", f"{signed(sv['far_error_mm'], 1)} mm", "")
     for n in d["notes"] if notes else ():
         add("note", n, "")
     return rows

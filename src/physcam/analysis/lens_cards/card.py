@@ -404,8 +404,20 @@ def _bokeh(camera, key, w, h, q, backend, notes):
 
 # ---- drawing --------------------------------------------------------------------------------------
 def _draw_diagram(ax, card, units):
+    """The lens section in its grid cell, its title set from the cell's left edge at the largest size that
+    fits the cell's width on one line: the equal-aspect box of a short (or a very long) lens is narrower
+    than the cell and centred in it, and a title set from the box's left ran into the key numbers."""
+    from ...figures import STYLE, fit_title
+
     card.diagram.draw(ax, units=units, width_in=5.0, title=False)
-    ax.set_title("lens section, rays from the axis and the widest unvignetted field", loc="left")
+    ax.apply_aspect()  # the box the equal aspect leaves, inside the cell
+    box, cell = ax.get_position(), ax.get_position(original=True)
+    cell_in = cell.width * ax.figure.get_figwidth()
+    text = "lens section, rays from the axis and the widest unvignetted field"
+    sizes = [s for s in (STYLE["axes.titlesize"], 8.0, 7.5, 7.0, 6.5) if s <= STYLE["axes.titlesize"]]
+    size = next((s for s in sizes if "\n" not in fit_title(text, 0.97 * cell_in, fontsize=s)), sizes[-1])
+    ax.set_title(fit_title(text, 0.97 * cell_in, fontsize=size), loc="left", fontsize=size,
+                 x=(cell.x0 - box.x0) / box.width)  # axes fraction of the cell's left edge
 
 
 def _draw_key(ax, key, units):

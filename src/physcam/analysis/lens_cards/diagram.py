@@ -7,7 +7,8 @@ clear semi-diameter. Rays are traced for real, meridionally, inside this module
 (surface intersection by Newton iteration on the sag, Snell's law in vector form,
 as in Welford, *Aberrations of Optical Systems*, ch. 4): a marginal fan from an
 axial object at the focus distance, and the chief and rim rays of an off-axis field
-aimed at the paraxial entrance pupil. A ray that misses a surface, leaves its
+aimed at the paraxial entrance pupil (the rim rays at the edges of the part of that
+pencil every aperture passes: a vignetted field's pencil is narrower). A ray that misses a surface, leaves its
 clear aperture or is totally reflected stops where that happens.
 Cardinal points (F, F', H, H', entrance and exit pupils) are the Gaussian ones of
 :mod:`physcam.optics.paraxial` at the same focus.
@@ -218,6 +219,42 @@ def _default_field(p: Prescription, g: paraxial.GaussianData, axis: str, wavelen
     return math.atan(min(u, 1.5))
 
 
+def _pencil_edges(p: Prescription, ray, a: float, axis: str, wavelength_nm) -> tuple[float, ...]:
+    """The rim of a pencil: the lowest and highest pupil heights ``h`` in [-0.98 a, 0.98 a] whose ray
+    ``ray(h) -> (y0, z0, dy, dz)`` passes every clear aperture and the stop (a vignetted pencil is
+    narrower than the paraxial pupil; real pupil aberration moves its edge). The pupil is sampled and
+    the run of passing rays nearest h = 0 refined to 1e-4 a by bisection; () when none passes."""
+    import numpy as np
+
+    from ...trace import OK, RayBatch, trace_path
+
+    def passes(hs):
+        y0, z0, dy, dz = (np.broadcast_to(np.asarray(v, dtype=float), np.shape(hs)) for v in ray(np.asarray(hs)))
+        zero = np.zeros(np.shape(hs))
+        pos = np.stack([zero, y0, z0] if axis == "y" else [y0, zero, z0], axis=1)
+        d = np.stack([zero, dy, dz] if axis == "y" else [dy, zero, dz], axis=1)
+        _, out = trace_path(p, RayBatch.from_arrays(pos, d, wavelength_nm), clip=True)
+        return out.flag == OK
+
+    hs = np.linspace(-0.98 * a, 0.98 * a, 49)
+    ok = passes(hs)
+    if not ok.any():
+        return ()
+    lo = hi = int(np.flatnonzero(ok)[np.argmin(np.abs(hs[ok]))])  # the passing sample nearest h = 0
+    while lo > 0 and ok[lo - 1]:
+        lo -= 1
+    while hi < len(hs) - 1 and ok[hi + 1]:
+        hi += 1
+    edges = []
+    for k, step in ((lo, -1), (hi, 1)):
+        inside, outside = hs[k], (hs[k + step] if 0 <= k + step < len(hs) else None)
+        while outside is not None and abs(outside - inside) > 1e-4 * a:
+            mid = 0.5 * (inside + outside)
+            inside, outside = (mid, outside) if passes(np.array([mid]))[0] else (inside, mid)
+        edges.append(float(inside))
+    return tuple(edges)
+
+
 @takes_camera
 def lens_diagram(camera: CameraState, *, axis: str = "y", field_deg: float | None = None, wavelength_nm=None,
                  rays: int = 3) -> LensDiagram:
@@ -255,19 +292,26 @@ def lens_diagram(camera: CameraState, *, axis: str = "y", field_deg: float | Non
         z_start = max(z_start, st.object_z)
     ep, a = g.z_entrance_pupil, g.entrance_pupil_diameter / 2
     out = []
-    fan = [a * (2 * j / (rays - 1) - 1) for j in range(rays)] if rays > 1 else [a]
-    for h in fan:  # marginal fan from the axial object
-        if math.isinf(st.object_z):
-            pts = trace_meridional_ray(p, h, z_start, 0.0, 1.0, axis=axis, wavelength_nm=wavelength_nm, film_z=g.z_film)
-        else:
-            pts = trace_meridional_ray(p, 0.0, st.object_z, h, ep - st.object_z, axis=axis,
-                                       wavelength_nm=wavelength_nm, film_z=g.z_film)
-        out.append(("marginal", pts))
+    if math.isinf(st.object_z):  # the axial pencil: parallel rays at pupil height h, or a fan from the object
+        def marginal(h):
+            return h, z_start, 0.0, 1.0
+    else:
+        def marginal(h):
+            return 0.0, st.object_z, h, ep - st.object_z
+    lo_hi = _pencil_edges(p, marginal, a, axis, wavelength_nm) or (-a, a)
+    fan = [lo_hi[0] + (lo_hi[1] - lo_hi[0]) * j / (rays - 1) for j in range(rays)] if rays > 1 else [lo_hi[1]]
+    for h in fan:  # marginal fan from the axial object, its outer rays at the pencil's rim
+        y0, z0, dy, dz = marginal(h)
+        out.append(("marginal", trace_meridional_ray(p, y0, z0, dy, dz, axis=axis, wavelength_nm=wavelength_nm,
+                                                     film_z=g.z_film)))
     tu = math.tan(half)
-    for h, kind in ((0.0, "chief"), (a * 0.98, "rim"), (-a * 0.98, "rim")):  # field aimed at the paraxial EP
-        y_start = h - tu * (ep - z_start)
-        out.append((kind, trace_meridional_ray(p, y_start, z_start, tu, 1.0, axis=axis, wavelength_nm=wavelength_nm,
-                                               film_z=g.z_film)))
+
+    def field(h):
+        return h - tu * (ep - z_start), z_start, tu, 1.0
+
+    rims = _pencil_edges(p, field, a, axis, wavelength_nm)  # the rim of what passes of the off-axis pencil
+    for h, kind in ((0.0, "chief"),) + tuple((h, "rim") for h in rims[::-1]):  # aimed at the paraxial EP
+        out.append((kind, trace_meridional_ray(p, *field(h), axis=axis, wavelength_nm=wavelength_nm, film_z=g.z_film)))
     return LensDiagram(p, g, axis, math.degrees(half), out, cam)
 
 

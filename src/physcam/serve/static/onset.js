@@ -492,7 +492,8 @@
         solved.hyperfocal_parameter_from_near_mm = hpNear;
         solved.hyperfocal_parameter_from_far_mm = hpFar;
         solved.consistency = Math.abs(hpFar - hpNear) / hpNear;
-        notes.push(`near and far limits agree to ${(100 * solved.consistency).toFixed(1)}% in the hyperfocal parameter`);
+        // over-determined only: the focus and stop solved from both limits agree by construction (the CLI's note too)
+        if (!split) notes.push(`near and far limits agree to ${(100 * solved.consistency).toFixed(1)}% in the hyperfocal parameter`);
       }
       if (N === null || r.coc !== null) {
         const marked = N;
