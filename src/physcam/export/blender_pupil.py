@@ -351,27 +351,36 @@ class _RimSet:
 
 def _first_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, backend: str) -> tuple[list, list]:
     """Per film point (fx, 0): the box (x0, x1, y1) of its first grid and the grid (:func:`_trace`).
-    The rear element's square, unless fewer than :data:`~physcam.trace.pupil_bounds.MIN_HITS` of its
+    The rear element's square on the rear vertex plane, and its rim seen from the film point there
+    (the rim lies sag off that plane: a ray the rim passes crosses the plane up to d / (d - sag) of the
+    way from the film point toward it, d the film's distance from the rear vertex; where the rear
+    surface bows toward the film the passing aims of a point far off axis reach past the square), unless
+    fewer than :data:`~physcam.trace.pupil_bounds.MIN_HITS` of its
     aims pass at the widest iris radius (``radii[0]``; a cover glass close to the film: the spot is under one grid
     step); then a window about the point straight ahead, half as wide as the film's distance from
     the rear vertex, doubled while the passing aims touch its edge or none pass."""
+    from ..lens.geometry import sag
     from ..trace.pupil_bounds import MIN_HITS
 
-    full, s_max = (-r_rear, r_rear, r_rear), radii[0]
-    boxes = [full] * len(fxs)
+    s_max = radii[0]
+    rear, d = q.surfaces[-1], film_z - q.vertex_z[-1]
+    ks = [d / (d - sag(rear, r_rear, ax)) for ax in ("x", "y")] + [1.0]
+    boxes = [(min(f * (1 - k) - k * r_rear for k in ks), max(f * (1 - k) + k * r_rear for k in ks), max(ks) * r_rear)
+             for f in np.asarray(fxs, dtype=float).tolist()]
+    outer = list(boxes)  # the windows below stay inside each point's box
     grids = _trace(q, film_z, fxs, boxes, radii, big, backend)
     pending = [p for p, g in enumerate(grids) if (g[2] & (g[3] <= s_max)).sum() < MIN_HITS]
     h = 0.5 * (film_z - q.vertex_z[-1])
     while pending and h < 2 * r_rear:
-        wins = {p: (max(fxs[p] - h, -r_rear), min(fxs[p] + h, r_rear), min(h, r_rear)) for p in pending}
+        wins = {p: (max(fxs[p] - h, outer[p][0]), min(fxs[p] + h, outer[p][1]), min(h, outer[p][2])) for p in pending}
         wins = {p: w for p, w in wins.items() if w[1] > w[0]}
         done = set()
         for p, g in zip(wins, _trace(q, film_z, [fxs[p] for p in wins], list(wins.values()), radii, big, backend) if wins else []):
-            w, sel = wins[p], g[2] & (g[3] <= s_max)
+            w, sel, o = wins[p], g[2] & (g[3] <= s_max), outer[p]
             if sel.any():
                 x, y = g[0][sel], g[1][sel]
-                edge = ((w[0] > -r_rear and x.min() < w[0] + g[4]) or (w[1] < r_rear and x.max() > w[1] - g[4])
-                        or (w[2] < r_rear and y.max() > w[2] - g[5]))
+                edge = ((w[0] > o[0] and x.min() < w[0] + g[4]) or (w[1] < o[1] and x.max() > w[1] - g[4])
+                        or (w[2] < o[2] and y.max() > w[2] - g[5]))
                 if not edge:
                     boxes[p], grids[p] = w, g
                     done.add(p)
