@@ -352,6 +352,7 @@ def test_a_plain_camera_file_is_told_apart_from_a_physical_one(tmp_path, capsys)
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "name the one" not in err
         assert f"no physical camera to {verb}" in err and "UsdGeomCamera prims (/cams/shotcam)" in err
+        assert err.count("plain.usda") == 1, err  # the file named once (check and refresh named it twice)
 
 
 def test_usd_write_places_the_camera_from_the_notes(tmp_path, capsys):

@@ -366,10 +366,7 @@ def check_shot(file, path: str | None = None) -> dict:
     stage = open_stage(file)
     stage.Reload()  # the referenced files as they are on disk now, not as this process cached them
     if path is None:
-        try:
-            path = only_camera(stage, "check")
-        except ExportError as exc:
-            raise ExportError(f"{file}: {exc}") from None
+        path = only_camera(stage, "check")  # its error names the file
     geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
     if not geom:
         raise ExportError(f"{path}: has no companion camera to check")
@@ -416,10 +413,7 @@ def refresh_shot(file, path: str | None = None) -> dict:
     stage = Usd.Stage.Open(layer)
     stage.Reload()  # the shot and its referenced files as they are on disk now
     if path is None:
-        try:
-            path = only_camera(stage, "refresh")
-        except ExportError as exc:
-            raise ExportError(f"{file}: {exc}") from None
+        path = only_camera(stage, "refresh")  # its error names the file
     if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):  # else there is no companion yet: write it
         now = check_shot(file, path)
         if not now["stale"]:
