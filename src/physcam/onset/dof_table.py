@@ -74,9 +74,12 @@ def _row(report, mark) -> dict:
 def format_squeeze(sensor) -> float:
     """The anamorphic desqueeze the camera table gives ``sensor``'s recording format (``squeeze="format"``,
     ``--squeeze format``); InputError, saying what it offers, when it gives none or several."""
-    from ..optics.sensors import find_sensor
+    from ..optics.sensors import Sensor, find_sensor
 
-    sensor = find_sensor(sensor) if isinstance(sensor, str) else sensor
+    if isinstance(sensor, str):
+        sensor = find_sensor(sensor)
+    elif not isinstance(sensor, Sensor):
+        raise InputError(f"squeeze format needs a sensor (a name or a Sensor), got {type(sensor).__name__}")
     offered = tuple(getattr(sensor, "anamorphic", ()) or ())
     if len(offered) != 1:
         what = "no anamorphic desqueeze" if not offered else "desqueezes " + ", ".join(f"{v:g}" for v in offered)
