@@ -82,7 +82,7 @@ def _shader_polygon(ft, k0, fw, rho, s, ap):
     return (kp if poly < math.pi and fill >= POLY_FILL else 0.0), cx, ax + bump, ay + bump
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=40, deadline=None)
 @given(k=st.floats(0.0, 0.999), fw=st.floats(0.0, 1.0), log_n=st.floats(0.0, 1.0), rho=st.floats(0.0, 21.6),
        blades=st.integers(5, 9), angle=st.floats(0.0, 360.0), roundness=st.sampled_from([0.0, 0.3]))
 def test_the_sampled_polygon_holds_every_passing_ray(table, k, fw, log_n, rho, blades, angle, roundness):
