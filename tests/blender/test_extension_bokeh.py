@@ -33,7 +33,6 @@ LENS, MARK_MM, FSTOP, BLADES, CORNER_DEG = "dgauss_50mm", 2000.0, 2.8, 6, 15.0
 NEAR_MM, SPHERE_M = 700.0, 0.001  # the sphere: mm from the film, radius (m)
 CROP_MM, CROP_PX = 3.0, 128
 BORDER_PX = 36  # the render: only this many px either side of the crop's centre (module notes)
-NOISE_FSTOP = 5.6  # the noise renders' stop (the iris alone bounds the set on the axis there)
 
 BOKEH = INSTALLED_EXTENSION_SCENE + '''
 scene.cycles.max_bounces = 0
@@ -69,20 +68,7 @@ scene.render.filepath = sys.argv[2] + "/bokeh.exr"
 bpy.ops.render.render(write_still=True)
 img = bpy.data.images.load(scene.render.filepath)
 a = np.array(img.pixels[:], dtype=np.float64).reshape(n, n, 4)[..., 0]
-bpy.data.images.remove(img)
-noise = {}  # the noise renders: a round and a 5-bladed iris at another stop, 32 samples, seeds 0 and 1
-c0, c1 = n // 2 - int(sys.argv[12]), n // 2 + int(sys.argv[12])
-p.fstop = float(sys.argv[13]); scene.cycles.samples = 32
-for blades in (0, 5):
-    p.blades = blades
-    for seed in (0, 1):
-        scene.cycles.seed = seed
-        bpy.ops.render.render(write_still=True)
-        img = bpy.data.images.load(scene.render.filepath)
-        b = np.array(img.pixels[:], dtype=np.float64).reshape(n, n, 4)[c0:c1, c0:c1, 0]
-        bpy.data.images.remove(img)
-        noise.setdefault(str(blades), []).append(b.tolist())
-print(json.dumps({"message": p.message, "img": a.tolist(), "noise": noise}))
+print(json.dumps({"message": p.message, "img": a.tolist()}))
 '''
 
 
@@ -96,44 +82,7 @@ def _pupil_from_film(lens, mark_mm):
                                       lens=lens).camera).pupil_from_film_mm
 
 
-@pytest.fixture(scope="module")
-def rendered(extension_zip, tmp_path_factory):
-    """The Blender run: the bokeh at 512 samples, and the noise renders (NOISE_FSTOP, 32 samples, two seeds)."""
-    lens = load_lens(LENS)
-    tmp_path = tmp_path_factory.mktemp("bokeh")
-    # the camera object is the entrance pupil: the sphere NEAR_MM from the film is that less the
-    # pupil's distance in front of the camera
-    depth_m = (NEAR_MM - _pupil_from_film(lens, MARK_MM)) / 1000.0
-    return run_blender(BOKEH, extension_zip, tmp_path, LENS, CROP_MM, MARK_MM / 1000.0, FSTOP, BLADES, CORNER_DEG,
-                       depth_m, SPHERE_M, CROP_PX, BORDER_PX, NOISE_FSTOP,
-                       env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
-
-
-def _relative_noise(pair) -> float:
-    """The RMS difference of two seeds' renders over sqrt(2), over the mean, where their mean is over a
-    fifth of its 99th percentile (the bokeh's core)."""
-    a, b = (np.array(x) for x in pair)
-    m = 0.5 * (a + b)
-    core = m > 0.2 * np.percentile(m, 99)
-    return float(np.sqrt(((a - b)[core] ** 2 / 2).mean()) / m[core].mean())
-
-
-def test_a_bladed_iris_keeps_most_of_the_round_irises_strata(rendered):
-    """At equal samples (32) a 5-bladed iris renders the bokeh of a small light far out of focus (each
-    pixel sees it through a small part of the pupil, so how evenly the samples cover the pupil is all of
-    its noise) at most 1.4 times as noisy as the round iris of the same area (docs/conventions.md), at
-    f/5.6 where the iris alone bounds the passing set. Before 2026-11-29 the shader sampled the round
-    iris's ellipse there: the quarter of first samples in the corners the blades cut away was redrawn
-    from hashed numbers, which lose Cycles' strata, and the 5 blades had 1.53 times the round iris's
-    noise (0.443 against 0.290); sampling the blades' polygon (5 % larger than its ellipse's, which
-    the Canon 14 mm retrofocus needs: tests/blender/test_extension_polygon_sampling.py) brings it to
-    1.31 (0.380). Without that growth it would be 1.07: the rest is its redraws."""
-    round_, bladed = (_relative_noise(rendered["noise"][k]) for k in ("0", "5"))
-    print(f"bokeh at f/{NOISE_FSTOP:g}, 32 samples: relative noise round {round_:.4f}, 5 blades {bladed:.4f}")
-    assert bladed < 1.4 * round_
-
-
-def test_bokeh_diameter_and_iris_corners_match_bokeh_image(rendered):
+def test_bokeh_diameter_and_iris_corners_match_bokeh_image(extension_zip, tmp_path):
     """The rendered bokeh's second-moment diameter (the sphere's own image removed in quadrature)
     is physcam's within 3 %, and its rim has 6 corners pointing where physcam's do within 3 deg."""
     lens = load_lens(LENS)
@@ -147,7 +96,11 @@ def test_bokeh_diameter_and_iris_corners_match_bokeh_image(rendered):
     near = bokeh_image(st.prescription, NEAR_MM, rays=2_000_000, pixels=CROP_PX, extent_mm=(-h, h, -h, h), **kw)
     off = bokeh_image(st.prescription, NEAR_MM, 10.0, rays=200_000, pixels=64, **kw)
     mag = abs(off.to_dict()["centroid_mm"][0]) / 10.0  # the sphere's own image: lateral magnification
-    out = rendered
+    # the camera object is the entrance pupil: the sphere NEAR_MM from the film is that less the
+    # pupil's distance in front of the camera
+    depth_m = (NEAR_MM - _pupil_from_film(lens, MARK_MM)) / 1000.0
+    out = run_blender(BOKEH, extension_zip, tmp_path, LENS, CROP_MM, MARK_MM / 1000.0, FSTOP, BLADES, CORNER_DEG,
+                      depth_m, SPHERE_M, CROP_PX, BORDER_PX, env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
     assert out["message"] == ""
     img = np.array(out["img"])
     px = CROP_MM / CROP_PX
