@@ -89,6 +89,8 @@ def run(lens_name: str, src: str | None, out: str) -> float:
 def table_change(old: dict, new: dict) -> dict:
     """The largest differences between two sides' tables of one lens (module notes)."""
     a, b = old["radial"], new["radial"]
+    if a.shape != b.shape or old["norm"].shape != new["norm"].shape:  # another grid of radii or levels
+        return {"ellipse": math.nan, "area": math.nan, "trust_flips": -1, "norm": math.nan}
     out = {"norm": float(np.max(np.abs(new["norm"] / old["norm"] - 1)))}
     if a.size == 0:
         return out | {"ellipse": 0.0, "area": 0.0, "trust_flips": 0}
@@ -119,6 +121,7 @@ def main() -> None:
         head += f" {'base CPU s':>10s} {'ratio':>6s} {'ellipse':>9s} {'area':>9s} {'flips':>5s} {'norm':>9s}"
     print(head)
     tot, tot_b, worst = 0.0, 0.0, {"ellipse": 0.0, "area": 0.0, "trust_flips": 0, "norm": 0.0}
+    incomparable = 0  # lenses whose two sides tabulate other radii or levels (their nan left out of worst)
     with tempfile.TemporaryDirectory() as tmp:
         for name in names:
             new_f, old_f = os.path.join(tmp, "new.npz"), os.path.join(tmp, "old.npz")
@@ -129,6 +132,7 @@ def main() -> None:
                 base = run(name, args.baseline_src, old_f)
                 tot_b += base
                 d = table_change(dict(np.load(old_f)), dict(np.load(new_f)))
+                incomparable += d["trust_flips"] < 0
                 worst = {k: max(worst[k], d[k]) for k in worst}
                 line += (f" {base:10.2f} {base / cpu:6.2f} {d['ellipse']:9.2e} {d['area']:9.2e} {d['trust_flips']:5d}"
                          f" {d['norm']:9.2e}")
@@ -136,7 +140,9 @@ def main() -> None:
     print(f"{'total':28s} {tot:10.2f}" + (f" {tot_b:10.2f} {tot_b / tot:6.2f}" if args.baseline_src else ""))
     if args.baseline_src:
         print("largest change over every lens: ellipse {ellipse:.2e} of its size, area {area:.2e}, "
-              "{trust_flips} entries whose area trust differs, norm {norm:.2e}".format(**worst))
+              "{trust_flips} entries whose area trust differs, norm {norm:.2e}".format(**worst)
+              + (f" (over the others: {incomparable} lens(es) tabulated on other radii or levels, not compared)"
+                 if incomparable else ""))
     print(f"load average after: {load()}")
 
 

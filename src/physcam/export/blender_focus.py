@@ -323,7 +323,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
     from ..trace.camera_tracer import CameraTracer
-    from .blender_pupil import iris_levels, radial_pupil_table
+    from .blender_pupil import _centre_ellipses, iris_levels, radial_pupil_table
 
     axis = focus_axis(closest_focus(lens), n_focus)
     states = []
@@ -347,7 +347,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
         else:
             radial.append(radial_pupil_table(tracer.lens, st.film_z, levels))
             b = _centre_bounds(tracer.lens, radial[-1][0, 0])
-            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in radial[-1][:, 0]], levels))
+            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(radial[-1])], levels))
         if i == 0:
             table0, bounds0 = tracer.film_side_table, (b if lens.is_anamorphic else None)
             loss = tracer.centre_weight(b, samples=64, fresnel=True) / tracer.centre_weight(b, samples=64)
@@ -532,9 +532,11 @@ def _arr32(name, values, size) -> str:
     a = np.asarray(values, float).ravel()
     if not np.isfinite(a).all():
         _num32(a[~np.isfinite(a)][0])  # raises osl_number's error
-    # _num32 of each, inlined (osl_number of a finite float: its repr, with ".0" when that is an integer)
-    nums = [repr(float(format(v, ".9g"))) for v in a.tolist()]
-    return f"    float {name}[{size}] = {{{', '.join(r if ('.' in r or 'e' in r) else r + '.0' for r in nums)}}};"
+    # _num32 of each (osl_number of the nine-digit rounding: its repr, with ".0" when that is an
+    # integer). Where "%.9g" writes a fraction without exponent (1e-4 <= |v| < 1e9) that is the repr
+    # already: it strips its zeros, and no shorter decimal names the same double
+    nums = [r if ("." in r and "e" not in r) else osl_number(float(r)) for r in map("%.9g".__mod__, a.tolist())]
+    return f"    float {name}[{size}] = {{{', '.join(nums)}}};"
 
 
 def _arr32_once(ft: FocusTable, name, values, size) -> str:
