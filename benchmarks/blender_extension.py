@@ -2,6 +2,12 @@
 
 Run:  .venv/bin/python benchmarks/blender_extension.py [--lenses dgauss_50mm,tessar_50mm]
                                                        [--baseline-src <other checkout>/src]
+      .venv/bin/python benchmarks/blender_extension.py --build [--workers 2] [--baseline-src ...]
+
+``--build``: the whole command instead (``physcam export blender-extension --workers N``, the lenses
+given or every bundled one), its CPU seconds as user + system of the process and its workers
+(``os.wait4``), with the zip's size: the part outside ``lens_payload`` too (worker start-up, the zip's
+deflate), one side after the other.
 
 Goal (issue 41 follow-up): every bundled lens in under ~2.5 min of CPU (the extension build was
 about 8 min). CPU time (``time.process_time``: every thread of the process), so the figure holds on a
@@ -86,6 +92,42 @@ def run(lens_name: str, src: str | None, out: str) -> float:
     return row["cpu_s"]
 
 
+def build(src: str | None, names, workers: int, out: str) -> tuple[float, float, float, int]:
+    """(user CPU s, system CPU s, wall s, zip bytes) of one whole ``physcam export blender-extension`` in a
+    fresh process with ``PYTHONPATH=<src>`` (its worker processes' CPU included: ``os.wait4``)."""
+    env = dict(os.environ)
+    if src:
+        env["PYTHONPATH"] = os.path.abspath(src)
+    cmd = [sys.executable, "-m", "physcam", "export", "blender-extension", "-o", out, "--workers", str(workers), "--force"]
+    for name in names or ():
+        cmd += ["--lens", name]
+    t = time.perf_counter()
+    p = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, ru = os.wait4(p.pid, 0)
+    wall = time.perf_counter() - t
+    if os.waitstatus_to_exitcode(status):
+        sys.exit(f"the build failed ({src or 'this checkout'}): {p.stderr.read().decode().strip().splitlines()[-1]}")
+    (zp,) = [f for f in os.listdir(out) if f.endswith(".zip")]
+    return ru.ru_utime, ru.ru_stime, wall, os.path.getsize(os.path.join(out, zp))
+
+
+def main_build(args, here: str) -> None:
+    names = args.lenses.split(",") if args.lenses else None
+    sides = [("this checkout", here)] + ([("baseline", args.baseline_src)] if args.baseline_src else [])
+    print(f"load average before: {load()}")
+    cpu = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for label, src in sides:
+            out = os.path.join(tmp, label.replace(" ", "_"))
+            os.mkdir(out)
+            user, system, wall, size = build(src, names, args.workers, out)
+            cpu[label] = user + system
+            print(f"{label:14s} CPU {user + system:7.1f} s (user {user:.1f}, system {system:.1f}), wall {wall:6.1f} s, "
+                  f"zip {size / 1e6:.1f} MB, load {load()}", flush=True)
+    if args.baseline_src:
+        print(f"ratio (baseline / this): {cpu['baseline'] / cpu['this checkout']:.2f}")
+
+
 def table_change(old: dict, new: dict) -> dict:
     """The largest differences between two sides' tables of one lens (module notes)."""
     a, b = old["radial"], new["radial"]
@@ -106,6 +148,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--lenses", help="comma-separated bundled slugs (default: every bundled lens)")
     ap.add_argument("--baseline-src", help="another checkout's src directory to compare against")
+    ap.add_argument("--build", action="store_true", help="time the whole CLI build (module notes)")
+    ap.add_argument("--workers", type=int, default=2, help="--build's worker processes (default 2)")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--out", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -113,8 +157,10 @@ def main() -> None:
         return worker(args.worker, args.out)
     from physcam.lens.library import list_lenses
 
-    names = args.lenses.split(",") if args.lenses else [r.slug for r in list_lenses()]
     here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src")
+    if args.build:
+        return main_build(args, here)
+    names = args.lenses.split(",") if args.lenses else [r.slug for r in list_lenses()]
     print(f"load average before: {load()}")
     head = f"{'lens':28s} {'this CPU s':>10s}"
     if args.baseline_src:

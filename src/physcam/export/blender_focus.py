@@ -515,11 +515,12 @@ def _rect_tables(tracer, semi_max, grid_half_mm):
     nx, ny = _GRID
     q = tracer.lens
     semi_file = q.surfaces[q.stop_index].semi_diameter
-    # the stop's semi-diameter as a prescription stopped to each fraction of the file's holds it
-    b = tracer.stopped_pupil_bounds([float(semi_file * (semi_max / semi_file))], grid_half_mm, grid_half_mm,
-                                    nx=nx, ny=ny, samples=48)[0]
-    levels = tracer.stopped_pupil_bounds([float(semi_file * (f * semi_max / semi_file)) for f in STOP_LEVELS],
-                                         grid_half_mm, grid_half_mm, nx=nx, ny=ny, samples=32)
+    # the stop's semi-diameter as a prescription stopped to each fraction of the file's holds it. The widest
+    # iris and the stopped ones share their rays (one trace with the stop opened, each iris's mask the
+    # tracer's own test: stopped_pupil_bounds): the widest's rectangles are what a trace of it alone gives,
+    # the stopped ones are sampled as finely (48 aims across, not 32) for no more rays
+    b, *levels = tracer.stopped_pupil_bounds([float(semi_file * (f * semi_max / semi_file)) for f in (1.0,) + STOP_LEVELS],
+                                             grid_half_mm, grid_half_mm, nx=nx, ny=ny, samples=48)
     return b, b.rects, [lv.rects for lv in levels]
 
 
