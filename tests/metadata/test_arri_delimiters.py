@@ -39,12 +39,29 @@ def test_a_copy_with_another_delimiter_is_the_same_clip(tmp_path, delimiter):
     assert dataclasses.replace(got, files=want.files) == want
 
 
-def test_a_comma_copy_without_its_timecode_is_named_arri(tmp_path):
+def test_a_semicolon_copy_with_decimal_commas_is_the_same_clip(tmp_path):
+    """A copy saved in a decimal-comma locale: semicolons between cells, "4,812" for 4.812 (the review of
+    round 9: its first number was refused)."""
+    import re
+
+    with open(ARRI, encoding="utf-8", newline="") as fh:
+        table = list(csv.reader(fh, delimiter="\t"))
+    p = tmp_path / "clip.csv"
+    with open(p, "w", encoding="utf-8", newline="") as fh:
+        csv.writer(fh, delimiter=";").writerows(
+            [table[0]] + [[re.sub(r"(\d)\.(\d)", r"\1,\2", c) for c in r] for r in table[1:]])
+    assert "," in p.read_text(encoding="utf-8").splitlines()[1]  # the copy has decimal commas to read
+    got, want = load(p), load(ARRI)
+    assert dataclasses.replace(got, files=want.files) == want
+
+
+@pytest.mark.parametrize("delimiter", [",", ";"])
+def test_a_copy_without_its_timecode_is_named_arri(tmp_path, delimiter):
     """A header with ARRI's columns but no Master TC is said to be ARRI's, not another maker's."""
-    _, table = _copy(tmp_path, ",", rows=3)
+    _, table = _copy(tmp_path, delimiter, rows=3)
     keep = [i for i, c in enumerate(table[0]) if c != "Master TC"]
     p = tmp_path / "no_tc.csv"
     with open(p, "w", encoding="utf-8", newline="") as fh:
-        csv.writer(fh).writerows([[r[i] for i in keep] for r in table])
+        csv.writer(fh, delimiter=delimiter).writerows([[r[i] for i in keep] for r in table])
     with pytest.raises(MetadataError, match="ARRI Meta Extract CSV but has no 'Master TC'"):
         detect_file(p)

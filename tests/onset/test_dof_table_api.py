@@ -84,12 +84,29 @@ def test_the_formats_squeeze_is_the_commands(capsys):
     (dict(), "give either a focal length"),
     (dict(focal_length_mm=35, focus_marks_mm=[-1.0]), "focus mark"),
     (dict(focal_length_mm=35, fstops=[]), "1 to 24 f-stops"),
+    (dict(focal_length_mm=35, fstops=["f/2.8"]), "an f-stop of the table is a positive number"),
+    (dict(focal_length_mm=35, fstops=[None]), "an f-stop of the table is a positive number"),
+    (dict(focal_length_mm=35, fstops=[math.nan]), "an f-stop of the table is a positive number"),
+    (dict(focal_length_mm=35, fstops=object()), "fstops: give a number"),
 ])
 def test_bad_input_is_an_input_error(kwargs, words):
     from physcam.onset.dof_table import dof_table
 
     with pytest.raises(InputError, match=words):
         dof_table(sensor="S35", **kwargs)
+
+
+def test_one_mark_one_stop_and_numpy_numbers_are_what_a_list_of_them_gives():
+    """A single mark or stop is a one-entry table ("2m" was read letter by letter), and numpy's numbers
+    are distances and f-stops like Python's (np.int64(2000) was refused as "not a distance")."""
+    import numpy as np
+
+    from physcam.onset.dof_table import dof_table
+
+    want = dof_table(50, sensor="S35", fstops=[2.8], focus_marks_mm=[2000.0])["rows"]
+    assert dof_table(50, sensor="S35", fstops=2.8, focus_marks_mm="2m")["rows"] == want
+    for marks in (np.array([2000]), np.array([2000.0], dtype=np.float32)):
+        assert dof_table(50, sensor="S35", fstops=np.array([2.8]), focus_marks_mm=marks)["rows"] == want
 
 
 def test_the_docs_example_runs():

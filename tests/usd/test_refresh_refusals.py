@@ -51,3 +51,34 @@ def test_a_lens_camera_without_its_stored_lens_is_refused(tmp_path, capsys):
     err = _refused(capsys, "refresh", f)
     assert f"{CAM}/Prescription is missing" in err and "Double Gauss 50mm" in err
     assert f"physcam usd write {f} --lens NAME" in err
+
+
+def test_a_moving_camera_with_a_still_lens_is_checked_and_refreshed(tmp_path, capsys):
+    """A layout's move (time-sampled xformOp:translate) is not an input of the lens: check and refresh
+    treat the camera as still (the review of round 9 found the move refused)."""
+    f = tmp_path / "move.usda"
+    assert main(["usd", "write", str(f), "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--sensor", "S35"]) == 0
+    stage = Usd.Stage.Open(str(f))
+    cam = stage.GetPrimAtPath(CAM)
+    op = next(a for a in cam.GetAttributes() if a.GetName() == "xformOp:translate")
+    op.Set((0.0, 0.0, 0.0), 1.0)
+    op.Set((100.0, 0.0, 0.0), 24.0)
+    cam.GetAttribute("lens:main:fStop").Set(4.0)  # the stop edited: the companion is stale
+    stage.Save()
+    capsys.readouterr()
+    assert main(["usd", "check", str(f)]) == 1  # stale, not refused
+    assert main(["usd", "refresh", str(f)]) == 0
+    assert main(["usd", "check", str(f)]) == 0
+    after = Usd.Stage.Open(str(f))
+    moved = after.GetPrimAtPath(CAM).GetAttribute("xformOp:translate")
+    assert moved.GetNumTimeSamples() == 2 and tuple(moved.Get(24.0)) == (100.0, 0.0, 0.0)
+
+
+def test_a_path_with_no_prim_is_a_one_line_error(tmp_path, capsys):
+    f = tmp_path / "cam.usda"
+    assert main(["usd", "write", str(f), "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--sensor", "S35"]) == 0
+    for action in ("check", "refresh"):
+        capsys.readouterr()
+        assert main(["usd", action, str(f), "--path", "/Nope"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "/Nope" in err and "Traceback" not in err, err

@@ -87,7 +87,7 @@ def _missing_columns(first_line: str) -> str | None:
 
     layouts = (("an ARRI Meta Extract CSV", arri), ("a REDline frames CSV", red), ("a Canon per-frame CSV", canon),
                ("a Sony VENICE per-frame CSV", venice))
-    for delimiter in ("\t", ","):
+    for delimiter in arri.DELIMITERS:
         cols = set(header_columns(first_line, delimiter))
         for what, reader in layouts:
             if any(m in cols for m in reader.LAYOUT_MARKERS):

@@ -48,6 +48,8 @@ LAYOUT_MARKERS = ("Master TC", "Lens Linear Iris", "Camera Clip Name")
 #: The delimiters an AME header is read with: Meta Extract writes tabs; a copy saved again by a spreadsheet
 #: (or exported with another setting) has commas or, in locales with a decimal comma, semicolons
 DELIMITERS = ("\t", ",", ";")
+#: a decimal comma between two digits (a semicolon-separated copy's numbers)
+_DECIMAL_COMMA = re.compile(r"(\d),(\d)")
 
 
 def delimiter_of(head: str) -> str | None:
@@ -119,8 +121,11 @@ def _frame(path, line, r, no_unit: list) -> FrameSample:
 
 def read(path) -> ClipRecord:
     """The clip of one AME CSV (module notes), read row by row."""
-    header, data = rows(path, _delimiter(path))
+    delimiter = _delimiter(path)
+    header, data = rows(path, delimiter)
     require_columns(path, header, REQUIRED, "an ARRI Meta Extract CSV")
+    if delimiter == ";":  # a decimal-comma locale's copy: "4,812" is 4.812, "1,4 + 7/10" is 1.4 + 7/10
+        data = ((line, {k: _DECIMAL_COMMA.sub(r"\1.\2", v) for k, v in r.items()}) for line, r in data)
     frames, no_unit, first = [], [], None
     for line, r in data:
         if first is None:

@@ -12,6 +12,7 @@ vertical ones: a defocused point's blur is oval, so across the frame the CoC is 
 from __future__ import annotations
 
 import math
+import numbers
 import warnings
 
 from ..errors import InputError, PhysCamWarning
@@ -39,10 +40,27 @@ def _mark(m):
         if t in (HYPERFOCAL, "hyper"):
             return HYPERFOCAL
         return parse_distance(m, name="focus mark", allow_inf=True)
-    if isinstance(m, bool) or not isinstance(m, (int, float)) or math.isnan(m) or m <= 0:
+    if isinstance(m, bool) or not isinstance(m, numbers.Real) or math.isnan(m) or m <= 0:
         raise InputError(f"a focus mark is a distance in mm from the film, text with a unit ('2m') or "
                          f"'hyperfocal', got {m!r}")
     return float(m)
+
+
+def _fstop(n) -> float:
+    """An f-number of the table: a positive finite number (numpy's included)."""
+    if isinstance(n, bool) or not isinstance(n, numbers.Real) or not math.isfinite(n) or n <= 0:
+        raise InputError(f"an f-stop of the table is a positive number (2.8), got {n!r}")
+    return float(n)
+
+
+def _listed(values, what: str) -> list:
+    """``values`` as a list: one number or text is one entry (focus_marks_mm="2m", fstops=2.8)."""
+    if isinstance(values, (str, bytes, numbers.Real)):
+        return [values]
+    try:
+        return list(values)
+    except TypeError:
+        raise InputError(f"{what}: give a number, text or a list of them, got {type(values).__name__}") from None
 
 
 def _row(report, mark) -> dict:
@@ -74,9 +92,12 @@ def _row(report, mark) -> dict:
 def format_squeeze(sensor) -> float:
     """The anamorphic desqueeze the camera table gives ``sensor``'s recording format (``squeeze="format"``,
     ``--squeeze format``); InputError, saying what it offers, when it gives none or several."""
-    from ..optics.sensors import find_sensor
+    from ..optics.sensors import Sensor, find_sensor
 
-    sensor = find_sensor(sensor) if isinstance(sensor, str) else sensor
+    if isinstance(sensor, str):
+        sensor = find_sensor(sensor)
+    elif not isinstance(sensor, Sensor):
+        raise InputError(f"squeeze format needs a sensor (a name or a Sensor), got {type(sensor).__name__}")
     offered = tuple(getattr(sensor, "anamorphic", ()) or ())
     if len(offered) != 1:
         what = "no anamorphic desqueeze" if not offered else "desqueezes " + ", ".join(f"{v:g}" for v in offered)
@@ -102,8 +123,8 @@ def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops
         raise InputError("give either a focal length (focal_length_mm=35) or a lens (lens=load_lens(name))")
     if isinstance(squeeze, str) and squeeze.strip().lower() == "format":
         squeeze = format_squeeze(sensor)
-    fstops = [float(n) for n in fstops]
-    marks = [_mark(m) for m in focus_marks_mm]
+    fstops = [_fstop(n) for n in _listed(fstops, "fstops")]
+    marks = [_mark(m) for m in _listed(focus_marks_mm, "focus_marks_mm")]
     if not fstops or len(fstops) > MAX_FSTOPS:
         raise InputError(f"a table takes 1 to {MAX_FSTOPS} f-stops, got {len(fstops)}")
     if not marks or len(marks) > MAX_MARKS:

@@ -438,9 +438,13 @@ _ANIMATED_FIRST = ("focusDistance", f"lens:{LENS_INSTANCE}:fStop", "focalLength"
 def _refuse_time_samples(stage, path, file, action: str) -> None:
     """ExportError naming the file and an animated attribute when the camera at ``path`` (or its lens model or
     companion) has time samples: check and refresh compare and recompute one still camera (its default
-    values), and an animation's per-frame lens (``usd animate``) is not stored in the file to solve again."""
+    values), and an animation's per-frame lens (``usd animate``) is not stored in the file to solve again.
+    A moving camera (time-sampled ``xformOp:*``, a layout's move) is still: its placement is not an input."""
     cam = stage.GetPrimAtPath(str(path))
-    sampled = [(p, a) for p in (cam, *cam.GetChildren()) for a in p.GetAttributes() if a.GetNumTimeSamples()]
+    if not cam:
+        raise ExportError(f"{file}: no prim at {path}")
+    sampled = [(p, a) for p in (cam, *cam.GetChildren()) for a in p.GetAttributes()
+               if a.GetNumTimeSamples() and not a.GetName().startswith("xformOp")]
     if not sampled:
         return
     sampled.sort(key=lambda pa: (pa[1].GetName() not in _ANIMATED_FIRST, pa[0] != cam, str(pa[0].GetPath())))
