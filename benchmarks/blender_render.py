@@ -19,7 +19,10 @@ pictures' difference over sqrt(2) (Monte Carlo noise only, whatever the picture)
 built-in camera's s_ref; the script renders it again at those samples (again from the noise reached
 while that is over s_ref by more than 3 %; the check column: the noise reached) and reports that
 render's CPU seconds (the process's, all of Cycles' threads: the machine
-may be shared, so wall time would measure the neighbours) over the built-in camera's.
+may be shared, so wall time would measure the neighbours) over the built-in camera's. The built-in
+camera renders with Cycles' own shading (SVM), as an artist renders it; an OSL camera switches the
+whole render to OSL shading, so its ratio is also given against the built-in camera rendered with
+OSL shading (the camera's own price).
 """
 
 from __future__ import annotations
@@ -181,6 +184,9 @@ def _cameras(lens, slug, fstop, tmp, ext_src):
 
     def builtin_cam(scene):
         scene.camera.data.type = "PERSP"
+        # Cycles' own shading (SVM), as an artist renders with the built-in camera: an OSL camera
+        # switches the whole render to OSL shading (about 10 % slower here), part of its price
+        scene.cycles.shading_system = False
         runpy.run_path(str(builtin), run_name="physcam_builtin")["apply"](scene)
 
     return {"builtin": builtin_cam, "baked": baked, "extension": extension}
@@ -229,8 +235,9 @@ def main() -> None:
     print(f"lens {lens.name}, focus {FOCUS_MM / 1000:g} m, {W} x {H} px, Cycles CPU, 2 threads, {n} samples; "
           f"load average at the start {load0[0]:.1f} (1 min), {os.cpu_count()} CPUs")
     print("| scene | f-stop | camera | CPU s at {n} samples | noise at {n} | samples for the built-in's noise | "
-          "CPU s at equal noise | ratio to built-in | check: noise reached |".format(n=n))
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+          "CPU s at equal noise | ratio to built-in | ratio to built-in under OSL shading | check: noise reached |"
+          .format(n=n))
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     scene = bpy.context.scene
     for scene_name in args.scenes:
         SCENES[scene_name](scene)
@@ -242,8 +249,13 @@ def main() -> None:
                 t, s, need, t_eq, ratio, s_eq = _row(scene, tmp, cams, name, n, ref)
                 if ref is None:
                     ref = (t, s)
+                    # the same built-in render with OSL shading (what the OSL cameras' renders use): the
+                    # camera's own price, apart from the switch of the whole render to OSL
+                    scene.cycles.shading_system = True
+                    t_osl = _noise(scene, tmp, "builtin_osl", n)[0]
+                    scene.cycles.shading_system = False
                 print(f"| {scene_name} | f/{fstop:g} | {name} | {t:.2f} | {s:.5f} | {need} | {t_eq:.2f} | "
-                      f"{ratio:.2f} | {s_eq:.5f} |", flush=True)
+                      f"{ratio:.2f} | {t_eq / t_osl:.2f} (built-in {t_osl:.2f}) | {s_eq:.5f} |", flush=True)
     load1 = os.getloadavg()
     print(f"load average at the end {load1[0]:.1f} (1 min), {load1[2]:.1f} (15 min)")
 

@@ -17,7 +17,8 @@ Goals (issue 47, median of the runs): the README's MTF chart (`mtf`) under 1 s; 
 
 `--tree DIR` (repeat) runs each case against the source tree DIR/src (PYTHONPATH) instead of the
 installed physcam, the trees alternating run by run, so a before/after pair shares the machine's
-load (export the old tree with `git archive COMMIT | tar -x -C DIR`).
+load (export the old tree with `git archive COMMIT | tar -x -C DIR`); with two trees each case also
+prints the median of the paired CPU differences (the second tree minus the first).
 """
 
 from __future__ import annotations
@@ -191,6 +192,11 @@ def main() -> None:
                 if cpu_goal is not None:
                     line += f"; goal {cpu_goal:g} s CPU: {'met' if cmed < cpu_goal else 'NOT met'}"
                 print(line + f" (load {load()})", flush=True)
+            if len(trees) == 2:  # the runs were made in pairs, one of each tree: the pairs' differences
+                d = [b - a for a, b in zip(res[trees[0]][1], res[trees[1]][1])]
+                print(f"{name}: paired CPU difference, second tree minus first: median "
+                      f"{statistics.median(d) * 1000:+.0f} ms, {sum(x < 0 for x in d)} of {len(d)} pairs faster",
+                      flush=True)
     t0 = time.perf_counter()
     subprocess.run([sys.executable, "-c", "pass"], check=True)
     print(f"(bare python start-up: {(time.perf_counter() - t0) * 1000:.0f} ms; load {load()} at end)")

@@ -333,3 +333,26 @@ def test_page_and_server_take_a_camera_name_alike():
             assert not g["ok"], (name, g)
             continue
         assert g["ok"] and g["body"]["key"] == s.key, (name, g)
+
+
+def test_page_says_which_format_a_bare_camera_name_is_as_the_cli(monkeypatch, tmp_path):
+    """A bare camera name ("ALEXA 35") is its camera's full sensor: the page's own report carries the CLI's note
+    (physcam.optics.sensors.camera_name_note, first-day walkthrough round 9: the offline page left it out). Every
+    label of every sensor row gets the library's note (or none) from the page's cameraNameNote, and the page's
+    report for "ALEXA 35" carries it as the server's (`physcam report --json`) does."""
+    from physcam.optics.sensors import camera_name_note
+
+    monkeypatch.setenv("HOME", str(tmp_path))  # no user config: the CLI's defaults, as the page's
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path))
+    table = sensor_table()
+    labels = sorted({lab for s in table for lab in (s["key"], s["name"], *s["aliases"])})
+    got = run_page_solver({"sensors": table, "calls": [["cameraNameNote", n] for n in labels]})
+    want = [camera_name_note(n) for n in labels]
+    assert sum(bool(w) for w in want) >= 10  # the camera names the table gives a meaning
+    assert [g["body"] for g in got] == want
+    q = {"focal": "50", "fstop": "2.8", "focus": "3m", "sensor": "ALEXA 35"}
+    page, cli = run_page_solver({"sensors": table, "setups": [q]})[0], cli_answers([q])[0]
+    assert page["ok"] and cli["ok"]
+    note = camera_name_note("ALEXA 35")
+    assert note in cli["body"]["notes"] and note in page["body"]["notes"]
+    assert page["body"]["notes"][-1] == note  # after the report's own notes, as the CLI adds it

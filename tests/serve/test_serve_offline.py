@@ -13,6 +13,7 @@ import pytest
 from _serve_helpers import request, running_server
 
 from physcam.cli import main
+from physcam.optics.sensors import camera_name_note
 
 pytestmark = pytest.mark.slow
 
@@ -87,12 +88,16 @@ def test_a_new_setup_opens_from_the_cache_with_the_server_stopped(capsys):
             for query, argv in ((("focal=35&fstop=4&focus=2m&sensor=S35"),
                                  ("--focal", "35", "--fstop", "4", "--focus", "2m", "--sensor", "S35")),
                                 (("focal=50&fstop=2.8&focus=3m&sensor=FX6%20FF%204K%2017%3A9"),
-                                 ("--focal", "50", "--fstop", "2.8", "--focus", "3m", "--sensor", "FX6 FF 4K 17:9"))):
+                                 ("--focal", "50", "--fstop", "2.8", "--focus", "3m", "--sensor", "FX6 FF 4K 17:9")),
+                                (("focal=50&fstop=2.8&focus=3m&sensor=ALEXA%2035"),  # a bare camera name: the note
+                                 ("--focal", "50", "--fstop", "2.8", "--focus", "3m", "--sensor", "ALEXA 35"))):
                 pg.goto(f"{url}?{query}")
                 pg.wait_for_selector("body[data-ready='1'][data-source='page'][data-offline='1']")
                 doc = cli_report(capsys, *argv)
                 assert_numbers(pg, doc)
                 assert pg.locator("#sensor").input_value() == doc["sensor"]["key"]
+                said = camera_name_note(argv[-1])  # the CLI's note of which format a camera name is, or ""
+                assert not said or (said in doc["notes"] and said in pg.locator("#notes li").all_text_contents())
             the_done_when_path(pg, url, capsys)
             ctx.close()
         finally:

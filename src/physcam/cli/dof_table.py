@@ -25,7 +25,8 @@ examples:
   physcam dof-table --focal 50 --sensor "ALEXA 35 3.3K 6:5" --squeeze format --fstops 2.8,4 --focus 2m,3m
 """
 
-#: The f-stops and marks of a table when none are given (the full stops of a cine lens; common marks).
+#: The f-stops and marks of a table when none are given: physcam.onset.dof_table's (a test holds them equal;
+#: written out here so that the command's help does not import the solver).
 DEFAULT_FSTOPS = (1.4, 2.0, 2.8, 4.0, 5.6, 8.0, 11.0, 16.0)
 DEFAULT_FOCUS = "1m,1.5m,2m,3m,5m,10m,hyperfocal,inf"
 
@@ -50,17 +51,12 @@ def _squeeze(text):
 
 def squeeze_of(args, sensor) -> float:
     """The desqueeze the table takes: --squeeze's number, or with ``format`` the one the camera table
-    gives the format (refused, with what it offers, when it gives none or several)."""
-    from ..errors import InputError
+    gives the format (:func:`physcam.onset.dof_table.format_squeeze`; refused, with what it offers, when it
+    gives none or several)."""
+    from ..onset.dof_table import format_squeeze
 
     sq = getattr(args, "squeeze", 1.0)
-    if sq != "format":
-        return float(sq)
-    offered = tuple(getattr(sensor, "anamorphic", ()) or ())
-    if len(offered) != 1:
-        what = "no anamorphic desqueeze" if not offered else "desqueezes " + ", ".join(f"{v:g}" for v in offered)
-        raise InputError(f"--squeeze format: the camera table gives {sensor.name} {what}; give --squeeze S")
-    return float(offered[0])
+    return format_squeeze(sensor) if sq == "format" else float(sq)
 
 
 def register(sub) -> None:
@@ -110,11 +106,11 @@ def cell_report(args, lens, sensor, fstop, focus):
 
 
 def build(args) -> dict:
-    """The table as a dict (the JSON payload): inputs, rows (one per f-stop and mark) and hyperfocals."""
-    import warnings
-
-    from ..errors import InputError, PhysCamWarning
-    from ._common import resolve_sensor
+    """The table as a dict (the JSON payload): :func:`physcam.onset.dof_table.dof_table` of the options,
+    with the zoom block of ``--zoom``."""
+    from ..errors import InputError
+    from ..onset.dof_table import dof_table
+    from ._common import coc_of, resolve_sensor
 
     lens = None
     if args.lens:
@@ -133,47 +129,11 @@ def build(args) -> dict:
     if len(marks) > 40:
         raise InputError(f"a table takes up to 40 focus marks, got {len(marks)}")
     sensor = resolve_sensor(args)
-    rows, hyper, first = [], [], None
-    with warnings.catch_warnings():  # one warning per lens, not per cell (the real field of view)
-        warnings.simplefilter("ignore", PhysCamWarning)
-        for n in args.fstops:
-            for m in marks:
-                r = cell_report(args, lens, sensor, n, m)
-                first = first or r
-                d = r.dof
-                row = {
-                    "fstop": r.fstop,
-                    "focus": m if isinstance(m, str) else ("infinity" if math.isinf(m) else None),
-                    "focus_from_film_mm": None if math.isinf(r.focus_from_film_mm) else r.focus_from_film_mm,
-                    "near_from_film_mm": d.near_from_film_mm,
-                    "far_from_film_mm": None if d.far_is_infinite else d.far_from_film_mm,
-                    "total_mm": None if d.far_is_infinite else d.total_mm,
-                    "far_is_infinite": d.far_is_infinite,
-                    "hyperfocal_from_film_mm": d.hyperfocal_from_film_mm,
-                    "focal_length_mm": r.focal_length_mm,
-                    "hfov_deg": r.hfov_focus_deg, "vfov_deg": r.vfov_focus_deg,
-                }
-                if r.dof_horizontal is not None:  # an anamorphic: the limits across the frame (oval blur)
-                    dh = r.dof_horizontal
-                    row.update({
-                        "near_horizontal_from_film_mm": dh.near_from_film_mm,
-                        "far_horizontal_from_film_mm": None if dh.far_is_infinite else dh.far_from_film_mm,
-                        "total_horizontal_mm": None if dh.far_is_infinite else dh.total_mm,
-                        "far_horizontal_is_infinite": dh.far_is_infinite,
-                        "hyperfocal_horizontal_from_film_mm": dh.hyperfocal_from_film_mm})
-                rows.append(row)
-            hyper.append({"fstop": n, "hyperfocal_from_film_mm": rows[-1]["hyperfocal_from_film_mm"]})
-    return {
-        "lens": None if lens is None else lens.name, "model": first.model, "focal_length_mm": first.focal_length_mm,
-        "sensor": {"name": sensor.name, "width_mm": sensor.width_mm, "height_mm": sensor.height_mm},
-        "coc_mm": first.coc_mm, "coc_convention": first.coc_convention, "squeeze": first.squeeze,
-        "dof_aspect": first.dof_aspect, "fstops": list(args.fstops),
-        "focus": [m if isinstance(m, str) else ("infinity" if math.isinf(m) else m) for m in marks],
-        "rows": rows, "hyperfocal": hyper, "zoom": getattr(args, "zoom_block", None),
-        "definition": "distances from the film plane; each row is `physcam report` at that f-stop and focus mark "
-                      "(null far and total: infinite); hfov_deg and vfov_deg: the desqueezed picture's field at the "
-                      "mark; *_horizontal_*: an anamorphic's limits across the frame, where the CoC is c / dof_aspect",
-    }
+    d = dof_table(None if lens is not None else args.focal, lens=lens, sensor=sensor, fstops=args.fstops,
+                  focus_marks_mm=marks, coc=coc_of(args), squeeze=squeeze_of(args, sensor))
+    d["focus"] = [m if isinstance(m, str) else ("infinity" if math.isinf(m) else m) for m in marks]
+    d["zoom"] = getattr(args, "zoom_block", None)
+    return d
 
 
 def _label(m, units) -> str:

@@ -342,7 +342,15 @@ def run_kit(args) -> int:
     elif kind == "lens":
         if not args.characterizations:
             raise InputError("physcam usd kit lens needs --characterizations CSV (date, focal_length_mm, ...)")
-        path = kit.write_lens_file(args.file, _read_characterizations(args.characterizations), **common)
+        days = _read_characterizations(args.characterizations)
+        path = kit.write_lens_file(args.file, days, **common)
+        unknown = [d for d, spec in days.items() if spec.entrance_pupil_mm is None]
+        if unknown:
+            from ._common import note
+
+            note(f"{path}: no entrance_pupil_mm for {', '.join(sorted(unknown))}: the entrance pupil is left "
+                 "unknown (not written); a shot composing the lens places its camera at the thin-lens pupil at "
+                 "the shot's focus")
     elif kind == "body":
         from ..usd.author import CameraSpec
 

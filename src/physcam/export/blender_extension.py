@@ -30,6 +30,10 @@ __all__ = ["build_extension", "lens_payload", "extension_manifest", "REFERENCE_F
 
 #: f-number the per-focus reports are solved at (the numbers stored do not depend on it).
 REFERENCE_FSTOP = 8.0
+#: zlib level of the zip's deflate: 1, not the default 6. The shaders' data lines are most of the 300 MB
+#: the zip holds; at 6 their deflate took about 14 of the build's CPU seconds, at 1 about 2, for a zip
+#: 10 % larger (docs/performance.md, round 9).
+_DEFLATE_LEVEL = 1
 #: Sensor (mm) of the stored reports' CoC and field of view: full frame, the pupil table's span.
 REPORT_SENSOR_MM = (36.0, 24.0)
 
@@ -220,7 +224,7 @@ def build_extension(out_dir, *, lenses=None, force: bool = False, progress=None,
         load_lens(name)
     buf = io.BytesIO()
     index = []
-    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED, compresslevel=_DEFLATE_LEVEL) as z:
         z.writestr("blender_manifest.toml", extension_manifest(__version__))
         z.writestr("__init__.py", _addon_source())
         for slug, lens_name, data, shaders in _payloads(names, workers or os.cpu_count() or 1):

@@ -323,7 +323,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
     from ..trace.camera_tracer import CameraTracer
-    from .blender_pupil import iris_levels, radial_pupil_table
+    from .blender_pupil import _centre_ellipses, iris_levels, radial_pupil_table
 
     axis = focus_axis(closest_focus(lens), n_focus)
     states = []
@@ -347,7 +347,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
         else:
             radial.append(radial_pupil_table(tracer.lens, st.film_z, levels))
             b = _centre_bounds(tracer.lens, radial[-1][0, 0])
-            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in radial[-1][:, 0]], levels))
+            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(radial[-1])], levels))
         if i == 0:
             table0, bounds0 = tracer.film_side_table, (b if lens.is_anamorphic else None)
             loss = tracer.centre_weight(b, samples=64, fresnel=True) / tracer.centre_weight(b, samples=64)
@@ -515,11 +515,12 @@ def _rect_tables(tracer, semi_max, grid_half_mm):
     nx, ny = _GRID
     q = tracer.lens
     semi_file = q.surfaces[q.stop_index].semi_diameter
-    # the stop's semi-diameter as a prescription stopped to each fraction of the file's holds it
-    b = tracer.stopped_pupil_bounds([float(semi_file * (semi_max / semi_file))], grid_half_mm, grid_half_mm,
-                                    nx=nx, ny=ny, samples=48)[0]
-    levels = tracer.stopped_pupil_bounds([float(semi_file * (f * semi_max / semi_file)) for f in STOP_LEVELS],
-                                         grid_half_mm, grid_half_mm, nx=nx, ny=ny, samples=32)
+    # the stop's semi-diameter as a prescription stopped to each fraction of the file's holds it. The widest
+    # iris and the stopped ones share their rays (one trace with the stop opened, each iris's mask the
+    # tracer's own test: stopped_pupil_bounds): the widest's rectangles are what a trace of it alone gives,
+    # the stopped ones are sampled as finely (48 aims across, not 32) for no more rays
+    b, *levels = tracer.stopped_pupil_bounds([float(semi_file * (f * semi_max / semi_file)) for f in (1.0,) + STOP_LEVELS],
+                                             grid_half_mm, grid_half_mm, nx=nx, ny=ny, samples=48)
     return b, b.rects, [lv.rects for lv in levels]
 
 
@@ -532,9 +533,11 @@ def _arr32(name, values, size) -> str:
     a = np.asarray(values, float).ravel()
     if not np.isfinite(a).all():
         _num32(a[~np.isfinite(a)][0])  # raises osl_number's error
-    # _num32 of each, inlined (osl_number of a finite float: its repr, with ".0" when that is an integer)
-    nums = [repr(float(format(v, ".9g"))) for v in a.tolist()]
-    return f"    float {name}[{size}] = {{{', '.join(r if ('.' in r or 'e' in r) else r + '.0' for r in nums)}}};"
+    # _num32 of each (osl_number of the nine-digit rounding: its repr, with ".0" when that is an
+    # integer). Where "%.9g" writes a fraction without exponent (1e-4 <= |v| < 1e9) that is the repr
+    # already: it strips its zeros, and no shorter decimal names the same double
+    nums = [r if ("." in r and "e" not in r) else osl_number(float(r)) for r in map("%.9g".__mod__, a.tolist())]
+    return f"    float {name}[{size}] = {{{', '.join(nums)}}};"
 
 
 def _arr32_once(ft: FocusTable, name, values, size) -> str:

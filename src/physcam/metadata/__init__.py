@@ -20,7 +20,7 @@ from .record import ClipRecord, CookeData, FrameSample, TrackerPose
 __all__ = ["ClipRecord", "CookeData", "FrameSample", "TrackerPose", "detect", "detect_file", "load", "FORMATS"]
 
 #: the sources physcam reads, and what each is
-FORMATS = {"arri": "ARRI Meta Extract CSV (tab-separated, one row per frame)",
+FORMATS = {"arri": "ARRI Meta Extract CSV (tab-separated, or a copy with commas or semicolons; one row per frame)",
            "arri-json": "ARRI Reference Tool JSON (metadata_output v2: clip and per-frame metadata sets)",
            "red": "REDline --printMeta 5 frames CSV (+ --printMeta 3 static CSV)",
            "venice": "Sony VENICE per-frame CSV (+ NonRealTimeMeta XML)",
@@ -87,14 +87,15 @@ def _missing_columns(first_line: str) -> str | None:
 
     layouts = (("an ARRI Meta Extract CSV", arri), ("a REDline frames CSV", red), ("a Canon per-frame CSV", canon),
                ("a Sony VENICE per-frame CSV", venice))
-    for delimiter in ("\t", ","):
+    for delimiter in arri.DELIMITERS:
         cols = set(header_columns(first_line, delimiter))
         for what, reader in layouts:
             if any(m in cols for m in reader.LAYOUT_MARKERS):
                 lacking = [" or ".join(repr(n + ("...)" if n.endswith("(") else "")) for n in g)
                            for g in lacking_columns(cols, reader.LAYOUT_GROUPS)]
-                if lacking:
-                    return f"the header looks like {what} but has no {', no '.join(lacking)} column"
+                if not lacking:  # every column of this layout: not another layout's file missing columns
+                    break
+                return f"the header looks like {what} but has no {', no '.join(lacking)} column"
     return None
 
 

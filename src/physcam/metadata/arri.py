@@ -1,4 +1,5 @@
-"""ARRI Meta Extract (AME) CSV: one tab-separated row per frame of an ALEXA clip.
+"""ARRI Meta Extract (AME) CSV: one tab-separated row per frame of an ALEXA clip (a copy saved with commas
+or semicolons is read alike: the delimiter is the one with which the header has AME's columns).
 
 Fields read (AME 4.4 column names; one row per recorded frame):
 
@@ -44,10 +45,38 @@ LAYOUT_GROUPS = (("Master TC",), ("Lens Focus Distance", "Lens Focal Length", "L
 LAYOUT_MARKERS = ("Master TC", "Lens Linear Iris", "Camera Clip Name")
 
 
+#: The delimiters an AME header is read with: Meta Extract writes tabs; a copy saved again by a spreadsheet
+#: (or exported with another setting) has commas or, in locales with a decimal comma, semicolons
+DELIMITERS = ("\t", ",", ";")
+#: a decimal comma between two digits (a semicolon-separated copy's numbers)
+_DECIMAL_COMMA = re.compile(r"(\d),(\d)")
+
+
+def delimiter_of(head: str) -> str | None:
+    """The delimiter with which ``head`` (the file's first line) is an AME header, or None."""
+    for d in DELIMITERS:
+        if d in head and not lacking_columns(header_columns(head, d), LAYOUT_GROUPS):
+            return d
+    return None
+
+
 def sniff(head: str) -> bool:
-    """True when ``head`` (the file's first line) is an AME header."""
+    """True when ``head`` (the file's first line) is an AME header, tab-, comma- or semicolon-separated."""
     require_type("head", head, str, "the first bytes of a metadata file")
-    return not lacking_columns(header_columns(head, "\t"), LAYOUT_GROUPS)
+    return delimiter_of(head) is not None
+
+
+def _delimiter(path) -> str:
+    """The delimiter of the file's header (:func:`delimiter_of`); tab, Meta Extract's own, when none fits (the
+    reader then names the columns it lacks)."""
+    from ._text import lines
+
+    read = lines(path)
+    try:
+        first = next(read, (1, ""))[1]
+    finally:
+        read.close()
+    return delimiter_of(first) or "\t"
 
 
 def _focus_mm(path, line, unit, text):
@@ -92,8 +121,11 @@ def _frame(path, line, r, no_unit: list) -> FrameSample:
 
 def read(path) -> ClipRecord:
     """The clip of one AME CSV (module notes), read row by row."""
-    header, data = rows(path, "\t")
+    delimiter = _delimiter(path)
+    header, data = rows(path, delimiter)
     require_columns(path, header, REQUIRED, "an ARRI Meta Extract CSV")
+    if delimiter == ";":  # a decimal-comma locale's copy: "4,812" is 4.812, "1,4 + 7/10" is 1.4 + 7/10
+        data = ((line, {k: _DECIMAL_COMMA.sub(r"\1.\2", v) for k, v in r.items()}) for line, r in data)
     frames, no_unit, first = [], [], None
     for line, r in data:
         if first is None:

@@ -213,7 +213,14 @@ def author_camera(stage, path: str, spec: CameraSpec, *, position=(0.0, 0.0, 0.0
     if "sensor" in parts:
         _author_sensor(cam, spec)
     if "lens" in parts:
-        _author_lens(stage, cam, spec, eye, su)
+        # a lens file (no body to place) whose characterization gives no pupil: none is invented (a
+        # thin-lens pupil at the spec's focus, the default 3 m when the maker gave none); the shot that
+        # composes it computes the pupil at its own focus (read_camera reads it as unknown)
+        # (a datasheet without --pupil likewise: the camera is placed at H1, the report's fallback, but
+        # entrancePupilDistance is not claimed)
+        unknown = (("body" not in parts and spec.entrance_pupil_mm is None)
+                   or (report is not None and report.entrance_pupil_source == "unknown"))
+        _author_lens(stage, cam, spec, None if unknown else eye, su)
     if "render" in parts:
         geom = author_render_camera(stage, sdf_path, spec, report=report, lens_distortion=lens_distortion,
                                     opencv_distortion=opencv_distortion)
@@ -271,14 +278,25 @@ def _author_sensor(cam, spec):
         cam.SetCustomDataByKey("physcam:sensorName", usd_text(spec.sensor_name, "sensor name"))
 
 
+#: customData on a lens file's camera whose entrance pupil is not known (entrancePupilDistance unauthored)
+PUPIL_UNKNOWN_KEY = "physcam:entrancePupil"
+PUPIL_UNKNOWN = ("unknown: the lens's characterization or datasheet gives no entrance pupil, so none is written; "
+                 "the camera is placed at the thin-lens pupil at its focus (a datasheet's: its front principal "
+                 "plane H1); give the pupil (entrance_pupil_mm, --pupil) to know it")
+
+
 def _author_lens(stage, cam, spec, eye, su):
+    """The lens API's values and the lens model prim; ``eye`` None: the pupil is unknown, not authored."""
     from pxr import Gf, Sdf
 
     sdf_path = cam.GetPath()
     lp = f"lens:{LENS_INSTANCE}:"
     _set(cam, lp + "fStop", Sdf.ValueTypeNames.Float, spec.fstop)
     _set(cam, lp + "iris", Sdf.ValueTypeNames.Float, iris_mm(spec))
-    _set(cam, lp + "entrancePupilDistance", Sdf.ValueTypeNames.Float, eye)
+    if eye is None:
+        cam.SetCustomDataByKey(PUPIL_UNKNOWN_KEY, PUPIL_UNKNOWN)
+    else:
+        _set(cam, lp + "entrancePupilDistance", Sdf.ValueTypeNames.Float, eye)
     if spec.horizontal_entrance_pupil_mm is not None:  # an anamorphic's pan pivot (docs/anamorphic.md)
         _set(cam, lp + "horizontalEntrancePupilDistance", Sdf.ValueTypeNames.Float, spec.horizontal_entrance_pupil_mm)
     if spec.principal_planes_mm is not None:

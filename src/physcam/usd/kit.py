@@ -367,6 +367,7 @@ def check_shot(file, path: str | None = None) -> dict:
     stage.Reload()  # the referenced files as they are on disk now, not as this process cached them
     if path is None:
         path = only_camera(stage, "check")  # its error names the file
+    _refuse_time_samples(stage, path, file, "check")
     geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
     if not geom:
         raise ExportError(f"{path}: has no companion camera to check")
@@ -414,10 +415,12 @@ def refresh_shot(file, path: str | None = None) -> dict:
     stage.Reload()  # the shot and its referenced files as they are on disk now
     if path is None:
         path = only_camera(stage, "refresh")  # its error names the file
+    _refuse_time_samples(stage, path, file, "refresh")
     if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):  # else there is no companion yet: write it
         now = check_shot(file, path)
         if not now["stale"]:
             return dict(now, written=False, changed=[])
+    _refuse_lens_not_stored(stage, path, file)
     layer = stage.GetRootLayer()
     before = _authored_values(layer, path)
     notes = _companion_notes(stage, path)
@@ -426,6 +429,45 @@ def refresh_shot(file, path: str | None = None) -> dict:
     _keep_equal_notes(stage, path, notes)
     save_stage(stage, file, force=True)
     return dict(check_shot(file, path), written=True, changed=changed)
+
+
+#: the attributes named first when a camera is animated: the inputs an animation samples (usd animate)
+_ANIMATED_FIRST = ("focusDistance", f"lens:{LENS_INSTANCE}:fStop", "focalLength")
+
+
+def _refuse_time_samples(stage, path, file, action: str) -> None:
+    """ExportError naming the file and an animated attribute when the camera at ``path`` (or its lens model or
+    companion) has time samples: check and refresh compare and recompute one still camera (its default
+    values), and an animation's per-frame lens (``usd animate``) is not stored in the file to solve again.
+    A moving camera (time-sampled ``xformOp:*``, a layout's move) is still: its placement is not an input."""
+    cam = stage.GetPrimAtPath(str(path))
+    if not cam:
+        raise ExportError(f"{file}: no prim at {path}")
+    sampled = [(p, a) for p in (cam, *cam.GetChildren()) for a in p.GetAttributes()
+               if a.GetNumTimeSamples() and not a.GetName().startswith("xformOp")]
+    if not sampled:
+        return
+    sampled.sort(key=lambda pa: (pa[1].GetName() not in _ANIMATED_FIRST, pa[0] != cam, str(pa[0].GetPath())))
+    prim, attr = sampled[0]
+    raise ExportError(f"{file}: {prim.GetPath()}.{attr.GetName()} is animated ({attr.GetNumTimeSamples()} time "
+                      f"samples): usd {action} handles a still camera only; write the animation again with "
+                      f"`physcam usd animate {file} --marks CSV ... --force`")
+
+
+def _refuse_lens_not_stored(stage, path, file) -> None:
+    """ExportError when the camera was written from a real lens (its companion shows the lens's traced field,
+    ``physcam:fieldOfView``) by a ``usd write --lens`` older than the stored lens (``<path>/Prescription``):
+    a refresh would solve a thin lens in its place."""
+    from pxr import Sdf
+
+    geom = stage.GetPrimAtPath(Sdf.Path(str(path)).AppendChild("Camera"))
+    if composed_prescription(stage, path) is not None or not geom or geom.GetCustomDataByKey("physcam:fieldOfView") is None:
+        return
+    model = stage.GetPrimAtPath(Sdf.Path(str(path)).AppendChild("Pinhole"))
+    name = model.GetCustomDataByKey("physcam:lensName") if model else None
+    raise ExportError(f"{file}: {path} was written from a real lens{f' ({name})' if name else ''} by a physcam "
+                      f"that did not store it ({path}/Prescription is missing), so a refresh cannot solve it again: "
+                      f"write it again with `physcam usd write {file} --lens NAME --focus ... --fstop ... --force`")
 
 
 #: the companion's customData entries of numbers that a refresh recomputes (author_render_camera, usd write)

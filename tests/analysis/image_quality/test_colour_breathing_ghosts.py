@@ -180,3 +180,35 @@ def test_colour_names_each_glass_model_and_its_uncertainty():
         cf.append(z(float(m.index(LINE_C_NM))) - z(float(m.index(LINE_F_NM))))
     assert res.longitudinal_uncertainty_mm == pytest.approx(abs(cf[0] - cf[1]) / 2, rel=1e-6)
     assert res.to_dict()["uncertainty"]["longitudinal_paraxial_mm"] == res.longitudinal_uncertainty_mm
+
+
+def test_ghost_ranking_traces_each_first_leg_once_and_matches_each_path_traced_alone(monkeypatch):
+    # issue 47: the paths that reflect first at surface i share their first leg (forward to i and the
+    # reflection there), so a ranking traces one first leg per i and two legs per path (main traced
+    # three legs per path); each path's flux and centroid are still those of the path traced alone
+    # with the public trace_ghost (the same rays, to the bit)
+    import physcam.trace.trace as tr
+    from physcam.analysis.image_quality.ghosts import _beam
+    from physcam.optics.state import camera_state
+
+    lens = load_lens("tessar_50mm_f2_8")
+    pairs = ghost_pairs(lens)
+    calls = []
+    real = tr.trace_packed
+    monkeypatch.setattr(tr, "trace_packed", lambda *a, **k: calls.append(1) or real(*a, **k))
+    cam = camera_state(lens)
+    res = ghost_analysis(cam, 5.0, rank_rays=400, backend="numpy")
+    monkeypatch.undo()
+    assert len(calls) == len({i for i, _ in pairs}) + 2 * len(pairs)
+    beam = _beam(lens, 5.0, res.wavelength_nm, 400)
+    direct = trace_to_film(lens, beam, res.film_z_mm, fresnel=True, coating=res.coating, backend="numpy")
+    flux0 = float(direct.weight[direct.ok].sum())
+    by_path = {(p.i, p.j): p for p in res.paths}
+    assert sum(p.relative_flux > 0 for p in res.paths) > len(pairs) // 2
+    for i, j in pairs:
+        g = trace_ghost(cam, beam, i, j, coating=res.coating, backend="numpy")
+        ok = g.ok & (g.weight > 0)
+        flux = float(g.weight[ok].sum())
+        assert by_path[i, j].relative_flux == pytest.approx(flux / flux0, rel=1e-12, abs=0.0)
+        if flux > 0:
+            assert by_path[i, j].centroid_y_mm == float((g.y[ok] * g.weight[ok]).sum() / flux)

@@ -70,14 +70,39 @@ def rim_profile(img, n_angles: int = 360):
     return th, rs[last]
 
 
+#: Share of the rim's range (largest radius less smallest) a corner stands out by, from the lower of
+#: the troughs either side (a smaller bump is noise: polygon_corners)
+CORNER_PROMINENCE = 0.1
+
+
 def polygon_corners(img) -> tuple[int, int, float]:
     """(corners counted, dominant harmonic, angle of one corner in degrees modulo 360/harmonic) of a
-    blob's rim: the rim profile low-passed to 12 harmonics, its local maxima counted."""
+    blob's rim: the rim profile low-passed to 12 harmonics, its local maxima counted that stand out by
+    :data:`CORNER_PROMINENCE` of the profile's range from the higher trough either side (topographic
+    prominence on the circle). A 512-sample Cycles render's rim wanders by about 0.05 px, which on a
+    hexagon's flat side (2.5 px from corner to flat) made a seventh maximum 0.04 px high."""
     th, r = rim_profile(img)
     F = np.fft.rfft(r)
     F[13:] = 0.0
     smooth = np.fft.irfft(F, r.size)
-    peaks = np.flatnonzero((smooth > np.roll(smooth, 1)) & (smooth >= np.roll(smooth, -1)))
     k = int(np.argmax(np.abs(F[1:13]))) + 1
     phase = -np.angle(F[k]) / k
-    return len(peaks), k, float(math.degrees(phase) % (360.0 / k))
+    return _prominent_peaks(smooth, CORNER_PROMINENCE * float(smooth.max() - smooth.min())), k, \
+        float(math.degrees(phase) % (360.0 / k))
+
+
+def _prominent_peaks(v, least: float) -> int:
+    """How many local maxima of the circular sequence ``v`` rise at least ``least`` above the higher
+    of the troughs between them and their higher neighbours: of its alternating maxima and minima, the
+    adjacent pair that differs least is dropped while it differs by less."""
+    peaks = (v > np.roll(v, 1)) & (v >= np.roll(v, -1))
+    troughs = (v < np.roll(v, 1)) & (v <= np.roll(v, -1))
+    ext = [(float(v[i]), bool(peaks[i])) for i in np.flatnonzero(peaks | troughs).tolist()]
+    while len(ext) > 2:
+        gaps = [abs(ext[i][0] - ext[(i + 1) % len(ext)][0]) for i in range(len(ext))]
+        i = int(np.argmin(gaps))
+        if gaps[i] >= least:
+            break
+        # dropping an adjacent maximum and minimum leaves the others alternating
+        ext = [e for m, e in enumerate(ext) if m not in (i, (i + 1) % len(ext))]
+    return sum(1 for _, is_peak in ext if is_peak)

@@ -340,18 +340,37 @@ class _AtFocus:
 
     def heights_for(self, axis, fields_deg, reach_mm):
         """Film heights whose object points lie ``fields_deg`` off axis (seen from the entrance pupil), and
-        which were found: bisection on the film height from the axis to ``reach_mm``, where the object angle
-        grows with the height (a height whose chief ray does not leave the lens counts as too far)."""
+        which were found: the root of tan(angle) - tan(field) in the film height from the axis to ``reach_mm``,
+        where the object angle grows with the height (a height whose chief ray does not leave the lens counts
+        as too far), by the Illinois method (regula falsi kept inside its bracket; Dowell and Jarratt, BIT 11,
+        1971), halving the bracket while its far end has no chief ray."""
         fields = np.asarray(fields_deg, dtype=float)
         want = np.tan(np.radians(np.abs(fields)))
         f = self.g[axis].pinhole_focal_length
+        tol = 1e-11 * want + 1e-14  # within the check below (1e-9), above the Newton aim's own noise
         lo, hi = np.zeros(fields.shape), np.full(fields.shape, float(reach_mm))
-        for _ in range(64):  # to the float's own resolution
-            mid = 0.5 * (lo + hi)
-            ideal, ok = self.ideal(axis, mid)
-            below = ok & (np.abs(ideal) / f < want)
-            lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
-        h = 0.5 * (lo + hi)
+        g_lo = -want  # the axis: angle 0
+        ideal, ok = self.ideal(axis, hi)
+        g_hi = np.where(ok, np.abs(ideal) / f - want, np.nan)
+        done, h, side = want == 0.0, np.zeros(fields.shape), np.zeros(fields.shape, int)
+        for _ in range(64):
+            if done.all():
+                break
+            falsi = np.isfinite(g_hi) & (g_hi > g_lo)
+            x = np.where(falsi, (lo * g_hi - hi * g_lo) / np.where(falsi, g_hi - g_lo, 1.0), 0.5 * (lo + hi))
+            x = np.where((x > lo) & (x < hi), x, 0.5 * (lo + hi))
+            ideal, ok = self.ideal(axis, x)
+            g = np.where(ok, np.abs(ideal) / f - want, np.nan)
+            new = ~done & ok & (np.abs(g) <= tol)
+            h[new], done = x[new], done | new
+            below = ok & (g < 0)
+            # Illinois: the end that stayed twice in a row has its value halved
+            g_hi = np.where(below & (side == -1), 0.5 * g_hi, g_hi)
+            g_lo = np.where(~below & (side == 1), 0.5 * g_lo, g_lo)
+            lo, g_lo = np.where(below, x, lo), np.where(below, g, g_lo)
+            hi, g_hi = np.where(below, hi, x), np.where(below, g_hi, g)
+            side = np.where(below, -1, 1)
+        h = np.where(done, h, 0.5 * (lo + hi))
         ideal, ok = self.ideal(axis, h)
         found = ok & (np.abs(np.abs(ideal) / f - want) <= 1e-9 * want + 1e-12)
         return np.sign(fields) * h, found

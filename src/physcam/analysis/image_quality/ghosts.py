@@ -109,7 +109,7 @@ class GhostResult:
 
 @takes_prescription
 def ghost_pairs(lens: Prescription) -> list[tuple[int, int]]:
-    """All (i, j), j < i, of surfaces that reflect (index changes across them)."""
+    """All (i, j), j < i, of surfaces that reflect (index changes across them), grouped by i in order."""
     media = [(1.0, 0.0)] + [(s.medium.nd, s.medium.vd) for s in lens.surfaces]
     refl = [k for k, s in enumerate(lens.surfaces) if not s.is_stop and media[k] != media[k + 1]]
     return [(i, j) for a, i in enumerate(refl) for j in refl[:a]]
@@ -128,6 +128,13 @@ class _Tables:
         self.fwd, self.rev = self.pf.table, self.pr.table
         self.Sf, self.kf = self.pf.S, self.pf.kinds
         self.Sr, self.kr = self.pr.S, self.pr.kinds
+
+    def indexed(self, wl, one: bool):
+        """The forward and reverse tables for a batch of wavelengths ``wl``: with its index columns
+        at the batch's one wavelength where ``one``, else the tables of every wavelength."""
+        if one:
+            return self.pf.at_wavelength(float(wl[0])), self.pr.at_wavelength(float(wl[0]))
+        return self.Sf, self.Sr
 
     @staticmethod
     def _ending(S, kinds, a, b):
@@ -215,32 +222,46 @@ def trace_ghost(lens: Prescription, rays, i: int, j: int, film_z: float | None =
     return _ghost_path(lens, rays, i, j, film_z, coating, stop_semi_diameter, backend, _tables)
 
 
-def _ghost_path(lens, rays, i, j, film_z, coating, stop_semi_diameter, backend, _tables):
-    """:func:`trace_ghost` of a prescription, its film plane and stop."""
-    from ...trace.kernels import get_kernel
-    from ...trace.trace import DEFAULT_CHUNK, trace_packed
-
+def _ghost_path(lens, rays, i, j, film_z, coating, stop_semi_diameter, backend, _tables, first=None):
+    """:func:`trace_ghost` of a prescription, its film plane and stop. ``first``: the rays after
+    :func:`_first_bounce` of ``rays`` at ``i`` if already traced (copied here, not changed)."""
     n = len(lens.surfaces)
     if not (0 <= j < i < n):
         raise InputError(f"a ghost path needs 0 <= j < i < {n} surfaces, got i={i}, j={j}")
     T = _tables or _Tables(lens, coating, stop_semi_diameter)
-    kern = get_kernel(backend)
-    r = rays.copy()
-    wl = r.wavelength_nm
-    # one wavelength (the usual beam): the tables' index columns for it, computed once per lens
-    one = wl.size > 0 and bool(wl.min() == wl.max()) and 1e-100 < float(wl[0]) < 1e100
-    Sf = T.pf.at_wavelength(float(wl[0])) if one else T.Sf
-    Sr = T.pr.at_wavelength(float(wl[0])) if one else T.Sr
-    run = lambda S, K, end=None: trace_packed(kern, r, S, K, clip=True, fresnel=True, end_z=end,  # noqa: E731
-                                      chunk_size=DEFAULT_CHUNK, indexed=one)
-    # leg 1: forward through 0..i-1, stop on surface i; reflect there
-    run(*T._ending(Sf, T.kf, 0, i + 1))
-    _reflect(r, T.fwd, i, True)
+    r = (first if first is not None else _first_bounce(lens, rays, i, T, backend)).copy()
+    run, one = _leg_runner(T, r, backend)
+    Sf, Sr = T.indexed(r.wavelength_nm, one)
     # leg 2: backward through i-1..j+1 (reverse table rows n-i .. n-1-j), stop on surface j; reflect
     run(*T._ending(Sr, T.kr, n - i, n - j))
     _reflect(r, T.rev, n - 1 - j, False)
     # leg 3: forward through j+1..n-1 to the film
     run(Sf[j + 1:], T.kf[j + 1:], float(film_z))
+    return r
+
+
+def _leg_runner(T, r, backend):
+    """``run(S, kinds, end_z=None)``: one leg of a ghost path traced in place on ``r``; and whether the
+    batch has one wavelength (the tables' index columns for it then computed once per lens)."""
+    from ...trace.kernels import get_kernel
+    from ...trace.trace import DEFAULT_CHUNK, trace_packed
+
+    kern = get_kernel(backend)
+    wl = r.wavelength_nm
+    one = wl.size > 0 and bool(wl.min() == wl.max()) and 1e-100 < float(wl[0]) < 1e100
+    return (lambda S, K, end=None: trace_packed(kern, r, S, K, clip=True, fresnel=True, end_z=end,
+                                                 chunk_size=DEFAULT_CHUNK, indexed=one)), one
+
+
+def _first_bounce(lens, rays, i, T, backend):
+    """Leg 1 of every ghost path (i, j): a copy of ``rays`` traced forward through surfaces 0..i-1,
+    stopped on surface i and reflected there. It does not depend on j, so the paths that share i
+    share it (ghost_analysis traces it once per i: issue 47)."""
+    r = rays.copy()
+    run, one = _leg_runner(T, r, backend)
+    Sf, _ = T.indexed(r.wavelength_nm, one)
+    run(*T._ending(Sf, T.kf, 0, i + 1))
+    _reflect(r, T.fwd, i, True)
     return r
 
 
@@ -332,6 +353,8 @@ def ghost_analysis(
     film_z = require_finite("film_z", film_z)
     pairs = ghost_pairs(lens)
     T = _Tables(lens, coating, stop_semi_diameter)
+    if image_rays == 0:
+        backend = _ranking_backend(backend, len(lens.surfaces), pairs, rank_rays)
     def direct_image(f):
         b = _beam(lens, f, wl, rank_rays)
         return b, trace_to_film(lens, b, film_z, fresnel=True, coating=coating, stop_semi_diameter=stop_semi_diameter,
@@ -358,8 +381,11 @@ def ghost_analysis(
     wd = direct.weight[direct.ok]
     dc = (float((direct.x[direct.ok] * wd).sum() / wd.sum()), float((direct.y[direct.ok] * wd).sum() / wd.sum()))
     paths = []
-    for i, j in pairs:
-        g = _ghost_path(lens, beam, i, j, film_z, coating, stop_semi_diameter, backend, T)
+    first_i, first = None, None  # the beam after leg 1 of the paths that reflect first at first_i
+    for i, j in pairs:  # (grouped by i: one first leg in memory at a time, each traced once)
+        if i != first_i:
+            first_i, first = i, _first_bounce(lens, beam, i, T, backend)
+        g = _ghost_path(lens, beam, i, j, film_z, coating, stop_semi_diameter, backend, T, first)
         ok = g.ok & (g.weight > 0)
         wt = g.weight[ok]
         flux = float(wt.sum())
@@ -379,6 +405,18 @@ def ghost_analysis(
         res.image = img / (flux0 * pix_area)
         res.image_paths, res.image_rays = len(chosen), int(image_rays)
     return res
+
+
+def _ranking_backend(backend, n, pairs, rays):
+    """The backend for ranking ``pairs`` of an ``n``-surface lens with ``rays`` rays, decided for the
+    whole job at once (:func:`physcam.trace.kernels.backend_for_job`): numpy when the direct image,
+    each surface's first bounce and every path's last two legs together cost the numpy kernel less
+    than loading numba (dgauss_50mm: 45 paths of 4000 rays, issue 47); each leg's calls counted
+    as rays (the kernel's per-surface cost, :data:`~physcam.trace.kernels.NUMPY_SURFACE_S`)."""
+    from ...trace.kernels import NUMPY_RAY_SURFACE_S, NUMPY_SURFACE_S, backend_for_job
+
+    rows = (n + 1) + sum(i + 1 for i in {i for i, _ in pairs}) + sum((i - j) + (n - j) for i, j in pairs)
+    return backend_for_job(backend, rows * (rays + NUMPY_SURFACE_S / NUMPY_RAY_SURFACE_S))
 
 
 def _ghost_image(lens, chosen, fd, wl, film_z, T, sensor, pixels, image_rays, chunk, seed, backend):

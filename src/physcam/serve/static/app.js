@@ -16,7 +16,7 @@ const MARKS = {
 };
 const DEFAULTS = { focal: "50", fstop: "2.8", focus: "3m" };
 
-const st = { units: "metric", lensmode: "focal", solve: "dof", report: null, squeezeFromFormat: false };
+const st = { units: "metric", lensmode: "focal", solve: "dof", report: null, squeezeFromFormat: false, sensorAsked: null };
 let SENSORS = [];
 let timer = null;
 let settle = null;
@@ -85,7 +85,9 @@ function apiParams() {
     if (val("sensor-width")) p.set("sensor-width", val("sensor-width"));
     if (val("sensor-height")) p.set("sensor-height", val("sensor-height"));
   } else if (s) {
-    p.set("sensor", s);
+    // a bare camera name the page was opened with ("ALEXA 35"), while its format is still chosen: asked by that
+    // name, so the report (the page's, the server's) says which format it is, as the CLI's does
+    p.set("sensor", st.sensorAsked && st.sensorAsked.key === s ? st.sensorAsked.name : s);
   }
   if ($("squeeze").value !== "1") p.set("squeeze", $("squeeze").value);
   if (st.solve !== "fstop" && val("fstop")) p.set("fstop", stop(val("fstop")));
@@ -551,6 +553,8 @@ function applyState(q, serverUnits) {
   } else if (q.has("sensor")) {
     const key = findSensor(q.get("sensor"));
     if (key) $("sensor").value = key; else addOption($("sensor"), q.get("sensor"));
+    st.sensorAsked = key && window.PhysOnset && PhysOnset.cameraNameNote(q.get("sensor"), SENSORS)
+      ? { name: q.get("sensor"), key } : null;
   } else {
     $("sensor").value = DEFAULT_SENSOR;
   }

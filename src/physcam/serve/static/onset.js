@@ -195,6 +195,34 @@
     return fail(`unknown sensor '${name}'. \`physcam sensors\` lists them all`);
   }
 
+  // physcam.optics.sensors.camera_name_note: a bare camera name ("ALEXA 35") that a sensors.csv row (a gate,
+  // no camera) answers is that camera's full sensor; say which format of the camera table it is and how to
+  // name another (the CLI's and the server's report note), "" for any other name
+  function cameraNameNote(name, table) {
+    const key = norm(name);
+    const gate = table.find((s) => !s.camera && [s.key, s.name, ...(s.aliases || [])].some((l) => norm(l) === key));
+    if (!gate || name.trim() === gate.key) return "";
+    const cams = new Map(); // "ARRI ALEXA 35" -> its formats, in table order (sensors.cameras)
+    for (const s of table) if (s.camera) cams.set(`${s.maker} ${s.camera}`, [...(cams.get(`${s.maker} ${s.camera}`) || []), s]);
+    let best = null;
+    for (const [full, rows] of cams) {
+      const short = norm(rows[0].camera);
+      const same = rows.filter((r) => Math.abs(r.width_mm - gate.width_mm) <= 0.011 && Math.abs(r.height_mm - gate.height_mm) <= 0.011);
+      if (rows.length > 1 && same.length && norm(full).includes(key)) {
+        const rank = [key !== short && key !== norm(full) ? 1 : 0, norm(gate.name).includes(norm(full)) ? 0 : 1, full.length];
+        const before = (a, b) => a[0] - b[0] || a[1] - b[1] || a[2] - b[2];
+        if (best === null || before(rank, best.rank) < 0 || (before(rank, best.rank) === 0 && full < best.full)) {
+          best = { rank, full, fmt: same[0] };
+        }
+      }
+    }
+    if (best === null) return "";
+    const rows = cams.get(best.full), f = best.fmt, g = (x) => String(Number(x.toPrecision(6))); // Python's :g
+    return `'${name}' is the ${best.full}'s full sensor, its ${f.format} (${g(f.width_mm)} x ${g(f.height_mm)} mm); the camera `
+      + `records in ${rows.length} formats and the crop sets the depth of field and the field of view: name another `
+      + `as the sensor, e.g. '${rows[1].aliases[0]}' (\`physcam sensors "${best.full}"\` lists them)`;
+  }
+
   function customSensor(w, h) {
     if (!Number.isFinite(w) || !Number.isFinite(h)) fail("sensor width and height must be finite numbers");
     if (!(0.5 <= w && w <= 1000 && 0.5 <= h && h <= 1000)) {
@@ -262,8 +290,10 @@
     if (r.pupilFraction === null) r.pupilFraction = 0.4;
     // cli._common.resolve_sensor
     if ("sensor" in q && (sw !== null || sh !== null)) fail("give either --sensor NAME or --sensor-width/--sensor-height, not both");
-    if ("sensor" in q) r.sensor = findSensor(sensors, q.sensor);
-    else if (sw !== null || sh !== null) {
+    if ("sensor" in q) {
+      r.sensor = findSensor(sensors, q.sensor);
+      r.sensorNote = cameraNameNote(q.sensor, sensors);
+    } else if (sw !== null || sh !== null) {
       if (sw === null || sh === null) fail("give both --sensor-width and --sensor-height");
       r.sensor = customSensor(sw, sh);
     } else {
@@ -620,6 +650,7 @@
       separation_mm: pupil === null ? null : 0.0, pan_pivot_camera_space_mm: pivot, tilt_pivot_camera_space_mm: pivot };
     d.diffraction = diffraction(d, sensor);
     notes.push(diffractionNote(d));
+    if (r.sensorNote) notes.push(r.sensorNote); // a bare camera name: which format it is (cli.report)
     if (r.sensorDefaulted) notes.push(`no --sensor given: ${sensor.name}, ${w} x ${h} mm`);
     checkFinite(d, "");
     return d;
@@ -758,7 +789,7 @@
   }
 
   const api = { ReportError, solveReport, report, parseDistance, exposureStops, compensate, closeUp, splitFocus, parseCoc, circleOfConfusion, setCocConventions,
-    findSensor, hyperfocalDistance, dofLimits, imageDistance, objectDistanceForMarked, stopsBetween, fovDeg,
+    findSensor, cameraNameNote, hyperfocalDistance, dofLimits, imageDistance, objectDistanceForMarked, stopsBetween, fovDeg,
     HYPERFOCAL, COC_CONVENTIONS };
   root.PhysOnset = api;
   if (typeof module !== "undefined" && module.exports) module.exports = api;
