@@ -89,6 +89,19 @@ US_4310222_EX5 = [
     (35.387, 0.927, None, None), (-489.874, 0.7, 1.92286, 21.3), (16.7027, 3.684, 1.48749, 70.1),
     (-11.9649, 0.15, None, None), (23.5946, 2.925, 1.7725, 49.6), (-31.1173, None, None, None),
 ]
+#: The second embodiment: the table of column 10 (R3 non-spherical; R12-R13 a filter, radius 0 = the table's
+#: infinity); the stop sits in D17. R16 is printed 12.614; its own Petzval term, h columns and the lens's shape
+#: need -12.614 (the file's; the table here holds what the file must have, US_4310222_EX2_R16_PRINTED the print).
+US_4310222_EX2_R16_PRINTED = 12.614
+US_4310222_EX2 = [
+    (38.794, 3.1, 1.72, 50.2), (24.997, 12.41, None, None), (58.28, 5.02, 1.6031, 60.7), (46.009, 0.15, None, None),
+    (33.022, 1.7, 1.6968, 55.5), (17.647, 5.39, None, None), (32.787, 1.3, 1.7725, 49.7), (17.218, 6.32, None, None),
+    (266.96, 1.5, 1.6968, 55.5), (13.984, 12.08, 1.60342, 38.0), (-43.016, 2.2, None, None),
+    (0.0, 1.8, 1.51633, 64.1), (0.0, 0.8, None, None), (74.564, 7.84, 1.51118, 51.0), (-14.201, 0.94, None, None),
+    (-12.614, 0.9, 1.7725, 49.7), (-26.958, 1.7, None, None), (129.909, 2.0, 1.64769, 33.8),
+    (12.278, 6.9, 1.69895, 30.1), (50.377, 0.83, None, None), (-80.749, 0.8, 1.84666, 23.9),
+    (28.151, 4.4, 1.48749, 70.1), (-15.466, 0.15, None, None), (493.467, 2.85, 1.7725, 49.7), (-33.952, None, None, None),
+]
 #: What the patent prints beside each of the two tables: R3's non-spherical coefficients B, C, D, E (A = 0:
 #: X = R(1 - (1 - H^2/R^2)^(1/2)) + A H^2 + B H^4 + ... + E H^10); the h (axial paraxial ray, incident height
 #: 1) and h-bar (principal ray, f = 1) columns; the third-order table's PT (Petzval) column and its total
@@ -104,6 +117,16 @@ US_4310222_COLUMNS = {
         pt=(0.1322, -0.2300, 0.0943, -0.0910, 0.1806, -0.3735, 0.1818, -0.3804, 0.0289, -0.0387, 0.1280, 0.0867,
             0.3531, -0.4914, 0.2350, 0.0418, 0.0257, -0.0988, -0.1187, -0.6776, 0.3016, 0.0479, 0.1658),
         pt_total=0.1138, groups=((1, 8, -1.06), (9, 15, 2.67), (16, 23, 2.37)), f=14.2, bf=36.6),
+    "canon_wide_angle_us4310222_14mm_f2_8_ex2": dict(
+        asphere=(9.556e-6, 2.591e-9, -1.015e-11, 2.128e-14),
+        h=(1.000, 0.967, 1.082, 1.076, 1.078, 1.067, 1.237, 1.239, 1.606, 1.653, 2.142, 2.219, 2.260, 2.288,
+           2.387, 2.324, 2.363, 2.376, 2.371, 2.315, 2.330, 2.348, 2.563, 2.562, 2.542),
+        hbar=(-2.087, -1.891, -1.217, -1.007, -0.999, -0.925, -0.718, -0.678, -0.521, -0.498, -0.326, -0.266,
+              -0.233, -0.211, -0.062, -0.033, -0.018, 0.033, 0.068, 0.187, 0.213, 0.228, 0.337, 0.341, 0.382),
+        pt=(0.1540, -0.2391, 0.0921, -0.1167, 0.1775, -0.3322, 0.1898, -0.3614, 0.0219, -0.0350, 0.1249, 0.0000,
+            0.0000, 0.0647, 0.3401, -0.4933, 0.2308, 0.0432, 0.0212, -0.1166, -0.0810, -0.0663, 0.3023, 0.0126,
+            0.1832),
+        pt_total=0.1172, groups=((9, 17, 3.24), (18, 25, 2.24)), f=14.2, bf=36.3),
     "canon_wide_angle_us4310222_17mm_f2_8": dict(
         asphere=(2.530e-5, 1.505e-8, -2.012e-11, 2.102e-13),
         h=(1.000, 0.972, 1.086, 1.081, 1.084, 1.074, 1.539, 1.844, 1.808, 1.849, 1.887, 1.913, 1.910, 1.918,
@@ -144,6 +167,9 @@ PRIMARY = {
     # The stated 14.2 is nominal: the patent's own h column gives f = bf / 2.563 = 14.280 (test below), which the
     # lens has (+0.56 %), so the EFL's tolerance is 0.6 % here and the design's f is checked at 0.1 % below
     "canon_wide_angle_us4310222_14mm_f2_8": (US_4310222, dict(efl=14.2, efl_rel=6e-3, fno=2.8, bf=36.6, bf_tol=0.05)),
+    # the same, second embodiment (the first's f, F No. and field): "f = 14.2, bf = 36.3, F No. = 1:2.8, Angle of
+    # field = 114 deg"; like the first, its h column ends at bf/f = 36.3/2.542, f = 14.280, +0.56 % from the nominal 14.2
+    "canon_wide_angle_us4310222_14mm_f2_8_ex2": (US_4310222_EX2, dict(efl=14.2, efl_rel=6e-3, fno=2.8, bf=36.3, bf_tol=0.005)),
     # the same, fourth embodiment: "f = 17.34, bf = 36.61, F No. = 1:2.8, Angle of field = 104 deg"
     "canon_wide_angle_us4310222_17mm_f2_8": (US_4310222_EX4, dict(efl=17.34, fno=2.8, bf=36.61, bf_tol=0.005)),
     # the same, fifth embodiment: "f = 5.52 ... bf = 17.2, F No. = 1:1.6, Angle of field = 99.8 deg". The printed

@@ -16,7 +16,8 @@ from physcam.lens.library import find_lens, load_lens
 from physcam.lens.provenance import primary_source_claim_gaps, provenance_of
 from physcam.optics.paraxial import gaussian, media_indices, paraxial_trace, system_matrix
 
-from primary_stated import PRIMARY, US_3841736_R14_PRINTED, US_4310222_COLUMNS, US_4310222_R6_PRINTED
+from primary_stated import (PRIMARY, US_3841736_R14_PRINTED, US_4310222_COLUMNS, US_4310222_EX2_R16_PRINTED,
+                             US_4310222_R6_PRINTED)
 
 ORACLE = json.loads((Path(__file__).resolve().parents[1] / "data" / "optiland_library.json").read_text())["lenses"]
 
@@ -134,11 +135,15 @@ class TestCanonUS4310222:
     def test_the_patents_petzval_terms_and_group_focal_lengths(self, slug):
         p, col = load_lens(slug), US_4310222_COLUMNS[slug]
         st, f, n = p.stop_index, gaussian(p).efl, media_indices(p)
-        pt = [(f / s.radius) * (1.0 / n[i] - 1.0 / n[i + 1]) for i, s in enumerate(p.surfaces) if i != st]
+        pt = [(f / s.radius if s.radius else 0.0) * (1.0 / n[i] - 1.0 / n[i + 1])  # a flat (the filter): 0
+              for i, s in enumerate(p.surfaces) if i != st]
         printed = list(col["pt"])
         if slug.endswith("14mm_f2_8"):  # row 20 is printed -0.6776; the printed total is the sum with -0.0676
             assert pt[19] == pytest.approx(-0.0676, abs=1e-4) and sum(printed) == pytest.approx(-0.4967, abs=1e-4)
             printed[19] = -0.0676
+        if slug.endswith("_ex2"):  # row 23 is printed 0.3023; the printed total 0.1172 is the lens's sum (0.11725)
+            assert pt[22] == pytest.approx(0.3026, abs=1e-4) and sum(pt) == pytest.approx(col["pt_total"], abs=1e-4)
+            printed[22] = 0.3026
         assert pt == pytest.approx(printed, abs=2e-4)
         assert sum(printed) == pytest.approx(col["pt_total"], abs=1e-3)
 
@@ -161,3 +166,19 @@ def test_a_misprinted_radius_of_us4310222_is_corrected_by_its_own_columns():
     h, _ = paraxial_trace(printed, 1.0, 0.0)
     assert h[6] == pytest.approx(2.547, abs=1e-3)  # the patent's h column: 1.710
     assert gaussian(printed).efl == pytest.approx(2.927, abs=1e-3)  # the patent's f: 5.52
+
+
+def test_a_sign_lost_in_us4310222s_second_table_is_restored_by_its_own_columns():
+    """The second embodiment's R16 prints as 12.614; its Petzval term (-0.4933), its h column and the lens's
+    shape are those of -12.614, which the file uses: with +12.614 the convex R15 and R16, 0.94 mm apart, meet
+    inside the f/2.8 beam and the h column from R17 on is not the patent's."""
+    from physcam.errors import PhysCamError
+
+    p = load_lens("canon_wide_angle_us4310222_14mm_f2_8_ex2")
+    i = 15  # R16, before the stop
+    assert p.surfaces[i].radius == pytest.approx(-12.614) and "12.614" in provenance_of(p).corrections[0]
+    f, n = gaussian(p).efl, media_indices(p)
+    assert (f / US_4310222_EX2_R16_PRINTED) * (1.0 / n[i] - 1.0 / n[i + 1]) == pytest.approx(0.4934, abs=1e-4)
+    with pytest.raises(PhysCamError, match="crosses surface 16"):  # the printed sign: two faces crossing
+        p.with_surfaces(dataclasses.replace(x, radius=US_4310222_EX2_R16_PRINTED) if k == i else x
+                        for k, x in enumerate(p.surfaces)).validate()
