@@ -102,7 +102,18 @@ US_4310222_EX2 = [
     (12.278, 6.9, 1.69895, 30.1), (50.377, 0.83, None, None), (-80.749, 0.8, 1.84666, 23.9),
     (28.151, 4.4, 1.48749, 70.1), (-15.466, 0.15, None, None), (493.467, 2.85, 1.7725, 49.7), (-33.952, None, None, None),
 ]
-#: What the patent prints beside each of the two tables: R3's non-spherical coefficients B, C, D, E (A = 0:
+#: The third embodiment: the table of column 12 (R3 non-spherical; R12-R13 the filter again); the stop sits in D18.
+US_4310222_EX3 = [
+    (41.022, 3.1, 1.6968, 55.5), (25.486, 11.61, None, None), (59.586, 5.8, 1.60311, 60.7), (53.247, 0.15, None, None),
+    (31.755, 1.7, 1.6968, 55.5), (16.408, 5.63, None, None), (32.689, 1.3, 1.7725, 49.7), (16.569, 5.98, None, None),
+    (327.3, 1.5, 1.6968, 55.5), (13.739, 10.42, 1.60342, 38.0), (-62.67, 2.2, None, None),
+    (0.0, 1.8, 1.51633, 64.1), (0.0, 0.8, None, None), (50.943, 6.24, 1.51118, 51.0),
+    (-12.241, 1.0, 1.6968, 55.5), (-14.812, 1.14, None, None), (-13.815, 0.9, 1.7725, 49.7),
+    (-26.056, 1.7, None, None), (122.96, 9.74, 1.69895, 30.1), (-17.987, 2.15, 1.59551, 39.2),
+    (56.343, 0.68, None, None), (-160.37, 0.8, 1.92286, 21.3), (28.576, 4.77, 1.48749, 70.1),
+    (-17.792, 0.15, None, None), (219.82, 2.75, 1.7725, 49.7), (-42.458, None, None, None),
+]
+#: What the patent prints beside each of its tables: R3's non-spherical coefficients B, C, D, E (A = 0:
 #: X = R(1 - (1 - H^2/R^2)^(1/2)) + A H^2 + B H^4 + ... + E H^10); the h (axial paraxial ray, incident height
 #: 1) and h-bar (principal ray, f = 1) columns; the third-order table's PT (Petzval) column and its total
 #: (row 20 of the first is printed -0.6776); its lens groups' focal lengths (first and last surface, in units
@@ -127,6 +138,17 @@ US_4310222_COLUMNS = {
             0.0000, 0.0647, 0.3401, -0.4933, 0.2308, 0.0432, 0.0212, -0.1166, -0.0810, -0.0663, 0.3023, 0.0126,
             0.1832),
         pt_total=0.1172, groups=((9, 17, 3.24), (18, 25, 2.24)), f=14.2, bf=36.3),
+    "canon_wide_angle_us4310222_14mm_f2_8_ex3": dict(
+        asphere=(9.452e-6, 2.539e-9, -1.049e-11, 2.118e-14),
+        h=(1.000, 0.969, 1.079, 1.074, 1.076, 1.063, 1.245, 1.247, 1.612, 1.662, 2.110, 2.217, 2.274, 2.313,
+           2.418, 2.454, 2.393, 2.434, 2.448, 2.415, 2.389, 2.393, 2.401, 2.581, 2.578, 2.541),
+        hbar=(-2.036, -1.845, -1.216, -0.975, -0.967, -0.890, -0.672, -0.632, -0.481, -0.457, -0.307, -0.249,
+              -0.218, -0.198, -0.082, -0.066, -0.032, -0.017, 0.032, 0.195, 0.232, 0.252, 0.265, 0.379, 0.382,
+              0.419),
+        pt=(0.1429, -0.2301, 0.0901, -0.1009, 0.1847, -0.3574, 0.1904, -0.3757, 0.0179, -0.0356, 0.0857, 0.0000,
+            0.0000, 0.0948, -0.0844, 0.3960, -0.4506, 0.2389, 0.0477, 0.0303, -0.0946, -0.0427, -0.0760, 0.2631,
+            0.0283, 0.1466),
+        pt_total=0.1094, groups=((1, 8, -1.15), (9, 18, 3.19), (19, 26, 2.30)), f=14.2, bf=36.3),
     "canon_wide_angle_us4310222_17mm_f2_8": dict(
         asphere=(2.530e-5, 1.505e-8, -2.012e-11, 2.102e-13),
         h=(1.000, 0.972, 1.086, 1.081, 1.084, 1.074, 1.539, 1.844, 1.808, 1.849, 1.887, 1.913, 1.910, 1.918,
@@ -170,6 +192,8 @@ PRIMARY = {
     # the same, second embodiment (the first's f, F No. and field): "f = 14.2, bf = 36.3, F No. = 1:2.8, Angle of
     # field = 114 deg"; like the first, its h column ends at bf/f = 36.3/2.542, f = 14.280, +0.56 % from the nominal 14.2
     "canon_wide_angle_us4310222_14mm_f2_8_ex2": (US_4310222_EX2, dict(efl=14.2, efl_rel=6e-3, fno=2.8, bf=36.3, bf_tol=0.005)),
+    # the third embodiment, the same stated values as the second; its h column ends at 36.3/2.541: f = 14.286
+    "canon_wide_angle_us4310222_14mm_f2_8_ex3": (US_4310222_EX3, dict(efl=14.2, efl_rel=6e-3, fno=2.8, bf=36.3, bf_tol=0.005)),
     # the same, fourth embodiment: "f = 17.34, bf = 36.61, F No. = 1:2.8, Angle of field = 104 deg"
     "canon_wide_angle_us4310222_17mm_f2_8": (US_4310222_EX4, dict(efl=17.34, fno=2.8, bf=36.61, bf_tol=0.005)),
     # the same, fifth embodiment: "f = 5.52 ... bf = 17.2, F No. = 1:1.6, Angle of field = 99.8 deg". The printed
