@@ -113,6 +113,16 @@ US_4310222_EX3 = [
     (56.343, 0.68, None, None), (-160.37, 0.8, 1.92286, 21.3), (28.576, 4.77, 1.48749, 70.1),
     (-17.792, 0.15, None, None), (219.82, 2.75, 1.7725, 49.7), (-42.458, None, None, None),
 ]
+#: The sixth embodiment: the table of columns 16 and 17 (R3 non-spherical); the stop sits in D14.
+US_4310222_EX6 = [
+    (47.3142, 2.3, 1.6968, 55.5), (14.9039, 4.613, None, None), (46.113, 4.0, 1.60311, 60.7), (46.113, 1.0, None, None),
+    (21.4146, 1.0, 1.6968, 55.5), (8.4483, 5.667, None, None), (577.663, 1.5, 1.6968, 55.5), (7.603, 9.482, 1.60342, 38.0),
+    (-220.61, 1.3, None, None), (30.088, 6.54, 1.60342, 38.0), (-13.4264, 1.0, 1.6968, 55.5),
+    (-16.0569, 1.672, None, None), (-10.9266, 1.0, 1.7725, 49.6), (-18.0916, 1.7, None, None),
+    (131.185, 5.98, 1.59551, 39.2), (35.313, 0.92, None, None), (-488.534, 0.7, 1.92286, 21.3),
+    (16.7051, 3.605, 1.48749, 70.1), (-11.9702, 0.15, None, None), (23.5131, 2.961, 1.7725, 49.6),
+    (-31.1174, None, None, None),
+]
 #: What the patent prints beside each of its tables: R3's non-spherical coefficients B, C, D, E (A = 0:
 #: X = R(1 - (1 - H^2/R^2)^(1/2)) + A H^2 + B H^4 + ... + E H^10); the h (axial paraxial ray, incident height
 #: 1) and h-bar (principal ray, f = 1) columns; the third-order table's PT (Petzval) column and its total
@@ -167,6 +177,15 @@ US_4310222_COLUMNS = {
         pt=(0.0462, -0.1502, 0.0439, -0.0439, 0.1062, -0.2709, 0.0044, -0.0244, 0.0148, 0.0618, 0.1288, -0.2204,
             0.1326, 0.0156, -0.0582, -0.0054, -0.0503, 0.1511, 0.1019, 0.0773),
         pt_total=0.0611, groups=((1, 6, -1.976), (7, 13, 7.22), (14, 20, 2.735)), f=5.52, bf=17.4),
+    "canon_wide_angle_us4310222_5_5mm_f1_6_ex6": dict(
+        asphere=(1.099e-4, -1.747e-7, -1.411e-11, 6.880e-12),
+        h=(1.000, 0.980, 1.123, 1.164, 1.196, 1.192, 1.707, 1.786, 2.442, 2.577, 2.791, 2.834, 2.748, 2.829,
+           2.867, 2.903, 2.957, 2.980, 3.323, 3.324, 3.152),
+        hbar=(-2.582, -2.285, -1.767, -1.429, -1.312, -1.218, -0.883, -0.830, -0.535, -0.468, -0.221, -0.186,
+              -0.073, -0.038, 0.070, 0.308, 0.371, 0.396, 0.589, 0.597, 0.658),
+        pt=(0.0479, -0.1520, 0.0450, -0.0450, 0.1058, -0.2683, 0.0039, -0.0249, 0.0094, 0.0690, -0.0141, 0.1411,
+            -0.2201, 0.1329, 0.0157, -0.0583, -0.0054, -0.0502, 0.1511, 0.1023, 0.0773),
+        pt_total=0.0630, groups=((1, 6, -1.991), (7, 14, 7.343), (15, 21, 2.738)), f=5.52, bf=17.4),
 }
 
 #: slug -> (the patent's table, what the patent states: focal length, f-number, back focus from the last
@@ -200,4 +219,6 @@ PRIMARY = {
     # bf 17.2 is not this table's: its own h column ends at bf/f = 3.152, i.e. 17.40 (test below), as the
     # sixth embodiment's bf = 17.4 reads; the back focus is checked against 17.4
     "canon_wide_angle_us4310222_5_5mm_f1_6": (US_4310222_EX5, dict(efl=5.52, fno=1.6, bf=17.4, bf_tol=0.005)),
+    # the same, sixth embodiment: "f = 5.52, bf = 17.4, F No. = 1:1.6, Angle of field = 99.8 deg"
+    "canon_wide_angle_us4310222_5_5mm_f1_6_ex6": (US_4310222_EX6, dict(efl=5.52, fno=1.6, bf=17.4, bf_tol=0.005)),
 }
