@@ -123,9 +123,21 @@ US_4310222_EX6 = [
     (16.7051, 3.605, 1.48749, 70.1), (-11.9702, 0.15, None, None), (23.5131, 2.961, 1.7725, 49.6),
     (-31.1174, None, None, None),
 ]
+#: The seventh embodiment: the table of columns 19 and 20 (R3 non-spherical, on the plastic meniscus R3-R4,
+#: N 1.493; R12-R13 a filter); no h columns. The stop: 0.30 f behind R15 (the patent's "surface R"), in D18.
+US_4310222_EX7 = [
+    (42.889, 3.1, 1.6968, 55.5), (26.161, 11.55, None, None), (61.567, 5.83, 1.493, 54.2), (57.577, 0.15, None, None),
+    (30.956, 1.7, 1.6968, 55.5), (16.443, 5.75, None, None), (32.978, 1.3, 1.7725, 49.6), (16.486, 5.95, None, None),
+    (357.247, 1.5, 1.6968, 55.5), (12.444, 10.4, 1.60342, 38.0), (-55.993, 2.53, None, None),
+    (0.0, 1.8, 1.51633, 64.1), (0.0, 0.7, None, None), (49.441, 5.6, 1.51742, 52.3),
+    (-12.228, 1.5, 1.6968, 55.5), (-14.588, 1.08, None, None), (-13.862, 0.9, 1.7725, 49.6),
+    (-25.881, 1.7, None, None), (136.4, 9.65, 1.68893, 31.1), (-21.198, 1.9, 1.59551, 39.2),
+    (54.226, 0.69, None, None), (-160.011, 0.8, 1.92286, 21.3), (28.566, 5.53, 1.48749, 70.1),
+    (-17.829, 0.1, None, None), (277.71, 2.63, 1.804, 46.6), (-43.605, None, None, None),
+]
 #: What the patent prints beside each of its tables: R3's non-spherical coefficients B, C, D, E (A = 0:
 #: X = R(1 - (1 - H^2/R^2)^(1/2)) + A H^2 + B H^4 + ... + E H^10); the h (axial paraxial ray, incident height
-#: 1) and h-bar (principal ray, f = 1) columns; the third-order table's PT (Petzval) column and its total
+#: 1) and h-bar (principal ray, f = 1) columns (the seventh embodiment prints none); the third-order table's PT (Petzval) column and its total
 #: (row 20 of the first is printed -0.6776); its lens groups' focal lengths (first and last surface, in units
 #: of the stated f); and the stated f those are in.
 US_4310222_COLUMNS = {
@@ -186,6 +198,12 @@ US_4310222_COLUMNS = {
         pt=(0.0479, -0.1520, 0.0450, -0.0450, 0.1058, -0.2683, 0.0039, -0.0249, 0.0094, 0.0690, -0.0141, 0.1411,
             -0.2201, 0.1329, 0.0157, -0.0583, -0.0054, -0.0502, 0.1511, 0.1023, 0.0773),
         pt_total=0.0630, groups=((1, 6, -1.991), (7, 14, 7.343), (15, 21, 2.738)), f=5.52, bf=17.4),
+    "canon_wide_angle_us4310222_14mm_f2_8_ex7": dict(
+        asphere=(1.07336e-5, 5.38038e-9, -1.98246e-11, 3.65339e-14),
+        pt=(0.1368, -0.2243, 0.0766, -0.0819, 0.1895, -0.3568, 0.1888, -0.3777, 0.0164, -0.0394, 0.0960, 0.0000,
+            0.0000, 0.0985, -0.0814, 0.4022, -0.4492, 0.2406, 0.0427, 0.0233, -0.0983, -0.0428, -0.0761, 0.2626,
+            0.0229, 0.1460),
+        pt_total=0.1151, groups=(), f=14.2, bf=36.1),
 }
 
 #: slug -> (the patent's table, what the patent states: focal length, f-number, back focus from the last
@@ -221,4 +239,7 @@ PRIMARY = {
     "canon_wide_angle_us4310222_5_5mm_f1_6": (US_4310222_EX5, dict(efl=5.52, fno=1.6, bf=17.4, bf_tol=0.005)),
     # the same, sixth embodiment: "f = 5.52, bf = 17.4, F No. = 1:1.6, Angle of field = 99.8 deg"
     "canon_wide_angle_us4310222_5_5mm_f1_6_ex6": (US_4310222_EX6, dict(efl=5.52, fno=1.6, bf=17.4, bf_tol=0.005)),
+    # the seventh embodiment: "f = 14.2; F No. = 1:2.8; bf = 36.1; Angle of field = 113.4 deg". No h column here, but its
+    # Petzval column is computed with the table's f, 14.290 (+0.63 %; test below), the nominal 14.2 of the first three
+    "canon_wide_angle_us4310222_14mm_f2_8_ex7": (US_4310222_EX7, dict(efl=14.2, efl_rel=7e-3, fno=2.8, bf=36.1, bf_tol=0.005)),
 }

@@ -108,29 +108,16 @@ def test_a_misprinted_radius_is_corrected_by_the_patents_own_stated_values():
 
 @pytest.mark.parametrize("slug", sorted(US_4310222_COLUMNS))
 class TestCanonUS4310222:
-    """US 4,310,222 prints, beside each table, what its own paraxial trace gave (the h and h-bar columns),
-    the Petzval term of every surface and its lens groups' focal lengths: numbers computed from every
-    radius, gap and index at once, held here against physcam's paraxial trace of the file."""
+    """US 4,310,222 prints, beside each table, the Petzval term of every surface, computed with the design's f
+    (each term is (f/r)(1/n - 1/n')) and its lens groups' focal lengths, and (but for the seventh) what its own
+    paraxial trace gave (the h and h-bar columns, below): numbers computed from every radius, gap and index at
+    once, held here against physcam's paraxial trace of the file."""
 
     def test_the_asphere_is_the_patents(self, slug):
         p = load_lens(slug)
         (r3,) = [s for s in p.surfaces if s.kind == "aspheric"]
         assert r3 is p.surfaces[2] and r3.conic == 0.0
         assert tuple(r3.aspheric) == pytest.approx(US_4310222_COLUMNS[slug]["asphere"], rel=1e-12)
-
-    def test_the_patents_paraxial_columns(self, slug):
-        p, col = load_lens(slug), US_4310222_COLUMNS[slug]
-        st, f = p.stop_index, gaussian(p).efl
-        h, _ = paraxial_trace(p, 1.0, 0.0)  # the axial ray, incident height 1
-        a, _ = paraxial_trace(p, 0.0, 1.0)  # principal ray of f = 1: nu = 1, aimed at the stop's centre
-        b, _ = paraxial_trace(p, 1.0, 1.0)
-        y0 = -a[st] / (b[st] - a[st])
-        hbar, _ = paraxial_trace(p, y0, 1.0)
-        assert [y for i, y in enumerate(h) if i != st] == pytest.approx(col["h"], abs=5.1e-4)
-        assert [y / f for i, y in enumerate(hbar) if i != st] == pytest.approx(col["hbar"], abs=1e-3)
-        # the h column ends at bf/f (f = 1): the first embodiment's design f is 14.28, not the stated 14.2;
-        # the fifth's bf is 17.40, not the 17.2 printed with it
-        assert col["bf"] / col["h"][-1] == pytest.approx(f, rel=1e-3)
 
     def test_the_patents_petzval_terms_and_group_focal_lengths(self, slug):
         p, col = load_lens(slug), US_4310222_COLUMNS[slug]
@@ -154,6 +141,23 @@ class TestCanonUS4310222:
             m = system_matrix(p, first=index(first), last=index(last))
             # to the printed digits, or 0.1 % of a long one (the sixth embodiment's 7.343f is the lens's 7.336f)
             assert -1.0 / m[2] / col["f"] == pytest.approx(in_f, abs=0.005, rel=1.1e-3)
+
+
+@pytest.mark.parametrize("slug", sorted(s for s, col in US_4310222_COLUMNS.items() if "h" in col))
+def test_the_patents_paraxial_columns_of_us4310222(slug):
+    """The h and h-bar columns the patent prints beside each table but the seventh's: its own paraxial trace."""
+    p, col = load_lens(slug), US_4310222_COLUMNS[slug]
+    st, f = p.stop_index, gaussian(p).efl
+    h, _ = paraxial_trace(p, 1.0, 0.0)  # the axial ray, incident height 1
+    a, _ = paraxial_trace(p, 0.0, 1.0)  # principal ray of f = 1: nu = 1, aimed at the stop's centre
+    b, _ = paraxial_trace(p, 1.0, 1.0)
+    y0 = -a[st] / (b[st] - a[st])
+    hbar, _ = paraxial_trace(p, y0, 1.0)
+    assert [y for i, y in enumerate(h) if i != st] == pytest.approx(col["h"], abs=5.1e-4)
+    assert [y / f for i, y in enumerate(hbar) if i != st] == pytest.approx(col["hbar"], abs=1e-3)
+    # the h column ends at bf/f (f = 1): the first embodiment's design f is 14.28, not the stated 14.2;
+    # the fifth's bf is 17.40, not the 17.2 printed with it
+    assert col["bf"] / col["h"][-1] == pytest.approx(f, rel=1e-3)
 
 
 def test_a_misprinted_radius_of_us4310222_is_corrected_by_its_own_columns():
@@ -183,3 +187,23 @@ def test_a_sign_lost_in_us4310222s_second_table_is_restored_by_its_own_columns()
     with pytest.raises(PhysCamError, match="crosses surface 16"):  # the printed sign: two faces crossing
         p.with_surfaces(dataclasses.replace(x, radius=US_4310222_EX2_R16_PRINTED) if k == i else x
                         for k, x in enumerate(p.surfaces)).validate()
+
+
+def test_the_seventh_embodiments_petzval_column_is_computed_with_its_tables_f():
+    """US 4,310,222's seventh embodiment prints no h columns; its Petzval terms, (f/r)(1/n - 1/n') each, are
+    the file's with the table's own f (14.290, held above) and not with the stated 14.2. Its stated focal
+    distance of the plastic lens R3-R4, -265 f, is not the table's (-245 f): recorded in the file as not met."""
+    slug = "canon_wide_angle_us4310222_14mm_f2_8_ex7"
+    p, col = load_lens(slug), US_4310222_COLUMNS[slug]
+    st, n = p.stop_index, media_indices(p)
+    at_stated = [(14.2 / s.radius if s.radius else 0.0) * (1.0 / n[i] - 1.0 / n[i + 1])
+                 for i, s in enumerate(p.surfaces) if i != st]
+    assert max(abs(a - b) for a, b in zip(at_stated, col["pt"])) > 2e-3  # R16: 0.3998 against the printed 0.4022
+
+    def thick_lens_f(n, r1, r2, t):  # Smith, Modern Optical Engineering, eq. 2.48
+        return 1.0 / ((n - 1.0) * (1.0 / r1 - 1.0 / r2 + (n - 1.0) * t / (n * r1 * r2)))
+
+    r3, r4 = p.surfaces[2], p.surfaces[3]
+    f_plastic = thick_lens_f(r3.medium.nd, r3.radius, r4.radius, r3.thickness)
+    assert f_plastic / 14.2 == pytest.approx(-245.2, abs=0.1)
+    assert "-265 f" in " ".join(provenance_of(p).checks)
