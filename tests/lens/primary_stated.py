@@ -135,9 +135,21 @@ US_4310222_EX7 = [
     (54.226, 0.69, None, None), (-160.011, 0.8, 1.92286, 21.3), (28.566, 5.53, 1.48749, 70.1),
     (-17.829, 0.1, None, None), (277.71, 2.63, 1.804, 46.6), (-43.605, None, None, None),
 ]
+#: The eighth embodiment: the table of column 21 (R3 non-spherical, on the plastic meniscus R3-R4); no h columns.
+#: N7 is printed 1.6968 (v 30.1); the file has 1.69895 (US_4310222_EX8_N7_PRINTED the print; test below). The stop:
+#: 0.19 f behind R10 (the patent's "surface R"), in D12.
+US_4310222_EX8_N7_PRINTED = 1.6968
+US_4310222_EX8 = [
+    (35.43, 2.5, 1.6968, 55.5), (17.531, 6.8, None, None), (35.8, 5.3, 1.493, 54.2), (36.5, 0.15, None, None),
+    (21.591, 1.5, 1.6968, 55.5), (10.2174, 6.0, None, None), (300.0, 8.0, 1.60342, 38.0), (-46.177, 1.5, None, None),
+    (124.799, 7.0, 1.60342, 38.0), (-14.3706, 1.1, None, None), (-13.0615, 1.0, 1.6968, 55.5),
+    (-36.637, 2.3, None, None), (67.788, 3.7, 1.69895, 30.1), (-129.82, 1.0, 1.66672, 48.3),
+    (55.651, 1.2, None, None), (-51.303, 1.0, 1.92286, 21.3), (29.3603, 4.5, 1.48749, 70.1),
+    (-15.9063, 0.15, None, None), (-340.986, 3.2, 1.7725, 49.6), (-23.448, None, None, None),
+]
 #: What the patent prints beside each of its tables: R3's non-spherical coefficients B, C, D, E (A = 0:
 #: X = R(1 - (1 - H^2/R^2)^(1/2)) + A H^2 + B H^4 + ... + E H^10); the h (axial paraxial ray, incident height
-#: 1) and h-bar (principal ray, f = 1) columns (the seventh embodiment prints none); the third-order table's PT (Petzval) column and its total
+#: 1) and h-bar (principal ray, f = 1) columns (the seventh and eighth print none); the third-order table's PT (Petzval) column and its total
 #: (row 20 of the first is printed -0.6776); its lens groups' focal lengths (first and last surface, in units
 #: of the stated f); and the stated f those are in.
 US_4310222_COLUMNS = {
@@ -204,6 +216,11 @@ US_4310222_COLUMNS = {
             0.0000, 0.0985, -0.0814, 0.4022, -0.4492, 0.2406, 0.0427, 0.0233, -0.0983, -0.0428, -0.0761, 0.2626,
             0.0229, 0.1460),
         pt_total=0.1151, groups=(), f=14.2, bf=36.1),
+    "canon_wide_angle_us4310222_17mm_f2_8_ex8": dict(
+        asphere=(2.51989e-5, 2.25528e-8, -2.51574e-11, 3.21205e-13),
+        pt=(0.2009, -0.4061, 0.1599, -0.1568, 0.3297, -0.6969, 0.0217, 0.1413, 0.0522, 0.4540, -0.5451, 0.1943,
+            0.1052, 0.0015, -0.1246, -0.1622, -0.0898, 0.3572, -0.0221, 0.3223),
+        pt_total=0.1367, groups=(), f=17.3, bf=36.2),
 }
 
 #: slug -> (the patent's table, what the patent states: focal length, f-number, back focus from the last
@@ -242,4 +259,6 @@ PRIMARY = {
     # the seventh embodiment: "f = 14.2; F No. = 1:2.8; bf = 36.1; Angle of field = 113.4 deg". No h column here, but its
     # Petzval column is computed with the table's f, 14.290 (+0.63 %; test below), the nominal 14.2 of the first three
     "canon_wide_angle_us4310222_14mm_f2_8_ex7": (US_4310222_EX7, dict(efl=14.2, efl_rel=7e-3, fno=2.8, bf=36.1, bf_tol=0.005)),
+    # the eighth embodiment: "f = 17.3; F No. = 1:2.8; bf = 36.2; Angle of field = 102.7 deg"
+    "canon_wide_angle_us4310222_17mm_f2_8_ex8": (US_4310222_EX8, dict(efl=17.3, fno=2.8, bf=36.2, bf_tol=0.05)),
 }

@@ -17,7 +17,7 @@ from physcam.lens.provenance import primary_source_claim_gaps, provenance_of
 from physcam.optics.paraxial import gaussian, media_indices, paraxial_trace, system_matrix
 
 from primary_stated import (PRIMARY, US_3841736_R14_PRINTED, US_4310222_COLUMNS, US_4310222_EX2_R16_PRINTED,
-                             US_4310222_R6_PRINTED)
+                             US_4310222_EX8_N7_PRINTED, US_4310222_R6_PRINTED)
 
 ORACLE = json.loads((Path(__file__).resolve().parents[1] / "data" / "optiland_library.json").read_text())["lenses"]
 
@@ -109,7 +109,7 @@ def test_a_misprinted_radius_is_corrected_by_the_patents_own_stated_values():
 @pytest.mark.parametrize("slug", sorted(US_4310222_COLUMNS))
 class TestCanonUS4310222:
     """US 4,310,222 prints, beside each table, the Petzval term of every surface, computed with the design's f
-    (each term is (f/r)(1/n - 1/n')) and its lens groups' focal lengths, and (but for the seventh) what its own
+    (each term is (f/r)(1/n - 1/n')) and its lens groups' focal lengths, and (but for the seventh and eighth) what its own
     paraxial trace gave (the h and h-bar columns, below): numbers computed from every radius, gap and index at
     once, held here against physcam's paraxial trace of the file."""
 
@@ -145,7 +145,7 @@ class TestCanonUS4310222:
 
 @pytest.mark.parametrize("slug", sorted(s for s, col in US_4310222_COLUMNS.items() if "h" in col))
 def test_the_patents_paraxial_columns_of_us4310222(slug):
-    """The h and h-bar columns the patent prints beside each table but the seventh's: its own paraxial trace."""
+    """The h and h-bar columns the patent prints beside each table but the last two: its own paraxial trace."""
     p, col = load_lens(slug), US_4310222_COLUMNS[slug]
     st, f = p.stop_index, gaussian(p).efl
     h, _ = paraxial_trace(p, 1.0, 0.0)  # the axial ray, incident height 1
@@ -207,3 +207,26 @@ def test_the_seventh_embodiments_petzval_column_is_computed_with_its_tables_f():
     f_plastic = thick_lens_f(r3.medium.nd, r3.radius, r4.radius, r3.thickness)
     assert f_plastic / 14.2 == pytest.approx(-245.2, abs=0.1)
     assert "-265 f" in " ".join(provenance_of(p).checks)
+
+
+def test_a_misprinted_index_of_us4310222s_eighth_table_is_corrected_by_its_petzval_column():
+    """The eighth embodiment prints N7 = 1.6968 with v 30.1 (1.6968 goes with v 55.5 everywhere else in the patent,
+    1.69895 with 30.1); its own Petzval column, each term (f/r)(1/n - 1/n') with the lens's f, is the file's only
+    with 1.69895, and so are the stated f = 17.3 and bf = 36.2 most nearly."""
+    slug = "canon_wide_angle_us4310222_17mm_f2_8_ex8"
+    p, col = load_lens(slug), US_4310222_COLUMNS[slug]
+    i = next(k for k, s in enumerate(p.surfaces) if s.radius == pytest.approx(67.788))  # R13, N7 behind it
+    assert p.surfaces[i].medium.nd == pytest.approx(1.69895) and "1.6968" in provenance_of(p).corrections[0]
+    printed = p.with_surfaces(dataclasses.replace(x, medium=dataclasses.replace(x.medium, nd=US_4310222_EX8_N7_PRINTED))
+                              if k == i else x for k, x in enumerate(p.surfaces))
+
+    def petzval(q):
+        st, f, n = q.stop_index, gaussian(q).efl, media_indices(q)
+        return [(f / s.radius) * (1.0 / n[j] - 1.0 / n[j + 1]) for j, s in enumerate(q.surfaces) if j != st]
+
+    assert petzval(p) == pytest.approx(col["pt"], abs=2e-4)
+    misses = [abs(a - b) for a, b in zip(petzval(printed), col["pt"])]
+    assert sum(m > 2.5e-4 for m in misses) == 9 and max(misses) > 6e-4
+    g, g_printed = gaussian(p), gaussian(printed)
+    assert abs(g.efl - 17.3) < abs(g_printed.efl - 17.3) and abs(g.bfl - 36.2) < abs(g_printed.bfl - 36.2)
+    assert g_printed.efl == pytest.approx(17.357, abs=1e-3) and g_printed.bfl == pytest.approx(36.229, abs=1e-3)
