@@ -3,8 +3,15 @@
 import os
 import tempfile
 
-import pytest
-from hypothesis import HealthCheck, settings
+# numpy's BLAS on one thread in every process of the session (before anything loads numpy), as the
+# `physcam` program runs it (physcam.cli.run): the suite's two xdist workers already keep both cores
+# busy, and OpenBLAS's second thread only spins beside them (tests/analysis/image_quality and
+# test_no_nan_analyses.py: 42.1 -> 31.0 s CPU side by side at load 2, the same results;
+# docs/performance.md). The library's own users keep OpenBLAS's default.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import pytest  # noqa: E402
+from hypothesis import HealthCheck, settings  # noqa: E402
 
 # Tests never read the real user's physcam config (~/.config/physcam/config.toml): every process of
 # the session, subprocesses included, reads an empty config file of its own. A test of the config

@@ -89,9 +89,67 @@ US_4310222_EX5 = [
     (35.387, 0.927, None, None), (-489.874, 0.7, 1.92286, 21.3), (16.7027, 3.684, 1.48749, 70.1),
     (-11.9649, 0.15, None, None), (23.5946, 2.925, 1.7725, 49.6), (-31.1173, None, None, None),
 ]
-#: What the patent prints beside each of the two tables: R3's non-spherical coefficients B, C, D, E (A = 0:
+#: The second embodiment: the table of column 10 (R3 non-spherical; R12-R13 a filter, radius 0 = the table's
+#: infinity); the stop sits in D17. R16 is printed 12.614; its own Petzval term, h columns and the lens's shape
+#: need -12.614 (the file's; the table here holds what the file must have, US_4310222_EX2_R16_PRINTED the print).
+US_4310222_EX2_R16_PRINTED = 12.614
+US_4310222_EX2 = [
+    (38.794, 3.1, 1.72, 50.2), (24.997, 12.41, None, None), (58.28, 5.02, 1.6031, 60.7), (46.009, 0.15, None, None),
+    (33.022, 1.7, 1.6968, 55.5), (17.647, 5.39, None, None), (32.787, 1.3, 1.7725, 49.7), (17.218, 6.32, None, None),
+    (266.96, 1.5, 1.6968, 55.5), (13.984, 12.08, 1.60342, 38.0), (-43.016, 2.2, None, None),
+    (0.0, 1.8, 1.51633, 64.1), (0.0, 0.8, None, None), (74.564, 7.84, 1.51118, 51.0), (-14.201, 0.94, None, None),
+    (-12.614, 0.9, 1.7725, 49.7), (-26.958, 1.7, None, None), (129.909, 2.0, 1.64769, 33.8),
+    (12.278, 6.9, 1.69895, 30.1), (50.377, 0.83, None, None), (-80.749, 0.8, 1.84666, 23.9),
+    (28.151, 4.4, 1.48749, 70.1), (-15.466, 0.15, None, None), (493.467, 2.85, 1.7725, 49.7), (-33.952, None, None, None),
+]
+#: The third embodiment: the table of column 12 (R3 non-spherical; R12-R13 the filter again); the stop sits in D18.
+US_4310222_EX3 = [
+    (41.022, 3.1, 1.6968, 55.5), (25.486, 11.61, None, None), (59.586, 5.8, 1.60311, 60.7), (53.247, 0.15, None, None),
+    (31.755, 1.7, 1.6968, 55.5), (16.408, 5.63, None, None), (32.689, 1.3, 1.7725, 49.7), (16.569, 5.98, None, None),
+    (327.3, 1.5, 1.6968, 55.5), (13.739, 10.42, 1.60342, 38.0), (-62.67, 2.2, None, None),
+    (0.0, 1.8, 1.51633, 64.1), (0.0, 0.8, None, None), (50.943, 6.24, 1.51118, 51.0),
+    (-12.241, 1.0, 1.6968, 55.5), (-14.812, 1.14, None, None), (-13.815, 0.9, 1.7725, 49.7),
+    (-26.056, 1.7, None, None), (122.96, 9.74, 1.69895, 30.1), (-17.987, 2.15, 1.59551, 39.2),
+    (56.343, 0.68, None, None), (-160.37, 0.8, 1.92286, 21.3), (28.576, 4.77, 1.48749, 70.1),
+    (-17.792, 0.15, None, None), (219.82, 2.75, 1.7725, 49.7), (-42.458, None, None, None),
+]
+#: The sixth embodiment: the table of columns 16 and 17 (R3 non-spherical); the stop sits in D14.
+US_4310222_EX6 = [
+    (47.3142, 2.3, 1.6968, 55.5), (14.9039, 4.613, None, None), (46.113, 4.0, 1.60311, 60.7), (46.113, 1.0, None, None),
+    (21.4146, 1.0, 1.6968, 55.5), (8.4483, 5.667, None, None), (577.663, 1.5, 1.6968, 55.5), (7.603, 9.482, 1.60342, 38.0),
+    (-220.61, 1.3, None, None), (30.088, 6.54, 1.60342, 38.0), (-13.4264, 1.0, 1.6968, 55.5),
+    (-16.0569, 1.672, None, None), (-10.9266, 1.0, 1.7725, 49.6), (-18.0916, 1.7, None, None),
+    (131.185, 5.98, 1.59551, 39.2), (35.313, 0.92, None, None), (-488.534, 0.7, 1.92286, 21.3),
+    (16.7051, 3.605, 1.48749, 70.1), (-11.9702, 0.15, None, None), (23.5131, 2.961, 1.7725, 49.6),
+    (-31.1174, None, None, None),
+]
+#: The seventh embodiment: the table of columns 19 and 20 (R3 non-spherical, on the plastic meniscus R3-R4,
+#: N 1.493; R12-R13 a filter); no h columns. The stop: 0.30 f behind R15 (the patent's "surface R"), in D18.
+US_4310222_EX7 = [
+    (42.889, 3.1, 1.6968, 55.5), (26.161, 11.55, None, None), (61.567, 5.83, 1.493, 54.2), (57.577, 0.15, None, None),
+    (30.956, 1.7, 1.6968, 55.5), (16.443, 5.75, None, None), (32.978, 1.3, 1.7725, 49.6), (16.486, 5.95, None, None),
+    (357.247, 1.5, 1.6968, 55.5), (12.444, 10.4, 1.60342, 38.0), (-55.993, 2.53, None, None),
+    (0.0, 1.8, 1.51633, 64.1), (0.0, 0.7, None, None), (49.441, 5.6, 1.51742, 52.3),
+    (-12.228, 1.5, 1.6968, 55.5), (-14.588, 1.08, None, None), (-13.862, 0.9, 1.7725, 49.6),
+    (-25.881, 1.7, None, None), (136.4, 9.65, 1.68893, 31.1), (-21.198, 1.9, 1.59551, 39.2),
+    (54.226, 0.69, None, None), (-160.011, 0.8, 1.92286, 21.3), (28.566, 5.53, 1.48749, 70.1),
+    (-17.829, 0.1, None, None), (277.71, 2.63, 1.804, 46.6), (-43.605, None, None, None),
+]
+#: The eighth embodiment: the table of column 21 (R3 non-spherical, on the plastic meniscus R3-R4); no h columns.
+#: N7 is printed 1.6968 (v 30.1); the file has 1.69895 (US_4310222_EX8_N7_PRINTED the print; test below). The stop:
+#: 0.19 f behind R10 (the patent's "surface R"), in D12.
+US_4310222_EX8_N7_PRINTED = 1.6968
+US_4310222_EX8 = [
+    (35.43, 2.5, 1.6968, 55.5), (17.531, 6.8, None, None), (35.8, 5.3, 1.493, 54.2), (36.5, 0.15, None, None),
+    (21.591, 1.5, 1.6968, 55.5), (10.2174, 6.0, None, None), (300.0, 8.0, 1.60342, 38.0), (-46.177, 1.5, None, None),
+    (124.799, 7.0, 1.60342, 38.0), (-14.3706, 1.1, None, None), (-13.0615, 1.0, 1.6968, 55.5),
+    (-36.637, 2.3, None, None), (67.788, 3.7, 1.69895, 30.1), (-129.82, 1.0, 1.66672, 48.3),
+    (55.651, 1.2, None, None), (-51.303, 1.0, 1.92286, 21.3), (29.3603, 4.5, 1.48749, 70.1),
+    (-15.9063, 0.15, None, None), (-340.986, 3.2, 1.7725, 49.6), (-23.448, None, None, None),
+]
+#: What the patent prints beside each of its tables: R3's non-spherical coefficients B, C, D, E (A = 0:
 #: X = R(1 - (1 - H^2/R^2)^(1/2)) + A H^2 + B H^4 + ... + E H^10); the h (axial paraxial ray, incident height
-#: 1) and h-bar (principal ray, f = 1) columns; the third-order table's PT (Petzval) column and its total
+#: 1) and h-bar (principal ray, f = 1) columns (the seventh and eighth print none); the third-order table's PT (Petzval) column and its total
 #: (row 20 of the first is printed -0.6776); its lens groups' focal lengths (first and last surface, in units
 #: of the stated f); and the stated f those are in.
 US_4310222_COLUMNS = {
@@ -104,6 +162,27 @@ US_4310222_COLUMNS = {
         pt=(0.1322, -0.2300, 0.0943, -0.0910, 0.1806, -0.3735, 0.1818, -0.3804, 0.0289, -0.0387, 0.1280, 0.0867,
             0.3531, -0.4914, 0.2350, 0.0418, 0.0257, -0.0988, -0.1187, -0.6776, 0.3016, 0.0479, 0.1658),
         pt_total=0.1138, groups=((1, 8, -1.06), (9, 15, 2.67), (16, 23, 2.37)), f=14.2, bf=36.6),
+    "canon_wide_angle_us4310222_14mm_f2_8_ex2": dict(
+        asphere=(9.556e-6, 2.591e-9, -1.015e-11, 2.128e-14),
+        h=(1.000, 0.967, 1.082, 1.076, 1.078, 1.067, 1.237, 1.239, 1.606, 1.653, 2.142, 2.219, 2.260, 2.288,
+           2.387, 2.324, 2.363, 2.376, 2.371, 2.315, 2.330, 2.348, 2.563, 2.562, 2.542),
+        hbar=(-2.087, -1.891, -1.217, -1.007, -0.999, -0.925, -0.718, -0.678, -0.521, -0.498, -0.326, -0.266,
+              -0.233, -0.211, -0.062, -0.033, -0.018, 0.033, 0.068, 0.187, 0.213, 0.228, 0.337, 0.341, 0.382),
+        pt=(0.1540, -0.2391, 0.0921, -0.1167, 0.1775, -0.3322, 0.1898, -0.3614, 0.0219, -0.0350, 0.1249, 0.0000,
+            0.0000, 0.0647, 0.3401, -0.4933, 0.2308, 0.0432, 0.0212, -0.1166, -0.0810, -0.0663, 0.3023, 0.0126,
+            0.1832),
+        pt_total=0.1172, groups=((9, 17, 3.24), (18, 25, 2.24)), f=14.2, bf=36.3),
+    "canon_wide_angle_us4310222_14mm_f2_8_ex3": dict(
+        asphere=(9.452e-6, 2.539e-9, -1.049e-11, 2.118e-14),
+        h=(1.000, 0.969, 1.079, 1.074, 1.076, 1.063, 1.245, 1.247, 1.612, 1.662, 2.110, 2.217, 2.274, 2.313,
+           2.418, 2.454, 2.393, 2.434, 2.448, 2.415, 2.389, 2.393, 2.401, 2.581, 2.578, 2.541),
+        hbar=(-2.036, -1.845, -1.216, -0.975, -0.967, -0.890, -0.672, -0.632, -0.481, -0.457, -0.307, -0.249,
+              -0.218, -0.198, -0.082, -0.066, -0.032, -0.017, 0.032, 0.195, 0.232, 0.252, 0.265, 0.379, 0.382,
+              0.419),
+        pt=(0.1429, -0.2301, 0.0901, -0.1009, 0.1847, -0.3574, 0.1904, -0.3757, 0.0179, -0.0356, 0.0857, 0.0000,
+            0.0000, 0.0948, -0.0844, 0.3960, -0.4506, 0.2389, 0.0477, 0.0303, -0.0946, -0.0427, -0.0760, 0.2631,
+            0.0283, 0.1466),
+        pt_total=0.1094, groups=((1, 8, -1.15), (9, 18, 3.19), (19, 26, 2.30)), f=14.2, bf=36.3),
     "canon_wide_angle_us4310222_17mm_f2_8": dict(
         asphere=(2.530e-5, 1.505e-8, -2.012e-11, 2.102e-13),
         h=(1.000, 0.972, 1.086, 1.081, 1.084, 1.074, 1.539, 1.844, 1.808, 1.849, 1.887, 1.913, 1.910, 1.918,
@@ -122,6 +201,26 @@ US_4310222_COLUMNS = {
         pt=(0.0462, -0.1502, 0.0439, -0.0439, 0.1062, -0.2709, 0.0044, -0.0244, 0.0148, 0.0618, 0.1288, -0.2204,
             0.1326, 0.0156, -0.0582, -0.0054, -0.0503, 0.1511, 0.1019, 0.0773),
         pt_total=0.0611, groups=((1, 6, -1.976), (7, 13, 7.22), (14, 20, 2.735)), f=5.52, bf=17.4),
+    "canon_wide_angle_us4310222_5_5mm_f1_6_ex6": dict(
+        asphere=(1.099e-4, -1.747e-7, -1.411e-11, 6.880e-12),
+        h=(1.000, 0.980, 1.123, 1.164, 1.196, 1.192, 1.707, 1.786, 2.442, 2.577, 2.791, 2.834, 2.748, 2.829,
+           2.867, 2.903, 2.957, 2.980, 3.323, 3.324, 3.152),
+        hbar=(-2.582, -2.285, -1.767, -1.429, -1.312, -1.218, -0.883, -0.830, -0.535, -0.468, -0.221, -0.186,
+              -0.073, -0.038, 0.070, 0.308, 0.371, 0.396, 0.589, 0.597, 0.658),
+        pt=(0.0479, -0.1520, 0.0450, -0.0450, 0.1058, -0.2683, 0.0039, -0.0249, 0.0094, 0.0690, -0.0141, 0.1411,
+            -0.2201, 0.1329, 0.0157, -0.0583, -0.0054, -0.0502, 0.1511, 0.1023, 0.0773),
+        pt_total=0.0630, groups=((1, 6, -1.991), (7, 14, 7.343), (15, 21, 2.738)), f=5.52, bf=17.4),
+    "canon_wide_angle_us4310222_14mm_f2_8_ex7": dict(
+        asphere=(1.07336e-5, 5.38038e-9, -1.98246e-11, 3.65339e-14),
+        pt=(0.1368, -0.2243, 0.0766, -0.0819, 0.1895, -0.3568, 0.1888, -0.3777, 0.0164, -0.0394, 0.0960, 0.0000,
+            0.0000, 0.0985, -0.0814, 0.4022, -0.4492, 0.2406, 0.0427, 0.0233, -0.0983, -0.0428, -0.0761, 0.2626,
+            0.0229, 0.1460),
+        pt_total=0.1151, groups=(), f=14.2, bf=36.1),
+    "canon_wide_angle_us4310222_17mm_f2_8_ex8": dict(
+        asphere=(2.51989e-5, 2.25528e-8, -2.51574e-11, 3.21205e-13),
+        pt=(0.2009, -0.4061, 0.1599, -0.1568, 0.3297, -0.6969, 0.0217, 0.1413, 0.0522, 0.4540, -0.5451, 0.1943,
+            0.1052, 0.0015, -0.1246, -0.1622, -0.0898, 0.3572, -0.0221, 0.3223),
+        pt_total=0.1367, groups=(), f=17.3, bf=36.2),
 }
 
 #: slug -> (the patent's table, what the patent states: focal length, f-number, back focus from the last
@@ -144,10 +243,22 @@ PRIMARY = {
     # The stated 14.2 is nominal: the patent's own h column gives f = bf / 2.563 = 14.280 (test below), which the
     # lens has (+0.56 %), so the EFL's tolerance is 0.6 % here and the design's f is checked at 0.1 % below
     "canon_wide_angle_us4310222_14mm_f2_8": (US_4310222, dict(efl=14.2, efl_rel=6e-3, fno=2.8, bf=36.6, bf_tol=0.05)),
+    # the same, second embodiment (the first's f, F No. and field): "f = 14.2, bf = 36.3, F No. = 1:2.8, Angle of
+    # field = 114 deg"; like the first, its h column ends at bf/f = 36.3/2.542, f = 14.280, +0.56 % from the nominal 14.2
+    "canon_wide_angle_us4310222_14mm_f2_8_ex2": (US_4310222_EX2, dict(efl=14.2, efl_rel=6e-3, fno=2.8, bf=36.3, bf_tol=0.005)),
+    # the third embodiment, the same stated values as the second; its h column ends at 36.3/2.541: f = 14.286
+    "canon_wide_angle_us4310222_14mm_f2_8_ex3": (US_4310222_EX3, dict(efl=14.2, efl_rel=6e-3, fno=2.8, bf=36.3, bf_tol=0.005)),
     # the same, fourth embodiment: "f = 17.34, bf = 36.61, F No. = 1:2.8, Angle of field = 104 deg"
     "canon_wide_angle_us4310222_17mm_f2_8": (US_4310222_EX4, dict(efl=17.34, fno=2.8, bf=36.61, bf_tol=0.005)),
     # the same, fifth embodiment: "f = 5.52 ... bf = 17.2, F No. = 1:1.6, Angle of field = 99.8 deg". The printed
     # bf 17.2 is not this table's: its own h column ends at bf/f = 3.152, i.e. 17.40 (test below), as the
     # sixth embodiment's bf = 17.4 reads; the back focus is checked against 17.4
     "canon_wide_angle_us4310222_5_5mm_f1_6": (US_4310222_EX5, dict(efl=5.52, fno=1.6, bf=17.4, bf_tol=0.005)),
+    # the same, sixth embodiment: "f = 5.52, bf = 17.4, F No. = 1:1.6, Angle of field = 99.8 deg"
+    "canon_wide_angle_us4310222_5_5mm_f1_6_ex6": (US_4310222_EX6, dict(efl=5.52, fno=1.6, bf=17.4, bf_tol=0.005)),
+    # the seventh embodiment: "f = 14.2; F No. = 1:2.8; bf = 36.1; Angle of field = 113.4 deg". No h column here, but its
+    # Petzval column is computed with the table's f, 14.290 (+0.63 %; test below), the nominal 14.2 of the first three
+    "canon_wide_angle_us4310222_14mm_f2_8_ex7": (US_4310222_EX7, dict(efl=14.2, efl_rel=7e-3, fno=2.8, bf=36.1, bf_tol=0.005)),
+    # the eighth embodiment: "f = 17.3; F No. = 1:2.8; bf = 36.2; Angle of field = 102.7 deg"
+    "canon_wide_angle_us4310222_17mm_f2_8_ex8": (US_4310222_EX8, dict(efl=17.3, fno=2.8, bf=36.2, bf_tol=0.05)),
 }

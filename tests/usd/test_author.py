@@ -6,7 +6,7 @@ import subprocess
 import sys
 
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from physcam.errors import ExportError, InputError, PhysCamError
@@ -59,6 +59,38 @@ def test_gf_camera_reproduces_fov(mpu, focal, w, h, squeeze):
     ulp = 40.0 * F32_EPS * 4  # float32 result: one ulp is 2^-24 relative, FOVs here are below 160 degrees
     assert cam.GetFieldOfView(Gf.Camera.FOVHorizontal) == pytest.approx(fov_deg(w * squeeze, focal), abs=4 * ulp)
     assert cam.GetFieldOfView(Gf.Camera.FOVVertical) == pytest.approx(fov_deg(h, focal), abs=4 * ulp)
+
+
+def _f32_around(x, k):
+    """The float32 nearest ``x`` and the ``k`` float32 values each side of it, walked with numpy's nextafter."""
+    import numpy as np
+
+    c = np.float32(x)
+    lo, hi = [c], [c]
+    for _ in range(k):
+        lo.insert(0, np.nextafter(lo[0], np.float32(-np.inf)))
+        hi.append(np.nextafter(hi[-1], np.float32(np.inf)))
+    return [float(v) for v in lo[:-1] + hi]
+
+
+@settings(max_examples=50)
+@given(st.floats(0.5, 2000.0), st.floats(0.05, 40.0), st.floats(0.05, 40.0), st.integers(0, 24))
+def test_fov_preserving_float32_is_the_best_candidate(focal, rw, rh, k):
+    """fov_preserving_float32 against a brute force over the same candidates, one at a time: each float32
+    focal within k steps, each aperture the float32 nearest its ratio (of the rounding and its two
+    neighbours, the first of equals), the focal whose worse ratio error is least (the first of equals)."""
+    from physcam.usd.author import fov_preserving_float32
+
+    width, height = rw * focal, rh * focal
+    rw, rh = width / focal, height / focal
+    best = None
+    for fc in _f32_around(focal, k):
+        cw = min(_f32_around(rw * fc, 1), key=lambda w: abs(w / fc - rw))
+        ch = min(_f32_around(rh * fc, 1), key=lambda h: abs(h / fc - rh))
+        err = max(abs(cw / fc - rw) / rw, abs(ch / fc - rh) / rh)
+        if best is None or err < best[0]:
+            best = (err, (fc, cw, ch))
+    assert fov_preserving_float32(focal, width, height, k) == best[1]
 
 
 @pytest.mark.parametrize("mpu,focal_expected", [(0.01, 50.0), (1.0, 0.5), (0.0254, 50.0 / 2.54)])

@@ -97,10 +97,13 @@ def _f32(x: float) -> float:
     return struct.unpack("f", struct.pack("f", x))[0]
 
 
-def _f32_neighbours(x: float, k: int):
-    """``x`` rounded to float32 and the ``k`` float32 values on either side of it."""
-    bits = struct.unpack("i", struct.pack("f", _f32(x)))[0]
-    return [struct.unpack("f", struct.pack("i", bits + d))[0] for d in range(-k, k + 1)]
+def _f32_steps(x, steps):
+    """The float32 rounding of each ``x`` moved by each of ``steps`` float32 steps (a new last axis), as
+    float64: the float32 values beside ``x`` (adjacent float32 values differ by one in their bit pattern)."""
+    import numpy as np
+
+    bits = np.asarray(x, dtype=np.float32).view(np.int32)[..., None] + np.asarray(steps, dtype=np.int32)
+    return bits.view(np.float32).astype(np.float64)
 
 
 def fov_preserving_float32(focal: float, width: float, height: float, k: int = 24) -> tuple[float, float, float]:
@@ -110,17 +113,21 @@ def fov_preserving_float32(focal: float, width: float, height: float, k: int = 2
     of view by up to ~3e-6 degrees. The field of view depends only on aperture / focal
     length, so this picks, within ``k`` float32 steps of the focal length, the value
     whose best-rounded apertures give ratios closest to the exact ones (each value stays
-    within a few ulps, ~1e-6 relative, of its exact value).
+    within a few ulps, ~1e-6 relative, of its exact value). The first of equals wins; the
+    2k + 1 candidates are weighed as arrays (a live take writes one camera a frame).
     """
+    import numpy as np
+
     rw, rh = width / focal, height / focal
-    best = None
-    for fc in _f32_neighbours(focal, k):
-        cw = min(_f32_neighbours(rw * fc, 1), key=lambda w: abs(w / fc - rw))
-        ch = min(_f32_neighbours(rh * fc, 1), key=lambda h: abs(h / fc - rh))
-        err = max(abs(cw / fc - rw) / rw, abs(ch / fc - rh) / rh)
-        if best is None or err < best[0]:
-            best = (err, fc, cw, ch)
-    return best[1], best[2], best[3]
+    fc = _f32_steps(_f32(focal), np.arange(-k, k + 1))
+    rows = np.arange(fc.size)
+    picks = []
+    for r in (rw, rh):
+        c = _f32_steps(r * fc, (-1, 0, 1))  # the aperture's float32 rounding and its neighbours, per focal
+        picks.append(c[rows, np.argmin(np.abs(c / fc[:, None] - r), axis=1)])
+    cw, ch = picks
+    best = int(np.argmin(np.maximum(np.abs(cw / fc - rw) / rw, np.abs(ch / fc - rh) / rh)))
+    return float(fc[best]), float(cw[best]), float(ch[best])
 
 
 def _set(prim, name, type_name, value, custom=False):

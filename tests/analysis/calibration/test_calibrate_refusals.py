@@ -134,6 +134,24 @@ def test_a_wrong_grid_from_the_detector_is_refused_naming_the_photo(checker_phot
     assert pts.shape == (54, 2)
 
 
+def test_a_grid_missed_at_half_size_is_found_at_full_size_at_the_same_corners(checker_photo, monkeypatch):
+    """A 1280 x 960 photo is searched at half size first (HALF_SIZE_SEARCH_PX); when that finds no grid
+    (injected here) the full-size search finds it, and both ways give the same refined corners to 0.05 px
+    (the refinement's own scatter from different starting points)."""
+    _, img, _ = checker_photo
+    quick, _ = detect_chart(img, CHECKER)
+    real, sizes = cv2.findChessboardCornersSB, []
+
+    def blind_at_half_size(image, size, flags=0):
+        sizes.append(image.shape)
+        return (False, None) if image.shape != img.shape else real(image, size, flags=flags)
+
+    monkeypatch.setattr(cv2, "findChessboardCornersSB", blind_at_half_size)
+    full, _ = detect_chart(img, CHECKER)
+    assert sizes == [(480, 640), (960, 1280)]
+    assert np.abs(full - quick).max() < 0.05
+
+
 # ---- image bombs: refused from the header --------------------------------------------------------------
 def _png_header_only(path: Path, width: int, height: int, depth: int = 8) -> Path:
     """A PNG whose IHDR says ``width`` x ``height`` (grey, ``depth`` bits), followed by one compressed row:

@@ -48,6 +48,11 @@ MIN_CORNERS_PER_VIEW = 8
 #: A checkerboard's corners in every 3 x 3 block must fit a homography to this fraction of a square
 #: (a plane's picture through a lens: a homography locally, bent only by the distortion's curvature)
 GRID_TOLERANCE = 0.2
+#: A checkerboard photograph of at least this many pixels is searched at half size first (a quarter of
+#: the pixels; the sector detector's time goes with them: 1.45 -> 0.46 s CPU a 1280 x 960 photo) and the
+#: corners found are refined in the full image; the full-size search follows when that finds no grid
+#: or a grid out of order (:func:`_half_size_grid`)
+HALF_SIZE_SEARCH_PX = 1_000_000
 
 
 def _cv2():
@@ -236,8 +241,10 @@ def detect_chart(image: np.ndarray, chart: ChartSpec):
     cv2 = _cv2()
     img = _to8(image)
     if chart.kind == "checkerboard":
-        flags = cv2.CALIB_CB_EXHAUSTIVE | cv2.CALIB_CB_ACCURACY | cv2.CALIB_CB_NORMALIZE_IMAGE
-        ok, corners = cv2.findChessboardCornersSB(img, chart.inner, flags=flags)
+        refined = _half_size_grid(cv2, img, chart.inner)
+        if refined is not None:
+            return refined, chart.object_points()
+        ok, corners = cv2.findChessboardCornersSB(img, chart.inner, flags=_checkerboard_flags(cv2))
         if not ok:
             return None
         refined = _refine_checkerboard(cv2, img, corners.reshape(-1, 2), chart.inner)
@@ -257,6 +264,31 @@ def detect_chart(image: np.ndarray, chart: ChartSpec):
     pts = cv2.cornerSubPix(img, pts, (5, 5), (-1, -1), crit)
     obj = np.asarray(board.getChessboardCorners(), np.float64).reshape(-1, 3)
     return pts.reshape(-1, 2).astype(np.float64), obj[ids.ravel()]
+
+
+def _checkerboard_flags(cv2) -> int:
+    return cv2.CALIB_CB_EXHAUSTIVE | cv2.CALIB_CB_ACCURACY | cv2.CALIB_CB_NORMALIZE_IMAGE
+
+
+def _half_size_grid(cv2, img, inner):
+    """The refined corners of the checkerboard found in ``img`` halved (area average), or None when the
+    image is under :data:`HALF_SIZE_SEARCH_PX`, no grid is found at half size, or the grid found fails
+    :func:`grid_problem` (the full-size search then decides). A half-size pixel's centre (i + 0.5) lies
+    at full-size 2 (i + 0.5); the refinement (:func:`_refine_checkerboard`, its window 2-15 px) takes
+    the corners from there to where the full-size search's would be (within 0.05 px on 16 rendered photographs,
+    most within 1e-4 px)."""
+    h, w = img.shape
+    if h * w < HALF_SIZE_SEARCH_PX:
+        return None
+    small = cv2.resize(img, (w // 2, h // 2), interpolation=cv2.INTER_AREA)
+    ok, corners = cv2.findChessboardCornersSB(small, inner, flags=_checkerboard_flags(cv2))
+    if not ok:
+        return None
+    corners = (corners.reshape(-1, 2).astype(np.float64) + 0.5) * [w / small.shape[1], h / small.shape[0]] - 0.5
+    if grid_problem(corners, inner, folds_only=True):
+        return None
+    refined = _refine_checkerboard(cv2, img, corners, inner)
+    return None if grid_problem(refined, inner) else refined
 
 
 def grid_problem(points, inner, *, folds_only: bool = False) -> str | None:

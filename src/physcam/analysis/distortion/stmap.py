@@ -133,20 +133,30 @@ class _Grid:
         return out
 
     def row_blocks(self, width, height, origin=(0.0, 0.0), rows=ROW_BLOCK):
-        """Values at pixel centres origin + (i + 0.5, j + 0.5), rows top first, as (first row, values
-        (n, width, 2)) for blocks of ``rows`` rows: a full 8K frame of float64 pairs would be 0.5 GB."""
+        """Values at pixel centres origin + (i + 0.5, j + 0.5), rows top first, as (first row, [x values,
+        y values], each (n, width)) for blocks of ``rows`` rows: a full 8K frame of float64 pairs would be
+        0.5 GB. Separable: every padded row of nodes is interpolated across the frame once ((ny + 2, width)
+        per channel), then a block's rows mix only the few node rows their cubic reaches (a band of
+        ``rows`` / dy + 4): the dense product over every node row and column cost ~20x the arithmetic
+        (one pass over an 8K frame 2.3 -> 0.65 s CPU; docs/performance.md)."""
         mx = _matrix((origin[0] + np.arange(width) + 0.5 - self.x0) / self.dx, self.nx)
+        across = [self.p[:, :, c] @ mx.T for c in range(2)]
         my = _matrix((origin[1] + np.arange(height) + 0.5 - self.y0) / self.dy, self.ny)[::-1]  # top row first
         for r0 in range(0, height, rows):
             m = my[r0:r0 + rows]
-            yield r0, np.stack([m @ self.p[:, :, c] @ mx.T for c in range(2)], axis=-1)
+            used = np.flatnonzero(m.any(axis=0))
+            lo, hi = (used[0], used[-1] + 1) if used.size else (0, 1)
+            band = np.ascontiguousarray(m[:, lo:hi])  # my[::-1]'s negative strides would keep matmul off BLAS
+            yield r0, [band @ a[lo:hi] for a in across]
 
     def fill(self, out, scale, offset=(0.0, 0.0), origin=(0.0, 0.0)):
         """Write (value + offset) / scale into channels 0 and 1 of the image ``out`` (h, w, >= 2), block by block."""
         h, w = out.shape[:2]
         for r0, v in self.row_blocks(w, h, origin):
             for c in range(2):
-                out[r0:r0 + v.shape[0], :, c] = (v[..., c] + offset[c]) / scale[c]
+                v[c] += offset[c]
+                v[c] /= scale[c]
+                out[r0:r0 + v[c].shape[0], :, c] = v[c]
 
 
 def _nodes(extent_px, spacing=NODE_SPACING_PX):
@@ -364,9 +374,9 @@ def _overscan_px(fwd: _Grid, nodes, w_px: int, h_px: int, xscale: float = 1.0) -
     """
     edges = np.concatenate([nodes[0], nodes[-1], nodes[:, 0], nodes[:, -1]])
     lo, hi = edges.min(axis=0), edges.max(axis=0)
-    for _, block in fwd.row_blocks(w_px, h_px):
-        lo = np.minimum(lo, block.reshape(-1, 2).min(axis=0))
-        hi = np.maximum(hi, block.reshape(-1, 2).max(axis=0))
+    for _, (bx, by) in fwd.row_blocks(w_px, h_px):
+        lo = np.minimum(lo, [bx.min(), by.min()])
+        hi = np.maximum(hi, [bx.max(), by.max()])
     ox = int(math.ceil(xscale * max(0.0, -lo[0], hi[0] - w_px) - 1e-9))
     oy = int(math.ceil(max(0.0, -lo[1], hi[1] - h_px) - 1e-9))
     W2, H2 = round(w_px * xscale) + 2 * ox, h_px + 2 * oy
