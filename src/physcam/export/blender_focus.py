@@ -407,7 +407,7 @@ def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=(
     rectangle its sides moved out. A passing area is trusted (its sign, :func:`~physcam.export.blender_pupil.cell_area`)
     only where every traced table the cubic reads trusts it and the two interpolations agree within
     :data:`~physcam.export.blender_pupil.AREA_TOLERANCE`. With ``checks`` (each traced table's areas at
-    :func:`~physcam.export.blender_pupil.check_points` of the iris radii ``levels``, radial_pupil_table's)
+    :func:`~physcam.export.blender_pupil._check_points` of the iris radii ``levels``, radial_pupil_table's)
     a filled mark is checked as a traced one is instead (:func:`_filled_trust`): a cell a traced mark
     distrusts (its rho or iris interpolation misses there) is not withdrawn at every mark the cubic reads
     it from. A rectangle is empty only where the two traced about it are; next to an empty one it is the other's."""
@@ -460,13 +460,13 @@ def _filled_trust(traced, levels, area, c, want_c, want_l, unlit) -> np.ndarray:
     marks' errors), where that cubic and the line (``want_l``) agree within AREA_TOLERANCE, as
     :func:`~physcam.export.blender_pupil.radial_pupil_table` checks a traced mark; ``unlit``: nothing passes
     at a traced mark the cubic reads."""
-    from .blender_pupil import AREA_TOLERANCE, trusted_cells
+    from .blender_pupil import AREA_TOLERANCE, _checked_trust
 
     table = np.concatenate([c[..., :3], area[..., None], c[..., 4:5]], axis=-1)
     doubtful = np.abs(want_c - want_l) > AREA_TOLERANCE * np.maximum(np.abs(want_c), 1e-12)
     untrusted = unlit.copy()
     for i in sorted(set(range(len(area))) - set(np.asarray(traced).tolist())):
-        untrusted[i] |= ~trusted_cells(table[i], levels, np.maximum(want_c[i], 0.0), doubtful=doubtful[i])
+        untrusted[i] |= ~_checked_trust(table[i], levels, np.maximum(want_c[i], 0.0), doubtful=doubtful[i])
     return untrusted
 
 

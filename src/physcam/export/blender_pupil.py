@@ -49,8 +49,7 @@ import numpy as np
 from ..errors import InputError, require_finite, require_type
 
 __all__ = ["RADIAL_MAX_MM", "N_RADIAL", "LEVEL_RATIO", "N_LEVEL", "radial_pupil_table", "iris_levels",
-           "level_bracket", "interpolated_ellipse", "interpolated_area", "cell_area", "hermite", "radial_cubic",
-           "check_points", "trusted_cells"]
+           "level_bracket", "interpolated_ellipse", "interpolated_area", "cell_area", "hermite", "radial_cubic"]
 
 #: Film radius the table reaches (mm): the half diagonal of physcam's largest sensor (IMAX 15/70).
 RADIAL_MAX_MM = 44.0
@@ -580,8 +579,8 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", check
     :func:`cell_area`). ``backend``: the
     tracing backend (:func:`~physcam.trace.trace.trace_through`; "auto" picks one for the whole table,
     :func:`~physcam.trace.kernels.backend_for_job`: both give the same rays). ``checks``: a list that
-    receives the traced areas at :func:`check_points` (0 where nothing passes), for tables filled between
-    focus marks to be checked as this one is (:func:`trusted_cells`)."""
+    receives the traced areas at :func:`_check_points` (0 where nothing passes), for tables filled between
+    focus marks to be checked as this one is (:func:`_checked_trust`)."""
     from ..lens.prescription import require_prescription
     from ..trace.kernels import backend_for_job
 
@@ -617,7 +616,7 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", check
     # every film point (nodes and mids) at every iris radius checked: the shader's reading there must hold
     # the traced set (grown until it does) and, for its cell to be trusted, give its area
     cols = [at[float(s)] for s in checked]
-    read_rho, read_s = check_points(levels)
+    read_rho, read_s = _check_points(levels)
     read_rim = index[:, cols].ravel()
     has = read_rim >= 0
     _grow(table, levels, read_rho[has], read_s[has], read_rim[has], rims)
@@ -629,7 +628,7 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", check
     want = area[read_rim]
     if checks is not None:
         checks.append(want)
-    table[..., 3] = np.where(trusted_cells(table, levels, want), table[..., 3], -1.0 - table[..., 3])
+    table[..., 3] = np.where(_checked_trust(table, levels, want), table[..., 3], -1.0 - table[..., 3])
     return table
 
 
@@ -643,22 +642,22 @@ def _check_axes(levels) -> tuple[np.ndarray, np.ndarray]:
     return rhos, checked
 
 
-def check_points(levels) -> tuple[np.ndarray, np.ndarray]:
+def _check_points(levels) -> tuple[np.ndarray, np.ndarray]:
     """(film radius, iris radius) of every check of :func:`radial_pupil_table` at the iris radii ``levels``, in
     the order of its ``checks`` areas: every film radius of :func:`_check_axes` with every iris radius."""
     rhos, checked = _check_axes(levels)
     return np.repeat(rhos, len(checked)), np.tile(checked, len(rhos))
 
 
-def trusted_cells(table, levels, want, *, doubtful=None) -> np.ndarray:
+def _checked_trust(table, levels, want, *, doubtful=None) -> np.ndarray:
     """Per entry of the radial ``table`` (its area column's sign ignored), whether the shader may weigh rays
-    by the area in its cell: the shader's area at every :func:`check_points` is ``want`` (the passing sets'
+    by the area in its cell: the shader's area at every :func:`_check_points` is ``want`` (the passing sets'
     areas there, 0 where nothing passes) within :data:`AREA_TOLERANCE` on and in the cell, no check point
     of ``doubtful`` (a mask over them: ``want`` itself not known to that tolerance) lies on or in it, and
     something passes at its corners (:func:`_trusted_cells`)."""
     table = np.array(table, dtype=float)
     table[..., 3] = cell_area(table[..., 3])
-    read_rho, read_s = check_points(levels)
+    read_rho, read_s = _check_points(levels)
     want = np.asarray(want, dtype=float)
     got = _areas_at(table, levels, read_rho, read_s)
     bad = np.abs(got - want) > AREA_TOLERANCE * np.maximum(want, 1e-12)
