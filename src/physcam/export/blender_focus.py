@@ -36,7 +36,7 @@ from .osl import lens_data, osl_array, osl_number, render_template
 
 __all__ = ["FocusAxis", "FocusTable", "blend_weights", "blended_geometry", "focus_axis", "focus_geometry", "focus_table",
            "focus_table_shader", "fill_pupil_tables", "ghost_rows", "hermite_basis", "pupil_marks", "N_FOCUS", "GRID_HALF_MM",
-           "PUPIL_STRIDE", "ANAMORPHIC_PUPIL_STRIDE", "STOP_LEVELS"]
+           "PUPIL_STRIDE", "ANAMORPHIC_PUPIL_STRIDE", "FIRST_INTERVAL_MIDDLE", "STOP_LEVELS"]
 
 #: Focus states tabulated (infinity first, uniform in :class:`FocusAxis`'s s).
 N_FOCUS = 32
@@ -53,6 +53,11 @@ N_TRY = 8
 #: Every PUPIL_STRIDE-th focus mark (and the last) has its pupil and normalisation tables traced; the
 #: marks between are interpolated (:func:`fill_pupil_tables`; docs/blender.md, "Focus tables").
 PUPIL_STRIDE = 4
+#: For a lens with rotational symmetry, the middle of the first interval (infinity to the first traced mark)
+#: is traced too: the infinity mark distrusts area cells the finite marks trust (the double Gauss at f/2.8,
+#: film radius 8.6-9.8 mm), and a filled mark is checked only against marks the cubic reads, so without it
+#: marks 1-3 (2.5-10 m on the double Gauss) inherit the infinity mark's misses (issue 41, round 9).
+FIRST_INTERVAL_MIDDLE = True
 #: The same for an anamorphic lens: its exit-pupil rectangles step by a window sample as the lens
 #: focuses (not smooth), so every other mark is traced and a mark between holds both neighbours'.
 ANAMORPHIC_PUPIL_STRIDE = 2
@@ -317,7 +322,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
                 pupil_stride: int | None = None) -> FocusTable:
     """Tabulate ``lens``'s focus states (module notes). The pupil and normalisation tables are traced at
     :func:`pupil_marks` (``pupil_stride`` 1: at every mark; None: :data:`PUPIL_STRIDE`, or
-    :data:`ANAMORPHIC_PUPIL_STRIDE` for an anamorphic lens) and interpolated between them
+    :data:`ANAMORPHIC_PUPIL_STRIDE` for an anamorphic lens; :data:`FIRST_INTERVAL_MIDDLE`) and interpolated between them
     (:func:`fill_pupil_tables`). Raises OpticsError when the lens passes no ray at the film centre."""
     from ..optics.focusing import closest_focus, gaussian_at_focus
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
@@ -335,7 +340,9 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     if pupil_stride is None:
         pupil_stride = ANAMORPHIC_PUPIL_STRIDE if lens.is_anamorphic else PUPIL_STRIDE
     traced = pupil_marks(n_focus, pupil_stride)
-    radial, rects, stopped, norm = [], [], [], []
+    if FIRST_INTERVAL_MIDDLE and not lens.is_anamorphic and traced[1] > 2:  # the first interval's middle too
+        traced = np.unique(np.append(traced, traced[1] // 2))
+    radial, rects, stopped, norm, checks = [], [], [], [], []
     for i in traced.tolist():
         st = states[i]
         tracer = CameraTracer(st.prescription, st.film_z)  # the lens at this focus state as the file stops it
@@ -345,7 +352,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
             stopped.append(rect_levels)
             norm.append(_centre_norms(tracer, [np.array(b.rect_at(0.0, 0.0))] * len(levels), levels))
         else:
-            radial.append(radial_pupil_table(tracer.lens, st.film_z, levels))
+            radial.append(radial_pupil_table(tracer.lens, st.film_z, levels, checks=checks))
             b = _centre_bounds(tracer.lens, radial[-1][0, 0])
             norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(radial[-1])], levels))
         if i == 0:
@@ -354,7 +361,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     if not all(min(v) > 0 for v in norm):
         raise OpticsError(f"no ray from the film centre passes through {lens.name!r} at some focus")
     radial, rects, stopped, norm = fill_pupil_tables(traced, n_focus, radial=radial, rects=rects, stopped=stopped,
-                                                     norm=norm)
+                                                     norm=norm, checks=checks, levels=levels)
     return FocusTable(lens, axis, film_z, slope, vz, radial, rects, stopped,
                       norm, table0, bounds0, float(k), float(n_open), float(n_min), axis.near_mm, float(loss))
 
@@ -388,7 +395,7 @@ def _interpolation_weights(traced: np.ndarray, n: int) -> tuple[np.ndarray, np.n
     return cubic, linear
 
 
-def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=()):
+def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=(), checks=(), levels=()):
     """(radial, rects, stopped, norm) at every one of ``n`` focus marks from the tables traced at the marks
     ``traced`` (:func:`pupil_marks`; empty sequences give None). Between traced marks each number is the
     cubic in the index through the four traced marks about it (the tables are smooth in the axis's s,
@@ -399,8 +406,11 @@ def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=(
     ellipse's own norm) and by its entry's :func:`_roughness`, a
     rectangle its sides moved out. A passing area is trusted (its sign, :func:`~physcam.export.blender_pupil.cell_area`)
     only where every traced table the cubic reads trusts it and the two interpolations agree within
-    :data:`~physcam.export.blender_pupil.AREA_TOLERANCE`. A rectangle is empty only where the two traced
-    about it are; next to an empty one it is the other's."""
+    :data:`~physcam.export.blender_pupil.AREA_TOLERANCE`. With ``checks`` (each traced table's areas at
+    :func:`~physcam.export.blender_pupil._check_points` of the iris radii ``levels``, radial_pupil_table's)
+    a filled mark is checked as a traced one is instead (:func:`_filled_trust`): a cell a traced mark
+    distrusts (its rho or iris interpolation misses there) is not withdrawn at every mark the cubic reads
+    it from. A rectangle is empty only where the two traced about it are; next to an empty one it is the other's."""
     from .blender_pupil import AREA_TOLERANCE, cell_area
 
     traced = np.asarray(traced)
@@ -420,6 +430,9 @@ def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=(
         scale = 1.0 + d[..., 0] / c[..., 1]
         area_c, area_l = blend(cubic, cell_area(tab[..., 3])), blend(linear, cell_area(tab[..., 3]))
         untrusted = blend(reads.astype(float), tab[..., 3] < 0) > 0
+        if len(checks):  # withdrawn at a traced mark the cubic reads: checked at the filled mark itself
+            untrusted &= _filled_trust(traced, levels, np.maximum(area_c, 0.0), c, blend(cubic, checks),
+                                       blend(linear, checks), blend(reads.astype(float), cell_area(tab[..., 3]) <= 0) > 0)
         untrusted |= np.abs(area_c - area_l) > AREA_TOLERANCE * np.maximum(np.abs(area_c), 1e-12)
         area = np.maximum(area_c, 0.0)
         scale = scale * _roughness(traced, tab)[None]
@@ -437,6 +450,24 @@ def fill_pupil_tables(traced, n: int, *, radial=(), rects=(), stopped=(), norm=(
         out_norm = blend(cubic, norm)
         out_norm[traced] = np.asarray(norm, dtype=float)
     return out_radial, out_rects, out_stopped, out_norm
+
+
+def _filled_trust(traced, levels, area, c, want_c, want_l, unlit) -> np.ndarray:
+    """Per entry of the filled radial tables (marks, levels, radii), whether its cell is untrusted, the
+    traced marks' own trust left as it is: at a filled mark the shader's area (from the filled entries
+    ``area``, ellipses ``c``) is checked against the cubic in the index through the traced marks' check
+    areas (``want_c``; what linear in the tables, the shader's error there is the cubic through the traced
+    marks' errors), where that cubic and the line (``want_l``) agree within AREA_TOLERANCE, as
+    :func:`~physcam.export.blender_pupil.radial_pupil_table` checks a traced mark; ``unlit``: nothing passes
+    at a traced mark the cubic reads."""
+    from .blender_pupil import AREA_TOLERANCE, _checked_trust
+
+    table = np.concatenate([c[..., :3], area[..., None], c[..., 4:5]], axis=-1)
+    doubtful = np.abs(want_c - want_l) > AREA_TOLERANCE * np.maximum(np.abs(want_c), 1e-12)
+    untrusted = unlit.copy()
+    for i in sorted(set(range(len(area))) - set(np.asarray(traced).tolist())):
+        untrusted[i] |= ~_checked_trust(table[i], levels, np.maximum(want_c[i], 0.0), doubtful=doubtful[i])
+    return untrusted
 
 
 def _ellipse_reach(e, f) -> np.ndarray:

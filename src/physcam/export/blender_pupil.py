@@ -570,7 +570,7 @@ def _fill(table: np.ndarray, empty: np.ndarray) -> None:
             table[:, j] = table[:, near]
 
 
-def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto") -> np.ndarray:
+def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", checks: list | None = None) -> np.ndarray:
     """The table (len(levels) x :data:`N_RADIAL` x 5: cx, ax, ay in mm on the rear vertex plane, the
     passing set's area in mm^2 and its slope in mm^2 per mm of iris radius) of the focused lens ``q``
     (a Prescription) with its film at ``film_z``, at the iris radii ``levels`` (:func:`iris_levels`).
@@ -578,7 +578,9 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto") -> np
     is -1 - area where the shader may not weigh rays by the area in its cell (:func:`_trusted_cells`,
     :func:`cell_area`). ``backend``: the
     tracing backend (:func:`~physcam.trace.trace.trace_through`; "auto" picks one for the whole table,
-    :func:`~physcam.trace.kernels.backend_for_job`: both give the same rays)."""
+    :func:`~physcam.trace.kernels.backend_for_job`: both give the same rays). ``checks``: a list that
+    receives the traced areas at :func:`_check_points` (0 where nothing passes), for tables filled between
+    focus marks to be checked as this one is (:func:`_checked_trust`)."""
     from ..lens.prescription import require_prescription
     from ..trace.kernels import backend_for_job
 
@@ -591,15 +593,11 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto") -> np
     if not film_z > q.vertex_z[-1]:
         raise InputError(f"the film (z = {film_z:g} mm) must lie behind the lens's last vertex (z = {q.vertex_z[-1]:g} mm)")
     semi_max = levels[0]
-    mids = np.sqrt(levels[:-1] * levels[1:])
-    below = levels[-1] / 2
-    checked = np.unique(np.concatenate([levels, mids, [below]]))[::-1]
+    rhos, checked = _check_axes(levels)
     near = levels * (1 - _DS)  # the area's slope at each level (one-sided: one radius more per level, not two)
     radii = np.unique(np.concatenate([checked, near]))[::-1]
     r_rear = q.surfaces[-1].semi_diameter
     big = 20.0 * max(semi_max, q.surfaces[q.stop_index].semi_diameter)
-    step = RADIAL_MAX_MM / (N_RADIAL - 1)
-    rhos = np.concatenate([np.arange(N_RADIAL) * step, (np.arange(N_RADIAL - 1) + 0.5) * step])  # nodes, then mids
     wanted = np.ones((rhos.size, radii.size), dtype=bool)
     wanted[N_RADIAL:] = np.isin(radii, checked)  # between the nodes only the checks
     index, rims = _passing_sets(q, film_z, rhos.tolist(), radii, wanted, r_rear, big, backend)
@@ -618,7 +616,7 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto") -> np
     # every film point (nodes and mids) at every iris radius checked: the shader's reading there must hold
     # the traced set (grown until it does) and, for its cell to be trusted, give its area
     cols = [at[float(s)] for s in checked]
-    read_rho, read_s = np.repeat(rhos, len(cols)), np.tile(checked, len(rhos))
+    read_rho, read_s = _check_points(levels)
     read_rim = index[:, cols].ravel()
     has = read_rim >= 0
     _grow(table, levels, read_rho[has], read_s[has], read_rim[has], rims)
@@ -628,11 +626,45 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto") -> np
     # trace's within 0.4 % either way, module notes); an entry's sign says whether its cell is trusted (untrusted:
     # -1 - area, cell_area). A failed check withdraws only the cells it lies on or in.
     want = area[read_rim]
+    if checks is not None:
+        checks.append(want)
+    table[..., 3] = np.where(_checked_trust(table, levels, want), table[..., 3], -1.0 - table[..., 3])
+    return table
+
+
+def _check_axes(levels) -> tuple[np.ndarray, np.ndarray]:
+    """(film radii, iris radii) where :func:`radial_pupil_table` checks the shader's reading: the nodes and the
+    mids between them; the levels, the mids between them and half the last level (largest first)."""
+    levels = np.asarray(levels, dtype=float)
+    step = RADIAL_MAX_MM / (N_RADIAL - 1)
+    rhos = np.concatenate([np.arange(N_RADIAL) * step, (np.arange(N_RADIAL - 1) + 0.5) * step])  # nodes, then mids
+    checked = np.unique(np.concatenate([levels, np.sqrt(levels[:-1] * levels[1:]), [levels[-1] / 2]]))[::-1]
+    return rhos, checked
+
+
+def _check_points(levels) -> tuple[np.ndarray, np.ndarray]:
+    """(film radius, iris radius) of every check of :func:`radial_pupil_table` at the iris radii ``levels``, in
+    the order of its ``checks`` areas: every film radius of :func:`_check_axes` with every iris radius."""
+    rhos, checked = _check_axes(levels)
+    return np.repeat(rhos, len(checked)), np.tile(checked, len(rhos))
+
+
+def _checked_trust(table, levels, want, *, doubtful=None) -> np.ndarray:
+    """Per entry of the radial ``table`` (its area column's sign ignored), whether the shader may weigh rays
+    by the area in its cell: the shader's area at every :func:`_check_points` is ``want`` (the passing sets'
+    areas there, 0 where nothing passes) within :data:`AREA_TOLERANCE` on and in the cell, no check point
+    of ``doubtful`` (a mask over them: ``want`` itself not known to that tolerance) lies on or in it, and
+    something passes at its corners (:func:`_trusted_cells`)."""
+    table = np.array(table, dtype=float)
+    table[..., 3] = cell_area(table[..., 3])
+    read_rho, read_s = _check_points(levels)
+    want = np.asarray(want, dtype=float)
     got = _areas_at(table, levels, read_rho, read_s)
     bad = np.abs(got - want) > AREA_TOLERANCE * np.maximum(want, 1e-12)
-    trusted = _trusted_cells(levels, np.stack([read_rho[bad], read_s[bad]], axis=1), table[..., 3] > 0, step)
-    table[..., 3] = np.where(trusted, table[..., 3], -1.0 - table[..., 3])
-    return table
+    if doubtful is not None:
+        bad |= np.asarray(doubtful, dtype=bool)
+    step = RADIAL_MAX_MM / (N_RADIAL - 1)
+    return _trusted_cells(levels, np.stack([read_rho[bad], read_s[bad]], axis=1), table[..., 3] > 0, step)
 
 
 def _trusted_cells(levels, failed, lit, step: float) -> np.ndarray:
