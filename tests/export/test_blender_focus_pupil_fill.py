@@ -140,6 +140,23 @@ def test_the_film_slope_is_the_difference_of_exact_solves(slug):
         assert slope[k] == pytest.approx(ref, abs=2e-5), (slug, k)
 
 
+def _dense_passing(q, film_z, rho, s, cx, ax, ay, reach, n):
+    """(aim x, aim y, passing) of an n x n grid of aims on the rear vertex plane over ``reach`` times the
+    ellipse (cx, ax, ay), traced from the film point (rho, 0) through the focused lens ``q`` with the
+    iris at semi-diameter ``s``: the dense trace the tables are checked against."""
+    from physcam.trace.rays import OK, RayBatch
+    from physcam.trace.trace import trace_through
+
+    u = (np.arange(n) + 0.5) / n * 2 - 1
+    gx, gy = np.meshgrid(cx + u * reach * ax, u * reach * ay)
+    gx, gy = gx.ravel(), gy.ravel()
+    rays = RayBatch.from_arrays(np.broadcast_to([rho, 0.0, film_z], (gx.size, 3)),
+                                np.stack([gx - rho, gy, np.full(gx.size, q.vertex_z[-1] - film_z)], axis=1),
+                                q.wavelength_nm)
+    trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=s, in_place=True)
+    return gx, gy, rays.flag == OK
+
+
 @pytest.mark.slow
 def test_a_filled_mark_holds_the_rays_at_the_frame_edge_stopped_far_down(dgauss_table):
     """The double Gauss at filled mark 1 (between traced 0 and 2; round 8: 0 and 4), a film point 26.6 mm off axis (past full
@@ -154,8 +171,6 @@ def test_a_filled_mark_holds_the_rays_at_the_frame_edge_stopped_far_down(dgauss_
     efficiency."""
     from physcam.export.blender_pupil import interpolated_ellipse
     from physcam.trace.camera_tracer import CameraTracer
-    from physcam.trace.rays import OK, RayBatch
-    from physcam.trace.trace import trace_through
 
     lens = load_lens("dgauss_50mm")
     ft = dgauss_table
@@ -163,14 +178,7 @@ def test_a_filled_mark_holds_the_rays_at_the_frame_edge_stopped_far_down(dgauss_
     q = CameraTracer(st.prescription, st.film_z).lens
     rho, s = 26.583333333333332, ft.levels[-1] / 2
     cx, ax, ay = interpolated_ellipse(ft.radial[1], ft.levels, rho, s)
-    n = 300
-    gx, gy = np.meshgrid(cx + ((np.arange(n) + 0.5) / n * 2 - 1) * 3 * ax, ((np.arange(n) + 0.5) / n * 2 - 1) * 3 * ay)
-    gx, gy = gx.ravel(), gy.ravel()
-    rays = RayBatch.from_arrays(np.broadcast_to([rho, 0.0, st.film_z], (gx.size, 3)),
-                                np.stack([gx - rho, gy, np.full(gx.size, q.vertex_z[-1] - st.film_z)], axis=1),
-                                q.wavelength_nm)
-    trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=s, in_place=True)
-    ok = rays.flag == OK
+    gx, gy, ok = _dense_passing(q, st.film_z, rho, s, cx, ax, ay, 3.0, 300)
     inside = ((gx - cx) / ax) ** 2 + (gy / ay) ** 2 <= 1
     assert ok.sum() > 500
     assert (ok & ~inside).sum() == 0
@@ -224,8 +232,6 @@ def test_the_area_a_filled_mark_trusts_in_that_band_is_a_dense_traces(dgauss_tab
     with the iris stopped to f/2.8."""
     from physcam.export.blender_pupil import interpolated_area, interpolated_ellipse
     from physcam.trace.camera_tracer import CameraTracer
-    from physcam.trace.rays import OK, RayBatch
-    from physcam.trace.trace import trace_through
 
     ft = dgauss_table
     st = focus(load_lens("dgauss_50mm"), float(ft.marks_mm[k]))
@@ -235,14 +241,7 @@ def test_the_area_a_filled_mark_trusts_in_that_band_is_a_dense_traces(dgauss_tab
         area = interpolated_area(ft.radial[k], ft.levels, rho, s)
         assert area > 0, (k, rho)
         cx, ax, ay = interpolated_ellipse(ft.radial[k], ft.levels, rho, s)
-        u = (np.arange(n) + 0.5) / n * 2 - 1
-        gx, gy = np.meshgrid(cx + u * 1.3 * ax, u * 1.3 * ay)
-        gx, gy = gx.ravel(), gy.ravel()
-        rays = RayBatch.from_arrays(np.broadcast_to([rho, 0.0, st.film_z], (gx.size, 3)),
-                                    np.stack([gx - rho, gy, np.full(gx.size, q.vertex_z[-1] - st.film_z)], axis=1),
-                                    q.wavelength_nm)
-        trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=s, in_place=True)
-        ok = rays.flag == OK
+        _, _, ok = _dense_passing(q, st.film_z, rho, s, cx, ax, ay, 1.3, n)
         assert not ok.reshape(n, n)[[0, -1]].any() and not ok.reshape(n, n)[:, [0, -1]].any()  # the set lies inside
         dense = ok.sum() / n**2 * (2 * 1.3 * ax) * (2 * 1.3 * ay)
         print(f"mark {k} rho {rho}: table {area:.4f} mm^2, dense {dense:.4f} mm^2 ({area / dense - 1:+.2%})")
