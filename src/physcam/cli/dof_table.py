@@ -109,7 +109,7 @@ def build(args) -> dict:
     """The table as a dict (the JSON payload): :func:`physcam.onset.dof_table.dof_table` of the options,
     with the zoom block of ``--zoom``."""
     from ..errors import InputError
-    from ..onset.dof_table import dof_table
+    from ..onset.dof_table import MAX_MARKS, dof_table
     from ._common import coc_of, resolve_sensor
 
     lens = None
@@ -126,12 +126,11 @@ def build(args) -> dict:
     elif args.focal is None:
         raise InputError("give the focal length, e.g. --focal 35, or a lens with --lens NAME")
     marks = args.focus if args.focus is not None else focus_list("focus marks")(DEFAULT_FOCUS)
-    if len(marks) > 40:
-        raise InputError(f"a table takes up to 40 focus marks, got {len(marks)}")
+    if len(marks) > MAX_MARKS:  # before the sensor is resolved: the command's own order of refusals
+        raise InputError(f"a table takes up to {MAX_MARKS} focus marks, got {len(marks)}")
     sensor = resolve_sensor(args)
     d = dof_table(None if lens is not None else args.focal, lens=lens, sensor=sensor, fstops=args.fstops,
                   focus_marks_mm=marks, coc=coc_of(args), squeeze=squeeze_of(args, sensor))
-    d["focus"] = [m if isinstance(m, str) else ("infinity" if math.isinf(m) else m) for m in marks]
     d["zoom"] = getattr(args, "zoom_block", None)
     return d
 
