@@ -292,6 +292,70 @@ def pyplot():
     return _PLOT
 
 
+def dots(ax, x, y, sizes, color="k"):
+    """``ax.scatter(x, y, s=sizes, c=color, lw=0)`` (round dots, ``sizes`` in points^2) drawn as what
+    they cover on a raster canvas: each dot's area in pixels spread bilinearly over the four pixels
+    around its centre and the dots composited over one another as Agg composites them
+    (1 - prod(1 - coverage)), one image instead of one antialiased path per dot (a spot diagram's
+    56,000 dots: 0.22 s of Agg's path rendering, issue 47). Dots under a pixel across are where
+    the two agree (tests/test_figures_dots.py measures both); SVG and PDF draw the scatter itself."""
+    coll = ax.scatter(x, y, s=sizes, c=color, lw=0)
+    coll.__class__ = _coverage_dots_class()
+    return coll
+
+
+@functools.cache
+def _coverage_dots_class():
+    from matplotlib.backends.backend_agg import RendererAgg
+    from matplotlib.collections import PathCollection
+
+    class CoverageDots(PathCollection):
+        """A scatter of round dots that an Agg canvas draws as one coverage image (:func:`dots`)."""
+
+        def draw(self, renderer):
+            if not isinstance(renderer, RendererAgg) or not self.get_visible():
+                return super().draw(renderer)
+            renderer.open_group("dots", self.get_gid())
+            gc = renderer.new_gc()
+            self._set_gc_clip(gc)
+            image, x0, y0 = _coverage_image(self, renderer.points_to_pixels(1.0), self.axes.bbox)
+            if image is not None:
+                renderer.draw_image(gc, x0, y0, image)
+            gc.restore()
+            renderer.close_group("dots")
+            self.stale = False
+
+    return CoverageDots
+
+
+def _coverage_image(coll, px_per_pt: float, box):
+    """(RGBA image, left, bottom) of :func:`dots` over the pixels of ``box`` (display units)."""
+    import numpy as np
+
+    xy = coll.get_offset_transform().transform(coll.get_offsets())
+    area = np.broadcast_to(coll.get_sizes(), (len(xy),)) * (np.pi / 4.0 * px_per_pt ** 2)  # diameter^2 pi / 4
+    x0, y0 = int(np.floor(box.x0)), int(np.floor(box.y0))
+    w, h = int(np.ceil(box.x1)) - x0, int(np.ceil(box.y1)) - y0
+    u, v = xy[:, 0] - x0 - 0.5, xy[:, 1] - y0 - 0.5  # from the first pixel's centre
+    inside = (u > -1.0) & (u < w) & (v > -1.0) & (v < h) & (area > 0)
+    if w <= 0 or h <= 0 or not inside.any():
+        return None, x0, y0
+    u, v, area = u[inside], v[inside], area[inside]
+    i, j = np.floor(u), np.floor(v)
+    fu, fv = u - i, v - j
+    i, j = i.astype(np.int64) + 1, j.astype(np.int64) + 1  # a border of one pixel each side, cut below
+    lost = np.zeros((h + 2) * (w + 2))  # sum of log(1 - coverage) per pixel
+    for di, wu in ((0, 1.0 - fu), (1, fu)):
+        for dj, wv in ((0, 1.0 - fv), (1, fv)):
+            cover = np.minimum(area * wu * wv, 1.0 - 1e-12)
+            lost += np.bincount((j + dj) * (w + 2) + i + di, weights=np.log1p(-cover), minlength=lost.size)
+    alpha = -np.expm1(lost.reshape(h + 2, w + 2)[1:-1, 1:-1])
+    rgba = np.empty((h, w, 4), dtype=np.uint8)
+    rgba[..., :3] = np.round(np.asarray(coll.get_facecolor()[0][:3]) * 255.0).astype(np.uint8)
+    rgba[..., 3] = np.round(alpha * (255.0 * coll.get_facecolor()[0][3]))
+    return rgba, x0, y0  # the first row at the bottom, as draw_image takes it
+
+
 def _skip_layout_rerun(fig) -> None:
     """After ``fig.tight_layout()`` matplotlib leaves a do-nothing placeholder layout engine, and
     ``savefig`` then draws the whole figure once more (without rendering) just to run it: for a
