@@ -89,11 +89,12 @@ PROGRAM_IMPORT = False
 
 
 def _lean_import() -> None:
-    """Import matplotlib for the ``physcam`` program, skipping three things it never uses (issue 47,
+    """Import matplotlib for the ``physcam`` program, skipping what it never uses (issue 47,
     measured in docs/performance.md): the property tables matplotlib writes into the docstring of
     every artist class's ``set()`` as the class is made (``matplotlib.artist.kwdoc``: a third of
-    matplotlib's import, 0.15 s of CPU), the signature listing those properties (0.04-0.06 s), and
-    its 3-D toolkit, which registering the ``3d`` projection imports with every figure. Only when
+    matplotlib's import, 0.15 s of CPU), the signature listing those properties (0.04-0.06 s),
+    its 3-D toolkit, which registering the ``3d`` projection imports with every figure, and the code of
+    :data:`LAZY_MODULES` until something reads them. Only when
     matplotlib is not imported yet and :data:`PROGRAM_IMPORT` (or :data:`physcam._program.RUNNING`) is
     set; a library caller's matplotlib is left whole."""
     import sys
@@ -111,6 +112,39 @@ def _lean_import() -> None:
     # method of the class (matplotlib.artist.ArtistInspector: 92 classes, 0.06 s of CPU); set() itself
     # takes its keywords from the class's alias map, so the program keeps only the flag it checks
     matplotlib.artist.Artist._update_set_signature_and_docstring = classmethod(_mark_set_generated)
+    finder = _LazyModules()
+    sys.meta_path.insert(0, finder)
+    try:
+        _import_projections(sys, warnings)
+    finally:
+        sys.meta_path.remove(finder)
+
+
+#: Modules matplotlib imports once, with a plain ``import``, and reads only for what physcam's figures never
+#: draw: TeX's glyph names (``matplotlib.dviread``'s ``fontTools.agl``, 7-10 ms of CPU). The program imports
+#: them lazily: a module's code runs at its first use (docs/performance.md, "Round 10"). (dateutil's parser
+#: cannot be: ``matplotlib.dates`` imports it a second time, and a second import runs a lazy module.)
+LAZY_MODULES = ("fontTools.agl",)
+
+
+class _LazyModules:
+    """A meta-path finder that hands out :data:`LAZY_MODULES` through ``importlib.util.LazyLoader``
+    (the standard library's lazy import: the module object now, its code at the first attribute read)."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name not in LAZY_MODULES:
+            return None
+        import importlib.machinery
+        import importlib.util
+
+        spec = importlib.machinery.PathFinder.find_spec(name, path)
+        if spec is not None and spec.loader is not None:
+            spec.loader = importlib.util.LazyLoader(spec.loader)
+        return spec
+
+
+def _import_projections(sys, warnings) -> None:
+    """matplotlib's projections without the 3-D toolkit (:func:`_lean_import`)."""
     if "mpl_toolkits.mplot3d" not in sys.modules:
         sys.modules["mpl_toolkits.mplot3d"] = None  # the projections' import of it fails: no "3d" projection
         try:
