@@ -187,11 +187,29 @@ def figure_style():
         import matplotlib
 
         with _LOCK, matplotlib.rc_context():
-            matplotlib.rcdefaults()  # (keeps the backend and the other settings styles never touch)
+            _rcdefaults(matplotlib)  # (keeps the backend and the other settings styles never touch)
             matplotlib.rcParams.update(_style_params())
             yield
     finally:
         _STATE.depth = max(0, _depth() - 1)
+
+
+#: The settings ``matplotlib.rcdefaults()`` leaves as they are (matplotlib's style blacklist: the backend, the
+#: interactive and GUI settings, the date epoch, ...; tests/test_figures_rcparams.py checks this copy against it).
+RC_KEPT = frozenset({"backend", "backend_fallback", "date.epoch", "docstring.hardcopy", "figure.max_open_warning",
+                     "figure.raise_window", "interactive", "savefig.directory", "timezone", "tk.window_focus", "toolbar",
+                     "webagg.address", "webagg.open_in_browser", "webagg.port", "webagg.port_retries"})
+
+
+def _rcdefaults(matplotlib) -> None:
+    """What ``matplotlib.rcdefaults()`` does, without importing ``matplotlib.style`` for its blacklist (which
+    reads matplotlib's whole style library, 9 ms of a cold figure command: issue 47)."""
+    import warnings
+
+    with warnings.catch_warnings():  # deprecated settings warned once, when matplotlib made its defaults
+        warnings.simplefilter("ignore", matplotlib.MatplotlibDeprecationWarning)
+        matplotlib.rcParams.clear()
+        matplotlib.rcParams.update({k: v for k, v in matplotlib.rcParamsDefault.items() if k not in RC_KEPT})
 
 
 def _settle(fig) -> None:
