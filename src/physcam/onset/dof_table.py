@@ -20,7 +20,7 @@ from ..units import parse_distance
 from .report import HYPERFOCAL, solve_report
 from .request import report_camera
 
-__all__ = ["DEFAULT_FOCUS", "DEFAULT_FSTOPS", "dof_table", "format_squeeze"]
+__all__ = ["DEFAULT_FOCUS", "DEFAULT_FSTOPS", "dof_cells", "dof_table", "format_squeeze"]
 
 #: The f-stops and marks of a table when none are given (the full stops of a cine lens; common marks).
 DEFAULT_FSTOPS = (1.4, 2.0, 2.8, 4.0, 5.6, 8.0, 11.0, 16.0)
@@ -123,10 +123,25 @@ def _table_lens(focal_length_mm, lens, sensor, squeeze, zoom):
     return lens, squeeze, zoom_block
 
 
-def _cell(focal_length_mm, lens, sensor, coc, squeeze, fstop, mark):
-    """The lens report of one cell: ``physcam report`` of this lens at ``fstop`` and ``mark``."""
-    return solve_report(report_camera(focal_length_mm=focal_length_mm, lens=lens, sensor=sensor, fstop=fstop,
-                                      focus_mm=mark, coc=coc, squeeze=squeeze))
+def _cells(focal_length_mm, lens, sensor, coc, squeeze, zoom):
+    """(``cell(fstop, mark) -> LensReport``, the lens at its zoom position, the ``zoom`` block) of a table's
+    options: each cell ``physcam report`` of this lens at that stop and mark, the lens zoomed and the squeeze read
+    once."""
+    lens, squeeze, zoom_block = _table_lens(focal_length_mm, lens, sensor, squeeze, zoom)
+
+    def cell(fstop, mark):
+        return solve_report(report_camera(focal_length_mm=focal_length_mm, lens=lens, sensor=sensor, fstop=fstop,
+                                          focus_mm=mark, coc=coc, squeeze=squeeze))
+
+    return cell, lens, zoom_block
+
+
+def dof_cells(focal_length_mm: float | None = None, *, lens=None, sensor, coc=None, squeeze: float | str = 1.0,
+              zoom=None):
+    """``cell(fstop, focus_mark) -> LensReport``: the report of one cell of :func:`dof_table` with these options
+    (its own names and checks), at any stop and mark, for a chart drawn beside the table (``physcam dof-table -o``'s
+    card) that must agree with it cell by cell: the table's rows are made by the same function."""
+    return _cells(focal_length_mm, lens, sensor, coc, squeeze, zoom)[0]
 
 
 def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops=DEFAULT_FSTOPS,
@@ -145,7 +160,7 @@ def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops
     ``*_from_film_mm``, ``total_mm``, fields of view), ``hyperfocal``, ``sensor``, ``coc_mm``, ``zoom`` (the
     position's block, None without one), ...
     """
-    lens, squeeze, zoom_block = _table_lens(focal_length_mm, lens, sensor, squeeze, zoom)
+    cell, lens, zoom_block = _cells(focal_length_mm, lens, sensor, coc, squeeze, zoom)
     fstops = [_fstop(n) for n in _listed(fstops, "fstops")]
     marks = [_mark(m) for m in _listed(focus_marks_mm, "focus_marks_mm")]
     if not fstops or len(fstops) > MAX_FSTOPS:
@@ -157,7 +172,7 @@ def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops
         warnings.simplefilter("ignore", PhysCamWarning)
         for n in fstops:
             for m in marks:
-                r = _cell(focal_length_mm, lens, sensor, coc, squeeze, n, m)
+                r = cell(n, m)
                 first = first or r
                 rows.append(_row(r, m))
             hyper.append({"fstop": n, "hyperfocal_from_film_mm": rows[-1]["hyperfocal_from_film_mm"]})
