@@ -160,3 +160,38 @@ def test_samples_check_and_refresh_cannot_follow_are_refused(tmp_path, capsys, e
     for action in ("check", "refresh"):
         assert expected in _refused(capsys, action, f)
 
+
+
+def test_a_shots_keyed_focus_over_a_vendor_lens_is_refreshed_in_the_shot(tmp_path):
+    """A shot (body and vendor lens files referenced, physcam.usd.kit) whose focus override a layout artist keys:
+    the refresh writes its samples as shot opinions, the lens file untouched, and the shot checks current."""
+    from physcam.lens.library import load_lens
+    from physcam.onset.report import report_camera, solve_report
+    from physcam.optics.sensors import Sensor
+    from physcam.usd.author import CameraSpec
+    from physcam.usd.kit import check_shot, refresh_shot, write_body_file, write_shot, write_vendor_lens
+
+    lens, body, shot = (tmp_path / n for n in ("lens.usda", "body.usda", "shot.usda"))
+    write_vendor_lens(lens, load_lens("dgauss_50mm"), focus_mm=3000.0, fstop=2.8)
+    write_body_file(body, CameraSpec.of(focal_length_mm=50.0, fstop=2.8, focus_mm=3000.0, sensor_width_mm=24.89,
+                                        sensor_height_mm=18.66))
+    write_shot(shot, body, lens, overrides={"focus_mm": 2500.0})
+    lens_bytes = lens.read_bytes()
+    stage = Usd.Stage.Open(str(shot))
+    focus = stage.GetPrimAtPath("/Cameras/Shot/Pinhole").GetAttribute("focusDistance")
+    focus.Set(2000.0, 1.0)
+    focus.Set(4000.0, 48.0)
+    stage.Save()
+    before = check_shot(shot)
+    assert before["stale"] and [s["time"] for s in before["stale_samples"]] == [1.0, 48.0]
+    after = refresh_shot(shot)
+    assert after["written"] and not after["stale"] and lens.read_bytes() == lens_bytes
+    stage = Usd.Stage.Open(str(shot))
+    assert validation_errors(stage) == []
+    w, h = stage.GetPrimAtPath("/Cameras/Shot").GetAttribute("sensor:main:aperture").Get()
+    r = solve_report(report_camera(focal_length_mm=None, lens=load_lens("dgauss_50mm"), fstop=2.8, focus_mm=4000.0,
+                                   sensor=Sensor(key="custom", name="S35", width_mm=float(w), height_mm=float(h))))
+    geom = stage.GetPrimAtPath("/Cameras/Shot/Camera")
+    assert _rel(geom.GetAttribute("focalLength").Get(48.0), r.pinhole_focal_length_mm, 2e-5)
+    assert _rel(stage.GetPrimAtPath("/Cameras/Shot").GetAttribute("lens:main:entrancePupilDistance").Get(48.0),
+                r.entrance_pupil_from_film_mm)

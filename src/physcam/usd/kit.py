@@ -629,8 +629,9 @@ def _refuse_unkeyable_samples(stage, path, file, action: str) -> None:
                 raise ExportError(f"{file}: {name} is animated from a real lens that the file does not store "
                                   f"(usd animate --lens): usd {action} cannot solve it again; write the animation "
                                   f"again with `physcam usd animate {file} --marks CSV ... --force`")
-            raise ExportError(f"{file}: {name} is animated ({a.GetNumTimeSamples()} time samples): usd {action} "
-                              "follows a keyed focus, f-stop and focal length sample by sample, not this attribute")
+            n = a.GetNumTimeSamples()
+            raise ExportError(f"{file}: {name} is animated ({n} time sample{'s' * (n != 1)}): usd {action} follows "
+                              "a keyed focus, f-stop and focal length sample by sample, not this attribute")
 
 
 def _stale_samples(stage, path, expected: dict) -> list[dict]:
