@@ -14,6 +14,7 @@ import math
 
 import pytest
 
+from _documents import check_document
 from physcam.cli import main
 from physcam.usd.validate import validation_errors
 
@@ -29,7 +30,9 @@ def _rel(a, b, tol=2e-6):
 def _check_json(capsys, f):
     capsys.readouterr()
     rc = main(["usd", "check", str(f), "--json"])
-    return rc, json.loads(capsys.readouterr().out)
+    doc = json.loads(capsys.readouterr().out)
+    assert check_document(doc) == "physcam.usd_check"  # the schema's time_codes and stale_samples
+    return rc, doc
 
 
 def _pull(tmp_path, name="pull"):
@@ -62,7 +65,11 @@ def test_an_edited_thin_lens_pull_is_stale_at_its_time_codes_and_refreshed_to_th
     assert main(["usd", "check", str(f)]) == 1
     assert "time code 10: stale" in capsys.readouterr().out
 
-    assert main(["usd", "refresh", str(f)]) == 0
+    capsys.readouterr()
+    assert main(["usd", "refresh", str(f), "--json"]) == 0
+    done = json.loads(capsys.readouterr().out)
+    assert check_document(done) == "physcam.usd_refresh" and done["written"] and not done["stale"]
+    assert {c["time"] for c in done["changed"]} == {5.0, 10.0}  # frame 1's samples kept as they were
     stage = Usd.Stage.Open(str(f))
     assert validation_errors(stage) == []
     cam, model, geom = (stage.GetPrimAtPath(p) for p in (CAM, MODEL, GEOM))
