@@ -29,7 +29,7 @@ from ..lens.prescription import Prescription, takes_prescription
 from ..lens.zoom import prescription_at, tabulated_encoders
 from . import focusing, paraxial
 
-__all__ = ["ZoomRow", "encoder_for_focal_length", "at_zoom", "zoom_encoder", "efl_at", "zoom_table",
+__all__ = ["ZoomRow", "encoder_for_focal_length", "at_zoom", "named_at_zoom", "zoom_encoder", "efl_at", "zoom_table",
            "zoom_breathing", "default_encoders"]
 
 #: Samples of EFL(u) that check monotonicity and bracket a requested focal length.
@@ -129,6 +129,22 @@ def zoom_encoder(lens: Prescription, zoom, *, wavelength_nm=None) -> float:
 def at_zoom(lens: Prescription, zoom, *, wavelength_nm=None) -> Prescription:
     """The plain prescription of a zoom lens at ``zoom`` (:func:`zoom_encoder`'s forms)."""
     return prescription_at(lens, zoom_encoder(lens, zoom, wavelength_nm=wavelength_nm))
+
+
+@takes_prescription
+def named_at_zoom(lens: Prescription, zoom, *, wavelength_nm=None) -> tuple[Prescription, dict]:
+    """(the prescription of a zoom ``lens`` at ``zoom``, its ``zoom`` block): the prescription named with its
+    position (``"<name> at 135.0 mm (zoom 0.5)"``, the paraxial EFL and the encoder value, as tables, cards and
+    ST-map headers carry it), and the block the commands' JSON documents hold: ``{"asked": the position as
+    given, "encoder": 0..1, "efl_mm": the paraxial EFL there}``. ``zoom``: :func:`zoom_encoder`'s forms; a focal
+    length outside the zoom range (the error names the range) and a prime lens are InputErrors."""
+    from .._record import replace
+
+    u = zoom_encoder(lens, zoom, wavelength_nm=wavelength_nm)
+    q = prescription_at(lens, u)
+    block = {"asked": str(zoom), "encoder": u, "efl_mm": paraxial.gaussian(q).efl}
+    name = f"{lens.name} at {block['efl_mm']:.1f} mm (zoom {u:.4g})"
+    return replace(q, metadata=replace(q.metadata, name=name)), block
 
 
 @takes_prescription
