@@ -292,77 +292,9 @@ def new_figure(figsize=None, dpi=None, **kwargs):
     inside = _depth() > 0
     with figure_style():
         fig = Figure(figsize=figsize, dpi=dpi, **kwargs)
-    _canvas_class()(fig)
+    FigureCanvasAgg(fig)
     fig._physcam_unstyled = not inside  # STRICT_ENV: a physcam figure made outside the style is a bug
     return fig
-
-
-@functools.cache
-def _canvas_class():
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    class Canvas(FigureCanvasAgg):
-        """matplotlib's Agg canvas, writing PNG files itself (:func:`png_bytes`): the same pixels as
-        ``print_png``, without Pillow's plugins and row filters (issue 47, docs/performance.md "Round 10")."""
-
-        def print_png(self, filename_or_obj, *, metadata=None, pil_kwargs=None, **ignored):
-            # ``ignored``: what savefig hands a print method outside matplotlib (dpi, facecolor, edgecolor,
-            # orientation, bbox_inches_restore), all of it already applied to the figure; Agg's own ignores it
-            import matplotlib
-
-            meta = {"Software": f"Matplotlib version{matplotlib.__version__}, https://matplotlib.org/",
-                    **(metadata or {})}
-            meta = {k: v for k, v in meta.items() if v is not None}
-            if pil_kwargs or not all(_latin1(k) and _latin1(v) and 0 < len(k) < 80 for k, v in meta.items()):
-                return super().print_png(filename_or_obj, metadata=metadata, pil_kwargs=pil_kwargs)
-            FigureCanvasAgg.draw(self)
-            data = png_bytes(self.buffer_rgba(), dpi=self.figure.dpi, text=meta)
-            if hasattr(filename_or_obj, "write"):
-                filename_or_obj.write(data)
-            else:
-                Path(filename_or_obj).write_bytes(data)
-
-    return Canvas
-
-
-def _latin1(text) -> bool:
-    try:
-        str(text).encode("latin-1")
-    except UnicodeEncodeError:
-        return False
-    return True
-
-
-def png_bytes(rgba, *, dpi: float | None = None, text: dict | None = None) -> bytes:
-    """A PNG file (ISO/IEC 15948, "Portable Network Graphics") of an (h, w, 4) uint8 RGBA image, first row
-    at the top: 8-bit truecolour (RGB, colour type 2) when every pixel is opaque, else with alpha (type 6);
-    rows unfiltered (filter type 0) and compressed by zlib at level 6 (a figure's flat colours compress
-    better so than with Pillow's per-row filters: 17-30 % smaller, in half the time); ``dpi`` as the
-    physical pixel size (pHYs, pixels per metre) and ``text`` as tEXt chunks (Latin-1), as Pillow writes them."""
-    import struct
-    import zlib
-
-    import numpy as np
-
-    a = np.asarray(rgba)
-    h, w = a.shape[:2]
-    opaque = bool((a[..., 3] == 255).all())
-    px = np.ascontiguousarray(a[..., :3] if opaque else a).reshape(h, -1)
-    raw = np.empty((h, px.shape[1] + 1), dtype=np.uint8)
-    raw[:, 0] = 0  # each row's filter type: none
-    raw[:, 1:] = px
-
-    def chunk(kind: bytes, body: bytes) -> bytes:
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
-
-    out = [b"\x89PNG\r\n\x1a\n", chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2 if opaque else 6, 0, 0, 0))]
-    if dpi is not None:
-        ppm = int(dpi / 0.0254 + 0.5)
-        out.append(chunk(b"pHYs", struct.pack(">IIB", ppm, ppm, 1)))
-    for k, v in (text or {}).items():
-        out.append(chunk(b"tEXt", str(k).encode("latin-1") + b"\0" + str(v).encode("latin-1")))
-    out += [chunk(b"IDAT", zlib.compress(raw.tobytes(), 6)), chunk(b"IEND", b"")]
-    return b"".join(out)
 
 
 def subplots(nrows: int = 1, ncols: int = 1, *, figsize=None, dpi=None, squeeze: bool = True, **kwargs):
