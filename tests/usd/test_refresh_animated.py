@@ -202,3 +202,45 @@ def test_a_shots_keyed_focus_over_a_vendor_lens_is_refreshed_in_the_shot(tmp_pat
     assert _rel(geom.GetAttribute("focalLength").Get(48.0), r.pinhole_focal_length_mm, 2e-5)
     assert _rel(stage.GetPrimAtPath("/Cameras/Shot").GetAttribute("lens:main:entrancePupilDistance").Get(48.0),
                 r.entrance_pupil_from_film_mm)
+
+
+def _dgauss(tmp_path, name="lens.usda"):
+    f = tmp_path / name
+    assert main(["usd", "write", str(f), "--lens", "dgauss_50mm", "--fstop", "2.8", "--focus", "3m", "--sensor",
+                 "S35"]) == 0
+    return f
+
+
+def test_keys_without_a_default_still_check_and_refresh_the_cameras_other_inputs(tmp_path, capsys):
+    """A DCC export writes a keyed focus as samples only (no default): an ISO, shutter and clipping change on the
+    body is stale, and the refresh writes them to the companion (the closed forms: ISO as is, the shutter's close
+    = open + duration x frame rate (24 fps), the clipping range as the lens gives it, in scene units)."""
+    f = _dgauss(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
+    focus.Set(3000.0, 1.0)
+    focus.Set(1500.0, 24.0)
+    focus.ClearDefault()
+    stage.Save()
+    assert main(["usd", "refresh", str(f)]) == 0
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and doc["time_codes"] == [1.0, 24.0]
+    stage = Usd.Stage.Open(str(f))
+    cam = stage.GetPrimAtPath(CAM)
+    cam.GetAttribute("sensor:main:iso").Set(3200.0)
+    cam.GetAttribute("shutterDuration").Set(0.01)
+    cam.GetAttribute("lens:main:clippingRange").Set((1.0, 500.0))
+    stage.Save()
+    rc, doc = _check_json(capsys, f)
+    assert rc == 1 and doc["stale"] and doc["stale_samples"] == []
+    assert main(["usd", "refresh", str(f)]) == 0
+    stage = Usd.Stage.Open(str(f))
+    geom = stage.GetPrimAtPath(GEOM)
+    assert geom.GetAttribute("exposure:iso").Get() == 3200.0
+    assert _rel(geom.GetAttribute("shutter:close").Get() - geom.GetAttribute("shutter:open").Get(), 0.01 * 24)
+    assert tuple(geom.GetAttribute("clippingRange").Get()) == (1.0, 500.0)  # the lens's, in the stage's unit
+    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")  # no default added to the keys
+    assert focus.GetResolveInfo(Usd.TimeCode.Default()).GetSource() != Usd.ResolveInfoSourceDefault
+    assert validation_errors(stage) == []
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and not doc["stale"]

@@ -247,24 +247,26 @@ def _read_spec(stage, path):
     return read_camera(stage, path).spec
 
 
-def _author_shot_companion(stage, path) -> str:
+def _author_shot_companion(stage, path, time: float | None = None) -> str:
     """(Re)compute the shot's companion UsdGeomCamera from the composed camera; return the inputs hash.
 
     With a prescription the lens is re-evaluated at the composed focus and f-stop on the composed
     (body's) sensor; its derived lens values are written as shot opinions and its distortion is
     fitted for that sensor. The hash of every input (:func:`companion_inputs_hash`) is stored
-    as ``customData physcam:companionInputs`` on the companion, for :func:`check_shot`.
+    as ``customData physcam:companionInputs`` on the companion, for :func:`check_shot`. ``time``: the
+    time code whose values a keyed lens without default values gives its still part (:func:`_still_time`).
     """
     from pxr import Sdf
 
     from .author import _eye_from_film, author_anamorphic_distortion, iris_mm
 
-    spec, rx, report, derived = _lens_solved(stage, path)
+    spec, rx, report, derived = _lens_solved(stage, path, time)
     cam = stage.GetPrimAtPath(path)
     distortion, opencv, anamorphic = None, None, []
     if derived is not None:
         _author_lens_derived(stage, cam, derived)
-        _author_model_focal_length(stage, cam, derived.focal_length_mm)
+        if time is None:  # else the model's focal length is keyed, with no default to give it
+            _author_model_focal_length(stage, cam, derived.focal_length_mm)
         distortion = prescription_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
         anamorphic = prescription_anamorphic_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm,
                                                         focus_mm=spec.focus_mm)
@@ -284,7 +286,7 @@ def _author_shot_companion(stage, path) -> str:
 
         # usd write's account of the thin lens against the real one, at the stop and focus now authored
         geom.GetPrim().SetCustomDataByKey("physcam:thinLensGap", _usd_dict(thin_lens_gap(report).to_dict()))
-    digest = companion_inputs(stage, path)
+    digest = companion_inputs(stage, path, time=time)
     geom.GetPrim().SetCustomDataByKey("physcam:companionInputs", digest)
     return digest
 
@@ -400,8 +402,7 @@ def check_shot(file, path: str | None = None) -> dict:
     if not geom:
         raise ExportError(f"{path}: has no companion camera to check")
     samples = _stale_samples(stage, path, _samples_solved(stage, path, file, "check", times)) if times else []
-    still = not times or _has_default_lens(stage, stage.GetPrimAtPath(path))
-    current = companion_inputs(stage, path) if still else None
+    current = companion_inputs(stage, path, time=_still_time(stage, path, times))
     stored = geom.GetCustomDataByKey("physcam:companionInputs")
     mpu = UsdGeom.GetStageMetersPerUnit(stage)
     units = []
@@ -412,7 +413,7 @@ def check_shot(file, path: str | None = None) -> dict:
         if lm is not None and float(lm) != mpu:
             units.append({"file": ref_layer.identifier, "meters_per_unit": float(lm)})
     reasons = []
-    if still and stored != current:
+    if stored != current:
         reasons.append("the companion carries no inputs hash (written by hand or by an older physcam)" if stored is None
                        else "the camera's composed values (its body, lens or shot opinions) changed since the companion "
                             "was computed")
@@ -470,17 +471,18 @@ def refresh_shot(file, path: str | None = None) -> dict:
     if path is None:
         path = only_camera(stage, "refresh")  # its error names the file
     times = _refuse_what_cannot_be_followed(stage, path, file, "refresh")
-    if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):  # else there is no companion yet: write it
+    now = None  # no companion yet: write it
+    if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):
         now = check_shot(file, path)
         if not now["stale"]:
             return dict(now, written=False, changed=[])
     _refuse_lens_not_stored(stage, path, file)
     layer = stage.GetRootLayer()
     changed = []
-    if not times or _has_default_lens(stage, stage.GetPrimAtPath(path)):  # the still camera, its default values
+    if now is None or now["stored"] != now["current"]:  # the still camera (its default values) is stale
         before = _authored_values(layer, path)
         notes = _companion_notes(stage, path)
-        _author_shot_companion(stage, path)
+        _author_shot_companion(stage, path, _still_time(stage, path, times))
         changed = _keep_equal_values(layer, before, _authored_values(layer, path), path)
         _keep_equal_notes(stage, path, notes)
     if times:  # a keyed lens: sample by sample
@@ -544,6 +546,16 @@ def _has_default_lens(stage, cam) -> bool:
 
     return all(a.GetResolveInfo(Usd.TimeCode.Default()).GetSource() == Usd.ResolveInfoSourceDefault
                for a in _keyed_inputs(stage, cam))
+
+
+def _still_time(stage, path, times) -> float | None:
+    """The time code whose values the still part of the camera at ``path`` (what its companion's default values
+    and inputs hash are computed from) is read at: None (the default values) for a still lens or a keyed one
+    with default values; the first of ``times`` for keys with no default value (a DCC export's samples only),
+    so a change to the camera's other inputs (ISO, shutter, clipping range) is still seen."""
+    if not times or _has_default_lens(stage, stage.GetPrimAtPath(str(path))):
+        return None
+    return times[0]
 
 
 def _sampled_derived(stage, path, time: float) -> dict:
