@@ -244,3 +244,61 @@ def test_keys_without_a_default_still_check_and_refresh_the_cameras_other_inputs
     assert validation_errors(stage) == []
     rc, doc = _check_json(capsys, f)
     assert rc == 0 and not doc["stale"]
+
+
+def _layer(name):
+    from pxr import Sdf
+
+    layer = Sdf.Layer.CreateNew(str(name))
+    layer.defaultPrim = "Cameras"
+    layer.pseudoRoot.SetInfo("metersPerUnit", 0.01)
+    layer.pseudoRoot.SetInfo("upAxis", "Y")
+    return layer
+
+
+def test_a_focus_pull_in_a_sublayer_refreshes_only_its_samples_in_the_root_layer(tmp_path, capsys):
+    """The animation in a sublayer over a current still camera: the refresh writes only the samples' values in
+    the shot's root layer, no copy of the still companion, and reports only time-coded changes."""
+    from pxr import Sdf
+
+    _dgauss(tmp_path, "camera.usda")
+    anim = _layer(tmp_path / "anim.usda")
+    model = Sdf.CreatePrimInLayer(anim, MODEL)
+    for p in ("/Cameras", CAM, MODEL):
+        anim.GetPrimAtPath(p).specifier = Sdf.SpecifierOver
+    a = Sdf.AttributeSpec(model, "focusDistance", Sdf.ValueTypeNames.Float)
+    anim.SetTimeSample(a.path, 1, 3000.0)
+    anim.SetTimeSample(a.path, 24, 1500.0)
+    anim.Save()
+    shot = _layer(tmp_path / "shot.usda")
+    shot.subLayerPaths[:] = ["anim.usda", "camera.usda"]
+    shot.Save()
+    f = tmp_path / "shot.usda"
+    capsys.readouterr()
+    assert main(["usd", "refresh", str(f), "--json"]) == 0
+    done = json.loads(capsys.readouterr().out)
+    assert done["written"] and not done["stale"] and done["changed"]
+    assert all("time" in c for c in done["changed"]), [c for c in done["changed"] if "time" not in c][:3]
+    assert _root_defaults(f) == []
+    camera = Usd.Stage.Open(str(tmp_path / "camera.usda"))  # the body's ISO, in the still camera's layer
+    camera.GetPrimAtPath(CAM).GetAttribute("sensor:main:iso").Set(800.0)
+    camera.Save()
+    capsys.readouterr()
+    assert main(["usd", "refresh", str(f), "--json"]) == 0
+    done = json.loads(capsys.readouterr().out)
+    assert done["written"] and not done["stale"]
+    assert [(c["attribute"], c["before"], c["after"]) for c in done["changed"]] == [
+        (f"{GEOM}.exposure:iso", 100.0, 800.0)]  # the one value that changed, and no copy of the others
+    assert _root_defaults(f) == [f"{GEOM}.exposure:iso"]
+    assert validation_errors(Usd.Stage.Open(str(f))) == []
+
+
+def _root_defaults(f):
+    from pxr import Sdf
+
+    root = Sdf.Layer.FindOrOpen(str(f))
+    root.Reload()
+    out = []
+    root.Traverse("/", lambda p: out.append(str(p)) if p.IsPropertyPath() and root.GetAttributeAtPath(p)
+                  .HasDefaultValue() else None)
+    return out

@@ -480,10 +480,10 @@ def refresh_shot(file, path: str | None = None) -> dict:
     layer = stage.GetRootLayer()
     changed = []
     if now is None or now["stored"] != now["current"]:  # the still camera (its default values) is stale
-        before = _authored_values(layer, path)
+        before, root = _composed_values(stage, path), _authored_values(layer, path)
         notes = _companion_notes(stage, path)
         _author_shot_companion(stage, path, _still_time(stage, path, times))
-        changed = _keep_equal_values(layer, before, _authored_values(layer, path), path)
+        changed = _keep_equal_values(layer, before, _composed_values(stage, path), path, root)
         _keep_equal_notes(stage, path, notes)
     if times:  # a keyed lens: sample by sample
         changed += _author_samples(stage, path, file, times)
@@ -768,6 +768,34 @@ def _authored_values(layer, path) -> dict:
     return out
 
 
+def _composed_values(stage, path) -> dict:
+    """Attribute path -> its composed default value, of every attribute at or below ``path`` whose value comes
+    from an authored default (in any layer: a shot's sublayers and references included)."""
+    from pxr import Usd
+
+    out = {}
+    for prim in Usd.PrimRange(stage.GetPrimAtPath(str(path))):
+        for a in prim.GetAttributes():
+            if a.GetResolveInfo(Usd.TimeCode.Default()).GetSource() == Usd.ResolveInfoSourceDefault:
+                out[str(a.GetPath())] = a.Get()
+    return out
+
+
+def _restore_root_default(layer, name: str, old) -> None:
+    """Give the root layer back its default value ``old`` of the attribute ``name``; ``old`` None: the root layer
+    had none (the value came from another layer), so the refresh's opinion goes, and its spec if nothing else
+    is left on it."""
+    spec = layer.GetAttributeAtPath(name)
+    if not spec:
+        return
+    if old is not None:
+        if spec.default != old:
+            spec.default = old
+    elif spec.HasDefaultValue():
+        spec.ClearDefaultValue()
+        layer.RemovePropertyIfHasOnlyRequiredFields(spec)
+
+
 def _numbers(v):
     """The numbers of a scalar, vector or array value, or None for any other value."""
     if isinstance(v, bool):
@@ -811,9 +839,11 @@ def _same_view(old: dict, new: dict, geom: str) -> bool:
     return steps <= 49 and _same_value([w0 / f0, h0 / f0], [w1 / f1, h1 / f1])
 
 
-def _keep_equal_values(layer, before: dict, after: dict, path) -> list[dict]:
+def _keep_equal_values(layer, before: dict, after: dict, path, root: dict) -> list[dict]:
     """Give back the file's value to every recomputed attribute equal to it (:func:`_same_value`,
-    :func:`_same_view`); return the changes left, as the refresh reports them."""
+    :func:`_same_view`; ``before`` and ``after`` the composed values, :func:`_composed_values`; ``root`` the root
+    layer's before, :func:`_authored_values`, which a kept attribute is restored to); return the changes left, as
+    the refresh reports them."""
     from pxr import Sdf
 
     geom = str(Sdf.Path(path).AppendChild("Camera"))
@@ -823,8 +853,7 @@ def _keep_equal_values(layer, before: dict, after: dict, path) -> list[dict]:
     changed = []
     for name in sorted(set(before) | set(after)):
         if name in keep:
-            if after[name] != before[name]:
-                layer.GetAttributeAtPath(name).default = before[name]
+            _restore_root_default(layer, name, root.get(name))
             continue
         old, new = before.get(name), after.get(name)
         if old is None or new is None or old != new:
