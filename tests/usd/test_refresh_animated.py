@@ -80,6 +80,7 @@ def test_an_edited_thin_lens_pull_is_stale_at_its_time_codes_and_refreshed_to_th
         s_img = (focus - math.sqrt(focus * (focus - 4 * f_mm))) / 2  # the lens in front of the film
         assert _rel(geom.GetAttribute("focalLength").Get(t), s_img, 5e-6), t  # cm stage: tenths of a cm are mm
         assert _rel(cam.GetAttribute("lens:main:iris").Get(t), f_mm / fstop)
+        assert _rel(cam.GetAttribute("iris").Get(t), f_mm / fstop)  # usd animate keys the body's too: kept in step
         assert _rel(geom.GetAttribute("fStop").Get(t), fstop * s_img / f_mm, 5e-6)
         assert _rel(geom.GetAttribute("exposure:fStop").Get(t), fstop)
         pupil = cam.GetAttribute("lens:main:entrancePupilDistance").Get(t)  # a thin lens's pupil: the file's
@@ -302,3 +303,23 @@ def _root_defaults(f):
     root.Traverse("/", lambda p: out.append(str(p)) if p.IsPropertyPath() and root.GetAttributeAtPath(p)
                   .HasDefaultValue() else None)
     return out
+
+
+def test_a_kit_shots_body_iris_is_not_a_sample_of_the_lens(tmp_path, capsys):
+    """A shot (body and lens files) keyed at its still focus: the body's own ``iris`` (used only when no lens is
+    applied, the schema) is not stale, and the refresh does not key it."""
+    def run(*argv):
+        capsys.readouterr()
+        return main(["usd", *map(str, argv)])
+
+    body, lens, shot = (tmp_path / n for n in ("alexa35.usda", "dgauss50.usda", "camera.usda"))
+    assert run("kit", "body", body, "--sensor", "ALEXA 35", "--flange", "44") == 0
+    assert run("kit", "vendor", lens, "--lens", "dgauss.50mm", "--focus", "1.5m", "--fstop", "4") == 0
+    assert run("kit", "shot", shot, "--body", body, "--lens", lens, "--focus", "2m", "--fstop", "2.8") == 0
+    stage = Usd.Stage.Open(str(shot))
+    stage.GetPrimAtPath("/Cameras/Shot/Pinhole").GetAttribute("focusDistance").Set(2000.0, 1.0)
+    stage.Save()
+    rc, doc = _check_json(capsys, shot)
+    assert rc == 0 and doc["stale_samples"] == [], doc["stale_samples"]
+    assert run("refresh", shot) == 0
+    assert not Usd.Stage.Open(str(shot)).GetPrimAtPath("/Cameras/Shot").GetAttribute("iris").GetNumTimeSamples()

@@ -575,7 +575,8 @@ def _sampled_derived(stage, path, time: float) -> dict:
         if model is not None and model.GetTypeName() == "PhysicalCameraLensModelPinhole":
             out[f"{model.GetPath()}.focalLength"] = float(derived.focal_length_mm)
     out[f"{path}.lens:{LENS_INSTANCE}:iris"] = iris_mm(spec)
-    if cam.GetAttribute("iris") and cam.GetAttribute("iris").HasAuthoredValue():  # the body's, as usd animate keys it
+    body_iris = cam.GetAttribute("iris")  # the body's own, used only when no lens is applied (the schema): kept in
+    if body_iris and body_iris.GetNumTimeSamples():  # step where usd animate keys it, else left as it is (still)
         out[f"{path}.iris"] = iris_mm(spec)
     stage_ = cam.GetStage()
     values, _eye = sampled_render_values(spec, report, UsdGeom.GetStageMetersPerUnit(stage_),
