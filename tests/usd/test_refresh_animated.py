@@ -13,6 +13,8 @@ import json
 import math
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from _documents import check_document
 from physcam.cli import main
@@ -323,3 +325,30 @@ def test_a_kit_shots_body_iris_is_not_a_sample_of_the_lens(tmp_path, capsys):
     assert rc == 0 and doc["stale_samples"] == [], doc["stale_samples"]
     assert run("refresh", shot) == 0
     assert not Usd.Stage.Open(str(shot)).GetPrimAtPath("/Cameras/Shot").GetAttribute("iris").GetNumTimeSamples()
+
+
+def test_time_codes_are_printed_as_the_time_codes_they_are(tmp_path, capsys):
+    """Keys at time codes 123456, 123456.5 and 1234567 (a long shot's frame numbers, a half frame): each stale one
+    is named exactly, not rounded to six digits (123456.5 read as 123456; 1234567 as 1.23457e+06)."""
+    f = _dgauss(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
+    for t, mark in ((123456.0, 3000.0), (123456.5, 2000.0), (1234567.0, 1000.0)):
+        focus.Set(mark, t)
+    stage.Save()
+    capsys.readouterr()
+    assert main(["usd", "check", str(f)]) == 1
+    out = capsys.readouterr().out
+    assert "(first 123456.5: " in out and "  time code 123456.5: stale" in out and "  time code 1234567: stale" in out
+    assert main(["usd", "refresh", str(f)]) == 0
+    out = capsys.readouterr().out
+    assert " at time code 123456.5: " in out and " at time code 1234567: " in out and "e+06" not in out
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.floats(allow_nan=False, allow_infinity=False))
+def test_a_time_codes_text_reads_back_to_that_time_code(t):
+    from physcam.usd.kit import time_code_text
+
+    text = time_code_text(t)
+    assert float(text) == t and ("." not in text and "e" not in text) == float(t).is_integer()

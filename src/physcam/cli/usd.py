@@ -475,7 +475,7 @@ def run_animate(args) -> int:
 
 
 def run_check(args) -> int:
-    from ..usd.kit import check_shot
+    from ..usd.kit import check_shot, time_code_text
 
     res = check_shot(args.file, args.path)
     rc = 1 if res["stale"] else 0  # a checker: 1 when it finds a problem (docs/cli.md, "Exit status")
@@ -488,7 +488,7 @@ def run_check(args) -> int:
     keyed = f" ({len(res['time_codes'])} keyed time codes)" if res["time_codes"] else ""
     print(f"{res['path']}: companion camera{keyed} {state}")
     for sample in res["stale_samples"]:
-        print(f"  time code {sample['time']:g}: stale {', '.join(sample['attributes'])}")
+        print(f"  time code {time_code_text(sample['time'])}: stale {', '.join(sample['attributes'])}")
     for u in res["units"]:
         print(f"  note: {u['file']} is in metersPerUnit {u['meters_per_unit']:g}, the shot in "
               f"{res['meters_per_unit']:g} (composed in the shot's unit)")
@@ -496,7 +496,7 @@ def run_check(args) -> int:
 
 
 def run_refresh(args) -> int:
-    from ..usd.kit import refresh_shot
+    from ..usd.kit import refresh_shot, time_code_text
 
     res = refresh_shot(args.file, args.path)
     if args.json:
@@ -510,7 +510,7 @@ def run_refresh(args) -> int:
         print(f"{res['path']}: companion camera recomputed; {n} value{'s' * (n != 1)} changed"
               + (":" if n else " (the inputs hash only)"))
         for c in res["changed"]:
-            at = f" at time code {c['time']:g}" if "time" in c else ""
+            at = f" at time code {time_code_text(c['time'])}" if "time" in c else ""
             print(f"  {c['attribute']}{at}: {_shown(c['before'])} -> {_shown(c['after'])}")
     return 0
 

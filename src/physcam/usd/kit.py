@@ -419,11 +419,18 @@ def check_shot(file, path: str | None = None) -> dict:
                             "was computed")
     if samples:
         first = samples[0]
-        reasons.append(f"{len(samples)} of its time codes are stale (first {first['time']:g}: "
+        reasons.append(f"{len(samples)} of its time codes are stale (first {time_code_text(first['time'])}: "
                        f"{', '.join(first['attributes'])})")
     return {"path": path, "stale": bool(reasons), "stored": stored, "current": current,
             "meters_per_unit": mpu, "units": units, "reason": "; ".join(reasons) or None,
             "time_codes": times, "stale_samples": samples}
+
+
+def time_code_text(t: float) -> str:
+    """A USD time code as text that names it exactly: an integral one as an integer (``1234567``), another as
+    the shortest decimal that reads back to the same double (``123456.5``), never rounded to a neighbour."""
+    t = float(t)
+    return str(int(t)) if t.is_integer() else repr(t)
 
 
 def _refuse_what_cannot_be_followed(stage, path, file, action: str) -> list[float]:
@@ -596,7 +603,7 @@ def _samples_solved(stage, path, file, action: str, times) -> dict:
         try:
             out[t] = _sampled_derived(stage, path, t)
         except PhysCamError as e:
-            raise ExportError(f"{file}: {path} at time code {t:g}: {e}; usd {action} cannot solve this sample") \
+            raise ExportError(f"{file}: {path} at time code {time_code_text(t)}: {e}; usd {action} cannot solve this sample") \
                 from None
     return out
 
