@@ -149,7 +149,8 @@ def test_a_sample_that_cannot_be_focused_is_refused_naming_its_time_code(tmp_pat
     stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance").Set(150.0, 7.0)  # inside 4 f: no image of it
     stage.Save()
     for action in ("check", "refresh"):
-        assert "at time code 7" in _refused(capsys, action, f)
+        err = _refused(capsys, action, f)
+        assert "at time code 7" in err and f"usd {action} cannot solve this sample" in err, err  # the command run
 
 
 @pytest.mark.parametrize("edit", ["sensor", "real-lens"])
@@ -352,3 +353,23 @@ def test_a_time_codes_text_reads_back_to_that_time_code(t):
 
     text = time_code_text(t)
     assert float(text) == t and ("." not in text and "e" not in text) == float(t).is_integer()
+
+
+def test_one_keyed_time_code_reads_in_the_singular(tmp_path, capsys):
+    f = _dgauss(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance").Set(2000.0, 1.0)
+    stage.Save()
+    capsys.readouterr()
+    assert main(["usd", "check", str(f)]) == 1
+    out = capsys.readouterr().out
+    assert "(1 keyed time code) STALE: 1 of its time codes is stale (first 1: " in out, out
+
+
+def test_a_path_that_is_not_a_camera_is_named_so_on_an_animated_file(tmp_path, capsys):
+    f = _pull(tmp_path)
+    for action in ("check", "refresh"):
+        capsys.readouterr()
+        assert main(["usd", action, str(f), "--path", "/Cameras"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.endswith("/Cameras is a Xform, not a PhysicalCamera") and str(f) in err, err

@@ -485,7 +485,8 @@ def run_check(args) -> int:
         emit_json(document("usd_check", d))
         return rc
     state = f"STALE: {res['reason']}; run physcam usd refresh {args.file}" if res["stale"] else "current"
-    keyed = f" ({len(res['time_codes'])} keyed time codes)" if res["time_codes"] else ""
+    n = len(res["time_codes"])
+    keyed = f" ({n} keyed time code{'s' * (n != 1)})" if n else ""
     print(f"{res['path']}: companion camera{keyed} {state}")
     for sample in res["stale_samples"]:
         print(f"  time code {time_code_text(sample['time'])}: stale {', '.join(sample['attributes'])}")

@@ -389,6 +389,12 @@ def check_shot(file, path: str | None = None) -> dict:
     or carries no stored hash. ``units`` lists referenced files whose metersPerUnit differs from
     the shot's (composed correctly by :func:`write_shot`, worth knowing).
     """
+    return _checked(file, path, "check")
+
+
+def _checked(file, path, action: str) -> dict:
+    """:func:`check_shot`'s answer; ``action`` the command the user ran (check, or refresh, which checks first),
+    which its errors name."""
     from pxr import Sdf, UsdGeom
 
     from .read import only_camera, open_stage
@@ -396,12 +402,12 @@ def check_shot(file, path: str | None = None) -> dict:
     stage = open_stage(file)
     stage.Reload()  # the referenced files as they are on disk now, not as this process cached them
     if path is None:
-        path = only_camera(stage, "check")  # its error names the file
-    times = _refuse_what_cannot_be_followed(stage, path, file, "check")
+        path = only_camera(stage, action)  # its error names the file
+    times = _refuse_what_cannot_be_followed(stage, path, file, action)
     geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
     if not geom:
         raise ExportError(f"{path}: has no companion camera to check")
-    samples = _stale_samples(stage, path, _samples_solved(stage, path, file, "check", times)) if times else []
+    samples = _stale_samples(stage, path, _samples_solved(stage, path, file, action, times)) if times else []
     current = companion_inputs(stage, path, time=_still_time(stage, path, times))
     stored = geom.GetCustomDataByKey("physcam:companionInputs")
     mpu = UsdGeom.GetStageMetersPerUnit(stage)
@@ -419,7 +425,7 @@ def check_shot(file, path: str | None = None) -> dict:
                             "was computed")
     if samples:
         first = samples[0]
-        reasons.append(f"{len(samples)} of its time codes are stale (first {time_code_text(first['time'])}: "
+        reasons.append(f"{len(samples)} of its time codes {'is' if len(samples) == 1 else 'are'} stale (first {time_code_text(first['time'])}: "
                        f"{', '.join(first['attributes'])})")
     return {"path": path, "stale": bool(reasons), "stored": stored, "current": current,
             "meters_per_unit": mpu, "units": units, "reason": "; ".join(reasons) or None,
@@ -437,7 +443,7 @@ def _refuse_what_cannot_be_followed(stage, path, file, action: str) -> list[floa
     """The camera's keyed time codes (:func:`_keyed_time_codes`) after the refusals: a still lens with other
     time samples (:func:`_refuse_time_samples`), an animated one with samples check and refresh cannot follow
     (:func:`_refuse_unkeyable_samples`)."""
-    _refuse_no_prim(stage, path, file)
+    _refuse_not_a_camera(stage, path, file)
     times = _keyed_time_codes(stage, path)
     if times:
         _refuse_unkeyable_samples(stage, path, file, action)
@@ -446,9 +452,16 @@ def _refuse_what_cannot_be_followed(stage, path, file, action: str) -> list[floa
     return times
 
 
-def _refuse_no_prim(stage, path, file) -> None:
-    if not stage.GetPrimAtPath(str(path)):
+def _refuse_not_a_camera(stage, path, file) -> None:
+    """ExportError naming the file when ``path`` holds no prim or one that is not a PhysicalCamera (checked before
+    its attributes, whose time samples would be named otherwise)."""
+    from pxr import Usd
+
+    prim = stage.GetPrimAtPath(str(path))
+    if not prim:
         raise ExportError(f"{file}: no prim at {path}")
+    if not prim.IsA(Usd.SchemaRegistry.GetTypeFromSchemaTypeName("PhysicalCamera")):
+        raise ExportError(f"{file}: {path} is a {prim.GetTypeName() or 'typeless prim'}, not a PhysicalCamera")
 
 
 def refresh_shot(file, path: str | None = None) -> dict:
@@ -480,7 +493,7 @@ def refresh_shot(file, path: str | None = None) -> dict:
     times = _refuse_what_cannot_be_followed(stage, path, file, "refresh")
     now = None  # no companion yet: write it
     if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):
-        now = check_shot(file, path)
+        now = _checked(file, path, "refresh")
         if not now["stale"]:
             return dict(now, written=False, changed=[])
     _refuse_lens_not_stored(stage, path, file)
@@ -516,8 +529,8 @@ def _refuse_time_samples(stage, path, file, action: str) -> None:
         return
     sampled.sort(key=lambda pa: (pa[1].GetName() not in _ANIMATED_FIRST, pa[0] != cam, str(pa[0].GetPath())))
     prim, attr = sampled[0]
-    raise ExportError(f"{file}: {prim.GetPath()}.{attr.GetName()} is animated ({attr.GetNumTimeSamples()} time "
-                      f"samples): usd {action} handles a still camera only; write the animation again with "
+    n = attr.GetNumTimeSamples()
+    raise ExportError(f"{file}: {prim.GetPath()}.{attr.GetName()} is animated ({n} time sample{'s' * (n != 1)}): usd {action} handles a still camera only; write the animation again with "
                       f"`physcam usd animate {file} --marks CSV ... --force`")
 
 
