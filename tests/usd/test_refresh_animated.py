@@ -373,3 +373,41 @@ def test_a_path_that_is_not_a_camera_is_named_so_on_an_animated_file(tmp_path, c
         assert main(["usd", action, str(f), "--path", "/Cameras"]) == 2
         err = capsys.readouterr().err.strip()
         assert err.endswith("/Cameras is a Xform, not a PhysicalCamera") and str(f) in err, err
+
+
+@pytest.mark.parametrize("lens", ["still", "keyed"])
+def test_a_hand_keyed_companion_sample_is_refused_not_deleted(tmp_path, capsys, lens):
+    """A companion attribute keyed by hand where the lens is not keyed: refused in one line naming it, on a still
+    lens as on a keyed one (before, a keyed lens's refresh deleted the artist's key), the file left as it was."""
+    f = _dgauss(tmp_path) if lens == "still" else _pull(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    stage.GetPrimAtPath(GEOM).GetAttribute("focalLength").Set(40.0, 5.0)
+    stage.Save()
+    for action in ("check", "refresh"):
+        err = _refused(capsys, action, f)
+        assert f"{GEOM}.focalLength is keyed at time code 5, where the lens's focus" in err, err
+
+
+def test_a_still_lens_with_one_sampled_sensor_reads_in_the_singular(tmp_path, capsys):
+    f = _dgauss(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    stage.GetPrimAtPath(CAM).GetAttribute("sensor:main:aperture").Set((20.0, 15.0), 4.0)
+    stage.Save()
+    assert f"{CAM}.sensor:main:aperture is animated (1 time sample): usd check" in _refused(capsys, "check", f)
+
+
+def test_a_deleted_focus_key_is_no_longer_a_keyed_time_code(tmp_path, capsys):
+    """A real lens keyed at 1, 12 and 24, refreshed, then the key at 12 deleted: the refresh's own samples there
+    (the model's focal length, the EFL at the focus, among them) do not keep 12 keyed; they are named, not deleted."""
+    f = _dgauss(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
+    for t, mark in ((1.0, 2000.0), (12.0, 2500.0), (24.0, 5000.0)):
+        focus.Set(mark, t)
+    stage.Save()
+    assert main(["usd", "refresh", str(f)]) == 0
+    stage = Usd.Stage.Open(str(f))
+    stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance").ClearAtTime(12.0)
+    stage.Save()
+    err = _refused(capsys, "check", f)
+    assert "is keyed at time code 12, where the lens's focus" in err, err

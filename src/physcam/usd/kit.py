@@ -440,15 +440,11 @@ def time_code_text(t: float) -> str:
 
 
 def _refuse_what_cannot_be_followed(stage, path, file, action: str) -> list[float]:
-    """The camera's keyed time codes (:func:`_keyed_time_codes`) after the refusals: a still lens with other
-    time samples (:func:`_refuse_time_samples`), an animated one with samples check and refresh cannot follow
-    (:func:`_refuse_unkeyable_samples`)."""
+    """The camera's keyed time codes (:func:`_keyed_time_codes`) after the refusals: not a camera
+    (:func:`_refuse_not_a_camera`), samples check and refresh cannot follow (:func:`_refuse_samples_not_followed`)."""
     _refuse_not_a_camera(stage, path, file)
     times = _keyed_time_codes(stage, path)
-    if times:
-        _refuse_unkeyable_samples(stage, path, file, action)
-    else:
-        _refuse_time_samples(stage, path, file, action)
+    _refuse_samples_not_followed(stage, path, file, action, times)
     return times
 
 
@@ -511,29 +507,6 @@ def refresh_shot(file, path: str | None = None) -> dict:
     return dict(check_shot(file, path), written=True, changed=changed)
 
 
-#: the attributes named first when a camera is animated: the inputs an animation samples (usd animate)
-_ANIMATED_FIRST = ("focusDistance", f"lens:{LENS_INSTANCE}:fStop", "focalLength")
-
-
-def _refuse_time_samples(stage, path, file, action: str) -> None:
-    """ExportError naming the file and an animated attribute when the camera at ``path`` (or its lens model or
-    companion) has time samples: check and refresh compare and recompute one still camera (its default
-    values), and an animation's per-frame lens (``usd animate``) is not stored in the file to solve again.
-    A moving camera (time-sampled ``xformOp:*``, a layout's move) is still: its placement is not an input."""
-    cam = stage.GetPrimAtPath(str(path))
-    if not cam:
-        raise ExportError(f"{file}: no prim at {path}")
-    sampled = [(p, a) for p in (cam, *cam.GetChildren()) for a in p.GetAttributes()
-               if a.GetNumTimeSamples() and not a.GetName().startswith("xformOp")]
-    if not sampled:
-        return
-    sampled.sort(key=lambda pa: (pa[1].GetName() not in _ANIMATED_FIRST, pa[0] != cam, str(pa[0].GetPath())))
-    prim, attr = sampled[0]
-    n = attr.GetNumTimeSamples()
-    raise ExportError(f"{file}: {prim.GetPath()}.{attr.GetName()} is animated ({n} time sample{'s' * (n != 1)}): usd {action} handles a still camera only; write the animation again with "
-                      f"`physcam usd animate {file} --marks CSV ... --force`")
-
-
 def _lens_model(stage, cam):
     rel = cam.GetRelationship(f"lens:{LENS_INSTANCE}:lensModel")
     targets = rel.GetForwardedTargets() if rel else []
@@ -542,12 +515,15 @@ def _lens_model(stage, cam):
 
 
 def _keyed_inputs(stage, cam) -> list:
-    """The attributes an animation keys (:data:`_ANIMATED_FIRST`): the lens model's focus and focal length,
-    the lens's f-stop."""
+    """The attributes an animation keys: the lens model's focus, the lens's f-stop, and the model's focal length
+    unless the lens is stored (a prescription's focal length at the focus is derived, :func:`_sampled_derived`:
+    the refresh's own samples of it are not keys)."""
     model = _lens_model(stage, cam)
     attrs = [cam.GetAttribute(f"lens:{LENS_INSTANCE}:fStop")]
     if model is not None:
-        attrs += [model.GetAttribute("focusDistance"), model.GetAttribute("focalLength")]
+        attrs.append(model.GetAttribute("focusDistance"))
+        if composed_prescription(stage, str(cam.GetPath())) is None:
+            attrs.append(model.GetAttribute("focalLength"))
     return [a for a in attrs if a]
 
 
@@ -639,10 +615,12 @@ def _derived_names(stage, path) -> set:
     return out
 
 
-def _refuse_unkeyable_samples(stage, path, file, action: str) -> None:
-    """ExportError naming the file and an attribute of an animated camera that check and refresh cannot follow
-    sample by sample: a time-sampled attribute that is neither a keyed input (focus, f-stop, focal length), a
-    thin lens's pupil or stop (read at each time code), nor one the refresh derives (:func:`_derived_names`); and a lens
+def _refuse_samples_not_followed(stage, path, file, action: str, times) -> None:
+    """ExportError naming the file and a time-sampled attribute of the camera at ``path`` (or of its children) that
+    check and refresh cannot follow, still lens or keyed (``times``, :func:`_keyed_time_codes`): one that is neither
+    a keyed input, a thin lens's pupil or stop read at each keyed time code, a layout's move (the camera's
+    ``xformOp:*``), nor one the refresh derives (:func:`_derived_names`); a derived one keyed at a time code where
+    the lens is not (an artist's key, or one left by a deleted key: the refresh does not delete keys); and a lens
     solved from a real lens the file does not store (``usd animate --lens`` samples its pupils and pinhole but
     keeps no prescription to solve them again)."""
     cam = stage.GetPrimAtPath(str(path))
@@ -650,32 +628,46 @@ def _refuse_unkeyable_samples(stage, path, file, action: str) -> None:
     derived = _derived_names(stage, path)
     lp = f"lens:{LENS_INSTANCE}:"
     stored = composed_prescription(stage, path) is not None
-    read_at_time = set() if stored else {f"{path}.{lp}entrancePupilDistance", f"{path}.{lp}apertureDistance"}
+    read_at_time = set() if stored or not times else {f"{path}.{lp}entrancePupilDistance", f"{path}.{lp}apertureDistance"}
     for prim in (cam, *cam.GetChildren()):
         for a in prim.GetAttributes():
             name = str(a.GetPath())
-            if not a.GetNumTimeSamples() or name in keyed | derived | read_at_time:
+            if not a.GetNumTimeSamples() or name in keyed | read_at_time:
                 continue
             if prim == cam and a.GetName().startswith("xformOp"):
                 continue  # the layout's move: not an input of the lens
-            if not stored and a.GetName() in _LENS_DERIVED:
+            if name in derived:
+                _refuse_unkeyed_samples(a, file, action, times)
+                continue
+            if times and not stored and a.GetName() in _LENS_DERIVED:
                 raise ExportError(f"{file}: {name} is animated from a real lens that the file does not store "
                                   f"(usd animate --lens): usd {action} cannot solve it again; write the animation "
                                   f"again with `physcam usd animate {file} --marks CSV ... --force`")
             n = a.GetNumTimeSamples()
-            raise ExportError(f"{file}: {name} is animated ({n} time sample{'s' * (n != 1)}): usd {action} follows "
-                              "a keyed focus, f-stop and focal length sample by sample, not this attribute")
+            raise ExportError(f"{file}: {name} is animated ({n} time sample{'s' * (n != 1)}): usd {action} "
+                              "follows a keyed focus, f-stop and focal length sample by sample, not this attribute")
+
+
+def _refuse_unkeyed_samples(attr, file, action: str, times) -> None:
+    """ExportError naming a derived attribute keyed at a time code where the lens is not (an artist's key, or one
+    a deleted key left): the refresh recomputes samples at the lens's time codes and deletes none."""
+    unkeyed = sorted(set(map(float, attr.GetTimeSamples())) - set(times))
+    if unkeyed:
+        t = time_code_text(unkeyed[0])
+        raise ExportError(f"{file}: {attr.GetPath()} is keyed at time code {t}, where the lens's focus, f-stop and "
+                          f"focal length are not: usd {action} deletes no keys; remove the samples at time code {t} "
+                          "(or key the lens there) and run it again")
 
 
 def _stale_samples(stage, path, expected: dict) -> list[dict]:
     """``[{"time", "attributes"}]`` of each time code where an attribute of ``expected`` (time code ->
     :func:`_sampled_derived`) differs from the file at float32 precision (the companion's field of view:
-    :func:`_same_view`), or where a derived attribute holds a sample at a time code no input is keyed at."""
+    :func:`_same_view`); a derived sample at a time code no input is keyed at is refused before
+    (:func:`_refuse_samples_not_followed`)."""
     from pxr import Sdf
 
     geom = str(Sdf.Path(path).AppendChild("Camera"))
     out = []
-    names = sorted({n for values in expected.values() for n in values})
     for t, values in expected.items():
         now = {n: stage.GetAttributeAtPath(Sdf.Path(n)).Get(t) for n in values}
         bad = [n for n in sorted(values) if now[n] is None or not _same_value(now[n], values[n])]
@@ -684,19 +676,13 @@ def _stale_samples(stage, path, expected: dict) -> list[dict]:
                                                                        "verticalAperture")}]
         if bad:
             out.append({"time": t, "attributes": bad})
-    extra = {}
-    for n in names:
-        for t in stage.GetAttributeAtPath(Sdf.Path(n)).GetTimeSamples():
-            if float(t) not in expected:
-                extra.setdefault(float(t), []).append(n)
-    out += [{"time": t, "attributes": extra[t]} for t in sorted(extra)]
     return sorted(out, key=lambda d: d["time"])
 
 
 def _author_samples(stage, path, file, times) -> list[dict]:
     """Rewrite, at every keyed time code, each derived attribute stale at one of them (:func:`_stale_samples`;
-    an attribute that is sampled at all is sampled at every keyed time code, and its samples at other time
-    codes go); a sample equal to the recomputed value at float32 precision keeps the file's digits. Returns the
+    an attribute that is sampled at all is sampled at every keyed time code; it has none at other time codes,
+    :func:`_refuse_samples_not_followed`); a sample equal to the recomputed value at float32 precision keeps the file's digits. Returns the
     changes as the refresh reports them, each with its ``time``."""
     from pxr import Sdf
 
@@ -721,10 +707,6 @@ def _author_samples(stage, path, file, times) -> list[dict]:
             attrs[n].Set(new, t)
             if old[n] is None or not _same_value(old[n], new):
                 changed.append({"attribute": n, "time": t, "before": _shown_value(old[n]), "after": _shown_value(new)})
-    for n in names:
-        for t in sorted(had[n] - set(times)):
-            changed.append({"attribute": n, "time": t, "before": _shown_value(attrs[n].Get(t)), "after": None})
-            attrs[n].ClearAtTime(t)
     return sorted(changed, key=lambda c: (c["attribute"], c["time"]))
 
 
