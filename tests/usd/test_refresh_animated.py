@@ -349,7 +349,7 @@ def test_time_codes_are_printed_as_the_time_codes_they_are(tmp_path, capsys):
 @settings(max_examples=200, deadline=None)
 @given(st.floats(allow_nan=False, allow_infinity=False))
 def test_a_time_codes_text_reads_back_to_that_time_code(t):
-    from physcam.usd.kit import time_code_text
+    from physcam.usd.keyed_lens import time_code_text
 
     text = time_code_text(t)
     assert float(text) == t and ("." not in text and "e" not in text) == float(t).is_integer()

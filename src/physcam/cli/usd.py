@@ -475,7 +475,8 @@ def run_animate(args) -> int:
 
 
 def run_check(args) -> int:
-    from ..usd.kit import check_shot, time_code_text
+    from ..usd.keyed_lens import time_code_text
+    from ..usd.kit import check_shot
 
     res = check_shot(args.file, args.path)
     rc = 1 if res["stale"] else 0  # a checker: 1 when it finds a problem (docs/cli.md, "Exit status")
@@ -497,7 +498,8 @@ def run_check(args) -> int:
 
 
 def run_refresh(args) -> int:
-    from ..usd.kit import refresh_shot, time_code_text
+    from ..usd.keyed_lens import time_code_text
+    from ..usd.kit import refresh_shot
 
     res = refresh_shot(args.file, args.path)
     if args.json:
