@@ -494,14 +494,15 @@ def test_a_deleted_key_with_other_samples_is_refused_not_deleted(tmp_path, capsy
     _delete_keys(f, 5.0, *_THIN_LENS_KEYS)
     stage = Usd.Stage.Open(str(f))
     geom = stage.GetPrimAtPath(GEOM)
-    if edit == "hand key":
+    if edit == "hand key":  # named before the derived samples beside it
         geom.GetAttribute("clippingRange").Set((1.0, 1000.0), 5.0)
+        expected = f"{GEOM}.clippingRange is animated (1 time sample): usd "
     else:
         geom.GetAttribute("focalLength").ClearAtTime(5.0)
+        expected = "is keyed at time code 5, where the lens's focus, f-stop and focal length are not: usd "
     stage.Save()
     for action in ("check", "refresh"):
-        err = _refused(capsys, action, f)
-        assert f"is keyed at time code 5, where the lens's focus, f-stop and focal length are not: usd {action}" in err
+        assert expected + action in _refused(capsys, action, f)
 
 
 def test_samples_left_in_a_sublayer_are_refused_naming_the_layer(tmp_path, capsys):
@@ -524,3 +525,37 @@ def test_samples_left_in_a_sublayer_are_refused_naming_the_layer(tmp_path, capsy
         assert "left from a deleted key, in " in err and "anim.usda: usd " in err and "at time code 5" in err, err
     anim.Reload()
     assert anim.ExportToString() == before
+
+
+def test_a_key_deleted_in_a_sublayer_leaves_root_layer_samples_the_refresh_removes(tmp_path, capsys):
+    """The focus keys in a sublayer (anim.usda), the refresh's samples in the shot's root layer: the key at 12
+    deleted in anim.usda, the refresh removes its samples at 12 from the root layer, anim.usda untouched."""
+    from pxr import Sdf
+
+    _dgauss(tmp_path, "camera.usda")
+    anim = _layer(tmp_path / "anim.usda")
+    Sdf.CreatePrimInLayer(anim, MODEL)
+    for p in ("/Cameras", CAM, MODEL):
+        anim.GetPrimAtPath(p).specifier = Sdf.SpecifierOver
+    focus = Sdf.AttributeSpec(anim.GetPrimAtPath(MODEL), "focusDistance", Sdf.ValueTypeNames.Float).path
+    for t, mark in ((1, 2000.0), (12, 2500.0), (24, 5000.0)):
+        anim.SetTimeSample(focus, t, mark)
+    anim.Save()
+    shot = _layer(tmp_path / "shot.usda")
+    shot.subLayerPaths[:] = ["anim.usda", "camera.usda"]
+    shot.Save()
+    f = tmp_path / "shot.usda"
+    assert main(["usd", "refresh", str(f)]) == 0
+    written = _samples(f, 12.0) - {f"{MODEL}.focusDistance"}
+    assert {f"{CAM}.lens:main:entrancePupilDistance", f"{GEOM}.focusDistance"} <= written
+    anim.EraseTimeSample(focus, 12)
+    anim.Save()
+    before = (tmp_path / "anim.usda").read_bytes()
+    rc, doc = _check_json(capsys, f)
+    assert rc == 1 and [(s["time"], s["left"], set(s["attributes"])) for s in doc["stale_samples"]] == [
+        (12.0, True, written)]
+    assert main(["usd", "refresh", str(f)]) == 0
+    assert _samples(f, 12.0) == set() and (tmp_path / "anim.usda").read_bytes() == before
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and not doc["stale"] and doc["time_codes"] == [1.0, 24.0]
+    assert validation_errors(Usd.Stage.Open(str(f))) == []

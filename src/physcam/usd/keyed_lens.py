@@ -138,23 +138,23 @@ def _refuse_samples_not_followed(stage, path, file, action: str, times) -> list[
     read_at_time = set() if stored or not times else {f"{path}.{lp}entrancePupilDistance", f"{path}.{lp}apertureDistance"}
     left = _left_samples(stage, path, file, action, times, derived | read_at_time)
     left_times = {d["time"] for d in left}
-    for prim in (cam, *cam.GetChildren()):
-        for a in prim.GetAttributes():
-            name = str(a.GetPath())
-            if not a.GetNumTimeSamples() or name in keyed | read_at_time:
-                continue
-            if prim == cam and a.GetName().startswith("xformOp"):
-                continue  # the layout's move: not an input of the lens
-            if name in derived:
-                _refuse_unkeyed_samples(a, file, action, [*times, *left_times])
-                continue
-            if times and not stored and a.GetName() in _LENS_DERIVED:
-                raise ExportError(f"{file}: {name} is animated from a real lens that the file does not store "
-                                  f"(usd animate --lens): usd {action} cannot solve it again; write the animation "
-                                  f"again with `physcam usd animate {file} --marks CSV ... --force`")
-            n = a.GetNumTimeSamples()
-            raise ExportError(f"{file}: {name} is animated ({n} time sample{'s' * (n != 1)}): usd {action} "
-                              "follows a keyed focus, f-stop and focal length sample by sample, not this attribute")
+    attrs = [a for prim in (cam, *cam.GetChildren()) for a in prim.GetAttributes()]
+    for a in sorted(attrs, key=lambda a: str(a.GetPath()) in derived):  # a hand key on another attribute named first
+        name = str(a.GetPath())
+        if not a.GetNumTimeSamples() or name in keyed | read_at_time:
+            continue
+        if a.GetPrim() == cam and a.GetName().startswith("xformOp"):
+            continue  # the layout's move: not an input of the lens
+        if name in derived:
+            _refuse_unkeyed_samples(a, file, action, [*times, *left_times])
+            continue
+        if times and not stored and a.GetName() in _LENS_DERIVED:
+            raise ExportError(f"{file}: {name} is animated from a real lens that the file does not store "
+                              f"(usd animate --lens): usd {action} cannot solve it again; write the animation "
+                              f"again with `physcam usd animate {file} --marks CSV ... --force`")
+        n = a.GetNumTimeSamples()
+        raise ExportError(f"{file}: {name} is animated ({n} time sample{'s' * (n != 1)}): usd {action} "
+                          "follows a keyed focus, f-stop and focal length sample by sample, not this attribute")
     return left
 
 
