@@ -17,8 +17,7 @@ import numpy as np
 
 from ...errors import InputError
 
-__all__ = ["FEATURES", "SPHERE_KIND", "template_text", "render_template", "lens_data", "osl_number", "osl_array",
-           "osl_kinds"]
+__all__ = ["FEATURES", "SPHERE_KIND", "template_text", "render_template", "lens_data", "osl_number", "osl_array"]
 
 #: The template's feature switches: a data block that defines one keeps that code, else it goes.
 FEATURES = ("PHYSCAM_FOCUS_TABLE", "HAS_ASPHERE", "PHYSCAM_DISPERSION", "PHYSCAM_FRESNEL", "PHYSCAM_APERTURE",
@@ -54,7 +53,7 @@ def osl_array(name: str, values, size: str, kind: str = "float") -> str:
     return f"    {kind} {name}[{size}] = {{{vals}}};"
 
 
-def osl_kinds(table) -> np.ndarray:
+def _osl_kinds(table) -> np.ndarray:
     """The shader's surface kinds: physcam's tracer's (0 plane, 1 stop, 2 quadric, 3 asphere), a quadric
     whose three coefficients are equal (a sphere) marked :data:`SPHERE_KIND`."""
     kinds = np.asarray(table.kind).copy()
@@ -128,7 +127,7 @@ def lens_data(table, aperture, wavelength_nm: float, bounds, *, dispersion: bool
         nx, ny = len(bounds.xs), len(bounds.ys)
         defines += [f"#define N_BX {nx}", f"#define N_BY {ny}", f"#define N_RECT {nx * ny * 4}"]
     defines += [f"#define N_ASPH {n * 7}  // OSL array sizes must be plain integer literals", f"#define N_DISP {n * 9}"]
-    data = [osl_array("KIND", osl_kinds(table), "N_SURF", "int")]
+    data = [osl_array("KIND", _osl_kinds(table), "N_SURF", "int")]
     for name, col in (("AX", table.ax), ("AY", table.ay), ("AZ", table.az), ("CV", table.curvature),
                       ("CK", table.conic)):
         data.append(osl_array(name, col, "N_SURF"))
