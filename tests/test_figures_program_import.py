@@ -1,5 +1,6 @@
 """The ``physcam`` program imports matplotlib without what it never uses (figures.PROGRAM_IMPORT,
-issue 47: the property tables of artist docstrings and set() signatures, and the 3-D toolkit, 0.2 s of CPU): the
+issue 47: the property tables of artist docstrings and set() signatures, the 3-D toolkit, 0.2 s of CPU, and the
+code of TeX's glyph names until read): the
 pictures are the same, byte for byte, and a library caller's matplotlib stays whole."""
 
 from __future__ import annotations
@@ -18,7 +19,10 @@ def _draw(tmp_path, program: bool):
             f"    assert main(['spot', '--lens', 'dgauss_50mm', '--rings', '4', '-o', {str(out)!r}]) == 0\n"
             "import matplotlib.lines\n"
             "print('mpl_toolkits.mplot3d' in sys.modules, 'Properties:' in (matplotlib.lines.Line2D.set.__doc__ or ''),\n"
-            "      '__signature__' in vars(matplotlib.lines.Line2D.set))\n")
+            "      '__signature__' in vars(matplotlib.lines.Line2D.set),\n"
+            "      type(sys.modules['fontTools.agl']).__name__ == '_LazyModule')\n"
+            "import fontTools.agl\n"  # read, a lazy module runs its code: the same module
+            "print(fontTools.agl.toUnicode('Alpha') == '\\u0391')\n")
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
     return out.read_bytes(), p.stdout.split()
@@ -28,5 +32,6 @@ def test_the_program_draws_the_same_pictures_and_the_library_keeps_matplotlib_wh
     lean, seen_lean = _draw(tmp_path, True)
     whole, seen_whole = _draw(tmp_path, False)
     assert lean[:8] == b"\x89PNG\r\n\x1a\n" and lean == whole
-    assert seen_lean == ["False", "False", "False"]  # no 3-D toolkit, no property table or signature for set()
-    assert seen_whole == ["True", "True", "True"]
+    # no 3-D toolkit, no property table or signature for set(), TeX's glyph names not run yet
+    assert seen_lean == ["False", "False", "False", "True", "True"]
+    assert seen_whole == ["True", "True", "True", "False", "True"]

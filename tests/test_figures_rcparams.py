@@ -212,3 +212,20 @@ def test_threads_drawing_at_once_leave_the_callers_rcparams(dgauss):
     assert len(figs) == 9
     assert {f.axes[0].xaxis.label.get_fontsize() for f in figs} == {STYLE["axes.labelsize"]}
     assert {matplotlib.colors.to_hex(f.get_facecolor()) for f in figs} == {"#ffffff"}
+
+
+def test_physcams_reset_is_matplotlibs_rcdefaults():
+    """figures._rcdefaults (issue 47: without the style library rcdefaults imports) sets every setting
+    as matplotlib.rcdefaults() does, from caller settings that include those rcdefaults keeps."""
+    from physcam import figures
+
+    caller = {**SENTINEL, "interactive": True, "figure.max_open_warning": 7, "savefig.directory": "/tmp/x",
+              "webagg.port": 9999, "toolbar": "None", "timezone": "Europe/Paris"}
+    with matplotlib.rc_context(caller):
+        figures._rcdefaults(matplotlib)
+        ours = dict(matplotlib.rcParams)
+    with matplotlib.rc_context(caller):
+        matplotlib.rcdefaults()
+        theirs = dict(matplotlib.rcParams)
+    assert changed_keys(ours, theirs) == []
+    assert ours["interactive"] is True and ours["figure.max_open_warning"] == 7  # kept, as rcdefaults keeps them

@@ -102,7 +102,7 @@ def test_the_core_installs_light_and_runs_the_report(installed):
     # bundled lenses, sensors and the JSON schemas came with the wheel
     lenses = json.loads(_physcam(inst, "lenses", "--json").stdout)
     bundled = [lens for lens in lenses["lenses"] if lens["library"] == "bundled"]
-    assert len(bundled) == len(list((ROOT / "src/physcam/data/lenses").glob("*.toml"))) == 49  # 45 primes, 4 zooms (issue 45)
+    assert len(bundled) == len(list((ROOT / "src/physcam/data/lenses").glob("*.toml"))) == 51  # 47 primes, 4 zooms (issue 45)
     assert "ALEXA 35" in _physcam(inst, "sensors", "ARRI").stdout
     shipped = _run([inst["py"], "-c", "import importlib.resources as r; print(len(list(r.files('physcam.cli.schemas')"
                                       ".iterdir())))"], inst["work"], env=inst["env"]).stdout

@@ -89,11 +89,12 @@ PROGRAM_IMPORT = False
 
 
 def _lean_import() -> None:
-    """Import matplotlib for the ``physcam`` program, skipping three things it never uses (issue 47,
+    """Import matplotlib for the ``physcam`` program, skipping what it never uses (issue 47,
     measured in docs/performance.md): the property tables matplotlib writes into the docstring of
     every artist class's ``set()`` as the class is made (``matplotlib.artist.kwdoc``: a third of
-    matplotlib's import, 0.15 s of CPU), the signature listing those properties (0.04-0.06 s), and
-    its 3-D toolkit, which registering the ``3d`` projection imports with every figure. Only when
+    matplotlib's import, 0.15 s of CPU), the signature listing those properties (0.04-0.06 s),
+    its 3-D toolkit, which registering the ``3d`` projection imports with every figure, and the code of
+    :data:`LAZY_MODULES` until something reads them. Only when
     matplotlib is not imported yet and :data:`PROGRAM_IMPORT` (or :data:`physcam._program.RUNNING`) is
     set; a library caller's matplotlib is left whole."""
     import sys
@@ -111,6 +112,39 @@ def _lean_import() -> None:
     # method of the class (matplotlib.artist.ArtistInspector: 92 classes, 0.06 s of CPU); set() itself
     # takes its keywords from the class's alias map, so the program keeps only the flag it checks
     matplotlib.artist.Artist._update_set_signature_and_docstring = classmethod(_mark_set_generated)
+    finder = _LazyModules()
+    sys.meta_path.insert(0, finder)
+    try:
+        _import_projections(sys, warnings)
+    finally:
+        sys.meta_path.remove(finder)
+
+
+#: Modules matplotlib imports once, with a plain ``import``, and reads only for what physcam's figures never
+#: draw: TeX's glyph names (``matplotlib.dviread``'s ``fontTools.agl``, 7-10 ms of CPU). The program imports
+#: them lazily: a module's code runs at its first use (docs/performance.md, "Round 10"). (dateutil's parser
+#: cannot be: ``matplotlib.dates`` imports it a second time, and a second import runs a lazy module.)
+LAZY_MODULES = ("fontTools.agl",)
+
+
+class _LazyModules:
+    """A meta-path finder that hands out :data:`LAZY_MODULES` through ``importlib.util.LazyLoader``
+    (the standard library's lazy import: the module object now, its code at the first attribute read)."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name not in LAZY_MODULES:
+            return None
+        import importlib.machinery
+        import importlib.util
+
+        spec = importlib.machinery.PathFinder.find_spec(name, path)
+        if spec is not None and spec.loader is not None:
+            spec.loader = importlib.util.LazyLoader(spec.loader)
+        return spec
+
+
+def _import_projections(sys, warnings) -> None:
+    """matplotlib's projections without the 3-D toolkit (:func:`_lean_import`)."""
     if "mpl_toolkits.mplot3d" not in sys.modules:
         sys.modules["mpl_toolkits.mplot3d"] = None  # the projections' import of it fails: no "3d" projection
         try:
@@ -153,11 +187,29 @@ def figure_style():
         import matplotlib
 
         with _LOCK, matplotlib.rc_context():
-            matplotlib.rcdefaults()  # (keeps the backend and the other settings styles never touch)
+            _rcdefaults(matplotlib)  # (keeps the backend and the other settings styles never touch)
             matplotlib.rcParams.update(_style_params())
             yield
     finally:
         _STATE.depth = max(0, _depth() - 1)
+
+
+#: The settings ``matplotlib.rcdefaults()`` leaves as they are (matplotlib's style blacklist: the backend, the
+#: interactive and GUI settings, the date epoch, ...; tests/test_figures_rcparams.py checks this copy against it).
+RC_KEPT = frozenset({"backend", "backend_fallback", "date.epoch", "docstring.hardcopy", "figure.max_open_warning",
+                     "figure.raise_window", "interactive", "savefig.directory", "timezone", "tk.window_focus", "toolbar",
+                     "webagg.address", "webagg.open_in_browser", "webagg.port", "webagg.port_retries"})
+
+
+def _rcdefaults(matplotlib) -> None:
+    """What ``matplotlib.rcdefaults()`` does, without importing ``matplotlib.style`` for its blacklist (which
+    reads matplotlib's whole style library, 9 ms of a cold figure command: issue 47)."""
+    import warnings
+
+    with warnings.catch_warnings():  # deprecated settings warned once, when matplotlib made its defaults
+        warnings.simplefilter("ignore", matplotlib.MatplotlibDeprecationWarning)
+        matplotlib.rcParams.clear()
+        matplotlib.rcParams.update({k: v for k, v in matplotlib.rcParamsDefault.items() if k not in RC_KEPT})
 
 
 def _settle(fig) -> None:
@@ -290,6 +342,70 @@ def pyplot():
     """pyplot's ``subplots``/``figure``/``close`` on Agg canvases (anything else: the real
     ``matplotlib.pyplot`` on the non-interactive Agg backend)."""
     return _PLOT
+
+
+def dots(ax, x, y, sizes, color="k"):
+    """``ax.scatter(x, y, s=sizes, c=color, lw=0)`` (round dots, ``sizes`` in points^2) drawn as what
+    they cover on a raster canvas: each dot's area in pixels spread bilinearly over the four pixels
+    around its centre and the dots composited over one another as Agg composites them
+    (1 - prod(1 - coverage)), one image instead of one antialiased path per dot (a spot diagram's
+    56,000 dots: 0.22 s of Agg's path rendering, issue 47). Dots under a pixel across are where
+    the two agree (tests/test_figures_dots.py measures both); SVG and PDF draw the scatter itself."""
+    coll = ax.scatter(x, y, s=sizes, c=color, lw=0)
+    coll.__class__ = _coverage_dots_class()
+    return coll
+
+
+@functools.cache
+def _coverage_dots_class():
+    from matplotlib.backends.backend_agg import RendererAgg
+    from matplotlib.collections import PathCollection
+
+    class CoverageDots(PathCollection):
+        """A scatter of round dots that an Agg canvas draws as one coverage image (:func:`dots`)."""
+
+        def draw(self, renderer):
+            if not isinstance(renderer, RendererAgg) or not self.get_visible():
+                return super().draw(renderer)
+            renderer.open_group("dots", self.get_gid())
+            gc = renderer.new_gc()
+            self._set_gc_clip(gc)
+            image, x0, y0 = _coverage_image(self, renderer.points_to_pixels(1.0), self.axes.bbox)
+            if image is not None:
+                renderer.draw_image(gc, x0, y0, image)
+            gc.restore()
+            renderer.close_group("dots")
+            self.stale = False
+
+    return CoverageDots
+
+
+def _coverage_image(coll, px_per_pt: float, box):
+    """(RGBA image, left, bottom) of :func:`dots` over the pixels of ``box`` (display units)."""
+    import numpy as np
+
+    xy = coll.get_offset_transform().transform(coll.get_offsets())
+    area = np.broadcast_to(coll.get_sizes(), (len(xy),)) * (np.pi / 4.0 * px_per_pt ** 2)  # diameter^2 pi / 4
+    x0, y0 = int(np.floor(box.x0)), int(np.floor(box.y0))
+    w, h = int(np.ceil(box.x1)) - x0, int(np.ceil(box.y1)) - y0
+    u, v = xy[:, 0] - x0 - 0.5, xy[:, 1] - y0 - 0.5  # from the first pixel's centre
+    inside = (u > -1.0) & (u < w) & (v > -1.0) & (v < h) & (area > 0)
+    if w <= 0 or h <= 0 or not inside.any():
+        return None, x0, y0
+    u, v, area = u[inside], v[inside], area[inside]
+    i, j = np.floor(u), np.floor(v)
+    fu, fv = u - i, v - j
+    i, j = i.astype(np.int64) + 1, j.astype(np.int64) + 1  # a border of one pixel each side, cut below
+    lost = np.zeros((h + 2) * (w + 2))  # sum of log(1 - coverage) per pixel
+    for di, wu in ((0, 1.0 - fu), (1, fu)):
+        for dj, wv in ((0, 1.0 - fv), (1, fv)):
+            cover = np.minimum(area * wu * wv, 1.0 - 1e-12)
+            lost += np.bincount((j + dj) * (w + 2) + i + di, weights=np.log1p(-cover), minlength=lost.size)
+    alpha = -np.expm1(lost.reshape(h + 2, w + 2)[1:-1, 1:-1])
+    rgba = np.empty((h, w, 4), dtype=np.uint8)
+    rgba[..., :3] = np.round(np.asarray(coll.get_facecolor()[0][:3]) * 255.0).astype(np.uint8)
+    rgba[..., 3] = np.round(alpha * (255.0 * coll.get_facecolor()[0][3]))
+    return rgba, x0, y0  # the first row at the bottom, as draw_image takes it
 
 
 def _skip_layout_rerun(fig) -> None:

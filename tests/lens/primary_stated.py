@@ -28,6 +28,16 @@ US_3583791 = [
     (-140.91, 19.58, None, None), (-65.04, 16.22, 1.7552, 27.5), (188.11, 2.52, None, None), (-323.43, 7.00, 1.713, 53.9),
     (-65.39, 0.18, None, None), (-8741.25, 6.64, 1.6583, 57.3), (-117.55, None, None, None),
 ]
+#: US 3,583,791, Example II as claim 3 (column 4) prints it (column 3 prints the same but R13 = 3,921.60, which
+#: would make the focal length 95.79 and Bf 131.29): L5 (R9-R9') and L5' (R9'-R10) cemented; the stop sits in d8.
+US_3583791_EX2_R13_COLUMN3 = 3921.60
+US_3583791_EX2 = [
+    (94.12, 3.14, 1.62041, 60.3), (52.16, 15.69, None, None), (117.65, 3.14, 1.62041, 60.3), (67.84, 52.94, None, None),
+    (101.96, 14.90, 1.76684, 46.2), (-188.83, 4.71, None, None), (-190.20, 14.41, 1.76684, 46.2),
+    (-140.79, 20.59, None, None), (-64.48, 1.96, 1.79504, 28.4), (147.06, 15.29, 1.79668, 45.3),
+    (191.18, 2.88, None, None), (-323.53, 6.08, 1.6968, 55.6), (-66.47, 0.2, None, None),
+    (-3921.60, 6.47, 1.6425, 58.1), (-99.63, None, None, None),
+]
 #: US 3,451,745 (T. Kazamaki, Y. Takahashi / Asahi Kogaku, 1969), the table of column 4 (claim 1 prints it
 #: in units of F); the stop sits in d6.
 US_3451745 = [
@@ -50,6 +60,23 @@ US_3841736 = [
     (-1416.27, 16.64, 1.69350, 53.3), (-110.97, 0.49, None, None), (-887.30, 5.27, 1.80518, 25.4),
     (118.00, 10.71, None, None), (-1386.54, 16.31, 1.64850, 53.0), (-98.62, None, None, None),
 ]
+#: US 3,841,736, the second embodiment (Fig. 3): Table III (claim 2 prints the same); r3 flat (0 here, as physcam
+#: writes a flat); the stop sits in d12.
+US_3841736_EX2 = [
+    (229.52, 8.64, 1.64000, 60.2), (94.56, 47.57, None, None), (0.0, 39.89, 1.51633, 64.1),
+    (-312.73, 1.62, None, None), (150.12, 9.62, 1.64000, 60.2), (56.47, 18.91, None, None),
+    (167.82, 9.62, 1.51633, 64.1), (65.37, 16.22, None, None), (333.50, 9.62, 1.64000, 60.2),
+    (-1093.72, 21.62, None, None), (181.10, 25.40, 1.62588, 35.7), (-95.77, 15.68, None, None),
+    (424.27, 23.24, 1.51633, 64.1), (-58.17, 6.40, 1.83400, 37.2), (253.87, 8.11, None, None),
+    (-1502.70, 14.59, 1.48749, 70.1), (-72.53, 0.54, None, None), (324.32, 5.78, 1.80518, 25.4),
+    (121.74, 10.81, None, None), (1043.14, 18.92, 1.51633, 64.1), (-106.74, None, None, None),
+]
+#: What column 6 prints beside Table III: the focal lengths F7, F8 of lenses 7 and 8, |F1.2.3.4| = F/1.786 and
+#: F1.2.3.4.5.6 = F/0.878; and Table IV's P (Petzval) column, headed "for the lens system of Table I" but Table
+#: III's (Table II is Table I's), with its printed sum.
+US_3841736_EX2_STATED = dict(f7=100.70, f8=-56.22, f1234=-55.99, f123456=113.90,
+                             pt=(0.17, -0.41, 0.00, 0.11, 0.26, -0.69, 0.20, -0.52, 0.12, 0.04, 0.21, 0.40, 0.08,
+                                 -0.20, -0.18, -0.02, 0.45, 0.14, -0.37, 0.03, 0.32), pt_sum=0.14)
 #: US 3,506,336 (Y. Takahashi / Asahi Kogaku, 1970), Table 1 (claim 1 prints the same); the stop sits in t4.
 US_3506336 = [
     (450.000, 7.00, 1.58913, 61.2), (80.137, 47.00, None, None), (-2300.000, 10.00, 1.76200, 40.3),
@@ -236,9 +263,14 @@ PRIMARY = {
     "asahi_us3451745_100mm_f1_2": (US_3451745, dict(efl=100.0, fno=1.2, bf=None)),
     # Takahashi and Okudaira: F 100, "aperture ratio of 1:3.5" (column 6), F_B = 1.987F = 198.7
     "asahi_wide_angle_us3841736_100mm_f3_5": (US_3841736, dict(efl=100.0, fno=3.5, bf=198.7, bf_tol=0.05)),
+    # the same, Table III: "likewise based on a lens system of focal length F = 100", Fig. 4's aberrations to
+    # "1:3.5", F_B = 1.997F = 199.7
+    "asahi_wide_angle_us3841736_100mm_f3_5_ex2": (US_3841736_EX2, dict(efl=100.0, fno=3.5, bf=199.7, bf_tol=0.05)),
     # Takahashi: "resultant focal length F=100" (column 2), Fig. 2's aberrations to "1:2.0"; no back focus
     "asahi_wide_angle_us3506336_100mm_f2": (US_3506336, dict(efl=100.0, fno=2.0, bf=None)),
     "nikon_retrofocus_us3583791_100mm_f2_8": (US_3583791, dict(efl=100.0, fno=2.8, bf=131.19, bf_tol=0.005 * 131.19)),
+    # Mori, Example II: "the relative aperture is F/2.8, angle of field is 78 deg, and the focal length is f=100", Bf=137.24
+    "nikon_retrofocus_us3583791_100mm_f2_8_ex2": (US_3583791_EX2, dict(efl=100.0, fno=2.8, bf=137.24, bf_tol=0.005)),
     # Ikemori: "f (focal distance) = 14.2; F No. = 1:2.8, bf (back focal distance) = 36.6, Angle of field = 114 deg".
     # The stated 14.2 is nominal: the patent's own h column gives f = bf / 2.563 = 14.280 (test below), which the
     # lens has (+0.56 %), so the EFL's tolerance is 0.6 % here and the design's f is checked at 0.1 % below

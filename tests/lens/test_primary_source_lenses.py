@@ -16,8 +16,9 @@ from physcam.lens.library import find_lens, load_lens
 from physcam.lens.provenance import primary_source_claim_gaps, provenance_of
 from physcam.optics.paraxial import gaussian, media_indices, paraxial_trace, system_matrix
 
-from primary_stated import (PRIMARY, US_3841736_R14_PRINTED, US_4310222_COLUMNS, US_4310222_EX2_R16_PRINTED,
-                             US_4310222_EX8_N7_PRINTED, US_4310222_R6_PRINTED)
+from primary_stated import (PRIMARY, US_3583791_EX2_R13_COLUMN3, US_3841736_EX2_STATED, US_3841736_R14_PRINTED,
+                             US_4310222_COLUMNS, US_4310222_EX2_R16_PRINTED, US_4310222_EX8_N7_PRINTED,
+                             US_4310222_R6_PRINTED)
 
 ORACLE = json.loads((Path(__file__).resolve().parents[1] / "data" / "optiland_library.json").read_text())["lenses"]
 
@@ -104,6 +105,46 @@ def test_a_misprinted_radius_is_corrected_by_the_patents_own_stated_values():
     printed = p.with_surfaces(dataclasses.replace(x, radius=US_3841736_R14_PRINTED) if k == i else x
                               for k, x in enumerate(p.surfaces))
     assert gaussian(printed).efl == pytest.approx(117.51, abs=0.01)
+
+
+def test_us3841736s_second_table_meets_its_printed_focal_lengths_and_table_ivs_petzval_column():
+    """Column 6 prints beside Table III the focal lengths of lenses 7 and 8 and of the first four and six lenses,
+    and Table IV (headed "for the lens system of Table I") the Seidel coefficients: its P column is Table III's,
+    (F/r)(1/n - 1/n') with F = 100, every radius and index of the file to the printed digits (Table I's first
+    row would be 0.23, not 0.17)."""
+    p, want = load_lens("asahi_wide_angle_us3841736_100mm_f3_5_ex2"), US_3841736_EX2_STATED
+    st, n = p.stop_index, media_indices(p)
+    pt = [(100.0 / s.radius if s.radius else 0.0) * (1.0 / n[i] - 1.0 / n[i + 1])  # r3 is flat: 0
+          for i, s in enumerate(p.surfaces) if i != st]
+    assert pt == pytest.approx(want["pt"], abs=0.0051) and sum(pt) == pytest.approx(want["pt_sum"], abs=0.005)
+    assert (100.0 / 196.25) * (1.0 - 1.0 / 1.80610) == pytest.approx(0.23, abs=0.005)  # Table I's r1, n1
+
+    def group_f(first, last):  # the file's surface indices (the stop is index 12, after r12), last one into air
+        return -1.0 / system_matrix(p, first=first, last=last)[2]
+
+    def thick_lens_f(k):  # lens k in air (Smith, Modern Optical Engineering, eq. 2.48); its surfaces k, k + 1
+        r1, r2, t, nk = p.surfaces[k].radius, p.surfaces[k + 1].radius, p.surfaces[k].thickness, n[k + 1]
+        return 1.0 / ((nk - 1.0) * (1.0 / r1 - 1.0 / r2 + (nk - 1.0) * t / (nk * r1 * r2)))
+
+    assert thick_lens_f(13) == pytest.approx(want["f7"], rel=5e-4)  # 100.729: 0.03 % from the printed 100.70
+    assert thick_lens_f(14) == pytest.approx(want["f8"], abs=0.005)
+    assert group_f(0, 7) == pytest.approx(want["f1234"], abs=0.005)
+    assert group_f(0, 11) == pytest.approx(want["f123456"], abs=0.015)
+
+
+def test_a_sign_lost_in_us3583791s_second_example_is_restored_by_its_stated_values():
+    """Example II's R13 is printed 3,921.60 in column 3 and -3921.60 in claim 3: only the minus sign gives the
+    stated f = 100 and Bf = 137.24 (95.79 and 131.29 with the plus), and makes L7 the positive meniscus convex
+    to the image that claim 1 ends the lens with."""
+    p = load_lens("nikon_retrofocus_us3583791_100mm_f2_8_ex2")
+    s = [x for x in p.surfaces if x.kind != "stop"]
+    assert s[13].radius == pytest.approx(-3921.60) and "3,921.60" in provenance_of(p).corrections[0]
+    assert s[13].radius < 0 and s[14].radius < 0 and abs(s[14].radius) < abs(s[13].radius)  # concave to the object
+    i = p.surfaces.index(s[13])
+    printed = p.with_surfaces(dataclasses.replace(x, radius=US_3583791_EX2_R13_COLUMN3) if k == i else x
+                              for k, x in enumerate(p.surfaces))
+    g = gaussian(printed)
+    assert g.efl == pytest.approx(95.79, abs=0.01) and g.bfl == pytest.approx(131.29, abs=0.01)
 
 
 @pytest.mark.parametrize("slug", sorted(US_4310222_COLUMNS))

@@ -65,3 +65,53 @@ def test_a_copy_without_its_timecode_is_named_arri(tmp_path, delimiter):
         csv.writer(fh, delimiter=delimiter).writerows([[r[i] for i in keep] for r in table])
     with pytest.raises(MetadataError, match="ARRI Meta Extract CSV but has no 'Master TC'"):
         detect_file(p)
+
+
+#: the file whose opens the audit hook counts, then each open's mode; empty: the hook is idle
+_OPENS: list = []
+_HOOKED: list = []
+
+
+def _count_opens(event, args):
+    if event == "open" and _OPENS and str(args[0]) == _OPENS[0]:
+        _OPENS.append(args[1])
+
+
+@pytest.mark.parametrize("delimiter", ["\t", ";"])
+def test_the_reader_opens_the_file_once_and_reads_its_header_once(tmp_path, delimiter):
+    """Round 10: the reader opened the file twice, once for the first line to pick the delimiter and again for its
+    rows (and each open twice, once more for the encoding). Python's audit hook sees every real open of the file
+    (sys.addaudithook; a hook stays for the process, so it is added once and idles between tests)."""
+    import sys
+
+    from physcam.metadata import arri
+
+    p, table = _copy(tmp_path, delimiter)
+    if not _HOOKED:
+        sys.addaudithook(_count_opens)
+        _HOOKED.append(True)
+    _OPENS[:] = [str(p)]
+    try:
+        clip = arri.read(p)
+    finally:
+        modes, _OPENS[:] = _OPENS[1:], []
+    assert len(modes) == 1, modes  # one open: the header read once, for the delimiter and the columns
+    assert len(clip.frames) == len(table) - 1 == 500
+
+
+def test_a_file_the_reader_refuses_is_closed(tmp_path):
+    # a blank first line: no delimiter gives AME's header, so the reader refuses it; the file it opened must
+    # be closed then, not left to the garbage collector (a review's find: a ResourceWarning under -X dev)
+    import gc
+    import warnings
+
+    from physcam.metadata import arri
+
+    p = tmp_path / "clip.csv"
+    p.write_text("\n" + ARRI.read_text(encoding="utf-8"), encoding="utf-8")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ResourceWarning)
+        with pytest.raises(MetadataError):
+            arri.read(p)
+        gc.collect()
+    assert not [w for w in caught if issubclass(w.category, ResourceWarning)]

@@ -134,7 +134,8 @@ def test_a_command_that_writes_no_file_loads_neither_the_writers_modules_nor_plo
 def test_the_issue_47_commands_load_only_what_they_draw_or_print(tmp_path):
     # issue 47, as the program runs them (_program.start: matplotlib's lean import): the commands that
     # print load neither matplotlib nor numba; the figures load Figure and the Agg canvas, never pyplot,
-    # matplotlib's 3-D toolkit or numba (their rays cost the numpy kernel less than numba's load; a
+    # matplotlib's 3-D toolkit, its style library (figures._rcdefaults) or numba (their rays cost the numpy
+    # kernel less than numba's load; a
     # compare of one lens with few bokeh rays keeps the test cheap: the figure is the same kind)
     printed = [["mtf", "--lens", "dgauss_50mm", "--field", "0"]]
     drawn = [["compare", "--lens", "tessar_50mm_f2_8", "--focus", "2m", "--sensor", "S35", "--rays", "2000", "-o",
@@ -143,7 +144,8 @@ def test_the_issue_47_commands_load_only_what_they_draw_or_print(tmp_path):
     code = ("import sys, io, contextlib\nfrom physcam import _program\nfrom physcam.cli import main\n"
             "import physcam.trace.kernels as K\n_program.start()\n"
             "def loaded():\n"
-            "    return sorted(m for m in ('numba', 'matplotlib', 'matplotlib.pyplot', 'mpl_toolkits.mplot3d')"
+            "    return sorted(m for m in ('numba', 'matplotlib', 'matplotlib.pyplot', 'mpl_toolkits.mplot3d',"
+            " 'matplotlib.style')"
             " if sys.modules.get(m) is not None)\n"
             f"for argv in {printed!r}:\n"
             "    K._numpy_spent = 0.0\n"

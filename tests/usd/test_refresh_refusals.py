@@ -1,9 +1,10 @@
 """`physcam usd check/refresh` of cameras they cannot recompute right say so in one line, naming the file
-(first-day walkthrough, round 9): an animated camera (time-sampled focus and f-stop, `usd animate`) was
-called current and left as it was after a sample was edited; a camera written by a `usd write --lens` from
-before the lens was stored (no <camera>/Prescription) would be refreshed as a thin lens.
+(first-day walkthrough, round 9): a camera written by a `usd write --lens` from before the lens was stored (no
+<camera>/Prescription) would be refreshed as a thin lens. An animated camera (a keyed focus and f-stop) is
+checked and refreshed time code by time code since round 10 (tests/usd/test_refresh_animated.py, which also
+holds the samples that are still refused).
 
-Oracle: the files themselves, edited with usd-core (a sample changed, the stored lens removed), and the
+Oracle: the files themselves, edited with usd-core (the stored lens removed, a layout's move), and the
 file's bytes, which a refusal leaves as they were.
 """
 
@@ -24,19 +25,6 @@ def _refused(capsys, action, f):
     assert len(err.splitlines()) == 1 and str(f) in err, err
     assert f.read_bytes() == before
     return err
-
-
-def test_an_animated_camera_is_refused_naming_the_attribute(tmp_path, capsys):
-    marks = tmp_path / "pull.csv"
-    marks.write_text("frame,focus,fstop\n1,2m,2.8\n10,4m,4\n", encoding="utf-8")
-    f = tmp_path / "pull.usda"
-    assert main(["usd", "animate", str(f), "--focal", "50", "--marks", str(marks), "--sensor", "S35"]) == 0
-    stage = Usd.Stage.Open(str(f))
-    stage.GetPrimAtPath(CAM).GetAttribute("lens:main:fStop").Set(5.6, 10.0)  # the pull's last stop edited
-    stage.Save()
-    for action in ("refresh", "check"):
-        err = _refused(capsys, action, f)
-        assert "lens:main:fStop is animated (2 time samples)" in err and "usd animate" in err
 
 
 def test_a_lens_camera_without_its_stored_lens_is_refused(tmp_path, capsys):

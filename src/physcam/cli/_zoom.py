@@ -46,16 +46,17 @@ def zoom_info(args, lens) -> dict | None:
 
 def at_zoom_named(lens, args):
     """``lens`` at ``--zoom`` for a command whose outputs carry the lens's name (ST-map headers, cards, tables):
-    the prescription there named with its position (paraxial EFL and encoder value), and ``args.zoom_block``
-    the JSON ``zoom`` block (None without --zoom). A prime given --zoom is refused (InputError)."""
-    from .._record import replace
-
-    q = zoomed(lens, args)
-    args.zoom_block = zoom_info(args, q) if q is not lens else None
-    if args.zoom_block is None:
+    :func:`physcam.optics.zoom.named_at_zoom`, and ``args.zoom_block`` the JSON ``zoom`` block (None without
+    --zoom). A prime given --zoom is refused (InputError)."""
+    zoom = getattr(args, "zoom", None)
+    args.zoom_block = None
+    if zoom is None:
         return lens
-    b = args.zoom_block
-    return replace(q, metadata=replace(q.metadata, name=f"{lens.name} at {b['efl_mm']:.1f} mm (zoom {b['encoder']:.4g})"))
+    from ..optics.zoom import named_at_zoom
+
+    q, args.zoom_block = named_at_zoom(lens, zoom, wavelength_nm=getattr(args, "wavelength", None))
+    args.zoom_encoder = args.zoom_block["encoder"]
+    return q
 
 
 def register_zoom(lsub, add_lens_argument, add_sensor_options, add_output_options, number) -> None:

@@ -96,43 +96,47 @@ def register(sub) -> None:
     p.set_defaults(handler=run)
 
 
-def cell_report(args, lens, sensor, fstop, focus):
-    """The lens report of one cell: what `physcam report` gives for these options."""
-    from ..onset.report import report_camera, solve_report
-    from ._common import coc_of
-
-    return solve_report(report_camera(focal_length_mm=None if lens is not None else args.focal, lens=lens, sensor=sensor,
-                                      fstop=fstop, focus_mm=focus, coc=coc_of(args), squeeze=squeeze_of(args, sensor)))
-
-
 def build(args) -> dict:
-    """The table as a dict (the JSON payload): :func:`physcam.onset.dof_table.dof_table` of the options,
-    with the zoom block of ``--zoom``."""
+    """The table as a dict (the JSON payload): :func:`physcam.onset.dof_table.dof_table` of the options
+    (``--zoom`` its ``zoom``)."""
     from ..errors import InputError
     from ..onset.dof_table import MAX_MARKS, dof_table
-    from ._common import coc_of, resolve_sensor
 
-    lens = None
-    if args.lens:
-        if args.focal is not None:
-            raise InputError("give either --lens or --focal: the lens sets its own focal length")
-        from ..lens.library import load_lens
-        from ._zoom import at_zoom_named
-
-        args.loaded_lens = load_lens(args.lens, lenient=args.lenient)
-        lens = args.table_lens = at_zoom_named(args.loaded_lens, args)
-    elif getattr(args, "zoom", None) is not None:
-        raise InputError("--zoom takes a zoom lens: give it with --lens NAME (a thin --focal lens has no zoom)")
-    elif args.focal is None:
-        raise InputError("give the focal length, e.g. --focal 35, or a lens with --lens NAME")
+    _lens_option(args)
     marks = args.focus if args.focus is not None else focus_list("focus marks")(DEFAULT_FOCUS)
     if len(marks) > MAX_MARKS:  # before the sensor is resolved: the command's own order of refusals
         raise InputError(f"a table takes up to {MAX_MARKS} focus marks, got {len(marks)}")
-    sensor = resolve_sensor(args)
-    d = dof_table(None if lens is not None else args.focal, lens=lens, sensor=sensor, fstops=args.fstops,
-                  focus_marks_mm=marks, coc=coc_of(args), squeeze=squeeze_of(args, sensor))
-    d["zoom"] = getattr(args, "zoom_block", None)
-    return d
+    return dof_table(**_table_options(args), fstops=args.fstops, focus_marks_mm=marks)
+
+
+def _lens_option(args):
+    """The --lens prescription (loaded once, kept as ``args.loaded_lens``), or None for a thin --focal lens;
+    InputError for the lens options the command refuses: both, neither, --zoom without --lens."""
+    from ..errors import InputError
+
+    if args.lens:
+        if args.focal is not None:
+            raise InputError("give either --lens or --focal: the lens sets its own focal length")
+        if getattr(args, "loaded_lens", None) is None:
+            from ..lens.library import load_lens
+
+            args.loaded_lens = load_lens(args.lens, lenient=args.lenient)
+        return args.loaded_lens
+    if getattr(args, "zoom", None) is not None:
+        raise InputError("--zoom takes a zoom lens: give it with --lens NAME (a thin --focal lens has no zoom)")
+    if args.focal is None:
+        raise InputError("give the focal length, e.g. --focal 35, or a lens with --lens NAME")
+    return None
+
+
+def _table_options(args) -> dict:
+    """The keywords of :func:`physcam.onset.dof_table.dof_table` and ``dof_cells`` the options give (all but
+    the stops and marks): the lens or focal length, sensor, CoC, squeeze and zoom."""
+    from ._common import coc_of, resolve_sensor
+
+    lens, sensor = _lens_option(args), resolve_sensor(args)
+    return dict(focal_length_mm=None if lens is not None else args.focal, lens=lens, sensor=sensor, coc=coc_of(args),
+                squeeze=squeeze_of(args, sensor), zoom=getattr(args, "zoom", None))
 
 
 def _label(m, units) -> str:
@@ -261,22 +265,22 @@ def _print_horizontal(d, units, heads, labels) -> None:
 def _card_chart(args):
     """(report, chart data) of the DOF chart under the card's table: the table's stops (up to six of them,
     spread from its first to its last: never a stop the table does not have) against focus, every cell a
-    report as the table's."""
+    cell of the table (:func:`physcam.onset.dof_table.dof_cells` of the same options)."""
     import warnings
 
     from ..errors import PhysCamWarning
     from ..onset.dof_plot import dof_chart_data
-    from ._common import resolve_sensor
+    from ..onset.dof_table import dof_cells
 
-    lens, sensor = getattr(args, "table_lens", None), resolve_sensor(args)
+    cell = dof_cells(**_table_options(args))
     marks = [m for m in (args.focus or []) if isinstance(m, float) and math.isfinite(m)]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PhysCamWarning)
-        report = cell_report(args, lens, sensor, args.fstops[0], marks[len(marks) // 2] if marks else 3000.0)
+        report = cell(args.fstops[0], marks[len(marks) // 2] if marks else 3000.0)
         stops = list(args.fstops)
         if len(stops) > CHART_STOPS:
             stops = [stops[round(k * (len(stops) - 1) / (CHART_STOPS - 1))] for k in range(CHART_STOPS)]
-        data = dof_chart_data(report, lambda n, m: cell_report(args, lens, sensor, n, m), fstops=stops)
+        data = dof_chart_data(report, cell, fstops=stops)
     return report, data
 
 

@@ -485,7 +485,10 @@ def run_check(args) -> int:
         emit_json(document("usd_check", d))
         return rc
     state = f"STALE: {res['reason']}; run physcam usd refresh {args.file}" if res["stale"] else "current"
-    print(f"{res['path']}: companion camera {state}")
+    keyed = f" ({len(res['time_codes'])} keyed time codes)" if res["time_codes"] else ""
+    print(f"{res['path']}: companion camera{keyed} {state}")
+    for sample in res["stale_samples"]:
+        print(f"  time code {sample['time']:g}: stale {', '.join(sample['attributes'])}")
     for u in res["units"]:
         print(f"  note: {u['file']} is in metersPerUnit {u['meters_per_unit']:g}, the shot in "
               f"{res['meters_per_unit']:g} (composed in the shot's unit)")
@@ -507,7 +510,8 @@ def run_refresh(args) -> int:
         print(f"{res['path']}: companion camera recomputed; {n} value{'s' * (n != 1)} changed"
               + (":" if n else " (the inputs hash only)"))
         for c in res["changed"]:
-            print(f"  {c['attribute']}: {_shown(c['before'])} -> {_shown(c['after'])}")
+            at = f" at time code {c['time']:g}" if "time" in c else ""
+            print(f"  {c['attribute']}{at}: {_shown(c['before'])} -> {_shown(c['after'])}")
     return 0
 
 

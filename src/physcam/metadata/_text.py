@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import itertools
 import math
 import re
 from fractions import Fraction
@@ -53,16 +54,22 @@ def read_text(path, limit: int = MAX_BYTES) -> str:
 def _open_text(p: Path):
     """The file opened as text (UTF-8 or UTF-16 by its BOM, the BOM dropped, newlines kept for the csv
     module), after the size and binary checks."""
+    import io
+
     _check_size(p, MAX_BYTES)
     try:
-        with open(p, "rb") as fh:
-            head = fh.read(4096)
+        fh = open(p, "rb")  # opened once: its first bytes read for the encoding, then read again as text
+    except OSError as exc:
+        raise MetadataError(f"cannot read it ({exc.strerror or exc})", p) from None
+    try:
+        head = fh.peek(4096)[:4096]
         encoding = encoding_of(head)
         if encoding != "utf-16" and b"\0" in head:
             raise MetadataError("a binary file, not a metadata text export", p, 1)
-        return open(p, encoding=encoding, newline="")
-    except OSError as exc:
-        raise MetadataError(f"cannot read it ({exc.strerror or exc})", p) from None
+        return io.TextIOWrapper(fh, encoding=encoding, newline="")
+    except BaseException:
+        fh.close()
+        raise
 
 
 def lines(path):
@@ -78,29 +85,48 @@ def lines(path):
             raise MetadataError("not UTF-8 or UTF-16 text", p, n + 1) from None
 
 
-def rows(path, delimiter: str = ",") -> tuple[list[str], object]:
+def rows(path, delimiter=",") -> tuple[list[str], object]:
     """(header, rows) of a delimited file, streamed: ``rows`` yields (line, {column: cell}) one row at
     a time, so a reader keeps only what it takes from each row (memory near the file's size at
     most). A row whose field count differs from the header's (a truncated file) is an error naming
-    its line; a blank line is skipped. Duplicate columns keep the first."""
+    its line; a blank line is skipped. Duplicate columns keep the first. ``delimiter``: one character, or
+    a function of the file's first line (its text, without the line break) that picks it: the header is
+    read once, for both."""
     p = Path(path)
     fh = _open_text(p)
-    reader = csv.reader(fh, delimiter=delimiter)
+    try:  # the file is closed here when the header cannot be read (or the delimiter not picked), else by the rows
+        header, reader = _header(p, fh, delimiter)
+    except BaseException:
+        fh.close()
+        raise
+    data = _data_rows(p, fh, reader, header)
+    next(data)  # inside its `with fh` now: a reader that drops the rows unread (a missing column) closes the file
+    return header, data
+
+
+def _header(p, fh, delimiter):
+    """(header, csv reader positioned after it) of the open file ``fh`` (:func:`rows`)."""
+    try:
+        first = fh.readline()
+    except UnicodeDecodeError:
+        raise MetadataError("not UTF-8 or UTF-16 text", p, 1) from None
+    if callable(delimiter):
+        delimiter = delimiter(first.rstrip("\r\n"))
+    reader = csv.reader(itertools.chain([first] if first else [], fh), delimiter=delimiter)
     try:
         header = next(reader)
     except StopIteration:
-        fh.close()
         raise MetadataError("the file is empty", p, 1) from None
     except (csv.Error, UnicodeDecodeError) as exc:
-        fh.close()
         why = "not UTF-8 or UTF-16 text" if isinstance(exc, UnicodeDecodeError) else f"cannot read the header ({exc})"
         raise MetadataError(why, p, 1) from None
-    header = [h.strip() for h in header]
-    return header, _data_rows(p, fh, reader, header)
+    return [h.strip() for h in header], reader
 
 
 def _data_rows(p, fh, reader, header):
+    """The rows of :func:`rows`; its first ``next`` only enters the file's ``with`` (yields None)."""
     with fh:
+        yield None
         try:
             for cells in reader:
                 line = reader.line_num

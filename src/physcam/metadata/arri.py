@@ -66,17 +66,10 @@ def sniff(head: str) -> bool:
     return delimiter_of(head) is not None
 
 
-def _delimiter(path) -> str:
-    """The delimiter of the file's header (:func:`delimiter_of`); tab, Meta Extract's own, when none fits (the
-    reader then names the columns it lacks)."""
-    from ._text import lines
-
-    read = lines(path)
-    try:
-        first = next(read, (1, ""))[1]
-    finally:
-        read.close()
-    return delimiter_of(first) or "\t"
+def _delimiter(head: str) -> str:
+    """The delimiter of the file's header line ``head`` (:func:`delimiter_of`); tab, Meta Extract's own, when
+    none fits (the reader then names the columns it lacks)."""
+    return delimiter_of(head) or "\t"
 
 
 def _focus_mm(path, line, unit, text):
@@ -121,10 +114,15 @@ def _frame(path, line, r, no_unit: list) -> FrameSample:
 
 def read(path) -> ClipRecord:
     """The clip of one AME CSV (module notes), read row by row."""
-    delimiter = _delimiter(path)
-    header, data = rows(path, delimiter)
+    picked = {}
+
+    def pick(head: str) -> str:  # the delimiter from the header line rows reads: the file's first line read once
+        picked["delimiter"] = _delimiter(head)
+        return picked["delimiter"]
+
+    header, data = rows(path, pick)
     require_columns(path, header, REQUIRED, "an ARRI Meta Extract CSV")
-    if delimiter == ";":  # a decimal-comma locale's copy: "4,812" is 4.812, "1,4 + 7/10" is 1.4 + 7/10
+    if picked["delimiter"] == ";":  # a decimal-comma locale's copy: "4,812" is 4.812, "1,4 + 7/10" is 1.4 + 7/10
         data = ((line, {k: _DECIMAL_COMMA.sub(r"\1.\2", v) for k, v in r.items()}) for line, r in data)
     frames, no_unit, first = [], [], None
     for line, r in data:

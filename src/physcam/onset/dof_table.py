@@ -20,7 +20,7 @@ from ..units import parse_distance
 from .report import HYPERFOCAL, solve_report
 from .request import report_camera
 
-__all__ = ["DEFAULT_FOCUS", "DEFAULT_FSTOPS", "dof_table", "format_squeeze"]
+__all__ = ["DEFAULT_FOCUS", "DEFAULT_FSTOPS", "dof_cells", "dof_table", "format_squeeze"]
 
 #: The f-stops and marks of a table when none are given (the full stops of a cine lens; common marks).
 DEFAULT_FSTOPS = (1.4, 2.0, 2.8, 4.0, 5.6, 8.0, 11.0, 16.0)
@@ -106,8 +106,46 @@ def format_squeeze(sensor) -> float:
     return float(offered[0])
 
 
+def _table_lens(focal_length_mm, lens, sensor, squeeze, zoom):
+    """(lens at its zoom position, squeeze, the ``zoom`` block or None) of a table's options, checked."""
+    if (lens is None) == (focal_length_mm is None):
+        raise InputError("give either a focal length (focal_length_mm=35) or a lens (lens=load_lens(name))")
+    zoom_block = None
+    if zoom is not None:
+        if lens is None:
+            raise InputError("a zoom position takes a zoom lens (lens=load_lens(name)): a thin lens of "
+                             "focal_length_mm has no zoom")
+        from ..optics.zoom import named_at_zoom
+
+        lens, zoom_block = named_at_zoom(lens, zoom)
+    if isinstance(squeeze, str) and squeeze.strip().lower() == "format":
+        squeeze = format_squeeze(sensor)
+    return lens, squeeze, zoom_block
+
+
+def _cells(focal_length_mm, lens, sensor, coc, squeeze, zoom):
+    """(``cell(fstop, mark) -> LensReport``, the lens at its zoom position, the ``zoom`` block) of a table's
+    options: each cell ``physcam report`` of this lens at that stop and mark, the lens zoomed and the squeeze read
+    once."""
+    lens, squeeze, zoom_block = _table_lens(focal_length_mm, lens, sensor, squeeze, zoom)
+
+    def cell(fstop, mark):
+        return solve_report(report_camera(focal_length_mm=focal_length_mm, lens=lens, sensor=sensor, fstop=fstop,
+                                          focus_mm=mark, coc=coc, squeeze=squeeze))
+
+    return cell, lens, zoom_block
+
+
+def dof_cells(focal_length_mm: float | None = None, *, lens=None, sensor, coc=None, squeeze: float | str = 1.0,
+              zoom=None):
+    """``cell(fstop, focus_mark) -> LensReport``: the report of one cell of :func:`dof_table` with these options
+    (its own names and checks), at any stop and mark, for a chart drawn beside the table (``physcam dof-table -o``'s
+    card) that must agree with it cell by cell: the table's rows are made by the same function."""
+    return _cells(focal_length_mm, lens, sensor, coc, squeeze, zoom)[0]
+
+
 def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops=DEFAULT_FSTOPS,
-              focus_marks_mm=DEFAULT_FOCUS, coc=None, squeeze: float | str = 1.0) -> dict:
+              focus_marks_mm=DEFAULT_FOCUS, coc=None, squeeze: float | str = 1.0, zoom=None) -> dict:
     """The depth-of-field table of a thin lens of ``focal_length_mm`` or of ``lens`` (a prescription,
     the technical model) on ``sensor`` (a name or a Sensor; required, as the report's): one row per
     f-stop and focus mark, each the lens report there, and the hyperfocal distance per f-stop.
@@ -115,14 +153,14 @@ def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops
     ``focus_marks_mm``: marks from the film plane, each mm (a number), ``math.inf``, ``"hyperfocal"`` or text
     with a unit ("2m", "6ft"); ``coc``: mm or a convention's name (None: the sensor's default);
     ``squeeze``: an anamorphic desqueeze, or ``"format"`` for the one the camera table gives the sensor's
-    format (:func:`format_squeeze`). Returns the dict ``physcam dof-table --json`` prints (without
-    its ``schema``/``version``/``units`` keys and the zoom block): keys ``rows`` (fstop, focus,
-    ``*_from_film_mm``, ``total_mm``, fields of view), ``hyperfocal``, ``sensor``, ``coc_mm``, ...
+    format (:func:`format_squeeze`); ``zoom``: a zoom lens's position, a focal length with its unit ("135mm")
+    or the encoder value 0..1 (``--zoom``; default its first tabulated position; out of the zoom range, and
+    for a prime, an InputError: :func:`physcam.optics.zoom.named_at_zoom`). Returns the dict ``physcam
+    dof-table --json`` prints (without its ``schema``/``version``/``units`` keys): keys ``rows`` (fstop, focus,
+    ``*_from_film_mm``, ``total_mm``, fields of view), ``hyperfocal``, ``sensor``, ``coc_mm``, ``zoom`` (the
+    position's block, None without one), ...
     """
-    if (lens is None) == (focal_length_mm is None):
-        raise InputError("give either a focal length (focal_length_mm=35) or a lens (lens=load_lens(name))")
-    if isinstance(squeeze, str) and squeeze.strip().lower() == "format":
-        squeeze = format_squeeze(sensor)
+    cell, lens, zoom_block = _cells(focal_length_mm, lens, sensor, coc, squeeze, zoom)
     fstops = [_fstop(n) for n in _listed(fstops, "fstops")]
     marks = [_mark(m) for m in _listed(focus_marks_mm, "focus_marks_mm")]
     if not fstops or len(fstops) > MAX_FSTOPS:
@@ -134,8 +172,7 @@ def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops
         warnings.simplefilter("ignore", PhysCamWarning)
         for n in fstops:
             for m in marks:
-                r = solve_report(report_camera(focal_length_mm=focal_length_mm, lens=lens, sensor=sensor, fstop=n,
-                                               focus_mm=m, coc=coc, squeeze=squeeze))
+                r = cell(n, m)
                 first = first or r
                 rows.append(_row(r, m))
             hyper.append({"fstop": n, "hyperfocal_from_film_mm": rows[-1]["hyperfocal_from_film_mm"]})
@@ -146,5 +183,5 @@ def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops
         "coc_mm": first.coc_mm, "coc_convention": first.coc_convention, "squeeze": first.squeeze,
         "dof_aspect": first.dof_aspect, "fstops": fstops,
         "focus": [m if isinstance(m, str) else ("infinity" if math.isinf(m) else m) for m in marks],
-        "rows": rows, "hyperfocal": hyper, "zoom": None, "definition": DEFINITION,
+        "rows": rows, "hyperfocal": hyper, "zoom": zoom_block, "definition": DEFINITION,
     }

@@ -29,7 +29,7 @@ from ..lens.prescription import Prescription, takes_prescription
 from ..lens.zoom import prescription_at, tabulated_encoders
 from . import focusing, paraxial
 
-__all__ = ["ZoomRow", "encoder_for_focal_length", "at_zoom", "zoom_encoder", "efl_at", "zoom_table",
+__all__ = ["ZoomRow", "encoder_for_focal_length", "at_zoom", "named_at_zoom", "zoom_encoder", "efl_at", "zoom_table",
            "zoom_breathing", "default_encoders"]
 
 #: Samples of EFL(u) that check monotonicity and bracket a requested focal length.
@@ -70,6 +70,10 @@ def _samples(lens, wavelength_nm):
     return us, [efl_at(lens, u, wavelength_nm) for u in us]
 
 
+#: a focal length this close outside a zoom's paraxial range names its end (the range is printed to 0.01 mm)
+ZOOM_END_TOLERANCE_MM = 0.005
+
+
 @takes_prescription
 def encoder_for_focal_length(lens: Prescription, focal_length_mm: float, *, wavelength_nm=None) -> float:
     """The normalised zoom coordinate where the zoom lens's paraxial EFL is ``focal_length_mm``
@@ -81,7 +85,8 @@ def encoder_for_focal_length(lens: Prescription, focal_length_mm: float, *, wave
         raise OpticsError(f"the EFL of {lens.name!r} does not run monotonically across its zoom: a focal length "
                           "names no single position; give the zoom as an encoder value 0..1")
     lo, hi = min(efls), max(efls)
-    if not lo * (1 - 1e-9) <= f <= hi * (1 + 1e-9):
+    # an end as the range is printed (0.01 mm) is that end: 196 mm on a zoom whose long end is 195.9996
+    if not lo - ZOOM_END_TOLERANCE_MM <= f <= hi + ZOOM_END_TOLERANCE_MM:
         stated = lens.zoom.stated_focal_length
         said = f"; the source labels it {stated[0]:g}-{stated[-1]:g} mm" if stated else ""
         raise InputError(f"{f:g} mm is outside the zoom range of {lens.name!r}: {lo:.2f} to {hi:.2f} mm (paraxial "
@@ -129,6 +134,22 @@ def zoom_encoder(lens: Prescription, zoom, *, wavelength_nm=None) -> float:
 def at_zoom(lens: Prescription, zoom, *, wavelength_nm=None) -> Prescription:
     """The plain prescription of a zoom lens at ``zoom`` (:func:`zoom_encoder`'s forms)."""
     return prescription_at(lens, zoom_encoder(lens, zoom, wavelength_nm=wavelength_nm))
+
+
+@takes_prescription
+def named_at_zoom(lens: Prescription, zoom, *, wavelength_nm=None) -> tuple[Prescription, dict]:
+    """(the prescription of a zoom ``lens`` at ``zoom``, its ``zoom`` block): the prescription named with its
+    position (``"<name> at 135.0 mm (zoom 0.5)"``, the paraxial EFL and the encoder value, as tables, cards and
+    ST-map headers carry it), and the block the commands' JSON documents hold: ``{"asked": the position as
+    given, "encoder": 0..1, "efl_mm": the paraxial EFL there}``. ``zoom``: :func:`zoom_encoder`'s forms; a focal
+    length outside the zoom range (the error names the range) and a prime lens are InputErrors."""
+    from .._record import replace
+
+    u = zoom_encoder(lens, zoom, wavelength_nm=wavelength_nm)
+    q = prescription_at(lens, u)
+    block = {"asked": str(zoom), "encoder": u, "efl_mm": paraxial.gaussian(q).efl}
+    name = f"{lens.name} at {block['efl_mm']:.1f} mm (zoom {u:.4g})"
+    return replace(q, metadata=replace(q.metadata, name=name)), block
 
 
 @takes_prescription

@@ -54,6 +54,8 @@ __all__ = [
     "author_render_settings",
     "render_camera_values",
     "sample_render_camera",
+    "sampled_render_values",
+    "SAMPLED_RENDER_ATTRIBUTES",
     "iris_mm",
     "author_anamorphic_distortion",
     "author_prescription",
@@ -336,20 +338,34 @@ def sample_render_camera(geom, spec: CameraSpec, report, meters_per_unit: float,
     """Time-sample a companion UsdGeomCamera ``geom`` at ``time`` from ``spec`` (one frame of a moving
     camera): focal length, apertures, f-stop, focus distance and its translate (the eye, in front of
     the film), from :func:`render_camera_values`. Returns the eye distance (mm from the film)."""
-    from pxr import Gf, UsdGeom
+    values, eye = sampled_render_values(spec, report, meters_per_unit, time_codes_per_second, where=where)
+    prim = geom.GetPrim()
+    for name, value in values.items():
+        prim.GetAttribute(name).Set(value, time)
+    return eye
+
+
+#: the companion's attributes an animated camera time-samples (:func:`sample_render_camera`), the
+#: translate its first transform op
+SAMPLED_RENDER_ATTRIBUTES = ("focalLength", "horizontalAperture", "verticalAperture", "fStop", "exposure:fStop",
+                             "focusDistance", "xformOp:translate")
+
+
+def sampled_render_values(spec: CameraSpec, report, meters_per_unit: float, time_codes_per_second: float, *,
+                          where: str = "camera") -> tuple[dict, float]:
+    """(companion attribute -> value, eye distance in mm from the film) of one frame of an animated camera:
+    the :data:`SAMPLED_RENDER_ATTRIBUTES` of :func:`render_camera_values`, the T-stop as authored, and the
+    translate that puts the eye (entrance pupil) in front of the film."""
+    from pxr import Gf
 
     from ..export.usdgeom import mm_to_scene_units
 
     values, eye = render_camera_values(spec, report, meters_per_unit, time_codes_per_second, where=where)
-    geom.GetFocalLengthAttr().Set(values["focalLength"], time)
-    geom.GetHorizontalApertureAttr().Set(values["horizontalAperture"], time)
-    geom.GetVerticalApertureAttr().Set(values["verticalAperture"], time)
-    geom.GetFStopAttr().Set(values["fStop"], time)
-    geom.GetExposureFStopAttr().Set(spec.t_stop, time)  # the T-stop, as authored
-    geom.GetFocusDistanceAttr().Set(values["focusDistance"], time)
-    translate = UsdGeom.Xformable(geom.GetPrim()).GetOrderedXformOps()[0]
-    translate.Set(Gf.Vec3d(0.0, 0.0, -mm_to_scene_units(eye, meters_per_unit)), time)
-    return eye
+    out = {name: values[name] for name in SAMPLED_RENDER_ATTRIBUTES[:4]}
+    out["exposure:fStop"] = spec.t_stop  # the T-stop, as authored
+    out["focusDistance"] = values["focusDistance"]
+    out["xformOp:translate"] = Gf.Vec3d(0.0, 0.0, -mm_to_scene_units(eye, meters_per_unit))
+    return out, eye
 
 
 def render_camera_values(spec: CameraSpec, report, meters_per_unit: float, time_codes_per_second: float, *,

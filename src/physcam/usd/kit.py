@@ -257,35 +257,18 @@ def _author_shot_companion(stage, path) -> str:
     """
     from pxr import Sdf
 
-    from .author import _eye_from_film, author_anamorphic_distortion, iris_mm, spec_from_report
-    from .read import read_camera
+    from .author import _eye_from_film, author_anamorphic_distortion, iris_mm
 
-    spec = read_camera(stage, path).spec
-    rx = composed_prescription(stage, path)
+    spec, rx, report, derived = _lens_solved(stage, path)
     cam = stage.GetPrimAtPath(path)
-    report, distortion, opencv, anamorphic = None, None, None, []
-    if rx is not None and spec.projection == "perspective":
-        from ..onset.report import report_camera, solve_report
-        from ..optics.sensors import Sensor
-
-        sensor = Sensor(key="custom", name=spec.sensor_name or f"{spec.sensor_width_mm:g} x {spec.sensor_height_mm:g} mm",
-                        width_mm=spec.sensor_width_mm, height_mm=spec.sensor_height_mm)
-        report = solve_report(report_camera(focal_length_mm=None, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
-                               coc=spec.coc_mm, lens=rx))
-        derived = spec_from_report(report)
+    distortion, opencv, anamorphic = None, None, []
+    if derived is not None:
         _author_lens_derived(stage, cam, derived)
         _author_model_focal_length(stage, cam, derived.focal_length_mm)
-        spec = spec.replaced(focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
-                             principal_planes_mm=derived.principal_planes_mm,
-                             pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
-                             pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze,
-                             fstop_at_focus=derived.fstop_at_focus)
         distortion = prescription_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
         anamorphic = prescription_anamorphic_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm,
                                                         focus_mm=spec.focus_mm)
         opencv = prescription_opencv(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
-    elif spec.pinhole_focal_length_mm is None:  # no lens solved at a focus (a thin lens): the iris is f / N
-        spec = spec.replaced(fstop_at_focus=None)
     # values derived from the composed lens, rewritten every time: the iris (the entrance pupil at the focus,
     # f / N but for an internal-focus lens, whose f-number moves: iris_mm) and the film's place behind the
     # pupil, so the pupil stays where the shot put it when the lens file changes
@@ -304,6 +287,37 @@ def _author_shot_companion(stage, path) -> str:
     digest = companion_inputs(stage, path)
     geom.GetPrim().SetCustomDataByKey("physcam:companionInputs", digest)
     return digest
+
+
+def _lens_solved(stage, path, time: float | None = None):
+    """(spec, prescription, report, derived): the composed camera at time code ``time`` (default: its default
+    values) as a refresh computes the companion from it. With a stored prescription the lens is solved again at
+    that focus and f-stop (``report``; ``derived``, :func:`~physcam.usd.author.spec_from_report` of it, holds
+    the lens values a refresh writes) and ``spec`` carries them; a thin lens's iris is f / N (``report`` and
+    ``derived`` None)."""
+    from .author import spec_from_report
+    from .read import read_camera
+
+    spec = read_camera(stage, path, time=time).spec
+    rx = composed_prescription(stage, path)
+    if rx is None or spec.projection != "perspective":
+        if spec.pinhole_focal_length_mm is None:  # no lens solved at a focus (a thin lens): the iris is f / N
+            spec = spec.replaced(fstop_at_focus=None)
+        return spec, rx, None, None
+    from ..onset.report import report_camera, solve_report
+    from ..optics.sensors import Sensor
+
+    sensor = Sensor(key="custom", name=spec.sensor_name or f"{spec.sensor_width_mm:g} x {spec.sensor_height_mm:g} mm",
+                    width_mm=spec.sensor_width_mm, height_mm=spec.sensor_height_mm)
+    report = solve_report(report_camera(focal_length_mm=None, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
+                                        coc=spec.coc_mm, lens=rx))
+    derived = spec_from_report(report)
+    spec = spec.replaced(focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
+                         principal_planes_mm=derived.principal_planes_mm,
+                         pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
+                         pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze,
+                         fstop_at_focus=derived.fstop_at_focus)
+    return spec, rx, report, derived
 
 
 def _move_film_behind_pupil(cam, pupil_mm: float) -> None:
@@ -329,24 +343,38 @@ def _author_model_focal_length(stage, cam, efl_mm: float) -> None:
             attr.Set(float(efl_mm))
 
 
+#: the lens attributes a refresh derives from a stored prescription (:func:`_lens_derived_values`)
+_LENS_DERIVED = tuple(f"lens:{LENS_INSTANCE}:{n}" for n in (
+    "entrancePupilDistance", "iris", "pinholeFocalLength", "pinholeSqueeze", "horizontalEntrancePupilDistance",
+    "apertureDistance", "frontPrincipalPlaneDistance", "rearPrincipalPlaneDistance"))
+
+
+def _lens_derived_values(spec) -> dict:
+    """Lens attribute -> value a prescription gives at the focus (``spec``: spec_from_report of its report);
+    values the lens does not have (a second pupil, an unknown stop) are left out."""
+    lp = f"lens:{LENS_INSTANCE}:"
+    values = {lp + "entrancePupilDistance": spec.entrance_pupil_mm, lp + "iris": spec.focal_length_mm / spec.fstop,
+              lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze": spec.pinhole_squeeze,
+              lp + "horizontalEntrancePupilDistance": spec.horizontal_entrance_pupil_mm,
+              lp + "apertureDistance": spec.aperture_distance_mm}  # the stop moves with a unit-focusing lens
+    if spec.principal_planes_mm is not None:
+        values[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]
+        values[lp + "rearPrincipalPlaneDistance"] = spec.principal_planes_mm[1]
+    return {name: float(v) for name, v in values.items() if v is not None}
+
+
 def _author_lens_derived(stage, cam, spec) -> None:
     """Lens values a prescription gives at the shot's focus, as shot opinions."""
     from pxr import Sdf
 
     F = Sdf.ValueTypeNames.Float
     lp = f"lens:{LENS_INSTANCE}:"
-    values = {lp + "entrancePupilDistance": spec.entrance_pupil_mm, lp + "iris": spec.focal_length_mm / spec.fstop,
-              lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze": spec.pinhole_squeeze,
-              lp + "horizontalEntrancePupilDistance": spec.horizontal_entrance_pupil_mm}
-    stop = cam.GetAttribute(lp + "apertureDistance")  # the stop moves with a unit-focusing lens
-    if spec.aperture_distance_mm is not None and not (stop and _same_value(stop.Get(), spec.aperture_distance_mm)):
-        values[lp + "apertureDistance"] = spec.aperture_distance_mm
-    if spec.principal_planes_mm is not None:
-        values[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]
-        values[lp + "rearPrincipalPlaneDistance"] = spec.principal_planes_mm[1]
+    values = _lens_derived_values(spec)
+    stop = cam.GetAttribute(lp + "apertureDistance")  # no shot opinion where the lens file says it already
+    if lp + "apertureDistance" in values and stop and _same_value(stop.Get(), values[lp + "apertureDistance"]):
+        del values[lp + "apertureDistance"]
     for name, v in values.items():
-        if v is not None:
-            (cam.GetAttribute(name) or cam.CreateAttribute(name, F)).Set(float(v))
+        (cam.GetAttribute(name) or cam.CreateAttribute(name, F)).Set(v)
     if spec.horizontal_entrance_pupil_mm is None and cam.GetAttribute(lp + "horizontalEntrancePupilDistance"):
         cam.GetAttribute(lp + "horizontalEntrancePupilDistance").Clear()  # a lens with one pupil now
 
@@ -367,11 +395,13 @@ def check_shot(file, path: str | None = None) -> dict:
     stage.Reload()  # the referenced files as they are on disk now, not as this process cached them
     if path is None:
         path = only_camera(stage, "check")  # its error names the file
-    _refuse_time_samples(stage, path, file, "check")
+    times = _refuse_what_cannot_be_followed(stage, path, file, "check")
     geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
     if not geom:
         raise ExportError(f"{path}: has no companion camera to check")
-    current = companion_inputs(stage, path)
+    samples = _stale_samples(stage, path, _samples_solved(stage, path, file, "check", times)) if times else []
+    still = not times or _has_default_lens(stage, stage.GetPrimAtPath(path))
+    current = companion_inputs(stage, path) if still else None
     stored = geom.GetCustomDataByKey("physcam:companionInputs")
     mpu = UsdGeom.GetStageMetersPerUnit(stage)
     units = []
@@ -381,12 +411,36 @@ def check_shot(file, path: str | None = None) -> dict:
         lm = ref_layer.pseudoRoot.GetInfo("metersPerUnit") if ref_layer.pseudoRoot.HasInfo("metersPerUnit") else None
         if lm is not None and float(lm) != mpu:
             units.append({"file": ref_layer.identifier, "meters_per_unit": float(lm)})
-    return {"path": path, "stale": stored != current, "stored": stored, "current": current,
-            "meters_per_unit": mpu, "units": units,
-            "reason": None if stored == current else (
-                "the companion carries no inputs hash (written by hand or by an older physcam)" if stored is None
-                else "the camera's composed values (its body, lens or shot opinions) changed since the companion "
-                     "was computed")}
+    reasons = []
+    if still and stored != current:
+        reasons.append("the companion carries no inputs hash (written by hand or by an older physcam)" if stored is None
+                       else "the camera's composed values (its body, lens or shot opinions) changed since the companion "
+                            "was computed")
+    if samples:
+        first = samples[0]
+        reasons.append(f"{len(samples)} of its time codes are stale (first {first['time']:g}: "
+                       f"{', '.join(first['attributes'])})")
+    return {"path": path, "stale": bool(reasons), "stored": stored, "current": current,
+            "meters_per_unit": mpu, "units": units, "reason": "; ".join(reasons) or None,
+            "time_codes": times, "stale_samples": samples}
+
+
+def _refuse_what_cannot_be_followed(stage, path, file, action: str) -> list[float]:
+    """The camera's keyed time codes (:func:`_keyed_time_codes`) after the refusals: a still lens with other
+    time samples (:func:`_refuse_time_samples`), an animated one with samples check and refresh cannot follow
+    (:func:`_refuse_unkeyable_samples`)."""
+    _refuse_no_prim(stage, path, file)
+    times = _keyed_time_codes(stage, path)
+    if times:
+        _refuse_unkeyable_samples(stage, path, file, action)
+    else:
+        _refuse_time_samples(stage, path, file, action)
+    return times
+
+
+def _refuse_no_prim(stage, path, file) -> None:
+    if not stage.GetPrimAtPath(str(path)):
+        raise ExportError(f"{file}: no prim at {path}")
 
 
 def refresh_shot(file, path: str | None = None) -> dict:
@@ -415,18 +469,22 @@ def refresh_shot(file, path: str | None = None) -> dict:
     stage.Reload()  # the shot and its referenced files as they are on disk now
     if path is None:
         path = only_camera(stage, "refresh")  # its error names the file
-    _refuse_time_samples(stage, path, file, "refresh")
+    times = _refuse_what_cannot_be_followed(stage, path, file, "refresh")
     if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):  # else there is no companion yet: write it
         now = check_shot(file, path)
         if not now["stale"]:
             return dict(now, written=False, changed=[])
     _refuse_lens_not_stored(stage, path, file)
     layer = stage.GetRootLayer()
-    before = _authored_values(layer, path)
-    notes = _companion_notes(stage, path)
-    _author_shot_companion(stage, path)
-    changed = _keep_equal_values(layer, before, _authored_values(layer, path), path)
-    _keep_equal_notes(stage, path, notes)
+    changed = []
+    if not times or _has_default_lens(stage, stage.GetPrimAtPath(path)):  # the still camera, its default values
+        before = _authored_values(layer, path)
+        notes = _companion_notes(stage, path)
+        _author_shot_companion(stage, path)
+        changed = _keep_equal_values(layer, before, _authored_values(layer, path), path)
+        _keep_equal_notes(stage, path, notes)
+    if times:  # a keyed lens: sample by sample
+        changed += _author_samples(stage, path, file, times)
     save_stage(stage, file, force=True)
     return dict(check_shot(file, path), written=True, changed=changed)
 
@@ -452,6 +510,189 @@ def _refuse_time_samples(stage, path, file, action: str) -> None:
     raise ExportError(f"{file}: {prim.GetPath()}.{attr.GetName()} is animated ({attr.GetNumTimeSamples()} time "
                       f"samples): usd {action} handles a still camera only; write the animation again with "
                       f"`physcam usd animate {file} --marks CSV ... --force`")
+
+
+def _lens_model(stage, cam):
+    rel = cam.GetRelationship(f"lens:{LENS_INSTANCE}:lensModel")
+    targets = rel.GetForwardedTargets() if rel else []
+    model = stage.GetPrimAtPath(targets[0]) if targets else None
+    return model if model else None
+
+
+def _keyed_inputs(stage, cam) -> list:
+    """The attributes an animation keys (:data:`_ANIMATED_FIRST`): the lens model's focus and focal length,
+    the lens's f-stop."""
+    model = _lens_model(stage, cam)
+    attrs = [cam.GetAttribute(f"lens:{LENS_INSTANCE}:fStop")]
+    if model is not None:
+        attrs += [model.GetAttribute("focusDistance"), model.GetAttribute("focalLength")]
+    return [a for a in attrs if a]
+
+
+def _keyed_time_codes(stage, path) -> list[float]:
+    """The time codes of the camera at ``path``'s keyed lens (every time sample of its focus distance,
+    f-stop and focal length), in order; [] for a still lens (a camera that only moves included)."""
+    cam = stage.GetPrimAtPath(str(path))
+    if not cam:
+        raise ExportError(f"no prim at {path}")
+    return sorted({float(t) for a in _keyed_inputs(stage, cam) for t in a.GetTimeSamples()})
+
+
+def _has_default_lens(stage, cam) -> bool:
+    """Whether every keyed input also has an authored default value (the still camera a check hashes)."""
+    from pxr import Usd
+
+    return all(a.GetResolveInfo(Usd.TimeCode.Default()).GetSource() == Usd.ResolveInfoSourceDefault
+               for a in _keyed_inputs(stage, cam))
+
+
+def _sampled_derived(stage, path, time: float) -> dict:
+    """Attribute path -> the value a refresh authors at time code ``time`` of an animated camera: the lens
+    values a stored prescription gives there (the pinhole model's ``focalLength`` the EFL), the iris, and
+    the companion's :data:`~physcam.usd.author.SAMPLED_RENDER_ATTRIBUTES` (``usd animate``'s per frame)."""
+    from pxr import Sdf, UsdGeom
+
+    from .author import iris_mm, sampled_render_values
+
+    spec, _rx, report, derived = _lens_solved(stage, path, time)
+    cam = stage.GetPrimAtPath(path)
+    out = {}
+    if derived is not None:
+        out.update({f"{path}.{n}": v for n, v in _lens_derived_values(derived).items()})
+        model = _lens_model(stage, cam)
+        if model is not None and model.GetTypeName() == "PhysicalCameraLensModelPinhole":
+            out[f"{model.GetPath()}.focalLength"] = float(derived.focal_length_mm)
+    out[f"{path}.lens:{LENS_INSTANCE}:iris"] = iris_mm(spec)
+    if cam.GetAttribute("iris") and cam.GetAttribute("iris").HasAuthoredValue():  # the body's, as usd animate keys it
+        out[f"{path}.iris"] = iris_mm(spec)
+    stage_ = cam.GetStage()
+    values, _eye = sampled_render_values(spec, report, UsdGeom.GetStageMetersPerUnit(stage_),
+                                         stage_.GetTimeCodesPerSecond(), where=path)
+    geom = Sdf.Path(path).AppendChild("Camera")
+    out.update({f"{geom}.{n}": v for n, v in values.items()})
+    return out
+
+
+def _samples_solved(stage, path, file, action: str, times) -> dict:
+    """Time code -> :func:`_sampled_derived` for each of ``times``; an ExportError naming the file, the camera
+    and the time code of a sample whose lens cannot be solved (a focus inside the lens's close focus, ...)."""
+    from ..errors import PhysCamError
+
+    out = {}
+    for t in times:
+        try:
+            out[t] = _sampled_derived(stage, path, t)
+        except PhysCamError as e:
+            raise ExportError(f"{file}: {path} at time code {t:g}: {e}; usd {action} cannot solve this sample") \
+                from None
+    return out
+
+
+def _derived_names(stage, path) -> set:
+    """The attribute paths :func:`_sampled_derived` gives values of (some may be left out for a lens without
+    them: a second pupil, an unknown stop)."""
+    from pxr import Sdf
+
+    from .author import SAMPLED_RENDER_ATTRIBUTES
+
+    cam = stage.GetPrimAtPath(str(path))
+    out = {f"{path}.lens:{LENS_INSTANCE}:iris", f"{path}.iris"}
+    out |= {f"{Sdf.Path(path).AppendChild('Camera')}.{n}" for n in SAMPLED_RENDER_ATTRIBUTES}
+    if composed_prescription(stage, path) is not None:
+        out |= {f"{path}.{n}" for n in _LENS_DERIVED}
+        model = _lens_model(stage, cam)
+        if model is not None:
+            out.add(f"{model.GetPath()}.focalLength")
+    return out
+
+
+def _refuse_unkeyable_samples(stage, path, file, action: str) -> None:
+    """ExportError naming the file and an attribute of an animated camera that check and refresh cannot follow
+    sample by sample: a time-sampled attribute that is neither a keyed input (focus, f-stop, focal length), a
+    thin lens's pupil or stop (read at each time code), nor one the refresh derives (:func:`_derived_names`); and a lens
+    solved from a real lens the file does not store (``usd animate --lens`` samples its pupils and pinhole but
+    keeps no prescription to solve them again)."""
+    cam = stage.GetPrimAtPath(str(path))
+    keyed = {str(a.GetPath()) for a in _keyed_inputs(stage, cam)}
+    derived = _derived_names(stage, path)
+    lp = f"lens:{LENS_INSTANCE}:"
+    stored = composed_prescription(stage, path) is not None
+    read_at_time = set() if stored else {f"{path}.{lp}entrancePupilDistance", f"{path}.{lp}apertureDistance"}
+    for prim in (cam, *cam.GetChildren()):
+        for a in prim.GetAttributes():
+            name = str(a.GetPath())
+            if not a.GetNumTimeSamples() or name in keyed | derived | read_at_time:
+                continue
+            if prim == cam and a.GetName().startswith("xformOp"):
+                continue  # the layout's move: not an input of the lens
+            if not stored and a.GetName() in _LENS_DERIVED:
+                raise ExportError(f"{file}: {name} is animated from a real lens that the file does not store "
+                                  f"(usd animate --lens): usd {action} cannot solve it again; write the animation "
+                                  f"again with `physcam usd animate {file} --marks CSV ... --force`")
+            n = a.GetNumTimeSamples()
+            raise ExportError(f"{file}: {name} is animated ({n} time sample{'s' * (n != 1)}): usd {action} follows "
+                              "a keyed focus, f-stop and focal length sample by sample, not this attribute")
+
+
+def _stale_samples(stage, path, expected: dict) -> list[dict]:
+    """``[{"time", "attributes"}]`` of each time code where an attribute of ``expected`` (time code ->
+    :func:`_sampled_derived`) differs from the file at float32 precision (the companion's field of view:
+    :func:`_same_view`), or where a derived attribute holds a sample at a time code no input is keyed at."""
+    from pxr import Sdf
+
+    geom = str(Sdf.Path(path).AppendChild("Camera"))
+    out = []
+    names = sorted({n for values in expected.values() for n in values})
+    for t, values in expected.items():
+        now = {n: stage.GetAttributeAtPath(Sdf.Path(n)).Get(t) for n in values}
+        bad = [n for n in sorted(values) if now[n] is None or not _same_value(now[n], values[n])]
+        if _same_view(now, values, geom):
+            bad = [n for n in bad if n not in {f"{geom}.{v}" for v in ("focalLength", "horizontalAperture",
+                                                                       "verticalAperture")}]
+        if bad:
+            out.append({"time": t, "attributes": bad})
+    extra = {}
+    for n in names:
+        for t in stage.GetAttributeAtPath(Sdf.Path(n)).GetTimeSamples():
+            if float(t) not in expected:
+                extra.setdefault(float(t), []).append(n)
+    out += [{"time": t, "attributes": extra[t]} for t in sorted(extra)]
+    return sorted(out, key=lambda d: d["time"])
+
+
+def _author_samples(stage, path, file, times) -> list[dict]:
+    """Rewrite, at every keyed time code, each derived attribute stale at one of them (:func:`_stale_samples`;
+    an attribute that is sampled at all is sampled at every keyed time code, and its samples at other time
+    codes go); a sample equal to the recomputed value at float32 precision keeps the file's digits. Returns the
+    changes as the refresh reports them, each with its ``time``."""
+    from pxr import Sdf
+
+    expected = _samples_solved(stage, path, file, "refresh", times)
+    names = {n for d in _stale_samples(stage, path, expected) for n in d["attributes"]}
+    geom = str(Sdf.Path(path).AppendChild("Camera"))
+    view = {f"{geom}.{v}" for v in ("focalLength", "horizontalAperture", "verticalAperture")}
+    names = sorted(names | view if names & view else names)  # one field of view: its three values together
+    attrs = {n: stage.GetAttributeAtPath(Sdf.Path(n)) for n in names}
+    had = {n: {float(t) for t in a.GetTimeSamples()} for n, a in attrs.items()}
+    olds = {t: {n: a.Get(t) for n, a in attrs.items()} for t in times}  # all read before any is written
+    changed = []
+    for t in times:
+        old = olds[t]
+        keep = {n for n in names if t in had[n] and _same_value(old[n], expected[t].get(n))}
+        if view <= attrs.keys() and all(t in had[n] for n in view) and _same_view(old, expected[t], geom):
+            keep |= view
+        for n in names:
+            new = expected[t].get(n)
+            if new is None or n in keep:
+                continue
+            attrs[n].Set(new, t)
+            if old[n] is None or not _same_value(old[n], new):
+                changed.append({"attribute": n, "time": t, "before": _shown_value(old[n]), "after": _shown_value(new)})
+    for n in names:
+        for t in sorted(had[n] - set(times)):
+            changed.append({"attribute": n, "time": t, "before": _shown_value(attrs[n].Get(t)), "after": None})
+            attrs[n].ClearAtTime(t)
+    return sorted(changed, key=lambda c: (c["attribute"], c["time"]))
 
 
 def _refuse_lens_not_stored(stage, path, file) -> None:

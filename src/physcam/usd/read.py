@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..errors import ExportError, require_type
+from ..errors import ExportError, require_finite, require_type
 from .spec import LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec
 from .plugin import ensure_registered, require_prim, require_stage
 
@@ -104,44 +104,47 @@ def _listed(paths: list[str], most: int = 5) -> str:
     return ", ".join(paths[:most]) + (f" and {len(paths) - most} more" if len(paths) > most else "")
 
 
-def _get(prim, name, what):
+def _get(prim, name, what, time=None):
     attr = prim.GetAttribute(name)
     if not attr:
         raise ExportError(f"{prim.GetPath()}: has no {name} attribute; {what}")
-    v = attr.Get()
+    v = attr.Get() if time is None else attr.Get(time)
     if v is None:
         raise ExportError(f"{prim.GetPath()}: {name} has no value; {what}")
     return v
 
 
-def _pair(prim, name: str, default):
+def _pair(prim, name: str, default, time=None):
     attr = prim.GetAttribute(name)
-    v = attr.Get() if attr else None
+    v = (attr.Get() if time is None else attr.Get(time)) if attr else None
     return default if v is None else (float(v[0]), float(v[1]))
 
 
-def _optional(prim, name: str):
-    """An authored float attribute's value, or None when it is not authored."""
+def _optional(prim, name: str, time=None):
+    """An authored float attribute's value (at ``time``, default the default value), or None when it is not
+    authored."""
     attr = prim.GetAttribute(name)
-    return float(attr.Get()) if attr and attr.HasAuthoredValue() else None
+    if not attr or not attr.HasAuthoredValue():
+        return None
+    return float(attr.Get() if time is None else attr.Get(time))
 
 
-def _fstop_at_focus(prim, lp: str, focal_mm: float):
+def _fstop_at_focus(prim, lp: str, focal_mm: float, time=None):
     """The f-number at the focus from the lens's ``iris`` (focal length / iris) when it differs from its
     ``fStop`` beyond float32 rounding (an internal-focus lens: physcam.onset.report), else None."""
-    iris, n = _optional(prim, lp + "iris"), _optional(prim, lp + "fStop")
+    iris, n = _optional(prim, lp + "iris", time), _optional(prim, lp + "fStop", time)
     if iris is None or n is None or not iris > 0:
         return None
     at_focus = focal_mm / iris
     return at_focus if abs(at_focus - n) > 1e-5 * n else None
 
 
-def _principal_planes(prim, lp: str):
+def _principal_planes(prim, lp: str, time=None):
     """(H1, H2) in front of the film when both are authored, else None (a thin lens)."""
     a = prim.GetAttribute(lp + "frontPrincipalPlaneDistance")
     b = prim.GetAttribute(lp + "rearPrincipalPlaneDistance")
-    h1 = a.Get() if a else None
-    h2 = b.Get() if b else None
+    h1 = (a.Get() if time is None else a.Get(time)) if a else None
+    h2 = (b.Get() if time is None else b.Get(time)) if b else None
     if (h1 is None) != (h2 is None):
         raise ExportError(f"{prim.GetPath()}: author both {lp}frontPrincipalPlaneDistance and "
                           f"{lp}rearPrincipalPlaneDistance, or neither")
@@ -213,8 +216,10 @@ def read_prescription(model_prim):
         raise ExportError(f"{where}: {exc}") from None
 
 
-def read_camera(stage, path: str | None = None) -> CameraReading:
-    """Read the PhysicalCamera at ``path`` (default: the only one on the stage)."""
+def read_camera(stage, path: str | None = None, *, time: float | None = None) -> CameraReading:
+    """Read the PhysicalCamera at ``path`` (default: the only one on the stage), its values at time code
+    ``time`` (default: the authored default values, what a still camera holds; an animated camera's
+    time-sampled focus and f-stop at one frame with a time code)."""
     ensure_registered()
     require_stage(stage)
     from pxr import Sdf, Usd, UsdGeom
@@ -223,6 +228,7 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
 
     if path is None:
         path = only_camera(stage, "read")
+    t = None if time is None else Usd.TimeCode(require_finite("time code", time))
     prim = stage.GetPrimAtPath(Sdf.Path(path)) if Sdf.Path.IsValidPathString(path) else None
     if not prim:
         raise ExportError(f"{path}: no prim at that path")
@@ -250,11 +256,11 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
     mtype = model.GetTypeName()
     rx = None
     if mtype == "PhysicalCameraLensModelPinhole":
-        focal = float(_get(model, "focalLength", "author the focal length in mm"))
+        focal = float(_get(model, "focalLength", "author the focal length in mm", t))
         projection, magnification = "perspective", 1.0
     elif mtype == "PhysicalCameraLensModelOrthographic":
         focal = float(model.GetCustomDataByKey("physcam:focalLength") or 50.0)
-        projection, magnification = "orthographic", float(_get(model, "magnification", "author it"))
+        projection, magnification = "orthographic", float(_get(model, "magnification", "author it", t))
     elif mtype == "PhysicalCameraLensModelPrescription":
         from ..optics.paraxial import gaussian
 
@@ -265,40 +271,40 @@ def read_camera(stage, path: str | None = None) -> CameraReading:
         raise ExportError(f"{path}: {lp}lensModel points at {model.GetPath()}, a {mtype or 'typeless prim'}, "
                           "not a PhysicalCameraLensModel")
     mpu = UsdGeom.GetStageMetersPerUnit(stage)
-    clip = _get(prim, lp + "clippingRange", "author it in scene units")
+    clip = _get(prim, lp + "clippingRange", "author it in scene units", t)
     to_mm = 1.0 / mm_to_scene_units(1.0, mpu)
-    aperture = _get(prim, sp + "aperture", "author the sensor size in mm")
-    shift = _get(prim, sp + "shift", "")
-    opening = _get(prim, "shutterOpening", "")
+    aperture = _get(prim, sp + "aperture", "author the sensor size in mm", t)
+    shift = _get(prim, sp + "shift", "", t)
+    opening = _get(prim, "shutterOpening", "", t)
     spec = CameraSpec.of(
         focal_length_mm=focal,
         sensor_width_mm=float(aperture[0]),
         sensor_height_mm=float(aperture[1]),
-        fstop=float(_get(prim, lp + "fStop", "author the f-stop")),
-        focus_mm=float(_get(model, "focusDistance", "author the focus distance in mm")),
-        coc_mm=float(_get(prim, sp + "circleOfConfusion", "")),
-        squeeze=float(_get(model, "squeeze", "")),
-        entrance_pupil_mm=_optional(prim, lp + "entrancePupilDistance"),  # unauthored: unknown, not the fallback
-        horizontal_entrance_pupil_mm=_optional(prim, lp + "horizontalEntrancePupilDistance"),
-        principal_planes_mm=_principal_planes(prim, lp),
-        pinhole_focal_length_mm=_optional(prim, lp + "pinholeFocalLength"),
-        pinhole_squeeze=_optional(prim, lp + "pinholeSqueeze"),
-        fstop_at_focus=_fstop_at_focus(prim, lp, focal),
+        fstop=float(_get(prim, lp + "fStop", "author the f-stop", t)),
+        focus_mm=float(_get(model, "focusDistance", "author the focus distance in mm", t)),
+        coc_mm=float(_get(prim, sp + "circleOfConfusion", "", t)),
+        squeeze=float(_get(model, "squeeze", "", t)),
+        entrance_pupil_mm=_optional(prim, lp + "entrancePupilDistance", t),  # unauthored: unknown, not the fallback
+        horizontal_entrance_pupil_mm=_optional(prim, lp + "horizontalEntrancePupilDistance", t),
+        principal_planes_mm=_principal_planes(prim, lp, t),
+        pinhole_focal_length_mm=_optional(prim, lp + "pinholeFocalLength", t),
+        pinhole_squeeze=_optional(prim, lp + "pinholeSqueeze", t),
+        fstop_at_focus=_fstop_at_focus(prim, lp, focal, t),
         shift_mm=(float(shift[0]), float(shift[1])),
-        iso=float(_get(prim, sp + "iso", "")),
-        transmittance=float(_get(model, "transmittance", "")),
-        flange_distance_mm=float(_get(prim, "flangeDistance", "")),
-        aperture_distance_mm=_optional(prim, lp + "apertureDistance"),
-        enlarge=_pair(prim, sp + "enlarge", (1.0, 1.0)),
-        handedness=float(prim.GetAttribute(sp + "handedness").Get()) if prim.GetAttribute(sp + "handedness")
+        iso=float(_get(prim, sp + "iso", "", t)),
+        transmittance=float(_get(model, "transmittance", "", t)),
+        flange_distance_mm=float(_get(prim, "flangeDistance", "", t)),
+        aperture_distance_mm=_optional(prim, lp + "apertureDistance", t),
+        enlarge=_pair(prim, sp + "enlarge", (1.0, 1.0), t),
+        handedness=float(_get(prim, sp + "handedness", "", t)) if prim.GetAttribute(sp + "handedness")
         and prim.GetAttribute(sp + "handedness").Get() is not None else 1.0,
-        shutter_open_s=float(_get(prim, "shutterOpen", "")),
-        shutter_duration_s=float(_get(prim, "shutterDuration", "")),
+        shutter_open_s=float(_get(prim, "shutterOpen", "", t)),
+        shutter_duration_s=float(_get(prim, "shutterDuration", "", t)),
         shutter_opening=(float(opening[0]), float(opening[1])),
-        aperture_blades=int(_get(prim, lp + "shutterBlades", "")),
-        aperture_angle_deg=float(_get(prim, lp + "apertureAngle", "")),
-        aperture_roundness=float(_get(prim, lp + "apertureRoundness", "")),
-        aperture_density=float(_get(prim, lp + "apertureDensity", "")),
+        aperture_blades=int(_get(prim, lp + "shutterBlades", "", t)),
+        aperture_angle_deg=float(_get(prim, lp + "apertureAngle", "", t)),
+        aperture_roundness=float(_get(prim, lp + "apertureRoundness", "", t)),
+        aperture_density=float(_get(prim, lp + "apertureDensity", "", t)),
         clipping_mm=(float(clip[0]) * to_mm, float(clip[1]) * to_mm),
         projection=projection,
         magnification=magnification,

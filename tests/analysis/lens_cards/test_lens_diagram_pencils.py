@@ -31,3 +31,55 @@ def test_diagram_prints_where_it_wrote(tmp_path, capsys):
     out = tmp_path / "d.png"
     assert main(["lens", "diagram", "--lens", "cooke_triplet_50mm_f4_5", "-o", str(out)]) == 0
     assert out.stat().st_size > 0 and capsys.readouterr().out.strip() == f"wrote {out}"
+
+
+@pytest.mark.parametrize("name, field_deg", [("dgauss_50mm", 18.0), ("cooke_triplet_50mm_f4_5", 0.0)])
+def test_pencil_edges_are_where_a_fine_scan_of_the_pupil_finds_them(name, field_deg):
+    """The bisected rim of a pencil (both ends in one batch per step, issue 47) against an independent
+    scan: 40,001 rays across the pupil in one trace, the outermost of the run through h = 0 that pass."""
+    import math
+
+    import numpy as np
+
+    from physcam.analysis.lens_cards import diagram as D
+    from physcam.optics import focusing, paraxial
+    from physcam.trace import OK, RayBatch, trace_through
+
+    lens = load_lens(name)
+    wl = float(lens.wavelength_nm)
+    p = focusing.focus(lens, math.inf, axis="y", wavelength_nm=wl).prescription
+    g = paraxial.gaussian(p, axis="y", wavelength_nm=wl)
+    a, tu = g.entrance_pupil_diameter / 2, math.tan(math.radians(field_deg))
+    z0 = -10.0
+
+    def ray(h):
+        return h - tu * (g.z_entrance_pupil - z0), z0, tu, 1.0
+
+    lo, hi = D._pencil_edges(p, ray, a, "y", wl)
+    hs = np.linspace(-0.98 * a, 0.98 * a, 40_001)
+    y0 = hs - tu * (g.z_entrance_pupil - z0)
+    pos = np.stack([np.zeros_like(hs), y0, np.full_like(hs, z0)], axis=1)
+    d = np.broadcast_to([0.0, tu, 1.0], pos.shape)
+    ok = trace_through(p, RayBatch.from_arrays(pos, d, wl), clip=True).flag == OK
+    run = np.flatnonzero(ok)
+    centre = run[np.argmin(np.abs(hs[run]))]
+    k0, k1 = centre, centre
+    while k0 > 0 and ok[k0 - 1]:
+        k0 -= 1
+    while k1 < hs.size - 1 and ok[k1 + 1]:
+        k1 += 1
+    step = hs[1] - hs[0]
+    assert lo == pytest.approx(hs[k0], abs=step + 1e-4 * a) and hi == pytest.approx(hs[k1], abs=step + 1e-4 * a)
+    assert lo < hi
+
+
+def test_the_diagram_traces_its_pencil_edges_in_few_kernel_calls(monkeypatch):
+    """Whether a ray passes needs no path: the pencils' 49-ray scans and bisections run one kernel call through
+    every surface each, both ends of a pencil together (main traced them surface by surface: 292 calls)."""
+    import physcam.trace.trace as T
+
+    calls = []
+    real = T._run
+    monkeypatch.setattr(T, "_run", lambda *a, **k: (calls.append(1), real(*a, **k))[1])
+    lens_diagram(camera_state(load_lens("dgauss_50mm")))
+    assert len(calls) < 100  # 83: the six drawn rays keep their per-surface paths

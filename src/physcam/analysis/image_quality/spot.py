@@ -107,7 +107,7 @@ class SpotDiagram:
     @styled
     def plot(self, path=None, *, force: bool = False):
         """Draw one panel per field (positions relative to the centroid, um); write it to ``path`` (PNG/SVG/PDF) and return the path, else return the figure."""
-        from ...figures import fit_title, pyplot
+        from ...figures import dots, fit_title, pyplot
 
         plt = pyplot()
 
@@ -123,7 +123,7 @@ class SpotDiagram:
                 ax.set_title(f"{f.field_deg:g} deg\nRMS undefined", fontsize=8)
                 continue
             size = 0.3 * f.weight / f.weight.max()  # refined rim rays weigh less: drawn smaller
-            ax.scatter((f.x_mm - f.centroid_x_mm) * 1e3, (f.y_mm - f.centroid_y_mm) * 1e3, s=size, c="k", lw=0)
+            dots(ax, (f.x_mm - f.centroid_x_mm) * 1e3, (f.y_mm - f.centroid_y_mm) * 1e3, size, "k")
             ax.set_title(f"{f.field_deg:g}°: RMS {f.rms_radius_um:.2f} µm,\nGEO {f.geometric_radius_um:.2f} µm",
                          fontsize=8)
         fig.suptitle(fit_title(f"{self.lens_name}: spot diagram at {self.wavelength_nm:g} nm", 3.0 * n), fontsize=9)

@@ -223,17 +223,19 @@ def _pencil_edges(p: Prescription, ray, a: float, axis: str, wavelength_nm) -> t
     """The rim of a pencil: the lowest and highest pupil heights ``h`` in [-0.98 a, 0.98 a] whose ray
     ``ray(h) -> (y0, z0, dy, dz)`` passes every clear aperture and the stop (a vignetted pencil is
     narrower than the paraxial pupil; real pupil aberration moves its edge). The pupil is sampled and
-    the run of passing rays nearest h = 0 refined to 1e-4 a by bisection; () when none passes."""
+    the run of passing rays nearest h = 0 refined to 1e-4 a by bisection, both ends in one batch per
+    step (each ray's fate is its own: the same steps as one end at a time); () when none passes."""
     import numpy as np
 
-    from ...trace import OK, RayBatch, trace_path
+    from ...trace import OK, RayBatch, trace_through
 
     def passes(hs):
         y0, z0, dy, dz = (np.broadcast_to(np.asarray(v, dtype=float), np.shape(hs)) for v in ray(np.asarray(hs)))
         zero = np.zeros(np.shape(hs))
         pos = np.stack([zero, y0, z0] if axis == "y" else [y0, zero, z0], axis=1)
         d = np.stack([zero, dy, dz] if axis == "y" else [dy, zero, dz], axis=1)
-        _, out = trace_path(p, RayBatch.from_arrays(pos, d, wavelength_nm), clip=True)
+        # whether it passes, not its path: every surface in one call of the kernel
+        out = trace_through(p, RayBatch.from_arrays(pos, d, wavelength_nm), clip=True, backend="numpy")
         return out.flag == OK
 
     hs = np.linspace(-0.98 * a, 0.98 * a, 49)
@@ -245,14 +247,14 @@ def _pencil_edges(p: Prescription, ray, a: float, axis: str, wavelength_nm) -> t
         lo -= 1
     while hi < len(hs) - 1 and ok[hi + 1]:
         hi += 1
-    edges = []
-    for k, step in ((lo, -1), (hi, 1)):
-        inside, outside = hs[k], (hs[k + step] if 0 <= k + step < len(hs) else None)
-        while outside is not None and abs(outside - inside) > 1e-4 * a:
-            mid = 0.5 * (inside + outside)
-            inside, outside = (mid, outside) if passes(np.array([mid]))[0] else (inside, mid)
-        edges.append(float(inside))
-    return tuple(edges)
+    ends = [[hs[k], hs[k + step] if 0 <= k + step < len(hs) else None] for k, step in ((lo, -1), (hi, 1))]
+    while True:
+        open_ = [e for e in ends if e[1] is not None and abs(e[1] - e[0]) > 1e-4 * a]
+        if not open_:
+            return tuple(float(e[0]) for e in ends)
+        mids = [0.5 * (e[0] + e[1]) for e in open_]
+        for e, mid, inside in zip(open_, mids, passes(np.array(mids))):
+            e[int(not inside)] = mid
 
 
 @takes_camera

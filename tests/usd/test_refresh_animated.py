@@ -1,0 +1,204 @@
+"""`physcam usd check` / `usd refresh` of a camera with a keyed lens (a focus pull, an f-stop ramp): checked and
+recomputed time code by time code (round 10; before, any time-sampled focus or f-stop was refused).
+
+Oracles: a thin lens's closed form at each time code's focus F and f-stop N (the lens s' in front of the film
+with s + s' = F and 1/s + 1/s' = 1/f: s' = (F - sqrt(F (F - 4 f))) / 2; the companion's fStop keeps
+focalLength / fStop = f / N); for a real lens, physcam's own on-set report of that lens at that focus and stop
+(physcam.onset.report, called directly); a stage refreshed then checked is current; usd-core's validators pass.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from _documents import check_document
+from physcam.cli import main
+from physcam.usd.validate import validation_errors
+
+from pxr import Usd  # noqa: E402
+
+CAM, MODEL, GEOM = "/Cameras/Camera", "/Cameras/Camera/Pinhole", "/Cameras/Camera/Camera"
+
+
+def _rel(a, b, tol=2e-6):
+    return abs(a - b) <= tol * max(abs(a), abs(b))
+
+
+def _check_json(capsys, f):
+    capsys.readouterr()
+    rc = main(["usd", "check", str(f), "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert check_document(doc) == "physcam.usd_check"  # the schema's time_codes and stale_samples
+    return rc, doc
+
+
+def _pull(tmp_path, name="pull"):
+    marks = tmp_path / f"{name}.csv"
+    marks.write_text("frame,focus,fstop\n1,2m,2.8\n10,4m,4\n", encoding="utf-8")
+    f = tmp_path / f"{name}.usda"
+    assert main(["usd", "animate", str(f), "--focal", "50", "--marks", str(marks), "--sensor", "S35"]) == 0
+    return f
+
+
+def test_a_focus_pull_as_written_is_current(tmp_path, capsys):
+    f = _pull(tmp_path)
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and doc["stale"] is False and doc["time_codes"] == [1.0, 10.0] and doc["stale_samples"] == []
+
+
+def test_an_edited_thin_lens_pull_is_stale_at_its_time_codes_and_refreshed_to_the_closed_form(tmp_path, capsys):
+    f = _pull(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    stage.GetPrimAtPath(CAM).GetAttribute("lens:main:fStop").Set(5.6, 10.0)  # the ramp's last stop
+    stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance").Set(3000.0, 5.0)  # a new mark at frame 5
+    stage.Save()
+    rc, doc = _check_json(capsys, f)
+    assert rc == 1 and doc["stale"] and doc["time_codes"] == [1.0, 5.0, 10.0]
+    stale = {s["time"]: s["attributes"] for s in doc["stale_samples"]}
+    assert sorted(stale) == [5.0, 10.0]  # frame 1 is as it was
+    assert f"{GEOM}.fStop" in stale[10.0] and f"{GEOM}.focalLength" not in stale[10.0]  # the stop, not the focus
+    assert f"{GEOM}.focalLength" in stale[5.0] and f"{GEOM}.focusDistance" in stale[5.0]
+    capsys.readouterr()
+    assert main(["usd", "check", str(f)]) == 1
+    assert "time code 10: stale" in capsys.readouterr().out
+
+    capsys.readouterr()
+    assert main(["usd", "refresh", str(f), "--json"]) == 0
+    done = json.loads(capsys.readouterr().out)
+    assert check_document(done) == "physcam.usd_refresh" and done["written"] and not done["stale"]
+    assert {c["time"] for c in done["changed"]} == {5.0, 10.0}  # frame 1's samples kept as they were
+    stage = Usd.Stage.Open(str(f))
+    assert validation_errors(stage) == []
+    cam, model, geom = (stage.GetPrimAtPath(p) for p in (CAM, MODEL, GEOM))
+    f_mm = 50.0
+    for t, focus, fstop in ((1.0, 2000.0, 2.8), (5.0, 3000.0, 2.8 + (5.6 - 2.8) * 4 / 9), (10.0, 4000.0, 5.6)):
+        assert _rel(model.GetAttribute("focusDistance").Get(t), focus) and _rel(cam.GetAttribute(
+            "lens:main:fStop").Get(t), fstop)
+        s_img = (focus - math.sqrt(focus * (focus - 4 * f_mm))) / 2  # the lens in front of the film
+        assert _rel(geom.GetAttribute("focalLength").Get(t), s_img, 5e-6), t  # cm stage: tenths of a cm are mm
+        assert _rel(cam.GetAttribute("lens:main:iris").Get(t), f_mm / fstop)
+        assert _rel(geom.GetAttribute("fStop").Get(t), fstop * s_img / f_mm, 5e-6)
+        assert _rel(geom.GetAttribute("exposure:fStop").Get(t), fstop)
+        pupil = cam.GetAttribute("lens:main:entrancePupilDistance").Get(t)  # a thin lens's pupil: the file's
+        assert _rel(geom.GetAttribute("focusDistance").Get(t), (focus - pupil) / 10.0)
+        assert _rel(-geom.GetAttribute("xformOp:translate").Get(t)[2], pupil / 10.0)
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and doc["stale_samples"] == []
+
+
+def test_a_keyed_focus_on_a_real_lens_is_solved_at_each_time_code(tmp_path, capsys):
+    from physcam.lens.library import load_lens
+    from physcam.onset.report import report_camera, solve_report
+    from physcam.optics.sensors import Sensor
+
+    f = tmp_path / "lens.usda"
+    assert main(["usd", "write", str(f), "--lens", "dgauss_50mm", "--fstop", "2.8", "--focus", "3m", "--sensor",
+                 "S35"]) == 0
+    stage = Usd.Stage.Open(str(f))  # a layout artist keys a focus pull and an f-stop over the default
+    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
+    focus.Set(2000.0, 1.0)
+    focus.Set(5000.0, 24.0)
+    stop = stage.GetPrimAtPath(CAM).GetAttribute("lens:main:fStop")
+    stop.Set(2.8, 1.0)
+    stop.Set(4.0, 24.0)
+    stage.Save()
+    assert main(["usd", "check", str(f)]) == 1
+    assert main(["usd", "refresh", str(f)]) == 0
+    stage = Usd.Stage.Open(str(f))
+    assert validation_errors(stage) == []
+    cam, model, geom = (stage.GetPrimAtPath(p) for p in (CAM, MODEL, GEOM))
+    w, h = cam.GetAttribute("sensor:main:aperture").Get()
+    sensor = Sensor(key="custom", name="S35", width_mm=float(w), height_mm=float(h))
+    lens = load_lens("dgauss_50mm")
+    for t, mark, n in ((1.0, 2000.0, 2.8), (24.0, 5000.0, 4.0)):
+        r = solve_report(report_camera(focal_length_mm=None, sensor=sensor, fstop=n, focus_mm=mark, coc=0.025,
+                                       lens=lens))
+        assert _rel(model.GetAttribute("focalLength").Get(t), r.focal_length_mm)  # the EFL at the focus
+        assert _rel(cam.GetAttribute("lens:main:entrancePupilDistance").Get(t), r.entrance_pupil_from_film_mm)
+        assert _rel(cam.GetAttribute("lens:main:frontPrincipalPlaneDistance").Get(t), r.h1_from_film_mm)
+        assert _rel(cam.GetAttribute("lens:main:rearPrincipalPlaneDistance").Get(t), r.h2_from_film_mm)
+        assert _rel(cam.GetAttribute("lens:main:pinholeFocalLength").Get(t), r.pinhole_focal_length_mm)
+        assert _rel(geom.GetAttribute("focalLength").Get(t), r.pinhole_focal_length_mm, 2e-5)  # a float32 view
+        assert _rel(geom.GetAttribute("focusDistance").Get(t), (mark - r.entrance_pupil_from_film_mm) / 10.0)
+    assert _rel(model.GetAttribute("focusDistance").Get(), 3000.0)  # the default, kept
+    pulled = [geom.GetAttribute("focalLength").Get(t) for t in (1.0, 24.0)]
+    assert pulled[0] > pulled[1]  # breathing: the closer focus frames tighter
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and doc["time_codes"] == [1.0, 24.0] and doc["stale_samples"] == []
+
+
+def _refused(capsys, action, f):
+    before = f.read_bytes()
+    capsys.readouterr()
+    assert main(["usd", action, str(f)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and str(f) in err and "Traceback" not in err, err
+    assert f.read_bytes() == before
+    return err
+
+
+def test_a_sample_that_cannot_be_focused_is_refused_naming_its_time_code(tmp_path, capsys):
+    f = _pull(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance").Set(150.0, 7.0)  # inside 4 f: no image of it
+    stage.Save()
+    for action in ("check", "refresh"):
+        assert "at time code 7" in _refused(capsys, action, f)
+
+
+@pytest.mark.parametrize("edit", ["sensor", "real-lens"])
+def test_samples_check_and_refresh_cannot_follow_are_refused(tmp_path, capsys, edit):
+    if edit == "sensor":
+        f = _pull(tmp_path)
+        stage = Usd.Stage.Open(str(f))
+        stage.GetPrimAtPath(CAM).GetAttribute("sensor:main:aperture").Set((20.0, 15.0), 4.0)
+        stage.Save()
+        expected = "sensor:main:aperture is animated"
+    else:  # usd animate --lens keys the real lens's pupils without storing the lens
+        marks = tmp_path / "pull.csv"
+        marks.write_text("frame,focus\n1,2m\n10,4m\n", encoding="utf-8")
+        f = tmp_path / "rx.usda"
+        assert main(["usd", "animate", str(f), "--lens", "dgauss_50mm", "--fstop", "2.8", "--marks", str(marks),
+                     "--sensor", "S35"]) == 0
+        expected = "does not store"
+    for action in ("check", "refresh"):
+        assert expected in _refused(capsys, action, f)
+
+
+
+def test_a_shots_keyed_focus_over_a_vendor_lens_is_refreshed_in_the_shot(tmp_path):
+    """A shot (body and vendor lens files referenced, physcam.usd.kit) whose focus override a layout artist keys:
+    the refresh writes its samples as shot opinions, the lens file untouched, and the shot checks current."""
+    from physcam.lens.library import load_lens
+    from physcam.onset.report import report_camera, solve_report
+    from physcam.optics.sensors import Sensor
+    from physcam.usd.author import CameraSpec
+    from physcam.usd.kit import check_shot, refresh_shot, write_body_file, write_shot, write_vendor_lens
+
+    lens, body, shot = (tmp_path / n for n in ("lens.usda", "body.usda", "shot.usda"))
+    write_vendor_lens(lens, load_lens("dgauss_50mm"), focus_mm=3000.0, fstop=2.8)
+    write_body_file(body, CameraSpec.of(focal_length_mm=50.0, fstop=2.8, focus_mm=3000.0, sensor_width_mm=24.89,
+                                        sensor_height_mm=18.66))
+    write_shot(shot, body, lens, overrides={"focus_mm": 2500.0})
+    lens_bytes = lens.read_bytes()
+    stage = Usd.Stage.Open(str(shot))
+    focus = stage.GetPrimAtPath("/Cameras/Shot/Pinhole").GetAttribute("focusDistance")
+    focus.Set(2000.0, 1.0)
+    focus.Set(4000.0, 48.0)
+    stage.Save()
+    before = check_shot(shot)
+    assert before["stale"] and [s["time"] for s in before["stale_samples"]] == [1.0, 48.0]
+    after = refresh_shot(shot)
+    assert after["written"] and not after["stale"] and lens.read_bytes() == lens_bytes
+    stage = Usd.Stage.Open(str(shot))
+    assert validation_errors(stage) == []
+    w, h = stage.GetPrimAtPath("/Cameras/Shot").GetAttribute("sensor:main:aperture").Get()
+    r = solve_report(report_camera(focal_length_mm=None, lens=load_lens("dgauss_50mm"), fstop=2.8, focus_mm=4000.0,
+                                   sensor=Sensor(key="custom", name="S35", width_mm=float(w), height_mm=float(h))))
+    geom = stage.GetPrimAtPath("/Cameras/Shot/Camera")
+    assert _rel(geom.GetAttribute("focalLength").Get(48.0), r.pinhole_focal_length_mm, 2e-5)
+    assert _rel(stage.GetPrimAtPath("/Cameras/Shot").GetAttribute("lens:main:entrancePupilDistance").Get(48.0),
+                r.entrance_pupil_from_film_mm)
