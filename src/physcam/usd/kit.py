@@ -340,7 +340,10 @@ def check_shot(file, path: str | None = None) -> dict:
     ``stale`` is true when the companion was computed from other inputs than the composed camera
     now has (a lens file's ``current`` characterization changed, a body file was edited, ...),
     or carries no stored hash. ``units`` lists referenced files whose metersPerUnit differs from
-    the shot's (composed correctly by :func:`write_shot`, worth knowing).
+    the shot's (composed correctly by :func:`write_shot`, worth knowing). An animated camera adds
+    ``time_codes`` (its lens's keys) and ``stale_samples`` (``{"time", "attributes", "left"}``: a keyed
+    time code's stale derived samples, or with ``left`` true a deleted key's own samples, which
+    :func:`refresh_shot` removes; docs/usd.md).
     """
     return _checked(file, path, "check")
 
