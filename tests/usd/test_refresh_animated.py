@@ -396,9 +396,71 @@ def test_a_still_lens_with_one_sampled_sensor_reads_in_the_singular(tmp_path, ca
     assert f"{CAM}.sensor:main:aperture is animated (1 time sample): usd check" in _refused(capsys, "check", f)
 
 
-def test_a_deleted_focus_key_is_no_longer_a_keyed_time_code(tmp_path, capsys):
-    """A real lens keyed at 1, 12 and 24, refreshed, then the key at 12 deleted: the refresh's own samples there
-    (the model's focal length, the EFL at the focus, among them) do not keep 12 keyed; they are named, not deleted."""
+def _delete_keys(f, t, *attrs):
+    """A layout artist deletes the lens's keys at time code ``t`` (usd-core, as a DCC would)."""
+    stage = Usd.Stage.Open(str(f))
+    for prim, name in attrs:
+        stage.GetPrimAtPath(prim).GetAttribute(name).ClearAtTime(t)
+    stage.Save()
+
+
+def _samples(f, t):
+    stage = Usd.Stage.Open(str(f))
+    return {str(a.GetPath()) for p in (CAM, MODEL, GEOM) for a in stage.GetPrimAtPath(p).GetAttributes()
+            if t in a.GetTimeSamples()}
+
+
+def _values_at(f, t):
+    stage = Usd.Stage.Open(str(f))
+    return {n: stage.GetAttributeAtPath(n).Get(t) for n in _samples(f, t)}
+
+
+_THIN_LENS_KEYS = ((MODEL, "focusDistance"), (CAM, "lens:main:fStop"), (MODEL, "focalLength"))
+_THIN_LENS_LEFT = {f"{CAM}.{n}" for n in ("iris", "lens:main:iris", "lens:main:entrancePupilDistance",
+                                          "lens:main:apertureDistance")} | {
+    f"{GEOM}.{n}" for n in ("focalLength", "horizontalAperture", "verticalAperture", "fStop", "exposure:fStop",
+                            "focusDistance", "xformOp:translate")}  # usd animate --focal's samples but its keys
+
+
+def _three_marks(tmp_path):
+    marks = tmp_path / "pull.csv"
+    marks.write_text("frame,focus,fstop\n1,2m,2.8\n5,3m,4\n10,4m,4\n", encoding="utf-8")
+    f = tmp_path / "pull.usda"
+    assert main(["usd", "animate", str(f), "--focal", "50", "--marks", str(marks), "--sensor", "S35"]) == 0
+    return f
+
+
+def test_a_deleted_thin_lens_key_leaves_samples_the_refresh_removes(tmp_path, capsys):
+    """usd animate --focal keys frames 1, 5 and 10; the artist deletes the lens's keys at 5 (focus, f-stop and the
+    thin lens's focal length): the check names the eleven samples left there (the list written out by hand from
+    usd animate's per-frame attributes), the refresh removes them and only them, and the file checks current."""
+    f = _three_marks(tmp_path)
+    kept = {t: _values_at(f, t) for t in (1.0, 10.0)}
+    _delete_keys(f, 5.0, *_THIN_LENS_KEYS)
+    rc, doc = _check_json(capsys, f)
+    assert rc == 1 and doc["stale"] and doc["time_codes"] == [1.0, 10.0]
+    assert [(s["time"], s["left"], set(s["attributes"])) for s in doc["stale_samples"]] == [(5.0, True, _THIN_LENS_LEFT)]
+    capsys.readouterr()
+    assert main(["usd", "check", str(f)]) == 1
+    out = capsys.readouterr().out
+    assert "time code 5: stale, left from a deleted key at time code 5: " in out and "deleted key (first 5: 11 " in out
+
+    capsys.readouterr()
+    assert main(["usd", "refresh", str(f), "--json"]) == 0
+    done = json.loads(capsys.readouterr().out)
+    assert check_document(done) == "physcam.usd_refresh" and done["written"] and not done["stale"]
+    assert {(c["attribute"], c["time"]) for c in done["changed"]} == {(n, 5.0) for n in _THIN_LENS_LEFT}
+    assert all(c["after"] is None and c["before"] is not None for c in done["changed"])
+    assert _samples(f, 5.0) == set() and {t: _values_at(f, t) for t in (1.0, 10.0)} == kept  # the others untouched
+    assert validation_errors(Usd.Stage.Open(str(f))) == []
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and doc["stale_samples"] == [] and doc["time_codes"] == [1.0, 10.0]
+
+
+def test_a_deleted_focus_key_on_a_stored_lens_leaves_samples_the_refresh_removes(tmp_path, capsys):
+    """A real lens (stored) keyed at 1, 12 and 24 and refreshed, then the focus key at 12 deleted: the refresh's own
+    samples there (the lens's pupils and principal planes among them) no longer keep 12 keyed; the text
+    refresh lists each removal, and the file checks current."""
     f = _dgauss(tmp_path)
     stage = Usd.Stage.Open(str(f))
     focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
@@ -406,8 +468,94 @@ def test_a_deleted_focus_key_is_no_longer_a_keyed_time_code(tmp_path, capsys):
         focus.Set(mark, t)
     stage.Save()
     assert main(["usd", "refresh", str(f)]) == 0
+    written = _samples(f, 12.0) - {f"{MODEL}.focusDistance"}
+    assert {f"{CAM}.lens:main:pinholeFocalLength", f"{CAM}.lens:main:entrancePupilDistance"} <= written
+    kept = {t: _values_at(f, t) for t in (1.0, 24.0)}
+    _delete_keys(f, 12.0, (MODEL, "focusDistance"))
+    rc, doc = _check_json(capsys, f)
+    assert rc == 1 and [(s["time"], s["left"], set(s["attributes"])) for s in doc["stale_samples"]] == [
+        (12.0, True, written)]
+    capsys.readouterr()
+    assert main(["usd", "refresh", str(f)]) == 0
+    out = capsys.readouterr().out
+    assert all(f"  {n} at time code 12: " in out for n in written) and out.count("-> (none)") == len(written), out
+    assert _samples(f, 12.0) == set() and {t: _values_at(f, t) for t in (1.0, 24.0)} == kept
+    assert validation_errors(Usd.Stage.Open(str(f))) == []
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and not doc["stale"]
+
+
+@pytest.mark.parametrize("edit", ["hand key", "one fewer"])
+def test_a_deleted_key_with_other_samples_is_refused_not_deleted(tmp_path, capsys, edit):
+    """At a time code no lens input is keyed at, only exactly the samples usd animate and refresh write there are
+    removed: one more (an artist's key on the companion's clipping range) or one fewer (an artist deleted the
+    companion's focal length key too: what is left may be theirs) is today's refusal, the file left as it was."""
+    f = _three_marks(tmp_path)
+    _delete_keys(f, 5.0, *_THIN_LENS_KEYS)
     stage = Usd.Stage.Open(str(f))
-    stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance").ClearAtTime(12.0)
+    geom = stage.GetPrimAtPath(GEOM)
+    if edit == "hand key":  # named before the derived samples beside it
+        geom.GetAttribute("clippingRange").Set((1.0, 1000.0), 5.0)
+        expected = f"{GEOM}.clippingRange is animated (1 time sample): usd "
+    else:
+        geom.GetAttribute("focalLength").ClearAtTime(5.0)
+        expected = "is keyed at time code 5, where the lens's focus, f-stop and focal length are not: usd "
     stage.Save()
-    err = _refused(capsys, "check", f)
-    assert "is keyed at time code 12, where the lens's focus" in err, err
+    for action in ("check", "refresh"):
+        assert expected + action in _refused(capsys, action, f)
+
+
+def test_samples_left_in_a_sublayer_are_refused_naming_the_layer(tmp_path, capsys):
+    """The pull and its samples in a sublayer (anim.usda) under the shot's root layer: the refresh writes only the
+    root layer, so samples a deleted key left in anim.usda are refused naming it, both files left as they were."""
+    from pxr import Sdf
+
+    f = _three_marks(tmp_path)
+    f.rename(tmp_path / "anim.usda")
+    shot = _layer(tmp_path / "shot.usda")
+    shot.subLayerPaths[:] = ["anim.usda"]
+    shot.Save()
+    anim = Sdf.Layer.FindOrOpen(str(tmp_path / "anim.usda"))
+    for prim, name in _THIN_LENS_KEYS:
+        anim.EraseTimeSample(Sdf.Path(f"{prim}.{name}"), 5.0)
+    anim.Save()
+    before = anim.ExportToString()
+    for action in ("check", "refresh"):
+        err = _refused(capsys, action, tmp_path / "shot.usda")
+        assert "left from a deleted key, in " in err and "anim.usda: usd " in err and "at time code 5" in err, err
+    anim.Reload()
+    assert anim.ExportToString() == before
+
+
+def test_a_key_deleted_in_a_sublayer_leaves_root_layer_samples_the_refresh_removes(tmp_path, capsys):
+    """The focus keys in a sublayer (anim.usda), the refresh's samples in the shot's root layer: the key at 12
+    deleted in anim.usda, the refresh removes its samples at 12 from the root layer, anim.usda untouched."""
+    from pxr import Sdf
+
+    _dgauss(tmp_path, "camera.usda")
+    anim = _layer(tmp_path / "anim.usda")
+    Sdf.CreatePrimInLayer(anim, MODEL)
+    for p in ("/Cameras", CAM, MODEL):
+        anim.GetPrimAtPath(p).specifier = Sdf.SpecifierOver
+    focus = Sdf.AttributeSpec(anim.GetPrimAtPath(MODEL), "focusDistance", Sdf.ValueTypeNames.Float).path
+    for t, mark in ((1, 2000.0), (12, 2500.0), (24, 5000.0)):
+        anim.SetTimeSample(focus, t, mark)
+    anim.Save()
+    shot = _layer(tmp_path / "shot.usda")
+    shot.subLayerPaths[:] = ["anim.usda", "camera.usda"]
+    shot.Save()
+    f = tmp_path / "shot.usda"
+    assert main(["usd", "refresh", str(f)]) == 0
+    written = _samples(f, 12.0) - {f"{MODEL}.focusDistance"}
+    assert {f"{CAM}.lens:main:entrancePupilDistance", f"{GEOM}.focusDistance"} <= written
+    anim.EraseTimeSample(focus, 12)
+    anim.Save()
+    before = (tmp_path / "anim.usda").read_bytes()
+    rc, doc = _check_json(capsys, f)
+    assert rc == 1 and [(s["time"], s["left"], set(s["attributes"])) for s in doc["stale_samples"]] == [
+        (12.0, True, written)]
+    assert main(["usd", "refresh", str(f)]) == 0
+    assert _samples(f, 12.0) == set() and (tmp_path / "anim.usda").read_bytes() == before
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and not doc["stale"] and doc["time_codes"] == [1.0, 24.0]
+    assert validation_errors(Usd.Stage.Open(str(f))) == []

@@ -490,7 +490,9 @@ def run_check(args) -> int:
     keyed = f" ({n} keyed time code{'s' * (n != 1)})" if n else ""
     print(f"{res['path']}: companion camera{keyed} {state}")
     for sample in res["stale_samples"]:
-        print(f"  time code {time_code_text(sample['time'])}: stale {', '.join(sample['attributes'])}")
+        t = time_code_text(sample["time"])
+        why = f"stale, left from a deleted key at time code {t}:" if sample["left"] else "stale"
+        print(f"  time code {t}: {why} {', '.join(sample['attributes'])}")
     for u in res["units"]:
         print(f"  note: {u['file']} is in metersPerUnit {u['meters_per_unit']:g}, the shot in "
               f"{res['meters_per_unit']:g} (composed in the shot's unit)")

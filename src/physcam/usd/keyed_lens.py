@@ -121,12 +121,13 @@ def _derived_names(stage, path) -> set:
     return out
 
 
-def _refuse_samples_not_followed(stage, path, file, action: str, times) -> None:
+def _refuse_samples_not_followed(stage, path, file, action: str, times) -> list[dict]:
     """ExportError naming the file and a time-sampled attribute of the camera at ``path`` (or of its children) that
     check and refresh cannot follow, still lens or keyed (``times``, :func:`_keyed_time_codes`): one that is neither
     a keyed input, a thin lens's pupil or stop read at each keyed time code, a layout's move (the camera's
     ``xformOp:*``), nor one the refresh derives (:func:`_derived_names`); a derived one keyed at a time code where
-    the lens is not (an artist's key, or one left by a deleted key: the refresh does not delete keys); and a lens
+    the lens is not, unless that time code holds exactly the refresh's own samples (:func:`_left_samples`, which
+    are returned); and a lens
     solved from a real lens the file does not store (``usd animate --lens`` samples its pupils and pinhole but
     keeps no prescription to solve them again)."""
     cam = stage.GetPrimAtPath(str(path))
@@ -135,41 +136,110 @@ def _refuse_samples_not_followed(stage, path, file, action: str, times) -> None:
     lp = f"lens:{LENS_INSTANCE}:"
     stored = composed_prescription(stage, path) is not None
     read_at_time = set() if stored or not times else {f"{path}.{lp}entrancePupilDistance", f"{path}.{lp}apertureDistance"}
+    left = _left_samples(stage, path, file, action, times, derived | read_at_time)
+    left_times = {d["time"] for d in left}
+    attrs = [a for prim in (cam, *cam.GetChildren()) for a in prim.GetAttributes()]
+    for a in sorted(attrs, key=lambda a: str(a.GetPath()) in derived):  # a hand key on another attribute named first
+        name = str(a.GetPath())
+        if not a.GetNumTimeSamples() or name in keyed | read_at_time:
+            continue
+        if a.GetPrim() == cam and a.GetName().startswith("xformOp"):
+            continue  # the layout's move: not an input of the lens
+        if name in derived:
+            _refuse_unkeyed_samples(a, file, action, [*times, *left_times])
+            continue
+        if times and not stored and a.GetName() in _LENS_DERIVED:
+            raise ExportError(f"{file}: {name} is animated from a real lens that the file does not store "
+                              f"(usd animate --lens): usd {action} cannot solve it again; write the animation "
+                              f"again with `physcam usd animate {file} --marks CSV ... --force`")
+        n = a.GetNumTimeSamples()
+        raise ExportError(f"{file}: {name} is animated ({n} time sample{'s' * (n != 1)}): usd {action} "
+                          "follows a keyed focus, f-stop and focal length sample by sample, not this attribute")
+    return left
+
+
+def _samples_at(cam) -> dict:
+    """Time code -> the attribute paths of the camera ``cam`` and its children (its lens model, its companion)
+    holding a time sample there, the camera's own ``xformOp:*`` (the layout's move) left out."""
+    out: dict = {}
     for prim in (cam, *cam.GetChildren()):
         for a in prim.GetAttributes():
-            name = str(a.GetPath())
-            if not a.GetNumTimeSamples() or name in keyed | read_at_time:
-                continue
             if prim == cam and a.GetName().startswith("xformOp"):
-                continue  # the layout's move: not an input of the lens
-            if name in derived:
-                _refuse_unkeyed_samples(a, file, action, times)
                 continue
-            if times and not stored and a.GetName() in _LENS_DERIVED:
-                raise ExportError(f"{file}: {name} is animated from a real lens that the file does not store "
-                                  f"(usd animate --lens): usd {action} cannot solve it again; write the animation "
-                                  f"again with `physcam usd animate {file} --marks CSV ... --force`")
-            n = a.GetNumTimeSamples()
-            raise ExportError(f"{file}: {name} is animated ({n} time sample{'s' * (n != 1)}): usd {action} "
-                              "follows a keyed focus, f-stop and focal length sample by sample, not this attribute")
+            for t in a.GetTimeSamples():
+                out.setdefault(float(t), set()).add(str(a.GetPath()))
+    return out
+
+
+def _left_samples(stage, path, file, action: str, times, written) -> list[dict]:
+    """``[{"time", "attributes", "left": True}]`` of each time code no lens input is keyed at whose samples are
+    exactly the ones the refresh writes at each keyed time code of this camera: the attributes of ``written``
+    (the derived ones, a thin lens's pupils) sampled at its keyed ``times``, all of them and no other (the
+    samples a deleted key left; a set with one more or one fewer is an artist's, refused by the caller). An
+    ExportError naming the layer when one of them is authored in a layer weaker than the file's root layer
+    (a sublayer, a referenced file): the refresh writes only the root layer."""
+    if not times:
+        return []
+    from pxr import Sdf
+
+    at = _samples_at(stage.GetPrimAtPath(str(path)))
+    keyed_set = set().union(*(at.get(t, set()) for t in times)) & written
+    root = stage.GetRootLayer()
+    out = []
+    for t in sorted(set(at) - set(times)):
+        if not keyed_set or at[t] != keyed_set:
+            continue
+        for name in sorted(at[t]):
+            layer = _sample_layer(stage.GetAttributeAtPath(Sdf.Path(name)), t)
+            if layer is not None and layer != root:
+                tc = time_code_text(t)
+                raise ExportError(f"{file}: {name} holds a sample at time code {tc}, left from a deleted key, in "
+                                  f"{layer.identifier}: usd {action} writes only {root.identifier}; remove the "
+                                  f"samples at time code {tc} in that layer (or key the lens there) and run it again")
+        out.append({"time": t, "attributes": sorted(at[t]), "left": True})
+    return out
+
+
+def _sample_layer(attr, t: float):
+    """The layer whose time samples ``attr`` composes (the strongest spec holding any), or None."""
+    for spec in attr.GetPropertyStack():
+        if spec.layer.GetNumTimeSamplesForPath(spec.path):
+            return spec.layer if t in spec.layer.ListTimeSamplesForPath(spec.path) else None
+    return None
+
+
+def _remove_left_samples(stage, left) -> list[dict]:
+    """Remove, in the root layer, the samples of ``left`` (:func:`_left_samples`); return the removals as the
+    refresh reports its changes (``after`` None), each with its ``time``."""
+    from pxr import Sdf
+
+    changed = []
+    for d in left:
+        for name in d["attributes"]:
+            attr = stage.GetAttributeAtPath(Sdf.Path(name))
+            before = attr.Get(d["time"])
+            attr.ClearAtTime(d["time"])
+            changed.append({"attribute": name, "time": d["time"], "before": _shown_value(before), "after": None})
+    return changed
 
 
 def _refuse_unkeyed_samples(attr, file, action: str, times) -> None:
-    """ExportError naming a derived attribute keyed at a time code where the lens is not (an artist's key, or one
-    a deleted key left): the refresh recomputes samples at the lens's time codes and deletes none."""
+    """ExportError naming a derived attribute keyed at a time code where the lens is not, ``times`` the lens's and
+    those whose samples a deleted key left (:func:`_left_samples`): an artist's key, which the refresh does not
+    delete."""
     unkeyed = sorted(set(map(float, attr.GetTimeSamples())) - set(times))
     if unkeyed:
         t = time_code_text(unkeyed[0])
         raise ExportError(f"{file}: {attr.GetPath()} is keyed at time code {t}, where the lens's focus, f-stop and "
-                          f"focal length are not: usd {action} deletes no keys; remove the samples at time code {t} "
+                          f"focal length are not: usd {action} deletes no hand keys; remove the samples at time code {t} "
                           "(or key the lens there) and run it again")
 
 
 def _stale_samples(stage, path, expected: dict) -> list[dict]:
     """``[{"time", "attributes"}]`` of each time code where an attribute of ``expected`` (time code ->
     :func:`_sampled_derived`) differs from the file at float32 precision (the companion's field of view:
-    :func:`_same_view`); a derived sample at a time code no input is keyed at is refused before
-    (:func:`_refuse_samples_not_followed`)."""
+    :func:`_same_view`), each with ``left`` False; a derived sample at a time code no input is keyed at is
+    refused before or is a deleted key's (:func:`_refuse_samples_not_followed`)."""
     from pxr import Sdf
 
     geom = str(Sdf.Path(path).AppendChild("Camera"))
@@ -181,7 +251,7 @@ def _stale_samples(stage, path, expected: dict) -> list[dict]:
             bad = [n for n in bad if n not in {f"{geom}.{v}" for v in ("focalLength", "horizontalAperture",
                                                                        "verticalAperture")}]
         if bad:
-            out.append({"time": t, "attributes": bad})
+            out.append({"time": t, "attributes": bad, "left": False})
     return sorted(out, key=lambda d: d["time"])
 
 

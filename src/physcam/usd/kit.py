@@ -25,8 +25,8 @@ from ..lens.prescription import takes_prescription
 from .author import (LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec, author_camera, author_prescription, author_render_camera,
                      new_stage, save_stage)
 from .float32_values import _same_value, _same_view, _shown_value
-from .keyed_lens import (_author_samples, _keyed_time_codes, _refuse_samples_not_followed, _samples_solved,
-                         _stale_samples, _still_time, time_code_text)
+from .keyed_lens import (_author_samples, _keyed_time_codes, _refuse_samples_not_followed, _remove_left_samples,
+                         _samples_solved, _stale_samples, _still_time, time_code_text)
 from .read import companion_inputs, companion_inputs_hash, composed_prescription
 from .solved_lens import _lens_derived_values, _lens_solved
 from .plugin import ensure_registered
@@ -340,7 +340,10 @@ def check_shot(file, path: str | None = None) -> dict:
     ``stale`` is true when the companion was computed from other inputs than the composed camera
     now has (a lens file's ``current`` characterization changed, a body file was edited, ...),
     or carries no stored hash. ``units`` lists referenced files whose metersPerUnit differs from
-    the shot's (composed correctly by :func:`write_shot`, worth knowing).
+    the shot's (composed correctly by :func:`write_shot`, worth knowing). An animated camera adds
+    ``time_codes`` (its lens's keys) and ``stale_samples`` (``{"time", "attributes", "left"}``: a keyed
+    time code's stale derived samples, or with ``left`` true a deleted key's own samples, which
+    :func:`refresh_shot` removes; docs/usd.md).
     """
     return _checked(file, path, "check")
 
@@ -356,7 +359,7 @@ def _checked(file, path, action: str) -> dict:
     stage.Reload()  # the referenced files as they are on disk now, not as this process cached them
     if path is None:
         path = only_camera(stage, action)  # its error names the file
-    times = _refuse_what_cannot_be_followed(stage, path, file, action)
+    times, left = _refuse_what_cannot_be_followed(stage, path, file, action)
     geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
     if not geom:
         raise ExportError(f"{path}: has no companion camera to check")
@@ -376,22 +379,26 @@ def _checked(file, path, action: str) -> dict:
         reasons.append("the companion carries no inputs hash (written by hand or by an older physcam)" if stored is None
                        else "the camera's composed values (its body, lens or shot opinions) changed since the companion "
                             "was computed")
+    if left:
+        t = time_code_text(left[0]["time"])
+        reasons.append(f"{len(left)} time code{'s' * (len(left) != 1)} hold{'s' * (len(left) == 1)} samples left from "
+                       f"a deleted key (first {t}: {len(left[0]['attributes'])} derived attributes)")
     if samples:
         first = samples[0]
         reasons.append(f"{len(samples)} of its time codes {'is' if len(samples) == 1 else 'are'} stale (first {time_code_text(first['time'])}: "
                        f"{', '.join(first['attributes'])})")
     return {"path": path, "stale": bool(reasons), "stored": stored, "current": current,
             "meters_per_unit": mpu, "units": units, "reason": "; ".join(reasons) or None,
-            "time_codes": times, "stale_samples": samples}
+            "time_codes": times, "stale_samples": sorted(samples + left, key=lambda d: d["time"])}
 
 
-def _refuse_what_cannot_be_followed(stage, path, file, action: str) -> list[float]:
-    """The camera's keyed time codes (:func:`_keyed_time_codes`) after the refusals: not a camera
-    (:func:`_refuse_not_a_camera`), samples check and refresh cannot follow (:func:`_refuse_samples_not_followed`)."""
+def _refuse_what_cannot_be_followed(stage, path, file, action: str) -> tuple[list[float], list[dict]]:
+    """The camera's keyed time codes (:func:`_keyed_time_codes`) and the samples a deleted key left
+    (:func:`~physcam.usd.keyed_lens._left_samples`) after the refusals: not a camera (:func:`_refuse_not_a_camera`),
+    samples check and refresh cannot follow (:func:`_refuse_samples_not_followed`)."""
     _refuse_not_a_camera(stage, path, file)
     times = _keyed_time_codes(stage, path)
-    _refuse_samples_not_followed(stage, path, file, action, times)
-    return times
+    return times, _refuse_samples_not_followed(stage, path, file, action, times)
 
 
 def _refuse_not_a_camera(stage, path, file) -> None:
@@ -432,7 +439,7 @@ def refresh_shot(file, path: str | None = None) -> dict:
     stage.Reload()  # the shot and its referenced files as they are on disk now
     if path is None:
         path = only_camera(stage, "refresh")  # its error names the file
-    times = _refuse_what_cannot_be_followed(stage, path, file, "refresh")
+    times, left = _refuse_what_cannot_be_followed(stage, path, file, "refresh")
     now = None  # no companion yet: write it
     if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):
         now = _checked(file, path, "refresh")
@@ -449,6 +456,7 @@ def refresh_shot(file, path: str | None = None) -> dict:
         _keep_equal_notes(stage, path, notes)
     if times:  # a keyed lens: sample by sample
         changed += _author_samples(stage, path, file, times)
+    changed += _remove_left_samples(stage, left)  # the refresh's own samples at a deleted key's time code
     save_stage(stage, file, force=True)
     return dict(check_shot(file, path), written=True, changed=changed)
 
