@@ -642,6 +642,34 @@ def _check_axes(levels) -> tuple[np.ndarray, np.ndarray]:
     return rhos, checked
 
 
+def _refined_levels(levels, tables, checks) -> np.ndarray:
+    """``levels`` with the geometric middle of every interval where the shader's cubic in iris radius
+    misses a traced table's area at the interval's middle (:func:`_check_points`) by over
+    :data:`AREA_TOLERANCE` at a film radius whose reads at both levels hold it: where another surface
+    begins to cut the passing set between the two (the area bends there, a kink the cubic rounds off),
+    halving the interval halves the miss (the double Gauss at f/2.8 focused at 2.5 m: 0.64 % at film
+    radius 10.4 mm between 6.79 and 6.05 mm, 0.21 % between the middle and either level). ``tables``
+    (radial_pupil_table's at ``levels``) and ``checks`` (the areas its ``checks`` received, one per
+    table): the traced focus marks of one lens, which share its levels."""
+    levels = _levels(levels)
+    rhos, checked = _check_axes(levels)
+    read_rho, read_s = _check_points(levels)
+    is_level = np.isin(checked, levels)
+    misses = np.zeros(len(levels) - 1, dtype=bool)
+    for table, want in zip(tables, checks):
+        table = np.array(table, dtype=float)
+        table[..., 3] = cell_area(table[..., 3])
+        want = np.asarray(want, dtype=float)
+        got = _areas_at(table, levels, read_rho, read_s)
+        lit = (want > 0).reshape(len(rhos), len(checked))
+        bad = (np.abs(got - want) > AREA_TOLERANCE * np.maximum(want, 1e-12)).reshape(len(rhos), len(checked)) | ~lit
+        for c in np.flatnonzero(~is_level[1:-1]) + 1:  # a middle between the levels checked[c - 1] and checked[c + 1]
+            misses[np.searchsorted(-levels, -checked[c]) - 1] |= bool((bad[:, c] & lit[:, c] & ~bad[:, c - 1]
+                                                                       & ~bad[:, c + 1]).any())
+    mid = np.sqrt(levels[:-1] * levels[1:])[misses]
+    return np.sort(np.concatenate([levels, mid]))[::-1]
+
+
 def _check_points(levels) -> tuple[np.ndarray, np.ndarray]:
     """(film radius, iris radius) of every check of :func:`radial_pupil_table` at the iris radii ``levels``, in
     the order of its ``checks`` areas: every film radius of :func:`_check_axes` with every iris radius."""
