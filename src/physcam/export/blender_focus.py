@@ -238,10 +238,10 @@ class FocusTable:
     film_z: np.ndarray  # (n,) film plane z, lens space
     film_slope: np.ndarray  # (n,) d film_z / d index at each state (the shader's cubic Hermite)
     vertex_z: np.ndarray  # (n, surfaces)
-    radial: np.ndarray | None  # (n, N_LEVEL, N_RADIAL, 3) pupil ellipses (blender_pupil); None: anamorphic
+    radial: np.ndarray | None  # (n, len(levels), N_RADIAL, 5) pupil ellipses and areas (blender_pupil); None: anamorphic
     rects: np.ndarray | None  # (n, ny, nx, 4) exit-pupil rectangles at the widest iris (anamorphic only)
     rects_stopped: np.ndarray | None  # (n, len(STOP_LEVELS), ny, nx, 4): the same stopped to each level
-    norm: np.ndarray  # (n, N_LEVEL) mean weight at the film centre, the round iris at each of iris_levels(semi_max)
+    norm: np.ndarray  # (n, len(levels)) mean weight at the film centre, the round iris at each of levels
     table: object  # SurfaceTable at infinity (the rows that do not move)
     bounds: object  # PupilBounds at infinity (the 2-D grid; anamorphic only, else None)
     iris_k: float  # iris semi-diameter x f-number (mm)
@@ -333,7 +333,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
     from ..trace.camera_tracer import CameraTracer
-    from .blender_pupil import _centre_ellipses, _refined_levels, iris_levels, radial_pupil_table
+    from .blender_pupil import _assembled, _centre_ellipses, _refined_levels, iris_levels, radial_pupil_table
 
     axis = focus_axis(closest_focus(lens), n_focus)
     states = []
@@ -350,11 +350,11 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     radial, rects, stopped, norm, checks = [], [], [], [], []
     tracers = [CameraTracer(states[i].prescription, states[i].film_z) for i in traced.tolist()]  # as the file stops it
     if not lens.is_anamorphic:
-        radial = [radial_pupil_table(t.lens, t.film_z, levels, checks=checks) for t in tracers]
+        radial, sets = zip(*(radial_pupil_table(t.lens, t.film_z, levels, checks=checks, finer=True) for t in tracers))
         refined = _refined_levels(levels, radial, checks)
-        if len(refined) > len(levels):  # a level between two whose cubic misses the area: every traced mark again
-            levels, checks = refined, []
-            radial = [radial_pupil_table(t.lens, t.film_z, levels, checks=checks) for t in tracers]
+        if len(refined) > len(levels):  # a level between two whose cubic misses a traced mark's area: every table
+            levels, checks = refined, []  # at the levels with it, from the sets already traced
+            radial = [_assembled(t, levels, checks) for t in sets]
     for i, tracer in zip(traced.tolist(), tracers):
         if lens.is_anamorphic:
             b, rect, rect_levels = _rect_tables(tracer, levels[0], grid_half_mm)
