@@ -44,7 +44,12 @@ def test_arrays_are_physcams_surface_table_of_the_focused_lens(slug, focus_mm, f
     semi = None if fstop is None else stop_semi_diameter_for_fstop(lens, fstop)
     t = surface_table(q, reverse=True, stop_semi_diameter=semi)
     assert re.search(rf"#define N_SURF {len(lens.surfaces)}\b", src)
-    assert _array(src, "KIND").tolist() == t.kind.tolist()
+    # the tracer's kinds, a sphere (a spherical surface, or an aspheric one with no terms, of conic 0)
+    # marked 4: the shader's shortcut (physcam.export.osl.SPHERE_KIND)
+    sphere = [s.kind in ("spherical", "aspheric") and s.conic == 0.0 and s.radius != 0.0
+              and not any(s.aspheric) for s in reversed(q.surfaces)]
+    assert _array(src, "KIND").tolist() == [4 if sp else k for k, sp in zip(t.kind.tolist(), sphere)]
+    assert 4 in _array(src, "KIND").tolist()
     for name, col in (("VZ", t.vertex_z), ("AX", t.ax), ("AY", t.ay), ("AZ", t.az), ("CV", t.curvature),
                       ("CK", t.conic), ("SEMI", t.semi_diameter), ("DB", t.disp_before), ("DA", t.disp_after)):
         assert np.array_equal(_array(src, name), col.ravel()), name

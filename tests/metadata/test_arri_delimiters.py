@@ -97,3 +97,21 @@ def test_the_reader_opens_the_file_once_and_reads_its_header_once(tmp_path, deli
         modes, _OPENS[:] = _OPENS[1:], []
     assert len(modes) == 1, modes  # one open: the header read once, for the delimiter and the columns
     assert len(clip.frames) == len(table) - 1 == 500
+
+
+def test_a_file_the_reader_refuses_is_closed(tmp_path):
+    # a blank first line: no delimiter gives AME's header, so the reader refuses it; the file it opened must
+    # be closed then, not left to the garbage collector (a review's find: a ResourceWarning under -X dev)
+    import gc
+    import warnings
+
+    from physcam.metadata import arri
+
+    p = tmp_path / "clip.csv"
+    p.write_text("\n" + ARRI.read_text(encoding="utf-8"), encoding="utf-8")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ResourceWarning)
+        with pytest.raises(MetadataError):
+            arri.read(p)
+        gc.collect()
+    assert not [w for w in caught if issubclass(w.category, ResourceWarning)]

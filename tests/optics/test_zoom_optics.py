@@ -148,3 +148,14 @@ def test_breathing_over_zoom_and_focus():
         assert rows[1].hfov_deg < rows[0].hfov_deg  # this internal-focus zoom's field narrows as it focuses close
     with pytest.raises(InputError):
         zoom_breathing(p, encoders=[])
+
+
+def test_a_focal_length_at_an_end_as_printed_names_that_end():
+    # the Nikon's long end is 195.9996 mm (paraxial), printed "196.00": "196mm" is that end, not outside the
+    # range (a review's find: dof-table --zoom 196mm was refused with "71.50 to 196.00 mm")
+    p = load_lens("nikon_af_s_70_200mm_f2_8e_zoom")
+    hi = efl_at(p, 1.0)
+    assert 195.995 < hi < 196.0
+    assert zoom_encoder(p, "196mm") == 1.0
+    with pytest.raises(InputError, match="outside the zoom range"):
+        zoom_encoder(p, "196.01mm")

@@ -13,6 +13,8 @@ import json
 import math
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from _documents import check_document
 from physcam.cli import main
@@ -80,6 +82,7 @@ def test_an_edited_thin_lens_pull_is_stale_at_its_time_codes_and_refreshed_to_th
         s_img = (focus - math.sqrt(focus * (focus - 4 * f_mm))) / 2  # the lens in front of the film
         assert _rel(geom.GetAttribute("focalLength").Get(t), s_img, 5e-6), t  # cm stage: tenths of a cm are mm
         assert _rel(cam.GetAttribute("lens:main:iris").Get(t), f_mm / fstop)
+        assert _rel(cam.GetAttribute("iris").Get(t), f_mm / fstop)  # usd animate keys the body's too: kept in step
         assert _rel(geom.GetAttribute("fStop").Get(t), fstop * s_img / f_mm, 5e-6)
         assert _rel(geom.GetAttribute("exposure:fStop").Get(t), fstop)
         pupil = cam.GetAttribute("lens:main:entrancePupilDistance").Get(t)  # a thin lens's pupil: the file's
@@ -146,7 +149,8 @@ def test_a_sample_that_cannot_be_focused_is_refused_naming_its_time_code(tmp_pat
     stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance").Set(150.0, 7.0)  # inside 4 f: no image of it
     stage.Save()
     for action in ("check", "refresh"):
-        assert "at time code 7" in _refused(capsys, action, f)
+        err = _refused(capsys, action, f)
+        assert "at time code 7" in err and f"usd {action} cannot solve this sample" in err, err  # the command run
 
 
 @pytest.mark.parametrize("edit", ["sensor", "real-lens"])
@@ -202,3 +206,208 @@ def test_a_shots_keyed_focus_over_a_vendor_lens_is_refreshed_in_the_shot(tmp_pat
     assert _rel(geom.GetAttribute("focalLength").Get(48.0), r.pinhole_focal_length_mm, 2e-5)
     assert _rel(stage.GetPrimAtPath("/Cameras/Shot").GetAttribute("lens:main:entrancePupilDistance").Get(48.0),
                 r.entrance_pupil_from_film_mm)
+
+
+def _dgauss(tmp_path, name="lens.usda"):
+    f = tmp_path / name
+    assert main(["usd", "write", str(f), "--lens", "dgauss_50mm", "--fstop", "2.8", "--focus", "3m", "--sensor",
+                 "S35"]) == 0
+    return f
+
+
+def test_keys_without_a_default_still_check_and_refresh_the_cameras_other_inputs(tmp_path, capsys):
+    """A DCC export writes a keyed focus as samples only (no default): an ISO, shutter and clipping change on the
+    body is stale, and the refresh writes them to the companion (the closed forms: ISO as is, the shutter's close
+    = open + duration x frame rate (24 fps), the clipping range as the lens gives it, in scene units)."""
+    f = _dgauss(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
+    focus.Set(3000.0, 1.0)
+    focus.Set(1500.0, 24.0)
+    focus.ClearDefault()
+    stage.Save()
+    assert main(["usd", "refresh", str(f)]) == 0
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and doc["time_codes"] == [1.0, 24.0]
+    stage = Usd.Stage.Open(str(f))
+    cam = stage.GetPrimAtPath(CAM)
+    cam.GetAttribute("sensor:main:iso").Set(3200.0)
+    cam.GetAttribute("shutterDuration").Set(0.01)
+    cam.GetAttribute("lens:main:clippingRange").Set((1.0, 500.0))
+    stage.Save()
+    rc, doc = _check_json(capsys, f)
+    assert rc == 1 and doc["stale"] and doc["stale_samples"] == []
+    assert main(["usd", "refresh", str(f)]) == 0
+    stage = Usd.Stage.Open(str(f))
+    geom = stage.GetPrimAtPath(GEOM)
+    assert geom.GetAttribute("exposure:iso").Get() == 3200.0
+    assert _rel(geom.GetAttribute("shutter:close").Get() - geom.GetAttribute("shutter:open").Get(), 0.01 * 24)
+    assert tuple(geom.GetAttribute("clippingRange").Get()) == (1.0, 500.0)  # the lens's, in the stage's unit
+    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")  # no default added to the keys
+    assert focus.GetResolveInfo(Usd.TimeCode.Default()).GetSource() != Usd.ResolveInfoSourceDefault
+    assert validation_errors(stage) == []
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and not doc["stale"]
+
+
+def _layer(name):
+    from pxr import Sdf
+
+    layer = Sdf.Layer.CreateNew(str(name))
+    layer.defaultPrim = "Cameras"
+    layer.pseudoRoot.SetInfo("metersPerUnit", 0.01)
+    layer.pseudoRoot.SetInfo("upAxis", "Y")
+    return layer
+
+
+def test_a_focus_pull_in_a_sublayer_refreshes_only_its_samples_in_the_root_layer(tmp_path, capsys):
+    """The animation in a sublayer over a current still camera: the refresh writes only the samples' values in
+    the shot's root layer, no copy of the still companion, and reports only time-coded changes."""
+    from pxr import Sdf
+
+    _dgauss(tmp_path, "camera.usda")
+    anim = _layer(tmp_path / "anim.usda")
+    model = Sdf.CreatePrimInLayer(anim, MODEL)
+    for p in ("/Cameras", CAM, MODEL):
+        anim.GetPrimAtPath(p).specifier = Sdf.SpecifierOver
+    a = Sdf.AttributeSpec(model, "focusDistance", Sdf.ValueTypeNames.Float)
+    anim.SetTimeSample(a.path, 1, 3000.0)
+    anim.SetTimeSample(a.path, 24, 1500.0)
+    anim.Save()
+    shot = _layer(tmp_path / "shot.usda")
+    shot.subLayerPaths[:] = ["anim.usda", "camera.usda"]
+    shot.Save()
+    f = tmp_path / "shot.usda"
+    capsys.readouterr()
+    assert main(["usd", "refresh", str(f), "--json"]) == 0
+    done = json.loads(capsys.readouterr().out)
+    assert done["written"] and not done["stale"] and done["changed"]
+    assert all("time" in c for c in done["changed"]), [c for c in done["changed"] if "time" not in c][:3]
+    assert _root_defaults(f) == []
+    camera = Usd.Stage.Open(str(tmp_path / "camera.usda"))  # the body's ISO, in the still camera's layer
+    camera.GetPrimAtPath(CAM).GetAttribute("sensor:main:iso").Set(800.0)
+    camera.Save()
+    capsys.readouterr()
+    assert main(["usd", "refresh", str(f), "--json"]) == 0
+    done = json.loads(capsys.readouterr().out)
+    assert done["written"] and not done["stale"]
+    assert [(c["attribute"], c["before"], c["after"]) for c in done["changed"]] == [
+        (f"{GEOM}.exposure:iso", 100.0, 800.0)]  # the one value that changed, and no copy of the others
+    assert _root_defaults(f) == [f"{GEOM}.exposure:iso"]
+    assert validation_errors(Usd.Stage.Open(str(f))) == []
+
+
+def _root_defaults(f):
+    from pxr import Sdf
+
+    root = Sdf.Layer.FindOrOpen(str(f))
+    root.Reload()
+    out = []
+    root.Traverse("/", lambda p: out.append(str(p)) if p.IsPropertyPath() and root.GetAttributeAtPath(p)
+                  .HasDefaultValue() else None)
+    return out
+
+
+def test_a_kit_shots_body_iris_is_not_a_sample_of_the_lens(tmp_path, capsys):
+    """A shot (body and lens files) keyed at its still focus: the body's own ``iris`` (used only when no lens is
+    applied, the schema) is not stale, and the refresh does not key it."""
+    def run(*argv):
+        capsys.readouterr()
+        return main(["usd", *map(str, argv)])
+
+    body, lens, shot = (tmp_path / n for n in ("alexa35.usda", "dgauss50.usda", "camera.usda"))
+    assert run("kit", "body", body, "--sensor", "ALEXA 35", "--flange", "44") == 0
+    assert run("kit", "vendor", lens, "--lens", "dgauss.50mm", "--focus", "1.5m", "--fstop", "4") == 0
+    assert run("kit", "shot", shot, "--body", body, "--lens", lens, "--focus", "2m", "--fstop", "2.8") == 0
+    stage = Usd.Stage.Open(str(shot))
+    stage.GetPrimAtPath("/Cameras/Shot/Pinhole").GetAttribute("focusDistance").Set(2000.0, 1.0)
+    stage.Save()
+    rc, doc = _check_json(capsys, shot)
+    assert rc == 0 and doc["stale_samples"] == [], doc["stale_samples"]
+    assert run("refresh", shot) == 0
+    assert not Usd.Stage.Open(str(shot)).GetPrimAtPath("/Cameras/Shot").GetAttribute("iris").GetNumTimeSamples()
+
+
+def test_time_codes_are_printed_as_the_time_codes_they_are(tmp_path, capsys):
+    """Keys at time codes 123456, 123456.5 and 1234567 (a long shot's frame numbers, a half frame): each stale one
+    is named exactly, not rounded to six digits (123456.5 read as 123456; 1234567 as 1.23457e+06)."""
+    f = _dgauss(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
+    for t, mark in ((123456.0, 3000.0), (123456.5, 2000.0), (1234567.0, 1000.0)):
+        focus.Set(mark, t)
+    stage.Save()
+    capsys.readouterr()
+    assert main(["usd", "check", str(f)]) == 1
+    out = capsys.readouterr().out
+    assert "(first 123456.5: " in out and "  time code 123456.5: stale" in out and "  time code 1234567: stale" in out
+    assert main(["usd", "refresh", str(f)]) == 0
+    out = capsys.readouterr().out
+    assert " at time code 123456.5: " in out and " at time code 1234567: " in out and "e+06" not in out
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.floats(allow_nan=False, allow_infinity=False))
+def test_a_time_codes_text_reads_back_to_that_time_code(t):
+    from physcam.usd.keyed_lens import time_code_text
+
+    text = time_code_text(t)
+    assert float(text) == t and ("." not in text and "e" not in text) == float(t).is_integer()
+
+
+def test_one_keyed_time_code_reads_in_the_singular(tmp_path, capsys):
+    f = _dgauss(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance").Set(2000.0, 1.0)
+    stage.Save()
+    capsys.readouterr()
+    assert main(["usd", "check", str(f)]) == 1
+    out = capsys.readouterr().out
+    assert "(1 keyed time code) STALE: 1 of its time codes is stale (first 1: " in out, out
+
+
+def test_a_path_that_is_not_a_camera_is_named_so_on_an_animated_file(tmp_path, capsys):
+    f = _pull(tmp_path)
+    for action in ("check", "refresh"):
+        capsys.readouterr()
+        assert main(["usd", action, str(f), "--path", "/Cameras"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.endswith("/Cameras is a Xform, not a PhysicalCamera") and str(f) in err, err
+
+
+@pytest.mark.parametrize("lens", ["still", "keyed"])
+def test_a_hand_keyed_companion_sample_is_refused_not_deleted(tmp_path, capsys, lens):
+    """A companion attribute keyed by hand where the lens is not keyed: refused in one line naming it, on a still
+    lens as on a keyed one (before, a keyed lens's refresh deleted the artist's key), the file left as it was."""
+    f = _dgauss(tmp_path) if lens == "still" else _pull(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    stage.GetPrimAtPath(GEOM).GetAttribute("focalLength").Set(40.0, 5.0)
+    stage.Save()
+    for action in ("check", "refresh"):
+        err = _refused(capsys, action, f)
+        assert f"{GEOM}.focalLength is keyed at time code 5, where the lens's focus" in err, err
+
+
+def test_a_still_lens_with_one_sampled_sensor_reads_in_the_singular(tmp_path, capsys):
+    f = _dgauss(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    stage.GetPrimAtPath(CAM).GetAttribute("sensor:main:aperture").Set((20.0, 15.0), 4.0)
+    stage.Save()
+    assert f"{CAM}.sensor:main:aperture is animated (1 time sample): usd check" in _refused(capsys, "check", f)
+
+
+def test_a_deleted_focus_key_is_no_longer_a_keyed_time_code(tmp_path, capsys):
+    """A real lens keyed at 1, 12 and 24, refreshed, then the key at 12 deleted: the refresh's own samples there
+    (the model's focal length, the EFL at the focus, among them) do not keep 12 keyed; they are named, not deleted."""
+    f = _dgauss(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
+    for t, mark in ((1.0, 2000.0), (12.0, 2500.0), (24.0, 5000.0)):
+        focus.Set(mark, t)
+    stage.Save()
+    assert main(["usd", "refresh", str(f)]) == 0
+    stage = Usd.Stage.Open(str(f))
+    stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance").ClearAtTime(12.0)
+    stage.Save()
+    err = _refused(capsys, "check", f)
+    assert "is keyed at time code 12, where the lens's focus" in err, err

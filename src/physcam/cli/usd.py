@@ -475,6 +475,7 @@ def run_animate(args) -> int:
 
 
 def run_check(args) -> int:
+    from ..usd.keyed_lens import time_code_text
     from ..usd.kit import check_shot
 
     res = check_shot(args.file, args.path)
@@ -485,10 +486,11 @@ def run_check(args) -> int:
         emit_json(document("usd_check", d))
         return rc
     state = f"STALE: {res['reason']}; run physcam usd refresh {args.file}" if res["stale"] else "current"
-    keyed = f" ({len(res['time_codes'])} keyed time codes)" if res["time_codes"] else ""
+    n = len(res["time_codes"])
+    keyed = f" ({n} keyed time code{'s' * (n != 1)})" if n else ""
     print(f"{res['path']}: companion camera{keyed} {state}")
     for sample in res["stale_samples"]:
-        print(f"  time code {sample['time']:g}: stale {', '.join(sample['attributes'])}")
+        print(f"  time code {time_code_text(sample['time'])}: stale {', '.join(sample['attributes'])}")
     for u in res["units"]:
         print(f"  note: {u['file']} is in metersPerUnit {u['meters_per_unit']:g}, the shot in "
               f"{res['meters_per_unit']:g} (composed in the shot's unit)")
@@ -496,6 +498,7 @@ def run_check(args) -> int:
 
 
 def run_refresh(args) -> int:
+    from ..usd.keyed_lens import time_code_text
     from ..usd.kit import refresh_shot
 
     res = refresh_shot(args.file, args.path)
@@ -510,7 +513,7 @@ def run_refresh(args) -> int:
         print(f"{res['path']}: companion camera recomputed; {n} value{'s' * (n != 1)} changed"
               + (":" if n else " (the inputs hash only)"))
         for c in res["changed"]:
-            at = f" at time code {c['time']:g}" if "time" in c else ""
+            at = f" at time code {time_code_text(c['time'])}" if "time" in c else ""
             print(f"  {c['attribute']}{at}: {_shown(c['before'])} -> {_shown(c['after'])}")
     return 0
 

@@ -94,10 +94,21 @@ def rows(path, delimiter=",") -> tuple[list[str], object]:
     read once, for both."""
     p = Path(path)
     fh = _open_text(p)
+    try:  # the file is closed here when the header cannot be read (or the delimiter not picked), else by the rows
+        header, reader = _header(p, fh, delimiter)
+    except BaseException:
+        fh.close()
+        raise
+    data = _data_rows(p, fh, reader, header)
+    next(data)  # inside its `with fh` now: a reader that drops the rows unread (a missing column) closes the file
+    return header, data
+
+
+def _header(p, fh, delimiter):
+    """(header, csv reader positioned after it) of the open file ``fh`` (:func:`rows`)."""
     try:
         first = fh.readline()
     except UnicodeDecodeError:
-        fh.close()
         raise MetadataError("not UTF-8 or UTF-16 text", p, 1) from None
     if callable(delimiter):
         delimiter = delimiter(first.rstrip("\r\n"))
@@ -105,18 +116,17 @@ def rows(path, delimiter=",") -> tuple[list[str], object]:
     try:
         header = next(reader)
     except StopIteration:
-        fh.close()
         raise MetadataError("the file is empty", p, 1) from None
     except (csv.Error, UnicodeDecodeError) as exc:
-        fh.close()
         why = "not UTF-8 or UTF-16 text" if isinstance(exc, UnicodeDecodeError) else f"cannot read the header ({exc})"
         raise MetadataError(why, p, 1) from None
-    header = [h.strip() for h in header]
-    return header, _data_rows(p, fh, reader, header)
+    return [h.strip() for h in header], reader
 
 
 def _data_rows(p, fh, reader, header):
+    """The rows of :func:`rows`; its first ``next`` only enters the file's ``with`` (yields None)."""
     with fh:
+        yield None
         try:
             for cells in reader:
                 line = reader.line_num

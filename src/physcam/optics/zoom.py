@@ -70,6 +70,10 @@ def _samples(lens, wavelength_nm):
     return us, [efl_at(lens, u, wavelength_nm) for u in us]
 
 
+#: a focal length this close outside a zoom's paraxial range names its end (the range is printed to 0.01 mm)
+ZOOM_END_TOLERANCE_MM = 0.005
+
+
 @takes_prescription
 def encoder_for_focal_length(lens: Prescription, focal_length_mm: float, *, wavelength_nm=None) -> float:
     """The normalised zoom coordinate where the zoom lens's paraxial EFL is ``focal_length_mm``
@@ -81,7 +85,8 @@ def encoder_for_focal_length(lens: Prescription, focal_length_mm: float, *, wave
         raise OpticsError(f"the EFL of {lens.name!r} does not run monotonically across its zoom: a focal length "
                           "names no single position; give the zoom as an encoder value 0..1")
     lo, hi = min(efls), max(efls)
-    if not lo * (1 - 1e-9) <= f <= hi * (1 + 1e-9):
+    # an end as the range is printed (0.01 mm) is that end: 196 mm on a zoom whose long end is 195.9996
+    if not lo - ZOOM_END_TOLERANCE_MM <= f <= hi + ZOOM_END_TOLERANCE_MM:
         stated = lens.zoom.stated_focal_length
         said = f"; the source labels it {stated[0]:g}-{stated[-1]:g} mm" if stated else ""
         raise InputError(f"{f:g} mm is outside the zoom range of {lens.name!r}: {lo:.2f} to {hi:.2f} mm (paraxial "

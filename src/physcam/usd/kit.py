@@ -24,7 +24,11 @@ from ..export._codetext import printable_line
 from ..lens.prescription import takes_prescription
 from .author import (LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec, author_camera, author_prescription, author_render_camera,
                      new_stage, save_stage)
+from .float32_values import _same_value, _same_view, _shown_value
+from .keyed_lens import (_author_samples, _keyed_time_codes, _refuse_samples_not_followed, _samples_solved,
+                         _stale_samples, _still_time, time_code_text)
 from .read import companion_inputs, companion_inputs_hash, composed_prescription
+from .solved_lens import _lens_derived_values, _lens_solved
 from .plugin import ensure_registered
 
 __all__ = [
@@ -247,24 +251,26 @@ def _read_spec(stage, path):
     return read_camera(stage, path).spec
 
 
-def _author_shot_companion(stage, path) -> str:
+def _author_shot_companion(stage, path, time: float | None = None) -> str:
     """(Re)compute the shot's companion UsdGeomCamera from the composed camera; return the inputs hash.
 
     With a prescription the lens is re-evaluated at the composed focus and f-stop on the composed
     (body's) sensor; its derived lens values are written as shot opinions and its distortion is
     fitted for that sensor. The hash of every input (:func:`companion_inputs_hash`) is stored
-    as ``customData physcam:companionInputs`` on the companion, for :func:`check_shot`.
+    as ``customData physcam:companionInputs`` on the companion, for :func:`check_shot`. ``time``: the
+    time code whose values a keyed lens without default values gives its still part (:func:`_still_time`).
     """
     from pxr import Sdf
 
     from .author import _eye_from_film, author_anamorphic_distortion, iris_mm
 
-    spec, rx, report, derived = _lens_solved(stage, path)
+    spec, rx, report, derived = _lens_solved(stage, path, time)
     cam = stage.GetPrimAtPath(path)
     distortion, opencv, anamorphic = None, None, []
     if derived is not None:
         _author_lens_derived(stage, cam, derived)
-        _author_model_focal_length(stage, cam, derived.focal_length_mm)
+        if time is None:  # else the model's focal length is keyed, with no default to give it
+            _author_model_focal_length(stage, cam, derived.focal_length_mm)
         distortion = prescription_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm, focus_mm=spec.focus_mm)
         anamorphic = prescription_anamorphic_distortion(rx, spec.sensor_width_mm, spec.sensor_height_mm,
                                                         focus_mm=spec.focus_mm)
@@ -284,40 +290,9 @@ def _author_shot_companion(stage, path) -> str:
 
         # usd write's account of the thin lens against the real one, at the stop and focus now authored
         geom.GetPrim().SetCustomDataByKey("physcam:thinLensGap", _usd_dict(thin_lens_gap(report).to_dict()))
-    digest = companion_inputs(stage, path)
+    digest = companion_inputs(stage, path, time=time)
     geom.GetPrim().SetCustomDataByKey("physcam:companionInputs", digest)
     return digest
-
-
-def _lens_solved(stage, path, time: float | None = None):
-    """(spec, prescription, report, derived): the composed camera at time code ``time`` (default: its default
-    values) as a refresh computes the companion from it. With a stored prescription the lens is solved again at
-    that focus and f-stop (``report``; ``derived``, :func:`~physcam.usd.author.spec_from_report` of it, holds
-    the lens values a refresh writes) and ``spec`` carries them; a thin lens's iris is f / N (``report`` and
-    ``derived`` None)."""
-    from .author import spec_from_report
-    from .read import read_camera
-
-    spec = read_camera(stage, path, time=time).spec
-    rx = composed_prescription(stage, path)
-    if rx is None or spec.projection != "perspective":
-        if spec.pinhole_focal_length_mm is None:  # no lens solved at a focus (a thin lens): the iris is f / N
-            spec = spec.replaced(fstop_at_focus=None)
-        return spec, rx, None, None
-    from ..onset.report import report_camera, solve_report
-    from ..optics.sensors import Sensor
-
-    sensor = Sensor(key="custom", name=spec.sensor_name or f"{spec.sensor_width_mm:g} x {spec.sensor_height_mm:g} mm",
-                    width_mm=spec.sensor_width_mm, height_mm=spec.sensor_height_mm)
-    report = solve_report(report_camera(focal_length_mm=None, sensor=sensor, fstop=spec.fstop, focus_mm=spec.focus_mm,
-                                        coc=spec.coc_mm, lens=rx))
-    derived = spec_from_report(report)
-    spec = spec.replaced(focal_length_mm=derived.focal_length_mm, entrance_pupil_mm=derived.entrance_pupil_mm,
-                         principal_planes_mm=derived.principal_planes_mm,
-                         pinhole_focal_length_mm=derived.pinhole_focal_length_mm,
-                         pinhole_squeeze=derived.pinhole_squeeze, squeeze=derived.squeeze,
-                         fstop_at_focus=derived.fstop_at_focus)
-    return spec, rx, report, derived
 
 
 def _move_film_behind_pupil(cam, pupil_mm: float) -> None:
@@ -341,26 +316,6 @@ def _author_model_focal_length(stage, cam, efl_mm: float) -> None:
         attr = model.GetAttribute("focalLength")
         if not _same_value(attr.Get(), float(efl_mm)):  # no shot opinion where the lens file says it already
             attr.Set(float(efl_mm))
-
-
-#: the lens attributes a refresh derives from a stored prescription (:func:`_lens_derived_values`)
-_LENS_DERIVED = tuple(f"lens:{LENS_INSTANCE}:{n}" for n in (
-    "entrancePupilDistance", "iris", "pinholeFocalLength", "pinholeSqueeze", "horizontalEntrancePupilDistance",
-    "apertureDistance", "frontPrincipalPlaneDistance", "rearPrincipalPlaneDistance"))
-
-
-def _lens_derived_values(spec) -> dict:
-    """Lens attribute -> value a prescription gives at the focus (``spec``: spec_from_report of its report);
-    values the lens does not have (a second pupil, an unknown stop) are left out."""
-    lp = f"lens:{LENS_INSTANCE}:"
-    values = {lp + "entrancePupilDistance": spec.entrance_pupil_mm, lp + "iris": spec.focal_length_mm / spec.fstop,
-              lp + "pinholeFocalLength": spec.pinhole_focal_length_mm, lp + "pinholeSqueeze": spec.pinhole_squeeze,
-              lp + "horizontalEntrancePupilDistance": spec.horizontal_entrance_pupil_mm,
-              lp + "apertureDistance": spec.aperture_distance_mm}  # the stop moves with a unit-focusing lens
-    if spec.principal_planes_mm is not None:
-        values[lp + "frontPrincipalPlaneDistance"] = spec.principal_planes_mm[0]
-        values[lp + "rearPrincipalPlaneDistance"] = spec.principal_planes_mm[1]
-    return {name: float(v) for name, v in values.items() if v is not None}
 
 
 def _author_lens_derived(stage, cam, spec) -> None:
@@ -387,6 +342,12 @@ def check_shot(file, path: str | None = None) -> dict:
     or carries no stored hash. ``units`` lists referenced files whose metersPerUnit differs from
     the shot's (composed correctly by :func:`write_shot`, worth knowing).
     """
+    return _checked(file, path, "check")
+
+
+def _checked(file, path, action: str) -> dict:
+    """:func:`check_shot`'s answer; ``action`` the command the user ran (check, or refresh, which checks first),
+    which its errors name."""
     from pxr import Sdf, UsdGeom
 
     from .read import only_camera, open_stage
@@ -394,14 +355,13 @@ def check_shot(file, path: str | None = None) -> dict:
     stage = open_stage(file)
     stage.Reload()  # the referenced files as they are on disk now, not as this process cached them
     if path is None:
-        path = only_camera(stage, "check")  # its error names the file
-    times = _refuse_what_cannot_be_followed(stage, path, file, "check")
+        path = only_camera(stage, action)  # its error names the file
+    times = _refuse_what_cannot_be_followed(stage, path, file, action)
     geom = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera"))
     if not geom:
         raise ExportError(f"{path}: has no companion camera to check")
-    samples = _stale_samples(stage, path, _samples_solved(stage, path, file, "check", times)) if times else []
-    still = not times or _has_default_lens(stage, stage.GetPrimAtPath(path))
-    current = companion_inputs(stage, path) if still else None
+    samples = _stale_samples(stage, path, _samples_solved(stage, path, file, action, times)) if times else []
+    current = companion_inputs(stage, path, time=_still_time(stage, path, times))
     stored = geom.GetCustomDataByKey("physcam:companionInputs")
     mpu = UsdGeom.GetStageMetersPerUnit(stage)
     units = []
@@ -412,13 +372,13 @@ def check_shot(file, path: str | None = None) -> dict:
         if lm is not None and float(lm) != mpu:
             units.append({"file": ref_layer.identifier, "meters_per_unit": float(lm)})
     reasons = []
-    if still and stored != current:
+    if stored != current:
         reasons.append("the companion carries no inputs hash (written by hand or by an older physcam)" if stored is None
                        else "the camera's composed values (its body, lens or shot opinions) changed since the companion "
                             "was computed")
     if samples:
         first = samples[0]
-        reasons.append(f"{len(samples)} of its time codes are stale (first {first['time']:g}: "
+        reasons.append(f"{len(samples)} of its time codes {'is' if len(samples) == 1 else 'are'} stale (first {time_code_text(first['time'])}: "
                        f"{', '.join(first['attributes'])})")
     return {"path": path, "stale": bool(reasons), "stored": stored, "current": current,
             "meters_per_unit": mpu, "units": units, "reason": "; ".join(reasons) or None,
@@ -426,21 +386,24 @@ def check_shot(file, path: str | None = None) -> dict:
 
 
 def _refuse_what_cannot_be_followed(stage, path, file, action: str) -> list[float]:
-    """The camera's keyed time codes (:func:`_keyed_time_codes`) after the refusals: a still lens with other
-    time samples (:func:`_refuse_time_samples`), an animated one with samples check and refresh cannot follow
-    (:func:`_refuse_unkeyable_samples`)."""
-    _refuse_no_prim(stage, path, file)
+    """The camera's keyed time codes (:func:`_keyed_time_codes`) after the refusals: not a camera
+    (:func:`_refuse_not_a_camera`), samples check and refresh cannot follow (:func:`_refuse_samples_not_followed`)."""
+    _refuse_not_a_camera(stage, path, file)
     times = _keyed_time_codes(stage, path)
-    if times:
-        _refuse_unkeyable_samples(stage, path, file, action)
-    else:
-        _refuse_time_samples(stage, path, file, action)
+    _refuse_samples_not_followed(stage, path, file, action, times)
     return times
 
 
-def _refuse_no_prim(stage, path, file) -> None:
-    if not stage.GetPrimAtPath(str(path)):
+def _refuse_not_a_camera(stage, path, file) -> None:
+    """ExportError naming the file when ``path`` holds no prim or one that is not a PhysicalCamera (checked before
+    its attributes, whose time samples would be named otherwise)."""
+    from pxr import Usd
+
+    prim = stage.GetPrimAtPath(str(path))
+    if not prim:
         raise ExportError(f"{file}: no prim at {path}")
+    if not prim.IsA(Usd.SchemaRegistry.GetTypeFromSchemaTypeName("PhysicalCamera")):
+        raise ExportError(f"{file}: {path} is a {prim.GetTypeName() or 'typeless prim'}, not a PhysicalCamera")
 
 
 def refresh_shot(file, path: str | None = None) -> dict:
@@ -470,229 +433,24 @@ def refresh_shot(file, path: str | None = None) -> dict:
     if path is None:
         path = only_camera(stage, "refresh")  # its error names the file
     times = _refuse_what_cannot_be_followed(stage, path, file, "refresh")
-    if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):  # else there is no companion yet: write it
-        now = check_shot(file, path)
+    now = None  # no companion yet: write it
+    if stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")):
+        now = _checked(file, path, "refresh")
         if not now["stale"]:
             return dict(now, written=False, changed=[])
     _refuse_lens_not_stored(stage, path, file)
     layer = stage.GetRootLayer()
     changed = []
-    if not times or _has_default_lens(stage, stage.GetPrimAtPath(path)):  # the still camera, its default values
-        before = _authored_values(layer, path)
+    if now is None or now["stored"] != now["current"]:  # the still camera (its default values) is stale
+        before, root = _composed_values(stage, path), _authored_values(layer, path)
         notes = _companion_notes(stage, path)
-        _author_shot_companion(stage, path)
-        changed = _keep_equal_values(layer, before, _authored_values(layer, path), path)
+        _author_shot_companion(stage, path, _still_time(stage, path, times))
+        changed = _keep_equal_values(layer, before, _composed_values(stage, path), path, root)
         _keep_equal_notes(stage, path, notes)
     if times:  # a keyed lens: sample by sample
         changed += _author_samples(stage, path, file, times)
     save_stage(stage, file, force=True)
     return dict(check_shot(file, path), written=True, changed=changed)
-
-
-#: the attributes named first when a camera is animated: the inputs an animation samples (usd animate)
-_ANIMATED_FIRST = ("focusDistance", f"lens:{LENS_INSTANCE}:fStop", "focalLength")
-
-
-def _refuse_time_samples(stage, path, file, action: str) -> None:
-    """ExportError naming the file and an animated attribute when the camera at ``path`` (or its lens model or
-    companion) has time samples: check and refresh compare and recompute one still camera (its default
-    values), and an animation's per-frame lens (``usd animate``) is not stored in the file to solve again.
-    A moving camera (time-sampled ``xformOp:*``, a layout's move) is still: its placement is not an input."""
-    cam = stage.GetPrimAtPath(str(path))
-    if not cam:
-        raise ExportError(f"{file}: no prim at {path}")
-    sampled = [(p, a) for p in (cam, *cam.GetChildren()) for a in p.GetAttributes()
-               if a.GetNumTimeSamples() and not a.GetName().startswith("xformOp")]
-    if not sampled:
-        return
-    sampled.sort(key=lambda pa: (pa[1].GetName() not in _ANIMATED_FIRST, pa[0] != cam, str(pa[0].GetPath())))
-    prim, attr = sampled[0]
-    raise ExportError(f"{file}: {prim.GetPath()}.{attr.GetName()} is animated ({attr.GetNumTimeSamples()} time "
-                      f"samples): usd {action} handles a still camera only; write the animation again with "
-                      f"`physcam usd animate {file} --marks CSV ... --force`")
-
-
-def _lens_model(stage, cam):
-    rel = cam.GetRelationship(f"lens:{LENS_INSTANCE}:lensModel")
-    targets = rel.GetForwardedTargets() if rel else []
-    model = stage.GetPrimAtPath(targets[0]) if targets else None
-    return model if model else None
-
-
-def _keyed_inputs(stage, cam) -> list:
-    """The attributes an animation keys (:data:`_ANIMATED_FIRST`): the lens model's focus and focal length,
-    the lens's f-stop."""
-    model = _lens_model(stage, cam)
-    attrs = [cam.GetAttribute(f"lens:{LENS_INSTANCE}:fStop")]
-    if model is not None:
-        attrs += [model.GetAttribute("focusDistance"), model.GetAttribute("focalLength")]
-    return [a for a in attrs if a]
-
-
-def _keyed_time_codes(stage, path) -> list[float]:
-    """The time codes of the camera at ``path``'s keyed lens (every time sample of its focus distance,
-    f-stop and focal length), in order; [] for a still lens (a camera that only moves included)."""
-    cam = stage.GetPrimAtPath(str(path))
-    if not cam:
-        raise ExportError(f"no prim at {path}")
-    return sorted({float(t) for a in _keyed_inputs(stage, cam) for t in a.GetTimeSamples()})
-
-
-def _has_default_lens(stage, cam) -> bool:
-    """Whether every keyed input also has an authored default value (the still camera a check hashes)."""
-    from pxr import Usd
-
-    return all(a.GetResolveInfo(Usd.TimeCode.Default()).GetSource() == Usd.ResolveInfoSourceDefault
-               for a in _keyed_inputs(stage, cam))
-
-
-def _sampled_derived(stage, path, time: float) -> dict:
-    """Attribute path -> the value a refresh authors at time code ``time`` of an animated camera: the lens
-    values a stored prescription gives there (the pinhole model's ``focalLength`` the EFL), the iris, and
-    the companion's :data:`~physcam.usd.author.SAMPLED_RENDER_ATTRIBUTES` (``usd animate``'s per frame)."""
-    from pxr import Sdf, UsdGeom
-
-    from .author import iris_mm, sampled_render_values
-
-    spec, _rx, report, derived = _lens_solved(stage, path, time)
-    cam = stage.GetPrimAtPath(path)
-    out = {}
-    if derived is not None:
-        out.update({f"{path}.{n}": v for n, v in _lens_derived_values(derived).items()})
-        model = _lens_model(stage, cam)
-        if model is not None and model.GetTypeName() == "PhysicalCameraLensModelPinhole":
-            out[f"{model.GetPath()}.focalLength"] = float(derived.focal_length_mm)
-    out[f"{path}.lens:{LENS_INSTANCE}:iris"] = iris_mm(spec)
-    if cam.GetAttribute("iris") and cam.GetAttribute("iris").HasAuthoredValue():  # the body's, as usd animate keys it
-        out[f"{path}.iris"] = iris_mm(spec)
-    stage_ = cam.GetStage()
-    values, _eye = sampled_render_values(spec, report, UsdGeom.GetStageMetersPerUnit(stage_),
-                                         stage_.GetTimeCodesPerSecond(), where=path)
-    geom = Sdf.Path(path).AppendChild("Camera")
-    out.update({f"{geom}.{n}": v for n, v in values.items()})
-    return out
-
-
-def _samples_solved(stage, path, file, action: str, times) -> dict:
-    """Time code -> :func:`_sampled_derived` for each of ``times``; an ExportError naming the file, the camera
-    and the time code of a sample whose lens cannot be solved (a focus inside the lens's close focus, ...)."""
-    from ..errors import PhysCamError
-
-    out = {}
-    for t in times:
-        try:
-            out[t] = _sampled_derived(stage, path, t)
-        except PhysCamError as e:
-            raise ExportError(f"{file}: {path} at time code {t:g}: {e}; usd {action} cannot solve this sample") \
-                from None
-    return out
-
-
-def _derived_names(stage, path) -> set:
-    """The attribute paths :func:`_sampled_derived` gives values of (some may be left out for a lens without
-    them: a second pupil, an unknown stop)."""
-    from pxr import Sdf
-
-    from .author import SAMPLED_RENDER_ATTRIBUTES
-
-    cam = stage.GetPrimAtPath(str(path))
-    out = {f"{path}.lens:{LENS_INSTANCE}:iris", f"{path}.iris"}
-    out |= {f"{Sdf.Path(path).AppendChild('Camera')}.{n}" for n in SAMPLED_RENDER_ATTRIBUTES}
-    if composed_prescription(stage, path) is not None:
-        out |= {f"{path}.{n}" for n in _LENS_DERIVED}
-        model = _lens_model(stage, cam)
-        if model is not None:
-            out.add(f"{model.GetPath()}.focalLength")
-    return out
-
-
-def _refuse_unkeyable_samples(stage, path, file, action: str) -> None:
-    """ExportError naming the file and an attribute of an animated camera that check and refresh cannot follow
-    sample by sample: a time-sampled attribute that is neither a keyed input (focus, f-stop, focal length), a
-    thin lens's pupil or stop (read at each time code), nor one the refresh derives (:func:`_derived_names`); and a lens
-    solved from a real lens the file does not store (``usd animate --lens`` samples its pupils and pinhole but
-    keeps no prescription to solve them again)."""
-    cam = stage.GetPrimAtPath(str(path))
-    keyed = {str(a.GetPath()) for a in _keyed_inputs(stage, cam)}
-    derived = _derived_names(stage, path)
-    lp = f"lens:{LENS_INSTANCE}:"
-    stored = composed_prescription(stage, path) is not None
-    read_at_time = set() if stored else {f"{path}.{lp}entrancePupilDistance", f"{path}.{lp}apertureDistance"}
-    for prim in (cam, *cam.GetChildren()):
-        for a in prim.GetAttributes():
-            name = str(a.GetPath())
-            if not a.GetNumTimeSamples() or name in keyed | derived | read_at_time:
-                continue
-            if prim == cam and a.GetName().startswith("xformOp"):
-                continue  # the layout's move: not an input of the lens
-            if not stored and a.GetName() in _LENS_DERIVED:
-                raise ExportError(f"{file}: {name} is animated from a real lens that the file does not store "
-                                  f"(usd animate --lens): usd {action} cannot solve it again; write the animation "
-                                  f"again with `physcam usd animate {file} --marks CSV ... --force`")
-            n = a.GetNumTimeSamples()
-            raise ExportError(f"{file}: {name} is animated ({n} time sample{'s' * (n != 1)}): usd {action} follows "
-                              "a keyed focus, f-stop and focal length sample by sample, not this attribute")
-
-
-def _stale_samples(stage, path, expected: dict) -> list[dict]:
-    """``[{"time", "attributes"}]`` of each time code where an attribute of ``expected`` (time code ->
-    :func:`_sampled_derived`) differs from the file at float32 precision (the companion's field of view:
-    :func:`_same_view`), or where a derived attribute holds a sample at a time code no input is keyed at."""
-    from pxr import Sdf
-
-    geom = str(Sdf.Path(path).AppendChild("Camera"))
-    out = []
-    names = sorted({n for values in expected.values() for n in values})
-    for t, values in expected.items():
-        now = {n: stage.GetAttributeAtPath(Sdf.Path(n)).Get(t) for n in values}
-        bad = [n for n in sorted(values) if now[n] is None or not _same_value(now[n], values[n])]
-        if _same_view(now, values, geom):
-            bad = [n for n in bad if n not in {f"{geom}.{v}" for v in ("focalLength", "horizontalAperture",
-                                                                       "verticalAperture")}]
-        if bad:
-            out.append({"time": t, "attributes": bad})
-    extra = {}
-    for n in names:
-        for t in stage.GetAttributeAtPath(Sdf.Path(n)).GetTimeSamples():
-            if float(t) not in expected:
-                extra.setdefault(float(t), []).append(n)
-    out += [{"time": t, "attributes": extra[t]} for t in sorted(extra)]
-    return sorted(out, key=lambda d: d["time"])
-
-
-def _author_samples(stage, path, file, times) -> list[dict]:
-    """Rewrite, at every keyed time code, each derived attribute stale at one of them (:func:`_stale_samples`;
-    an attribute that is sampled at all is sampled at every keyed time code, and its samples at other time
-    codes go); a sample equal to the recomputed value at float32 precision keeps the file's digits. Returns the
-    changes as the refresh reports them, each with its ``time``."""
-    from pxr import Sdf
-
-    expected = _samples_solved(stage, path, file, "refresh", times)
-    names = {n for d in _stale_samples(stage, path, expected) for n in d["attributes"]}
-    geom = str(Sdf.Path(path).AppendChild("Camera"))
-    view = {f"{geom}.{v}" for v in ("focalLength", "horizontalAperture", "verticalAperture")}
-    names = sorted(names | view if names & view else names)  # one field of view: its three values together
-    attrs = {n: stage.GetAttributeAtPath(Sdf.Path(n)) for n in names}
-    had = {n: {float(t) for t in a.GetTimeSamples()} for n, a in attrs.items()}
-    olds = {t: {n: a.Get(t) for n, a in attrs.items()} for t in times}  # all read before any is written
-    changed = []
-    for t in times:
-        old = olds[t]
-        keep = {n for n in names if t in had[n] and _same_value(old[n], expected[t].get(n))}
-        if view <= attrs.keys() and all(t in had[n] for n in view) and _same_view(old, expected[t], geom):
-            keep |= view
-        for n in names:
-            new = expected[t].get(n)
-            if new is None or n in keep:
-                continue
-            attrs[n].Set(new, t)
-            if old[n] is None or not _same_value(old[n], new):
-                changed.append({"attribute": n, "time": t, "before": _shown_value(old[n]), "after": _shown_value(new)})
-    for n in names:
-        for t in sorted(had[n] - set(times)):
-            changed.append({"attribute": n, "time": t, "before": _shown_value(attrs[n].Get(t)), "after": None})
-            attrs[n].ClearAtTime(t)
-    return sorted(changed, key=lambda c: (c["attribute"], c["time"]))
 
 
 def _refuse_lens_not_stored(stage, path, file) -> None:
@@ -756,52 +514,39 @@ def _authored_values(layer, path) -> dict:
     return out
 
 
-def _numbers(v):
-    """The numbers of a scalar, vector or array value, or None for any other value."""
-    if isinstance(v, bool):
-        return None
-    if isinstance(v, (int, float)):
-        return [float(v)]
-    try:
-        out = [float(x) for x in v]
-    except (TypeError, ValueError):
-        return None
-    return None if isinstance(v, str) else out
+def _composed_values(stage, path) -> dict:
+    """Attribute path -> its composed default value, of every attribute at or below ``path`` whose value comes
+    from an authored default (in any layer: a shot's sublayers and references included)."""
+    from pxr import Usd
+
+    out = {}
+    for prim in Usd.PrimRange(stage.GetPrimAtPath(str(path))):
+        for a in prim.GetAttributes():
+            if a.GetResolveInfo(Usd.TimeCode.Default()).GetSource() == Usd.ResolveInfoSourceDefault:
+                out[str(a.GetPath())] = a.Get()
+    return out
 
 
-#: two values computed from one camera's 32-bit attributes are the same when they differ by at most
-#: this much relative: two float32 rounding steps (2 x 2^-23), the round trip's, not a change
-_F32_SAME = 2.0 ** -22
+def _restore_root_default(layer, name: str, old) -> None:
+    """Give the root layer back its default value ``old`` of the attribute ``name``; ``old`` None: the root layer
+    had none (the value came from another layer), so the refresh's opinion goes, and its spec if nothing else
+    is left on it."""
+    spec = layer.GetAttributeAtPath(name)
+    if not spec:
+        return
+    if old is not None:
+        if spec.default != old:
+            spec.default = old
+    elif spec.HasDefaultValue():
+        spec.ClearDefaultValue()
+        layer.RemovePropertyIfHasOnlyRequiredFields(spec)
 
 
-def _same_value(a, b) -> bool:
-    """Whether ``a`` and ``b`` (attribute values) are equal at float32 precision (:data:`_F32_SAME`)."""
-    x, y = _numbers(a), _numbers(b)
-    if x is None or y is None:
-        return a == b
-    return len(x) == len(y) and all(abs(p - q) <= _F32_SAME * max(abs(p), abs(q)) for p, q in zip(x, y))
-
-
-def _same_view(old: dict, new: dict, geom: str) -> bool:
-    """Whether the companion's (focalLength, horizontalAperture, verticalAperture) before and after give
-    one field of view: the aperture / focal length ratios equal at float32 precision and the focal
-    lengths within 49 float32 steps (each pick of fov_preserving_float32 lies within 24 of its exact
-    focal length, and the two exact ones, a double and its float32 read back, within one)."""
-    import numpy as np
-
-    names = [f"{geom}.{n}" for n in ("focalLength", "horizontalAperture", "verticalAperture")]
-    if not all(n in old and n in new for n in names):
-        return False
-    (f0, w0, h0), (f1, w1, h1) = ([float(d[n]) for n in names] for d in (old, new))
-    if min(f0, f1) <= 0.0:
-        return False
-    steps = abs(f0 - f1) / float(np.spacing(np.float32(max(f0, f1))))
-    return steps <= 49 and _same_value([w0 / f0, h0 / f0], [w1 / f1, h1 / f1])
-
-
-def _keep_equal_values(layer, before: dict, after: dict, path) -> list[dict]:
+def _keep_equal_values(layer, before: dict, after: dict, path, root: dict) -> list[dict]:
     """Give back the file's value to every recomputed attribute equal to it (:func:`_same_value`,
-    :func:`_same_view`); return the changes left, as the refresh reports them."""
+    :func:`_same_view`; ``before`` and ``after`` the composed values, :func:`_composed_values`; ``root`` the root
+    layer's before, :func:`_authored_values`, which a kept attribute is restored to); return the changes left, as
+    the refresh reports them."""
     from pxr import Sdf
 
     geom = str(Sdf.Path(path).AppendChild("Camera"))
@@ -811,21 +556,12 @@ def _keep_equal_values(layer, before: dict, after: dict, path) -> list[dict]:
     changed = []
     for name in sorted(set(before) | set(after)):
         if name in keep:
-            if after[name] != before[name]:
-                layer.GetAttributeAtPath(name).default = before[name]
+            _restore_root_default(layer, name, root.get(name))
             continue
         old, new = before.get(name), after.get(name)
         if old is None or new is None or old != new:
             changed.append({"attribute": name, "before": _shown_value(old), "after": _shown_value(new)})
     return changed
-
-
-def _shown_value(v):
-    """An attribute value as JSON: numbers, lists of numbers, text; None for none."""
-    if v is None or isinstance(v, (bool, int, float, str)):
-        return v
-    nums = _numbers(v)
-    return nums if nums is not None else str(v)
 
 
 def _shot_attributes(spec, su):

@@ -353,7 +353,8 @@ def companion_inputs_hash(spec, prescription=None) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def companion_inputs(stage, path) -> str:
+def companion_inputs(stage, path, *, time: float | None = None) -> str:
     """The hash of what the companion of the PhysicalCamera ``path`` is computed from, as the stage
-    composes now (read back, so float32 storage is what is hashed)."""
-    return companion_inputs_hash(read_camera(stage, path).spec, composed_prescription(stage, path))
+    composes now (read back, so float32 storage is what is hashed), at time code ``time`` (default: its
+    default values; a keyed lens with no default value, a DCC's samples only: its first time code)."""
+    return companion_inputs_hash(read_camera(stage, path, time=time).spec, composed_prescription(stage, path))

@@ -17,11 +17,15 @@ import numpy as np
 
 from ...errors import InputError
 
-__all__ = ["FEATURES", "template_text", "render_template", "lens_data", "osl_number", "osl_array"]
+__all__ = ["FEATURES", "SPHERE_KIND", "template_text", "render_template", "lens_data", "osl_number", "osl_array"]
 
 #: The template's feature switches: a data block that defines one keeps that code, else it goes.
 FEATURES = ("PHYSCAM_FOCUS_TABLE", "HAS_ASPHERE", "PHYSCAM_DISPERSION", "PHYSCAM_FRESNEL", "PHYSCAM_APERTURE",
             "PHYSCAM_POLYGON", "PHYSCAM_GHOSTS", "PHYSCAM_PUPIL_ORIGIN", "PHYSCAM_RADIAL_PUPIL", "PHYSCAM_SP", "PHYSCAM_ZOOM")
+#: The shader's kind of a sphere: the tracer's quadric (kind 2) with AX = AY = AZ. Its gradient at a
+#: point of the surface is a unit vector and a unit direction meets it with A = AX, so the shader skips
+#: a normalisation and five products per sphere (docs/performance.md, Blender render, round 10).
+SPHERE_KIND = 4
 #: Wavelengths sampled per ray when dispersion is on (uniform).
 WAVELENGTH_RANGE_NM = (400.0, 700.0)
 
@@ -47,6 +51,14 @@ def osl_array(name: str, values, size: str, kind: str = "float") -> str:
     else:
         vals = ", ".join(osl_number(v) for v in np.asarray(values, dtype=float).ravel())
     return f"    {kind} {name}[{size}] = {{{vals}}};"
+
+
+def _osl_kinds(table) -> np.ndarray:
+    """The shader's surface kinds: physcam's tracer's (0 plane, 1 stop, 2 quadric, 3 asphere), a quadric
+    whose three coefficients are equal (a sphere) marked :data:`SPHERE_KIND`."""
+    kinds = np.asarray(table.kind).copy()
+    kinds[(kinds == 2) & (table.ax == table.ay) & (table.ay == table.az)] = SPHERE_KIND
+    return kinds
 
 
 def _resolve(lines: list[str], on: set[str]) -> list[str]:
@@ -109,13 +121,13 @@ def lens_data(table, aperture, wavelength_nm: float, bounds, *, dispersion: bool
     require_type("table", table, SurfaceTable, "physcam.trace.surfaces.surface_table(lens)")
 
     n = len(table)
-    S, kinds = pack(table)
+    S, _ = pack(table)
     defines = [f"#define N_SURF {n}", f"#define STOP_ROW {int(np.flatnonzero(table.kind == 1)[0])}"]
     if bounds is not None:  # the exit-pupil rectangles' grid (a radial pupil table has none)
         nx, ny = len(bounds.xs), len(bounds.ys)
         defines += [f"#define N_BX {nx}", f"#define N_BY {ny}", f"#define N_RECT {nx * ny * 4}"]
     defines += [f"#define N_ASPH {n * 7}  // OSL array sizes must be plain integer literals", f"#define N_DISP {n * 9}"]
-    data = [osl_array("KIND", kinds, "N_SURF", "int")]
+    data = [osl_array("KIND", _osl_kinds(table), "N_SURF", "int")]
     for name, col in (("AX", table.ax), ("AY", table.ay), ("AZ", table.az), ("CV", table.curvature),
                       ("CK", table.conic)):
         data.append(osl_array(name, col, "N_SURF"))
