@@ -238,10 +238,10 @@ class FocusTable:
     film_z: np.ndarray  # (n,) film plane z, lens space
     film_slope: np.ndarray  # (n,) d film_z / d index at each state (the shader's cubic Hermite)
     vertex_z: np.ndarray  # (n, surfaces)
-    radial: np.ndarray | None  # (n, N_LEVEL, N_RADIAL, 3) pupil ellipses (blender_pupil); None: anamorphic
+    radial: np.ndarray | None  # (n, len(levels), N_RADIAL, 5) pupil ellipses and areas (blender_pupil); None: anamorphic
     rects: np.ndarray | None  # (n, ny, nx, 4) exit-pupil rectangles at the widest iris (anamorphic only)
     rects_stopped: np.ndarray | None  # (n, len(STOP_LEVELS), ny, nx, 4): the same stopped to each level
-    norm: np.ndarray  # (n, N_LEVEL) mean weight at the film centre, the round iris at each of iris_levels(semi_max)
+    norm: np.ndarray  # (n, len(levels)) mean weight at the film centre, the round iris at each of levels
     table: object  # SurfaceTable at infinity (the rows that do not move)
     bounds: object  # PupilBounds at infinity (the 2-D grid; anamorphic only, else None)
     iris_k: float  # iris semi-diameter x f-number (mm)
@@ -254,6 +254,9 @@ class FocusTable:
     #: a zoom lens's zoom axis (:class:`physcam.export.blender_zoom.ZoomGrid`): the arrays above then
     #: hold zoom x focus blocks (:func:`physcam.export.blender_zoom.zoom_focus_table`); None: a lens without zoom
     zoom: object = None
+    #: the iris radii (mm) of the pupil and normalisation tables when not :func:`~physcam.export.blender_pupil.iris_levels`'
+    #: (:func:`focus_table` adds levels where the area's interpolation misses: blender_pupil._refined_levels)
+    iris_radii: np.ndarray | None = None
 
     @property
     def marks_mm(self) -> np.ndarray:
@@ -272,6 +275,8 @@ class FocusTable:
 
         if self.zoom is not None:
             return self.zoom.levels
+        if self.iris_radii is not None:
+            return self.iris_radii
         return iris_levels(self.semi_max, self.iris_k / self.fstop_open)
 
 
@@ -328,7 +333,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
     from ..trace.camera_tracer import CameraTracer
-    from .blender_pupil import _centre_ellipses, iris_levels, radial_pupil_table
+    from .blender_pupil import _assembled, _centre_ellipses, _refined_levels, iris_levels, radial_pupil_table
 
     axis = focus_axis(closest_focus(lens), n_focus)
     states = []
@@ -343,18 +348,23 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     if FIRST_INTERVAL_MIDDLE and not lens.is_anamorphic and traced[1] > 2:  # the first interval's middle too
         traced = np.unique(np.append(traced, traced[1] // 2))
     radial, rects, stopped, norm, checks = [], [], [], [], []
-    for i in traced.tolist():
-        st = states[i]
-        tracer = CameraTracer(st.prescription, st.film_z)  # the lens at this focus state as the file stops it
+    tracers = [CameraTracer(states[i].prescription, states[i].film_z) for i in traced.tolist()]  # as the file stops it
+    if not lens.is_anamorphic:
+        radial, sets = zip(*(radial_pupil_table(t.lens, t.film_z, levels, checks=checks, finer=True) for t in tracers))
+        refined = _refined_levels(levels, radial, checks)
+        if len(refined) > len(levels):  # a level between two whose cubic misses a traced mark's area: every table
+            levels, checks = refined, []  # at the levels with it, from the sets already traced
+            radial = [_assembled(t, levels, checks) for t in sets]
+    for i, tracer in zip(traced.tolist(), tracers):
         if lens.is_anamorphic:
             b, rect, rect_levels = _rect_tables(tracer, levels[0], grid_half_mm)
             rects.append(rect)
             stopped.append(rect_levels)
             norm.append(_centre_norms(tracer, [np.array(b.rect_at(0.0, 0.0))] * len(levels), levels))
         else:
-            radial.append(radial_pupil_table(tracer.lens, st.film_z, levels, checks=checks))
-            b = _centre_bounds(tracer.lens, radial[-1][0, 0])
-            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(radial[-1])], levels))
+            tab = radial[len(norm)]
+            b = _centre_bounds(tracer.lens, tab[0, 0])
+            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(tab)], levels))
         if i == 0:
             table0, bounds0 = tracer.film_side_table, (b if lens.is_anamorphic else None)
             loss = tracer.centre_weight(b, samples=64, fresnel=True) / tracer.centre_weight(b, samples=64)
@@ -363,7 +373,8 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     radial, rects, stopped, norm = fill_pupil_tables(traced, n_focus, radial=radial, rects=rects, stopped=stopped,
                                                      norm=norm, checks=checks, levels=levels)
     return FocusTable(lens, axis, film_z, slope, vz, radial, rects, stopped,
-                      norm, table0, bounds0, float(k), float(n_open), float(n_min), axis.near_mm, float(loss))
+                      norm, table0, bounds0, float(k), float(n_open), float(n_min), axis.near_mm, float(loss),
+                      iris_radii=levels)
 
 
 def pupil_marks(n: int, stride: int) -> np.ndarray:
@@ -620,7 +631,7 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
     the frame's aspect), iris and ghosts are shader parameters (defaults from the keywords; ``fstop``
     0 is wide open). ``pupil_mm``: the entrance pupil's distance in front of the film at each focus
     state; given, the camera's origin is the entrance pupil (the film behind it), else the film plane."""
-    from .blender_pupil import N_LEVEL, N_RADIAL, RADIAL_MAX_MM
+    from .blender_pupil import N_RADIAL, RADIAL_MAX_MM
 
     require_type("ft", ft, FocusTable, "physcam.export.blender_focus.focus_table(lens)")
     n_focus = len(ft.marks_mm)
@@ -630,7 +641,7 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
     zoom = ft.zoom is not None
     n_states = len(ft.film_z)  # n_focus, or (zoom positions x n_focus) for a zoom lens
     defines += ["#define PHYSCAM_FOCUS_TABLE 1", "#define PHYSCAM_APERTURE 1", "#define PHYSCAM_POLYGON 1",
-                f"#define N_FOCUS {n_focus}", f"#define N_VZ_TAB {n_states * n}", f"#define N_IRIS {N_LEVEL}",
+                f"#define N_FOCUS {n_focus}", f"#define N_VZ_TAB {n_states * n}", f"#define N_IRIS {len(ft.levels)}",
                 f"#define N_NORM_TAB {ft.norm.size}", f"#define FOCUS_CLOSEST_M {_num32(ft.axis.closest_mm / 1000.0)}",
                 f"#define FOCUS_S_NEAR {_num32(ft.axis.s_near)}"]
     if not zoom:  # a zoom lens's iris rule changes along the zoom: _zoom_defines

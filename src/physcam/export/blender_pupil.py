@@ -36,8 +36,10 @@ edge it is the iris's image cut by the other elements (cat's eye), and 0.75-0.9 
 area (the shader then redraws missed aims) is read as a cubic in rho through four nodes
 (:func:`radial_cubic`) and in s through two levels' areas and slopes (:func:`hermite`), and trusted
 per cell where the mid checks agree (:func:`radial_pupil_table`): on the double Gauss focused at
-2.5 m, over 0.95 of a full frame's film radii at f/2.8 and all of them at f/5.6 and f/16 (issue 41;
-main's table, which never trusted a set other surfaces cut, about 0.3 at f/2.8).
+2.5 m, every film radius of a full frame at f/2.8, f/5.6 and f/16 (issue 41; round 9: 0.945 at f/2.8,
+where other surfaces begin to cut the set between two levels the cubic in s rounds the area's kink off,
+so the focus table adds a level there, :func:`_refined_levels`; round 7's table, which never trusted a
+set other surfaces cut, about 0.3).
 """
 
 from __future__ import annotations
@@ -239,12 +241,17 @@ def _rims(uses, edges, radii, wanted) -> "_RimSet":
     r0, r1 = np.array([u[1] for u in uses]), np.array([u[2] for u in uses])
     first = np.concatenate([[0], np.cumsum(r1 - r0)])  # each grid's first rim
 
+    # the wanted radii grid after grid (wanted_i), and per grid how many of them lie below each radius index
+    wanted = np.asarray(wanted, dtype=bool)
+    below = np.concatenate([np.zeros((wanted.shape[0], 1), dtype=np.int64), np.cumsum(wanted, axis=1)], axis=1)
+    below += np.concatenate([[0], np.cumsum(below[:-1, -1])])[:, None]
+    wanted_i = np.nonzero(wanted)[1]
+
     def expand(g, lo, hi):  # (rim index, radius index, which entry) of every entry's wanted radii in [lo, hi)
-        n = hi - lo
+        a = below[g, lo]
+        n = below[g, hi] - a
         e = np.repeat(np.arange(g.size), n)
-        i = lo[e] + np.arange(e.size) - np.repeat(np.cumsum(n) - n, n)
-        keep = wanted[g[e], i]
-        e, i = e[keep], i[keep]
+        i = wanted_i[a[e] + np.arange(e.size) - np.repeat(np.cumsum(n) - n, n)]
         return first[g[e]] + i - r0[g[e]], i, e
 
     small = np.int16 if max(int(first[-1]), radii.size) < 2**15 else np.int64
@@ -389,12 +396,11 @@ def _first_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, backen
     return boxes, grids
 
 
-def _passing_sets(q, film_z: float, fxs, radii, wanted, r_rear: float, big: float, backend: str) -> tuple:
-    """(index, rims): the rims of the passing sets (:class:`_RimSet`, :func:`_rims`) and per film
-    point (fx, 0) and iris radius in ``radii`` (descending) the index of its rim there, -1 where
-    nothing passes (or the rim is not ``wanted``: film points x radii). A point's grid zooms in on its
-    passing set once that has shrunk under :data:`_ZOOM` of the grid."""
-    radii = np.asarray(radii, dtype=float)
+def _passing_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, backend: str) -> tuple:
+    """(used, p, r0, r1, edges): the grids traced for film points (fx, 0) (:func:`_trace`), each with the
+    first and end index into the descending iris radii ``radii`` it serves, the film point it serves (p) and
+    those indices again as arrays, and their clip edges (:func:`_clip_edges`). A point's grid zooms in on
+    its passing set once that has shrunk under :data:`_ZOOM` of the grid."""
     boxes, grids = _first_grids(q, film_z, fxs, radii, r_rear, big, backend)
     start = [0] * len(fxs)  # the first radius each point's current grid serves
     uses = [[] for _ in fxs]  # per film point: (grid, the first and end index of the radii it serves)
@@ -414,16 +420,63 @@ def _passing_sets(q, film_z: float, fxs, radii, wanted, r_rear: float, big: floa
             grids[p], boxes[p] = g, zoom[p]
         pending = list(zoom)
     flat = [(p, use) for p, u in enumerate(uses) for use in u if use[2] > use[1]]
-    index = np.full((len(fxs), radii.size), -1)
     if not flat:
-        return index, _RimSet(np.zeros(0), np.zeros(0), np.zeros(1, dtype=int), np.zeros(0))
+        return [], np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0, dtype=int), None
     used = [use for _, use in flat]
     p, r0, r1 = (np.array(v) for v in zip(*((p, use[1], use[2]) for p, use in flat)))
-    rims = _rims(used, _clip_edges(q, film_z, used, radii, big, backend), radii, np.asarray(wanted)[p])
+    return used, p, r0, r1, _clip_edges(q, film_z, used, radii, big, backend)
+
+
+def _grid_rims(grids, radii, wanted, n_points: int) -> tuple:
+    """(index, rims): the rims (:class:`_RimSet`, :func:`_rims`) of the grids of :func:`_passing_grids`
+    (``grids``) at the ``wanted`` (film points x ``radii``) iris radii, and per film point and iris radius the
+    index of its rim there, -1 where nothing passes (or the rim is not wanted)."""
+    used, p, r0, r1, edges = grids
+    index = np.full((n_points, radii.size), -1)
+    if not used:
+        return index, _RimSet(np.zeros(0), np.zeros(0), np.zeros(1, dtype=int), np.zeros(0))
+    rims = _rims(used, edges, radii, np.asarray(wanted)[p])
     n = r1 - r0
     k = np.arange(int(n.sum()))  # the rims in their order: grid after grid, radius after radius
     index[np.repeat(p, n), np.repeat(r0 - (np.cumsum(n) - n), n) + k] = np.where(rims.cuts[k + 1] > rims.cuts[k], k, -1)
     return index, rims
+
+
+class _PassingSets:
+    """The passing sets of one focused lens's film points (the film radii of :func:`_check_axes`), traced
+    once at every iris radius a table at ``levels`` reads (with ``finer``: also at those of a table whose
+    levels add any of the geometric middles between them, :func:`_refined_levels`), their rims found as
+    tables ask for them (:meth:`table`): a radius more costs its rims, not a trace."""
+
+    def __init__(self, q, film_z: float, levels, backend: str, *, finer: bool = False):
+        levels = _levels(levels)
+        fine = np.sort(np.concatenate([levels, np.sqrt(levels[:-1] * levels[1:])]))[::-1] if finer else levels
+        rhos, checked = _check_axes(fine)
+        self.film_z, self.rhos = film_z, rhos
+        self.radii = np.unique(np.concatenate([checked, fine * (1 - _DS)]))[::-1]
+        self.big = 20.0 * max(levels[0], q.surfaces[q.stop_index].semi_diameter)
+        self.grids = _passing_grids(q, film_z, rhos.tolist(), self.radii, q.surfaces[-1].semi_diameter, self.big,
+                                    backend)
+        self.index = np.full((rhos.size, self.radii.size), -1)
+        self.have = np.zeros((rhos.size, self.radii.size), dtype=bool)
+        self.rims = _RimSet(np.zeros(0), np.zeros(0), np.zeros(1, dtype=int), np.zeros(0))
+
+    def need(self, levels) -> None:
+        """Find the rims a table at ``levels`` reads that are not found yet: at the nodes every level, its
+        slope's radius (:data:`_DS`) and the checks, between them only the checks."""
+        _, checked = _check_axes(levels)
+        wanted = np.zeros_like(self.have)
+        wanted[:N_RADIAL] = np.isin(self.radii, np.concatenate([checked, np.asarray(levels) * (1 - _DS)]))
+        wanted[N_RADIAL:] = np.isin(self.radii, checked)
+        wanted &= ~self.have
+        if not wanted.any():
+            return
+        index, rims = _grid_rims(self.grids, self.radii, wanted, self.rhos.size)
+        n, old = self.rims.area.size, self.rims
+        self.index = np.where(index >= 0, index + n, self.index)
+        self.rims = _RimSet(np.concatenate([old.x, rims.x]), np.concatenate([old.y, rims.y]),
+                            np.concatenate([old.cuts, rims.cuts[1:] + old.x.size]), np.concatenate([old.area, rims.area]))
+        self.have |= wanted
 
 
 def _n_passing(radii, t) -> np.ndarray:
@@ -570,7 +623,8 @@ def _fill(table: np.ndarray, empty: np.ndarray) -> None:
             table[:, j] = table[:, near]
 
 
-def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", checks: list | None = None) -> np.ndarray:
+def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", checks: list | None = None,
+                       finer: bool = False):
     """The table (len(levels) x :data:`N_RADIAL` x 5: cx, ax, ay in mm on the rear vertex plane, the
     passing set's area in mm^2 and its slope in mm^2 per mm of iris radius) of the focused lens ``q``
     (a Prescription) with its film at ``film_z``, at the iris radii ``levels`` (:func:`iris_levels`).
@@ -580,7 +634,9 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", check
     tracing backend (:func:`~physcam.trace.trace.trace_through`; "auto" picks one for the whole table,
     :func:`~physcam.trace.kernels.backend_for_job`: both give the same rays). ``checks``: a list that
     receives the traced areas at :func:`_check_points` (0 where nothing passes), for tables filled between
-    focus marks to be checked as this one is (:func:`_checked_trust`)."""
+    focus marks to be checked as this one is (:func:`_checked_trust`). ``finer``: (table, passing sets), the
+    sets traced also at the iris radii a table with levels between these reads (:class:`_PassingSets`: a
+    table at :func:`_refined_levels` from them, :func:`_assembled`, costs no trace)."""
     from ..lens.prescription import require_prescription
     from ..trace.kernels import backend_for_job
 
@@ -589,19 +645,22 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", check
     if q.is_anamorphic:
         raise InputError(f"{q.name!r} is anamorphic: the radial pupil table needs a lens with rotational symmetry")
     levels = _levels(levels)
-    backend = backend_for_job(backend, TABLE_RAYS * (len(q.surfaces) + 1))
     if not film_z > q.vertex_z[-1]:
         raise InputError(f"the film (z = {film_z:g} mm) must lie behind the lens's last vertex (z = {q.vertex_z[-1]:g} mm)")
-    semi_max = levels[0]
-    rhos, checked = _check_axes(levels)
+    sets = _PassingSets(q, film_z, levels, backend_for_job(backend, TABLE_RAYS * (len(q.surfaces) + 1)), finer=finer)
+    table = _assembled(sets, levels, checks)
+    return (table, sets) if finer else table
+
+
+def _assembled(sets: _PassingSets, levels, checks) -> np.ndarray:
+    """The table of :func:`radial_pupil_table` at the iris radii ``levels`` from the passing sets ``sets``
+    (which find the rims it reads, :meth:`_PassingSets.need`)."""
+    levels = _levels(levels)
+    sets.need(levels)
+    _, checked = _check_axes(levels)
     near = levels * (1 - _DS)  # the area's slope at each level (one-sided: one radius more per level, not two)
-    radii = np.unique(np.concatenate([checked, near]))[::-1]
-    r_rear = q.surfaces[-1].semi_diameter
-    big = 20.0 * max(semi_max, q.surfaces[q.stop_index].semi_diameter)
-    wanted = np.ones((rhos.size, radii.size), dtype=bool)
-    wanted[N_RADIAL:] = np.isin(radii, checked)  # between the nodes only the checks
-    index, rims = _passing_sets(q, film_z, rhos.tolist(), radii, wanted, r_rear, big, backend)
-    at = {float(s): i for i, s in enumerate(radii)}
+    index, rims = sets.index, sets.rims
+    at = {float(s): i for i, s in enumerate(sets.radii)}
     area = np.append(rims.area, 0.0)  # index -1: nothing passes
     node = index[:N_RADIAL, [at[float(s)] for s in levels]].T  # (levels, radii): the rims the entries fit
     lit = node >= 0
@@ -640,6 +699,34 @@ def _check_axes(levels) -> tuple[np.ndarray, np.ndarray]:
     rhos = np.concatenate([np.arange(N_RADIAL) * step, (np.arange(N_RADIAL - 1) + 0.5) * step])  # nodes, then mids
     checked = np.unique(np.concatenate([levels, np.sqrt(levels[:-1] * levels[1:]), [levels[-1] / 2]]))[::-1]
     return rhos, checked
+
+
+def _refined_levels(levels, tables, checks) -> np.ndarray:
+    """``levels`` with the geometric middle of every interval where the shader's cubic in iris radius
+    misses a traced table's area at the interval's middle (:func:`_check_points`) by over
+    :data:`AREA_TOLERANCE` at a film radius whose reads at both levels hold it: where another surface
+    begins to cut the passing set between the two (the area bends there, a kink the cubic rounds off),
+    halving the interval halves the miss (the double Gauss's table traced at 2.5 m: 0.64 % at film radius
+    10.4 mm between 6.79 and 6.05 mm, f/2.8's interval; at most 0.21 % between the middle and either level). ``tables``
+    (radial_pupil_table's at ``levels``) and ``checks`` (the areas its ``checks`` received, one per
+    table): the traced focus marks of one lens, which share its levels."""
+    levels = _levels(levels)
+    rhos, checked = _check_axes(levels)
+    read_rho, read_s = _check_points(levels)
+    is_level = np.isin(checked, levels)
+    misses = np.zeros(len(levels) - 1, dtype=bool)
+    for table, want in zip(tables, checks):
+        table = np.array(table, dtype=float)
+        table[..., 3] = cell_area(table[..., 3])
+        want = np.asarray(want, dtype=float)
+        got = _areas_at(table, levels, read_rho, read_s)
+        lit = (want > 0).reshape(len(rhos), len(checked))
+        bad = (np.abs(got - want) > AREA_TOLERANCE * np.maximum(want, 1e-12)).reshape(len(rhos), len(checked)) | ~lit
+        for c in np.flatnonzero(~is_level[1:-1]) + 1:  # a middle between the levels checked[c - 1] and checked[c + 1]
+            misses[np.searchsorted(-levels, -checked[c]) - 1] |= bool((bad[:, c] & lit[:, c] & ~bad[:, c - 1]
+                                                                       & ~bad[:, c + 1]).any())
+    mid = np.sqrt(levels[:-1] * levels[1:])[misses]
+    return np.sort(np.concatenate([levels, mid]))[::-1]
 
 
 def _check_points(levels) -> tuple[np.ndarray, np.ndarray]:
