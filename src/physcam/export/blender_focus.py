@@ -333,7 +333,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
     from ..trace.camera_tracer import CameraTracer
-    from .blender_pupil import _assembled, _centre_ellipses, _refined_levels, iris_levels, radial_pupil_table
+    from .blender_pupil import _centre_ellipses, iris_levels, refined_pupil_tables
 
     axis = focus_axis(closest_focus(lens), n_focus)
     states = []
@@ -350,11 +350,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     radial, rects, stopped, norm, checks = [], [], [], [], []
     tracers = [CameraTracer(states[i].prescription, states[i].film_z) for i in traced.tolist()]  # as the file stops it
     if not lens.is_anamorphic:
-        radial, sets = zip(*(radial_pupil_table(t.lens, t.film_z, levels, checks=checks, finer=True) for t in tracers))
-        refined = _refined_levels(levels, radial, checks)
-        if len(refined) > len(levels):  # a level between two whose cubic misses a traced mark's area: every table
-            levels, checks = refined, []  # at the levels with it, from the sets already traced
-            radial = [_assembled(t, levels, checks) for t in sets]
+        levels, radial = refined_pupil_tables([(t.lens, t.film_z) for t in tracers], levels, checks=checks)
     for i, tracer in zip(traced.tolist(), tracers):
         if lens.is_anamorphic:
             b, rect, rect_levels = _rect_tables(tracer, levels[0], grid_half_mm)

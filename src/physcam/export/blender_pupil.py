@@ -50,7 +50,7 @@ import numpy as np
 
 from ..errors import InputError, require_finite, require_type
 
-__all__ = ["RADIAL_MAX_MM", "N_RADIAL", "LEVEL_RATIO", "N_LEVEL", "radial_pupil_table", "iris_levels",
+__all__ = ["RADIAL_MAX_MM", "N_RADIAL", "LEVEL_RATIO", "N_LEVEL", "radial_pupil_table", "refined_pupil_tables", "iris_levels",
            "level_bracket", "interpolated_ellipse", "interpolated_area", "cell_area", "hermite", "radial_cubic"]
 
 #: Film radius the table reaches (mm): the half diagonal of physcam's largest sensor (IMAX 15/70).
@@ -623,8 +623,7 @@ def _fill(table: np.ndarray, empty: np.ndarray) -> None:
             table[:, j] = table[:, near]
 
 
-def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", checks: list | None = None,
-                       finer: bool = False):
+def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", checks: list | None = None) -> np.ndarray:
     """The table (len(levels) x :data:`N_RADIAL` x 5: cx, ax, ay in mm on the rear vertex plane, the
     passing set's area in mm^2 and its slope in mm^2 per mm of iris radius) of the focused lens ``q``
     (a Prescription) with its film at ``film_z``, at the iris radii ``levels`` (:func:`iris_levels`).
@@ -634,9 +633,27 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", check
     tracing backend (:func:`~physcam.trace.trace.trace_through`; "auto" picks one for the whole table,
     :func:`~physcam.trace.kernels.backend_for_job`: both give the same rays). ``checks``: a list that
     receives the traced areas at :func:`_check_points` (0 where nothing passes), for tables filled between
-    focus marks to be checked as this one is (:func:`_checked_trust`). ``finer``: (table, passing sets), the
-    sets traced also at the iris radii a table with levels between these reads (:class:`_PassingSets`: a
-    table at :func:`_refined_levels` from them, :func:`_assembled`, costs no trace)."""
+    focus marks to be checked as this one is (:func:`_checked_trust`)."""
+    return _table_and_sets(q, film_z, levels, backend, checks, finer=False)[0]
+
+
+def refined_pupil_tables(focused, levels, *, checks: list, backend: str = "auto") -> tuple[np.ndarray, list]:
+    """(levels, tables): :func:`radial_pupil_table` of each focused lens of ``focused`` ((prescription, film z)
+    pairs: one lens's traced focus marks, which share their levels), at ``levels`` with a level added between
+    two wherever the area's cubic misses a traced area at their middle (:func:`_refined_levels`); the passing
+    sets are traced once, at the radii the added levels read too (:class:`_PassingSets`). ``checks`` receives
+    each table's traced check areas at the returned levels."""
+    found = [_table_and_sets(q, film_z, levels, backend, checks, finer=True) for q, film_z in focused]
+    refined = _refined_levels(levels, [table for table, _ in found], checks)
+    if len(refined) == len(_levels(levels)):
+        return _levels(levels), [table for table, _ in found]
+    checks.clear()  # the tables again at the refined levels, from the sets already traced
+    return refined, [_assembled(sets, refined, checks) for _, sets in found]
+
+
+def _table_and_sets(q, film_z: float, levels, backend: str, checks, *, finer: bool) -> tuple:
+    """(table, passing sets) of :func:`radial_pupil_table` (``finer``: the sets traced also at the radii of
+    the levels :func:`_refined_levels` may add)."""
     from ..lens.prescription import require_prescription
     from ..trace.kernels import backend_for_job
 
@@ -648,8 +665,7 @@ def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", check
     if not film_z > q.vertex_z[-1]:
         raise InputError(f"the film (z = {film_z:g} mm) must lie behind the lens's last vertex (z = {q.vertex_z[-1]:g} mm)")
     sets = _PassingSets(q, film_z, levels, backend_for_job(backend, TABLE_RAYS * (len(q.surfaces) + 1)), finer=finer)
-    table = _assembled(sets, levels, checks)
-    return (table, sets) if finer else table
+    return _assembled(sets, levels, checks), sets
 
 
 def _assembled(sets: _PassingSets, levels, checks) -> np.ndarray:
