@@ -559,3 +559,40 @@ def test_a_key_deleted_in_a_sublayer_leaves_root_layer_samples_the_refresh_remov
     rc, doc = _check_json(capsys, f)
     assert rc == 0 and not doc["stale"] and doc["time_codes"] == [1.0, 24.0]
     assert validation_errors(Usd.Stage.Open(str(f))) == []
+
+
+def test_a_pull_in_a_sublayer_edited_at_one_key_keeps_every_keys_values(tmp_path, capsys):
+    """usd animate's pull (keys 1, 5, 10, 15) as the sublayer of a shot, its focus edited at 10 in that sublayer:
+    the refresh writes into the shot's root layer, whose samples of an attribute replace the sublayer's whole
+    set, so it must write every key there, not only the changed one (a review's find, older than round 10: the
+    companion then held frame 10's value on every frame). Oracle: the thin lens's closed form at each key."""
+    from pxr import Sdf
+
+    marks = tmp_path / "pull.csv"
+    marks.write_text("frame,focus,fstop\n1,2m,2.8\n5,3m,2.8\n10,4m,4\n15,6m,4\n", encoding="utf-8")
+    assert main(["usd", "animate", str(tmp_path / "anim.usda"), "--focal", "50", "--marks", str(marks),
+                 "--sensor", "S35"]) == 0
+    shot = _layer(tmp_path / "shot.usda")
+    shot.subLayerPaths[:] = ["anim.usda"]
+    shot.Save()
+    anim = Sdf.Layer.FindOrOpen(str(tmp_path / "anim.usda"))
+    anim.SetTimeSample(Sdf.Path(f"{MODEL}.focusDistance"), 10.0, 4500.0)
+    anim.Save()
+    f = tmp_path / "shot.usda"
+    assert main(["usd", "refresh", str(f)]) == 0
+    stage = Usd.Stage.Open(str(f))
+    focus = stage.GetAttributeAtPath(f"{GEOM}.focusDistance")
+    assert focus.GetTimeSamples() == [1.0, 5.0, 10.0, 15.0]
+    model = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
+    pupil = stage.GetPrimAtPath(CAM).GetAttribute("lens:main:entrancePupilDistance")
+    for t in (1.0, 5.0, 10.0, 15.0):
+        F = model.Get(t)  # mm from the film
+        s_img = (F - math.sqrt(F * (F - 4.0 * 50.0))) / 2.0
+        # the companion focuses at the subject's distance from the pupil (cm): the thin lens s' in front of the
+        # film at the keys left alone; at 10 the pupil as the file holds it (a thin lens's is not re-solved)
+        at = s_img if t != 10.0 else pupil.Get(t)
+        assert _rel(focus.Get(t) * 10.0, F - at, 1e-6), (t, focus.Get(t), F - at)
+    capsys.readouterr()
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and doc["stale_samples"] == [], doc["stale_samples"]
+    assert validation_errors(stage) == []

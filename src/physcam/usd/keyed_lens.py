@@ -270,17 +270,28 @@ def _author_samples(stage, path, file, times) -> list[dict]:
     attrs = {n: stage.GetAttributeAtPath(Sdf.Path(n)) for n in names}
     had = {n: {float(t) for t in a.GetTimeSamples()} for n, a in attrs.items()}
     olds = {t: {n: a.Get(t) for n, a in attrs.items()} for t in times}  # all read before any is written
-    changed = []
+    kept = {}
     for t in times:
         old = olds[t]
         keep = {n for n in names if t in had[n] and _same_value(old[n], expected[t].get(n))}
         if view <= attrs.keys() and all(t in had[n] for n in view) and _same_view(old, expected[t], geom):
             keep |= view
+        kept[t] = keep | {n for n in names if expected[t].get(n) is None}
+    # samples in the layer refresh writes replace a weaker layer's (a sublayer's) whole set of an attribute:
+    # where that layer holds none of an attribute yet, every keyed time code is written there, the kept ones
+    # with the value they compose to now
+    layer = stage.GetEditTarget().GetLayer()
+    whole = {n for n in names if any(n not in kept[t] for t in times)
+             and not layer.ListTimeSamplesForPath(Sdf.Path(n))}
+    changed = []
+    for t in times:
         for n in names:
-            new = expected[t].get(n)
-            if new is None or n in keep:
+            if n in kept[t]:
+                if n in whole and olds[t][n] is not None:
+                    attrs[n].Set(olds[t][n], t)
                 continue
+            old, new = olds[t][n], expected[t][n]
             attrs[n].Set(new, t)
-            if old[n] is None or not _same_value(old[n], new):
-                changed.append({"attribute": n, "time": t, "before": _shown_value(old[n]), "after": _shown_value(new)})
+            if old is None or not _same_value(old, new):
+                changed.append({"attribute": n, "time": t, "before": _shown_value(old), "after": _shown_value(new)})
     return sorted(changed, key=lambda c: (c["attribute"], c["time"]))
