@@ -596,3 +596,27 @@ def test_a_pull_in_a_sublayer_edited_at_one_key_keeps_every_keys_values(tmp_path
     rc, doc = _check_json(capsys, f)
     assert rc == 0 and doc["stale_samples"] == [], doc["stale_samples"]
     assert validation_errors(stage) == []
+
+
+def test_a_key_added_refreshed_then_deleted_leaves_samples_the_refresh_removes(tmp_path, capsys):
+    """The everyday loop (a review's find): usd animate keys 1, 5 and 10; the artist adds a focus key at 7, refreshes
+    (every derived attribute is sampled at 7 then, also where its value between the old keys was right), then
+    deletes that key: the samples at 7 are refresh's own (usd animate's pupils are not among them), so a check
+    reports them left and a refresh removes them; the file then checks current and the other keys are untouched."""
+    f = _three_marks(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance").Set(2500.0, 7.0)
+    stage.Save()
+    assert main(["usd", "refresh", str(f)]) == 0
+    at7 = _samples(f, 7.0) - {f"{MODEL}.focusDistance"}
+    assert at7 == _THIN_LENS_LEFT - {f"{CAM}.lens:main:entrancePupilDistance", f"{CAM}.lens:main:apertureDistance"}
+    kept = {t: _values_at(f, t) for t in (1.0, 5.0, 10.0)}
+    _delete_keys(f, 7.0, (MODEL, "focusDistance"))
+    rc, doc = _check_json(capsys, f)
+    assert rc == 1 and [(d["time"], d["left"]) for d in doc["stale_samples"]] == [(7.0, True)]
+    assert main(["usd", "refresh", str(f)]) == 0
+    assert _samples(f, 7.0) == set()
+    assert {t: _values_at(f, t) for t in (1.0, 5.0, 10.0)} == kept
+    rc, doc = _check_json(capsys, f)
+    assert rc == 0 and doc["stale_samples"] == []
+    assert validation_errors(Usd.Stage.Open(str(f))) == []

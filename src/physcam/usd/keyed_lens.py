@@ -136,7 +136,7 @@ def _refuse_samples_not_followed(stage, path, file, action: str, times) -> list[
     lp = f"lens:{LENS_INSTANCE}:"
     stored = composed_prescription(stage, path) is not None
     read_at_time = set() if stored or not times else {f"{path}.{lp}entrancePupilDistance", f"{path}.{lp}apertureDistance"}
-    left = _left_samples(stage, path, file, action, times, derived | read_at_time)
+    left = _left_samples(stage, path, file, action, times, derived | read_at_time, derived)
     left_times = {d["time"] for d in left}
     attrs = [a for prim in (cam, *cam.GetChildren()) for a in prim.GetAttributes()]
     for a in sorted(attrs, key=lambda a: str(a.GetPath()) in derived):  # a hand key on another attribute named first
@@ -171,11 +171,13 @@ def _samples_at(cam) -> dict:
     return out
 
 
-def _left_samples(stage, path, file, action: str, times, written) -> list[dict]:
+def _left_samples(stage, path, file, action: str, times, written, derived) -> list[dict]:
     """``[{"time", "attributes", "left": True}]`` of each time code no lens input is keyed at whose samples are
-    exactly the ones the refresh writes at each keyed time code of this camera: the attributes of ``written``
-    (the derived ones, a thin lens's pupils) sampled at its keyed ``times``, all of them and no other (the
-    samples a deleted key left; a set with one more or one fewer is an artist's, refused by the caller). An
+    the ones usd animate or the refresh wrote at a key of this camera: of the attributes of ``written`` (the
+    derived ones, a thin lens's pupils) sampled at its keyed ``times``, every ``derived`` one (what a refresh
+    writes at a key the artist added) and no other attribute (with or without usd animate's pupils: the
+    samples a deleted key left; a set with one more attribute, or without one the refresh derives, is an
+    artist's, refused by the caller). An
     ExportError naming the layer when one of them is authored in a layer weaker than the file's root layer
     (a sublayer, a referenced file): the refresh writes only the root layer."""
     if not times:
@@ -187,7 +189,7 @@ def _left_samples(stage, path, file, action: str, times, written) -> list[dict]:
     root = stage.GetRootLayer()
     out = []
     for t in sorted(set(at) - set(times)):
-        if not keyed_set or at[t] != keyed_set:
+        if not keyed_set or not (keyed_set & derived) <= at[t] <= keyed_set:
             continue
         for name in sorted(at[t]):
             layer = _sample_layer(stage.GetAttributeAtPath(Sdf.Path(name)), t)
@@ -264,6 +266,14 @@ def _author_samples(stage, path, file, times) -> list[dict]:
 
     expected = _samples_solved(stage, path, file, "refresh", times)
     names = {n for d in _stale_samples(stage, path, expected) for n in d["attributes"]}
+    # a derived attribute that is sampled is sampled at every keyed time code: at a key the artist added, also
+    # where its value between the old keys happens to be right (else the key, deleted later, would leave a
+    # partial set of refresh's samples, which a refresh refuses as hand keys: _left_samples)
+    for n in {n for t in times for n in expected[t]} - names:
+        attr = stage.GetAttributeAtPath(Sdf.Path(n))
+        samples = set(attr.GetTimeSamples()) if attr else set()
+        if samples and not samples >= set(times):
+            names.add(n)
     geom = str(Sdf.Path(path).AppendChild("Camera"))
     view = {f"{geom}.{v}" for v in ("focalLength", "horizontalAperture", "verticalAperture")}
     names = sorted(names | view if names & view else names)  # one field of view: its three values together
