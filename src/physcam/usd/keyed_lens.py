@@ -196,7 +196,7 @@ def _left_samples(stage, path, file, action: str, times, written, derived) -> li
             if layer is not None and layer != root:
                 tc = time_code_text(t)
                 raise ExportError(f"{file}: {name} holds a sample at time code {tc}, left from a deleted key, in "
-                                  f"{layer.identifier}: usd {action} writes only {root.identifier}; remove the "
+                                  f"{layer.identifier}: usd refresh writes only {root.identifier}; remove the "
                                   f"samples at time code {tc} in that layer (or key the lens there) and run it again")
         out.append({"time": t, "attributes": sorted(at[t]), "left": True})
     return out
