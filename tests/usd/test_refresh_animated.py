@@ -215,6 +215,17 @@ def _dgauss(tmp_path, name="lens.usda"):
     return f
 
 
+def _keyed_dgauss(tmp_path, keys):
+    """:func:`_dgauss` with its focus keyed as a layout artist keys it: ``keys`` (time code, mark in mm) pairs."""
+    f = _dgauss(tmp_path)
+    stage = Usd.Stage.Open(str(f))
+    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
+    for t, mark in keys:
+        focus.Set(mark, t)
+    stage.Save()
+    return f
+
+
 def test_keys_without_a_default_still_check_and_refresh_the_cameras_other_inputs(tmp_path, capsys):
     """A DCC export writes a keyed focus as samples only (no default): an ISO, shutter and clipping change on the
     body is stale, and the refresh writes them to the companion (the closed forms: ISO as is, the shutter's close
@@ -331,12 +342,7 @@ def test_a_kit_shots_body_iris_is_not_a_sample_of_the_lens(tmp_path, capsys):
 def test_time_codes_are_printed_as_the_time_codes_they_are(tmp_path, capsys):
     """Keys at time codes 123456, 123456.5 and 1234567 (a long shot's frame numbers, a half frame): each stale one
     is named exactly, not rounded to six digits (123456.5 read as 123456; 1234567 as 1.23457e+06)."""
-    f = _dgauss(tmp_path)
-    stage = Usd.Stage.Open(str(f))
-    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
-    for t, mark in ((123456.0, 3000.0), (123456.5, 2000.0), (1234567.0, 1000.0)):
-        focus.Set(mark, t)
-    stage.Save()
+    f = _keyed_dgauss(tmp_path, ((123456.0, 3000.0), (123456.5, 2000.0), (1234567.0, 1000.0)))
     capsys.readouterr()
     assert main(["usd", "check", str(f)]) == 1
     out = capsys.readouterr().out
@@ -461,12 +467,7 @@ def test_a_deleted_focus_key_on_a_stored_lens_leaves_samples_the_refresh_removes
     """A real lens (stored) keyed at 1, 12 and 24 and refreshed, then the focus key at 12 deleted: the refresh's own
     samples there (the lens's pupils and principal planes among them) no longer keep 12 keyed; the text
     refresh lists each removal, and the file checks current."""
-    f = _dgauss(tmp_path)
-    stage = Usd.Stage.Open(str(f))
-    focus = stage.GetPrimAtPath(MODEL).GetAttribute("focusDistance")
-    for t, mark in ((1.0, 2000.0), (12.0, 2500.0), (24.0, 5000.0)):
-        focus.Set(mark, t)
-    stage.Save()
+    f = _keyed_dgauss(tmp_path, ((1.0, 2000.0), (12.0, 2500.0), (24.0, 5000.0)))
     assert main(["usd", "refresh", str(f)]) == 0
     written = _samples(f, 12.0) - {f"{MODEL}.focusDistance"}
     assert {f"{CAM}.lens:main:pinholeFocalLength", f"{CAM}.lens:main:entrancePupilDistance"} <= written
