@@ -104,11 +104,16 @@ def _listed(paths: list[str], most: int = 5) -> str:
     return ", ".join(paths[:most]) + (f" and {len(paths) - most} more" if len(paths) > most else "")
 
 
+def _at(attr, time=None):
+    """``attr``'s value at the time code ``time`` (a Usd.TimeCode), or its default value when ``time`` is None."""
+    return attr.Get() if time is None else attr.Get(time)
+
+
 def _get(prim, name, what, time=None):
     attr = prim.GetAttribute(name)
     if not attr:
         raise ExportError(f"{prim.GetPath()}: has no {name} attribute; {what}")
-    v = attr.Get() if time is None else attr.Get(time)
+    v = _at(attr, time)
     if v is None:
         raise ExportError(f"{prim.GetPath()}: {name} has no value; {what}")
     return v
@@ -116,7 +121,7 @@ def _get(prim, name, what, time=None):
 
 def _pair(prim, name: str, default, time=None):
     attr = prim.GetAttribute(name)
-    v = (attr.Get() if time is None else attr.Get(time)) if attr else None
+    v = _at(attr, time) if attr else None
     return default if v is None else (float(v[0]), float(v[1]))
 
 
@@ -126,7 +131,7 @@ def _optional(prim, name: str, time=None):
     attr = prim.GetAttribute(name)
     if not attr or not attr.HasAuthoredValue():
         return None
-    return float(attr.Get() if time is None else attr.Get(time))
+    return float(_at(attr, time))
 
 
 def _fstop_at_focus(prim, lp: str, focal_mm: float, time=None):
@@ -143,8 +148,8 @@ def _principal_planes(prim, lp: str, time=None):
     """(H1, H2) in front of the film when both are authored, else None (a thin lens)."""
     a = prim.GetAttribute(lp + "frontPrincipalPlaneDistance")
     b = prim.GetAttribute(lp + "rearPrincipalPlaneDistance")
-    h1 = (a.Get() if time is None else a.Get(time)) if a else None
-    h2 = (b.Get() if time is None else b.Get(time)) if b else None
+    h1 = _at(a, time) if a else None
+    h2 = _at(b, time) if b else None
     if (h1 is None) != (h2 is None):
         raise ExportError(f"{prim.GetPath()}: author both {lp}frontPrincipalPlaneDistance and "
                           f"{lp}rearPrincipalPlaneDistance, or neither")
