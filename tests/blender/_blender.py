@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import tempfile
 from pathlib import Path
@@ -124,12 +125,22 @@ def run_blender_log(script: str, *args, timeout: float = 300.0, env: dict | None
         path.write_text(OSL_PATH_PRELUDE + script)
         p = subprocess.run(runner.command(path, *map(str, args)), capture_output=True, text=True, timeout=timeout,
                            env=env)
+    _remove_installed_extensions(env)
     if p.returncode != 0:
         raise AssertionError(f"Blender script failed (exit {p.returncode}):\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}")
     lines = [ln for ln in p.stdout.strip().splitlines() if ln.startswith("{")]
     if not lines:
         raise AssertionError(f"Blender script printed no JSON:\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}")
     return json.loads(lines[-1]), p.stdout + p.stderr
+
+
+def _remove_installed_extensions(env: dict) -> None:
+    """Remove the extensions a run installed into its own ``BLENDER_USER_RESOURCES`` (every test gives each
+    Blender a fresh one): the physcam extension unpacks to about 470 MB of shaders, and a dozen copies kept
+    until the session ends filled a CI machine's disk. No test reads that folder after its Blender exits."""
+    user = env.get("BLENDER_USER_RESOURCES")
+    if user:
+        shutil.rmtree(Path(user) / "extensions", ignore_errors=True)
 
 
 def light_centroid(img, c, r, win: int):

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from physcam.lens.catalog import BUILTIN_CATALOGS, catalog
 from physcam.optics import glass
-from physcam.optics.glassfit import STORED_DIR, stored_form, tracer_form
+from physcam.optics.glassfit import STORED_DIR, stored_form
 
 
 @settings(max_examples=200, deadline=None)
@@ -20,10 +20,12 @@ def test_normal_line_solve_is_numpys(nd, vd):
     uf, uc, ug = (glass._u(w) for w in (glass.LINE_F_NM, glass.LINE_C_NM, glass.LINE_G_NM))
     pgf = glass.normal_line_pgf(vd)
     dn = (nd - 1.0) / vd
-    b, c = np.linalg.solve(np.array([[uf - uc, uf * uf - uc * uc], [ug - uf, ug * ug - uf * uf]]),
-                           np.array([dn, pgf * dn]))
+    a = np.array([[uf - uc, uf * uf - uc * uc], [ug - uf, ug * ug - uf * uf]])
+    b, c = np.linalg.solve(a, np.array([dn, pgf * dn]))
     _, b1, c1 = glass._cauchy3(nd, vd, pgf)
-    assert math.isclose(b1, b, rel_tol=1e-14) and math.isclose(c1, c, rel_tol=1e-14)
+    # two solvers of one system each err by up to about cond(A) x eps (Higham 2002, ch. 7): 4 of those apart
+    tol = 4.0 * np.linalg.cond(a) * np.finfo(float).eps  # cond 44: 3.9e-14 (an AVX2 machine's LAPACK: 1.5e-14 apart)
+    assert math.isclose(b1, b, rel_tol=tol) and math.isclose(c1, c, rel_tol=tol)
 
 
 @settings(max_examples=100, deadline=None)
@@ -45,13 +47,22 @@ def test_every_refitted_catalogue_glass_is_stored_with_its_current_data():
                 assert stored_form(g, glass._traced_band(g)) is not None, f"{name} {g.name}: not stored"
 
 
-def test_stored_fits_are_what_fitting_gives():
-    """The middle glass of each catalogue fitted anew: the stored form to 1e-12
-    (a BLAS of another machine may round the least squares differently in the last bits)."""
+def test_stored_fits_meet_their_formula_within_their_stored_error():
+    """Every stored fit evaluated as the tracer does (:func:`glass.evaluate`) against its catalogue formula at
+    the wavelengths the fit used: the largest difference is the error stored beside it. Not "a fit anew gives
+    the same coefficients": the Levenberg-Marquardt path depends on the BLAS's rounding (on an AVX2 machine
+    a fit anew lands on other coefficients, 0.08-20x the stored error), which is why physcam reads the stored
+    fits everywhere: the same glass indices on every machine."""
+    import numpy as np
+
+    from physcam.lens.glassformulas import formula_index
+    from physcam.optics.glassfit import _KEY_UM
+
     for name, table in _stored().items():
-        keys = sorted(table)
-        for key in (keys[len(keys) // 2],):
-            e = table[key]
-            form, err = tracer_form(e["formula"], tuple(e["coefficients"]), tuple(e["band_nm"]))
-            assert all(math.isclose(a, b, rel_tol=1e-12, abs_tol=1e-18) for a, b in zip(form, e["form"])), key
-            assert math.isclose(err, e["error"], rel_tol=1e-6, abs_tol=1e-12)
+        for key, e in table.items():
+            band = e["band_nm"]
+            lam_um = np.concatenate([np.linspace(band[0], band[1], 161) / 1000.0, _KEY_UM])
+            want = np.asarray(formula_index(e["formula"], tuple(e["coefficients"]), lam_um), dtype=float)
+            got = glass.evaluate(tuple(e["form"]), lam_um * 1000.0)
+            assert math.isclose(float(np.max(np.abs(got - want))), e["error"], rel_tol=1e-6, abs_tol=1e-12), \
+                (name, key)

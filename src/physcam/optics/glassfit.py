@@ -26,8 +26,10 @@ from pathlib import Path
 __all__ = ["tracer_form", "stored_form", "fit_table"]
 
 #: The fits of the bundled catalogues, one file per catalogue (``scripts/glass_fits.py`` writes them with
-#: :func:`fit_table`): the same numbers :func:`tracer_form` computes, read instead of fitted (issue 43: a
-#: lens of HOYA or CDGM glass reported without numpy, and 50 ms less per glass).
+#: :func:`fit_table`): the numbers :func:`tracer_form` computed where they were written, read instead of
+#: fitted (issue 43: a lens of HOYA or CDGM glass reported without numpy, and 50 ms less per glass). Read, they
+#: give every machine the same indices: a fit's Levenberg-Marquardt path follows the BLAS's rounding, and on
+#: another CPU (AVX2 against AVX-512) it can end on other coefficients, each within its own stated error.
 STORED_DIR = Path(__file__).parent.parent / "data" / "glass" / "fits"
 
 _KEY_UM = (0.6562725, 0.5875618, 0.4861327)  # C, d, F
