@@ -137,7 +137,15 @@ latest-run:
 	  | tr '\n' ' ' | sed 's/^/physcam: newest versions tested: /'; echo
 	$(LATEST_PY) -m pytest -n 2 -q -m "not slow" -p no:cacheprovider tests/optics \
 	  tests/usd tests/live tests/trace/test_tracer.py tests/analysis/image_quality/test_image_quality_closed_forms.py \
-	  tests/farm/test_farm_jobs.py
+	  tests/farm/test_farm_jobs.py $(LATEST_LEFT_OUT)
+
+# Left to `make test` (the constraints' versions), for the CI's budget: they grew to half of this run's
+# CPU (2026-11-29: 260 of 480 s) while leaning on the dependencies less than the rest: the formulas'
+# NaN and inf properties (pure Python and numpy's ufuncs), the catalogue glasses (stored fits, no
+# fitting), the live parser's hostile input (physcam's own limits), the usd commands' CLI (the same
+# USD calls as tests/usd's authoring and kit tests).
+LATEST_LEFT_OUT := --ignore=tests/optics/test_no_nan_formulas.py --ignore=tests/optics/test_glass.py \
+	  --ignore=tests/live/test_attacks.py --ignore=tests/usd/test_cli_usd.py
 
 # physcam's own bytecode, written once before the suite: the editable install leaves src/ uncompiled and
 # CI sets PYTHONDONTWRITEBYTECODE, so every subprocess of the suite (the CLI, Blender, the fork servers)
