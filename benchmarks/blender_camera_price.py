@@ -85,11 +85,12 @@ def main() -> None:
     for p in glob.glob(bpy.utils.resource_path("LOCAL") + "/python/lib/python3*/site-packages"):
         sys.path.insert(0, p)
     from physcam.export.blender_extension import build_extension
+    from physcam.export.blender_variant import variant_source
     from physcam.lens.library import load_lens
 
     lens, slug, tmp = load_lens(args.lens), Path(args.lens).stem, Path(tempfile.mkdtemp())
-    with zipfile.ZipFile(build_extension(tmp, lenses=[args.lens])) as z:
-        ext_src = z.read(f"shaders/{slug}__d0f0.osl").decode()
+    with zipfile.ZipFile(build_extension(tmp, lenses=[args.lens])) as z:  # dispersion and Fresnel off, as the add-on writes it
+        ext_src = variant_source(z.read(f"shaders/{slug}.osl").decode(), dispersion=False, fresnel=False)
     scene = bpy.context.scene
     br.SCENES[args.scene](scene)
 

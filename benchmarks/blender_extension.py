@@ -2,12 +2,14 @@
 
 Run:  .venv/bin/python benchmarks/blender_extension.py [--lenses dgauss_50mm,tessar_50mm]
                                                        [--baseline-src <other checkout>/src]
-      .venv/bin/python benchmarks/blender_extension.py --build [--workers 2] [--baseline-src ...]
+      .venv/bin/python benchmarks/blender_extension.py --build [--workers 2] [--baseline-src ...] [--install]
 
 ``--build``: the whole command instead (``physcam export blender-extension --workers N``, the lenses
 given or every bundled one), its CPU seconds as user + system of the process and its workers
 (``os.wait4``), with the zip's size: the part outside ``lens_payload`` too (worker start-up, the zip's
-deflate), one side after the other.
+deflate), one side after the other. ``--install``: then Blender's installer of each side's zip
+(``package_install_files`` in a fresh user folder, the Blender tests' way; the Blender of
+``physcam.export.blender_runner.find_blender``), its wall and CPU seconds and the megabytes it unpacks.
 
 Goal (issue 41 follow-up): every bundled lens in under ~2.5 min of CPU (the extension build was
 about 8 min). CPU time (``time.process_time``: every thread of the process), so the figure holds on a
@@ -111,6 +113,29 @@ def build(src: str | None, names, workers: int, out: str) -> tuple[float, float,
     return ru.ru_utime, ru.ru_stime, wall, os.path.getsize(os.path.join(out, zp))
 
 
+_INSTALL = """
+import os, json, sys, time
+import bpy
+t, c = time.perf_counter(), time.process_time()
+bpy.ops.extensions.package_install_files(filepath=sys.argv[-1], repo="user_default", enable_on_install=True)
+print(json.dumps({"wall_s": time.perf_counter() - t, "cpu_s": time.process_time() - c}))
+"""
+
+
+def install(zip_path: str, tmp: str) -> tuple[float, float, float]:
+    """(wall s, CPU s, MB unpacked) of Blender's installer of ``zip_path`` into a fresh user folder."""
+    from physcam.export.blender_runner import find_blender
+
+    user, script = os.path.join(tmp, "user"), os.path.join(tmp, "install.py")
+    with open(script, "w") as fh:
+        fh.write(_INSTALL)
+    r = subprocess.run(find_blender().command(script, zip_path), capture_output=True, text=True,
+                       env=dict(os.environ, BLENDER_USER_RESOURCES=user), check=True)
+    row = json.loads([ln for ln in r.stdout.splitlines() if ln.startswith("{")][-1])
+    size = sum(os.path.getsize(os.path.join(d, f)) for d, _, fs in os.walk(os.path.join(user, "extensions")) for f in fs)
+    return row["wall_s"], row["cpu_s"], size / 1e6
+
+
 def main_build(args, here: str) -> None:
     names = args.lenses.split(",") if args.lenses else None
     sides = [("this checkout", here)] + ([("baseline", args.baseline_src)] if args.baseline_src else [])
@@ -124,6 +149,11 @@ def main_build(args, here: str) -> None:
             cpu[label] = user + system
             print(f"{label:14s} CPU {user + system:7.1f} s (user {user:.1f}, system {system:.1f}), wall {wall:6.1f} s, "
                   f"zip {size / 1e6:.1f} MB, load {load()}", flush=True)
+            if args.install:
+                (zp,) = [os.path.join(out, f) for f in os.listdir(out) if f.endswith(".zip")]
+                i_wall, i_cpu, i_mb = install(zp, out)
+                print(f"{label:14s} Blender install: wall {i_wall:.1f} s, CPU {i_cpu:.1f} s, {i_mb:.1f} MB unpacked",
+                      flush=True)
     if args.baseline_src:
         print(f"ratio (baseline / this): {cpu['baseline'] / cpu['this checkout']:.2f}")
 
@@ -150,6 +180,7 @@ def main() -> None:
     ap.add_argument("--baseline-src", help="another checkout's src directory to compare against")
     ap.add_argument("--build", action="store_true", help="time the whole CLI build (module notes)")
     ap.add_argument("--workers", type=int, default=2, help="--build's worker processes (default 2)")
+    ap.add_argument("--install", action="store_true", help="--build: time Blender's installer of each zip too")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--out", help=argparse.SUPPRESS)
     args = ap.parse_args()

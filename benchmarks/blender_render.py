@@ -242,13 +242,14 @@ def main() -> None:
     for p in glob.glob(bpy.utils.resource_path("LOCAL") + "/python/lib/python3*/site-packages"):
         sys.path.insert(0, p)
     from physcam.export.blender_extension import build_extension
+    from physcam.export.blender_variant import variant_source
     from physcam.lens.library import load_lens
 
     lens = load_lens(args.lens)
     slug = Path(args.lens).stem
     tmp = Path(tempfile.mkdtemp())
-    with zipfile.ZipFile(build_extension(tmp, lenses=[args.lens])) as z:
-        ext_src = z.read(f"shaders/{slug}__d0f0.osl").decode()
+    with zipfile.ZipFile(build_extension(tmp, lenses=[args.lens])) as z:  # dispersion and Fresnel off, as the add-on writes it
+        ext_src = variant_source(z.read(f"shaders/{slug}.osl").decode(), dispersion=False, fresnel=False)
     load0 = os.getloadavg()
     n = args.samples
     print(f"lens {lens.name}, focus {FOCUS_MM / 1000:g} m, {W} x {H} px, Cycles CPU, 2 threads, {n} samples, "

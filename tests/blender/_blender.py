@@ -136,8 +136,8 @@ def run_blender_log(script: str, *args, timeout: float = 300.0, env: dict | None
 
 def _remove_installed_extensions(env: dict) -> None:
     """Remove the extensions a run installed into its own ``BLENDER_USER_RESOURCES`` (every test gives each
-    Blender a fresh one): the physcam extension unpacks to about 470 MB of shaders, and a dozen copies kept
-    until the session ends filled a CI machine's disk. No test reads that folder after its Blender exits."""
+    Blender a fresh one): the physcam extension unpacks to about 120 MB of shaders (470 MB before one
+    source per lens, round 11), and a dozen 470 MB copies kept until the session ends filled a CI machine's disk. No test reads that folder after its Blender exits."""
     user = env.get("BLENDER_USER_RESOURCES")
     if user:
         shutil.rmtree(Path(user) / "extensions", ignore_errors=True)

@@ -44,13 +44,28 @@ cam = scene.camera.data
 
 def test_installs_registers_and_every_lens_compiles(extension_zip, tmp_path):
     """Blender's installer puts the zip in a fresh user folder and enables it; the Camera panel's
-    property group exists; each bundled lens, chosen in the enum, gives a compiled OSL camera."""
+    property group exists; each bundled lens, chosen in the enum, gives a compiled OSL camera. One lens's
+    four variants (dispersion, Fresnel) are texts named as the four-shader zips named them, each
+    compiled from the lens's one source with its #define lines, and a text of that name already in the
+    file (a .blend saved with an earlier extension) is kept as it is."""
     out = run_blender(INSTALL + '''
+import zipfile
 p = cam.physcam
 p.focus_distance = 5.0; p.fstop = 8.0
-res = {"installed": bool(installed), "user_dir": bpy.utils.user_resource("EXTENSIONS"), "lenses": {}}
+res = {"installed": bool(installed), "user_dir": bpy.utils.user_resource("EXTENSIONS"), "lenses": {}, "variants": {}}
 slugs = json.loads(sys.argv[3])
+slug = slugs[0]
+saved = bpy.data.texts.new(f"physcam_{slug}__d0f0.osl")
+saved.write("// saved by an earlier physcam\\n" + zipfile.ZipFile(zip_path).read(f"shaders/{slug}.osl").decode())
 p.enabled = True
+p.lens = slug
+res["kept"] = [cam.custom_shader.name, cam.custom_shader.lines[0].body, len(cam.custom_bytecode)]
+for d, f in ((False, False), (False, True), (True, True), (True, False)):  # one switch at a time: one compile each
+    p.dispersion = d; p.fresnel = f
+    t = cam.custom_shader
+    res["variants"][f"{int(d)}{int(f)}"] = [t.name, [ln.body for ln in t.lines[:3] if ln.body.startswith("#define")],
+                                            len(cam.custom_bytecode), p.message]
+p.dispersion = False
 for slug in slugs:
     p.lens = slug
     res["lenses"][slug] = {"bytecode": len(cam.custom_bytecode), "message": p.message,
@@ -63,6 +78,14 @@ print(json.dumps(res))
     assert set(out["lenses"]) == {r.slug for r in list_lenses()}
     for slug, r in out["lenses"].items():
         assert r["message"] == "" and r["bytecode"] > 0 and slug in r["shader"], (slug, r)
+    first = list_lenses()[0].slug
+    assert out["kept"][:2] == [f"physcam_{first}__d0f0.osl", "// saved by an earlier physcam"] and out["kept"][2] > 0
+    for key, (name, defines, size, message) in out["variants"].items():
+        assert name == f"physcam_{first}__d{key[0]}f{key[1]}.osl" and message == "", (key, name, message)
+        assert defines == ["#define PHYSCAM_DISPERSION 1"] * (key[0] == "1") + ["#define PHYSCAM_FRESNEL 1"] * (key[1] == "1")
+    # each variant compiled its own code: four bytecodes, dispersion's (a wavelength per ray) the longer
+    sizes = {k: v[2] for k, v in out["variants"].items()}
+    assert len(set(sizes.values())) == 4 and sizes["10"] > sizes["00"] and sizes["11"] > sizes["01"], sizes
 
 
 PULL = INSTALL + '''

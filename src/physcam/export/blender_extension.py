@@ -3,9 +3,11 @@
 Inside Blender's own Python (numpy, no physcam) the add-on needs only numbers, so physcam computes
 them here, at build time, and the zip carries **precomputed data** (docs/blender.md says why):
 
-- per lens, four OSL camera shaders (dispersion and Fresnel on/off) from the template with the
-  lens's focus table (:func:`physcam.export.blender_focus.focus_table_shader`): focus, f-stop,
-  sensor and iris are shader parameters, so a keyframed pull renders with no rebuild;
+- per lens, one OSL camera shader source from the template with the lens's focus table
+  (:func:`physcam.export.blender_focus.focus_table_shader`): focus, f-stop, sensor and iris are shader
+  parameters, so a keyframed pull renders with no rebuild; dispersion and Fresnel (on/off) are
+  ``#ifdef`` blocks the add-on switches with ``#define`` lines in front of it
+  (:mod:`physcam.export.blender_variant`, in the zip as ``shader_variant.py``: four variants, one copy);
 - per lens, a JSON table of physcam's lens report at each focus state of that table
   (:func:`physcam.onset.report.solve_lens_report` at f/``REFERENCE_FSTOP``): EFL, best-match pinhole,
   entrance pupil, H1, CoC, and the closest focus and widest f-stop the panel checks against;
@@ -81,7 +83,8 @@ def _report_rows(lens, marks_mm) -> list[dict]:
 
 
 def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
-    """(the lens's JSON table, its four shaders by file name) for the zip."""
+    """(the lens's JSON table, its shader source by file name, ``{"<slug>.osl": source}``) for the zip
+    (:mod:`physcam.export.blender_variant` makes the four variants of the source)."""
     from ..errors import require_type
 
     require_type("slug", slug, str, "the lens's name in the zip, e.g. 'dgauss_50mm'")
@@ -102,11 +105,7 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
         ft = focus_table(lens)
         rows = _report_rows(lens, ft.marks_mm)
         pupil = [r["pupil_from_film_mm"] for r in rows]  # the camera object is the entrance pupil
-    shaders = {}
-    for disp in (False, True):
-        for fres in (False, True):
-            shaders[f"{slug}__d{int(disp)}f{int(fres)}.osl"] = focus_table_shader(ft, dispersion=disp, fresnel=fres,
-                                                                               pupil_mm=pupil)
+    shaders = {f"{slug}.osl": focus_table_shader(ft, dispersion=None, fresnel=None, pupil_mm=pupil)}
     data = {"slug": slug, "name": lens.name, "closest_m": ft.closest_mm / 1000.0, "fstop_min": ft.fstop_min,
             "fstop_open": ft.fstop_open, "fstop_max": MAX_F_NUMBER,
             # the focus axis (blender_focus.FocusAxis): the add-on finds a mark's rows as the shader does
@@ -169,12 +168,13 @@ def _limits() -> dict:
     return {"sensor_half_diagonal_max_mm": RADIAL_MAX_MM, "sensor_largest": largest.name}
 
 
-def _addon_source() -> str:
-    return resources.files(__package__).joinpath("blender_addon.py.in").read_text(encoding="utf-8")
+def _addon_source(name: str = "blender_addon.py.in") -> str:
+    """The text of a file of this package (the add-on's template, or a module the add-on imports)."""
+    return resources.files(__package__).joinpath(name).read_text(encoding="utf-8")
 
 
 def _payload_job(name) -> tuple[str, str, dict, dict[str, str]]:
-    """One lens's part of the zip, in a worker process: (slug, lens name, JSON table, shaders)."""
+    """One lens's part of the zip, in a worker process: (slug, lens name, JSON table, shader source)."""
     from ..lens.library import load_lens
 
     lens = load_lens(name)
@@ -227,6 +227,7 @@ def build_extension(out_dir, *, lenses=None, force: bool = False, progress=None,
     with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED, compresslevel=_DEFLATE_LEVEL) as z:
         z.writestr("blender_manifest.toml", extension_manifest(__version__))
         z.writestr("__init__.py", _addon_source())
+        z.writestr("shader_variant.py", _addon_source("blender_variant.py"))
         for slug, lens_name, data, shaders in _payloads(names, workers or os.cpu_count() or 1):
             z.writestr(f"lenses/{slug}.json", json.dumps(data))
             for fname, text in shaders.items():

@@ -620,13 +620,16 @@ def _zoom_defines(ft: FocusTable) -> tuple[list[str], list[str]]:
     return defines, data
 
 
-def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: bool = False, focus_m: float = 3.0,
-                       fstop: float = 0.0, sensor_mm=(DEFAULT_SENSOR_WIDTH_MM, DEFAULT_SENSOR_HEIGHT_MM),
-                       pupil_mm=None) -> str:
+def focus_table_shader(ft: FocusTable, *, dispersion: bool | None = False, fresnel: bool | None = False,
+                       focus_m: float = 3.0, fstop: float = 0.0,
+                       sensor_mm=(DEFAULT_SENSOR_WIDTH_MM, DEFAULT_SENSOR_HEIGHT_MM), pupil_mm=None) -> str:
     """The template with ``ft``'s focus table: focus, f-stop, sensor (with Blender's sensor fit and
     the frame's aspect), iris and ghosts are shader parameters (defaults from the keywords; ``fstop``
     0 is wide open). ``pupil_mm``: the entrance pupil's distance in front of the film at each focus
-    state; given, the camera's origin is the entrance pupil (the film behind it), else the film plane."""
+    state; given, the camera's origin is the entrance pupil (the film behind it), else the film plane.
+    ``dispersion`` and ``fresnel`` None: the source of all four settings, each chosen by OSL's
+    preprocessor from ``#define PHYSCAM_DISPERSION`` / ``PHYSCAM_FRESNEL`` lines written in front of it
+    (:func:`physcam.export.blender_variant.variant_source`; the extension's one shader per lens)."""
     from .blender_pupil import N_RADIAL, RADIAL_MAX_MM
 
     require_type("ft", ft, FocusTable, "physcam.export.blender_focus.focus_table(lens)")
@@ -663,7 +666,9 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
         data += [_arr32_once(ft, "RECT_TAB", np.concatenate([ft.rects[:, None], ft.rects_stopped], axis=1), "N_RECT_TAB"),
                  osl_array("STOP_LEVEL", (1.0,) + STOP_LEVELS, "N_LEVEL")]
     # with Fresnel on, the centre's transmission at infinity is in the norm (it hardly changes with focus)
-    norm = ft.norm * (ft.fresnel_loss if fresnel else 1.0)
+    norms = {f: _arr32("NORM_TAB", ft.norm * (ft.fresnel_loss if f else 1.0), "N_NORM_TAB") for f in (False, True)}
+    norm = (["#ifdef PHYSCAM_FRESNEL", norms[True], "#else", norms[False], "#endif"] if fresnel is None
+            else [norms[fresnel]])
     ga, gb = ghost_rows(ft)
     if ga:
         from ..lens.geometry import sag
@@ -672,7 +677,9 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
         sags = [sag(rear, rear.semi_diameter, ax) for ax in ("x", "y")]
         defines += ["#define PHYSCAM_GHOSTS 1", f"#define N_GHOST {len(ga)}",
                     f"#define REAR_SAG_LO {_num32(min(sags + [0.0]))}", f"#define REAR_SAG_HI {_num32(max(sags + [0.0]))}",
-                    f"#define FRESNEL_LOSS {_num32(ft.fresnel_loss)}"] + ([] if fresnel else ["#define PHYSCAM_SP 1"])
+                    f"#define FRESNEL_LOSS {_num32(ft.fresnel_loss)}"]
+        defines += (["#ifndef PHYSCAM_FRESNEL", "#define PHYSCAM_SP 1", "#endif"] if fresnel is None
+                    else [] if fresnel else ["#define PHYSCAM_SP 1"])
         data += [osl_array("GHOST_A", ga, "N_GHOST", "int"), osl_array("GHOST_B", gb, "N_GHOST", "int")]
     if pupil_mm is not None:
         if len(pupil_mm) != n_states:
@@ -680,11 +687,15 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool = False, fresnel: boo
         defines.append("#define PHYSCAM_PUPIL_ORIGIN 1")
         data.append(_arr32("PUPIL_TAB", pupil_mm, "N_GEO_TAB" if zoom else "N_FOCUS"))
     data += [_arr32("FILM_Z_TAB", ft.film_z, "N_GEO_TAB" if zoom else "N_FOCUS"),
-             _arr32("FILM_DZ_TAB", ft.film_slope, "N_GEO_TAB" if zoom else "N_FOCUS"), _arr32("NORM_TAB", norm, "N_NORM_TAB"),
+             _arr32("FILM_DZ_TAB", ft.film_slope, "N_GEO_TAB" if zoom else "N_FOCUS"), *norm,
              _arr32("VZ_TAB", ft.vertex_z, "N_VZ_TAB"), osl_array("SEMI_OPEN", ft.table.semi_diameter, "N_SURF"),
              _arr32("IRIS_LEVEL", ft.levels, "N_IRIS")]
     zoom_note = (f" at each of {len(ft.zoom.geometry_u)} zoom positions (pupil tables at {len(ft.zoom.pupil_u)})"
                  if zoom else "")
+    variant = ("dispersion and Fresnel as PHYSCAM_DISPERSION and PHYSCAM_FRESNEL say (#define lines written "
+               "in front of this source)" if dispersion is None or fresnel is None else
+               f"dispersion {'on' if dispersion else 'off'}, Fresnel {'on' if fresnel else 'off'}")
     head = [f"// {osl_comment(ft.lens.name)}: {n_focus} focus states from infinity to {ft.closest_mm / 1000:.3g} m "
-            f"(uniform in sqrt(1 - closest / distance)){zoom_note}; dispersion {'on' if dispersion else 'off'}, Fresnel {'on' if fresnel else 'off'}."]
-    return render_template(head + defines, data)
+            f"(uniform in sqrt(1 - closest / distance)){zoom_note}; {variant}."]
+    left = (("PHYSCAM_DISPERSION",) if dispersion is None else ()) + (("PHYSCAM_FRESNEL", "PHYSCAM_SP") if fresnel is None else ())
+    return render_template(head + defines, data, left=left)

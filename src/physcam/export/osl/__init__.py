@@ -3,7 +3,9 @@
 The template holds the optics as OSL; physcam fills two lines: ``@PHYSCAM_DEFINES@`` (array sizes
 and the feature switches) and ``@PHYSCAM_LENS_DATA@`` (the lens's arrays, inside the shader body:
 OSL has no global arrays). The feature switches (:data:`FEATURES`) are resolved here, so the
-written shader holds only the code it runs; every other preprocessor line is left to OSL.
+written shader holds only the code it runs; every other preprocessor line is left to OSL, and so are
+the switches a caller leaves (``render_template``'s ``left``: the Blender extension's one source per
+lens keeps dispersion and Fresnel as ``#ifdef`` blocks: :func:`lens_data` with None).
 Used by :mod:`physcam.export.blender` (one baked focus) and :mod:`physcam.export.blender_focus`
 (the focus table of the Blender extension).
 """
@@ -61,15 +63,15 @@ def _osl_kinds(table) -> np.ndarray:
     return kinds
 
 
-def _resolve(lines: list[str], on: set[str]) -> list[str]:
+def _resolve(lines: list[str], on: set[str], left=()) -> list[str]:
     """Keep the code of the switched-on features, drop the rest (nested #ifdef/#else/#endif of
-    :data:`FEATURES` only; other directives are OSL's)."""
+    :data:`FEATURES` not in ``left`` only; other directives are OSL's)."""
     out, stack = [], []  # stack: (is ours, keeping) per open #if
     for line in lines:
         word = line.strip().split()
         head = word[0] if word else ""
         keeping = all(k for _, k in stack)
-        if head in ("#ifdef", "#ifndef") and len(word) > 1 and word[1] in FEATURES:
+        if head in ("#ifdef", "#ifndef") and len(word) > 1 and word[1] in FEATURES and word[1] not in left:
             want = (word[1] in on) == (head == "#ifdef")
             stack.append((True, want))
             continue
@@ -89,15 +91,16 @@ def _resolve(lines: list[str], on: set[str]) -> list[str]:
     return out
 
 
-def render_template(defines: list[str], data: list[str]) -> str:
+def render_template(defines: list[str], data: list[str], left=()) -> str:
     """The shader: the template with ``defines`` and ``data`` in place and its switches resolved
-    (a ``#define NAME`` line in ``defines`` switches NAME on)."""
+    (a ``#define NAME`` line in ``defines`` switches NAME on), but those in ``left`` (names of
+    :data:`FEATURES`), whose ``#ifdef`` lines are kept for OSL's preprocessor."""
     for name, lines in (("defines", defines), ("data", data)):
         if isinstance(lines, str) or not all(isinstance(ln, str) for ln in lines):
             from ...errors import WrongTypeError
 
             raise WrongTypeError(f"{name} must be a list of OSL lines (text), got {lines!r:.60}")
-    on = {ln.split()[1] for ln in defines if ln.startswith("#define ") and ln.split()[1] in FEATURES}
+    on = {ln.split()[1] for ln in defines if ln.startswith("#define ") and ln.split()[1] in FEATURES} - set(left)
     out = []
     for line in template_text().splitlines():
         if line.strip() == "@PHYSCAM_DEFINES@":
@@ -106,13 +109,17 @@ def render_template(defines: list[str], data: list[str]) -> str:
             out.extend(data)
         else:
             out.append(line)
-    return "\n".join(_resolve(out, on)) + "\n"
+    return "\n".join(_resolve(out, on, left)) + "\n"
 
 
-def lens_data(table, aperture, wavelength_nm: float, bounds, *, dispersion: bool, fresnel: bool) -> tuple[list[str], list[str]]:
+def lens_data(table, aperture, wavelength_nm: float, bounds, *, dispersion: bool | None,
+              fresnel: bool | None) -> tuple[list[str], list[str]]:
     """The defines and the data lines that do not change with focus: surface kinds, quadric and
     asphere coefficients, indices (or dispersion coefficients), Fresnel scales and the iris shape
-    (``aperture``; in a focus-table shader the iris is the shader's parameters, pass None). ``table``: a :func:`physcam.trace.surfaces.surface_table` (film side first);
+    (``aperture``; in a focus-table shader the iris is the shader's parameters, pass None).
+    ``dispersion`` or ``fresnel`` None: both settings' lines, chosen by ``#ifdef PHYSCAM_DISPERSION``
+    (``PHYSCAM_FRESNEL``, which defines PHYSCAM_SP), which the lines do not define: leave those switches
+    to OSL (``render_template``'s ``left``). ``table``: a :func:`physcam.trace.surfaces.surface_table` (film side first);
     ``bounds``: the exit-pupil rectangles' PupilBounds, or None for a radial pupil table."""
     from ...errors import require_type
     from ...trace.kernels._layout import NA, NB, SA, SB, index_rows, pack
@@ -134,16 +141,23 @@ def lens_data(table, aperture, wavelength_nm: float, bounds, *, dispersion: bool
     if np.any(table.aspheric != 0.0):
         defines.append("#define HAS_ASPHERE 1")
         data.append(osl_array("ASPH", table.aspheric, "N_ASPH"))
-    if dispersion:
-        lo, hi = WAVELENGTH_RANGE_NM
-        defines += ["#define PHYSCAM_DISPERSION 1", f"#define WAVELENGTH_LO {osl_number(lo)}",
-                    f"#define WAVELENGTH_HI {osl_number(hi)}"]
-        data += [osl_array("DB", table.disp_before, "N_DISP"), osl_array("DA", table.disp_after, "N_DISP")]
+    lo, hi = WAVELENGTH_RANGE_NM
+    disp_defines = [f"#define WAVELENGTH_LO {osl_number(lo)}", f"#define WAVELENGTH_HI {osl_number(hi)}"]
+    disp_data = [osl_array("DB", table.disp_before, "N_DISP"), osl_array("DA", table.disp_after, "N_DISP")]
+    with np.errstate(all="ignore"):
+        index_data = [osl_array("N1", index_rows(S, NB, SB, wavelength_nm), "N_SURF"),
+                      osl_array("N2", index_rows(S, NA, SA, wavelength_nm), "N_SURF")]
+    if dispersion is None:
+        defines += ["#ifdef PHYSCAM_DISPERSION", *disp_defines, "#endif"]
+        data += ["#ifdef PHYSCAM_DISPERSION", *disp_data, "#else", *index_data, "#endif"]
+    elif dispersion:
+        defines += ["#define PHYSCAM_DISPERSION 1", *disp_defines]
+        data += disp_data
     else:
-        with np.errstate(all="ignore"):
-            data += [osl_array("N1", index_rows(S, NB, SB, wavelength_nm), "N_SURF"),
-                     osl_array("N2", index_rows(S, NA, SA, wavelength_nm), "N_SURF")]
-    if fresnel:
+        data += index_data
+    if fresnel is None:
+        defines += ["#ifdef PHYSCAM_FRESNEL", "#define PHYSCAM_SP 1", "#endif"]
+    elif fresnel:
         defines += ["#define PHYSCAM_FRESNEL 1", "#define PHYSCAM_SP 1"]
     data.append(osl_array("RSC", table.r_scale, "N_SURF"))  # Fresnel, and ghosts' reflectances
     return defines + _aperture_defines(aperture), data
