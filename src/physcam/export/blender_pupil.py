@@ -39,7 +39,12 @@ per cell where the mid checks agree (:func:`radial_pupil_table`): on the double 
 2.5 m, every film radius of a full frame at f/2.8, f/5.6 and f/16 (issue 41; round 9: 0.945 at f/2.8,
 where other surfaces begin to cut the set between two levels the cubic in s rounds the area's kink off,
 so the focus table adds a level there, :func:`_refined_levels`; round 7's table, which never trusted a
-set other surfaces cut, about 0.3).
+set other surfaces cut, about 0.3). A level is added only for a miss inside the lens's image circle
+(:func:`_in_circle`: the film radii where the chief ray passes at every traced focus, physcam's image
+circle as the lens cards give it). Past it a stopped-down picture is black and an open one is lit only
+through the pupil's edge, by a sensor the lens does not cover; there a miss leaves its cell untrusted
+(more noise, no bias) instead of growing every table of the lens (round 10 counted misses to
+:data:`RADIAL_MAX_MM`: 483 levels added over the 44 bundled primes, now 357).
 """
 
 from __future__ import annotations
