@@ -756,8 +756,9 @@ def _in_circle(rhos, lit_smallest) -> np.ndarray:
     that holds a part of the lens's image circle at every traced focus: the film radii below the first where
     nothing passes at the smallest iris radius checked at some focus (``lit_smallest``: per focus, whether
     anything passes at half the last level, 1/32 of the file's stop). There the chief ray (through the stop's
-    centre) is cut, to within that iris: physcam's image circle (lens cards, ``image_circle_radius``). It grows as
-    the lens focuses closer; a sensor the lens covers at every focus lies inside the smallest."""
+    centre) is cut by a clear aperture, to within that iris: physcam's image circle (the lens cards'
+    ``field_limit_deg``). It grows as the lens focuses closer; a sensor the lens covers at every focus lies
+    inside the smallest."""
     rhos = np.asarray(rhos, dtype=float)
     dark = rhos[~np.all(np.asarray(lit_smallest, dtype=bool).reshape(-1, rhos.size), axis=0)]
     if not dark.size:
