@@ -39,7 +39,12 @@ per cell where the mid checks agree (:func:`radial_pupil_table`): on the double 
 2.5 m, every film radius of a full frame at f/2.8, f/5.6 and f/16 (issue 41; round 9: 0.945 at f/2.8,
 where other surfaces begin to cut the set between two levels the cubic in s rounds the area's kink off,
 so the focus table adds a level there, :func:`_refined_levels`; round 7's table, which never trusted a
-set other surfaces cut, about 0.3).
+set other surfaces cut, about 0.3). A level is added only for a miss inside the lens's image circle
+(:func:`_in_circle`: the film radii where the chief ray passes at every traced focus, physcam's image
+circle as the lens cards give it). Past it a stopped-down picture is black and an open one is lit only
+through the pupil's edge, by a sensor the lens does not cover; there a miss leaves its cell untrusted
+(more noise, no bias) instead of growing every table of the lens (round 10 counted misses to
+:data:`RADIAL_MAX_MM`: 483 levels added over the 44 bundled primes, now 357).
 """
 
 from __future__ import annotations
@@ -720,17 +725,18 @@ def _check_axes(levels) -> tuple[np.ndarray, np.ndarray]:
 def _refined_levels(levels, tables, checks) -> np.ndarray:
     """``levels`` with the geometric middle of every interval where the shader's cubic in iris radius
     misses a traced table's area at the interval's middle (:func:`_check_points`) by over
-    :data:`AREA_TOLERANCE` at a film radius whose reads at both levels hold it: where another surface
-    begins to cut the passing set between the two (the area bends there, a kink the cubic rounds off),
-    halving the interval halves the miss (the double Gauss's table traced at 2.5 m: 0.64 % at film radius
-    10.4 mm between 6.79 and 6.05 mm, f/2.8's interval; at most 0.21 % between the middle and either level). ``tables``
-    (radial_pupil_table's at ``levels``) and ``checks`` (the areas its ``checks`` received, one per
-    table): the traced focus marks of one lens, which share its levels."""
+    :data:`AREA_TOLERANCE` at a film radius of the lens's image circle (:func:`_in_circle`) whose reads at
+    both levels hold it: where another surface begins to cut the passing set between the two (the area bends
+    there, a kink the cubic rounds off), halving the interval halves the miss (the double Gauss's table traced
+    at 2.5 m: 0.64 % at film radius 10.4 mm between 6.79 and 6.05 mm, f/2.8's interval; at most 0.21 % between
+    the middle and either level). ``tables`` (radial_pupil_table's at ``levels``) and ``checks`` (the areas its
+    ``checks`` received, one per table): the traced focus marks of one lens, which share its levels."""
     levels = _levels(levels)
     rhos, checked = _check_axes(levels)
     read_rho, read_s = _check_points(levels)
     is_level = np.isin(checked, levels)
     misses = np.zeros(len(levels) - 1, dtype=bool)
+    inside = _in_circle(rhos, [np.reshape(want, (len(rhos), len(checked)))[:, -1] > 0 for want in checks])
     for table, want in zip(tables, checks):
         table = np.array(table, dtype=float)
         table[..., 3] = cell_area(table[..., 3])
@@ -740,9 +746,25 @@ def _refined_levels(levels, tables, checks) -> np.ndarray:
         bad = (np.abs(got - want) > AREA_TOLERANCE * np.maximum(want, 1e-12)).reshape(len(rhos), len(checked)) | ~lit
         for c in np.flatnonzero(~is_level[1:-1]) + 1:  # a middle between the levels checked[c - 1] and checked[c + 1]
             misses[np.searchsorted(-levels, -checked[c]) - 1] |= bool((bad[:, c] & lit[:, c] & ~bad[:, c - 1]
-                                                                       & ~bad[:, c + 1]).any())
+                                                                       & ~bad[:, c + 1] & inside).any())
     mid = np.sqrt(levels[:-1] * levels[1:])[misses]
     return np.sort(np.concatenate([levels, mid]))[::-1]
+
+
+def _in_circle(rhos, lit_smallest) -> np.ndarray:
+    """Per film radius ``rhos`` (:func:`_check_axes`), whether it lies on a cell (between two film radius nodes)
+    that holds a part of the lens's image circle at every traced focus: the film radii below the first where
+    nothing passes at the smallest iris radius checked at some focus (``lit_smallest``: per focus, whether
+    anything passes at half the last level, 1/32 of the file's stop). There the chief ray (through the stop's
+    centre) is cut by a clear aperture, to within that iris: physcam's image circle (the lens cards'
+    ``field_limit_deg``). It grows as the lens focuses closer; a sensor the lens covers at every focus lies
+    inside the smallest."""
+    rhos = np.asarray(rhos, dtype=float)
+    dark = rhos[~np.all(np.asarray(lit_smallest, dtype=bool).reshape(-1, rhos.size), axis=0)]
+    if not dark.size:
+        return np.ones(rhos.size, dtype=bool)
+    step = RADIAL_MAX_MM / (N_RADIAL - 1)
+    return rhos <= math.ceil(dark.min() / step - 1e-9) * step + 1e-9  # the node that ends the edge's cell
 
 
 def _check_points(levels) -> tuple[np.ndarray, np.ndarray]:
