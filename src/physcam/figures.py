@@ -506,7 +506,9 @@ def figure_problems(fig) -> list[str]:
     from .errors import require_type
 
     require_type("fig", fig, Figure, "a matplotlib Figure (physcam's figures return one)")
-    fig.canvas.draw()
+    # laid out as drawn (ticks, constrained layout, text sizes) without rasterising a pixel: the text
+    # extents are the same as after canvas.draw() (compared on the lens cards), in half the time
+    fig.draw_without_rendering()
     renderer = fig.canvas.get_renderer()
     box = fig.bbox
     problems = []
