@@ -119,13 +119,14 @@ def run_blender(script: str, *args, timeout: float = 300.0, env: dict | None = N
 def run_blender_log(script: str, *args, timeout: float = 300.0, env: dict | None = None) -> tuple[dict, str]:
     """:func:`run_blender`, and everything Blender printed (stdout, then stderr)."""
     runner = require_blender()
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""), **(env or {}))
+    own = env or {}  # the test's own variables: only a user folder the test gave is cleaned up
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""), **own)
     with tempfile.TemporaryDirectory(prefix="physcam-blender-") as tmp:
         path = Path(tmp) / "script.py"
         path.write_text(OSL_PATH_PRELUDE + script)
         p = subprocess.run(runner.command(path, *map(str, args)), capture_output=True, text=True, timeout=timeout,
                            env=env)
-    _remove_installed_extensions(env)
+    _remove_installed_extensions(own)
     if p.returncode != 0:
         raise AssertionError(f"Blender script failed (exit {p.returncode}):\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}")
     lines = [ln for ln in p.stdout.strip().splitlines() if ln.startswith("{")]
@@ -135,8 +136,9 @@ def run_blender_log(script: str, *args, timeout: float = 300.0, env: dict | None
 
 
 def _remove_installed_extensions(env: dict) -> None:
-    """Remove the extensions a run installed into its own ``BLENDER_USER_RESOURCES`` (every test gives each
-    Blender a fresh one): the physcam extension unpacks to about 120 MB of shaders (470 MB before one
+    """Remove the extensions a run installed into the ``BLENDER_USER_RESOURCES`` its test gave it (``env``: the
+    test's own variables, never the shell's: a user's portable Blender keeps its extensions; every test gives
+    each Blender a fresh folder): the physcam extension unpacks to about 120 MB of shaders (470 MB before one
     source per lens, round 11), and a dozen 470 MB copies kept until the session ends filled a CI machine's disk. No test reads that folder after its Blender exits."""
     user = env.get("BLENDER_USER_RESOURCES")
     if user:
