@@ -139,7 +139,8 @@ def _remove_installed_extensions(env: dict) -> None:
     """Remove the extensions a run installed into the ``BLENDER_USER_RESOURCES`` its test gave it (``env``: the
     test's own variables, never the shell's: a user's portable Blender keeps its extensions; every test gives
     each Blender a fresh folder): the physcam extension unpacks to about 120 MB of shaders (470 MB before one
-    source per lens, round 11), and a dozen 470 MB copies kept until the session ends filled a CI machine's disk. No test reads that folder after its Blender exits."""
+    source per lens, round 11), and a dozen 470 MB copies kept until the session ended filled a CI machine's
+    disk. No test reads that folder after its Blender exits."""
     user = env.get("BLENDER_USER_RESOURCES")
     if user:
         shutil.rmtree(Path(user) / "extensions", ignore_errors=True)
