@@ -58,12 +58,11 @@ def test_stored_fits_meet_their_formula_within_their_stored_error():
     import numpy as np
 
     from physcam.lens.glassformulas import formula_index
-    from physcam.optics.glassfit import _KEY_UM
+    from physcam.optics.glassfit import _fit_wavelengths_um
 
     for name, table in _stored().items():
         for key, e in table.items():
-            band = e["band_nm"]
-            lam_um = np.concatenate([np.linspace(band[0], band[1], 161) / 1000.0, _KEY_UM])
+            lam_um = _fit_wavelengths_um(tuple(e["band_nm"]))
             want = np.asarray(formula_index(e["formula"], tuple(e["coefficients"]), lam_um), dtype=float)
             got = glass.evaluate(tuple(e["form"]), lam_um * 1000.0)
             assert math.isclose(float(np.max(np.abs(got - want))), e["error"], rel_tol=1e-6, abs_tol=1e-12), \
