@@ -83,3 +83,16 @@ def extension_zip(tmp_path_factory):
             assert main(["export", "blender-extension", "-o", str(out), "--workers", "2"]) == 0
     (zp,) = out.glob("physcam-*.zip")
     return zp
+
+
+@pytest.fixture(scope="session")
+def extension_user(extension_zip, tmp_path_factory):
+    """The ``env`` of a Blender user folder (``BLENDER_USER_RESOURCES``) where :func:`extension_zip` is
+    installed with Blender's own installer, once per session and shared by the extension's render tests
+    (tests/blender/_blender.py, ``install_extension``); their scripts enable it. Under pytest-xdist the
+    first worker to ask installs it under a session lock."""
+    from _blender import install_extension
+    from _session import session_lock
+
+    with session_lock(tmp_path_factory, "blender-extension-user") as root:
+        return install_extension(extension_zip, root / "blender-user")

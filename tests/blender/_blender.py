@@ -65,12 +65,16 @@ world = bpy.data.worlds.new("black"); scene.world = world; world.use_nodes = Tru
 world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
 """
 
-#: The start of a script run through the installed physcam extension (argv[1]: its zip): installed with
-#: Blender's own installer, Cycles on the CPU with 2 threads, no denoising, linear EXR out.
+#: The start of a script run through the physcam extension installed in its Blender user folder
+#: (``BLENDER_USER_RESOURCES``: the session's shared install, :func:`install_extension`; argv[1]: the zip
+#: it was installed from): enabled as Blender enables an installed add-on at start-up, Cycles on the CPU
+#: with 2 threads, no denoising, linear EXR out.
 INSTALLED_EXTENSION_SCENE = """
 import json, math, sys
 import numpy as np
-bpy.ops.extensions.package_install_files(filepath=sys.argv[1], repo="user_default", enable_on_install=True)
+import addon_utils
+addon_utils.enable("bl_ext.user_default.physcam", default_set=True)
+assert hasattr(bpy.types.Camera, "physcam"), "the physcam extension is not installed in BLENDER_USER_RESOURCES"
 scene = bpy.context.scene
 scene.render.engine = "CYCLES"; scene.cycles.device = "CPU"; scene.cycles.use_denoising = False
 scene.render.threads_mode = "FIXED"; scene.render.threads = 2
@@ -135,6 +139,37 @@ def run_blender_log(script: str, *args, timeout: float = 300.0, env: dict | None
     return json.loads(lines[-1]), p.stdout + p.stderr
 
 
+#: The file marking a Blender user folder shared by the session's tests (:func:`install_extension`): no run
+#: removes its extensions.
+SHARED_USER_MARK = ".physcam-shared-by-the-session"
+
+#: Installs argv[1] (the zip) with Blender's own installer into the user folder Blender was started with.
+_INSTALL = """
+bpy.ops.extensions.package_install_files(filepath=sys.argv[1], repo="user_default", enable_on_install=True)
+import json
+print(json.dumps({"installed": hasattr(bpy.types.Camera, "physcam")}))
+"""
+
+
+def install_extension(zip_path, user: Path) -> dict:
+    """Install the extension ``zip_path`` into the Blender user folder ``user`` (once: a folder already
+    marked shared is kept) with Blender's own installer; returns the ``env`` giving a run that folder.
+
+    The extension's render tests share one install, as an artist's Blender keeps an installed extension
+    from one session to the next: each of 11 runs installing its own copy wrote 111 MB and cost about
+    2 s CPU and 5 s wall (2026-11-29). Installing is itself tested by tests/blender/test_extension.py."""
+    env = {"BLENDER_USER_RESOURCES": str(user)}
+    done = user / ".physcam-installed"
+    if not done.exists():
+        shutil.rmtree(user, ignore_errors=True)  # a half-made install of an interrupted run
+        user.mkdir(parents=True)
+        (user / SHARED_USER_MARK).touch()  # first: the run below must not remove what it installs
+        out = run_blender(_INSTALL, zip_path, env=env)
+        assert out["installed"], out
+        done.touch()
+    return env
+
+
 def _remove_installed_extensions(env: dict) -> None:
     """Remove the extensions a run installed into the ``BLENDER_USER_RESOURCES`` its test gave it (``env``: the
     test's own variables, never the shell's: a user's portable Blender keeps its extensions; every test gives
@@ -142,7 +177,7 @@ def _remove_installed_extensions(env: dict) -> None:
     source per lens, round 11), and a dozen 470 MB copies kept until the session ended filled a CI machine's
     disk. No test reads that folder after its Blender exits."""
     user = env.get("BLENDER_USER_RESOURCES")
-    if user:
+    if user and not (Path(user) / SHARED_USER_MARK).exists():
         shutil.rmtree(Path(user) / "extensions", ignore_errors=True)
 
 

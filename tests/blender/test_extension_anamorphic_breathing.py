@@ -74,11 +74,11 @@ def _marks():
 
 
 @pytest.fixture(scope="module")
-def renders(extension_zip, tmp_path_factory):
+def renders(extension_zip, extension_user, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("anamorphic_breathing")
     marks = _marks()
     out, _ = run_blender_log(SCENE, extension_zip, LENS, W, H, json.dumps(marks), tmp,
-                             env={"BLENDER_USER_RESOURCES": str(tmp / "user")})
+                             env=extension_user)
     return marks, out
 
 

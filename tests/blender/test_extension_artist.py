@@ -131,9 +131,9 @@ print(json.dumps(out))
 
 
 @pytest.fixture(scope="module")
-def artist(extension_zip, tmp_path_factory):
+def artist(extension_zip, extension_user, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("artist")
-    return run_blender_log(ARTIST, extension_zip, tmp, env={"BLENDER_USER_RESOURCES": str(tmp / "user")})
+    return run_blender_log(ARTIST, extension_zip, tmp, env=extension_user)
 
 
 def test_bad_input_never_reaches_the_render(artist):

@@ -82,7 +82,7 @@ def _pupil_from_film(lens, mark_mm):
                                       lens=lens).camera).pupil_from_film_mm
 
 
-def test_bokeh_diameter_and_iris_corners_match_bokeh_image(extension_zip, tmp_path):
+def test_bokeh_diameter_and_iris_corners_match_bokeh_image(extension_zip, extension_user, tmp_path):
     """The rendered bokeh's second-moment diameter (the sphere's own image removed in quadrature)
     is physcam's within 3 %, and its rim has 6 corners pointing where physcam's do within 3 deg."""
     lens = load_lens(LENS)
@@ -100,7 +100,7 @@ def test_bokeh_diameter_and_iris_corners_match_bokeh_image(extension_zip, tmp_pa
     # pupil's distance in front of the camera
     depth_m = (NEAR_MM - _pupil_from_film(lens, MARK_MM)) / 1000.0
     out = run_blender(BOKEH, extension_zip, tmp_path, LENS, CROP_MM, MARK_MM / 1000.0, FSTOP, BLADES, CORNER_DEG,
-                      depth_m, SPHERE_M, CROP_PX, BORDER_PX, env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
+                      depth_m, SPHERE_M, CROP_PX, BORDER_PX, env=extension_user)
     assert out["message"] == ""
     img = np.array(out["img"])
     px = CROP_MM / CROP_PX

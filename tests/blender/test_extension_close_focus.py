@@ -68,13 +68,13 @@ def _traced_rms_px(lens) -> tuple[float, float]:
     return rms / (SW / W), cam.at_mark.pupil_from_film_mm
 
 
-def test_a_point_at_the_closest_focus_renders_sharp(extension_zip, tmp_path):
+def test_a_point_at_the_closest_focus_renders_sharp(extension_zip, extension_user, tmp_path):
     """The light's rms radius in the render (about its centroid, px) equals the trace's, its 1 px box
     filter added (rms^2 + 1/6 px^2), within 0.15 px; it lands on the frame's centre within 0.15 px."""
     lens = load_lens(SLUG)
     want, pupil_mm = _traced_rms_px(lens)
     out = run_blender(SPOT, extension_zip, tmp_path, SLUG, MARK_MM / 1000.0, FSTOP, (MARK_MM - pupil_mm) / 1000.0,
-                      LIGHT_MM / 1000.0, env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
+                      LIGHT_MM / 1000.0, env=extension_user)
     assert out["message"] == ""
     img = np.clip(np.array(out["img"]), 0, None)
     yy, xx = np.indices(img.shape)

@@ -59,7 +59,7 @@ def _tent_means(wls, heights):
     return float(red @ heights / red.sum()), float(blue @ heights / blue.sum())
 
 
-def test_lateral_colour_at_the_corner_matches_physcam(extension_zip, tmp_path):
+def test_lateral_colour_at_the_corner_matches_physcam(extension_zip, extension_user, tmp_path):
     """The red and blue centroids of the light's image, along the diagonal, differ by physcam's
     tent-weighted lateral colour within 5 % (seen -138.1 um rendered, -137.5 um physcam: 2 px at
     512 px), and each lies within 1 px of its chief ray's tent-weighted height (seen 0.45 px: an
@@ -85,7 +85,7 @@ def test_lateral_colour_at_the_corner_matches_physcam(extension_zip, tmp_path):
 
     c, r = pixel(0.5 * (h_red + h_blue))
     out = run_blender(COLOUR, extension_zip, tmp_path, SLUG, SW, SH, FSTOP, json.dumps(light), W, H,
-                      json.dumps([round(c), round(r), 24]), env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
+                      json.dumps([round(c), round(r), 24]), env=extension_user)
     assert out["message"] == ""
     img = np.array(out["img"])
     yy, xx = np.mgrid[0:H, 0:W]

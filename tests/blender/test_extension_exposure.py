@@ -102,11 +102,11 @@ def _predicted(lens, fstop):
 
 
 @pytest.fixture(scope="module")
-def white(extension_zip, tmp_path_factory):
+def white(extension_zip, extension_user, tmp_path_factory):
     """The white world's renders (the script's JSON)."""
     tmp_path = tmp_path_factory.mktemp("white")
     return run_blender(WHITE, extension_zip, tmp_path, LENS, SW, SH, W, H, json.dumps(BLOCKS), json.dumps(FSTOPS),
-                       env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
+                       env=extension_user)
 
 
 def test_stopped_down_pupil_tables_keep_the_picture(white):

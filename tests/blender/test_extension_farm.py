@@ -61,8 +61,9 @@ print(json.dumps({"message": p.message, "sensor_fit": cam_obj.data.sensor_fit}))
 RENDER = '''
 import json, sys
 import numpy as np
-if sys.argv[1] != "none":
-    bpy.ops.extensions.package_install_files(filepath=sys.argv[1], repo="user_default", enable_on_install=True)
+if sys.argv[1] != "none":  # a farm node where the extension is installed and enabled
+    import addon_utils
+    addon_utils.enable("bl_ext.user_default.physcam", default_set=True)
 bpy.ops.wm.open_mainfile(filepath=sys.argv[2])
 scene = bpy.context.scene
 scene.render.filepath = sys.argv[3] + "/frame_####"
@@ -144,17 +145,18 @@ def predictions():
 
 
 @pytest.fixture(scope="module")
-def renders(extension_zip, tmp_path_factory):
+def renders(extension_zip, extension_user, tmp_path_factory):
     """The shot built and saved by one Blender, rendered as an animation by two fresh ones: with the
     extension (the file saved on frame 3) and without it (saved on frame 1)."""
     tmp = tmp_path_factory.mktemp("farm")
     built, log = run_blender_log(BUILD, extension_zip, tmp, W, H, json.dumps(LIGHTS), LENS, SW, SH, json.dumps(KEYS),
-                                 env={"BLENDER_USER_RESOURCES": str(tmp / "user_artist")})
+                                 env=extension_user)
     out = {"built": built, "logs": {"artist": log}}
     for name, zip_arg, saved in (("with", extension_zip, 3), ("without", "none", 1)):
-        (tmp / name).mkdir()
+        (tmp / name).mkdir()  # without: a fresh user folder, no extension in it
         res, log = run_blender_log(RENDER, zip_arg, tmp / f"saved_on_{saved}.blend", tmp / name,
-                                   env={"BLENDER_USER_RESOURCES": str(tmp / f"user_{name}")})
+                                   env=extension_user if name == "with" else
+                                   {"BLENDER_USER_RESOURCES": str(tmp / f"user_{name}")})
         out[name] = res
         out["logs"][name] = log
     return out

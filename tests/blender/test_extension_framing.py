@@ -72,10 +72,10 @@ print(json.dumps(out))
 
 
 @pytest.fixture(scope="module")
-def framing(extension_zip, tmp_path_factory):
+def framing(extension_zip, extension_user, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("framing")
     out, log = run_blender_log(FRAMING, extension_zip, LENS, json.dumps(CASES), DIST + 0.05, SPOT, tmp, DIST,
-                               env={"BLENDER_USER_RESOURCES": str(tmp / "user")})
+                               env=extension_user)
     return out, log
 
 

@@ -73,7 +73,7 @@ def _centroid(a):
     return np.array([(a * xx).sum(), (a * yy).sum()]) / a.sum()
 
 
-def test_ghost_lands_where_the_ghost_analysis_puts_it(extension_zip, tmp_path):
+def test_ghost_lands_where_the_ghost_analysis_puts_it(extension_zip, extension_user, tmp_path):
     """One ghost path (a compact one, wholly on the sensor): its rendered centroid within 0.05 mm
     (0.7 px at 512 px; the ghost's rms radius is 1.8 mm) and its flux / the direct image's within
     5 % of ghost_analysis's (seen 0.03 mm and 0.6 %); all paths together (the "Ghosts only" image,
@@ -90,7 +90,7 @@ def test_ghost_lands_where_the_ghost_analysis_puts_it(extension_zip, tmp_path):
                  and math.hypot(g.centroid_y_mm - res.direct_centroid_mm[1], g.centroid_x_mm) > 5.0)
     k = pairs.index((ghost.i, ghost.j))
     out = run_blender(GHOSTS, extension_zip, tmp_path, SLUG, SW, SH, FSTOP, FIELD_DEG, W, H, k,
-                      env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
+                      env=extension_user)
     assert out["message"] == ""
     direct, one, every, picture = (np.array(out[n]) for n in ("direct", "one", "all", "picture"))
     # the direct image lands where the analysis's direct beam does (the set-up is the same)

@@ -120,11 +120,11 @@ print(json.dumps({"frames": frames, "extension": hasattr(bpy.types.Camera, "phys
 
 
 @pytest.fixture(scope="module")
-def renders(extension_zip, tmp_path_factory, predictions):
+def renders(extension_zip, extension_user, tmp_path_factory, predictions):
     tmp = tmp_path_factory.mktemp("zoom")
     keys = [(p["zoom_mm"], p["focus_m"]) for p in predictions]
     built, _ = run_blender_log(ARTIST, extension_zip, tmp, W, H, LENS, X_MM, DIST_MM, R_MM, json.dumps(keys),
-                               env={"BLENDER_USER_RESOURCES": str(tmp / "user_artist")})
+                               env=extension_user)
     (tmp / "farm").mkdir()
     farm, _ = run_blender_log(FARM, tmp / "shot.blend", tmp / "farm", env={"BLENDER_USER_RESOURCES": str(tmp / "user_farm")})
     return built, farm
