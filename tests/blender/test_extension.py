@@ -12,7 +12,7 @@ import json
 import numpy as np
 import pytest
 
-from _blender import run_blender
+from _blender import INSTALLED_EXTENSION_SCENE, run_blender
 from physcam.lens.library import list_lenses, load_lens
 from physcam.optics.focusing import breathing_table
 from physcam.trace.rays import RayBatch
@@ -88,13 +88,9 @@ print(json.dumps(res))
     assert len(set(sizes.values())) == 4 and sizes["10"] > sizes["00"] and sizes["11"] > sizes["01"], sizes
 
 
-PULL = INSTALL + '''
-import numpy as np
-scene.cycles.use_denoising = False
-scene.render.threads_mode = "FIXED"; scene.render.threads = 2
-scene.view_settings.view_transform = "Standard"
-scene.render.image_settings.file_format = "OPEN_EXR"
+PULL = INSTALLED_EXTENSION_SCENE + '''
 cam_obj = scene.camera
+cam = cam_obj.data
 cam_obj.location = (0.0, 0.0, 0.0); cam_obj.rotation_euler = (0.0, 0.0, 0.0)
 for o in list(bpy.data.objects):
     if o.type != "CAMERA":
@@ -185,7 +181,7 @@ def _predict(lens, mark_mm, world, sh):
     return np.array(out)
 
 
-def test_keyframed_focus_pull_renders_physcams_focus_states(extension_zip, tmp_path):
+def test_keyframed_focus_pull_renders_physcams_focus_states(extension_zip, extension_user, tmp_path):
     """Focus keyframed 1 m -> 5 m (frames 1, 2) through the Distagon 35 at f/8, a chart of small
     lights 30 m away: each frame's markers land within 0.5 px (512 px wide) of physcam's trace at
     that frame's focus; the framing change between the frames (marker spread) equals `physcam lens
@@ -203,8 +199,7 @@ def test_keyframed_focus_pull_renders_physcams_focus_states(extension_zip, tmp_p
     D = 30.0
     world = [(x, y, -D) for y in (-4.0, 0.0, 4.0) for x in (-12.0, -6.0, 0.0, 6.0, 12.0)]
     world += [(-2.2, 0.0, -5.0, 0.03), (2.2, 0.0, -5.0, 0.03)]  # 23.7 degrees: the edge, 20 px beyond the outer column
-    out = run_blender(PULL, extension_zip, tmp_path, SLUG, W, H, SW, sh, json.dumps(world), 0.12,
-                      env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
+    out = run_blender(PULL, extension_zip, tmp_path, SLUG, W, H, SW, sh, json.dumps(world), 0.12, env=extension_user)
     lens = load_lens(SLUG)
     spreads = {}
     for frame, mark in (("1", 1000.0), ("2", 5000.0)):
