@@ -123,7 +123,8 @@ EXTRA_JSON_RUNS = {
     "psf_fft": ["psf", "dgauss_50mm", "--fstop", "8"],
     "mtf_chart_best_focus": ["mtf", "dgauss_50mm", "--fstop", "4", "--fields", "3", "--pupil-samples", "32",
                              "--frequency", "20", "--best-focus", "20"],
-    "report_dof_real": ["report", "--lens", "dgauss_50mm", "--fstop", "5.6", "--focus", "3m", "--dof", "real"],
+    # f/2.8: its document has the keys and value types of f/5.6's (the former run here), in 2/3 of the CPU
+    "report_dof_real": ["report", "--lens", "dgauss_50mm", "--fstop", "2.8", "--focus", "3m", "--dof", "real"],
     "distortion_field": ["distortion", "dgauss_50mm", "--resolution", "256x171", "--focus", "2m", "--fit", "brown"],
     "distortion_across_focus": ["distortion", "dgauss_50mm", "--resolution", "256x171", "--across-focus", "1m,inf"],
     "report_at_infinity": ["report", "--lens", "dgauss_50mm", "--fstop", "2.8", "--focus", "inf", "--cameras"],

@@ -1,7 +1,8 @@
 """Fuzz every CLI subcommand (issue 8): hypothesis picks flags and extreme, empty and non-numeric
 values; each run is forked (from a clean fork server) with an address-space limit and must end with exit 0 or 2, no
 traceback, a single "physcam: error:" line when it refuses, no NaN/inf printed as a result, and
-a peak resident memory under 2 GB.
+a peak resident memory under 2 GB (the run's whole process: the modules the server loaded before
+forking count, as they would in a `physcam` process that imported them itself; :data:`FORK_SERVER`).
 
 Hostile values too (issue 24 item 12): names and paths of 300 characters (past the system's 255),
 400-digit integers, subnormals (1e-320), 1e400, a lens file and a user config nested 5000 deep.
@@ -136,17 +137,57 @@ def _argv_strategy(path, parser):
     return build()
 
 
+#: What the fork server imports before it forks, besides every command module of physcam.cli: the
+#: libraries and physcam modules many runs reach, so that each forked run does not import them again
+#: (of this module's 729 runs, 2026-11-29: NumPy in 84, 0.2-0.3 s of CPU each; USD's Python modules in
+#: 55, 0.4 s; the lens library in 122; a run refused in argparse costs 15 ms instead of 60 ms; the
+#: module's CPU 176 -> 81 s with the server shared by the leaves). Only imports, no work: the server never
+#: traces a ray, runs a numba or OpenMP kernel (it imports no numba), opens a USD stage or registers
+#: physcam's USD plugin (`physcam.usd` does, and USD's plugin registry starts worker threads); it checks
+#: it has one thread at start and before every fork. numpy's BLAS runs on one thread
+#: (OPENBLAS_NUM_THREADS=1, tests/conftest.py, inherited), so numpy starts none; physcam draws no random
+#: number from numpy's global state (which forked runs would share), and none of these modules reads the
+#: environment or the config at import (each run sets its own). The runs register physcam's USD plugin
+#: as before, each in its own process: PXR_PLUGINPATH_NAME was set by the session's `import physcam.usd`
+#: (tests/conftest.py) before the server started.
+#: What the preloads mean for the bounds: a forked run's peak resident memory (``ru_maxrss``) counts the
+#: pages it shares with the server, as it counts what a process imported itself (a run that loads no
+#: lens: about 57 MB, was 12 MB; the largest, the demo: about 370 MB either way), so the 2 GB bound is
+#: still on the run's whole process, at most 45 MB of it modules the run would not have loaded; its
+#: address space starts at the server's (about 0.65 GB of :data:`ADDRESS_SPACE_BYTES`), as in a `physcam`
+#: process that imported these modules itself.
+PRELOAD = ("numpy", "pxr.Usd", "pxr.UsdGeom", "pxr.Sdf", "pxr.Gf",
+           "physcam.lens.library", "physcam.onset.report", "physcam.optics.state", "physcam.trace.trace", "physcam.io",
+           "physcam.progress", "physcam.cli._config", "physcam.live.sample", "physcam.metadata")
+
 #: A fresh process that forks one child per run. Forking the pytest worker itself is unsafe once
 #: it has run numba's OpenMP kernels (GNU OpenMP aborts a forked child); this server only imports
-#: physcam, so its children start clean. One JSON request per line on stdin, one reply per line.
+#: physcam's command modules and :data:`PRELOAD`, so its children start clean. It serves every leaf of
+#: the module (its state never changes: only the children run commands). One JSON request per line on
+#: stdin, one reply per line.
 FORK_SERVER = r"""
-import json, os, resource, sys, time, signal
+import importlib, json, os, resource, sys, time, signal
+import physcam.cli
 from physcam.cli import main
 
 limit, timeout = int(sys.argv[1]), float(sys.argv[2])
+for name in sorted(set(physcam.cli.COMMAND_MODULES.values())):
+    importlib.import_module("physcam.cli." + name)
+for name in sys.argv[3].split(","):
+    importlib.import_module(name)
+
+
+def threads():
+    return len(os.listdir("/proc/self/task")) if os.path.isdir("/proc/self/task") else 1
+
+
+print(json.dumps({"threads": threads()}), flush=True)
 for line in sys.stdin:
     req = json.loads(line)
     out_path, err_path = req["out"], req["err"]
+    if threads() != 1:
+        print(json.dumps({"threads": threads()}), flush=True)
+        continue
     pid = os.fork()
     if pid == 0:
         rc = 99
@@ -191,10 +232,13 @@ for line in sys.stdin:
 
 class ForkServer:
     def __init__(self):
+        import json
         import subprocess
 
-        self.proc = subprocess.Popen([sys.executable, "-c", FORK_SERVER, str(ADDRESS_SPACE_BYTES), str(RUN_TIMEOUT_S)],
-                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        self.proc = subprocess.Popen([sys.executable, "-c", FORK_SERVER, str(ADDRESS_SPACE_BYTES), str(RUN_TIMEOUT_S),
+                                      ",".join(PRELOAD)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        ready = json.loads(self.proc.stdout.readline())
+        assert ready["threads"] == 1, f"the fork server has {ready['threads']} threads after its imports: forking it is unsafe"
 
     def run(self, argv, workdir, config=""):
         """Run ``main(argv)`` in a forked child of the server; returns (rc, stdout, stderr, peak RSS bytes)."""
@@ -206,6 +250,7 @@ class ForkServer:
                                           "config": config}) + "\n")
         self.proc.stdin.flush()
         reply = json.loads(self.proc.stdout.readline())
+        assert "rc" in reply, f"the fork server has {reply['threads']} threads: forking it is unsafe"
         if reply["timed_out"]:
             pytest.fail(f"physcam {' '.join(argv)} ran for more than {RUN_TIMEOUT_S} s")
         with open(out_path, errors="replace") as f:
@@ -254,11 +299,18 @@ def _without_names_given(out: str, argv) -> str:
 LEAVES = [pytest.param(path, parser, id=" ".join(path)) for path, parser in _leaf_parsers(build_parser())]
 
 
+@pytest.fixture(scope="module")
+def server():
+    """One fork server for the module's leaves (starting one per leaf cost a Python and its imports each)."""
+    s = ForkServer()
+    yield s
+    s.close()
+
+
 @pytest.mark.parametrize("path, parser", LEAVES)
-def test_cli_fuzz(path, parser):
+def test_cli_fuzz(path, parser, server):
     workdir = tempfile.mkdtemp(prefix="physcam-fuzz-")
     _hostile_files(workdir)
-    server = ForkServer()
 
     @settings(max_examples=EXAMPLES.get(tuple(path), 12), database=None)
     @given(_argv_strategy(path, parser))
@@ -281,5 +333,4 @@ def test_cli_fuzz(path, parser):
     try:
         one()
     finally:
-        server.close()
         shutil.rmtree(workdir, ignore_errors=True)  # each leaf's folder holds tens of MB of outputs

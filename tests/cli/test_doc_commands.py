@@ -53,6 +53,22 @@ SKIP = {
         "listens 30 s for a stream (tests/live/test_cli_live.py records one sent by a second process)",
 }
 
+#: Commands shown the same on several pages, run once per test process (the first page to run one keeps its
+#: exit status and output; every page that shows it compares its shown output with them): each reads only
+#: bundled data (a bundled lens, the sensor table) and the session's empty config, nothing of a page's
+#: folder nor a page's lens library, and no later command of these pages reads what it writes (a page
+#: that reuses the run has not those files). The ST-maps of 4608x3164 px are 12 s of CPU (README.md and
+#: docs/distortion.md), the comparison 2 s (README.md and docs/cli.md). Pages that xdist runs on
+#: different workers each run it.
+SHARED = {
+    'physcam distortion --lens zeiss_distagon_35mm_f4 --focus 2m --sensor ALEXA 35 --resolution 4608x3164 --stmap out/ '
+    '--fit 3de4 --fit brown --fit nuke --fit usd',
+    "physcam compare --lens dgauss_50mm --lens sonnar_50mm_f1_5 --lens tessar_50mm_f2_8 --focus 2m --fstop 2.8 --sensor "
+    "S35 -o compare.png",
+}
+#: {command: (exit status, stdout, stderr)} of the :data:`SHARED` commands run so far in this process
+_SHARED_RUNS: dict[str, tuple[int, str, str]] = {}
+
 
 def _broken_sample(d: Path) -> None:
     sample = json.loads((REPO / "tests/live/data/recommended_dynamic_example.json").read_text())
@@ -201,6 +217,9 @@ def test_the_pages_have_commands():
     known = {" ".join(argv_of(c)) for p in PAGES for _, c, _, _ in doc_commands(p)}
     for cmd in SKIP:
         assert cmd in known, f"SKIP names a command no page has any more: {cmd}"
+    for cmd in SHARED:
+        pages = [p.name for p in PAGES if cmd in {" ".join(argv_of(c)) for _, c, _, _ in doc_commands(p)}]
+        assert len(pages) >= 2, f"SHARED names a command fewer than two pages show: {cmd} ({pages})"
     refused = [c for p in PAGES for _, c, _, rc in doc_commands(p) if rc == 2]
     assert "physcam live validate broken.json" in refused
 
@@ -245,8 +264,13 @@ def test_every_command_of_the_page_runs(page, tmp_path, capsys, monkeypatch):
                 if "/" in a and a.endswith((".usda", ".usd", ".usdc")) and not Path(a).exists():
                     Path(a).parent.mkdir(parents=True, exist_ok=True)
             argv = [*argv, *BOUNDED.get(argv[1], ([],))[0]]
-            rc = main(argv[1:])
-            out, err = capsys.readouterr()
+            if key in _SHARED_RUNS:
+                rc, out, err = _SHARED_RUNS[key]
+            else:
+                rc = main(argv[1:])
+                out, err = capsys.readouterr()
+                if key in SHARED:
+                    _SHARED_RUNS[key] = rc, out, err
             if rc != want:
                 failures.append(f"{page.name}:{line}: `{text}` exited {rc} (want {want}): {err.strip()[-400:]}")
             elif "Traceback" in err:
