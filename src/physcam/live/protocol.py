@@ -105,7 +105,9 @@ def fletcher16(data, modulus: int = 256) -> int:
 
 
 _CHUNK = 8192  # bytes summed at a time: the working arrays stay at 128 KiB whatever the packet's size
-_WEIGHTS = np.arange(_CHUNK, 0, -1, dtype=np.int64)  # a chunk of n bytes weighs them n, n-1, ..., 1
+# a chunk of n bytes weighs them n, n-1, ..., 1; summed in float64, exactly: every product and partial sum is
+# an integer under 255 x 8192 x 8193 / 2 < 2^53, so any order of summation (BLAS, SIMD) gives the same sums
+_WEIGHTS = np.arange(_CHUNK, 0, -1, dtype=np.float64)
 
 
 def _sums(parts) -> tuple[int, int]:
@@ -120,10 +122,10 @@ def _sums(parts) -> tuple[int, int]:
             continue
         d = np.frombuffer(part, dtype=np.uint8)
         for start in range(0, d.size, _CHUNK):
-            c = d[start:start + _CHUNK]
+            c = d[start:start + _CHUNK].astype(np.float64)  # 0.6 x the time of int64's dot (no BLAS for ints)
             n = c.size
-            t1 = int(c.sum(dtype=np.int64))
-            t2 = int(np.dot(_WEIGHTS[_CHUNK - n:], c.astype(np.int64)))
+            t1 = int(c.sum())
+            t2 = int(_WEIGHTS[_CHUNK - n:] @ c)
             s1, s2 = s1 + t1, s2 + n * s1 + t2
     return s1, s2
 
