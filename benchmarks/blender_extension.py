@@ -7,7 +7,8 @@ Run:  .venv/bin/python benchmarks/blender_extension.py [--lenses dgauss_50mm,tes
 ``--build``: the whole command instead (``physcam export blender-extension --workers N``, the lenses
 given or every bundled one), its CPU seconds as user + system of the process and its workers
 (``os.wait4``), with the zip's size: the part outside ``lens_payload`` too (worker start-up, the zip's
-deflate), one side after the other. ``--install``: then Blender's installer of each side's zip
+deflate), one side after the other; with ``--baseline-src``, whether each lens's files in the two zips
+(``lenses/<slug>.json``, ``shaders/<slug>.osl``) are the same bytes. ``--install``: then Blender's installer of each side's zip
 (``package_install_files`` in a fresh user folder, the Blender tests' way; the Blender of
 ``physcam.export.blender_runner.find_blender``), its wall and CPU seconds and the megabytes it unpacks.
 
@@ -140,7 +141,7 @@ def main_build(args, here: str) -> None:
     names = args.lenses.split(",") if args.lenses else None
     sides = [("this checkout", here)] + ([("baseline", args.baseline_src)] if args.baseline_src else [])
     print(f"load average before: {load()}")
-    cpu = {}
+    cpu, zips = {}, {}
     with tempfile.TemporaryDirectory() as tmp:
         for label, src in sides:
             out = os.path.join(tmp, label.replace(" ", "_"))
@@ -149,13 +150,29 @@ def main_build(args, here: str) -> None:
             cpu[label] = user + system
             print(f"{label:14s} CPU {user + system:7.1f} s (user {user:.1f}, system {system:.1f}), wall {wall:6.1f} s, "
                   f"zip {size / 1e6:.1f} MB, load {load()}", flush=True)
+            (zips[label],) = [os.path.join(out, f) for f in os.listdir(out) if f.endswith(".zip")]
             if args.install:
-                (zp,) = [os.path.join(out, f) for f in os.listdir(out) if f.endswith(".zip")]
-                i_wall, i_cpu, i_mb = install(zp, out)
+                i_wall, i_cpu, i_mb = install(zips[label], out)
                 print(f"{label:14s} Blender install: wall {i_wall:.1f} s, CPU {i_cpu:.1f} s, {i_mb:.1f} MB unpacked",
                       flush=True)
+        if args.baseline_src:
+            same, differ = same_lens_files(zips["baseline"], zips["this checkout"])
+            print(f"lens files (lenses/*.json, shaders/*.osl) byte for byte the baseline's: {same} of {same + len(differ)}"
+                  + (f"; differ: {', '.join(differ[:8])}{' ...' if len(differ) > 8 else ''}" if differ else ""))
     if args.baseline_src:
         print(f"ratio (baseline / this): {cpu['baseline'] / cpu['this checkout']:.2f}")
+
+
+def same_lens_files(zip_a: str, zip_b: str) -> tuple[int, list[str]]:
+    """(how many of the two zips' per-lens files are the same bytes, the names of those that are not or are
+    in one zip only): each lens's JSON table and shader source."""
+    import zipfile
+
+    with zipfile.ZipFile(zip_a) as a, zipfile.ZipFile(zip_b) as b:
+        names = sorted({n for z in (a, b) for n in z.namelist() if n.startswith(("lenses/", "shaders/"))})
+        na, nb = set(a.namelist()), set(b.namelist())
+        differ = [n for n in names if n not in na or n not in nb or a.read(n) != b.read(n)]
+    return len(names) - len(differ), differ
 
 
 def table_change(old: dict, new: dict) -> dict:

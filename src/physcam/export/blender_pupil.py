@@ -245,6 +245,7 @@ def _rims(uses, edges, radii, wanted) -> "_RimSet":
     e_key, e_lo, e_hi, e_rad = edges
     r0, r1 = np.array([u[1] for u in uses]), np.array([u[2] for u in uses])
     first = np.concatenate([[0], np.cumsum(r1 - r0)])  # each grid's first rim
+    first_r0 = first[:-1] - r0  # a grid's rim at radius index i: first_r0 + i
 
     # the wanted radii grid after grid (wanted_i), and per grid how many of them lie below each radius index
     wanted = np.asarray(wanted, dtype=bool)
@@ -256,8 +257,8 @@ def _rims(uses, edges, radii, wanted) -> "_RimSet":
         a = below[g, lo]
         n = below[g, hi] - a
         e = np.repeat(np.arange(g.size), n)
-        i = wanted_i[a[e] + np.arange(e.size) - np.repeat(np.cumsum(n) - n, n)]
-        return first[g[e]] + i - r0[g[e]], i, e
+        i = wanted_i[np.arange(e.size) + np.repeat(a - (np.cumsum(n) - n), n)]
+        return np.repeat(first_r0[g], n) + i, i, e
 
     small = np.int16 if max(int(first[-1]), radii.size) < 2**15 else np.int64
     r0_, r1_ = r0.astype(small)[:, None, None], r1.astype(small)[:, None, None]
@@ -267,7 +268,11 @@ def _rims(uses, edges, radii, wanted) -> "_RimSet":
     # toward +x, -x and +y: the sample's (a) and its neighbour's (b) cells
     for d, ((ja, ia_), (jb, ib), (sx, sy)) in enumerate(_TOWARD):
         lo, hi = np.maximum(n_in[:, jb, ib], r0_), np.minimum(n_in[:, ja, ia_], r1_)
-        g, jj, ii = np.nonzero(hi > lo)  # the pairs with a rim point at some radius of their grid
+        # the pairs with a rim point at some radius of their grid (np.nonzero's order, from the flat index)
+        h, w = hi.shape[1:]
+        flat = np.flatnonzero(hi > lo)
+        g, rest = np.divmod(flat, h * w)
+        jj, ii = np.divmod(rest, w)
         a = (g * ny + jj + (ja.start or 0)) * nx + ii + (ia_.start or 0)  # the cells in the flat grids
         b = (g * ny + jj + (jb.start or 0)) * nx + ii + (ib.start or 0)
         ra, nb_ok = rad[a], ok[b]
@@ -648,17 +653,18 @@ def refined_pupil_tables(focused, levels, *, checks: list, backend: str = "auto"
     two wherever the area's cubic misses a traced area at their middle (:func:`_refined_levels`); the passing
     sets are traced once, at the radii the added levels read too (:class:`_PassingSets`). ``checks`` receives
     each table's traced check areas at the returned levels."""
-    found = [_table_and_sets(q, film_z, levels, backend, checks, finer=True) for q, film_z in focused]
-    refined = _refined_levels(levels, [table for table, _ in found], checks)
+    # the drafts (no growth, no trust: what _refined_levels reads) first; only the tables kept are finished
+    found = [_table_and_sets(q, film_z, levels, backend, checks, finer=True, draft=True) for q, film_z in focused]
+    refined = _refined_levels(levels, [draft[0] for draft, _ in found], checks)
     if len(refined) == len(_levels(levels)):
-        return _levels(levels), [table for table, _ in found]
+        return _levels(levels), [_finished(*draft, _levels(levels), sets.rims) for draft, sets in found]
     checks.clear()  # the tables again at the refined levels, from the sets already traced
     return refined, [_assembled(sets, refined, checks) for _, sets in found]
 
 
-def _table_and_sets(q, film_z: float, levels, backend: str, checks, *, finer: bool) -> tuple:
+def _table_and_sets(q, film_z: float, levels, backend: str, checks, *, finer: bool, draft: bool = False) -> tuple:
     """(table, passing sets) of :func:`radial_pupil_table` (``finer``: the sets traced also at the radii of
-    the levels :func:`_refined_levels` may add)."""
+    the levels :func:`_refined_levels` may add; ``draft``: the table's draft instead, :func:`_drafted`)."""
     from ..lens.prescription import require_prescription
     from ..trace.kernels import backend_for_job
 
@@ -670,12 +676,20 @@ def _table_and_sets(q, film_z: float, levels, backend: str, checks, *, finer: bo
     if not film_z > q.vertex_z[-1]:
         raise InputError(f"the film (z = {film_z:g} mm) must lie behind the lens's last vertex (z = {q.vertex_z[-1]:g} mm)")
     sets = _PassingSets(q, film_z, levels, backend_for_job(backend, TABLE_RAYS * (len(q.surfaces) + 1)), finer=finer)
-    return _assembled(sets, levels, checks), sets
+    return (_drafted(sets, levels, checks) if draft else _assembled(sets, levels, checks)), sets
 
 
 def _assembled(sets: _PassingSets, levels, checks) -> np.ndarray:
     """The table of :func:`radial_pupil_table` at the iris radii ``levels`` from the passing sets ``sets``
     (which find the rims it reads, :meth:`_PassingSets.need`)."""
+    levels = _levels(levels)
+    return _finished(*_drafted(sets, levels, checks), levels, sets.rims)
+
+
+def _drafted(sets: _PassingSets, levels, checks) -> tuple:
+    """(table, the rim each check reads, its area): :func:`_assembled`'s table before its ellipses are grown
+    and its cells' trust is signed (:func:`_finished`), its areas and slopes final (what
+    :func:`_refined_levels` reads). ``checks`` receives the check areas."""
     levels = _levels(levels)
     sets.need(levels)
     _, checked = _check_axes(levels)
@@ -693,11 +707,18 @@ def _assembled(sets: _PassingSets, levels, checks) -> np.ndarray:
     empty = ~lit
     _fill(table, empty)
     table[..., 3:5] = np.where(lit[..., None], table[..., 3:5], 0.0)  # nothing passes (the ellipse is a neighbour's)
+    read_rim = index[:, [at[float(s)] for s in checked]].ravel()
+    want = area[read_rim]
+    if checks is not None:
+        checks.append(want)
+    return table, read_rim, want
+
+
+def _finished(table, read_rim, want, levels, rims) -> np.ndarray:
+    """The table of :func:`_drafted` (in place) with its ellipses grown and its cells' trust signed."""
     # every film point (nodes and mids) at every iris radius checked: the shader's reading there must hold
     # the traced set (grown until it does) and, for its cell to be trusted, give its area
-    cols = [at[float(s)] for s in checked]
     read_rho, read_s = _check_points(levels)
-    read_rim = index[:, cols].ravel()
     has = read_rim >= 0
     _grow(table, levels, read_rho[has], read_s[has], read_rim[has], rims)
     # the area weighs rays only in the cells (between two levels and two radii) where the shader's
@@ -705,9 +726,6 @@ def _assembled(sets: _PassingSets, levels, checks) -> np.ndarray:
     # the cell, whatever bounds the set (the iris alone, or other surfaces too: the rim's area is a dense
     # trace's within 0.4 % either way, module notes); an entry's sign says whether its cell is trusted (untrusted:
     # -1 - area, cell_area). A failed check withdraws only the cells it lies on or in.
-    want = area[read_rim]
-    if checks is not None:
-        checks.append(want)
     table[..., 3] = np.where(_checked_trust(table, levels, want), table[..., 3], -1.0 - table[..., 3])
     return table
 
