@@ -64,15 +64,14 @@ def pytest_collection_modifyitems(config, items):
 
 @pytest.fixture(scope="session")
 def extension_zip(tmp_path_factory):
-    """``physcam export blender-extension`` of every bundled lens, built once per test session and shared
-    by the Blender extension's tests (building it solves every bundled lens's focus table, the slowest
-    step). Under pytest-xdist the workers share one build: the first worker to ask builds it under a
+    """``physcam export blender-extension`` of ``_session.EXTENSION_LENSES``, built once per test session and shared
+    by the Blender extension's tests (building it solves each lens's focus table, the slowest step). Under pytest-xdist the workers share one build: the first worker to ask builds it under a
     session lock, with two processes (`--workers`; its module runs first, :data:`LONG_FIRST`, so the build
     starts at once and the other worker runs other tests meanwhile), the other
     reads it (each worker building its own doubled the suite's slowest step; putting every test that
     uses it on one worker, xdist's loadgroup, made that worker the suite's last by a minute). Here, not
     in tests/blender/conftest.py: with --doctest-modules two conftest modules of one name collide."""
-    from _session import session_lock
+    from _session import EXTENSION_LENSES, session_lock
 
     from physcam.cli import main
 
@@ -80,7 +79,12 @@ def extension_zip(tmp_path_factory):
         out = root / "blender-extension"
         if not list(out.glob("physcam-*.zip")):
             out.mkdir(exist_ok=True)
-            assert main(["export", "blender-extension", "-o", str(out), "--workers", "2"]) == 0
+            from physcam.lens.library import list_lenses
+
+            lenses = [r.slug for r in list_lenses() if r.slug in EXTENSION_LENSES]  # the library's order
+            assert len(lenses) == len(EXTENSION_LENSES), set(EXTENSION_LENSES) - set(lenses)
+            assert main(["export", "blender-extension", "-o", str(out), "--workers", "2",
+                         *(f"--lens={slug}" for slug in lenses)]) == 0
     (zp,) = out.glob("physcam-*.zip")
     return zp
 

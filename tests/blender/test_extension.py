@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from _blender import INSTALLED_EXTENSION_SCENE, run_blender
+from _session import EXTENSION_LENSES
 from physcam.lens.library import list_lenses, load_lens
 from physcam.optics.focusing import breathing_table
 from physcam.trace.rays import RayBatch
@@ -44,10 +45,12 @@ cam = scene.camera.data
 
 def test_installs_registers_and_every_lens_compiles(extension_zip, tmp_path):
     """Blender's installer puts the zip in a fresh user folder and enables it; the Camera panel's
-    property group exists; each bundled lens, chosen in the enum, gives a compiled OSL camera. One lens's
+    property group exists; each lens of the zip (the session's, tests/_session.py ``EXTENSION_LENSES``: one
+    of each kind the builder and the shader treat apart), chosen in the enum, gives a compiled OSL camera. One lens's
     four variants (dispersion, Fresnel) are texts named as the four-shader zips named them, each
     compiled from the lens's one source with its #define lines, and a text of that name already in the
     file (a .blend saved with an earlier extension) is kept as it is."""
+    lenses = [r.slug for r in list_lenses() if r.slug in EXTENSION_LENSES]  # the zip's, in the library's order
     out = run_blender(INSTALL + '''
 import zipfile
 p = cam.physcam
@@ -71,14 +74,14 @@ for slug in slugs:
     res["lenses"][slug] = {"bytecode": len(cam.custom_bytecode), "message": p.message,
                            "shader": cam.custom_shader.name if cam.custom_shader else None}
 print(json.dumps(res))
-''', extension_zip, tmp_path, json.dumps([r.slug for r in list_lenses()]),
+''', extension_zip, tmp_path, json.dumps(lenses),
         env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
     assert out["installed"], out
     assert str(tmp_path / "user") in out["user_dir"]
-    assert set(out["lenses"]) == {r.slug for r in list_lenses()}
+    assert set(out["lenses"]) == set(EXTENSION_LENSES)
     for slug, r in out["lenses"].items():
         assert r["message"] == "" and r["bytecode"] > 0 and slug in r["shader"], (slug, r)
-    first = list_lenses()[0].slug
+    first = lenses[0]
     assert out["kept"][:2] == [f"physcam_{first}__d0f0.osl", "// saved by an earlier physcam"] and out["kept"][2] > 0
     for key, (name, defines, size, message) in out["variants"].items():
         assert name == f"physcam_{first}__d{key[0]}f{key[1]}.osl" and message == "", (key, name, message)
