@@ -225,7 +225,7 @@ for line in sys.stdin:
             timed_out = True
             break
         time.sleep(0.005)
-    print(json.dumps({"rc": os.waitstatus_to_exitcode(status), "rss": usage.ru_maxrss * 1024,
+    print(json.dumps({"id": req["id"], "rc": os.waitstatus_to_exitcode(status), "rss": usage.ru_maxrss * 1024,
                       "timed_out": timed_out}), flush=True)
 """
 
@@ -238,6 +238,7 @@ class ForkServer:
         self.proc = subprocess.Popen([sys.executable, "-c", FORK_SERVER, str(ADDRESS_SPACE_BYTES), str(RUN_TIMEOUT_S),
                                       ",".join(PRELOAD)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         ready = json.loads(self.proc.stdout.readline())
+        self.requests = 0
         assert ready["threads"] == 1, f"the fork server has {ready['threads']} threads after its imports: forking it is unsafe"
 
     def run(self, argv, workdir, config=""):
@@ -246,11 +247,14 @@ class ForkServer:
 
         out_path = os.path.join(workdir, ".stdout")
         err_path = os.path.join(workdir, ".stderr")
-        self.proc.stdin.write(json.dumps({"argv": argv, "cwd": workdir, "out": out_path, "err": err_path,
-                                          "config": config}) + "\n")
+        self.requests += 1  # the reply names its request: the reply of a run interrupted before it was read
+        # (Ctrl-C) fails the next run of the module's server loudly instead of passing for that run's own
+        self.proc.stdin.write(json.dumps({"id": self.requests, "argv": argv, "cwd": workdir, "out": out_path,
+                                          "err": err_path, "config": config}) + "\n")
         self.proc.stdin.flush()
         reply = json.loads(self.proc.stdout.readline())
         assert "rc" in reply, f"the fork server has {reply['threads']} threads: forking it is unsafe"
+        assert reply["id"] == self.requests, f"the fork server answered request {reply['id']}, not {self.requests}"
         if reply["timed_out"]:
             pytest.fail(f"physcam {' '.join(argv)} ran for more than {RUN_TIMEOUT_S} s")
         with open(out_path, errors="replace") as f:
