@@ -11,8 +11,9 @@ tests/trace alone took 103.7 s CPU from an empty cache and 59.5 s from a warm on
 
 Every feature set is compiled for float64 rays, and the one-wavelength sets without optical path for
 float32 (what single-precision camera rays use): the 17 variants a whole `make test` leaves in the
-cache, and three more. Each is compiled by tracing a few rays through a bundled lens (the double Gauss;
-the Canon RF 85 mm for aspheres), as any command would. Usage: ``python scripts/compile_jit.py``.
+cache, and three more. Each is compiled by the JIT kernel's first call on a few rays and a bundled lens's
+packed table (the double Gauss; the Canon RF 85 mm for aspheres), the call every traced command makes.
+Usage: ``python scripts/compile_jit.py`` (a second run loads the 20 variants in a few seconds).
 """
 
 from __future__ import annotations

@@ -152,11 +152,12 @@ print(json.dumps({"installed": hasattr(bpy.types.Camera, "physcam")}))
 
 
 def install_extension(zip_path, user: Path) -> dict:
-    """Install the extension ``zip_path`` into the Blender user folder ``user`` (once: a folder already
-    marked shared is kept) with Blender's own installer; returns the ``env`` giving a run that folder.
+    """Install the extension ``zip_path`` into the Blender user folder ``user`` with Blender's own installer
+    (once: a folder where it is already installed is kept; the folder is marked shared first, so that no
+    run, this one included, removes it); returns the ``env`` giving a run that folder.
 
     The extension's render tests share one install, as an artist's Blender keeps an installed extension
-    from one session to the next: each of 11 runs installing its own copy wrote 111 MB and cost about
+    from one session to the next: each of 12 runs installing its own copy wrote 111 MB and cost about
     2 s CPU and 5 s wall (2026-11-29). Installing is itself tested by tests/blender/test_extension.py."""
     env = {"BLENDER_USER_RESOURCES": str(user)}
     done = user / ".physcam-installed"
