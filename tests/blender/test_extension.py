@@ -1,9 +1,8 @@
 """The physcam Blender extension in Blender: installed by Blender's own extension installer into a
 fresh user folder, registered, every lens of the session's zip (one of each kind, tests/_session.py)
-selectable and compiled; a keyframed focus pull
-renders each frame where physcam's tracer puts the markers at that frame's focus, and its framing
-changes as `physcam lens breathing` says; Blender's built-in camera (viewport, EEVEE) frames like
-the OSL camera."""
+selectable and compiled; a keyframed focus pull renders each frame where physcam's tracer puts the
+markers at that frame's focus, and its framing changes as `physcam lens breathing` says; Blender's
+built-in camera (viewport, EEVEE) frames like the OSL camera."""
 
 from __future__ import annotations
 
