@@ -45,9 +45,8 @@ def main() -> int:
     lenses = {False: load_lens("dgauss_50mm"), True: load_lens("canon_rf_85mm_f1_2")}
     t0, n = time.process_time(), 0
     for asphere, mono, opl, fresnel in itertools.product((False, True), repeat=4):
-        packed = {}
         for dtype in (np.float64, np.float32) if mono and not opl else (np.float64,):
-            table = packed.setdefault(dtype, packed_table(lenses[asphere], dtype=dtype))
+            table = packed_table(lenses[asphere], dtype=dtype)
             assert (table.kinds.max() >= 3) == asphere  # the variant asked for: aspheres in the table or none
             rays = _rays(dtype, mono)
             S = table.at_wavelength(float(rays.wavelength_nm[0])) if mono else table.S

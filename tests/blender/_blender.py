@@ -65,17 +65,21 @@ world = bpy.data.worlds.new("black"); scene.world = world; world.use_nodes = Tru
 world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
 """
 
+#: Enables the physcam extension installed in the user folder Blender was started with, as Blender enables
+#: an installed add-on at start-up.
+ENABLE_EXTENSION = """import addon_utils
+addon_utils.enable("bl_ext.user_default.physcam", default_set=True)
+assert hasattr(bpy.types.Camera, "physcam"), "the physcam extension is not installed in BLENDER_USER_RESOURCES"
+"""
+
 #: The start of a script run through the physcam extension installed in its Blender user folder
 #: (``BLENDER_USER_RESOURCES``: the session's shared install, :func:`install_extension`; argv[1]: the zip
-#: it was installed from): enabled as Blender enables an installed add-on at start-up, Cycles on the CPU
+#: it was installed from): enabled (:data:`ENABLE_EXTENSION`), Cycles on the CPU
 #: with 2 threads, no denoising, linear EXR out.
 INSTALLED_EXTENSION_SCENE = """
 import json, math, sys
 import numpy as np
-import addon_utils
-addon_utils.enable("bl_ext.user_default.physcam", default_set=True)
-assert hasattr(bpy.types.Camera, "physcam"), "the physcam extension is not installed in BLENDER_USER_RESOURCES"
-scene = bpy.context.scene
+""" + ENABLE_EXTENSION + """scene = bpy.context.scene
 scene.render.engine = "CYCLES"; scene.cycles.device = "CPU"; scene.cycles.use_denoising = False
 scene.render.threads_mode = "FIXED"; scene.render.threads = 2
 scene.view_settings.view_transform = "Standard"

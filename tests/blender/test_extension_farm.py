@@ -16,11 +16,12 @@ from __future__ import annotations
 
 import json
 import math
+import textwrap
 
 import numpy as np
 import pytest
 
-from _blender import installed_dark_scene, predicted_block_brightness, run_blender_log
+from _blender import ENABLE_EXTENSION, installed_dark_scene, predicted_block_brightness, run_blender_log
 from physcam.analysis.defocus.blob import blob_moments
 from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.export.blender import bake_camera
@@ -62,9 +63,7 @@ RENDER = '''
 import json, sys
 import numpy as np
 if sys.argv[1] != "none":  # a farm node where the extension is installed and enabled
-    import addon_utils
-    addon_utils.enable("bl_ext.user_default.physcam", default_set=True)
-bpy.ops.wm.open_mainfile(filepath=sys.argv[2])
+''' + textwrap.indent(ENABLE_EXTENSION, "    ") + '''bpy.ops.wm.open_mainfile(filepath=sys.argv[2])
 scene = bpy.context.scene
 scene.render.filepath = sys.argv[3] + "/frame_####"
 bpy.ops.render.render(animation=True)
