@@ -17,7 +17,7 @@ BLENDER_PY    := $(BLENDER_VENV)/bin/python
 BLENDER_STAMP := $(BLENDER_VENV)/.physcam-installed
 BPY_VERSION   ?= 5.0.1
 
-.PHONY: bytecode jit demo test venv blender blender-extension bench clean schema chromium shell test-latest latest-venv latest-run wheel usd-min lint
+.PHONY: bytecode test-bytecode jit demo test venv blender blender-extension bench clean schema chromium shell test-latest latest-venv latest-run wheel usd-min lint
 
 # Installs go through uv (https://docs.astral.sh/uv/, installed into .venv by pip first): it resolves
 # the same versions as pip (constraints.txt) and installs them 2-3x faster, which the 15-minute CI
@@ -91,7 +91,7 @@ chromium:
 # newest-versions environment), then the suite, then the oldest USD's tests beside the newest versions'.
 # (Three xdist workers on the two cores were slower: 792 s against 742 s, the Blender tests queued last.)
 test:
-	$(MAKE) --no-print-directory -j5 $(STAMP) $(BLENDER_BPY) chromium latest-venv jit
+	$(MAKE) --no-print-directory -j5 $(STAMP) $(BLENDER_BPY) chromium latest-venv jit test-bytecode
 	$(MAKE) --no-print-directory $(BLENDER_STAMP) lint bytecode
 	PHYSCAM_BLENDER_PYTHON=$(abspath $(BLENDER_PY)) $(PY) -m pytest -n 2 --dist worksteal -q
 	$(MAKE) --no-print-directory -j2 usd-min latest-run
@@ -153,6 +153,12 @@ LATEST_LEFT_OUT := --ignore=tests/optics/test_no_nan_formulas.py --ignore=tests/
 # and test_lens_zoom.py: 23.2 -> 21.7 s CPU). 1 s; Python still checks each file's time stamp.
 bytecode: $(STAMP)
 	$(PY) -m compileall -q -j0 src >/dev/null
+
+# the tests' bytecode, with pytest's assertion rewriting, written once before the suite: under
+# PYTHONDONTWRITEBYTECODE each xdist worker rewrote and compiled every test module again (14 s CPU of a
+# worker's 24 s collection; scripts/compile_tests.py says more)
+test-bytecode: $(STAMP)
+	$(PY) scripts/compile_tests.py tests
 
 # physcam's JIT ray-tracing kernels compiled into numba's disk cache before the suite, beside the other
 # installs (scripts/compile_jit.py says why: a fresh clone's processes each compiled them side by side)
