@@ -456,6 +456,16 @@ def _slow_stats(port) -> dict:
     return json.loads(body)["slow"]
 
 
+def _settled_stats(port) -> dict:
+    """:func:`_slow_stats` once the worker has nothing pending (at most 30 s)."""
+    for _ in range(300):
+        stats = _slow_stats(port)
+        if stats["pending"] == 0:
+            break
+        time.sleep(0.1)
+    return stats
+
+
 @needs_loopback_net
 def test_charts_for_clients_that_hung_up_are_not_drawn(server):
     """Round 13: one address asks 8 new charts on 8 connections and hangs up at once (a phone that
@@ -465,7 +475,7 @@ def test_charts_for_clients_that_hung_up_are_not_drawn(server):
     drew all 8 for nobody (9 done with the other's)."""
     port, proc = server
     assert get(port, _chart(1000))[0] == 200  # the first chart imports matplotlib
-    before = _slow_stats(port)
+    before = _settled_stats(port)  # (nothing left of a test before)
     socks = [connect(port, "127.0.5.1") for _ in range(8)]
     for k, s in enumerate(socks):
         s.sendall(f"GET {_chart(7000 + k)} HTTP/1.1\r\nHost: x\r\n\r\n".encode())
@@ -473,11 +483,7 @@ def test_charts_for_clients_that_hung_up_are_not_drawn(server):
         s.close()
     status, _, body = get(port, _chart(7100), source="127.0.5.2", timeout=60)
     assert status == 200 and body.startswith(b"<?xml")
-    for _ in range(300):  # until the worker has nothing left (the old code: 7 more charts to draw)
-        after = _slow_stats(port)
-        if after["pending"] == 0:
-            break
-        time.sleep(0.1)
+    after = _settled_stats(port)  # (the old code: 7 more charts to draw)
     done = after["done"] - before["done"]
     assert after["pending"] == 0 and 1 <= done <= 2, (before, after)
     assert proc.poll() is None
