@@ -14,6 +14,7 @@ from _serve_helpers import get_json, request, running_server
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import physcam
 from physcam.cli import main
 from physcam.errors import InputError
 from physcam.serve import bind_socket, lan_addresses, qr_text
@@ -222,8 +223,12 @@ def test_methods_and_bodies_are_refused(server):
     with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
         s.sendall(b"GET /api/report?focal=\xff\xfe HTTP/1.1\r\nHost: x\r\n\r\n")
         assert s.recv(100).split(b" ")[1] in (b"400", b"422")
-    assert get_json(port, "/api/health") == (200, {"ok": True, "version": json.loads(request(port, "/api/health")[2])["version"],
-                                                   "units": "m"})  # the page's default: the user config's units (none here)
+    status, health = get_json(port, "/api/health")
+    assert status == 200 and health == {"ok": True, "version": physcam.__version__,
+                                        "units": "m",  # the page's default: the user config's units (none here)
+                                        "slow": health["slow"]}
+    assert set(health["slow"]) == {"done", "dropped", "pending"}  # the worker's jobs (round 13)
+    assert all(isinstance(v, int) and v >= 0 for v in health["slow"].values())
 
 
 NAMES = ["focal", "fstop", "tstop", "focus", "sensor", "sensor-width", "sensor-height", "squeeze", "coc", "near",

@@ -244,9 +244,11 @@ def _chart(focus_mm: int) -> str:
 
 async def _flood(port, rate, seconds, statuses, stop, drawn):
     """Distinct charts from ABUSER at ``rate`` per second, open loop, one connection each; ``drawn``
-    gets the time (monotonic) each chart answered 200 came back."""
+    gets the time (monotonic) each chart answered 200 came back. Once ``stop`` is set the requests
+    still waiting hang up (the server drops their charts)."""
 
     async def one(path):
+        w = None
         try:
             r, w = await asyncio.open_connection("127.0.0.1", port, local_addr=(ABUSER, 0))
             w.write(f"GET {path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n".encode())
@@ -254,9 +256,11 @@ async def _flood(port, rate, seconds, statuses, stop, drawn):
             statuses.append(int(line.split()[1]) if line else None)
             if statuses[-1] == 200:
                 drawn.append(time.monotonic())
-            w.close()
         except (TimeoutError, OSError, ValueError, IndexError):
             statuses.append(None)
+        finally:
+            if w is not None:
+                w.close()
 
     tasks, t0 = [], time.monotonic()
     for i in range(int(rate * seconds)):
@@ -264,7 +268,11 @@ async def _flood(port, rate, seconds, statuses, stop, drawn):
             break
         await asyncio.sleep(max(0.0, t0 + i / rate - time.monotonic()))
         tasks.append(asyncio.ensure_future(one(_chart(3000 + i))))
-    await asyncio.gather(*tasks)
+    while not stop.is_set() and not all(t.done() for t in tasks):
+        await asyncio.sleep(0.05)
+    for t in tasks:
+        t.cancel()
+    await asyncio.gather(*tasks, return_exceptions=True)
 
 
 @needs_loopback_net
@@ -301,19 +309,23 @@ def test_a_flood_of_slow_work_from_one_address_does_not_starve_another(server):
 async def _closed_loops(port, sources, loops, stop, statuses, drawn):
     """From each address in ``sources``, ``loops`` clients each asking a new distinct chart as soon as
     the last one is answered (after 0.2 s when refused); ``drawn`` gets the time each chart answered
-    200 came back."""
+    200 came back. Once ``stop`` is set every client hangs up, its chart no longer wanted (the
+    server drops what nobody waits for: test_charts_for_clients_that_hung_up_are_not_drawn)."""
 
     async def loop(source, first):
         i = 0
-        while not stop.is_set():
+        while not stop.is_set():  # (Python 3.11's wait_for can swallow a cancel that meets an answer)
+            w = None
             try:
                 r, w = await asyncio.open_connection("127.0.0.1", port, local_addr=(source, 0))
                 w.write(f"GET {_chart(first + i)} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n".encode())
                 line = await asyncio.wait_for(r.readline(), 180)
-                w.close()
                 status = int(line.split()[1]) if line else None
             except (TimeoutError, OSError, ValueError, IndexError):
                 status = None
+            finally:
+                if w is not None:
+                    w.close()
             i += 1
             statuses.append(status)
             if status == 200:
@@ -321,8 +333,13 @@ async def _closed_loops(port, sources, loops, stop, statuses, drawn):
             else:
                 await asyncio.sleep(0.2)
 
-    await asyncio.gather(*(loop(s, 100_000 + 1000 * (loops * k + j)) for k, s in enumerate(sources)
-                           for j in range(loops)))
+    clients = [asyncio.ensure_future(loop(s, 100_000 + 1000 * (loops * k + j))) for k, s in enumerate(sources)
+               for j in range(loops)]
+    while not stop.is_set():
+        await asyncio.sleep(0.05)
+    for c in clients:
+        c.cancel()
+    await asyncio.gather(*clients, return_exceptions=True)
 
 
 @pytest.mark.slow
@@ -429,6 +446,69 @@ def test_the_worker_bounds_the_addresses_with_work():
     for f in futures:
         f.result(timeout=10)
     assert w.submit("C", lambda: 7).result(timeout=10) == 7  # room again once A and B are done
+    w.close()
+
+
+def _slow_stats(port) -> dict:
+    """The server's own count of its slow jobs (/api/health): done, dropped, pending."""
+    status, _, body = get(port, "/api/health")
+    assert status == 200
+    return json.loads(body)["slow"]
+
+
+def _settled_stats(port) -> dict:
+    """:func:`_slow_stats` once the worker has nothing pending (at most 30 s)."""
+    for _ in range(300):
+        stats = _slow_stats(port)
+        if stats["pending"] == 0:
+            break
+        time.sleep(0.1)
+    return stats
+
+
+@needs_loopback_net
+def test_charts_for_clients_that_hung_up_are_not_drawn(server):
+    """Round 13: one address asks 8 new charts on 8 connections and hangs up at once (a phone that
+    gave up, a retrying script's timeout). The worker draws at most the one it had already started
+    (counted by the server itself: /api/health's jobs done); the rest are dropped, or never queued
+    when the hang-up is seen first, and another address's chart is answered. Before, the worker
+    drew all 8 for nobody (9 done with the other's)."""
+    port, proc = server
+    assert get(port, _chart(1000))[0] == 200  # the first chart imports matplotlib
+    before = _settled_stats(port)  # (nothing left of a test before)
+    socks = [connect(port, "127.0.5.1") for _ in range(8)]
+    for k, s in enumerate(socks):
+        s.sendall(f"GET {_chart(7000 + k)} HTTP/1.1\r\nHost: x\r\n\r\n".encode())
+    for s in socks:
+        s.close()
+    status, _, body = get(port, _chart(7100), source="127.0.5.2", timeout=60)
+    assert status == 200 and body.startswith(b"<?xml")
+    after = _settled_stats(port)  # (the old code: 7 more charts to draw)
+    done = after["done"] - before["done"]
+    assert after["pending"] == 0 and 1 <= done <= 2, (before, after)
+    assert proc.poll() is None
+
+
+def test_the_worker_drops_a_cancelled_job_before_it_starts():
+    """A job cancelled while it waits leaves its queue at once: it never runs, its address's place
+    is free again (per_client 2: A may queue another), the others run in turn, and the worker
+    counts it dropped. A job already running cannot be cancelled (concurrent.futures). Before,
+    a cancelled job held its place until the worker reached it."""
+    from physcam.serve.worker import FairWorker
+
+    w = FairWorker(per_client=2, total=8)
+    gate, started, done = threading.Event(), threading.Event(), []
+    hold = w.submit("A", lambda: (started.set(), gate.wait()))
+    assert started.wait(10)
+    a1 = w.submit("A", lambda: done.append("A1"))
+    b1 = w.submit("B", lambda: done.append("B1"))
+    assert not hold.cancel() and a1.cancel()
+    assert w.pending("A") == 1 and w.stats() == {"done": 0, "dropped": 1, "pending": 2}
+    a2 = w.submit("A", lambda: done.append("A2"))  # A's second place is free again
+    gate.set()
+    for f in (hold, b1, a2):
+        f.result(timeout=10)
+    assert done == ["B1", "A2"] and w.stats() == {"done": 3, "dropped": 1, "pending": 0}
     w.close()
 
 

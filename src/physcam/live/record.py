@@ -3,9 +3,10 @@
 Each :class:`~physcam.live.frames.TrackedFrame` is solved as an on-set lens report
 (:func:`physcam.onset.report.solve_lens_report`, the practical model with the streamed entrance
 pupil and best-match pinhole) and written as one USD time sample through physcam's own authoring
-(:func:`physcam.usd.author.author_camera` for the first frame, then
-:func:`physcam.usd.author.sample_render_camera` per frame, as :mod:`physcam.usd.animate` does for
-a focus pull):
+(:func:`physcam.usd.author.author_camera` for the first frame, then the companion's
+:func:`physcam.usd.author.sampled_render_values` per frame, as :mod:`physcam.usd.animate` does for
+a focus pull); the take's samples go into the layer in one ``Sdf.ChangeBlock`` at the end
+(:class:`_TimeSamples`: the same file, byte for byte, as a ``Usd.Attribute.Set`` per sample):
 
 * the PhysicalCamera body's transform: ``translate`` (where the entrance pupil is),
   ``rotateZXY`` = (tilt, pan, -roll) and ``translate:pupilToFilm``, so the film plane lands where
@@ -416,13 +417,53 @@ def _usd_from_stage(v, mpu):
 def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.01, path: str = "/Cameras/Camera",
                         resolution=(4096, None), force: bool = False):
     """Write the solved frames (:func:`solve_frames`) as one time-sampled camera (module notes); return the Path."""
-    import numpy as np
-    from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
-    from pxr import Gf, Sdf, UsdGeom, Vt
+    return _write_recording(file, solved, rate=rate, meters_per_unit=meters_per_unit, path=path,
+                            resolution=resolution, force=force, batch=True)
 
-    from ..export.usdgeom import mm_to_scene_units, require_meters_per_unit
-    from ..usd.author import author_camera, iris_mm, new_stage, sample_render_camera, save_stage, spec_from_report
-    from .frames import rotation_matrix
+
+class _TimeSamples:
+    """A take's time samples, per attribute, written into the stage's root layer at the end in one
+    ``Sdf.ChangeBlock`` (``Sdf.Layer.SetTimeSample``: the layer casts each value to its attribute's
+    type, as ``Usd.Attribute.Set`` does). Round 13: about 25 ``Usd.Attribute.Set`` calls a frame,
+    each a change notice of its own, took 14 s of CPU for 10,000 frames (docs/performance.md). An
+    attribute without a spec in the layer yet (a schema's, first sampled) gets it from
+    ``Usd.Attribute.Set`` at once, so specs are made as and in the order they were before.
+    ``batch=False`` sets each sample through USD at once: the writer as it was."""
+
+    def __init__(self, stage, batch: bool = True):
+        self.layer, self.batch = stage.GetRootLayer(), batch
+        self.samples: dict = {}  # id of the attribute object -> (attribute, [(time, value)])
+
+    def set(self, attr, value, time) -> None:
+        """``attr.Set(value, time)``, gathered (the writer passes the same attribute objects each frame)."""
+        held = self.samples.get(id(attr))
+        if held is not None:
+            held[1].append((time, value))
+        elif not self.batch or not self.layer.GetAttributeAtPath(attr.GetPath()):
+            attr.Set(value, time)  # (no spec yet: made here, in its turn)
+            if self.batch:
+                self.samples[id(attr)] = (attr, [])
+        else:
+            self.samples[id(attr)] = (attr, [(time, value)])
+
+    def write(self) -> None:
+        from pxr import Sdf
+
+        paths = [(attr.GetPath(), samples) for attr, samples in self.samples.values()]
+        with Sdf.ChangeBlock():
+            for path, samples in paths:
+                for time, value in samples:
+                    self.layer.SetTimeSample(path, time, value)
+        self.samples.clear()
+
+
+def _write_recording(file, solved, *, rate, meters_per_unit, path, resolution, force, batch):
+    """:func:`write_recording_usd`, its samples written in one batch or each through USD (:class:`_TimeSamples`)."""
+    from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
+    from pxr import Sdf
+
+    from ..export.usdgeom import require_meters_per_unit
+    from ..usd.author import author_camera, new_stage, save_stage, spec_from_report
 
     if isinstance(solved, (str, bytes)) or not hasattr(solved, "__iter__"):
         from ..errors import WrongTypeError
@@ -438,7 +479,6 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
     if tcps > 1000.0:  # new_stage's bound; record at a lower rate would misplace samples
         raise InputError(f"the stream's sample rate {tcps:g} fps is above USD stage rates physcam writes (1000)")
     mpu = require_meters_per_unit(meters_per_unit)
-    su = lambda mm: mm_to_scene_units(mm, mpu)  # noqa: E731
     shutter = 0.5 / tcps
 
     stage = new_stage(mpu, tcps, up_axis="Y")
@@ -449,14 +489,31 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
     cam = author_camera(stage, path, spec0, report=s0.report)
     cam.SetCustomDataByKey("physcam:source", "OpenTrackIO stream recorded by physcam live record")
     cam.SetCustomDataByKey("physcam:live:carryOver", CARRY_OVER_NOTE)
-    model = stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Pinhole"))
-    geom = UsdGeom.Camera(stage.GetPrimAtPath(Sdf.Path(path).AppendChild("Camera")))
+    samples = _TimeSamples(stage, batch)
+    _sample_frames(stage, cam, Sdf.Path(path), solved, samples, mpu, tcps, shutter, resolution)
+    samples.write()
+    return save_stage(stage, file, force=force)
+
+
+def _sample_frames(stage, cam, path, solved, samples, mpu, tcps, shutter, resolution):
+    """Every frame's time samples of the recording's camera ``cam`` (module notes) into ``samples``."""
+    import numpy as np
+    from pxr import Gf, Sdf, UsdGeom, Vt
+
+    from ..export.usdgeom import mm_to_scene_units
+    from ..usd.author import iris_mm, sampled_render_values, spec_from_report
+    from .frames import rotation_matrix
+
+    su = lambda mm: mm_to_scene_units(mm, mpu)  # noqa: E731
+    put = samples.set
+    model = stage.GetPrimAtPath(path.AppendChild("Pinhole"))
+    geom = UsdGeom.Camera(stage.GetPrimAtPath(path.AppendChild("Camera")))
     # the body: pupil position, OpenTrackIO's rotation as rotateZXY, back to the film plane
     body = UsdGeom.Xformable(cam)
     body.ClearXformOpOrder()
-    op_pupil = body.AddTranslateOp()
-    op_rot = body.AddRotateZXYOp()
-    op_film = body.AddTranslateOp(opSuffix="pupilToFilm")
+    op_pupil = body.AddTranslateOp().GetAttr()
+    op_rot = body.AddRotateZXYOp().GetAttr()
+    op_film = body.AddTranslateOp(opSuffix="pupilToFilm").GetAttr()
     lp = "lens:main:"
     names = {n: cam.GetAttribute(lp + n) for n in ("fStop", "iris", "entrancePupilDistance", "pinholeFocalLength")}
     body_iris = cam.GetAttribute("iris")
@@ -476,51 +533,56 @@ def write_recording_usd(file, solved, *, rate=None, meters_per_unit: float = 0.0
     if any(s.entrance_pupil_horizontal_mm is not None for s in solved):
         a_pupil_x = cam.GetAttribute(lp + "horizontalEntrancePupilDistance") \
             or cam.CreateAttribute(lp + "horizontalEntrancePupilDistance", Sdf.ValueTypeNames.Float)
+    a_model_squeeze, a_focal, a_focus = (model.GetAttribute(n) for n in ("squeeze", "focalLength", "focusDistance"))
+    companion, companion_attrs = geom.GetPrim(), {}
     omni = None
     c = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])  # OpenTrackIO stage -> USD Y-up
     for s in solved:
         f, t, report = s.frame, s.time_code, s.report
         spec = spec_from_report(report, shutter_duration_s=shutter, shift_mm=_shift(s))
         eye = spec.entrance_pupil_mm
-        a_squeeze.Set(float(s.squeeze), t)
-        a_proj.Set(Gf.Vec2d(*s.projection_offset_mm), t)
-        a_doff.Set(Gf.Vec2d(*s.distortion_offset_mm), t)
+        put(a_squeeze, float(s.squeeze), t)
+        put(a_proj, Gf.Vec2d(*s.projection_offset_mm), t)
+        put(a_doff, Gf.Vec2d(*s.distortion_offset_mm), t)
         if a_shift:
-            a_shift.Set(Gf.Vec2f(*spec.shift_mm), t)
-        model.GetAttribute("squeeze").Set(float(spec.squeeze), t)
+            put(a_shift, Gf.Vec2f(*spec.shift_mm), t)
+        put(a_model_squeeze, float(spec.squeeze), t)
         rot = c @ rotation_matrix(*f.rotation_deg) @ c.T
         film = np.array(_usd_from_stage(f.translation_m, mpu))
         pupil = film + rot @ np.array([0.0, 0.0, -su(eye)])
-        op_pupil.Set(Gf.Vec3d(*map(float, pupil)), t)
+        put(op_pupil, Gf.Vec3d(*map(float, pupil)), t)
         pan, tilt, roll = f.rotation_deg
-        op_rot.Set(Gf.Vec3f(tilt, pan, -roll), t)
-        op_film.Set(Gf.Vec3d(0.0, 0.0, su(eye)), t)
-        model.GetAttribute("focalLength").Set(spec.focal_length_mm, t)
-        model.GetAttribute("focusDistance").Set(spec.focus_mm, t)
-        names["fStop"].Set(spec.fstop, t)
-        names["iris"].Set(iris_mm(spec), t)
-        body_iris.Set(iris_mm(spec), t)
-        names["entrancePupilDistance"].Set(eye, t)
+        put(op_rot, Gf.Vec3f(tilt, pan, -roll), t)
+        put(op_film, Gf.Vec3d(0.0, 0.0, su(eye)), t)
+        put(a_focal, spec.focal_length_mm, t)
+        put(a_focus, spec.focus_mm, t)
+        put(names["fStop"], spec.fstop, t)
+        put(names["iris"], iris_mm(spec), t)
+        put(body_iris, iris_mm(spec), t)
+        put(names["entrancePupilDistance"], eye, t)
         if a_pupil_x is not None:
-            a_pupil_x.Set(float(eye if s.entrance_pupil_horizontal_mm is None else s.entrance_pupil_horizontal_mm), t)
+            put(a_pupil_x, float(eye if s.entrance_pupil_horizontal_mm is None else s.entrance_pupil_horizontal_mm), t)
         if names["pinholeFocalLength"]:
-            names["pinholeFocalLength"].Set(report.pinhole[0], t)
-        sample_render_camera(geom, spec, report, mpu, tcps, t, where=path)
+            put(names["pinholeFocalLength"], report.pinhole[0], t)
+        values, _ = sampled_render_values(spec, report, mpu, tcps, where=str(path))  # the companion's frame
+        for name, value in values.items():
+            if name not in companion_attrs:
+                companion_attrs[name] = companion.GetAttribute(name)
+            put(companion_attrs[name], value, t)
         if f.sequence_number is not None:
-            a_seq.Set(int(f.sequence_number), t)
+            put(a_seq, int(f.sequence_number), t)
         if f.timecode is not None:
-            a_tc.Set(f.timecode, t)
+            put(a_tc, f.timecode, t)
         if f.source_id is not None:
-            a_src.Set(str(f.source_id), t)
-        a_carried.Set(Vt.StringArray(list(s.carried)), t)
-        a_default.Set(Vt.StringArray(list(s.defaulted)), t)
+            put(a_src, str(f.source_id), t)
+        put(a_carried, Vt.StringArray(list(s.carried)), t)
+        put(a_default, Vt.StringArray(list(s.defaulted)), t)
         if f.distortion is not None:
             d = f.distortion
-            a_model.Set(str(d.get("model", "Brown-Conrady D-U")), t)
-            a_radial.Set(Vt.DoubleArray([float(v) for v in d.get("radial", [])]), t)
-            a_tang.Set(Vt.DoubleArray([float(v) for v in d.get("tangential", [])]), t)
-            omni = _omni_sample(geom.GetPrim(), omni, d, report, resolution, t)
-    return save_stage(stage, file, force=force)
+            put(a_model, str(d.get("model", "Brown-Conrady D-U")), t)
+            put(a_radial, Vt.DoubleArray([float(v) for v in d.get("radial", [])]), t)
+            put(a_tang, Vt.DoubleArray([float(v) for v in d.get("tangential", [])]), t)
+            omni = _omni_sample(companion, omni, d, report, resolution, t, put)
 
 
 def _shift(solved: SolvedFrame) -> tuple[float, float]:
@@ -530,9 +592,10 @@ def _shift(solved: SolvedFrame) -> tuple[float, float]:
     return (-dx + 0.0, dy + 0.0)
 
 
-def _omni_sample(prim, attrs, distortion, report, resolution, t):
+def _omni_sample(prim, attrs, distortion, report, resolution, t, put):
     """One time sample of Omniverse's OpenCV-pinhole distortion on the companion camera (normalised
-    coefficients, pixels of a ``resolution`` image); skipped for models it cannot express."""
+    coefficients, pixels of a ``resolution`` image), given to ``put(attribute, value, time)``;
+    skipped for models it cannot express."""
     from .. import usd as _usd  # noqa: F401  (one line naming the 'usd' extra when usd-core is missing)
     from pxr import Gf, Sdf
 
@@ -555,7 +618,7 @@ def _omni_sample(prim, attrs, distortion, report, resolution, t):
                  for k in ("fx", "fy", "cx", "cy", "k1", "k2", "k3", "p1", "p2")}
     values = dict(cv, fx=f_pin * w_px / s.width_mm, fy=f_pin * h_px / s.height_mm, cx=w_px / 2.0, cy=h_px / 2.0)
     for k, a in attrs.items():
-        a.Set(float(values[k]), t)
+        put(a, float(values[k]), t)
     return attrs
 
 

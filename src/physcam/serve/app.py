@@ -12,7 +12,7 @@ Routes (GET or HEAD only; every answer is JSON, SVG or the page):
 ``/api/lenses``                        ``physcam lenses --json``'s ``lenses`` list
 ``/api/lens/{name}?focus=2m...``       ``physcam lens show NAME ... --json``
 ``/api/lens/{name}/diagram.svg?...``   ``physcam lens diagram NAME ... -o diagram.svg``
-``/api/health``                        ``{"ok": true, "version": ..., "units": "m" or "ft"}``
+``/api/health``                        ``{"ok": true, "version": ..., "units": "m" or "ft", "slow": {...}}``
 =====================================  =============================================================
 
 Query parameters are the CLI flags without their dashes (``sensor-width=24.89``); which ones an
@@ -20,7 +20,8 @@ endpoint takes comes from the backend (the CLI's own parsers). Safety, all in
 :class:`Limits`: a bounded URL, a bounded number and length of parameters, printable values only,
 no request body, a token bucket per client address (429 with ``Retry-After``), the slow work
 shared between client addresses in turn with bounded queues (worker.py: an address's first slow
-request always taken; 429 for one address's share, 503 in all), and one JSON line
+request always taken; 429 for one address's share, 503 in all; a job dropped before it starts
+when every client asking it has hung up, counted in ``/api/health``'s "slow"), and one JSON line
 ``{"error": "..."}`` for every refusal (422 for bad input), never a traceback. An unexpected exception answers 500 with its class name and is
 logged as one line; the server keeps serving.
 """
@@ -241,6 +242,8 @@ class _Guard:
         try:
             self._check(scope)
             await self.app(scope, receive, guarded_send)
+        except _HungUp:
+            pass  # nobody to answer
         except Refused as r:
             if not started:
                 await _send(guarded_send, r.status, _error_body(r.reason), "application/json", r.headers, head)
@@ -273,7 +276,7 @@ class _App:
     def __init__(self, backend: Backend, limits: Limits):
         self.backend, self.limits = backend, limits
         self.cache = _Cache(limits.cache_bytes)
-        self.running: dict = {}  # cache key -> the asyncio future of its slow answer being computed
+        self.running: dict = {}  # cache key -> the _Job of its slow answer being computed
         # One worker thread (numba's tracer and matplotlib are not to be entered from two threads at
         # once), shared between client addresses in turn (worker.py); an address's first slow
         # request is always taken, up to one address per connection the server accepts.
@@ -312,26 +315,12 @@ class _App:
         return out
 
     # --- answers ---------------------------------------------------------------------------
-    async def answer(self, scope, key, fn, *, heavy: bool, media: str):
-        """Compute ``fn()`` (inline when light, on the worker in ``client``'s turn when heavy),
+    async def answer(self, request, key, fn, *, heavy: bool, media: str):
+        """Compute ``fn()`` (inline when light, on the worker in the client's turn when heavy),
         cached by ``key``; a :class:`PhysCamError` becomes 422 with its first line."""
         hit = self.cache.get(key)
         if hit is None and heavy:
-            # the same question asked again while it is being computed waits for that computation
-            # (issue 47: every connection asking one setup at once queued its own copy of the work and
-            # filled its address's queue: 429s and a stall)
-            running = self.running.get(key)
-            if running is None:
-                try:
-                    future = self.worker.submit(client_address(scope), lambda: _computed(fn, media))
-                except Full as full:
-                    raise Refused(503 if full.everyone else 429,
-                                  f"{'the server is busy with' if full.everyone else 'this address has'} "
-                                  f"{full.limit} slow requests (lenses, charts) waiting; try again",
-                                  [(b"retry-after", b"1")]) from None
-                running = self.running[key] = asyncio.wrap_future(future)
-                running.add_done_callback(lambda f, key=key: self._done(key, f))
-            hit = await asyncio.shield(running)  # a waiter that goes away cancels nothing shared
+            hit = await self._slow(request.scope, request.receive, key, fn, media)
         elif hit is None:
             hit = _computed(fn, media)
             self.cache.put(key, hit)
@@ -340,11 +329,75 @@ class _App:
             raise Refused(status, body.decode())
         return body
 
-    def _done(self, key, future) -> None:
+    async def _slow(self, scope, receive, key, fn, media):
+        """The worker's answer for ``key``, shared by every request asking it while it is computed
+        (issue 47: each connection asking one setup at once queued its own copy and filled its
+        address's queue). A request whose client hangs up stops waiting (:class:`_HungUp`); a job
+        nobody waits for any more is dropped before it starts (round 13: 80 retrying clients had
+        the worker draw charts for requests long gone). A request already hung up queues nothing."""
+        hang_up = asyncio.ensure_future(_hung_up(receive))
+        try:
+            await asyncio.sleep(0)  # hang_up reads what is already there: a closed connection ends it now
+            if hang_up.done():
+                raise _HungUp()
+            job = self.running.get(key)
+            if job is None:
+                try:
+                    work = self.worker.submit(client_address(scope), lambda: _computed(fn, media))
+                except Full as full:
+                    raise Refused(503 if full.everyone else 429,
+                                  f"{'the server is busy with' if full.everyone else 'this address has'} "
+                                  f"{full.limit} slow requests (lenses, charts) waiting; try again",
+                                  [(b"retry-after", b"1")]) from None
+                job = self.running[key] = _Job(asyncio.wrap_future(work), work)
+                job.future.add_done_callback(lambda f, key=key, job=job: self._done(key, job))
+            job.waiters += 1
+            try:  # (asyncio.wait cancels neither: a waiter that goes away cancels nothing shared)
+                await asyncio.wait((job.future, hang_up), return_when=asyncio.FIRST_COMPLETED)
+            finally:
+                job.waiters -= 1
+            if job.future.done():
+                return job.future.result()
+            if job.waiters == 0 and job.work.cancel():  # nobody waits and it has not started: dropped
+                if self.running.get(key) is job:
+                    del self.running[key]
+            raise _HungUp()
+        finally:
+            hang_up.cancel()
+
+    def _done(self, key, job) -> None:
         """A slow answer is in: cached, and no longer running."""
-        self.running.pop(key, None)
-        if not future.cancelled() and future.exception() is None:
-            self.cache.put(key, future.result())
+        if self.running.get(key) is job:
+            del self.running[key]
+        if not job.future.cancelled() and job.future.exception() is None:
+            self.cache.put(key, job.future.result())
+
+
+class _HungUp(Exception):
+    """The client hung up before its answer was ready: nothing is sent."""
+
+
+class _Job:
+    """A slow answer being computed: its asyncio future, the worker's future, the requests waiting."""
+
+    __slots__ = ("future", "work", "waiters")
+
+    def __init__(self, future, work):
+        self.future, self.work, self.waiters = future, work, 0
+
+
+async def _hung_up(receive) -> None:
+    """Returns when the client hangs up (ASGI's ``http.disconnect``: a server answers ``receive()``
+    after the request's last part only then); waits for ever where the server cannot tell."""
+    while True:
+        message = await receive()
+        if message["type"] == "http.disconnect":
+            return
+        if message["type"] == "http.request" and not message.get("more_body", False):
+            break
+    if (await receive())["type"] == "http.disconnect":
+        return
+    await asyncio.get_running_loop().create_future()  # not an ASGI server that tells
 
 
 def settle_heap() -> None:
@@ -406,7 +459,7 @@ def _report_endpoints(core: _App, backend: Backend, limits: Limits) -> dict:
 
     async def report(request):
         q = core.query(request.scope, "report")
-        body = await core.answer(request.scope, ("report", tuple(sorted(q.items()))), lambda: backend.report(q),
+        body = await core.answer(request, ("report", tuple(sorted(q.items()))), lambda: backend.report(q),
                                  heavy=heavy_report(q), media="application/json")
         return _no_store(body, "application/json")
 
@@ -428,12 +481,12 @@ def _report_endpoints(core: _App, backend: Backend, limits: Limits) -> dict:
             return rows
 
         key = ("focus-table", tuple(marks), tuple(sorted(q.items())))
-        body = await core.answer(request.scope, key, table, heavy=heavy_report(q), media="application/json")
+        body = await core.answer(request, key, table, heavy=heavy_report(q), media="application/json")
         return _no_store(body, "application/json")
 
     async def dof_svg(request):
         q = core.query(request.scope, "report")
-        body = await core.answer(request.scope, ("dof.svg", tuple(sorted(q.items()))), lambda: backend.dof_svg(q),
+        body = await core.answer(request, ("dof.svg", tuple(sorted(q.items()))), lambda: backend.dof_svg(q),
                                  heavy=True, media="image/svg+xml")
         return _no_store(body, "image/svg+xml")
 
@@ -445,13 +498,13 @@ def _catalogue_endpoints(core: _App, backend: Backend, limits: Limits) -> dict:
 
     async def sensors(request):
         q = core.query(request.scope, "sensors")
-        body = await core.answer(request.scope, ("sensors", tuple(sorted(q.items()))), lambda: backend.sensors(q),
+        body = await core.answer(request, ("sensors", tuple(sorted(q.items()))), lambda: backend.sensors(q),
                                  heavy=False, media="application/json")
         return _no_store(body, "application/json")
 
     async def lenses(request):
         core.query(request.scope, "lenses")
-        body = await core.answer(request.scope, ("lenses",), backend.lenses, heavy=True, media="application/json")
+        body = await core.answer(request, ("lenses",), backend.lenses, heavy=True, media="application/json")
         return _no_store(body, "application/json")
 
     def _name(request) -> str:
@@ -463,14 +516,14 @@ def _catalogue_endpoints(core: _App, backend: Backend, limits: Limits) -> dict:
     async def lens(request):
         name = _name(request)
         q = core.query(request.scope, "lens")
-        body = await core.answer(request.scope, ("lens", name, tuple(sorted(q.items()))), lambda: backend.lens(name, q),
+        body = await core.answer(request, ("lens", name, tuple(sorted(q.items()))), lambda: backend.lens(name, q),
                                  heavy=True, media="application/json")
         return _no_store(body, "application/json")
 
     async def diagram(request):
         name = _name(request)
         q = core.query(request.scope, "diagram")
-        body = await core.answer(request.scope, ("diagram", name, tuple(sorted(q.items()))),
+        body = await core.answer(request, ("diagram", name, tuple(sorted(q.items()))),
                                  lambda: backend.diagram_svg(name, q), heavy=True, media="image/svg+xml")
         return _no_store(body, "image/svg+xml")
 
@@ -510,8 +563,8 @@ def create_app(backend: Backend, limits: Limits | None = None, *, log=None):
 
     async def health(request):
         core.query(request.scope, "health")
-        return _no_store(json.dumps({"ok": True, "version": __version__, "units": backend.units}).encode(),
-                         "application/json")
+        return _no_store(json.dumps({"ok": True, "version": __version__, "units": backend.units,
+                                     "slow": core.worker.stats()}).encode(), "application/json")
 
     async def favicon(request):
         return Response(status_code=204)

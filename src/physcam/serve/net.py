@@ -171,9 +171,14 @@ def asgi_get(app, path: str) -> tuple[int, dict, bytes]:
              "path": p, "raw_path": p.encode(), "query_string": q.encode(), "root_path": "",
              "headers": [(b"host", b"localhost")], "client": ("127.0.0.1", 0), "server": ("127.0.0.1", 0)}
     out = {"status": 0, "headers": {}, "body": b""}
+    asked, answered = [], []  # (the events are made inside asyncio.run's loop)
 
-    async def receive():
-        return {"type": "http.request", "body": b"", "more_body": False}
+    async def receive():  # the request, then (as an ASGI server does) nothing until the client hangs up
+        if not asked:
+            asked.append(True)
+            return {"type": "http.request", "body": b"", "more_body": False}
+        await answered[0].wait()
+        return {"type": "http.disconnect"}
 
     async def send(message):
         if message["type"] == "http.response.start":
@@ -181,7 +186,13 @@ def asgi_get(app, path: str) -> tuple[int, dict, bytes]:
             out["headers"] = {k.decode(): v.decode() for k, v in message.get("headers", [])}
         elif message["type"] == "http.response.body":
             out["body"] += message.get("body", b"")
+            if not message.get("more_body", False):
+                answered[0].set()
 
-    asyncio.run(app(scope, receive, send))
+    async def run():
+        answered.append(asyncio.Event())
+        await app(scope, receive, send)
+
+    asyncio.run(run())
     return out["status"], out["headers"], out["body"]
 

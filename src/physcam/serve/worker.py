@@ -17,6 +17,12 @@ taken only while all addresses together have fewer than ``total`` pending, and a
 raises :class:`Full` and the server answers 429 (this address) or 503 (everyone; docs/serve.md).
 A newly arrived address therefore waits for at most one job of each of the other addresses with
 work pending (fewer than ``addresses``) and the job being done.
+
+Dropping (round 13): a job whose future is cancelled before the thread starts it leaves its queue
+at once and frees its address's place; it is never run (``Future.cancel`` fails once it runs).
+The server cancels a job when every request waiting for it has hung up, so a flood of clients
+that give up costs only the work someone still waits for. :meth:`FairWorker.stats` counts the
+jobs done and dropped.
 """
 
 from __future__ import annotations
@@ -53,6 +59,13 @@ class FairWorker:
         self._pending: dict[str, int] = {}  # waiting + running, per address
         self._closed = False
         self._thread: threading.Thread | None = None
+        self._done = self._dropped = 0
+
+    def stats(self) -> dict[str, int]:
+        """Jobs ``done`` (run, whatever their outcome), ``dropped`` (cancelled before they started)
+        and ``pending`` (waiting or running) since the worker was made."""
+        with self._cv:
+            return {"done": self._done, "dropped": self._dropped, "pending": sum(self._pending.values())}
 
     def pending(self, client: str | None = None) -> int:
         """Jobs waiting or running: of ``client``, or of everyone."""
@@ -75,12 +88,37 @@ class FairWorker:
                 raise Full(True, self.total)
             future: Future = Future()
             self._queues.setdefault(client, deque()).append((future, fn))
+            future.add_done_callback(lambda f, client=client: self._drop(client, f))
             self._pending[client] = self._pending.get(client, 0) + 1
             if self._thread is None:
                 self._thread = threading.Thread(target=self._run, name=self.name, daemon=True)
                 self._thread.start()
             self._cv.notify()
         return future
+
+    def _drop(self, client: str, future: Future) -> None:
+        """A cancelled job still queued leaves its queue and frees its place (module notes); one the
+        thread has already taken is left to it (``set_running_or_notify_cancel`` skips it)."""
+        if not future.cancelled():
+            return
+        with self._cv:
+            queue = self._queues.get(client)
+            at = next((i for i, job in enumerate(queue or ()) if job[0] is future), None)
+            if at is None:
+                return
+            del queue[at]
+            if not queue:
+                del self._queues[client]
+            self._dropped += 1
+            self._release(client)
+
+    def _release(self, client: str) -> None:
+        """One job of ``client`` is no longer pending. Holds the lock."""
+        left = self._pending[client] - 1
+        if left:
+            self._pending[client] = left
+        else:
+            del self._pending[client]
 
     def close(self) -> None:
         """Stop taking jobs; the thread ends once the queued ones are done."""
@@ -109,16 +147,18 @@ class FairWorker:
             if job is None:
                 return
             client, future, fn = job
+            ran = False
             try:
                 if future.set_running_or_notify_cancel():
+                    ran = True
                     try:
                         future.set_result(fn())
                     except BaseException as exc:  # noqa: BLE001 - handed to the waiting request
                         future.set_exception(exc)
             finally:
                 with self._cv:
-                    left = self._pending[client] - 1
-                    if left:
-                        self._pending[client] = left
+                    if ran:
+                        self._done += 1
                     else:
-                        del self._pending[client]
+                        self._dropped += 1  # cancelled between leaving its queue and starting
+                    self._release(client)
