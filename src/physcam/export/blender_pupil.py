@@ -340,7 +340,7 @@ def _rims_compiled(uses, edges, radii, wanted, kernel) -> "_RimSet":
                        c(e_key, dtype=np.int64), c(e_lo, dtype=float), c(e_hi, dtype=float), c(e_rad, dtype=float),
                        int(first[-1]))
     k = np.repeat(np.arange(cuts.size - 1), np.diff(cuts))
-    x, y, xa, ya = (np.ascontiguousarray(pts[:, c]) for c in range(4))
+    x, y, xa, ya = (c(pts[:, j]) for j in range(4))
     return _RimSet(x, y, cuts, _polygon_areas(k, xa, ya, cuts))
 
 
