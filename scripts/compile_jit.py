@@ -12,7 +12,8 @@ tests/trace alone took 103.7 s CPU from an empty cache and 59.5 s from a warm on
 Every feature set is compiled for float64 rays, and the one-wavelength sets without optical path for
 float32 (what single-precision camera rays use): the 17 variants a whole `make test` leaves in the
 cache, and three more. Each is compiled by the JIT kernel's first call on a few rays and a bundled lens's
-packed table (the double Gauss; the Canon RF 85 mm for aspheres), the call every traced command makes.
+packed table (the double Gauss; the Canon RF 85 mm for aspheres), the call every traced command makes. Then
+the Blender extension's rim pass (physcam.trace.kernels._rimpass), by one pupil table of the double Gauss.
 Usage: ``python scripts/compile_jit.py`` (a second run loads the 20 variants in a few seconds).
 """
 
@@ -53,7 +54,15 @@ def main() -> int:
             kernel(*rays.columns(), S, table.kinds, True, fresnel, 0.0, False, mono,
                    np.zeros(rays.x.shape[0]) if opl else None)
             n += 1
-    print(f"compile_jit: {n} kernel variants compiled or loaded in {time.process_time() - t0:.1f} s CPU")
+    # the Blender extension's compiled rim pass (kernels.rim_pass), by the pupil table that calls it: one signature
+    from physcam.export.blender_pupil import iris_levels, radial_pupil_table
+    from physcam.optics.focusing import focus
+
+    st = focus(lenses[False], 2500.0)
+    stop = st.prescription.surfaces[st.prescription.stop_index].semi_diameter
+    radial_pupil_table(st.prescription, st.film_z, iris_levels(stop, stop), backend="numba")
+    print(f"compile_jit: {n} kernel variants and the pupil tables' rim pass compiled or loaded in "
+          f"{time.process_time() - t0:.1f} s CPU")
     return 0
 
 

@@ -323,6 +323,27 @@ def _rims(uses, edges, radii, wanted) -> "_RimSet":
     return _RimSet(x, y, cuts, _polygon_areas(k, xa, ya, cuts))
 
 
+def _rims_compiled(uses, edges, radii, wanted, kernel) -> "_RimSet":
+    """:func:`_rims` by the compiled rim pass ``kernel`` (:func:`~physcam.trace.kernels.rim_pass`): the same
+    points in the same order, bit for bit, so the same rims and areas, without the numpy pass's gathers and sort."""
+    ny, nx = _GRID // 2, _GRID
+    ok = np.stack([g[2] for g, _, _ in uses]).reshape(-1, ny, nx)
+    rad = np.stack([g[3] for g, _, _ in uses]).reshape(-1, ny, nx)
+    n_in = np.stack([g[7] for g, _, _ in uses]).reshape(-1, ny, nx).astype(np.int64)
+    x0, y0, dx, dy = (np.array(v, dtype=float) for v in zip(*((g[0][0], g[1][0], g[4], g[5]) for g, _, _ in uses)))
+    r0, r1 = np.array([u[1] for u in uses], dtype=np.int64), np.array([u[2] for u in uses], dtype=np.int64)
+    first = np.concatenate([[0], np.cumsum(r1 - r0)])
+    e_key, e_lo, e_hi, e_rad = edges
+    # C-ordered arrays of these types: the one signature scripts/compile_jit.py compiles
+    c = np.ascontiguousarray
+    pts, cuts = kernel(ok, rad, n_in, x0, y0, dx, dy, r0, r1, first[:-1] - r0, c(wanted, dtype=bool), c(radii, dtype=float),
+                       c(e_key, dtype=np.int64), c(e_lo, dtype=float), c(e_hi, dtype=float), c(e_rad, dtype=float),
+                       int(first[-1]))
+    k = np.repeat(np.arange(cuts.size - 1), np.diff(cuts))
+    x, y, xa, ya = (c(pts[:, j]) for j in range(4))
+    return _RimSet(x, y, cuts, _polygon_areas(k, xa, ya, cuts))
+
+
 def _polygon_areas(k, xa, ya, cuts) -> np.ndarray:
     """Per rim (points ``k`` sorted, rim i's from ``cuts[i]`` to ``cuts[i + 1]``): the set's area (mm^2,
     both halves), the polygon through its edge points (xa, ya >= 0) and their mirror images, taken in
@@ -437,15 +458,20 @@ def _passing_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, back
     return used, p, r0, r1, _clip_edges(q, film_z, used, radii, big, backend)
 
 
-def _grid_rims(grids, radii, wanted, n_points: int) -> tuple:
+def _grid_rims(grids, radii, wanted, n_points: int, backend: str = "numpy") -> tuple:
     """(index, rims): the rims (:class:`_RimSet`, :func:`_rims`) of the grids of :func:`_passing_grids`
     (``grids``) at the ``wanted`` (film points x ``radii``) iris radii, and per film point and iris radius the
-    index of its rim there, -1 where nothing passes (or the rim is not wanted)."""
+    index of its rim there, -1 where nothing passes (or the rim is not wanted). With numba (``backend``,
+    :func:`~physcam.trace.kernels.rim_pass`) the compiled pass finds the same rims."""
+    from ..trace.kernels import rim_pass
+
     used, p, r0, r1, edges = grids
     index = np.full((n_points, radii.size), -1)
     if not used:
         return index, _RimSet(np.zeros(0), np.zeros(0), np.zeros(1, dtype=int), np.zeros(0))
-    rims = _rims(used, edges, radii, np.asarray(wanted)[p])
+    kernel = rim_pass(backend)
+    rims = (_rims(used, edges, radii, np.asarray(wanted)[p]) if kernel is None
+            else _rims_compiled(used, edges, radii, np.asarray(wanted)[p], kernel))
     n = r1 - r0
     k = np.arange(int(n.sum()))  # the rims in their order: grid after grid, radius after radius
     index[np.repeat(p, n), np.repeat(r0 - (np.cumsum(n) - n), n) + k] = np.where(rims.cuts[k + 1] > rims.cuts[k], k, -1)
@@ -462,7 +488,7 @@ class _PassingSets:
         levels = _levels(levels)
         fine = np.sort(np.concatenate([levels, np.sqrt(levels[:-1] * levels[1:])]))[::-1] if finer else levels
         rhos, checked = _check_axes(fine)
-        self.film_z, self.rhos = film_z, rhos
+        self.film_z, self.rhos, self.backend = film_z, rhos, backend
         self.radii = np.unique(np.concatenate([checked, fine * (1 - _DS)]))[::-1]
         self.big = 20.0 * max(levels[0], q.surfaces[q.stop_index].semi_diameter)
         self.grids = _passing_grids(q, film_z, rhos.tolist(), self.radii, q.surfaces[-1].semi_diameter, self.big,
@@ -481,7 +507,7 @@ class _PassingSets:
         wanted &= ~self.have
         if not wanted.any():
             return
-        index, rims = _grid_rims(self.grids, self.radii, wanted, self.rhos.size)
+        index, rims = _grid_rims(self.grids, self.radii, wanted, self.rhos.size, self.backend)
         n, old = self.rims.area.size, self.rims
         self.index = np.where(index >= 0, index + n, self.index)
         self.rims = _RimSet(np.concatenate([old.x, rims.x]), np.concatenate([old.y, rims.y]),

@@ -26,6 +26,9 @@ traced without the GIL: a thread costs tens of microseconds to wake, and on a bu
 a core (benchmarks/small_calls.py). Serial and threaded runs give identical rays. Compiled kernels
 are cached on disk under a key that includes physcam's version and a hash of the kernel sources
 (:mod:`._jitcache`).
+
+The same cache holds the Blender extension's rim pass (:func:`rim_pass`, :mod:`._rimpass`): the rim points of
+its pupil tables' aim grids, the numpy pass's bit for bit, compiled because that pass was half of a table's CPU.
 """
 
 from __future__ import annotations
@@ -35,7 +38,7 @@ import os
 from ...errors import BackendError
 
 __all__ = ["BACKENDS", "SERIAL_BELOW", "backend_for_job", "get_kernel", "resolve_backend", "numba_available", "jit_kernel",
-           "numba_load_cost", "set_compile_reporter", "set_threads", "threads"]
+           "numba_load_cost", "rim_pass", "set_compile_reporter", "set_threads", "threads"]
 
 BACKENDS = ("auto", "numba", "numpy")
 #: Batches smaller than this run the JIT kernel serially (measured crossover, docs/performance.md).
@@ -315,6 +318,22 @@ def resolve_backend(backend: str = "auto") -> str:
                                "backend='numpy' or PHYSCAM_BACKEND=numpy)")
         raise BackendError(f"the numba backend is unavailable ({_numba_error}); use backend='numpy'")
     return backend
+
+
+def rim_pass(backend: str = "auto"):
+    """The compiled rim pass of the Blender extension's pupil tables (``_rimpass.rim_points``: the numpy
+    pass's points bit for bit) when ``backend`` traces with numba: "numba", or "auto" once this process
+    has loaded numba (the tracer's kernel); None otherwise (the numpy pass then)."""
+    if backend == "auto" and os.environ.get("PHYSCAM_BACKEND", "auto") == "auto":
+        if _numba_kernel is None:
+            return None
+    elif resolve_backend(backend) != "numba":
+        return None
+    if _load_numba() is None:
+        return None
+    from . import _rimpass
+
+    return _rimpass.rim_points
 
 
 def get_kernel(backend: str = "auto"):
