@@ -57,6 +57,26 @@ def test_the_wavelengths_of_a_lens_without_dispersion_share_one_sub_cell_layout(
         own = P.pupil_function(alone, P.wavefront_on(alone, fp.setup.film_z, ref))
         assert np.array_equal(P.sub_cell_pupil(own), P.sub_cell_pupil(pf))
         assert (own.slope_x, own.slope_y) == (pf.slope_x, pf.slope_y)
+        # the wavefront's geometry and the cells' sums, shared too: the same numbers as computed alone
+        assert np.array_equal(own.opd, pf.opd) and np.array_equal(own.amplitude0, pf.amplitude0)
+        assert np.array_equal(own._ws.opd_waves, pf._ws.opd_waves)
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.lists(st.tuples(*[st.floats(-1e6, 1e6, allow_subnormal=False)] * 3).filter(lambda d: any(d)),
+                min_size=1, max_size=20))
+def test_unit_directions_are_what_a_ray_batch_makes_of_them(dirs):
+    # the pupil engine makes its batches of unit_directions' columns as they are: they must be the
+    # directions RayBatch.from_columns would have made, to the bit
+    from physcam.trace import RayBatch
+
+    d = np.array(dirs, dtype=float)
+    got = P.unit_directions(d[:, 0], d[:, 1], d[:, 2])
+    want = RayBatch.from_columns(*np.zeros((3, len(d))), d[:, 0], d[:, 1], d[:, 2])
+    for g, w in zip(got, (want.L, want.M, want.N)):
+        assert np.array_equal(g, w)
+    one = P.unit_directions(*(d[:1, k] for k in range(3)))  # a beam's one direction, normalised alone
+    assert all(np.array_equal(a, b[:1]) for a, b in zip(one, got))
 
 
 def test_the_phasors_at_closed_form_points():

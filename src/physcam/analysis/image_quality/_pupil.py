@@ -166,9 +166,11 @@ class _Tracer:
     def n_image(self, wavelength_nm: float) -> float:
         return self.indices(wavelength_nm)[1]
 
-    def trace(self, columns, opl0, wavelengths, *, clip=True) -> Traced:
+    def trace(self, columns, opl0, wavelengths, *, clip=True, unit=False) -> Traced:
         """Trace rays given as six columns (x, y, z of the start, the direction's x, y, z; 1-D, one
-        length) with per-ray ``wavelengths`` (nm) front to back, adding n (p' - p) . d per leg."""
+        length) with per-ray ``wavelengths`` (nm) front to back, adding n (p' - p) . d per leg.
+        ``unit``: the directions are :func:`unit_directions` already (finite starts of the pupil
+        grids), so the batch is made of the columns as they are."""
         from ...trace import OK, RayBatch
         from ...trace.trace import trace_packed
 
@@ -177,7 +179,12 @@ class _Tracer:
         while rest.size:
             self.indices(rest[0])
             rest = rest[rest != rest[0]]
-        rays = RayBatch.from_columns(*columns, wl)
+        if unit:  # what RayBatch.from_columns makes of them, without normalising them again
+            n = wl.shape[0]
+            rays = RayBatch(*(np.ascontiguousarray(c, dtype=np.float64) for c in columns), wl.copy(), np.ones(n),
+                            np.zeros(n, dtype=np.uint8))
+        else:
+            rays = RayBatch.from_columns(*columns, wl)
         opl = np.array(opl0, dtype=np.float64, copy=True)
         amp = np.ones(len(rays))
         # the kernel adds each leg's optical path: one call through every row, or two around a shaped stop
@@ -349,9 +356,19 @@ def image_circle_radius(st: Setup, wavelength_nm: float, outside_mm: float, tol_
     return lo
 
 
+def unit_directions(dx, dy, dz):
+    """The directions (dx, dy, dz) normalised as :meth:`physcam.trace.RayBatch.from_columns` normalises
+    them (scaled by the largest component first, then by the length), bit for bit: a beam's one
+    direction is normalised once instead of once per ray."""
+    big = np.maximum(np.maximum(np.abs(dx), np.abs(dy)), np.abs(dz))
+    dx, dy, dz = dx / big, dy / big, dz / big
+    norm = np.sqrt(dx * dx + dy * dy + dz * dz)
+    return dx / norm, dy / norm, dz / norm
+
+
 def _starts(st: Setup, fl: Field, n_object: float, gx: np.ndarray, gy: np.ndarray):
-    """Start points and directions (six columns) and starting optical paths of rays aimed at (gx, gy)
-    on the entrance-pupil plane."""
+    """Start points and unit directions (six columns, :func:`unit_directions`) and starting optical
+    paths of rays aimed at (gx, gy) on the entrance-pupil plane."""
     from .._chief import start_plane_z
 
     n = gx.size
@@ -362,10 +379,11 @@ def _starts(st: Setup, fl: Field, n_object: float, gx: np.ndarray, gy: np.ndarra
         x, y = gx - t * d[0], gy - t * d[1]
         c = fl.chief_start  # the plane wavefront through the chief ray's start: n d . (p - p_chief)
         opl0 = n_object * ((x - c[0]) * d[0] + (y - c[1]) * d[1] + (z0 - c[2]) * d[2])
-        return (x, y, np.full(n, z0), *(np.broadcast_to(v, (n,)) for v in d)), opl0
+        u = unit_directions(*(np.asarray(d[k:k + 1], dtype=np.float64) for k in range(3)))
+        return (x, y, np.full(n, z0), *(np.broadcast_to(v, (n,)) for v in u)), opl0
     o = fl.object_point
     start = tuple(np.broadcast_to(v, (n,)) for v in o)
-    return (*start, gx - o[0], gy - o[1], np.full(n, st.z_ep - o[2])), np.zeros(n)
+    return (*start, *unit_directions(gx - o[0], gy - o[1], np.full(n, st.z_ep - o[2]))), np.zeros(n)
 
 
 def _trace_groups(tracer: _Tracer, groups, *, clip=True) -> list[Traced]:
@@ -382,7 +400,7 @@ def _trace_groups(tracer: _Tracer, groups, *, clip=True) -> list[Traced]:
         wls.append(np.full(gx.size, fl.wavelength_nm))
         sizes.append(gx.size)
     res = tracer.trace([np.concatenate(c) for c in zip(*columns)], np.concatenate(opls), np.concatenate(wls),
-                       clip=clip)
+                       clip=clip, unit=True)
     cut = np.cumsum([0] + sizes)
     out: list = [None] * len(groups)
     for j, i in enumerate(order):
@@ -610,8 +628,23 @@ def chief_point(pt: PupilTrace, film_z: float) -> tuple[float, float, float]:
 
 def wavefront_on(pt: PupilTrace, film_z: float, reference=None) -> WavefrontSamples:
     """OPD of the pupil rays for the film at ``film_z`` (reference sphere centred on ``reference``,
-    default the chief ray's film point, through the paraxial exit pupil point)."""
+    default the chief ray's film point, through the paraxial exit pupil point). The geometry (each
+    ray's point on the sphere, its path difference in mm) depends on the rays alone: the wavelengths
+    that share them (``pt.shared``) divide the same path difference by their own wavelength."""
     cp = chief_point(pt, film_z)
+    key = (float(film_z), cp if reference is None else tuple(float(v) for v in reference), float(pt.n_image))
+    last = pt.shared.get("wavefront")
+    if last is None or last[0] != key:
+        pt.shared["wavefront"] = last = (key, *_sphere_paths(pt, film_z, cp, reference))
+    _, path, film_x, film_y, ref_l, ref_m, centre, radius = last
+    return WavefrontSamples(path / (pt.wavelength_nm * 1e-6), film_x, film_y, ref_l, ref_m, centre, radius,
+                            (cp[0], cp[1]))
+
+
+def _sphere_paths(pt: PupilTrace, film_z: float, cp, reference):
+    """(the chief ray's optical path to the reference sphere less each ray's, in mm; the rays' film x
+    and y; the directions L, M from their points on the sphere to its centre; the centre; the radius)
+    of :func:`wavefront_on`."""
     C = np.array(cp if reference is None else reference, dtype=float)
     E = np.array([0.0, 0.0, pt.z_xp])
     R = float(np.linalg.norm(C - E))
@@ -631,13 +664,12 @@ def wavefront_on(pt: PupilTrace, film_z: float, reference=None) -> WavefrontSamp
         raise OpticsError(f"rays of field {pt.field.field_deg:g} degrees miss the reference sphere: the wavefront "
                           "is too aberrated for a diffraction calculation (use the geometric MTF)")
     r = pt.rays
-    lam_mm = pt.wavelength_nm * 1e-6
-    w = ((pt.chief.opl[0] + pt.n_image * tc[0]) - (r.opl + pt.n_image * t)) / lam_mm
+    path = (pt.chief.opl[0] + pt.n_image * tc[0]) - (r.opl + pt.n_image * t)
     # the ray's point on the sphere and the direction from it to the centre
     sx, sy = r.x + t * r.L, r.y + t * r.M
     tf = (film_z - r.z) / r.N
-    return WavefrontSamples(w, r.x + tf * r.L, r.y + tf * r.M, (C[0] - sx) / R, (C[1] - sy) / R,
-                            (float(C[0]), float(C[1]), float(C[2])), R, (cp[0], cp[1]))
+    return (path, r.x + tf * r.L, r.y + tf * r.M, (C[0] - sx) / R, (C[1] - sy) / R,
+            (float(C[0]), float(C[1]), float(C[2])), R)
 
 
 # --------------------------------------------------------------------------------------------
@@ -715,12 +747,16 @@ def direction_slopes(pt: PupilTrace, ws: WavefrontSamples) -> tuple[float, float
 
 def pupil_function(pt: PupilTrace, ws: WavefrontSamples) -> PupilFunction:
     n = pt.n
-    idx = pt.row * n + pt.col
-    wa = pt.weight * pt.rays.amplitude
-    a0 = np.bincount(idx, weights=wa, minlength=n * n)
+    cells = pt.shared.get("cells")  # what the rays alone give (one for every wavelength that shares them)
+    if cells is None:
+        idx = pt.row * n + pt.col
+        wa = pt.weight * pt.rays.amplitude
+        a0 = np.bincount(idx, weights=wa, minlength=n * n)
+        mask = a0 > 0
+        pt.shared["cells"] = cells = (idx, wa, a0, mask, np.where(mask, a0, 1.0))
+    idx, wa, a0, mask, den = cells
     wsum = np.bincount(idx, weights=wa * ws.opd_waves, minlength=n * n)
-    mask = a0 > 0
-    wmean = np.where(mask, wsum / np.where(mask, a0, 1.0), 0.0).reshape(n, n)
+    wmean = np.where(mask, wsum / den, 0.0).reshape(n, n)
     # the slopes depend on the rays and the reference sphere alone: the same for every wavelength sharing them
     key = ("slopes", ws.reference)
     if key not in pt.shared:
