@@ -54,10 +54,10 @@ def work_variants(src: str) -> dict[str, str]:
     """The extension's shader rendering the pinhole's rays: all its work, without the trace, and also
     without the pupil ellipse (its table reads)."""
     a = _swap(src, "    throughput = color(0);\n", f"    {_PIN_RAYS}\n")
-    a = _swap(a, "    position = point(px * 0.001, py * 0.001, (FILM_Z - pz - ORIGIN_MM) * 0.001);\n"
-                 "    direction = vector(dx, dy, -dz);\n",
-              "    position = position + 1e-30 * point(px * 0.001, py * 0.001, (FILM_Z - pz - ORIGIN_MM) * 0.001);\n"
-              "    direction = direction + 1e-30 * vector(dx, dy, -dz);\n")
+    a = _swap(a, "    position = point(ray_in[0], ray_in[1], ray_in[2]);\n",
+              "    position = position + 1e-30 * point(ray_in[0], ray_in[1], ray_in[2]);\n")
+    a = _swap(a, "    direction = vector(ray_in[3], ray_in[4], ray_in[5])",
+              "    direction = direction + 1e-30 * vector(ray_in[3], ray_in[4], ray_in[5])")
     a = _swap(a, "    throughput = color(w);\n", "    throughput = color(1.0 + 1e-30 * w);\n")
     b = _swap(a, "for (int q = 0; q < n_steps; q++) {", "for (int q = 0; q < 0; q++) {")
     i = b.index("    if (rho < RAD_MAX) {")

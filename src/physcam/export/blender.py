@@ -181,7 +181,7 @@ def _check_switches(dispersion, fresnel) -> None:
 
 def _emit(b: BakedCamera, *, dispersion: bool, fresnel: bool) -> str:
     """The template with the data block of one baked focus and stop."""
-    from .osl import lens_data, render_template
+    from .osl import lens_data, ray_differential_define, render_template
 
     fno = "open" if b.fstop is None else f"f/{b.fstop:g}"
     focus_txt = "infinity" if math.isinf(b.focus_mm) else f"{b.focus_mm:g} mm"
@@ -191,6 +191,7 @@ def _emit(b: BakedCamera, *, dispersion: bool, fresnel: bool) -> str:
     defines, data = lens_data(b.table, b.aperture, b.wavelength_nm, b.bounds, dispersion=dispersion, fresnel=fresnel)
     defines += [f"#define {k} {_num(v)}" for k, v in (("HALF_W", b.sensor_width_mm / 2), ("HALF_H", b.sensor_height_mm / 2),
                                                    ("GRID_HW", b.sensor_width_mm / 2), ("GRID_HH", b.sensor_height_mm / 2))]
+    defines.append(ray_differential_define(b.camera.gaussian.efl))
     data = [f"    float FILM_Z = {_num(b.film_z)};", f"    float REAR_Z = {_num(b.bounds.z_plane)};",
             f"    float NORM = {_num(b.norm)};", _arr("VZ", b.table.vertex_z, "N_SURF"),
             _arr("SEMI", b.table.semi_diameter, "N_SURF"), _arr("RECT", b.bounds.rects, "N_RECT"), *data]

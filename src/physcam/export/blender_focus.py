@@ -32,7 +32,7 @@ from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH
 from ..errors import InputError, OpticsError, require_positive, require_type
 from ..lens.prescription import Prescription, takes_prescription
 from ._codetext import osl_comment
-from .osl import lens_data, osl_array, osl_number, render_template
+from .osl import lens_data, osl_array, osl_number, ray_differential_define, render_template
 
 __all__ = ["FocusAxis", "FocusTable", "blend_weights", "blended_geometry", "focus_axis", "focus_geometry", "focus_table",
            "focus_table_shader", "fill_pupil_tables", "ghost_rows", "hermite_basis", "pupil_marks", "N_FOCUS", "GRID_HALF_MM",
@@ -613,7 +613,7 @@ def _zoom_defines(ft: FocusTable) -> tuple[list[str], list[str]]:
                f"#define RAD_ZSTRIDE {ft.radial[0].size * nf}", f"#define NORM_ZSTRIDE {nf * n_iris}",
                # the iris rule's numbers at the zoom position (the shader's locals)
                "#define IRIS_K zoom_iris_k", "#define FSTOP_OPEN zoom_fstop_open", "#define FSTOP_MIN zoom_fstop_min",
-               "#define SEMI_MAX zoom_semi_max"]
+               "#define SEMI_MAX zoom_semi_max", "#define RAY_DIFF_F_MM zoom_focal_length"]
     data = [_arr32("ZOOM_EFL", z.efl_u_mm, "N_ZEFL"), _arr32("ZOOM_PU", z.pupil_u, "N_ZP"),
             _arr32("ZOOM_IRIS_K", z.iris_k, "N_ZG"), _arr32("ZOOM_FSTOP_OPEN", z.fstop_open, "N_ZG"),
             _arr32("ZOOM_FSTOP_MIN", z.fstop_min, "N_ZG")]
@@ -630,6 +630,7 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool | None = False, fresn
     ``dispersion`` and ``fresnel`` None: the source of all four settings, each chosen by OSL's
     preprocessor from ``#define PHYSCAM_DISPERSION`` / ``PHYSCAM_FRESNEL`` lines written in front of it
     (:func:`physcam.export.blender_variant.variant_source`; the extension's one shader per lens)."""
+    from ..optics import paraxial
     from .blender_pupil import N_RADIAL, RADIAL_MAX_MM
 
     require_type("ft", ft, FocusTable, "physcam.export.blender_focus.focus_table(lens)")
@@ -645,7 +646,8 @@ def focus_table_shader(ft: FocusTable, *, dispersion: bool | None = False, fresn
                 f"#define FOCUS_S_NEAR {_num32(ft.axis.s_near)}"]
     if not zoom:  # a zoom lens's iris rule changes along the zoom: _zoom_defines
         defines += [f"#define IRIS_K {_num32(ft.iris_k)}", f"#define FSTOP_OPEN {_num32(ft.fstop_open)}",
-                    f"#define FSTOP_MIN {_num32(ft.fstop_min)}", f"#define SEMI_MAX {_num32(ft.semi_max)}"]
+                    f"#define FSTOP_MIN {_num32(ft.fstop_min)}", f"#define SEMI_MAX {_num32(ft.semi_max)}",
+                    ray_differential_define(paraxial.gaussian(ft.lens).efl)]
     defines += [f"#define FOCUS_DEFAULT_M {osl_number(focus_m)}",
                 f"#define FSTOP_DEFAULT {osl_number(fstop)}", f"#define SENSOR_W_DEFAULT {osl_number(sensor_mm[0])}",
                 f"#define SENSOR_H_DEFAULT {osl_number(sensor_mm[1])}",

@@ -19,7 +19,8 @@ import numpy as np
 
 from ...errors import InputError
 
-__all__ = ["FEATURES", "SPHERE_KIND", "template_text", "render_template", "lens_data", "osl_number", "osl_array"]
+__all__ = ["FEATURES", "SPHERE_KIND", "template_text", "render_template", "lens_data", "osl_number", "osl_array",
+           "ray_differential_define"]
 
 #: The template's feature switches: a data block that defines one keeps that code, else it goes.
 FEATURES = ("PHYSCAM_FOCUS_TABLE", "HAS_ASPHERE", "PHYSCAM_DISPERSION", "PHYSCAM_FRESNEL", "PHYSCAM_APERTURE",
@@ -53,6 +54,19 @@ def osl_array(name: str, values, size: str, kind: str = "float") -> str:
     else:
         vals = ", ".join(osl_number(v) for v in np.asarray(values, dtype=float).ravel())
     return f"    {kind} {name}[{size}] = {{{vals}}};"
+
+
+def ray_differential_define(efl_mm: float) -> str:
+    """``#define RAY_DIFF_F_MM <mm>``: the focal length of the pinhole whose ray derivatives the shader gives
+    Cycles, as Blender's perspective camera does (dP zero, dD the pinhole's through the pixel): the lens's
+    paraxial EFL ``efl_mm`` (:func:`physcam.optics.paraxial.gaussian`; its size). The traced ray carries no
+    derivatives: OSL would carry them through the whole trace (docs/performance.md, Blender render, round 13)."""
+    f = abs(float(efl_mm))
+    if not (math.isfinite(f) and f > 0.0):
+        from ...errors import OpticsError
+
+        raise OpticsError(f"a camera shader needs the lens's focal length: its paraxial EFL is {efl_mm}")
+    return f"#define RAY_DIFF_F_MM {osl_number(f)}"
 
 
 def _osl_kinds(table) -> np.ndarray:
