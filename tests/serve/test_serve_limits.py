@@ -489,6 +489,63 @@ def test_charts_for_clients_that_hung_up_are_not_drawn(server):
     assert proc.poll() is None
 
 
+@needs_loopback_net
+def test_a_client_that_timed_out_and_asks_again_keeps_its_place(server):
+    """Review of round 13: a script whose timeout is shorter than its wait asks the same chart
+    again. Its first request is queued behind another address's charts and hangs up; the retry
+    joins that job where it stands, and the chart is drawn once for it: nothing dropped. Before
+    the fix the hang-up dropped the job at once and the retry went to the back of the queue (under
+    a steady flood it never got its chart: 25 tries in 25 s, answered at the second try before
+    round 13); here that is one job dropped."""
+    port, _ = server
+    assert get(port, _chart(1000), timeout=60)[0] == 200  # the first chart imports matplotlib
+    before = _settled_stats(port)
+    busy = [connect(port, "127.0.6.1", timeout=60) for _ in range(3)]
+    for k, s in enumerate(busy):  # another address keeps the worker drawing meanwhile
+        s.sendall(f"GET {_chart(8000 + k)} HTTP/1.1\r\nHost: x\r\n\r\n".encode())
+    first = connect(port, "127.0.6.2")
+    try:
+        first.sendall(f"GET {_chart(8100)} HTTP/1.1\r\nHost: x\r\n\r\n".encode())
+        for _ in range(200):  # queued (counted pending) before it hangs up
+            if _slow_stats(port)["pending"] - before["pending"] >= 4:
+                break
+            time.sleep(0.01)
+    finally:
+        first.close()
+    status, _, body = get(port, _chart(8100), source="127.0.6.2", timeout=60)
+    try:
+        assert status == 200 and body.startswith(b"<?xml")
+        assert [read_answer(s)[0] for s in busy] == [200] * 3
+    finally:
+        for s in busy:
+            s.close()
+    after = _settled_stats(port)
+    assert after["dropped"] - before["dropped"] == 0 and after["done"] - before["done"] == 4, (before, after)
+
+
+def test_the_worker_drops_a_job_nobody_wants_at_its_turn():
+    """A job submitted with ``wanted`` is asked at its turn: False, and it is dropped (never run, its
+    future cancelled, counted); True, and it runs. Until its turn it keeps its place (A's two places
+    stay taken). The counts are settled before the job's waiters wake."""
+    from physcam.serve.worker import Full, FairWorker
+
+    w = FairWorker(per_client=2, total=8)
+    gate, started, done, want = threading.Event(), threading.Event(), [], {"A1": True, "B1": True}
+    hold = w.submit("A", lambda: (started.set(), gate.wait()))
+    assert started.wait(10)
+    a1 = w.submit("A", lambda: done.append("A1"), wanted=lambda: want["A1"])
+    b1 = w.submit("B", lambda: done.append("B1"), wanted=lambda: want["B1"])
+    want["A1"] = False  # its client left while it waited
+    with pytest.raises(Full):
+        w.submit("A", lambda: None)  # A's places are both still taken until A1's turn
+    gate.set()
+    hold.result(timeout=10)
+    b1.result(timeout=10)
+    assert w.stats() == {"done": 2, "dropped": 1, "pending": 0}, w.stats()
+    assert a1.cancelled() and done == ["B1"]
+    w.close()
+
+
 def test_the_worker_drops_a_cancelled_job_before_it_starts():
     """A job cancelled while it waits leaves its queue at once: it never runs, its address's place
     is free again (per_client 2: A may queue another), the others run in turn, and the worker

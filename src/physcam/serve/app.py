@@ -20,7 +20,7 @@ endpoint takes comes from the backend (the CLI's own parsers). Safety, all in
 :class:`Limits`: a bounded URL, a bounded number and length of parameters, printable values only,
 no request body, a token bucket per client address (429 with ``Retry-After``), the slow work
 shared between client addresses in turn with bounded queues (worker.py: an address's first slow
-request always taken; 429 for one address's share, 503 in all; a job dropped before it starts
+request always taken; 429 for one address's share, 503 in all; a job dropped at its turn
 when every client asking it has hung up, counted in ``/api/health``'s "slow"), and one JSON line
 ``{"error": "..."}`` for every refusal (422 for bad input), never a traceback. An unexpected exception answers 500 with its class name and is
 logged as one line; the server keeps serving.
@@ -332,38 +332,46 @@ class _App:
     async def _slow(self, scope, receive, key, fn, media):
         """The worker's answer for ``key``, shared by every request asking it while it is computed
         (issue 47: each connection asking one setup at once queued its own copy and filled its
-        address's queue). A request whose client hangs up stops waiting (:class:`_HungUp`); a job
-        nobody waits for any more is dropped before it starts (round 13: 80 retrying clients had
-        the worker draw charts for requests long gone). A request already hung up queues nothing."""
+        address's queue). A request whose client hangs up stops waiting (:class:`_HungUp`); when its
+        turn comes, a job nobody waits for any more is dropped (round 13: 80 retrying clients had the
+        worker draw charts for requests long gone), while a client that timed out and asks again
+        joins it in its place. A request already hung up queues nothing."""
         hang_up = asyncio.ensure_future(_hung_up(receive))
         try:
             await asyncio.sleep(0)  # hang_up reads what is already there: a closed connection ends it now
-            if hang_up.done():
-                raise _HungUp()
-            job = self.running.get(key)
-            if job is None:
-                try:
-                    work = self.worker.submit(client_address(scope), lambda: _computed(fn, media))
-                except Full as full:
-                    raise Refused(503 if full.everyone else 429,
-                                  f"{'the server is busy with' if full.everyone else 'this address has'} "
-                                  f"{full.limit} slow requests (lenses, charts) waiting; try again",
-                                  [(b"retry-after", b"1")]) from None
-                job = self.running[key] = _Job(asyncio.wrap_future(work), work)
-                job.future.add_done_callback(lambda f, key=key, job=job: self._done(key, job))
-            job.waiters += 1
-            try:  # (asyncio.wait cancels neither: a waiter that goes away cancels nothing shared)
-                await asyncio.wait((job.future, hang_up), return_when=asyncio.FIRST_COMPLETED)
-            finally:
-                job.waiters -= 1
-            if job.future.done():
-                return job.future.result()
-            if job.waiters == 0 and job.work.cancel():  # nobody waits and it has not started: dropped
-                if self.running.get(key) is job:
-                    del self.running[key]
+            while not hang_up.done():
+                job = self._join(scope, key, fn, media)
+                try:  # (asyncio.wait cancels neither: a waiter that goes away cancels nothing shared)
+                    await asyncio.wait((job.future, hang_up), return_when=asyncio.FIRST_COMPLETED)
+                finally:
+                    job.waiters -= 1
+                if job.future.done() and not job.future.cancelled():
+                    return job.future.result()
+                # else hung up, or the job was dropped as this request joined it: asked again
             raise _HungUp()
         finally:
             hang_up.cancel()
+
+    def _join(self, scope, key, fn, media) -> _Job:
+        """The job computing ``key`` (a new one on the worker, in the client's turn, when none is or
+        the last was dropped), with this request counted among its waiters."""
+        job = self.running.get(key)
+        if job is not None and not job.future.cancelled():
+            job.waiters += 1
+            return job
+        job = _Job()  # counted before it is queued: the worker may ask wanted() at once
+        try:
+            work = self.worker.submit(client_address(scope), lambda: _computed(fn, media),
+                                      wanted=lambda: job.waiters > 0)
+        except Full as full:
+            raise Refused(503 if full.everyone else 429,
+                          f"{'the server is busy with' if full.everyone else 'this address has'} "
+                          f"{full.limit} slow requests (lenses, charts) waiting; try again",
+                          [(b"retry-after", b"1")]) from None
+        job.future = asyncio.wrap_future(work)
+        self.running[key] = job
+        job.future.add_done_callback(lambda f, key=key, job=job: self._done(key, job))
+        return job
 
     def _done(self, key, job) -> None:
         """A slow answer is in: cached, and no longer running."""
@@ -378,12 +386,13 @@ class _HungUp(Exception):
 
 
 class _Job:
-    """A slow answer being computed: its asyncio future, the worker's future, the requests waiting."""
+    """A slow answer being computed: its asyncio future and the number of requests waiting for it
+    (read by the worker's thread when its turn comes: none, and it is dropped)."""
 
-    __slots__ = ("future", "work", "waiters")
+    __slots__ = ("future", "waiters")
 
-    def __init__(self, future, work):
-        self.future, self.work, self.waiters = future, work, 0
+    def __init__(self):
+        self.future, self.waiters = None, 1
 
 
 async def _hung_up(receive) -> None:

@@ -18,11 +18,13 @@ raises :class:`Full` and the server answers 429 (this address) or 503 (everyone;
 A newly arrived address therefore waits for at most one job of each of the other addresses with
 work pending (fewer than ``addresses``) and the job being done.
 
-Dropping (round 13): a job whose future is cancelled before the thread starts it leaves its queue
-at once and frees its address's place; it is never run (``Future.cancel`` fails once it runs).
-The server cancels a job when every request waiting for it has hung up, so a flood of clients
-that give up costs only the work someone still waits for. :meth:`FairWorker.stats` counts the
-jobs done and dropped.
+Dropping (round 13): a job submitted with ``wanted`` is asked, when its turn comes, whether
+anyone still wants it; if not it is dropped (never run) and the thread goes on to the next. It keeps
+its place until then, so a client that timed out and asks again joins the job where it stands
+(the server: ``wanted`` is "a request still waits for it"). A flood of clients that give up costs
+only the work someone still waits for. A job whose future is cancelled while it waits leaves its
+queue at once and frees its place (``Future.cancel`` fails once it runs). :meth:`FairWorker.stats`
+counts the jobs done and dropped.
 """
 
 from __future__ import annotations
@@ -72,9 +74,10 @@ class FairWorker:
         with self._cv:
             return sum(self._pending.values()) if client is None else self._pending.get(client, 0)
 
-    def submit(self, client: str, fn) -> Future:
+    def submit(self, client: str, fn, wanted=None) -> Future:
         """Queue ``fn()`` for ``client`` (module notes: its first job always, further ones within
-        ``per_client`` and ``total``); its future holds the result (or the exception)."""
+        ``per_client`` and ``total``); its future holds the result (or the exception). ``wanted()``,
+        called on the worker's thread when the job's turn comes, False drops it (module notes)."""
         with self._cv:
             if self._closed:
                 raise RuntimeError("the worker is closed")
@@ -87,7 +90,7 @@ class FairWorker:
             elif sum(self._pending.values()) >= self.total:
                 raise Full(True, self.total)
             future: Future = Future()
-            self._queues.setdefault(client, deque()).append((future, fn))
+            self._queues.setdefault(client, deque()).append((future, fn, wanted))
             future.add_done_callback(lambda f, client=client: self._drop(client, f))
             self._pending[client] = self._pending.get(client, 0) + 1
             if self._thread is None:
@@ -127,18 +130,18 @@ class FairWorker:
             self._cv.notify()
 
     def _next(self):
-        """The next (client, future, fn) in turn, or None when closed and empty. Holds the lock."""
+        """The next (client, future, fn, wanted) in turn, or None when closed and empty. Holds the lock."""
         while not self._queues:
             if self._closed:
                 return None
             self._cv.wait()
         client, queue = next(iter(self._queues.items()))
-        future, fn = queue.popleft()
+        future, fn, wanted = queue.popleft()
         if queue:
             self._queues.move_to_end(client)  # its next job waits for every other address's turn
         else:
             del self._queues[client]
-        return client, future, fn
+        return client, future, fn, wanted
 
     def _run(self) -> None:
         while True:
@@ -146,19 +149,23 @@ class FairWorker:
                 job = self._next()
             if job is None:
                 return
-            client, future, fn = job
-            ran = False
-            try:
-                if future.set_running_or_notify_cancel():
-                    ran = True
-                    try:
-                        future.set_result(fn())
-                    except BaseException as exc:  # noqa: BLE001 - handed to the waiting request
-                        future.set_exception(exc)
-            finally:
-                with self._cv:
-                    if ran:
-                        self._done += 1
-                    else:
-                        self._dropped += 1  # cancelled between leaving its queue and starting
-                    self._release(client)
+            client, future, fn, wanted = job
+            if wanted is not None and not wanted():
+                future.cancel()  # nobody waits for it any more: dropped, and its waiters told
+            ran = future.set_running_or_notify_cancel()
+            result = error = None
+            if ran:
+                try:
+                    result = fn()
+                except BaseException as exc:  # noqa: BLE001 - handed to the waiting request
+                    error = exc
+            with self._cv:  # counted and released before its waiters wake: stats() and the place agree
+                if ran:
+                    self._done += 1
+                else:
+                    self._dropped += 1  # not wanted at its turn, or cancelled as it left its queue
+                self._release(client)
+            if ran and error is None:
+                future.set_result(result)
+            elif ran:
+                future.set_exception(error)
