@@ -62,6 +62,18 @@ def test_the_wavelengths_of_a_lens_without_dispersion_share_one_sub_cell_layout(
         assert np.array_equal(own._ws.opd_waves, pf._ws.opd_waves)
 
 
+def test_the_wavelengths_of_a_dispersive_lens_keep_their_own_traces():
+    # review of round 13: the sharing is keyed on each medium's index at the wavelength; the Zuiko's
+    # glasses disperse, so its d, F and C pupils must each be traced and laid out on their own
+    cam = camera_state(load_lens("zuiko_18mm_f3_5"))
+    fp = S.field_pupils(cam, 10.0, wavelengths_nm=WHITE_LIGHT_NM, min_frequency=10.0, waves_per_cell=S.WAVES_PER_CELL_MTF)
+    ref = fp.reference_point(0.0)
+    pfs = [fp.pupil(i, 0.0, ref) for i in range(3)]
+    cells = [P._sub_cells(t) for t in fp.traces]
+    assert cells[0] is not cells[1] and cells[1] is not cells[2] and cells[0] is not cells[2]
+    assert not np.array_equal(pfs[0].opd, pfs[1].opd) and not np.array_equal(pfs[1].opd, pfs[2].opd)
+
+
 @settings(max_examples=50, deadline=None)
 @given(st.lists(st.tuples(*[st.floats(-1e6, 1e6, allow_subnormal=False)] * 3).filter(lambda d: any(d)),
                 min_size=1, max_size=20))
