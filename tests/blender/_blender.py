@@ -86,6 +86,21 @@ scene.view_settings.view_transform = "Standard"
 scene.render.image_settings.file_format = "OPEN_EXR"
 """
 
+#: Blender code defining ``direction_world()``: a new world whose colour is the ray's direction plus 2 (every
+#: channel positive, strength 1), so that a render pictures the camera's rays. Needs ``scene`` (SCENE's).
+DIRECTION_WORLD = """
+def direction_world():
+    world = bpy.data.worlds.new("dir"); scene.world = world; world.use_nodes = True
+    nt = world.node_tree
+    tc = nt.nodes.new("ShaderNodeTexCoord")   # in the world, Generated is the ray's direction
+    add = nt.nodes.new("ShaderNodeVectorMath"); add.operation = "ADD"
+    add.inputs[1].default_value = (2.0, 2.0, 2.0)
+    nt.links.new(tc.outputs["Generated"], add.inputs[0])
+    bg = nt.nodes["Background"]; bg.inputs["Strength"].default_value = 1.0
+    nt.links.new(add.outputs[0], bg.inputs["Color"])
+"""
+
+
 #: Blender code defining ``glow(name, strength)``: a new material that only emits (white light of that
 #: strength), what the lit objects of the rendered tests are made of.
 GLOW_MATERIAL = """

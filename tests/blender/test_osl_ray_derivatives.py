@@ -22,7 +22,7 @@ import re
 import numpy as np
 import pytest
 
-from _blender import run_blender
+from _blender import DIRECTION_WORLD, run_blender
 from test_blender_camera import SCENE
 from physcam.export.blender import osl_camera_shader
 from physcam.lens.library import load_lens
@@ -38,15 +38,7 @@ _DERIVS = ("    vector traced = vector(dx, dy, -dz);\n    point raster = camera_
            "    vector d_raster = Dx(raster);\n"
            "    throughput = color(length(Dx(direction)), length(Dx(traced)), d_raster[0]);\n")
 
-RUN = SCENE + '''
-def direction_world():
-    world = bpy.data.worlds.new("dir"); scene.world = world; world.use_nodes = True
-    nt = world.node_tree
-    tc = nt.nodes.new("ShaderNodeTexCoord")   # in the world, Generated is the ray's direction
-    add = nt.nodes.new("ShaderNodeVectorMath"); add.operation = "ADD"
-    add.inputs[1].default_value = (2.0, 2.0, 2.0)
-    nt.links.new(tc.outputs["Generated"], add.inputs[0])
-    nt.links.new(add.outputs[0], nt.nodes["Background"].inputs["Color"])
+RUN = SCENE + DIRECTION_WORLD + '''
 from cycles import osl
 scene.cycles.shading_system = True
 scene.cycles.use_adaptive_sampling = False

@@ -17,7 +17,7 @@ import re
 import numpy as np
 import pytest
 
-from _blender import run_blender
+from _blender import DIRECTION_WORLD, run_blender
 from test_blender_camera import SCENE
 from physcam.export.blender import osl_camera_shader
 from physcam.export.osl import SPHERE_KIND
@@ -45,15 +45,8 @@ def test_sphere_shortcut_gives_the_generic_quadrics_rays(tmp_path):
     assert kinds.count(SPHERE_KIND) == 10  # every glass surface of the double Gauss is a sphere
     (tmp_path / "sphere.osl").write_text(src)
     (tmp_path / "generic.osl").write_text(_generic(src))
-    out = run_blender(SCENE + '''
-world = bpy.data.worlds.new("dir"); scene.world = world; world.use_nodes = True
-nt = world.node_tree
-tc = nt.nodes.new("ShaderNodeTexCoord")   # in the world, Generated is the ray's direction
-add = nt.nodes.new("ShaderNodeVectorMath"); add.operation = "ADD"
-add.inputs[1].default_value = (2.0, 2.0, 2.0)
-nt.links.new(tc.outputs["Generated"], add.inputs[0])
-bg = nt.nodes["Background"]; bg.inputs["Strength"].default_value = 1.0
-nt.links.new(add.outputs[0], bg.inputs["Color"])
+    out = run_blender(SCENE + DIRECTION_WORLD + '''
+direction_world()
 scene.cycles.shading_system = True
 scene.cycles.use_adaptive_sampling = False
 scene.cycles.seed = 0
