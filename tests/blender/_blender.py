@@ -145,6 +145,9 @@ def run_blender_log(script: str, *args, timeout: float = 300.0, env: dict | None
     own = env or {}  # the test's own variables: only a user folder the test gave is cleaned up
     env = dict(os.environ, PYTHONPATH=str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""), **own)
     with tempfile.TemporaryDirectory(prefix="physcam-blender-") as tmp:
+        # Blender's temporary files (Cycles leaves the .oso of every camera shader the scripts compile
+        # themselves) go into the script's folder, removed after, unless the test chose a TMPDIR
+        env.setdefault("TMPDIR", tmp)
         path = Path(tmp) / "script.py"
         path.write_text(OSL_PATH_PRELUDE + script)
         p = subprocess.run(runner.command(path, *map(str, args)), capture_output=True, text=True, timeout=timeout,

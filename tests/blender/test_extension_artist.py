@@ -126,6 +126,8 @@ for f in (1, 2):
     bpy.data.images.remove(img)
 out["focus_object"] = focus
 out["message_end"] = p.message
+import os, tempfile
+out["oso_left"] = sorted(f for f in os.listdir(tempfile.gettempdir()) if f.endswith(".oso"))
 print(json.dumps(out))
 '''
 
@@ -133,7 +135,8 @@ print(json.dumps(out))
 @pytest.fixture(scope="module")
 def artist(extension_zip, extension_user, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("artist")
-    return run_blender_log(ARTIST, extension_zip, tmp, env=extension_user)
+    own_temp = tmp_path_factory.mktemp("artist-tempdir")  # Blender's TMPDIR: what the add-on leaves there
+    return run_blender_log(ARTIST, extension_zip, tmp, env={**extension_user, "TMPDIR": str(own_temp)})
 
 
 def test_bad_input_never_reaches_the_render(artist):
@@ -236,6 +239,14 @@ def test_viewport_depth_of_field_can_be_switched_off(artist):
     """Blender's own switch: off stays off while the physcam focus and f-stop change."""
     out, _ = artist
     assert out["viewport_dof_after_changes"] is False
+
+
+def test_switching_lenses_leaves_no_compiled_shader_behind(artist):
+    """Cycles compiles an internal camera shader into a temporary .oso it never removes (0.06-6.5 MB each,
+    on every lens or setting that changes the shader): the add-on compiles in a folder of its own and
+    removes it, so the dozen lens and f-stop switches above leave nothing in Blender's temp folder."""
+    out, _ = artist
+    assert out["oso_left"] == []
 
 
 def test_no_dependency_cycle(artist):

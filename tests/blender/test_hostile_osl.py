@@ -20,12 +20,13 @@ pytestmark = pytest.mark.slow
 EVIL = "evil \\\n#define N_SURF 1\nshader x(){}\n??/\n#define HALF_W 0.0\r\n*/ \"\"\" \\"
 
 SCRIPT = r"""
-import hashlib, json, re, runpy, sys
+import hashlib, json, os, re, runpy, sys, tempfile
 out = {}
 for label, path in (("evil", sys.argv[1]), ("plain", sys.argv[2])):
     cam = runpy.run_path(path)["apply"](bpy.context.scene)
     code = re.sub(r"/[^ \t\n{}]*tmp\w+[.]os[lo]", "SHADER", cam.data.custom_bytecode)  # Blender's temporary names
     out[label] = {"bytes": len(code), "sha": hashlib.sha256(code.encode()).hexdigest()}
+out["oso_left"] = sorted(f for f in os.listdir(tempfile.gettempdir()) if f.endswith(".oso"))
 print(json.dumps(out))
 """
 
@@ -42,6 +43,11 @@ def test_a_hostile_lens_name_compiles_to_the_harmless_names_bytecode(tmp_path):
         path.write_text(blender_setup_script(src, sensor_width_mm=24.0, sensor_height_mm=18.0,
                                              text_name="physcam_lens.osl"), encoding="utf-8")
         paths.append(path)
-    got = run_blender(SCRIPT, *paths, timeout=600)
+    own_temp = tmp_path / "blender-tmp"
+    own_temp.mkdir()
+    got = run_blender(SCRIPT, *paths, timeout=600, env={"TMPDIR": str(own_temp)})
     assert got["plain"]["bytes"] > 1000  # compiled
     assert got["evil"] == got["plain"]
+    # Cycles leaves the .oso of an internal camera shader in the temp folder; the setup script compiles
+    # in a folder of its own and removes it
+    assert got["oso_left"] == [] and not list(own_temp.glob("*.oso"))
