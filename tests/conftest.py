@@ -1,5 +1,6 @@
 """Test-session set-up shared by every test module."""
 
+import atexit
 import os
 import tempfile
 
@@ -23,6 +24,17 @@ os.environ["PHYSCAM_CONFIG"] = _EMPTY_CONFIG
 # empty one of its own, so "every lens" means the bundled ones. Tests of the user library point
 # PHYSCAM_LENS_LIBRARY at a folder of their own with monkeypatch.
 os.environ["PHYSCAM_LENS_LIBRARY"] = tempfile.mkdtemp(prefix="physcam-test-lenses-")
+
+
+def _remove_session_folders(config=_EMPTY_CONFIG, library=os.environ["PHYSCAM_LENS_LIBRARY"]):
+    """The empty config and lens library go when the process that made them ends (each xdist worker)."""
+    import shutil
+    shutil.rmtree(library, ignore_errors=True)
+    if os.path.exists(config):
+        os.remove(config)
+
+
+atexit.register(_remove_session_folders)
 
 # USD builds its schema registry once per process: register physcam's PhysicalCamera plugin
 # before any test (in any xdist worker, in any order) creates a stage.
