@@ -53,13 +53,13 @@ SKIP = {
         "listens 30 s for a stream (tests/live/test_cli_live.py records one sent by a second process)",
 }
 
-#: Commands shown the same on several pages, run once per test process (the first page to run one keeps its
+#: Commands shown the same on several pages, run once per test session (the first page to run one keeps its
 #: exit status and output; every page that shows it compares its shown output with them): each reads only
 #: bundled data (a bundled lens, the sensor table) and the session's empty config, nothing of a page's
 #: folder nor a page's lens library, and no later command of these pages reads what it writes (a page
 #: that reuses the run has not those files). The ST-maps of 4608x3164 px are 12 s of CPU (README.md and
 #: docs/distortion.md), the comparison 2 s (README.md and docs/cli.md). Pages that xdist runs on
-#: different workers each run it.
+#: different workers share the run through the session's folder (:func:`_shared_run`).
 SHARED = {
     'physcam distortion --lens zeiss_distagon_35mm_f4 --focus 2m --sensor ALEXA 35 --resolution 4608x3164 --stmap out/ '
     '--fit 3de4 --fit brown --fit nuke --fit usd',
@@ -68,6 +68,29 @@ SHARED = {
 }
 #: {command: (exit status, stdout, stderr)} of the :data:`SHARED` commands run so far in this process
 _SHARED_RUNS: dict[str, tuple[int, str, str]] = {}
+
+
+def _shared_run(key: str, argv: list[str], capsys, tmp_path_factory) -> tuple[int, str, str]:
+    """(exit status, stdout, stderr) of the :data:`SHARED` command ``key``: run here by the first page of the
+    session to reach it, and kept in the session's folder for the pages on other xdist workers (a worker
+    reaching it while another runs it waits for that run, under the command's own lock)."""
+    import hashlib
+
+    from _session import session_lock
+
+    if key in _SHARED_RUNS:
+        return _SHARED_RUNS[key]
+    name = "doc-shared-" + hashlib.sha256(key.encode()).hexdigest()[:16]
+    with session_lock(tmp_path_factory, name) as folder:
+        kept = folder / f"{name}.json"
+        if kept.exists():
+            rc, out, err = json.loads(kept.read_text())
+        else:
+            rc = main(argv[1:])
+            out, err = capsys.readouterr()
+            kept.write_text(json.dumps([rc, out, err]))
+    _SHARED_RUNS[key] = rc, out, err
+    return rc, out, err
 
 
 def _broken_sample(d: Path) -> None:
@@ -237,7 +260,7 @@ def test_technical_examples_are_physically_consistent(capsys):
 
 
 @pytest.mark.parametrize("page", [p for p in PAGES if doc_commands(p)], ids=lambda p: p.name)
-def test_every_command_of_the_page_runs(page, tmp_path, capsys, monkeypatch):
+def test_every_command_of_the_page_runs(page, tmp_path, capsys, monkeypatch, tmp_path_factory):
     # pages that show no command (architecture, conventions, ...) have nothing to run: not parametrized
     from _doc_output import compare
 
@@ -264,13 +287,11 @@ def test_every_command_of_the_page_runs(page, tmp_path, capsys, monkeypatch):
                 if "/" in a and a.endswith((".usda", ".usd", ".usdc")) and not Path(a).exists():
                     Path(a).parent.mkdir(parents=True, exist_ok=True)
             argv = [*argv, *BOUNDED.get(argv[1], ([],))[0]]
-            if key in _SHARED_RUNS:
-                rc, out, err = _SHARED_RUNS[key]
+            if key in SHARED:
+                rc, out, err = _shared_run(key, argv, capsys, tmp_path_factory)
             else:
                 rc = main(argv[1:])
                 out, err = capsys.readouterr()
-                if key in SHARED:
-                    _SHARED_RUNS[key] = rc, out, err
             if rc != want:
                 failures.append(f"{page.name}:{line}: `{text}` exited {rc} (want {want}): {err.strip()[-400:]}")
             elif "Traceback" in err:
