@@ -62,14 +62,14 @@ p.focus_distance = 5.0; p.fstop = 8.0
 res = {"installed": bool(installed), "user_dir": bpy.utils.user_resource("EXTENSIONS"), "lenses": {}, "variants": {}}
 slugs = json.loads(sys.argv[3])
 slug = slugs[0]
-import hashlib, re, tempfile
+import hashlib, re
 def bytecode_md5():
     """The MD5 of the bytecode, the compile's temporary file names left out (the oso names its source, a
     new temporary file each compile); None when Cycles stored another bytecode's MD5 with it."""
     b = cam.custom_bytecode
     if hashlib.md5(b.encode(), usedforsecurity=False).hexdigest() != cam.custom_bytecode_hash:
         return None
-    b = re.sub(re.escape(tempfile.gettempdir()) + r"/tmp\\w+\\.os[lo]", "TEMP", b)
+    b = re.sub(r'[^\\s"]*tmp\\w+\\.os[lo]', "TEMP", b)  # wherever the compile put them
     return hashlib.md5(b.encode(), usedforsecurity=False).hexdigest()
 saved = bpy.data.texts.new(f"physcam_{slug}__d0f0.osl")
 saved.write("// saved by an earlier physcam\\n" + zipfile.ZipFile(zip_path).read(f"shaders/{slug}.osl").decode())
