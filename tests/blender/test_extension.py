@@ -49,7 +49,11 @@ def test_installs_registers_and_every_lens_compiles(extension_zip, tmp_path):
     of each kind the builder and the shader treat apart), chosen in the enum, gives a compiled OSL camera. One lens's
     four variants (dispersion, Fresnel) are texts named as the four-shader zips named them, each
     compiled from the lens's one source with its #define lines, and a text of that name already in the
-    file (a .blend saved with an earlier extension) is kept as it is."""
+    file (a .blend saved with an earlier extension) is kept as it is. The camera's bytecode follows every
+    change: each lens and each variant its own (their MD5s all differ, the compile's temporary file names
+    left out; Cycles stores each bytecode with its own MD5), and with Cycles not the scene's engine (Blender
+    then compiles nothing when the shader text is set: the add-on compiles) a change of lens and one of
+    variant give the bytecode that lens and variant gave under Cycles."""
     lenses = [r.slug for r in list_lenses() if r.slug in EXTENSION_LENSES]  # the zip's, in the library's order
     out = run_blender(INSTALL + '''
 import zipfile
@@ -58,6 +62,15 @@ p.focus_distance = 5.0; p.fstop = 8.0
 res = {"installed": bool(installed), "user_dir": bpy.utils.user_resource("EXTENSIONS"), "lenses": {}, "variants": {}}
 slugs = json.loads(sys.argv[3])
 slug = slugs[0]
+import hashlib, re
+def bytecode_md5():
+    """The MD5 of the bytecode, the compile's temporary file names left out (the oso names its source, a
+    new temporary file each compile); None when Cycles stored another bytecode's MD5 with it."""
+    b = cam.custom_bytecode
+    if hashlib.md5(b.encode(), usedforsecurity=False).hexdigest() != cam.custom_bytecode_hash:
+        return None
+    b = re.sub(r'[^\\s"]*tmp\\w+\\.os[lo]', "TEMP", b)  # wherever the compile put them
+    return hashlib.md5(b.encode(), usedforsecurity=False).hexdigest()
 saved = bpy.data.texts.new(f"physcam_{slug}__d0f0.osl")
 saved.write("// saved by an earlier physcam\\n" + zipfile.ZipFile(zip_path).read(f"shaders/{slug}.osl").decode())
 p.enabled = True
@@ -67,12 +80,18 @@ for d, f in ((False, False), (False, True), (True, True), (True, False)):  # one
     p.dispersion = d; p.fresnel = f
     t = cam.custom_shader
     res["variants"][f"{int(d)}{int(f)}"] = [t.name, [ln.body for ln in t.lines[:3] if ln.body.startswith("#define")],
-                                            len(cam.custom_bytecode), p.message]
+                                            len(cam.custom_bytecode), p.message, bytecode_md5()]
 p.dispersion = False
 for slug in slugs:
     p.lens = slug
     res["lenses"][slug] = {"bytecode": len(cam.custom_bytecode), "message": p.message,
-                           "shader": cam.custom_shader.name if cam.custom_shader else None}
+                           "shader": cam.custom_shader.name if cam.custom_shader else None, "md5": bytecode_md5()}
+scene.render.engine = "BLENDER_EEVEE"  # setting the shader text compiles nothing now
+res["eevee"] = {}
+p.lens = slugs[0]
+res["eevee"]["lens"] = bytecode_md5()
+p.fresnel = True
+res["eevee"]["fresnel"] = bytecode_md5()
 print(json.dumps(res))
 ''', extension_zip, tmp_path, json.dumps(lenses),
         env={"BLENDER_USER_RESOURCES": str(tmp_path / "user")})
@@ -83,12 +102,17 @@ print(json.dumps(res))
         assert r["message"] == "" and r["bytecode"] > 0 and slug in r["shader"], (slug, r)
     first = lenses[0]
     assert out["kept"][:2] == [f"physcam_{first}__d0f0.osl", "// saved by an earlier physcam"] and out["kept"][2] > 0
-    for key, (name, defines, size, message) in out["variants"].items():
+    for key, (name, defines, size, message, _) in out["variants"].items():
         assert name == f"physcam_{first}__d{key[0]}f{key[1]}.osl" and message == "", (key, name, message)
         assert defines == ["#define PHYSCAM_DISPERSION 1"] * (key[0] == "1") + ["#define PHYSCAM_FRESNEL 1"] * (key[1] == "1")
     # each variant compiled its own code: four bytecodes, dispersion's (a wavelength per ray) the longer
     sizes = {k: v[2] for k, v in out["variants"].items()}
     assert len(set(sizes.values())) == 4 and sizes["10"] > sizes["00"] and sizes["11"] > sizes["01"], sizes
+    # the bytecode follows every change: each lens's and variant's its own, and the same without Cycles
+    md5 = {**{k: v[4] for k, v in out["variants"].items()}, **{s: r["md5"] for s, r in out["lenses"].items()}}
+    assert None not in md5.values() and len(set(md5.values())) == len(md5) - 1, md5  # the first lens's d0f0 twice
+    assert md5[first] == md5["00"]
+    assert out["eevee"] == {"lens": md5[first], "fresnel": md5["01"]}, out["eevee"]
 
 
 PULL = INSTALLED_EXTENSION_SCENE + '''

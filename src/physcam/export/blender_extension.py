@@ -97,9 +97,11 @@ def lens_payload(lens, slug: str) -> tuple[dict, dict[str, str]]:
         from ..lens.zoom import prescription_at
         from .blender_zoom import N_ZOOM_ROWS, rows_to_geometry, zoom_focus_table
 
-        ft = zoom_focus_table(lens)
+        positions = {}  # the geometry's prescriptions: the rows' positions are among them, focus states kept
+        ft = zoom_focus_table(lens, positions=positions)
         rows_u = np.linspace(0.0, 1.0, N_ZOOM_ROWS)
-        rows = [r for u in rows_u for r in _report_rows(prescription_at(lens, float(u)), ft.marks_mm)]
+        rows = [r for u in rows_u.tolist()
+                for r in _report_rows(positions.get(u) or prescription_at(lens, u), ft.marks_mm)]
         pupil = rows_to_geometry([r["pupil_from_film_mm"] for r in rows], len(ft.marks_mm))
     else:
         ft = focus_table(lens)

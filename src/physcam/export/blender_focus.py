@@ -157,8 +157,12 @@ def focus_geometry(lens: Prescription, axis: FocusAxis, *, states: list | None =
     geometry. The slope is physcam's own at infinity (a difference of exact focus solves 1e-3 index steps
     apart, one-sided), in closed form at the other marks (:func:`_unit_film_slope`, :func:`_internal_film_slope`:
     no more focus solves). ``states``: a list that receives each mark's
-    :class:`~physcam.optics.focusing.FocusState` (solved once, for the caller's tables too)."""
+    :class:`~physcam.optics.focusing.FocusState` (solved once, for the caller's tables too). The marks'
+    states are solved through ``lens``'s lens model (:func:`physcam.optics.lens_model.lens_model_of`), which
+    keeps them: a camera state of this prescription object at a mark of the table (the extension's
+    per-mark lens reports) then solves no focus again."""
     from ..optics.focusing import focus, focus_method
+    from ..optics.lens_model import lens_model_of
     from ..optics.paraxial import gaussian
     from ..trace.surfaces import surface_table
 
@@ -171,8 +175,9 @@ def focus_geometry(lens: Prescription, axis: FocusAxis, *, states: list | None =
     internal = focus_method(lens) == "internal"
     gauss = None if internal else gaussian(lens)
     film_z, slope, vz = [], [], []
+    model = lens_model_of(lens)
     for k in range(axis.n):
-        st = focus(lens, axis.mark(k))
+        st = model.focus_state(axis.mark(k))  # focus(lens, mark), kept for the lens's later camera states
         if states is not None:
             states.append(st)
         film_z.append(st.film_z)

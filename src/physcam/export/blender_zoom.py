@@ -83,13 +83,16 @@ def _iris_rule(q: Prescription) -> tuple[float, float, float]:
 
 @takes_prescription
 def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geometry: int = N_ZOOM_GEOMETRY,
-                     pupil_stride: int = ZOOM_PUPIL_STRIDE):
+                     pupil_stride: int = ZOOM_PUPIL_STRIDE, positions: dict | None = None):
     """The :class:`~physcam.export.blender_focus.FocusTable` of a zoom lens over zoom x focus (module
     notes): ``film_z`` and ``vertex_z`` hold ``n_geometry`` blocks of ``n_focus`` states (u major),
     ``radial`` and ``norm`` one block per tabulated position (traced at every ``pupil_stride``-th mark and the
     last, :func:`~physcam.export.blender_focus.fill_pupil_tables` between); ``zoom`` the :class:`ZoomGrid`. Its
     ``fstop_open``/``fstop_min`` are the slowest over the zoom (an f-stop every position reaches) and
-    ``closest_mm`` the farthest closest focus (a mark every position focuses to)."""
+    ``closest_mm`` the farthest closest focus (a mark every position focuses to). ``positions``: a dict that
+    receives the plain prescription at each geometry position, by its encoder; each keeps its marks' focus
+    states (:func:`~physcam.export.blender_focus.focus_geometry`), so the caller's camera states of it at
+    those marks solve no focus again."""
     from ..lens.zoom import prescription_at, tabulated_encoders
     from ..optics.focusing import focus
     from ..optics.zoom import efl_at
@@ -106,6 +109,8 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     geo_u = np.linspace(0.0, 1.0, n_geometry)
     pupil_u = np.array(tabulated_encoders(lens), dtype=float)
     geo_q = [prescription_at(lens, float(u)) for u in geo_u]
+    if positions is not None:
+        positions.update(zip(geo_u.tolist(), geo_q))
     axis = zoom_focus_axis(geo_q, n_focus)
     marks = axis.marks_mm
     rows_u = np.linspace(0.0, 1.0, N_ZOOM_ROWS)
