@@ -1,4 +1,4 @@
-"""2,500 samples over loopback UDP with bad packets mixed in (garbage, truncated, wrong checksum,
+"""10,000 samples over loopback UDP with bad packets mixed in (garbage, truncated, wrong checksum,
 duplicated, out of order, oversized, schema-invalid): the recorded USD holds every good sample, in
 order, with the values that were sent, and the receiver's memory stays bounded (measured)."""
 
@@ -25,12 +25,9 @@ from _udp import PacedSender
 
 pytestmark = pytest.mark.slow
 
-#: The samples sent. 10,000 until round 14 (37 s of the suite); 2,500 hold every case the test counts:
-#: the sequence numbers wrap 536 samples in, every kind of bad packet recurs at least 12 times (the
-#: rarest, oversized, every 200th sample), 61 pairs go out of order, and the memory bound is per
-#: sample kept (20 KiB each, 195 MiB for 10,000 as before). Writing 10,000 frames is
-#: benchmarks/live_usd.py's.
-N = 2_500
+#: The samples sent: 10,000, as issue 17 asks of this test ("streams 10,000 samples at full speed with
+#: injected bad packets"). The memory bound is per sample kept (20 KiB each: 195 MiB for 10,000).
+N = 10_000
 
 
 def _rss_bytes() -> int:
@@ -55,7 +52,7 @@ def _invalid_sample(good):
     return bad
 
 
-def test_a_long_stream_with_bad_packets(tmp_path):
+def test_ten_thousand_samples_with_bad_packets(tmp_path):
     pxr = pytest.importorskip("pxr")
     from pxr import Usd, UsdGeom
 
