@@ -12,7 +12,7 @@ extra      packages                              what it gives
 fast       numba                                 the JIT tracing kernels (same rays, faster)
 usd        usd-core                              PhysicalCamera USD files, kits, readers
 exr        OpenEXR                               ST-maps and images as EXR
-live       jsonschema, cbor2                     OpenTrackIO samples (physcam live)
+live       jsonschema, fastjsonschema, cbor2     OpenTrackIO samples (physcam live)
 dask       dask[distributed], bokeh, pyarrow     physcam characterize on a cluster
 serve      starlette, uvicorn, httptools, segno  physcam serve, the phone page
 calibrate  opencv-python-headless                physcam calibrate: charts found in photographs
@@ -35,7 +35,7 @@ EXTRAS = {
     "fast": (("numba", "numba"),),
     "usd": (("pxr", "usd-core"),),
     "exr": (("OpenEXR", "OpenEXR"),),
-    "live": (("jsonschema", "jsonschema"), ("cbor2", "cbor2")),
+    "live": (("jsonschema", "jsonschema"), ("fastjsonschema", "fastjsonschema"), ("cbor2", "cbor2")),
     "dask": (("distributed", "dask[distributed]"), ("bokeh", "bokeh"), ("pyarrow", "pyarrow")),
     "serve": (("starlette", "starlette"), ("uvicorn", "uvicorn"), ("httptools", "httptools"), ("segno", "segno")),
     "calibrate": (("cv2", "opencv-python-headless"),),

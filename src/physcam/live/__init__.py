@@ -7,7 +7,7 @@ camera and lens), ``receiver`` and ``sender`` (UDP), ``record`` (time-sampled US
 lens report), ``usd_io`` (frames read back from a PhysicalCamera), ``frustum`` (the LED wall's inner
 frustum). Layer 8.5: above ``usd`` (whose authoring it uses), below ``cli``.
 
-The 'live' extra (jsonschema, cbor2) is needed where samples are validated or carried as CBOR
+The 'live' extra (jsonschema, fastjsonschema, cbor2) is needed where samples are validated or carried as CBOR
 (:mod:`physcam.live.sample`, which says so in one line); the rest (frames, lens data, the per-frame
 lens report) runs in the core, so ``physcam metadata report`` does not need it.
 """
