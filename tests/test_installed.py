@@ -178,9 +178,11 @@ def test_the_core_reads_camera_metadata_and_a_take_needs_usd_before_it_is_receiv
     clip = inst["site"] / "physcam" / "data" / "samples" / "arri_alexa_lf_B001C001_first48.csv"
     p = _physcam(inst, "metadata", "report", clip, "--json")
     assert len(json.loads(p.stdout)["frames"]) == 48
-    # with the 'live' extra but not 'usd' (its two packages on a side path), a recording stops at once
+    # with the 'live' extra but not 'usd' (its packages on a side path), a recording stops at once
+    from physcam.extras import EXTRAS
+
     side = inst["tmp"] / "live-only"
-    _add(inst, "jsonschema", "cbor2", target=side)
+    _add(inst, *(pypi for _, pypi in EXTRAS["live"]), target=side)
     env = dict(inst["env"], PYTHONPATH=str(side))
     t0 = time.perf_counter()
     p = _run([inst["bin"] / "physcam", "live", "record", "take.usda", "--port", "55631", "--duration", "30"],
