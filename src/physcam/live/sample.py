@@ -5,8 +5,9 @@ The schema is SMPTE RIS-OSVP's ``opentrackio-schema-1.0.1.json`` (draft 2020-12)
 ``Draft202012Validator``, a complete implementation of the draft (docs/live.md says why this
 library). A valid sample's yes comes from the same schema compiled to Python by :mod:`fastjsonschema`
 (its keywords mean the same in draft 7, which fastjsonschema implements: :data:`_SAME_IN_DRAFT_7`;
-1-3 ms -> tens of microseconds a sample); any other sample is judged and reported by jsonschema. Plus one rule the schema cannot state and camdkit's model checks: a timecode's ``frames``
-is below its ``frameRate`` (rounded up). A sample that fails is reported by its JSON path (``$.lens.fStop``) and the schema rule it
+1-3 ms -> tens of microseconds a sample); any other sample is judged and reported by jsonschema.
+Plus one rule the schema cannot state and camdkit's model checks: a timecode's ``frames`` is below
+its ``frameRate`` (rounded up). A sample that fails is reported by its JSON path (``$.lens.fStop``) and the schema rule it
 broke (``exclusiveMinimum``), the first problem first in document order.
 
 Numbers that JSON cannot carry (NaN, Infinity) and CBOR can are refused too, with their path, and so
