@@ -90,9 +90,10 @@ chromium:
 # The installs are mostly downloads and unpacking: they run side by side (.venv, bpy, chromium, the
 # newest-versions environment), then the suite.
 # (Three xdist workers on the two cores were slower: 792 s against 742 s, the Blender tests queued last.)
-# The oldest USD's and the newest versions' tests run beside the suite, niced: they fill the cores the suite
-# leaves idle (its servers, browsers and subprocesses wait about a tenth of its time), and their output
-# comes after the suite's.
+# The oldest USD's and the newest versions' tests run beside the suite, niced, their output after the
+# suite's: no 45 s tail after it. The suite is CPU-bound most of the time, so they mostly take their CPU
+# from it (its servers, browsers and subprocesses leave a core idle about a tenth of its time);
+# docs/performance.md, round 14.
 SIDE_LOG := .test-side.log
 test:
 	$(MAKE) --no-print-directory -j6 $(STAMP) $(BLENDER_BPY) chromium editables jit test-bytecode lint bytecode

@@ -51,9 +51,7 @@ def _mutate(sample, data):
         if not paths:
             break
         path = data.draw(st.sampled_from(paths))
-        parent = s
-        for k in path[:-1]:
-            parent = parent[k]
+        parent = _get(s, path[:-1])
         how = data.draw(st.sampled_from(["replace", "replace", "remove", "add"]))
         if how == "replace":
             parent[path[-1]] = data.draw(VALUES)

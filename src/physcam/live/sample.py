@@ -137,12 +137,11 @@ def _schema_keywords(node, out=None) -> set:
 @lru_cache(maxsize=1)
 def _fast_is_valid():
     """The schema compiled by fastjsonschema (as draft 7: :data:`_SAME_IN_DRAFT_7`), as ``sample -> bool``;
-    None where fastjsonschema is missing or the schema uses a keyword outside that set."""
+    None where the schema uses a keyword outside that set. (The live extra brings fastjsonschema:
+    :func:`_validator` has checked it is installed.)"""
+    import fastjsonschema
+
     s = schema()
-    try:
-        import fastjsonschema
-    except ImportError:
-        return None
     if not _schema_keywords(s) <= _SAME_IN_DRAFT_7:
         return None
     check = fastjsonschema.compile({**s, "$schema": "http://json-schema.org/draft-07/schema#"},
