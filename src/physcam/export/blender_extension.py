@@ -139,14 +139,16 @@ def _focus_object_fits(rows) -> dict:
     d = mark - pupil
     out = {"d_min_m": float(d.min())}
     for key, y in (("pupil_m", pupil), ("pinhole_mm", np.array([r["pinhole_mm"] for r in rows]))):
-        def err(c):
-            w = 1.0 / (d + c)
-            return float(np.abs(np.polyval(np.polyfit(w, y, 1), w) - y).max())
+        def err(cs):  # per c of cs, the worst residual of the least-squares line in w = 1 / (D + c), all at once
+            w = 1.0 / (d[None, :] + cs[:, None])
+            wc = w - w.mean(axis=1, keepdims=True)
+            slope = (wc @ (y - y.mean())) / np.einsum("ij,ij->i", wc, wc)
+            return np.abs(slope[:, None] * wc + y.mean() - y).max(axis=1)
 
         lo, hi = -0.99 * d.min(), 10.0 * max(d.min(), 0.1)
         for _ in range(5):  # a scan, refined about its best four times
             cs = np.linspace(lo, hi, 101)
-            best = min(range(cs.size), key=lambda i: err(cs[i]))
+            best = int(np.argmin(err(cs)))
             lo, hi = cs[max(best - 1, 0)], cs[min(best + 1, cs.size - 1)]
         c = float(cs[best])
         b, a = np.polyfit(1.0 / (d + c), y, 1)

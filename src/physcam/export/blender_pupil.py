@@ -659,6 +659,20 @@ def _fill(table: np.ndarray, empty: np.ndarray) -> None:
             table[:, j] = table[:, near]
 
 
+def _tables_backend(backend: str, n_tables: int, n_surfaces: int) -> str:
+    """The tracing backend of a job of ``n_tables`` radial pupil tables of a lens of ``n_surfaces`` surfaces
+    (about :data:`TABLE_RAYS` rays each): :func:`~physcam.trace.kernels.backend_for_job` for the whole job,
+    and where that leaves "auto" (the job pays for loading numba), the JIT kernel at once, numba loaded now
+    (:func:`~physcam.trace.kernels.resolve_backend`). Asked per table, "auto" gave a lens's first tables to the
+    numpy kernel (each about 0.1 s of numba's work, under the load budget), which traced them 5-10 times
+    slower than the JIT kernel traced the rest: about 1.5 s of CPU lost per process building a focus table
+    (round 15). Both kernels give the same rays (:mod:`physcam.trace.kernels`): the tables do not change."""
+    from ..trace.kernels import backend_for_job, resolve_backend
+
+    chosen = backend_for_job(backend, n_tables * TABLE_RAYS * (n_surfaces + 1))
+    return resolve_backend(chosen) if chosen == "auto" else chosen
+
+
 def radial_pupil_table(q, film_z: float, levels, *, backend: str = "auto", checks: list | None = None) -> np.ndarray:
     """The table (len(levels) x :data:`N_RADIAL` x 5: cx, ax, ay in mm on the rear vertex plane, the
     passing set's area in mm^2 and its slope in mm^2 per mm of iris radius) of the focused lens ``q``
@@ -680,6 +694,8 @@ def refined_pupil_tables(focused, levels, *, checks: list, backend: str = "auto"
     sets are traced once, at the radii the added levels read too (:class:`_PassingSets`). ``checks`` receives
     each table's traced check areas at the returned levels."""
     # the drafts (no growth, no trust: what _refined_levels reads) first; only the tables kept are finished
+    if focused:  # the job's backend, chosen once for all its tables
+        backend = _tables_backend(backend, len(focused), len(focused[0][0].surfaces))
     found = [_table_and_sets(q, film_z, levels, backend, checks, finer=True, draft=True) for q, film_z in focused]
     refined = _refined_levels(levels, [draft[0] for draft, _ in found], checks)
     if len(refined) == len(_levels(levels)):
@@ -692,7 +708,6 @@ def _table_and_sets(q, film_z: float, levels, backend: str, checks, *, finer: bo
     """(table, passing sets) of :func:`radial_pupil_table` (``finer``: the sets traced also at the radii of
     the levels :func:`_refined_levels` may add; ``draft``: the table's draft instead, :func:`_drafted`)."""
     from ..lens.prescription import require_prescription
-    from ..trace.kernels import backend_for_job
 
     q = require_prescription(q)
     film_z = require_finite("film z", film_z)
@@ -701,7 +716,7 @@ def _table_and_sets(q, film_z: float, levels, backend: str, checks, *, finer: bo
     levels = _levels(levels)
     if not film_z > q.vertex_z[-1]:
         raise InputError(f"the film (z = {film_z:g} mm) must lie behind the lens's last vertex (z = {q.vertex_z[-1]:g} mm)")
-    sets = _PassingSets(q, film_z, levels, backend_for_job(backend, TABLE_RAYS * (len(q.surfaces) + 1)), finer=finer)
+    sets = _PassingSets(q, film_z, levels, _tables_backend(backend, 1, len(q.surfaces)), finer=finer)
     return (_drafted(sets, levels, checks) if draft else _assembled(sets, levels, checks)), sets
 
 

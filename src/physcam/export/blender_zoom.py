@@ -99,7 +99,7 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     from ..trace.camera_tracer import CameraTracer
     from .blender_focus import (FocusTable, _centre_bounds, _centre_norms, _ellipse_rect, fill_pupil_tables, focus_geometry,
                                 pupil_marks)
-    from .blender_pupil import _centre_ellipses, iris_levels, radial_pupil_table
+    from .blender_pupil import _centre_ellipses, iris_levels, radial_pupil_table, _tables_backend
 
     if lens.zoom is None:
         raise InputError(f"{lens.name!r} is not a zoom lens: use blender_focus.focus_table")
@@ -124,12 +124,13 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     film_z, slope, vz = (np.concatenate([g[i] for g in geometry]) for i in range(3))
     traced = pupil_marks(n_focus, pupil_stride)
     radial, norm = [], []
+    backend = _tables_backend("auto", len(pupil_q) * len(traced), len(lens.surfaces))  # once, for every table
     for q in pupil_q:
         block, block_norm = [], []
         for mk in marks[traced]:
             st = focus(q, float(mk))
             tracer = CameraTracer(st.prescription, st.film_z)  # the lens at this zoom and focus as the file stops it
-            block.append(radial_pupil_table(tracer.lens, st.film_z, levels))
+            block.append(radial_pupil_table(tracer.lens, st.film_z, levels, backend=backend))
             block_norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(block[-1])], levels))
         if not all(min(v) > 0 for v in block_norm):
             from ..errors import OpticsError
