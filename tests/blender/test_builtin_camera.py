@@ -19,81 +19,140 @@ from _blender import run_blender
 
 pytestmark = pytest.mark.slow
 
+#: Renders each job of the list argv[1] in a fresh scene (Blender's factory start-up file, read again
+#: between jobs: no camera setting, object or material of one job reaches the next): the camera
+#: authored by the job's script, emissive spheres, each window's centroid and second moment (and the
+#: picture itself when the job asks). One Blender process for the file's renders: each process costs
+#: about 1.3 s of CPU before its first render (2026-11-29).
 SCENE = '''
 import bpy, json, math, sys
 import numpy as np
-spec = json.loads(sys.argv[1])
-scene = bpy.context.scene
-for o in list(bpy.data.objects):
-    if o.type != "CAMERA":
-        bpy.data.objects.remove(o)
-cam = scene.camera
-cam.location = (0.0, 0.0, 0.0)
-cam.rotation_euler = (0.0, 0.0, 0.0)          # looks down -Z, +Y up
-ns = {}
-exec(spec["script"], ns)
-ns["apply"](scene)
-scene.render.engine = "CYCLES"
-scene.cycles.device = "CPU"
-scene.cycles.samples = spec["samples"]
-scene.cycles.use_denoising = False
-scene.cycles.filter_width = spec["filter_width"]
-scene.cycles.max_bounces = 0
-world = bpy.data.worlds.new("black"); scene.world = world; world.use_nodes = True
-world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-mat = bpy.data.materials.new("glow"); mat.use_nodes = True
-nodes = mat.node_tree.nodes
-for n in list(nodes):
-    nodes.remove(n)
-em = nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = 10.0
-out = nodes.new("ShaderNodeOutputMaterial")
-mat.node_tree.links.new(em.outputs["Emission"], out.inputs["Surface"])
-for x, y, z, r in spec["spheres"]:
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=r, location=(x, y, z), segments=48, ring_count=24)
-    bpy.context.object.data.materials.append(mat)
-    bpy.ops.object.shade_smooth()
-scene.render.image_settings.file_format = "OPEN_EXR"
-scene.render.filepath = spec["out"]
-bpy.ops.render.render(write_still=True)
-img = bpy.data.images.load(spec["out"])
-w, h = img.size
-a = np.array(img.pixels[:], dtype=float).reshape(h, w, 4)[::-1, :, 0]   # rows top to bottom
-blobs = []
-for x0, x1 in spec["windows"]:
-    sub = a[:, x0:x1]
-    tot = sub.sum()
-    yy, xx = np.mgrid[0:h, x0:x1]
-    cx, cy = (xx * sub).sum() / tot + 0.5, (yy * sub).sum() / tot + 0.5   # pixel centres
-    m2 = (((xx + 0.5 - cx) ** 2 + (yy + 0.5 - cy) ** 2) * sub).sum() / tot
-    blobs.append({"cx": cx, "cy": cy, "m2": m2, "sum": tot})
-print(json.dumps({"size": [w, h], "blobs": blobs}))
+results = []
+for spec in json.loads(sys.argv[1]):
+    bpy.ops.wm.read_factory_settings(use_empty=False)
+    scene = bpy.context.scene
+    for o in list(bpy.data.objects):
+        if o.type != "CAMERA":
+            bpy.data.objects.remove(o)
+    cam = scene.camera
+    cam.location = (0.0, 0.0, 0.0)
+    cam.rotation_euler = (0.0, 0.0, 0.0)          # looks down -Z, +Y up
+    ns = {}
+    exec(spec["script"], ns)
+    ns["apply"](scene)
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = spec["samples"]
+    scene.cycles.use_denoising = False
+    scene.cycles.filter_width = spec["filter_width"]
+    scene.cycles.max_bounces = 0
+    world = bpy.data.worlds.new("black"); scene.world = world; world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    mat = bpy.data.materials.new("glow"); mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    for n in list(nodes):
+        nodes.remove(n)
+    em = nodes.new("ShaderNodeEmission"); em.inputs["Strength"].default_value = 10.0
+    out = nodes.new("ShaderNodeOutputMaterial")
+    mat.node_tree.links.new(em.outputs["Emission"], out.inputs["Surface"])
+    for x, y, z, r in spec["spheres"]:
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=r, location=(x, y, z), segments=48, ring_count=24)
+        bpy.context.object.data.materials.append(mat)
+        bpy.ops.object.shade_smooth()
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.filepath = spec["out"]
+    bpy.ops.render.render(write_still=True)
+    img = bpy.data.images.load(spec["out"])
+    w, h = img.size
+    a = np.array(img.pixels[:], dtype=float).reshape(h, w, 4)[::-1, :, 0]   # rows top to bottom
+    bpy.data.images.remove(img)
+    blobs = []
+    for x0, x1 in spec["windows"]:
+        sub = a[:, x0:x1]
+        tot = sub.sum()
+        yy, xx = np.mgrid[0:h, x0:x1]
+        cx, cy = (xx * sub).sum() / tot + 0.5, (yy * sub).sum() / tot + 0.5   # pixel centres
+        m2 = (((xx + 0.5 - cx) ** 2 + (yy + 0.5 - cy) ** 2) * sub).sum() / tot
+        blobs.append({"cx": cx, "cy": cy, "m2": m2, "sum": tot})
+    res = {"size": [w, h], "blobs": blobs}
+    if spec.get("img"):
+        res["img"] = a[::-1].tolist()  # row 0 at the bottom
+    results.append(res)
+print(json.dumps({"results": results}))
 '''
 
 
-def _render(tmp_path, values, spheres, windows, samples, filter_width):
-    """Render emissive spheres (x, y, z, radius in metres from the **entrance pupil**, looking down -Z) and
-    return each window's (pixel columns) intensity centroid and second moment (pixels). The scene camera
-    starts at the origin, which the script reads as the film plane: it must move the camera forward to the
-    pupil, where the spheres are placed from (issue 24: it used to stay at the film, 1.5 % wider)."""
+def _job(values, spheres, windows, samples, filter_width, out, img=False):
+    """One render of :data:`SCENE`: emissive spheres (x, y, z, radius in metres from the **entrance pupil**,
+    looking down -Z), each window's (pixel columns) intensity centroid and second moment (pixels) measured.
+    The scene camera starts at the origin, which the script reads as the film plane: it must move the camera
+    forward to the pupil, where the spheres are placed from (issue 24: it used to stay at the film, 1.5 %
+    wider)."""
     p = values["entrance_pupil_from_film_mm"] / 1000.0
     spheres = [(x, y, z - p, r) for x, y, z, r in spheres]
-    spec = {"script": blender_camera_script(values), "spheres": spheres, "windows": windows, "samples": samples,
-            "filter_width": filter_width, "out": str(tmp_path / "render.exr")}
-    return run_blender(SCENE, json.dumps(spec))
+    return {"script": blender_camera_script(values), "spheres": spheres, "windows": windows, "samples": samples,
+            "filter_width": filter_width, "out": str(out), "img": img}
 
 
-def test_builtin_camera_frames_like_the_thin_lens(tmp_path):
-    """Markers at +-15 degrees seen from the entrance pupil, on the focus plane, land at
-    f_pin tan(15 deg) from the centre, f_pin = s' of the 50 mm thin lens at its 2 m mark (1 % is the
-    issue's bar; the measured agreement is far tighter)."""
+def _frames_case():
     r = solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("FF"), fstop=8.0, focus_mm=2000.0)
     v = blender_camera_values(r, resolution_x=768)
-    w, h = v["render"]["resolution_x"], v["render"]["resolution_y"]
+    w = v["render"]["resolution_x"]
     d = v["camera"]["dof.focus_distance"]  # metres from the camera (the pupil) to the focus plane
     t = math.tan(math.radians(15.0))
     spheres = [(-d * t, 0.0, -d, 0.004), (d * t, 0.0, -d, 0.004)]
     # a symmetric pixel filter (Cycles' default, 1.5 px) antialiases the markers without biasing centroids
-    out = _render(tmp_path, v, spheres, [(0, w // 2), (w // 2, w)], samples=64, filter_width=1.5)
+    return r, v, dict(spheres=spheres, windows=[(0, w // 2), (w // 2, w)], samples=64, filter_width=1.5)
+
+
+def _blur_case():
+    r = solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("FF"), fstop=2.0, focus_mm=2000.0)
+    v = blender_camera_values(r, resolution_x=512)
+    w = v["render"]["resolution_x"]
+    d_mm, radius_mm = 500.0, 2.0
+    # no pixel filter (samples at pixel centres): the blur measured is the lens's alone
+    return r, v, dict(spheres=[(0.0, 0.0, -d_mm / 1000.0, radius_mm / 1000.0)], windows=[(0, w)], samples=256,
+                      filter_width=0.01)
+
+
+def _shift_case():
+    r = solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("FF"), fstop=8.0, focus_mm=2000.0)
+    v = blender_camera_values(r, resolution_x=512, shift_mm=(3.0, -2.0))
+    w = v["render"]["resolution_x"]
+    d = v["camera"]["dof.focus_distance"]
+    return r, v, dict(spheres=[(0.0, 0.0, -d, 0.004)], windows=[(0, w)], samples=64, filter_width=1.5)
+
+
+def _iris_case():
+    r = solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("FF"), fstop=2.0, focus_mm=2000.0)
+    v = blender_camera_values(r, resolution_x=512, blades=6, blade_rotation_deg=15.0)
+    v["camera"].update({"sensor_width": 4.0, "sensor_height": 4.0})  # a 4 mm crop: the blur is ~2.5 mm
+    v["render"].update({"resolution_x": 160, "resolution_y": 160})
+    # the light 0.5 m in front of the entrance pupil (_job moves it from the pupil)
+    return r, v, dict(spheres=[(0.0, 0.0, -0.5, 0.001)], windows=[], samples=256, filter_width=0.01, img=True)
+
+
+CASES = {"frames": _frames_case, "blur": _blur_case, "shift": _shift_case, "iris": _iris_case}
+
+
+@pytest.fixture(scope="module")
+def renders(tmp_path_factory):
+    """Per case of :data:`CASES`: (lens report, camera values, the render's measures), all rendered by one
+    Blender process (:data:`SCENE`)."""
+    tmp = tmp_path_factory.mktemp("builtin")
+    cases = {name: make() for name, make in CASES.items()}
+    jobs = [_job(v, out=tmp / f"{name}.exr", **kw) for name, (r, v, kw) in cases.items()]
+    out = run_blender(SCENE, json.dumps(jobs))
+    return {name: (r, v, res) for (name, (r, v, _)), res in zip(cases.items(), out["results"])}
+
+
+def test_builtin_camera_frames_like_the_thin_lens(renders):
+    """Markers at +-15 degrees seen from the entrance pupil, on the focus plane, land at
+    f_pin tan(15 deg) from the centre, f_pin = s' of the 50 mm thin lens at its 2 m mark (1 % is the
+    issue's bar; the measured agreement is far tighter)."""
+    r, v, out = renders["frames"]
+    w, h = v["render"]["resolution_x"], v["render"]["resolution_y"]
+    t = math.tan(math.radians(15.0))
     px_per_mm = w / 36.0
     s_img = r.image_distance_mm  # the thin lens's s' at this mark, from the report's Gaussian model
     half_sep = (out["blobs"][1]["cx"] - out["blobs"][0]["cx"]) / 2
@@ -103,18 +162,14 @@ def test_builtin_camera_frames_like_the_thin_lens(tmp_path):
         assert b["cy"] == pytest.approx(h / 2, abs=0.5)
 
 
-def test_builtin_camera_blurs_like_the_thin_lens(tmp_path):
+def test_builtin_camera_blurs_like_the_thin_lens(renders):
     """An emissive sphere 0.5 m from the camera, the lens focused at a 2 m mark, f/2: the thin
     lens blurs it into a disk of diameter c = A s' |1/d - 1/s| on the film (A = f/N; distances from
     the lens). The render's disk (from the blob's second moment, the sphere's own image removed in
     quadrature: E[r^2] = c^2/8 + e^2/8 for a disk convolved with a disk) matches within 1 %."""
-    r = solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("FF"), fstop=2.0, focus_mm=2000.0)
-    v = blender_camera_values(r, resolution_x=512)
+    r, v, out = renders["blur"]
     w = v["render"]["resolution_x"]
     d_mm, radius_mm = 500.0, 2.0
-    # no pixel filter (samples at pixel centres): the blur measured is the lens's alone
-    out = _render(tmp_path, v, [(0.0, 0.0, -d_mm / 1000.0, radius_mm / 1000.0)], [(0, w)], samples=256,
-                  filter_width=0.01)
     px_per_mm = w / 36.0
     A, s, s_img = 50.0 / 2.0, r.object_distance_mm, r.image_distance_mm
     c = A * s_img * abs(1.0 / d_mm - 1.0 / s)
@@ -125,14 +180,11 @@ def test_builtin_camera_blurs_like_the_thin_lens(tmp_path):
     assert measured != pytest.approx(c * (s - 50.0) / s, rel=0.01)
 
 
-def test_builtin_camera_shift_moves_the_frame_by_millimetres(tmp_path):
+def test_builtin_camera_shift_moves_the_frame_by_millimetres(renders):
     """A 3 mm horizontal, -2 mm vertical sensor shift moves the frame over the image: a marker on the
     axis lands 3 mm left of and 2 mm above the frame centre (image y grows downward)."""
-    r = solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("FF"), fstop=8.0, focus_mm=2000.0)
-    v = blender_camera_values(r, resolution_x=512, shift_mm=(3.0, -2.0))
+    r, v, out = renders["shift"]
     w, h = v["render"]["resolution_x"], v["render"]["resolution_y"]
-    d = v["camera"]["dof.focus_distance"]
-    out = _render(tmp_path, v, [(0.0, 0.0, -d, 0.004)], [(0, w)], samples=64, filter_width=1.5)
     px_per_mm = w / 36.0
     assert out["blobs"][0]["cx"] == pytest.approx(w / 2 - 3.0 * px_per_mm, abs=0.5)
     assert out["blobs"][0]["cy"] == pytest.approx(h / 2 - 2.0 * px_per_mm, abs=0.5)
@@ -163,7 +215,7 @@ print(json.dumps({"lens": cam.lens, "fstop": cam.dof.aperture_fstop, "blades": c
     assert out["focus"] == pytest.approx((1500.0 - planes.entrance_pupil_from_film_mm) / 1000.0, rel=1e-6)
 
 
-def test_builtin_iris_corners_where_physcam_puts_them(tmp_path):
+def test_builtin_iris_corners_where_physcam_puts_them(renders):
     """A 6-blade iris with a corner 15 degrees from +x (physcam's and RenderMan's apertureAngle) renders a
     hexagonal bokeh with a corner at 15 degrees (mod 60; a near light's blur is the iris turned 180 degrees,
     which maps a hexagon onto itself). Blender's polygon has a flat side toward +x at rotation 0: without
@@ -172,17 +224,7 @@ def test_builtin_iris_corners_where_physcam_puts_them(tmp_path):
 
     from physcam.analysis.defocus.blob import polygon_corners
 
-    r = solve_lens_report(focal_length_mm=50.0, sensor=find_sensor("FF"), fstop=2.0, focus_mm=2000.0)
-    v = blender_camera_values(r, resolution_x=512, blades=6, blade_rotation_deg=15.0)
-    v["camera"].update({"sensor_width": 4.0, "sensor_height": 4.0})  # a 4 mm crop: the blur is ~2.5 mm
-    v["render"].update({"resolution_x": 160, "resolution_y": 160})
-    scene = SCENE.replace('print(json.dumps({"size": [w, h], "blobs": blobs}))',
-                          'print(json.dumps({"img": a[::-1].tolist()}))')  # row 0 at the bottom
-    p = r.entrance_pupil_from_film_mm / 1000.0
-    out = run_blender(scene, json.dumps({"script": blender_camera_script(v), "windows": [],
-                                         "spheres": [(0.0, 0.0, -0.5 - p, 0.001)], "samples": 256,
-                                         "filter_width": 0.01, "out": str(tmp_path / "iris.exr")}))
-    img = np.array(out["img"])
+    img = np.array(renders["iris"][2]["img"])
     n, harmonic, corner = polygon_corners(img)
     assert (n, harmonic) == (6, 6)
     assert abs((corner - 15.0 + 30.0) % 60.0 - 30.0) < 3.0
