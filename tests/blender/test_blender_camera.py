@@ -128,33 +128,22 @@ def _film_from_object(lens, film_z, points_mm, n=48):
     return np.array(out)
 
 
-def test_markers_land_where_physcam_traces_them(tmp_path):
-    """Small emissive spheres across the field of the Distagon 35 (strong barrel distortion at the
-    edge), focused on them at 3 m: each marker's centroid in Cycles' render lands where physcam's
-    forward trace from the marker through the focused lens puts its image, within 0.5 px at
-    384 x 256 (36 x 24 mm; seen: 0.1 px). A pinhole of the paraxial focal length misplaces the corner
-    markers by about 1.8 px, so the test sees the lens's distortion. Also checks the camera-space
-    convention end to end (+X right, +Y up, picture upright)."""
-    lens = load_lens("zeiss_distagon_35mm_f4")
-    sw, sh, W, H = 36.0, 24.0, 384, 256
-    D = 3000.0  # mm from the film plane
-    b = bake_camera(lens, focus_mm=D, fstop=8.0, sensor_width_mm=sw, sensor_height_mm=sh)
-    src = osl_camera_shader(lens, focus_mm=D, fstop=8.0, sensor_width_mm=sw, sensor_height_mm=sh)
-    setup = tmp_path / "setup.py"
-    setup.write_text(blender_setup_script(src, sensor_width_mm=sw, sensor_height_mm=sh, resolution=(W, H)))
-    # markers in Blender world space (m): the camera at the origin looks down -Z
-    xs = np.array([-1.35, -0.7, 0.0, 0.7, 1.35])
-    ys = np.array([-0.8, 0.0, 0.8])
-    world = np.array([(x, y, -D / 1000.0) for y in ys for x in xs])
-    world[:, 0] += 0.013 * np.arange(len(world)) / len(world)  # break the symmetry a little
-    radius_m = 0.012
-    # physcam: lens-space points (x, y, film_z - distance), film centroid, then raster -> pixel
-    pts = [(1000 * X, 1000 * Y, b.film_z + 1000 * Z) for X, Y, Z in world]
-    film = _film_from_object(b.lens, b.film_z, pts)
-    col = (1 - film[:, 0] / (sw / 2)) / 2 * W - 0.5
-    row = (1 - film[:, 1] / (sh / 2)) / 2 * H - 0.5  # row 0 = bottom of the picture
-    out = run_blender(SCENE + '''
+#: The markers of :func:`test_markers_land_where_physcam_traces_them` in Blender world space (m): the camera at
+#: the origin looks down -Z, 3 m in front of the film (``MARKERS_D_MM``), the symmetry broken a little.
+MARKERS_D_MM = 3000.0
+MARKERS = [(x + 0.013 * i / 15, y, -MARKERS_D_MM / 1000.0)
+           for i, (y, x) in enumerate((y, x) for y in (-0.8, 0.0, 0.8) for x in (-1.35, -0.7, 0.0, 0.7, 1.35))]
+MARKERS_FRAME = (36.0, 24.0, 384, 256)  # sensor (mm) and picture (px)
+EXPOSURE_FRAME = (36.0, 24.0, 36, 24)
+#: pixel blocks (rows from the bottom, columns) of the exposure test: the picture is upright, so pixel
+#: (c, r) reads the film at (-(2u - 1) w/2, -(2v - 1) h/2)
+EXPOSURE_BLOCKS = {"centre": (10, 14, 16, 20), "right": (10, 14, 31, 35), "top": (19, 23, 16, 20), "corner": (0, 3, 0, 3)}
+
+#: The markers' render (argv 1-6), then, in Blender's factory start-up scene read again, the white world's
+#: (argv 7-11): one Blender process for both (each costs about 1.3 s of CPU before its first render).
+TWO_RENDERS = SCENE + '''
 import runpy
+results = {}
 mod = runpy.run_path(sys.argv[1], run_name="physcam_setup")
 mod["apply"](scene)
 set_world(0.0)
@@ -169,8 +158,58 @@ for loc in markers:
     bpy.ops.object.shade_smooth()
 t0 = time.perf_counter()
 a = render(sys.argv[4] + "/markers.exr", int(sys.argv[5]), int(sys.argv[6]), 48)
-print(json.dumps({"img": a[..., 0].tolist(), "seconds": time.perf_counter() - t0}))
-''', setup, json.dumps(world.tolist()), radius_m, tmp_path, W, H)
+results["markers"] = {"img": a[..., 0].tolist(), "seconds": time.perf_counter() - t0}
+bpy.ops.wm.read_factory_settings(use_empty=False)
+''' + SCENE + '''
+set_world(1.0)
+scene.cycles.shading_system = True
+text = bpy.data.texts.new("cam.osl"); text.write(open(sys.argv[7]).read())
+cam = cam_obj.data
+cam.type = "CUSTOM"; cam.custom_mode = "INTERNAL"; cam.custom_shader = text
+scene.cycles.filter_width = 0.01   # box-like: a pixel averages its own film area
+a = render(sys.argv[8] + "/white.exr", int(sys.argv[9]), int(sys.argv[10]), 1024)
+blocks = json.loads(sys.argv[11])
+results["exposure"] = {k: float(a[r0:r1, c0:c1, :3].mean()) for k, (r0, r1, c0, c1) in blocks.items()}
+print(json.dumps(results))
+'''
+
+
+@pytest.fixture(scope="module")
+def renders(tmp_path_factory):
+    """The cameras baked for the markers' and the white world's tests and their renders, by one Blender
+    process (:data:`TWO_RENDERS`): {"markers": (baked camera, render), "exposure": (baked camera, render)}."""
+    tmp = tmp_path_factory.mktemp("osl_camera")
+    sw, sh, W, H = MARKERS_FRAME
+    lens = load_lens("zeiss_distagon_35mm_f4")
+    b = bake_camera(lens, focus_mm=MARKERS_D_MM, fstop=8.0, sensor_width_mm=sw, sensor_height_mm=sh)
+    src = osl_camera_shader(lens, focus_mm=MARKERS_D_MM, fstop=8.0, sensor_width_mm=sw, sensor_height_mm=sh)
+    setup = tmp / "setup.py"
+    setup.write_text(blender_setup_script(src, sensor_width_mm=sw, sensor_height_mm=sh, resolution=(W, H)))
+    esw, esh, eW, eH = EXPOSURE_FRAME
+    lens = load_lens("dgauss_50mm")
+    b2 = bake_camera(lens, focus_mm=math.inf, sensor_width_mm=esw, sensor_height_mm=esh)
+    (tmp / "cam.osl").write_text(osl_camera_shader(lens, focus_mm=math.inf, sensor_width_mm=esw, sensor_height_mm=esh))
+    out = run_blender(TWO_RENDERS, setup, json.dumps(MARKERS), 0.012, tmp, W, H,
+                      tmp / "cam.osl", tmp, eW, eH, json.dumps(EXPOSURE_BLOCKS))
+    return {"markers": (b, out["markers"]), "exposure": (b2, out["exposure"])}
+
+
+def test_markers_land_where_physcam_traces_them(renders):
+    """Small emissive spheres across the field of the Distagon 35 (strong barrel distortion at the
+    edge), focused on them at 3 m: each marker's centroid in Cycles' render lands where physcam's
+    forward trace from the marker through the focused lens puts its image, within 0.5 px at
+    384 x 256 (36 x 24 mm; seen: 0.1 px). A pinhole of the paraxial focal length misplaces the corner
+    markers by about 1.8 px, so the test sees the lens's distortion. Also checks the camera-space
+    convention end to end (+X right, +Y up, picture upright)."""
+    sw, sh, W, H = MARKERS_FRAME
+    D = MARKERS_D_MM  # mm from the film plane
+    b, out = renders["markers"]
+    world = np.array(MARKERS)
+    # physcam: lens-space points (x, y, film_z - distance), film centroid, then raster -> pixel
+    pts = [(1000 * X, 1000 * Y, b.film_z + 1000 * Z) for X, Y, Z in world]
+    film = _film_from_object(b.lens, b.film_z, pts)
+    col = (1 - film[:, 0] / (sw / 2)) / 2 * W - 0.5
+    row = (1 - film[:, 1] / (sh / 2)) / 2 * H - 0.5  # row 0 = bottom of the picture
     img = np.array(out["img"])
     assert img.shape == (H, W)
     got = []
@@ -193,33 +232,16 @@ print(json.dumps({"img": a[..., 0].tolist(), "seconds": time.perf_counter() - t0
     assert pin_err.max() > 1.0  # twice the tolerance, ten times the error seen
 
 
-def test_exposure_follows_physcams_relative_illumination(tmp_path):
+def test_exposure_follows_physcams_relative_illumination(renders):
     """A uniform white world through the double Gauss at f/2: the centre renders 1 (the shader's
     normalisation) and the frame's corners and edges fall off as physcam's camera_rays weight
     predicts (its mean over the pupil at those film points, float64 numpy), within 3 %."""
-    lens = load_lens("dgauss_50mm")
-    sw, sh, W, H = 36.0, 24.0, 36, 24
-    b = bake_camera(lens, focus_mm=math.inf, sensor_width_mm=sw, sensor_height_mm=sh)
-    src = osl_camera_shader(lens, focus_mm=math.inf, sensor_width_mm=sw, sensor_height_mm=sh)
-    # pixel blocks (rows from the bottom, columns) and their film centres: the picture is upright,
-    # so pixel (c, r) reads the film at (-(2u - 1) w/2, -(2v - 1) h/2)
-    blocks = {"centre": (10, 14, 16, 20), "right": (10, 14, 31, 35), "top": (19, 23, 16, 20),
-              "corner": (0, 3, 0, 3)}
+    sw, sh, W, H = EXPOSURE_FRAME
+    b, out = renders["exposure"]
+    blocks = EXPOSURE_BLOCKS
     predicted = predicted_block_brightness(b, blocks, W, H, (sw, sh))
-    out = run_blender(SCENE + '''
-set_world(1.0)
-scene.cycles.shading_system = True
-text = bpy.data.texts.new("cam.osl"); text.write(open(sys.argv[1]).read())
-cam = cam_obj.data
-cam.type = "CUSTOM"; cam.custom_mode = "INTERNAL"; cam.custom_shader = text
-scene.cycles.filter_width = 0.01   # box-like: a pixel averages its own film area
-a = render(sys.argv[2] + "/white.exr", int(sys.argv[3]), int(sys.argv[4]), 1024)
-blocks = json.loads(sys.argv[5])
-print(json.dumps({k: float(a[r0:r1, c0:c1, :3].mean()) for k, (r0, r1, c0, c1) in blocks.items()}))
-''', tmp_path / "cam.osl" if (tmp_path / "cam.osl").write_text(src) else None, tmp_path, W, H, json.dumps(blocks))
     print({k: (round(out[k], 4), round(predicted[k], 4)) for k in blocks})
     assert abs(out["centre"] - 1.0) < 0.02
     assert predicted["corner"] < 0.8  # there is falloff to see
     for k in blocks:
         assert out[k] == pytest.approx(predicted[k], rel=0.03), k
-
