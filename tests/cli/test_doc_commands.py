@@ -6,7 +6,8 @@ do not start with ``$`` are its output), or a ``physcam ...`` line of a ``sh`` b
 compiles once), in a temporary folder of their own: files a page writes are there for its later
 commands. A ``$ cat FILE`` in a console block shows a file the page reads: its lines are written
 to FILE first. A few input files the pages name are provided (INPUTS); a short list of commands
-cannot run here, each with its reason (SKIP). A command whose shown output is a refusal
+cannot run here, each with its reason (SKIP); a few run bounded (BOUNDED) or with flags that change how, not
+what, they compute (CHEAPER). A command whose shown output is a refusal
 (``physcam: error: ...``) must refuse: exit 2. **What a page shows a command print is what it prints**
 (issue 39): every number of a console block's shown output is compared with the command's, within
 one unit in its last digit (tests/cli/_doc_output.py says how, and how a block states another
@@ -40,6 +41,14 @@ BOUNDED = {
     "serve": (["--check", "--port", "0"], "serves until Ctrl-C; --check binds the address (any free port here), "
                                           "answers the page and one report in-process and exits (tests/serve drives "
                                           "a running server)"),
+}
+#: Commands run with flags that change how, not what, they compute (added like :data:`BOUNDED`'s), and why.
+CHEAPER = {
+    "physcam export blender-extension -o dist/ --lens zeiss_distagon_35mm_f4 --lens dgauss_50mm": (
+        ["--workers", "1"], "one process instead of one per core: the zip is the same byte for byte whatever the "
+        "number (tests/export/test_blender_extension_build.py), the page shows only its name and lens count, and the "
+        "session's extension zip is built by two workers (tests/conftest.py); two spawned Pythons, each importing "
+        "physcam and loading its JIT kernels for one lens, were 10 of this page's 17 s of CPU"),
 }
 #: Commands that cannot run in a test, and why.
 SKIP = {
@@ -240,6 +249,8 @@ def test_the_pages_have_commands():
     known = {" ".join(argv_of(c)) for p in PAGES for _, c, _, _ in doc_commands(p)}
     for cmd in SKIP:
         assert cmd in known, f"SKIP names a command no page has any more: {cmd}"
+    for cmd in CHEAPER:
+        assert cmd in known, f"CHEAPER names a command no page has any more: {cmd}"
     for cmd in SHARED:
         pages = [p.name for p in PAGES if cmd in {" ".join(argv_of(c)) for _, c, _, _ in doc_commands(p)}]
         assert len(pages) >= 2, f"SHARED names a command fewer than two pages show: {cmd} ({pages})"
@@ -286,7 +297,7 @@ def test_every_command_of_the_page_runs(page, tmp_path, capsys, monkeypatch, tmp
             for a in argv:  # folders a command writes into (lenses/x.usda)
                 if "/" in a and a.endswith((".usda", ".usd", ".usdc")) and not Path(a).exists():
                     Path(a).parent.mkdir(parents=True, exist_ok=True)
-            argv = [*argv, *BOUNDED.get(argv[1], ([],))[0]]
+            argv = [*argv, *BOUNDED.get(argv[1], ([],))[0], *CHEAPER.get(key, ([],))[0]]
             if key in SHARED:
                 rc, out, err = _shared_run(key, argv, capsys, tmp_path_factory)
             else:

@@ -87,6 +87,18 @@ def _needs_live(what: str) -> None:
     require_extra("live", f"{what} (physcam live)")
 
 
+def _cbor2():
+    """The cbor2 module; :class:`~physcam.errors.MissingExtraError` naming the live extra when it cannot be
+    imported. (Asking for the extra each sample searched the import path for its three packages: 10,000
+    CBOR samples spent a second of CPU there.)"""
+    try:
+        import cbor2
+    except ImportError:
+        _needs_live("CBOR samples")
+        raise
+    return cbor2
+
+
 @lru_cache(maxsize=1)
 def schema() -> dict:
     """The OpenTrackIO 1.0.1 JSON schema (a dict; do not modify it)."""
@@ -137,8 +149,8 @@ def _schema_keywords(node, out=None) -> set:
 @lru_cache(maxsize=1)
 def _fast_is_valid():
     """The schema compiled by fastjsonschema (as draft 7: :data:`_SAME_IN_DRAFT_7`), as ``sample -> bool``;
-    None where the schema uses a keyword outside that set. (The live extra brings fastjsonschema:
-    :func:`_validator` has checked it is installed.)"""
+    None where the schema uses a keyword outside that set."""
+    _needs_live("validating OpenTrackIO samples")  # the live extra brings fastjsonschema
     import fastjsonschema
 
     s = schema()
@@ -285,8 +297,11 @@ def sample_problems(sample) -> list[SampleProblem]:
     bad = _non_finite(sample, ())
     if bad:
         return [bad]
-    v, fast = _validator(), _fast_is_valid()
-    if fast(sample) if fast is not None else v.is_valid(sample):
+    fast = _fast_is_valid()  # jsonschema's validator is built only for a sample this refuses (or no fast path):
+    if fast is not None and fast(sample):  # importing jsonschema and checking the schema is 0.2 s of a process
+        return _timecode_problems(sample)
+    v = _validator()
+    if fast is None and v.is_valid(sample):
         return _timecode_problems(sample)
     out = []
     for e in sorted(v.iter_errors(sample), key=_order_key):
@@ -341,14 +356,11 @@ def decode_sample(payload, encoding: str = "json", *, validate: bool = True) -> 
         require_type("payload", payload, (bytes, bytearray, memoryview))
     if encoding not in ("json", "cbor"):
         raise InputError(f"encoding must be json or cbor, got {encoding!r}")
-    if encoding == "cbor":  # a missing extra is said as such, not as a malformed sample
-        _needs_live("CBOR samples")
+    cbor2 = _cbor2() if encoding == "cbor" else None  # a missing extra is said as such, not as a malformed sample
     try:
         if encoding == "json":
             obj = json.loads(bytes(payload).decode("utf-8"), parse_constant=_reject_constant, parse_int=_json_int)
         else:
-            import cbor2
-
             obj = cbor2.loads(bytes(payload))
     except (ValueError, UnicodeDecodeError, RecursionError) as exc:
         raise SampleError([SampleProblem("$", encoding, f"not {encoding.upper()}: {str(exc)[:120]}")]) from None
@@ -368,8 +380,5 @@ def encode_sample(sample, encoding: str = "json") -> bytes:
         except ValueError as exc:
             raise InputError(f"the sample holds a number JSON cannot carry: {exc}") from None
     if encoding == "cbor":
-        _needs_live("CBOR samples")
-        import cbor2
-
-        return cbor2.dumps(sample)
+        return _cbor2().dumps(sample)
     raise InputError(f"encoding must be json or cbor, got {encoding!r}")
