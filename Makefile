@@ -150,10 +150,17 @@ latest-venv: | $(STAMP)
 	$(PYTHON) -m venv $(LATEST_VENV)
 	$(UV) pip install --quiet --compile-bytecode --python $(LATEST_PY) --upgrade -e '.[all]' pytest pytest-xdist hypothesis opencv-python-headless
 
+# The tree's JIT cache (trace/kernels/__pycache__) is shared with .venv's suite, which runs beside this:
+# under another numba version each would find the other's cache index stale and rewrite it, recompiling
+# the kernels by turns, so a numba other than .venv's gets a cache folder of its own.
+NUMBA_VERSION := import importlib.metadata as m; print(m.version("numba"))
 latest-run:
 	@$(UV) pip list --python $(LATEST_PY) --format=freeze 2>/dev/null \
 	  | grep -i -E '^(numpy|numba|matplotlib|usd-core|openexr|jsonschema|cbor2|dask|pyarrow|starlette|uvicorn|openjd-model|opencue.pyoutline)=' \
 	  | tr '\n' ' ' | sed 's/^/physcam: newest versions tested: /'; echo
+	@cache=; if [ "$$($(LATEST_PY) -c '$(NUMBA_VERSION)')" != "$$($(PY) -c '$(NUMBA_VERSION)')" ]; then \
+	  cache="$(abspath $(LATEST_VENV))/numba-cache"; echo "physcam: the newest numba is not .venv's: its JIT cache is $$cache"; fi; \
+	  env $${cache:+NUMBA_CACHE_DIR=$$cache} \
 	$(LATEST_PY) -m pytest -n 2 -q -m "not slow" -p no:cacheprovider tests/optics \
 	  tests/usd tests/live tests/trace/test_tracer.py tests/analysis/image_quality/test_image_quality_closed_forms.py \
 	  tests/farm/test_farm_jobs.py $(LATEST_LEFT_OUT)
