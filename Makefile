@@ -144,10 +144,11 @@ test-latest:
 	$(MAKE) --no-print-directory latest-venv
 	$(MAKE) --no-print-directory latest-run
 
-# after .venv's install: two editable builds of one source tree must not run at once
+# after .venv's install: two editable builds of one source tree must not run at once; uv installs into it,
+# so it is made without pip (ensurepip's own install of pip: 3-4 s of CPU)
 latest-venv: | $(STAMP)
 	rm -rf $(LATEST_VENV)
-	$(PYTHON) -m venv $(LATEST_VENV)
+	$(PYTHON) -m venv --without-pip $(LATEST_VENV)
 	$(UV) pip install --quiet --compile-bytecode --python $(LATEST_PY) --upgrade -e '.[all]' pytest pytest-xdist hypothesis opencv-python-headless
 
 # The tree's JIT cache (trace/kernels/__pycache__) is shared with .venv's suite, which runs beside this:
