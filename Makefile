@@ -29,9 +29,16 @@ $(PY):
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --disable-pip-version-check -c constraints.txt uv
 
+# What scripts/compile_jit.py needs (numpy, numba; constraints.txt's versions) goes into .venv first, so the
+# JIT compile (the installs' longest step, ~52 s of one core) starts while the rest of .venv installs.
+JIT_DEPS := $(VENV)/.jit-deps
+$(JIT_DEPS): $(PY) constraints.txt
+	$(UV) pip install --quiet --compile-bytecode --python $(PY) -c constraints.txt numpy numba
+	touch $(JIT_DEPS)
+
 # The test environment gets the exact versions of constraints.txt (reproducible CI); the library's own
 # dependencies are ranges (pyproject.toml), so a studio can install physcam into its environment.
-$(STAMP): $(PY) pyproject.toml constraints.txt
+$(STAMP): $(JIT_DEPS) pyproject.toml constraints.txt
 	$(UV) pip install --quiet --compile-bytecode --python $(PY) -c constraints.txt -e '.[test]'
 	touch $(STAMP)
 
@@ -137,16 +144,24 @@ test-latest:
 	$(MAKE) --no-print-directory latest-venv
 	$(MAKE) --no-print-directory latest-run
 
-# after .venv's install: two editable builds of one source tree must not run at once
+# after .venv's install: two editable builds of one source tree must not run at once; uv installs into it,
+# so it is made without pip (ensurepip's own install of pip: 3-4 s of CPU)
 latest-venv: | $(STAMP)
 	rm -rf $(LATEST_VENV)
-	$(PYTHON) -m venv $(LATEST_VENV)
+	$(PYTHON) -m venv --without-pip $(LATEST_VENV)
 	$(UV) pip install --quiet --compile-bytecode --python $(LATEST_PY) --upgrade -e '.[all]' pytest pytest-xdist hypothesis opencv-python-headless
 
+# The tree's JIT cache (trace/kernels/__pycache__) is shared with .venv's suite, which runs beside this:
+# under another numba version each would find the other's cache index stale and rewrite it, recompiling
+# the kernels by turns, so a numba other than .venv's gets a cache folder of its own.
+NUMBA_VERSION := import importlib.metadata as m; print(m.version("numba"))
 latest-run:
 	@$(UV) pip list --python $(LATEST_PY) --format=freeze 2>/dev/null \
 	  | grep -i -E '^(numpy|numba|matplotlib|usd-core|openexr|jsonschema|cbor2|dask|pyarrow|starlette|uvicorn|openjd-model|opencue.pyoutline)=' \
 	  | tr '\n' ' ' | sed 's/^/physcam: newest versions tested: /'; echo
+	@cache=; if [ "$$($(LATEST_PY) -c '$(NUMBA_VERSION)')" != "$$($(PY) -c '$(NUMBA_VERSION)')" ]; then \
+	  cache="$(abspath $(LATEST_VENV))/numba-cache"; echo "physcam: the newest numba is not .venv's: its JIT cache is $$cache"; fi; \
+	  env $${cache:+NUMBA_CACHE_DIR=$$cache} \
 	$(LATEST_PY) -m pytest -n 2 -q -m "not slow" -p no:cacheprovider tests/optics \
 	  tests/usd tests/live tests/trace/test_tracer.py tests/analysis/image_quality/test_image_quality_closed_forms.py \
 	  tests/farm/test_farm_jobs.py $(LATEST_LEFT_OUT)
@@ -173,9 +188,10 @@ test-bytecode: $(STAMP)
 	$(PY) scripts/compile_tests.py tests
 
 # physcam's JIT ray-tracing kernels compiled into numba's disk cache before the suite, beside the other
-# installs (scripts/compile_jit.py says why: a fresh clone's processes each compiled them side by side)
-jit: $(STAMP)
-	$(PY) scripts/compile_jit.py
+# installs (scripts/compile_jit.py says why: a fresh clone's processes each compiled them side by side),
+# from the source tree as soon as numba is in .venv (JIT_DEPS), while the rest of .venv installs
+jit: $(JIT_DEPS)
+	PYTHONPATH="$(abspath src)" $(PY) scripts/compile_jit.py
 
 # ruff (pyproject.toml [tool.ruff]): unused imports and variables, undefined names, pycodestyle errors
 lint: $(STAMP)

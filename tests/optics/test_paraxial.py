@@ -280,3 +280,23 @@ def test_finite_conjugate_magnification_matches_newton(p, s):
     g = gaussian(p, object_z=z_obj)
     assert g.magnification == pytest.approx(-g0.efl / s, rel=1e-8)
     assert g.z_image - g0.z_rear_focal_point == pytest.approx(g0.efl**2 / s, rel=1e-7, abs=1e-9)
+
+
+def test_media_indices_follow_the_lens_and_wavelength_asked_about():
+    """The indices are remembered by the surfaces' identity (paraxial._BY_SURFACES): a lens with another glass,
+    another wavelength, or more lenses than the memo holds, each gets its own indices (the glass's own formula)."""
+    from physcam._record import replace
+    from physcam.optics.glass import medium_index
+    from physcam.optics.paraxial import _BY_SURFACES_MAX, media_indices
+
+    lens = dgauss()
+    first = media_indices(lens)
+    assert first == [1.0] + [float(medium_index(s.medium, lens.wavelength_nm)) for s in lens.surfaces]
+    i = next(k for k, s in enumerate(lens.surfaces) if s.medium != AIR)
+    other = replace(lens, surfaces=tuple(replace(s, medium=Medium(nd=1.9, vd=20.0)) if k == i else s
+                                         for k, s in enumerate(lens.surfaces)))
+    assert media_indices(other)[i + 1] == pytest.approx(float(medium_index(Medium(nd=1.9, vd=20.0), lens.wavelength_nm)))
+    assert media_indices(other)[i + 1] != first[i + 1] and media_indices(lens) == first
+    assert media_indices(lens, LINE_F_NM) == [1.0] + [float(medium_index(s.medium, LINE_F_NM)) for s in lens.surfaces]
+    many = [scaled_lens(lens, 1.0 + k / 1000) for k in range(_BY_SURFACES_MAX + 5)]  # past the memo: the oldest go
+    assert all(media_indices(m) == first for m in many) and media_indices(lens) == first

@@ -224,7 +224,7 @@ class _JitKernel:
                     if reporter is not None:
                         reporter(state["done"], total)
 
-        with event.install_listener("numba:compile", Progress()):
+        with _jitcache.compile_lock(), event.install_listener("numba:compile", Progress()):
             f(*args, 0, 0)
         if state["started"] or not _jitcache.is_warm():  # compiled now, or loaded from a cache left unmarked
             _jitcache.mark_compiled()
@@ -331,9 +331,34 @@ def rim_pass(backend: str = "auto"):
         return None
     if _load_numba() is None:
         return None
-    from . import _rimpass
+    global _rim_points
+    if _rim_points is None:
+        from . import _rimpass
 
-    return _rimpass.rim_points
+        _rim_points = _locked_first(_rimpass.rim_points)
+    return _rim_points
+
+
+def _locked_first(fn):
+    """``fn`` (a JIT function, or a Python function calling some) with its first call in this process under
+    :func:`._jitcache.compile_lock`: that call compiles its JIT code or loads it from the disk cache
+    (:mod:`._jitcache` says why); later calls run unlocked."""
+    first = [True]
+
+    def call(*args):
+        if first[0]:
+            from . import _jitcache
+
+            with _jitcache.compile_lock():
+                out = fn(*args)
+            first[0] = False
+            return out
+        return fn(*args)
+
+    return call
+
+
+_rim_points = None
 
 
 def get_kernel(backend: str = "auto"):

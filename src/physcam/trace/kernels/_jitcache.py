@@ -15,10 +15,20 @@ system install), to the user cache (``$XDG_CACHE_HOME`` or ``~/.cache``, under `
 locator class (``numba.core.caching._CacheLocator``, the class ``NUMBA_CACHE_LOCATOR_CLASSES``
 names; an internal of numba) and is registered ahead of numba's own, for functions defined in
 this directory only: other numba users are unaffected.
+
+numba reads a function's cache index, adds an entry and writes the index back without a lock
+(``numba.core.caching.IndexDataCacheFile.save``), naming the new machine-code file after the entries it
+read. Two processes compiling two variants of one kernel at once (a cold cache under a farm's or
+``--workers``' processes) could both take the name ``.1.nbc``, and the index could then point one
+variant's key at the other's machine code: wrong rays, silently. :func:`compile_lock` serialises
+physcam's compiles and cache loads across processes (an exclusive ``flock`` on a file in the cache
+folder; where there is no ``fcntl``, Windows, none): the second process waits, then loads what the
+first compiled.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import sys
@@ -112,6 +122,34 @@ def mark_compiled() -> None:
     except OSError:
         return
     _warm = True
+
+
+LOCK_NAME = "physcam-compile.lock"
+
+
+@contextlib.contextmanager
+def compile_lock():
+    """Hold an exclusive lock on :func:`cache_dir` while a kernel compiles or loads from numba's cache
+    (module notes: numba's index is read, extended and written without one). Blocks while another
+    process holds it; no lock where the folder cannot be written or there is no ``fcntl``."""
+    try:
+        import fcntl
+    except ImportError:  # Windows
+        fcntl = None
+    d = cache_dir(create=True)
+    fd = None
+    if fcntl is not None and d is not None:
+        try:
+            fd = os.open(os.path.join(d, LOCK_NAME), os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError:
+            fd = None
+    try:
+        if fd is not None:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        if fd is not None:
+            os.close(fd)  # closing the descriptor releases the lock
 
 
 def install() -> bool:
