@@ -493,6 +493,22 @@ def _has_unit(label: str) -> bool:
     return bool(re.search(r"\([^)]*\S[^)]*\)", label)) or any(w.lower() in label.lower() for w in UNITLESS_WORDS)
 
 
+def _texts(artist, ticks) -> list:
+    """Every Text under ``artist``, in the order of ``artist.findobj(Text)``, an axis's ticks taken from
+    ``ticks`` (id of the axis: its major and minor ticks) where given instead of asked for again."""
+    from matplotlib.text import Text
+
+    if id(artist) in ticks:
+        major, minor = ticks[id(artist)]
+        children = [artist.label, artist.offsetText, *major, *minor]  # matplotlib's Axis.get_children()
+    else:
+        children = artist.get_children()
+    out = [t for c in children for t in _texts(c, ticks)]
+    if isinstance(artist, Text):
+        out.append(artist)
+    return out
+
+
 @styled
 def figure_problems(fig) -> list[str]:
     """What breaks the figure style in ``fig``, drawn (in the style, as physcam saves it): text
@@ -501,7 +517,6 @@ def figure_problems(fig) -> list[str]:
     import re
 
     from matplotlib.figure import Figure
-    from matplotlib.text import Text
 
     from .errors import require_type
 
@@ -513,16 +528,19 @@ def figure_problems(fig) -> list[str]:
     box = fig.bbox
     problems = []
     hidden = set()  # tick labels of ticks outside the view: matplotlib keeps them but does not draw them
+    ticks = {}  # each axis's ticks as the draw left them, asked once (each ask runs its tick locator)
     for ax in fig.axes:
         for axis in (ax.xaxis, ax.yaxis):
             if not ax.get_visible() or not ax.axison:  # an axes shown off (an image) draws no axis text
                 hidden.update(id(t) for t in axis.get_ticklabels(which="both") + [axis.label])
+                ticks[id(axis)] = axis.get_major_ticks(), axis.get_minor_ticks()
                 continue
+            ticks[id(axis)] = major, minor = axis.get_major_ticks(), axis.get_minor_ticks()
             lo, hi = sorted(axis.get_view_interval())
-            for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+            for tick in major + minor:
                 if not lo - 1e-9 * abs(hi - lo) <= tick.get_loc() <= hi + 1e-9 * abs(hi - lo):
                     hidden.update({id(tick.label1), id(tick.label2)})
-    for t in fig.findobj(Text):
+    for t in _texts(fig, ticks):
         if not t.get_visible() or not t.get_text().strip() or id(t) in hidden:
             continue
         b = t.get_window_extent(renderer)
@@ -532,7 +550,9 @@ def figure_problems(fig) -> list[str]:
         if not ax.get_visible() or not ax.axison:
             continue
         for name, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
-            if not axis.get_visible() or not [t for t in axis.get_ticklabels() if t.get_text()]:
+            # its major tick labels as drawn (what axis.get_ticklabels() gives after updating the ticks again)
+            labels = [t for tick in ticks[id(axis)][0] for t in (tick.label1, tick.label2) if t.get_visible()]
+            if not axis.get_visible() or not [t for t in labels if t.get_text()]:
                 continue
             label = axis.get_label_text()
             if not label.strip():
