@@ -694,8 +694,16 @@ def refined_pupil_tables(focused, levels, *, checks: list, backend: str = "auto"
     sets are traced once, at the radii the added levels read too (:class:`_PassingSets`). ``checks`` receives
     each table's traced check areas at the returned levels."""
     # the drafts (no growth, no trust: what _refined_levels reads) first; only the tables kept are finished
+    from ..errors import WrongTypeError
+    from ..lens.prescription import require_prescription
+
+    try:
+        focused = [(q, film_z) for q, film_z in focused]
+    except (TypeError, ValueError):
+        raise WrongTypeError("focused must be (prescription, film z) pairs, one per traced focus mark, "
+                             "e.g. [(state.prescription, state.film_z)]") from None
     if focused:  # the job's backend, chosen once for all its tables
-        backend = _tables_backend(backend, len(focused), len(focused[0][0].surfaces))
+        backend = _tables_backend(backend, len(focused), len(require_prescription(focused[0][0]).surfaces))
     found = [_table_and_sets(q, film_z, levels, backend, checks, finer=True, draft=True) for q, film_z in focused]
     refined = _refined_levels(levels, [draft[0] for draft, _ in found], checks)
     if len(refined) == len(_levels(levels)):
