@@ -74,3 +74,22 @@ def test_the_lock_is_released_after_the_block_and_on_error(tmp_path, monkeypatch
         with _jitcache.compile_lock():
             raise RuntimeError("a compile failing")
     assert free()
+
+
+def test_a_file_system_without_locks_compiles_unlocked(tmp_path, monkeypatch):
+    """Where ``flock`` fails (an NFS mount without locks: ENOLCK), the compile goes on without the lock rather
+    than failing the trace."""
+    import errno
+
+    fcntl = pytest.importorskip("fcntl")
+    from physcam.trace.kernels import _jitcache
+
+    def refuse(fd, op):
+        raise OSError(errno.ENOLCK, "No locks available")
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(fcntl, "flock", refuse)
+    ran = []
+    with _jitcache.compile_lock():
+        ran.append(True)
+    assert ran == [True]

@@ -131,7 +131,8 @@ LOCK_NAME = "physcam-compile.lock"
 def compile_lock():
     """Hold an exclusive lock on :func:`cache_dir` while a kernel compiles or loads from numba's cache
     (module notes: numba's index is read, extended and written without one). Blocks while another
-    process holds it; no lock where the folder cannot be written or there is no ``fcntl``."""
+    process holds it; no lock where the folder cannot be written, its file system refuses locks (an NFS
+    mount without them) or there is no ``fcntl``."""
     try:
         import fcntl
     except ImportError:  # Windows
@@ -141,11 +142,12 @@ def compile_lock():
     if fcntl is not None and d is not None:
         try:
             fd = os.open(os.path.join(d, LOCK_NAME), os.O_RDWR | os.O_CREAT, 0o666)
+            fcntl.flock(fd, fcntl.LOCK_EX)
         except OSError:
+            if fd is not None:
+                os.close(fd)
             fd = None
     try:
-        if fd is not None:
-            fcntl.flock(fd, fcntl.LOCK_EX)
         yield
     finally:
         if fd is not None:
