@@ -56,9 +56,11 @@ def checker_photo(tmp_path_factory):
     img = _charts.render(CHECKER, r, t, board=board, seed=0)
     path = tmp_path_factory.mktemp("checker") / "board.png"
     cv2.imwrite(str(path), img)
-    # OpenCV's sector detector with physcam's flags (chart._checkerboard_flags): CALIB_CB_ACCURACY's upsampled
-    # search took 3x the CPU for corners within 0.9 px of these, 0.03 of a 30-px square (the checks below: 0.2)
-    ok, corners = cv2.findChessboardCornersSB(img, (9, 6), flags=cv2.CALIB_CB_EXHAUSTIVE | cv2.CALIB_CB_NORMALIZE_IMAGE)
+    # OpenCV's sector detector with physcam's flags: CALIB_CB_ACCURACY's upsampled search took 3x the CPU for
+    # corners within 0.9 px of these, 0.03 of a 30-px square (the checks below: 0.2)
+    from physcam.analysis.calibration.chart import _checkerboard_flags
+
+    ok, corners = cv2.findChessboardCornersSB(img, (9, 6), flags=_checkerboard_flags(cv2))
     assert ok
     return path, img, corners.reshape(6, 9, 2)
 
