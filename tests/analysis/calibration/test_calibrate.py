@@ -16,7 +16,7 @@ sys.path.insert(0, str(Path(__file__).parents[1]))  # tests/analysis: _charts
 sys.path.insert(0, str(Path(__file__).parents[2]))  # tests
 
 import _charts
-from _charts import CHARUCO, DIST_TRUE, K_TRUE, SENSOR_MM, SIZE
+from _charts import DIST_TRUE, K_TRUE, SENSOR_MM, SIZE
 
 from physcam.analysis.calibration.calibrate import calibrate_mark
 from physcam.cli import main
@@ -52,17 +52,17 @@ def test_physcam_brown_ud_is_opencvs_model_with_y_up():
     assert cal.distortion == pytest.approx(DIST_TRUE, rel=1e-4, abs=1e-7)
 
 
-def _write_views(folder: Path, n=15, seed=1):
+def _write_views(folder: Path, images):
     folder.mkdir(parents=True, exist_ok=True)
-    board = _charts.board_image(CHARUCO, 12.0)
-    for k, (r, t) in enumerate(_charts.poses(n, seed)):
-        cv2.imwrite(str(folder / f"chart_{k:02d}.png"), _charts.render(CHARUCO, r, t, board=board, seed=k))
+    for k, img in enumerate(images):
+        cv2.imwrite(str(folder / f"chart_{k:02d}.png"), img)
     return folder
 
 
 @pytest.fixture(scope="module")
-def photos(tmp_path_factory):
-    return _write_views(tmp_path_factory.mktemp("charts") / "day1")
+def photos(tmp_path_factory, charuco_photographs):
+    """15 ChArUco photographs of K_TRUE and DIST_TRUE, poses(15, 1), every third cut by the frame (conftest.py)."""
+    return _write_views(tmp_path_factory.mktemp("charts") / "day1", charuco_photographs(15))
 
 
 CHARUCO_ARGS = ["--sensor-width", "12.8", "--sensor-height", "9.6", "--chart", "charuco", "--corners", "24x18",
@@ -136,13 +136,10 @@ def _refused(capsys, argv, out: Path, words: str):
     assert not out.exists()
 
 
-def _few(tmp_path, n):
-    board = _charts.board_image(CHARUCO, 12.0)
-    d = tmp_path / f"few{n}"
-    d.mkdir()
-    for k, (r, t) in enumerate(_charts.poses(n, 3, partial=False)):
-        cv2.imwrite(str(d / f"c{k}.png"), _charts.render(CHARUCO, r, t, board=board, seed=k))
-    return d
+def _few(tmp_path, n, charuco_photographs):
+    """``n`` photographs of the chart (the first of the module's: these refusals are about their number and
+    size, which any photographs of the chart show)."""
+    return _write_views(tmp_path / f"few{n}", charuco_photographs(n))
 
 
 def test_an_image_without_a_chart_is_refused(tmp_path, capsys):
@@ -152,17 +149,17 @@ def test_an_image_without_a_chart_is_refused(tmp_path, capsys):
              "no charuco of 24x18 squares found in it")
 
 
-def test_too_few_views_are_refused(tmp_path, capsys):
-    d = _few(tmp_path, 3)
+def test_too_few_views_are_refused(tmp_path, capsys, charuco_photographs):
+    d = _few(tmp_path, 3, charuco_photographs)
     _refused(capsys, ["calibrate", str(d), *CHARUCO_ARGS, "-o", str(tmp_path / "o")], tmp_path / "o",
              "3 views of the chart: calibrating needs 5 or more")
 
 
-def test_mixed_resolutions_are_refused(tmp_path, capsys):
-    d = _few(tmp_path, 1)
+def test_mixed_resolutions_are_refused(tmp_path, capsys, charuco_photographs):
+    d = _few(tmp_path, 1, charuco_photographs)
     small = tmp_path / "small.png"
-    cv2.imwrite(str(small), cv2.resize(cv2.imread(str(d / "c0.png")), (640, 480)))
-    _refused(capsys, ["calibrate", str(d / "c0.png"), str(small), *CHARUCO_ARGS, "-o", str(tmp_path / "o")],
+    cv2.imwrite(str(small), cv2.resize(cv2.imread(str(d / "chart_00.png")), (640, 480)))
+    _refused(capsys, ["calibrate", str(d / "chart_00.png"), str(small), *CHARUCO_ARGS, "-o", str(tmp_path / "o")],
              tmp_path / "o", "give images of one camera mode")
 
 

@@ -320,12 +320,12 @@ def test_the_opentrackio_block_carries_only_accepted_models():
 
 
 @pytest.fixture(scope="module")
-def photos(tmp_path_factory):
-    """8 ChArUco photographs (tests/analysis/calibration/test_calibrate.py's renders of K_TRUE and DIST_TRUE)."""
+def photos(tmp_path_factory, charuco_photographs):
+    """8 ChArUco photographs (tests/analysis/calibration/test_calibrate.py's first 8 renders of K_TRUE and DIST_TRUE,
+    conftest.py)."""
     folder = tmp_path_factory.mktemp("charuco")
-    board = _charts.board_image(_charts.CHARUCO, 12.0)
-    for k, (r, t) in enumerate(_charts.poses(8, 1)):
-        cv2.imwrite(str(folder / f"chart_{k:02d}.png"), _charts.render(_charts.CHARUCO, r, t, board=board, seed=k))
+    for k, img in enumerate(charuco_photographs(8)):
+        cv2.imwrite(str(folder / f"chart_{k:02d}.png"), img)
     return folder
 
 

@@ -338,20 +338,46 @@ class _AtFocus:
             lo, hi = (mid, hi) if self.ideal(axis, [mid])[1][0] else (lo, mid)
         return lo
 
+    def _bracket(self, axis, want, f, reach_mm):
+        """(lo, g(lo), hi, g(hi)) about the roots of g(h) = tan(angle(h)) - ``want``: the axis (g = -want) and
+        ``reach_mm``, narrowed by the heights f want x 1, 1.05, 1.1, 1.2, 1.4 (a barrel's root lies below f want,
+        a pincushion's above), each tried only while a root is still below it, a height whose ray does not
+        leave the lens ending the tries (the far end, g NaN); g(``reach_mm``) traced only for a root still
+        unbracketed after them (NaN where its ray does not leave the lens). 1903 -> 1525 aims, 191 -> 65
+        continuations for the distortion at the lens cards' fields of every library lens at 1 m, 2 m, infinity."""
+        lo, g_lo = np.zeros(want.shape), -want  # the axis: angle 0
+        hi, g_hi = np.full(want.shape, reach_mm), np.full(want.shape, np.nan)
+        open_, far = want > 0.0, want > 0.0
+        for factor in (1.0, 1.05, 1.1, 1.2, 1.4):
+            x = np.minimum(f * want * factor, reach_mm)
+            if not open_.any():
+                break
+            ideal, ok = self.ideal(axis, np.where(open_, x, 0.0))
+            g = np.where(ok, np.abs(ideal) / f - want, np.nan)
+            end, below = open_ & ~(ok & (g <= 0.0)), open_ & ok & (g <= 0.0)
+            hi, g_hi, far = np.where(end, x, hi), np.where(end, g, g_hi), far & ~end
+            lo, g_lo = np.where(below, x, lo), np.where(below, g, g_lo)
+            open_ &= below & (x < reach_mm)
+        if far.any():
+            ideal, ok = self.ideal(axis, np.where(far, hi, 0.0))
+            g_hi = np.where(far & ok, np.abs(ideal) / f - want, g_hi)
+        return lo, g_lo, hi, g_hi
+
     def heights_for(self, axis, fields_deg, reach_mm):
         """Film heights whose object points lie ``fields_deg`` off axis (seen from the entrance pupil), and
         which were found: the root of tan(angle) - tan(field) in the film height from the axis to ``reach_mm``,
         where the object angle grows with the height (a height whose chief ray does not leave the lens counts
         as too far), by the Illinois method (regula falsi kept inside its bracket; Dowell and Jarratt, BIT 11,
-        1971), halving the bracket while its far end has no chief ray."""
+        1971), halving the bracket while its far end has no chief ray.
+
+        The bracket starts about the pinhole's own height f tan(field) (:meth:`_bracket`): a chief ray traced
+        from ``reach_mm``, far outside the frame, mostly does not leave the lens, and aiming it walks out from
+        the axis until its branch ends (continuation), most of the time this search took."""
         fields = np.asarray(fields_deg, dtype=float)
         want = np.tan(np.radians(np.abs(fields)))
         f = self.g[axis].pinhole_focal_length
         tol = 1e-11 * want + 1e-14  # within the check below (1e-9), above the Newton aim's own noise
-        lo, hi = np.zeros(fields.shape), np.full(fields.shape, float(reach_mm))
-        g_lo = -want  # the axis: angle 0
-        ideal, ok = self.ideal(axis, hi)
-        g_hi = np.where(ok, np.abs(ideal) / f - want, np.nan)
+        lo, g_lo, hi, g_hi = self._bracket(axis, want, f, float(reach_mm))
         done, h, side = want == 0.0, np.zeros(fields.shape), np.zeros(fields.shape, int)
         for _ in range(64):
             if done.all():
