@@ -93,7 +93,7 @@ def _indices(prescription: Prescription, lam: float) -> tuple[float, ...]:
     key = (id(surfaces), lam)
     hit = _BY_SURFACES.get(key)
     if hit is None or hit[0] is not surfaces:
-        hit = (surfaces, _media_indices(tuple(s.medium for s in surfaces), lam))
+        hit = (surfaces, _by_media(tuple(s.medium for s in surfaces), lam))
         with _BY_SURFACES_LOCK:  # (physcam serve solves in threads)
             _BY_SURFACES[key] = hit
             if len(_BY_SURFACES) > _BY_SURFACES_MAX:
@@ -108,6 +108,24 @@ def _indices(prescription: Prescription, lam: float) -> tuple[float, ...]:
 _BY_SURFACES: dict = {}
 _BY_SURFACES_MAX = 256
 _BY_SURFACES_LOCK = threading.Lock()
+
+
+def _by_media(media: tuple, lam: float) -> tuple[float, ...]:
+    """:func:`_media_indices`, first looked up by the media objects' identities (kept with the answer): a new
+    focus or zoom state's surfaces are new, their media the lens's own, and the memo's key by value hashed
+    every medium again (a quarter of the paraxial work of a Blender extension build)."""
+    key = (tuple(map(id, media)), lam)
+    hit = _BY_MEDIA.get(key)
+    if hit is None or any(a is not b for a, b in zip(hit[0], media)):
+        hit = (media, _media_indices(media, lam))
+        with _BY_SURFACES_LOCK:
+            _BY_MEDIA[key] = hit
+            if len(_BY_MEDIA) > _BY_SURFACES_MAX:
+                del _BY_MEDIA[next(iter(_BY_MEDIA))]  # the oldest
+    return hit[1]
+
+
+_BY_MEDIA: dict = {}
 
 
 @lru_cache(maxsize=1024)
