@@ -184,6 +184,8 @@ def test_a_failed_check_withdraws_only_the_cells_it_lies_on():
     assert sorted(zip(*np.nonzero(~ok))) == [(1, 0), (1, 1), (2, 0), (2, 1)]
     ok = _trusted_cells(levels, [(3.2, 0.5)], lit, 1.0)
     assert sorted(zip(*np.nonzero(~ok))) == [(3, 3)]
+    ok = _trusted_cells(levels, [(3.2, 0.5), (2.5, 3.5), (1.0, 2.0)], lit, 1.0)  # together: the union of the three
+    assert sorted(zip(*np.nonzero(~ok))) == [(0, 2), (1, 0), (1, 1), (2, 0), (2, 1), (3, 3)]
     dark = lit.copy()
     dark[2, 2] = False
     ok = _trusted_cells(levels, [], dark, 1.0)
