@@ -537,12 +537,13 @@ def gaussian(
     ``flange_focal_distance_mm``: the flange lies this far in front of the film.
     Raises :class:`OpticsError` for an afocal lens or an object at the front focal point.
     """
-    args = (axis, wavelength_nm, fstop, object_z, film_z, flange_focal_distance_mm, stop_semi_diameter)
-    key = _memo_key(prescription, args)
+    key = _memo_key(prescription, (axis, wavelength_nm, fstop, object_z, film_z, flange_focal_distance_mm,
+                                   stop_semi_diameter))
     hit = _GAUSSIAN.get(key) if key is not None else None
     if hit is not None and hit[0] is prescription:
         return hit[1]
-    g = _gaussian(prescription, *args)
+    g = _gaussian(prescription, axis, wavelength_nm, fstop, object_z, film_z, flange_focal_distance_mm,
+                  stop_semi_diameter)
     if key is not None:
         with _BY_SURFACES_LOCK:
             _GAUSSIAN[key] = (prescription, g)
