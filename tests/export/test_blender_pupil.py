@@ -184,6 +184,8 @@ def test_a_failed_check_withdraws_only_the_cells_it_lies_on():
     assert sorted(zip(*np.nonzero(~ok))) == [(1, 0), (1, 1), (2, 0), (2, 1)]
     ok = _trusted_cells(levels, [(3.2, 0.5)], lit, 1.0)
     assert sorted(zip(*np.nonzero(~ok))) == [(3, 3)]
+    ok = _trusted_cells(levels, [(3.2, 0.5), (2.5, 3.5), (1.0, 2.0)], lit, 1.0)  # together: the union of the three
+    assert sorted(zip(*np.nonzero(~ok))) == [(0, 2), (1, 0), (1, 1), (2, 0), (2, 1), (3, 3)]
     dark = lit.copy()
     dark[2, 2] = False
     ok = _trusted_cells(levels, [], dark, 1.0)
@@ -285,7 +287,10 @@ def test_the_batched_reading_is_the_shaders(seed):
 
 @settings(max_examples=25, deadline=None)
 @given(st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64) | st.floats(-1e4, 1e4).map(round)
-                | st.sampled_from([0.0, -0.0, 1e-4, 9.99999999e-5, 1e9, 999999999.5, 1.5e9, 1e16, 5e-324]),
+                | st.sampled_from([0.0, -0.0, 1e-4, 9.99999999e-5, 1e9, 999999999.5, 1.5e9, 1e16, 5e-324,
+                                   1.00004999e-4, 1.0001e-4, 0.99999999951, 2.9999999949, 9999999.995, 9999999.5,
+                                   12345678.9, 99999999.95, -1.0, 1.0])
+                | st.tuples(st.integers(-10**6, 10**6), st.floats(-0.011, 0.011)).map(lambda t: t[0] + t[1]),
                 min_size=1, max_size=40))
 def test_the_shaders_data_lines_write_each_number_as_its_nine_digit_repr(values):
     """Every number of a data line (the pupil table's 154,000 among them) is osl_number of its nine-digit

@@ -300,3 +300,26 @@ def test_media_indices_follow_the_lens_and_wavelength_asked_about():
     assert media_indices(lens, LINE_F_NM) == [1.0] + [float(medium_index(s.medium, LINE_F_NM)) for s in lens.surfaces]
     many = [scaled_lens(lens, 1.0 + k / 1000) for k in range(_BY_SURFACES_MAX + 5)]  # past the memo: the oldest go
     assert all(media_indices(m) == first for m in many) and media_indices(lens) == first
+
+
+def test_gaussian_answers_remembered_follow_the_lens_and_arguments():
+    """Solves are remembered by the prescription's identity and the arguments (paraxial._GAUSSIAN): a repeat is
+    the same answer; another film plane, object, stop, meridian, wavelength or lens gets its own (a thin lens's
+    closed forms: image at 1/s' = 1/f + 1/s, stop scaling the pupil); past the memo's size the answers stay right."""
+    from physcam.optics.paraxial import _GAUSSIAN_MAX
+
+    f = 50.0
+    lens = thin_lens(f)
+    g = gaussian(lens)
+    assert gaussian(lens) is g and g.efl == pytest.approx(f, rel=1e-12)
+    near = gaussian(lens, object_z=-200.0)
+    assert near.z_image == pytest.approx(1.0 / (1.0 / f - 1.0 / 200.0), rel=1e-12) and gaussian(lens).z_image == g.z_image
+    assert gaussian(lens, film_z=60.0).z_film == 60.0 and gaussian(lens, film_z=61.0).z_film == 61.0
+    half = gaussian(lens, stop_semi_diameter=0.5 * g.stop_semi_diameter)
+    assert half.entrance_pupil_diameter == pytest.approx(0.5 * g.entrance_pupil_diameter, rel=1e-12)
+    assert gaussian(lens, wavelength_nm=LINE_F_NM).wavelength_nm == LINE_F_NM and gaussian(lens, axis="x").axis == "x"
+    assert math.copysign(1.0, gaussian(lens, film_z=-0.0).z_film) == -1.0  # -0.0 is not 0.0's answer
+    assert math.copysign(1.0, gaussian(lens, film_z=0.0).z_film) == 1.0
+    many = [scaled_lens(lens, 1.0 + k / 1000) for k in range(_GAUSSIAN_MAX + 5)]
+    assert all(gaussian(m).efl == pytest.approx(f * (1.0 + k / 1000), rel=1e-9) for k, m in enumerate(many))
+    assert gaussian(thin_lens(2 * f)).efl == pytest.approx(2 * f, rel=1e-12) and gaussian(lens).efl == g.efl

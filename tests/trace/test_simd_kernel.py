@@ -70,6 +70,48 @@ def test_serial_and_parallel_paths_agree_bit_for_bit_at_block_edges():
             np.testing.assert_array_equal(u, v)
 
 
+@pytest.mark.parametrize("mixed", [False, True])
+def test_blocks_whose_rays_all_stopped_end_as_the_reference(mixed):
+    """A block whose every ray has stopped leaves the surface loop early (no pass changes a stopped lane):
+    blocks of rays that all miss the first surface's rim, or all stop at a later one, among live blocks,
+    with the optical path and Fresnel weights on, end as the numpy kernel leaves them (flags, positions,
+    directions and the optical path bit for bit; a stopped ray's weights untouched past its stop)."""
+    from physcam.trace.kernels import get_kernel
+    from physcam.trace.kernels._numba import BLOCK
+    from physcam.trace.tables import packed_table
+    from physcam.trace.trace import trace_packed
+
+    lens = load_lens("canon_rf_85mm_f1_2")  # aspheres: a stopped block skips their Newton steps too
+    sd = lens.surfaces[0].semi_diameter
+    rng = np.random.default_rng(3)
+    n = 4 * BLOCK + 17
+    pos = np.stack([rng.uniform(-0.8 * sd, 0.8 * sd, n), rng.uniform(-0.8 * sd, 0.8 * sd, n), np.full(n, -2.0)], axis=1)
+    d = np.stack([rng.normal(0, 0.05, n), rng.normal(0, 0.05, n), np.ones(n)], axis=1)
+    pos[BLOCK:2 * BLOCK, 0] = np.linspace(1.5, 3.0, BLOCK) * sd  # block 1: every ray past the front rim
+    pos[2 * BLOCK:3 * BLOCK, 0] = 0.9 * sd  # block 2: inside the front rim, aimed outward, stopped further in
+    pos[2 * BLOCK:3 * BLOCK, 1] *= 0.1
+    d[2 * BLOCK:3 * BLOCK, 0] = 0.2
+    rays = RayBatch.from_arrays(pos, d, rng.uniform(400, 700, n) if mixed else 550.0)
+    p = packed_table(lens, coating="single")
+    outs = []
+    for backend in ("numba", "numpy"):
+        r = rays.copy()
+        opl = np.zeros(r.x.shape[0])
+        trace_packed(get_kernel(backend), r, p.S, p.kinds, clip=True, fresnel=True, end_z=lens.vertex_z[-1] + 40.0,
+                     opl=opl)
+        outs.append((r, opl))
+    (a, opl_a), (b, opl_b) = outs
+    assert (a.flag[BLOCK:2 * BLOCK] != 0).all() and (a.flag[2 * BLOCK:3 * BLOCK] != 0).all()
+    assert (a.flag[:BLOCK] == 0).any() and (a.z[2 * BLOCK:3 * BLOCK] > -2.0).all()  # block 2 stopped past the first surface
+    np.testing.assert_array_equal(a.flag, b.flag)
+    for u, v in zip(a.columns()[:6] + (opl_a,), b.columns()[:6] + (opl_b,)):
+        np.testing.assert_array_equal(u, v)
+    stopped = slice(BLOCK, 2 * BLOCK)
+    np.testing.assert_array_equal(a.weight[stopped], b.weight[stopped])
+    nsurf = len(lens.surfaces)
+    np.testing.assert_allclose(a.weight, b.weight, rtol=4 * nsurf * EPS, atol=4 * nsurf * EPS)
+
+
 def _fresh_asm(fn, *args):
     import numba
 

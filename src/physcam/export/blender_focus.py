@@ -164,7 +164,6 @@ def focus_geometry(lens: Prescription, axis: FocusAxis, *, states: list | None =
     from ..optics.focusing import focus, focus_method
     from ..optics.lens_model import lens_model_of
     from ..optics.paraxial import gaussian
-    from ..trace.surfaces import surface_table
 
     require_type("axis", axis, FocusAxis, "physcam.export.blender_focus.focus_axis(closest_mm, n_focus)")
     eps = 1e-3
@@ -181,7 +180,7 @@ def focus_geometry(lens: Prescription, axis: FocusAxis, *, states: list | None =
         if states is not None:
             states.append(st)
         film_z.append(st.film_z)
-        vz.append(surface_table(st.prescription, reverse=True, coating="none").vertex_z)
+        vz.append(np.asarray(st.prescription.vertex_z, dtype=np.float64)[::-1])  # surface_table(reverse=True)'s
         if internal and k > 0:
             slope.append(_internal_film_slope(lens, axis, k, st.object_distance_mm))
         elif k > 0:
@@ -583,9 +582,29 @@ def _arr32(name, values, size) -> str:
         _num32(a[~np.isfinite(a)][0])  # raises osl_number's error
     # _num32 of each (osl_number of the nine-digit rounding: its repr, with ".0" when that is an
     # integer). Where "%.9g" writes a fraction without exponent (1e-4 <= |v| < 1e9) that is the repr
-    # already: it strips its zeros, and no shorter decimal names the same double
-    nums = [r if ("." in r and "e" not in r) else osl_number(float(r)) for r in map("%.9g".__mod__, a.tolist())]
+    # already: it strips its zeros, and no shorter decimal names the same double. All are written by
+    # one format operation; only the numbers that may not be such a fraction are looked at again
+    # (:func:`_maybe_whole_or_exponent`), most of them the tables' 0 and -1, whose literals are looked up.
+    vals = a.tolist()
+    nums = (", ".join(["%.9g"] * len(vals)) % tuple(vals)).split(", ") if vals else []
+    fixed = _WHOLE
+    for i in np.flatnonzero(_maybe_whole_or_exponent(a)).tolist():
+        r = nums[i]
+        if "." not in r or "e" in r:
+            nums[i] = fixed.get(r) or osl_number(float(r))
     return f"    float {name}[{size}] = {{{', '.join(nums)}}};"
+
+
+def _maybe_whole_or_exponent(a: np.ndarray) -> np.ndarray:
+    """Where "%.9g" may write no point or an exponent (a superset): |v| under 1e-4 (and a margin) or 1e7 and
+    over (from 1e8 the nine digits hold no fraction), or within 0.01 of a whole number (below 1e7 the nine
+    digits keep at least two decimals, so a fraction further off stays one)."""
+    m = np.abs(a)
+    return (m < 1.0001e-4) | (m >= 1e7) | (np.abs(a - np.rint(a)) < 1e-2)
+
+
+#: osl_number of the whole numbers the tables hold most ("%.9g" writes them without a point).
+_WHOLE = {"0": "0.0", "-0": "-0.0", "1": "1.0", "-1": "-1.0"}
 
 
 def _arr32_once(ft: FocusTable, name, values, size) -> str:

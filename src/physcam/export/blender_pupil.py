@@ -874,7 +874,16 @@ def _trusted_cells(levels, failed, lit, step: float) -> np.ndarray:
     on_k = np.concatenate([(lv[1:] <= s) & (s <= lv[:-1]), s <= lv[-1]], axis=1)  # (failed, levels)
     j = np.arange(n_rad)
     on_j = (j[:-1] * step - 1e-9 <= rho) & (rho <= j[1:] * step + 1e-9)  # (failed, cells across)
-    ok[:, :-1] &= ~((on_k.T.astype(np.int32) @ on_j.astype(np.int32)) > 0)
+    # every (level, cell) pair of each failed point (one or two of each), paired point by point: the
+    # cells the integer product on_k.T @ on_j counts, without its dense loop over every point
+    fk, kk = np.nonzero(on_k)
+    fj, jj = np.nonzero(on_j)
+    cj = np.bincount(fj, minlength=len(failed))
+    rep = cj[fk]
+    offs = np.arange(int(rep.sum())) - np.repeat(np.cumsum(rep) - rep, rep)
+    hit = np.zeros((n_level, n_rad - 1), dtype=bool)
+    hit[np.repeat(kk, rep), jj[np.repeat((np.cumsum(cj) - cj)[fk], rep) + offs]] = True
+    ok[:, :-1] &= ~hit
     return ok
 
 
@@ -887,11 +896,20 @@ def cell_area(v):
 def _reads(table, levels, rhos, ss):
     """Per (film radius, iris radius) pair, arrays of what the shader reads: j0, rw (:func:`_radial`)
     and l0, lw, shrink (:func:`_bracket`)."""
-    rho_u, rho_i = np.unique(np.asarray(rhos, dtype=float), return_inverse=True)
-    s_u, s_i = np.unique(np.asarray(ss, dtype=float), return_inverse=True)
-    j0, rw = (np.array(v)[rho_i.ravel()] for v in zip(*(_radial(table, rho) for rho in rho_u.tolist())))
-    l0, lw, shrink = (np.array(v)[s_i.ravel()] for v in zip(*(_bracket(levels, s) for s in s_u.tolist())))
-    return j0, rw, l0, lw, shrink
+    # _radial and _bracket of each, in whole arrays: the same comparisons and IEEE operations
+    rho, s = np.asarray(rhos, dtype=float).ravel(), np.asarray(ss, dtype=float).ravel()
+    n_rad = table.shape[1]
+    ri = np.minimum(np.maximum(rho / (RADIAL_MAX_MM / (n_rad - 1)), 0.0), n_rad - 1.0)
+    j0 = np.minimum(np.floor(ri).astype(np.int64), n_rad - 2)
+    lv = np.asarray(levels, dtype=float)
+    n = len(lv)
+    below = s <= lv[-1]
+    l0 = np.minimum(np.maximum(np.searchsorted(-lv, -s, side="right") - 1, 0), n - 2)
+    gap = lv[l0] - lv[l0 + 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lw = np.where(gap > 0, np.minimum(np.maximum((lv[l0] - s) / gap, 0.0), 1.0), 1.0)
+    return (j0, ri - j0, np.where(below, n - 2, l0), np.where(below, 1.0, lw),
+            np.where(below, s / lv[-1], 1.0))
 
 
 def _ellipses_at(table, levels, rhos, ss) -> np.ndarray:

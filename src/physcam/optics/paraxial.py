@@ -84,17 +84,21 @@ def media_indices(prescription: Prescription, wavelength_nm=None) -> list[float]
     (:func:`physcam.optics.glass.medium_index`: catalogue Sellmeier or normal line) at
     ``wavelength_nm`` (default: the prescription's design wavelength).
     """
-    lam = _wavelength(prescription, wavelength_nm)
+    return list(_indices(prescription, _wavelength(prescription, wavelength_nm)))
+
+
+def _indices(prescription: Prescription, lam: float) -> tuple[float, ...]:
+    """:func:`media_indices` at wavelength ``lam`` (nm, checked), remembered by the surfaces' identity."""
     surfaces = prescription.surfaces
     key = (id(surfaces), lam)
     hit = _BY_SURFACES.get(key)
     if hit is None or hit[0] is not surfaces:
-        hit = (surfaces, _media_indices(tuple(s.medium for s in surfaces), lam))
+        hit = (surfaces, _by_media(tuple(s.medium for s in surfaces), lam))
         with _BY_SURFACES_LOCK:  # (physcam serve solves in threads)
             _BY_SURFACES[key] = hit
             if len(_BY_SURFACES) > _BY_SURFACES_MAX:
                 del _BY_SURFACES[next(iter(_BY_SURFACES))]  # the oldest
-    return list(hit[1])
+    return hit[1]
 
 
 #: The media's indices of the last surface tuples asked about, by the tuple's identity (the tuple kept,
@@ -104,6 +108,24 @@ def media_indices(prescription: Prescription, wavelength_nm=None) -> list[float]
 _BY_SURFACES: dict = {}
 _BY_SURFACES_MAX = 256
 _BY_SURFACES_LOCK = threading.Lock()
+
+
+def _by_media(media: tuple, lam: float) -> tuple[float, ...]:
+    """:func:`_media_indices`, first looked up by the media objects' identities (kept with the answer): a new
+    focus or zoom state's surfaces are new, their media the lens's own, and the memo's key by value hashed
+    every medium again (a quarter of the paraxial work of a Blender extension build)."""
+    key = (tuple(map(id, media)), lam)
+    hit = _BY_MEDIA.get(key)
+    if hit is None or any(a is not b for a, b in zip(hit[0], media)):
+        hit = (media, _media_indices(media, lam))
+        with _BY_SURFACES_LOCK:
+            _BY_MEDIA[key] = hit
+            if len(_BY_MEDIA) > _BY_SURFACES_MAX:
+                del _BY_MEDIA[next(iter(_BY_MEDIA))]  # the oldest
+    return hit[1]
+
+
+_BY_MEDIA: dict = {}
 
 
 @lru_cache(maxsize=1024)
@@ -125,12 +147,32 @@ def _media_indices(media: tuple, lam: float) -> tuple[float, ...]:
 def surface_powers(prescription: Prescription, axis: str = "y", wavelength_nm=None) -> list[float]:
     """Paraxial power (1/mm) of each surface in the ``axis`` meridian: phi = c (n' - n)."""
     _axis(axis)
-    n = media_indices(prescription, wavelength_nm)
-    out = []
-    for i, s in enumerate(prescription.surfaces):
-        c = s.curvature_x if axis == "x" else s.curvature_y
-        out.append(c * (n[i + 1] - n[i]))
-    return out
+    return list(_powers(prescription, axis, _wavelength(prescription, wavelength_nm)))
+
+
+def _powers(prescription: Prescription, axis: str, lam: float) -> tuple[float, ...]:
+    """:func:`surface_powers` at wavelength ``lam`` (nm), remembered by the surfaces' identity like the
+    indices (:data:`_BY_SURFACES`): a Blender extension build asks for the same state's powers tens of
+    thousands of times (every system matrix, pupil and conjugate of every focus and zoom state)."""
+    surfaces = prescription.surfaces
+    key = (id(surfaces), axis, lam)
+    hit = _POWERS.get(key)
+    if hit is None or hit[0] is not surfaces:
+        n = _indices(prescription, lam)
+        if axis == "x":
+            phi = tuple(s.curvature_x * (n[i + 1] - n[i]) for i, s in enumerate(surfaces))
+        else:
+            phi = tuple(s.curvature_y * (n[i + 1] - n[i]) for i, s in enumerate(surfaces))
+        hit = (surfaces, phi)
+        with _BY_SURFACES_LOCK:
+            _POWERS[key] = hit
+            if len(_POWERS) > _BY_SURFACES_MAX:
+                del _POWERS[next(iter(_POWERS))]  # the oldest
+    return hit[1]
+
+
+#: The surfaces' powers by the surfaces tuple's identity, meridian and wavelength (:func:`_powers`).
+_POWERS: dict = {}
 
 
 @takes_prescription
@@ -142,8 +184,14 @@ def paraxial_trace(prescription: Prescription, y0: float, nu0: float, axis: str 
     each vertex and the reduced angle after each surface (Smith, eqs. 2.31-2.32:
     n'u' = nu - y phi, y_next = y + t u').
     """
-    phi = surface_powers(prescription, axis, wavelength_nm)
-    n = media_indices(prescription, wavelength_nm)
+    _axis(axis)
+    return _paraxial_trace(prescription, y0, nu0, axis, _wavelength(prescription, wavelength_nm))
+
+
+def _paraxial_trace(prescription: Prescription, y0: float, nu0: float, axis: str, lam: float):
+    """:func:`paraxial_trace` at wavelength ``lam`` (nm, checked)."""
+    phi = _powers(prescription, axis, lam)
+    n = _indices(prescription, lam)
     ys, nus = [], []
     y, nu = float(y0), float(nu0)
     last = len(prescription.surfaces) - 1
@@ -172,17 +220,27 @@ def system_matrix(prescription: Prescription, axis: str = "y", wavelength_nm=Non
     Defaults: the whole lens, first vertex to last vertex. Power is ``-C``.
     Gaps between the surfaces are included; the gap after ``last`` is not.
     """
-    phi = surface_powers(prescription, axis, wavelength_nm)
-    n = media_indices(prescription, wavelength_nm)
+    _axis(axis)
+    return _system_matrix(prescription, axis, _wavelength(prescription, wavelength_nm), first, last)
+
+
+def _system_matrix(prescription: Prescription, axis: str, lam: float, first: int = 0, last: int | None = None):
+    """:func:`system_matrix` at wavelength ``lam``: each surface's refraction (1, 0, -phi, 1) and each gap's
+    transfer (1, t / n', 0, 1) multiplied on the left, written out: the products of :func:`_mul`, term for
+    term in its order (the same numbers), without a call and a tuple per step."""
+    phi = _powers(prescription, axis, lam)
+    n = _indices(prescription, lam)
+    surfaces = prescription.surfaces
     if last is None:
-        last = len(prescription.surfaces) - 1
-    m = (1.0, 0.0, 0.0, 1.0)
+        last = len(surfaces) - 1
+    m0, m1, m2, m3 = 1.0, 0.0, 0.0, 1.0
     for i in range(first, last + 1):
-        m = _mul((1.0, 0.0, -phi[i], 1.0), m)
+        c = -phi[i]
+        m0, m1, m2, m3 = 1.0 * m0 + 0.0 * m2, 1.0 * m1 + 0.0 * m3, c * m0 + 1.0 * m2, c * m1 + 1.0 * m3
         if i < last:
-            t = prescription.surfaces[i].thickness
-            m = _mul((1.0, t / n[i + 1], 0.0, 1.0), m)
-    return m
+            b = surfaces[i].thickness / n[i + 1]
+            m0, m1, m2, m3 = 1.0 * m0 + b * m2, 1.0 * m1 + b * m3, 0.0 * m0 + 1.0 * m2, 0.0 * m1 + 1.0 * m3
+    return (m0, m1, m2, m3)
 
 
 def _propagate(m, y, nu):
@@ -347,7 +405,7 @@ def stop_semi_diameter_for_fstop(prescription: Prescription, fstop: float, axis:
 def _cardinal_points(prescription: Prescription, axis: str, lam: float, n_obj: float, n_img: float) -> dict:
     """Focal lengths, focal, principal and nodal points from the system matrix (Smith 3.3), as GaussianData fields."""
     z_last = prescription.vertex_z[-1]
-    A, B, C, D = system_matrix(prescription, axis, lam)
+    A, B, C, D = _system_matrix(prescription, axis, lam)
     phi = -C
     if abs(phi) < 1e-12:
         raise OpticsError(f"lens {prescription.name!r} is afocal in the {axis.upper()} meridian (no focal length)")
@@ -399,8 +457,8 @@ def _pupils(prescription: Prescription, axis: str, lam: float, n: tuple, stop_se
     z_last = prescription.vertex_z[-1]
     k = prescription.stop_index
     # front group: first vertex -> stop vertex (the stop has no power)
-    front = _mul((1.0, surfaces[k - 1].thickness / n[k], 0.0, 1.0), system_matrix(prescription, axis, lam, 0, k - 1)) if k > 0 else (1.0, 0.0, 0.0, 1.0)
-    back = system_matrix(prescription, axis, lam, k, len(surfaces) - 1)
+    front = _mul((1.0, surfaces[k - 1].thickness / n[k], 0.0, 1.0), _system_matrix(prescription, axis, lam, 0, k - 1)) if k > 0 else (1.0, 0.0, 0.0, 1.0)
+    back = _system_matrix(prescription, axis, lam, k, len(surfaces) - 1)
     inv = _inverse(front)
     # chief ray: through the stop centre; in object space it crosses the axis at the EP
     y0, nu0 = _propagate(inv, 0.0, 1.0)
@@ -432,14 +490,14 @@ def _conjugate(prescription: Prescription, axis: str, lam: float, n: tuple, obje
         z_img = z_rear_focal_point
         mag = 0.0
         # marginal ray from infinity at the EP edge
-        ys, nus = paraxial_trace(prescription, ep_semi, 0.0, axis, lam)
+        ys, nus = _paraxial_trace(prescription, ep_semi, 0.0, axis, lam)
     else:
         if object_z >= 0:
             raise InputError(f"the object must lie in front of the first vertex (z < 0), got z = {object_z:g} mm")
         # ray from the axial object point to the EP edge
         u = ep_semi / (z_ep - object_z)
         y_first = u * (0.0 - object_z)
-        ys, nus = paraxial_trace(prescription, y_first, n_obj * u, axis, lam)
+        ys, nus = _paraxial_trace(prescription, y_first, n_obj * u, axis, lam)
         if abs(nus[-1]) < 1e-15:
             raise OpticsError("the object is at the front focal point: its image is at infinity")
         z_img = z_last - ys[-1] * n_img / nus[-1]
@@ -479,6 +537,48 @@ def gaussian(
     ``flange_focal_distance_mm``: the flange lies this far in front of the film.
     Raises :class:`OpticsError` for an afocal lens or an object at the front focal point.
     """
+    key = _memo_key(prescription, (axis, wavelength_nm, fstop, object_z, film_z, flange_focal_distance_mm,
+                                   stop_semi_diameter))
+    hit = _GAUSSIAN.get(key) if key is not None else None
+    if hit is not None and hit[0] is prescription:
+        return hit[1]
+    g = _gaussian(prescription, axis, wavelength_nm, fstop, object_z, film_z, flange_focal_distance_mm,
+                  stop_semi_diameter)
+    if key is not None:
+        with _BY_SURFACES_LOCK:
+            _GAUSSIAN[key] = (prescription, g)
+            if len(_GAUSSIAN) > _GAUSSIAN_MAX:
+                del _GAUSSIAN[next(iter(_GAUSSIAN))]  # the oldest
+    return g
+
+
+#: The last Gaussian solves by the prescription's identity (kept with the answer, so its id is not reused) and
+#: the arguments: a lens model asks again and again for the same state's data (every mark's f-number ratio
+#: solves the lens at infinity again, every report row both meridians at infinity; two thirds of the solves
+#: building the Blender extension were repeats). Prescriptions and :class:`GaussianData` are frozen.
+_GAUSSIAN: dict = {}
+_GAUSSIAN_MAX = 512
+
+
+def _memo_key(prescription: Prescription, args: tuple):
+    """``(id, arguments)`` for :data:`_GAUSSIAN`, each float by its type and exact bits (``-0.0`` is not
+    ``0.0``), or None (no memo) when an argument is neither a number, a string nor None."""
+    key = [id(prescription)]
+    for v in args:
+        if v is None or type(v) is str:
+            key.append(v)
+        elif isinstance(v, float):
+            key.append((type(v), float.hex(v)))
+        elif type(v) is int:
+            key.append((int, v))
+        else:
+            return None
+    return tuple(key)
+
+
+def _gaussian(prescription: Prescription, axis, wavelength_nm, fstop, object_z, film_z, flange_focal_distance_mm,
+              stop_semi_diameter) -> GaussianData:
+    """:func:`gaussian`, solved."""
     _axis(axis)
     _check_lens(prescription)
     lam = _wavelength(prescription, wavelength_nm)

@@ -607,6 +607,15 @@ def _build(MONO, OPL, FRESNEL, ASPHERE):
                     good = good & (wl[i0 + k] > zero) & (u - u == zero)
                 buf[_CD * B + k] = miss if ((cd == zero) & (not good)) else cd
             for s in range(S.shape[0]):
+                # every lane of the block stopped: no pass changes a stopped lane, so the rest of the
+                # surfaces would leave the block as it is (a pupil grid's aims mostly die at the rear rim)
+                alive = False
+                for k in range(m):
+                    if buf[_CD * B + k] == zero:
+                        alive = True
+                        break
+                if not alive:
+                    break
                 kd = kinds[s]
                 vz = S[s, VZ]
                 ax = S[s, AX]
