@@ -42,10 +42,11 @@ def _physcam_fit(lens, focus_mm):
     """physcam's own distortion model of the lens at this focus (OpenCV form, normalised by F_y)."""
     from physcam.analysis.distortion.models import fit_brown_conrady, samples_from_field
     from physcam.analysis.distortion.stmap import distortion_field
+    from physcam.optics.state import camera_state
 
     h_px = round(WIDTH_PX * S35.height_mm / S35.width_mm)
-    field = distortion_field(lens, focus_mm=focus_mm, sensor_width_mm=S35.width_mm, sensor_height_mm=S35.height_mm,
-                             width_px=WIDTH_PX, height_px=h_px, maps=False)
+    camera = camera_state(lens, focus_mm=focus_mm, sensor_mm=(S35.width_mm, S35.height_mm))
+    field = distortion_field(camera, width_px=WIDTH_PX, height_px=h_px, maps=False)
     c = fit_brown_conrady(samples_from_field(field), "U-D", max_residual_px=math.inf).coefficients
     return [c["k1"], c["k2"], c["k3"], 0.0, 0.0, 0.0], c["fy_mm"]
 

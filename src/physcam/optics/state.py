@@ -449,7 +449,9 @@ def _camera_at_the_door(value, given: dict, where: str) -> CameraState:
         given["focus_mm"] = given.pop("focus_from_film_mm")
     model = lens_model_of(value)
     if given:
-        words = ", ".join(f"{k}=" for k in given)
+        # camera_state's own names: the sensor's two sizes are one sensor_mm=(width, height) there
+        names = dict.fromkeys("sensor_mm" if k in ("sensor_width_mm", "sensor_height_mm") else k for k in given)
+        words = ", ".join(f"{k}=" for k in names)
         warnings.warn(f"{where}(lens, {words}...) is now {where}(camera_state(lens, {words}...)): the camera is "
                       f"built once, at its door; the keywords go in physcam {UNTIL}", DeprecationWarning, stacklevel=3)
     w, h = given.pop("sensor_width_mm", None), given.pop("sensor_height_mm", None)
