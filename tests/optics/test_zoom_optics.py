@@ -104,6 +104,32 @@ def test_a_focal_length_outside_the_range_names_the_range():
     assert zoom_encoder(p, "0.25") == 0.25
 
 
+@settings(max_examples=10, deadline=None)
+@given(st.floats(0.0, 1.0))
+def test_a_zoom_tabulated_long_end_first_round_trips_too(t):
+    """Every bundled zoom tabulates its wide end first; the same Laikin zoom with its positions in the
+    reverse order (EFL falling along the encoder) names each focal length at 1 - u of the original's u."""
+    from dataclasses import replace
+
+    from physcam.lens.prescription import ZoomGap
+
+    from physcam.lens.zoom import prescription_at
+
+    p = load_lens("laikin_zoom_15_150mm")
+    z = p.zoom
+    assert z.close_distance is None  # what runs along the positions: the gaps, the stop, the labels
+    rev = lambda v: None if v is None else tuple(v[::-1])  # noqa: E731
+    back = replace(prescription_at(p, 1.0), zoom=replace(
+        z, gaps=tuple(ZoomGap(x.surface, x.thickness[::-1]) for x in z.gaps),
+        encoder=tuple(1.0 - e for e in z.encoder[::-1]), stop_semi_diameter=rev(z.stop_semi_diameter),
+        stated_focal_length=rev(z.stated_focal_length))).validate()
+    lo, hi = efl_at(p, 0.0), efl_at(p, 1.0)
+    f = lo + t * (hi - lo)
+    u = encoder_for_focal_length(back, f)
+    assert efl_at(back, u) == pytest.approx(f, rel=1e-9)
+    assert u == pytest.approx(1.0 - encoder_for_focal_length(p, f), abs=1e-9)
+
+
 def test_a_zoom_whose_focal_length_turns_back_names_no_position():
     from dataclasses import replace
 

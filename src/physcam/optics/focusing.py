@@ -32,6 +32,7 @@ from ..data.default_sensor import DEFAULT_SENSOR_WIDTH_MM
 from ..errors import InputError, OpticsError, renamed_parameter, require_positive, require_type
 from ..lens.prescription import Prescription, takes_prescription
 from . import paraxial
+from ._roots import bracketed_root
 
 __all__ = [
     "FOCUS_METHODS",
@@ -342,36 +343,6 @@ def close_focus(prescription: Prescription, *, method: str = "auto", wavelength_
     return CloseFocus(limit, "unit focusing limit", "unit focusing limit, not the lens's MOD", max(limit, near))
 
 
-def _bracketed_root(f, a: float, fa: float, b: float, fb: float, tol: float) -> float:
-    """A root of ``f`` in [a, b] (``fa`` = f(a) <= 0 <= ``fb`` = f(b)) to within ``tol``: regula falsi, Illinois
-    variant (M. Dowell and P. Jarratt, "A modified regula falsi method for computing the root of an equation",
-    BIT 11, 1971: an end kept twice in a row has its value halved, so both ends close in; superlinear, and
-    never leaving the bracket). The internal-focus residual is smooth and nearly linear in the subject distance
-    (its slope about 1): a handful of evaluations where bisection took about 35. The answer: a point whose
-    residual is below ``tol`` / 10, or the middle of the last bracket, narrower than ``tol`` (bisection's answer)."""
-    side = 0
-    for _ in range(200):
-        if b - a < tol:
-            break
-        c = (a * fb - b * fa) / (fb - fa) if fb != fa else 0.5 * (a + b)
-        if not a < c < b:  # rounding at a narrow bracket
-            c = 0.5 * (a + b)
-        fc = f(c)
-        if abs(fc) < 0.1 * tol:
-            return c
-        if fc > 0:
-            b, fb = c, fc
-            if side == 1:
-                fa *= 0.5
-            side = 1
-        else:
-            a, fa = c, fc
-            if side == -1:
-                fb *= 0.5
-            side = -1
-    return 0.5 * (a + b)
-
-
 def _internal_focus(p: Prescription, mark: float, axis: str, lam) -> FocusState:
     q_inf, b_inf, _ = _internal_state(p, math.inf, axis, lam)
     if math.isinf(mark):
@@ -392,7 +363,7 @@ def _internal_focus(p: Prescription, mark: float, axis: str, lam) -> FocusState:
     r_hi = residual(hi)
     if r_hi < 0:
         raise OpticsError(f"lens {p.name!r}: no internal focus solution for {mark:.1f} mm from the film")
-    d = _bracketed_root(residual, d_close, r_lo, hi, r_hi, 1e-9 * max(1.0, hi))
+    d = bracketed_root(residual, d_close, r_lo, hi, r_hi, 1e-9 * max(1.0, hi))
     q, back, alpha = _internal_state(p, d, axis, lam)
     if back <= 0:
         raise OpticsError(f"lens {p.name!r}: at {mark:.1f} mm the image falls inside the lens (back focus {back:.2f} mm)")

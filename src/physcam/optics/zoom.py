@@ -3,7 +3,7 @@ zoom (docs/zoom.md).
 
 A zoom position is the normalised zoom coordinate u of :mod:`physcam.lens.zoom` (0 the first
 tabulated position, 1 the last) or a focal length, solved for u on the paraxial EFL (d line unless
-asked, Y meridian, infinity focus) by bisection inside the bracket where EFL(u) crosses it; a focal
+asked, Y meridian, infinity focus) by regula falsi (Illinois) inside the bracket where EFL(u) crosses it; a focal
 length outside the lens's paraxial range is refused, naming the range. The EFL must run
 monotonically across the zoom for a focal length to name one position (checked on 33 samples).
 
@@ -21,6 +21,7 @@ drift from the designer's (``+``: the image lies behind the film). Breathing ove
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import asdict, dataclass
 
 from ..data.default_sensor import DEFAULT_SENSOR_WIDTH_MM
@@ -28,6 +29,7 @@ from ..errors import InputError, OpticsError, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 from ..lens.zoom import prescription_at, tabulated_encoders
 from . import focusing, paraxial
+from ._roots import bracketed_root
 
 __all__ = ["ZoomRow", "encoder_for_focal_length", "at_zoom", "named_at_zoom", "zoom_encoder", "efl_at", "zoom_table",
            "zoom_breathing", "default_encoders"]
@@ -66,8 +68,22 @@ def efl_at(lens: Prescription, encoder: float, wavelength_nm=None) -> float:
 
 
 def _samples(lens, wavelength_nm):
-    us = [k / (_SAMPLES - 1) for k in range(_SAMPLES)]
-    return us, [efl_at(lens, u, wavelength_nm) for u in us]
+    """(encoders, EFLs) at :data:`_SAMPLES` points across the zoom, remembered per lens (by its identity, the
+    lens kept with them; prescriptions are frozen): a take's every zoom position asked them again."""
+    key = (id(lens), wavelength_nm)
+    hit = _SAMPLED.get(key)
+    if hit is None or hit[0] is not lens:
+        us = [k / (_SAMPLES - 1) for k in range(_SAMPLES)]
+        hit = (lens, us, [efl_at(lens, u, wavelength_nm) for u in us])
+        with _SAMPLED_LOCK:  # (physcam serve solves in threads)
+            _SAMPLED[key] = hit
+            if len(_SAMPLED) > 64:
+                del _SAMPLED[next(iter(_SAMPLED))]  # the oldest
+    return list(hit[1]), list(hit[2])
+
+
+_SAMPLED: dict = {}
+_SAMPLED_LOCK = threading.Lock()
 
 
 #: a focal length this close outside a zoom's paraxial range names its end (the range is printed to 0.01 mm)
@@ -93,21 +109,14 @@ def encoder_for_focal_length(lens: Prescription, focal_length_mm: float, *, wave
                          f"EFL){said}")
     f = min(max(f, lo), hi)
     k = next(i for i in range(len(us) - 1) if (efls[i] - f) * (efls[i + 1] - f) <= 0)
-    a, b, fa = us[k], us[k + 1], efls[k] - f
+    a, b, fa, fb = us[k], us[k + 1], efls[k] - f, efls[k + 1] - f
     if fa == 0.0:
         return a
-    if efls[k + 1] == f:
+    if fb == 0.0:
         return b
-    for _ in range(100):  # bisection: EFL is monotone inside the bracket, fa has the sign of the left end
-        m = 0.5 * (a + b)
-        fm = efl_at(lens, m, wavelength_nm) - f
-        if fm == 0.0 or b - a < 1e-13:
-            return m
-        if (fm < 0) == (fa < 0):
-            a, fa = m, fm
-        else:
-            b = m
-    return 0.5 * (a + b)
+    sign = 1.0 if fa < 0 else -1.0  # EFL is monotone inside the bracket: the residual rising from a to b
+    return bracketed_root(lambda u: sign * (efl_at(lens, u, wavelength_nm) - f), a, sign * fa, b,
+                          sign * fb, 1e-13)
 
 
 def zoom_encoder(lens: Prescription, zoom, *, wavelength_nm=None) -> float:
