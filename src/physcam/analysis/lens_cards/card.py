@@ -404,7 +404,7 @@ def _bokeh(camera, key, w, h, q, backend, notes):
 
 # ---- drawing --------------------------------------------------------------------------------------
 #: The title's place of a panel whose y axis never shows an offset or a power of ten (a fraction from 0 to 1,
-#: an image without y ticks, no axis) nor x ticks on top: where matplotlib's automatic placement puts it
+#: an image without y ticks, no axis, the lens section's heights in mm about the axis) nor x ticks on top: where matplotlib's automatic placement puts it
 #: (``Axes._update_title_position`` moves a title only above such text), given so that no draw measures the
 #: panel's ticks once more to find that out (docs/performance.md, "Round 16").
 _TITLE_Y = 1.0
@@ -424,7 +424,7 @@ def _draw_diagram(ax, card, units):
     sizes = [s for s in (STYLE["axes.titlesize"], 8.0, 7.5, 7.0, 6.5) if s <= STYLE["axes.titlesize"]]
     size = next((s for s in sizes if "\n" not in fit_title(text, 0.97 * cell_in, fontsize=s)), sizes[-1])
     ax.set_title(fit_title(text, 0.97 * cell_in, fontsize=size), loc="left", fontsize=size,
-                 x=(cell.x0 - box.x0) / box.width)  # axes fraction of the cell's left edge
+                 x=(cell.x0 - box.x0) / box.width, y=_TITLE_Y)  # axes fraction of the cell's left edge
 
 
 def _draw_key(ax, key, units):
