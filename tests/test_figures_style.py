@@ -98,6 +98,39 @@ def test_the_checker_sees_a_cut_off_title_and_a_label_without_unit():
     assert not any("height" in p for p in problems)
 
 
+@pytest.mark.parametrize("fmt", ["png", "svg", "pdf"])
+def test_the_strict_check_is_made_on_the_draw_that_saves(fmt, tmp_path, monkeypatch):
+    """With PHYSCAM_STRICT_FIGURES=1 a saved figure is checked on the draw that writes it (one draw per save;
+    the check drew it once more before), and one that breaks the style is refused with nothing written."""
+    from matplotlib.figure import Figure
+
+    from physcam.errors import ExportError
+    from physcam.figures import save_figure
+
+    monkeypatch.setenv(STRICT_ENV, "1")
+    draws = []
+    draw = Figure.draw
+    monkeypatch.setattr(Figure, "draw", lambda self, renderer: (draws.append(1), draw(self, renderer))[1])
+
+    def figure(title):
+        with figure_style():
+            fig = new_figure(figsize=(3.0, 2.0))
+            ax = fig.add_subplot(1, 1, 1)
+            ax.plot([0, 1], [0, 1])
+            ax.set_title(title)
+            ax.set_xlabel("x (mm)")
+            ax.set_ylabel("y (mm)")
+            fig.tight_layout()
+        return fig
+
+    assert save_figure(figure("fits"), tmp_path / f"ok.{fmt}", dpi=50).stat().st_size > 0
+    assert len(draws) == 1
+    with pytest.raises(ExportError, match="reaches outside the figure"):
+        save_figure(figure("a title far too long for a figure three inches wide, running off both of its edges"),
+                    tmp_path / f"bad.{fmt}", dpi=50)
+    assert not (tmp_path / f"bad.{fmt}").exists()
+
+
 def test_fit_title_wraps_to_the_width():
     text = "Double Gauss 50mm f/2  f/2.8  focus 3.000 m  CoC 0.02264 mm (d/1500)  ARRI ALEXA 35 4.6K 3:2 Open Gate"
     with figure_style():  # the title's size is the style's (fit_title measures in it)

@@ -29,6 +29,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import io
+import os
 import threading
 from pathlib import Path
 
@@ -453,14 +454,18 @@ def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130, description: str | No
     if fmt not in _FORMATS.values():
         _PLOT.close(fig)
         raise ExportError(f"cannot draw a figure as {fmt!r}: use one of png, svg, pdf")
-    _check_style(fig)
+    check = _StyleCheck(fig) if os.environ.get(STRICT_ENV) == "1" else None
     _skip_layout_rerun(fig)
     buf = io.BytesIO()
     try:
         meta = None if description is None or fmt == "png" else {"Description" if fmt == "svg" else "Subject":
                                                                      description}
         fig.savefig(buf, format=fmt, dpi=dpi, metadata=meta)
+        if check is not None:
+            check.verdict()
     finally:
+        if check is not None:
+            check.disconnect()
         _PLOT.close(fig)
     return buf.getvalue()
 
@@ -471,19 +476,29 @@ def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130, description: str | No
 STRICT_ENV = "PHYSCAM_STRICT_FIGURES"
 
 
-def _check_style(fig) -> None:
-    import os
+class _StyleCheck:
+    """The strict check (:data:`STRICT_ENV`) of a figure being saved: :func:`figure_problems` of the draw that
+    writes it (matplotlib's ``draw_event``, at the file's dpi), not of a draw of its own before, which drew every
+    figure twice; :meth:`verdict` raises ExportError on a problem, before a byte is written."""
 
-    if os.environ.get(STRICT_ENV) != "1":
-        return
-    problems = figure_problems(fig)
-    if getattr(fig, "_physcam_unstyled", False):
-        problems.append("it was made outside physcam.figures.figure_style (a drawing function without @styled)")
-    if problems:
-        from .errors import ExportError
+    def __init__(self, fig):
+        self.fig, self.problems = fig, None
+        self.cid = fig.canvas.mpl_connect("draw_event", self._drawn)
 
-        _PLOT.close(fig)
-        raise ExportError("the figure breaks physcam's figure style: " + "; ".join(problems))
+    def _drawn(self, event) -> None:
+        self.problems = _drawn_problems(self.fig, event.renderer)
+
+    def disconnect(self) -> None:
+        self.fig.canvas.mpl_disconnect(self.cid)
+
+    def verdict(self) -> None:
+        problems = figure_problems(self.fig) if self.problems is None else list(self.problems)  # (drawn: always)
+        if getattr(self.fig, "_physcam_unstyled", False):
+            problems.append("it was made outside physcam.figures.figure_style (a drawing function without @styled)")
+        if problems:
+            from .errors import ExportError
+
+            raise ExportError("the figure breaks physcam's figure style: " + "; ".join(problems))
 
 
 def _has_unit(label: str) -> bool:
@@ -495,10 +510,13 @@ def _has_unit(label: str) -> bool:
 
 def _texts(artist, ticks) -> list:
     """Every Text under ``artist``, in the order of ``artist.findobj(Text)``, an axis's ticks taken from
-    ``ticks`` (id of the axis: its major and minor ticks) where given instead of asked for again."""
+    ``ticks`` (id of the axis: its major and minor ticks) where given instead of asked for again; none of an
+    axis whose entry is None (not drawn)."""
     from matplotlib.text import Text
 
     if id(artist) in ticks:
+        if ticks[id(artist)] is None:  # an axis not drawn
+            return []
         major, minor = ticks[id(artist)]
         children = [artist.label, artist.offsetText, *major, *minor]  # matplotlib's Axis.get_children()
     else:
@@ -514,8 +532,6 @@ def figure_problems(fig) -> list[str]:
     """What breaks the figure style in ``fig``, drawn (in the style, as physcam saves it): text
     (titles, labels, ticks, legends) reaching outside the figure, and axes with ticks but no label or
     a label without a unit. Empty when none."""
-    import re
-
     from matplotlib.figure import Figure
 
     from .errors import require_type
@@ -524,16 +540,21 @@ def figure_problems(fig) -> list[str]:
     # laid out as drawn (ticks, constrained layout, text sizes) without rasterising a pixel: the text
     # extents are the same as after canvas.draw() (compared on the lens cards), in half the time
     fig.draw_without_rendering()
-    renderer = fig.canvas.get_renderer()
+    return _drawn_problems(fig, fig.canvas.get_renderer())
+
+
+def _drawn_problems(fig, renderer) -> list[str]:
+    """:func:`figure_problems` of ``fig`` just drawn by ``renderer``."""
+    import re
+
     box = fig.bbox
     problems = []
     hidden = set()  # tick labels of ticks outside the view: matplotlib keeps them but does not draw them
     ticks = {}  # each axis's ticks as the draw left them, asked once (each ask runs its tick locator)
     for ax in fig.axes:
         for axis in (ax.xaxis, ax.yaxis):
-            if not ax.get_visible() or not ax.axison:  # an axes shown off (an image) draws no axis text
-                hidden.update(id(t) for t in axis.get_ticklabels(which="both") + [axis.label])
-                ticks[id(axis)] = axis.get_major_ticks(), axis.get_minor_ticks()
+            if not ax.get_visible() or not ax.axison:  # an axes shown off (an image) draws no axis text:
+                ticks[id(axis)] = None  # none of it is looked at (nor its ticks made and located to be skipped)
                 continue
             ticks[id(axis)] = major, minor = axis.get_major_ticks(), axis.get_minor_ticks()
             lo, hi = sorted(axis.get_view_interval())
