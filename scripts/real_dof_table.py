@@ -14,6 +14,7 @@ from physcam.errors import PhysCamError
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
 from physcam.optics.sensors import find_sensor
+from physcam.optics.state import camera_state
 
 CASES = [("dgauss_50mm", 2.8, 1000.0), ("dgauss_50mm", 2.8, 3000.0), ("dgauss_50mm", 5.6, 3000.0),
          ("tessar_50mm_f2_8", 2.8, 2000.0), ("sonnar_50mm_f1_5", 2.0, 2000.0), ("zeiss_distagon_35mm_f4", 4.0, 2000.0),
@@ -35,8 +36,9 @@ def row(name: str, n: float, mark: float) -> str:
     head = f"| {name} | f/{n:g} | {mark / 1000:g} | {m(r.dof.near_from_film_mm)}-{m(r.dof.far_from_film_mm)} " \
            f"| {r.dof.total_mm:.0f} |"
     try:
-        c = real_depth_of_field(lens, focus_mm=mark, fstop=n, coc_mm=r.coc_mm, measure="energy")
-        p = real_depth_of_field(lens, focus_mm=mark, fstop=n, coc_mm=r.coc_mm, measure="energy", focusing="paraxial")
+        cam = camera_state(lens, focus_mm=mark, fstop=n)
+        c = real_depth_of_field(cam, coc_mm=r.coc_mm, measure="energy")
+        p = real_depth_of_field(cam, coc_mm=r.coc_mm, measure="energy", focusing="paraxial")
     except PhysCamError as exc:
         return head + f" none: {str(exc).split(': ')[-1]} | | | |"
     return head + (f" {m(c.near_from_film_mm)}-{m(c.far_from_film_mm)} | {c.total_mm:.0f} "

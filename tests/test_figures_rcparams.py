@@ -84,8 +84,9 @@ def _dof_zone(lens):
 
 def _diagram(lens):
     from physcam.analysis.lens_cards.diagram import lens_diagram
+    from physcam.optics.state import camera_state
 
-    return lens_diagram(lens, focus_mm=2000.0, fstop=4.0).figure()
+    return lens_diagram(camera_state(lens, focus_mm=2000.0, fstop=4.0)).figure()
 
 
 def _breathing(lens):
@@ -103,9 +104,10 @@ def _real_breathing(lens):
 
 def _mtf_chart(lens):
     from physcam.analysis.image_quality.mtf import mtf_chart
+    from physcam.optics.state import camera_state
 
-    return mtf_chart(lens, focus_mm=3000.0, fstop=8.0, n_fields=2, max_image_height_mm=5.0, frequencies=(10.0,),
-                     wavelengths_nm=(587.5618,), pupil_samples=16).plot()
+    return mtf_chart(camera_state(lens, focus_mm=3000.0, fstop=8.0), n_fields=2, max_image_height_mm=5.0,
+                     frequencies=(10.0,), wavelengths_nm=(587.5618,), pupil_samples=16).plot()
 
 
 def _spot(lens):

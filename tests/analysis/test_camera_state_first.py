@@ -27,17 +27,25 @@ MARK, N = 2000.0, 4.0
 STATE = camera_state(DGAUSS, focus_mm=MARK, fstop=N)
 
 
+def _old_door(name):
+    """``name``'s pre-issue-43 door (the lens and its camera keywords): it warns until physcam 0.3."""
+    return pytest.warns(DeprecationWarning, match=rf"{name}\(lens, .*\) is now {name}\(camera_state\(lens")
+
+
 def test_distortion_field_at_a_stop_is_the_same_through_either_door():
     from physcam.analysis.distortion.stmap import distortion_field
 
     kw = dict(width_px=48, height_px=32, maps=False)
     a = distortion_field(camera_state(DGAUSS, focus_mm=MARK, fstop=N, sensor_mm=(36.0, 24.0)), **kw)
-    b = distortion_field(DGAUSS, focus_mm=MARK, fstop=N, sensor_width_mm=36.0, sensor_height_mm=24.0, **kw)
+    with _old_door("distortion_field"):
+        b = distortion_field(DGAUSS, focus_mm=MARK, fstop=N, sensor_width_mm=36.0, sensor_height_mm=24.0, **kw)
     assert a.fstop == b.fstop == N
     assert np.array_equal(a.traced_ideal_px, b.traced_ideal_px) and a.residual_px == b.residual_px
     # a state made without an f-stop maps chief rays, as a Prescription without one does
-    c = distortion_field(camera_state(DGAUSS, focus_mm=MARK), sensor_width_mm=36.0, sensor_height_mm=24.0, **kw)
-    d = distortion_field(DGAUSS, focus_mm=MARK, sensor_width_mm=36.0, sensor_height_mm=24.0, **kw)
+    with pytest.warns(DeprecationWarning, match=r"distortion_field\(camera, sensor_width_mm=.*give them to the camera"):
+        c = distortion_field(camera_state(DGAUSS, focus_mm=MARK), sensor_width_mm=36.0, sensor_height_mm=24.0, **kw)
+    with _old_door("distortion_field"):
+        d = distortion_field(DGAUSS, focus_mm=MARK, sensor_width_mm=36.0, sensor_height_mm=24.0, **kw)
     assert c.fstop is None and np.array_equal(c.traced_ideal_px, d.traced_ideal_px)
     with pytest.raises(InputError, match="carries its own"):
         distortion_field(STATE, fstop=2.8, sensor_width_mm=36.0, sensor_height_mm=24.0, **kw)
@@ -51,11 +59,12 @@ def test_real_blur_is_the_same_through_either_door():
     from physcam.analysis.defocus.real_dof import blur_diameter_mm, real_depth_of_field
 
     a = blur_diameter_mm(STATE, 1000.0, image_height_mm=5.0)
-    b = blur_diameter_mm(DGAUSS, 1000.0, focus_mm=MARK, fstop=N, image_height_mm=5.0)
+    with _old_door("blur_diameter_mm"):
+        b = blur_diameter_mm(DGAUSS, 1000.0, focus_mm=MARK, fstop=N, image_height_mm=5.0)
     assert a == b > 0
     with pytest.raises(InputError, match="carries its own"):
         real_depth_of_field(STATE, focus_mm=MARK, coc_mm=0.03)
-    with pytest.raises(InputError, match="focus_mm and fstop"):
+    with _old_door("real_depth_of_field"), pytest.raises(InputError, match="focus_mm and fstop"):
         real_depth_of_field(DGAUSS, fstop=N, coc_mm=0.03)
     with pytest.raises(InputError, match="focus mark"):
         blur_diameter_mm(camera_state(DGAUSS, fstop=N), 1000.0)  # a state at infinity has no finite mark
@@ -68,7 +77,8 @@ def test_defocus_camera_is_the_same_through_either_door():
 
     s = camera_state(DGAUSS, focus_mm=MARK, fstop=2.8, sensor_mm=(36.0, 24.0))
     a = defocus_camera(s, width=128, height=72)
-    b = defocus_camera(DGAUSS, focus_mm=MARK, fstop=2.8, sensor_width_mm=36.0, width=128, height=72)
+    with _old_door("defocus_camera"):
+        b = defocus_camera(DGAUSS, focus_mm=MARK, fstop=2.8, sensor_width_mm=36.0, width=128, height=72)
     assert a.key() == b.key()  # every input the kernels depend on
     assert (a.film_z, a.stop_semi, a.pinhole_mm, a.pupil_from_film_mm) == (b.film_z, b.stop_semi, b.pinhole_mm,
                                                                            b.pupil_from_film_mm)
@@ -77,8 +87,10 @@ def test_defocus_camera_is_the_same_through_either_door():
 
     six = defocus_camera(camera_state(DGAUSS, focus_mm=MARK, fstop=2.8, sensor_mm=(36.0, 24.0), aperture=Aperture(6)),
                          width=128, height=72)  # the state's iris shape
-    assert six.key() == defocus_camera(DGAUSS, focus_mm=MARK, fstop=2.8, sensor_width_mm=36.0, width=128, height=72,
-                                       aperture=6).key() != a.key()
+    with _old_door("defocus_camera"):
+        old_six = defocus_camera(DGAUSS, focus_mm=MARK, fstop=2.8, sensor_width_mm=36.0, width=128, height=72,
+                                 aperture=6)
+    assert six.key() == old_six.key() != a.key()
     with pytest.raises(InputError, match="carries its own"):
         defocus_camera(s, fstop=2.8, width=128, height=72)
     with pytest.raises(InputError, match="sensor"):
@@ -91,7 +103,8 @@ def test_lens_diagram_is_the_same_through_either_door():
     from physcam.analysis.lens_cards.diagram import lens_diagram
 
     a = lens_diagram(STATE, rays=3)
-    b = lens_diagram(DGAUSS, focus_mm=MARK, fstop=N, rays=3)
+    with _old_door("lens_diagram"):
+        b = lens_diagram(DGAUSS, focus_mm=MARK, fstop=N, rays=3)
     assert (a.fstop, a.focus_from_film_mm) == (b.fstop, b.focus_from_film_mm) == (N, MARK)
     assert a.rays == b.rays
     assert a.prescription.surfaces[DGAUSS.stop_index].semi_diameter == pytest.approx(iris_semi_diameter(DGAUSS, N),
@@ -150,12 +163,17 @@ def test_thin_lens_gap_takes_the_reports_camera_state():
         warnings.simplefilter("ignore")
         r = solve_lens_report(focal_length_mm=None, lens=DGAUSS, sensor=find_sensor("Super 35"), fstop=8.0,
                               focus_mm=MARK)
-    a = thin_lens_gap(r, camera_state(DGAUSS, focus_mm=MARK, fstop=8.0))
-    b = thin_lens_gap(r, DGAUSS)
-    assert a.bokeh == b.bokeh and a.hfov_difference_pct == b.hfov_difference_pct
-    with pytest.raises(InputError, match="not the report's"):
+    def old():
+        return pytest.warns(DeprecationWarning, match=r"thin_lens_gap\(report, lens\): .*call thin_lens_gap\(report\)")
+
+    with old():
+        a = thin_lens_gap(r, camera_state(DGAUSS, focus_mm=MARK, fstop=8.0))
+    with old():
+        b = thin_lens_gap(r, DGAUSS)
+    assert a.bokeh == b.bokeh == thin_lens_gap(r).bokeh and a.hfov_difference_pct == b.hfov_difference_pct
+    with old(), pytest.raises(InputError, match="not the report's"):
         thin_lens_gap(r, STATE)  # f/4, the report's f/8
-    with pytest.raises(WrongTypeError):
+    with old(), pytest.raises(WrongTypeError):
         thin_lens_gap(r, "dgauss_50mm")
 
 

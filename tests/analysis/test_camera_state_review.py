@@ -28,7 +28,8 @@ def test_the_lens_diagram_of_a_state_is_at_the_states_wavelength(canon):
 
     blue = 486.1327
     got = lens_diagram(camera_state(canon, focus_mm=900.0, fstop=4.0, wavelengths_nm=[blue]))
-    want = lens_diagram(canon, focus_mm=900.0, fstop=4.0, wavelength_nm=blue)
+    with pytest.warns(DeprecationWarning, match=r"lens_diagram\(lens, focus_mm=, fstop=...\) is now"):  # until 0.3
+        want = lens_diagram(canon, focus_mm=900.0, fstop=4.0, wavelength_nm=blue)
     assert got.gaussian.wavelength_nm == blue and got.gaussian.efl == want.gaussian.efl
 
 

@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 from physcam.errors import PhysCamError
 from physcam.lens.library import list_lenses, load_lens
+from physcam.optics.state import as_designed, camera_state
 
 SLUGS = [r.slug for r in list_lenses()]
 pytestmark = pytest.mark.slow
@@ -71,7 +72,8 @@ def test_spot_and_field_limit(slug, field, wl, clip, film_dz):
             film_z = paraxial_image_z(lens) + film_dz
         except PhysCamError:
             return
-    _check(lambda: spot_diagram(lens, [field], wavelength_nm=wl, film_z=film_z, rings=8, refine=2, clip=clip))
+    _check(lambda: spot_diagram(as_designed(lens) if film_z is None else camera_state(lens, film_z=film_z), [field],
+                                wavelength_nm=wl, rings=8, refine=2, clip=clip))
 
 
 @settings(max_examples=30, database=None)
@@ -94,9 +96,8 @@ def test_distortion_illumination_colour(slug, w, h, top):
 
     lens = load_lens(slug)
     _check(lambda: real_distortion(lens, sensor_width_mm=w, sensor_height_mm=h, n_fields=5))
-    _check(lambda: relative_illumination(lens, max_field_deg=top, n_fields=3, sensor_width_mm=w,
-                                         sensor_height_mm=h, grid=24))
-    _check(lambda: chromatic_aberration(lens, max_field_deg=top, sensor_width_mm=w, sensor_height_mm=h, n_fields=3))
+    _check(lambda: relative_illumination(as_designed(lens, sensor_mm=(w, h)), max_field_deg=top, n_fields=3, grid=24))
+    _check(lambda: chromatic_aberration(as_designed(lens, sensor_mm=(w, h)), max_field_deg=top, n_fields=3))
 
 
 @settings(max_examples=15, database=None)

@@ -38,6 +38,11 @@ def _by_hand(lens, mark, fstop):
     return st.prescription, st.film_z, focusing.iris_semi_diameter(lens, fstop)
 
 
+def _old_door():
+    """The lens with its keywords, the pre-issue-43 form: it warns until physcam 0.3."""
+    return pytest.warns(DeprecationWarning, match=r"is now \w+\(camera_state\(lens, .*physcam 0\.3")
+
+
 def _rms(res):
     return [f.rms_radius_um for f in res.fields]
 
@@ -46,7 +51,8 @@ def test_spot_from_a_state_is_the_spot_of_its_lens_stop_and_film():
     s = camera_state(DGAUSS, fstop=4.0)
     a = spot_diagram(s, (0.0, 5.0), **SPOT)
     _, film, iris = _by_hand(DGAUSS, math.inf, 4.0)
-    b = spot_diagram(DGAUSS, (0.0, 5.0), fstop=4.0, film_z=film, **SPOT)
+    with _old_door():
+        b = spot_diagram(DGAUSS, (0.0, 5.0), fstop=4.0, film_z=film, **SPOT)
     assert _rms(a) == pytest.approx(_rms(b), rel=1e-9)
     assert s.stop_semi_diameter == iris
     assert a.film_z_mm == pytest.approx(film, abs=1e-9)
@@ -60,7 +66,8 @@ def test_a_focused_state_images_its_object_point_where_the_paraxial_optics_put_i
     assert res.fields[1].centroid_y_mm == pytest.approx(s.gaussian.magnification * y_obj, rel=2e-3)
     # in focus: as sharp as the lens at infinity, far sharper than light from infinity on that film
     sharp = spot_diagram(camera_state(DGAUSS, fstop=4.0), (0.0,), **SPOT).fields[0].rms_radius_um
-    blurred = spot_diagram(s.focused, (0.0,), film_z=s.film_z, fstop=4.0, **SPOT).fields[0].rms_radius_um
+    with _old_door():
+        blurred = spot_diagram(s.focused, (0.0,), film_z=s.film_z, fstop=4.0, **SPOT).fields[0].rms_radius_um
     assert res.fields[0].rms_radius_um < 2 * sharp < blurred / 10
 
 
@@ -72,8 +79,9 @@ def test_bokeh_from_a_state_is_the_bokeh_of_the_lens_focused_and_stopped_by_hand
     # the hexagon has the round iris's area (docs/conventions.md): its corners at iris x equal_area_scale
     # (f/4 is far inside the widest iris, so no clamp); the ray-level form draws inside the radius given
     corner = iris * hexagon.equal_area_scale()
-    b = bokeh_image(lens, 1000.0, 2.0, 1.0, film_z=film, stop_semi_diameter=corner, aperture=hexagon, rays=20_000,
-                    pixels=32)
+    with _old_door():
+        b = bokeh_image(lens, 1000.0, 2.0, 1.0, film_z=film, stop_semi_diameter=corner, aperture=hexagon, rays=20_000,
+                        pixels=32)
     assert np.array_equal(a.image, b.image) and a.extent_mm == b.extent_mm and a.rays_passed == b.rays_passed
 
 
@@ -81,8 +89,9 @@ def test_illumination_from_a_state_uses_its_iris_and_sensor():
     s = camera_state(DGAUSS, fstop=4.0, sensor_mm=(36.0, 24.0))
     a = relative_illumination(s, n_fields=4, grid=32)
     _, film, iris = _by_hand(DGAUSS, math.inf, 4.0)
-    b = relative_illumination(DGAUSS, n_fields=4, grid=32, stop_semi_diameter=iris, film_z=film,
-                              sensor_width_mm=36.0, sensor_height_mm=24.0)
+    with _old_door():
+        b = relative_illumination(DGAUSS, n_fields=4, grid=32, stop_semi_diameter=iris, film_z=film,
+                                  sensor_width_mm=36.0, sensor_height_mm=24.0)
     assert [p.field_deg for p in a.points] == [p.field_deg for p in b.points]  # to the 36 x 24 corner
     assert [p.relative_illumination for p in a.points] == pytest.approx([p.relative_illumination for p in b.points],
                                                                         rel=1e-9)
@@ -92,7 +101,8 @@ def test_colour_from_a_state_is_the_colour_of_its_lens_on_its_film():
     s = camera_state(SONNAR, focus_mm=3000.0)
     a = chromatic_aberration(s, [0.0, 8.0])
     lens, film, _ = _by_hand(SONNAR, 3000.0, 2.0)
-    b = chromatic_aberration(lens, [0.0, 8.0], film_z=film)
+    with _old_door():
+        b = chromatic_aberration(lens, [0.0, 8.0], film_z=film)
     assert a.longitudinal_real_mm != 0.0
     assert a.to_dict() == b.to_dict()
 
@@ -101,7 +111,8 @@ def test_ghosts_from_a_state_are_the_ghosts_of_its_lens_stop_and_film():
     s = camera_state(DGAUSS, focus_mm=2000.0, fstop=2.8)
     a = ghost_analysis(s, 5.0, rank_rays=400)
     lens, film, iris = _by_hand(DGAUSS, 2000.0, 2.8)
-    b = ghost_analysis(lens, 5.0, rank_rays=400, film_z=film, stop_semi_diameter=iris)
+    with _old_door():
+        b = ghost_analysis(lens, 5.0, rank_rays=400, film_z=film, stop_semi_diameter=iris)
     assert [(p.i, p.j) for p in a.paths] == [(p.i, p.j) for p in b.paths]
     assert [p.relative_flux for p in a.paths] == pytest.approx([p.relative_flux for p in b.paths], rel=1e-12)
     assert a.film_z_mm == b.film_z_mm

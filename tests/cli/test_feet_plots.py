@@ -91,9 +91,10 @@ def test_distortion_across_focus_axis_in_feet(dgauss):
 
 def test_mtf_chart_title_focus_in_feet(dgauss):
     from physcam.analysis.image_quality.mtf import mtf_chart
+    from physcam.optics.state import camera_state
 
-    chart = mtf_chart(dgauss, focus_mm=3000.0, fstop=8.0, n_fields=2, max_image_height_mm=5.0, frequencies=(10.0,),
-                      wavelengths_nm=(587.5618,), pupil_samples=16)
+    chart = mtf_chart(camera_state(dgauss, focus_mm=3000.0, fstop=8.0), n_fields=2, max_image_height_mm=5.0,
+                      frequencies=(10.0,), wavelengths_nm=(587.5618,), pupil_samples=16)
     tm = chart.plot(units="m").axes[0].get_title()
     tf = chart.plot(units="ft").axes[0].get_title()
     assert "focus 3.000 m," in tm
@@ -105,8 +106,9 @@ def test_mtf_chart_title_focus_in_feet(dgauss):
 def test_distortion_fit_residual_title_in_feet(dgauss):
     from physcam.analysis.distortion.models import fit_brown_conrady, samples_from_field
     from physcam.analysis.distortion.stmap import distortion_field
+    from physcam.optics.state import camera_state
 
-    field = distortion_field(dgauss, focus_mm=2000.0, sensor_width_mm=36.0, sensor_height_mm=24.0, width_px=64,
+    field = distortion_field(camera_state(dgauss, focus_mm=2000.0, sensor_mm=(36.0, 24.0)), width_px=64,
                              height_px=43, maps=False)
     fit = fit_brown_conrady(samples_from_field(field), "D-U")
     assert "at focus 2.000 m\n" in fit.plot_residual(units="m").axes[0].get_title()
@@ -138,8 +140,9 @@ def test_dof_zone_marks_and_title_in_feet():
 
 def test_lens_diagram_title_in_feet(dgauss):
     from physcam.analysis.lens_cards.diagram import lens_diagram
+    from physcam.optics.state import camera_state
 
-    d = lens_diagram(dgauss, focus_mm=2000.0, fstop=4.0)
+    d = lens_diagram(camera_state(dgauss, focus_mm=2000.0, fstop=4.0))
     assert "focus 2.000 m," in d.figure(units="m").axes[0].get_title()
     assert f"focus {feet_inches(2000.0)}," in d.figure(units="ft").axes[0].get_title()
 

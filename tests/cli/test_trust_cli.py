@@ -115,10 +115,11 @@ def test_ghost_image_sizes_are_bounded_in_the_api():
     from physcam.analysis.image_quality.ghosts import ghost_analysis
     from physcam.errors import InputError, SensorError
     from physcam.lens.library import load_lens
+    from physcam.optics.state import as_designed
 
     lens = load_lens("dgauss_50mm")
     with pytest.raises(SensorError, match="between 0.5 and 1000"):
-        ghost_analysis(lens, 10.0, sensor_width_mm=0.001, sensor_height_mm=24.0)
+        ghost_analysis(as_designed(lens, sensor_mm=(0.001, 24.0)), 10.0)
     with pytest.raises(InputError, match="pixels <= 4096"):
         ghost_analysis(lens, 10.0, pixels=100_000, image_rays=1000)
 

@@ -71,8 +71,9 @@ def test_a_fit_is_good_in_the_cli_and_on_its_figure(tmp_path, capsys):
     from physcam.analysis.distortion.models import fit_models, samples_from_field
     from physcam.analysis.distortion.stmap import distortion_field
     from physcam.lens.library import load_lens
+    from physcam.optics.state import camera_state
 
-    res = distortion_field(load_lens("dgauss_50mm"), focus_mm=2000.0, sensor_width_mm=24.89, sensor_height_mm=18.66,
+    res = distortion_field(camera_state(load_lens("dgauss_50mm"), focus_mm=2000.0, sensor_mm=(24.89, 18.66)),
                            width_px=512, height_px=384, maps=False)
     fit = fit_models(samples_from_field(res), ["brown"])[0]
     fig = fit.plot_residual()

@@ -37,8 +37,7 @@ def test_arrays_are_physcams_surface_table_of_the_focused_lens(slug, focus_mm, f
     physcam's focus solution (internal focusing for the Canon and the Navarro, unit focusing for
     the Distagon), with the stop at the f-number's semi-diameter, and FILM_Z is its film plane."""
     lens = load_lens(slug)
-    src = osl_camera_shader(lens, focus_mm=focus_mm, fstop=fstop, sensor_width_mm=24.0, sensor_height_mm=18.0,
-                            dispersion=True)
+    src = osl_camera_shader(camera_state(lens, focus_mm=focus_mm, fstop=fstop, sensor_mm=(24.0, 18.0)), dispersion=True)
     st = focus(lens, focus_mm)
     q = st.prescription
     semi = None if fstop is None else stop_semi_diameter_for_fstop(lens, fstop)
@@ -65,7 +64,7 @@ def test_arrays_are_physcams_surface_table_of_the_focused_lens(slug, focus_mm, f
 
 def test_monochrome_indices_are_physcams_at_the_design_wavelength():
     lens = load_lens("dgauss_50mm")
-    src = osl_camera_shader(lens, focus_mm=2000.0, sensor_width_mm=36.0, sensor_height_mm=24.0, fresnel=True)
+    src = osl_camera_shader(camera_state(lens, focus_mm=2000.0, sensor_mm=(36.0, 24.0)), fresnel=True)
     q = focus(lens, 2000.0).prescription
     t = surface_table(q, reverse=True)
     np.testing.assert_allclose(_array(src, "N1"), t.index_before(lens.wavelength_nm), rtol=1e-15)
@@ -78,35 +77,35 @@ def test_monochrome_indices_are_physcams_at_the_design_wavelength():
 
 def test_aperture_and_features_are_emitted():
     lens = load_lens("dgauss_50mm")
-    src = osl_camera_shader(lens, focus_mm=3000.0, sensor_width_mm=36.0, sensor_height_mm=24.0,
-                            aperture=dict(nsides=6, angle_deg=30.0, roundness=0.25, density=-0.5))
+    iris = dict(nsides=6, angle_deg=30.0, roundness=0.25, density=-0.5)
+    src = osl_camera_shader(camera_state(lens, focus_mm=3000.0, sensor_mm=(36.0, 24.0)), aperture=iris)
     # the iris's numbers in the data block (the template's code reads them by name)
     assert f"#define AP_WEDGE {2 * math.pi / 6!r}\n" in src
     assert f"#define AP_ANGLE {math.radians(30.0)!r}\n" in src
     assert "#define AP_ROUNDNESS 0.25\n" in src and "#define AP_DENSITY -0.5\n" in src
     assert "AP_ROUNDNESS * (1.0 - pg)" in src and "AP_DENSITY * (2.0 * sr - 1.0)" in src
-    plain = osl_camera_shader(lens, focus_mm=3000.0, sensor_width_mm=36.0, sensor_height_mm=24.0)
+    plain = osl_camera_shader(camera_state(lens, focus_mm=3000.0, sensor_mm=(36.0, 24.0)))
     assert "AP_WEDGE" not in plain and "Ts *=" not in plain
 
 
 def test_bad_input_is_a_clear_error(tmp_path):
     lens = load_lens("zeiss_distagon_35mm_f4")
-    kw = dict(sensor_width_mm=36.0, sensor_height_mm=24.0)
+    kw = dict(sensor_mm=(36.0, 24.0))
     with pytest.raises(OpticsError, match="closest real focus"):
-        osl_camera_shader(lens, focus_mm=50.0, **kw)
+        osl_camera_shader(camera_state(lens, focus_mm=50.0, **kw))
     with pytest.raises(OpticsError, match="faster than this lens opens"):
-        osl_camera_shader(lens, focus_mm=3000.0, fstop=1.0, **kw)
+        osl_camera_shader(camera_state(lens, focus_mm=3000.0, fstop=1.0, **kw))
     for bad in (0.0, -5.0, float("nan"), "three metres", True):  # ("3m" reads as 3000 mm, as camera_state reads it)
         with pytest.raises(InputError):
-            osl_camera_shader(lens, focus_mm=bad, **kw)
+            osl_camera_shader(camera_state(lens, focus_mm=bad, **kw))
     with pytest.raises(InputError, match="sensor width"):
-        osl_camera_shader(lens, focus_mm=3000.0, sensor_width_mm=-1.0, sensor_height_mm=24.0)
+        osl_camera_shader(camera_state(lens, focus_mm=3000.0, sensor_mm=(-1.0, 24.0)))
     with pytest.raises(InputError, match="aperture"):
-        osl_camera_shader(lens, focus_mm=3000.0, aperture="hexagon", **kw)
+        osl_camera_shader(camera_state(lens, focus_mm=3000.0, **kw), aperture="hexagon")
     with pytest.raises(InputError, match="roundness"):
-        osl_camera_shader(lens, focus_mm=3000.0, aperture=(6, 0.0, 2.0, 0.0), **kw)
+        osl_camera_shader(camera_state(lens, focus_mm=3000.0, **kw), aperture=(6, 0.0, 2.0, 0.0))
     with pytest.raises(InputError):
-        osl_camera_shader(lens, focus_mm=3000.0, dispersion="yes", **kw)
+        osl_camera_shader(camera_state(lens, focus_mm=3000.0, **kw), dispersion="yes")
     with pytest.raises(TypeError):
         osl_camera_shader("zeiss_distagon_35mm_f4", focus_mm=3000.0, **kw)
     with pytest.raises(InputError, match="aspect"):

@@ -31,8 +31,9 @@ def test_a_camera_state_writes_the_same_osl_as_its_lens_focus_and_stop(slug, mar
     lens = load_lens(slug)
     state = camera_state(lens, focus_mm=mark, fstop=fstop, sensor_mm=SENSOR, aperture=aperture)
     by_state = osl_camera_shader(state, dispersion=True)
-    by_lens = osl_camera_shader(lens, focus_mm=mark, fstop=fstop, sensor_width_mm=SENSOR[0],
-                                sensor_height_mm=SENSOR[1], aperture=aperture, dispersion=True)
+    with pytest.warns(DeprecationWarning, match=r"is now osl_camera_shader\(camera_state\(lens"):  # until physcam 0.3
+        by_lens = osl_camera_shader(lens, focus_mm=mark, fstop=fstop, sensor_width_mm=SENSOR[0],
+                                    sensor_height_mm=SENSOR[1], aperture=aperture, dispersion=True)
     assert by_state == by_lens
     assert (", open;" in by_state) == (fstop is None)  # the header names the stop as the lens path did
 
@@ -40,8 +41,10 @@ def test_a_camera_state_writes_the_same_osl_as_its_lens_focus_and_stop(slug, mar
 def test_write_blender_camera_from_a_state_writes_the_same_files(tmp_path):
     lens = load_lens("dgauss_50mm")
     kw = dict(resolution=(360, 270), name="cam")
-    a = write_blender_camera(tmp_path / "a", camera_state(lens, focus_mm=2000.0, fstop=4.0, sensor_mm=SENSOR), **kw)
-    with pytest.warns(DeprecationWarning, match="camera_state"):  # the pre-issue-43 form, until physcam 0.3
+    a = write_blender_camera(camera_state(lens, focus_mm=2000.0, fstop=4.0, sensor_mm=SENSOR), tmp_path / "a", **kw)
+    # the pre-issue-43 form (out_dir first, the lens and its keywords), until physcam 0.3
+    with pytest.warns(DeprecationWarning, match="the old order goes"), \
+            pytest.warns(DeprecationWarning, match="camera_state"):
         b = write_blender_camera(tmp_path / "b", lens, focus_mm=2000.0, fstop=4.0, sensor_width_mm=SENSOR[0],
                                  sensor_height_mm=SENSOR[1], **kw)
     assert [p.name for p in a] == [p.name for p in b] == ["cam.osl", "setup_cam.py"]
@@ -127,6 +130,11 @@ def test_fit_opencv_pinhole_of_a_state_is_the_fit_at_its_mark_and_sensor():
         fit_opencv_pinhole(lens, 24.0, 18.0, 960, 720, focus_mm=4000.0)
 
 
+def _old_door_shader(lens):
+    with pytest.warns(DeprecationWarning, match=r"is now osl_camera_shader\(camera_state\(lens"):  # until physcam 0.3
+        return osl_camera_shader(lens, focus_mm=2000.0, sensor_width_mm=36.0, sensor_height_mm=24.0, aperture=6)
+
+
 def test_the_iris_shape_in_the_state_or_beside_it_is_the_same_iris():
     """A six-blade iris in the state, or a number of blades (the shader's shorthand) given with a round
     state or with the lens: one six-blade iris in the shader. (A state holds an iris shape, not a
@@ -137,6 +145,6 @@ def test_the_iris_shape_in_the_state_or_beside_it_is_the_same_iris():
     kw = dict(focus_mm=2000.0, sensor_mm=(36.0, 24.0))
     texts = {osl_camera_shader(camera_state(lens, aperture=Aperture(6), **kw)),
              osl_camera_shader(camera_state(lens, **kw), aperture=6),
-             osl_camera_shader(lens, focus_mm=2000.0, sensor_width_mm=36.0, sensor_height_mm=24.0, aperture=6)}
+             _old_door_shader(lens)}
     assert len(texts) == 1
     assert f"#define AP_WEDGE {2 * math.pi / 6!r}\n" in texts.pop()

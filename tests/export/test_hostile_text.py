@@ -104,8 +104,9 @@ def _writable(text: str) -> None:
 @pytest.fixture(scope="module")
 def baked(triplet):
     from physcam.export.blender import bake_camera
+    from physcam.optics.state import camera_state
 
-    return bake_camera(triplet, focus_mm=2000.0, sensor_width_mm=24.0, sensor_height_mm=18.0)
+    return bake_camera(camera_state(triplet, focus_mm=2000.0, sensor_mm=(24.0, 18.0)))
 
 
 @pytest.mark.parametrize("name", HOSTILE, ids=IDS)
@@ -240,10 +241,11 @@ def hash_tokens(text: str) -> list[str]:
 
 @pytest.fixture(scope="module")
 def report(triplet):
-    from physcam.onset.report import ReportRequest, solve_report
+    from physcam.onset.report import solve_report
+    from physcam.onset.request import report_camera
     from physcam.optics.sensors import custom_sensor
 
-    return solve_report(ReportRequest(focal_length_mm=None, sensor=custom_sensor(24.0, 18.0), fstop=5.6,
+    return solve_report(report_camera(focal_length_mm=None, sensor=custom_sensor(24.0, 18.0), fstop=5.6,
                                       focus_mm=2000.0, lens=triplet))
 
 
@@ -351,8 +353,9 @@ def test_nuke_script_quotes_paths_or_refuses_them(name):
 def tde4_fit(triplet):
     from physcam.analysis.distortion.models import fit_tde4_radial, samples_from_field
     from physcam.analysis.distortion.stmap import distortion_field
+    from physcam.optics.state import camera_state
 
-    res = distortion_field(triplet, focus_mm=2000.0, sensor_width_mm=24.0, sensor_height_mm=18.0, width_px=96,
+    res = distortion_field(camera_state(triplet, focus_mm=2000.0, sensor_mm=(24.0, 18.0)), width_px=96,
                            height_px=72, maps=False)
     return fit_tde4_radial(samples_from_field(res))
 
@@ -419,7 +422,7 @@ def test_usd_camera_reads_the_names_back_or_refuses_them(tmp_path, report, name)
     from physcam.usd.author import author_camera, new_stage, save_stage
     from physcam.usd.spec import spec_from_report
 
-    spec = dataclasses.replace(spec_from_report(report), lens_name=name, sensor_name=name)
+    spec = spec_from_report(report).replaced(lens_name=name, sensor_name=name)
     stage = new_stage()
     if _usd_refused(name):
         with pytest.raises(ExportError, match="cannot carry"):

@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from contextlib import nullcontext
 
 import pytest
 
+from physcam.errors import PhysCamWarning
 from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
 from physcam.optics.sensors import find_sensor
@@ -49,9 +51,11 @@ def test_every_consumer_writes_the_same_iris(name, mark):
     lens = load_lens(name)
     sensor = find_sensor("Super 35")
     iris = 2.0 * focusing.iris_semi_diameter(lens, N)
-    report = solve_lens_report(focal_length_mm=None, lens=lens, sensor=sensor, fstop=N, focus_mm=mark)
-    baked = bake_camera(lens, focus_mm=mark, fstop=N, sensor_width_mm=sensor.width_mm,
-                        sensor_height_mm=sensor.height_mm)
+    # the Zuiko 18 mm's strong distortion: the report says its render camera is no pinhole (PhysCamWarning)
+    strong = pytest.warns(PhysCamWarning, match="is not a pinhole") if name == "zuiko_18mm_f3_5" else nullcontext()
+    with strong:
+        report = solve_lens_report(focal_length_mm=None, lens=lens, sensor=sensor, fstop=N, focus_mm=mark)
+    baked = bake_camera(camera_state(lens, focus_mm=mark, fstop=N, sensor_mm=(sensor.width_mm, sensor.height_mm)))
     written = {
         "Blender OSL": 2.0 * baked.lens.surfaces[baked.lens.stop_index].semi_diameter,
         "analyses (MTF, PSF)": 2.0 * setup(camera_state(lens, fstop=N, focus_mm=mark)).stop_semi_diameter,

@@ -1,6 +1,8 @@
+from contextlib import nullcontext
+
 import pytest
 
-from physcam.errors import ExportError, LensFileError
+from physcam.errors import ExportError, LensFileError, PhysCamWarning
 from physcam.lens.catalog import find_glass
 from physcam.lens.formats import dumps_lens, loads_lens
 from physcam.lens.library import load_lens
@@ -146,7 +148,9 @@ def test_a_truncated_file_is_an_error_never_another_lens(slug):
     raises LensFileError or, when only lines after the image surface's data were lost, reads
     back the very same surfaces."""
     lens = load_lens(slug)
-    text = dumps_lens(lens, "zemax")
+    moving = slug == "canon_rf_85mm_f1_2"  # a .zmx holds one focus: the writer says it drops the groups
+    with pytest.warns(PhysCamWarning, match="drops the focus groups") if moving else nullcontext():
+        text = dumps_lens(lens, "zemax")
     whole = loads_lens(text, "zemax").surfaces
     lines = text.splitlines(keepends=True)
     first_surf = next(i for i, ln in enumerate(lines) if ln.startswith("SURF"))

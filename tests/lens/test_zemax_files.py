@@ -6,6 +6,7 @@ unknown glasses, truncation, .agf catalogues, --glass-catalog and the config key
 import json
 import math
 import warnings
+from contextlib import nullcontext
 from pathlib import Path
 
 import pytest
@@ -25,7 +26,10 @@ ORACLE = json.loads((DATA / "optiland_zemax.json").read_text())["lenses"]
 @pytest.mark.parametrize("name", sorted(ORACLE))
 def test_efl_bfl_fnumber_against_optiland(name):
     want = ORACLE[name]
-    lens = read_lens(DATA / "zemax" / f"{name}.zmx")
+    # two files name glasses SCHOTT no longer makes: read from the 2008 catalogue, saying so
+    legacy = name in ("double_gauss_legacy", "thorlabs_ACL3026U")
+    with pytest.warns(PhysCamWarning, match="taken from SCHOTT_LEGACY") if legacy else nullcontext():
+        lens = read_lens(DATA / "zemax" / f"{name}.zmx")
     assert lens.wavelength_nm == pytest.approx(want["wavelength_um"] * 1000.0, abs=1e-9)  # WAVM/PWAV kept
     g = gaussian(lens)
     assert g.efl == pytest.approx(want["efl_mm"], rel=1e-3)

@@ -56,10 +56,11 @@ def _blur_widths(lens, mark, fstop, light_mm):
     """(width, height) of a point light's blur on the film, 4 sqrt(second moment) per axis (the full
     width of a uniform ellipse), traced through the real lens with the iris at ``fstop``."""
     from physcam.analysis.defocus.bokeh import bokeh_image
+    from physcam.optics.state import camera_state
 
     st = focusing.focus(lens, mark)
-    img = bokeh_image(st.prescription, light_mm, film_z=st.film_z, rays=100_000, pixels=192, fresnel=False,
-                      stop_semi_diameter=focusing.iris_semi_diameter(lens, fstop))
+    cam = camera_state(st.prescription, film_z=st.film_z, stop_semi_diameter=focusing.iris_semi_diameter(lens, fstop))
+    img = bokeh_image(cam, light_mm, rays=100_000, pixels=192, fresnel=False)
     a = img.image.sum(axis=2)
     x0, x1, y0, y1 = img.extent_mm
     ys, xs = np.indices(a.shape)

@@ -41,8 +41,8 @@ def test_analyses_take_distances_with_units():
     assert focus(DGAUSS, "10ft").focus_from_film_mm == 3048.0
     assert real_distortion(DGAUSS, [10.0], focus_mm="2m").points == real_distortion(DGAUSS, [10.0],
                                                                                    focus_mm=2000.0).points
-    a = real_depth_of_field(DGAUSS, focus_mm="3m", fstop=5.6, coc_mm=0.02, grid=32)
-    b = real_depth_of_field(DGAUSS, focus_mm=3000.0, fstop=5.6, coc_mm=0.02, grid=32)
+    a = real_depth_of_field(camera_state(DGAUSS, focus_mm="3m", fstop=5.6), coc_mm=0.02, grid=32)
+    b = real_depth_of_field(camera_state(DGAUSS, focus_mm=3000.0, fstop=5.6), coc_mm=0.02, grid=32)
     assert a == b
 
 

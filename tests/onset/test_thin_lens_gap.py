@@ -32,7 +32,7 @@ def test_the_thin_lens_blur_is_the_renderers_formula():
     """A |1/d - 1/s| f_pin with d, s from the entrance pupil (Blender manual, "Depth of Field"; RenderMan's
     PxrCamera): worked from the report's numbers for dgauss_50mm at 2 m, f/2.8 and a light 1 m from the film."""
     r = _report("dgauss_50mm", 2000.0, 2.8)
-    gap = thin_lens_gap(r, load_lens("dgauss_50mm"))
+    gap = thin_lens_gap(r)
     light, thin, real, pct = gap.bokeh[0]
     assert light == 1000.0
     p = r.entrance_pupil_from_film_mm
@@ -43,7 +43,7 @@ def test_the_thin_lens_blur_is_the_renderers_formula():
 
 def test_a_well_corrected_lens_stopped_down_is_close_to_its_thin_lens():
     """dgauss_50mm at f/8: small aberrations, little distortion, so the thin lens is within a few percent."""
-    gap = thin_lens_gap(_report("dgauss_50mm", 2000.0, 8.0), load_lens("dgauss_50mm"))
+    gap = thin_lens_gap(_report("dgauss_50mm", 2000.0, 8.0))
     assert abs(gap.hfov_difference_pct) < 1.0
     assert len(gap.bokeh) == 2 and all(abs(row[3]) < 4.0 for row in gap.bokeh)
 
@@ -51,7 +51,7 @@ def test_a_well_corrected_lens_stopped_down_is_close_to_its_thin_lens():
 def test_the_wide_angle_at_close_focus_is_far_from_its_thin_lens():
     """The review's case: Zuiko 18 mm at f/4, 0.45 m. The thin lens frames narrower (distortion) and its blur
     is wrong by tens of percent (aberrations at a working aperture)."""
-    gap = thin_lens_gap(_report("zuiko_18mm_f3_5", 450.0, 4.0), load_lens("zuiko_18mm_f3_5"))
+    gap = thin_lens_gap(_report("zuiko_18mm_f3_5", 450.0, 4.0))
     assert gap.hfov_difference_pct < -3.0
     assert max(abs(row[3]) for row in gap.bokeh) > 30.0
     assert "not Zuiko 18mm f/3.5 at f/4" in gap.summary()

@@ -54,10 +54,12 @@ def test_the_analyses_take_the_state_first_and_agree_with_the_old_door():
 
     s = camera_state(DGAUSS, focus_mm=2000.0, fstop=4.0)
     a = mtf(s, 14.0, frequencies=[10, 20, 40], pupil_samples=64)
-    b = mtf(DGAUSS, 14.0, frequencies=[10, 20, 40], pupil_samples=64, fstop=4.0, focus_mm=2000.0)
+    with pytest.warns(DeprecationWarning, match=r"mtf\(lens, focus_mm=, fstop=...\) is now mtf\(camera_state"):
+        b = mtf(DGAUSS, 14.0, frequencies=[10, 20, 40], pupil_samples=64, fstop=4.0, focus_mm=2000.0)
     assert list(a.tangential) == list(b.tangential) and list(a.sagittal) == list(b.sagittal)
-    assert wavefront(s, 0.0, pupil_samples=32).rms_waves == wavefront(DGAUSS, 0.0, pupil_samples=32, fstop=4.0,
-                                                                      focus_mm=2000.0).rms_waves
+    with pytest.warns(DeprecationWarning, match=r"wavefront\(lens, focus_mm=, fstop=...\) is now"):
+        old = wavefront(DGAUSS, 0.0, pupil_samples=32, fstop=4.0, focus_mm=2000.0)
+    assert wavefront(s, 0.0, pupil_samples=32).rms_waves == old.rms_waves
     with pytest.raises(InputError, match="carries its own"):
         mtf(s, 0.0, frequencies=[10], fstop=8.0)
 

@@ -8,6 +8,7 @@ import pytest
 from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.lens.library import load_lens
 from physcam.optics import focusing, paraxial
+from physcam.optics.state import camera_state
 from physcam.trace.aperture import Aperture
 
 
@@ -29,8 +30,8 @@ def test_hexagonal_iris_gives_hexagonal_bokeh(nsides, ratio):
     st = focusing.focus(lens, 3000.0)
     stop = paraxial.stop_semi_diameter_for_fstop(st.prescription, 8.0)
     ap = Aperture(nsides=nsides, angle_deg=0.0) if nsides else None
-    res = bokeh_image(st.prescription, 600.0, film_z=st.film_z, rays=200_000, pixels=200,
-                      stop_semi_diameter=stop, aperture=ap, fresnel=False)
+    cam = camera_state(st.prescription, film_z=st.film_z, stop_semi_diameter=stop, aperture=ap)
+    res = bokeh_image(cam, 600.0, rays=200_000, pixels=200, fresnel=False)
     w, h = _extents(res.image, res.extent_mm)
     small, big = sorted((w, h))
     assert small / big == pytest.approx(ratio, abs=0.03)
@@ -40,8 +41,8 @@ def test_density_ramp_brightens_the_rim():
     lens = load_lens("dgauss_50mm")
     st = focusing.focus(lens, 3000.0)
     stop = paraxial.stop_semi_diameter_for_fstop(st.prescription, 8.0)
-    res = bokeh_image(st.prescription, 600.0, film_z=st.film_z, rays=200_000, pixels=64, stop_semi_diameter=stop,
-                      aperture=Aperture(density=0.8), fresnel=False)
+    cam = camera_state(st.prescription, film_z=st.film_z, stop_semi_diameter=stop, aperture=Aperture(density=0.8))
+    res = bokeh_image(cam, 600.0, rays=200_000, pixels=64, fresnel=False)
     img = res.image.sum(axis=2)
     ys, xs = np.indices(img.shape)
     lit = img > 0

@@ -10,6 +10,7 @@ import pytest
 from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.lens.library import load_lens
 from physcam.optics import focusing
+from physcam.optics.state import camera_state
 
 
 def _scene():
@@ -19,8 +20,9 @@ def _scene():
 
 def test_error_is_well_below_the_poisson_noise_of_random_rays():
     lens, film_z = _scene()
-    ref = bokeh_image(lens, 1000.0, film_z=film_z, rays=4_000_000, pixels=64, seed=99)
-    img = bokeh_image(lens, 1000.0, film_z=film_z, rays=100_000, pixels=64, extent_mm=ref.extent_mm, seed=3)
+    cam = camera_state(lens, film_z=film_z)
+    ref = bokeh_image(cam, 1000.0, rays=4_000_000, pixels=64, seed=99)
+    img = bokeh_image(cam, 1000.0, rays=100_000, pixels=64, extent_mm=ref.extent_mm, seed=3)
     R, I = ref.image[..., 0], img.image[..., 0]
     lit = R > 0.2 * R.max()
     # rays per lit pixel, hence the relative RMS error 1/sqrt(lambda) random rays would have
@@ -34,8 +36,9 @@ def test_error_is_well_below_the_poisson_noise_of_random_rays():
 
 def test_the_picture_does_not_depend_on_the_chunk_size():
     lens, film_z = _scene()
-    a = bokeh_image(lens, 1000.0, 2.0, -1.0, film_z=film_z, rays=30_000, chunk=7_000, pixels=32, spectral=True)
-    b = bokeh_image(lens, 1000.0, 2.0, -1.0, film_z=film_z, rays=30_000, chunk=30_000, pixels=32, spectral=True)
+    cam = camera_state(lens, film_z=film_z)
+    a = bokeh_image(cam, 1000.0, 2.0, -1.0, rays=30_000, chunk=7_000, pixels=32, spectral=True)
+    b = bokeh_image(cam, 1000.0, 2.0, -1.0, rays=30_000, chunk=30_000, pixels=32, spectral=True)
     assert a.extent_mm == b.extent_mm and a.rays_passed == b.rays_passed
     np.testing.assert_allclose(a.image, b.image, rtol=1e-12, atol=1e-300)
 
@@ -44,7 +47,7 @@ def test_spectral_rays_split_evenly_between_the_wavelengths():
     # ray i goes to wavelength i mod 3, each wavelength with its own Sobol sequence: with no
     # colour-dependent losses to speak of on the axis, each channel gets a third of the flux
     lens, film_z = _scene()
-    img = bokeh_image(lens, 1000.0, film_z=film_z, rays=30_000, pixels=32, spectral=True, fresnel=False)
+    img = bokeh_image(camera_state(lens, film_z=film_z), 1000.0, rays=30_000, pixels=32, spectral=True, fresnel=False)
     share = img.image.sum(axis=(0, 1)) / img.image.sum()
     np.testing.assert_allclose(share, 1 / 3, atol=2e-3)
 
@@ -65,7 +68,7 @@ def test_flux_agrees_with_independent_random_rays():
 
     lens, film_z = _scene()
     depth, x_l = 1000.0, 150.0
-    img = bokeh_image(lens, depth, x_l, film_z=film_z, rays=250_000, pixels=64)
+    img = bokeh_image(camera_state(lens, film_z=film_z), depth, x_l, rays=250_000, pixels=64)
     rng = np.random.default_rng(11)
     n = 2_000_000
     z_src = film_z - depth

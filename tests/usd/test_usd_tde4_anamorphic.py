@@ -66,6 +66,7 @@ def _attrs(prim, degree):
 def test_the_stored_model_reproduces_the_traced_field(stage, degree, max_px):
     from physcam.analysis.distortion.models import samples_from_field
     from physcam.analysis.distortion.stmap import distortion_field
+    from physcam.optics.state import camera_state
     from physcam.lens.library import load_lens
 
     assert validation_errors(stage) == []
@@ -77,8 +78,8 @@ def test_the_stored_model_reproduces_the_traced_field(stage, degree, max_px):
     assert attrs["pixelAspect"] == pytest.approx(fy / fx, rel=1e-5)  # 2.0 at 3 m, the desqueezed pinhole round
     assert tuple(attrs["filmback"]) == pytest.approx((W * fy / fx, H), rel=1e-5)
     # the traced chief rays, on a 4096-pixel-wide plate of the same frame
-    s = samples_from_field(distortion_field(load_lens(SLUG), focus_mm=3000.0, sensor_width_mm=W, sensor_height_mm=H,
-                                            width_px=512, height_px=384, maps=False))
+    cam = camera_state(load_lens(SLUG), focus_mm=3000.0, sensor_mm=(W, H))
+    s = samples_from_field(distortion_field(cam, width_px=512, height_px=384, maps=False))
     got = _published_undistort(attrs, degree, s.distorted_mm)
     err_px = np.hypot(*((got - s.undistorted_mm) * (4096 / W)).T)
     assert err_px.max() < max_px

@@ -21,14 +21,18 @@ from physcam.analysis.defocus.cache import STACK_GLOB
 from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
 from physcam.errors import PhysCamWarning
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
+from physcam.data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM
+
+SENSOR_MM = (36.0, DEFAULT_SENSOR_HEIGHT_MM)  # 36 mm wide imaged on the width; the height is not used
 
 W, H = 160, 90
 
 
 @pytest.fixture(scope="module")
 def cam():
-    return defocus_camera(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_width_mm=36.0, width=W,
-                          height=H, tile=32)
+    return defocus_camera(camera_state(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_mm=SENSOR_MM),
+                          width=W, height=H, tile=32)
 
 
 def _moments(k):
@@ -228,8 +232,8 @@ def test_bright_spot_near_focus_matches_kernels_traced_at_its_corners(blur_px):
     small aberrated kernel turns with the azimuth: before the fix its blend of four field nodes'
     kernels missed the traced one by 10-30 % of the peak (measured: 16.5 % at 2K in the benchmark)."""
     w, h = 512, 270
-    cam = defocus_camera(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_width_mm=36.0, width=w,
-                         height=h, tile=32)
+    cam = defocus_camera(camera_state(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_mm=SENSOR_MM),
+                         width=w, height=h, tile=32)
     img = np.zeros((h, w, 1), np.float32)
     x, y = int(0.62 * w), int(0.3 * h)
     img[y, x] = 100.0
@@ -252,9 +256,10 @@ def test_a_bladed_iris_blurs_as_the_round_iris_of_its_f_number():
     from physcam.trace.aperture import Aperture
 
     lens = load_lens("dgauss_50mm")
-    kw = dict(focus_mm=2000.0, fstop=2.8, sensor_width_mm=36.0, width=320, height=180, tile=32)
-    rnd = defocus_camera(lens, **kw)
-    hexa = defocus_camera(lens, aperture=Aperture(6), **kw)
+    kw = dict(width=320, height=180, tile=32)
+    state = camera_state(lens, focus_mm=2000.0, fstop=2.8, sensor_mm=SENSOR_MM)
+    rnd = defocus_camera(state, **kw)
+    hexa = defocus_camera(state, aperture=Aperture(6), **kw)
     assert hexa.stop_semi / rnd.stop_semi == pytest.approx(math.sqrt(math.pi / (3 * math.sin(math.pi / 3))), rel=1e-6)
     point = [(160.0, 90.0, 500.0)]  # on the axis, 0.5 m from the pupil: a blur about 12 px across
     radii = []

@@ -14,6 +14,7 @@ from physcam.lens.library import load_lens
 from physcam.onset.report import solve_lens_report
 from physcam.optics.sensors import find_sensor
 from physcam.optics import focusing
+from physcam.optics.state import camera_state
 
 from _image_quality import perfect_lens
 
@@ -25,8 +26,9 @@ def _brute_force_blur(lens, mark, fstop, light_mm, fraction=None, film_shift=0.0
     element, a histogram on the film; nothing shared with the real-DOF code but the tracer): the
     second-moment diameter sqrt(8 E[r^2]), or the diameter holding ``fraction`` of the light."""
     st = focusing.focus(lens, mark)
-    img = bokeh_image(st.prescription, light_mm, film_z=st.film_z + film_shift, rays=400_000, pixels=512, fresnel=False,
-                      stop_semi_diameter=focusing.iris_semi_diameter(lens, fstop))
+    cam = camera_state(st.prescription, film_z=st.film_z + film_shift,
+                       stop_semi_diameter=focusing.iris_semi_diameter(lens, fstop))
+    img = bokeh_image(cam, light_mm, rays=400_000, pixels=512, fresnel=False)
     a = img.image.sum(axis=2)
     x0, x1, y0, y1 = img.extent_mm
     ys, xs = np.indices(a.shape)
@@ -51,7 +53,7 @@ def test_at_the_real_limits_the_traced_blur_is_the_coc(measure, fraction):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         r = solve_lens_report(focal_length_mm=None, lens=lens, sensor=S35, fstop=2.8, focus_mm=3000.0)
-    d = real_depth_of_field(lens, focus_mm=3000.0, fstop=2.8, coc_mm=r.coc_mm, measure=measure,
+    d = real_depth_of_field(camera_state(lens, focus_mm=3000.0, fstop=2.8), coc_mm=r.coc_mm, measure=measure,
                             energy_fraction=fraction or 0.8)
     assert d.near_from_film_mm < d.sharpest_from_film_mm < d.far_from_film_mm
     for limit in (d.near_from_film_mm, d.far_from_film_mm):  # the film where the collimated lens has it
@@ -59,7 +61,7 @@ def test_at_the_real_limits_the_traced_blur_is_the_coc(measure, fraction):
                                                                                                       rel=0.03)
     # the blur at the sharpest distance is below the CoC, and the same by both computations
     assert d.sharpest_blur_mm < r.coc_mm
-    assert blur_diameter_mm(lens, d.near_from_film_mm, focus_mm=3000.0, fstop=2.8, measure=measure,
+    assert blur_diameter_mm(camera_state(lens, focus_mm=3000.0, fstop=2.8), d.near_from_film_mm, measure=measure,
                             energy_fraction=fraction or 0.8, film_shift_mm=d.film_shift_mm,
                             grid=d.pupil_grid) == pytest.approx(r.coc_mm, rel=1e-3)
 
@@ -72,7 +74,7 @@ def test_a_nearly_perfect_slow_lens_has_the_models_depth_of_field():
         warnings.simplefilter("ignore")
         r = solve_lens_report(focal_length_mm=None, lens=lens, sensor=find_sensor("FF"), fstop=22.0, focus_mm=2000.0,
                               coc=0.03)
-    d = real_depth_of_field(lens, focus_mm=2000.0, fstop=22.0, coc_mm=0.03, measure="moment")
+    d = real_depth_of_field(camera_state(lens, focus_mm=2000.0, fstop=22.0), coc_mm=0.03, measure="moment")
     assert d.near_from_film_mm == pytest.approx(r.dof.near_from_film_mm, rel=0.01)
     assert d.far_from_film_mm == pytest.approx(r.dof.far_from_film_mm, rel=0.01)
 
@@ -81,4 +83,4 @@ def test_a_blur_larger_than_the_coc_everywhere_is_said_plainly():
     from physcam.errors import OpticsError
 
     with pytest.raises(OpticsError, match="no depth of field"):
-        real_depth_of_field(load_lens("dgauss_50mm"), focus_mm=3000.0, fstop=2.8, coc_mm=0.001)
+        real_depth_of_field(camera_state(load_lens("dgauss_50mm"), focus_mm=3000.0, fstop=2.8), coc_mm=0.001)

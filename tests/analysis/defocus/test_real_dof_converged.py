@@ -25,6 +25,7 @@ from physcam.cli import main
 from physcam.lens.library import load_lens
 from physcam.optics import focusing as focusing_mod
 from physcam.optics.paraxial import gaussian
+from physcam.optics.state import camera_state
 from physcam.trace import RayBatch, trace_to_film
 
 pytestmark = pytest.mark.slow
@@ -76,7 +77,8 @@ def _limit(lens, mark, fstop, inside_mm, outside_mm, film_shift=0.0):
 
 def test_distagon_near_limit_converges_to_the_independent_trace():
     lens = load_lens("zeiss_distagon_35mm_f4")
-    d = real_depth_of_field(lens, focus_mm=2000.0, fstop=4.0, coc_mm=S35_COC, measure="energy", focusing="paraxial")
+    d = real_depth_of_field(camera_state(lens, focus_mm=2000.0, fstop=4.0), coc_mm=S35_COC, measure="energy",
+                            focusing="paraxial")
     assert d.converged and d.pupil_grid > 32
     near = _limit(lens, 2000.0, 4.0, 2000.0, 1700.0)
     far = _limit(lens, 2000.0, 4.0, 2100.0, 2600.0)
@@ -87,7 +89,7 @@ def test_distagon_near_limit_converges_to_the_independent_trace():
 
 def test_collimated_lens_is_sharpest_at_its_mark():
     lens = load_lens("dgauss_50mm")
-    d = real_depth_of_field(lens, focus_mm=3000.0, fstop=2.8, coc_mm=S35_COC, measure="energy")
+    d = real_depth_of_field(camera_state(lens, focus_mm=3000.0, fstop=2.8), coc_mm=S35_COC, measure="energy")
     assert d.focusing == "collimated"
     assert d.sharpest_from_film_mm == pytest.approx(3000.0, rel=2e-3)
     assert d.near_from_film_mm < 3000.0 < d.far_from_film_mm  # paraxially it read 2.601-2.976 m

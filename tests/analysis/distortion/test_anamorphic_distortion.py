@@ -19,6 +19,7 @@ from physcam.analysis.distortion.anamorphic import (TDE4Anamorphic, fit_tde4_ana
 from physcam.analysis.distortion.models import samples_from_field
 from physcam.analysis.distortion.stmap import distortion_field
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 
 #: sensors each lens covers (mm); the fit is traced at 1024 px wide, residuals scaled to 4096 px
 SENSORS = {"navarro_anamorphic_2x": (24.89, 18.66), "neil_front_anamorphic_2x": (18.0, 13.5),
@@ -28,7 +29,7 @@ TO_4K = 4096 / 1024
 
 def _samples(slug, focus):
     w, h = SENSORS[slug]
-    res = distortion_field(load_lens(slug), focus_mm=focus, sensor_width_mm=w, sensor_height_mm=h,
+    res = distortion_field(camera_state(load_lens(slug), focus_mm=focus, sensor_mm=(w, h)),
                            width_px=1024, height_px=round(1024 * h / w), maps=False)
     return samples_from_field(res)
 

@@ -25,6 +25,7 @@ import pytest
 from physcam.analysis.distortion.field import real_distortion
 from physcam.analysis.lens_cards.card import _distortion, _QUALITY
 from physcam.lens.library import list_lenses, load_lens
+from physcam.optics.state import camera_state
 
 from _forward_chief import forward_chief_marching
 
@@ -127,8 +128,8 @@ def test_stmap_field_agrees_with_the_card(slug, focus_mm):
     lens = load_lens(slug)
     res = _card_curve(lens, focus_mm)
     w_px, h_px = 1024, 768
-    fld = distortion_field(lens, focus_mm=focus_mm, sensor_width_mm=SENSOR[0], sensor_height_mm=SENSOR[1],
-                           width_px=w_px, height_px=h_px, maps=False)
+    fld = distortion_field(camera_state(lens, focus_mm=focus_mm, sensor_mm=SENSOR), width_px=w_px, height_px=h_px,
+                           maps=False)
     sx, sy = w_px / SENSOR[0], h_px / SENSOR[1]
     for p in res.points:
         if p.real_height_mm == 0 or p.real_height_mm > SENSOR[1 if p.axis == "y" else 0] / 2:

@@ -17,6 +17,7 @@ from physcam.analysis.distortion.models import (
 from physcam.analysis.distortion.stmap import distortion_field
 from physcam.errors import ExportError, PhysCamError
 from physcam.lens.library import load_lens
+from physcam.optics.state import as_designed, camera_state
 
 from _forward_chief import ideal_grid_and_real
 
@@ -119,8 +120,8 @@ def test_fitting_recovers_a_known_brown_conrady_model(k1, k2, k3, p1, p2, direct
 @pytest.fixture(scope="module")
 def distagon():
     lens = load_lens("zeiss_distagon_35mm_f4")
-    res = distortion_field(lens, focus_mm=FOCUS, sensor_width_mm=SENSOR[0], sensor_height_mm=SENSOR[1],
-                           width_px=W_PX, height_px=H_PX, maps=False)
+    res = distortion_field(camera_state(lens, focus_mm=FOCUS, sensor_mm=SENSOR), width_px=W_PX, height_px=H_PX,
+                           maps=False)
     return lens, res, fit_models(samples_from_field(res), ("brown", "3de4", "usd"))
 
 
@@ -146,7 +147,7 @@ def test_usd_fit_agrees_with_the_radial_fit_of_the_field_angle_table():
     from physcam.analysis.distortion.field import real_distortion
 
     lens = load_lens("dgauss_50mm")
-    res = distortion_field(lens, sensor_width_mm=36, sensor_height_mm=24, width_px=W_PX, height_px=H_PX, maps=False)
+    res = distortion_field(as_designed(lens, sensor_mm=(36, 24)), width_px=W_PX, height_px=H_PX, maps=False)
     usd = fit_usd_standard(samples_from_field(res))
     radial = real_distortion(lens, sensor_width_mm=36.0, sensor_height_mm=24.0).fit
     r = np.linspace(0.5, 21.6, 40)
@@ -160,7 +161,7 @@ def test_a_wide_lens_is_not_called_a_good_fit_and_is_not_exported(tmp_path):
     from physcam.export.tde4 import tde4_lens_text
 
     lens = load_lens("zuiko_18mm_f3_5")
-    res = distortion_field(lens, focus_mm=FOCUS, sensor_width_mm=36, sensor_height_mm=24, width_px=W_PX,
+    res = distortion_field(camera_state(lens, focus_mm=FOCUS, sensor_mm=(36, 24)), width_px=W_PX,
                            height_px=H_PX, maps=False)
     fit = fit_tde4_radial(samples_from_field(res))
     assert not fit.acceptable and fit.max_residual_px > 0.5
@@ -198,7 +199,7 @@ def test_3de4_lens_file_reads_back_as_3de_reads_it():
     from physcam.export.tde4 import tde4_lens_text
 
     lens = load_lens("dgauss_50mm")
-    res = distortion_field(lens, focus_mm=FOCUS, sensor_width_mm=36, sensor_height_mm=24, width_px=W_PX,
+    res = distortion_field(camera_state(lens, focus_mm=FOCUS, sensor_mm=(36, 24)), width_px=W_PX,
                            height_px=H_PX, maps=False)
     fit = fit_tde4_radial(samples_from_field(res))
     assert fit.acceptable
@@ -248,8 +249,7 @@ def test_anamorphic_lens_gets_maps_and_a_3de4_cylindric_fit():
 
     lens = load_lens("navarro_anamorphic_2x")
     sensor, size, focus_mm = (24.9, 18.7), (1536, 1152), 3000.0
-    res = distortion_field(lens, focus_mm=focus_mm, sensor_width_mm=sensor[0], sensor_height_mm=sensor[1],
-                           width_px=size[0], height_px=size[1])
+    res = distortion_field(camera_state(lens, focus_mm=focus_mm, sensor_mm=sensor), width_px=size[0], height_px=size[1])
     fx, fy = res.pinhole_focal_length_mm
     assert fy / fx == pytest.approx(1.96, abs=0.05)  # the squeeze, per meridian
     ideal, real = ideal_grid_and_real(lens, focus_mm, sensor, size, margin=(30, 25))
@@ -284,8 +284,8 @@ def test_bad_fit_inputs_are_clear_errors(distagon):
 def test_a_fisheye_on_a_large_sensor_is_refused_not_mapped():
     """The Nikkor 16 mm fisheye covers 180 degrees on 36 x 24: a pinhole cannot hold the frame's corners."""
     with pytest.raises(PhysCamError, match="fisheye"):
-        distortion_field(load_lens("nikkor_fisheye_16mm_f2_8"), focus_mm=FOCUS, sensor_width_mm=36,
-                         sensor_height_mm=24, width_px=512, height_px=342, maps=False)
+        distortion_field(camera_state(load_lens("nikkor_fisheye_16mm_f2_8"), focus_mm=FOCUS, sensor_mm=(36, 24)),
+                         width_px=512, height_px=342, maps=False)
 
 
 def test_opentrackio_entry_is_the_same_map_in_millimetres_y_down():
@@ -319,7 +319,7 @@ def test_distortions_opentrackio_block_reads_right_in_camdkit_and_unreal(reader)
 
     lens = load_lens("dgauss_50mm")
     w, h, W = 24.89, 18.66, 4096
-    field = distortion_field(lens, focus_mm=2000.0, sensor_width_mm=w, sensor_height_mm=h, width_px=W,
+    field = distortion_field(camera_state(lens, focus_mm=2000.0, sensor_mm=(w, h)), width_px=W,
                              height_px=round(W * h / w), maps=False)
     fits = [fit_brown_conrady(samples_from_field(field), d, max_residual_px=math.inf) for d in ("D-U", "U-D")]
     block = brown_conrady_document("dgauss_50mm", fits)["opentrackio_lens_distortion"]

@@ -15,6 +15,7 @@ import pytest
 
 from physcam.errors import PhysCamError
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 from _forward_chief import ideal_grid_and_real
 
 W_PX, H_PX = 2048, 1366
@@ -38,8 +39,7 @@ def case(request):
     from physcam.analysis.distortion.stmap import distortion_field
 
     lens = load_lens(request.param)
-    res = distortion_field(lens, focus_mm=FOCUS, sensor_width_mm=SENSOR[0], sensor_height_mm=SENSOR[1],
-                           width_px=W_PX, height_px=H_PX)
+    res = distortion_field(camera_state(lens, focus_mm=FOCUS, sensor_mm=SENSOR), width_px=W_PX, height_px=H_PX)
     return lens, res
 
 
@@ -156,7 +156,8 @@ def test_exr_files_open_as_float_rgb(tmp_path, case):
 def test_bad_inputs_are_one_clear_error(kw):
     from physcam.analysis.distortion.stmap import distortion_field
 
+    kw = dict(kw)
+    focus_mm = kw.pop("focus_mm", 2000.0)
     with pytest.raises(PhysCamError) as e:
-        distortion_field(load_lens("zeiss_distagon_35mm_f4"), sensor_width_mm=36, sensor_height_mm=24,
-                         **{"focus_mm": 2000.0, **kw})
+        distortion_field(camera_state(load_lens("zeiss_distagon_35mm_f4"), focus_mm=focus_mm, sensor_mm=(36, 24)), **kw)
     assert str(e.value).strip().endswith((".", ")")) or len(str(e.value)) > 20

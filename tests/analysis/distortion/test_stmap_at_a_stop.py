@@ -19,6 +19,7 @@ from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.analysis.distortion.stmap import distortion_field
 from physcam.lens.library import load_lens
 from physcam.optics import focusing, paraxial
+from physcam.optics.state import camera_state
 
 W_MM, H_MM, W_PX, H_PX = 24.89, 18.66, 2048, 1535
 MARK, N = 450.0, 4.0
@@ -29,6 +30,7 @@ def _markers(lens):
     st = focusing.focus(lens, MARK)
     g = {a: paraxial.gaussian(st.prescription, axis=a, object_z=st.object_z, film_z=st.film_z) for a in "xy"}
     iris = focusing.iris_semi_diameter(lens, N)
+    cam = camera_state(st.prescription, film_z=st.film_z, stop_semi_diameter=iris)
     sx, sy = W_PX / W_MM, H_PX / H_MM
     out = []
     for fx in (0.1, 0.3, 0.5, 0.7, 0.9):
@@ -37,8 +39,7 @@ def _markers(lens):
             # the object point the pinhole at the entrance pupil puts there (upright picture: +X right)
             X = (ideal[0] - W_PX / 2) / sx / g["x"].pinhole_focal_length * (g["x"].z_entrance_pupil - st.object_z)
             Y = (ideal[1] - H_PX / 2) / sy / g["y"].pinhole_focal_length * (g["y"].z_entrance_pupil - st.object_z)
-            img = bokeh_image(st.prescription, MARK, X, Y, film_z=st.film_z, rays=60_000, pixels=384, fresnel=False,
-                              stop_semi_diameter=iris)
+            img = bokeh_image(cam, MARK, X, Y, rays=60_000, pixels=384, fresnel=False)
             cx, cy = img.to_dict()["centroid_mm"]
             real = np.array([-cx * sx + W_PX / 2, -cy * sy + H_PX / 2])  # the film image turned by 180 degrees
             out.append((ideal, real))

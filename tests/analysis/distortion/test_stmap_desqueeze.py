@@ -20,6 +20,7 @@ from _forward_chief import ideal_grid_and_real
 from physcam.analysis.distortion.stmap import distortion_field
 from physcam.cli import main
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 
 LENS = "neil_front_anamorphic_2x"
 SENSOR = (18.0, 13.5)  # 4:3, square plate pixels: 640 / 18 = 480 / 13.5 px per mm
@@ -29,7 +30,7 @@ FOCUS = 3000.0
 
 @pytest.fixture(scope="module")
 def field():
-    return distortion_field(load_lens(LENS), focus_mm=FOCUS, sensor_width_mm=SENSOR[0], sensor_height_mm=SENSOR[1],
+    return distortion_field(camera_state(load_lens(LENS), focus_mm=FOCUS, sensor_mm=SENSOR),
                             width_px=W, height_px=H, desqueeze=True)
 
 
@@ -68,7 +69,7 @@ def test_each_desqueezed_pixel_takes_the_plate_from_its_forward_traced_chief_ray
 
 
 def test_a_spherical_lens_is_its_own_desqueezed_picture():
-    res = distortion_field(load_lens("dgauss_50mm"), focus_mm=FOCUS, sensor_width_mm=36.0, sensor_height_mm=24.0,
+    res = distortion_field(camera_state(load_lens("dgauss_50mm"), focus_mm=FOCUS, sensor_mm=(36.0, 24.0)),
                            width_px=96, height_px=64, desqueeze=True)
     assert res.frame_px == (96, 64)
     assert any("not anamorphic" in n for n in res.notes)

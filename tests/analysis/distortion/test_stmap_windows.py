@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 from _forward_chief import ideal_grid_and_real
 
 oiio = pytest.importorskip("OpenImageIO", reason="OpenImageIO (pip openimageio, the test extra) is not installed")
@@ -57,8 +58,7 @@ def maps(tmp_path_factory):
     from physcam.analysis.distortion.stmap import distortion_field, write_stmaps
 
     lens = load_lens("zeiss_distagon_35mm_f4")
-    res = distortion_field(lens, focus_mm=FOCUS, sensor_width_mm=SENSOR[0], sensor_height_mm=SENSOR[1],
-                           width_px=W_PX, height_px=H_PX)
+    res = distortion_field(camera_state(lens, focus_mm=FOCUS, sensor_mm=SENSOR), width_px=W_PX, height_px=H_PX)
     folder = tmp_path_factory.mktemp("maps")
     write_stmaps(res, folder)
     return lens, res, folder

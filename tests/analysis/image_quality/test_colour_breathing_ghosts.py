@@ -13,6 +13,7 @@ from physcam.errors import InputError, OpticsError
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import breathing_table
 from physcam.optics.glass import LINE_C_NM, LINE_F_NM, refractive_index
+from physcam.optics.state import camera_state
 from physcam.trace import RayBatch, trace_to_film
 
 from _analysis_lenses import N_BK7, plano_convex, plate
@@ -99,7 +100,7 @@ def _fresnel_rsp(theta, n):
 
 
 def test_plate_ghost_normal_incidence():
-    res = ghost_analysis(plate(), 0.0, film_z=60.0, rank_rays=2000)
+    res = ghost_analysis(camera_state(plate(), film_z=60.0), 0.0, rank_rays=2000)
     assert [(p.i, p.j) for p in res.paths] == [(2, 1)]
     R = ((1.5 - 1) / (1.5 + 1)) ** 2
     assert res.paths[0].relative_flux == pytest.approx(R * R, rel=1e-12)  # T R R T / (T T)

@@ -13,6 +13,7 @@ import pytest
 from physcam.analysis.image_quality.mtf import diffraction_limited_mtf, geometric_mtf, mtf, through_focus_mtf
 from physcam.analysis.image_quality.psf import psf
 from physcam.analysis.image_quality.wavefront import noll_indices, wavefront, zernike_noll
+from physcam.optics.state import as_designed
 from physcam.trace.aperture import Aperture
 
 from _image_quality import (F_MM, defocus_opd_exact, defocus_otf, disk_mtf, perfect_lens, reference_sine, sin_u,
@@ -37,12 +38,12 @@ def _exit_pupil_to_focus():
 
 @pytest.mark.parametrize("fstop", [8.0, 16.0])
 def test_perfect_lens_gives_the_textbook_mtf(fstop):
-    wf = wavefront(LENS, 0.0, wavelength_nm=WL, fstop=fstop)
+    wf = wavefront(as_designed(LENS, fstop=fstop), 0.0, wavelength_nm=WL)
     assert np.abs(wf.opd_waves).max() < 1e-6  # stigmatic: every ray through F
     h = F_MM / (2 * fstop)  # the entrance pupil (the stop) radius
     cutoff_real = 2 * float(sin_u(h)) / LAM_MM  # 2 NA' / lambda with the real marginal ray
     nu = np.linspace(0.0, cutoff_real, 41)
-    m = mtf(LENS, 0.0, frequencies=nu, wavelengths_nm=[WL], fstop=fstop)
+    m = mtf(as_designed(LENS, fstop=fstop), 0.0, frequencies=nu, wavelengths_nm=[WL])
     ref = textbook_mtf(nu / cutoff_real)
     assert np.abs(m.tangential - ref).max() < 0.005
     assert np.abs(m.sagittal - ref).max() < 0.005
@@ -54,7 +55,7 @@ def test_perfect_lens_gives_the_textbook_mtf(fstop):
     assert np.allclose(m.diffraction_limit_tangential, m.tangential, atol=1e-9)
     assert m.cutoff_tangential_lpmm == pytest.approx(cutoff_real, rel=0.01)
     # Strehl of a perfect pupil
-    assert psf(LENS, 0.0, wavelength_nm=WL, fstop=fstop).strehl == pytest.approx(1.0, abs=1e-3)
+    assert psf(as_designed(LENS, fstop=fstop), 0.0, wavelength_nm=WL).strehl == pytest.approx(1.0, abs=1e-3)
 
 
 def test_diffraction_limited_mtf_closed_form():
@@ -78,7 +79,7 @@ def _defocus_for(w20_waves, fstop):
 def test_pure_defocus_opd_is_the_closed_form():
     fstop = 16.0
     dz = _defocus_for(0.5, fstop)
-    wf = wavefront(LENS, 0.0, wavelength_nm=WL, fstop=fstop, defocus_mm=dz)
+    wf = wavefront(as_designed(LENS, fstop=fstop), 0.0, wavelength_nm=WL, defocus_mm=dz)
     h = np.hypot(wf.x, wf.y) * F_MM / (2 * fstop)  # entrance heights (the stop is the entrance pupil)
     R = _exit_pupil_to_focus()
     expected = defocus_opd_exact(sin_u(h), R, dz) / LAM_MM
@@ -102,7 +103,7 @@ def test_pure_defocus_mtf_matches_hopkins(w20):
     dz = _defocus_for(w20, fstop)
     cutoff = _cutoff_at(fstop, dz)
     nu = np.linspace(0.0, 0.96 * cutoff, 13)
-    m = mtf(LENS, 0.0, frequencies=nu, wavelengths_nm=[WL], fstop=fstop, defocus_mm=dz)
+    m = mtf(as_designed(LENS, fstop=fstop), 0.0, frequencies=nu, wavelengths_nm=[WL], defocus_mm=dz)
     ref = np.array([abs(defocus_otf(v / cutoff, w20)) for v in nu])
     assert np.abs(m.tangential - ref).max() < 0.005
     assert np.abs(m.sagittal - ref).max() < 0.005
@@ -111,7 +112,7 @@ def test_pure_defocus_mtf_matches_hopkins(w20):
 @pytest.mark.parametrize("w20", [0.1, 0.5])
 def test_pure_defocus_strehl_exact_and_marechal(w20):
     fstop = 16.0
-    p = psf(LENS, 0.0, wavelength_nm=WL, fstop=fstop, defocus_mm=_defocus_for(w20, fstop))
+    p = psf(as_designed(LENS, fstop=fstop), 0.0, wavelength_nm=WL, defocus_mm=_defocus_for(w20, fstop))
     assert p.strehl == pytest.approx(strehl_defocus(w20), abs=0.005)
     if w20 <= 0.1:  # Marechal: exp(-(2 pi sigma)^2), sigma = W20 / sqrt(12)
         assert p.strehl == pytest.approx(math.exp(-(2 * math.pi * w20 / math.sqrt(12)) ** 2), abs=0.003)
@@ -122,7 +123,7 @@ def test_through_focus_is_defocus_at_each_film_position():
     dzs = [-_defocus_for(0.5, fstop), 0.0, _defocus_for(0.25, fstop), _defocus_for(0.5, fstop)]
     cutoff = 2 * float(sin_u(F_MM / (2 * fstop))) / LAM_MM
     freqs = [0.1 * cutoff, 0.3 * cutoff]
-    tf = through_focus_mtf(LENS, 0.0, freqs, defocus_mm=dzs, wavelengths_nm=[WL], fstop=fstop)
+    tf = through_focus_mtf(as_designed(LENS, fstop=fstop), 0.0, freqs, defocus_mm=dzs, wavelengths_nm=[WL])
     for j, dz in enumerate(dzs):
         # the film in front of the focus (dz < 0) gives negative defocus of the same size
         w20 = float(defocus_opd_exact(sin_u(F_MM / (2 * fstop)), _exit_pupil_to_focus(), dz)) / LAM_MM
@@ -139,7 +140,7 @@ def test_polychromatic_mtf_of_a_perfect_lens_is_the_weighted_sum():
     wls, wts = [450.0, 550.0, 650.0], [1.0, 2.0, 1.0]
     s = float(sin_u(F_MM / (2 * fstop)))
     nu = np.linspace(0.0, 2 * s / (650e-6), 21)
-    m = mtf(LENS, 0.0, frequencies=nu, wavelengths_nm=wls, weights=wts, fstop=fstop)
+    m = mtf(as_designed(LENS, fstop=fstop), 0.0, frequencies=nu, wavelengths_nm=wls, weights=wts)
     ref = sum(w * textbook_mtf(nu * (lam * 1e-6) / (2 * s)) for lam, w in zip(wls, wts)) / sum(wts)
     assert np.abs(m.tangential - ref).max() < 0.005
 
@@ -152,7 +153,8 @@ def test_geometric_mtf_of_a_large_defocus_is_a_uniform_disk():
     radius = dz * s / math.sqrt(1 - s * s)  # the marginal ray dz past F
     first_zero = 3.8317 / (2 * math.pi * radius)
     nu = np.linspace(0.0, 1.6 * first_zero, 21)
-    g = geometric_mtf(LENS, 0.0, frequencies=nu, wavelengths_nm=[WL], fstop=fstop, defocus_mm=dz, pupil_samples=128)
+    g = geometric_mtf(as_designed(LENS, fstop=fstop), 0.0, frequencies=nu, wavelengths_nm=[WL], defocus_mm=dz,
+                      pupil_samples=128)
     ref = disk_mtf(nu, radius)
     assert np.abs(g.tangential - ref).max() < 0.01
     assert np.abs(g.sagittal - ref).max() < 0.01
@@ -163,11 +165,11 @@ def test_hexagonal_iris_sets_the_pupil_shape():
     # radius R has area (3 sqrt 3 / 2) R^2, so its corners lie sqrt(2 pi / (3 sqrt 3)) = 1.0996 round
     # radii out and it lights the whole of the round pupil's area (inscribed in the round iris, the old
     # convention, it lit 0.827 of it)
-    wf = wavefront(LENS, 0.0, wavelength_nm=WL, fstop=16.0, aperture=Aperture(nsides=6))
+    wf = wavefront(as_designed(LENS, fstop=16.0, aperture=Aperture(nsides=6)), 0.0, wavelength_nm=WL)
     assert wf.lit_fraction == pytest.approx(1.0, abs=0.004)
     # along x a vertex reaches the corner radius, along y the flats sit at cos 30 of it: the tangential
     # cut-off is 0.866 of the sagittal one
-    m = mtf(LENS, 0.0, wavelengths_nm=[WL], fstop=16.0, aperture=Aperture(nsides=6))
+    m = mtf(as_designed(LENS, fstop=16.0, aperture=Aperture(nsides=6)), 0.0, wavelengths_nm=[WL])
     assert m.cutoff_tangential_lpmm / m.cutoff_sagittal_lpmm == pytest.approx(math.cos(math.pi / 6), abs=0.01)
 
 

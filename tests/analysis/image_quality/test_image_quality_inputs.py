@@ -16,6 +16,7 @@ from physcam.analysis.image_quality.wavefront import noll_indices, wavefront
 from physcam.errors import InputError, OpticsError, PhysCamError
 from physcam.lens.library import load_lens
 from physcam.lens.prescription import LensMetadata, Medium, Prescription, Surface
+from physcam.optics.state import as_designed
 
 DGAUSS = load_lens("dgauss_50mm")
 
@@ -34,16 +35,16 @@ def window_lens():
 def test_pupil_sampling_too_coarse_for_the_frequency():
     # at f/2.8 one cell of a 16-cell grid spans ~42 lp/mm: 2 lp/mm would be read inside one cell
     with pytest.raises(InputError, match=r"too coarse.*lp/mm.*use at least \d+ pupil samples"):
-        mtf(DGAUSS, 0.0, frequencies=[2.0], fstop=2.8, pupil_samples=16)
+        mtf(as_designed(DGAUSS, fstop=2.8), 0.0, frequencies=[2.0], pupil_samples=16)
     # left to itself the grid grows until it is fine enough
-    m = mtf(DGAUSS, 0.0, frequencies=[2.0], fstop=2.8)
+    m = mtf(as_designed(DGAUSS, fstop=2.8), 0.0, frequencies=[2.0])
     assert m.pupil_samples >= 184 and 0.99 < m.tangential[0] <= 1.0
 
 
 def test_pupil_sampling_too_coarse_for_the_wavefront():
     # f/2.8 at 14 degrees: 6 waves peak-to-valley, 0.84 waves between cells of a 64-cell grid
     with pytest.raises(InputError, match="too coarse.*waves between neighbouring cells"):
-        psf(DGAUSS, 14.0, fstop=2.8, pupil_samples=64)
+        psf(as_designed(DGAUSS, fstop=2.8), 14.0, pupil_samples=64)
 
 
 def test_field_outside_the_lens_field():
@@ -69,7 +70,7 @@ def test_fully_vignetted_field():
     (lambda: mtf(DGAUSS, 0.0, wavelengths_nm=[100.0]), InputError),
     (lambda: mtf(DGAUSS, 0.0, wavelengths_nm=[550.0, 600.0], weights=[1.0]), InputError),
     (lambda: mtf(DGAUSS, 0.0, weights=[-1.0]), InputError),
-    (lambda: mtf(DGAUSS, 0.0, fstop=1.0), OpticsError),  # faster than the lens opens
+    (lambda: mtf(as_designed(DGAUSS, fstop=1.0), 0.0), OpticsError),  # faster than the lens opens
     (lambda: mtf(DGAUSS, 0.0, pupil_samples=8), InputError),
     (lambda: psf(DGAUSS, 0.0, padding=1), InputError),
     (lambda: wavefront(DGAUSS, 0.0, zernike_terms=0), InputError),
@@ -89,7 +90,7 @@ def test_bad_arguments_are_refused_with_a_sentence(call, err):
 @given(field=st.floats(0.0, 16.0), fstop=st.sampled_from([2.8, 5.6, 11.0]), nu=st.floats(5.0, 80.0))
 def test_mtf_never_beats_the_diffraction_limit_of_its_pupil(field, fstop, nu):
     # |sum P P*| <= sum |P||P*| (triangle inequality) at every frequency, wavelength by wavelength
-    m = mtf(DGAUSS, field, frequencies=[0.0, nu], wavelengths_nm=[587.5618, 486.1327], fstop=fstop)
+    m = mtf(as_designed(DGAUSS, fstop=fstop), field, frequencies=[0.0, nu], wavelengths_nm=[587.5618, 486.1327])
     for curve, limit in ((m.tangential, m.diffraction_limit_tangential), (m.sagittal, m.diffraction_limit_sagittal)):
         assert curve[0] == pytest.approx(1.0)
         assert np.all((curve >= 0) & (curve <= limit + 1e-9))
@@ -99,14 +100,16 @@ def test_mtf_never_beats_the_diffraction_limit_of_its_pupil(field, fstop, nu):
 def test_geometric_and_diffraction_mtf_agree_where_aberrations_dominate():
     # f/2 on axis: about 1.5 waves RMS of spherical aberration; at low frequency the geometric
     # approximation and the diffraction MTF meet (Smith, Modern Optical Engineering, 11.9)
-    d = mtf(DGAUSS, 0.0, frequencies=[5.0, 10.0], fstop=2.03)
-    g = geometric_mtf(DGAUSS, 0.0, frequencies=[5.0, 10.0], fstop=2.03)
+    cam = as_designed(DGAUSS, fstop=2.03)
+    d = mtf(cam, 0.0, frequencies=[5.0, 10.0])
+    g = geometric_mtf(cam, 0.0, frequencies=[5.0, 10.0])
     assert np.abs(d.tangential - g.tangential).max() < 0.05
 
 
 def test_strehl_tracks_marechal_for_a_small_aberration():
-    wf = wavefront(DGAUSS, 14.0, fstop=8.0)
-    p = psf(DGAUSS, 14.0, fstop=8.0)
+    cam = as_designed(DGAUSS, fstop=8.0)
+    wf = wavefront(cam, 14.0)
+    p = psf(cam, 14.0)
     assert wf.rms_to_centroid_waves < 0.1
     assert p.strehl == pytest.approx(wf.strehl_marechal, abs=0.01)
     assert p.image.max() == pytest.approx(p.strehl, rel=0.05)  # the FFT grid's peak is near the refined one
