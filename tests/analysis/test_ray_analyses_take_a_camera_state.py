@@ -40,7 +40,7 @@ def _by_hand(lens, mark, fstop):
 
 def _old_door():
     """The lens with its keywords, the pre-issue-43 form: it warns until physcam 0.3."""
-    return pytest.warns(DeprecationWarning, match=r"is now \w+\(camera_state\(lens, .*physcam 0\.3")
+    return pytest.warns(DeprecationWarning, match=r"is now \w+\((camera_state|as_designed)\(lens, .*physcam 0\.3")
 
 
 def _rms(res):

@@ -9,7 +9,7 @@ model focused and stopped; a focus or an f-stop solved from measured limits is s
 :mod:`physcam.onset.inverse`), the circle of confusion, the :class:`MeasuredLimits` and the
 :class:`References` (figures from elsewhere the report compares or takes: a T-stop, a tape-measured
 pupil, a best-match pinhole or an f-number at the focus recorded in a USD file). Then
-``solve_report(*inputs)``, or ``inputs.solve()``.
+``solve_report(inputs)``, or ``inputs.solve()``.
 
 Distances measured on set (``focus_mm``, ``near_mm``, ``far_mm``, ``sensor_front_mm``) are from the
 film plane; datasheet offsets (``h1_mm``, ``h2_mm``, ``pupil_mm``) are in front of
@@ -331,7 +331,7 @@ def _check_planes(r) -> dict:
 
 class ReportRequest:
     """Deprecated (issue 43; goes in physcam 0.3): the report's inputs as one record. Use
-    :func:`report_camera` (the same keywords), then ``solve_report(*inputs)``, or build the camera
+    :func:`report_camera` (the same keywords), then ``solve_report(inputs)``, or build the camera
     yourself (:func:`physcam.optics.state.camera_state`) and call ``solve_report(camera, coc=...)``.
 
     Checked when it is made, as before; its inputs read as attributes (``request.focus_mm``)."""
