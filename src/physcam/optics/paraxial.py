@@ -20,12 +20,12 @@ front of the reference, toward the subject), the on-set convention.
 from __future__ import annotations
 
 import math
-import threading
 from functools import lru_cache
 
 from .._record import asdict, field, record
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from ..lens.prescription import Prescription, takes_prescription
+from ._memo import IdentityMemo, same_items
 
 __all__ = [
     "AXES",
@@ -91,23 +91,16 @@ def _indices(prescription: Prescription, lam: float) -> tuple[float, ...]:
     """:func:`media_indices` at wavelength ``lam`` (nm, checked), remembered by the surfaces' identity."""
     surfaces = prescription.surfaces
     key = (id(surfaces), lam)
-    hit = _BY_SURFACES.get(key)
-    if hit is None or hit[0] is not surfaces:
-        hit = (surfaces, _by_media(tuple(s.medium for s in surfaces), lam))
-        with _BY_SURFACES_LOCK:  # (physcam serve solves in threads)
-            _BY_SURFACES[key] = hit
-            if len(_BY_SURFACES) > _BY_SURFACES_MAX:
-                del _BY_SURFACES[next(iter(_BY_SURFACES))]  # the oldest
-    return hit[1]
+    n = _BY_SURFACES.get(key, surfaces)
+    return n if n is not None else _BY_SURFACES.put(key, surfaces, _by_media(tuple(s.medium for s in surfaces), lam))
 
 
 #: The media's indices of the last surface tuples asked about, by the tuple's identity (the tuple kept,
 #: so its id is not reused): a zoom's or a focus search's thousands of paraxial solves ask again and again
 #: for the same lens, and keying :func:`_media_indices` by value rehashed every medium each time (2.6
 #: million record hashes building one zoom lens's Blender tables; 10 % of its CPU).
-_BY_SURFACES: dict = {}
 _BY_SURFACES_MAX = 256
-_BY_SURFACES_LOCK = threading.Lock()
+_BY_SURFACES = IdentityMemo(_BY_SURFACES_MAX)
 
 
 def _by_media(media: tuple, lam: float) -> tuple[float, ...]:
@@ -115,17 +108,11 @@ def _by_media(media: tuple, lam: float) -> tuple[float, ...]:
     focus or zoom state's surfaces are new, their media the lens's own, and the memo's key by value hashed
     every medium again (a quarter of the paraxial work of a Blender extension build)."""
     key = (tuple(map(id, media)), lam)
-    hit = _BY_MEDIA.get(key)
-    if hit is None or any(a is not b for a, b in zip(hit[0], media)):
-        hit = (media, _media_indices(media, lam))
-        with _BY_SURFACES_LOCK:
-            _BY_MEDIA[key] = hit
-            if len(_BY_MEDIA) > _BY_SURFACES_MAX:
-                del _BY_MEDIA[next(iter(_BY_MEDIA))]  # the oldest
-    return hit[1]
+    n = _BY_MEDIA.get(key, media)
+    return n if n is not None else _BY_MEDIA.put(key, media, _media_indices(media, lam))
 
 
-_BY_MEDIA: dict = {}
+_BY_MEDIA = IdentityMemo(_BY_SURFACES_MAX, same_items)
 
 
 @lru_cache(maxsize=1024)
@@ -156,23 +143,19 @@ def _powers(prescription: Prescription, axis: str, lam: float) -> tuple[float, .
     thousands of times (every system matrix, pupil and conjugate of every focus and zoom state)."""
     surfaces = prescription.surfaces
     key = (id(surfaces), axis, lam)
-    hit = _POWERS.get(key)
-    if hit is None or hit[0] is not surfaces:
+    phi = _POWERS.get(key, surfaces)
+    if phi is None:
         n = _indices(prescription, lam)
         if axis == "x":
             phi = tuple(s.curvature_x * (n[i + 1] - n[i]) for i, s in enumerate(surfaces))
         else:
             phi = tuple(s.curvature_y * (n[i + 1] - n[i]) for i, s in enumerate(surfaces))
-        hit = (surfaces, phi)
-        with _BY_SURFACES_LOCK:
-            _POWERS[key] = hit
-            if len(_POWERS) > _BY_SURFACES_MAX:
-                del _POWERS[next(iter(_POWERS))]  # the oldest
-    return hit[1]
+        _POWERS.put(key, surfaces, phi)
+    return phi
 
 
 #: The surfaces' powers by the surfaces tuple's identity, meridian and wavelength (:func:`_powers`).
-_POWERS: dict = {}
+_POWERS = IdentityMemo(_BY_SURFACES_MAX)
 
 
 @takes_prescription
@@ -539,16 +522,12 @@ def gaussian(
     """
     key = _memo_key(prescription, (axis, wavelength_nm, fstop, object_z, film_z, flange_focal_distance_mm,
                                    stop_semi_diameter))
-    hit = _GAUSSIAN.get(key) if key is not None else None
-    if hit is not None and hit[0] is prescription:
-        return hit[1]
-    g = _gaussian(prescription, axis, wavelength_nm, fstop, object_z, film_z, flange_focal_distance_mm,
-                  stop_semi_diameter)
-    if key is not None:
-        with _BY_SURFACES_LOCK:
-            _GAUSSIAN[key] = (prescription, g)
-            if len(_GAUSSIAN) > _GAUSSIAN_MAX:
-                del _GAUSSIAN[next(iter(_GAUSSIAN))]  # the oldest
+    g = _GAUSSIAN.get(key, prescription) if key is not None else None
+    if g is None:
+        g = _gaussian(prescription, axis, wavelength_nm, fstop, object_z, film_z, flange_focal_distance_mm,
+                      stop_semi_diameter)
+        if key is not None:
+            _GAUSSIAN.put(key, prescription, g)
     return g
 
 
@@ -556,8 +535,8 @@ def gaussian(
 #: the arguments: a lens model asks again and again for the same state's data (every mark's f-number ratio
 #: solves the lens at infinity again, every report row both meridians at infinity; two thirds of the solves
 #: building the Blender extension were repeats). Prescriptions and :class:`GaussianData` are frozen.
-_GAUSSIAN: dict = {}
 _GAUSSIAN_MAX = 512
+_GAUSSIAN = IdentityMemo(_GAUSSIAN_MAX)
 
 
 def _memo_key(prescription: Prescription, args: tuple):

@@ -21,7 +21,6 @@ drift from the designer's (``+``: the image lies behind the film). Breathing ove
 from __future__ import annotations
 
 import math
-import threading
 from dataclasses import asdict, dataclass
 
 from ..data.default_sensor import DEFAULT_SENSOR_WIDTH_MM
@@ -29,6 +28,7 @@ from ..errors import InputError, OpticsError, require_positive
 from ..lens.prescription import Prescription, takes_prescription
 from ..lens.zoom import prescription_at, tabulated_encoders
 from . import focusing, paraxial
+from ._memo import IdentityMemo
 from ._roots import bracketed_root
 
 __all__ = ["ZoomRow", "encoder_for_focal_length", "at_zoom", "named_at_zoom", "zoom_encoder", "efl_at", "zoom_table",
@@ -71,19 +71,14 @@ def _samples(lens, wavelength_nm):
     """(encoders, EFLs) at :data:`_SAMPLES` points across the zoom, remembered per lens (by its identity, the
     lens kept with them; prescriptions are frozen): a take's every zoom position asked them again."""
     key = (id(lens), wavelength_nm)
-    hit = _SAMPLED.get(key)
-    if hit is None or hit[0] is not lens:
-        us = [k / (_SAMPLES - 1) for k in range(_SAMPLES)]
-        hit = (lens, us, [efl_at(lens, u, wavelength_nm) for u in us])
-        with _SAMPLED_LOCK:  # (physcam serve solves in threads)
-            _SAMPLED[key] = hit
-            if len(_SAMPLED) > 64:
-                del _SAMPLED[next(iter(_SAMPLED))]  # the oldest
-    return list(hit[1]), list(hit[2])
+    efls = _SAMPLED.get(key, lens)
+    us = [k / (_SAMPLES - 1) for k in range(_SAMPLES)]
+    if efls is None:
+        efls = _SAMPLED.put(key, lens, tuple(efl_at(lens, u, wavelength_nm) for u in us))
+    return us, list(efls)
 
 
-_SAMPLED: dict = {}
-_SAMPLED_LOCK = threading.Lock()
+_SAMPLED = IdentityMemo(64)
 
 
 #: a focal length this close outside a zoom's paraxial range names its end (the range is printed to 0.01 mm)
