@@ -15,7 +15,7 @@ def same_items(a: tuple, b: tuple) -> bool:
 
 class IdentityMemo:
     """``get(key, owner)`` the answer remembered for ``key`` while it was ``owner``'s (the ``same`` test:
-    identity, or :func:`same_items` for a tuple of objects), else None; ``put`` remembers one."""
+    identity, or :func:`same_items` for a tuple of objects), else None; ``put`` remembers one, ``clear`` forgets all."""
 
     def __init__(self, size: int, same=None):
         self._store: dict = {}
@@ -30,6 +30,11 @@ class IdentityMemo:
         if hit[0] is owner if self._same is None else self._same(hit[0], owner):
             return hit[1]
         return None
+
+    def clear(self) -> None:
+        """Forget every answer."""
+        with self._lock:
+            self._store.clear()
 
     def put(self, key, owner, value):
         with self._lock:

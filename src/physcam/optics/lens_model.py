@@ -26,6 +26,7 @@ from typing import NamedTuple, Protocol, runtime_checkable
 
 from ..errors import InputError, OpticsError, require_finite, require_positive
 from . import thinlens
+from ._memo import IdentityMemo
 
 from .._record import field, record
 
@@ -359,7 +360,8 @@ class PrescriptionLens:
                            pinhole=(planes.pinhole_focal_length_mm, gx.pinhole_focal_length))
 
 
-_MODELS: dict[int, PrescriptionLens] = {}
+#: each prescription's lens model, by the prescription's identity (the last 64)
+_MODELS = IdentityMemo(64)
 
 
 def lens_model_of(lens) -> LensModel:
@@ -370,12 +372,8 @@ def lens_model_of(lens) -> LensModel:
     from ..lens.prescription import Prescription
 
     if isinstance(lens, Prescription):
-        model = _MODELS.get(id(lens))
-        if model is None or model.prescription is not lens:
-            if len(_MODELS) >= 64:
-                _MODELS.pop(next(iter(_MODELS)))
-            model = _MODELS[id(lens)] = PrescriptionLens(lens)
-        return model
+        model = _MODELS.get(id(lens), lens)
+        return model if model is not None else _MODELS.put(id(lens), lens, PrescriptionLens(lens))
     if isinstance(lens, LensModel):  # a lens model of the user's own
         return lens
     from ..errors import WrongTypeError
