@@ -436,10 +436,6 @@ def as_camera_state(lens, *, focus_mm=None, fstop=None, **state) -> CameraState:
     return camera_state(lens, focus_mm=focus_mm, fstop=fstop, **state)
 
 
-#: :func:`as_designed`'s keywords: an old form given only these is the lens as its file focuses it
-_AS_DESIGNED = {"fstop", "sensor", "sensor_mm", "wavelengths_nm", "weights", "aperture", "stop_semi_diameter"}
-
-
 def _camera_at_the_door(value, given: dict, where: str) -> CameraState:
     """The camera of a function's first argument ``value`` and the camera keywords it was also given."""
     import warnings
@@ -456,8 +452,10 @@ def _camera_at_the_door(value, given: dict, where: str) -> CameraState:
         # camera_state's own names: the sensor's two sizes are one sensor_mm=(width, height) there
         names = dict.fromkeys("sensor_mm" if k in ("sensor_width_mm", "sensor_height_mm") else k for k in given)
         words = ", ".join(f"{k}=" for k in names)
-        # without a focus or a film plane the old form is the lens as its file focuses it: as_designed's camera
-        door = "as_designed" if set(names) <= _AS_DESIGNED else "camera_state"
+        # given only as_designed's keywords (no focus, no film plane) the old form is the lens as its file focuses it
+        import inspect
+
+        door = "as_designed" if set(names) <= set(inspect.signature(as_designed).parameters) else "camera_state"
         warnings.warn(f"{where}(lens, {words}...) is now {where}({door}(lens, {words}...)): the camera is "
                       f"built once, at its door; the keywords go in physcam {UNTIL}", DeprecationWarning, stacklevel=3)
     w, h = given.pop("sensor_width_mm", None), given.pop("sensor_height_mm", None)
