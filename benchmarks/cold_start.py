@@ -164,6 +164,22 @@ def measure(name: str, trees: list, runs: int, scratch: str) -> dict:
     return out
 
 
+def machine_marks() -> str:
+    """How fast this host is, for comparing figures measured on different machines: a pure-Python
+    loop (``sum(range(10**6))``, best of 5) and matplotlib's import in a fresh process (CPU)."""
+    loop = min(_timed(lambda: sum(range(10**6))) for _ in range(5))
+    child = [sys.executable, "-c", "import time; import matplotlib.figure; print(time.process_time())"]
+    mpl = min(float(subprocess.run(child, check=True, capture_output=True, text=True).stdout) for _ in range(3))
+    return (f"this machine: sum(range(10**6)) {loop * 1000:.1f} ms; "
+            f"import matplotlib.figure {mpl * 1000:.0f} ms CPU (best of 3, fresh processes)")
+
+
+def _timed(fn) -> float:
+    t0 = time.perf_counter()
+    fn()
+    return time.perf_counter() - t0
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=5)
@@ -177,6 +193,7 @@ def main() -> None:
         raise SystemExit(f"unknown case(s) {unknown}; cases: {', '.join(CASES)}")
     trees = args.tree or [None]
     print(f"{os.cpu_count()} cores; load average {load()} at start; {args.runs} runs per case and tree")
+    print(machine_marks())
     with tempfile.TemporaryDirectory() as scratch:
         for name in names:
             res = measure(name, trees, args.runs, scratch)
