@@ -179,15 +179,18 @@ def test_thin_lens_gap_takes_the_reports_camera_state():
 
 def test_the_old_doors_warning_names_a_call_that_works():
     """The DeprecationWarning of an old door spells the new call with camera_state's own keywords: the
-    sensor's two sizes are one ``sensor_mm=`` there (a user who followed ``sensor_width_mm=`` got a TypeError)."""
+    sensor's two sizes are one ``sensor_mm=(width, height)`` there (a user who followed ``sensor_width_mm=`` got a
+    TypeError; one who wrote ``sensor_mm=36.0`` for it got another, now a sentence)."""
     from physcam.analysis.distortion.stmap import distortion_field
 
     kw = dict(width_px=48, height_px=32, maps=False)
     with pytest.warns(DeprecationWarning) as caught:
         old = distortion_field(DGAUSS, focus_mm=MARK, sensor_width_mm=36.0, sensor_height_mm=24.0, **kw)
     (message,) = [str(w.message) for w in caught if issubclass(w.category, DeprecationWarning)]
-    assert "camera_state(lens, focus_mm=, sensor_mm=...)" in message, message
+    assert "is now distortion_field(camera_state(lens, focus_mm=, sensor_mm=(width, height)...))" in message, message
     assert "sensor_width_mm" not in message.split("is now", 1)[1], message
+    with pytest.raises(InputError, match=r"sensor_mm takes the sensor's \(width, height\)"):
+        camera_state(DGAUSS, focus_mm=MARK, sensor_mm=36.0)  # the width alone, as sensor_width_mm took it
     new = distortion_field(camera_state(DGAUSS, focus_mm=MARK, sensor_mm=(36.0, 24.0)), **kw)  # the call it names
     assert np.array_equal(old.traced_ideal_px, new.traced_ideal_px)
 

@@ -230,6 +230,9 @@ def _sensor_of(sensor, sensor_mm) -> Sensor | None:
         return require_type("sensor", sensor, Sensor, "physcam.optics.sensors.find_sensor(name) or custom_sensor(w, h)")
     if sensor_mm is None:
         return None
+    if isinstance(sensor_mm, (str, bytes)) or not hasattr(sensor_mm, "__len__") or len(sensor_mm) != 2:
+        raise InputError(f"sensor_mm takes the sensor's (width, height) in mm, e.g. sensor_mm=(36.0, 24.0), "
+                         f"got {sensor_mm!r}")
     w, h = (require_finite(name, v) for name, v in zip(("sensor width", "sensor height"), sensor_mm))
     for name, v in (("sensor width", w), ("sensor height", h)):
         if not 0.0 < v <= 1000.0:
@@ -451,13 +454,14 @@ def _camera_at_the_door(value, given: dict, where: str) -> CameraState:
     if given:
         # camera_state's own names: the sensor's two sizes are one sensor_mm=(width, height) there
         names = dict.fromkeys("sensor_mm" if k in ("sensor_width_mm", "sensor_height_mm") else k for k in given)
-        words = ", ".join(f"{k}=" for k in names)
+        words = ", ".join("sensor_mm=(width, height)" if k == "sensor_mm" else f"{k}=" for k in names)
         # given only as_designed's keywords (no focus, no film plane) the old form is the lens as its file focuses it
         import inspect
 
         door = "as_designed" if set(names) <= set(inspect.signature(as_designed).parameters) else "camera_state"
-        warnings.warn(f"{where}(lens, {words}...) is now {where}({door}(lens, {words}...)): the camera is "
-                      f"built once, at its door; the keywords go in physcam {UNTIL}", DeprecationWarning, stacklevel=3)
+        warnings.warn(f"{where}(lens, {', '.join(f'{k}=' for k in given)}...) is now {where}({door}(lens, {words}...)): "
+                      f"the camera is built once, at its door; the keywords go in physcam {UNTIL}",
+                      DeprecationWarning, stacklevel=3)
     w, h = given.pop("sensor_width_mm", None), given.pop("sensor_height_mm", None)
     if (w is None) != (h is None):
         from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH_MM
