@@ -169,8 +169,9 @@ def _cameras(lens, slug, fstop, tmp, ext_src):
     from physcam.export.blender_camera import blender_camera_script, blender_camera_values
     from physcam.onset.report import solve_lens_report
     from physcam.optics.sensors import find_sensor
+    from physcam.optics.state import camera_state
 
-    src = osl_camera_shader(lens, focus_mm=FOCUS_MM, fstop=fstop, sensor_width_mm=36.0, sensor_height_mm=24.0)
+    src = osl_camera_shader(camera_state(lens, focus_mm=FOCUS_MM, fstop=fstop, sensor_mm=(36.0, 24.0)))
     setup = tmp / "setup.py"
     setup.write_text(blender_setup_script(src, sensor_width_mm=36.0, sensor_height_mm=24.0, resolution=(W, H)))
     report = solve_lens_report(focal_length_mm=None, sensor=find_sensor("FF"), fstop=fstop, focus_mm=FOCUS_MM, lens=lens)

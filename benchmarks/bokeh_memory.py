@@ -11,6 +11,7 @@ import time
 from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.lens.library import load_lens
 from physcam.optics import focusing
+from physcam.optics.state import camera_state
 
 
 def main() -> None:
@@ -21,7 +22,7 @@ def main() -> None:
     st = focusing.focus(lens, 3000.0)
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     t = time.perf_counter()
-    res = bokeh_image(st.prescription, 1200.0, 250.0, 150.0, film_z=st.film_z, rays=args.rays, pixels=512,
+    res = bokeh_image(camera_state(st.prescription, film_z=st.film_z), 1200.0, 250.0, 150.0, rays=args.rays, pixels=512,
                       spectral=True)
     dt = time.perf_counter() - t
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024

@@ -47,9 +47,10 @@ def run(width, height, tile, kernel_cache=None):
     from physcam.analysis.defocus.render import defocus, inverse_depth
     from physcam.analysis.defocus.kernels import KernelCache, defocus_camera
     from physcam.lens.library import load_lens
+    from physcam.optics.state import camera_state
 
-    cam = defocus_camera(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_width_mm=36.0, width=width,
-                         height=height, tile=tile)
+    state = camera_state(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_mm=(36.0, 36.0 * height / width))
+    cam = defocus_camera(state, width=width, height=height, tile=tile)  # (the defocus reads the sensor's width)
     img, z = frame(width, height)
     u = inverse_depth(z, cam)
     cache = KernelCache(cam, kernel_cache)

@@ -27,6 +27,7 @@ from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.analysis.image_quality.spot import equal_area_disk
 from physcam.lens.library import list_lenses, load_lens
 from physcam.optics.paraxial import gaussian
+from physcam.optics.state import camera_state
 from physcam.trace import RayBatch, camera_rays, paraxial_image_z, trace_to_film
 
 
@@ -70,14 +71,15 @@ def max_field(lens) -> float:
 
 
 def bokeh_errors(lens, film, y_mm, rays):
-    kw = dict(rays=rays, pixels=128, film_z=film, chunk=min(rays, 250_000))
+    kw = dict(rays=rays, pixels=128, chunk=min(rays, 250_000))
     try:
-        ext = bokeh_image(lens, 1000.0, 0.0, y_mm, precision="double", **(kw | dict(rays=1000, chunk=1000))).extent_mm
+        cam = camera_state(lens, film_z=film)
+        ext = bokeh_image(cam, 1000.0, 0.0, y_mm, precision="double", **(kw | dict(rays=1000, chunk=1000))).extent_mm
     except Exception as exc:  # no light reaches the film from there
         return None, str(exc)[:60]
     # both with the same window, so both draw the same random rays
-    a = bokeh_image(lens, 1000.0, 0.0, y_mm, precision="double", extent_mm=ext, **kw)
-    b = bokeh_image(lens, 1000.0, 0.0, y_mm, precision="single", extent_mm=ext, **kw)
+    a = bokeh_image(cam, 1000.0, 0.0, y_mm, precision="double", extent_mm=ext, **kw)
+    b = bokeh_image(cam, 1000.0, 0.0, y_mm, precision="single", extent_mm=ext, **kw)
     l1 = float(np.abs(a.image - b.image).sum() / a.image.sum())
     ca, cb = a.to_dict()["centroid_mm"], b.to_dict()["centroid_mm"]
     return dict(l1=l1, passed=(a.rays_passed, b.rays_passed),

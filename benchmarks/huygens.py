@@ -16,24 +16,25 @@ import time
 from physcam.analysis.image_quality.huygens import huygens_psf
 from physcam.analysis.image_quality.mtf import mtf
 from physcam.lens.library import load_lens
+from physcam.optics.state import as_designed
 
 REPEATS = 5
 FREQS = (10.0, 20.0, 40.0)
 
 
 def main() -> None:
-    lens = load_lens("dgauss_50mm")
-    kw = dict(fstop=4.0, wavelengths_nm=[587.5618], pupil_samples=256)
+    camera = as_designed(load_lens("dgauss_50mm"), fstop=4.0)
+    kw = dict(wavelengths_nm=[587.5618], pupil_samples=256)
     t0 = time.perf_counter()
-    huygens_psf(lens, 14.0, image_samples=128, **kw)
+    huygens_psf(camera, 14.0, image_samples=128, **kw)
     cold = time.perf_counter() - t0
     times = []
     for _ in range(REPEATS):
         t0 = time.perf_counter()
-        p = huygens_psf(lens, 14.0, image_samples=128, **kw)
+        p = huygens_psf(camera, 14.0, image_samples=128, **kw)
         times.append(time.perf_counter() - t0)
     t0 = time.perf_counter()
-    f = mtf(lens, 14.0, frequencies=FREQS, **kw)
+    f = mtf(camera, 14.0, frequencies=FREQS, **kw)
     fft = time.perf_counter() - t0
     warm = statistics.median(times)
     print(f"Huygens PSF, dgauss_50mm 14 deg f/4, 256 x 256 pupil, 128 x 128 image: cold {cold:.2f} s, warm median "

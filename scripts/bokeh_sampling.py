@@ -19,6 +19,7 @@ import numpy as np
 from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.lens.library import load_lens
 from physcam.optics import focusing
+from physcam.optics.state import camera_state
 from physcam.trace import RayBatch, trace_to_film
 
 
@@ -49,7 +50,8 @@ def main() -> None:
     st = focusing.focus(lens, math.inf)
     depth, pixels = 1000.0, 256
     t0 = time.perf_counter()
-    ref = bokeh_image(st.prescription, depth, film_z=st.film_z, rays=args.reference_rays, pixels=pixels, seed=12345)
+    cam = camera_state(st.prescription, film_z=st.film_z)
+    ref = bokeh_image(cam, depth, rays=args.reference_rays, pixels=pixels, seed=12345)
     extent = ref.extent_mm
     R = ref.image[..., 0]
     mask = R > 0.2 * R.max()
@@ -64,7 +66,7 @@ def main() -> None:
 
     print(f"{'rays':>10} | {'low-discrepancy RMS':>20} {'L1':>6} | {'random RMS':>11} {'L1':>6} | Poisson 1/sqrt(rays/px)")
     for n in (250_000, 500_000, 1_000_000, 4_000_000):
-        q = bokeh_image(st.prescription, depth, film_z=st.film_z, rays=n, pixels=pixels, extent_mm=extent, seed=1)
+        q = bokeh_image(cam, depth, rays=n, pixels=pixels, extent_mm=extent, seed=1)
         rnd = random_image(st.prescription, st.film_z, depth, n, extent, pixels, seed=1)
         per_px = n * (q.rays_passed / n) * float(q.image[..., 0][mask].sum() / q.image[..., 0].sum()) / lit
         eq, lq = err(q.image[..., 0])

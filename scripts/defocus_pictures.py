@@ -100,10 +100,15 @@ def _before(jobs, checkout):
         return [np.load(a[-1]) for a in args]
 
 
+def _dgauss_at_2m(w, h):
+    """dgauss_50mm at 2 m, f/2.8, on a 36 mm wide sensor of the frame's aspect (the defocus reads its width)."""
+    return camera_state(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_mm=(36.0, 36.0 * h / w))
+
+
 def _issue_scenes():
     """(name, image, depth m, width, height, tile): the in-focus checker and the spot beside a surface."""
     w, h = 256, 144
-    cam = defocus_camera(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_width_mm=36.0, width=w, height=h)
+    cam = defocus_camera(_dgauss_at_2m(w, h), width=w, height=h)
     ys, xs = np.indices((h, w))
     check = np.where(((xs // 8) + (ys // 8)) % 2, 1.0, 0.5).astype(np.float32)[..., None].repeat(3, axis=2)
     focus = np.full((h, w), (cam.focus_mm - cam.pupil_from_film_mm) / 1000)
@@ -123,10 +128,9 @@ def main():
     a = ap.parse_args()
     d = Path(a.spherical)
     lens = load_lens("dgauss_50mm")
-    cam = defocus_camera(lens, focus_mm=2000.0, fstop=2.8, sensor_width_mm=SW, width=W, height=H,
-                         aperture=Aperture(6, 15.0), tile=32)
-    dist = distortion_field(camera_state(lens, focus_mm=2000.0, fstop=2.8, sensor_mm=(SW, SW * H / W)), width_px=W,
-                            height_px=H)
+    state = camera_state(lens, focus_mm=2000.0, fstop=2.8, sensor_mm=(SW, SW * H / W))
+    cam = defocus_camera(state, width=W, height=H, aperture=Aperture(6, 15.0), tile=32)
+    dist = distortion_field(state, width_px=W, height_px=H)
     cache = KernelCache(cam)
     jobs, imgs = [], {}
     for tag in ("", "_spheres"):
@@ -159,8 +163,7 @@ def _issue_pictures(scenes, before):
     """Before and after on the two scenes of issue 42."""
     panels, labels = [], []
     for (name, img, z, w, h, tile), old in zip(scenes, before):
-        cam = defocus_camera(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_width_mm=36.0, width=w,
-                             height=h, tile=tile)
+        cam = defocus_camera(_dgauss_at_2m(w, h), width=w, height=h, tile=tile)
         cache = KernelCache(cam)
         new = defocus(img, inverse_depth(z, cam), cache)
         if name == "checker":  # divided by the plate and T: 1 everywhere when light is kept and nothing steps
@@ -181,9 +184,9 @@ def _anamorphic(d: Path):
     """The anamorphic oval bokeh: truth and physcam, enlarged, both squeezed (the film image)."""
     lens = load_lens("neil_front_anamorphic_2x")
     w, h = 384, 288
-    cam = defocus_camera(lens, focus_mm=2000.0, fstop=2.8, sensor_width_mm=20.0, width=w, height=h, tile=32)
-    dist = distortion_field(camera_state(lens, focus_mm=2000.0, fstop=2.8, sensor_mm=(20.0, 15.0)), width_px=w,
-                            height_px=h)
+    state = camera_state(lens, focus_mm=2000.0, fstop=2.8, sensor_mm=(20.0, 15.0))
+    cam = defocus_camera(state, width=w, height=h, tile=32)
+    dist = distortion_field(state, width_px=w, height_px=h)
     u = inverse_depth(read_exr(d / "depth_spheres.exr").channels["R"], cam)
     phys = apply_stmap(defocus(_rgb(d / "pinhole_spheres.exr"), u, KernelCache(cam)), dist.distortion_stmap)
     truth = _rgb(d / "truth_spheres.exr")

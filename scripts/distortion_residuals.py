@@ -13,6 +13,7 @@ from physcam.analysis.distortion.models import fit_models, samples_from_field
 from physcam.analysis.distortion.stmap import distortion_field
 from physcam.errors import PhysCamError
 from physcam.lens.library import list_lenses, load_lens
+from physcam.optics.state import camera_state
 
 SENSORS = [("36 x 24", 36.0, 24.0), ("Super 35 24.89 x 18.66", 24.89, 18.66), ("16 mm 12.52 x 7.41", 12.52, 7.41),
            ("2/3 in 8.8 x 6.6", 8.8, 6.6), ("1/3 in 4.8 x 3.6", 4.8, 3.6), ("1.6 x 1.2", 1.6, 1.2)]
@@ -31,7 +32,7 @@ def main() -> None:
         for focus in (2000.0, math.inf):
             for label, w, h in SENSORS:
                 try:
-                    res = distortion_field(lens, focus_mm=focus, sensor_width_mm=w, sensor_height_mm=h,
+                    res = distortion_field(camera_state(lens, focus_mm=focus, sensor_mm=(w, h)),
                                            width_px=2048, height_px=round(2048 * h / w), maps=False)
                 except PhysCamError:
                     continue

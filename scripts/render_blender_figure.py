@@ -31,11 +31,12 @@ def main() -> None:
         sys.path.insert(0, p)  # Cycles compiles OSL through Blender's bundled oslquery
     from physcam.export.blender import blender_setup_script, osl_camera_shader
     from physcam.lens.library import load_lens
+    from physcam.optics.state import camera_state
     from physcam.trace.aperture import Aperture
 
     lens = load_lens("zeiss_distagon_35mm_f4")
     W, H = 480, 320
-    src = osl_camera_shader(lens, focus_mm=3000.0, fstop=4.0, sensor_width_mm=36.0, sensor_height_mm=24.0,
+    src = osl_camera_shader(camera_state(lens, focus_mm=3000.0, fstop=4.0, sensor_mm=(36.0, 24.0)),
                             aperture=Aperture(nsides=6, roundness=0.0))
     setup = Path(tempfile.mkdtemp()) / "setup.py"
     setup.write_text(blender_setup_script(src, sensor_width_mm=36.0, sensor_height_mm=24.0, resolution=(W, H)))

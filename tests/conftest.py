@@ -61,20 +61,9 @@ LONG_FIRST = (
 )
 
 
-#: physcam's deprecated forms ("... goes in physcam 0.3") fail a test (pyproject.toml, filterwarnings), except in
-#: these folders, whose tests still call the old forms in passing: there they only warn (but physcam's own
-#: code calling one still fails), until they move
-OLD_FORMS_ALLOWED = ("tests/blender/",)
-
-
 def pytest_collection_modifyitems(config, items):
     """Put :data:`LONG_FIRST`'s modules first, then every other module with a test marked slow, then the
-    rest, each module's tests together and in their order (a stable sort on the module's rank); the tests of
-    :data:`OLD_FORMS_ALLOWED` only warn at an old form."""
-    for item in items:
-        if item.nodeid.startswith(OLD_FORMS_ALLOWED):
-            item.add_marker(pytest.mark.filterwarnings(r"default:.*physcam 0\.3:DeprecationWarning",  # the later wins:
-                                                       r"error:.*physcam 0\.3:DeprecationWarning:physcam"))
+    rest, each module's tests together and in their order (a stable sort on the module's rank)."""
     rank = {path: i for i, path in enumerate(LONG_FIRST)}
     slow_modules = {item.nodeid.split("::", 1)[0] for item in items if item.get_closest_marker("slow")}
 

@@ -19,6 +19,7 @@ from _blender import predicted_block_brightness, run_blender
 from physcam.export.blender import bake_camera, blender_setup_script, osl_camera_shader
 from physcam.lens.library import list_lenses, load_lens
 from physcam.optics.paraxial import gaussian
+from physcam.optics.state import camera_state
 from physcam.trace.rays import RayBatch
 from physcam.trace.trace import trace_to_film
 
@@ -74,7 +75,7 @@ def test_every_bundled_lens_compiles_and_renders(tmp_path):
         lens = load_lens(rec.slug)
         full = rec.anamorphic or any(s.kind == "aspheric" for s in lens.surfaces)
         k = min(1.0, gaussian(lens).efl / 50.0)  # a frame the lens covers (dgauss_77deg is a 3.5 mm lens)
-        src = osl_camera_shader(lens, focus_mm=5000.0, sensor_width_mm=24.0 * k, sensor_height_mm=16.0 * k,
+        src = osl_camera_shader(camera_state(lens, focus_mm=5000.0, sensor_mm=(24.0 * k, 16.0 * k)),
                                 dispersion=full, fresnel=full, aperture=(7, 15.0, 0.3, 0.0) if full else None)
         p = tmp_path / f"{rec.slug}.osl"
         p.write_text(src)
@@ -181,14 +182,16 @@ def renders(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("osl_camera")
     sw, sh, W, H = MARKERS_FRAME
     lens = load_lens("zeiss_distagon_35mm_f4")
-    b = bake_camera(lens, focus_mm=MARKERS_D_MM, fstop=8.0, sensor_width_mm=sw, sensor_height_mm=sh)
-    src = osl_camera_shader(lens, focus_mm=MARKERS_D_MM, fstop=8.0, sensor_width_mm=sw, sensor_height_mm=sh)
+    cam = camera_state(lens, focus_mm=MARKERS_D_MM, fstop=8.0, sensor_mm=(sw, sh))
+    b = bake_camera(cam)
+    src = osl_camera_shader(cam)
     setup = tmp / "setup.py"
     setup.write_text(blender_setup_script(src, sensor_width_mm=sw, sensor_height_mm=sh, resolution=(W, H)))
     esw, esh, eW, eH = EXPOSURE_FRAME
     lens = load_lens("dgauss_50mm")
-    b2 = bake_camera(lens, focus_mm=math.inf, sensor_width_mm=esw, sensor_height_mm=esh)
-    (tmp / "cam.osl").write_text(osl_camera_shader(lens, focus_mm=math.inf, sensor_width_mm=esw, sensor_height_mm=esh))
+    cam = camera_state(lens, focus_mm=math.inf, sensor_mm=(esw, esh))
+    b2 = bake_camera(cam)
+    (tmp / "cam.osl").write_text(osl_camera_shader(cam))
     out = run_blender(TWO_RENDERS, setup, json.dumps(MARKERS), 0.012, tmp, W, H,
                       tmp / "cam.osl", tmp, eW, eH, json.dumps(EXPOSURE_BLOCKS))
     return {"markers": (b, out["markers"]), "exposure": (b2, out["exposure"])}

@@ -68,6 +68,7 @@ import pytest
 from _blender import DARK_SCENE_CAMERA_AT_FILM, run_blender
 from physcam.export.blender import blender_setup_script, osl_camera_shader
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 
 cv2 = pytest.importorskip("cv2")
 pytestmark = pytest.mark.slow
@@ -198,8 +199,7 @@ def photographs(tmp_path_factory):
     cv2.imwrite(str(tmp / "board.png"), _board())
     renders, rows = [], []
     for k, mark in enumerate(MARKS_MM):
-        src = osl_camera_shader(lens, focus_mm=mark, fstop=FSTOP, sensor_width_mm=SENSOR_MM[0],
-                                sensor_height_mm=SENSOR_MM[1])
+        src = osl_camera_shader(camera_state(lens, focus_mm=mark, fstop=FSTOP, sensor_mm=SENSOR_MM))
         setup = tmp / f"mark{k}.py"
         setup.write_text(blender_setup_script(src, sensor_width_mm=SENSOR_MM[0], sensor_height_mm=SENSOR_MM[1],
                                               resolution=SIZE, text_name=f"mark{k}.osl"))

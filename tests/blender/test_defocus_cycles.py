@@ -107,10 +107,10 @@ print(json.dumps({"ok": True}))
 def scene(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("defocus_cycles")
     lens = load_lens(LENS)
-    cam = defocus_camera(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_width_mm=SW, width=W, height=H, aperture=IRIS,
-                         tile=TILE)
     sh = SW * H / W
-    src = osl_camera_shader(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_width_mm=SW, sensor_height_mm=sh, aperture=IRIS)
+    state = camera_state(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_mm=(SW, sh))  # (the defocus uses its width only)
+    cam = defocus_camera(state, width=W, height=H, aperture=IRIS, tile=TILE)
+    src = osl_camera_shader(state, aperture=IRIS)
     (tmp / "setup.py").write_text(blender_setup_script(src, sensor_width_mm=SW, sensor_height_mm=sh, resolution=(W, H)))
     ep = cam.pupil_from_film_mm
 
@@ -131,7 +131,7 @@ def scene(tmp_path_factory):
            "samples_pinhole": 16}
     run_blender(SCRIPT, json.dumps(job), timeout=900)
     cache = KernelCache(cam)
-    dist = distortion_field(camera_state(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_mm=(SW, sh)), width_px=W, height_px=H)
+    dist = distortion_field(state, width_px=W, height_px=H)
     out = {"dir": tmp}
     for tag in ("_spheres", ""):
         d = defocused(tmp, tag, cam, cache, dist.distortion_stmap)

@@ -79,9 +79,10 @@ print(json.dumps({"ok": True}))
 def scene(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("defocus_anamorphic")
     lens = load_lens(LENS)
-    cam = defocus_camera(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_width_mm=SW, width=W, height=H, tile=32)
+    state = camera_state(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_mm=(SW, SH))  # (the defocus uses its width only)
+    cam = defocus_camera(state, width=W, height=H, tile=32)
     assert cam.pinhole_x_mm < 0.6 * cam.pinhole_mm  # squeezed about 2x
-    src = osl_camera_shader(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_width_mm=SW, sensor_height_mm=SH)
+    src = osl_camera_shader(state)
     (tmp / "setup.py").write_text(blender_setup_script(src, sensor_width_mm=SW, sensor_height_mm=SH, resolution=(W, H)))
     ep = cam.pupil_from_film_mm
 
@@ -100,7 +101,7 @@ def scene(tmp_path_factory):
            "pupil_m": ep / 1000, "samples_osl": 256, "samples_osl_full": 32, "samples_pinhole": 16, "windows": windows}
     run_blender(SCRIPT, json.dumps(job), timeout=1200)
     cache = KernelCache(cam)
-    dist = distortion_field(camera_state(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_mm=(SW, SH)), width_px=W, height_px=H)
+    dist = distortion_field(state, width_px=W, height_px=H)
     out = {"cam": cam, "dir": tmp}
     for tag in ("_spheres", ""):
         d = defocused(tmp, tag, cam, cache, dist.distortion_stmap)

@@ -173,13 +173,14 @@ def _centroids(img, guesses, r=8):
 
 def _report_at(lens, mark_mm, sh):
     """physcam's lens report at mark_mm: (entrance pupil from the film, best-match pinhole), mm."""
-    from physcam.onset.request import ReportRequest
+    from physcam.onset.request import report_camera
     from physcam.optics.sensors import custom_sensor
     from physcam.onset.solvers import field_of_view, lens_at_mark
 
-    req = ReportRequest(sensor=custom_sensor(SW, sh), fstop=8.0, focus_mm=mark_mm, lens=lens)
-    state = lens_at_mark(req)
-    return state.pupil_from_film_mm, field_of_view(req, state, state.h2_from_film_mm)["pinhole_focal_length_mm"]
+    inputs = report_camera(sensor=custom_sensor(SW, sh), fstop=8.0, focus_mm=mark_mm, lens=lens)
+    at = lens_at_mark(inputs.camera, inputs.references)
+    fov = field_of_view(inputs.camera, at.h2_from_film_mm, inputs.references, at)
+    return at.pupil_from_film_mm, fov["pinhole_focal_length_mm"]
 
 
 def _predict(lens, mark_mm, world, sh):
@@ -187,9 +188,10 @@ def _predict(lens, mark_mm, world, sh):
     camera object (the world origin) at the entrance pupil, the film behind it by the pupil's
     distance: the film centroid, as a pixel (column, row from the bottom)."""
     from physcam.export.blender import bake_camera
+    from physcam.optics.state import camera_state
 
     pupil = _report_at(lens, mark_mm, sh)[0]
-    b = bake_camera(lens, focus_mm=mark_mm, fstop=8.0, sensor_width_mm=SW, sensor_height_mm=sh)
+    b = bake_camera(camera_state(lens, focus_mm=mark_mm, fstop=8.0, sensor_mm=(SW, sh)))
     r0 = b.lens.surfaces[0].semi_diameter
     g = (np.arange(40) + 0.5) / 40 * 2 - 1
     gx, gy = [a.ravel() for a in np.meshgrid(g, g)]

@@ -25,6 +25,7 @@ from physcam.analysis.defocus.blob import blob_moments, polygon_corners
 from physcam.analysis.defocus.bokeh import bokeh_image
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus, iris_semi_diameter
+from physcam.optics.state import camera_state
 from physcam.trace.aperture import Aperture
 
 pytestmark = pytest.mark.slow
@@ -89,12 +90,14 @@ def test_bokeh_diameter_and_iris_corners_match_bokeh_image(extension_zip, extens
     st = focus(lens, MARK_MM)
     iris = Aperture(BLADES, CORNER_DEG)
     h = CROP_MM / 2
-    # the bladed iris has the area of the round iris of f/2.8 (docs/conventions.md): physcam's tracer
-    # draws the polygon inside the stop's circle, so that circle is sqrt(pi / polygon area) larger
-    corner = iris_semi_diameter(lens, FSTOP) * math.sqrt(math.pi / iris.area())
-    kw = dict(film_z=st.film_z, fresnel=False, stop_semi_diameter=corner, aperture=iris)
-    near = bokeh_image(st.prescription, NEAR_MM, rays=2_000_000, pixels=CROP_PX, extent_mm=(-h, h, -h, h), **kw)
-    off = bokeh_image(st.prescription, NEAR_MM, 10.0, rays=200_000, pixels=64, **kw)
+    # the bladed iris has the area of the round iris of f/2.8 (docs/conventions.md): the camera of that
+    # round iris draws the polygon inside a circle sqrt(pi / polygon area) larger (CameraState.iris_corner_semi)
+    cam = camera_state(st.prescription, film_z=st.film_z, stop_semi_diameter=iris_semi_diameter(lens, FSTOP),
+                       aperture=iris)
+    assert cam.iris_corner_semi == pytest.approx(iris_semi_diameter(lens, FSTOP) * math.sqrt(math.pi / iris.area()),
+                                                 rel=1e-12)
+    near = bokeh_image(cam, NEAR_MM, rays=2_000_000, pixels=CROP_PX, extent_mm=(-h, h, -h, h), fresnel=False)
+    off = bokeh_image(cam, NEAR_MM, 10.0, rays=200_000, pixels=64, fresnel=False)
     mag = abs(off.to_dict()["centroid_mm"][0]) / 10.0  # the sphere's own image: lateral magnification
     # the camera object is the entrance pupil: the sphere NEAR_MM from the film is that less the
     # pupil's distance in front of the camera

@@ -19,6 +19,7 @@ from _blender import installed_dark_scene, run_blender
 from physcam.analysis.image_quality.colour import chromatic_aberration
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus
+from physcam.optics.state import camera_state
 
 pytestmark = pytest.mark.slow
 
@@ -68,7 +69,7 @@ def test_lateral_colour_at_the_corner_matches_physcam(extension_zip, extension_u
     lens = load_lens(SLUG)
     st = focus(lens, math.inf)
     wls = np.arange(400.0, 701.0, 10.0)
-    ca = chromatic_aberration(st.prescription, [FIELD_DEG], wavelengths_nm=wls, film_z=st.film_z)
+    ca = chromatic_aberration(camera_state(st.prescription, film_z=st.film_z), [FIELD_DEG], wavelengths_nm=wls)
     pt = ca.lateral[0]
     heights = np.array([pt.heights_mm[k] for k in sorted(pt.heights_mm, key=float) if float(k) in set(wls)])
     assert heights.size == wls.size

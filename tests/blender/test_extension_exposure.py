@@ -18,6 +18,7 @@ import pytest
 from _blender import INSTALLED_EXTENSION_SCENE, run_blender
 from physcam.export.blender import bake_camera
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 from physcam.trace.trace import camera_rays
 
 pytestmark = pytest.mark.slow
@@ -84,7 +85,7 @@ print(json.dumps(out))
 def _predicted(lens, fstop):
     """camera_rays' mean weight per block, relative to the centre block's (the lens at infinity,
     stopped by physcam's iris rule)."""
-    b = bake_camera(lens, focus_mm=math.inf, fstop=fstop, sensor_width_mm=SW, sensor_height_mm=SH)
+    b = bake_camera(camera_state(lens, focus_mm=math.inf, fstop=fstop, sensor_mm=(SW, SH)))
     m = 64
     u = (np.arange(m) + 0.5) / m
     uu, vv = [a.ravel() for a in np.meshgrid(u, u)]

@@ -15,6 +15,7 @@ from _blender import INSTALLED_EXTENSION_SCENE, run_blender
 from physcam.analysis.image_quality.ghosts import ghost_analysis, ghost_pairs
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus, iris_semi_diameter
+from physcam.optics.state import camera_state
 
 pytestmark = pytest.mark.slow
 
@@ -83,8 +84,9 @@ def test_ghost_lands_where_the_ghost_analysis_puts_it(extension_zip, extension_u
     seen 7 %)."""
     lens = load_lens(SLUG)
     st = focus(lens, math.inf)
-    res = ghost_analysis(st.prescription, FIELD_DEG, coating="none", film_z=st.film_z, sensor_width_mm=SW,
-                         sensor_height_mm=SH, stop_semi_diameter=iris_semi_diameter(lens, FSTOP))
+    cam = camera_state(st.prescription, film_z=st.film_z, sensor_mm=(SW, SH),
+                       stop_semi_diameter=iris_semi_diameter(lens, FSTOP))
+    res = ghost_analysis(cam, FIELD_DEG, coating="none")
     pairs = ghost_pairs(lens)
     ghost = next(g for g in res.paths if g.on_sensor_fraction > 0.999 and g.rms_radius_mm < 2.5
                  and math.hypot(g.centroid_y_mm - res.direct_centroid_mm[1], g.centroid_x_mm) > 5.0)

@@ -14,6 +14,7 @@ import pytest
 from _blender import run_blender
 from physcam.export.blender import _emit, bake_camera, blender_setup_script
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 
 pytestmark = pytest.mark.slow
 
@@ -33,7 +34,7 @@ print(json.dumps(out))
 
 def test_a_hostile_lens_name_compiles_to_the_harmless_names_bytecode(tmp_path):
     lens = load_lens("cooke_triplet_50mm_f4_5")
-    b = bake_camera(lens, focus_mm=2000.0, sensor_width_mm=24.0, sensor_height_mm=18.0)
+    b = bake_camera(camera_state(lens, focus_mm=2000.0, sensor_mm=(24.0, 18.0)))
     paths = []
     for label, name in (("evil", EVIL), ("plain", "harmless lens")):
         renamed = dataclasses.replace(b, lens=dataclasses.replace(b.lens, metadata=dataclasses.replace(

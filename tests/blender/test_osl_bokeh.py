@@ -40,6 +40,7 @@ from physcam.export.blender import blender_setup_script, osl_camera_shader
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus
 from physcam.optics.paraxial import stop_semi_diameter_for_fstop
+from physcam.optics.state import camera_state
 from physcam.trace.aperture import Aperture
 
 pytestmark = pytest.mark.slow
@@ -112,8 +113,7 @@ def renders(tmp_path_factory):
     #    sub-pixel spot on the axis falls in one pixel instead of being split over four), the 0.5 mm
     #    sphere on the plane of sharp focus
     sh = 36.0 * FOCUS_PX[1] / FOCUS_PX[0]
-    src = osl_camera_shader(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_width_mm=36.0, sensor_height_mm=sh,
-                            aperture=IRIS)
+    src = osl_camera_shader(camera_state(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_mm=(36.0, sh)), aperture=IRIS)
     (tmp / "focus.py").write_text(blender_setup_script(src, sensor_width_mm=36.0, sensor_height_mm=sh,
                                                        resolution=FOCUS_PX, text_name="focus.osl"))
     #    rendered in a border of FOCUS_BORDER_PX about the centre pixel (module notes)
@@ -121,7 +121,7 @@ def renders(tmp_path_factory):
     jobs.append({"name": "focus", "setup": str(tmp / "focus.py"), "samples": 256, "border": [border[i] for i in (0, 2, 1, 3)],
                  "sphere": [0.0, 0.0, -MARK_MM / 1000.0, FOCUS_SPHERE_M], "out": str(tmp / "focus.exr")})
     # 2./3. a 3 x 3 mm crop of the film centre, the 1 mm sphere 0.7 m from the film
-    src = osl_camera_shader(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_width_mm=CROP_MM, sensor_height_mm=CROP_MM,
+    src = osl_camera_shader(camera_state(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_mm=(CROP_MM, CROP_MM)),
                             aperture=IRIS)
     (tmp / "bokeh.py").write_text(blender_setup_script(src, sensor_width_mm=CROP_MM, sensor_height_mm=CROP_MM,
                                                        resolution=(CROP_PX, CROP_PX), text_name="bokeh.osl"))
@@ -146,18 +146,20 @@ def predicted():
     the shader."""
     lens = load_lens(LENS)
     st = focus(lens, MARK_MM)
-    # the hexagon has the area of f/2.8's round iris (docs/conventions.md): physcam's tracer draws the
-    # polygon inside the stop's circle, so that circle is sqrt(pi / hexagon's area) larger
-    semi = stop_semi_diameter_for_fstop(lens, FSTOP) * math.sqrt(math.pi / IRIS.area())
+    # the hexagon has the area of f/2.8's round iris (docs/conventions.md): the camera of that round iris
+    # draws the polygon inside a circle sqrt(pi / hexagon's area) larger (CameraState.iris_corner_semi)
+    cam = camera_state(st.prescription, film_z=st.film_z, stop_semi_diameter=stop_semi_diameter_for_fstop(lens, FSTOP),
+                       aperture=IRIS)
+    assert cam.iris_corner_semi == pytest.approx(stop_semi_diameter_for_fstop(lens, FSTOP)
+                                                 * math.sqrt(math.pi / IRIS.area()), rel=1e-12)
     h = CROP_MM / 2
-    kw = dict(film_z=st.film_z, fresnel=False, stop_semi_diameter=semi, aperture=IRIS)
     t0 = time.perf_counter()
-    near = bokeh_image(st.prescription, NEAR_MM, rays=2_000_000, pixels=CROP_PX, extent_mm=(-h, h, -h, h), **kw)
+    near = bokeh_image(cam, NEAR_MM, rays=2_000_000, pixels=CROP_PX, extent_mm=(-h, h, -h, h), fresnel=False)
     # the sphere's own image: the lateral magnification at NEAR_MM (centroid of a light 10 mm off axis)
-    off = bokeh_image(st.prescription, NEAR_MM, 10.0, rays=200_000, pixels=64, **kw)
+    off = bokeh_image(cam, NEAR_MM, 10.0, rays=200_000, pixels=64, fresnel=False)
     mag = abs(off.to_dict()["centroid_mm"][0]) / 10.0
     # the lens's own spot at the mark, for the report
-    spot = bokeh_image(st.prescription, MARK_MM, rays=400_000, pixels=64, extent_mm=(-0.15, 0.15, -0.15, 0.15), **kw)
+    spot = bokeh_image(cam, MARK_MM, rays=400_000, pixels=64, extent_mm=(-0.15, 0.15, -0.15, 0.15), fresnel=False)
     print(f"\nphyscam bokeh_image: {time.perf_counter() - t0:.1f} s")
     return {"near": near.image[..., 0], "mag_near": mag, "spot": spot.image[..., 0], "film_z": st.film_z}
 
@@ -167,8 +169,7 @@ def test_apply_compiles_the_shader_in_a_fresh_scene(tmp_path):
     default, EEVEE) must leave a compiled camera. Blender compiles a custom camera shader when it
     is assigned and only under Cycles; apply() used to assign it first and switch to Cycles after,
     leaving no bytecode, and every render came out black."""
-    src = osl_camera_shader(load_lens(LENS), focus_mm=MARK_MM, fstop=FSTOP, sensor_width_mm=36.0,
-                            sensor_height_mm=24.0)
+    src = osl_camera_shader(camera_state(load_lens(LENS), focus_mm=MARK_MM, fstop=FSTOP, sensor_mm=(36.0, 24.0)))
     (tmp_path / "setup.py").write_text(blender_setup_script(src, sensor_width_mm=36.0, sensor_height_mm=24.0,
                                                             resolution=(36, 24)))
     out = run_blender('''

@@ -22,6 +22,7 @@ from _blender import predicted_block_brightness, run_blender
 from test_blender_camera import SCENE
 from physcam.export.blender import bake_camera, osl_camera_shader
 from physcam.lens.library import load_lens
+from physcam.optics.state import camera_state
 
 pytestmark = pytest.mark.slow
 
@@ -65,8 +66,9 @@ def test_rays_from_beside_a_deep_bowl_pass_as_in_the_tracer(tmp_path):
     path.write_text(BOWL)
     lens = load_lens(str(path))
     sw, sh, W, H = 36.0, 24.0, 36, 24
-    b = bake_camera(lens, focus_mm=math.inf, sensor_width_mm=sw, sensor_height_mm=sh)
-    src = osl_camera_shader(lens, focus_mm=math.inf, sensor_width_mm=sw, sensor_height_mm=sh)
+    cam = camera_state(lens, focus_mm=math.inf, sensor_mm=(sw, sh))
+    b = bake_camera(cam)
+    src = osl_camera_shader(cam)
     blocks = {"centre": (10, 14, 16, 20), "left": (10, 14, 0, 3), "right": (10, 14, 33, 36)}
     predicted = predicted_block_brightness(b, blocks, W, H, (sw, sh))
     (tmp_path / "cam.osl").write_text(src)

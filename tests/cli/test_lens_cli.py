@@ -185,3 +185,18 @@ def test_lens_check_exit_status_says_what_it_found(capsys, tmp_path):
     assert run(capsys, "lens", "check", "petzval_85mm_f2_4", "--strict")[0] == 1  # ... unless --strict
     rc, _, err = run(capsys, "lens", "check", str(tmp_path / "absent.toml"))
     assert rc == 2 and err.count("\n") == 1
+
+
+def test_lens_check_with_a_sensor_probes_its_corner(capsys):
+    """`lens check --sensor` adds the corner probe (docs/lens-check.md): dgauss_50mm on Super 35 (24.89 x
+    18.66 mm) is probed at the sensor's corner, the paraxial field atan(half diagonal / EFL) with pbrt's
+    published EFL 50.3582 mm (17.16 deg, docs/analyses.md), where it is darker than at the centre. The
+    probe reached relative_illumination through its old door (the lens with sensor_width_mm=...), a
+    DeprecationWarning that goes in physcam 0.3 (an error here)."""
+    rc, out, _ = run(capsys, "lens", "check", "dgauss_50mm", "--sensor", "Super 35", "--json")
+    assert rc == 0
+    corner = next(f for f in json.loads(out)["findings"] if f["code"] == "corner_vignetting")["values"]
+    diagonal = math.hypot(24.89, 18.66)
+    assert corner["sensor_diagonal_mm"] == pytest.approx(diagonal, rel=1e-12)
+    assert corner["field_deg"] == pytest.approx(math.degrees(math.atan(diagonal / 2 / 50.3582)), abs=1e-4)
+    assert 0 < corner["relative_illumination"] < 1

@@ -45,14 +45,14 @@ def ray_probes(sensor_name: str | None):
         from ...errors import OpticsError
         from ...optics.sensors import find_sensor
         from ...optics.paraxial import gaussian
+        from ...optics.state import as_designed
 
         s = find_sensor(sensor_name)
         half = 0.5 * s.diagonal_mm
         efl = gaussian(p).efl
         corner_deg = float(_chief.field_angles_deg(None, None, 2, half, efl)[-1])
         try:
-            res = relative_illumination(p, [corner_deg], sensor_width_mm=s.width_mm, sensor_height_mm=s.height_mm,
-                                        grid=64, backend="numpy")
+            res = relative_illumination(as_designed(p, sensor=s), [corner_deg], grid=64, backend="numpy")
         except OpticsError as exc:
             limit = _chief.field_limit_deg(p, "y", wavelength_nm=p.wavelength_nm)
             circle = 2 * abs(efl) * math.tan(math.radians(limit))
