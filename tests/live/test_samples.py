@@ -293,3 +293,33 @@ def test_the_millimetre_coefficients_distort_like_opencv():
                                  rel=1e-12)
     with pytest.raises(InputError, match="denominator"):
         opentrackio_to_opencv(dist, f)  # OpenCV's five coefficients cannot hold k4-k6
+
+
+# the largest finite double, 2**1024 - 2**971 (IEEE 754 binary64), as an integer; an integer past it is no double
+_DOUBLE_MAX = 2**1024 - 2**971
+
+
+class _Count(int):
+    """An int subclass (an IntEnum's kind): a number, not one of JSON's own types by name."""
+
+
+@pytest.mark.parametrize("value, finite", [
+    (0, True), (-7, True), (True, True), (None, True), ("", True), (1.5, True), (-0.0, True), (5e-324, True),
+    (1.7976931348623157e308, True), (_DOUBLE_MAX, True), (-_DOUBLE_MAX, True), (_Count(3), True),
+    (_DOUBLE_MAX + 1, False), (-_DOUBLE_MAX - 1, False), (math.inf, False), (-math.inf, False), (math.nan, False),
+    (Fraction(1, 3), True), (Fraction(10**400), False)])
+def test_a_decoded_value_is_kept_exactly_when_a_double_holds_it(value, finite):
+    """The walk over a decoded sample passes JSON's own scalars at once: an integer up to the largest
+    double (2**1024 - 2**971) and a finite float are kept, one past it, inf and NaN are each a problem
+    (the sample's value path named), a CBOR rational becomes its float where one holds it."""
+    from physcam.live.sample import _non_finite
+
+    doc = {"lens": {"custom": [value]}}
+    problem = _non_finite(doc, ())
+    assert (problem is None) == finite, problem
+    if finite:
+        kept = doc["lens"]["custom"][0]
+        assert kept == (float(value) if isinstance(value, Fraction) else value) and type(kept) is (
+            float if isinstance(value, Fraction) else type(value))
+    else:
+        assert problem.path == "$.lens.custom[0]"

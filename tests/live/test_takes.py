@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 import csv
 import dataclasses
+import functools
 import json
 import os
 import signal
@@ -548,12 +549,43 @@ def test_absent_frames_counts_what_a_line_lacks(line, dropped, by):
     or the sequence numbers."""
     from physcam.live.record import absent_frames
 
-    frames = [f for i, f in enumerate(LINES[line]) if i not in dropped]
+    frames = [f for i, f in enumerate(_line_by(line, by)) if i not in dropped]
+    assert absent_frames(frames) == len(dropped)
+
+
+@functools.cache
+def _line_by(line, by):
+    """LINES[line] with only what places a frame ``by``: without timestamps, and without timecodes for
+    sequence numbers (made once per line and clock: dataclasses.replace of 2,000 frames for each of the
+    hypothesis examples was most of the test's time)."""
+    frames = LINES[line]
     if by != "timestamps":
         frames = [dataclasses.replace(f, time_ns=None) for f in frames]
     if by == "sequence numbers":
         frames = [dataclasses.replace(f, timecode=None) for f in frames]
-    assert absent_frames(frames) == len(dropped)
+    return frames
+
+
+RATES = [Fraction(24), Fraction(25), Fraction(24000, 1001), Fraction(30000, 1001), Fraction(120), Fraction(2),
+         Fraction(60000, 1001)]
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.sampled_from(RATES), st.lists(st.integers(0, 10**13), min_size=1, max_size=20),
+       st.lists(st.sampled_from([0, 10**9 // 4, 10**9 // 2, 3 * 10**9 // 4]), min_size=1, max_size=20))
+def test_timestamps_give_the_places_and_time_codes_of_exact_fractions(rate, offsets_ns, halves_ns):
+    """A frame's place (absent_frames) and USD time code (time_codes) from its timestamp, in integers,
+    are Python's Fraction arithmetic's: round(Fraction(dt, 1e9) * rate) (ties to even: quarter and half
+    seconds at 2 fps land on .5 of a frame) and round(float(that product), 6)."""
+    from physcam.live.record import _nearest, time_codes
+
+    stamps = sorted(T0_NS + o for o in offsets_ns + halves_ns)
+    for dt in (t - stamps[0] for t in stamps):
+        assert _nearest(dt, rate.numerator, 10**9 * rate.denominator) == round(Fraction(dt, 10**9) * rate)
+    frames = [TrackedFrame(time_ns=t, rate=rate) for t in stamps]
+    codes, fr = time_codes(frames)
+    assert fr == rate
+    assert codes == [round(float(Fraction(t - stamps[0], 10**9) * rate), 6) for t in stamps]
 
 
 @pytest.mark.parametrize("call", ["multicast_group", "build_packet", "Receiver", "timecode_fields", "Sender"])

@@ -121,3 +121,27 @@ def test_the_docs_example_runs():
     runner = doctest.DocTestRunner()
     runner.run(test)
     assert runner.summarize(verbose=False) == (0, 5)
+
+
+def test_a_real_lens_table_has_its_full_reports_limits_and_fields():
+    """A table's cells skip the real-ray field of view (nothing of the table reads it): each row of a
+    traced lens still holds its full report's limits, hyperfocal and paraxial field (solve_lens_report)."""
+    import warnings
+
+    from physcam.errors import PhysCamWarning
+    from physcam.lens.library import load_lens
+    from physcam.onset.dof_table import dof_cells, dof_table
+    from physcam.onset.report import solve_lens_report
+    from physcam.optics.sensors import find_sensor
+
+    lens, sensor = load_lens("dgauss_50mm"), find_sensor("S35")
+    d = dof_table(lens=lens, sensor=sensor, fstops=[2.8, 8], focus_marks_mm=[1500.0, 4000.0], coc=C)
+    cells = [(n, m) for n in (2.8, 8) for m in (1500.0, 4000.0)]
+    for (n, m), row in zip(cells, d["rows"]):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PhysCamWarning)
+            full = solve_lens_report(focal_length_mm=None, lens=lens, sensor=sensor, fstop=n, focus_mm=m, coc=C)
+        assert full.real_fov is not None  # the full report traces it
+        assert (row["near_from_film_mm"], row["far_from_film_mm"], row["hyperfocal_from_film_mm"], row["hfov_deg"]) == \
+            (full.dof.near_from_film_mm, full.dof.far_from_film_mm, full.dof.hyperfocal_from_film_mm, full.hfov_focus_deg)
+        assert dof_cells(lens=lens, sensor=sensor, coc=C)(n, m).dof == full.dof

@@ -237,6 +237,38 @@ def test_rectilinear_lens_real_field_agrees_and_does_not_warn():
     assert not r.real_fov_differs
 
 
+@pytest.mark.parametrize("lens_name", ["nikkor_fisheye_16mm_f2_8", "dgauss_50mm"])
+def test_a_report_without_the_real_field_is_the_full_report_less_it(lens_name):
+    """real_fov=False (a depth-of-field chart's cells) leaves out the traced field, its note and its warning;
+    every other number is the full report's. The chart's cells, solved so, have the full reports' limits."""
+    import warnings
+
+    from physcam.cli.report import dof_chart_solver
+    from physcam.lens.library import load_lens
+    from physcam.onset.report import solve_report
+    from physcam.onset.request import report_camera
+
+    inputs = dict(focal_length_mm=None, sensor=find_sensor("FF"), focus_mm=3000.0, fstop=4.0, lens=load_lens(lens_name))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PhysCamWarning)  # the fisheye's (test_fisheye_report_gives_the_real_ray_field...)
+        full = solve_report(report_camera(**inputs))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", PhysCamWarning)
+        lean = solve_report(report_camera(**inputs), real_fov=False)
+    assert full.real_fov is not None and lean.real_fov is None
+    a, b = full.to_dict(), lean.to_dict()
+    for d in (a, b):
+        d["fov_deg"].pop("real"), d["fov_deg"].pop("real_differs")
+        d["notes"] = [n for n in d["notes"] if "real chief rays" not in n]
+    assert a == b
+    solve = dof_chart_solver(None, full)
+    for fstop, mark in ((2.8, 1000.0), (8.0, 2500.0), (16.0, 9000.0)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", PhysCamWarning)
+            expected = solve_lens_report(**dict(inputs, fstop=fstop, focus_mm=mark)).dof
+        assert solve(fstop, mark).dof == expected
+
+
 def test_a_flange_distance_only_moves_offsets_given_from_the_flange():
     """Datasheet offsets are in front of their reference plane (docs/conventions.md): from the film, a
     flange focal distance given beside them changes nothing; from the flange, H1 = FFD + offset (by hand:

@@ -169,7 +169,8 @@ def dof_chart_solver(args, report):
     """``solve(fstop, focus_mm)`` for :func:`physcam.onset.dof_plot.dof_chart_figure`: the report of the
     camera of ``report`` (after :func:`solve_from_args`) at another stop and focus mark, with the report's
     CoC and sensor and no measured limits, so that the chart and the report agree at the report's own
-    cell. The cameras share the lens model, so a prescription focuses at each mark once."""
+    cell. The cameras share the lens model, so a prescription focuses at each mark once; a cell's report
+    leaves out the real-ray field of view (the chart reads its depth of field: ``real_fov=False``)."""
     from .._record import replace
 
     from ..onset.report import solve_report
@@ -180,7 +181,7 @@ def dof_chart_solver(args, report):
     def solve(fstop, focus_mm):
         at = camera_state(cam.lens_model, focus_mm=focus_mm, fstop=fstop, sensor=cam.sensor, squeeze=cam.squeeze,
                           zoom=cam.zoom)
-        return solve_report(at, coc=report.coc_mm, references=refs)
+        return solve_report(at, coc=report.coc_mm, references=refs, real_fov=False)
 
     return solve
 

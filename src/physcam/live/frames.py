@@ -35,7 +35,9 @@ are composed too; the camera's orientation is the rotation left after removing t
 
 from __future__ import annotations
 
+import functools
 import math
+import re
 import uuid
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
@@ -122,7 +124,7 @@ def rate_fraction(rate) -> Fraction:
         ntsc = round(r * 1.001)
         fr = Fraction(ntsc * 1000, 1001) if abs(r * 1.001 - ntsc) < 5e-4 and abs(r - ntsc) > 1e-6 \
             else Fraction(r).limit_denominator(1001)
-    if not 0 < fr <= 10000:
+    if not 0 < fr.numerator <= 10000 * fr.denominator:  # 0 < fr <= 10000 (a denominator is > 0), in integers
         raise InputError(f"frame rate must lie in (0, 10000] fps, got {float(fr):g}")
     return fr
 
@@ -133,34 +135,49 @@ def rational(rate) -> dict:
     return {"num": fr.numerator, "denom": fr.denominator}
 
 
-def _drop_count(tc_rate: Fraction) -> int:
-    """Frame numbers a drop-frame timecode skips each minute (SMPTE ST 12-1: 2 at 30000/1001, 4 at
-    60000/1001); 0 where the rate has no drop-frame form."""
-    return {Fraction(30000, 1001): 2, Fraction(60000, 1001): 4}.get(tc_rate, 0)
+_DROP_COUNTS = {Fraction(30000, 1001): 2, Fraction(60000, 1001): 4}
 
 
-def _timecode_rate(fr: Fraction) -> tuple[int, Fraction, int]:
-    """(samples per timecode frame k, the timecode's rate, its nominal frames per second)."""
+@functools.lru_cache(maxsize=64)
+def _clock(num: int, den: int) -> tuple[int, Fraction, int, int]:
+    """The timecode of the sample rate num/den: (samples per timecode frame k, the timecode's rate, its
+    nominal frames per second, the frame numbers drop-frame counting skips each minute: 2 at 30000/1001,
+    4 at 60000/1001, SMPTE ST 12-1; 0 where the rate has no drop-frame form). Remembered per rate (by
+    its integers: a Fraction's hash is a modular inverse): every sample sent and every timecode read
+    asks it again, of the stream's one rate."""
+    fr = Fraction(num, den)
     nominal = math.ceil(fr - Fraction(1, 10**6))
     k = max(1, math.ceil(nominal / 60))  # samples per timecode frame
-    return k, fr / k, math.ceil(nominal / k)
+    tc_rate = fr / k
+    return k, tc_rate, math.ceil(nominal / k), _DROP_COUNTS.get(tc_rate, 0)
+
+
+def _timecode_clock(fr: Fraction) -> tuple[int, Fraction, int, int]:
+    """:func:`_clock` of the sample rate ``fr`` (a :func:`rate_fraction`)."""
+    return _clock(fr.numerator, fr.denominator)
+
+
+_TIMECODE = re.compile(r"(\d{1,2}):(\d{2}):(\d{2})([:;.])(\d{1,3})")
+_SUB_FRAME = re.compile(r"(.+[:;]\d{1,3})\.(\d{1,3})")
 
 
 def parse_timecode(text, rate, drop_frame: bool = False) -> int:
     """The timecode frame count of ``text`` ("HH:MM:SS:FF", ";" before FF for drop-frame) at ``rate``:
     the number of timecode frames since 00:00:00:00 (a drop-frame label's skipped numbers not counted)."""
-    import re
+    return _frame_count(text, _timecode_clock(rate_fraction(rate)), drop_frame)
 
-    fr = rate_fraction(rate)
-    _, tc_rate, per_s = _timecode_rate(fr)
-    m = re.fullmatch(r"(\d{1,2}):(\d{2}):(\d{2})([:;.])(\d{1,3})", str(text).strip())
+
+def _frame_count(text, clock, drop_frame: bool) -> int:
+    """:func:`parse_timecode` at the rate whose :func:`_clock` is ``clock``."""
+    _, tc_rate, per_s, drop_count = clock
+    m = _TIMECODE.fullmatch(str(text).strip())
     if not m:
         raise InputError(f"a timecode is HH:MM:SS:FF, got {text!r:.40}")
-    h, mi, se, ff = (int(m.group(i)) for i in (1, 2, 3, 5))
+    h, mi, se, ff = int(m.group(1)), int(m.group(2)), int(m.group(3)), int(m.group(5))
     drop = drop_frame or m.group(4) == ";"
     if h > 23 or mi > 59 or se > 59 or ff >= per_s:
         raise InputError(f"timecode {text} is out of range at {per_s} frames a second")
-    d = _drop_count(tc_rate) if drop else 0
+    d = drop_count if drop else 0
     if drop and not d:
         raise InputError(f"drop-frame timecode exists at 30000/1001 and 60000/1001 fps, not {tc_rate}")
     if d and se == 0 and ff < d and mi % 10:
@@ -174,15 +191,13 @@ def timecode_index(text, rate, drop_frame: bool = False) -> int:
     ("HH:MM:SS:FF", ";" before FF for drop-frame, ".N" after it for the sub-frame above 60 fps) at the
     stream's sample ``rate``: :func:`parse_timecode`'s frame count times the samples per timecode
     frame, plus the sub-frame."""
-    import re
-
-    fr = rate_fraction(rate)
-    k = _timecode_rate(fr)[0]
-    m = re.fullmatch(r"(.+[:;]\d{1,3})\.(\d{1,3})", str(text).strip())
+    clock = _timecode_clock(rate_fraction(rate))
+    k = clock[0]
+    m = _SUB_FRAME.fullmatch(str(text).strip())
     label, sub = (m.group(1), int(m.group(2))) if m else (text, 0)
     if sub >= k:
         raise InputError(f"timecode {text} has a sub-frame beyond the {k} samples of a timecode frame")
-    return parse_timecode(label, fr, drop_frame) * k + sub
+    return _frame_count(label, clock, drop_frame) * k + sub
 
 
 def timecode_fields(frame: int, rate, *, start: int = 0, drop_frame: bool = False) -> dict:
@@ -198,8 +213,8 @@ def timecode_fields(frame: int, rate, *, start: int = 0, drop_frame: bool = Fals
         raise InputError(f"frame must be a whole number >= 0, got {shown(frame)}")
     if isinstance(start, bool) or not isinstance(start, (int, np.integer)) or start < 0:
         raise InputError(f"the start timecode must be a whole number of frames >= 0, got {shown(start)}")
-    k, tc_rate, per_s = _timecode_rate(fr)
-    d = _drop_count(tc_rate) if drop_frame else 0
+    k, tc_rate, per_s, drop_count = _timecode_clock(fr)
+    d = drop_count if drop_frame else 0
     if drop_frame and not d:
         raise InputError(f"drop-frame timecode exists at 30000/1001 and 60000/1001 fps, not {tc_rate}")
     f, sub = divmod(int(frame), k)

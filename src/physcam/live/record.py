@@ -168,15 +168,26 @@ def time_codes(frames, rate=None) -> tuple[list[float], Fraction]:
     if fr is None:
         raise InputError("the stream gives no sample rate; give the frame rate (--fps)")
     if all(f.time_ns is not None for f in frames):
-        t0 = frames[0].time_ns
+        t0 = int(frames[0].time_ns)
         # integer-nanosecond stamps of a rational rate land within 1e-6 of a frame: snap to 1e-6
-        codes = [round(float(Fraction(f.time_ns - t0, 1_000_000_000) * fr), 6) for f in frames]
+        # (dt / 1e9 s) * fr in integers: Python's int / int is correctly rounded, as float(Fraction) is,
+        # without a Fraction made per frame
+        q = fr if isinstance(fr, Fraction) else Fraction(fr)  # a rate given as a float: its exact value
+        num, den = q.numerator, 1_000_000_000 * q.denominator
+        codes = [round((int(f.time_ns) - t0) * num / den, 6) for f in frames]
     elif all(f.sequence_number is not None for f in frames):
         s0 = frames[0].sequence_number
         codes = [float(f.sequence_number - s0) for f in frames]
     else:
         codes = [float(i) for i in range(len(frames))]
     return codes, fr
+
+
+def _nearest(n: int, num: int, den: int) -> int:
+    """round(n * num / den) in integers (den > 0), ties to even as round(Fraction) does: a frame's place
+    from its timestamp without a Fraction made per frame."""
+    q, r = divmod(n * num, den)
+    return q + (2 * r > den or (2 * r == den and q % 2 == 1))
 
 
 def absent_frames(frames, rate=None) -> int:
@@ -195,8 +206,10 @@ def absent_frames(frames, rate=None) -> int:
     fr = next((f.rate for f in frames if f.rate is not None), None)
     fr = rate_fraction(rate) if fr is None and rate is not None else fr
     if fr is not None and all(f.time_ns is not None for f in frames):
-        t0 = frames[0].time_ns
-        places = {round(Fraction(f.time_ns - t0, 1_000_000_000) * fr) for f in frames}
+        t0 = int(frames[0].time_ns)
+        q = fr if isinstance(fr, Fraction) else Fraction(fr)
+        num, den = q.numerator, 1_000_000_000 * q.denominator
+        places = {_nearest(int(f.time_ns) - t0, num, den) for f in frames}
     elif fr is not None and all(f.timecode is not None for f in frames):
         places = {timecode_index(f.timecode, fr, f.drop_frame) for f in frames}
     elif all(f.sequence_number is not None for f in frames):

@@ -267,6 +267,10 @@ def _non_finite(obj, parts, depth=0):
                                      f"a key that is {shown(k)}, not text (JSON keys are text)")
     items = obj.items() if isinstance(obj, dict) else enumerate(obj) if isinstance(obj, list) else ()
     for k, v in items:
+        t = type(v)  # JSON's own scalars, finite, passed at once (an isinstance of the numbers ABC is slow):
+        if t is str or t is float and math.isfinite(v) or t is bool or v is None \
+                or t is int and -_FLOAT_MAX_INT <= v <= _FLOAT_MAX_INT:  # what the branches below would pass
+            continue
         if isinstance(v, (dict, list)):
             bad = _non_finite(v, parts + (k,), depth + 1)
             if bad:

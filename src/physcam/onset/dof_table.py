@@ -126,12 +126,13 @@ def _table_lens(focal_length_mm, lens, sensor, squeeze, zoom):
 def _cells(focal_length_mm, lens, sensor, coc, squeeze, zoom):
     """(``cell(fstop, mark) -> LensReport``, the lens at its zoom position, the ``zoom`` block) of a table's
     options: each cell ``physcam report`` of this lens at that stop and mark, the lens zoomed and the squeeze read
-    once."""
+    once. A cell reads its limits and the paraxial field: its report leaves out a traced lens's real-ray field of
+    view (``real_fov=False``: tracing it took most of a real lens's cell)."""
     lens, squeeze, zoom_block = _table_lens(focal_length_mm, lens, sensor, squeeze, zoom)
 
     def cell(fstop, mark):
         return solve_report(report_camera(focal_length_mm=focal_length_mm, lens=lens, sensor=sensor, fstop=fstop,
-                                          focus_mm=mark, coc=coc, squeeze=squeeze))
+                                          focus_mm=mark, coc=coc, squeeze=squeeze), real_fov=False)
 
     return cell, lens, zoom_block
 

@@ -387,7 +387,7 @@ def _frame_dict(report) -> dict | None:
 
 # --------------------------------------------------------------------------------------
 def solve_report(camera, *, coc=None, measured: MeasuredLimits | None = None,
-                 references: References | None = None) -> LensReport:
+                 references: References | None = None, real_fov: bool = True) -> LensReport:
     """The lens report of ``camera`` (:class:`~physcam.optics.state.CameraState`: a lens model focused
     and stopped on a sensor): a view of the camera, composed of the solvers of
     :mod:`physcam.onset.solvers` in the order the optics needs them.
@@ -402,6 +402,9 @@ def solve_report(camera, *, coc=None, measured: MeasuredLimits | None = None,
     f-number at the focus (:attr:`LensReport.f_number_at_focus`). A :class:`ReportRequest` first (the
     pre-issue-43 form) or the :class:`~physcam.onset.request.ReportInputs` of
     :func:`~physcam.onset.request.report_camera` is read as its camera and options.
+    ``real_fov`` False leaves out the real-ray field of view of a traceable lens (its chief rays traced, about
+    three quarters of such a report's time; the paraxial field stays), for callers that read other numbers
+    of many reports: a depth-of-field chart's cells (:func:`physcam.onset.dof_plot.dof_chart_data`).
     """
     if isinstance(camera, (ReportRequest, ReportInputs)):  # the inputs of a front end, whole
         camera, coc, measured, references = camera.inputs if isinstance(camera, ReportRequest) else camera
@@ -443,7 +446,7 @@ def solve_report(camera, *, coc=None, measured: MeasuredLimits | None = None,
         entrance_pupil_horizontal_from_film_mm=at.pupil_x_from_film_mm if pupil_src == "prescription" else None,
         **field_of_view(camera, h2_film, refs, at))
     report = replace(report, notes=report.notes + (report.diffraction_note(),))
-    if camera.traceable:
+    if camera.traceable and real_fov:
         report = _with_real_fov(report, camera)
     _check_finite(report)
     return report
