@@ -21,7 +21,8 @@ With ``--baseline-src`` the same lenses are measured with that checkout's physca
 ``PYTHONPATH=<src>``, one lens of each side in turn, so both see the same load), and the ratio is printed
 with the largest difference between the two sides' pupil tables (``FocusTable.radial``: per entry the
 change of cx, ax and ay over the entry's size max(ax, ay); the area's relative change where both sides
-trust it, and the entries whose trust differs) and norm tables (relative).
+trust it, and the entries whose trust differs) and norm tables (relative), at the iris levels both sides
+tabulate.
 """
 
 from __future__ import annotations
@@ -77,7 +78,8 @@ def worker(lens_name: str, out: str) -> None:
     lens_payload(lens, lens_name)
     cpu = time.process_time() - t
     ft = kept["ft"]
-    np.savez(out, radial=ft.radial if ft.radial is not None else np.zeros(0), norm=ft.norm)
+    np.savez(out, radial=ft.radial if ft.radial is not None else np.zeros(0), norm=ft.norm,
+             levels=np.asarray(ft.levels, dtype=float))
     print(json.dumps({"lens": lens_name, "cpu_s": cpu, "src": os.path.dirname(os.path.dirname(bf.__file__))}))
 
 
@@ -176,11 +178,17 @@ def same_lens_files(zip_a: str, zip_b: str) -> tuple[int, list[str]]:
 
 
 def table_change(old: dict, new: dict) -> dict:
-    """The largest differences between two sides' tables of one lens (module notes)."""
-    a, b = old["radial"], new["radial"]
-    if a.shape != b.shape or old["norm"].shape != new["norm"].shape:  # another grid of radii or levels
+    """The largest differences between two sides' tables of one lens (module notes), at the iris levels both
+    tabulate (a lens's refined levels may differ: the levels a side adds, :func:`_refined_levels`, are left out)."""
+    a, b, na, nb = old["radial"], new["radial"], old["norm"], new["norm"]
+    if "levels" in old and "levels" in new and a.ndim == 4 and b.ndim == 4:  # (marks, levels, radii, 5)
+        la, lb = old["levels"], new["levels"]
+        common = np.intersect1d(la, lb)
+        ia, ib = np.searchsorted(-la, -common[::-1]), np.searchsorted(-lb, -common[::-1])
+        a, b, na, nb = a[:, ia], b[:, ib], na[:, ia], nb[:, ib]
+    if a.shape != b.shape or na.shape != nb.shape:  # another grid of radii or levels
         return {"ellipse": math.nan, "area": math.nan, "trust_flips": -1, "norm": math.nan}
-    out = {"norm": float(np.max(np.abs(new["norm"] / old["norm"] - 1)))}
+    out = {"norm": float(np.max(np.abs(nb / na - 1)))}
     if a.size == 0:
         return out | {"ellipse": 0.0, "area": 0.0, "trust_flips": 0}
     size = np.maximum(a[..., 1], a[..., 2])

@@ -576,6 +576,9 @@ _FAN = 41  # meridional aims across a film point's box where its chief aim is lo
 #: The lines serve an iris radius only where it is under every cut line's edge (in stop radius) by this
 #: share: there the iris alone bounds the set (module notes); the wider radii take the aim grids
 _LINE_MARGIN = 0.05
+#: ... and only where the rim's place on every line is the same, to this share of its distance from the chief aim,
+#: by the quadratics through the samples about it and the next one in or out (:meth:`_LineSets._rim_t`)
+_LINE_DOUBT = 2e-4
 
 
 def _chief_aims(q, film_z: float, fxs, boxes, big: float, backend: str) -> tuple[np.ndarray, np.ndarray]:
@@ -617,7 +620,7 @@ class _LineSets:
     over :data:`_LINE_SPAN` out past the widest's, extended while the last one passes inside the widest
     iris), and where another surface cuts the line its edge is halved :data:`_LINE_HALVINGS` times. The rim of
     iris radius s on a line is where r = s, interpolated in log t against log r between the two samples
-    about it (exact where r grows as a power of t; from c to the first sample r ~ t), or the clip edge where
+    about it and the next (Lagrange's quadratic in log r; from c to the first sample r ~ t), or the clip edge where
     the line is cut before r reaches s (held at the halving's far end, its area at the middle). The set's
     area is the polar integral of t(theta)^2 by the trapezoid rule over the lines (t(theta)^2 is periodic
     and even in theta: the rule converges faster than any power of the step where the rim is smooth), and its
@@ -690,24 +693,40 @@ class _LineSets:
         self.c, self.t, self.r, self.n = cx[star], t[star], r[star], n[star]
         self.lo, self.hi, self.cut = lo[star], hi[star], cut[star]
         self.theta = theta
+        # the lines serve no radius at or above one whose interpolation they doubt (the grids take those)
+        doubt = (self._rim_t(radii)[2] > _LINE_DOUBT).any(axis=1)  # (points, radii)
+        self.first = np.maximum(self.first, np.where(doubt.any(axis=1), radii.size - np.argmax(doubt[:, ::-1], axis=1), 0))
+
+    def _rim_t(self, s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(held t, mean t, doubt): per film point, line and iris radius of ``s``, where the rim crosses the line
+        (held: a cut line's far end; mean: its middle) and the interpolation's doubt (relative, in t)."""
+        s = np.asarray(s, dtype=float)
+        j = (self.r[:, :, None, :] < s[None, None, :, None]).sum(axis=3)  # the samples under s (an empty slot's r is inf)
+        beyond = j >= self.n[..., None]  # past the last passing sample: the clip edge (every line is cut or reaches s)
+        lt, lr = np.log(self.t), np.log(self.r)
+        ls = np.log(np.broadcast_to(s[None, None, :], j.shape))
+
+        def quad(a):  # Lagrange's quadratic of log t in log r through the samples a, a + 1, a + 2
+            t0, t1, t2 = (np.take_along_axis(lt, a + i, 2) for i in range(3))
+            r0, r1, r2 = (np.take_along_axis(lr, a + i, 2) for i in range(3))
+            return (t0 * (ls - r1) * (ls - r2) / ((r0 - r1) * (r0 - r2)) + t1 * (ls - r0) * (ls - r2) / ((r1 - r0) * (r1 - r2))
+                    + t2 * (ls - r0) * (ls - r1) / ((r2 - r0) * (r2 - r1)))
+
+        n = self.n[..., None]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            # the two samples about s and the next one out (in at the line's last), and the one in instead: where
+            # the two quadratics differ the curve bends too fast for the samples (r flattens toward a clip)
+            q1, q2 = quad(np.clip(j - 1, 0, n - 3)), quad(np.clip(j - 2, 0, n - 3))
+            t_iris = np.where(j == 0, np.exp(lt[..., :1] + ls - lr[..., :1]), np.exp(q1))  # under the first: r ~ t
+            doubt = np.where((j == 0) | beyond, 0.0, np.abs(np.expm1(q2 - q1)))
+        held = np.where(beyond, self.hi[..., None], t_iris)
+        mean = np.where(beyond, 0.5 * (self.lo[..., None] + self.hi[..., None]), t_iris)
+        return held, mean, np.where(np.isfinite(doubt), doubt, np.inf)
 
     def rims(self, s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(x, y, area): per film point served and iris radius of ``s``, the rim's points held out (x, y: points
         x radii x lines) and the passing set's area (mm^2, both halves)."""
-        s = np.asarray(s, dtype=float)
-        t, r = self.t[:, :, None, :], self.r[:, :, None, :]  # (points, lines, 1, samples)
-        j = (r < s[None, None, :, None]).sum(axis=3)  # the samples under s (r rises; an empty slot's r is inf)
-        beyond = j >= self.n[..., None]  # past the last passing sample: the clip edge (every line is cut or reaches s)
-        at = np.minimum(j, t.shape[3] - 1)[..., None]
-        t1, r1 = np.take_along_axis(t[:, :, 0], at[..., 0], 2), np.take_along_axis(r[:, :, 0], at[..., 0], 2)
-        b = np.maximum(at[..., 0] - 1, 0)
-        t0, r0 = np.take_along_axis(t[:, :, 0], b, 2), np.take_along_axis(r[:, :, 0], b, 2)
-        sb = np.broadcast_to(s[None, None, :], j.shape)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t_iris = np.where(j == 0, t1 * sb / r1, t0 * np.exp(np.log(sb / r0) / np.log(r1 / r0) * np.log(t1 / t0)))
-        lo, hi = self.lo[..., None], self.hi[..., None]
-        held = np.where(beyond, hi, t_iris)
-        mean = np.where(beyond, 0.5 * (lo + hi), t_iris)
+        held, mean, _ = self._rim_t(s)
         step = self.theta[1] - self.theta[0]
         w = np.full(self.theta.size, step)
         w[[0, -1]] *= 0.5
