@@ -579,6 +579,7 @@ _LINE_MARGIN = 0.05
 #: ... and only where the rim's place on every line is the same, to this share of its distance from the chief aim,
 #: by the quadratics through the samples about it and the next one in or out (:meth:`_LineSets._rim_t`)
 _LINE_DOUBT = 2e-4
+_BAND = 400.0  # :meth:`_LineSets._rim_t`'s search: each line's log stop radii in a band this wide
 
 
 def _chief_aims(q, film_z: float, fxs, boxes, big: float, backend: str) -> tuple[np.ndarray, np.ndarray]:
@@ -684,6 +685,7 @@ class _LineSets:
         valid = np.isfinite(t)
         with np.errstate(invalid="ignore"):
             star &= ~(valid[..., 1:] & ~(np.diff(r, axis=2) > 0)).any(axis=(1, 2))  # r rises along every line
+        star &= (valid.sum(axis=2) >= 3).all(axis=1)  # three samples a line at least (the rim's quadratic)
         n = valid.sum(axis=2)
         # the stop radius at each cut line's last passing point (r rises along it): an iris radius s with
         # s (1 + _LINE_MARGIN) under every one of them is the iris's alone on every line
@@ -693,40 +695,60 @@ class _LineSets:
         self.c, self.t, self.r, self.n = cx[star], t[star], r[star], n[star]
         self.lo, self.hi, self.cut = lo[star], hi[star], cut[star]
         self.theta = theta
-        # the lines serve no radius at or above one whose interpolation they doubt (the grids take those)
-        doubt = (self._rim_t(radii)[2] > _LINE_DOUBT).any(axis=1)  # (points, radii)
+        # every rim's place on every line, once; the lines serve no radius at or above one whose interpolation
+        # they doubt (the grids take those)
+        self.radii = radii
+        self.held, self.mean, doubt = self._rim_t(radii)
+        doubt = (doubt > _LINE_DOUBT).any(axis=1)  # (points, radii)
         self.first = np.maximum(self.first, np.where(doubt.any(axis=1), radii.size - np.argmax(doubt[:, ::-1], axis=1), 0))
 
     def _rim_t(self, s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(held t, mean t, doubt): per film point, line and iris radius of ``s``, where the rim crosses the line
         (held: a cut line's far end; mean: its middle) and the interpolation's doubt (relative, in t)."""
         s = np.asarray(s, dtype=float)
-        j = (self.r[:, :, None, :] < s[None, None, :, None]).sum(axis=3)  # the samples under s (an empty slot's r is inf)
-        beyond = j >= self.n[..., None]  # past the last passing sample: the clip edge (every line is cut or reaches s)
-        lt, lr = np.log(self.t), np.log(self.r)
-        ls = np.log(np.broadcast_to(s[None, None, :], j.shape))
+        n_points, n_lines, n_samples = self.t.shape
+        lines = n_points * n_lines
+        if not lines:  # no film point on lines
+            return (np.zeros((n_points, n_lines, s.size)),) * 3
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lt, lr = np.log(self.t).reshape(lines, -1), np.log(self.r).reshape(lines, -1)
+            # Newton's divided differences of log t in log r of every three samples in a row (empty slots: nan)
+            d01 = np.diff(lt, axis=1) / np.diff(lr, axis=1)
+            d012 = (np.diff(d01, axis=1) / (lr[:, 2:] - lr[:, :-2])).ravel()
+        d01 = d01.ravel()
+        # the samples under s per line (r rises along it; an empty slot's is inf): one search over every line's
+        # log r, each line in its own band (log r spans far less than _BAND)
+        line = np.arange(lines)[:, None]
+        band = line * _BAND
+        ls = np.log(s)[None, :]
+        j = np.searchsorted((band + np.minimum(lr, _BAND / 4)).ravel(), (band + ls).ravel(), side="left").reshape(lines, -1)
+        j -= line * n_samples
+        n = self.n.reshape(lines, 1)
+        beyond = j >= n  # past the last passing sample: the clip edge (every line is cut or reaches s)
+        lt, lr = lt.ravel(), lr.ravel()
 
-        def quad(a):  # Lagrange's quadratic of log t in log r through the samples a, a + 1, a + 2
-            t0, t1, t2 = (np.take_along_axis(lt, a + i, 2) for i in range(3))
-            r0, r1, r2 = (np.take_along_axis(lr, a + i, 2) for i in range(3))
-            return (t0 * (ls - r1) * (ls - r2) / ((r0 - r1) * (r0 - r2)) + t1 * (ls - r0) * (ls - r2) / ((r1 - r0) * (r1 - r2))
-                    + t2 * (ls - r0) * (ls - r1) / ((r2 - r0) * (r2 - r1)))
+        def quad(a):  # Lagrange's quadratic of log t in log r through the samples a, a + 1, a + 2 of each line
+            i, k = line * n_samples + a, line * (n_samples - 2) + a
+            return lt[i] + (ls - lr[i]) * (d01[i - line] + (ls - lr[i + 1]) * d012[k])
 
-        n = self.n[..., None]
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        with np.errstate(invalid="ignore", over="ignore"):
             # the two samples about s and the next one out (in at the line's last), and the one in instead: where
             # the two quadratics differ the curve bends too fast for the samples (r flattens toward a clip)
             q1, q2 = quad(np.clip(j - 1, 0, n - 3)), quad(np.clip(j - 2, 0, n - 3))
-            t_iris = np.where(j == 0, np.exp(lt[..., :1] + ls - lr[..., :1]), np.exp(q1))  # under the first: r ~ t
+            first = line * n_samples
+            t_iris = np.where(j == 0, np.exp(lt[first] + ls - lr[first]), np.exp(q1))  # under the first: r ~ t
             doubt = np.where((j == 0) | beyond, 0.0, np.abs(np.expm1(q2 - q1)))
+        shape = (n_points, n_lines, s.size)
+        t_iris, doubt, beyond = t_iris.reshape(shape), doubt.reshape(shape), beyond.reshape(shape)
         held = np.where(beyond, self.hi[..., None], t_iris)
         mean = np.where(beyond, 0.5 * (self.lo[..., None] + self.hi[..., None]), t_iris)
         return held, mean, np.where(np.isfinite(doubt), doubt, np.inf)
 
     def rims(self, s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(x, y, area): per film point served and iris radius of ``s``, the rim's points held out (x, y: points
-        x radii x lines) and the passing set's area (mm^2, both halves)."""
-        held, mean, _ = self._rim_t(s)
+        """(x, y, area): per film point served and iris radius of ``s`` (radii the sets were traced for), the rim's
+        points held out (x, y: points x radii x lines) and the passing set's area (mm^2, both halves)."""
+        at = np.searchsorted(-self.radii, -np.asarray(s, dtype=float))  # the radii of s among those traced for
+        held, mean = self.held[:, :, at], self.mean[:, :, at]
         step = self.theta[1] - self.theta[0]
         w = np.full(self.theta.size, step)
         w[[0, -1]] *= 0.5
