@@ -27,11 +27,12 @@ surfaces or not; the double Gauss and the Canon RF 85, f/2 to f/16, film radius 
 Where the iris alone bounds a set the grids are not needed: its rim is found along 25 lines from the
 film point's chief aim (the aim whose ray crosses the stop's centre: every set holds it, and a convex set
 is star-shaped from it), the stop radius sampled geometrically along each line and the rim interpolated
-where it reaches s (:class:`_LineSets`; about 600 rays a film point against 3,000 in grids). The lines serve
-the iris radii under every cut line's clip edge by 5 %, so no other surface reaches the set; the wider
-radii (where other surfaces cut the set: wide open, off axis) and the film points whose chief ray is cut
-(outside the image circle) keep the grids. Their areas are a dense trace's within 0.2 % (the fisheye, a
-zoom, the double Gauss, the Canon RF 85: tests/export/test_blender_pupil_lines.py).
+where it reaches s (:class:`_LineSets`; about 620 rays a film point against about 3,400 in grids). The lines
+serve the iris radii under every cut line's clip edge by 5 %, so no other surface reaches the set, and only
+where the interpolation is sure of the rim (:data:`_LINE_DOUBT`); the wider radii (where other surfaces cut
+the set: wide open, off axis) and the film points whose chief ray is cut (outside the image circle) keep the
+grids. The lines' areas are a dense trace's within 0.1 % (the grids' about 0.25 % short; the double Gauss,
+a fisheye, a zoom, the Canon RF 85 and the Angenieux f/1: tests/export/test_blender_pupil_lines.py).
 
 The shader interpolates the ellipse linearly in rho between nodes, in s between levels (below the
 last level it scales the last level's axes by s / s_last: the pupil's linear regime) and between
