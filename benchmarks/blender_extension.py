@@ -169,7 +169,7 @@ def main_build(args, here: str) -> None:
 def main_rims(names) -> None:
     """``--rims``: per lens with rotational symmetry, at infinity and the closest focus (a zoom at both ends), every
     rim the pupil tables find along lines (``blender_pupil._LineSets``) against the aim grids' at the same film and
-    iris radius (``_PassingSets`` without lines: the dense search), and the largest one against a dense trace
+    iris radius (``_PassingSets`` without lines: the dense search), and the largest and smallest ratio against a dense trace
     (400 x 200 aims over the y >= 0 half of its ellipse's box, 1.25x): areas, and the dense passing aims outside
     the ellipse fitted to the lines' rim."""
     import physcam.export.blender_pupil as bp
@@ -186,7 +186,7 @@ def main_rims(names) -> None:
         lens0 = load_lens(name)
         if lens0.is_anamorphic:
             continue
-        rels, worst, points = [], None, 0
+        rels, ends, points = [], {}, 0
         for u in ([0.0, 1.0] if lens0.zoom is not None else [None]):
             lens = lens0 if u is None else prescription_at(lens0, u)
             for d in (math.inf, closest_focus(lens) * 1.0001):
@@ -206,29 +206,34 @@ def main_rims(names) -> None:
                 both = served & ln.have & (g.index >= 0) & (ln.index >= 0)
                 rel = ln.rims.area[ln.index[both]] / g.rims.area[g.index[both]] - 1
                 rels.append(rel)
-                if rel.size:
-                    i = int(np.argmax(np.abs(rel)))
-                    if worst is None or abs(rel[i]) > abs(worst[0]):
-                        p, r = (a[i] for a in np.nonzero(both))
-                        worst = (rel[i], q, film_z, g, ln, p, r, u, d)
+                for side, pick in (("largest", np.argmax), ("smallest", np.argmin)):
+                    if rel.size:
+                        i = int(pick(rel))
+                        if side not in ends or (rel[i] > ends[side][0]) == (side == "largest"):
+                            p, r = (a[i] for a in np.nonzero(both))
+                            ends[side] = (rel[i], q, film_z, g, ln, p, r, u, d)
         rel = np.concatenate(rels)
         every.append(rel)
-        r_, q, film_z, g, ln, p, r, u, d = worst
-        s, rho = g.radii[r], g.rhos[p]
-        cx, ax, ay, a_l = bp._fits(ln.rims, np.array([ln.index[p, r]]))[0]
-        gx, gy = np.meshgrid(cx + ((np.arange(400) + 0.5) / 400 * 2 - 1) * 1.25 * ax, (np.arange(200) + 0.5) / 200 * 1.25 * ay)
-        gx, gy = gx.ravel(), gy.ravel()
-        rays = RayBatch.from_arrays(np.broadcast_to([rho, 0.0, film_z], (gx.size, 3)),
-                                    np.stack([gx - rho, gy, np.full(gx.size, q.vertex_z[-1] - film_z)], axis=1), q.wavelength_nm)
-        trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=s, in_place=True)
-        ok = rays.flag == OK
-        dense = 2 * ok.sum() / gx.size * (2.5 * ax) * (1.25 * ay)
-        out = int((((gx[ok] - cx) / ax) ** 2 + (gy[ok] / ay) ** 2 > 1).sum())
+        text = []
+        for side, (r_, q, film_z, g, ln, p, r, u, d) in ends.items():
+            s, rho = g.radii[r], g.rhos[p]
+            cx, ax, ay, a_l = bp._fits(ln.rims, np.array([ln.index[p, r]]))[0]
+            gx, gy = np.meshgrid(cx + ((np.arange(400) + 0.5) / 400 * 2 - 1) * 1.25 * ax,
+                                 (np.arange(200) + 0.5) / 200 * 1.25 * ay)
+            gx, gy = gx.ravel(), gy.ravel()
+            rays = RayBatch.from_arrays(np.broadcast_to([rho, 0.0, film_z], (gx.size, 3)),
+                                        np.stack([gx - rho, gy, np.full(gx.size, q.vertex_z[-1] - film_z)], axis=1),
+                                        q.wavelength_nm)
+            trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=s, in_place=True)
+            ok = rays.flag == OK
+            dense = 2 * ok.sum() / gx.size * (2.5 * ax) * (1.25 * ay)
+            out = int((((gx[ok] - cx) / ax) ** 2 + (gy[ok] / ay) ** 2 > 1).sum())
+            text.append(f"{side} {r_:+.4f} (film radius {rho:.2f} mm, iris {s:.3f} mm" + (f", zoom {u}" if u is not None else "")
+                        + f", focus {d:.0f} mm; against a dense trace: lines {a_l / dense - 1:+.4f}, grids "
+                        f"{g.rims.area[g.index[p, r]] / dense - 1:+.4f}, passing aims outside the lines' ellipse {out} of "
+                        f"{int(ok.sum())})")
         print(f"{name}: {points} film points on lines, {rel.size} rims; lines / grids - 1 median {np.median(rel):+.4f}, "
-              f"largest {r_:+.4f} (film radius {rho:.2f} mm, iris {s:.3f} mm" + (f", zoom {u}" if u is not None else "")
-              + f", focus {d:.0f} mm); there against a dense trace: lines {a_l / dense - 1:+.4f}, grids "
-              f"{g.rims.area[g.index[p, r]] / dense - 1:+.4f}; passing aims outside the lines' ellipse {out} of {int(ok.sum())}",
-              flush=True)
+              + "; ".join(text), flush=True)
     rel = np.concatenate(every)
     print(f"all: {rel.size} rims, lines / grids - 1 median {np.median(rel):+.4f}, 99 % of |.| under "
           f"{np.quantile(np.abs(rel), 0.99):.4f}, largest |.| {np.abs(rel).max():.4f}")

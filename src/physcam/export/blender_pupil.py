@@ -578,8 +578,9 @@ _FAN = 41  # meridional aims across a film point's box where its chief aim is lo
 #: share: there the iris alone bounds the set (module notes); the wider radii take the aim grids
 _LINE_MARGIN = 0.05
 #: ... and only where the rim's place on every line is the same, to this share of its distance from the chief aim,
-#: by the quadratics through the samples about it and the next one in or out (:meth:`_LineSets._rim_t`)
-_LINE_DOUBT = 2e-4
+#: by the quadratics through the samples about it and the next one in or out (:meth:`_LineSets._rim_t`): at most
+#: 0.2 % of the area, half AREA_TOLERANCE (the lines' areas measured within 0.15 % of a dense trace, docs/performance.md)
+_LINE_DOUBT = 1e-3
 _BAND = 400.0  # :meth:`_LineSets._rim_t`'s search: each line's log stop radii in a band this wide
 
 
