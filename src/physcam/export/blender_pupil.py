@@ -31,7 +31,7 @@ where it reaches s (:class:`_LineSets`; about 620 rays a film point against abou
 serve the iris radii under every cut line's clip edge by 5 %, so no other surface reaches the set, and only
 where the interpolation is sure of the rim (:data:`_LINE_DOUBT`); the wider radii (where other surfaces cut
 the set: wide open, off axis) and the film points whose chief ray is cut (outside the image circle) keep the
-grids. The lines' areas are a dense trace's within 0.1 % (the grids' about 0.25 % short; the double Gauss,
+grids. The lines' areas are a dense trace's within 0.15 % (the grids' up to 0.27 % short; the double Gauss,
 a fisheye, a zoom, the Canon RF 85 and the Angenieux f/1: tests/export/test_blender_pupil_lines.py).
 
 The shader interpolates the ellipse linearly in rho between nodes, in s between levels (below the
