@@ -8,7 +8,8 @@ Run:  .venv/bin/python benchmarks/blender_extension.py [--lenses dgauss_50mm,tes
 given or every bundled one), its CPU seconds as user + system of the process and its workers
 (``os.wait4``), with the zip's size: the part outside ``lens_payload`` too (worker start-up, the zip's
 deflate), one side after the other; with ``--baseline-src``, whether each lens's files in the two zips
-(``lenses/<slug>.json``, ``shaders/<slug>.osl``) are the same bytes. ``--install``: then Blender's installer of each side's zip
+(``lenses/<slug>.json``, ``shaders/<slug>.osl``) are the same bytes. ``--rims``: the pupil tables' rims found along lines against the aim grids' (:func:`main_rims`), no timing.
+``--install``: then Blender's installer of each side's zip
 (``package_install_files`` in a fresh user folder, the Blender tests' way; the Blender of
 ``physcam.export.blender_runner.find_blender``), its wall and CPU seconds and the megabytes it unpacks.
 
@@ -21,7 +22,8 @@ With ``--baseline-src`` the same lenses are measured with that checkout's physca
 ``PYTHONPATH=<src>``, one lens of each side in turn, so both see the same load), and the ratio is printed
 with the largest difference between the two sides' pupil tables (``FocusTable.radial``: per entry the
 change of cx, ax and ay over the entry's size max(ax, ay); the area's relative change where both sides
-trust it, and the entries whose trust differs) and norm tables (relative).
+trust it, and the entries whose trust differs) and norm tables (relative), at the iris levels both sides
+tabulate.
 """
 
 from __future__ import annotations
@@ -77,7 +79,8 @@ def worker(lens_name: str, out: str) -> None:
     lens_payload(lens, lens_name)
     cpu = time.process_time() - t
     ft = kept["ft"]
-    np.savez(out, radial=ft.radial if ft.radial is not None else np.zeros(0), norm=ft.norm)
+    np.savez(out, radial=ft.radial if ft.radial is not None else np.zeros(0), norm=ft.norm,
+             levels=np.asarray(ft.levels, dtype=float))
     print(json.dumps({"lens": lens_name, "cpu_s": cpu, "src": os.path.dirname(os.path.dirname(bf.__file__))}))
 
 
@@ -163,6 +166,79 @@ def main_build(args, here: str) -> None:
         print(f"ratio (baseline / this): {cpu['baseline'] / cpu['this checkout']:.2f}")
 
 
+def main_rims(names) -> None:
+    """``--rims``: per lens with rotational symmetry, at infinity and the closest focus (a zoom at both ends), every
+    rim the pupil tables find along lines (``blender_pupil._LineSets``) against the aim grids' at the same film and
+    iris radius (``_PassingSets`` without lines: the dense search), and the largest and smallest ratio against a dense trace
+    (400 x 200 aims over the y >= 0 half of its ellipse's box, 1.25x): areas, and the dense passing aims outside
+    the ellipse fitted to the lines' rim."""
+    import physcam.export.blender_pupil as bp
+    from physcam.lens.library import load_lens
+    from physcam.lens.zoom import prescription_at
+    from physcam.optics.focusing import closest_focus, focus
+    from physcam.trace.kernels import resolve_backend
+    from physcam.trace.rays import OK, RayBatch
+    from physcam.trace.trace import trace_through
+
+    resolve_backend("auto")
+    every = []
+    for name in names:
+        lens0 = load_lens(name)
+        if lens0.is_anamorphic:
+            continue
+        rels, ends, points = [], {}, 0
+        for u in ([0.0, 1.0] if lens0.zoom is not None else [None]):
+            lens = lens0 if u is None else prescription_at(lens0, u)
+            for d in (math.inf, closest_focus(lens) * 1.0001):
+                st = focus(lens, d)
+                q, film_z = st.prescription, st.film_z
+                semi = q.surfaces[q.stop_index].semi_diameter
+                levels = bp.iris_levels(semi * 1.03, semi)
+                fine = np.sort(np.concatenate([levels, np.sqrt(levels[:-1] * levels[1:])]))[::-1]
+                g = bp._PassingSets(q, film_z, levels, "numba", finer=True)
+                ln = bp._PassingSets(q, film_z, levels, "numba", finer=True, lines=True)
+                for sets in (g, ln):
+                    sets.need(levels)
+                    sets.need(fine)
+                points += ln.lines.points.size
+                served = np.zeros_like(ln.have)
+                served[ln.lines.points] = np.arange(ln.radii.size)[None, :] >= ln.lines.first[:, None]
+                both = served & ln.have & (g.index >= 0) & (ln.index >= 0)
+                rel = ln.rims.area[ln.index[both]] / g.rims.area[g.index[both]] - 1
+                rels.append(rel)
+                for side, pick in (("largest", np.argmax), ("smallest", np.argmin)):
+                    if rel.size:
+                        i = int(pick(rel))
+                        if side not in ends or (rel[i] > ends[side][0]) == (side == "largest"):
+                            p, r = (a[i] for a in np.nonzero(both))
+                            ends[side] = (rel[i], q, film_z, g, ln, p, r, u, d)
+        rel = np.concatenate(rels)
+        every.append(rel)
+        text = []
+        for side, (r_, q, film_z, g, ln, p, r, u, d) in ends.items():
+            s, rho = g.radii[r], g.rhos[p]
+            cx, ax, ay, a_l = bp._fits(ln.rims, np.array([ln.index[p, r]]))[0]
+            gx, gy = np.meshgrid(cx + ((np.arange(400) + 0.5) / 400 * 2 - 1) * 1.25 * ax,
+                                 (np.arange(200) + 0.5) / 200 * 1.25 * ay)
+            gx, gy = gx.ravel(), gy.ravel()
+            rays = RayBatch.from_arrays(np.broadcast_to([rho, 0.0, film_z], (gx.size, 3)),
+                                        np.stack([gx - rho, gy, np.full(gx.size, q.vertex_z[-1] - film_z)], axis=1),
+                                        q.wavelength_nm)
+            trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=s, in_place=True)
+            ok = rays.flag == OK
+            dense = 2 * ok.sum() / gx.size * (2.5 * ax) * (1.25 * ay)
+            out = int((((gx[ok] - cx) / ax) ** 2 + (gy[ok] / ay) ** 2 > 1).sum())
+            text.append(f"{side} {r_:+.4f} (film radius {rho:.2f} mm, iris {s:.3f} mm" + (f", zoom {u}" if u is not None else "")
+                        + f", focus {d:.0f} mm; against a dense trace: lines {a_l / dense - 1:+.4f}, grids "
+                        f"{g.rims.area[g.index[p, r]] / dense - 1:+.4f}, passing aims outside the lines' ellipse {out} of "
+                        f"{int(ok.sum())})")
+        print(f"{name}: {points} film points on lines, {rel.size} rims; lines / grids - 1 median {np.median(rel):+.4f}, "
+              + "; ".join(text), flush=True)
+    rel = np.concatenate(every)
+    print(f"all: {rel.size} rims, lines / grids - 1 median {np.median(rel):+.4f}, 99 % of |.| under "
+          f"{np.quantile(np.abs(rel), 0.99):.4f}, largest |.| {np.abs(rel).max():.4f}")
+
+
 def same_lens_files(zip_a: str, zip_b: str) -> tuple[int, list[str]]:
     """(how many of the two zips' per-lens files are the same bytes, the names of those that are not or are
     in one zip only): each lens's JSON table and shader source."""
@@ -176,11 +252,17 @@ def same_lens_files(zip_a: str, zip_b: str) -> tuple[int, list[str]]:
 
 
 def table_change(old: dict, new: dict) -> dict:
-    """The largest differences between two sides' tables of one lens (module notes)."""
-    a, b = old["radial"], new["radial"]
-    if a.shape != b.shape or old["norm"].shape != new["norm"].shape:  # another grid of radii or levels
+    """The largest differences between two sides' tables of one lens (module notes), at the iris levels both
+    tabulate (a lens's refined levels may differ: the levels a side adds, :func:`_refined_levels`, are left out)."""
+    a, b, na, nb = old["radial"], new["radial"], old["norm"], new["norm"]
+    if "levels" in old and "levels" in new and a.ndim == 4 and b.ndim == 4:  # (marks, levels, radii, 5)
+        la, lb = old["levels"], new["levels"]
+        common = np.intersect1d(la, lb)
+        ia, ib = np.searchsorted(-la, -common[::-1]), np.searchsorted(-lb, -common[::-1])
+        a, b, na, nb = a[:, ia], b[:, ib], na[:, ia], nb[:, ib]
+    if a.shape != b.shape or na.shape != nb.shape:  # another grid of radii or levels
         return {"ellipse": math.nan, "area": math.nan, "trust_flips": -1, "norm": math.nan}
-    out = {"norm": float(np.max(np.abs(new["norm"] / old["norm"] - 1)))}
+    out = {"norm": float(np.max(np.abs(nb / na - 1)))}
     if a.size == 0:
         return out | {"ellipse": 0.0, "area": 0.0, "trust_flips": 0}
     size = np.maximum(a[..., 1], a[..., 2])
@@ -198,6 +280,8 @@ def main() -> None:
     ap.add_argument("--build", action="store_true", help="time the whole CLI build (module notes)")
     ap.add_argument("--workers", type=int, default=2, help="--build's worker processes (default 2)")
     ap.add_argument("--install", action="store_true", help="--build: time Blender's installer of each zip too")
+    ap.add_argument("--rims", action="store_true", help="the pupil tables' rims along lines against the aim grids' "
+                    "(main_rims)")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--out", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -209,6 +293,8 @@ def main() -> None:
     if args.build:
         return main_build(args, here)
     names = args.lenses.split(",") if args.lenses else [r.slug for r in list_lenses()]
+    if args.rims:
+        return main_rims(names)
     print(f"load average before: {load()}")
     head = f"{'lens':28s} {'this CPU s':>10s}"
     if args.baseline_src:

@@ -24,6 +24,15 @@ halving's last passing point already exceeds s: then the rim is interpolated the
 grid zooms in once its set spans under :data:`_ZOOM` of it across or along, so a set spans at least
 about 20 of the 36 samples each way: a rim's area is a dense trace's within 0.4 % (cut by other
 surfaces or not; the double Gauss and the Canon RF 85, f/2 to f/16, film radius to 22 mm).
+Where the iris alone bounds a set the grids are not needed: its rim is found along 25 lines from the
+film point's chief aim (the aim whose ray crosses the stop's centre: every set holds it, and a convex set
+is star-shaped from it), the stop radius sampled geometrically along each line and the rim interpolated
+where it reaches s (:class:`_LineSets`; about 620 rays a film point against about 3,400 in grids). The lines
+serve the iris radii under every cut line's clip edge by 5 %, so no other surface reaches the set, and only
+where the interpolation is sure of the rim (:data:`_LINE_DOUBT`); the wider radii (where other surfaces cut
+the set: wide open, off axis) and the film points whose chief ray is cut (outside the image circle) keep the
+grids. The lines' areas are a dense trace's within 0.15 % (the grids' up to 0.27 % short; the double Gauss,
+a fisheye, a zoom, the Canon RF 85 and the Angenieux f/1: tests/export/test_blender_pupil_lines.py).
 
 The shader interpolates the ellipse linearly in rho between nodes, in s between levels (below the
 last level it scales the last level's axes by s / s_last: the pupil's linear regime) and between
@@ -138,16 +147,23 @@ class _StopCrossing:
     place on the stop's unit disk, then traces on): keeps each ray's radius there and passes them all."""
 
     def __init__(self):
-        self.radius = None
+        self.radius = self.x = self.y = None
 
     def density_at(self, x, y):
-        self.radius = np.hypot(x, y)
+        self.x, self.y, self.radius = x, y, np.hypot(x, y)
         return np.ones_like(self.radius)
 
 
 def _aims(q, film_z: float, fx, px, py, big: float, backend: str):
     """(passes every surface but the stop, radius where it crosses the stop plane) of rays from film
     points (fx, 0) to aim points (px, py) on the rear vertex plane, in one trace."""
+    ok, probe = _aims_probe(q, film_z, fx, px, py, big, backend)
+    return ok, probe.radius * big
+
+
+def _aims_probe(q, film_z: float, fx, px, py, big: float, backend: str):
+    """(passes every surface but the stop, the stop crossings in units of ``big``: :class:`_StopCrossing`)
+    of :func:`_aims`' rays."""
     from ..trace.rays import OK, RayBatch
     from ..trace.trace import trace_through
 
@@ -162,7 +178,7 @@ def _aims(q, film_z: float, fx, px, py, big: float, backend: str):
     probe = _StopCrossing()
     trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=big, aperture=probe, in_place=True,
                   backend=backend)
-    return rays.flag == OK, probe.radius * big
+    return rays.flag == OK, probe
 
 
 #: Neighbours a rim is looked for toward: +x, -x and +y (the y = 0 side mirrors itself), as the
@@ -387,6 +403,17 @@ class _RimSet:
         return self.x[idx], self.y[idx], n
 
 
+def _rear_boxes(q, film_z: float, fxs, r_rear: float) -> list:
+    """Per film point (fx, 0): the box (x0, x1, y1) on the rear vertex plane that holds the rear element's
+    rim as the point sees it (:func:`_first_grids`)."""
+    from ..lens.geometry import sag
+
+    rear, d = q.surfaces[-1], film_z - q.vertex_z[-1]
+    ks = [d / (d - sag(rear, r_rear, ax)) for ax in ("x", "y")] + [1.0]
+    return [(min(f * (1 - k) - k * r_rear for k in ks), max(f * (1 - k) + k * r_rear for k in ks), max(ks) * r_rear)
+            for f in np.asarray(fxs, dtype=float).tolist()]
+
+
 def _first_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, backend: str) -> tuple[list, list]:
     """Per film point (fx, 0): the box (x0, x1, y1) of its first grid and the grid (:func:`_trace`).
     The rear element's square on the rear vertex plane, and its rim seen from the film point there
@@ -397,14 +424,10 @@ def _first_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, backen
     aims pass at the widest iris radius (``radii[0]``; a cover glass close to the film: the spot is under one grid
     step); then a window about the point straight ahead, half as wide as the film's distance from
     the rear vertex, doubled while the passing aims touch its edge or none pass."""
-    from ..lens.geometry import sag
     from ..trace.pupil_bounds import MIN_HITS
 
     s_max = radii[0]
-    rear, d = q.surfaces[-1], film_z - q.vertex_z[-1]
-    ks = [d / (d - sag(rear, r_rear, ax)) for ax in ("x", "y")] + [1.0]
-    boxes = [(min(f * (1 - k) - k * r_rear for k in ks), max(f * (1 - k) + k * r_rear for k in ks), max(ks) * r_rear)
-             for f in np.asarray(fxs, dtype=float).tolist()]
+    boxes = _rear_boxes(q, film_z, fxs, r_rear)
     outer = list(boxes)  # the windows below stay inside each point's box
     grids = _trace(q, film_z, fxs, boxes, radii, big, backend)
     pending = [p for p, g in enumerate(grids) if (g[2] & (g[3] <= s_max)).sum() < MIN_HITS]
@@ -427,11 +450,14 @@ def _first_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, backen
     return boxes, grids
 
 
-def _passing_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, backend: str) -> tuple:
+def _passing_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, backend: str, ends=None) -> tuple:
     """(used, p, r0, r1, edges): the grids traced for film points (fx, 0) (:func:`_trace`), each with the
     first and end index into the descending iris radii ``radii`` it serves, the film point it serves (p) and
     those indices again as arrays, and their clip edges (:func:`_clip_edges`). A point's grid zooms in on
-    its passing set once that has shrunk under :data:`_ZOOM` of the grid."""
+    its passing set once that has shrunk under :data:`_ZOOM` of the grid. ``ends``: per film point, the
+    radius index its grids stop at (the radii from there on are found along lines, :class:`_LineSets`;
+    None: every radius)."""
+    ends = [radii.size] * len(fxs) if ends is None else [int(e) for e in ends]
     boxes, grids = _first_grids(q, film_z, fxs, radii, r_rear, big, backend)
     start = [0] * len(fxs)  # the first radius each point's current grid serves
     uses = [[] for _ in fxs]  # per film point: (grid, the first and end index of the radii it serves)
@@ -441,9 +467,9 @@ def _passing_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, back
                                             [start[p] for p in pending])
         zoom = {}
         for i, p in enumerate(pending):
-            f, dx, dy = int(first[i]), grids[p][4], grids[p][5]
+            f, dx, dy = min(int(first[i]), ends[p]), grids[p][4], grids[p][5]
             uses[p].append((grids[p], start[p], f))
-            if f < radii.size:
+            if f < ends[p]:
                 zoom[p] = (xmin[i, f] - 2 * dx, xmax[i, f] + 2 * dx, ymax[i, f] + 2 * dy)
                 start[p] = f
         for p, g in zip(zoom, _trace(q, film_z, [fxs[p] for p in zoom], list(zoom.values()), radii, big, backend)
@@ -482,17 +508,28 @@ class _PassingSets:
     """The passing sets of one focused lens's film points (the film radii of :func:`_check_axes`), traced
     once at every iris radius a table at ``levels`` reads (with ``finer``: also at those of a table whose
     levels add any of the geometric middles between them, :func:`_refined_levels`), their rims found as
-    tables ask for them (:meth:`table`): a radius more costs its rims, not a trace."""
+    tables ask for them (:meth:`table`): a radius more costs its rims, not a trace. With ``lines``, the film
+    points whose sets are star-shaped from their chief aim are sampled along lines from it (:class:`_LineSets`)
+    and only the others on aim grids (:func:`_passing_grids`, the dense search)."""
 
-    def __init__(self, q, film_z: float, levels, backend: str, *, finer: bool = False):
+    def __init__(self, q, film_z: float, levels, backend: str, *, finer: bool = False, lines: bool = False):
         levels = _levels(levels)
         fine = np.sort(np.concatenate([levels, np.sqrt(levels[:-1] * levels[1:])]))[::-1] if finer else levels
         rhos, checked = _check_axes(fine)
         self.film_z, self.rhos, self.backend = film_z, rhos, backend
         self.radii = np.unique(np.concatenate([checked, fine * (1 - _DS)]))[::-1]
         self.big = 20.0 * max(levels[0], q.surfaces[q.stop_index].semi_diameter)
-        self.grids = _passing_grids(q, film_z, rhos.tolist(), self.radii, q.surfaces[-1].semi_diameter, self.big,
-                                    backend)
+        r_rear = q.surfaces[-1].semi_diameter
+        self.lines = (_LineSets(q, film_z, rhos, self.radii, _rear_boxes(q, film_z, rhos, r_rear), self.big, backend)
+                      if lines else None)
+        # per film point, the radius index from which its rims are found along lines (none: radii.size)
+        self.line_from = np.full(rhos.size, self.radii.size)
+        if lines:
+            self.line_from[self.lines.points] = self.lines.first
+        self.on_grid = np.flatnonzero(self.line_from > 0)
+        self.grids = (_passing_grids(q, film_z, rhos[self.on_grid].tolist(), self.radii, r_rear, self.big, backend,
+                                     self.line_from[self.on_grid])
+                      if self.on_grid.size else ([], None, None, None, None))
         self.index = np.full((rhos.size, self.radii.size), -1)
         self.have = np.zeros((rhos.size, self.radii.size), dtype=bool)
         self.rims = _RimSet(np.zeros(0), np.zeros(0), np.zeros(1, dtype=int), np.zeros(0))
@@ -507,12 +544,221 @@ class _PassingSets:
         wanted &= ~self.have
         if not wanted.any():
             return
-        index, rims = _grid_rims(self.grids, self.radii, wanted, self.rhos.size, self.backend)
+        if self.on_grid.size:
+            index, rims = _grid_rims(self.grids, self.radii, wanted[self.on_grid], self.on_grid.size, self.backend)
+            self._add(self.on_grid, index, rims)
+        if self.lines is not None and self.lines.points.size:
+            p = self.lines.points
+            on = wanted[p] & (np.arange(self.radii.size)[None, :] >= self.lines.first[:, None])
+            cols = np.flatnonzero(on.any(axis=0))
+            x, y, area = self.lines.rims(self.radii[cols])
+            sel = on[:, cols]
+            n = int(sel.sum())
+            index = np.full((p.size, self.radii.size), -1)
+            gi, ci = np.nonzero(sel)
+            index[gi, cols[ci]] = np.arange(n)
+            self._add(p, index, _RimSet(x[sel].ravel(), y[sel].ravel(), np.arange(n + 1) * _LINES, area[sel]))
+        self.have |= wanted
+
+    def _add(self, points, index, rims) -> None:
+        """Keep ``rims`` (indexed per film point of ``points`` and radius by ``index``, -1: none) with the found ones."""
         n, old = self.rims.area.size, self.rims
-        self.index = np.where(index >= 0, index + n, self.index)
+        self.index[points] = np.where(index >= 0, index + n, self.index[points])
         self.rims = _RimSet(np.concatenate([old.x, rims.x]), np.concatenate([old.y, rims.y]),
                             np.concatenate([old.cuts, rims.cuts[1:] + old.x.size]), np.concatenate([old.area, rims.area]))
-        self.have |= wanted
+
+#: Lines from a film point's chief aim, over the y >= 0 half (both ends on the meridional axis), along
+#: which :class:`_LineSets` finds each iris radius's rim
+_LINES = 25
+_LINE_STEP = 1.35  # the samples along a line: geometric, this ratio apart
+_LINE_SPAN = 1.6  # from this times the widest iris's rim (the linear estimate) in to the smallest's over it
+_LINE_HALVINGS = 6  # a clip edge on a line is found to 1/64 of its sample step
+_FAN = 41  # meridional aims across a film point's box where its chief aim is looked for
+#: The lines serve an iris radius only where it is under every cut line's edge (in stop radius) by this
+#: share: there the iris alone bounds the set (module notes); the wider radii take the aim grids
+_LINE_MARGIN = 0.05
+#: ... and only where the rim's place on every line is the same, to this share of its distance from the chief aim,
+#: by the quadratics through the samples about it and the next one in or out (:meth:`_LineSets._rim_t`): at most
+#: 0.2 % of the area, half AREA_TOLERANCE (the lines' areas measured within 0.15 % of a dense trace, docs/performance.md)
+_LINE_DOUBT = 1e-3
+_BAND = 400.0  # :meth:`_LineSets._rim_t`'s search: each line's log stop radii in a band this wide
+
+
+def _chief_aims(q, film_z: float, fxs, boxes, big: float, backend: str) -> tuple[np.ndarray, np.ndarray]:
+    """Per film point (fx, 0): (the aim x on the rear vertex plane of its ray through the stop's centre, the
+    rate d x_stop / d aim x there), nan where none is found: no passing pair of :data:`_FAN` meridional aims
+    across the point's box (:func:`_rear_boxes`) brackets it (the chief ray is cut), or a Newton step fails."""
+    fxs = np.asarray(fxs, dtype=float)
+    b = np.asarray(boxes, dtype=float).reshape(-1, 3)
+    px = b[:, :1] + (np.arange(_FAN) + 0.5)[None, :] / _FAN * (b[:, 1:2] - b[:, :1])
+    ok, probe = _aims_probe(q, film_z, np.repeat(fxs, _FAN), px.ravel(), np.zeros(px.size), big, backend)
+    ok, xs = ok.reshape(px.shape), (probe.x * big).reshape(px.shape)
+    pair = ok[:, :-1] & ok[:, 1:] & ((xs[:, :-1] <= 0) != (xs[:, 1:] <= 0))
+    i, j = np.arange(fxs.size), np.argmax(pair, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = np.where(pair.any(axis=1), px[i, j] + (px[i, j + 1] - px[i, j]) * xs[i, j] / (xs[i, j] - xs[i, j + 1]), np.nan)
+    rate = np.full(fxs.size, np.nan)
+    h = 1e-4 * (b[:, 1] - b[:, 0])
+    for _ in range(3):  # Newton's steps, the rate by a forward difference
+        g = np.flatnonzero(np.isfinite(c))
+        if not g.size:
+            break
+        ok, probe = _aims_probe(q, film_z, np.tile(fxs[g], 2), np.concatenate([c[g], c[g] + h[g]]), np.zeros(2 * g.size),
+                                big, backend)
+        x = probe.x * big
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d = (x[g.size:] - x[:g.size]) / h[g]
+            good = ok[:g.size] & ok[g.size:] & np.isfinite(d) & (d != 0)
+            c[g] = np.where(good, c[g] - x[:g.size] / np.where(good, d, 1.0), np.nan)
+        rate[g] = d
+    return c, rate
+
+
+class _LineSets:
+    """The passing sets of film points (fx, 0) sampled along :data:`_LINES` lines from each one's chief aim c
+    (:func:`_chief_aims`; module notes): a ray through c crosses the stop at its centre, so c passes at every
+    iris radius, and where the sets are star-shaped from c (convex sets that hold it are: the iris's image cut
+    by other round apertures) each iris radius's rim crosses each line once. Along a line the stop radius r(t)
+    rises from 0 at c; the samples are geometric in t (:data:`_LINE_STEP` apart, from the smallest iris's rim
+    over :data:`_LINE_SPAN` out past the widest's, extended while the last one passes inside the widest
+    iris), and where another surface cuts the line its edge is halved :data:`_LINE_HALVINGS` times. The rim of
+    iris radius s on a line is where r = s, interpolated in log t against log r between the two samples
+    about it and the next (Lagrange's quadratic in log r; from c to the first sample r ~ t), or the clip edge where
+    the line is cut before r reaches s (held at the halving's far end, its area at the middle). The set's
+    area is the polar integral of t(theta)^2 by the trapezoid rule over the lines (t(theta)^2 is periodic
+    and even in theta: the rule converges faster than any power of the step where the rim is smooth), and its
+    rim points are pushed out by 1 / cos(half the lines' angle) from c (a circle about c is then held
+    between lines). ``star``: per film point, whether its chief aim was found and every line showed a
+    star-shaped set (its innermost sample passes, nothing passes past a cut, r rises along it, and it
+    reaches the widest iris or is cut): the film points without it take the aim grids."""
+
+    def __init__(self, q, film_z: float, fxs, radii, boxes, big: float, backend: str):
+        fxs = np.asarray(fxs, dtype=float)
+        c, rate = _chief_aims(q, film_z, fxs, boxes, big, backend)
+        g = np.flatnonzero(np.isfinite(c) & np.isfinite(rate) & (rate != 0))
+        theta = np.linspace(0.0, math.pi, _LINES)
+        ux, uy = np.cos(theta), np.sin(theta)
+        m = int(math.ceil(math.log(_LINE_SPAN**2 * radii[0] / radii[-1]) / math.log(_LINE_STEP))) + 1
+        t0 = radii[-1] / (_LINE_SPAN * np.abs(rate[g]))
+        t = np.broadcast_to((t0[:, None] * _LINE_STEP ** np.arange(m))[:, None, :], (g.size, _LINES, m))
+        fx, cx = fxs[g], c[g]
+
+        def trace(gi, ki, tt):  # (passes, stop radius) of the samples at t = tt on lines ki of points gi
+            return _aims(q, film_z, fx[gi], cx[gi] + tt * ux[ki], tt * uy[ki], big, backend)
+
+        gg, kk = (a.ravel() for a in np.meshgrid(np.arange(g.size), np.arange(_LINES), indexing="ij"))
+        ok, r = trace(np.repeat(gg, m), np.repeat(kk, m), t.reshape(-1))
+        ts, oks, rs = [t], [ok.reshape(t.shape)], [r.reshape(t.shape)]
+        for _ in range(8):  # on out while the last sample passes inside the widest iris
+            more = oks[-1][..., -1] & (rs[-1][..., -1] < radii[0])
+            if not more.any():
+                break
+            gi, ki = np.nonzero(more)
+            tn = ts[-1][gi, ki, -1] * _LINE_STEP
+            okn, rn = trace(gi, ki, tn)
+            col_t, col_ok, col_r = np.full(more.shape, np.nan), np.zeros(more.shape, dtype=bool), np.full(more.shape, np.inf)
+            col_t[gi, ki], col_ok[gi, ki], col_r[gi, ki] = tn, okn, rn
+            ts, oks, rs = ts + [col_t[..., None]], oks + [col_ok[..., None]], rs + [col_r[..., None]]
+        t, ok, r = (np.concatenate(a, axis=2) for a in (ts, oks, rs))
+        traced = np.isfinite(t)
+        fail = traced & ~ok
+        n_in = np.where(fail.any(axis=2), np.argmax(fail, axis=2), traced.sum(axis=2))  # the passing samples before a cut
+        inside = np.arange(t.shape[2]) < n_in[..., None]
+        cut = fail.any(axis=2)
+        last = np.take_along_axis(np.where(inside, r, -np.inf), np.maximum(n_in - 1, 0)[..., None], 2)[..., 0]
+        star = ((n_in > 0) & ~(ok & traced & ~inside).any(axis=2) & (cut | (last >= radii[0]))).all(axis=1)
+        # the clip edges, halved: the passing middles join the samples
+        lo = np.take_along_axis(t, np.maximum(n_in - 1, 0)[..., None], 2)[..., 0]
+        hi = np.take_along_axis(t, np.minimum(n_in, t.shape[2] - 1)[..., None], 2)[..., 0]
+        gi, ki = np.nonzero(cut & (n_in > 0))
+        extra_t, extra_r = [], []
+        for _ in range(_LINE_HALVINGS if gi.size else 0):
+            mid = 0.5 * (lo[gi, ki] + hi[gi, ki])
+            okm, rm = trace(gi, ki, mid)
+            lo[gi, ki], hi[gi, ki] = np.where(okm, mid, lo[gi, ki]), np.where(okm, hi[gi, ki], mid)
+            col_t, col_r = np.full(lo.shape, np.nan), np.full(lo.shape, np.inf)
+            col_t[gi[okm], ki[okm]], col_r[gi[okm], ki[okm]] = mid[okm], rm[okm]
+            extra_t.append(col_t[..., None])
+            extra_r.append(col_r[..., None])
+        t = np.concatenate([np.where(inside, t, np.nan)] + extra_t, axis=2)
+        r = np.concatenate([np.where(inside, r, np.inf)] + extra_r, axis=2)
+        o = np.argsort(np.where(np.isnan(t), np.inf, t), axis=2, kind="stable")  # each line's samples outward
+        t, r = np.take_along_axis(t, o, 2), np.take_along_axis(r, o, 2)
+        valid = np.isfinite(t)
+        with np.errstate(invalid="ignore"):
+            star &= ~(valid[..., 1:] & ~(np.diff(r, axis=2) > 0)).any(axis=(1, 2))  # r rises along every line
+        star &= (valid.sum(axis=2) >= 3).all(axis=1)  # three samples a line at least (the rim's quadratic)
+        n = valid.sum(axis=2)
+        # the stop radius at each cut line's last passing point (r rises along it): an iris radius s with
+        # s (1 + _LINE_MARGIN) under every one of them is the iris's alone on every line
+        edge = np.where(cut, np.take_along_axis(r, np.maximum(n - 1, 0)[..., None], 2)[..., 0], np.inf).min(axis=1)
+        self.points = g[star]  # the film points (indices into fxs) the lines serve
+        self.first = np.searchsorted(-radii, -(edge[star] / (1 + _LINE_MARGIN)), side="left")
+        self.c, self.t, self.r, self.n = cx[star], t[star], r[star], n[star]
+        self.lo, self.hi, self.cut = lo[star], hi[star], cut[star]
+        self.theta = theta
+        # every rim's place on every line, once; the lines serve no radius at or above one whose interpolation
+        # they doubt (the grids take those)
+        self.radii = radii
+        self.held, self.mean, doubt = self._rim_t(radii)
+        doubt = (doubt > _LINE_DOUBT).any(axis=1)  # (points, radii)
+        self.first = np.maximum(self.first, np.where(doubt.any(axis=1), radii.size - np.argmax(doubt[:, ::-1], axis=1), 0))
+
+    def _rim_t(self, s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(held t, mean t, doubt): per film point, line and iris radius of ``s``, where the rim crosses the line
+        (held: a cut line's far end; mean: its middle) and the interpolation's doubt (relative, in t)."""
+        s = np.asarray(s, dtype=float)
+        n_points, n_lines, n_samples = self.t.shape
+        lines = n_points * n_lines
+        if not lines:  # no film point on lines
+            return (np.zeros((n_points, n_lines, s.size)),) * 3
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lt, lr = np.log(self.t).reshape(lines, -1), np.log(self.r).reshape(lines, -1)
+            # Newton's divided differences of log t in log r of every three samples in a row (empty slots: nan)
+            d01 = np.diff(lt, axis=1) / np.diff(lr, axis=1)
+            d012 = (np.diff(d01, axis=1) / (lr[:, 2:] - lr[:, :-2])).ravel()
+        d01 = d01.ravel()
+        # the samples under s per line (r rises along it; an empty slot's is inf): one search over every line's
+        # log r, each line in its own band (log r spans far less than _BAND)
+        line = np.arange(lines)[:, None]
+        band = line * _BAND
+        ls = np.log(s)[None, :]
+        j = np.searchsorted((band + np.minimum(lr, _BAND / 4)).ravel(), (band + ls).ravel(), side="left").reshape(lines, -1)
+        j -= line * n_samples
+        n = self.n.reshape(lines, 1)
+        beyond = j >= n  # past the last passing sample: the clip edge (every line is cut or reaches s)
+        lt, lr = lt.ravel(), lr.ravel()
+
+        def quad(a):  # Lagrange's quadratic of log t in log r through the samples a, a + 1, a + 2 of each line
+            i, k = line * n_samples + a, line * (n_samples - 2) + a
+            return lt[i] + (ls - lr[i]) * (d01[i - line] + (ls - lr[i + 1]) * d012[k])
+
+        with np.errstate(invalid="ignore", over="ignore"):
+            # the two samples about s and the next one out (in at the line's last), and the one in instead: where
+            # the two quadratics differ the curve bends too fast for the samples (r flattens toward a clip)
+            q1, q2 = quad(np.clip(j - 1, 0, n - 3)), quad(np.clip(j - 2, 0, n - 3))
+            first = line * n_samples
+            t_iris = np.where(j == 0, np.exp(lt[first] + ls - lr[first]), np.exp(q1))  # under the first: r ~ t
+            doubt = np.where((j == 0) | beyond, 0.0, np.abs(np.expm1(q2 - q1)))
+        shape = (n_points, n_lines, s.size)
+        t_iris, doubt, beyond = t_iris.reshape(shape), doubt.reshape(shape), beyond.reshape(shape)
+        held = np.where(beyond, self.hi[..., None], t_iris)
+        mean = np.where(beyond, 0.5 * (self.lo[..., None] + self.hi[..., None]), t_iris)
+        return held, mean, np.where(np.isfinite(doubt), doubt, np.inf)
+
+    def rims(self, s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(x, y, area): per film point served and iris radius of ``s`` (radii the sets were traced for), the rim's
+        points held out (x, y: points x radii x lines) and the passing set's area (mm^2, both halves)."""
+        at = np.searchsorted(-self.radii, -np.asarray(s, dtype=float))  # the radii of s among those traced for
+        held, mean = self.held[:, :, at], self.mean[:, :, at]
+        step = self.theta[1] - self.theta[0]
+        w = np.full(self.theta.size, step)
+        w[[0, -1]] *= 0.5
+        area = np.einsum("k,pkr->pr", w, mean * mean)  # both halves: 2 x the half's integral of t^2 / 2
+        out = held / math.cos(step / 2)
+        x = self.c[:, None, None] + out.transpose(0, 2, 1) * np.cos(self.theta)
+        y = out.transpose(0, 2, 1) * np.sin(self.theta)
+        return x, y, area
 
 
 def _n_passing(radii, t) -> np.ndarray:
@@ -724,7 +970,7 @@ def _table_and_sets(q, film_z: float, levels, backend: str, checks, *, finer: bo
     levels = _levels(levels)
     if not film_z > q.vertex_z[-1]:
         raise InputError(f"the film (z = {film_z:g} mm) must lie behind the lens's last vertex (z = {q.vertex_z[-1]:g} mm)")
-    sets = _PassingSets(q, film_z, levels, _tables_backend(backend, 1, len(q.surfaces)), finer=finer)
+    sets = _PassingSets(q, film_z, levels, _tables_backend(backend, 1, len(q.surfaces)), finer=finer, lines=True)
     return (_drafted(sets, levels, checks) if draft else _assembled(sets, levels, checks)), sets
 
 
