@@ -168,11 +168,12 @@ def main_build(args, here: str) -> None:
 
 def main_rims(names) -> None:
     """``--rims``: per lens with rotational symmetry, at infinity and the closest focus (a zoom at both ends), every
-    rim the pupil tables find along lines (``blender_pupil._LineSets``) against the aim grids' at the same film and
+    rim the pupil tables find along lines (``blender_pupil_sets._LineSets``) against the aim grids' at the same film and
     iris radius (``_PassingSets`` without lines: the dense search), and the largest and smallest ratio against a dense trace
     (400 x 200 aims over the y >= 0 half of its ellipse's box, 1.25x): areas, and the dense passing aims outside
     the ellipse fitted to the lines' rim."""
     import physcam.export.blender_pupil as bp
+    import physcam.export.blender_pupil_sets as bps
     from physcam.lens.library import load_lens
     from physcam.lens.zoom import prescription_at
     from physcam.optics.focusing import closest_focus, focus
@@ -217,7 +218,7 @@ def main_rims(names) -> None:
         text = []
         for side, (r_, q, film_z, g, ln, p, r, u, d) in ends.items():
             s, rho = g.radii[r], g.rhos[p]
-            cx, ax, ay, a_l = bp._fits(ln.rims, np.array([ln.index[p, r]]))[0]
+            cx, ax, ay, a_l = bps._fits(ln.rims, np.array([ln.index[p, r]]))[0]
             gx, gy = np.meshgrid(cx + ((np.arange(400) + 0.5) / 400 * 2 - 1) * 1.25 * ax,
                                  (np.arange(200) + 0.5) / 200 * 1.25 * ay)
             gx, gy = gx.ravel(), gy.ravel()

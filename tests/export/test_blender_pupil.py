@@ -245,7 +245,7 @@ def test_the_ellipse_holds_the_spot_behind_a_cover_glass():
 def test_the_rim_area_of_a_regular_polygon():
     """The batched shoelace area (both halves from the y >= 0 half) against a regular polygon's closed form
     n/2 R^2 sin(2 pi / n): two rims in one call, their points shuffled, one rim empty."""
-    from physcam.export.blender_pupil import _polygon_areas
+    from physcam.export.blender_pupil_sets import _polygon_areas
 
     rng = np.random.default_rng(3)
     k, xs, ys, want = [], [], [], []

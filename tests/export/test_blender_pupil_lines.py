@@ -1,4 +1,4 @@
-"""The pupil tables' rims found along lines from each film point's chief aim (physcam.export.blender_pupil
+"""The pupil tables' rims found along lines from each film point's chief aim (physcam.export.blender_pupil_sets
 ._LineSets) against the oracle, physcam's tracer run the plain way on a dense grid of aims with the iris
 stopped to each radius: on a prime (the double Gauss), a fisheye (the Nikkor 16 mm), a zoom (the Canon
 70-200 at its long end) and a lens whose sets other surfaces cut wide open (the Canon RF 85 at 1 m: clip
@@ -16,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from physcam.export.blender_pupil import AREA_TOLERANCE, _fits, _PassingSets, iris_levels
+from physcam.export.blender_pupil import AREA_TOLERANCE, _PassingSets, iris_levels
+from physcam.export.blender_pupil_sets import _fits
 from physcam.lens.library import load_lens
 from physcam.lens.zoom import prescription_at
 from physcam.optics.focusing import focus

@@ -1,6 +1,6 @@
 """The compiled rim pass of the extension's pupil tables (physcam.trace.kernels._rimpass, picked by
 physcam.trace.kernels.rim_pass when the tables trace with numba) finds the rims the numpy pass finds
-(physcam.export.blender_pupil._rims, the reference that tests/export/test_blender_pupil*.py hold against
+(physcam.export.blender_pupil_sets._rims, the reference that tests/export/test_blender_pupil*.py hold against
 dense traces): the same points in the same order, so the same areas, ellipses and trust, on a lens's real
 aim grids. Both run in this process on the same grids, IEEE arithmetic without contraction on both sides,
 so the comparison is exact: any difference is a different point, not rounding."""
@@ -10,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from physcam.export.blender_pupil import _grid_rims, _PassingSets, iris_levels
+from physcam.export.blender_pupil import _PassingSets, iris_levels
+from physcam.export.blender_pupil_sets import _grid_rims
 from physcam.lens.library import load_lens
 from physcam.optics.focusing import focus
 from physcam.trace.kernels import numba_available, rim_pass

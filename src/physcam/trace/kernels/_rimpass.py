@@ -1,7 +1,7 @@
 """The compiled rim pass of the Blender extension's pupil tables: the rim points of traced aim grids.
 
 The same points, in the same order and by the same IEEE operations, as the numpy pass in
-:func:`physcam.export.blender_pupil._rims` (the reference; its notes have the geometry): per grid,
+:func:`physcam.export.blender_pupil_sets._rims` (the reference; its notes have the geometry): per grid,
 toward +x, -x and +y, every pair of neighbouring samples where one passes at an iris radius and the
 other does not gives a rim point at that radius (the stop radius interpolated to it, or the halved
 clip edge), and every passing sample on the grid's edge a point a step out. The numpy pass builds
@@ -22,7 +22,7 @@ _CACHE = _jitcache.install()  # before any @njit below: cache keyed by version a
 #: IEEE arithmetic (no contraction): the points are the numpy pass's bit for bit
 _OPTS = dict(fastmath=False, error_model="numpy", nogil=True, cache=_CACHE)
 
-# toward +x, -x, +y (blender_pupil._TOWARD): the view's rows and columns less, the sample's (a) and
+# toward +x, -x, +y (blender_pupil_sets._TOWARD): the view's rows and columns less, the sample's (a) and
 # the neighbour's (b) offsets in the grid, the step's direction
 _DIRS = np.array([[0, 1, 0, 0, 0, 1, 1, 0], [0, 1, 0, 1, 0, 0, -1, 0], [1, 0, 0, 0, 1, 0, 0, 1]], dtype=np.int64)
 
@@ -132,7 +132,7 @@ def _write(ok, rad, n_in, x0, y0, dx, dy, r0, r1, first_r0, w_at, w_idx, radii, 
 def rim_points(ok, rad, n_in, x0, y0, dx, dy, r0, r1, first_r0, wanted, radii, e_key, e_lo, e_hi, e_rad, n_rims):
     """(points, cuts): the rim points (columns x, y, xa, ya) of the grids (``ok``, ``rad``, ``n_in``: (grids,
     ny, nx) bool, float64, int64) rim after rim, rim k's rows ``cuts[k]`` to ``cuts[k + 1]``, in the numpy
-    pass's order (blender_pupil._rims: its arguments, as C-ordered int64, float64 and bool arrays)."""
+    pass's order (blender_pupil_sets._rims: its arguments, as C-ordered int64, float64 and bool arrays)."""
     n_grid, n_rad = wanted.shape
     # the wanted radius indices grid after grid (w_idx), and per grid how many lie below each radius index
     w_idx = np.nonzero(wanted)[1].astype(np.int64)
