@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -71,7 +72,7 @@ def test_bad_input_is_one_sentence():
         camera_state(DGAUSS, focus_mm=10.0)  # inside the lens's closest focus
     with pytest.raises(InputError, match="sensor"):
         camera_state(DGAUSS, sensor_mm=(0.0, 24.0))
-    for bad in (36.0, (36.0,), "36x24", (36.0, 24.0, 1.0)):
+    for bad in (36.0, (36.0,), "36x24", (36.0, 24.0, 1.0), np.array(36.0), np.float64(36.0)):
         with pytest.raises(InputError, match=r"sensor_mm takes the sensor's \(width, height\) in mm"):
             camera_state(DGAUSS, sensor_mm=bad)
     with pytest.raises(InputError, match="weight"):

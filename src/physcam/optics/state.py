@@ -230,7 +230,11 @@ def _sensor_of(sensor, sensor_mm) -> Sensor | None:
         return require_type("sensor", sensor, Sensor, "physcam.optics.sensors.find_sensor(name) or custom_sensor(w, h)")
     if sensor_mm is None:
         return None
-    if isinstance(sensor_mm, (str, bytes)) or not hasattr(sensor_mm, "__len__") or len(sensor_mm) != 2:
+    try:
+        pair = not isinstance(sensor_mm, (str, bytes)) and len(sensor_mm) == 2
+    except TypeError:  # a number, or an array of none
+        pair = False
+    if not pair:
         raise InputError(f"sensor_mm takes the sensor's (width, height) in mm, e.g. sensor_mm=(36.0, 24.0), "
                          f"got {sensor_mm!r}")
     w, h = (require_finite(name, v) for name, v in zip(("sensor width", "sensor height"), sensor_mm))
