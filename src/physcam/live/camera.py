@@ -97,7 +97,6 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
     t0 = time.time_ns() if t0_ns is None else int(t0_ns)
     out: list[TrackedFrame] = []
     cache: dict = {}
-    ends = None if u0 is None else (_wide_end_first(lens), focal_range(lens))  # once per take, not per frame
     for i in range(frames):
         u = i / (frames - 1) if frames > 1 else 0.0
         mark = f0 + (f1 - f0) * u
@@ -106,8 +105,8 @@ def camera_frames(*, sensor, frames: int, rate, focus_mm, fstop=None, lens=None,
             cache[mark, zu] = _optics_at(sensor, mark, lens if zu is None else prescription_at(lens, zu),
                                          focal_length_mm, fstop, tstop, distortion)
         rep, dist = cache[mark, zu]
-        zoomed = {} if zu is None else {"encoders": {"zoom": zu if ends[0] else 1.0 - zu},  # opentrackio_zoom's rule
-                                         "focal_range_mm": ends[1]}
+        zoomed = {} if zu is None else {"encoders": {"zoom": opentrackio_zoom(lens, zu)},
+                                         "focal_range_mm": focal_range(lens)}
         pos, rot = move.at(i / float(fr))
         pupil = rep.entrance_pupil_from_film_mm
         out.append(with_time(TrackedFrame(
@@ -205,7 +204,6 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
     zooms = iter(zooms) if zooms is not None else None
     static, sent_squeeze, cache = None, None, {}
     encoders: dict = {}  # a clip's zoom positions, each solved once for the samples that repeat it
-    ends = None  # (wide end first, focal range) of a zoom lens, solved once per clip
     for s in samples:
         zu = None
         if zoom_lens:
@@ -216,7 +214,6 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
                 zu = encoders[type(z), z] = zoom_path(lens, z, None)[0]
             else:
                 zu = encoders[type(z), z]
-            ends = ends or (_wide_end_first(lens), list(focal_range(lens)))
         static = s.get("static") or static
         dims = ((static or {}).get("camera") or {}).get("activeSensorPhysicalDimensions")
         lens_d = s.get("lens") or {}
@@ -232,8 +229,7 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
         rep, dist = cache[key]
         out = dict(s, lens=dict(lens_d, pinholeFocalLength=float(rep.pinhole[0])))
         if zu is not None:
-            sent = zu if ends[0] else 1.0 - zu  # opentrackio_zoom's rule
-            out["lens"]["encoders"] = dict(lens_d.get("encoders") or {}, zoom=sent)
+            out["lens"]["encoders"] = dict(lens_d.get("encoders") or {}, zoom=opentrackio_zoom(lens, zu))
         pupil = rep.entrance_pupil_from_film_mm if rep.entrance_pupil_from_film_mm is not None else rep.h1_from_film_mm
         out["lens"]["entrancePupilOffset"] = float(pupil) / 1000.0
         prior = s.get("custom")
@@ -242,7 +238,7 @@ def with_optics(samples, *, lens=None, focal_length_mm=None, distortion: bool = 
             if rep.entrance_pupil_horizontal_from_film_mm is not None:  # an anamorphic's pan pivot (frames.py)
                 custom[HORIZONTAL_PUPIL_KEY] = float(rep.entrance_pupil_horizontal_from_film_mm) / 1000.0
             if zu is not None and s.get("static"):
-                custom[FOCAL_RANGE_KEY] = list(ends[1])
+                custom[FOCAL_RANGE_KEY] = list(focal_range(lens))
             if custom or prior is not None:
                 out["custom"] = custom
         if zu is not None and "nominalFocalLength" in ((out.get("static") or {}).get("lens") or {}):

@@ -63,22 +63,26 @@ class ZoomRow:
 
 @takes_prescription
 def efl_at(lens: Prescription, encoder: float, wavelength_nm=None) -> float:
-    """Paraxial EFL (Y meridian) of a zoom lens at the normalised zoom coordinate ``encoder``."""
-    return paraxial.gaussian(prescription_at(lens, encoder), wavelength_nm=wavelength_nm).efl
+    """Paraxial EFL (Y meridian) of a zoom lens at the normalised zoom coordinate ``encoder``, remembered by the
+    lens's identity (the lens kept with it; prescriptions are frozen), the encoder and the wavelength: a focal
+    length's search asks the zoom's samples again for every position, a take its ends for every frame."""
+    key = (id(lens), encoder, wavelength_nm) if isinstance(encoder, (int, float)) else None
+    efl = None if key is None else _EFLS.get(key, lens)
+    if efl is None:
+        efl = paraxial.gaussian(prescription_at(lens, encoder), wavelength_nm=wavelength_nm).efl
+        if key is not None:
+            _EFLS.put(key, lens, efl)
+    return efl
+
+
+#: :func:`efl_at`'s answers (64 lenses' :data:`_SAMPLES` samples and the searches' positions between them)
+_EFLS = IdentityMemo(4096)
 
 
 def _samples(lens, wavelength_nm):
-    """(encoders, EFLs) at :data:`_SAMPLES` points across the zoom, remembered per lens (by its identity, the
-    lens kept with them; prescriptions are frozen): a take's every zoom position asked them again."""
-    key = (id(lens), wavelength_nm)
-    efls = _SAMPLED.get(key, lens)
+    """(encoders, EFLs) at :data:`_SAMPLES` points across the zoom."""
     us = [k / (_SAMPLES - 1) for k in range(_SAMPLES)]
-    if efls is None:
-        efls = _SAMPLED.put(key, lens, tuple(efl_at(lens, u, wavelength_nm) for u in us))
-    return us, list(efls)
-
-
-_SAMPLED = IdentityMemo(64)
+    return us, [efl_at(lens, u, wavelength_nm) for u in us]
 
 
 #: a focal length this close outside a zoom's paraxial range names its end (the range is printed to 0.01 mm)
