@@ -21,8 +21,8 @@ from physcam.export.blender_pupil import (RADIAL_MAX_MM, interpolated_area, inte
 from physcam.lens.library import load_lens
 from physcam.optics.sensors import sensors
 from physcam.optics.focusing import focus
-from physcam.trace.rays import OK, RayBatch
-from physcam.trace.trace import trace_through
+
+from _dense_pupil import passing_aims
 
 pytestmark = pytest.mark.slow
 
@@ -48,11 +48,7 @@ def _passing(q, film_z, rho, s, cx, ax, ay, n=160):
     """(passing rays outside the ellipse, passing rays, aim points inside it) on an n x n grid 1.3x the ellipse."""
     gx, gy = np.meshgrid(cx + ((np.arange(n) + 0.5) / n * 2 - 1) * 1.3 * ax, ((np.arange(n) + 0.5) / n * 2 - 1) * 1.3 * ay)
     gx, gy = gx.ravel(), gy.ravel()
-    rays = RayBatch.from_arrays(np.broadcast_to([rho, 0.0, film_z], (gx.size, 3)),
-                                np.stack([gx - rho, gy, np.full(gx.size, q.vertex_z[-1] - film_z)], axis=1),
-                                q.wavelength_nm)
-    trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=s, in_place=True)
-    ok = rays.flag == OK
+    ok = passing_aims(q, film_z, rho, s, gx, gy)
     inside = ((gx - cx) / ax) ** 2 + (gy / ay) ** 2 <= 1
     return int((ok & ~inside).sum()), int(ok.sum()), int(inside.sum()), int((ok & inside).sum())
 
@@ -90,11 +86,7 @@ def test_every_passing_ray_past_full_frame_is_in_the_ellipse(table):
     for s in (ft.levels[0], ft.levels[-1]):
         for rho in np.arange(22.0, 32.01, 0.5).tolist():
             cx, ax, ay = interpolated_ellipse(ft.radial[0], ft.levels, rho, s)
-            rays = RayBatch.from_arrays(np.broadcast_to([rho, 0.0, film_z], (gx.size, 3)),
-                                        np.stack([gx - rho, gy, np.full(gx.size, q.vertex_z[-1] - film_z)], axis=1),
-                                        q.wavelength_nm)
-            trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=s, in_place=True)
-            ok = rays.flag == OK
+            ok = passing_aims(q, film_z, rho, s, gx, gy)
             out = int((ok & (((gx - cx) / ax) ** 2 + (gy / ay) ** 2 > 1)).sum())
             if out:
                 lost.append((round(s, 3), rho, out, int(ok.sum())))
@@ -232,11 +224,7 @@ def test_the_ellipse_holds_the_spot_behind_a_cover_glass():
         s = semi * n_open / n
         for rho in (0.0, 10.0):
             gx, gy = [a.ravel() for a in np.meshgrid(rho + u, u)]
-            rays = RayBatch.from_arrays(np.broadcast_to([rho, 0.0, film_z], (gx.size, 3)),
-                                        np.stack([gx - rho, gy, np.full(gx.size, q.vertex_z[-1] - film_z)], axis=1),
-                                        q.wavelength_nm)
-            trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=s, in_place=True)
-            ok = rays.flag == OK
+            ok = passing_aims(q, film_z, rho, s, gx, gy)
             cx, ax, ay = interpolated_ellipse(table, levels, rho, s)
             assert ok.sum() > 100 and ax > 0 and ay > 0
             assert (((gx[ok] - cx) / ax) ** 2 + (gy[ok] / ay) ** 2 <= 1).all(), (n, rho)
@@ -317,10 +305,6 @@ def test_levels_that_share_the_centres_aims_sample_a_region_holding_their_sets(t
         cx, ax, ay = shared[k]
         u = np.linspace(-1.0, 1.0, 121)
         gx, gy = [a.ravel() for a in np.meshgrid(u * ft.radial[0][k, 0, 1] * 1.2, u * ft.radial[0][k, 0, 2] * 1.2)]
-        rays = RayBatch.from_arrays(np.broadcast_to([0.0, 0.0, st_.film_z], (gx.size, 3)),
-                                    np.stack([gx, gy, np.full(gx.size, q.vertex_z[-1] - st_.film_z)], axis=1),
-                                    q.wavelength_nm)
-        trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=float(ft.levels[k]), in_place=True)
-        ok = rays.flag == OK
+        ok = passing_aims(q, st_.film_z, 0.0, float(ft.levels[k]), gx, gy)
         assert ok.sum() > 100
         assert (np.abs(gx[ok] - cx) <= ax).all() and (np.abs(gy[ok]) <= ay).all(), k

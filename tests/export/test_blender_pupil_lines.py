@@ -21,8 +21,8 @@ from physcam.export.blender_pupil_sets import _fits
 from physcam.lens.library import load_lens
 from physcam.lens.zoom import prescription_at
 from physcam.optics.focusing import focus
-from physcam.trace.rays import OK, RayBatch
-from physcam.trace.trace import trace_through
+
+from _dense_pupil import passing_aims
 
 pytestmark = pytest.mark.slow
 
@@ -32,11 +32,7 @@ def _dense(q, film_z, rho, s, box, n=300):
     x0, x1, y1 = box
     gx, gy = np.meshgrid(x0 + (np.arange(n) + 0.5) / n * (x1 - x0), (np.arange(n // 2) + 0.5) / (n // 2) * y1)
     gx, gy = gx.ravel(), gy.ravel()
-    rays = RayBatch.from_arrays(np.broadcast_to([rho, 0.0, film_z], (gx.size, 3)),
-                                np.stack([gx - rho, gy, np.full(gx.size, q.vertex_z[-1] - film_z)], axis=1),
-                                q.wavelength_nm)
-    trace_through(q, rays, reverse=True, clip=True, stop_semi_diameter=s, in_place=True)
-    ok = rays.flag == OK
+    ok = passing_aims(q, film_z, rho, s, gx, gy)
     return 2 * ok.sum() / gx.size * (x1 - x0) * y1, gx[ok], gy[ok]
 
 
