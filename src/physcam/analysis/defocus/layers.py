@@ -262,38 +262,48 @@ def _kernel_at_scale(k: np.ndarray, s: int) -> np.ndarray:
     if s == 1:
         return k
     r = k.shape[0] // 2
-    ys, xs = _offsets(r)
-    m = k[..., k.shape[2] // 2].astype(float)
-    t = m.sum()
-    mx, my = (m * xs).sum() / t, (m * ys).sum() / t
-    cov = np.array([[(m * (xs - mx) ** 2).sum(), (m * (xs - mx) * (ys - my)).sum()],
-                    [(m * (xs - mx) * (ys - my)).sum(), (m * (ys - my) ** 2).sum()]]) / t
-    lam, vec = np.linalg.eigh(cov)
-    c = np.sqrt(np.clip(1.0 - (5.0 * s * s / 12.0) / np.maximum(lam, 1e-12), 0.25, 1.0))
-    M = (vec * c) @ vec.T
-    px = (M[0, 0] * xs + M[0, 1] * ys) / s  # coarse-pixel coordinates of each fine pixel
-    py = (M[1, 0] * xs + M[1, 1] * ys) / s
+    m00, m01, m11 = _scale_map(k[..., k.shape[2] // 2].astype(float), s)
+    ys, xs = np.nonzero(k.any(axis=2) if k.shape[2] > 1 else k[..., 0])  # the lit pixels (the rest add nothing)
+    xo, yo = xs - float(r), ys - float(r)
+    px = (m00 * xo + m01 * yo) / s  # coarse-pixel coordinates of each fine pixel
+    py = (m01 * xo + m11 * yo) / s
     R = int(math.ceil(max(np.abs(px).max(), np.abs(py).max()))) + 1
     n = 2 * R + 1
-    x0, y0 = np.floor(px).astype(int), np.floor(py).astype(int)
+    x0, y0 = np.floor(px), np.floor(py)
     fx, fy = px - x0, py - y0
-    at = ((y0 + R) * n + (x0 + R)).ravel()
+    at = (y0.astype(np.int64) + R) * n + (x0.astype(np.int64) + R)
     idx = np.concatenate([at, at + 1, at + n, at + n + 1])  # the four coarse pixels around each fine one
-    w = np.concatenate([((1 - fy) * (1 - fx)).ravel(), ((1 - fy) * fx).ravel(), (fy * (1 - fx)).ravel(),
-                        (fy * fx).ravel()])
-    out = np.stack([np.bincount(idx, weights=w * np.tile(k[..., ch].ravel(), 4), minlength=n * n).reshape(n, n)
-                    for ch in range(k.shape[2])], axis=-1)
-    return _trim_kernel(out.astype(np.float32))
+    gx, gy = 1.0 - fx, 1.0 - fy
+    w = np.concatenate([gy * gx, gy * fx, fy * gx, fy * fx])
+    out = np.empty((n, n, k.shape[2]), np.float32)
+    for ch in range(k.shape[2]):
+        v = k[ys, xs, ch]
+        out[..., ch] = np.bincount(idx, weights=w * np.concatenate([v, v, v, v]), minlength=n * n).reshape(n, n)
+    return _trim_kernel(out)
 
 
-_OFFSETS: dict = {}
+def _scale_map(m: np.ndarray, s: int) -> tuple[float, float, float]:
+    """M (m00, m01, m11; symmetric) of :func:`_kernel_at_scale` for the light ``m`` (2r + 1, 2r + 1):
+    its covariance from the row and column sums, and V diag(c) V^T in closed form for a 2 x 2
+    symmetric matrix (c_- I + (c_+ - c_-) P_+, P_+ = (C - lambda_- I) / (lambda_+ - lambda_-), the
+    projector on the larger axis)."""
+    r = m.shape[0] // 2
+    o = np.arange(-r, r + 1, dtype=float)
+    col, row = m.sum(axis=0), m.sum(axis=1)  # the light of each column (x) and row (y)
+    t = col.sum()
+    dx, dy = o - (col * o).sum() / t, o - (row * o).sum() / t
+    vxx, vyy = (col * dx * dx).sum() / t, (row * dy * dy).sum() / t
+    vxy = ((m * dx).sum(axis=1) * dy).sum() / t
+    half, disc = 0.5 * (vxx + vyy), math.hypot(0.5 * (vxx - vyy), vxy)
 
+    def c(lam):
+        return math.sqrt(min(max(1.0 - (5.0 * s * s / 12.0) / max(lam, 1e-12), 0.25), 1.0))
 
-def _offsets(r: int) -> tuple[np.ndarray, np.ndarray]:
-    """The pixel offsets (rows y, columns x; float) of a kernel of radius r from its centre (memoised)."""
-    if r not in _OFFSETS:
-        _OFFSETS[r] = tuple(a.astype(float) for a in np.mgrid[-r:r + 1, -r:r + 1])
-    return _OFFSETS[r]
+    hi, lo = c(half + disc), c(half - disc)
+    if not disc > 1e-12 * half:  # round: M = c I
+        return hi, 0.0, hi
+    a = (hi - lo) / (2.0 * disc)
+    return lo + a * (vxx - half + disc), a * vxy, lo + a * (vyy - half + disc)
 
 
 def _trim_kernel(k: np.ndarray) -> np.ndarray:
