@@ -422,7 +422,7 @@ def _corners(f: Frame, cache, n: int, low: dict, s: int, t: int, origin):
                     out["G"][(slice(None),) + box] += res[i, c:2 * c]
                 out["cov"][(slice(None),) + box] += res[i, -len(cover):]
     cut = (slice(None), slice(0, h + 2 * R), slice(0, w + 2 * R))
-    planes = {k: np.moveaxis(np.maximum(out[k][cut], 0.0), 0, 2) for k in ("V", "G") if k in out}
+    planes = {k: np.maximum(out[k][cut], 0.0) for k in ("V", "G") if k in out}  # (c, h, w)
     for i, k in enumerate(cover):
         planes[k] = np.maximum(out["cov"][i][cut[1:]], 0.0)
     return planes, R
@@ -508,7 +508,7 @@ def _to_full(planes: dict, s: int, origin, r: int, H: int, W: int) -> dict:
     h, w = planes["A"].shape
     oy, ox = y0 - R, x0 - R
     ya, xa, yb, xb = max(oy, 0), max(ox, 0), min(oy + h, H), min(ox + w, W)
-    lay = {k: v[ya - oy:yb - oy, xa - ox:xb - ox] for k, v in planes.items()}
+    lay = {k: v[..., ya - oy:yb - oy, xa - ox:xb - ox] for k, v in planes.items()}
     lay.setdefault("G", None)
     lay["box"] = (slice(ya, yb), slice(xa, xb))
     lay["radius"] = R
@@ -516,18 +516,23 @@ def _to_full(planes: dict, s: int, origin, r: int, H: int, W: int) -> dict:
 
 
 def _upsample(a: np.ndarray, s: int) -> np.ndarray:
-    """(h, w, ...) values per s x s block to (h s, w s, ...) values per pixel: bilinear between block
-    centres (clamped at the ends), divided by s^2, so that each block's sum is kept."""
+    """(..., h, w) values per s x s block to (..., h s, w s) values per pixel: bilinear between block
+    centres (clamped at the ends), divided by s^2, so that each block's sum is kept. The last two
+    axes are the picture's (colour planes first: every pass runs over whole rows)."""
     a = np.asarray(a, dtype=np.float32) / np.float32(s * s)
-    for axis in (0, 1):
-        a = np.moveaxis(a, axis, 0)
-        prev = np.concatenate([a[:1], a[:-1]])
-        nxt = np.concatenate([a[1:], a[-1:]])
-        out = np.empty((a.shape[0] * s,) + a.shape[1:], np.float32)
+    for axis in (a.ndim - 2, a.ndim - 1):
+        def cut(part, axis=axis):
+            return (slice(None),) * axis + (part,)
+
+        prev = np.concatenate([a[cut(slice(0, 1))], a[cut(slice(0, -1))]], axis=axis)
+        nxt = np.concatenate([a[cut(slice(1, None))], a[cut(slice(-1, None))]], axis=axis)
+        out = np.empty(a.shape[:axis] + (a.shape[axis] * s,) + a.shape[axis + 1:], np.float32)
         for q in range(s):
             d = np.float32((q + 0.5) / s - 0.5)  # the pixel's offset from its block's centre, in blocks
-            out[q::s] = (1 - abs(d)) * a + abs(d) * (prev if d < 0 else nxt)
-        a = np.moveaxis(out, 0, axis)
+            o = out[cut(slice(q, None, s))]
+            np.multiply(a, 1 - abs(d), out=o)
+            o += abs(d) * (prev if d < 0 else nxt)
+        a = out
     return a
 
 
