@@ -247,8 +247,17 @@ def _trim(img: np.ndarray, keep: float = 1.0) -> np.ndarray:
     tot = float(m.sum())
     if not tot > 0:
         return img[r:r + 1, r:r + 1]
-    ys, xs = np.indices(m.shape)
-    ring = np.maximum(np.abs(ys - r), np.abs(xs - r))  # each pixel's square "radius"
-    inside = np.cumsum(np.bincount(ring.ravel(), weights=m.ravel(), minlength=r + 1))
+    inside = np.cumsum(np.bincount(_ring(r), weights=m.ravel(), minlength=r + 1))
     e = int(np.searchsorted(inside, keep * tot * (1 - 1e-12)))
     return img[r - e:r + e + 1, r - e:r + e + 1]
+
+
+_RINGS: dict = {}
+
+
+def _ring(r: int) -> np.ndarray:
+    """Each pixel's square "radius" max(|dy|, |dx|) from the centre of a (2r + 1)^2 image, flat (memoised)."""
+    if r not in _RINGS:
+        ys, xs = np.indices((2 * r + 1, 2 * r + 1))
+        _RINGS[r] = np.maximum(np.abs(ys - r), np.abs(xs - r)).ravel()
+    return _RINGS[r]

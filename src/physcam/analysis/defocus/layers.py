@@ -388,10 +388,11 @@ def _corners(f: Frame, cache, n: int, low: dict, s: int, t: int, origin):
     g = np.moveaxis(low["G"], 2, 0) if "G" in low else None
     cov = np.stack([low[k] for k in cover])
     kern, groups = {}, {}
+    lit = _tiles_lit([cov, light] + ([g] if g is not None else []), t)
+    lit_g = _tiles_lit([g], t) if g is not None else None
     for ty in range(-(-h // t)):
         for tx in range(-(-w // t)):
-            sl = (slice(None), slice(ty * t, (ty + 1) * t), slice(tx * t, (tx + 1) * t))
-            if not (cov[sl].any() or light[sl].any() or (g is not None and g[sl].any())):
+            if not lit[ty, tx]:
                 continue
             corners = ((ty, tx), (ty, tx + 1), (ty + 1, tx), (ty + 1, tx + 1))
             for cy, cx in corners:
@@ -399,7 +400,7 @@ def _corners(f: Frame, cache, n: int, low: dict, s: int, t: int, origin):
                     pos = (f.origin[0] + origin[1] + cx * t * s, f.origin[1] + origin[0] + cy * t * s)
                     kern[(cy, cx)] = cache.scaled_kernel(pos[0], pos[1], n, s, _kernel_at_scale)
             r = max(kern[cn].shape[0] for cn in corners) // 2
-            key = (g is not None and bool(g[sl].any()), _varies(kern, ty, tx), r + r % 2)  # radii batched in pairs
+            key = (lit_g is not None and bool(lit_g[ty, tx]), _varies(kern, ty, tx), r + r % 2)  # radii batched in pairs
             groups.setdefault(key, []).append((ty, tx))
     R = max(k for _, _, k in groups)
     H2, W2 = -(-h // t) * t, -(-w // t) * t  # whole tiles: the last row and column padded with zeros
@@ -428,6 +429,18 @@ def _corners(f: Frame, cache, n: int, low: dict, s: int, t: int, origin):
     return planes, R
 
 
+def _tiles_lit(planes, t: int) -> np.ndarray:
+    """(tiles down, tiles across): whether any of ``planes`` ((k, h, w) arrays) is non-zero in each t x t tile."""
+    nz = np.zeros(planes[0].shape[1:], bool)
+    for p in planes:
+        nz |= (p != 0).any(axis=0)
+    h, w = nz.shape
+    ny, nx = -(-h // t), -(-w // t)
+    if (ny * t, nx * t) != (h, w):
+        nz = np.pad(nz, ((0, ny * t - h), (0, nx * t - w)))
+    return nz.reshape(ny, t, nx, t).any(axis=(1, 3))
+
+
 #: a tile whose corner kernels differ by less than this (sum of absolute differences) is blurred
 #: with their mean alone
 SAME_KERNEL = 2e-3
@@ -450,12 +463,12 @@ def _blur_tiles(stack, tiles, kern, padded, t, r, names, c, varies) -> np.ndarra
         for cn in ((ty, tx), (ty, tx + 1), (ty + 1, tx), (ty + 1, tx + 1)):
             if (cn, r) not in padded:
                 padded[(cn, r)] = _pad_kernel(kern[cn], r)
-    kb = np.stack([_terms(padded, ty, tx, r) for ty, tx in tiles])  # (k, 4, channels, n, n)
+    kb = _terms(padded, tiles, r, varies)  # (k, 4 or 1, channels, n, n)
     if varies:
         bx = blocks * ramp[None, None, None, :]
         terms = np.stack([blocks, bx, blocks * ramp[None, None, :, None], bx * ramp[None, None, :, None]], axis=1)
     else:
-        terms, kb = blocks[:, None], kb[:, :1]
+        terms = blocks[:, None]
     plane_of = _kernel_index(names, c, kb.shape[2])
     if r <= DIRECT_RADIUS:
         return np.stack([sum(convolve(terms[i, j], kb[i, j][plane_of]) for j in range(terms.shape[1]))
@@ -466,15 +479,19 @@ def _blur_tiles(stack, tiles, kern, padded, t, r, names, c, varies) -> np.ndarra
     return np.fft.irfft2(spec.sum(axis=1), s=(size, size))[..., :t + 2 * r, :t + 2 * r]
 
 
-def _terms(padded: dict, ty: int, tx: int, r: int) -> np.ndarray:
-    """(4, channels, 2r + 1, 2r + 1): the kernels Kc, Kx, Ky, Kxy of tile (ty, tx) (see :func:`_corners`)."""
-    k00, k01 = padded[((ty, tx), r)], padded[((ty, tx + 1), r)]
-    k10, k11 = padded[((ty + 1, tx), r)], padded[((ty + 1, tx + 1), r)]
+def _terms(padded: dict, tiles, r: int, varies: bool = True) -> np.ndarray:
+    """(tiles, 4, channels, 2r + 1, 2r + 1): the kernels Kc, Kx, Ky, Kxy of each tile (ty, tx) (see
+    :func:`_corners`); Kc alone (tiles, 1, ...) unless ``varies``."""
+    k = np.stack([[padded[(cn, r)] for cn in ((ty, tx), (ty, tx + 1), (ty + 1, tx), (ty + 1, tx + 1))]
+                  for ty, tx in tiles])  # (tiles, 4 corners, n, n, channels)
+    k00, k01, k10, k11 = k[:, 0], k[:, 1], k[:, 2], k[:, 3]
     kc = 0.25 * (k00 + k01 + k10 + k11)
+    if not varies:
+        return np.moveaxis(kc[:, None], 4, 2).astype(np.float32)
     kx = 0.5 * (k01 + k11 - k00 - k10)
     ky = 0.5 * (k10 + k11 - k00 - k01)
     kxy = k00 + k11 - k01 - k10
-    return np.moveaxis(np.stack([kc, kx, ky, kxy]), 3, 1).astype(np.float32)
+    return np.moveaxis(np.stack([kc, kx, ky, kxy], axis=1), 4, 2).astype(np.float32)
 
 
 def _kernel_index(names, c: int, channels: int) -> np.ndarray:

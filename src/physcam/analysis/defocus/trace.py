@@ -280,7 +280,8 @@ def _trace_batch(cam, jobs, wls, z_ep) -> list[Fan]:
         L2 *= N2
         M2 *= N2
         N2 *= dz
-        np.power(N2, 3, out=w2)  # before the trace moves the directions
+        np.multiply(N2, N2, out=w2)  # cos^3, before the trace moves the directions (np.power(N2, 3): 10x the CPU)
+        w2 *= N2
         w2 *= bw * bh / n
     wl = np.full(total, wls[0]) if k == 1 else np.concatenate([wls[chs[:n]] for n in counts[order]])
     rays = RayBatch(x, y, z, L, M, N, wl, np.ones(total), np.zeros(total, dtype=np.uint8))
