@@ -36,7 +36,7 @@ import numpy as np
 
 @dataclass
 class Frame:
-    """The padded picture: colour (h, w, c), coverage ``a`` (h, w), lower node ``lo`` and upper
+    """The padded picture: colour (c, h, w: planes first), coverage ``a`` (h, w), lower node ``lo`` and upper
     weight ``t`` per pixel, ``inside`` (the picture, not its margin), the margin width, the tile,
     the display position of pixel (0, 0) and per-tile fill statistics (:func:`fill_stats`)."""
 
@@ -68,7 +68,8 @@ def frame_of(colour, a, lo, t, margin, tile, origin, has_alpha) -> Frame:
     h, w = lo.shape
     inside = np.zeros((h + 2 * m, w + 2 * m), dtype=bool)
     inside[m:m + h, m:m + w] = True
-    f = Frame(np.pad(colour, pad2 + ((0, 0),), mode="edge").astype(np.float32), np.pad(a, pad2, mode="edge").astype(np.float32),
+    planes = np.ascontiguousarray(np.moveaxis(np.asarray(colour), 2, 0), dtype=np.float32)
+    f = Frame(np.pad(planes, ((0, 0),) + pad2, mode="edge"), np.pad(a, pad2, mode="edge").astype(np.float32),
               np.pad(lo, pad2, mode="edge").astype(np.int32), np.pad(t, pad2, mode="edge").astype(np.float32), inside,
               m, int(tile), (origin[0] - m, origin[1] - m), has_alpha)
     f.stats = fill_stats(f)
@@ -86,7 +87,7 @@ def fill_stats(f: Frame) -> dict:
     key = (tid * len(groups) + gi).ravel()
     size = ny * nx * len(groups)
     S = np.bincount(key, weights=f.a.ravel(), minlength=size).reshape(ny, nx, len(groups))
-    L = np.stack([np.bincount(key, weights=f.colour[..., c].ravel(), minlength=size) for c in range(f.colour.shape[2])],
+    L = np.stack([np.bincount(key, weights=f.colour[c].ravel(), minlength=size) for c in range(f.colour.shape[0])],
                  axis=-1).reshape(ny, nx, len(groups), -1)
     near = np.zeros((h, w), dtype=np.int32)  # each pixel's nearest 4-neighbour's group
     near[:] = f.lo
@@ -159,7 +160,7 @@ def _tile_weights(n_tiles: int, tile: int, index: int, length: int) -> np.ndarra
 
 
 def _fill(f: Frame, ty: int, tx: int, g: int, sl):
-    """Group g's density (h, w) and light per unit of coverage (h, w, c) behind the pixels of tile
+    """Group g's density (h, w) and light per unit of coverage (c, h, w) behind the pixels of tile
     (ty, tx) at least two nodes nearer than it, those pixels, and its density in pixels (alpha 1:
     the coverage an opaque picture would have); None if there are none (module notes)."""
     st = f.stats
@@ -178,7 +179,7 @@ def _fill(f: Frame, ty: int, tx: int, g: int, sl):
             return np.where(d > 0, (wy @ num @ wx.T) / np.where(d > 0, d, 1.0), 0.0)
 
     rho = ratio(st["S"][ys, xs, gi], st["A"])
-    light = np.stack([ratio(st["L"][ys, xs, gi][..., c], st["A"]) for c in range(st["L"].shape[-1])], axis=-1)
+    light = np.stack([ratio(st["L"][ys, xs, gi][..., c], st["A"]) for c in range(st["L"].shape[-1])])
     rho1 = ratio(st["S1"][ys, xs, gi], st["A1"]) if f.has_alpha else rho
     return rho, light, hole, rho1
 
@@ -204,7 +205,7 @@ def _scale(radius: int, tile: int) -> int:
 
 def _sources(f: Frame, n: int, tiles, box, s: int) -> dict:
     """The planes node n receives (module notes) over ``box`` (y0, y1, x0, x1 of the padded frame,
-    multiples of s), summed over s x s blocks: V, G (h, w, c) light (before the transmission), A, U
+    multiples of s), summed over s x s blocks: V, G (c, h, w) light (before the transmission), A, U
     coverage, and A1, U1 with alpha; G only when a fill brings light."""
     y0, y1, x0, x1 = box
     H, W = f.lo.shape
@@ -214,7 +215,7 @@ def _sources(f: Frame, n: int, tiles, box, s: int) -> dict:
     one = np.float32(1.0)
     share_lo = np.where((lo == n) & ins, one - tt, np.float32(0.0))
     share_up = np.where((lo == n - 1) & ins, tt, np.float32(0.0))
-    planes = {"V": (share_lo + share_up)[..., None] * f.colour[sub], "A": share_lo * a, "U": share_up * a}
+    planes = {"V": (share_lo + share_up) * f.colour[(slice(None),) + sub], "A": share_lo * a, "U": share_up * a}
     if f.has_alpha:
         planes["A1"], planes["U1"] = share_lo, share_up
     for ty, tx, fill in tiles:
@@ -228,26 +229,26 @@ def _sources(f: Frame, n: int, tiles, box, s: int) -> dict:
         behind = np.where(hole, f.a[sl], 0.0)  # the fill lies behind the nearer pixels' coverage
         if "G" not in planes:
             planes["G"] = np.zeros_like(planes["V"])
-        planes["G"][dst] += behind[..., None] * fl
+        planes["G"][(slice(None),) + dst] += behind * fl
         planes["A"][dst] += behind * rho
         if f.has_alpha:
             planes["A1"][dst] += hole * rho1
     shape = (y1 - y0, x1 - x0)
     out = {}
     for k, v in planes.items():
-        if v.shape[:2] != shape:
-            full = np.zeros(shape + v.shape[2:], np.float32)
-            full[ya - y0:ya - y0 + v.shape[0], xa - x0:xa - x0 + v.shape[1]] = v
+        if v.shape[-2:] != shape:
+            full = np.zeros(v.shape[:-2] + shape, np.float32)
+            full[..., ya - y0:ya - y0 + v.shape[-2], xa - x0:xa - x0 + v.shape[-1]] = v
             v = full
         out[k] = _block_sum(v, s)
     return out
 
 
 def _block_sum(a: np.ndarray, s: int) -> np.ndarray:
-    """Sums over s x s blocks (the first two axes; their lengths are multiples of s)."""
+    """Sums over s x s blocks (the last two axes; their lengths are multiples of s)."""
     while s > 1:  # halve each axis in turn: strided adds are cheaper than a reduction over a reshape
-        a = a[0::2] + a[1::2]
-        a = a[:, 0::2] + a[:, 1::2]
+        a = a[..., 0::2, :] + a[..., 1::2, :]
+        a = a[..., 0::2] + a[..., 1::2]
         s //= 2
     return a
 
@@ -330,6 +331,7 @@ def blur_layer(f: Frame, cache, n: int, tiles) -> dict | None:
     s, step, (y0, y1, x0, x1) = layer_grid(f, cache.camera, n, tiles)
     low = _sources(f, n, tiles, (y0, y1, x0, x1), s)
     T = _transmission_blocks(f, cache, n, y0, x0, low["A"].shape, s)
+    T = np.moveaxis(T, 2, 0)  # (channels, h, w), as the light planes
     low["V"] = low["V"] * T
     if "G" in low:
         low["G"] = low["G"] * T
@@ -382,10 +384,10 @@ def _corners(f: Frame, cache, n: int, low: dict, s: int, t: int, origin):
     continuous across tile borders (no seams). Tiles are batched by the size of their own kernels.
     Returns the blurred planes over the box grown by the largest kernel radius R, and R."""
     h, w = low["A"].shape
-    c = f.colour.shape[2]
+    c = f.colour.shape[0]
     cover = [k for k in ("A", "U", "A1", "U1") if k in low]
-    light = np.moveaxis(low["V"], 2, 0)
-    g = np.moveaxis(low["G"], 2, 0) if "G" in low else None
+    light = low["V"]
+    g = low.get("G")
     cov = np.stack([low[k] for k in cover])
     kern, groups = {}, {}
     lit = _tiles_lit([cov, light] + ([g] if g is not None else []), t)

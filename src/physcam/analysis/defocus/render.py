@@ -214,7 +214,7 @@ def _used_corners(f, cam, n, tiles, xs, ys) -> list[tuple[float, float, int]]:
 def _composite(f, cache, pairs, progress):
     """The nodes blurred and composited near to far (module notes): the colour (c, H, W) and the coverage."""
     H, W = f.lo.shape
-    c = f.colour.shape[2]
+    c = f.colour.shape[0]
     out = np.zeros((c, H, W), dtype=np.float32)  # colour planes first (as the layers': whole rows)
     cov = np.zeros((H, W), dtype=np.float32)  # coverage of the groups composited so far
     cov1 = np.zeros((H, W), dtype=np.float32) if f.has_alpha else None
