@@ -215,9 +215,11 @@ def _sources(f: Frame, n: int, tiles, box, s: int) -> dict:
     one = np.float32(1.0)
     share_lo = np.where((lo == n) & ins, one - tt, np.float32(0.0))
     share_up = np.where((lo == n - 1) & ins, tt, np.float32(0.0))
-    planes = {"V": (share_lo + share_up) * f.colour[(slice(None),) + sub], "A": share_lo * a, "U": share_up * a}
+    planes = {"V": (share_lo + share_up) * f.colour[(slice(None),) + sub]}
     if f.has_alpha:
-        planes["A1"], planes["U1"] = share_lo, share_up
+        planes.update(A=share_lo * a, U=share_up * a, A1=share_lo, U1=share_up)
+    else:  # an opaque picture: coverage 1 (frame_of), so A and U are the shares themselves
+        planes.update(A=share_lo, U=share_up)
     for ty, tx, fill in tiles:
         got = _fill(f, ty, tx, n, f.tile_slice(ty, tx)) if fill else None
         if got is None:
@@ -538,7 +540,7 @@ def _upsample(a: np.ndarray, s: int) -> np.ndarray:
     """(..., h, w) values per s x s block to (..., h s, w s) values per pixel: bilinear between block
     centres (clamped at the ends), divided by s^2, so that each block's sum is kept. The last two
     axes are the picture's (colour planes first: every pass runs over whole rows)."""
-    a = np.asarray(a, dtype=np.float32) / np.float32(s * s)
+    a = np.asarray(a, dtype=np.float32)
     for axis in (a.ndim - 2, a.ndim - 1):
         def cut(part, axis=axis):
             return (slice(None),) * axis + (part,)
@@ -546,11 +548,12 @@ def _upsample(a: np.ndarray, s: int) -> np.ndarray:
         prev = np.concatenate([a[cut(slice(0, 1))], a[cut(slice(0, -1))]], axis=axis)
         nxt = np.concatenate([a[cut(slice(1, None))], a[cut(slice(-1, None))]], axis=axis)
         out = np.empty(a.shape[:axis] + (a.shape[axis] * s,) + a.shape[axis + 1:], np.float32)
+        k = np.float32(1 / s) if axis == a.ndim - 2 else np.float32(1)  # 1/s^2 at the first pass: exact, a power of 2
         for q in range(s):
             d = np.float32((q + 0.5) / s - 0.5)  # the pixel's offset from its block's centre, in blocks
             o = out[cut(slice(q, None, s))]
-            np.multiply(a, 1 - abs(d), out=o)
-            o += abs(d) * (prev if d < 0 else nxt)
+            np.multiply(a, (1 - abs(d)) * k * k, out=o)
+            o += (abs(d) * k * k) * (prev if d < 0 else nxt)
         a = out
     return a
 
