@@ -479,7 +479,8 @@ def _blur_tiles(stack, tiles, kern, padded, t, r, names, c, varies) -> np.ndarra
                          for i in range(len(tiles))])
     size = fast_len(t + 2 * r)
     spec = np.fft.rfft2(terms, s=(size, size))
-    spec *= np.fft.rfft2(kb, s=(size, size))[:, :, plane_of]
+    ks = np.fft.rfft2(kb, s=(size, size))
+    spec *= ks if ks.shape[2] == 1 else ks[:, :, plane_of]  # one kernel channel: broadcast over the planes
     return np.fft.irfft2(spec.sum(axis=1), s=(size, size))[..., :t + 2 * r, :t + 2 * r]
 
 
