@@ -123,7 +123,9 @@ def _node_weights(u: np.ndarray, cam: DefocusCamera):
     """Each pixel's lower depth node and its weight on the node above (linear in u)."""
     n_far = cam.node_far()
     lo = np.maximum(np.floor(cam.node_index(u) + 1e-9), n_far).astype(np.int64)
-    u_lo, u_hi = cam.node_u(lo), cam.node_u(lo + 1)
+    first = int(lo.min())
+    table = cam.node_u(np.arange(first, int(lo.max()) + 2))  # the nodes' u, looked up (not per pixel)
+    u_lo, u_hi = table[lo - first], table[lo - first + 1]
     w_hi = np.clip((u - u_lo) / (u_hi - u_lo), 0.0, 1.0)
     return lo, w_hi
 
