@@ -44,8 +44,9 @@ import numpy as np
 from ...errors import OpticsError
 
 
-#: rays per tracer call (about 100 bytes of memory per ray in flight)
-CHUNK_RAYS = 1 << 20
+#: rays per tracer call (about 100 bytes of memory per ray in flight: a quarter million keeps a chunk's
+#: columns nearer the cache from their writing to the trace than a million did, about 10 % less CPU)
+CHUNK_RAYS = 1 << 18
 #: the depth of the "infinity" node, mm (10 km: its blur differs from infinity's by
 #: D_ep f_pin 1e-7 / p, 0.001 px for a 50 mm f/2.8 on 0.1 mm pixels). Not farther: from 1e9 mm the
 #: traced rays lose precision and the kernel grows a halo tens of pixels wide
