@@ -475,13 +475,30 @@ def _blur_tiles(stack, tiles, kern, padded, t, r, names, c, varies) -> np.ndarra
         terms = blocks[:, None]
     plane_of = _kernel_index(names, c, kb.shape[2])
     if r <= DIRECT_RADIUS:
-        return np.stack([sum(convolve(terms[i, j], kb[i, j][plane_of]) for j in range(terms.shape[1]))
-                         for i in range(len(tiles))])
+        return _direct_sum(terms, kb[:, :, plane_of])
     size = fast_len(t + 2 * r)
     spec = np.fft.rfft2(terms, s=(size, size))
     ks = np.fft.rfft2(kb, s=(size, size))
     spec *= ks if ks.shape[2] == 1 else ks[:, :, plane_of]  # one kernel channel: broadcast over the planes
     return np.fft.irfft2(spec.sum(axis=1), s=(size, size))[..., :t + 2 * r, :t + 2 * r]
+
+
+def _direct_sum(terms: np.ndarray, kers: np.ndarray) -> np.ndarray:
+    """Sum over j of the full convolutions of ``terms[:, j]`` (tiles, planes, t, t) with ``kers[:, j]``
+    (tiles, planes, n, n), by direct sums (all the batch's tiles at once): (tiles, planes, t + n - 1,
+    t + n - 1)."""
+    k, m, p, h, w = terms.shape
+    n = kers.shape[-1]
+    out = None
+    for j in range(m):
+        part = np.zeros((k, p, h + n - 1, w + n - 1), dtype=np.float32)
+        for dy in range(n):
+            for dx in range(n):
+                cf = kers[:, j, :, dy, dx]
+                if cf.any():
+                    part[:, :, dy:dy + h, dx:dx + w] += cf[:, :, None, None] * terms[:, j]
+        out = part if out is None else out + part
+    return out
 
 
 def _terms(padded: dict, tiles, r: int, varies: bool = True) -> np.ndarray:
@@ -579,24 +596,3 @@ def fast_len(n: int) -> int:
             p35 *= 3
         p5 *= 5
     return best
-
-
-def convolve(src: np.ndarray, ker: np.ndarray) -> np.ndarray:
-    """Full 2-D convolution of each plane of ``src`` (k, h, w) with ``ker`` (n, n) or, per plane,
-    (k, n, n): (k, h + n - 1, w + n - 1). Direct for small kernels, else FFT (float32)."""
-    k, h, w = src.shape
-    n = ker.shape[-1]
-    kers = np.broadcast_to(ker, (k, n, n)) if ker.ndim == 2 else ker
-    if n <= 7:
-        out = np.zeros((k, h + n - 1, w + n - 1), dtype=np.float32)
-        for dy in range(n):
-            for dx in range(n):
-                cf = kers[:, dy, dx]
-                if cf.any():
-                    out[:, dy:dy + h, dx:dx + w] += cf[:, None, None] * src
-        return out
-    sy, sx = fast_len(h + n - 1), fast_len(w + n - 1)
-    fs = np.fft.rfft2(src, s=(sy, sx))
-    fk = np.fft.rfft2(ker, s=(sy, sx))
-    res = np.fft.irfft2(fs * fk, s=(sy, sx))[:, : h + n - 1, : w + n - 1]
-    return np.maximum(res, 0.0).astype(np.float32, copy=False)
