@@ -98,7 +98,8 @@ def fill_stats(f: Frame) -> dict:
     edge = (near >= f.lo + 2).ravel()  # the far side of a depth edge: a neighbour two nodes nearer or more
     E = np.bincount(key[edge], minlength=size).reshape(ny, nx, len(groups)) > 0
     S1 = np.bincount(key, minlength=size).reshape(ny, nx, len(groups)).astype(float)  # with alpha 1 (pixel counts)
-    return {"groups": groups, "S": S, "A": np.cumsum(S, axis=2), "L": L, "edge": E, "S1": S1, "A1": np.cumsum(S1, axis=2)}
+    return {"groups": groups, "S": S, "A": np.cumsum(S, axis=2), "L": L, "edge": E, "S1": S1, "A1": np.cumsum(S1, axis=2),
+            "key": key}
 
 
 #: a group is continued behind nearer pixels (a fill) only where it meets them at a depth edge (a
@@ -132,15 +133,18 @@ def layer_pairs(f: Frame) -> dict:
         if f.has_alpha:
             dense |= np.nan_to_num(sums["S1"] / sums["A1"]) >= FILL_MIN_DENSITY
         near = dense & E3
+    # per tile and group: pixels sending light to the group's lower node (t < 1) and to its upper one (t > 0)
+    key, t, size = st["key"], f.t.ravel(), ny * nx * len(groups)
+    to_lo = np.bincount(key[t < 1], minlength=size).reshape(ny, nx, len(groups)) > 0
+    to_up = np.bincount(key[t > 0], minlength=size).reshape(ny, nx, len(groups)) > 0
+    inside = np.bincount(key // len(groups), weights=f.inside.ravel(), minlength=ny * nx).reshape(ny, nx) > 0
     for ty in range(ny):
         for tx in range(nx):
-            sl = f.tile_slice(ty, tx)
-            if not f.inside[sl].any():  # the margin sends nothing (light leaving the frame is folded back)
+            if not inside[ty, tx]:  # the margin sends nothing (light leaving the frame is folded back)
                 continue
-            lo, t = f.lo[sl], f.t[sl]
-            nodes = set(np.unique(lo[t < 1]).tolist()) | set((np.unique(lo[t > 0]) + 1).tolist())
-            top = int(lo.max())
-            fills = {int(g) for i, g in enumerate(groups) if near[ty, tx, i] and g + 2 <= top}
+            nodes = set(groups[to_lo[ty, tx]].tolist()) | set((groups[to_up[ty, tx]] + 1).tolist())
+            top = groups[np.flatnonzero(st["S1"][ty, tx] > 0)[-1]]  # the tile's nearest group
+            fills = set(groups[near[ty, tx] & (groups + 2 <= top)].tolist())
             for n in nodes | fills:
                 pairs.setdefault(int(n), []).append((ty, tx, int(n) in fills))
     return pairs
