@@ -169,7 +169,8 @@ def defocus(image, u, cache: KernelCache, *, origin=(0, 0), edge_px: int = 1, al
     lo, t = _node_weights(near_edges(np.asarray(u, dtype=np.float64), int(edge_px)), cam)
     keep = [i for i in range(c) if i != alpha_channel]
     a = np.clip(img[..., alpha_channel], 0.0, 1.0) if alpha_channel is not None else np.ones((h, w), np.float32)
-    nodes = np.unique(np.concatenate([np.unique(lo), np.unique(lo) + 1]))
+    groups = np.unique(lo)
+    nodes = np.unique(np.concatenate([groups, groups + 1]))
     margin = int(math.ceil(0.75 * float(np.max(cam.blur_px_at(nodes))))) + 4
     f = frame_of(img[..., keep], a, lo, t, margin, cam.tile, origin, alpha_channel is not None)
     pairs = layer_pairs(f)
