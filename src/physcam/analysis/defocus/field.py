@@ -238,10 +238,12 @@ def direct_kernels(cam, fans, unwarps) -> list[np.ndarray]:
     by_size: dict = {}
     for i, fan in enumerate(fans):
         by_size.setdefault(len(fan.w), []).append(i)
-    for idx in by_size.values():
-        got = bin_fans([fans[i] for i in idx], len(cam.wavelengths_nm), [unwarps[i] for i in idx])
-        for i, (_, (img, _)) in zip(idx, got):
-            out[i] = _unit_kernel(img)
+    for same in by_size.values():
+        for b in range(0, len(same), 128):  # about 10 arrays of (128, samples) float64 at once
+            idx = same[b:b + 128]
+            got = bin_fans([fans[i] for i in idx], len(cam.wavelengths_nm), [unwarps[i] for i in idx])
+            for i, (_, (img, _)) in zip(idx, got):
+                out[i] = _unit_kernel(img)
     return out
 
 
