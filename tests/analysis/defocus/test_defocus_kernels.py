@@ -267,3 +267,26 @@ def test_a_bladed_iris_blurs_as_the_round_iris_of_its_f_number():
         sx, sy = _moments(c.kernels(point)[0].image)
         radii.append(math.hypot(sx, sy))
     assert radii[1] / radii[0] == pytest.approx(1.0077 ** 0.5, abs=0.02)
+
+
+@pytest.mark.parametrize("dispersion", [False, True])
+def test_direct_kernels_binned_together_are_the_node_kernels_binned_one_by_one(dispersion):
+    """field.direct_kernels bins a frame's many small fans in one bincount (trace.bin_fans): the same
+    sums in the same order as node_kernel fan by fan, so the same kernels to the bit (both here, in
+    one process, no BLAS); with fans of two sample counts, three wavelengths, a fan without light."""
+    from physcam.analysis.defocus.field import box_depths, direct_kernels, node_kernel
+
+    c = defocus_camera(camera_state(load_lens("dgauss_50mm"), focus_mm=2000.0, fstop=2.8, sensor_mm=SENSOR_MM),
+                       width=W, height=H, tile=32, dispersion=dispersion)
+    pts = [(3.0, 5.0), (80.0, 45.0), (150.0, 12.5)]
+    boxes = dt.pupil_boxes(c, pts, box_depths(c))
+    unwarps = np.linalg.inv(dt.distortion_jacobians(c, pts))
+    jobs = [(p, u, b, k) for (p, b) in zip(pts, boxes) for u, k in ((1 / 900.0, 4096), (1 / 6000.0, 8192))]
+    fans = dt.trace_fans(c, jobs)
+    f = fans[0]
+    fans.append(dt.Fan(f.field_px, f.u, np.zeros_like(f.ox), np.zeros_like(f.oy), np.zeros_like(f.w), f.ch, f.ex, f.ey))
+    uw = [unwarps[i // 2] for i in range(len(jobs))] + [unwarps[0]]
+    got = direct_kernels(c, fans, uw)
+    want = [node_kernel(c, fan, fan, 0, None, u)[0] for fan, u in zip(fans, uw)]
+    assert all(a.shape == b.shape and np.array_equal(a, b) for a, b in zip(got, want))
+    assert got[-1].shape == (1, 1, len(c.wavelengths_nm)) and max(k.shape[0] for k in got) >= 3  # a unit kernel; blurs

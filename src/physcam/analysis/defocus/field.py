@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .trace import FAR_MM, bin_fan, fan_centroid, interpolate_fan, pupil_boxes, solid_angles, trace_fans
+from .trace import FAR_MM, bin_fan, bin_fans, fan_centroid, interpolate_fan, pupil_boxes, solid_angles, trace_fans
 
 
 #: the blend of two nodes' kernels may sit this far (px) from the kernel traced between them
@@ -227,12 +227,33 @@ def node_kernel(cam, fan_a, fan_b, n, maps=None, unwarp=None) -> tuple[np.ndarra
     u = float(cam.node_u(n))
     fan = interpolate_fan(fan_a, fan_b, u, maps) if fan_a is not fan_b else fan_a
     centre = fan_centroid(fan)
-    img, tot = bin_fan(fan, centre, len(cam.wavelengths_nm), unwarp)
+    img, _ = bin_fan(fan, centre, len(cam.wavelengths_nm), unwarp)
+    return _unit_kernel(img), centre
+
+
+def direct_kernels(cam, fans, unwarps) -> list[np.ndarray]:
+    """:func:`node_kernel` of each fan traced at its node's own depth (``fans[i]`` with ``unwarps[i]``),
+    binned together (:func:`~physcam.analysis.defocus.trace.bin_fans`, by sample count): the same kernels."""
+    out: list = [None] * len(fans)
+    by_size: dict = {}
+    for i, fan in enumerate(fans):
+        by_size.setdefault(len(fan.w), []).append(i)
+    for same in by_size.values():
+        for b in range(0, len(same), 128):  # about 10 arrays of (128, samples) float64 at once
+            idx = same[b:b + 128]
+            got = bin_fans([fans[i] for i in idx], len(cam.wavelengths_nm), [unwarps[i] for i in idx])
+            for i, (_, (img, _)) in zip(idx, got):
+                out[i] = _unit_kernel(img)
+    return out
+
+
+def _unit_kernel(img: np.ndarray) -> np.ndarray:
+    """A binned kernel trimmed to :data:`KERNEL_LIGHT` of its light and scaled to a unit sum per channel (float32)."""
     img = _trim(img, KERNEL_LIGHT)
     tot = img.sum(axis=(0, 1))
     with np.errstate(invalid="ignore", divide="ignore"):
         img = np.where(tot > 0, img / np.where(tot > 0, tot, 1.0), 0.0)
-    return img.astype(np.float32), centre
+    return img.astype(np.float32)
 
 
 #: a kernel is cut to the smallest centred square holding this much of its light (the rest, a few
@@ -247,8 +268,17 @@ def _trim(img: np.ndarray, keep: float = 1.0) -> np.ndarray:
     tot = float(m.sum())
     if not tot > 0:
         return img[r:r + 1, r:r + 1]
-    ys, xs = np.indices(m.shape)
-    ring = np.maximum(np.abs(ys - r), np.abs(xs - r))  # each pixel's square "radius"
-    inside = np.cumsum(np.bincount(ring.ravel(), weights=m.ravel(), minlength=r + 1))
+    inside = np.cumsum(np.bincount(_ring(r), weights=m.ravel(), minlength=r + 1))
     e = int(np.searchsorted(inside, keep * tot * (1 - 1e-12)))
     return img[r - e:r + e + 1, r - e:r + e + 1]
+
+
+_RINGS: dict = {}
+
+
+def _ring(r: int) -> np.ndarray:
+    """Each pixel's square "radius" max(|dy|, |dx|) from the centre of a (2r + 1)^2 image, flat (memoised)."""
+    if r not in _RINGS:
+        ys, xs = np.indices((2 * r + 1, 2 * r + 1))
+        _RINGS[r] = np.maximum(np.abs(ys - r), np.abs(xs - r)).ravel()
+    return _RINGS[r]

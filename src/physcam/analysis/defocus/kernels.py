@@ -532,7 +532,7 @@ class KernelCache:
         """Trace, in one batch, the kernels at picture positions and depth nodes ``points`` ((x, y, n)
         triples) of a small blur (:data:`DIRECT_BLUR_PX`), each at its own place and its node's own
         depth, so that :meth:`tile_kernel` reads them instead of blending field nodes; returns the new ones."""
-        from .field import box_depths, node_kernel
+        from .field import box_depths, direct_kernels
         from .trace import distortion_jacobians, pupil_boxes, trace_fans
 
         cam = self.camera
@@ -545,8 +545,7 @@ class KernelCache:
             part = todo[b:b + 512]
             fans = trace_fans(cam, [((x, y), float(cam.node_u(n)), self._places[(x, y)][0], cam.samples(n, n))
                                     for x, y, n in part])
-            for key, fan in zip(part, fans):
-                self._direct[key] = node_kernel(cam, fan, fan, key[2], None, self._places[key[:2]][1])[0]
+            self._direct.update(zip(part, direct_kernels(cam, fans, [self._places[key[:2]][1] for key in part])))
         self.traced += len(todo)
         return {k: self._direct[k] for k in todo}
 

@@ -123,7 +123,9 @@ def _node_weights(u: np.ndarray, cam: DefocusCamera):
     """Each pixel's lower depth node and its weight on the node above (linear in u)."""
     n_far = cam.node_far()
     lo = np.maximum(np.floor(cam.node_index(u) + 1e-9), n_far).astype(np.int64)
-    u_lo, u_hi = cam.node_u(lo), cam.node_u(lo + 1)
+    first = int(lo.min())
+    table = cam.node_u(np.arange(first, int(lo.max()) + 2))  # the nodes' u, looked up (not per pixel)
+    u_lo, u_hi = table[lo - first], table[lo - first + 1]
     w_hi = np.clip((u - u_lo) / (u_hi - u_lo), 0.0, 1.0)
     return lo, w_hi
 
@@ -167,7 +169,8 @@ def defocus(image, u, cache: KernelCache, *, origin=(0, 0), edge_px: int = 1, al
     lo, t = _node_weights(near_edges(np.asarray(u, dtype=np.float64), int(edge_px)), cam)
     keep = [i for i in range(c) if i != alpha_channel]
     a = np.clip(img[..., alpha_channel], 0.0, 1.0) if alpha_channel is not None else np.ones((h, w), np.float32)
-    nodes = np.unique(np.concatenate([np.unique(lo), np.unique(lo) + 1]))
+    groups = np.unique(lo)
+    nodes = np.unique(np.concatenate([groups, groups + 1]))
     margin = int(math.ceil(0.75 * float(np.max(cam.blur_px_at(nodes))))) + 4
     f = frame_of(img[..., keep], a, lo, t, margin, cam.tile, origin, alpha_channel is not None)
     pairs = layer_pairs(f)
@@ -175,7 +178,7 @@ def defocus(image, u, cache: KernelCache, *, origin=(0, 0), edge_px: int = 1, al
     colour, cover = _composite(f, cache, pairs, progress)
     m = f.margin
     out = np.empty_like(img)
-    out[..., keep] = colour[m:m + h, m:m + w]
+    out[..., keep] = np.moveaxis(colour[:, m:m + h, m:m + w], 0, 2)
     if alpha_channel is not None:
         out[..., alpha_channel] = cover[m:m + h, m:m + w]
     return out if np.ndim(image) == 3 else out[..., 0]
@@ -212,10 +215,10 @@ def _used_corners(f, cam, n, tiles, xs, ys) -> list[tuple[float, float, int]]:
 
 
 def _composite(f, cache, pairs, progress):
-    """The nodes blurred and composited near to far (module notes): the colour and the coverage."""
+    """The nodes blurred and composited near to far (module notes): the colour (c, H, W) and the coverage."""
     H, W = f.lo.shape
-    c = f.colour.shape[2]
-    out = np.zeros((H, W, c), dtype=np.float32)
+    c = f.colour.shape[0]
+    out = np.zeros((c, H, W), dtype=np.float32)  # colour planes first (as the layers': whole rows)
     cov = np.zeros((H, W), dtype=np.float32)  # coverage of the groups composited so far
     cov1 = np.zeros((H, W), dtype=np.float32) if f.has_alpha else None
     carry = None  # (U, U1, box): the upper shares of the next farther group
@@ -229,7 +232,7 @@ def _composite(f, cache, pairs, progress):
         if lay is not None:
             box = lay["box"]
             tr = f.inside[box] * (1.0 - np.clip(cov[box], 0.0, 1.0))
-            out[box] += tr[..., None] * lay["V"]
+            out[(slice(None),) + box] += tr * lay["V"]
             if n in fills or n - 1 in fills:
                 budget.spend(out, box, tr, lay)
         else:
@@ -269,7 +272,7 @@ def _fold(f, lay):
             a = lay.get(k)
             if a is None:
                 continue
-            a = np.moveaxis(a, axis, 0)  # a view: folding it folds the plane
+            a = np.moveaxis(a, axis - 2, 0)  # a view: folding it folds the plane (its last two axes)
             n = a.shape[0]
             if lo_out:  # rows 0 .. lo_out-1 of the box lie before the picture: mirror them in
                 k = min(lo_out, n - lo_out)
@@ -311,17 +314,16 @@ class _Budget:
             cy1, cx1 = -(-box[0].stop // q) + 1, -(-box[1].stop // q) + 1
             part = _upsample_cells(scale[cy0:cy1, cx0:cx1], q)  # the cells that exist (the last ones hold the box)
             part = part[y0 - cy0 * q: box[0].stop - cy0 * q, x0 - cx0 * q: box[1].stop - cx0 * q]  # (0, 0): (cy0 q, cx0 q)
-            out[box] += (part * tr)[..., None] * g
+            out[(slice(None),) + box] += (part * tr) * g
             avail = np.maximum(avail - scale * gc, 0.0)
         self.carry = np.minimum(avail, own)  # a node's loss funds its own fill and the next one's, no more
 
 
 def _channel_sum(a: np.ndarray) -> np.ndarray:
-    """The sum of an (h, w, c) array's channels, channel by channel (a reduction over a short last
-    axis is several times slower)."""
-    out = a[..., 0].copy()
-    for c in range(1, a.shape[2]):
-        out += a[..., c]
+    """The sum of a (c, h, w) array's colour planes, plane by plane."""
+    out = a[0].copy()
+    for c in range(1, a.shape[0]):
+        out += a[c]
     return out
 
 
