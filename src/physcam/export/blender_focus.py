@@ -326,6 +326,56 @@ def _centre_norms(tracer, rects, levels) -> list[float]:
             for g, ok in zip(np.ravel(which).tolist(), passing)]
 
 
+#: The film centre's meridional fan of aims (:func:`_centre_disk_norms`): samples from the axis to the rear rim, then
+#: rounds of a search splitting each level's bracket in 16 (to 1 / (512 x 16^4) of the rim's reach, 3e-8)
+_DISK_FAN, _DISK_SPLIT, _DISK_ROUNDS = 512, 16, 4
+
+
+def _centre_disk_norms(q, film_z: float, levels, backend: str) -> list[float] | None:
+    """:func:`_centre_norms` of a lens with rotational symmetry in closed form, or None where its film centre's
+    passing set is not a disk about the axis (then the grid estimate serves). From the film centre a lens with
+    rotational symmetry passes, at each iris radius, aims on the rear vertex plane within some radius R of the
+    axis; a camera ray aimed at radius r weighs cos^4(theta) A / d^2 (:func:`~physcam.trace.trace.camera_rays`:
+    A the sampled region's area, d the film's distance from the rear vertex, cos(theta) = d / sqrt(d^2 + r^2)),
+    so the mean weight over any region that holds the disk is (1 / d^2) times the integral of cos^4(theta) over
+    it: 2 pi d^2 int_0^R r / (d^2 + r^2)^2 dr = pi R^2 / (d^2 + R^2), exactly (the 64 x 64 grid it replaces was
+    within 0.3-0.7 % of a dense trace, docs/performance.md). R per level: along a fan of :data:`_DISK_FAN` aims
+    from the axis (y = 0, out past the rear rim as the centre sees it) the passing aims (every other surface
+    passes them and they cross the stop within the level's radius, the tracer's test) must be one run from the
+    axis, and the first that fails is bracketed by :data:`_DISK_ROUNDS` rounds of :data:`_DISK_SPLIT` aims each."""
+    from .blender_pupil_sets import _aims, _rear_boxes
+
+    s = np.asarray(levels, dtype=float)
+    r_rear = q.surfaces[-1].semi_diameter
+    big = 20.0 * max(float(s.max()), q.surfaces[q.stop_index].semi_diameter)
+    reach = 1.05 * _rear_boxes(q, film_z, [0.0], r_rear)[0][1]
+    d = float(film_z - q.vertex_z[-1])
+
+    def passing(x):  # which aims (x, 0) pass at each level: x one fan for every level, or a row per level
+        ok, rad = _aims(q, film_z, np.zeros(x.size), x.ravel(), np.zeros(x.size), big, backend)
+        if x.ndim == 1:
+            return ok[None, :] & (rad[None, :] <= s[:, None])
+        return (ok & (rad <= np.repeat(s, x.shape[1]))).reshape(x.shape)
+
+    x = np.linspace(0.0, reach, _DISK_FAN + 1)
+    p = passing(x)
+    n = np.argmin(p, axis=1)  # per level the first aim that fails (0: the axis fails, or none does)
+    if (n == 0).any() or (np.arange(x.size)[None, :] < n[:, None]).__ne__(p).any():  # not one run from the axis
+        return None
+    lo, hi = x[n - 1], x[n]
+    rows = np.arange(s.size)
+    for _ in range(_DISK_ROUNDS):
+        xs = lo[:, None] + (hi - lo)[:, None] * (np.arange(1, _DISK_SPLIT) / _DISK_SPLIT)[None, :]
+        p = passing(xs)
+        k = np.argmin(np.concatenate([p, np.zeros((s.size, 1), dtype=bool)], axis=1), axis=1)  # the first that fails
+        if (np.arange(_DISK_SPLIT - 1)[None, :] < k[:, None]).__ne__(p).any():
+            return None
+        edges = np.concatenate([lo[:, None], xs, hi[:, None]], axis=1)
+        lo, hi = edges[rows, k], edges[rows, k + 1]
+    r2 = (0.5 * (lo + hi)) ** 2
+    return (math.pi * r2 / (d * d + r2)).tolist()
+
+
 @takes_prescription
 def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: float = GRID_HALF_MM,
                 pupil_stride: int | None = None) -> FocusTable:
@@ -337,7 +387,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
     from ..trace.camera_tracer import CameraTracer
-    from .blender_pupil import _centre_ellipses, iris_levels, refined_pupil_tables
+    from .blender_pupil import _centre_ellipses, _tables_backend, iris_levels, refined_pupil_tables
 
     axis = focus_axis(closest_focus(lens), n_focus)
     states = []
@@ -354,7 +404,8 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     radial, rects, stopped, norm, checks = [], [], [], [], []
     tracers = [CameraTracer(states[i].prescription, states[i].film_z) for i in traced.tolist()]  # as the file stops it
     if not lens.is_anamorphic:
-        levels, radial = refined_pupil_tables([(t.lens, t.film_z) for t in tracers], levels, checks=checks)
+        backend = _tables_backend("auto", len(tracers), len(lens.surfaces))  # refined_pupil_tables' own choice
+        levels, radial = refined_pupil_tables([(t.lens, t.film_z) for t in tracers], levels, checks=checks, backend=backend)
     for i, tracer in zip(traced.tolist(), tracers):
         if lens.is_anamorphic:
             b, rect, rect_levels = _rect_tables(tracer, levels[0], grid_half_mm)
@@ -364,7 +415,8 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
         else:
             tab = radial[len(norm)]
             b = _centre_bounds(tracer.lens, tab[0, 0])
-            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(tab)], levels))
+            norm.append(_centre_disk_norms(tracer.lens, tracer.film_z, levels, backend)
+                        or _centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(tab)], levels))
         if i == 0:
             table0, bounds0 = tracer.film_side_table, (b if lens.is_anamorphic else None)
             loss = tracer.centre_weight(b, samples=64, fresnel=True) / tracer.centre_weight(b, samples=64)
