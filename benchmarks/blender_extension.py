@@ -9,6 +9,7 @@ given or every bundled one), its CPU seconds as user + system of the process and
 (``os.wait4``), with the zip's size: the part outside ``lens_payload`` too (worker start-up, the zip's
 deflate), one side after the other; with ``--baseline-src``, whether each lens's files in the two zips
 (``lenses/<slug>.json``, ``shaders/<slug>.osl``) are the same bytes. ``--rims``: the pupil tables' rims found along lines against the aim grids' (:func:`main_rims`), no timing.
+``--norms``: the centre's normalisation in closed form against a dense trace (:func:`main_norms`), no timing.
 ``--install``: then Blender's installer of each side's zip
 (``package_install_files`` in a fresh user folder, the Blender tests' way; the Blender of
 ``physcam.export.blender_runner.find_blender``), its wall and CPU seconds and the megabytes it unpacks.
@@ -240,6 +241,54 @@ def main_rims(names) -> None:
           f"{np.quantile(np.abs(rel), 0.99):.4f}, largest |.| {np.abs(rel).max():.4f}")
 
 
+def main_norms(names) -> None:
+    """``--norms``: per lens with rotational symmetry, at infinity and the closest focus (a zoom at both ends), the
+    centre's normalisation in closed form (``blender_focus._centre_disk_norms``) at the widest iris, the file's stop,
+    the 10th level and the last, against the mean weight of physcam's camera rays from the film centre over a
+    1024 x 1024 grid of aims on a square 1.02 times the disk's radius, the iris stopped to the level."""
+    from physcam.export.blender_focus import _centre_disk_norms
+    from physcam.export.blender_pupil import iris_levels
+    from physcam.lens.library import load_lens
+    from physcam.lens.zoom import prescription_at
+    from physcam.optics.focusing import closest_focus, focus
+    from physcam.trace.kernels import resolve_backend
+    from physcam.trace.pupil_bounds import PupilBounds
+    from physcam.trace.trace import camera_rays
+
+    resolve_backend("auto")
+    m = 1024
+    u = (np.arange(m) + 0.5) / m
+    uv = np.stack([a.ravel() for a in np.meshgrid(u, u)], axis=1)
+    every = []
+    for name in names:
+        lens0 = load_lens(name)
+        if lens0.is_anamorphic:
+            continue
+        for zu in ([0.0, 1.0] if lens0.zoom is not None else [None]):
+            lens = lens0 if zu is None else prescription_at(lens0, zu)
+            for d in (math.inf, closest_focus(lens) * 1.0001):
+                st = focus(lens, d)
+                q, film_z = st.prescription, st.film_z
+                semi = q.surfaces[q.stop_index].semi_diameter
+                levels = iris_levels(semi * 1.03, semi)
+                norms = _centre_disk_norms(q, film_z, levels, "numba")
+                if norms is None:
+                    print(f"{name} at {d:.0f} mm: not a disk (the grid estimate serves)")
+                    continue
+                dz = film_z - q.vertex_z[-1]
+                rel = []
+                for k in (0, 1, 9, len(levels) - 1):
+                    h = 1.02 * math.sqrt(norms[k] * dz * dz / (math.pi - norms[k]))
+                    rect = np.broadcast_to(np.array([-h, h, -h, h]), (2, 2, 4)).copy()
+                    b = PupilBounds(np.array([-1.0, 1.0]), np.array([-1.0, 1.0]), rect, float(q.vertex_z[-1]))
+                    cr = camera_rays(q, np.zeros((uv.shape[0], 2)), uv, film_z, bounds=b, stop_semi_diameter=float(levels[k]))
+                    rel.append(norms[k] / float(np.mean(np.where(cr.ok, cr.weight, 0.0))) - 1)
+                every += rel
+                print(f"{name}" + (f" zoom {zu}" if zu is not None else "") + f" at {d:.0f} mm: closed form / dense - 1 at "
+                      "the widest iris, the file's stop, levels 10 and last: " + ", ".join(f"{r:+.1e}" for r in rel), flush=True)
+    print(f"all: {len(every)} norms, closed form / dense - 1 from {min(every):+.1e} to {max(every):+.1e}")
+
+
 def same_lens_files(zip_a: str, zip_b: str) -> tuple[int, list[str]]:
     """(how many of the two zips' per-lens files are the same bytes, the names of those that are not or are
     in one zip only): each lens's JSON table and shader source."""
@@ -283,6 +332,8 @@ def main() -> None:
     ap.add_argument("--install", action="store_true", help="--build: time Blender's installer of each zip too")
     ap.add_argument("--rims", action="store_true", help="the pupil tables' rims along lines against the aim grids' "
                     "(main_rims)")
+    ap.add_argument("--norms", action="store_true", help="the centre's normalisation in closed form against a dense trace "
+                    "(main_norms)")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--out", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -296,6 +347,8 @@ def main() -> None:
     names = args.lenses.split(",") if args.lenses else [r.slug for r in list_lenses()]
     if args.rims:
         return main_rims(names)
+    if args.norms:
+        return main_norms(names)
     print(f"load average before: {load()}")
     head = f"{'lens':28s} {'this CPU s':>10s}"
     if args.baseline_src:

@@ -326,6 +326,56 @@ def _centre_norms(tracer, rects, levels) -> list[float]:
             for g, ok in zip(np.ravel(which).tolist(), passing)]
 
 
+#: The film centre's meridional fan of aims (:func:`_centre_disk_norms`): samples from the axis to the rear rim, then
+#: rounds of a search splitting each level's bracket in 16 (to 1 / (512 x 16^4) of the rim's reach, 3e-8)
+_DISK_FAN, _DISK_SPLIT, _DISK_ROUNDS = 512, 16, 4
+
+
+def _centre_disk_norms(q, film_z: float, levels, backend: str) -> list[float] | None:
+    """:func:`_centre_norms` of a lens with rotational symmetry in closed form, or None where its film centre's
+    passing set is not a disk about the axis (then the grid estimate serves). From the film centre a lens with
+    rotational symmetry passes, at each iris radius, aims on the rear vertex plane within some radius R of the
+    axis; a camera ray aimed at radius r weighs cos^4(theta) A / d^2 (:func:`~physcam.trace.trace.camera_rays`:
+    A the sampled region's area, d the film's distance from the rear vertex, cos(theta) = d / sqrt(d^2 + r^2)),
+    so the mean weight over any region that holds the disk is (1 / d^2) times the integral of cos^4(theta) over
+    it: 2 pi d^2 int_0^R r / (d^2 + r^2)^2 dr = pi R^2 / (d^2 + R^2), exactly (the 64 x 64 grid it replaces was
+    within 0.3-0.7 % of a dense trace, docs/performance.md). R per level: along a fan of :data:`_DISK_FAN` aims
+    from the axis (y = 0, out past the rear rim as the centre sees it) the passing aims (every other surface
+    passes them and they cross the stop within the level's radius, the tracer's test) must be one run from the
+    axis, and the first that fails is bracketed by :data:`_DISK_ROUNDS` rounds of :data:`_DISK_SPLIT` aims each."""
+    from .blender_pupil_sets import _aims, _rear_boxes
+
+    s = np.asarray(levels, dtype=float)
+    r_rear = q.surfaces[-1].semi_diameter
+    big = 20.0 * max(float(s.max()), q.surfaces[q.stop_index].semi_diameter)
+    reach = 1.05 * _rear_boxes(q, film_z, [0.0], r_rear)[0][1]
+    d = float(film_z - q.vertex_z[-1])
+
+    def passing(x):  # which aims (x, 0) pass at each level: x one fan for every level, or a row per level
+        ok, rad = _aims(q, film_z, np.zeros(x.size), x.ravel(), np.zeros(x.size), big, backend)
+        if x.ndim == 1:
+            return ok[None, :] & (rad[None, :] <= s[:, None])
+        return (ok & (rad <= np.repeat(s, x.shape[1]))).reshape(x.shape)
+
+    x = np.linspace(0.0, reach, _DISK_FAN + 1)
+    p = passing(x)
+    n = np.argmin(p, axis=1)  # per level the first aim that fails (0: the axis fails, or none does)
+    if (n == 0).any() or (np.arange(x.size)[None, :] < n[:, None]).__ne__(p).any():  # not one run from the axis
+        return None
+    lo, hi = x[n - 1], x[n]
+    rows = np.arange(s.size)
+    for _ in range(_DISK_ROUNDS):
+        xs = lo[:, None] + (hi - lo)[:, None] * (np.arange(1, _DISK_SPLIT) / _DISK_SPLIT)[None, :]
+        p = passing(xs)
+        k = np.argmin(np.concatenate([p, np.zeros((s.size, 1), dtype=bool)], axis=1), axis=1)  # the first that fails
+        if (np.arange(_DISK_SPLIT - 1)[None, :] < k[:, None]).__ne__(p).any():
+            return None
+        edges = np.concatenate([lo[:, None], xs, hi[:, None]], axis=1)
+        lo, hi = edges[rows, k], edges[rows, k + 1]
+    r2 = (0.5 * (lo + hi)) ** 2
+    return (math.pi * r2 / (d * d + r2)).tolist()
+
+
 @takes_prescription
 def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: float = GRID_HALF_MM,
                 pupil_stride: int | None = None) -> FocusTable:
@@ -337,7 +387,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
     from ..trace.camera_tracer import CameraTracer
-    from .blender_pupil import _centre_ellipses, iris_levels, refined_pupil_tables
+    from .blender_pupil import _centre_ellipses, _tables_backend, iris_levels, refined_pupil_tables
 
     axis = focus_axis(closest_focus(lens), n_focus)
     states = []
@@ -354,7 +404,8 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     radial, rects, stopped, norm, checks = [], [], [], [], []
     tracers = [CameraTracer(states[i].prescription, states[i].film_z) for i in traced.tolist()]  # as the file stops it
     if not lens.is_anamorphic:
-        levels, radial = refined_pupil_tables([(t.lens, t.film_z) for t in tracers], levels, checks=checks)
+        backend = _tables_backend("auto", len(tracers), len(lens.surfaces))  # refined_pupil_tables' own choice
+        levels, radial = refined_pupil_tables([(t.lens, t.film_z) for t in tracers], levels, checks=checks, backend=backend)
     for i, tracer in zip(traced.tolist(), tracers):
         if lens.is_anamorphic:
             b, rect, rect_levels = _rect_tables(tracer, levels[0], grid_half_mm)
@@ -364,7 +415,8 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
         else:
             tab = radial[len(norm)]
             b = _centre_bounds(tracer.lens, tab[0, 0])
-            norm.append(_centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(tab)], levels))
+            norm.append(_centre_disk_norms(tracer.lens, tracer.film_z, levels, backend)
+                        or _centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(tab)], levels))
         if i == 0:
             table0, bounds0 = tracer.film_side_table, (b if lens.is_anamorphic else None)
             loss = tracer.centre_weight(b, samples=64, fresnel=True) / tracer.centre_weight(b, samples=64)
@@ -566,9 +618,61 @@ def _rect_tables(tracer, semi_max, grid_half_mm):
     # iris and the stopped ones share their rays (one trace with the stop opened, each iris's mask the
     # tracer's own test: stopped_pupil_bounds): the widest's rectangles are what a trace of it alone gives,
     # the stopped ones are sampled as finely (48 aims across, not 32) for no more rays
-    b, *levels = tracer.stopped_pupil_bounds([float(semi_file * (f * semi_max / semi_file)) for f in (1.0,) + STOP_LEVELS],
-                                             grid_half_mm, grid_half_mm, nx=nx, ny=ny, samples=48)
+    b, *levels = _mirrored_pupil_bounds(q, tracer.film_z, [float(semi_file * (f * semi_max / semi_file))
+                                                           for f in (1.0,) + STOP_LEVELS],
+                                        grid_half_mm, nx=nx, ny=ny, samples=48)
     return b, b.rects, [lv.rects for lv in levels]
+
+
+def _mirrored_pupil_bounds(q, film_z: float, stops, half: float, *, nx: int, ny: int, samples: int) -> list:
+    """:func:`~physcam.trace.pupil_bounds.stopped_pupil_bounds` over the film square of half side ``half`` (odd
+    ``nx``, ``ny``), its nodes traced only where x >= 0 and y >= 0 and the others mirrored: every prescription
+    physcam reads is symmetric about the planes x = 0 and y = 0 (spherical, aspheric and cylindrical surfaces
+    centred on the axis, the cylinders' axes along x or y, round apertures), so the rays from node (-x, y) to the
+    mirrored aims pass exactly where those from (x, y) do, and the window searches mirror too (the same rounds
+    and boxes). The rectangles are the whole grid's to rounding (the aims' places: within 5.3e-15 mm at every traced
+    focus mark of the three anamorphics of the extension's tests) for a third of the rays (25 of 81 nodes)."""
+    from ..trace.pupil_bounds import MIN_HITS, PupilBounds, _box_hits, _rects, _touches
+
+    r = q.surfaces[-1].semi_diameter
+    u = (np.arange(samples) + 0.5) / samples
+    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
+    xs, ys = np.linspace(-half, half, nx), np.linspace(-half, half, ny)
+    fy, fx = (a.ravel() for a in np.meshgrid(ys[ny // 2:], xs[nx // 2:], indexing="ij"))  # the quarter, row by row
+    full = np.array([-r, r, -r, r])
+    box = np.broadcast_to(full, (len(stops), fx.size, 4)).copy()
+    ext = _box_hits(q, fx, fy, film_z, box[0], uu, vv, stops, "auto")
+    pending = ext[..., 4] < MIN_HITS
+    h = 0.5 * (film_z - q.vertex_z[-1])
+    while pending.any():  # stopped_pupil_bounds' window search, node for node
+        live = pending.any(axis=0) & (h < r + np.maximum(np.abs(fx), np.abs(fy)))
+        if not live.any():
+            break
+        win = np.stack([np.maximum(fx - h, -r), np.minimum(fx + h, r), np.maximum(fy - h, -r), np.minimum(fy + h, r)],
+                       axis=1)
+        nodes = np.flatnonzero(live & (win[:, 1] > win[:, 0]) & (win[:, 3] > win[:, 2]))
+        if nodes.size:
+            got = _box_hits(q, fx[nodes], fy[nodes], film_z, win[nodes], uu, vv, stops, "auto")
+            take = pending[:, nodes] & (got[..., 4] > 0) & ~_touches(got, win[nodes], full, samples)
+            k, i = np.nonzero(take)
+            ext[k, nodes[i]], box[k, nodes[i]] = got[k, i], win[nodes[i]]
+            pending[k, nodes[i]] = False
+        h *= 2
+    out = []
+    for e, b in zip(ext, box):
+        quarter = _rects(e, b, r, samples).reshape(ny - ny // 2, nx - nx // 2, 4)
+        rects = np.zeros((ny, nx, 4))
+        rects[ny // 2:, nx // 2:] = quarter
+        x_mirror = np.stack([-quarter[..., 1], -quarter[..., 0], quarter[..., 2], quarter[..., 3]], axis=-1)
+        rects[ny // 2:, :nx // 2 + 1] = x_mirror[:, ::-1]  # the centre column from its own rectangle, mirrored
+        rects[ny // 2:, nx // 2:] = quarter
+        rows = rects[ny // 2:]  # y = 0 up; the rows below mirror those above the centre row
+        rects[:ny // 2] = np.stack([rows[..., 0], rows[..., 1], -rows[..., 3], -rows[..., 2]], axis=-1)[:0:-1]
+        rects += 0.0  # no negative zeros (an empty node is (0, 0, 0, 0))
+        if not (rects[..., 1] > rects[..., 0]).any():
+            raise OpticsError(f"no ray from the film reaches the scene through {q.name!r}")
+        out.append(PupilBounds(xs, ys, rects, float(q.vertex_z[-1])))
+    return out
 
 
 def _num32(x) -> str:

@@ -542,29 +542,35 @@ class _LineSets:
             lt, lr = np.log(self.t).reshape(lines, -1), np.log(self.r).reshape(lines, -1)
             # Newton's divided differences of log t in log r of every three samples in a row (empty slots: nan)
             d01 = np.diff(lt, axis=1) / np.diff(lr, axis=1)
-            d012 = (np.diff(d01, axis=1) / (lr[:, 2:] - lr[:, :-2])).ravel()
-        d01 = d01.ravel()
-        # the samples under s per line (r rises along it; an empty slot's is inf): one search over every line's
-        # log r, each line in its own band (log r spans far less than _BAND)
+            d012 = np.diff(d01, axis=1) / (lr[:, 2:] - lr[:, :-2])
+        # the samples under s per line (r rises along it; an empty slot's is inf): j = #{k: log r_k < log s}, compared
+        # as band + log r against band + log s (each line in its own band: log r spans far less than _BAND), found
+        # from the other side in one search, every line's log s in its band ascending, and a count per line
         line = np.arange(lines)[:, None]
         band = line * _BAND
         ls = np.log(s)[None, :]
-        j = np.searchsorted((band + np.minimum(lr, _BAND / 4)).ravel(), (band + ls).ravel(), side="left").reshape(lines, -1)
-        j -= line * n_samples
+        o = np.argsort(ls[0], kind="stable")
+        w = (band + ls[:, o]).ravel()
+        pos = np.searchsorted(w, (band + np.minimum(lr, _BAND / 4)).ravel(), side="right").reshape(lines, -1)
+        pos -= line * s.size  # per sample, how many of its line's log s lie at or under its log r
+        count = np.bincount((line * (s.size + 1) + pos).ravel(), minlength=lines * (s.size + 1)).reshape(lines, -1)
+        j = np.empty((lines, s.size), dtype=np.int64)
+        j[:, o] = np.cumsum(count, axis=1)[:, :s.size]
         n = self.n.reshape(lines, 1)
         beyond = j >= n  # past the last passing sample: the clip edge (every line is cut or reaches s)
-        lt, lr = lt.ravel(), lr.ravel()
+        # per line and first sample a of three in a row: log t_a, log r_a, the divided differences and log r_a+1
+        m = n_samples - 2
+        coef = np.stack([lt[:, :m], lr[:, :m], d01[:, :m], lr[:, 1:m + 1], d012]).reshape(5, -1)
 
         def quad(a):  # Lagrange's quadratic of log t in log r through the samples a, a + 1, a + 2 of each line
-            i, k = line * n_samples + a, line * (n_samples - 2) + a
-            return lt[i] + (ls - lr[i]) * (d01[i - line] + (ls - lr[i + 1]) * d012[k])
+            lt_a, lr_a, d01_a, lr_b, d012_a = np.take(coef, (line * m + a).ravel(), axis=1).reshape(5, lines, -1)
+            return lt_a + (ls - lr_a) * (d01_a + (ls - lr_b) * d012_a)
 
         with np.errstate(invalid="ignore", over="ignore"):
             # the two samples about s and the next one out (in at the line's last), and the one in instead: where
             # the two quadratics differ the curve bends too fast for the samples (r flattens toward a clip)
             q1, q2 = quad(np.clip(j - 1, 0, n - 3)), quad(np.clip(j - 2, 0, n - 3))
-            first = line * n_samples
-            t_iris = np.where(j == 0, np.exp(lt[first] + ls - lr[first]), np.exp(q1))  # under the first: r ~ t
+            t_iris = np.where(j == 0, np.exp(lt[:, :1] + ls - lr[:, :1]), np.exp(q1))  # under the first: r ~ t
             doubt = np.where((j == 0) | beyond, 0.0, np.abs(np.expm1(q2 - q1)))
         shape = (n_points, n_lines, s.size)
         t_iris, doubt, beyond = t_iris.reshape(shape), doubt.reshape(shape), beyond.reshape(shape)
