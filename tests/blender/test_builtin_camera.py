@@ -61,6 +61,10 @@ for spec in json.loads(sys.argv[1]):
         bpy.ops.object.shade_smooth()
     scene.render.image_settings.file_format = "OPEN_EXR"
     scene.render.filepath = spec["out"]
+    if spec["border"]:  # black outside it (_border)
+        scene.render.use_border = True; scene.render.use_crop_to_border = False
+        (scene.render.border_min_x, scene.render.border_max_x, scene.render.border_min_y,
+         scene.render.border_max_y) = spec["border"]
     bpy.ops.render.render(write_still=True)
     img = bpy.data.images.load(spec["out"])
     w, h = img.size
@@ -82,16 +86,34 @@ print(json.dumps({"results": results}))
 '''
 
 
-def _job(values, spheres, windows, samples, filter_width, out, img=False):
+def _job(values, spheres, windows, samples, filter_width, out, img=False, border=None):
     """One render of :data:`SCENE`: emissive spheres (x, y, z, radius in metres from the **entrance pupil**,
-    looking down -Z), each window's (pixel columns) intensity centroid and second moment (pixels) measured.
+    looking down -Z), each window's (pixel columns) intensity centroid and second moment (pixels) measured,
+    only inside ``border`` when given (:func:`_border`).
     The scene camera starts at the origin, which the script reads as the film plane: it must move the camera
     forward to the pupil, where the spheres are placed from (issue 24: it used to stay at the film, 1.5 %
     wider)."""
     p = values["entrance_pupil_from_film_mm"] / 1000.0
     spheres = [(x, y, z - p, r) for x, y, z, r in spheres]
     return {"script": blender_camera_script(values), "spheres": spheres, "windows": windows, "samples": samples,
-            "filter_width": filter_width, "out": str(out), "img": img}
+            "filter_width": filter_width, "out": str(out), "img": img, "border": border}
+
+
+def _border(values, cols, rows, half_px):
+    """Cycles' render border (fractions of the frame, y up) about the pixel columns ``cols`` and rows ``rows``
+    (from the top) where the thin lens puts the lights, ``half_px`` beyond them each way.
+
+    The markers are a few pixels across in a black world: rendering the whole frame spent 95 % of its samples on
+    pixels no light reaches (the frames, blur and shift renders: 14.6 s of Blender's CPU, 1.2 s with the borders,
+    2026-11-30). Cycles seeds a pixel's samples by its place in the frame, so the pixels inside a border are the full frame's
+    bit for bit, and the frame's other pixels are 0 as they were (the four pictures and every measure checked
+    against full frames, 2026-11-30). A light the camera put outside its border would leave its window dark
+    and fail the test; the borders reach 24 px and more beyond where the lights should be, errors of the size
+    these tests look for (0.5 px, 1 %) land well inside them."""
+    w, h = values["render"]["resolution_x"], values["render"]["resolution_y"]
+    x0, x1 = max(min(cols) - half_px, 0) / w, min(max(cols) + half_px, w) / w
+    y0, y1 = max(h - max(rows) - half_px, 0) / h, min(h - min(rows) + half_px, h) / h
+    return [x0, x1, y0, y1]
 
 
 def _frames_case():
@@ -102,7 +124,10 @@ def _frames_case():
     t = math.tan(math.radians(15.0))
     spheres = [(-d * t, 0.0, -d, 0.004), (d * t, 0.0, -d, 0.004)]
     # a symmetric pixel filter (Cycles' default, 1.5 px) antialiases the markers without biasing centroids
-    return r, v, dict(spheres=spheres, windows=[(0, w // 2), (w // 2, w)], samples=64, filter_width=1.5)
+    dx = r.image_distance_mm * t * w / 36.0  # where the thin lens puts them (the test's prediction)
+    h = v["render"]["resolution_y"]
+    return r, v, dict(spheres=spheres, windows=[(0, w // 2), (w // 2, w)], samples=64, filter_width=1.5,
+                      border=_border(v, [w / 2 - dx, w / 2 + dx], [h / 2], 24))
 
 
 def _blur_case():
@@ -110,9 +135,11 @@ def _blur_case():
     v = blender_camera_values(r, resolution_x=512)
     w = v["render"]["resolution_x"]
     d_mm, radius_mm = 500.0, 2.0
-    # no pixel filter (samples at pixel centres): the blur measured is the lens's alone
+    # no pixel filter (samples at pixel centres): the blur measured is the lens's alone. The border: the thin
+    # lens's blur, about 28 px across, and 34 px more each way
+    h = v["render"]["resolution_y"]
     return r, v, dict(spheres=[(0.0, 0.0, -d_mm / 1000.0, radius_mm / 1000.0)], windows=[(0, w)], samples=256,
-                      filter_width=0.01)
+                      filter_width=0.01, border=_border(v, [w / 2], [h / 2], 48))
 
 
 def _shift_case():
@@ -120,7 +147,9 @@ def _shift_case():
     v = blender_camera_values(r, resolution_x=512, shift_mm=(3.0, -2.0))
     w = v["render"]["resolution_x"]
     d = v["camera"]["dof.focus_distance"]
-    return r, v, dict(spheres=[(0.0, 0.0, -d, 0.004)], windows=[(0, w)], samples=64, filter_width=1.5)
+    h, px_per_mm = v["render"]["resolution_y"], w / 36.0
+    return r, v, dict(spheres=[(0.0, 0.0, -d, 0.004)], windows=[(0, w)], samples=64, filter_width=1.5,
+                      border=_border(v, [w / 2 - 3.0 * px_per_mm], [h / 2 - 2.0 * px_per_mm], 24))
 
 
 def _iris_case():
@@ -128,7 +157,8 @@ def _iris_case():
     v = blender_camera_values(r, resolution_x=512, blades=6, blade_rotation_deg=15.0)
     v["camera"].update({"sensor_width": 4.0, "sensor_height": 4.0})  # a 4 mm crop: the blur is ~2.5 mm
     v["render"].update({"resolution_x": 160, "resolution_y": 160})
-    # the light 0.5 m in front of the entrance pupil (_job moves it from the pupil)
+    # the light 0.5 m in front of the entrance pupil (_job moves it from the pupil); the whole picture is
+    # measured (its blur fills half of it): no border
     return r, v, dict(spheres=[(0.0, 0.0, -0.5, 0.001)], windows=[], samples=256, filter_width=0.01, img=True)
 
 

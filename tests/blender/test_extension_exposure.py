@@ -5,7 +5,12 @@ world through the double Gauss at f/2.8, f/4.5 and f/8 falls off from the centre
 the corner as physcam's ``camera_rays`` weight predicts for the lens stopped to that f-number (its
 mean over the pupil, float64); and a 5- or 6-blade iris at f/4.5 renders the centre as bright as
 the round one (the polygon has its area). Where the shader knows the passing set's area it redraws
-missed aims: the centre at f/2.8 renders without their noise."""
+missed aims: the centre at f/2.8 renders without their noise.
+
+Each render is made only in a render border about the pixel blocks it is measured in (black outside it): the
+f-numbers' about all three blocks (the lower 14 rows), the blades' about the centre, the noise's about the
+centre and the right edge. Cycles seeds a pixel's samples by its place in the frame, so every block's mean
+is the full frame's bit for bit (checked 2026-11-30); Blender's CPU 12.3, 12.5 s -> 8.1, 8.2 s."""
 
 from __future__ import annotations
 
@@ -43,7 +48,17 @@ scene.render.resolution_x, scene.render.resolution_y = W, H
 scene.render.resolution_percentage = 100
 scene.cycles.samples = 1024; scene.cycles.use_adaptive_sampling = False
 blocks = json.loads(sys.argv[8])
+scene.render.use_crop_to_border = False
+
+def border(*names):  # render only the pixels of these blocks' bounding box (module notes): black outside it
+    r0, c0 = (min(blocks[k][i] for k in names) for i in (0, 2))
+    r1, c1 = (max(blocks[k][i] for k in names) for i in (1, 3))
+    scene.render.use_border = True
+    scene.render.border_min_x, scene.render.border_max_x = c0 / W, c1 / W
+    scene.render.border_min_y, scene.render.border_max_y = r0 / H, r1 / H  # rows from the bottom, as a's
+
 out = {}
+border(*blocks)
 for n in json.loads(sys.argv[9]):
     p.fstop = n
     scene.render.filepath = sys.argv[2] + f"/white{n}.exr"
@@ -53,6 +68,7 @@ for n in json.loads(sys.argv[9]):
     bpy.data.images.remove(img)
     out[str(n)] = {k: float(a[r0:r1, c0:c1, :3].mean()) for k, (r0, r1, c0, c1) in blocks.items()}
 p.fstop = 4.5
+border("centre")
 for blades in (5, 6):  # a bladed iris has the round one's area (docs/conventions.md): the same exposure
     p.blades = blades
     scene.render.filepath = sys.argv[2] + f"/blades{blades}.exr"
@@ -60,11 +76,13 @@ for blades in (5, 6):  # a bladed iris has the round one's area (docs/convention
     img = bpy.data.images.load(scene.render.filepath)
     a = np.array(img.pixels[:], dtype=np.float64).reshape(H, W, 4)
     bpy.data.images.remove(img)
-    out[f"blades{blades}"] = {k: float(a[r0:r1, c0:c1, :3].mean()) for k, (r0, r1, c0, c1) in blocks.items()}
+    r0, r1, c0, c1 = blocks["centre"]
+    out[f"blades{blades}"] = {"centre": float(a[r0:r1, c0:c1, :3].mean())}
 p.blades = 0
 # the centre's pixel noise at f/2.8 and 16 samples: two seeds, the RMS of their difference over sqrt(2)
 p.fstop = 2.8
 scene.cycles.samples = 16
+border("centre", "right")
 pics = []
 for seed in (0, 1):
     scene.cycles.seed = seed

@@ -39,6 +39,9 @@ WINDOW = 14  # px around a light
 
 BUILD = installed_dark_scene(samples=64) + '''
 scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = int(sys.argv[3]), int(sys.argv[4]), 100
+scene.render.use_border = True; scene.render.use_crop_to_border = False  # the columns measured (_border)
+scene.render.border_min_x, scene.render.border_max_x = json.loads(sys.argv[10])
+scene.render.border_min_y, scene.render.border_max_y = 0.0, 1.0
 light = glow("light", 20.0)
 for x, y, z, r in json.loads(sys.argv[5]).values():
     bpy.ops.mesh.primitive_uv_sphere_add(radius=r, location=(x, y, z), segments=24, ring_count=12)
@@ -112,6 +115,24 @@ def _pinhole(lens, mark_mm):
     return field_of_view(inputs.camera, at.h2_from_film_mm, inputs.references, at)["pinhole_focal_length_mm"]
 
 
+def _border():
+    """The saved file's render border (fractions of the frame's width): the columns from WINDOW + 16 px left of
+    the left light to as far right of the right one, where a pinhole at the pupil puts them (physcam's best-match
+    pinhole at 0.6 and 3 m, the wider of the two; the lights breathe 5 px at most), and the backdrop's columns;
+    every row (the near light's window reaches the bottom, the backdrop the top).
+
+    The frames' columns outside it (black sky and the backdrop's ends, never measured) held a fifth of the two
+    farm renders' samples: 31.1 s of Blender's CPU for both, 28.0 s with the border (2026-11-30). Cycles seeds
+    a pixel's samples by its place in the frame, so the pixels inside are the full frame's bit for bit, the
+    others 0 (all eight frames checked against full frames, 2026-11-30); a light the camera put beyond the
+    border would be cut from its window, failing the test."""
+    lens = load_lens(LENS)
+    f = max(_pinhole(lens, 600.0), _pinhole(lens, 3000.0))
+    cols = [W / 2 - 0.5 + f * x / -z * W / SW for x, _, z, _ in LIGHTS.values()]  # the picture is upright
+    c0, c1 = min(min(cols) - WINDOW - 16, BACKDROP["cols"][0]), max(max(cols) + WINDOW + 16, BACKDROP["cols"][1])
+    return [max(c0, 0) / W, min(c1, W) / W]
+
+
 @pytest.fixture(scope="module")
 def predictions():
     """Per frame and light, physcam's tracer (a point light) at that frame's focus and stop: (column,
@@ -149,6 +170,7 @@ def renders(extension_zip, extension_user, tmp_path_factory):
     extension (the file saved on frame 3) and without it (saved on frame 1)."""
     tmp = tmp_path_factory.mktemp("farm")
     built, log = run_blender_log(BUILD, extension_zip, tmp, W, H, json.dumps(LIGHTS), LENS, SW, SH, json.dumps(KEYS),
+                                 json.dumps(_border()),
                                  env=extension_user)
     out = {"built": built, "logs": {"artist": log}}
     for name, zip_arg, saved in (("with", extension_zip, 3), ("without", "none", 1)):

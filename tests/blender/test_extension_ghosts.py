@@ -6,6 +6,7 @@ and its flux relative to the direct image are those of :func:`physcam.analysis.i
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -48,12 +49,17 @@ scene.render.resolution_x, scene.render.resolution_y = W, H
 scene.render.resolution_percentage = 100
 scene.cycles.samples = 64; scene.cycles.use_adaptive_sampling = False
 out = {"message": p.message}
+borders = json.loads(sys.argv[11])  # black outside them (_border)
 for name, view, path, on in (("direct", "NONE", -1, False), ("one", "GHOSTS", int(sys.argv[10]), False),
                              ("all", "GHOSTS", -1, False), ("picture", "NONE", -1, True)):
     p.debug_view = view; p.ghost_path = path; p.ghosts = on; p.ghost_fraction = 0.5
     # every path at once is the noisiest estimate: 8 x the samples (the sums need no resolution)
     scene.render.resolution_percentage = 50 if name == "all" else 100
     scene.cycles.samples = 512 if name == "all" else 64
+    scene.render.use_border = name in borders; scene.render.use_crop_to_border = False
+    if name in borders:
+        (scene.render.border_min_x, scene.render.border_max_x, scene.render.border_min_y,
+         scene.render.border_max_y) = borders[name]
     scene.render.filepath = sys.argv[2] + "/" + name + ".exr"
     bpy.ops.render.render(write_still=True)
     img = bpy.data.images.load(scene.render.filepath)
@@ -67,6 +73,21 @@ print(json.dumps(out))
 def _pixel(x_mm, y_mm):
     """Film point (mm) -> pixel (column, row from the bottom): the lens inverts, the picture is upright."""
     return (1 - x_mm / (SW / 2)) / 2 * W - 0.5, (1 - y_mm / (SH / 2)) / 2 * H - 0.5
+
+
+def _border(c, r, half_px):
+    """Cycles' render border (fractions of the frame, y up) of ``half_px`` each way about pixel (``c``, ``r``
+    from the bottom).
+
+    The direct light and the one ghost path are small in a black frame: rendering the whole frame spent 8.7 s
+    of Blender's CPU on them, 2026-11-30 (of the four renders' 18.6 s); in borders about where the analysis
+    puts them, 16 px about the direct light (4 px across) and 48 px about the ghost (its light within 20 px of
+    its centroid, rms radius 13 px), 1.9 s. Cycles seeds a pixel's samples by its place in the frame, so the
+    pixels inside a border are the full frame's bit for bit and the frame's other pixels are 0 as they were
+    (checked against full frames, 2026-11-30); light the camera put outside a border would be missing from the
+    sums and centroids the test compares, failing it. The "all" and "picture" renders, spread over the
+    frame, are whole."""
+    return [max(c - half_px, 0) / W, min(c + half_px + 1, W) / W, max(r - half_px, 0) / H, min(r + half_px + 1, H) / H]
 
 
 def _centroid(a):
@@ -91,7 +112,9 @@ def test_ghost_lands_where_the_ghost_analysis_puts_it(extension_zip, extension_u
     ghost = next(g for g in res.paths if g.on_sensor_fraction > 0.999 and g.rms_radius_mm < 2.5
                  and math.hypot(g.centroid_y_mm - res.direct_centroid_mm[1], g.centroid_x_mm) > 5.0)
     k = pairs.index((ghost.i, ghost.j))
-    out = run_blender(GHOSTS, extension_zip, tmp_path, SLUG, SW, SH, FSTOP, FIELD_DEG, W, H, k,
+    borders = {"direct": _border(*_pixel(*res.direct_centroid_mm), 16),
+               "one": _border(*_pixel(ghost.centroid_x_mm, ghost.centroid_y_mm), 48)}
+    out = run_blender(GHOSTS, extension_zip, tmp_path, SLUG, SW, SH, FSTOP, FIELD_DEG, W, H, k, json.dumps(borders),
                       env=extension_user)
     assert out["message"] == ""
     direct, one, every, picture = (np.array(out[n]) for n in ("direct", "one", "all", "picture"))
