@@ -25,6 +25,37 @@ def start() -> None:
     gc.set_threshold(GC_THRESHOLD, *gc.get_threshold()[1:])
 
 
+#: Freed memory glibc's malloc keeps at the top of the heap in the program (M_TOP_PAD; glibc's default
+#: 128 KiB). The numpy analyses make and free arrays of 0.1-10 MB by the thousand: at the default the heap
+#: shrank and grew again 559 times in a cold `physcam mtf --lens dgauss_50mm` (brk calls), each page
+#: faulted in anew (57,000 minor faults, 0.2-0.25 s of system time); with 64 MB, 12 brk calls and 22,000
+#: faults, the same peak memory (docs/performance.md, issue 47 round 18).
+HEAP_TOP_PAD = 64 << 20
+_roomy = False
+
+
+def roomy_heap() -> bool:
+    """In the program only (:data:`RUNNING`; a library caller's allocator is left alone), on glibc:
+    keep :data:`HEAP_TOP_PAD` bytes of freed memory at the heap's top (``mallopt(M_TOP_PAD)``) before
+    an analysis makes its large arrays. Called by the analyses that do (ctypes, 4 ms to import, stays
+    off a report's path); once per process. True when the setting is in force."""
+    global _roomy
+    if _roomy or not RUNNING:
+        return _roomy
+    import os
+    import sys
+
+    try:
+        if not sys.platform.startswith("linux") or not os.confstr("CS_GNU_LIBC_VERSION").startswith("glibc"):
+            return False
+        import ctypes
+
+        _roomy = ctypes.CDLL("libc.so.6").mallopt(-2, HEAP_TOP_PAD) == 1  # M_TOP_PAD is -2 in glibc's malloc.h
+    except (OSError, ValueError, AttributeError):
+        return False
+    return _roomy
+
+
 def finish() -> None:
     """The program has answered and is about to exit (``sys.exit``): skip CPython's collection before
     the module teardown, which scans every object start-up built (about 5 ms of a ``physcam report``). The

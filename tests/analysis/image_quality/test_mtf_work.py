@@ -146,3 +146,26 @@ def test_a_fields_pupil_is_traced_once_for_its_wavefront_and_its_mtf(monkeypatch
     assert np.array_equal(kept.sagittal, fresh.sagittal) and np.array_equal(kept.tangential, fresh.tangential)
     mtf(camera_state(load_lens("dgauss_50mm"), fstop=4.0), 5.0, frequencies=[10.0])  # another camera: traced
     assert len(jobs) == 3
+
+
+def test_the_heap_keeps_its_freed_pages_in_the_program_only():
+    # the library leaves a caller's allocator alone (Blender, a notebook): no malloc setting without the program
+    from physcam import _program
+
+    cam = camera_state(load_lens("dgauss_50mm"), fstop=4.0)
+    P.setup(cam)
+    assert not _program.RUNNING and _program.roomy_heap() is False
+    # the program (a fresh process, as `physcam` starts): the pupil engine's setup asks glibc for the pad
+    import os
+    import subprocess
+    import sys
+
+    if not sys.platform.startswith("linux") or not os.confstr("CS_GNU_LIBC_VERSION").startswith("glibc"):
+        pytest.skip("M_TOP_PAD is glibc's")
+    code = ("from physcam import _program\n_program.start()\nfrom physcam.analysis.image_quality import _pupil as P\n"
+            "from physcam.lens.library import load_lens\nfrom physcam.optics.state import camera_state\n"
+            "assert not _program._roomy\nP.setup(camera_state(load_lens('dgauss_50mm'), fstop=4.0))\n"
+            "print(_program._roomy)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    assert out.stdout.strip() == "True"

@@ -89,9 +89,11 @@ class Setup:
 def setup(camera: CameraState, *, backend: str = "auto") -> Setup:
     """The pupil engine's setup of ``camera`` (a :class:`~physcam.optics.state.CameraState`: the lens
     focused and stopped once, in the optics layer) and how to trace it."""
+    from ... import _program
     from ...errors import require_type
 
     require_type("camera", camera, CameraState, "physcam.optics.state.camera_state(lens, focus_mm=..., fstop=...)")
+    _program.roomy_heap()  # the program's heap keeps freed pages: the pupils' arrays come and go by the thousand
     return Setup(camera, backend)
 
 
