@@ -9,12 +9,12 @@ the variants they met, the same ones side by side, and each of them judged numba
 life, so physcam's "auto" backend kept batches on the slower numpy kernel (kernels.numba_load_cost).
 tests/trace alone took 103.7 s CPU from an empty cache and 59.5 s from a warm one (2026-11-29).
 
-Every feature set is compiled for float64 rays, and the one-wavelength sets without optical path for
-float32 (what single-precision camera rays use): the 17 variants a whole `make test` leaves in the
-cache, and three more. Each is compiled by the JIT kernel's first call on a few rays and a bundled lens's
+Every feature set is compiled for float64 rays, and for float32 the one-wavelength sets without optical
+path (what single-precision camera rays use) and the sets without optical path or Fresnel weights (the
+defocus fans, one wavelength or three): 22 variants. Each is compiled by the JIT kernel's first call on a few rays and a bundled lens's
 packed table (the double Gauss; the Canon RF 85 mm for aspheres), the call every traced command makes. Then
 the Blender extension's rim pass (physcam.trace.kernels._rimpass), by one pupil table of the double Gauss.
-Usage: ``python scripts/compile_jit.py`` (a second run loads the 20 variants in a few seconds).
+Usage: ``python scripts/compile_jit.py`` (a second run loads the 22 variants in a few seconds).
 """
 
 from __future__ import annotations
@@ -46,7 +46,8 @@ def main() -> int:
     lenses = {False: load_lens("dgauss_50mm"), True: load_lens("canon_rf_85mm_f1_2")}
     t0, n = time.process_time(), 0
     for asphere, mono, opl, fresnel in itertools.product((False, True), repeat=4):
-        for dtype in (np.float64, np.float32) if mono and not opl else (np.float64,):
+        # float32: camera rays (one wavelength, no optical path) and defocus fans (either mode, no Fresnel)
+        for dtype in (np.float64, np.float32) if not opl and (mono or not fresnel) else (np.float64,):
             table = packed_table(lenses[asphere], dtype=dtype)
             assert (table.kinds.max() >= 3) == asphere  # the variant asked for: aspheres in the table or none
             rays = _rays(dtype, mono)
