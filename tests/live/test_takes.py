@@ -106,8 +106,9 @@ def _wait_for_samples(path: Path, n: int, proc, timeout: float = 60.0) -> None:
     sent; its once-a-second counters lines are not counted)."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
-        if proc.poll() is not None:
-            raise RuntimeError(f"the recorder exited ({proc.returncode}) before journaling {n} samples")
+        if proc.poll() is not None:  # its one line says why (read here: the test's own error is raised first)
+            err = proc.stderr.read() if proc.stderr is not None else ""
+            raise RuntimeError(f"the recorder exited ({proc.returncode}) before journaling {n} samples: {err!r}")
         if path.exists() and sum(line.startswith(b'{"sequence":') and line.endswith(b"\n")
                                  for line in path.read_bytes().splitlines(keepends=True)) >= n:
             return
