@@ -3,7 +3,7 @@ picture Cycles renders through it agrees with physcam's own tracer (an independe
 implementation, traced the other way: from the scene to the film).
 
 The shaders are generated here (main environment); Blender (bpy, its own environment) compiles
-and renders them in one subprocess per test.
+and renders them in one subprocess.
 """
 
 from __future__ import annotations
@@ -64,11 +64,23 @@ def render(path, w, h, samples):
 '''
 
 
-def test_every_bundled_lens_compiles_and_renders(tmp_path):
+def test_every_bundled_lens_compiles_and_renders(renders):
     """Done-when of issue 10 part 1: every bundled lens (spherical, aspheric, anamorphic) gives a
     shader that Cycles compiles (Blender's own compile path, no OSL error) and that renders a
     uniform white world at about 1 in the image centre (the shader's normalisation), with all
     features on for the anamorphic and aspheric lenses (dispersion, Fresnel, a 7-blade iris)."""
+    files, generate_s, out = renders["lenses"]
+    out = dict(out)
+    print({k: round(v["centre"] or 0, 3) for k, v in out.items() if k[0] != "_"})
+    print(f"generate {generate_s:.1f} s, compile + render {out.pop('_seconds'):.1f} s for {len(files)} lenses")
+    assert set(out) == set(files)
+    for slug, r in out.items():
+        assert r["bytecode"] > 0 and not any("ERROR" in k for k, _ in r["msgs"]), (slug, r["msgs"])
+        assert 0.8 < r["centre"] < 1.2, (slug, r["centre"])
+
+
+def _lens_shaders(tmp):
+    """Every bundled lens's shader, written into ``tmp``: {slug: path}, and the seconds that took."""
     files = {}
     t0 = time.perf_counter()
     for rec in list_lenses():
@@ -77,36 +89,10 @@ def test_every_bundled_lens_compiles_and_renders(tmp_path):
         k = min(1.0, gaussian(lens).efl / 50.0)  # a frame the lens covers (dgauss_77deg is a 3.5 mm lens)
         src = osl_camera_shader(camera_state(lens, focus_mm=5000.0, sensor_mm=(24.0 * k, 16.0 * k)),
                                 dispersion=full, fresnel=full, aperture=(7, 15.0, 0.3, 0.0) if full else None)
-        p = tmp_path / f"{rec.slug}.osl"
+        p = tmp / f"{rec.slug}.osl"
         p.write_text(src)
         files[rec.slug] = str(p)
-    generate_s = time.perf_counter() - t0
-    out = run_blender(SCENE + '''
-from cycles import osl
-files = json.loads(sys.argv[1])
-set_world(1.0)
-scene.cycles.shading_system = True
-res = {}
-t0 = time.perf_counter()
-for slug, path in files.items():
-    msgs = []
-    text = bpy.data.texts.new(slug); text.write(open(path).read())
-    cam = cam_obj.data
-    cam.type = "CUSTOM"; cam.custom_mode = "INTERNAL"; cam.custom_shader = text
-    osl.update_custom_camera_shader(cam, lambda kind, msg: msgs.append([sorted(kind), msg]))
-    ok = len(cam.custom_bytecode) > 0
-    a = render(sys.argv[2] + "/" + slug + ".exr", 24, 16, 64) if ok else None
-    res[slug] = {"bytecode": len(cam.custom_bytecode), "msgs": msgs,
-                 "centre": None if a is None else float(a[6:10, 10:14, :3].mean())}
-res["_seconds"] = time.perf_counter() - t0
-print(json.dumps(res))
-''', json.dumps(files), tmp_path)
-    print({k: round(v["centre"] or 0, 3) for k, v in out.items() if k[0] != "_"})
-    print(f"generate {generate_s:.1f} s, compile + render {out.pop('_seconds'):.1f} s for {len(files)} lenses")
-    assert set(out) == set(files)
-    for slug, r in out.items():
-        assert r["bytecode"] > 0 and not any("ERROR" in k for k, _ in r["msgs"]), (slug, r["msgs"])
-        assert 0.8 < r["centre"] < 1.2, (slug, r["centre"])
+    return files, time.perf_counter() - t0
 
 
 def _film_from_object(lens, film_z, points_mm, n=48):
@@ -141,8 +127,9 @@ EXPOSURE_FRAME = (36.0, 24.0, 36, 24)
 EXPOSURE_BLOCKS = {"centre": (10, 14, 16, 20), "right": (10, 14, 31, 35), "top": (19, 23, 16, 20), "corner": (0, 3, 0, 3)}
 
 #: The markers' render (argv 1-6), then, in Blender's factory start-up scene read again, the white world's
-#: (argv 7-11): one Blender process for both (each costs about 1.3 s of CPU before its first render).
-TWO_RENDERS = SCENE + '''
+#: (argv 7-11), then, in it read again, every lens's shader (argv 12, {slug: path}) compiled and rendered
+#: (into argv 13): one Blender process for all (each costs about 1.3 s of CPU before its first render).
+RENDERS = SCENE + '''
 import runpy
 results = {}
 mod = runpy.run_path(sys.argv[1], run_name="physcam_setup")
@@ -171,14 +158,36 @@ scene.cycles.filter_width = 0.01   # box-like: a pixel averages its own film are
 a = render(sys.argv[8] + "/white.exr", int(sys.argv[9]), int(sys.argv[10]), 1024)
 blocks = json.loads(sys.argv[11])
 results["exposure"] = {k: float(a[r0:r1, c0:c1, :3].mean()) for k, (r0, r1, c0, c1) in blocks.items()}
+bpy.ops.wm.read_factory_settings(use_empty=False)
+''' + SCENE + '''
+from cycles import osl
+files = json.loads(sys.argv[12])
+set_world(1.0)
+scene.cycles.shading_system = True
+res = {}
+t0 = time.perf_counter()
+for slug, path in files.items():
+    msgs = []
+    text = bpy.data.texts.new(slug); text.write(open(path).read())
+    cam = cam_obj.data
+    cam.type = "CUSTOM"; cam.custom_mode = "INTERNAL"; cam.custom_shader = text
+    osl.update_custom_camera_shader(cam, lambda kind, msg: msgs.append([sorted(kind), msg]))
+    ok = len(cam.custom_bytecode) > 0
+    a = render(sys.argv[13] + "/" + slug + ".exr", 24, 16, 64) if ok else None
+    res[slug] = {"bytecode": len(cam.custom_bytecode), "msgs": msgs,
+                 "centre": None if a is None else float(a[6:10, 10:14, :3].mean())}
+res["_seconds"] = time.perf_counter() - t0
+results["lenses"] = res
 print(json.dumps(results))
 '''
 
 
 @pytest.fixture(scope="module")
 def renders(tmp_path_factory):
-    """The cameras baked for the markers' and the white world's tests and their renders, by one Blender
-    process (:data:`TWO_RENDERS`): {"markers": (baked camera, render), "exposure": (baked camera, render)}."""
+    """The cameras baked for the markers' and the white world's tests and their renders, and every lens's
+    shader compiled and rendered, by one Blender process (:data:`RENDERS`): {"markers": (baked camera,
+    render), "exposure": (baked camera, render), "lenses": ({slug: shader file}, seconds to write them,
+    {slug: compile and render})}."""
     tmp = tmp_path_factory.mktemp("osl_camera")
     sw, sh, W, H = MARKERS_FRAME
     lens = load_lens("zeiss_distagon_35mm_f4")
@@ -192,9 +201,11 @@ def renders(tmp_path_factory):
     cam = camera_state(lens, focus_mm=math.inf, sensor_mm=(esw, esh))
     b2 = bake_camera(cam)
     (tmp / "cam.osl").write_text(osl_camera_shader(cam))
-    out = run_blender(TWO_RENDERS, setup, json.dumps(MARKERS), 0.012, tmp, W, H,
-                      tmp / "cam.osl", tmp, eW, eH, json.dumps(EXPOSURE_BLOCKS))
-    return {"markers": (b, out["markers"]), "exposure": (b2, out["exposure"])}
+    (tmp / "lenses").mkdir()
+    files, generate_s = _lens_shaders(tmp / "lenses")
+    out = run_blender(RENDERS, setup, json.dumps(MARKERS), 0.012, tmp, W, H,
+                      tmp / "cam.osl", tmp, eW, eH, json.dumps(EXPOSURE_BLOCKS), json.dumps(files), tmp / "lenses")
+    return {"markers": (b, out["markers"]), "exposure": (b2, out["exposure"]), "lenses": (files, generate_s, out["lenses"])}
 
 
 def test_markers_land_where_physcam_traces_them(renders):

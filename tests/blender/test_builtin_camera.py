@@ -23,13 +23,19 @@ pytestmark = pytest.mark.slow
 #: between jobs: no camera setting, object or material of one job reaches the next): the camera
 #: authored by the job's script, emissive spheres, each window's centroid and second moment (and the
 #: picture itself when the job asks). One Blender process for the file's renders: each process costs
-#: about 1.3 s of CPU before its first render (2026-11-29).
+#: about 1.3 s of CPU before its first render (2026-11-29). A job ``{"builtin_script": path}`` renders nothing: it
+#: runs that script's ``apply`` on the factory scene as a user would, and returns the camera it set.
 SCENE = '''
-import bpy, json, math, sys
+import bpy, json, math, runpy, sys
 import numpy as np
 results = []
 for spec in json.loads(sys.argv[1]):
     bpy.ops.wm.read_factory_settings(use_empty=False)
+    if "builtin_script" in spec:
+        cam = runpy.run_path(spec["builtin_script"])["apply"](bpy.context.scene)
+        results.append({"lens": cam.lens, "fstop": cam.dof.aperture_fstop, "blades": cam.dof.aperture_blades,
+                        "focus": cam.dof.focus_distance, "w": cam.sensor_width})
+        continue
     scene = bpy.context.scene
     for o in list(bpy.data.objects):
         if o.type != "CAMERA":
@@ -168,12 +174,22 @@ CASES = {"frames": _frames_case, "blur": _blur_case, "shift": _shift_case, "iris
 @pytest.fixture(scope="module")
 def renders(tmp_path_factory):
     """Per case of :data:`CASES`: (lens report, camera values, the render's measures), all rendered by one
-    Blender process (:data:`SCENE`)."""
+    Blender process (:data:`SCENE`), which then (after the renders: it touches none of them) runs the script
+    `physcam export blender dgauss_50mm --focus 1.5m --fstop 4 --sensor FF --builtin --blades 6` wrote; "export":
+    the command's exit code and the camera the script set (None when the command failed)."""
+    from physcam.cli import main
+
     tmp = tmp_path_factory.mktemp("builtin")
     cases = {name: make() for name, make in CASES.items()}
     jobs = [_job(v, out=tmp / f"{name}.exr", **kw) for name, (r, v, kw) in cases.items()]
+    code = main(["export", "blender", "dgauss_50mm", "--focus", "1.5m", "--fstop", "4", "--sensor", "FF",
+                 "--builtin", "--blades", "6", "-o", str(tmp / "export")])
+    if code == 0:
+        jobs.append({"builtin_script": str(tmp / "export" / "builtin_dgauss_50mm.py")})
     out = run_blender(SCENE, json.dumps(jobs))
-    return {name: (r, v, res) for (name, (r, v, _)), res in zip(cases.items(), out["results"])}
+    got = {name: (r, v, res) for (name, (r, v, _)), res in zip(cases.items(), out["results"])}
+    got["export"] = (code, out["results"][len(cases)] if code == 0 else None)
+    return got
 
 
 def test_builtin_camera_frames_like_the_thin_lens(renders):
@@ -220,23 +236,16 @@ def test_builtin_camera_shift_moves_the_frame_by_millimetres(renders):
     assert out["blobs"][0]["cy"] == pytest.approx(h / 2 - 2.0 * px_per_mm, abs=0.5)
 
 
-def test_export_blender_builtin_script_sets_the_lens_pinhole(tmp_path):
+def test_export_blender_builtin_script_sets_the_lens_pinhole(renders):
     """`physcam export blender LENS --builtin` writes a script that gives Blender's camera the lens's
     best-match pinhole at the mark (52.048 mm for dgauss.50mm at 1.5 m, issue 9.6's figure), and
-    the aperture that keeps the entrance pupil's diameter."""
-    from physcam.cli import main
+    the aperture that keeps the entrance pupil's diameter (the script run by the renders' Blender, in
+    its factory scene read again)."""
     from physcam.optics.focusing import technical_planes
     from physcam.lens.library import load_lens
 
-    assert main(["export", "blender", "dgauss_50mm", "--focus", "1.5m", "--fstop", "4", "--sensor", "FF",
-                 "--builtin", "--blades", "6", "-o", str(tmp_path)]) == 0
-    out = run_blender('''
-import bpy, json, runpy, sys
-ns = runpy.run_path(sys.argv[1])
-cam = ns["apply"](bpy.context.scene)
-print(json.dumps({"lens": cam.lens, "fstop": cam.dof.aperture_fstop, "blades": cam.dof.aperture_blades,
-                  "focus": cam.dof.focus_distance, "w": cam.sensor_width}))
-''', tmp_path / "builtin_dgauss_50mm.py")
+    code, out = renders["export"]
+    assert code == 0
     planes = technical_planes(load_lens("dgauss_50mm"), 1500.0, fstop=4.0)
     assert out["lens"] == pytest.approx(52.048, abs=1e-3)
     assert out["lens"] == pytest.approx(planes.pinhole_focal_length_mm, rel=1e-6)

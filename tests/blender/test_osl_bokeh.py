@@ -60,6 +60,9 @@ BOKEH_BORDER_PX = 36  # the bokeh's render: only this many px either side of the
 #: Renders emissive spheres (black world, no bounces, CPU, OSL) through each physcam setup script
 #: and returns the red channel (rows from the bottom of the picture). One Blender process, one
 #: render per job; each job's setup script uses its own text block, so its shader is compiled anew.
+#: After the renders (touching none of them), "fresh": the setup script argv[2]'s apply() on the factory
+#: scene read again (test_apply_compiles_the_shader_in_a_fresh_scene; a Blender process of its own cost about
+#: 1.3 s of CPU, 2026-11-29).
 SCENE = '''
 import json, runpy, sys, time
 import numpy as np
@@ -100,6 +103,12 @@ for job in jobs:
     a = np.array(img.pixels[:], dtype=np.float64).reshape(h, w, 4)[:, :, 0]   # row 0 = bottom
     bpy.data.images.remove(img)
     out[job["name"]] = {"img": a.tolist(), "seconds": time.perf_counter() - t0}
+# then argv[2]'s apply() on Blender's factory start-up scene read again (its engine Blender's default)
+bpy.ops.wm.read_factory_settings(use_empty=False)
+scene = bpy.context.scene
+engine = scene.render.engine
+cam = runpy.run_path(sys.argv[2], run_name="physcam_setup")["apply"](scene)
+out["fresh"] = {"engine_before": engine, "bytecode": len(cam.data.custom_bytecode)}
 print(json.dumps(out))
 '''
 
@@ -129,11 +138,16 @@ def renders(tmp_path_factory):
     b = [(CROP_PX / 2 - BOKEH_BORDER_PX) / CROP_PX, (CROP_PX / 2 + BOKEH_BORDER_PX) / CROP_PX]
     jobs.append({"name": "bokeh", "setup": str(tmp / "bokeh.py"), "samples": 512, "border": b + b,
                  "sphere": [0.0, 0.0, -NEAR_MM / 1000.0, NEAR_SPHERE_M], "out": str(tmp / "bokeh.exr")})
+    # the fresh scene's camera: a 36 x 24 mm frame at 36 x 24 px
+    src = osl_camera_shader(camera_state(lens, focus_mm=MARK_MM, fstop=FSTOP, sensor_mm=(36.0, 24.0)))
+    (tmp / "setup.py").write_text(blender_setup_script(src, sensor_width_mm=36.0, sensor_height_mm=24.0,
+                                                       resolution=(36, 24)))
     t0 = time.perf_counter()
-    out = run_blender(SCENE, json.dumps(jobs))
+    out = run_blender(SCENE, json.dumps(jobs), tmp / "setup.py")
     wall = time.perf_counter() - t0
+    fresh = out.pop("fresh")
     print(f"\nBlender: {wall:.1f} s wall; renders " + ", ".join(f"{k} {v['seconds']:.1f} s" for k, v in out.items()))
-    return {k: np.array(v["img"]) for k, v in out.items()}
+    return {"fresh": fresh, **{k: np.array(v["img"]) for k, v in out.items()}}
 
 
 
@@ -164,21 +178,13 @@ def predicted():
     return {"near": near.image[..., 0], "mag_near": mag, "spot": spot.image[..., 0], "film_z": st.film_z}
 
 
-def test_apply_compiles_the_shader_in_a_fresh_scene(tmp_path):
+def test_apply_compiles_the_shader_in_a_fresh_scene(renders):
     """Regression: the setup script's apply() on a scene whose engine is not yet Cycles (Blender's
     default, EEVEE) must leave a compiled camera. Blender compiles a custom camera shader when it
     is assigned and only under Cycles; apply() used to assign it first and switch to Cycles after,
-    leaving no bytecode, and every render came out black."""
-    src = osl_camera_shader(camera_state(load_lens(LENS), focus_mm=MARK_MM, fstop=FSTOP, sensor_mm=(36.0, 24.0)))
-    (tmp_path / "setup.py").write_text(blender_setup_script(src, sensor_width_mm=36.0, sensor_height_mm=24.0,
-                                                            resolution=(36, 24)))
-    out = run_blender('''
-import json, runpy
-scene = bpy.context.scene
-engine = scene.render.engine
-cam = runpy.run_path(sys.argv[1], run_name="physcam_setup")["apply"](scene)
-print(json.dumps({"engine_before": engine, "bytecode": len(cam.data.custom_bytecode)}))
-''', tmp_path / "setup.py")
+    leaving no bytecode, and every render came out black. (Run by the renders' Blender after them, on
+    its factory scene read again.)"""
+    out = renders["fresh"]
     assert out["engine_before"] != "CYCLES"  # the case under test
     assert out["bytecode"] > 0
 
