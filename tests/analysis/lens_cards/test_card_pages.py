@@ -26,6 +26,7 @@ from pathlib import Path
 
 import pytest
 
+from _draft_cards import draft_card
 from _anamorphic_yu import _surfaces, _yu, hand_framing_focal_lengths, hand_pupils_from_film
 from _zoom_abcd import abcd_position
 from physcam.analysis.lens_cards.anamorphic_page import ANAMORPHIC_PANELS
@@ -42,12 +43,12 @@ OPTILAND = json.loads((Path(__file__).parents[2] / "data" / "optiland_zoom.json"
 
 @pytest.fixture(scope="module")
 def canon_card():
-    return lens_card(load_lens(CANON), quality="draft")
+    return draft_card(CANON)
 
 
 @pytest.fixture(scope="module")
 def neil_card():
-    return lens_card(load_lens(NEIL), quality="draft")
+    return draft_card(NEIL)
 
 
 # ---- oracles ------------------------------------------------------------------------------------
@@ -258,7 +259,7 @@ def test_a_lens_longer_than_its_close_marks_still_has_breathing_pupils_and_bokeh
     stand in front of the lens. (Before: no breathing table and no bokeh on its card.)"""
     slug = "panavision_rear_anamorphic_1_3x"
     lens = load_lens(slug)
-    card = lens_card(lens, quality="draft")
+    card = draft_card(slug)
     length = lens.total_track + lens.surfaces[-1].thickness
     marks = [r.focus_from_film_mm for r in card.breathing]
     assert math.isinf(marks[0]) and marks[-1] == 500.0 and marks[-1] > 1.5 * length

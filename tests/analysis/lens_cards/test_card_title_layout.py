@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import pytest
 
+from _draft_cards import draft_card
 from physcam.analysis.lens_cards.card import lens_card
 from physcam.lens.library import list_lenses, load_lens
 
@@ -41,10 +42,10 @@ def _by_track():
 def test_section_title_does_not_run_into_the_key_numbers(which, tmp_path):
     if which == "singlet":
         (tmp_path / "singlet.toml").write_text(SINGLET)
-        lens = load_lens(str(tmp_path / "singlet.toml"))
+        card = lens_card(load_lens(str(tmp_path / "singlet.toml")), quality="draft")
     else:
-        lens = load_lens(_by_track()[0 if which == "shortest" else -1][1])
-    fig = lens_card(lens, quality="draft").figure(dpi=40)
+        card = draft_card(_by_track()[0 if which == "shortest" else -1][1])
+    fig = card.figure(dpi=40)
     fig.canvas.draw()
     r = fig.canvas.get_renderer()
     axes = {ax.get_label(): ax for ax in fig.axes}

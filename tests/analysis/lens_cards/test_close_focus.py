@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 
+from _draft_cards import draft_card
 from physcam.analysis.lens_cards.card import lens_card
 from physcam.cli import main
 from physcam.lens.library import find_lens, load_lens
@@ -41,7 +42,7 @@ def test_without_a_mod_the_unit_limit_is_named_and_breathing_starts_at_ten_focal
     assert cf.breathing_near_mm == 500.0  # 10 x 50.358 mm = 503.6, to two significant figures
     marks = [r.focus_from_film_mm for r in breathing_table(lens)]
     assert min(marks) == 500.0  # not 200 mm: the 0.2-0.5 m a real 50 mm never reaches
-    card = lens_card(lens, quality="draft")
+    card = draft_card("dgauss_50mm")
     fig = card.figure(dpi=30)
     key = next(ax for ax in fig.axes if ax.get_label() == "key numbers")
     texts = [t.get_text() for t in key.texts]

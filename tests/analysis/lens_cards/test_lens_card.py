@@ -16,11 +16,11 @@ set of pages a bundled lens's card can have.
 
 from __future__ import annotations
 
-import functools
 import re
 
 import pytest
 
+from _draft_cards import draft_card
 from physcam.analysis.lens_cards.card import PAGES, PANELS, lens_card, save_lens_card
 from physcam.lens.library import list_lenses, load_lens
 
@@ -32,13 +32,6 @@ LENSES = [r.slug for r in list_lenses()]
 def _pages_wanted(lens) -> list[str]:
     """One page, and a second for a zoom (across its range) or an anamorphic (its two meridians)."""
     return ["main"] + (["zoom"] if lens.zoom is not None else []) + (["anamorphic"] if lens.squeeze != 1.0 else [])
-
-
-@functools.cache
-def _draft_card(slug):
-    """The draft card of a bundled lens, computed once for this module's tests (a card holds numbers; each
-    test draws its own figures from it)."""
-    return lens_card(load_lens(slug), quality="draft")
 
 
 def test_page_sizes_are_a4_and_letter():
@@ -53,7 +46,7 @@ def test_every_bundled_lens_has_a_card_with_every_panel(slug):
     from physcam.optics.paraxial import gaussian
 
     lens = load_lens(slug)
-    card = _draft_card(slug)
+    card = draft_card(slug)
     assert card.key["efl_mm"] == pytest.approx(gaussian(lens).efl, rel=1e-12)
     assert card.key["image_circle_mm"] > 0
     assert card.pages == _pages_wanted(lens)
@@ -81,7 +74,7 @@ def test_the_kinds_cover_every_set_of_pages_a_bundled_card_has():
 @pytest.mark.parametrize("slug", KINDS)
 def test_the_pdf_has_one_page_per_card_page(slug, tmp_path):
     lens = load_lens(slug)
-    card = _draft_card(slug)
+    card = draft_card(slug)
     data = save_lens_card(card, tmp_path / "card.pdf", dpi=30).read_bytes()
     assert data.startswith(b"%PDF")
     assert len(re.findall(rb"/Type\s*/Page[^s]", data)) == len(_pages_wanted(lens)) == len(card.pages)
