@@ -155,3 +155,29 @@ def test_stopped_bounds_are_the_bounds_of_the_stopped_lens(name):
         ref = exit_pupil_bounds(q.with_surfaces(surfs), 12.0, 8.0, st.film_z, nx=3, ny=3, samples=24)
         assert (ref.rects[..., 1] > ref.rects[..., 0]).all()
         assert np.array_equal(pb.rects, ref.rects)
+
+
+@pytest.mark.parametrize("name", ["navarro_anamorphic_2x", "arri_signature_prime_58mm_ex1"])
+def test_mirrored_bounds_are_the_whole_grids(name):
+    # mirror=True traces the nodes with x >= 0 and y >= 0 and mirrors them (every prescription is symmetric about
+    # x = 0 and y = 0): the whole grid's rectangles to the rounding of the aims' places, the same empty nodes; the
+    # Signature's nodes go through the window search (above), so the search mirrors too
+    import math
+
+    from physcam.errors import InputError
+    from physcam.lens.library import load_lens
+    from physcam.optics.focusing import focus
+    from physcam.trace.pupil_bounds import stopped_pupil_bounds
+
+    st = focus(load_lens(name), math.inf)
+    q = st.prescription
+    semi = q.surfaces[q.stop_index].semi_diameter
+    stops = [semi, 0.5 * semi]
+    whole = stopped_pupil_bounds(q, stops, 12.0, 8.0, st.film_z, nx=5, ny=5, samples=24)
+    half = stopped_pupil_bounds(q, stops, 12.0, 8.0, st.film_z, nx=5, ny=5, samples=24, mirror=True)
+    for a, b in zip(whole, half):
+        assert np.array_equal(a.xs, b.xs) and np.array_equal(a.ys, b.ys)
+        assert ((a.rects[..., 1] > a.rects[..., 0]) == (b.rects[..., 1] > b.rects[..., 0])).all()
+        np.testing.assert_allclose(b.rects, a.rects, rtol=0, atol=1e-12)
+    with pytest.raises(InputError, match="odd number of nodes"):
+        stopped_pupil_bounds(q, stops, 12.0, 8.0, st.film_z, nx=4, ny=5, samples=24, mirror=True)

@@ -618,61 +618,9 @@ def _rect_tables(tracer, semi_max, grid_half_mm):
     # iris and the stopped ones share their rays (one trace with the stop opened, each iris's mask the
     # tracer's own test: stopped_pupil_bounds): the widest's rectangles are what a trace of it alone gives,
     # the stopped ones are sampled as finely (48 aims across, not 32) for no more rays
-    b, *levels = _mirrored_pupil_bounds(q, tracer.film_z, [float(semi_file * (f * semi_max / semi_file))
-                                                           for f in (1.0,) + STOP_LEVELS],
-                                        grid_half_mm, nx=nx, ny=ny, samples=48)
+    b, *levels = tracer.stopped_pupil_bounds([float(semi_file * (f * semi_max / semi_file)) for f in (1.0,) + STOP_LEVELS],
+                                             grid_half_mm, grid_half_mm, nx=nx, ny=ny, samples=48, mirror=True)
     return b, b.rects, [lv.rects for lv in levels]
-
-
-def _mirrored_pupil_bounds(q, film_z: float, stops, half: float, *, nx: int, ny: int, samples: int) -> list:
-    """:func:`~physcam.trace.pupil_bounds.stopped_pupil_bounds` over the film square of half side ``half`` (odd
-    ``nx``, ``ny``), its nodes traced only where x >= 0 and y >= 0 and the others mirrored: every prescription
-    physcam reads is symmetric about the planes x = 0 and y = 0 (spherical, aspheric and cylindrical surfaces
-    centred on the axis, the cylinders' axes along x or y, round apertures), so the rays from node (-x, y) to the
-    mirrored aims pass exactly where those from (x, y) do, and the window searches mirror too (the same rounds
-    and boxes). The rectangles are the whole grid's to rounding (the aims' places: within 5.3e-15 mm at every traced
-    focus mark of the three anamorphics of the extension's tests) for a third of the rays (25 of 81 nodes)."""
-    from ..trace.pupil_bounds import MIN_HITS, PupilBounds, _box_hits, _rects, _touches
-
-    r = q.surfaces[-1].semi_diameter
-    u = (np.arange(samples) + 0.5) / samples
-    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
-    xs, ys = np.linspace(-half, half, nx), np.linspace(-half, half, ny)
-    fy, fx = (a.ravel() for a in np.meshgrid(ys[ny // 2:], xs[nx // 2:], indexing="ij"))  # the quarter, row by row
-    full = np.array([-r, r, -r, r])
-    box = np.broadcast_to(full, (len(stops), fx.size, 4)).copy()
-    ext = _box_hits(q, fx, fy, film_z, box[0], uu, vv, stops, "auto")
-    pending = ext[..., 4] < MIN_HITS
-    h = 0.5 * (film_z - q.vertex_z[-1])
-    while pending.any():  # stopped_pupil_bounds' window search, node for node
-        live = pending.any(axis=0) & (h < r + np.maximum(np.abs(fx), np.abs(fy)))
-        if not live.any():
-            break
-        win = np.stack([np.maximum(fx - h, -r), np.minimum(fx + h, r), np.maximum(fy - h, -r), np.minimum(fy + h, r)],
-                       axis=1)
-        nodes = np.flatnonzero(live & (win[:, 1] > win[:, 0]) & (win[:, 3] > win[:, 2]))
-        if nodes.size:
-            got = _box_hits(q, fx[nodes], fy[nodes], film_z, win[nodes], uu, vv, stops, "auto")
-            take = pending[:, nodes] & (got[..., 4] > 0) & ~_touches(got, win[nodes], full, samples)
-            k, i = np.nonzero(take)
-            ext[k, nodes[i]], box[k, nodes[i]] = got[k, i], win[nodes[i]]
-            pending[k, nodes[i]] = False
-        h *= 2
-    out = []
-    for e, b in zip(ext, box):
-        quarter = _rects(e, b, r, samples).reshape(ny - ny // 2, nx - nx // 2, 4)
-        rects = np.zeros((ny, nx, 4))
-        rects[ny // 2:, nx // 2:] = quarter
-        x_mirror = np.stack([-quarter[..., 1], -quarter[..., 0], quarter[..., 2], quarter[..., 3]], axis=-1)
-        rects[ny // 2:, :nx // 2 + 1] = x_mirror[:, ::-1]  # the centre column from its own rectangle, mirrored
-        rects[ny // 2:, nx // 2:] = quarter
-        rows = rects[ny // 2:]  # y = 0 up; the rows below mirror those above the centre row
-        rects[:ny // 2] = np.stack([rows[..., 0], rows[..., 1], -rows[..., 3], -rows[..., 2]], axis=-1)[:0:-1]
-        rects += 0.0  # no negative zeros (an empty node is (0, 0, 0, 0))
-        if not (rects[..., 1] > rects[..., 0]).any():
-            raise OpticsError(f"no ray from the film reaches the scene through {q.name!r}")
-        out.append(PupilBounds(xs, ys, rects, float(q.vertex_z[-1])))
-    return out
 
 
 def _num32(x) -> str:

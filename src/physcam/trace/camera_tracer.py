@@ -62,13 +62,14 @@ class CameraTracer:
                                  samples=samples)
 
     def stopped_pupil_bounds(self, stop_semi_diameters, film_half_width: float, film_half_height: float, *, nx: int,
-                             ny: int, samples: int) -> list:
+                             ny: int, samples: int, mirror: bool = False) -> list:
         """:func:`physcam.trace.pupil_bounds.stopped_pupil_bounds`: :meth:`exit_pupil_bounds` with the stop
-        set to each semi-diameter of the sequence (mm; None: this tracer's own), one trace for them all."""
+        set to each semi-diameter of the sequence (mm; None: this tracer's own), one trace for them all
+        (``mirror``: a quarter of the film nodes traced, the rest mirrored)."""
         from .pupil_bounds import stopped_pupil_bounds
 
         return stopped_pupil_bounds(self.lens, stop_semi_diameters, film_half_width, film_half_height, self.film_z,
-                                    nx=nx, ny=ny, samples=samples)
+                                    nx=nx, ny=ny, samples=samples, mirror=mirror)
 
     def iris_camera_rays(self, film_xy, pupil_samples, stop_semi_diameters, *, bounds=None):
         """:func:`physcam.trace.pupil_bounds.iris_camera_rays`: camera rays for several round irises (mm) in one

@@ -71,28 +71,56 @@ _OPEN_STOP = 2.0 ** 20
 
 def stopped_pupil_bounds(lens, stop_semi_diameter, film_half_width: float, film_half_height: float,
                          film_z: float | None = None, *, nx: int = 17, ny: int = 17, samples: int = 64,
-                         backend: str = "auto") -> list[PupilBounds]:
+                         backend: str = "auto", mirror: bool = False) -> list[PupilBounds]:
     """:func:`exit_pupil_bounds` with the stop's semi-diameter set to each size of the sequence
     ``stop_semi_diameter`` (mm; None: the lens's own), one :class:`PupilBounds` each. The aims of every node are traced in
     one call for all irises (:func:`iris_camera_rays`), and so are the windows of every node still
-    searching (module notes), round by round."""
+    searching (module notes), round by round.
+
+    ``mirror`` (odd ``nx`` and ``ny``): only the nodes with x >= 0 and y >= 0 are traced, the others are their
+    mirror images. Every prescription physcam reads is symmetric about the planes x = 0 and y = 0 (spherical,
+    aspheric and cylindrical surfaces centred on the axis, the cylinders' axes along x or y, round apertures), so
+    the rays from node (-x, y) to the mirrored aims pass where those from (x, y) do, and the window search mirrors
+    too: the rectangles are the whole grid's to the rounding of the aims' places (5.3e-15 mm on the anamorphic
+    lenses of the Blender extension's tests, tests/export/test_blender_pupil_mirrored.py), for 25 of 81 nodes."""
     from .trace import paraxial_image_z
 
     hw = require_positive("film half width", film_half_width)
     hh = require_positive("film half height", film_half_height)
     if nx < 2 or ny < 2 or samples < 4:
         raise InputError("pupil bounds need nx, ny >= 2 and samples >= 4")
+    if mirror and not (nx % 2 and ny % 2):
+        raise InputError(f"mirrored pupil bounds need an odd number of nodes each way (a centre row and column), "
+                         f"got nx={nx}, ny={ny}")
     sd = [s if s is None else require_positive("stop semi-diameter", s) for s in stop_semi_diameter]
     if any(s is None for s in sd) and not all(s is None for s in sd):  # the lens's own among others
         sd = [float(lens.surfaces[lens.stop_index].semi_diameter) if s is None else s for s in sd]
     if film_z is None:
         film_z = paraxial_image_z(lens)
     r = lens.surfaces[-1].semi_diameter
-    u = (np.arange(samples) + 0.5) / samples
-    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
     xs = np.linspace(-hw, hw, nx)
     ys = np.linspace(-hh, hh, ny)
-    fy, fx = (a.ravel() for a in np.meshgrid(ys, xs, indexing="ij"))  # the nodes, row by row
+    traced_x, traced_y = (xs[nx // 2:], ys[ny // 2:]) if mirror else (xs, ys)
+    fy, fx = (a.ravel() for a in np.meshgrid(traced_y, traced_x, indexing="ij"))  # the nodes traced, row by row
+    ext, box = _node_hits(lens, fx, fy, film_z, sd, samples, backend)
+    out = []
+    for e, b in zip(ext, box):
+        rects = _rects(e, b, r, samples).reshape(traced_y.size, traced_x.size, 4)
+        if mirror:
+            rects = _mirrored(rects)
+        if not (rects[..., 1] > rects[..., 0]).any():
+            raise OpticsError(f"no ray from the film reaches the scene through {lens.name!r}")
+        out.append(PupilBounds(xs, ys, rects, float(lens.vertex_z[-1])))
+    return out
+
+
+def _node_hits(lens, fx, fy, film_z: float, sd, samples: int, backend: str):
+    """Per stop and film node (``fx``, ``fy``): the extremes and count of the passing aims (stops, nodes, 5) and the box
+    they were found on (stops, nodes, 4): first the rear rim's square, then windows about the node doubling in size
+    while a node has too few hits (module notes)."""
+    r = lens.surfaces[-1].semi_diameter
+    u = (np.arange(samples) + 0.5) / samples
+    uu, vv = [a.ravel() for a in np.meshgrid(u, u)]
     full = np.array([-r, r, -r, r])
     box = np.broadcast_to(full, (len(sd), fx.size, 4)).copy()  # per stop and node: the box its hits are on
     ext = _box_hits(lens, fx, fy, film_z, box[0], uu, vv, sd, backend)  # (stops, nodes, 5): extremes, count
@@ -112,13 +140,21 @@ def stopped_pupil_bounds(lens, stop_semi_diameter, film_half_width: float, film_
             ext[k, nodes[i]], box[k, nodes[i]] = got[k, i], win[nodes[i]]
             pending[k, nodes[i]] = False
         h *= 2
-    out = []
-    for e, b in zip(ext, box):
-        rects = _rects(e, b, r, samples).reshape(ny, nx, 4)
-        if not (rects[..., 1] > rects[..., 0]).any():
-            raise OpticsError(f"no ray from the film reaches the scene through {lens.name!r}")
-        out.append(PupilBounds(xs, ys, rects, float(lens.vertex_z[-1])))
-    return out
+    return ext, box
+
+
+def _mirrored(quarter: np.ndarray) -> np.ndarray:
+    """The whole grid of rectangles (x0, x1, y0, y1) from its quarter of nodes with x >= 0 and y >= 0 (rows from the
+    centre row up, columns from the centre column right): each node (-x, y) holds (x, y)'s rectangle mirrored in x,
+    each (x, -y) mirrored in y."""
+    qy, qx = quarter.shape[:2]
+    rects = np.zeros((2 * qy - 1, 2 * qx - 1, 4))
+    x_mirror = np.stack([-quarter[..., 1], -quarter[..., 0], quarter[..., 2], quarter[..., 3]], axis=-1)
+    rects[qy - 1:, :qx] = x_mirror[:, ::-1]  # the centre column from its own rectangle, mirrored onto itself
+    rects[qy - 1:, qx - 1:] = quarter
+    rows = rects[qy - 1:]  # the centre row up; the rows below mirror those above it
+    rects[:qy - 1] = np.stack([rows[..., 0], rows[..., 1], -rows[..., 3], -rows[..., 2]], axis=-1)[:0:-1]
+    return rects + 0.0  # no negative zeros (an empty node is (0, 0, 0, 0))
 
 
 class _StopCrossing:
