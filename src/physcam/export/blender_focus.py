@@ -376,6 +376,16 @@ def _centre_disk_norms(q, film_z: float, levels, backend: str) -> list[float] | 
     return (math.pi * r2 / (d * d + r2)).tolist()
 
 
+def _state_norms(tracer, table, levels, backend: str) -> list[float]:
+    """The centre normalisation of one focus state (its tracer and radial pupil ``table``): in closed form where the
+    film centre passes a disk of aims (:func:`_centre_disk_norms`), else the grid estimate over the table's centre
+    ellipses (:func:`_centre_norms`)."""
+    from .blender_pupil import _centre_ellipses
+
+    return (_centre_disk_norms(tracer.lens, tracer.film_z, levels, backend)
+            or _centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(table)], levels))
+
+
 @takes_prescription
 def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: float = GRID_HALF_MM,
                 pupil_stride: int | None = None) -> FocusTable:
@@ -387,7 +397,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
     from ..optics.paraxial import STOP_OPENING_TOLERANCE
     from ..optics.state import camera_state
     from ..trace.camera_tracer import CameraTracer
-    from .blender_pupil import _centre_ellipses, _tables_backend, iris_levels, refined_pupil_tables
+    from .blender_pupil import _tables_backend, iris_levels, refined_pupil_tables
 
     axis = focus_axis(closest_focus(lens), n_focus)
     states = []
@@ -415,8 +425,7 @@ def focus_table(lens: Prescription, *, n_focus: int = N_FOCUS, grid_half_mm: flo
         else:
             tab = radial[len(norm)]
             b = _centre_bounds(tracer.lens, tab[0, 0])
-            norm.append(_centre_disk_norms(tracer.lens, tracer.film_z, levels, backend)
-                        or _centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(tab)], levels))
+            norm.append(_state_norms(tracer, tab, levels, backend))
         if i == 0:
             table0, bounds0 = tracer.film_side_table, (b if lens.is_anamorphic else None)
             loss = tracer.centre_weight(b, samples=64, fresnel=True) / tracer.centre_weight(b, samples=64)

@@ -97,9 +97,8 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
     from ..optics.focusing import focus
     from ..optics.zoom import efl_at
     from ..trace.camera_tracer import CameraTracer
-    from .blender_focus import (FocusTable, _centre_bounds, _centre_disk_norms, _centre_norms, _ellipse_rect,
-                                fill_pupil_tables, focus_geometry, pupil_marks)
-    from .blender_pupil import _centre_ellipses, iris_levels, radial_pupil_table, _tables_backend
+    from .blender_focus import FocusTable, _centre_bounds, _state_norms, fill_pupil_tables, focus_geometry, pupil_marks
+    from .blender_pupil import iris_levels, radial_pupil_table, _tables_backend
 
     if lens.zoom is None:
         raise InputError(f"{lens.name!r} is not a zoom lens: use blender_focus.focus_table")
@@ -131,8 +130,7 @@ def zoom_focus_table(lens: Prescription, *, n_focus: int = N_FOCUS_ZOOM, n_geome
             st = focus(q, float(mk))
             tracer = CameraTracer(st.prescription, st.film_z)  # the lens at this zoom and focus as the file stops it
             block.append(radial_pupil_table(tracer.lens, st.film_z, levels, backend=backend))
-            block_norm.append(_centre_disk_norms(tracer.lens, st.film_z, levels, backend)
-                              or _centre_norms(tracer, [_ellipse_rect(e) for e in _centre_ellipses(block[-1])], levels))
+            block_norm.append(_state_norms(tracer, block[-1], levels, backend))
         if not all(min(v) > 0 for v in block_norm):
             from ..errors import OpticsError
 
