@@ -167,6 +167,27 @@ def main_build(args, here: str) -> None:
         print(f"ratio (baseline / this): {cpu['baseline'] / cpu['this checkout']:.2f}")
 
 
+def round_states(name):
+    """The focus states ``--rims`` and ``--norms`` check for the lens ``name``, none for an anamorphic: at infinity and
+    the closest focus (a zoom at both ends), each (zoom position or None, focus distance, prescription, film z, iris
+    levels from 1.03 times the file's stop)."""
+    from physcam.export.blender_pupil import iris_levels
+    from physcam.lens.library import load_lens
+    from physcam.lens.zoom import prescription_at
+    from physcam.optics.focusing import closest_focus, focus
+
+    lens0 = load_lens(name)
+    if lens0.is_anamorphic:
+        return
+    for u in ([0.0, 1.0] if lens0.zoom is not None else [None]):
+        lens = lens0 if u is None else prescription_at(lens0, u)
+        for d in (math.inf, closest_focus(lens) * 1.0001):
+            st = focus(lens, d)
+            q = st.prescription
+            semi = q.surfaces[q.stop_index].semi_diameter
+            yield u, d, q, st.film_z, iris_levels(semi * 1.03, semi)
+
+
 def main_rims(names) -> None:
     """``--rims``: per lens with rotational symmetry, at infinity and the closest focus (a zoom at both ends), every
     rim the pupil tables find along lines (``blender_pupil_sets._LineSets``) against the aim grids' at the same film and
@@ -175,9 +196,6 @@ def main_rims(names) -> None:
     the ellipse fitted to the lines' rim."""
     import physcam.export.blender_pupil as bp
     import physcam.export.blender_pupil_sets as bps
-    from physcam.lens.library import load_lens
-    from physcam.lens.zoom import prescription_at
-    from physcam.optics.focusing import closest_focus, focus
     from physcam.trace.kernels import resolve_backend
     from physcam.trace.rays import OK, RayBatch
     from physcam.trace.trace import trace_through
@@ -185,35 +203,28 @@ def main_rims(names) -> None:
     resolve_backend("auto")
     every = []
     for name in names:
-        lens0 = load_lens(name)
-        if lens0.is_anamorphic:
-            continue
         rels, ends, points = [], {}, 0
-        for u in ([0.0, 1.0] if lens0.zoom is not None else [None]):
-            lens = lens0 if u is None else prescription_at(lens0, u)
-            for d in (math.inf, closest_focus(lens) * 1.0001):
-                st = focus(lens, d)
-                q, film_z = st.prescription, st.film_z
-                semi = q.surfaces[q.stop_index].semi_diameter
-                levels = bp.iris_levels(semi * 1.03, semi)
-                fine = np.sort(np.concatenate([levels, np.sqrt(levels[:-1] * levels[1:])]))[::-1]
-                g = bp._PassingSets(q, film_z, levels, "numba", finer=True)
-                ln = bp._PassingSets(q, film_z, levels, "numba", finer=True, lines=True)
-                for sets in (g, ln):
-                    sets.need(levels)
-                    sets.need(fine)
-                points += ln.lines.points.size
-                served = np.zeros_like(ln.have)
-                served[ln.lines.points] = np.arange(ln.radii.size)[None, :] >= ln.lines.first[:, None]
-                both = served & ln.have & (g.index >= 0) & (ln.index >= 0)
-                rel = ln.rims.area[ln.index[both]] / g.rims.area[g.index[both]] - 1
-                rels.append(rel)
-                for side, pick in (("largest", np.argmax), ("smallest", np.argmin)):
-                    if rel.size:
-                        i = int(pick(rel))
-                        if side not in ends or (rel[i] > ends[side][0]) == (side == "largest"):
-                            p, r = (a[i] for a in np.nonzero(both))
-                            ends[side] = (rel[i], q, film_z, g, ln, p, r, u, d)
+        for u, d, q, film_z, levels in round_states(name):
+            fine = np.sort(np.concatenate([levels, np.sqrt(levels[:-1] * levels[1:])]))[::-1]
+            g = bp._PassingSets(q, film_z, levels, "numba", finer=True)
+            ln = bp._PassingSets(q, film_z, levels, "numba", finer=True, lines=True)
+            for sets in (g, ln):
+                sets.need(levels)
+                sets.need(fine)
+            points += ln.lines.points.size
+            served = np.zeros_like(ln.have)
+            served[ln.lines.points] = np.arange(ln.radii.size)[None, :] >= ln.lines.first[:, None]
+            both = served & ln.have & (g.index >= 0) & (ln.index >= 0)
+            rel = ln.rims.area[ln.index[both]] / g.rims.area[g.index[both]] - 1
+            rels.append(rel)
+            for side, pick in (("largest", np.argmax), ("smallest", np.argmin)):
+                if rel.size:
+                    i = int(pick(rel))
+                    if side not in ends or (rel[i] > ends[side][0]) == (side == "largest"):
+                        p, r = (a[i] for a in np.nonzero(both))
+                        ends[side] = (rel[i], q, film_z, g, ln, p, r, u, d)
+        if not rels:  # an anamorphic: no states
+            continue
         rel = np.concatenate(rels)
         every.append(rel)
         text = []
@@ -247,10 +258,6 @@ def main_norms(names) -> None:
     the 10th level and the last, against the mean weight of physcam's camera rays from the film centre over a
     1024 x 1024 grid of aims on a square 1.02 times the disk's radius, the iris stopped to the level."""
     from physcam.export.blender_focus import _centre_disk_norms
-    from physcam.export.blender_pupil import iris_levels
-    from physcam.lens.library import load_lens
-    from physcam.lens.zoom import prescription_at
-    from physcam.optics.focusing import closest_focus, focus
     from physcam.trace.kernels import resolve_backend
     from physcam.trace.pupil_bounds import PupilBounds
     from physcam.trace.trace import camera_rays
@@ -261,31 +268,22 @@ def main_norms(names) -> None:
     uv = np.stack([a.ravel() for a in np.meshgrid(u, u)], axis=1)
     every = []
     for name in names:
-        lens0 = load_lens(name)
-        if lens0.is_anamorphic:
-            continue
-        for zu in ([0.0, 1.0] if lens0.zoom is not None else [None]):
-            lens = lens0 if zu is None else prescription_at(lens0, zu)
-            for d in (math.inf, closest_focus(lens) * 1.0001):
-                st = focus(lens, d)
-                q, film_z = st.prescription, st.film_z
-                semi = q.surfaces[q.stop_index].semi_diameter
-                levels = iris_levels(semi * 1.03, semi)
-                norms = _centre_disk_norms(q, film_z, levels, "numba")
-                if norms is None:
-                    print(f"{name} at {d:.0f} mm: not a disk (the grid estimate serves)")
-                    continue
-                dz = film_z - q.vertex_z[-1]
-                rel = []
-                for k in (0, 1, 9, len(levels) - 1):
-                    h = 1.02 * math.sqrt(norms[k] * dz * dz / (math.pi - norms[k]))
-                    rect = np.broadcast_to(np.array([-h, h, -h, h]), (2, 2, 4)).copy()
-                    b = PupilBounds(np.array([-1.0, 1.0]), np.array([-1.0, 1.0]), rect, float(q.vertex_z[-1]))
-                    cr = camera_rays(q, np.zeros((uv.shape[0], 2)), uv, film_z, bounds=b, stop_semi_diameter=float(levels[k]))
-                    rel.append(norms[k] / float(np.mean(np.where(cr.ok, cr.weight, 0.0))) - 1)
-                every += rel
-                print(f"{name}" + (f" zoom {zu}" if zu is not None else "") + f" at {d:.0f} mm: closed form / dense - 1 at "
-                      "the widest iris, the file's stop, levels 10 and last: " + ", ".join(f"{r:+.1e}" for r in rel), flush=True)
+        for zu, d, q, film_z, levels in round_states(name):
+            norms = _centre_disk_norms(q, film_z, levels, "numba")
+            if norms is None:
+                print(f"{name} at {d:.0f} mm: not a disk (the grid estimate serves)")
+                continue
+            dz = film_z - q.vertex_z[-1]
+            rel = []
+            for k in (0, 1, 9, len(levels) - 1):
+                h = 1.02 * math.sqrt(norms[k] * dz * dz / (math.pi - norms[k]))
+                rect = np.broadcast_to(np.array([-h, h, -h, h]), (2, 2, 4)).copy()
+                b = PupilBounds(np.array([-1.0, 1.0]), np.array([-1.0, 1.0]), rect, float(q.vertex_z[-1]))
+                cr = camera_rays(q, np.zeros((uv.shape[0], 2)), uv, film_z, bounds=b, stop_semi_diameter=float(levels[k]))
+                rel.append(norms[k] / float(np.mean(np.where(cr.ok, cr.weight, 0.0))) - 1)
+            every += rel
+            print(f"{name}" + (f" zoom {zu}" if zu is not None else "") + f" at {d:.0f} mm: closed form / dense - 1 at "
+                  "the widest iris, the file's stop, levels 10 and last: " + ", ".join(f"{r:+.1e}" for r in rel), flush=True)
     print(f"all: {len(every)} norms, closed form / dense - 1 from {min(every):+.1e} to {max(every):+.1e}")
 
 
