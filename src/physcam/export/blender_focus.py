@@ -360,7 +360,7 @@ def _centre_disk_norms(q, film_z: float, levels, backend: str) -> list[float] | 
     x = np.linspace(0.0, reach, _DISK_FAN + 1)
     p = passing(x)
     n = np.argmin(p, axis=1)  # per level the first aim that fails (0: the axis fails, or none does)
-    if (n == 0).any() or (np.arange(x.size)[None, :] < n[:, None]).__ne__(p).any():  # not one run from the axis
+    if (n == 0).any() or ((np.arange(x.size)[None, :] < n[:, None]) != p).any():  # not one run from the axis
         return None
     lo, hi = x[n - 1], x[n]
     rows = np.arange(s.size)
@@ -368,7 +368,7 @@ def _centre_disk_norms(q, film_z: float, levels, backend: str) -> list[float] | 
         xs = lo[:, None] + (hi - lo)[:, None] * (np.arange(1, _DISK_SPLIT) / _DISK_SPLIT)[None, :]
         p = passing(xs)
         k = np.argmin(np.concatenate([p, np.zeros((s.size, 1), dtype=bool)], axis=1), axis=1)  # the first that fails
-        if (np.arange(_DISK_SPLIT - 1)[None, :] < k[:, None]).__ne__(p).any():
+        if ((np.arange(_DISK_SPLIT - 1)[None, :] < k[:, None]) != p).any():
             return None
         edges = np.concatenate([lo[:, None], xs, hi[:, None]], axis=1)
         lo, hi = edges[rows, k], edges[rows, k + 1]
