@@ -31,28 +31,28 @@ def start() -> None:
 #: faulted in anew (57,000 minor faults, 0.2-0.25 s of system time); with 64 MB, 12 brk calls and 22,000
 #: faults, the same peak memory (docs/performance.md, issue 47 round 18).
 HEAP_TOP_PAD = 64 << 20
-_roomy = False
+_roomy: bool | None = None  # None: not asked yet in the program
 
 
 def roomy_heap() -> bool:
     """In the program only (:data:`RUNNING`; a library caller's allocator is left alone), on glibc:
     keep :data:`HEAP_TOP_PAD` bytes of freed memory at the heap's top (``mallopt(M_TOP_PAD)``) before
     an analysis makes its large arrays. Called by the analyses that do (ctypes, 4 ms to import, stays
-    off a report's path); once per process. True when the setting is in force."""
+    off a report's path); asked once per process, whatever the answer. True when the setting is in force."""
     global _roomy
-    if _roomy or not RUNNING:
-        return _roomy
+    if _roomy is not None or not RUNNING:
+        return bool(_roomy)
+    _roomy = False
     import os
     import sys
 
     try:
-        if not sys.platform.startswith("linux") or not os.confstr("CS_GNU_LIBC_VERSION").startswith("glibc"):
-            return False
-        import ctypes
+        if sys.platform.startswith("linux") and os.confstr("CS_GNU_LIBC_VERSION").startswith("glibc"):
+            import ctypes
 
-        _roomy = ctypes.CDLL("libc.so.6").mallopt(-2, HEAP_TOP_PAD) == 1  # M_TOP_PAD is -2 in glibc's malloc.h
+            _roomy = ctypes.CDLL("libc.so.6").mallopt(-2, HEAP_TOP_PAD) == 1  # M_TOP_PAD is -2 in glibc's malloc.h
     except (OSError, ValueError, AttributeError):
-        return False
+        pass
     return _roomy
 
 
