@@ -17,17 +17,21 @@ BLENDER_PY    := $(BLENDER_VENV)/bin/python
 BLENDER_STAMP := $(BLENDER_VENV)/.physcam-installed
 BPY_VERSION   ?= 5.0.1
 
-.PHONY: bytecode test-bytecode jit editables demo test venv blender blender-extension bench clean schema chromium shell test-latest latest-venv latest-run wheel usd-min lint
+.PHONY: bytecode test-bytecode jit editables demo test venv blender blender-extension bench clean schema chromium shell test-latest latest-venv latest-editable latest-run wheel usd-min lint
 
 # Installs go through uv (https://docs.astral.sh/uv/, installed into .venv by pip first): it resolves
 # the same versions as pip (constraints.txt) and installs them 2-3x faster, which the 15-minute CI
 # budget needs (docs/performance.md, "make test"). A user's own `pip install physcam` is unaffected.
 # --compile-bytecode, as pip does: under PYTHONDONTWRITEBYTECODE (CI sets it) every test's subprocess
 # would otherwise compile numpy, matplotlib and physcam's dependencies from source again (+185 s).
+# The environment is made without ensurepip's own pip install (7 s of the installs' critical path): the base
+# Python's pip puts uv in (pip >= 22.3's --python), and uv adds pip with the dependencies (DEPS), so .venv
+# still has its pip; where the base Python has no pip, ensurepip does as before.
 UV := $(VENV)/bin/uv
 $(PY):
-	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --disable-pip-version-check -c constraints.txt uv
+	$(PYTHON) -m venv --without-pip $(VENV)
+	$(PYTHON) -m pip --python $(PY) install --quiet --disable-pip-version-check -c constraints.txt uv 2>/dev/null \
+	  || { $(PY) -m ensurepip >/dev/null && $(PY) -m pip install --quiet --disable-pip-version-check -c constraints.txt uv; }
 
 # What scripts/compile_jit.py needs (numpy, numba; constraints.txt's versions) goes into .venv first, so the
 # JIT compile (the installs' longest step, ~52 s of one core) starts while the rest of .venv installs.
@@ -38,8 +42,16 @@ $(JIT_DEPS): $(PY) constraints.txt
 
 # The test environment gets the exact versions of constraints.txt (reproducible CI); the library's own
 # dependencies are ranges (pyproject.toml), so a studio can install physcam into its environment.
-$(STAMP): $(JIT_DEPS) pyproject.toml constraints.txt
-	$(UV) pip install --quiet --compile-bytecode --python $(PY) -c constraints.txt -e '.[test]'
+# An environment's dependencies go in first, read from pyproject.toml (uv: no build of the source tree, so
+# they install beside the other environments'), then physcam itself, editable and --no-deps (a few seconds):
+# two editable builds of one source tree must not run at once, and only these short steps take turns.
+DEPS := $(VENV)/.deps-installed
+$(DEPS): $(JIT_DEPS) pyproject.toml constraints.txt
+	$(UV) pip install --quiet --compile-bytecode --python $(PY) -c constraints.txt -r pyproject.toml --extra test pip
+	touch $(DEPS)
+
+$(STAMP): $(DEPS)
+	$(UV) pip install --quiet --compile-bytecode --python $(PY) --no-deps -e .
 	touch $(STAMP)
 
 venv: $(STAMP)
@@ -59,19 +71,27 @@ shell: $(STAMP)
 
 # Where bpy cannot be installed (another Python, another platform) the Blender tests skip and
 # pytest's summary says why; the rest of the suite runs. bpy (a 300 MB download) is fetched on its
-# own (BLENDER_BPY), so `make test` can fetch it while .venv installs; physcam's editable install
-# follows .venv's (two editable builds of one source tree must not run at once).
+# own (BLENDER_BPY), so `make test` can fetch it while .venv installs; then physcam's dependencies (the
+# `fast` extra; bpy's numpy stays) beside .venv's, and physcam's editable install after .venv's. uv
+# installs into it: it is made without pip.
 BLENDER_BPY := $(BLENDER_VENV)/.bpy-installed
+BLENDER_DEPS := $(BLENDER_VENV)/.deps-installed
 $(BLENDER_BPY): | $(PY)
-	@( $(PYTHON) -m venv $(BLENDER_VENV) \
+	@( $(PYTHON) -m venv --without-pip $(BLENDER_VENV) \
 	  && $(UV) pip install --quiet --compile-bytecode --python $(BLENDER_PY) "bpy==$(BPY_VERSION)" \
 	  && touch $(BLENDER_BPY) ) \
 	|| ( echo "physcam: Blender (bpy==$(BPY_VERSION)) could not be installed here; the Blender tests will be skipped" >&2; \
 	     rm -rf $(BLENDER_VENV) )
 
-$(BLENDER_STAMP): pyproject.toml $(STAMP) | $(BLENDER_BPY)
+$(BLENDER_DEPS): pyproject.toml | $(BLENDER_BPY) $(PY)
 	@if [ -f $(BLENDER_BPY) ]; then \
-	  $(UV) pip install --quiet --compile-bytecode --python $(BLENDER_PY) -e '.[fast]' && touch $(BLENDER_STAMP) \
+	  $(UV) pip install --quiet --compile-bytecode --python $(BLENDER_PY) -r pyproject.toml --extra fast && touch $(BLENDER_DEPS) \
+	  || { echo "physcam: physcam's dependencies could not be installed beside Blender; the Blender tests will be skipped" >&2; \
+	       rm -rf $(BLENDER_VENV); }; fi
+
+$(BLENDER_STAMP): pyproject.toml $(STAMP) | $(BLENDER_DEPS)
+	@if [ -f $(BLENDER_DEPS) ]; then \
+	  $(UV) pip install --quiet --compile-bytecode --python $(BLENDER_PY) --no-deps -e . && touch $(BLENDER_STAMP) \
 	  || { echo "physcam: physcam could not be installed beside Blender; the Blender tests will be skipped" >&2; \
 	       rm -rf $(BLENDER_VENV); }; fi
 
@@ -94,8 +114,8 @@ chromium:
 	  || echo "physcam: chromium could not be installed; the browser tests will be skipped" >&2; \
 	fi
 
-# The installs are mostly downloads and unpacking: they run side by side (.venv, bpy, chromium, the
-# newest-versions environment), then the suite.
+# The installs are mostly downloads and unpacking: they run side by side (the three environments'
+# dependencies, bpy, chromium, the JIT compile), then the suite.
 # (Three xdist workers on the two cores were slower: 792 s against 742 s, the Blender tests queued last.)
 # The oldest USD's and the newest versions' tests run beside the suite, niced, their output after the
 # suite's: no 45 s tail after it. The suite is CPU-bound most of the time, so they mostly take their CPU
@@ -103,16 +123,16 @@ chromium:
 # docs/performance.md, round 14.
 SIDE_LOG := .test-side.log
 test:
-	$(MAKE) --no-print-directory -j6 $(STAMP) $(BLENDER_BPY) chromium editables jit test-bytecode lint bytecode
+	$(MAKE) --no-print-directory -j6 $(STAMP) $(BLENDER_BPY) $(BLENDER_DEPS) latest-venv chromium editables jit test-bytecode lint bytecode
 	@rm -f $(SIDE_LOG); ( nice -n 10 $(MAKE) --no-print-directory -j2 usd-min latest-run > $(SIDE_LOG) 2>&1; \
 	  echo "side-rc=$$?" >> $(SIDE_LOG) ) & \
 	PHYSCAM_BLENDER_PYTHON=$(abspath $(BLENDER_PY)) $(PY) -m pytest -n 2 --dist worksteal -q; rc=$$?; \
 	wait; cat $(SIDE_LOG); grep -q '^side-rc=0$$' $(SIDE_LOG) && exit $$rc; exit 1
 
 # the editable installs one after the other (two builds of one source tree must not run at once): the
-# newest versions' environment, then physcam beside Blender
-editables: | $(STAMP) $(BLENDER_BPY)
-	$(MAKE) --no-print-directory latest-venv
+# newest versions' environment, then physcam beside Blender; a few seconds each (--no-deps)
+editables: | $(STAMP) $(BLENDER_DEPS) latest-venv
+	$(MAKE) --no-print-directory latest-editable
 	$(MAKE) --no-print-directory $(BLENDER_STAMP)
 
 # The oldest usd-core physcam supports, the `usd` extra's lower bound in pyproject.toml (the two must
@@ -137,19 +157,28 @@ usd-min: $(STAMP)
 # numba, USD, OpenTrackIO's schema and CBOR, finufft, OpenJD) that need no Blender, browser or renderer.
 # The on-set report and the lens readers (no numpy on their paths but lens comparison's and the pupil
 # plot's) are left to `make test`: the CI's 15-minute budget.
-# `make test` builds it (latest-venv) beside its other installs and runs it (latest-run) at the end.
+# `make test` makes it (latest-venv, then latest-editable) beside its other installs and runs it
+# (latest-run) beside the suite.
 LATEST_VENV ?= .venv-latest
 LATEST_PY   := $(LATEST_VENV)/bin/python
 test-latest:
 	$(MAKE) --no-print-directory latest-venv
+	$(MAKE) --no-print-directory latest-editable
 	$(MAKE) --no-print-directory latest-run
 
-# after .venv's install: two editable builds of one source tree must not run at once; uv installs into it,
-# so it is made without pip (ensurepip's own install of pip: 3-4 s of CPU)
-latest-venv: | $(STAMP)
+# The dependencies, newest versions, read from pyproject.toml: nothing is built from the source tree, so
+# this runs beside the other installs, after numba is in .venv and niced, so that the JIT compile (the
+# installs' longest step) starts and runs first. uv installs into it, so it is made without pip
+# (ensurepip's own install of pip: 3-4 s of CPU).
+latest-venv: | $(JIT_DEPS)
 	rm -rf $(LATEST_VENV)
 	$(PYTHON) -m venv --without-pip $(LATEST_VENV)
-	$(UV) pip install --quiet --compile-bytecode --python $(LATEST_PY) --upgrade -e '.[all]' pytest pytest-xdist hypothesis opencv-python-headless
+	nice -n 10 $(UV) pip install --quiet --compile-bytecode --python $(LATEST_PY) --upgrade -r pyproject.toml --extra all \
+	  pytest pytest-xdist hypothesis opencv-python-headless
+
+# physcam itself into it, after .venv's (two editable builds of one source tree must not run at once)
+latest-editable: | $(STAMP)
+	$(UV) pip install --quiet --compile-bytecode --python $(LATEST_PY) --no-deps -e .
 
 # The tree's JIT cache (trace/kernels/__pycache__) is shared with .venv's suite, which runs beside this:
 # under another numba version each would find the other's cache index stale and rewrite it, recompiling
