@@ -185,6 +185,7 @@ latest-editable: | $(STAMP)
 # the kernels by turns, so a numba other than .venv's gets a cache folder of its own.
 NUMBA_VERSION := import importlib.metadata as m; print(m.version("numba"))
 latest-run:
+	@$(LATEST_PY) scripts/compile_tests.py tests
 	@$(UV) pip list --python $(LATEST_PY) --format=freeze 2>/dev/null \
 	  | grep -i -E '^(numpy|numba|matplotlib|usd-core|openexr|jsonschema|cbor2|dask|pyarrow|starlette|uvicorn|openjd-model|opencue.pyoutline)=' \
 	  | tr '\n' ' ' | sed 's/^/physcam: newest versions tested: /'; echo
@@ -212,7 +213,7 @@ bytecode: $(STAMP)
 
 # the tests' bytecode, with pytest's assertion rewriting, written once before the suite: under
 # PYTHONDONTWRITEBYTECODE each xdist worker rewrote and compiled every test module again (14 s CPU of a
-# worker's 24 s collection; scripts/compile_tests.py says more)
+# worker's 24 s collection), and every pytest process its plugins' modules (3 s; scripts/compile_tests.py)
 test-bytecode: $(STAMP)
 	$(PY) scripts/compile_tests.py tests
 
