@@ -10,8 +10,13 @@ scheduler: the receive path's own CPU), then the samples it delivers become fram
 and written (:func:`~physcam.live.record.write_recording_usd`, :func:`~physcam.live.record.write_lens_report`).
 Prints CPU microseconds per sample of each step (the best of ``--repeat`` runs of the receive step);
 ``--out DIR`` keeps the take (take.usdc, take.csv) to compare two trees' bytes with ``cmp``.
+``--receive-only`` stops after the receive step, and ``--repeat 0`` before it (after the warm-up): the
+difference of two runs under ``valgrind --tool=callgrind`` (``PYTHONHASHSEED=0``) is the receive step's
+instruction count, which the machine's load does not change; ``--stream FILE`` keeps the datagrams
+(pickled; made when absent), so those runs do not build the stream under valgrind.
 
     PYTHONPATH=src .venv/bin/python benchmarks/live_receive.py [--samples 2000] [--repeat 3] [--out DIR]
+        [--receive-only] [--stream FILE]
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
+import pickle
 import random
 import tempfile
 import time
@@ -89,13 +95,25 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=2000)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--out", help="keep the take here (take.usdc, take.csv)")
+    ap.add_argument("--receive-only", action="store_true", help="stop after the receive step")
+    ap.add_argument("--stream", help="the datagrams and samples, pickled here (made when absent)")
     args = ap.parse_args()
     from physcam.live.frames import frame_from_sample
     from physcam.live.record import solve_frames, write_lens_report, write_recording_usd
 
     n = args.samples
-    datagrams, samples = stream(n)
+    if args.stream and os.path.exists(args.stream):
+        with open(args.stream, "rb") as f:
+            datagrams, samples = pickle.load(f)
+    else:
+        datagrams, samples = stream(n)
+        if args.stream:
+            with open(args.stream, "wb") as f:
+                pickle.dump((datagrams, samples), f)
+    n = len(samples)
     receive(datagrams[:200], n)  # imports, the compiled schema and jsonschema's validator: once a process
+    if args.repeat == 0:
+        return
     clock, cpu = time.process_time, {}
     best = None
     for _ in range(args.repeat):
@@ -104,6 +122,9 @@ def main() -> None:
         best = min(best or 1e9, clock() - t)
     assert [s["sampleId"] for s in got] == [s["sampleId"] for s in samples], counters
     cpu["receive (parse, reassemble, decode, validate, order)"] = best
+    if args.receive_only:
+        print(f"{n} samples, {len(datagrams)} datagrams; receive {best / n * 1e6:.1f} us a sample")
+        return
     t = clock()
     frames, static = [], None
     for s in got:
