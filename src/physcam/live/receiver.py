@@ -27,9 +27,9 @@ lay behind, **stray** if ahead.
 Conflicts: UDP cannot be authenticated, so a different valid sample may claim a number its source has
 used (a forged or replayed copy). A digest of each source's last ``HANDED_MEMORY`` (64) samples handed
 on is kept (their content, whatever the encoding; made when a number is disputed, from the sample's
-payload, which is kept till then when it is at most ``LAZY_DIGEST_BYTES``, 4 KiB: a digest made for
-every sample cost a tenth of its receiving); a different valid sample for one of those numbers,
-or for one waiting in the window, is counted **conflict** (never late) and handed on flagged
+payload, kept till then when it is at most ``LAZY_DIGEST_BYTES``, 4 KiB: made for every sample, as
+sorted JSON, it was a large part of receiving one); a different valid sample for one of those
+numbers, or for one waiting in the window, is counted **conflict** (never late) and handed on flagged
 (:attr:`ReceivedSample.conflict`) after the sample it disputes, for the take to judge
 (:mod:`physcam.live.take`, "Conflicts").
 
@@ -46,8 +46,8 @@ Memory is bounded whatever arrives: one 64 KiB receive buffer; reassembly of at 
 ``max_pending`` (16) unfinished samples of 64 KiB each with an 8 KiB map (1.125 MiB,
 :class:`~physcam.live.protocol.Reassembler`); the keys of the last 4,096 datagrams (duplicates);
 at most 16 sources, each holding ``reorder_window`` samples in its window and as many in a run; and
-``queue_size`` samples in the queue; for the digests, up to 64 payloads of at most 4 KiB per source (4 MiB). :meth:`Receiver.stop` (or leaving the ``with`` block) ends the
-thread and closes the socket.
+``queue_size`` samples in the queue; for the digests, up to 64 payloads of at most 4 KiB per source
+(4 MiB). :meth:`Receiver.stop` (or leaving the ``with`` block) ends the thread and closes the socket.
 """
 
 from __future__ import annotations
