@@ -573,3 +573,26 @@ def test_a_flood_of_forged_copies_of_one_number_is_counted_and_bounded():
     assert [i.sample["sampleId"] for i in got if not i.conflict] == [s["sampleId"] for s in good], c
     assert [i.sample["sampleId"][-2:] for i in got if i.conflict] == ["00", "01", "02", "03"]
     assert c["conflict"] == 10 and c["late"] == 0 and c["delivered"] == 5
+
+
+def test_a_sample_handed_on_and_sent_again_in_another_encoding_is_no_conflict():
+    """Sample 2 arrives as CBOR with its f-stop and focus as CBOR decimal fractions (read as the floats
+    2.8 and the mark's metres), is handed on, and comes again as JSON with the same numbers: the copy is
+    the same content, so it is no conflict (counted late: its number was handed on), and nothing is
+    handed on twice. The handed-on sample's digest is made only when the copy disputes its number, from
+    its payload (receiver.LAZY_DIGEST_BYTES): read again, its decimals become the same floats."""
+    from decimal import Decimal
+
+    good = _samples(5)
+    as_decimals = copy.deepcopy(good[2])
+    as_decimals["lens"]["fStop"] = Decimal(repr(good[2]["lens"]["fStop"]))
+    as_decimals["lens"]["focusDistance"] = Decimal(repr(good[2]["lens"]["focusDistance"]))
+    order = [("tx", _datagrams(good[i], i)) for i in (0, 1)] + [("tx", _datagrams(as_decimals, 2, "cbor"))] + \
+        [("tx", _datagrams(good[3], 3)), ("tx", _datagrams(good[2], 2)), ("tx", _datagrams(good[4], 4))]
+    with Receiver(0, host="127.0.0.1", reorder_timeout_s=5.0) as rx:
+        got = _stream(rx, order)
+        _drain(rx, got, 5, timeout=1.0)
+        c = rx.counters()
+    assert [(i.sample["sampleId"], i.conflict) for i in got] == [(s["sampleId"], False) for s in good], c
+    assert got[2].sample["lens"]["fStop"] == good[2]["lens"]["fStop"]  # the decimal, read as the float sent
+    assert c["conflict"] == 0 and c["late"] == 1 and c["delivered"] == 5 and c["missing"] == 0, c

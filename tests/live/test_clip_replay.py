@@ -20,7 +20,7 @@ import pytest
 
 from physcam.cli import main
 from physcam.live.sample import decode_sample
-from _udp import free_port, needs_proc_net_udp, wait_for_port
+from _udp import needs_proc_net_udp, recorder_port
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "camera-metadata"
 ARRI = DATA / "arri" / "B001C001_180327_R1ZA.mov.csv"
@@ -44,12 +44,11 @@ def _red_columns():
 def _record(tmp_path, count, send_args, *record_args):
     """Start `live record` for ``count`` samples, run ``send_args`` (a physcam command line, in this
     process) at its port, and return the lens report's rows."""
-    port = free_port()
     out, rep = tmp_path / "take.usda", tmp_path / "take.csv"
-    proc = subprocess.Popen([sys.executable, "-m", "physcam", "live", "record", str(out), "--port", str(port),
+    proc = subprocess.Popen([sys.executable, "-m", "physcam", "live", "record", str(out), "--port", "0",
                              "--host", "127.0.0.1", "--count", str(count), "--duration", "60", "--report", str(rep),
                              "--json", *record_args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    wait_for_port(proc, port)
+    port, _ = recorder_port(proc)
     assert main([*send_args, "--port", str(port), "--cbor"]) == 0
     stdout, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 0, stderr

@@ -37,7 +37,7 @@ from physcam.live.record import solve_frames
 from physcam.live.sample import SampleError, decode_sample
 from physcam.live.sender import Sender
 from physcam.optics.sensors import find_sensor
-from _udp import free_port, needs_proc_net_udp, wait_for_port, wait_until_read
+from _udp import needs_proc_net_udp, recorder_port, wait_until_read
 
 SID_A = "urn:uuid:0a0a0a0a-0000-4000-8000-00000000000a"
 SID_B = "urn:uuid:0b0b0b0b-0000-4000-8000-00000000000b"
@@ -71,27 +71,29 @@ def _send_raw(sock, port, payload: bytes, seq: int, encoding: str) -> None:
 
 
 class _Recorder:
-    """A `physcam live record take.usda` process on a free loopback port, killed whatever fails."""
+    """A `physcam live record take.usda` process on the loopback port the system gives it (``--port 0``;
+    :func:`_udp.recorder_port`), killed whatever fails. ``stderr`` is what it said besides its port."""
 
     def __init__(self, folder: Path, *args, argv_prefix=(), env=None, out=None):
-        self.port = free_port()
+        self.port, self.said = None, ""
         self.out = out or folder / "take.usda"
         self.proc = subprocess.Popen([*argv_prefix, sys.executable, "-m", "physcam", "live", "record", str(self.out),
-                                      "--port", str(self.port), "--host", "127.0.0.1", "--duration", "120", *args],
+                                      "--port", "0", "--host", "127.0.0.1", "--duration", "120", *args],
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=folder, env=env)
 
     def __enter__(self):
         return self
 
     def wait_for_port(self):
-        wait_for_port(self.proc, self.port)
+        self.port, self.said = recorder_port(self.proc)
         return self
 
     def finish(self, sig=None):
         if sig is not None:
             wait_until_read(self.proc, self.port)
             self.proc.send_signal(sig)
-        self.stdout, self.stderr = self.proc.communicate(timeout=120)
+        self.stdout, stderr = self.proc.communicate(timeout=120)
+        self.stderr = self.said + stderr
         return self.proc.returncode
 
     def __exit__(self, *exc):
@@ -352,7 +354,7 @@ def test_a_killed_recorder_keeps_its_take_and_recover_writes_it(tmp_path, capsys
 
     monkeypatch.chdir(tmp_path)
     capsys.readouterr()
-    assert main(["live", "record", "take.usda", "--port", str(free_port()), "--host", "127.0.0.1",
+    assert main(["live", "record", "take.usda", "--port", "0", "--host", "127.0.0.1",
                  "--duration", "0.2"]) == 2  # nothing arrives; it says where the unfinished take is
     err = capsys.readouterr().err
     assert f"an unfinished take is kept in {journal.name}: `physcam live recover {journal.name}`" in err

@@ -23,7 +23,7 @@ from physcam.lens.library import load_lens
 from physcam.lens.zoom import prescription_at
 from physcam.optics.focusing import technical_planes
 from physcam.optics.zoom import efl_at, encoder_for_focal_length
-from _udp import free_port, needs_proc_net_udp, wait_for_port
+from _udp import needs_proc_net_udp, recorder_port
 
 CANON = "canon_ef_70_200mm_f2_8_zoom"
 
@@ -113,12 +113,11 @@ def test_the_recorder_solves_a_frame_that_sends_only_the_zoom_encoder(capsys):
 def test_a_focus_and_zoom_pull_comes_back_through_live_record(tmp_path):
     pytest.importorskip("pxr")
     lens = load_lens(CANON)
-    port = free_port()
     out, rep = tmp_path / "take.usda", tmp_path / "take.csv"
-    proc = subprocess.Popen([sys.executable, "-m", "physcam", "live", "record", str(out), "--port", str(port),
+    proc = subprocess.Popen([sys.executable, "-m", "physcam", "live", "record", str(out), "--port", "0",
                              "--host", "127.0.0.1", "--count", "4", "--duration", "60", "--report", str(rep),
                              "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    wait_for_port(proc, port)
+    port, _ = recorder_port(proc)
     assert main(["live", "send", *PULL, "--port", str(port), "--cbor"]) == 0
     stdout, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 0, stderr

@@ -269,6 +269,9 @@ def run_record(args) -> int:
     try:
         with StopSignals() as stop:
             with receiver:
+                if args.port == 0:  # the system chose the port: say which, for the senders (and scripts)
+                    print(f"physcam: listening on UDP {group or args.host}:{receiver.port}", file=sys.stderr,
+                          flush=True)
                 interrupted = _receive(args, receiver, rec, stop)
             stop.restore("SIGINT")  # a second Ctrl-C while writing aborts; SIGTERM and SIGHUP wait for the file
             while (item := receiver.get()) is not None and not rec.take.full:  # samples still queued

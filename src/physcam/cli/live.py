@@ -52,7 +52,8 @@ def _count(text):
 
 
 def _network_args(p, *, receive: bool) -> None:
-    p.add_argument("--port", type=_port, default=55555, help="UDP port (default 55555, OpenTrackIO's)")
+    p.add_argument("--port", type=_port, default=55555,
+                   help="UDP port (default 55555, OpenTrackIO's)" + ("; 0: a free one, said on stderr" if receive else ""))
     p.add_argument("--multicast", type=whole("multicast source number", lo=0), default=None, metavar="N",
                    help="use the multicast group 239.135.1.N of source number N instead of unicast")
     p.add_argument("--interface", default="127.0.0.1",

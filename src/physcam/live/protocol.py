@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import struct
 from dataclasses import dataclass
+from itertools import accumulate
 
 import numpy as np
 
@@ -116,9 +117,8 @@ def _sums(parts) -> tuple[int, int]:
     s1 = s2 = 0
     for part in parts:
         if len(part) <= 64:  # a header: plain Python beats numpy's call overhead
-            b = bytes(part)
-            n = len(b)
-            s1, s2 = s1 + sum(b), s2 + n * s1 + sum((n - i) * v for i, v in enumerate(b))
+            b = bytes(part)  # sum((n - i) d_i) is the sum of the n prefix sums d_0 + ... + d_k
+            s1, s2 = s1 + sum(b), s2 + len(b) * s1 + sum(accumulate(b))
             continue
         d = np.frombuffer(part, dtype=np.uint8)
         for start in range(0, d.size, _CHUNK):

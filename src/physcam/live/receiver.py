@@ -26,8 +26,10 @@ lay behind, **stray** if ahead.
 
 Conflicts: UDP cannot be authenticated, so a different valid sample may claim a number its source has
 used (a forged or replayed copy). A digest of each source's last ``HANDED_MEMORY`` (64) samples handed
-on is kept (their content, whatever the encoding); a different valid sample for one of those numbers,
-or for one waiting in the window, is counted **conflict** (never late) and handed on flagged
+on is kept (their content, whatever the encoding; made when a number is disputed, from the sample's
+payload, kept till then when it is at most ``LAZY_DIGEST_BYTES``, 4 KiB: made for every sample, as
+sorted JSON, it was a large part of receiving one); a different valid sample for one of those
+numbers, or for one waiting in the window, is counted **conflict** (never late) and handed on flagged
 (:attr:`ReceivedSample.conflict`) after the sample it disputes, for the take to judge
 (:mod:`physcam.live.take`, "Conflicts").
 
@@ -44,8 +46,8 @@ Memory is bounded whatever arrives: one 64 KiB receive buffer; reassembly of at 
 ``max_pending`` (16) unfinished samples of 64 KiB each with an 8 KiB map (1.125 MiB,
 :class:`~physcam.live.protocol.Reassembler`); the keys of the last 4,096 datagrams (duplicates);
 at most 16 sources, each holding ``reorder_window`` samples in its window and as many in a run; and
-``queue_size`` samples in the queue. :meth:`Receiver.stop` (or leaving the ``with`` block) ends the
-thread and closes the socket.
+``queue_size`` samples in the queue; for the digests, up to 64 payloads of at most 4 KiB per source
+(4 MiB). :meth:`Receiver.stop` (or leaving the ``with`` block) ends the thread and closes the socket.
 """
 
 from __future__ import annotations
@@ -77,6 +79,8 @@ _DUPLICATE_MEMORY = 4096  # keys of the last datagrams accepted, to know a repea
 _EXPIRE_EVERY_S = 0.005
 #: sequence numbers per source whose handed-on sample is remembered (a digest), to know a rival claimant
 HANDED_MEMORY = 64
+#: a handed-on sample's payload up to this size is kept for its digest, made only if its number is disputed
+LAZY_DIGEST_BYTES = 4096
 #: rival claimants held per number while it waits in the window (more are counted, not handed on)
 MAX_RIVALS = 4
 #: the reasons kept for refused payloads (:meth:`Receiver.refusals`); the counters count them all
@@ -328,7 +332,7 @@ class Receiver:
             if key in self._streams:  # its number is held as a gap a valid sample may still fill (a forged or
                 self._place(key, header.sequence, None, now)  # corrupt copy must not cost the real frame)
             return
-        self._place(key, header.sequence, ReceivedSample(obj, 0, enc, now), now)
+        self._place(key, header.sequence, _Arrived(obj, 0, enc, now, payload=payload), now)
 
     def _note(self, sequence: int, addr, problem) -> None:
         """Keep the reason a payload was refused, the first MAX_REFUSALS_NOTED of them (one line each)."""
@@ -405,9 +409,9 @@ class Receiver:
                 if self._rival(st, ext, item):
                     self._count("conflict")
                     if len(st.handed[ext]) <= MAX_RIVALS:  # more are counted, not handed on (bounded)
-                        st.handed[ext] += (_digest(item),)
+                        st.handed[ext] = _handed(st, ext) + (_digest(item),)
                         self._hand_on(item, ext, conflict=True)
-                elif ext < st.next and _digest(item) in st.handed.get(ext, ()):
+                elif ext < st.next and _digest(item) in _handed(st, ext):
                     self._count("duplicate")  # a sample handed on already, in another encoding
                 else:
                     self._count("late" if ext < st.next else "stray")
@@ -416,7 +420,7 @@ class Receiver:
     @staticmethod
     def _rival(st: "_Stream", ext: int, item) -> bool:
         """Whether ``item`` is a different sample for the number ``ext`` that this source handed on lately."""
-        return ext < st.next and ext in st.handed and _digest(item) not in st.handed[ext]
+        return ext < st.next and ext in st.handed and _digest(item) not in _handed(st, ext)
 
     def _resync(self, st: "_Stream", now: float) -> None:
         """The run becomes the stream: hand on what the window holds, then number from the run's first."""
@@ -444,7 +448,10 @@ class Receiver:
         stamp = _stamp(item)
         if stamp is not None:
             st.stamp = stamp if st.stamp is None else max(st.stamp, stamp)
-        st.handed[ext] = (_digest(item), *map(_digest, rivals))
+        payload = getattr(item, "payload", None)  # its digest made when asked (_handed), the payload kept till then
+        first = _Later(payload, item.encoding) if payload is not None and len(payload) <= LAZY_DIGEST_BYTES \
+            else _digest(item)
+        st.handed[ext] = (first, *map(_digest, rivals))
         if len(st.handed) > HANDED_MEMORY:
             del st.handed[next(iter(st.handed))]
         if self._hand_on(item, ext):
@@ -502,6 +509,7 @@ class _Stream:
         # (seq, number, arrival, item, counted late already)
         self.stamp: int | None = None  # the newest sampleTimestamp handed on (ns)
         self.handed: dict[int, tuple] = {}  # number -> digests of the samples handed on, the last HANDED_MEMORY
+        # (the first a _Later until it is asked for: _handed)
         self.rivals: dict[int, list] = {}  # number in the window -> other valid samples claiming it
 
 
@@ -516,7 +524,44 @@ def _source_key(obj) -> tuple:
 
 def _digest(item) -> int:
     """A digest of a sample's content, whatever its encoding (JSON or CBOR of one sample digest alike)."""
-    return hash(json.dumps(item.sample, sort_keys=True, separators=(",", ":"), default=repr))
+    return _content_digest(item.sample)
+
+
+def _content_digest(sample) -> int:
+    return hash(json.dumps(sample, sort_keys=True, separators=(",", ":"), default=repr))
+
+
+@dataclass(frozen=True)
+class _Arrived(ReceivedSample):
+    """A valid sample as the receiver holds it until it is handed on: with its payload (for :class:`_Later`)."""
+
+    payload: bytes | None = None
+
+
+class _Later:
+    """The digest of a handed-on sample, made from its payload when first asked (:func:`_handed`)."""
+
+    __slots__ = ("payload", "encoding")
+
+    def __init__(self, payload: bytes, encoding: str):
+        self.payload, self.encoding = payload, encoding
+
+    def digest(self) -> int:
+        """The sample's digest as :func:`_digest` made it when it was handed on: the payload decoded and
+        checked again (a valid sample; the check turns CBOR's decimals and fractions into floats, in place,
+        as it did then)."""
+        sample = decode_sample(self.payload, self.encoding, validate=False)
+        sample_problems(sample)
+        return _content_digest(sample)
+
+
+def _handed(st: "_Stream", ext: int) -> tuple:
+    """The digests of the samples ``st`` handed on for number ``ext`` (empty if none), the first made now
+    if it was left for later."""
+    got = st.handed.get(ext, ())
+    if got and isinstance(got[0], _Later):
+        got = st.handed[ext] = (got[0].digest(), *got[1:])
+    return got
 
 
 def _stamp(item) -> int | None:

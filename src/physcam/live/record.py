@@ -550,6 +550,15 @@ def _sample_frames(stage, cam, path, solved, samples, mpu, tcps, shutter, resolu
     companion, companion_attrs = geom.GetPrim(), {}
     omni = None
     c = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, -1.0, 0]])  # OpenTrackIO stage -> USD Y-up
+    arrays: dict = {}  # a take names the same few carried or defaulted values frame after frame
+
+    def names_array(names: tuple):
+        """``Vt.StringArray(list(names))``, one per distinct tuple (each time sample is copied from it)."""
+        a = arrays.get(names)
+        if a is None:
+            a = arrays[names] = Vt.StringArray(list(names))
+        return a
+
     for s in solved:
         f, t, report = s.frame, s.time_code, s.report
         spec = spec_from_report(report, shutter_duration_s=shutter, shift_mm=_shift(s))
@@ -588,8 +597,8 @@ def _sample_frames(stage, cam, path, solved, samples, mpu, tcps, shutter, resolu
             put(a_tc, f.timecode, t)
         if f.source_id is not None:
             put(a_src, str(f.source_id), t)
-        put(a_carried, Vt.StringArray(list(s.carried)), t)
-        put(a_default, Vt.StringArray(list(s.defaulted)), t)
+        put(a_carried, names_array(s.carried), t)
+        put(a_default, names_array(s.defaulted), t)
         if f.distortion is not None:
             d = f.distortion
             put(a_model, str(d.get("model", "Brown-Conrady D-U")), t)

@@ -327,12 +327,16 @@ def _cut(message: str) -> str:
 def _timecode_problems(sample) -> list[SampleProblem]:
     """A valid sample's timecode counting a frame its own rate never reaches: frames must be below
     ceil(frameRate) (camdkit's ``Timecode`` model refuses the rest; the schema alone allows 0-119)."""
-    from fractions import Fraction
-
     tc = sample.get("timing", {}).get("timecode")
     if not tc:
         return []
-    limit = math.ceil(Fraction(tc["frameRate"]["num"], tc["frameRate"]["denom"]))
+    num, denom = tc["frameRate"]["num"], tc["frameRate"]["denom"]
+    if type(num) is int and type(denom) is int:
+        limit = -(-num // denom)  # ceil(num / denom) in integers, without a Fraction made per sample
+    else:  # the schema's integers written as floats (30.0): as before
+        from fractions import Fraction
+
+        limit = math.ceil(Fraction(num, denom))
     if tc["frames"] >= limit:
         return [SampleProblem("$.timing.timecode.frames", "frameRate",
                               f"frame {tc['frames']} does not exist at {limit} frames a second (0 to {limit - 1})")]
