@@ -33,14 +33,15 @@ _GRID = 36  # aim samples across a grid (half as many across its y >= 0 half)
 
 class _StopCrossing:
     """Stands in for the iris shape in physcam's tracer (which calls ``density_at`` with every ray's
-    place on the stop's unit disk, then traces on): keeps each ray's radius there and passes them all."""
+    place on the stop's unit disk, then traces on): keeps each ray's radius there and passes them all (a
+    density of 1.0: the tracer leaves the rays as they are)."""
 
     def __init__(self):
         self.radius = self.x = self.y = None
 
     def density_at(self, x, y):
         self.x, self.y, self.radius = x, y, np.hypot(x, y)
-        return np.ones_like(self.radius)
+        return 1.0
 
 
 def _aims(q, film_z: float, fx, px, py, big: float, backend: str):
