@@ -33,14 +33,15 @@ _GRID = 36  # aim samples across a grid (half as many across its y >= 0 half)
 
 class _StopCrossing:
     """Stands in for the iris shape in physcam's tracer (which calls ``density_at`` with every ray's
-    place on the stop's unit disk, then traces on): keeps each ray's radius there and passes them all."""
+    place on the stop's unit disk, then traces on): keeps each ray's radius there and passes them all (a
+    density of 1.0: the tracer leaves the rays as they are)."""
 
     def __init__(self):
         self.radius = self.x = self.y = None
 
     def density_at(self, x, y):
         self.x, self.y, self.radius = x, y, np.hypot(x, y)
-        return np.ones_like(self.radius)
+        return 1.0
 
 
 def _aims(q, film_z: float, fx, px, py, big: float, backend: str):
@@ -527,17 +528,19 @@ class _LineSets:
         # they doubt (the grids take those)
         self.radii = radii
         self.held, self.mean, doubt = self._rim_t(radii)
-        doubt = (doubt > _LINE_DOUBT).any(axis=1)  # (points, radii)
+        doubt = doubt.any(axis=1)  # (points, radii)
         self.first = np.maximum(self.first, np.where(doubt.any(axis=1), radii.size - np.argmax(doubt[:, ::-1], axis=1), 0))
 
     def _rim_t(self, s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(held t, mean t, doubt): per film point, line and iris radius of ``s``, where the rim crosses the line
-        (held: a cut line's far end; mean: its middle) and the interpolation's doubt (relative, in t)."""
+        (held: a cut line's far end; mean: its middle) and whether the interpolation is doubtful there (the two
+        quadratics about it differ by over :data:`_LINE_DOUBT` of t, or by an unknown share)."""
         s = np.asarray(s, dtype=float)
         n_points, n_lines, n_samples = self.t.shape
         lines = n_points * n_lines
         if not lines:  # no film point on lines
-            return (np.zeros((n_points, n_lines, s.size)),) * 3
+            return np.zeros((n_points, n_lines, s.size)), np.zeros((n_points, n_lines, s.size)), np.zeros(
+                (n_points, n_lines, s.size), dtype=bool)
         with np.errstate(divide="ignore", invalid="ignore"):
             lt, lr = np.log(self.t).reshape(lines, -1), np.log(self.r).reshape(lines, -1)
             # Newton's divided differences of log t in log r of every three samples in a row (empty slots: nan)
@@ -554,29 +557,44 @@ class _LineSets:
         pos = np.searchsorted(w, (band + np.minimum(lr, _BAND / 4)).ravel(), side="right").reshape(lines, -1)
         pos -= line * s.size  # per sample, how many of its line's log s lie at or under its log r
         count = np.bincount((line * (s.size + 1) + pos).ravel(), minlength=lines * (s.size + 1)).reshape(lines, -1)
-        j = np.empty((lines, s.size), dtype=np.int64)
-        j[:, o] = np.cumsum(count, axis=1)[:, :s.size]
-        n = self.n.reshape(lines, 1)
+        j = np.empty((lines, s.size), dtype=np.int32)
+        j[:, o] = np.cumsum(count, axis=1, dtype=np.int32)[:, :s.size]
+        n = self.n.reshape(lines, 1).astype(np.int32)
         beyond = j >= n  # past the last passing sample: the clip edge (every line is cut or reaches s)
+        under = j == 0  # under the first sample
         # per line and first sample a of three in a row: log t_a, log r_a, the divided differences and log r_a+1
         m = n_samples - 2
         coef = np.stack([lt[:, :m], lr[:, :m], d01[:, :m], lr[:, 1:m + 1], d012]).reshape(5, -1)
+        base, top = (line * m).astype(np.int32), n - 3
 
-        def quad(a):  # Lagrange's quadratic of log t in log r through the samples a, a + 1, a + 2 of each line
-            lt_a, lr_a, d01_a, lr_b, d012_a = np.take(coef, (line * m + a).ravel(), axis=1).reshape(5, lines, -1)
-            return lt_a + (ls - lr_a) * (d01_a + (ls - lr_b) * d012_a)
+        def quad(shift):  # Lagrange's quadratic of log t in log r through the samples a, a + 1, a + 2 of each line
+            # (a = j - shift held to 0..n - 3), in place in the gathered rows: the same IEEE operations as
+            # lt_a + (ls - lr_a) * (d01_a + (ls - lr_b) * d012_a)
+            a = j - np.int32(shift)
+            np.maximum(a, 0, out=a)
+            np.minimum(a, top, out=a)
+            a += base
+            lt_a, lr_a, d01_a, lr_b, d012_a = np.take(coef, a.ravel(), axis=1).reshape(5, lines, -1)
+            u = np.subtract(ls, lr_b, out=lr_b)
+            u *= d012_a
+            u += d01_a
+            u *= np.subtract(ls, lr_a, out=lr_a)
+            u += lt_a
+            return u
 
         with np.errstate(invalid="ignore", over="ignore"):
             # the two samples about s and the next one out (in at the line's last), and the one in instead: where
             # the two quadratics differ the curve bends too fast for the samples (r flattens toward a clip)
-            q1, q2 = quad(np.clip(j - 1, 0, n - 3)), quad(np.clip(j - 2, 0, n - 3))
-            t_iris = np.where(j == 0, np.exp(lt[:, :1] + ls - lr[:, :1]), np.exp(q1))  # under the first: r ~ t
-            doubt = np.where((j == 0) | beyond, 0.0, np.abs(np.expm1(q2 - q1)))
+            q1, q2 = quad(1), quad(2)
+            d = np.subtract(q2, q1, out=q2)
+            np.abs(np.expm1(d, out=d), out=d)
+            doubt = ~(d <= _LINE_DOUBT) & ~(under | beyond)  # nan and inf doubted too
+            t_iris = np.exp(np.where(under, lt[:, :1] + ls - lr[:, :1], q1))  # under the first: r ~ t
         shape = (n_points, n_lines, s.size)
         t_iris, doubt, beyond = t_iris.reshape(shape), doubt.reshape(shape), beyond.reshape(shape)
         held = np.where(beyond, self.hi[..., None], t_iris)
         mean = np.where(beyond, 0.5 * (self.lo[..., None] + self.hi[..., None]), t_iris)
-        return held, mean, np.where(np.isfinite(doubt), doubt, np.inf)
+        return held, mean, doubt
 
     def rims(self, s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(x, y, area): per film point served and iris radius of ``s`` (radii the sets were traced for), the rim's

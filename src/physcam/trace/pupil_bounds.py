@@ -159,14 +159,14 @@ def _mirrored(quarter: np.ndarray) -> np.ndarray:
 
 class _StopCrossing:
     """An iris shape for the tracer (``density_at`` gets every ray's crossing on the stop's unit disk)
-    that keeps the crossings and passes every ray."""
+    that keeps the crossings and passes every ray (a density of 1.0: the tracer leaves the rays as they are)."""
 
     def __init__(self):
         self.x = self.y = None
 
     def density_at(self, x, y):
         self.x, self.y = x, y
-        return np.ones_like(x)
+        return 1.0
 
 
 def iris_camera_rays(lens, film_xy, pupil_samples, film_z: float, stop_semi_diameter, *, bounds=None,

@@ -145,7 +145,9 @@ def trace_through(
 
     ``aperture`` (an :class:`~physcam.trace.aperture.Aperture`, seed 002) shapes the stop: rays
     are traced to the stop, masked and weighted there by the aperture density on the stop's
-    unit disk, then traced on. ``in_place`` traces ``rays`` itself instead of a copy.
+    unit disk, then traced on (a density of the float 1.0, a clear stop, leaves them as they are: a weight of 1
+    changes none, and the kernel flags a live ray whose weight is not finite). ``in_place`` traces ``rays``
+    itself instead of a copy.
     Rays in float32 (:meth:`RayBatch.astype`) are traced in single precision (docs/ray-tracing.md).
     Returns the rays after the last surface (or on the end plane) with flags and weights.
     """
@@ -172,6 +174,8 @@ def trace_through(
     _run(kernel, out, packed, slice(0, k + 1), clip, fresnel, None, chunk_size)
     rstop = packed.table.semi_diameter[k]
     dens = aperture.density_at(out.x / rstop, out.y / rstop)
+    if type(dens) is float and dens == 1.0:  # a clear stop (a probe recording the crossings): the rays as they are
+        return _run(kernel, out, packed, slice(k + 1, None), clip, fresnel, end_z, chunk_size)
     live = out.flag == OK
     out.scale_weight(dens[live], live)  # polarisation-blind: scales the s and p halves alike
     blocked = live & ~((dens > 0.0) & np.isfinite(out.weight) & np.isfinite(out.weight_sp))
