@@ -167,13 +167,13 @@ test-latest:
 	$(MAKE) --no-print-directory latest-run
 
 # The dependencies, newest versions, read from pyproject.toml: nothing is built from the source tree, so
-# this runs beside the other installs, after numba is in .venv and niced, so that the JIT compile (the
-# installs' longest step) starts and runs first. uv installs into it, so it is made without pip
-# (ensurepip's own install of pip: 3-4 s of CPU).
+# this runs beside the other installs, after numba is in .venv, so that the JIT compile (the installs'
+# longest step) starts first (not niced: the suite waits for its editable step). uv installs into it, so
+# it is made without pip (ensurepip's own install of pip: 3-4 s of CPU).
 latest-venv: | $(JIT_DEPS)
 	rm -rf $(LATEST_VENV)
 	$(PYTHON) -m venv --without-pip $(LATEST_VENV)
-	nice -n 10 $(UV) pip install --quiet --compile-bytecode --python $(LATEST_PY) --upgrade -r pyproject.toml --extra all \
+	$(UV) pip install --quiet --compile-bytecode --python $(LATEST_PY) --upgrade -r pyproject.toml --extra all \
 	  pytest pytest-xdist hypothesis opencv-python-headless
 
 # physcam itself into it, after .venv's (two editable builds of one source tree must not run at once)
