@@ -263,7 +263,7 @@ def fit_title(text: str, width_in: float, *, fontsize: float | None = None, weig
     Greedy: a line takes words while it fits. A run of a line's glyphs is never wider than the line (the
     glyphs are set left to right, a run's box is inside the line's), so where what is left of a paragraph
     fits on one line every line the greedy would try fits too and is not measured."""
-    size = float(fontsize or STYLE["axes.titlesize"])
+    size = fontsize or STYLE["axes.titlesize"]
     limit = width_in * 72.0
 
     def width(s: str) -> float:
@@ -296,9 +296,10 @@ def _greedy_join(words: list[str]) -> str:
 
 
 @functools.lru_cache(maxsize=4096)
-def _title_width_pt(text: str, size: float, weight: str) -> float:
-    """The width (points) of ``text`` set in the style's font at ``size`` points and ``weight`` (matplotlib's
-    text-to-path measure), remembered: titles and their trial lines repeat from figure to figure."""
+def _title_width_pt(text: str, size, weight: str) -> float:
+    """The width (points) of ``text`` set in the style's font at ``size`` (points, or a size name) and
+    ``weight`` (matplotlib's text-to-path measure), remembered: titles and their trial lines repeat from
+    figure to figure."""
     from matplotlib.font_manager import FontProperties
     from matplotlib.textpath import text_to_path
 
