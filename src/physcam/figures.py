@@ -258,28 +258,53 @@ def unbroken(text: str) -> str:
 def fit_title(text: str, width_in: float, *, fontsize: float | None = None, weight: str = "normal") -> str:
     """``text`` wrapped at word boundaries so that each line, set in the style's font at ``fontsize``
     points (default the title size) and ``weight``, is at most ``width_in`` inches wide (measured by
-    matplotlib); never at a :data:`NO_BREAK` space (see :func:`unbroken`), which comes out as a plain space."""
-    from matplotlib.font_manager import FontProperties
-    from matplotlib.textpath import text_to_path
+    matplotlib); never at a :data:`NO_BREAK` space (see :func:`unbroken`), which comes out as a plain space.
 
-    prop = FontProperties(family=STYLE["font.sans-serif"], size=fontsize or STYLE["axes.titlesize"], weight=weight)
+    Greedy: a line takes words while it fits. A run of a line's glyphs is never wider than the line (the
+    glyphs are set left to right, a run's box is inside the line's), so where what is left of a paragraph
+    fits on one line every line the greedy would try fits too and is not measured."""
+    size = fontsize or STYLE["axes.titlesize"]
     limit = width_in * 72.0
 
     def width(s: str) -> float:
-        return text_to_path.get_text_width_height_descent(s, prop, ismath=False)[0]
+        return _title_width_pt(s, size, weight)
 
     out = []
     for para in str(text).split("\n"):
+        words = para.split(" ")
+        fits = len(words) == 1 or width(_greedy_join(words)) <= limit  # the rest of the paragraph fits
         line = ""
-        for word in para.split(" "):
+        for k, word in enumerate(words):
             trial = f"{line} {word}" if line else word
-            if line and width(trial) > limit:
+            if line and not fits and width(trial) > limit:
                 out.append(line)
                 line = word
+                fits = width(_greedy_join(words[k:])) <= limit
             else:
                 line = trial
         out.append(line)
     return "\n".join(out).replace(NO_BREAK, " ")
+
+
+def _greedy_join(words: list[str]) -> str:
+    """``words`` joined as :func:`fit_title` joins them when nothing breaks (an empty first word, of a
+    leading space, dropped)."""
+    line = ""
+    for word in words:
+        line = f"{line} {word}" if line else word
+    return line
+
+
+@functools.lru_cache(maxsize=4096)
+def _title_width_pt(text: str, size, weight: str) -> float:
+    """The width (points) of ``text`` set in the style's font at ``size`` (points, or a size name) and
+    ``weight`` (matplotlib's text-to-path measure), remembered: titles and their trial lines repeat from
+    figure to figure."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import text_to_path
+
+    prop = FontProperties(family=STYLE["font.sans-serif"], size=size, weight=weight)
+    return text_to_path.get_text_width_height_descent(text, prop, ismath=False)[0]
 
 
 def new_figure(figsize=None, dpi=None, **kwargs):

@@ -34,7 +34,7 @@ from ..lens.prescription import Prescription, takes_prescription
 from ._chief_float import AIM_MAX_ITER, AIM_TOL_MM
 
 __all__ = ["AimedRays", "aim_from_infinity", "aim_from_film", "field_direction", "start_plane_z", "chief_ray_passes",
-           "field_limit_deg", "widest_passing_deg", "clamp_note"]
+           "field_limit_deg", "bisect_together", "widest_passing_deg", "clamp_note"]
 
 @dataclass
 class AimedRays:
@@ -310,13 +310,37 @@ def field_limit_deg(lens: Prescription, axis: str = "y", *, max_deg: float = 89.
             break
     if lo is None:
         return float(max_deg)
-    while hi - lo > tol_deg:
-        mid = 0.5 * (lo + hi)
-        if chief_ray_passes(lens, [mid], axis, wavelength_nm=wavelength_nm, backend=backend)[0]:
-            lo = mid
-        else:
-            hi = mid
-    return lo
+    bracket = [lo, hi]
+    bisect_together(lambda mids: chief_ray_passes(lens, mids, axis, wavelength_nm=wavelength_nm, backend=backend),
+                    [bracket], tol_deg)
+    return bracket[0]
+
+
+def bisect_together(passes, brackets, tol: float, depth: int = 10) -> None:
+    """Bisect each bracket [x that passes, x that fails] of ``brackets`` in place until shorter than ``tol``
+    (``passes(xs)``: a bool per x; each x's answer its own). Every midpoint the next ``depth`` steps can reach
+    is asked in one batch (a step asks one ray; a tracer call costs about the same for one ray or a
+    thousand), then the steps are taken by those answers: the same midpoints, computed alike, as one step
+    at a time."""
+    while True:
+        open_ = [e for e in brackets if abs(e[1] - e[0]) > tol]
+        if not open_:
+            return
+        reach = []  # every (passing, failing) bracket the next steps can hold
+
+        def grow(inside, outside, left):
+            if left and abs(outside - inside) > tol:
+                reach.append((inside, outside))
+                mid = 0.5 * (inside + outside)
+                grow(mid, outside, left - 1)
+                grow(inside, mid, left - 1)
+
+        for e in open_:
+            grow(e[0], e[1], depth)
+        known = dict(zip(reach, passes(np.array([0.5 * (i + o) for i, o in reach]))))
+        for e in open_:
+            while (e[0], e[1]) in known and abs(e[1] - e[0]) > tol:
+                e[int(not known[(e[0], e[1])])] = 0.5 * (e[0] + e[1])
 
 
 def widest_passing_deg(passes, good_deg: float, bad_deg: float, *, tol_deg: float = 0.01) -> float:

@@ -42,26 +42,36 @@ def trace_meridional_ray(prescription: Prescription, y0: float, z0: float, dy: f
     (``film_z``), or at the surface whose clear aperture blocks the ray, or where it misses a
     surface or is totally reflected.
     """
-    import numpy as np
+    wl = prescription.wavelength_nm if wavelength_nm is None else wavelength_nm
+    return _meridional_polylines(prescription, [(y0, z0, dy, dz)], axis, wl, film_z)[0]
 
+
+def _meridional_polylines(prescription: Prescription, starts, axis: str, wl, film_z):
+    """The polylines of :func:`trace_meridional_ray` of the rays ``starts`` [(y0, z0, dy, dz), ...], traced in
+    one batch (each ray's fate in the kernel is its own: the same numbers as one ray at a time)."""
     from ...trace import OK, RayBatch, trace_path
 
-    wl = prescription.wavelength_nm if wavelength_nm is None else wavelength_nm
-    pos = [[0.0, y0, z0]] if axis == "y" else [[y0, 0.0, z0]]
-    d = [[0.0, dy, dz]] if axis == "y" else [[dy, 0.0, dz]]
+    pos = [[0.0, y0, z0] if axis == "y" else [y0, 0.0, z0] for y0, z0, _, _ in starts]
+    d = [[0.0, dy, dz] if axis == "y" else [dy, 0.0, dz] for _, _, dy, dz in starts]
     rays = RayBatch.from_arrays(pos, d, wl)
     # unclipped, to draw the ray up to the surface that stops it; a lost ray repeats its last point
     pts, out = trace_path(prescription, rays, end_z=film_z, clip=False)
-    h = pts[:, 0, 1] if axis == "y" else pts[:, 0, 0]
-    z = pts[:, 0, 2]
+    return [_polyline(prescription, pts[:, i, 2], pts[:, i, 1] if axis == "y" else pts[:, i, 0], out.flag[i] == OK,
+                      film_z) for i in range(len(starts))]
+
+
+def _polyline(prescription: Prescription, z, h, ok: bool, film_z):
+    """One traced ray's polyline: its points up to where it is lost (module notes)."""
+    import numpy as np
+
     poly = [(float(z[0]), float(h[0]))]
     for k, surf in enumerate(prescription.surfaces, start=1):
-        if (z[k], h[k]) == (z[k - 1], h[k - 1]) and out.flag[0] != OK:
+        if (z[k], h[k]) == (z[k - 1], h[k - 1]) and not ok:
             return poly  # missed or totally reflected here
         poly.append((float(z[k]), float(h[k])))
         if abs(h[k]) > surf.semi_diameter * (1 + 1e-9):
             return poly  # vignetted by this surface's clear aperture
-    if film_z is not None and out.flag[0] == OK and np.isfinite(z[-1]):
+    if film_z is not None and ok and np.isfinite(z[-1]):
         poly.append((float(z[-1]), float(h[-1])))
     return poly
 
@@ -223,11 +233,12 @@ def _pencil_edges(p: Prescription, ray, a: float, axis: str, wavelength_nm) -> t
     """The rim of a pencil: the lowest and highest pupil heights ``h`` in [-0.98 a, 0.98 a] whose ray
     ``ray(h) -> (y0, z0, dy, dz)`` passes every clear aperture and the stop (a vignetted pencil is
     narrower than the paraxial pupil; real pupil aberration moves its edge). The pupil is sampled and
-    the run of passing rays nearest h = 0 refined to 1e-4 a by bisection, both ends in one batch per
-    step (each ray's fate is its own: the same steps as one end at a time); () when none passes."""
+    the run of passing rays nearest h = 0 refined to 1e-4 a by bisection, the midpoints of both ends' steps
+    in one batch (each ray's fate is its own: the same steps as one at a time); () when none passes."""
     import numpy as np
 
     from ...trace import OK, RayBatch, trace_through
+    from .._chief import bisect_together
 
     def passes(hs):
         y0, z0, dy, dz = (np.broadcast_to(np.asarray(v, dtype=float), np.shape(hs)) for v in ray(np.asarray(hs)))
@@ -248,13 +259,8 @@ def _pencil_edges(p: Prescription, ray, a: float, axis: str, wavelength_nm) -> t
     while hi < len(hs) - 1 and ok[hi + 1]:
         hi += 1
     ends = [[hs[k], hs[k + step] if 0 <= k + step < len(hs) else None] for k, step in ((lo, -1), (hi, 1))]
-    while True:
-        open_ = [e for e in ends if e[1] is not None and abs(e[1] - e[0]) > 1e-4 * a]
-        if not open_:
-            return tuple(float(e[0]) for e in ends)
-        mids = [0.5 * (e[0] + e[1]) for e in open_]
-        for e, mid, inside in zip(open_, mids, passes(np.array(mids))):
-            e[int(not inside)] = mid
+    bisect_together(passes, [e for e in ends if e[1] is not None], 1e-4 * a)  # a batch for many steps
+    return tuple(float(e[0]) for e in ends)
 
 
 @takes_camera
@@ -293,7 +299,6 @@ def lens_diagram(camera: CameraState, *, axis: str = "y", field_deg: float | Non
     if math.isfinite(st.object_z):
         z_start = max(z_start, st.object_z)
     ep, a = g.z_entrance_pupil, g.entrance_pupil_diameter / 2
-    out = []
     if math.isinf(st.object_z):  # the axial pencil: parallel rays at pupil height h, or a fan from the object
         def marginal(h):
             return h, z_start, 0.0, 1.0
@@ -302,18 +307,17 @@ def lens_diagram(camera: CameraState, *, axis: str = "y", field_deg: float | Non
             return 0.0, st.object_z, h, ep - st.object_z
     lo_hi = _pencil_edges(p, marginal, a, axis, wavelength_nm) or (-a, a)
     fan = [lo_hi[0] + (lo_hi[1] - lo_hi[0]) * j / (rays - 1) for j in range(rays)] if rays > 1 else [lo_hi[1]]
-    for h in fan:  # marginal fan from the axial object, its outer rays at the pencil's rim
-        y0, z0, dy, dz = marginal(h)
-        out.append(("marginal", trace_meridional_ray(p, y0, z0, dy, dz, axis=axis, wavelength_nm=wavelength_nm,
-                                                     film_z=g.z_film)))
+    # the marginal fan from the axial object, its outer rays at the pencil's rim
+    drawn = [("marginal", marginal(h)) for h in fan]
     tu = math.tan(half)
 
     def field(h):
         return h - tu * (ep - z_start), z_start, tu, 1.0
 
     rims = _pencil_edges(p, field, a, axis, wavelength_nm)  # the rim of what passes of the off-axis pencil
-    for h, kind in ((0.0, "chief"),) + tuple((h, "rim") for h in rims[::-1]):  # aimed at the paraxial EP
-        out.append((kind, trace_meridional_ray(p, *field(h), axis=axis, wavelength_nm=wavelength_nm, film_z=g.z_film)))
+    drawn += [(kind, field(h)) for h, kind in ((0.0, "chief"),) + tuple((h, "rim") for h in rims[::-1])]  # at the EP
+    lines = _meridional_polylines(p, [start for _, start in drawn], axis, wavelength_nm, g.z_film)
+    out = [(kind, line) for (kind, _), line in zip(drawn, lines)]
     return LensDiagram(p, g, axis, math.degrees(half), out, cam)
 
 
