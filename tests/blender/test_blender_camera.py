@@ -4,6 +4,11 @@ implementation, traced the other way: from the scene to the film).
 
 The shaders are generated here (main environment); Blender (bpy, its own environment) compiles
 and renders them in one subprocess.
+
+Every lens's 24 x 16 px render is made only in a render border about the 4 x 4 px centre block the test
+reads (black outside it, ``use_crop_to_border`` off). Cycles seeds a pixel's samples by its place in the
+frame, so the block's mean is the full frame's bit for bit (all 51 lenses checked, 2026-11-30): the 51
+renders' Blender CPU 10.9 -> 7.8 s (what is left is each render's set-up).
 """
 
 from __future__ import annotations
@@ -165,6 +170,9 @@ files = json.loads(sys.argv[12])
 set_world(1.0)
 scene.cycles.shading_system = True
 res = {}
+# only the centre block read below is rendered (black elsewhere): module notes
+scene.render.use_border = True; scene.render.use_crop_to_border = False
+scene.render.border_min_x, scene.render.border_max_x, scene.render.border_min_y, scene.render.border_max_y = 10 / 24, 14 / 24, 6 / 16, 10 / 16
 t0 = time.perf_counter()
 for slug, path in files.items():
     msgs = []
