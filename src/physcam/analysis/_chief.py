@@ -34,7 +34,7 @@ from ..lens.prescription import Prescription, takes_prescription
 from ._chief_float import AIM_MAX_ITER, AIM_TOL_MM
 
 __all__ = ["AimedRays", "aim_from_infinity", "aim_from_film", "field_direction", "start_plane_z", "chief_ray_passes",
-           "field_limit_deg", "bisect_together", "widest_passing_deg", "clamp_note"]
+           "field_limit_deg", "widest_passing_deg", "clamp_note"]
 
 @dataclass
 class AimedRays:
