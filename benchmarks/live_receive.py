@@ -22,29 +22,24 @@ instruction count, which the machine's load does not change; ``--stream FILE`` k
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import os
 import pickle
 import random
 import tempfile
 import time
+import sys
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import live_usd  # noqa: E402  (the take's samples and frames: the same stream as the USD writer's benchmark)
 
 
 def stream(n: int):
     """(datagrams, samples) of the test's stream (module notes), its timestamps from 0."""
-    from physcam.live.camera import CameraMove, camera_frames, frames_to_samples
     from physcam.live.protocol import ENCODING_CBOR, ENCODING_JSON, build_packet, packetize
     from physcam.live.sample import encode_sample
-    from physcam.optics.sensors import find_sensor
 
-    frames = camera_frames(sensor=find_sensor("ALEXA 35"), frames=n, rate=240, focus_mm=1500.0, focus_to_mm=6000.0,
-                           fstop=2.8, focal_length_mm=35.0, t0_ns=0,
-                           move=CameraMove(velocity_m_s=(0.2, 0.5, 0.0), rate_deg_s=(15.0, -3.0, 1.0)))
-    frames = [dataclasses.replace(f, distortion={"model": "Brown-Conrady U-D", "radial": [-2e-5 - 1e-9 * i, 1e-8, 0.0],
-                                                 "tangential": [0.0, 0.0]}) for i, f in enumerate(frames)]
-    samples = list(frames_to_samples(frames, static_every=240,
-                                     source_id="urn:uuid:00000000-0000-4000-8000-000000000017"))
+    samples = live_usd.samples(n)
     rnd, seq, out = random.Random(17), 65_000, []
     for i, s in enumerate(samples):
         enc = ENCODING_CBOR if i % 2 else ENCODING_JSON
@@ -98,7 +93,6 @@ def main() -> None:
     ap.add_argument("--receive-only", action="store_true", help="stop after the receive step")
     ap.add_argument("--stream", help="the datagrams and samples, pickled here (made when absent)")
     args = ap.parse_args()
-    from physcam.live.frames import frame_from_sample
     from physcam.live.record import solve_frames, write_lens_report, write_recording_usd
 
     n = args.samples
@@ -126,10 +120,7 @@ def main() -> None:
         print(f"{n} samples, {len(datagrams)} datagrams; receive {best / n * 1e6:.1f} us a sample")
         return
     t = clock()
-    frames, static = [], None
-    for s in got:
-        static = s.get("static", static)
-        frames.append(frame_from_sample(s, static=static))
+    frames = live_usd.frames_of(got)
     cpu["frame_from_sample"] = clock() - t
     t = clock()
     solved = solve_frames(frames)

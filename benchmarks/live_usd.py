@@ -19,9 +19,10 @@ import time
 from pathlib import Path
 
 
-def take(n: int):
+def samples(n: int) -> list:
+    """The take's ``n`` OpenTrackIO samples (module notes), timestamps from 0: benchmarks/live_receive.py
+    sends the same stream."""
     from physcam.live.camera import CameraMove, camera_frames, frames_to_samples
-    from physcam.live.frames import frame_from_sample
     from physcam.optics.sensors import find_sensor
 
     frames = camera_frames(sensor=find_sensor("ALEXA 35"), frames=n, rate=240, focus_mm=1500.0, focus_to_mm=6000.0,
@@ -29,11 +30,22 @@ def take(n: int):
                            move=CameraMove(velocity_m_s=(0.2, 0.5, 0.0), rate_deg_s=(15.0, -3.0, 1.0)))
     frames = [dataclasses.replace(f, distortion={"model": "Brown-Conrady U-D", "radial": [-2e-5 - 1e-9 * i, 1e-8, 0.0],
                                                  "tangential": [0.0, 0.0]}) for i, f in enumerate(frames)]
+    return list(frames_to_samples(frames, static_every=240, source_id="urn:uuid:00000000-0000-4000-8000-000000000017"))
+
+
+def frames_of(received) -> list:
+    """The frames of samples in order, each with the last static block seen (as a recorder reads them)."""
+    from physcam.live.frames import frame_from_sample
+
     out, static = [], None
-    for s in frames_to_samples(frames, static_every=240, source_id="urn:uuid:00000000-0000-4000-8000-000000000017"):
+    for s in received:
         static = s.get("static", static)
         out.append(frame_from_sample(s, static=static))
     return out
+
+
+def take(n: int):
+    return frames_of(samples(n))
 
 
 def main() -> None:
