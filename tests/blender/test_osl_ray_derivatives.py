@@ -7,7 +7,9 @@ the pixel at the lens's paraxial focal length.
 In Cycles itself, double Gauss focused at 2.5 m, f/2.8, 48 x 32 px, 8 samples, seed 0:
 
 - the shader as written and the shader with the traced ray written to the outputs directly (the code
-  before round 13) render a world whose colour is the ray's direction plus (2, 2, 2) to the same bits;
+  before round 13) render a world whose colour is the ray's direction plus (2, 2, 2) alike to 8 units
+  in the last place of the EXR's float32 (the same bits on the Xeons of rounds 13-19; an AVX-512 Xeon
+  gave up to 4 in 770 of the 4608 values: OSL's JIT fuses multiply-adds differently in different code);
 - a white world through the shader with the throughput replaced by three derivatives (the output
   direction's, the traced direction's as OSL differentiates the trace itself, and the raster
   position's): at the frame's centre the output's is the pinhole's in closed form, 2 (w / 2) Dx(u) / f
@@ -72,7 +74,7 @@ def test_traced_ray_unchanged_and_pinhole_derivatives(tmp_path):
     out = run_blender(RUN, tmp_path)
     a, b = np.array(out["message"]), np.array(out["direct"])
     assert (b.sum(axis=2) > 0).mean() > 0.5  # most of the frame sees the world through the lens
-    assert np.array_equal(a, b)
+    np.testing.assert_array_max_ulp(a.astype(np.float32), b.astype(np.float32), maxulp=8)
 
     d = np.array(out["derivs"])  # row 0 = bottom; a pixel: the mean over its samples (lost rays: 0)
     lit = d[..., 2] > 0
