@@ -48,12 +48,11 @@ def _refused(capsys, argv, words, *absent):
 
 # ---- a checkerboard grid out of order ---------------------------------------------------------------
 @pytest.fixture(scope="module")
-def checker_photo(tmp_path_factory):
+def checker_photo(tmp_path_factory, checker_photographs):
     """One checkerboard photograph rendered through K_TRUE and DIST_TRUE (OpenCV's projection, blur,
-    grey-level noise) and OpenCV's own detection of its 9 x 6 inner corners."""
-    board = _charts.board_image(CHECKER, 12.0)
-    r, t = _charts.whole_board_poses(1, 1)[0]
-    img = _charts.render(CHECKER, r, t, board=board, seed=0)
+    grey-level noise; test_calibrate.py's first at 2 m, tests/conftest.py's ``checker_photographs``) and
+    OpenCV's own detection of its 9 x 6 inner corners."""
+    (img,) = checker_photographs(1, 1, K_TRUE)
     path = tmp_path_factory.mktemp("checker") / "board.png"
     cv2.imwrite(str(path), img)
     # OpenCV's sector detector with physcam's flags: CALIB_CB_ACCURACY's upsampled search took 3x the CPU for
