@@ -123,8 +123,9 @@ def extension_user(extension_zip, tmp_path_factory):
 #   OpenCV's real detector the first time a picture (its decoded pixels, shape and type) is seen with a
 #   ChArUco chart; later calls with the same pixels and chart get copies of that answer. OpenCV's
 #   detector is deterministic, so each test sees exactly what it would detect itself, and every photograph
-#   is still read and checked by physcam as before (header, size, mixed modes). Checkerboards are never
-#   memoised: the refusal tests inject the sector detector's failures (test_calibrate_refusals.py).
+#   is still read and checked by physcam as before (header, size, mixed modes). Checkerboards are not
+#   memoised here: the refusal tests inject the sector detector's failures (test_calibrate_refusals.py, which
+#   asks OpenCV's search of its one photograph once per image size, under the injections).
 # - **The ChArUco renders once.** test_calibrate.py's 15 photographs and test_calibrate_refusals.py's 8 are
 #   the same renders (poses(n, 1), board at 12 px/mm, noise seed k): the ``charuco_photographs`` fixture renders
 #   each once and the modules write the files they need. tests/farm/test_farm_run.py's 5 are the first 5 of them.
