@@ -123,20 +123,29 @@ def extension_user(extension_zip, tmp_path_factory):
 #   OpenCV's real detector the first time a picture (its decoded pixels, shape and type) is seen with a
 #   ChArUco chart; later calls with the same pixels and chart get copies of that answer. OpenCV's
 #   detector is deterministic, so each test sees exactly what it would detect itself, and every photograph
-#   is still read and checked by physcam as before (header, size, mixed modes). Checkerboards are never
-#   memoised: the refusal tests inject the sector detector's failures (test_calibrate_refusals.py).
+#   is still read and checked by physcam as before (header, size, mixed modes). Checkerboards are not
+#   memoised here: the refusal tests inject the sector detector's failures (test_calibrate_refusals.py, which
+#   asks OpenCV's search of its one photograph once per image size, under the injections).
 # - **The ChArUco renders once.** test_calibrate.py's 15 photographs and test_calibrate_refusals.py's 8 are
 #   the same renders (poses(n, 1), board at 12 px/mm, noise seed k): the ``charuco_photographs`` fixture renders
-#   each once and the modules write the files they need.
+#   each once and the modules write the files they need. tests/farm/test_farm_run.py's 5 are the first 5 of them.
+# - **The checkerboard renders once.** test_calibrate.py's two shoots and test_calibrate_refusals.py's one photograph
+#   are renders of one board picture (9 x 6 inner corners at 12 px/mm, 0.8 s of CPU to draw), and the refusals'
+#   photograph is test_calibrate.py's first at 2 m (whole_board_poses(n, 1)'s first pose, noise seed 0): the
+#   ``checker_photographs`` fixture draws the board once and renders each photograph once.
 CALIBRATION_TESTS = "tests/analysis/calibration/"
+#: the farm's calibrate test: its direct run in this process detects the first five ChArUco photographs (its
+#: openjd tasks, other processes, run OpenCV's detector themselves)
+FARM_CALIBRATION = "tests/farm/test_farm_run.py::test_openjd_calibrate"
 _DETECTED: dict = {}
 _RENDERED: list = []
+_CHECKER_RENDERED: dict = {}
 
 
 @pytest.fixture(autouse=True)
 def _detect_each_charuco_photograph_once(request, monkeypatch):
     """The calibration tests' ChArUco detection once per photograph (notes above); other tests untouched."""
-    if not request.node.nodeid.startswith(CALIBRATION_TESTS):
+    if not request.node.nodeid.startswith((CALIBRATION_TESTS, FARM_CALIBRATION)):
         return
     from physcam.analysis.calibration import chart
 
@@ -164,6 +173,7 @@ def charuco_photographs():
     """``photographs(n)``: the first ``n`` (up to 15) of the ChArUco photographs of K_TRUE and DIST_TRUE,
     poses(15, 1) rendered by tests/analysis/_charts.py on a board at 12 px/mm, noise seed k for the k-th
     (8-bit arrays), each rendered once in the test process."""
+    pytest.importorskip("cv2")
     import _charts  # tests/analysis (pyproject.toml's pythonpath)
 
     def photographs(n: int) -> list:
@@ -174,5 +184,30 @@ def charuco_photographs():
             _RENDERED.extend(_charts.render(_charts.CHARUCO, r, t, board=board, seed=k)
                              for k, (r, t) in enumerate(poses[len(_RENDERED):n], start=len(_RENDERED)))
         return _RENDERED[:n]
+
+    return photographs
+
+
+@pytest.fixture(scope="session")
+def checker_photographs():
+    """``photographs(n, seed, K)``: the first ``n`` checkerboard photographs of a shoot through ``K`` (3 x 3) and
+    DIST_TRUE, rendered by tests/analysis/_charts.py: the board (``_charts.CHECKER``) at 12 px/mm in the poses
+    ``whole_board_poses(n, seed, K=K)``, noise seed k for the k-th (8-bit arrays). The board is drawn once and
+    each photograph rendered once in the test process (the first ``n`` poses of a shoot are the same whatever
+    ``n``: the poses are drawn in order from one generator)."""
+    pytest.importorskip("cv2")
+    import _charts  # tests/analysis (pyproject.toml's pythonpath)
+    import numpy as np
+
+    def photographs(n: int, seed: int, K) -> list:
+        K = np.asarray(K, np.float64)
+        done = _CHECKER_RENDERED.setdefault((K.tobytes(), seed), [])
+        if len(done) < n:
+            if "board" not in _CHECKER_RENDERED:
+                _CHECKER_RENDERED["board"] = _charts.board_image(_charts.CHECKER, 12.0)
+            poses = _charts.whole_board_poses(n, seed, K=K)
+            done.extend(_charts.render(_charts.CHECKER, r, t, board=_CHECKER_RENDERED["board"], seed=k, K=K)
+                        for k, (r, t) in enumerate(poses[len(done):n], start=len(done)))
+        return done[:n]
 
     return photographs

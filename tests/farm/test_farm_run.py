@@ -182,20 +182,17 @@ def test_openjd_characterize_grid_gives_the_direct_bytes_after_a_kill(tmp_path):
 
 
 # ---- calibrate -------------------------------------------------------------------------------------
-def test_openjd_calibrate_gives_the_direct_deliverables_and_variant(tmp_path):
-    """Five ChArUco photographs (OpenCV's projection of a known camera, tests/analysis/_charts.py): the
+def test_openjd_calibrate_gives_the_direct_deliverables_and_variant(tmp_path, charuco_photographs):
+    """Five ChArUco photographs (OpenCV's projection of a known camera, tests/analysis/_charts.py; the first
+    five of the calibration tests' renders, tests/conftest.py's ``charuco_photographs``): the
     calibrate and usd steps through openjd run write the deliverables byte for byte as physcam calibrate
     does (both folders written whole, manifests included) and the same USD variant (but the folder's name);
     run again, both steps find their outputs and skip."""
     cv2 = pytest.importorskip("cv2")
-    sys.path.insert(0, str(Path(__file__).parents[1] / "analysis"))
-    import _charts
 
-    board = _charts.board_image(_charts.CHARUCO, 12.0)
     (tmp_path / "charts").mkdir()
-    for k, (r, t) in enumerate(_charts.poses(5, 1)):
-        cv2.imwrite(str(tmp_path / "charts" / f"c_{k:02d}.png"),
-                    _charts.render(_charts.CHARUCO, r, t, board=board, seed=k))
+    for k, img in enumerate(charuco_photographs(5)):
+        cv2.imwrite(str(tmp_path / "charts" / f"c_{k:02d}.png"), img)
     args = ["charts", "--sensor-width", "12.8", "--sensor-height", "9.6", "--chart", "charuco", "--corners", "24x18",
             "--square", "15mm", "--marker", "11mm", "--dictionary", "DICT_5X5_250", "--focus", "2m", "--bootstrap", "0",
             "--max-residual", "2",

@@ -287,25 +287,25 @@ CHECKER_ARGS = ["--sensor-width", "12.8", "--sensor-height", "9.6", "--chart", "
                 "--square", "30mm"]
 
 
-def _checker_shoot(folder: Path, K, seed, n=8):
+def _checker_shoot(folder: Path, images):
     folder.mkdir(parents=True, exist_ok=True)
-    board = _charts.board_image(_charts.CHECKER, 12.0)
     names = []
-    for k, (r, t) in enumerate(_charts.whole_board_poses(n, seed, K=K)):
+    for k, img in enumerate(images):
         name = folder / f"{folder.name}_{k:02d}.png"
-        cv2.imwrite(str(name), _charts.render(_charts.CHECKER, r, t, board=board, seed=k, K=K))
+        cv2.imwrite(str(name), img)
         names.append(name)
     return names
 
 
 @pytest.fixture(scope="module")
-def checker_marks(tmp_path_factory):
+def checker_marks(tmp_path_factory, checker_photographs):
     """8 views of a 9x6 checkerboard at 2 m through K_TRUE and 8 at 500 mm through K_NEAR, rendered with
-    OpenCV's projection; calibrated by ``physcam calibrate IMAGES --marks marks.csv`` (no --focus) into
-    a new lens file's variant day_1."""
+    OpenCV's projection (both shoots of one board picture: tests/conftest.py's ``checker_photographs``);
+    calibrated by ``physcam calibrate IMAGES --marks marks.csv`` (no --focus) into a new lens file's variant
+    day_1."""
     tmp = tmp_path_factory.mktemp("checker")
-    far = _checker_shoot(tmp / "far", K_TRUE, 1)
-    near = _checker_shoot(tmp / "near", K_NEAR, 4)
+    far = _checker_shoot(tmp / "far", checker_photographs(8, 1, K_TRUE))
+    near = _checker_shoot(tmp / "near", checker_photographs(8, 4, K_NEAR))
     marks = tmp / "marks.csv"  # the far images by their paths, the near ones by their file names
     marks.write_text("image,mark\n" + "".join(f"{p},2m\n" for p in far) + "".join(f"{p.name},500mm\n" for p in near))
     out = tmp / "calib"

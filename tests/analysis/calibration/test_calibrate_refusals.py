@@ -6,6 +6,7 @@ deliverables from two fits."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import signal
@@ -36,6 +37,32 @@ CHARUCO_ARGS = ["--sensor-width", "12.8", "--sensor-height", "9.6", "--chart", "
 CHECKER_ARGS = ["--sensor-width", "12.8", "--sensor-height", "9.6", "--corners", "9x6", "--square", "30mm"]
 
 
+#: OpenCV's own sector search (cv2.findChessboardCornersSB), kept before any test wraps it
+_REAL_SEARCH = cv2.findChessboardCornersSB
+#: {(image's SHA-256, shape, pattern, flags): OpenCV's answer} of the searches this module has asked
+_SEARCHED: dict = {}
+
+
+def _search(image, size, flags=0):
+    """OpenCV's sector search of ``image``, asked once per image, pattern and flags in this module: the module's
+    one checkerboard photograph is searched at full size by its fixture, by the wrong-grid test's run and by the
+    half-size test's fallback (1.3 s of CPU each), and at half size by three runs (0.45 s each). The search is
+    deterministic (four calls on each size: the same corners bit for bit), so each caller gets what its own call
+    would return (a copy); the tests' injected failures wrap this function as they wrapped OpenCV's."""
+    a = np.ascontiguousarray(image)
+    key = (hashlib.sha256(a.tobytes()).hexdigest(), a.shape, a.dtype.str, tuple(size), flags)
+    if key not in _SEARCHED:
+        _SEARCHED[key] = _REAL_SEARCH(image, size, flags=flags)
+    ok, corners = _SEARCHED[key]
+    return ok, None if corners is None else corners.copy()
+
+
+@pytest.fixture(autouse=True)
+def _each_search_once(monkeypatch):
+    """physcam's checkerboard detection in this module's tests meets :func:`_search` for OpenCV's search."""
+    monkeypatch.setattr(cv2, "findChessboardCornersSB", _search)
+
+
 def _refused(capsys, argv, words, *absent):
     rc = main(argv)
     err = capsys.readouterr().err.strip()
@@ -48,19 +75,18 @@ def _refused(capsys, argv, words, *absent):
 
 # ---- a checkerboard grid out of order ---------------------------------------------------------------
 @pytest.fixture(scope="module")
-def checker_photo(tmp_path_factory):
+def checker_photo(tmp_path_factory, checker_photographs):
     """One checkerboard photograph rendered through K_TRUE and DIST_TRUE (OpenCV's projection, blur,
-    grey-level noise) and OpenCV's own detection of its 9 x 6 inner corners."""
-    board = _charts.board_image(CHECKER, 12.0)
-    r, t = _charts.whole_board_poses(1, 1)[0]
-    img = _charts.render(CHECKER, r, t, board=board, seed=0)
+    grey-level noise; test_calibrate.py's first at 2 m, tests/conftest.py's ``checker_photographs``) and
+    OpenCV's own detection of its 9 x 6 inner corners."""
+    (img,) = checker_photographs(1, 1, K_TRUE)
     path = tmp_path_factory.mktemp("checker") / "board.png"
     cv2.imwrite(str(path), img)
     # OpenCV's sector detector with physcam's flags: CALIB_CB_ACCURACY's upsampled search took 3x the CPU for
     # corners within 0.9 px of these, 0.03 of a 30-px square (the checks below: 0.2)
     from physcam.analysis.calibration.chart import _checkerboard_flags
 
-    ok, corners = cv2.findChessboardCornersSB(img, (9, 6), flags=_checkerboard_flags(cv2))
+    ok, corners = _search(img, (9, 6), flags=_checkerboard_flags(cv2))
     assert ok
     return path, img, corners.reshape(6, 9, 2)
 
@@ -141,7 +167,8 @@ def test_a_wrong_grid_from_the_detector_is_refused_naming_the_photo(checker_phot
 def test_a_grid_missed_at_half_size_is_found_at_full_size_at_the_same_corners(checker_photo, monkeypatch):
     """A 1280 x 960 photo is searched at half size first (HALF_SIZE_SEARCH_PX); when that finds no grid
     (injected here) the full-size search finds it, and both ways give the same refined corners to 0.05 px
-    (the refinement's own scatter from different starting points)."""
+    (the refinement's own scatter from different starting points). Each size's search is OpenCV's answer for
+    this very image, asked once in the module (:func:`_search`)."""
     _, img, _ = checker_photo
     quick, _ = detect_chart(img, CHECKER)
     real, sizes = cv2.findChessboardCornersSB, []

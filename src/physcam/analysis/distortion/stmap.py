@@ -138,16 +138,20 @@ class _Grid:
         0.5 GB. Separable: every padded row of nodes is interpolated across the frame once ((ny + 2, width)
         per channel), then a block's rows mix only the few node rows their cubic reaches (a band of
         ``rows`` / dy + 4): the dense product over every node row and column cost ~20x the arithmetic
-        (one pass over an 8K frame 2.3 -> 0.65 s CPU; docs/performance.md)."""
+        (one pass over an 8K frame 2.3 -> 0.65 s CPU; docs/performance.md). The two arrays of a block are
+        written into the same two buffers block after block (valid until the next block is asked for): a new
+        16 MB pair per block of an 8K frame was mapped fresh from the system each time and faulted in page by
+        page (the same products, bit for bit; an 8K field 3.60 -> 3.33 s CPU, docs/performance.md, round 20)."""
         mx = _matrix((origin[0] + np.arange(width) + 0.5 - self.x0) / self.dx, self.nx)
         across = [self.p[:, :, c] @ mx.T for c in range(2)]
         my = _matrix((origin[1] + np.arange(height) + 0.5 - self.y0) / self.dy, self.ny)[::-1]  # top row first
+        buffers = [np.empty((min(rows, height), width)) for _ in across]
         for r0 in range(0, height, rows):
             m = my[r0:r0 + rows]
             used = np.flatnonzero(m.any(axis=0))
             lo, hi = (used[0], used[-1] + 1) if used.size else (0, 1)
             band = np.ascontiguousarray(m[:, lo:hi])  # my[::-1]'s negative strides would keep matmul off BLAS
-            yield r0, [band @ a[lo:hi] for a in across]
+            yield r0, [np.matmul(band, a[lo:hi], out=b[:len(band)]) for a, b in zip(across, buffers)]
 
     def fill(self, out, scale, offset=(0.0, 0.0), origin=(0.0, 0.0)):
         """Write (value + offset) / scale into channels 0 and 1 of the image ``out`` (h, w, >= 2), block by block."""
@@ -618,10 +622,17 @@ def _map_array(rgb) -> np.ndarray:
 
 
 def _preview(rgb: np.ndarray) -> np.ndarray:
-    """``rgb`` (h, w, 3) in 0..1 as 8-bit values, converted in blocks of rows (no float copy of the frame)."""
+    """``rgb`` (h, w, 3) in 0..1 as 8-bit values, converted in blocks of rows (no float copy of the frame),
+    each block's clip, scale and rounding offset in one buffer of the block's type, reused block after block
+    (the same operations on the same type as ``np.clip(block, 0.0, 1.0) * 255.0 + 0.5``, without its three
+    new arrays a block: the same bytes)."""
     out = np.empty(rgb.shape, dtype=np.uint8)
+    buf = np.empty((min(ROW_BLOCK, rgb.shape[0]),) + rgb.shape[1:], dtype=np.clip(rgb[:1, :1], 0.0, 1.0).dtype)
     for r0 in range(0, rgb.shape[0], ROW_BLOCK):
-        out[r0:r0 + ROW_BLOCK] = np.clip(rgb[r0:r0 + ROW_BLOCK], 0.0, 1.0) * 255.0 + 0.5
+        b = np.clip(rgb[r0:r0 + ROW_BLOCK], 0.0, 1.0, out=buf[:min(ROW_BLOCK, rgb.shape[0] - r0)])
+        b *= 255.0
+        b += 0.5
+        out[r0:r0 + ROW_BLOCK] = b
     return out
 
 
