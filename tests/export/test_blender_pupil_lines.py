@@ -1,8 +1,10 @@
 """The pupil tables' rims found along lines from each film point's chief aim (physcam.export.blender_pupil_sets
 ._LineSets) against the oracle, physcam's tracer run the plain way on a dense grid of aims with the iris
 stopped to each radius: on a prime (the double Gauss), a fisheye (the Nikkor 16 mm), a zoom (the Canon
-70-200 at its long end) and a lens whose sets other surfaces cut wide open (the Canon RF 85 at 1 m: clip
-edges), every film radius node the lines serve and four iris radii from the widest to the last level.
+70-200 at its long end), a lens whose sets other surfaces cut wide open (the Canon RF 85 at 1 m: clip
+edges) and one whose film lies 1.0 mm behind its rear vertex (the ARRI Signature 58 mm: its chief aims found by
+the window fan, round 20), every film radius node the lines serve and four iris radii from the widest to the
+last level.
 
 Tolerances. The area: the shader weighs a ray by the tabulated area only in the cells where the table's
 reading matches the traced areas within AREA_TOLERANCE (0.4 %), which assumes the traced areas are the

@@ -13,13 +13,16 @@ about 20 of the 36 samples each way: a rim's area is a dense trace's within 0.4 
 surfaces or not; the double Gauss and the Canon RF 85, f/2 to f/16, film radius to 22 mm).
 Where the iris alone bounds a set the grids are not needed: its rim is found along 25 lines from the
 film point's chief aim (the aim whose ray crosses the stop's centre: every set holds it, and a convex set
-is star-shaped from it), the stop radius sampled geometrically along each line and the rim interpolated
+is star-shaped from it; found from meridional fans, also where the film lies so close behind the rear vertex
+that a point's passing spot there is under one step of the fan across the rear element, :func:`_chief_aims`),
+the stop radius sampled geometrically along each line and the rim interpolated
 where it reaches s (:class:`_LineSets`; about 620 rays a film point against about 3,400 in grids). The lines
 serve the iris radii under every cut line's clip edge by 5 %, so no other surface reaches the set, and only
 where the interpolation is sure of the rim (:data:`_LINE_DOUBT`); the wider radii (where other surfaces cut
 the set: wide open, off axis) and the film points whose chief ray is cut (outside the image circle) keep the
 grids. The lines' areas are a dense trace's within 0.15 % (the grids' up to 0.27 % short; the double Gauss,
-a fisheye, a zoom, the Canon RF 85 and the Angenieux f/1: tests/export/test_blender_pupil_lines.py).
+a fisheye, a zoom, the Canon RF 85, the Angenieux f/1 and the ARRI Signature 58 mm, whose film lies 1.0 mm
+behind its rear vertex: tests/export/test_blender_pupil_lines.py).
 """
 
 from __future__ import annotations
