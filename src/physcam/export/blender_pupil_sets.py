@@ -13,13 +13,16 @@ about 20 of the 36 samples each way: a rim's area is a dense trace's within 0.4 
 surfaces or not; the double Gauss and the Canon RF 85, f/2 to f/16, film radius to 22 mm).
 Where the iris alone bounds a set the grids are not needed: its rim is found along 25 lines from the
 film point's chief aim (the aim whose ray crosses the stop's centre: every set holds it, and a convex set
-is star-shaped from it), the stop radius sampled geometrically along each line and the rim interpolated
+is star-shaped from it; found from meridional fans, also where the film lies so close behind the rear vertex
+that a point's passing spot there is under one step of the fan across the rear element, :func:`_chief_aims`),
+the stop radius sampled geometrically along each line and the rim interpolated
 where it reaches s (:class:`_LineSets`; about 620 rays a film point against about 3,400 in grids). The lines
 serve the iris radii under every cut line's clip edge by 5 %, so no other surface reaches the set, and only
 where the interpolation is sure of the rim (:data:`_LINE_DOUBT`); the wider radii (where other surfaces cut
 the set: wide open, off axis) and the film points whose chief ray is cut (outside the image circle) keep the
 grids. The lines' areas are a dense trace's within 0.15 % (the grids' up to 0.27 % short; the double Gauss,
-a fisheye, a zoom, the Canon RF 85 and the Angenieux f/1: tests/export/test_blender_pupil_lines.py).
+a fisheye, a zoom, the Canon RF 85, the Angenieux f/1 and the ARRI Signature 58 mm, whose film lies 1.0 mm
+behind its rear vertex: tests/export/test_blender_pupil_lines.py).
 """
 
 from __future__ import annotations
@@ -409,25 +412,51 @@ _LINE_MARGIN = 0.05
 #: 0.2 % of the area, half AREA_TOLERANCE (the lines' areas measured within 0.15 % of a dense trace, docs/performance.md)
 _LINE_DOUBT = 1e-3
 _BAND = 400.0  # :meth:`_LineSets._rim_t`'s search: each line's log stop radii in a band this wide
+_SEEDED_STEPS = 3  # Newton's steps more for a chief aim seeded by one passing fan aim (:func:`_chief_aims`)
+_SEEDED_MISS = 1e-9  # ... and how near the stop's centre its ray must then cross, as a share of the fan's span
 
 
-def _chief_aims(q, film_z: float, fxs, boxes, big: float, backend: str) -> tuple[np.ndarray, np.ndarray]:
-    """Per film point (fx, 0): (the aim x on the rear vertex plane of its ray through the stop's centre, the
-    rate d x_stop / d aim x there), nan where none is found: no passing pair of :data:`_FAN` meridional aims
-    across the point's box (:func:`_rear_boxes`) brackets it (the chief ray is cut), or a Newton step fails."""
-    fxs = np.asarray(fxs, dtype=float)
-    b = np.asarray(boxes, dtype=float).reshape(-1, 3)
-    px = b[:, :1] + (np.arange(_FAN) + 0.5)[None, :] / _FAN * (b[:, 1:2] - b[:, :1])
+def _fan(q, film_z: float, fxs, x0, x1, big: float, backend: str) -> tuple[np.ndarray, np.ndarray]:
+    """Per film point (fx, 0), :data:`_FAN` meridional aims from x0 to x1: (the chief aim where a passing pair of
+    them brackets it, linear between the two, else nan; the passing aim whose ray crosses the stop nearest its
+    centre, nan where none passes)."""
+    px = x0[:, None] + (np.arange(_FAN) + 0.5)[None, :] / _FAN * (x1 - x0)[:, None]
     ok, probe = _aims_probe(q, film_z, np.repeat(fxs, _FAN), px.ravel(), np.zeros(px.size), big, backend)
     ok, xs = ok.reshape(px.shape), (probe.x * big).reshape(px.shape)
     pair = ok[:, :-1] & ok[:, 1:] & ((xs[:, :-1] <= 0) != (xs[:, 1:] <= 0))
     i, j = np.arange(fxs.size), np.argmax(pair, axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         c = np.where(pair.any(axis=1), px[i, j] + (px[i, j + 1] - px[i, j]) * xs[i, j] / (xs[i, j] - xs[i, j + 1]), np.nan)
+    near = np.where(ok, np.abs(xs), np.inf)
+    k = np.argmin(near, axis=1)
+    return c, np.where(np.isfinite(near[i, k]), px[i, k], np.nan)
+
+
+def _chief_aims(q, film_z: float, fxs, boxes, big: float, backend: str) -> tuple[np.ndarray, np.ndarray]:
+    """Per film point (fx, 0): (the aim x on the rear vertex plane of its ray through the stop's centre, the
+    rate d x_stop / d aim x there), nan where none is found. A passing pair of :data:`_FAN` meridional aims
+    across the point's box (:func:`_rear_boxes`) brackets it and three Newton steps find it. Where none does
+    (the film close behind the rear vertex: its passing spot there under one step of the fan; or a point on the
+    image circle's vignetted edge, its chief aim between a cut aim and a passing one), a fan across the window
+    about the point straight ahead, half as wide as the film's distance from the rear vertex (the first
+    window :func:`_first_grids` looks in), brackets it or, failing that, the passing aim of either fan whose
+    ray crosses the stop nearest its centre seeds Newton's steps; there :data:`_SEEDED_STEPS` more, and the
+    aim is kept only where its ray passes and crosses the stop within :data:`_SEEDED_MISS` of the fan's span
+    of its centre (else nan: the chief ray is cut, outside the image circle)."""
+    fxs = np.asarray(fxs, dtype=float)
+    b = np.asarray(boxes, dtype=float).reshape(-1, 3)
+    c, seed = _fan(q, film_z, fxs, b[:, 0], b[:, 1], big, backend)
+    seeded = np.isnan(c)
+    w = np.flatnonzero(seeded)
+    if w.size:
+        half = 0.5 * (film_z - q.vertex_z[-1])
+        c[w], seed_w = _fan(q, film_z, fxs[w], np.maximum(fxs[w] - half, b[w, 0]), np.minimum(fxs[w] + half, b[w, 1]),
+                            big, backend)
+        c[w] = np.where(np.isnan(c[w]), np.where(np.isnan(seed_w), seed[w], seed_w), c[w])
     rate = np.full(fxs.size, np.nan)
     h = 1e-4 * (b[:, 1] - b[:, 0])
-    for _ in range(3):  # Newton's steps, the rate by a forward difference
-        g = np.flatnonzero(np.isfinite(c))
+    for step in range(3 + _SEEDED_STEPS):  # Newton's steps, the rate by a forward difference (more from a seed)
+        g = np.flatnonzero(np.isfinite(c) & ((step < 3) | seeded))
         if not g.size:
             break
         ok, probe = _aims_probe(q, film_z, np.tile(fxs[g], 2), np.concatenate([c[g], c[g] + h[g]]), np.zeros(2 * g.size),
@@ -438,6 +467,10 @@ def _chief_aims(q, film_z: float, fxs, boxes, big: float, backend: str) -> tuple
             good = ok[:g.size] & ok[g.size:] & np.isfinite(d) & (d != 0)
             c[g] = np.where(good, c[g] - x[:g.size] / np.where(good, d, 1.0), np.nan)
         rate[g] = d
+    g = np.flatnonzero(seeded & np.isfinite(c))
+    if g.size:  # kept only where its ray passes and crosses the stop at its centre
+        ok, probe = _aims_probe(q, film_z, fxs[g], c[g], np.zeros(g.size), big, backend)
+        c[g[~(ok & (np.abs(probe.x * big) <= _SEEDED_MISS * (b[g, 1] - b[g, 0])))]] = np.nan
     return c, rate
 
 
