@@ -470,7 +470,8 @@ def _chief_aims(q, film_z: float, fxs, boxes, big: float, backend: str) -> tuple
     g = np.flatnonzero(seeded & np.isfinite(c))
     if g.size:  # kept only where its ray passes and crosses the stop at its centre
         ok, probe = _aims_probe(q, film_z, fxs[g], c[g], np.zeros(g.size), big, backend)
-        c[g[~(ok & (np.abs(probe.x * big) <= _SEEDED_MISS * (b[g, 1] - b[g, 0])))]] = np.nan
+        cut = g[~(ok & (np.abs(probe.x * big) <= _SEEDED_MISS * (b[g, 1] - b[g, 0])))]
+        c[cut], rate[cut] = np.nan, np.nan
     return c, rate
 
 
