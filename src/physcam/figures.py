@@ -135,6 +135,7 @@ def _lean_import() -> None:
             import matplotlib.figure  # noqa: F401
         finally:
             sys.meta_path.remove(finder)
+        _png_plugin_only()
     finally:
         gc.freeze()
         if collecting:
@@ -174,6 +175,18 @@ def _import_projections(sys, warnings) -> None:
                 import matplotlib.projections  # noqa: F401
         finally:
             del sys.modules["mpl_toolkits.mplot3d"]
+
+
+def _png_plugin_only() -> None:
+    """Pillow's first save with a format named (matplotlib's PNG) runs ``PIL.Image.preinit``, which imports
+    the BMP, GIF, JPEG and PPM plugins beside PNG's (7-14 ms of CPU). matplotlib has imported PNG's plugin
+    (``matplotlib.colors`` reads its ``PngInfo``), so the program marks that first step done (:func:`_lean_import`).
+    Nothing is lost: Pillow loads every plugin (``PIL.Image.init``) when asked to open or save a format it
+    has not registered, as it does for any format past the first five."""
+    from PIL import Image
+
+    if getattr(Image, "_initialized", None) == 0 and "PNG" in getattr(Image, "SAVE", {}):
+        Image._initialized = 1
 
 
 def _mark_set_generated(cls) -> None:
