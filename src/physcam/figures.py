@@ -100,10 +100,10 @@ def _lean_import() -> None:
     set; a library caller's matplotlib is left whole.
 
     The cycle collector is kept out of the import and then shown the door (``gc.freeze``, as
-    ``physcam serve`` settles its heap): matplotlib's import makes some 60,000 objects that live as long
+    ``physcam serve`` settles its heap): matplotlib's import makes some 75,000 objects that live as long
     as the process (modules, classes, functions), and the program's collection threshold (50,000,
-    :data:`physcam._program.GC_THRESHOLD`) fell twice inside it, each time scanning them all (15-27 ms
-    a collection), and the interpreter's last collection at exit scanned them once more. Frozen, they
+    :data:`physcam._program.GC_THRESHOLD`) fell twice inside it, each collection scanning the 50,000
+    made since the last (15-27 ms), and the interpreter's last collection at exit scanned them once more. Frozen, they
     are never scanned: a cold figure command takes about 0.1 s less CPU (docs/performance.md, issue 47
     round 20). What is alive then stays alive (a frozen cycle is never freed): what the command has
     made so far, which it holds to the end anyway, and the import's own few hundred objects of
