@@ -180,6 +180,15 @@ def _timed(fn) -> float:
     return time.perf_counter() - t0
 
 
+def _tree(path: str) -> str:
+    """``path`` made absolute: the runs start in their own empty folders, where a relative ``--tree .`` would
+    name nothing and Python would import the installed physcam instead (silently measuring it twice)."""
+    tree = os.path.abspath(path)
+    if not os.path.isfile(os.path.join(tree, "src", "physcam", "__init__.py")):
+        raise SystemExit(f"--tree {path}: no src/physcam/__init__.py under {tree}")
+    return tree
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=5)
@@ -191,7 +200,7 @@ def main() -> None:
     unknown = [n for n in names if n not in CASES]
     if unknown:
         raise SystemExit(f"unknown case(s) {unknown}; cases: {', '.join(CASES)}")
-    trees = args.tree or [None]
+    trees = [_tree(t) for t in args.tree] if args.tree else [None]
     print(f"{os.cpu_count()} cores; load average {load()} at start; {args.runs} runs per case and tree")
     print(machine_marks())
     with tempfile.TemporaryDirectory() as scratch:

@@ -97,28 +97,49 @@ def _lean_import() -> None:
     its 3-D toolkit, which registering the ``3d`` projection imports with every figure, and the code of
     :data:`LAZY_MODULES` until something reads them. Only when
     matplotlib is not imported yet and :data:`PROGRAM_IMPORT` (or :data:`physcam._program.RUNNING`) is
-    set; a library caller's matplotlib is left whole."""
+    set; a library caller's matplotlib is left whole.
+
+    The cycle collector is kept out of the import and then shown the door (``gc.freeze``, as
+    ``physcam serve`` settles its heap): matplotlib's import makes some 75,000 objects that live as long
+    as the process (modules, classes, functions), and the program's collection threshold (50,000,
+    :data:`physcam._program.GC_THRESHOLD`) fell twice inside it, each collection scanning the 50,000
+    made since the last (15-27 ms), and the interpreter's last collection at exit scanned them once more. Frozen, they
+    are never scanned: a cold figure command takes about 0.1 s less CPU (docs/performance.md, issue 47
+    round 20). What is alive then stays alive (a frozen cycle is never freed): what the command has
+    made so far, which it holds to the end anyway, and the import's own few hundred objects of
+    garbage."""
     import sys
 
     from . import _program
 
     if not (PROGRAM_IMPORT or _program.RUNNING) or "matplotlib.artist" in sys.modules:
         return
+    import gc
     import warnings
 
-    import matplotlib.artist
-
-    matplotlib.artist.kwdoc = lambda artist: "(see the matplotlib documentation)"
-    # each artist class's set() gets a signature listing its properties, found by inspecting every
-    # method of the class (matplotlib.artist.ArtistInspector: 92 classes, 0.06 s of CPU); set() itself
-    # takes its keywords from the class's alias map, so the program keeps only the flag it checks
-    matplotlib.artist.Artist._update_set_signature_and_docstring = classmethod(_mark_set_generated)
-    finder = _LazyModules()
-    sys.meta_path.insert(0, finder)
+    collecting = gc.isenabled()
+    gc.disable()
     try:
-        _import_projections(sys, warnings)
+        import matplotlib.artist
+
+        matplotlib.artist.kwdoc = lambda artist: "(see the matplotlib documentation)"
+        # each artist class's set() gets a signature listing its properties, found by inspecting every
+        # method of the class (matplotlib.artist.ArtistInspector: 92 classes, 0.06 s of CPU); set() itself
+        # takes its keywords from the class's alias map, so the program keeps only the flag it checks
+        matplotlib.artist.Artist._update_set_signature_and_docstring = classmethod(_mark_set_generated)
+        finder = _LazyModules()
+        sys.meta_path.insert(0, finder)
+        try:
+            _import_projections(sys, warnings)
+            import matplotlib.backends.backend_agg  # noqa: F401  (every figure's canvas)
+            import matplotlib.figure  # noqa: F401
+        finally:
+            sys.meta_path.remove(finder)
+        _png_plugin_only()
     finally:
-        sys.meta_path.remove(finder)
+        gc.freeze()
+        if collecting:
+            gc.enable()
 
 
 #: Modules matplotlib imports once, with a plain ``import``, and reads only for what physcam's figures never
@@ -154,6 +175,18 @@ def _import_projections(sys, warnings) -> None:
                 import matplotlib.projections  # noqa: F401
         finally:
             del sys.modules["mpl_toolkits.mplot3d"]
+
+
+def _png_plugin_only() -> None:
+    """Pillow's first save with a format named (matplotlib's PNG) runs ``PIL.Image.preinit``, which imports
+    the BMP, GIF, JPEG and PPM plugins beside PNG's (7-14 ms of CPU). matplotlib has imported PNG's plugin
+    (``matplotlib.colors`` reads its ``PngInfo``), so the program marks that first step done (:func:`_lean_import`).
+    Nothing is lost: Pillow loads every plugin (``PIL.Image.init``) when asked to open or save a format it
+    has not registered, as it does for any format past the first five."""
+    from PIL import Image
+
+    if getattr(Image, "_initialized", None) == 0 and "PNG" in getattr(Image, "SAVE", {}):
+        Image._initialized = 1
 
 
 def _mark_set_generated(cls) -> None:

@@ -17,7 +17,8 @@ exits 2; a closed pipe exits 0; anything else is a bug and shows a traceback (ex
 The ``physcam`` program is :func:`run`: :func:`main`, then the exit. Once numba's compiler has
 been initialised (a command that traced enough rays to load the JIT kernel), the interpreter's
 module teardown costs 80-100 ms on this machine (docs/performance.md), a sixth of such a
-command's run; :func:`run` then exits the process directly, after the exit handlers have run,
+command's run, and once matplotlib is loaded (a figure command) 9-13 ms, a fiftieth of a cold
+``lens diagram``; :func:`run` then exits the process directly, after the exit handlers have run,
 unreachable objects have been finalised and the output streams flushed.
 """
 
@@ -331,7 +332,7 @@ def run() -> None:
     # spins and doubles the CPU time (`mtf --field 0`: 0.85 -> 0.5 s, the same output; docs/performance.md)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     code = main()
-    if "numba" in sys.modules:
+    if "numba" in sys.modules or "matplotlib" in sys.modules:
         _exit_without_teardown(code)
     _program.finish()
     sys.exit(code)
