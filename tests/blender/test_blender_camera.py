@@ -43,6 +43,7 @@ scene.render.threads_mode = "FIXED"
 scene.render.threads = 2
 scene.view_settings.view_transform = "Standard"
 scene.render.image_settings.file_format = "OPEN_EXR"
+scene.render.use_persistent_data = True  # Cycles keeps its scene and compiled shaders from one render to the next
 for o in list(bpy.data.objects):
     if o.type != "CAMERA":
         bpy.data.objects.remove(o)

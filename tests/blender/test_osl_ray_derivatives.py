@@ -49,11 +49,10 @@ scene.render.image_settings.color_depth = "32"
 cam = cam_obj.data
 cam.type = "CUSTOM"; cam.custom_mode = "INTERNAL"
 pics = {}
+direction_world()  # one world for the message and direct shaders' renders: compiled once (persistent data)
 for name in ("message", "direct", "derivs"):
     if name == "derivs":
         set_world(1.0)
-    else:
-        direction_world()
     text = bpy.data.texts.new(name + ".osl"); text.write(open(sys.argv[1] + "/" + name + ".osl").read())
     cam.custom_shader = text
     errors = []
