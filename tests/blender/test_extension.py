@@ -218,16 +218,19 @@ def _predict(lens, mark_mm, world, sh):
 
 
 def _rows_border(rows):
-    """Cycles' render border's rows (fractions of the frame from the bottom): 24 px beyond the highest and the
-    lowest marker where physcam's trace puts them at either frame's focus (the centroids' windows reach 8 px).
+    """Cycles' render border's rows (fractions of the frame from the bottom): 12 px beyond the highest and the
+    lowest marker where physcam's trace puts them at either frame's focus (the centroids' windows reach 8 px;
+    the markers land within 0.5 px of the trace).
 
     The markers fill three rows of lights across the middle half of the frame: rendering whole frames spent
     46 % of the samples on rows no window reads (the test's Blender 22.8 s CPU, 15.0 s with the border,
-    2026-11-30). Cycles seeds a pixel's samples by its place in
-    the frame, so the pixels inside the border are the full frame's bit for bit (every window's pixels checked
-    against full frames, both frames and the built-in camera's, 2026-11-30); a marker the camera put beyond the
-    border would be cut from its window, failing the test."""
-    return [float(max(min(rows) - 24, 0)) / H, float(min(max(rows) + 25, H)) / H]
+    2026-11-30; 24 px beyond the markers then, 12 now: the two frames' renders 3.28 -> 3.04 s, round 20).
+    Cycles seeds a pixel's samples by its place in the frame, so the pixels inside the border are the full
+    frame's bit for bit (every window's pixels checked against full frames, both frames and the built-in
+    camera's, 2026-11-30; every row inside the 12 px border against the 24 px border's, and every figure the
+    test prints the same, round 20); a marker the camera put beyond the border would be cut from its window,
+    failing the test."""
+    return [float(max(min(rows) - 12, 0)) / H, float(min(max(rows) + 13, H)) / H]
 
 
 def test_keyframed_focus_pull_renders_physcams_focus_states(extension_zip, extension_user, tmp_path):

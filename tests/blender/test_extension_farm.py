@@ -36,12 +36,13 @@ KEYS = ((3.0, 2.8), (0.6, 4.0), (3.0, 8.0), (0.6, 16.0))  # (focus m from the fi
 LIGHTS = {"left": (-0.55, 0.0, -2.95, 0.012), "right": (0.55, 0.0, -2.95, 0.012), "near": (0.0, -0.05, -0.40, 0.0017)}
 BACKDROP = {"rows": (128, 140), "cols": (104, 152)}  # rows from the bottom: the backdrop spans the top
 WINDOW = 14  # px around a light
+PAD = 4  # px of the render border beyond a light's window (_border)
 
 BUILD = installed_dark_scene(samples=64) + '''
 scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = int(sys.argv[3]), int(sys.argv[4]), 100
-scene.render.use_border = True; scene.render.use_crop_to_border = False  # the columns measured (_border)
-scene.render.border_min_x, scene.render.border_max_x = json.loads(sys.argv[10])
-scene.render.border_min_y, scene.render.border_max_y = 0.0, 1.0
+scene.render.use_border = True; scene.render.use_crop_to_border = False  # the pixels measured (_border)
+(scene.render.border_min_x, scene.render.border_max_x, scene.render.border_min_y,
+ scene.render.border_max_y) = json.loads(sys.argv[10])
 light = glow("light", 20.0)
 for x, y, z, r in json.loads(sys.argv[5]).values():
     bpy.ops.mesh.primitive_uv_sphere_add(radius=r, location=(x, y, z), segments=24, ring_count=12)
@@ -116,21 +117,27 @@ def _pinhole(lens, mark_mm):
 
 
 def _border():
-    """The saved file's render border (fractions of the frame's width): the columns from WINDOW + 16 px left of
-    the left light to as far right of the right one, where a pinhole at the pupil puts them (physcam's best-match
-    pinhole at 0.6 and 3 m, the wider of the two; the lights breathe 5 px at most), and the backdrop's columns;
-    every row (the near light's window reaches the bottom, the backdrop the top).
+    """The saved file's render border (fractions of the frame, rows from the bottom): the lights' windows
+    (WINDOW px each way) and :data:`PAD` px more, where a pinhole at the pupil puts the lights (physcam's
+    best-match pinhole at 0.6 and 3 m, each light's outermost of the two: the lights breathe 5 px; the trace
+    puts them within 0.25 px of that, 2026-11-30), and the backdrop's block.
 
-    The frames' columns outside it (black sky and the backdrop's ends, never measured) held a fifth of the two
-    farm renders' samples: 31.1 s of Blender's CPU for both, 28.0 s with the border (2026-11-30). Cycles seeds
-    a pixel's samples by its place in the frame, so the pixels inside are the full frame's bit for bit, the
-    others 0 (all eight frames checked against full frames, 2026-11-30); a light the camera put beyond the
-    border would be cut from its window, failing the test."""
+    The frames' pixels outside it (black sky and the backdrop's ends, never measured) held a fifth of the two
+    farm renders' samples: 31.1 s of Blender's CPU for both, 28.0 s with the columns' border (2026-11-30); the
+    rows from the near light's window to the backdrop's and 4 px of pad instead of 16 (17 % fewer pixels
+    again): the two renders 15.8 -> 13.0 s of Blender's CPU (round 20, docs/performance.md). Cycles seeds a
+    pixel's samples by its place in the frame, so the pixels inside are the full frame's bit for bit, the
+    others 0 (all eight frames checked against full frames, 2026-11-30; every pixel inside the border, so
+    every window and the backdrop's block, against the wider border's, bit for bit, round 20); a light the
+    camera put beyond the border would be cut from its window, failing
+    the test."""
     lens = load_lens(LENS)
-    f = max(_pinhole(lens, 600.0), _pinhole(lens, 3000.0))
-    cols = [W / 2 - 0.5 + f * x / -z * W / SW for x, _, z, _ in LIGHTS.values()]  # the picture is upright
-    c0, c1 = min(min(cols) - WINDOW - 16, BACKDROP["cols"][0]), max(max(cols) + WINDOW + 16, BACKDROP["cols"][1])
-    return [max(c0, 0) / W, min(c1, W) / W]
+    px = [[(W / 2 - 0.5 + f * x / -z * W / SW, H / 2 - 0.5 + f * y / -z * W / SW) for x, y, z, _ in LIGHTS.values()]
+          for f in (_pinhole(lens, 600.0), _pinhole(lens, 3000.0))]  # the picture is upright
+    (c0, r0), (c1, r1) = np.min(px, axis=(0, 1)) - WINDOW - PAD, np.max(px, axis=(0, 1)) + WINDOW + PAD
+    c0, c1 = min(c0, BACKDROP["cols"][0]), max(c1, BACKDROP["cols"][1])
+    r0, r1 = min(r0, BACKDROP["rows"][0]), max(r1, BACKDROP["rows"][1])
+    return [float(max(c0, 0) / W), float(min(c1, W) / W), float(max(r0, 0) / H), float(min(r1, H) / H)]
 
 
 @pytest.fixture(scope="module")
@@ -138,7 +145,13 @@ def predictions():
     """Per frame and light, physcam's tracer (a point light) at that frame's focus and stop: (column,
     row, second moment of the blur in px^2, of the sphere's own image, a disk 2 r f_pin / distance
     across, in px^2); and the backdrop's brightness (camera_rays' relative illumination at those film
-    points, over the centre's)."""
+    points, over the centre's).
+
+    100,000 rays a light (Sobol, ``bokeh_image``), not 400,000: against 400,000 (seed 0), seeds 0-2 at 100,000
+    put every centroid within 0.005 px and every blur diameter within 0.006 px (0.4 %) of it, where the test
+    allows 0.35 px and 12 % or 0.5 px (0.098 -> 0.023 s a light). The backdrop on a 24 x 24 pupil grid a
+    pixel, not 48 x 48: within 0.0014 (0.15 %) of a 96 x 96 grid on every frame (48 x 48: 0.0017), where the
+    test allows 3 % (0.4 -> 0.08 s a frame). Measured 2026-11-30, round 20."""
     lens = load_lens(LENS)
     pitch = SW / W
     out = {}
@@ -152,14 +165,14 @@ def predictions():
             pilot = bokeh_image(state, depth, x * 1000.0, y * 1000.0, rays=20_000, pixels=16, fresnel=False)
             cx, cy = pilot.to_dict()["centroid_mm"]
             h = WINDOW * pitch
-            bk = bokeh_image(state, depth, x * 1000.0, y * 1000.0, rays=400_000, pixels=8 * (2 * WINDOW + 1),
+            bk = bokeh_image(state, depth, x * 1000.0, y * 1000.0, rays=100_000, pixels=8 * (2 * WINDOW + 1),
                              extent_mm=(cx - h, cx + h, cy - h, cy + h), fresnel=False)
             c, row = _to_px(*bk.to_dict()["centroid_mm"])
             own = (2 * r * f_pin / -z) ** 2 / 8
             lights[name] = (c, row, blob_moments(bk.image[..., 0], pitch / 8)[2] / pitch**2, own / pitch**2)
         b = bake_camera(state)
         rows, cols = BACKDROP["rows"], BACKDROP["cols"]
-        bright = predicted_block_brightness(b, {"backdrop": (*rows, *cols)}, W, H, (SW, FRAME_H), samples=48)
+        bright = predicted_block_brightness(b, {"backdrop": (*rows, *cols)}, W, H, (SW, FRAME_H), samples=24)
         out[frame] = {"lights": lights, "backdrop": bright["backdrop"]}
     return out
 

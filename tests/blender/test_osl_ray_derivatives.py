@@ -15,6 +15,14 @@ In Cycles itself, double Gauss focused at 2.5 m, f/2.8, 48 x 32 px, 8 samples, s
   position's): at the frame's centre the output's is the pinhole's in closed form, 2 (w / 2) Dx(u) / f
   (f: physcam.optics.paraxial.gaussian's EFL), and off the axis the trace's own is within 5 % of it
   (seen: 0.03-2 %).
+
+The renders keep Cycles' scene from one to the next (``use_persistent_data``; round 20): the direction
+world's OSL is compiled once, not for each of the two compared renders (Blender's CPU 3.1 -> 2.0 s, the
+pictures the same bit for bit). Persistent data is a cache, and a stale one would make the comparison pass
+whatever the direct shader does (the extension's ghost test saw a camera parameter kept from an earlier
+render, round 20): so a canary shader, the message shader with its throughput times 1.001, is rendered
+between the two compared, and must come out 1.001 times the first picture; the direct shader's render
+follows it, so a stale one would be the canary's, 1000 ulps off.
 """
 
 from __future__ import annotations
@@ -36,6 +44,8 @@ pytestmark = pytest.mark.slow
 _OUT = re.compile(r"    float pin_f = .*?\n    direction = vector\(ray_in\[3\][^\n]*\n", re.S)
 _DIRECT = ("    position = point(px * 0.001, py * 0.001, (FILM_Z - pz) * 0.001);\n"
            "    direction = vector(dx, dy, -dz);\n")
+#: The canary's throughput: the message shader's picture times 1.001 (module notes)
+_CANARY = "    throughput = color(w * 1.001);\n"
 _DERIVS = ("    vector traced = vector(dx, dy, -dz);\n    point raster = camera_shader_raster_position();\n"
            "    vector d_raster = Dx(raster);\n"
            "    throughput = color(length(Dx(direction)), length(Dx(traced)), d_raster[0]);\n")
@@ -49,11 +59,11 @@ scene.render.image_settings.color_depth = "32"
 cam = cam_obj.data
 cam.type = "CUSTOM"; cam.custom_mode = "INTERNAL"
 pics = {}
-for name in ("message", "direct", "derivs"):
+scene.render.use_persistent_data = True  # the direction world compiled once for three renders (module notes)
+direction_world()
+for name in ("message", "canary", "direct", "derivs"):  # the canary between the two compared (module notes)
     if name == "derivs":
         set_world(1.0)
-    else:
-        direction_world()
     text = bpy.data.texts.new(name + ".osl"); text.write(open(sys.argv[1] + "/" + name + ".osl").read())
     cam.custom_shader = text
     errors = []
@@ -71,10 +81,13 @@ def test_traced_ray_unchanged_and_pinhole_derivatives(tmp_path):
     (tmp_path / "message.osl").write_text(src)
     (tmp_path / "direct.osl").write_text(_OUT.sub(_DIRECT, src))
     (tmp_path / "derivs.osl").write_text(src.replace("    throughput = color(w);\n", _DERIVS))
+    (tmp_path / "canary.osl").write_text(src.replace("    throughput = color(w);\n", _CANARY))
     out = run_blender(RUN, tmp_path)
     a, b = np.array(out["message"]), np.array(out["direct"])
     assert (b.sum(axis=2) > 0).mean() > 0.5  # most of the frame sees the world through the lens
     np.testing.assert_array_max_ulp(a.astype(np.float32), b.astype(np.float32), maxulp=8)
+    lit = a > 0  # the canary's render is its own: 1.001 times the message shader's, not the render before
+    np.testing.assert_allclose(np.array(out["canary"])[lit] / a[lit], 1.001, rtol=1e-5)
 
     d = np.array(out["derivs"])  # row 0 = bottom; a pixel: the mean over its samples (lost rays: 0)
     lit = d[..., 2] > 0

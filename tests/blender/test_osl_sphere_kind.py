@@ -8,6 +8,14 @@ round 10): a world whose colour is the ray's direction plus (2, 2, 2), so each p
 ray's weight times its direction. The two pictures agree to float32 rounding (seen: 3e-7 relative;
 with the spheres' A made 1e-4 too large, 9e-6: caught), and the same pixels are dark (rays the lens
 stops).
+
+The renders keep Cycles' scene from one to the next (``use_persistent_data``, tests/blender/test_blender_camera.py's
+SCENE; round 20): the direction world's OSL is compiled once (Blender's CPU 2.9 -> 1.8 s, the pictures the same bit
+for bit). Persistent data is a cache, and a stale one would make the comparison pass whatever the generic code
+does (the extension's ghost test saw a camera parameter kept from an earlier render, round 20): so a canary
+shader, the sphere shader with its throughput times 1.001, is rendered between the two compared, and must come
+out 1.001 times the first picture; the generic shader's render follows it, so a stale one would be the
+canary's, 1e-3 off.
 """
 
 from __future__ import annotations
@@ -45,6 +53,8 @@ def test_sphere_shortcut_gives_the_generic_quadrics_rays(tmp_path):
     assert kinds.count(SPHERE_KIND) == 10  # every glass surface of the double Gauss is a sphere
     (tmp_path / "sphere.osl").write_text(src)
     (tmp_path / "generic.osl").write_text(_generic(src))
+    assert src.count("    throughput = color(w);\n") == 1
+    (tmp_path / "canary.osl").write_text(src.replace("    throughput = color(w);\n", "    throughput = color(w * 1.001);\n"))
     out = run_blender(SCENE + DIRECTION_WORLD + '''
 direction_world()
 scene.cycles.shading_system = True
@@ -55,7 +65,7 @@ scene.render.image_settings.color_depth = "32"
 cam = cam_obj.data
 cam.type = "CUSTOM"; cam.custom_mode = "INTERNAL"
 pics = {}
-for name in ("sphere", "generic"):
+for name in ("sphere", "canary", "generic"):  # the canary between the two compared (module notes)
     text = bpy.data.texts.new(name + ".osl"); text.write(open(sys.argv[1] + "/" + name + ".osl").read())
     cam.custom_shader = text
     pics[name] = render(sys.argv[1] + "/" + name + ".exr", 48, 32, 2)[..., :3].tolist()
@@ -69,3 +79,5 @@ print(json.dumps(pics))
     rel = np.abs(a[both] - b[both]) / np.abs(b[both])
     print("max relative difference", float(rel.max()), "pixels lit", int(both.sum()))
     assert float(rel.max()) < 2e-6
+    lit = a > 0  # the canary's render is its own: 1.001 times the sphere shader's, not the render before
+    np.testing.assert_allclose(np.array(out["canary"])[lit] / a[lit], 1.001, rtol=1e-5)
