@@ -48,7 +48,7 @@ settings.load_profile("physcam")
 
 
 #: Test modules run before every other: the one whose first test builds the session's extension zip
-#: (in one process, the suite's longest step, which every Blender extension test waits for).
+#: (two processes, the suite's longest step, which every Blender extension test waits for).
 #: `make test`'s pytest-xdist (--dist worksteal) hands each worker one half of the collection in
 #: order, and a worker that runs out takes the tail of the other's queue. In the folders' order the zip
 #: was built wherever tests/blender came up on its worker (a fresh clone under load, 2026-11-28: 45
@@ -78,16 +78,15 @@ def pytest_collection_modifyitems(config, items):
 def extension_zip(tmp_path_factory):
     """``physcam export blender-extension`` of ``_session.EXTENSION_LENSES``, built once per test session and shared
     by the Blender extension's tests (building it solves each lens's focus table, the slowest step). Under pytest-xdist the workers share one build: the first worker to ask builds it under a
-    session lock (its module runs first, :data:`LONG_FIRST`, so the build starts at once and the other worker
-    runs other tests meanwhile), the other
+    session lock, with two processes (`--workers`; its module runs first, :data:`LONG_FIRST`, so the build
+    starts at once and the other worker runs other tests meanwhile), the other
     reads it (each worker building its own doubled the suite's slowest step; putting every test that
     uses it on one worker, xdist's loadgroup, made that worker the suite's last by a minute). Here, not
     in tests/blender/conftest.py: with --doctest-modules two conftest modules of one name collide.
 
-    In this process (``--workers 1``), not two spawned ones: the suite's other worker keeps the second core
-    busy meanwhile, and each spawned process imports physcam and compiles the tracer's kernels again: the
-    build 24.2, 24.8 s CPU with two processes, 19.4, 20.3 s with one (this and its child processes,
-    ``/usr/bin/time``, alternating, load 7-9, round 20), the zip's files the same bytes."""
+    Two processes, not this one (round 20 measured this one at 4.6 s less CPU): the session's zip is the
+    pooled build tests/export/test_blender_extension_build.py holds to the one-process tables, the only
+    pooled build of the suite."""
     from _session import EXTENSION_LENSES, session_lock
 
     from physcam.cli import main
@@ -100,7 +99,7 @@ def extension_zip(tmp_path_factory):
 
             lenses = [r.slug for r in list_lenses() if r.slug in EXTENSION_LENSES]  # the library's order
             assert len(lenses) == len(EXTENSION_LENSES), set(EXTENSION_LENSES) - set(lenses)
-            assert main(["export", "blender-extension", "-o", str(out), "--workers", "1",
+            assert main(["export", "blender-extension", "-o", str(out), "--workers", "2",
                          *(f"--lens={slug}" for slug in lenses)]) == 0
     (zp,) = out.glob("physcam-*.zip")
     return zp
