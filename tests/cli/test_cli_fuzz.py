@@ -160,6 +160,12 @@ PRELOAD = ("numpy", "pxr.Usd", "pxr.UsdGeom", "pxr.Sdf", "pxr.Gf",
            "physcam.lens.library", "physcam.onset.report", "physcam.optics.state", "physcam.trace.trace", "physcam.io",
            "physcam.progress", "physcam.cli._config", "physcam.live.sample", "physcam.metadata")
 
+#: A fresh process that forks one child per run. Forking the pytest worker itself is unsafe once
+#: it has run numba's OpenMP kernels (GNU OpenMP aborts a forked child); this server only imports
+#: physcam's command modules and :data:`PRELOAD`, so its children start clean. It serves every leaf of
+#: the module (its state never changes: only the children run commands). One JSON request per line on
+#: stdin, one reply per line.
+#:
 #: Besides imports, the server reads the bundled lens library once (``physcam.lens.library._bundled_index``,
 #: the 51 bundled TOML files parsed and checked: 0.1-0.25 s of CPU in every run that lists the lenses or names a
 #: lens other than by its slug, as most of the drawn lens values do: ``no_such_lens``, ``""``, the long names).
@@ -168,11 +174,6 @@ PRELOAD = ("numpy", "pxr.Usd", "pxr.UsdGeom", "pxr.Sdf", "pxr.Gf",
 #: is tested by tests/lens, and their listing by the CLI by tests/cli/test_lens_cli.py. The module's 727 runs
 #: but the demo's, replayed through both servers: 24.1 -> 22.0 s of CPU (docs/performance.md, round 20); their
 #: peaks now count the index's pages too (a stricter bound, if anything).
-#: A fresh process that forks one child per run. Forking the pytest worker itself is unsafe once
-#: it has run numba's OpenMP kernels (GNU OpenMP aborts a forked child); this server only imports
-#: physcam's command modules and :data:`PRELOAD`, so its children start clean. It serves every leaf of
-#: the module (its state never changes: only the children run commands). One JSON request per line on
-#: stdin, one reply per line.
 FORK_SERVER = r"""
 import importlib, json, os, resource, sys, time, signal
 import physcam.cli
@@ -184,7 +185,7 @@ for name in sorted(set(physcam.cli.COMMAND_MODULES.values())):
 for name in sys.argv[3].split(","):
     importlib.import_module(name)
 import physcam.lens.library
-physcam.lens.library._bundled_index()  # the bundled lenses read once (INDEX_PRELOAD)
+physcam.lens.library._bundled_index()  # the bundled lenses read once (FORK_SERVER's notes)
 
 
 def threads():
