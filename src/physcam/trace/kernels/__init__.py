@@ -40,7 +40,7 @@ from ...errors import BackendError
 __all__ = ["BACKENDS", "SERIAL_BELOW", "backend_for_job", "get_kernel", "resolve_backend", "numba_available", "jit_kernel",
            "numba_load_cost", "rim_pass", "set_compile_reporter", "set_threads", "threads"]
 
-BACKENDS = ("auto", "numba", "numpy")
+BACKENDS = ("auto", "c", "numba", "numpy")
 #: Batches smaller than this run the JIT kernel serially (measured crossover, docs/performance.md).
 SERIAL_BELOW = 1024
 #: "auto" before numba is loaded: the numpy kernel's cost per ray and surface, and per surface and
@@ -136,6 +136,87 @@ def numba_load_cost() -> float:
     return NUMBA_LOAD_S if _jitcache.is_warm() else NUMBA_COMPILE_S
 
 
+_pool = None
+
+
+def run_blocks(f, args, n: int, block: int, serial_below: int) -> None:
+    """Run ``f(*args, b0, b1)`` over the ``n`` rays' blocks of ``block``: on the calling thread below
+    ``serial_below`` rays (or with fewer than two blocks or threads), else one range of blocks per thread
+    (:func:`threads`), the first on the calling thread. Both compiled kernels trace a range without the GIL,
+    and a ray's answer does not depend on its block's range: serial and threaded runs give identical rays."""
+    nb = (n + block - 1) // block
+    k = min(threads(), nb)
+    if n < serial_below or k < 2:
+        f(*args, 0, nb)
+        return
+    global _pool
+    if _pool is None:
+        from concurrent.futures import ThreadPoolExecutor
+
+        _pool = ThreadPoolExecutor(max_workers=max(1, threads() - 1), thread_name_prefix="physcam-trace")
+    cuts = [nb * i // k for i in range(k + 1)]
+    futures = [_pool.submit(f, *args, cuts[i], cuts[i + 1]) for i in range(1, k)]
+    f(*args, cuts[0], cuts[1])
+    for fut in futures:
+        fut.result()
+
+
+class _CKernel:
+    """The compiled C kernel (:mod:`._c`) with the numpy kernel's signature: large batches as one range of
+    blocks per thread as the JIT kernel's (:func:`run_blocks`, :data:`SERIAL_BELOW`, :data:`LOAD_AWARE`)."""
+
+    def __init__(self):
+        from . import _c
+
+        self._C = _c
+
+    def __call__(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
+        below = SERIAL_BELOW
+        if x.shape[0] >= below and LOAD_AWARE and _busy():
+            below = x.shape[0] + 1
+        self.run(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, below, opl)
+
+    def run(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, serial_below,
+            opl=None):
+        """Trace in place (the JIT kernel's :meth:`_JitKernel.run`; an empty ``opl`` is no optical path)."""
+        C = self._C
+        if C.mixed_precision(x, S):
+            from ._numpy import trace_rays
+
+            return trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono,
+                              opl if opl is not None and opl.shape[0] else None)
+        args = (x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono,
+                opl if opl is not None and opl.shape[0] else None)
+        run_blocks(C.trace_range, args, x.shape[0], C.BLOCK, serial_below)
+
+
+_c_kernel = None
+_c_error: str | None = None
+
+
+def _load_c():
+    """The C kernel, or None where the extension was not built (:data:`_c_error` says why)."""
+    global _c_kernel, _c_error
+    if _c_kernel is None and _c_error is None:
+        try:
+            _c_kernel = _CKernel()
+        except ImportError as exc:
+            _c_error = f"{type(exc).__name__}: {exc}"
+    return _c_kernel
+
+
+def c_available() -> bool:
+    """Whether this install has the compiled C kernel (built when physcam was installed: docs/install.md)."""
+    return _load_c() is not None
+
+
+def c_kernel():
+    """The C kernel's ``run`` (the signature of :func:`jit_kernel`'s), None where it was not built. For
+    benchmarks and tests."""
+    k = _load_c()
+    return None if k is None else k.run
+
+
 class _JitKernel:
     """The JIT kernel with the numpy kernel's signature: picks the variant (``_numba.variant``) of the
     call's features, compiles or loads it on first use (telling the compile reporter), and runs a
@@ -150,7 +231,6 @@ class _JitKernel:
         self._no_opl = np.empty(0)
         self._variants: dict = {}  # (features, ray and table dtypes) -> the variant, compiled or loaded for them
         self._asphere: dict = {}  # kinds' bytes -> whether they hold an even asphere
-        self._pool = None
 
     def __call__(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
         below = SERIAL_BELOW
@@ -176,25 +256,7 @@ class _JitKernel:
         if key not in self._variants:
             self._first_call(f, key[:4], args)
             self._variants[key] = f
-        n = x.shape[0]
-        block = self._K.BLOCK
-        nb = (n + block - 1) // block
-        if n < serial_below or nb < 2:
-            f(*args, 0, nb)
-            return
-        k = min(threads(), nb)
-        if k < 2:
-            f(*args, 0, nb)
-            return
-        if self._pool is None:
-            from concurrent.futures import ThreadPoolExecutor
-
-            self._pool = ThreadPoolExecutor(max_workers=max(1, threads() - 1), thread_name_prefix="physcam-trace")
-        cuts = [nb * i // k for i in range(k + 1)]
-        futures = [self._pool.submit(f, *args, cuts[i], cuts[i + 1]) for i in range(1, k)]
-        f(*args, cuts[0], cuts[1])
-        for fut in futures:
-            fut.result()
+        run_blocks(f, args, x.shape[0], self._K.BLOCK, serial_below)
 
     def _first_call(self, f, key, args) -> None:
         """Compile (or load from numba's disk cache) variant ``f`` for these argument types by a call on
@@ -311,6 +373,11 @@ def resolve_backend(backend: str = "auto") -> str:
             raise BackendError(f"PHYSCAM_BACKEND={backend!r} is not one of {', '.join(BACKENDS)}")
     if backend == "auto":
         return "numba" if numba_available() else "numpy"
+    if backend == "c" and not c_available():
+        raise BackendError(f"the c backend is not built in this install ({_c_error}): reinstall physcam from a "
+                           "platform wheel, or from source with a C compiler present (pip install --force-reinstall "
+                           "--no-deps physcam), or trace with backend='numpy' (the same rays) or 'numba' (pip install "
+                           "'physcam[fast]')")
     if backend == "numba" and not numba_available():
         if _numba_error.startswith(("ModuleNotFoundError", "ImportError")) and "numba" in _numba_error:
             raise BackendError("the numba backend needs physcam's 'fast' extra (numba is not installed): "
@@ -368,8 +435,11 @@ def get_kernel(backend: str = "auto"):
         if env == "auto":
             return _numba_kernel if _numba_kernel is not None else _auto
         backend = resolve_backend(backend)  # PHYSCAM_BACKEND, checked (its message names the variable)
-    if resolve_backend(backend) == "numba":
+    backend = resolve_backend(backend)
+    if backend == "numba":
         return _load_numba()
+    if backend == "c":
+        return _load_c()
     from ._numpy import trace_rays
 
     return trace_rays

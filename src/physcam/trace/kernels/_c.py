@@ -1,0 +1,31 @@
+"""The compiled C kernel (``_ckernel``, built from ``_ckernel.c`` when physcam is installed) with the numpy
+kernel's signature: the numba kernel's blocked passes compiled ahead of time, so tracing with it costs no
+JIT load or compile (docs/ray-tracing.md, "Three kernels"; docs/install.md, "The fast path").
+
+Imported only through :mod:`physcam.trace.kernels`, which also splits large batches into one range of blocks
+per thread for it (:func:`physcam.trace.kernels.run_blocks`, the numba kernel's way: identical rays serial or
+threaded; the C code releases the GIL). A table whose dtype is not the rays' (a mix no physcam caller makes)
+goes to the numpy kernel: the C kernel traces in the rays' precision only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _ckernel  # ImportError where the extension was not built: the caller says how to get it
+
+BLOCK = _ckernel.BLOCK
+trace_blocks = _ckernel.trace_blocks
+_NO_OPL = np.empty(0)
+
+
+def trace_range(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl, b0, b1):
+    """Blocks ``b0`` .. ``b1`` of the batch (the numba variants' ``(..., opl, b0, b1)`` shape, ``opl`` empty
+    for none), on the calling thread without the GIL."""
+    trace_blocks(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, bool(clip), bool(fresnel), float(end_z),
+                 bool(has_end), bool(mono), opl, b0, b1)
+
+
+def mixed_precision(x, S) -> bool:
+    """Whether the table's precision differs from the rays' (the numpy kernel traces those)."""
+    return x.dtype != S.dtype
