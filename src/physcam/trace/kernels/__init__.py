@@ -37,7 +37,8 @@ import os
 
 from ...errors import BackendError
 
-__all__ = ["BACKENDS", "SERIAL_BELOW", "backend_for_job", "get_kernel", "resolve_backend", "numba_available", "jit_kernel",
+__all__ = ["BACKENDS", "SERIAL_BELOW", "backend_for_job", "c_available", "c_kernel", "get_kernel", "loaded_backend",
+           "resolve_backend", "numba_available", "jit_kernel", "run_blocks",
            "numba_load_cost", "rim_pass", "set_compile_reporter", "set_threads", "threads"]
 
 BACKENDS = ("auto", "c", "numba", "numpy")
@@ -60,6 +61,12 @@ NUMBA_LOAD_S = 0.35
 #: (0.12-0.18 s of numpy work) loaded numba for nothing.
 NUMPY_BUDGET_S = NUMBA_LOAD_S
 NUMPY_CALL_MAX_S = NUMBA_LOAD_S
+#: "auto" with the C kernel (where built): its CPU per ray and surface by the instruction set it runs, and the
+#: part of that the JIT kernel saves (dgauss_50mm, 5e5 rays, one wavelength and three with Fresnel, serial,
+#: both kernels on this machine: docs/performance.md, "Round 21: the C kernel"). "auto" rents the C kernel
+#: and counts as rent only what numba would have saved, so numba loads once that reaches its load cost.
+C_RAY_SURFACE_S = {"avx512": 4.6e-9, "avx2": 6.4e-9, "baseline": 10.7e-9}
+C_EXCESS = {"avx512": 0.12, "avx2": 0.35, "baseline": 0.6}
 #: Large batches too run serially while the machine is busy (1-minute load average above the
 #: cores numba uses, plus 0.5): numba's parallel loop splits the blocks statically, so with other
 #: processes on the cores it waits for its slowest thread (benchmarks/small_calls.py measured the
@@ -169,6 +176,7 @@ class _CKernel:
         from . import _c
 
         self._C = _c
+        self.isa = _c.isa  # the instruction set it runs ("avx512", "avx2", "baseline")
 
     def __call__(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
         below = SERIAL_BELOW
@@ -319,23 +327,38 @@ def jit_kernel():
     return None if k is None else k.run
 
 
+def _rent(n: int, rows: int) -> tuple[float, object]:
+    """What a call of ``n`` rays through ``rows`` rows (and the end plane) costs "auto" before numba loads,
+    and the kernel that traces it then: the numpy kernel's time (:data:`NUMPY_RAY_SURFACE_S`,
+    :data:`NUMPY_SURFACE_S`) and None (the numpy kernel), or where the C kernel is built the part of its time
+    the JIT kernel would save (:data:`C_RAY_SURFACE_S` times :data:`C_EXCESS`, by the instruction set it
+    runs) and the C kernel."""
+    c = _load_c()
+    if c is None:
+        return (rows + 1) * (NUMPY_SURFACE_S + n * NUMPY_RAY_SURFACE_S), None
+    isa = c.isa()
+    return (rows + 1) * n * C_RAY_SURFACE_S.get(isa, C_RAY_SURFACE_S["baseline"]) * C_EXCESS.get(isa, 1.0), c
+
+
 def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
-    """The "auto" kernel: numpy until numba pays for its loading, then the JIT kernel (module notes)."""
+    """The "auto" kernel: the C kernel (or, where it was not built, the numpy kernel) until numba pays for
+    its loading, then the JIT kernel (module notes)."""
     global _numpy_spent
     k = _numba_kernel
     if k is None:
+        est, rented = _rent(x.shape[0], kinds.shape[0])
         if _numba_error is None:
-            est = (kinds.shape[0] + 1) * (NUMPY_SURFACE_S + x.shape[0] * NUMPY_RAY_SURFACE_S)
             # a cold JIT cache: compiling costs more than loading (scale >= 1); a call numpy takes even at
             # scale 1 (a report's few chief rays) does not look at the cache (_jitcache: hashlib, the sources)
             small = est < NUMPY_CALL_MAX_S and _numpy_spent + est < NUMPY_BUDGET_S
             scale = 1.0 if small else numba_load_cost() / NUMBA_LOAD_S
             if est < NUMPY_CALL_MAX_S * scale and _numpy_spent + est < NUMPY_BUDGET_S * scale:
                 _numpy_spent += est
-                k = None
             else:
                 k = _load_numba()
         if k is None:
+            if rented is not None:
+                return rented(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl)
             from ._numpy import trace_rays
 
             return trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl)
@@ -346,25 +369,40 @@ def backend_for_job(backend: str, ray_surfaces: float) -> str:
     """The backend for a job whose whole size is known before it starts: ``ray_surfaces`` ray-surface
     intersections in all (a bokeh: its rays times the surfaces plus the film).
 
-    "numpy" when ``backend`` is "auto" (and ``PHYSCAM_BACKEND`` does not say otherwise), numba is
-    not loaded yet and the numpy kernel would do the whole job (:data:`NUMPY_RAY_SURFACE_S` per
-    intersection), with the numpy work this process has done so far, in less time than loading
-    numba takes (:data:`NUMBA_LOAD_S`); ``backend`` unchanged otherwise, so a process that keeps
-    tracing pays for numba once its numpy work would have paid for it. Either way the rays are the
+    "c" (where the C kernel is built) or "numpy" when ``backend`` is "auto" (and ``PHYSCAM_BACKEND`` does
+    not say otherwise), numba is not loaded yet and the job's rent (:func:`_rent`: the numpy kernel's time,
+    or the part of the C kernel's that numba would save), with the rent this process has paid so far, stays
+    under what loading numba costs (:data:`NUMBA_LOAD_S`); ``backend`` unchanged otherwise, so a process
+    that keeps tracing pays for numba once its rent would have paid for it. Either way the rays are the
     same (module notes).
     """
     global _numpy_spent
     if backend != "auto" or os.environ.get("PHYSCAM_BACKEND", "auto") != "auto" or _numba_kernel is not None:
         return backend
-    est = ray_surfaces * NUMPY_RAY_SURFACE_S
+    c = _load_c()
+    if c is None:
+        est = ray_surfaces * NUMPY_RAY_SURFACE_S
+    else:
+        est = _rent(int(ray_surfaces), 0)[0]
+    if _numba_error is not None:  # numba cannot load: the rent is all there is
+        return "numpy" if c is None else "c"
     if _numpy_spent + est < numba_load_cost():
         _numpy_spent += est
-        return "numpy"
+        return "numpy" if c is None else "c"
     return backend
 
 
+def loaded_backend() -> str:
+    """The kernel "auto" traces with in this process now: "numba" once loaded, else "c" where the C kernel is
+    built, else "numpy" (``python -m physcam.trace.kernels`` prints it with what this install has)."""
+    if _numba_kernel is not None:
+        return "numba"
+    return "c" if c_available() else "numpy"
+
+
 def resolve_backend(backend: str = "auto") -> str:
-    """The concrete backend name ("numba" or "numpy") for ``backend``."""
+    """The concrete backend name ("c", "numba" or "numpy") for ``backend``: "auto" resolves to numba where
+    it loads (this loads it: for jobs known to be large), else to the C kernel where built, else numpy."""
     if backend not in BACKENDS:
         raise BackendError(f"unknown tracing backend {backend!r}; use one of {', '.join(BACKENDS)}")
     if backend == "auto":
@@ -372,7 +410,9 @@ def resolve_backend(backend: str = "auto") -> str:
         if backend not in BACKENDS:
             raise BackendError(f"PHYSCAM_BACKEND={backend!r} is not one of {', '.join(BACKENDS)}")
     if backend == "auto":
-        return "numba" if numba_available() else "numpy"
+        if numba_available():
+            return "numba"
+        return "c" if c_available() else "numpy"
     if backend == "c" and not c_available():
         raise BackendError(f"the c backend is not built in this install ({_c_error}): reinstall physcam from a "
                            "platform wheel, or from source with a C compiler present (pip install --force-reinstall "

@@ -16,6 +16,9 @@ from . import _ckernel  # ImportError where the extension was not built: the cal
 
 BLOCK = _ckernel.BLOCK
 trace_blocks = _ckernel.trace_blocks
+#: the instruction set the kernel runs: the widest this CPU has of the build's ("avx512", "avx2" on x86-64
+#: with GCC; else "baseline"); ``set_isa`` picks another of ``isa_levels()`` (tests: each gives the same rays)
+isa, isa_levels, set_isa = _ckernel.isa, _ckernel.isa_levels, _ckernel.set_isa
 _NO_OPL = np.empty(0)
 
 
