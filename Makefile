@@ -50,7 +50,8 @@ $(DEPS): $(JIT_DEPS) pyproject.toml constraints.txt
 	$(UV) pip install --quiet --compile-bytecode --python $(PY) -c constraints.txt -r pyproject.toml --extra test pip
 	touch $(DEPS)
 
-$(STAMP): $(DEPS)
+# the editable install builds the C tracing kernel into src/ (setup.py): a change to its source rebuilds it
+$(STAMP): $(DEPS) setup.py src/physcam/trace/kernels/_ckernel.c
 	$(UV) pip install --quiet --compile-bytecode --python $(PY) --no-deps -e .
 	touch $(STAMP)
 

@@ -7,6 +7,9 @@ setuptools. The flags keep IEEE arithmetic in the reference's order: no fast-mat
 multiply-adds (they change the last bits; docs/ray-tracing.md); -fno-math-errno lets sqrt be one instruction.
 """
 
+import os
+import shutil
+
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
@@ -16,13 +19,24 @@ MSVC_FLAGS = ["/O2", "/fp:precise"]
 
 
 class BuildExt(build_ext):
-    """build_ext with the compiler's flags for IEEE arithmetic (module notes)."""
+    """build_ext with the compiler's flags for IEEE arithmetic (module notes), whose copy into the source tree
+    (an editable install, ``--inplace``) replaces the module file instead of writing over it: the test
+    environments install the same tree editable one after another while another's suite may have the old
+    module loaded (a shared library written over in place can crash the process that mapped it)."""
 
     def build_extensions(self):
         flags = MSVC_FLAGS if self.compiler.compiler_type == "msvc" else UNIX_FLAGS
         for ext in self.extensions:
             ext.extra_compile_args = list(flags)
         super().build_extensions()
+
+    def copy_file(self, infile, outfile, *args, **kwargs):
+        if not str(outfile).endswith((".so", ".pyd")) or not os.path.isfile(infile):
+            return super().copy_file(infile, outfile, *args, **kwargs)
+        tmp = f"{outfile}.{os.getpid()}.tmp"
+        shutil.copy2(infile, tmp)
+        os.replace(tmp, outfile)
+        return outfile, 1
 
 
 setup(

@@ -135,10 +135,29 @@ def test_the_core_installs_light_and_runs_the_report(installed):
     fits = [p.name for p in (inst["site"] / "physcam" / "data" / "glass" / "fits").glob("*.json")]
     assert sorted(fits) == sorted(p.name for p in (ROOT / "src/physcam/data/glass/fits").glob("*.json")) != []
     assert "warning" not in listed.stderr, listed.stderr
-    # the light core (issue 26's goal, under 300 MB): numba is the 'fast' extra, the numpy kernels trace
+    # the light core (issue 26's goal, under 300 MB): numba is the 'fast' extra; the C kernel (or, where it could
+    # not be built, the numpy kernel) traces
     assert inst["core_mb"] < 300.0, f"the core install is {inst['core_mb']:.0f} MB"
     assert "No module named 'numba'" in _run([inst["py"], "-c", "import numba"], inst["work"], env=inst["env"],
                                              check=False).stderr
+    # issue 47's install row, the fast path without numba: the core wheel is a platform wheel with the compiled
+    # C kernel (setup.py), which "auto" traces with; a command's output is the numpy kernel's to the byte
+    # (both kernels give the same rays: tests/trace/test_simd_kernel.py), and the process loaded the C
+    # kernel, never numba. (One process for both runs: the second sets PHYSCAM_BACKEND=numpy.)
+    assert "-py3-none-any" not in inst["wheel"].name, inst["wheel"].name
+    kinds = _run([inst["py"], "-m", "physcam.trace.kernels"], inst["work"], env=inst["env"]).stdout.splitlines()
+    assert kinds[0].startswith("c: built (") and kinds[1:] == ["numba: not installed", "numpy: always", "auto: c"]
+    code = ("import io, os, sys, json, contextlib\nfrom physcam.cli import main\nout = []\n"
+            "for backend in ('auto', 'numpy'):\n"
+            "    os.environ['PHYSCAM_BACKEND'] = backend\n    buf = io.StringIO()\n"
+            "    with contextlib.redirect_stdout(buf):\n"
+            "        assert main(['bokeh', '--lens', 'dgauss_50mm', '--rays', '20000', '--pixels', '16', '--spectral',"
+            " '--json']) == 0\n"
+            "    out.append(buf.getvalue())\n"
+            "    if backend == 'auto':\n"
+            "        seen = ['physcam.trace.kernels._ckernel' in sys.modules, 'numba' in sys.modules]\n"
+            "print(json.dumps([out[0] == out[1], json.loads(out[0])['rays_passed'] > 0, *seen]))")
+    assert json.loads(_run([inst["py"], "-c", code], inst["work"], env=inst["env"]).stdout) == [True, True, True, False]
     # the tracer and an analysis figure
     _physcam(inst, "mtf", "dgauss_50mm", "--fstop", "8", "--field", "5", "--pupil-samples", "32", "-o", "mtf.png")
     assert (inst["work"] / "mtf.png").stat().st_size > 10_000

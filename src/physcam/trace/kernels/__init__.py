@@ -85,7 +85,7 @@ _threads_default: int | None = None
 
 
 def set_threads(n: int | None) -> None:
-    """Threads the JIT kernel runs large batches on (None: numba's ``NUMBA_NUM_THREADS``, the cores)."""
+    """Threads the compiled kernels run large batches on (None: numba's ``NUMBA_NUM_THREADS``, the cores)."""
     global _threads_set
     if n is not None and (isinstance(n, bool) or not isinstance(n, int) or n < 1):
         raise BackendError(f"threads must be a whole number from 1, got {n!r}")
@@ -93,17 +93,22 @@ def set_threads(n: int | None) -> None:
 
 
 def threads() -> int:
-    """Threads the JIT kernel uses for a large batch (:func:`set_threads`)."""
+    """Threads the compiled kernels use for a large batch (:func:`set_threads`; by default numba's
+    ``NUMBA_NUM_THREADS``: the cores this process may use)."""
     if _threads_set is not None:
         return _threads_set
     global _threads_default
     if _threads_default is None:
-        try:
-            import numba
+        import sys
 
+        numba = sys.modules.get("numba")  # never imported for this: the C kernel runs without numba
+        try:
             _threads_default = max(1, int(numba.config.NUMBA_NUM_THREADS))
-        except (ImportError, AttributeError):
-            _threads_default = os.cpu_count() or 1
+        except AttributeError:  # numba not loaded: its setting, else the cores this process may use (numba's default)
+            try:
+                _threads_default = max(1, int(os.environ.get("NUMBA_NUM_THREADS") or len(os.sched_getaffinity(0))))
+            except (AttributeError, ValueError):
+                _threads_default = os.cpu_count() or 1
     return _threads_default
 
 
