@@ -14,7 +14,7 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 #: GCC and clang; MSVC's /fp:precise does not contract (its /fp:contract is off unless asked for)
-UNIX_FLAGS = ["-O3", "-ffp-contract=off", "-fno-fast-math", "-fno-math-errno", "-fno-trapping-math", "-std=c99"]
+UNIX_FLAGS = ["-O3", "-g0", "-ffp-contract=off", "-fno-fast-math", "-fno-math-errno", "-fno-trapping-math", "-std=c99"]
 MSVC_FLAGS = ["/O2", "/fp:precise"]
 
 

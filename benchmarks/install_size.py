@@ -8,7 +8,12 @@ then where the bulk sits inside (bytecode, test suites, static libraries nobody 
 pip and setuptools are not in the figure (`python -m venv` adds 22.3 MB of them on Python 3.11, pip
 alone on 3.12 and later): they are printed apart with `--venv-tools`.
 
+It also says whether the install has physcam's compiled tracing kernel (the C extension built into a
+platform wheel: the fast path without numba, issue 47's install row) and what "auto" traces with there
+(``python -m physcam.trace.kernels`` run in the venv).
+
     .venv/bin/python benchmarks/install_size.py --extras fast --scratch /tmp/r8-size/bench
+    .venv/bin/python benchmarks/install_size.py --extras '' --scratch /tmp/r21-size   # the core alone
     .venv/bin/python benchmarks/install_size.py --measure /tmp/r8-size/fast     # an existing venv
 """
 
@@ -60,6 +65,17 @@ def bulk(site: Path) -> list[tuple[str, float]]:
             ("matplotlib's fonts (mpl-data/fonts)", _mb(site.glob("matplotlib/mpl-data/fonts/**/*")))]
 
 
+def fast_path(venv: Path, site: Path) -> str:
+    """The compiled C kernel in the install (its file and size) and the kernels it reports."""
+    built = sorted(site.glob("physcam/trace/kernels/_ckernel*"))
+    built = [p for p in built if p.suffix in (".so", ".pyd")]
+    what = (f"compiled C kernel: {built[0].name} ({_mb(built) * 1e3:.0f} kB)" if built
+            else "compiled C kernel: none (not built: the numpy kernel traces)")
+    p = subprocess.run([str(venv / "bin" / "python"), "-m", "physcam.trace.kernels"], capture_output=True, text=True,
+                       cwd=str(venv))
+    return what + "\n" + (p.stdout.strip() if p.returncode == 0 else f"(python -m physcam.trace.kernels: {p.stderr})")
+
+
 def install(extras: str, scratch: Path) -> Path:
     dist = scratch / "dist"
     subprocess.run([sys.executable, "-m", "build", "--wheel", "-o", str(dist), str(ROOT)], check=True,
@@ -90,6 +106,7 @@ def main(argv=None) -> None:
     print(f"| all | **{total:.1f}** |\n")
     for what, mb in bulk(site):
         print(f"{what}: {mb:.1f} MB")
+    print(fast_path(venv, site))
     if args.venv_tools:
         with tempfile.TemporaryDirectory() as tmp:
             subprocess.run([sys.executable, "-m", "venv", tmp], check=True)
