@@ -1,22 +1,30 @@
-"""Kernel dispatch: ``backend="auto" | "numba" | "numpy"``.
+"""Kernel dispatch: ``backend="auto" | "c" | "numba" | "numpy"``.
 
-The only module that imports numba. Both kernels have the signature of :func:`._numpy.trace_rays`
-(its optional ``opl``: each leg's optical path added to a float64 array, the same in both
-kernels, for the wavefront analyses) and give the same rays: identical flags, positions and directions, Fresnel weights within a few
-units in the last place (docs/ray-tracing.md, tests/trace/test_simd_kernel.py). Set
-``PHYSCAM_BACKEND=numpy`` (or ``numba``) to force one.
+The only module that imports numba. The three kernels have the signature of :func:`._numpy.trace_rays`
+(its optional ``opl``: each leg's optical path added to a float64 array, the same in all, for the wavefront
+analyses) and give the same rays: identical flags, positions and directions, Fresnel weights within a few
+units in the last place (the numba kernel's; the C kernel's are the numpy kernel's bit for bit)
+(docs/ray-tracing.md, "Three kernels"; tests/trace/test_simd_kernel.py). The C kernel (:mod:`._c`) is the
+numba kernel's blocked passes compiled ahead of time when physcam is installed (setup.py: an optional
+extension, so an install without a C compiler has the other two); the numba kernel is the ``fast`` extra.
+Set ``PHYSCAM_BACKEND=c`` (or ``numba``, ``numpy``) to force one; ``python -m physcam.trace.kernels`` says
+which this install has and which "auto" traces with (:func:`loaded_backend`).
 
-"auto" loads numba lazily, when it pays: importing numba and loading the cached JIT kernel cost
-about 0.2 s once per process, more than a short command's whole tracing work in the numpy kernel
-(a spot diagram, a distortion curve: 10-40 ms). So "auto" runs the numpy kernel while the work it
-has done (estimated from rays x surfaces, :data:`NUMPY_RAY_SURFACE_S`, :data:`NUMPY_SURFACE_S`)
-stays under :data:`NUMPY_BUDGET_S` and the call at hand under :data:`NUMPY_CALL_MAX_S`; the first
-call past either loads numba, and from then on (or whenever numba is already loaded) every call
-uses the JIT kernel. Since the kernels agree, the answer does not depend on which one ran. Before
+"auto" rents a kernel that costs nothing to load, the C kernel where built (else the numpy kernel), and
+loads numba only when that pays: rent-or-buy on what numba would save (:func:`_rent`). With the numpy
+kernel that is its whole time: importing numba and loading the cached JIT kernel cost about 0.2 s once per
+process, more than a short command's whole tracing work in the numpy kernel (a spot diagram, a distortion
+curve: 10-40 ms). With the C kernel it is the part of the C kernel's time the JIT kernel would save
+(:data:`C_RAY_SURFACE_S` times :data:`C_EXCESS`, by instruction set: 10 % at AVX-512, 40 % at AVX2), so
+numba loads only after seconds of tracing. So "auto" runs the rented kernel while the rent it has paid
+stays under :data:`NUMPY_BUDGET_S` and the call at hand's under :data:`NUMPY_CALL_MAX_S`; the first call
+past either loads numba, and from then on (or whenever numba is already loaded) every call uses the JIT
+kernel. Since the kernels agree, the answer does not depend on which one ran. Before
 numba's disk cache holds compiled kernels (the first commands after an install or upgrade), making
 the JIT kernel ready means compiling it (:data:`NUMBA_COMPILE_S`, :func:`numba_load_cost`), and the
 budgets grow in proportion: a job the numpy kernel does faster than the compile stays in numpy.
 
+The C kernel runs large batches as the JIT kernel does (:func:`run_blocks`), with no variants to compile.
 The JIT kernel is one compiled variant per feature set (``_numba.variant``: one wavelength or each
 ray's own, optical path, Fresnel weights, aspheres), each compiled on first use with the passes it
 calls only; :func:`set_compile_reporter` hears about a compile as it happens. It runs on the calling
@@ -62,11 +70,13 @@ NUMBA_LOAD_S = 0.35
 NUMPY_BUDGET_S = NUMBA_LOAD_S
 NUMPY_CALL_MAX_S = NUMBA_LOAD_S
 #: "auto" with the C kernel (where built): its CPU per ray and surface by the instruction set it runs, and the
-#: part of that the JIT kernel saves (dgauss_50mm, 5e5 rays, one wavelength and three with Fresnel, serial,
-#: both kernels on this machine: docs/performance.md, "Round 21: the C kernel"). "auto" rents the C kernel
-#: and counts as rent only what numba would have saved, so numba loads once that reaches its load cost.
-C_RAY_SURFACE_S = {"avx512": 4.6e-9, "avx2": 6.4e-9, "baseline": 10.7e-9}
-C_EXCESS = {"avx512": 0.12, "avx2": 0.35, "baseline": 0.6}
+#: part of that the JIT kernel saves (benchmarks/trace.py, dgauss_50mm, 1e6 rays, one thread, each kernel
+#: paired with the JIT kernel on this machine: 18.7 against 19.7 M rays/s at AVX-512, 12.4 against 19.6 at
+#: AVX2, 6.4 against 19.0 at the x86-64 baseline; docs/performance.md, "Round 21: the C kernel"). "auto"
+#: rents the C kernel and counts as rent only what numba would have saved, so numba loads once that reaches
+#: its load cost: after about 3.5 s of the C kernel's work at AVX-512, 0.9 s at AVX2, 0.5 s at the baseline.
+C_RAY_SURFACE_S = {"avx512": 4.5e-9, "avx2": 6.7e-9, "baseline": 13e-9}
+C_EXCESS = {"avx512": 0.1, "avx2": 0.4, "baseline": 0.67}
 #: Large batches too run serially while the machine is busy (1-minute load average above the
 #: cores numba uses, plus 0.5): numba's parallel loop splits the blocks statically, so with other
 #: processes on the cores it waits for its slowest thread (benchmarks/small_calls.py measured the
@@ -474,7 +484,7 @@ _rim_points = None
 
 
 def get_kernel(backend: str = "auto"):
-    """The ``trace_rays`` function of ``backend`` ("auto": numpy until numba pays, module notes)."""
+    """The ``trace_rays`` function of ``backend`` ("auto": the C or numpy kernel until numba pays, module notes)."""
     if backend == "auto":
         env = os.environ.get("PHYSCAM_BACKEND", "auto")
         if env == "auto":

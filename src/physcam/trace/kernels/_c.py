@@ -10,16 +10,11 @@ goes to the numpy kernel: the C kernel traces in the rays' precision only.
 
 from __future__ import annotations
 
-import numpy as np
-
-from . import _ckernel  # ImportError where the extension was not built: the caller says how to get it
-
-BLOCK = _ckernel.BLOCK
-trace_blocks = _ckernel.trace_blocks
-#: the instruction set the kernel runs: the widest this CPU has of the build's ("avx512", "avx2" on x86-64
-#: with GCC; else "baseline"); ``set_isa`` picks another of ``isa_levels()`` (tests: each gives the same rays)
-isa, isa_levels, set_isa = _ckernel.isa, _ckernel.isa_levels, _ckernel.set_isa
-_NO_OPL = np.empty(0)
+# ImportError where the extension was not built: the caller says how to get it. (Absolute: the extension has
+# no .py source for the architecture tests to find.)
+# isa: the instruction set the kernel runs, the widest this CPU has of the build's ("avx512", "avx2" on x86-64
+# with GCC; else "baseline"); set_isa picks another of isa_levels() (tests: each gives the same rays)
+from physcam.trace.kernels._ckernel import BLOCK, isa, isa_levels, set_isa, trace_blocks  # noqa: F401  (compiled)
 
 
 def trace_range(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl, b0, b1):
