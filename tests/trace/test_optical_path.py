@@ -10,13 +10,13 @@ import pytest
 from physcam.lens.library import load_lens
 from physcam.lens.prescription import Medium, Prescription, Surface
 from physcam.trace import OK, RayBatch
-from physcam.trace.kernels import get_kernel, numba_available
+from physcam.trace.kernels import c_available, get_kernel, numba_available
 from physcam.trace.kernels._layout import pack
 from physcam.trace.surfaces import surface_table
 from physcam.trace.tables import packed_table
 from physcam.trace.trace import trace_packed
 
-BACKENDS = ["numpy"] + (["numba"] if numba_available() else [])
+BACKENDS = ["numpy"] + (["numba"] if numba_available() else []) + (["c"] if c_available() else [])
 
 
 def fan(n, seed, sd, mixed):
