@@ -29,6 +29,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#if defined(_MSC_VER) && !defined(__clang__)
+#define restrict __restrict /* MSVC's C before C11 */
+#endif
+
 #define BLOCK 256
 /* scratch columns, each BLOCK long (the numba kernel's; ACT, CONV reuse CI, CT and DS reuses UPD) */
 enum { PX, PY, PZ, DX, DY, DZ, W, WD, CD, T, L2, U, N1, N2, ETA, GX, GY, GZ, CI, CT, UPD, NCOL };
