@@ -203,8 +203,10 @@ class Grid:
         if bad or not kinds:
             raise InputError(f"cell kinds are some of {', '.join(KINDS)}, got {list(self.kinds)!r}"
                              + (": the grid is empty" if not kinds else ""))
-        if self.backend not in ("auto", "numba", "numpy"):
-            raise InputError(f"backend is auto, numba or numpy, got {self.backend!r}")
+        from ..trace.kernels import BACKENDS  # (the tracer's backends: auto, c, numba, numpy)
+
+        if self.backend not in BACKENDS:
+            raise InputError(f"backend is one of {', '.join(BACKENDS)}, got {self.backend!r}")
         return replace(self, focus_mm=marks, fstops=stops, wavelengths_nm=wl, kinds=kinds,
                        sensor_mm=(float(self.sensor_mm[0]), float(self.sensor_mm[1])), resolution=tuple(res))
 
