@@ -289,3 +289,39 @@ def test_strided_columns_and_a_table_of_another_precision_give_the_same_rays():
     get_kernel("numpy")(*b.columns(), p.S, p.kinds, True, True, 120.0, True, False)
     for u, v in zip(a.columns(), b.columns()):
         np.testing.assert_array_equal(u, v)
+
+
+@needs_c
+def test_the_c_kernel_releases_the_gil_while_it_traces():
+    """Python runs on another thread while the C kernel traces (else its block ranges on threads would run
+    one after another): a thread traces 1e6 rays through a lens with aspheres (about 0.1-0.5 s) while the
+    main thread sleeps 10 ms from the moment the trace began; waking needs the GIL, so the main thread wakes
+    before the trace ends only if the C call gave the GIL up (a build without Py_BEGIN_ALLOW_THREADS wakes
+    after, checked)."""
+    import threading
+    import time
+
+    from physcam.trace.kernels import _c
+    from physcam.trace.tables import packed_table
+
+    lens = load_lens("canon_rf_85mm_f1_2")
+    p = packed_table(lens, coating="single")
+    a = random_rays(lens, 1_000_000, 2, True)
+    nb = (len(a) + _c.BLOCK - 1) // _c.BLOCK
+    cols = a.columns()
+    started = threading.Event()
+    times = {}
+
+    def work():
+        started.set()
+        _c.trace_blocks(*cols, p.S, p.kinds, True, True, 120.0, True, False, None, 0, nb)
+        times["end"] = time.perf_counter()
+
+    t = threading.Thread(target=work)
+    t.start()
+    started.wait()
+    time.sleep(0.01)
+    times["woke"] = time.perf_counter()
+    t.join()
+    assert times["woke"] < times["end"]
+    assert (a.flag == 0).sum() > 1000
