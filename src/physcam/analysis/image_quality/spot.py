@@ -317,10 +317,12 @@ def spot_diagram(
     paraxial entrance pupil, not overfilled). A field where no ray reaches the film is undefined
     (module notes).
     """
+    from ... import _program
     from ...optics.paraxial import gaussian
     from ...trace import CLIPPED, MISSED, OK, TIR, paraxial_image_z, trace_to_film
     from .._camera import ray_view
 
+    _program.roomy_heap()  # the program's heap keeps freed pages: the levels' arrays of 1e5 rays come and go
     lens, object_z, film_z, stop, aperture, wl, _ = ray_view(camera, wavelength_nm=wavelength_nm)
     wl = require_finite("wavelength_nm", wl)
     rings = _whole("rings", rings, 1, MAX_RINGS)
