@@ -483,8 +483,14 @@ def _skip_layout_rerun(fig) -> None:
         pass
 
 
+#: The dots per inch figures are saved at (:func:`save_figure`, :func:`figure_bytes`). A figure laid out at the
+#: dpi it is saved at (made with ``dpi=SAVE_DPI``) is measured and drawn by one renderer, which remembers its
+#: text metrics (``physcam compare``'s figure: docs/performance.md, round 21).
+SAVE_DPI = 130
+
+
 @styled
-def save_figure(fig, path, *, force: bool = False, dpi: int = 130) -> Path:
+def save_figure(fig, path, *, force: bool = False, dpi: int = SAVE_DPI) -> Path:
     """Write ``fig`` to ``path`` (.png, .svg or .pdf, from the extension) and close it.
 
     Raises :class:`~physcam.errors.ExportError` for another extension or an existing file
@@ -503,7 +509,7 @@ def save_figure(fig, path, *, force: bool = False, dpi: int = 130) -> Path:
 
 
 @styled
-def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130, description: str | None = None) -> bytes:
+def figure_bytes(fig, fmt: str = "svg", *, dpi: int = SAVE_DPI, description: str | None = None) -> bytes:
     """``fig`` drawn in memory as ``fmt`` ("png", "svg" or "pdf") and closed: what :func:`save_figure`
     writes, for a caller that sends it elsewhere (``physcam serve``). ``description`` (SVG and PDF)
     goes into the file's metadata (SVG: ``dc:description``), e.g. numbers a web page reads."""

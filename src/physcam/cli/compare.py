@@ -312,17 +312,21 @@ def run_lenses(args) -> int:
 
 
 @styled
-def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False):
+def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False, dpi=None):
     """One figure: breathing, distortion and illumination curves of every lens, and their bokeh; the focus
     and light distances in the title and the breathing axis (1 / mark) in ``units`` (m, or ft for feet
-    and inches; film coordinates and bokeh sizes stay in mm). Saved to ``path``, or the Figure."""
+    and inches; film coordinates and bokeh sizes stay in mm). Saved to ``path``, or the Figure.
+
+    ``dpi``: the figure's own, at which it is laid out (default matplotlib's for a returned Figure; for a
+    file, the dpi it is saved at, :data:`physcam.figures.SAVE_DPI`: the layout's text metrics are then the
+    drawing's, measured once, issue 47 round 21)."""
     import numpy as np
 
-    from ..figures import new_figure, save_figure
+    from ..figures import SAVE_DPI, new_figure, save_figure
     from ..units import format_distance
 
     n = len(rows)
-    fig = new_figure(figsize=(11.0, 7.0))
+    fig = new_figure(figsize=(11.0, 7.0), dpi=dpi if dpi is not None or path is None else SAVE_DPI)
     gs = fig.add_gridspec(2, max(3, n))
     cols = max(3, n)
     ax_b = fig.add_subplot(gs[0, : cols // 3])
