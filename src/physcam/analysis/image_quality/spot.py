@@ -176,12 +176,14 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
     flags, fx, fy = trace(F, *points(I, J, 0))
     levels = [(F, I, J, flags, fx, fy)]  # per level: the traced cells (field, i, j) and results
     lookup = []  # per level: sorted keys of the traced cells and their pass/fail status
+    orders = []  # per level: the traced cells' order by key (the lookup's)
     refined = []  # per level: which traced cells were split
 
     def remember(f, i, j, level, st):
         k = keys(f, i, j, level)
         order = np.argsort(k, kind="stable")
         lookup.append((k[order], st[order]))
+        orders.append(order)
 
     def status(f, i, j, level):
         """Pass/fail of cells (f, i, j) at ``level``: their own, else their finest traced ancestor's."""
@@ -206,7 +208,7 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
         ni, nj = ns << lv, nphi << lv
         # visit the cells in key order: each direction's neighbour keys then come nearly sorted,
         # which numpy's binary search exploits
-        order = np.argsort(keys(F, I, J, lv), kind="stable")
+        order = orders[lv]  # (the key order remember() found for this level)
         Fs, Is, Js = F[order], I[order], J[order]
         st = (fl == OK)[order]
         diff_s = np.zeros(I.size, dtype=bool)
