@@ -487,8 +487,8 @@ def _skip_layout_rerun(fig) -> None:
 #: each title itself at every layout pass and every draw (``Axes._update_title_position``), laying out the y
 #: axis whole (ticks, tick labels, label) only to find its offset text, and moves the title only above top
 #: tick labels, a top x label or an offset text it would meet; on an axes with none of these it leaves the
-#: title here, so the picture is the same, byte for byte, for a fifth less of the figure's CPU (a spot
-#: diagram: 25-35 ms; issue 47, round 21). For axes whose ticks and labels stay at the bottom and left.
+#: title here, so the picture is the same, byte for byte, for about a sixth less of the figure's CPU (a spot
+#: diagram's: 25-35 ms; issue 47, round 21). For axes whose ticks and labels stay at the bottom and left.
 TITLE_Y = 1.0
 
 #: The dots per inch figures are saved at (:func:`save_figure`, :func:`figure_bytes`). A figure laid out at the
