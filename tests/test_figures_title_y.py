@@ -1,14 +1,16 @@
-"""Titles placed once (``physcam.figures.TITLE_Y``, issue 47 round 21) are where matplotlib's own placement
+"""Titles placed once (``physcam.figures.title_y``, issue 47 round 21) are where matplotlib's own placement
 leaves them, so the pictures are the same.
 
 matplotlib places each title at every layout pass and draw (``Axes._update_title_position``, matplotlib
 3.11): it starts it at y = 1.0 (axes fraction) and moves it up only (a) above the x axis's tick labels or
 label when they are at the top ("top" or "unknown" tick position, or the label at the top), or (b) above the
 y axis's offset text when that is shown and meets the title, or (c) when the title's bottom is below the
-top of the axes (of its twins and aligned axes too: these figures have none). Checked here on the
-figures that pass ``y=TITLE_Y`` (the spot diagram, the lens comparison), drawn as they are saved, over
-lenses and field counts: none of (a)-(c) holds, so matplotlib would have left each title at 1.0; their
-PNG bytes equal the previous ones' (the round's notes, docs/performance.md)."""
+top of the axes (of its twins and aligned axes too). An offset text can meet the title during a layout
+pass, before the axes have their final place, and so move the margins: ``title_y`` leaves an axes with an
+offset on its y axis (or top ticks, or a twin) to matplotlib (checked on axes made to have each). On the
+figures that pass ``y=title_y(ax)`` (the spot diagram, the lens comparison), drawn as they are saved over
+lenses and field counts, every title is placed once and none of (a)-(c) holds, so matplotlib would have left
+each at 1.0; their PNG bytes equal the previous ones' (the round's notes, docs/performance.md)."""
 
 from __future__ import annotations
 
@@ -16,7 +18,7 @@ import pytest
 
 from physcam.analysis.image_quality.spot import spot_diagram
 from physcam.cli.compare import compare_figure, measure_lens
-from physcam.figures import SAVE_DPI, TITLE_Y, figure_problems
+from physcam.figures import SAVE_DPI, TITLE_Y, figure_problems, new_figure, title_y
 from physcam.lens.library import load_lens
 from physcam.optics.sensors import find_sensor
 from physcam.optics.state import as_designed
@@ -58,3 +60,15 @@ def test_compare_titles():
     for n, r in zip(("dgauss_50mm", "sonnar_50mm_f1_5", "tessar_50mm_f2_8"), rows):
         r["name"] = n
     assert _titles_where_matplotlib_leaves_them(compare_figure(rows, curves, sensor=sensor, dpi=SAVE_DPI)) == 6
+
+
+def test_title_y_leaves_to_matplotlib_what_it_might_move():
+    fig = new_figure(figsize=(6.0, 2.0))
+    plain, tiny, top, twinned = fig.subplots(1, 4)
+    for ax in (plain, top, twinned):
+        ax.plot([0.0, 1.0], [-3.0, 2.0])
+    tiny.plot([0.0, 1.0], [0.0, 3e-7])  # the y axis's ticks need an offset text ("1e-7")
+    top.xaxis.tick_top()
+    twinned.twinx()
+    assert title_y(plain) == TITLE_Y
+    assert title_y(tiny) is None and title_y(top) is None and title_y(twinned) is None

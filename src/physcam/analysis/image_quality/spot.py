@@ -117,7 +117,7 @@ class SpotDiagram:
         """Draw one panel per field (positions relative to the centroid, um); write it to ``path`` (PNG/SVG/PDF)
         and return the path, else return the figure. ``context`` (the shot: f-stop, focus) is a line under
         the panels, laid out with them in one pass (:meth:`_lay_out`)."""
-        from ...figures import TITLE_Y, dots, fit_title, pyplot
+        from ...figures import dots, fit_title, pyplot, title_y
 
         plt = pyplot()
 
@@ -130,12 +130,12 @@ class SpotDiagram:
             if not f.defined:
                 ax.text(0.5, 0.5, "undefined:\nno ray reaches the film", ha="center", va="center",
                         transform=ax.transAxes, fontsize=8)
-                ax.set_title(f"{f.field_deg:g} deg\nRMS undefined", fontsize=8, y=TITLE_Y)
+                ax.set_title(f"{f.field_deg:g} deg\nRMS undefined", fontsize=8, y=title_y(ax))
                 continue
             size = 0.3 * f.weight / f.weight.max()  # refined rim rays weigh less: drawn smaller
             dots(ax, (f.x_mm - f.centroid_x_mm) * 1e3, (f.y_mm - f.centroid_y_mm) * 1e3, size, "k")
             ax.set_title(f"{f.field_deg:g}°: RMS {f.rms_radius_um:.2f} µm,\nGEO {f.geometric_radius_um:.2f} µm",
-                         fontsize=8, y=TITLE_Y)  # (placed once: the ticks stay at the bottom and left)
+                         fontsize=8, y=title_y(ax))  # (placed once where matplotlib would leave it)
         fig.suptitle(fit_title(f"{self.lens_name}: spot diagram at {self.wavelength_nm:g} nm", 3.0 * n), fontsize=9)
         self._lay_out(fig, context)
         if path is None:
