@@ -4,7 +4,7 @@ Each run is a fresh process that runs the command as ``python -m physcam`` does 
 one BLAS thread, ``physcam.cli.main``, the exit without teardown), with CPU time (``time.process_time``: every
 thread of the process, from the interpreter's start) summed inside named functions as the process enters them.
 A function is wrapped when its module is first imported (an import hook), so the run imports nothing it would
-not; a function called inside itself counts once (the outermost call). The parts, for the cases of
+not; a part's functions called inside one another count once (the outermost call). The parts, for the cases of
 ``benchmarks/cold_start.py`` that draw a figure:
 
 - ``kernel``: the ray-tracing kernel, ``trace_rays`` of ``physcam.trace.kernels._numpy`` (the kernel these
@@ -57,18 +57,17 @@ def _child(parts: list[tuple[str, str, str]], argv: list[str]) -> None:
     import time
 
     spent: dict[str, float] = {}
+    depth: dict[str, int] = {}  # per part, so functions of one part called inside one another count once
 
     def timed(fn, part):
-        depth = [0]
-
         def inner(*args, **kwargs):
-            depth[0] += 1
+            depth[part] = depth.get(part, 0) + 1
             t0 = time.process_time()
             try:
                 return fn(*args, **kwargs)
             finally:
-                depth[0] -= 1
-                if depth[0] == 0:
+                depth[part] -= 1
+                if depth[part] == 0:
                     spent[part] = spent.get(part, 0.0) + time.process_time() - t0
 
         return inner
