@@ -173,7 +173,13 @@ def _whole(name: str, value, lo: int, hi: int) -> int:
     return int(value)
 
 
-def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
+#: Largest fine grid (fields x rings x angles at a level) whose cells' pass/fail is looked up in a dense table
+#: (one byte a cell, -1 where not traced at that level) rather than by binary search of sorted keys: the
+#: default spot's finest looked-up level is 6.3 million cells (two fields), 6 MB (issue 47, round 21).
+DENSE_CELLS = 1 << 24
+
+
+def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1, dense_cells: int = DENSE_CELLS):
     """Equal-area cells on the unit disk's (rho^2, phi) grid, refined at the edge of what passes.
 
     ``trace(f, u, v)`` takes field indices and points on the unit disk (all fields in one call,
@@ -183,8 +189,10 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
     A cell is split when its ray passes and an 8-connected neighbour's does not, or the reverse
     (phi wraps, rho^2 does not: beyond the first and last ring the ring itself stands in). A
     neighbour at the current level that was not traced has the status of its finest traced
-    ancestor. Cells are kept sparse (sorted integer keys per level), so the bookkeeping grows with
-    the rays traced, not with the 4^level fine grid.
+    ancestor. A level's cells are looked up in a dense table of its grid while that has at most
+    ``dense_cells`` cells, else kept sparse (sorted integer keys), so the bookkeeping grows with the
+    rays traced, not with the 4^level fine grid; both give the same answers
+    (tests/analysis/image_quality/test_spot_lookup.py compares them).
     """
     from ...trace import OK
 
@@ -207,12 +215,18 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
     I, J = np.tile(i0, n_fields), np.tile(j0, n_fields)
     flags, fx, fy = trace(F, *points(I, J, 0))
     levels = [(F, I, J, flags, fx, fy)]  # per level: the traced cells (field, i, j) and results
-    lookup = []  # per level: sorted keys of the traced cells and their pass/fail status
-    orders = []  # per level: the traced cells' order by key (the lookup's)
+    lookup = []  # per level: a dense table of the grid (-1: not traced), or the traced cells' sorted keys and status
+    orders = []  # per level: the traced cells' order by key (the sparse lookup's), None for a dense one
     refined = []  # per level: which traced cells were split
 
     def remember(f, i, j, level, st):
         k = keys(f, i, j, level)
+        size = n_fields * (ns << level) * (nphi << level)
+        if size <= dense_cells:
+            lookup.append(np.full(size, -1, dtype=np.int8))
+            lookup[-1][k] = st
+            orders.append(None)
+            return
         order = np.argsort(k, kind="stable")
         lookup.append((k[order], st[order]))
         orders.append(order)
@@ -224,10 +238,15 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
         for lv in range(level, -1, -1):
             sh = level - lv
             k = keys(f[todo], i[todo] >> sh, j[todo] >> sh, lv)
-            ks, st = lookup[lv]
-            pos = np.minimum(np.searchsorted(ks, k), ks.size - 1)
-            found = ks[pos] == k
-            out[todo[found]] = st[pos[found]]
+            if orders[lv] is None:  # dense
+                got = lookup[lv][k]
+                found = got >= 0
+                out[todo[found]] = got[found] > 0
+            else:
+                ks, st = lookup[lv]
+                pos = np.minimum(np.searchsorted(ks, k), ks.size - 1)
+                found = ks[pos] == k
+                out[todo[found]] = st[pos[found]]
             todo = todo[~found]
             if todo.size == 0:
                 break
@@ -238,18 +257,19 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
         F, I, J, fl = levels[-1][:4]
         lv = level - 1
         ni, nj = ns << lv, nphi << lv
-        # visit the cells in key order: each direction's neighbour keys then come nearly sorted,
-        # which numpy's binary search exploits
-        order = orders[lv]  # (the key order remember() found for this level)
-        Fs, Is, Js = F[order], I[order], J[order]
-        st = (fl == OK)[order]
+        # a sparse level's cells in key order (remember()'s): neighbour keys come nearly sorted for the search
+        order = orders[lv]
+        Fs, Is, Js, st = (F, I, J, fl == OK) if order is None else (F[order], I[order], J[order], (fl == OK)[order])
         diff_s = np.zeros(I.size, dtype=bool)
+        rows = {di: np.clip(Is + di, 0, ni - 1) for di in (-1, 0, 1)}
+        cols = {dj: (Js + dj) % nj for dj in (-1, 0, 1)}
         for di in (-1, 0, 1):
             for dj in (-1, 0, 1):
                 if di or dj:
-                    diff_s |= status(Fs, np.clip(Is + di, 0, ni - 1), (Js + dj) % nj, lv) != st
-        diff = np.empty_like(diff_s)
-        diff[order] = diff_s
+                    diff_s |= status(Fs, rows[di], cols[dj], lv) != st
+        diff = diff_s if order is None else np.empty_like(diff_s)
+        if order is not None:
+            diff[order] = diff_s
         refined.append(diff)
         if not diff.any():
             break
