@@ -142,11 +142,13 @@ def _lean_import() -> None:
             gc.enable()
 
 
-#: Modules matplotlib imports once, with a plain ``import``, and reads only for what physcam's figures never
-#: draw: TeX's glyph names (``matplotlib.dviread``'s ``fontTools.agl``, 7-10 ms of CPU). The program imports
-#: them lazily: a module's code runs at its first use (docs/performance.md, "Round 10"). (dateutil's parser
-#: cannot be: ``matplotlib.dates`` imports it a second time, and a second import runs a lazy module.)
-LAZY_MODULES = ("fontTools.agl",)
+#: Modules matplotlib imports with a plain ``import``, and reads only for what physcam's figures never
+#: draw: TeX's glyph names (``matplotlib.dviread``'s ``fontTools.agl``, 7-10 ms of CPU), and dates on an axis
+#: (``matplotlib.dates``, imported by ``matplotlib.axes`` to register its unit converters, with dateutil's
+#: rrule, tz and parser; the parser also imported by ``matplotlib.category``: 8-10 ms of CPU). The program
+#: imports them lazily: a module's code runs at its first use, or at its next ``import``, which reads the module
+#: (docs/performance.md, "Round 10", "Round 21"); the date converters are then registered as matplotlib does.
+LAZY_MODULES = ("fontTools.agl", "matplotlib.dates", "dateutil.parser")
 
 
 class _LazyModules:
@@ -481,8 +483,38 @@ def _skip_layout_rerun(fig) -> None:
         pass
 
 
+#: Where matplotlib leaves a title that has nothing to clear (axes fraction): :func:`title_y`.
+TITLE_Y = 1.0
+
+
+def title_y(ax):
+    """``ax.set_title(..., y=title_y(ax))``, called once the axes holds its data: :data:`TITLE_Y` (the title
+    placed once) where matplotlib's own placement would leave it there, else None (matplotlib places it).
+
+    matplotlib places each title at every layout pass and every draw (``Axes._update_title_position``),
+    laying out the y axis whole (ticks, tick labels, label) to find its offset text, and moves the title only
+    above top tick labels, a top x label or an offset text ("1e-7") it meets at that moment, which can be
+    during a layout pass, before the axes have their final place. An axes with none of these (x ticks and
+    label at the bottom, no offset on the y axis for its ticks now, no twin) keeps its title at 1.0, and the
+    picture is the same, byte for byte, for about a sixth less of a figure's CPU (a spot diagram's 25-35 ms;
+    issue 47, round 21)."""
+    xaxis, yaxis = ax.xaxis, ax.yaxis
+    if xaxis.get_ticks_position() in ("top", "unknown") or xaxis.get_label_position() == "top":
+        return None
+    if ax._twinned_axes.get_siblings(ax) != [ax] or ax.child_axes:
+        return None
+    formatter = yaxis.get_major_formatter()
+    formatter.format_ticks(yaxis.get_majorticklocs())  # (what each draw does first: its offset for these ticks)
+    return None if formatter.get_offset() else TITLE_Y
+
+#: The dots per inch figures are saved at (:func:`save_figure`, :func:`figure_bytes`). A figure laid out at the
+#: dpi it is saved at (made with ``dpi=SAVE_DPI``) is measured and drawn by one renderer, which remembers its
+#: text metrics (``physcam compare``'s figure: docs/performance.md, round 21).
+SAVE_DPI = 130
+
+
 @styled
-def save_figure(fig, path, *, force: bool = False, dpi: int = 130) -> Path:
+def save_figure(fig, path, *, force: bool = False, dpi: int = SAVE_DPI) -> Path:
     """Write ``fig`` to ``path`` (.png, .svg or .pdf, from the extension) and close it.
 
     Raises :class:`~physcam.errors.ExportError` for another extension or an existing file
@@ -501,7 +533,7 @@ def save_figure(fig, path, *, force: bool = False, dpi: int = 130) -> Path:
 
 
 @styled
-def figure_bytes(fig, fmt: str = "svg", *, dpi: int = 130, description: str | None = None) -> bytes:
+def figure_bytes(fig, fmt: str = "svg", *, dpi: int = SAVE_DPI, description: str | None = None) -> bytes:
     """``fig`` drawn in memory as ``fmt`` ("png", "svg" or "pdf") and closed: what :func:`save_figure`
     writes, for a caller that sends it elsewhere (``physcam serve``). ``description`` (SVG and PDF)
     goes into the file's metadata (SVG: ``dc:description``), e.g. numbers a web page reads."""

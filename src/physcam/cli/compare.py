@@ -312,17 +312,21 @@ def run_lenses(args) -> int:
 
 
 @styled
-def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False):
+def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False, dpi=None):
     """One figure: breathing, distortion and illumination curves of every lens, and their bokeh; the focus
     and light distances in the title and the breathing axis (1 / mark) in ``units`` (m, or ft for feet
-    and inches; film coordinates and bokeh sizes stay in mm). Saved to ``path``, or the Figure."""
+    and inches; film coordinates and bokeh sizes stay in mm). Saved to ``path``, or the Figure.
+
+    ``dpi``: the figure's own, at which it is laid out (default matplotlib's for a returned Figure; for a
+    file, the dpi it is saved at, :data:`physcam.figures.SAVE_DPI`: the layout's text metrics are then the
+    drawing's, measured once, issue 47 round 21)."""
     import numpy as np
 
-    from ..figures import new_figure, save_figure
+    from ..figures import SAVE_DPI, new_figure, save_figure, title_y
     from ..units import format_distance
 
     n = len(rows)
-    fig = new_figure(figsize=(11.0, 7.0))
+    fig = new_figure(figsize=(11.0, 7.0), dpi=dpi if dpi is not None or path is None else SAVE_DPI)
     gs = fig.add_gridspec(2, max(3, n))
     cols = max(3, n)
     ax_b = fig.add_subplot(gs[0, : cols // 3])
@@ -340,14 +344,14 @@ def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False):
             ax_i.plot(*c["illumination"], marker="o", ms=2, label=r["name"])
     ax_b.set_xlabel(f"1 / focus mark (1/{'m' if units == 'm' else 'ft'}; 0 = infinity)")
     ax_b.set_ylabel("HFOV change from infinity (%)")
-    ax_b.set_title("focus breathing", fontsize=9)
+    ax_b.set_title("focus breathing", fontsize=9, y=title_y(ax_b))  # (placed once where matplotlib would leave it)
     ax_d.set_xlabel("field angle (deg)")
     ax_d.set_ylabel("real distortion (%)")
-    ax_d.set_title("distortion", fontsize=9)
+    ax_d.set_title("distortion", fontsize=9, y=title_y(ax_d))
     ax_i.set_xlabel("field angle (deg)")
     ax_i.set_ylabel("relative illumination")
     ax_i.set_ylim(0, 1.05)
-    ax_i.set_title("illumination", fontsize=9)
+    ax_i.set_title("illumination", fontsize=9, y=title_y(ax_i))
     for ax in (ax_b, ax_d, ax_i):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=6)
@@ -357,10 +361,10 @@ def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False):
             img, ext = c["bokeh"]
             top = float(np.percentile(img[img > 0], 95)) if (img > 0).any() else 1.0
             ax.imshow(np.clip(img / top, 0, 1), origin="lower", extent=ext, cmap="magma")
-            ax.set_title(f"{r['name']}\nbokeh {r['bokeh_diameter_mm']:.3f} mm", fontsize=7)
+            ax.set_title(f"{r['name']}\nbokeh {r['bokeh_diameter_mm']:.3f} mm", fontsize=7, y=title_y(ax))
         else:
             ax.set_axis_off()
-            ax.set_title(f"{r['name']}\n(no bokeh)", fontsize=7)
+            ax.set_title(f"{r['name']}\n(no bokeh)", fontsize=7, y=title_y(ax))
         ax.set_xlabel("film x (mm)", fontsize=7)
         ax.set_ylabel("film y (mm)", fontsize=7)
         ax.tick_params(labelsize=6)

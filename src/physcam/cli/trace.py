@@ -82,11 +82,9 @@ def run_spot(args) -> int:
 
     res = spot_diagram(as_designed(lens, fstop=args.fstop), tuple(args.field or (0.0, 5.0)),
                        wavelength_nm=args.wavelength, rings=args.rings, clip=args.clip)
-    if args.output:
-        from ._output import save_plot
-
-        save_plot(res, args.output, force=args.force,
-                  context=(f"f/{args.fstop:g}" if args.fstop else "wide open") + ", focused at infinity")
+    if args.output:  # the context line laid out with the panels in one pass (save_plot lays a figure out again)
+        res.plot(args.output, force=args.force,
+                 context=(f"f/{args.fstop:g}" if args.fstop else "wide open") + ", focused at infinity")
     if args.json:
         emit_json(document("spot", mark_repaired(res.to_dict(), lens), units=dict(WAVE_UNITS, spot="um")))
     elif args.csv:

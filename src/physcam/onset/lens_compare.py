@@ -50,8 +50,10 @@ def lens_measurements(lens, *, focus_mm=None, fstop=None, sensor, coc=None, ligh
     """The comparison's figures of ``lens`` (a :class:`~physcam.optics.state.CameraState`, or a
     Prescription focused at ``focus_mm``, a mark from the film, inf allowed, at ``fstop``) on
     ``sensor``; curves for the figure under ``_curves``; ``notes``."""
+    from .. import _program
     from .report import report_camera, solve_report
 
+    _program.roomy_heap()  # the program's heap keeps freed pages: the illumination's and bokeh's ray arrays
     lens, focus_mm, fstop, state = _camera(lens, focus_mm, fstop)
     r = solve_report(report_camera(focal_length_mm=None, lens=lens, sensor=sensor, fstop=fstop, focus_mm=focus_mm,
                       coc=coc))

@@ -88,6 +88,14 @@ class SpotField:
             "reason")}
 
 
+#: The panels' share of a spot figure with a context line under it (figure fractions: left, bottom, right,
+#: top), the room ``physcam.cli._output.save_plot`` leaves for its context line.
+CONTEXT_RECT = (0.0, 0.05, 1.0, 1.0)
+#: Margins (inches: left, right, bottom, top) and ``wspace`` where ``tight_layout``'s two passes end for a
+#: spot figure (dgauss_50mm's two fields); :meth:`SpotDiagram.plot` starts its one pass there.
+CONVERGED_MARGINS = (0.606, 0.127, 0.684, 0.707, 0.232)
+
+
 @dataclass
 class SpotDiagram:
     lens_name: str
@@ -105,9 +113,11 @@ class SpotDiagram:
                 "fields": [f.to_dict() for f in self.fields]}
 
     @styled
-    def plot(self, path=None, *, force: bool = False):
-        """Draw one panel per field (positions relative to the centroid, um); write it to ``path`` (PNG/SVG/PDF) and return the path, else return the figure."""
-        from ...figures import dots, fit_title, pyplot
+    def plot(self, path=None, *, force: bool = False, context: str = ""):
+        """Draw one panel per field (positions relative to the centroid, um); write it to ``path`` (PNG/SVG/PDF)
+        and return the path, else return the figure. ``context`` (the shot: f-stop, focus) is a line under
+        the panels, laid out with them in one pass (:meth:`_lay_out`)."""
+        from ...figures import dots, fit_title, pyplot, title_y
 
         plt = pyplot()
 
@@ -120,19 +130,41 @@ class SpotDiagram:
             if not f.defined:
                 ax.text(0.5, 0.5, "undefined:\nno ray reaches the film", ha="center", va="center",
                         transform=ax.transAxes, fontsize=8)
-                ax.set_title(f"{f.field_deg:g} deg\nRMS undefined", fontsize=8)
+                ax.set_title(f"{f.field_deg:g} deg\nRMS undefined", fontsize=8, y=title_y(ax))
                 continue
             size = 0.3 * f.weight / f.weight.max()  # refined rim rays weigh less: drawn smaller
             dots(ax, (f.x_mm - f.centroid_x_mm) * 1e3, (f.y_mm - f.centroid_y_mm) * 1e3, size, "k")
             ax.set_title(f"{f.field_deg:g}°: RMS {f.rms_radius_um:.2f} µm,\nGEO {f.geometric_radius_um:.2f} µm",
-                         fontsize=8)
+                         fontsize=8, y=title_y(ax))  # (placed once where matplotlib would leave it)
         fig.suptitle(fit_title(f"{self.lens_name}: spot diagram at {self.wavelength_nm:g} nm", 3.0 * n), fontsize=9)
-        fig.tight_layout()
+        self._lay_out(fig, context)
         if path is None:
             return fig
         from ...figures import save_figure
 
         return save_figure(fig, path, force=force)
+
+    @staticmethod
+    def _lay_out(fig, context: str) -> None:
+        """One ``tight_layout`` pass, started from :data:`CONVERGED_MARGINS`; a ``context`` line under the panels.
+
+        ``tight_layout`` is one step of an iteration: it measures the panels' text where they stand and
+        moves the margins to fit. Equal-aspect panels then shrink inside their new slots, so one step from
+        matplotlib's default margins lands short (issue 47, round 21; five lenses at one to four fields). Without
+        a context line (the library's ``plot()`` on main) the x labels reached 2-6 px below the figure's edge in
+        19 of the 20 cases of two to four fields (``figure_problems`` flags them) and the figure's title came
+        within 0-4 px of the panels' titles; with it (``physcam spot -o``) the line lay 1-6 px into the x labels,
+        so the command laid the figure out twice (without the line, then with it: 25-40 ms of a cold run).
+        Started where two passes end, one step lands where two do, in all 25 cases: the x labels 13 px inside
+        the figure, or the line 16 px clear of them, and the titles 19 px apart
+        (tests/analysis/image_quality/test_spot_figure.py checks the clearances)."""
+        if context:
+            fig.text(0.5, 0.01, context, ha="center", va="bottom", fontsize=7, color="0.3")
+        width, height = fig.get_size_inches()
+        left, right, bottom, top, wspace = CONVERGED_MARGINS
+        fig.subplots_adjust(left=left / width, right=1.0 - right / width, bottom=bottom / height,
+                            top=1.0 - top / height, wspace=wspace)
+        fig.tight_layout(**({"rect": CONTEXT_RECT} if context else {}))
 
 
 def _whole(name: str, value, lo: int, hi: int) -> int:
@@ -141,7 +173,13 @@ def _whole(name: str, value, lo: int, hi: int) -> int:
     return int(value)
 
 
-def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
+#: Largest fine grid (fields x rings x angles at a level) whose cells' pass/fail is looked up in a dense table
+#: (one byte a cell, -1 where not traced at that level) rather than by binary search of sorted keys: the
+#: default spot's finest looked-up level is 6.3 million cells (two fields), 6 MB (issue 47, round 21).
+DENSE_CELLS = 1 << 24
+
+
+def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1, dense_cells: int = DENSE_CELLS):
     """Equal-area cells on the unit disk's (rho^2, phi) grid, refined at the edge of what passes.
 
     ``trace(f, u, v)`` takes field indices and points on the unit disk (all fields in one call,
@@ -151,8 +189,10 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
     A cell is split when its ray passes and an 8-connected neighbour's does not, or the reverse
     (phi wraps, rho^2 does not: beyond the first and last ring the ring itself stands in). A
     neighbour at the current level that was not traced has the status of its finest traced
-    ancestor. Cells are kept sparse (sorted integer keys per level), so the bookkeeping grows with
-    the rays traced, not with the 4^level fine grid.
+    ancestor. A level's cells are looked up in a dense table of its grid while that has at most
+    ``dense_cells`` cells, else kept sparse (sorted integer keys), so the bookkeeping grows with the
+    rays traced, not with the 4^level fine grid; both give the same answers
+    (tests/analysis/image_quality/test_spot_lookup.py compares them).
     """
     from ...trace import OK
 
@@ -175,13 +215,21 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
     I, J = np.tile(i0, n_fields), np.tile(j0, n_fields)
     flags, fx, fy = trace(F, *points(I, J, 0))
     levels = [(F, I, J, flags, fx, fy)]  # per level: the traced cells (field, i, j) and results
-    lookup = []  # per level: sorted keys of the traced cells and their pass/fail status
+    lookup = []  # per level: a dense table of the grid (-1: not traced), or the traced cells' sorted keys and status
+    orders = []  # per level: the traced cells' order by key (the sparse lookup's), None for a dense one
     refined = []  # per level: which traced cells were split
 
     def remember(f, i, j, level, st):
         k = keys(f, i, j, level)
+        size = n_fields * (ns << level) * (nphi << level)
+        if size <= dense_cells:
+            lookup.append(np.full(size, -1, dtype=np.int8))
+            lookup[-1][k] = st
+            orders.append(None)
+            return
         order = np.argsort(k, kind="stable")
         lookup.append((k[order], st[order]))
+        orders.append(order)
 
     def status(f, i, j, level):
         """Pass/fail of cells (f, i, j) at ``level``: their own, else their finest traced ancestor's."""
@@ -190,10 +238,15 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
         for lv in range(level, -1, -1):
             sh = level - lv
             k = keys(f[todo], i[todo] >> sh, j[todo] >> sh, lv)
-            ks, st = lookup[lv]
-            pos = np.minimum(np.searchsorted(ks, k), ks.size - 1)
-            found = ks[pos] == k
-            out[todo[found]] = st[pos[found]]
+            if orders[lv] is None:  # dense
+                got = lookup[lv][k]
+                found = got >= 0
+                out[todo[found]] = got[found] > 0
+            else:
+                ks, st = lookup[lv]
+                pos = np.minimum(np.searchsorted(ks, k), ks.size - 1)
+                found = ks[pos] == k
+                out[todo[found]] = st[pos[found]]
             todo = todo[~found]
             if todo.size == 0:
                 break
@@ -204,18 +257,19 @@ def _refined_samples(trace, rings: int, refine: int, n_fields: int = 1):
         F, I, J, fl = levels[-1][:4]
         lv = level - 1
         ni, nj = ns << lv, nphi << lv
-        # visit the cells in key order: each direction's neighbour keys then come nearly sorted,
-        # which numpy's binary search exploits
-        order = np.argsort(keys(F, I, J, lv), kind="stable")
-        Fs, Is, Js = F[order], I[order], J[order]
-        st = (fl == OK)[order]
+        # a sparse level's cells in key order (remember()'s): neighbour keys come nearly sorted for the search
+        order = orders[lv]
+        Fs, Is, Js, st = (F, I, J, fl == OK) if order is None else (F[order], I[order], J[order], (fl == OK)[order])
         diff_s = np.zeros(I.size, dtype=bool)
+        rows = {di: np.clip(Is + di, 0, ni - 1) for di in (-1, 0, 1)}
+        cols = {dj: (Js + dj) % nj for dj in (-1, 0, 1)}
         for di in (-1, 0, 1):
             for dj in (-1, 0, 1):
                 if di or dj:
-                    diff_s |= status(Fs, np.clip(Is + di, 0, ni - 1), (Js + dj) % nj, lv) != st
-        diff = np.empty_like(diff_s)
-        diff[order] = diff_s
+                    diff_s |= status(Fs, rows[di], cols[dj], lv) != st
+        diff = diff_s if order is None else np.empty_like(diff_s)
+        if order is not None:
+            diff[order] = diff_s
         refined.append(diff)
         if not diff.any():
             break
@@ -317,10 +371,12 @@ def spot_diagram(
     paraxial entrance pupil, not overfilled). A field where no ray reaches the film is undefined
     (module notes).
     """
+    from ... import _program
     from ...optics.paraxial import gaussian
     from ...trace import CLIPPED, MISSED, OK, TIR, paraxial_image_z, trace_to_film
     from .._camera import ray_view
 
+    _program.roomy_heap()  # the program's heap keeps freed pages: the levels' arrays of 1e5 rays come and go
     lens, object_z, film_z, stop, aperture, wl, _ = ray_view(camera, wavelength_nm=wavelength_nm)
     wl = require_finite("wavelength_nm", wl)
     rings = _whole("rings", rings, 1, MAX_RINGS)
