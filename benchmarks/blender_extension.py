@@ -8,7 +8,11 @@ Run:  .venv/bin/python benchmarks/blender_extension.py [--lenses dgauss_50mm,tes
 given or every bundled one), its CPU seconds as user + system of the process and its workers
 (``os.wait4``), with the zip's size: the part outside ``lens_payload`` too (worker start-up, the zip's
 deflate), one side after the other; with ``--baseline-src``, whether each lens's files in the two zips
-(``lenses/<slug>.json``, ``shaders/<slug>.osl``) are the same bytes. ``--rims``: the pupil tables' rims found along lines against the aim grids' (:func:`main_rims`), no timing.
+(``lenses/<slug>.json``, ``shaders/<slug>.osl``) are the same bytes. ``--issue47``: with ``--build``, issue 47's row exactly: the 19 lenses bundled when it was filed (:data:`ISSUE_47_LENSES`, the
+18 files of the library before 43f450d7, and ``double_gauss_50mm_f2``, then a copy of ``dgauss_50mm``, since dropped:
+here ``dgauss_50mm``'s file copied under that name, so it is built twice as it was then). ``--repeat N``: with
+``--build``, N runs of each side, the sides alternated (this checkout first in odd runs, the baseline first in even
+ones), and each side's median. ``--rims``: the pupil tables' rims found along lines against the aim grids' (:func:`main_rims`), no timing.
 ``--norms``: the centre's normalisation in closed form against a dense trace (:func:`main_norms`), no timing.
 ``--install``: then Blender's installer of each side's zip
 (``package_install_files`` in a fresh user folder, the Blender tests' way; the Blender of
@@ -39,6 +43,28 @@ import tempfile
 import time
 
 import numpy as np
+
+
+#: Issue 47's "physcam export blender-extension (19 lenses)": the library's 18 files before 43f450d7 (which added 12
+#: patent lenses), and ``double_gauss_50mm_f2`` (:data:`ISSUE_47_COPY`), a copy of ``dgauss_50mm`` then.
+ISSUE_47_LENSES = ("canon_rf_85mm_f1_2", "cooke_triplet_50mm_f4_5", "dgauss_50mm", "dgauss_77deg_3_5201mm",
+                   "double_gauss_100mm_f1_7", "fisheye_10mm", "mamiya_150mm_f4_soft", "mamiya_55mm_f2_8",
+                   "navarro_anamorphic_2x", "neil_front_anamorphic_2x", "nikkor_fisheye_16mm_f2_8", "petzval_85mm_f2_4",
+                   "sonnar_50mm_f1_5", "telephoto_250mm", "tessar_50mm_f2_8", "zeiss_distagon_35mm_f4",
+                   "zeiss_planar_80mm_f2_8", "zuiko_18mm_f3_5")
+#: The issue's 19th lens: (its slug then, the bundled lens whose copy it was).
+ISSUE_47_COPY = ("double_gauss_50mm_f2", "dgauss_50mm")
+
+
+def issue47_lenses(tmp: str) -> list[str]:
+    """:data:`ISSUE_47_LENSES` and the copy's lens file, written in ``tmp`` under the slug it had."""
+    from physcam.lens.library import library_dir
+
+    slug, of = ISSUE_47_COPY
+    path = os.path.join(tmp, f"{slug}.toml")
+    with open(library_dir() / f"{of}.toml", "rb") as src, open(path, "wb") as dst:
+        dst.write(src.read())
+    return list(ISSUE_47_LENSES) + [path]
 
 
 def load() -> str:
@@ -146,29 +172,41 @@ def install(zip_path: str, tmp: str) -> tuple[float, float, float]:
 
 
 def main_build(args, here: str) -> None:
-    names = args.lenses.split(",") if args.lenses else None
     sides = [("this checkout", here)] + ([("baseline", args.baseline_src)] if args.baseline_src else [])
-    print(f"load average before: {load()}")
-    cpu, zips = {}, {}
+    print(f"load average before: {load()}, mark {mark():.1f} ms")
+    cpu, zips = {label: [] for label, _ in sides}, {}
     with tempfile.TemporaryDirectory() as tmp:
-        for label, src in sides:
-            out = os.path.join(tmp, label.replace(" ", "_"))
-            os.mkdir(out)
-            user, system, wall, size = build(src, names, args.workers, out)
-            cpu[label] = user + system
-            print(f"{label:14s} CPU {user + system:7.1f} s (user {user:.1f}, system {system:.1f}), wall {wall:6.1f} s, "
-                  f"zip {size / 1e6:.1f} MB, load {load()}", flush=True)
-            (zips[label],) = [os.path.join(out, f) for f in os.listdir(out) if f.endswith(".zip")]
-            if args.install:
-                i_wall, i_cpu, i_mb = install(zips[label], out)
-                print(f"{label:14s} Blender install: wall {i_wall:.1f} s, CPU {i_cpu:.1f} s, {i_mb:.1f} MB unpacked",
-                      flush=True)
+        names = (issue47_lenses(tmp) if args.issue47 else args.lenses.split(",") if args.lenses else None)
+        for k in range(args.repeat):
+            for label, src in (sides if k % 2 == 0 else sides[::-1]):
+                out = os.path.join(tmp, label.replace(" ", "_"))
+                os.makedirs(out, exist_ok=True)
+                user, system, wall, size = build(src, names, args.workers, out)
+                cpu[label].append(user + system)
+                print(f"{label:14s} CPU {user + system:7.1f} s (user {user:.1f}, system {system:.1f}), wall {wall:6.1f} s, "
+                      f"zip {size / 1e6:.1f} MB, load {load()}, mark {mark():.1f} ms", flush=True)
+                (zips[label],) = [os.path.join(out, f) for f in os.listdir(out) if f.endswith(".zip")]
+                if args.install and k == 0:
+                    i_wall, i_cpu, i_mb = install(zips[label], out)
+                    print(f"{label:14s} Blender install: wall {i_wall:.1f} s, CPU {i_cpu:.1f} s, {i_mb:.1f} MB unpacked",
+                          flush=True)
         if args.baseline_src:
             same, differ = same_lens_files(zips["baseline"], zips["this checkout"])
             print(f"lens files (lenses/*.json, shaders/*.osl) byte for byte the baseline's: {same} of {same + len(differ)}"
                   + (f"; differ: {', '.join(differ[:8])}{' ...' if len(differ) > 8 else ''}" if differ else ""))
+    med = {label: float(np.median(v)) for label, v in cpu.items()}
+    if args.repeat > 1:
+        print("median CPU s of " + str(args.repeat) + ": " + ", ".join(f"{label} {m:.2f}" for label, m in med.items()))
     if args.baseline_src:
-        print(f"ratio (baseline / this): {cpu['baseline'] / cpu['this checkout']:.2f}")
+        print(f"ratio (baseline / this){' of the medians' if args.repeat > 1 else ''}: "
+              f"{med['baseline'] / med['this checkout']:.3f}")
+
+
+def mark() -> float:
+    """The machine's mark (the project's): milliseconds of ``sum(range(10**6))`` in this process."""
+    t = time.perf_counter()
+    sum(range(10**6))
+    return (time.perf_counter() - t) * 1e3
 
 
 def round_states(name):
@@ -333,6 +371,8 @@ def main() -> None:
     ap.add_argument("--build", action="store_true", help="time the whole CLI build (module notes)")
     ap.add_argument("--workers", type=int, default=2, help="--build's worker processes (default 2)")
     ap.add_argument("--install", action="store_true", help="--build: time Blender's installer of each zip too")
+    ap.add_argument("--issue47", action="store_true", help="--build: issue 47's 19 lenses (ISSUE_47_LENSES, module notes)")
+    ap.add_argument("--repeat", type=int, default=1, help="--build: runs of each side, alternated; medians printed")
     ap.add_argument("--rims", action="store_true", help="the pupil tables' rims along lines against the aim grids' "
                     "(main_rims)")
     ap.add_argument("--norms", action="store_true", help="the centre's normalisation in closed form against a dense trace "
