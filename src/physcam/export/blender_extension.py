@@ -187,20 +187,32 @@ def _payload_job(name) -> tuple[str, str, dict, dict[str, str]]:
     return slug, lens.name, data, shaders
 
 
+def _worker_start(trace_threads: int) -> None:
+    """A worker process's start: the JIT kernel's large batches on ``trace_threads`` threads
+    (:func:`physcam.trace.kernels.set_threads`; the rays are the same on any number)."""
+    from ..trace.kernels import set_threads
+
+    set_threads(trace_threads)
+
+
 def _payloads(names, workers: int):
     """Each lens's ``_payload_job`` in the order of ``names``, computed by ``workers`` processes.
 
     A lens's payload is mostly Python (the pupil tables' searches), so threads would share one core;
     processes (``spawn``: no JIT state or trace threads forked) take one lens each, as
-    ``physcam characterize`` does with its cells. One worker computes here, in order."""
+    ``physcam characterize`` does with its cells. One worker computes here, in order.
+    The workers share the cores: each traces its large batches on cores / workers threads (one on two
+    cores with two workers), not on every core, which made two workers' four threads wait for two cores."""
     if workers <= 1 or len(names) <= 1:
         yield from map(_payload_job, names)
         return
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    with ProcessPoolExecutor(max_workers=min(workers, len(names)),
-                             mp_context=multiprocessing.get_context("spawn")) as pool:
+    n = min(workers, len(names))
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=n, mp_context=context, initializer=_worker_start,
+                             initargs=(max(1, (os.cpu_count() or 1) // n),)) as pool:
         yield from pool.map(_payload_job, names)  # in order; a lens's error is raised here, as its own class
 
 
