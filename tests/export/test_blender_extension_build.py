@@ -2,6 +2,9 @@
 the zip one process gives (the session's shared zip is built with two workers, tests/conftest.py)."""
 
 import json
+import os
+import subprocess
+import sys
 import zipfile
 
 import pytest
@@ -31,6 +34,38 @@ def test_tables_of_the_pooled_build_are_the_one_process_ones(extension_zip):
         assert json.loads(z.read(f"lenses/{LENS}.json")) == json.loads(json.dumps(data))
         for name, text in shaders.items():
             assert z.read(f"shaders/{name}").decode("utf-8") == text, name
+
+
+#: Two of the cheapest lenses to tabulate, one of them anamorphic (its rectangle tables, not the radial ones)
+FORKED = ("dgauss_77deg_3_5201mm", "neil_front_anamorphic_2x")
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the program forks its workers on Linux only")
+def test_the_programs_forked_workers_give_the_one_process_tables(tmp_path):
+    """The ``physcam`` program (``python -m physcam``) on Linux forks its two workers from itself once it has
+    loaded numba and the tables' modules (blender_extension._forks, asked in the same program here: a library
+    caller gets fresh processes): each lens's table and shader in its zip are the ones computed here, in this
+    process, byte for byte, and the lenses come in the order asked."""
+    probe = ("from physcam import _program; _program.start(); from physcam.export.blender_extension import _forks; "
+             f"print(_forks({FORKED[0]!r}))")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    forks = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env, check=True)
+    assert forks.stdout.split() == ["True"]
+    from physcam.export.blender_extension import _forks
+
+    assert not _forks(FORKED[0])  # the library (this test's process) spawns fresh workers
+    argv = ["export", "blender-extension", "-o", str(tmp_path), "--workers", "2"]
+    for name in FORKED:
+        argv += ["--lens", name]
+    r = subprocess.run([sys.executable, "-m", "physcam", *argv], capture_output=True, text=True, env=env)
+    assert r.returncode == 0, r.stderr
+    (zp,) = tmp_path.glob("*.zip")
+    with zipfile.ZipFile(zp) as z:
+        assert [e["slug"] for e in json.loads(z.read("lenses/index.json"))] == list(FORKED)
+        for name in FORKED:
+            data, shaders = lens_payload(load_lens(name), name)
+            assert z.read(f"lenses/{name}.json") == json.dumps(data).encode("utf-8")
+            assert z.read(f"shaders/{name}.osl") == shaders[f"{name}.osl"].encode("utf-8")
 
 
 @pytest.mark.parametrize("workers", [0, 257, 1.5, True])

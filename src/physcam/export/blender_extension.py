@@ -25,7 +25,7 @@ import zipfile
 from importlib import resources
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, PhysCamError
 from ..optics.thinlens import MAX_F_NUMBER
 
 __all__ = ["build_extension", "lens_payload", "extension_manifest", "REFERENCE_FSTOP", "REPORT_SENSOR_MM"]
@@ -195,12 +195,48 @@ def _worker_start(trace_threads: int) -> None:
     set_threads(trace_threads)
 
 
+def _forks(first) -> bool:
+    """Whether the workers are forks of this process: in the ``physcam`` program (:data:`physcam._program.RUNNING`,
+    never a library caller, whose threads and libraries a fork would copy mid-flight) on Linux, with no other
+    thread running; the modules a lens's tables need and the JIT kernel are then loaded here first, once, for
+    every worker (``first``: the first lens's name, through which one ray is traced)."""
+    import sys
+    import threading
+
+    from .. import _program
+
+    if not (_program.RUNNING and sys.platform.startswith("linux") and threading.active_count() == 1):
+        return False
+    import numpy as np
+
+    from ..lens.library import load_lens
+    from ..onset import solvers  # noqa: F401  (the reports' solvers: imported once, for every worker)
+    from ..optics.focusing import focus
+    from ..trace import kernels
+    from ..trace.rays import RayBatch
+    from ..trace.trace import trace_through
+    from . import blender_focus, blender_pupil, blender_zoom  # noqa: F401
+
+    if os.environ.get("PHYSCAM_BACKEND") != "numpy" and kernels.numba_available():  # numba and its machine code loaded
+        try:
+            st = focus(load_lens(first), math.inf)
+            q = st.prescription
+            rays = RayBatch.from_arrays(np.array([[0.0, 0.0, st.film_z]]),
+                                        np.array([[0.0, 0.0, q.vertex_z[-1] - st.film_z]]), q.wavelength_nm)
+            trace_through(q, rays, reverse=True, clip=True, backend="numba")
+        except PhysCamError:  # the lens's own error is its worker's to raise, as without the fork
+            pass
+    return threading.active_count() == 1
+
+
 def _payloads(names, workers: int):
     """Each lens's ``_payload_job`` in the order of ``names``, computed by ``workers`` processes.
 
     A lens's payload is mostly Python (the pupil tables' searches), so threads would share one core;
-    processes (``spawn``: no JIT state or trace threads forked) take one lens each, as
-    ``physcam characterize`` does with its cells. One worker computes here, in order.
+    processes take one lens each, as ``physcam characterize`` does with its cells: fresh ones (``spawn``: no
+    JIT state or trace threads copied), or in the ``physcam`` program on Linux forks of it (:func:`_forks`),
+    which start with numba and the tables' modules loaded and end without the interpreter's teardown:
+    0.6-0.8 CPU seconds less a worker (docs/performance.md, round 21). One worker computes here, in order.
     The workers share the cores: each traces its large batches on cores / workers threads (one on two
     cores with two workers), not on every core, which made two workers' four threads wait for two cores."""
     if workers <= 1 or len(names) <= 1:
@@ -210,7 +246,7 @@ def _payloads(names, workers: int):
     from concurrent.futures import ProcessPoolExecutor
 
     n = min(workers, len(names))
-    context = multiprocessing.get_context("spawn")
+    context = multiprocessing.get_context("fork" if _forks(names[0]) else "spawn")
     with ProcessPoolExecutor(max_workers=n, mp_context=context, initializer=_worker_start,
                              initargs=(max(1, (os.cpu_count() or 1) // n),)) as pool:
         yield from pool.map(_payload_job, names)  # in order; a lens's error is raised here, as its own class
