@@ -644,16 +644,18 @@ def _arr32(name, values, size) -> str:
     # _num32 of each (osl_number of the nine-digit rounding: its repr, with ".0" when that is an
     # integer). Where "%.9g" writes a fraction without exponent (1e-4 <= |v| < 1e9) that is the repr
     # already: it strips its zeros, and no shorter decimal names the same double. All are written by
-    # one format operation; only the numbers that may not be such a fraction are looked at again
-    # (:func:`_maybe_whole_or_exponent`), most of them the tables' 0 and -1, whose literals are looked up.
+    # one format operation; the numbers that may not be such a fraction (:func:`_maybe_whole_or_exponent`),
+    # most of them the tables' 0 and -1, whose literals are looked up, are written first, each on its own,
+    # and where "%.9g" writes no point or an exponent the format takes the literal ("%s") instead (no
+    # split of the whole text into numbers and join again: 0.13 -> 0.10 s on three lenses' 500,000 numbers)
     vals = a.tolist()
-    nums = (", ".join(["%.9g"] * len(vals)) % tuple(vals)).split(", ") if vals else []
+    fmts = ["%.9g"] * len(vals)
     fixed = _WHOLE
     for i in np.flatnonzero(_maybe_whole_or_exponent(a)).tolist():
-        r = nums[i]
+        r = "%.9g" % vals[i]
         if "." not in r or "e" in r:
-            nums[i] = fixed.get(r) or osl_number(float(r))
-    return f"    float {name}[{size}] = {{{', '.join(nums)}}};"
+            vals[i], fmts[i] = fixed.get(r) or osl_number(float(r)), "%s"
+    return f"    float {name}[{size}] = {{{', '.join(fmts) % tuple(vals)}}};"
 
 
 def _maybe_whole_or_exponent(a: np.ndarray) -> np.ndarray:
