@@ -82,7 +82,7 @@ def _resolve(lines: list[str], on: set[str], left=()) -> list[str]:
     :data:`FEATURES` not in ``left`` only; other directives are OSL's)."""
     out, stack = [], []  # stack: (is ours, keeping) per open #if
     for line in lines:
-        word = line.strip().split()
+        word = line.split(None, 2)  # the first two words are all it reads (not a data line's 100,000 numbers)
         head = word[0] if word else ""
         keeping = all(k for _, k in stack)
         if head in ("#ifdef", "#ifndef") and len(word) > 1 and word[1] in FEATURES and word[1] not in left:
