@@ -209,10 +209,13 @@ def _forks(first) -> bool:
         return False
     import numpy as np
 
+    # what a lens's tables import (a worker's first lens imported them itself: 0.06 s each)
+    from ..analysis.image_quality import ghosts  # noqa: F401
     from ..lens.library import load_lens
-    from ..onset import solvers  # noqa: F401  (the reports' solvers: imported once, for every worker)
+    from ..onset import solvers  # noqa: F401
+    from ..optics import coc  # noqa: F401
     from ..optics.focusing import focus
-    from ..trace import kernels
+    from ..trace import camera_tracer, kernels, pupil_bounds  # noqa: F401
     from ..trace.rays import RayBatch
     from ..trace.trace import trace_through
     from . import blender_focus, blender_pupil, blender_zoom  # noqa: F401
