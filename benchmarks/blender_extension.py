@@ -3,16 +3,19 @@
 Run:  .venv/bin/python benchmarks/blender_extension.py [--lenses dgauss_50mm,tessar_50mm]
                                                        [--baseline-src <other checkout>/src]
       .venv/bin/python benchmarks/blender_extension.py --build [--workers 2] [--baseline-src ...] [--install]
+      .venv/bin/python benchmarks/blender_extension.py --build --issue47 --repeat 5 --baseline-src <main>/src
 
 ``--build``: the whole command instead (``physcam export blender-extension --workers N``, the lenses
 given or every bundled one), its CPU seconds as user + system of the process and its workers
-(``os.wait4``), with the zip's size: the part outside ``lens_payload`` too (worker start-up, the zip's
-deflate), one side after the other; with ``--baseline-src``, whether each lens's files in the two zips
-(``lenses/<slug>.json``, ``shaders/<slug>.osl``) are the same bytes. ``--issue47``: with ``--build``, issue 47's row exactly: the 19 lenses bundled when it was filed (:data:`ISSUE_47_LENSES`, the
-18 files of the library before 43f450d7, and ``double_gauss_50mm_f2``, then a copy of ``dgauss_50mm``, since dropped:
-here ``dgauss_50mm``'s file copied under that name, so it is built twice as it was then). ``--repeat N``: with
+(``os.wait4``: forked or spawned, they are its children), with the zip's size: the part outside ``lens_payload``
+too (worker start-up, the zip's deflate), one side after the other; with ``--baseline-src``, whether each lens's
+files in the two zips (``lenses/<slug>.json``, ``shaders/<slug>.osl``) are the same bytes. ``--issue47``: with
+``--build``, issue 47's row exactly: the 19 lenses bundled when it was filed (:data:`ISSUE_47_LENSES`, the 18 files
+of the library before 43f450d7, and ``double_gauss_50mm_f2``, then a copy of ``dgauss_50mm``, since dropped: here
+``dgauss_50mm``'s file copied under that name, so it is built twice as it was then). ``--repeat N``: with
 ``--build``, N runs of each side, the sides alternated (this checkout first in odd runs, the baseline first in even
-ones), and each side's median. ``--rims``: the pupil tables' rims found along lines against the aim grids' (:func:`main_rims`), no timing.
+ones), and each side's median. ``--rims``: the pupil tables' rims found along lines against the aim grids'
+(:func:`main_rims`), no timing.
 ``--norms``: the centre's normalisation in closed form against a dense trace (:func:`main_norms`), no timing.
 ``--install``: then Blender's installer of each side's zip
 (``package_install_files`` in a fresh user folder, the Blender tests' way; the Blender of
