@@ -187,12 +187,34 @@ def _payload_job(name) -> tuple[str, str, dict, dict[str, str]]:
     return slug, lens.name, data, shaders
 
 
-def _worker_start(trace_threads: int) -> None:
-    """A worker process's start: the JIT kernel's large batches on ``trace_threads`` threads
-    (:func:`physcam.trace.kernels.set_threads`; the rays are the same on any number)."""
+def _worker_start(trace_threads: int, jit: bool) -> None:
+    """A worker process's start: the compiled kernels' large batches on ``trace_threads`` threads
+    (:func:`physcam.trace.kernels.set_threads`; the rays are the same on any number), and with ``jit`` numba's
+    JIT kernel loaded first (:func:`_load_jit`)."""
     from ..trace.kernels import set_threads
 
     set_threads(trace_threads)
+    if jit:
+        _load_jit()
+
+
+#: A process that builds this many lenses or more loads numba's JIT kernel first (:func:`_load_jit`)
+_JIT_LENSES = 2
+
+
+def _load_jit() -> bool:
+    """Load numba's JIT kernel where it is installed and ``PHYSCAM_BACKEND`` leaves the choice to physcam (or
+    names numba); whether it is loaded. Then the tables' traces take it ("auto" does once numba is loaded) and
+    their rims the compiled rim pass (:func:`physcam.trace.kernels.rim_pass`, numba's only). Rented, the C
+    kernel traces a lens's tables as fast, but their rims are then the numpy pass's: the Canon RF 85's
+    payload 1.00 s of CPU against 0.77-0.85 s (docs/performance.md, round 21), while loading numba costs a
+    process 0.35-0.45 s once, so a process building two lenses or more (:data:`_JIT_LENSES`) loads it first.
+    The tables are the same bytes whichever kernel and pass find them."""
+    if os.environ.get("PHYSCAM_BACKEND", "auto") not in ("auto", "numba"):
+        return False
+    from ..trace import kernels
+
+    return kernels.numba_available()
 
 
 def _forks(first) -> bool:
@@ -220,7 +242,7 @@ def _forks(first) -> bool:
     from ..trace.trace import trace_through
     from . import blender_focus, blender_pupil, blender_zoom  # noqa: F401
 
-    if os.environ.get("PHYSCAM_BACKEND") != "numpy" and kernels.numba_available():  # numba and its machine code loaded
+    if _load_jit():  # numba imported, and the machine code of the variant the first lens's trace needs
         try:
             st = focus(load_lens(first), math.inf)
             q = st.prescription
@@ -240,9 +262,12 @@ def _payloads(names, workers: int):
     JIT state or trace threads copied), or in the ``physcam`` program on Linux forks of it (:func:`_forks`),
     which start with numba and the tables' modules loaded and end without the interpreter's teardown:
     0.6-0.8 CPU seconds less a worker (docs/performance.md, round 21). One worker computes here, in order.
+    A process with :data:`_JIT_LENSES` lenses or more to build loads numba's JIT kernel first (:func:`_load_jit`).
     The workers share the cores: each traces its large batches on cores / workers threads (one on two
     cores with two workers), not on every core, which made two workers' four threads wait for two cores."""
     if workers <= 1 or len(names) <= 1:
+        if len(names) >= _JIT_LENSES:
+            _load_jit()
         yield from map(_payload_job, names)
         return
     import multiprocessing
@@ -251,7 +276,7 @@ def _payloads(names, workers: int):
     n = min(workers, len(names))
     context = multiprocessing.get_context("fork" if _forks(names[0]) else "spawn")
     with ProcessPoolExecutor(max_workers=n, mp_context=context, initializer=_worker_start,
-                             initargs=(max(1, (os.cpu_count() or 1) // n),)) as pool:
+                             initargs=(max(1, (os.cpu_count() or 1) // n), len(names) >= _JIT_LENSES * n)) as pool:
         yield from pool.map(_payload_job, names)  # in order; a lens's error is raised here, as its own class
 
 
