@@ -7,8 +7,9 @@ A function is wrapped when its module is first imported (an import hook), so the
 not; a part's functions called inside one another count once (the outermost call). The parts, for the cases of
 ``benchmarks/cold_start.py`` that draw a figure:
 
-- ``kernel``: the ray-tracing kernel, ``trace_rays`` of ``physcam.trace.kernels._numpy`` (the kernel these
-  commands run cold; ``--wrap MODULE:FUNCTION`` adds another, e.g. a compiled kernel's);
+- ``kernel``: the ray-tracing kernel: ``trace_rays`` of ``physcam.trace.kernels._numpy`` and
+  ``physcam.trace.kernels.run_blocks`` (the compiled kernels' batches: the C kernel these commands run cold where it
+  is built); ``--wrap MODULE:FUNCTION`` adds another;
 - ``matplotlib import``: ``physcam.figures._lean_import``;
 - ``measure``: the command's analysis (the spot's rays: ``spot_diagram``; each compared lens: ``lens_measurements``);
 - ``figure``: making and laying out the figure (``SpotDiagram.plot``, ``compare_figure``), the save included;
@@ -39,6 +40,7 @@ from cold_start import CASES, _tree, child_env, load, machine_marks  # noqa: E40
 #: (module, attribute path, part) of the functions timed in every run.
 PARTS = [
     ("physcam.trace.kernels._numpy", "trace_rays", "kernel"),
+    ("physcam.trace.kernels", "run_blocks", "kernel"),
     ("physcam.figures", "_lean_import", "matplotlib import"),
     ("physcam.analysis.image_quality.spot", "spot_diagram", "measure"),
     ("physcam.onset.lens_compare", "lens_measurements", "measure"),
