@@ -140,3 +140,76 @@ def test_the_c_backend_names_the_fix_when_it_is_not_built(monkeypatch):
     monkeypatch.setenv("PHYSCAM_BACKEND", "c")
     with pytest.raises(BackendError, match="not built"):
         kernels.get_kernel("auto")
+
+
+def _dgauss_rays(n, seed=7):
+    lens = build_pbrt(DGAUSS_ROWS, abbe=ABBE)
+    rng = np.random.default_rng(seed)
+    p = np.stack([rng.uniform(-10, 10, n), rng.uniform(-10, 10, n), np.full(n, -3.0)], axis=1)
+    d = np.stack([rng.normal(0, 0.1, n), rng.normal(0, 0.1, n), np.ones(n)], axis=1)
+    return lens, RayBatch.from_arrays(p, d, 587.6)
+
+
+@pytest.mark.skipif(not kernels_c_available(), reason="the C kernel is not built")
+def test_a_forked_child_traces_after_its_parent_traced_on_threads(monkeypatch):
+    """A process that traced a large batch on threads (the C kernel's pool, "auto" in the core install) and then
+    forks (multiprocessing's default on Linux before Python 3.14): the child has none of the parent's trace
+    threads, so the pool it copied must not be used: it traces on its own and gets the parent's rays. Before
+    the fork hook the child waited for ever on the first threaded batch (round 21's review)."""
+    import os
+    import signal
+
+    from physcam.trace import kernels
+
+    if not hasattr(os, "fork"):
+        pytest.skip("no fork on this platform")
+    monkeypatch.setattr(kernels, "LOAD_AWARE", False)
+    kernels.set_threads(2)
+    try:
+        lens, rays = _dgauss_rays(100_000)
+        parent = trace_through(lens, rays.copy(), backend="c")
+        assert kernels._pool is not None  # the batch went through the thread pool
+        pid = os.fork()
+        if pid == 0:  # the child: a second threaded batch, within 20 s or SIGALRM ends it
+            code = 1
+            try:
+                signal.alarm(20)
+                child = trace_through(lens, rays.copy(), backend="c")
+                code = 0 if all(np.array_equal(u, v) for u, v in zip(child.columns(), parent.columns())) else 3
+            finally:
+                os._exit(code)
+        _, status = os.waitpid(pid, 0)
+        assert os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0, f"the forked child ended with status {status}"
+    finally:
+        kernels.set_threads(None)
+
+
+def test_the_reported_kernel_follows_physcam_backend(monkeypatch):
+    """``loaded_backend`` (what ``python -m physcam.trace.kernels`` prints as "auto") names the kernel a forced
+    ``PHYSCAM_BACKEND`` traces with, and refuses a name tracing would refuse."""
+    from physcam.trace import kernels
+
+    monkeypatch.setenv("PHYSCAM_BACKEND", "numpy")
+    assert kernels.loaded_backend() == "numpy"
+    monkeypatch.setenv("PHYSCAM_BACKEND", "bogus")
+    with pytest.raises(BackendError, match="PHYSCAM_BACKEND='bogus'"):
+        kernels.loaded_backend()
+
+
+def test_auto_traces_a_float32_optical_path_as_the_numpy_kernel_does(monkeypatch):
+    """An optical path array in float32 (the C kernel adds float64 only): "auto" gives it to the numpy kernel,
+    which traces it as before the C kernel, instead of raising."""
+    from physcam.trace.kernels import get_kernel
+    from physcam.trace.tables import packed_table
+    from physcam.trace.trace import trace_packed
+
+    monkeypatch.delenv("PHYSCAM_BACKEND", raising=False)
+    lens, rays = _dgauss_rays(2000)
+    table = packed_table(lens, coating="single")
+    out = []
+    for backend in ("auto", "numpy"):
+        r, opl = rays.copy(), np.zeros(2000, np.float32)
+        trace_packed(get_kernel(backend), r, table.S, table.kinds, clip=True, fresnel=False, end_z=80.0, opl=opl)
+        out.append(r.columns() + (opl,))
+    for u, v in zip(*out):
+        np.testing.assert_array_equal(u, v)

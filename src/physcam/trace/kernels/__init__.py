@@ -161,6 +161,17 @@ def numba_load_cost() -> float:
 _pool = None
 
 
+def _forget_pool() -> None:
+    """In a forked child: a fork copies only the forking thread, so the parent's pool names trace threads the
+    child does not have and would wait for them for ever; the child starts its own pool when it needs one."""
+    global _pool
+    _pool = None
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_pool)
+
+
 def run_blocks(f, args, n: int, block: int, serial_below: int) -> None:
     """Run ``f(*args, b0, b1)`` over the ``n`` rays' blocks of ``block``: on the calling thread below
     ``serial_below`` rays (or with fewer than two blocks or threads), else one range of blocks per thread
@@ -203,7 +214,9 @@ class _CKernel:
             opl=None):
         """Trace in place (the JIT kernel's :meth:`_JitKernel.run`; an empty ``opl`` is no optical path)."""
         C = self._C
-        if C.mixed_precision(x, S):
+        if C.mixed_precision(x, S) or (opl is not None and opl.shape[0] and opl.dtype.char != "d"):
+            # (inputs the C kernel does not take and the numpy kernel does: a table not in the rays' precision,
+            # an optical path not in float64; no physcam caller makes them)
             from ._numpy import trace_rays
 
             return trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono,
@@ -408,8 +421,15 @@ def backend_for_job(backend: str, ray_surfaces: float) -> str:
 
 
 def loaded_backend() -> str:
-    """The kernel "auto" traces with in this process now: "numba" once loaded, else "c" where the C kernel is
-    built, else "numpy" (``python -m physcam.trace.kernels`` prints it with what this install has)."""
+    """The kernel "auto" traces with in this process now: the one ``PHYSCAM_BACKEND`` names (raising
+    :class:`~physcam.errors.BackendError` as tracing would, for a name it does not know or a kernel this install
+    lacks), else "numba" once loaded, else "c" where the C kernel is built, else "numpy"
+    (``python -m physcam.trace.kernels`` prints it with what this install has)."""
+    env = os.environ.get("PHYSCAM_BACKEND", "auto")
+    if env != "auto":  # forced: that kernel, or its BackendError (an unknown name, a kernel not here)
+        if env not in BACKENDS:
+            raise BackendError(f"PHYSCAM_BACKEND={env!r} is not one of {', '.join(BACKENDS)}")
+        return resolve_backend(env)
     if _numba_kernel is not None:
         return "numba"
     return "c" if c_available() else "numpy"

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib.util
 
+from ...errors import BackendError
 from . import c_available, loaded_backend
 
 
@@ -23,7 +24,11 @@ def main() -> int:
         print(f"c: not built ({_c_error})")
     print("numba: " + ("installed (physcam[fast])" if importlib.util.find_spec("numba") else "not installed"))
     print("numpy: always")
-    print(f"auto: {loaded_backend()}")
+    try:
+        print(f"auto: {loaded_backend()}")
+    except BackendError as exc:  # PHYSCAM_BACKEND names a kernel that cannot trace here
+        print(f"auto: {exc}")
+        return 2
     return 0
 
 
