@@ -142,13 +142,13 @@ def _lean_import() -> None:
             gc.enable()
 
 
-#: Modules matplotlib imports with a plain ``import``, and reads only for what physcam's figures never
-#: draw: TeX's glyph names (``matplotlib.dviread``'s ``fontTools.agl``, 7-10 ms of CPU), and dates on an axis
-#: (``matplotlib.dates``, imported by ``matplotlib.axes`` to register its unit converters, with dateutil's
-#: rrule, tz and parser; the parser also imported by ``matplotlib.category``: 8-10 ms of CPU). The program
-#: imports them lazily: a module's code runs at its first use, or at its next ``import``, which reads the module
-#: (docs/performance.md, "Round 10", "Round 21"); the date converters are then registered as matplotlib does.
-LAZY_MODULES = ("fontTools.agl", "matplotlib.dates", "dateutil.parser")
+#: Modules matplotlib imports once, with a plain ``import``, and reads only for what physcam's figures never
+#: draw: TeX's glyph names (``matplotlib.dviread``'s ``fontTools.agl``, 7-10 ms of CPU). The program imports
+#: them lazily: a module's code runs at its first use (docs/performance.md, "Round 10"). (dateutil's parser
+#: cannot be: ``matplotlib.dates`` imports it a second time, and a second import runs a lazy module. Nor can
+#: ``matplotlib.dates`` itself: importing it registers the date converters, which ``matplotlib.axes`` never
+#: reads, so lazily a date axis would find none: round 21 tried it and its review found a date plot failing.)
+LAZY_MODULES = ("fontTools.agl",)
 
 
 class _LazyModules:
