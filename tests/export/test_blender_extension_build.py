@@ -68,6 +68,26 @@ def test_the_programs_forked_workers_give_the_one_process_tables(tmp_path):
             assert z.read(f"shaders/{name}.osl") == shaders[f"{name}.osl"].encode("utf-8")
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the program forks its workers on Linux only")
+def test_the_program_forks_beside_its_waiting_progress_timer_only():
+    """At a terminal the program runs a progress timer thread from the start (``slow_command_progress``): a quiet
+    thread (physcam.progress.quiet_thread: it waits, then takes FORK_LOCK before drawing), beside which the
+    workers are still forks (round 21's review: they were spawned at every terminal); any other thread (a
+    display already drawing, a caller's own) still means fresh processes."""
+    probe = ("import threading, time\n"
+             "from physcam import _program; _program.start()\n"
+             "from physcam.progress import quiet_thread\n"
+             "from physcam.export.blender_extension import _forks\n"
+             "t = quiet_thread(threading.Timer(60, print)); t.daemon = True; t.start(); time.sleep(0.05)\n"
+             f"print(_forks({FORKED[0]!r}))\n"
+             "e = threading.Event(); u = threading.Thread(target=e.wait, daemon=True); u.start()\n"
+             f"print(_forks({FORKED[0]!r}))\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.split() == ["True", "False"]
+
+
 @pytest.mark.parametrize("workers", [0, 257, 1.5, True])
 def test_a_bad_number_of_workers_is_refused(workers, tmp_path):
     with pytest.raises(PhysCamError, match="workers"):

@@ -60,8 +60,20 @@ def test_geometry_is_bitwise_the_reference_and_fresnel_weights_within_a_few_ulps
 
 @pytest.mark.parametrize("backend", COMPILED)
 def test_serial_and_parallel_paths_agree_bit_for_bit_at_block_edges(backend):
+    """Serial and threaded runs of a batch (block ranges on two threads, whatever the cores this process may
+    use: set_threads) give identical rays at every block edge."""
+    from physcam.trace import kernels
     from physcam.trace.kernels import c_kernel, jit_kernel
     from physcam.trace.tables import packed_table
+
+    kernels.set_threads(2)  # threaded even where this process may use one core
+    try:
+        _serial_and_parallel(backend, c_kernel, jit_kernel, packed_table)
+    finally:
+        kernels.set_threads(None)
+
+
+def _serial_and_parallel(backend, c_kernel, jit_kernel, packed_table):
 
     jit = jit_kernel() if backend == "numba" else c_kernel()
     BLOCK = 256  # both kernels' block (_numba.BLOCK, _ckernel.BLOCK)

@@ -30,6 +30,7 @@ import threading
 
 from ..data.default_sensor import DEFAULT_SENSOR, DEFAULT_SENSOR_LABEL
 from ..errors import PhysCamError
+from ..progress import FORK_LOCK, quiet_thread
 from ..units import UNIT_SYSTEMS, parse_distance
 
 # DEFAULT_SENSOR: the sensor every command uses when none is given (and the user config names none);
@@ -695,7 +696,7 @@ class slow_command_progress:
         self._done = False
 
     def _start(self):
-        with self._lock:
+        with FORK_LOCK, self._lock:  # (never while this process forks workers: physcam.progress.FORK_LOCK)
             if self._done or _LIVE:
                 return
             self._bar = progress_bar(f"physcam {self.name}").__enter__()
@@ -707,7 +708,8 @@ class slow_command_progress:
                 delay = PROGRESS_AFTER_S if after is None else max(0.0, float(after))
             except ValueError:
                 delay = PROGRESS_AFTER_S
-            self._timer = threading.Timer(delay, self._start)
+            # quiet: a build that forks workers may fork while it waits; it draws only outside the fork
+            self._timer = quiet_thread(threading.Timer(delay, self._start))
             self._timer.daemon = True
             self._timer.start()
         return self

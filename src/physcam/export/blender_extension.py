@@ -26,6 +26,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..errors import InputError, PhysCamError
+from ..progress import FORK_LOCK, others_quiet
 from ..optics.thinlens import MAX_F_NUMBER
 
 __all__ = ["build_extension", "lens_payload", "extension_manifest", "REFERENCE_FSTOP", "REPORT_SENSOR_MM"]
@@ -220,14 +221,14 @@ def _load_jit() -> bool:
 def _forks(first) -> bool:
     """Whether the workers are forks of this process: in the ``physcam`` program (:data:`physcam._program.RUNNING`,
     never a library caller, whose threads and libraries a fork would copy mid-flight) on Linux, with no other
-    thread running; the modules a lens's tables need and the JIT kernel are then loaded here first, once, for
+    thread running but quiet ones (the program's progress timer while it waits: :func:`physcam.progress.quiet_thread`;
+    the caller holds :data:`physcam.progress.FORK_LOCK` until the workers have started); the modules a lens's tables need and the JIT kernel are then loaded here first, once, for
     every worker (``first``: the first lens's name, through which one ray is traced)."""
     import sys
-    import threading
 
     from .. import _program
 
-    if not (_program.RUNNING and sys.platform.startswith("linux") and threading.active_count() == 1):
+    if not (_program.RUNNING and sys.platform.startswith("linux") and others_quiet()):
         return False
     import numpy as np
 
@@ -251,7 +252,7 @@ def _forks(first) -> bool:
             trace_through(q, rays, reverse=True, clip=True, backend="numba")
         except PhysCamError:  # the lens's own error is its worker's to raise, as without the fork
             pass
-    return threading.active_count() == 1
+    return others_quiet()
 
 
 def _payloads(names, workers: int):
@@ -274,10 +275,17 @@ def _payloads(names, workers: int):
     from concurrent.futures import ProcessPoolExecutor
 
     n = min(workers, len(names))
-    context = multiprocessing.get_context("fork" if _forks(names[0]) else "spawn")
-    with ProcessPoolExecutor(max_workers=n, mp_context=context, initializer=_worker_start,
-                             initargs=(max(1, (os.cpu_count() or 1) // n), len(names) >= _JIT_LENSES * n)) as pool:
-        yield from pool.map(_payload_job, names)  # in order; a lens's error is raised here, as its own class
+    with FORK_LOCK:  # no display thread starts drawing while the workers start (physcam.progress)
+        context = multiprocessing.get_context("fork" if _forks(names[0]) else "spawn")
+        pool = ProcessPoolExecutor(max_workers=n, mp_context=context, initializer=_worker_start,
+                                   initargs=(max(1, (os.cpu_count() or 1) // n), len(names) >= _JIT_LENSES * n))
+        try:
+            results = pool.map(_payload_job, names)  # every lens submitted: the workers have started
+        except BaseException:
+            pool.shutdown(cancel_futures=True)
+            raise
+    with pool:
+        yield from results  # in order; a lens's error is raised here, as its own class
 
 
 def build_extension(out_dir, *, lenses=None, force: bool = False, progress=None, workers: int | None = 1) -> Path:

@@ -76,7 +76,7 @@ typedef struct {
 /* The passes for each instruction set: the baseline of the platform, and on x86-64 with GCC also AVX2 and
    AVX-512 (the same C under #pragma GCC target; the widest the CPU supports is chosen at import, isa()).
    Packed and scalar IEEE operations round alike and nothing is contracted or reassociated, so every level
-   gives the same rays (tests/trace/test_c_kernel.py runs each level the machine has). */
+   gives the same rays (tests/trace/test_simd_kernel.py runs each level the machine has). */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define CK_X86_LEVELS 1
 #endif
