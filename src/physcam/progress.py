@@ -4,13 +4,14 @@ The library reports, the front end decides how to show it: a reporter per kind o
 function ``fn(done, total)``, set with :func:`set_reporter` (None: silence, the default, as for
 any Python caller). Kinds: ``"compile"``, numba compiling a variant of the JIT tracing kernel
 (:mod:`physcam.trace.kernels`: ``(0, total)`` when it starts, a step per pass, ``(total, total)``
-at the end). This module imports nothing but ``threading``, so a front end can set reporters without loading
+at the end). This module imports nothing but ``os`` and ``threading``, so a front end can set reporters without loading
 the library's numerical modules. It also keeps the rule by which a library process that forks workers and a
 front end's display thread stay out of each other's way (:data:`FORK_LOCK`, :func:`quiet_thread`).
 """
 
 from __future__ import annotations
 
+import os as _os
 import threading as _threading
 
 __all__ = ["KINDS", "FORK_LOCK", "set_reporter", "reporter", "quiet_thread", "others_quiet"]
@@ -22,6 +23,8 @@ _REPORTERS: dict = {}
 #: thread holds the console's locks while it draws, which a forked child would inherit held).
 FORK_LOCK = _threading.Lock()
 _QUIET: set = set()  # the idents of the threads registered by quiet_thread that have not ended
+if hasattr(_os, "register_at_fork"):  # a forked child has none of them (and may reuse their idents)
+    _os.register_at_fork(after_in_child=_QUIET.clear)
 
 
 def quiet_thread(thread):
