@@ -194,7 +194,19 @@ def run_blocks(f, args, n: int, block: int, serial_below: int) -> None:
         fut.result()
 
 
-class _CKernel:
+class _CompiledKernel:
+    """What the two compiled kernels share: called with the numpy kernel's signature, a batch runs on the calling
+    thread below :data:`SERIAL_BELOW` rays (and at any size while the machine is busy, :data:`LOAD_AWARE`), else
+    on threads (:func:`run_blocks`); each kernel's ``run`` takes the threshold."""
+
+    def __call__(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
+        below = SERIAL_BELOW
+        if x.shape[0] >= below and LOAD_AWARE and _busy():
+            below = x.shape[0] + 1
+        self.run(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, below, opl)
+
+
+class _CKernel(_CompiledKernel):
     """The compiled C kernel (:mod:`._c`) with the numpy kernel's signature: large batches as one range of
     blocks per thread as the JIT kernel's (:func:`run_blocks`, :data:`SERIAL_BELOW`, :data:`LOAD_AWARE`)."""
 
@@ -203,12 +215,6 @@ class _CKernel:
 
         self._C = _c
         self.isa = _c.isa  # the instruction set it runs ("avx512", "avx2", "baseline")
-
-    def __call__(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
-        below = SERIAL_BELOW
-        if x.shape[0] >= below and LOAD_AWARE and _busy():
-            below = x.shape[0] + 1
-        self.run(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, below, opl)
 
     def run(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, serial_below,
             opl=None):
@@ -253,7 +259,7 @@ def c_kernel():
     return None if k is None else k.run
 
 
-class _JitKernel:
+class _JitKernel(_CompiledKernel):
     """The JIT kernel with the numpy kernel's signature: picks the variant (``_numba.variant``) of the
     call's features, compiles or loads it on first use (telling the compile reporter), and runs a
     batch of :data:`SERIAL_BELOW` rays or more as one range of blocks per thread (module notes)."""
@@ -267,12 +273,6 @@ class _JitKernel:
         self._no_opl = np.empty(0)
         self._variants: dict = {}  # (features, ray and table dtypes) -> the variant, compiled or loaded for them
         self._asphere: dict = {}  # kinds' bytes -> whether they hold an even asphere
-
-    def __call__(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
-        below = SERIAL_BELOW
-        if x.shape[0] >= below and LOAD_AWARE and _busy():
-            below = x.shape[0] + 1
-        self.run(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, below, opl)
 
     def run(self, x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, serial_below,
             opl=None):
