@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 from ...errors import InputError, OpticsError
 from ...lens.prescription import Prescription, takes_prescription
-from ...figures import PALETTE, styled
+from ...figures import PALETTE, TITLE_Y, styled
 
 __all__ = ["PAGES", "PANELS", "LensCard", "lens_card", "save_lens_card", "card_pages", "card_files"]
 
@@ -403,11 +403,11 @@ def _bokeh(camera, key, w, h, q, backend, notes):
 
 
 # ---- drawing --------------------------------------------------------------------------------------
-#: The title's place of a panel whose y axis never shows an offset or a power of ten (a fraction from 0 to 1,
-#: an image without y ticks, no axis, the lens section's heights in mm about the axis) nor x ticks on top: where matplotlib's automatic placement puts it
-#: (``Axes._update_title_position`` moves a title only above such text), given so that no draw measures the
-#: panel's ticks once more to find that out (docs/performance.md, "Round 16").
-_TITLE_Y = 1.0
+# Every panel's title is given at figures.TITLE_Y, where matplotlib's automatic placement puts it: no card panel's
+# y axis ever shows an offset or a power of ten (a fraction from 0 to 1, an image without y ticks, no axis, the
+# lens section's heights in mm about the axis) nor x ticks on top (``Axes._update_title_position`` moves a title
+# only above such text), so no draw measures the panel's ticks once more to find that out (docs/performance.md,
+# "Round 16"; figures.title_y asks the same of a panel that may have them).
 
 
 def _draw_diagram(ax, card, units):
@@ -424,7 +424,7 @@ def _draw_diagram(ax, card, units):
     sizes = [s for s in (STYLE["axes.titlesize"], 8.0, 7.5, 7.0, 6.5) if s <= STYLE["axes.titlesize"]]
     size = next((s for s in sizes if "\n" not in fit_title(text, 0.97 * cell_in, fontsize=s)), sizes[-1])
     ax.set_title(fit_title(text, 0.97 * cell_in, fontsize=size), loc="left", fontsize=size,
-                 x=(cell.x0 - box.x0) / box.width, y=_TITLE_Y)  # axes fraction of the cell's left edge
+                 x=(cell.x0 - box.x0) / box.width, y=TITLE_Y)  # axes fraction of the cell's left edge
 
 
 def _draw_key(ax, key, units):
@@ -448,7 +448,7 @@ def _draw_key(ax, key, units):
         rows.insert(6, ("", f"beyond the focus model (reaches {dist(key['close_focus_from_film_mm'])})"))
     if key["squeeze"] != 1.0:
         rows.append(("squeeze", f"{key['squeeze']:g}x"))
-    ax.set_title("key numbers", loc="left", y=_TITLE_Y)
+    ax.set_title("key numbers", loc="left", y=TITLE_Y)
     for i, (k, v) in enumerate(rows):
         y = 0.95 - i * 0.1
         note = k == ""  # a qualifier of the row above, in small type
@@ -471,7 +471,7 @@ def _no_data(ax, text):
 
 def _draw_mtf(ax, chart, label, note):
     if chart is None:
-        ax.set_title(f"MTF, {label}", loc="left", y=_TITLE_Y)
+        ax.set_title(f"MTF, {label}", loc="left", y=TITLE_Y)
         _no_data(ax, note)
         return
     for k, f in enumerate(chart.frequencies_lpmm):
@@ -489,7 +489,7 @@ def _draw_mtf(ax, chart, label, note):
     from ...figures import fit_title
 
     ax.set_title(fit_title(f"MTF at f/{chart.fstop:.3g} ({label}), {light}", 3.2, fontsize=7), loc="left", fontsize=7,
-                 y=_TITLE_Y)
+                 y=TITLE_Y)
     ax.legend(ncol=3, loc="lower left", fontsize=5.5, handlelength=1.6, columnspacing=0.8)
 
 
@@ -512,7 +512,7 @@ def _draw_distortion(ax, res):
 
 
 def _draw_illumination(ax, res):
-    ax.set_title("relative illumination, full aperture", loc="left", y=_TITLE_Y)
+    ax.set_title("relative illumination, full aperture", loc="left", y=TITLE_Y)
     if res is None:
         _no_data(ax, "no relative illumination: see the notes")
         return
@@ -541,7 +541,7 @@ def _draw_breathing(ax, card, units):
 def _draw_bokeh(ax, img, label, height_mm):
     import numpy as np
 
-    ax.set_title(f"bokeh, {label} ({height_mm:.1f} mm)", loc="left", fontsize=7.5, y=_TITLE_Y)
+    ax.set_title(f"bokeh, {label} ({height_mm:.1f} mm)", loc="left", fontsize=7.5, y=TITLE_Y)
     if img is None:
         _no_data(ax, "no light reaches the film")
         return
