@@ -220,15 +220,14 @@ class _CKernel(_CompiledKernel):
             opl=None):
         """Trace in place (the JIT kernel's :meth:`_JitKernel.run`; an empty ``opl`` is no optical path)."""
         C = self._C
-        if C.mixed_precision(x, S) or (opl is not None and opl.shape[0] and opl.dtype.char != "d"):
+        opl = opl if opl is not None and opl.shape[0] else None
+        if C.mixed_precision(x, S) or (opl is not None and opl.dtype.char != "d"):
             # (inputs the C kernel does not take and the numpy kernel does: a table not in the rays' precision,
             # an optical path not in float64; no physcam caller makes them)
             from ._numpy import trace_rays
 
-            return trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono,
-                              opl if opl is not None and opl.shape[0] else None)
-        args = (x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono,
-                opl if opl is not None and opl.shape[0] else None)
+            return trace_rays(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl)
+        args = (x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl)
         run_blocks(C.trace_range, args, x.shape[0], C.BLOCK, serial_below)
 
 
