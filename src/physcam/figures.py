@@ -483,6 +483,17 @@ def _skip_layout_rerun(fig) -> None:
         pass
 
 
+#: The panels' share of a figure with a context line under it (figure fractions: left, bottom, right, top):
+#: :func:`context_line`.
+CONTEXT_RECT = (0.0, 0.05, 1.0, 1.0)
+
+
+def context_line(fig, text: str) -> None:
+    """``text`` (the shot: f-stop, focus, sensor) as a line under ``fig``'s panels, so a plot says what it is
+    of; lay the panels out in :data:`CONTEXT_RECT` (``fig.tight_layout(rect=CONTEXT_RECT)``) to leave it room."""
+    fig.text(0.5, 0.01, text, ha="center", va="bottom", fontsize=7, color="0.3")
+
+
 #: Where matplotlib leaves a title that has nothing to clear (axes fraction): :func:`title_y`.
 TITLE_Y = 1.0
 

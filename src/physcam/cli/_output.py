@@ -179,12 +179,12 @@ def save_plot(result, path, *, force: bool = False, context: str = "", units: st
     (film coordinates, spot sizes, lp/mm) stay metric."""
     import inspect
 
-    from ..figures import figure_style, save_figure
+    from ..figures import CONTEXT_RECT, context_line, figure_style, save_figure
 
     takes_units = units is not None and "units" in inspect.signature(result.plot).parameters
     with figure_style():  # the context line too is physcam's (this module loads no figure code for `report`)
         fig = result.plot(None, units=units) if takes_units else result.plot(None)
         if context:
-            fig.text(0.5, 0.01, context, ha="center", va="bottom", fontsize=7, color="0.3")
-            fig.tight_layout(rect=(0.0, 0.05, 1.0, 1.0))
+            context_line(fig, context)
+            fig.tight_layout(rect=CONTEXT_RECT)
         return save_figure(fig, path, force=force)

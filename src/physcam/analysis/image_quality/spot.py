@@ -88,9 +88,6 @@ class SpotField:
             "reason")}
 
 
-#: The panels' share of a spot figure with a context line under it (figure fractions: left, bottom, right,
-#: top), the room ``physcam.cli._output.save_plot`` leaves for its context line.
-CONTEXT_RECT = (0.0, 0.05, 1.0, 1.0)
 #: Margins (inches: left, right, bottom, top) and ``wspace`` where ``tight_layout``'s two passes end for a
 #: spot figure (dgauss_50mm's two fields); :meth:`SpotDiagram.plot` starts its one pass there.
 CONVERGED_MARGINS = (0.606, 0.127, 0.684, 0.707, 0.232)
@@ -158,8 +155,10 @@ class SpotDiagram:
         Started where two passes end, one step lands where two do, in all 25 cases: the x labels 13 px inside
         the figure, or the line 16 px clear of them, and the titles 19 px apart
         (tests/analysis/image_quality/test_spot_figure.py checks the clearances)."""
+        from ...figures import CONTEXT_RECT, context_line
+
         if context:
-            fig.text(0.5, 0.01, context, ha="center", va="bottom", fontsize=7, color="0.3")
+            context_line(fig, context)
         width, height = fig.get_size_inches()
         left, right, bottom, top, wspace = CONVERGED_MARGINS
         fig.subplots_adjust(left=left / width, right=1.0 - right / width, bottom=bottom / height,
