@@ -88,7 +88,7 @@ LOAD_AWARE = True
 NUMBA_COMPILE_S = 4.0
 _numba_kernel = None
 _numba_error: str | None = None
-_numpy_spent = 0.0
+_rent_paid = 0.0
 _load_seen = (-1.0, False)  # (monotonic time of the last look, busy then)
 _threads_set: int | None = None
 _threads_default: int | None = None
@@ -370,17 +370,17 @@ def _rent(n: int, rows: int) -> tuple[float, object]:
 def _auto(x, y, z, L, M, N, wl, w, wd, flag, S, kinds, clip, fresnel, end_z, has_end, mono, opl=None):
     """The "auto" kernel: the C kernel (or, where it was not built, the numpy kernel) until numba pays for
     its loading, then the JIT kernel (module notes)."""
-    global _numpy_spent
+    global _rent_paid
     k = _numba_kernel
     if k is None:
         est, rented = _rent(x.shape[0], kinds.shape[0])
         if _numba_error is None:
             # a cold JIT cache: compiling costs more than loading (scale >= 1); a call numpy takes even at
             # scale 1 (a report's few chief rays) does not look at the cache (_jitcache: hashlib, the sources)
-            small = est < NUMPY_CALL_MAX_S and _numpy_spent + est < NUMPY_BUDGET_S
+            small = est < NUMPY_CALL_MAX_S and _rent_paid + est < NUMPY_BUDGET_S
             scale = 1.0 if small else numba_load_cost() / NUMBA_LOAD_S
-            if est < NUMPY_CALL_MAX_S * scale and _numpy_spent + est < NUMPY_BUDGET_S * scale:
-                _numpy_spent += est
+            if est < NUMPY_CALL_MAX_S * scale and _rent_paid + est < NUMPY_BUDGET_S * scale:
+                _rent_paid += est
             else:
                 k = _load_numba()
         if k is None:
@@ -403,7 +403,7 @@ def backend_for_job(backend: str, ray_surfaces: float) -> str:
     that keeps tracing pays for numba once its rent would have paid for it. Either way the rays are the
     same (module notes).
     """
-    global _numpy_spent
+    global _rent_paid
     if backend != "auto" or os.environ.get("PHYSCAM_BACKEND", "auto") != "auto" or _numba_kernel is not None:
         return backend
     c = _load_c()
@@ -413,8 +413,8 @@ def backend_for_job(backend: str, ray_surfaces: float) -> str:
         est = _rent(int(ray_surfaces), 0)[0]
     if _numba_error is not None:  # numba cannot load: the rent is all there is
         return "numpy" if c is None else "c"
-    if _numpy_spent + est < numba_load_cost():
-        _numpy_spent += est
+    if _rent_paid + est < numba_load_cost():
+        _rent_paid += est
         return "numpy" if c is None else "c"
     return backend
 
