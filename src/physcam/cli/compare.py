@@ -313,7 +313,8 @@ def run_lenses(args) -> int:
 
 @styled
 def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False, dpi=None):
-    """One figure: breathing, distortion and illumination curves of every lens, and their bokeh; the focus
+    """One figure: breathing, distortion and illumination curves of every lens, and their bokeh (all at one
+    film scale, the widest image's, so that their sizes compare at a glance); the focus
     and light distances in the title and the breathing axis (1 / mark) in ``units`` (m, or ft for feet
     and inches; film coordinates and bokeh sizes stay in mm). Saved to ``path``, or the Figure.
 
@@ -355,19 +356,30 @@ def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False, d
     for ax in (ax_b, ax_d, ax_i):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=6)
+    first = None  # the first bokeh panel: the others share its axes, so every bokeh is drawn at one film scale
     for k, (r, c) in enumerate(zip(rows, curves)):
-        ax = fig.add_subplot(gs[1, k])
-        if "bokeh" in c:
-            img, ext = c["bokeh"]
-            top = float(np.percentile(img[img > 0], 95)) if (img > 0).any() else 1.0
-            ax.imshow(np.clip(img / top, 0, 1), origin="lower", extent=ext, cmap="magma")
-            ax.set_title(f"{r['name']}\nbokeh {r['bokeh_diameter_mm']:.3f} mm", fontsize=7, y=title_y(ax))
-        else:
+        if "bokeh" not in c:
+            ax = fig.add_subplot(gs[1, k])
             ax.set_axis_off()
             ax.set_title(f"{r['name']}\n(no bokeh)", fontsize=7, y=title_y(ax))
+            continue
+        ax = fig.add_subplot(gs[1, k], **({} if first is None else {"sharex": first, "sharey": first}))
+        img, ext = c["bokeh"]
+        top = float(np.percentile(img[img > 0], 95)) if (img > 0).any() else 1.0
+        ax.imshow(np.clip(img / top, 0, 1), origin="lower", extent=ext, cmap="magma")
+        ax.set_facecolor(ax.images[0].cmap(0.0))  # beyond a smaller image's edge: its own dark
+        ax.set_title(f"{r['name']}\nbokeh {r['bokeh_diameter_mm']:.3f} mm", fontsize=7, y=title_y(ax))
         ax.set_xlabel("film x (mm)", fontsize=7)
-        ax.set_ylabel("film y (mm)", fontsize=7)
+        if first is None:
+            ax.set_ylabel("film y (mm)", fontsize=7)
+            first = ax
+        else:
+            ax.tick_params(labelleft=False)
         ax.tick_params(labelsize=6)
+    if first is not None:  # the widest image's half-width, about the axis
+        half = max(abs(v) for c in curves if "bokeh" in c for v in c["bokeh"][1])
+        first.set_xlim(-half, half)
+        first.set_ylim(-half, half)
     r0 = rows[0]
     focus = format_distance(math.inf if r0["focus_from_film_mm"] is None else r0["focus_from_film_mm"], units)
     stops = ", ".join(dict.fromkeys(f"f/{r['fstop']:.3g}" for r in rows))
