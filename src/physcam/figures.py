@@ -33,7 +33,7 @@ import os
 import threading
 from pathlib import Path
 
-__all__ = ["pyplot", "subplots", "new_figure", "save_figure", "figure_bytes", "PALETTE", "STYLE", "apply_style",
+__all__ = ["pyplot", "subplots", "new_figure", "save_figure", "figure_bytes", "figure_format", "PALETTE", "STYLE", "apply_style",
            "figure_style", "styled", "fit_title", "unbroken", "NO_BREAK", "figure_problems", "UNITLESS_WORDS"]
 
 _FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
@@ -524,6 +524,19 @@ def title_y(ax):
 SAVE_DPI = 130
 
 
+def figure_format(path) -> str:
+    """The format a figure file is written in, from its name's extension: "png", "svg" or "pdf"; an
+    :class:`~physcam.errors.ExportError` for any other name (the program refuses it as it reads the
+    command line, ``physcam.cli._common.figure_file``, before the command's work)."""
+    from .errors import ExportError
+
+    p = Path(path)
+    fmt = _FORMATS.get(p.suffix.lower())
+    if fmt is None:
+        raise ExportError(f"cannot save a figure as {p.name!r}: use a .png, .svg or .pdf file name")
+    return fmt
+
+
 @styled
 def save_figure(fig, path, *, force: bool = False, dpi: int = SAVE_DPI) -> Path:
     """Write ``fig`` to ``path`` (.png, .svg or .pdf, from the extension) and close it.
@@ -535,10 +548,11 @@ def save_figure(fig, path, *, force: bool = False, dpi: int = SAVE_DPI) -> Path:
     from .io import atomic_write, check_writable
 
     p = Path(path)
-    fmt = _FORMATS.get(p.suffix.lower())
-    if fmt is None:
+    try:
+        fmt = figure_format(p)
+    except ExportError:
         _PLOT.close(fig)
-        raise ExportError(f"cannot save a figure as {p.name!r}: use a .png, .svg or .pdf file name")
+        raise
     check_writable(p, force=force)
     return atomic_write(p, figure_bytes(fig, fmt, dpi=dpi), force=force)
 

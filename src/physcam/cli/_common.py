@@ -136,6 +136,19 @@ def _bound(v: int) -> str:
     return "2**53" if v == WHOLE_LIMIT else "-2**53" if v == -WHOLE_LIMIT else str(v)
 
 
+def figure_file(text: str) -> str:
+    """The argparse type of a figure's file name (``-o``, ``--plot``): one ending .png, .svg or .pdf
+    (:func:`physcam.figures.figure_format`), else refused as the command line is read (exit 2), not after
+    the command's seconds of work."""
+    from ..figures import figure_format
+
+    try:
+        figure_format(text)
+    except PhysCamError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
 def whole(name: str, *, lo: int | None = None, hi: int | None = None):
     """An argparse type reading a whole number (``12``, ``1_000``) within ``lo``..``hi`` (default:
     the integers a float holds exactly, +-2**53). Every integer option uses it, never bare ``int``:

@@ -61,6 +61,8 @@ def at_zoom_named(lens, args):
 
 def register_zoom(lsub, add_lens_argument, add_sensor_options, add_output_options, number) -> None:
     """``physcam lens zoom``'s parser."""
+    from ._common import figure_file
+
     z = lsub.add_parser("zoom", help="a zoom lens across its range: EFL, f-number, entrance pupil, back focus and the "
                                      "image-plane shift (parfocality) at every position; breathing over zoom x focus",
                         description="One row per zoom position (default: the tabulated positions and the midpoints "
@@ -74,7 +76,7 @@ def register_zoom(lsub, add_lens_argument, add_sensor_options, add_output_option
     z.add_argument("--wavelength", type=number("wavelength"), default=None, metavar="NM",
                    help="wavelength in nm (default: the lens's design wavelength)")
     add_sensor_options(z)
-    z.add_argument("-o", "--output", default=None, metavar="FILE",
+    z.add_argument("-o", "--output", default=None, metavar="FILE", type=figure_file,
                    help="also draw breathing (field of view over focus at each tabulated position) and parfocality "
                         "(image-plane shift over the zoom) to this file (.png, .svg, .pdf)")
     z.add_argument("--force", action="store_true", help="overwrite an existing figure")

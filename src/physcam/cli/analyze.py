@@ -12,7 +12,7 @@ images, as ``physcam distortion`` does.
 from __future__ import annotations
 
 
-from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, focus, hidden_alias, number, whole
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, focus, hidden_alias, number, whole, figure_file
 from ._output import add_output_options, document, emit_json, print_csv
 from ._common import add_lenient, mark_repaired
 from .lens import WAVE_UNITS
@@ -27,7 +27,7 @@ def _common(p, plot_help: str) -> None:
     add_lens_argument(p)
     add_lenient(p)
     add_output_options(p, csv=True, what="the analysis")
-    p.add_argument("-o", "--output", metavar="FILE.png", help=plot_help)
+    p.add_argument("-o", "--output", metavar="FILE.png", type=figure_file, help=plot_help)
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
 
 

@@ -6,10 +6,11 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 
 from ..figures import styled
 from ._common import (FOCUS_HELP, FOLDER_FORCE_HELP, add_lens_argument, add_sensor_options, add_units_option, distance,
-                      focus, number, whole)
+                      focus, number, whole, figure_file)
 
 EPILOG = """\
 example:
@@ -194,7 +195,7 @@ def _register_lenses(s) -> None:
     add_lenient(c)
     add_units_option(c)
     add_output_options(c, csv=True, what="the comparison")
-    c.add_argument("-o", "--output", metavar="FIGURE", help="draw the comparison figure (.png, .svg or .pdf)")
+    c.add_argument("-o", "--output", metavar="FIGURE", type=figure_file, help="draw the comparison figure (.png, .svg or .pdf)")
     c.add_argument("--force", action="store_true", help="overwrite an existing figure")
     c.set_defaults(handler=run_lenses)
 
@@ -283,7 +284,7 @@ def run_lenses(args) -> int:
     curves = [r.pop("_curves") for r in rows]
     for name, r in zip(args.lenses, rows):
         r["name"] = name
-    if args.output:
+    if args.output and (args.json or args.csv):  # a pipeline's document follows the file it names
         compare_figure(rows, curves, args.output, sensor=sensor, units=units, force=args.force)
     d = {"sensor": {"name": sensor.name, "width_mm": sensor.width_mm, "height_mm": sensor.height_mm},
          "focus": args.focus if isinstance(args.focus, str) else (None if math.isinf(args.focus) else args.focus),
@@ -306,7 +307,9 @@ def run_lenses(args) -> int:
     for name, r in zip(args.lenses, rows):
         for n in r["notes"]:
             print(f"note: {name}: {n}")
-    if args.output:
+    if args.output:  # the table is read while the figure is drawn (the figure is most of a cold run's time)
+        sys.stdout.flush()
+        compare_figure(rows, curves, args.output, sensor=sensor, units=units, force=args.force)
         print(f"wrote {args.output}")
     return 0
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from ..figures import styled
-from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus_list, list_items, number
+from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus_list, list_items, number, figure_file
 
 EPILOG = """\
 examples:
@@ -89,7 +89,7 @@ def register(sub) -> None:
     add_coc_option(g)
     add_units_option(p)
     add_output_options(p, csv=True, what="the table")
-    p.add_argument("-o", "--output", metavar="CARD", help="draw a printable card (.pdf, .png or .svg)")
+    p.add_argument("-o", "--output", metavar="CARD", type=figure_file, help="draw a printable card (.pdf, .png or .svg)")
     p.add_argument("--page", choices=("a4", "letter"), default="a4",
                    help="the card's page, portrait: a4 (210 x 297 mm, default) or letter (8.5 x 11 in)")
     p.add_argument("--force", action="store_true", help="overwrite an existing card")

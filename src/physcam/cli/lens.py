@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from ..errors import PhysCamError
 from ._common import (add_lenient, add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus,
-                      hidden_alias, mark_repaired, number, whole)
+                      hidden_alias, mark_repaired, number, whole, figure_file)
 from ._output import add_output_options
 from ._zoom import add_zoom_option, at_zoom_named, register_zoom, zoom_info, zoomed
 
@@ -64,7 +64,7 @@ def register(sub) -> None:
 
     d = lsub.add_parser("diagram", help="draw elements, stop, rays and cardinal points to PNG/SVG/PDF")
     common(d)
-    d.add_argument("-o", "--output", required=True, metavar="FILE", help="output file (.png, .svg or .pdf)")
+    d.add_argument("-o", "--output", required=True, metavar="FILE", type=figure_file, help="output file (.png, .svg or .pdf)")
     d.add_argument("--axis", choices=("x", "y"), default="y", help="meridian to draw (x shows anamorphic cylinders)")
     d.add_argument("--field", type=number("field angle"), default=None, metavar="DEG",
                    help="half field angle of the off-axis rays in degrees (default: widest unvignetted)")
@@ -79,7 +79,7 @@ def register(sub) -> None:
                         f"{FOCUS_HELP}; hyperfocal wide open)")
     hidden_alias(b, "--at", "at", type=focus("focus distance"), nargs="+")
     add_sensor_options(b)
-    b.add_argument("-o", "--output", default=None, metavar="FILE", help="also plot to this file (.png, .svg, .pdf)")
+    b.add_argument("-o", "--output", default=None, metavar="FILE", type=figure_file, help="also plot to this file (.png, .svg, .pdf)")
     b.add_argument("--force", action="store_true", help="overwrite an existing plot")
     add_units_option(b)
     add_output_options(b, csv=True, what="the breathing table")
@@ -102,7 +102,7 @@ def register(sub) -> None:
     k.add_argument("--page", choices=("a4", "letter"), default="a4", help="page size, portrait (default a4)")
     k.add_argument("--draft", action="store_true", help="fewer fields and rays: a quick look (seconds)")
     k.add_argument("--dpi", type=whole("dpi", lo=30, hi=600), default=150, help="resolution of a PNG (default 150)")
-    k.add_argument("-o", "--output", required=True, metavar="FILE", help="output file (.pdf, .png or .svg)")
+    k.add_argument("-o", "--output", required=True, metavar="FILE", type=figure_file, help="output file (.pdf, .png or .svg)")
     k.add_argument("--force", action="store_true", help="overwrite an existing file")
     add_units_option(k)
     add_lenient(k)

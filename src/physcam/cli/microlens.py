@@ -4,7 +4,7 @@ field, sub-aperture views and refocused pictures (docs/microlens.md)."""
 
 from __future__ import annotations
 
-from ._common import add_lens_argument, add_units_option, distance, focus, number
+from ._common import add_lens_argument, add_units_option, distance, focus, number, figure_file
 from ._output import add_output_options, document, emit_json
 
 EPILOG = """\
@@ -101,7 +101,7 @@ def register(sub) -> None:
     r.add_argument("--spp", type=_count("--spp", 1, MAX_CLI_SPP), default=4, metavar="N",
                    help="rays per sensor pixel for the plane (default 4)")
     r.add_argument("--seed", type=_count("--seed", 0, 2**31 - 1), default=0, help="random seed (default 0)")
-    r.add_argument("-o", "--output", metavar="FILE", help="draw the figure to FILE (.png, .svg or .pdf)")
+    r.add_argument("-o", "--output", metavar="FILE", type=figure_file, help="draw the figure to FILE (.png, .svg or .pdf)")
     r.add_argument("--force", action="store_true", help="overwrite an existing figure")
     add_output_options(r, what="the numbers")
     add_units_option(r)

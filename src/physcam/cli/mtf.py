@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number, whole
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number, whole, figure_file
 from ._output import add_output_options, document, emit_json, print_csv
 from ._common import add_lenient, mark_repaired
 from .lens import WAVE_UNITS
@@ -74,7 +74,7 @@ def register(sub) -> None:
     add_sensor_options(p)
     add_units_option(p)
     add_output_options(p, csv=True, what="the chart (or the field's figures)")
-    p.add_argument("-o", "--output", metavar="FILE.png", help="write the chart (or the field's MTF curve) as PNG/SVG/PDF")
+    p.add_argument("-o", "--output", metavar="FILE.png", type=figure_file, help="write the chart (or the field's MTF curve) as PNG/SVG/PDF")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(handler=run)
 

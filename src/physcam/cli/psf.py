@@ -3,7 +3,7 @@ summation (docs/image-quality.md)."""
 
 from __future__ import annotations
 
-from ._common import add_lens_argument, FOCUS_HELP, focus, number, whole
+from ._common import add_lens_argument, FOCUS_HELP, focus, number, whole, figure_file
 from ._output import add_output_options, document, emit_json
 from ._common import add_lenient, mark_repaired
 from .lens import WAVE_UNITS
@@ -46,7 +46,7 @@ def register(sub) -> None:
     p.add_argument("--pixel", type=number("pixel size", positive=True), default=None, metavar="UM",
                    help="Huygens image pixel in micrometres (default a quarter of lambda N)")
     add_output_options(p, what="the PSF's figures")
-    p.add_argument("-o", "--output", metavar="FILE.png", help="draw the PSF (log scale) as PNG/SVG/PDF")
+    p.add_argument("-o", "--output", metavar="FILE.png", type=figure_file, help="draw the PSF (log scale) as PNG/SVG/PDF")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(handler=run)
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import FOCUS_HELP, coc_value, distance, focus, number
+from ._common import FOCUS_HELP, coc_value, distance, focus, number, figure_file
 
 EPILOG = """\
 distances accept units as said on set: 3m, 10ft, 6in, 450mm, 10'6" (a bare focus, near or far is mm,
@@ -56,7 +56,7 @@ def register(sub) -> None:
     g.add_argument("--focusing", choices=("collimated", "paraxial"), default="collimated",
                    help="where the real lens's film sits: collimated = its best focus at the mark, as a lens "
                         "technician sets it (default); paraxial = at the mark's paraxial image (Gaussian optics)")
-    p.add_argument("--plot", metavar="FILE", help="draw the depth-of-field chart (near and far against focus, a band per "
+    p.add_argument("--plot", metavar="FILE", type=figure_file, help="draw the depth-of-field chart (near and far against focus, a band per "
                                                   "stop) to FILE (.png, .svg or .pdf; in feet with --units ft)")
     p.add_argument("--force", action="store_true", help="overwrite an existing --plot file")
     p.set_defaults(handler=run)

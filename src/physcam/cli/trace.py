@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number, whole
+from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, hidden_alias, number, whole, figure_file
 from ._output import add_output_options, document, emit_json, print_csv
 from ._common import add_lenient, mark_repaired
 from .lens import WAVE_UNITS
@@ -23,7 +23,7 @@ def register(sub) -> None:
     p.add_argument("--no-clip", dest="clip", action="store_false",
                    help="no element rim or stop clips: trace the whole paraxial entrance pupil")
     add_output_options(p, csv=True, what="the spot sizes")
-    p.add_argument("-o", "--output", metavar="FILE.png", help="write the spot diagram plot")
+    p.add_argument("-o", "--output", metavar="FILE.png", type=figure_file, help="write the spot diagram plot")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(handler=run_spot)
 
@@ -54,7 +54,7 @@ def register(sub) -> None:
                    help="-1..1: brightness ramp across the aperture (+ brighter rim, - brighter centre)")
     add_output_options(b, what="the bokeh measurements")
     add_units_option(b)
-    b.add_argument("-o", "--output", metavar="FILE.png", help="write the bokeh plot (film millimetre axes)")
+    b.add_argument("-o", "--output", metavar="FILE.png", type=figure_file, help="write the bokeh plot (film millimetre axes)")
     b.add_argument("--image", metavar="NAME", default=None,
                    help="write the bokeh as a photograph: NAME.exr (linear, RGB with --spectral) and NAME.png "
                         "(tone-mapped, with a scale bar in sensor pixels)")
