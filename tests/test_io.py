@@ -305,3 +305,32 @@ def test_the_refusal_to_overwrite_speaks_to_both_kinds_of_user(tmp_path):
     with pytest.raises(ExportError, match=r"already exists; pass --force \(in Python, force=True\) to overwrite it"):
         atomic_write(f, b"y")
     assert f.read_bytes() == b"x"
+
+
+@pytest.mark.parametrize("below", ["x.png", "a/b/x.png"])
+def test_a_file_in_the_outputs_folder_path_is_refused_before_writing(tmp_path, below):
+    """An output under a file (``notes.txt/x.png``, ``notes.txt/a/b/x.png``) cannot be written: refused
+    by the check a command runs before its work, naming the file, and nothing is made."""
+    from physcam.io import check_writable
+
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(ExportError, match=r"a part of its folder .*notes\.txt is a file, not a folder"):
+        check_writable(tmp_path / "notes.txt" / below)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
+    assert (tmp_path / "notes.txt").read_text() == "mine"
+
+
+def test_a_figure_under_a_file_is_refused_before_the_lens_is_loaded(tmp_path, capsys):
+    """The CLI's check comes first: given a lens that does not exist, the refusal names the folder."""
+    from physcam.cli import main
+
+    (tmp_path / "notes.txt").write_text("mine")
+    assert main(["spot", "--lens", "no_such_lens_anywhere", "-o", str(tmp_path / "notes.txt" / "x.png")]) == 2
+    err = capsys.readouterr().err
+    assert "is a file, not a folder" in err and "no_such_lens_anywhere" not in err
+
+
+def test_an_output_in_folders_not_made_yet_passes_the_check(tmp_path):
+    from physcam.io import check_writable
+
+    assert check_writable(tmp_path / "new" / "deeper" / "x.png") == tmp_path / "new" / "deeper" / "x.png"

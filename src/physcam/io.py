@@ -84,8 +84,24 @@ def _refuse_special(p: Path) -> None:
                               "for standard output)")
 
 
+def _refuse_file_in_folder(p: Path) -> None:
+    """:class:`ExportError` when the nearest existing part of ``p``'s folder is a file: the write would fail
+    there (:func:`_make_folder`), and a command checking its output first says so before its work."""
+    for part in (p.parent, *p.parent.parents):
+        try:
+            mode = os.stat(part).st_mode
+        except (FileNotFoundError, NotADirectoryError):  # not there yet (made on writing), or under a file
+            continue
+        except (OSError, ValueError):
+            return
+        if not stat.S_ISDIR(mode):
+            raise ExportError(f"cannot write {p}: a part of its folder {part} is a file, not a folder")
+        return
+
+
 def check_writable(path, *, force: bool = False) -> Path:
-    """Return ``path`` as a Path; raise :class:`ExportError` if it exists and ``force`` is false.
+    """Return ``path`` as a Path; raise :class:`ExportError` if it exists and ``force`` is false, or if a
+    part of its folder that exists is a file.
 
     A device, FIFO or socket is refused even with ``force`` (renaming a file over it would replace
     it), except the targets written through, never replaced and needing no ``force``: the null
@@ -94,6 +110,7 @@ def check_writable(path, *, force: bool = False) -> Path:
     if _through_fd(p) is not None:
         return p
     _refuse_special(p)
+    _refuse_file_in_folder(p)
     if p.exists() and not force:
         raise ExportError(f"{p} already exists; pass --force (in Python, force=True) to overwrite it")
     if p.exists() and p.is_dir():
