@@ -712,3 +712,29 @@ def test_judge_claimants_keeps_the_one_its_neighbours_clocks_agree_with(rival_fr
     assert judge_claimants([(real, 11), (rival, 11)], neighbours)[0] == kept
     assert why in judge_claimants([(real, 11), (rival, 11)], neighbours)[1]
     assert judge_claimants([(real, 11), (rival, 11)], []) == (None, "no undisputed neighbour to judge by")
+
+
+@pytest.mark.slow
+@needs_proc_net_udp
+def test_a_take_named_in_upper_case_is_written(tmp_path):
+    """USD tells a layer's format by its extension in any case (``TAKE.USDA`` is text). The recorder took the
+    name at the start of a take, and its USD writer, which knew only lower-case names, refused it at the end
+    (the take was left in its journal, which `live recover` could not write either). Now one rule says both
+    (``physcam.usd_names``): 10 frames recorded to TAKE.USDA are written there, as text, all 10."""
+    pytest.importorskip("pxr")
+    samples = _samples(10)
+    with _Recorder(tmp_path, "--count", "10", out=tmp_path / "TAKE.USDA") as rec:
+        rec.wait_for_port()
+        with Sender("127.0.0.1", rec.port, encoding="cbor") as tx:
+            tx.stream(samples, 240)
+        assert rec.finish() == 0, rec.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["TAKE.USDA"]
+    assert (tmp_path / "TAKE.USDA").read_bytes().startswith(b"#usda 1.0")
+    assert _sequence_numbers(tmp_path / "TAKE.USDA") == list(range(10))
+
+
+def test_a_take_name_usd_cannot_write_is_refused_before_listening(tmp_path, capsys):
+    assert main(["live", "record", str(tmp_path / "take.txt"), "--port", "0", "--duration", "0.1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "take.txt: a USD file's name ends in .usda, .usd or .usdc" in err, err
+    assert list(tmp_path.iterdir()) == []

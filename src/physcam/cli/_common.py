@@ -149,6 +149,19 @@ def figure_file(text: str) -> str:
     return text
 
 
+def usd_file(text: str) -> str:
+    """The argparse type of a USD file physcam writes: one ending .usda, .usd or .usdc in any case
+    (:func:`physcam.usd_names.usd_layer_format`), refused as the command line is read (exit 2), before the
+    command's work and usd-core's import."""
+    from ..usd_names import usd_layer_format
+
+    try:
+        usd_layer_format(text)
+    except PhysCamError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
 def whole(name: str, *, lo: int | None = None, hi: int | None = None):
     """An argparse type reading a whole number (``12``, ``1_000``) within ``lo``..``hi`` (default:
     the integers a float holds exactly, +-2**53). Every integer option uses it, never bare ``int``:

@@ -69,6 +69,7 @@ def settings(args, kept: dict | None = None, *, check_outputs: bool = True) -> S
     Raises a PhysCamError in one line before anything is received."""
     from ..errors import InputError
     from ..io import check_writable
+    from ..usd_names import usd_layer_format
 
     opts = dict(kept or {})
     for name in KEPT_OPTIONS:
@@ -95,8 +96,7 @@ def settings(args, kept: dict | None = None, *, check_outputs: bool = True) -> S
         fiz = read_fiz_table(opts["fiz"])
         opts["fiz"] = str(Path(opts["fiz"]).resolve())
     file, report = args.file, args.report
-    if not str(file).lower().endswith((".usda", ".usd", ".usdc")):
-        raise InputError(f"{file}: a USD file name ends in .usda, .usd or .usdc")
+    usd_layer_format(file)
     if report is not None and not str(report).lower().endswith((".csv", ".json")):
         raise InputError("--report is written as .csv or .json")
     if check_outputs:  # a recording starts only when its names are free (or --force); recover takes free names

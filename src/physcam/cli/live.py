@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from ._common import distance, focus, number, numbers, whole
+from ._common import distance, focus, number, numbers, usd_file, whole
 from ._live_record import resolve_sensor_opt as _resolve_sensor_opt
 from ._live_record import source_id
 from ._output import add_output_options, document, emit_json
@@ -83,7 +83,7 @@ def _clip_arg(p) -> None:
 
 def _record_parser(s) -> None:
     r = s.add_parser("record", help="record a stream into a time-sampled USD camera (and a lens report)")
-    r.add_argument("file", help="output .usda/.usd/.usdc")
+    r.add_argument("file", type=usd_file, help="output .usda/.usd/.usdc")
     _network_args(r, receive=True)
     r.add_argument("--count", type=_count, default=None, help="stop once the source recorded has this many samples")
     r.add_argument("--report", metavar="FILE", help="also write the per-frame lens report (.csv or .json)")
@@ -116,7 +116,7 @@ def _recover_parser(s) -> None:
                                   "report it names, under their names or the first free ones beside them. The "
                                   "options given override the recording's own (docs/live.md).")
     rc.add_argument("journal", help="the journal, e.g. take.usda.journal")
-    rc.add_argument("-o", "--output", dest="file", default=None,
+    rc.add_argument("-o", "--output", dest="file", default=None, type=usd_file,
                     help="output .usda/.usd/.usdc (default: the recording's, beside the journal)")
     rc.add_argument("--report", metavar="FILE", help="the lens report (default: the recording's, if it asked one)")
     _sensor_args(rc)
@@ -209,7 +209,7 @@ def register(sub) -> None:
     pl.set_defaults(handler=run_play)
 
     w = s.add_parser("wall", help="write an LED wall mesh (flat or curved) for the frustum")
-    w.add_argument("file", help="output .usda/.usd/.usdc")
+    w.add_argument("file", type=usd_file, help="output .usda/.usd/.usdc")
     w.add_argument("--kind", choices=("flat", "curved"), default="flat", help="flat plane or cylinder arc")
     w.add_argument("--width", type=number("width", positive=True, hi=1000.0), default=12.0,
                    help="metres (a curved wall: arc length)")

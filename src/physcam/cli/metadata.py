@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import LENS_HELP, add_sensor_options, add_units_option, distance, number
+from ._common import LENS_HELP, add_sensor_options, add_units_option, distance, number, usd_file
 from ._output import add_output_options, document, emit_json
 from .report import add_coc_option
 
@@ -74,7 +74,7 @@ def register(sub) -> None:
 
     u = s.add_parser("usd", help="one animated PhysicalCamera (focus and iris pulls, breathing, tracker pose)")
     _clip_args(u)
-    u.add_argument("-o", "--output", dest="file", required=True, help="output .usda/.usd/.usdc")
+    u.add_argument("-o", "--output", dest="file", required=True, type=usd_file, help="output .usda/.usd/.usdc")
     _solve_args(u)
     u.add_argument("--plate", default=None, metavar="PATH", help="the plate (image sequence or movie) shot with it")
     u.add_argument("--plate-frames", type=_frame_range, default=None, metavar="FIRST-LAST",

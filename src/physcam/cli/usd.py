@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import FOCUS_HELP, add_sensor_options, add_units_option, coc_of, distance, focus, number, numbers, whole
+from ._common import FOCUS_HELP, add_sensor_options, add_units_option, coc_of, distance, focus, number, numbers, usd_file, whole
 from ._output import add_output_options, document, emit_json
 from .report import add_coc_option, resolve_sensor
 
@@ -32,7 +32,7 @@ def register(sub) -> None:
     s = p.add_subparsers(dest="usd_command", metavar="ACTION")
 
     w = s.add_parser("write", help="write the USD camera of a lens report")
-    w.add_argument("file", help="output .usda/.usd/.usdc")
+    w.add_argument("file", type=usd_file, help="output .usda/.usd/.usdc")
     from .report import add_report_arguments
 
     add_report_arguments(w)  # brings --meters-per-unit and --shutter-angle with it
@@ -71,7 +71,7 @@ def register(sub) -> None:
                      description="Write the files of the proposal's use cases (docs/usd.md).",
                      epilog=KIT_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     k.add_argument("kind", choices=("previs", "vendor", "lens", "body", "shot"), help="which use case to write")
-    k.add_argument("file", help="output .usda/.usd/.usdc")
+    k.add_argument("file", type=usd_file, help="output .usda/.usd/.usdc")
     k.add_argument("--lens", help="vendor: bundled lens name or prescription file; shot: the lens file to reference")
     k.add_argument("--body", help="shot: the body file to reference")
     k.add_argument("--characterizations", metavar="CSV",

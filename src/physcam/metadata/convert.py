@@ -182,6 +182,7 @@ def write_usd(file, record, solved, *, plate=None, plate_frames=None, meters_per
 
     from ..export._codetext import printable_line
     from ..io import check_writable
+    from ..usd_names import usd_layer_format
     from ..live.record import write_recording_usd
     from ..usd.author import save_stage
 
@@ -191,8 +192,7 @@ def write_usd(file, record, solved, *, plate=None, plate_frames=None, meters_per
         n = plate_d["lastFrame"] - plate_d["firstFrame"] + 1
         raise InputError(f"the plate's {n} frames do not match the clip's {len(solved)} frames")
     p = check_writable(file, force=force)
-    if p.suffix not in (".usda", ".usd", ".usdc"):
-        raise InputError(f"{p}: a USD file name ends in .usda, .usd or .usdc")
+    usd_layer_format(p)
     rate = solved[0].frame.rate if solved else None
     if plate_d and "firstFrame" in plate_d:  # the plate's frame numbers are the time codes
         solved = [replace(s, time_code=float(plate_d["firstFrame"] + i)) for i, s in enumerate(solved)]

@@ -670,17 +670,17 @@ def save_stage(stage, file, *, force: bool = False):
     Path. ``.usda`` writes text; ``.usd``/``.usdc`` write crate.
     """
     from ..io import atomic_write, check_writable, staged
+    from ..usd_names import usd_layer_format
     from .validate import check_stage
 
     p = check_writable(file, force=force)
-    if p.suffix not in (".usda", ".usd", ".usdc"):
-        raise ExportError(f"{p}: a USD file name ends in .usda, .usd or .usdc")
+    fmt = usd_layer_format(p)
     # schema fallback types (the root layer's fallbackPrimTypes): a process without physcam's
     # plugin reads a PhysicalCamera as an Xform, so the body's transform still places the
     # companion UsdGeomCamera (docs/usd.md, "Without the plugin")
     stage.WriteFallbackPrimTypes()
     check_stage(stage)
-    if p.suffix == ".usda":
+    if fmt == "usda":
         return atomic_write(p, stage.GetRootLayer().ExportToString(), force=force)
     # binary crate: USD exports into a temporary next to the target (named for it, this host and this
     # process: a killed writer's is removed by the next write, physcam.io), which is then renamed

@@ -22,6 +22,7 @@ from ..data.default_sensor import DEFAULT_SENSOR_HEIGHT_MM, DEFAULT_SENSOR_WIDTH
 from ..errors import ExportError, InputError, require_type
 from ..export._codetext import printable_line
 from ..lens.prescription import takes_prescription
+from ..usd_names import usd_layer_format
 from .author import (LENS_INSTANCE, SENSOR_INSTANCE, CameraSpec, author_camera, author_prescription, author_render_camera,
                      new_stage, save_stage)
 from .float32_values import _same_value, _same_view, _shown_value
@@ -944,8 +945,7 @@ def characterization_target(file, variant: str) -> dict:
     require_type("lens file", file, (str, Path), "a .usda/.usdc path")
     variant = _variant_identifier(variant)
     p = Path(file)
-    if p.suffix not in (".usda", ".usdc", ".usd"):
-        raise InputError(f"{p}: a lens file's name ends in .usda, .usdc or .usd")
+    usd_layer_format(p, what="a lens file's name")
     if not p.exists():
         if not p.parent.is_dir():
             raise ExportError(f"{p}: its folder {p.parent} does not exist")
