@@ -40,6 +40,7 @@ class BuildExt(build_ext):
 
 
 setup(
-    ext_modules=[Extension("physcam.trace.kernels._ckernel", ["src/physcam/trace/kernels/_ckernel.c"], optional=True)],
+    ext_modules=[Extension("physcam.trace.kernels._ckernel", ["src/physcam/trace/kernels/_ckernel.c",
+                                                              "src/physcam/trace/kernels/_rimpass.c"], optional=True)],
     cmdclass={"build_ext": BuildExt},
 )
