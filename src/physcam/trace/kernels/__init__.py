@@ -35,8 +35,12 @@ a core (benchmarks/small_calls.py). Serial and threaded runs give identical rays
 are cached on disk under a key that includes physcam's version and a hash of the kernel sources
 (:mod:`._jitcache`).
 
-The same cache holds the Blender extension's rim pass (:func:`rim_pass`, :mod:`._rimpass`): the rim points of
-its pupil tables' aim grids, the numpy pass's bit for bit, compiled because that pass was half of a table's CPU.
+The Blender extension's pupil tables have a compiled rim pass too (:func:`rim_pass`): the rim points of their aim
+grids, the numpy pass's bit for bit, compiled because that pass was half of a table's CPU. Two ports of it: in C
+(``_rimpass.c``, built into the C kernel's module, :func:`._c.rim_points`), which "auto" takes where the C kernel
+is built, and numba's (:mod:`._rimpass`, in the same disk cache as the JIT kernel), where only numba is. Both run
+as fast (round 22, docs/performance.md); the C one has no JIT code to load, so a process that traces with the C
+kernel never loads numba for its rims.
 """
 
 from __future__ import annotations
