@@ -18,8 +18,9 @@ ones), and each side's median. ``--rims``: the pupil tables' rims found along li
 (:func:`main_rims`), no timing.
 ``--norms``: the centre's normalisation in closed form against a dense trace (:func:`main_norms`), no timing.
 ``--table``: one lens's radial pupil table by a library call (``radial_pupil_table``, "auto": numba not loaded
-first) in a fresh process, the call's CPU seconds and whether it loaded numba, ``--repeat`` times alternated with
-``--baseline-src``'s, and whether the two tables are the same bytes (:func:`main_table`; round 22's before/after).
+first) in a fresh process, then its whole payload (``lens_payload``: the tables of every focus state), each call's
+CPU seconds and whether numba got loaded, ``--repeat`` times alternated with ``--baseline-src``'s, and whether the
+two sides' outputs are the same bytes (:func:`main_table`; round 22's before/after).
 ``--install``: then Blender's installer of each side's zip
 (``package_install_files`` in a fresh user folder, the Blender tests' way; the Blender of
 ``physcam.export.blender_runner.find_blender``), its wall and CPU seconds and the megabytes it unpacks.
@@ -134,7 +135,13 @@ def table_worker(lens_name: str) -> None:
     t = time.process_time()
     table = radial_pupil_table(q, st.film_z, levels)
     cpu = time.process_time() - t
-    print(json.dumps({"cpu_s": cpu, "numba": "numba" in sys.modules, "sha1": hashlib.sha1(table.tobytes()).hexdigest()}))
+    from physcam.export.blender_extension import lens_payload
+
+    t = time.process_time()
+    data, _ = lens_payload(load_lens(lens_name), lens_name)
+    payload = time.process_time() - t
+    print(json.dumps({"cpu_s": cpu, "payload_s": payload, "numba": "numba" in sys.modules,
+                      "sha1": hashlib.sha1(table.tobytes() + json.dumps(data).encode()).hexdigest()}))
 
 
 def main_table(args, here: str) -> None:
@@ -154,9 +161,10 @@ def main_table(args, here: str) -> None:
             for side in (list(sides) if i % 2 == 0 else list(sides)[::-1]):
                 sides[side][1].append(one(sides[side][0], name))
         for side, (_, rows) in sides.items():
-            cpu = sorted(r["cpu_s"] for r in rows)
-            print(f"{name:24s} {side:5s} call CPU median {cpu[len(cpu) // 2]:.3f} s (range {cpu[0]:.3f}-{cpu[-1]:.3f}),"
-                  f" numba loaded: {sorted({r['numba'] for r in rows})}, sha1 {sorted({r['sha1'][:12] for r in rows})}")
+            cpu, pay = sorted(r["cpu_s"] for r in rows), sorted(r["payload_s"] for r in rows)
+            print(f"{name:24s} {side:5s} table CPU median {cpu[len(cpu) // 2]:.3f} s ({cpu[0]:.3f}-{cpu[-1]:.3f}), then"
+                  f" its payload {pay[len(pay) // 2]:.3f} s ({pay[0]:.3f}-{pay[-1]:.3f}); numba loaded:"
+                  f" {sorted({r['numba'] for r in rows})}, sha1 {sorted({r['sha1'][:12] for r in rows})}")
     print(f"load average after: {load()}, mark {mark():.1f} ms")
 
 
