@@ -14,27 +14,32 @@ from physcam.cli import main
 from physcam.errors import PhysCamError
 from physcam.export.blender_extension import build_extension, lens_payload
 from physcam.lens.library import list_lenses, load_lens
-from physcam.trace.kernels import c_available
+from physcam.trace.kernels import c_available, numba_available
 
 LENS = "dgauss_77deg_3_5201mm"  # the cheapest lens to tabulate (~2 s)
 
 
-def test_tables_of_the_pooled_build_are_the_one_process_ones(extension_zip):
+def test_tables_of_the_pooled_build_are_the_one_process_ones(extension_zip, monkeypatch):
     """Every lens asked for (the session's, tests/_session.py) is in the pooled zip, in the order asked
     (the library's), with one shader source (its four variants' #define lines are the add-on's:
     shader_variant.py), and one lens's table and shader computed here, in this process, are the zip's
-    byte for byte."""
-    data, shaders = lens_payload(load_lens(LENS), LENS)
-    assert list(shaders) == [f"{LENS}.osl"]
-    asked = [r.slug for r in list_lenses() if r.slug in EXTENSION_LENSES]
-    with zipfile.ZipFile(extension_zip) as z:
-        index = json.loads(z.read("lenses/index.json"))
-        assert [e["slug"] for e in index] == asked
-        assert sorted(n for n in z.namelist() if n.startswith("shaders/")) == sorted(f"shaders/{s}.osl" for s in asked)
-        assert "def variant_source(" in z.read("shader_variant.py").decode("utf-8")
-        assert json.loads(z.read(f"lenses/{LENS}.json")) == json.loads(json.dumps(data))
-        for name, text in shaders.items():
-            assert z.read(f"shaders/{name}").decode("utf-8") == text, name
+    byte for byte, whichever rim pass finds them: the zip's workers trace with "auto" (the C kernel and its rim
+    pass where built), this process with the numpy kernel and pass (``PHYSCAM_BACKEND=numpy``) and, where numba
+    is installed, with numba's kernel and pass (tests/export/test_blender_pupil_rimpass.py holds the passes'
+    points equal; this holds that the zip's bytes are too)."""
+    for backend in ("numpy", "numba") if numba_available() else ("numpy",):
+        monkeypatch.setenv("PHYSCAM_BACKEND", backend)
+        data, shaders = lens_payload(load_lens(LENS), LENS)
+        assert list(shaders) == [f"{LENS}.osl"]
+        asked = [r.slug for r in list_lenses() if r.slug in EXTENSION_LENSES]
+        with zipfile.ZipFile(extension_zip) as z:
+            index = json.loads(z.read("lenses/index.json"))
+            assert [e["slug"] for e in index] == asked
+            assert sorted(n for n in z.namelist() if n.startswith("shaders/")) == sorted(f"shaders/{s}.osl" for s in asked)
+            assert "def variant_source(" in z.read("shader_variant.py").decode("utf-8")
+            assert z.read(f"lenses/{LENS}.json") == json.dumps(data).encode("utf-8"), backend
+            for name, text in shaders.items():
+                assert z.read(f"shaders/{name}") == text.encode("utf-8"), (backend, name)
 
 
 #: Two of the cheapest lenses to tabulate, one of them anamorphic (its rectangle tables, not the radial ones)

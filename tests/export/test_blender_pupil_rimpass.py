@@ -5,18 +5,16 @@ dense traces): the same points in the same order, so the same areas, ellipses an
 aim grids, on made grids at the edge cases (nothing passing, everything passing, passing only on the grid's
 edge, several rims per grid, every clip-edge branch) and on random grids (hypothesis). All run in this process
 on the same grids, IEEE arithmetic without contraction on every side, so the comparison is exact: any
-difference is a different point, not rounding. A compiled pass this install lacks is skipped, with the reason."""
+difference is a different point, not rounding. A compiled pass this install lacks is skipped, with the reason.
+(The zip the same bytes whichever pass runs: tests/export/test_blender_extension_build.py, the pooled build.)"""
 
 from __future__ import annotations
-
-import json
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from physcam.export.blender_extension import lens_payload
 from physcam.export.blender_pupil import _PassingSets, iris_levels
 from physcam.export.blender_pupil_sets import _GRID, _TOWARD, _grid_rims, _n_passing, _rims, _rims_compiled
 from physcam.lens.library import load_lens
@@ -211,26 +209,12 @@ def test_the_c_pass_refuses_what_would_index_past_its_arrays():
 def test_random_grids_give_the_numpy_rims(seed, n_grids, p_ok, on_radii):
     """Random grids (pass flags at any density, stop radii random or exactly on the iris radii, where a rim point's
     fraction is 0, -0.0 or NaN, as np.clip keeps them), random radius ranges and wanted rims: the C pass's rims
-    are the numpy pass's, byte for byte."""
+    (and numba's, where installed) are the numpy pass's, byte for byte."""
     rng = np.random.default_rng(seed)
     oks = rng.random((n_grids, NY, NX)) < p_ok
     rads = rng.choice(RADII, (n_grids, NY, NX)) if on_radii else rng.uniform(0.2, 3.5, (n_grids, NY, NX))
     ranges = [tuple(sorted(rng.integers(0, RADII.size + 1, 2))) for _ in range(n_grids)]
     uses = _uses(oks, rads, RADII, ranges)
-    _check(uses, RADII, rng.random((n_grids, RADII.size)) < 0.7, _edges(uses, rng), "c")
-
-
-@pytest.mark.parametrize("compiled", PASSES)
-def test_the_zip_is_the_same_bytes_whichever_rim_pass_runs(compiled, monkeypatch):
-    """A lens's part of the extension zip (``lens_payload``: its table and shader, what build_extension writes)
-    with the numpy pass (PHYSCAM_BACKEND=numpy: the numpy kernel and rims) and with each compiled pass (the C or
-    numba kernel and its rims): the same bytes. The cheapest lens to tabulate (~1 s): the passes' points are
-    already held equal above; this holds that nothing after them differs either."""
-    lens = "dgauss_77deg_3_5201mm"
-    out = {}
-    for backend in ("numpy", compiled):
-        monkeypatch.setenv("PHYSCAM_BACKEND", backend)
-        assert (rim_pass("auto") is None) == (backend == "numpy")
-        data, shaders = lens_payload(load_lens(lens), lens)
-        out[backend] = (json.dumps(data).encode("utf-8"), shaders[f"{lens}.osl"].encode("utf-8"))
-    assert out["numpy"] == out[compiled]
+    wanted, edges = rng.random((n_grids, RADII.size)) < 0.7, _edges(uses, rng)
+    for compiled in ("c", "numba") if numba_available() else ("c",):
+        _check(uses, RADII, wanted, edges, compiled)
