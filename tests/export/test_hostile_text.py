@@ -528,3 +528,21 @@ def test_a_tab_in_a_lens_note_is_a_space_in_the_exported_comment():
     assert printable_line("a\tb\nc") == "a b\ufffdc"
     text, _ = pbrt_lens_text(load_lens("dgauss_50mm"))
     assert "# D-GAUSS F/2 22deg HFOV" in text.splitlines()
+
+
+def test_cli_commands_to_paste_keep_a_folder_with_spaces_one_word(tmp_path, capsys):
+    """`export blender` prints the Blender command lines to paste; with ``-o "blender cams"`` they read
+    ``--python blender cams/setup_....py``, two words to a shell. Quoted (shlex), a shell reads the paths back."""
+    import shlex
+
+    from physcam.cli import main
+
+    out = tmp_path / "blender cams ' $HOME"
+    assert main(["export", "blender", "--lens", "cooke_triplet_50mm_f4_5", "--focus", "2m", "--sensor", "S35",
+                 "-o", str(out), "--builtin"]) == 0
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if "blender your.blend --python" in ln]
+    assert len(lines) == 2
+    for ln, name in zip(lines, ("setup_cooke_triplet_50mm_f4_5.py", "builtin_cooke_triplet_50mm_f4_5.py")):
+        words = shlex.split(ln.split(": ", 1)[1].split("  (")[0])
+        assert words[:3] == ["blender", "your.blend", "--python"] and words[3] == str(out / name)
+        assert Path(words[3]).is_file()
