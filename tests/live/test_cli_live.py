@@ -128,6 +128,23 @@ def test_multicast_on_loopback():
     assert {g.encoding for g in got} == {"cbor"}
 
 
+def test_a_multicast_sender_says_the_groups_source_number(capsys):
+    """OpenTrackIO ties the multicast group 239.135.1.N to source number N: `live send --multicast 3` sent to
+    239.135.1.3 samples that said source 1 (a review found it). Every sample now says 3, as the group does."""
+    from physcam.cli import main
+    from physcam.live.sample import validate_sample
+
+    assert main(["live", "send", "--focal", "35", "--fstop", "2.8", "--focus", "3m", "--sensor", "S35",
+                 "--frames", "4", "--multicast", "3", "--print"]) == 0
+    samples = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert len(samples) == 4 and {s["sourceNumber"] for s in samples} == {3}
+    for s in samples:
+        validate_sample(s)
+    assert main(["live", "send", "--focal", "35", "--fstop", "2.8", "--focus", "3m", "--sensor", "S35",
+                 "--frames", "2", "--print"]) == 0
+    assert {json.loads(x)["sourceNumber"] for x in capsys.readouterr().out.splitlines()} == {1}
+
+
 @pytest.mark.slow
 @needs_proc_net_udp
 @pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP", "SIGINT"])

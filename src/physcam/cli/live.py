@@ -336,8 +336,12 @@ def _sender(args):
 
 
 def _stream(args, samples, rate) -> int:
+    """Send (or with --print, write) ``samples`` at ``rate``; with --multicast N each is of source number N, the
+    number OpenTrackIO ties to the group 239.135.1.N (a sample said source 1 whatever group it went to)."""
     import json
 
+    if getattr(args, "multicast", None) is not None:
+        samples = ({**sm, "sourceNumber": args.multicast} for sm in samples)
     if getattr(args, "print", False):
         n = 0
         for sm in samples:
