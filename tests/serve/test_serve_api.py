@@ -213,6 +213,19 @@ def test_refusals_are_one_json_line(server, path, status, fragment):
     assert fragment in err and "\n" not in err and "Traceback" not in err
 
 
+def test_a_space_of_any_width_is_text_not_a_control_character(server, capsys):
+    """A no-break space (a phone keyboard's, "3\u00a0m") was refused as a control character, though the command
+    line reads it; the server answers as `physcam report` does. A line break, a bidi override and a NUL are
+    still refused."""
+    port, _ = server
+    status, got = get_json(port, "/api/report?focal=50&fstop=2.8&focus=3%C2%A0m")
+    assert status == 200, got
+    assert got == cli_json(capsys, ["report", "--focal", "50", "--fstop", "2.8", "--focus", "3\u00a0m"])
+    for bad in ("%0a", "%E2%80%AE", "%00", "%E2%80%A8"):
+        got, _, body = request(port, f"/api/report?focal=50&fstop=2.8&focus=3m{bad}")
+        assert got == 422 and "control character" in json.loads(body)["error"], (bad, body)
+
+
 def test_methods_and_bodies_are_refused(server):
     port, _ = server
     status, headers, body = request(port, "/api/report?focal=50", method="POST", body=b"x=1")

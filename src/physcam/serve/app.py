@@ -43,6 +43,18 @@ from .. import __version__
 from ..errors import PhysCamError, WrongTypeError
 from .worker import FairWorker, Full
 
+#: Unicode categories of what a query value may not hold: controls (Cc), format characters (Cf: the bidi
+#: overrides), surrogates, private use, unassigned, line and paragraph separators; the categories
+#: physcam.export._codetext keeps off a written line. A space of any width (Zs: a no-break space from a phone's
+#: keyboard, "3\u00a0m") is text the command line reads too (``str.isprintable`` refused it).
+_CONTROL = frozenset(("Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"))
+
+
+def _holds_control(value: str) -> bool:
+    import unicodedata
+
+    return not value.isprintable() and any(unicodedata.category(c) in _CONTROL for c in value)
+
 __all__ = ["Backend", "Limits", "create_app", "settle_heap", "STATIC_FILES"]
 
 #: The page's files (package data, ``physcam/serve/static``) and their media types.
@@ -309,7 +321,7 @@ class _App:
                 raise Refused(422, f"parameter {name!r} is given twice")
             if len(value) > lim.max_value:
                 raise Refused(422, f"parameter {name!r} is longer than {lim.max_value} characters")
-            if not value.isprintable():
+            if _holds_control(value):
                 raise Refused(422, f"parameter {name!r} holds a control character")
             out[name] = value
         return out
