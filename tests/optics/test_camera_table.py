@@ -477,3 +477,23 @@ def test_no_format_name_repeats_a_word_and_every_name_finds_its_own_format():
             for label in (s.name, *s.aliases):  # or the sensors.csv gate of that name, the same area
                 found = find_sensor(label)
                 assert found is s or (found.width_mm, found.height_mm) == (s.width_mm, s.height_mm), (label, s.name)
+
+
+@pytest.mark.parametrize("name", ["é", "!!!", "\U0001F3A5"])
+def test_a_name_of_letters_no_sensor_is_named_in_is_unknown_not_empty(name, capsys):
+    """Sensor names are matched on a-z and digits; "é" or "!!!" were "the sensor name is empty" to find_sensor,
+    and `physcam sensors é` (and the page's /api/sensors?name=é) listed all the sensors. Each is now an unknown
+    sensor, and a filter word of such letters matches none; punctuation between words is still ignored."""
+    from physcam.cli import main
+    from physcam.errors import SensorError
+    from physcam.optics.sensors import filter_sensors, find_sensor
+
+    with pytest.raises(SensorError, match=r"unknown sensor .*sensors are named in letters a-z and digits"):
+        find_sensor(name)
+    assert filter_sensors(name) == []
+    assert main(["sensors", name]) == 2
+    assert "unknown sensor" in capsys.readouterr().err
+    with pytest.raises(SensorError, match="the sensor name is empty"):
+        find_sensor("  ")
+    assert [s.key for s in filter_sensors("ALEXA - Mini LF")] == [s.key for s in filter_sensors("ALEXA Mini LF")]
+    assert filter_sensors("ALEXA - Mini LF") and filter_sensors("Ü 35") == []

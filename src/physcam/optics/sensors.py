@@ -290,7 +290,10 @@ def filter_sensors(query: str = "", *, maker: str | None = None, fmt: str | None
     for name, v in (("query", query), ("maker", maker), ("format", fmt)):
         if v is not None and not isinstance(v, str):
             raise SensorError(f"a sensor {name} is text, got {type(v).__name__}")
-    words = [_norm(w) for w in (query or "").split() if _norm(w)]
+    typed = (query or "").split()
+    words = [_norm(w) for w in typed if _norm(w)]
+    if typed and (not words or any(not _norm(w) and any(c.isalnum() for c in w) for w in typed)):
+        return []  # only marks ("!!!"), or a word of letters no sensor is named in ("é"): nothing matches
     out = []
     for s in sensors():
         text = " ".join(_norm(t) for t in (s.key, s.name, s.maker, s.kind, *s.aliases))
@@ -320,6 +323,9 @@ def find_sensor(name: str) -> Sensor:
         raise SensorError(f"a sensor name must be text, got {type(name).__name__}")
     key = _norm(name)
     if not key:
+        if name.strip():  # "é", "!!!": letters and marks no sensor's name is told by (a-z, 0-9)
+            raise SensorError(f"unknown sensor {name!r}: sensors are named in letters a-z and digits. "
+                              "`physcam sensors` lists them all")
         raise SensorError("the sensor name is empty. `physcam sensors` lists them all")
     if key in FAMILY_NAMES:
         fam = _norm(FAMILY_NAMES[key])
