@@ -48,21 +48,28 @@
     return v;
   }
 
+  // typographic foot marks (U+2019, U+2018, U+2032) as ', inch marks (U+201D, U+201C, U+2033) as ", and two
+  // foot marks as an inch mark (6'' or 6’’ is 6 inches): physcam.units.plain_marks
+  function plainMarks(text) {
+    return text.replace(/[\u2019\u2018\u2032]/g, "'").replace(/[\u201d\u201c\u2033]/g, '"').replace(/''/g, '"');
+  }
+
   function parseDistance(text, name = "distance", allowInf = false) {
     if (typeof text === "number") return text;
     const s = String(text).trim();
+    const t = plainMarks(s); // refusals quote what was typed, s
     if (INFINITY_WORDS.includes(s.toLowerCase())) {
       if (allowInf) return Infinity;
       fail(`${name} must be finite, got '${s}'`);
     }
     let v;
-    let m = /['"/]/.test(s) || /\d\s*(ft|feet|foot)\s*\d/.test(s) ? FEET_INCHES.exec(s) : null;
-    m = m || (s.includes("/") ? FEET_BARE_INCHES.exec(s) : null);
+    let m = /['"/]/.test(t) || /\d\s*(ft|feet|foot)\s*\d/.test(t) ? FEET_INCHES.exec(t) : null;
+    m = m || (t.includes("/") ? FEET_BARE_INCHES.exec(t) : null);
     if (m && (m[1] !== undefined || m.slice(2).some((g) => g !== undefined))) {
       v = Math.abs(Number(m[1] || 0.0)) * 304.8 + inches(...m.slice(2, 7)) * 25.4;
-      if (s.startsWith("-")) v = -v;
+      if (t.startsWith("-")) v = -v;
     } else {
-      m = SIMPLE.exec(s);
+      m = SIMPLE.exec(t);
       if (!m) fail(`cannot read ${name} '${s}': write a number with an optional unit, e.g. 3m, 10ft, 6in, 450mm`);
       v = toMm(Number(m[1]), m[2] || "mm");
     }
@@ -788,7 +795,7 @@
       given_far_from_film_mm: given && given.dof.far_from_film_mm };
   }
 
-  const api = { ReportError, solveReport, report, parseDistance, exposureStops, compensate, closeUp, splitFocus, parseCoc, circleOfConfusion, setCocConventions,
+  const api = { ReportError, solveReport, report, plainMarks, parseDistance, exposureStops, compensate, closeUp, splitFocus, parseCoc, circleOfConfusion, setCocConventions,
     findSensor, cameraNameNote, hyperfocalDistance, dofLimits, imageDistance, objectDistanceForMarked, stopsBetween, fovDeg,
     HYPERFOCAL, COC_CONVENTIONS };
   root.PhysOnset = api;
