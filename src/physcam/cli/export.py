@@ -142,10 +142,11 @@ def run_unreal(args) -> int:
     if args.json:
         emit_json(document("export_unreal", {"written": str(args.output), "lens_file": data}))
         return 0
-    if args.csv:
-        print_csv(pc["marks"])
-        return 0
     from ._common import units_of
+
+    if args.csv:
+        print_csv(pc["marks"], units=units_of(args))
+        return 0
     from ._output import Table, print_table
 
     units = units_of(args)

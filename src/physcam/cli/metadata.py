@@ -212,10 +212,10 @@ def run_report(args) -> int:
             "clip": rec.static_dict(), "lens": args.lens, "model": "prescription" if lens is not None else "thin lens",
             "sensor_mm": [s.width_mm, s.height_mm], "notes": notes, "frames": rows}))
         return 0
-    if args.csv:
-        print_csv(rows)
-        return 0
     u = units_of(args)
+    if args.csv:
+        print_csv(rows, units=u)
+        return 0
     what = f"lens {args.lens}" if lens is not None else "a thin lens of the recorded focal length"
     cols = ["frame", "timecode", "focus", "stop", "near", "far", "hyperfocal", "hfov_deg"]
     t = Table(f"{_clip(rec)}: {what}, sensor {s.width_mm:g} x {s.height_mm:g} mm", cols,
