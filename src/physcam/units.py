@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 import re
 
-from .errors import UnitError
+from .errors import UnitError, require_type
 
 __all__ = ["MM_PER_UNIT", "UNIT_SYSTEMS", "unit_system", "plain_marks", "parse_distance", "format_feet_inches", "format_distance", "mm_to", "to_mm",
            "inch_fraction_for"]
@@ -93,7 +93,7 @@ def plain_marks(text: str) -> str:
     >>> print(plain_marks("10’6”"), plain_marks("10′ 6″"), plain_marks("10'6''"))
     10'6" 10' 6" 10'6"
     """
-    return text.translate(_MARKS).replace("''", '"')
+    return require_type("text", text, str).translate(_MARKS).replace("''", '"')
 
 
 def parse_distance(text, *, name: str = "distance", allow_inf: bool = False) -> float:
