@@ -383,3 +383,20 @@ def test_page_reads_typographic_marks_as_the_server():
     for q, a, b in zip(setups, page, cli):
         assert not _agree(a, b), (q, _agree(a, b))
     assert cli[0]["body"]["focus_from_film_mm"] == pytest.approx(3200.4, rel=1e-12)
+
+
+def test_page_keeps_the_libraries_coc_and_focal_bounds():
+    """The one range of a circle of confusion (0.001 to 1 mm, physcam.optics.coc.require_coc) and of a focal length
+    (1 mm to 100 m, physcam.optics.thinlens.require_focal_length): the page refuses where the server refuses and
+    answers the edges as it does (round 22: coc=1e-300 gave a 300-digit hyperfocal, focal=0.001 "0.0 mm")."""
+    base = {"fstop": "2", "focus": "3m", "sensor": "S35"}
+    setups = [dict(base, focal="50", coc=c) for c in ("1e-300", "5m", "0.0009", "1.001", "0.001", "1", "1um", "1mm")]
+    setups += [dict(base, focal=f, focus="inf") for f in ("0.001", "0.999", "1", "1e5", "1.1e5")]
+    want = [False, False, False, False, True, True, True, True, False, False, True, True, False]
+    page, cli = run_page_solver({"sensors": sensor_table(), "setups": setups}), cli_answers(setups)
+    assert [c["ok"] for c in cli] == want, [c["body"] for c in cli]
+    assert [p["ok"] for p in page] == want, [p["body"] for p in page]
+    for a, b in zip(page, cli):
+        assert not _agree(a, b)
+    calls = [["closeUp", 0.5, 4, 0.025, 1000, 1], ["closeUp", 50, 4, 5000, 1000, 1], ["closeUp", 1, 4, 0.001, 1000, 1]]
+    assert [g["ok"] for g in run_page_solver({"calls": calls})] == [False, False, True]

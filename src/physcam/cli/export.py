@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import sys
 
-from ._common import (FOCUS_HELP, FOLDER_FORCE_HELP, add_lens_argument, add_units_option, distance, focus, number, numbers,
+from ._common import (FOCUS_HELP, FOLDER_FORCE_HELP, add_lens_argument, add_units_option, focal_length, focus, number, numbers,
                       whole)
 from ._output import add_output_options, document, emit_json, print_csv
 
@@ -444,7 +444,7 @@ def _register_pbrt(s) -> None:
     b.add_argument("-o", "--output", required=True, metavar="DIR",
                    help="folder to write the files into (written whole, with a physcam-manifest.json)")
     b.add_argument("--lens", metavar="NAME_OR_FILE", help="a real lens (bundled name or prescription file)")
-    b.add_argument("--focal", metavar="MM", type=distance("focal length"),
+    b.add_argument("--focal", metavar="MM", type=focal_length(),
                    help="or a thin lens of this focal length (mm): the perspective camera only")
     b.add_argument("--fstop", metavar="N", type=number("f-stop", positive=True),
                    help="f-stop (geometric f-number; with --lens default wide open)")
