@@ -112,7 +112,7 @@ def parse_distance(text, *, name: str = "distance", allow_inf: bool = False) -> 
         v = float(text)
     else:
         s = str(text).strip()
-        t = plain_marks(s)  # refusals quote what was typed, s
+        t = s if s.isascii() and "''" not in s else plain_marks(s)  # refusals quote what was typed, s
         if s.lower() in ("inf", "infinity", "∞"):
             if allow_inf:
                 return math.inf
