@@ -115,7 +115,7 @@ def add_coc_option(p, extra: str = "") -> None:
     """--coc: a convention name or a value with units (the one definition)."""
     p.add_argument("--coc", type=coc_value, default=None, metavar="COC",
                    help=f"{extra}circle of confusion: d/1500 (default, or `coc` in the user config), d/1000, d/1730, "
-                        "cine (0.025 mm) or a value (0.025, 25um, 0.025mm; a bare number is mm)")
+                        "cine (0.025 mm) or a value from 0.001 to 1 mm (0.025, 25um, 0.025mm; a bare number is mm)")
 
 
 def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):
