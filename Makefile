@@ -51,7 +51,7 @@ $(DEPS): $(JIT_DEPS) pyproject.toml constraints.txt
 	touch $(DEPS)
 
 # the editable install builds the C tracing kernel into src/ (setup.py): a change to its source rebuilds it
-$(STAMP): $(DEPS) setup.py src/physcam/trace/kernels/_ckernel.c
+$(STAMP): $(DEPS) setup.py src/physcam/trace/kernels/_ckernel.c src/physcam/trace/kernels/_rimpass.c
 	$(UV) pip install --quiet --compile-bytecode --python $(PY) --no-deps -e .
 	touch $(STAMP)
 

@@ -1,4 +1,5 @@
-"""The optional compiled tracing kernel (physcam.trace.kernels._ckernel; docs/install.md, "The fast path").
+"""The optional compiled tracing kernel (physcam.trace.kernels._ckernel; docs/install.md, "The fast path"), with the
+Blender extension's rim pass in the same module (_rimpass.c).
 
 Everything else about the package is in pyproject.toml. The extension is ``optional``: where it cannot be
 built (no C compiler) setuptools warns and installs physcam without it, and the numpy kernel traces the same
@@ -40,6 +41,7 @@ class BuildExt(build_ext):
 
 
 setup(
-    ext_modules=[Extension("physcam.trace.kernels._ckernel", ["src/physcam/trace/kernels/_ckernel.c"], optional=True)],
+    ext_modules=[Extension("physcam.trace.kernels._ckernel", ["src/physcam/trace/kernels/_ckernel.c",
+                                                              "src/physcam/trace/kernels/_rimpass.c"], optional=True)],
     cmdclass={"build_ext": BuildExt},
 )

@@ -17,6 +17,10 @@ of the library before 43f450d7, and ``double_gauss_50mm_f2``, then a copy of ``d
 ones), and each side's median. ``--rims``: the pupil tables' rims found along lines against the aim grids'
 (:func:`main_rims`), no timing.
 ``--norms``: the centre's normalisation in closed form against a dense trace (:func:`main_norms`), no timing.
+``--table``: one lens's radial pupil table by a library call (``radial_pupil_table``, "auto": numba not loaded
+first) in a fresh process, then its whole payload (``lens_payload``: the tables of every focus state), each call's
+CPU seconds and whether numba got loaded, ``--repeat`` times alternated with ``--baseline-src``'s, and whether the
+two sides' outputs are the same bytes (:func:`main_table`; round 22's before/after).
 ``--install``: then Blender's installer of each side's zip
 (``package_install_files`` in a fresh user folder, the Blender tests' way; the Blender of
 ``physcam.export.blender_runner.find_blender``), its wall and CPU seconds and the megabytes it unpacks.
@@ -112,6 +116,56 @@ def worker(lens_name: str, out: str) -> None:
     np.savez(out, radial=ft.radial if ft.radial is not None else np.zeros(0), norm=ft.norm,
              levels=np.asarray(ft.levels, dtype=float))
     print(json.dumps({"lens": lens_name, "cpu_s": cpu, "src": os.path.dirname(os.path.dirname(bf.__file__))}))
+
+
+def table_worker(lens_name: str) -> None:
+    """One lens's radial pupil table (focused at 2.5 m, at its iris levels) by a library call in this fresh
+    process, "auto" backend, nothing loaded first: print the call's CPU seconds, whether numba was loaded after
+    it and the table's sha1, as JSON."""
+    import hashlib
+
+    from physcam.export.blender_pupil import iris_levels, radial_pupil_table
+    from physcam.lens.library import load_lens
+    from physcam.optics.focusing import focus
+
+    st = focus(load_lens(lens_name), 2500.0)
+    q = st.prescription
+    stop = q.surfaces[q.stop_index].semi_diameter
+    levels = iris_levels(stop * 1.05, stop)
+    t = time.process_time()
+    table = radial_pupil_table(q, st.film_z, levels)
+    cpu = time.process_time() - t
+    from physcam.export.blender_extension import lens_payload
+
+    t = time.process_time()
+    data, _ = lens_payload(load_lens(lens_name), lens_name)
+    payload = time.process_time() - t
+    print(json.dumps({"cpu_s": cpu, "payload_s": payload, "numba": "numba" in sys.modules,
+                      "sha1": hashlib.sha1(table.tobytes() + json.dumps(data).encode()).hexdigest()}))
+
+
+def main_table(args, here: str) -> None:
+    """``--table`` (module notes): per lens, ``--repeat`` runs of each side alternated, each side's median."""
+    env = {k: v for k, v in os.environ.items() if k != "PHYSCAM_BACKEND"}
+    env.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+    def one(src, name):
+        r = subprocess.run([sys.executable, __file__, "--table-worker", name], env=dict(env, PYTHONPATH=os.path.abspath(src)),
+                           capture_output=True, text=True, check=True)
+        return json.loads(r.stdout.strip().splitlines()[-1])
+
+    print(f"load average before: {load()}, mark {mark():.1f} ms")
+    for name in (args.lenses.split(",") if args.lenses else ["dgauss_50mm", "canon_rf_85mm_f1_2"]):
+        sides = {"this": (here, []), "base": (args.baseline_src, [])} if args.baseline_src else {"this": (here, [])}
+        for i in range(args.repeat):
+            for side in (list(sides) if i % 2 == 0 else list(sides)[::-1]):
+                sides[side][1].append(one(sides[side][0], name))
+        for side, (_, rows) in sides.items():
+            cpu, pay = sorted(r["cpu_s"] for r in rows), sorted(r["payload_s"] for r in rows)
+            print(f"{name:24s} {side:5s} table CPU median {cpu[len(cpu) // 2]:.3f} s ({cpu[0]:.3f}-{cpu[-1]:.3f}), then"
+                  f" its payload {pay[len(pay) // 2]:.3f} s ({pay[0]:.3f}-{pay[-1]:.3f}); numba loaded:"
+                  f" {sorted({r['numba'] for r in rows})}, sha1 {sorted({r['sha1'][:12] for r in rows})}")
+    print(f"load average after: {load()}, mark {mark():.1f} ms")
 
 
 def run(lens_name: str, src: str | None, out: str) -> float:
@@ -380,16 +434,23 @@ def main() -> None:
                     "(main_rims)")
     ap.add_argument("--norms", action="store_true", help="the centre's normalisation in closed form against a dense trace "
                     "(main_norms)")
+    ap.add_argument("--table", action="store_true", help="one lens's pupil table by a library call, alternated with "
+                    "--baseline-src's (main_table)")
+    ap.add_argument("--table-worker", help=argparse.SUPPRESS)
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     ap.add_argument("--out", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.worker:
         return worker(args.worker, args.out)
+    if args.table_worker:
+        return table_worker(args.table_worker)
     from physcam.lens.library import list_lenses
 
     here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src")
     if args.build:
         return main_build(args, here)
+    if args.table:
+        return main_table(args, here)
     names = args.lenses.split(",") if args.lenses else [r.slug for r in list_lenses()]
     if args.rims:
         return main_rims(names)

@@ -645,8 +645,8 @@ def _texts(artist, ticks) -> list:
 @styled
 def figure_problems(fig) -> list[str]:
     """What breaks the figure style in ``fig``, drawn (in the style, as physcam saves it): text
-    (titles, labels, ticks, legends) reaching outside the figure, and axes with ticks but no label or
-    a label without a unit. Empty when none."""
+    (titles, labels, ticks, legends) reaching outside the figure, tick labels of one axis running into
+    each other, and axes with ticks but no label or a label without a unit. Empty when none."""
     from matplotlib.figure import Figure
 
     from .errors import require_type
@@ -656,6 +656,21 @@ def figure_problems(fig) -> list[str]:
     # extents are the same as after canvas.draw() (compared on the lens cards), in half the time
     fig.draw_without_rendering()
     return _drawn_problems(fig, fig.canvas.get_renderer())
+
+
+def _overlapping_ticks(name, ax, major, hidden, renderer) -> list[str]:
+    """The major tick labels of one side of an axis (``label1``, then ``label2``) that run into their neighbour
+    as drawn: ``16' 5"9' 10 1/8"`` under a breathing plot's marks, which crowd toward close focus."""
+    out = []
+    for side in ("label1", "label2"):
+        shown = [t for t in (getattr(tick, side) for tick in major)
+                 if t.get_visible() and t.get_text().strip() and id(t) not in hidden]
+        boxes = sorted(((t.get_window_extent(renderer), t) for t in shown), key=lambda p: (p[0].x0, p[0].y0))
+        for (a, ta), (b, tb) in zip(boxes, boxes[1:]):
+            if a.overlaps(b):
+                out.append(f"{name} tick labels {ta.get_text()!r} and {tb.get_text()!r} of "
+                           f"{ax.get_title(loc='left')[:40] or ax.get_title()[:40]!r} overlap")
+    return out
 
 
 def _drawn_problems(fig, renderer) -> list[str]:
@@ -690,6 +705,7 @@ def _drawn_problems(fig, renderer) -> list[str]:
             labels = [t for tick in ticks[id(axis)][0] for t in (tick.label1, tick.label2) if t.get_visible()]
             if not axis.get_visible() or not [t for t in labels if t.get_text()]:
                 continue
+            problems += _overlapping_ticks(name, ax, ticks[id(axis)][0], hidden, renderer)
             label = axis.get_label_text()
             if not label.strip():
                 problems.append(f"{name} axis of {ax.get_title()[:40]!r} has tick labels but no label")

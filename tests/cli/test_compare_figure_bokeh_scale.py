@@ -49,3 +49,29 @@ def test_only_the_first_bokeh_panel_labels_film_y():
     assert not any(t.get_visible() and t.get_text() for t in second.get_yticklabels())
     empty = [ax for ax in fig.axes if not ax.axison]
     assert [ax.get_title() for ax in empty] == ["B\n(no bokeh)"]
+
+
+def test_eight_lenses_take_two_rows_of_four_with_titles_apart():
+    """Eight lenses' bokeh panels in one row of an 11-inch figure were 1.4 inches wide: their two-line titles
+    (a 28-character lens name) ran into one another and past the figure's edge. More than four lenses now take
+    two rows (four and four here), and one legend beside the curves names them all."""
+    y, x = np.mgrid[-1:1:32j, -1:1:32j]
+    disk = (x * x + y * y < 0.8).astype(float)
+    rows, curves = [], []
+    for k in range(8):
+        rows.append({"name": f"a_rather_long_lens_name_{k}_mm", "fstop": 2.8, "focus_from_film_mm": 2000.0,
+                     "bokeh_light_from_film_mm": 4000.0, "bokeh_diameter_mm": 0.3})
+        curves.append({"breathing": ([math.inf, 1000.0], [0.0, -k]), "distortion": ([0.0, 10.0], [0.0, k / 4]),
+                       "illumination": ([0.0, 10.0], [1.0, 0.8]), "bokeh": (disk, (-0.2, 0.2, -0.2, 0.2))})
+    fig = compare_figure(rows, curves, sensor=find_sensor("S35"))
+    assert figure_problems(fig) == []
+    panels = [ax for ax in fig.axes if ax.images]
+    lefts = sorted({round(ax.get_position().x0, 3) for ax in panels})
+    tops = sorted({round(ax.get_position().y1, 3) for ax in panels})
+    assert len(lefts) == 4 and len(tops) == 2
+    renderer = fig.canvas.get_renderer()
+    boxes = [ax.title.get_window_extent(renderer) for ax in panels]
+    assert all(fig.bbox.x0 <= b.x0 and b.x1 <= fig.bbox.x1 for b in boxes)
+    assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])
+    legends = [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None]
+    assert len(legends) == 1 and [t.get_text() for t in legends[0].get_texts()] == [r["name"] for r in rows]

@@ -35,7 +35,7 @@ def test_the_card_is_one_page_of_that_size(tmp_path, page, points):
 def test_every_word_fits_its_cell_and_the_chart_has_only_the_tables_stops():
     args = _args("--focal", "35", "--sensor", "S35")  # the default stops: f/1.4 to f/16, eight of them
     d = build(args)
-    fig = card_figure(d, chart=_card_chart(args))
+    fig = card_figure(d, chart=_card_chart(args, d["fstops"]))
     fig.canvas.draw()
     r = fig.canvas.get_renderer()
     table = next(a for a in fig.axes if a.tables).tables[0]
@@ -58,7 +58,7 @@ def test_an_anamorphic_card_says_the_horizontal_limits_and_they_fit(page):
 
     args = _args("--focal", "50", "--sensor", "ALEXA 35 3.3K 6:5", "--squeeze", "format", "--coc", "0.025")
     d = build(args)
-    fig = card_figure(d, chart=_card_chart(args), page=page)
+    fig = card_figure(d, chart=_card_chart(args, d["fstops"]), page=page)
     fig.canvas.draw()
     r = fig.canvas.get_renderer()
     table = next(a for a in fig.axes if a.tables).tables[0]

@@ -103,6 +103,28 @@ def test_user_config_sets_sensor_units_coc_and_output_folder(capsys, tmp_path, m
     assert "units must be one of m, ft" in one_line_error(rc, err)
 
 
+def test_a_config_that_is_not_there_or_not_a_file_is_refused(capsys, tmp_path, monkeypatch):
+    """PHYSCAM_CONFIG naming a file that is not there (a typo, another machine's path) or a folder was
+    passed over for physcam's defaults without a word (a review found `config show` saying "not there"
+    of an existing folder); each is now one line naming it. Unset or empty still means defaults."""
+    monkeypatch.setenv("PHYSCAM_CONFIG", str(tmp_path / "typo.toml"))
+    rc, _, err = run(capsys, "report", "--focal", "50", "--fstop", "2.8", "--focus", "3m")
+    assert f"PHYSCAM_CONFIG names {tmp_path / 'typo.toml'}, which is not there" in one_line_error(rc, err)
+    monkeypatch.setenv("PHYSCAM_CONFIG", str(tmp_path))
+    rc, _, err = run(capsys, "config", "show")
+    assert f"the physcam config {tmp_path} is a folder" in one_line_error(rc, err)
+    monkeypatch.setenv("PHYSCAM_CONFIG", "")
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "nothing-here"))
+    rc, out, _ = run(capsys, "config", "show", "--json")
+    assert rc == 0 and all(v["source"] == "default" for v in json.loads(out)["settings"].values())
+    monkeypatch.delenv("PHYSCAM_CONFIG")
+    rc, out, _ = run(capsys, "config", "show", "--json")  # the default place, not there: the defaults
+    assert rc == 0 and json.loads(out)["path"] == str(tmp_path / "nothing-here" / "physcam" / "config.toml")
+    (tmp_path / "nothing-here" / "physcam" / "config.toml").mkdir(parents=True)
+    rc, _, err = run(capsys, "config", "show")
+    assert "config.toml is a folder" in one_line_error(rc, err)
+
+
 def test_tests_read_no_user_config(capsys):
     rc, out, _ = run(capsys, "config", "show", "--json")
     d = json.loads(out)

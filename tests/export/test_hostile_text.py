@@ -58,6 +58,7 @@ HOSTILE = [
     "xml --> <!-- & <tag a=\"1\"> -",
     "tcl [exec rm -rf ~] $HOME {brace} }",
     "\u202eright-to-left override\u202c",
+    "tab\tseparated\twords",
     "tab\tand escape \x1b[31m red",
     "\\N{BULLET} \\x41 \\u0041 escapes",
     "x" * 5000 + "\n#define N_SURF 1",
@@ -516,3 +517,32 @@ def test_cli_metadata_usd_of_a_clip_with_an_undecodable_file_name(tmp_path, caps
     stage = Usd.Stage.Open(str(tmp_path / "cam.usda"))
     sources = [p.GetCustomDataByKey("physcam:source") for p in stage.Traverse() if p.GetTypeName() == "PhysicalCamera"]
     assert sources == ["arri camera metadata read by physcam metadata usd (clip\ufffd.csv)"]
+
+
+def test_a_tab_in_a_lens_note_is_a_space_in_the_exported_comment():
+    """pbrt's own dgauss.50mm.dat separates its header's words with tabs; exported, the note read
+    "D-GAUSS\ufffdF/2\ufffd22deg\ufffdHFOV" (a tab was a control character to printable_line)."""
+    from physcam.export._codetext import printable_line
+    from physcam.export.pbrt import pbrt_lens_text
+
+    assert printable_line("a\tb\nc") == "a b\ufffdc"
+    text, _ = pbrt_lens_text(load_lens("dgauss_50mm"))
+    assert "# D-GAUSS F/2 22deg HFOV" in text.splitlines()
+
+
+def test_cli_commands_to_paste_keep_a_folder_with_spaces_one_word(tmp_path, capsys):
+    """`export blender` prints the Blender command lines to paste; with ``-o "blender cams"`` they read
+    ``--python blender cams/setup_....py``, two words to a shell. Quoted (shlex), a shell reads the paths back."""
+    import shlex
+
+    from physcam.cli import main
+
+    out = tmp_path / "blender cams ' $HOME"
+    assert main(["export", "blender", "--lens", "cooke_triplet_50mm_f4_5", "--focus", "2m", "--sensor", "S35",
+                 "-o", str(out), "--builtin"]) == 0
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if "blender your.blend --python" in ln]
+    assert len(lines) == 2
+    for ln, name in zip(lines, ("setup_cooke_triplet_50mm_f4_5.py", "builtin_cooke_triplet_50mm_f4_5.py")):
+        words = shlex.split(ln.split(": ", 1)[1].split("  (")[0])
+        assert words[:3] == ["blender", "your.blend", "--python"] and words[3] == str(out / name)
+        assert Path(words[3]).is_file()

@@ -3,7 +3,7 @@ from pathlib import Path
 
 import pytest
 
-from physcam.errors import InputError
+from physcam.errors import InputError, LensFileError
 from physcam.lens.formats import dumps_lens, loads_lens, read_lens
 from physcam.lens.formats._common import extra
 from physcam.lens.library import find_lens, list_lenses, load_lens
@@ -179,3 +179,29 @@ def test_lens_check_says_what_the_provenance_record_says():
     assert "Blender" in notes["provenance_unchecked"].implication
     assert "NOASSERTION" in notes["licence_unresolved"].message
     assert not {"provenance_unchecked", "licence_unresolved"} & {f.code for f in check(REFERENCE / "pbrt-dat" / "dgauss.50mm.dat")}
+
+
+def test_a_file_named_as_no_lens_of_the_library_is_read(tmp_path, monkeypatch):
+    """A lens file in the current folder, named without ./ and without a lens-file extension (a vendor's
+    ``lens file.txt``), was refused with "no bundled lens called 'lens file.txt'" though the file was right there.
+    Where no lens of the library has the name, the file of that name is read; a library name still wins."""
+    from physcam.lens.library import library_dir
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "lens file.txt").write_bytes((library_dir() / "tessar_50mm_f2_8.toml").read_bytes())
+    assert load_lens("lens file.txt").surfaces == load_lens("tessar_50mm_f2_8").surfaces
+    (tmp_path / "Tessar 50mm f-2.8").write_text("not a lens")  # a lens's name as a file here: the library's lens
+    assert find_lens("Tessar 50mm f-2.8").slug == "tessar_50mm_f2_8"
+    assert load_lens("Tessar 50mm f-2.8").surfaces == load_lens("tessar_50mm_f2_8").surfaces
+    with pytest.raises(InputError, match="no bundled lens called 'no_such'"):
+        load_lens("no_such")
+
+
+def test_a_lens_archive_given_as_a_lens_file_says_how_to_install_it(tmp_path):
+    import zipfile
+
+    archive = tmp_path / "my lens.lens.zip"
+    with zipfile.ZipFile(archive, "w") as z:
+        z.writestr("lens.toml", "x")
+    with pytest.raises(LensFileError, match=r"a zip archive, not a lens file: .*`physcam lens add '.*my lens\.lens\.zip'`"):
+        load_lens(archive)

@@ -133,6 +133,35 @@ def test_anamorphic_formats_carry_their_desqueeze():
     assert all(math.isfinite(s.width_mm) for s in sensors())
 
 
+@pytest.mark.parametrize("name", ["Scope", "CinemaScope", "Anamorphic", "35mm anamorphic"])
+def test_the_35mm_anamorphic_gate_takes_the_2x_squeeze(name, capsys):
+    """The 35mm anamorphic camera aperture (0.866 x 0.732 in) is shot through 2x lenses: Wikipedia, "Anamorphic
+    format" ("the anamorphic lenses in virtually all 35 mm anamorphic systems provide a 2:1 squeeze"; SMPTE
+    PH22.106's projector apertures "after a 2x unsqueeze"), and the gate's name in the shared reference table,
+    "(2x)". The film gates of sensors.csv had no anamorphic column: `--squeeze format` refused the gate."""
+    import json
+
+    from physcam.cli import main
+
+    assert find_sensor(name).key == "anamorphic-35" and find_sensor(name).anamorphic == (2.0,)
+    argv = ["dof-table", "--focal", "50", "--sensor", name, "--fstops", "2.8", "--focus", "2m", "--json"]
+    assert main([*argv, "--squeeze", "format"]) == 0
+    by_format = json.loads(capsys.readouterr().out)
+    assert main([*argv, "--squeeze", "2"]) == 0
+    assert by_format["squeeze"] == 2.0 and by_format["rows"] == json.loads(capsys.readouterr().out)["rows"]
+
+
+def test_every_gate_named_anamorphic_gives_its_squeeze_and_no_spherical_gate_does():
+    """A gate (sensors.csv) or camera format (cameras.csv) whose name says anamorphic or "(2x)" offers a
+    desqueeze; a film gate that does not say so offers none (Academy, Super 35, VistaVision, 65 mm, IMAX)."""
+    for s in sensors():
+        named = "anamorphic" in f"{s.name} {s.fmt}".lower() or "(2x)" in s.name
+        if named:
+            assert s.anamorphic == (2.0,), s.name
+        elif s.kind == "film":
+            assert s.anamorphic == (), s.name
+
+
 # --- what issue 46 asks for, and where each row's figure comes from ---------------------------------------------
 
 #: The issue's list of what was missing ("no FX6/FX3/Burano, Komodo, Canon, Blackmagic, Panasonic, ALEXA 265, APS-C;

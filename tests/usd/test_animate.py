@@ -8,7 +8,7 @@ import pytest
 from pxr import Usd, UsdGeom
 
 from physcam.cli import main
-from physcam.errors import InputError, LensFileError
+from physcam.errors import InputError, LensFileError, PhysCamError
 from physcam.usd.read import open_stage
 
 from _thin_lens import image_distance_at_mark
@@ -85,6 +85,31 @@ def test_bad_marks_name_file_and_line(tmp_path):
     with pytest.raises(InputError, match="increase"):
         write_animated_camera(tmp_path / "x.usda", [FocusKey(2, 3000.0), FocusKey(1, 2000.0)],
                               sensor=find_sensor("FF"), focal_length_mm=50.0, fstop=2.8)
+
+
+def test_a_marks_value_the_lens_refuses_names_file_and_line(tmp_path, capsys):
+    """A value read well but refused by the lens (an f-stop faster than it opens, a zoom position outside its
+    range) was one line without the file and line (a review found it); now it names both, in the library and
+    the command. The keys read from a file still equal keys made by hand (where they came from is not compared)."""
+    from physcam.lens.library import load_lens
+    from physcam.optics.sensors import find_sensor
+    from physcam.usd.animate import FocusKey, read_focus_marks, write_animated_camera
+
+    iris = _csv(tmp_path, ["1,3m,2.8", "12,3m,1.0", "13,3m,4"], header="frame,focus,fstop")
+    keys = read_focus_marks(iris)
+    assert keys[1] == FocusKey(12.0, 3000.0, 1.0) and (keys[1].source, keys[1].line) == (str(iris), 3)
+    with pytest.raises(LensFileError, match=r"pull.csv:3: f/1 is faster than this lens opens"):
+        write_animated_camera(tmp_path / "x.usda", keys, sensor=find_sensor("S35"), lens=load_lens("dgauss_50mm"))
+    zoom = _csv(tmp_path, ["1,3m,90mm", "12,3m,70mm"], header="frame,focus,zoom")
+    assert main(["usd", "animate", str(tmp_path / "z.usda"), "--marks", str(zoom), "--lens",
+                 "canon_ef_70_200mm_f2_8_zoom", "--sensor", "S35", "--fstop", "4"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "pull.csv:3: 70 mm is outside the zoom range" in err[0], err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pull.csv"]
+    with pytest.raises(PhysCamError, match="faster than this lens opens") as info:  # keys made by hand: no line
+        write_animated_camera(tmp_path / "y.usda", [FocusKey(1, 3000.0, 1.0)], sensor=find_sensor("S35"),
+                              lens=load_lens("dgauss_50mm"))
+    assert not isinstance(info.value, LensFileError)
 
 
 def test_an_anamorphic_pulls_pinhole_squeeze_is_sampled_per_frame(tmp_path, capsys):

@@ -13,7 +13,8 @@ always wins::
     glass_catalogs = ["~/zemax/glasscat/CORNING.AGF"]   # Zemax .agf catalogues searched for glasses
 
 An unknown key, a value of the wrong kind, a file that is not TOML or one nested too deeply to
-read is refused with the file's name, so a typo never silently falls back to a default.
+read is refused with the file's name, so a typo never silently falls back to a default; so are a
+``PHYSCAM_CONFIG`` naming a file that is not there and a config path that is a folder.
 """
 
 from __future__ import annotations
@@ -86,13 +87,22 @@ _CACHE: dict = {}
 
 
 def load_config() -> Config:
-    """The user config (cached per file and modification time, and while there is none)."""
+    """The user config (cached per file and modification time, and while there is none). The file named by
+    ``PHYSCAM_CONFIG`` must be there, and whichever file is read must be a regular file: a config that is a
+    folder, or a variable naming a file that is not there (a typo, a path of another machine), is refused in
+    one line, not passed over for physcam's defaults."""
     path = config_path()
     try:
         st = None if path is None else os.stat(path)
     except (OSError, ValueError):
         st = None
-    key = (path, None if st is None or not stat.S_ISREG(st.st_mode) else st.st_mtime_ns)
+    if path is not None and st is None and os.environ.get("PHYSCAM_CONFIG", "").strip():
+        raise InputError(f"PHYSCAM_CONFIG names {path}, which is not there: make it, or unset PHYSCAM_CONFIG "
+                         f"(or set it empty) for no config")
+    if st is not None and not stat.S_ISREG(st.st_mode):
+        kind = "a folder" if stat.S_ISDIR(st.st_mode) else "not a regular file"
+        raise InputError(f"the physcam config {path} is {kind}: a config is a TOML file (physcam config show)")
+    key = (path, None if st is None else st.st_mtime_ns)
     if key not in _CACHE:
         _CACHE.clear()
         _CACHE[key] = Config(path=path, exists=False) if key[1] is None else _read(path)

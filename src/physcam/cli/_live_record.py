@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from shlex import quote
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -258,7 +259,7 @@ def run_record(args) -> int:
 
     s = settings(args)  # every option and file checked before a packet is read
     for old in unfinished_journals(s.file):
-        print(f"physcam: note: an unfinished take is kept in {old}: `physcam live recover {old}` writes it",
+        print(f"physcam: note: an unfinished take is kept in {old}: `physcam live recover {quote(str(old))}` writes it",
               file=sys.stderr)
     group = multicast_group(args.multicast) if args.multicast is not None else None
     receiver = Receiver(args.port, host=args.host, group=group, interface=args.interface,
@@ -298,7 +299,7 @@ def _nothing_written(s, take, counters, journal_path, receiver) -> str:
     if take.source is not None and heard:
         names = ", ".join(f"{h['source_id']} ({h['samples']} samples)" for h in heard[:4])
         return (f"no sample of source {take.source} arrived (heard: {names}); the samples are kept in "
-                f"{journal_path}: `physcam live recover {journal_path} --source ID` writes another source's")
+                f"{journal_path}: `physcam live recover {quote(str(journal_path))} --source ID` writes another source's")
     why = f" ({take.refusals[0]})" if take.refusals else ""
     if receiver is None:
         return f"the journal {journal_path} holds no sample physcam can record{why}; nothing written"
@@ -379,8 +380,8 @@ def _write_one(write, asked: str, force: bool, journal_path) -> tuple[Path, bool
             raise first
         written = write_under_free_name(write, spare / Path(asked).name)
     except ExportError:
-        raise ExportError(f"{first}; the take is kept in {journal_path}: `physcam live recover {journal_path}` "
-                          "writes it once there is room") from None
+        raise ExportError(f"{first}; the take is kept in {journal_path}: `physcam live recover "
+                          f"{quote(str(journal_path))}` writes it once that is mended") from None
     print(f"physcam: warning: {first}; written to {written} instead (the journal {journal_path} is kept)",
           file=sys.stderr)
     return written, True

@@ -314,28 +314,52 @@ def run_lenses(args) -> int:
     return 0
 
 
+#: Most bokeh panels in one row of the comparison figure; more lenses take a second row.
+BOKEH_PER_ROW = 4
+#: Most lenses whose curves each carry their own legend; more share one legend beside the curves.
+LEGENDS_UP_TO = 3
+
+
 @styled
 def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False, dpi=None):
     """One figure: breathing, distortion and illumination curves of every lens, and their bokeh (all at one
-    film scale, the widest image's, so that their sizes compare at a glance); the focus
-    and light distances in the title and the breathing axis (1 / mark) in ``units`` (m, or ft for feet
-    and inches; film coordinates and bokeh sizes stay in mm). Saved to ``path``, or the Figure.
+    film scale, the widest image's, so that their sizes compare at a glance; up to :data:`BOKEH_PER_ROW` a
+    row); the focus and light distances in the title and the breathing axis (1 / mark) in ``units`` (m, or
+    ft for feet and inches; film coordinates and bokeh sizes stay in mm). Saved to ``path``, or the Figure.
 
     ``dpi``: the figure's own, at which it is laid out (default matplotlib's for a returned Figure; for a
     file, the dpi it is saved at, :data:`physcam.figures.SAVE_DPI`: the layout's text metrics are then the
     drawing's, measured once, issue 47 round 21)."""
-    import numpy as np
-
-    from ..figures import SAVE_DPI, new_figure, save_figure, title_y
+    from ..figures import SAVE_DPI, new_figure, save_figure
     from ..units import format_distance
 
     n = len(rows)
-    fig = new_figure(figsize=(11.0, 7.0), dpi=dpi if dpi is not None or path is None else SAVE_DPI)
-    gs = fig.add_gridspec(2, max(3, n))
-    cols = max(3, n)
-    ax_b = fig.add_subplot(gs[0, : cols // 3])
-    ax_d = fig.add_subplot(gs[0, cols // 3: 2 * cols // 3])
-    ax_i = fig.add_subplot(gs[0, 2 * cols // 3:])
+    per_row = n if n <= BOKEH_PER_ROW else math.ceil(n / 2)
+    bokeh_rows = math.ceil(n / per_row)
+    cols = math.lcm(3, per_row)  # the curves take a third each, the bokeh panels an equal share each
+    fig = new_figure(figsize=(11.0, 7.0 + 2.6 * (bokeh_rows - 1)),
+                     dpi=dpi if dpi is not None or path is None else SAVE_DPI)
+    gs = fig.add_gridspec(1 + bokeh_rows, cols)
+    _curve_panels(fig, [gs[0, j * cols // 3: (j + 1) * cols // 3] for j in range(3)], rows, curves, units)
+    span = cols // per_row
+    _bokeh_panels(fig, [gs[1 + k // per_row, (k % per_row) * span: (k % per_row + 1) * span] for k in range(n)],
+                  rows, curves)
+    r0 = rows[0]
+    focus = format_distance(math.inf if r0["focus_from_film_mm"] is None else r0["focus_from_film_mm"], units)
+    stops = ", ".join(dict.fromkeys(f"f/{r['fstop']:.3g}" for r in rows))
+    fig.suptitle(f"focus {focus} ({rows[0]['name']}), {stops}, {sensor.name} ({sensor.width_mm:g} x "
+                 f"{sensor.height_mm:g} mm); bokeh: light at {format_distance(r0['bokeh_light_from_film_mm'], units)}",
+                 fontsize=9)
+    fig.tight_layout()
+    return fig if path is None else save_figure(fig, path, force=force)
+
+
+def _curve_panels(fig, slots, rows, curves, units) -> None:
+    """Breathing (against 1 / mark in ``units``), distortion and illumination of every lens, in ``slots``; a
+    legend in each, or one beside the three for more than :data:`LEGENDS_UP_TO` lenses."""
+    from ..figures import title_y
+
+    ax_b, ax_d, ax_i = (fig.add_subplot(slot) for slot in slots)
     per = 1000.0 if units == "m" else 304.8
     for r, c in zip(rows, curves):
         if "breathing" in c:
@@ -358,39 +382,46 @@ def compare_figure(rows, curves, path=None, *, sensor, units="m", force=False, d
     ax_i.set_title("illumination", fontsize=9, y=title_y(ax_i))
     for ax in (ax_b, ax_d, ax_i):
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=6)
-    first = None  # the first bokeh panel: the others share its axes, so every bokeh is drawn at one film scale
-    for k, (r, c) in enumerate(zip(rows, curves)):
+        if len(rows) <= LEGENDS_UP_TO:
+            ax.legend(fontsize=6)
+    if len(rows) > LEGENDS_UP_TO:
+        handles, labels = ax_b.get_legend_handles_labels()
+        if len(labels) < len(rows):  # a lens without breathing still has its colour in the others
+            handles, labels = max((a.get_legend_handles_labels() for a in (ax_b, ax_d, ax_i)), key=lambda hl: len(hl[1]))
+        ax_i.legend(handles, labels, fontsize=6, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+
+
+def _bokeh_panels(fig, slots, rows, curves) -> None:
+    """Each lens's bokeh in its slot, every panel sharing the first's axes at the widest image's half-width
+    about the axis; film y labelled on the first panel of each row."""
+    import numpy as np
+
+    from ..figures import title_y
+
+    first = None
+    for slot, r, c in zip(slots, rows, curves):
         if "bokeh" not in c:
-            ax = fig.add_subplot(gs[1, k])
+            ax = fig.add_subplot(slot)
             ax.set_axis_off()
             ax.set_title(f"{r['name']}\n(no bokeh)", fontsize=7, y=title_y(ax))
             continue
-        ax = fig.add_subplot(gs[1, k], **({} if first is None else {"sharex": first, "sharey": first}))
+        ax = fig.add_subplot(slot, **({} if first is None else {"sharex": first, "sharey": first}))
         img, ext = c["bokeh"]
         top = float(np.percentile(img[img > 0], 95)) if (img > 0).any() else 1.0
         ax.imshow(np.clip(img / top, 0, 1), origin="lower", extent=ext, cmap="magma")
         ax.set_facecolor(ax.images[0].cmap(0.0))  # beyond a smaller image's edge: its own dark
         ax.set_title(f"{r['name']}\nbokeh {r['bokeh_diameter_mm']:.3f} mm", fontsize=7, y=title_y(ax))
         ax.set_xlabel("film x (mm)", fontsize=7)
-        if first is None:
+        if first is None or slot.colspan.start == 0:
             ax.set_ylabel("film y (mm)", fontsize=7)
-            first = ax
         else:
             ax.tick_params(labelleft=False)
+        first = first or ax
         ax.tick_params(labelsize=6)
-    if first is not None:  # the widest image's half-width, about the axis
+    if first is not None:
         half = max(abs(v) for c in curves if "bokeh" in c for v in c["bokeh"][1])
         first.set_xlim(-half, half)
         first.set_ylim(-half, half)
-    r0 = rows[0]
-    focus = format_distance(math.inf if r0["focus_from_film_mm"] is None else r0["focus_from_film_mm"], units)
-    stops = ", ".join(dict.fromkeys(f"f/{r['fstop']:.3g}" for r in rows))
-    fig.suptitle(f"focus {focus} ({rows[0]['name']}), {stops}, {sensor.name} ({sensor.width_mm:g} x "
-                 f"{sensor.height_mm:g} mm); bokeh: light at {format_distance(r0['bokeh_light_from_film_mm'], units)}",
-                 fontsize=9)
-    fig.tight_layout()
-    return fig if path is None else save_figure(fig, path, force=force)
 
 
 def _config_blender():

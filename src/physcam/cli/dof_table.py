@@ -32,14 +32,15 @@ DEFAULT_FOCUS = "1m,1.5m,2m,3m,5m,10m,hyperfocal,inf"
 
 
 def _fstops(text):
-    """Comma-separated f-stops (argparse type)."""
+    """Comma-separated f-stops (argparse type): f-numbers, bare or as "f/2.8"; a T-stop ("T2.8") is refused
+    with the report's explanation (:func:`physcam.cli._common.number`), not read as the f-number."""
     import argparse
 
     one = number("f-stop", positive=True)
     parts = list_items(text, "f-stops", "2,2.8,4,5.6")
     if len(parts) > 24:
         raise argparse.ArgumentTypeError(f"a table takes up to 24 f-stops, got {len(parts)}")
-    return [one(t.removeprefix("f/").removeprefix("T")) for t in parts]
+    return [one(t.removeprefix("f/")) for t in parts]  # "T2.8" refused: a T-stop is not the f-number
 
 
 def _squeeze(text):
@@ -78,8 +79,9 @@ def register(sub) -> None:
                    help="a real lens (bundled name or prescription file) instead of --focal: the technical model")
     add_lenient(p)
     add_zoom_option(g)
-    g.add_argument("--fstops", type=_fstops, default=list(DEFAULT_FSTOPS), metavar="LIST",
-                   help="f-stops (geometric f-numbers), comma-separated (default 1.4,2,2.8,4,5.6,8,11,16)")
+    g.add_argument("--fstops", type=_fstops, default=None, metavar="LIST",
+                   help="f-stops (geometric f-numbers), comma-separated (default 1.4,2,2.8,4,5.6,8,11,16; with "
+                        "--lens those it opens to, from its widest, with a note)")
     g.add_argument("--focus", type=focus_list("focus marks"), default=None, metavar="LIST",
                    help=f"focus marks from the film plane, comma-separated (default {DEFAULT_FOCUS}; {FOCUS_HELP})")
     add_sensor_options(g, what="group")
@@ -212,8 +214,12 @@ def run(args) -> int:
         from ._common import mark_repaired
 
         d = mark_repaired(d, args.loaded_lens)
+    for text in d["notes"]:
+        from ._common import note
+
+        note(text)
     if args.output:
-        card(d, args.output, units=units, force=args.force, chart=_card_chart(args), page=args.page)
+        card(d, args.output, units=units, force=args.force, chart=_card_chart(args, d["fstops"]), page=args.page)
     if args.json:
         emit_json(document("dof_table", d))
         return 0
@@ -262,8 +268,8 @@ def _print_horizontal(d, units, heads, labels) -> None:
     print_table(t)
 
 
-def _card_chart(args):
-    """(report, chart data) of the DOF chart under the card's table: the table's stops (up to six of them,
+def _card_chart(args, fstops):
+    """(report, chart data) of the DOF chart under the card's table: the table's ``fstops`` (up to six of them,
     spread from its first to its last: never a stop the table does not have) against focus, every cell a
     cell of the table (:func:`physcam.onset.dof_table.dof_cells` of the same options)."""
     import warnings
@@ -276,8 +282,8 @@ def _card_chart(args):
     marks = [m for m in (args.focus or []) if isinstance(m, float) and math.isfinite(m)]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PhysCamWarning)
-        report = cell(args.fstops[0], marks[len(marks) // 2] if marks else 3000.0)
-        stops = list(args.fstops)
+        report = cell(fstops[0], marks[len(marks) // 2] if marks else 3000.0)
+        stops = list(fstops)
         if len(stops) > CHART_STOPS:
             stops = [stops[round(k * (len(stops) - 1) / (CHART_STOPS - 1))] for k in range(CHART_STOPS)]
         data = dof_chart_data(report, cell, fstops=stops)

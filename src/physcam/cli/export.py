@@ -3,6 +3,7 @@ Blender Cycles OSL lens cameras, RenderMan RIB camera blocks, pbrt-v4 cameras)."
 
 from __future__ import annotations
 
+import shlex
 import sys
 
 from ._common import (FOCUS_HELP, FOLDER_FORCE_HELP, add_lens_argument, add_units_option, focal_length, focus, number, numbers,
@@ -239,9 +240,10 @@ def run_blender(args) -> int:
 
     print(f"wrote {osl} and {setup}: {lens.name} focused at {_mark(focus, units_of(args))}"
           f"{'' if args.fstop is None else f', f/{args.fstop:g}'} on {sw:g} x {sh:g} mm, {w} x {h} px")
-    print(f"  in Blender: blender your.blend --python {setup}  (Cycles, CPU, OSL)")
+    # the commands are for pasting into a shell: a path with a space stays one word
+    print(f"  in Blender: blender your.blend --python {shlex.quote(str(setup))}  (Cycles, CPU, OSL)")
     if builtin is not None:
-        print(f"  or Blender's own camera, matched: blender your.blend --python {builtin}")
+        print(f"  or Blender's own camera, matched: blender your.blend --python {shlex.quote(str(builtin))}")
         print(f"  note: {gap.summary(units_of(args))}")
     return 0
 
@@ -264,7 +266,7 @@ def run_blender_extension(args) -> int:
         emit_json(document("export_blender_extension", data, units={"time": "s"}))
         return 0
     print(f"wrote {path}: {len(names)} lens{'' if len(names) == 1 else 'es'}")
-    print(f"  install: blender --command extension install-file -r user_default -e {path}")
+    print(f"  install: blender --command extension install-file -r user_default -e {shlex.quote(str(path))}")
     return 0
 
 

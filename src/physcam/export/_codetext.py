@@ -11,7 +11,8 @@ The common first step, :func:`printable_line`, keeps a text on one line: every c
 Unicode categories Cc (controls: NUL, CR, LF, TAB, ESC, DEL, C1), Cf (format: the bidirectional
 overrides of "Trojan Source", CVE-2021-42574), Cs (lone surrogates, what non-UTF-8 bytes decode to
 with ``surrogateescape``), Co, Cn, Zl and Zp (U+2028, U+2029) becomes U+FFFD, so no language sees a
-line end (Python's ``str.splitlines`` boundaries included) and the file always encodes as UTF-8.
+line end (Python's ``str.splitlines`` boundaries included) and the file always encodes as UTF-8. A tab,
+white space within a line (pbrt's own lens files separate their header's words with tabs), becomes a space.
 """
 
 from __future__ import annotations
@@ -32,9 +33,9 @@ _UNSAFE = frozenset(("Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"))
 
 
 def printable_line(text, *, limit: int | None = None) -> str:
-    """``text`` (any object; ``str()`` of it) on one printable line: characters of the categories in
-    the module notes become U+FFFD; cut to ``limit`` characters (the last an ellipsis) when given."""
-    s = "".join(REPLACEMENT if unicodedata.category(c) in _UNSAFE else c for c in str(text))
+    """``text`` (any object; ``str()`` of it) on one printable line: a tab becomes a space, characters of the
+    categories in the module notes U+FFFD; cut to ``limit`` characters (the last an ellipsis) when given."""
+    s = "".join(" " if c == "\t" else REPLACEMENT if unicodedata.category(c) in _UNSAFE else c for c in str(text))
     if limit is not None and len(s) > limit:
         s = s[: limit - 1] + "\u2026"
     return s

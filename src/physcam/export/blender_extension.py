@@ -25,7 +25,7 @@ import zipfile
 from importlib import resources
 from pathlib import Path
 
-from ..errors import InputError, PhysCamError
+from ..errors import InputError
 from ..progress import FORK_LOCK, others_quiet
 from ..optics.thinlens import MAX_F_NUMBER
 
@@ -188,70 +188,38 @@ def _payload_job(name) -> tuple[str, str, dict, dict[str, str]]:
     return slug, lens.name, data, shaders
 
 
-def _worker_start(trace_threads: int, jit: bool) -> None:
+def _worker_start(trace_threads: int) -> None:
     """A worker process's start: the compiled kernels' large batches on ``trace_threads`` threads
-    (:func:`physcam.trace.kernels.set_threads`; the rays are the same on any number), and with ``jit`` numba's
-    JIT kernel loaded first (:func:`_load_jit`)."""
+    (:func:`physcam.trace.kernels.set_threads`; the rays are the same on any number)."""
     from ..trace.kernels import set_threads
 
     set_threads(trace_threads)
-    if jit:
-        _load_jit()
 
 
-#: A process that builds this many lenses or more loads numba's JIT kernel first (:func:`_load_jit`)
-_JIT_LENSES = 2
-
-
-def _load_jit() -> bool:
-    """Load numba's JIT kernel where it is installed and ``PHYSCAM_BACKEND`` leaves the choice to physcam (or
-    names numba); whether it is loaded. Then the tables' traces take it ("auto" does once numba is loaded) and
-    their rims the compiled rim pass (:func:`physcam.trace.kernels.rim_pass`, numba's only). Rented, the C
-    kernel traces a lens's tables as fast, but their rims are then the numpy pass's: the Canon RF 85's
-    payload 1.00 s of CPU against 0.77-0.85 s (docs/performance.md, round 21), while loading numba costs a
-    process 0.35-0.45 s once, so a process building two lenses or more (:data:`_JIT_LENSES`) loads it first.
-    The tables are the same bytes whichever kernel and pass find them."""
-    if os.environ.get("PHYSCAM_BACKEND", "auto") not in ("auto", "numba"):
-        return False
-    from ..trace import kernels
-
-    return kernels.numba_available()
-
-
-def _forks(first) -> bool:
+def _forks() -> bool:
     """Whether the workers are forks of this process: in the ``physcam`` program (:data:`physcam._program.RUNNING`,
     never a library caller, whose threads and libraries a fork would copy mid-flight) on Linux, with no other
     thread running but quiet ones (the program's progress timer while it waits: :func:`physcam.progress.quiet_thread`;
-    the caller holds :data:`physcam.progress.FORK_LOCK` until the workers have started); the modules a lens's tables need and the JIT kernel are then loaded here first, once, for
-    every worker (``first``: the first lens's name, through which one ray is traced)."""
+    the caller holds :data:`physcam.progress.FORK_LOCK` until the workers have started); the modules a lens's
+    tables need and the compiled C kernel (with its rim pass) are then loaded here first, once, for every worker.
+    Numba is not: "auto" rents the C kernel for a lens's tables, and their rims take the C pass
+    (:func:`physcam.trace.kernels.rim_pass`), as fast as numba's without its 0.35-0.45 s load (docs/performance.md,
+    round 22)."""
     import sys
 
     from .. import _program
 
     if not (_program.RUNNING and sys.platform.startswith("linux") and others_quiet()):
         return False
-    import numpy as np
-
     # what a lens's tables import (a worker's first lens imported them itself: 0.06 s each)
     from ..analysis.image_quality import ghosts  # noqa: F401
-    from ..lens.library import load_lens
+    from ..lens import library  # noqa: F401
     from ..onset import solvers  # noqa: F401
-    from ..optics import coc  # noqa: F401
-    from ..optics.focusing import focus
-    from ..trace import camera_tracer, kernels, pupil_bounds  # noqa: F401
-    from ..trace.rays import RayBatch
-    from ..trace.trace import trace_through
+    from ..optics import coc, focusing  # noqa: F401
+    from ..trace import camera_tracer, kernels, pupil_bounds, rays, trace  # noqa: F401
     from . import blender_focus, blender_pupil, blender_zoom  # noqa: F401
 
-    if _load_jit():  # numba imported, and the machine code of the variant the first lens's trace needs
-        try:
-            st = focus(load_lens(first), math.inf)
-            q = st.prescription
-            rays = RayBatch.from_arrays(np.array([[0.0, 0.0, st.film_z]]),
-                                        np.array([[0.0, 0.0, q.vertex_z[-1] - st.film_z]]), q.wavelength_nm)
-            trace_through(q, rays, reverse=True, clip=True, backend="numba")
-        except PhysCamError:  # the lens's own error is its worker's to raise, as without the fork
-            pass
+    kernels.c_available()  # the C kernel's module, where built
     return others_quiet()
 
 
@@ -261,14 +229,11 @@ def _payloads(names, workers: int):
     A lens's payload is mostly Python (the pupil tables' searches), so threads would share one core;
     processes take one lens each, as ``physcam characterize`` does with its cells: fresh ones (``spawn``: no
     JIT state or trace threads copied), or in the ``physcam`` program on Linux forks of it (:func:`_forks`),
-    which start with numba and the tables' modules loaded and end without the interpreter's teardown:
+    which start with the tables' modules loaded and end without the interpreter's teardown:
     0.6-0.8 CPU seconds less a worker (docs/performance.md, round 21). One worker computes here, in order.
-    A process with :data:`_JIT_LENSES` lenses or more to build loads numba's JIT kernel first (:func:`_load_jit`).
     The workers share the cores: each traces its large batches on cores / workers threads (one on two
     cores with two workers), not on every core, which made two workers' four threads wait for two cores."""
     if workers <= 1 or len(names) <= 1:
-        if len(names) >= _JIT_LENSES:
-            _load_jit()
         yield from map(_payload_job, names)
         return
     import multiprocessing
@@ -276,9 +241,9 @@ def _payloads(names, workers: int):
 
     n = min(workers, len(names))
     with FORK_LOCK:  # no display thread starts drawing while the workers start (physcam.progress)
-        context = multiprocessing.get_context("fork" if _forks(names[0]) else "spawn")
+        context = multiprocessing.get_context("fork" if _forks() else "spawn")
         pool = ProcessPoolExecutor(max_workers=n, mp_context=context, initializer=_worker_start,
-                                   initargs=(max(1, (os.cpu_count() or 1) // n), len(names) >= _JIT_LENSES * n))
+                                   initargs=(max(1, (os.cpu_count() or 1) // n),))
         try:
             results = pool.map(_payload_job, names)  # every lens submitted: the workers have started
         except BaseException:

@@ -380,8 +380,8 @@ def _passing_grids(q, film_z: float, fxs, radii, r_rear: float, big: float, back
 def _grid_rims(grids, radii, wanted, n_points: int, backend: str = "numpy") -> tuple:
     """(index, rims): the rims (:class:`_RimSet`, :func:`_rims`) of the grids of :func:`_passing_grids`
     (``grids``) at the ``wanted`` (film points x ``radii``) iris radii, and per film point and iris radius the
-    index of its rim there, -1 where nothing passes (or the rim is not wanted). With numba (``backend``,
-    :func:`~physcam.trace.kernels.rim_pass`) the compiled pass finds the same rims."""
+    index of its rim there, -1 where nothing passes (or the rim is not wanted). Where ``backend`` has a compiled
+    rim pass (:func:`~physcam.trace.kernels.rim_pass`: the C kernel's, or numba's) it finds the same rims."""
     from ..trace.kernels import rim_pass
 
     used, p, r0, r1, edges = grids

@@ -303,7 +303,8 @@ def load_lens(name_or_path, lenient: bool = False) -> Prescription:
     """A bundled lens by slug/name/alias, or any lens file by path (format from its extension).
 
     A string with a path separator or a lens-file extension that names an existing file
-    is read as a file; otherwise it is looked up in the library.
+    is read as a file; otherwise it is looked up in the library, and where no lens there has the
+    name, a file of that name (``lens file.txt``, ``vendor.lens.zip`` in the current folder) is read.
 
     A file that does not describe a buildable lens raises :class:`LensFileError` whose message
     says how to get further (``physcam lens fix`` and ``lenient`` only where a repair is defined). With ``lenient=True`` such a file is repaired as ``physcam lens fix``
@@ -316,26 +317,31 @@ def load_lens(name_or_path, lenient: bool = False) -> Prescription:
     return lens if what is None else require_camera_lens(lens, str(name_or_path), what)
 
 
+def _read_file(p: Path, s: str, lenient: bool) -> Prescription:
+    """The lens file ``p`` (named ``s`` by the caller), repaired as ``physcam lens fix`` would when ``lenient``."""
+    from .formats import read_lens
+
+    try:
+        return read_lens(p)
+    except LensFileError as exc:
+        if not lenient:
+            raise LensFileError(f"{exc.reason}{_way_forward(p, s)}", exc.path, exc.line) from None
+        import warnings
+
+        from ..errors import PhysCamWarning
+
+        q, repairs = load_repaired(p)
+        for r in repairs:
+            warnings.warn(f"{s}: repaired on load: {r.message}", PhysCamWarning, stacklevel=4)
+        return q
+
+
 def _load(name_or_path, lenient: bool) -> Prescription:
     s = str(name_or_path)
     p = Path(s)
     looks_like_path = isinstance(name_or_path, Path) or "/" in s or "\\" in s or p.suffix.lower() in _FILE_SUFFIXES
     if p.is_file() and looks_like_path:
-        from .formats import read_lens
-
-        try:
-            return read_lens(p)
-        except LensFileError as exc:
-            if not lenient:
-                raise LensFileError(f"{exc.reason}{_way_forward(p, s)}", exc.path, exc.line) from None
-            import warnings
-
-            from ..errors import PhysCamWarning
-
-            q, repairs = load_repaired(p)
-            for r in repairs:
-                warnings.warn(f"{s}: repaired on load: {r.message}", PhysCamWarning, stacklevel=3)
-            return q
+        return _read_file(p, s, lenient)
     if not looks_like_path and s in _slugs():
         # a slug, as the CLI is usually given it: read that one file, not the whole library (the
         # index reads every bundled lens, 25 ms). The same object the index holds;
@@ -346,6 +352,8 @@ def _load(name_or_path, lenient: bool) -> Prescription:
     except InputError:
         if looks_like_path and p.suffix.lower() in _FILE_SUFFIXES:
             raise InputError(f"{s}: no such lens file, and no bundled lens of that name") from None
+        if p.is_file():  # no lens of the library has the name: the file of that name here is the one meant
+            return _read_file(p, s, lenient)
         raise
     for r, lens in _index():
         if r.slug == rec.slug:

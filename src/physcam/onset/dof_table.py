@@ -20,7 +20,7 @@ from ..units import parse_distance
 from .report import HYPERFOCAL, solve_report
 from .request import report_camera
 
-__all__ = ["DEFAULT_FOCUS", "DEFAULT_FSTOPS", "dof_cells", "dof_table", "format_squeeze"]
+__all__ = ["DEFAULT_FOCUS", "DEFAULT_FSTOPS", "default_fstops", "dof_cells", "dof_table", "format_squeeze"]
 
 #: The f-stops and marks of a table when none are given (the full stops of a cine lens; common marks).
 DEFAULT_FSTOPS = (1.4, 2.0, 2.8, 4.0, 5.6, 8.0, 11.0, 16.0)
@@ -145,7 +145,32 @@ def dof_cells(focal_length_mm: float | None = None, *, lens=None, sensor, coc=No
     return _cells(focal_length_mm, lens, sensor, coc, squeeze, zoom)[0]
 
 
-def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops=DEFAULT_FSTOPS,
+def default_fstops(lens) -> tuple[list[float], list[str]]:
+    """(the stops of a table not given any, notes): :data:`DEFAULT_FSTOPS` from ``lens``'s widest.
+
+    A thin lens (None), or a lens model that does not know its widest, takes them all. A lens takes those it
+    opens to, led by its widest f-stop (rounded to 3 significant figures, as the report's note prints it) where
+    it left some out and no kept stop is within :data:`physcam.onset.lens_compare.FSTOP_SLACK` of it:
+    ``physcam compare``'s rule ("compared wide open") of the stop a lens opens to, its engraved widest f-stop or
+    the file's own stop's f-number when slower (:meth:`physcam.optics.lens_model.PrescriptionLens.wide_open`)."""
+    from ..optics.lens_model import lens_model_of
+    from .lens_compare import FSTOP_SLACK
+
+    wide = None if lens is None else lens_model_of(lens).wide_open()
+    if wide is None:
+        return list(DEFAULT_FSTOPS), []
+    kept = [n for n in DEFAULT_FSTOPS if n >= wide * (1 - FSTOP_SLACK)]
+    if len(kept) == len(DEFAULT_FSTOPS):
+        return kept, []
+    dropped = ", ".join(f"f/{n:g}" for n in DEFAULT_FSTOPS[:len(DEFAULT_FSTOPS) - len(kept)])
+    widest = float(f"{wide:.3g}")
+    if not kept or kept[0] > wide * (1 + FSTOP_SLACK):
+        kept.insert(0, widest)
+    return kept, [f"the lens opens only to f/{widest:g}: the default f-stops start there, wide open "
+                  f"({dropped} left out)"]
+
+
+def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops=None,
               focus_marks_mm=DEFAULT_FOCUS, coc=None, squeeze: float | str = 1.0, zoom=None) -> dict:
     """The depth-of-field table of a thin lens of ``focal_length_mm`` or of ``lens`` (a prescription,
     the technical model) on ``sensor`` (a name or a Sensor; required, as the report's): one row per
@@ -156,12 +181,17 @@ def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops
     ``squeeze``: an anamorphic desqueeze, or ``"format"`` for the one the camera table gives the sensor's
     format (:func:`format_squeeze`); ``zoom``: a zoom lens's position, a focal length with its unit ("135mm")
     or the encoder value 0..1 (``--zoom``; default its first tabulated position; out of the zoom range, and
-    for a prime, an InputError: :func:`physcam.optics.zoom.named_at_zoom`). Returns the dict ``physcam
+    for a prime, an InputError: :func:`physcam.optics.zoom.named_at_zoom`); ``fstops``: f-numbers (one faster than
+    the lens opens refused), or None for :data:`DEFAULT_FSTOPS` from the lens's widest (:func:`default_fstops`,
+    at its zoom position, its note in ``notes``). Returns the dict ``physcam
     dof-table --json`` prints (without its ``schema``/``version``/``units`` keys): keys ``rows`` (fstop, focus,
     ``*_from_film_mm``, ``total_mm``, fields of view), ``hyperfocal``, ``sensor``, ``coc_mm``, ``zoom`` (the
-    position's block, None without one), ...
+    position's block, None without one), ``notes`` (what the table chose for the user), ...
     """
     cell, lens, zoom_block = _cells(focal_length_mm, lens, sensor, coc, squeeze, zoom)
+    notes = []
+    if fstops is None:
+        fstops, notes = default_fstops(lens)
     fstops = [_fstop(n) for n in _listed(fstops, "fstops")]
     marks = [_mark(m) for m in _listed(focus_marks_mm, "focus_marks_mm")]
     if not fstops or len(fstops) > MAX_FSTOPS:
@@ -184,5 +214,5 @@ def dof_table(focal_length_mm: float | None = None, *, lens=None, sensor, fstops
         "coc_mm": first.coc_mm, "coc_convention": first.coc_convention, "squeeze": first.squeeze,
         "dof_aspect": first.dof_aspect, "fstops": fstops,
         "focus": [m if isinstance(m, str) else ("infinity" if math.isinf(m) else m) for m in marks],
-        "rows": rows, "hyperfocal": hyper, "zoom": zoom_block, "definition": DEFINITION,
+        "rows": rows, "hyperfocal": hyper, "zoom": zoom_block, "notes": notes, "definition": DEFINITION,
     }

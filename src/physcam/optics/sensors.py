@@ -143,6 +143,11 @@ def camera_aliases() -> dict[str, tuple[str, ...]]:
             for r in csv.DictReader(_data("camera_aliases.csv").splitlines())}
 
 
+def _squeezes(text: str) -> tuple[float, ...]:
+    """An ``anamorphic`` cell of sensors.csv or cameras.csv: the desqueezes offered, ";"-separated ("" none)."""
+    return tuple(float(x) for x in text.split(";") if x.strip())
+
+
 def _camera_formats() -> list[Sensor]:
     """The camera table's rows (cameras.csv) as sensors: "maker camera format", also "camera format" and
     "other-name format" (:func:`camera_aliases`), the doubled word of "KOMODO 6K 6K 17:9" once."""
@@ -159,14 +164,15 @@ def _camera_formats() -> list[Sensor]:
             source=row["source"], pitch_um=round(w * 1000.0 / int(across), 3) if across else None,
             pitch_source=f"width / photosites: {across} photosites across (the row's source)" if across else "",
             camera=row["camera"], fmt=row["format"],
-            make=row["maker"], anamorphic=tuple(float(x) for x in row["anamorphic"].split(";") if x.strip()),
+            make=row["maker"], anamorphic=_squeezes(row["anamorphic"]),
             read=row["read"], method=row["method"], maker_spec=row["maker_spec"]))
     return out
 
 
 @lru_cache(maxsize=1)
 def _gates() -> tuple[Sensor, ...]:
-    """The sensors and film gates of sensors.csv, in table order (the first rows of :func:`sensors`)."""
+    """The sensors and film gates of sensors.csv, in table order (the first rows of :func:`sensors`); a film
+    gate made for anamorphic lenses gives their desqueeze (``anamorphic``, as the camera table's formats)."""
     out = []
     for row in csv.DictReader(_data("sensors.csv").splitlines()):
         out.append(
@@ -180,6 +186,7 @@ def _gates() -> tuple[Sensor, ...]:
                 source=row["source"],
                 pitch_um=float(row["pitch_um"]) if row.get("pitch_um") else None,
                 pitch_source=row.get("pitch_source", ""),
+                anamorphic=_squeezes(row.get("anamorphic", "")),
             )
         )
     return tuple(out)

@@ -29,11 +29,12 @@ frame (the CSV of a focus-pull recording is). Lengths in mm (docs/conventions.md
 
 from __future__ import annotations
 
+import contextlib
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import ExportError, InputError, LensFileError, PhysCamWarning, require_finite, require_positive
+from ..errors import ExportError, InputError, LensFileError, PhysCamError, PhysCamWarning, require_finite, require_positive
 from ..lens.zoom import prescription_at
 
 __all__ = ["FocusKey", "read_focus_marks", "write_animated_camera", "ntsc_rate"]
@@ -48,12 +49,29 @@ MAX_FRAMES = 28_800
 @dataclass(frozen=True)
 class FocusKey:
     """One frame: its number, the focus mark from the film plane (mm), an f-stop (None: unchanged) and a
-    zoom lens's position (a focal length ``"135mm"`` or an encoder value 0..1; None: unchanged)."""
+    zoom lens's position (a focal length ``"135mm"`` or an encoder value 0..1; None: unchanged); ``source``
+    and ``line``: where :func:`read_focus_marks` read it, named by an error about its values (not compared)."""
 
     frame: float
     focus_mm: float
     fstop: float | None = None
     zoom: str | float | None = None
+    source: str | None = field(default=None, compare=False)
+    line: int | None = field(default=None, compare=False)
+
+
+@contextlib.contextmanager
+def _from_key(k: FocusKey):
+    """An error about ``k``'s values (an f-stop the lens does not open to, a zoom outside its range) named by
+    the file and line the key was read from, where it was read from one (``physcam usd animate``'s CSV)."""
+    try:
+        yield
+    except LensFileError:
+        raise
+    except PhysCamError as exc:
+        if k.source is None:
+            raise
+        raise LensFileError(str(exc), k.source, k.line) from None
 
 
 def read_focus_marks(path) -> list[FocusKey]:
@@ -93,7 +111,7 @@ def read_focus_marks(path) -> list[FocusKey]:
             raise LensFileError(str(exc) if isinstance(exc, InputError) else f"not a number: {exc}", str(p), line) \
                 from None
         zoom = (row.get("zoom") or "").strip() or None
-        keys.append(FocusKey(frame, focus, fstop, zoom))
+        keys.append(FocusKey(frame, focus, fstop, zoom, source=str(p), line=line))
         if len(keys) > MAX_FRAMES:
             raise LensFileError(f"more than {MAX_FRAMES} frames in one camera", str(p), line)
     if not keys:
@@ -164,7 +182,7 @@ def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: flo
     frames = []
     seen_notes: set[str] = set()
     for k, u in zip(keys, zooms):
-        with warnings.catch_warnings(record=True) as caught:
+        with warnings.catch_warnings(record=True) as caught, _from_key(k):
             warnings.simplefilter("always", PhysCamWarning)
             report = solve_report(report_camera(focal_length_mm=focal_length_mm, sensor=sensor,
                                                  fstop=k.fstop if k.fstop is not None else fstop, focus_mm=k.focus_mm,
@@ -231,6 +249,7 @@ def _zoom_encoders(keys, lens, zoom) -> list:
     out, held = [], zoom_encoder(lens, 0.0 if zoom is None else zoom)
     for k in keys:
         if k.zoom is not None:
-            held = zoom_encoder(lens, k.zoom)
+            with _from_key(k):
+                held = zoom_encoder(lens, k.zoom)
         out.append(held)
     return out

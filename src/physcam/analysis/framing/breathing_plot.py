@@ -33,6 +33,7 @@ def breathing_figure(rows, *, title: str = "focus breathing", sensor_width_mm: f
     draw_breathing(ax, rows, sensor_width_mm=sensor_width_mm, units=units)
     ax.set_title(fit_title(title, 7.0))
     fig.tight_layout()
+    _thin_ticks(ax)  # the axes as tight_layout left them
     return fig
 
 
@@ -76,17 +77,26 @@ def draw_breathing(ax, rows, *, sensor_width_mm: float | None = None, units: str
     return ax2
 
 
-def _thin_ticks(ax, gap: float = 0.06) -> None:
-    """Hide tick labels closer than ``gap`` of the axis span to the last one shown (marks crowd
-    toward close focus on a 1/distance axis)."""
-    ticks = sorted(zip(ax.get_xticks(), ax.get_xticklabels()), key=lambda p: p[0])
-    span = (ticks[-1][0] - ticks[0][0]) or 1.0
-    last = None
-    for x, lab in ticks:
-        if last is not None and x - last < gap * span:
+def _thin_ticks(ax, pad_pt: float = 4.0) -> None:
+    """Hide the x tick labels that would run into the last one shown, left to right, measured: each label's
+    width as drawn at its size against where its tick stands on the axes as laid out now, ``pad_pt`` points
+    apart at least. Marks crowd toward close focus on a 1/distance axis and feet and inches are long
+    (``16' 5"`` beside ``9' 10 1/8"``), while a fraction of the span (the rule before) hid a metric card's 10 m
+    with room to spare. A figure laid out again after (tight_layout) thins again."""
+    fig = ax.figure
+    r = fig.canvas.get_renderer()
+    lo, hi = ax.get_xlim()
+    box = ax.get_window_extent(r)
+    scale, pad = box.width / ((hi - lo) or 1.0), pad_pt * fig.dpi / 72.0
+    right = -math.inf
+    for x, lab in sorted(zip(ax.get_xticks(), ax.get_xticklabels()), key=lambda p: p[0]):
+        lab.set_visible(True)  # measured shown (a hidden text has no extent), then hidden if it collides
+        half = 0.5 * lab.get_window_extent(r).width
+        centre = box.x0 + (x - lo) * scale
+        if centre - half < right + pad:
             lab.set_visible(False)
         else:
-            last = x
+            right = centre + half
 
 
 @styled

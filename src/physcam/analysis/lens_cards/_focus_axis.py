@@ -20,5 +20,5 @@ def focus_axis(ax, marks_mm, units: str) -> None:
     marks = sorted(set(marks_mm), reverse=True)
     ax.set_xticks([focus_x(m, units) for m in marks])
     ax.set_xticklabels([tick_label(m, units) for m in marks], fontsize=6.5)
-    _thin_ticks(ax, 0.08)
+    _thin_ticks(ax)
     ax.set_xlabel(f"focus mark from the film plane ({'m' if units == 'm' else 'feet and inches'})")

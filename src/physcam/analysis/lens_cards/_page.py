@@ -14,6 +14,13 @@ def sensor_size(sensor_mm) -> tuple[float, float]:
     return require_positive("sensor width", sensor_mm[0]), require_positive("sensor height", sensor_mm[1])
 
 
+def millimetres(length_mm: float) -> str:
+    """A length inside the camera (the entrance pupil in front of the film) as a card prints it: millimetres to
+    0.1 mm in every unit system, as docs/cli.md says of focal length, principal planes, pupil, CoC and sensor
+    (:func:`physcam.units.format_distance` in metres prints the same below 1 m; in feet it gave 1/8 inches)."""
+    return f"{float(length_mm):.1f} mm"
+
+
 def checked_drawing(fig, page, cls, units) -> None:
     """The arguments of a page's drawing function: a matplotlib Figure, its page, and m or ft."""
     from matplotlib.figure import Figure

@@ -428,17 +428,23 @@ def _draw_diagram(ax, card, units):
 
 
 def _draw_key(ax, key, units):
+    """The key numbers: the close focus, a distance in the scene, in ``units``; the lengths inside the camera
+    (EFL, pupil, image circle, track) in millimetres in every unit system (docs/cli.md), as they are engraved."""
     from ...units import format_distance
+    from ._page import millimetres
 
     ax.set_axis_off()
 
     def dist(v):
         return "–" if v is None else format_distance(v, units)
 
+    def inside(v):
+        return "–" if v is None else millimetres(v)
+
     rows = [("EFL", f"{key['efl_mm']:.2f} mm"), ("f-number (wide open)", f"f/{key['f_number']:.2f}"),
             ("T-stop", "not given in the file" if key["tstop"] is None else f"T{key['tstop']:.2f}"),
             ("entrance pupil", f"Ø {key['entrance_pupil_diameter_mm']:.1f} mm"),
-            ("  in front of film", dist(key["entrance_pupil_from_film_mm"])),
+            ("  in front of film", inside(key["entrance_pupil_from_film_mm"])),
             ("close focus" + {"maker": " (MOD)", "focus groups": " (focus groups)"}.get(key["close_focus_source"], ""),
              dist(_shown_close_focus(key))),
             ("image circle", f"Ø {key['image_circle_mm']:.1f} mm"), ("total track", f"{key['total_track_mm']:.1f} mm")]

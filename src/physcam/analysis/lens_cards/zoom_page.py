@@ -124,7 +124,7 @@ def draw_zoom_page(fig, page: ZoomPage, units: str) -> None:
     _draw_table(fig.add_subplot(gs[1, :], label="zoom table"), page)
     _draw_focal_length(fig.add_subplot(gs[2, 0], label="zoom focal length"), page)
     _draw_fnumber(fig.add_subplot(gs[2, 1], label="zoom f-number"), page)
-    _draw_pupil(fig.add_subplot(gs[3, 0], label="zoom entrance pupil"), page, units)
+    _draw_pupil(fig.add_subplot(gs[3, 0], label="zoom entrance pupil"), page)
     _draw_parfocality(fig.add_subplot(gs[3, 1], label="zoom parfocality"), page)
     _draw_breathing(fig.add_subplot(gs[4, 0], label="zoom breathing"), page, units)
     _draw_distortion(fig.add_subplot(gs[4, 1], label="zoom distortion"), page)
@@ -199,20 +199,21 @@ def _draw_fnumber(ax, page):
     ax.legend(lines, [ln.get_label() for ln in lines], loc="upper left", fontsize=6)
 
 
-def _draw_pupil(ax, page, units):
+def _draw_pupil(ax, page):
+    """The entrance pupil and front vertex in front of the film across the zoom: lengths inside the camera, in
+    millimetres in every unit system (docs/cli.md), as the page's other lengths."""
     ax.set_title("entrance pupil (the nodal pivot) in front of the film", loc="left", fontsize=8)
-    scale = 1.0 if units == "m" else 1.0 / 25.4
     xs = [r.encoder for r in page.curve]
-    ax.plot(xs, [scale * r.entrance_pupil_from_film_mm for r in page.curve], color=PALETTE[2],
+    ax.plot(xs, [r.entrance_pupil_from_film_mm for r in page.curve], color=PALETTE[2],
             label="entrance pupil")
-    ax.plot(xs, [scale * r.front_vertex_to_film_mm for r in page.curve], color="0.45", ls="--",
+    ax.plot(xs, [r.front_vertex_to_film_mm for r in page.curve], color="0.45", ls="--",
             label="front vertex")
     tab = [r for r in page.positions if r.tabulated]
-    ax.plot([r.encoder for r in tab], [scale * r.entrance_pupil_from_film_mm for r in tab], "o", ms=3.5,
+    ax.plot([r.encoder for r in tab], [r.entrance_pupil_from_film_mm for r in tab], "o", ms=3.5,
             color=PALETTE[2])
     _mark_card(ax, page)
     _zoom_axis(ax)
-    ax.set_ylabel(f"in front of the film ({'mm' if units == 'm' else 'in'})")
+    ax.set_ylabel("in front of the film (mm)")
     ax.legend(loc="best", fontsize=6)
 
 

@@ -46,6 +46,13 @@ def decode(data: bytes, path: str | None) -> str:
     except UnicodeDecodeError as exc:
         if path is not None and str(path).lower().endswith(".zmx") and b"\x00" not in data:
             text = data.decode("cp1252", errors="replace")  # OpticStudio's "ANSI" files
+        elif data[:4] == b"PK\x03\x04":  # a zip: most likely a lens archive of `physcam lens pack`
+            import shlex
+
+            named = shlex.quote(str(path))
+            raise LensFileError(f"a zip archive, not a lens file: a lens archive (NAME.lens.zip) is installed with "
+                                f"`physcam lens add {named}` and then named by its lens (`physcam lens check {named}` "
+                                f"checks it first)", path) from None
         else:
             line = data[: exc.start].count(b"\n") + 1
             raise LensFileError("not a UTF-8 text file (binary data?)", path, line) from None

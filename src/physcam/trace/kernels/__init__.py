@@ -35,8 +35,12 @@ a core (benchmarks/small_calls.py). Serial and threaded runs give identical rays
 are cached on disk under a key that includes physcam's version and a hash of the kernel sources
 (:mod:`._jitcache`).
 
-The same cache holds the Blender extension's rim pass (:func:`rim_pass`, :mod:`._rimpass`): the rim points of
-its pupil tables' aim grids, the numpy pass's bit for bit, compiled because that pass was half of a table's CPU.
+The Blender extension's pupil tables have a compiled rim pass too (:func:`rim_pass`): the rim points of their aim
+grids, the numpy pass's bit for bit, compiled because that pass was half of a table's CPU. Two ports of it: in C
+(``_rimpass.c``, built into the C kernel's module, :func:`._c.rim_points`), which "auto" takes where the C kernel
+is built, and numba's (:mod:`._rimpass`, in the same disk cache as the JIT kernel), where only numba is. Both run
+as fast (round 22, docs/performance.md); the C one has no JIT code to load, so a process that traces with the C
+kernel never loads numba for its rims.
 """
 
 from __future__ import annotations
@@ -462,15 +466,18 @@ def resolve_backend(backend: str = "auto") -> str:
 
 
 def rim_pass(backend: str = "auto"):
-    """The compiled rim pass of the Blender extension's pupil tables (``_rimpass.rim_points``: the numpy
-    pass's points bit for bit) when ``backend`` traces with numba: "numba", or "auto" once this process
-    has loaded numba (the tracer's kernel); None otherwise (the numpy pass then)."""
+    """The compiled rim pass of the Blender extension's pupil tables for ``backend`` (both give the numpy pass's
+    points bit for bit): the C pass (:func:`._c.rim_points`) for "c", numba's (``_rimpass.rim_points``) for
+    "numba"; for "auto" the C pass where the C kernel is built (as fast as numba's, with no JIT code to load:
+    docs/performance.md, round 22), else numba's once this process has loaded numba; None (the numpy pass) for
+    "numpy" and where neither is. ``PHYSCAM_BACKEND`` forces one as it does the tracer."""
     if backend == "auto" and os.environ.get("PHYSCAM_BACKEND", "auto") == "auto":
-        if _numba_kernel is None:
-            return None
-    elif resolve_backend(backend) != "numba":
-        return None
-    if _load_numba() is None:
+        backend = "c" if c_available() else ("numba" if _numba_kernel is not None else "numpy")
+    else:
+        backend = resolve_backend(backend)
+    if backend == "c":
+        return _load_c()._C.rim_points
+    if backend != "numba" or _load_numba() is None:
         return None
     global _rim_points
     if _rim_points is None:

@@ -357,8 +357,15 @@ static PyObject *set_isa(PyObject *self, PyObject *arg)
     return NULL;
 }
 
+/* the Blender extension's rim pass (_rimpass.c, built into this module) */
+extern const char physcam_rim_counts_doc[], physcam_rim_write_doc[];
+PyObject *physcam_rim_counts(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+PyObject *physcam_rim_write(PyObject *self, PyObject *const *args, Py_ssize_t nargs);
+
 static PyMethodDef methods[] = {
     {"trace_blocks", trace_blocks, METH_VARARGS, trace_blocks_doc},
+    {"rim_counts", (PyCFunction)(void (*)(void))physcam_rim_counts, METH_FASTCALL, physcam_rim_counts_doc},
+    {"rim_write", (PyCFunction)(void (*)(void))physcam_rim_write, METH_FASTCALL, physcam_rim_write_doc},
     {"isa", isa, METH_NOARGS, "The instruction set the kernel runs with (the widest this CPU has, or set_isa's)."},
     {"isa_levels", isa_levels, METH_NOARGS, "The instruction sets this build has and this CPU runs."},
     {"set_isa", set_isa, METH_O, "Run with one of isa_levels() (tests: every level gives the same rays)."},

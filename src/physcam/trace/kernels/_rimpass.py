@@ -8,7 +8,9 @@ clip edge), and every passing sample on the grid's edge a point a step out. The 
 each point in whole arrays and then sorts the 250,000 points of a table by rim; this one loops over
 the pairs twice (count the points per rim, then write each in its rim's slot), so no sort and none
 of the gathers. Imported only through :mod:`physcam.trace.kernels` (:func:`~physcam.trace.kernels.rim_pass`),
-cached on disk as the tracer's kernels are (:mod:`._jitcache`).
+cached on disk as the tracer's kernels are (:mod:`._jitcache`). ``_rimpass.c`` is the same loops in C, built into
+the C kernel's module (:func:`._c.rim_points`, this signature): "auto" takes that one where it is built, and this
+one for "numba" (``backend`` or ``PHYSCAM_BACKEND``) or where only numba is.
 """
 
 from __future__ import annotations
