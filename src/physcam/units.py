@@ -3,7 +3,8 @@
 physcam works in millimetres inside (docs/conventions.md). At the edges (CLI,
 files) a distance may carry a unit: ``3m``, ``10ft``, ``6in``, ``450mm``,
 ``2.5 cm``, ``10'6"``, ``9' 10 1/8"`` (feet and inches, fractional inches too). A bare
-number is millimetres.
+number is millimetres. The feet and inch marks may be typographic, as a phone's keyboard types them
+(``10’6”``) or as a typesetter sets them (primes, ``10′6″``): :func:`plain_marks`.
 
 Printed distances follow a *unit system* (``--units``): ``m`` (metres, millimetres below one
 metre) or ``ft`` (feet and inches, to the nearest 1/8 inch below 10 feet and the nearest inch
@@ -15,9 +16,9 @@ from __future__ import annotations
 import math
 import re
 
-from .errors import UnitError
+from .errors import UnitError, require_type
 
-__all__ = ["MM_PER_UNIT", "UNIT_SYSTEMS", "unit_system", "parse_distance", "format_feet_inches", "format_distance", "mm_to", "to_mm",
+__all__ = ["MM_PER_UNIT", "UNIT_SYSTEMS", "unit_system", "plain_marks", "parse_distance", "format_feet_inches", "format_distance", "mm_to", "to_mm",
            "inch_fraction_for"]
 
 #: Millimetres in one of each accepted unit.
@@ -46,6 +47,13 @@ _INCHES = r"(?:(\d+(?:\.\d*)?)(?:\s+(\d+)/(\d+))?|(\d+)/(\d+))"
 #: before inches alone, -1 1/4", as before feet)
 _FEET_INCHES = rf"^\s*(?:[+-](?=[\d.]))?(?:({_NUMBER})\s*(?:ft|feet|foot|'))?\s*(?:{_INCHES}\s*(?:in|inch|inches|\"))?\s*$"
 _FEET_BARE_INCHES = rf"^\s*({_NUMBER})\s*(?:ft|feet|foot|')\s*{_INCHES}\s*$"
+
+#: Typographic foot and inch marks, read as ``'`` and ``"``: the right and left single quotation marks
+#: (U+2019, U+2018: what the "smart punctuation" of iOS and Android keyboards makes of ``'``) and the prime
+#: (U+2032, the typesetter's foot mark); the right and left double quotation marks (U+201D, U+201C) and the
+#: double prime (U+2033, the inch mark). Unicode's code charts annotate U+2032 "minutes, feet" and U+2033
+#: "seconds, inches".
+_MARKS = str.maketrans("\u2019\u2018\u2032\u201d\u201c\u2033", "'" * 3 + '"' * 3)
 
 #: The unit systems distances are printed in (``--units``): metric or feet and inches.
 UNIT_SYSTEMS = ("m", "ft")
@@ -76,11 +84,24 @@ def mm_to(value_mm: float, unit: str) -> float:
     return float(value_mm) / to_mm(1.0, unit)
 
 
+def plain_marks(text: str) -> str:
+    """``text`` with its typographic foot and inch marks (:data:`_MARKS`) made ``'`` and ``"``, and two foot
+    marks in a row made one inch mark (``6''`` or ``6’’`` is 6 inches: the typewriter's way of writing the
+    double prime; a phone's keyboard makes ``''`` typed into ``’’``). serve's page reads marks by the same rule
+    (``plainMarks`` in serve/static/onset.js).
+
+    >>> print(plain_marks("10’6”"), plain_marks("10′ 6″"), plain_marks("10'6''"))
+    10'6" 10' 6" 10'6"
+    """
+    return require_type("text", text, str).translate(_MARKS).replace("''", '"')
+
+
 def parse_distance(text, *, name: str = "distance", allow_inf: bool = False) -> float:
     """Read a distance such as ``3m``, ``10ft``, ``6in``, ``450mm`` or ``10'6"``; return mm.
 
-    A bare number is millimetres. ``inf`` (or ``infinity``) is accepted only with
-    ``allow_inf``. Raises :class:`~physcam.errors.UnitError` naming ``name`` otherwise.
+    A bare number is millimetres; feet and inch marks may be typographic (``10’6”``, ``10′6″``:
+    :func:`plain_marks`). ``inf`` (or ``infinity``) is accepted only with ``allow_inf``.
+    Raises :class:`~physcam.errors.UnitError` naming ``name`` otherwise.
 
     >>> parse_distance("10ft")
     3048.0
@@ -91,20 +112,21 @@ def parse_distance(text, *, name: str = "distance", allow_inf: bool = False) -> 
         v = float(text)
     else:
         s = str(text).strip()
+        t = s if s.isascii() and "''" not in s else plain_marks(s)  # refusals quote what was typed, s
         if s.lower() in ("inf", "infinity", "∞"):
             if allow_inf:
                 return math.inf
             raise UnitError(f"{name} must be finite, got {s!r}")
-        m = re.match(_FEET_INCHES, s) if any(c in s for c in "'\"/") or re.search(r"\d\s*(ft|feet|foot)\s*\d", s) \
+        m = re.match(_FEET_INCHES, t) if any(c in t for c in "'\"/") or re.search(r"\d\s*(ft|feet|foot)\s*\d", t) \
             else None
-        m = m or (re.match(_FEET_BARE_INCHES, s) if "/" in s else None)
+        m = m or (re.match(_FEET_BARE_INCHES, t) if "/" in t else None)
         if m and (m.group(1) is not None or any(g is not None for g in m.groups()[1:])):
             # a sign belongs to the whole distance: -1' 2" is -(1 foot 2 inches)
             v = abs(float(m.group(1) or 0.0)) * 304.8 + _inches(*m.groups()[1:]) * 25.4
-            if s.lstrip().startswith("-"):
+            if t.lstrip().startswith("-"):
                 v = -v
         else:
-            m = _SIMPLE.match(s)
+            m = _SIMPLE.match(t)
             if not m:
                 raise UnitError(
                     f"cannot read {name} {s!r}: write a number with an optional unit, e.g. 3m, 10ft, 6in, 450mm"

@@ -68,10 +68,15 @@ def _len(rng: random.Random, mm: float) -> str:
         ft, inch = divmod(inches, 12)
         whole, part = int(inch), round((inch - int(inch)) * 8)
         frac = f" {part}/8" if part else ""
-        return f"{int(ft)}' {whole}{frac}\""
+        foot, inch_mark = MARKS[int(mm) % len(MARKS)]  # typed with a phone's marks too (no draw: same setups)
+        return f"{int(ft)}{foot} {whole}{frac}{inch_mark}"
     if form == 4:
         return f"{mm / 10:.5g} cm"
     return f"{mm / 25.4:.5g}in"
+
+
+#: foot and inch marks as typed: ASCII, a phone's smart quotes, primes, a phone's two single quotes for inches
+MARKS = [("'", '"'), ("’", "”"), ("′", "″"), ("'", "''"), ("’", "’’"), ("‘", "“")]
 
 
 def _log_uniform(rng, lo, hi):
@@ -356,3 +361,42 @@ def test_page_says_which_format_a_bare_camera_name_is_as_the_cli(monkeypatch, tm
     note = camera_name_note("ALEXA 35")
     assert note in cli["body"]["notes"] and note in page["body"]["notes"]
     assert page["body"]["notes"][-1] == note  # after the report's own notes, as the CLI adds it
+
+
+def test_page_reads_typographic_marks_as_the_server():
+    """10’6” (an iPhone's smart quotes), 10′6″ (primes), 6’’ (two single quotes): the page's parseDistance gives
+    the millimetres worked by hand (tests/test_units_typographic_marks.py: 10 ft 6 in = 126 x 25.4 = 3200.4 mm)
+    and the page's report equals the server's (`physcam report --json`) for focus, near and far typed so; both
+    refused the marks before round 22 (the page with "cannot read focus distance")."""
+    from _typed_distances import TYPED
+
+    got = run_page_solver({"calls": [["parseDistance", text] for text, _ in TYPED]})
+    assert [g["ok"] for g in got] == [True] * len(TYPED), got
+    assert [g["body"] for g in got] == pytest.approx([mm for _, mm in TYPED], rel=1e-12)
+    setups = [{"focal": "50", "fstop": "2.8", "focus": "10’6”"}, {"focal": "35", "fstop": "4", "focus": "10′ 6″"},
+              {"focal": "50", "near": "8’", "far": "14’ 6”", "units": "ft"},
+              {"focal": "50", "fstop": "2", "focus": "9’ 10 1/8”", "near": "9’ 6’’"},
+              {"focal": "50", "fstop": "2", "focus": "x’"}]
+    table = sensor_table()
+    page, cli = run_page_solver({"sensors": table, "setups": setups}), cli_answers(setups)
+    assert [p["ok"] for p in page] == [c["ok"] for c in cli] == [True, True, True, True, False]
+    for q, a, b in zip(setups, page, cli):
+        assert not _agree(a, b), (q, _agree(a, b))
+    assert cli[0]["body"]["focus_from_film_mm"] == pytest.approx(3200.4, rel=1e-12)
+
+
+def test_page_keeps_the_libraries_coc_and_focal_bounds():
+    """The one range of a circle of confusion (0.001 to 1 mm, physcam.optics.coc.require_coc) and of a focal length
+    (1 mm to 100 m, physcam.optics.thinlens.require_focal_length): the page refuses where the server refuses and
+    answers the edges as it does (round 22: coc=1e-300 gave a 300-digit hyperfocal, focal=0.001 "0.0 mm")."""
+    base = {"fstop": "2", "focus": "3m", "sensor": "S35"}
+    setups = [dict(base, focal="50", coc=c) for c in ("1e-300", "5m", "0.0009", "1.001", "0.001", "1", "1um", "1mm")]
+    setups += [dict(base, focal=f, focus="inf") for f in ("0.001", "0.999", "1", "1e5", "1.1e5")]
+    want = [False, False, False, False, True, True, True, True, False, False, True, True, False]
+    page, cli = run_page_solver({"sensors": sensor_table(), "setups": setups}), cli_answers(setups)
+    assert [c["ok"] for c in cli] == want, [c["body"] for c in cli]
+    assert [p["ok"] for p in page] == want, [p["body"] for p in page]
+    for a, b in zip(page, cli):
+        assert not _agree(a, b)
+    calls = [["closeUp", 0.5, 4, 0.025, 1000, 1], ["closeUp", 50, 4, 5000, 1000, 1], ["closeUp", 1, 4, 0.001, 1000, 1]]
+    assert [g["ok"] for g in run_page_solver({"calls": calls})] == [False, False, True]

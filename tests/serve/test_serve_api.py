@@ -44,6 +44,8 @@ REPORTS = [
     {"focal": "50", "fstop": "2", "focus": "2m", "model": "technical", "h1": "62", "h2": "51.3", "pupil": "92"},
     {"focal": "24", "fstop": "8", "focus": "100m", "sensor-width": "36", "sensor-height": "24", "coc": "d/1000"},
     {"lens": "dgauss_50mm", "fstop": "2.8", "focus": "2m"},
+    {"focal": "50", "fstop": "2.8", "focus": "10’6”"},  # an iPhone's smart quotes (422 before round 22)
+    {"focal": "35", "fstop": "4", "focus": "10′ 6″", "near": "8’", "far": "14’"},  # primes
 ]
 
 
@@ -117,6 +119,15 @@ def test_the_servers_query_parser_is_argparses():
         assert outcome(lambda: quick.parse(params)) == outcome(lambda: parser.parse_args(_options(params)))
 
     same()
+
+
+def test_typographic_feet_and_inches_are_read(server):
+    """GET /api/report?focus=10%E2%80%996%E2%80%9D (10’6”, as a phone types 10'6") marks 10 ft 6 in = 3200.4 mm
+    (by hand: 126 in x 25.4 mm); it was a 422 "cannot read focus distance"."""
+    port, _ = server
+    status, got = get_json(port, "/api/report?focal=50&fstop=2.8&focus=10%E2%80%996%E2%80%9D")
+    assert status == 200, got
+    assert got["focus_from_film_mm"] == pytest.approx(3200.4, rel=1e-12)
 
 
 def test_far_at_infinity_is_null(server):

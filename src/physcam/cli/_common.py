@@ -83,6 +83,23 @@ def distance(name: str, allow_inf: bool = False, *, scene: bool = False):
     return parse
 
 
+def focal_length(name: str = "focal length"):
+    """An argparse type reading a focal length (a distance with units, a bare number mm) within the library's one
+    range (:func:`physcam.optics.thinlens.require_focal_length`: 1 mm to 100 m); outside it, argparse's one line."""
+    read = distance(name)
+
+    def parse(text):
+        from ..optics.thinlens import require_focal_length
+
+        try:
+            return require_focal_length(read(text), name)
+        except PhysCamError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parse.__name__ = name
+    return parse
+
+
 def resolve_bare_distances(args) -> None:
     """After parsing: every scene distance typed as a bare number (:class:`BareDistance`) read by
     :data:`BARE_RULE`: under feet (``--units ft`` or the config's ``units``) its number becomes feet, and a

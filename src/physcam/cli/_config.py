@@ -145,7 +145,12 @@ def _read(path: Path) -> Config:
     values: dict = {}
     for k, v in data.items():
         if k == "coc" and isinstance(v, (int, float)) and not isinstance(v, bool):
-            values[k] = float(v)
+            from ..optics.coc import require_coc
+
+            try:
+                values[k] = require_coc(float(v))
+            except InputError as exc:  # out of the one range (0.001 to 1 mm)
+                raise InputError(f"the physcam config {path}: coc: {exc}") from None
             continue
         if k == "glass_catalogs":
             v = [v] if isinstance(v, str) else v

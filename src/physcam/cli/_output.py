@@ -7,7 +7,9 @@
 - **Tables**: :class:`Table` renders as a rich table at a terminal and as plain, complete,
   aligned text when piped or redirected (never cut at 80 columns).
 - **CSV** (``--csv``): :func:`print_csv` writes the rows of the JSON document (numbers at full
-  precision, an empty cell for null, lists joined with ``;``), so CSV and JSON agree cell by cell.
+  precision, an empty cell for null, lists joined with ``;``), so CSV and JSON agree cell by cell;
+  under ``--units ft`` its scene distances are decimal feet in columns named ``*_ft``
+  (:func:`csv_in_units`, the one rule for every command's CSV, docs/cli.md "Units").
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import sys
 from pathlib import Path
 
 __all__ = ["document", "emit_json", "schema_file", "SCHEMA_DIR", "Table", "print_table", "print_csv",
-           "csv_text", "add_output_options", "LENGTH_UNITS", "save_plot"]
+           "csv_text", "csv_in_units", "scene_distance_column", "add_output_options", "LENGTH_UNITS", "save_plot"]
 
 SCHEMA_DIR = Path(__file__).resolve().parent / "schemas"
 #: The units most documents use: lengths in mm, angles in degrees.
@@ -166,8 +168,59 @@ def csv_text(rows, columns=None) -> str:
     return buf.getvalue()
 
 
-def print_csv(rows, columns=None) -> None:
-    """Write :func:`csv_text` to stdout."""
+#: Words of a column's name (before ``_from_...`` and ``_mm``) that make it a distance in the scene: a focus
+#: mark, a limit or the depth of the depth of field, a subject's or a light's distance, a close focus.
+_SCENE_WORDS = frozenset({"focus", "near", "far", "hyperfocal", "total", "depth", "closest", "subject", "light",
+                          "sharpest", "object", "distance"})
+#: ...and the words that keep a length inside the camera, in mm whatever the units (docs/cli.md: focal length,
+#: principal planes, pupil, CoC, sensor): the back focus, a focal length, the image and the film side, the
+#: lens's track, a z coordinate along the axis.
+_CAMERA_WORDS = frozenset({"back", "focal", "flange", "image", "film", "track", "z"})
+
+
+def scene_distance_column(name: str) -> bool:
+    """Whether a CSV column ``name`` (a JSON key) is a scene distance, which ``--units ft`` gives in feet:
+    ``focus_from_film_mm``, ``near_from_film_mm``, ``dof_total_mm``, ``closest_focus_mm``, ``total_mm``,
+    ``bokeh_light_from_film_mm`` are; ``entrance_pupil_from_film_mm``, ``efl_mm``, ``back_focus_mm``,
+    ``focal_length_mm``, ``image_height_mm`` are not (what the commands' tables print with
+    :func:`physcam.units.format_distance`, and what they print in mm)."""
+    if not name.endswith("_mm"):
+        return False
+    words = name[:-3].split("_from_")[0].split("_")
+    return bool(_SCENE_WORDS.intersection(words)) and not _CAMERA_WORDS.intersection(words)
+
+
+def csv_in_units(rows, units: str = "m") -> list[dict]:
+    """``rows`` (the JSON document's, in mm) as ``--csv`` writes them under ``units``: as they are in metres; in
+    feet (``ft``) every :func:`scene_distance_column` in decimal feet (the millimetres / 304.8, the
+    international foot) under its name with ``_ft`` for ``_mm``, every other column as it is."""
+    rows = list(rows)
+    if units != "ft":
+        return rows
+    out = []
+    for r in rows:
+        q = {}
+        for k, v in r.items():
+            if scene_distance_column(k):
+                q[k[:-3] + "_ft"] = _feet(v)
+            else:
+                q[k] = v
+        out.append(q)
+    return out
+
+
+def _feet(v):
+    """Millimetres (a number, or a list of them; None stays None) in decimal feet."""
+    if isinstance(v, (list, tuple)):
+        return [_feet(x) for x in v]
+    return v / 304.8 if isinstance(v, (int, float)) and not isinstance(v, bool) else v
+
+
+def print_csv(rows, columns=None, *, units: str = "m") -> None:
+    """Write :func:`csv_text` of ``rows`` in ``units`` (:func:`csv_in_units`) to stdout."""
+    rows = csv_in_units(rows, units)
+    if columns is not None and units == "ft":
+        columns = [k[:-3] + "_ft" if scene_distance_column(k) else k for k in columns]
     sys.stdout.write(csv_text(rows, columns))
 
 

@@ -165,7 +165,9 @@ def plot_context(args) -> str:
 def _csv(args, res, command: str) -> bool:
     """With --csv: print the analysis's rows (as in its JSON) and say so."""
     if args.csv and not args.json:
-        print_csv(res.to_dict()[DOCS[command][1]])
+        from ._common import units_of
+
+        print_csv(res.to_dict()[DOCS[command][1]], units=units_of(args) if hasattr(args, "units") else "m")
         return True
     return False
 

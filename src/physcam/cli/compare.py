@@ -296,7 +296,7 @@ def run_lenses(args) -> int:
         emit_json(document("compare", d))
         return 0
     if args.csv:
-        print_csv(rows)
+        print_csv(rows, units=units)
         return 0
     t = Table(f"lenses compared on {sensor.name} ({sensor.width_mm:g} x {sensor.height_mm:g} mm)",
               ["", *args.lenses], justify=["left"] + ["right"] * len(rows))

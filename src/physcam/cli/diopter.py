@@ -3,7 +3,7 @@ then is and its depth of field (physcam.onset.diopter, thin lenses in contact)."
 
 from __future__ import annotations
 
-from ._common import FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, list_items, number
+from ._common import FOCUS_HELP, add_sensor_options, add_units_option, focal_length, focus, list_items, number
 
 EPILOG = """\
 examples:
@@ -29,7 +29,7 @@ def register(sub) -> None:
                                    "at the CoC of the sensor. The diopter is taken in contact with the lens (1/f = "
                                    "1/f_lens + P); the pupil keeps its diameter.", epilog=EPILOG,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--focal", required=True, type=distance("focal length"), metavar="MM", help="focal length (mm)")
+    p.add_argument("--focal", required=True, type=focal_length(), metavar="MM", help="focal length (mm)")
     p.add_argument("--fstop", required=True, type=number("f-stop", positive=True), metavar="N", help="f-stop")
     p.add_argument("--focus", required=True, type=focus("focus mark"), metavar="DIST",
                    help=f"the lens's focus mark, from the film plane ({FOCUS_HELP})")

@@ -111,7 +111,7 @@ def run_distortion(args) -> int:
     res = real_distortion(lens, args.field, sensor_width_mm=args.sensor_width, sensor_height_mm=args.sensor_height,
                           wavelength_nm=args.wavelength, focus_mm=math.inf if args.focus is None else args.focus)
     if args.csv and not args.json:
-        print_csv(res.to_dict()["points"])
+        print_csv(res.to_dict()["points"], units=units_of(args))
     elif not args.json:
         from ._output import Table, print_table
 
@@ -147,8 +147,6 @@ def _run_across_focus(args, lens) -> int:
                                   sensor_height_mm=args.sensor_height, width_px=args.resolution[0],
                                   height_px=args.resolution[1], wavelength_nm=args.wavelength)
     if args.output:
-        from ._common import units_of
-
         tab.plot(args.output, force=args.force, units=units_of(args))
     if args.json:
         emit_json(document("distortion_across_focus", mark_repaired({**tab.to_dict(), "zoom": args.zoom_block},
@@ -159,10 +157,9 @@ def _run_across_focus(args, lens) -> int:
                  brown_du_max_px=r["brown_du"]["max_px"], tde4_c2=r["tde4"]["Distortion - Degree 2"],
                  tde4_c4=r["tde4"]["Quartic Distortion - Degree 4"], tde4_max_px=r["tde4"]["max_px"]) for r in tab.rows]
     if args.csv:
-        print_csv(rows)
+        print_csv(rows, units=units_of(args))
         return 0
     from ..units import format_distance
-    from ._common import units_of
     from ._output import Table, print_table
 
     units = units_of(args)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import shlex
 import sys
 
-from ._common import (FOCUS_HELP, FOLDER_FORCE_HELP, add_lens_argument, add_units_option, distance, focus, number, numbers,
+from ._common import (FOCUS_HELP, FOLDER_FORCE_HELP, add_lens_argument, add_units_option, focal_length, focus, number, numbers,
                       whole)
 from ._output import add_output_options, document, emit_json, print_csv
 
@@ -143,10 +143,11 @@ def run_unreal(args) -> int:
     if args.json:
         emit_json(document("export_unreal", {"written": str(args.output), "lens_file": data}))
         return 0
-    if args.csv:
-        print_csv(pc["marks"])
-        return 0
     from ._common import units_of
+
+    if args.csv:
+        print_csv(pc["marks"], units=units_of(args))
+        return 0
     from ._output import Table, print_table
 
     units = units_of(args)
@@ -243,7 +244,7 @@ def run_blender(args) -> int:
     print(f"  in Blender: blender your.blend --python {shlex.quote(str(setup))}  (Cycles, CPU, OSL)")
     if builtin is not None:
         print(f"  or Blender's own camera, matched: blender your.blend --python {shlex.quote(str(builtin))}")
-        print(f"  note: {gap.summary()}")
+        print(f"  note: {gap.summary(units_of(args))}")
     return 0
 
 
@@ -427,7 +428,7 @@ def run_rib(args) -> int:
           f"(shorter side); fStop {proj['fStop']:.4g}, focalLength {proj['focalLength']:.6g}, focalDistance "
           f"{proj['focalDistance']:.6g} (units of {mpu:g} m); dofaspect {proj['dofaspect']:.4g}")
     if gap is not None:
-        print(f"  note: {gap.summary()}")
+        print(f"  note: {gap.summary(units_of(args))}")
     return 0
 
 
@@ -445,7 +446,7 @@ def _register_pbrt(s) -> None:
     b.add_argument("-o", "--output", required=True, metavar="DIR",
                    help="folder to write the files into (written whole, with a physcam-manifest.json)")
     b.add_argument("--lens", metavar="NAME_OR_FILE", help="a real lens (bundled name or prescription file)")
-    b.add_argument("--focal", metavar="MM", type=distance("focal length"),
+    b.add_argument("--focal", metavar="MM", type=focal_length(),
                    help="or a thin lens of this focal length (mm): the perspective camera only")
     b.add_argument("--fstop", metavar="N", type=number("f-stop", positive=True),
                    help="f-stop (geometric f-number; with --lens default wide open)")
@@ -598,8 +599,9 @@ def _register_mitsuba(s) -> None:
     m.set_defaults(handler=run_mitsuba, output_folders=("output",))
 
 
-def _mitsuba_files(args, xml_path, json_path) -> dict:
-    """Solve the report of ``args``, write the scene XML and dict JSON, return the camera values."""
+def _mitsuba_files(args, xml_path, json_path) -> tuple:
+    """Solve the report of ``args``, write the scene XML and dict JSON, return the camera values and the thin-lens
+    gap (or None)."""
     import json
 
     from ..errors import InputError
@@ -619,7 +621,7 @@ def _mitsuba_files(args, xml_path, json_path) -> dict:
         values["physcam"]["notes"].append(gap.summary())
     atomic_write(xml_path, mitsuba_scene_xml(values))
     atomic_write(json_path, json.dumps(mitsuba_scene_dict(values), indent=2, allow_nan=False) + "\n")
-    return values
+    return values, gap
 
 
 def run_mitsuba(args) -> int:
@@ -635,7 +637,7 @@ def run_mitsuba(args) -> int:
         raise InputError("--output must name a folder")
     xml_path, json_path = Path(args.output) / f"{name}.xml", Path(args.output) / f"{name}.json"
     with output_folder(args.output, force=args.force, command="export mitsuba") as tmp:  # written whole
-        values = _mitsuba_files(args, tmp / xml_path.name, tmp / json_path.name)
+        values, gap = _mitsuba_files(args, tmp / xml_path.name, tmp / json_path.name)
     if args.json:
         emit_json(document("export_mitsuba", {"xml": str(xml_path), "json": str(json_path), **values},
                            units={"length": "mm", "angle": "degree", "sensor": "scene units of meters_per_unit m"}))
@@ -648,6 +650,9 @@ def run_mitsuba(args) -> int:
     print(f"  fov {sn['fov']:.4f} deg (x; infinity focus would be {pc['hfov_infinity_deg']:.4f}), aperture_radius "
           f"{sn['aperture_radius']:.6g}, focus_distance {sn['focus_distance']:.6g} (scene units of "
           f"{pc['meters_per_unit']:g} m), film {sn['film']['width']} x {sn['film']['height']} px")
-    for n in pc["notes"]:
+    notes = list(pc["notes"])
+    if gap is not None:  # the files' notes, the thin-lens gap's last: printed in --units (the files keep metres)
+        notes[-1] = gap.summary(units_of(args))
+    for n in notes:
         print(f"  note: {n}")
     return 0

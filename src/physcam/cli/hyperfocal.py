@@ -16,9 +16,9 @@ DEFAULT_FSTOPS = (2.0, 2.8, 4.0, 5.6, 8.0, 11.0, 16.0)
 
 
 def _focals(text):
-    from ._common import distance
+    from ._common import focal_length
 
-    one = distance("focal length")
+    one = focal_length()
     return [one(t) for t in list_items(text, "focal lengths", "18,25,35,50")]
 
 

@@ -353,7 +353,7 @@ def run_show(args) -> int:
     if args.csv:
         from ._output import print_csv
 
-        print_csv(show_points(data))
+        print_csv(show_points(data), units=units_of(args))
         return 0
     g0 = data["y"]
     print(f"{p.name}  (wavelength {g0.wavelength_nm:g} nm, focus {format_distance(st.focus_from_film_mm, units_of(args))} "
@@ -486,7 +486,7 @@ def run_breathing(args) -> int:
              "plot": None if path is None else str(path), "zoom": zoom_info(args, p)}, p)))
         return 0
     if args.csv:
-        print_csv([r.to_dict() for r in rows])
+        print_csv([r.to_dict() for r in rows], units=units)
         return 0
     if p.is_anamorphic:
         _print_breathing_per_axis(p, rows, sensor_name, units)

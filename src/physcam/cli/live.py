@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from ._common import distance, focus, number, numbers, usd_file, whole
+from ._common import distance, focal_length, focus, number, numbers, usd_file, whole
 from ._live_record import resolve_sensor_opt as _resolve_sensor_opt
 from ._live_record import source_id
 from ._output import add_output_options, document, emit_json
@@ -88,7 +88,7 @@ def _record_parser(s) -> None:
     r.add_argument("--count", type=_count, default=None, help="stop once the source recorded has this many samples")
     r.add_argument("--report", metavar="FILE", help="also write the per-frame lens report (.csv or .json)")
     _sensor_args(r)
-    r.add_argument("--focal", type=distance("focal length"), help="pinhole focal length when the stream has none")
+    r.add_argument("--focal", type=focal_length(), help="pinhole focal length when the stream has none")
     r.add_argument("--lens", help="bundled lens name or prescription file: a frame without a pinhole focal length "
                                   "is solved through it at its focus (breathing, entrance pupil, squeeze)")
     r.add_argument("--fiz", metavar="CSV", help="encoder calibration table (axis,encoder,value rows; docs/live.md): "
@@ -120,7 +120,7 @@ def _recover_parser(s) -> None:
                     help="output .usda/.usd/.usdc (default: the recording's, beside the journal)")
     rc.add_argument("--report", metavar="FILE", help="the lens report (default: the recording's, if it asked one)")
     _sensor_args(rc)
-    rc.add_argument("--focal", type=distance("focal length"), help="pinhole focal length when the stream has none")
+    rc.add_argument("--focal", type=focal_length(), help="pinhole focal length when the stream has none")
     rc.add_argument("--lens", help="bundled lens name or prescription file (as live record)")
     rc.add_argument("--fiz", metavar="CSV", help="encoder calibration table (as live record)")
     rc.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop when the stream has none")
@@ -157,7 +157,7 @@ def register(sub) -> None:
                                    "recorded clip's camera metadata")
     _clip_arg(se)
     se.add_argument("--lens", help="bundled lens name or prescription file (breathing, pupil, distortion)")
-    se.add_argument("--focal", type=distance("focal length"), help="or a thin lens of this focal length")
+    se.add_argument("--focal", type=focal_length(), help="or a thin lens of this focal length")
     from ._common import add_sensor_options
 
     add_sensor_options(se)
@@ -198,7 +198,7 @@ def register(sub) -> None:
                                            "record (or --clip)")
     _clip_arg(pl)
     pl.add_argument("--lens", help="with --clip: bundled lens name or prescription file (breathing, pupil, distortion)")
-    pl.add_argument("--focal", type=distance("focal length"), help="with --clip: or a thin lens of this focal length")
+    pl.add_argument("--focal", type=focal_length(), help="with --clip: or a thin lens of this focal length")
     pl.add_argument("--zoom", default=None, metavar="POSITION",
                     help="with --clip and a zoom --lens: the position of frames that record no focal length")
     pl.add_argument("--path", default=None, help="camera prim path (default: the only PhysicalCamera)")

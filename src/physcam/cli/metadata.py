@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import LENS_HELP, add_sensor_options, add_units_option, distance, number, usd_file
+from ._common import LENS_HELP, add_sensor_options, add_units_option, focal_length, number, usd_file
 from ._output import add_output_options, document, emit_json
 from .report import add_coc_option
 
@@ -41,7 +41,7 @@ def _solve_args(p) -> None:
     p.add_argument("--lens", default=None, metavar="NAME_OR_FILE",
                    help=LENS_HELP + "; optional: without it a thin lens of the recorded focal length")
     add_sensor_options(p)
-    p.add_argument("--focal", type=distance("focal length"), default=None,
+    p.add_argument("--focal", type=focal_length(), default=None,
                    help="focal length when the file records none (mm, or with units)")
     p.add_argument("--fstop", type=number("f-stop", positive=True), default=None,
                    help="f-stop when the file records no stop")
@@ -212,10 +212,10 @@ def run_report(args) -> int:
             "clip": rec.static_dict(), "lens": args.lens, "model": "prescription" if lens is not None else "thin lens",
             "sensor_mm": [s.width_mm, s.height_mm], "notes": notes, "frames": rows}))
         return 0
-    if args.csv:
-        print_csv(rows)
-        return 0
     u = units_of(args)
+    if args.csv:
+        print_csv(rows, units=u)
+        return 0
     what = f"lens {args.lens}" if lens is not None else "a thin lens of the recorded focal length"
     cols = ["frame", "timecode", "focus", "stop", "near", "far", "hyperfocal", "hfov_deg"]
     t = Table(f"{_clip(rec)}: {what}, sensor {s.width_mm:g} x {s.height_mm:g} mm", cols,

@@ -14,7 +14,7 @@ import math
 
 from ._common import add_lens_argument, FOCUS_HELP, add_sensor_options, add_units_option, distance, focus, number, whole, figure_file
 from ._output import add_output_options, document, emit_json, print_csv
-from ._common import add_lenient, mark_repaired
+from ._common import add_lenient, mark_repaired, units_of
 from .lens import WAVE_UNITS
 
 #: The CLI's largest pupil grids (the Python API goes to 1024): bound a chart's time and memory
@@ -133,8 +133,6 @@ def run(args) -> int:
                           max_pupil_samples=CHART_MAX_PUPIL_SAMPLES, progress=bar, best_focus=args.best_focus,
                           best_focus_rule=args.best_focus_rule, method=args.method)
     if args.output:
-        from ._common import units_of
-
         chart.plot(args.output, force=args.force, units=units_of(args))
     if args.json:
         d = chart.to_dict()
@@ -142,10 +140,9 @@ def run(args) -> int:
         emit_json(document("mtf_chart", mark_repaired(d, lens), units=dict(WAVE_UNITS, frequency="lp/mm")))
         return 0
     if args.csv:
-        print_csv(chart.points())
+        print_csv(chart.points(), units=units_of(args))
         return 0
     from ..units import format_distance
-    from ._common import units_of
 
     foc = format_distance(math.inf if focus is None else focus, units_of(args))
     print(f"{chart.lens_name}: MTF at f/{chart.fstop:.3g}, focus {foc} from the film "
@@ -207,7 +204,7 @@ def _one_field(args, camera, wls, weights, freqs) -> int:
                            units=dict(WAVE_UNITS, wavefront="waves", frequency="lp/mm", psf="um")))
         return 0
     if args.csv:
-        print_csv(points)
+        print_csv(points, units=units_of(args))
         return 0
     print(f"{wf.lens_name}: field {wf.field_deg:g} deg (chief ray at {wf.chief_image_height_mm:.3f} mm), "
           f"f/{wf.fstop:.3g}")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import FOCUS_HELP, coc_value, distance, focus, number, figure_file
+from ._common import FOCUS_HELP, coc_value, distance, focal_length, focus, number, figure_file
 
 EPILOG = """\
 distances accept units as said on set: 3m, 10ft, 6in, 450mm, 10'6" (a bare focus, near or far is mm,
@@ -69,7 +69,7 @@ def add_report_arguments(p) -> None:
     from ._zoom import add_zoom_option
 
     add_zoom_option(g)
-    g.add_argument("--focal", metavar="MM", type=distance("focal length"), help="focal length (mm)")
+    g.add_argument("--focal", metavar="MM", type=focal_length(), help="focal length (mm)")
     g.add_argument("--fstop", metavar="N", type=number("f-stop"), help="f-stop (geometric f-number); solved from --near/--far if omitted (with --lens: wide open)")
     g.add_argument("--tstop", metavar="T", type=number("T-stop"), help="marked T-stop, compared with the effective f-stop")
     g.add_argument("--focus", metavar="DIST", type=focus("focus distance"),
@@ -115,7 +115,7 @@ def add_coc_option(p, extra: str = "") -> None:
     """--coc: a convention name or a value with units (the one definition)."""
     p.add_argument("--coc", type=coc_value, default=None, metavar="COC",
                    help=f"{extra}circle of confusion: d/1500 (default, or `coc` in the user config), d/1000, d/1730, "
-                        "cine (0.025 mm) or a value (0.025, 25um, 0.025mm; a bare number is mm)")
+                        "cine (0.025 mm) or a value from 0.001 to 1 mm (0.025, 25um, 0.025mm; a bare number is mm)")
 
 
 def resolve_sensor(args, default: str | None = None, *, quiet: bool = False):

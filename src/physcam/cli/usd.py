@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import FOCUS_HELP, add_sensor_options, add_units_option, coc_of, distance, focus, number, numbers, usd_file, whole
+from ._common import FOCUS_HELP, add_sensor_options, add_units_option, coc_of, distance, focal_length, focus, number, numbers, usd_file, whole
 from ._output import add_output_options, document, emit_json
 from .report import add_coc_option, resolve_sensor
 
@@ -106,7 +106,7 @@ def register(sub) -> None:
     a.add_argument("file", help="output .usda/.usd/.usdc")
     a.add_argument("--marks", required=True, metavar="CSV", help="focus marks per frame: frame,focus[,fstop]")
     a.add_argument("--lens", help="bundled lens name or prescription file (breathing from the real lens)")
-    a.add_argument("--focal", type=distance("focal length"), help="or a thin lens of this focal length")
+    a.add_argument("--focal", type=focal_length(), help="or a thin lens of this focal length")
     a.add_argument("--fstop", type=number("f-stop", positive=True), help="f-stop for frames without one")
     a.add_argument("--zoom", default=None, metavar="POSITION",
                    help="a zoom lens's position for frames without a zoom column: a focal length with its unit "

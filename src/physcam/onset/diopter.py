@@ -50,9 +50,11 @@ class CloseUp(NamedTuple):
 def close_up(focal_length_mm: float, fstop: float, coc_mm: float, focus_mm: float, diopter: float) -> CloseUp:
     """A +``diopter`` close-up lens on a thin lens of ``focal_length_mm`` at ``fstop``, its focus ring at
     ``focus_mm`` (film plane to subject; ``math.inf`` for infinity), CoC ``coc_mm``."""
-    f = require_positive("focal length", focal_length_mm)
+    from ..optics.coc import require_coc
+
+    f = thinlens.require_focal_length(focal_length_mm)
     n = require_positive("f-stop", fstop, unit="")
-    c = require_positive("circle of confusion", coc_mm)
+    c = require_coc(coc_mm)
     p = require_positive("diopter", diopter, unit="dioptres")  # a close-up lens converges
     if p > 20.0:
         raise InputError(f"+{p:g} dioptres is a 50 mm magnifier, not a close-up lens; give the power in dioptres")

@@ -28,7 +28,7 @@ from .._record import record
 from ..errors import InputError, require_finite, require_positive, require_type
 from ..optics.sensors import Sensor
 from ..optics.state import HYPERFOCAL
-from ..optics.thinlens import MAX_F_NUMBER, MIN_F_NUMBER, require_f_number
+from ..optics.thinlens import MAX_F_NUMBER, MIN_F_NUMBER, require_f_number, require_focal_length
 
 __all__ = ["report_camera", "ReportInputs", "MeasuredLimits", "References", "ReportRequest", "INPUTS", "HYPERFOCAL",
            "DIFFRACTION_WAVELENGTH_NM", "MIN_F_NUMBER", "MAX_F_NUMBER", "MAX_DISTANCE_MM"]
@@ -250,10 +250,7 @@ def _check_lens_or_datasheet(r) -> dict:
     if r.lens is None:
         if r.focal_length_mm is None:
             raise InputError("give the focal length (--focal) or a lens (--lens)")
-        f = require_positive("focal length", r.focal_length_mm)
-        if f > 1.0e5:
-            raise InputError(f"focal length {f:g} mm is beyond any camera lens; give it in mm (e.g. --focal 50)")
-        return {"focal_length_mm": f}
+        return {"focal_length_mm": require_focal_length(r.focal_length_mm)}
     from ..lens.prescription import Prescription
 
     require_type("lens", r.lens, Prescription, "physcam.lens.library.load_lens(name or file)")

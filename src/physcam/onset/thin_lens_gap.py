@@ -44,14 +44,15 @@ class ThinLensGap(OfACamera):
     bokeh: tuple[tuple[float, float, float, float], ...] = ()
     notes: tuple[str, ...] = field(default_factory=tuple)
 
-    def summary(self) -> str:
-        """One line for a note or a script's comment."""
+    def summary(self, units: str = "m") -> str:
+        """One line for a note or a script's comment, its distances in ``units`` (``--units``): metres to three
+        figures (``m``, what files carry), or feet and inches (``ft``, :func:`physcam.units.format_distance`)."""
         parts = []
         if self.hfov_difference_pct is not None:
             parts.append(f"horizontal field of view {self.hfov_difference_pct:+.2f} %")
         for light, _, _, pct in self.bokeh:
-            parts.append(f"bokeh {pct:+.0f} % for a light {light / 1000.0:.3g} m from the film")
-        focus = "infinity" if math.isinf(self.focus_from_film_mm) else f"{self.focus_from_film_mm / 1000.0:.3g} m"
+            parts.append(f"bokeh {pct:+.0f} % for a light {_distance(light, units)} from the film")
+        focus = "infinity" if math.isinf(self.focus_from_film_mm) else _distance(self.focus_from_film_mm, units)
         what = "; ".join(parts) if parts else "not measured"
         return (f"a thin-lens camera is not {self.lens_name} at f/{self.fstop:.3g}, focus {focus}: "
                 f"{what} (thin lens against the real lens's traced rays)")
@@ -67,6 +68,13 @@ class ThinLensGap(OfACamera):
                           "film of an on-axis point light",
             "notes": list(self.notes),
         }
+
+
+def _distance(mm: float, units: str) -> str:
+    """A distance of :meth:`ThinLensGap.summary`: metres to three figures, or feet and inches."""
+    from ..units import format_distance
+
+    return format_distance(mm, "ft") if units == "ft" else f"{mm / 1000.0:.3g} m"
 
 
 def _thin_lens_blur_mm(report, light_from_film_mm: float) -> float:

@@ -10,7 +10,7 @@ conventions below are the ones camera departments actually quote.
   picture value (ACM 1986, quoted by DOFMaster): "Super 35 cine", what pullers' apps default to.
 - ``full-frame``: 0.03 mm, the full-frame (36 x 24) still value of DOFMaster and Canon.
 - ``16mm``: 0.015 mm, the ACM's 16 mm motion picture value (quoted by DOFMaster).
-- a number: the user's own value in mm.
+- a number: the user's own value in mm, from :data:`MIN_COC_MM` to :data:`MAX_COC_MM` (:func:`require_coc`).
 
 See ``reference/formats/coc_conventions.csv`` in the shared data for sources.
 """
@@ -21,8 +21,8 @@ import math
 
 from ..errors import InputError, require_positive
 
-__all__ = ["COC_CONVENTIONS", "DEFAULT_COC_CONVENTION", "circle_of_confusion", "named_circle_of_confusion",
-           "parse_coc"]
+__all__ = ["COC_CONVENTIONS", "DEFAULT_COC_CONVENTION", "MIN_COC_MM", "MAX_COC_MM", "require_coc",
+           "circle_of_confusion", "named_circle_of_confusion", "parse_coc"]
 
 #: name -> (description, function of (width_mm, height_mm) -> coc_mm)
 COC_CONVENTIONS = {
@@ -38,6 +38,26 @@ _ALIASES = {"zeiss": "d/1500", "modern": "d/1500", "traditional": "d/1000", "acm
             "s16": "16mm", "0.015": "16mm"}
 
 DEFAULT_COC_CONVENTION = "d/1500"
+
+#: The circles of confusion a person may give (mm). The values camera departments use run from 0.0127 mm
+#: (1/2000 in, Panavision's "hard look") to 0.0508 mm (1/500 in, heavy diffusion; Panaflex User's Manual) and
+#: 0.05 mm (historic 35 mm tables); the diagonal rules give 0.0084 mm (Super 16, d/1730) to 0.088 mm (IMAX 15/70,
+#: d/1000), the widest format in the shared reference/formats tables. 1 um is a third of the finest photosite in
+#: the camera table (2.99 um, LUMIX GH6) and about the Airy disk of an f/0.75 lens (2.44 x 0.55 um x 0.75); 1 mm is
+#: 11 times IMAX's d/1000 and three times 8 x 10 in sheet film's (0.33 mm). Beyond them a value is a slip
+#: (``--coc 5m``, ``1e-300``) whose hyperfocal distance means nothing.
+MIN_COC_MM = 0.001
+MAX_COC_MM = 1.0
+
+
+def require_coc(value, name: str = "circle of confusion") -> float:
+    """``value`` (mm) as a float if a circle of confusion may be that (:data:`MIN_COC_MM` to :data:`MAX_COC_MM`),
+    else an :class:`InputError` in one line."""
+    c = require_positive(name, value)
+    if not MIN_COC_MM <= c <= MAX_COC_MM:
+        raise InputError(f"{name} {c:g} mm is out of range: give {MIN_COC_MM:g} mm (1 um) to {MAX_COC_MM:g} mm "
+                         f"(0.025 mm is Super 35 cine), or a convention such as d/1500")
+    return c
 
 
 def circle_of_confusion(width_mm: float, height_mm: float, convention: str | float | None = None):
@@ -56,7 +76,7 @@ def circle_of_confusion(width_mm: float, height_mm: float, convention: str | flo
     if convention is None:
         convention = DEFAULT_COC_CONVENTION
     if isinstance(convention, (int, float)):
-        return require_positive("circle of confusion", convention), "user"
+        return require_coc(convention), "user"
     key = str(convention).strip().lower()
     key = _ALIASES.get(key, key)
     if key in COC_CONVENTIONS:
@@ -72,7 +92,7 @@ def circle_of_confusion(width_mm: float, height_mm: float, convention: str | flo
             f"unknown circle-of-confusion convention {convention!r}{hint}; "
             f"use one of {', '.join(COC_CONVENTIONS)} or a value in mm"
         ) from None
-    return require_positive("circle of confusion", value), "user"
+    return require_coc(value), "user"
 
 
 def named_circle_of_confusion(width_mm: float, height_mm: float, convention: str | float | None = None):
@@ -91,8 +111,8 @@ def named_circle_of_confusion(width_mm: float, height_mm: float, convention: str
 def parse_coc(text):
     """A circle of confusion as written by a person: a convention name (``d/1500``, ``cine``, ...)
     stays text (checked by :func:`circle_of_confusion` against the sensor); a number with an
-    optional unit (``0.025``, ``25um``, ``0.025mm``; a bare number is mm) becomes a float in mm.
-    A malformed length is an InputError; None stays None."""
+    optional unit (``0.025``, ``25um``, ``0.025mm``; a bare number is mm) becomes a float in mm, within
+    :func:`require_coc`'s bounds. A malformed length or one out of bounds is an InputError; None stays None."""
     from ..units import parse_distance
 
     if text is None:
@@ -100,10 +120,12 @@ def parse_coc(text):
     if str(text).strip().lower() in COC_CONVENTIONS or str(text).strip().lower() in _ALIASES:
         return str(text).strip()  # a name, though it starts with a digit ("16mm")
     try:
-        return float(text)
+        value = float(text)
     except ValueError:
-        pass
+        value = None
+    if value is not None:
+        return require_coc(value)
     t = str(text).strip()
     if t and (t[0].isdigit() or t[0] in ".+-") and "/" not in t:
-        return parse_distance(t, name="circle of confusion")
+        return require_coc(parse_distance(t, name="circle of confusion"))
     return text

@@ -142,9 +142,7 @@ class _OnTheFilm:
     flange_focal_distance_mm: float | None = None
 
     def __post_init__(self):
-        f = require_positive("focal length", self.focal_length_mm)
-        if f > 1.0e5:
-            raise InputError(f"focal length {f:g} mm is beyond any camera lens; give it in mm (e.g. --focal 50)")
+        f = thinlens.require_focal_length(self.focal_length_mm)
         sq = require_positive("anamorphic squeeze", self.squeeze, unit="")
         if not 0.1 <= sq <= 10.0:
             raise InputError(f"anamorphic squeeze must lie between 0.1 and 10, got {sq:g}")

@@ -23,6 +23,9 @@ __all__ = [
     "MIN_F_NUMBER",
     "MAX_F_NUMBER",
     "require_f_number",
+    "MIN_FOCAL_LENGTH_MM",
+    "MAX_FOCAL_LENGTH_MM",
+    "require_focal_length",
     "image_distance",
     "object_distance",
     "magnification",
@@ -50,6 +53,29 @@ def require_f_number(name: str, value) -> float:
                else f"f-numbers above {MAX_F_NUMBER:g} are not camera apertures")
         raise InputError(f"{name} {v:g} is out of range: {why}")
     return v
+
+
+#: The shortest focal length accepted (mm): the shortest lenses made for cameras are phones' ultra-wides (1.54 mm
+#: in the iPhone 11 to 15's EXIF) and board cameras' fisheyes of about 1 mm; a lens-set file's floor too
+#: (onset/lens_set.py). Below it a value is a slip (``--focal 0.001`` gave "hyperfocal 0.0 mm").
+MIN_FOCAL_LENGTH_MM = 1.0
+#: The longest (mm): 100 m, far beyond any camera lens (the longest made are about 5 m, Canon's 5200 mm f/14).
+MAX_FOCAL_LENGTH_MM = 1.0e5
+
+
+def require_focal_length(value, name: str = "focal length") -> float:
+    """``value`` (mm) as a float between :data:`MIN_FOCAL_LENGTH_MM` and :data:`MAX_FOCAL_LENGTH_MM`, else an
+    InputError in one line (the one focal-length range of the thin-lens and datasheet models, the on-set
+    report, close-up lenses and the CLI's ``--focal``)."""
+    from ..errors import InputError, require_positive
+
+    f = require_positive(name, value)
+    if f > MAX_FOCAL_LENGTH_MM:
+        raise InputError(f"{name} {f:g} mm is beyond any camera lens; give it in mm (e.g. --focal 50)")
+    if f < MIN_FOCAL_LENGTH_MM:
+        raise InputError(f"{name} {f:g} mm is shorter than any camera lens (at least {MIN_FOCAL_LENGTH_MM:g} mm); "
+                         "give it in mm (e.g. --focal 50)")
+    return f
 
 
 def image_distance(focal_length, object_distance):

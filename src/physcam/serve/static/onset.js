@@ -48,21 +48,28 @@
     return v;
   }
 
+  // typographic foot marks (U+2019, U+2018, U+2032) as ', inch marks (U+201D, U+201C, U+2033) as ", and two
+  // foot marks as an inch mark (6'' or 6’’ is 6 inches): physcam.units.plain_marks
+  function plainMarks(text) {
+    return text.replace(/[\u2019\u2018\u2032]/g, "'").replace(/[\u201d\u201c\u2033]/g, '"').replace(/''/g, '"');
+  }
+
   function parseDistance(text, name = "distance", allowInf = false) {
     if (typeof text === "number") return text;
     const s = String(text).trim();
+    const t = plainMarks(s); // refusals quote what was typed, s
     if (INFINITY_WORDS.includes(s.toLowerCase())) {
       if (allowInf) return Infinity;
       fail(`${name} must be finite, got '${s}'`);
     }
     let v;
-    let m = /['"/]/.test(s) || /\d\s*(ft|feet|foot)\s*\d/.test(s) ? FEET_INCHES.exec(s) : null;
-    m = m || (s.includes("/") ? FEET_BARE_INCHES.exec(s) : null);
+    let m = /['"/]/.test(t) || /\d\s*(ft|feet|foot)\s*\d/.test(t) ? FEET_INCHES.exec(t) : null;
+    m = m || (t.includes("/") ? FEET_BARE_INCHES.exec(t) : null);
     if (m && (m[1] !== undefined || m.slice(2).some((g) => g !== undefined))) {
       v = Math.abs(Number(m[1] || 0.0)) * 304.8 + inches(...m.slice(2, 7)) * 25.4;
-      if (s.startsWith("-")) v = -v;
+      if (t.startsWith("-")) v = -v;
     } else {
-      m = SIMPLE.exec(s);
+      m = SIMPLE.exec(t);
       if (!m) fail(`cannot read ${name} '${s}': write a number with an optional unit, e.g. 3m, 10ft, 6in, 450mm`);
       v = toMm(Number(m[1]), m[2] || "mm");
     }
@@ -107,6 +114,17 @@
     return v;
   }
 
+  // the focal lengths of camera lenses, mm (physcam.optics.thinlens.require_focal_length)
+  const MIN_FOCAL_LENGTH_MM = 1.0;
+  const MAX_FOCAL_LENGTH_MM = 1.0e5;
+
+  function requireFocalLength(f, name = "focal length") {
+    positive(name, f);
+    if (f > MAX_FOCAL_LENGTH_MM) fail(`${name} ${f} mm is beyond any camera lens; give it in mm (e.g. --focal 50)`);
+    if (f < MIN_FOCAL_LENGTH_MM) fail(`${name} ${f} mm is shorter than any camera lens (at least ${MIN_FOCAL_LENGTH_MM} mm); give it in mm (e.g. --focal 50)`);
+    return f;
+  }
+
   function requireDistance(name, v) {
     positive(name, v);
     if (v > MAX_DISTANCE_MM) fail(`${name} ${v} mm is beyond 1000 km; for a subject at infinity use a far limit of inf`);
@@ -135,6 +153,19 @@
     { name: "16mm", kind: "fixed", value: 0.015, aliases: ["s16", "0.015"] },
   ]);
 
+  // the circles of confusion a person may give, mm (physcam.optics.coc.MIN_COC_MM, MAX_COC_MM, require_coc)
+  const MIN_COC_MM = 0.001;
+  const MAX_COC_MM = 1.0;
+
+  function requireCoc(v) {
+    if (!Number.isFinite(v)) fail(`circle of confusion must be a finite number, got ${v}`);
+    if (v <= 0) fail(`circle of confusion must be greater than 0 mm, got ${v}`);
+    if (!(v >= MIN_COC_MM && v <= MAX_COC_MM)) {
+      fail(`circle of confusion ${v} mm is out of range: give ${MIN_COC_MM} mm (1 um) to ${MAX_COC_MM} mm (0.025 mm is Super 35 cine), or a convention such as d/1500`);
+    }
+    return v;
+  }
+
   function cocRule(conv, w, h) {
     return conv.kind === "diagonal" ? Math.hypot(w, h) / conv.value : conv.value;
   }
@@ -145,19 +176,15 @@
     const name = String(text).trim().toLowerCase();
     if (name in COC_CONVENTIONS || name in COC_ALIASES) return String(text).trim(); // "16mm" is a name
     const f = pyFloat(text);
-    if (f !== undefined) return f;
+    if (f !== undefined) return requireCoc(f);
     const t = String(text).trim();
-    if (t && /^[0-9.+-]/.test(t) && !t.includes("/")) return parseDistance(t, "circle of confusion");
+    if (t && /^[0-9.+-]/.test(t) && !t.includes("/")) return requireCoc(parseDistance(t, "circle of confusion"));
     return text;
   }
 
   function circleOfConfusion(w, h, convention) {
     if (convention === null || convention === undefined) convention = "d/1500";
-    if (typeof convention === "number") {
-      if (!Number.isFinite(convention) || Number.isNaN(convention)) fail(`circle of confusion must be a finite number, got ${convention}`);
-      if (convention <= 0) fail(`circle of confusion must be greater than 0 mm, got ${convention}`);
-      return [convention, "user"];
-    }
+    if (typeof convention === "number") return [requireCoc(convention), "user"];
     let key = String(convention).trim().toLowerCase();
     key = COC_ALIASES[key] || key;
     if (key in COC_CONVENTIONS) return [cocRule(COC_CONVENTIONS[key], w, h), key];
@@ -165,9 +192,7 @@
     if (v === undefined) {
       fail(`unknown circle-of-confusion convention '${convention}'; use one of ${Object.keys(COC_CONVENTIONS).join(", ")} or a value in mm`);
     }
-    if (!Number.isFinite(v)) fail(`circle of confusion must be a finite number, got ${v}`);
-    if (v <= 0) fail(`circle of confusion must be greater than 0 mm, got ${v}`);
-    return [v, "user"];
+    return [requireCoc(v), "user"];
   }
 
   function namedCoc(w, h, given, c, name) {
@@ -313,8 +338,7 @@
     }
     positive("anamorphic squeeze", r.squeeze, "");
     if (!(r.squeeze >= 0.1 && r.squeeze <= 10)) fail(`anamorphic squeeze must lie between 0.1 and 10, got ${r.squeeze}`);
-    positive("focal length", r.focal);
-    if (r.focal > 1.0e5) fail(`focal length ${r.focal} mm is beyond any camera lens; give it in mm (e.g. --focal 50)`);
+    requireFocalLength(r.focal);
     if (r.fstop !== null) requireFNumber("f-stop", r.fstop);
     if (r.tstop !== null) requireFNumber("T-stop", r.tstop);
     const limits = r.near !== null || r.far !== null;
@@ -751,7 +775,7 @@
 
   function closeUp(f, n, c, mark, p) {
     // a +p diopter in contact with a thin lens at its principal plane (physcam.onset.diopter.close_up)
-    positive("focal length", f); positive("f-stop", n, ""); positive("circle of confusion", c);
+    requireFocalLength(f); positive("f-stop", n, ""); requireCoc(c);
     positive("diopter", p, "dioptres");
     if (p > 20.0) fail(`+${p} dioptres is a 50 mm magnifier, not a close-up lens; give the power in dioptres`);
     const s = objectDistanceForMarked(f, mark);
@@ -788,7 +812,7 @@
       given_far_from_film_mm: given && given.dof.far_from_film_mm };
   }
 
-  const api = { ReportError, solveReport, report, parseDistance, exposureStops, compensate, closeUp, splitFocus, parseCoc, circleOfConfusion, setCocConventions,
+  const api = { ReportError, solveReport, report, plainMarks, parseDistance, exposureStops, compensate, closeUp, splitFocus, parseCoc, circleOfConfusion, setCocConventions,
     findSensor, cameraNameNote, hyperfocalDistance, dofLimits, imageDistance, objectDistanceForMarked, stopsBetween, fovDeg,
     HYPERFOCAL, COC_CONVENTIONS };
   root.PhysOnset = api;
