@@ -106,6 +106,34 @@ def test_a_new_setup_opens_from_the_cache_with_the_server_stopped(capsys):
 
 
 
+def test_a_report_opened_in_a_tab_does_not_become_the_offline_page(capsys):
+    """The page links its report as JSON (#json-link). The worker kept whatever a navigation answered as "/":
+    one tap on the link, and with the server stopped every setup opened the raw JSON instead of the page (a
+    review found it). Now only "/" is kept as the page: after the tap, a setup still opens offline and shows
+    `physcam report`'s numbers."""
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--disable-dev-shm-usage"])
+        try:
+            ctx = b.new_context()
+            pg = ctx.new_page()
+            pg.set_default_timeout(30_000)
+            with running_server() as (url, _port, proc):
+                pg.goto(f"{url}?focal=35&fstop=4&focus=2m&sensor=S35")
+                pg.wait_for_selector("body[data-ready='1'][data-worker='ready']")
+                pg.wait_for_function("async () => navigator.serviceWorker.controller !== null"
+                                     " && !!(await caches.match('/')) && !!(await caches.match('/static/onset.js'))")
+                pg.wait_for_selector("#json-link[href*='/api/report']")
+                pg.click("#json-link")
+                pg.wait_for_function("() => document.body && document.body.textContent.includes('physcam.lens_report')")
+            assert proc.poll() is not None  # the laptop is off
+            pg.goto(f"{url}?focal=50&fstop=2.8&focus=3m&sensor=S35")
+            pg.wait_for_selector("body[data-ready='1'][data-source='page'][data-offline='1']")
+            assert_numbers(pg, cli_report(capsys, "--focal", "50", "--fstop", "2.8", "--focus", "3m", "--sensor", "S35"))
+            ctx.close()
+        finally:
+            b.close()
+
+
 def the_done_when_path(pg, url, capsys):
     """Issue 46's done-when, as a puller does it with the laptop off: a 390 x 844 phone opens the page from its
     cache, picks the camera "Sony FX6" then its format "FF 4K 17:9", a lens of their set (typed on the phone) and a

@@ -5,7 +5,9 @@
 // page, which reads the setup from its own URL. Charts, real lenses and diagrams need the server.
 "use strict";
 
-const CACHE = "physcam-v1";
+// v2: v1 kept any page opened in a tab (a report's JSON, a chart's SVG) as "/", the page itself (round 22);
+// the new name empties every v1 cache when this worker takes over
+const CACHE = "physcam-v2";
 const SHELL = ["/", "/static/app.js", "/static/onset.js", "/static/tools.js", "/static/app.css",
   "/static/icon.svg", "/static/icon-192.png", "/manifest.webmanifest", "/api/sensors"];
 // answers kept whenever they come: the catalogues the page needs to compute alone
@@ -24,7 +26,8 @@ self.addEventListener("activate", (event) => {
 function keep(request) {
   const url = new URL(request.url);
   if (url.origin !== self.location.origin || request.method !== "GET") return null;
-  if (request.mode === "navigate" || url.pathname === "/") return "/";
+  if (url.pathname === "/") return "/"; // the page, whatever setup its URL carries; never another page opened
+  if (request.mode === "navigate") return null; // a report's JSON or a chart opened in a tab: the server's
   if (SHELL.includes(url.pathname) || KEPT.includes(url.pathname)) return url.pathname;
   return null;
 }
