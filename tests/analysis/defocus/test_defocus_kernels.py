@@ -320,3 +320,29 @@ def test_fans_in_single_precision_land_where_double_precision_rays_from_the_obje
         assert (ok != (fan.w > 0)).sum() <= n // 1000
         assert np.hypot(fan.ox[both] - ox[both], fan.oy[both] - oy[both]).max() * cam.pitch_mm < 5e-4
         np.testing.assert_allclose(fan.w[both], w[both], rtol=1e-12)
+
+
+def test_field_positions_without_light_are_said_not_left_black_in_silence():
+    """At f/1000 on dgauss_50mm the kernels' pupil search found no light toward the frame's corners (its
+    entrance pupil is 0.05 mm there), and `physcam defocus` wrote black corners with only numpy's RuntimeWarning
+    (a review found it: at f/22 to f/300 the corner keeps about cos^4 of the centre's light). Such positions are
+    now said in a PhysCamWarning; at f/22 nothing is said and no position is dark."""
+    import warnings
+
+    from physcam.analysis.defocus.field import field_table
+    from physcam.analysis.defocus.kernels import defocus_camera
+    from physcam.errors import PhysCamWarning
+    from physcam.lens.library import load_lens
+    from physcam.optics.state import camera_state
+
+    for fstop, dark in ((1000.0, True), (22.0, False)):
+        cam = defocus_camera(camera_state(load_lens("dgauss_50mm"), focus_mm=600.0, fstop=fstop, sensor="S35"),
+                             width=96, height=64)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            table = field_table(cam, None, {cam.node_far()})
+        said = [w for w in caught if issubclass(w.category, PhysCamWarning) and "no light reached" in str(w.message)]
+        assert not [w for w in caught if issubclass(w.category, RuntimeWarning)]
+        assert bool(said) == dark, [str(w.message) for w in caught]
+        t = table.transmission[cam.node_far()]
+        assert (t.max(axis=1) <= 0).any() == dark and t[0].max() == pytest.approx(1.0)
