@@ -58,6 +58,20 @@ def _text(m, cal) -> str:
     return "\n".join(lines)
 
 
+#: Characters of the sheet's text a line holds: its panel (two thirds of an A4 page's width, 7.8 in) in 7 pt
+#: monospace (0.6 em a character, 4.2 pt), with room to spare. A longer line (a verdict with its reasons) ran off
+#: the page, and tight_layout, unable to make room for it, left the sheet unlaid with a warning (round 22).
+TEXT_CHARS = 120
+
+
+def _wrapped(text: str) -> str:
+    """``text``'s lines cut at words to :data:`TEXT_CHARS`, a cut line's rest indented."""
+    import textwrap
+
+    return "\n".join("\n".join(textwrap.wrap(line, TEXT_CHARS, subsequent_indent="    ")) or line
+                     for line in text.split("\n"))
+
+
 @styled
 def calibration_sheet(calibration, path=None, *, force: bool = False):
     """The sheet of ``calibration`` (a :class:`~physcam.analysis.calibration.calibrate.Calibration`); written to
@@ -94,7 +108,7 @@ def calibration_sheet(calibration, path=None, *, force: bool = False):
         ax.axis("off")
     ax = fig.add_subplot(gs[1, :2])
     ax.axis("off")
-    ax.text(0.0, 1.0, _text(m, calibration), va="top", family="monospace", fontsize=7)
+    ax.text(0.0, 1.0, _wrapped(_text(m, calibration)), va="top", family="monospace", fontsize=7)
     fig.suptitle(f"physcam calibration sheet: {calibration.lens_name}", fontsize=11)
     fig.tight_layout()
     return fig if path is None else save_figure(fig, path, force=force)
