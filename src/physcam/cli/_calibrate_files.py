@@ -169,6 +169,15 @@ def _folder(out: Path, m, several: bool) -> Path:
                   else f"focus_{m.mark_mm:.0f}mm")
 
 
+def sensor_of(args):
+    """The command line's sensor, resolved once (its note said once)."""
+    from ._common import resolve_sensor
+
+    if not hasattr(args, "_sensor_obj"):
+        args._sensor_obj = resolve_sensor(args)
+    return args._sensor_obj
+
+
 def check_outputs(args) -> dict:
     """Every option, output and image header checked before the fit; returns the plan: the folder's
     ``force`` and the USD file's target (:func:`physcam.usd.kit.characterization_target`), or None."""
@@ -205,6 +214,11 @@ def check_outputs(args) -> dict:
         if size != first[0]:
             what = "flat fields of the same camera mode" if p in flats else "images of one camera mode"
             raise InputError(f"{p}: {size[0]}x{size[1]} px, but {first[1]} is {first[0][0]}x{first[0][1]}: give {what}")
+    if first is not None:  # the sensor's recorded area against the images' pixels, before the charts are looked for
+        from ..analysis.calibration.calibrate import photosite_pitch
+
+        s = sensor_of(args)
+        photosite_pitch(first[0], (s.width_mm, s.height_mm))
     usd = None
     if args.usd is not None:
         import datetime as _dt

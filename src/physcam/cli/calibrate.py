@@ -131,6 +131,7 @@ def _views(args, lens):
 
     from ..analysis.calibration.chart import ChartSpec, detect_views, image_files
     from ..errors import InputError
+    from ._calibrate_files import sensor_of
     from ._common import resolve_focus
 
     if args.focus is not None and args.marks is not None:
@@ -153,22 +154,15 @@ def _views(args, lens):
             marks.append(m)
     else:
         marks = [args.focus] * len(paths)
-    sensor = _sensor(args)
+    sensor = sensor_of(args)
     marks = [None if m is None else resolve_focus(m, lens=lens, sensor=sensor, args=args) for m in marks]
     return detect_views(paths, chart, marks, max_pixels=args.max_pixels)
-
-
-def _sensor(args):
-    from ._common import resolve_sensor
-
-    if not hasattr(args, "_sensor_obj"):
-        args._sensor_obj = resolve_sensor(args)
-    return args._sensor_obj
 
 
 def compute(args):
     """The calibration of the command line (nothing written)."""
     from ..analysis.calibration.calibrate import calibrate_views
+    from ._calibrate_files import sensor_of
 
     lens = None
     if args.lens is not None:
@@ -177,7 +171,7 @@ def compute(args):
         lens = load_lens(args.lens)
     args.loaded_lens = lens
     views = _views(args, lens)
-    s = _sensor(args)
+    s = sensor_of(args)
     name = lens.name if lens is not None else "measured"
     cal = calibrate_views(views, (s.width_mm, s.height_mm), lens_name=name, bootstrap=args.bootstrap,
                           max_residual_px=args.max_residual)

@@ -252,6 +252,16 @@ def test_options_are_checked_before_the_fit(tmp_path, capsys, blank, extra, word
     _refused(capsys, [a.format(tmp=tmp_path) for a in argv], words, tmp_path / "o")
 
 
+def test_a_sensor_whose_photosites_would_not_be_square_is_refused_before_detection(tmp_path, capsys, blank):
+    """1280 x 960 px images and a 36 x 24 mm sensor: 0.028 mm a pixel across, 0.025 down. The refusal came after
+    OpenCV had searched every photograph for the chart (7.7 s on a review's eight); the images' headers say the size,
+    so it now comes with the other checks before the fit: the blank image (no chart) shows detection never ran."""
+    argv = ["calibrate", str(blank), "--sensor-width", "36", "--sensor-height", "24", *CHARUCO_ARGS[4:],
+            "-o", str(tmp_path / "o")]
+    _refused(capsys, argv, ["the images are 1280x960 px but the sensor is 36 x 24 mm: the photosites would not be "
+                            "square"], tmp_path / "o")
+
+
 def test_an_existing_lens_file_variant_and_a_foreign_folder_are_refused_before_the_fit(tmp_path, capsys, blank):
     pytest.importorskip("pxr")
     from physcam.lens.library import load_lens

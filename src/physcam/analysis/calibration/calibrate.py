@@ -246,6 +246,19 @@ def _bootstrap(views, size, aspect, fix_aspect, guess, pitch, n, seed):
             "field_rms_px": float(field_std), "field_std_px": fields.std(axis=0, ddof=1)}
 
 
+def photosite_pitch(size_px, sensor_mm, *, square: bool = True) -> tuple[float, float]:
+    """(x, y) mm per pixel of images of ``size_px`` (width, height) recording a sensor area of ``sensor_mm``;
+    with ``square``, an InputError where the two differ by over 1 % (the calibration fixes fx / fy to them)."""
+    sw, sh = (require_positive("sensor width", sensor_mm[0], unit="mm"),
+              require_positive("sensor height", sensor_mm[1], unit="mm"))
+    pitch = (sw / size_px[0], sh / size_px[1])
+    if square and abs(pitch[0] / pitch[1] - 1.0) > 0.01:
+        raise InputError(f"the images are {size_px[0]}x{size_px[1]} px but the sensor is {sw:g} x {sh:g} mm: the "
+                         "photosites would not be square; give the sensor's recorded area (--sensor-width/"
+                         "--sensor-height)")
+    return pitch
+
+
 def calibrate_mark(views, sensor_mm, *, fix_aspect: bool = True, bootstrap: int = 30, seed: int = 0,
                    max_residual_px: float = DEFAULT_MAX_RESIDUAL_PX, models=("brown", "3de4", "usd"),
                    lens_name: str = "measured") -> MarkCalibration:
@@ -257,12 +270,8 @@ def calibrate_mark(views, sensor_mm, *, fix_aspect: bool = True, bootstrap: int 
         raise InputError(f"{len(views)} view{'s' if len(views) != 1 else ''} of the chart"
                          f"{_at(views)}: calibrating needs {MIN_VIEWS} or more, at several angles")
     size = views[0].size_px
-    sw, sh = (require_positive("sensor width", sensor_mm[0], unit="mm"),
-              require_positive("sensor height", sensor_mm[1], unit="mm"))
-    pitch = (sw / size[0], sh / size[1])
-    if abs(pitch[0] / pitch[1] - 1.0) > 0.01 and fix_aspect:
-        raise InputError(f"the images are {size[0]}x{size[1]} px but the sensor is {sw:g} x {sh:g} mm: the photosites "
-                         "would not be square; give the sensor's recorded area (--sensor-width/--sensor-height)")
+    pitch = photosite_pitch(size, sensor_mm, square=fix_aspect)
+    sw, sh = sensor_mm
     aspect = pitch[1] / pitch[0]  # fx / fy for square-on-the-sensor pixels
     bootstrap = _bootstrap_count(bootstrap)
     rms, K, dist, per_view, std_in = _calibrate(views, size, aspect, fix_aspect)
