@@ -93,8 +93,8 @@ def test_compare_focus_in_feet_by_hand(capsys):
      "--squeeze", "2"],
 ])
 def test_dof_table_csv_is_the_shared_rule(argv, capsys, tmp_path, monkeypatch):
-    """dof-table's --csv (its own conversion, cli/dof_table.csv_rows) is byte for byte the shared rule's
-    (cli/_output.csv_in_units) on its JSON rows, in feet and in metres."""
+    """dof-table's --csv is byte for byte the shared rule's (cli/_output.csv_in_units) on its JSON rows, in feet
+    and in metres (its own conversion, cli/dof_table.csv_rows, gave these very bytes: round 22 replaced it)."""
     monkeypatch.setenv("HOME", str(tmp_path))
     monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path))
     rows = json.loads(_run(capsys, [*argv, "--json"]))["rows"]

@@ -180,23 +180,6 @@ def grid(d, units, horizontal: bool = False):
     return labels, [f"f/{n:g}" for n in fs], cells
 
 
-def csv_rows(d, units) -> list[dict]:
-    """The rows for --csv: the JSON rows in mm, or with --units ft every distance in decimal feet
-    (columns named ``*_ft``), the millimetres divided by 304.8."""
-    if units == "m":
-        return d["rows"]
-    out = []
-    for r in d["rows"]:
-        q = {}
-        for k, v in r.items():
-            if k.endswith("_mm") and k != "focal_length_mm":
-                q[k[:-3] + "_ft"] = None if v is None else v / 304.8
-            else:
-                q[k] = v
-        out.append(q)
-    return out
-
-
 def run(args) -> int:
     from ..io import check_writable
     from ._common import units_of
@@ -224,7 +207,7 @@ def run(args) -> int:
         emit_json(document("dof_table", d))
         return 0
     if args.csv:
-        print_csv(csv_rows(d, units))
+        print_csv(d["rows"], units=units)
         return 0
     labels, heads, cells = grid(d, units)
     t = Table(_title(d, units), ["focus", *(f"{h} near - far" for h in heads)], justify=["left"] + ["right"] * len(heads))
