@@ -12,7 +12,8 @@ USD the ``usd`` extra).
   with the true f-number), and each report's notes say so.
 * :func:`write_usd`: the solved frames through :func:`physcam.live.record.write_recording_usd`
   (the authoring ``physcam live record`` uses), then the clip and the plate on the camera prim:
-  customData ``physcam:source``, ``physcam:clip`` (the static values as JSON text) and
+  customData ``physcam:source``, ``physcam:clip`` (the static values as JSON text; ``drop_frame`` only
+  when true) and
   ``physcam:plate``: a dictionary of ``path`` (as given, a string: a plate that is not there yet or a
   ``####`` sequence pattern is no unresolvable asset for USD's validators) and ``firstFrame`` /
   ``lastFrame``. With a plate frame range the camera is authored on the plate's frame numbers
@@ -203,7 +204,9 @@ def write_usd(file, record, solved, *, plate=None, plate_frames=None, meters_per
         cam = stage.GetPrimAtPath(path)
         cam.SetCustomDataByKey("physcam:source", printable_line(f"{record.source} camera metadata read by physcam "
                                                                 f"metadata usd ({', '.join(Path(f).name for f in record.files)})"))
-        static = {k: v for k, v in record.static_dict().items() if v is not None and k != "notes"}
+        # values the file gives; drop_frame only when true (a non-drop clip's camera stays as before round 22)
+        static = {k: v for k, v in record.static_dict().items()
+                  if v is not None and k != "notes" and (k != "drop_frame" or v)}
         cam.SetCustomDataByKey("physcam:clip", json.dumps(static, sort_keys=True))
         if plate_d:
             cam.SetCustomDataByKey("physcam:plate", plate_d)
