@@ -205,19 +205,21 @@ def test_a_missing_focus_column_is_said_missing_not_a_lens_without_focus(tmp_pat
     assert [(f.timecode, f.tstop) for f in rec.frames] == [(f.timecode, f.tstop) for f in real.frames]
 
 
-def test_a_latin1_copy_names_its_first_non_utf8_byte(tmp_path, capsys):
-    """The real take with "éclair" added to the first row's lens name and saved as Latin-1 (é = 0xE9, the
-    reviewer's latin1b): refused at that byte's offset (found here in the file's bytes) and line 2 as not
-    UTF-8; it was "byte 0: a binary file that is not a Mo-Sys F4 recording"."""
+@pytest.mark.parametrize("row", [1, 100])
+def test_a_latin1_copy_names_its_first_non_utf8_byte(tmp_path, capsys, row):
+    """The real take with "éclair" added to one row's lens name and saved as Latin-1 (é = 0xE9, the reviewer's
+    latin1b): refused at that byte's offset (found here in the file's bytes) and its line as not UTF-8. Row 1
+    (in the first 4 kB, where the format is told) was "byte 0: a binary file that is not a Mo-Sys F4
+    recording"; row 100 (117 kB in) was "line 95: not UTF-8 text", the line the text reader had decoded
+    ahead to."""
     lines = ARRI.read_text(encoding="utf-8").splitlines()
-    lines[1] = lines[1].replace("\tARRI SP40 T1.8\t", "\tARRI SP40 T1.8 éclair\t", 1)
+    lines[row] = lines[row].replace("\tARRI SP40 T1.8\t", "\tARRI SP40 T1.8 éclair\t", 1)
     data = ("\n".join(lines) + "\n").encode("latin-1")
     at = data.index(b"\xe9")
-    assert 0 < at < 4096
     (tmp_path / "latin1.csv").write_bytes(data)
     assert main(["metadata", "show", str(tmp_path / "latin1.csv")]) == 2
     err = capsys.readouterr().err
-    assert f"latin1.csv: byte {at}: not UTF-8 text: byte 0xE9 (line 2)" in err and "binary" not in err
+    assert f"latin1.csv: byte {at}: not UTF-8 text: byte 0xE9 (line {row + 1})" in err and "binary" not in err
 
 
 @pytest.mark.parametrize("encoding, first_nul, order", [("utf-16-le", 1, "little"), ("utf-16-be", 0, "big")])

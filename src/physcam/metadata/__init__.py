@@ -74,7 +74,7 @@ def _head_text(p: Path, head: bytes) -> str:
     MetadataError at the first byte that is not: a NUL byte (binary, or UTF-16 saved without its
     byte-order mark: ASCII text with every other byte 0) or a byte UTF-8 does not allow (a Latin-1 or
     Windows-1252 export: "é" is the one byte 0xE9), named by its offset and line."""
-    from ._text import encoding_of
+    from ._text import encoding_of, not_utf8
 
     if encoding_of(head) == "utf-16":  # a whole number of code units; a pair cut at 4 kB is dropped
         return head[: len(head) // 2 * 2].decode("utf-16", errors="ignore")
@@ -92,9 +92,7 @@ def _head_text(p: Path, head: bytes) -> str:
         at = bom + exc.start
         if len(head) == 4096 and at >= len(head) - 3 and exc.reason == "unexpected end of data":
             return head[bom:at].decode("utf-8")  # a character cut at the 4 kB boundary
-        line = head[:at].count(b"\n") + 1
-        raise MetadataError(f"not UTF-8 text: byte 0x{head[at]:02X} (line {line}) is no UTF-8 character (a Latin-1 "
-                            "or Windows-1252 export writes \u00e9 as 0xE9): save it as UTF-8", p, offset=at) from None
+        raise not_utf8(p, head[at], at, head[:at].count(b"\n") + 1) from None
 
 
 def _missing_columns(first_line: str) -> str | None:
