@@ -144,6 +144,21 @@ def test_the_drop_frame_column_counts_a_colon_timecode_drop_frame(tmp_path):
         load(ndf)
 
 
+def test_the_usd_camera_says_drop_frame_only_of_a_drop_frame_clip(tmp_path):
+    """physcam:clip (the static values as JSON) carries drop_frame true for r2997df, and no drop_frame key for
+    the real 24 fps take, whose USD is thus byte-for-byte what it was before the flag existed."""
+    pytest.importorskip("pxr")
+    from pxr import Usd
+
+    def clip_of(src, name):
+        assert main(["metadata", "usd", str(src), "-o", str(tmp_path / name)]) == 0
+        stage = Usd.Stage.Open(str(tmp_path / name))
+        return json.loads(stage.GetPrimAtPath("/Cameras/Camera").GetCustomDataByKey("physcam:clip"))
+
+    assert clip_of(EDITED / "r2997df.mov.csv", "df.usda")["drop_frame"] is True
+    assert "drop_frame" not in clip_of(ARRI, "ndf.usda")
+
+
 @pytest.mark.parametrize("fps", ["25.000", "24.000"])
 def test_drop_frame_at_a_rate_without_it_is_refused(tmp_path, fps):
     """SMPTE ST 12-1 drops frame numbers at 30000/1001 and 60000/1001 only: a drop-frame clip at 25 or 24 fps
