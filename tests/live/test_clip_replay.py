@@ -71,6 +71,28 @@ def test_an_arri_clip_plays_into_the_recorder_frame_by_frame(tmp_path):
 
 @pytest.mark.slow
 @needs_proc_net_udp
+def test_a_played_drop_frame_clip_records_without_missing_frames(tmp_path):
+    """`live play --clip r2997df` into `live record`: 60 gapless rows through the minute at 29.97 drop-frame;
+    the recorder counted 2 missing (00:00:59;29 -> 00:01:00;02 read as non-drop) before the flag was sent."""
+    pytest.importorskip("pxr")
+    clip = DATA / "arri-edited" / "r2997df.mov.csv"  # the reviewer's copy (its README.txt)
+    proc = subprocess.Popen([sys.executable, "-m", "physcam", "live", "record", str(tmp_path / "take.usda"),
+                             "--port", "0", "--host", "127.0.0.1", "--count", "60", "--duration", "60",
+                             "--fstop", "1.4", "--report", str(tmp_path / "take.csv"), "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    port, _ = recorder_port(proc)
+    assert main(["live", "play", "--clip", str(clip), "--rate", "1000", "--port", str(port), "--cbor"]) == 0
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 0, stderr
+    out = json.loads(stdout)
+    assert out["counters"]["missing"] == 0 and out["frames"] == 60
+    rows = list(csv.DictReader((tmp_path / "take.csv").open()))
+    tcs = [r["Master TC"].strip() for r in csv.DictReader(clip.open(encoding="utf-8"), delimiter="\t")]
+    assert [r["timecode"] for r in rows] == tcs and tcs[9:12] == ["00:00:59;29", "00:01:00;02", "00:01:00;03"]
+
+
+@pytest.mark.slow
+@needs_proc_net_udp
 def test_a_red_clip_sent_with_a_named_lens_records_its_focus_iris_and_breathing(tmp_path, capsys):
     pytest.importorskip("pxr")
     tcs, focus, stop = _red_columns()

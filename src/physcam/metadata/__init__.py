@@ -33,7 +33,6 @@ def detect_file(path) -> tuple[str, str]:
     """(format, role) of one file from its first bytes: role "frames" (the per-frame file),
     "static" (RED's or Canon's static CSV) or "xml" (VENICE's). Unknown content is a MetadataError."""
     from . import arri, arri_json, bmd, canon, mosys, red, venice
-    from ._text import encoding_of
 
     p = Path(path)
     try:
@@ -45,19 +44,7 @@ def detect_file(path) -> tuple[str, str]:
         raise MetadataError("the file is empty", p, 1)
     if mosys.sniff(head):
         return "mosys", "frames"
-    try:
-        if encoding_of(head) == "utf-16":  # a whole number of code units; a pair cut at 4 kB is dropped
-            text = head[: len(head) // 2 * 2].decode("utf-16", errors="ignore")
-        else:
-            text = head.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        if exc.start < len(head) - 4:  # not a character cut at the 4 kB boundary: binary
-            raise MetadataError("a binary file that is not a Mo-Sys F4 recording (no 0xF4 packet with a valid "
-                                "checksum at its start)", p, offset=0) from None
-        text = head[: exc.start].decode("utf-8-sig")
-    if "\0" in text:
-        raise MetadataError("a binary file that is not a Mo-Sys F4 recording (no 0xF4 packet with a valid "
-                            "checksum at its start)", p, offset=0)
+    text = _head_text(p, head)
     if arri_json.sniff(text):
         return "arri-json", "frames"
     first = text.splitlines()[0] if text.splitlines() else ""
@@ -77,6 +64,35 @@ def detect_file(path) -> tuple[str, str]:
         raise MetadataError(missing, p, 1)
     raise MetadataError("unknown column layout: not an ARRI Meta Extract or ARRI Reference Tool JSON, REDline, "
                         "VENICE, Canon, Blackmagic ExtractMetadata or Mo-Sys F4 file", p, 1)
+
+
+_NOT_MOSYS = "a binary file that is not a Mo-Sys F4 recording (no 0xF4 packet with a valid checksum at its start)"
+
+
+def _head_text(p: Path, head: bytes) -> str:
+    """The first bytes of a text file as text (UTF-8, or UTF-16 after its byte-order mark), else a
+    MetadataError at the first byte that is not: a NUL byte (binary, or UTF-16 saved without its
+    byte-order mark: ASCII text with every other byte 0) or a byte UTF-8 does not allow (a Latin-1 or
+    Windows-1252 export: "é" is the one byte 0xE9), named by its offset and line."""
+    from ._text import encoding_of, not_utf8
+
+    if encoding_of(head) == "utf-16":  # a whole number of code units; a pair cut at 4 kB is dropped
+        return head[: len(head) // 2 * 2].decode("utf-16", errors="ignore")
+    nul = head.find(b"\0")
+    if nul >= 0:
+        for order, text, zeros in (("little", head[0:64:2], head[1:64:2]), ("big", head[1:64:2], head[0:64:2])):
+            if len(head) >= 8 and not zeros.strip(b"\0") and all(9 <= b < 127 for b in text):
+                raise MetadataError(f"UTF-16 ({order}-endian) text without a byte-order mark, not UTF-8 text: "
+                                    "save it as UTF-8 (or UTF-16 with its byte-order mark)", p, offset=nul)
+        raise MetadataError(_NOT_MOSYS, p, offset=nul)
+    bom = 3 if head.startswith(b"\xef\xbb\xbf") else 0
+    try:
+        return head[bom:].decode("utf-8")
+    except UnicodeDecodeError as exc:
+        at = bom + exc.start
+        if len(head) == 4096 and at >= len(head) - 3 and exc.reason == "unexpected end of data":
+            return head[bom:at].decode("utf-8")  # a character cut at the 4 kB boundary
+        raise not_utf8(p, head[at], at, head[:at].count(b"\n") + 1) from None
 
 
 def _missing_columns(first_line: str) -> str | None:
@@ -141,4 +157,8 @@ def load(paths) -> ClipRecord:
         record = venice.read(roles["frames"], roles.get("xml"))
     else:
         record = {"red": red.read, "canon": canon.read}[fmt](roles["frames"], roles.get("static"))
+    if not record.drop_frame and any(f.timecode is not None and ";" in f.timecode for f in record.frames):
+        from dataclasses import replace
+
+        record = replace(record, drop_frame=True)  # a ";" timecode is drop-frame, whatever the format
     return check_record(record)

@@ -31,6 +31,41 @@ def encoding_of(head: bytes) -> str:
     return "utf-16" if head[:2] in (b"\xff\xfe", b"\xfe\xff") else "utf-8-sig"
 
 
+def not_utf8(p, byte: int, offset: int, line: int) -> MetadataError:
+    """The refusal of a file whose byte at ``offset`` (on ``line``), ``byte``, is no UTF-8 character (a
+    Latin-1 or Windows-1252 export writes "\u00e9" as the one byte 0xE9)."""
+    return MetadataError(f"not UTF-8 text: byte 0x{byte:02X} (line {line}) is no UTF-8 character (a Latin-1 or "
+                         "Windows-1252 export writes \u00e9 as 0xE9): save it as UTF-8", p, offset=offset)
+
+
+def _decode_error(p: Path, encoding: str) -> MetadataError:
+    """The refusal of a text file that does not decode. UTF-8: the first offending byte, found by reading the
+    file again in 1 MB blocks (the text reader decodes ahead of the line it gives, so its line is not the
+    byte's), with its offset and line; UTF-16: the file, not a position."""
+    if encoding == "utf-16":
+        return MetadataError("not UTF-16 text (a lone surrogate or an odd number of bytes)", p)
+    pos, lines_before, carry = 0, 0, b""
+    with open(p, "rb") as fh:
+        while True:
+            block = fh.read(1 << 20)
+            buf = carry + block
+            if pos == 0 and buf.startswith(b"\xef\xbb\xbf"):
+                buf, pos = buf[3:], 3
+            try:
+                buf.decode("utf-8")
+                carry = b""
+            except UnicodeDecodeError as exc:
+                if not (block and exc.reason == "unexpected end of data"):
+                    return not_utf8(p, buf[exc.start], pos + exc.start,
+                                    lines_before + buf[:exc.start].count(b"\n") + 1)
+                carry = buf[exc.start:]  # a character cut at the block's end: decoded with the next block
+            if not block:
+                return MetadataError("not UTF-8 text", p)
+            done = len(buf) - len(carry)
+            lines_before += buf[:done].count(b"\n")
+            pos += done
+
+
 def read_text(path, limit: int = MAX_BYTES) -> str:
     """A small metadata file (a static CSV, an XML) as text (UTF-8, or UTF-16 with its BOM; a BOM
     dropped); a binary file or a missing one is a MetadataError. Per-frame files are read row by row
@@ -47,8 +82,10 @@ def read_text(path, limit: int = MAX_BYTES) -> str:
     try:
         return data.decode(encoding)
     except UnicodeDecodeError as exc:
-        line = data[: exc.start].decode(encoding, errors="ignore").count("\n") + 1
-        raise MetadataError(f"not {'UTF-16' if encoding == 'utf-16' else 'UTF-8'} text", p, line) from None
+        if encoding == "utf-16":
+            raise _decode_error(p, encoding) from None
+        at = exc.start + (3 if data.startswith(b"\xef\xbb\xbf") else 0)
+        raise not_utf8(p, data[at], at, data[:at].count(b"\n") + 1) from None
 
 
 def _open_text(p: Path):
@@ -82,7 +119,7 @@ def lines(path):
             for n, raw in enumerate(fh, 1):
                 yield n, raw.rstrip("\r\n")
         except UnicodeDecodeError:
-            raise MetadataError("not UTF-8 or UTF-16 text", p, n + 1) from None
+            raise _decode_error(p, fh.encoding) from None
 
 
 def rows(path, delimiter=",") -> tuple[list[str], object]:
@@ -109,7 +146,7 @@ def _header(p, fh, delimiter):
     try:
         first = fh.readline()
     except UnicodeDecodeError:
-        raise MetadataError("not UTF-8 or UTF-16 text", p, 1) from None
+        raise _decode_error(p, fh.encoding) from None
     if callable(delimiter):
         delimiter = delimiter(first.rstrip("\r\n"))
     reader = csv.reader(itertools.chain([first] if first else [], fh), delimiter=delimiter)
@@ -117,9 +154,10 @@ def _header(p, fh, delimiter):
         header = next(reader)
     except StopIteration:
         raise MetadataError("the file is empty", p, 1) from None
-    except (csv.Error, UnicodeDecodeError) as exc:
-        why = "not UTF-8 or UTF-16 text" if isinstance(exc, UnicodeDecodeError) else f"cannot read the header ({exc})"
-        raise MetadataError(why, p, 1) from None
+    except UnicodeDecodeError:
+        raise _decode_error(p, fh.encoding) from None
+    except csv.Error as exc:
+        raise MetadataError(f"cannot read the header ({exc})", p, 1) from None
     return [h.strip() for h in header], reader
 
 
@@ -142,7 +180,7 @@ def _data_rows(p, fh, reader, header):
         except csv.Error as exc:
             raise MetadataError(f"cannot read the row ({exc})", p, reader.line_num) from None
         except UnicodeDecodeError:
-            raise MetadataError("not UTF-8 text", p, reader.line_num + 1) from None
+            raise _decode_error(p, fh.encoding) from None
 
 
 def single_row(path, what: str, columns=()) -> tuple[list[str], int, dict]:
@@ -198,6 +236,27 @@ def number(path, line, name, text, *, empty_none: bool = True) -> float | None:
     if not math.isfinite(v):
         raise MetadataError(f"{name} {t!r} is not a finite number", path, line)
     return v
+
+
+def exact_rate(fps) -> Fraction | None:
+    """A file's frame rate (a number, or an exact Fraction) as the exact fraction every reader gives:
+    an NTSC rate written to two or three decimals (23.976, 29.97, 47.952, 59.94, 119.88) is N x
+    1000/1001 (24000/1001, 30000/1001...: SMPTE ST 12-1's rates), any other the nearest fraction with a
+    denominator up to 1001. The rule of :func:`physcam.live.frames.rate_fraction` (what ``live send
+    --fps`` and ``live record`` use), written here so the readers need no numpy; a value no camera
+    records (0 or negative) is kept for :mod:`.limits` to refuse. None stays None.
+
+    >>> exact_rate(23.976), exact_rate(29.97), exact_rate(25.0), exact_rate(Fraction(30000, 1001))
+    (Fraction(24000, 1001), Fraction(30000, 1001), Fraction(25, 1), Fraction(30000, 1001))
+    """
+    if fps is None:
+        return None
+    r = float(fps)
+    ntsc = round(r * 1.001)
+    if r > 0 and abs(r * 1.001 - ntsc) < 5e-4 and abs(r - ntsc) > 1e-6:
+        return Fraction(ntsc * 1000, 1001)
+    return Fraction(fps) if isinstance(fps, Fraction) and fps.denominator <= 1001 \
+        else Fraction(r).limit_denominator(1001)
 
 
 _STOP = re.compile(r"^\s*T?\s*(\d+(?:\.\d+)?)\s*(?:\+?\s*(\d+)\s*/\s*10)?\s*$")

@@ -4,11 +4,15 @@ or semicolons is read alike: the delimiter is the one with which the header has 
 Fields read (AME 4.4 column names; one row per recorded frame):
 
 * ``Master TC`` (HH:MM:SS:FF; the column appears twice, the first is read), ``Index``;
+  ``Master TC Drop Frame`` ("yes": the timecode is counted drop-frame, SMPTE ST 12-1, whether its
+  text has ``;`` or ``:`` before the frames; a ``;`` timecode is drop-frame whatever the column says);
 * ``Lens Distance Unit`` ("Meter" or "Feet") and ``Lens Focus Distance`` in that unit, the lens
   data system's (LDS) focus mark from the film plane; converted to mm (1 ft = 304.8 mm).
   A value in feet-and-inches notation (``12'6"``) under "Meter" is refused. A lens that reports
-  no focus (no unit, or no focus column: a zoom's focal length read without focus data) leaves
-  the focus absent and the clip's notes say so; its timecode, iris and focal length are kept;
+  no focus (no unit or an empty cell) leaves the focus absent and the clip's notes count the
+  frames; a file without the ``Lens Focus Distance`` column leaves it absent too and the notes
+  say the column is missing (not that the lens reported none); timecode, iris and focal length
+  are kept;
 * ``Lens Iris``: the T-stop as a whole-stop marking plus tenths ("1.4 + 7/10" = T1.4 and 7/10
   of a stop = T1.80); ``Lens Linear Iris``, the same in 1/1000 stop with 1000 = T1
   (T = 2^((L - 1000) / 2000), camdkit's reading), is preferred when present (finer);
@@ -24,10 +28,9 @@ published formats table (LF 16:9 HD and UHD: 31.68 x 17.82 mm, LF Open Gate: 36.
 from __future__ import annotations
 
 import re
-from fractions import Fraction
 
 from ..errors import MetadataError, require_type
-from ._text import FOOT_MM, header_columns, lacking_columns, number, require_columns, rows, stop_from_marking, timecode
+from ._text import FOOT_MM, exact_rate, header_columns, lacking_columns, number, require_columns, rows, stop_from_marking, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -112,6 +115,15 @@ def _frame(path, line, r, no_unit: list) -> FrameSample:
                        focal_length_mm=number(path, line, "focal length", r.get("Lens Focal Length", "")))
 
 
+def _drop_frame(path, line, text, semicolon: int | None) -> bool:
+    """Drop-frame: the first row's ``Master TC Drop Frame`` says "yes", or a timecode has ``;`` before its
+    frames (``semicolon``: the line of the first; SMPTE's drop-frame notation, whatever the column says)."""
+    t = (text or "").strip().lower()
+    if t not in ("", "--", "yes", "no"):
+        raise MetadataError(f"Master TC Drop Frame {text.strip()!r} is neither yes nor no", path, line)
+    return t == "yes" or semicolon is not None
+
+
 def read(path) -> ClipRecord:
     """The clip of one AME CSV (module notes), read row by row."""
     picked = {}
@@ -124,14 +136,17 @@ def read(path) -> ClipRecord:
     require_columns(path, header, REQUIRED, "an ARRI Meta Extract CSV")
     if picked["delimiter"] == ";":  # a decimal-comma locale's copy: "4,812" is 4.812, "1,4 + 7/10" is 1.4 + 7/10
         data = ((line, {k: _DECIMAL_COMMA.sub(r"\1.\2", v) for k, v in r.items()}) for line, r in data)
-    frames, no_unit, first = [], [], None
+    frames, no_unit, first, semicolon = [], [], None, None
     for line, r in data:
         if first is None:
             first = (line, r)
         frames.append(_frame(path, line, r, no_unit))
+        if semicolon is None and ";" in (frames[-1].timecode or ""):
+            semicolon = line
     if first is None:
         raise MetadataError("no frame rows after the header", path, 2)
     line, first = first
+    drop = _drop_frame(path, line, first.get("Master TC Drop Frame"), semicolon)
     g = lambda k: (first.get(k) or "").strip() or None  # noqa: E731
     num = lambda k: number(path, line, k, first.get(k, ""))  # noqa: E731
     w, h = num("Image Width"), num("Image Height")
@@ -149,12 +164,16 @@ def read(path) -> ClipRecord:
         active_area_source="ARRI ALEXA LF formats and resolutions table" if area else None,
         lens_make="ARRI" if lens_model and lens_model.startswith("ARRI ") else None, lens_model=lens_model,
         lens_serial=g("Lens Serial Number"),
-        squeeze=num("Lens Squeeze"), frame_rate=Fraction(str(fps)).limit_denominator(1001) if fps else None,
+        squeeze=num("Lens Squeeze"), frame_rate=exact_rate(fps) if fps else None, drop_frame=drop,
         shutter_angle_deg=num("Shutter Angle"), exposure_time_s=exposure_s,
-        iso=int(iso) if iso is not None else None, notes=_notes(frames, no_unit, first))
+        iso=int(iso) if iso is not None else None,
+        notes=_notes(frames, no_unit, first, "Lens Focus Distance" in header))
 
 
-def _notes(frames, no_unit, first) -> tuple[str, ...]:
+def _notes(frames, no_unit, first, focus_column: bool) -> tuple[str, ...]:
+    if not focus_column:  # the column itself is missing (an edited copy, or an export without lens data)
+        return (f"no 'Lens Focus Distance' column: the file records no focus distance on any of its "
+                f"{len(frames)} frames; timecode, iris and focal length kept",)
     unit = (first.get("Lens Distance Unit") or "").strip()
     if unit in ("Meter", "Feet"):
         notes = [f"focus distances recorded in {'metres' if unit == 'Meter' else 'feet'}, converted to mm"]

@@ -17,7 +17,8 @@ sample clips, whose ARRI Meta Extract CSV of the same day gives the same lens in
 * ``Project Rate`` (``timebase``, ``dropframe``) is the frame rate; ``Clip Info``'s
   ``clipStartFrameNumber`` is the first frame's timecode counted in frames at that rate (as AME's
   ``Master TC Frame Count``: 1176223 at 24 fps is AME's 13:36:49:07), so frame ``frameNo`` has
-  timecode start + frameNo; a frame's own ``timecode`` text is read when the export writes one.
+  timecode start + frameNo; a frame's own ``timecode`` text is read when the export writes one. A
+  start below 0 or past a day's frames (it would wrap to another time of day) is refused.
   ``clipDuration`` is checked against the frames;
 * ``Camera Device`` (model, serial), ``Lens Device`` (``lensModel``, ``lensSerialNumber``,
   ``lensSqueezeFactor`` "4/3" or "2"), ``Image Size``'s ``storedSize`` (pixels), ``Sensor Device``'s
@@ -26,7 +27,9 @@ sample clips, whose ARRI Meta Extract CSV of the same day gives the same lens in
   17.82 mm); the export's ``sensorDimensions`` is not read (0 in ARRI's sample, unit unpublished).
 
 A focus at infinity (-1) or not available is left absent and the notes count the frames; a
-drop-frame project rate gives no derived timecode (the notes say so).
+drop-frame project rate gives no derived timecode (the notes say so) and marks the clip drop-frame.
+A ``timebase`` of "23.976" (29.97, 59.94) is the exact 24000/1001 (30000/1001, 60000/1001), as every
+reader's rate (:func:`._text.exact_rate`).
 """
 
 from __future__ import annotations
@@ -37,7 +40,7 @@ from fractions import Fraction
 from pathlib import Path
 
 from ..errors import MetadataError, require_type
-from ._text import read_text, timecode
+from ._text import exact_rate, read_text, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read", "MAX_JSON_BYTES"]
@@ -141,6 +144,17 @@ def _frame(p, i, fr, start, rate) -> tuple[FrameSample, str | None]:
                        entrance_pupil_mm=pupil), why
 
 
+def _start_frame(p, start, rate: Fraction) -> int:
+    """``clipStartFrameNumber``: a whole number of frames since midnight, below a day's at the nominal rate
+    (86,400 x 24 at 24 fps); a negative or larger one would wrap to another time of day, so it is refused."""
+    day = 86400 * math.ceil(rate - Fraction(1, 10**6))
+    if start != int(start) or not 0 <= start < day:
+        raise MetadataError(f"Clip Info: clipStartFrameNumber {start!r} is not a frame of the day (a whole number "
+                            f"from 0 to {day - 1} at the project rate {float(rate):g} fps): the first frame's "
+                            "timecode would wrap to another time", p)
+    return int(start)
+
+
 def _timecode_text(count: int, rate: Fraction) -> str:
     """Non-drop-frame HH:MM:SS:FF of ``count`` frames since midnight at the nominal integer rate."""
     per_s = math.ceil(rate - Fraction(1, 10**6))
@@ -158,14 +172,17 @@ def read(path) -> ClipRecord:
         raise MetadataError("no frameBasedMetadata.frames: no per-frame metadata", p)
     project = clip.get("Project Rate", {})
     rate = _rational(p, "Project Rate", "timebase", project.get("timebase"))
+    drop = project.get("dropframe", False)
+    if not isinstance(drop, bool):
+        raise MetadataError(f"Project Rate: dropframe {str(drop)[:40]!r} is not true or false", p)
     info = clip.get("Clip Info", {})
     start = info.get("clipStartFrameNumber")
     notes = []
-    if start is not None and (rate is None or rate <= 0 or project.get("dropframe")):
+    if start is not None and (rate is None or rate <= 0 or drop):
         start = None
         notes.append("no timecode derived: the project rate is missing or drop-frame")
     elif start is not None:
-        start = _int(p, "Clip Info", "clipStartFrameNumber", start)
+        start = _start_frame(p, _int(p, "Clip Info", "clipStartFrameNumber", start), rate)
     duration = info.get("clipDuration")
     if duration is not None and duration != len(frames):
         raise MetadataError(f"Clip Info says {duration} frames, frameBasedMetadata holds {len(frames)}", p)
@@ -179,6 +196,7 @@ def read(path) -> ClipRecord:
               for why, idx in absent.items()]
     notes.append("read from ARRI Reference Tool JSON; frame N is frameNo N (the line column counts frames)")
     return ClipRecord(source="arri", files=(str(p),), frames=tuple(samples), notes=tuple(notes),
+                      drop_frame=drop,
                       **_static(p, desc, clip, frames, rate, doc.get("arriJsonHeader")))
 
 
@@ -209,7 +227,7 @@ def _static(p, desc, clip, frames, rate, doc_header) -> dict:
             "lens_make": "ARRI" if model and str(model).startswith("ARRI ") else None, "lens_model": text(model),
             "lens_serial": text(lens.get("lensSerialNumber")),
             "squeeze": None if squeeze is None else float(squeeze),
-            "frame_rate": rate if rate is None else rate.limit_denominator(1001),
+            "frame_rate": exact_rate(rate),
             "shutter_angle_deg": float(360 * exposure * sample_rate) if exposure and sample_rate else None,
             "exposure_time_s": None if exposure is None else float(exposure),
             "iso": int(_int(p, "Sensor State", "exposureIndex", iso)) if iso is not None else None,

@@ -12,7 +12,8 @@ USD the ``usd`` extra).
   with the true f-number), and each report's notes say so.
 * :func:`write_usd`: the solved frames through :func:`physcam.live.record.write_recording_usd`
   (the authoring ``physcam live record`` uses), then the clip and the plate on the camera prim:
-  customData ``physcam:source``, ``physcam:clip`` (the static values as JSON text) and
+  customData ``physcam:source``, ``physcam:clip`` (the static values as JSON text; ``drop_frame`` only
+  when true) and
   ``physcam:plate``: a dictionary of ``path`` (as given, a string: a plate that is not there yet or a
   ``####`` sequence pattern is no unresolvable asset for USD's validators) and ``firstFrame`` /
   ``lastFrame``. With a plate frame range the camera is authored on the plate's frame numbers
@@ -68,7 +69,7 @@ def tracked_frames(record, *, rate=None) -> list:
     for i, f in enumerate(record.frames):
         t = f.tracker
         out.append(TrackedFrame(
-            sequence_number=i, timecode=f.timecode, rate=fr,
+            sequence_number=i, timecode=f.timecode, rate=fr, drop_frame=record.drop_frame,
             translation_m=(0.0, 0.0, 0.0) if t is None else tuple(float(v) for v in t.translation),
             rotation_deg=(0.0, 0.0, 0.0) if t is None else tuple(float(v) for v in t.rotation_deg),
             focus_from_film_mm=f.focus_mm, fstop=f.fstop, tstop=f.tstop, entrance_pupil_mm=f.entrance_pupil_mm,
@@ -203,20 +204,26 @@ def write_usd(file, record, solved, *, plate=None, plate_frames=None, meters_per
         cam = stage.GetPrimAtPath(path)
         cam.SetCustomDataByKey("physcam:source", printable_line(f"{record.source} camera metadata read by physcam "
                                                                 f"metadata usd ({', '.join(Path(f).name for f in record.files)})"))
-        static = {k: v for k, v in record.static_dict().items() if v is not None and k != "notes"}
+        # values the file gives; drop_frame only when true (a non-drop clip's camera stays as before round 22)
+        static = {k: v for k, v in record.static_dict().items()
+                  if v is not None and k != "notes" and (k != "drop_frame" or v)}
         cam.SetCustomDataByKey("physcam:clip", json.dumps(static, sort_keys=True))
         if plate_d:
             cam.SetCustomDataByKey("physcam:plate", plate_d)
         return save_stage(stage, p, force=force)
 
 
-def _timecode(tc: str, rate: Fraction) -> dict | None:
-    """OpenTrackIO's timecode object of the file's ``HH:MM:SS:FF`` (None above 120 fps)."""
+def _timecode(tc: str, rate: Fraction, drop_frame: bool = False) -> dict | None:
+    """OpenTrackIO's timecode object of the file's ``HH:MM:SS:FF`` (None above 120 fps), with
+    ``dropFrame`` true when the clip's timecode is drop-frame (OpenTrackIO 1.0.1 ``timing.timecode``)."""
     if tc is None or rate is None or rate > 120:
         return None
     h, m, s, f = (int(x) for x in tc.replace(";", ":").split(":"))
-    return {"hours": h, "minutes": m, "seconds": s, "frames": f,
-            "frameRate": {"num": rate.numerator, "denom": rate.denominator}}
+    out = {"hours": h, "minutes": m, "seconds": s, "frames": f,
+           "frameRate": {"num": rate.numerator, "denom": rate.denominator}}
+    if drop_frame:
+        out["dropFrame"] = True
+    return out
 
 
 def opentrackio_samples(record, *, rate=None) -> list[dict]:
@@ -242,7 +249,7 @@ def opentrackio_samples(record, *, rate=None) -> list[dict]:
         tf = replace(tf, pinhole_focal_length_mm=_pinhole(record, i, f))
         s = sample_from_frame(tf, source_id=_source_urn(record), sequence_number=i,
                               static=static if i == 0 else None, status=f"physcam metadata ({record.source})")
-        tc = _timecode(f.timecode, tf.rate)
+        tc = _timecode(f.timecode, tf.rate, record.drop_frame)
         if tc is not None:
             s["timing"]["timecode"] = tc
         elif "timecode" in s["timing"]:

@@ -17,7 +17,9 @@ A timecode that goes back (other than through midnight) means the file holds sev
 after another (a concatenated recording): refused, naming each place a take starts, so the file
 can be split there. With the clip's frame rate known, a timecode must be a time at that rate
 (frames 00 to the nominal rate - 1, seconds and minutes below 60, hours below 24) and each frame's
-must follow the last by one frame (a drop-frame ``;`` timecode counted as SMPTE 12M drops it): a
+must follow the last by one frame (a drop-frame timecode, :attr:`ClipRecord.drop_frame`, counted as
+SMPTE ST 12-1 drops it: numbers 00 and 01 of each minute but every tenth skipped at 29.97 fps, 00 to
+03 at 59.94, so a day is 2,589,408 frames at 29.97; drop-frame at another rate is refused): a
 skip is a dropped or deleted row, which would shift every later frame onto the wrong plate frame,
 or a frame rate the timecode was not counted at (a 25 fps clip with a 24 fps timecode skips a frame
 every second). Both are refused at the line where they happen.
@@ -98,10 +100,28 @@ def _where_in_file(record, f) -> tuple[str, int | None]:
     return (f"packet {f.line}: ", None) if record.source == "mosys" else ("", f.line)
 
 
+#: the nominal rates at which drop-frame timecode exists, and the frame numbers it skips each minute
+#: (SMPTE ST 12-1: 2 at 30000/1001, 4 at 60000/1001)
+_DROP = {Fraction(30000, 1001): 2, Fraction(60000, 1001): 4}
+
+
+def _drops(record) -> int:
+    """Frame numbers the clip's timecode skips each minute but every tenth: 0 unless drop-frame."""
+    if not record.drop_frame:
+        return 0
+    d = _DROP.get(Fraction(record.frame_rate))
+    if d is None:
+        raise MetadataError(f"a drop-frame timecode at {float(record.frame_rate):g} fps: drop-frame counting "
+                            "exists at 29.97 and 59.94 fps (30000/1001, 60000/1001; SMPTE ST 12-1) only",
+                            record.files[0])
+    return d
+
+
 def _check_timecode_fields(record) -> None:
     if record.frame_rate is None:
         return
     n = _nominal(record.frame_rate)
+    d = _drops(record)
     for f in record.frames:
         if f.timecode is None:
             continue
@@ -111,36 +131,39 @@ def _check_timecode_fields(record) -> None:
             raise MetadataError(f"{where}timecode {f.timecode} is not a time at the clip's {float(record.frame_rate):g} "
                                 f"fps: frames run 00 to {n - 1:02d}, seconds and minutes 00 to 59, hours 00 to 23",
                                 record.files[0], line)
+        if d and s == 0 and ff < d and m % 10:
+            where, line = _where_in_file(record, f)
+            raise MetadataError(f"{where}timecode {f.timecode} names a frame number drop-frame counting skips "
+                                f"(frames 00 to {d - 1:02d} of each minute but every tenth; SMPTE ST 12-1)",
+                                record.files[0], line)
 
 
-def _tc_count(tc: str, nominal: int) -> int:
-    """Frames since midnight of ``tc``; a drop-frame (``;``) timecode skips frames 0..d-1 of each minute but
-    every tenth, d = 2 per 30 nominal fps (SMPTE ST 12-1)."""
+def _tc_count(tc: str, nominal: int, drops: int = 0) -> int:
+    """Frames since midnight of ``tc``; drop-frame counting (``drops`` > 0, :func:`_drops`) skips frame
+    numbers 0..drops-1 of each minute but every tenth (SMPTE ST 12-1)."""
     h, m, s, f = _tc_key(tc)
-    count = ((h * 60 + m) * 60 + s) * nominal + f
-    if ";" in tc:
-        minutes = h * 60 + m
-        count -= 2 * round(nominal / 30) * (minutes - minutes // 10)
-    return count
+    minutes = h * 60 + m
+    return (minutes * 60 + s) * nominal + f - drops * (minutes - minutes // 10)
 
 
 def _check_timecode_steps(record) -> None:
     if record.frame_rate is None:
         return
     n = _nominal(record.frame_rate)
-    day = _tc_count("24:00:00:00", n)
+    d = _drops(record)
+    day = _tc_count("24:00:00:00", n, d)  # a drop-frame day: 2,589,408 frames at 29.97 (not 2,592,000)
     prev = None
     for f in record.frames:
         if f.timecode is None:
             continue
         if prev is not None:
-            step = (_tc_count(f.timecode, n) - _tc_count(prev.timecode, n)) % day
+            step = (_tc_count(f.timecode, n, d) - _tc_count(prev.timecode, n, d)) % day
             if step > 1:
                 where, line = _where_in_file(record, f)
                 raise MetadataError(f"{where}the timecode skips {step - 1} frame{'s' if step > 2 else ''} from "
-                                    f"{prev.timecode} to {f.timecode} at the clip's {float(record.frame_rate):g} fps: "
-                                    "a dropped or deleted row, or a frame rate the timecode was not counted at",
-                                    record.files[0], line)
+                                    f"{prev.timecode} to {f.timecode} at the clip's {float(record.frame_rate):g} fps"
+                                    f"{' drop-frame' if d else ''}: a dropped or deleted row, or a frame rate the "
+                                    "timecode was not counted at", record.files[0], line)
         prev = f
 
 

@@ -71,7 +71,8 @@ class ClipRecord:
     venice, canon, bmd, mosys); ``files``: what was read; ``resolution_px``: the recorded image
     (width, height) in pixels; ``active_area_mm``: the sensor area those pixels cover, when the
     file or the camera maker's published format table gives it (``active_area_source`` says
-    which); ``frame_rate``: frames per second; ``shutter_angle_deg``; ``squeeze``: anamorphic
+    which); ``frame_rate``: frames per second; ``drop_frame``: the timecode is counted drop-frame (SMPTE
+    ST 12-1; the file says so, or its timecodes carry ``;`` before the frames); ``shutter_angle_deg``; ``squeeze``: anamorphic
     squeeze; ``notes``: what the reader says about its reading."""
 
     source: str
@@ -91,6 +92,7 @@ class ClipRecord:
     nominal_focal_length_mm: float | None = None
     squeeze: float | None = None
     frame_rate: Fraction | None = None
+    drop_frame: bool = False
     shutter_angle_deg: float | None = None
     exposure_time_s: float | None = None
     iso: int | None = None

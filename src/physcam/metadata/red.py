@@ -16,11 +16,9 @@ photosite pitch (RED's published pitches: MONSTRO 8K VV, HELIUM 8K S35...), whic
 
 from __future__ import annotations
 
-from fractions import Fraction
-
 from ..errors import MetadataError, require_type
 from . import cooke
-from ._text import header_columns, lacking_columns, number, require_columns, rows, single_row, timecode
+from ._text import exact_rate, header_columns, lacking_columns, number, require_columns, rows, single_row, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -81,7 +79,7 @@ def _static(path) -> dict:
             "active_area_source": "RED's published photosite pitch of the sensor" if res and pitch else None,
             "lens_make": g("Lens Brand"), "lens_model": g("Lens Name"), "lens_serial": g("Lens Serial Number"),
             "squeeze": num("Pixel Aspect Ratio"), "nominal_focal_length_mm": _mm(path, line, g("Focal Length")),
-            "frame_rate": Fraction(str(fps)).limit_denominator(1001) if fps else None,
+            "frame_rate": exact_rate(fps) if fps else None,
             "shutter_angle_deg": num("Shutter (deg)"),
             "exposure_time_s": None if num("Shutter (ms)") is None else num("Shutter (ms)") / 1000.0,
             "iso": None if num("ISO") is None else int(num("ISO")),

@@ -19,7 +19,7 @@ import xml.etree.ElementTree as ET
 from fractions import Fraction
 
 from ..errors import MetadataError, require_type
-from ._text import FOOT_MM, header_columns, lacking_columns, number, read_text, rows, stop_from_marking, timecode
+from ._text import FOOT_MM, exact_rate, header_columns, lacking_columns, number, read_text, rows, stop_from_marking, timecode
 from .record import ClipRecord, FrameSample
 
 __all__ = ["sniff", "read"]
@@ -97,7 +97,7 @@ def _xml(path) -> tuple[dict, int | None]:
     duration = attr("Duration", "value")
     return {"camera_make": attr("Camera", "manufacturer"), "camera_model": attr("Camera", "modelName"),
             "camera_serial": attr("Camera", "serialNo"), "lens_model": attr("Lens", "modelName"),
-            "frame_rate": None if fps is None else Fraction(fps.rstrip("pi")).limit_denominator(1001),
+            "frame_rate": None if fps is None else exact_rate(Fraction(fps.rstrip("pi"))),
             "resolution_px": (int(w), int(h)) if w and h else None,
             "shutter_angle_deg": None if shutter is None else num(shutter, "ShutterSpeedAngle") / 100.0,
             "squeeze": None if squeeze is None else num(squeeze, "AnamorphicLensSqueezeRatio") / 100.0,
