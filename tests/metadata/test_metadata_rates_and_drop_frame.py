@@ -261,3 +261,22 @@ def test_an_art_start_frame_outside_the_day_is_refused(tmp_path, start):
     with pytest.raises(MetadataError, match=rf"start.json: Clip Info: clipStartFrameNumber {start} is not a frame "
                                             "of the day .* 0 to 2073599"):
         load(p)
+
+
+@pytest.mark.parametrize("written, exact", [
+    (23.976, Fraction(24000, 1001)), (23.98, Fraction(24000, 1001)), (29.97, Fraction(30000, 1001)),
+    (47.95, Fraction(48000, 1001)), (59.94, Fraction(60000, 1001)), (119.88, Fraction(120000, 1001)),
+    (24.0, Fraction(24)), (25.0, Fraction(25)), (23.9, Fraction(239, 10)), (999.0, Fraction(999)),
+    (1000.0, Fraction(1000))])
+def test_one_frame_rate_rule_with_two_decimal_ntsc(written, exact):
+    """VENICE writes captureFps "23.98p" (Avid and Resolve say 23.98 too): two decimals of 24000/1001, read
+    as 1199/50 (0.017 % fast: a frame's drift every 2.5 minutes against the plate). The one rule
+    (physcam.frame_rates) reads it as 24000/1001 for the metadata readers, OpenTrackIO and animated USD alike;
+    24, 25 and rates near no NTSC rate are unchanged."""
+    from physcam.frame_rates import exact_frame_rate
+    from physcam.live.frames import rate_fraction
+    from physcam.metadata._text import exact_rate
+    from physcam.usd.animate import ntsc_rate
+
+    assert exact_frame_rate(written) == rate_fraction(written) == exact_rate(written) == exact
+    assert ntsc_rate(written) == (float(exact) if exact.denominator == 1001 else written)

@@ -45,6 +45,7 @@ from fractions import Fraction
 import numpy as np
 
 from ..errors import InputError, require_finite, require_type
+from ..frame_rates import exact_frame_rate
 from .sample import PROTOCOL_VERSION, shown
 
 #: the key of the horizontal (X) entrance pupil in a sample's top-level ``custom`` object (module notes)
@@ -109,8 +110,9 @@ class TrackedFrame:
 
 
 def rate_fraction(rate) -> Fraction:
-    """A frame rate as an exact fraction: NTSC rates (23.976, 29.97, 59.94, 119.88) become
-    N*1000/1001, others the nearest fraction with a denominator up to 1001.
+    """A frame rate as an exact fraction (:func:`physcam.frame_rates.exact_frame_rate`: NTSC rates, 23.976 or
+    23.98, 29.97, 59.94, 119.88, become N*1000/1001, others the nearest fraction with a denominator up to
+    1001); a Fraction is taken as it is.
 
     >>> rate_fraction(23.976), rate_fraction(25), rate_fraction(Fraction(30000, 1001))
     (Fraction(24000, 1001), Fraction(25, 1), Fraction(30000, 1001))
@@ -121,9 +123,7 @@ def rate_fraction(rate) -> Fraction:
         r = require_finite("frame rate", rate)
         if r <= 0:
             raise InputError(f"frame rate must be > 0, got {r:g}")
-        ntsc = round(r * 1.001)
-        fr = Fraction(ntsc * 1000, 1001) if abs(r * 1.001 - ntsc) < 5e-4 and abs(r - ntsc) > 1e-6 \
-            else Fraction(r).limit_denominator(1001)
+        fr = exact_frame_rate(r)
     if not 0 < fr.numerator <= 10000 * fr.denominator:  # 0 < fr <= 10000 (a denominator is > 0), in integers
         raise InputError(f"frame rate must lie in (0, 10000] fps, got {float(fr):g}")
     return fr

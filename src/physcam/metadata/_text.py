@@ -240,23 +240,17 @@ def number(path, line, name, text, *, empty_none: bool = True) -> float | None:
 
 def exact_rate(fps) -> Fraction | None:
     """A file's frame rate (a number, or an exact Fraction) as the exact fraction every reader gives:
-    an NTSC rate written to two or three decimals (23.976, 29.97, 47.952, 59.94, 119.88) is N x
-    1000/1001 (24000/1001, 30000/1001...: SMPTE ST 12-1's rates), any other the nearest fraction with a
-    denominator up to 1001. The rule of :func:`physcam.live.frames.rate_fraction` (what ``live send
-    --fps`` and ``live record`` use), written here so the readers need no numpy; a value no camera
-    records (0 or negative) is kept for :mod:`.limits` to refuse. None stays None.
+    :func:`physcam.frame_rates.exact_frame_rate`, the rule ``live send --fps``, ``live record`` and ``usd
+    animate --fps`` use (an NTSC rate, 23.976 or VENICE's 23.98, 29.97, 59.94, is N x 1000/1001: SMPTE ST
+    12-1's rates; any other the nearest fraction with a denominator up to 1001); a value no camera records
+    (0 or negative) is kept for :mod:`.limits` to refuse. None stays None.
 
     >>> exact_rate(23.976), exact_rate(29.97), exact_rate(25.0), exact_rate(Fraction(30000, 1001))
     (Fraction(24000, 1001), Fraction(30000, 1001), Fraction(25, 1), Fraction(30000, 1001))
     """
-    if fps is None:
-        return None
-    r = float(fps)
-    ntsc = round(r * 1.001)
-    if r > 0 and abs(r * 1.001 - ntsc) < 5e-4 and abs(r - ntsc) > 1e-6:
-        return Fraction(ntsc * 1000, 1001)
-    return Fraction(fps) if isinstance(fps, Fraction) and fps.denominator <= 1001 \
-        else Fraction(r).limit_denominator(1001)
+    from ..frame_rates import exact_frame_rate
+
+    return None if fps is None else exact_frame_rate(fps)
 
 
 _STOP = re.compile(r"^\s*T?\s*(\d+(?:\.\d+)?)\s*(?:\+?\s*(\d+)\s*/\s*10)?\s*$")

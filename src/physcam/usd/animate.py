@@ -138,17 +138,18 @@ def _check_keys(keys) -> list[FocusKey]:
 
 
 def ntsc_rate(fps) -> float:
-    """``fps`` as the stage's timeCodesPerSecond: an NTSC rate given to three decimals (23.976,
-    29.97, 59.94, 119.88) is the exact N x 1000/1001 (24000/1001 = 23.976023...), as a recording of a
+    """``fps`` as the stage's timeCodesPerSecond: an NTSC rate given to two or three decimals (23.976 or
+    23.98, 29.97, 59.94, 119.88: :func:`physcam.frame_rates.exact_frame_rate`) is the exact N x 1000/1001
+    (24000/1001 = 23.976023...), as a recording of a
     stream at that rate writes it (:func:`physcam.live.frames.rate_fraction`), so the two line up frame
     for frame; other rates are kept as given."""
+    from ..frame_rates import exact_frame_rate
+
     rate = require_finite("frames per second", fps)
     if rate <= 0:
         raise InputError(f"frames per second must be > 0, got {rate:g}")
-    n = round(rate * 1.001)
-    if abs(rate * 1.001 - n) < 5e-4 and abs(rate - n) > 1e-6:
-        return n * 1000 / 1001
-    return rate
+    fr = exact_frame_rate(rate)
+    return fr.numerator / fr.denominator if fr.denominator == 1001 else rate
 
 
 def write_animated_camera(file, keys, *, sensor, lens=None, focal_length_mm: float | None = None,
