@@ -73,10 +73,7 @@ def distance(name: str, allow_inf: bool = False, *, scene: bool = False):
     :data:`BARE_RULE` (returned as a :class:`BareDistance`)."""
 
     def parse(text):
-        try:
-            v = parse_distance(text, name=name, allow_inf=allow_inf)
-        except PhysCamError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
+        v = as_argument(lambda t: parse_distance(t, name=name, allow_inf=allow_inf), text)
         return BareDistance(v, text) if scene and _BARE.match(str(text)) else v
 
     parse.__name__ = name
@@ -91,10 +88,7 @@ def focal_length(name: str = "focal length"):
     def parse(text):
         from ..optics.thinlens import require_focal_length
 
-        try:
-            return require_focal_length(read(text), name)
-        except PhysCamError as exc:
-            raise argparse.ArgumentTypeError(str(exc)) from None
+        return as_argument(lambda t: require_focal_length(read(t), name), text)
 
     parse.__name__ = name
     return parse
@@ -153,16 +147,22 @@ def _bound(v: int) -> str:
     return "2**53" if v == WHOLE_LIMIT else "-2**53" if v == -WHOLE_LIMIT else str(v)
 
 
+def as_argument(read, text):
+    """``read(text)``, the library's reading of an option's text, as an argparse type: its
+    :class:`~physcam.errors.PhysCamError` becomes argparse's one line (exit 2) as the command line is read."""
+    try:
+        return read(text)
+    except PhysCamError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def figure_file(text: str) -> str:
     """The argparse type of a figure's file name (``-o``, ``--plot``): one ending .png, .svg or .pdf
     (:func:`physcam.figures.figure_format`), else refused as the command line is read (exit 2), not after
     the command's seconds of work."""
     from ..figures import figure_format
 
-    try:
-        figure_format(text)
-    except PhysCamError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+    as_argument(figure_format, text)
     return text
 
 
@@ -172,10 +172,7 @@ def usd_file(text: str) -> str:
     command's work and usd-core's import."""
     from ..usd_names import usd_layer_format
 
-    try:
-        usd_layer_format(text)
-    except PhysCamError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+    as_argument(usd_layer_format, text)
     return text
 
 
@@ -375,10 +372,7 @@ def coc_value(text):
     becomes a float in mm; a malformed length is argparse's error."""
     from ..optics.coc import parse_coc
 
-    try:
-        return parse_coc(text)
-    except PhysCamError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+    return as_argument(parse_coc, text)
 
 
 def coc_of(args):
