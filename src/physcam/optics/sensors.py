@@ -290,9 +290,9 @@ def filter_sensors(query: str = "", *, maker: str | None = None, fmt: str | None
     for name, v in (("query", query), ("maker", maker), ("format", fmt)):
         if v is not None and not isinstance(v, str):
             raise SensorError(f"a sensor {name} is text, got {type(v).__name__}")
-    typed = (query or "").split()
-    words = [_norm(w) for w in typed if _norm(w)]
-    if typed and (not words or any(not _norm(w) and any(c.isalnum() for c in w) for w in typed)):
+    typed = [(w, _norm(w)) for w in (query or "").split()]
+    words = [n for _, n in typed if n]
+    if typed and (not words or any(not n and any(c.isalnum() for c in w) for w, n in typed)):
         return []  # only marks ("!!!"), or a word of letters no sensor is named in ("é"): nothing matches
     out = []
     for s in sensors():
