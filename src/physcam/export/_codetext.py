@@ -23,19 +23,21 @@ import unicodedata
 from ..errors import ExportError
 
 __all__ = ["printable_line", "osl_comment", "hash_comment", "python_docstring", "python_comment",
-           "xml_comment", "xml_attribute", "pbrt_string", "nuke_file_path", "usd_text", "REPLACEMENT", "COMMENT_CHARS"]
+           "xml_comment", "xml_attribute", "pbrt_string", "nuke_file_path", "usd_text", "REPLACEMENT", "COMMENT_CHARS",
+           "UNSAFE_CATEGORIES"]
 
 #: What stands in for a character a line cannot hold (U+FFFD REPLACEMENT CHARACTER).
 REPLACEMENT = "\ufffd"
 #: Longest text a comment keeps (characters); a longer one is cut and ends in an ellipsis.
 COMMENT_CHARS = 400
-_UNSAFE = frozenset(("Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"))
+#: Unicode categories no line written (nor a query value ``physcam serve`` reads) may hold: the module notes.
+UNSAFE_CATEGORIES = frozenset(("Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"))
 
 
 def printable_line(text, *, limit: int | None = None) -> str:
     """``text`` (any object; ``str()`` of it) on one printable line: a tab becomes a space, characters of the
     categories in the module notes U+FFFD; cut to ``limit`` characters (the last an ellipsis) when given."""
-    s = "".join(" " if c == "\t" else REPLACEMENT if unicodedata.category(c) in _UNSAFE else c for c in str(text))
+    s = "".join(" " if c == "\t" else REPLACEMENT if unicodedata.category(c) in UNSAFE_CATEGORIES else c for c in str(text))
     if limit is not None and len(s) > limit:
         s = s[: limit - 1] + "\u2026"
     return s

@@ -43,17 +43,18 @@ from .. import __version__
 from ..errors import PhysCamError, WrongTypeError
 from .worker import FairWorker, Full
 
-#: Unicode categories of what a query value may not hold: controls (Cc), format characters (Cf: the bidi
-#: overrides), surrogates, private use, unassigned, line and paragraph separators; the categories
-#: physcam.export._codetext keeps off a written line. A space of any width (Zs: a no-break space from a phone's
-#: keyboard, "3\u00a0m") is text the command line reads too (``str.isprintable`` refused it).
-_CONTROL = frozenset(("Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"))
-
-
 def _holds_control(value: str) -> bool:
+    """Whether a query value holds what no written line may (controls, format characters such as the bidi
+    overrides, surrogates, line and paragraph separators: ``physcam.export._codetext.UNSAFE_CATEGORIES``). A
+    space of any width (a no-break space from a phone's keyboard, "3\u00a0m") is text the command line reads too
+    (``str.isprintable`` refused it)."""
+    if value.isprintable():
+        return False
     import unicodedata
 
-    return not value.isprintable() and any(unicodedata.category(c) in _CONTROL for c in value)
+    from ..export._codetext import UNSAFE_CATEGORIES
+
+    return any(unicodedata.category(c) in UNSAFE_CATEGORIES for c in value)
 
 __all__ = ["Backend", "Limits", "create_app", "settle_heap", "STATIC_FILES"]
 
