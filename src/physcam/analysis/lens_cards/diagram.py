@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from ...errors import ExportError, InputError
+from ...errors import InputError
 from ...lens.geometry import sag
 from ...lens.prescription import Prescription, takes_prescription
 from ...optics import focusing, paraxial
@@ -326,12 +326,11 @@ def lens_diagram(camera: CameraState, *, axis: str = "y", field_deg: float | Non
 def save_lens_diagram(camera: CameraState, path, *, force: bool = False, **kwargs) -> Path:
     """Draw the diagram to ``path`` (.png, .svg or .pdf) through atomic_write; kwargs as :func:`lens_diagram`,
     and ``units`` (m or ft) for the focus in the title."""
-    from ...figures import save_figure
+    from ...figures import figure_format, save_figure
     from ...io import check_writable
 
     p = Path(path)
-    if p.suffix.lower().lstrip(".") not in DIAGRAM_FORMATS:
-        raise ExportError(f"cannot draw a diagram to {p.name!r}: use a .png, .svg or .pdf file name")
-    check_writable(p, force=force)  # before the work of drawing
+    figure_format(p)  # before the work of drawing, as the output's place
+    check_writable(p, force=force)
     units = kwargs.pop("units", "m")
     return save_figure(lens_diagram(camera, **kwargs).figure(units=units), p, force=force, dpi=150)
